@@ -1,0 +1,38 @@
+"""Exceptions raised by woodcam.
+
+Every error names the argument, the rule it broke, the value received and a fix. The CLI turns a
+:class:`WoodcamError` into one clean line on stderr and a non-zero exit, never a traceback.
+"""
+
+from __future__ import annotations
+
+
+class WoodcamError(ValueError):
+    """Base class of the errors a user can cause and fix (bad input, bad option, missing extra)."""
+
+
+class MissingDependencyError(WoodcamError, ImportError):
+    """An optional dependency is not installed; the message gives the install command."""
+
+
+def require(module: str, extra: str, purpose: str):
+    """Import an optional heavy module where it is used, failing with the install command.
+
+    Parameters
+    ----------
+    module : str
+        Importable module name, e.g. ``"build123d"``.
+    extra : str
+        The ``woodcam`` extra that installs it, e.g. ``"cad"``.
+    purpose : str
+        What the caller needs it for, shown in the error.
+    """
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError as err:  # pragma: no cover - depends on the environment
+        raise MissingDependencyError(
+            f"{purpose} needs the optional package {module!r}, which is not installed; "
+            f"install it with: pip install 'woodcam[{extra}]'"
+        ) from err

@@ -1,0 +1,132 @@
+"""The growth-time field protocol, the annual-ring field and rigid placement of a log frame.
+
+A growth-time field (GTF) maps points ``points_mm : (n, 3) float`` in the block frame (mm) to
+``years : (n,) float``: growth time since the pith, 0 on the pith, growing outward. Ring
+boundaries are its integer iso-surfaces. The annual-ring field is ``ARF = (GTF mod 1)^2``
+(eq. 6 of seed 000): 0 at the start of earlywood, near 1 for latewood just before a boundary.
+
+A field may also answer ``grain_direction(points_mm) -> (n, 3)`` unit vectors along the wood
+fibres (the pith axis for a straight stem, the branch axis inside a knot); appearances use it
+to tell end grain from side grain. :func:`grain_direction` falls back to the gradient-free
+default of the field's ``axis`` attribute, else ``+Z``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field as dc_field
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from ..errors import WoodcamError
+from ..tolerances import MAX_BATCH_POINTS
+
+
+@runtime_checkable
+class GrowthField(Protocol):
+    """Anything callable as ``field(points_mm (n, 3)) -> years (n,)``."""
+
+    def __call__(self, points_mm: np.ndarray) -> np.ndarray: ...
+
+
+def check_points(points_mm, name: str = "points_mm") -> np.ndarray:
+    """Return ``points_mm`` as a float64 ``(n, 3)`` array or raise a clear error."""
+    p = np.asarray(points_mm, dtype=float)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise WoodcamError(f"{name} must have shape (n, 3) in mm; got shape {p.shape}")
+    return p
+
+
+def evaluate(field, points_mm, batch: int = MAX_BATCH_POINTS) -> np.ndarray:
+    """Evaluate ``field`` on ``(n, 3)`` points in bounded batches; returns ``years : (n,)``."""
+    p = check_points(points_mm)
+    if len(p) <= batch:
+        return np.asarray(field(p), dtype=float).reshape(len(p))
+    out = np.empty(len(p))
+    for i in range(0, len(p), batch):
+        out[i:i + batch] = field(p[i:i + batch])
+    return out
+
+
+def arf(years) -> np.ndarray:
+    """Annual-ring field from growth time: ``(years mod 1)^2`` (eq. 6 of seed 000).
+
+    Always apply it to a (possibly interpolated) growth time, never interpolate its output:
+    interpolating the ARF would blur the sharp latewood -> earlywood step at ring boundaries.
+    """
+    g = np.asarray(years, dtype=float)
+    return np.mod(g, 1.0) ** 2
+
+
+def grain_direction(field, points_mm) -> np.ndarray:
+    """Unit fibre directions ``(n, 3)`` of ``field`` at ``points_mm`` (see module docstring)."""
+    p = check_points(points_mm)
+    fn = getattr(field, "grain_direction", None)
+    if fn is not None:
+        return np.asarray(fn(p), dtype=float)
+    axis = np.asarray(getattr(field, "axis", (0.0, 0.0, 1.0)), dtype=float)
+    return np.broadcast_to(axis / np.linalg.norm(axis), p.shape)
+
+
+def _unit(v, name: str) -> np.ndarray:
+    v = np.asarray(v, dtype=float)
+    n = np.linalg.norm(v)
+    if v.shape != (3,) or not np.isfinite(n) or n < 1e-12:
+        raise WoodcamError(f"{name} must be a non-zero 3-vector; got {v!r}")
+    return v / n
+
+
+@dataclass(frozen=True)
+class LogFrame:
+    """Rigid placement of a log's own frame in the block frame.
+
+    The log frame has its ``z`` axis on the pith, pointing along ``axis``; ``x`` points along
+    ``reference`` made orthogonal to the axis; ``y = z x x``. The pith passes through
+    ``pith_point_mm`` (block frame), which may lie outside the block.
+
+    Parameters
+    ----------
+    pith_point_mm : (3,) float
+        A point on the pith axis, block frame, mm; log-frame ``z = 0`` there.
+    axis : (3,) float
+        Direction of the pith axis (normalised here); need not be axis-aligned.
+    reference : (3,) float
+        Direction that becomes the log frame's ``+x`` (azimuth 0); default picks one.
+    """
+
+    pith_point_mm: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    axis: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    reference: tuple[float, float, float] | None = None
+    _rot: np.ndarray = dc_field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        z = _unit(self.axis, "axis")
+        ref = self.reference
+        if ref is None:
+            ref = (1.0, 0.0, 0.0) if abs(z[0]) < 0.9 else (0.0, 1.0, 0.0)
+        x = _unit(ref, "reference")
+        x = x - z * (x @ z)
+        if np.linalg.norm(x) < 1e-9:
+            raise WoodcamError(f"reference must not be parallel to axis; got {ref!r} and {self.axis!r}")
+        x /= np.linalg.norm(x)
+        y = np.cross(z, x)
+        object.__setattr__(self, "_rot", np.stack([x, y, z]))  # rows: log axes in block frame
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """(3, 3) matrix whose rows are the log frame's x, y, z axes in the block frame."""
+        return self._rot
+
+    def to_log(self, points_mm) -> np.ndarray:
+        """Block-frame points ``(n, 3)`` -> log-frame points ``(n, 3)`` (mm)."""
+        p = check_points(points_mm)
+        return (p - np.asarray(self.pith_point_mm, float)) @ self._rot.T
+
+    def to_block(self, points_log_mm) -> np.ndarray:
+        """Log-frame points ``(n, 3)`` -> block-frame points ``(n, 3)`` (mm)."""
+        p = check_points(points_log_mm, "points_log_mm")
+        return p @ self._rot + np.asarray(self.pith_point_mm, float)
+
+    def direction_to_block(self, dirs_log) -> np.ndarray:
+        """Rotate log-frame direction vectors ``(n, 3)`` into the block frame."""
+        return np.asarray(dirs_log, dtype=float) @ self._rot

@@ -1,0 +1,220 @@
+"""The block frame, its six faces and the pixel <-> block mapping (``docs/conventions.md`` in code).
+
+Block frame: origin at the block's bottom-front-left corner, ``+X`` right (width ``W``), ``+Y``
+away from the viewer (depth ``D``), ``+Z`` up (height ``H``); the block is
+``[0, W] x [0, D] x [0, H]`` in millimetres. Face images are seen from outside the block; pixel
+``(row r, col c)`` of an ``n_rows x n_cols`` image has ``u = (c + 0.5) / n_cols`` and
+``v = (r + 0.5) / n_rows`` and maps to the block by the table in :data:`_FACE_MAPS`.
+Pixel coordinates here are continuous: pixel centres sit at integer ``(r, c)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal, get_args
+
+import numpy as np
+
+from .errors import WoodcamError
+
+FaceName = Literal["front", "top", "left", "bottom", "right", "back"]
+
+#: The six faces in the conventions' order.
+FACES: tuple[FaceName, ...] = get_args(FaceName)
+
+#: Mokume dataset letter of each face.
+MOKUME_LETTER: dict[FaceName, str] = {
+    "front": "A", "top": "B", "left": "C", "bottom": "D", "right": "E", "back": "F",
+}
+FACE_OF_LETTER: dict[str, FaceName] = {v: k for k, v in MOKUME_LETTER.items()}
+
+#: Outward unit normal of each face in the block frame.
+FACE_NORMAL: dict[FaceName, tuple[int, int, int]] = {
+    "front": (0, -1, 0), "top": (0, 0, 1), "left": (-1, 0, 0),
+    "bottom": (0, 0, -1), "right": (1, 0, 0), "back": (0, 1, 0),
+}
+
+#: Axis (0 = X, 1 = Y, 2 = Z) each face is perpendicular to.
+FACE_AXIS: dict[FaceName, int] = {f: int(np.flatnonzero(n)[0]) for f, n in FACE_NORMAL.items()}
+
+# For each face: (X, Y, Z) as affine functions of (u, v) in units of (W, D, H).
+# Each entry is (constant, du coefficient, dv coefficient) for one block coordinate,
+# straight from the table in conventions.md.
+_FACE_MAPS: dict[FaceName, tuple[tuple[float, float, float], ...]] = {
+    #          X               Y               Z
+    "front":  ((0, 1, 0),     (0, 0, 0),      (1, 0, -1)),
+    "back":   ((1, -1, 0),    (1, 0, 0),      (1, 0, -1)),
+    "top":    ((0, 1, 0),     (1, 0, -1),     (1, 0, 0)),
+    "bottom": ((0, 1, 0),     (0, 0, 1),      (0, 0, 0)),
+    "left":   ((0, 0, 0),     (1, -1, 0),     (1, 0, -1)),
+    "right":  ((1, 0, 0),     (0, 1, 0),      (1, 0, -1)),
+}
+
+
+def check_face(face: str) -> FaceName:
+    """Return ``face`` as a :data:`FaceName`, accepting Mokume letters ``A``..``F`` too."""
+    if face in FACES:
+        return face  # type: ignore[return-value]
+    if isinstance(face, str) and face.upper() in FACE_OF_LETTER:
+        return FACE_OF_LETTER[face.upper()]
+    raise WoodcamError(
+        f"face must be one of {', '.join(FACES)} or a Mokume letter A-F; got {face!r}"
+    )
+
+
+def check_size(size_mm) -> np.ndarray:
+    """Validate a block size ``(W, D, H)`` in mm and return it as a float array of shape (3,)."""
+    size = np.asarray(size_mm, dtype=float)
+    if size.shape != (3,) or not np.all(np.isfinite(size)) or np.any(size <= 0):
+        raise WoodcamError(
+            f"size_mm must be three positive lengths (W, D, H) in mm; got {size_mm!r}"
+        )
+    return size
+
+
+def face_image_size_mm(face: str, size_mm) -> tuple[float, float]:
+    """Physical ``(height, width)`` in mm that a face image of ``face`` covers (rows, cols)."""
+    face = check_face(face)
+    W, D, H = check_size(size_mm)
+    return {
+        "front": (H, W), "back": (H, W), "top": (D, W), "bottom": (D, W),
+        "left": (H, D), "right": (H, D),
+    }[face]
+
+
+def _affine(face: FaceName, size) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(A, b)`` with ``xyz = A @ (u, v) + b`` for one face; A is (3, 2), b is (3,)."""
+    m = np.asarray(_FACE_MAPS[face], dtype=float)  # (3, 3): const, du, dv per coordinate
+    return m[:, 1:] * size[:, None], m[:, 0] * size
+
+
+def uv_to_block(face: str, u, v, size_mm) -> np.ndarray:
+    """Map face coordinates ``u, v`` in [0, 1] (any broadcastable shapes) to block points.
+
+    Returns
+    -------
+    points_mm : (..., 3) float
+    """
+    face = check_face(face)
+    A, b = _affine(face, check_size(size_mm))
+    uv = np.stack(np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float)), axis=-1)
+    return uv @ A.T + b
+
+
+def pixel_to_block(face: str, rows, cols, image_shape, size_mm) -> np.ndarray:
+    """Map continuous pixel coordinates of a face image to block points (mm).
+
+    Parameters
+    ----------
+    face : FaceName or Mokume letter
+    rows, cols : array_like
+        Pixel coordinates, centre of pixel ``(r, c)`` at integer values; broadcast together.
+    image_shape : (n_rows, n_cols)
+    size_mm : (W, D, H)
+
+    Returns
+    -------
+    points_mm : (..., 3) float, on the face plane.
+    """
+    n_rows, n_cols = _check_shape(image_shape)
+    u = (np.asarray(cols, float) + 0.5) / n_cols
+    v = (np.asarray(rows, float) + 0.5) / n_rows
+    return uv_to_block(face, u, v, size_mm)
+
+
+def block_to_pixel(face: str, points_mm, image_shape, size_mm) -> tuple[np.ndarray, np.ndarray]:
+    """Inverse of :func:`pixel_to_block`: project block points onto a face image.
+
+    The coordinate normal to the face is ignored (orthographic projection along the normal).
+
+    Returns
+    -------
+    rows, cols : (...,) float, continuous pixel coordinates.
+    """
+    face = check_face(face)
+    n_rows, n_cols = _check_shape(image_shape)
+    A, b = _affine(face, check_size(size_mm))
+    p = np.asarray(points_mm, dtype=float)
+    if p.shape[-1] != 3:
+        raise WoodcamError(f"points_mm must have shape (..., 3); got {p.shape}")
+    # Each column of A has exactly one non-zero entry, so (u, v) is read off two coordinates.
+    iu, iv = int(np.flatnonzero(A[:, 0])[0]), int(np.flatnonzero(A[:, 1])[0])
+    u = (p[..., iu] - b[iu]) / A[iu, 0]
+    v = (p[..., iv] - b[iv]) / A[iv, 1]
+    return v * n_rows - 0.5, u * n_cols - 0.5
+
+
+def face_pixel_points(face: str, image_shape, size_mm) -> np.ndarray:
+    """Block points (mm) of every pixel centre of a face image, shape ``(n_rows, n_cols, 3)``."""
+    n_rows, n_cols = _check_shape(image_shape)
+    r, c = np.meshgrid(np.arange(n_rows), np.arange(n_cols), indexing="ij")
+    return pixel_to_block(face, r, c, (n_rows, n_cols), size_mm)
+
+
+def _check_shape(image_shape) -> tuple[int, int]:
+    shape = tuple(int(s) for s in tuple(image_shape)[:2])
+    if len(shape) != 2 or min(shape) <= 0:
+        raise WoodcamError(f"image_shape must be (n_rows, n_cols) > 0; got {image_shape!r}")
+    return shape
+
+
+# -- the unfolded cross --------------------------------------------------------------------------
+
+#: Grid cell (row, col) of each face in the unfolded cross: left|front|right|back in the middle
+#: row, top above front, bottom below front.
+CROSS_CELL: dict[FaceName, tuple[int, int]] = {
+    "top": (0, 1), "left": (1, 0), "front": (1, 1), "right": (1, 2), "back": (1, 3),
+    "bottom": (2, 1),
+}
+
+
+@dataclass(frozen=True)
+class CrossLayout:
+    """Pixel layout of the six faces in one unfolded-cross image at ``px_per_mm``.
+
+    ``origin[face]`` is the (row, col) of the face image's top-left pixel in the cross image.
+    """
+
+    size_mm: tuple[float, float, float]
+    px_per_mm: float
+
+    def face_shape(self, face: FaceName) -> tuple[int, int]:
+        h, w = face_image_size_mm(face, self.size_mm)
+        return max(1, round(h * self.px_per_mm)), max(1, round(w * self.px_per_mm))
+
+    @property
+    def origin(self) -> dict[FaceName, tuple[int, int]]:
+        W, D, H = (round(s * self.px_per_mm) for s in self.size_mm)
+        col0 = {0: 0, 1: D, 2: D + W, 3: 2 * D + W}
+        row0 = {0: 0, 1: D, 2: D + H}
+        return {f: (row0[r], col0[c]) for f, (r, c) in CROSS_CELL.items()}
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        W, D, H = (round(s * self.px_per_mm) for s in self.size_mm)
+        return 2 * D + H, 2 * D + 2 * W
+
+
+def unfold_cross(images: dict, size_mm, background=0) -> np.ndarray:
+    """Lay six face images (dict face -> (h, w[, c]) array) out as one unfolded-cross image.
+
+    All images must share one pixel density; faces that are absent stay ``background``.
+    """
+    size = check_size(size_mm)
+    faces = {check_face(k): np.asarray(v) for k, v in images.items()}
+    if not faces:
+        raise WoodcamError("images must hold at least one face image; got an empty dict")
+    f0, im0 = next(iter(faces.items()))
+    px_per_mm = im0.shape[1] / face_image_size_mm(f0, size)[1]
+    layout = CrossLayout(tuple(size), px_per_mm)
+    out = np.full(layout.shape + im0.shape[2:], background, dtype=im0.dtype)
+    for face, im in faces.items():
+        want = layout.face_shape(face)
+        if im.shape[:2] != want:
+            raise WoodcamError(
+                f"image of face {face!r} must be {want[0]}x{want[1]} px to share the density "
+                f"{px_per_mm:.3g} px/mm of face {f0!r}; got {im.shape[0]}x{im.shape[1]}"
+            )
+        r0, c0 = layout.origin[face]
+        out[r0:r0 + want[0], c0:c0 + want[1]] = im
+    return out

@@ -1,0 +1,36 @@
+"""Numerical tolerances used across woodcam, each with its reason.
+
+Kept in one place so a test or a module never invents its own magic number.
+"""
+
+#: Chord tolerance (mm) when tessellating B-rep parts. 0.05 mm is below what a 0.1 mm
+#: texel or a CNC finishing pass resolves, and keeps a 70 mm bowl around 10-30k triangles.
+TESSELLATION_TOL_MM = 0.05
+
+#: Angular tolerance (degrees) for tessellation: curved walls keep at most this normal jump.
+TESSELLATION_ANGLE_DEG = 5.0
+
+#: Relative volume error we accept between a carved mesh and an analytic volume. It is set by
+#: the tessellation: a circle of radius r tessellated with chord tolerance t loses about
+#: (2/3) t / r of its area, 0.1 % for r = 30 mm and t = 0.05 mm, doubled for margin.
+CARVE_VOLUME_RTOL = 2e-3
+
+#: A part is "outside the block" by less than this volume (mm^3) only through round-off of
+#: the boolean; smaller outside volumes are not reported as warnings.
+OUTSIDE_VOLUME_EPS_MM3 = 1e-3
+
+#: Points are considered on a block face within this distance (mm): float32 mesh vertices
+#: of a 100 mm block carry ~1e-5 mm of round-off.
+ON_FACE_TOL_MM = 1e-4
+
+#: Pixels of padding ("dilation") added around every chart in a baked atlas, so bilinear
+#: filtering and mip levels up to 2^3 never reach unpainted texels.
+ATLAS_PADDING_PX = 8
+
+#: Maximum points evaluated in one batch by fields and appearances; bounds peak memory at
+#: roughly 100 floats per point -> ~0.2 GB per batch.
+MAX_BATCH_POINTS = 1 << 18
+
+#: Smallest allowed radius-scaling value in the radial family (eq. 9 of seed 000) after the
+#: linear blend; guards division by zero when a blend is extrapolated.
+MIN_RADIUS_SCALE = 0.05
