@@ -1,0 +1,139 @@
+"""A measured (or synthetic) block: its size, its six faces and, when known, its true field.
+
+Face images follow ``docs/conventions.md``: each is seen from outside the block, pixel
+``(row, col)`` maps to the block by :func:`woodcam.frames.pixel_to_block`. Ring traces are
+polylines in continuous pixel coordinates ``(row, col)`` (pixel centres at integers) with an
+optional integer year label counted outward from the pith. A ring map is a grey image in
+[0, 1], bright on ring boundaries, with no year labels (the Mokume ``arl`` maps).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import WoodcamError
+from ..frames import FACES, FaceName, check_face, check_size, face_image_size_mm, pixel_to_block
+
+
+@dataclass(frozen=True)
+class RingTrace:
+    """One traced ring on a face.
+
+    Attributes
+    ----------
+    points_px : (k, 2) float
+        Polyline vertices as continuous pixel coordinates ``(row, col)``.
+    year : int or None
+        Growth year of the ring boundary (the integer iso-line ``GTF = year``), if labelled.
+    """
+
+    points_px: np.ndarray
+    year: int | None = None
+
+    def __post_init__(self):
+        p = np.asarray(self.points_px, dtype=float)
+        if p.ndim != 2 or p.shape[1] != 2 or len(p) < 2:
+            raise WoodcamError(
+                f"points_px of a ring trace must have shape (k >= 2, 2) as (row, col); got {p.shape}"
+            )
+        object.__setattr__(self, "points_px", p)
+
+
+@dataclass
+class Face:
+    """What is known about one face of a block.
+
+    Attributes
+    ----------
+    name : FaceName
+    shape : (n_rows, n_cols)
+        Pixel size of the face's images (photo and ring map share it); traces use it too.
+    photo : (n_rows, n_cols, 3) uint8 or None
+    traces : list of RingTrace
+    ring_map : (n_rows, n_cols) float32 in [0, 1] or None
+    """
+
+    name: FaceName
+    shape: tuple[int, int]
+    photo: np.ndarray | None = None
+    traces: list[RingTrace] = field(default_factory=list)
+    ring_map: np.ndarray | None = None
+
+    def __post_init__(self):
+        self.name = check_face(self.name)
+        self.shape = (int(self.shape[0]), int(self.shape[1]))
+        if self.photo is not None:
+            self.photo = _check_image(self.photo, self.shape, 3, f"photo of face {self.name!r}")
+        if self.ring_map is not None:
+            self.ring_map = _check_image(self.ring_map, self.shape, 0, f"ring_map of face {self.name!r}")
+
+    @property
+    def has_rings(self) -> bool:
+        return bool(self.traces) or self.ring_map is not None
+
+
+def _check_image(im, shape, channels: int, what: str) -> np.ndarray:
+    a = np.asarray(im)
+    want = tuple(shape) + ((channels,) if channels else ())
+    if a.shape != want:
+        raise WoodcamError(f"{what} must have shape {want} like the face; got {a.shape}")
+    return a
+
+
+@dataclass
+class Block:
+    """A block of wood in the block frame: ``[0, W] x [0, D] x [0, H]`` mm.
+
+    Attributes
+    ----------
+    size_mm : (W, D, H) float
+    faces : dict FaceName -> Face
+        Only the faces something is known about; any subset of the six.
+    true_field : growth field or None
+        The true growth-time field in the block frame, for synthetic blocks.
+    name : str
+    meta : dict
+        Free-form provenance (source folder, generator seed, sawing pattern, ...).
+    """
+
+    size_mm: tuple[float, float, float]
+    faces: dict[str, Face] = field(default_factory=dict)
+    true_field: Any = None
+    name: str = "block"
+    meta: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        self.size_mm = tuple(float(s) for s in check_size(self.size_mm))
+        faces = {}
+        for key, face in self.faces.items():
+            if check_face(key) != face.name:
+                raise WoodcamError(f"faces[{key!r}] holds face {face.name!r}; keys must match Face.name")
+            faces[face.name] = face
+        self.faces = {f: faces[f] for f in FACES if f in faces}
+
+    def face_pixel_size_mm(self, face: str) -> tuple[float, float]:
+        """Size in mm of one pixel ``(row step, col step)`` of ``face``'s images."""
+        f = self.faces[check_face(face)]
+        h, w = face_image_size_mm(f.name, self.size_mm)
+        return h / f.shape[0], w / f.shape[1]
+
+    def trace_points_mm(self, faces: list[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """All traced ring vertices as block points with their years.
+
+        Returns
+        -------
+        points_mm : (n, 3) float
+        years : (n,) float, NaN for unlabelled traces
+        """
+        pts, yrs = [], []
+        for name in faces or list(self.faces):
+            f = self.faces[check_face(name)]
+            for t in f.traces:
+                pts.append(pixel_to_block(f.name, t.points_px[:, 0], t.points_px[:, 1], f.shape, self.size_mm))
+                yrs.append(np.full(len(t.points_px), np.nan if t.year is None else float(t.year)))
+        if not pts:
+            return np.empty((0, 3)), np.empty(0)
+        return np.concatenate(pts), np.concatenate(yrs)
