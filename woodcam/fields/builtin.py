@@ -67,10 +67,12 @@ def builtin_block(name: str) -> BuiltinBlock:
     pith, axis, ring_w, species, seed, desc = _SPECS[name]
     rng = np.random.default_rng(seed)
     frame = LogFrame(pith, axis)
-    field = RadialScalingField.random(frame, ring_w, rng, half_length_mm=60.0)
+    # Gentler than the seed's training distribution (sigma 0.1 over the block): real stems vary
+    # little over 100 mm, so sigma 0.06 and a 200 mm blend length read as one tree.
+    field = RadialScalingField.random(frame, ring_w, rng, sigma=0.06, half_length_mm=200.0)
     # Put the axial blend's centre in the middle of the block so both radius functions show.
     centre = np.asarray(BUILTIN_SIZE_MM) / 2
     z_mid = float((centre - np.asarray(pith)) @ frame.rotation[2])
     frame = LogFrame(tuple(np.asarray(pith) + z_mid * frame.rotation[2]), axis)
-    field = RadialScalingField(frame, ring_w, field.r_minus, field.r_plus, 60.0)
+    field = RadialScalingField(frame, ring_w, field.r_minus, field.r_plus, 200.0)
     return BuiltinBlock(name, BUILTIN_SIZE_MM, field, species, desc)
