@@ -214,7 +214,8 @@ def cut_block(log_field, size_mm, pattern: SawPattern = "flat-sawn", *, distance
     angle_deg : float, optional
         Override of the pattern's radial direction angle.
     tilt_deg : float
-        Rotation of the pith axis away from +Z about the tangential direction (slope of grain).
+        Rotation of the pith axis away from +Z about the tangential direction (slope of grain);
+        positive leans its upper end along the outward radial direction.
     log_frame : LogFrame, optional
         Give the placement directly instead (any orientation); the other placement arguments
         are then ignored.
@@ -263,7 +264,7 @@ def cut_block(log_field, size_mm, pattern: SawPattern = "flat-sawn", *, distance
 # -- rendering ------------------------------------------------------------------------------------
 
 _EARLYWOOD = np.array([0.88, 0.73, 0.56])
-_LATEWOOD = np.array([0.62, 0.42, 0.25])
+_LATEWOOD = np.array([0.66, 0.45, 0.27])
 
 
 def _default_color(years: np.ndarray, end_grain: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -272,8 +273,9 @@ def _default_color(years: np.ndarray, end_grain: np.ndarray, rng: np.random.Gene
     Earlywood -> latewood by the ARF (eq. 6 of seed 000) sharpened towards the boundary, a
     per-ring tone, and end grain (``end_grain`` = |fibre . normal| in [0, 1]) a little darker.
     """
-    a = arf(years)
-    late = np.clip((a - 0.55) / 0.4, 0.0, 1.0) ** 1.5
+    a = arf(years)                                  # (years mod 1)^2
+    x = np.clip((a - 0.3) / 0.5, 0.0, 1.0)         # latewood band: about the last 30 % of a ring
+    late = x * x * (3.0 - 2.0 * x)                  # smoothstep
     ring = np.floor(years).astype(np.int64)
     tone = 1.0 + 0.04 * np.sin(ring * 2.399 + rng.uniform(0, 2 * np.pi))  # per-ring brightness
     rgb = _EARLYWOOD + late[:, None] * (_LATEWOOD - _EARLYWOOD)
@@ -446,7 +448,7 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
                 trace_jitter_mm: float = 0.0, trace_jitter_corr_mm: float = 1.0,
                 mislabel_fraction: float = 0.0, unlabelled_fraction: float = 0.0,
                 photo_noise: float = 0.012, photo_variation: float = 0.03,
-                ring_map_sigma_px: float = 1.0, ring_map_noise: float = 0.02,
+                ring_map_sigma_px: float = 1.5, ring_map_noise: float = 0.02,
                 seed: int = 0, rng: np.random.Generator | None = None,
                 name: str = "synthetic", meta: dict | None = None) -> Block:
     """Render a synthetic :class:`Block` from a growth field placed in the block frame.
@@ -510,7 +512,10 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
     if not px_per_mm > 0:
         raise WoodcamError(f"px_per_mm must be > 0; got {px_per_mm!r}")
     rng = np.random.default_rng(seed) if rng is None else rng
-    layout = CrossLayout(tuple(size), float(px_per_mm))
+    # A whole number of pixels across W: unfold_cross infers the density from the front face's
+    # width, so this keeps all six face shapes consistent with it.
+    px_per_mm = max(1, round(size[0] * float(px_per_mm))) / size[0]
+    layout = CrossLayout(tuple(size), px_per_mm)
 
     out = {}
     for face in faces:
@@ -578,7 +583,7 @@ def random_log_placement(rng: np.random.Generator, pattern: SawPattern, size_mm,
     log = AnalyticLogField(
         ring_width_mm=width / (1.0 + slope * distance), width_slope_per_mm=slope,
         eccentricity=rng.uniform(0.0, 0.15), eccentric_azimuth_deg=rng.uniform(0, 360),
-        lobe_amplitude=rng.uniform(0.0, 0.04), lobes=int(rng.integers(3, 7)),
+        lobe_amplitude=rng.uniform(0.0, 0.025), lobes=int(rng.integers(3, 7)),
         lobe_phase_deg=rng.uniform(0, 360),
     )
     placement = {
