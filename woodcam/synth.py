@@ -283,10 +283,14 @@ def _default_color(years: np.ndarray, end_grain: np.ndarray, rng: np.random.Gene
     return np.clip(rgb, 0.0, 1.0)
 
 
-def _camera(rgb: np.ndarray, rng: np.random.Generator, noise: float, variation: float) -> np.ndarray:
-    """Photograph an ``(h, w, 3)`` float image: exposure, white balance, vignetting, sensor noise."""
+def _camera(rgb: np.ndarray, rng: np.random.Generator, noise: float, variation: float,
+            blur_px: float = 0.0) -> np.ndarray:
+    """Photograph an ``(h, w, 3)`` float image: lens blur (Gaussian, ``blur_px``), exposure and
+    white balance, vignetting, sensor noise; returns uint8."""
+    from scipy.ndimage import gaussian_filter
+
     h, w, _ = rgb.shape
-    out = rgb
+    out = gaussian_filter(rgb, (blur_px, blur_px, 0), mode="nearest") if blur_px > 0 else rgb
     if variation > 0:
         gain = 1.0 + variation * rng.standard_normal() + variation * 0.3 * rng.standard_normal(3)
         rr, cc = np.meshgrid(np.linspace(-1, 1, h), np.linspace(-1, 1, w), indexing="ij")
@@ -336,11 +340,11 @@ def _refine(field, face, shape, size, rc: np.ndarray, level: np.ndarray, iters: 
     h = TRACE_FD_STEP_PX
     n = len(rc)
     offs = np.array([[0, 0], [h, 0], [-h, 0], [0, h], [0, -h]], float)
-    for _ in range(iters + 1):
+    for it in range(iters + 1):
         q = (rc[None, :, :] + offs[:, None, :]).reshape(-1, 2)
         v = evaluate(field, pixel_to_block(face, q[:, 0], q[:, 1], shape, size)).reshape(5, n)
         res = v[0] - level
-        if _ == iters:
+        if it == iters:
             break
         grad = np.stack([(v[1] - v[2]) / (2 * h), (v[3] - v[4]) / (2 * h)], axis=1)
         g2 = np.maximum((grad ** 2).sum(1), 1e-18)
@@ -357,10 +361,18 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 def _trace_face(field, face, shape, size, g: np.ndarray) -> list[RingTrace]:
-    """Clean traces of the integer iso-lines of ``field`` on one face (pixel coordinates)."""
+    """Clean traces of the integer iso-lines of ``field`` on one face (pixel coordinates).
+
+    Marching squares (contourpy) on ``g``, the field sampled at pixel centres, gives polylines
+    within ``[0, n - 1]`` px (half a pixel short of the face edges); :func:`_refine` then moves
+    every vertex onto the true iso-line. Vertices that do not converge (a kink of the field,
+    e.g. where a knot meets the stem, or a vanishing gradient) or leave the face are dropped and
+    the polyline is split there.
+    """
     import contourpy
 
-    lo, hi = math.ceil(np.nanmin(g)), math.floor(np.nanmax(g))
+    # Ring boundaries are the iso-lines years = 1, 2, ...; years = 0 is the pith itself.
+    lo, hi = max(1, math.ceil(np.nanmin(g))), math.floor(np.nanmax(g))
     if hi < lo:
         return []
     gen = contourpy.contour_generator(z=g, line_type=contourpy.LineType.Separate)
@@ -447,7 +459,7 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
                 trace_dropout: float = 0.0, trace_dropout_chunk_mm: float = 3.0,
                 trace_jitter_mm: float = 0.0, trace_jitter_corr_mm: float = 1.0,
                 mislabel_fraction: float = 0.0, unlabelled_fraction: float = 0.0,
-                photo_noise: float = 0.012, photo_variation: float = 0.03,
+                photo_noise: float = 0.012, photo_variation: float = 0.03, photo_blur_px: float = 0.6,
                 ring_map_sigma_px: float = 1.5, ring_map_noise: float = 0.02,
                 seed: int = 0, rng: np.random.Generator | None = None,
                 name: str = "synthetic", meta: dict | None = None) -> Block:
@@ -478,7 +490,9 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
         Traces with ``year=None``.
     photo_noise : float
         Sensor noise std (fraction of full scale); ``photo_variation`` the std of the per-face
-        exposure (and ~ the vignetting strength). Both 0 gives the clean rendering.
+        exposure (and ~ the vignetting strength); ``photo_blur_px`` the Gaussian lens blur
+        (px), which also anti-aliases the sharp latewood -> earlywood step. All 0 gives the
+        clean rendering: exactly ``round(255 * color)``.
     ring_map_sigma_px, ring_map_noise : float
         Ring-map line half-width (px) and additive noise std.
     seed, rng
@@ -530,7 +544,7 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
         else:
             fib = grain_direction(field, pts)
             rgb = _default_color(g, np.abs((fib * normals).sum(1)), rng)
-        photo = _camera(rgb.reshape(shape + (3,)), rng, photo_noise, photo_variation)
+        photo = _camera(rgb.reshape(shape + (3,)), rng, photo_noise, photo_variation, photo_blur_px)
         g = g.reshape(shape)
         ring_map = _ring_map(g, ring_map_sigma_px, ring_map_noise, rng) if face in ring_map_faces else None
         traces = []
@@ -555,7 +569,7 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
         "trace_dropout": trace_dropout, "trace_dropout_chunk_mm": trace_dropout_chunk_mm,
         "trace_jitter_mm": trace_jitter_mm, "trace_jitter_corr_mm": trace_jitter_corr_mm,
         "mislabel_fraction": mislabel_fraction, "unlabelled_fraction": unlabelled_fraction,
-        "photo_noise": photo_noise, "photo_variation": photo_variation,
+        "photo_noise": photo_noise, "photo_variation": photo_variation, "photo_blur_px": photo_blur_px,
         "ring_map_sigma_px": ring_map_sigma_px, "ring_map_noise": ring_map_noise,
     }
     return Block(tuple(size), faces=out, true_field=field, name=name, meta={**settings, **(meta or {})})
