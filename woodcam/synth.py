@@ -261,26 +261,78 @@ def cut_block(log_field, size_mm, pattern: SawPattern = "flat-sawn", *, distance
     return PlacedField(log_field, frame)
 
 
+#: Line width (mm) of the Mokume U-Net ring maps as ``sigma`` of ``exp(-(d / sigma)^2)``:
+#: their lines are 5.1-5.9 px wide at half maximum on 256 px faces of ~50 mm cubes
+#: (measured on H11 and CN03 face E), and FWHM = 1.665 sigma -> sigma ~ 3.2 px ~ 0.62 mm.
+MOKUME_RING_SIGMA_MM = 0.62
+
+
 # -- rendering ------------------------------------------------------------------------------------
 
 _EARLYWOOD = np.array([0.88, 0.73, 0.56])
 _LATEWOOD = np.array([0.66, 0.45, 0.27])
 
 
-def _default_color(years: np.ndarray, end_grain: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """Built-in colour map (used when no appearance is given): rgb ``(n, 3)`` in [0, 1].
+class _BuiltinWood:
+    """Built-in appearance (used when no ``wood`` is given): ``color(points_mm, normals)``.
 
-    Earlywood -> latewood by the ARF (eq. 6 of seed 000) sharpened towards the boundary, a
-    per-ring tone, and end grain (``end_grain`` = |fibre . normal| in [0, 1]) a little darker.
+    Earlywood -> latewood by the field's ARF (eq. 6 of seed 000) with a smooth latewood band
+    over about the last 30 % of each ring, a per-ring tone, end grain (|fibre . normal| near 1)
+    a little darker, and a fibre texture: smooth 3-D noise stretched along the fibres
+    (``_FIBRE_SCALES_MM``: streaks on side grain, pores on end grain). All random parts are
+    drawn once per block, so the six faces agree where they meet.
     """
-    a = arf(years)                                  # (years mod 1)^2
-    x = np.clip((a - 0.3) / 0.5, 0.0, 1.0)         # latewood band: about the last 30 % of a ring
-    late = x * x * (3.0 - 2.0 * x)                  # smoothstep
-    ring = np.floor(years).astype(np.int64)
-    tone = 1.0 + 0.04 * np.sin(ring * 2.399 + rng.uniform(0, 2 * np.pi))  # per-ring brightness
-    rgb = _EARLYWOOD + late[:, None] * (_LATEWOOD - _EARLYWOOD)
-    rgb = rgb * (tone * (1.0 - 0.15 * end_grain))[:, None]
-    return np.clip(rgb, 0.0, 1.0)
+
+    #: (across-fibre, along-fibre) noise scales (mm) and weights of the fibre texture octaves.
+    _FIBRE_SCALES_MM = ((0.22, 6.0, 0.6), (0.9, 25.0, 0.4))
+    _FIBRE_AMPLITUDE = 0.05
+
+    def __init__(self, field, rng: np.random.Generator, lattice: int = 64):
+        self.field = field
+        self.phase = rng.uniform(0, 2 * np.pi)
+        self.lattice = [rng.standard_normal((lattice,) * 3).astype(np.float32) for _ in self._FIBRE_SCALES_MM]
+        self.offsets = rng.uniform(0, lattice, (len(self._FIBRE_SCALES_MM), 3))
+
+    def _fibre_texture(self, p: np.ndarray, fib: np.ndarray) -> np.ndarray:
+        from scipy.ndimage import map_coordinates
+
+        along = (p * fib).sum(1, keepdims=True)
+        tex = np.zeros(len(p))
+        for (l_across, l_along, w), grid, off in zip(self._FIBRE_SCALES_MM, self.lattice, self.offsets):
+            # stretched coordinates: 1 cell = l_across across the fibres, l_along along them
+            q = p / l_across - (1.0 / l_across - 1.0 / l_along) * along * fib + off
+            tex += w * map_coordinates(grid, q.T, order=1, mode="grid-wrap")
+        return tex
+
+    def color(self, points_mm, normals, years=None, years_per_px=None) -> np.ndarray:
+        """rgb ``(n, 3)`` in [0, 1] at ``points_mm (n, 3)`` with outward ``normals (n, 3)``.
+
+        ``years (n,)`` may be passed when already evaluated; ``years_per_px (n,)``, the growth
+        time spanned by one pixel, anti-aliases the latewood -> earlywood step at each ring
+        boundary (a box filter: the step becomes a one-pixel ramp).
+        """
+        p = check_points(points_mm)
+        years = evaluate(self.field, p) if years is None else years
+        fib = np.asarray(grain_direction(self.field, p), dtype=float)
+        end_grain = np.abs((fib * np.asarray(normals, float)).sum(1))
+        a = arf(years)                                  # (years mod 1)^2
+        x = np.clip((a - 0.3) / 0.5, 0.0, 1.0)         # latewood band: about the last 30 % of a ring
+        late = x * x * (3.0 - 2.0 * x)                  # smoothstep
+        if years_per_px is not None:
+            frac = years - np.floor(years)
+            w = np.maximum(np.asarray(years_per_px, float), 1e-6)
+            # box filter of the pixel [frac - w/2, frac + w/2] across the step at the boundary:
+            # the part past it is earlywood (late = 0), the part before a ring's start is the
+            # previous ring's latewood (late ~ 1)
+            before = np.clip((1.0 - frac) / w + 0.5, 0.0, 1.0)
+            prev = np.clip(0.5 - frac / w, 0.0, 1.0)
+            late = late * before * (1.0 - prev) + prev
+        ring = np.floor(years)
+        tone = 1.0 + 0.04 * np.sin(ring * 2.399 + self.phase)   # per-ring brightness
+        tex = 1.0 + self._FIBRE_AMPLITUDE * self._fibre_texture(p, fib)
+        rgb = _EARLYWOOD + late[:, None] * (_LATEWOOD - _EARLYWOOD)
+        rgb = rgb * (tone * tex * (1.0 - 0.15 * end_grain))[:, None]
+        return np.clip(rgb, 0.0, 1.0)
 
 
 def _camera(rgb: np.ndarray, rng: np.random.Generator, noise: float, variation: float,
@@ -460,7 +512,7 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
                 trace_jitter_mm: float = 0.0, trace_jitter_corr_mm: float = 1.0,
                 mislabel_fraction: float = 0.0, unlabelled_fraction: float = 0.0,
                 photo_noise: float = 0.012, photo_variation: float = 0.03, photo_blur_px: float = 0.6,
-                ring_map_sigma_px: float = 1.5, ring_map_noise: float = 0.02,
+                ring_map_sigma_px: float | None = None, ring_map_noise: float = 0.02,
                 seed: int = 0, rng: np.random.Generator | None = None,
                 name: str = "synthetic", meta: dict | None = None) -> Block:
     """Render a synthetic :class:`Block` from a growth field placed in the block frame.
@@ -494,7 +546,9 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
         (px), which also anti-aliases the sharp latewood -> earlywood step. All 0 gives the
         clean rendering: exactly ``round(255 * color)``.
     ring_map_sigma_px, ring_map_noise : float
-        Ring-map line half-width (px) and additive noise std.
+        Ring-map line width ``sigma`` (px) of ``exp(-(d / sigma)^2)`` and additive noise std.
+        Default sigma: :data:`MOKUME_RING_SIGMA_MM` times ``px_per_mm``, the width of the
+        Mokume U-Net maps.
     seed, rng
         ``rng`` if given, else ``np.random.default_rng(seed)``; the same seed gives the same block.
 
@@ -530,7 +584,11 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
     # width, so this keeps all six face shapes consistent with it.
     px_per_mm = max(1, round(size[0] * float(px_per_mm))) / size[0]
     layout = CrossLayout(tuple(size), px_per_mm)
+    if ring_map_sigma_px is None:
+        ring_map_sigma_px = MOKUME_RING_SIGMA_MM * px_per_mm
 
+    appearance = "builtin" if wood is None else type(wood).__name__
+    wood = _BuiltinWood(field, rng) if wood is None else wood
     out = {}
     for face in faces:
         shape = layout.face_shape(face)
@@ -539,11 +597,11 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
         pts = _face_points(face, shape, size)
         g = evaluate(field, pts)
         normals = np.broadcast_to(np.asarray(FACE_NORMAL[face], float), pts.shape)
-        if wood is not None:
-            rgb = np.asarray(wood.color(pts, normals), dtype=float)
+        if isinstance(wood, _BuiltinWood):
+            gr, gc = np.gradient(g.reshape(shape))
+            rgb = wood.color(pts, normals, years=g, years_per_px=np.hypot(gr, gc).ravel())
         else:
-            fib = grain_direction(field, pts)
-            rgb = _default_color(g, np.abs((fib * normals).sum(1)), rng)
+            rgb = np.asarray(wood.color(pts, normals), dtype=float)
         photo = _camera(rgb.reshape(shape + (3,)), rng, photo_noise, photo_variation, photo_blur_px)
         g = g.reshape(shape)
         ring_map = _ring_map(g, ring_map_sigma_px, ring_map_noise, rng) if face in ring_map_faces else None
@@ -564,7 +622,7 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
 
     settings = {
         "generator": "woodcam.synth.synth_block", "seed": seed,
-        "px_per_mm": float(px_per_mm), "appearance": "builtin" if wood is None else type(wood).__name__,
+        "px_per_mm": float(px_per_mm), "appearance": appearance,
         "trace_faces": sorted(trace_faces), "ring_map_faces": sorted(ring_map_faces),
         "trace_dropout": trace_dropout, "trace_dropout_chunk_mm": trace_dropout_chunk_mm,
         "trace_jitter_mm": trace_jitter_mm, "trace_jitter_corr_mm": trace_jitter_corr_mm,
