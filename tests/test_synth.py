@@ -164,6 +164,22 @@ def test_ring_map_bright_on_rings_dark_between():
     assert face.ring_map[frac * RING_MM / px_mm > 3.0].max() < 1e-3     # 3 px away
 
 
+def test_builtin_photo_is_dark_on_latewood_and_end_grain():
+    """The photo follows the field at each face's own pixel points (catches a wrong mapping)."""
+    size = (40, 40, 40)
+    field = cut_block(radial_log, size, "rift", distance_mm=50)
+    block = synth_block(field, size, face_px=96, photo_noise=0, photo_variation=0, seed=0)
+    lum = {}
+    for name, face in block.faces.items():
+        g = evaluate(field, face_pixel_points(name, face.shape, size).reshape(-1, 3))
+        frac = g - np.floor(g)
+        y = face.photo.reshape(-1, 3).astype(float).mean(1)
+        late, early = y[(frac > 0.85) & (frac < 0.97)].mean(), y[(frac > 0.05) & (frac < 0.4)].mean()
+        assert late < early - 20, name
+        lum[name] = y.mean()
+    assert max(lum["top"], lum["bottom"]) < min(lum[n] for n in ("front", "back", "left", "right"))
+
+
 def test_same_seed_same_block_other_seed_other_photos():
     field = cut_block(radial_log, SIZE, "rift")
     kw = dict(face_px=48, trace_dropout=0.2, trace_jitter_mm=0.1, mislabel_fraction=0.2)

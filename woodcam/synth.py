@@ -670,8 +670,8 @@ def random_log_placement(rng: np.random.Generator, pattern: SawPattern, size_mm,
 def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
                         size_range_mm=(30.0, 80.0), ring_width_range_mm=(1.5, 6.0),
                         log_fields: Callable[[np.random.Generator], object] | None = None,
-                        knotted_fraction: float = 0.5, progress: bool = True,
-                        **synth_kwargs) -> list[Path]:
+                        knotted_fraction: float = 0.5, wood_factory: Callable[[object], object] | None = None,
+                        progress: bool = True, **synth_kwargs) -> list[Path]:
     """Write ``count`` synthetic blocks to ``out_dir/block_0000`` ... plus ``out_dir/index.json``.
 
     Block ``i`` is drawn from ``np.random.default_rng([seed, i])`` alone, so any block of a set
@@ -685,6 +685,9 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
         Factory of knotted log fields (pith on log ``z``). When given, a block is knotted with
         probability ``knotted_fraction``. TODO(knots/logs): pass the knotted log generator from
         ``woodcam.logs`` here once it exists; until then every block is knot-free.
+    wood_factory : callable ``block-frame field -> wood``, optional
+        Appearance for each block (e.g. ``lambda f: woodcam.appearance.Wood(f, ...)``); default
+        the built-in colour map.
     synth_kwargs
         Passed to :func:`synth_block` (e.g. ``trace_dropout``); default clean full annotation.
 
@@ -719,7 +722,8 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
         info = {"name": name, "index": i, "size_mm": list(size), "knotted": bool(knotted),
                 "ring_width_mm": log.ring_width_at(placement["distance_mm"]) if not knotted else None,
                 **{k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in placement.items()}}
-        block = synth_block(field, size, face_px=face_px, rng=rng, seed=None, name=name,
+        wood = None if wood_factory is None else wood_factory(field)
+        block = synth_block(field, size, wood=wood, face_px=face_px, rng=rng, seed=None, name=name,
                             meta={"benchmark_seed": int(seed), **info}, **synth_kwargs)
         folder = out_dir / name
         write_block(block, folder)
