@@ -13,6 +13,7 @@ from pathlib import Path
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Add the ``block`` command (with ``synth`` and ``show``) to an argparse sub-parser set."""
     p = subparsers.add_parser("block", help="synthesise or show blocks (six face photos + rings)")
+    p.set_defaults(func=run)          # woodcam.cli dispatches on args.func
     sub = p.add_subparsers(dest="block_command", required=True, metavar="{synth,show}")
 
     s = sub.add_parser("synth", help="write a reproducible set of synthetic blocks")
@@ -67,7 +68,7 @@ def main(argv=None) -> int:
     add_parser(sub)
     args = parser.parse_args(argv)
     try:
-        return run(args)
+        return args.func(args)        # as woodcam.cli dispatches
     except WoodcamError as err:
         import sys
 
