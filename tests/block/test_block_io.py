@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from woodcam.block import Block, Face, RingTrace, read_block, write_block
+from woodcam.block import Block, Face, RingTrace, block_from_images, read_block, write_block
 from woodcam.errors import WoodcamError
 from woodcam.synth import AnalyticLogField, cut_block, synth_block
 from woodcam.tolerances import RING_MAP_QUANT_8BIT, RING_MAP_QUANT_16BIT
@@ -108,3 +108,24 @@ def test_bad_inputs_raise(tmp_path, block):
         write_block(block, tmp_path / "w", overwrite=False)
     with pytest.raises(WoodcamError, match="points_px of a ring trace must have shape"):
         RingTrace(np.zeros((1, 2)), 3)
+
+
+def test_block_from_images_of_a_real_block(tmp_path):
+    rng = np.random.default_rng(0)
+    top = rng.integers(0, 256, (30, 40, 3), dtype=np.uint8)
+    Image.fromarray(top).save(tmp_path / "top.jpg.png")
+    grey = rng.integers(0, 256, (20, 40), dtype=np.uint8)
+    ring16 = rng.integers(0, 65536, (20, 40), dtype=np.uint16)
+    b = block_from_images((40, 30, 20), photos={"B": tmp_path / "top.jpg.png", "front": grey},
+                          ring_maps={"A": ring16}, name="walnut", meta={"camera": "phone"})
+    assert list(b.faces) == ["front", "top"] and b.faces["top"].shape == (30, 40)
+    assert np.array_equal(b.faces["top"].photo, top)
+    assert np.array_equal(b.faces["front"].photo[..., 1], grey)
+    np.testing.assert_allclose(b.faces["front"].ring_map, ring16 / 65535, atol=1e-7)
+    write_block(b, tmp_path / "walnut")
+    back = read_block(tmp_path / "walnut")
+    assert np.array_equal(back.faces["top"].photo, top) and back.meta == {"camera": "phone"}
+    with pytest.raises(WoodcamError, match=r"ring_map of face 'front' must be 20x40 px like its face; got 21x40"):
+        block_from_images((40, 30, 20), photos={"front": grey}, ring_maps={"front": np.zeros((21, 40))})
+    with pytest.raises(WoodcamError, match="photo of face 'top' must be an 8-bit RGB image"):
+        block_from_images((40, 30, 20), photos={"top": np.zeros((4, 4, 3))})

@@ -410,3 +410,65 @@ def read_mokume(folder, size_mm=MOKUME_DEFAULT_SIZE_MM, *, name: str | None = No
             "size_assumed_mm": [float(s) for s in size_mm],
             "note": "Mokume cubes are normalised; size_mm was given to read_mokume, not measured"}
     return Block(tuple(size_mm), faces=faces, name=name or folder.name, meta=meta)
+
+
+# -- real blocks from image files ----------------------------------------------------------------
+
+def _load_image(src, what: str) -> np.ndarray:
+    if isinstance(src, (str, os.PathLike)):
+        return _read_png(Path(src), what)  # PIL reads JPEG/TIFF/... the same way
+    return np.asarray(src)
+
+
+def block_from_images(size_mm, photos: dict | None = None, ring_maps: dict | None = None, *,
+                      name: str = "block", meta: dict | None = None) -> Block:
+    """Build a (real) block from face images, ready for :func:`write_block`.
+
+    Parameters
+    ----------
+    size_mm : (W, D, H)
+        Measured block size in mm.
+    photos : dict face -> path or (rows, cols, 3) uint8 array, optional
+        Face photos, already rectified to the face and oriented as ``docs/conventions.md``
+        says (seen from outside; Mokume letters ``A``..``F`` accepted as keys). Grey images
+        are repeated to RGB.
+    ring_maps : dict face -> path or (rows, cols) array, optional
+        Ring maps: float arrays in [0, 1], or uint8 / uint16 images (scaled by 255 / 65535).
+    name, meta
+        Block name and provenance.
+
+    Raises
+    ------
+    WoodcamError
+        When a face's photo and ring map differ in size, or a photo is not uint8 RGB.
+    """
+    from ..frames import check_face
+
+    images: dict[str, dict] = {}
+    for kind, src_map in (("photo", photos or {}), ("ring_map", ring_maps or {})):
+        for key, src in src_map.items():
+            face = check_face(key)
+            a = _load_image(src, f"{kind} of face {face!r}")
+            if kind == "photo":
+                if a.ndim == 2:
+                    a = np.repeat(a[..., None], 3, axis=2)
+                if a.ndim != 3 or a.shape[2] < 3 or a.dtype != np.uint8:
+                    raise WoodcamError(
+                        f"photo of face {face!r} must be an 8-bit RGB image (rows, cols, 3) uint8; "
+                        f"got shape {a.shape}, dtype {a.dtype}"
+                    )
+                a = a[..., :3]
+            else:
+                if a.ndim == 3:
+                    a = a[..., :3].mean(axis=2).astype(a.dtype)
+                if a.dtype in (np.uint8, np.uint16):
+                    a = (a.astype(np.float64) / (255.0 if a.dtype == np.uint8 else 65535.0))
+                a = np.asarray(a, dtype=np.float32)
+            images.setdefault(face, {})[kind] = a
+    faces = {}
+    for face, imgs in images.items():
+        shape = next(iter(imgs.values())).shape[:2]
+        for kind, a in imgs.items():
+            _check_shape(a, shape, f"{kind} of face {face!r}")
+        faces[face] = Face(face, shape, photo=imgs.get("photo"), ring_map=imgs.get("ring_map"))
+    return Block(tuple(size_mm), faces=faces, name=name, meta=dict(meta or {}))
