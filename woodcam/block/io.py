@@ -16,11 +16,16 @@ Manifest (``"format": "woodcam-block"``, ``"version": 1``)::
                          "ring_map": "front_ring_map.png" | null,
                          "ring_map_bits": 16 | 8,
                          "traces": [{"year": int | null, "points_px": [[row, col], ...]}, ...],
+                         "traces_svg": "front_traces.svg",    (optional, read only: see below)
                          "extras": {"knot_mask": {"png": "front_knot_mask.png", "dtype": "bool"},
                                     "note": {"json": ...}}},
                ...},
      "true_field": {"saved": bool, "type": "module:QualName", "file": "true_field.json",
                     "reason": str}}
+
+A hand-made manifest of a real block may also name an SVG per face (``"traces_svg"``) with
+rings drawn over the photo in a vector editor (:mod:`woodcam.block.svg`); :func:`read_block`
+adds those traces to the JSON ones. :func:`write_block` always writes traces as JSON.
 
 Precision: photos and traces round-trip exactly (PNG is lossless; JSON floats are written with
 ``repr`` precision); a ring map in [0, 1] is quantised to ``ring_map_bits`` bits, so it comes
@@ -163,6 +168,10 @@ def read_block(folder) -> Block:
             ring_map = (raw.astype(np.float64) / (2 ** bits - 1)).astype(np.float32)
         traces = [RingTrace(np.asarray(t["points_px"], dtype=float), t.get("year"))
                   for t in entry.get("traces", [])]
+        if entry.get("traces_svg"):
+            from .svg import read_traces_svg
+
+            traces += read_traces_svg(folder / entry["traces_svg"], shape)
         extras = {k: _read_extra(folder, v, shape, f"extras[{k!r}] of face {name!r}")
                   for k, v in entry.get("extras", {}).items()}
         faces[name] = Face(name, shape, photo=photo, traces=traces, ring_map=ring_map, extras=extras)
