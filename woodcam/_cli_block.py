@@ -47,7 +47,14 @@ def run(args) -> int:
         from .block.io import MANIFEST, MOKUME_DEFAULT_SIZE_MM, read_block, read_mokume
         from .block.render import save_cross_png
 
+        from .errors import WoodcamError
+
         folder = Path(args.folder)
+        if not folder.exists():
+            raise WoodcamError(
+                f"folder must be a block folder (with {MANIFEST}) or a Mokume sample folder; "
+                f"{str(folder)!r} does not exist"
+            )
         if (folder / MANIFEST).exists() or folder.name == MANIFEST:
             block = read_block(folder)
         else:
