@@ -34,3 +34,20 @@ MAX_BATCH_POINTS = 1 << 18
 #: Smallest allowed radius-scaling value in the radial family (eq. 9 of seed 000) after the
 #: linear blend; guards division by zero when a blend is extrapolated.
 MIN_RADIUS_SCALE = 0.05
+
+#: Largest error (years) allowed between a refined synthetic ring trace vertex and its integer
+#: iso-line. Newton refinement on the true field reaches ~1e-9 years in three steps; vertices that
+#: do not (on a field kink or where the gradient vanishes, e.g. at the pith) are dropped.
+#: The acceptance test uses 1e-3 years (about 3 um at 3 mm rings), so 1e-4 leaves margin.
+TRACE_ISO_TOL_YEARS = 1e-4
+
+#: Finite-difference step (pixels) for the in-face gradient used to refine ring traces: small
+#: enough to resolve 1.5 mm rings at 5 px/mm, large enough that float64 round-off of years of
+#: order 100 stays ~1e-12 relative.
+TRACE_FD_STEP_PX = 1e-3
+
+#: Ring maps stored as 16-bit PNG come back within half a quantisation step, 0.5 / 65535.
+RING_MAP_QUANT_16BIT = 0.5 / 65535
+
+#: Ring maps stored as 8-bit PNG (and Mokume's own maps) carry 0.5 / 255 of quantisation.
+RING_MAP_QUANT_8BIT = 0.5 / 255
