@@ -28,7 +28,7 @@ import numpy as np
 
 from .block import Block, Face, RingTrace
 from .block.io import field_from_state, field_to_state, write_block
-from .errors import WoodcamError, require
+from .errors import WoodcamError
 from .fields.base import LogFrame, arf, check_points, evaluate, grain_direction
 from .frames import FACE_NORMAL, FACES, CrossLayout, check_face, check_size, face_image_size_mm, pixel_to_block
 from .tolerances import TRACE_FD_STEP_PX, TRACE_ISO_TOL_YEARS
@@ -421,8 +421,7 @@ def _trace_face(field, face, shape, size, g: np.ndarray) -> list[RingTrace]:
     e.g. where a knot meets the stem, or a vanishing gradient) or leave the face are dropped and
     the polyline is split there.
     """
-    # marching squares from contourpy (installed with matplotlib): maintained, C++, no skimage
-    contourpy = require("contourpy", "view", "tracing the rings of a synthetic block")
+    import contourpy  # marching squares: maintained, C++, a core dependency
 
     # Ring boundaries are the iso-lines years = 1, 2, ...; years = 0 is the pith itself.
     lo, hi = max(1, math.ceil(np.nanmin(g))), math.floor(np.nanmax(g))
