@@ -224,9 +224,9 @@ def _manifold_from_scene(scene, origin: str):
     meshes = [g for g in scene.dump() if isinstance(g, trimesh.Trimesh) and len(g.faces)]
     if not meshes:
         raise WoodcamError(
-            f"{origin} contains no triangles (geometry found: "
+            f"{origin} contains no triangles: it is empty or not a valid mesh (geometry found: "
             f"{[type(g).__name__ for g in scene.geometry.values()]}); it must hold a closed "
-            f"triangle mesh of the part"
+            f"triangle mesh of the part: re-export it as a binary STL, OBJ or GLB"
         )
     return _union([_manifold_from_trimesh(m, origin) for m in meshes], origin)
 
@@ -246,6 +246,13 @@ def _manifold_from_trimesh(mesh, origin: str):
     # Fresh mesh without visuals: processing welds vertices by position only (UV/normal seams
     # in OBJ/GLB would otherwise split the surface) and drops degenerate faces.
     welded = trimesh.Trimesh(vertices=vertices, faces=faces, process=True)
+    # Welding collapses the fans at B-rep poles (a sphere's degenerate edges) into triangles
+    # with a repeated vertex; drop them so the edges they shared close up.
+    f = welded.faces
+    keep = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
+    if not keep.all():
+        welded.update_faces(keep)
+        welded.remove_unreferenced_vertices()
     if not welded.is_watertight or not welded.is_winding_consistent:
         trimesh.repair.fill_holes(welded)
         trimesh.repair.fix_winding(welded)
