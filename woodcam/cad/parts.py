@@ -174,7 +174,14 @@ def _load_script(path: Path, tol_mm: float, ang_rad: float):
             f"e.g. `part = Box(10, 10, 10)` (a build123d/cadquery solid, trimesh mesh or "
             f"manifold) at the end of the script"
         )
-    return _load(namespace["part"], tol_mm, ang_rad, origin=f"`part` of script {str(path)!r}")
+    part = namespace["part"]
+    origin = f"`part` of script {str(path)!r}"
+    if isinstance(part, (str, Path)):
+        raise WoodcamError(
+            f"{origin} is a path ({str(part)!r}), but a script must define the part itself; "
+            f"load the file in the script (e.g. build123d import_step) or pass the path directly"
+        )
+    return _load(part, tol_mm, ang_rad, origin=origin)
 
 
 def _load_step(path: Path, tol_mm: float, ang_rad: float):
