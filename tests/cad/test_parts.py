@@ -142,9 +142,28 @@ def test_unsupported_object_raises():
         load_part(42)
 
 
-def test_build123d_face_without_solid_raises(bd):
-    with pytest.raises(WoodcamError, match="contains no solid"):
-        load_part(bd.Face(bd.Rectangle(10, 10).wire()) if hasattr(bd, "Face") else None)
+def test_build123d_sketch_without_solid_raises(bd):
+    with pytest.raises(WoodcamError, match="contains no solid .only faces"):
+        load_part(bd.Rectangle(10, 10))
+
+
+def test_non_shape_cad_objects_raise(bd, cq):
+    with pytest.raises(WoodcamError, match="cannot use an object of type build123d.*Vector"):
+        load_part(bd.Vector(1, 2, 3))
+    with pytest.raises(WoodcamError, match="holds no shape"):
+        load_part(cq.Workplane("XY").center(1, 2))
+    with pytest.raises(WoodcamError, match="is None; the script or builder produced no shape"):
+        load_part(None)
+
+
+def test_list_of_sources_is_unioned(bd):
+    a = bd.Box(10, 10, 10, align=bd.Align.MIN)
+    b = trimesh.creation.box(extents=(10, 10, 10))
+    b.apply_translation((10, 5, 5))  # overlaps a by 5 x 10 x 10
+    assert load_part([a, b]).volume() == pytest.approx(1500, rel=1e-9)
+    assert load_part(bd.ShapeList([a])).volume() == pytest.approx(1000, rel=1e-12)
+    with pytest.raises(WoodcamError, match="empty list"):
+        load_part([])
 
 
 @pytest.mark.parametrize(("kwargs", "pattern"), [

@@ -128,8 +128,11 @@ def carve(
         warnings.warn(message, WoodcamWarning, stacklevel=2)
 
     mesh_out = carved.to_mesh64()
-    vertices = np.asarray(mesh_out.vert_properties, dtype=np.float64)[:, :3]
-    faces = np.asarray(mesh_out.tri_verts, dtype=np.int64)
+    # copies, so the arrays do not keep manifold3d's Mesh64 buffers alive (nanobind reports
+    # such buffers as leaks at interpreter exit)
+    vertices = np.array(mesh_out.vert_properties[:, :3], dtype=np.float64, copy=True)
+    faces = np.array(mesh_out.tri_verts, dtype=np.int64, copy=True)
+    del mesh_out
     mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
     return CarveResult(
         mesh=mesh,

@@ -97,6 +97,11 @@ def _load(source: Any, tol_mm: float, ang_rad: float, origin: str):
     import manifold3d
     import trimesh
 
+    if source is None:
+        raise WoodcamError(
+            f"{origin} is None; the script or builder produced no shape: make sure it builds "
+            f"a solid and assigns it"
+        )
     if isinstance(source, manifold3d.Manifold):
         return _check_manifold(source, origin)
     if isinstance(source, trimesh.Trimesh):
@@ -106,15 +111,24 @@ def _load(source: Any, tol_mm: float, ang_rad: float, origin: str):
     if isinstance(source, (str, Path)):
         return _load_path(Path(source), tol_mm, ang_rad)
 
+    if isinstance(source, (list, tuple)):  # incl. build123d ShapeList: union of the items
+        if not source:
+            raise WoodcamError(f"{origin} is an empty {type(source).__name__}; pass a solid")
+        return _union([_load(item, tol_mm, ang_rad, f"{origin}[{i}]")
+                       for i, item in enumerate(source)], origin)
+
+    # the CAD kernels are only imported when the object already comes from one of them
     module = type(source).__module__ or ""
     if module.startswith("build123d"):
-        if hasattr(source, "wrapped"):  # Shape: Part, Solid, Compound, ...
+        bd = require("build123d", "cad", "loading build123d parts")
+        if isinstance(source, bd.Shape):  # Part, Solid, Compound, ...
             return _manifold_from_topods(source.wrapped, tol_mm, ang_rad, origin)
-        if hasattr(source, "part"):  # BuildPart builder
-            return _load(source.part, tol_mm, ang_rad, origin)
+        if isinstance(source, bd.BuildPart):
+            return _load(source.part, tol_mm, ang_rad, f"{origin} (BuildPart.part)")
     if module.startswith("cadquery"):
-        if hasattr(source, "vals"):  # Workplane: every Shape on the stack
-            shapes = [v.wrapped for v in source.vals() if hasattr(v, "wrapped")]
+        cq = require("cadquery", "cad", "loading cadquery parts")
+        if isinstance(source, cq.Workplane):  # every Shape on the stack
+            shapes = [v.wrapped for v in source.vals() if isinstance(v, cq.Shape)]
             if not shapes:
                 raise WoodcamError(
                     f"{origin}: the cadquery Workplane holds no shape (its stack is "
@@ -122,9 +136,9 @@ def _load(source: Any, tol_mm: float, ang_rad: float, origin: str):
                 )
             return _union([_manifold_from_topods(s, tol_mm, ang_rad, origin) for s in shapes],
                           origin)
-        if hasattr(source, "wrapped"):  # cadquery Shape
+        if isinstance(source, cq.Shape):
             return _manifold_from_topods(source.wrapped, tol_mm, ang_rad, origin)
-    if type(source).__module__.startswith("OCP") and hasattr(source, "ShapeType"):
+    if module.startswith("OCP") and hasattr(source, "ShapeType"):  # raw TopoDS_Shape
         return _manifold_from_topods(source, tol_mm, ang_rad, origin)
 
     raise WoodcamError(
