@@ -16,13 +16,10 @@ import math
 import sys
 
 from build123d import (
-    Align,
-    Box,
     Plane,
     Pos,
     Rectangle,
     RectangleRounded,
-    Sketch,
     export_stl,
     extrude,
     fillet,
@@ -47,8 +44,9 @@ BEVEL_ANGLE_DEG = 30.0          # bevel slope against the plate's top face
 def make_lid():
     """Return the lid as a build123d ``Part`` in the block frame (mm), lid centre at origin XY."""
     px, py = PLATE_SIZE
+    lip_corner_radius = PLATE_CORNER_RADIUS - LIP_INSET + 2.0  # a box's inside corner radius
     lip = extrude(
-        RectangleRounded(px - 2 * LIP_INSET, py - 2 * LIP_INSET, PLATE_CORNER_RADIUS - LIP_INSET + 2),
+        RectangleRounded(px - 2 * LIP_INSET, py - 2 * LIP_INSET, lip_corner_radius),
         amount=LIP_HEIGHT,
     )
     plate = Pos(0, 0, LIP_HEIGHT) * extrude(

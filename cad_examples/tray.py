@@ -64,4 +64,5 @@ if __name__ == "__main__":
     cq.exporters.export(part, out, tolerance=0.05, angularTolerance=0.1)
     bb = part.val().BoundingBox()
     print(f"wrote {out}: volume {part.val().Volume():.1f} mm^3, bounds "
-          f"({bb.xmin:.2f}, {bb.ymin:.2f}, {bb.zmin:.2f}) .. ({bb.xmax:.2f}, {bb.ymax:.2f}, {bb.zmax:.2f})")
+          f"({bb.xmin:.2f}, {bb.ymin:.2f}, {bb.zmin:.2f}) .. "
+          f"({bb.xmax:.2f}, {bb.ymax:.2f}, {bb.zmax:.2f})")

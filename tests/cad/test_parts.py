@@ -250,22 +250,36 @@ def test_python_script_defining_part(tmp_path, bd):
     np.testing.assert_allclose(solid.bounding_box(), (1, 2, 3, 11, 22, 33), atol=1e-9)
 
 
+def test_python_script_imports_helpers_next_to_it(tmp_path):
+    (tmp_path / "my_dimensions.py").write_text("SIDE = 7.0\n")
+    script = tmp_path / "uses_helper.py"
+    script.write_text("import manifold3d\nfrom my_dimensions import SIDE\n"
+                      "part = manifold3d.Manifold.cube((SIDE, SIDE, SIDE))\n")
+    assert load_part(script).volume() == pytest.approx(343, rel=1e-12)
+
+
 def test_python_script_with_trimesh_part(tmp_path):
     script = tmp_path / "mesh_part.py"
     script.write_text("import trimesh\npart = trimesh.creation.box(extents=(2, 3, 4))\n")
     assert load_part(script).volume() == pytest.approx(24, rel=1e-12)
 
 
+_UNREADABLE = r"(not a valid mesh|could not be read)"
+
+
 @pytest.mark.parametrize(("name", "content", "pattern"), [
-    ("garbage.stl", "this is not a mesh\n", r"mesh file '.*garbage\.stl'.*(not a valid mesh|could not be read)"),
-    ("empty.stl", "", r"mesh file '.*empty\.stl'.*(not a valid mesh|could not be read)"),
-    ("garbage.obj", "hello\nworld\n", r"mesh file '.*garbage\.obj'.*(not a valid mesh|could not be read)"),
+    ("garbage.stl", "this is not a mesh\n", r"mesh file '.*garbage\.stl'.*" + _UNREADABLE),
+    ("empty.stl", "", r"mesh file '.*empty\.stl'.*" + _UNREADABLE),
+    ("garbage.obj", "hello\nworld\n", r"mesh file '.*garbage\.obj'.*" + _UNREADABLE),
     ("garbage.glb", "not a glb", r"mesh file '.*garbage\.glb'.*could not be read"),
     ("garbage.step", "ISO-10303-21; nonsense", r"'.*garbage\.step' is not a readable STEP file"),
-    ("no_part.py", "x = 1\n", r"script '.*no_part\.py' does not define a module-level variable `part`"),
-    ("broken.py", "raise RuntimeError('boom')\n", r"script '.*broken\.py' failed with RuntimeError: boom"),
+    ("no_part.py", "x = 1\n",
+     r"script '.*no_part\.py' does not define a module-level variable `part`"),
+    ("broken.py", "raise RuntimeError('boom')\n",
+     r"script '.*broken\.py' failed with RuntimeError: boom"),
     ("exits.py", "import sys\nsys.exit(3)\n", r"script '.*exits\.py' called sys\.exit\(3\)"),
-    ("wrong_type.py", "part = 3.5\n", r"`part` of script '.*wrong_type\.py'.*cannot use an object of type builtins\.float"),
+    ("wrong_type.py", "part = 3.5\n",
+     r"`part` of script '.*wrong_type\.py'.*cannot use an object of type builtins\.float"),
     ("path_part.py", "part = 'other.stl'\n", r"`part` of script '.*path_part\.py' is a path"),
     ("part.txt", "10 10 10", r"unsupported suffix '\.txt'; use one of \.step"),
 ])

@@ -11,6 +11,7 @@ Accepted sources (:func:`load_part`):
 - a cadquery ``Workplane`` (all solids on its stack) or ``Shape``;
 - a ``trimesh.Trimesh`` or ``trimesh.Scene``;
 - a ``manifold3d.Manifold``;
+- a list or tuple of any of these (incl. a build123d ``ShapeList``): their union;
 - a path (``str`` / ``Path``) to ``.step``/``.stp`` (B-rep, read with OpenCascade),
   ``.stl``/``.obj``/``.glb``/``.gltf`` (meshes, read with trimesh, coordinates taken as mm in the
   block frame as stored: no unit or Y-up conversion), or a ``.py`` script that defines a
@@ -27,6 +28,7 @@ from __future__ import annotations
 
 import math
 import runpy
+import sys
 from numbers import Real
 from pathlib import Path
 from typing import Any
@@ -54,9 +56,12 @@ def load_part(
     Parameters
     ----------
     source : build123d Shape | BuildPart | cadquery Workplane | cadquery Shape | trimesh.Trimesh
-        | trimesh.Scene | manifold3d.Manifold | str | Path
+        | trimesh.Scene | manifold3d.Manifold | list of these | str | Path
         The part, modelled in the block frame in millimetres, or a path to a ``.step``/``.stp``,
-        ``.stl``, ``.obj``, ``.glb``/``.gltf`` file or a ``.py`` script defining ``part``.
+        ``.stl``, ``.obj``, ``.glb``/``.gltf`` file or a ``.py`` script defining ``part``
+        (run with ``runpy`` under the name ``"__woodcam_part__"``, so its
+        ``if __name__ == "__main__":`` block does not run; its folder is on ``sys.path``
+        meanwhile so it can import helpers next to it).
     tolerance_mm : float
         Chord tolerance (mm, > 0) for tessellating B-rep sources: the largest distance between
         the true surface and its triangles. Ignored for mesh sources.
@@ -155,7 +160,8 @@ def _load_path(path: Path, tol_mm: float, ang_rad: float):
     if suffix not in SUPPORTED_SUFFIXES:
         raise WoodcamError(
             f"part file {str(path)!r} has unsupported suffix {path.suffix!r}; use one of "
-            f"{', '.join(SUPPORTED_SUFFIXES)} (export the part from your CAD program as STEP or STL)"
+            f"{', '.join(SUPPORTED_SUFFIXES)} (export the part from your CAD program as STEP or "
+            f"STL)"
         )
     if not path.is_file():
         raise WoodcamError(
@@ -170,6 +176,8 @@ def _load_path(path: Path, tol_mm: float, ang_rad: float):
 
 def _load_script(path: Path, tol_mm: float, ang_rad: float):
     """Run a part script (``runpy``, not as ``__main__``) and load its module-level ``part``."""
+    folder = str(path.resolve().parent)
+    sys.path.insert(0, folder)  # like `python script.py`: helpers next to the script import
     try:
         namespace = runpy.run_path(str(path), run_name="__woodcam_part__")
     except SystemExit as err:
@@ -182,6 +190,9 @@ def _load_script(path: Path, tol_mm: float, ang_rad: float):
             f"part script {str(path)!r} failed with {type(err).__name__}: {err}; run it with "
             f"`python {path}` to see the traceback and fix the script"
         ) from err
+    finally:
+        if folder in sys.path:
+            sys.path.remove(folder)
     if "part" not in namespace:
         raise WoodcamError(
             f"part script {str(path)!r} does not define a module-level variable `part`; add "
