@@ -34,3 +34,7 @@ MAX_BATCH_POINTS = 1 << 18
 #: Smallest allowed radius-scaling value in the radial family (eq. 9 of seed 000) after the
 #: linear blend; guards division by zero when a blend is extrapolated.
 MIN_RADIUS_SCALE = 0.05
+
+#: Colours a wood returns may overshoot [0, 1] by this much (round-off of blends and colour
+#: transforms) and are clipped; a larger excursion is an error (e.g. 0..255 colours passed).
+COLOR_RANGE_TOL = 1e-3
