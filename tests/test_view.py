@@ -18,7 +18,7 @@ from woodcam.errors import WoodcamError  # noqa: E402
 from woodcam.tolerances import ON_FACE_TOL_MM  # noqa: E402
 from woodcam import view  # noqa: E402
 from woodcam.view import (  # noqa: E402
-    PART_ACTOR, SECTION_ACTOR, CutPlaneCallback, block_outline, cut_plane_image,
+    PART_ACTOR, SECTION_ACTOR, CutPlaneCallback, block_outline, build_scene, cut_plane_image,
     mesh_to_pyvista, preview,
 )
 
@@ -269,6 +269,48 @@ def test_cut_plane_callback_clip_hides_the_part_behind_the_plane():
     centre_col = SMALL[0] / 2   # the camera frames the block centred: x = 50 mm is mid-picture
     assert cols.size > 2000
     assert cols.min() > centre_col - 3
+
+
+def test_interactive_scene_widget_drives_the_cut():
+    """The interactive scene, built on an off-screen plotter: moving the widget moves the cut."""
+    plotter = pv.Plotter(off_screen=True, window_size=SMALL)
+    try:
+        callback = build_scene(plotter, _textured_box(), wood=PositionWood(), size_mm=SIZE,
+                               widget=True, max_samples=20_000)
+        # pyvista 0.47+ keeps widgets under plotter.widgets; older ones on the plotter.
+        widgets = getattr(plotter, "widgets", plotter).plane_widgets
+        assert len(widgets) == 1
+        widget = widgets[0]
+        # Placed at the block centre, normal to the longest axis (X), section drawn at once.
+        np.testing.assert_allclose(widget.GetOrigin(), (50.0, 40.0, 20.0))
+        np.testing.assert_allclose(np.asarray(callback.section.points)[:, 0], 50.0, atol=1e-9)
+        # Drag: the widget fires InteractionEvent; the section and the part's clip follow.
+        widget.SetOrigin(80.0, 40.0, 20.0)
+        widget.SetNormal(0.0, 0.0, 1.0)
+        widget.InvokeEvent("InteractionEvent")
+        shown = plotter.actors[SECTION_ACTOR].mapper.dataset
+        np.testing.assert_allclose(np.asarray(shown.points)[:, 2], 20.0, atol=1e-9)
+        assert shown.n_points <= 20_000
+        np.testing.assert_allclose(np.asarray(shown.point_data["RGB"]) / 255.0,
+                                   np.asarray(shown.points) / np.asarray(SIZE), atol=RGB_ATOL)
+        np.testing.assert_allclose(callback.clip_plane.GetNormal(), (0.0, 0.0, 1.0))
+        img = plotter.screenshot(return_img=True)
+        assert np.any(img != 255, axis=-1).mean() > 0.2
+    finally:
+        plotter.close()
+
+
+def test_interactive_scene_without_wood_clips_only():
+    plotter = pv.Plotter(off_screen=True, window_size=SMALL)
+    try:
+        callback = build_scene(plotter, _textured_box(), size_mm=SIZE, widget=True)
+        assert callback is not None and callback.section is None
+        assert SECTION_ACTOR not in plotter.actors and PART_ACTOR in plotter.actors
+        # Without a widget and without a wood there is nothing to cut: no callback.
+        plotter.clear()
+        assert build_scene(plotter, _textured_box(), size_mm=SIZE) is None
+    finally:
+        plotter.close()
 
 
 def test_default_cut_normal_faces_the_camera_along_the_longest_axis():

@@ -137,6 +137,14 @@ def _check_wood(wood):
     return wood
 
 
+def _check_size_with_wood(wood, size) -> None:
+    if wood is not None and size is None:
+        raise WoodcamError(
+            "size_mm is needed with wood: the cut plane shows the wood inside the block "
+            "[0, W] x [0, D] x [0, H]; pass size_mm=(W, D, H)"
+        )
+
+
 def _load_mesh(mesh_or_path):
     """A ``trimesh.Trimesh`` from a mesh, a scene or a path (scenes are concatenated)."""
     import trimesh
@@ -423,8 +431,10 @@ def cut_plane_image(
 
 def _add_part(plotter, part, texture, *, name: str = PART_ACTOR):
     """Add (or replace, by ``name``) the part with its texture or colours."""
-    style = dict(smooth_shading=True, split_sharp_edges=True, specular=0.15, specular_power=20.0,
-                 name=name, show_scalar_bar=False)
+    # Some ambient light keeps faces turned from the lights close to the wood's own colour
+    # (the unlit cut plane shows that colour); diffuse and a little specular give the shape.
+    style = dict(smooth_shading=True, split_sharp_edges=True, ambient=0.25, diffuse=0.8,
+                 specular=0.15, specular_power=20.0, name=name, show_scalar_bar=False)
     if texture is not None and part.active_texture_coordinates is not None:
         return plotter.add_mesh(part, texture=texture, **style)
     if "RGB" in part.point_data or "RGB" in part.cell_data:
@@ -477,11 +487,7 @@ class CutPlaneCallback:
         self.plotter = plotter
         self.wood = _check_wood(wood)
         self.size_mm = None if size_mm is None else _check_size(size_mm)
-        if wood is not None and self.size_mm is None:
-            raise WoodcamError(
-                "size_mm is needed with a wood: the cut plane shows the wood inside the block "
-                "[0, W] x [0, D] x [0, H]; pass size_mm=(W, D, H)"
-            )
+        _check_size_with_wood(wood, self.size_mm)
         self.resolution_mm = resolution_mm
         self.max_samples = max_samples
         self.section = None
@@ -575,6 +581,74 @@ def _prefer_egl_off_screen() -> None:
         os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"
 
 
+def build_scene(
+    plotter,
+    mesh_or_path,
+    *,
+    wood=None,
+    size_mm=None,
+    cut_plane: bool = True,
+    widget: bool = False,
+    camera: Camera = "iso",
+    background="white",
+    cut_origin=None,
+    cut_normal=None,
+    resolution_mm: float = SECTION_RESOLUTION_MM,
+    max_samples: int | None = SECTION_MAX_SAMPLES_SCREENSHOT,
+) -> CutPlaneCallback | None:
+    """Fill a pyvista plotter with the part, the block and the cut plane; frame the camera.
+
+    :func:`preview` calls this for both modes; it is public so that a notebook or a test can
+    build the scene on its own plotter (off-screen plotters accept the plane widget too).
+
+    Parameters
+    ----------
+    plotter : pyvista.Plotter
+    widget : bool
+        With ``cut_plane``: add the interactive plane widget (bounded by the block), whose
+        callback redraws the cut as it is dragged. Without ``widget`` the cut is drawn once at
+        ``cut_origin`` / ``cut_normal``, and only when a wood is given.
+    max_samples : int or None
+        Cap on wood samples per section (see :func:`cut_plane_image`).
+    Other parameters as in :func:`preview`.
+
+    Returns
+    -------
+    CutPlaneCallback or None
+        The cut-plane callback when a cut is shown, else None.
+    """
+    _check_wood(wood)
+    camera = _check_camera(camera)
+    size = None if size_mm is None else _check_size(size_mm)
+    _check_size_with_wood(wood, size)
+    part, texture = mesh_to_pyvista(mesh_or_path)
+    bounds = (0.0, size[0], 0.0, size[1], 0.0, size[2]) if size is not None else part.bounds
+    b = np.asarray(bounds, dtype=float).reshape(3, 2)
+    origin = (b.mean(axis=1) if cut_origin is None
+              else _check_vector(cut_origin, "cut_origin", unit=False))
+    normal = (_default_cut_normal(camera, b[:, 1] - b[:, 0]) if cut_normal is None
+              else _check_vector(cut_normal, "cut_normal", unit=True))
+
+    plotter.set_background(background)
+    if size is not None:
+        _add_block(plotter, size)
+    callback = None
+    if cut_plane and (widget or wood is not None):
+        callback = CutPlaneCallback(plotter, part, texture, wood, size,
+                                    resolution_mm=resolution_mm, max_samples=max_samples)
+        if widget:
+            # The widget calls back once now, then at every move ("always": as it is dragged).
+            plotter.add_plane_widget(callback, normal=normal, origin=origin, bounds=bounds,
+                                     factor=1.0, interaction_event="always",
+                                     outline_opacity=0.0)
+        else:
+            callback(normal, origin)
+    else:
+        _add_part(plotter, part, texture)
+    _set_camera(plotter, camera, bounds)
+    return callback
+
+
 def preview(
     mesh_or_path,
     *,
@@ -606,7 +680,8 @@ def preview(
     window_size : (width, height) pixels
     cut_plane : bool
         Interactive: add a plane widget that clips the part and shows the wood on the plane as
-        it is dragged. Screenshot with a wood: show one cut plane (see ``cut_origin``).
+        it is dragged (without a wood it only clips the part). Screenshot with a wood: show one
+        cut plane at ``cut_origin`` / ``cut_normal``.
     camera : "iso" | "top" | "front" | "back" | "left" | "right" | "bottom"
         View direction; "iso" looks from front-right-above.
     background : colour
@@ -625,14 +700,6 @@ def preview(
         The PNG written, or None after the interactive window closes.
     """
     pv = _pyvista()
-    _check_wood(wood)
-    camera = _check_camera(camera)
-    size = None if size_mm is None else _check_size(size_mm)
-    if wood is not None and size is None:
-        raise WoodcamError(
-            "size_mm is needed with wood: the cut plane shows the wood inside the block "
-            "[0, W] x [0, D] x [0, H]; pass size_mm=(W, D, H)"
-        )
     ws = np.asarray(window_size)
     if ws.shape != (2,) or not np.all(np.isfinite(ws)) or np.any(ws < 16) or np.any(ws % 1):
         raise WoodcamError(
@@ -640,26 +707,21 @@ def preview(
             f"{window_size!r}; e.g. (1280, 960)"
         )
     window_size = (int(ws[0]), int(ws[1]))
+    if screenshot is not None and Path(screenshot).suffix.lower() != ".png":
+        raise WoodcamError(
+            f"screenshot must be a .png path; got {str(screenshot)!r}; e.g. out/part.png"
+        )
     if screenshot is None and not _display_available():
         raise WoodcamError(
             "preview: an interactive window needs a display, but neither DISPLAY nor "
             "WAYLAND_DISPLAY is set; render off-screen instead with screenshot='part.png' "
             "(CLI: woodcam preview PART --screenshot part.png)"
         )
-    if screenshot is not None and Path(screenshot).suffix.lower() != ".png":
-        raise WoodcamError(
-            f"screenshot must be a .png path; got {str(screenshot)!r}; e.g. out/part.png"
-        )
-    part, texture = mesh_to_pyvista(mesh_or_path)
-    if size is not None:
-        bounds = (0.0, size[0], 0.0, size[1], 0.0, size[2])
-    else:
-        bounds = part.bounds
-    b = np.asarray(bounds, dtype=float).reshape(3, 2)
-    origin = b.mean(axis=1) if cut_origin is None else _check_vector(cut_origin, "cut_origin",
-                                                                      unit=False)
-    normal = (_default_cut_normal(camera, b[:, 1] - b[:, 0]) if cut_normal is None
-              else _check_vector(cut_normal, "cut_normal", unit=True))
+    # Check the mesh and options before a window opens.
+    _check_wood(wood)
+    _check_camera(camera)
+    _check_size_with_wood(wood, None if size_mm is None else _check_size(size_mm))
+    mesh = _load_mesh(mesh_or_path)
 
     off_screen = screenshot is not None
     if off_screen:
@@ -667,31 +729,19 @@ def preview(
     plotter = pv.Plotter(off_screen=off_screen, window_size=window_size,
                          title="woodcam preview")
     try:
-        plotter.set_background(background)
-        if size is not None:
-            _add_block(plotter, size)
+        build_scene(
+            plotter, mesh, wood=wood, size_mm=size_mm, cut_plane=cut_plane,
+            widget=not off_screen, camera=camera, background=background,
+            cut_origin=cut_origin, cut_normal=cut_normal, resolution_mm=resolution_mm,
+            max_samples=(SECTION_MAX_SAMPLES_SCREENSHOT if off_screen
+                         else SECTION_MAX_SAMPLES_INTERACTIVE),
+        )
+        plotter.enable_anti_aliasing("ssaa")
         if off_screen:
-            if cut_plane and wood is not None:
-                CutPlaneCallback(plotter, part, texture, wood, size, resolution_mm=resolution_mm,
-                                 max_samples=SECTION_MAX_SAMPLES_SCREENSHOT)(normal, origin)
-            else:
-                _add_part(plotter, part, texture)
-            _set_camera(plotter, camera, bounds)
-            plotter.enable_anti_aliasing("ssaa")
             path = Path(screenshot)
             path.parent.mkdir(parents=True, exist_ok=True)
             plotter.screenshot(str(path))
             return path
-        if cut_plane:
-            callback = CutPlaneCallback(plotter, part, texture, wood, size,
-                                        resolution_mm=resolution_mm,
-                                        max_samples=SECTION_MAX_SAMPLES_INTERACTIVE)
-            plotter.add_plane_widget(callback, normal=normal, origin=origin, bounds=bounds,
-                                     interaction_event="always", outline_translucency=True)
-        else:
-            _add_part(plotter, part, texture)
-        _set_camera(plotter, camera, bounds)
-        plotter.enable_anti_aliasing("ssaa")
         plotter.add_axes()
         plotter.show()
         return None
