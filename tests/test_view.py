@@ -169,6 +169,24 @@ def test_screenshot_without_size_frames_the_part(tmp_path):
     assert (_red(img) | _blue(img)).mean() > 0.25
 
 
+def test_part_outside_the_block_stays_in_the_picture(tmp_path):
+    far = _textured_box(center=(140.0, 40.0, 20.0))      # x in 110..170, block x in 0..100
+    img = _read(preview(far, size_mm=SIZE, screenshot=tmp_path / "p.png", window_size=SMALL))
+    assert (_red(img) | _blue(img)).mean() > 0.05
+
+
+def test_scene_of_two_meshes_is_concatenated(tmp_path):
+    scene = trimesh.Scene([_textured_box(extents=(20, 20, 20), center=(20, 40, 20)),
+                           _textured_box(extents=(20, 20, 20), center=(80, 40, 20))])
+    poly, texture = mesh_to_pyvista(scene)
+    assert poly.n_cells == 24 and texture is not None
+    img = _read(preview(scene, size_mm=SIZE, screenshot=tmp_path / "p.png", window_size=SMALL))
+    cols = np.nonzero(_red(img) | _blue(img))[1]
+    # Two parts, left and right of the centre, with a gap between them.
+    assert np.sum(cols < SMALL[0] * 0.4) > 200 and np.sum(cols > SMALL[0] * 0.6) > 200
+    assert np.sum(np.abs(cols - SMALL[0] / 2) < 10) == 0
+
+
 # ---------------------------------------------------------------------------- cut plane
 
 

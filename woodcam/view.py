@@ -645,7 +645,10 @@ def build_scene(
             callback(normal, origin)
     else:
         _add_part(plotter, part, texture)
-    _set_camera(plotter, camera, bounds)
+    # Frame the block and the part together (a part sticking out of its block stays in view).
+    frame = np.stack([np.minimum(b[:, 0], np.asarray(part.bounds).reshape(3, 2)[:, 0]),
+                      np.maximum(b[:, 1], np.asarray(part.bounds).reshape(3, 2)[:, 1])], axis=1)
+    _set_camera(plotter, camera, frame.ravel())
     return callback
 
 
