@@ -239,8 +239,12 @@ def test_cut_plane_resolution_and_sample_cap():
     assert section.n_points == (80 / 0.5 + 1) * (40 / 0.5 + 1)
     capped = cut_plane_image(PositionWood(), SIZE, (30, 0, 0), (1, 0, 0), resolution_mm=0.1,
                              max_samples=5000)
-    assert 2500 < capped.n_points <= 5000
+    assert 4000 < capped.n_points <= 5000
     assert capped.field_data["resolution_mm"][0] > 0.1
+    # A long thin section (100 x 1 mm) still respects the cap.
+    thin = cut_plane_image(PositionWood((100.0, 1.0, 40.0)), (100.0, 1.0, 40.0), (0, 0, 20),
+                           (0, 0, 1), resolution_mm=0.01, max_samples=1000)
+    assert 0 < thin.n_points <= 1000
 
 
 def test_cut_plane_that_misses_the_block_is_empty():
@@ -430,5 +434,7 @@ def test_cut_plane_rejects_bad_arguments():
         cut_plane_image(PositionWood(), SIZE, (50, 40, 20), (1, 0, 0), resolution_mm=0)
     with pytest.raises(WoodcamError, match="normal must be a non-zero"):
         cut_plane_image(PositionWood(), SIZE, (50, 40, 20), (0, 0, 0))
+    with pytest.raises(WoodcamError, match="max_samples must be an integer"):
+        cut_plane_image(PositionWood(), SIZE, (50, 40, 20), (1, 0, 0), max_samples=2)
     with pytest.raises(WoodcamError, match="origin must be three finite"):
         cut_plane_image(PositionWood(), SIZE, (50, np.nan, 20), (1, 0, 0))

@@ -381,8 +381,10 @@ def cut_plane_image(
             f"resolution_mm must be a positive number of mm; got {resolution_mm!r}; e.g. 0.25"
         )
     if max_samples is not None and (not isinstance(max_samples, (int, np.integer))
-                                    or max_samples < 4):
-        raise WoodcamError(f"max_samples must be an integer >= 4 or None; got {max_samples!r}")
+                                    or max_samples < 16):
+        raise WoodcamError(
+            f"max_samples must be an integer >= 16 or None; got {max_samples!r}; e.g. 60000"
+        )
 
     u, v = _plane_basis(normal)
     poly_uv = _box_section_uv(size, origin, normal, u, v)
@@ -394,8 +396,12 @@ def cut_plane_image(
         return pv.PolyData()
     step = float(resolution_mm)
     if max_samples is not None:
-        # (extent / step + 1) per axis must multiply to at most max_samples.
-        step = max(step, float(np.sqrt(extent[0] * extent[1] / max_samples)) * 1.05)
+        # Each axis gets ceil(extent / step) + 1 <= extent / step + 2 points; the largest
+        # t = 1 / step with (a t + 2)(b t + 2) <= max_samples solves a quadratic in t.
+        a, b = extent
+        t = (-2.0 * (a + b) + np.sqrt(4.0 * (a + b) ** 2 - 4.0 * a * b * (4.0 - max_samples))) \
+            / (2.0 * a * b)
+        step = max(step, 1.0 / t)
     n_u, n_v = (np.ceil(extent / step).astype(int) + 1).clip(min=2)
     section = _grid_polydata(pv, origin, u, v, (lo[0], hi[0]), (lo[1], hi[1]), n_u, n_v)
 
