@@ -18,8 +18,8 @@ from woodcam.errors import WoodcamError  # noqa: E402
 from woodcam.tolerances import ON_FACE_TOL_MM  # noqa: E402
 from woodcam import view  # noqa: E402
 from woodcam.view import (  # noqa: E402
-    PART_ACTOR, SECTION_ACTOR, CutPlaneCallback, block_outline, build_scene, cut_plane_image,
-    mesh_to_pyvista, preview,
+    OUTLINE_ACTOR, PART_ACTOR, SECTION_ACTOR, WASTE_ACTOR, CutPlaneCallback, block_outline,
+    build_scene, cut_plane_image, mesh_to_pyvista, preview,
 )
 
 SIZE = (100.0, 80.0, 40.0)
@@ -89,6 +89,12 @@ def _green(img):
     return (img[..., 1] > img[..., 0] + 80) & (img[..., 1] > img[..., 2] + 80)
 
 
+def _light_green(img):
+    """Translucent green over a light background."""
+    return ((img[..., 1] > img[..., 0] + 30) & (img[..., 1] > img[..., 2] + 30)
+            & (img[..., 0] > 100))
+
+
 # ---------------------------------------------------------------------------- screenshots
 
 
@@ -152,15 +158,26 @@ def test_preview_reads_a_textured_file(tmp_path, suffix):
 
 
 def test_screenshot_with_wood_shows_the_section_and_cut_plane_false_hides_it(tmp_path):
+    """Default cut: x = W/2, normal +X toward the camera; the part's near half is cut away.
+
+    The part's cross-section (40 x 20 mm) is opaque wood (pure green), the waste around it
+    translucent (light green over the background), the part's far half still textured.
+    """
     box = _textured_box()
     with_cut = _read(preview(box, wood=GreenWood(), size_mm=SIZE,
                              screenshot=tmp_path / "a.png", window_size=SMALL))
     no_cut = _read(preview(box, wood=GreenWood(), size_mm=SIZE, cut_plane=False,
                            screenshot=tmp_path / "b.png", window_size=SMALL))
-    assert _green(with_cut).mean() > 0.05
-    assert _green(no_cut).mean() == 0.0
+    pure = (with_cut[..., 1] > 200) & (with_cut[..., 0] < 60) & (with_cut[..., 2] < 60)
+    assert pure.mean() > 0.015, pure.mean()
+    assert _light_green(with_cut).mean() > 0.03, _light_green(with_cut).mean()
+    # The opaque cap is the part's section: its pixels lie where the uncut part was.
+    part_no_cut = _red(no_cut) | _blue(no_cut)
+    saturated = (no_cut.max(axis=-1) - no_cut.min(axis=-1)) > 40   # any part face, shaded
+    assert saturated[pure].mean() > 0.97
+    assert _green(no_cut).mean() == 0.0 and _light_green(no_cut).mean() == 0.0
     # The part is clipped to one side of the plane, so less of the checker shows.
-    assert (_red(with_cut) | _blue(with_cut)).sum() < 0.8 * (_red(no_cut) | _blue(no_cut)).sum()
+    assert (_red(with_cut) | _blue(with_cut)).sum() < 0.8 * part_no_cut.sum()
 
 
 def test_screenshot_without_size_frames_the_part(tmp_path):
@@ -252,6 +269,49 @@ def test_cut_plane_that_misses_the_block_is_empty():
     assert section.n_points == 0
 
 
+def test_cut_plane_splits_part_from_waste():
+    """Box part 60 x 40 x 20 mm centred at (50, 40, 20), cut at x: the cap is 40 x 20 mm.
+
+    The outline is exact along the grid rows (u = Y here) and within one row spacing across
+    them (v = Z), so the cap's area is 800 mm^2 up to 2 edges x 40 mm x one spacing.
+    """
+    part, _ = mesh_to_pyvista(_textured_box())
+    res = 0.5
+    section = cut_plane_image(PositionWood(), SIZE, (50.0, 40.0, 20.0), (1, 0, 0),
+                              resolution_mm=res, part=part)
+    in_part = np.asarray(section.cell_data["in_part"]).astype(bool)
+    cap = section.remove_cells(~in_part).triangulate()
+    waste = section.remove_cells(in_part)
+    p = np.asarray(cap.points)
+    assert p[:, 1].min() == pytest.approx(20.0, abs=1e-6)
+    assert p[:, 1].max() == pytest.approx(60.0, abs=1e-6)
+    assert abs(p[:, 2].min() - 10.0) <= res and abs(p[:, 2].max() - 30.0) <= res
+    cap_area = cap.area
+    assert abs(cap_area - 800.0) <= 2 * 40 * res
+    total = section.triangulate().area
+    assert total == pytest.approx(SIZE[1] * SIZE[2], rel=1e-9)   # nothing lost in the split
+    assert waste.n_cells > 0
+    # Colours stay exact at every point, including the new points on the outline.
+    np.testing.assert_allclose(np.asarray(section.point_data["RGB"]) / 255.0,
+                               np.asarray(section.points) / np.asarray(SIZE), atol=RGB_ATOL)
+
+
+def test_cut_plane_split_of_a_disk_matches_its_polygon():
+    """A 64-sided cylinder (r = 30 mm) cut across its axis: the cap is the 64-gon."""
+    cyl = trimesh.creation.cylinder(radius=30.0, height=30.0, sections=64)
+    cyl.apply_translation((50.0, 40.0, 20.0))
+    res = 0.25
+    section = cut_plane_image(PositionWood(), SIZE, (50.0, 40.0, 20.0), (0, 0, 1),
+                              resolution_mm=res, part=cyl)
+    in_part = np.asarray(section.cell_data["in_part"]).astype(bool)
+    cap = section.remove_cells(~in_part).triangulate()
+    polygon = 0.5 * 64 * 30.0**2 * np.sin(2 * np.pi / 64)
+    perimeter = 64 * 2 * 30.0 * np.sin(np.pi / 64)
+    assert abs(cap.area - polygon) <= perimeter * res / 2
+    r = np.hypot(*(np.asarray(cap.points)[:, :2] - (50.0, 40.0)).T)
+    assert r.max() <= 30.0 + res
+
+
 def test_cut_plane_callback_replaces_the_section_and_clips_the_part():
     plotter = pv.Plotter(off_screen=True, window_size=SMALL)
     try:
@@ -260,23 +320,36 @@ def test_cut_plane_callback_replaces_the_section_and_clips_the_part():
                                     resolution_mm=2.0)
         assert PART_ACTOR in plotter.actors and SECTION_ACTOR not in plotter.actors
         n_actors = len(plotter.actors)
-        for x in (20.0, 70.0):
+        for x in (30.0, 70.0):
             section = callback((1.0, 0.0, 0.0), (x, 40.0, 20.0))
-            shown = plotter.actors[SECTION_ACTOR].mapper.dataset
-            np.testing.assert_allclose(np.asarray(shown.points)[:, 0], x, atol=1e-9)
-            np.testing.assert_allclose(np.asarray(shown.point_data["RGB"]) / 255.0,
-                                       np.asarray(shown.points) / np.asarray(SIZE),
-                                       atol=RGB_ATOL)
-            assert shown.n_points == section.n_points
-            assert len(plotter.actors) == n_actors + 1   # replaced, not stacked
+            assert {SECTION_ACTOR, WASTE_ACTOR, OUTLINE_ACTOR} <= set(plotter.actors)
+            cap, waste, outline = (callback.shown[n]
+                                   for n in (SECTION_ACTOR, WASTE_ACTOR, OUTLINE_ACTOR))
+            assert cap.n_cells + waste.n_cells == section.n_cells
+            for shown in (cap, waste, outline):
+                np.testing.assert_allclose(np.asarray(shown.points)[:, 0], x, atol=1e-9)
+            for shown in (cap, waste):
+                np.testing.assert_allclose(np.asarray(shown.point_data["RGB"]) / 255.0,
+                                           np.asarray(shown.points) / np.asarray(SIZE),
+                                           atol=RGB_ATOL)
+            # The outline is the box's 40 x 20 mm rectangle at this x.
+            o = np.asarray(outline.points)
+            np.testing.assert_allclose([o[:, 1].min(), o[:, 1].max(), o[:, 2].min(),
+                                        o[:, 2].max()], [20, 60, 10, 30], atol=1e-9)
+            assert len(plotter.actors) == n_actors + 3   # replaced, not stacked
+            # The part keeps the side opposite the normal.
             np.testing.assert_allclose(callback.clip_plane.GetOrigin(), (x, 40.0, 20.0))
-            np.testing.assert_allclose(callback.clip_plane.GetNormal(), (1.0, 0.0, 0.0))
+            np.testing.assert_allclose(callback.clip_plane.GetNormal(), (-1.0, 0.0, 0.0))
+        # A plane beside the part: no cap, no outline, all waste.
+        callback((1.0, 0.0, 0.0), (10.0, 40.0, 20.0))
+        assert SECTION_ACTOR not in plotter.actors and OUTLINE_ACTOR not in plotter.actors
+        assert WASTE_ACTOR in plotter.actors
     finally:
         plotter.close()
 
 
-def test_cut_plane_callback_clip_hides_the_part_behind_the_plane():
-    """Seen from the top, the part keeps only the side the normal points to (+X: right)."""
+def test_cut_plane_callback_clip_hides_the_part_on_the_normal_side():
+    """Seen from the top, the part keeps only the side opposite the normal (+X: left half)."""
     plotter = pv.Plotter(off_screen=True, window_size=SMALL)
     try:
         part, texture = mesh_to_pyvista(_textured_box())
@@ -290,7 +363,7 @@ def test_cut_plane_callback_clip_hides_the_part_behind_the_plane():
     cols = np.nonzero(part_px)[1]
     centre_col = SMALL[0] / 2   # the camera frames the block centred: x = 50 mm is mid-picture
     assert cols.size > 2000
-    assert cols.min() > centre_col - 3
+    assert cols.max() < centre_col + 3
 
 
 def test_interactive_scene_widget_drives_the_cut():
@@ -310,12 +383,16 @@ def test_interactive_scene_widget_drives_the_cut():
         widget.SetOrigin(80.0, 40.0, 20.0)
         widget.SetNormal(0.0, 0.0, 1.0)
         widget.InvokeEvent("InteractionEvent")
-        shown = plotter.actors[SECTION_ACTOR].mapper.dataset
-        np.testing.assert_allclose(np.asarray(shown.points)[:, 2], 20.0, atol=1e-9)
-        assert shown.n_points <= 20_000
-        np.testing.assert_allclose(np.asarray(shown.point_data["RGB"]) / 255.0,
-                                   np.asarray(shown.points) / np.asarray(SIZE), atol=RGB_ATOL)
-        np.testing.assert_allclose(callback.clip_plane.GetNormal(), (0.0, 0.0, 1.0))
+        section = callback.section
+        np.testing.assert_allclose(np.asarray(section.points)[:, 2], 20.0, atol=1e-9)
+        # The cap bounds the grid's samples; the part's outline adds points along it.
+        assert section.n_points <= 20_000 * 1.05
+        np.testing.assert_allclose(np.asarray(section.point_data["RGB"]) / 255.0,
+                                   np.asarray(section.points) / np.asarray(SIZE), atol=RGB_ATOL)
+        assert SECTION_ACTOR in plotter.actors
+        cap = callback.shown[SECTION_ACTOR]
+        np.testing.assert_allclose(np.asarray(cap.points)[:, 2], 20.0, atol=1e-9)
+        np.testing.assert_allclose(callback.clip_plane.GetNormal(), (0.0, 0.0, -1.0))
         img = plotter.screenshot(return_img=True)
         assert np.any(img != 255, axis=-1).mean() > 0.2
     finally:

@@ -13,8 +13,9 @@ What is drawn:
 - the part with its texture (lit, smooth-shaded with sharp edges kept);
 - the block as a translucent box with dark edges (:func:`block_outline`);
 - with a wood, a cut plane: the wood of the whole block sampled on the plane
-  (:func:`cut_plane_image`), with the part clipped so that only the side the plane's normal
-  points to is kept (the part's surface on one side, the wood section where the plane cuts).
+  (:func:`cut_plane_image`), opaque where the plane cuts the part and translucent in the waste
+  around it, with the part clipped away on the side the plane's normal points to (toward the
+  viewer): a cutaway, the part's textured surface behind, its inside wood on the plane.
 
 Off-screen rendering (``screenshot=...``) needs no display; the interactive window adds a plane
 widget whose callback (:class:`CutPlaneCallback`) is a plain object tests can call with an
@@ -68,9 +69,19 @@ BLOCK_COLOR = (0.80, 0.70, 0.55)
 BLOCK_EDGE_COLOR = (0.25, 0.22, 0.20)
 UNTEXTURED_PART_COLOR = (0.78, 0.62, 0.42)
 
+#: Opacity of the waste wood on the cut plane (the section outside the part): the wood around
+#: the part stays readable while the part's far half shows through it.
+WASTE_OPACITY = 0.3
+
+#: Colour and width (pixels) of the part's outline drawn on the cut plane.
+OUTLINE_COLOR = (0.20, 0.12, 0.06)
+OUTLINE_WIDTH = 3.0
+
 #: Actor names, so that re-adding with the same name replaces (the cut-plane callback).
 PART_ACTOR = "woodcam-part"
 SECTION_ACTOR = "woodcam-section"
+WASTE_ACTOR = "woodcam-section-waste"
+OUTLINE_ACTOR = "woodcam-section-outline"
 
 # The 12 edges of a box as pairs of corner indices; corner k has bits (x, y, z) = k's bits.
 _BOX_EDGES = np.array(
@@ -331,6 +342,85 @@ def _wood_rgb(wood, points_mm: np.ndarray, normal: np.ndarray) -> np.ndarray:
     return np.clip(out, 0.0, 1.0)
 
 
+def _part_triangles(part) -> tuple[np.ndarray, np.ndarray]:
+    """``(points (n, 3) float mm, triangles (m, 3) int)`` of a part given as pyvista or trimesh."""
+    if hasattr(part, "vertices") and hasattr(part, "faces") and not hasattr(part, "n_cells"):
+        return np.asarray(part.vertices, dtype=float), np.asarray(part.faces, dtype=np.int64)
+    if not part.is_all_triangles:
+        part = part.triangulate()
+    return np.asarray(part.points, dtype=float), np.asarray(part.regular_faces, dtype=np.int64)
+
+
+def _cut_segments(points, triangles, origin, normal) -> np.ndarray:
+    """Where a plane cuts a triangle mesh: segments ``(k, 2, 3)``, block frame mm.
+
+    Vertices are classed above (``d > 0``) or not; a triangle with both classes is cut along
+    its two edges whose ends differ, so a vertex on the plane never yields a degenerate
+    crossing.
+    """
+    d = (points - origin) @ normal                               # (n,) mm
+    above = d > 0
+    cls = above[triangles]                                       # (m, 3)
+    cut = cls.any(axis=1) & ~cls.all(axis=1)
+    tri = triangles[cut]
+    if len(tri) == 0:
+        return np.empty((0, 2, 3))
+    a_idx = tri                                                  # edge (a -> b) per corner
+    b_idx = np.roll(tri, -1, axis=1)
+    da, db = d[a_idx], d[b_idx]
+    differs = above[a_idx] != above[b_idx]                       # exactly two per triangle
+    w = np.where(differs, da / np.where(differs, da - db, 1.0), 0.0)
+    pa, pb = points[a_idx], points[b_idx]                        # (k, 3, 3)
+    cross = pa + w[..., None] * (pb - pa)
+    return cross[differs].reshape(-1, 2, 3)
+
+
+def _signed_row_distance(seg_uv, su, sv) -> np.ndarray:
+    """Signed distance (mm) along ``u`` from grid points to a closed outline, > 0 inside.
+
+    The grid is ``su (n_u,) x sv (n_v,)`` (row ``j`` is ``v = sv[j]``). Each row is a scan
+    line: the outline's crossings with it, sorted, give inside (odd count to the left) and the
+    distance to the nearest crossing. Rows with no crossing are outside. Returns
+    ``(n_u, n_v)``. Exact along ``u``; between rows a clip interpolates, so the outline is
+    placed within one row spacing where it runs nearly along ``u``.
+    """
+    n_u, n_v = len(su), len(sv)
+    far = float(su[-1] - su[0]) + 1.0
+    out = np.full((n_u, n_v), -far)
+    if len(seg_uv) == 0:
+        return out
+    v1, v2 = seg_uv[:, 0, 1], seg_uv[:, 1, 1]
+    dv = (sv[-1] - sv[0]) / (n_v - 1)
+    lo_j = np.floor((np.minimum(v1, v2) - sv[0]) / dv).astype(np.int64) - 1
+    hi_j = np.ceil((np.maximum(v1, v2) - sv[0]) / dv).astype(np.int64) + 1
+    lo_j, hi_j = lo_j.clip(0, n_v - 1), hi_j.clip(0, n_v - 1)
+    count = np.maximum(hi_j - lo_j + 1, 0)
+    seg = np.repeat(np.arange(len(seg_uv)), count)               # candidate (segment, row)
+    row = lo_j[seg] + (np.arange(len(seg)) - np.repeat(np.cumsum(count) - count, count))
+    vj = sv[row]
+    a, b = seg_uv[seg, 0], seg_uv[seg, 1]
+    hit = (a[:, 1] <= vj) != (b[:, 1] <= vj)                     # half-open: no double count
+    seg, row, vj, a, b = seg[hit], row[hit], vj[hit], a[hit], b[hit]
+    uc = a[:, 0] + (vj - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    uc = np.clip(uc, su[0] - 1.0, su[-1] + 1.0)                  # keeps the order in the row
+    span = float(su[-1] - su[0]) + 3.0
+    key = np.sort(row * span + (uc - su[0] + 1.0))               # rows apart, sorted by u
+    grid_row = np.broadcast_to(np.arange(n_v), (n_u, n_v))
+    grid_key = grid_row * span + (su[:, None] - su[0] + 1.0)
+    first = np.searchsorted(key, np.arange(n_v) * span)          # (n_v,) row starts
+    last = np.searchsorted(key, (np.arange(n_v) + 1) * span)     # (n_v,) row ends
+    k = np.searchsorted(key, grid_key)                           # (n_u, n_v)
+    left = k - first[None, :]                                    # crossings left of the point
+    has_left = k > first[None, :]
+    has_right = k < last[None, :]
+    d_left = np.where(has_left, grid_key - key[np.maximum(k - 1, 0)], np.inf)
+    d_right = np.where(has_right, key[np.minimum(k, len(key) - 1)] - grid_key, np.inf)
+    dist = np.minimum(d_left, d_right)
+    any_hit = np.isfinite(dist)
+    out[any_hit] = np.where(left[any_hit] % 2 == 1, dist[any_hit], -dist[any_hit])
+    return out
+
+
 def cut_plane_image(
     wood,
     size_mm,
@@ -339,6 +429,7 @@ def cut_plane_image(
     resolution_mm: float = SECTION_RESOLUTION_MM,
     *,
     max_samples: int | None = None,
+    part=None,
 ):
     """The wood on the part of a plane inside the block, as coloured polydata.
 
@@ -359,14 +450,20 @@ def cut_plane_image(
         Grid spacing, mm.
     max_samples : int, optional
         Coarsen the spacing when the grid would have more points than this.
+    part : pyvista.PolyData or trimesh.Trimesh, optional
+        A closed part surface (block frame, mm). The section is then split along the part's
+        outline on the plane and its cells get ``"in_part"`` (1 inside the part, 0 in the
+        waste around it). The outline is exact along the grid's rows and placed within one
+        sample spacing across them.
 
     Returns
     -------
     pyvista.PolyData
         Points ``(n, 3)`` float64 mm inside the block; point array ``"RGB"`` ``(n, 3)`` uint8
-        (``round(255 * wood.color)``), the active scalars; field data ``"normal"`` ``(1, 3)``
-        and ``"resolution_mm"`` ``(1,)``. Empty (``n_points == 0``) when the plane misses the
-        block.
+        (``round(255 * wood.color)``, computed at the final points, so boundary points are
+        exact too), the active scalars; cell array ``"in_part"`` ``(n_cells,)`` uint8 with
+        ``part``; field data ``"normal"`` ``(1, 3)`` and ``"resolution_mm"`` ``(1,)``. Empty
+        (``n_points == 0``) when the plane misses the block.
     """
     pv = _pyvista()
     _check_wood(wood)
@@ -404,6 +501,11 @@ def cut_plane_image(
         step = max(step, 1.0 / t)
     n_u, n_v = (np.ceil(extent / step).astype(int) + 1).clip(min=2)
     section = _grid_polydata(pv, origin, u, v, (lo[0], hi[0]), (lo[1], hi[1]), n_u, n_v)
+    if part is not None:
+        ends = _cut_segments(*_part_triangles(part), origin, normal) - origin
+        seg_uv = np.stack([ends @ u, ends @ v], axis=-1)         # (k, 2, 2) mm
+        su, sv = np.linspace(lo[0], hi[0], n_u), np.linspace(lo[1], hi[1], n_v)
+        section.point_data["part_mm"] = _signed_row_distance(seg_uv, su, sv).reshape(-1)
 
     # Clip to the box by the face planes the grid actually crosses (none when the normal is
     # a block axis: the grid rectangle is then the section itself).
@@ -419,12 +521,26 @@ def cut_plane_image(
             section = section.clip(normal=plane_normal, origin=plane_origin, invert=True)
             if section.n_points == 0:
                 return pv.PolyData()
-    section = section.clean(tolerance=0.0) if section.n_points else section
+    in_part = None
+    if part is not None:
+        inside, outside = section.clip_scalar(scalars="part_mm", value=0.0, invert=False,
+                                              both=True)
+        inside.cell_data["in_part"] = np.ones(inside.n_cells, np.uint8)
+        outside.cell_data["in_part"] = np.zeros(outside.n_cells, np.uint8)
+        section = pv.merge([d for d in (inside, outside) if d.n_cells], merge_points=True) \
+            if inside.n_cells + outside.n_cells else pv.PolyData()
+        if section.n_cells:
+            in_part = np.asarray(section.cell_data["in_part"]).astype(np.uint8)
+    if section.n_cells == 0:
+        return pv.PolyData()
+    section = section.clean(tolerance=0.0)
+    if in_part is not None:
+        in_part = np.asarray(section.cell_data["in_part"]).astype(np.uint8)
     points = np.clip(np.asarray(section.points, dtype=float), 0.0, size)
     rgb = _wood_rgb(wood, points, normal)
-    out = pv.PolyData(points, faces=section.faces) if section.n_cells else pv.PolyData()
-    if out.n_points == 0:
-        return out
+    out = pv.PolyData(points, faces=section.faces)
+    if in_part is not None:
+        out.cell_data["in_part"] = in_part
     out.point_data["RGB"] = np.rint(rgb * 255.0).astype(np.uint8)
     out.set_active_scalars("RGB")
     out.field_data["normal"] = normal[None, :]
@@ -457,20 +573,23 @@ def _add_block(plotter, size):
 
 
 class CutPlaneCallback:
-    """Redraw the wood section and the clipped part for a plane ``(normal, origin)``.
+    """Redraw the cut for a plane ``(normal, origin)``: a cutaway of the part in its block.
 
     The plane widget calls it as ``callback(normal, origin)`` while the plane is dragged; tests
     call it the same way on an off-screen plotter. Creating it adds the part (actor
     :data:`PART_ACTOR`) with a clipping plane on its mapper; each call moves that plane, so the
-    part keeps only the side the normal points to (clipping on the GPU keeps the texture seams
-    and costs nothing), and replaces the wood section (actor :data:`SECTION_ACTOR`, if a wood
-    was given) that fills the plane inside the block.
+    part keeps only the side *opposite* the normal (the normal points at the viewer and at the
+    half that is cut away; clipping on the GPU keeps texture seams and costs nothing). With a
+    wood, each call also replaces the wood on the plane inside the block: where the plane cuts
+    the part, opaque (actor :data:`SECTION_ACTOR`: the inside of the part, facing the viewer),
+    around it the waste wood, translucent (actor :data:`WASTE_ACTOR`), and the part's outline
+    on the plane as a dark line (actor :data:`OUTLINE_ACTOR`).
 
     Parameters
     ----------
     plotter : pyvista.Plotter
     part : pyvista.PolyData
-        The whole part, as from :func:`mesh_to_pyvista`.
+        The whole part, as from :func:`mesh_to_pyvista` (closed, for the in/out split).
     texture : pyvista.Texture or None
     wood : object with ``color(points_mm, normals)``, or None (then only the part is clipped)
     size_mm : (3,) float or None
@@ -481,9 +600,14 @@ class CutPlaneCallback:
     Attributes
     ----------
     clip_plane : vtkPlane
-        The part's clipping plane (origin mm, unit normal), as of the last call.
+        The part's clipping plane (origin mm; its normal is minus the cut's normal).
     section : pyvista.PolyData or None
-        The last wood section.
+        The last wood section, whole (cell array ``"in_part"`` tells part from waste).
+    shown : dict[str, pyvista.PolyData | None]
+        What the last call drew under each actor name (:data:`SECTION_ACTOR`,
+        :data:`WASTE_ACTOR`, :data:`OUTLINE_ACTOR`); None where that actor was removed.
+        (Reading the meshes back through ``actor.mapper.dataset`` is unreliable in pyvista
+        0.49: it reads empty once another mesh is added, although the picture is right.)
     """
 
     def __init__(self, plotter, part, texture, wood=None, size_mm=None, *,
@@ -491,12 +615,14 @@ class CutPlaneCallback:
         from vtkmodules.vtkCommonDataModel import vtkPlane
 
         self.plotter = plotter
+        self.part = part
         self.wood = _check_wood(wood)
         self.size_mm = None if size_mm is None else _check_size(size_mm)
         _check_size_with_wood(wood, self.size_mm)
         self.resolution_mm = resolution_mm
         self.max_samples = max_samples
         self.section = None
+        self.shown = {}
         self.clip_plane = vtkPlane()
         self.part_actor = _add_part(plotter, part, texture)
         self.part_actor.mapper.AddClippingPlane(self.clip_plane)
@@ -505,20 +631,38 @@ class CutPlaneCallback:
         """Move the cut to the plane; returns the section polydata (None without a wood)."""
         normal = _check_vector(normal, "normal", unit=True)
         origin = _check_vector(origin, "origin", unit=False)
-        # vtkPlane clipping keeps points with normal . (x - origin) >= 0.
+        # vtkPlane clipping keeps points with plane_normal . (x - origin) >= 0.
         self.clip_plane.SetOrigin(*origin)
-        self.clip_plane.SetNormal(*normal)
+        self.clip_plane.SetNormal(*(-normal))
         if self.wood is None:
             return None
         section = cut_plane_image(self.wood, self.size_mm, origin, normal, self.resolution_mm,
-                                  max_samples=self.max_samples)
-        if section.n_points:
-            # Unlit: the section shows the wood's own colour, as a fresh planed face would.
-            self.plotter.add_mesh(section, scalars="RGB", rgb=True, lighting=False,
-                                  name=SECTION_ACTOR, show_scalar_bar=False)
-        else:
-            self.plotter.remove_actor(SECTION_ACTOR, render=False)
+                                  max_samples=self.max_samples, part=self.part)
         self.section = section
+        in_part = (np.asarray(section.cell_data["in_part"]).astype(bool) if section.n_cells
+                   else np.zeros(0, bool))
+        # Unlit: the plane shows the wood's own colour, as a freshly planed face would.
+        for name, cells, opacity in ((SECTION_ACTOR, in_part, 1.0),
+                                     (WASTE_ACTOR, ~in_part, WASTE_OPACITY)):
+            shown = section.remove_cells(~cells) if cells.any() else None
+            self.shown[name] = shown
+            if shown is not None:
+                self.plotter.add_mesh(shown, scalars="RGB", rgb=True, lighting=False,
+                                      opacity=opacity, name=name, show_scalar_bar=False)
+            else:
+                self.plotter.remove_actor(name, render=False)
+        # The part's outline on the plane, so its inside stands out from the waste.
+        segments = _cut_segments(*_part_triangles(self.part), origin, normal)
+        if len(segments):
+            lines = np.hstack([np.full((len(segments), 1), 2),
+                               np.arange(2 * len(segments)).reshape(-1, 2)]).ravel()
+            outline = _pyvista().PolyData(segments.reshape(-1, 3), lines=lines)
+            self.shown[OUTLINE_ACTOR] = outline
+            self.plotter.add_mesh(outline, color=OUTLINE_COLOR, line_width=OUTLINE_WIDTH,
+                                  lighting=False, name=OUTLINE_ACTOR, show_scalar_bar=False)
+        else:
+            self.shown[OUTLINE_ACTOR] = None
+            self.plotter.remove_actor(OUTLINE_ACTOR, render=False)
         return section
 
 
@@ -697,8 +841,8 @@ def preview(
         Any colour pyvista accepts ("white", "#202020", (r, g, b) in 0..1).
     cut_origin, cut_normal : (3,) float, optional
         The initial cut plane; default the block centre and the block's longest axis facing
-        the camera, signed toward it (the part is kept on the camera side of the plane, with
-        the wood section behind it).
+        the camera, signed toward it (the part's half on the camera side is cut away, so the
+        plane shows its inside wood).
     resolution_mm : float
         Sample spacing of the wood on the plane (coarsened for very large sections and, in the
         interactive window, while dragging).
@@ -745,6 +889,8 @@ def preview(
             max_samples=(SECTION_MAX_SAMPLES_SCREENSHOT if off_screen
                          else SECTION_MAX_SAMPLES_INTERACTIVE),
         )
+        # Translucent block and waste wood over the part: sort them per pixel.
+        plotter.enable_depth_peeling()
         plotter.enable_anti_aliasing("ssaa")
         if off_screen:
             path = Path(screenshot)
