@@ -343,7 +343,9 @@ def _wood_rgb(wood, points_mm: np.ndarray, normal: np.ndarray) -> np.ndarray:
 
 
 def _part_triangles(part) -> tuple[np.ndarray, np.ndarray]:
-    """``(points (n, 3) float mm, triangles (m, 3) int)`` of a part given as pyvista or trimesh."""
+    """``(points (n, 3) float mm, triangles (m, 3) int)`` of a part: pyvista, trimesh or a pair."""
+    if isinstance(part, tuple) and len(part) == 2:
+        return np.asarray(part[0], dtype=float), np.asarray(part[1], dtype=np.int64)
     if hasattr(part, "vertices") and hasattr(part, "faces") and not hasattr(part, "n_cells"):
         return np.asarray(part.vertices, dtype=float), np.asarray(part.faces, dtype=np.int64)
     if not part.is_all_triangles:
@@ -360,13 +362,16 @@ def _cut_segments(points, triangles, origin, normal) -> np.ndarray:
     """
     d = (points - origin) @ normal                               # (n,) mm
     above = d > 0
-    cls = above[triangles]                                       # (m, 3)
-    cut = cls.any(axis=1) & ~cls.all(axis=1)
-    tri = triangles[cut]
+    n_above = (above[triangles[:, 0]].astype(np.uint8) + above[triangles[:, 1]]
+               + above[triangles[:, 2]])                         # (m,) column adds: fast
+    tri = triangles[(n_above == 1) | (n_above == 2)]
     if len(tri) == 0:
         return np.empty((0, 2, 3))
-    a_idx = tri                                                  # edge (a -> b) per corner
-    b_idx = np.roll(tri, -1, axis=1)
+    # Each edge runs from its vertex above the plane to the other one, so the two triangles
+    # sharing an edge compute the same crossing bit for bit (the scan lines rely on it).
+    e0, e1 = tri, np.roll(tri, -1, axis=1)                       # (k, 3) corner -> next
+    a_idx = np.where(above[e0], e0, e1)
+    b_idx = np.where(above[e0], e1, e0)
     da, db = d[a_idx], d[b_idx]
     differs = above[a_idx] != above[b_idx]                       # exactly two per triangle
     w = np.where(differs, da / np.where(differs, da - db, 1.0), 0.0)
@@ -450,7 +455,7 @@ def cut_plane_image(
         Grid spacing, mm.
     max_samples : int, optional
         Coarsen the spacing when the grid would have more points than this.
-    part : pyvista.PolyData or trimesh.Trimesh, optional
+    part : pyvista.PolyData, trimesh.Trimesh or (points (n, 3), triangles (m, 3)), optional
         A closed part surface (block frame, mm). The section is then split along the part's
         outline on the plane and its cells get ``"in_part"`` (1 inside the part, 0 in the
         waste around it). The outline is exact along the grid's rows and placed within one
@@ -461,9 +466,12 @@ def cut_plane_image(
     pyvista.PolyData
         Points ``(n, 3)`` float64 mm inside the block; point array ``"RGB"`` ``(n, 3)`` uint8
         (``round(255 * wood.color)``, computed at the final points, so boundary points are
-        exact too), the active scalars; cell array ``"in_part"`` ``(n_cells,)`` uint8 with
-        ``part``; field data ``"normal"`` ``(1, 3)`` and ``"resolution_mm"`` ``(1,)``. Empty
-        (``n_points == 0``) when the plane misses the block.
+        exact too), the active scalars; with ``part``, cell array ``"in_part"``
+        ``(n_cells,)`` uint8 and, if the plane cuts the part, field data ``"outline_mm"``
+        ``(2 k, 3)``: the ends of the ``k`` segments where it cuts the part's triangles
+        (pairs of rows); field data ``"normal"``
+        ``(1, 3)`` and ``"resolution_mm"`` ``(1,)``. Empty (``n_points == 0``) when the plane
+        misses the block.
     """
     pv = _pyvista()
     _check_wood(wood)
@@ -501,8 +509,10 @@ def cut_plane_image(
         step = max(step, 1.0 / t)
     n_u, n_v = (np.ceil(extent / step).astype(int) + 1).clip(min=2)
     section = _grid_polydata(pv, origin, u, v, (lo[0], hi[0]), (lo[1], hi[1]), n_u, n_v)
+    segments = None
     if part is not None:
-        ends = _cut_segments(*_part_triangles(part), origin, normal) - origin
+        segments = _cut_segments(*_part_triangles(part), origin, normal)
+        ends = segments - origin
         seg_uv = np.stack([ends @ u, ends @ v], axis=-1)         # (k, 2, 2) mm
         su, sv = np.linspace(lo[0], hi[0], n_u), np.linspace(lo[1], hi[1], n_v)
         section.point_data["part_mm"] = _signed_row_distance(seg_uv, su, sv).reshape(-1)
@@ -533,9 +543,6 @@ def cut_plane_image(
             in_part = np.asarray(section.cell_data["in_part"]).astype(np.uint8)
     if section.n_cells == 0:
         return pv.PolyData()
-    section = section.clean(tolerance=0.0)
-    if in_part is not None:
-        in_part = np.asarray(section.cell_data["in_part"]).astype(np.uint8)
     points = np.clip(np.asarray(section.points, dtype=float), 0.0, size)
     rgb = _wood_rgb(wood, points, normal)
     out = pv.PolyData(points, faces=section.faces)
@@ -545,6 +552,8 @@ def cut_plane_image(
     out.set_active_scalars("RGB")
     out.field_data["normal"] = normal[None, :]
     out.field_data["resolution_mm"] = np.array([step])
+    if segments is not None and len(segments):
+        out.field_data["outline_mm"] = segments.reshape(-1, 3)
     return out
 
 
@@ -623,6 +632,7 @@ class CutPlaneCallback:
         self.max_samples = max_samples
         self.section = None
         self.shown = {}
+        self._triangles = _part_triangles(part)                  # (points, triangles), once
         self.clip_plane = vtkPlane()
         self.part_actor = _add_part(plotter, part, texture)
         self.part_actor.mapper.AddClippingPlane(self.clip_plane)
@@ -637,7 +647,7 @@ class CutPlaneCallback:
         if self.wood is None:
             return None
         section = cut_plane_image(self.wood, self.size_mm, origin, normal, self.resolution_mm,
-                                  max_samples=self.max_samples, part=self.part)
+                                  max_samples=self.max_samples, part=self._triangles)
         self.section = section
         in_part = (np.asarray(section.cell_data["in_part"]).astype(bool) if section.n_cells
                    else np.zeros(0, bool))
@@ -652,7 +662,8 @@ class CutPlaneCallback:
             else:
                 self.plotter.remove_actor(name, render=False)
         # The part's outline on the plane, so its inside stands out from the waste.
-        segments = _cut_segments(*_part_triangles(self.part), origin, normal)
+        segments = (np.asarray(section.field_data["outline_mm"]).reshape(-1, 2, 3)
+                    if "outline_mm" in section.field_data else np.empty((0, 2, 3)))
         if len(segments):
             lines = np.hstack([np.full((len(segments), 1), 2),
                                np.arange(2 * len(segments)).reshape(-1, 2)]).ravel()
