@@ -621,6 +621,7 @@ class CutPlaneCallback:
 
     def __init__(self, plotter, part, texture, wood=None, size_mm=None, *,
                  resolution_mm: float = SECTION_RESOLUTION_MM, max_samples: int | None = None):
+        _pyvista()  # a clear MissingDependencyError before vtk is touched
         from vtkmodules.vtkCommonDataModel import vtkPlane
 
         self.plotter = plotter
