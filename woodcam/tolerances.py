@@ -51,3 +51,7 @@ RING_MAP_QUANT_16BIT = 0.5 / 65535
 
 #: Ring maps stored as 8-bit PNG (and Mokume's own maps) carry 0.5 / 255 of quantisation.
 RING_MAP_QUANT_8BIT = 0.5 / 255
+
+#: Colours a wood returns may overshoot [0, 1] by this much (round-off of blends and colour
+#: transforms) and are clipped; a larger excursion is an error (e.g. 0..255 colours passed).
+COLOR_RANGE_TOL = 1e-3
