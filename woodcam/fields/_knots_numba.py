@@ -151,7 +151,7 @@ def eval_points(pts, zg0, inv_dz, pxy, speed, bin_z0, inv_bw, bin_ptr, bin_knots
                 dv = min(max(6.0 * (ts - Td) / _L, 0.0), 1.0)
                 if dv > deadmax:
                     deadmax = dv
-            if (not dead) and tb < Td and r_death[k] < r_end[k]:
+            if (not dead) and (tb - Td) * vb < th and r_death[k] < r_end[k]:
                 gap = (Td - sm) * vb
                 if gap >= 0.0 and gap <= th:
                     outline = 1.0

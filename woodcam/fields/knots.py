@@ -491,7 +491,9 @@ class KnottedLogField:
         inside_dead = inr & (tb < Td) & (ts > Td)
         deadf = np.max(np.where(inside_dead, np.clip(6.0 * (ts - Td) / L, 0.0, 1.0), 0.0), axis=0)
         gap = (Td - sm) * vb                                              # mm across the knot
-        outl = inr & ~dead & (tb < Td) & (self._r_death[kidx, None] < self._r_end[kidx, None])
+        # the bark ring: just inside the knot's size at death, up to where the field jumps
+        outl = inr & ~dead & ((tb - Td) * vb < P.outline_mm) & \
+            (self._r_death[kidx, None] < self._r_end[kidx, None])
         outline = np.max(outl & (gap >= 0.0) & (gap <= P.outline_mm), axis=0).astype(float)
         j = np.argmin(tb2, axis=0)
         cols = np.arange(m)

@@ -127,7 +127,8 @@ class Knot:
         the knot's length. ``r_death < 0.1`` means the branch died at once (treated as 0).
         """
         r_top = float(max(r_end, r_max_mm or 0.0))
-        r = np.linspace(0.0, r_top, samples)
+        # quadratic spacing: dense near the pith, where sqrt(r) and ln(r) bend most
+        r = r_top * np.linspace(0.0, 1.0, samples) ** 2
         rr = np.maximum(r, _R_FLOOR_MM)
         rise = D * np.sqrt(r) + E * r
         twist = G * np.log(rr)
@@ -288,6 +289,17 @@ class Log:
         except KeyError as err:
             raise WoodcamError(f"log file is missing the key {err.args[0]!r}; it needs "
                                "pith_z_mm, pith_xy_mm and radii_mm") from err
+
+
+def simple_log(length_mm: float = 600.0, radius_mm: float = 100.0, knots=(), *,
+               z_step_mm: float = 10.0, azimuths: int = 36, name: str = "simple") -> Log:
+    """A straight cylindrical log (pith on the ``z`` axis, constant radius) with ``knots``:
+    the analytic test case and a starting point for hand-made logs."""
+    if not (length_mm > 0 and radius_mm > 0):
+        raise WoodcamError(f"length_mm and radius_mm must be > 0; got {length_mm}, {radius_mm}")
+    z = np.arange(0.0, length_mm + 0.5 * z_step_mm, z_step_mm)
+    return Log(z, np.zeros((len(z), 2)), np.full((len(z), azimuths), float(radius_mm)),
+               tuple(knots), name)
 
 
 def write_log(log: Log, path) -> Path:
