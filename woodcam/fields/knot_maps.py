@@ -52,7 +52,8 @@ DEFAULT_DIAMETER = (0.2, -0.05)
 
 def _q(x, lo, hi):
     """Quantise ``x`` in ``[lo, hi]`` to 0..255 (rounded, clipped)."""
-    return np.clip(np.rint((np.asarray(x, float) - lo) / (hi - lo) * 255.0), 0, 255)
+    span = max(hi - lo, 1e-9)          # a round log has r_min == r_max
+    return np.clip(np.rint((np.asarray(x, float) - lo) / span * 255.0), 0, 255)
 
 
 def _dq(v, lo, hi):
@@ -195,7 +196,10 @@ def read_maps(folder) -> Log:
     if missing:
         raise WoodcamError(f"map folder {str(folder)!r} lacks {missing}; it needs "
                            f"{sorted(MAP_FILES.values())}")
-    maps = {k: np.asarray(Image.open(folder / f).convert("RGB"))
-            for k, f in MAP_FILES.items() if k != "params"}
+    maps = {}
+    for k, f in MAP_FILES.items():
+        if k != "params":
+            with Image.open(folder / f) as im:
+                maps[k] = np.asarray(im.convert("RGB"))
     params = json.loads((folder / MAP_FILES["params"]).read_text())
     return decode_maps(maps, params)
