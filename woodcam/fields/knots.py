@@ -590,6 +590,31 @@ def place_block_in_log(log_field, origin_mm, rotation=None) -> PlacedField:
     return PlacedField(log_field, origin_mm, rotation)
 
 
+def block_at_knot(log, knot_index: int, size_mm, *, front_r_mm: float | None = None):
+    """Placement ``(origin_mm, rotation)`` of a ``W x D x H`` block whose front face (Y = 0)
+    is a tangential face of ``log`` cut through knot ``knot_index``.
+
+    The block's Z runs along the log, its Y points from the front face toward the pith, its X
+    is tangential; the front face lies ``front_r_mm`` from the pith (default: where the knot
+    is 10 mm short of its end or the outer radius) and is centred on the knot's crossing.
+    Feed the result to :func:`place_block_in_log`.
+    """
+    W, D, H = (float(v) for v in size_mm)
+    k = log.knots[knot_index]
+    if front_r_mm is None:
+        front_r_mm = max(min(k.r_end_mm, log.r_min_mm) - 10.0, D + 5.0)
+    p = log.knot_point(knot_index, [front_r_mm])[0]
+    c = log.pith_at([p[2]])[0]
+    n = np.array([p[0] - c[0], p[1] - c[1], 0.0])
+    n /= np.linalg.norm(n)
+    ez = np.array([0.0, 0.0, 1.0])
+    t = np.cross(-n, ez)
+    R = np.stack([t, -n, ez], axis=1)          # columns: block X, Y, Z in the log frame
+    centre_front = np.array([c[0], c[1], p[2]]) + front_r_mm * n
+    origin = centre_front - R @ np.array([W / 2, 0.0, H / 2])
+    return origin, R
+
+
 # ---------------------------------------------------------------------------------------------
 # appearance hook
 
