@@ -76,3 +76,40 @@ def test_bad_inputs_name_the_rule(tmp_path):
         Log([0, 10], [[0, 0], [0, 0]], [[1.0] * 3, [1.0] * 3])
     with pytest.raises(WoodcamError, match="length_mm"):
         simple_log(-1)
+
+
+def test_diameter_model_against_the_bark_bumps(gran1):
+    """Where a knot leaves through the bark the measured radius has a bump; its width along
+    the azimuth follows the power law ``A r^(1+B)`` better than the quadratic ``A r + B r^2/100``
+    (the other reading of the README's "diameter model coefficients"), which gives 64 mm knots
+    in a 125 mm-radius log."""
+    from scipy.ndimage import median_filter
+
+    ratios_pow, ratios_quad = [], []
+    for i, k in enumerate(gran1.knots):
+        if k.r_end_mm < 110:
+            continue
+        p = gran1.knot_point(i, [k.r_end_mm])[0]
+        c = gran1.pith_at([p[2]])[0]
+        j = int(round(np.degrees(np.arctan2(p[1] - c[1], p[0] - c[0])))) % 360
+        iz = int(round(p[2] / 10))
+        if not 1 <= iz <= 398:
+            continue
+        prof = gran1.radii_mm[iz, (j + np.arange(-40, 41)) % 360]
+        bump = prof - median_filter(prof, size=41, mode="nearest")
+        peak = bump[35:46].max()
+        if peak < 0.8:                                  # no clear bump (mm)
+            continue
+        ic = 35 + int(np.argmax(bump[35:46]))
+        lo, hi = ic, ic
+        while lo > 0 and bump[lo] > peak / 2:
+            lo -= 1
+        while hi < 80 and bump[hi] > peak / 2:
+            hi += 1
+        width = np.radians(hi - lo) * k.r_end_mm
+        A, B = k.coefficients["A"], k.coefficients["B"]
+        ratios_pow.append(width / (A * k.r_end_mm ** (1 + B)))
+        ratios_quad.append(width / (A * k.r_end_mm + B * k.r_end_mm ** 2 / 100))
+    assert len(ratios_pow) == 12
+    spread_pow, spread_quad = np.std(np.log(ratios_pow)), np.std(np.log(ratios_quad))
+    assert spread_pow < 0.75 * spread_quad            # 0.33 vs 0.51
