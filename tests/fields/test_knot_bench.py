@@ -42,7 +42,8 @@ def _points(n, seed=0):
 def test_throughput_real_log(gran1, backend):
     n = 1_000_000 if backend == "numba" else 200_000
     p = _points(n)
-    fs, ff = KnottedLogField(gran1.with_knots([]), backend=backend), KnottedLogField(gran1, backend=backend)
+    fs = KnottedLogField(gran1.with_knots([]), backend=backend)
+    ff = KnottedLogField(gran1, backend=backend)
     stem, full = _rate(fs, p), _rate(ff, p)
     stem_cpu, full_cpu = _rate(fs, p, cpu=True), _rate(ff, p, cpu=True)
     print(f"\n[{backend}] real log, 108 knots: {full / 1e6:.2f} M points/s wall-clock "

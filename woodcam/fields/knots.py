@@ -253,8 +253,7 @@ class KnottedLogField:
         zs = log.pith_z_mm
         dzmin = float(np.min(np.diff(zs)))
         nz = int(np.ceil((zs[-1] - zs[0]) / dzmin - 1e-9)) + 1
-        self._z = zs[0] + dzmin * np.arange(nz)
-        self._z[-1] = min(self._z[-1], zs[-1]) if nz > 1 else zs[-1]
+        self._z = zs[0] + dzmin * np.arange(max(nz, 2))  # may end past zs[-1]: np.interp clamps
         self._zg0, self._inv_dz = float(zs[0]), 1.0 / dzmin
         self._pxy = np.stack([np.interp(self._z, zs, log.pith_xy_mm[:, 0]),
                               np.interp(self._z, zs, log.pith_xy_mm[:, 1])], axis=1)
@@ -376,7 +375,8 @@ class KnottedLogField:
         best = np.empty(n, np.int64)
         eval_points(np.ascontiguousarray(p), self._zg0, self._inv_dz, self._pxy, self._speed,
                     z0, 1.0 / bw, bin_ptr, bin_knots, self._r_end, self._r_death, self._Zf,
-                    self._CWf, self._SWf, self._RHOf, self._nr + 1, 1.0 / self._dr, self._phase, prm, out,
+                    self._CWf, self._SWf, self._RHOf, self._nr + 1, 1.0 / self._dr, self._phase,
+                    prm, out,
                     best)
         res = {"years": out[0] / self.ring_width_mm, "knot": out[1], "dead": out[2],
                "outline": out[3]}

@@ -108,7 +108,8 @@ def busiest_board(log: Log, *, offset_mm: float = 60.0, length_mm: float = 600.0
             continue
         cz, ct = np.array(cross).T
         for zc in zs:
-            cnt = int(np.sum((np.abs(cz - zc) < length_mm / 2 - 20) & (np.abs(ct) < width_mm / 2 - 10)))
+            inside = (np.abs(cz - zc) < length_mm / 2 - 20) & (np.abs(ct) < width_mm / 2 - 10)
+            cnt = int(np.sum(inside))
             if cnt > best[2]:
                 best = (float(zc), float(az), cnt)
     return best
@@ -150,9 +151,9 @@ def render_section(field: KnottedLogField, section: Section, *, background=BACKG
     p = pts.reshape(-1, 3)
     out = field.evaluate(p)
     P = field.params
-    rgb = colour_years(out["years"], out,
-                       alive_darkening=P.alive_darkening if alive_darkening is None else alive_darkening,
-                       dead_darkening=P.dead_darkening if dead_darkening is None else dead_darkening)
+    alive = P.alive_darkening if alive_darkening is None else alive_darkening
+    dead = P.dead_darkening if dead_darkening is None else dead_darkening
+    rgb = colour_years(out["years"], out, alive_darkening=alive, dead_darkening=dead)
     rel = p[:, :2] - field.log.pith_at(p[:, 2])
     outside = np.hypot(rel[:, 0], rel[:, 1]) > field.log.radius_at(
         p[:, 2], np.arctan2(rel[:, 1], rel[:, 0]))
