@@ -33,6 +33,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     r.add_argument("--out", required=True, help="output folder")
     r.add_argument("--ring-width", type=float, default=2.0, help="mm per year (default 2)")
     r.add_argument("--px-per-mm", type=float, default=2.0, help="resolution (default 2)")
+    r.add_argument("--supersample", type=int, default=2,
+                   help="samples per pixel side, averaged (default 2; knot rings alias)")
     r.add_argument("--board", nargs=3, type=float, metavar=("Z_MM", "AZIMUTH_DEG", "OFFSET_MM"),
                    help="tangential board centre height, facing azimuth and distance from "
                         "the pith (default: the board through the most knots at 60 mm)")
@@ -103,5 +105,6 @@ def run(args) -> int:
     if args.disc is not None:
         secs[1] = lr.end_grain_disc(log, args.disc, px_per_mm=args.px_per_mm)
     for s in secs:
-        print(lr.save_png(lr.render_section(field, s), out / f"{log.name}_{s.name}.png"))
+        img = lr.render_section(field, s, supersample=args.supersample)
+        print(lr.save_png(img, out / f"{log.name}_{s.name}.png"))
     return 0

@@ -238,3 +238,17 @@ def test_params_are_checked():
         KnottedLogField(simple_log(), ring_width_mm=0)
     with pytest.raises(WoodcamError, match="backend"):
         KnottedLogField(simple_log(), backend="gpu")
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_irregular_pith_samples(backend):
+    from woodcam.fields.tree_data import Log
+
+    z = np.array([0.0, 5.0, 20.0, 60.0, 100.0])
+    xy = np.stack([0.1 * z, np.zeros_like(z)], 1)          # a leaning, straight pith
+    log = Log(z, xy, np.full((5, 8), 80.0))
+    f = KnottedLogField(log, ring_width_mm=2.0, backend=backend)
+    rng = np.random.default_rng(6)
+    p = rng.uniform([-60, -60, 0], [60, 60, 100], (2000, 3))
+    expected = np.hypot(p[:, 0] - 0.1 * p[:, 2], p[:, 1]) / 2.0
+    assert np.allclose(f(p), expected, atol=1e-9)

@@ -138,12 +138,13 @@ def render_section(field: KnottedLogField, section: Section, *, background=BACKG
     """
     s = int(supersample)
     if s > 1:
-        fine = Section(section.origin_mm, section.u, section.v, section.size_mm,
-                       section.px_per_mm * s, section.name)
-        img = render_section(field, fine, background=background,
-                             alive_darkening=alive_darkening, dead_darkening=dead_darkening)
         rows, cols = section.shape()
-        img = img[:rows * s, :cols * s].astype(float)
+        ppm = section.px_per_mm
+        fine = Section(section.origin_mm, section.u, section.v, (cols / ppm, rows / ppm),
+                       ppm * s, section.name)
+        img = render_section(field, fine, background=background,
+                             alive_darkening=alive_darkening,
+                             dead_darkening=dead_darkening).astype(float)
         img = img.reshape(rows, s, cols, s, 3).mean(axis=(1, 3))
         return (img + 0.5).astype(np.uint8)
     pts = section.points()
@@ -173,13 +174,16 @@ def save_png(image: np.ndarray, path) -> Path:
 
 
 def default_sections(log: Log, *, px_per_mm: float = 2.0) -> list[Section]:
-    """A tangential board through the most knots and an end-grain disc through one of them."""
+    """A tangential board through the most knots and an end-grain disc through the log's
+    biggest whorl (the height where most knot axes pass 50 mm from the pith, +-12 mm)."""
     zc, az, _ = busiest_board(log)
     secs = [tangential_board(log, zc, az, 60.0, px_per_mm=px_per_mm)]
     if log.knots:
-        # disc through the knot nearest the board centre, at its height 60 mm from the pith
-        zk = np.array([log.knot_point(i, [60.0])[0, 2] for i in range(len(log.knots))])
-        zd = float(zk[np.argmin(np.abs(zk - zc))])
+        zk = np.array([log.knot_point(i, [50.0])[0, 2] for i in range(len(log.knots))])
+        cands = np.arange(log.pith_z_mm[0], log.pith_z_mm[-1], 5.0)
+        counts = np.array([np.sum(np.abs(zk - z) < 12.0) for z in cands])
+        z_best = cands[int(np.argmax(counts))]
+        zd = float(np.median(zk[np.abs(zk - z_best) < 12.0]))
     else:
         zd = float(log.pith_z_mm[len(log.pith_z_mm) // 2])
     zd = float(np.clip(zd, log.pith_z_mm[0], log.pith_z_mm[-1]))
