@@ -113,3 +113,31 @@ def test_diameter_model_against_the_bark_bumps(gran1):
     assert len(ratios_pow) == 12
     spread_pow, spread_quad = np.std(np.log(ratios_pow)), np.std(np.log(ratios_quad))
     assert spread_pow < 0.75 * spread_quad            # 0.33 vs 0.51
+
+
+def test_log_from_generated_duck_typed():
+    """The adapter for woodcam.logs' GeneratedLog, on a stand-in with the same interface."""
+    from types import SimpleNamespace
+
+    from woodcam.fields.tree_data import log_from_generated
+
+    knot = SimpleNamespace(
+        height=lambda rho: 500.0 + 0.2 * np.asarray(rho),
+        azimuth=lambda rho: np.full(np.shape(rho), 1.0),
+        radius=lambda rho: 0.1 * np.asarray(rho),
+        knot=SimpleNamespace(params=SimpleNamespace(gamma=0.81)),
+        end_mm=110.0, death_mm=70.0)
+    gen = SimpleNamespace(
+        length_mm=1000.0,
+        centreline_points=lambda z: np.stack([0.01 * z, np.zeros_like(z), z], 1),
+        outer_radius=lambda z, t: 120.0 + 2.0 * np.cos(t),
+        knots=(knot,))
+    log = log_from_generated(gen, z_step_mm=10.0, azimuths=90)
+    assert log.length_mm == 1000.0 and log.radii_mm.shape == (101, 90)
+    assert log.radius_at([300.0], [0.0])[0] == pytest.approx(122.0)
+    assert np.allclose(log.pith_at([400.0]), [[4.0, 0.0]])
+    k = log.knots[0]
+    z, w = k.axis_at([50.0])
+    assert z[0] == pytest.approx(510.0) and w[0] == pytest.approx(1.0)
+    assert k.diameter_at([50.0])[0] == pytest.approx(2 * 5.0 * 0.9)   # equal-area circle
+    assert (k.r_end_mm, k.r_death_mm) == (110.0, 70.0)

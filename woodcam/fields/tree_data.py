@@ -306,6 +306,41 @@ def simple_log(length_mm: float = 600.0, radius_mm: float = 100.0, knots=(), *,
                tuple(knots), name)
 
 
+def log_from_generated(gen, *, z_step_mm: float = 5.0, azimuths: int = 360,
+                       samples: int = KNOT_TABLE_SAMPLES, name: str = "generated") -> Log:
+    """Convert a synthetic log of :mod:`woodcam.logs.generate` (``GeneratedLog``) to a
+    :class:`Log`, by duck typing (``fields`` may not import ``logs``, which sits above it).
+
+    Uses ``gen.length_mm``, ``gen.centreline_points(z) -> (n, 3)``,
+    ``gen.outer_radius(z, theta) -> (n,)`` and, per knot ``k`` of ``gen.knots``:
+    ``k.height(rho)``, ``k.azimuth(rho)``, ``k.radius(rho)`` (horizontal semi-axis),
+    ``k.knot.params.gamma`` (vertical / horizontal semi-axis; the knot model here is round, so
+    the diameter is that of the circle of equal area, ``2 radius sqrt(gamma)``), ``k.end_mm``
+    and ``k.death_mm``. Both modules share the log frame (``z`` along the log, azimuth
+    counter-clockwise from ``+x``, mm).
+    """
+    L = float(gen.length_mm)
+    z = np.arange(0.0, L + 0.5 * z_step_mm, z_step_mm)
+    z[-1] = min(z[-1], L)
+    pith = np.asarray(gen.centreline_points(z), float)[:, :2]
+    th = 2 * np.pi * np.arange(azimuths) / azimuths
+    zz, tt = np.meshgrid(z, th, indexing="ij")
+    radii = np.asarray(gen.outer_radius(zz.ravel(), tt.ravel()), float).reshape(zz.shape)
+    knots = []
+    for k in gen.knots:
+        end = float(k.end_mm)
+        r = max(end, 1.0) * np.linspace(0.0, 1.0, samples) ** 2
+        rho = np.maximum(r, 1e-6)
+        hgt = np.asarray(k.height(rho), float)
+        az = np.asarray(k.azimuth(rho), float)
+        gamma = float(getattr(getattr(k.knot, "params", None), "gamma", 1.0))
+        diam = 2.0 * np.asarray(k.radius(rho), float) * np.sqrt(max(gamma, 0.0))
+        diam[0] = 0.0
+        knots.append(Knot(float(hgt[0]), float(az[0]), r, hgt - hgt[0], az - az[0],
+                          np.maximum(diam, 0.0), end, float(k.death_mm)))
+    return Log(z, pith, radii, tuple(knots), name)
+
+
 def write_log(log: Log, path) -> Path:
     """Write ``log`` as a woodcam log file (JSON, mm); returns the path."""
     path = Path(path)
