@@ -41,7 +41,6 @@ from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
-from scipy.ndimage import uniform_filter
 
 from ..errors import WoodcamError
 from .base import LogFrame, check_points
@@ -245,6 +244,8 @@ class KnottedLogField:
         self.backend = _pick_backend(backend)
         self.chunk = int(chunk or 2048)
         self.axis = (0.0, 0.0, 1.0)
+        from scipy.ndimage import uniform_filter
+
         # stem: relative growth speed per (height, azimuth)
         rs = uniform_filter(log.radii_mm, size=surface_smoothing, mode=("nearest", "wrap"))
         speed = rs / rs.mean(axis=1, keepdims=True)
