@@ -39,6 +39,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="tangential board centre height, facing azimuth and distance from "
                         "the pith (default: the board through the most knots at 60 mm)")
     r.add_argument("--disc", type=float, metavar="Z_MM", help="end-grain disc height")
+    r.add_argument("--radial", nargs=2, type=float, metavar=("Z_MM", "AZIMUTH_DEG"),
+                   help="also a quarter-sawn section through the pith (knots as spikes)")
     r.add_argument("--k-stem", type=float, default=1.5, help="smoothness k outside knots")
     r.add_argument("--k-knot", type=float, default=5.0, help="smoothness k inside knots")
     r.add_argument("--alive-darkening", type=float, default=0.35, help="0..1")
@@ -104,6 +106,9 @@ def run(args) -> int:
         secs[0] = lr.tangential_board(log, z, np.radians(az), off, px_per_mm=args.px_per_mm)
     if args.disc is not None:
         secs[1] = lr.end_grain_disc(log, args.disc, px_per_mm=args.px_per_mm)
+    if args.radial:
+        z, az = args.radial
+        secs.append(lr.radial_section(log, z, np.radians(az), px_per_mm=args.px_per_mm))
     for s in secs:
         img = lr.render_section(field, s, supersample=args.supersample)
         print(lr.save_png(img, out / f"{log.name}_{s.name}.png"))

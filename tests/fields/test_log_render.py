@@ -40,6 +40,17 @@ def test_board_shows_the_knot_where_it_crosses():
     assert ring < 0.45 * clear
 
 
+def test_radial_section_shows_the_knot_as_a_spike_from_the_pith():
+    log = _log()
+    s = lr.radial_section(log, 300.0, 0.0, length_mm=100, px_per_mm=1.0, margin_mm=0.0)
+    f = KnottedLogField(log)
+    P = s.points()
+    kn = f.knot_features(P.reshape(-1, 3))["knot"].reshape(P.shape[:2])
+    # rows: from x = +100 (row 0) through the pith (row 100) to x = -100; column 50: z = 300
+    assert kn[100 - 60, 50] > 0.9 and kn[100 - 90, 50] > 0.9      # along the knot axis
+    assert kn[100 + 60, 50] < 0.01 and kn[100 - 60, 20] < 0.01     # opposite side, beside it
+
+
 def test_disc_background_outside_the_log():
     log = _log()
     s = lr.end_grain_disc(log, 100.0, px_per_mm=1.0)
@@ -59,10 +70,10 @@ def _parse(argv):
 def test_cli_renders_a_log_file(tmp_path):
     path = write_log(_log(), tmp_path / "log.json")
     args = _parse(["log", "render", str(path), "--out", str(tmp_path / "out"),
-                   "--px-per-mm", "1", "--disc", "300"])
+                   "--px-per-mm", "1", "--disc", "300", "--radial", "300", "0"])
     assert args.func(args) == 0
     pngs = sorted((tmp_path / "out").glob("*.png"))
-    assert len(pngs) == 2
+    assert len(pngs) == 3
     for p in pngs:
         with Image.open(p) as im:
             assert im.mode == "RGB"

@@ -80,6 +80,21 @@ def tangential_board(log: Log, z_center_mm: float, azimuth_rad: float, offset_mm
                    f"board_z{z_center_mm:.0f}_az{np.degrees(azimuth_rad):.0f}_off{offset_mm:.0f}")
 
 
+def radial_section(log: Log, z_center_mm: float, azimuth_rad: float, *,
+                   length_mm: float = 300.0, px_per_mm: float = 2.0,
+                   margin_mm: float = 5.0) -> Section:
+    """Quarter-sawn face: the plane through the pith (at ``z_center_mm``) containing the
+    azimuth ``azimuth_rad``, from the far bark to the near bark. Columns run along the log
+    (``+z`` to the right); rows from ``azimuth_rad`` (top) through the pith to the opposite
+    side. Knots show as spikes growing out of the pith."""
+    c = log.pith_at(np.array([z_center_mm]))[0]
+    n = np.array([np.cos(azimuth_rad), np.sin(azimuth_rad), 0.0])
+    h = log.r_max_mm + margin_mm
+    origin = np.array([c[0], c[1], z_center_mm - 0.5 * length_mm]) + h * n
+    return Section(tuple(origin), (0, 0, 1), tuple(-n), (length_mm, 2 * h), px_per_mm,
+                   f"radial_z{z_center_mm:.0f}_az{np.degrees(azimuth_rad):.0f}")
+
+
 def busiest_board(log: Log, *, offset_mm: float = 60.0, length_mm: float = 600.0,
                   width_mm: float = 120.0, step_deg: float = 10.0, step_mm: float = 50.0):
     """The (z_center, azimuth) of the tangential board that cuts the most knots (knot axes
