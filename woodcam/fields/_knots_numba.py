@@ -44,6 +44,7 @@ def eval_points(pts, zg0, inv_dz, pxy, speed, bin_z0, inv_bw, bin_ptr, bin_knots
         prm[6], prm[7]
     d0, k0, d1, k1, noise_a, th, sharp = prm[8], prm[9], prm[10], prm[11], prm[12], prm[13], \
         prm[14]
+    band = prm[15]
     fr = f2 - f1
     m = pts.shape[0]
     nz = pxy.shape[0]
@@ -127,15 +128,16 @@ def eval_points(pts, zg0, inv_dz, pxy, speed, bin_z0, inv_bw, bin_ptr, bin_knots
             sm = mn + delta
             Td = r_death[k] / spi
             tb2 = tb
-            dead = sm > Td
-            if dead:
+            wd = min(max((sm - Td) / band, 0.0), 1.0)
+            wd = wd * wd * (3.0 - 2.0 * wd)
+            if wd > 0.0:
                 ta = ts - Td
-                tb2 = tb + ta
-                d2, _ = _delta(ts, tb2, kk + rate * ta)
+                tb2 = tb + wd * ta
+                d2, _ = _delta(ts, tb + ta, kk + rate * ta)
                 td2 = ta / f_len - 1.0
                 fac = 1.0 - 0.5 * fr * td2 / (0.3 + abs(td2)) + f1 + 0.5 * fr
                 fac = 1.0 + (fac - 1.0) * (1.0 - bfly * sb * sb)
-                delta = fac * d2
+                delta = (1.0 - wd) * delta + wd * fac * d2
             prog = (db - range0) / (range1 - range0)
             if prog > 0.0:
                 delta *= 1.0 - min(prog, 1.0)
@@ -151,9 +153,8 @@ def eval_points(pts, zg0, inv_dz, pxy, speed, bin_z0, inv_bw, bin_ptr, bin_knots
                 dv = min(max(6.0 * (ts - Td) / _L, 0.0), 1.0)
                 if dv > deadmax:
                     deadmax = dv
-            if (not dead) and (tb - Td) * vb < th and r_death[k] < r_end[k]:
-                gap = (Td - sm) * vb
-                if gap >= 0.0 and gap <= th:
+            if wd < 1.0 and (tb - Td) * vb < th and r_death[k] < r_end[k]:
+                if (Td - sm) * vb <= th:
                     outline = 1.0
         if inv2 > 0.0:
             tsoft = 1.0 / math.sqrt(inv2)

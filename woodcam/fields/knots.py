@@ -23,7 +23,11 @@ radius", so that all constants have physical units; ``years = t / ring_width_mm`
    ``tD = t_s - t_b`` (Sec. 4.2.1). After death (where ``smin > t_death``) the knot stops
    thickening (``t_b += t_s - t_death``), ``k`` rises with the time since death and ``delta`` is
    scaled by ``f(t_since_death, beta)`` that turns negative (inverted smoothing, Sec. 4.2.2) and
-   varies with the orientation ``beta`` around the knot axis (butterfly). Many knots:
+   varies with the orientation ``beta`` around the knot axis (butterfly). Unlike the seed's
+   shader, the dead form is blended in over ``death_band_mm`` of ``smin - t_death``: the
+   field then stays continuous on the ring-parallel surface where the switch happens away from
+   the knot, and still breaks (a step far narrower than the outline) at the knot's bark ring,
+   where the time since death is large. Many knots:
    ``min(t_s, t_b1..t_bn) + sum_i delta_i'`` (eq. 6), with each knot's delta faded to 0 over
    its distance range and inside other knots, as the seed's reference shader does.
 3. Knot features for rendering (Sec. 4.3): ``knot`` (darkening weight, 0..1), ``dead``
@@ -95,6 +99,9 @@ class KnotParams:
         death and tends to ``death_f_min`` (< 0: inverted smoothing) far after death.
     death_f_length_mm : float
         Stem radius after death over which ``f`` flips (shader ``1/f3``).
+    death_band_mm : float
+        Width (in ``smin - t_death``, mm of stem radius) over which the dead form blends in;
+        the seed switches abruptly, which also breaks rings far from the knot.
     butterfly : float
         0..1, how much weaker the inversion is above/below the knot than at its sides
         (``f = 1 + (f - 1)(1 - butterfly sin^2 beta)``, beta from the tangential direction).
@@ -119,6 +126,7 @@ class KnotParams:
     death_f_min: float = -1.5
     death_f_max: float = 0.2
     death_f_length_mm: float = 12.5
+    death_band_mm: float = 0.5
     butterfly: float = 0.5
     range_d0_mm: float = 10.0
     range_k0: float = 0.8
@@ -144,6 +152,8 @@ class KnotParams:
             v = getattr(self, name)
             if not (0 <= v <= 1):
                 raise WoodcamError(f"KnotParams.{name} must be in [0, 1]; got {v}")
+        if not self.death_band_mm > 0:
+            raise WoodcamError(f"KnotParams.death_band_mm must be > 0; got {self.death_band_mm}")
         if self.outline_mm < 0:
             raise WoodcamError(f"KnotParams.outline_mm must be >= 0 mm; got {self.outline_mm}")
 
@@ -371,7 +381,7 @@ class KnottedLogField:
         prm = np.array([P.k_stem, P.k_knot, P.k_transition_mm, P.death_k_rate_per_mm,
                         P.death_f_min, P.death_f_max, P.death_f_length_mm, P.butterfly,
                         P.range_d0_mm, P.range_k0, P.range_d1_mm, P.range_k1, P.knot_noise,
-                        P.outline_mm, P.knot_edge_sharpness])
+                        P.outline_mm, P.knot_edge_sharpness, P.death_band_mm])
         out = np.empty((5, n))
         best = np.empty(n, np.int64)
         eval_points(np.ascontiguousarray(p), self._zg0, self._inv_dz, self._pxy, self._speed,
@@ -463,16 +473,21 @@ class KnottedLogField:
         sm = mn + delta
         # --- dead knots (Sec. 4.2.2, eq. 5)
         Td = self._r_death[kidx, None] / sp                               # (K, m)
-        dead = (sm > Td) & inr
+        # the seed switches to the dead form where smin > t_death; blending it in over
+        # death_band_mm keeps the field continuous where that switch happens far from the
+        # knot (a ring-parallel surface), while at the knot's bark ring the time since death is
+        # large and the blend is a step narrower than the outline: the rings break there.
+        wd = np.where(inr, _smoothstep((sm - Td) * (1.0 / P.death_band_mm)), 0.0)
+        dead = wd > 0.0
         ta = np.where(dead, ts - Td, 0.0)
-        tb2 = tb + ta
+        tb2 = tb + wd * ta
         if dead.any():
-            d2, _ = _smooth_delta(ts, tb2, kk + P.death_k_rate_per_mm * ta)
+            d2, _ = _smooth_delta(ts, tb + ta, kk + P.death_k_rate_per_mm * ta)
             td2 = ta * (1.0 / P.death_f_length_mm) - 1.0
             fr = P.death_f_max - P.death_f_min
             fac = 1.0 - 0.5 * fr * td2 / (0.3 + np.abs(td2)) + P.death_f_min + 0.5 * fr
             fac = 1.0 + (fac - 1.0) * (1.0 - P.butterfly * sb * sb)
-            delta = np.where(dead, fac * d2, delta)
+            delta = np.where(dead, (1.0 - wd) * delta + wd * fac * d2, delta)
         # --- distance range of each knot: fade delta, drop the knot outside
         prog = np.clip((db - range0) / (range1 - range0), 0.0, 1.0)
         delta = np.where(inr, delta * (1.0 - prog), 0.0)
@@ -493,9 +508,9 @@ class KnottedLogField:
         deadf = np.max(np.where(inside_dead, np.clip(6.0 * (ts - Td) / L, 0.0, 1.0), 0.0), axis=0)
         gap = (Td - sm) * vb                                              # mm across the knot
         # the bark ring: just inside the knot's size at death, up to where the field jumps
-        outl = inr & ~dead & ((tb - Td) * vb < P.outline_mm) & \
+        outl = inr & (wd < 1.0) & ((tb - Td) * vb < P.outline_mm) & \
             (self._r_death[kidx, None] < self._r_end[kidx, None])
-        outline = np.max(outl & (gap >= 0.0) & (gap <= P.outline_mm), axis=0).astype(float)
+        outline = np.max(outl & (gap <= P.outline_mm), axis=0).astype(float)
         j = np.argmin(tb2, axis=0)
         cols = np.arange(m)
         best = np.where(np.isfinite(tbm), kidx[j], -1)
