@@ -1,0 +1,359 @@
+"""Random logs with known insides (seed 001 §4.2-4.3 "Generation").
+
+:func:`generate_log` draws a :class:`GeneratedLog`: a Chebyshev centreline, a heightmap surface
+(thickness eq. 6 + Fourier x Chebyshev base + knot bumps eq. 7-9 + Gabor grain) and knots of the
+9-parameter model (:mod:`.knot`) grouped in whorls. Knot parameters follow the compound Gaussian
+of eq. 10 at three levels (:class:`CompoundGaussian`): a log draws its own mean, each whorl draws
+its mean around the log's, and the knots of a whorl scatter around the whorl's mean with the
+covariance ``(sigma sigma^T) o P``. Knots of one whorl are therefore alike and whorls differ.
+Distributions live in the unconstrained coordinates of :func:`.fit.params_to_unconstrained`
+(log for lengths and ovality, logit for the incline ratios), so every draw satisfies the
+model's constraints (``alpha >= 0``, concave curves).
+
+Everything is in the log frame, mm: ``z`` (= log-centric ``l``) along the log from 0 to
+``length_mm``, the centreline at ``(x(z), y(z))``, azimuth ``theta`` from ``+x`` towards ``+y``.
+The same ``seed`` gives the identical log.
+
+Default statistics (:data:`SPRUCE`) and their sources:
+
+* knot parameters: mean and whorl-to-whorl / within-whorl spread of the 9-parameter fits to
+  the 108 CT-measured knots of the Norway spruce log ``Gran_1`` (Larsson et al. 2022, in
+  ``shared/data/trees``; whorls = knots whose start heights lie within 40 mm), see
+  ``tests/logs/test_fit.py::test_fit_real_log``. That log's lower knots droop (``phi1 < 0.5``,
+  negative end incline), as spruce branches do. Log-to-log spread: not measurable from one log;
+  set to half the whorl-to-whorl spread (an assumption).
+* whorl spacing and knots per whorl: ``Gran_1`` has 108 knots on 4 m; 170 +- 50 mm spacing
+  and 1 + Poisson(3.3) knots per whorl give ~100 knots per 4 m.
+* radius 125 mm and taper -0.004 mm/mm: ``Gran_1`` (mean radius 126 mm at the butt, 120 mm at
+  the top after its butt swell) and the common ~1 cm per m diameter taper of spruce sawlogs.
+* base-shape and centreline coefficient spreads: magnitudes of a 10 x 10 base fit and a 4-term
+  centreline fit to ``Gran_1`` (``fit_surface_base``, ``fit_centreline``).
+* death: a knot dies at a per-whorl fraction (``N(0.55, 0.15)`` clipped to [0.15, 1]) of its
+  length (a whorl's branches share the crown's history); a fifth of the whorls are overgrown,
+  their knots ending at ``U(0.35, 0.8)`` of the way to the surface (Gran_1 has many knots that
+  stop at 55-65 mm). Only knots that reach the surface make a bump.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from ..errors import WoodcamError
+from .centreline import Centreline
+from .fit import unconstrained_to_params
+from .knot import Knot
+from .surface import SurfaceBase, SurfaceKnot, Thickness, add_surface_knots, gabor_noise, heightmap_axes
+
+#: Order of the generated knot parameters (unconstrained; ``l0`` comes from the whorl).
+GEN_PARAM_NAMES = ("s0_mm", "log_gamma", "log_rho_max", "logit_phi0", "logit_phi1", "log_r_max",
+                   "logit_psi0", "logit_psi1")
+
+
+@dataclass(frozen=True)
+class CompoundGaussian:
+    """Three-level compound Gaussian of seed 001 eq. 10 over a parameter vector ``(p,)``.
+
+    ``mu_log ~ N(mean, sd_log^2)``; ``mu_whorl ~ N(mu_log, sd_whorl^2)``; the within-whorl SD
+    of a log is ``sigma = sd_knot * exp(N(0, sd_knot_logsd^2))`` (the "sigma ~ N(mu_2, sigma_2)"
+    level, kept positive); knots ``X ~ N(mu_whorl, (sigma sigma^T) o corr)``.
+    """
+
+    mean: np.ndarray
+    sd_log: np.ndarray
+    sd_whorl: np.ndarray
+    sd_knot: np.ndarray
+    corr: np.ndarray
+    sd_knot_logsd: float = 0.15
+
+    def __post_init__(self):
+        p = len(self.mean)
+        for name in ("sd_log", "sd_whorl", "sd_knot"):
+            v = np.asarray(getattr(self, name), float)
+            if v.shape != (p,) or np.any(v < 0):
+                raise WoodcamError(f"{name} must be ({p},) non-negative like mean; got {v!r}")
+        c = np.asarray(self.corr, float)
+        if c.shape != (p, p) or not np.allclose(c, c.T) or np.any(np.linalg.eigvalsh(c) < -1e-9):
+            raise WoodcamError(f"corr must be a symmetric positive semi-definite ({p}, {p}) matrix")
+
+    def sample_log(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """``(mu_log (p,), sigma_log (p,))`` for one log."""
+        mu = np.asarray(self.mean) + np.asarray(self.sd_log) * rng.standard_normal(len(self.mean))
+        sig = np.asarray(self.sd_knot) * np.exp(self.sd_knot_logsd * rng.standard_normal(len(self.mean)))
+        return mu, sig
+
+    def sample_whorl(self, rng: np.random.Generator, mu_log) -> np.ndarray:
+        """Mean ``(p,)`` of one whorl of a log with mean ``mu_log``."""
+        return mu_log + np.asarray(self.sd_whorl) * rng.standard_normal(len(mu_log))
+
+    def sample_knots(self, rng: np.random.Generator, mu_whorl, sigma, n: int) -> np.ndarray:
+        """``(n, p)`` knots of one whorl: ``N(mu_whorl, (sigma sigma^T) o corr)``."""
+        cov = np.outer(sigma, sigma) * np.asarray(self.corr)
+        w, v = np.linalg.eigh(cov)
+        L = v * np.sqrt(np.clip(w, 0, None))
+        return mu_whorl + rng.standard_normal((n, len(mu_whorl))) @ L.T
+
+
+@dataclass(frozen=True)
+class LogStats:
+    """Statistics of a species' logs used by :func:`generate_log` (see module docstring)."""
+
+    knots: CompoundGaussian
+    radius_mm: tuple[float, float] = (125.0, 15.0)          # butt radius mean, SD
+    taper: tuple[float, float] = (-0.004, 0.0015)           # mm of radius per mm of length
+    whorl_spacing_mm: tuple[float, float] = (170.0, 50.0)   # mean, SD; clipped at 60 mm
+    knots_per_whorl: float = 3.3                            # 1 + Poisson(this), at most 8
+    l0_jitter_mm: float = 8.0                               # knot start height around its whorl
+    azimuth_jitter_rad: float = 0.3                         # around the even split of a whorl
+    whorl_bulge_mm: tuple[float, float] = (1.5, 0.7)        # eq. 6 alpha_i (mean, SD), >= 0
+    whorl_bulge_width_mm: tuple[float, float] = (50.0, 10.0)  # eq. 6 gamma_i
+    overgrown_fraction: float = 0.2
+    death_fraction: tuple[float, float] = (0.55, 0.15)
+    centreline_sd_mm: tuple[float, ...] = (8.0, 3.0, 2.0, 0.6)
+    fourier_sd_mm: tuple[float, ...] = (0.0, 3.5, 3.5, 1.5, 1.5, 0.6, 0.6, 0.3, 0.3, 0.2)
+    cheb_decay: tuple[float, ...] = (1.0, 0.8, 0.5, 0.35, 0.25, 0.2, 0.15, 0.12, 0.1, 0.08)
+    bump_alpha: tuple[float, float] = (0.3, 0.5)            # uniform range, both axes
+    bump_m: tuple[float, float] = (2.0, 4.0)                # uniform range
+    bump_height_frac: tuple[float, float] = (0.08, 0.2)     # bump height / knot radius, uniform
+    grain_amplitude_mm: float = 0.25
+    grain_wavelength_mm: float = 10.0
+
+
+def _spruce_knot_stats() -> CompoundGaussian:
+    # Means and spreads from the Gran_1 fits (module docstring); order GEN_PARAM_NAMES.
+    mean = np.array([0.0, 0.0, np.log(30.0), 0.4, -0.3, np.log(9.0), 0.0, 0.0])
+    sd_whorl = np.array([0.5, 0.15, 0.5, 0.6, 0.25, 0.35, 0.8, 0.6])
+    sd_knot = np.array([0.8, 0.15, 0.5, 0.6, 0.25, 0.35, 0.8, 0.6])
+    corr = np.eye(8)
+    return CompoundGaussian(mean, 0.5 * sd_whorl, sd_whorl, sd_knot, corr)
+
+
+#: Default statistics: Norway spruce sawlogs (sources in the module docstring).
+SPRUCE = LogStats(knots=_spruce_knot_stats())
+
+
+@dataclass(frozen=True)
+class GeneratedKnot:
+    """A knot of a generated log, with what a growth-field converter needs (log frame, mm).
+
+    Attributes
+    ----------
+    knot : Knot
+        The 9-parameter model (log-centric).
+    whorl : int
+        Index of its whorl (0 at the butt).
+    end_mm : float
+        Distance from the pith where the knot ends (on the surface, or inside if overgrown).
+    death_mm : float
+        Distance from the pith where the branch died (``<= end_mm``).
+    reaches_surface : bool
+    centreline : Centreline
+        The log's centreline (to place the knot in the log frame).
+    """
+
+    knot: Knot
+    whorl: int
+    end_mm: float
+    death_mm: float
+    reaches_surface: bool
+    centreline: Centreline = field(repr=False)
+
+    @property
+    def start_height_mm(self) -> float:
+        """Height where the knot leaves the pith (``l0``)."""
+        return self.knot.params.l0_mm
+
+    @property
+    def start_azimuth_rad(self) -> float:
+        """Azimuth where the knot leaves the pith (its mean azimuth; generated knots have ``s0 = 0``)."""
+        return float(self.knot.azimuth(np.array([1e3]))[0]) if self.knot.params.s0_mm else self.knot.theta_mean_rad
+
+    def height(self, rho_mm) -> np.ndarray:
+        """Height (mm) of the knot centre at distance ``rho_mm : (n,)`` from the pith."""
+        return self.knot.height(rho_mm)
+
+    def azimuth(self, rho_mm) -> np.ndarray:
+        """Azimuth (rad) of the knot centre at ``rho_mm : (n,)`` (constant: no twist)."""
+        return self.knot.azimuth(rho_mm)
+
+    def radius(self, rho_mm) -> np.ndarray:
+        """Knot radius (mm, horizontal semi-axis) at ``rho_mm : (n,)``; vertical is ``gamma`` times it."""
+        return self.knot.radius(rho_mm)
+
+    def vertical_radius(self, rho_mm) -> np.ndarray:
+        """Vertical semi-axis (mm) at ``rho_mm : (n,)``."""
+        return self.knot.params.gamma * self.knot.radius(rho_mm)
+
+    def centerline(self, rho_mm) -> np.ndarray:
+        """Knot centre points ``(n, 3)`` in the log frame (mm) at ``rho_mm : (n,)`` from the pith."""
+        return self.centreline.to_log_frame(self.knot.centerline_lcs(rho_mm))
+
+
+@dataclass(frozen=True)
+class GeneratedLog:
+    """A generated log (module docstring for frames and units).
+
+    Attributes
+    ----------
+    length_mm : float
+    centreline : Centreline
+    thickness : Thickness
+        Mean radius along the log (eq. 6).
+    base : SurfaceBase
+        Out-of-round shape (its Fourier constant column is zero: the mean is ``thickness``).
+    knots : tuple[GeneratedKnot, ...]
+    surface_knots : tuple[SurfaceKnot, ...]
+    heightmap_mm : (n_l, n_theta) float
+        Full surface radius on the grid of :func:`.surface.heightmap_axes`.
+    seed : int or None
+    """
+
+    length_mm: float
+    centreline: Centreline
+    thickness: Thickness
+    base: SurfaceBase
+    knots: tuple[GeneratedKnot, ...]
+    surface_knots: tuple[SurfaceKnot, ...]
+    heightmap_mm: np.ndarray = field(repr=False)
+    seed: int | None = None
+
+    @property
+    def axes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Heights ``(n_l,)`` mm and azimuths ``(n_theta,)`` rad of :attr:`heightmap_mm`."""
+        return heightmap_axes(self.length_mm, *self.heightmap_mm.shape)
+
+    def base_radius(self, l_mm, theta_rad) -> np.ndarray:
+        """Smooth outer radius ``(n,)`` mm (thickness + base shape, no bumps or grain)."""
+        l = np.asarray(l_mm, float).reshape(-1)
+        t = np.asarray(theta_rad, float).reshape(-1)
+        return self.thickness(l) + self.base.at(l, t)
+
+    def outer_radius(self, l_mm, theta_rad, detail: Literal["full", "base"] = "full") -> np.ndarray:
+        """Outer radius ``(n,)`` mm at ``(l_mm[i], theta_rad[i])``, measured from the centreline.
+
+        ``detail="full"`` interpolates the heightmap bilinearly (periodic in azimuth);
+        ``"base"`` is the smooth :meth:`base_radius`.
+        """
+        if detail == "base":
+            return self.base_radius(l_mm, theta_rad)
+        if detail != "full":
+            raise WoodcamError(f"detail must be 'full' or 'base'; got {detail!r}")
+        l = np.asarray(l_mm, float).reshape(-1)
+        t = np.asarray(theta_rad, float).reshape(-1)
+        n_l, n_t = self.heightmap_mm.shape
+        fi = np.clip(l / self.length_mm * (n_l - 1), 0, n_l - 1 - 1e-9)
+        fj = np.mod(t, 2 * np.pi) / (2 * np.pi) * n_t
+        i0, j0 = np.floor(fi).astype(int), np.floor(fj).astype(int) % n_t
+        i1, j1 = np.minimum(i0 + 1, n_l - 1), (j0 + 1) % n_t
+        wi, wj = fi - np.floor(fi), fj - np.floor(fj)
+        h = self.heightmap_mm
+        return ((1 - wi) * ((1 - wj) * h[i0, j0] + wj * h[i0, j1]) + wi * ((1 - wj) * h[i1, j0] + wj * h[i1, j1]))
+
+    def centreline_points(self, l_mm) -> np.ndarray:
+        """Pith points ``(n, 3)`` in the log frame at heights ``l_mm : (n,)``."""
+        return self.centreline.points(l_mm)
+
+
+def _surface_distances(knots: list[Knot], base_radius, iterations: int = 6) -> np.ndarray:
+    """Distances ``(k,)`` from the pith where each knot's centre meets the smooth surface.
+
+    Fixed-point iteration ``rho <- R(l(rho), theta)``: converges because the radius changes
+    slowly along the log (|dR/dl| << 1/|dl/drho|).
+    """
+    theta = np.array([k.theta_mean_rad for k in knots])
+    rho = base_radius(np.array([k.params.l0_mm for k in knots]), theta)
+    for _ in range(iterations):
+        l = np.array([k.height(rho[i:i + 1])[0] for i, k in enumerate(knots)])
+        rho = base_radius(l, theta)
+    return rho
+
+
+def generate_log(seed: int | np.random.Generator | None = 0, *, length_mm: float = 4000.0,
+                 stats: LogStats = SPRUCE, heightmap_shape: tuple[int, int] | None = None) -> GeneratedLog:
+    """Draw a random log (seed 001 §4); same integer ``seed`` -> identical log.
+
+    Parameters
+    ----------
+    seed : int, numpy Generator or None
+    length_mm : float
+        Log length (mm), > 100.
+    stats : LogStats
+        Distributions; default :data:`SPRUCE`.
+    heightmap_shape : (n_l, n_theta), optional
+        Heightmap grid; default one row per 5 mm and one column per degree.
+    """
+    if not (np.isfinite(length_mm) and length_mm > 100):
+        raise WoodcamError(f"length_mm must be > 100 mm; got {length_mm!r}")
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    n_l, n_t = heightmap_shape or (int(np.ceil(length_mm / 5.0)) + 1, 360)
+    if n_l < 10 or n_t < 16:
+        raise WoodcamError(f"heightmap_shape must be at least (10, 16); got {(n_l, n_t)}")
+    l_ax, t_ax = heightmap_axes(length_mm, n_l, n_t)
+
+    # log level
+    r0 = float(np.clip(rng.normal(*stats.radius_mm), 40.0, 400.0))
+    taper = float(rng.normal(*stats.taper))
+    csd = np.asarray(stats.centreline_sd_mm)
+    centreline = Centreline(length_mm, csd * rng.standard_normal(len(csd)), csd * rng.standard_normal(len(csd)))
+    fsd = np.asarray(stats.fourier_sd_mm)[None, :] * np.asarray(stats.cheb_decay)[:, None]
+    base = SurfaceBase(length_mm, fsd * rng.standard_normal(fsd.shape))
+    mu_log, sigma_log = stats.knots.sample_log(rng)
+
+    # whorls
+    heights = []
+    h = rng.uniform(0.2, 1.0) * stats.whorl_spacing_mm[0]
+    while h < length_mm - 20.0:
+        heights.append(h)
+        h += max(rng.normal(*stats.whorl_spacing_mm), 60.0)
+    heights = np.array(heights)
+    nw = len(heights)
+    bulge = np.abs(rng.normal(*stats.whorl_bulge_mm, size=nw))
+    width = np.clip(rng.normal(*stats.whorl_bulge_width_mm, size=nw), 10.0, None)
+    shift = rng.normal(0.0, 10.0, size=nw)
+    thickness = Thickness(taper, r0, heights, bulge, shift, width)
+
+    def base_radius(l, t):
+        return thickness(l) + base.at(l, t)
+
+    drawn: list[tuple[Knot, int, bool, float, float]] = []
+    for w, hw in enumerate(heights):
+        n = int(min(1 + rng.poisson(stats.knots_per_whorl), 8))
+        mu_w = stats.knots.sample_whorl(rng, mu_log)
+        z = stats.knots.sample_knots(rng, mu_w, sigma_log, n)
+        az0 = rng.uniform(0, 2 * np.pi)
+        az = az0 + 2 * np.pi * np.arange(n) / n + rng.normal(0, stats.azimuth_jitter_rad, n)
+        l0 = hw + rng.normal(0, stats.l0_jitter_mm, n)
+        overgrown = bool(rng.uniform() < stats.overgrown_fraction)
+        end_frac = rng.uniform(0.35, 0.8) if overgrown else 1.0
+        death_frac = float(np.clip(rng.normal(*stats.death_fraction), 0.15, 1.0))
+        for i in range(n):
+            p = unconstrained_to_params(np.r_[0.0, l0[i], z[i, 1:]])
+            drawn.append((Knot(p, float(np.mod(az[i], 2 * np.pi))), w, overgrown, end_frac, death_frac))
+    rho_s = _surface_distances([d[0] for d in drawn], base_radius) if drawn else np.zeros(0)
+    knots = [GeneratedKnot(k, w, float(r * ef), float(r * ef * df), not og, centreline)
+             for (k, w, og, ef, df), r in zip(drawn, rho_s)]
+
+    # surface: thickness + base + bumps + grain
+    hm = thickness(l_ax)[:, None] + base.grid(l_ax, t_ax)
+    bumps = []
+    for gk in knots:
+        if not gk.reaches_surface:
+            continue
+        rho = np.array([gk.end_mm])
+        lk = float(gk.height(rho)[0])
+        if not (0.0 <= lk <= length_mm):
+            continue
+        r = float(gk.radius(rho)[0])
+        stretch = float(np.sqrt(1 + gk.knot.height_slope(rho)[0] ** 2))
+        a_l, a_s = rng.uniform(*stats.bump_alpha, size=2)
+        bumps.append(SurfaceKnot(lk, float(gk.azimuth(rho)[0]), gk.knot.params.gamma * r * stretch, r,
+                                 float(a_l), float(a_s), float(rng.uniform(*stats.bump_m)),
+                                 float(r * rng.uniform(*stats.bump_height_frac))))
+    hm = add_surface_knots(hm, l_ax, t_ax, bumps, arc_radius_mm=r0)
+    ds = 2 * np.pi * r0 / n_t
+    hm += gabor_noise(n_l, n_t, l_ax[1] - l_ax[0], ds, rng, wavelength_mm=stats.grain_wavelength_mm,
+                      amplitude_mm=stats.grain_amplitude_mm)
+    return GeneratedLog(float(length_mm), centreline, thickness, base, tuple(knots), tuple(bumps), hm,
+                        seed if isinstance(seed, (int, np.integer)) else None)
