@@ -28,7 +28,7 @@ from ..errors import WoodcamError
 from .knot import MAX_INCLINE, Knot, KnotParams, to_slr
 
 _LOGIT_CLIP = 30.0  # only guards exp() overflow; sigmoid(30) is 1 to double precision
-_INIT_LOGIT = 3.0  # start LM with ratios in [0.05, 0.95], where the sigmoid still has slope
+_INIT_LOGIT = 1.5  # start LM with ratios in [0.18, 0.82], where the sigmoid still has slope
 
 
 def _logit(p):
@@ -103,10 +103,13 @@ def _init_params(slr: np.ndarray) -> np.ndarray:
         k = Knot(unconstrained_to_params(np.r_[s0, z[0], 0.0, z[1], z[2], z[3], 0.0, 0.0, 0.0]))
         return k.height(rho_c) - l_c
 
+    # a nearly straight knot leaves rho_max free: keep it inside the sampled range
+    lo = np.array([-np.inf, np.log(max(0.05 * rho_top, 0.5)), -4.0, -4.0])
+    hi = np.array([np.inf, np.log(rho_top), 4.0, 4.0])
     best = None
-    for frac in (0.1, 0.35, 1.0):
+    for frac in (0.1, 0.35, 0.95):
         z0 = np.array([l_c[0] - m * rho_c[0], np.log(frac * rho_top), 0.0, _logit(phi1)])
-        r = least_squares(traj_res, z0, method="trf")
+        r = least_squares(traj_res, np.clip(z0, lo + 1e-9, hi - 1e-9), method="trf", bounds=(lo, hi))
         if best is None or r.cost < best.cost:
             best = r
     l0, lrm, lp0, lp1 = best.x
