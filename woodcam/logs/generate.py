@@ -44,7 +44,7 @@ import numpy as np
 from ..errors import WoodcamError
 from .centreline import Centreline
 from .fit import unconstrained_to_params
-from .knot import Knot
+from .knot import Knot, KnotParams
 from .surface import SurfaceBase, SurfaceKnot, Thickness, add_surface_knots, gabor_noise, heightmap_axes
 
 #: Order of the generated knot parameters (unconstrained; ``l0`` comes from the whorl).
@@ -94,6 +94,60 @@ class CompoundGaussian:
         w, v = np.linalg.eigh(cov)
         L = v * np.sqrt(np.clip(w, 0, None))
         return mu_whorl + rng.standard_normal((n, len(mu_whorl))) @ L.T
+
+
+def group_whorls(start_heights_mm, gap_mm: float = 40.0) -> np.ndarray:
+    """Whorl index ``(n,)`` of knots by start height: a new whorl where sorted heights jump > ``gap_mm``."""
+    h = np.asarray(start_heights_mm, dtype=float).reshape(-1)
+    order = np.argsort(h)
+    ids = np.empty(len(h), dtype=int)
+    ids[order] = np.concatenate([[0], np.cumsum(np.diff(h[order]) > gap_mm)]) if len(h) else []
+    return ids
+
+
+def knot_stats_from_fits(params, whorl, *, shrink: float = 0.5, logit_clip: float = 4.0) -> CompoundGaussian:
+    """Estimate the knot-level :class:`CompoundGaussian` from fitted knots of one log (seed 001 §4.2).
+
+    Parameters
+    ----------
+    params : (n, 9) float
+        :class:`KnotParams` vectors (e.g. from :func:`.fit.fit_knot`).
+    whorl : (n,) int
+        Whorl index of each knot (:func:`group_whorls`).
+    shrink : float
+        Weight of the identity in the within-whorl correlation (few knots per whorl make the
+        raw estimate noisy).
+    logit_clip : float
+        Ratios fitted on their bounds are pulled to ``|logit| <= logit_clip`` first.
+
+    Within-whorl SD is pooled over whorls with >= 2 knots; whorl-to-whorl SD is the SD of the
+    whorl means less the within-whorl part; log-to-log SD is not estimable from one log and is
+    set to half the whorl-to-whorl SD (an assumption).
+    """
+    from .fit import params_to_unconstrained
+
+    P = np.asarray(params, dtype=float)
+    w = np.asarray(whorl, dtype=int)
+    z = np.array([params_to_unconstrained(KnotParams.from_array(p)) for p in P])
+    z = np.delete(z, 1, axis=1)  # drop l0: it comes from the whorl height
+    z[:, [3, 4, 6, 7]] = np.clip(z[:, [3, 4, 6, 7]], -logit_clip, logit_clip)
+    ids = np.unique(w)
+    means = np.array([z[w == i].mean(0) for i in ids])
+    counts = np.array([(w == i).sum() for i in ids])
+    resid = np.concatenate([z[w == i] - z[w == i].mean(0) for i in ids if (w == i).sum() >= 2])
+    dof = int(sum(c - 1 for c in counts if c >= 2))
+    sd_knot = np.sqrt((resid**2).sum(0) / max(dof, 1))
+    between = means.var(0, ddof=1) - sd_knot**2 * np.mean(1.0 / counts)
+    sd_whorl = np.sqrt(np.clip(between, 0.0, None))
+    sd = resid.std(0)
+    ok = sd > 1e-12
+    corr = np.eye(z.shape[1])
+    if len(resid) > 2 and ok.sum() > 1:
+        r = resid[:, ok] / sd[ok]
+        corr[np.ix_(ok, ok)] = r.T @ r / len(r)
+    corr = (1 - shrink) * corr + shrink * np.eye(z.shape[1])
+    np.fill_diagonal(corr, 1.0)
+    return CompoundGaussian(z.mean(0), 0.5 * sd_whorl, sd_whorl, sd_knot, corr)
 
 
 @dataclass(frozen=True)
