@@ -19,7 +19,7 @@ log = generate_log(seed, length_mm=2000.0)
 
 # 3-D view: lying log, translucent surface, live knots brown, dead parts dark
 pv.OFF_SCREEN = True
-pl = pv.Plotter(off_screen=True, window_size=(1400, 500))
+pl = pv.Plotter(off_screen=True, window_size=(1400, 420))
 s = surface_mesh(log, max_rows=200, max_cols=120)
 rot = np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0]], float)  # log axis z -> view x
 pl.add_mesh(pv.wrap(s.vertices @ rot.T).cast_to_unstructured_grid() if False else
@@ -33,11 +33,11 @@ for k in log.knots:
 pl.set_background("white")
 pl.camera_position = "xz"
 pl.camera.elevation = 20
-pl.camera.zoom(1.6)
+pl.camera.zoom(2.3)
 pl.screenshot(f"{out}/log_knots.png")
 
 img, (lo, hi) = heightmap_image(log, "detail")
-fig, ax = plt.subplots(figsize=(7, 3.2), dpi=110)
+fig, ax = plt.subplots(figsize=(7, 3.2), dpi=90)
 im = ax.imshow((lo + img * (hi - lo)).T[::-1], cmap="RdBu_r", vmin=lo, vmax=hi, aspect="auto",
                extent=[0, log.length_mm, 0, 360])
 ax.set_xlabel("l along the log (mm)")

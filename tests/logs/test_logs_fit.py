@@ -85,10 +85,12 @@ def test_gran_knot_rows_load_and_sample(gran_knots_json):
 
 
 def test_fit_real_log_subset(gran_knots_json):
-    table = fit_gran_knots(gran_knots_json, indices=range(0, 108, 9))
+    """Four knots spread along the log (the full table is the slow test below)."""
+    table = fit_gran_knots(gran_knots_json, indices=[0, 27, 54, 81])
     s = table.summary()
-    assert s["knots"] == 12
+    assert s["knots"] == 4
     assert s["rmse_mean_mm"] < REAL_MEAN_RMSE_MM
+    assert all(f.rmse_mm < f.init_rmse_mm + 1e-9 for f in table.fits)
 
 
 @pytest.mark.slow

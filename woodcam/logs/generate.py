@@ -14,29 +14,41 @@ Everything is in the log frame, mm: ``z`` (= log-centric ``l``) along the log fr
 ``length_mm``, the centreline at ``(x(z), y(z))``, azimuth ``theta`` from ``+x`` towards ``+y``.
 The same ``seed`` gives the identical log.
 
-Default statistics (:data:`SPRUCE`) and their sources:
+Default statistics (:data:`SPRUCE`) and their sources. The reference is the CT-measured
+Norway spruce log ``Gran_1`` (Larsson et al. 2022, ``shared/data/trees``: 108 knots in 36
+whorls over 4 m), whose knots we fitted with :func:`.fit.fit_gran_knots` (mean RMSE 1.05 mm):
 
-* knot parameters: mean and whorl-to-whorl / within-whorl spread of the 9-parameter fits to
-  the 108 CT-measured knots of the Norway spruce log ``Gran_1`` (Larsson et al. 2022, in
-  ``shared/data/trees``; whorls = knots whose start heights lie within 40 mm), see
-  ``tests/logs/test_fit.py::test_fit_real_log``. That log's lower knots droop (``phi1 < 0.5``,
-  negative end incline), as spruce branches do. Log-to-log spread: not measurable from one log;
-  set to half the whorl-to-whorl spread (an assumption).
-* whorl spacing and knots per whorl: ``Gran_1`` has 108 knots on 4 m; 170 +- 50 mm spacing
-  and 1 + Poisson(3.3) knots per whorl give ~100 knots per 4 m.
-* radius 125 mm and taper -0.004 mm/mm: ``Gran_1`` (mean radius 126 mm at the butt, 120 mm at
-  the top after its butt swell) and the common ~1 cm per m diameter taper of spruce sawlogs.
-* base-shape and centreline coefficient spreads: magnitudes of a 10 x 10 base fit and a 4-term
-  centreline fit to ``Gran_1`` (``fit_surface_base``, ``fit_centreline``).
-* death: a knot dies at a per-whorl fraction (``N(0.55, 0.15)`` clipped to [0.15, 1]) of its
-  length (a whorl's branches share the crown's history); a fifth of the whorls are overgrown,
-  their knots ending at ``U(0.35, 0.8)`` of the way to the surface (Gran_1 has many knots that
-  stop at 55-65 mm). Only knots that reach the surface make a bump.
+* knot parameter means follow the medians of those fits where they are well identified: the
+  end incline ``phi1`` (median 0.436, i.e. -10 degrees: this spruce's knots droop) and the
+  ovality (median 0.94). The raw spreads of the fits are not usable as they are: for nearly
+  straight knots ``rho_max`` and ``phi0`` trade off (fitted ``rho_max`` is bimodal, 6-130 mm)
+  and ``psi0`` only shapes the first millimetres, so their fitted spread is mostly
+  non-identifiability. :func:`knot_stats_from_fits` gives those raw estimates; the defaults
+  instead pick ``rho_max`` ~ 40 mm, ``r_max`` ~ 6 mm and ``psi1`` ~ 0.4 so that a typical knot
+  ends with Gran_1's median end radius (10 mm, from its diameter model), and spreads chosen
+  by eye so generated knots look like Gran_1's. Whorl-to-whorl spread exceeds the within-whorl
+  spread (seed 001 §4.2: knots of a whorl are alike); in Gran_1 this shows for size
+  (``log r_max``: 0.62 between whorls) and ovality. Log-to-log spread: half the
+  whorl-to-whorl spread (one log cannot tell; an assumption). Knot radius at the surface is
+  capped at ``max_knot_radius_mm`` by scaling ``r_max`` (the radius curve is linear in it).
+* whorls: Gran_1's whorl spacing is 110 +- 39 mm with 3.0 knots per whorl; we use
+  110 +- 40 mm and 1 + Poisson(2) knots (~108 knots per 4 m).
+* radius 125 +- 15 mm and taper -0.004 mm/mm: Gran_1 (mean radius 126 mm at the butt, 120 mm
+  at the top after its butt swell) and the common ~1 cm per m diameter taper of sawlogs.
+* base-shape and centreline coefficient spreads: magnitudes of a 10 x 10 base fit
+  (RMSE 2.4 mm) and a 4-term centreline fit to Gran_1 (``fit_surface_base``,
+  ``fit_centreline``).
+* death: a knot dies at a per-whorl fraction ``N(0.85, 0.25)`` (clipped to [0.3, 1]) of its
+  length (a whorl's branches share the crown's history); Gran_1's death fraction has median
+  0.78 and 38 % of its knots live to their end. A tenth of the whorls are overgrown, their
+  knots ending at ``U(0.45, 0.8)`` of the way to the surface (9 % of Gran_1's knots end
+  before 100 mm). Only knots that reach the surface make a bump.
+* surface bumps (eq. 7-9) and grain: chosen by eye (no heightmap of a debarked log here).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -157,14 +169,16 @@ class LogStats:
     knots: CompoundGaussian
     radius_mm: tuple[float, float] = (125.0, 15.0)          # butt radius mean, SD
     taper: tuple[float, float] = (-0.004, 0.0015)           # mm of radius per mm of length
-    whorl_spacing_mm: tuple[float, float] = (170.0, 50.0)   # mean, SD; clipped at 60 mm
-    knots_per_whorl: float = 3.3                            # 1 + Poisson(this), at most 8
+    whorl_spacing_mm: tuple[float, float] = (110.0, 40.0)   # mean, SD; clipped at 40 mm
+    knots_per_whorl: float = 2.0                            # 1 + Poisson(this), at most 8
     l0_jitter_mm: float = 8.0                               # knot start height around its whorl
     azimuth_jitter_rad: float = 0.3                         # around the even split of a whorl
     whorl_bulge_mm: tuple[float, float] = (1.5, 0.7)        # eq. 6 alpha_i (mean, SD), >= 0
     whorl_bulge_width_mm: tuple[float, float] = (50.0, 10.0)  # eq. 6 gamma_i
-    overgrown_fraction: float = 0.2
-    death_fraction: tuple[float, float] = (0.55, 0.15)
+    overgrown_fraction: float = 0.1
+    overgrown_end: tuple[float, float] = (0.45, 0.8)        # uniform fraction of the way out
+    max_knot_radius_mm: float = 30.0
+    death_fraction: tuple[float, float] = (0.85, 0.25)      # clipped to [0.3, 1]
     centreline_sd_mm: tuple[float, ...] = (8.0, 3.0, 2.0, 0.6)
     fourier_sd_mm: tuple[float, ...] = (0.0, 3.5, 3.5, 1.5, 1.5, 0.6, 0.6, 0.3, 0.3, 0.2)
     cheb_decay: tuple[float, ...] = (1.0, 0.8, 0.5, 0.35, 0.25, 0.2, 0.15, 0.12, 0.1, 0.08)
@@ -176,12 +190,12 @@ class LogStats:
 
 
 def _spruce_knot_stats() -> CompoundGaussian:
-    # Means and spreads from the Gran_1 fits (module docstring); order GEN_PARAM_NAMES.
-    mean = np.array([0.0, 0.0, np.log(30.0), 0.4, -0.3, np.log(9.0), 0.0, 0.0])
-    sd_whorl = np.array([0.5, 0.15, 0.5, 0.6, 0.25, 0.35, 0.8, 0.6])
-    sd_knot = np.array([0.8, 0.15, 0.5, 0.6, 0.25, 0.35, 0.8, 0.6])
-    corr = np.eye(8)
-    return CompoundGaussian(mean, 0.5 * sd_whorl, sd_whorl, sd_knot, corr)
+    # Order GEN_PARAM_NAMES; sources in the module docstring.
+    mean = np.array([0.0, np.log(0.94), np.log(40.0), np.log(0.2 / 0.8), np.log(0.436 / 0.564), np.log(6.0), 0.5,
+                     np.log(0.4 / 0.6)])
+    sd_whorl = np.array([0.0, 0.12, 0.25, 0.5, 0.2, 0.35, 0.5, 0.5])
+    sd_knot = np.array([0.0, 0.06, 0.15, 0.3, 0.1, 0.15, 0.3, 0.3])
+    return CompoundGaussian(mean, 0.5 * sd_whorl, sd_whorl, sd_knot, np.eye(8))
 
 
 #: Default statistics: Norway spruce sawlogs (sources in the module docstring).
@@ -360,7 +374,7 @@ def generate_log(seed: int | np.random.Generator | None = 0, *, length_mm: float
     h = rng.uniform(0.2, 1.0) * stats.whorl_spacing_mm[0]
     while h < length_mm - 20.0:
         heights.append(h)
-        h += max(rng.normal(*stats.whorl_spacing_mm), 60.0)
+        h += max(rng.normal(*stats.whorl_spacing_mm), 40.0)
     heights = np.array(heights)
     nw = len(heights)
     bulge = np.abs(rng.normal(*stats.whorl_bulge_mm, size=nw))
@@ -380,12 +394,18 @@ def generate_log(seed: int | np.random.Generator | None = 0, *, length_mm: float
         az = az0 + 2 * np.pi * np.arange(n) / n + rng.normal(0, stats.azimuth_jitter_rad, n)
         l0 = hw + rng.normal(0, stats.l0_jitter_mm, n)
         overgrown = bool(rng.uniform() < stats.overgrown_fraction)
-        end_frac = rng.uniform(0.35, 0.8) if overgrown else 1.0
-        death_frac = float(np.clip(rng.normal(*stats.death_fraction), 0.15, 1.0))
+        end_frac = rng.uniform(*stats.overgrown_end) if overgrown else 1.0
+        death_frac = float(np.clip(rng.normal(*stats.death_fraction), 0.3, 1.0))
         for i in range(n):
             p = unconstrained_to_params(np.r_[0.0, l0[i], z[i, 1:]])
             drawn.append((Knot(p, float(np.mod(az[i], 2 * np.pi))), w, overgrown, end_frac, death_frac))
     rho_s = _surface_distances([d[0] for d in drawn], base_radius) if drawn else np.zeros(0)
+    for i, ((k, *rest), r) in enumerate(zip(drawn, rho_s)):
+        r_end = float(k.radius(np.array([r]))[0])
+        if r_end > stats.max_knot_radius_mm:  # cap: K_r is linear in r_max
+            p = k.params
+            k = Knot(replace(p, r_max_mm=p.r_max_mm * stats.max_knot_radius_mm / r_end), k.theta_mean_rad)
+            drawn[i] = (k, *rest)
     knots = [GeneratedKnot(k, w, float(r * ef), float(r * ef * df), not og, centreline)
              for (k, w, og, ef, df), r in zip(drawn, rho_s)]
 
