@@ -193,16 +193,22 @@ def gran_knot_diameter(row, r_mm) -> np.ndarray:
 
 
 def sample_gran_knot_points(row, *, n_along: int = 24, n_around: int = 12,
-                            r_start_mm: float = 5.0) -> np.ndarray:
+                            r_start_mm: float = 1.0, spacing_power: float = 1.5) -> np.ndarray:
     """Points on one ``Gran_1`` knot's surface, ``(n_along * n_around, 3)`` as ``(theta, l, rho)``.
 
     Centre curve (data README): height ``z0 + D sqrt(r) + E r`` and azimuth ``w0 + G ln r`` at
     distance ``r`` from the pith, for ``r`` in ``[r_start_mm, r_end]``; circular cross-sections
     of diameter :func:`gran_knot_diameter` perpendicular to the 3-D curve. Coordinates are
     relative to the pith, so they are log-centric directly (``l`` = height).
+
+    Sections are spaced as ``u ** spacing_power`` (``u`` uniform in [0, 1]): denser near the
+    pith. With uniform spacing from 5 mm the fit often replaced the first millimetres by a
+    steep spurious rise, putting the knot origin ``l0`` 20-30 mm below ``z0`` at a slightly
+    lower RMSE; starting at 1 mm with power 1.5 pins ``l0`` within 1 mm of ``z0``.
     """
     A, B, z0, D, E, w0, G, r_end, _ = np.asarray(row, dtype=float)
-    r = np.linspace(r_start_mm, max(r_end, r_start_mm + 1.0), n_along)[:, None]
+    u = np.linspace(0.0, 1.0, n_along) ** spacing_power  # denser near the pith, where l0 is pinned
+    r = (r_start_mm + (max(r_end, r_start_mm + 1.0) - r_start_mm) * u)[:, None]
     w = w0 + G * np.log(r)
     z = z0 + D * np.sqrt(r) + E * r
     c = np.concatenate([r * np.cos(w), r * np.sin(w), z], axis=1)
