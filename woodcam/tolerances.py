@@ -34,3 +34,8 @@ MAX_BATCH_POINTS = 1 << 18
 #: Smallest allowed radius-scaling value in the radial family (eq. 9 of seed 000) after the
 #: linear blend; guards division by zero when a blend is extrapolated.
 MIN_RADIUS_SCALE = 0.05
+
+#: A point counts as on a knot's surface (the envelope of its elliptic cross-sections) when its
+#: signed distance is above -this (mm): the projection onto the knot's centre curve converges
+#: to ~1e-5 mm, and cross-section points truly inside a sharply bent knot are >= 0.01 mm in.
+KNOT_SURFACE_TOL_MM = 1e-3

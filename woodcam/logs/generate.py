@@ -235,8 +235,9 @@ class GeneratedKnot:
 
     @property
     def start_azimuth_rad(self) -> float:
-        """Azimuth where the knot leaves the pith (its mean azimuth; generated knots have ``s0 = 0``)."""
-        return float(self.knot.azimuth(np.array([1e3]))[0]) if self.knot.params.s0_mm else self.knot.theta_mean_rad
+        """Azimuth (rad) where the knot leaves the pith: its mean azimuth (generated knots have
+        ``s0 = 0``, so the azimuth is the same all along the knot)."""
+        return self.knot.theta_mean_rad
 
     def height(self, rho_mm) -> np.ndarray:
         """Height (mm) of the knot centre at distance ``rho_mm : (n,)`` from the pith."""
@@ -396,7 +397,7 @@ def generate_log(seed: int | np.random.Generator | None = 0, *, length_mm: float
         overgrown = bool(rng.uniform() < stats.overgrown_fraction)
         end_frac = rng.uniform(*stats.overgrown_end) if overgrown else 1.0
         death_frac = float(np.clip(rng.normal(*stats.death_fraction), 0.3, 1.0))
-        for i in range(n):
+        for i in range(n):  # s0 = 0: the knot's azimuth is its drawn azimuth (z[:, 0] unused)
             p = unconstrained_to_params(np.r_[0.0, l0[i], z[i, 1:]])
             drawn.append((Knot(p, float(np.mod(az[i], 2 * np.pi))), w, overgrown, end_frac, death_frac))
     rho_s = _surface_distances([d[0] for d in drawn], base_radius) if drawn else np.zeros(0)

@@ -44,6 +44,7 @@ from dataclasses import astuple, dataclass, fields
 import numpy as np
 
 from ..errors import WoodcamError
+from ..tolerances import KNOT_SURFACE_TOL_MM
 
 #: Largest incline angle of a knot trajectory against the radial direction (rad). 80 degrees:
 #: a knot steeper than that would run along the pith, which branches do not do.
@@ -257,7 +258,7 @@ class Knot:
         """
         slr = self.surface_points_slr(rho_mm, n_around)
         slr = slr[(slr[:, 2] > min_rho_mm) & (np.abs(slr[:, 0]) < 0.5 * np.pi * slr[:, 2])]
-        slr = slr[self.surface_residuals(slr) > -1e-3]
+        slr = slr[self.surface_residuals(slr) > -KNOT_SURFACE_TOL_MM]
         return np.stack([self.theta_mean_rad + slr[:, 0] / slr[:, 2], slr[:, 1], slr[:, 2]], axis=1)
 
     def surface_residuals(self, points_slr, iterations: int = 6) -> np.ndarray:
