@@ -16,21 +16,25 @@ The same ``seed`` gives the identical log.
 
 Default statistics (:data:`SPRUCE`) and their sources. The reference is the CT-measured
 Norway spruce log ``Gran_1`` (Larsson et al. 2022, ``shared/data/trees``: 108 knots in 36
-whorls over 4 m), whose knots we fitted with :func:`.fit.fit_gran_knots` (mean RMSE 1.05 mm):
+whorls over 4 m), whose knots we fitted with :func:`.fit.fit_gran_knots` (mean RMSE 1.28 mm,
+knot origins within 1.5 mm of the data's):
 
 * knot parameter means follow the medians of those fits where they are well identified: the
-  end incline ``phi1`` (median 0.436, i.e. -10 degrees: this spruce's knots droop) and the
-  ovality (median 0.94). The raw spreads of the fits are not usable as they are: for nearly
-  straight knots ``rho_max`` and ``phi0`` trade off (fitted ``rho_max`` is bimodal, 6-130 mm)
-  and ``psi0`` only shapes the first millimetres, so their fitted spread is mostly
-  non-identifiability. :func:`knot_stats_from_fits` gives those raw estimates; the defaults
-  instead pick ``rho_max`` ~ 40 mm, ``r_max`` ~ 6 mm and ``psi1`` ~ 0.4 so that a typical knot
-  ends with Gran_1's median end radius (10 mm, from its diameter model), and spreads chosen
-  by eye so generated knots look like Gran_1's. Whorl-to-whorl spread exceeds the within-whorl
-  spread (seed 001 §4.2: knots of a whorl are alike); in Gran_1 this shows for size
-  (``log r_max``: 0.62 between whorls) and ovality. Log-to-log spread: half the
-  whorl-to-whorl spread (one log cannot tell; an assumption). Knot radius at the surface is
-  capped at ``max_knot_radius_mm`` by scaling ``r_max`` (the radius curve is linear in it).
+  end incline ``phi1`` (median 0.434, i.e. -11 degrees: this spruce's knots droop), a nearly
+  straight start (``phi0`` median 0.08; we use 0.1), the ovality (median 0.88) and a steep
+  start of the radius curve (``psi0`` mostly on its upper bound; we use 0.88). The raw
+  spreads of the fits are not usable as they are: for nearly straight knots ``rho_max``
+  hardly matters (fitted 1-580 mm) and size trades off between ``r_max``, ``rho_max`` and
+  ``psi1``, so their fitted spreads are mostly non-identifiability.
+  :func:`knot_stats_from_fits` gives those raw estimates; the defaults instead take
+  ``rho_max`` = 40 mm, ``r_max`` = 6 mm and ``psi1`` = 0.4, which end a typical knot with the
+  fits' median end radius (13-14 mm), and spreads chosen by eye so generated knots look like
+  Gran_1's. Whorl-to-whorl spread exceeds the within-whorl spread, as seed 001 §4.2 intends
+  (knots of a whorl are alike); in Gran_1 the whorl-to-whorl spread of size is large too
+  (0.9 in ``log r_max``) but its within-whorl spread is larger still (1.1), partly from the
+  trade-offs above. Log-to-log spread: half the whorl-to-whorl spread (one log cannot tell;
+  an assumption). Knot radius at the surface is capped at ``max_knot_radius_mm`` by scaling
+  ``r_max`` (the radius curve is linear in it).
 * whorls: Gran_1's whorl spacing is 110 +- 39 mm with 3.0 knots per whorl; we use
   110 +- 40 mm and 1 + Poisson(2) knots (~108 knots per 4 m).
 * radius 125 +- 15 mm and taper -0.004 mm/mm: Gran_1 (mean radius 126 mm at the butt, 120 mm
@@ -190,11 +194,13 @@ class LogStats:
 
 
 def _spruce_knot_stats() -> CompoundGaussian:
-    # Order GEN_PARAM_NAMES; sources in the module docstring.
-    mean = np.array([0.0, np.log(0.94), np.log(40.0), np.log(0.2 / 0.8), np.log(0.436 / 0.564), np.log(6.0), 0.5,
-                     np.log(0.4 / 0.6)])
-    sd_whorl = np.array([0.0, 0.12, 0.25, 0.5, 0.2, 0.35, 0.5, 0.5])
-    sd_knot = np.array([0.0, 0.06, 0.15, 0.3, 0.1, 0.15, 0.3, 0.3])
+    # Order GEN_PARAM_NAMES; sources in the module docstring. Ratios as logits.
+    def logit(p):
+        return float(np.log(p / (1 - p)))
+
+    mean = np.array([0.0, np.log(0.88), np.log(40.0), logit(0.1), logit(0.434), np.log(6.0), logit(0.88), logit(0.4)])
+    sd_whorl = np.array([0.0, 0.12, 0.25, 0.5, 0.2, 0.4, 0.5, 0.5])
+    sd_knot = np.array([0.0, 0.06, 0.15, 0.3, 0.1, 0.2, 0.3, 0.3])
     return CompoundGaussian(mean, 0.5 * sd_whorl, sd_whorl, sd_knot, np.eye(8))
 
 
