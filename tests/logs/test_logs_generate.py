@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from woodcam.errors import WoodcamError
-from woodcam.logs.generate import (SPRUCE, CompoundGaussian, generate_log, group_whorls, knot_stats_from_fits)
-from woodcam.logs.knot import growth_curve_slope, radius_coefficients, trajectory_coefficients
+from woodcam.logs.generate import CompoundGaussian, generate_log, group_whorls, knot_stats_from_fits
+from woodcam.logs.knot import radius_coefficients, trajectory_coefficients
 
 
 @pytest.fixture(scope="module")
