@@ -55,3 +55,8 @@ RING_MAP_QUANT_8BIT = 0.5 / 255
 #: Colours a wood returns may overshoot [0, 1] by this much (round-off of blends and colour
 #: transforms) and are clipped; a larger excursion is an error (e.g. 0..255 colours passed).
 COLOR_RANGE_TOL = 1e-3
+
+#: A point counts as on a knot's surface (the envelope of its elliptic cross-sections) when its
+#: signed distance is above -this (mm): the projection onto the knot's centre curve converges
+#: to ~1e-5 mm, and cross-section points truly inside a sharply bent knot are >= 0.01 mm in.
+KNOT_SURFACE_TOL_MM = 1e-3
