@@ -70,6 +70,11 @@ _MIN_RESCALE = 0.85
 #: roughly 40 bytes x this (~170 MB).
 _RASTER_CHUNK_PAIRS = 1 << 22
 
+#: Extra reach (texels) of the conservative rasterisation beyond the exact bilinear footprint of
+#: 1 texel: covers float32 UVs in GLB files (2^-24 x 8192 texels = 5e-4) and the float32 edge
+#: tests here (~1e-3 texel), so a sample exactly on a chart border never reads an unpainted texel.
+_RASTER_MARGIN_TEXELS = 0.02
+
 #: Atlas width and height are rounded up to a multiple of this, so mip levels 1..3 halve exactly.
 _ATLAS_SIZE_MULTIPLE = 8
 
@@ -369,10 +374,11 @@ def _rasterise(xy: np.ndarray, faces: np.ndarray, width: int, height: int, *,
 
     lo = p.min(axis=1)
     hi = p.max(axis=1)
-    c0 = np.clip(np.ceil(lo[:, 0] - 1.5), 0, width - 1).astype(np.int64)
-    c1 = np.clip(np.floor(hi[:, 0] + 0.5), 0, width - 1).astype(np.int64)
-    r0 = np.clip(np.ceil(lo[:, 1] - 1.5), 0, height - 1).astype(np.int64)
-    r1 = np.clip(np.floor(hi[:, 1] + 0.5), 0, height - 1).astype(np.int64)
+    reach = 1.0 + _RASTER_MARGIN_TEXELS  # footprint half-width, texels
+    c0 = np.clip(np.ceil(lo[:, 0] - 0.5 - reach), 0, width - 1).astype(np.int64)
+    c1 = np.clip(np.floor(hi[:, 0] - 0.5 + reach), 0, width - 1).astype(np.int64)
+    r0 = np.clip(np.ceil(lo[:, 1] - 0.5 - reach), 0, height - 1).astype(np.int64)
+    r1 = np.clip(np.floor(hi[:, 1] - 0.5 + reach), 0, height - 1).astype(np.int64)
     bw = c1 - c0 + 1
     bh = r1 - r0 + 1
 
@@ -387,7 +393,7 @@ def _rasterise(xy: np.ndarray, faces: np.ndarray, width: int, height: int, *,
     base = (-l_first * heights).astype(np.float32)  # (f, 3)
     gx = (-grad_l[..., 0] * heights).astype(np.float32)
     gy = (-grad_l[..., 1] * heights).astype(np.float32)
-    sup = support.astype(np.float32)
+    sup = (support * reach).astype(np.float32)
 
     owner = np.full(height * width, -1, dtype=np.int64)
     border_idx: list[np.ndarray] = []
