@@ -6,7 +6,9 @@ Data form
 * The wood is any object with ``color(points_mm: (n, 3) float, normals: (n, 3) float unit)
   -> (n, 3) float RGB in [0, 1]`` (seed 000, eq. 10 is one such appearance: a normal-weighted
   blend of three colour volumes). The baker never looks inside it.
-* The atlas is an image ``(h, w, 3) uint8``; row 0 is the TOP row of the image file.
+* The atlas is an image ``(h, w, 3) uint8``; row 0 is the TOP row of the image file. Colours
+  are stored as ``round(255 * rgb)``: ``wood.color`` is taken to return display (sRGB-encoded)
+  values, which is how glTF and OBJ viewers read a base-colour texture.
 
 Texel / UV convention (the "v flip")
 ------------------------------------
@@ -24,10 +26,11 @@ Pipeline (each step timed in :attr:`BakeResult.timings`)
 --------------------------------------------------------
 1. ``unwrap``: xatlas charts + packing at ``texels_per_unit = texels_per_mm`` (the mesh is in mm,
    so one xatlas "unit" is a millimetre), one atlas, charts ``padding_px`` texels apart.
-2. ``rasterise``: every triangle is rasterised conservatively in texel space, vectorised over
-   (triangle, texel) pairs from each triangle's bounding box (no per-texel Python loop). A texel is
-   painted when its centre lies within L-infinity distance 1 texel of the triangle, which is
-   exactly the set of texels bilinear sampling at any point of the triangle can read. A texel
+2. ``rasterise``: every triangle is rasterised conservatively in texel space: triangles are
+   grouped by bounding-box size and each group is tested as one broadcast numpy array
+   (triangles x rows x cols) of edge functions (no per-texel Python loop). A texel is painted
+   when its centre lies within L-infinity distance 1 (+ a 0.02 texel margin) of the triangle,
+   which covers every texel bilinear sampling at any point of the triangle can read. A texel
    whose centre lies inside a triangle takes that triangle; a texel only in border rings takes the
    nearest triangle and the triangle's affine map is extrapolated to it (a point in the
    triangle's plane at most ~1.5 texels outside it).
@@ -141,10 +144,11 @@ def bake(
         Texels between charts in the atlas (>= 0); 8 keeps mip levels up to 3 inside one chart's
         dilation.
     normals : {"face", "smooth"}
-        Normal passed to ``wood.color``: the flat triangle normal, or the area-weighted vertex
-        normal interpolated barycentrically and renormalised.
+        Normal passed to ``wood.color``: the flat triangle normal (right for CAD parts with sharp
+        edges), or trimesh's vertex normal of the INPUT mesh (before the seam split) interpolated
+        barycentrically and renormalised (for smooth organic surfaces).
     progress : bool
-        Show a tqdm bar over the rasterisation chunks.
+        Show a tqdm bar over the rasterisation groups.
 
     Returns
     -------
