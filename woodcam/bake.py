@@ -94,7 +94,9 @@ class BakeResult:
     ----------
     mesh : trimesh.Trimesh
         The input surface with vertices split at UV seams (as xatlas returns them), mm, block
-        frame, ``visual = TextureVisuals(uv (m, 2), material=PBRMaterial(baseColorTexture=PIL))``.
+        frame, ``visual = TextureVisuals(uv (m, 2), material=PBRMaterial(baseColorTexture=PIL))``;
+        faces in the input's order. With ``normals="smooth"`` its ``vertex_normals`` are the
+        input's (seam-free shading).
     atlas : (h, w, 3) uint8
         The baked, dilated texture; row 0 is the image's top row.
     coverage_mask : (h, w) bool
@@ -202,6 +204,11 @@ def bake(
 
     uv = np.column_stack([xy[:, 0] / img_w, 1.0 - xy[:, 1] / img_h])
     out = _textured_mesh(trimesh, verts, faces, uv, atlas)
+    if normals == "smooth":
+        # Shading normals from the unsplit input, so viewers show no shading seam where xatlas
+        # split vertices (normals recomputed on the split mesh differ on each side of a seam).
+        # The GLB exporter writes them as NORMAL; "face" mode leaves them out (flat shading).
+        out.vertex_normals = np.asarray(mesh.vertex_normals, dtype=np.float64)[vmap]
     timings["total"] = time.perf_counter() - t_start
     for msg in messages:
         warnings.warn(msg, UserWarning, stacklevel=2)

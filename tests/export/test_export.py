@@ -69,6 +69,18 @@ def test_obj_writes_obj_mtl_png_named_after_the_obj_and_reloads(baked, tmp_path)
     assert baked.mesh.visual.material.name == "wood"
 
 
+def test_glb_keeps_seam_free_smooth_normals(tmp_path):
+    sphere = trimesh.creation.icosphere(subdivisions=2, radius=10.0)
+    result = bake(sphere, _Wood(), texels_per_mm=2.0, normals="smooth")
+    path = export_glb(result.mesh, tmp_path / "sphere.glb")
+    loaded = load_textured(path)
+    expected = sphere.vertex_normals[result.vertex_map]
+    np.testing.assert_allclose(loaded.vertex_normals, expected, atol=1e-5)
+    # on a sphere the smooth normal is the radial direction, also across UV seams
+    radial = loaded.vertices / np.linalg.norm(loaded.vertices, axis=1, keepdims=True)
+    assert np.min(np.sum(loaded.vertex_normals * radial, axis=1)) > 0.99
+
+
 def test_glb_metadata_round_trip(baked, tmp_path):
     meta = {"block": {"size_mm": [30.0, 20.0, 16.0], "species": "oak"}, "field": {"kind": "radial"}}
     path = export_glb(baked.mesh, tmp_path / "meta.glb", metadata=meta)

@@ -185,8 +185,13 @@ def load_textured(path):
                 f"load_textured: {str(path)!r} holds {len(geoms)} meshes; expected exactly one "
                 "(files from woodcam.export hold one)"
             )
-        # Apply the node transform (identity for files written here).
-        loaded = loaded.to_mesh() if hasattr(loaded, "to_mesh") else loaded.dump(concatenate=True)
+        node = loaded.graph.nodes_geometry[0]
+        transform = loaded.graph[node][0]
+        if np.allclose(transform, np.eye(4)):
+            # files written here: keep the geometry as stored, with its NORMAL attribute
+            loaded = geoms[0]
+        else:  # someone else's file with a node transform: bake it into the vertices
+            loaded = loaded.to_mesh()
     return loaded
 
 
