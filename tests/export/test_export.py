@@ -18,7 +18,9 @@ from woodcam.export import export_glb, export_obj, load_textured, read_glb_metad
 
 _REPO = Path(__file__).resolve().parents[2]
 _VALIDATOR_JS = _REPO / "tests" / "_gltf_validate.js"
-_NODE_MODULES = Path(os.environ.get("WOODCAM_NODE_MODULES", _REPO / ".cache" / "node" / "node_modules"))
+_NODE_MODULES = Path(
+    os.environ.get("WOODCAM_NODE_MODULES", _REPO / ".cache" / "node" / "node_modules")
+)
 
 
 class _Wood:
@@ -125,8 +127,14 @@ def _validate(path: Path) -> dict:
     return json.loads(run.stdout)
 
 
-def test_glb_passes_the_khronos_validator(baked, tmp_path):
-    path = export_glb(baked.mesh, tmp_path / "valid.glb", metadata={"block": {"size_mm": [30, 20, 16]}})
+@pytest.mark.parametrize("normals", ["face", "smooth"])
+def test_glb_passes_the_khronos_validator(baked, tmp_path, normals):
+    if normals == "face":
+        mesh = baked.mesh  # no NORMAL attribute: viewers shade flat
+    else:
+        sphere = trimesh.creation.icosphere(subdivisions=2, radius=10.0)
+        mesh = bake(sphere, _Wood(), texels_per_mm=2.0, normals="smooth").mesh  # with NORMAL
+    path = export_glb(mesh, tmp_path / "valid.glb", metadata={"block": {"size_mm": [30, 20, 16]}})
     report = _validate(path)
     issues = report["issues"]
     errors = [m for m in issues["messages"] if m["severity"] == 0]
