@@ -308,7 +308,7 @@ def test_too_large_atlas_lowers_density_with_a_warning():
         ({"texels_per_mm": 0.0}, "texels_per_mm must be a finite number > 0"),
         ({"texels_per_mm": float("nan")}, "texels_per_mm must be a finite number > 0"),
         ({"normals": "vertex"}, r"normals must be one of \('face', 'smooth'\)"),
-        ({"padding_px": -1}, "padding_px must be an integer >= 0"),
+        ({"padding_px": 1}, "padding_px must be an integer >= 2"),
         ({"max_atlas_px": 10}, "max_atlas_px must be an integer >= 64"),
     ],
 )

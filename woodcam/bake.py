@@ -155,8 +155,9 @@ def bake(
     max_atlas_px : int
         Largest allowed atlas side in texels; the density is lowered (with a warning) to fit.
     padding_px : int
-        Texels between charts in the atlas (>= 0); 8 keeps mip levels up to 3 inside one chart's
-        dilation.
+        Texels between charts in the atlas, >= 2 (with 0 or 1 a texel between two charts would
+        need two colours: measured errors reach the bound's limit). 8 keeps mip levels 1-2 inside
+        one chart's dilation.
     normals : {"face", "smooth"}
         Normal passed to ``wood.color``: the flat triangle normal (right for CAD parts with sharp
         edges), or trimesh's vertex normal of the INPUT mesh (before the seam split) interpolated
@@ -262,10 +263,11 @@ def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals) ->
         raise WoodcamError(
             f"bake: max_atlas_px must be an integer >= 64; got {max_atlas_px!r}; use e.g. 4096"
         )
-    if not isinstance(padding_px, (int, np.integer)) or padding_px < 0:
+    if not isinstance(padding_px, (int, np.integer)) or padding_px < 2:
         raise WoodcamError(
-            f"bake: padding_px must be an integer >= 0; got {padding_px!r}; use e.g. "
-            f"{ATLAS_PADDING_PX}"
+            f"bake: padding_px must be an integer >= 2 (each chart needs its own 1-texel ring "
+            f"for bilinear sampling, so charts must be 2 texels apart); got {padding_px!r}; use "
+            f"e.g. {ATLAS_PADDING_PX}"
         )
     if normals not in get_args(NormalsMode):
         raise WoodcamError(
