@@ -203,6 +203,15 @@ def test_baked_texture_matches_wood_at_random_surface_points(make, normals, tpm)
     assert result.texels_per_mm == pytest.approx(tpm)
 
 
+def test_smallest_padding_still_meets_the_bound():
+    """padding_px=2 leaves each chart exactly its own 1-texel bilinear ring."""
+    mesh = _carved()
+    result = bake(mesh, SmoothWood(), texels_per_mm=4.0, padding_px=2)
+    err, bound, _ = _check_against_wood(result.mesh, result.atlas, mesh, "face",
+                                        np.random.default_rng(5), coverage=result.coverage_mask)
+    assert err <= bound
+
+
 def test_flat_charts_are_second_order_accurate():
     """On a box every chart is planar with one normal and border texels continue the same affine
     map, so the texture is exactly f sampled at texel centres and bilinear interpolation errs by
