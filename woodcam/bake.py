@@ -66,8 +66,12 @@ _MAX_CHART_FACES = 256
 
 #: When xatlas' packed atlas overshoots ``max_atlas_px`` by a factor down to this, the layout is
 #: scaled down instead of re-unwrapped: chart gaps shrink from ``padding_px`` to at worst
-#: 0.85 x ``padding_px`` (the dilation fills them regardless), and xatlas' ~1 s is not repeated.
+#: 0.85 x ``padding_px`` (never below _MIN_PADDING_PX), and xatlas' ~1 s is not repeated.
 _MIN_RESCALE = 0.85
+
+#: Smallest gap (texels) between charts: each chart needs its own 1-texel ring for bilinear
+#: sampling, so two charts need 2 texels between them.
+_MIN_PADDING_PX = 2
 
 #: (triangle, texel) candidate pairs processed per rasterisation chunk: bounds peak memory to
 #: roughly 40 bytes x this (~170 MB).
@@ -263,7 +267,7 @@ def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals) ->
         raise WoodcamError(
             f"bake: max_atlas_px must be an integer >= 64; got {max_atlas_px!r}; use e.g. 4096"
         )
-    if not isinstance(padding_px, (int, np.integer)) or padding_px < 2:
+    if not isinstance(padding_px, (int, np.integer)) or padding_px < _MIN_PADDING_PX:
         raise WoodcamError(
             f"bake: padding_px must be an integer >= 2 (each chart needs its own 1-texel ring "
             f"for bilinear sampling, so charts must be 2 texels apart); got {padding_px!r}; use "
@@ -315,7 +319,7 @@ def _unwrap(mesh, tpm: float, max_px: int, padding: int, messages: list[str]):
         atlas.generate(chart_options, pack_options)
         width, height = int(atlas.width), int(atlas.height)
         scale = max_px / max(width, height)
-        if scale >= _MIN_RESCALE:
+        if scale >= _MIN_RESCALE and scale * padding >= _MIN_PADDING_PX:
             break
         tpm *= (max_px - 2 * padding) / (max(width, height) - 2 * padding) * 0.97
     else:  # pragma: no cover - xatlas overshooting four times in a row
