@@ -311,6 +311,26 @@ def test_too_large_atlas_lowers_density_with_a_warning():
     np.testing.assert_allclose(mm_per_texel, 1 / result.texels_per_mm, rtol=0.05)
 
 
+@pytest.mark.parametrize("efficiency", [1.0, 20.0], ids=["mild", "far"])
+def test_atlas_overshoot_is_rescaled_or_re_unwrapped(monkeypatch, efficiency):
+    """Fool the size prediction so xatlas' atlas overshoots max_atlas_px (here by 18 % and 35 %:
+    xatlas runs again at a lower density, whose result overshoots by < 1 % and is scaled down).
+    The atlas fits, the density is reported and the bake still meets the bound."""
+    import woodcam.bake as bake_module
+
+    monkeypatch.setattr(bake_module, "_PACK_EFFICIENCY", efficiency)
+    mesh = _carved()
+    with pytest.warns(UserWarning, match="texels_per_mm lowered from 6"):
+        result = bake(mesh, SmoothWood(), texels_per_mm=6.0, max_atlas_px=384)
+    assert max(result.atlas.shape[:2]) <= 384
+    out = result.mesh
+    stretch = _texel_jacobians(out, result.atlas.shape, np.asarray(out.vertices))
+    assert np.median(stretch) == pytest.approx(1 / result.texels_per_mm, rel=0.05)
+    err, bound, _ = _check_against_wood(out, result.atlas, mesh, "face",
+                                        np.random.default_rng(6), coverage=result.coverage_mask)
+    assert err <= bound
+
+
 @pytest.mark.parametrize(
     "kwargs, match",
     [
