@@ -198,18 +198,28 @@ def bake(
     # ---- 3. colour -------------------------------------------------------------------------
     t0 = time.perf_counter()
     verts = np.asarray(mesh.vertices, dtype=np.float64)[vmap]
-    centres = np.column_stack([painted % img_w + 0.5, painted // img_w + 0.5])
-    points = _affine_at_texels(xy, faces, verts, tri, centres)
+    point_map = _affine_maps(xy, faces, verts)
     if normals == "face":
         # xatlas keeps face order, so output face i is input face i.
-        nrm = np.asarray(mesh.face_normals, dtype=np.float64)[tri]
+        face_normals = np.asarray(mesh.face_normals, dtype=np.float64)
     else:
-        vnormals = np.asarray(mesh.vertex_normals, dtype=np.float64)[vmap]
-        nrm = _affine_at_texels(xy, faces, vnormals, tri, centres)
-        nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-12)
-    rgb = _color_batched(wood, points, nrm)
+        normal_map = _affine_maps(xy, faces, np.asarray(mesh.vertex_normals,
+                                                         dtype=np.float64)[vmap])
     atlas = np.zeros((img_h * img_w, 3), dtype=np.uint8)
-    atlas[painted] = np.round(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
+    # Batches of MAX_BATCH_POINTS texels: bounded memory, arrays that stay in cache.
+    for s in range(0, len(painted), MAX_BATCH_POINTS):
+        idx = painted[s:s + MAX_BATCH_POINTS]
+        t = tri[s:s + MAX_BATCH_POINTS]
+        cx = (idx % img_w + 0.5)[:, None]
+        cy = (idx // img_w + 0.5)[:, None]
+        points = _apply_affine(point_map, t, cx, cy)
+        if normals == "face":
+            nrm = face_normals[t]
+        else:
+            nrm = _apply_affine(normal_map, t, cx, cy)
+            nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-12)
+        rgb = _color_checked(wood, points, nrm)
+        atlas[idx] = np.round(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
     atlas = atlas.reshape(img_h, img_w, 3)
     coverage = (tri_of_texel >= 0).reshape(img_h, img_w)
     timings["color"] = time.perf_counter() - t0
@@ -547,14 +557,11 @@ def _test_blocks(state, tri, row0, col0, base, gx, gy, sup, gh, gw, row_max, col
         state.border_out.append(out[g, yy, xx])
 
 
-def _affine_at_texels(xy, faces, values, tri, centres) -> np.ndarray:
-    """Interpolate per-vertex ``values (m, d)`` at texel ``centres (k, 2)`` (texel coordinates)
-    with the affine map of triangles ``tri (k,)``: barycentric interpolation inside a triangle,
-    linear extrapolation of the same map outside it (border texels). Returns (k, d) float64.
-
-    The map is precomputed per triangle (``value = origin + jac_x * x + jac_y * y``) so each texel
-    costs three gathers, not a (k, 3, d) corner array.
-    """
+def _affine_maps(xy, faces, values):
+    """Per-triangle affine maps from texel coordinates to per-vertex ``values (m, d)``:
+    ``value(x, y) = origin + jac_x * x + jac_y * y`` (barycentric interpolation inside the
+    triangle, linear extrapolation of the same map outside it). Returns three (f, d) arrays, so
+    each texel later costs three gathers instead of a (k, 3, d) corner array."""
     p, minv, _, _ = _triangle_frames(xy, faces)
     v = values[faces]  # (f, 3, d)
     e1 = v[:, 1] - v[:, 0]
@@ -562,21 +569,24 @@ def _affine_at_texels(xy, faces, values, tri, centres) -> np.ndarray:
     jac_x = e1 * minv[:, 0, 0, None] + e2 * minv[:, 1, 0, None]
     jac_y = e1 * minv[:, 0, 1, None] + e2 * minv[:, 1, 1, None]
     origin = v[:, 0] - jac_x * p[:, 0, 0, None] - jac_y * p[:, 0, 1, None]
-    return origin[tri] + jac_x[tri] * centres[:, :1] + jac_y[tri] * centres[:, 1:]
+    return origin, jac_x, jac_y
 
 
-def _color_batched(wood, points: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """``wood.color`` over ``(k, 3)`` points in batches of ``MAX_BATCH_POINTS``; (k, 3) float."""
-    rgb = np.empty((len(points), 3), dtype=np.float64)
-    for s in range(0, len(points), MAX_BATCH_POINTS):
-        e = min(s + MAX_BATCH_POINTS, len(points))
-        c = np.asarray(wood.color(points[s:e], normals[s:e]), dtype=np.float64)
-        if c.shape != (e - s, 3):
-            raise WoodcamError(
-                f"bake: wood.color must return an (n, 3) RGB array for n={e - s} points; got "
-                f"shape {c.shape}; fix the appearance's color()"
-            )
-        rgb[s:e] = c
+def _apply_affine(maps, tri, cx, cy) -> np.ndarray:
+    """Evaluate :func:`_affine_maps` of triangles ``tri (k,)`` at texel centres
+    ``cx, cy (k, 1)``; (k, d) float64."""
+    origin, jac_x, jac_y = maps
+    return origin[tri] + jac_x[tri] * cx + jac_y[tri] * cy
+
+
+def _color_checked(wood, points: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """``wood.color(points (k, 3), normals (k, 3))`` checked for shape and finiteness; (k, 3)."""
+    rgb = np.asarray(wood.color(points, normals), dtype=np.float64)
+    if rgb.shape != (len(points), 3):
+        raise WoodcamError(
+            f"bake: wood.color must return an (n, 3) RGB array for n={len(points)} points; got "
+            f"shape {rgb.shape}; fix the appearance's color()"
+        )
     if not np.all(np.isfinite(rgb)):
         raise WoodcamError(
             "bake: wood.color returned NaN or infinite colours; check the appearance and that "
