@@ -50,7 +50,12 @@ from typing import Any, Literal, get_args
 import numpy as np
 
 from woodcam.errors import WoodcamError
-from woodcam.tolerances import ATLAS_PADDING_PX, MAX_BATCH_POINTS
+from woodcam.tolerances import (
+    ATLAS_PADDING_PX,
+    MAX_BATCH_POINTS,
+    MIN_UV_AREA_TEXELS2,
+    RASTER_MARGIN_TEXELS,
+)
 
 NormalsMode = Literal["face", "smooth"]
 
@@ -77,11 +82,6 @@ _MIN_PADDING_PX = 2
 #: roughly 40 bytes x this (~170 MB).
 _RASTER_CHUNK_PAIRS = 1 << 22
 
-#: Extra reach (texels) of the conservative rasterisation beyond the exact bilinear footprint of
-#: 1 texel: covers float32 UVs in GLB files (2^-24 x 8192 texels = 5e-4) and the float32 edge
-#: tests here (~1e-3 texel), so a sample exactly on a chart border never reads an unpainted texel.
-_RASTER_MARGIN_TEXELS = 0.02
-
 #: Side (texels) of the square tiles large or sliver triangles are rasterised in. Measured
 #: (CPU s, rasterising a 20k-triangle sphere at 2k^2 / an 8.8k-triangle carved block at 1k^2,
 #: with every triangle above 8 texels tiled): tile 4: 0.67 / 0.48, 8: 0.45 / 0.34,
@@ -96,10 +96,6 @@ _SMALL_MIN_FILL = 0.2
 
 #: Atlas width and height are rounded up to a multiple of this, so mip levels 1..3 halve exactly.
 _ATLAS_SIZE_MULTIPLE = 8
-
-#: Triangles whose texel-space area (texels^2) is below this are degenerate in UV: their
-#: barycentric inverse is ill-conditioned; they are skipped (their neighbours paint the texels).
-_MIN_UV_AREA_TEXELS2 = 1e-10
 
 
 @dataclass
@@ -364,7 +360,7 @@ def _triangle_frames(xy: np.ndarray, faces: np.ndarray):
     e1 = p[:, 1] - p[:, 0]
     e2 = p[:, 2] - p[:, 0]
     det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    valid = np.abs(det) > 2.0 * _MIN_UV_AREA_TEXELS2
+    valid = np.abs(det) > 2.0 * MIN_UV_AREA_TEXELS2
     inv_det = np.where(valid, 1.0 / np.where(valid, det, 1.0), 0.0)
     # (l1, l2) = inv([e1 e2]) @ (x - p0)
     minv = np.empty((len(faces), 2, 2))
@@ -405,7 +401,7 @@ def _rasterise(xy: np.ndarray, faces: np.ndarray, width: int, height: int, *,
     ``_TILE x _TILE`` tiles; tiles the expanded triangle cannot reach are culled with the same
     edge test at the tile centre widened by the tile's half-extent, and the rest are tested as
     one group of equal-size blocks. No per-texel Python loop. The edge tests run in float32
-    (texel coordinates <= 2^13 keep ~1e-3 texel precision, inside ``_RASTER_MARGIN_TEXELS``);
+    (texel coordinates <= 2^13 keep ~1e-3 texel precision, inside ``RASTER_MARGIN_TEXELS``);
     the owners' points are recomputed in float64.
     """
     p, minv, det, valid = _triangle_frames(xy, faces)
@@ -416,7 +412,7 @@ def _rasterise(xy: np.ndarray, faces: np.ndarray, width: int, height: int, *,
     heights = np.abs(det)[:, None] / lengths
     support = (np.abs(edges[..., 0]) + np.abs(edges[..., 1])) / lengths
 
-    reach = 1.0 + _RASTER_MARGIN_TEXELS  # footprint half-width, texels
+    reach = 1.0 + RASTER_MARGIN_TEXELS  # footprint half-width, texels
     lo = p.min(axis=1)
     hi = p.max(axis=1)
     c0 = np.clip(np.ceil(lo[:, 0] - 0.5 - reach), 0, width - 1).astype(np.int64)

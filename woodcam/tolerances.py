@@ -34,3 +34,13 @@ MAX_BATCH_POINTS = 1 << 18
 #: Smallest allowed radius-scaling value in the radial family (eq. 9 of seed 000) after the
 #: linear blend; guards division by zero when a blend is extrapolated.
 MIN_RADIUS_SCALE = 0.05
+
+#: Extra reach (texels) of the bake's conservative rasterisation beyond the exact bilinear
+#: footprint of 1 texel: covers float32 UVs in GLB files (2^-24 x 8192 texels = 5e-4) and the
+#: float32 edge tests (~1e-3 texel), so a sample exactly on a chart border never reads an
+#: unpainted texel.
+RASTER_MARGIN_TEXELS = 0.02
+
+#: Triangles whose texel-space area (texels^2) is below this are degenerate in UV: their
+#: barycentric inverse is ill-conditioned, so the baker skips them (neighbours paint the texels).
+MIN_UV_AREA_TEXELS2 = 1e-10
