@@ -59,7 +59,7 @@ from woodcam.tolerances import (
 
 NormalsMode = Literal["face", "smooth"]
 
-#: Fraction of the atlas xatlas fills with charts at 8 px padding (measured 0.6-0.85 on
+#: Fraction of the atlas xatlas fills with charts at 8 px padding (measured 0.5-0.85 on
 #: spheres and carved boxes); used only to predict the atlas side before unwrapping.
 _PACK_EFFICIENCY = 0.6
 
