@@ -60,7 +60,7 @@ def open_stock(spec: str, *, species: str | None = None,
         b = builtin_block(spec.split(":", 1)[1])
         app = ColorMapAppearance(species or b.species, **appearance_params)
         meta = {"species": app.species.name}
-        if hasattr(b.field, "to_dict"):
+        if hasattr(b.field, "to_dict"):  # every built-in field is saveable
             meta["field"] = b.field.to_dict()
         return Stock(spec, b.size_mm, Wood(b.field, app), b.description, meta)
     path = Path(spec)

@@ -41,7 +41,7 @@ cost grows with the knots near a point, not with all knots of the log.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -549,61 +549,17 @@ class KnottedLogField:
         return KnottedLogField(self.log, self.ring_width_mm, replace(self.params, **changes),
                                chunk=self.chunk, backend=self.backend)
 
-
-# ---------------------------------------------------------------------------------------------
-# placement of a block in the log
-
-class PlacedField:
-    """A log-frame field seen from a block frame: ``field(points_block_mm) -> years``.
-
-    ``points_log = origin_mm + points_block @ rotation.T``: ``rotation (3, 3)`` maps block-frame
-    vectors to log-frame vectors (its columns are the block's X, Y, Z axes in the log frame),
-    ``origin_mm (3,)`` is the block's origin corner in the log frame. Forwards
-    ``knot_features`` and ``grain_direction`` (rotated back into the block frame).
-    """
-
-    def __init__(self, field, origin_mm=(0.0, 0.0, 0.0), rotation=None):
-        R = np.eye(3) if rotation is None else np.asarray(rotation, float)
-        o = np.asarray(origin_mm, float)
-        if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6) \
-                or np.linalg.det(R) < 0:
-            raise WoodcamError("rotation must be a proper 3x3 rotation matrix (orthonormal, "
-                               f"det +1); got {R.tolist()}; build it with scipy Rotation")
-        if o.shape != (3,):
-            raise WoodcamError(f"origin_mm must be a 3-vector (mm, log frame); got {o.shape}")
-        self.field = field
-        self.origin_mm = o
-        self.rotation = R
+    def to_dict(self) -> dict:
+        """JSON-serialisable description (the log in its file format, ring width, parameters)."""
+        return {"log": self.log.to_json(), "ring_width_mm": float(self.ring_width_mm),
+                "params": asdict(self.params)}
 
     @classmethod
-    def from_log_frame(cls, field, frame: LogFrame) -> "PlacedField":
-        """Use a :class:`~.base.LogFrame` (the log's frame placed in the block frame)."""
-        R = frame.rotation  # rows: log axes in block coords = block->log matrix
-        return cls(field, -(R @ np.asarray(frame.pith_point_mm, float)), R)
-
-    def to_log(self, points_mm) -> np.ndarray:
-        return self.origin_mm + check_points(points_mm) @ self.rotation.T
-
-    def __call__(self, points_mm) -> np.ndarray:
-        return self.field(self.to_log(points_mm))
-
-    def knot_features(self, points_mm) -> dict:
-        return self.field.knot_features(self.to_log(points_mm))
-
-    def evaluate(self, points_mm, *, directions: bool = False) -> dict:
-        out = self.field.evaluate(self.to_log(points_mm), directions=directions)
-        if directions:
-            out["direction"] = out["direction"] @ self.rotation
-        return out
-
-    def grain_direction(self, points_mm) -> np.ndarray:
-        return self.field.grain_direction(self.to_log(points_mm)) @ self.rotation
+    def from_dict(cls, d: dict) -> "KnottedLogField":
+        return cls(Log.from_json(d["log"]), d["ring_width_mm"], KnotParams(**d["params"]))
 
 
-def place_block_in_log(log_field, origin_mm, rotation=None) -> PlacedField:
-    """Place a block in a log: block point ``p`` sits at ``origin_mm + rotation @ p`` (log
-    frame, mm). See :class:`PlacedField`."""
-    return PlacedField(log_field, origin_mm, rotation)
+from .placement import PlacedField, place_block_in_log  # noqa: E402,F401  (re-exported)
 
 
 def block_at_knot(log, knot_index: int, size_mm, *, front_r_mm: float | None = None):
