@@ -51,3 +51,15 @@ RING_MAP_QUANT_16BIT = 0.5 / 65535
 
 #: Ring maps stored as 8-bit PNG (and Mokume's own maps) carry 0.5 / 255 of quantisation.
 RING_MAP_QUANT_8BIT = 0.5 / 255
+
+#: Mean colour error (fraction of full scale) allowed when a translation network trained on one
+#: face redraws another face of the same axis from its ARF, against that face's photo resampled
+#: to the grid (synthetic photos that are a known colour function of the ARF). The network is
+#: small and trained for seconds ("draft"); the remaining error sits on the sharp latewood ->
+#: earlywood steps. Measured 0.02-0.03 on the test cube; 0.04 leaves margin across seeds.
+NEURAL_FACE_MAE = 0.04
+
+#: Mean colour error allowed inside the block (trilinear lookup in the colour volumes against the
+#: known colour function): the face error plus the trilinear blur of ring steps between cell
+#: centres (cells of 0.67 mm against 3.5 mm rings in the test). Measured ~0.03.
+NEURAL_VOLUME_MAE = 0.05
