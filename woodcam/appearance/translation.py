@@ -254,6 +254,11 @@ def train_translation(pairs, spec: TranslationSpec | None = None, *, progress: b
     if not pairs:
         raise WoodcamError("pairs must hold at least one (inputs, photo, mask) image pair; got none")
     c_in = int(np.asarray(pairs[0][0]).shape[0])
+    # Images smaller than the patch (thin blocks at low resolution) shrink the patch to the
+    # largest even size that fits the biggest image, never below 8 px.
+    fit = max(min(np.asarray(x).shape[1:]) for x, _, _ in pairs) // 2 * 2
+    if fit < spec.patch_px:
+        spec = replace(spec, patch_px=max(8, fit))
     if threads:
         torch.set_num_threads(int(threads))
     t0 = time.perf_counter()
