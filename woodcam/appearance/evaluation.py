@@ -4,7 +4,8 @@ For each face with a photo: train without it, synthesise it from its ring image 
 ARF, or for a real block without a fitted field its ring map), and compare with its photo, for
 
 - ``neural``: the orientation-dependent model, the network of the face's axis (trained on the
-  other face of that axis);
+  other face of that axis; with ``finetune_epochs > 0`` fine-tuned on it from the network
+  trained on all remaining faces);
 - ``agnostic``: one network trained on all remaining faces, used for every orientation (the
   orientation-agnostic variant of seed 000's Fig. 13);
 - ``colormap``: the photo-fitted colour map (:meth:`ColorMapAppearance.fit_to_block` on the
@@ -192,11 +193,12 @@ def leave_one_face_out(block, field=None, *, resolution: int = 128, quality: Qua
         end_grain = end_grain_faces(field, block.size_mm) if field is not None else {}
     nets = {}
 
-    def net_for(train_faces):
-        key = tuple(sorted(train_faces))
+    def net_for(train_faces, init_faces=None):
+        key = (tuple(sorted(train_faces)), tuple(sorted(init_faces or ())))
         if key not in nets:
-            nets[key] = train_translation([pairs[f] for f in key], spec, progress=progress,
-                                          desc=f"eval: train on {'+'.join(key)}", threads=threads)
+            init = net_for(init_faces) if init_faces else None
+            nets[key] = train_translation([pairs[f] for f in key[0]], spec, progress=progress, init=init,
+                                          desc=f"eval: train on {'+'.join(key[0])}", threads=threads)
         return nets[key]
 
     out = []
@@ -206,7 +208,7 @@ def leave_one_face_out(block, field=None, *, resolution: int = 128, quality: Qua
         same = [g for g in rest if FACE_AXIS[g] == FACE_AXIS[f]]
         ev = FaceEval(f, end_grain.get(f), photo)
         if same:
-            ev.predictions["neural"] = net_for(same)(x)
+            ev.predictions["neural"] = net_for(same, rest if spec.finetune_epochs > 0 else None)(x)
         ev.predictions["agnostic"] = net_for(rest)(x)
         if field is not None:
             cm = ColorMapAppearance.fit_to_block(_without_photo(block, f), field, species)
@@ -254,7 +256,7 @@ def side_by_side(results: list[FaceEval], path, title: str = "") -> None:
         pads = [np.pad(i, ((0, h - i.shape[0]), (0, 4), (0, 0)), constant_values=1.0) for i in ims]
         rows.append((r, np.concatenate(pads, axis=1)))
     width = max(a.shape[1] for _, a in rows)
-    label_h = 14
+    label_h = 26
     canvas = np.ones((28 + sum(a.shape[0] + label_h for _, a in rows), width, 3))
     y = 28
     boxes = []
@@ -265,10 +267,66 @@ def side_by_side(results: list[FaceEval], path, title: str = "") -> None:
     img = Image.fromarray((np.clip(canvas, 0, 1) * 255 + 0.5).astype(np.uint8))
     d = ImageDraw.Draw(img)
     d.text((4, 2), title, fill=(0, 0, 0))
-    d.text((4, 14), " | ".join(cols), fill=(0, 0, 0))
+    d.text((4, 14), " | ".join(cols) + "   (hist / spectrum / patch distance, lower is better)", fill=(0, 0, 0))
+    col_w = r.photo.shape[1] + 4
     for y0, r in boxes:
         grain = {True: "end grain", False: "side grain", None: "grain ?"}[r.end_grain]
-        sc = "  ".join(f"{m}: hist {r.scores[m]['histogram']:.3f} spec {r.scores[m]['spectrum']:.2f} "
-                       f"patch {r.scores[m]['patch']:.3f}" for m in MODELS if m in r.scores)
-        d.text((4, y0 + 1), f"{r.face} ({grain})  {sc}", fill=(0, 0, 0))
+        d.text((4, y0 + 1), f"{r.face}", fill=(0, 0, 0))
+        d.text((4, y0 + 12), f"({grain})", fill=(0, 0, 0))
+        for i, m in enumerate(MODELS):
+            if m in r.scores:
+                sc = r.scores[m]
+                d.text(((i + 1) * col_w + 2, y0 + 1), m, fill=(0, 0, 0))
+                d.text(((i + 1) * col_w + 2, y0 + 12),
+                       f"{sc['histogram']:.3f}/{sc['spectrum']:.2f}/{sc['patch']:.3f}", fill=(0, 0, 0))
     img.save(path)
+
+
+# -- looking at a whole block: parts carved from it ------------------------------------------------
+
+def _view_basis(view):
+    v = np.asarray(view, float)
+    v = v / np.linalg.norm(v)
+    up = np.array([0.0, 0.0, 1.0]) if abs(v[2]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    e1 = np.cross(up, v)
+    e1 /= np.linalg.norm(e1)
+    return v, e1, np.cross(v, e1)
+
+
+def render_sphere(wood, size_mm, px: int = 256, view=(1.0, -1.3, 0.9), radius_frac: float = 0.45,
+                  light=(0.4, -0.6, 1.0)) -> np.ndarray:
+    """Orthographic picture ``(px, px, 3)`` float of a sphere carved from the block's centre.
+
+    ``view`` points from the sphere to the camera; white background; Lambert shading
+    ``0.65 + 0.35 n.l`` so the colour of the wood dominates.
+    """
+    size = np.asarray(size_mm, float)
+    c, r = size / 2, radius_frac * size.min()
+    v, e1, e2 = _view_basis(view)
+    s = (np.arange(px) + 0.5) / px * 2 - 1
+    u, w = np.meshgrid(s, -s)
+    inside = u ** 2 + w ** 2 < 1
+    depth = np.sqrt(np.clip(1 - u ** 2 - w ** 2, 0, 1))
+    n = u[..., None] * e1 + w[..., None] * e2 + depth[..., None] * v
+    pts = c + r * n[inside]
+    rgb = wood.color(pts, n[inside])
+    lgt = np.asarray(light, float) / np.linalg.norm(light)
+    shade = 0.65 + 0.35 * np.clip(n[inside] @ lgt, 0, 1)
+    out = np.ones((px, px, 3))
+    out[inside] = np.clip(rgb * shade[:, None], 0, 1)
+    return out
+
+
+def render_plane(wood, size_mm, normal=(1.0, 1.0, 1.0), px: int = 256) -> np.ndarray:
+    """The cut surface ``(px, px, 3)`` float of the plane through the block centre with ``normal``
+    (white outside the block), seen along the normal."""
+    size = np.asarray(size_mm, float)
+    v, e1, e2 = _view_basis(normal)
+    half = 0.5 * np.linalg.norm(size)
+    s = ((np.arange(px) + 0.5) / px * 2 - 1) * half
+    u, w = np.meshgrid(s, -s)
+    pts = size / 2 + u[..., None] * e1 + w[..., None] * e2
+    inside = np.all((pts >= 0) & (pts <= size), axis=-1)
+    out = np.ones((px, px, 3))
+    out[inside] = wood.color(pts[inside], np.broadcast_to(v, (int(inside.sum()), 3)))
+    return out

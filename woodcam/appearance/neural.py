@@ -105,7 +105,8 @@ def train_axis_networks(block, grid: VolumeGrid, spec, *, field=None, source: st
     Parameters
     ----------
     faces : face names to learn from (default: every face with a photo).
-    orientation : "dependent" trains one network per axis on the faces of that axis (an axis
+    orientation : "dependent" trains one network per axis on the faces of that axis (with
+        ``spec.finetune_epochs > 0`` by fine-tuning the network trained on all faces; an axis
         whose faces have no photo gets the network trained on all faces, noted in the result);
         "agnostic" trains one network on all faces.
 
@@ -138,7 +139,8 @@ def train_axis_networks(block, grid: VolumeGrid, spec, *, field=None, source: st
     for k in range(3):
         mine = [pairs[f] for f in faces if FACE_AXIS[f] == k]
         if mine:
-            nets.append(train_translation(mine, spec, progress=progress, threads=threads,
+            init = pooled_net() if spec.finetune_epochs > 0 else None
+            nets.append(train_translation(mine, spec, progress=progress, threads=threads, init=init,
                                           desc=f"appearance: {_AXIS_NAMES[k]} faces"))
         else:
             notes.append(f"no photo of a face normal to {_AXIS_NAMES[k].upper()}: "

@@ -58,6 +58,10 @@ class TranslationSpec:
         Add the solid-noise input channel.
     noise_mm : float
         Lattice cell of the solid noise (mm).
+    finetune_epochs : int
+        Per-axis networks start from a network trained on all faces and are fine-tuned for
+        this many epochs on their axis's faces (more data than one axis's one or two photos,
+        while keeping each axis's look); 0 trains each axis from scratch, as the seed does.
     seed : int
         Seeds torch and the patch sampler: the same spec and data give the same network.
     """
@@ -71,6 +75,7 @@ class TranslationSpec:
     texture_weight: float = 1.0
     noise: bool = True
     noise_mm: float = 0.6
+    finetune_epochs: int = 2
     seed: int = 0
 
     @property
@@ -227,7 +232,8 @@ def _crop_pool(pairs, spec: TranslationSpec, rng: np.random.Generator):
 
 
 def train_translation(pairs, spec: TranslationSpec | None = None, *, progress: bool = True,
-                      desc: str = "translation", threads: int | None = 1) -> TranslationNet:
+                      desc: str = "translation", threads: int | None = 1,
+                      init: TranslationNet | None = None) -> TranslationNet:
     """Train one translation network from scratch on aligned image pairs.
 
     Parameters
@@ -237,6 +243,8 @@ def train_translation(pairs, spec: TranslationSpec | None = None, *, progress: b
     spec : TranslationSpec, default the "normal" preset.
     progress : bool
         Show a tqdm bar over the optimisation steps.
+    init : TranslationNet, optional
+        Start from a copy of this network's weights and train ``spec.finetune_epochs`` epochs.
     threads : int or None
         ``torch.set_num_threads`` for the run (None leaves torch's setting). Default 1: these
         convolutions are too small to split, and on a busy 2-core machine torch's OpenMP
@@ -266,6 +274,9 @@ def train_translation(pairs, spec: TranslationSpec | None = None, *, progress: b
     torch.manual_seed(spec.seed)
     X, Y, M = (torch.from_numpy(a) for a in _crop_pool(pairs, spec, rng))
     net = _build_net(c_in, spec.channels)
+    if init is not None:
+        net.load_state_dict(init.module.state_dict())
+        spec = replace(spec, epochs=max(1, spec.finetune_epochs))
     opt = torch.optim.Adam(net.parameters(), lr=spec.lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, spec.steps, eta_min=0.05 * spec.lr)
     order = torch.from_numpy(rng.permutation(np.resize(np.arange(len(X)), spec.steps * spec.batch)))
