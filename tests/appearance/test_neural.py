@@ -242,3 +242,17 @@ def test_errors_name_the_rule():
         fit_neural_appearance(replace(clean_block(faces=("top",)), true_field=None), None, cache_dir=False)
     with pytest.raises(WoodcamError, match="appearance must be one of colormap, neural"):
         block_appearance(clean_block(faces=("top",)), FIELD, "fancy")
+
+
+def test_ring_map_source_uses_the_face_ring_map_or_the_field():
+    blk = synth_block(FIELD, SIZE, wood=KnownWood(FIELD), face_px=96, ring_map_faces=("top",),
+                      photo_noise=0, photo_variation=0, photo_blur_px=0, ring_map_noise=0.0)
+    top = face_pair(blk, "top", GRID, SPEC, field=None, source="ring_map")[0][0]
+    front = face_pair(blk, "front", GRID, SPEC, field=FIELD, source="ring_map")[0][0]
+    # The synthetic ring map of the top face and the field's ring-map-like image agree.
+    g = FIELD(GRID.face_points("top").reshape(-1, 3)).reshape(top.shape)
+    like = ring_map_like(g, float(GRID.cell_mm[0]))
+    assert np.corrcoef(top.ravel(), like.ravel())[0, 1] > 0.8
+    assert front.max() > 0.9 and front.min() < 0.05
+    with pytest.raises(WoodcamError, match="face 'front' needs a field"):
+        face_pair(blk, "front", GRID, SPEC, field=None, source="ring_map")

@@ -32,6 +32,7 @@ from .translation import Quality, TranslationNet, train_translation, translation
 from .volumes import ColorVolumes, VolumeGrid, cache_key, face_pair, translate_volume, years_volume
 
 Orientation = Literal["dependent", "agnostic"]
+Source = Literal["arf", "ring_map"]
 AppearanceKind = Literal["colormap", "neural"]
 APPEARANCE_KINDS: tuple[str, ...] = get_args(AppearanceKind)
 
@@ -151,8 +152,9 @@ def train_axis_networks(block, grid: VolumeGrid, spec, *, field=None, source: st
 
 def fit_neural_appearance(block, field=None, *, resolution: int = 128, quality: Quality = "normal",
                           epochs: int | None = None, seed: int = 0,
-                          orientation: Orientation = "dependent", cache_dir=None,
-                          progress: bool = True, threads: int | None = 1) -> NeuralAppearance:
+                          orientation: Orientation = "dependent", source: Source = "arf",
+                          cache_dir=None, progress: bool = True,
+                          threads: int | None = 1) -> NeuralAppearance:
     """Learn a block's appearance from its photos and build its colour volumes (cached).
 
     Parameters
@@ -167,6 +169,11 @@ def fit_neural_appearance(block, field=None, *, resolution: int = 128, quality: 
     quality, epochs, seed : the translation spec (:func:`~.translation.translation_spec`).
     orientation : "dependent" (three volumes, eq. 10) or "agnostic" (one volume from a network
         trained on all faces).
+    source : "arf" (the seed's choice: networks translate the ARF, on faces and in the volume)
+        or "ring_map": networks learn (face ring map -> photo) and run on ring-map-like slices of
+        the field (:func:`~.volumes.ring_map_like`). Use it for real blocks whose field was
+        fitted to ring maps: the ring maps sit exactly on the photos' rings, a fitted field's
+        ARF only roughly, and its ring phase (earlywood vs latewood side) is not known.
     cache_dir : folder for the cached volumes and weights, default :func:`default_cache_dir`;
         ``False`` disables the cache.
 
@@ -189,7 +196,7 @@ def fit_neural_appearance(block, field=None, *, resolution: int = 128, quality: 
     grid = VolumeGrid(block.size_mm, resolution)
     spec = translation_spec(quality, epochs, seed)
     settings = {"version": CACHE_VERSION, "grid": grid.to_dict(), "spec": spec.to_dict(),
-                "orientation": orientation, "source": "arf"}
+                "orientation": orientation, "source": source}
     key = cache_key(block, field, settings)
     path = None
     if cache_dir is not False:
@@ -201,13 +208,13 @@ def fit_neural_appearance(block, field=None, *, resolution: int = 128, quality: 
             vols.meta["cache_path"] = str(path)
             return NeuralAppearance(vols)
     t0 = time.perf_counter()
-    trained = train_axis_networks(block, grid, spec, field=field, orientation=orientation,
-                                  progress=progress, threads=threads)
+    trained = train_axis_networks(block, grid, spec, field=field, source=source,
+                                  orientation=orientation, progress=progress, threads=threads)
     t1 = time.perf_counter()
     years = years_volume(field, grid)
     axes = range(3) if orientation == "dependent" else [2]
     nets = trained["nets"]
-    vols = np.stack([translate_volume(nets[i], years, grid, k) for i, k in enumerate(axes)])
+    vols = np.stack([translate_volume(nets[i], years, grid, k, source) for i, k in enumerate(axes)])
     t2 = time.perf_counter()
     meta = {"key": key, "settings": settings, "block": block.name, "cache": "miss" if path else "off",
             "train_s": round(t1 - t0, 3), "apply_s": round(t2 - t1, 3),

@@ -165,22 +165,26 @@ def face_pair(block, face: str, grid: VolumeGrid, spec, field=None, source="arf"
     """One training pair of ``face``: ``(inputs (c, h, w), photo (h, w, 3), mask (h, w))``.
 
     ``source="arf"`` takes the ring channel from ``field`` (eq. 6 ARF at the face's grid
-    points); ``"ring_map"`` resamples the face's own ring map (real blocks with no fitted
-    field yet). Photos are resampled to the grid's cell size.
+    points); ``"ring_map"`` resamples the face's own ring map, which lies exactly on the photo's
+    rings even where a fitted field is off (a face without one gets :func:`ring_map_like` of
+    ``field``). Photos are resampled to the grid's cell size.
     """
     f = block.faces[face]
     pts = grid.face_points(face)
     cell = float(grid.cell_mm[list(PLANE_AXES[FACE_AXIS[face]])].mean())
-    if source == "arf":
-        if field is None:
-            raise WoodcamError("source='arf' needs a field; pass field= or use source='ring_map'")
-        ring = arf(evaluate(field, pts.reshape(-1, 3))).reshape(pts.shape[:2])
-    elif source == "ring_map":
-        if f.ring_map is None:
-            raise WoodcamError(f"face {face!r} has no ring map for source='ring_map'; use source='arf'")
-        ring = _resample(f.ring_map, face, f.shape, block.size_mm, pts, cell)
-    else:
+    if source not in ("arf", "ring_map"):
         raise WoodcamError(f"source must be 'arf' or 'ring_map'; got {source!r}")
+    if source == "ring_map" and f.ring_map is not None:
+        ring = _resample(f.ring_map, face, f.shape, block.size_mm, pts, cell)
+    elif field is None:
+        raise WoodcamError(
+            f"face {face!r} needs a field for source={source!r}"
+            + (" (it has no ring map)" if source == "ring_map" else "")
+            + "; pass field= or use source='ring_map' on faces with ring maps"
+        )
+    else:
+        g = evaluate(field, pts.reshape(-1, 3)).reshape(pts.shape[:2])
+        ring = arf(g) if source == "arf" else ring_map_like(g, cell)
     x = input_channels(ring, pts, spec)
     photo = None
     if f.photo is not None:
