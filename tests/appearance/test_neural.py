@@ -256,3 +256,20 @@ def test_ring_map_source_uses_the_face_ring_map_or_the_field():
     assert front.max() > 0.9 and front.min() < 0.05
     with pytest.raises(WoodcamError, match="face 'front' needs a field"):
         face_pair(blk, "front", GRID, SPEC, field=None, source="ring_map")
+
+
+def test_auto_source_prefers_ring_maps_for_fitted_fields(monkeypatch):
+    seen = []
+
+    def fake_train(block, grid, spec, *, source, **kw):
+        seen.append(source)
+        raise NoPhotosError("stop here")
+
+    monkeypatch.setattr("woodcam.appearance.neural.train_axis_networks", fake_train)
+    blk = clean_block(faces=("top", "left"))               # ring maps on every face, true field
+    for field, want in ((None, "arf"), (FIELD.base, "ring_map")):
+        with pytest.raises(NoPhotosError, match="stop here"):
+            fit_neural_appearance(blk, field, cache_dir=False)
+        assert seen.pop() == want
+    with pytest.raises(WoodcamError, match="source must be one of auto, arf, ring_map"):
+        fit_neural_appearance(blk, FIELD, source="photo", cache_dir=False)

@@ -27,12 +27,12 @@ from ..errors import WoodcamError
 from ..fields.base import check_points
 from ..frames import FACE_AXIS
 from .colormap import ColorMapAppearance
-from .orientation import blend_axis_colors
+from .orientation import axis_weights
 from .translation import Quality, TranslationNet, train_translation, translation_spec
 from .volumes import ColorVolumes, VolumeGrid, cache_key, face_pair, translate_volume, years_volume
 
 Orientation = Literal["dependent", "agnostic"]
-Source = Literal["arf", "ring_map"]
+Source = Literal["auto", "arf", "ring_map"]
 AppearanceKind = Literal["colormap", "neural"]
 APPEARANCE_KINDS: tuple[str, ...] = get_args(AppearanceKind)
 
@@ -84,8 +84,17 @@ class NeuralAppearance:
         p = check_points(points_mm)
         if len(self.volumes.volumes) == 1:
             return self.volumes.sample(p, 0)
-        yz, zx, xy = (self.volumes.sample(p, k) for k in range(3))
-        return blend_axis_colors(yz, zx, xy, normals).astype(np.float32)
+        # Eq. 10, looking up each volume only where its weight is non-zero (flat CAD faces are
+        # mostly axis-aligned, so this skips two of the three lookups there).
+        w = axis_weights(normals)
+        out = np.zeros((len(p), 3), np.float32)
+        for k in range(3):
+            idx = np.flatnonzero(w[:, k] > 0)
+            if len(idx) == len(p):
+                out += w[:, k:k + 1] * self.volumes.sample(p, k)
+            elif len(idx):
+                out[idx] += w[idx, k:k + 1] * self.volumes.sample(p[idx], k)
+        return out
 
     def agnostic(self, index: int = 2) -> "NeuralAppearance":
         """The same block seen through one volume for every normal (default ``RGB_XY``)."""
@@ -152,7 +161,7 @@ def train_axis_networks(block, grid: VolumeGrid, spec, *, field=None, source: st
 
 def fit_neural_appearance(block, field=None, *, resolution: int = 128, quality: Quality = "normal",
                           epochs: int | None = None, seed: int = 0,
-                          orientation: Orientation = "dependent", source: Source = "arf",
+                          orientation: Orientation = "dependent", source: Source = "auto",
                           cache_dir=None, progress: bool = True,
                           threads: int | None = 1) -> NeuralAppearance:
     """Learn a block's appearance from its photos and build its colour volumes (cached).
@@ -174,6 +183,8 @@ def fit_neural_appearance(block, field=None, *, resolution: int = 128, quality: 
         the field (:func:`~.volumes.ring_map_like`). Use it for real blocks whose field was
         fitted to ring maps: the ring maps sit exactly on the photos' rings, a fitted field's
         ARF only roughly, and its ring phase (earlywood vs latewood side) is not known.
+        "auto" (default): "arf" when ``field`` is the block's true field (synthetic blocks) or
+        a photo face lacks a ring map, else "ring_map".
     cache_dir : folder for the cached volumes and weights, default :func:`default_cache_dir`;
         ``False`` disables the cache.
 
@@ -183,6 +194,11 @@ def fit_neural_appearance(block, field=None, *, resolution: int = 128, quality: 
         ``meta`` holds the cache key, whether the cache was hit, timings and notes.
     """
     field = block.true_field if field is None else field
+    if source == "auto":
+        maps = all(block.faces[f].ring_map is not None for f in photo_faces(block))
+        source = "ring_map" if maps and field is not block.true_field else "arf"
+    if source not in ("arf", "ring_map"):
+        raise WoodcamError(f"source must be one of auto, arf, ring_map; got {source!r}")
     if field is None or not callable(field):
         raise WoodcamError(
             f"field must be a growth field (callable (n, 3) mm -> years) to build colour volumes of "
