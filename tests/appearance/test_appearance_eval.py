@@ -102,3 +102,18 @@ def test_cli_parser_wires_run():
     assert a.func is _cli_appearance.run and a.epochs == 2 and a.quality == "draft"
     with pytest.raises(WoodcamError, match="block must be builtin:NAME"):
         _cli_appearance.load_eval_block("/nonexistent/folder")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sample", ["H11", "CN03"])
+def test_leave_one_face_out_on_mokume_cubes(shared_data, sample):
+    """Real cubes without a fitted field: ring maps in, photos out (draft size)."""
+    from woodcam.block.io import read_mokume
+
+    block = read_mokume(shared_data / "mokume" / sample)
+    res = leave_one_face_out(block, None, resolution=64, quality="draft", faces=["top", "front"],
+                             end_grain={"top": True, "front": False}, progress=False)
+    for r in res:
+        assert r.photo.shape == (64, 64, 3)
+        for m in MODELS:
+            assert all(np.isfinite(v) for v in r.scores[m].values())
