@@ -28,6 +28,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--resolution", type=int, default=128, help="grid cells along the longest side (default 128)")
     p.add_argument("--quality", choices=("draft", "normal", "high"), default="normal")
     p.add_argument("--epochs", type=int, default=None, help="training epochs (overrides --quality's)")
+    p.add_argument("--finetune-epochs", type=int, default=None, metavar="N",
+                   help="per-axis networks fine-tuned N epochs from the all-faces network "
+                   "(default 2; 0 trains each axis from scratch, as seed 000 does)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--end-grain", default=None, metavar="FACES",
                    help="comma-separated end-grain faces (default: from the field; unknown without one)")
@@ -72,6 +75,7 @@ def run(args) -> int:
             end_grain = {f: f in eg for f in block.faces}
         res = leave_one_face_out(block, field, resolution=args.resolution, quality=args.quality,
                                  epochs=args.epochs, seed=args.seed, end_grain=end_grain,
+                                 finetune_epochs=args.finetune_epochs,
                                  progress=not args.quiet)
         name = block.name.replace("/", "_")
         side_by_side(res, args.out / f"{name}.png",

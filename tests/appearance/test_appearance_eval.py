@@ -117,3 +117,25 @@ def test_leave_one_face_out_on_mokume_cubes(shared_data, sample):
         assert r.photo.shape == (64, 64, 3)
         for m in MODELS:
             assert all(np.isfinite(v) for v in r.scores[m].values())
+
+
+class _NormalColour:
+    """An appearance that paints |normal|: lets the renders be checked geometrically."""
+
+    def color(self, points_mm, normals):
+        return np.abs(np.asarray(normals, float))
+
+
+def test_renders_put_the_surface_where_the_geometry_says():
+    from woodcam.appearance.evaluation import render_plane, render_sphere
+
+    size = (40.0, 40.0, 40.0)
+    plane = render_plane(_NormalColour(), size, normal=(0.0, 0.0, 1.0), px=64)
+    # A horizontal cut through a cube seen from above: a square of colour |n| = (0, 0, 1).
+    inside = np.all(plane != 1.0, axis=2) | np.all(plane == [0, 0, 1], axis=2)
+    np.testing.assert_array_equal(plane[inside], np.tile([0.0, 0.0, 1.0], (int(inside.sum()), 1)))
+    side = 40.0 / (np.sqrt(3) * 40.0)                       # block side over the view's width
+    assert inside.mean() == pytest.approx(side ** 2, rel=0.1)
+    sphere = render_sphere(_NormalColour(), size, px=128, light=(0, 0, 1))
+    disc = np.any(sphere != 1.0, axis=2)
+    assert disc.mean() == pytest.approx(np.pi / 4, rel=0.03)
