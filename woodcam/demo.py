@@ -50,10 +50,12 @@ class DemoReport:
 
 
 def run_demo(out_dir, *, quick: bool = False, texels_per_mm: float | None = None,
-             progress: bool = True) -> DemoReport:
+             progress: bool = True, appearance: str = "colormap") -> DemoReport:
     """Carve, bake, export and render every part of :data:`DEMO_PARTS` into ``out_dir``.
 
-    ``quick`` lowers the texel density (4 texels/mm instead of 10) for CI.
+    ``quick`` lowers the texel density (4 texels/mm instead of 10) for CI. ``appearance`` is
+    ``"colormap"`` (fast, default) or ``"neural"`` (colour volumes learnt from each built-in
+    block's rendered photos, cached; ``quick`` uses the "draft" quality).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -61,7 +63,11 @@ def run_demo(out_dir, *, quick: bool = False, texels_per_mm: float | None = None
     report = DemoReport()
     t0 = time.perf_counter()
     for script, spec in DEMO_PARTS:
-        stock = open_stock(spec)
+        if appearance == "neural":
+            stock = open_stock(spec, appearance="neural", quality="draft" if quick else "normal",
+                               progress=progress)
+        else:
+            stock = open_stock(spec, appearance=appearance)
         res = preview_part(examples_dir() / script, stock, out / f"{Path(script).stem}.glb",
                            texels_per_mm=tpm, progress=progress)
         res.meta_block = spec

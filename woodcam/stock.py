@@ -20,7 +20,7 @@ from .appearance import ColorMapAppearance, Wood
 from .errors import WoodcamError
 from .fields.builtin import BUILTIN_NAMES, builtin_block
 
-AppearanceKind = Literal["colormap"]
+AppearanceKind = Literal["colormap", "neural"]
 
 
 @dataclass
@@ -53,14 +53,29 @@ def open_stock(spec: str, *, species: str | None = None,
     spec : str
     species : str, optional
         Colour preset (``woodcam.appearance.SPECIES``); default: the block's own.
-    appearance : "colormap"
+    appearance : "colormap" (fast, the default) or "neural"
+        ``"neural"`` learns colour volumes from the block's face photos
+        (:func:`~woodcam.appearance.neural.fit_neural_appearance`, cached on disk); a built-in
+        block's photos are first rendered by :func:`woodcam.synth.synth_block`, and a block
+        without photos falls back to the colour map with an ``AppearanceFallbackWarning``.
     **appearance_params
-        Passed to :class:`~woodcam.appearance.ColorMapAppearance` (e.g. knot darkening).
+        Passed to :class:`~woodcam.appearance.ColorMapAppearance` (e.g. knot darkening), or for
+        ``"neural"`` to ``fit_neural_appearance`` (``resolution``, ``quality``, ``epochs``,
+        ``cache_dir``, ``progress``).
     """
-    if appearance != "colormap":
-        raise WoodcamError(f"appearance must be one of ['colormap']; got {appearance!r}")
+    if appearance not in ("colormap", "neural"):
+        raise WoodcamError(f"appearance must be one of ['colormap', 'neural']; got {appearance!r}")
     if spec.startswith("builtin:"):
         b = builtin_block(spec.split(":", 1)[1])
+        if appearance == "neural":
+            from .appearance.neural import fit_neural_appearance
+            from .synth import synth_block
+
+            photos = synth_block(b.field, b.size_mm, face_px=256, seed=0, name=f"builtin-{b.name}")
+            app = fit_neural_appearance(photos, b.field, **appearance_params)
+            return Stock(spec, b.size_mm, Wood(b.field, app), b.description,
+                         {"field": b.field.to_dict(), "appearance": "neural",
+                          "appearance_key": app.meta.get("key")})
         app = ColorMapAppearance(species or b.species, **appearance_params)
         meta = {"species": app.species.name}
         if hasattr(b.field, "to_dict"):  # every built-in field is saveable
@@ -70,14 +85,14 @@ def open_stock(spec: str, *, species: str | None = None,
         return _open_log_block(spec, species, appearance_params)
     path = Path(spec)
     if path.is_dir() and (path / "block.json").is_file():
-        return _open_block_folder(path, species, appearance_params)
+        return _open_block_folder(path, species, appearance, appearance_params)
     raise WoodcamError(
         f"block spec {spec!r} is neither 'builtin:NAME' (NAME one of {', '.join(BUILTIN_NAMES)}), "
         "'log:LOG@KNOT[:WxDxH]', nor a block folder with a block.json manifest"
     )
 
 
-def _open_block_folder(path: Path, species, appearance_params) -> Stock:
+def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
     from .block.io import read_block  # block I/O sits beside; imported when a folder is used
 
     block = read_block(path)
@@ -87,7 +102,12 @@ def _open_block_folder(path: Path, species, appearance_params) -> Stock:
             f"'woodcam fit {path}' first"
         )
     field = block.true_field
-    if any(f.photo is not None for f in block.faces.values()):
+    if appearance == "neural":
+        from .appearance.neural import block_appearance
+
+        appearance_params.setdefault("cache_dir", path / ".woodcam-cache")
+        app = block_appearance(block, field, "neural", species=species or "oak", **appearance_params)
+    elif any(f.photo is not None for f in block.faces.values()):
         app = ColorMapAppearance.fit_to_block(block, field, species or "oak", **appearance_params)
     else:
         app = ColorMapAppearance(species or "oak", **appearance_params)

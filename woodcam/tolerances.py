@@ -70,3 +70,15 @@ RASTER_MARGIN_TEXELS = 0.02
 #: Triangles whose texel-space area (texels^2) is below this are degenerate in UV: their
 #: barycentric inverse is ill-conditioned, so the baker skips them (neighbours paint the texels).
 MIN_UV_AREA_TEXELS2 = 1e-10
+
+#: Mean colour error (fraction of full scale) allowed when a translation network trained on one
+#: face redraws another face of the same axis from its ARF, against that face's photo resampled
+#: to the grid (synthetic photos that are a known colour function of the ARF). The network is
+#: small and trained for seconds ("draft"); the remaining error sits on the sharp latewood ->
+#: earlywood steps. Measured 0.02-0.03 on the test cube; 0.04 leaves margin across seeds.
+NEURAL_FACE_MAE = 0.04
+
+#: Mean colour error allowed inside the block (trilinear lookup in the colour volumes against the
+#: known colour function): the face error plus the trilinear blur of ring steps between cell
+#: centres (cells of 0.67 mm against 3.5 mm rings in the test). Measured ~0.03.
+NEURAL_VOLUME_MAE = 0.05

@@ -1,0 +1,141 @@
+"""Appearance evaluation: the image measures against known answers; leave-one-face-out runs."""
+
+import argparse
+
+import numpy as np
+import pytest
+
+from woodcam.appearance.evaluation import (
+    MODELS, histogram_distance, leave_one_face_out, patch_distance, radial_power_spectrum, side_by_side,
+    spectrum_distance, summarise,
+)
+from woodcam.block import Block, Face
+from woodcam.errors import WoodcamError
+
+
+def _stripes(h=64, w=64, period=8.0, phase=0.0):
+    x = np.arange(w)
+    s = 0.5 + 0.3 * np.sin(2 * np.pi * (x / period) + phase)
+    return np.repeat(np.tile(s, (h, 1))[..., None], 3, axis=2)
+
+
+def test_histogram_distance_of_a_uniform_shift_is_the_shift(rng):
+    a = rng.uniform(0.2, 0.6, (40, 50, 3))
+    assert histogram_distance(a, a) == 0.0
+    assert histogram_distance(a, a + 0.1) == pytest.approx(0.1, abs=1e-9)
+    # A permutation of the pixels keeps the colour distribution.
+    perm = a.reshape(-1, 3)[rng.permutation(2000)].reshape(a.shape)
+    assert histogram_distance(a, perm) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_power_spectrum_peaks_at_the_stripe_frequency_and_sees_blur():
+    a = _stripes(period=8.0)
+    p = radial_power_spectrum(a)
+    assert np.argmax(p) + 1 == 64 // 8            # bins start at radius 1
+    assert spectrum_distance(a, _stripes(phase=1.0)) < 0.05  # shift: same spectrum
+    assert spectrum_distance(a, _stripes(period=4.0)) > 1.0  # other frequency: decades apart
+
+
+def test_patch_distance_sees_texture_that_histograms_miss(rng):
+    """Same colours, different arrangement: fine noise against its sorted (smooth) version."""
+    a = rng.uniform(0.3, 0.7, (64, 64, 3))
+    smooth = np.sort(a.reshape(-1, 3), axis=0).reshape(a.shape)
+    assert histogram_distance(a, smooth) == pytest.approx(0.0, abs=1e-12)
+    assert patch_distance(a, a) == 0.0
+    assert patch_distance(a, smooth) > 0.05
+
+
+def test_measures_reject_mismatched_images():
+    with pytest.raises(WoodcamError, match="images must both be"):
+        histogram_distance(np.zeros((4, 4, 3)), np.zeros((4, 5, 3)))
+
+
+def _tiny_eval_block():
+    from woodcam.fields.builtin import builtin_block
+    from woodcam.synth import synth_block
+
+    b = builtin_block("pith-inside")
+    return synth_block(b.field, b.size_mm, face_px=64, seed=0, name="tiny"), b.field
+
+
+def test_leave_one_face_out_runs_all_models(tmp_path):
+    block, field = _tiny_eval_block()
+    res = leave_one_face_out(block, field, resolution=40, quality="draft", epochs=1,
+                             faces=["top", "front"], progress=False)
+    assert [r.face for r in res] == ["top", "front"]
+    # The pith runs along Z: top is end grain, front side grain.
+    assert res[0].end_grain is True and res[1].end_grain is False
+    for r in res:
+        assert set(r.predictions) == set(MODELS)
+        for m in MODELS:
+            assert r.predictions[m].shape == r.photo.shape
+            assert set(r.scores[m]) == {"histogram", "spectrum", "patch", "l1"}
+    s = summarise(res)
+    assert s["end_grain"]["faces"] == ["top"] and s["side_grain"]["faces"] == ["front"]
+    side_by_side(res, tmp_path / "sbs.png", title="tiny")
+    from PIL import Image
+
+    with Image.open(tmp_path / "sbs.png") as im:
+        assert im.size[0] >= 4 * res[0].photo.shape[1]
+
+
+def test_leave_one_face_out_on_ring_maps_without_a_field():
+    block, _ = _tiny_eval_block()
+    res = leave_one_face_out(block, None, resolution=40, quality="draft", epochs=1, faces=["left"],
+                             progress=False)
+    assert res[0].end_grain is None and set(res[0].predictions) == set(MODELS)
+
+
+def test_leave_one_face_out_needs_two_photos():
+    one = Block((10, 10, 10), faces={"top": Face("top", (8, 8), photo=np.zeros((8, 8, 3), np.uint8))})
+    with pytest.raises(WoodcamError, match="at least two faces"):
+        leave_one_face_out(one, lambda p: p[:, 0], progress=False)
+
+
+def test_cli_parser_wires_run():
+    from woodcam import _cli_appearance
+
+    p = argparse.ArgumentParser()
+    sub = p.add_subparsers(dest="command")
+    _cli_appearance.add_parser(sub)
+    a = p.parse_args(["eval-appearance", "builtin:rift", "--out", "x", "--quality", "draft", "--epochs", "2"])
+    assert a.func is _cli_appearance.run and a.epochs == 2 and a.quality == "draft"
+    with pytest.raises(WoodcamError, match="block must be builtin:NAME"):
+        _cli_appearance.load_eval_block("/nonexistent/folder")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sample", ["H11", "CN03"])
+def test_leave_one_face_out_on_mokume_cubes(shared_data, sample):
+    """Real cubes without a fitted field: ring maps in, photos out (draft size)."""
+    from woodcam.block.io import read_mokume
+
+    block = read_mokume(shared_data / "mokume" / sample)
+    res = leave_one_face_out(block, None, resolution=64, quality="draft", faces=["top", "front"],
+                             end_grain={"top": True, "front": False}, progress=False)
+    for r in res:
+        assert r.photo.shape == (64, 64, 3)
+        for m in MODELS:
+            assert all(np.isfinite(v) for v in r.scores[m].values())
+
+
+class _NormalColour:
+    """An appearance that paints |normal|: lets the renders be checked geometrically."""
+
+    def color(self, points_mm, normals):
+        return np.abs(np.asarray(normals, float))
+
+
+def test_renders_put_the_surface_where_the_geometry_says():
+    from woodcam.appearance.evaluation import render_plane, render_sphere
+
+    size = (40.0, 40.0, 40.0)
+    plane = render_plane(_NormalColour(), size, normal=(0.0, 0.0, 1.0), px=64)
+    # A horizontal cut through a cube seen from above: a square of colour |n| = (0, 0, 1).
+    inside = np.all(plane != 1.0, axis=2) | np.all(plane == [0, 0, 1], axis=2)
+    np.testing.assert_array_equal(plane[inside], np.tile([0.0, 0.0, 1.0], (int(inside.sum()), 1)))
+    side = 40.0 / (np.sqrt(3) * 40.0)                       # block side over the view's width
+    assert inside.mean() == pytest.approx(side ** 2, rel=0.1)
+    sphere = render_sphere(_NormalColour(), size, px=128, light=(0, 0, 1))
+    disc = np.any(sphere != 1.0, axis=2)
+    assert disc.mean() == pytest.approx(np.pi / 4, rel=0.03)

@@ -1,0 +1,316 @@
+"""Colour volumes: per-axis translation networks run over axis-aligned slices (seed 000, 3.3.1).
+
+A :class:`VolumeGrid` covers the block ``[0, W] x [0, D] x [0, H]`` with ``shape = (nx, ny, nz)``
+cells of (nearly) equal size, ``resolution`` cells along the longest side; samples sit on
+cell centres ``((i + 0.5) W / nx, ...)``. A colour volume is ``(nx, ny, nz, 3)`` uint8 sRGB.
+:class:`ColorVolumes` holds three of them (``RGB_YZ``, ``RGB_ZX``, ``RGB_XY``: the colour
+of surfaces normal to X, Y, Z, the order of eq. 10's weights in
+:func:`~woodcam.appearance.orientation.axis_weights`) or one (orientation-agnostic).
+
+Canonical images
+----------------
+A network for axis ``k`` always sees images in one orientation, whichever face or slice they
+come from: for in-plane axes ``(a, b)`` = (Y, Z) for X, (X, Z) for Y, (X, Y) for Z, image rows run
+along ``b`` descending and columns along ``a`` ascending (the right, front and top faces as
+photographed; left, back and bottom photos are mirrored into it). Face photos are resampled
+to the grid's cell size, so a network trained on faces sees slices at the scale it learnt.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import WoodcamError
+from ..fields.base import arf, check_points, evaluate
+from ..frames import FACE_AXIS, FACE_NORMAL, block_to_pixel, check_size
+from .noise import value_noise
+
+#: In-plane axes (a, b) of the canonical image of each block axis.
+PLANE_AXES: dict[int, tuple[int, int]] = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
+
+#: Width (mm) of the ring lines of Mokume's U-Net ring maps, for ring-map-like images of a
+#: field (the same value as ``woodcam.synth.MOKUME_RING_SIGMA_MM``, which sits above this module).
+RING_MAP_SIGMA_MM = 0.62
+
+#: Largest allowed volume resolution (cells along the longest side): 256^3 x 3 x 3 bytes = 150 MB.
+MAX_RESOLUTION = 256
+
+
+@dataclass(frozen=True)
+class VolumeGrid:
+    """Cell-centred grid over the block (see module docstring).
+
+    Attributes
+    ----------
+    size_mm : (W, D, H)
+    resolution : int
+        Cells along the longest block side.
+    """
+
+    size_mm: tuple[float, float, float]
+    resolution: int = 128
+
+    def __post_init__(self):
+        object.__setattr__(self, "size_mm", tuple(float(s) for s in check_size(self.size_mm)))
+        if not 4 <= int(self.resolution) <= MAX_RESOLUTION:
+            raise WoodcamError(
+                f"resolution must be an integer in [4, {MAX_RESOLUTION}] cells along the longest "
+                f"side; got {self.resolution!r}"
+            )
+        object.__setattr__(self, "resolution", int(self.resolution))
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        cell = max(self.size_mm) / self.resolution
+        return tuple(max(2, int(round(s / cell))) for s in self.size_mm)
+
+    @property
+    def cell_mm(self) -> np.ndarray:
+        """Cell size ``(3,)`` mm along X, Y, Z."""
+        return np.asarray(self.size_mm) / np.asarray(self.shape)
+
+    def centres(self, axis: int) -> np.ndarray:
+        """Cell-centre coordinates (mm) along block axis ``axis``."""
+        return (np.arange(self.shape[axis]) + 0.5) * self.cell_mm[axis]
+
+    def points(self) -> np.ndarray:
+        """All cell centres, ``(nx, ny, nz, 3)`` float32 mm."""
+        x, y, z = np.meshgrid(*(self.centres(k).astype(np.float32) for k in range(3)), indexing="ij")
+        return np.stack([x, y, z], axis=-1)
+
+    def image_shape(self, axis: int) -> tuple[int, int]:
+        """Canonical image shape ``(rows, cols)`` of a slice normal to ``axis``."""
+        a, b = PLANE_AXES[axis]
+        return self.shape[b], self.shape[a]
+
+    def face_points(self, face: str) -> np.ndarray:
+        """Block points ``(rows, cols, 3)`` mm of the canonical image of ``face`` on its plane."""
+        k = FACE_AXIS[face]
+        a, b = PLANE_AXES[k]
+        pa = self.centres(a)
+        pb = self.centres(b)[::-1]
+        out = np.empty((len(pb), len(pa), 3))
+        out[..., a] = pa[None, :]
+        out[..., b] = pb[:, None]
+        out[..., k] = 0.0 if sum(FACE_NORMAL[face]) < 0 else self.size_mm[k]
+        return out
+
+    def to_images(self, vol: np.ndarray, axis: int) -> np.ndarray:
+        """Slices of ``vol (nx, ny, nz, ...)`` normal to ``axis`` as canonical images
+        ``(n_axis, rows, cols, ...)`` (a view)."""
+        a, b = PLANE_AXES[axis]
+        v = np.moveaxis(vol, (axis, b, a), (0, 1, 2))
+        return v[:, ::-1]
+
+    def from_images(self, images: np.ndarray, axis: int) -> np.ndarray:
+        """Inverse of :meth:`to_images`: ``(n_axis, rows, cols, ...)`` -> ``(nx, ny, nz, ...)``."""
+        a, b = PLANE_AXES[axis]
+        return np.moveaxis(images[:, ::-1], (0, 1, 2), (axis, b, a))
+
+    def to_dict(self) -> dict:
+        return {"size_mm": list(self.size_mm), "resolution": self.resolution}
+
+
+# -- input channels ----------------------------------------------------------------------------------
+
+def ring_map_like(years_img: np.ndarray, cell_mm: float, sigma_mm: float = RING_MAP_SIGMA_MM) -> np.ndarray:
+    """Mokume-style ring map of growth-time images ``(..., h, w)``: ``exp(-(d / sigma)^2)``.
+
+    ``d = |g - round(g)| / |grad g|`` is the in-image distance (mm) to the nearest ring boundary,
+    to first order (the formula of ``woodcam.synth``'s ring maps, repeated here because synth sits
+    above this module).
+    """
+    g = np.asarray(years_img, np.float64)
+    gr, gc = np.gradient(g, cell_mm, axis=(-2, -1))
+    d = np.abs(g - np.round(g)) / np.maximum(np.hypot(gr, gc), 1e-9)
+    return np.exp(-((d / sigma_mm) ** 2)).astype(np.float32)
+
+
+def input_channels(ring: np.ndarray, points_mm: np.ndarray | None, spec) -> np.ndarray:
+    """Stack network inputs ``(..., c, h, w)`` from ring images ``(..., h, w)`` and the images'
+    block points ``(..., h, w, 3)`` (for the solid-noise channel when ``spec.noise``)."""
+    ring = np.asarray(ring, np.float32)
+    chans = [ring]
+    if spec.noise:
+        if points_mm is None:
+            raise WoodcamError("points_mm are needed for the noise channel (spec.noise=True)")
+        q = np.asarray(points_mm, np.float32).reshape(-1, 3) / np.float32(spec.noise_mm)
+        chans.append(value_noise(q, spec.seed + 7).reshape(ring.shape))
+    return np.stack(chans, axis=-3)
+
+
+def _resample(image: np.ndarray, face: str, face_shape, size_mm, points: np.ndarray, cell_mm: float):
+    """Bilinear samples of a face image ``(rows, cols[, ch])`` at block ``points (h, w, 3)``,
+    low-passed first when the grid is coarser than the image (no aliasing of fine grain)."""
+    from scipy import ndimage
+
+    img = np.asarray(image, np.float32)
+    rows, cols = block_to_pixel(face, points, face_shape, size_mm)
+    px_mm = max(size_mm[i] for i in range(3) if i != FACE_AXIS[face]) / max(face_shape)
+    sigma = 0.5 * max(0.0, cell_mm / px_mm - 1.0)
+    chans = img[..., None] if img.ndim == 2 else img
+    out = np.empty(points.shape[:2] + (chans.shape[2],), np.float32)
+    for c in range(chans.shape[2]):
+        ch = ndimage.gaussian_filter(chans[..., c], sigma) if sigma > 0.05 else chans[..., c]
+        out[..., c] = ndimage.map_coordinates(ch, [rows, cols], order=1, mode="nearest")
+    return out[..., 0] if img.ndim == 2 else out
+
+
+def face_pair(block, face: str, grid: VolumeGrid, spec, field=None, source="arf"):
+    """One training pair of ``face``: ``(inputs (c, h, w), photo (h, w, 3), mask (h, w))``.
+
+    ``source="arf"`` takes the ring channel from ``field`` (eq. 6 ARF at the face's grid
+    points); ``"ring_map"`` resamples the face's own ring map, which lies exactly on the photo's
+    rings even where a fitted field is off (a face without one gets :func:`ring_map_like` of
+    ``field``). Photos are resampled to the grid's cell size.
+    """
+    f = block.faces[face]
+    pts = grid.face_points(face)
+    cell = float(grid.cell_mm[list(PLANE_AXES[FACE_AXIS[face]])].mean())
+    if source not in ("arf", "ring_map"):
+        raise WoodcamError(f"source must be 'arf' or 'ring_map'; got {source!r}")
+    if source == "ring_map" and f.ring_map is not None:
+        ring = _resample(f.ring_map, face, f.shape, block.size_mm, pts, cell)
+    elif field is None:
+        raise WoodcamError(
+            f"face {face!r} needs a field for source={source!r}"
+            + (" (it has no ring map)" if source == "ring_map" else "")
+            + "; pass field= or use source='ring_map' on faces with ring maps"
+        )
+    else:
+        g = evaluate(field, pts.reshape(-1, 3)).reshape(pts.shape[:2])
+        ring = arf(g) if source == "arf" else ring_map_like(g, cell)
+    x = input_channels(ring, pts, spec)
+    photo = None
+    if f.photo is not None:
+        photo = _resample(f.photo.astype(np.float32) / 255.0, face, f.shape, block.size_mm, pts, cell)
+    # Every pixel is learnt from, knots included: the ARF / ring map carries their distortion.
+    mask = np.ones(ring.shape, bool)
+    return x, photo, mask
+
+
+# -- the volumes -------------------------------------------------------------------------------------
+
+@dataclass
+class ColorVolumes:
+    """Three (or one) uint8 colour volumes on one grid.
+
+    Attributes
+    ----------
+    grid : VolumeGrid
+    volumes : (k, nx, ny, nz, 3) uint8, k = 3 (RGB_YZ, RGB_ZX, RGB_XY) or 1 (agnostic)
+    meta : dict
+        Settings, timings and the cache key.
+    """
+
+    grid: VolumeGrid
+    volumes: np.ndarray
+    meta: dict
+
+    def __post_init__(self):
+        v = np.asarray(self.volumes)
+        if v.dtype != np.uint8 or v.ndim != 5 or v.shape[0] not in (1, 3) or v.shape[1:] != self.grid.shape + (3,):
+            raise WoodcamError(
+                f"volumes must be uint8 of shape (1 or 3, {', '.join(map(str, self.grid.shape))}, 3); "
+                f"got {v.dtype} {v.shape}"
+            )
+        self.volumes = v
+
+    def sample(self, points_mm, index: int) -> np.ndarray:
+        """Trilinear colour ``(n, 3)`` float32 in [0, 1] of volume ``index`` at ``points_mm``.
+
+        Points outside the cell centres clamp to the border cells (a face lies half a cell
+        outside the outermost centres).
+        """
+        p = check_points(points_mm)
+        vol = self.volumes[index]
+        shape = np.asarray(self.grid.shape)
+        t = p / self.grid.cell_mm - 0.5
+        t = np.clip(t, 0.0, shape - 1.0)
+        i0 = np.minimum(t.astype(np.int64), shape - 2)
+        f = (t - i0).astype(np.float32)
+        out = np.zeros((len(p), 3), np.float32)
+        # Hand-written rather than scipy.ndimage.map_coordinates: one pass over the 8 corners
+        # for all three channels of a uint8 volume, without converting the volume to float.
+        for dx in (0, 1):
+            wx = f[:, 0] if dx else 1 - f[:, 0]
+            for dy in (0, 1):
+                wy = f[:, 1] if dy else 1 - f[:, 1]
+                for dz in (0, 1):
+                    wz = f[:, 2] if dz else 1 - f[:, 2]
+                    c = vol[i0[:, 0] + dx, i0[:, 1] + dy, i0[:, 2] + dz]
+                    out += (wx * wy * wz)[:, None] * c
+        return out * np.float32(1.0 / 255.0)
+
+    def save(self, path) -> Path:
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.name + ".tmp.npz")
+        np.savez(tmp, volumes=self.volumes, grid=json.dumps(self.grid.to_dict()),
+                 meta=json.dumps(self.meta))
+        tmp.replace(path)  # atomic: a reader never sees half a cache file
+        return path
+
+    @classmethod
+    def load(cls, path) -> "ColorVolumes":
+        with np.load(path) as z:
+            g = json.loads(str(z["grid"]))
+            return cls(VolumeGrid(tuple(g["size_mm"]), g["resolution"]), z["volumes"],
+                       json.loads(str(z["meta"])))
+
+
+def years_volume(field, grid: VolumeGrid) -> np.ndarray:
+    """Growth time at every cell centre, ``(nx, ny, nz)`` float64 (evaluated in batches)."""
+    pts = grid.points()
+    return evaluate(field, pts.reshape(-1, 3)).reshape(grid.shape)
+
+
+def translate_volume(net, years: np.ndarray, grid: VolumeGrid, axis: int, source: str = "arf",
+                     chunk: int = 16) -> np.ndarray:
+    """Run ``net`` over every slice normal to ``axis`` -> ``(nx, ny, nz, 3)`` uint8.
+
+    ``years`` is the growth-time volume of :func:`years_volume`; the ring channel is its ARF
+    (``source="arf"``) or a ring-map-like image of each slice (``"ring_map"``).
+    """
+    g_img = grid.to_images(years, axis)
+    p_img = grid.to_images(grid.points(), axis)
+    cell = float(grid.cell_mm[list(PLANE_AXES[axis])].mean())
+    out = np.empty(g_img.shape + (3,), np.uint8)
+    for i in range(0, len(g_img), chunk):
+        g = g_img[i:i + chunk]
+        ring = arf(g) if source == "arf" else ring_map_like(g, cell)
+        x = input_channels(ring, p_img[i:i + chunk], net.spec)
+        out[i:i + chunk] = np.clip(net(x) * 255.0 + 0.5, 0, 255).astype(np.uint8)
+    return np.ascontiguousarray(grid.from_images(out, axis))
+
+
+# -- cache keys ----------------------------------------------------------------------------------------
+
+def field_fingerprint(field, size_mm, n: int = 2048) -> str:
+    """A digest of any field callable: its growth time at fixed pseudo-random block points
+    (rounded to 1e-6 years), so two fields that agree there share cached volumes."""
+    pts = np.random.default_rng(918273).uniform(0, 1, (n, 3)) * np.asarray(check_size(size_mm))
+    g = np.round(evaluate(field, pts), 6)
+    return hashlib.sha256(g.astype("<f8").tobytes()).hexdigest()
+
+
+def block_fingerprint(block) -> str:
+    """A digest of a block's size and face photos and ring maps."""
+    h = hashlib.sha256(np.asarray(block.size_mm, "<f8").tobytes())
+    for name, f in block.faces.items():
+        h.update(name.encode())
+        for a in (f.photo, f.ring_map):
+            h.update(b"-" if a is None else np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
+
+
+def cache_key(block, field, settings: dict) -> str:
+    """Key of a block's colour volumes: block images, field and settings."""
+    doc = json.dumps({"block": block_fingerprint(block), "field": field_fingerprint(field, block.size_mm),
+                      "settings": settings}, sort_keys=True)
+    return hashlib.sha256(doc.encode()).hexdigest()[:20]
