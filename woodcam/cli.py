@@ -11,7 +11,7 @@ from pathlib import Path
 from .errors import WoodcamError
 
 #: Modules that add their own subcommands through ``add_parser(subparsers)`` / ``run(args)``.
-_COMMAND_MODULES: tuple[str, ...] = ("woodcam._cli_block", "woodcam._cli_log")
+_COMMAND_MODULES: tuple[str, ...] = ("woodcam._cli_block", "woodcam._cli_log", "woodcam._cli_appearance")
 
 _EPILOG = """\
 Block specs: 'builtin:NAME' (see 'woodcam blocks') or a block folder with a block.json.
@@ -23,6 +23,24 @@ examples:
   woodcam bake cad_examples/bowl.py --block builtin:flat-sawn --out out/bowl.glb
   woodcam preview out/bowl.glb --screenshot out/bowl.png
 """
+
+
+def _add_appearance(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--appearance", choices=("colormap", "neural"), default="colormap",
+                   help="colormap: fast colour-of-ring model (default); neural: colour volumes "
+                   "learnt from the block's photos per axis (seed 000 sec. 3.3, cached on disk)")
+    p.add_argument("--quality", choices=("draft", "normal", "high"), default=None,
+                   help="training effort of the neural appearance (default normal)")
+    p.add_argument("--epochs", type=int, default=None, help="override the neural training epochs")
+
+
+def _appearance_params(args) -> dict:
+    if args.appearance != "neural":
+        if args.quality or args.epochs:
+            raise WoodcamError("--quality and --epochs apply to --appearance neural only; "
+                               f"got --appearance {args.appearance}")
+        return {}
+    return {k: v for k, v in (("quality", args.quality), ("epochs", args.epochs)) if v is not None}
 
 
 def _add_common_bake(p: argparse.ArgumentParser) -> None:
@@ -50,6 +68,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_true", help="lower texture resolution (for CI)")
     p.add_argument("--texels-per-mm", type=float, default=None, metavar="T",
                    help="texture resolution (default 10, or 4 with --quick)")
+    p.add_argument("--appearance", choices=("colormap", "neural"), default="colormap",
+                   help="colormap (fast, default) or neural (learnt colour volumes, cached)")
     p.set_defaults(func=_cmd_demo)
 
     p = sub.add_parser("bake", help="carve a part out of a block and bake its wood texture",
@@ -61,6 +81,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--tolerance", type=float, default=None, metavar="MM",
                    help="tessellation chord tolerance for B-rep parts (default 0.05 mm)")
     _add_common_bake(p)
+    _add_appearance(p)
     p.set_defaults(func=_cmd_bake)
 
     p = sub.add_parser("preview", help="view a baked part (window, or --screenshot PNG)",
@@ -95,7 +116,8 @@ def _print_warnings(items) -> None:
 def _cmd_demo(args) -> int:
     from .demo import run_demo
 
-    report = run_demo(args.out, quick=args.quick, texels_per_mm=args.texels_per_mm)
+    report = run_demo(args.out, quick=args.quick, texels_per_mm=args.texels_per_mm,
+                      appearance=args.appearance)
     print(report.summary())
     return 0
 
@@ -104,7 +126,8 @@ def _cmd_bake(args) -> int:
     from .pipeline import preview_part
     from .stock import open_stock
 
-    stock = open_stock(args.block, species=args.species)
+    stock = open_stock(args.block, species=args.species, appearance=args.appearance,
+                       **_appearance_params(args))
     res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
                        tolerance_mm=args.tolerance, obj=not args.no_obj, screenshot=False,
                        progress=True)

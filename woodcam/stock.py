@@ -67,22 +67,12 @@ def open_stock(spec: str, *, species: str | None = None,
         raise WoodcamError(f"appearance must be one of ['colormap', 'neural']; got {appearance!r}")
     if spec.startswith("builtin:"):
         b = builtin_block(spec.split(":", 1)[1])
-        if appearance == "neural":
-            from .appearance.neural import fit_neural_appearance
-            from .synth import synth_block
-
-            photos = synth_block(b.field, b.size_mm, face_px=256, seed=0, name=f"builtin-{b.name}")
-            app = fit_neural_appearance(photos, b.field, **appearance_params)
-            return Stock(spec, b.size_mm, Wood(b.field, app), b.description,
-                         {"field": b.field.to_dict(), "appearance": "neural",
-                          "appearance_key": app.meta.get("key")})
-        app = ColorMapAppearance(species or b.species, **appearance_params)
-        meta = {"species": app.species.name}
-        if hasattr(b.field, "to_dict"):  # every built-in field is saveable
-            meta["field"] = b.field.to_dict()
-        return Stock(spec, b.size_mm, Wood(b.field, app), b.description, meta)
+        return _synthetic_stock(spec, b.field, b.size_mm, species or b.species, b.description,
+                                appearance, appearance_params)
     if spec.startswith("log:"):
-        return _open_log_block(spec, species, appearance_params)
+        field, size_mm, description = _log_block_field(spec)
+        return _synthetic_stock(spec, field, size_mm, species or "spruce", description,
+                                appearance, appearance_params)
     path = Path(spec)
     if path.is_dir() and (path / "block.json").is_file():
         return _open_block_folder(path, species, appearance, appearance_params)
@@ -90,6 +80,27 @@ def open_stock(spec: str, *, species: str | None = None,
         f"block spec {spec!r} is neither 'builtin:NAME' (NAME one of {', '.join(BUILTIN_NAMES)}), "
         "'log:LOG@KNOT[:WxDxH]', nor a block folder with a block.json manifest"
     )
+
+
+def _synthetic_stock(spec, field, size_mm, species, description, appearance, params) -> Stock:
+    """A stock whose true field is known but which has no photos of its own."""
+    from .fields.state import is_saveable
+
+    meta = {"appearance": appearance}
+    if is_saveable(field):
+        meta["field"] = field.to_dict()
+    if appearance == "neural":
+        # The neural appearance learns from face photos: render them from the field first.
+        from .appearance.neural import fit_neural_appearance
+        from .synth import synth_block
+
+        photos = synth_block(field, size_mm, face_px=256, seed=0, name=spec.replace(":", "-"))
+        app = fit_neural_appearance(photos, field, **params)
+        meta["appearance_key"] = app.meta.get("key")
+    else:
+        app = ColorMapAppearance(species, **params)
+        meta["species"] = app.species.name
+    return Stock(spec, tuple(size_mm), Wood(field, app), description, meta)
 
 
 def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
@@ -114,7 +125,8 @@ def _open_block_folder(path: Path, species, appearance, appearance_params) -> St
     return Stock(str(path), block.size_mm, Wood(field, app), block.name, dict(block.meta))
 
 
-def _open_log_block(spec: str, species, appearance_params) -> Stock:
+def _log_block_field(spec: str):
+    """``log:LOG@K[:WxDxH]`` -> (block-frame field, size_mm, description)."""
     from .fields import KnottedLogField, block_at_knot, place_block_in_log, read_gran1, read_log
 
     body = spec[len("log:"):]
@@ -134,6 +146,4 @@ def _open_log_block(spec: str, species, appearance_params) -> Stock:
     if not 0 <= knot < len(log.knots):
         raise WoodcamError(f"knot index in {spec!r} must be 0..{len(log.knots) - 1}; got {knot}")
     field = place_block_in_log(KnottedLogField(log), *block_at_knot(log, knot, size_mm))
-    app = ColorMapAppearance(species or "spruce", **appearance_params)
-    return Stock(spec, size_mm, Wood(field, app), f"block through knot {knot} of log {source}",
-                 {"species": app.species.name})
+    return field, size_mm, f"block through knot {knot} of log {source}"
