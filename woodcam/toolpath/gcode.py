@@ -179,8 +179,8 @@ class _Reader:
 
     def __init__(self, chord_tol_mm, start_mm):
         self.tol = float(chord_tol_mm)
-        self.pos = (np.full(3, np.nan) if start_mm is None
-                    else np.asarray(start_mm, float).reshape(3).copy())
+        self.pos = ([math.nan] * 3 if start_mm is None
+                    else [float(v) for v in np.asarray(start_mm, float).reshape(3)])
         self.motion = None
         self.plane = 17
         self.scale = 1.0  # mm per program unit
@@ -201,18 +201,18 @@ class _Reader:
 
     # -- output ---------------------------------------------------------------------------
     def _emit(self, end, kind, line):
-        end = np.asarray(end, float)
-        if np.isnan(self.pos).any():
-            self.pos = np.where(np.isnan(end), self.pos, end)
+        """Move to ``end`` (3 floats, NaN = axis not given). Plain floats: called per line."""
+        pos = self.pos
+        new = [p if math.isnan(e) else e for p, e in zip(pos, end)]
+        if any(math.isnan(p) for p in pos):
+            self.pos = new
             return
-        if np.isnan(end).any():
-            end = np.where(np.isnan(end), self.pos, end)
-        if not np.array_equal(end, self.pos):
-            self.out_s.append(self.pos.copy())
-            self.out_e.append(end.copy())
+        if new != pos:
+            self.out_s.append(pos)
+            self.out_e.append(new)
             self.out_meta.append((kind, self.tool, line, self.feed, self.spindle))
             self.tools_used.add(self.tool)
-        self.pos = end.copy()
+        self.pos = new
 
     def run(self, text: str, source: str) -> Program:
         for lineno, raw in enumerate(text.splitlines(), start=1):
@@ -282,7 +282,7 @@ class _Reader:
                 raise GcodeError(lineno, tok, f"unsupported word {letter} (woodcam simulates a "
                                  "3-axis mill: no A/B/C/U/V/W axes or other letters)",
                                  "post-process for 3 axes", n_word)
-        for group, codes in _G_GROUPS.items():
+        for group, codes in (_G_GROUPS.items() if len(g) > 1 else ()):
             hits = [tok for v, tok in g if v in codes]
             if len(hits) > 1:
                 raise GcodeError(lineno, " ".join(hits), f"two {group} G codes in one block",
@@ -347,12 +347,12 @@ class _Reader:
             self.ended = True
 
     def _target(self, vals, err):
-        end = self.pos.copy()
+        end = list(self.pos)
         for i, a in enumerate("XYZ"):
             if a in vals:
                 v = vals[a] * self.scale
                 if self.incremental:
-                    if np.isnan(self.pos[i]):
+                    if math.isnan(self.pos[i]):
                         raise err(_fmt(a, vals[a]), f"incremental (G91) move before the {a} "
                                   "position is known", "start with an absolute (G90) move")
                     end[i] = self.pos[i] + v
@@ -377,7 +377,7 @@ class _Reader:
 
     def _arc(self, lineno, vals, end, cw, err):
         a1, a2, an = _PLANES[self.plane]
-        start = self.pos
+        start = np.array(self.pos)
         if np.isnan(start).any():
             raise err(f"G{2 if cw else 3}", "arc before the start position is known",
                       "move to the arc start with G0/G1 first")
@@ -447,7 +447,7 @@ class _Reader:
         pts[:, a2] = centre[1] + rad * np.sin(ang)
         pts[:, an] = start[an] + (end[an] - start[an]) * t
         pts[-1] = end  # exact end point
-        for p in pts:
+        for p in pts.tolist():
             self._emit(p, FEED, lineno)
 
     def _cycle(self, lineno, vals, err):
@@ -468,7 +468,7 @@ class _Reader:
             raise err(code, "drilling cycle without R and Z", "give R (retract) and Z (depth)")
         if self.motion == 83.0 and math.isnan(self.cycle_q):
             raise err(code, "G83 needs a peck depth Q", "give Q > 0")
-        if np.isnan(self.pos).any():
+        if any(math.isnan(v) for v in self.pos):
             raise err(code, "drilling cycle before the start position is known",
                       "move above the first hole with G0 first")
         z_init = self.pos[2]

@@ -22,7 +22,7 @@ cell's coordinate along the move's XY direction, ``d`` its distance from the mov
 ``[-a, L - a] ∩ [-sqrt(R^2 - d^2), sqrt(R^2 - d^2)]``. The bracket is convex in ``w`` (``h``
 convex and non-decreasing, the distance convex), so the constrained minimiser is the
 unconstrained one clipped to the interval; each tool solves it in closed form
-(:meth:`Tool._argmin`; bisection for the bull nose on ramps). The result is exact at every cell
+(:meth:`Tool._sweep`; bisection for the bull nose on ramps). The result is exact at every cell
 centre, so the only error of the height field is sampling (one cell) and arc chords.
 
 Moves are processed in vectorised batches: moves whose bounding boxes (in cells) fit the same
@@ -44,9 +44,9 @@ from ..tolerances import SIM_CONTACT_TOL_MM
 from .gcode import FEED, RAPID, Program
 from .tools import Tool
 
-#: Cells evaluated per vectorised batch: bounds peak memory (~25 float64 temporaries per cell,
-#: so ~0.2 GB at 1M cells).
-_BATCH_CELLS = 1 << 20
+#: Cells evaluated per vectorised batch: ~20 float32 temporaries of 64k cells stay in L2/L3
+#: cache (measured 1.4x faster than 1M-cell batches on the raster benchmark).
+_BATCH_CELLS = 1 << 16
 
 
 @dataclass(frozen=True)
@@ -202,7 +202,7 @@ def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
         idx_run = act[run]
         tool = lookup[int(tool_of[idx_run[0]])]
         # Group moves by window size (rounded up to multiples of 8 cells) so each group is a
-        # dense (batch, wy, wx) array of bounded size.
+        # dense (batch, wy, wx) array of bounded size (small enough to stay in cache).
         wy = (j1[idx_run] - j0[idx_run] + 1 + 7) // 8 * 8
         wx = (i1[idx_run] - i0[idx_run] + 1 + 7) // 8 * 8
         order = np.lexsort((wx, wy))
@@ -234,49 +234,43 @@ def _add(issues, kind, line, message):
 def _sweep_batch(hm, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind, lines, issues):
     """Lower envelope of ``len(a)`` straight moves over their windows; min-update ``hm``.
 
-    ``a, b : (n, 3)`` block-frame tip positions (mm); windows start at cells ``(j0, i0)`` and are
-    ``wy x wx`` cells (padded; cells beyond ``(j1, i1)`` are masked). Returns cells evaluated.
+    ``a, b : (n, 3)`` block-frame tip positions (mm); each window is the ``wy x wx`` cells from
+    ``(j0, i0)``, shifted to lie inside the grid. Cells of a window that the swept tool does not
+    cover come back from the kernel as ``+inf`` (the footprint test is part of the kernel), so
+    padding needs no mask. Float32 inside the kernel: coordinates are relative to the move start
+    (|x| < ~50 mm, round-off < 1e-5 mm). Returns the number of covered cells.
     """
     n = len(a)
     ny, nx = hm.shape
-    R = tool.radius_mm
-    jj = j0[:, None, None] + np.arange(wy)[None, :, None]
-    ii = i0[:, None, None] + np.arange(wx)[None, None, :]
-    inwin = (jj <= j1[:, None, None]) & (ii <= i1[:, None, None])
-    jj = np.minimum(jj, ny - 1)
-    ii = np.minimum(ii, nx - 1)
-    cx = (ii + 0.5) * dx - a[:, 0, None, None]
-    cy = (jj + 0.5) * dy - a[:, 1, None, None]
+    wy, wx = min(wy, ny), min(wx, nx)
+    js = np.clip(j0, 0, ny - wy)
+    is_ = np.clip(i0, 0, nx - wx)
+    f32 = np.float32
+    cx = ((is_[:, None] + np.arange(wx)[None, :] + 0.5) * dx - a[:, 0, None]).astype(f32)
+    cy = ((js[:, None] + np.arange(wy)[None, :] + 0.5) * dy - a[:, 1, None]).astype(f32)
     ex, ey, ez = (b - a).T
     L = np.hypot(ex, ey)
-    plunge = L < 1e-9
+    plunge = L < 1e-9  # vertical move: along = x, clipped to t = 0 below, so rho = |cell - p|
     Ls = np.where(plunge, 1.0, L)
-    ux, uy = ex / Ls, ey / Ls
+    ux, uy = np.where(plunge, 1.0, ex / Ls), np.where(plunge, 0.0, ey / Ls)
     s = np.where(plunge, 0.0, ez / Ls)
-    zb = np.where(plunge, np.minimum(a[:, 2], b[:, 2]), a[:, 2])
+    z0 = np.where(plunge, np.minimum(a[:, 2], b[:, 2]), a[:, 2])
     L = np.where(plunge, 0.0, L)
-    ux, uy, s3, L3 = ux[:, None, None], uy[:, None, None], s[:, None, None], L[:, None, None]
-    along = cx * ux + cy * uy
-    d = np.abs(cx * uy - cy * ux)
-    d = np.where(plunge[:, None, None], np.hypot(cx, cy), d)
-    along = np.where(plunge[:, None, None], 0.0, along)
-    re = np.sqrt(np.maximum(R * R - d * d, 0.0))
-    lo = np.maximum(-along, -re)
-    hi = np.minimum(L3 - along, re)
-    valid = inwin & (d <= R) & (lo <= hi)
-    hi = np.maximum(hi, lo)
-    w = tool._argmin(s3, d, lo, hi)
-    env = zb[:, None, None] + s3 * (along + w) + tool._h(np.minimum(np.hypot(w, d), R))
-    env = np.where(valid, env, np.inf)
-    flat = (jj * nx + ii).reshape(n, -1)
-    env = env.reshape(n, -1)
+    col = lambda v: np.asarray(v, f32)[:, None, None]  # noqa: E731
+    along = (cx * ux[:, None].astype(f32))[:, None, :] + (cy * uy[:, None].astype(f32))[:, :, None]
+    rr = (cx * cx)[:, None, :] + (cy * cy)[:, :, None]
+    d2 = rr - along * along
+    env = tool._sweep(along, d2, col(s), col(L), col(z0))
     rap = kind == RAPID
     if rap.any():
-        # a rapid cuts stock if its envelope is below the stock as it is before this batch
-        cur = hm.reshape(-1)[flat[rap]]
-        depth = (cur - env[rap]).max(axis=1)
-        for k in np.flatnonzero(depth > SIM_CONTACT_TOL_MM):
-            _add(issues, "rapid_through_stock", lines[rap][k],
-                 f"rapid move (G0) cuts up to {depth[k]:.3f} mm into the stock")
-    np.minimum.at(hm.reshape(-1), flat.reshape(-1), env.reshape(-1))
-    return int(valid.sum())
+        # a rapid cuts stock if its envelope is below the stock as cut by all earlier moves
+        for k in np.flatnonzero(rap):
+            cur = hm[js[k]:js[k] + wy, is_[k]:is_[k] + wx]
+            depth = float((cur - env[k]).max())
+            if depth > SIM_CONTACT_TOL_MM:
+                _add(issues, "rapid_through_stock", lines[k],
+                     f"rapid move (G0) cuts up to {depth:.3f} mm into the stock")
+    for k in range(n):  # scatter: one slice per move (windows overlap, so no fancy indexing)
+        view = hm[js[k]:js[k] + wy, is_[k]:is_[k] + wx]
+        np.minimum(view, env[k], out=view)
+    return int(np.isfinite(env).sum())

@@ -82,28 +82,44 @@ class Tool:
     def _h(self, r):
         raise NotImplementedError
 
-    def _argmin(self, s, d, lo, hi):
-        """Minimiser ``w`` in ``[lo, hi]`` of ``s w + h(sqrt(w^2 + d^2))`` (all arrays, mm).
-
-        ``s`` is the move's slope dz/dl, ``d`` the cell's distance from the move's line.
-        Generic version: bisection on the sign of the derivative (convex in ``w``).
-        """
-        if not np.any(s):  # horizontal move: f is even in w, minimum at w = 0
-            return np.clip(0.0, lo, hi)
-        a, b = np.array(lo, float), np.array(hi, float)
-        # 30 halvings of a <= tool-diameter interval: |w - w*| < 1e-8 D, far below a cell.
-        for _ in range(30):
-            m = 0.5 * (a + b)
-            rho = np.sqrt(m * m + d * d)
-            slope = self._dh(np.minimum(rho, self.radius_mm))
-            der = s + slope * np.where(rho > 0, m / np.where(rho > 0, rho, 1.0), 0.0)
-            right = der > 0
-            b = np.where(right, m, b)
-            a = np.where(right, a, m)
-        return 0.5 * (a + b)
-
     def _dh(self, r):
         raise NotImplementedError
+
+    def _sweep(self, along, d2, s, L, z0):
+        """Lower envelope (mm) of the tool swept along a straight move, ``+inf`` where uncovered.
+
+        ``along, d2 : (n, wy, wx)``: a cell's coordinate along the move's XY direction from its
+        start and its squared distance from the move's XY line; ``s, L, z0 : (n, 1, 1)``: the
+        slope dz/dl, XY length and start height. The envelope is
+        ``min over t in [0, L], |t - along| <= sqrt(R^2 - d2) of z0 + s t + h(rho)``,
+        ``rho^2 = d2 + (t - along)^2``, convex in ``t``; subclasses solve it in closed form.
+        Generic version: bisection on the sign of the derivative.
+        """
+        R = self.radius_mm
+        re = np.sqrt(np.maximum(R * R - d2, 0.0))
+        lo = np.maximum(along - re, 0.0)
+        hi = np.minimum(along + re, L)
+        ok = (d2 <= R * R) & (lo <= hi)
+        hi = np.maximum(hi, lo)
+        d2c = np.maximum(d2, 0.0)
+        if np.any(s):
+            a, b = lo, hi
+            # 30 halvings of an interval <= L + D: |t - t*| < 1e-9 (L + D), far below a cell.
+            for _ in range(30):
+                m = 0.5 * (a + b)
+                w = m - along
+                rho = np.sqrt(d2c + w * w)
+                der = s + self._dh(np.minimum(rho, R)) * np.where(rho > 0, w / np.maximum(rho, 1e-30), 0.0)
+                right = der > 0
+                b = np.where(right, m, b)
+                a = np.where(right, a, m)
+            t = 0.5 * (a + b)
+        else:  # horizontal move: minimum at the foot of the perpendicular (even in w)
+            t = np.clip(along, lo, hi)
+        w = t - along
+        rho = np.sqrt(d2c + w * w)
+        env = z0 + s * t + self._h(np.minimum(rho, R))
+        return np.where(ok, env, np.inf)
 
     def spec(self) -> str:
         raise NotImplementedError
@@ -134,9 +150,14 @@ class FlatEndMill(Tool):
     def _dh(self, r):
         return np.zeros_like(r)
 
-    def _argmin(self, s, d, lo, hi):
-        # f(w) = s w on the chord |w| <= sqrt(R^2 - d^2): the lower end when the move climbs.
-        return np.where(s > 0, lo, np.where(s < 0, hi, np.clip(0.0, lo, hi)))
+    def _sweep(self, along, d2, s, L, z0):
+        # z0 + s t on the chord |t - along| <= sqrt(R^2 - d2), t in [0, L]: the lowest end.
+        R = self.radius_mm
+        re = np.sqrt(np.maximum(R * R - d2, 0.0))
+        lo = np.maximum(along - re, 0.0)
+        hi = np.minimum(along + re, L)
+        t = np.where(s > 0, lo, hi)
+        return np.where((d2 <= R * R) & (lo <= hi), z0 + s * t, np.inf)
 
     def spec(self):
         return f"flat:{self.diameter_mm:g}"
@@ -162,10 +183,17 @@ class BallEndMill(Tool):
         R = self.radius_mm
         return r / np.sqrt(np.maximum(R * R - r * r, 1e-30))
 
-    def _argmin(self, s, d, lo, hi):
-        # Sphere centre on the line: tangent point at w = -s Re / sqrt(1 + s^2), Re^2 = R^2 - d^2.
-        re = np.sqrt(np.maximum(self.radius_mm ** 2 - d * d, 0.0))
-        return np.clip(-s * re / np.sqrt(1.0 + s * s), lo, hi)
+    def _sweep(self, along, d2, s, L, z0):
+        # Sphere centre on the line: tangent at w = t - along = -s Re / sqrt(1 + s^2),
+        # Re^2 = R^2 - d2; then clip t to the move. Uncovered where Re^2 - w^2 < 0.
+        R = self.radius_mm
+        re2 = R * R - d2
+        re = np.sqrt(np.maximum(re2, 0.0))
+        t = np.clip(along - (s / np.sqrt(1.0 + s * s)) * re, 0.0, L)
+        w = t - along
+        q = re2 - w * w
+        env = (z0 + R) + s * t - np.sqrt(np.maximum(q, 0.0))
+        return np.where(q >= 0, env, np.inf)
 
     def spec(self):
         return f"ball:{self.diameter_mm:g}"
@@ -222,14 +250,21 @@ class VBit(Tool):
     def _dh(self, r):
         return np.full_like(r, self._k)
 
-    def _argmin(self, s, d, lo, hi):
+    def _sweep(self, along, d2, s, L, z0):
         # s + k w / rho = 0 -> w = -s d / sqrt(k^2 - s^2) when the move is shallower than the
         # cone (|s| < k); otherwise the minimum sits at the end of the interval.
-        k = self._k
-        inside = np.abs(s) < k
-        w = np.where(inside, -s * d / np.sqrt(np.maximum(k * k - s * s, 1e-300)),
-                     np.where(s > 0, -np.inf, np.inf))
-        return np.clip(w, lo, hi)
+        k, R = self._k, self.radius_mm
+        d2c = np.maximum(d2, 0.0)
+        re = np.sqrt(np.maximum(R * R - d2, 0.0))
+        lo = np.maximum(along - re, 0.0)
+        hi = np.minimum(along + re, L)
+        ok = (d2 <= R * R) & (lo <= hi)
+        w = -s * np.sqrt(d2c) / np.sqrt(np.maximum(k * k - s * s, 1e-30))
+        w = np.where(np.abs(s) >= k, np.where(s > 0, -np.inf, np.inf), w)
+        t = np.clip(along + w, lo, np.maximum(hi, lo))
+        w = t - along
+        env = z0 + s * t + k * np.sqrt(d2c + w * w)
+        return np.where(ok, env, np.inf)
 
     def spec(self):
         return f"vbit:{self.angle_deg:g}:{self.diameter_mm:g}"
