@@ -38,9 +38,6 @@ def _planar_levels(z, tol):
     """Planarity flags per quadtree level: ``levels[k] : (qy >> k, qx >> k) bool``."""
     qy, qx = z.shape[0] - 1, z.shape[1] - 1
     q0 = np.abs(z[:-1, :-1] + z[1:, 1:] - z[:-1, 1:] - z[1:, :-1]) <= tol
-    # border quads have non-uniform spacing (half a cell): never merge them
-    q0[0, :] = q0[-1, :] = False
-    q0[:, 0] = q0[:, -1] = False
     levels = [q0]
     k = 1
     while (qy >> k) >= 1 and (qx >> k) >= 1:
@@ -88,27 +85,30 @@ def heightfield_mesh(heightmap, size_mm, *, flat_tol_mm: float = 1e-9):
     verts = [np.column_stack([X.ravel(), Y.ravel(), z.ravel()])]
     faces = []
 
-    levels = _planar_levels(z, flat_tol_mm)
+    # quadtree over the uniform interior (between cell centres); the half-cell border quads
+    # (non-uniform spacing) stay plain quads. Interior vertex (j, i) is grid vertex (j+1, i+1).
+    levels = _planar_levels(z[1:-1, 1:-1], flat_tol_mm) if min(nyv, nxv) > 3 else []
     qy, qx = nyv - 1, nxv - 1
     covered = np.zeros((qy, qx), bool)
+    inner = covered[1:-1, 1:-1]
     for k in range(len(levels) - 1, 0, -1):
         s = 1 << k
         lev = levels[k]
         by, bx = lev.shape
-        blk_cov = covered[: by * s, : bx * s].reshape(by, s, bx, s).any(axis=(1, 3))
+        blk_cov = inner[: by * s, : bx * s].reshape(by, s, bx, s).any(axis=(1, 3))
         leaf = lev & ~blk_cov
         bj, bi = np.nonzero(leaf)
         if not len(bj):
             continue
-        covered[: by * s, : bx * s] |= np.repeat(np.repeat(leaf, s, 0), s, 1)
+        inner[: by * s, : bx * s] |= np.repeat(np.repeat(leaf, s, 0), s, 1)
         r = np.arange(s)
         # perimeter, counter-clockwise seen from +Z (row index grows with Y)
         pj = np.concatenate([np.zeros(s, int), r, np.full(s, s), s - r])
         pi = np.concatenate([r, np.full(s, s), s - r, np.zeros(s, int)])
-        J = bj[:, None] * s + pj[None, :]
-        I = bi[:, None] * s + pi[None, :]
+        J = 1 + bj[:, None] * s + pj[None, :]
+        I = 1 + bi[:, None] * s + pi[None, :]
         ring = vid[J, I]
-        centre = vid[bj * s + s // 2, bi * s + s // 2]
+        centre = vid[1 + bj * s + s // 2, 1 + bi * s + s // 2]
         nxt = np.roll(ring, -1, axis=1)
         faces.append(np.stack([np.broadcast_to(centre[:, None], ring.shape), ring, nxt],
                               axis=-1).reshape(-1, 3))

@@ -173,9 +173,10 @@ def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
     over = (i1 >= i0) & (j1 >= j0)
     below_top = zmin < H - SIM_CONTACT_TOL_MM
     kind, lines = program.kind, program.line
-    for k in np.flatnonzero(below_top & (zmin < -SIM_CONTACT_TOL_MM) & over):
+    # a move ending below the bottom (the retract out of it is not reported again)
+    for k in np.flatnonzero((p1[:, 2] < -SIM_CONTACT_TOL_MM) & over):
         _add(issues, "below_stock_bottom", lines[k],
-             f"tool tip at z = {zmin[k] - off[2]:.3f} mm (G-code frame), {-zmin[k]:.3f} mm "
+             f"tool tip at z = {p1[k, 2] - off[2]:.3f} mm (G-code frame), {-p1[k, 2]:.3f} mm "
              "below the stock bottom")
     for k in np.flatnonzero(below_top & outside & (kind == FEED)):
         _add(issues, "cut_outside_stock", lines[k],
