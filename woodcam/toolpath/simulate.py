@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Mapping
+from typing import Literal, Mapping
 
 import numpy as np
 
@@ -49,16 +49,47 @@ from .tools import Tool
 _BATCH_CELLS = 1 << 16
 
 
+IssueKind = Literal["rapid_through_stock", "below_stock_bottom", "cut_outside_stock"]
+
+#: Issues of one kind listed one by one before the rest are summarised in one entry.
+MAX_ISSUES_PER_KIND = 12
+
+
 @dataclass(frozen=True)
 class Issue:
-    """A problem the simulation found: ``kind`` and the 1-based G-code ``line``."""
+    """A problem the simulation found on G-code lines ``line .. last_line`` (1-based)."""
 
-    kind: str  # "rapid_through_stock" | "below_stock_bottom" | "cut_outside_stock"
+    kind: IssueKind
     line: int
     message: str
+    last_line: int | None = None
 
     def __str__(self):
-        return f"line {self.line}: {self.kind}: {self.message}"
+        where = f"line {self.line}" if not self.last_line or self.last_line == self.line \
+            else f"lines {self.line}-{self.last_line}"
+        return f"{where}: {self.kind}: {self.message}"
+
+
+def _summarise(issues: dict) -> list[Issue]:
+    """Merge runs of adjacent lines of one kind; cap each kind at MAX_ISSUES_PER_KIND."""
+    out = []
+    for kind in ("rapid_through_stock", "below_stock_bottom", "cut_outside_stock"):
+        items = sorted((i for (k, _), i in issues.items() if k == kind), key=lambda i: i.line)
+        runs: list[list[Issue]] = []
+        for it in items:
+            if runs and it.line <= runs[-1][-1].line + 1:
+                runs[-1].append(it)
+            else:
+                runs.append([it])
+        merged = [Issue(kind, r[0].line, r[0].message, r[-1].line) for r in runs]
+        if len(merged) > MAX_ISSUES_PER_KIND:
+            rest = merged[MAX_ISSUES_PER_KIND:]
+            n_lines = sum(len(r) for r in runs[MAX_ISSUES_PER_KIND:])
+            merged = merged[:MAX_ISSUES_PER_KIND] + [Issue(
+                kind, rest[0].line, f"and {n_lines} more lines like this, the last at line "
+                f"{rest[-1].last_line}", rest[-1].last_line)]
+        out += merged
+    return sorted(out, key=lambda i: (i.line, i.kind))
 
 
 @dataclass
@@ -219,7 +250,7 @@ def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
     n_active = len(act)
     np.clip(hm, 0.0, H, out=hm)
     wall = time.perf_counter() - t0
-    report = sorted(issues.values(), key=lambda i: (i.line, i.kind))
+    report = _summarise(issues)
     stats = {"moves": len(program), "moves_cutting_window": n_active, "cell_updates": cells,
              "wall_s": wall, "moves_per_s": len(program) / max(wall, 1e-12),
              "cell_updates_per_s": cells / max(wall, 1e-12), "grid": (ny, nx)}
@@ -259,8 +290,9 @@ def _sweep_batch(hm, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind, lines, is
     L = np.where(plunge, 0.0, L)
     col = lambda v: np.asarray(v, f32)[:, None, None]  # noqa: E731
     along = (cx * ux[:, None].astype(f32))[:, None, :] + (cy * uy[:, None].astype(f32))[:, :, None]
-    rr = (cx * cx)[:, None, :] + (cy * cy)[:, :, None]
-    d2 = rr - along * along
+    # perpendicular distance directly (rr - along^2 would cancel catastrophically in float32)
+    perp = (cx * uy[:, None].astype(f32))[:, None, :] - (cy * ux[:, None].astype(f32))[:, :, None]
+    d2 = perp * perp
     env = tool._sweep(along, d2, col(s), col(L), col(z0))
     rap = kind == RAPID
     if rap.any():

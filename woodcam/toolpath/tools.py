@@ -128,13 +128,14 @@ class Tool:
         """The tool as a ``manifold3d.Manifold``: tip at the origin, up to ``z = top_mm``."""
         from manifold3d import CrossSection, Manifold
 
-        n = 64
-        r = np.linspace(0.0, self.radius_mm, n)
+        # r = R sin(theta) samples densely where ball/bull profiles turn vertical; the polygon
+        # is inscribed in the convex profile (sagitta < R (1 - cos(pi / 4 / (n - 1))) ~ 0.1 %).
+        n = 24
+        r = self.radius_mm * np.sin(np.linspace(0.0, 0.5 * np.pi, n))
         h = self._h(r)
         top = max(float(top_mm), float(h[-1]) + 1e-3)
         poly = [(0.0, 0.0)] + [(float(a), float(b)) for a, b in zip(r[1:], h[1:])]
         poly += [(self.radius_mm, top), (0.0, top)]
-        # drop repeated points (flat bottoms give collinear runs; manifold handles those)
         return Manifold.revolve(CrossSection([poly]), segments)
 
 
