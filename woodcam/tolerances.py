@@ -49,3 +49,20 @@ ARC_RADIUS_MISMATCH_MM = 0.01
 #: simulation reports rapids through stock and cuts outside it: the float32 sweep kernel has
 #: ~1e-5 mm round-off at 100 mm, and a CAM clearance plane sits >= 0.5 mm above the stock.
 SIM_CONTACT_TOL_MM = 1e-4
+
+#: Largest error (years) allowed between a refined synthetic ring trace vertex and its integer
+#: iso-line. Newton refinement on the true field reaches ~1e-9 years in three steps; vertices that
+#: do not (on a field kink or where the gradient vanishes, e.g. at the pith) are dropped.
+#: The acceptance test uses 1e-3 years (about 3 um at 3 mm rings), so 1e-4 leaves margin.
+TRACE_ISO_TOL_YEARS = 1e-4
+
+#: Finite-difference step (pixels) for the in-face gradient used to refine ring traces: small
+#: enough to resolve 1.5 mm rings at 5 px/mm, large enough that float64 round-off of years of
+#: order 100 stays ~1e-12 relative.
+TRACE_FD_STEP_PX = 1e-3
+
+#: Ring maps stored as 16-bit PNG come back within half a quantisation step, 0.5 / 65535.
+RING_MAP_QUANT_16BIT = 0.5 / 65535
+
+#: Ring maps stored as 8-bit PNG (and Mokume's own maps) carry 0.5 / 255 of quantisation.
+RING_MAP_QUANT_8BIT = 0.5 / 255
