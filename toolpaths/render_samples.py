@@ -37,7 +37,19 @@ def _render_mesh(mesh, size_mm):
     return trimesh.util.concatenate([top, trimesh.Trimesh(wv, wf, process=False)])
 
 
-def render(mesh, wood, png, size_mm, window=(640, 440)):
+def _depth_inset(heightmap, size_mm, height_px):
+    """Top view of the height field (cell depth below the top face, viridis), ``height_px`` high."""
+    from matplotlib import colormaps
+    from PIL import Image
+
+    depth = size_mm[2] - heightmap[::-1]  # row 0 of an image is the back (+Y) edge
+    rgb = colormaps["viridis"](depth / max(depth.max(), 1e-9))[..., :3]
+    img = Image.fromarray((rgb * 255).astype(np.uint8))
+    w = round(height_px * heightmap.shape[1] / heightmap.shape[0])
+    return img.resize((w, height_px), Image.Resampling.LANCZOS)
+
+
+def render(mesh, wood, png, size_mm, window=(640, 440), heightmap=None):
     import pyvista as pv
     from PIL import Image
 
@@ -55,9 +67,15 @@ def render(mesh, wood, png, size_mm, window=(640, 440)):
     pl.camera.up = (0, 0, 1)
     pl.camera.zoom(1.05)
     pl.enable_anti_aliasing("ssaa")
-    img = pl.screenshot(return_img=True)
+    img = Image.fromarray(pl.screenshot(return_img=True))
     pl.close()
-    Image.fromarray(img).quantize(colors=192, method=Image.Quantize.MEDIANCUT).save(
+    if heightmap is not None:  # side panel: the height field seen from above
+        inset = _depth_inset(heightmap, size_mm, window[1] - 40)
+        canvas = Image.new("RGB", (window[0] + inset.width + 20, window[1]), "white")
+        canvas.paste(img, (0, 0))
+        canvas.paste(inset, (window[0], 20))
+        img = canvas
+    img.quantize(colors=192, method=Image.Quantize.MEDIANCUT).save(
         png, optimize=True)
 
 
@@ -78,7 +96,7 @@ def main(argv=None):
         res = simulate(prog, tools, stock.size_mm)
         mesh = res.to_mesh(flat_tol_mm=-1.0)  # full grid: vertex colours need it
         png = HERE / "img" / f"{name}.png"
-        render(mesh, stock.wood, png, stock.size_mm)
+        render(mesh, stock.wood, png, stock.size_mm, heightmap=res.heightmap)
         print(f"{name}: {len(prog)} moves, {len(mesh.faces)} triangles, watertight "
               f"{mesh.is_watertight}, {png.stat().st_size // 1024} KB, "
               f"{time.perf_counter() - t0:.1f} s; report: {len(res.report)} entries",

@@ -101,13 +101,14 @@ def test_report_names_lines():
             "G1 Z-13\n"              # 4 below the bottom (stock is 12 high)
             "G0 Z2\n"                # 5
             "G0 X-10\n"              # 6
-            "G1 Z-1\n"               # 7 plunge outside the stock: nothing to cut, not reported
+            "G1 Z-1\n"               # 7 feed below the top outside the stock
             "G1 X3\n"                # 8 cuts in from outside
             "G0 Z2\n")
     res = simulate(read_gcode(text), FlatEndMill(4), SIZE)
-    got = {(i.kind, i.line) for i in res.report}
-    assert got == {("rapid_through_stock", 3), ("below_stock_bottom", 4),
-                   ("cut_outside_stock", 7), ("cut_outside_stock", 8)}
+    got = {(i.kind, i.line, i.last_line) for i in res.report}
+    assert got == {("rapid_through_stock", 3, 3), ("below_stock_bottom", 4, 4),
+                   ("cut_outside_stock", 7, 8)}  # adjacent lines of one kind are merged
+    assert "lines 7-8: cut_outside_stock" in [str(i)[:28] for i in res.report]
     assert "cuts up to 1.000 mm" in next(str(i) for i in res.report if i.line == 3)
     assert res.heightmap.min() == 0.0  # clamped to the stock bottom
 
@@ -163,3 +164,14 @@ def test_program_from_arrays_and_errors():
         simulate(prog, FlatEndMill(2), SIZE, resolution_mm=0)
     with pytest.raises(WoodcamError, match="tools must be a Tool"):
         simulate(prog, "flat:2", SIZE)
+
+
+def test_long_reports_are_summarised():
+    # 30 rapids through the stock on non-adjacent lines: 12 listed, the rest in one entry
+    lines = ["G0 X2 Y5 Z2", "G1 Z-1 F300"]
+    for k in range(30):
+        lines += [f"G0 X{3 + k}", f"G1 Y{5 + (k % 2)}"]
+    res = simulate(read_gcode("\n".join(lines)), FlatEndMill(1), SIZE)
+    rap = [i for i in res.report if i.kind == "rapid_through_stock"]
+    assert len(rap) == 13 and [i.line for i in rap[:12]] == list(range(3, 27, 2))
+    assert "and 18 more lines like this, the last at line 61" in rap[-1].message
