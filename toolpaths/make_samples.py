@@ -107,9 +107,9 @@ def profile_tabs() -> str:
         tabs = z < tab_top
         out.append(f"G1 Z{_f(z)} F300")
 
-        def side(p_from, p_to, axis):
+        def side(p_from, p_to, axis, tab=True):
             # straight side with a tab in its middle when this pass is below the tab top
-            if not tabs:
+            if not (tabs and tab):
                 return [f"G1 {axis}{_f(p_to)} F1500"]
             mid = 0.5 * (p_from + p_to)
             sgn = 1 if p_to > p_from else -1
@@ -126,7 +126,7 @@ def profile_tabs() -> str:
         out.append(f"G3 X{_f(xa)} Y{_f(cy + hh - rc)} I0 J{_f(-r)}")
         out += side(cy + hh - rc, cy - hh + rc, "Y")
         out.append(f"G3 X{_f(cx - hw + rc)} Y{_f(ya)} I{_f(r)} J0")
-        out += side(cx - hw + rc, cx, "X")
+        out += side(cx - hw + rc, cx, "X", tab=False)  # bottom side: one tab, on its right half
     return "\n".join(out + _tail()) + "\n"
 
 
