@@ -1,7 +1,7 @@
 """Benchmark: the 20,100-move ball-end 3D raster over a 100 x 100 mm stock at 0.1 mm.
 
 Run with ``pytest -m bench -s tests/bench/test_toolpath_bench.py``. Reports wall and CPU time,
-moves/s and cell updates/s (cells of the moves' windows evaluated and min-updated), and the
+moves/s and cell updates/s (cells covered by a swept tool and min-updated), and the
 speed ratio against the exact manifold3d reference (hulls of the tool at both ends of every move,
 unioned, subtracted from the box) on the same moves. The reference costs ~25 ms of CPU per
 move, so by default it runs on the program's first ``WOODCAM_BENCH_REF_MOVES`` = 2,000 moves

@@ -127,8 +127,7 @@ _G_GROUPS = {  # modal groups: two words of one group in a block is an error
     "distance": {90.0, 91.0}, "arc distance": {90.1, 91.1}, "retract": {98.0, 99.0},
 }
 _M_KNOWN = {0, 1, 2, 30, 3, 4, 5, 6, 7, 8, 9}
-_AXIS_WORDS = "XYZIJKRPQ"
-_VALUE_WORDS = set("XYZIJKRPQFSTNHG M".replace(" ", ""))
+_VALUE_WORDS = set("XYZIJKRPQFSTH")
 # (first, second, normal) axis indices of the arc planes; first x second = normal (right-handed)
 _PLANES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}
 _PLANE_CENTRE_WORDS = {17: "IJ", 18: "KI", 19: "JK"}

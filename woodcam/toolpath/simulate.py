@@ -26,9 +26,13 @@ unconstrained one clipped to the interval; each tool solves it in closed form
 centre, so the only error of the height field is sampling (one cell) and arc chords.
 
 Moves are processed in vectorised batches: moves whose bounding boxes (in cells) fit the same
-padded window are stacked into ``(batch, wy, wx)`` arrays, evaluated at once, and scattered
-with ``np.minimum.at``. There is no per-cell Python loop; the per-move Python work is a few
-scalar operations when grouping.
+padded window are stacked into ``(batch, wy, wx)`` float32 arrays and evaluated at once; each
+move's window is then min-merged into the height field as one slice (``np.minimum(view, env,
+out=view)``: windows of consecutive moves overlap, so a fancy-indexed assignment would lose
+updates, and a slice per move avoids the slower unbuffered ``np.minimum.at``). There is no per-cell Python loop; the per-move
+Python work is that one slice. Batches are formed within runs of the program that share a tool
+and contain no rapid below the stock top, so the rapid check sees the stock as cut by every
+earlier move.
 """
 
 from __future__ import annotations
@@ -141,7 +145,7 @@ def _tool_lookup(program: Program, tools) -> dict[int, Tool]:
             line = int(program.line[np.argmax(program.tool == t)])
             raise WoodcamError(f"simulate: the program uses tool {t} (first at line {line}) "
                                f"but tools has {sorted(tools)}; add T{t} to the tool table or "
-                               "pass --tool {t}=SPEC".replace("{t}", str(t)))
+                               f"pass --tool {t}=SPEC")
     return out
 
 
