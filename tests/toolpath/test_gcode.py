@@ -115,7 +115,7 @@ def test_drilling_cycles_expand_to_moves():
 
 
 @pytest.mark.parametrize("text, line, word", [
-    ("G21\nG0 X0 Y0 Z5\nG28 Z0\n", 3, "G28"),
+    ("G21\nG0 X0 Y0 Z5\nG30 Z0\n", 3, "G30"),
     ("G0 X0 Y0 Z5\nG1 X1..2 F100\n", 2, ".2"),
     ("G0 X0 Y0 Z5\nG1 A10 F100\n", 2, "A10"),
     ("G0 X0 Y0 Z5\nG1 X10\n", 2, "G1"),              # no feed rate yet
@@ -134,8 +134,8 @@ def test_malformed_and_unsupported_lines_name_line_and_word(text, line, word):
 
 
 def test_error_shows_n_word():
-    with pytest.raises(GcodeError, match=r"line 2 \(N20\): 'G28'"):
-        read_gcode("N10 G0 X0 Y0 Z0\nN20 G28\n")
+    with pytest.raises(GcodeError, match=r"line 2 \(N20\): 'G30'"):
+        read_gcode("N10 G0 X0 Y0 Z0\nN20 G30\n")
 
 
 def test_reads_file(tmp_path):
@@ -153,3 +153,13 @@ def test_comments_block_delete_and_unknown_start():
     np.testing.assert_allclose(prog.start_mm, [[10, 20, 5], [10, 20, -2]])
     np.testing.assert_allclose(prog.end_mm, [[10, 20, -2], [30, 20, -2]])
     assert prog.line.tolist() == [7, 8]
+
+
+def test_program_number_g28_and_g53_make_axes_unknown():
+    prog = read_gcode("O1001\nG0 X10 Y10 Z5\nG1 Z-1 F100\nG91 G28 Z2\nG90\n"
+                      "G53 G0 Z0\nG0 X20 Y10\nG0 Z5\nG1 Z-1\n")
+    # G28 Z2 (incremental): rapid up 2 mm to the intermediate point, then Z is unknown; the
+    # G53 retract is in machine coordinates; the next moves only re-establish the position
+    np.testing.assert_allclose(prog.start_mm, [[10, 10, 5], [10, 10, -1], [20, 10, 5]])
+    np.testing.assert_allclose(prog.end_mm, [[10, 10, -1], [10, 10, 1], [20, 10, -1]])
+    assert prog.line.tolist() == [3, 4, 9]

@@ -16,13 +16,16 @@ What is read
 ``I/J/K``, helical arcs), ``G4`` dwell, ``G17/G18/G19`` planes, ``G20/G21`` units,
 ``G90/G91`` distance mode, ``G90.1/G91.1`` arc-centre mode, the drilling cycles
 ``G81/G82/G83`` with ``G98/G99`` (expanded to rapid/feed moves, absolute mode only), ``G80``,
-``F S T N`` words, ``M0 M1 M2 M30 M3 M4 M5 M6 M7 M8 M9``, no-op modes ``G40 G49 G54 G61 G64 G94``
-and ``G43 H..`` (tools are measured from their tip), ``( )`` and ``;`` comments, ``%`` lines.
+``F S T N O`` words, ``M0 M1 M2 M30 M3 M4 M5 M6 M7 M8 M9``, no-op modes
+``G40 G49 G54 G61 G64 G94`` and ``G43 H..`` (tools are measured from their tip), ``G28`` and
+``G53`` (the named axes go to machine positions outside the work frame and become unknown, see
+below), ``( )`` and ``;`` comments, ``%`` lines.
 Anything else is an error naming the line and the word.
 
 Start position: the machine position is unknown until the program sets it. Axes start unknown;
 a motion that starts from an unknown axis only sets the position (no move is emitted), the usual
 ``G0 Z5`` / ``G0 X.. Y..`` preamble. Pass ``start_mm`` to start from a known point instead.
+After ``G28``/``G53`` the homed axes are unknown again in the same way.
 
 Why a hand-written tokenizer: the maintained PyPI parsers do not fit. ``pygcode`` (last release
 0.2.1, 2017) is unmaintained; ``gcodeparser`` (0.3.0) splits a line into one command and a
@@ -120,8 +123,8 @@ _COMMENT = re.compile(r"\([^()]*\)")
 
 _G_MOTION = {0.0, 1.0, 2.0, 3.0, 80.0, 81.0, 82.0, 83.0}
 _G_NOOP = {40.0, 49.0, 54.0, 61.0, 64.0, 94.0, 43.0}
-_G_KNOWN = _G_MOTION | _G_NOOP | {4.0, 17.0, 18.0, 19.0, 20.0, 21.0, 90.0, 91.0, 90.1, 91.1,
-                                  98.0, 99.0}
+_G_KNOWN = _G_MOTION | _G_NOOP | {4.0, 17.0, 18.0, 19.0, 20.0, 21.0, 28.0, 53.0, 90.0, 91.0,
+                                  90.1, 91.1, 98.0, 99.0}
 _G_GROUPS = {  # modal groups: two words of one group in a block is an error
     "motion": _G_MOTION, "plane": {17.0, 18.0, 19.0}, "units": {20.0, 21.0},
     "distance": {90.0, 91.0}, "arc distance": {90.1, 91.1}, "retract": {98.0, 99.0},
@@ -258,11 +261,14 @@ class _Reader:
         for letter, value, tok in words:
             if letter == "N":
                 n_word = int(value)
+            elif letter == "O":  # program number (Fanuc-style posts): nothing to do
+                continue
             elif letter == "G":
                 v = round(value, 1)
                 if v not in _G_KNOWN:
                     raise GcodeError(lineno, tok, "unsupported G code (woodcam reads G0-G4, "
-                                     "G17-G21, G40, G43, G49, G54, G61, G64, G80-G83, G90, G91, "
+                                     "G17-G21, G28, G40, G43, G49, G53, G54, G61, G64, G80-G83, "
+                                     "G90, G91, "
                                      "G90.1, G91.1, G94, G98, G99)",
                                      "post-process the program for a 3-axis mill with these "
                                      "codes", n_word)
@@ -327,6 +333,9 @@ class _Reader:
             if any(k in vals for k in "XYZIJKR"):
                 raise err("G4", "G4 dwell takes no axis words", "move on a separate line")
             return
+        if 28.0 in gv or 53.0 in gv:
+            self._home(gv, vals, lineno, err)
+            return
         motion = [v for v in gv if v in _G_MOTION]
         if motion:
             self.motion = motion[0]
@@ -344,6 +353,21 @@ class _Reader:
             raise err(tok, "arc words without an end point", "give X/Y/Z with G2/G3")
         if mv & {2, 30}:
             self.ended = True
+
+    def _home(self, gv, vals, lineno, err):
+        """G28 (rapid via an intermediate point to machine home) and G53 (a move in machine
+        coordinates): machine home and machine coordinates are not in the work frame, so the
+        named axes (all three for a bare G28) become unknown again, as at program start; the
+        next moves re-establish them (module docstring)."""
+        axes = [a for a in "XYZ" if a in vals]
+        if 28.0 in gv:
+            if axes:
+                self._emit(self._target(vals, err), RAPID, lineno)  # the intermediate point
+            else:
+                axes = list("XYZ")
+        elif not axes:
+            raise err("G53", "G53 without axis words", "give the machine-coordinate target")
+        self.pos = [math.nan if a in axes else p for a, p in zip("XYZ", self.pos)]
 
     def _target(self, vals, err):
         end = list(self.pos)
