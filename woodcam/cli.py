@@ -11,7 +11,7 @@ from pathlib import Path
 from .errors import WoodcamError
 
 #: Modules that add their own subcommands through ``add_parser(subparsers)`` / ``run(args)``.
-_COMMAND_MODULES: tuple[str, ...] = ("woodcam._cli_block",)
+_COMMAND_MODULES: tuple[str, ...] = ("woodcam._cli_block", "woodcam._cli_log")
 
 _EPILOG = """\
 Block specs: 'builtin:NAME' (see 'woodcam blocks') or a block folder with a block.json.

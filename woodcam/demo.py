@@ -30,6 +30,7 @@ def examples_dir() -> Path:
 class DemoReport:
     parts: list[PartPreview] = field(default_factory=list)
     total_s: float = 0.0
+    overview: Path | None = None
 
     def summary(self) -> str:
         """A plain-text table: one row per part, one column per stage (seconds)."""
@@ -40,7 +41,7 @@ class DemoReport:
             atlas = f"{p.atlas_px[1]}x{p.atlas_px[0]}"
             rows.append(f"{p.name:<10}{p.meta_block:<24}{p.triangles:>8}{atlas:>11}"
                         + "".join(f"{p.timings_s.get(s, 0.0):>8.2f}" for s in stages))
-        rows.append(f"total {self.total_s:.1f} s; files in the output folder:")
+        rows.append(f"total {self.total_s:.1f} s; overview picture: {self.overview}; files:")
         for p in self.parts:
             rows.append("  " + ", ".join(str(f) for f in p.files.values()))
         for p in self.parts:
@@ -65,5 +66,27 @@ def run_demo(out_dir, *, quick: bool = False, texels_per_mm: float | None = None
                            texels_per_mm=tpm, progress=progress)
         res.meta_block = spec
         report.parts.append(res)
+    report.overview = render_overview(report.parts, out / "demo.png")
     report.total_s = time.perf_counter() - t0
     return report
+
+
+def render_overview(parts: list[PartPreview], png, *, tile_px: tuple[int, int] = (640, 520)) -> Path:
+    """One picture of all demo parts side by side, whole (no cut plane), for a quick look."""
+    from PIL import Image
+
+    from .view import preview
+
+    tiles = []
+    for p in parts:
+        tile = Path(png).with_name(f"_{p.name}_tile.png")
+        preview(p.files["glb"], screenshot=tile, window_size=tile_px, cut_plane=False)
+        tiles.append(Image.open(tile).convert("RGB"))
+        tile.unlink()
+    strip = Image.new("RGB", (sum(t.width for t in tiles), max(t.height for t in tiles)), "white")
+    x = 0
+    for t in tiles:
+        strip.paste(t, (x, 0))
+        x += t.width
+    strip.save(png)
+    return Path(png)

@@ -59,8 +59,10 @@ def open_stock(spec: str, *, species: str | None = None,
     if spec.startswith("builtin:"):
         b = builtin_block(spec.split(":", 1)[1])
         app = ColorMapAppearance(species or b.species, **appearance_params)
-        return Stock(spec, b.size_mm, Wood(b.field, app), b.description,
-                     {"field": b.field.to_dict(), "species": app.species.name})
+        meta = {"species": app.species.name}
+        if hasattr(b.field, "to_dict"):  # every built-in field is saveable
+            meta["field"] = b.field.to_dict()
+        return Stock(spec, b.size_mm, Wood(b.field, app), b.description, meta)
     path = Path(spec)
     if path.is_dir() and (path / "block.json").is_file():
         return _open_block_folder(path, species, appearance_params)

@@ -27,9 +27,11 @@ from typing import Callable, Literal, get_args
 import numpy as np
 
 from .block import Block, Face, RingTrace
-from .block.io import field_from_state, field_to_state, write_block
+from .block.io import write_block
 from .errors import WoodcamError
 from .fields.base import LogFrame, arf, check_points, evaluate, grain_direction
+from .fields.placement import PlacedField
+from .fields.state import field_from_state, field_to_state
 from .frames import FACE_NORMAL, FACES, CrossLayout, check_face, check_size, face_image_size_mm, pixel_to_block
 from .tolerances import TRACE_FD_STEP_PX, TRACE_ISO_TOL_YEARS
 
@@ -114,58 +116,6 @@ class AnalyticLogField:
         return cls(**d)
 
 
-class PlacedField:
-    """A log-frame growth field seen in a block frame through a rigid :class:`LogFrame`.
-
-    ``years(p) = log_field(frame.to_log(p))`` for block points ``p : (n, 3)`` mm. Fibre
-    directions are rotated into the block frame. Serialisable (``to_dict``) when the log field is.
-    """
-
-    def __init__(self, log_field, frame: LogFrame):
-        if not callable(log_field):
-            raise WoodcamError(f"log_field must be callable (n, 3) mm -> years; got {type(log_field).__name__}")
-        self.log_field = log_field
-        self.frame = frame
-
-    @property
-    def axis(self) -> np.ndarray:
-        """Pith direction in the block frame (unit 3-vector)."""
-        return self.frame.rotation[2].copy()
-
-    def _to_log(self, points_mm) -> np.ndarray:
-        # Same as LogFrame.to_log; einsum because a (n, 3) @ (3, 3) matmul goes through BLAS,
-        # which is several times slower for this shape on a busy 2-core machine.
-        p = check_points(points_mm) - np.asarray(self.frame.pith_point_mm, float)
-        return np.einsum("ij,kj->ik", p, self.frame.rotation)
-
-    def __call__(self, points_mm) -> np.ndarray:
-        return np.asarray(self.log_field(self._to_log(points_mm)), dtype=float)
-
-    def grain_direction(self, points_mm) -> np.ndarray:
-        """Unit fibre directions ``(n, 3)`` in the block frame."""
-        p = check_points(points_mm)
-        if not callable(getattr(self.log_field, "grain_direction", None)):
-            return np.broadcast_to(self.frame.direction_to_block(grain_direction(self.log_field, p[:1]))[0], p.shape)
-        d = np.asarray(self.log_field.grain_direction(self._to_log(p)), dtype=float)
-        return np.einsum("ij,jk->ik", d, self.frame.rotation)
-
-    def to_dict(self) -> dict:
-        f = self.frame
-        return {
-            "log_field": field_to_state(self.log_field),
-            "frame": {"pith_point_mm": [float(v) for v in f.pith_point_mm],
-                      "axis": [float(v) for v in f.axis],
-                      "reference": None if f.reference is None else [float(v) for v in f.reference]},
-        }
-
-    @classmethod
-    def from_dict(cls, d: dict) -> "PlacedField":
-        fr = d["frame"]
-        ref = fr.get("reference")
-        frame = LogFrame(tuple(fr["pith_point_mm"]), tuple(fr["axis"]), None if ref is None else tuple(ref))
-        return cls(field_from_state(d["log_field"]), frame)
-
-
 def _rotate(v: np.ndarray, axis: np.ndarray, angle_rad: float) -> np.ndarray:
     """Rodrigues rotation of vector ``v`` about unit ``axis``."""
     return (v * math.cos(angle_rad) + np.cross(axis, v) * math.sin(angle_rad)
@@ -229,7 +179,7 @@ def cut_block(log_field, size_mm, pattern: SawPattern = "flat-sawn", *, distance
     if pattern not in PATTERNS:
         raise WoodcamError(f"pattern must be one of {', '.join(PATTERNS)}; got {pattern!r}")
     if log_frame is not None:
-        return PlacedField(log_field, log_frame)
+        return PlacedField.from_log_frame(log_field, log_frame)
     W, D, _ = size
     if distance_mm is None:
         distance_mm = 0.0 if pattern == "pith-inside" else 1.5 * max(W, D)
@@ -258,7 +208,7 @@ def cut_block(log_field, size_mm, pattern: SawPattern = "flat-sawn", *, distance
             f"inside; use distance_mm > {0.5 * math.hypot(W, D):g} or pattern='pith-inside'"
         )
     frame = LogFrame(tuple(pith_point), tuple(z), tuple(x_axis))
-    return PlacedField(log_field, frame)
+    return PlacedField.from_log_frame(log_field, frame)
 
 
 #: Line width (mm) of the Mokume U-Net ring maps as ``sigma`` of ``exp(-(d / sigma)^2)``:

@@ -66,3 +66,22 @@ RING_MAP_QUANT_16BIT = 0.5 / 65535
 
 #: Ring maps stored as 8-bit PNG (and Mokume's own maps) carry 0.5 / 255 of quantisation.
 RING_MAP_QUANT_8BIT = 0.5 / 255
+
+#: Colours a wood returns may overshoot [0, 1] by this much (round-off of blends and colour
+#: transforms) and are clipped; a larger excursion is an error (e.g. 0..255 colours passed).
+COLOR_RANGE_TOL = 1e-3
+
+#: A point counts as on a knot's surface (the envelope of its elliptic cross-sections) when its
+#: signed distance is above -this (mm): the projection onto the knot's centre curve converges
+#: to ~1e-5 mm, and cross-section points truly inside a sharply bent knot are >= 0.01 mm in.
+KNOT_SURFACE_TOL_MM = 1e-3
+
+#: Extra reach (texels) of the bake's conservative rasterisation beyond the exact bilinear
+#: footprint of 1 texel: covers float32 UVs in GLB files (2^-24 x 8192 texels = 5e-4) and the
+#: float32 edge tests (~1e-3 texel), so a sample exactly on a chart border never reads an
+#: unpainted texel.
+RASTER_MARGIN_TEXELS = 0.02
+
+#: Triangles whose texel-space area (texels^2) is below this are degenerate in UV: their
+#: barycentric inverse is ill-conditioned, so the baker skips them (neighbours paint the texels).
+MIN_UV_AREA_TEXELS2 = 1e-10

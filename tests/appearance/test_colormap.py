@@ -132,3 +132,21 @@ def test_bad_species_and_normals():
         ColorMapAppearance("balsa-wood")
     with pytest.raises(WoodcamError, match="normals must have the shape"):
         Wood(AXIS_Z).color(np.zeros((3, 3)), np.zeros((2, 3)))
+
+
+def test_knots_show_darker_and_dead_knots_outlined():
+    """The built-in knotty board: knot wood is darker than the stem wood around it, and the
+    dead knot's outline is darker still."""
+    from woodcam.stock import open_stock
+
+    stock = open_stock("builtin:knotty")
+    shape = (100, 200)
+    p = face_pixel_points("front", shape, stock.size_mm).reshape(-1, 3)
+    rgb = stock.wood.color(p, np.tile([0.0, -1.0, 0.0], (len(p), 1))).mean(1)
+    f = stock.wood.field.knot_features(p)
+    alive = (f["knot"] > 0.9) & (f["dead"] < 0.1)
+    outline = f["outline"] > 0.9
+    clear = f["knot"] < 0.01
+    assert alive.sum() > 100 and outline.sum() > 20
+    assert rgb[alive].mean() < rgb[clear].mean() - 0.1
+    assert rgb[outline].mean() < rgb[alive].mean() - 0.1

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, grain_direction
+from ..fields.knots import knot_shading
 from ..frames import FACE_AXIS, face_pixel_points
 from .noise import grain_noise, value_noise
 from .orientation import blend_axis_colors
@@ -137,8 +138,8 @@ class ColorMapAppearance:
         """The three per-axis colourings of eq. 10, shape ``(3, n, 3)``: normals X, Y, Z."""
         p = check_points(points_mm)
         s = self.species
-        a = arf(field(p)).astype(np.float32)
-        grain = np.asarray(grain_direction(field, p), dtype=np.float32)
+        years, grain, knots = _field_sample(field, p)
+        a = arf(years).astype(np.float32)
         latewood = _smoothstep(s.latewood_start, 1.0, a)
         base = self.ramp(a)
 
@@ -159,24 +160,13 @@ class ColorMapAppearance:
                 col = _lut_lookup(self.axis_luts[k], a)
             else:
                 col = base * (1.0 - s.endgrain_darkening * end * end)[:, None]
-            factor = shade * (1.0 + s.endgrain_roughness * end * rough)
-            out[k] = col * factor[:, None]
-        self._shade_knots(field, p, out)
+            col = col * (shade * (1.0 + s.endgrain_roughness * end * rough))[:, None]
+            if knots is not None:
+                col = knot_shading(col, knots, alive_darkening=self.knot_darkening_alive,
+                                   dead_darkening=self.knot_darkening_dead,
+                                   outline_rgb=self.dead_outline_rgb)
+            out[k] = col
         return np.clip(out, 0.0, 1.0)
-
-    def _shade_knots(self, field, points_mm, colors) -> None:
-        """Darken knot wood and draw dead-knot outlines in place, for fields that report knots."""
-        features = getattr(field, "knot_features", None)
-        if features is None:
-            return
-        f = features(points_mm)
-        knot = np.asarray(f.get("knot", 0.0), np.float32)
-        dead = np.asarray(f.get("dead", 0.0), np.float32)
-        outline = np.asarray(f.get("outline", 0.0), np.float32)
-        dark = knot * ((1 - dead) * self.knot_darkening_alive + dead * self.knot_darkening_dead)
-        colors *= (1.0 - dark)[None, :, None]
-        ol = np.asarray(self.dead_outline_rgb, np.float32)
-        colors += outline[None, :, None] * (ol - colors)
 
     def color(self, field, points_mm, normals) -> np.ndarray:
         """Colour ``(n, 3)`` in [0, 1] of surfaces at ``points_mm`` with unit ``normals``."""
@@ -226,6 +216,20 @@ class ColorMapAppearance:
     def with_params(self, **changes) -> "ColorMapAppearance":
         """Copy with some parameters changed."""
         return replace(self, **changes)
+
+
+def _field_sample(field, points_mm):
+    """Growth time, fibre directions and (for knotted fields) knot features in one pass.
+
+    Knotted fields answer ``evaluate(points, directions=True)`` with everything at once, which
+    is several times cheaper than calling the field, ``grain_direction`` and ``knot_features``
+    separately. Returns ``(years (n,), grain (n, 3) float32, knots dict or None)``.
+    """
+    evaluate_all = getattr(field, "evaluate", None)
+    if callable(evaluate_all):
+        out = evaluate_all(points_mm, directions=True)
+        return out["years"], np.asarray(out["direction"], np.float32), out
+    return field(points_mm), np.asarray(grain_direction(field, points_mm), np.float32), None
 
 
 def _lut_lookup(lut: np.ndarray, a: np.ndarray) -> np.ndarray:

@@ -44,7 +44,6 @@ optional ``X_ann.png`` and ``X_knot.png``, for letters ``X`` = ``A``..``F`` mapp
 
 from __future__ import annotations
 
-import importlib
 import json
 import os
 from pathlib import Path
@@ -53,6 +52,7 @@ from typing import Literal
 import numpy as np
 
 from ..errors import WoodcamError
+from ..fields.state import field_from_state, field_to_state, field_type, jsonable
 from ..frames import FACES, MOKUME_LETTER
 from .block import Block, Face, RingTrace
 
@@ -122,7 +122,7 @@ def write_block(block: Block, folder, *, ring_map_bits: Literal[8, 16] = 16,
         faces[name] = entry
     manifest = {
         "format": FORMAT, "version": VERSION, "name": block.name,
-        "size_mm": list(block.size_mm), "meta": _jsonable(block.meta, "block.meta"),
+        "size_mm": list(block.size_mm), "meta": jsonable(block.meta, "block.meta"),
         "faces": faces, "true_field": _write_field(block.true_field, folder),
     }
     manifest_path.write_text(json.dumps(manifest, indent=1))
@@ -207,7 +207,7 @@ def _write_extra(folder: Path, face: str, key: str, value) -> dict:
                 f"stored as PNG; got dtype {value.dtype}, shape {value.shape}"
             )
         return {"png": fname, "dtype": str(value.dtype)}
-    return {"json": _jsonable(value, f"extras[{key!r}] of face {face!r}")}
+    return {"json": jsonable(value, f"extras[{key!r}] of face {face!r}")}
 
 
 def _read_extra(folder: Path, entry: dict, shape, what: str):
@@ -220,18 +220,13 @@ def _read_extra(folder: Path, entry: dict, shape, what: str):
     return entry.get("json")
 
 
-def _field_type(obj) -> str:
-    cls = type(obj)
-    return f"{cls.__module__}:{cls.__qualname__}"
-
-
 def _write_field(field, folder: Path) -> dict:
     target = folder / "true_field.json"
     if field is None:
         if target.exists():
             target.unlink()
         return {"saved": False, "reason": "the block has no true field"}
-    kind = _field_type(field)
+    kind = field_type(field)
     to_dict = getattr(field, "to_dict", None)
     from_dict = getattr(type(field), "from_dict", None)
     if to_dict is None or from_dict is None or not kind.startswith("woodcam."):
@@ -240,7 +235,7 @@ def _write_field(field, folder: Path) -> dict:
         return {"saved": False, "type": kind,
                 "reason": "the field is not a woodcam class with to_dict()/from_dict(); truth not saved"}
     try:
-        state = _jsonable(to_dict(), "true_field.to_dict()")
+        state = jsonable(to_dict(), "true_field.to_dict()")
     except (WoodcamError, TypeError, AttributeError) as err:
         # e.g. a placement wrapper around a field that itself cannot be serialised
         if target.exists():
@@ -250,65 +245,11 @@ def _write_field(field, folder: Path) -> dict:
     return {"saved": True, "type": kind, "file": target.name}
 
 
-def field_to_state(field) -> dict:
-    """``{"type": "module:QualName", "state": field.to_dict()}`` for a woodcam field class.
-
-    Used by wrappers (e.g. a placed field) to serialise the field they wrap.
-    """
-    kind = _field_type(field)
-    if not kind.startswith("woodcam.") or not hasattr(field, "to_dict") \
-            or not hasattr(type(field), "from_dict"):
-        raise WoodcamError(
-            f"field of type {kind!r} must be a woodcam class with to_dict()/from_dict() to be saved"
-        )
-    return {"type": kind, "state": _jsonable(field.to_dict(), f"{kind}.to_dict()")}
-
-
-def field_from_state(d: dict):
-    """Inverse of :func:`field_to_state`."""
-    return _read_field({"saved": True, "type": d["type"]}, None, state=d["state"])
-
-
-def _read_field(entry, folder: Path | None, state=None):
+def _read_field(entry, folder: Path):
     if not entry or not entry.get("saved"):
         return None
-    module, _, qualname = entry["type"].partition(":")
-    # Only woodcam's own classes are restored: a manifest must never make us import arbitrary code.
-    if not module.startswith("woodcam."):
-        raise WoodcamError(f"true_field type must be a woodcam class; got {entry['type']!r}")
-    try:
-        obj = importlib.import_module(module)
-        for part in qualname.split("."):
-            obj = getattr(obj, part)
-    except (ImportError, AttributeError) as err:
-        raise WoodcamError(
-            f"true_field type {entry['type']!r} in the manifest cannot be imported from this "
-            f"woodcam version; upgrade woodcam or drop the true_field entry"
-        ) from err
-    if state is None:
-        state = json.loads((folder / entry["file"]).read_text())
-    return obj.from_dict(state)
-
-
-def _jsonable(obj, what: str):
-    """Convert numpy scalars/arrays inside ``obj`` to plain JSON types, or raise naming ``what``."""
-    def default(o):
-        if isinstance(o, np.generic):
-            return o.item()
-        if isinstance(o, np.ndarray):
-            return o.tolist()
-        if isinstance(o, (Path, os.PathLike)):
-            return str(o)
-        if isinstance(o, (set, tuple)):
-            return list(o)
-        raise TypeError(type(o).__name__)
-    try:
-        return json.loads(json.dumps(obj, default=default))
-    except (TypeError, ValueError) as err:
-        raise WoodcamError(
-            f"{what} must be JSON-serialisable (numbers, strings, lists, dicts, numpy arrays); "
-            f"found a {err}"
-        ) from err
+    state = json.loads((folder / entry["file"]).read_text())
+    return field_from_state({"type": entry["type"], "state": state})
 
 
 # -- images ---------------------------------------------------------------------------------------

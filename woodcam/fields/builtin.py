@@ -10,6 +10,8 @@ of seed 000 whose radius functions come from a fixed seed, so the truth is known
 - ``rift``: pith 110 mm below and in front (about 45 deg to the faces), along X.
 - ``pith-inside``: pith vertical through the block slightly off-centre (a turning blank cut
   from the heart): concentric rings on top and bottom, end grain there.
+- ``knotty``: a tangential board from a synthetic spruce log with a whorl of branches (the
+  knot model of seed 003): an alive knot through the front face and a dead one beside it.
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ class BuiltinBlock:
 
     name: str
     size_mm: tuple[float, float, float]
-    field: RadialScalingField
+    field: object
     species: str
     description: str
 
@@ -55,11 +57,32 @@ _SPECS = {
 }
 
 #: Names of the built-in blocks.
-BUILTIN_NAMES: tuple[str, ...] = tuple(_SPECS)
+BUILTIN_NAMES: tuple[str, ...] = tuple(_SPECS) + ("knotty",)
+
+
+def _knotty_block() -> BuiltinBlock:
+    """A 100 x 80 x 50 mm board (Z along the log) through a whorl of a straight synthetic log."""
+    from .knots import KnottedLogField, block_at_knot, place_block_in_log
+    from .tree_data import Knot, simple_log
+
+    r = np.linspace(0.0, 160.0, 33)
+    knots = []
+    for i, (az_deg, death_mm) in enumerate([(0.0, 200.0), (28.0, 45.0), (150.0, 200.0), (260.0, 60.0)]):
+        knots.append(Knot(
+            z0_mm=300.0 + 6.0 * i, azimuth0_rad=np.radians(az_deg), r_mm=r,
+            rise_mm=22.0 * np.sqrt(r / 10.0) * 0.6, twist_rad=0.0 * r,
+            diameter_mm=np.minimum(3.0 + 0.16 * r, 24.0), r_end_mm=150.0, r_death_mm=death_mm))
+    log = simple_log(600.0, 160.0, knots, name="builtin-knotty")
+    origin, rotation = block_at_knot(log, 0, BUILTIN_SIZE_MM, front_r_mm=95.0)
+    field = place_block_in_log(KnottedLogField(log, ring_width_mm=2.2), origin, rotation)
+    return BuiltinBlock("knotty", BUILTIN_SIZE_MM, field, "spruce",
+                        "tangential spruce board through a whorl: alive and dead knots")
 
 
 def builtin_block(name: str) -> BuiltinBlock:
     """Return the built-in block ``name`` (see :data:`BUILTIN_NAMES`)."""
+    if name == "knotty":
+        return _knotty_block()
     if name not in _SPECS:
         raise WoodcamError(
             f"unknown built-in block {name!r}; choose one of: {', '.join(BUILTIN_NAMES)}"

@@ -1,0 +1,77 @@
+"""Saving and restoring fields as JSON: ``{"type": "module:QualName", "state": to_dict()}``.
+
+Only woodcam's own classes with ``to_dict()`` / ``from_dict()`` are saved, and only they are
+restored: a manifest must never make woodcam import arbitrary code.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import WoodcamError
+
+
+def field_type(obj) -> str:
+    """``"module:QualName"`` of an object's class."""
+    cls = type(obj)
+    return f"{cls.__module__}:{cls.__qualname__}"
+
+
+def jsonable(obj, what: str):
+    """Convert numpy scalars/arrays inside ``obj`` to plain JSON types, or raise naming ``what``."""
+    def default(o):
+        if isinstance(o, np.generic):
+            return o.item()
+        if isinstance(o, np.ndarray):
+            return o.tolist()
+        if isinstance(o, (Path, os.PathLike)):
+            return str(o)
+        if isinstance(o, (set, tuple)):
+            return list(o)
+        raise TypeError(type(o).__name__)
+    try:
+        return json.loads(json.dumps(obj, default=default))
+    except (TypeError, ValueError) as err:
+        raise WoodcamError(
+            f"{what} must be JSON-serialisable (numbers, strings, lists, dicts, numpy arrays); "
+            f"found a {err}"
+        ) from err
+
+
+def is_saveable(field) -> bool:
+    """Whether :func:`field_to_state` can save ``field``."""
+    return (field_type(field).startswith("woodcam.") and hasattr(field, "to_dict")
+            and hasattr(type(field), "from_dict"))
+
+
+def field_to_state(field) -> dict:
+    """``{"type": "module:QualName", "state": field.to_dict()}`` for a woodcam field class."""
+    kind = field_type(field)
+    if not is_saveable(field):
+        raise WoodcamError(
+            f"field of type {kind!r} must be a woodcam class with to_dict()/from_dict() to be saved"
+        )
+    return {"type": kind, "state": jsonable(field.to_dict(), f"{kind}.to_dict()")}
+
+
+def field_from_state(d: dict):
+    """Inverse of :func:`field_to_state`."""
+    kind = d["type"]
+    module, _, qualname = kind.partition(":")
+    if not module.startswith("woodcam."):
+        raise WoodcamError(f"field type must be a woodcam class; got {kind!r}")
+    try:
+        obj = importlib.import_module(module)
+        for part in qualname.split("."):
+            obj = getattr(obj, part)
+    except (ImportError, AttributeError) as err:
+        raise WoodcamError(
+            f"field type {kind!r} cannot be imported from this woodcam version; upgrade woodcam "
+            "or drop the saved field"
+        ) from err
+    return obj.from_dict(d["state"])
