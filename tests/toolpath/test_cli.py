@@ -58,3 +58,17 @@ def test_run_simulates_and_hands_a_watertight_mesh_to_the_pipeline(tmp_path, mon
     assert mesh.volume == pytest.approx(W * D * H - 3 * (60 * 6 + 3.14159265 * 9), rel=5e-3)
     assert seen["meta"]["tools"] == {"0": "flat:6"}
     assert "slot.nc: 3 moves" in capsys.readouterr().out
+
+
+@pytest.mark.slow
+def test_gcode_end_to_end_writes_a_baked_glb(tmp_path):
+    from woodcam.export import read_glb_metadata
+
+    prog = tmp_path / "slot.nc"
+    prog.write_text("G0 X20 Y40 Z2\nG1 Z-3 F300\nX80\nG0 Z2\n")
+    out = tmp_path / "slot.glb"
+    args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out", str(out), "--tool",
+                   "ball:6", "--resolution", "0.25", "--texels-per-mm", "2", "--no-obj"])
+    assert args.func(args) == 0
+    meta = read_glb_metadata(out)
+    assert meta["block"] == "builtin:flat-sawn" and meta["tools"] == {"0": "ball:6"}
