@@ -170,7 +170,7 @@ def test_long_reports_are_summarised():
     # 30 rapids through the stock on non-adjacent lines: 12 listed, the rest in one entry
     lines = ["G0 X2 Y5 Z2", "G1 Z-1 F300"]
     for k in range(30):
-        lines += [f"G0 X{3 + k}", f"G1 Y{5 + (k % 2)}"]
+        lines += [f"G0 X{3 + k}", f"G1 Y{6 - (k % 2)}"]
     res = simulate(read_gcode("\n".join(lines)), FlatEndMill(1), SIZE)
     rap = [i for i in res.report if i.kind == "rapid_through_stock"]
     assert len(rap) == 13 and [i.line for i in rap[:12]] == list(range(3, 27, 2))

@@ -74,14 +74,16 @@ class Issue:
         return f"{where}: {self.kind}: {self.message}"
 
 
-def _summarise(issues: dict) -> list[Issue]:
-    """Merge runs of adjacent lines of one kind; cap each kind at MAX_ISSUES_PER_KIND."""
+def _summarise(issues: dict, move_lines: np.ndarray) -> list[Issue]:
+    """Merge runs of one kind on consecutive moving lines (lines without a move in between,
+    such as a lone ``F`` word, do not break a run); cap each kind at MAX_ISSUES_PER_KIND."""
+    ranks = {int(v): k for k, v in enumerate(np.unique(move_lines))}
     out = []
     for kind in ("rapid_through_stock", "below_stock_bottom", "cut_outside_stock"):
         items = sorted((i for (k, _), i in issues.items() if k == kind), key=lambda i: i.line)
         runs: list[list[Issue]] = []
         for it in items:
-            if runs and it.line <= runs[-1][-1].line + 1:
+            if runs and ranks[it.line] <= ranks[runs[-1][-1].line] + 1:
                 runs[-1].append(it)
             else:
                 runs.append([it])
@@ -254,7 +256,7 @@ def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
     n_active = len(act)
     np.clip(hm, 0.0, H, out=hm)
     wall = time.perf_counter() - t0
-    report = _summarise(issues)
+    report = _summarise(issues, program.line)
     stats = {"moves": len(program), "moves_cutting_window": n_active, "cell_updates": cells,
              "wall_s": wall, "moves_per_s": len(program) / max(wall, 1e-12),
              "cell_updates_per_s": cells / max(wall, 1e-12), "grid": (ny, nx)}
