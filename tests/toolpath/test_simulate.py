@@ -175,3 +175,13 @@ def test_long_reports_are_summarised():
     rap = [i for i in res.report if i.kind == "rapid_through_stock"]
     assert len(rap) == 13 and [i.line for i in rap[:12]] == list(range(3, 27, 2))
     assert "and 18 more lines like this, the last at line 61" in rap[-1].message
+
+
+def test_mesh_of_a_through_cut_stays_closed():
+    # a slot cut through the whole 12 mm: the top lies on the bottom there (zero thickness)
+    res = simulate(read_gcode("G0 X10 Y15 Z2\nG1 Z-12.5 F300\nX30\nG0 Z2\n"), FlatEndMill(6),
+                   SIZE, resolution_mm=0.2)
+    assert (res.heightmap == 0).sum() > 0
+    mesh = res.to_mesh()
+    assert mesh.is_watertight
+    assert mesh.volume == pytest.approx(np.prod(SIZE) - res.removed_volume_mm3, rel=1e-12)
