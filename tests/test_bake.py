@@ -47,7 +47,10 @@ class SmoothWood:
     phase = np.array([0.0, 1.0, 2.0])
 
     def color(self, points_mm, normals):
-        return 0.5 + _A * np.sin(points_mm @ self.dirs.T / _L + self.phase) + _B * normals
+        # einsum, not ``points_mm @ dirs.T``: OpenBLAS threads an (n, 3) x (3, 3) product and on
+        # the loaded 2-core machine that took 1.4 s for 2M points instead of 0.04-0.08 s.
+        phase = np.einsum("nk,jk->nj", points_mm, self.dirs) / _L + self.phase
+        return 0.5 + _A * np.sin(phase) + _B * normals
 
 
 #: Darkest colour the appearance can produce; anything darker in the texture is unpainted.

@@ -98,7 +98,7 @@ def uv_to_block(face: str, u, v, size_mm) -> np.ndarray:
     face = check_face(face)
     A, b = _affine(face, check_size(size_mm))
     uv = np.stack(np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float)), axis=-1)
-    return uv @ A.T + b
+    return np.einsum("...j,kj->...k", uv, A) + b  # einsum: see LogFrame.to_log
 
 
 def pixel_to_block(face: str, rows, cols, image_shape, size_mm) -> np.ndarray:
