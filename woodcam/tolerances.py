@@ -35,6 +35,21 @@ MAX_BATCH_POINTS = 1 << 18
 #: linear blend; guards division by zero when a blend is extrapolated.
 MIN_RADIUS_SCALE = 0.05
 
+#: Largest sagitta (mm) between a G2/G3 arc and the chords it is split into. 0.005 mm is a
+#: twentieth of the default 0.1 mm simulation cell, so chords never show in the height field,
+#: and a 10 mm radius arc still needs only ~70 chords per turn.
+ARC_CHORD_TOL_MM = 0.005
+
+#: Largest difference (mm) between an I/J/K arc's start and end radius that we accept (plus
+#: 1e-4 of the radius). CAM posts round centres to 3-4 decimals (1 um .. 0.1 um); LinuxCNC
+#: accepts 0.002 mm relative; we allow 0.01 mm, beyond that the program is wrong.
+ARC_RADIUS_MISMATCH_MM = 0.01
+
+#: Heights (mm) within this of the stock surface count as "touching", not cutting, when the
+#: simulation reports rapids through stock and cuts outside it: the float32 sweep kernel has
+#: ~1e-5 mm round-off at 100 mm, and a CAM clearance plane sits >= 0.5 mm above the stock.
+SIM_CONTACT_TOL_MM = 1e-4
+
 #: Largest error (years) allowed between a refined synthetic ring trace vertex and its integer
 #: iso-line. Newton refinement on the true field reaches ~1e-9 years in three steps; vertices that
 #: do not (on a field kink or where the gradient vanishes, e.g. at the pith) are dropped.

@@ -1,0 +1,165 @@
+"""G-code reader: modal state, arcs against analytic circles, units/incremental, errors."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from woodcam.toolpath import GcodeError, read_gcode
+from woodcam.toolpath.gcode import FEED, RAPID
+
+
+def test_moves_kinds_feeds_lines():
+    prog = read_gcode("G21 G90\nT3 M6\nS12000 M3\nG0 X10 Y20 Z5\nG1 Z-2 F300\nX30\n"
+                      "Y25 F600\nG0 Z5\nM30\n")
+    np.testing.assert_allclose(prog.end_mm, [[10, 20, -2], [30, 20, -2], [30, 25, -2],
+                                             [30, 25, 5]])
+    assert prog.kind.tolist() == [FEED, FEED, FEED, RAPID]
+    assert prog.line.tolist() == [5, 6, 7, 8]
+    assert prog.feed_mm_min.tolist() == [300, 300, 600, 600]
+    assert prog.tool.tolist() == [3, 3, 3, 3] and prog.tool_numbers == [3]
+    assert prog[1].kind == "feed" and prog[1].spindle_rpm == 12000 and prog[1].line == 6
+
+
+def _arc_points(prog):
+    return np.vstack([prog.start_mm[:1], prog.end_mm])
+
+
+@pytest.mark.parametrize("cw", [True, False])
+def test_ij_arc_lies_on_analytic_circle_with_chord_tolerance(cw):
+    tol = 0.01
+    code = "G2" if cw else "G3"
+    prog = read_gcode(f"G90 G17 G0 X20 Y10 Z1\nG1 F100\n{code} X10 Y20 I-10 J0\n",
+                      chord_tol_mm=tol)
+    pts = _arc_points(prog)
+    c = np.array([10.0, 10.0])
+    r = np.hypot(*(pts[:, :2] - c).T)
+    np.testing.assert_allclose(r, 10.0, atol=1e-12)  # every vertex on the circle
+    mids = 0.5 * (prog.start_mm + prog.end_mm)[:, :2]
+    sag = 10.0 - np.hypot(*(mids - c).T)
+    assert sag.max() <= tol + 1e-12 and sag.max() > tol / 4  # not absurdly over-refined
+    ang = np.unwrap(np.arctan2(*(pts[:, :2] - c).T[::-1]))
+    sweep = ang[-1] - ang[0]
+    # from (20,10) at 0 rad to (10,20) at 90 deg: CCW is +90 deg, CW the long way -270 deg
+    assert sweep == pytest.approx(-1.5 * math.pi if cw else 0.5 * math.pi, abs=1e-9)
+    assert np.all(np.diff(ang) < 0) if cw else np.all(np.diff(ang) > 0)
+
+
+def test_full_circle_and_helix():
+    prog = read_gcode("G0 X5 Y0 Z0\nG1 F100\nG3 X5 Y0 Z-3 I-5 J0\n", chord_tol_mm=0.005)
+    pts = _arc_points(prog)
+    ang = np.unwrap(np.arctan2(pts[:, 1], pts[:, 0]))
+    assert ang[-1] - ang[0] == pytest.approx(2 * math.pi)
+    np.testing.assert_allclose(np.hypot(pts[:, 0], pts[:, 1]), 5.0, atol=1e-12)
+    # helix: z linear in the swept angle
+    np.testing.assert_allclose(pts[:, 2], -3 * (ang - ang[0]) / (2 * math.pi), atol=1e-12)
+
+
+@pytest.mark.parametrize("r_word, centre", [("R10", (20.0, 0.0)), ("R-10", (10.0, 10.0))])
+def test_r_form_minor_and_major_arc(r_word, centre):
+    # G2 from (10,0) to (20,10): R>0 is the short (90 deg) arc, R<0 the long (270 deg) one
+    prog = read_gcode(f"G0 X10 Y0 Z0\nG1 F100\nG2 X20 Y10 {r_word}\n", chord_tol_mm=0.001)
+    pts = _arc_points(prog)
+    np.testing.assert_allclose(np.hypot(*(pts[:, :2] - centre).T), 10.0, atol=1e-9)
+    ang = np.unwrap(np.arctan2(*(pts[:, :2] - centre).T[::-1]))
+    assert ang[-1] - ang[0] == pytest.approx(-0.5 * math.pi if r_word == "R10" else -1.5 * math.pi)
+
+
+@pytest.mark.parametrize("plane, words, centre_axes", [
+    ("G18", "X10 Z0 I5 K0", (0, 2)),
+    ("G19", "Y10 Z0 J5 K0", (1, 2)),
+])
+def test_arcs_in_xz_and_yz_planes(plane, words, centre_axes):
+    prog = read_gcode(f"G0 X0 Y0 Z0\nG1 F100\n{plane} G2 {words}\n")
+    pts = _arc_points(prog)
+    a, b = centre_axes
+    c = np.zeros(3)
+    c[a] = 5.0
+    np.testing.assert_allclose(np.linalg.norm(pts - c, axis=1), 5.0, atol=1e-12)
+    other = 3 - a - b
+    np.testing.assert_allclose(pts[:, other], 0.0)
+    # RS274: G2 is clockwise seen from the plane's positive normal (+Y for G18, +X for G19).
+    # Seen from +Y (Z up, X to the left) a clockwise half turn from X0 to X10 passes under
+    # the centre (Z = -5); seen from +X (Z up, Y to the right) from Y0 to Y10 it passes over.
+    mid = pts[len(pts) // 2]
+    if plane == "G18":
+        assert mid[2] < -4.9
+    else:
+        assert mid[2] > 4.9
+
+
+def test_inch_and_incremental_equal_absolute_mm():
+    mm = read_gcode("G21 G90\nG0 X25.4 Y12.7 Z5.08\nG1 Z-2.54 F254\nX50.8 Y25.4\n"
+                    "G2 X76.2 Y25.4 I12.7 J0\nG0 Z5.08\n")
+    inch = read_gcode("G20 G90\nG0 X1 Y0.5 Z0.2\nG1 Z-0.1 F10\nX2 Y1\n"
+                      "G2 X3 Y1 I0.5 J0\nG0 Z0.2\n")
+    inc = read_gcode("G21 G90\nG0 X25.4 Y12.7 Z5.08\nG91\nG1 Z-7.62 F254\nX25.4 Y12.7\n"
+                     "G2 X25.4 Y0 I12.7 J0\nG0 Z7.62\n")
+    for other in (inch, inc):
+        assert len(other) == len(mm)
+        np.testing.assert_allclose(other.start_mm, mm.start_mm, atol=1e-9)
+        np.testing.assert_allclose(other.end_mm, mm.end_mm, atol=1e-9)
+    np.testing.assert_allclose(inch.feed_mm_min, mm.feed_mm_min)
+
+
+def test_drilling_cycles_expand_to_moves():
+    prog = read_gcode("G90 G0 X0 Y0 Z10\nG99 G81 X5 Y5 Z-3 R2 F100\nX15\nG80\n"
+                      "G0 Z10\nG98 G83 X25 Y5 Z-6 R2 Q2.5\nG80\n")
+    feeds = prog.end_mm[prog.kind == FEED]
+    # G81: one feed to Z-3 per hole; G83: pecks to -0.5, -3, -5.5, -6
+    np.testing.assert_allclose(feeds[:, 2], [-3, -3, -0.5, -3, -5.5, -6])
+    np.testing.assert_allclose(feeds[:, :2], [[5, 5], [15, 5]] + [[25, 5]] * 4)
+    assert prog.end_mm[-1].tolist() == [25, 5, 10]  # G98: back to the initial Z
+
+
+@pytest.mark.parametrize("text, line, word", [
+    ("G21\nG0 X0 Y0 Z5\nG30 Z0\n", 3, "G30"),
+    ("G0 X0 Y0 Z5\nG1 X1..2 F100\n", 2, ".2"),
+    ("G0 X0 Y0 Z5\nG1 A10 F100\n", 2, "A10"),
+    ("G0 X0 Y0 Z5\nG1 X10\n", 2, "G1"),              # no feed rate yet
+    ("G0 X0 Y0 Z0\nG1 F10\nG2 X10 Y0 I4 J0\n", 3, "G2"),  # radius mismatch
+    ("G0 X0 Y0 Z0\nG1 F10\nG2 X0 Y0 R5\n", 3, "R5"),       # R-form full circle
+    ("G0 G1 X1 Y1 Z1\n", 1, "G0 G1"),
+    ("G0 X0 (open comment\n", 1, "("),
+    ("G0 X0 Y0 Z0\nM98 P100\n", 2, "M98"),
+    ("G91 G0 X5\n", 1, "X5"),                          # incremental from an unknown position
+    ("N7 G0 X0 Y0 Z0\nN8 G1 F10 X1 Y1 Z1 X2\n", 2, "X2"),
+])
+def test_malformed_and_unsupported_lines_name_line_and_word(text, line, word):
+    with pytest.raises(GcodeError, match=rf"line {line}\b.*'{__import__('re').escape(word)}") as e:
+        read_gcode(text)
+    assert e.value.line == line
+
+
+def test_error_shows_n_word():
+    with pytest.raises(GcodeError, match=r"line 2 \(N20\): 'G30'"):
+        read_gcode("N10 G0 X0 Y0 Z0\nN20 G30\n")
+
+
+def test_reads_file(tmp_path):
+    p = tmp_path / "a.nc"
+    p.write_text("G0 X0 Y0 Z1\nG1 Z-1 F100\n")
+    prog = read_gcode(p)
+    assert len(prog) == 1 and prog.source == str(p)
+    assert len(read_gcode(str(p))) == 1
+
+
+def test_comments_block_delete_and_unknown_start():
+    prog = read_gcode("%\n(header)\n; whole-line comment\nN10 G21 G90 G17 (modes) ; units\n"
+                      "G0 Z5\nG0 X10 Y20\n/G1 Z-2 F300\nX30\nM30\nG1 X99\n")
+    # G0 Z5 / G0 X10 Y20 only set the unknown start; block-delete line runs; M30 ends reading
+    np.testing.assert_allclose(prog.start_mm, [[10, 20, 5], [10, 20, -2]])
+    np.testing.assert_allclose(prog.end_mm, [[10, 20, -2], [30, 20, -2]])
+    assert prog.line.tolist() == [7, 8]
+
+
+def test_program_number_g28_and_g53_make_axes_unknown():
+    prog = read_gcode("O1001\nG0 X10 Y10 Z5\nG1 Z-1 F100\nG91 G28 Z2\nG90\n"
+                      "G53 G0 Z0\nG0 X20 Y10\nG0 Z5\nG1 Z-1\n")
+    # G28 Z2 (incremental): rapid up 2 mm to the intermediate point, then Z is unknown; the
+    # G53 retract is in machine coordinates; the next moves only re-establish the position
+    np.testing.assert_allclose(prog.start_mm, [[10, 10, 5], [10, 10, -1], [20, 10, 5]])
+    np.testing.assert_allclose(prog.end_mm, [[10, 10, -1], [10, 10, 1], [20, 10, -1]])
+    assert prog.line.tolist() == [3, 4, 9]

@@ -1,0 +1,187 @@
+"""Simulation: analytic cuts, exact manifold3d reference, equivalent programs, issue report,
+result mesh."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.ndimage import maximum_filter, minimum_filter
+
+from woodcam.errors import WoodcamError
+from woodcam.toolpath import (BallEndMill, FlatEndMill, Program, parse_tool_spec, read_gcode,
+                              simulate)
+from woodcam.toolpath.reference import manifold_heightmap, reference_stock
+
+SIZE = (40.0, 30.0, 12.0)
+
+
+def test_flat_slot_matches_analytic_volume_and_depth():
+    # 6 mm flat end mill, 20 mm slot, 3 mm deep: volume = 3 (20 * 6 + pi 3^2)
+    prog = read_gcode("G0 X10 Y15 Z2\nG1 Z-3 F300\nX30\nG0 Z2\n")
+    res = simulate(prog, FlatEndMill(6), SIZE, resolution_mm=0.05)
+    exact = 3 * (20 * 6 + math.pi * 9)
+    assert res.removed_volume_mm3 == pytest.approx(exact, rel=2e-3)
+    x, y = res.cell_centres_mm
+    assert res.heightmap[np.searchsorted(y, 15), np.searchsorted(x, 20)] == pytest.approx(9.0)
+    assert res.heightmap[np.searchsorted(y, 15), np.searchsorted(x, 5)] == SIZE[2]
+    assert res.report == []
+
+
+def test_ball_plunge_is_a_hemisphere():
+    prog = read_gcode("G0 X20 Y15 Z2\nG1 Z-3 F300\nG0 Z2\n")
+    res = simulate(prog, BallEndMill(6), SIZE, resolution_mm=0.05)
+    assert res.removed_volume_mm3 == pytest.approx(2 / 3 * math.pi * 27, rel=3e-3)
+    x, y = res.cell_centres_mm
+    X, Y = np.meshgrid(x, y)
+    r2 = (X - 20) ** 2 + (Y - 15) ** 2
+    inside = r2 < 9
+    np.testing.assert_allclose(res.heightmap[inside], 12 - np.sqrt(9 - r2[inside]), atol=1e-5)
+
+
+SMALL = """G21 G90 G17
+T1 M6
+G0 Z3
+G0 X8 Y8
+G1 Z-2.5 F400
+G1 X30 Y10 Z-4
+G2 X30 Y22 I0 J6 Z-3
+G1 X12 Y20
+G3 X8 Y8 R7.5
+G1 X8 Y8 Z-5.5
+G0 Z3
+"""
+
+
+@pytest.mark.parametrize("spec", ["flat:6", "ball:6", "bull:6:1.5", "vbit:60:8"])
+def test_against_exact_manifold_reference(spec):
+    """Removed volume within 0.5 % and height within one cell of the exact boolean result."""
+    prog = read_gcode(SMALL, chord_tol_mm=0.05)  # few chords: the reference stays fast
+    tool = parse_tool_spec(spec)
+    res = simulate(prog, tool, SIZE, resolution_mm=0.1)
+    ref = reference_stock(prog, tool, SIZE, segments=96)
+    v_ref = np.prod(SIZE) - ref.volume()
+    assert res.removed_volume_mm3 == pytest.approx(v_ref, rel=5e-3)
+    h_ref = manifold_heightmap(ref, SIZE, res.heightmap.shape)
+    # within one cell: the simulated height lies within the exact heights of the 3x3
+    # neighbourhood (at vertical walls the exact height jumps inside a cell)
+    hi = maximum_filter(h_ref, 3, mode="nearest")
+    lo = minimum_filter(h_ref, 3, mode="nearest")
+    dev = np.maximum(res.heightmap - hi, lo - res.heightmap)
+    assert dev.max() <= 2e-3  # 96-gon reference vs exact circle: R (1 - cos(pi/96)) < 2e-3 mm
+    # and away from walls (neighbourhood spread < 0.05 mm) the heights agree pointwise
+    smooth = (hi - lo) < 0.05
+    assert np.abs(res.heightmap - h_ref)[smooth].max() <= 0.05
+
+
+def _inch_incremental_variants():
+    mm = ("G21 G90\nG0 X10 Y10 Z2\nG1 Z-2.54 F300\nX35.4 Y10\nG2 X35.4 Y22.7 I0 J6.35\n"
+          "G1 X10\nG0 Z2\n")
+    inch = ("G20 G90\nG0 X{} Y{} Z{}\nG1 Z-0.1 F12\nX{} Y{}\nG2 X{} Y{} I0 J0.25\nG1 X{}\n"
+            "G0 Z{}\n").format(*(v / 25.4 for v in (10, 10, 2, 35.4, 10, 35.4, 22.7, 10, 2)))
+    inc = ("G21 G90\nG0 X10 Y10 Z2\nG91\nG1 Z-4.54 F300\nX25.4\nG2 X0 Y12.7 I0 J6.35\n"
+           "G1 X-25.4\nG0 Z4.54\n")
+    return mm, inch, inc
+
+
+def test_inch_and_incremental_give_the_same_stock():
+    mm, inch, inc = _inch_incremental_variants()
+    tool = BallEndMill(4)
+    ref = simulate(read_gcode(mm), tool, SIZE).heightmap
+    for text in (inch, inc):
+        np.testing.assert_allclose(simulate(read_gcode(text), tool, SIZE).heightmap, ref,
+                                   atol=1e-5)
+
+
+def test_report_names_lines():
+    text = ("G0 X5 Y5 Z2\n"          # 1
+            "G1 Z-1 F300\n"          # 2
+            "G0 X20\n"               # 3 rapid through stock
+            "G1 Z-13\n"              # 4 below the bottom (stock is 12 high)
+            "G0 Z2\n"                # 5
+            "G0 X-10\n"              # 6
+            "G1 Z-1\n"               # 7 feed below the top outside the stock
+            "G1 X3\n"                # 8 cuts in from outside
+            "G0 Z2\n")
+    res = simulate(read_gcode(text), FlatEndMill(4), SIZE)
+    got = {(i.kind, i.line, i.last_line) for i in res.report}
+    assert got == {("rapid_through_stock", 3, 3), ("below_stock_bottom", 4, 4),
+                   ("cut_outside_stock", 7, 8)}  # adjacent lines of one kind are merged
+    assert "lines 7-8: cut_outside_stock" in [str(i)[:28] for i in res.report]
+    assert "cuts up to 1.000 mm" in next(str(i) for i in res.report if i.line == 3)
+    assert res.heightmap.min() == 0.0  # clamped to the stock bottom
+
+
+def test_rapid_into_an_already_cut_pocket_is_not_reported():
+    text = "G0 X10 Y10 Z2\nG1 Z-3 F300\nX20\nG0 Z2\nG0 X10\nG0 Z-2\nG1 Z-4\nG0 Z2\n"
+    res = simulate(read_gcode(text), FlatEndMill(4), SIZE)
+    assert res.report == []
+
+
+def test_work_offset_moves_the_cut():
+    prog = read_gcode("G0 X0 Y0 Z2\nG1 Z-2 F100\nG0 Z2\n")
+    a = simulate(prog, FlatEndMill(4), SIZE, work_offset_mm=(20, 15, 12))
+    x, y = a.cell_centres_mm
+    assert a.heightmap[np.searchsorted(y, 15), np.searchsorted(x, 20)] == pytest.approx(10)
+    b = simulate(prog, FlatEndMill(4), SIZE, work_offset_mm=(20, 15, 0))  # zero on the bottom
+    assert b.heightmap.min() == 0.0 and any(i.kind == "below_stock_bottom" for i in b.report)
+
+
+def test_tool_table_lookup_and_missing_tool():
+    prog = read_gcode("T1 M6\nG0 X5 Y5 Z2\nG1 Z-1 F100\nG0 Z2\nT4 M6\nG0 X20\nG1 Z-1\nG0 Z2\n")
+    res = simulate(prog, {1: FlatEndMill(2), 4: FlatEndMill(8)}, SIZE, resolution_mm=0.05)
+    assert res.removed_volume_mm3 == pytest.approx(math.pi * (1 + 16), rel=5e-3)
+    with pytest.raises(WoodcamError, match=r"uses tool 4 \(first at line 6\)"):
+        simulate(prog, {1: FlatEndMill(2)}, SIZE)
+
+
+def test_mesh_is_watertight_with_volume_of_the_height_field():
+    prog = read_gcode(SMALL)
+    res = simulate(prog, parse_tool_spec("bull:6:1.5"), SIZE, resolution_mm=0.2)
+    full = res.to_mesh(flat_tol_mm=-1.0)  # no merging at all
+    mesh = res.to_mesh()
+    for m in (full, mesh):
+        assert m.is_watertight and m.is_winding_consistent
+        np.testing.assert_allclose(m.bounds, [[0, 0, 0], SIZE], atol=1e-12)
+    # cell-centre vertices + edge rows: the mesh volume is exactly the midpoint-rule integral
+    stock = np.prod(SIZE) - res.removed_volume_mm3
+    assert full.volume == pytest.approx(stock, rel=1e-12)
+    assert mesh.volume == pytest.approx(stock, rel=1e-12)
+    assert len(mesh.faces) < 0.6 * len(full.faces)  # the untouched top is merged
+    rough = res.to_mesh(flat_tol_mm=0.05)
+    assert rough.is_watertight and len(rough.faces) < len(mesh.faces)
+    assert rough.volume == pytest.approx(stock, rel=2e-3)
+
+
+def test_program_from_arrays_and_errors():
+    prog = Program.from_arrays([[5, 5, 1]], [[5, 5, -1]])
+    res = simulate(prog, FlatEndMill(2), SIZE)
+    assert res.removed_volume_mm3 == pytest.approx(math.pi, rel=2e-2)
+    with pytest.raises(WoodcamError, match="size_mm must be"):
+        simulate(prog, FlatEndMill(2), (10, 10))
+    with pytest.raises(WoodcamError, match="resolution_mm must be > 0"):
+        simulate(prog, FlatEndMill(2), SIZE, resolution_mm=0)
+    with pytest.raises(WoodcamError, match="tools must be a Tool"):
+        simulate(prog, "flat:2", SIZE)
+
+
+def test_long_reports_are_summarised():
+    # 30 rapids through the stock on non-adjacent lines: 12 listed, the rest in one entry
+    lines = ["G0 X2 Y5 Z2", "G1 Z-1 F300"]
+    for k in range(30):
+        lines += [f"G0 X{3 + k}", f"G1 Y{6 - (k % 2)}"]
+    res = simulate(read_gcode("\n".join(lines)), FlatEndMill(1), SIZE)
+    rap = [i for i in res.report if i.kind == "rapid_through_stock"]
+    assert len(rap) == 13 and [i.line for i in rap[:12]] == list(range(3, 27, 2))
+    assert "and 18 more lines like this, the last at line 61" in rap[-1].message
+
+
+def test_mesh_of_a_through_cut_stays_closed():
+    # a slot cut through the whole 12 mm: the top lies on the bottom there (zero thickness)
+    res = simulate(read_gcode("G0 X10 Y15 Z2\nG1 Z-12.5 F300\nX30\nG0 Z2\n"), FlatEndMill(6),
+                   SIZE, resolution_mm=0.2)
+    assert (res.heightmap == 0).sum() > 0
+    mesh = res.to_mesh()
+    assert mesh.is_watertight
+    assert mesh.volume == pytest.approx(np.prod(SIZE) - res.removed_volume_mm3, rel=1e-12)

@@ -1,0 +1,315 @@
+"""3-axis stock-removal simulation on a height field.
+
+Data form
+---------
+The stock is the box ``[0, W] x [0, D] x [0, H]`` of the block frame (mm). It is sampled on a
+grid of ``ny x nx`` cells, ``nx = round(W / resolution_mm)`` (so the cell size
+``dx = W / nx`` is within half a cell of the asked resolution and the grid ends on the stock's
+faces). ``heightmap[j, i]`` is the top of the remaining stock (block-frame Z, mm, clamped to
+``[0, H]``) above the cell centre ``(X, Y) = ((i + 0.5) dx, (j + 0.5) dy)``: row ``j`` runs along
++Y (depth), column ``i`` along +X (width).
+
+Machine frame: ``G-code (x, y, z) = block (X, Y, Z) - work_offset_mm``; the default offset
+``(0, 0, H)`` puts work zero on the stock's top-front-left corner (``docs/conventions.md``).
+
+Sweep kernel
+------------
+For a straight move from ``p0`` to ``p1`` (tool tip, block frame) the lower envelope of the swept
+tool above a cell is ``min over the move of z(l) + profile(|cell - p(l)|)``. With ``a`` the
+cell's coordinate along the move's XY direction, ``d`` its distance from the move's XY line and
+``s = dz / dl`` the slope, write ``w = l - a``: the envelope is
+``z0 + s a + min_w [ s w + h(sqrt(w^2 + d^2)) ]`` over ``w`` in
+``[-a, L - a] ∩ [-sqrt(R^2 - d^2), sqrt(R^2 - d^2)]``. The bracket is convex in ``w`` (``h``
+convex and non-decreasing, the distance convex), so the constrained minimiser is the
+unconstrained one clipped to the interval; each tool solves it in closed form
+(:meth:`Tool._sweep`; bisection for the bull nose on ramps). The result is exact at every cell
+centre, so the only error of the height field is sampling (one cell) and arc chords.
+
+Moves are processed in vectorised batches: moves whose bounding boxes (in cells) fit the same
+padded window are stacked into ``(batch, wy, wx)`` float32 arrays and evaluated at once; each
+move's window is then min-merged into the height field as one slice (``np.minimum(view, env,
+out=view)``: windows of consecutive moves overlap, so a fancy-indexed assignment would lose
+updates, and a slice per move avoids the slower unbuffered ``np.minimum.at``). There is no per-cell Python loop; the per-move
+Python work is that one slice. Batches are formed within runs of the program that share a tool
+and contain no rapid below the stock top, so the rapid check sees the stock as cut by every
+earlier move.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Literal, Mapping
+
+import numpy as np
+
+from ..errors import WoodcamError
+from ..tolerances import SIM_CONTACT_TOL_MM
+from .gcode import FEED, RAPID, Program
+from .tools import Tool
+
+#: Cells evaluated per vectorised batch: ~20 float32 temporaries of 64k cells stay in L2/L3
+#: cache (measured 1.4x faster than 1M-cell batches on the raster benchmark).
+_BATCH_CELLS = 1 << 16
+
+
+IssueKind = Literal["rapid_through_stock", "below_stock_bottom", "cut_outside_stock"]
+
+#: Issues of one kind listed one by one before the rest are summarised in one entry.
+MAX_ISSUES_PER_KIND = 12
+
+
+@dataclass(frozen=True)
+class Issue:
+    """A problem the simulation found on G-code lines ``line .. last_line`` (1-based)."""
+
+    kind: IssueKind
+    line: int
+    message: str
+    last_line: int | None = None
+
+    def __str__(self):
+        where = f"line {self.line}" if not self.last_line or self.last_line == self.line \
+            else f"lines {self.line}-{self.last_line}"
+        return f"{where}: {self.kind}: {self.message}"
+
+
+def _summarise(issues: dict, move_lines: np.ndarray) -> list[Issue]:
+    """Merge runs of one kind on consecutive moving lines (lines without a move in between,
+    such as a lone ``F`` word, do not break a run); cap each kind at MAX_ISSUES_PER_KIND."""
+    ranks = {int(v): k for k, v in enumerate(np.unique(move_lines))}
+    out = []
+    for kind in ("rapid_through_stock", "below_stock_bottom", "cut_outside_stock"):
+        items = sorted((i for (k, _), i in issues.items() if k == kind), key=lambda i: i.line)
+        runs: list[list[Issue]] = []
+        for it in items:
+            if runs and ranks[it.line] <= ranks[runs[-1][-1].line] + 1:
+                runs[-1].append(it)
+            else:
+                runs.append([it])
+        merged = [Issue(kind, r[0].line, r[0].message, r[-1].line) for r in runs]
+        if len(merged) > MAX_ISSUES_PER_KIND:
+            rest = merged[MAX_ISSUES_PER_KIND:]
+            n_lines = sum(len(r) for r in runs[MAX_ISSUES_PER_KIND:])
+            merged = merged[:MAX_ISSUES_PER_KIND] + [Issue(
+                kind, rest[0].line, f"and {n_lines} more lines like this, the last at line "
+                f"{rest[-1].last_line}", rest[-1].last_line)]
+        out += merged
+    return sorted(out, key=lambda i: (i.line, i.kind))
+
+
+@dataclass
+class SimResult:
+    """Result of :func:`simulate` (see the module docstring for the height-field form)."""
+
+    heightmap: np.ndarray
+    size_mm: tuple[float, float, float]
+    cell_mm: tuple[float, float]
+    report: list[Issue] = field(default_factory=list)
+    stats: dict = field(default_factory=dict)
+
+    @property
+    def cell_centres_mm(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(x (nx,), y (ny,))`` block-frame coordinates of the cell centres, mm."""
+        ny, nx = self.heightmap.shape
+        return ((np.arange(nx) + 0.5) * self.cell_mm[0], (np.arange(ny) + 0.5) * self.cell_mm[1])
+
+    @property
+    def removed_volume_mm3(self) -> float:
+        """Removed volume (mm^3), midpoint rule over the cells."""
+        return float((self.size_mm[2] - self.heightmap).sum() * self.cell_mm[0] * self.cell_mm[1])
+
+    def to_mesh(self, *, flat_tol_mm: float = 1e-9):
+        """Watertight ``trimesh.Trimesh`` of the remaining stock in the block frame (mm).
+
+        See :func:`woodcam.toolpath.mesh.heightfield_mesh`; ``flat_tol_mm`` is how far from
+        planar a region may be and still be merged into one fan (1e-9: exactly planar only).
+        """
+        from .mesh import heightfield_mesh
+
+        return heightfield_mesh(self.heightmap, self.size_mm, flat_tol_mm=flat_tol_mm)
+
+
+def _tool_lookup(program: Program, tools) -> dict[int, Tool]:
+    used = sorted(set(np.unique(program.tool).tolist()))
+    if isinstance(tools, Tool):
+        return {t: tools for t in used}
+    if not isinstance(tools, Mapping) or not all(isinstance(v, Tool) for v in tools.values()):
+        raise WoodcamError(f"simulate: tools must be a Tool or a mapping {{number: Tool}}, got "
+                           f"{type(tools).__name__}; e.g. {{1: parse_tool_spec('flat:6')}}")
+    out = {}
+    for t in used:
+        if t in tools:
+            out[t] = tools[t]
+        elif t == 0 and len(tools) == 1:  # program never loads a tool (no M6): the only one
+            out[t] = next(iter(tools.values()))
+        else:
+            line = int(program.line[np.argmax(program.tool == t)])
+            raise WoodcamError(f"simulate: the program uses tool {t} (first at line {line}) "
+                               f"but tools has {sorted(tools)}; add T{t} to the tool table or "
+                               f"pass --tool {t}=SPEC")
+    return out
+
+
+def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
+             work_offset_mm=None, progress: bool = False) -> SimResult:
+    """Remove the swept tools of ``program`` from a ``W x D x H`` stock on a height field.
+
+    Parameters
+    ----------
+    program : Program
+        Straight moves from :func:`woodcam.toolpath.read_gcode` (machine frame, mm).
+    tools : Tool | Mapping[int, Tool]
+        One tool for every move, or the tool table by tool number.
+    size_mm : (3,) float
+        Stock size ``(W, D, H)``, mm.
+    resolution_mm : float
+        Cell size (mm), default 0.1.
+    work_offset_mm : (3,) float | None
+        Block-frame position of G-code zero; ``None`` means ``(0, 0, H)``.
+    progress : bool
+        Show a tqdm progress bar over the batches.
+
+    Returns
+    -------
+    SimResult
+        ``heightmap (ny, nx)``, ``report`` (issues with line numbers), ``stats`` (timings).
+    """
+    size = np.asarray(size_mm, float).reshape(-1)
+    if size.shape != (3,) or not np.all(size > 0):
+        raise WoodcamError(f"simulate: size_mm must be (W, D, H) > 0 in mm, got {size_mm!r}")
+    if not resolution_mm > 0:
+        raise WoodcamError(f"simulate: resolution_mm must be > 0, got {resolution_mm!r}; "
+                           "use e.g. 0.1")
+    W, D, H = size
+    off = np.array([0.0, 0.0, H]) if work_offset_mm is None else np.asarray(work_offset_mm, float)
+    nx, ny = max(1, round(W / resolution_mm)), max(1, round(D / resolution_mm))
+    if nx * ny > 1 << 27:
+        raise WoodcamError(f"simulate: {nx} x {ny} cells is too many for resolution_mm="
+                           f"{resolution_mm}; use a coarser resolution")
+    dx, dy = W / nx, D / ny
+    lookup = _tool_lookup(program, tools)
+    t0 = time.perf_counter()
+    hm = np.full((ny, nx), H, float)
+    p0 = program.start_mm + off
+    p1 = program.end_mm + off
+    issues: dict[tuple[str, int], Issue] = {}
+    tool_of = program.tool
+    R = np.zeros(len(program))
+    for tnum, tool in lookup.items():
+        R[tool_of == tnum] = tool.radius_mm
+    zmin = np.minimum(p0[:, 2], p1[:, 2])
+    # cell index windows of the swept footprints
+    i0 = np.ceil((np.minimum(p0[:, 0], p1[:, 0]) - R) / dx - 0.5).astype(np.int64)
+    i1 = np.floor((np.maximum(p0[:, 0], p1[:, 0]) + R) / dx - 0.5).astype(np.int64)
+    j0 = np.ceil((np.minimum(p0[:, 1], p1[:, 1]) - R) / dy - 0.5).astype(np.int64)
+    j1 = np.floor((np.maximum(p0[:, 1], p1[:, 1]) + R) / dy - 0.5).astype(np.int64)
+    outside = (i0 < 0) | (j0 < 0) | (i1 >= nx) | (j1 >= ny)
+    i0, j0 = np.maximum(i0, 0), np.maximum(j0, 0)
+    i1, j1 = np.minimum(i1, nx - 1), np.minimum(j1, ny - 1)
+    over = (i1 >= i0) & (j1 >= j0)
+    below_top = zmin < H - SIM_CONTACT_TOL_MM
+    kind, lines = program.kind, program.line
+    # a move ending below the bottom (the retract out of it is not reported again)
+    for k in np.flatnonzero((p1[:, 2] < -SIM_CONTACT_TOL_MM) & over):
+        _add(issues, "below_stock_bottom", lines[k],
+             f"tool tip at z = {p1[k, 2] - off[2]:.3f} mm (G-code frame), {-p1[k, 2]:.3f} mm "
+             "below the stock bottom")
+    for k in np.flatnonzero(below_top & outside & (kind == FEED)):
+        _add(issues, "cut_outside_stock", lines[k],
+             f"tool T{tool_of[k]} is below the stock top (z = {zmin[k] - off[2]:.3f} mm) with "
+             "its footprint outside the stock")
+    act = np.flatnonzero(below_top & over)  # program order
+    # Runs in program order, broken at tool changes and before/after every rapid that reaches
+    # below the stock top: the rapid check must see the stock as cut by all earlier moves.
+    # Within a run the order does not matter (the height field is a minimum over moves).
+    brk = np.zeros(len(act), bool)
+    if len(act):
+        rap = kind[act] == RAPID
+        brk[1:] = (tool_of[act][1:] != tool_of[act][:-1]) | rap[1:] | rap[:-1]
+    runs = np.split(np.arange(len(act)), np.flatnonzero(brk))
+    cells = 0
+    it = runs
+    if progress:
+        from tqdm import tqdm
+
+        it = tqdm(runs, desc="simulate", unit="run")
+    for run in it:
+        if not len(run):
+            continue
+        idx_run = act[run]
+        tool = lookup[int(tool_of[idx_run[0]])]
+        # Group moves by window size (rounded up to multiples of 8 cells) so each group is a
+        # dense (batch, wy, wx) array of bounded size (small enough to stay in cache).
+        wy = (j1[idx_run] - j0[idx_run] + 1 + 7) // 8 * 8
+        wx = (i1[idx_run] - i0[idx_run] + 1 + 7) // 8 * 8
+        order = np.lexsort((wx, wy))
+        idx_run, wy, wx = idx_run[order], wy[order], wx[order]
+        breaks = np.flatnonzero((np.diff(wy) != 0) | (np.diff(wx) != 0)) + 1
+        for g in np.split(np.arange(len(idx_run)), breaks):
+            per = max(1, _BATCH_CELLS // int(wy[g[0]] * wx[g[0]]))
+            for st in range(0, len(g), per):
+                idx = idx_run[g[st:st + per]]
+                cells += _sweep_batch(hm, tool, p0[idx], p1[idx], i0[idx], j0[idx], i1[idx],
+                                      j1[idx], int(wy[g[0]]), int(wx[g[0]]), dx, dy, kind[idx],
+                                      lines[idx], issues)
+    n_active = len(act)
+    np.clip(hm, 0.0, H, out=hm)
+    wall = time.perf_counter() - t0
+    report = _summarise(issues, program.line)
+    stats = {"moves": len(program), "moves_cutting_window": n_active, "cell_updates": cells,
+             "wall_s": wall, "moves_per_s": len(program) / max(wall, 1e-12),
+             "cell_updates_per_s": cells / max(wall, 1e-12), "grid": (ny, nx)}
+    return SimResult(hm, (float(W), float(D), float(H)), (dx, dy), report, stats)
+
+
+def _add(issues, kind, line, message):
+    key = (kind, int(line))
+    if key not in issues:
+        issues[key] = Issue(kind, int(line), message)
+
+
+def _sweep_batch(hm, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind, lines, issues):
+    """Lower envelope of ``len(a)`` straight moves over their windows; min-update ``hm``.
+
+    ``a, b : (n, 3)`` block-frame tip positions (mm); each window is the ``wy x wx`` cells from
+    ``(j0, i0)``, shifted to lie inside the grid. Cells of a window that the swept tool does not
+    cover come back from the kernel as ``+inf`` (the footprint test is part of the kernel), so
+    padding needs no mask. Float32 inside the kernel: coordinates are relative to the move start
+    (|x| < ~50 mm, round-off < 1e-5 mm). Returns the number of covered cells.
+    """
+    n = len(a)
+    ny, nx = hm.shape
+    wy, wx = min(wy, ny), min(wx, nx)
+    js = np.clip(j0, 0, ny - wy)
+    is_ = np.clip(i0, 0, nx - wx)
+    f32 = np.float32
+    cx = ((is_[:, None] + np.arange(wx)[None, :] + 0.5) * dx - a[:, 0, None]).astype(f32)
+    cy = ((js[:, None] + np.arange(wy)[None, :] + 0.5) * dy - a[:, 1, None]).astype(f32)
+    ex, ey, ez = (b - a).T
+    L = np.hypot(ex, ey)
+    plunge = L < 1e-9  # vertical move: along = x, clipped to t = 0 below, so rho = |cell - p|
+    Ls = np.where(plunge, 1.0, L)
+    ux, uy = np.where(plunge, 1.0, ex / Ls), np.where(plunge, 0.0, ey / Ls)
+    s = np.where(plunge, 0.0, ez / Ls)
+    z0 = np.where(plunge, np.minimum(a[:, 2], b[:, 2]), a[:, 2])
+    L = np.where(plunge, 0.0, L)
+    col = lambda v: np.asarray(v, f32)[:, None, None]  # noqa: E731
+    along = (cx * ux[:, None].astype(f32))[:, None, :] + (cy * uy[:, None].astype(f32))[:, :, None]
+    # perpendicular distance directly (rr - along^2 would cancel catastrophically in float32)
+    perp = (cx * uy[:, None].astype(f32))[:, None, :] - (cy * ux[:, None].astype(f32))[:, :, None]
+    d2 = perp * perp
+    env = tool._sweep(along, d2, col(s), col(L), col(z0))
+    rap = kind == RAPID
+    if rap.any():
+        # a rapid cuts stock if its envelope is below the stock as cut by all earlier moves
+        for k in np.flatnonzero(rap):
+            cur = hm[js[k]:js[k] + wy, is_[k]:is_[k] + wx]
+            depth = float((cur - env[k]).max())
+            if depth > SIM_CONTACT_TOL_MM:
+                _add(issues, "rapid_through_stock", lines[k],
+                     f"rapid move (G0) cuts up to {depth:.3f} mm into the stock")
+    for k in range(n):  # scatter: one slice per move (windows overlap, so no fancy indexing)
+        view = hm[js[k]:js[k] + wy, is_[k]:is_[k] + wx]
+        np.minimum(view, env[k], out=view)
+    return int(np.isfinite(env).sum())
