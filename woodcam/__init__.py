@@ -32,6 +32,8 @@ _EXPORTS = {
     ".pipeline": ["PartPreview", "preview_mesh", "preview_part"],
     ".stock": ["Stock", "open_stock"],
     ".synth": ["cut_block", "synth_block"],
+    ".toolpath": ["Program", "SimResult", "Tool", "load_tool_table", "parse_tool_spec",
+                  "read_gcode", "simulate"],
     ".view": ["preview"],
 }
 _WHERE = {name: mod for mod, names in _EXPORTS.items() for name in names}

@@ -11,7 +11,8 @@ from pathlib import Path
 from .errors import WoodcamError
 
 #: Modules that add their own subcommands through ``add_parser(subparsers)`` / ``run(args)``.
-_COMMAND_MODULES: tuple[str, ...] = ("woodcam._cli_block", "woodcam._cli_log", "woodcam._cli_appearance")
+_COMMAND_MODULES: tuple[str, ...] = ("woodcam._cli_block", "woodcam._cli_log", "woodcam._cli_appearance",
+                                     "woodcam.toolpath.cli")
 
 _EPILOG = """\
 Block specs: 'builtin:NAME' (see 'woodcam blocks') or a block folder with a block.json.
@@ -22,6 +23,8 @@ examples:
   woodcam demo --out out/
   woodcam bake cad_examples/bowl.py --block builtin:flat-sawn --out out/bowl.glb
   woodcam preview out/bowl.glb --screenshot out/bowl.png
+  woodcam gcode toolpaths/vcarve_text.nc --tool vbit:60:12 --block builtin:flat-sawn \
+      --out out/vcarve_text.glb --screenshot
 """
 
 
