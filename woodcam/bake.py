@@ -49,7 +49,7 @@ from typing import Any, Literal, get_args
 
 import numpy as np
 
-from woodcam.errors import WoodcamError
+from woodcam.errors import WoodcamError, WoodcamWarning
 from woodcam.tolerances import (
     ATLAS_PADDING_PX,
     MAX_BATCH_POINTS,
@@ -234,7 +234,7 @@ def bake(
         out.vertex_normals = np.asarray(mesh.vertex_normals, dtype=np.float64)[vmap]
     timings["total"] = time.perf_counter() - t_start
     for msg in messages:
-        warnings.warn(msg, UserWarning, stacklevel=2)
+        warnings.warn(msg, WoodcamWarning, stacklevel=2)
     return BakeResult(
         mesh=out,
         atlas=atlas,

@@ -64,10 +64,14 @@ def check_face(face: str) -> FaceName:
 
 def check_size(size_mm) -> np.ndarray:
     """Validate a block size ``(W, D, H)`` in mm and return it as a float array of shape (3,)."""
-    size = np.asarray(size_mm, dtype=float)
+    try:
+        size = np.asarray(size_mm, dtype=float)
+    except (TypeError, ValueError):
+        size = np.empty(0)
     if size.shape != (3,) or not np.all(np.isfinite(size)) or np.any(size <= 0):
         raise WoodcamError(
-            f"size_mm must be three positive lengths (W, D, H) in mm; got {size_mm!r}"
+            f"size_mm must be three positive finite lengths (W, D, H) in mm; got {size_mm!r}; "
+            "pass the block size, e.g. size_mm=(100, 80, 50)"
         )
     return size
 

@@ -32,6 +32,7 @@ from typing import Literal, get_args
 import numpy as np
 
 from .errors import WoodcamError, require
+from .frames import check_size
 from .tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS, ON_FACE_TOL_MM
 
 Camera = Literal["iso", "top", "front", "back", "left", "right", "bottom"]
@@ -96,22 +97,6 @@ def _pyvista():
 
 
 # ---------------------------------------------------------------------------- input checks
-
-
-def _check_size(size_mm) -> np.ndarray:
-    """Return ``size_mm`` as a float ``(3,)`` array of positive finite ``(W, D, H)`` mm."""
-    try:
-        s = np.asarray(size_mm, dtype=float)
-    except (TypeError, ValueError) as err:
-        raise WoodcamError(
-            f"size_mm must be three positive numbers (W, D, H) in mm; got {size_mm!r}"
-        ) from err
-    if s.shape != (3,) or not np.all(np.isfinite(s)) or np.any(s <= 0):
-        raise WoodcamError(
-            f"size_mm must be three positive finite numbers (W, D, H) in mm; got {size_mm!r}; "
-            "pass the block size, e.g. size_mm=(100, 80, 40)"
-        )
-    return s
 
 
 def _check_vector(value, name: str, *, unit: bool) -> np.ndarray:
@@ -262,7 +247,7 @@ def block_outline(size_mm):
         The 12 edges as lines, drawn opaque in :data:`BLOCK_EDGE_COLOR`.
     """
     pv = _pyvista()
-    w, d, h = _check_size(size_mm)
+    w, d, h = check_size(size_mm)
     box = pv.Box(bounds=(0.0, w, 0.0, d, 0.0, h))
     edges = box.extract_feature_edges(
         boundary_edges=False, feature_edges=True, manifold_edges=False, feature_angle=30.0
@@ -477,7 +462,7 @@ def cut_plane_image(
     _check_wood(wood)
     if wood is None:
         raise WoodcamError("wood: cut_plane_image needs a wood to colour the plane; got None")
-    size = _check_size(size_mm)
+    size = check_size(size_mm)
     origin = _check_vector(origin, "origin", unit=False)
     normal = _check_vector(normal, "normal", unit=True)
     if not (isinstance(resolution_mm, (int, float)) and np.isfinite(resolution_mm)
@@ -627,7 +612,7 @@ class CutPlaneCallback:
         self.plotter = plotter
         self.part = part
         self.wood = _check_wood(wood)
-        self.size_mm = None if size_mm is None else _check_size(size_mm)
+        self.size_mm = None if size_mm is None else check_size(size_mm)
         _check_size_with_wood(wood, self.size_mm)
         self.resolution_mm = resolution_mm
         self.max_samples = max_samples
@@ -781,7 +766,7 @@ def build_scene(
     """
     _check_wood(wood)
     camera = _check_camera(camera)
-    size = None if size_mm is None else _check_size(size_mm)
+    size = None if size_mm is None else check_size(size_mm)
     _check_size_with_wood(wood, size)
     part, texture = mesh_to_pyvista(mesh_or_path)
     bounds = (0.0, size[0], 0.0, size[1], 0.0, size[2]) if size is not None else part.bounds
@@ -885,7 +870,7 @@ def preview(
     # Check the mesh and options before a window opens.
     _check_wood(wood)
     _check_camera(camera)
-    _check_size_with_wood(wood, None if size_mm is None else _check_size(size_mm))
+    _check_size_with_wood(wood, None if size_mm is None else check_size(size_mm))
     mesh = _load_mesh(mesh_or_path)
 
     off_screen = screenshot is not None

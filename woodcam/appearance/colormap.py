@@ -17,14 +17,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+import numba
 import numpy as np
 
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, grain_direction
-from ..fields.knots import knot_shading
 from ..frames import FACE_AXIS, face_pixel_points
-from .noise import grain_noise, value_noise
-from .orientation import blend_axis_colors
+from .noise import TABLE, noise_at
 
 #: Number of ARF bins of a fitted colour ramp.
 LUT_BINS = 32
@@ -136,42 +135,40 @@ class ColorMapAppearance:
 
     def axis_colors(self, field, points_mm) -> np.ndarray:
         """The three per-axis colourings of eq. 10, shape ``(3, n, 3)``: normals X, Y, Z."""
+        return self._shade(field, points_mm, None)
+
+    def color(self, field, points_mm, normals) -> np.ndarray:
+        """Colour ``(n, 3)`` in [0, 1] of surfaces at ``points_mm`` with unit ``normals``.
+
+        The three per-axis colourings blended by eq. 10 (:func:`blend_axis_colors`), computed
+        in one compiled pass per point.
+        """
+        return self._shade(field, points_mm, np.asarray(normals, np.float32))
+
+    def _shade(self, field, points_mm, normals):
         p = check_points(points_mm)
         s = self.species
         years, grain, knots = _field_sample(field, p)
-        a = arf(years).astype(np.float32)
-        latewood = _smoothstep(s.latewood_start, 1.0, a)
-        base = self.ramp(a)
-
-        # One solid pore/fibre noise, stretched along the grain: streaks on side grain,
-        # dots on end grain (a cut across the stretched cells).
-        fibre = grain_noise(p, grain, s.pore_across_mm, s.pore_along_mm, self.seed)
-        pores = np.maximum(fibre - 0.35, 0.0) * (1.0 / 0.65)
-        if s.ring_porous:
-            pores *= 1.0 - latewood
-        streaks = grain_noise(p, grain, 4 * s.pore_across_mm, 4 * s.pore_along_mm, self.seed + 1)
-        shade = (1.0 + s.streak_contrast * streaks) * (1.0 - s.pore_contrast * pores)
-        rough = value_noise(p * np.float32(1.0 / (0.5 * s.pore_across_mm)), self.seed + 2)
-
-        out = np.empty((3,) + base.shape, np.float32)
-        for k in range(3):
-            end = np.abs(grain[:, k])  # 1 where a plane normal to axis k cuts the fibres across
-            if self.axis_luts is not None and np.all(np.isfinite(self.axis_luts[k])):
-                col = _lut_lookup(self.axis_luts[k], a)
-            else:
-                col = base * (1.0 - s.endgrain_darkening * end * end)[:, None]
-            col = col * (shade * (1.0 + s.endgrain_roughness * end * rough))[:, None]
-            if knots is not None:
-                col = knot_shading(col, knots, alive_darkening=self.knot_darkening_alive,
-                                   dead_darkening=self.knot_darkening_dead,
-                                   outline_rgb=self.dead_outline_rgb)
-            out[k] = col
-        return np.clip(out, 0.0, 1.0)
-
-    def color(self, field, points_mm, normals) -> np.ndarray:
-        """Colour ``(n, 3)`` in [0, 1] of surfaces at ``points_mm`` with unit ``normals``."""
-        yz, zx, xy = self.axis_colors(field, points_mm)
-        return blend_axis_colors(yz, zx, xy, normals)
+        n = len(p)
+        if knots is None:
+            zeros = np.zeros(n, np.float32)
+            knot = dead = outline = zeros
+        else:
+            knot, dead, outline = (np.asarray(knots[k], np.float32) for k in ("knot", "dead", "outline"))
+        luts = self.axis_luts if self.axis_luts is not None else np.full((3, LUT_BINS, 3), np.nan, np.float32)
+        lut_ok = np.array([np.all(np.isfinite(luts[k])) for k in range(3)])
+        blend = normals is not None
+        out = np.empty((1 if blend else 3, n, 3), np.float32)
+        params = np.array([s.latewood_start, s.pore_contrast, float(s.ring_porous), s.pore_across_mm,
+                           s.pore_along_mm, s.streak_contrast, s.endgrain_darkening,
+                           s.endgrain_roughness, self.knot_darkening_alive,
+                           self.knot_darkening_dead], np.float32)
+        colours = np.array([s.earlywood_rgb, s.latewood_rgb, self.dead_outline_rgb], np.float32)
+        _shade_kernel(arf(years).astype(np.float32), np.ascontiguousarray(grain, np.float32),
+                      p.astype(np.float32), normals if blend else np.zeros((1, 3), np.float32),
+                      knot, dead, outline, params, colours, np.nan_to_num(luts).astype(np.float32),
+                      lut_ok, np.int64(self.seed), TABLE, blend, out)
+        return out[0] if blend else out
 
     # -- fitting to photos ------------------------------------------------------------------------
 
@@ -232,9 +229,71 @@ def _field_sample(field, points_mm):
     return field(points_mm), np.asarray(grain_direction(field, points_mm), np.float32), None
 
 
-def _lut_lookup(lut: np.ndarray, a: np.ndarray) -> np.ndarray:
-    """Linear interpolation of a ``(LUT_BINS, 3)`` ramp at ARF values ``a`` (bin centres)."""
-    t = np.clip(a * LUT_BINS - 0.5, 0.0, LUT_BINS - 1.0)
-    i0 = np.minimum(t.astype(np.int64), LUT_BINS - 2)
-    f = (t - i0)[:, None]
-    return lut[i0] * (1 - f) + lut[i0 + 1] * f
+@numba.njit(nogil=True, fastmath=True, cache=True)
+def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, luts, lut_ok,
+                  seed, table, blend, out):  # pragma: no cover - compiled
+    """Per point: ramp, pores and streaks, end grain per axis, knots, and eq. 10 (``blend``).
+
+    One compiled pass instead of ~40 numpy array operations with their temporaries, which
+    made colour lookup memory-bound. Writes the blend to ``out[0] (n, 3)`` when ``blend``,
+    else the three per-axis colourings to ``out (3, n, 3)``.
+    """
+    lw_start, pore_c, ring_porous, p_across, p_along = params[0], params[1], params[2], params[3], params[4]
+    streak_c, eg_dark, eg_rough, dark_alive, dark_dead = params[5], params[6], params[7], params[8], params[9]
+    inv_a, inv_l = 1.0 / p_across, 1.0 / p_along
+    inv_a4, inv_l4 = 0.25 * inv_a, 0.25 * inv_l
+    nb = luts.shape[1]
+    col = np.empty(3, np.float32)
+    for i in range(a.shape[0]):
+        # ramp between earlywood and latewood (smoothstep from latewood_start to 1)
+        t = min(max((a[i] - lw_start) / (1.0 - lw_start), 0.0), 1.0)
+        t = t * t * (3.0 - 2.0 * t)
+        gx, gy, gz = grain[i, 0], grain[i, 1], grain[i, 2]
+        px, py, pz = p[i, 0], p[i, 1], p[i, 2]
+        along = px * gx + py * gy + pz * gz
+        # one solid noise stretched along the grain: streaks on side grain, dots on end grain
+        s1 = along * (inv_l - inv_a)
+        fibre = noise_at(px * inv_a + s1 * gx, py * inv_a + s1 * gy, pz * inv_a + s1 * gz, table, seed)
+        pores = max(fibre - 0.35, 0.0) / 0.65
+        if ring_porous > 0.5:
+            pores *= 1.0 - t
+        s4 = along * (inv_l4 - inv_a4)
+        streak = noise_at(px * inv_a4 + s4 * gx, py * inv_a4 + s4 * gy, pz * inv_a4 + s4 * gz,
+                          table, seed + 1)
+        shade = (1.0 + streak_c * streak) * (1.0 - pore_c * pores)
+        rough = noise_at(2.0 * px * inv_a, 2.0 * py * inv_a, 2.0 * pz * inv_a, table, seed + 2)
+        # knot wood darker, dead-knot outline drawn over (as fields.knots.knot_shading)
+        kfac = (1.0 - dark_alive * knot[i]) * (1.0 - dark_dead * dead[i])
+        ol = outline[i]
+        # lut position (bin centres) for fitted ramps
+        tl = min(max(a[i] * nb - 0.5, 0.0), nb - 1.0)
+        i0 = min(int(tl), nb - 2)
+        fl = tl - i0
+        if blend:
+            nx, ny, nz = abs(normals[i, 0]), abs(normals[i, 1]), abs(normals[i, 2])
+            ns = nx + ny + nz
+            if ns > 0:
+                w0, w1, w2 = nx / ns, ny / ns, nz / ns
+            else:
+                w0 = w1 = w2 = 1.0 / 3.0
+            out[0, i, 0] = 0.0
+            out[0, i, 1] = 0.0
+            out[0, i, 2] = 0.0
+        for k in range(3):
+            g = abs(grain[i, k])  # 1 where a plane normal to axis k cuts the fibres across
+            f = shade * (1.0 + eg_rough * g * rough) * kfac
+            for c in range(3):
+                if lut_ok[k]:
+                    v = luts[k, i0, c] * (1.0 - fl) + luts[k, i0 + 1, c] * fl
+                else:
+                    v = (colours[0, c] + t * (colours[1, c] - colours[0, c])) * (1.0 - eg_dark * g * g)
+                v = v * f
+                v = v * (1.0 - ol) + colours[2, c] * ol
+                col[c] = min(max(v, 0.0), 1.0)
+            if blend:
+                w = w0 if k == 0 else (w1 if k == 1 else w2)
+                for c in range(3):
+                    out[0, i, c] += w * col[c]
+            else:
+                for c in range(3):
+                    out[k, i, c] = col[c]

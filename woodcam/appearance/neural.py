@@ -23,7 +23,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
-from ..errors import WoodcamError
+from ..errors import WoodcamError, WoodcamWarning
 from ..fields.base import check_points
 from ..frames import FACE_AXIS
 from .colormap import ColorMapAppearance
@@ -46,7 +46,7 @@ class NoPhotosError(WoodcamError):
     """The block has no face photos to learn an appearance from."""
 
 
-class AppearanceFallbackWarning(UserWarning):
+class AppearanceFallbackWarning(WoodcamWarning):
     """The neural appearance was asked for but the colour map is used instead (reason given)."""
 
 

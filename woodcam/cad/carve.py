@@ -11,7 +11,6 @@ bottom-front-left corner, X width, Y depth, Z up). Carving is the exact boolean
 
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import dataclass, field
 from typing import Any
@@ -19,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import WoodcamError, WoodcamWarning
+from ..frames import check_size
 from ..tolerances import OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG, TESSELLATION_TOL_MM
 from .parts import load_part
 
@@ -96,7 +96,7 @@ def carve(
     import manifold3d
     import trimesh
 
-    size = _check_size(size_mm)
+    size = tuple(float(v) for v in check_size(size_mm))
     # load_part also validates a Manifold (status, emptiness, orientation) without copying it
     solid = load_part(part, tolerance_mm=tolerance_mm, angular_tolerance_deg=angular_tolerance_deg)
 
@@ -143,22 +143,6 @@ def carve(
         warnings=messages,
         size_mm=size,
     )
-
-
-def _check_size(size_mm) -> tuple[float, float, float]:
-    """Validate the block size ``(W, D, H)`` in mm."""
-    try:
-        values = [float(v) for v in size_mm]
-    except (TypeError, ValueError) as err:
-        raise WoodcamError(
-            f"size_mm must be three lengths (W, D, H) in mm, got {size_mm!r}; e.g. (100, 80, 50)"
-        ) from err
-    if len(values) != 3 or not all(math.isfinite(v) and v > 0 for v in values):
-        raise WoodcamError(
-            f"size_mm must be three finite lengths > 0 (W, D, H) in mm, got {size_mm!r}; "
-            f"e.g. (100, 80, 50)"
-        )
-    return (values[0], values[1], values[2])
 
 
 def _bounds(solid) -> tuple[np.ndarray, np.ndarray]:
