@@ -210,14 +210,14 @@ def _refine(prob: _Problem, pith, d, max_nfev: int):
     theta0 = np.array([0.0, 0.0, off @ b1, off @ b2])
     scale = np.array([0.05, 0.05, 5.0, 5.0])
     res = least_squares(lambda th: prob.solve(*prob.axis_of(th, base))[0], theta0,
-                        x_scale=scale, diff_step=1e-4, max_nfev=max_nfev, method="trf")
+                        x_scale=scale, diff_step=1e-4, max_nfev=max_nfev, method="trf", ftol=1e-6, xtol=1e-6)
     pith, d = prob.axis_of(res.x, base)
     return pith, d, float(res.cost * 2)
 
 
 def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: float,
-                       n_directions: int = 120, n_search: int = 600, n_fit: int = 2500,
-                       n_starts: int = 4, seed: int = 0):
+                       n_directions: int = 120, n_search: int = 600, n_fit: int = 2000,
+                       n_starts: int = 6, coarse_K: int = 2, seed: int = 0):
     """Search + refine the pith axis; returns ``(RadialField, levels or None, group ids used)``.
 
     For labelled observations the returned field is the final least-squares fit. For unlabelled
@@ -239,14 +239,22 @@ def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: fl
 
     i_s, g_s = take(n_search)
     coarse = _Problem(obs.points_mm[i_s], obs.years[i_s] if labelled else None, g_s, centre, z_scale,
-                      min(K, 2), min(M, 1), ridge)
+                      min(K, coarse_K), min(M, 1), ridge)
     starts = []
     for d in _hemisphere(n_directions):
         pith = _circle_pith(coarse.points, coarse.years, coarse.group, d, centre)
         starts.append((_cost(coarse, pith, d), pith, d))
     starts.sort(key=lambda s: s[0])
     mid = _Problem(coarse.points, coarse.years, coarse.group, centre, z_scale, min(K, 4), M, ridge)
-    refined = [_refine(mid, p, d, max_nfev=40) for _, p, d in starts[:n_starts]]
+    # Refine the best starts whose directions differ by > ~10 deg: the cost landscape over the
+    # axis has several basins when only some faces are traced (a single best start got stuck).
+    chosen = []
+    for c in starts:
+        if all(abs(c[2] @ o[2]) < np.cos(np.deg2rad(10)) for o in chosen):
+            chosen.append(c)
+        if len(chosen) == n_starts:
+            break
+    refined = [_refine(mid, p, d, max_nfev=30) for _, p, d in chosen]
     pith, d, _ = min(refined, key=lambda r: r[2])
     i_f, g_f = take(n_fit)
     fine = _Problem(obs.points_mm[i_f], obs.years[i_f] if labelled else None, g_f, centre, z_scale, K, M, ridge)
@@ -310,7 +318,7 @@ def number_rings(levels: np.ndarray, weights: np.ndarray, spacing_mm: float):
 
 
 def _refit_labelled(obs: RingObservations, size_mm, start: RadialField, ridge: float,
-                    n_fit: int = 2500, seed: int = 0) -> RadialField:
+                    n_fit: int = 2000, seed: int = 0) -> RadialField:
     """Labelled least squares started from ``start``'s axis (no global search)."""
     size = np.asarray(size_mm, float)
     rng = np.random.default_rng(seed + 1)
@@ -334,8 +342,8 @@ def _relabel(obs: RingObservations, field: RadialField) -> tuple[RingObservation
     return RingObservations(obs.points_mm, years, obs.group, obs.face), changed
 
 
-def fit_radial(obs: RingObservations, size_mm, K: int = 7, M: int = 2, ridge: float = 1e-4,
-               max_relabel_rounds: int = 2, seed: int = 0) -> RadialField:
+def fit_radial(obs: RingObservations, size_mm, K: int = 12, M: int = 1, ridge: float = 1e-8,
+               max_relabel_rounds: int = 2, seed: int = 0, **search) -> RadialField:
     """Fit the radial model to labelled or unlabelled ring observations of a block.
 
     Labelled: axis search + variable-projection least squares; then traces whose median misfit
@@ -345,9 +353,9 @@ def fit_radial(obs: RingObservations, size_mm, K: int = 7, M: int = 2, ridge: fl
     (the pith sits at a year in [0, 1) up to the fit).
     """
     if obs.labelled:
-        field, _, _ = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed)
+        field, _, _ = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, **search)
     else:
-        shape_field, levels, groups = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed)
+        shape_field, levels, groups = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, **search)
         # Levels of every group from the fitted shape (groups not in the fitting subset too).
         vals = shape_field(obs.points_mm)
         n = obs.n_groups
