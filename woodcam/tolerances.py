@@ -62,3 +62,8 @@ EVAL_PIXEL_MM = 0.1
 
 #: Distance thresholds (mm) of the ring-accuracy metric, as in seed 000's Table 1.
 EVAL_THRESHOLDS_MM = (1.0, 2.0)
+
+#: Largest relative difference between a face image's row and column pixel sizes (mm/px) that
+#: is accepted as square pixels; a larger one means the image does not match the block size
+#: (a wrong size_mm or an uncropped photo). 5 % allows a pixel of rounding on a 20 px face.
+FACE_PIXEL_ASPECT_RTOL = 0.05

@@ -144,15 +144,14 @@ class PlaneScore:
 
 
 def score_plane(true_field, fitted_field, sample: PlaneSample, step_mm: float | None = None,
-                keep_lines: bool = False) -> PlaneScore:
-    """Compare ring lines of ``fitted_field`` with those of ``true_field`` on one sampled plane."""
-    step = sample.pixel_mm if step_mm is None else step_mm
-    flat = sample.points_mm.reshape(-1, 3)
-    shape = sample.inside.shape
-    g_true = evaluate(true_field, flat).reshape(shape)
-    g_fit = evaluate(fitted_field, flat).reshape(shape)
-    tp, ty = ring_lines(g_true, sample.inside, sample.pixel_mm, step)
-    pp, py = ring_lines(g_fit, sample.inside, sample.pixel_mm, step)
+                keep_lines: bool = False, true_lines=None) -> PlaneScore:
+    """Compare ring lines of ``fitted_field`` with those of ``true_field`` on one sampled plane.
+
+    ``true_lines`` may pass the true lines ``(points, years)`` precomputed by
+    :func:`plane_lines` when several fields are scored on one plane.
+    """
+    tp, ty = plane_lines(true_field, sample, step_mm) if true_lines is None else true_lines
+    pp, py = plane_lines(fitted_field, sample, step_mm)
     s = PlaneScore(
         sample.plane.name,
         _nearest_distance(pp, py, tp, ty, True),
@@ -162,6 +161,13 @@ def score_plane(true_field, fitted_field, sample: PlaneSample, step_mm: float | 
     if keep_lines:
         s.lines = {"true": (tp, ty), "fit": (pp, py)}
     return s
+
+
+def plane_lines(field, sample: PlaneSample, step_mm: float | None = None):
+    """Ring lines ``(points (m, 2) mm, years (m,))`` of ``field`` on a sampled plane."""
+    step = sample.pixel_mm if step_mm is None else step_mm
+    g = evaluate(field, sample.points_mm.reshape(-1, 3)).reshape(sample.inside.shape)
+    return ring_lines(g, sample.inside, sample.pixel_mm, step)
 
 
 def summarise(scores: list[PlaneScore], thresholds=EVAL_THRESHOLDS_MM) -> dict:
@@ -191,9 +197,87 @@ def evaluate_fit(true_field, fitted_field, size_mm, planes=DEFAULT_PLANES,
     summary : dict (see :func:`summarise`)
     scores : list of PlaneScore, one per plane
     """
-    scores = [score_plane(true_field, fitted_field, sample_plane(p, size_mm, pixel_mm),
-                          keep_lines=keep_lines) for p in planes]
-    return summarise(scores), scores
+    return evaluate_fits(true_field, {"fit": fitted_field}, size_mm, planes, pixel_mm, keep_lines)["fit"]
+
+
+def evaluate_fits(true_field, fitted: dict, size_mm, planes=DEFAULT_PLANES,
+                  pixel_mm: float = EVAL_PIXEL_MM, keep_lines: bool = False) -> dict:
+    """:func:`evaluate_fit` for several fields (dict name -> field) sharing the true lines.
+
+    Returns dict name -> ``(summary, scores)``.
+    """
+    out = {name: [] for name in fitted}
+    for p in planes:
+        sample = sample_plane(p, size_mm, pixel_mm)
+        truth = plane_lines(true_field, sample)
+        for name, f in fitted.items():
+            out[name].append(score_plane(true_field, f, sample, keep_lines=keep_lines, true_lines=truth))
+    return {name: (summarise(sc), sc) for name, sc in out.items()}
+
+
+def benchmark(blocks, methods=("rbf", "radial"), face_sets=None, out_dir=None,
+              planes=DEFAULT_PLANES, pixel_mm: float = EVAL_PIXEL_MM, progress=None) -> dict:
+    """Fit every block with every method and face set, score them on the cut planes.
+
+    Parameters
+    ----------
+    blocks : list of Block, each with a ``true_field``
+    methods : fitting methods (see :data:`woodcam.inference.fit.METHODS`)
+    face_sets : dict label -> list of faces or None (all); default ``{"full": None}``
+    out_dir : folder for ``table.md`` and one PNG per block and face set (predicted vs true
+        ring lines on every plane); nothing is written when None.
+    progress : optional callable taking one line of text per fit.
+
+    Returns
+    -------
+    dict face-set label -> list of rows ``{"name": block name, method: summary + fit_s}`` plus
+    ``"table"``: the markdown text.
+    """
+    import time
+    from pathlib import Path
+
+    from .fit import fit_block
+
+    face_sets = {"full": None} if face_sets is None else face_sets
+    result, tables = {}, []
+    for label, faces in face_sets.items():
+        rows = []
+        for b in blocks:
+            if b.true_field is None:
+                raise WoodcamError(
+                    f"block {b.name!r} has no true_field; evaluation needs the true growth field "
+                    f"(a synthetic block, or pass --truth FIELD_FILE)"
+                )
+            fields, times = {}, {}
+            for m in methods:
+                t0 = time.perf_counter()
+                fields[m] = fit_block(b, m, faces=faces)
+                times[m] = time.perf_counter() - t0
+            scored = evaluate_fits(b.true_field, fields, b.size_mm, planes, pixel_mm,
+                                   keep_lines=out_dir is not None)
+            row = {"name": b.name}
+            for m in methods:
+                row[m] = dict(scored[m][0], fit_s=times[m])
+            rows.append(row)
+            if progress:
+                progress(f"{label} {b.name}: " + ", ".join(
+                    f"{m} {row[m]['matched_1']:.1f}/{row[m]['matched_2']:.1f}% {times[m]:.1f}s" for m in methods))
+            if out_dir is not None:
+                Path(out_dir).mkdir(parents=True, exist_ok=True)
+                plot_planes(Path(out_dir) / f"{b.name}_{label}.png", {m: scored[m][1] for m in methods},
+                            title=f"{b.name} ({label}): black = true rings, colour = fitted")
+        mean = {"name": "**mean**"}
+        for m in methods:
+            keys = rows[0][m].keys()
+            mean[m] = {k: float(np.mean([r[m][k] for r in rows])) for k in keys}
+        rows.append(mean)
+        result[label] = rows
+        tables.append(f"### {label} ({'all faces' if faces is None else ', '.join(faces)})\n\n"
+                      + markdown_table(rows, list(methods)))
+    result["table"] = "\n\n".join(tables) + "\n"
+    if out_dir is not None:
+        (Path(out_dir) / "table.md").write_text(result["table"])
+    return result
 
 
 def plot_planes(path, scores_by_method: dict, title: str = ""):

@@ -13,8 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import WoodcamError
-from ..frames import FACES, check_face, pixel_to_block
-from ..tolerances import RING_MAP_THRESHOLD, TRACE_SAMPLE_STEP_MM
+from ..frames import FACES, check_face, face_image_size_mm, pixel_to_block
+from ..tolerances import FACE_PIXEL_ASPECT_RTOL, RING_MAP_THRESHOLD, TRACE_SAMPLE_STEP_MM
 
 
 @dataclass
@@ -97,6 +97,13 @@ def gather_observations(block, faces=None, step_mm: float = TRACE_SAMPLE_STEP_MM
     for name in names:
         f = block.faces[name]
         dr, dc = block.face_pixel_size_mm(name)
+        if abs(dr - dc) > FACE_PIXEL_ASPECT_RTOL * max(dr, dc):
+            h, w = face_image_size_mm(name, block.size_mm)
+            raise WoodcamError(
+                f"face {name!r} is {f.shape[0]}x{f.shape[1]} px but covers {h:g}x{w:g} mm of block "
+                f"{block.name!r} (size_mm {block.size_mm}): its pixels would be {dr:.3g}x{dc:.3g} mm, "
+                f"not square; check size_mm or crop the face image to the face"
+            )
         if f.traces:
             polys = [(t.points_px, t.year) for t in f.traces]
             px_step = step_mm / max(min(dr, dc), 1e-12)

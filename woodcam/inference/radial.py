@@ -217,7 +217,8 @@ def _refine(prob: _Problem, pith, d, max_nfev: int):
 
 def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: float,
                        n_directions: int = 120, n_search: int = 600, n_fit: int = 2000,
-                       n_starts: int = 6, coarse_K: int = 2, seed: int = 0):
+                       n_starts: int = 6, coarse_K: int = 2, n_final: int = 2, n_grid_directions: int = 20,
+                       pith_grid: int = 9, seed: int = 0):
     """Search + refine the pith axis; returns ``(RadialField, levels or None, group ids used)``.
 
     For labelled observations the returned field is the final least-squares fit. For unlabelled
@@ -245,6 +246,20 @@ def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: fl
         pith = _circle_pith(coarse.points, coarse.years, coarse.group, d, centre)
         starts.append((_cost(coarse, pith, d), pith, d))
     starts.sort(key=lambda s: s[0])
+    # The circle fit misplaces the pith when the traced faces see only a narrow wedge of rings;
+    # for the best directions also try a grid of pith positions (+-1.6 block sizes).
+    span = 1.6 * float(size.max())
+    offs = np.linspace(-span, span, pith_grid)
+    for j, (c, p, d) in enumerate(starts[:n_grid_directions]):
+        _, b1, b2 = _frame(d)
+        for u in offs:
+            for v in offs:
+                q = centre + u * b1 + v * b2
+                cq = _cost(coarse, q, d)
+                if cq < c:
+                    c, p = cq, q
+        starts[j] = (c, p, d)
+    starts.sort(key=lambda s: s[0])
     mid = _Problem(coarse.points, coarse.years, coarse.group, centre, z_scale, min(K, 4), M, ridge)
     # Refine the best starts whose directions differ by > ~10 deg: the cost landscape over the
     # axis has several basins when only some faces are traced (a single best start got stuck).
@@ -255,10 +270,13 @@ def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: fl
         if len(chosen) == n_starts:
             break
     refined = [_refine(mid, p, d, max_nfev=30) for _, p, d in chosen]
-    pith, d, _ = min(refined, key=lambda r: r[2])
+    refined.sort(key=lambda r: r[2])
     i_f, g_f = take(n_fit)
     fine = _Problem(obs.points_mm[i_f], obs.years[i_f] if labelled else None, g_f, centre, z_scale, K, M, ridge)
-    pith, d, _ = _refine(fine, pith, d, max_nfev=60)
+    # The low-order ranking can put the true basin second (seen with three faces traced), so
+    # the best n_final basins are finished at full order and compared there.
+    finals = [_refine(fine, p, d, max_nfev=60) for p, d, _ in refined[:n_final]]
+    pith, d, _ = min(finals, key=lambda r: r[2])
     _, coef, offset, levels = fine.solve(pith, d)
     field = RadialField(pith, _frame(d)[0], z_scale, K, M, coef, float(offset))
     return field, levels, (obs.group[i_f] if not labelled else None)
