@@ -3,16 +3,50 @@
 Photograph a block, infer its growth rings, carve a part out of it and see the wood on every
 surface before a single cut. Lengths are millimetres, growth time is years, points are in the
 block frame of ``docs/conventions.md`` (origin bottom-front-left, X width, Y depth, Z up).
+
+The pipeline, one name per stage::
+
+    stock = open_stock("builtin:flat-sawn")          # block size + Wood(field, appearance)
+    carved = carve(load_part("bowl.py"), stock.size_mm)
+    baked = bake(carved.mesh, stock.wood, texels_per_mm=10)
+    export_glb(baked.mesh, "bowl.glb"); preview("bowl.glb", wood=stock.wood, size_mm=stock.size_mm)
 """
 
-from .errors import MissingDependencyError, WoodcamError
-from .fields import GrowthField, LogFrame, arf, evaluate, grain_direction
-from .frames import FACES, FACE_NORMAL, MOKUME_LETTER, block_to_pixel, pixel_to_block, unfold_cross
+import importlib
+
+# Public names and the module each lives in. They load on first use (PEP 562), so
+# ``import woodcam`` and ``woodcam --help`` stay fast while trimesh, scipy and numba load later.
+_EXPORTS = {
+    ".appearance": ["SPECIES", "ColorMapAppearance", "Wood"],
+    ".bake": ["BakeResult", "bake"],
+    ".block": ["Block", "Face", "RingTrace", "read_block", "read_mokume", "write_block"],
+    ".cad": ["CarveResult", "carve", "load_part"],
+    ".errors": ["MissingDependencyError", "WoodcamError", "WoodcamWarning"],
+    ".export": ["export_glb", "export_obj", "load_textured", "read_glb_metadata"],
+    ".fields": ["GridField", "GrowthField", "KnottedLogField", "Log", "LogFrame", "PlacedField",
+                "RadialScalingField", "arf", "builtin_block", "evaluate", "grain_direction",
+                "read_gran1"],
+    ".frames": ["FACES", "FACE_NORMAL", "MOKUME_LETTER", "block_to_pixel", "pixel_to_block",
+                "unfold_cross"],
+    ".logs": ["GeneratedLog", "generate_log"],
+    ".pipeline": ["PartPreview", "preview_mesh", "preview_part"],
+    ".stock": ["Stock", "open_stock"],
+    ".synth": ["cut_block", "synth_block"],
+    ".view": ["preview"],
+}
+_WHERE = {name: mod for mod, names in _EXPORTS.items() for name in names}
 
 __version__ = "0.1.0"
+__all__ = sorted(_WHERE)
 
-__all__ = [
-    "FACES", "FACE_NORMAL", "GrowthField", "LogFrame", "MOKUME_LETTER", "MissingDependencyError",
-    "WoodcamError", "arf", "block_to_pixel", "evaluate", "grain_direction", "pixel_to_block",
-    "unfold_cross",
-]
+
+def __getattr__(name: str):
+    if name in _WHERE:
+        value = getattr(importlib.import_module(_WHERE[name], __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'woodcam' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

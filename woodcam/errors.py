@@ -36,3 +36,8 @@ def require(module: str, extra: str, purpose: str):
             f"{purpose} needs the optional package {module!r}, which is not installed; "
             f"install it with: pip install 'woodcam[{extra}]'"
         ) from err
+
+
+class WoodcamWarning(UserWarning):
+    """Something the user should know about but woodcam could carry on with (e.g. a part that
+    sticks out of the block is carved anyway and the lost volume is reported)."""

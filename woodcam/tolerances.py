@@ -67,3 +67,39 @@ EVAL_THRESHOLDS_MM = (1.0, 2.0)
 #: is accepted as square pixels; a larger one means the image does not match the block size
 #: (a wrong size_mm or an uncropped photo). 5 % allows a pixel of rounding on a 20 px face.
 FACE_PIXEL_ASPECT_RTOL = 0.05
+
+#: Largest error (years) allowed between a refined synthetic ring trace vertex and its integer
+#: iso-line. Newton refinement on the true field reaches ~1e-9 years in three steps; vertices that
+#: do not (on a field kink or where the gradient vanishes, e.g. at the pith) are dropped.
+#: The acceptance test uses 1e-3 years (about 3 um at 3 mm rings), so 1e-4 leaves margin.
+TRACE_ISO_TOL_YEARS = 1e-4
+
+#: Finite-difference step (pixels) for the in-face gradient used to refine ring traces: small
+#: enough to resolve 1.5 mm rings at 5 px/mm, large enough that float64 round-off of years of
+#: order 100 stays ~1e-12 relative.
+TRACE_FD_STEP_PX = 1e-3
+
+#: Ring maps stored as 16-bit PNG come back within half a quantisation step, 0.5 / 65535.
+RING_MAP_QUANT_16BIT = 0.5 / 65535
+
+#: Ring maps stored as 8-bit PNG (and Mokume's own maps) carry 0.5 / 255 of quantisation.
+RING_MAP_QUANT_8BIT = 0.5 / 255
+
+#: Colours a wood returns may overshoot [0, 1] by this much (round-off of blends and colour
+#: transforms) and are clipped; a larger excursion is an error (e.g. 0..255 colours passed).
+COLOR_RANGE_TOL = 1e-3
+
+#: A point counts as on a knot's surface (the envelope of its elliptic cross-sections) when its
+#: signed distance is above -this (mm): the projection onto the knot's centre curve converges
+#: to ~1e-5 mm, and cross-section points truly inside a sharply bent knot are >= 0.01 mm in.
+KNOT_SURFACE_TOL_MM = 1e-3
+
+#: Extra reach (texels) of the bake's conservative rasterisation beyond the exact bilinear
+#: footprint of 1 texel: covers float32 UVs in GLB files (2^-24 x 8192 texels = 5e-4) and the
+#: float32 edge tests (~1e-3 texel), so a sample exactly on a chart border never reads an
+#: unpainted texel.
+RASTER_MARGIN_TEXELS = 0.02
+
+#: Triangles whose texel-space area (texels^2) is below this are degenerate in UV: their
+#: barycentric inverse is ill-conditioned, so the baker skips them (neighbours paint the texels).
+MIN_UV_AREA_TEXELS2 = 1e-10

@@ -54,6 +54,10 @@ class Face:
     photo : (n_rows, n_cols, 3) uint8 or None
     traces : list of RingTrace
     ring_map : (n_rows, n_cols) float32 in [0, 1] or None
+    extras : dict
+        Other per-face data, e.g. ``"knot_mask"``: (n_rows, n_cols) bool, True on a knot
+        (Mokume ``X_knot.png``), or ``"annotation"``: the raw Mokume ``X_ann.png``. Array
+        values are written as PNG by :func:`woodcam.block.io.write_block`, others as JSON.
     """
 
     name: FaceName
@@ -61,6 +65,7 @@ class Face:
     photo: np.ndarray | None = None
     traces: list[RingTrace] = field(default_factory=list)
     ring_map: np.ndarray | None = None
+    extras: dict = field(default_factory=dict)
 
     def __post_init__(self):
         self.name = check_face(self.name)

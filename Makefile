@@ -1,0 +1,50 @@
+# Two commands on a fresh machine:  make demo  |  make test
+# Both create .venv idempotently. torch==2.13.0 is installed first and alone so pip takes the
+# local CPU wheel (a bare "torch" requirement would pull several GB of CUDA packages); the CAD
+# kernels are pinned in pyproject.toml (build123d 0.12 + cadquery 2.8, both on OCP 7.9).
+
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+NODE_DIR := .cache/node
+OUT    ?= out
+
+.PHONY: demo test bench slow clean
+
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+
+$(VENV)/.torch: | $(BIN)/python
+	$(BIN)/python -m pip install --quiet torch==2.13.0
+	touch $@
+
+$(VENV)/.demo-deps: pyproject.toml $(VENV)/.torch
+	$(BIN)/python -m pip install --quiet -e '.[cad,view,learn]'
+	touch $@
+
+$(VENV)/.dev-deps: pyproject.toml $(VENV)/.torch
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	touch $@
+
+# The Khronos glTF validator (npm package) used by the export tests.
+$(NODE_DIR)/node_modules/gltf-validator/package.json:
+	@command -v npm >/dev/null || { echo "npm not found: the glTF validator test will be skipped"; exit 0; }
+	npm install --silent --no-fund --no-audit --prefix $(NODE_DIR) gltf-validator
+
+demo: $(VENV)/.demo-deps
+	$(BIN)/woodcam demo --out $(OUT)
+
+# pytest exits 5 when it collects no test: that is a failure here, not a pass.
+test: $(VENV)/.dev-deps $(NODE_DIR)/node_modules/gltf-validator/package.json
+	$(BIN)/python -m pytest; rc=$$?; \
+	if [ $$rc -eq 5 ]; then echo "make test: pytest collected no tests" >&2; exit 1; fi; exit $$rc
+
+bench: $(VENV)/.dev-deps
+	$(BIN)/python -m pytest -m bench -s -p no:randomly
+
+slow: $(VENV)/.dev-deps
+	$(BIN)/python -m pytest -m slow
+
+clean:
+	rm -rf $(VENV) $(NODE_DIR) $(OUT) .pytest_cache

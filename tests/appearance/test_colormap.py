@@ -1,0 +1,152 @@
+"""Colour-map appearance: eq. 10, end grain, rings where the field says, fitting to photos."""
+
+import numpy as np
+import pytest
+
+from woodcam.appearance import ColorMapAppearance, Wood, axis_weights, blend_axis_colors
+from woodcam.appearance.colormap import LUT_BINS
+from woodcam.block import Block, Face
+from woodcam.errors import WoodcamError
+from woodcam.fields import LogFrame, arf
+from woodcam.fields.radial import RadialScalingField
+from woodcam.frames import FACE_NORMAL, FACES, face_image_size_mm, face_pixel_points
+
+AXIS_Z = RadialScalingField(LogFrame((-40.0, 20.0, 0.0), (0, 0, 1)), ring_width_mm=3.0)
+
+
+def test_eq10_axis_aligned_normals_pick_one_colouring(rng):
+    a, b, c = (rng.uniform(0, 1, (50, 3)) for _ in range(3))
+    for k, want in enumerate((a, b, c)):
+        n = np.zeros((50, 3))
+        n[:, k] = rng.choice([-1.0, 1.0], 50)
+        np.testing.assert_allclose(blend_axis_colors(a, b, c, n), want, rtol=1e-6)
+
+
+def test_eq10_weights_sum_to_one_and_follow_abs_normal(rng):
+    n = rng.normal(size=(100, 3))
+    w = axis_weights(n)
+    np.testing.assert_allclose(w.sum(1), 1, rtol=1e-6)
+    np.testing.assert_allclose(w, np.abs(n) / np.abs(n).sum(1, keepdims=True), rtol=1e-5)
+    assert np.allclose(axis_weights(np.zeros((2, 3))), 1 / 3)
+
+
+def test_end_grain_darker_than_side_grain(rng):
+    """Pith along Z: top (normal Z) is end grain, front (normal -Y) side grain."""
+    wood = Wood(AXIS_Z, ColorMapAppearance("oak"))
+    p = rng.uniform(0, 50, (20000, 3))
+    top = wood.color(p, np.tile([0.0, 0, 1], (len(p), 1)))
+    side = wood.color(p, np.tile([0.0, -1, 0], (len(p), 1)))
+    assert top.mean() < 0.85 * side.mean()
+    # ... and rougher: more relative variation at the same ring phase.
+    a = arf(AXIS_Z(p))
+    mid = (a > 0.1) & (a < 0.3)
+    rel = lambda c: (c[mid].std(0) / c[mid].mean(0)).mean()
+    assert rel(top) > 1.3 * rel(side)
+
+
+def test_rings_where_the_field_says(rng):
+    """Latewood (ARF near 1) is darker than earlywood (ARF near 0) on every face."""
+    wood = Wood(AXIS_Z, ColorMapAppearance("pine"))
+    p = rng.uniform(0, 50, (40000, 3))
+    a = wood.arf(p)
+    for n in ([0, 0, 1.0], [1.0, 0, 0], [0, 1.0, 0]):
+        c = wood.color(p, np.tile(n, (len(p), 1))).mean(1)
+        assert c[a > 0.85].mean() < c[a < 0.2].mean() - 0.08
+
+
+def test_pores_run_along_the_grain():
+    """Colour varies slowly along the fibres and fast across them on side grain."""
+    wood = Wood(RadialScalingField(LogFrame((0, -500.0, 0), (0, 0, 1)), 1e6), ColorMapAppearance("oak"))
+    t = np.linspace(0, 20, 4001)
+    along = np.stack([np.full_like(t, 7.0), np.zeros_like(t), t], 1)
+    across = np.stack([t, np.zeros_like(t), np.full_like(t, 7.0)], 1)
+    n = np.tile([0, -1.0, 0], (len(t), 1))
+    d_along = np.abs(np.diff(wood.color(along, n).mean(1))).mean()
+    d_across = np.abs(np.diff(wood.color(across, n).mean(1))).mean()
+    assert d_across > 4 * d_along
+
+
+def test_colour_is_continuous_across_a_cut(rng):
+    """Solid texture: two nearby points get nearly the same colour (no per-face randomness)."""
+    wood = Wood(AXIS_Z, ColorMapAppearance("maple"))
+    p = rng.uniform(5, 45, (2000, 3))
+    n = np.tile([0, -1.0, 0], (len(p), 1))
+    d = np.abs(wood.color(p, n) - wood.color(p + 1e-4, n)).max()
+    assert d < 0.01
+
+
+def test_threads_give_identical_colours(rng):
+    p = rng.uniform(0, 50, (200_000, 3))
+    n = rng.normal(size=p.shape)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    a = Wood(AXIS_Z, threads=1).color(p, n)
+    b = Wood(AXIS_Z, threads=2).color(p, n)
+    np.testing.assert_array_equal(a, b)
+
+
+def _render_block(field, luts, size=(60.0, 50.0, 40.0), px_per_mm=2.0):
+    """Faces coloured exactly by a known colour-of-ARF function per block axis."""
+    faces = {}
+    for f in FACES:
+        h, w = face_image_size_mm(f, size)
+        shape = (round(h * px_per_mm), round(w * px_per_mm))
+        a = arf(field(face_pixel_points(f, shape, size).reshape(-1, 3)))
+        k = int(np.flatnonzero(FACE_NORMAL[f])[0])
+        rgb = np.stack([np.interp(a, (np.arange(LUT_BINS) + 0.5) / LUT_BINS, luts[k, :, c]) for c in range(3)], 1)
+        faces[f] = Face(f, shape, photo=np.round(rgb * 255).astype(np.uint8).reshape(shape + (3,)))
+    return Block(size, faces)
+
+
+def test_fit_to_photos_recovers_per_axis_colour_of_arf():
+    centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
+    truth = np.stack([
+        np.stack([0.8 - 0.3 * centres, 0.6 - 0.25 * centres, 0.4 - 0.2 * centres], 1) * s
+        for s in (0.7, 1.0, 0.95)
+    ])
+    block = _render_block(AXIS_Z, truth)
+    fitted = ColorMapAppearance.fit_to_block(block, AXIS_Z).axis_luts
+    # Bin-mean of a linear ramp within a bin of width 1/32: error <= slope/64 + 1/255 rounding.
+    np.testing.assert_allclose(fitted, truth, atol=0.3 / 64 + 1 / 255 + 1e-3)
+
+
+def test_fit_with_only_some_faces_keeps_species_ramp_elsewhere():
+    centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
+    truth = np.tile(np.stack([0.5 + 0 * centres] * 3, 1), (3, 1, 1))
+    block = _render_block(AXIS_Z, truth)
+    block.faces = {f: block.faces[f] for f in ("front", "back")}
+    app = ColorMapAppearance.fit_to_block(block, AXIS_Z)
+    assert np.isfinite(app.axis_luts[1]).all()
+    assert np.isnan(app.axis_luts[0]).all() and np.isnan(app.axis_luts[2]).all()
+    wood = Wood(AXIS_Z, app)
+    c = wood.color(np.array([[10.0, 10, 10]]), np.array([[1.0, 0, 0]]))
+    assert np.isfinite(c).all()
+
+
+def test_fit_without_photos_is_a_clear_error():
+    with pytest.raises(WoodcamError, match="has no face photos"):
+        ColorMapAppearance.fit_to_block(Block((10, 10, 10)), AXIS_Z)
+
+
+def test_bad_species_and_normals():
+    with pytest.raises(WoodcamError, match="species must be one of"):
+        ColorMapAppearance("balsa-wood")
+    with pytest.raises(WoodcamError, match="normals must have the shape"):
+        Wood(AXIS_Z).color(np.zeros((3, 3)), np.zeros((2, 3)))
+
+
+def test_knots_show_darker_and_dead_knots_outlined():
+    """The built-in knotty board: knot wood is darker than the stem wood around it, and the
+    dead knot's outline is darker still."""
+    from woodcam.stock import open_stock
+
+    stock = open_stock("builtin:knotty")
+    shape = (100, 200)
+    p = face_pixel_points("front", shape, stock.size_mm).reshape(-1, 3)
+    rgb = stock.wood.color(p, np.tile([0.0, -1.0, 0.0], (len(p), 1))).mean(1)
+    f = stock.wood.field.knot_features(p)
+    alive = (f["knot"] > 0.9) & (f["dead"] < 0.1)
+    outline = f["outline"] > 0.9
+    clear = f["knot"] < 0.01
+    assert alive.sum() > 100 and outline.sum() > 20
+    assert rgb[alive].mean() < rgb[clear].mean() - 0.1
+    assert rgb[outline].mean() < rgb[alive].mean() - 0.1

@@ -1,0 +1,131 @@
+"""Block folders: write/read round trips, precision, truth saving, and bad inputs."""
+
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from woodcam.block import Block, Face, RingTrace, block_from_images, read_block, write_block
+from woodcam.errors import WoodcamError
+from woodcam.synth import AnalyticLogField, cut_block, synth_block
+from woodcam.tolerances import RING_MAP_QUANT_8BIT, RING_MAP_QUANT_16BIT
+
+SIZE = (42.0, 36.0, 30.0)
+
+
+@pytest.fixture(scope="module")
+def block():
+    field = cut_block(AnalyticLogField(ring_width_mm=2.2, eccentricity=0.1), SIZE, "rift", tilt_deg=2)
+    b = synth_block(field, SIZE, face_px=64, trace_jitter_mm=0.1, unlabelled_fraction=0.3, seed=4,
+                    meta={"note": "test", "numbers": np.arange(3)})
+    b.faces["left"].extras["knot_mask"] = np.arange(np.prod(b.faces["left"].shape)).reshape(b.faces["left"].shape) % 7 == 0
+    b.faces["left"].extras["comment"] = {"who": "test", "n": 2}
+    return b
+
+
+def _assert_same_traces(a, b):
+    assert len(a) == len(b)
+    for s, t in zip(a, b):
+        assert s.year == t.year
+        assert np.array_equal(s.points_px, t.points_px)   # exact: JSON keeps repr precision
+
+
+@pytest.mark.parametrize("bits, tol", [(16, RING_MAP_QUANT_16BIT), (8, RING_MAP_QUANT_8BIT)])
+def test_round_trip(tmp_path, block, bits, tol):
+    write_block(block, tmp_path, ring_map_bits=bits)
+    back = read_block(tmp_path)
+    assert back.size_mm == block.size_mm and back.name == block.name
+    assert back.meta == {**block.meta, "numbers": [0, 1, 2]}
+    assert list(back.faces) == list(block.faces)
+    for name, f in block.faces.items():
+        g = back.faces[name]
+        assert g.shape == f.shape
+        assert g.photo.dtype == np.uint8 and np.array_equal(g.photo, f.photo)
+        err = np.abs(g.ring_map.astype(float) - f.ring_map.astype(float)).max()
+        assert err <= tol + 1e-7            # float32 storage of the map adds ~6e-8
+        _assert_same_traces(f.traces, g.traces)
+    assert any(t.year is None for f in back.faces.values() for t in f.traces)
+    assert np.array_equal(back.faces["left"].extras["knot_mask"], block.faces["left"].extras["knot_mask"])
+    assert back.faces["left"].extras["comment"] == {"who": "test", "n": 2}
+    # the analytic true field was saved and comes back identical
+    p = np.random.default_rng(1).uniform(0, 30, (200, 3))
+    assert np.array_equal(back.true_field(p), block.true_field(p))
+
+
+def test_16bit_is_finer_than_8bit(tmp_path, block):
+    errs = []
+    for bits in (8, 16):
+        write_block(block, tmp_path / str(bits), ring_map_bits=bits)
+        back = read_block(tmp_path / str(bits))
+        errs.append(max(np.abs(back.faces[n].ring_map - block.faces[n].ring_map).max() for n in block.faces))
+    assert errs[1] < errs[0] / 50
+
+
+def test_unserialisable_truth_is_recorded_not_saved(tmp_path):
+    b = synth_block(lambda p: np.hypot(p[:, 0] + 50, p[:, 1]) / 3.0, SIZE, face_px=24)
+    write_block(b, tmp_path)
+    m = json.loads((tmp_path / "block.json").read_text())
+    assert m["true_field"]["saved"] is False and "truth not saved" in m["true_field"]["reason"]
+    assert not (tmp_path / "true_field.json").exists()
+    assert read_block(tmp_path).true_field is None
+
+
+def test_real_block_manifest_written_by_hand(tmp_path):
+    photo = np.random.default_rng(0).integers(0, 256, (20, 30, 3), dtype=np.uint8)
+    Image.fromarray(photo).save(tmp_path / "front.png")
+    (tmp_path / "block.json").write_text(json.dumps({
+        "format": "woodcam-block", "version": 1, "name": "oak offcut", "size_mm": [60, 45, 40],
+        "faces": {"front": {"shape": [20, 30], "photo": "front.png",
+                            "traces": [{"year": None, "points_px": [[1, 2], [3, 4.5]]}]}}}))
+    b = read_block(tmp_path / "block.json")
+    assert b.size_mm == (60.0, 45.0, 40.0) and list(b.faces) == ["front"] and b.true_field is None
+    assert np.array_equal(b.faces["front"].photo, photo)
+    assert b.faces["front"].traces[0].year is None
+
+
+def test_wrong_image_size_on_disk_raises(tmp_path, block):
+    write_block(block, tmp_path)
+    Image.fromarray(np.zeros((10, 11, 3), np.uint8)).save(tmp_path / "top_photo.png")
+    with pytest.raises(WoodcamError, match=r"photo of face 'top' .* must be \d+x64 px like its face; got 10x11"):
+        read_block(tmp_path)
+
+
+def test_bad_inputs_raise(tmp_path, block):
+    with pytest.raises(WoodcamError, match="must hold a block.json"):
+        read_block(tmp_path)
+    with pytest.raises(WoodcamError, match="ring_map_bits must be 8 or 16"):
+        write_block(block, tmp_path, ring_map_bits=12)
+    bad = Block(SIZE, {"front": Face("front", (4, 4), ring_map=np.full((4, 4), 1.5))})
+    with pytest.raises(WoodcamError, match=r"ring_map of face 'front' must hold finite values in \[0, 1\]"):
+        write_block(bad, tmp_path / "x")
+    with pytest.raises(WoodcamError, match="block.meta must be JSON-serialisable"):
+        write_block(Block(SIZE, meta={"f": object()}), tmp_path / "y")
+    with pytest.raises(WoodcamError, match="photo of face 'front' must be uint8"):
+        write_block(Block(SIZE, {"front": Face("front", (2, 2), photo=np.zeros((2, 2, 3)))}), tmp_path / "z")
+    write_block(block, tmp_path / "w")
+    with pytest.raises(WoodcamError, match="already holds a block.json"):
+        write_block(block, tmp_path / "w", overwrite=False)
+    with pytest.raises(WoodcamError, match="points_px of a ring trace must have shape"):
+        RingTrace(np.zeros((1, 2)), 3)
+
+
+def test_block_from_images_of_a_real_block(tmp_path):
+    rng = np.random.default_rng(0)
+    top = rng.integers(0, 256, (30, 40, 3), dtype=np.uint8)
+    Image.fromarray(top).save(tmp_path / "top.jpg.png")
+    grey = rng.integers(0, 256, (20, 40), dtype=np.uint8)
+    ring16 = rng.integers(0, 65536, (20, 40), dtype=np.uint16)
+    b = block_from_images((40, 30, 20), photos={"B": tmp_path / "top.jpg.png", "front": grey},
+                          ring_maps={"A": ring16}, name="walnut", meta={"camera": "phone"})
+    assert list(b.faces) == ["front", "top"] and b.faces["top"].shape == (30, 40)
+    assert np.array_equal(b.faces["top"].photo, top)
+    assert np.array_equal(b.faces["front"].photo[..., 1], grey)
+    np.testing.assert_allclose(b.faces["front"].ring_map, ring16 / 65535, atol=1e-7)
+    write_block(b, tmp_path / "walnut")
+    back = read_block(tmp_path / "walnut")
+    assert np.array_equal(back.faces["top"].photo, top) and back.meta == {"camera": "phone"}
+    with pytest.raises(WoodcamError, match=r"ring_map of face 'front' must be 20x40 px like its face; got 21x40"):
+        block_from_images((40, 30, 20), photos={"front": grey}, ring_maps={"front": np.zeros((21, 40))})
+    with pytest.raises(WoodcamError, match="photo of face 'top' must be an 8-bit RGB image"):
+        block_from_images((40, 30, 20), photos={"top": np.zeros((4, 4, 3))})

@@ -1,0 +1,81 @@
+"""The Mokume sample reader: faces, maps and H11's knot in block coordinates."""
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from woodcam.block import read_block, read_mokume, write_block
+from woodcam.errors import WoodcamError
+from woodcam.frames import FACES, pixel_to_block
+
+
+def _mokume(sample: str) -> Path:
+    root = Path(os.environ.get("WOODCAM_SHARED_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
+    folder = root / "mokume" / sample
+    if not folder.is_dir():
+        pytest.skip(f"Mokume sample {sample} not found under {root} (set WOODCAM_SHARED_DATA)")
+    return folder
+
+
+def test_reads_all_faces_as_stored():
+    folder = _mokume("CN03")
+    b = read_mokume(folder)
+    assert b.size_mm == (50.0, 50.0, 50.0) and b.name == "CN03" and list(b.faces) == list(FACES)
+    front = b.faces["front"]                                    # letter A
+    assert np.array_equal(front.photo, np.asarray(Image.open(folder / "A_col.png").convert("RGB")))
+    arl = np.asarray(Image.open(folder / "A_arl-unet.png"), dtype=float) / 255
+    assert front.ring_map.dtype == np.float32 and np.abs(front.ring_map - arl).max() < 1e-6
+    assert np.array_equal(b.faces["back"].photo, np.asarray(Image.open(folder / "F_col.png").convert("RGB")))
+    assert not any("knot_mask" in f.extras for f in b.faces.values())
+    assert read_mokume(folder, size_mm=(40, 40, 40)).size_mm == (40.0, 40.0, 40.0)
+
+
+def test_h11_knot_on_left_and_back_at_the_back_left_edge():
+    b = read_mokume(_mokume("H11"))
+    W, D, H = b.size_mm
+    with_knot = [n for n, f in b.faces.items() if "knot_mask" in f.extras]
+    assert with_knot == ["left", "back"]                        # Mokume C and F
+    centres = {}
+    for name in with_knot:
+        f = b.faces[name]
+        rows, cols = np.nonzero(f.extras["knot_mask"])
+        assert len(rows) >= 1
+        centres[name] = pixel_to_block(name, rows.mean(), cols.mean(), f.shape, b.size_mm)
+    left, back = centres["left"], centres["back"]
+    assert left[0] == 0.0 and back[1] == D                      # on their faces
+    assert left[1] > D / 2 and back[0] < W / 2                  # both towards the back-left edge
+    assert left[2] < H / 2 and back[2] < H / 2                  # both low
+    for p in (left, back):                                      # within half a side of that edge
+        assert np.hypot(p[0] - 0.0, p[1] - D) < 0.5 * W
+    # the masks mark the dark knot in the photos: darker than the face around it
+    for name in with_knot:
+        f = b.faces[name]
+        lum = f.photo.astype(float).mean(axis=2)
+        r, c = np.argwhere(f.extras["knot_mask"]).mean(axis=0)
+        rr, cc = np.ogrid[:f.shape[0], :f.shape[1]]
+        disc = (rr - r) ** 2 + (cc - c) ** 2 < 15 ** 2
+        assert lum[disc].mean() < np.median(lum) - 15, name
+
+
+def test_mokume_block_survives_the_manifest_round_trip(tmp_path):
+    b = read_mokume(_mokume("H11"))
+    write_block(b, tmp_path, ring_map_bits=8)
+    back = read_block(tmp_path)
+    for name, f in b.faces.items():
+        assert np.array_equal(back.faces[name].photo, f.photo)
+        assert np.array_equal(back.faces[name].ring_map, f.ring_map)   # 8-bit maps come back exactly
+    assert np.array_equal(back.faces["back"].extras["knot_mask"], b.faces["back"].extras["knot_mask"])
+
+
+def test_mismatched_or_missing_images_raise(tmp_path):
+    Image.fromarray(np.zeros((32, 32, 3), np.uint8)).save(tmp_path / "A_col.png")
+    Image.fromarray(np.zeros((16, 32), np.uint8)).save(tmp_path / "A_arl-unet.png")
+    with pytest.raises(WoodcamError, match=r"Mokume image A_\S+\.png must be 32x32 px like its face; got 16x32"):
+        read_mokume(tmp_path)
+    with pytest.raises(WoodcamError, match="must hold Mokume files like A_col.png"):
+        read_mokume(tmp_path / "..")
+    with pytest.raises(WoodcamError, match="is not a directory"):
+        read_mokume(tmp_path / "nope")

@@ -1,0 +1,134 @@
+"""carve: part ∩ block against analytic volumes; warnings for parts sticking out; miss errors.
+
+Known answers: block minus a cylinder (W D H - pi r^2 H), a box fully inside (its own volume,
+exact), a sphere centred on the top face (half inside, half outside), all within
+CARVE_VOLUME_RTOL (set by the tessellation of curved faces).
+"""
+
+from __future__ import annotations
+
+import math
+
+import manifold3d
+import numpy as np
+import pytest
+import trimesh
+
+from woodcam.cad import CarveResult, carve
+from woodcam.errors import WoodcamError, WoodcamWarning
+from woodcam.tolerances import CARVE_VOLUME_RTOL, ON_FACE_TOL_MM
+
+from .conftest import DEMO_BLOCK_MM
+
+W, D, H = DEMO_BLOCK_MM
+
+
+def _check_result(result: CarveResult) -> None:
+    """Invariants of every carve: closed mesh in the block, consistent volumes."""
+    assert isinstance(result, CarveResult)
+    assert result.mesh.is_watertight and result.mesh.is_winding_consistent
+    assert result.mesh.volume == pytest.approx(result.volume_mm3, rel=1e-9)
+    assert result.manifold.volume() == pytest.approx(result.volume_mm3, rel=1e-12)
+    lo, hi = result.mesh.bounds
+    assert np.all(lo >= -ON_FACE_TOL_MM) and np.all(hi <= np.array(result.size_mm) + ON_FACE_TOL_MM)
+    assert result.volume_mm3 + result.outside_volume_mm3 == pytest.approx(
+        result.part_volume_mm3, rel=1e-9)
+
+
+def test_block_minus_cylinder_matches_analytic_volume(bd):
+    r = 20.0
+    part = bd.Box(W, D, H, align=bd.Align.MIN) - bd.Pos(W / 2, D / 2, 0) * bd.Cylinder(
+        radius=r, height=H, align=(bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN))
+    result = carve(part, DEMO_BLOCK_MM)
+    _check_result(result)
+    assert result.volume_mm3 == pytest.approx(W * D * H - math.pi * r**2 * H, rel=CARVE_VOLUME_RTOL)
+    assert result.outside_volume_mm3 == pytest.approx(0, abs=1e-6)
+    assert result.warnings == []
+
+
+def test_box_fully_inside_keeps_its_volume_exactly():
+    part = manifold3d.Manifold.cube((30, 20, 10)).translate((5, 6, 7))
+    result = carve(part, DEMO_BLOCK_MM)
+    _check_result(result)
+    assert result.volume_mm3 == pytest.approx(6000, rel=1e-12)
+    assert result.part_volume_mm3 == pytest.approx(6000, rel=1e-12)
+    assert result.outside_volume_mm3 == 0.0
+    np.testing.assert_allclose(result.mesh.bounds, [[5, 6, 7], [35, 26, 17]], atol=1e-9)
+
+
+def test_part_filling_the_block_exactly_has_no_warning():
+    result = carve(manifold3d.Manifold.cube(DEMO_BLOCK_MM), DEMO_BLOCK_MM)
+    _check_result(result)
+    assert result.volume_mm3 == pytest.approx(W * D * H, rel=1e-12)
+    assert result.warnings == []
+
+
+def test_sphere_half_out_of_the_top_warns_with_outside_volume(bd):
+    r = 15.0
+    part = bd.Pos(W / 2, D / 2, H) * bd.Sphere(radius=r)
+    half = 2 / 3 * math.pi * r**3
+    with pytest.warns(WoodcamWarning, match=r"sticks out of the block: .* mm\^3 \(50(\.\d+)? %"):
+        result = carve(part, DEMO_BLOCK_MM)
+    _check_result(result)
+    assert result.volume_mm3 == pytest.approx(half, rel=CARVE_VOLUME_RTOL)
+    assert result.outside_volume_mm3 == pytest.approx(half, rel=CARVE_VOLUME_RTOL)
+    assert len(result.warnings) == 1
+    assert f"{result.outside_volume_mm3:.4g} mm^3" in result.warnings[0]
+    # the cut face is the block's top face: the highest vertices lie on z = H
+    assert result.mesh.bounds[1, 2] == pytest.approx(H, abs=ON_FACE_TOL_MM)
+
+
+def test_part_bigger_than_block_is_clipped_to_the_block():
+    part = manifold3d.Manifold.cube((W + 20, D + 20, H + 20)).translate((-10, -10, -10))
+    outside = (W + 20) * (D + 20) * (H + 20) - W * D * H
+    with pytest.warns(WoodcamWarning, match="sticks out") as record:
+        result = carve(part, DEMO_BLOCK_MM)
+    assert len(record) == 1
+    _check_result(result)
+    assert result.volume_mm3 == pytest.approx(W * D * H, rel=1e-12)
+    assert result.outside_volume_mm3 == pytest.approx(outside, rel=1e-9)
+    np.testing.assert_allclose(result.mesh.bounds, [[0, 0, 0], [W, D, H]], atol=1e-9)
+
+
+def test_part_missing_the_block_raises_with_both_bounding_boxes():
+    part = manifold3d.Manifold.cube((10, 10, 10)).translate((200, 0, 0))
+    with pytest.raises(WoodcamError, match=(
+            r"does not intersect the block: the part's bounding box is \[200, 210\] x \[0, 10\] "
+            r"x \[0, 10\] mm but the block is \[0, 100\] x \[0, 80\] x \[0, 50\] mm")):
+        carve(part, DEMO_BLOCK_MM)
+
+
+def test_part_only_touching_the_block_raises():
+    part = manifold3d.Manifold.cube((10, 10, 10)).translate((W, 0, 0))  # shares the right face
+    with pytest.raises(WoodcamError, match="does not intersect the block"):
+        carve(part, DEMO_BLOCK_MM)
+
+
+def test_part_modelled_around_the_origin_gets_a_hint(cq):
+    # a common mistake: a part centred on the origin instead of in the block frame
+    part = cq.Workplane("XY").box(20, 20, 20).translate((0, 0, -30))
+    with pytest.raises(WoodcamError, match=r"move it by \(50, 40, 55\) mm to centre it"):
+        carve(part, DEMO_BLOCK_MM)
+
+
+def test_carve_accepts_any_load_part_source(tmp_path):
+    mesh = trimesh.creation.box(extents=(10, 10, 10))
+    mesh.apply_translation((50, 40, 25))
+    path = tmp_path / "cube.stl"
+    mesh.export(path)
+    for source in (mesh, path, str(path)):
+        result = carve(source, DEMO_BLOCK_MM)
+        assert result.volume_mm3 == pytest.approx(1000, rel=1e-6)
+
+
+@pytest.mark.parametrize("size", [(100, 80), (100, 0, 50), (100, -1, 50), (100, float("inf"), 50),
+                                  "100x80x50", None])
+def test_bad_block_size_raises(size):
+    with pytest.raises(WoodcamError, match="size_mm must be three"):
+        carve(manifold3d.Manifold.cube((1, 1, 1)), size)
+
+
+def test_result_is_frozen():
+    result = carve(manifold3d.Manifold.cube((1, 1, 1)), DEMO_BLOCK_MM)
+    with pytest.raises(AttributeError):
+        result.volume_mm3 = 0.0  # type: ignore[misc]

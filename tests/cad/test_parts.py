@@ -1,0 +1,295 @@
+"""load_part: every accepted source type, file round trips, tessellation tolerance, errors.
+
+Known answers: analytic volumes of boxes/cylinders/spheres (within CARVE_VOLUME_RTOL, set by the
+tessellation), exact volumes for polyhedral parts, and lossless round trips of a mesh through
+STL/OBJ/GLB/glTF (float32 files: relative 1e-6).
+"""
+
+from __future__ import annotations
+
+import math
+
+import manifold3d
+import numpy as np
+import pytest
+import trimesh
+
+from woodcam.cad import load_part
+from woodcam.errors import WoodcamError
+from woodcam.tolerances import CARVE_VOLUME_RTOL
+
+#: Relative volume error of a mesh that went through a float32 file format (STL, GLB): vertex
+#: round-off ~6e-8 relative per coordinate, summed over the surface: 1e-6 is ample.
+FILE_ROUND_TRIP_RTOL = 1e-6
+
+
+def _tri_count(solid) -> int:
+    return solid.num_tri()
+
+
+# ----------------------------------------------------------------------------- source types
+
+
+def test_build123d_box_volume_is_exact(bd):
+    part = bd.Pos(10, 20, 30) * bd.Box(40, 30, 20)
+    solid = load_part(part)
+    assert isinstance(solid, manifold3d.Manifold)
+    assert solid.volume() == pytest.approx(40 * 30 * 20, rel=1e-12)
+    np.testing.assert_allclose(solid.bounding_box(), (-10, 5, 20, 30, 35, 40), atol=1e-9)
+
+
+def test_build123d_cylinder_volume_within_tessellation_tolerance(bd):
+    solid = load_part(bd.Cylinder(radius=20, height=30))
+    assert solid.volume() == pytest.approx(math.pi * 20**2 * 30, rel=CARVE_VOLUME_RTOL)
+    # the polygonal cylinder is inscribed: it can only lose volume
+    assert solid.volume() < math.pi * 20**2 * 30
+
+
+def test_build123d_builder_and_compound_of_overlapping_solids(bd):
+    with bd.BuildPart() as builder:
+        bd.Box(10, 10, 10, align=bd.Align.MIN)
+    assert load_part(builder).volume() == pytest.approx(1000, rel=1e-12)
+    # two boxes overlapping in a 5 x 10 x 10 slab, as separate solids of one compound:
+    # each solid is meshed on its own and the pieces are unioned, so the overlap counts once
+    a = bd.Box(10, 10, 10, align=bd.Align.MIN)
+    b = bd.Pos(5, 0, 0) * bd.Box(10, 10, 10, align=bd.Align.MIN)
+    compound = bd.Compound([a, b])
+    assert load_part(compound).volume() == pytest.approx(1500, rel=1e-9)
+
+
+def test_sphere_poles_weld_into_closed_mesh(bd):
+    """Regression: OCC meshes a sphere's degenerate pole edges as fans of coincident nodes;
+    welding turned them into repeated-vertex triangles and left 4 open edges."""
+    solid = load_part(bd.Sphere(radius=8))
+    assert solid.volume() == pytest.approx(4 / 3 * math.pi * 8**3, rel=CARVE_VOLUME_RTOL)
+
+
+def test_cadquery_workplane_and_shape(cq):
+    # 40 x 30 x 20 box centred on the origin with a 10 mm hole through its top face centre
+    wp = cq.Workplane("XY").box(40, 30, 20).faces(">Z").workplane().hole(10)
+    expected = 40 * 30 * 20 - math.pi * 5**2 * 20
+    assert load_part(wp).volume() == pytest.approx(expected, rel=CARVE_VOLUME_RTOL)
+    assert load_part(wp.val()).volume() == pytest.approx(expected, rel=CARVE_VOLUME_RTOL)
+    # the hole is where the model says: a 6 x 6 column on the z axis is empty
+    column = manifold3d.Manifold.cube((6, 6, 30), center=True)
+    assert (load_part(wp) ^ column).volume() == pytest.approx(0, abs=1e-9)
+
+
+def test_cadquery_workplane_with_several_solids_is_unioned(cq):
+    # two solids overlapping by 5 x 10 x 10 left uncombined on the stack
+    wp = cq.Workplane("XY").pushPoints([(0, 0), (5, 0)]).box(10, 10, 10, combine=False)
+    assert len(wp.vals()) == 2
+    assert load_part(wp).volume() == pytest.approx(1500, rel=1e-9)
+
+
+def test_cadquery_empty_workplane_raises(cq):
+    with pytest.raises(WoodcamError, match="holds no shape"):
+        load_part(cq.Workplane("XY"))
+
+
+def test_trimesh_input_and_inside_out_mesh():
+    box = trimesh.creation.box(extents=(10, 20, 30))
+    assert load_part(box).volume() == pytest.approx(6000, rel=1e-12)
+    inverted = box.copy()
+    inverted.invert()
+    assert inverted.volume < 0
+    assert load_part(inverted).volume() == pytest.approx(6000, rel=1e-12)
+
+
+def test_trimesh_scene_meshes_are_unioned():
+    a = trimesh.creation.box(extents=(10, 10, 10))
+    b = trimesh.creation.box(extents=(10, 10, 10))
+    b.apply_translation((5, 0, 0))  # overlaps a by 5 x 10 x 10
+    scene = trimesh.Scene([a, b])
+    assert load_part(scene).volume() == pytest.approx(1500, rel=1e-9)
+
+
+def test_mesh_with_holes_is_repaired():
+    box = trimesh.creation.box(extents=(10, 10, 10))
+    one_missing = trimesh.Trimesh(box.vertices, box.faces[:-1])
+    two_missing = trimesh.Trimesh(box.vertices, box.faces[:-2])  # a whole square face gone
+    assert not one_missing.is_watertight and not two_missing.is_watertight
+    assert load_part(one_missing).volume() == pytest.approx(1000, rel=1e-12)
+    assert load_part(two_missing).volume() == pytest.approx(1000, rel=1e-12)
+
+
+def test_open_surface_raises():
+    square = trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2], [0, 2, 3]])
+    with pytest.raises(WoodcamError, match="not a closed .watertight. mesh.*4 open"):
+        load_part(square)
+    sphere = trimesh.creation.icosphere()
+    cup = trimesh.Trimesh(sphere.vertices, sphere.faces[:160])
+    with pytest.raises(WoodcamError, match="not a closed"):
+        load_part(cup)
+
+
+def test_manifold_input_is_returned_as_is():
+    cube = manifold3d.Manifold.cube((3, 4, 5))
+    assert load_part(cube) is cube
+
+
+def test_empty_and_errored_manifolds_raise():
+    with pytest.raises(WoodcamError, match="empty"):
+        load_part(manifold3d.Manifold())
+    bad = manifold3d.Manifold(manifold3d.Mesh(
+        np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32), np.array([[0, 1, 2]], np.uint32)))
+    with pytest.raises(WoodcamError, match="NotManifold"):
+        load_part(bad)
+
+
+def test_unsupported_object_raises():
+    with pytest.raises(WoodcamError, match="cannot use an object of type builtins.int"):
+        load_part(42)
+
+
+def test_build123d_sketch_without_solid_raises(bd):
+    with pytest.raises(WoodcamError, match="contains no solid .only faces"):
+        load_part(bd.Rectangle(10, 10))
+
+
+def test_non_shape_cad_objects_raise(bd, cq):
+    with pytest.raises(WoodcamError, match="cannot use an object of type build123d.*Vector"):
+        load_part(bd.Vector(1, 2, 3))
+    with pytest.raises(WoodcamError, match="holds no shape"):
+        load_part(cq.Workplane("XY").center(1, 2))
+    with pytest.raises(WoodcamError, match="is None; the script or builder produced no shape"):
+        load_part(None)
+
+
+def test_list_of_sources_is_unioned(bd):
+    a = bd.Box(10, 10, 10, align=bd.Align.MIN)
+    b = trimesh.creation.box(extents=(10, 10, 10))
+    b.apply_translation((10, 5, 5))  # overlaps a by 5 x 10 x 10
+    assert load_part([a, b]).volume() == pytest.approx(1500, rel=1e-9)
+    assert load_part(bd.ShapeList([a])).volume() == pytest.approx(1000, rel=1e-12)
+    with pytest.raises(WoodcamError, match="empty list"):
+        load_part([])
+
+
+@pytest.mark.parametrize(("kwargs", "pattern"), [
+    ({"tolerance_mm": 0.0}, "tolerance_mm must be a finite number > 0"),
+    ({"tolerance_mm": float("nan")}, "tolerance_mm must be a finite number > 0"),
+    ({"angular_tolerance_deg": 120}, r"angular_tolerance_deg must be in \(0, 90\]"),
+])
+def test_bad_tolerances_raise(kwargs, pattern):
+    with pytest.raises(WoodcamError, match=pattern):
+        load_part(manifold3d.Manifold.cube((1, 1, 1)), **kwargs)
+
+
+# ----------------------------------------------------------------------------- tolerance
+
+
+def test_tolerance_changes_triangle_count_and_accuracy(bd):
+    cylinder = bd.Cylinder(radius=20, height=30)
+    exact = math.pi * 20**2 * 30
+    # coarse after fine and fine after coarse on the same shape object: OCC caches a
+    # triangulation on the shape; load_part must mesh a fresh copy each time
+    fine = load_part(cylinder, tolerance_mm=0.01, angular_tolerance_deg=1.0)
+    coarse = load_part(cylinder, tolerance_mm=1.0, angular_tolerance_deg=45.0)
+    fine_again = load_part(cylinder, tolerance_mm=0.01, angular_tolerance_deg=1.0)
+    assert _tri_count(coarse) < _tri_count(fine) / 10
+    assert _tri_count(fine_again) == _tri_count(fine)
+    assert abs(fine.volume() - exact) < abs(coarse.volume() - exact) / 100
+    # chord tolerance alone also matters (angular tolerance loose)
+    chord_fine = load_part(cylinder, tolerance_mm=0.01, angular_tolerance_deg=45.0)
+    chord_coarse = load_part(cylinder, tolerance_mm=1.0, angular_tolerance_deg=45.0)
+    assert _tri_count(chord_fine) > 2 * _tri_count(chord_coarse)
+
+
+# ----------------------------------------------------------------------------- files
+
+
+@pytest.fixture
+def block_minus_cylinder_mesh():
+    """A polyhedral part (64-gon hole) with an exact, tessellation-free volume."""
+    block = manifold3d.Manifold.cube((40, 30, 20))
+    hole = manifold3d.Manifold.cylinder(20, 8, circular_segments=64).translate((20, 15, 0))
+    solid = block - hole
+    mesh = solid.to_mesh()
+    return trimesh.Trimesh(mesh.vert_properties[:, :3], mesh.tri_verts), solid.volume()
+
+
+@pytest.mark.parametrize("suffix", [".stl", ".obj", ".glb", ".gltf"])
+def test_mesh_file_round_trip(tmp_path, block_minus_cylinder_mesh, suffix):
+    mesh, volume = block_minus_cylinder_mesh
+    path = tmp_path / f"part{suffix}"
+    # export to memory and write ourselves: trimesh's own .gltf file export leaves a file
+    # handle open (a ResourceWarning that the strict pytest config turns into an error)
+    data = mesh.export(file_type=suffix.lstrip("."))
+    files = data if isinstance(data, dict) else {path.name: data}  # .gltf: json + .bin buffers
+    for name, blob in files.items():
+        target = tmp_path / (path.name if name == "model.gltf" else name)
+        target.write_bytes(blob if isinstance(blob, bytes) else blob.encode())
+    solid = load_part(path)
+    assert solid.volume() == pytest.approx(volume, rel=FILE_ROUND_TRIP_RTOL)
+    np.testing.assert_allclose(solid.bounding_box(), (0, 0, 0, 40, 30, 20), atol=1e-5)
+    assert load_part(str(path)).volume() == pytest.approx(volume, rel=FILE_ROUND_TRIP_RTOL)
+
+
+def test_step_round_trip(tmp_path, bd):
+    part = bd.Pos(50, 40, 25) * (bd.Box(40, 30, 20) - bd.Cylinder(radius=8, height=20))
+    path = tmp_path / "part.step"
+    bd.export_step(part, str(path))
+    expected = 40 * 30 * 20 - math.pi * 8**2 * 20
+    solid = load_part(path)
+    assert solid.volume() == pytest.approx(expected, rel=CARVE_VOLUME_RTOL)
+    assert solid.volume() == pytest.approx(load_part(part).volume(), rel=1e-9)
+    np.testing.assert_allclose(solid.bounding_box(), (30, 25, 15, 70, 55, 35), atol=1e-6)
+
+
+def test_python_script_defining_part(tmp_path, bd):
+    script = tmp_path / "my_part.py"
+    script.write_text(
+        "from build123d import Box, Align, Pos\n"
+        "part = Pos(1, 2, 3) * Box(10, 20, 30, align=Align.MIN)\n"
+        "if __name__ == '__main__':\n"
+        "    raise SystemExit('the command-line block must not run when woodcam loads a part')\n"
+    )
+    solid = load_part(script)
+    assert solid.volume() == pytest.approx(6000, rel=1e-12)
+    np.testing.assert_allclose(solid.bounding_box(), (1, 2, 3, 11, 22, 33), atol=1e-9)
+
+
+def test_python_script_imports_helpers_next_to_it(tmp_path):
+    (tmp_path / "my_dimensions.py").write_text("SIDE = 7.0\n")
+    script = tmp_path / "uses_helper.py"
+    script.write_text("import manifold3d\nfrom my_dimensions import SIDE\n"
+                      "part = manifold3d.Manifold.cube((SIDE, SIDE, SIDE))\n")
+    assert load_part(script).volume() == pytest.approx(343, rel=1e-12)
+
+
+def test_python_script_with_trimesh_part(tmp_path):
+    script = tmp_path / "mesh_part.py"
+    script.write_text("import trimesh\npart = trimesh.creation.box(extents=(2, 3, 4))\n")
+    assert load_part(script).volume() == pytest.approx(24, rel=1e-12)
+
+
+_UNREADABLE = r"(not a valid mesh|could not be read)"
+
+
+@pytest.mark.parametrize(("name", "content", "pattern"), [
+    ("garbage.stl", "this is not a mesh\n", r"mesh file '.*garbage\.stl'.*" + _UNREADABLE),
+    ("empty.stl", "", r"mesh file '.*empty\.stl'.*" + _UNREADABLE),
+    ("garbage.obj", "hello\nworld\n", r"mesh file '.*garbage\.obj'.*" + _UNREADABLE),
+    ("garbage.glb", "not a glb", r"mesh file '.*garbage\.glb'.*could not be read"),
+    ("garbage.step", "ISO-10303-21; nonsense", r"'.*garbage\.step' is not a readable STEP file"),
+    ("no_part.py", "x = 1\n",
+     r"script '.*no_part\.py' does not define a module-level variable `part`"),
+    ("broken.py", "raise RuntimeError('boom')\n",
+     r"script '.*broken\.py' failed with RuntimeError: boom"),
+    ("exits.py", "import sys\nsys.exit(3)\n", r"script '.*exits\.py' called sys\.exit\(3\)"),
+    ("wrong_type.py", "part = 3.5\n",
+     r"`part` of script '.*wrong_type\.py'.*cannot use an object of type builtins\.float"),
+    ("path_part.py", "part = 'other.stl'\n", r"`part` of script '.*path_part\.py' is a path"),
+    ("part.txt", "10 10 10", r"unsupported suffix '\.txt'; use one of \.step"),
+])
+def test_bad_files_raise_clear_errors(tmp_path, name, content, pattern):
+    path = tmp_path / name
+    path.write_text(content)
+    with pytest.raises(WoodcamError, match=pattern):
+        load_part(path)
+
+
+def test_missing_file_raises(tmp_path):
+    with pytest.raises(WoodcamError, match="does not exist"):
+        load_part(tmp_path / "nowhere.stl")

@@ -1,0 +1,75 @@
+"""Throughput of the knotted-log field (benchmarks: run with ``-m bench -s``).
+
+Reports points/s for the real 108-knot log against the stem field alone (same points, same
+run) and how the cost grows with the number of knots. Ratios, not timed asserts.
+"""
+
+import time
+
+import numpy as np
+import pytest
+
+from woodcam.fields.knots import KnottedLogField, available_backends
+from woodcam.fields.tree_data import Knot, simple_log
+
+pytestmark = pytest.mark.bench
+
+
+def _rate(f, p, repeat=3, cpu=False):
+    """Points/s: best wall-clock of ``repeat`` runs, or with ``cpu=True`` points per CPU-second
+    times 2 (what 2 uncontended cores give: the machine is shared, wall-clock under-reports)."""
+    f(p[:1000])                                   # compile / warm up
+    best = np.inf
+    for _ in range(repeat):
+        t = time.process_time() if cpu else time.perf_counter()
+        f(p)
+        dt = (time.process_time() - t) / 2 if cpu else time.perf_counter() - t
+        best = min(best, dt)
+    return len(p) / best
+
+
+def _points(n, seed=0):
+    rng = np.random.default_rng(seed)
+    # a 100 mm block through the knottiest part of the log and a whole-log scatter
+    block = rng.uniform([-20.0, 20.0, 3550.0], [80.0, 120.0, 3650.0], (n // 2, 3))
+    rr = 135.0 * np.sqrt(rng.uniform(0, 1, n - n // 2))
+    th = rng.uniform(0, 2 * np.pi, n - n // 2)
+    whole = np.stack([rr * np.cos(th), rr * np.sin(th), rng.uniform(0, 3990, n - n // 2)], 1)
+    return np.concatenate([block, whole])
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_throughput_real_log(gran1, backend):
+    n = 1_000_000 if backend == "numba" else 200_000
+    p = _points(n)
+    fs = KnottedLogField(gran1.with_knots([]), backend=backend)
+    ff = KnottedLogField(gran1, backend=backend)
+    stem, full = _rate(fs, p), _rate(ff, p)
+    stem_cpu, full_cpu = _rate(fs, p, cpu=True), _rate(ff, p, cpu=True)
+    print(f"\n[{backend}] real log, 108 knots: {full / 1e6:.2f} M points/s wall-clock "
+          f"({full_cpu / 1e6:.2f} M points/s per 2 CPU-seconds); stem alone {stem / 1e6:.2f} "
+          f"({stem_cpu / 1e6:.2f}); knots cost {stem / full:.1f}x the stem")
+    assert full > 0
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_scaling_with_number_of_knots(gran1, backend):
+    n = 400_000 if backend == "numba" else 100_000
+    p = _points(n, seed=1)
+    base = _rate(KnottedLogField(gran1.with_knots([]), backend=backend), p, cpu=True)
+    rows = []
+    for m in (0, 13, 27, 54, 108):
+        knots = gran1.knots[::max(1, 108 // m)][:m] if m else []
+        rows.append((m, _rate(KnottedLogField(gran1.with_knots(knots), backend=backend), p,
+                              cpu=True)))
+    # a dense synthetic log: 4 x the real knot density (432 knots on 4 m) -> per-point cost
+    # follows the knots near a point, not the total
+    rng = np.random.default_rng(2)
+    dense = [Knot.from_model(0.2, -0.05, z, 0.1, -0.2, w, 0.01, 130.0, 90.0)
+             for z, w in zip(rng.uniform(0, 3990, 432), rng.uniform(0, 2 * np.pi, 432))]
+    rows.append((432, _rate(KnottedLogField(simple_log(3990, 135, dense), backend=backend), p,
+                            cpu=True)))
+    print(f"\n[{backend}] knots -> M points/s per 2 CPU-seconds (stem alone {base / 1e6:.2f}):")
+    for m, r in rows:
+        print(f"  {m:4d} knots: {r / 1e6:6.2f} M points/s  ({base / r:4.1f}x stem cost)")
+    assert all(r > 0 for _, r in rows)

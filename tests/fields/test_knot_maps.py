@@ -1,0 +1,77 @@
+"""Round trip of the seed's image encoding of a log (stem map + three knot maps)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from woodcam.errors import WoodcamError
+from woodcam.fields.knot_maps import decode_maps, encode_maps, read_maps, write_maps
+from woodcam.fields.knots import KnottedLogField
+
+
+def _check_round_trip(log, back, params):
+    h, r_min, r_max = params["height_mm"], params["r_min_mm"], params["r_max_mm"]
+    # stem: pith within half an 8-bit step of r_min, radii within a step of (r_max - r_min)
+    z = np.linspace(log.pith_z_mm[0], log.pith_z_mm[-1], 97)
+    assert np.max(np.abs(back.pith_at(z) - log.pith_at(z))) < r_min / 255 * 0.5 + 0.3
+    az = np.linspace(0, 2 * np.pi, 50, endpoint=False)
+    zz, aa = np.meshgrid(z, az)
+    err = np.abs(back.radius_at(zz.ravel(), aa.ravel()) - log.radius_at(zz.ravel(), aa.ravel()))
+    # one quantisation step plus the resampling of a bumpy measured surface (512 x 128)
+    assert np.median(err) < (r_max - r_min) / 255
+    assert len(back.knots) == len(log.knots)
+    col = r_max / 127
+    dstep = params["diameter_max_mm"] / 255
+    for a, b in zip(log.knots, back.knots):
+        assert abs(a.z0_mm - b.z0_mm) <= h / 255 * 0.5 + 1e-6
+        assert abs(np.angle(np.exp(1j * (a.azimuth0_rad - b.azimuth0_rad)))) <= np.pi / 255 + 1e-6
+        assert abs(a.r_death_mm - b.r_death_mm) <= r_max / 255 * 0.5 + 1e-6
+        assert abs(min(a.r_end_mm, r_max) - b.r_end_mm) <= col + 1e-6
+        r = np.linspace(5, min(a.r_end_mm, b.r_end_mm) - 1, 20)
+        za, wa = a.axis_at(r)
+        zb, wb = b.axis_at(r)
+        assert np.max(np.abs((za - a.z0_mm) - (zb - b.z0_mm))) <= r_min / 255 + 0.5
+        assert np.max(np.abs((wa - a.azimuth0_rad) - (wb - b.azimuth0_rad))) <= np.pi / 255 + 0.01
+        assert np.max(np.abs(a.diameter_at(r) - b.diameter_at(r))) <= dstep + 0.3
+
+
+def test_round_trip_of_the_real_log(gran1, tmp_path):
+    paths = write_maps(gran1, tmp_path)
+    assert {p.name for p in paths.values()} == {"stem_map.png", "knot_height_map.png",
+                                                 "knot_orientation_map.png", "knot_state_map.png",
+                                                 "map_params.json"}
+    back = read_maps(tmp_path)
+    params = json.loads(paths["params"].read_text())
+    assert params["n_knots"] == 108
+    _check_round_trip(gran1, back, params)
+    # the field of the decoded log: same rings away from the knots up to quantisation
+    f, g = KnottedLogField(gran1), KnottedLogField(back)
+    rng = np.random.default_rng(0)
+    p = rng.uniform([-100, -100, 100], [100, 100, 3800], (5000, 3))
+    d = np.abs(f(p) - g(p))
+    assert np.median(d) < 0.5                       # years, ring width 2 mm
+
+
+def test_round_trip_in_memory_and_clockwise_columns(gran1):
+    log = gran1.with_knots(gran1.knots[:10])
+    maps, params = encode_maps(log, clockwise=True, row_height=3)
+    assert maps["stem"].shape == (512, 128, 3) and maps["height"].shape == (30, 128, 3)
+    _check_round_trip(log, decode_maps(maps, params), params)
+
+
+def test_maps_without_diameter_channel_and_list_params(gran1):
+    # the seed tool's own maps: no B channel in the state map, params as a 4-list
+    log = gran1.with_knots(gran1.knots[:3])
+    maps, params = encode_maps(log)
+    maps["state"][:, :, 2] = 0
+    back = decode_maps(maps, [params["r_min_mm"], params["r_max_mm"], params["height_mm"], 3])
+    assert all(k.r_end_mm == pytest.approx(params["r_max_mm"]) for k in back.knots)
+    assert all(k.diameter_at([100.0])[0] > 5 for k in back.knots)
+
+
+def test_missing_maps_are_named(tmp_path):
+    with pytest.raises(WoodcamError, match="knot_state_map.png"):
+        read_maps(tmp_path)
+    with pytest.raises(WoodcamError, match="height_mm"):
+        decode_maps({}, {"r_min_mm": 1, "r_max_mm": 2})

@@ -1,0 +1,106 @@
+"""Planar sections through a log and the `woodcam log` command."""
+
+import argparse
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from woodcam import _cli_log
+from woodcam.errors import WoodcamError
+from woodcam.fields import log_render as lr
+from woodcam.fields.knots import KnottedLogField
+from woodcam.fields.tree_data import Knot, simple_log, write_log
+
+
+def _log():
+    k = Knot.from_model(0.25, 0.0, 300.0, 0.0, 0.0, 0.0, 0.0, 100.0, 45.0)   # dies at 45 mm
+    return simple_log(knots=[k])
+
+
+def test_section_pixel_centres():
+    s = lr.Section((0, 0, 0), (1, 0, 0), (0, -1, 0), (10, 5), 2.0)
+    p = s.points()
+    assert p.shape == (10, 20, 3)
+    assert np.allclose(p[0, 0], [0.25, -0.25, 0]) and np.allclose(p[-1, -1], [9.75, -4.75, 0])
+
+
+def test_board_shows_the_knot_where_it_crosses():
+    log = _log()
+    f = KnottedLogField(log)
+    s = lr.tangential_board(log, 300.0, 0.0, 70.0, length_mm=100, width_mm=60, px_per_mm=2)
+    img = lr.render_section(f, s).astype(float)
+    assert img.shape == (120, 200, 3)
+    # the knot crosses the board (plane x = 70) at z = 300, y = 0: the image centre
+    centre = img[55:65, 95:105].mean()
+    clear = img[55:65, 10:20].mean()
+    assert centre < 0.8 * clear                     # knot wood is darker
+    # dead at 70 mm: a dark outline ring ~5.6 mm (0.125 * 45) from the centre
+    ring = img[60, 100 + 9:100 + 14].min()
+    assert ring < 0.45 * clear
+
+
+def test_radial_section_shows_the_knot_as_a_spike_from_the_pith():
+    log = _log()
+    s = lr.radial_section(log, 300.0, 0.0, length_mm=100, px_per_mm=1.0, margin_mm=0.0)
+    f = KnottedLogField(log)
+    P = s.points()
+    kn = f.knot_features(P.reshape(-1, 3))["knot"].reshape(P.shape[:2])
+    # rows: from x = +100 (row 0) through the pith (row 100) to x = -100; column 50: z = 300
+    assert kn[100 - 60, 50] > 0.9 and kn[100 - 90, 50] > 0.9      # along the knot axis
+    assert kn[100 + 60, 50] < 0.01 and kn[100 - 60, 20] < 0.01     # opposite side, beside it
+
+
+def test_disc_background_outside_the_log():
+    log = _log()
+    s = lr.end_grain_disc(log, 100.0, px_per_mm=1.0)
+    img = lr.render_section(KnottedLogField(log), s)
+    bg = (np.array(lr.BACKGROUND_RGB) * 255 + 0.5).astype(np.uint8)
+    assert np.array_equal(img[0, 0], bg) and not np.array_equal(img[105, 105], bg)
+    with pytest.raises(WoodcamError, match="z_mm"):
+        lr.end_grain_disc(log, 5000.0)
+
+
+def _parse(argv):
+    ap = argparse.ArgumentParser(prog="woodcam")
+    _cli_log.add_parser(ap.add_subparsers(dest="command"))
+    return ap.parse_args(argv)
+
+
+def test_cli_renders_a_log_file(tmp_path):
+    path = write_log(_log(), tmp_path / "log.json")
+    args = _parse(["log", "render", str(path), "--out", str(tmp_path / "out"),
+                   "--px-per-mm", "1", "--disc", "300", "--radial", "300", "0"])
+    assert args.func(args) == 0
+    pngs = sorted((tmp_path / "out").glob("*.png"))
+    assert len(pngs) == 3
+    for p in pngs:
+        with Image.open(p) as im:
+            assert im.mode == "RGB"
+
+
+def test_cli_maps_and_export_round_trip(tmp_path):
+    src = write_log(_log(), tmp_path / "log.json")
+    a = _parse(["log", "maps", str(src), "--out", str(tmp_path / "maps")])
+    assert a.func(a) == 0
+    b = _parse(["log", "export", "--maps", str(tmp_path / "maps"), "--out",
+                str(tmp_path / "back.json")])
+    assert b.func(b) == 0
+    assert (tmp_path / "back.json").is_file()
+
+
+def test_cli_needs_exactly_one_log(tmp_path):
+    args = _parse(["log", "render", "--out", str(tmp_path)])
+    with pytest.raises(WoodcamError, match="exactly one log"):
+        args.func(args)
+
+
+def test_supersampling_keeps_the_shape_for_odd_sizes():
+    log = _log()
+    s = lr.end_grain_disc(log, 100.0, px_per_mm=2.0, margin_mm=3.375)   # 593.5 mm -> rounding
+    f = KnottedLogField(log)
+    a = lr.render_section(f, s)
+    b = lr.render_section(f, s, supersample=2)
+    assert a.shape == b.shape
+    # away from rings' sharp steps the average matches the single sample closely
+    assert np.median(np.abs(a.astype(int) - b.astype(int))) <= 12

@@ -1,0 +1,59 @@
+"""GLB and heightmap PNG of a generated log."""
+
+import numpy as np
+import pytest
+import trimesh
+
+from woodcam.errors import WoodcamError
+from woodcam.logs.export import (DEAD_KNOT_RGBA, LIVE_KNOT_RGBA, export_log_glb, heightmap_image, heightmap_png,
+                                 knots_mesh, read_heightmap_png, surface_mesh)
+from woodcam.logs.generate import generate_log
+
+
+@pytest.fixture(scope="module")
+def log():
+    return generate_log(4, length_mm=1200.0)
+
+
+def test_surface_mesh_is_closed_and_has_the_log_volume(log):
+    m = surface_mesh(log, max_rows=241, max_cols=360)
+    assert m.is_watertight and m.is_winding_consistent
+    # volume = integral of R^2/2 dtheta dl on the heightmap (trapezoid along l, polygon area)
+    l, t = log.axes
+    R = log.heightmap_mm
+    poly_area = 0.5 * np.sum(R * np.roll(R, -1, axis=1), axis=1) * np.sin(2 * np.pi / R.shape[1])
+    vol = np.trapezoid(poly_area, l)
+    assert m.volume == pytest.approx(vol, rel=2e-3)
+    assert m.bounds[0, 2] == 0.0 and m.bounds[1, 2] == pytest.approx(1200.0)
+
+
+def test_glb_round_trip_holds_surface_and_coloured_knots(log, tmp_path):
+    p = export_log_glb(log, tmp_path / "log.glb", surface_alpha=0.4)
+    scene = trimesh.load(p)
+    assert set(scene.geometry) == {"surface", "knots"}
+    knots = scene.geometry["knots"]
+    assert len(knots.faces) == len(knots_mesh(log).faces)
+    colours = {tuple(c) for c in np.unique(knots.visual.face_colors, axis=0)}
+    assert tuple(LIVE_KNOT_RGBA) in colours and tuple(DEAD_KNOT_RGBA) in colours
+    # knots stay inside the log's length (with the knots' own radius as slack)
+    assert knots.bounds[0, 2] > -40 and knots.bounds[1, 2] < 1240
+
+
+def test_heightmap_png_decodes_back_to_mm(log, tmp_path):
+    p = heightmap_png(log, tmp_path / "hm.png")
+    back = read_heightmap_png(p)
+    span = log.heightmap_mm.max() - log.heightmap_mm.min()
+    np.testing.assert_allclose(back, log.heightmap_mm, atol=span / 65535)
+    img, (lo, hi) = heightmap_image(log, "detail")
+    assert lo == -hi and img.min() >= 0 and img.max() <= 1
+
+
+def test_exports_refuse_wrong_suffixes_and_modes(log, tmp_path):
+    with pytest.raises(WoodcamError, match="must end in .glb"):
+        export_log_glb(log, tmp_path / "log.gltf")
+    with pytest.raises(WoodcamError, match="must end in .png"):
+        heightmap_png(log, tmp_path / "hm.jpg")
+    with pytest.raises(WoodcamError, match="mode must be 'height' or 'detail'"):
+        heightmap_image(log, "relief")
+    with pytest.raises(WoodcamError, match="surface_alpha must lie in"):
+        export_log_glb(log, tmp_path / "log.glb", surface_alpha=0.0)

@@ -1,0 +1,43 @@
+"""``woodcam block synth`` and ``woodcam block show`` through the parser the CLI uses."""
+
+import json
+
+import numpy as np
+from PIL import Image
+
+from woodcam._cli_block import main
+from woodcam.block import read_block
+from woodcam.frames import CrossLayout
+
+
+def test_block_synth_then_show(tmp_path, capsys):
+    out = tmp_path / "set"
+    assert main(["block", "synth", "--count", "2", "--seed", "5", "--out", str(out),
+                 "--face-px", "40", "--quiet"]) == 0
+    index = json.loads((out / "index.json").read_text())
+    assert [b["name"] for b in index["blocks"]] == ["block_0000", "block_0001"]
+    block = read_block(out / "block_0001")
+    png = tmp_path / "cross.png"
+    assert main(["block", "show", str(out / "block_0001"), "--out", str(png), "--no-traces"]) == 0
+    im = np.asarray(Image.open(png))
+    layout = CrossLayout(block.size_mm, block.faces["front"].shape[1] / block.size_mm[0])
+    assert im.shape == layout.shape + (3,)
+    for name, face in block.faces.items():          # every face photo sits where the cross says
+        r0, c0 = layout.origin[name]
+        assert np.array_equal(im[r0:r0 + face.shape[0], c0:c0 + face.shape[1]], face.photo), name
+    # with traces drawn, pixels change only on the faces, and some do
+    assert main(["block", "show", str(out / "block_0001"), "--out", str(png)]) == 0
+    assert (np.asarray(Image.open(png)) != im).any()
+    assert main(["block", "show", str(out / "block_0001"), "--out", str(png), "--layer", "both"]) == 0
+    assert np.asarray(Image.open(png)).shape == (2 * layout.shape[0] + 8, layout.shape[1], 3)
+
+
+def test_block_errors_are_one_line(tmp_path, capsys):
+    assert main(["block", "show", str(tmp_path), "--out", str(tmp_path / "x.png")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("woodcam: error: folder") and "Mokume files" in err and err.count("\n") == 1
+
+
+def test_show_of_a_missing_folder_says_what_it_wants(tmp_path, capsys):
+    assert main(["block", "show", str(tmp_path / "nope"), "--out", str(tmp_path / "x.png")]) == 2
+    assert "block folder (with block.json) or a Mokume sample folder" in capsys.readouterr().err

@@ -1,0 +1,255 @@
+"""Synthetic blocks: traces on the true iso-lines, placement by sawing pattern, knobs, seeds."""
+
+import json
+
+import numpy as np
+import pytest
+
+from woodcam.block import Face
+from woodcam.errors import WoodcamError
+from woodcam.fields import evaluate
+from woodcam.frames import FACES, CrossLayout, face_pixel_points, pixel_to_block
+from woodcam.synth import (
+    PATTERNS, AnalyticLogField, PlacedField, cut_block, synth_benchmark_set, synth_block,
+)
+
+RING_MM = 2.5
+
+
+def radial_log(points_log_mm):
+    """Knot-free log, pith on z, circular rings RING_MM wide: years = r / w."""
+    p = np.asarray(points_log_mm, float)
+    return np.hypot(p[:, 0], p[:, 1]) / RING_MM
+
+
+SIZE = (40.0, 30.0, 35.0)
+
+
+def _grad(field, p, h=1e-4):
+    e = np.eye(3) * h
+    return np.array([(field(p + e[i]) - field(p - e[i]))[0] / (2 * h) for i in range(3)])
+
+
+@pytest.mark.parametrize("pattern", PATTERNS)
+def test_clean_traces_lie_on_integer_isolines(pattern):
+    field = cut_block(radial_log, SIZE, pattern, tilt_deg=4.0, azimuth_deg=30.0)
+    block = synth_block(field, SIZE, face_px=96, seed=1)
+    n_checked = 0
+    for name, face in block.faces.items():
+        g = evaluate(field, face_pixel_points(name, face.shape, SIZE).reshape(-1, 3))
+        expected_years = set(range(max(1, int(np.ceil(g.min()))), int(np.floor(g.max())) + 1))
+        assert {t.year for t in face.traces} == expected_years, name
+        for t in face.traces:
+            pts = pixel_to_block(name, t.points_px[:, 0], t.points_px[:, 1], face.shape, SIZE)
+            assert np.abs(field(pts) - t.year).max() < 1e-3
+            assert t.points_px.min() >= -0.5 and (t.points_px <= np.array(face.shape) - 0.5).all()
+            n_checked += len(pts)
+    assert n_checked > 500
+
+
+def test_traces_stay_on_isolines_of_a_field_with_a_kink():
+    """A knot-like field: the minimum of two ring systems has a crease where they meet."""
+    def two_piths(p):
+        a = np.hypot(p[:, 0] - 10, p[:, 1] - 12) / 2.0
+        b = np.hypot(p[:, 0] - 32, p[:, 2] - 20) / 1.5 + 2.0
+        return np.minimum(a, b)
+
+    block = synth_block(two_piths, SIZE, face_px=96)
+    pts, years = block.trace_points_mm()
+    assert len(pts) > 300
+    assert np.abs(two_piths(pts) - years).max() < 1e-3
+    assert 0 not in years
+
+
+def test_block_trace_points_match_true_field():
+    field = cut_block(radial_log, SIZE, "rift")
+    block = synth_block(field, SIZE, face_px=64)
+    pts, years = block.trace_points_mm()
+    assert len(pts) > 100
+    np.testing.assert_allclose(field(pts), years, atol=1e-3)
+
+
+def test_cut_block_places_pith_by_pattern():
+    d = 70.0
+    centre = np.array(SIZE)[None] / 2
+    for pattern, radial in [("flat-sawn", (0, 1, 0)), ("quarter-sawn", (1, 0, 0)),
+                            ("rift", (np.sqrt(0.5), np.sqrt(0.5), 0))]:
+        f = cut_block(radial_log, SIZE, pattern, distance_mm=d)
+        # the block centre is d from the pith; the ring gradient there is the outward radial
+        assert f(centre)[0] == pytest.approx(d / RING_MM, abs=1e-9)
+        np.testing.assert_allclose(_grad(f, centre) * RING_MM, radial, atol=1e-6)
+        # the pith runs along +Z: no change of growth time going up
+        assert f(centre + [0, 0, 10])[0] == pytest.approx(d / RING_MM, abs=1e-9)
+    f = cut_block(radial_log, SIZE, "pith-inside", distance_mm=5.0, angle_deg=90.0)
+    assert f(centre - [5.0, 0, 0])[0] == pytest.approx(0.0, abs=1e-9)   # pith 5 mm to the left
+    tilted = cut_block(radial_log, SIZE, "flat-sawn", distance_mm=d, tilt_deg=10.0)
+    np.testing.assert_allclose(tilted.axis, [0, np.sin(np.radians(10)), np.cos(np.radians(10))], atol=1e-12)
+
+
+def test_cut_block_rejects_contradicting_placements():
+    with pytest.raises(WoodcamError, match="pith-inside.*needs the pith to cross"):
+        cut_block(radial_log, SIZE, "pith-inside", distance_mm=100.0)
+    with pytest.raises(WoodcamError, match="needs the pith outside"):
+        cut_block(radial_log, SIZE, "quarter-sawn", distance_mm=5.0)
+    with pytest.raises(WoodcamError, match="pattern must be one of"):
+        cut_block(radial_log, SIZE, "plain")
+
+
+def test_analytic_log_ring_width_varies_as_stated():
+    log = AnalyticLogField(ring_width_mm=2.0, width_slope_per_mm=0.004)
+    r = np.array([[50.0, 0, 0], [50.001, 0, 0]])
+    width = 0.001 / np.diff(log(r))[0]                # mm per year = ring width
+    assert width == pytest.approx(2.0 * (1 + 0.004 * 50), rel=1e-4)
+    assert log.ring_width_at(50.0) == pytest.approx(2.4)
+    assert log(np.zeros((1, 3)))[0] == 0.0
+
+
+def test_dropout_removes_about_the_fraction_asked():
+    field = cut_block(radial_log, (60, 60, 60), "rift", distance_mm=70)
+    kw = dict(face_px=128, photo_noise=0, photo_variation=0, seed=3)
+    clean = synth_block(field, (60, 60, 60), **kw)
+    dropped = synth_block(field, (60, 60, 60), trace_dropout=0.3, trace_dropout_chunk_mm=2.0, **kw)
+    n0 = sum(len(t.points_px) for f in clean.faces.values() for t in f.traces)
+    n1 = sum(len(t.points_px) for f in dropped.faces.values() for t in f.traces)
+    assert 1 - n1 / n0 == pytest.approx(0.3, abs=0.05)
+    # what is left still lies on the iso-lines
+    pts, years = dropped.trace_points_mm()
+    assert np.abs(field(pts) - years).max() < 1e-3
+
+
+@pytest.mark.parametrize("corr_mm", [0.0, 1.0])
+def test_jitter_moves_points_by_about_sigma(corr_mm):
+    size = (60, 60, 60)
+    field = cut_block(radial_log, size, "flat-sawn", distance_mm=80)   # pith along Z: top face sees true radii
+    block = synth_block(field, size, face_px=160, faces=["top"], trace_jitter_mm=0.2,
+                        trace_jitter_corr_mm=corr_mm, seed=5)
+    pts, years = block.trace_points_mm()
+    offset_mm = (field(pts) - years) * RING_MM      # radial distance off the ring
+    assert np.std(offset_mm) == pytest.approx(0.2, rel=0.15)
+    assert abs(np.mean(offset_mm)) < 0.05
+
+
+def test_labels_mislabelled_unlabelled_and_partial_faces():
+    size = (50, 50, 50)
+    field = cut_block(radial_log, size, "rift")
+    block = synth_block(field, size, face_px=64, trace_faces=["front", "top", "left"],
+                        ring_map_faces=["right"], mislabel_fraction=0.3, unlabelled_fraction=0.2, seed=2)
+    assert {n for n, f in block.faces.items() if f.traces} == {"front", "top", "left"}
+    assert {n for n, f in block.faces.items() if f.ring_map is not None} == {"right"}
+    assert all(f.photo is not None for f in block.faces.values()) and len(block.faces) == 6
+    traces = [(n, t) for n, f in block.faces.items() for t in f.traces]
+    unl = sum(t.year is None for _, t in traces)
+    wrong = []
+    for n, t in traces:
+        if t.year is None:
+            continue
+        f = block.faces[n]
+        true_year = np.round(field(pixel_to_block(n, *t.points_px[:1].T, f.shape, size)))[0]
+        wrong.append(abs(t.year - true_year))
+    assert set(wrong) <= {0, 1}
+    assert unl / len(traces) == pytest.approx(0.2, abs=0.12)
+    assert np.mean(wrong) == pytest.approx(0.3, abs=0.15)
+
+
+def test_ring_map_bright_on_rings_dark_between():
+    size = (40, 40, 40)
+    field = cut_block(radial_log, size, "quarter-sawn")
+    block = synth_block(field, size, face_px=128, ring_map_noise=0.0, ring_map_sigma_px=1.0)
+    face = block.faces["top"]
+    g = evaluate(field, face_pixel_points("top", face.shape, size).reshape(-1, 3)).reshape(face.shape)
+    frac = np.abs(g - np.round(g))
+    px_mm = 40 / 128
+    assert face.ring_map[frac * RING_MM / px_mm < 0.2].min() > 0.9      # within 0.2 px of a ring
+    assert face.ring_map[frac * RING_MM / px_mm > 3.0].max() < 1e-3     # 3 px away
+
+
+def test_builtin_photo_is_dark_on_latewood_and_end_grain():
+    """The photo follows the field at each face's own pixel points (catches a wrong mapping)."""
+    size = (40, 40, 40)
+    field = cut_block(radial_log, size, "rift", distance_mm=50)
+    block = synth_block(field, size, face_px=96, photo_noise=0, photo_variation=0, seed=0)
+    lum = {}
+    for name, face in block.faces.items():
+        g = evaluate(field, face_pixel_points(name, face.shape, size).reshape(-1, 3))
+        frac = g - np.floor(g)
+        y = face.photo.reshape(-1, 3).astype(float).mean(1)
+        late, early = y[(frac > 0.85) & (frac < 0.97)].mean(), y[(frac > 0.05) & (frac < 0.4)].mean()
+        assert late < early - 20, name
+        lum[name] = y.mean()
+    assert max(lum["top"], lum["bottom"]) < min(lum[n] for n in ("front", "back", "left", "right"))
+
+
+def test_same_seed_same_block_other_seed_other_photos():
+    field = cut_block(radial_log, SIZE, "rift")
+    kw = dict(face_px=48, trace_dropout=0.2, trace_jitter_mm=0.1, mislabel_fraction=0.2)
+    a, b = synth_block(field, SIZE, seed=7, **kw), synth_block(field, SIZE, seed=7, **kw)
+    c = synth_block(field, SIZE, seed=8, **kw)
+    for n in FACES:
+        fa, fb = a.faces[n], b.faces[n]
+        assert np.array_equal(fa.photo, fb.photo) and np.array_equal(fa.ring_map, fb.ring_map)
+        assert [(t.year, t.points_px.tolist()) for t in fa.traces] == [(t.year, t.points_px.tolist()) for t in fb.traces]
+    assert not np.array_equal(a.faces["front"].photo, c.faces["front"].photo)
+
+
+def test_wood_appearance_is_used_on_face_points():
+    class Grey:
+        def color(self, points_mm, normals):
+            # colour encodes the outward normal's axis: proves normals are FACE_NORMAL
+            return np.broadcast_to(0.5 + 0.25 * np.asarray(normals), points_mm.shape)
+
+    block = synth_block(cut_block(radial_log, SIZE, "rift"), SIZE, wood=Grey(), face_px=32,
+                        photo_noise=0, photo_variation=0, photo_blur_px=0)
+    assert (block.faces["top"].photo == np.round(np.array([0.5, 0.5, 0.75]) * 255)).all()
+    assert (block.faces["left"].photo == np.round(np.array([0.25, 0.5, 0.5]) * 255)).all()
+    with pytest.raises(WoodcamError, match="wood must have a color"):
+        synth_block(radial_log, SIZE, wood=object())
+
+
+def test_face_shapes_follow_cross_layout_and_bad_knobs_raise():
+    block = synth_block(cut_block(radial_log, SIZE, "rift"), SIZE, px_per_mm=2.0)
+    layout = CrossLayout(SIZE, 2.0)
+    assert {n: f.shape for n, f in block.faces.items()} == {n: layout.face_shape(n) for n in FACES}
+    with pytest.raises(WoodcamError, match="trace_dropout must be a fraction"):
+        synth_block(radial_log, SIZE, trace_dropout=1.5)
+    with pytest.raises(WoodcamError, match="face must be one of"):
+        synth_block(radial_log, SIZE, faces=["side"])
+    with pytest.raises(WoodcamError, match="photo of face 'front' must have shape"):
+        Face("front", (10, 12), photo=np.zeros((12, 10, 3), np.uint8))
+
+
+def test_benchmark_set_spans_and_reproduces(tmp_path):
+    folders = synth_benchmark_set(tmp_path / "a", 4, seed=11, face_px=40, progress=False)
+    index = json.loads((tmp_path / "a" / "index.json").read_text())
+    assert [b["pattern"] for b in index["blocks"]] == list(PATTERNS)
+    for b in index["blocks"]:
+        assert all(30 <= s <= 80 for s in b["size_mm"])
+        assert 1.5 * 0.95 <= b["ring_width_mm"] <= 6.0 * 1.05
+        assert not b["knotted"]
+    again = synth_benchmark_set(tmp_path / "b", 4, seed=11, face_px=40, progress=False)
+    for fa, fb in zip(folders, again):
+        for p in sorted(fa.iterdir()):
+            assert p.read_bytes() == (fb / p.name).read_bytes(), p.name
+    other = synth_benchmark_set(tmp_path / "c", 1, seed=12, face_px=40, progress=False)
+    assert (other[0] / "front_photo.png").read_bytes() != (folders[0] / "front_photo.png").read_bytes()
+
+
+def test_benchmark_set_uses_knotted_log_factory(tmp_path):
+    calls = []
+
+    def knotted(rng):
+        calls.append(1)
+        return AnalyticLogField(ring_width_mm=3.0)
+
+    synth_benchmark_set(tmp_path, 4, seed=0, face_px=24, progress=False, log_fields=knotted,
+                        knotted_fraction=1.0)
+    index = json.loads((tmp_path / "index.json").read_text())
+    assert len(calls) == 4 and all(b["knotted"] for b in index["blocks"])
+
+
+def test_placed_field_serialises_only_when_the_log_field_does():
+    f = cut_block(AnalyticLogField(ring_width_mm=2.0, eccentricity=0.1), SIZE, "rift", tilt_deg=3)
+    g = PlacedField.from_dict(json.loads(json.dumps(f.to_dict())))
+    p = np.random.default_rng(0).uniform(0, 40, (100, 3))
+    assert np.array_equal(f(p), g(p))
+    with pytest.raises(WoodcamError, match="must be a woodcam class"):
+        cut_block(radial_log, SIZE, "rift").to_dict()

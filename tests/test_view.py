@@ -1,0 +1,517 @@
+"""Tests of woodcam.view: off-screen screenshots, texture orientation, the wood cut plane.
+
+Pictures are rendered off-screen at small sizes (no display needed) and judged by counting
+pixels of known colours; the cut plane is checked against an analytic wood whose colour is its
+position divided by the block size, and against closed-form section areas.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pv = pytest.importorskip("pyvista")
+trimesh = pytest.importorskip("trimesh")
+from PIL import Image  # noqa: E402
+
+from woodcam.errors import WoodcamError  # noqa: E402
+from woodcam.tolerances import ON_FACE_TOL_MM  # noqa: E402
+from woodcam import view  # noqa: E402
+from woodcam.view import (  # noqa: E402
+    OUTLINE_ACTOR, PART_ACTOR, SECTION_ACTOR, WASTE_ACTOR, CutPlaneCallback, block_outline,
+    build_scene, cut_plane_image, mesh_to_pyvista, preview,
+)
+
+SIZE = (100.0, 80.0, 40.0)
+SMALL = (320, 240)
+RED = (220, 30, 30)
+BLUE = (30, 60, 220)
+
+#: One 8-bit step of colour quantisation (the section stores round(255 * rgb) as uint8).
+RGB_ATOL = 0.5 / 255 + 1e-9
+
+
+class PositionWood:
+    """Colour = position / block size, so every point's colour is known in closed form."""
+
+    def __init__(self, size=SIZE):
+        self.size = np.asarray(size, dtype=float)
+        self.normals = []
+
+    def color(self, points_mm, normals):
+        self.normals.append(np.array(normals))
+        return np.clip(np.asarray(points_mm) / self.size, 0.0, 1.0)
+
+
+class GreenWood:
+    def color(self, points_mm, normals):
+        return np.tile([0.0, 1.0, 0.0], (len(points_mm), 1))
+
+
+def _checker(n_cells=8, px=64, colours=(RED, BLUE)):
+    cell = px // n_cells
+    odd = ((np.arange(px)[:, None] // cell + np.arange(px)[None, :] // cell) % 2).astype(bool)
+    img = np.empty((px, px, 3), np.uint8)
+    img[odd], img[~odd] = colours
+    return Image.fromarray(img)
+
+
+def _textured_box(extents=(60.0, 40.0, 20.0), center=(50.0, 40.0, 20.0), image=None):
+    """A box with one uv chart per face (planar uv over the face) and a texture image."""
+    box = trimesh.creation.box(extents=extents)
+    box.apply_translation(center)
+    box.unmerge_vertices()
+    v, fn = box.vertices, box.face_normals
+    uv = np.zeros((len(v), 2))
+    lo, hi = box.bounds
+    for k in range(3):
+        on = np.abs(fn[:, k]) > 0.5
+        ax = [i for i in range(3) if i != k]
+        ids = box.faces[on].ravel()
+        uv[ids] = (v[ids][:, ax] - lo[ax]) / (hi[ax] - lo[ax])
+    visual = trimesh.visual.TextureVisuals(uv=uv, image=image or _checker())
+    return trimesh.Trimesh(box.vertices, box.faces, visual=visual, process=False)
+
+
+def _read(path) -> np.ndarray:
+    return np.asarray(Image.open(path).convert("RGB")).astype(int)
+
+
+def _red(img):
+    return (img[..., 0] > img[..., 1] + 60) & (img[..., 0] > img[..., 2] + 60)
+
+
+def _blue(img):
+    return (img[..., 2] > img[..., 0] + 60) & (img[..., 2] > img[..., 1] + 40)
+
+
+def _green(img):
+    return (img[..., 1] > img[..., 0] + 80) & (img[..., 1] > img[..., 2] + 80)
+
+
+def _light_green(img):
+    """Translucent green over a light background."""
+    return ((img[..., 1] > img[..., 0] + 30) & (img[..., 1] > img[..., 2] + 30)
+            & (img[..., 0] > 100))
+
+
+# ---------------------------------------------------------------------------- screenshots
+
+
+def test_screenshot_is_written_non_blank_and_differs_from_background(tmp_path):
+    out = preview(_textured_box(), size_mm=SIZE, screenshot=tmp_path / "sub" / "part.png",
+                  window_size=SMALL)
+    assert out == tmp_path / "sub" / "part.png" and out.is_file()
+    img = _read(out)
+    assert img.shape == (SMALL[1], SMALL[0], 3)
+    differs = np.any(img != 255, axis=-1).mean()   # background "white"
+    # The framed block fills most of the picture, the part about a fifth of it.
+    assert 0.2 < differs < 0.99, differs
+
+
+def test_background_colour_is_used(tmp_path):
+    out = preview(_textured_box(), size_mm=SIZE, screenshot=tmp_path / "p.png",
+                  window_size=SMALL, background="black")
+    img = _read(out)
+    assert np.all(img[0, 0] == 0) and np.all(img[-1, -1] == 0)
+    assert np.any(img != 0, axis=-1).mean() > 0.2
+
+
+def test_checker_texture_shows_red_and_blue(tmp_path):
+    img = _read(preview(_textured_box(), size_mm=SIZE, screenshot=tmp_path / "p.png",
+                        window_size=SMALL))
+    red, blue = _red(img).mean(), _blue(img).mean()
+    assert red > 0.03 and blue > 0.03, (red, blue)
+    # Untextured, the same box is wood-coloured: no red and no blue.
+    plain = _textured_box()
+    plain.visual = trimesh.visual.ColorVisuals(plain)
+    img = _read(preview(plain, size_mm=SIZE, screenshot=tmp_path / "q.png", window_size=SMALL))
+    assert _red(img).mean() < 0.002 and _blue(img).mean() < 0.002
+
+
+def test_texture_orientation_v1_is_image_top_row(tmp_path):
+    """A flat part with uv = (x/W, y/D): image top half red must land on the back (y > D/2).
+
+    Seen from the top (``+Y`` up in the picture), the back is the upper half of the picture.
+    """
+    w, d = SIZE[0], SIZE[1]
+    pts = np.array([[0, 0, 1], [w, 0, 1], [w, d, 1], [0, d, 1]], float)
+    img = np.empty((64, 64, 3), np.uint8)
+    img[:32], img[32:] = RED, BLUE                  # row 0 is the image's top
+    mesh = trimesh.Trimesh(pts, [[0, 1, 2], [0, 2, 3]], process=False,
+                           visual=trimesh.visual.TextureVisuals(
+                               uv=pts[:, :2] / [w, d], image=Image.fromarray(img)))
+    pic = _read(preview(mesh, size_mm=SIZE, screenshot=tmp_path / "p.png", window_size=SMALL,
+                        camera="top"))
+    rows = np.arange(pic.shape[0])[:, None] * np.ones(pic.shape[1])
+    red_rows, blue_rows = rows[_red(pic)], rows[_blue(pic)]
+    assert red_rows.size > 1000 and blue_rows.size > 1000
+    assert red_rows.max() < blue_rows.min() + 3     # red above blue, split in one row or so
+
+
+@pytest.mark.parametrize("suffix", ["glb", "obj"])
+def test_preview_reads_a_textured_file(tmp_path, suffix):
+    path = tmp_path / f"part.{suffix}"
+    _textured_box().export(path)
+    img = _read(preview(path, size_mm=SIZE, screenshot=tmp_path / "p.png", window_size=SMALL))
+    assert _red(img).mean() > 0.03 and _blue(img).mean() > 0.03
+
+
+def test_screenshot_with_wood_shows_the_section_and_cut_plane_false_hides_it(tmp_path):
+    """Default cut: x = W/2, normal +X toward the camera; the part's near half is cut away.
+
+    The part's cross-section (40 x 20 mm) is opaque wood (pure green), the waste around it
+    translucent (light green over the background), the part's far half still textured.
+    """
+    box = _textured_box()
+    with_cut = _read(preview(box, wood=GreenWood(), size_mm=SIZE,
+                             screenshot=tmp_path / "a.png", window_size=SMALL))
+    no_cut = _read(preview(box, wood=GreenWood(), size_mm=SIZE, cut_plane=False,
+                           screenshot=tmp_path / "b.png", window_size=SMALL))
+    pure = (with_cut[..., 1] > 200) & (with_cut[..., 0] < 60) & (with_cut[..., 2] < 60)
+    assert pure.mean() > 0.015, pure.mean()
+    assert _light_green(with_cut).mean() > 0.03, _light_green(with_cut).mean()
+    # The opaque cap is the part's section: its pixels lie where the uncut part was.
+    part_no_cut = _red(no_cut) | _blue(no_cut)
+    saturated = (no_cut.max(axis=-1) - no_cut.min(axis=-1)) > 40   # any part face, shaded
+    assert saturated[pure].mean() > 0.97
+    assert _green(no_cut).mean() == 0.0 and _light_green(no_cut).mean() == 0.0
+    # The part is clipped to one side of the plane, so less of the checker shows.
+    assert (_red(with_cut) | _blue(with_cut)).sum() < 0.8 * part_no_cut.sum()
+
+
+def test_screenshot_without_size_frames_the_part(tmp_path):
+    img = _read(preview(_textured_box(), screenshot=tmp_path / "p.png", window_size=SMALL))
+    # No block: the framed part alone fills a large share of the picture.
+    assert (_red(img) | _blue(img)).mean() > 0.25
+
+
+def test_part_outside_the_block_stays_in_the_picture(tmp_path):
+    far = _textured_box(center=(140.0, 40.0, 20.0))      # x in 110..170, block x in 0..100
+    img = _read(preview(far, size_mm=SIZE, screenshot=tmp_path / "p.png", window_size=SMALL))
+    assert (_red(img) | _blue(img)).mean() > 0.05
+
+
+def test_scene_of_two_meshes_is_concatenated(tmp_path):
+    scene = trimesh.Scene([_textured_box(extents=(20, 20, 20), center=(20, 40, 20)),
+                           _textured_box(extents=(20, 20, 20), center=(80, 40, 20))])
+    poly, texture = mesh_to_pyvista(scene)
+    assert poly.n_cells == 24 and texture is not None
+    img = _read(preview(scene, size_mm=SIZE, screenshot=tmp_path / "p.png", window_size=SMALL))
+    cols = np.nonzero(_red(img) | _blue(img))[1]
+    # Two parts, left and right of the centre, with a gap between them.
+    assert np.sum(cols < SMALL[0] * 0.4) > 200 and np.sum(cols > SMALL[0] * 0.6) > 200
+    assert np.sum(np.abs(cols - SMALL[0] / 2) < 10) == 0
+
+
+# ---------------------------------------------------------------------------- cut plane
+
+
+@pytest.mark.parametrize(
+    "origin, normal",
+    [((30.0, 0.0, 0.0), (1.0, 0.0, 0.0)),
+     ((50.0, 40.0, 20.0), (0.0, -2.0, 0.0)),
+     ((50.0, 40.0, 20.0), (1.0, 1.0, 0.3)),
+     ((10.0, 0.0, 0.0), (1.0, 1.0, 1.0))],
+)
+def test_cut_plane_colours_equal_wood_colour_at_the_points(origin, normal):
+    wood = PositionWood()
+    section = cut_plane_image(wood, SIZE, origin, normal, resolution_mm=2.0)
+    assert section.n_points > 10
+    pts = np.asarray(section.points)
+    rgb = np.asarray(section.point_data["RGB"])
+    assert rgb.dtype == np.uint8
+    np.testing.assert_allclose(rgb / 255.0, pts / np.asarray(SIZE), atol=RGB_ATOL)
+    # Points lie on the plane, and the wood was asked with the plane's unit normal.
+    n = np.asarray(normal) / np.linalg.norm(normal)
+    np.testing.assert_allclose((pts - origin) @ n, 0.0, atol=1e-6)  # VTK clip round-off
+    given = np.concatenate(wood.normals)
+    np.testing.assert_allclose(given, np.broadcast_to(n, given.shape), atol=1e-12)
+    np.testing.assert_allclose(section.field_data["normal"][0], n, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "size, origin, normal, area",
+    [
+        # Normal to X: the whole D x H face.
+        (SIZE, (30.0, 0.0, 0.0), (1.0, 0.0, 0.0), SIZE[1] * SIZE[2]),
+        # Diagonal of a square-based block: W*sqrt(2) long, H high.
+        ((100.0, 100.0, 40.0), (50.0, 50.0, 20.0), (1.0, -1.0, 0.0), 100 * np.sqrt(2) * 40),
+        # Cuts off a corner: equilateral triangle of side 10*sqrt(2).
+        (SIZE, (10.0, 0.0, 0.0), (1.0, 1.0, 1.0), np.sqrt(3) / 4 * 200.0),
+    ],
+)
+def test_cut_plane_is_clipped_to_the_block(size, origin, normal, area):
+    section = cut_plane_image(PositionWood(size), size, origin, normal, resolution_mm=1.0)
+    pts = np.asarray(section.points)
+    assert np.all(pts >= -ON_FACE_TOL_MM) and np.all(pts <= np.asarray(size) + ON_FACE_TOL_MM)
+    # The clip is exact (cut edges lie on the box faces), so the area is the analytic one.
+    got = section.triangulate().area
+    assert got == pytest.approx(area, rel=1e-9)
+
+
+def test_cut_plane_resolution_and_sample_cap():
+    section = cut_plane_image(PositionWood(), SIZE, (30, 0, 0), (1, 0, 0), resolution_mm=0.5)
+    # Normal to X: a regular grid over D x H with the requested spacing, corners included.
+    assert section.n_points == (80 / 0.5 + 1) * (40 / 0.5 + 1)
+    capped = cut_plane_image(PositionWood(), SIZE, (30, 0, 0), (1, 0, 0), resolution_mm=0.1,
+                             max_samples=5000)
+    assert 4000 < capped.n_points <= 5000
+    assert capped.field_data["resolution_mm"][0] > 0.1
+    # A long thin section (100 x 1 mm) still respects the cap.
+    thin = cut_plane_image(PositionWood((100.0, 1.0, 40.0)), (100.0, 1.0, 40.0), (0, 0, 20),
+                           (0, 0, 1), resolution_mm=0.01, max_samples=1000)
+    assert 0 < thin.n_points <= 1000
+
+
+def test_cut_plane_that_misses_the_block_is_empty():
+    section = cut_plane_image(PositionWood(), SIZE, (150.0, 0.0, 0.0), (1.0, 0.0, 0.0))
+    assert section.n_points == 0
+
+
+def test_cut_plane_splits_part_from_waste():
+    """Box part 60 x 40 x 20 mm centred at (50, 40, 20), cut at x: the cap is 40 x 20 mm.
+
+    The outline is exact along the grid rows (u = Y here) and within one row spacing across
+    them (v = Z), so the cap's area is 800 mm^2 up to 2 edges x 40 mm x one spacing.
+    """
+    part, _ = mesh_to_pyvista(_textured_box())
+    res = 0.5
+    section = cut_plane_image(PositionWood(), SIZE, (50.0, 40.0, 20.0), (1, 0, 0),
+                              resolution_mm=res, part=part)
+    in_part = np.asarray(section.cell_data["in_part"]).astype(bool)
+    cap = section.remove_cells(~in_part).triangulate()
+    waste = section.remove_cells(in_part)
+    p = np.asarray(cap.points)
+    assert p[:, 1].min() == pytest.approx(20.0, abs=1e-6)
+    assert p[:, 1].max() == pytest.approx(60.0, abs=1e-6)
+    assert abs(p[:, 2].min() - 10.0) <= res and abs(p[:, 2].max() - 30.0) <= res
+    cap_area = cap.area
+    assert abs(cap_area - 800.0) <= 2 * 40 * res
+    total = section.triangulate().area
+    assert total == pytest.approx(SIZE[1] * SIZE[2], rel=1e-9)   # nothing lost in the split
+    assert waste.n_cells > 0
+    # Colours stay exact at every point, including the new points on the outline.
+    np.testing.assert_allclose(np.asarray(section.point_data["RGB"]) / 255.0,
+                               np.asarray(section.points) / np.asarray(SIZE), atol=RGB_ATOL)
+
+
+def test_cut_plane_split_of_a_disk_matches_its_polygon():
+    """A 64-sided cylinder (r = 30 mm) cut across its axis: the cap is the 64-gon."""
+    cyl = trimesh.creation.cylinder(radius=30.0, height=30.0, sections=64)
+    cyl.apply_translation((50.0, 40.0, 20.0))
+    res = 0.25
+    section = cut_plane_image(PositionWood(), SIZE, (50.0, 40.0, 20.0), (0, 0, 1),
+                              resolution_mm=res, part=cyl)
+    in_part = np.asarray(section.cell_data["in_part"]).astype(bool)
+    cap = section.remove_cells(~in_part).triangulate()
+    polygon = 0.5 * 64 * 30.0**2 * np.sin(2 * np.pi / 64)
+    perimeter = 64 * 2 * 30.0 * np.sin(np.pi / 64)
+    assert abs(cap.area - polygon) <= perimeter * res / 2
+    r = np.hypot(*(np.asarray(cap.points)[:, :2] - (50.0, 40.0)).T)
+    assert r.max() <= 30.0 + res
+
+
+def test_cut_plane_callback_replaces_the_section_and_clips_the_part():
+    plotter = pv.Plotter(off_screen=True, window_size=SMALL)
+    try:
+        part, texture = mesh_to_pyvista(_textured_box())
+        callback = CutPlaneCallback(plotter, part, texture, PositionWood(), SIZE,
+                                    resolution_mm=2.0)
+        assert PART_ACTOR in plotter.actors and SECTION_ACTOR not in plotter.actors
+        n_actors = len(plotter.actors)
+        for x in (30.0, 70.0):
+            section = callback((1.0, 0.0, 0.0), (x, 40.0, 20.0))
+            assert {SECTION_ACTOR, WASTE_ACTOR, OUTLINE_ACTOR} <= set(plotter.actors)
+            cap, waste, outline = (callback.shown[n]
+                                   for n in (SECTION_ACTOR, WASTE_ACTOR, OUTLINE_ACTOR))
+            assert cap.n_cells + waste.n_cells == section.n_cells
+            for shown in (cap, waste, outline):
+                np.testing.assert_allclose(np.asarray(shown.points)[:, 0], x, atol=1e-9)
+            for shown in (cap, waste):
+                np.testing.assert_allclose(np.asarray(shown.point_data["RGB"]) / 255.0,
+                                           np.asarray(shown.points) / np.asarray(SIZE),
+                                           atol=RGB_ATOL)
+            # The outline is the box's 40 x 20 mm rectangle at this x.
+            o = np.asarray(outline.points)
+            np.testing.assert_allclose([o[:, 1].min(), o[:, 1].max(), o[:, 2].min(),
+                                        o[:, 2].max()], [20, 60, 10, 30], atol=1e-9)
+            assert len(plotter.actors) == n_actors + 3   # replaced, not stacked
+            # The part keeps the side opposite the normal.
+            np.testing.assert_allclose(callback.clip_plane.GetOrigin(), (x, 40.0, 20.0))
+            np.testing.assert_allclose(callback.clip_plane.GetNormal(), (-1.0, 0.0, 0.0))
+        # A plane beside the part: no cap, no outline, all waste.
+        callback((1.0, 0.0, 0.0), (10.0, 40.0, 20.0))
+        assert SECTION_ACTOR not in plotter.actors and OUTLINE_ACTOR not in plotter.actors
+        assert WASTE_ACTOR in plotter.actors
+    finally:
+        plotter.close()
+
+
+def test_cut_plane_callback_clip_hides_the_part_on_the_normal_side():
+    """Seen from the top, the part keeps only the side opposite the normal (+X: left half)."""
+    plotter = pv.Plotter(off_screen=True, window_size=SMALL)
+    try:
+        part, texture = mesh_to_pyvista(_textured_box())
+        callback = CutPlaneCallback(plotter, part, texture)   # no wood: clipping only
+        assert callback((1.0, 0.0, 0.0), (50.0, 40.0, 20.0)) is None
+        view._set_camera(plotter, "top", (0, SIZE[0], 0, SIZE[1], 0, SIZE[2]))
+        img = plotter.screenshot(return_img=True).astype(int)
+    finally:
+        plotter.close()
+    part_px = _red(img) | _blue(img)
+    cols = np.nonzero(part_px)[1]
+    centre_col = SMALL[0] / 2   # the camera frames the block centred: x = 50 mm is mid-picture
+    assert cols.size > 2000
+    assert cols.max() < centre_col + 3
+
+
+def test_interactive_scene_widget_drives_the_cut():
+    """The interactive scene, built on an off-screen plotter: moving the widget moves the cut."""
+    plotter = pv.Plotter(off_screen=True, window_size=SMALL)
+    try:
+        callback = build_scene(plotter, _textured_box(), wood=PositionWood(), size_mm=SIZE,
+                               widget=True, max_samples=20_000)
+        # pyvista 0.47+ keeps widgets under plotter.widgets; older ones on the plotter.
+        widgets = getattr(plotter, "widgets", plotter).plane_widgets
+        assert len(widgets) == 1
+        widget = widgets[0]
+        # Placed at the block centre, normal to the longest axis (X), section drawn at once.
+        np.testing.assert_allclose(widget.GetOrigin(), (50.0, 40.0, 20.0))
+        np.testing.assert_allclose(np.asarray(callback.section.points)[:, 0], 50.0, atol=1e-9)
+        # Drag: the widget fires InteractionEvent; the section and the part's clip follow.
+        widget.SetOrigin(80.0, 40.0, 20.0)
+        widget.SetNormal(0.0, 0.0, 1.0)
+        widget.InvokeEvent("InteractionEvent")
+        section = callback.section
+        np.testing.assert_allclose(np.asarray(section.points)[:, 2], 20.0, atol=1e-9)
+        # The cap bounds the grid's samples; the part's outline adds points along it.
+        assert section.n_points <= 20_000 * 1.05
+        np.testing.assert_allclose(np.asarray(section.point_data["RGB"]) / 255.0,
+                                   np.asarray(section.points) / np.asarray(SIZE), atol=RGB_ATOL)
+        assert SECTION_ACTOR in plotter.actors
+        cap = callback.shown[SECTION_ACTOR]
+        np.testing.assert_allclose(np.asarray(cap.points)[:, 2], 20.0, atol=1e-9)
+        np.testing.assert_allclose(callback.clip_plane.GetNormal(), (0.0, 0.0, -1.0))
+        img = plotter.screenshot(return_img=True)
+        assert np.any(img != 255, axis=-1).mean() > 0.2
+    finally:
+        plotter.close()
+
+
+def test_interactive_scene_without_wood_clips_only():
+    plotter = pv.Plotter(off_screen=True, window_size=SMALL)
+    try:
+        callback = build_scene(plotter, _textured_box(), size_mm=SIZE, widget=True)
+        assert callback is not None and callback.section is None
+        assert SECTION_ACTOR not in plotter.actors and PART_ACTOR in plotter.actors
+        # Without a widget and without a wood there is nothing to cut: no callback.
+        plotter.clear()
+        assert build_scene(plotter, _textured_box(), size_mm=SIZE) is None
+    finally:
+        plotter.close()
+
+
+def test_default_cut_normal_faces_the_camera_along_the_longest_axis():
+    size = np.asarray(SIZE)
+    np.testing.assert_array_equal(view._default_cut_normal("iso", size), [1, 0, 0])
+    np.testing.assert_array_equal(view._default_cut_normal("iso", size[[2, 1, 0]]), [0, 0, 1])
+    np.testing.assert_array_equal(view._default_cut_normal("front", size), [0, -1, 0])
+    np.testing.assert_array_equal(view._default_cut_normal("top", size), [0, 0, 1])
+
+
+# ---------------------------------------------------------------------------- conversion
+
+
+def test_mesh_to_pyvista_keeps_uv_and_image():
+    mesh = _textured_box()
+    poly, texture = mesh_to_pyvista(mesh)
+    np.testing.assert_array_equal(np.asarray(poly.points), mesh.vertices)
+    np.testing.assert_array_equal(np.asarray(poly.active_texture_coordinates), mesh.visual.uv)
+    assert poly.n_cells == len(mesh.faces)
+    assert texture is not None and texture.dimensions == (64, 64)
+
+
+def test_mesh_to_pyvista_vertex_colours_and_untextured():
+    mesh = trimesh.creation.box(extents=(10, 10, 10))
+    mesh.visual.vertex_colors = np.tile([10, 200, 30, 255], (len(mesh.vertices), 1))
+    poly, texture = mesh_to_pyvista(mesh)
+    assert texture is None
+    np.testing.assert_array_equal(poly.point_data["RGB"][0], [10, 200, 30])
+    poly, texture = mesh_to_pyvista(trimesh.creation.box(extents=(10, 10, 10)))
+    assert texture is None and poly.active_texture_coordinates is None
+
+
+def test_block_outline_is_the_block_box():
+    box, edges = block_outline(SIZE)
+    np.testing.assert_allclose(box.bounds, (0, 100, 0, 80, 0, 40))
+    assert edges.n_lines == 12
+    np.testing.assert_allclose(edges.bounds, (0, 100, 0, 80, 0, 40))
+
+
+# ---------------------------------------------------------------------------- bad inputs
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"size_mm": (100, -1, 40)}, "size_mm must be three positive"),
+        ({"size_mm": (100, 40)}, "size_mm must be three positive"),
+        ({"wood": PositionWood()}, "size_mm is needed with wood"),
+        ({"wood": object(), "size_mm": SIZE}, "wood must have a method color"),
+        ({"camera": "sideways"}, "camera must be one of iso, top"),
+        ({"window_size": (0, 10)}, "window_size must be two integers"),
+        ({"screenshot": "part.jpg"}, "screenshot must be a .png path"),
+        ({"cut_normal": (0, 0, 0), "wood": GreenWood(), "size_mm": SIZE}, "non-zero direction"),
+    ],
+)
+def test_preview_rejects_bad_arguments(tmp_path, kwargs, match):
+    kwargs.setdefault("screenshot", tmp_path / "p.png")
+    with pytest.raises(WoodcamError, match=match):
+        preview(_textured_box(), **kwargs)
+
+
+def test_preview_rejects_bad_meshes(tmp_path):
+    with pytest.raises(WoodcamError, match="no file at"):
+        preview(tmp_path / "missing.glb", screenshot=tmp_path / "p.png")
+    with pytest.raises(WoodcamError, match="must be a trimesh.Trimesh"):
+        preview(np.zeros((3, 3)), screenshot=tmp_path / "p.png")
+    with pytest.raises(WoodcamError, match="no faces"):
+        preview(trimesh.Trimesh(), screenshot=tmp_path / "p.png")
+
+
+def test_interactive_without_display_says_use_screenshot(monkeypatch):
+    monkeypatch.setattr(view.sys, "platform", "linux")
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    with pytest.raises(WoodcamError, match="needs a display.*--screenshot"):
+        preview(_textured_box(), size_mm=SIZE)
+
+
+@pytest.mark.parametrize(
+    "wood, match",
+    [
+        (type("W255", (), {"color": lambda self, p, n: np.full((len(p), 3), 200.0)})(),
+         r"rgb in \[0, 1\].*divide 0..255"),
+        (type("WShape", (), {"color": lambda self, p, n: np.zeros(len(p))})(),
+         r"shape \(n, 3\)"),
+        (type("WNaN", (), {"color": lambda self, p, n: np.full((len(p), 3), np.nan)})(),
+         "non-finite"),
+    ],
+)
+def test_cut_plane_rejects_bad_wood_colours(wood, match):
+    with pytest.raises(WoodcamError, match=match):
+        cut_plane_image(wood, SIZE, (50, 40, 20), (1, 0, 0), resolution_mm=5.0)
+
+
+def test_cut_plane_rejects_bad_arguments():
+    with pytest.raises(WoodcamError, match="needs a wood"):
+        cut_plane_image(None, SIZE, (50, 40, 20), (1, 0, 0))
+    with pytest.raises(WoodcamError, match="resolution_mm must be a positive"):
+        cut_plane_image(PositionWood(), SIZE, (50, 40, 20), (1, 0, 0), resolution_mm=0)
+    with pytest.raises(WoodcamError, match="normal must be a non-zero"):
+        cut_plane_image(PositionWood(), SIZE, (50, 40, 20), (0, 0, 0))
+    with pytest.raises(WoodcamError, match="max_samples must be an integer"):
+        cut_plane_image(PositionWood(), SIZE, (50, 40, 20), (1, 0, 0), max_samples=2)
+    with pytest.raises(WoodcamError, match="origin must be three finite"):
+        cut_plane_image(PositionWood(), SIZE, (50, np.nan, 20), (1, 0, 0))

@@ -1,0 +1,115 @@
+"""`woodcam log ...`: sections through knotted logs and log-file conversion (CLI glue only).
+
+Hook into ``woodcam/cli.py`` with ``_cli_log.add_parser(subparsers)``; the parser sets
+``func=run``, so the main CLI calls ``args.func(args)``.
+
+    woodcam log render [LOG_FILE | --real | --maps DIR] --out DIR [options]
+    woodcam log maps   [LOG_FILE | --real] --out DIR        # write the seed's image maps
+    woodcam log export --real --out FILE.json               # write a woodcam log file
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .errors import WoodcamError
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Add the ``log`` command (with ``render``, ``maps``, ``export``) to ``subparsers``."""
+    p = subparsers.add_parser("log", help="knotted logs: render sections, convert log files")
+    sub = p.add_subparsers(dest="log_command", required=True)
+
+    def source(sp):
+        sp.add_argument("log_file", nargs="?", help="woodcam log file (JSON, mm)")
+        sp.add_argument("--real", action="store_true",
+                        help="the CT-measured spruce log Gran_1 of the shared data")
+        sp.add_argument("--maps", metavar="DIR",
+                        help="a folder of seed image maps (stem_map.png, knot_*_map.png, ...)")
+
+    r = sub.add_parser("render", help="PNG sections: a tangential board and an end-grain disc")
+    source(r)
+    r.add_argument("--out", required=True, help="output folder")
+    r.add_argument("--ring-width", type=float, default=2.0, help="mm per year (default 2)")
+    r.add_argument("--px-per-mm", type=float, default=2.0, help="resolution (default 2)")
+    r.add_argument("--supersample", type=int, default=2,
+                   help="samples per pixel side, averaged (default 2; knot rings alias)")
+    r.add_argument("--board", nargs=3, type=float, metavar=("Z_MM", "AZIMUTH_DEG", "OFFSET_MM"),
+                   help="tangential board centre height, facing azimuth and distance from "
+                        "the pith (default: the board through the most knots at 60 mm)")
+    r.add_argument("--disc", type=float, metavar="Z_MM", help="end-grain disc height")
+    r.add_argument("--radial", nargs=2, type=float, metavar=("Z_MM", "AZIMUTH_DEG"),
+                   help="also a quarter-sawn section through the pith (knots as spikes)")
+    r.add_argument("--k-stem", type=float, default=1.5, help="smoothness k outside knots")
+    r.add_argument("--k-knot", type=float, default=5.0, help="smoothness k inside knots")
+    r.add_argument("--alive-darkening", type=float, default=0.35, help="0..1")
+    r.add_argument("--dead-darkening", type=float, default=0.3, help="0..1")
+    r.add_argument("--outline-mm", type=float, default=1.0,
+                   help="dead-knot outline thickness (mm)")
+    r.set_defaults(func=run)
+
+    m = sub.add_parser("maps", help="write the seed's image maps of a log")
+    source(m)
+    m.add_argument("--out", required=True, help="output folder")
+    m.set_defaults(func=run)
+
+    e = sub.add_parser("export", help="write a log as a woodcam log file (JSON)")
+    source(e)
+    e.add_argument("--out", required=True, help="output .json path")
+    e.set_defaults(func=run)
+    return p
+
+
+def _load(args):
+    from .fields.knot_maps import read_maps
+    from .fields.tree_data import read_gran1, read_log
+
+    given = [x for x in (args.log_file, args.real or None, args.maps) if x]
+    if len(given) != 1:
+        raise WoodcamError("give exactly one log: a LOG_FILE, --real or --maps DIR; got "
+                           f"{len(given)}")
+    if args.real:
+        return read_gran1()
+    if args.maps:
+        return read_maps(args.maps)
+    return read_log(args.log_file)
+
+
+def run(args) -> int:
+    """Run ``woodcam log <command>``; prints the files written, returns the exit code."""
+    import numpy as np
+
+    log = _load(args)
+    out = Path(args.out)
+    if args.log_command == "export":
+        from .fields.tree_data import write_log
+
+        print(write_log(log, out))
+        return 0
+    if args.log_command == "maps":
+        from .fields.knot_maps import write_maps
+
+        for path in write_maps(log, out).values():
+            print(path)
+        return 0
+    from .fields import log_render as lr
+    from .fields.knots import KnotParams, KnottedLogField
+
+    params = KnotParams(k_stem=args.k_stem, k_knot=args.k_knot,
+                        alive_darkening=args.alive_darkening,
+                        dead_darkening=args.dead_darkening, outline_mm=args.outline_mm)
+    field = KnottedLogField(log, ring_width_mm=args.ring_width, params=params)
+    secs = lr.default_sections(log, px_per_mm=args.px_per_mm)
+    if args.board:
+        z, az, off = args.board
+        secs[0] = lr.tangential_board(log, z, np.radians(az), off, px_per_mm=args.px_per_mm)
+    if args.disc is not None:
+        secs[1] = lr.end_grain_disc(log, args.disc, px_per_mm=args.px_per_mm)
+    if args.radial:
+        z, az = args.radial
+        secs.append(lr.radial_section(log, z, np.radians(az), px_per_mm=args.px_per_mm))
+    for s in secs:
+        img = lr.render_section(field, s, supersample=args.supersample)
+        print(lr.save_png(img, out / f"{log.name}_{s.name}.png"))
+    return 0

@@ -1,0 +1,618 @@
+"""Texture baking: UV-unwrap a carved mesh and paint the wood's colour into a texture atlas.
+
+Data form
+---------
+* Meshes are in the block frame, millimetres (``docs/conventions.md``).
+* The wood is any object with ``color(points_mm: (n, 3) float, normals: (n, 3) float unit)
+  -> (n, 3) float RGB in [0, 1]`` (seed 000, eq. 10 is one such appearance: a normal-weighted
+  blend of three colour volumes). The baker never looks inside it.
+* The atlas is an image ``(h, w, 3) uint8``; row 0 is the TOP row of the image file. Colours
+  are stored as ``round(255 * rgb)``: ``wood.color`` is taken to return display (sRGB-encoded)
+  values, which is how glTF and OBJ viewers read a base-colour texture.
+
+Texel / UV convention (the "v flip")
+------------------------------------
+Texel ``(row r, col c)`` of an atlas of ``h x w`` texels covers ``[c, c + 1] x [r, r + 1]`` in
+texel coordinates ``(x, y)``; its centre is ``(c + 0.5, r + 0.5)``.  The mesh carries trimesh /
+OBJ texture coordinates, origin at the image's bottom-left::
+
+    u = x / w,        v = 1 - y / h          (centre of texel (r, c): u = (c + .5) / w,
+                                                                   v = 1 - (r + .5) / h)
+
+trimesh's glTF exporter writes ``(u, 1 - v)``, i.e. glTF's top-left origin, so GLB viewers and
+OBJ viewers both sample texel (r, c) at the same surface point.
+
+Pipeline (each step timed in :attr:`BakeResult.timings`)
+--------------------------------------------------------
+1. ``unwrap``: xatlas charts + packing at ``texels_per_unit = texels_per_mm`` (the mesh is in mm,
+   so one xatlas "unit" is a millimetre), one atlas, charts ``padding_px`` texels apart.
+2. ``rasterise``: every triangle is rasterised conservatively in texel space: triangles are
+   grouped by bounding-box size and each group is tested as one broadcast numpy array
+   (triangles x rows x cols) of edge functions (no per-texel Python loop). A texel is painted
+   when its centre lies within L-infinity distance 1 (+ a 0.02 texel margin) of the triangle,
+   which covers every texel bilinear sampling at any point of the triangle can read. A texel
+   whose centre lies inside a triangle takes that triangle; a texel only in border rings takes the
+   nearest triangle and the triangle's affine map is extrapolated to it (a point in the
+   triangle's plane at most ~1.5 texels outside it).
+3. ``color``: 3D point and normal of every painted texel -> ``wood.color`` in bounded batches.
+4. ``dilate``: every unpainted texel takes the colour of its nearest painted texel (exact
+   Euclidean distance transform), so no mip level ever averages in black.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Literal, get_args
+
+import numpy as np
+
+from woodcam.errors import WoodcamError
+from woodcam.tolerances import (
+    ATLAS_PADDING_PX,
+    MAX_BATCH_POINTS,
+    MIN_UV_AREA_TEXELS2,
+    RASTER_MARGIN_TEXELS,
+)
+
+NormalsMode = Literal["face", "smooth"]
+
+#: Fraction of the atlas xatlas fills with charts at 8 px padding (measured 0.5-0.85 on
+#: spheres and carved boxes); used only to predict the atlas side before unwrapping.
+_PACK_EFFICIENCY = 0.6
+
+#: Upper bound on faces per xatlas chart, via ``ChartOptions.max_chart_area``. xatlas' chart
+#: growing is super-linear in chart size: a 20k-triangle sphere unwraps in ~4-7 s as 6 charts and
+#: in ~1.2 s with this cap (~120 charts). More charts means more seams, which the conservative
+#: rasterisation and the dilation make invisible.
+_MAX_CHART_FACES = 256
+
+#: When xatlas' packed atlas overshoots ``max_atlas_px`` by a factor down to this, the layout is
+#: scaled down instead of re-unwrapped: chart gaps shrink from ``padding_px`` to at worst
+#: 0.85 x ``padding_px`` (never below _MIN_PADDING_PX), and xatlas' ~1 s is not repeated.
+_MIN_RESCALE = 0.85
+
+#: Smallest gap (texels) between charts: each chart needs its own 1-texel ring for bilinear
+#: sampling, so two charts need 2 texels between them.
+_MIN_PADDING_PX = 2
+
+#: (triangle, texel) candidate pairs processed per rasterisation chunk: bounds peak memory to
+#: roughly 40 bytes x this (~170 MB).
+_RASTER_CHUNK_PAIRS = 1 << 22
+
+#: Side (texels) of the square tiles large or sliver triangles are rasterised in. Measured
+#: (CPU s, rasterising a 20k-triangle sphere at 2k^2 / an 8.8k-triangle carved block at 1k^2,
+#: with every triangle above 8 texels tiled): tile 4: 0.67 / 0.48, 8: 0.45 / 0.34,
+#: 16: 0.35 / 0.49 (slivers waste most of a big tile).
+_TILE = 8
+
+#: Triangles whose expanded bounding box is at most this many texels both ways, and which fill
+#: at least _SMALL_MIN_FILL of it, are rasterised as one block each (grouped by block size);
+#: the rest (big faces, slivers of CAD triangle fans) go through culled tiles.
+_SMALL_BBOX = 16
+_SMALL_MIN_FILL = 0.2
+
+#: Atlas width and height are rounded up to a multiple of this, so mip levels 1..3 halve exactly.
+_ATLAS_SIZE_MULTIPLE = 8
+
+
+@dataclass
+class BakeResult:
+    """What :func:`bake` returns.
+
+    Attributes
+    ----------
+    mesh : trimesh.Trimesh
+        The input surface with vertices split at UV seams (as xatlas returns them), mm, block
+        frame, ``visual = TextureVisuals(uv (m, 2), material=PBRMaterial(baseColorTexture=PIL))``;
+        faces in the input's order. With ``normals="smooth"`` its ``vertex_normals`` are the
+        input's (seam-free shading).
+    atlas : (h, w, 3) uint8
+        The baked, dilated texture; row 0 is the image's top row.
+    coverage_mask : (h, w) bool
+        Texels painted from a triangle (before dilation); the rest are dilation fill.
+    texels_per_mm : float
+        Texel density actually used (lower than asked when the atlas would exceed
+        ``max_atlas_px``; then ``warnings`` says so).
+    timings : dict[str, float]
+        Seconds per step: ``unwrap``, ``rasterise``, ``color``, ``dilate``, ``total``.
+    warnings : list[str]
+        Human-readable messages about anything the baker changed from what was asked.
+    vertex_map : (m,) int
+        Index of the input vertex each output vertex came from.
+    """
+
+    mesh: Any
+    atlas: np.ndarray
+    coverage_mask: np.ndarray
+    texels_per_mm: float
+    timings: dict[str, float]
+    warnings: list[str] = field(default_factory=list)
+    vertex_map: np.ndarray | None = None
+
+
+def bake(
+    mesh,
+    wood,
+    *,
+    texels_per_mm: float = 10.0,
+    max_atlas_px: int = 4096,
+    padding_px: int = ATLAS_PADDING_PX,
+    normals: NormalsMode = "face",
+    progress: bool = False,
+) -> BakeResult:
+    """Unwrap ``mesh`` and bake ``wood.color`` into a texture atlas.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+        Triangle surface in the block frame, mm (e.g. a carved part).
+    wood : object with ``color(points_mm (n, 3), normals (n, 3)) -> (n, 3) RGB in [0, 1]``
+    texels_per_mm : float
+        Wanted texel density (texels per mm along the surface), > 0.
+    max_atlas_px : int
+        Largest allowed atlas side in texels; the density is lowered (with a warning) to fit.
+    padding_px : int
+        Texels between charts in the atlas, >= 2 (with 0 or 1 a texel between two charts would
+        need two colours: measured errors reach the bound's limit). 8 keeps mip levels 1-2 inside
+        one chart's dilation.
+    normals : {"face", "smooth"}
+        Normal passed to ``wood.color``: the flat triangle normal (right for CAD parts with sharp
+        edges), or trimesh's vertex normal of the INPUT mesh (before the seam split) interpolated
+        barycentrically and renormalised (for smooth organic surfaces).
+    progress : bool
+        Show a tqdm bar over the rasterisation groups.
+
+    Returns
+    -------
+    BakeResult
+    """
+    import trimesh
+
+    t_start = time.perf_counter()
+    _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals)
+    messages: list[str] = []
+    timings: dict[str, float] = {}
+
+    # ---- 1. unwrap -------------------------------------------------------------------------
+    t0 = time.perf_counter()
+    vmap, faces, xy, width, height, tpm = _unwrap(mesh, float(texels_per_mm), int(max_atlas_px),
+                                                  int(padding_px), messages)
+    timings["unwrap"] = time.perf_counter() - t0
+    img_w = _round_up(width, _ATLAS_SIZE_MULTIPLE)
+    img_h = _round_up(height, _ATLAS_SIZE_MULTIPLE)
+
+    # ---- 2. rasterise ----------------------------------------------------------------------
+    t0 = time.perf_counter()
+    tri_of_texel = _rasterise(xy, faces, img_w, img_h, progress=progress)
+    painted = np.flatnonzero(tri_of_texel >= 0)
+    tri = tri_of_texel[painted]
+    timings["rasterise"] = time.perf_counter() - t0
+
+    # ---- 3. colour -------------------------------------------------------------------------
+    t0 = time.perf_counter()
+    verts = np.asarray(mesh.vertices, dtype=np.float64)[vmap]
+    point_map = _affine_maps(xy, faces, verts)
+    if normals == "face":
+        # xatlas keeps face order, so output face i is input face i.
+        face_normals = np.asarray(mesh.face_normals, dtype=np.float64)
+    else:
+        normal_map = _affine_maps(xy, faces, np.asarray(mesh.vertex_normals,
+                                                         dtype=np.float64)[vmap])
+    atlas = np.zeros((img_h * img_w, 3), dtype=np.uint8)
+    # Batches of MAX_BATCH_POINTS texels: bounded memory, arrays that stay in cache.
+    for s in range(0, len(painted), MAX_BATCH_POINTS):
+        idx = painted[s:s + MAX_BATCH_POINTS]
+        t = tri[s:s + MAX_BATCH_POINTS]
+        cx = (idx % img_w + 0.5)[:, None]
+        cy = (idx // img_w + 0.5)[:, None]
+        points = _apply_affine(point_map, t, cx, cy)
+        if normals == "face":
+            nrm = face_normals[t]
+        else:
+            nrm = _apply_affine(normal_map, t, cx, cy)
+            nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-12)
+        rgb = _color_checked(wood, points, nrm)
+        atlas[idx] = np.round(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
+    atlas = atlas.reshape(img_h, img_w, 3)
+    coverage = (tri_of_texel >= 0).reshape(img_h, img_w)
+    timings["color"] = time.perf_counter() - t0
+
+    # ---- 4. dilate -------------------------------------------------------------------------
+    t0 = time.perf_counter()
+    atlas = _dilate(atlas, coverage)
+    timings["dilate"] = time.perf_counter() - t0
+
+    uv = np.column_stack([xy[:, 0] / img_w, 1.0 - xy[:, 1] / img_h])
+    out = _textured_mesh(trimesh, verts, faces, uv, atlas)
+    if normals == "smooth":
+        # Shading normals from the unsplit input, so viewers show no shading seam where xatlas
+        # split vertices (normals recomputed on the split mesh differ on each side of a seam).
+        # The GLB exporter writes them as NORMAL; "face" mode leaves them out (flat shading).
+        out.vertex_normals = np.asarray(mesh.vertex_normals, dtype=np.float64)[vmap]
+    timings["total"] = time.perf_counter() - t_start
+    for msg in messages:
+        warnings.warn(msg, UserWarning, stacklevel=2)
+    return BakeResult(
+        mesh=out,
+        atlas=atlas,
+        coverage_mask=coverage,
+        texels_per_mm=tpm,
+        timings=timings,
+        warnings=messages,
+        vertex_map=vmap,
+    )
+
+
+# ------------------------------------------------------------------------------------------------
+# helpers
+
+
+def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals) -> None:
+    faces = getattr(mesh, "faces", None)
+    if faces is None or len(faces) == 0:
+        raise WoodcamError(
+            f"bake: mesh must be a trimesh.Trimesh with at least one triangle; got "
+            f"{type(mesh).__name__} with {0 if faces is None else len(faces)} faces; pass the "
+            "carved part's surface mesh"
+        )
+    if not callable(getattr(wood, "color", None)):
+        raise WoodcamError(
+            f"bake: wood must have a method color(points_mm, normals) -> rgb; got "
+            f"{type(wood).__name__}; pass a woodcam.appearance.Wood or any object with .color"
+        )
+    if not (isinstance(texels_per_mm, (int, float)) and math.isfinite(texels_per_mm)
+            and texels_per_mm > 0):
+        raise WoodcamError(
+            f"bake: texels_per_mm must be a finite number > 0; got {texels_per_mm!r}; "
+            "use e.g. 10 (0.1 mm texels)"
+        )
+    if not isinstance(max_atlas_px, (int, np.integer)) or max_atlas_px < 64:
+        raise WoodcamError(
+            f"bake: max_atlas_px must be an integer >= 64; got {max_atlas_px!r}; use e.g. 4096"
+        )
+    if not isinstance(padding_px, (int, np.integer)) or padding_px < _MIN_PADDING_PX:
+        raise WoodcamError(
+            f"bake: padding_px must be an integer >= 2 (each chart needs its own 1-texel ring "
+            f"for bilinear sampling, so charts must be 2 texels apart); got {padding_px!r}; use "
+            f"e.g. {ATLAS_PADDING_PX}"
+        )
+    if normals not in get_args(NormalsMode):
+        raise WoodcamError(
+            f"bake: normals must be one of {get_args(NormalsMode)}; got {normals!r}"
+        )
+
+
+def _round_up(n: int, k: int) -> int:
+    return int(-(-int(n) // k) * k)
+
+
+def _unwrap(mesh, tpm: float, max_px: int, padding: int, messages: list[str]):
+    """xatlas charts + packing into ONE atlas whose sides are <= ``max_px``.
+
+    Returns ``vmap (m,) int``, ``faces (f, 3) int``, ``xy (m, 2) float64`` texel coordinates,
+    atlas ``width``, ``height`` (texels) and the density used (texels / mm).
+    """
+    import xatlas
+
+    # The image side is later rounded up to a multiple of _ATLAS_SIZE_MULTIPLE: stay below.
+    max_px = max_px // _ATLAS_SIZE_MULTIPLE * _ATLAS_SIZE_MULTIPLE
+    verts = np.ascontiguousarray(mesh.vertices, dtype=np.float32)
+    faces_in = np.ascontiguousarray(mesh.faces, dtype=np.uint32)
+    area = float(mesh.area)
+    asked = tpm
+    # Predict the side from surface area and density; lower the density before unwrapping so a
+    # huge request never makes xatlas allocate a huge packing bitmap.
+    predicted = math.sqrt(area * tpm * tpm / _PACK_EFFICIENCY) + 2 * padding
+    if predicted > max_px:
+        tpm = tpm * (max_px - 2 * padding) / (predicted - 2 * padding) * 0.97
+    face_area = np.asarray(mesh.area_faces, dtype=np.float64)
+    max_chart_area = float(_MAX_CHART_FACES * np.median(face_area))
+
+    for _attempt in range(4):
+        atlas = xatlas.Atlas()
+        atlas.add_mesh(verts, faces_in)
+        chart_options = xatlas.ChartOptions()
+        chart_options.max_iterations = 0  # one pass of chart growing; see _MAX_CHART_FACES
+        chart_options.max_chart_area = max_chart_area
+        pack_options = xatlas.PackOptions()
+        pack_options.resolution = 0  # single atlas, size decided by texels_per_unit
+        pack_options.texels_per_unit = float(tpm)
+        pack_options.padding = int(padding)
+        pack_options.bilinear = True
+        atlas.generate(chart_options, pack_options)
+        width, height = int(atlas.width), int(atlas.height)
+        scale = max_px / max(width, height)
+        if scale >= _MIN_RESCALE and scale * padding >= _MIN_PADDING_PX:
+            break
+        tpm *= (max_px - 2 * padding) / (max(width, height) - 2 * padding) * 0.97
+    else:  # pragma: no cover - xatlas overshooting four times in a row
+        raise WoodcamError(
+            f"bake: could not fit the atlas into max_atlas_px={max_px} (last {width}x{height} at "
+            f"{tpm:.3g} texels/mm); raise max_atlas_px or lower texels_per_mm"
+        )
+    if atlas.atlas_count != 1:  # pragma: no cover - resolution=0 always gives one atlas
+        raise WoodcamError(f"bake: xatlas made {atlas.atlas_count} atlases; expected 1")
+    vmap, faces, uv = atlas[0]
+    # xatlas-python normalises by the atlas size; back to texel coordinates (float64).
+    xy = np.asarray(uv, dtype=np.float64) * np.array([width, height], dtype=np.float64)
+    if scale < 1.0:
+        # A slight overshoot: shrink the packed layout instead of re-running xatlas (~1 s).
+        xy *= scale
+        width = min(max_px, math.ceil(width * scale))
+        height = min(max_px, math.ceil(height * scale))
+        tpm *= scale
+    if tpm < asked:
+        messages.append(
+            f"bake: texels_per_mm lowered from {asked:g} to {tpm:.4g} (texel {1 / tpm:.3g} mm) "
+            f"so the {area:.0f} mm^2 surface fits a {width}x{height} atlas within "
+            f"max_atlas_px={max_px}; raise max_atlas_px for finer texels"
+        )
+    return vmap.astype(np.int64), faces.astype(np.int64), xy, width, height, float(tpm)
+
+
+def _triangle_frames(xy: np.ndarray, faces: np.ndarray):
+    """Per-triangle texel-space data: origin p0 (f, 2), inverse edge matrix (f, 2, 2), double
+    signed area (f,), and validity (f,) bool (non-degenerate in UV)."""
+    p = xy[faces]  # (f, 3, 2)
+    e1 = p[:, 1] - p[:, 0]
+    e2 = p[:, 2] - p[:, 0]
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    valid = np.abs(det) > 2.0 * MIN_UV_AREA_TEXELS2
+    inv_det = np.where(valid, 1.0 / np.where(valid, det, 1.0), 0.0)
+    # (l1, l2) = inv([e1 e2]) @ (x - p0)
+    minv = np.empty((len(faces), 2, 2))
+    minv[:, 0, 0] = e2[:, 1] * inv_det
+    minv[:, 0, 1] = -e2[:, 0] * inv_det
+    minv[:, 1, 0] = -e1[:, 1] * inv_det
+    minv[:, 1, 1] = e1[:, 0] * inv_det
+    return p, minv, det, valid
+
+
+def _rasterise(xy: np.ndarray, faces: np.ndarray, width: int, height: int, *,
+               progress: bool = False) -> np.ndarray:
+    """Conservative rasterisation of all triangles in texel space.
+
+    Parameters
+    ----------
+    xy : (m, 2) float64
+        Vertex texel coordinates (x right, y down; texel (r, c) centre at (c + .5, r + .5)).
+    faces : (f, 3) int
+    width, height : int
+        Atlas size in texels.
+
+    Returns
+    -------
+    (height * width,) int64
+        Triangle painting each texel (row-major), -1 where none. A texel whose centre is inside
+        (or on the edge of) a triangle takes that triangle; otherwise, if its centre is within
+        L-infinity distance 1 of some triangles (the bilinear footprint: the Minkowski sum of the
+        triangle and the square [-1, 1]^2, i.e. each edge pushed out by |n_x| + |n_y| plus the
+        bounding box grown by 1), the one with the smallest outward edge distance.
+
+    Notes
+    -----
+    Small compact triangles (bounding box <= ``_SMALL_BBOX`` texels both ways and at least
+    ``_SMALL_MIN_FILL`` of it covered) are grouped by bounding-box size, so each group is one
+    broadcast array ``(triangles, 3 edges, rows, cols)``. The others (big faces, long slivers of
+    CAD triangle fans, whose bounding box is mostly empty) are cut into
+    ``_TILE x _TILE`` tiles; tiles the expanded triangle cannot reach are culled with the same
+    edge test at the tile centre widened by the tile's half-extent, and the rest are tested as
+    one group of equal-size blocks. No per-texel Python loop. The edge tests run in float32
+    (texel coordinates <= 2^13 keep ~1e-3 texel precision, inside ``RASTER_MARGIN_TEXELS``);
+    the owners' points are recomputed in float64.
+    """
+    p, minv, det, valid = _triangle_frames(xy, faces)
+    # Edge opposite vertex i runs p[(i+1)%3] -> p[(i+2)%3]. Height of vertex i over it, and the
+    # support of the square [-reach, reach]^2 along its unit normal (reach (|n_x| + |n_y|)).
+    edges = np.stack([p[:, 2] - p[:, 1], p[:, 0] - p[:, 2], p[:, 1] - p[:, 0]], axis=1)
+    lengths = np.maximum(np.linalg.norm(edges, axis=2), 1e-300)  # (f, 3)
+    heights = np.abs(det)[:, None] / lengths
+    support = (np.abs(edges[..., 0]) + np.abs(edges[..., 1])) / lengths
+
+    reach = 1.0 + RASTER_MARGIN_TEXELS  # footprint half-width, texels
+    lo = p.min(axis=1)
+    hi = p.max(axis=1)
+    c0 = np.clip(np.ceil(lo[:, 0] - 0.5 - reach), 0, width - 1).astype(np.int64)
+    c1 = np.clip(np.floor(hi[:, 0] - 0.5 + reach), 0, width - 1).astype(np.int64)
+    r0 = np.clip(np.ceil(lo[:, 1] - 0.5 - reach), 0, height - 1).astype(np.int64)
+    r1 = np.clip(np.floor(hi[:, 1] - 0.5 + reach), 0, height - 1).astype(np.int64)
+    bw = c1 - c0 + 1
+    bh = r1 - r0 + 1
+
+    # Outward edge distance o_i = -l_i * h_i is affine in the texel centre; write it relative to
+    # the centre of the bbox's first texel: o_i = base_i + gx_i * j_col + gy_i * j_row.
+    grad_l1 = minv[:, 0, :]
+    grad_l2 = minv[:, 1, :]
+    grad_l = np.stack([-(grad_l1 + grad_l2), grad_l1, grad_l2], axis=1)  # (f, 3 edges, 2)
+    d0 = np.column_stack([c0 + 0.5 - p[:, 0, 0], r0 + 0.5 - p[:, 0, 1]])
+    l_first = np.column_stack([np.zeros(len(faces)), (minv @ d0[:, :, None])[:, :, 0]])
+    l_first[:, 0] = 1.0 - l_first[:, 1] - l_first[:, 2]
+    base = (-l_first * heights).astype(np.float32)  # (f, 3)
+    gx = (-grad_l[..., 0] * heights).astype(np.float32)
+    gy = (-grad_l[..., 1] * heights).astype(np.float32)
+    sup = (support * reach).astype(np.float32)
+
+    state = _RasterState(owner=np.full(height * width, -1, dtype=np.int64), width=width)
+
+    # -- small triangles: one broadcast block per bounding-box size ------------------------------
+    fill = 0.5 * np.abs(det) / (bw * bh)  # triangle area / bounding-box area
+    is_small = valid & (bw <= _SMALL_BBOX) & (bh <= _SMALL_BBOX) & (fill >= _SMALL_MIN_FILL)
+    small = np.flatnonzero(is_small)
+    key = bw[small] * (_SMALL_BBOX + 1) + bh[small]
+    order = np.argsort(key, kind="stable")
+    cuts = np.flatnonzero(np.diff(key[order])) + 1
+    groups = np.split(small[order], cuts) if len(small) else []
+    # -- large triangles: (triangle, tile) pairs that survive culling ----------------------------
+    large = np.flatnonzero(valid & ~is_small)
+    tiles = _cull_tiles(large, bw, bh, base, gx, gy, sup)
+
+    work = [("group", g) for g in groups] + [("tiles", tiles)] if len(tiles[0]) else \
+        [("group", g) for g in groups]
+    if progress:
+        from tqdm import tqdm
+
+        work = tqdm(work, desc="rasterise", unit="block")
+    for kind, item in work:
+        if kind == "group":
+            tri = item
+            gw, gh = int(bw[tri[0]]), int(bh[tri[0]])
+            _test_blocks(state, tri, r0[tri], c0[tri], base[tri], gx[tri], gy[tri], sup[tri],
+                         gh, gw, None, None)
+        else:
+            tri, ty, tx = item
+            off_r = ty * _TILE
+            off_c = tx * _TILE
+            tile_base = base[tri] + gx[tri] * off_c[:, None] + gy[tri] * off_r[:, None]
+            _test_blocks(state, tri, r0[tri] + off_r, c0[tri] + off_c, tile_base, gx[tri],
+                         gy[tri], sup[tri], _TILE, _TILE, r1[tri], c1[tri])
+    return state.finish()
+
+
+class _RasterState:
+    """Owner image being filled plus the border (ring) candidates collected so far."""
+
+    def __init__(self, owner: np.ndarray, width: int):
+        self.owner = owner
+        self.width = width
+        self.border_idx: list[np.ndarray] = []
+        self.border_tri: list[np.ndarray] = []
+        self.border_out: list[np.ndarray] = []
+
+    def finish(self) -> np.ndarray:
+        """Give each unowned texel with ring candidates the nearest candidate triangle."""
+        owner = self.owner
+        if self.border_idx:
+            bidx = np.concatenate(self.border_idx)
+            btri = np.concatenate(self.border_tri)
+            bout = np.concatenate(self.border_out)
+            keep = owner[bidx] < 0
+            bidx, btri, bout = bidx[keep], btri[keep], bout[keep]
+            if len(bidx):
+                order = np.lexsort((bout, bidx))  # by texel, then nearest triangle first
+                bidx, btri = bidx[order], btri[order]
+                first = np.ones(len(bidx), dtype=bool)
+                first[1:] = bidx[1:] != bidx[:-1]
+                owner[bidx[first]] = btri[first]
+        return owner
+
+
+def _cull_tiles(large, bw, bh, base, gx, gy, sup):
+    """(triangle, tile row, tile col) of the ``_TILE``-square tiles of each large triangle's
+    bounding box that its footprint can reach: min over the tile of every outward edge distance
+    (centre value minus |gx| + |gy| times the half-extent) is within the edge's support."""
+    ntx = -(-bw[large] // _TILE)
+    nty = -(-bh[large] // _TILE)
+    n = ntx * nty
+    if len(large) == 0 or n.sum() == 0:
+        empty = np.zeros(0, dtype=np.int64)
+        return empty, empty, empty
+    tri = np.repeat(large, n)
+    k = np.arange(int(n.sum()), dtype=np.int64) - np.repeat(np.cumsum(n) - n, n)
+    w = np.repeat(ntx, n)
+    tx = k % w
+    ty = k // w
+    half = (_TILE - 1) / 2.0
+    centre = (base[tri] + gx[tri] * (tx * _TILE + half)[:, None]
+              + gy[tri] * (ty * _TILE + half)[:, None])
+    extent = (np.abs(gx[tri]) + np.abs(gy[tri])) * half
+    keep = np.all(centre - extent <= sup[tri] + 1e-4, axis=1)
+    return tri[keep], ty[keep], tx[keep]
+
+
+def _test_blocks(state, tri, row0, col0, base, gx, gy, sup, gh, gw, row_max, col_max):
+    """Edge-test blocks of ``gh x gw`` texels starting at (row0, col0) for triangles ``tri``
+    (all (g,) / (g, 3) arrays), in chunks of about ``_RASTER_CHUNK_PAIRS`` texels; record inside
+    owners in ``state.owner`` and ring candidates in ``state``. ``row_max``/``col_max`` (g,)
+    clip blocks that run past the triangle's expanded bounding box (tiles), or None."""
+    per_chunk = max(1, _RASTER_CHUNK_PAIRS // (gw * gh))
+    jx = np.arange(gw, dtype=np.float32)[None, None, None, :]
+    jy = np.arange(gh, dtype=np.float32)[None, None, :, None]
+    ix = np.arange(gw)[None, None, :]
+    iy = np.arange(gh)[None, :, None]
+    width = state.width
+    for s in range(0, len(tri), per_chunk):
+        sl = slice(s, s + per_chunk)
+        t = tri[sl]
+        o = (base[sl][:, :, None, None] + gx[sl][:, :, None, None] * jx
+             + gy[sl][:, :, None, None] * jy)  # (g, 3, gh, gw)
+        out = o.max(axis=1)  # (g, gh, gw)
+        ok = np.all(o <= sup[sl][:, :, None, None], axis=1)
+        if row_max is not None:
+            ok &= (row0[sl][:, None, None] + iy <= row_max[sl][:, None, None])
+            ok &= (col0[sl][:, None, None] + ix <= col_max[sl][:, None, None])
+        inside = ok & (out <= 1e-6)
+        ring = ok & ~inside
+        g, yy, xx = np.nonzero(inside)
+        state.owner[(row0[sl][g] + yy) * width + col0[sl][g] + xx] = t[g]
+        g, yy, xx = np.nonzero(ring)
+        state.border_idx.append((row0[sl][g] + yy) * width + col0[sl][g] + xx)
+        state.border_tri.append(t[g])
+        state.border_out.append(out[g, yy, xx])
+
+
+def _affine_maps(xy, faces, values):
+    """Per-triangle affine maps from texel coordinates to per-vertex ``values (m, d)``:
+    ``value(x, y) = origin + jac_x * x + jac_y * y`` (barycentric interpolation inside the
+    triangle, linear extrapolation of the same map outside it). Returns three (f, d) arrays, so
+    each texel later costs three gathers instead of a (k, 3, d) corner array."""
+    p, minv, _, _ = _triangle_frames(xy, faces)
+    v = values[faces]  # (f, 3, d)
+    e1 = v[:, 1] - v[:, 0]
+    e2 = v[:, 2] - v[:, 0]
+    jac_x = e1 * minv[:, 0, 0, None] + e2 * minv[:, 1, 0, None]
+    jac_y = e1 * minv[:, 0, 1, None] + e2 * minv[:, 1, 1, None]
+    origin = v[:, 0] - jac_x * p[:, 0, 0, None] - jac_y * p[:, 0, 1, None]
+    return origin, jac_x, jac_y
+
+
+def _apply_affine(maps, tri, cx, cy) -> np.ndarray:
+    """Evaluate :func:`_affine_maps` of triangles ``tri (k,)`` at texel centres
+    ``cx, cy (k, 1)``; (k, d) float64."""
+    origin, jac_x, jac_y = maps
+    return origin[tri] + jac_x[tri] * cx + jac_y[tri] * cy
+
+
+def _color_checked(wood, points: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """``wood.color(points (k, 3), normals (k, 3))`` checked for shape and finiteness; (k, 3)."""
+    rgb = np.asarray(wood.color(points, normals), dtype=np.float64)
+    if rgb.shape != (len(points), 3):
+        raise WoodcamError(
+            f"bake: wood.color must return an (n, 3) RGB array for n={len(points)} points; got "
+            f"shape {rgb.shape}; fix the appearance's color()"
+        )
+    if not np.all(np.isfinite(rgb)):
+        raise WoodcamError(
+            "bake: wood.color returned NaN or infinite colours; check the appearance and that "
+            "the mesh lies inside the block"
+        )
+    return rgb
+
+
+def _dilate(atlas: np.ndarray, coverage: np.ndarray) -> np.ndarray:
+    """Fill every unpainted texel with the colour of its nearest painted texel (exact EDT).
+
+    Filling the whole atlas (not just ``padding_px`` rings) costs the same with a distance
+    transform and guarantees that no mip level averages in black.
+    """
+    if coverage.all() or not coverage.any():
+        return atlas
+    from scipy.ndimage import distance_transform_edt
+
+    rows, cols = distance_transform_edt(~coverage, return_distances=False, return_indices=True)
+    return atlas[rows, cols]
+
+
+def _textured_mesh(trimesh, verts, faces, uv, atlas):
+    from PIL import Image
+
+    material = trimesh.visual.material.PBRMaterial(
+        name="wood",
+        baseColorTexture=Image.fromarray(atlas),
+        metallicFactor=0.0,  # wood is a dielectric
+        roughnessFactor=0.8,  # unfinished / satin wood; a viewer-side choice, not measured
+    )
+    visual = trimesh.visual.TextureVisuals(uv=uv, material=material)
+    return trimesh.Trimesh(vertices=verts, faces=faces, visual=visual, process=False)

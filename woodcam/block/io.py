@@ -1,0 +1,483 @@
+"""Reading and writing blocks: the woodcam manifest folder and the Mokume sample layout.
+
+A **block folder** (synthetic or real) holds one manifest ``block.json`` and PNG images::
+
+    block.json                 manifest (below)
+    front_photo.png            (n_rows, n_cols, 3) uint8 RGB photo, stored losslessly
+    front_ring_map.png         ring map, 16-bit grey PNG by default (value = round(m * 65535))
+    front_knot_mask.png        an array in Face.extras (bool masks as 0 / 255)
+    true_field.json            only when the true field can be serialised (below)
+
+Manifest (``"format": "woodcam-block"``, ``"version": 1``)::
+
+    {"name": str, "size_mm": [W, D, H], "meta": {...},
+     "faces": {"front": {"shape": [n_rows, n_cols],
+                         "photo": "front_photo.png" | null,
+                         "ring_map": "front_ring_map.png" | null,
+                         "ring_map_bits": 16 | 8,
+                         "traces": [{"year": int | null, "points_px": [[row, col], ...]}, ...],
+                         "traces_svg": "front_traces.svg",    (optional, read only: see below)
+                         "extras": {"knot_mask": {"png": "front_knot_mask.png", "dtype": "bool"},
+                                    "note": {"json": ...}}},
+               ...},
+     "true_field": {"saved": bool, "type": "module:QualName", "file": "true_field.json",
+                    "reason": str}}
+
+A hand-made manifest of a real block may also name an SVG per face (``"traces_svg"``) with
+rings drawn over the photo in a vector editor (:mod:`woodcam.block.svg`); :func:`read_block`
+adds those traces to the JSON ones. :func:`write_block` always writes traces as JSON.
+
+Precision: photos and traces round-trip exactly (PNG is lossless; JSON floats are written with
+``repr`` precision); a ring map in [0, 1] is quantised to ``ring_map_bits`` bits, so it comes
+back within ``0.5 / (2**bits - 1)`` (:data:`woodcam.tolerances.RING_MAP_QUANT_16BIT`).
+
+**True field.** A growth field is in general arbitrary code and is not serialised. It is saved
+only when it has ``to_dict() -> dict`` (JSON-serialisable) and its class, which must live in a
+``woodcam.*`` module, has ``from_dict(dict)``; then ``true_field.json`` holds the dict and the
+manifest the class. Otherwise the manifest records ``"saved": false`` with the reason, and
+:func:`read_block` returns ``true_field=None``. Real blocks simply have no true field.
+
+**Mokume folders** (Larsson et al. 2025): ``X_col.png`` photo, ``X_arl-unet.png`` ring map,
+optional ``X_ann.png`` and ``X_knot.png``, for letters ``X`` = ``A``..``F`` mapped to faces by
+``docs/conventions.md``. See :func:`read_mokume`.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from ..errors import WoodcamError
+from ..frames import FACES, MOKUME_LETTER
+from .block import Block, Face, RingTrace
+
+MANIFEST = "block.json"
+FORMAT = "woodcam-block"
+VERSION = 1
+
+#: Default physical size of a Mokume cube (mm). The dataset normalises cubes by their largest
+#: side and does not store the physical size; its cubes are roughly 50 mm hardwood/softwood
+#: cubes, so 50 mm is the default here. Pass the real size when you know it.
+MOKUME_DEFAULT_SIZE_MM = (50.0, 50.0, 50.0)
+
+
+# -- woodcam manifest folders --------------------------------------------------------------------
+
+def write_block(block: Block, folder, *, ring_map_bits: Literal[8, 16] = 16,
+                overwrite: bool = True) -> Path:
+    """Write ``block`` to ``folder`` as ``block.json`` plus PNG images (see module docstring).
+
+    Parameters
+    ----------
+    block : Block
+    folder : path
+        Created if missing.
+    ring_map_bits : 8 or 16
+        Ring-map PNG depth; 16 keeps maps within 7.6e-6 of the original, 8 within 2e-3.
+    overwrite : bool
+        If False, refuse to write into a folder that already holds a manifest.
+
+    Returns
+    -------
+    Path of the manifest.
+    """
+    if ring_map_bits not in (8, 16):
+        raise WoodcamError(f"ring_map_bits must be 8 or 16; got {ring_map_bits!r}")
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    manifest_path = folder / MANIFEST
+    if manifest_path.exists() and not overwrite:
+        raise WoodcamError(
+            f"folder {str(folder)!r} already holds a {MANIFEST}; pass overwrite=True or pick a new folder"
+        )
+    faces = {}
+    for name, face in block.faces.items():
+        entry: dict = {"shape": list(face.shape), "photo": None, "ring_map": None}
+        if face.photo is not None:
+            photo = np.asarray(face.photo)
+            if photo.dtype != np.uint8:
+                raise WoodcamError(
+                    f"photo of face {name!r} must be uint8 to be stored losslessly; got {photo.dtype}; "
+                    "convert with np.clip(photo * 255, 0, 255).round().astype(np.uint8)"
+                )
+            entry["photo"] = f"{name}_photo.png"
+            _write_png(folder / entry["photo"], photo)
+        if face.ring_map is not None:
+            entry["ring_map"] = f"{name}_ring_map.png"
+            entry["ring_map_bits"] = int(ring_map_bits)
+            _write_png(folder / entry["ring_map"], _quantise(face.ring_map, ring_map_bits, name))
+        entry["traces"] = [
+            {"year": None if t.year is None else int(t.year), "points_px": t.points_px.tolist()}
+            for t in face.traces
+        ]
+        extras = {}
+        for key, value in face.extras.items():
+            extras[key] = _write_extra(folder, name, key, value)
+        entry["extras"] = extras
+        faces[name] = entry
+    manifest = {
+        "format": FORMAT, "version": VERSION, "name": block.name,
+        "size_mm": list(block.size_mm), "meta": _jsonable(block.meta, "block.meta"),
+        "faces": faces, "true_field": _write_field(block.true_field, folder),
+    }
+    manifest_path.write_text(json.dumps(manifest, indent=1))
+    return manifest_path
+
+
+def read_block(folder) -> Block:
+    """Read a block folder written by :func:`write_block` (or made by hand for a real block).
+
+    Faces missing from the manifest are absent from the block; ``true_field`` is None unless the
+    manifest says it was saved and its class can be restored.
+    """
+    folder = Path(folder)
+    path = folder / MANIFEST if folder.is_dir() else folder
+    folder = path.parent
+    if not path.exists():
+        raise WoodcamError(
+            f"folder {str(folder)!r} must hold a {MANIFEST} manifest; none found. "
+            "Use read_mokume() for a Mokume sample folder"
+        )
+    try:
+        m = json.loads(path.read_text())
+    except json.JSONDecodeError as err:
+        raise WoodcamError(f"{str(path)!r} must be valid JSON; {err}") from err
+    if m.get("format") != FORMAT:
+        raise WoodcamError(f"{str(path)!r} must have \"format\": \"{FORMAT}\"; got {m.get('format')!r}")
+    faces = {}
+    for name, entry in m.get("faces", {}).items():
+        shape = tuple(entry["shape"])
+        photo = ring_map = None
+        if entry.get("photo"):
+            photo = _read_png(folder / entry["photo"], f"photo of face {name!r}")
+            if photo.ndim == 2:
+                photo = np.repeat(photo[..., None], 3, axis=2)
+            photo = photo[..., :3].astype(np.uint8, copy=False)
+            _check_shape(photo, shape, f"photo of face {name!r} ({entry['photo']})")
+        if entry.get("ring_map"):
+            bits = int(entry.get("ring_map_bits", 8))
+            raw = _read_png(folder / entry["ring_map"], f"ring map of face {name!r}")
+            if raw.ndim == 3:
+                raw = raw[..., 0]
+            _check_shape(raw, shape, f"ring map of face {name!r} ({entry['ring_map']})")
+            ring_map = (raw.astype(np.float64) / (2 ** bits - 1)).astype(np.float32)
+        traces = [RingTrace(np.asarray(t["points_px"], dtype=float), t.get("year"))
+                  for t in entry.get("traces", [])]
+        if entry.get("traces_svg"):
+            from .svg import read_traces_svg
+
+            traces += read_traces_svg(folder / entry["traces_svg"], shape)
+        extras = {k: _read_extra(folder, v, shape, f"extras[{k!r}] of face {name!r}")
+                  for k, v in entry.get("extras", {}).items()}
+        faces[name] = Face(name, shape, photo=photo, traces=traces, ring_map=ring_map, extras=extras)
+    return Block(
+        tuple(m["size_mm"]), faces=faces, true_field=_read_field(m.get("true_field"), folder),
+        name=m.get("name", folder.name), meta=m.get("meta", {}),
+    )
+
+
+def _quantise(ring_map, bits: int, name: str) -> np.ndarray:
+    a = np.asarray(ring_map, dtype=np.float64)
+    if not np.all(np.isfinite(a)) or a.min() < 0.0 or a.max() > 1.0:
+        raise WoodcamError(
+            f"ring_map of face {name!r} must hold finite values in [0, 1]; got range "
+            f"[{np.nanmin(a):.3g}, {np.nanmax(a):.3g}]; clip it with np.clip(m, 0, 1)"
+        )
+    top = 2 ** bits - 1
+    return np.round(a * top).astype(np.uint16 if bits == 16 else np.uint8)
+
+
+def _write_extra(folder: Path, face: str, key: str, value) -> dict:
+    if isinstance(value, np.ndarray):
+        if not key.replace("_", "").replace("-", "").isalnum():
+            raise WoodcamError(f"extras key {key!r} of face {face!r} must be alphanumeric with _ or -")
+        fname = f"{face}_{key}.png"
+        if value.dtype == bool:
+            _write_png(folder / fname, value.astype(np.uint8) * 255)
+        elif value.dtype in (np.uint8, np.uint16) and value.ndim in (2, 3):
+            _write_png(folder / fname, value)
+        else:
+            raise WoodcamError(
+                f"extras[{key!r}] of face {face!r} must be a bool, uint8 or uint16 image to be "
+                f"stored as PNG; got dtype {value.dtype}, shape {value.shape}"
+            )
+        return {"png": fname, "dtype": str(value.dtype)}
+    return {"json": _jsonable(value, f"extras[{key!r}] of face {face!r}")}
+
+
+def _read_extra(folder: Path, entry: dict, shape, what: str):
+    if "png" in entry:
+        a = _read_png(folder / entry["png"], what)
+        _check_shape(a, shape, what)
+        if entry.get("dtype") == "bool":
+            return a > 127
+        return a.astype(entry.get("dtype", str(a.dtype)), copy=False)
+    return entry.get("json")
+
+
+def _field_type(obj) -> str:
+    cls = type(obj)
+    return f"{cls.__module__}:{cls.__qualname__}"
+
+
+def _write_field(field, folder: Path) -> dict:
+    target = folder / "true_field.json"
+    if field is None:
+        if target.exists():
+            target.unlink()
+        return {"saved": False, "reason": "the block has no true field"}
+    kind = _field_type(field)
+    to_dict = getattr(field, "to_dict", None)
+    from_dict = getattr(type(field), "from_dict", None)
+    if to_dict is None or from_dict is None or not kind.startswith("woodcam."):
+        if target.exists():
+            target.unlink()
+        return {"saved": False, "type": kind,
+                "reason": "the field is not a woodcam class with to_dict()/from_dict(); truth not saved"}
+    try:
+        state = _jsonable(to_dict(), "true_field.to_dict()")
+    except (WoodcamError, TypeError, AttributeError) as err:
+        # e.g. a placement wrapper around a field that itself cannot be serialised
+        if target.exists():
+            target.unlink()
+        return {"saved": False, "type": kind, "reason": f"to_dict() failed: {err}"}
+    target.write_text(json.dumps(state))
+    return {"saved": True, "type": kind, "file": target.name}
+
+
+def field_to_state(field) -> dict:
+    """``{"type": "module:QualName", "state": field.to_dict()}`` for a woodcam field class.
+
+    Used by wrappers (e.g. a placed field) to serialise the field they wrap.
+    """
+    kind = _field_type(field)
+    if not kind.startswith("woodcam.") or not hasattr(field, "to_dict") \
+            or not hasattr(type(field), "from_dict"):
+        raise WoodcamError(
+            f"field of type {kind!r} must be a woodcam class with to_dict()/from_dict() to be saved"
+        )
+    return {"type": kind, "state": _jsonable(field.to_dict(), f"{kind}.to_dict()")}
+
+
+def field_from_state(d: dict):
+    """Inverse of :func:`field_to_state`."""
+    return _read_field({"saved": True, "type": d["type"]}, None, state=d["state"])
+
+
+def _read_field(entry, folder: Path | None, state=None):
+    if not entry or not entry.get("saved"):
+        return None
+    module, _, qualname = entry["type"].partition(":")
+    # Only woodcam's own classes are restored: a manifest must never make us import arbitrary code.
+    if not module.startswith("woodcam."):
+        raise WoodcamError(f"true_field type must be a woodcam class; got {entry['type']!r}")
+    try:
+        obj = importlib.import_module(module)
+        for part in qualname.split("."):
+            obj = getattr(obj, part)
+    except (ImportError, AttributeError) as err:
+        raise WoodcamError(
+            f"true_field type {entry['type']!r} in the manifest cannot be imported from this "
+            f"woodcam version; upgrade woodcam or drop the true_field entry"
+        ) from err
+    if state is None:
+        state = json.loads((folder / entry["file"]).read_text())
+    return obj.from_dict(state)
+
+
+def _jsonable(obj, what: str):
+    """Convert numpy scalars/arrays inside ``obj`` to plain JSON types, or raise naming ``what``."""
+    def default(o):
+        if isinstance(o, np.generic):
+            return o.item()
+        if isinstance(o, np.ndarray):
+            return o.tolist()
+        if isinstance(o, (Path, os.PathLike)):
+            return str(o)
+        if isinstance(o, (set, tuple)):
+            return list(o)
+        raise TypeError(type(o).__name__)
+    try:
+        return json.loads(json.dumps(obj, default=default))
+    except (TypeError, ValueError) as err:
+        raise WoodcamError(
+            f"{what} must be JSON-serialisable (numbers, strings, lists, dicts, numpy arrays); "
+            f"found a {err}"
+        ) from err
+
+
+# -- images ---------------------------------------------------------------------------------------
+
+def _write_png(path: Path, a: np.ndarray) -> None:
+    from PIL import Image
+
+    a = np.asarray(a)
+    if a.dtype == np.uint16:
+        if a.ndim != 2:
+            raise WoodcamError(f"16-bit PNGs must be single-channel; got shape {a.shape} for {path.name}")
+        Image.fromarray(a).save(path)  # PIL picks mode I;16 for 2-D uint16
+    else:
+        Image.fromarray(np.ascontiguousarray(a)).save(path)
+
+
+def _read_png(path: Path, what: str) -> np.ndarray:
+    from PIL import Image
+
+    if not path.exists():
+        raise WoodcamError(f"{what}: image file {str(path)!r} is listed but missing")
+    with Image.open(path) as im:
+        if im.mode in ("I;16", "I;16B", "I;16L"):
+            return np.asarray(im).astype(np.uint16)
+        if im.mode == "I":
+            return np.asarray(im).astype(np.uint16)
+        if im.mode in ("P", "LA", "RGBA", "CMYK", "1"):
+            im = im.convert("RGB" if im.mode in ("P", "RGBA", "CMYK") else "L")
+        return np.asarray(im)
+
+
+def _check_shape(a: np.ndarray, shape, what: str) -> None:
+    if tuple(a.shape[:2]) != tuple(shape):
+        raise WoodcamError(
+            f"{what} must be {shape[0]}x{shape[1]} px like its face; got {a.shape[0]}x{a.shape[1]}; "
+            "resize the image or fix the face's shape"
+        )
+
+
+# -- Mokume sample folders -----------------------------------------------------------------------
+
+def read_mokume(folder, size_mm=MOKUME_DEFAULT_SIZE_MM, *, name: str | None = None) -> Block:
+    """Read one Mokume sample folder (``X_col.png``, ``X_arl-unet.png``, ... for X = A..F).
+
+    Parameters
+    ----------
+    folder : path
+        A sample folder such as ``../shared/data/mokume/H11``.
+    size_mm : (W, D, H)
+        Physical size of the cube in mm. Mokume cubes are normalised by their largest side and
+        the files do not record it, so it is an argument; default 50 mm cube
+        (:data:`MOKUME_DEFAULT_SIZE_MM`).
+    name : str, optional
+        Block name; default the folder name.
+
+    Returns
+    -------
+    Block
+        One face per letter that has any file. ``photo`` from ``X_col.png`` (uint8 RGB);
+        ``ring_map`` from ``X_arl-unet.png`` as float32 in [0, 1] (value / 255; the U-Net's
+        ring localisation, no year labels); ``extras["knot_mask"]`` from ``X_knot.png``
+        ((rows, cols) bool, True where the mask is dark: below the mid-grey between the
+        image's min and max); ``extras["annotation"]`` from ``X_ann.png`` as stored (uint8).
+        ``meta`` records the source folder and that the size was assumed.
+
+    Raises
+    ------
+    WoodcamError
+        When the folder has no Mokume files, or images of one face differ in size.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise WoodcamError(f"folder must be a Mokume sample folder; {str(folder)!r} is not a directory")
+    faces = {}
+    for face in FACES:
+        letter = MOKUME_LETTER[face]
+        files = {k: folder / f"{letter}_{k}.png" for k in ("col", "arl-unet", "ann", "knot")}
+        if not any(p.exists() for p in files.values()):
+            continue
+        images = {k: _read_png(p, f"Mokume {k} of face {letter}") for k, p in files.items() if p.exists()}
+        shape = next(iter(images.values())).shape[:2]
+        for k, a in images.items():
+            _check_shape(a, shape, f"Mokume image {files[k].name}")
+        photo = ring_map = None
+        extras = {}
+        if "col" in images:
+            a = images["col"]
+            photo = np.repeat(a[..., None], 3, axis=2) if a.ndim == 2 else a[..., :3]
+            photo = photo.astype(np.uint8, copy=False)
+        if "arl-unet" in images:
+            a = images["arl-unet"]
+            a = a[..., 0] if a.ndim == 3 else a
+            top = 65535.0 if a.dtype == np.uint16 else 255.0
+            ring_map = (a.astype(np.float64) / top).astype(np.float32)
+        if "knot" in images:
+            a = images["knot"]
+            a = a.mean(axis=2) if a.ndim == 3 else a.astype(float)
+            lo, hi = float(a.min()), float(a.max())
+            extras["knot_mask"] = a < 0.5 * (lo + hi) if hi > lo else np.zeros(a.shape, bool)
+        if "ann" in images:
+            extras["annotation"] = images["ann"]
+        faces[face] = Face(face, shape, photo=photo, ring_map=ring_map, extras=extras)
+    if not faces:
+        raise WoodcamError(
+            f"folder {str(folder)!r} must hold Mokume files like A_col.png or A_arl-unet.png; found none"
+        )
+    meta = {"source": "mokume", "folder": str(folder.resolve()),
+            "size_assumed_mm": [float(s) for s in size_mm],
+            "note": "Mokume cubes are normalised; size_mm was given to read_mokume, not measured"}
+    return Block(tuple(size_mm), faces=faces, name=name or folder.name, meta=meta)
+
+
+# -- real blocks from image files ----------------------------------------------------------------
+
+def _load_image(src, what: str) -> np.ndarray:
+    if isinstance(src, (str, os.PathLike)):
+        return _read_png(Path(src), what)  # PIL reads JPEG/TIFF/... the same way
+    return np.asarray(src)
+
+
+def block_from_images(size_mm, photos: dict | None = None, ring_maps: dict | None = None, *,
+                      name: str = "block", meta: dict | None = None) -> Block:
+    """Build a (real) block from face images, ready for :func:`write_block`.
+
+    Parameters
+    ----------
+    size_mm : (W, D, H)
+        Measured block size in mm.
+    photos : dict face -> path or (rows, cols, 3) uint8 array, optional
+        Face photos, already rectified to the face and oriented as ``docs/conventions.md``
+        says (seen from outside; Mokume letters ``A``..``F`` accepted as keys). Grey images
+        are repeated to RGB.
+    ring_maps : dict face -> path or (rows, cols) array, optional
+        Ring maps: float arrays in [0, 1], or uint8 / uint16 images (scaled by 255 / 65535).
+    name, meta
+        Block name and provenance.
+
+    Raises
+    ------
+    WoodcamError
+        When a face's photo and ring map differ in size, or a photo is not uint8 RGB.
+    """
+    from ..frames import check_face
+
+    images: dict[str, dict] = {}
+    for kind, src_map in (("photo", photos or {}), ("ring_map", ring_maps or {})):
+        for key, src in src_map.items():
+            face = check_face(key)
+            a = _load_image(src, f"{kind} of face {face!r}")
+            if kind == "photo":
+                if a.ndim == 2:
+                    a = np.repeat(a[..., None], 3, axis=2)
+                if a.ndim != 3 or a.shape[2] < 3 or a.dtype != np.uint8:
+                    raise WoodcamError(
+                        f"photo of face {face!r} must be an 8-bit RGB image (rows, cols, 3) uint8; "
+                        f"got shape {a.shape}, dtype {a.dtype}"
+                    )
+                a = a[..., :3]
+            else:
+                if a.ndim == 3:
+                    a = a[..., :3].mean(axis=2).astype(a.dtype)
+                if a.dtype in (np.uint8, np.uint16):
+                    a = (a.astype(np.float64) / (255.0 if a.dtype == np.uint8 else 65535.0))
+                a = np.asarray(a, dtype=np.float32)
+            images.setdefault(face, {})[kind] = a
+    faces = {}
+    for face, imgs in images.items():
+        shape = next(iter(imgs.values())).shape[:2]
+        for kind, a in imgs.items():
+            _check_shape(a, shape, f"{kind} of face {face!r}")
+        faces[face] = Face(face, shape, photo=imgs.get("photo"), ring_map=imgs.get("ring_map"))
+    return Block(tuple(size_mm), faces=faces, name=name, meta=dict(meta or {}))

@@ -1,0 +1,175 @@
+"""Carving: the part intersected with the block, as a watertight mesh in the block frame (mm).
+
+The block is the box ``[0, W] x [0, D] x [0, H]`` of ``docs/conventions.md`` (origin at the
+bottom-front-left corner, X width, Y depth, Z up). Carving is the exact boolean
+``part ∩ block`` computed by manifold3d, so the result is always a closed, oriented 2-manifold.
+
+- A part that misses the block entirely (empty intersection) is an error.
+- A part that sticks out of the block is carved anyway; the volume outside the block is reported
+  in :attr:`CarveResult.warnings` and emitted as a :class:`woodcam.errors.WoodcamWarning`.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import WoodcamError, WoodcamWarning
+from ..tolerances import OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG, TESSELLATION_TOL_MM
+from .parts import load_part
+
+
+@dataclass(frozen=True)
+class CarveResult:
+    """The carved part.
+
+    Attributes
+    ----------
+    mesh : trimesh.Trimesh
+        Watertight triangle mesh of ``part ∩ block``, block frame, mm (vertices ``(n, 3)``
+        float64, faces ``(m, 3)`` int64, outward normals). Built without vertex merging, so its
+        topology is exactly manifold3d's.
+    manifold : manifold3d.Manifold
+        The same solid as a manifold, for further booleans.
+    volume_mm3 : float
+        Volume of the carved solid (mm^3).
+    part_volume_mm3 : float
+        Volume of the whole part before carving (mm^3).
+    outside_volume_mm3 : float
+        ``part_volume_mm3 - volume_mm3``: volume of the part outside the block (mm^3), clipped
+        at 0 (boolean round-off can make it slightly negative).
+    warnings : list of str
+        Human-readable warnings (e.g. the part sticks out of the block).
+    size_mm : (3,) tuple of float
+        Block size ``(W, D, H)`` in mm the part was carved from.
+    """
+
+    mesh: Any
+    manifold: Any
+    volume_mm3: float
+    part_volume_mm3: float
+    outside_volume_mm3: float
+    warnings: list[str] = field(default_factory=list)
+    size_mm: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+def carve(
+    part: Any,
+    size_mm,
+    *,
+    tolerance_mm: float = TESSELLATION_TOL_MM,
+    angular_tolerance_deg: float = TESSELLATION_ANGLE_DEG,
+) -> CarveResult:
+    """Carve ``part`` out of the block ``[0, W] x [0, D] x [0, H]`` (block frame, mm).
+
+    Parameters
+    ----------
+    part : manifold3d.Manifold or any source :func:`woodcam.cad.load_part` accepts
+        The part in the block frame, mm. Non-manifold sources are loaded with ``load_part``
+        using the tolerances below.
+    size_mm : (3,) sequence of float
+        Block size ``(W, D, H)`` in mm, each finite and > 0.
+    tolerance_mm, angular_tolerance_deg : float
+        Tessellation tolerances passed to :func:`load_part` for B-rep sources.
+
+    Returns
+    -------
+    CarveResult
+        The carved mesh and manifold, volumes and warnings.
+
+    Raises
+    ------
+    WoodcamError
+        If ``size_mm`` is not three positive finite lengths, or the part does not intersect the
+        block (the message gives both bounding boxes).
+
+    Warns
+    -----
+    WoodcamWarning
+        If more than ``OUTSIDE_VOLUME_EPS_MM3`` of the part lies outside the block; the part is
+        carved anyway and the message gives the outside volume in mm^3 and percent.
+    """
+    import manifold3d
+    import trimesh
+
+    size = _check_size(size_mm)
+    # load_part also validates a Manifold (status, emptiness, orientation) without copying it
+    solid = load_part(part, tolerance_mm=tolerance_mm, angular_tolerance_deg=angular_tolerance_deg)
+
+    block = manifold3d.Manifold.cube(size)
+    carved = solid ^ block
+    part_volume = float(solid.volume())
+    volume = float(carved.volume()) if not carved.is_empty() else 0.0
+    if carved.is_empty() or volume <= OUTSIDE_VOLUME_EPS_MM3:
+        lo, hi = _bounds(solid)
+        raise WoodcamError(
+            f"part does not intersect the block: the part's bounding box is "
+            f"{_fmt_box(lo, hi)} mm but the block is {_fmt_box(np.zeros(3), np.array(size))} mm "
+            f"(block frame: origin at the bottom-front-left corner); model the part in the block "
+            f"frame, e.g. move it by {_fmt_vec(np.array(size) / 2 - (lo + hi) / 2)} mm to centre "
+            f"it, or give the right block size"
+        )
+
+    outside = max(part_volume - volume, 0.0)
+    messages: list[str] = []
+    if outside > OUTSIDE_VOLUME_EPS_MM3:
+        lo, hi = _bounds(solid)
+        message = (
+            f"part sticks out of the block: {outside:.4g} mm^3 "
+            f"({100.0 * outside / part_volume:.3g} % of the part's {part_volume:.6g} mm^3) lies "
+            f"outside and is not carved; part bounding box {_fmt_box(lo, hi)} mm, block "
+            f"{_fmt_box(np.zeros(3), np.array(size))} mm; move the part or use a larger block"
+        )
+        messages.append(message)
+        warnings.warn(message, WoodcamWarning, stacklevel=2)
+
+    mesh_out = carved.to_mesh64()
+    # copies, so the arrays do not keep manifold3d's Mesh64 buffers alive (nanobind reports
+    # such buffers as leaks at interpreter exit)
+    vertices = np.array(mesh_out.vert_properties[:, :3], dtype=np.float64, copy=True)
+    faces = np.array(mesh_out.tri_verts, dtype=np.int64, copy=True)
+    del mesh_out
+    mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+    return CarveResult(
+        mesh=mesh,
+        manifold=carved,
+        volume_mm3=volume,
+        part_volume_mm3=part_volume,
+        outside_volume_mm3=outside,
+        warnings=messages,
+        size_mm=size,
+    )
+
+
+def _check_size(size_mm) -> tuple[float, float, float]:
+    """Validate the block size ``(W, D, H)`` in mm."""
+    try:
+        values = [float(v) for v in size_mm]
+    except (TypeError, ValueError) as err:
+        raise WoodcamError(
+            f"size_mm must be three lengths (W, D, H) in mm, got {size_mm!r}; e.g. (100, 80, 50)"
+        ) from err
+    if len(values) != 3 or not all(math.isfinite(v) and v > 0 for v in values):
+        raise WoodcamError(
+            f"size_mm must be three finite lengths > 0 (W, D, H) in mm, got {size_mm!r}; "
+            f"e.g. (100, 80, 50)"
+        )
+    return (values[0], values[1], values[2])
+
+
+def _bounds(solid) -> tuple[np.ndarray, np.ndarray]:
+    """Axis-aligned bounds ``(lo (3,), hi (3,))`` of a manifold, mm."""
+    box = np.asarray(solid.bounding_box(), dtype=np.float64)
+    return box[:3], box[3:]
+
+
+def _fmt_vec(v) -> str:
+    return "(" + ", ".join(f"{x:.4g}" for x in v) + ")"
+
+
+def _fmt_box(lo, hi) -> str:
+    return f"[{lo[0]:.4g}, {hi[0]:.4g}] x [{lo[1]:.4g}, {hi[1]:.4g}] x [{lo[2]:.4g}, {hi[2]:.4g}]"

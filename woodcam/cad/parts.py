@@ -1,0 +1,436 @@
+"""Part sources -> one watertight :class:`manifold3d.Manifold` in the block frame, millimetres.
+
+A *part* is the solid a woodworker wants to cut out of the block. It is modelled directly in the
+block frame of ``docs/conventions.md`` (origin at the block's bottom-front-left corner, X width,
+Y depth, Z up, mm); woodcam never moves or scales it.
+
+Accepted sources (:func:`load_part`):
+
+- a build123d ``Part`` / ``Solid`` / ``Compound`` (any ``build123d`` ``Shape``), or a
+  ``BuildPart`` builder (its ``.part`` is used);
+- a cadquery ``Workplane`` (all solids on its stack) or ``Shape``;
+- a ``trimesh.Trimesh`` or ``trimesh.Scene``;
+- a ``manifold3d.Manifold``;
+- a list or tuple of any of these (incl. a build123d ``ShapeList``): their union;
+- a path (``str`` / ``Path``) to ``.step``/``.stp`` (B-rep, read with OpenCascade),
+  ``.stl``/``.obj``/``.glb``/``.gltf`` (meshes, read with trimesh, coordinates taken as mm in the
+  block frame as stored: no unit or Y-up conversion), or a ``.py`` script that defines a
+  module-level ``part`` (any of the objects above).
+
+B-rep shapes (build123d, cadquery, STEP) are tessellated with OpenCascade's
+``BRepMesh_IncrementalMesh`` at a chord tolerance (mm) and an angular tolerance (degrees at this
+API, radians inside), on a copy of the shape so an earlier, coarser triangulation cached on the
+user's shape never leaks in. Each solid becomes its own manifold and the solids are unioned, so
+solids that touch or overlap still give one valid manifold.
+"""
+
+from __future__ import annotations
+
+import math
+import runpy
+import sys
+from numbers import Real
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import WoodcamError, require
+from ..tolerances import TESSELLATION_ANGLE_DEG, TESSELLATION_TOL_MM
+
+#: File suffixes :func:`load_part` reads, by kind.
+STEP_SUFFIXES = (".step", ".stp")
+MESH_SUFFIXES = (".stl", ".obj", ".glb", ".gltf")
+SCRIPT_SUFFIXES = (".py",)
+SUPPORTED_SUFFIXES = STEP_SUFFIXES + MESH_SUFFIXES + SCRIPT_SUFFIXES
+
+
+def load_part(
+    source: Any,
+    *,
+    tolerance_mm: float = TESSELLATION_TOL_MM,
+    angular_tolerance_deg: float = TESSELLATION_ANGLE_DEG,
+):
+    """Turn a part source into one watertight manifold in the block frame (mm).
+
+    Parameters
+    ----------
+    source : build123d Shape | BuildPart | cadquery Workplane | cadquery Shape | trimesh.Trimesh
+        | trimesh.Scene | manifold3d.Manifold | list of these | str | Path
+        The part, modelled in the block frame in millimetres, or a path to a ``.step``/``.stp``,
+        ``.stl``, ``.obj``, ``.glb``/``.gltf`` file or a ``.py`` script defining ``part``
+        (run with ``runpy`` under the name ``"__woodcam_part__"``, so its
+        ``if __name__ == "__main__":`` block does not run; its folder is on ``sys.path``
+        meanwhile so it can import helpers next to it).
+    tolerance_mm : float
+        Chord tolerance (mm, > 0) for tessellating B-rep sources: the largest distance between
+        the true surface and its triangles. Ignored for mesh sources.
+    angular_tolerance_deg : float
+        Angular tolerance (degrees, in (0, 90]) for tessellating B-rep sources: the largest
+        normal jump between neighbouring triangles on a curved face. Ignored for meshes.
+
+    Returns
+    -------
+    manifold3d.Manifold
+        Non-empty, valid (oriented 2-manifold) solid with positive volume, block frame, mm.
+
+    Raises
+    ------
+    WoodcamError
+        For an unsupported object or suffix, a missing or unreadable file, a script that fails
+        or does not define ``part``, empty geometry, or a mesh that is not a closed solid even
+        after repair (hole filling, normal fixing).
+    """
+    if not (isinstance(tolerance_mm, Real) and math.isfinite(tolerance_mm) and tolerance_mm > 0):
+        raise WoodcamError(
+            f"tolerance_mm must be a finite number > 0 (chord tolerance in mm), got "
+            f"{tolerance_mm!r}; use e.g. {TESSELLATION_TOL_MM}"
+        )
+    if not (isinstance(angular_tolerance_deg, Real) and 0 < angular_tolerance_deg <= 90):
+        raise WoodcamError(
+            f"angular_tolerance_deg must be in (0, 90] degrees, got {angular_tolerance_deg!r}; "
+            f"use e.g. {TESSELLATION_ANGLE_DEG}"
+        )
+    return _load(source, float(tolerance_mm), math.radians(angular_tolerance_deg), origin="part")
+
+
+# --------------------------------------------------------------------------------- dispatch
+
+
+def _load(source: Any, tol_mm: float, ang_rad: float, origin: str):
+    """Dispatch on the source's type; ``origin`` names the source in error messages."""
+    import manifold3d
+    import trimesh
+
+    if source is None:
+        raise WoodcamError(
+            f"{origin} is None; the script or builder produced no shape: make sure it builds "
+            f"a solid and assigns it"
+        )
+    if isinstance(source, manifold3d.Manifold):
+        return _check_manifold(source, origin)
+    if isinstance(source, trimesh.Trimesh):
+        return _manifold_from_trimesh(source, origin)
+    if isinstance(source, trimesh.Scene):
+        return _manifold_from_scene(source, origin)
+    if isinstance(source, (str, Path)):
+        return _load_path(Path(source), tol_mm, ang_rad)
+
+    if isinstance(source, (list, tuple)):  # incl. build123d ShapeList: union of the items
+        if not source:
+            raise WoodcamError(f"{origin} is an empty {type(source).__name__}; pass a solid")
+        return _union([_load(item, tol_mm, ang_rad, f"{origin}[{i}]")
+                       for i, item in enumerate(source)], origin)
+
+    # the CAD kernels are only imported when the object already comes from one of them
+    module = type(source).__module__ or ""
+    if module.startswith("build123d"):
+        bd = require("build123d", "cad", "loading build123d parts")
+        if isinstance(source, bd.Shape):  # Part, Solid, Compound, ...
+            return _manifold_from_topods(source.wrapped, tol_mm, ang_rad, origin)
+        if isinstance(source, bd.BuildPart):
+            return _load(source.part, tol_mm, ang_rad, f"{origin} (BuildPart.part)")
+    if module.startswith("cadquery"):
+        cq = require("cadquery", "cad", "loading cadquery parts")
+        if isinstance(source, cq.Workplane):  # every Shape on the stack
+            shapes = [v.wrapped for v in source.vals() if isinstance(v, cq.Shape)]
+            if not shapes:
+                raise WoodcamError(
+                    f"{origin}: the cadquery Workplane holds no shape (its stack is "
+                    f"{source.vals()!r}); build a solid first, e.g. .box(...) or .extrude(...)"
+                )
+            return _union([_manifold_from_topods(s, tol_mm, ang_rad, origin) for s in shapes],
+                          origin)
+        if isinstance(source, cq.Shape):
+            return _manifold_from_topods(source.wrapped, tol_mm, ang_rad, origin)
+    if module.startswith("OCP") and hasattr(source, "ShapeType"):  # raw TopoDS_Shape
+        return _manifold_from_topods(source, tol_mm, ang_rad, origin)
+
+    raise WoodcamError(
+        f"{origin}: cannot use an object of type {type(source).__module__}."
+        f"{type(source).__qualname__} as a part; pass a build123d Part/Solid/Compound, a cadquery "
+        f"Workplane/Shape, a trimesh.Trimesh, a manifold3d.Manifold, or a path to a file with "
+        f"suffix {', '.join(SUPPORTED_SUFFIXES)}"
+    )
+
+
+def _load_path(path: Path, tol_mm: float, ang_rad: float):
+    """Read a part file; the suffix picks the reader."""
+    suffix = path.suffix.lower()
+    if suffix not in SUPPORTED_SUFFIXES:
+        raise WoodcamError(
+            f"part file {str(path)!r} has unsupported suffix {path.suffix!r}; use one of "
+            f"{', '.join(SUPPORTED_SUFFIXES)} (export the part from your CAD program as STEP or "
+            f"STL)"
+        )
+    if not path.is_file():
+        raise WoodcamError(
+            f"part file {str(path)!r} does not exist or is not a file; check the path"
+        )
+    if suffix in SCRIPT_SUFFIXES:
+        return _load_script(path, tol_mm, ang_rad)
+    if suffix in STEP_SUFFIXES:
+        return _load_step(path, tol_mm, ang_rad)
+    return _load_mesh_file(path)
+
+
+def _load_script(path: Path, tol_mm: float, ang_rad: float):
+    """Run a part script (``runpy``, not as ``__main__``) and load its module-level ``part``."""
+    folder = str(path.resolve().parent)
+    sys.path.insert(0, folder)  # like `python script.py`: helpers next to the script import
+    try:
+        namespace = runpy.run_path(str(path), run_name="__woodcam_part__")
+    except SystemExit as err:
+        raise WoodcamError(
+            f"part script {str(path)!r} called sys.exit({err.code!r}) while being loaded; "
+            f"guard command-line code with `if __name__ == \"__main__\":`"
+        ) from err
+    except Exception as err:
+        raise WoodcamError(
+            f"part script {str(path)!r} failed with {type(err).__name__}: {err}; run it with "
+            f"`python {path}` to see the traceback and fix the script"
+        ) from err
+    finally:
+        if folder in sys.path:
+            sys.path.remove(folder)
+    if "part" not in namespace:
+        raise WoodcamError(
+            f"part script {str(path)!r} does not define a module-level variable `part`; add "
+            f"e.g. `part = Box(10, 10, 10)` (a build123d/cadquery solid, trimesh mesh or "
+            f"manifold) at the end of the script"
+        )
+    part = namespace["part"]
+    origin = f"`part` of script {str(path)!r}"
+    if isinstance(part, (str, Path)):
+        raise WoodcamError(
+            f"{origin} is a path ({str(part)!r}), but a script must define the part itself; "
+            f"load the file in the script (e.g. build123d import_step) or pass the path directly"
+        )
+    return _load(part, tol_mm, ang_rad, origin=origin)
+
+
+def _load_step(path: Path, tol_mm: float, ang_rad: float):
+    """Read a STEP file with OpenCascade (lengths converted to mm by the reader)."""
+    require("OCP", "cad", "reading STEP parts")
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.STEPControl import STEPControl_Reader
+
+    reader = STEPControl_Reader()
+    status = reader.ReadFile(str(path))
+    if status != IFSelect_RetDone:
+        raise WoodcamError(
+            f"part file {str(path)!r} is not a readable STEP file (OpenCascade status "
+            f"{status}); re-export it from your CAD program as STEP AP203/AP214"
+        )
+    reader.TransferRoots()
+    shape = reader.OneShape()
+    if shape is None or shape.IsNull():
+        raise WoodcamError(
+            f"part file {str(path)!r} holds no shape; re-export the part as a solid"
+        )
+    return _manifold_from_topods(shape, tol_mm, ang_rad, origin=f"STEP file {str(path)!r}")
+
+
+def _load_mesh_file(path: Path):
+    """Read an STL/OBJ/GLB/glTF file with trimesh; every mesh in it becomes one solid."""
+    import trimesh
+
+    origin = f"mesh file {str(path)!r}"
+    try:
+        scene = trimesh.load_scene(str(path), file_type=path.suffix.lower().lstrip("."))
+    except Exception as err:
+        raise WoodcamError(
+            f"{origin} could not be read as {path.suffix.upper().lstrip('.')} "
+            f"({type(err).__name__}: {err}); check that it is a mesh file and re-export it"
+        ) from err
+    return _manifold_from_scene(scene, origin)
+
+
+# --------------------------------------------------------------------------------- meshes
+
+
+def _manifold_from_scene(scene, origin: str):
+    """Union of every triangle mesh of a trimesh Scene, transforms applied."""
+    import trimesh
+
+    meshes = [g for g in scene.dump() if isinstance(g, trimesh.Trimesh) and len(g.faces)]
+    if not meshes:
+        raise WoodcamError(
+            f"{origin} contains no triangles: it is empty or not a valid mesh (geometry found: "
+            f"{[type(g).__name__ for g in scene.geometry.values()]}); it must hold a closed "
+            f"triangle mesh of the part: re-export it as a binary STL, OBJ or GLB"
+        )
+    return _union([_manifold_from_trimesh(m, origin) for m in meshes], origin)
+
+
+def _manifold_from_trimesh(mesh, origin: str):
+    """Weld, repair if needed (fill holes, fix normals) and convert a trimesh to a manifold."""
+    import trimesh
+
+    vertices = np.asarray(mesh.vertices, dtype=np.float64)
+    faces = np.asarray(mesh.faces, dtype=np.int64)
+    if len(faces) == 0:
+        raise WoodcamError(f"{origin} has no triangles; the part must be a closed solid")
+    if not np.all(np.isfinite(vertices)):
+        raise WoodcamError(
+            f"{origin} has non-finite (NaN/inf) vertex coordinates; fix the mesh export"
+        )
+    # Fresh mesh without visuals: processing welds vertices by position only (UV/normal seams
+    # in OBJ/GLB would otherwise split the surface) and drops degenerate faces.
+    welded = trimesh.Trimesh(vertices=vertices, faces=faces, process=True)
+    # Welding collapses the fans at B-rep poles (a sphere's degenerate edges) into triangles
+    # with a repeated vertex; drop them so the edges they shared close up.
+    f = welded.faces
+    keep = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
+    if not keep.all():
+        welded.update_faces(keep)
+        welded.remove_unreferenced_vertices()
+    if not welded.is_watertight or not welded.is_winding_consistent:
+        trimesh.repair.fill_holes(welded)
+        trimesh.repair.fix_winding(welded)
+    if not welded.is_watertight:
+        raise WoodcamError(
+            f"{origin} is not a closed (watertight) mesh, even after filling holes: it has "
+            f"{_count_open_edges(welded)} open or non-manifold edges; close the mesh in your CAD "
+            f"program (export a solid, not surfaces) or repair it (e.g. Meshmixer, MeshLab)"
+        )
+    if welded.volume < 0:
+        welded.invert()
+    return _manifold_from_arrays(welded.vertices, welded.faces, origin)
+
+
+def _count_open_edges(mesh) -> int:
+    """Edges of ``mesh`` not shared by exactly two faces."""
+    counts = np.bincount(mesh.edges_unique_inverse, minlength=len(mesh.edges_unique))
+    return int(np.count_nonzero(counts != 2))
+
+
+def _manifold_from_arrays(vertices, faces, origin: str):
+    """Build a manifold from ``vertices (n, 3) float mm`` and ``faces (m, 3) int``."""
+    import manifold3d
+
+    mesh = manifold3d.Mesh64(
+        vert_properties=np.ascontiguousarray(vertices, dtype=np.float64),
+        tri_verts=np.ascontiguousarray(faces, dtype=np.uint64),
+    )
+    solid = manifold3d.Manifold(mesh)
+    if solid.status() != manifold3d.Error.NoError:
+        mesh.merge()  # best effort: weld open edges within manifold's own tolerance
+        solid = manifold3d.Manifold(mesh)
+    return _check_manifold(solid, origin)
+
+
+def _check_manifold(solid, origin: str):
+    """Reject errored, empty or inside-out manifolds."""
+    import manifold3d
+
+    status = solid.status()
+    if status != manifold3d.Error.NoError:
+        raise WoodcamError(
+            f"{origin} is not a valid closed solid (manifold3d reports {status.name}); the mesh "
+            f"must be a watertight, consistently oriented 2-manifold: re-export it as a solid"
+        )
+    if solid.is_empty():
+        raise WoodcamError(
+            f"{origin} is empty (no triangles or zero volume); the part must be a solid with "
+            f"volume"
+        )
+    if solid.volume() <= 0:
+        raise WoodcamError(
+            f"{origin} has non-positive volume {solid.volume():.6g} mm^3 (inside-out normals?); "
+            f"flip its faces so normals point outward"
+        )
+    return solid
+
+
+def _union(solids: list, origin: str):
+    """Boolean union of a non-empty list of manifolds."""
+    import manifold3d
+
+    solid = solids[0] if len(solids) == 1 else manifold3d.Manifold.batch_boolean(
+        solids, manifold3d.OpType.Add)
+    return _check_manifold(solid, origin)
+
+
+# --------------------------------------------------------------------------------- B-reps
+
+
+def _manifold_from_topods(shape, tol_mm: float, ang_rad: float, origin: str):
+    """Tessellate an OpenCascade ``TopoDS_Shape`` solid by solid and union the pieces."""
+    require("OCP", "cad", "tessellating B-rep parts")
+    from OCP.TopAbs import TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+
+    if shape is None or shape.IsNull():
+        raise WoodcamError(f"{origin} is an empty (null) shape; build a solid first")
+    solids = []
+    explorer = TopExp_Explorer(shape, TopAbs_SOLID)
+    while explorer.More():
+        solids.append(explorer.Current())
+        explorer.Next()
+    if not solids:
+        raise WoodcamError(
+            f"{origin} contains no solid (only faces, wires or an empty compound); extrude, "
+            f"revolve or thicken it into a solid"
+        )
+    pieces = []
+    for solid in solids:
+        vertices, faces = _tessellate_solid(solid, tol_mm, ang_rad)
+        if len(faces) == 0:
+            raise WoodcamError(f"{origin} has a solid that tessellates to no triangles")
+        pieces.append(_manifold_from_trimesh(_trimesh(vertices, faces), origin))
+    return _union(pieces, origin)
+
+
+def _trimesh(vertices, faces):
+    import trimesh
+
+    return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+
+
+def _tessellate_solid(solid, tol_mm: float, ang_rad: float):
+    """Mesh one solid with ``BRepMesh_IncrementalMesh``; returns ``(n, 3)`` mm and ``(m, 3)``.
+
+    The solid is copied first (``BRepBuilderAPI_Copy`` without its mesh) so the tolerances
+    given here always apply: OpenCascade otherwise keeps an existing triangulation that is
+    finer than asked. Faces are meshed with shared edge discretisations, so vertices on an edge
+    coincide exactly and welding by position closes the mesh. Per-node reads are a Python loop
+    because OCP exposes no array view of ``Poly_Triangulation`` (same approach as build123d's
+    ``Shape.tessellate``); it costs ~1 s per 100k triangles.
+    """
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
+    from OCP.BRepMesh import BRepMesh_IncrementalMesh
+    from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopLoc import TopLoc_Location
+    from OCP.TopoDS import TopoDS
+
+    copy = BRepBuilderAPI_Copy(solid, True, False).Shape()
+    BRepMesh_IncrementalMesh(copy, tol_mm, False, ang_rad, True)
+
+    all_vertices, all_faces, offset = [], [], 0
+    explorer = TopExp_Explorer(copy, TopAbs_FACE)
+    while explorer.More():
+        face = TopoDS.Face_s(explorer.Current())
+        explorer.Next()
+        location = TopLoc_Location()
+        poly = BRep_Tool.Triangulation_s(face, location)
+        if poly is None:
+            continue
+        trsf = location.Transformation()
+        nodes = np.array(
+            [poly.Node(i).Transformed(trsf).Coord() for i in range(1, poly.NbNodes() + 1)],
+            dtype=np.float64,
+        ).reshape(-1, 3)
+        tris = np.array(
+            [poly.Triangle(i).Get() for i in range(1, poly.NbTriangles() + 1)], dtype=np.int64
+        ).reshape(-1, 3) - 1
+        if face.Orientation() == TopAbs_REVERSED:
+            tris = tris[:, ::-1]
+        all_vertices.append(nodes)
+        all_faces.append(tris + offset)
+        offset += len(nodes)
+    if not all_faces:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
+    return np.concatenate(all_vertices), np.concatenate(all_faces)

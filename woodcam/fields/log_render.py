@@ -1,0 +1,206 @@
+"""Planar sections through a knotted log, as images (arrays), for `woodcam log render`.
+
+A section is a rectangle in the log frame (mm): ``origin`` (its corner at pixel row 0, column 0),
+``u`` (unit, along columns) and ``v`` (unit, along rows, downward in the image), ``size_mm =
+(width, height)`` and a resolution in pixels per mm. Pixel ``(row i, col j)`` samples the point
+``origin + (j + 0.5) / ppm * u + (i + 0.5) / ppm * v`` (pixel centres).
+
+Colours: a simple annual-ring colour map (earlywood -> latewood along ``ARF = (years mod 1)^2``,
+eq. 6 of seed 000) with :func:`~.knots.knot_shading`; points outside the log's outer surface get
+``background``. Functions return ``(rows, cols, 3) uint8`` arrays; only :func:`save_png` writes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import WoodcamError
+from .base import arf
+from .knots import KnottedLogField, knot_shading
+from .tree_data import Log
+
+#: Spruce colours (0..1 RGB): pale earlywood, orange-brown latewood.
+EARLYWOOD_RGB = (0.93, 0.83, 0.64)
+LATEWOOD_RGB = (0.74, 0.53, 0.30)
+BACKGROUND_RGB = (0.16, 0.16, 0.16)
+
+
+@dataclass(frozen=True)
+class Section:
+    """A planar rectangle in the log frame (see the module docstring)."""
+
+    origin_mm: tuple
+    u: tuple
+    v: tuple
+    size_mm: tuple
+    px_per_mm: float = 4.0
+    name: str = "section"
+
+    def shape(self) -> tuple[int, int]:
+        return (max(1, int(round(self.size_mm[1] * self.px_per_mm))),
+                max(1, int(round(self.size_mm[0] * self.px_per_mm))))
+
+    def points(self) -> np.ndarray:
+        """Pixel-centre points ``(rows, cols, 3)`` in the log frame, mm."""
+        rows, cols = self.shape()
+        o, u, v = (np.asarray(a, float) for a in (self.origin_mm, self.u, self.v))
+        j = (np.arange(cols) + 0.5) / self.px_per_mm
+        i = (np.arange(rows) + 0.5) / self.px_per_mm
+        return o + j[None, :, None] * u + i[:, None, None] * v
+
+
+def end_grain_disc(log: Log, z_mm: float, *, px_per_mm: float = 2.0, margin_mm: float = 5.0
+                   ) -> Section:
+    """Horizontal section at height ``z_mm`` covering the whole log cross-section, seen from
+    above (``+x`` to the right, ``+y`` up in the image)."""
+    if not (log.pith_z_mm[0] <= z_mm <= log.pith_z_mm[-1]):
+        raise WoodcamError(f"z_mm must lie in the log [{log.pith_z_mm[0]}, {log.pith_z_mm[-1]}] "
+                           f"mm; got {z_mm}")
+    c = log.pith_at(np.array([z_mm]))[0]
+    h = log.r_max_mm + margin_mm
+    return Section((c[0] - h, c[1] + h, z_mm), (1, 0, 0), (0, -1, 0), (2 * h, 2 * h), px_per_mm,
+                   f"disc_z{z_mm:.0f}")
+
+
+def tangential_board(log: Log, z_center_mm: float, azimuth_rad: float, offset_mm: float, *,
+                     length_mm: float = 600.0, width_mm: float = 120.0,
+                     px_per_mm: float = 2.0) -> Section:
+    """Face of a flat-sawn board: a plane parallel to the log axis at ``offset_mm`` from the
+    pith (at ``z_center_mm``), facing azimuth ``azimuth_rad``. Image columns run along the log
+    (``+z`` to the right), rows across it."""
+    c = log.pith_at(np.array([z_center_mm]))[0]
+    n = np.array([np.cos(azimuth_rad), np.sin(azimuth_rad), 0.0])
+    t = np.array([-np.sin(azimuth_rad), np.cos(azimuth_rad), 0.0])
+    centre = np.array([c[0], c[1], z_center_mm]) + offset_mm * n
+    origin = centre - 0.5 * length_mm * np.array([0, 0, 1.0]) + 0.5 * width_mm * t
+    return Section(tuple(origin), (0, 0, 1), tuple(-t), (length_mm, width_mm), px_per_mm,
+                   f"board_z{z_center_mm:.0f}_az{np.degrees(azimuth_rad):.0f}_off{offset_mm:.0f}")
+
+
+def radial_section(log: Log, z_center_mm: float, azimuth_rad: float, *,
+                   length_mm: float = 300.0, px_per_mm: float = 2.0,
+                   margin_mm: float = 5.0) -> Section:
+    """Quarter-sawn face: the plane through the pith (at ``z_center_mm``) containing the
+    azimuth ``azimuth_rad``, from the far bark to the near bark. Columns run along the log
+    (``+z`` to the right); rows from ``azimuth_rad`` (top) through the pith to the opposite
+    side. Knots show as spikes growing out of the pith."""
+    c = log.pith_at(np.array([z_center_mm]))[0]
+    n = np.array([np.cos(azimuth_rad), np.sin(azimuth_rad), 0.0])
+    h = log.r_max_mm + margin_mm
+    origin = np.array([c[0], c[1], z_center_mm - 0.5 * length_mm]) + h * n
+    return Section(tuple(origin), (0, 0, 1), tuple(-n), (length_mm, 2 * h), px_per_mm,
+                   f"radial_z{z_center_mm:.0f}_az{np.degrees(azimuth_rad):.0f}")
+
+
+def busiest_board(log: Log, *, offset_mm: float = 60.0, length_mm: float = 600.0,
+                  width_mm: float = 120.0, step_deg: float = 10.0, step_mm: float = 50.0):
+    """The (z_center, azimuth) of the tangential board that cuts the most knots (knot axes
+    crossing the board plane inside its rectangle), found by a coarse scan; returns
+    ``(z_center_mm, azimuth_rad, n_knots)``."""
+    best = (log.pith_z_mm[0] + length_mm / 2, 0.0, -1)
+    if not log.knots:
+        return best[0], best[1], 0
+    zs = np.arange(log.pith_z_mm[0] + length_mm / 2, log.pith_z_mm[-1] - length_mm / 2 + 1,
+                   step_mm)
+    r = np.linspace(0, log.r_max_mm, 200)
+    pts = [(k, log.knot_point(i, r)) for i, k in enumerate(log.knots)]
+    for az in np.radians(np.arange(0, 360, step_deg)):
+        n = np.array([np.cos(az), np.sin(az)])
+        t = np.array([-np.sin(az), np.cos(az)])
+        cross = []
+        for k, p in pts:
+            c = log.pith_at(p[:, 2])
+            rel = p[:, :2] - c
+            s = rel @ n - offset_mm
+            idx = np.nonzero((np.sign(s[:-1]) != np.sign(s[1:])) & (r[1:] <= k.r_end_mm))[0]
+            if len(idx):
+                i = idx[0]
+                cross.append((p[i, 2], rel[i] @ t))
+        if not cross:
+            continue
+        cz, ct = np.array(cross).T
+        for zc in zs:
+            inside = (np.abs(cz - zc) < length_mm / 2 - 20) & (np.abs(ct) < width_mm / 2 - 10)
+            cnt = int(np.sum(inside))
+            if cnt > best[2]:
+                best = (float(zc), float(az), cnt)
+    return best
+
+
+def colour_years(years, features=None, *, alive_darkening=0.35, dead_darkening=0.3,
+                 earlywood_rgb=EARLYWOOD_RGB, latewood_rgb=LATEWOOD_RGB) -> np.ndarray:
+    """Simple ARF colour map ``(n,) years -> (n, 3)`` float RGB, with knot shading."""
+    a = arf(years)[:, None]
+    e = np.asarray(earlywood_rgb, float)
+    late = np.asarray(latewood_rgb, float)
+    rgb = e + (late - e) * a
+    if features is not None:
+        rgb = knot_shading(rgb, features, alive_darkening=alive_darkening,
+                           dead_darkening=dead_darkening)
+    return rgb
+
+
+def render_section(field: KnottedLogField, section: Section, *, background=BACKGROUND_RGB,
+                   alive_darkening: float | None = None, dead_darkening: float | None = None,
+                   supersample: int = 1) -> np.ndarray:
+    """Colour image ``(rows, cols, 3) uint8`` of ``field`` on ``section``.
+
+    ``supersample = s`` evaluates ``s x s`` points per pixel and averages their colours (knot
+    rings are ~0.2 mm apart and alias into speckle at 2-4 px/mm).
+    """
+    s = int(supersample)
+    if s > 1:
+        rows, cols = section.shape()
+        ppm = section.px_per_mm
+        fine = Section(section.origin_mm, section.u, section.v, (cols / ppm, rows / ppm),
+                       ppm * s, section.name)
+        img = render_section(field, fine, background=background,
+                             alive_darkening=alive_darkening,
+                             dead_darkening=dead_darkening).astype(float)
+        img = img.reshape(rows, s, cols, s, 3).mean(axis=(1, 3))
+        return (img + 0.5).astype(np.uint8)
+    pts = section.points()
+    shp = pts.shape[:2]
+    p = pts.reshape(-1, 3)
+    out = field.evaluate(p)
+    P = field.params
+    alive = P.alive_darkening if alive_darkening is None else alive_darkening
+    dead = P.dead_darkening if dead_darkening is None else dead_darkening
+    rgb = colour_years(out["years"], out, alive_darkening=alive, dead_darkening=dead)
+    rel = p[:, :2] - field.log.pith_at(p[:, 2])
+    outside = np.hypot(rel[:, 0], rel[:, 1]) > field.log.radius_at(
+        p[:, 2], np.arctan2(rel[:, 1], rel[:, 0]))
+    outside |= (p[:, 2] < field.log.pith_z_mm[0]) | (p[:, 2] > field.log.pith_z_mm[-1])
+    rgb[outside] = background
+    return (np.clip(rgb, 0, 1) * 255 + 0.5).astype(np.uint8).reshape(*shp, 3)
+
+
+def save_png(image: np.ndarray, path) -> Path:
+    """Write a ``(rows, cols, 3) uint8`` image as PNG."""
+    from PIL import Image
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    Image.fromarray(np.asarray(image, np.uint8)).save(path)
+    return path
+
+
+def default_sections(log: Log, *, px_per_mm: float = 2.0) -> list[Section]:
+    """A tangential board through the most knots and an end-grain disc through the log's
+    biggest whorl (the height where most knot axes pass 50 mm from the pith, +-12 mm)."""
+    zc, az, _ = busiest_board(log)
+    secs = [tangential_board(log, zc, az, 60.0, px_per_mm=px_per_mm)]
+    if log.knots:
+        zk = np.array([log.knot_point(i, [50.0])[0, 2] for i in range(len(log.knots))])
+        cands = np.arange(log.pith_z_mm[0], log.pith_z_mm[-1], 5.0)
+        counts = np.array([np.sum(np.abs(zk - z) < 12.0) for z in cands])
+        z_best = cands[int(np.argmax(counts))]
+        zd = float(np.median(zk[np.abs(zk - z_best) < 12.0]))
+    else:
+        zd = float(log.pith_z_mm[len(log.pith_z_mm) // 2])
+    zd = float(np.clip(zd, log.pith_z_mm[0], log.pith_z_mm[-1]))
+    secs.append(end_grain_disc(log, zd, px_per_mm=px_per_mm))
+    return secs

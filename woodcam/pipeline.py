@@ -1,0 +1,98 @@
+"""The cut-preview pipeline: part -> carved in the stock -> baked wood texture -> files.
+
+Every front end (``woodcam bake``, ``woodcam demo``, ``woodcam gcode``) runs the same stages;
+:class:`PartPreview` keeps what each produced and how long it took.
+"""
+
+from __future__ import annotations
+
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .stock import Stock
+
+
+@dataclass
+class PartPreview:
+    """Result of :func:`preview_mesh` / :func:`preview_part`.
+
+    Attributes
+    ----------
+    name : str
+    volume_mm3 : float
+        Volume of the carved part.
+    triangles : int
+    atlas_px : (h, w)
+    files : dict kind -> Path ("glb", "obj", "png")
+    timings_s : dict stage -> seconds
+    warnings : list of str
+    """
+
+    name: str
+    volume_mm3: float = 0.0
+    triangles: int = 0
+    atlas_px: tuple[int, int] = (0, 0)
+    files: dict = field(default_factory=dict)
+    timings_s: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+    meta_block: str = ""
+
+    @contextmanager
+    def stage(self, name: str):
+        t0 = time.perf_counter()
+        yield
+        self.timings_s[name] = self.timings_s.get(name, 0.0) + time.perf_counter() - t0
+
+
+def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
+                 tolerance_mm: float | None = None, obj: bool = True,
+                 screenshot: bool = True, progress: bool = False) -> PartPreview:
+    """Carve ``source`` (anything :func:`woodcam.cad.load_part` takes) out of ``stock``, bake it
+    and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``)."""
+    from .cad import carve, load_part
+    from .tolerances import TESSELLATION_TOL_MM
+
+    out_glb = Path(out_glb)
+    result = PartPreview(out_glb.stem)
+    with result.stage("load"):
+        part = load_part(source, tolerance_mm=tolerance_mm or TESSELLATION_TOL_MM)
+    with result.stage("carve"):
+        carved = carve(part, stock.size_mm)
+    result.warnings += list(carved.warnings)
+    return preview_mesh(carved.mesh, stock, out_glb, texels_per_mm=texels_per_mm, obj=obj,
+                        screenshot=screenshot, progress=progress, result=result)
+
+
+def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, obj: bool = True,
+                 screenshot: bool = True, progress: bool = False,
+                 result: PartPreview | None = None, metadata: dict | None = None) -> PartPreview:
+    """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files."""
+    from .bake import bake
+    from .export import export_glb, export_obj
+
+    out_glb = Path(out_glb)
+    out_glb.parent.mkdir(parents=True, exist_ok=True)
+    result = result or PartPreview(out_glb.stem)
+    result.volume_mm3 = float(mesh.volume)
+    result.triangles = int(len(mesh.faces))
+    with result.stage("bake"):
+        baked = bake(mesh, stock.wood, texels_per_mm=texels_per_mm, progress=progress)
+    result.atlas_px = tuple(baked.atlas.shape[:2])
+    result.warnings += list(getattr(baked, "warnings", []))
+    meta = {"block": stock.spec, "size_mm": list(stock.size_mm), **(metadata or {}),
+            "texels_per_mm": float(baked.texels_per_mm)}
+    with result.stage("export"):
+        result.files["glb"] = Path(export_glb(baked.mesh, out_glb, metadata=meta) or out_glb)
+        if obj:
+            obj_path = out_glb.with_suffix(".obj")
+            result.files["obj"] = Path(export_obj(baked.mesh, obj_path) or obj_path)
+    if screenshot:
+        from .view import preview
+
+        png = out_glb.with_name(out_glb.stem + "_view.png")
+        with result.stage("render"):
+            preview(baked.mesh, wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
+        result.files["png"] = png
+    return result

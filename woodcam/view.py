@@ -1,0 +1,916 @@
+"""pyvista preview of a textured part inside its block: interactive window, cut plane, screenshot.
+
+Data form. The part is a ``trimesh.Trimesh`` in the block frame (mm, ``docs/conventions.md``:
+origin bottom-front-left, ``+X`` width ``W``, ``+Y`` depth ``D``, ``+Z`` up ``H``), usually with
+``TextureVisuals`` (``uv : (n_vertices, 2)`` with ``v = 1`` at the top row of the image, and a
+PIL material image), or a path to a ``.glb`` / ``.obj`` / ``.ply`` / ``.stl`` holding one. The
+block is the box ``[0, W] x [0, D] x [0, H]`` given by ``size_mm = (W, D, H)``. The optional
+``wood`` answers ``wood.color(points_mm (n, 3), normals (n, 3)) -> rgb (n, 3)`` floats in
+``[0, 1]`` (``docs/architecture.md``); the view never looks inside it.
+
+What is drawn:
+
+- the part with its texture (lit, smooth-shaded with sharp edges kept);
+- the block as a translucent box with dark edges (:func:`block_outline`);
+- with a wood, a cut plane: the wood of the whole block sampled on the plane
+  (:func:`cut_plane_image`), opaque where the plane cuts the part and translucent in the waste
+  around it, with the part clipped away on the side the plane's normal points to (toward the
+  viewer): a cutaway, the part's textured surface behind, its inside wood on the plane.
+
+Off-screen rendering (``screenshot=...``) needs no display; the interactive window adds a plane
+widget whose callback (:class:`CutPlaneCallback`) is a plain object tests can call with an
+origin and a normal.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+from typing import Literal, get_args
+
+import numpy as np
+
+from .errors import WoodcamError, require
+from .tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS, ON_FACE_TOL_MM
+
+Camera = Literal["iso", "top", "front", "back", "left", "right", "bottom"]
+CAMERAS: tuple[str, ...] = get_args(Camera)
+
+#: Direction from the focal point to the camera and the camera's up vector, block frame.
+#: "iso" looks from front-right-above (the viewer stands at -Y, conventions.md). "top" has +Y
+#: up in the picture and "bottom" has -Y up, so both show their face as its face image does.
+_CAMERA_VIEW: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
+    "iso": ((1.0, -1.0, 1.0), (0.0, 0.0, 1.0)),
+    "top": ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0)),
+    "bottom": ((0.0, 0.0, -1.0), (0.0, -1.0, 0.0)),
+    "front": ((0.0, -1.0, 0.0), (0.0, 0.0, 1.0)),
+    "back": ((0.0, 1.0, 0.0), (0.0, 0.0, 1.0)),
+    "left": ((-1.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
+    "right": ((1.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
+}
+
+#: Default sample spacing (mm) of the wood on a cut plane: finer than a 0.5 mm latewood band.
+SECTION_RESOLUTION_MM = 0.25
+
+#: At most this many wood samples on the screenshot's cut plane (~0.5 s for a fast wood); a
+#: larger section is sampled more coarsely than ``SECTION_RESOLUTION_MM``.
+SECTION_MAX_SAMPLES_SCREENSHOT = 400_000
+
+#: At most this many samples while dragging the interactive plane, so it follows the mouse.
+SECTION_MAX_SAMPLES_INTERACTIVE = 60_000
+
+#: Opacity of the block's translucent faces: enough to read the block, little enough to see
+#: the part through it.
+BLOCK_OPACITY = 0.15
+
+#: Colours (RGB 0..1) of the block box, its edges, and a part that carries no texture.
+BLOCK_COLOR = (0.80, 0.70, 0.55)
+BLOCK_EDGE_COLOR = (0.25, 0.22, 0.20)
+UNTEXTURED_PART_COLOR = (0.78, 0.62, 0.42)
+
+#: Opacity of the waste wood on the cut plane (the section outside the part): the wood around
+#: the part stays readable while the part's far half shows through it.
+WASTE_OPACITY = 0.3
+
+#: Colour and width (pixels) of the part's outline drawn on the cut plane.
+OUTLINE_COLOR = (0.20, 0.12, 0.06)
+OUTLINE_WIDTH = 3.0
+
+#: Actor names, so that re-adding with the same name replaces (the cut-plane callback).
+PART_ACTOR = "woodcam-part"
+SECTION_ACTOR = "woodcam-section"
+WASTE_ACTOR = "woodcam-section-waste"
+OUTLINE_ACTOR = "woodcam-section-outline"
+
+# The 12 edges of a box as pairs of corner indices; corner k has bits (x, y, z) = k's bits.
+_BOX_EDGES = np.array(
+    [[0, 1], [2, 3], [4, 5], [6, 7],   # along X
+     [0, 2], [1, 3], [4, 6], [5, 7],   # along Y
+     [0, 4], [1, 5], [2, 6], [3, 7]]   # along Z
+)
+
+
+def _pyvista():
+    return require("pyvista", "view", "the preview")
+
+
+# ---------------------------------------------------------------------------- input checks
+
+
+def _check_size(size_mm) -> np.ndarray:
+    """Return ``size_mm`` as a float ``(3,)`` array of positive finite ``(W, D, H)`` mm."""
+    try:
+        s = np.asarray(size_mm, dtype=float)
+    except (TypeError, ValueError) as err:
+        raise WoodcamError(
+            f"size_mm must be three positive numbers (W, D, H) in mm; got {size_mm!r}"
+        ) from err
+    if s.shape != (3,) or not np.all(np.isfinite(s)) or np.any(s <= 0):
+        raise WoodcamError(
+            f"size_mm must be three positive finite numbers (W, D, H) in mm; got {size_mm!r}; "
+            "pass the block size, e.g. size_mm=(100, 80, 40)"
+        )
+    return s
+
+
+def _check_vector(value, name: str, *, unit: bool) -> np.ndarray:
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as err:
+        raise WoodcamError(f"{name} must be three numbers (x, y, z); got {value!r}") from err
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise WoodcamError(f"{name} must be three finite numbers (x, y, z); got {value!r}")
+    if unit:
+        n = float(np.linalg.norm(v))
+        if n < 1e-12:
+            raise WoodcamError(
+                f"{name} must be a non-zero direction; got {value!r}; e.g. {name}=(1, 0, 0)"
+            )
+        v = v / n
+    return v
+
+
+def _check_camera(camera: str) -> str:
+    if camera not in _CAMERA_VIEW:
+        raise WoodcamError(
+            f"camera must be one of {', '.join(CAMERAS)}; got {camera!r}"
+        )
+    return camera
+
+
+def _check_wood(wood):
+    if wood is not None and not callable(getattr(wood, "color", None)):
+        raise WoodcamError(
+            "wood must have a method color(points_mm (n, 3), normals (n, 3)) -> rgb (n, 3); "
+            f"got {type(wood).__name__}; pass a woodcam Wood or wood=None"
+        )
+    return wood
+
+
+def _check_size_with_wood(wood, size) -> None:
+    if wood is not None and size is None:
+        raise WoodcamError(
+            "size_mm is needed with wood: the cut plane shows the wood inside the block "
+            "[0, W] x [0, D] x [0, H]; pass size_mm=(W, D, H)"
+        )
+
+
+def _load_mesh(mesh_or_path):
+    """A ``trimesh.Trimesh`` from a mesh, a scene or a path (scenes are concatenated)."""
+    import trimesh
+
+    if isinstance(mesh_or_path, (str, os.PathLike)):
+        path = Path(mesh_or_path)
+        if not path.is_file():
+            raise WoodcamError(
+                f"mesh_or_path: no file at {str(path)!r}; pass a .glb/.obj/.ply/.stl file "
+                "written by woodcam (e.g. out/part.glb) or a trimesh.Trimesh"
+            )
+        try:
+            loaded = trimesh.load(path, force="mesh")
+        except Exception as err:  # trimesh raises many types for unreadable files
+            raise WoodcamError(
+                f"mesh_or_path: could not read a mesh from {str(path)!r} ({err}); "
+                "pass a .glb/.obj/.ply/.stl file"
+            ) from err
+        mesh_or_path = loaded
+    if isinstance(mesh_or_path, trimesh.Scene):
+        meshes = [g for g in mesh_or_path.dump() if isinstance(g, trimesh.Trimesh)]
+        if not meshes:
+            raise WoodcamError("mesh_or_path: the scene holds no triangle mesh")
+        mesh_or_path = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
+    if not isinstance(mesh_or_path, trimesh.Trimesh):
+        raise WoodcamError(
+            "mesh_or_path must be a trimesh.Trimesh, a trimesh.Scene or a path to a mesh file; "
+            f"got {type(mesh_or_path).__name__}"
+        )
+    if len(mesh_or_path.faces) == 0:
+        raise WoodcamError("mesh_or_path: the mesh has no faces; nothing to preview")
+    return mesh_or_path
+
+
+# ---------------------------------------------------------------------------- geometry
+
+
+def _material_image(material):
+    """The colour image of a trimesh material (Simple: ``image``; PBR: ``baseColorTexture``)."""
+    if material is None:
+        return None
+    image = getattr(material, "image", None)
+    if image is None:
+        image = getattr(material, "baseColorTexture", None)
+    return image
+
+
+def mesh_to_pyvista(mesh):
+    """Convert a trimesh mesh to pyvista, keeping its texture or colours.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+        Triangles in the block frame (mm). With ``TextureVisuals`` (``uv : (n_vertices, 2)``,
+        ``v = 1`` at the image's top row, material image as PIL), the uv become the polydata's
+        active texture coordinates and the image a ``pv.Texture`` (VTK also puts ``v = 1`` at
+        the top row, so the image is used as stored). Vertex or face colours become an ``RGB``
+        uint8 point or cell array.
+
+    Returns
+    -------
+    poly : pyvista.PolyData
+        Points ``(n_vertices, 3)`` float64 mm, triangle faces.
+    texture : pyvista.Texture or None
+        The colour image, or None when the mesh has no textured material.
+    """
+    pv = _pyvista()
+    mesh = _load_mesh(mesh)
+    poly = pv.PolyData.from_regular_faces(
+        np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64)
+    )
+    texture = None
+    visual = mesh.visual
+    kind = getattr(visual, "kind", None)
+    if kind == "texture":
+        uv = getattr(visual, "uv", None)
+        image = _material_image(getattr(visual, "material", None))
+        if uv is not None and image is not None:
+            uv = np.asarray(uv, dtype=float)
+            if uv.shape != (len(mesh.vertices), 2):
+                raise WoodcamError(
+                    f"mesh.visual.uv must have shape (n_vertices, 2) = ({len(mesh.vertices)}, 2); "
+                    f"got {uv.shape}; give one uv per vertex (split vertices on uv seams)"
+                )
+            poly.active_texture_coordinates = uv
+            texture = pv.Texture(np.ascontiguousarray(np.asarray(image.convert("RGB"))))
+            texture.interpolate = True
+            texture.mipmap = True
+    elif kind == "vertex":
+        poly.point_data["RGB"] = np.asarray(visual.vertex_colors)[:, :3].astype(np.uint8)
+    elif kind == "face":
+        poly.cell_data["RGB"] = np.asarray(visual.face_colors)[:, :3].astype(np.uint8)
+    return poly, texture
+
+
+def block_outline(size_mm):
+    """The block ``[0, W] x [0, D] x [0, H]`` as a box surface and its 12 edges.
+
+    Returns
+    -------
+    box : pyvista.PolyData
+        The six faces; the preview draws them with opacity :data:`BLOCK_OPACITY`.
+    edges : pyvista.PolyData
+        The 12 edges as lines, drawn opaque in :data:`BLOCK_EDGE_COLOR`.
+    """
+    pv = _pyvista()
+    w, d, h = _check_size(size_mm)
+    box = pv.Box(bounds=(0.0, w, 0.0, d, 0.0, h))
+    edges = box.extract_feature_edges(
+        boundary_edges=False, feature_edges=True, manifold_edges=False, feature_angle=30.0
+    )
+    return box, edges
+
+
+def _plane_basis(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit in-plane axes ``(u, v)`` with ``u x v = normal``.
+
+    ``u`` is the block axis after the normal's dominant axis, projected onto the plane, so a
+    plane normal to a block axis gets block axes as ``u, v`` and its sample grid covers the
+    box's section exactly (no clipping needed).
+    """
+    k = int(np.argmax(np.abs(normal)))
+    a = np.zeros(3)
+    a[(k + 1) % 3] = 1.0
+    u = a - np.dot(a, normal) * normal
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    return u, v
+
+
+def _box_section_uv(size: np.ndarray, origin: np.ndarray, normal: np.ndarray, u, v):
+    """In-plane ``(u, v)`` coordinates (mm, relative to ``origin``) of the plane-box polygon.
+
+    The vertices are where the plane crosses the box's 12 edges (corners on the plane count).
+    Returns an ``(m, 2)`` array, ``m = 0`` when the plane misses the box.
+    """
+    bits = (np.arange(8)[:, None] >> np.arange(3)[None, :]) & 1
+    corners = bits * size                                       # (8, 3) mm
+    dist = (corners - origin) @ normal                           # (8,) signed distance, mm
+    on = np.abs(dist) <= ON_FACE_TOL_MM
+    pts = [corners[on]]
+    d0, d1 = dist[_BOX_EDGES[:, 0]], dist[_BOX_EDGES[:, 1]]
+    cross = (d0 * d1 < 0) & ~on[_BOX_EDGES[:, 0]] & ~on[_BOX_EDGES[:, 1]]
+    t = d0[cross] / (d0[cross] - d1[cross])
+    c0, c1 = corners[_BOX_EDGES[cross, 0]], corners[_BOX_EDGES[cross, 1]]
+    pts.append(c0 + t[:, None] * (c1 - c0))
+    p = np.concatenate(pts) - origin
+    return np.stack([p @ u, p @ v], axis=1)
+
+
+def _grid_polydata(pv, origin, u, v, u_range, v_range, n_u: int, n_v: int):
+    """A regular quad grid of ``n_u x n_v`` points spanning the ranges along ``u`` and ``v``."""
+    su = np.linspace(u_range[0], u_range[1], n_u)
+    sv = np.linspace(v_range[0], v_range[1], n_v)
+    gu, gv = np.meshgrid(su, sv, indexing="ij")                  # (n_u, n_v)
+    points = origin + gu.reshape(-1, 1) * u + gv.reshape(-1, 1) * v
+    idx = np.arange(n_u * n_v).reshape(n_u, n_v)
+    quads = np.stack(
+        [idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], axis=-1
+    ).reshape(-1, 4)
+    return pv.PolyData.from_regular_faces(points, quads)
+
+
+def _wood_rgb(wood, points_mm: np.ndarray, normal: np.ndarray) -> np.ndarray:
+    """``wood.color`` at ``points_mm (n, 3)`` with a constant normal, checked, in batches."""
+    n = len(points_mm)
+    out = np.empty((n, 3), dtype=float)
+    for start in range(0, n, MAX_BATCH_POINTS):
+        p = points_mm[start:start + MAX_BATCH_POINTS]
+        rgb = np.asarray(wood.color(p, np.broadcast_to(normal, p.shape).copy()), dtype=float)
+        if rgb.shape != p.shape:
+            raise WoodcamError(
+                f"wood.color must return rgb of shape (n, 3) = {p.shape}; got {rgb.shape}"
+            )
+        out[start:start + len(p)] = rgb
+    if not np.all(np.isfinite(out)):
+        raise WoodcamError("wood.color returned non-finite colours (NaN or inf); fix the wood")
+    lo, hi = float(out.min(initial=0.0)), float(out.max(initial=0.0))
+    if lo < -COLOR_RANGE_TOL or hi > 1.0 + COLOR_RANGE_TOL:
+        raise WoodcamError(
+            f"wood.color must return rgb in [0, 1]; got values in [{lo:.4g}, {hi:.4g}]; "
+            "divide 0..255 colours by 255"
+        )
+    return np.clip(out, 0.0, 1.0)
+
+
+def _part_triangles(part) -> tuple[np.ndarray, np.ndarray]:
+    """``(points (n, 3) float mm, triangles (m, 3) int)`` of a part: pyvista, trimesh or a pair."""
+    if isinstance(part, tuple) and len(part) == 2:
+        return np.asarray(part[0], dtype=float), np.asarray(part[1], dtype=np.int64)
+    if hasattr(part, "vertices") and hasattr(part, "faces") and not hasattr(part, "n_cells"):
+        return np.asarray(part.vertices, dtype=float), np.asarray(part.faces, dtype=np.int64)
+    if not part.is_all_triangles:
+        part = part.triangulate()
+    return np.asarray(part.points, dtype=float), np.asarray(part.regular_faces, dtype=np.int64)
+
+
+def _cut_segments(points, triangles, origin, normal) -> np.ndarray:
+    """Where a plane cuts a triangle mesh: segments ``(k, 2, 3)``, block frame mm.
+
+    Vertices are classed above (``d > 0``) or not; a triangle with both classes is cut along
+    its two edges whose ends differ, so a vertex on the plane never yields a degenerate
+    crossing.
+    """
+    d = (points - origin) @ normal                               # (n,) mm
+    above = d > 0
+    n_above = (above[triangles[:, 0]].astype(np.uint8) + above[triangles[:, 1]]
+               + above[triangles[:, 2]])                         # (m,) column adds: fast
+    tri = triangles[(n_above == 1) | (n_above == 2)]
+    if len(tri) == 0:
+        return np.empty((0, 2, 3))
+    # Each edge runs from its vertex above the plane to the other one, so the two triangles
+    # sharing an edge compute the same crossing bit for bit (the scan lines rely on it).
+    e0, e1 = tri, np.roll(tri, -1, axis=1)                       # (k, 3) corner -> next
+    a_idx = np.where(above[e0], e0, e1)
+    b_idx = np.where(above[e0], e1, e0)
+    da, db = d[a_idx], d[b_idx]
+    differs = above[a_idx] != above[b_idx]                       # exactly two per triangle
+    w = np.where(differs, da / np.where(differs, da - db, 1.0), 0.0)
+    pa, pb = points[a_idx], points[b_idx]                        # (k, 3, 3)
+    cross = pa + w[..., None] * (pb - pa)
+    return cross[differs].reshape(-1, 2, 3)
+
+
+def _signed_row_distance(seg_uv, su, sv) -> np.ndarray:
+    """Signed distance (mm) along ``u`` from grid points to a closed outline, > 0 inside.
+
+    The grid is ``su (n_u,) x sv (n_v,)`` (row ``j`` is ``v = sv[j]``). Each row is a scan
+    line: the outline's crossings with it, sorted, give inside (odd count to the left) and the
+    distance to the nearest crossing. Rows with no crossing are outside. Returns
+    ``(n_u, n_v)``. Exact along ``u``; between rows a clip interpolates, so the outline is
+    placed within one row spacing where it runs nearly along ``u``.
+    """
+    n_u, n_v = len(su), len(sv)
+    far = float(su[-1] - su[0]) + 1.0
+    out = np.full((n_u, n_v), -far)
+    if len(seg_uv) == 0:
+        return out
+    v1, v2 = seg_uv[:, 0, 1], seg_uv[:, 1, 1]
+    dv = (sv[-1] - sv[0]) / (n_v - 1)
+    lo_j = np.floor((np.minimum(v1, v2) - sv[0]) / dv).astype(np.int64) - 1
+    hi_j = np.ceil((np.maximum(v1, v2) - sv[0]) / dv).astype(np.int64) + 1
+    lo_j, hi_j = lo_j.clip(0, n_v - 1), hi_j.clip(0, n_v - 1)
+    count = np.maximum(hi_j - lo_j + 1, 0)
+    seg = np.repeat(np.arange(len(seg_uv)), count)               # candidate (segment, row)
+    row = lo_j[seg] + (np.arange(len(seg)) - np.repeat(np.cumsum(count) - count, count))
+    vj = sv[row]
+    a, b = seg_uv[seg, 0], seg_uv[seg, 1]
+    hit = (a[:, 1] <= vj) != (b[:, 1] <= vj)                     # half-open: no double count
+    seg, row, vj, a, b = seg[hit], row[hit], vj[hit], a[hit], b[hit]
+    uc = a[:, 0] + (vj - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    uc = np.clip(uc, su[0] - 1.0, su[-1] + 1.0)                  # keeps the order in the row
+    span = float(su[-1] - su[0]) + 3.0
+    key = np.sort(row * span + (uc - su[0] + 1.0))               # rows apart, sorted by u
+    grid_row = np.broadcast_to(np.arange(n_v), (n_u, n_v))
+    grid_key = grid_row * span + (su[:, None] - su[0] + 1.0)
+    first = np.searchsorted(key, np.arange(n_v) * span)          # (n_v,) row starts
+    last = np.searchsorted(key, (np.arange(n_v) + 1) * span)     # (n_v,) row ends
+    k = np.searchsorted(key, grid_key)                           # (n_u, n_v)
+    left = k - first[None, :]                                    # crossings left of the point
+    has_left = k > first[None, :]
+    has_right = k < last[None, :]
+    d_left = np.where(has_left, grid_key - key[np.maximum(k - 1, 0)], np.inf)
+    d_right = np.where(has_right, key[np.minimum(k, len(key) - 1)] - grid_key, np.inf)
+    dist = np.minimum(d_left, d_right)
+    any_hit = np.isfinite(dist)
+    out[any_hit] = np.where(left[any_hit] % 2 == 1, dist[any_hit], -dist[any_hit])
+    return out
+
+
+def cut_plane_image(
+    wood,
+    size_mm,
+    origin,
+    normal,
+    resolution_mm: float = SECTION_RESOLUTION_MM,
+    *,
+    max_samples: int | None = None,
+    part=None,
+):
+    """The wood on the part of a plane inside the block, as coloured polydata.
+
+    The plane through ``origin`` with unit ``normal`` is sampled on a regular grid of spacing
+    ``resolution_mm`` and clipped to the block ``[0, W] x [0, D] x [0, H]`` (the cut edges are
+    exact: the clip puts points on the box faces). The wood is asked for its colour at every
+    point with the plane normal as the surface normal.
+
+    Parameters
+    ----------
+    wood : object with ``color(points_mm (n, 3), normals (n, 3)) -> rgb (n, 3)`` in [0, 1]
+    size_mm : (3,) float
+        Block size ``(W, D, H)`` mm.
+    origin, normal : (3,) float
+        A point of the plane (mm, block frame; it may lie outside the block) and its normal
+        (any length, normalised here).
+    resolution_mm : float
+        Grid spacing, mm.
+    max_samples : int, optional
+        Coarsen the spacing when the grid would have more points than this.
+    part : pyvista.PolyData, trimesh.Trimesh or (points (n, 3), triangles (m, 3)), optional
+        A closed part surface (block frame, mm). The section is then split along the part's
+        outline on the plane and its cells get ``"in_part"`` (1 inside the part, 0 in the
+        waste around it). The outline is exact along the grid's rows and placed within one
+        sample spacing across them.
+
+    Returns
+    -------
+    pyvista.PolyData
+        Points ``(n, 3)`` float64 mm inside the block; point array ``"RGB"`` ``(n, 3)`` uint8
+        (``round(255 * wood.color)``, computed at the final points, so boundary points are
+        exact too), the active scalars; with ``part``, cell array ``"in_part"``
+        ``(n_cells,)`` uint8 and, if the plane cuts the part, field data ``"outline_mm"``
+        ``(2 k, 3)``: the ends of the ``k`` segments where it cuts the part's triangles
+        (pairs of rows); field data ``"normal"``
+        ``(1, 3)`` and ``"resolution_mm"`` ``(1,)``. Empty (``n_points == 0``) when the plane
+        misses the block.
+    """
+    pv = _pyvista()
+    _check_wood(wood)
+    if wood is None:
+        raise WoodcamError("wood: cut_plane_image needs a wood to colour the plane; got None")
+    size = _check_size(size_mm)
+    origin = _check_vector(origin, "origin", unit=False)
+    normal = _check_vector(normal, "normal", unit=True)
+    if not (isinstance(resolution_mm, (int, float)) and np.isfinite(resolution_mm)
+            and resolution_mm > 0):
+        raise WoodcamError(
+            f"resolution_mm must be a positive number of mm; got {resolution_mm!r}; e.g. 0.25"
+        )
+    if max_samples is not None and (not isinstance(max_samples, (int, np.integer))
+                                    or max_samples < 16):
+        raise WoodcamError(
+            f"max_samples must be an integer >= 16 or None; got {max_samples!r}; e.g. 60000"
+        )
+
+    u, v = _plane_basis(normal)
+    poly_uv = _box_section_uv(size, origin, normal, u, v)
+    if len(poly_uv) < 3:
+        return pv.PolyData()
+    lo, hi = poly_uv.min(axis=0), poly_uv.max(axis=0)
+    extent = hi - lo
+    if np.any(extent <= ON_FACE_TOL_MM):
+        return pv.PolyData()
+    step = float(resolution_mm)
+    if max_samples is not None:
+        # Each axis gets ceil(extent / step) + 1 <= extent / step + 2 points; the largest
+        # t = 1 / step with (a t + 2)(b t + 2) <= max_samples solves a quadratic in t.
+        a, b = extent
+        t = (-2.0 * (a + b) + np.sqrt(4.0 * (a + b) ** 2 - 4.0 * a * b * (4.0 - max_samples))) \
+            / (2.0 * a * b)
+        step = max(step, 1.0 / t)
+    n_u, n_v = (np.ceil(extent / step).astype(int) + 1).clip(min=2)
+    section = _grid_polydata(pv, origin, u, v, (lo[0], hi[0]), (lo[1], hi[1]), n_u, n_v)
+    segments = None
+    if part is not None:
+        segments = _cut_segments(*_part_triangles(part), origin, normal)
+        ends = segments - origin
+        seg_uv = np.stack([ends @ u, ends @ v], axis=-1)         # (k, 2, 2) mm
+        su, sv = np.linspace(lo[0], hi[0], n_u), np.linspace(lo[1], hi[1], n_v)
+        section.point_data["part_mm"] = _signed_row_distance(seg_uv, su, sv).reshape(-1)
+
+    # Clip to the box by the face planes the grid actually crosses (none when the normal is
+    # a block axis: the grid rectangle is then the section itself).
+    for axis in range(3):
+        for bound, sign in ((0.0, -1.0), (size[axis], 1.0)):
+            coord = section.points[:, axis]
+            if np.all(sign * (coord - bound) <= ON_FACE_TOL_MM):
+                continue
+            plane_normal = np.zeros(3)
+            plane_normal[axis] = sign
+            plane_origin = np.zeros(3)
+            plane_origin[axis] = bound
+            section = section.clip(normal=plane_normal, origin=plane_origin, invert=True)
+            if section.n_points == 0:
+                return pv.PolyData()
+    in_part = None
+    if part is not None:
+        inside, outside = section.clip_scalar(scalars="part_mm", value=0.0, invert=False,
+                                              both=True)
+        inside.cell_data["in_part"] = np.ones(inside.n_cells, np.uint8)
+        outside.cell_data["in_part"] = np.zeros(outside.n_cells, np.uint8)
+        section = pv.merge([d for d in (inside, outside) if d.n_cells], merge_points=True) \
+            if inside.n_cells + outside.n_cells else pv.PolyData()
+        if section.n_cells:
+            in_part = np.asarray(section.cell_data["in_part"]).astype(np.uint8)
+    if section.n_cells == 0:
+        return pv.PolyData()
+    points = np.clip(np.asarray(section.points, dtype=float), 0.0, size)
+    rgb = _wood_rgb(wood, points, normal)
+    out = pv.PolyData(points, faces=section.faces)
+    if in_part is not None:
+        out.cell_data["in_part"] = in_part
+    out.point_data["RGB"] = np.rint(rgb * 255.0).astype(np.uint8)
+    out.set_active_scalars("RGB")
+    out.field_data["normal"] = normal[None, :]
+    out.field_data["resolution_mm"] = np.array([step])
+    if segments is not None and len(segments):
+        out.field_data["outline_mm"] = segments.reshape(-1, 3)
+    return out
+
+
+# ---------------------------------------------------------------------------- scene
+
+
+def _add_part(plotter, part, texture, *, name: str = PART_ACTOR):
+    """Add (or replace, by ``name``) the part with its texture or colours."""
+    # Some ambient light keeps faces turned from the lights close to the wood's own colour
+    # (the unlit cut plane shows that colour); diffuse and a little specular give the shape.
+    style = dict(smooth_shading=True, split_sharp_edges=True, ambient=0.25, diffuse=0.8,
+                 specular=0.15, specular_power=20.0, name=name, show_scalar_bar=False)
+    if texture is not None and part.active_texture_coordinates is not None:
+        return plotter.add_mesh(part, texture=texture, **style)
+    if "RGB" in part.point_data or "RGB" in part.cell_data:
+        return plotter.add_mesh(part, scalars="RGB", rgb=True, **style)
+    return plotter.add_mesh(part, color=UNTEXTURED_PART_COLOR, **style)
+
+
+def _add_block(plotter, size):
+    box, edges = block_outline(size)
+    plotter.add_mesh(box, color=BLOCK_COLOR, opacity=BLOCK_OPACITY, lighting=False,
+                     name="woodcam-block", show_scalar_bar=False)
+    plotter.add_mesh(edges, color=BLOCK_EDGE_COLOR, line_width=2, name="woodcam-block-edges",
+                     show_scalar_bar=False)
+
+
+class CutPlaneCallback:
+    """Redraw the cut for a plane ``(normal, origin)``: a cutaway of the part in its block.
+
+    The plane widget calls it as ``callback(normal, origin)`` while the plane is dragged; tests
+    call it the same way on an off-screen plotter. Creating it adds the part (actor
+    :data:`PART_ACTOR`) with a clipping plane on its mapper; each call moves that plane, so the
+    part keeps only the side *opposite* the normal (the normal points at the viewer and at the
+    half that is cut away; clipping on the GPU keeps texture seams and costs nothing). With a
+    wood, each call also replaces the wood on the plane inside the block: where the plane cuts
+    the part, opaque (actor :data:`SECTION_ACTOR`: the inside of the part, facing the viewer),
+    around it the waste wood, translucent (actor :data:`WASTE_ACTOR`), and the part's outline
+    on the plane as a dark line (actor :data:`OUTLINE_ACTOR`).
+
+    Parameters
+    ----------
+    plotter : pyvista.Plotter
+    part : pyvista.PolyData
+        The whole part, as from :func:`mesh_to_pyvista` (closed, for the in/out split).
+    texture : pyvista.Texture or None
+    wood : object with ``color(points_mm, normals)``, or None (then only the part is clipped)
+    size_mm : (3,) float or None
+        Block size; needed with a wood.
+    resolution_mm, max_samples
+        Passed to :func:`cut_plane_image`.
+
+    Attributes
+    ----------
+    clip_plane : vtkPlane
+        The part's clipping plane (origin mm; its normal is minus the cut's normal).
+    section : pyvista.PolyData or None
+        The last wood section, whole (cell array ``"in_part"`` tells part from waste).
+    shown : dict[str, pyvista.PolyData | None]
+        What the last call drew under each actor name (:data:`SECTION_ACTOR`,
+        :data:`WASTE_ACTOR`, :data:`OUTLINE_ACTOR`); None where that actor was removed.
+        (Reading the meshes back through ``actor.mapper.dataset`` is unreliable in pyvista
+        0.49: it reads empty once another mesh is added, although the picture is right.)
+    """
+
+    def __init__(self, plotter, part, texture, wood=None, size_mm=None, *,
+                 resolution_mm: float = SECTION_RESOLUTION_MM, max_samples: int | None = None):
+        _pyvista()  # a clear MissingDependencyError before vtk is touched
+        from vtkmodules.vtkCommonDataModel import vtkPlane
+
+        self.plotter = plotter
+        self.part = part
+        self.wood = _check_wood(wood)
+        self.size_mm = None if size_mm is None else _check_size(size_mm)
+        _check_size_with_wood(wood, self.size_mm)
+        self.resolution_mm = resolution_mm
+        self.max_samples = max_samples
+        self.section = None
+        self.shown = {}
+        self._triangles = _part_triangles(part)                  # (points, triangles), once
+        self.clip_plane = vtkPlane()
+        self.part_actor = _add_part(plotter, part, texture)
+        self.part_actor.mapper.AddClippingPlane(self.clip_plane)
+
+    def __call__(self, normal, origin):
+        """Move the cut to the plane; returns the section polydata (None without a wood)."""
+        normal = _check_vector(normal, "normal", unit=True)
+        origin = _check_vector(origin, "origin", unit=False)
+        # vtkPlane clipping keeps points with plane_normal . (x - origin) >= 0.
+        self.clip_plane.SetOrigin(*origin)
+        self.clip_plane.SetNormal(*(-normal))
+        if self.wood is None:
+            return None
+        section = cut_plane_image(self.wood, self.size_mm, origin, normal, self.resolution_mm,
+                                  max_samples=self.max_samples, part=self._triangles)
+        self.section = section
+        in_part = (np.asarray(section.cell_data["in_part"]).astype(bool) if section.n_cells
+                   else np.zeros(0, bool))
+        # Unlit: the plane shows the wood's own colour, as a freshly planed face would.
+        for name, cells, opacity in ((SECTION_ACTOR, in_part, 1.0),
+                                     (WASTE_ACTOR, ~in_part, WASTE_OPACITY)):
+            shown = section.remove_cells(~cells) if cells.any() else None
+            self.shown[name] = shown
+            if shown is not None:
+                self.plotter.add_mesh(shown, scalars="RGB", rgb=True, lighting=False,
+                                      opacity=opacity, name=name, show_scalar_bar=False)
+            else:
+                self.plotter.remove_actor(name, render=False)
+        # The part's outline on the plane, so its inside stands out from the waste.
+        segments = (np.asarray(section.field_data["outline_mm"]).reshape(-1, 2, 3)
+                    if "outline_mm" in section.field_data else np.empty((0, 2, 3)))
+        if len(segments):
+            lines = np.hstack([np.full((len(segments), 1), 2),
+                               np.arange(2 * len(segments)).reshape(-1, 2)]).ravel()
+            outline = _pyvista().PolyData(segments.reshape(-1, 3), lines=lines)
+            self.shown[OUTLINE_ACTOR] = outline
+            self.plotter.add_mesh(outline, color=OUTLINE_COLOR, line_width=OUTLINE_WIDTH,
+                                  lighting=False, name=OUTLINE_ACTOR, show_scalar_bar=False)
+        else:
+            self.shown[OUTLINE_ACTOR] = None
+            self.plotter.remove_actor(OUTLINE_ACTOR, render=False)
+        return section
+
+
+def _default_cut_normal(camera: str, size: np.ndarray) -> np.ndarray:
+    """The block's longest axis, among those facing the camera, signed toward the camera."""
+    view = np.asarray(_CAMERA_VIEW[camera][0])
+    facing = np.abs(view) > 1e-9
+    k = int(np.argmax(np.where(facing, size, -np.inf)))
+    n = np.zeros(3)
+    n[k] = np.sign(view[k])
+    return n
+
+
+#: Fraction of the picture's half-width and half-height the framed block may fill.
+_FRAME_FILL = 0.92
+
+
+def _set_camera(plotter, camera: str, bounds) -> None:
+    """Look along the camera's direction and frame the box ``bounds`` tightly.
+
+    pyvista's ``reset_camera`` frames the bounding sphere, which leaves a flat block small in
+    the picture; here the eight corners are projected and the distance and focal point chosen
+    so that they fill :data:`_FRAME_FILL` of the picture (perspective, vertical view angle of
+    the camera, the window's aspect ratio).
+    """
+    direction, up = (np.asarray(a, dtype=float) for a in _CAMERA_VIEW[camera])
+    b = np.asarray(bounds, dtype=float).reshape(3, 2)
+    direction = direction / np.linalg.norm(direction)
+    right = np.cross(up, direction)
+    right /= np.linalg.norm(right)
+    up = np.cross(direction, right)
+    bits = (np.arange(8)[:, None] >> np.arange(3)[None, :]) & 1
+    corners = b[:, 0] + bits * (b[:, 1] - b[:, 0])               # (8, 3) mm
+    width, height = plotter.window_size
+    tan_y = np.tan(np.radians(plotter.camera.view_angle) / 2.0) * _FRAME_FILL
+    tan_x = tan_y * width / height
+    focal = b.mean(axis=1)
+    for _ in range(4):  # distance from the extents, then recentre; converges in a few steps
+        q = corners - focal
+        along = q @ direction                                    # towards the camera, mm
+        x, y = q @ right, q @ up
+        dist = float(np.max(along + np.maximum(np.abs(x) / tan_x, np.abs(y) / tan_y)))
+        depth = dist - along                                     # (8,) > 0
+        sx, sy = x / depth, y / depth                            # tangents on the picture
+        shift_x = 0.5 * (sx.max() + sx.min()) * dist
+        shift_y = 0.5 * (sy.max() + sy.min()) * dist
+        focal = focal + shift_x * right + shift_y * up
+    plotter.camera_position = [tuple(focal + dist * direction), tuple(focal), tuple(up)]
+    plotter.reset_camera_clipping_range()
+
+
+def _display_available() -> bool:
+    if sys.platform.startswith("linux"):
+        return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    return True
+
+
+def _prefer_egl_off_screen() -> None:
+    """Off screen on Linux without a display, make VTK pick its EGL window directly.
+
+    VTK 9.4+ otherwise tries X first and logs "bad X server connection" before falling back.
+    An explicit ``VTK_DEFAULT_OPENGL_WINDOW`` from the user is left alone.
+    """
+    if (sys.platform.startswith("linux") and not _display_available()
+            and "VTK_DEFAULT_OPENGL_WINDOW" not in os.environ):
+        os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"
+
+
+def build_scene(
+    plotter,
+    mesh_or_path,
+    *,
+    wood=None,
+    size_mm=None,
+    cut_plane: bool = True,
+    widget: bool = False,
+    camera: Camera = "iso",
+    background="white",
+    cut_origin=None,
+    cut_normal=None,
+    resolution_mm: float = SECTION_RESOLUTION_MM,
+    max_samples: int | None = SECTION_MAX_SAMPLES_SCREENSHOT,
+) -> CutPlaneCallback | None:
+    """Fill a pyvista plotter with the part, the block and the cut plane; frame the camera.
+
+    :func:`preview` calls this for both modes; it is public so that a notebook or a test can
+    build the scene on its own plotter (off-screen plotters accept the plane widget too).
+
+    Parameters
+    ----------
+    plotter : pyvista.Plotter
+    widget : bool
+        With ``cut_plane``: add the interactive plane widget (bounded by the block), whose
+        callback redraws the cut as it is dragged. Without ``widget`` the cut is drawn once at
+        ``cut_origin`` / ``cut_normal``, and only when a wood is given.
+    max_samples : int or None
+        Cap on wood samples per section (see :func:`cut_plane_image`).
+    Other parameters as in :func:`preview`.
+
+    Returns
+    -------
+    CutPlaneCallback or None
+        The cut-plane callback when a cut is shown, else None.
+    """
+    _check_wood(wood)
+    camera = _check_camera(camera)
+    size = None if size_mm is None else _check_size(size_mm)
+    _check_size_with_wood(wood, size)
+    part, texture = mesh_to_pyvista(mesh_or_path)
+    bounds = (0.0, size[0], 0.0, size[1], 0.0, size[2]) if size is not None else part.bounds
+    b = np.asarray(bounds, dtype=float).reshape(3, 2)
+    origin = (b.mean(axis=1) if cut_origin is None
+              else _check_vector(cut_origin, "cut_origin", unit=False))
+    normal = (_default_cut_normal(camera, b[:, 1] - b[:, 0]) if cut_normal is None
+              else _check_vector(cut_normal, "cut_normal", unit=True))
+
+    plotter.set_background(background)
+    if size is not None:
+        _add_block(plotter, size)
+    callback = None
+    if cut_plane and (widget or wood is not None):
+        callback = CutPlaneCallback(plotter, part, texture, wood, size,
+                                    resolution_mm=resolution_mm, max_samples=max_samples)
+        if widget:
+            # The widget calls back once now, then at every move ("always": as it is dragged).
+            plotter.add_plane_widget(callback, normal=normal, origin=origin, bounds=bounds,
+                                     factor=1.0, interaction_event="always",
+                                     outline_opacity=0.0)
+        else:
+            callback(normal, origin)
+    else:
+        _add_part(plotter, part, texture)
+    # Frame the block and the part together (a part sticking out of its block stays in view).
+    frame = np.stack([np.minimum(b[:, 0], np.asarray(part.bounds).reshape(3, 2)[:, 0]),
+                      np.maximum(b[:, 1], np.asarray(part.bounds).reshape(3, 2)[:, 1])], axis=1)
+    _set_camera(plotter, camera, frame.ravel())
+    return callback
+
+
+def preview(
+    mesh_or_path,
+    *,
+    wood=None,
+    size_mm=None,
+    screenshot: str | os.PathLike | None = None,
+    window_size: tuple[int, int] = (1280, 960),
+    cut_plane: bool = True,
+    camera: Camera = "iso",
+    background="white",
+    cut_origin=None,
+    cut_normal=None,
+    resolution_mm: float = SECTION_RESOLUTION_MM,
+) -> Path | None:
+    """Show a textured part inside its translucent block, or write a screenshot of it.
+
+    Parameters
+    ----------
+    mesh_or_path : trimesh.Trimesh, trimesh.Scene, str or Path
+        The part in the block frame (mm); a file is read with ``trimesh.load(force="mesh")``.
+    wood : object with ``color(points_mm (n, 3), normals (n, 3)) -> rgb (n, 3)``, optional
+        Colours the cut plane; without it there is no wood section.
+    size_mm : (W, D, H) mm, optional
+        The block; drawn as a translucent box. Needed with ``wood``. Without it the view frames
+        the part's bounds.
+    screenshot : path, optional
+        Render off-screen (no display needed) and write this PNG; parent folders are created.
+        Without it an interactive window opens (needs a display).
+    window_size : (width, height) pixels
+    cut_plane : bool
+        Interactive: add a plane widget that clips the part and shows the wood on the plane as
+        it is dragged (without a wood it only clips the part). Screenshot with a wood: show one
+        cut plane at ``cut_origin`` / ``cut_normal``.
+    camera : "iso" | "top" | "front" | "back" | "left" | "right" | "bottom"
+        View direction; "iso" looks from front-right-above.
+    background : colour
+        Any colour pyvista accepts ("white", "#202020", (r, g, b) in 0..1).
+    cut_origin, cut_normal : (3,) float, optional
+        The initial cut plane; default the block centre and the block's longest axis facing
+        the camera, signed toward it (the part's half on the camera side is cut away, so the
+        plane shows its inside wood).
+    resolution_mm : float
+        Sample spacing of the wood on the plane (coarsened for very large sections and, in the
+        interactive window, while dragging).
+
+    Returns
+    -------
+    Path or None
+        The PNG written, or None after the interactive window closes.
+    """
+    pv = _pyvista()
+    ws = np.asarray(window_size)
+    if ws.shape != (2,) or not np.all(np.isfinite(ws)) or np.any(ws < 16) or np.any(ws % 1):
+        raise WoodcamError(
+            f"window_size must be two integers >= 16 (width, height) in pixels; got "
+            f"{window_size!r}; e.g. (1280, 960)"
+        )
+    window_size = (int(ws[0]), int(ws[1]))
+    if screenshot is not None and Path(screenshot).suffix.lower() != ".png":
+        raise WoodcamError(
+            f"screenshot must be a .png path; got {str(screenshot)!r}; e.g. out/part.png"
+        )
+    if screenshot is None and not _display_available():
+        raise WoodcamError(
+            "preview: an interactive window needs a display, but neither DISPLAY nor "
+            "WAYLAND_DISPLAY is set; render off-screen instead with screenshot='part.png' "
+            "(CLI: woodcam preview PART --screenshot part.png)"
+        )
+    # Check the mesh and options before a window opens.
+    _check_wood(wood)
+    _check_camera(camera)
+    _check_size_with_wood(wood, None if size_mm is None else _check_size(size_mm))
+    mesh = _load_mesh(mesh_or_path)
+
+    off_screen = screenshot is not None
+    if off_screen:
+        _prefer_egl_off_screen()
+    plotter = pv.Plotter(off_screen=off_screen, window_size=window_size,
+                         title="woodcam preview")
+    try:
+        build_scene(
+            plotter, mesh, wood=wood, size_mm=size_mm, cut_plane=cut_plane,
+            widget=not off_screen, camera=camera, background=background,
+            cut_origin=cut_origin, cut_normal=cut_normal, resolution_mm=resolution_mm,
+            max_samples=(SECTION_MAX_SAMPLES_SCREENSHOT if off_screen
+                         else SECTION_MAX_SAMPLES_INTERACTIVE),
+        )
+        # Translucent block and waste wood over the part: sort them per pixel.
+        plotter.enable_depth_peeling()
+        plotter.enable_anti_aliasing("ssaa")
+        if off_screen:
+            path = Path(screenshot)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            plotter.screenshot(str(path))
+            return path
+        plotter.add_axes()
+        plotter.show()
+        return None
+    finally:
+        plotter.close()
