@@ -16,14 +16,13 @@ from .errors import WoodcamError
 PARTIAL_FACES = ("front", "top", "left")
 
 
-def _read_block(path):
-    try:
-        from .block.io import read_block
-    except ImportError as err:  # the block reader lives on the `block` branch until merged
-        raise WoodcamError(
-            f"reading block folder {str(path)!r} needs woodcam.block.io.read_block, which this "
-            f"installation lacks; update woodcam"
-        ) from err
+def _read_block(path, size_mm: float | None = None):
+    """A block folder (block.json) or a Mokume sample folder (A_col.png ...; cube of size_mm)."""
+    from .block.io import read_block, read_mokume
+
+    path = Path(path)
+    if path.is_dir() and not (path / "block.json").exists() and any(path.glob("A_*.png")):
+        return read_mokume(path) if size_mm is None else read_mokume(path, (size_mm,) * 3)
     return read_block(path)
 
 
@@ -40,6 +39,8 @@ def add_parser(subparsers) -> None:
     p.add_argument("--method", choices=METHODS, default="radial",
                    help="rbf: seed 000's RBF baseline; radial: our pith-axis least-squares fit")
     p.add_argument("--faces", default=None, help="comma-separated faces to use (default: all)")
+    p.add_argument("--size-mm", type=float, default=None,
+                   help="cube side in mm for a Mokume sample folder (its files carry no size)")
     p.add_argument("--out", type=Path, required=True, help="field file to write (.npz grid)")
     p.set_defaults(func=run_fit)
 
@@ -62,16 +63,16 @@ def run(args) -> int:
 def run_fit(args) -> int:
     from .inference.fit import fit_block
 
-    block = _read_block(args.block_dir)
+    block = _read_block(args.block_dir, args.size_mm)
     field = fit_block(block, args.method, faces=_faces(args.faces))
     path = field.save(args.out)
     print(f"wrote {path} ({args.method} fit of {block.name}, grid {field.years.shape}, "
-          f"{field.spacing_mm:g} mm)")
+          f"{field.spacing_mm[0]:g} mm)")
     return 0
 
 
 def run_eval(args) -> int:
-    from .inference.baked import BakedField
+    from .fields.grid import GridField
     from .inference.evaluate import benchmark
     from .inference.fit import METHODS
 
@@ -86,7 +87,7 @@ def run_eval(args) -> int:
                 f"--truth needs one field file per block: got {len(args.truth)} for {len(blocks)} blocks"
             )
         for b, t in zip(blocks, args.truth):
-            b.true_field = BakedField.load(t)
+            b.true_field = GridField.load(t)
     sets = {"full": None}
     if args.partial_faces.lower() != "none":
         sets["partial"] = _faces(args.partial_faces)

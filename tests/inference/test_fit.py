@@ -6,8 +6,9 @@ import pytest
 from _synth import make_block, random_field
 from woodcam.block import Block, Face, RingTrace
 from woodcam.errors import WoodcamError
+from woodcam.fields import GridField
 from woodcam.inference import (
-    DEFAULT_PLANES, BakedField, bake, evaluate_fit, fit_block, gather_observations,
+    DEFAULT_PLANES, bake, evaluate_fit, fit_block, gather_observations,
 )
 from woodcam.inference.radial import number_rings
 
@@ -34,7 +35,7 @@ def _interior(n=3000, seed=0):
 
 def test_radial_recovers_eq79_field(field, labelled_fit):
     block, fit = labelled_fit
-    assert isinstance(fit, BakedField)
+    assert isinstance(fit, GridField)
     summary, scores = evaluate_fit(field, fit, block.size_mm, planes=PLANES, pixel_mm=0.2)
     assert summary["matched_1"] >= FULL_BAR_1MM
     assert summary["matched_2"] >= FULL_BAR_2MM
@@ -131,8 +132,20 @@ def test_baked_field_round_trip(tmp_path, field):
     # cubic splines on a 1 mm grid: away from the pith cone the growth time is reproduced
     assert np.percentile(np.abs(baked(p) - field(p)), 95) < 0.01
     path = baked.save(tmp_path / "f.npz")
-    again = BakedField.load(path)
+    again = GridField.load(path)
     assert np.array_equal(again(p), baked(p))
     (tmp_path / "bad.npz").write_bytes(b"nope")
-    with pytest.raises(WoodcamError, match="is not a baked growth field"):
-        BakedField.load(tmp_path / "bad.npz")
+    with pytest.raises(WoodcamError, match="not a woodcam grid field"):
+        GridField.load(tmp_path / "bad.npz")
+
+
+def test_radial_field_state_round_trip(labelled_fit):
+    import json
+
+    from woodcam.inference import RadialField, fit_radial
+
+    obs = gather_observations(labelled_fit[0])
+    f = fit_radial(obs, labelled_fit[0].size_mm)
+    g = RadialField.from_dict(json.loads(json.dumps(f.to_dict())))
+    p = _interior(500)
+    assert np.array_equal(g(p), f(p))

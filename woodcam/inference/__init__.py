@@ -6,7 +6,7 @@
   of the true ring line (same year, or any year) on interior cut planes.
 """
 
-from .baked import BakedField, bake
+from .baked import bake
 from .evaluate import DEFAULT_PLANES, CutPlane, benchmark, evaluate_fit, evaluate_fits
 from .fit import METHODS, Method, fit_block
 from .observations import RingObservations, gather_observations
@@ -14,7 +14,7 @@ from .radial import RadialField, fit_radial
 from .rbf import fit_rbf
 
 __all__ = [
-    "BakedField", "CutPlane", "DEFAULT_PLANES", "METHODS", "Method", "RadialField",
+    "CutPlane", "DEFAULT_PLANES", "METHODS", "Method", "RadialField",
     "RingObservations", "bake", "benchmark", "evaluate_fit", "evaluate_fits", "fit_block",
     "fit_radial", "fit_rbf", "gather_observations",
 ]

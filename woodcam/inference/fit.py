@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Literal, get_args
 
 from ..errors import WoodcamError
-from .baked import BakedField, bake
+from .baked import bake
 from .observations import gather_observations
 from .radial import fit_radial
 from .rbf import fit_rbf
@@ -24,8 +24,8 @@ def fit_block(block, method: Method = "radial", faces=None, baked: bool = True):
         (ours: pith axis + smooth inverse ring width by least squares; also numbers unlabelled
         traces and ring maps).
     faces : list of face names / Mokume letters, optional; default every face of the block.
-    baked : return the field baked to a 1 mm grid (:class:`BakedField`, fast, saveable) rather
-        than the raw fitted callable.
+    baked : return the field baked to a 1 mm grid (:class:`woodcam.fields.GridField`, fast,
+        saveable with ``.save(path)``) rather than the raw fitted callable.
 
     Returns
     -------
@@ -41,4 +41,4 @@ def fit_block(block, method: Method = "radial", faces=None, baked: bool = True):
     return bake(field, block.size_mm) if baked else field
 
 
-__all__ = ["BakedField", "METHODS", "Method", "fit_block"]
+__all__ = ["METHODS", "Method", "fit_block"]

@@ -93,6 +93,18 @@ class RadialField:
         rho, B = _design(p, self.pith_mm, d, e1, e2, self.z_scale_mm, self.K, self.M)
         return self.offset + rho * (B @ self.coef)
 
+    def to_dict(self) -> dict:
+        """Plain-JSON state (see :mod:`woodcam.fields.state`)."""
+        return {"pith_mm": np.asarray(self.pith_mm, float).tolist(),
+                "axis": np.asarray(self.axis, float).tolist(), "z_scale_mm": float(self.z_scale_mm),
+                "K": int(self.K), "M": int(self.M), "coef": np.asarray(self.coef, float).tolist(),
+                "offset": float(self.offset)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "RadialField":
+        return cls(np.asarray(d["pith_mm"], float), np.asarray(d["axis"], float), float(d["z_scale_mm"]),
+                   int(d["K"]), int(d["M"]), np.asarray(d["coef"], float), float(d["offset"]))
+
     def grain_direction(self, points_mm) -> np.ndarray:
         p = check_points(points_mm)
         return np.broadcast_to(self.axis / np.linalg.norm(self.axis), p.shape).copy()
