@@ -18,6 +18,11 @@ that shows only a narrow wedge of azimuths stays well posed). Starting axes come
 directions on the hemisphere, each with its pith placed by an algebraic fit of concentric circles
 (radius linear in year) to the points projected along that direction.
 
+Robustness: traces whose median misfit exceeds half a year are renumbered and the fit repeated
+(mislabelled traces); the final coefficients take the strongest ridge that raises the residual
+by at most 5 % (jittered traces on a few faces otherwise let high harmonics swing where no face
+sees the rings).
+
 Unlabelled rings (traces without years, ring-map components) are fitted with one unknown level
 per ring group instead of the year, with the inverse ring width's mean over the data fixed to 1
 (no collapse to a flat field); the levels are then turned into years by the ring spacing
