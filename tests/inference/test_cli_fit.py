@@ -5,7 +5,7 @@ import argparse
 import numpy as np
 import pytest
 
-from _synth import make_block, random_field
+from _eq79_blocks import make_block, random_field
 from woodcam._cli_fit import add_parser, run
 from woodcam.block.io import write_block
 from woodcam.errors import WoodcamError

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from _synth import make_block, random_field
+from _eq79_blocks import make_block, random_field
 from woodcam.block import Block, Face, RingTrace
 from woodcam.errors import WoodcamError
 from woodcam.fields import GridField

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from _synth import random_field
+from _eq79_blocks import random_field
 from woodcam.errors import WoodcamError
 from woodcam.inference.evaluate import CutPlane, evaluate_fit, markdown_table, sample_plane
 

@@ -1,6 +1,6 @@
 """Benchmark: seed 000's Table 1 on 8 synthetic eq. 7-9 blocks, RBF baseline vs our radial fit.
 
-Run: ``WOODCAM_BENCH_OUT=/tmp/bench python -m pytest tests/inference/test_bench.py -m bench -s``
+Run: ``WOODCAM_BENCH_OUT=/tmp/bench python -m pytest tests/inference/test_inference_bench.py -m bench -s``
 (the table and cut-plane images go to that folder, else to pytest's tmp_path).
 50 mm cubes, rings 2-5 mm, seven interior cut planes each; full = six faces, partial = front,
 top, left (half the surface, meeting at a corner); clean traces, and realistic ones (0.3 mm
@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from _synth import make_block, random_field
+from _eq79_blocks import make_block, random_field
 from woodcam._cli_fit import PARTIAL_FACES
 from woodcam.inference import benchmark
 
