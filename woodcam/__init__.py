@@ -28,6 +28,7 @@ _EXPORTS = {
                 "read_gran1"],
     ".frames": ["FACES", "FACE_NORMAL", "MOKUME_LETTER", "block_to_pixel", "pixel_to_block",
                 "unfold_cross"],
+    ".inference": ["benchmark", "evaluate_fit", "fit_block"],
     ".logs": ["GeneratedLog", "generate_log"],
     ".pipeline": ["PartPreview", "preview_mesh", "preview_part"],
     ".stock": ["Stock", "open_stock"],

@@ -50,6 +50,39 @@ ARC_RADIUS_MISMATCH_MM = 0.01
 #: ~1e-5 mm round-off at 100 mm, and a CAM clearance plane sits >= 0.5 mm above the stock.
 SIM_CONTACT_TOL_MM = 1e-4
 
+#: Grid step (mm) of a baked growth field. Growth time is smooth (a cone only at the pith), so
+#: a 1 mm grid with cubic splines keeps ring lines within ~0.02 mm of the field it samples for
+#: rings >= 2 mm wide, while a 50 mm cube costs only ~150k evaluations of the fitted field.
+BAKE_SPACING_MM = 1.0
+
+#: Border (mm) added around the block when baking, so cubic splines are not evaluated at the
+#: edge of their grid on the block faces.
+BAKE_MARGIN_MM = 2.0
+
+#: Spacing (mm) at which ring traces are resampled before fitting: 0.5 mm is finer than any
+#: ring's curvature radius away from the pith and keeps a fully traced 50 mm cube near 3-6k points.
+TRACE_SAMPLE_STEP_MM = 0.5
+
+#: Grey level at or above which a ring-map pixel counts as a ring pixel (maps are in [0, 1],
+#: bright on ring boundaries; 0.5 is the natural mid-point of a soft boundary map).
+RING_MAP_THRESHOLD = 0.5
+
+#: Largest number of ring points the RBF fits use. Their dense solve is O(n^3): 2500 points take
+#: ~1 s on one core; at 0.5 mm trace sampling that still keeps a point every ~1-2 mm of ring.
+RBF_MAX_POINTS = 2500
+
+#: Pixel size (mm) at which cut planes are sampled for the ring-accuracy metric: 10x finer than
+#: the 1 mm threshold, so contour discretisation (< 0.01 mm for smooth fields) does not count.
+EVAL_PIXEL_MM = 0.1
+
+#: Distance thresholds (mm) of the ring-accuracy metric, as in seed 000's Table 1.
+EVAL_THRESHOLDS_MM = (1.0, 2.0)
+
+#: Largest relative difference between a face image's row and column pixel sizes (mm/px) that
+#: is accepted as square pixels; a larger one means the image does not match the block size
+#: (a wrong size_mm or an uncropped photo). 5 % allows a pixel of rounding on a 20 px face.
+FACE_PIXEL_ASPECT_RTOL = 0.05
+
 #: Largest error (years) allowed between a refined synthetic ring trace vertex and its integer
 #: iso-line. Newton refinement on the true field reaches ~1e-9 years in three steps; vertices that
 #: do not (on a field kink or where the gradient vanishes, e.g. at the pith) are dropped.

@@ -1,0 +1,60 @@
+"""``woodcam fit`` / ``woodcam eval`` through their argparse wiring (woodcam._cli_fit)."""
+
+import argparse
+
+import numpy as np
+import pytest
+
+from _eq79_blocks import make_block, random_field
+from woodcam._cli_fit import add_parser, run
+from woodcam.block.io import write_block
+from woodcam.errors import WoodcamError
+from woodcam.fields import GridField
+from woodcam.inference import bake
+
+
+def _parse(argv):
+    parser = argparse.ArgumentParser(prog="woodcam")
+    add_parser(parser.add_subparsers(dest="command", required=True))
+    return parser.parse_args(argv)
+
+
+@pytest.fixture(scope="module")
+def block_dir(tmp_path_factory):
+    field = random_field(np.random.default_rng(104))
+    block = make_block(field, px_per_mm=3)
+    folder = tmp_path_factory.mktemp("blk") / "b0"
+    write_block(block, folder)
+    truth = bake(field, block.size_mm).save(folder.parent / "truth.npz")
+    return folder, truth, field
+
+
+def test_fit_writes_a_grid_field_close_to_the_truth(block_dir, tmp_path, capsys):
+    folder, _, field = block_dir
+    out = tmp_path / "f.npz"
+    assert run(_parse(["fit", str(folder), "--method", "radial", "--out", str(out)])) == 0
+    assert "wrote" in capsys.readouterr().out
+    fit = GridField.load(out)
+    p = np.random.default_rng(0).uniform(3, 47, (2000, 3))
+    assert np.percentile(np.abs(fit(p) - field(p)), 99) < 0.1
+
+
+def test_eval_writes_table_and_images(block_dir, tmp_path):
+    folder, truth, _ = block_dir
+    out = tmp_path / "ev"
+    args = _parse(["eval", str(folder), "--truth", str(truth), "--methods", "radial",
+                   "--partial-faces", "none", "--out", str(out)])
+    assert run(args) == 0
+    table = (out / "table.md").read_text()
+    assert "radial matched 1 mm" in table
+    assert len(list(out.glob("*.png"))) == 1
+
+
+def test_cli_errors(block_dir, tmp_path):
+    folder, truth, _ = block_dir
+    with pytest.raises(SystemExit):  # argparse rejects an unknown method by name
+        _parse(["fit", str(folder), "--method", "neural", "--out", str(tmp_path / "x.npz")])
+    with pytest.raises(WoodcamError, match="--truth needs one field file per block"):
+        run(_parse(["eval", str(folder), str(folder), "--truth", str(truth), "--out", str(tmp_path)]))
+    with pytest.raises(WoodcamError, match="--methods must be from"):
+        run(_parse(["eval", str(folder), "--methods", "radial,magic", "--out", str(tmp_path)]))

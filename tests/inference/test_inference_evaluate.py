@@ -1,0 +1,62 @@
+"""The Table-1 ring accuracy metric on cut planes against known answers."""
+
+import numpy as np
+import pytest
+
+from _eq79_blocks import random_field
+from woodcam.errors import WoodcamError
+from woodcam.inference.evaluate import CutPlane, evaluate_fit, markdown_table, sample_plane
+
+
+class _Cylinder:
+    """years = distance from the vertical line x = y = 25 mm, in units of 2 mm rings."""
+
+    def __call__(self, p):
+        return np.hypot(p[:, 0] - 25, p[:, 1] - 25) / 2.0
+
+
+PLANE = (CutPlane("z", (0.5, 0.5, 0.5), (0, 0, 1)),)
+
+
+def test_perfect_fit_scores_100():
+    s, _ = evaluate_fit(_Cylinder(), _Cylinder(), (50, 50, 50), planes=PLANE, pixel_mm=0.2)
+    assert s["matched_1"] == 100 and s["unmatched_1"] == 100 and s["coverage_1"] == 100
+
+
+def test_shift_by_one_year_fails_matched_passes_unmatched():
+    true = _Cylinder()
+    s, _ = evaluate_fit(true, lambda p: true(p) + 1, (50, 50, 50), planes=PLANE, pixel_mm=0.2)
+    assert s["matched_1"] == 0  # ring n+1 sits 2 mm from ring n: matching by year fails
+    assert s["unmatched_1"] == 100  # every predicted line lies on some true line
+
+
+def test_radial_offset_in_mm_sets_the_share():
+    # predicted rings 1.5 mm too far out: none within 1 mm, all within 2 mm
+    true = _Cylinder()
+    s, _ = evaluate_fit(true, lambda p: true(p) - 0.75, (50, 50, 50), planes=PLANE, pixel_mm=0.1)
+    assert s["matched_1"] == 0
+    assert s["matched_2"] > 98  # lines clipped at the block edge end at slightly different places
+
+
+def test_oblique_plane_covers_its_cut_polygon_only():
+    sample = sample_plane(CutPlane("xyz", (0.5, 0.5, 0.5), (1, 1, 1)), (50, 50, 50), 0.5)
+    inside = sample.points_mm[sample.inside]
+    assert inside.min() >= -1e-9 and inside.max() <= 50 + 1e-9
+    # a regular hexagon of side 50/sqrt(2) mm: area 3 sqrt(3)/2 * 1250 = 3248 mm^2
+    assert sample.inside.sum() * 0.25 == pytest.approx(3247.6, rel=0.02)
+    with pytest.raises(WoodcamError, match="does not cross the block"):
+        sample_plane(CutPlane("out", (2, 2, 2), (0, 0, 1)), (50, 50, 50))
+
+
+def test_markdown_table_bolds_the_better_method():
+    row = {"name": "b", "a": {"matched_1": 50.0, "matched_2": 60.0, "unmatched_1": 70.0,
+                              "unmatched_2": 80.0, "coverage_1": 1.0, "fit_s": 1.0}}
+    row["c"] = {k: v + 1 for k, v in row["a"].items()}
+    text = markdown_table([row], ["a", "c"])
+    assert "| 50.0 | **51.0** |" in text
+
+
+def test_eq79_helper_is_exact_on_its_own_field():
+    f = random_field(np.random.default_rng(5))
+    s, _ = evaluate_fit(f, f, (50, 50, 50), planes=PLANE, pixel_mm=0.25)
+    assert s["matched_1"] == 100

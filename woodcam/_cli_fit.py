@@ -1,0 +1,97 @@
+"""``woodcam fit`` and ``woodcam eval``: infer a block's growth field; score fits on cut planes.
+
+Wire into ``woodcam/cli.py`` with ``_cli_fit.add_parser(subparsers)``; each subparser sets
+``func`` to the function that runs it.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .errors import WoodcamError
+
+#: Faces used for "partial annotation": three faces meeting at the front-top-left corner, half
+#: of the block's surface (seed 000, section 4.3 traces "half of the block only").
+PARTIAL_FACES = ("front", "top", "left")
+
+
+def _read_block(path, size_mm: float | None = None):
+    """A block folder (block.json) or a Mokume sample folder (A_col.png ...; cube of size_mm)."""
+    from .block.io import read_block, read_mokume
+
+    path = Path(path)
+    if path.is_dir() and not (path / "block.json").exists() and any(path.glob("A_*.png")):
+        return read_mokume(path) if size_mm is None else read_mokume(path, (size_mm,) * 3)
+    return read_block(path)
+
+
+def _faces(text):
+    return None if text in (None, "", "all") else [f.strip() for f in text.split(",") if f.strip()]
+
+
+def add_parser(subparsers) -> None:
+    """Add the ``fit`` and ``eval`` subcommands to an argparse ``subparsers`` object."""
+    from .inference.fit import METHODS
+
+    p = subparsers.add_parser("fit", help="infer a block's growth field from its traced faces")
+    p.add_argument("block_dir", type=Path, help="block folder (manifest, face images, traces)")
+    p.add_argument("--method", choices=METHODS, default="radial",
+                   help="rbf: seed 000's RBF baseline; radial: our pith-axis least-squares fit")
+    p.add_argument("--faces", default=None, help="comma-separated faces to use (default: all)")
+    p.add_argument("--size-mm", type=float, default=None,
+                   help="cube side in mm for a Mokume sample folder (its files carry no size)")
+    p.add_argument("--out", type=Path, required=True, help="field file to write (.npz grid)")
+    p.set_defaults(func=run_fit)
+
+    e = subparsers.add_parser("eval", help="score fits on interior cut planes (seed 000, Table 1)")
+    e.add_argument("block_dirs", type=Path, nargs="+", help="block folders with a known true field")
+    e.add_argument("--truth", type=Path, nargs="*", default=None,
+                   help="true field files (.npz), one per block; default: each block's own")
+    e.add_argument("--methods", default=",".join(METHODS), help=f"comma list of {', '.join(METHODS)}")
+    e.add_argument("--partial-faces", default=",".join(PARTIAL_FACES),
+                   help="faces of the partial-annotation run ('none' to skip it)")
+    e.add_argument("--out", type=Path, required=True, help="folder for table.md and cut-plane PNGs")
+    e.set_defaults(func=run_eval)
+
+
+def run(args) -> int:
+    """Run the subcommand chosen by :func:`add_parser`; returns the exit status."""
+    return args.func(args)
+
+
+def run_fit(args) -> int:
+    from .inference.fit import fit_block
+
+    block = _read_block(args.block_dir, args.size_mm)
+    field = fit_block(block, args.method, faces=_faces(args.faces))
+    path = field.save(args.out)
+    print(f"wrote {path} ({args.method} fit of {block.name}, grid {field.years.shape}, "
+          f"{field.spacing_mm[0]:g} mm)")
+    return 0
+
+
+def run_eval(args) -> int:
+    from .fields.grid import GridField
+    from .inference.evaluate import benchmark
+    from .inference.fit import METHODS
+
+    methods = _faces(args.methods) or list(METHODS)
+    bad = [m for m in methods if m not in METHODS]
+    if bad:
+        raise WoodcamError(f"--methods must be from {', '.join(METHODS)}; got {bad}")
+    blocks = [_read_block(p) for p in args.block_dirs]
+    if args.truth:
+        if len(args.truth) != len(blocks):
+            raise WoodcamError(
+                f"--truth needs one field file per block: got {len(args.truth)} for {len(blocks)} blocks"
+            )
+        for b, t in zip(blocks, args.truth):
+            b.true_field = GridField.load(t)
+    sets = {"full": None}
+    if args.partial_faces.lower() != "none":
+        sets["partial"] = _faces(args.partial_faces)
+    res = benchmark(blocks, methods, sets, out_dir=args.out, progress=print)
+    print(res["table"])
+    print(f"wrote {Path(args.out) / 'table.md'} and cut-plane images")
+    return 0

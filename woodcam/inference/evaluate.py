@@ -1,0 +1,337 @@
+"""Ring-line accuracy on interior cut planes: the metric of seed 000's Table 1 (section 4.3).
+
+On a planar cut through the block, the *true* ring lines are the integer iso-lines of the true
+growth field and the *predicted* ones those of a fitted field. The seed reports "the percentage
+of points on the inferred annual rings within 1.0 and 2.0 mm from the ground truth", with rings
+labelled by year. Here points are sampled every ``step_mm`` along the predicted lines and each is
+counted as a hit when it lies within the threshold of the true line of the *same year*
+(``matched``) or of *any* true line (``unmatched``, the looser reading). ``coverage`` is the
+reverse share: true-line points within 1 mm of the predicted line of the same year, so a fit
+that draws only a few, correct rings cannot score well unnoticed.
+
+Cut planes are given by a block-frame point and a normal; each is sampled on a square grid of
+``pixel_mm`` (0.1 mm by default) clipped to the block.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field as dc_field
+
+import numpy as np
+
+from ..errors import WoodcamError, require
+from ..fields.base import evaluate
+from ..frames import check_size
+from ..tolerances import EVAL_PIXEL_MM, EVAL_THRESHOLDS_MM
+from .observations import _resample_polyline
+
+
+@dataclass(frozen=True)
+class CutPlane:
+    """A planar cut: passes through ``point`` (fractions of the block size) with normal ``normal``."""
+
+    name: str
+    point: tuple[float, float, float]
+    normal: tuple[float, float, float]
+
+
+#: Seven interior cuts of different orientations: the three axis planes off-centre and four
+#: oblique planes, so a straight pith along any block axis is cut across, along and obliquely.
+DEFAULT_PLANES: tuple[CutPlane, ...] = (
+    CutPlane("z=0.5", (0.5, 0.5, 0.5), (0, 0, 1)),
+    CutPlane("x=0.35", (0.35, 0.5, 0.5), (1, 0, 0)),
+    CutPlane("y=0.65", (0.5, 0.65, 0.5), (0, 1, 0)),
+    CutPlane("xy-diag", (0.5, 0.5, 0.5), (1, 1, 0)),
+    CutPlane("xz-diag", (0.45, 0.5, 0.55), (1, 0, -1)),
+    CutPlane("yz-diag", (0.5, 0.55, 0.45), (0, 1, 1)),
+    CutPlane("xyz", (0.5, 0.5, 0.5), (1, 1, 1)),
+)
+
+
+@dataclass
+class PlaneSample:
+    """A cut plane sampled on a grid: ``points_mm (nr, nc, 3)`` and ``inside (nr, nc) bool``."""
+
+    plane: CutPlane
+    points_mm: np.ndarray
+    inside: np.ndarray
+    pixel_mm: float
+
+
+def sample_plane(plane: CutPlane, size_mm, pixel_mm: float = EVAL_PIXEL_MM) -> PlaneSample:
+    """Grid of block points on ``plane`` covering its intersection with the block."""
+    size = check_size(size_mm)
+    n = np.asarray(plane.normal, float)
+    n /= np.linalg.norm(n)
+    c = np.asarray(plane.point, float) * size
+    helper = np.eye(3)[int(np.argmin(np.abs(n)))]
+    e1 = np.cross(n, helper)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(n, e1)
+    # Intersections of the 12 block edges with the plane bound the cut polygon.
+    corners = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], float) * size
+    hits = []
+    for a in range(8):
+        for b in range(a + 1, 8):
+            if np.count_nonzero(corners[a] != corners[b]) != 1:
+                continue
+            da, db = (corners[a] - c) @ n, (corners[b] - c) @ n
+            if da * db <= 0 and da != db:
+                hits.append(corners[a] + (corners[b] - corners[a]) * da / (da - db))
+    if len(hits) < 3:
+        raise WoodcamError(f"cut plane {plane.name!r} does not cross the block {tuple(size)}")
+    st = (np.asarray(hits) - c) @ np.stack([e1, e2]).T
+    lo, hi = st.min(0), st.max(0)
+    s = np.arange(lo[0], hi[0] + pixel_mm, pixel_mm)
+    t = np.arange(lo[1], hi[1] + pixel_mm, pixel_mm)
+    S, T = np.meshgrid(s, t, indexing="ij")
+    pts = c + S[..., None] * e1 + T[..., None] * e2
+    eps = 1e-9
+    inside = np.all((pts >= -eps) & (pts <= size + eps), axis=-1)
+    return PlaneSample(plane, pts, inside, pixel_mm)
+
+
+def ring_lines(years_img: np.ndarray, inside: np.ndarray, pixel_mm: float, step_mm: float):
+    """Integer iso-lines of a growth-time image, resampled every ``step_mm``.
+
+    Returns
+    -------
+    points : (m, 2) float, plane coordinates in mm (row, col) * pixel_mm
+    years : (m,) int, the year of the line each point is on
+    """
+    contourpy = require("contourpy", "view", "tracing ring lines on cut planes")
+    z = np.ma.masked_array(years_img, ~inside)
+    gen = contourpy.contour_generator(z=z, line_type=contourpy.LineType.Separate)
+    vals = years_img[inside]
+    pts, yrs = [], []
+    if vals.size:
+        for year in range(int(np.ceil(vals.min())), int(np.floor(vals.max())) + 1):
+            for line in gen.lines(year):
+                if len(line) < 2:
+                    continue
+                p = _resample_polyline(line[:, ::-1] * pixel_mm, step_mm)
+                pts.append(p)
+                yrs.append(np.full(len(p), year))
+    if not pts:
+        return np.empty((0, 2)), np.empty(0, int)
+    return np.concatenate(pts), np.concatenate(yrs)
+
+
+def _nearest_distance(query, qyears, ref, ryears, match_years: bool) -> np.ndarray:
+    from scipy.spatial import cKDTree
+
+    d = np.full(len(query), np.inf)
+    if not len(query) or not len(ref):
+        return d
+    if not match_years:
+        return cKDTree(ref).query(query)[0]
+    for y in np.unique(qyears):
+        q, r = qyears == y, ryears == y
+        if r.any():
+            d[q] = cKDTree(ref[r]).query(query[q])[0]
+    return d
+
+
+@dataclass
+class PlaneScore:
+    """Distances for one plane and one fitted field (mm; inf where no true line of that year)."""
+
+    plane: str
+    d_matched: np.ndarray
+    d_unmatched: np.ndarray
+    d_coverage: np.ndarray
+    lines: dict = dc_field(default_factory=dict, repr=False)
+
+
+def score_plane(true_field, fitted_field, sample: PlaneSample, step_mm: float | None = None,
+                keep_lines: bool = False, true_lines=None) -> PlaneScore:
+    """Compare ring lines of ``fitted_field`` with those of ``true_field`` on one sampled plane.
+
+    ``true_lines`` may pass the true lines ``(points, years)`` precomputed by
+    :func:`plane_lines` when several fields are scored on one plane.
+    """
+    tp, ty = plane_lines(true_field, sample, step_mm) if true_lines is None else true_lines
+    pp, py = plane_lines(fitted_field, sample, step_mm)
+    s = PlaneScore(
+        sample.plane.name,
+        _nearest_distance(pp, py, tp, ty, True),
+        _nearest_distance(pp, py, tp, ty, False),
+        _nearest_distance(tp, ty, pp, py, True),
+    )
+    if keep_lines:
+        s.lines = {"true": (tp, ty), "fit": (pp, py)}
+    return s
+
+
+def plane_lines(field, sample: PlaneSample, step_mm: float | None = None):
+    """Ring lines ``(points (m, 2) mm, years (m,))`` of ``field`` on a sampled plane."""
+    step = sample.pixel_mm if step_mm is None else step_mm
+    g = evaluate(field, sample.points_mm.reshape(-1, 3)).reshape(sample.inside.shape)
+    return ring_lines(g, sample.inside, sample.pixel_mm, step)
+
+
+def summarise(scores: list[PlaneScore], thresholds=EVAL_THRESHOLDS_MM) -> dict:
+    """Pool the points of several planes: percentages within each threshold.
+
+    Returns a dict with ``matched_<t>``, ``unmatched_<t>`` (percent of predicted-line points) for
+    each threshold ``t`` in mm, ``coverage_1`` (percent of true-line points within 1 mm of the
+    same-year predicted line) and ``n_points``.
+    """
+    dm = np.concatenate([s.d_matched for s in scores]) if scores else np.empty(0)
+    du = np.concatenate([s.d_unmatched for s in scores]) if scores else np.empty(0)
+    dc = np.concatenate([s.d_coverage for s in scores]) if scores else np.empty(0)
+    out = {"n_points": int(len(dm))}
+    for t in thresholds:
+        out[f"matched_{t:g}"] = 100.0 * np.mean(dm <= t) if len(dm) else 0.0
+        out[f"unmatched_{t:g}"] = 100.0 * np.mean(du <= t) if len(du) else 0.0
+    out["coverage_1"] = 100.0 * np.mean(dc <= 1.0) if len(dc) else 0.0
+    return out
+
+
+def evaluate_fit(true_field, fitted_field, size_mm, planes=DEFAULT_PLANES,
+                 pixel_mm: float = EVAL_PIXEL_MM, keep_lines: bool = False):
+    """Table-1 accuracy of ``fitted_field`` against ``true_field`` on ``planes`` of a block.
+
+    Returns
+    -------
+    summary : dict (see :func:`summarise`)
+    scores : list of PlaneScore, one per plane
+    """
+    return evaluate_fits(true_field, {"fit": fitted_field}, size_mm, planes, pixel_mm, keep_lines)["fit"]
+
+
+def evaluate_fits(true_field, fitted: dict, size_mm, planes=DEFAULT_PLANES,
+                  pixel_mm: float = EVAL_PIXEL_MM, keep_lines: bool = False) -> dict:
+    """:func:`evaluate_fit` for several fields (dict name -> field) sharing the true lines.
+
+    Returns dict name -> ``(summary, scores)``.
+    """
+    out = {name: [] for name in fitted}
+    for p in planes:
+        sample = sample_plane(p, size_mm, pixel_mm)
+        truth = plane_lines(true_field, sample)
+        for name, f in fitted.items():
+            out[name].append(score_plane(true_field, f, sample, keep_lines=keep_lines, true_lines=truth))
+    return {name: (summarise(sc), sc) for name, sc in out.items()}
+
+
+def benchmark(blocks, methods=("rbf", "radial"), face_sets=None, out_dir=None,
+              planes=DEFAULT_PLANES, pixel_mm: float = EVAL_PIXEL_MM, progress=None) -> dict:
+    """Fit every block with every method and face set, score them on the cut planes.
+
+    Parameters
+    ----------
+    blocks : list of Block, each with a ``true_field``
+    methods : fitting methods (see :data:`woodcam.inference.fit.METHODS`)
+    face_sets : dict label -> list of faces or None (all); default ``{"full": None}``
+    out_dir : folder for ``table.md`` and one PNG per block and face set (predicted vs true
+        ring lines on every plane); nothing is written when None.
+    progress : optional callable taking one line of text per fit.
+
+    Returns
+    -------
+    dict face-set label -> list of rows ``{"name": block name, method: summary + fit_s}`` plus
+    ``"table"``: the markdown text.
+    """
+    import time
+    from pathlib import Path
+
+    from .fit import fit_block
+
+    face_sets = {"full": None} if face_sets is None else face_sets
+    result, tables = {}, []
+    for label, faces in face_sets.items():
+        rows = []
+        for b in blocks:
+            if b.true_field is None:
+                raise WoodcamError(
+                    f"block {b.name!r} has no true_field; evaluation needs the true growth field "
+                    f"(a synthetic block, or pass --truth FIELD_FILE)"
+                )
+            fields, times = {}, {}
+            for m in methods:
+                t0 = time.perf_counter()
+                fields[m] = fit_block(b, m, faces=faces)
+                times[m] = time.perf_counter() - t0
+            scored = evaluate_fits(b.true_field, fields, b.size_mm, planes, pixel_mm,
+                                   keep_lines=out_dir is not None)
+            row = {"name": b.name}
+            for m in methods:
+                row[m] = dict(scored[m][0], fit_s=times[m])
+            rows.append(row)
+            if progress:
+                progress(f"{label} {b.name}: " + ", ".join(
+                    f"{m} {row[m]['matched_1']:.1f}/{row[m]['matched_2']:.1f}% {times[m]:.1f}s" for m in methods))
+            if out_dir is not None:
+                Path(out_dir).mkdir(parents=True, exist_ok=True)
+                plot_planes(Path(out_dir) / f"{b.name}_{label}.png", {m: scored[m][1] for m in methods},
+                            title=f"{b.name} ({label}): black = true rings, colour = fitted")
+        mean = {"name": "**mean**"}
+        for m in methods:
+            keys = rows[0][m].keys()
+            mean[m] = {k: float(np.mean([r[m][k] for r in rows])) for k in keys}
+        rows.append(mean)
+        result[label] = rows
+        tables.append(f"### {label} ({'all faces' if faces is None else ', '.join(faces)})\n\n"
+                      + markdown_table(rows, list(methods)))
+    result["table"] = "\n\n".join(tables) + "\n"
+    if out_dir is not None:
+        (Path(out_dir) / "table.md").write_text(result["table"])
+    return result
+
+
+def plot_planes(path, scores_by_method: dict, title: str = ""):
+    """Save a PNG: for each plane, true ring lines (black) under each method's lines (colour).
+
+    scores_by_method : dict method -> list of PlaneScore made with ``keep_lines=True``.
+    """
+    matplotlib = require("matplotlib", "view", "drawing cut-plane ring images")
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    methods = list(scores_by_method)
+    n_planes = len(next(iter(scores_by_method.values())))
+    fig, axes = plt.subplots(len(methods), n_planes, figsize=(2.6 * n_planes, 2.8 * len(methods)),
+                             squeeze=False)
+    colours = ["tab:red", "tab:blue", "tab:green", "tab:orange"]
+    for r, m in enumerate(methods):
+        for c, s in enumerate(scores_by_method[m]):
+            ax = axes[r, c]
+            tp, _ = s.lines["true"]
+            pp, _ = s.lines["fit"]
+            ax.plot(tp[:, 1], tp[:, 0], ",", color="k", alpha=0.6)
+            ax.plot(pp[:, 1], pp[:, 0], ",", color=colours[r % len(colours)])
+            ok = np.mean(s.d_matched <= 1.0) * 100 if len(s.d_matched) else 0.0
+            ax.set_title(f"{m} {s.plane}\n{ok:.0f}% <1mm", fontsize=8)
+            ax.set_aspect("equal")
+            ax.invert_yaxis()
+            ax.set_xticks([])
+            ax.set_yticks([])
+    if title:
+        fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def markdown_table(rows: list[dict], methods: list[str], thresholds=EVAL_THRESHOLDS_MM) -> str:
+    """Markdown table: one row per entry of ``rows`` (dict with ``name`` and ``method -> summary``),
+    columns: for each threshold, each method, year-matched then unmatched, then coverage."""
+    head = ["block"]
+    for kind in ("matched", "unmatched"):
+        for t in thresholds:
+            head += [f"{m} {kind} {t:g} mm" for m in methods]
+    head += [f"{m} coverage 1 mm" for m in methods] + [f"{m} fit s" for m in methods]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for row in rows:
+        cells = [str(row["name"])]
+        for kind in ("matched", "unmatched"):
+            for t in thresholds:
+                vals = [row[m][f"{kind}_{t:g}"] for m in methods]
+                best = max(vals)
+                cells += [(f"**{v:.1f}**" if v == best and len(methods) > 1 else f"{v:.1f}") for v in vals]
+        cells += [f"{row[m]['coverage_1']:.1f}" for m in methods]
+        cells += [f"{row[m].get('fit_s', float('nan')):.2f}" for m in methods]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)

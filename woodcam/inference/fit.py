@@ -1,0 +1,44 @@
+"""Fit a growth field to a block's ring annotations: the method registry and :func:`fit_block`."""
+
+from __future__ import annotations
+
+from typing import Literal, get_args
+
+from ..errors import WoodcamError
+from .baked import bake
+from .observations import gather_observations
+from .radial import fit_radial
+from .rbf import fit_rbf
+
+Method = Literal["rbf", "radial"]
+METHODS: tuple[str, ...] = get_args(Method)
+
+
+def fit_block(block, method: Method = "radial", faces=None, baked: bool = True):
+    """Infer a block's growth field from the rings on its faces.
+
+    Parameters
+    ----------
+    block : woodcam.block.Block
+    method : "rbf" (seed 000's baseline: thin-plate RBF of labelled ring points) or "radial"
+        (ours: pith axis + smooth inverse ring width by least squares; also numbers unlabelled
+        traces and ring maps).
+    faces : list of face names / Mokume letters, optional; default every face of the block.
+    baked : return the field baked to a 1 mm grid (:class:`woodcam.fields.GridField`, fast,
+        saveable with ``.save(path)``) rather than the raw fitted callable.
+
+    Returns
+    -------
+    field : callable ``(n, 3) mm -> (n,) years`` in the block frame.
+    """
+    if method not in METHODS:
+        raise WoodcamError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
+    obs = gather_observations(block, faces)
+    if method == "rbf":
+        field = fit_rbf(obs)
+    else:
+        field = fit_radial(obs, block.size_mm)
+    return bake(field, block.size_mm) if baked else field
+
+
+__all__ = ["METHODS", "Method", "fit_block"]

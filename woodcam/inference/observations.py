@@ -1,0 +1,135 @@
+"""Ring observations of a block gathered for fitting: points on ring boundaries, block frame.
+
+Each observation is a point ``points_mm : (n, 3)`` on a ring boundary (an integer iso-surface of
+the growth field), grouped by ``group : (n,) int`` (one group per traced polyline or per
+connected ring-map component: all points of a group lie on one ring) with ``years : (n,) float``
+(NaN where unlabelled). ``face : (n,) int`` indexes :data:`woodcam.frames.FACES`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import WoodcamError
+from ..frames import FACES, check_face, face_image_size_mm, pixel_to_block
+from ..tolerances import FACE_PIXEL_ASPECT_RTOL, RING_MAP_THRESHOLD, TRACE_SAMPLE_STEP_MM
+
+
+@dataclass
+class RingObservations:
+    """Ring-boundary points of a block (see module docstring for shapes and frames)."""
+
+    points_mm: np.ndarray
+    years: np.ndarray
+    group: np.ndarray
+    face: np.ndarray
+
+    @property
+    def labelled(self) -> bool:
+        """True when every point carries a year label."""
+        return bool(len(self.years)) and bool(np.all(np.isfinite(self.years)))
+
+    @property
+    def n_groups(self) -> int:
+        return int(self.group.max()) + 1 if len(self.group) else 0
+
+    def subset(self, mask) -> "RingObservations":
+        m = np.asarray(mask)
+        _, g = np.unique(self.group[m], return_inverse=True)
+        return RingObservations(self.points_mm[m], self.years[m], g, self.face[m])
+
+
+def _resample_polyline(p: np.ndarray, step: float) -> np.ndarray:
+    """Points every ``step`` along a polyline ``(k, d)`` (ends kept); vectorised by interpolation."""
+    seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    if s[-1] <= 0:
+        return p[:1]
+    t = np.linspace(0.0, s[-1], max(2, int(np.ceil(s[-1] / step)) + 1))
+    return np.stack([np.interp(t, s, p[:, i]) for i in range(p.shape[1])], axis=1)
+
+
+def _ring_map_components(ring_map: np.ndarray, threshold: float):
+    """Connected bright components of a ring map -> list of ``(k, 2)`` pixel (row, col) arrays."""
+    from scipy import ndimage
+
+    mask = np.asarray(ring_map, float) >= threshold
+    lab, n = ndimage.label(mask, structure=np.ones((3, 3)))
+    if n == 0:
+        return []
+    rows, cols = np.nonzero(lab)
+    ids = lab[rows, cols]
+    order = np.argsort(ids, kind="stable")
+    splits = np.flatnonzero(np.diff(ids[order])) + 1
+    comps = np.split(np.stack([rows[order], cols[order]], axis=1).astype(float), splits)
+    return [c for c in comps if len(c) >= 3]
+
+
+def gather_observations(block, faces=None, step_mm: float = TRACE_SAMPLE_STEP_MM,
+                        ring_map_threshold: float = RING_MAP_THRESHOLD) -> RingObservations:
+    """Collect ring-boundary points from ``block``'s traces (preferred) or ring maps.
+
+    Parameters
+    ----------
+    block : woodcam.block.Block
+    faces : list of face names or Mokume letters, optional
+        Use only these faces (partial annotation); default all faces the block has.
+    step_mm : spacing (mm) at which traces are resampled, so long and densely traced rings do
+        not outweigh the others and fits stay fast.
+    ring_map_threshold : ring-map pixels at or above this grey value are ring pixels.
+
+    Raises
+    ------
+    WoodcamError
+        When a face name does not exist or is not on the block, or no ring is found.
+    """
+    names = list(block.faces) if faces is None else [check_face(f) for f in faces]
+    missing = [f for f in names if f not in block.faces]
+    if missing:
+        raise WoodcamError(
+            f"faces {missing} are not on block {block.name!r}, which has {list(block.faces)}; "
+            f"pass a subset of those"
+        )
+    pts, yrs, grp, fc = [], [], [], []
+    g = 0
+    for name in names:
+        f = block.faces[name]
+        dr, dc = block.face_pixel_size_mm(name)
+        if abs(dr - dc) > FACE_PIXEL_ASPECT_RTOL * max(dr, dc):
+            h, w = face_image_size_mm(name, block.size_mm)
+            raise WoodcamError(
+                f"face {name!r} is {f.shape[0]}x{f.shape[1]} px but covers {h:g}x{w:g} mm of block "
+                f"{block.name!r} (size_mm {block.size_mm}): its pixels would be {dr:.3g}x{dc:.3g} mm, "
+                f"not square; check size_mm or crop the face image to the face"
+            )
+        if f.traces:
+            polys = [(t.points_px, t.year) for t in f.traces]
+            px_step = step_mm / max(min(dr, dc), 1e-12)
+            polys = [(_resample_polyline(p, px_step), y) for p, y in polys]
+        elif f.ring_map is not None:
+            comps = _ring_map_components(f.ring_map, ring_map_threshold)
+            stride = max(1, int(round(step_mm / max(min(dr, dc), 1e-12))))
+            # Ring-map components are pixel blobs a few pixels thick; keep every stride-th
+            # pixel of each so their density matches resampled traces.
+            polys = [(c[::stride * 2] if len(c) > 4 * stride else c, None) for c in comps]
+        else:
+            continue
+        for p, year in polys:
+            pts.append(pixel_to_block(name, p[:, 0], p[:, 1], f.shape, block.size_mm))
+            yrs.append(np.full(len(p), np.nan if year is None else float(year)))
+            grp.append(np.full(len(p), g))
+            fc.append(np.full(len(p), FACES.index(name)))
+            g += 1
+    if not pts:
+        raise WoodcamError(
+            f"block {block.name!r} has no ring traces or ring-map rings on faces {names}; "
+            f"trace at least one ring (or give a ring map) on at least one face"
+        )
+    obs = RingObservations(np.concatenate(pts), np.concatenate(yrs), np.concatenate(grp), np.concatenate(fc))
+    lab = np.isfinite(obs.years)
+    if lab.any() and not lab.all():
+        # Mixed input: keep the labelled traces only; their labels pin the years.
+        obs = obs.subset(lab)
+    return obs
