@@ -34,3 +34,33 @@ def test_log_spec_puts_the_knot_on_the_front_face(shared_data):
 def test_bad_specs(spec, message):
     with pytest.raises(WoodcamError, match=message):
         open_stock(spec)
+
+
+def test_block_folder_without_truth_is_fitted_once_and_cached(tmp_path):
+    """A block folder with traced rings but no true field gets a fitted field, cached on disk."""
+    from woodcam.block.io import write_block
+    from woodcam.fields.builtin import builtin_block
+    from woodcam.synth import synth_block
+
+    truth = builtin_block("flat-sawn").field
+    block = synth_block(truth, (50, 40, 30), face_px=96, seed=0)
+    block.true_field = None
+    write_block(block, tmp_path / "b")
+    s = open_stock(str(tmp_path / "b"))
+    cache = tmp_path / "b" / ".woodcam-cache" / "field_radial.npz"
+    assert cache.is_file()
+    p = np.random.default_rng(0).uniform(0, 1, (5000, 3)) * (50, 40, 30)
+    # Clean traces of an eq. 7-9 field: the fit is within 0.05 years (0.15 mm at 3 mm rings).
+    assert np.abs(s.wood.field(p) - truth(p)).max() < 0.05
+    stamp = cache.stat().st_mtime
+    open_stock(str(tmp_path / "b"))
+    assert cache.stat().st_mtime == stamp  # reused, not refitted
+
+
+def test_block_folder_with_no_rings_is_a_clear_error(tmp_path):
+    from woodcam.block import Block
+    from woodcam.block.io import write_block
+
+    write_block(Block((10, 10, 10)), tmp_path / "empty")
+    with pytest.raises(WoodcamError, match="neither a true field nor traced rings"):
+        open_stock(str(tmp_path / "empty"))

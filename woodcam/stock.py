@@ -103,16 +103,35 @@ def _synthetic_stock(spec, field, size_mm, species, description, appearance, par
     return Stock(spec, tuple(size_mm), Wood(field, app), description, meta)
 
 
+def fitted_field(block, folder: Path, method: str = "radial"):
+    """The growth field fitted to a block's rings, fitted once and cached in the block folder.
+
+    The cache file ``<folder>/.woodcam-cache/field_<method>.npz`` is reused while it is newer
+    than the block's manifest; delete it (or rewrite the block) to fit again.
+    """
+    from .fields.grid import GridField
+    from .inference import fit_block
+
+    cache = folder / ".woodcam-cache" / f"field_{method}.npz"
+    manifest = folder / "block.json"
+    if cache.is_file() and cache.stat().st_mtime >= manifest.stat().st_mtime:
+        return GridField.load(cache)
+    if not any(f.has_rings for f in block.faces.values()):
+        raise WoodcamError(
+            f"block folder {folder} has neither a true field nor traced rings or ring maps to "
+            "fit one to; trace rings on at least one face (or use 'woodcam block synth')"
+        )
+    field = fit_block(block, method=method)
+    cache.parent.mkdir(exist_ok=True)
+    field.save(cache)
+    return field
+
+
 def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
     from .block.io import read_block  # block I/O sits beside; imported when a folder is used
 
     block = read_block(path)
-    if block.true_field is None:
-        raise WoodcamError(
-            f"block folder {path} has no growth field yet; fit one with "
-            f"'woodcam fit {path}' first"
-        )
-    field = block.true_field
+    field = block.true_field if block.true_field is not None else fitted_field(block, path)
     if appearance == "neural":
         from .appearance.neural import block_appearance
 

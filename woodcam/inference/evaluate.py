@@ -99,7 +99,7 @@ def ring_lines(years_img: np.ndarray, inside: np.ndarray, pixel_mm: float, step_
     points : (m, 2) float, plane coordinates in mm (row, col) * pixel_mm
     years : (m,) int, the year of the line each point is on
     """
-    contourpy = require("contourpy", "view", "tracing ring lines on cut planes")
+    import contourpy  # marching squares; a core dependency
     z = np.ma.masked_array(years_img, ~inside)
     gen = contourpy.contour_generator(z=z, line_type=contourpy.LineType.Separate)
     vals = years_img[inside]
