@@ -32,6 +32,7 @@ Design decisions (the seed leaves them open or we deliberately deviate):
 from __future__ import annotations
 
 import copy
+import functools
 import csv
 import json
 import time
@@ -140,6 +141,7 @@ class GTFSpec:
 # Training data: the eq. 7-9 family, vectorised over many fields
 
 
+@functools.lru_cache(maxsize=4)
 def _laplacian_smoother(n_constraints: int, m: int) -> np.ndarray:
     """(m, n_constraints) linear map from constraint values to radius samples.
 
