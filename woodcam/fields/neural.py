@@ -31,7 +31,6 @@ Design decisions (the seed leaves them open or we deliberately deviate):
 
 from __future__ import annotations
 
-import copy
 import functools
 import csv
 import json
@@ -291,21 +290,6 @@ def load_model(model_dir=None):
     return net, spec
 
 
-class NeuralGTF:
-    """One decoded field of the generic model, in normalised units: ``(n, 3) -> (n,)``."""
-
-    def __init__(self, net, code):
-        torch = _torch()
-        self.net = net
-        self.code = torch.as_tensor(np.asarray(code, np.float32))
-
-    def __call__(self, points) -> np.ndarray:
-        torch = _torch()
-        p = np.asarray(points, np.float32)
-        with torch.no_grad():
-            return self.net(self.code, torch.from_numpy(p)).double().numpy()
-
-
 # ---------------------------------------------------------------------------------------------
 # Training (eq. 3)
 
@@ -441,11 +425,3 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
     return {"step": arr[:, 0].astype(int), "loss": arr[:, 1], "time_s": arr[:, 2],
             "final_l1": final_l1, "final_rel": final_rel, "train_s": elapsed,
             "net": net, "codes": codes.detach().numpy().copy()}
-
-
-def trained_copy(net):
-    """A frozen deep copy of ``net`` (tests and fitters must not change the shared model)."""
-    n = copy.deepcopy(net)
-    for prm in n.parameters():
-        prm.requires_grad_(False)
-    return n.eval()

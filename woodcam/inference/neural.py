@@ -40,6 +40,9 @@ _DOMAIN_FILL = 0.95
 #: Trace points used in the grid search / the Adam refinement (random subsets, fixed seed).
 _GRID_POINTS = 128
 _ADAM_POINTS = 1000
+#: Adam learning rates (code: latent units; pose: normalised units and radians; scale: log K),
+#: decayed by a cosine to 5 %.
+_LR_CODE, _LR_POSE, _LR_SCALE = 3e-2, 1e-2, 1e-2
 
 
 @dataclass
@@ -241,9 +244,9 @@ def _fit(torch, block, model, faces, steps, seed, progress, spacing_mm) -> Neura
     shift = torch.zeros(3, dtype=torch.float64, requires_grad=True)
     w = torch.zeros(3, dtype=torch.float64, requires_grad=True)
     log_k = torch.tensor(np.log(k0), dtype=torch.float64, requires_grad=True)
-    opt = torch.optim.Adam([{"params": [code], "lr": 3e-2},
-                            {"params": [shift, w], "lr": 1e-2},
-                            {"params": [log_k], "lr": 1e-2}])
+    opt = torch.optim.Adam([{"params": [code], "lr": _LR_CODE},
+                            {"params": [shift, w], "lr": _LR_POSE},
+                            {"params": [log_k], "lr": _LR_SCALE}])
     base_lrs = [g["lr"] for g in opt.param_groups]
     it = range(steps)
     if progress:
