@@ -1,0 +1,149 @@
+"""The generic neural growth field (seed 000 §3.2.1-3.2.2, §3.2.5): data, model, training."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from woodcam.errors import WoodcamError  # noqa: E402
+from woodcam.fields.base import LogFrame  # noqa: E402
+from woodcam.fields.neural import (  # noqa: E402
+    LOG_NAME, MODELS_DIR, SPEC_NAME, WEIGHTS_NAME, GTFSpec, _laplacian_smoother, build_model,
+    encode, family_gtf, load_model, make_training_set, random_radius_samples, train_gtf,
+)
+from woodcam.fields.radial import RadialScalingField, RadiusFunction  # noqa: E402
+
+TINY = dict(n_fields=8, points_per_field=64, latent_dim=4, hidden=16, layers=2, n_harmonics=3,
+            batch_fields=4, batch_points=16, steps=40, checkpoint_every=20, log_every=10)
+
+
+def test_family_matches_radial_field():
+    """The vectorised eq. 7-9 equals RadialScalingField with ring width 1 and half length 1."""
+    rng = np.random.default_rng(3)
+    rm, rp = random_radius_samples(rng, 1), random_radius_samples(rng, 1)
+    f = RadialScalingField(LogFrame((0, 0, 0), (0, 0, 1), reference=(1, 0, 0)), 1.0,
+                           RadiusFunction(rm[0]), RadiusFunction(rp[0]), 1.0)
+    p = np.random.default_rng(1).uniform(-1.2, 1.2, (500, 3))
+    np.testing.assert_allclose(family_gtf(p[None], rm, rp)[0], f(p), rtol=1e-12, atol=1e-12)
+
+
+def test_smoother_matches_from_constraints():
+    c = np.clip(np.random.default_rng(5).normal(1, 0.1, 15), 0.5, 1.5)
+    np.testing.assert_allclose(c @ _laplacian_smoother(15, 360).T,
+                               RadiusFunction.from_constraints(c).samples, atol=1e-10)
+
+
+def test_training_set_pith_fraction_and_values():
+    spec = GTFSpec(**{**TINY, "points_per_field": 100})
+    pts, vals = make_training_set(spec)
+    assert pts.shape == (8, 100, 3) and vals.shape == (8, 100) and pts.dtype == np.float32
+    near = np.all(np.abs(pts[..., :2]) <= 0.1, axis=-1)
+    assert near[:, :20].all()  # the first 20 % are drawn near the pith
+    assert np.abs(pts).max() <= 1.0
+    rho = np.hypot(pts[..., 0], pts[..., 1])
+    # r' in [0.5, 1.5] bounds the growth time between rho / 1.5 and rho / 0.5
+    assert np.all(vals >= rho / 1.5 - 1e-6) and np.all(vals <= rho / 0.5 + 1e-6)
+
+
+def test_encoding_is_cylindrical_and_continuous():
+    phi = np.linspace(-np.pi, np.pi, 37)
+    r, z = 0.7, -0.3
+    p = torch.tensor(np.stack([r * np.cos(phi), r * np.sin(phi), np.full_like(phi, z)], -1))
+    e = encode(p, 4).numpy()
+    assert e.shape == (37, 10)
+    np.testing.assert_allclose(e[:, 0], r, atol=1e-12)
+    np.testing.assert_allclose(e[:, 1], z, atol=1e-12)
+    for k in range(1, 5):
+        np.testing.assert_allclose(e[:, 2 * k], np.cos(k * phi), atol=1e-9)
+        np.testing.assert_allclose(e[:, 2 * k + 1], np.sin(k * phi), atol=1e-9)
+    # no jump across the negative x axis (where atan2 and eq. 4's arccos/arcsin fold)
+    a = encode(torch.tensor([[-0.5, 1e-9, 0.0], [-0.5, -1e-9, 0.0]], dtype=torch.float64), 4)
+    assert float((a[0] - a[1]).abs().max()) < 1e-6
+    # finite at the pith
+    assert torch.isfinite(encode(torch.zeros(1, 3, dtype=torch.float64), 4)).all()
+
+
+def test_model_shape_grad_and_initial_field():
+    spec = GTFSpec(**TINY)
+    net = build_model(spec)
+    codes = torch.randn(5, 1, 4, requires_grad=True)
+    p = torch.rand(5, 7, 3) * 2 - 1
+    out = net(codes, p)
+    assert out.shape == (5, 7)
+    # zero-initialised last layer: the untrained model is the mean field f = rho
+    torch.testing.assert_close(out, torch.sqrt(p[..., 0] ** 2 + p[..., 1] ** 2 + 1e-12))
+    (out.sum() + sum(q.sum() for q in net.parameters())).backward()
+    assert codes.grad is not None and codes.grad.shape == codes.shape
+    # one code broadcast over many points
+    assert net(torch.zeros(4), p.reshape(-1, 3)).shape == (35,)
+
+
+def test_spec_round_trip_and_errors(tmp_path):
+    spec = GTFSpec(**TINY)
+    assert GTFSpec.load(spec.save(tmp_path / "s.json")) == spec
+    with pytest.raises(WoodcamError, match="unknown keys"):
+        GTFSpec.from_dict({**TINY, "depth": 3})
+    with pytest.raises(WoodcamError, match="spec.hidden must be a positive number"):
+        GTFSpec(**{**TINY, "hidden": 0})
+    with pytest.raises(WoodcamError, match="pith_fraction"):
+        GTFSpec(**{**TINY, "pith_fraction": 1.5})
+    (tmp_path / "bad.json").write_text("[1, 2]")
+    with pytest.raises(WoodcamError, match="JSON object"):
+        GTFSpec.load(tmp_path / "bad.json")
+
+
+def test_resumed_training_equals_straight_run(tmp_path):
+    spec = GTFSpec(**TINY)
+    straight = train_gtf(spec, tmp_path / "a", progress=False)
+    train_gtf(spec, tmp_path / "b", steps=20, progress=False)
+    resumed = train_gtf(spec, tmp_path / "b", progress=False)
+    sa = torch.load(tmp_path / "a" / WEIGHTS_NAME, weights_only=True)
+    sb = torch.load(tmp_path / "b" / WEIGHTS_NAME, weights_only=True)
+    for k in sa:
+        torch.testing.assert_close(sa[k], sb[k], rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(straight["codes"], resumed["codes"], rtol=1e-5, atol=1e-6)
+    np.testing.assert_array_equal(straight["step"], resumed["step"])
+    np.testing.assert_allclose(straight["loss"], resumed["loss"], rtol=1e-5)
+    # spec, weights and log written; the log holds every logged step
+    assert GTFSpec.load(tmp_path / "b" / SPEC_NAME) == spec
+    with open(tmp_path / "b" / LOG_NAME, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [int(r["step"]) for r in rows] == [10, 20, 30, 40]
+    # a checkpoint of another spec is refused
+    with pytest.raises(WoodcamError, match="another spec"):
+        train_gtf(GTFSpec(**{**TINY, "seed": 1}), tmp_path / "b", progress=False)
+
+
+def test_training_reduces_the_error(tmp_path):
+    spec = GTFSpec(**{**TINY, "steps": 300, "hidden": 32, "checkpoint_every": 300, "log_every": 50,
+                      "lr_net": 3e-3, "lr_latent": 3e-2})
+    pts, vals = make_training_set(spec)
+    untrained_l1 = np.abs(np.hypot(pts[..., 0], pts[..., 1]) - vals).mean()  # f = rho at init
+    r = train_gtf(spec, tmp_path, progress=False)
+    assert r["final_l1"] < 0.75 * untrained_l1
+
+
+def test_packaged_model():
+    """The committed weights load, match their spec, and were trained to a small error."""
+    if not (MODELS_DIR / WEIGHTS_NAME).is_file():
+        pytest.skip("packaged model not trained yet")
+    net, spec = load_model()
+    assert sum(p.numel() for p in net.parameters()) < 500_000
+    assert (MODELS_DIR / WEIGHTS_NAME).stat().st_size < 2_000_000
+    summary = json.loads((MODELS_DIR / "gtf_train_summary.json").read_text())
+    assert summary["steps"] == spec.steps
+    assert summary["final_l1"] < 0.01  # normalised units: ~1 % of the domain radius
+    # c = 0 decodes a plausible member of the family: 0 on the pith, ~rho elsewhere
+    p = torch.tensor([[0.0, 0.0, 0.0], [0.5, 0.0, 0.0], [0.0, -0.8, 0.5]])
+    out = net(torch.zeros(spec.latent_dim), p).numpy()
+    np.testing.assert_allclose(out, [0.0, 0.5, 0.8], atol=0.1)
+
+
+def test_load_model_missing(tmp_path):
+    with pytest.raises(WoodcamError, match="needs gtf_spec.json and gtf.pt"):
+        load_model(tmp_path)

@@ -1,0 +1,41 @@
+"""``woodcam train gtf`` (module woodcam._cli_train; the lead registers it in woodcam.cli)."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+
+import pytest
+
+pytest.importorskip("torch")
+
+from woodcam import _cli_train  # noqa: E402
+from woodcam.fields.neural import GTFSpec  # noqa: E402
+
+
+def _parse(argv):
+    parser = argparse.ArgumentParser(prog="woodcam")
+    _cli_train.add_parser(parser.add_subparsers(dest="command"))
+    return parser.parse_args(argv)
+
+
+def test_train_gtf_cli_writes_spec_weights_log_and_resumes(tmp_path, capsys):
+    spec = GTFSpec(n_fields=6, points_per_field=32, latent_dim=4, hidden=8, layers=2, n_harmonics=2,
+                   batch_fields=3, batch_points=8, steps=30, checkpoint_every=10, log_every=10)
+    spec_path = spec.save(tmp_path / "spec.json")
+    out = tmp_path / "model"
+    args = _parse(["train", "gtf", "--spec", str(spec_path), "--out", str(out), "--steps", "10"])
+    assert args.func(args) == 0
+    assert "trained 10 steps" in capsys.readouterr().out
+    args = _parse(["train", "gtf", "--spec", str(spec_path), "--out", str(out)])
+    assert args.func(args) == 0  # resumes from step 10 to the spec's 30
+    assert "trained 30 steps" in capsys.readouterr().out
+    assert GTFSpec.load(out / "gtf_spec.json") == spec
+    assert (out / "gtf.pt").is_file()
+    with open(out / "gtf_train_log.csv", newline="") as fh:
+        assert [int(r["step"]) for r in csv.DictReader(fh)] == [10, 20, 30]
+
+
+def test_train_rejects_unknown_model(tmp_path):
+    with pytest.raises(SystemExit):
+        _parse(["train", "sdf", "--out", str(tmp_path)])
