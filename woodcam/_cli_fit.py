@@ -48,7 +48,8 @@ def add_parser(subparsers) -> None:
     e.add_argument("block_dirs", type=Path, nargs="+", help="block folders with a known true field")
     e.add_argument("--truth", type=Path, nargs="*", default=None,
                    help="true field files (.npz), one per block; default: each block's own")
-    e.add_argument("--methods", default=",".join(METHODS), help=f"comma list of {', '.join(METHODS)}")
+    e.add_argument("--methods", default="rbf,radial",
+                   help=f"comma list of {', '.join(METHODS)} (default rbf,radial)")
     e.add_argument("--partial-faces", default=",".join(PARTIAL_FACES),
                    help="faces of the partial-annotation run ('none' to skip it)")
     e.add_argument("--out", type=Path, required=True, help="folder for table.md and cut-plane PNGs")
@@ -76,7 +77,7 @@ def run_eval(args) -> int:
     from .inference.evaluate import benchmark
     from .inference.fit import METHODS
 
-    methods = _faces(args.methods) or list(METHODS)
+    methods = _faces(args.methods) or ["rbf", "radial"]
     bad = [m for m in methods if m not in METHODS]
     if bad:
         raise WoodcamError(f"--methods must be from {', '.join(METHODS)}; got {bad}")

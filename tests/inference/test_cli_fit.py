@@ -53,7 +53,7 @@ def test_eval_writes_table_and_images(block_dir, tmp_path):
 def test_cli_errors(block_dir, tmp_path):
     folder, truth, _ = block_dir
     with pytest.raises(SystemExit):  # argparse rejects an unknown method by name
-        _parse(["fit", str(folder), "--method", "neural", "--out", str(tmp_path / "x.npz")])
+        _parse(["fit", str(folder), "--method", "magic", "--out", str(tmp_path / "x.npz")])
     with pytest.raises(WoodcamError, match="--truth needs one field file per block"):
         run(_parse(["eval", str(folder), str(folder), "--truth", str(truth), "--out", str(tmp_path)]))
     with pytest.raises(WoodcamError, match="--methods must be from"):

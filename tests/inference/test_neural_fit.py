@@ -125,3 +125,17 @@ def test_fit_analytic_log_blocks(model, pattern):
     err = np.concatenate(errs)
     assert err.mean() < 0.4, err.mean()
     assert np.mean(err < 0.5) > 0.7
+
+
+def test_fit_block_dispatches_to_the_neural_fitter():
+    """``fit_block(block, "neural")`` is the seed's eq. 5 fit, baked to a grid."""
+    from woodcam.fields import GridField, LogFrame, RadialScalingField
+    from woodcam.inference import fit_block
+    from woodcam.synth import synth_block
+
+    truth = RadialScalingField(LogFrame((25.0, 25.0, 0.0), (0.05, 0.0, 1.0)), 3.0)
+    block = synth_block(truth, (50, 50, 50), face_px=96, seed=0)
+    field = fit_block(block, "neural")
+    assert isinstance(field, GridField)
+    p = np.random.default_rng(1).uniform(5, 45, (4000, 3))
+    assert np.mean(np.abs(field(p) - truth(p))) < 0.3  # years, the bar of the pith-inside test

@@ -10,7 +10,7 @@ from .observations import gather_observations
 from .radial import fit_radial
 from .rbf import fit_rbf
 
-Method = Literal["rbf", "radial"]
+Method = Literal["rbf", "radial", "neural"]
 METHODS: tuple[str, ...] = get_args(Method)
 
 
@@ -22,7 +22,8 @@ def fit_block(block, method: Method = "radial", faces=None, baked: bool = True):
     block : woodcam.block.Block
     method : "rbf" (seed 000's baseline: thin-plate RBF of labelled ring points) or "radial"
         (ours: pith axis + smooth inverse ring width by least squares; also numbers unlabelled
-        traces and ring maps).
+        traces and ring maps) or "neural" (seed 000's eq. 5: the packaged generic neural GTF,
+        latent code and cut-out transform fitted to labelled traces; needs torch).
     faces : list of face names / Mokume letters, optional; default every face of the block.
     baked : return the field baked to a 1 mm grid (:class:`woodcam.fields.GridField`, fast,
         saveable with ``.save(path)``) rather than the raw fitted callable.
@@ -33,6 +34,10 @@ def fit_block(block, method: Method = "radial", faces=None, baked: bool = True):
     """
     if method not in METHODS:
         raise WoodcamError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
+    if method == "neural":
+        from .neural import fit_neural  # torch loads only here
+
+        return fit_neural(block, faces=faces)  # always baked to a grid (the net is slow)
     obs = gather_observations(block, faces)
     if method == "rbf":
         field = fit_rbf(obs)
