@@ -253,3 +253,20 @@ def test_placed_field_serialises_only_when_the_log_field_does():
     assert np.array_equal(f(p), g(p))
     with pytest.raises(WoodcamError, match="must be a woodcam class"):
         cut_block(radial_log, SIZE, "rift").to_dict()
+
+
+def test_benchmark_set_with_knotted_logs(tmp_path):
+    """Knotted blocks come from the seed-001 log generator through the seed-003 knot field;
+    their traces still lie on the integer iso-lines of the saved true field."""
+    from woodcam.block.io import read_block
+    from woodcam.frames import pixel_to_block
+    from woodcam.synth import knotted_log_field
+
+    folders = synth_benchmark_set(tmp_path, 1, 5, face_px=64, log_fields=knotted_log_field,
+                                  knotted_fraction=1.0, progress=False)
+    block = read_block(folders[0])
+    assert block.meta["knotted"] and block.true_field is not None
+    for face in block.faces.values():
+        for t in face.traces:
+            p = pixel_to_block(face.name, t.points_px[:, 0], t.points_px[:, 1], face.shape, block.size_mm)
+            np.testing.assert_allclose(block.true_field(p), t.year, atol=1e-3)

@@ -667,6 +667,11 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
         knotted = log_fields is not None and rng.uniform() < knotted_fraction
         if knotted:
             log = log_fields(rng)
+            # keep the block inside the knotted log (its outer radius), knots are near the bark
+            half_diag = 0.5 * math.hypot(size[0], size[1])
+            r_in = float(getattr(getattr(log, "log", None), "r_min_mm", 100.0)) - half_diag - 5.0
+            if placement["pattern"] != "pith-inside":
+                placement["distance_mm"] = max(half_diag + 2.0, min(placement["distance_mm"], r_in))
         field = cut_block(log, size, **placement)
         name = f"block_{i:04d}"
         info = {"name": name, "index": i, "size_mm": list(size), "knotted": bool(knotted),
@@ -681,6 +686,19 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
         index["blocks"].append(info)
     (out_dir / "index.json").write_text(json.dumps(index, indent=1))
     return folders
+
+
+def knotted_log_field(rng: np.random.Generator, ring_width_range_mm=(1.5, 6.0), *,
+                      length_mm: float = 1200.0):
+    """A knotted log field (log frame) from the log generator of seed 001 (``woodcam.logs``),
+    turned into the stem + knot field of seed 003; ring width log-uniform in the range.
+    The factory :func:`synth_benchmark_set` takes as ``log_fields``."""
+    from .fields import KnottedLogField, log_from_generated
+    from .logs import generate_log
+
+    gen = generate_log(int(rng.integers(1 << 31)), length_mm=length_mm)
+    width = math.exp(rng.uniform(*np.log(ring_width_range_mm)))
+    return KnottedLogField(log_from_generated(gen), ring_width_mm=width)
 
 
 def time_synth_block(face_px: int = 512, repeats: int = 1) -> float:
