@@ -12,8 +12,9 @@ torch = pytest.importorskip("torch")
 
 from woodcam.errors import WoodcamError  # noqa: E402
 from woodcam.fields.base import LogFrame  # noqa: E402
+from woodcam.fields.radial import laplacian_smoother  # noqa: E402
 from woodcam.fields.neural import (  # noqa: E402
-    LOG_NAME, MODELS_DIR, SPEC_NAME, WEIGHTS_NAME, GTFSpec, _laplacian_smoother, build_model,
+    LOG_NAME, MODELS_DIR, SPEC_NAME, WEIGHTS_NAME, GTFSpec, build_model,
     encode, family_gtf, load_model, make_training_set, random_radius_samples, train_gtf,
 )
 from woodcam.fields.radial import RadialScalingField, RadiusFunction  # noqa: E402
@@ -34,7 +35,7 @@ def test_family_matches_radial_field():
 
 def test_smoother_matches_from_constraints():
     c = np.clip(np.random.default_rng(5).normal(1, 0.1, 15), 0.5, 1.5)
-    np.testing.assert_allclose(c @ _laplacian_smoother(15, 360).T,
+    np.testing.assert_allclose(c @ laplacian_smoother(15, 360).T,
                                RadiusFunction.from_constraints(c).samples, atol=1e-10)
 
 

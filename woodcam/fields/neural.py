@@ -33,7 +33,6 @@ Design decisions (the seed leaves them open or we deliberately deviate):
 
 from __future__ import annotations
 
-import functools
 import csv
 import json
 import time
@@ -43,6 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import WoodcamError, require
+from .radial import laplacian_smoother
 
 #: Where the committed model lives (package data).
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
@@ -142,28 +142,10 @@ class GTFSpec:
 # Training data: the eq. 7-9 family, vectorised over many fields
 
 
-@functools.lru_cache(maxsize=4)
-def _laplacian_smoother(n_constraints: int, m: int) -> np.ndarray:
-    """(m, n_constraints) linear map from constraint values to radius samples.
-
-    :meth:`woodcam.fields.radial.RadiusFunction.from_constraints` solves one least-squares
-    problem per function; the solution is linear in the constraint values, so for thousands of
-    functions we solve once for the map and apply it with one matrix product.
-    """
-    idx = np.round(np.arange(n_constraints) * m / n_constraints).astype(int) % m
-    eye = np.eye(m)
-    lap = np.roll(eye, -1, axis=1) - 2 * eye + np.roll(eye, 1, axis=1)
-    free = np.setdiff1d(np.arange(m), idx)
-    a = np.zeros((m, n_constraints))
-    a[idx, np.arange(n_constraints)] = 1.0
-    a[free] = -np.linalg.lstsq(lap[:, free], lap[:, idx], rcond=None)[0]
-    return a
-
-
 def random_radius_samples(rng: np.random.Generator, count: int, n_constraints: int = 15,
                           sigma: float = 0.1, m: int = 360) -> np.ndarray:
     """``(count, m)`` radius functions, like ``RadiusFunction.random`` ``count`` times."""
-    smooth = _laplacian_smoother(n_constraints, m)
+    smooth = laplacian_smoother(n_constraints, m)
     vals = np.clip(rng.normal(1.0, sigma, (count, n_constraints)), 0.5, 1.5)
     return vals @ smooth.T
 

@@ -14,6 +14,7 @@ outward by one year every ``ring_width_mm * r'`` mm.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numba
@@ -24,6 +25,30 @@ from ..tolerances import MIN_RADIUS_SCALE
 from .base import LogFrame, check_points
 
 _TWO_PI = 2.0 * np.pi
+
+
+@functools.lru_cache(maxsize=8)
+def laplacian_smoother(n_constraints: int, m: int = 360) -> np.ndarray:
+    """``(m, n_constraints)`` linear map from constraint values to radius samples.
+
+    The samples minimise the squared periodic discrete Laplacian
+    ``sum (r[i-1] - 2 r[i] + r[i+1])^2`` subject to ``r(2 pi i / N_c) = values[i]`` exactly
+    (Laplacian smoothing of §3.2.5 of seed 000). The solution is linear in the constraint
+    values, so it is solved once per ``(N_c, m)`` and applied with a matrix product. Constraint
+    angles are rounded to the nearest of the ``m`` samples.
+    """
+    idx = np.round(np.arange(n_constraints) * m / n_constraints).astype(int) % m
+    if len(np.unique(idx)) != n_constraints:
+        raise WoodcamError(f"m={m} samples cannot hold {n_constraints} distinct constraints; raise m")
+    eye = np.eye(m)
+    lap = np.roll(eye, -1, axis=1) - 2 * eye + np.roll(eye, 1, axis=1)
+    free = np.setdiff1d(np.arange(m), idx)
+    a = np.zeros((m, n_constraints))
+    a[idx, np.arange(n_constraints)] = 1.0
+    if len(free):
+        a[free] = -np.linalg.lstsq(lap[:, free], lap[:, idx], rcond=None)[0]
+    a.setflags(write=False)
+    return a
 
 
 @dataclass(frozen=True)
@@ -55,19 +80,7 @@ class RadiusFunction:
         c = np.asarray(values, dtype=float).ravel()
         if len(c) < 1 or np.any(~np.isfinite(c)) or np.any(c <= 0):
             raise WoodcamError(f"values must be positive finite radius scalings; got {values!r}")
-        idx = np.unique(np.round(np.arange(len(c)) * m / len(c)).astype(int) % m)
-        if len(idx) != len(c):
-            raise WoodcamError(f"m={m} samples cannot hold {len(c)} distinct constraints; raise m")
-        # Periodic second-difference operator L (m x m); solve min |L r|^2 s.t. r[idx] = c by
-        # eliminating the constrained unknowns: L[:, free] r_free = -L[:, idx] c.
-        eye = np.eye(m)
-        lap = np.roll(eye, -1, axis=1) - 2 * eye + np.roll(eye, 1, axis=1)
-        free = np.setdiff1d(np.arange(m), idx)
-        r = np.empty(m)
-        r[idx] = c
-        if len(free):
-            r[free] = np.linalg.lstsq(lap[:, free], -lap[:, idx] @ c, rcond=None)[0]
-        return cls(r)
+        return cls(laplacian_smoother(len(c), m) @ c)
 
     @classmethod
     def random(cls, rng: np.random.Generator, n_constraints: int = 15, sigma: float = 0.1,
