@@ -67,6 +67,29 @@ TRACE_SAMPLE_STEP_MM = 0.5
 #: bright on ring boundaries; 0.5 is the natural mid-point of a soft boundary map).
 RING_MAP_THRESHOLD = 0.5
 
+#: Ring-map pixels within this distance (mm) of a face's knot mask (``extras["knot_mask"]``) are
+#: not ring observations: the ring detector fires on the knot's own rings and the stem's rings
+#: bend around the knot, neither of which the stem's growth field describes. On H11 the bent
+#: rings reach about 3 mm (15 px) beyond the knot's dark disc (looked at on faces C and F).
+KNOT_MASK_MARGIN_MM = 3.0
+
+#: A Mokume knot mask with at most this many dark pixels marks the knot's centre rather than its
+#: outline (H11's C and F masks are one pixel each); it is grown into the knot's dark region.
+KNOT_POINT_MAX_PX = 16
+
+#: Gaussian smoothing (px) of the photo's luminance before growing a knot region: wider than
+#: the latewood lines inside the knot (2-3 px on 256 px faces), so the knot is one dark blob.
+KNOT_REGION_SMOOTH_PX = 4.0
+
+#: Leave-one-face-out scores (``woodcam.inference.holdout``) count ring-map ridge pixels within
+#: 1 and 2 face pixels of a predicted ring line and the reverse (issue 5: "within 1 and 2 pixels"),
+#: and within 5 px: about 1 mm on a 256 px Mokume face of a 50 mm cube, Table 1's mm scale.
+HOLDOUT_THRESHOLDS_PX = (1.0, 2.0, 5.0)
+
+#: Predicted ring lines are sampled every 0.25 px for the distance queries: the sampling error
+#: (at most half a step) stays an eighth of the 1 px threshold.
+HOLDOUT_LINE_STEP_PX = 0.25
+
 #: Largest number of ring points the RBF fits use. Their dense solve is O(n^3): 2500 points take
 #: ~1 s on one core; at 0.5 mm trace sampling that still keeps a point every ~1-2 mm of ring.
 RBF_MAX_POINTS = 2500
@@ -130,3 +153,13 @@ NEURAL_FACE_MAE = 0.04
 #: known colour function): the face error plus the trilinear blur of ring steps between cell
 #: centres (cells of 0.67 mm against 3.5 mm rings in the test). Measured ~0.03.
 NEURAL_VOLUME_MAE = 0.05
+
+#: Growth history of the radial fit (``woodcam.inference.radial._fit_growth_history``): each
+#: year's level is shrunk towards the mean ring width as if this many points (about 10 mm of ring
+#: at the 0.5 mm trace spacing) sat exactly on it, so a ring glimpsed on a few points cannot bend
+#: the warp; 3 alternations of levels and shape change the levels by < 0.01 year after that
+#: (CN03, eq. 7-9 blocks); the 1e-3 year step keeps the levels strictly increasing for
+#: interpolation without moving any ring visibly (1e-3 year is a few micrometres).
+RING_HISTORY_PRIOR_POINTS = 20.0
+RING_HISTORY_ROUNDS = 3
+RING_HISTORY_MIN_STEP = 1e-3

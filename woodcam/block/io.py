@@ -54,6 +54,7 @@ import numpy as np
 from ..errors import WoodcamError
 from ..fields.state import field_from_state, field_to_state, field_type, jsonable
 from ..frames import FACES, MOKUME_LETTER
+from ..tolerances import KNOT_POINT_MAX_PX, KNOT_REGION_SMOOTH_PX
 from .block import Block, Face, RingTrace
 
 MANIFEST = "block.json"
@@ -312,7 +313,8 @@ def read_mokume(folder, size_mm=MOKUME_DEFAULT_SIZE_MM, *, name: str | None = No
         ``ring_map`` from ``X_arl-unet.png`` as float32 in [0, 1] (value / 255; the U-Net's
         ring localisation, no year labels); ``extras["knot_mask"]`` from ``X_knot.png``
         ((rows, cols) bool, True where the mask is dark: below the mid-grey between the
-        image's min and max); ``extras["annotation"]`` from ``X_ann.png`` as stored (uint8).
+        image's min and max; a mask of a few pixels marks the knot's centre and is grown to
+        the knot's dark region in the photo by :func:`knot_region`); ``extras["annotation"]`` from ``X_ann.png`` as stored (uint8).
         ``meta`` records the source folder and that the size was assumed.
 
     Raises
@@ -348,7 +350,10 @@ def read_mokume(folder, size_mm=MOKUME_DEFAULT_SIZE_MM, *, name: str | None = No
             a = images["knot"]
             a = a.mean(axis=2) if a.ndim == 3 else a.astype(float)
             lo, hi = float(a.min()), float(a.max())
-            extras["knot_mask"] = a < 0.5 * (lo + hi) if hi > lo else np.zeros(a.shape, bool)
+            mask = a < 0.5 * (lo + hi) if hi > lo else np.zeros(a.shape, bool)
+            if 0 < mask.sum() <= KNOT_POINT_MAX_PX and photo is not None:
+                mask = knot_region(photo, mask)
+            extras["knot_mask"] = mask
         if "ann" in images:
             extras["annotation"] = images["ann"]
         faces[face] = Face(face, shape, photo=photo, ring_map=ring_map, extras=extras)
@@ -363,6 +368,20 @@ def read_mokume(folder, size_mm=MOKUME_DEFAULT_SIZE_MM, *, name: str | None = No
 
 
 # -- real blocks from image files ----------------------------------------------------------------
+
+def knot_region(photo: np.ndarray, seeds: np.ndarray) -> np.ndarray:
+    """The knot around marked centre pixels: (h, w) bool, the connected region of the photo,
+    grown from ``seeds`` ((h, w) bool), whose smoothed luminance is darker than halfway between
+    the knot centre's and the face's median (H11's masks mark one pixel per knot; the knot
+    itself is the dark disc of end-grain branch wood around it)."""
+    from scipy import ndimage
+
+    lum = np.asarray(photo, float)[..., :3] @ np.array([0.299, 0.587, 0.114])
+    lum = ndimage.gaussian_filter(lum, KNOT_REGION_SMOOTH_PX)
+    dark = lum < 0.5 * (lum[seeds].mean() + np.median(lum))
+    lab, _ = ndimage.label(dark | seeds)
+    return np.isin(lab, np.unique(lab[seeds]))
+
 
 def _load_image(src, what: str) -> np.ndarray:
     if isinstance(src, (str, os.PathLike)):

@@ -14,7 +14,8 @@ import numpy as np
 
 from ..errors import WoodcamError
 from ..frames import FACES, check_face, face_image_size_mm, pixel_to_block
-from ..tolerances import FACE_PIXEL_ASPECT_RTOL, RING_MAP_THRESHOLD, TRACE_SAMPLE_STEP_MM
+from ..tolerances import (FACE_PIXEL_ASPECT_RTOL, KNOT_MASK_MARGIN_MM, RING_MAP_THRESHOLD,
+                          TRACE_SAMPLE_STEP_MM)
 
 
 @dataclass
@@ -51,11 +52,27 @@ def _resample_polyline(p: np.ndarray, step: float) -> np.ndarray:
     return np.stack([np.interp(t, s, p[:, i]) for i in range(p.shape[1])], axis=1)
 
 
-def _ring_map_components(ring_map: np.ndarray, threshold: float):
-    """Connected bright components of a ring map -> list of ``(k, 2)`` pixel (row, col) arrays."""
+def knot_exclusion(face, pixel_mm: float) -> np.ndarray | None:
+    """(h, w) bool: pixels on or within :data:`KNOT_MASK_MARGIN_MM` of ``face.extras["knot_mask"]``
+    (None without a mask), for square pixels of ``pixel_mm``. Ring pixels there are not
+    observations of the stem's growth field."""
+    mask = face.extras.get("knot_mask")
+    if mask is None or not np.any(mask):
+        return None
+    from scipy import ndimage
+
+    outside = ndimage.distance_transform_edt(~np.asarray(mask, bool))
+    return outside * pixel_mm <= KNOT_MASK_MARGIN_MM
+
+
+def _ring_map_components(ring_map: np.ndarray, threshold: float, exclude=None):
+    """Connected bright components of a ring map -> list of ``(k, 2)`` pixel (row, col) arrays;
+    ``exclude``: optional (h, w) bool of pixels to leave out."""
     from scipy import ndimage
 
     mask = np.asarray(ring_map, float) >= threshold
+    if exclude is not None:
+        mask &= ~exclude
     lab, n = ndimage.label(mask, structure=np.ones((3, 3)))
     if n == 0:
         return []
@@ -78,7 +95,8 @@ def gather_observations(block, faces=None, step_mm: float = TRACE_SAMPLE_STEP_MM
         Use only these faces (partial annotation); default all faces the block has.
     step_mm : spacing (mm) at which traces are resampled, so long and densely traced rings do
         not outweigh the others and fits stay fast.
-    ring_map_threshold : ring-map pixels at or above this grey value are ring pixels.
+    ring_map_threshold : ring-map pixels at or above this grey value are ring pixels; those on
+        or near a face's ``extras["knot_mask"]`` are ignored.
 
     Raises
     ------
@@ -109,7 +127,7 @@ def gather_observations(block, faces=None, step_mm: float = TRACE_SAMPLE_STEP_MM
             px_step = step_mm / max(min(dr, dc), 1e-12)
             polys = [(_resample_polyline(p, px_step), y) for p, y in polys]
         elif f.ring_map is not None:
-            comps = _ring_map_components(f.ring_map, ring_map_threshold)
+            comps = _ring_map_components(f.ring_map, ring_map_threshold, knot_exclusion(f, min(dr, dc)))
             stride = max(1, int(round(step_mm / max(min(dr, dc), 1e-12))))
             # Ring-map components are pixel blobs a few pixels thick; keep every stride-th
             # pixel of each so their density matches resampled traces.

@@ -23,6 +23,11 @@ Robustness: traces whose median misfit exceeds half a year are renumbered and th
 by at most 5 % (jittered traces on a few faces otherwise let high harmonics swing where no face
 sees the rings).
 
+Growth history: real trees lay down a different ring width each year, the same all around the
+stem, so the final model is ``years = h(a + rho * s)`` with ``h`` a monotone cubic warp
+through one level per observed year (identity for the eq. 7-9 family; continued with slope
+1 beyond the observed years), fitted by alternating with ``s``.
+
 Unlabelled rings (traces without years, ring-map components) are fitted with one unknown level
 per ring group instead of the year, with the inverse ring width's mean over the data fixed to 1
 (no collapse to a flat field); the levels are then turned into years by the ring spacing
@@ -37,6 +42,7 @@ import numpy as np
 
 from ..errors import WoodcamError
 from ..fields.base import check_points
+from ..tolerances import RING_HISTORY_MIN_STEP, RING_HISTORY_PRIOR_POINTS, RING_HISTORY_ROUNDS
 from .observations import RingObservations
 
 
@@ -91,28 +97,56 @@ class RadialField:
     M: int
     coef: np.ndarray
     offset: float = 0.0
+    history_levels: np.ndarray | None = None
+    history_years: np.ndarray | None = None
 
-    def __call__(self, points_mm) -> np.ndarray:
+    def linear(self, points_mm) -> np.ndarray:
+        """``offset + rho * s`` (years before the growth-history warp), ``(n,)``."""
         p = check_points(points_mm)
         d, e1, e2 = _frame(self.axis)
         rho, B = _design(p, self.pith_mm, d, e1, e2, self.z_scale_mm, self.K, self.M)
         return self.offset + rho * (B @ self.coef)
 
+    def __call__(self, points_mm) -> np.ndarray:
+        lin = self.linear(points_mm)
+        if self.history_levels is None:
+            return lin
+        return _warp(lin, self.history_levels, self.history_years)
+
     def to_dict(self) -> dict:
         """Plain-JSON state (see :mod:`woodcam.fields.state`)."""
-        return {"pith_mm": np.asarray(self.pith_mm, float).tolist(),
-                "axis": np.asarray(self.axis, float).tolist(), "z_scale_mm": float(self.z_scale_mm),
-                "K": int(self.K), "M": int(self.M), "coef": np.asarray(self.coef, float).tolist(),
-                "offset": float(self.offset)}
+        d = {"pith_mm": np.asarray(self.pith_mm, float).tolist(),
+             "axis": np.asarray(self.axis, float).tolist(), "z_scale_mm": float(self.z_scale_mm),
+             "K": int(self.K), "M": int(self.M), "coef": np.asarray(self.coef, float).tolist(),
+             "offset": float(self.offset)}
+        if self.history_levels is not None:
+            d["history_levels"] = np.asarray(self.history_levels, float).tolist()
+            d["history_years"] = np.asarray(self.history_years, float).tolist()
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> "RadialField":
+        hl, hy = d.get("history_levels"), d.get("history_years")
         return cls(np.asarray(d["pith_mm"], float), np.asarray(d["axis"], float), float(d["z_scale_mm"]),
-                   int(d["K"]), int(d["M"]), np.asarray(d["coef"], float), float(d["offset"]))
+                   int(d["K"]), int(d["M"]), np.asarray(d["coef"], float), float(d["offset"]),
+                   None if hl is None else np.asarray(hl, float), None if hy is None else np.asarray(hy, float))
 
     def grain_direction(self, points_mm) -> np.ndarray:
         p = check_points(points_mm)
         return np.broadcast_to(self.axis / np.linalg.norm(self.axis), p.shape).copy()
+
+
+def _warp(linear: np.ndarray, levels: np.ndarray, years: np.ndarray) -> np.ndarray:
+    """Growth-history warp ``h``: scipy's monotone cubic (PCHIP) through ``(levels, years)``
+    (both increasing; smooth growth between ring boundaries, never folding back), continued
+    outside them with slope 1 (the mean ring width of the linear model)."""
+    from scipy.interpolate import PchipInterpolator
+
+    out = PchipInterpolator(levels, years, extrapolate=False)(linear)
+    lo, hi = linear < levels[0], linear > levels[-1]
+    out[lo] = years[0] + (linear[lo] - levels[0])
+    out[hi] = years[-1] + (linear[hi] - levels[-1])
+    return out
 
 
 # -- the fit ----------------------------------------------------------------------------------
@@ -377,8 +411,17 @@ def _relabel(obs: RingObservations, field: RadialField) -> tuple[RingObservation
     return RingObservations(obs.points_mm, years, obs.group, obs.face), changed
 
 
-def fit_radial(obs: RingObservations, size_mm, K: int = 12, M: int = 1, ridge: float = 1e-8,
-               max_relabel_rounds: int = 2, seed: int = 0, **search) -> RadialField:
+def number_observations(obs: RingObservations, field) -> RingObservations:
+    """Label every ring group with the integer nearest ``field``'s median growth time on it
+    (e.g. to hand unlabelled ring maps to a method that needs years, numbered by a radial fit)."""
+    g = np.asarray(field(obs.points_mm), float)
+    years = np.array([np.round(np.median(g[obs.group == j])) for j in range(obs.n_groups)])
+    return RingObservations(obs.points_mm, years[obs.group], obs.group, obs.face)
+
+
+def fit_radial(obs: RingObservations, size_mm, K: int = 12, M: int = 3, ridge: float = 1e-8,
+               max_relabel_rounds: int = 2, seed: int = 0, history: bool = True,
+               **search) -> RadialField:
     """Fit the radial model to labelled or unlabelled ring observations of a block.
 
     Labelled: axis search + variable-projection least squares; then traces whose median misfit
@@ -387,9 +430,12 @@ def fit_radial(obs: RingObservations, size_mm, K: int = 12, M: int = 1, ridge: f
     :func:`number_rings` and the result is fitted as labelled; the integer age offset is then
     chosen so the pith sits at year ~0 (exact for fields of the eq. 7-9 family, otherwise the
     rings are right "up to the age offset").
+
+    history : also fit the tree's growth history, a monotone warp of the years that gives every
+        year its own ring width (:func:`_fit_growth_history`); False keeps the plain model.
     """
     with _one_blas_thread():
-        return _fit_radial(obs, size_mm, K, M, ridge, max_relabel_rounds, seed, search)
+        return _fit_radial(obs, size_mm, K, M, ridge, max_relabel_rounds, seed, history, search)
 
 
 def _one_blas_thread():
@@ -405,7 +451,7 @@ def _one_blas_thread():
     return threadpool_limits(1, user_api="blas")
 
 
-def _fit_radial(obs, size_mm, K, M, ridge, max_relabel_rounds, seed, search) -> RadialField:
+def _fit_radial(obs, size_mm, K, M, ridge, max_relabel_rounds, seed, history, search) -> RadialField:
     labelled_in = obs.labelled
     if labelled_in:
         field, _, _ = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, **search)
@@ -429,10 +475,16 @@ def _fit_radial(obs, size_mm, K, M, ridge, max_relabel_rounds, seed, search) -> 
             break
         field = _refit_labelled(obs, size_mm, field, ridge, seed=seed)
     field = _smoothest_coefficients(obs, field, seed)
+    if history:
+        field = _fit_growth_history(obs, field, seed)
     if numbered:
         # Our own numbering: pick the integer age offset that puts the pith at year ~0 (seed
         # eq. 5 fits an integer offset too); rings are unchanged by it.
-        field.offset -= float(np.round(field.offset))
+        shift = float(np.round(field(field.pith_mm[None])[0]))
+        field.offset -= shift
+        if field.history_levels is not None:
+            field.history_levels = field.history_levels - shift
+            field.history_years = field.history_years - shift
     return field
 
 
@@ -445,7 +497,7 @@ _FINAL_RSS_FACTOR = 1.05
 
 
 def _smoothest_coefficients(obs: RingObservations, field: RadialField, seed: int,
-                            n_fit: int = 3000) -> RadialField:
+                            n_fit: int = 3000, targets=None) -> RadialField:
     """Re-solve the coefficients at the fitted axis with the strongest ridge the traces allow.
 
     Why: with jittered traces on only some faces, a weak ridge lets the high azimuthal
@@ -454,11 +506,14 @@ def _smoothest_coefficients(obs: RingObservations, field: RadialField, seed: int
     rms misfit). Generalised cross-validation picked the weak ridge there (it only scores the
     traced faces), so the rule is a discrepancy one: the smoothest fit whose residual sum of
     squares is within :data:`_FINAL_RSS_FACTOR` of the least-smoothed one.
+
+    targets : (n,) values the linear model is fitted to (default ``obs.years``).
     """
     rng = np.random.default_rng(seed + 2)
     n = len(obs.points_mm)
     i = np.sort(rng.choice(n, n_fit, replace=False)) if n > n_fit else np.arange(n)
-    pts, yrs = obs.points_mm[i], obs.years[i]
+    pts = obs.points_mm[i]
+    yrs = (obs.years if targets is None else np.asarray(targets, float))[i]
     d, e1, e2 = _frame(field.axis)
     rho, B = _design(pts, field.pith_mm, d, e1, e2, field.z_scale_mm, field.K, field.M)
     X = np.concatenate([np.ones((len(pts), 1)), rho[:, None] * B], axis=1)
@@ -478,3 +533,37 @@ def _smoothest_coefficients(obs: RingObservations, field: RadialField, seed: int
     rss0 = fits[0][0]
     sol = [f for f in fits if f[0] <= _FINAL_RSS_FACTOR * rss0][-1][1]
     return RadialField(field.pith_mm, field.axis, field.z_scale_mm, field.K, field.M, sol[1:], float(sol[0]))
+
+
+def _fit_growth_history(obs: RingObservations, field: RadialField, seed: int) -> RadialField:
+    """Add the tree's growth history: ``years = h(offset + rho * s)`` with ``h`` monotone
+    through one level per observed year (:func:`_warp`).
+
+    Why: real trees grow a different ring width every year, the same all around the stem (a wet
+    year is wide everywhere), which a model linear in ``rho`` cannot follow: on the Mokume cube
+    CN03 its ring lines drift up to half a ring off the ring map. ``h`` carries those widths and
+    ``s`` keeps the shape. Alternating fit: each year's level is the median of the linear model
+    on that ring's points, shrunk towards the year itself by :data:`RING_HISTORY_PRIOR_POINTS`
+    (a ring seen on a few points stays near the mean width) and made increasing (scipy's
+    isotonic regression); then ``s`` is refitted to those levels.
+    """
+    from scipy.optimize import isotonic_regression
+
+    years, idx, counts = np.unique(obs.years, return_inverse=True, return_counts=True)
+    if len(years) < 3:
+        return field
+    order = np.argsort(idx, kind="stable")
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    for _ in range(RING_HISTORY_ROUNDS):
+        lin = field.linear(obs.points_mm)[order]
+        med = np.array([np.median(lin[a:a + c]) for a, c in zip(starts, counts)])  # one per year
+        lev = (counts * med + RING_HISTORY_PRIOR_POINTS * years) / (counts + RING_HISTORY_PRIOR_POINTS)
+        lev = isotonic_regression(lev, weights=counts).x
+        lev = lev + np.arange(len(lev)) * RING_HISTORY_MIN_STEP  # strictly increasing for interp
+        field = _smoothest_coefficients(obs, field, seed, targets=lev[idx])
+    lin = field.linear(obs.points_mm)[order]
+    med = np.array([np.median(lin[a:a + c]) for a, c in zip(starts, counts)])
+    lev = (counts * med + RING_HISTORY_PRIOR_POINTS * years) / (counts + RING_HISTORY_PRIOR_POINTS)
+    lev = isotonic_regression(lev, weights=counts).x + np.arange(len(years)) * RING_HISTORY_MIN_STEP
+    field.history_levels, field.history_years = lev, years.astype(float)
+    return field

@@ -1,0 +1,262 @@
+"""Leave-one-face-out scoring of growth-field fits against real ring maps (issue 5, part 6).
+
+A real block's inside is unknown, but each face's ring map is an independent measurement: fit on
+five faces, predict the sixth, and compare the predicted ring lines (integer iso-lines of the
+fitted growth time on that face) with the ring map's ridge (the one-pixel skeleton of its bright
+ring boundaries). Two shares, in pixels of the face image, both higher-is-better:
+
+- ``ridge_k``: ring-map ridge pixels within ``k`` px of a predicted ring line (are the real rings
+  predicted?);
+- ``line_k``: points on the predicted ring lines within ``k`` px of a ridge pixel (are the
+  predicted rings real?).
+
+``k`` = 1, 2 px (the issue's measure) and 5 px (~1 mm on a 256 px face of a 50 mm cube). Neither
+needs year numbers (ring maps have none). Pixels on or near a knot mask are left out of
+both, as they are left out of the fit (:data:`~woodcam.tolerances.KNOT_MASK_MARGIN_MM`). The same
+scores for a fit on all six faces (the face is then part of the fit) bound what the ring maps'
+own noise allows.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import WoodcamError, require
+from ..fields.base import arf
+from ..frames import pixel_to_block
+from ..tolerances import HOLDOUT_LINE_STEP_PX, HOLDOUT_THRESHOLDS_PX, RING_MAP_THRESHOLD
+from .observations import _resample_polyline, knot_exclusion
+
+#: Label of the in-sample fit (all faces) in results.
+ALL_FACES = "all faces"
+
+
+def ridge_pixels(ring_map: np.ndarray, threshold: float = RING_MAP_THRESHOLD,
+                 exclude: np.ndarray | None = None) -> np.ndarray:
+    """Ridge of a ring map: ``(k, 2)`` int pixel ``(row, col)`` of the skeleton of its ring pixels.
+
+    ring_map : (h, w) float in [0, 1], bright on ring boundaries.
+    exclude : optional (h, w) bool; ridge pixels there are dropped.
+    """
+    from skimage import morphology
+
+    skel = morphology.skeletonize(np.asarray(ring_map, float) >= threshold)
+    if exclude is not None:
+        skel &= ~exclude
+    return np.argwhere(skel)
+
+
+def face_years(field, face: str, shape, size_mm) -> np.ndarray:
+    """Growth time ``(h, w)`` of ``field`` at the pixel centres of a face image of ``shape``."""
+    rows, cols = np.meshgrid(np.arange(shape[0]), np.arange(shape[1]), indexing="ij")
+    pts = pixel_to_block(face, rows, cols, shape, size_mm).reshape(-1, 3)
+    return np.asarray(field(pts), float).reshape(shape)
+
+
+def ring_lines_px(years_img: np.ndarray, step_px: float = HOLDOUT_LINE_STEP_PX,
+                  exclude: np.ndarray | None = None) -> np.ndarray:
+    """Points ``(m, 2)`` (row, col) every ``step_px`` along the integer iso-lines of ``years_img``.
+
+    exclude : optional (h, w) bool; line points in those pixels are dropped.
+    """
+    import contourpy
+
+    y = np.asarray(years_img, float)
+    if not np.isfinite(y).all():
+        raise WoodcamError("the fitted growth time is not finite on the face; refit the block")
+    gen = contourpy.contour_generator(z=y, line_type="Separate")
+    out = []
+    for level in np.arange(np.ceil(y.min()), np.floor(y.max()) + 1):
+        for line in gen.lines(float(level)):
+            if len(line) >= 2:
+                out.append(_resample_polyline(line[:, ::-1], step_px))  # (x, y) -> (row, col)
+    if not out:
+        return np.zeros((0, 2))
+    pts = np.concatenate(out)
+    if exclude is not None:
+        r = np.clip(np.round(pts[:, 0]).astype(int), 0, y.shape[0] - 1)
+        c = np.clip(np.round(pts[:, 1]).astype(int), 0, y.shape[1] - 1)
+        pts = pts[~exclude[r, c]]
+    return pts
+
+
+def _nearest(query: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    from scipy.spatial import cKDTree
+
+    if len(query) == 0:
+        return np.zeros(0)
+    if len(ref) == 0:
+        return np.full(len(query), np.inf)
+    return cKDTree(ref).query(query)[0]
+
+
+@dataclass
+class FaceScore:
+    """One face's agreement between a ring map and a fitted field's ring lines (see module doc)."""
+
+    face: str
+    shares: dict            # "ridge_1", "ridge_2", "line_1", "line_2" -> percent
+    n_ridge: int
+    n_line: int
+    years: np.ndarray       # (h, w) fitted growth time on the face
+    ridge: np.ndarray       # (k, 2) ridge pixels
+    lines: np.ndarray       # (m, 2) predicted line points
+
+
+def score_face(field, block, face: str, thresholds=HOLDOUT_THRESHOLDS_PX) -> FaceScore:
+    """Score ``field``'s ring lines on ``face`` of ``block`` against that face's ring map."""
+    f = block.faces.get(face)
+    if f is None or f.ring_map is None:
+        raise WoodcamError(f"face {face!r} of block {block.name!r} has no ring map to score against; "
+                           f"score a face that has one")
+    excl = knot_exclusion(f, min(block.face_pixel_size_mm(face)))
+    years = face_years(field, face, f.shape, block.size_mm)
+    ridge = ridge_pixels(f.ring_map, exclude=excl)
+    lines = ring_lines_px(years, exclude=excl)
+    d_ridge = _nearest(ridge.astype(float), lines)
+    d_line = _nearest(lines, ridge.astype(float))
+    shares = {}
+    for t in thresholds:
+        shares[f"ridge_{t:g}"] = float(np.mean(d_ridge <= t) * 100) if len(d_ridge) else 0.0
+        shares[f"line_{t:g}"] = float(np.mean(d_line <= t) * 100) if len(d_line) else 0.0
+    return FaceScore(face, shares, len(ridge), len(lines), years, ridge, lines)
+
+
+def fit_for_holdout(block, method: str, faces):
+    """``fit_block`` on ``faces``; 'rbf' on unlabelled rings gets them numbered by the radial fit
+    first (the seed's RBF needs years, which ring maps do not carry)."""
+    from .fit import fit_block
+    from .observations import gather_observations
+    from .radial import fit_radial, number_observations
+    from .baked import bake
+    from .rbf import fit_rbf
+
+    if method == "rbf":
+        obs = gather_observations(block, faces)
+        if not obs.labelled:
+            obs = number_observations(obs, fit_radial(obs, block.size_mm))
+            return bake(fit_rbf(obs), block.size_mm)
+    return fit_block(block, method, faces=faces)
+
+
+def leave_one_face_out(block, methods=("rbf", "radial"), out_dir=None, progress=None) -> dict:
+    """Fit ``block`` on all faces but one for each face with a ring map, score the held-out face.
+
+    Parameters
+    ----------
+    block : woodcam.block.Block with ring maps on at least two faces.
+    methods : fitting methods (:data:`woodcam.inference.fit.METHODS`).
+    out_dir : folder for ``{block}_{method}.png`` (per face: photo, ring map, predicted ARF,
+        overlay of ridge and predicted lines) and ``{block}_holdout.md``; None writes nothing.
+    progress : optional callable taking one line of text per fit.
+
+    Returns
+    -------
+    dict with ``"held_out"`` and ``"all faces"``: each ``method -> list of FaceScore``;
+    ``"fit_s"``: method -> mean held-out fit seconds; ``"table"``: markdown text.
+    """
+    faces = [n for n, f in block.faces.items() if f.ring_map is not None]
+    if len(faces) < 2:
+        raise WoodcamError(f"block {block.name!r} has ring maps on {faces}; leave-one-face-out needs "
+                           f"at least two faces with ring maps")
+    held = {m: [] for m in methods}
+    insample = {m: [] for m in methods}
+    times = {m: [] for m in methods}
+    for m in methods:
+        full = fit_for_holdout(block, m, None)
+        for face in faces:
+            t0 = time.perf_counter()
+            fit = fit_for_holdout(block, m, [f for f in block.faces if f != face])
+            times[m].append(time.perf_counter() - t0)
+            held[m].append(score_face(fit, block, face))
+            insample[m].append(score_face(full, block, face))
+            if progress:
+                s = held[m][-1].shares
+                progress(f"{block.name} {m} hold out {face}: ridge {s['ridge_1']:.0f}/{s['ridge_2']:.0f}%, "
+                         f"line {s['line_1']:.0f}/{s['line_2']:.0f}% ({times[m][-1]:.1f} s)")
+    res = {"held_out": held, ALL_FACES: insample, "fit_s": {m: float(np.mean(t)) for m, t in times.items()}}
+    res["table"] = holdout_table(block.name, res, list(methods))
+    if out_dir is not None:
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / f"{block.name}_holdout.md").write_text(res["table"])
+        for m in methods:
+            plot_holdout(out / f"{block.name}_{m}.png", block, held[m],
+                         title=f"{block.name}, {m}: each face predicted from the other five")
+    return res
+
+
+def holdout_table(name: str, res: dict, methods: list[str], thresholds=HOLDOUT_THRESHOLDS_PX) -> str:
+    """Markdown: one row per held-out face plus the mean, and the mean of the all-faces fit."""
+    keys = [f"{k}_{t:g}" for k in ("ridge", "line") for t in thresholds]
+    head = ["face"] + [f"{m} {k.replace('_', ' ≤ ')} px" for k in keys for m in methods]
+    lines = [f"#### {name}", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+
+    def row(label, per_method):
+        cells = [label]
+        for k in keys:
+            vals = [per_method[m][k] for m in methods]
+            cells += [f"**{v:.1f}**" if len(methods) > 1 and v == max(vals) else f"{v:.1f}" for v in vals]
+        return "| " + " | ".join(cells) + " |"
+
+    held = res["held_out"]
+    for i, sc in enumerate(held[methods[0]]):
+        lines.append(row(sc.face, {m: held[m][i].shares for m in methods}))
+    for label, part in (("**mean, held out**", held), (f"mean, {ALL_FACES} (in-sample)", res[ALL_FACES])):
+        lines.append(row(label, {m: {k: float(np.mean([s.shares[k] for s in part[m]])) for k in keys}
+                                 for m in methods}))
+    lines.append("")
+    lines.append("Mean held-out fit time: " + ", ".join(f"{m} {res['fit_s'][m]:.1f} s" for m in methods))
+    return "\n".join(lines) + "\n"
+
+
+def plot_holdout(path, block, scores: list[FaceScore], title: str = ""):
+    """PNG, one row per face: photo, ring map, predicted ARF (eq. 6), overlay (grey ring map,
+    blue ridge pixels, red predicted ring lines, knot margin hatched out)."""
+    matplotlib = require("matplotlib", "view", "drawing leave-one-face-out images")
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(len(scores), 4, figsize=(8.4, 2.2 * len(scores)), squeeze=False)
+    for r, sc in enumerate(scores):
+        f = block.faces[sc.face]
+        panels = [(f.photo, "photo", None), (f.ring_map, "ring map", "gray"),
+                  (arf(sc.years), "predicted ARF", "gray"), (f.ring_map, "overlay", "gray")]
+        for c, (img, label, cmap) in enumerate(panels):
+            ax = axes[r, c]
+            if img is None:
+                ax.text(0.5, 0.5, "no photo", ha="center", va="center")
+            else:
+                ax.imshow(img, cmap=cmap, vmin=0, vmax=1 if cmap else None,
+                          alpha=0.5 if c == 3 else 1.0, interpolation="nearest")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            if c == 0:
+                ax.set_ylabel(sc.face, fontsize=8)
+            if r == 0:
+                ax.set_title(label, fontsize=8)
+        ax = axes[r, 3]
+        ax.plot(sc.ridge[:, 1], sc.ridge[:, 0], ",", color="tab:blue")
+        ax.plot(sc.lines[:, 1], sc.lines[:, 0], ",", color="tab:red")
+        excl = knot_exclusion(f, min(block.face_pixel_size_mm(sc.face)))
+        if excl is not None:
+            ax.contour(excl, levels=[0.5], colors="yellow", linewidths=0.6)
+        s = sc.shares
+        ax.set_xlabel(f"ridge {s['ridge_1']:.0f}/{s['ridge_2']:.0f}%  line {s['line_1']:.0f}/{s['line_2']:.0f}%",
+                      fontsize=7)
+        ax.set_xlim(0, f.shape[1] - 1)
+        ax.set_ylim(f.shape[0] - 1, 0)
+    if title:
+        fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+__all__ = ["ALL_FACES", "FaceScore", "face_years", "fit_for_holdout", "holdout_table",
+           "leave_one_face_out", "plot_holdout", "ridge_pixels", "ring_lines_px", "score_face"]
