@@ -98,6 +98,9 @@ _START_STEPS_SHARE = 0.5
 #: are dropped (a ring missing from the map or the tracing runs there).
 _NUMBER_CONFIDENCE = 0.35
 _GAP_MIN_PHASE = 0.2
+#: Knot masks (``face.extras["knot_mask"]``, Mokume ``X_knot.png``) are dilated by this many
+#: pixels before gap points on them are dropped (rings bend round a knot; the masks are tight).
+_KNOT_MARGIN_PX = 3
 
 
 @dataclass
@@ -285,7 +288,7 @@ def _fit(torch, block, model, faces, steps, seed, progress, spacing_mm, labels,
     field, grid_loss = _fit_labelled(torch, net, spec, ring.points_mm[keep], np.round(numbered[keep]),
                                      size, int(steps * _START_STEPS_SHARE), rng, progress, name,
                                      pith=pith)
-    gaps = _gap_points(ring.points_mm, ring.group, ring.face, field)
+    gaps = _gap_points(ring.points_mm, ring.group, ring.face, field, block)
     start_loss = _phase_loss(field, ring.points_mm)
     if year_free_steps and len(gaps):
         field = _refine_year_free(torch, net, spec, field, ring.points_mm, gaps, year_free_steps,
@@ -330,12 +333,19 @@ def _number_rings(block, faces, size, seed, name):
     return obs, radial(obs.points_mm), (radial.pith_mm, radial.axis)
 
 
-def _gap_points(points, group, face, field, max_points: int = 4 * _ADAM_POINTS) -> np.ndarray:
+def _gap_points(points, group, face, field, block=None, max_points: int = 4 * _ADAM_POINTS
+                ) -> np.ndarray:
     """Points between rings: midpoints from each ring point to the nearest point of another ring
     group on the same face, kept where ``field`` (the numbered start) is at least
     :data:`_GAP_MIN_PHASE` from an integer. That drops midpoints between two pieces of one ring
-    and those on a ring missing from the map or the tracing. (m, 3) block mm."""
+    and those on a ring missing from the map or the tracing. Midpoints on a face's
+    ``extras["knot_mask"]`` (dilated by :data:`_KNOT_MARGIN_PX`) are dropped too: rings bend
+    round a knot. points (n, 3) block mm, group (n,), face (n,) indices of
+    :data:`woodcam.frames.FACES` -> (m, 3) block mm."""
+    from scipy import ndimage
     from scipy.spatial import cKDTree
+
+    from ..frames import FACES, block_to_pixel
 
     out = []
     for f in np.unique(face):
@@ -343,12 +353,21 @@ def _gap_points(points, group, face, field, max_points: int = 4 * _ADAM_POINTS) 
         if len(np.unique(group[on])) < 2:
             continue
         p, g = points[on], group[on]
-        k = min(16, len(p))
+        k = min(64, len(p))
         _, idx = cKDTree(p).query(p, k=k)
         other = g[idx] != g[:, None]
         has = other.any(axis=1)
         j = idx[np.arange(len(p)), np.argmax(other, axis=1)]
-        out.append(0.5 * (p[has] + p[j[has]]))
+        mid = 0.5 * (p[has] + p[j[has]])
+        fc = block.faces.get(FACES[int(f)]) if block is not None else None
+        knot = None if fc is None else fc.extras.get("knot_mask")
+        if knot is not None and np.any(knot):
+            knot = ndimage.binary_dilation(np.asarray(knot, bool), iterations=_KNOT_MARGIN_PX)
+            r, c = block_to_pixel(fc.name, mid, fc.shape, block.size_mm)
+            r = np.clip(np.round(r).astype(int), 0, fc.shape[0] - 1)
+            c = np.clip(np.round(c).astype(int), 0, fc.shape[1] - 1)
+            mid = mid[~knot[r, c]]
+        out.append(mid)
     if not out:
         return np.empty((0, 3))
     mid = np.concatenate(out)
