@@ -84,6 +84,7 @@ _ADAM_POINTS = 1000
 _LR_CODE, _LR_POSE, _LR_SCALE = 3e-2, 1e-2, 1e-2
 
 Labels = Literal["auto", "years", "none"]
+Start = Literal["grid", "radial"]
 
 #: Year-free refinement (module docstring): L-BFGS iterations, gap-term weight and sharpness,
 #: log-K drift weight. The labelled start of an unlabelled fit runs this share of ``steps``
@@ -234,7 +235,7 @@ def _rodrigues(torch, w):
 def fit_neural_details(block, *, model=None, faces=None, steps: int = 300, seed: int = 0,
                        progress: bool = False, spacing_mm: float | None = None,
                        threads: int = 1, labels: Labels = "auto",
-                       year_free_steps: int = _YEAR_FREE_STEPS) -> NeuralFit:
+                       year_free_steps: int = _YEAR_FREE_STEPS, start: Start = "grid") -> NeuralFit:
     """Fit eq. 5 (labelled) or the year-free loss (unlabelled) to ``block``; see :func:`fit_neural`
     (this returns more)."""
     torch = require("torch", "learn", "fitting the neural growth field")
@@ -242,7 +243,7 @@ def fit_neural_details(block, *, model=None, faces=None, steps: int = 300, seed:
     torch.set_num_threads(int(threads))
     try:
         return _fit(torch, block, model, faces, steps, seed, progress, spacing_mm, labels,
-                    year_free_steps)
+                    year_free_steps, start)
     finally:
         torch.set_num_threads(old_threads)
 
@@ -254,12 +255,14 @@ def _check_steps(name: str, steps) -> int:
 
 
 def _fit(torch, block, model, faces, steps, seed, progress, spacing_mm, labels,
-         year_free_steps) -> NeuralFit:
+         year_free_steps, start) -> NeuralFit:
     t_start = time.perf_counter()
     steps = _check_steps("steps", steps)
     year_free_steps = _check_steps("year_free_steps", year_free_steps)
     if labels not in get_args(Labels):
         raise WoodcamError(f"labels must be one of {', '.join(get_args(Labels))}; got {labels!r}")
+    if start not in get_args(Start):
+        raise WoodcamError(f"start must be one of {', '.join(get_args(Start))}; got {start!r}")
     name = getattr(block, "name", "?")
     pts, yrs = block.trace_points_mm(faces)
     ok = np.isfinite(yrs)
@@ -275,7 +278,9 @@ def _fit(torch, block, model, faces, steps, seed, progress, spacing_mm, labels,
     rng = np.random.default_rng(seed)
     size = np.asarray(block.size_mm, float)
     if labels == "years" or (labels == "auto" and enough):
-        field, grid_loss = _fit_labelled(torch, net, spec, pts, yrs, size, steps, rng, progress, name)
+        pith = _radial_pith(block, faces, size, seed) if start == "radial" else None
+        field, grid_loss = _fit_labelled(torch, net, spec, pts, yrs, size, steps, rng, progress, name,
+                                         pith=pith)
         loss = float(np.mean(np.abs(field(pts) - yrs))) if steps else grid_loss
         return _finish(field, size, spacing_mm, loss, grid_loss, len(pts), "years", None, None,
                        None, t_start)
@@ -287,7 +292,7 @@ def _fit(torch, block, model, faces, steps, seed, progress, spacing_mm, labels,
         keep = np.ones(len(numbered), bool)
     field, grid_loss = _fit_labelled(torch, net, spec, ring.points_mm[keep], np.round(numbered[keep]),
                                      size, int(steps * _START_STEPS_SHARE), rng, progress, name,
-                                     pith=pith)
+                                     pith=pith, grid_directions=False)
     gaps = _gap_points(ring.points_mm, ring.group, ring.face, field, block)
     start_loss = _phase_loss(field, ring.points_mm)
     if year_free_steps and len(gaps):
@@ -310,6 +315,15 @@ def _phase_loss(field, points_mm) -> float:
     """Mean distance (years) of the field at ``points_mm`` to the nearest integer."""
     y = field(points_mm)
     return float(np.mean(np.abs(y - np.round(y))))
+
+
+def _radial_pith(block, faces, size, seed):
+    """The radial fitter's pith line ``(point, direction)`` from the labelled observations."""
+    from .observations import gather_observations
+    from .radial import fit_radial
+
+    radial = fit_radial(gather_observations(block, faces), size, seed=seed)
+    return radial.pith_mm, radial.axis
 
 
 def _number_rings(block, faces, size, seed, name):
@@ -377,13 +391,14 @@ def _gap_points(points, group, face, field, block=None, max_points: int = 4 * _A
     return mid[np.abs(y - np.round(y)) >= _GAP_MIN_PHASE]
 
 
-def _fit_labelled(torch, net, spec, pts, yrs, size, steps, rng, progress, name, pith=None):
+def _fit_labelled(torch, net, spec, pts, yrs, size, steps, rng, progress, name, pith=None,
+                  grid_directions: bool = True):
     """Eq. 5 in two steps (grid search with ``c = 0``, then Adam with ``a`` fixed).
 
     pts (n, 3) block mm, yrs (n,) years -> (NeuralBlockField, grid-search L1 loss in years).
     ``pith``: an optional pith line ``(point (3,), direction (3,))`` in the block frame (the radial
-    fitter's, for unlabelled rings); the grid search then tries only that direction, with the
-    usual offsets plus the given point (when it lies within the grid's reach).
+    fitter's); the grid search also tries that direction, with the usual offsets plus the given
+    point (when it lies within the grid's reach). ``grid_directions=False`` tries only it.
     """
     center = size / 2
     corners = _corners(size)
@@ -391,15 +406,17 @@ def _fit_labelled(torch, net, spec, pts, yrs, size, steps, rng, progress, name, 
     # --- step 1: coarse grid search with c = 0 ------------------------------------------------
     sub = rng.choice(len(pts), min(_GRID_POINTS, len(pts)), replace=False)
     ps, gs = pts[sub], yrs[sub]
-    dirs = _directions() if pith is None else np.asarray(pith[1], float)[None]
+    dirs = _directions() if grid_directions or pith is None else np.empty((0, 3))
+    if pith is not None:
+        dirs = np.concatenate([dirs, np.asarray(pith[1], float)[None]])
     cands = []  # (rotation, origin, length)
-    for d in dirs:
+    for i, d in enumerate(dirs):
         rot = _rotation_to(d)
         cc = (corners - center) @ rot.T
         radius = np.max(np.hypot(cc[:, 0], cc[:, 1]))
         half_len = np.max(np.abs(cc[:, 2]))
         offs = [np.array([u, v, 0.0]) * radius for u in _OFFSETS for v in _OFFSETS]
-        if pith is not None:
+        if pith is not None and i == len(dirs) - 1:
             off = rot @ (np.asarray(pith[0], float) - center)
             off[2] = 0.0
             if np.hypot(off[0], off[1]) <= _OFFSETS.max() * radius:
@@ -545,7 +562,8 @@ def _refine_year_free(torch, net, spec, start: NeuralBlockField, ring_mm, gap_mm
 
 def fit_neural(block, *, model=None, faces=None, steps: int = 300, seed: int = 0,
                progress: bool = False, spacing_mm: float | None = None, threads: int = 1,
-               labels: Labels = "auto", year_free_steps: int = _YEAR_FREE_STEPS) -> GridField:
+               labels: Labels = "auto", year_free_steps: int = _YEAR_FREE_STEPS,
+               start: Start = "grid") -> GridField:
     """Growth field of ``block`` from its ring traces or ring maps with the generic neural model.
 
     Parameters
@@ -571,7 +589,12 @@ def fit_neural(block, *, model=None, faces=None, steps: int = 300, seed: int = 0
         and fit the rings year-free (module docstring); "auto": "years" when the traces carry
         at least 10 labelled points of 2 different years, else "none".
     year_free_steps : int
-        Adam iterations of the year-free refinement (unlabelled fits only; 0: numbering only).
+        L-BFGS iterations of the year-free refinement (unlabelled fits only; 0: numbering only).
+    start : "grid" or "radial"
+        Labelled fits: "grid" is the seed's coarse grid search (13 pith directions); "radial"
+        adds the pith line of the radial fitter (:func:`woodcam.inference.fit_radial`, ~1-2 s)
+        as a candidate, which rescues blocks where no grid direction is close enough to the
+        pith for Adam to recover. Unlabelled fits always start from the radial fitter's line.
 
     Returns
     -------
@@ -589,4 +612,4 @@ def fit_neural(block, *, model=None, faces=None, steps: int = 300, seed: int = 0
     """
     return fit_neural_details(block, model=model, faces=faces, steps=steps, seed=seed,
                               progress=progress, spacing_mm=spacing_mm, threads=threads,
-                              labels=labels, year_free_steps=year_free_steps).grid
+                              labels=labels, year_free_steps=year_free_steps, start=start).grid
