@@ -56,7 +56,9 @@ without enough years) are fitted in three steps:
    Without any gap point (a single ring group per face) the numbered start is kept unrefined.
    Measured on an eq. 7-9 block (tests): started from a field of twice the ring density (every
    ring on an even integer) the ring term alone stays there (a minimum: rings fit as well as
-   the truth), with the gap term it leaves; started from the numbered fit, K stays within 5 %.
+   the truth), with the gap term it leaves (the refinement is local: it does not reach the
+   right density from there, the numbering has to); from the numbered fit the ring density
+   stays within 5 % of the truth.
 """
 
 from __future__ import annotations
