@@ -164,7 +164,7 @@ def _ring_density(field, truth, size, n=2000, h=0.05):
     return float(np.median(grad(field) / grad(truth)))
 
 
-def test_unlabelled_ring_maps_give_the_rings_of_labelled_traces(model, eq79_maps, eq79_fits):
+def test_unlabelled_ring_maps_give_the_rings_of_labelled_traces(eq79_maps, eq79_fits):
     from woodcam.inference.evaluate import DEFAULT_PLANES, evaluate_fits
 
     truth, blk, maps = eq79_maps
