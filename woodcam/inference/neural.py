@@ -402,8 +402,8 @@ def _fit_labelled(torch, net, spec, pts, yrs, size, steps, rng, progress, name, 
     fitter's) used instead of the grid search; when its point lies beyond the grid's reach
     (:data:`_OFFSETS`), the grid's offsets along its direction are searched. Why not add it to
     the grid as one more candidate: the grid ranks candidates by their ``c = 0`` misfit, and on
-    two of eight eq. 7-9 blocks a wrong offset beat the right pith there (0.90 vs 1.00 years)
-    but not after Adam (unmatched 1 mm 77 % vs 99.9 % on block 103).
+    eq. 7-9 block 103 of the benchmark set a wrong offset beat the right pith there (0.90 vs
+    1.00 years) but not after Adam (unmatched 1 mm 77 % vs 99.9 %).
     """
     center = size / 2
     corners = _corners(size)
