@@ -60,6 +60,13 @@ without enough years) are fitted in three steps:
    the truth), with the gap term it leaves (the refinement is local: it does not reach the
    right density from there, the numbering has to); from the numbered fit the ring density
    stays within 5 % of the truth.
+
+Measured (eq. 7-9 blocks 100-107 of ``tests/inference/_eq79_blocks.py``, 50 mm cubes at 5 px/mm;
+Table-1 share of predicted ring-line points within 1 mm of a true ring line, any year, mean over
+the 8 blocks): year-labelled traces 76.6 % with the seed's grid start, 98.0 % with
+``start="radial"``; the same traces without years 98.8 %; ring maps only 98.6 %. CPU time of an
+unlabelled fit (one torch thread) 6.5-7.0 s mean, 8.4 s at most; the Mokume cubes CN03 / H11
+(256 px ring maps) 9.0 / 8.4 s. The radial numbering takes 2.5-5 s of that.
 """
 
 from __future__ import annotations
