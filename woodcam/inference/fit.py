@@ -23,7 +23,9 @@ def fit_block(block, method: Method = "radial", faces=None, baked: bool = True):
     method : "rbf" (seed 000's baseline: thin-plate RBF of labelled ring points) or "radial"
         (ours: pith axis + smooth inverse ring width by least squares; also numbers unlabelled
         traces and ring maps) or "neural" (seed 000's eq. 5: the packaged generic neural GTF,
-        latent code and cut-out transform fitted to labelled traces; needs torch).
+        latent code and cut-out transform fitted to labelled traces; unlabelled traces and ring
+        maps are numbered by the radial fitter, then refined with a year-free periodic loss;
+        needs torch).
     faces : list of face names / Mokume letters, optional; default every face of the block.
     baked : return the field baked to a 1 mm grid (:class:`woodcam.fields.GridField`, fast,
         saveable with ``.save(path)``) rather than the raw fitted callable.
