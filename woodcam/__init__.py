@@ -28,7 +28,7 @@ _EXPORTS = {
                 "read_gran1"],
     ".frames": ["FACES", "FACE_NORMAL", "MOKUME_LETTER", "block_to_pixel", "pixel_to_block",
                 "unfold_cross"],
-    ".inference": ["benchmark", "evaluate_fit", "fit_block"],
+    ".inference": ["benchmark", "evaluate_fit", "fit_block", "leave_one_face_out"],
     ".logs": ["GeneratedLog", "generate_log"],
     ".pipeline": ["PartPreview", "preview_mesh", "preview_part"],
     ".stock": ["Stock", "open_stock"],

@@ -2,19 +2,25 @@
 
 - :func:`fit_block` ``(block, method, faces) -> field``: ``"rbf"`` is the seed's baseline,
   ``"radial"`` our least-squares fit of a pith axis and a smooth inverse ring width.
+  ``"neural"`` the seed's eq. 5 fit of the generic neural field (labelled traces, or ring maps
+  with a year-free loss).
 - :func:`evaluate_fit` / :func:`benchmark`: share of predicted ring-line points within 1 / 2 mm
   of the true ring line (same year, or any year) on interior cut planes.
+- :func:`leave_one_face_out`: for real blocks (no true field), each face predicted from the
+  others and scored against its ring map.
 """
 
 from .baked import bake
 from .evaluate import DEFAULT_PLANES, CutPlane, benchmark, evaluate_fit, evaluate_fits
 from .fit import METHODS, Method, fit_block
+from .holdout import leave_one_face_out, score_face
 from .observations import RingObservations, gather_observations
-from .radial import RadialField, fit_radial
+from .radial import RadialField, fit_radial, number_observations
 from .rbf import fit_rbf
 
 __all__ = [
     "CutPlane", "DEFAULT_PLANES", "METHODS", "Method", "RadialField",
     "RingObservations", "bake", "benchmark", "evaluate_fit", "evaluate_fits", "fit_block",
-    "fit_radial", "fit_rbf", "gather_observations",
+    "fit_radial", "fit_rbf", "gather_observations", "leave_one_face_out", "number_observations",
+    "score_face",
 ]

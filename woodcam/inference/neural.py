@@ -109,9 +109,6 @@ _START_STEPS_SHARE = 0.5
 #: are dropped (a ring missing from the map or the tracing runs there).
 _NUMBER_CONFIDENCE = 0.35
 _GAP_MIN_PHASE = 0.2
-#: Knot masks (``face.extras["knot_mask"]``, Mokume ``X_knot.png``) are dilated by this many
-#: pixels before gap points on them are dropped (rings bend round a knot; the masks are tight).
-_KNOT_MARGIN_PX = 3
 
 
 @dataclass
@@ -363,13 +360,13 @@ def _gap_points(points, group, face, field, block=None, max_points: int = 4 * _A
     group on the same face, kept where ``field`` (the numbered start) is at least
     :data:`_GAP_MIN_PHASE` from an integer. That drops midpoints between two pieces of one ring
     and those on a ring missing from the map or the tracing. Midpoints on a face's
-    ``extras["knot_mask"]`` (dilated by :data:`_KNOT_MARGIN_PX`) are dropped too: rings bend
-    round a knot. points (n, 3) block mm, group (n,), face (n,) indices of
+    knot exclusion (:func:`~woodcam.inference.observations.knot_exclusion`) are dropped too:
+    rings bend round a knot. points (n, 3) block mm, group (n,), face (n,) indices of
     :data:`woodcam.frames.FACES` -> (m, 3) block mm."""
-    from scipy import ndimage
     from scipy.spatial import cKDTree
 
     from ..frames import FACES, block_to_pixel
+    from .observations import knot_exclusion
 
     out = []
     for f in np.unique(face):
@@ -384,9 +381,8 @@ def _gap_points(points, group, face, field, block=None, max_points: int = 4 * _A
         j = idx[np.arange(len(p)), np.argmax(other, axis=1)]
         mid = 0.5 * (p[has] + p[j[has]])
         fc = block.faces.get(FACES[int(f)]) if block is not None else None
-        knot = None if fc is None else fc.extras.get("knot_mask")
-        if knot is not None and np.any(knot):
-            knot = ndimage.binary_dilation(np.asarray(knot, bool), iterations=_KNOT_MARGIN_PX)
+        knot = None if fc is None else knot_exclusion(fc, min(block.face_pixel_size_mm(fc.name)))
+        if knot is not None:
             r, c = block_to_pixel(fc.name, mid, fc.shape, block.size_mm)
             r = np.clip(np.round(r).astype(int), 0, fc.shape[0] - 1)
             c = np.clip(np.round(c).astype(int), 0, fc.shape[1] - 1)
