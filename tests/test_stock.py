@@ -5,6 +5,7 @@ import pytest
 
 from woodcam.errors import WoodcamError
 from woodcam.fields import block_at_knot, read_gran1
+from woodcam.inference.fit import FIT_VERSION
 from woodcam.stock import open_stock
 
 
@@ -47,7 +48,7 @@ def test_block_folder_without_truth_is_fitted_once_and_cached(tmp_path):
     block.true_field = None
     write_block(block, tmp_path / "b")
     s = open_stock(str(tmp_path / "b"))
-    cache = tmp_path / "b" / ".woodcam-cache" / "field_radial.npz"
+    cache = tmp_path / "b" / ".woodcam-cache" / f"field_radial_v{FIT_VERSION}.npz"
     assert cache.is_file()
     p = np.random.default_rng(0).uniform(0, 1, (5000, 3)) * (50, 40, 30)
     # Clean traces of an eq. 7-9 field: the fit is within 0.05 years (0.15 mm at 3 mm rings).

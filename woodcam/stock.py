@@ -106,13 +106,14 @@ def _synthetic_stock(spec, field, size_mm, species, description, appearance, par
 def fitted_field(block, folder: Path, method: str = "radial"):
     """The growth field fitted to a block's rings, fitted once and cached in the block folder.
 
-    The cache file ``<folder>/.woodcam-cache/field_<method>.npz`` is reused while it is newer
-    than the block's manifest; delete it (or rewrite the block) to fit again.
+    The cache file ``<folder>/.woodcam-cache/field_<method>_v<FIT_VERSION>.npz`` is reused while
+    it is newer than the block's manifest; delete it (or rewrite the block) to fit again.
     """
     from .fields.grid import GridField
     from .inference import fit_block
+    from .inference.fit import FIT_VERSION
 
-    cache = folder / ".woodcam-cache" / f"field_{method}.npz"
+    cache = folder / ".woodcam-cache" / f"field_{method}_v{FIT_VERSION}.npz"
     manifest = folder / "block.json"
     if cache.is_file() and cache.stat().st_mtime >= manifest.stat().st_mtime:
         return GridField.load(cache)

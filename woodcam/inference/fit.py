@@ -13,6 +13,10 @@ from .rbf import fit_rbf
 Method = Literal["rbf", "radial", "neural"]
 METHODS: tuple[str, ...] = get_args(Method)
 
+#: Bumped whenever a fitter changes what it returns for the same block, so fields cached by
+#: :func:`woodcam.stock.fitted_field` are refitted (2: growth history, knot masks, year-free neural).
+FIT_VERSION = 2
+
 
 def fit_block(block, method: Method = "radial", faces=None, baked: bool = True):
     """Infer a block's growth field from the rings on its faces.
@@ -48,4 +52,4 @@ def fit_block(block, method: Method = "radial", faces=None, baked: bool = True):
     return bake(field, block.size_mm) if baked else field
 
 
-__all__ = ["METHODS", "Method", "fit_block"]
+__all__ = ["FIT_VERSION", "METHODS", "Method", "fit_block"]

@@ -419,7 +419,7 @@ def number_observations(obs: RingObservations, field) -> RingObservations:
     return RingObservations(obs.points_mm, years[obs.group], obs.group, obs.face)
 
 
-def fit_radial(obs: RingObservations, size_mm, K: int = 12, M: int = 3, ridge: float = 1e-8,
+def fit_radial(obs: RingObservations, size_mm, K: int = 12, M: int = 1, ridge: float = 1e-8,
                max_relabel_rounds: int = 2, seed: int = 0, history: bool = True,
                **search) -> RadialField:
     """Fit the radial model to labelled or unlabelled ring observations of a block.
