@@ -150,3 +150,41 @@ def test_knots_show_darker_and_dead_knots_outlined():
     assert alive.sum() > 100 and outline.sum() > 20
     assert rgb[alive].mean() < rgb[clear].mean() - 0.1
     assert rgb[outline].mean() < rgb[alive].mean() - 0.1
+
+
+def test_fit_to_real_block_reads_ring_colours_off_its_ring_maps():
+    """Bug seen on the Mokume cubes: a field fitted to ring maps sits a fraction of a ring off
+    the photos' rings, and the ARF-binned ramp came out flat (bakes without rings). Anchored on
+    the ring maps, the ramp keeps most of the true ring contrast; on the field, it loses it."""
+    from woodcam.synth import synth_block
+
+    size = (40.0, 30.0, 30.0)
+    block = synth_block(AXIS_Z, size, face_px=160, seed=3, photo_noise=0.0, photo_variation=0.0)
+    luma = np.array([0.299, 0.587, 0.114])
+
+    def contrast(app):
+        lum = app.axis_luts @ luma                      # (3, LUT_BINS)
+        return lum.max(axis=1) - lum.min(axis=1)
+
+    truth = contrast(ColorMapAppearance.fit_to_block(block, AXIS_Z))   # true field: anchor=field
+    assert truth.min() > 0.1
+
+    def off(p):          # rings up to 0.35 of a ring off, the error varying across the block
+        p = np.asarray(p, float)
+        return AXIS_Z(p) + 0.35 * np.sin(2 * np.pi * (p[:, 0] + p[:, 1] + p[:, 2]) / 30.0)
+
+    on_field = contrast(ColorMapAppearance.fit_to_block(block, off, anchor="field"))
+    on_maps = contrast(ColorMapAppearance.fit_to_block(block, off))    # auto: not the true field
+    assert np.all(on_maps > 0.5 * truth), (on_maps, truth)
+    assert np.all(on_field < 0.5 * on_maps), (on_field, on_maps)
+    # Latewood (ARF near 1) darker than earlywood, as in the photos.
+    lut = ColorMapAppearance.fit_to_block(block, off).axis_luts @ luma
+    assert np.all(lut[:, -1] < lut[:, 0])
+
+
+def test_fit_anchor_is_checked():
+    block = _render_block(AXIS_Z, np.full((3, LUT_BINS, 3), 0.5))
+    with pytest.raises(WoodcamError, match="anchor must be one of"):
+        ColorMapAppearance.fit_to_block(block, AXIS_Z, anchor="photo")
+    with pytest.raises(WoodcamError, match="needs a ring map on every photographed face"):
+        ColorMapAppearance.fit_to_block(block, AXIS_Z, anchor="ring_map")
