@@ -335,3 +335,28 @@ def test_detail_round_trips_through_the_cache_file(tmp_path, rng):
         ColorVolumes(grid, vols, {}, guides, None)
     with pytest.raises(WoodcamError, match="guides must have shape"):
         ColorVolumes(grid, vols, {}, guides[:1], slopes)
+
+
+def test_mirror_augmentation_keeps_patch_and_photo_aligned(rng):
+    import torch
+
+    from woodcam.appearance.translation import _mirror
+
+    x = torch.from_numpy(rng.normal(size=(64, 2, 6, 6)).astype(np.float32))
+    y = x[:, :1] * 2 + 1                       # the "photo" is a pixelwise function of the input
+    xm, ym = _mirror(torch, np.random.default_rng(0), x, y)
+    np.testing.assert_array_equal(ym.numpy(), (xm[:, :1] * 2 + 1).numpy())
+    flipped = [not torch.equal(xm[i], x[i]) for i in range(len(x))]
+    assert 30 < sum(flipped) < 64              # 3/4 of patches mirrored in some way
+    # Each patch is one of its four mirror images.
+    for i in range(8):
+        cands = [x[i], x[i].flip(2), x[i].flip(1), x[i].flip(1).flip(2)]
+        assert any(torch.equal(xm[i], c) for c in cands)
+
+
+def test_augmented_spec_trains_and_changes_the_network(block):
+    pair = face_pair(block, "top", GRID, SPEC, field=FIELD)
+    spec = translation_spec("draft", epochs=1, seed=11)
+    a = train_translation([pair], spec, progress=False)(pair[0])
+    b = train_translation([pair], replace(spec, augment=True), progress=False)(pair[0])
+    assert np.isfinite(b).all() and not np.array_equal(a, b)

@@ -165,7 +165,7 @@ def end_grain_faces(field, size_mm, threshold: float = 0.7) -> dict:
 def leave_one_face_out(block, field=None, *, resolution: int = 128, quality: Quality = "normal",
                        epochs: int | None = None, seed: int = 0, faces=None, end_grain=None,
                        species: str = "oak", progress: bool = True, threads: int | None = 1,
-                       finetune_epochs: int | None = None) -> list[FaceEval]:
+                       finetune_epochs: int | None = None, augment: bool | None = None) -> list[FaceEval]:
     """Leave-one-face-out evaluation of the models in :data:`MODELS` (module docstring).
 
     Parameters
@@ -176,6 +176,7 @@ def leave_one_face_out(block, field=None, *, resolution: int = 128, quality: Qua
     faces : faces to hold out (default all with a photo).
     end_grain : dict face -> bool, optional; default from the field's grain direction, else unknown.
     finetune_epochs : overrides the spec's (0: per-axis networks from scratch, the seed's way).
+    augment : overrides the spec's (mirrored training patches).
 
     Returns
     -------
@@ -190,6 +191,8 @@ def leave_one_face_out(block, field=None, *, resolution: int = 128, quality: Qua
         )
     grid = VolumeGrid(block.size_mm, resolution)
     extra = {} if finetune_epochs is None else {"finetune_epochs": int(finetune_epochs)}
+    if augment is not None:
+        extra["augment"] = bool(augment)
     spec = translation_spec(quality, epochs, seed, **extra)
     pairs = {f: face_pair(block, f, grid, spec, field=field, source=source) for f in usable}
     if end_grain is None:
