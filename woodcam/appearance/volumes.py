@@ -211,8 +211,8 @@ class ColorVolumes:
         each slice): the guide of the sub-cell detail.
     slopes : (k, nx, ny, nz, 3) float32 or None (float16 on disk)
         Local slope of colour over guide (:func:`guide_slopes`). With both, :meth:`sample`
-        adds ``slope * (guide at the point - interpolated guide)``: the volume gives the colour
-        of the cell, the field's exact rings at the point give the detail inside it.
+        extrapolates each cell's colour to the guide at the point itself: the volume gives the
+        colour of the cells, the field's exact rings at the point the detail inside them.
     """
 
     grid: VolumeGrid
@@ -250,24 +250,61 @@ class ColorVolumes:
 
         Points outside the cell centres clamp to the border cells (a face lies half a cell
         outside the outermost centres). With ``guide (n,)`` (the networks' ring input at the
-        points themselves) and sub-cell detail stored, the detail is added (class docstring).
+        points themselves) and sub-cell detail stored, the detail is added (:meth:`_detailed`).
         """
         p = check_points(points_mm)
-        i0, f = self._corners(p)
-        out = _trilinear(self.volumes[index], i0, f) * np.float32(1.0 / 255.0)
-        if guide is not None and self.has_detail:
-            g_cell = _trilinear(self.guides[index][..., None], i0, f)[:, 0]
-            slope = _trilinear(self.slopes[index], i0, f)
-            out += slope * (np.asarray(guide, np.float32) - g_cell)[:, None]
-            np.clip(out, 0.0, 1.0, out=out)
-        return out
+        corners = self._corners(p)
+        if guide is None or not self.has_detail:
+            return _trilinear(self.volumes[index], corners) * np.float32(1.0 / 255.0)
+        return self._detailed(index, corners, np.asarray(guide, np.float32))
+
+    def _detailed(self, index: int, corners, guide: np.ndarray) -> np.ndarray:
+        """Each of the 8 corners extrapolates its colour to the point's guide value along its
+        slope (``C_k + s_k (g - g_k)``), and the corners are blended by their trilinear weights
+        times a range weight ``exp(-((g_k - g) / DETAIL_RANGE)^2)`` (joint bilateral
+        upsampling, Kopf et al. 2007): a corner across a ring boundary from the point, whose
+        guide differs a lot, hardly counts, so the boundary falls where the field puts it."""
+        idx, w = corners
+        flat_c = self.volumes[index].reshape(-1, 3)
+        flat_g = self.guides[index].reshape(-1)
+        flat_s = self.slopes[index].reshape(-1, 3)
+        gk = flat_g[idx]                                         # (8, n)
+        ww = w * np.exp(-np.square((gk - guide[None]) * np.float32(1.0 / DETAIL_RANGE)))
+        total = ww.sum(axis=0)
+        # No corner near the point's guide value (a feature thinner than a cell): trilinear.
+        lost = total < 1e-6
+        if lost.any():
+            ww[:, lost] = w[:, lost]
+            total[lost] = w[:, lost].sum(axis=0)
+        out = np.zeros((len(guide), 3), np.float32)
+        for k in range(8):
+            col = flat_c[idx[k]] * np.float32(1.0 / 255.0) + flat_s[idx[k]] * (guide - gk[k])[:, None]
+            out += ww[k][:, None] * col
+        out /= total[:, None]
+        return np.clip(out, 0.0, 1.0, out=out)
 
     def _corners(self, p):
+        """Flat cell indices ``(8, n)`` of the 8 corners around each point and their trilinear
+        weights ``(8, n)`` float32, shared by every volume of the grid."""
         shape = np.asarray(self.grid.shape)
         t = p / self.grid.cell_mm - 0.5
         t = np.clip(t, 0.0, shape - 1.0)
         i0 = np.minimum(t.astype(np.int64), shape - 2)
-        return i0, (t - i0).astype(np.float32)
+        f = (t - i0).astype(np.float32)
+        base = (i0[:, 0] * shape[1] + i0[:, 1]) * shape[2] + i0[:, 2]
+        idx = np.empty((8, len(p)), np.int64)
+        w = np.empty((8, len(p)), np.float32)
+        k = 0
+        for dx in (0, 1):
+            wx = f[:, 0] if dx else 1 - f[:, 0]
+            for dy in (0, 1):
+                wy = f[:, 1] if dy else 1 - f[:, 1]
+                for dz in (0, 1):
+                    wz = f[:, 2] if dz else 1 - f[:, 2]
+                    idx[k] = base + (dx * shape[1] + dy) * shape[2] + dz
+                    w[k] = wx * wy * wz
+                    k += 1
+        return idx, w
 
     def save(self, path) -> Path:
         path = Path(path)
@@ -289,22 +326,26 @@ class ColorVolumes:
                        json.loads(str(z["meta"])), **detail)
 
 
-def _trilinear(vol: np.ndarray, i0: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """Trilinear samples ``(n, c)`` float32 of ``vol (nx, ny, nz, c)`` (any dtype) at corner
-    indices ``i0 (n, 3)`` and fractions ``f (n, 3)``."""
-    out = np.zeros((len(i0), vol.shape[-1]), np.float32)
-    # Hand-written rather than scipy.ndimage.map_coordinates: one pass over the 8 corners
-    # for all channels of a uint8 / float16 volume, without converting the volume to float32.
-    for dx in (0, 1):
-        wx = f[:, 0] if dx else 1 - f[:, 0]
-        for dy in (0, 1):
-            wy = f[:, 1] if dy else 1 - f[:, 1]
-            for dz in (0, 1):
-                wz = f[:, 2] if dz else 1 - f[:, 2]
-                c = vol[i0[:, 0] + dx, i0[:, 1] + dy, i0[:, 2] + dz]
-                out += (wx * wy * wz)[:, None] * c
+def _trilinear(vol: np.ndarray, corners) -> np.ndarray:
+    """Trilinear samples ``(n, c)`` float32 of ``vol (nx, ny, nz, c)`` (any dtype) at the
+    corners of :meth:`ColorVolumes._corners`."""
+    idx, w = corners
+    flat = vol.reshape(-1, vol.shape[-1])
+    out = np.zeros((idx.shape[1], vol.shape[-1]), np.float32)
+    # Hand-written rather than scipy.ndimage.map_coordinates: one gather per corner for all
+    # channels of a uint8 / float32 volume, without converting the volume to float; the corner
+    # indices are computed once per lookup and shared by colour, guide and slopes.
+    for k in range(8):
+        out += w[k][:, None] * flat[idx[k]]
     return out
 
+
+#: Guide difference (guide units) at which a corner's range weight in a detailed lookup falls
+#: to 1/e: a tenth of the ARF's range, so corners across a ring boundary (ARF ~1 against ~0)
+#: drop out while corners within a ring (ARF differing by ~0.1-0.2 a cell) still count. Chosen
+#: on synthetic rings with sharp and smooth latewood profiles (error 0.021 against 0.027 for
+#: the plain guided-filter correction and 0.038-0.054 for trilinear lookup).
+DETAIL_RANGE = 0.1
 
 #: Half-width (cells) of the window of the colour-over-guide regression of :func:`guide_slopes`.
 DETAIL_RADIUS_CELLS = 1
