@@ -188,3 +188,27 @@ def test_fit_anchor_is_checked():
         ColorMapAppearance.fit_to_block(block, AXIS_Z, anchor="photo")
     with pytest.raises(WoodcamError, match="needs a ring map on every photographed face"):
         ColorMapAppearance.fit_to_block(block, AXIS_Z, anchor="ring_map")
+
+
+def test_register_ring_phase_moves_a_fitted_fields_rings_onto_the_ring_map():
+    """A field up to 0.35 of a ring off (the error varying across the face) is moved back onto
+    the true rings where the ring map has lines; the ring order is kept (no whole-year jumps)."""
+    from woodcam.appearance.colormap import register_ring_phase
+    from woodcam.synth import synth_block
+
+    size = (40.0, 30.0, 30.0)
+    block = synth_block(AXIS_Z, size, face_px=160, seed=3)
+    face = block.faces["front"]
+    pts = face_pixel_points("front", face.shape, size).reshape(-1, 3)
+    true = AXIS_Z(pts).reshape(face.shape)
+    off = true + 0.35 * np.sin(2 * np.pi * (pts[:, 0] + pts[:, 2]) / 30.0).reshape(face.shape)
+
+    def phase_err(g):
+        d = np.abs(g - true)
+        return np.minimum(d % 1, 1 - d % 1)
+
+    reg = register_ring_phase(off, face.ring_map, sigma_px=12 * 160 / 256)
+    assert phase_err(reg).mean() < 0.3 * phase_err(off).mean(), (phase_err(reg).mean(), phase_err(off).mean())
+    assert np.abs(reg - true).max() < 0.5                     # no ring skipped
+    # A map without lines leaves the field as it is.
+    np.testing.assert_array_equal(register_ring_phase(off, np.zeros(face.shape), 5.0), off)

@@ -395,3 +395,4 @@ def test_fitted_volumes_carry_detail_that_brings_them_closer_to_the_truth(fitted
     plain = np.abs(app.color(None, p, n) - truth).mean()
     detailed = np.abs(app.color(FIELD, p, n) - truth).mean()
     assert detailed < 0.9 * plain, (detailed, plain)
+

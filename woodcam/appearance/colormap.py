@@ -256,27 +256,34 @@ def _field_lut(faces, field, size_mm, centres, register: bool = False) -> np.nda
 
 
 def _registered_years(face, years: np.ndarray) -> np.ndarray:
-    """``years (h, w)`` of a field on ``face`` with its ring phase moved onto the face's ring map.
+    """``years (h, w)`` of a field on ``face``'s pixels, its ring phase moved onto the face's
+    ring map (:func:`register_ring_phase` at the face's image scale)."""
+    sigma = RING_REGISTRATION_BLUR_PX_PER_SIDE * max(face.shape) / 256.0
+    return register_ring_phase(years, face.ring_map, sigma)
+
+
+def register_ring_phase(years: np.ndarray, ring_map: np.ndarray, sigma_px: float) -> np.ndarray:
+    """Growth-time image ``years (h, w)`` with its ring phase moved onto ``ring_map (h, w)``.
 
     On the ring map's lines (value > 0.5) the field should be at a whole year; the offset
     ``round(g) - g`` there is averaged around each pixel (circular mean, Gaussian window of
-    :data:`RING_REGISTRATION_BLUR_PX_PER_SIDE`) and added to ``g``. The field keeps the ring
-    order and which side of a boundary is latewood (growth runs outward); the ring map says
-    exactly where the boundary is.
+    ``sigma_px`` pixels) and added to ``g``. The field keeps the ring order and which side of a
+    boundary is latewood (growth runs outward); the ring map says exactly where the boundary
+    is. Far from any line the shift fades out. Returns ``years`` unchanged when the map has
+    (almost) no lines.
     """
     from scipy import ndimage
 
-    on = np.asarray(face.ring_map, float) > 0.5
+    years = np.asarray(years, float)
+    on = np.asarray(ring_map, float) > 0.5
     if on.sum() < 16:
         return years
     delta = np.where(on, np.round(years) - years, 0.0)
-    sigma = RING_REGISTRATION_BLUR_PX_PER_SIDE * max(face.shape) / 256.0
     z = np.where(on, np.exp(2j * np.pi * delta), 0.0)
-    re = ndimage.gaussian_filter(z.real, sigma, mode="reflect")
-    im = ndimage.gaussian_filter(z.imag, sigma, mode="reflect")
-    weight = ndimage.gaussian_filter(on.astype(float), sigma, mode="reflect")
+    re = ndimage.gaussian_filter(z.real, sigma_px, mode="reflect")
+    im = ndimage.gaussian_filter(z.imag, sigma_px, mode="reflect")
+    weight = ndimage.gaussian_filter(on.astype(float), sigma_px, mode="reflect")
     shift = np.angle(re + 1j * im) / (2 * np.pi)
-    # Far from any ring line (weight ~ 0) the shift fades out rather than jumping.
     return years + shift * np.clip(weight / (weight.max() + 1e-12) * 4.0, 0.0, 1.0)
 
 
