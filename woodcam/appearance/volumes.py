@@ -23,6 +23,7 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
+import numba
 import numpy as np
 
 from ..errors import WoodcamError
@@ -211,8 +212,8 @@ class ColorVolumes:
         each slice): the guide of the sub-cell detail.
     slopes : (k, nx, ny, nz, 3) float32 or None (float16 on disk)
         Local slope of colour over guide (:func:`guide_slopes`). With both, :meth:`sample`
-        extrapolates each cell's colour to the guide at the point itself: the volume gives the
-        colour of the cells, the field's exact rings at the point the detail inside them.
+        adds ``slope * (guide at the point - interpolated guide)``: the volume gives the colour
+        of the cells, the field's exact rings at the point the detail inside them.
     """
 
     grid: VolumeGrid
@@ -259,29 +260,16 @@ class ColorVolumes:
         return self._detailed(index, corners, np.asarray(guide, np.float32))
 
     def _detailed(self, index: int, corners, guide: np.ndarray) -> np.ndarray:
-        """Each of the 8 corners extrapolates its colour to the point's guide value along its
-        slope (``C_k + s_k (g - g_k)``), and the corners are blended by their trilinear weights
-        times a range weight ``exp(-((g_k - g) / DETAIL_RANGE)^2)`` (joint bilateral
-        upsampling, Kopf et al. 2007): a corner across a ring boundary from the point, whose
-        guide differs a lot, hardly counts, so the boundary falls where the field puts it."""
+        """Guided-filter upsampling (He et al. 2013): the trilinear colour plus the trilinear
+        slope times the difference between the point's own guide and the trilinear guide, so a
+        ring boundary falls exactly where the field puts it instead of being smeared over a
+        cell. (A joint-bilateral variant that drops corners across a boundary scored a little
+        better on synthetic profiles but showed cell-sized kinks in latewood bands on bevels.)"""
         idx, w = corners
-        flat_c = self.volumes[index].reshape(-1, 3)
-        flat_g = self.guides[index].reshape(-1)
-        flat_s = self.slopes[index].reshape(-1, 3)
-        gk = flat_g[idx]                                         # (8, n)
-        ww = w * np.exp(-np.square((gk - guide[None]) * np.float32(1.0 / DETAIL_RANGE)))
-        total = ww.sum(axis=0)
-        # No corner near the point's guide value (a feature thinner than a cell): trilinear.
-        lost = total < 1e-6
-        if lost.any():
-            ww[:, lost] = w[:, lost]
-            total[lost] = w[:, lost].sum(axis=0)
-        out = np.zeros((len(guide), 3), np.float32)
-        for k in range(8):
-            col = flat_c[idx[k]] * np.float32(1.0 / 255.0) + flat_s[idx[k]] * (guide - gk[k])[:, None]
-            out += ww[k][:, None] * col
-        out /= total[:, None]
-        return np.clip(out, 0.0, 1.0, out=out)
+        out = np.empty((len(guide), 3), np.float32)
+        _detailed_kernel(idx, w, self.volumes[index].reshape(-1, 3), self.guides[index].reshape(-1),
+                         self.slopes[index].reshape(-1, 3), np.ascontiguousarray(guide, np.float32), out)
+        return out
 
     def _corners(self, p):
         """Flat cell indices ``(8, n)`` of the 8 corners around each point and their trilinear
@@ -340,12 +328,37 @@ def _trilinear(vol: np.ndarray, corners) -> np.ndarray:
     return out
 
 
-#: Guide difference (guide units) at which a corner's range weight in a detailed lookup falls
-#: to 1/e: a tenth of the ARF's range, so corners across a ring boundary (ARF ~1 against ~0)
-#: drop out while corners within a ring (ARF differing by ~0.1-0.2 a cell) still count. Chosen
-#: on synthetic rings with sharp and smooth latewood profiles (error 0.021 against 0.027 for
-#: the plain guided-filter correction and 0.038-0.054 for trilinear lookup).
-DETAIL_RANGE = 0.1
+@numba.njit(nogil=True, fastmath=True, cache=True)
+def _detailed_kernel(idx, w, vol, guides, slopes, guide, out):  # pragma: no cover - compiled
+    """Per point, the detailed lookup of :meth:`ColorVolumes._detailed` in one compiled pass
+    (in numpy, gathering the 8 corners of three arrays made it 2-3x slower than trilinear).
+
+    idx, w : (8, n) flat corner indices and trilinear weights; vol : (m, 3) uint8;
+    guides : (m,) float32; slopes : (m, 3) float32; guide : (n,) float32; out : (n, 3) float32.
+    """
+    for i in range(guide.shape[0]):
+        c0 = 0.0
+        c1 = 0.0
+        c2 = 0.0
+        s0 = 0.0
+        s1 = 0.0
+        s2 = 0.0
+        g = 0.0
+        for k in range(8):
+            j = idx[k, i]
+            wk = w[k, i]
+            c0 += wk * vol[j, 0]
+            c1 += wk * vol[j, 1]
+            c2 += wk * vol[j, 2]
+            s0 += wk * slopes[j, 0]
+            s1 += wk * slopes[j, 1]
+            s2 += wk * slopes[j, 2]
+            g += wk * guides[j]
+        d = guide[i] - g
+        out[i, 0] = min(max(c0 * (1.0 / 255.0) + s0 * d, 0.0), 1.0)
+        out[i, 1] = min(max(c1 * (1.0 / 255.0) + s1 * d, 0.0), 1.0)
+        out[i, 2] = min(max(c2 * (1.0 / 255.0) + s2 * d, 0.0), 1.0)
+
 
 #: Half-width (cells) of the window of the colour-over-guide regression of :func:`guide_slopes`.
 DETAIL_RADIUS_CELLS = 1
