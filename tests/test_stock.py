@@ -65,3 +65,27 @@ def test_block_folder_with_no_rings_is_a_clear_error(tmp_path):
     write_block(Block((10, 10, 10)), tmp_path / "empty")
     with pytest.raises(WoodcamError, match="neither a true field nor traced rings"):
         open_stock(str(tmp_path / "empty"))
+
+
+def test_mokume_folder_is_a_stock_with_a_cached_fitted_field(shared_data, tmp_path, monkeypatch):
+    """A Mokume sample folder opens as a 50 mm cube; its field is fitted to the ring maps once
+    and cached under the cache dir (the shared folder is not written to)."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path))
+    folder = shared_data / "mokume" / "CN03"
+    before = sorted(p.name for p in folder.iterdir())
+    s = open_stock(str(folder))
+    assert s.size_mm == (50.0, 50.0, 50.0) and s.spec == str(folder)
+    cached = list((tmp_path / "fields").glob("CN03-*-radial.npz"))
+    assert len(cached) == 1
+    assert sorted(p.name for p in folder.iterdir()) == before
+    # The field puts whole years on the ring map's lines of the top face (within a fifth of a
+    # ring on most of them), and the second open reads the same field back from the cache.
+    from woodcam.block.io import read_mokume
+    from woodcam.frames import face_pixel_points
+
+    top = read_mokume(folder).faces["top"]
+    pts = face_pixel_points("top", top.shape, s.size_mm)[top.ring_map > 0.5]
+    g = s.wood.field(pts)
+    assert np.mean(np.abs(g - np.round(g)) < 0.2) > 0.7
+    again = open_stock(str(folder))
+    np.testing.assert_allclose(again.wood.field(pts), g, atol=1e-9)

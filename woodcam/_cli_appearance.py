@@ -31,6 +31,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--finetune-epochs", type=int, default=None, metavar="N",
                    help="per-axis networks fine-tuned N epochs from the all-faces network "
                    "(default 2; 0 trains each axis from scratch, as seed 000 does)")
+    p.add_argument("--augment", action="store_true",
+                   help="train on randomly mirrored patches too (measured on H11/CN03: no better)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--end-grain", default=None, metavar="FACES",
                    help="comma-separated end-grain faces (default: from the field; unknown without one)")
@@ -76,6 +78,7 @@ def run(args) -> int:
         res = leave_one_face_out(block, field, resolution=args.resolution, quality=args.quality,
                                  epochs=args.epochs, seed=args.seed, end_grain=end_grain,
                                  finetune_epochs=args.finetune_epochs,
+                                 augment=True if getattr(args, "augment", False) else None,
                                  progress=not args.quiet)
         name = block.name.replace("/", "_")
         side_by_side(res, args.out / f"{name}.png",

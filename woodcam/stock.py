@@ -8,6 +8,10 @@ A block spec is a string the CLI and GLB metadata carry:
   woodcam log file (``.json``); size default 100x80x50 mm, Z along the log.
 - a block folder with a ``block.json`` manifest (real or synthetic): its true field if it has
   one, otherwise a field fitted to its rings (fit once, cached in the folder).
+- a Mokume sample folder (``A_col.png``, ``A_arl-unet.png``, ... as in the Mokume dataset): a
+  cube of ``MOKUME_DEFAULT_SIZE_MM`` (50 mm) whose field is fitted to its ring maps, fit once
+  and cached under ``$WOODCAM_CACHE_DIR`` / ``~/.cache/woodcam`` (the sample folder is left
+  untouched: it is often read-only shared data).
 """
 
 from __future__ import annotations
@@ -76,9 +80,12 @@ def open_stock(spec: str, *, species: str | None = None,
     path = Path(spec)
     if path.is_dir() and (path / "block.json").is_file():
         return _open_block_folder(path, species, appearance, appearance_params)
+    if path.is_dir() and (any(path.glob("?_col.png")) or any(path.glob("?_arl-unet.png"))):
+        return _open_mokume_folder(path, species, appearance, appearance_params)
     raise WoodcamError(
         f"block spec {spec!r} is neither 'builtin:NAME' (NAME one of {', '.join(BUILTIN_NAMES)}), "
-        "'log:LOG@KNOT[:WxDxH]', nor a block folder with a block.json manifest"
+        "'log:LOG@KNOT[:WxDxH]', a block folder with a block.json manifest, nor a Mokume sample "
+        "folder (A_col.png, A_arl-unet.png, ...)"
     )
 
 
@@ -128,21 +135,52 @@ def fitted_field(block, folder: Path, method: str = "radial"):
     return field
 
 
+def _mokume_fitted_field(block, method: str = "radial"):
+    """The field fitted to a Mokume block, cached by the block's images and size (not in its
+    folder: see the module docstring)."""
+    from .appearance.neural import default_cache_dir
+    from .appearance.volumes import block_fingerprint
+    from .fields.grid import GridField
+    from .inference import fit_block
+
+    cache = default_cache_dir().parent / "fields" / f"{block.name}-{block_fingerprint(block)[:16]}-{method}.npz"
+    if cache.is_file():
+        return GridField.load(cache)
+    field = fit_block(block, method=method)
+    cache.parent.mkdir(parents=True, exist_ok=True)
+    field.save(cache)
+    return field
+
+
+def _open_mokume_folder(path: Path, species, appearance, appearance_params) -> Stock:
+    from .block.io import read_mokume
+
+    block = read_mokume(path)
+    return _real_block_stock(str(path), block, _mokume_fitted_field(block), species, appearance,
+                             appearance_params, cache_dir=None)
+
+
 def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
     from .block.io import read_block  # block I/O sits beside; imported when a folder is used
 
     block = read_block(path)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
+    return _real_block_stock(str(path), block, field, species, appearance, appearance_params,
+                             cache_dir=path / ".woodcam-cache")
+
+
+def _real_block_stock(spec, block, field, species, appearance, appearance_params, cache_dir) -> Stock:
     if appearance == "neural":
         from .appearance.neural import block_appearance
 
-        appearance_params.setdefault("cache_dir", path / ".woodcam-cache")
+        if cache_dir is not None:
+            appearance_params.setdefault("cache_dir", cache_dir)
         app = block_appearance(block, field, "neural", species=species or "oak", **appearance_params)
     elif any(f.photo is not None for f in block.faces.values()):
         app = ColorMapAppearance.fit_to_block(block, field, species or "oak", **appearance_params)
     else:
         app = ColorMapAppearance(species or "oak", **appearance_params)
-    return Stock(str(path), block.size_mm, Wood(field, app), block.name, dict(block.meta))
+    return Stock(spec, block.size_mm, Wood(field, app), block.name, dict(block.meta))
 
 
 def _log_block_field(spec: str):

@@ -150,3 +150,65 @@ def test_knots_show_darker_and_dead_knots_outlined():
     assert alive.sum() > 100 and outline.sum() > 20
     assert rgb[alive].mean() < rgb[clear].mean() - 0.1
     assert rgb[outline].mean() < rgb[alive].mean() - 0.1
+
+
+def test_fit_to_real_block_reads_ring_colours_off_its_ring_maps():
+    """Bug seen on the Mokume cubes: a field fitted to ring maps sits a fraction of a ring off
+    the photos' rings, and the ARF-binned ramp came out flat (bakes without rings). Anchored on
+    the ring maps, the ramp keeps most of the true ring contrast; on the field, it loses it."""
+    from woodcam.synth import synth_block
+
+    size = (40.0, 30.0, 30.0)
+    block = synth_block(AXIS_Z, size, face_px=160, seed=3, photo_noise=0.0, photo_variation=0.0)
+    luma = np.array([0.299, 0.587, 0.114])
+
+    def contrast(app):
+        lum = app.axis_luts @ luma                      # (3, LUT_BINS)
+        return lum.max(axis=1) - lum.min(axis=1)
+
+    truth = contrast(ColorMapAppearance.fit_to_block(block, AXIS_Z))   # true field: anchor=field
+    assert truth.min() > 0.1
+
+    def off(p):          # rings up to 0.35 of a ring off, the error varying across the block
+        p = np.asarray(p, float)
+        return AXIS_Z(p) + 0.35 * np.sin(2 * np.pi * (p[:, 0] + p[:, 1] + p[:, 2]) / 30.0)
+
+    on_field = contrast(ColorMapAppearance.fit_to_block(block, off, anchor="field"))
+    on_maps = contrast(ColorMapAppearance.fit_to_block(block, off))    # auto: not the true field
+    assert np.all(on_maps > 0.5 * truth), (on_maps, truth)
+    assert np.all(on_field < 0.5 * on_maps), (on_field, on_maps)
+    # Latewood (ARF near 1) darker than earlywood, as in the photos.
+    lut = ColorMapAppearance.fit_to_block(block, off).axis_luts @ luma
+    assert np.all(lut[:, -1] < lut[:, 0])
+
+
+def test_fit_anchor_is_checked():
+    block = _render_block(AXIS_Z, np.full((3, LUT_BINS, 3), 0.5))
+    with pytest.raises(WoodcamError, match="anchor must be one of"):
+        ColorMapAppearance.fit_to_block(block, AXIS_Z, anchor="photo")
+    with pytest.raises(WoodcamError, match="needs a ring map on every photographed face"):
+        ColorMapAppearance.fit_to_block(block, AXIS_Z, anchor="ring_map")
+
+
+def test_register_ring_phase_moves_a_fitted_fields_rings_onto_the_ring_map():
+    """A field up to 0.35 of a ring off (the error varying across the face) is moved back onto
+    the true rings where the ring map has lines; the ring order is kept (no whole-year jumps)."""
+    from woodcam.appearance.colormap import register_ring_phase
+    from woodcam.synth import synth_block
+
+    size = (40.0, 30.0, 30.0)
+    block = synth_block(AXIS_Z, size, face_px=160, seed=3)
+    face = block.faces["front"]
+    pts = face_pixel_points("front", face.shape, size).reshape(-1, 3)
+    true = AXIS_Z(pts).reshape(face.shape)
+    off = true + 0.35 * np.sin(2 * np.pi * (pts[:, 0] + pts[:, 2]) / 30.0).reshape(face.shape)
+
+    def phase_err(g):
+        d = np.abs(g - true)
+        return np.minimum(d % 1, 1 - d % 1)
+
+    reg = register_ring_phase(off, face.ring_map, sigma_px=12 * 160 / 256)
+    assert phase_err(reg).mean() < 0.3 * phase_err(off).mean(), (phase_err(reg).mean(), phase_err(off).mean())
+    assert np.abs(reg - true).max() < 0.5                     # no ring skipped
+    # A map without lines leaves the field as it is.
+    np.testing.assert_array_equal(register_ring_phase(off, np.zeros(face.shape), 5.0), off)

@@ -273,3 +273,126 @@ def test_auto_source_prefers_ring_maps_for_fitted_fields(monkeypatch):
         assert seen.pop() == want
     with pytest.raises(WoodcamError, match="source must be one of auto, arf, ring_map"):
         fit_neural_appearance(blk, FIELD, source="photo", cache_dir=False)
+
+
+# -- sub-cell detail (guided by the field's rings at the exact point) -------------------------------
+
+def test_guide_slopes_recover_a_linear_colour_of_the_guide(rng):
+    from woodcam.appearance.volumes import guide_slopes
+
+    g = rng.uniform(0, 1, (12, 10, 8))
+    colour = 0.2 + np.stack([0.5 * g, -0.3 * g, 0.1 * g], -1)
+    s = guide_slopes(colour, g, eps=1e-6)
+    np.testing.assert_allclose(s[2:-2, 2:-2, 2:-2], np.broadcast_to([0.5, -0.3, 0.1], s[2:-2, 2:-2, 2:-2].shape),
+                               atol=1e-3)
+    # A constant guide carries no detail: the slope is 0, not noise over a tiny variance.
+    assert np.abs(guide_slopes(colour, np.full(g.shape, 0.4))).max() < 1e-4
+
+
+def _ring_volume(grid, field, colour_of_arf):
+    """A colour volume that is exactly ``colour_of_arf(ARF)`` at the cell centres, with its guide."""
+    g = arf(years_volume(field, grid))
+    return np.rint(colour_of_arf(g) * 255).astype(np.uint8), g
+
+
+def test_sub_cell_detail_restores_sharp_rings_that_trilinear_blurs(rng):
+    """Rings 2.5 mm apart on a 0.8 mm grid: trilinear lookup smears each latewood-to-earlywood
+    step over a cell (the blur seen on bevels); the detail term puts it back at the field's exact
+    ring boundary. The truth is the colour function evaluated at the points themselves."""
+    from woodcam.appearance.volumes import guide_slopes
+
+    field = RadialScalingField(LogFrame((-200.0, 10.0, 10.0), (0, 0, 1)), ring_width_mm=2.5)
+    grid = VolumeGrid((24.0, 20.0, 20.0), 30)                       # 0.8 mm cells
+
+    def colour_of_arf(a):
+        return C0 + (C1 - C0) * np.asarray(a)[..., None]
+
+    vol, guide = _ring_volume(grid, field, colour_of_arf)
+    plain = ColorVolumes(grid, vol[None], {})
+    sharp = ColorVolumes(grid, vol[None], {}, guide[None], guide_slopes(vol, guide)[None])
+    p = rng.uniform(2, 18, (4000, 3))
+    a = arf(field(p))
+    truth = colour_of_arf(a)
+    err_plain = np.abs(plain.sample(p, 0) - truth).mean()
+    err_sharp = np.abs(sharp.sample(p, 0, a) - truth).mean()
+    assert err_sharp < 0.35 * err_plain, (err_sharp, err_plain)
+    assert err_sharp < 0.02
+    # Without the point's guide the lookup is the plain trilinear one.
+    np.testing.assert_array_equal(sharp.sample(p, 0), plain.sample(p, 0))
+
+
+def test_detail_round_trips_through_the_cache_file(tmp_path, rng):
+    grid = VolumeGrid((10.0, 8.0, 6.0), 10)
+    vols = rng.integers(0, 256, (3,) + grid.shape + (3,), dtype=np.uint8)
+    guides = rng.uniform(0, 1, (3,) + grid.shape)
+    slopes = rng.normal(0, 0.2, (3,) + grid.shape + (3,))
+    cv = ColorVolumes(grid, vols, {"a": 1}, guides, slopes)
+    back = ColorVolumes.load(cv.save(tmp_path / "v.npz"))
+    assert back.has_detail
+    np.testing.assert_allclose(back.guides, guides, atol=1e-3)
+    np.testing.assert_allclose(back.slopes, slopes, atol=1e-3)
+    with pytest.raises(WoodcamError, match="guides and slopes must be given together"):
+        ColorVolumes(grid, vols, {}, guides, None)
+    with pytest.raises(WoodcamError, match="guides must have shape"):
+        ColorVolumes(grid, vols, {}, guides[:1], slopes)
+
+
+def test_mirror_augmentation_keeps_patch_and_photo_aligned(rng):
+    import torch
+
+    from woodcam.appearance.translation import _mirror
+
+    x = torch.from_numpy(rng.normal(size=(64, 2, 6, 6)).astype(np.float32))
+    y = x[:, :1] * 2 + 1                       # the "photo" is a pixelwise function of the input
+    xm, ym = _mirror(torch, np.random.default_rng(0), x, y)
+    np.testing.assert_array_equal(ym.numpy(), (xm[:, :1] * 2 + 1).numpy())
+    flipped = [not torch.equal(xm[i], x[i]) for i in range(len(x))]
+    assert 30 < sum(flipped) < 64              # 3/4 of patches mirrored in some way
+    # Each patch is one of its four mirror images.
+    for i in range(8):
+        cands = [x[i], x[i].flip(2), x[i].flip(1), x[i].flip(1).flip(2)]
+        assert any(torch.equal(xm[i], c) for c in cands)
+
+
+def test_augmented_spec_trains_and_changes_the_network(block):
+    pair = face_pair(block, "top", GRID, SPEC, field=FIELD)
+    spec = translation_spec("draft", epochs=1, seed=11)
+    a = train_translation([pair], spec, progress=False)(pair[0])
+    b = train_translation([pair], replace(spec, augment=True), progress=False)(pair[0])
+    assert np.isfinite(b).all() and not np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("source", ["arf", "ring_map"])
+def test_point_guide_matches_the_slices_the_volume_was_made_from(source):
+    """At cell centres the guide of a lookup equals the networks' ring input on the slices
+    (ARF, or the ring-map-like image with the in-plane gradient), for each axis."""
+    from woodcam.appearance.volumes import PLANE_AXES, point_guide
+
+    grid = VolumeGrid((20.0, 16.0, 12.0), 40)
+    years = years_volume(FIELD, grid)
+    pts = grid.points()
+    for axis in range(3):
+        cell = float(grid.cell_mm[list(PLANE_AXES[axis])].mean())
+        imgs = grid.to_images(years, axis)
+        ring = arf(imgs) if source == "arf" else ring_map_like(imgs, cell)
+        want = grid.from_images(ring, axis)[2:-2, 2:-2, 2:-2].ravel()
+        got = point_guide(FIELD, pts[2:-2, 2:-2, 2:-2].reshape(-1, 3), axis, source, cell)
+        # np.gradient's central differences over a cell against a tenth of a cell: close, not equal.
+        tol = 1e-6 if source == "arf" else 0.05
+        assert np.abs(got - want).mean() < tol / 5 and np.quantile(np.abs(got - want), 0.99) < 4 * tol
+
+
+def test_fitted_volumes_carry_detail_that_brings_them_closer_to_the_truth(fitted):
+    """The learnt volumes store guides and slopes; looking up with the field (as a Wood does)
+    is closer to the known colour inside the block than the plain trilinear lookup."""
+    app, _ = fitted
+    assert app.volumes.has_detail and app.meta["settings"]["detail"] is True
+    rng = np.random.default_rng(1)
+    p = rng.uniform(2.0, 30.0, (6000, 3))
+    truth = KnownWood(FIELD).color(p)
+    n = np.zeros_like(p)
+    n[:, 2] = 1.0
+    plain = np.abs(app.color(None, p, n) - truth).mean()
+    detailed = np.abs(app.color(FIELD, p, n) - truth).mean()
+    assert detailed < 0.9 * plain, (detailed, plain)
+

@@ -16,6 +16,7 @@ both sRGB and the model only interpolates between observed colours).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Literal
 
 import numba
 import numpy as np
@@ -27,6 +28,13 @@ from .noise import TABLE, noise_at
 
 #: Number of ARF bins of a fitted colour ramp.
 LUT_BINS = 32
+
+#: Window (Gaussian sigma, pixels of a 256-pixel face side) over which the offset between a
+#: fitted field's rings and a face's ring map is averaged: about one ring spacing on the Mokume
+#: cubes (rings 15-30 px apart), so each ring is registered mostly by itself and its neighbours.
+RING_REGISTRATION_BLUR_PX_PER_SIDE = 12.0
+
+RampAnchor = Literal["auto", "field", "ring_map"]
 
 
 @dataclass(frozen=True)
@@ -173,46 +181,110 @@ class ColorMapAppearance:
     # -- fitting to photos ------------------------------------------------------------------------
 
     @classmethod
-    def fit_to_block(cls, block, field, species="oak", **kwargs) -> "ColorMapAppearance":
+    def fit_to_block(cls, block, field, species="oak", *, anchor: RampAnchor = "auto",
+                     **kwargs) -> "ColorMapAppearance":
         """Fit per-axis colour ramps (colour as a function of ARF) to a block's face photos.
 
-        For every face with a photo, the ARF of ``field`` at each pixel centre is binned into
-        :data:`LUT_BINS` bins and the mean photo colour per bin is taken; both faces of an axis
-        are pooled. Bins no pixel falls in are filled by linear interpolation along the ARF.
-        Axes without photos keep the species ramp. Raises if no face has a photo.
+        ``anchor="field"``: for every face with a photo, the ARF of ``field`` at each pixel
+        centre is binned into :data:`LUT_BINS` bins and the mean photo colour per bin is taken;
+        both faces of an axis are pooled. Bins no pixel falls in are filled by linear
+        interpolation along the ARF. Right when ``field`` puts its rings exactly on the photos'
+        rings (a block's true field).
+
+        ``anchor="ring_map"``: the same, after moving the field's ring phase on each face onto
+        the face's own ring map (:func:`_registered_years`). A field fitted to ring maps puts
+        its rings within a fraction of a ring of the photos' (0.1-0.2 of a ring on the Mokume
+        cubes), enough to smear a latewood band over every ARF bin: the field-anchored ramp of
+        a real block came out nearly flat (bakes without rings).
+
+        ``"auto"`` (default): ``"field"`` when ``field`` is the block's true field or an axis's
+        photo faces lack ring maps, else ``"ring_map"`` (per axis), as the neural appearance
+        chooses its source. Axes without photos keep the species ramp. Raises if no face has
+        a photo.
         """
-        sums = np.zeros((3, LUT_BINS, 3))
-        counts = np.zeros((3, LUT_BINS))
-        for face in block.faces.values():
-            if face.photo is None:
-                continue
-            pts = face_pixel_points(face.name, face.shape, block.size_mm).reshape(-1, 3)
-            a = arf(field(pts))
-            b = np.minimum((a * LUT_BINS).astype(int), LUT_BINS - 1)
-            k = FACE_AXIS[face.name]
-            rgb = face.photo.reshape(-1, 3).astype(float) / 255.0
-            np.add.at(counts[k], b, 1)
-            for c in range(3):
-                sums[k, :, c] += np.bincount(b, rgb[:, c], minlength=LUT_BINS)
-        if not counts.any():
+        if anchor not in ("auto", "field", "ring_map"):
+            raise WoodcamError(f"anchor must be one of auto, field, ring_map; got {anchor!r}")
+        species = get_species(species)
+        photo_faces = [f for f in block.faces.values() if f.photo is not None]
+        if not photo_faces:
             raise WoodcamError(
                 f"block {block.name!r} has no face photos to fit a colour map to; "
                 "use a species preset instead (ColorMapAppearance(species=...))"
             )
         luts = np.full((3, LUT_BINS, 3), np.nan)
         centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
+        true_field = field is getattr(block, "true_field", None)
         for k in range(3):
-            ok = counts[k] > 0
-            if not ok.any():
+            faces = [f for f in photo_faces if FACE_AXIS[f.name] == k]
+            if not faces:
                 continue
-            mean = sums[k][ok] / counts[k][ok, None]
-            for c in range(3):
-                luts[k, :, c] = np.interp(centres, centres[ok], mean[:, c])
+            maps = all(f.ring_map is not None for f in faces)
+            use_maps = anchor == "ring_map" or (anchor == "auto" and maps and not true_field)
+            if use_maps and not maps:
+                raise WoodcamError(
+                    f"anchor='ring_map' needs a ring map on every photographed face; faces "
+                    f"{[f.name for f in faces if f.ring_map is None]} of block {block.name!r} have none; "
+                    "use anchor='field'"
+                )
+            luts[k] = _field_lut(faces, field, block.size_mm, centres, register=use_maps)
         return cls(species=species, axis_luts=luts, **kwargs)
 
     def with_params(self, **changes) -> "ColorMapAppearance":
         """Copy with some parameters changed."""
         return replace(self, **changes)
+
+
+def _field_lut(faces, field, size_mm, centres, register: bool = False) -> np.ndarray:
+    """Mean photo colour per ARF bin of ``field`` over ``faces`` ``(LUT_BINS, 3)``; with
+    ``register``, the field's ring phase is first moved onto each face's ring map
+    (:func:`_registered_years`)."""
+    sums = np.zeros((LUT_BINS, 3))
+    counts = np.zeros(LUT_BINS)
+    for face in faces:
+        pts = face_pixel_points(face.name, face.shape, size_mm).reshape(-1, 3)
+        g = np.asarray(field(pts), float)
+        if register:
+            g = _registered_years(face, g.reshape(face.shape)).ravel()
+        b = np.minimum((arf(g) * LUT_BINS).astype(int), LUT_BINS - 1)
+        rgb = face.photo.reshape(-1, 3).astype(float) / 255.0
+        counts += np.bincount(b, minlength=LUT_BINS)
+        for c in range(3):
+            sums[:, c] += np.bincount(b, rgb[:, c], minlength=LUT_BINS)
+    ok = counts > 0
+    mean = sums[ok] / counts[ok, None]
+    return np.stack([np.interp(centres, centres[ok], mean[:, c]) for c in range(3)], axis=1)
+
+
+def _registered_years(face, years: np.ndarray) -> np.ndarray:
+    """``years (h, w)`` of a field on ``face``'s pixels, its ring phase moved onto the face's
+    ring map (:func:`register_ring_phase` at the face's image scale)."""
+    sigma = RING_REGISTRATION_BLUR_PX_PER_SIDE * max(face.shape) / 256.0
+    return register_ring_phase(years, face.ring_map, sigma)
+
+
+def register_ring_phase(years: np.ndarray, ring_map: np.ndarray, sigma_px: float) -> np.ndarray:
+    """Growth-time image ``years (h, w)`` with its ring phase moved onto ``ring_map (h, w)``.
+
+    On the ring map's lines (value > 0.5) the field should be at a whole year; the offset
+    ``round(g) - g`` there is averaged around each pixel (circular mean, Gaussian window of
+    ``sigma_px`` pixels) and added to ``g``. The field keeps the ring order and which side of a
+    boundary is latewood (growth runs outward); the ring map says exactly where the boundary
+    is. Far from any line the shift fades out. Returns ``years`` unchanged when the map has
+    (almost) no lines.
+    """
+    from scipy import ndimage
+
+    years = np.asarray(years, float)
+    on = np.asarray(ring_map, float) > 0.5
+    if on.sum() < 16:
+        return years
+    delta = np.where(on, np.round(years) - years, 0.0)
+    z = np.where(on, np.exp(2j * np.pi * delta), 0.0)
+    re = ndimage.gaussian_filter(z.real, sigma_px, mode="reflect")
+    im = ndimage.gaussian_filter(z.imag, sigma_px, mode="reflect")
+    weight = ndimage.gaussian_filter(on.astype(float), sigma_px, mode="reflect")
+    shift = np.angle(re + 1j * im) / (2 * np.pi)
+    return years + shift * np.clip(weight / (weight.max() + 1e-12) * 4.0, 0.0, 1.0)
 
 
 def _field_sample(field, points_mm):

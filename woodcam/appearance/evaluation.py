@@ -165,7 +165,8 @@ def end_grain_faces(field, size_mm, threshold: float = 0.7) -> dict:
 def leave_one_face_out(block, field=None, *, resolution: int = 128, quality: Quality = "normal",
                        epochs: int | None = None, seed: int = 0, faces=None, end_grain=None,
                        species: str = "oak", progress: bool = True, threads: int | None = 1,
-                       finetune_epochs: int | None = None) -> list[FaceEval]:
+                       finetune_epochs: int | None = None, augment: bool | None = None,
+                       source: str | None = None) -> list[FaceEval]:
     """Leave-one-face-out evaluation of the models in :data:`MODELS` (module docstring).
 
     Parameters
@@ -176,13 +177,18 @@ def leave_one_face_out(block, field=None, *, resolution: int = 128, quality: Qua
     faces : faces to hold out (default all with a photo).
     end_grain : dict face -> bool, optional; default from the field's grain direction, else unknown.
     finetune_epochs : overrides the spec's (0: per-axis networks from scratch, the seed's way).
+    augment : overrides the spec's (mirrored training patches).
+    source : the networks' ring input, "arf" or "ring_map" (see
+        :func:`~.neural.fit_neural_appearance`); default "arf" with a field, "ring_map" without.
+        A real block evaluated with its fitted field and "ring_map" learns as ``woodcam bake``
+        does (``source="auto"``) and scores the photo-fitted colour map of that field.
 
     Returns
     -------
     list of FaceEval
     """
-    source = "arf" if field is not None else "ring_map"
-    usable = [f for f in photo_faces(block) if source == "arf" or block.faces[f].ring_map is not None]
+    source = source or ("arf" if field is not None else "ring_map")
+    usable = [f for f in photo_faces(block) if source != "ring_map" or block.faces[f].ring_map is not None]
     if len(usable) < 2:
         raise WoodcamError(
             f"block {block.name!r} needs photos (and, without a field, ring maps) on at least two faces "
@@ -190,6 +196,8 @@ def leave_one_face_out(block, field=None, *, resolution: int = 128, quality: Qua
         )
     grid = VolumeGrid(block.size_mm, resolution)
     extra = {} if finetune_epochs is None else {"finetune_epochs": int(finetune_epochs)}
+    if augment is not None:
+        extra["augment"] = bool(augment)
     spec = translation_spec(quality, epochs, seed, **extra)
     pairs = {f: face_pair(block, f, grid, spec, field=field, source=source) for f in usable}
     if end_grain is None:

@@ -58,6 +58,11 @@ class TranslationSpec:
         Add the solid-noise input channel.
     noise_mm : float
         Lattice cell of the solid noise (mm).
+    augment : bool
+        Train on randomly mirrored patches too (left-right and up-down, each with probability
+        1/2, input and photo together): mirrored wood is still plausible wood on side and end
+        grain alike, and a network that learns one or two photos then memorises less of their
+        layout.
     finetune_epochs : int
         Per-axis networks start from a network trained on all faces and are fine-tuned for
         this many epochs on their axis's faces (more data than one axis's one or two photos,
@@ -75,6 +80,7 @@ class TranslationSpec:
     texture_weight: float = 1.0
     noise: bool = True
     noise_mm: float = 0.6
+    augment: bool = False
     finetune_epochs: int = 2
     seed: int = 0
 
@@ -231,6 +237,20 @@ def _crop_pool(pairs, spec: TranslationSpec, rng: np.random.Generator):
             np.concatenate(ms).astype(np.float32))
 
 
+def _mirror(torch, rng: np.random.Generator, *batch):
+    """The same random left-right / up-down mirroring of each patch of every tensor
+    ``(b, c, p, p)`` in ``batch`` (a patch and its photo stay aligned)."""
+    b = batch[0].shape[0]
+    flips = rng.random((2, b)) < 0.5
+    out = []
+    for t in batch:
+        for dim, f in ((3, flips[0]), (2, flips[1])):
+            sel = torch.from_numpy(f).view(b, 1, 1, 1)
+            t = torch.where(sel, t.flip(dim), t)
+        out.append(t)
+    return out
+
+
 def train_translation(pairs, spec: TranslationSpec | None = None, *, progress: bool = True,
                       desc: str = "translation", threads: int | None = 1,
                       init: TranslationNet | None = None) -> TranslationNet:
@@ -288,6 +308,8 @@ def train_translation(pairs, spec: TranslationSpec | None = None, *, progress: b
     for s in bar:
         idx = order[s * spec.batch:(s + 1) * spec.batch]
         x, y, m = X[idx], Y[idx], M[idx]
+        if spec.augment:
+            x, y, m = _mirror(torch, rng, x, y, m)
         out = net(x)
         l1 = ((out - y).abs() * m).sum() / (3 * m.sum()).clamp(min=1)
         loss = l1
