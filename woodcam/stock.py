@@ -110,42 +110,35 @@ def _synthetic_stock(spec, field, size_mm, species, description, appearance, par
     return Stock(spec, tuple(size_mm), Wood(field, app), description, meta)
 
 
-def fitted_field(block, folder: Path, method: str = "radial"):
-    """The growth field fitted to a block's rings, fitted once and cached in the block folder.
+def fitted_field(block, folder: Path | None, method: str = "radial"):
+    """The growth field fitted to a block's rings, fitted once and cached.
 
-    The cache file ``<folder>/.woodcam-cache/field_<method>_v<FIT_VERSION>.npz`` is reused while
-    it is newer than the block's manifest; delete it (or rewrite the block) to fit again.
+    folder : the block folder: the cache ``<folder>/.woodcam-cache/field_<method>_v<N>.npz`` is
+        reused while it is newer than the block's manifest (delete it, or rewrite the block, to
+        fit again). None (a Mokume sample folder, which is never written to): cached under
+        ``$WOODCAM_CACHE_DIR`` / ``~/.cache/woodcam`` keyed by the block's images and size.
+    ``N`` is :data:`woodcam.inference.fit.FIT_VERSION`, so a changed fitter refits.
     """
-    from .fields.grid import GridField
-    from .inference import fit_block
-    from .inference.fit import FIT_VERSION
-
-    cache = folder / ".woodcam-cache" / f"field_{method}_v{FIT_VERSION}.npz"
-    manifest = folder / "block.json"
-    if cache.is_file() and cache.stat().st_mtime >= manifest.stat().st_mtime:
-        return GridField.load(cache)
-    if not any(f.has_rings for f in block.faces.values()):
-        raise WoodcamError(
-            f"block folder {folder} has neither a true field nor traced rings or ring maps to "
-            "fit one to; trace rings on at least one face (or use 'woodcam block synth')"
-        )
-    field = fit_block(block, method=method)
-    cache.parent.mkdir(exist_ok=True)
-    field.save(cache)
-    return field
-
-
-def _mokume_fitted_field(block, method: str = "radial"):
-    """The field fitted to a Mokume block, cached by the block's images and size (not in its
-    folder: see the module docstring)."""
     from .appearance.neural import default_cache_dir
     from .appearance.volumes import block_fingerprint
     from .fields.grid import GridField
     from .inference import fit_block
+    from .inference.fit import FIT_VERSION
 
-    cache = default_cache_dir().parent / "fields" / f"{block.name}-{block_fingerprint(block)[:16]}-{method}.npz"
-    if cache.is_file():
+    if folder is None:
+        cache = (default_cache_dir().parent / "fields"
+                 / f"{block.name}-{block_fingerprint(block)[:16]}-{method}_v{FIT_VERSION}.npz")
+        fresh = cache.is_file()
+    else:
+        cache = folder / ".woodcam-cache" / f"field_{method}_v{FIT_VERSION}.npz"
+        fresh = cache.is_file() and cache.stat().st_mtime >= (folder / "block.json").stat().st_mtime
+    if fresh:
         return GridField.load(cache)
+    if not any(f.has_rings for f in block.faces.values()):
+        raise WoodcamError(
+            f"block {folder or block.name} has neither a true field nor traced rings or ring maps "
+            "to fit one to; trace rings on at least one face (or use 'woodcam block synth')"
+        )
     field = fit_block(block, method=method)
     cache.parent.mkdir(parents=True, exist_ok=True)
     field.save(cache)
@@ -156,7 +149,7 @@ def _open_mokume_folder(path: Path, species, appearance, appearance_params) -> S
     from .block.io import read_mokume
 
     block = read_mokume(path)
-    return _real_block_stock(str(path), block, _mokume_fitted_field(block), species, appearance,
+    return _real_block_stock(str(path), block, fitted_field(block, None), species, appearance,
                              appearance_params, cache_dir=None)
 
 
