@@ -16,7 +16,8 @@ _COMMAND_MODULES: tuple[str, ...] = ("woodcam._cli_block", "woodcam._cli_log", "
                                      "woodcam.toolpath.cli")
 
 _EPILOG = """\
-Block specs: 'builtin:NAME' (see 'woodcam blocks') or a block folder with a block.json.
+Block specs: 'builtin:NAME' (see 'woodcam blocks'), 'log:gran1@K[:WxDxH]', a block folder with a
+block.json, or a Mokume sample folder (six photos and ring maps of a 50 mm cube).
 Units are millimetres; the block frame has its origin at the bottom-front-left corner,
 X to the right (width), Y away from the viewer (depth), Z up (height).
 
@@ -80,7 +81,8 @@ def build_parser() -> argparse.ArgumentParser:
                        description="PART is a build123d/cadquery script defining `part`, or a "
                        "STEP/STL/OBJ/GLB file, modelled in the block frame (mm).")
     p.add_argument("part", help="part file (.py script, .step, .stl, .obj, .glb)")
-    p.add_argument("--block", required=True, help="block spec: builtin:NAME or a block folder")
+    p.add_argument("--block", required=True, help="block spec: builtin:NAME, log:gran1@K, a block folder, or a Mokume "
+                   "sample folder (a 50 mm cube)")
     p.add_argument("--out", type=Path, required=True, help="output .glb path")
     p.add_argument("--tolerance", type=float, default=None, metavar="MM",
                    help="tessellation chord tolerance for B-rep parts (default 0.05 mm)")

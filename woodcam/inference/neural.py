@@ -92,6 +92,10 @@ _ADAM_POINTS = 1000
 #: Adam learning rates (code: latent units; pose: normalised units and radians; scale: log K),
 #: decayed by a cosine to 5 %.
 _LR_CODE, _LR_POSE, _LR_SCALE = 3e-2, 1e-2, 1e-2
+#: Grid placements refined by a trial Adam run of steps // _TRIAL_SHARE steps; the best trial
+#: gets the full run (see _fit_labelled).
+_STARTS = 4
+_TRIAL_SHARE = 4
 
 Labels = Literal["auto", "years", "none"]
 Start = Literal["grid", "radial"]
@@ -183,7 +187,8 @@ def _rotation_to(axis: np.ndarray) -> np.ndarray:
 
 
 def _directions() -> np.ndarray:
-    """13 pith directions: block axes, face diagonals, body diagonals (sign is irrelevant)."""
+    """13 pith directions: block axes, face diagonals, body diagonals (sign is irrelevant).
+    (48 more spread over the hemisphere doubled the fit time and changed no benchmark block.)"""
     d = [(1, 0, 0), (0, 1, 0), (0, 0, 1),
          (1, 1, 0), (1, -1, 0), (1, 0, 1), (1, 0, -1), (0, 1, 1), (0, 1, -1),
          (1, 1, 1), (1, 1, -1), (1, -1, 1), (-1, 1, 1)]
@@ -415,8 +420,8 @@ def _fit_labelled(torch, net, spec, pts, yrs, size, steps, rng, progress, name, 
     sub = rng.choice(len(pts), min(_GRID_POINTS, len(pts)), replace=False)
     ps, gs = pts[sub], yrs[sub]
     dirs = _directions() if pith is None else np.asarray(pith[1], float)[None]
-    cands = []  # (rotation, origin, length)
-    for d in dirs:
+    cands, dir_of = [], []  # (rotation, origin, length), direction index
+    for di, d in enumerate(dirs):
         rot = _rotation_to(d)
         cc = (corners - center) @ rot.T
         radius = np.max(np.hypot(cc[:, 0], cc[:, 1]))
@@ -431,6 +436,7 @@ def _fit_labelled(torch, net, spec, pts, yrs, size, steps, rng, progress, name, 
             rho_max = np.max(np.hypot(cc[:, 0] - off[0], cc[:, 1] - off[1]))
             length = max(rho_max, half_len) / _DOMAIN_FILL
             cands.append((rot, center + rot.T @ off, length))
+            dir_of.append(di)
     rots = np.stack([c[0] for c in cands])
     origins = np.stack([c[1] for c in cands])
     lengths = np.array([c[2] for c in cands])
@@ -439,26 +445,50 @@ def _fit_labelled(torch, net, spec, pts, yrs, size, steps, rng, progress, name, 
     with torch.no_grad():
         f = net(zero, torch.from_numpy(q.astype(np.float32))).double().numpy()
     k, a, score = _solve_scale_offset(f, gs)
-    best = int(np.argmin(score))
-    if not np.isfinite(score[best]):
+    if not np.isfinite(score).any():
         raise WoodcamError(f"block {name!r}: no pith placement makes the "
                            f"labelled years grow away from a pith; check the trace year labels")
-    rot0, origin0, length0 = rots[best], origins[best], float(lengths[best])
-    a_fix = float(a[best])
-    # re-solve K and a on all points for the chosen placement
-    q_all = ((pts - origin0) @ rot0.T / length0).astype(np.float32)
-    with torch.no_grad():
-        f_all = net(zero, torch.from_numpy(q_all)).double().numpy()
-    k_all, a_all, s_all = _solve_scale_offset(f_all[None], yrs)
-    if np.isfinite(s_all[0]):
-        k0, a_fix, grid_loss = float(k_all[0]), float(a_all[0]), float(s_all[0])
-    else:
-        k0, grid_loss = float(k[best]), float(score[best])
+    sub = rng.choice(len(pts), min(_ADAM_POINTS, len(pts)), replace=False)
+    # the best placement of each pith direction, best first: distinct starts
+    order = np.argsort(score)
+    _, first = np.unique(np.asarray(dir_of)[order], return_index=True)
+    tops = order[np.sort(first)][:_STARTS]
+    starts = []
+    for best in tops:
+        if not np.isfinite(score[best]):
+            break
+        rot0, origin0, length0 = rots[best], origins[best], float(lengths[best])
+        # re-solve K and a on all points for this placement
+        q_all = ((pts - origin0) @ rot0.T / length0).astype(np.float32)
+        with torch.no_grad():
+            f_all = net(zero, torch.from_numpy(q_all)).double().numpy()
+        k_all, a_all, s_all = _solve_scale_offset(f_all[None], yrs)
+        if np.isfinite(s_all[0]):
+            start = (rot0, origin0, length0, float(k_all[0]), float(a_all[0]), float(s_all[0]))
+        else:
+            start = (rot0, origin0, length0, float(k[best]), float(a[best]), float(score[best]))
+        starts.append(start)
 
     # --- step 2: Adam over c, t, w, log K with a fixed ----------------------------------------
-    sub = rng.choice(len(pts), min(_ADAM_POINTS, len(pts)), replace=False)
-    p_t = torch.from_numpy(((pts[sub] - origin0) @ rot0.T / length0))  # float64, trunk frame
-    g_t = torch.from_numpy(yrs[sub] - a_fix)
+    # Multi-start: the grid ranks placements by their c = 0 misfit, which a wrong placement can
+    # win (eq. 7-9 benchmark blocks 101 and 103: 7 % and 62 % within 1 mm from the top
+    # placement). A short Adam run from the best placement of each of the _STARTS best pith
+    # directions, then the full run from the one whose misfit fell lowest.
+    if len(starts) > 1 and steps:
+        trial = max(steps // _TRIAL_SHARE, 1)
+        losses = [_adam_from(torch, net, spec, pts[sub], yrs[sub], st, trial, False)[1] for st in starts]
+        starts = [starts[int(np.argmin(losses))]]
+    field, _ = _adam_from(torch, net, spec, pts[sub], yrs[sub], starts[0], steps, progress)
+    return field, starts[0][5]
+
+
+def _adam_from(torch, net, spec, pts, yrs, start, steps, progress):
+    """Adam over ``c, t, w, log K`` (``a`` fixed) from a grid placement ``start`` = (rotation,
+    origin, length, K, a, grid loss) on points ``pts`` (n, 3) block mm with years ``yrs`` (n,).
+    Returns ``(NeuralBlockField, final L1 misfit in years)``."""
+    rot0, origin0, length0, k0, a_fix, _ = start
+    p_t = torch.from_numpy(((pts - origin0) @ rot0.T / length0))  # float64, trunk frame
+    g_t = torch.from_numpy(yrs - a_fix)
     code = torch.zeros(spec.latent_dim, dtype=torch.float64, requires_grad=True)
     shift = torch.zeros(3, dtype=torch.float64, requires_grad=True)
     w = torch.zeros(3, dtype=torch.float64, requires_grad=True)
@@ -473,12 +503,14 @@ def _fit_labelled(torch, net, spec, pts, yrs, size, steps, rng, progress, name, 
 
     _adam(torch, opt, w, loss_fn, steps, progress, "fit neural")
     with torch.no_grad():
-        rmat = _rodrigues(torch, w).numpy()
+        rmat = _rodrigues(torch, w)
+        l1 = float((torch.exp(log_k) * net(code.float(), (p_t @ rmat.T + shift).float()).double()
+                    - g_t).abs().mean())
     field = NeuralBlockField(net=net, code=code.detach().numpy().astype(np.float32),
-                             rotation=rmat @ rot0, origin_mm=origin0, length_mm=length0,
+                             rotation=rmat.numpy() @ rot0, origin_mm=origin0, length_mm=length0,
                              shift=shift.detach().numpy().copy(), scale=float(np.exp(log_k.item())),
                              age_offset=a_fix)
-    return field, grid_loss
+    return field, l1
 
 
 def _adam(torch, opt, w, loss_fn, steps, progress, desc):
