@@ -14,7 +14,7 @@ ring boundaries). Two shares, in pixels of the face image, both higher-is-better
 needs year numbers (ring maps have none). Pixels on or near a knot mask are left out of
 both, as they are left out of the fit (:data:`~woodcam.tolerances.KNOT_MASK_MARGIN_MM`). The same
 scores for a fit on all six faces (the face is then part of the fit) bound what the ring maps'
-own noise allows.
+own noise allows, and the held-out predictions moved by half a ring give the chance level.
 """
 
 from __future__ import annotations
@@ -31,8 +31,10 @@ from ..frames import pixel_to_block
 from ..tolerances import HOLDOUT_LINE_STEP_PX, HOLDOUT_THRESHOLDS_PX, RING_MAP_THRESHOLD
 from .observations import _resample_polyline, knot_exclusion
 
-#: Label of the in-sample fit (all faces) in results.
+#: Labels in results: the in-sample fit (all faces), and the chance control: every held-out
+#: prediction moved by half a ring (right spacing and direction, rings where none are).
 ALL_FACES = "all faces"
+CONTROL = "held out, moved half a ring (chance)"
 
 
 def ridge_pixels(ring_map: np.ndarray, threshold: float = RING_MAP_THRESHOLD,
@@ -156,7 +158,8 @@ def leave_one_face_out(block, methods=("rbf", "radial"), out_dir=None, progress=
 
     Returns
     -------
-    dict with ``"held_out"`` and ``"all faces"``: each ``method -> list of FaceScore``;
+    dict with ``"held_out"``, :data:`CONTROL` and ``"all faces"``: each ``method -> list of
+    FaceScore``;
     ``"fit_s"``: method -> mean held-out fit seconds; ``"table"``: markdown text.
     """
     faces = [n for n, f in block.faces.items() if f.ring_map is not None]
@@ -164,6 +167,7 @@ def leave_one_face_out(block, methods=("rbf", "radial"), out_dir=None, progress=
         raise WoodcamError(f"block {block.name!r} has ring maps on {faces}; leave-one-face-out needs "
                            f"at least two faces with ring maps")
     held = {m: [] for m in methods}
+    control = {m: [] for m in methods}
     insample = {m: [] for m in methods}
     times = {m: [] for m in methods}
     for m in methods:
@@ -173,12 +177,13 @@ def leave_one_face_out(block, methods=("rbf", "radial"), out_dir=None, progress=
             fit = fit_for_holdout(block, m, [f for f in block.faces if f != face])
             times[m].append(time.perf_counter() - t0)
             held[m].append(score_face(fit, block, face))
+            control[m].append(score_face(lambda p, f=fit: f(p) + 0.5, block, face))
             insample[m].append(score_face(full, block, face))
             if progress:
                 s = held[m][-1].shares
                 progress(f"{block.name} {m} hold out {face}: ridge {s['ridge_1']:.0f}/{s['ridge_2']:.0f}%, "
                          f"line {s['line_1']:.0f}/{s['line_2']:.0f}% ({times[m][-1]:.1f} s)")
-    res = {"held_out": held, ALL_FACES: insample, "fit_s": {m: float(np.mean(t)) for m, t in times.items()}}
+    res = {"held_out": held, CONTROL: control, ALL_FACES: insample, "fit_s": {m: float(np.mean(t)) for m, t in times.items()}}
     res["table"] = holdout_table(block.name, res, list(methods))
     if out_dir is not None:
         out = Path(out_dir)
@@ -206,7 +211,8 @@ def holdout_table(name: str, res: dict, methods: list[str], thresholds=HOLDOUT_T
     held = res["held_out"]
     for i, sc in enumerate(held[methods[0]]):
         lines.append(row(sc.face, {m: held[m][i].shares for m in methods}))
-    for label, part in (("**mean, held out**", held), (f"mean, {ALL_FACES} (in-sample)", res[ALL_FACES])):
+    for label, part in (("**mean, held out**", held), (f"mean, {CONTROL}", res[CONTROL]),
+                        (f"mean, {ALL_FACES} (in-sample)", res[ALL_FACES])):
         lines.append(row(label, {m: {k: float(np.mean([s.shares[k] for s in part[m]])) for k in keys}
                                  for m in methods}))
     lines.append("")
@@ -258,5 +264,5 @@ def plot_holdout(path, block, scores: list[FaceScore], title: str = ""):
     return path
 
 
-__all__ = ["ALL_FACES", "FaceScore", "face_years", "fit_for_holdout", "holdout_table",
+__all__ = ["ALL_FACES", "CONTROL", "FaceScore", "face_years", "fit_for_holdout", "holdout_table",
            "leave_one_face_out", "plot_holdout", "ridge_pixels", "ring_lines_px", "score_face"]
