@@ -60,7 +60,8 @@ def random_field(rng, size_mm=(50.0, 50.0, 50.0)) -> Eq79Field:
 def make_block(field, size_mm=(50.0, 50.0, 50.0), px_per_mm: float = 5.0, rng=None,
                labelled: bool = True, jitter_mm: float = 0.0, missing: float = 0.0,
                n_mislabelled: int = 0, ring_map: bool = False, traces: bool = True,
-               segment_mm: float = 10.0, faces=FACES, year_offset: int = 0) -> Block:
+               segment_mm: float = 10.0, faces=FACES, year_offset: int = 0,
+               knot_masks: bool = False) -> Block:
     """Trace the integer iso-lines of ``field`` on the block's faces.
 
     jitter_mm : std of i.i.d. Gaussian noise added to trace vertices.
@@ -68,6 +69,8 @@ def make_block(field, size_mm=(50.0, 50.0, 50.0), px_per_mm: float = 5.0, rng=No
     n_mislabelled : number of traces whose year label is moved by +-1.
     ring_map : also render a ring map (bright within ~0.15 mm of a ring boundary).
     year_offset : added to every label (a tentative age, as in seed 000 section 3.2.3).
+    knot_masks : for a knotted field (``knot_features``), mark each face's knots in
+        ``extras["knot_mask"]`` (knot weight > 0.5), as a tracer marks the knots on a photo.
     """
     import contourpy
 
@@ -103,7 +106,11 @@ def make_block(field, size_mm=(50.0, 50.0, 50.0), px_per_mm: float = 5.0, rng=No
             grad = np.hypot(gr, gc) * px_per_mm  # years per mm
             d = np.abs(g - np.round(g)) / np.maximum(grad, 1e-9)
             rm = np.exp(-0.5 * (d / 0.15) ** 2).astype(np.float32)
-        out[name] = Face(name, shape, traces=tr, ring_map=rm)
+        extras = {}
+        if knot_masks:
+            pts = face_pixel_points(name, shape, size_mm).reshape(-1, 3)
+            extras["knot_mask"] = (field.knot_features(pts)["knot"] > 0.5).reshape(shape)
+        out[name] = Face(name, shape, traces=tr, ring_map=rm, extras=extras)
     if n_mislabelled and labelled:
         all_tr = [(n, i) for n in out for i in range(len(out[n].traces))]
         for k in rng.choice(len(all_tr), min(n_mislabelled, len(all_tr)), replace=False):

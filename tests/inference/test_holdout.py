@@ -101,6 +101,14 @@ def test_knot_mask_removes_ring_map_pixels(field, mapped):
     near = lambda o: np.sum(np.linalg.norm(o.points_mm - centre, axis=1) < 5.0 + 3.0)  # 25 px half side + margin
     assert near(before) > 20 and near(after) == 0
     assert len(after.points_mm) < len(before.points_mm)
+    # traces too: a tracer's knot rings (or stem rings bent round it) inside the margin
+    traced = make_block(field, px_per_mm=5, faces=("front",))
+    t_face = traced.faces["front"]
+    t_masked = Face("front", t_face.shape, traces=t_face.traces, extras={"knot_mask": knot})
+    t_before = gather_observations(traced)
+    t_after = gather_observations(Block(mapped.size_mm, {"front": t_masked}))
+    assert near(t_before) > 20 and near(t_after) == 0
+    assert 0 < len(t_after.points_mm) < len(t_before.points_mm)
 
 
 def test_mokume_knot_point_grows_to_the_knot(shared_data):

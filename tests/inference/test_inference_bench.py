@@ -10,7 +10,9 @@ the surface, meeting at a corner). Three kinds of block, 8 each:
   block mislabelled by +-1 year;
 - knotted: cut from logs of the log generator (seed 001) through the knot field (seed 003),
   rings 2-5 mm, the block's front face through a knot; clean traces of every ring, knot rings
-  included (what a careful tracer draws).
+  included, and each face's knots marked (``extras["knot_mask"]``, as on Mokume's H11), which
+  the fits leave out with a 3 mm margin. The cut planes score every true ring line, knot rings
+  included.
 """
 
 import os
@@ -46,7 +48,7 @@ def knotted_block(i: int, size_mm=(50.0, 50.0, 50.0)):
                    if kn.r_end_mm > size_mm[1] + 15.0 and 150.0 < kn.z0_mm < 1050.0]
     k = int(rng.choice(long_enough))
     field = place_block_in_log(log_field, *block_at_knot(log, k, size_mm))
-    return make_block(field, size_mm, rng=rng)
+    return make_block(field, size_mm, rng=rng, knot_masks=True)
 
 
 def _blocks(kind: str):

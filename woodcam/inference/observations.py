@@ -65,6 +65,11 @@ def knot_exclusion(face, pixel_mm: float) -> np.ndarray | None:
     return outside * pixel_mm <= KNOT_MASK_MARGIN_MM
 
 
+def _pixel_index(coord: np.ndarray, n: int) -> np.ndarray:
+    """Nearest pixel index of continuous pixel coordinates, clipped to ``[0, n)``."""
+    return np.clip(np.round(coord).astype(int), 0, n - 1)
+
+
 def _ring_map_components(ring_map: np.ndarray, threshold: float, exclude=None):
     """Connected bright components of a ring map -> list of ``(k, 2)`` pixel (row, col) arrays;
     ``exclude``: optional (h, w) bool of pixels to leave out."""
@@ -95,8 +100,10 @@ def gather_observations(block, faces=None, step_mm: float = TRACE_SAMPLE_STEP_MM
         Use only these faces (partial annotation); default all faces the block has.
     step_mm : spacing (mm) at which traces are resampled, so long and densely traced rings do
         not outweigh the others and fits stay fast.
-    ring_map_threshold : ring-map pixels at or above this grey value are ring pixels; those on
-        or near a face's ``extras["knot_mask"]`` are ignored.
+    ring_map_threshold : ring-map pixels at or above this grey value are ring pixels.
+
+    Ring-map pixels and trace points on or near a face's ``extras["knot_mask"]``
+    (:func:`knot_exclusion`) are left out.
 
     Raises
     ------
@@ -122,12 +129,17 @@ def gather_observations(block, faces=None, step_mm: float = TRACE_SAMPLE_STEP_MM
                 f"{block.name!r} (size_mm {block.size_mm}): its pixels would be {dr:.3g}x{dc:.3g} mm, "
                 f"not square; check size_mm or crop the face image to the face"
             )
+        excl = knot_exclusion(f, min(dr, dc))
         if f.traces:
             polys = [(t.points_px, t.year) for t in f.traces]
             px_step = step_mm / max(min(dr, dc), 1e-12)
             polys = [(_resample_polyline(p, px_step), y) for p, y in polys]
+            if excl is not None:  # traced knot rings, or stem rings bent round the knot
+                polys = [(p[~excl[_pixel_index(p[:, 0], f.shape[0]), _pixel_index(p[:, 1], f.shape[1])]], y)
+                         for p, y in polys]
+                polys = [(p, y) for p, y in polys if len(p)]
         elif f.ring_map is not None:
-            comps = _ring_map_components(f.ring_map, ring_map_threshold, knot_exclusion(f, min(dr, dc)))
+            comps = _ring_map_components(f.ring_map, ring_map_threshold, excl)
             stride = max(1, int(round(step_mm / max(min(dr, dc), 1e-12))))
             # Ring-map components are pixel blobs a few pixels thick; keep every stride-th
             # pixel of each so their density matches resampled traces.
