@@ -314,7 +314,8 @@ def read_mokume(folder, size_mm=MOKUME_DEFAULT_SIZE_MM, *, name: str | None = No
         ring localisation, no year labels); ``extras["knot_mask"]`` from ``X_knot.png``
         ((rows, cols) bool, True where the mask is dark: below the mid-grey between the
         image's min and max; a mask of a few pixels marks the knot's centre and is grown to
-        the knot's dark region in the photo by :func:`knot_region`); ``extras["annotation"]`` from ``X_ann.png`` as stored (uint8).
+        the knot's dark region in the photo by :func:`knot_region`);
+        ``extras["annotation"]`` from ``X_ann.png`` as stored (uint8).
         ``meta`` records the source folder and that the size was assumed.
 
     Raises

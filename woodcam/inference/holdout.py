@@ -29,7 +29,7 @@ from ..errors import WoodcamError, require
 from ..fields.base import arf
 from ..frames import pixel_to_block
 from ..tolerances import HOLDOUT_LINE_STEP_PX, HOLDOUT_THRESHOLDS_PX, RING_MAP_THRESHOLD
-from .observations import _resample_polyline, knot_exclusion
+from .observations import _pixel_index, _resample_polyline, knot_exclusion
 
 #: Labels in results: the in-sample fit (all faces), and the chance control: every held-out
 #: prediction moved by half a ring (right spacing and direction, rings where none are).
@@ -80,9 +80,7 @@ def ring_lines_px(years_img: np.ndarray, step_px: float = HOLDOUT_LINE_STEP_PX,
         return np.zeros((0, 2))
     pts = np.concatenate(out)
     if exclude is not None:
-        r = np.clip(np.round(pts[:, 0]).astype(int), 0, y.shape[0] - 1)
-        c = np.clip(np.round(pts[:, 1]).astype(int), 0, y.shape[1] - 1)
-        pts = pts[~exclude[r, c]]
+        pts = pts[~exclude[_pixel_index(pts[:, 0], y.shape[0]), _pixel_index(pts[:, 1], y.shape[1])]]
     return pts
 
 

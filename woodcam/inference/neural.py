@@ -371,7 +371,7 @@ def _gap_points(points, group, face, field, block=None, max_points: int = 4 * _A
     from scipy.spatial import cKDTree
 
     from ..frames import FACES, block_to_pixel
-    from .observations import knot_exclusion
+    from .observations import _pixel_index, knot_exclusion
 
     out = []
     for f in np.unique(face):
@@ -389,9 +389,7 @@ def _gap_points(points, group, face, field, block=None, max_points: int = 4 * _A
         knot = None if fc is None else knot_exclusion(fc, min(block.face_pixel_size_mm(fc.name)))
         if knot is not None:
             r, c = block_to_pixel(fc.name, mid, fc.shape, block.size_mm)
-            r = np.clip(np.round(r).astype(int), 0, fc.shape[0] - 1)
-            c = np.clip(np.round(c).astype(int), 0, fc.shape[1] - 1)
-            mid = mid[~knot[r, c]]
+            mid = mid[~knot[_pixel_index(r, fc.shape[0]), _pixel_index(c, fc.shape[1])]]
         out.append(mid)
     if not out:
         return np.empty((0, 3))

@@ -540,12 +540,14 @@ def _fit_growth_history(obs: RingObservations, field: RadialField, seed: int) ->
     through one level per observed year (:func:`_warp`).
 
     Why: real trees grow a different ring width every year, the same all around the stem (a wet
-    year is wide everywhere), which a model linear in ``rho`` cannot follow: on the Mokume cube
-    CN03 its ring lines drift up to half a ring off the ring map. ``h`` carries those widths and
-    ``s`` keeps the shape. Alternating fit: each year's level is the median of the linear model
-    on that ring's points, shrunk towards the year itself by :data:`RING_HISTORY_PRIOR_POINTS`
-    (a ring seen on a few points stays near the mean width) and made increasing (scipy's
-    isotonic regression); then ``s`` is refitted to those levels.
+    year is wide everywhere), which a model linear in ``rho`` cannot follow. Measured: on an
+    eq. 7-9 field warped by such a history (tests), the 90th-percentile interior error falls from
+    0.32-0.54 to 0.05-0.10 year; on the Mokume cube CN03 (all faces), ring-map ridge pixels
+    within 1 px of a ring line rise from 16.6 to 20.8 %, though its held-out faces do not gain
+    (6.2 -> 4.8 %, near the 4.5 % chance level either way). Alternating fit: each year's level
+    is the median of the linear model on that ring's points, shrunk towards the year itself by
+    :data:`RING_HISTORY_PRIOR_POINTS` (a ring seen on a few points stays near the mean width) and
+    made increasing (scipy's isotonic regression); then ``s`` is refitted to those levels.
     """
     from scipy.optimize import isotonic_regression
 
@@ -554,16 +556,15 @@ def _fit_growth_history(obs: RingObservations, field: RadialField, seed: int) ->
         return field
     order = np.argsort(idx, kind="stable")
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    for _ in range(RING_HISTORY_ROUNDS):
-        lin = field.linear(obs.points_mm)[order]
+
+    def levels(f: RadialField) -> np.ndarray:
+        lin = f.linear(obs.points_mm)[order]
         med = np.array([np.median(lin[a:a + c]) for a, c in zip(starts, counts)])  # one per year
         lev = (counts * med + RING_HISTORY_PRIOR_POINTS * years) / (counts + RING_HISTORY_PRIOR_POINTS)
-        lev = isotonic_regression(lev, weights=counts).x
-        lev = lev + np.arange(len(lev)) * RING_HISTORY_MIN_STEP  # strictly increasing for interp
-        field = _smoothest_coefficients(obs, field, seed, targets=lev[idx])
-    lin = field.linear(obs.points_mm)[order]
-    med = np.array([np.median(lin[a:a + c]) for a, c in zip(starts, counts)])
-    lev = (counts * med + RING_HISTORY_PRIOR_POINTS * years) / (counts + RING_HISTORY_PRIOR_POINTS)
-    lev = isotonic_regression(lev, weights=counts).x + np.arange(len(years)) * RING_HISTORY_MIN_STEP
-    field.history_levels, field.history_years = lev, years.astype(float)
+        # strictly increasing for the interpolation
+        return isotonic_regression(lev, weights=counts).x + np.arange(len(years)) * RING_HISTORY_MIN_STEP
+
+    for _ in range(RING_HISTORY_ROUNDS):
+        field = _smoothest_coefficients(obs, field, seed, targets=levels(field)[idx])
+    field.history_levels, field.history_years = levels(field), years.astype(float)
     return field
