@@ -21,6 +21,9 @@ def _read_block(path, size_mm: float | None = None):
     from .block.io import read_block, read_mokume
 
     path = Path(path)
+    if not path.exists():
+        raise WoodcamError(f"block folder {str(path)!r} does not exist; pass a block folder or a "
+                           f"Mokume sample folder")
     if path.is_dir() and not (path / "block.json").exists() and any(path.glob("A_*.png")):
         return read_mokume(path) if size_mm is None else read_mokume(path, (size_mm,) * 3)
     return read_block(path)

@@ -56,6 +56,8 @@ def test_cli_errors(block_dir, tmp_path):
         _parse(["fit", str(folder), "--method", "magic", "--out", str(tmp_path / "x.npz")])
     with pytest.raises(WoodcamError, match="--truth needs one field file per block"):
         run(_parse(["eval", str(folder), str(folder), "--truth", str(truth), "--out", str(tmp_path)]))
+    with pytest.raises(WoodcamError, match="does not exist"):
+        run(_parse(["fit", str(tmp_path / "nowhere"), "--out", str(tmp_path / "x.npz")]))
     with pytest.raises(WoodcamError, match="--methods must be from"):
         run(_parse(["eval", str(folder), "--methods", "radial,magic", "--out", str(tmp_path)]))
 

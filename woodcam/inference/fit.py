@@ -7,7 +7,7 @@ from typing import Literal, get_args
 from ..errors import WoodcamError
 from .baked import bake
 from .observations import gather_observations
-from .radial import fit_radial
+from .radial import fit_radial, number_observations
 from .rbf import fit_rbf
 
 Method = Literal["rbf", "radial", "neural"]
@@ -24,7 +24,8 @@ def fit_block(block, method: Method = "radial", faces=None, baked: bool = True):
     Parameters
     ----------
     block : woodcam.block.Block
-    method : "rbf" (seed 000's baseline: thin-plate RBF of labelled ring points) or "radial"
+    method : "rbf" (seed 000's baseline: thin-plate RBF of labelled ring points; unlabelled rings
+        are numbered by the radial fit first) or "radial"
         (ours: pith axis + smooth inverse ring width by least squares; also numbers unlabelled
         traces and ring maps) or "neural" (seed 000's eq. 5: the packaged generic neural GTF,
         latent code and cut-out transform fitted to labelled traces; unlabelled traces and ring
@@ -46,6 +47,8 @@ def fit_block(block, method: Method = "radial", faces=None, baked: bool = True):
         return fit_neural(block, faces=faces)  # always baked to a grid (the net is slow)
     obs = gather_observations(block, faces)
     if method == "rbf":
+        if not obs.labelled:  # the seed's RBF needs years: number the rings as the radial fit does
+            obs = number_observations(obs, fit_radial(obs, block.size_mm))
         field = fit_rbf(obs)
     else:
         field = fit_radial(obs, block.size_mm)

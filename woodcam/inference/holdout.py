@@ -29,6 +29,7 @@ from ..errors import WoodcamError, require
 from ..fields.base import arf
 from ..frames import pixel_to_block
 from ..tolerances import HOLDOUT_LINE_STEP_PX, HOLDOUT_THRESHOLDS_PX, RING_MAP_THRESHOLD
+from .fit import fit_block
 from .observations import _pixel_index, _resample_polyline, knot_exclusion
 
 #: Labels in results: the in-sample fit (all faces), and the chance control: every held-out
@@ -126,23 +127,6 @@ def score_face(field, block, face: str, thresholds=HOLDOUT_THRESHOLDS_PX) -> Fac
     return FaceScore(face, shares, len(ridge), len(lines), years, ridge, lines)
 
 
-def fit_for_holdout(block, method: str, faces):
-    """``fit_block`` on ``faces``; 'rbf' on unlabelled rings gets them numbered by the radial fit
-    first (the seed's RBF needs years, which ring maps do not carry)."""
-    from .fit import fit_block
-    from .observations import gather_observations
-    from .radial import fit_radial, number_observations
-    from .baked import bake
-    from .rbf import fit_rbf
-
-    if method == "rbf":
-        obs = gather_observations(block, faces)
-        if not obs.labelled:
-            obs = number_observations(obs, fit_radial(obs, block.size_mm))
-            return bake(fit_rbf(obs), block.size_mm)
-    return fit_block(block, method, faces=faces)
-
-
 def leave_one_face_out(block, methods=("rbf", "radial"), out_dir=None, progress=None) -> dict:
     """Fit ``block`` on all faces but one for each face with a ring map, score the held-out face.
 
@@ -169,10 +153,10 @@ def leave_one_face_out(block, methods=("rbf", "radial"), out_dir=None, progress=
     insample = {m: [] for m in methods}
     times = {m: [] for m in methods}
     for m in methods:
-        full = fit_for_holdout(block, m, None)
+        full = fit_block(block, m)
         for face in faces:
             t0 = time.perf_counter()
-            fit = fit_for_holdout(block, m, [f for f in block.faces if f != face])
+            fit = fit_block(block, m, faces=[f for f in block.faces if f != face])
             times[m].append(time.perf_counter() - t0)
             held[m].append(score_face(fit, block, face))
             control[m].append(score_face(lambda p, f=fit: f(p) + 0.5, block, face))
@@ -262,5 +246,5 @@ def plot_holdout(path, block, scores: list[FaceScore], title: str = ""):
     return path
 
 
-__all__ = ["ALL_FACES", "CONTROL", "FaceScore", "face_years", "fit_for_holdout", "holdout_table",
+__all__ = ["ALL_FACES", "CONTROL", "FaceScore", "face_years", "holdout_table",
            "leave_one_face_out", "plot_holdout", "ridge_pixels", "ring_lines_px", "score_face"]
