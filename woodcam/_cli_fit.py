@@ -38,9 +38,12 @@ def add_parser(subparsers) -> None:
     from .inference.fit import METHODS
 
     p = subparsers.add_parser("fit", help="infer a block's growth field from its traced faces")
-    p.add_argument("block_dir", type=Path, help="block folder (manifest, face images, traces)")
+    p.add_argument("block_dir", type=Path, help="block folder (manifest, face images, traces) or a "
+                   "Mokume sample folder")
     p.add_argument("--method", choices=METHODS, default="radial",
-                   help="rbf: seed 000's RBF baseline; radial: our pith-axis least-squares fit")
+                   help="rbf: seed 000's RBF baseline (unlabelled rings numbered by the radial fit); "
+                   "neural: seed 000's eq. 5 with the generic neural field (needs torch); radial "
+                   "(default): our pith axis, ring-width shape and growth history by least squares")
     p.add_argument("--faces", default=None, help="comma-separated faces to use (default: all)")
     p.add_argument("--size-mm", type=float, default=None,
                    help="cube side in mm for a Mokume sample folder (its files carry no size)")
