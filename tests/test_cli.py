@@ -49,6 +49,12 @@ def test_bake_and_preview_from_the_command_line(tmp_path, capsys):
      "unknown built-in block 'oak-burl'"),
     (["bake", "cad_examples/tray.py", "--block", "nowhere/", "--out", "x.glb"],
      "neither 'builtin:NAME'"),
+    (["bake", "cad_examples/tray.py", "--block", "builtin:knotty", "--out", "x.glb",
+      "--knot-darkening", "0.3"], "--knot-darkening takes 2 comma-separated numbers in [0, 1]; got '0.3'"),
+    (["bake", "cad_examples/tray.py", "--block", "builtin:knotty", "--out", "x.glb",
+      "--knot-outline", "0.1,0.1,2"], "--knot-outline takes 3"),
+    (["bake", "cad_examples/tray.py", "--block", "builtin:knotty", "--out", "x.glb",
+      "--appearance", "neural", "--knot-darkening", "0.3,0.4"], "apply to --appearance colormap only"),
 ])
 def test_errors_are_one_clean_line(argv, message, tmp_path):
     res = subprocess.run([sys.executable, "-m", "woodcam.cli", *argv], cwd=REPO,
@@ -57,6 +63,28 @@ def test_errors_are_one_clean_line(argv, message, tmp_path):
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("woodcam: error:") and message in lines[0]
     assert "Traceback" not in res.stderr
+
+
+def test_knot_flags_reach_the_colour_map(tmp_path):
+    """--knot-darkening 0,0 leaves knot wood as light as the stem's; 0.9,0.9 makes it dark."""
+    from woodcam.cli import _appearance_params, build_parser
+    from woodcam.stock import open_stock
+
+    base = ["bake", "x.py", "--block", "builtin:knotty", "--out", "x.glb"]
+    args = build_parser().parse_args(base + ["--knot-darkening", "0.9,0.8", "--knot-outline", "0,0.5,1"])
+    params = _appearance_params(args)
+    assert params == {"knot_darkening_alive": 0.9, "knot_darkening_dead": 0.8,
+                      "dead_outline_rgb": (0.0, 0.5, 1.0)}
+    wood_light = open_stock("builtin:knotty", knot_darkening_alive=0.0, knot_darkening_dead=0.0).wood
+    stock = open_stock("builtin:knotty", **params)
+    wood_dark, field = stock.wood, stock.wood.field
+    pts = np.random.default_rng(0).uniform((0, 0, 0), stock.size_mm, (20000, 3))
+    knot = field.knot_features(pts)["knot"] > 0.9
+    assert knot.sum() > 50
+    n = np.tile([0.0, 1.0, 0.0], (int(knot.sum()), 1))
+    light = wood_light.appearance.color(field, pts[knot], n).mean()
+    dark = wood_dark.appearance.color(field, pts[knot], n).mean()
+    assert dark < 0.5 * light, (dark, light)
 
 
 def test_help_explains_block_frame():

@@ -37,14 +37,40 @@ def _add_appearance(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quality", choices=("draft", "normal", "high"), default=None,
                    help="training effort of the neural appearance (default normal)")
     p.add_argument("--epochs", type=int, default=None, help="override the neural training epochs")
+    p.add_argument("--knot-darkening", default=None, metavar="ALIVE,DEAD",
+                   help="colour map: relative darkening of alive and dead knot wood, each in "
+                   "[0, 1] (default 0.25,0.45)")
+    p.add_argument("--knot-outline", default=None, metavar="R,G,B",
+                   help="colour map: colour of the bark ring round dead knots, each in [0, 1] "
+                   "(default 0.16,0.10,0.06)")
+
+
+def _floats(text: str, n: int, option: str) -> tuple[float, ...]:
+    """``"a,b,..."`` -> n floats in [0, 1], or a WoodcamError naming the option."""
+    try:
+        vals = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        vals = ()
+    if len(vals) != n or not all(0.0 <= v <= 1.0 for v in vals):
+        raise WoodcamError(f"{option} takes {n} comma-separated numbers in [0, 1]; got {text!r}")
+    return vals
 
 
 def _appearance_params(args) -> dict:
+    knots = {}
+    if args.knot_darkening is not None:
+        knots["knot_darkening_alive"], knots["knot_darkening_dead"] = _floats(
+            args.knot_darkening, 2, "--knot-darkening")
+    if args.knot_outline is not None:
+        knots["dead_outline_rgb"] = _floats(args.knot_outline, 3, "--knot-outline")
     if args.appearance != "neural":
         if args.quality or args.epochs:
             raise WoodcamError("--quality and --epochs apply to --appearance neural only; "
                                f"got --appearance {args.appearance}")
-        return {}
+        return knots
+    if knots:
+        raise WoodcamError("--knot-darkening and --knot-outline apply to --appearance colormap "
+                           "only (the neural appearance learns knot colours from the photos)")
     return {k: v for k, v in (("quality", args.quality), ("epochs", args.epochs)) if v is not None}
 
 
