@@ -110,13 +110,24 @@ class FaceScore:
 
 def score_face(field, block, face: str, thresholds=HOLDOUT_THRESHOLDS_PX) -> FaceScore:
     """Score ``field``'s ring lines on ``face`` of ``block`` against that face's ring map."""
+    excl, ridge = _face_reference(block, face)
+    f = block.faces[face]
+    return _score(face, face_years(field, face, f.shape, block.size_mm), ridge, excl, thresholds)
+
+
+def _face_reference(block, face: str):
+    """``(knot exclusion or None, ridge pixels (k, 2))`` of a face's ring map: what every
+    prediction of that face is scored against (the skeleton is computed once per face)."""
     f = block.faces.get(face)
     if f is None or f.ring_map is None:
         raise WoodcamError(f"face {face!r} of block {block.name!r} has no ring map to score against; "
                            f"score a face that has one")
     excl = knot_exclusion(f, min(block.face_pixel_size_mm(face)))
-    years = face_years(field, face, f.shape, block.size_mm)
-    ridge = ridge_pixels(f.ring_map, exclude=excl)
+    return excl, ridge_pixels(f.ring_map, exclude=excl)
+
+
+def _score(face: str, years: np.ndarray, ridge: np.ndarray, excl, thresholds) -> FaceScore:
+    """Shares (module docstring) of the integer iso-lines of ``years (h, w)`` against ``ridge``."""
     lines = ring_lines_px(years, exclude=excl)
     d_ridge = _nearest(ridge.astype(float), lines)
     d_line = _nearest(lines, ridge.astype(float))
@@ -148,6 +159,7 @@ def leave_one_face_out(block, methods=("rbf", "radial"), out_dir=None, progress=
     if len(faces) < 2:
         raise WoodcamError(f"block {block.name!r} has ring maps on {faces}; leave-one-face-out needs "
                            f"at least two faces with ring maps")
+    refs = {face: _face_reference(block, face) for face in faces}
     held = {m: [] for m in methods}
     control = {m: [] for m in methods}
     insample = {m: [] for m in methods}
@@ -155,17 +167,22 @@ def leave_one_face_out(block, methods=("rbf", "radial"), out_dir=None, progress=
     for m in methods:
         full = fit_block(block, m)
         for face in faces:
+            excl, ridge = refs[face]
             t0 = time.perf_counter()
             fit = fit_block(block, m, faces=[f for f in block.faces if f != face])
             times[m].append(time.perf_counter() - t0)
-            held[m].append(score_face(fit, block, face))
-            control[m].append(score_face(lambda p, f=fit: f(p) + 0.5, block, face))
-            insample[m].append(score_face(full, block, face))
+            shape = block.faces[face].shape
+            years = face_years(fit, face, shape, block.size_mm)
+            held[m].append(_score(face, years, ridge, excl, HOLDOUT_THRESHOLDS_PX))
+            control[m].append(_score(face, years + 0.5, ridge, excl, HOLDOUT_THRESHOLDS_PX))
+            insample[m].append(_score(face, face_years(full, face, shape, block.size_mm), ridge, excl,
+                                      HOLDOUT_THRESHOLDS_PX))
             if progress:
                 s = held[m][-1].shares
                 progress(f"{block.name} {m} hold out {face}: ridge {s['ridge_1']:.0f}/{s['ridge_2']:.0f}%, "
                          f"line {s['line_1']:.0f}/{s['line_2']:.0f}% ({times[m][-1]:.1f} s)")
-    res = {"held_out": held, CONTROL: control, ALL_FACES: insample, "fit_s": {m: float(np.mean(t)) for m, t in times.items()}}
+    res = {"held_out": held, CONTROL: control, ALL_FACES: insample,
+           "fit_s": {m: float(np.mean(t)) for m, t in times.items()}}
     res["table"] = holdout_table(block.name, res, list(methods))
     if out_dir is not None:
         out = Path(out_dir)

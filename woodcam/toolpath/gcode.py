@@ -52,6 +52,15 @@ RAPID, FEED = 0, 1
 _KIND_NAMES = ("rapid", "feed")
 
 
+
+#: Modal G codes that only switch a state flag: code -> (attribute, value), applied in this
+#: order (a line naming both codes of a pair ends in the second one's state).
+_MODAL_FLAGS = {
+    90.0: ("incremental", False), 91.0: ("incremental", True),      # distance mode
+    90.1: ("arc_absolute", True), 91.1: ("arc_absolute", False),    # arc centre I J K mode
+    98.0: ("retract_r", False), 99.0: ("retract_r", True),          # canned-cycle retract
+}
+
 class GcodeError(WoodcamError):
     """A G-code line that woodcam cannot read; ``line`` is the 1-based source line."""
 
@@ -314,18 +323,9 @@ class _Reader:
         for code in (17, 18, 19):
             if float(code) in gv:
                 self.plane = code
-        if 90.0 in gv:
-            self.incremental = False
-        if 91.0 in gv:
-            self.incremental = True
-        if 90.1 in gv:
-            self.arc_absolute = True
-        if 91.1 in gv:
-            self.arc_absolute = False
-        if 98.0 in gv:
-            self.retract_r = False
-        if 99.0 in gv:
-            self.retract_r = True
+        for code, (attr, value) in _MODAL_FLAGS.items():
+            if code in gv:
+                setattr(self, attr, value)
         if 43.0 in gv and "H" not in vals:
             raise err("G43", "G43 needs an H word", "write G43 Hn or remove it")
         if 4.0 in gv:  # dwell: no motion; P is its time and not an axis word here
