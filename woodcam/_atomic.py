@@ -226,8 +226,8 @@ def check_output_path(path, *, suffixes: Iterable[str] | None = None, what: str 
     if suffixes is not None:
         allowed = tuple(s.lower() for s in suffixes)
         if path.suffix.lower() not in allowed:
-            raise WoodcamError(f"{what}: output file must end in one of {', '.join(allowed)}; got "
-                               f"{str(path)!r}; give a file name such as 'part{allowed[0]}'")
+            raise WoodcamError(f"{what} must end in {' or '.join(allowed)}; got {str(path)!r}; "
+                               f"give a file name such as 'part{allowed[0]}'")
     if path.is_dir():
         raise WoodcamError(f"{what}: {str(path)!r} is an existing folder, not a file; "
                            f"give a file name inside it, e.g. '{path / ('part' + path.suffix)}'")

@@ -155,9 +155,10 @@ def _cmd_demo(args) -> int:
 
 
 def _cmd_bake(args) -> int:
-    from .pipeline import preview_part
+    from .pipeline import check_outputs, preview_part
     from .stock import open_stock
 
+    check_outputs(args.out, obj=not args.no_obj, screenshot=args.screenshot or False)
     stock = open_stock(args.block, species=args.species, appearance=args.appearance,
                        **_appearance_params(args))
     res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,

@@ -92,7 +92,7 @@ def test_unique_temp_names_for_concurrent_writers(tmp_path):
 
 
 @pytest.mark.parametrize("case, match", [
-    ("suffix", "must end in one of .glb, .obj"),
+    ("suffix", "must end in .glb or .obj"),
     ("dir", "is an existing folder"),
     ("noparent", "does not exist"),
     ("parentfile", "is a file, not a folder"),

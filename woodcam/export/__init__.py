@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from woodcam._atomic import atomic_files, check_output_path, write_bytes
 from woodcam.errors import WoodcamError
 
 #: Key under the glTF scene ``extras`` that holds woodcam's metadata.
@@ -68,11 +69,7 @@ def export_glb(mesh, path, metadata: dict | None = None) -> Path:
     from trimesh.exchange.gltf import export_glb as _trimesh_export_glb
 
     _require_textured(mesh, "export_glb")
-    path = Path(path)
-    if path.suffix.lower() != ".glb":
-        raise WoodcamError(
-            f"export_glb: path must end in .glb; got {str(path)!r}; use e.g. 'part.glb'"
-        )
+    path = check_output_path(path, suffixes=(".glb",), what="export_glb: path", mkdir=True)
     payload = {"units": "mm", "frame": "block"}
     if metadata is not None:
         try:
@@ -92,8 +89,7 @@ def export_glb(mesh, path, metadata: dict | None = None) -> Path:
     scene = trimesh.Scene()
     scene.add_geometry(mesh, geom_name="part", node_name="part")
     data = _trimesh_export_glb(scene, tree_postprocessor=_add_extras)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_bytes(data)
+    write_bytes(path, data)  # atomic: a complete GLB or none
     return path
 
 
@@ -131,11 +127,7 @@ def export_obj(mesh, path) -> Path:
     from trimesh.exchange.obj import export_obj as _trimesh_export_obj
 
     _require_textured(mesh, "export_obj")
-    path = Path(path)
-    if path.suffix.lower() != ".obj":
-        raise WoodcamError(
-            f"export_obj: path must end in .obj; got {str(path)!r}; use e.g. 'part.obj'"
-        )
+    path = check_output_path(path, suffixes=(".obj",), what="export_obj: path", mkdir=True)
     stem = path.stem
     # trimesh names the image after the material: a shallow copy named after the file gives
     # NAME.png without touching the caller's mesh.
@@ -155,10 +147,13 @@ def export_obj(mesh, path) -> Path:
     text, files = _trimesh_export_obj(
         out, include_texture=True, return_texture=True, mtl_name=f"{stem}.mtl"
     )
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text)
-    for name, blob in files.items():
-        (path.parent / name).write_bytes(blob)
+    # OBJ + MTL + PNG as one unit: all renamed into place only once every one is written, the
+    # OBJ (which references the others) last.
+    names = list(files)
+    with atomic_files([path] + [path.parent / n for n in names]) as temps:
+        temps[0].write_text(text)
+        for tmp, name in zip(temps[1:], names):
+            tmp.write_bytes(files[name])
     return path
 
 
