@@ -80,6 +80,11 @@ def _add_common_bake(p: argparse.ArgumentParser) -> None:
     p.add_argument("--species", default=None,
                    help="colour preset (oak, maple, walnut, cherry, pine, spruce); default: the block's")
     p.add_argument("--no-obj", action="store_true", help="write only the GLB, not OBJ+MTL+PNG")
+    p.add_argument("--obj-units", choices=("m", "mm"), default="m",
+                   help="length unit of the OBJ's coordinates (default m, what Blender and most "
+                   "viewers assume; mm for CAM tools). The GLB is always metres, Y up (glTF)")
+    p.add_argument("--obj-up", choices=("y", "z"), default="y",
+                   help="up axis of the OBJ (default y, the OBJ habit; z keeps the block frame)")
     p.add_argument("--screenshot", type=Path, default=None, metavar="PNG",
                    help="also render the result to this PNG (no display needed)")
 
@@ -162,7 +167,7 @@ def _cmd_bake(args) -> int:
                        **_appearance_params(args))
     res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
                        tolerance_mm=args.tolerance, obj=not args.no_obj, screenshot=False,
-                       progress=True)
+                       progress=True, obj_units=args.obj_units, obj_up=args.obj_up)
     if args.screenshot:
         from .view import preview
 
