@@ -68,7 +68,8 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
 
 def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                  tolerance_mm: float | None = None, obj: bool = True,
-                 screenshot: bool = True, progress: bool = False) -> PartPreview:
+                 screenshot: bool = True, progress: bool = False, obj_units: str = "m",
+                 obj_up: str = "y") -> PartPreview:
     """Carve ``source`` (anything :func:`woodcam.cad.load_part` takes) out of ``stock``, bake it
     and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``)."""
     from .cad import carve, load_part
@@ -82,13 +83,16 @@ def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
         carved = carve(part, stock.size_mm)
     result.warnings += list(carved.warnings)
     return preview_mesh(carved.mesh, stock, out_glb, texels_per_mm=texels_per_mm, obj=obj,
-                        screenshot=screenshot, progress=progress, result=result)
+                        screenshot=screenshot, progress=progress, result=result,
+                        obj_units=obj_units, obj_up=obj_up)
 
 
 def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, obj: bool = True,
                  screenshot: bool = True, progress: bool = False,
-                 result: PartPreview | None = None, metadata: dict | None = None) -> PartPreview:
-    """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files."""
+                 result: PartPreview | None = None, metadata: dict | None = None,
+                 obj_units: str = "m", obj_up: str = "y") -> PartPreview:
+    """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files: the GLB
+    in metres, Y up (glTF's convention); the OBJ in ``obj_units`` with ``obj_up`` up."""
     from .bake import bake
     from .export import export_glb, export_obj
 
@@ -106,7 +110,8 @@ def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, ob
         result.files["glb"] = Path(export_glb(baked.mesh, out_glb, metadata=meta) or out_glb)
         if obj:
             obj_path = out_glb.with_suffix(".obj")
-            result.files["obj"] = Path(export_obj(baked.mesh, obj_path) or obj_path)
+            result.files["obj"] = Path(export_obj(baked.mesh, obj_path, units=obj_units,
+                                                           up=obj_up) or obj_path)
     if screenshot:
         from .view import preview
 

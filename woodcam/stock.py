@@ -80,16 +80,62 @@ def open_stock(spec: str, *, species: str | None = None,
         field, size_mm, description = _log_block_field(spec)
         return _synthetic_stock(spec, field, size_mm, species or "spruce", description,
                                 appearance, appearance_params)
-    path = Path(spec)
-    if path.is_dir() and (path / "block.json").is_file():
+    path = _existing_folder(spec)
+    if (path / "block.json").is_file():
         return _open_block_folder(path, species, appearance, appearance_params)
-    if path.is_dir() and (any(path.glob("?_col.png")) or any(path.glob("?_arl-unet.png"))):
-        return _open_mokume_folder(path, species, appearance, appearance_params)
-    raise WoodcamError(
-        f"block spec {spec!r} is neither 'builtin:NAME' (NAME one of {', '.join(BUILTIN_NAMES)}), "
-        "'log:LOG@KNOT[:WxDxH]', a block folder with a block.json manifest, nor a Mokume sample "
-        "folder (A_col.png, A_arl-unet.png, ...)"
-    )
+    return _open_mokume_folder(path, species, appearance, appearance_params)
+
+
+def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
+    """Resolve a block spec to ``(block, field)``: the one block resolver of every command.
+
+    Parameters
+    ----------
+    spec : str
+        As :func:`open_stock`: ``builtin:NAME`` and ``log:LOG@K[:WxDxH]`` give a synthetic
+        block whose six face photos, ring maps and traces are rendered by
+        :func:`woodcam.synth.synth_block` (seed 0) from the true field; a folder is read by
+        :func:`woodcam.block.io.read_block_folder` (block folder or Mokume sample folder).
+    size_mm : float, optional
+        Cube side of a Mokume sample folder (its files carry no size; default 50 mm).
+    face_px : int
+        Pixels along the largest face side of a synthetic block's photos.
+
+    Returns
+    -------
+    (Block, field or None)
+        The field is the block's true field where one is known (synthetic blocks, block
+        folders that store one), else None: no field is fitted here.
+    """
+    if spec.startswith(("builtin:", "log:")):
+        from .synth import synth_block
+
+        if spec.startswith("builtin:"):
+            b = builtin_block(spec.split(":", 1)[1])
+            field, size, name = b.field, b.size_mm, b.name
+        else:
+            field, size, _ = _log_block_field(spec)
+            name = spec.replace(":", "-").replace("/", "_")
+        return synth_block(field, size, face_px=face_px, seed=0, name=name), field
+    from .block.io import read_block_folder
+
+    block = read_block_folder(_existing_folder(spec),
+                              None if size_mm is None else (float(size_mm),) * 3)
+    return block, block.true_field
+
+
+def _existing_folder(spec: str) -> Path:
+    """The folder a non-builtin, non-log spec names, or the error listing every kind of spec."""
+    path = Path(spec)
+    if path.name == "block.json" and path.is_file():
+        path = path.parent
+    if not path.is_dir():
+        raise WoodcamError(
+            f"block spec {spec!r} is neither 'builtin:NAME' (NAME one of "
+            f"{', '.join(BUILTIN_NAMES)}), 'log:LOG@KNOT[:WxDxH]', nor an existing folder: a block "
+            "folder (with block.json) or a Mokume sample folder (A_col.png, A_arl-unet.png, ...)"
+        )
+    return path
 
 
 def _synthetic_stock(spec, field, size_mm, species, description, appearance, params) -> Stock:
@@ -149,19 +195,17 @@ def fitted_field(block, folder: Path | None = None, method: str = "radial"):
 
 
 def _open_mokume_folder(path: Path, species, appearance, appearance_params) -> Stock:
-    from .block.io import read_mokume
+    from .block.io import read_block_folder
 
-    block = read_mokume(path)
+    block = read_block_folder(path)
     return _real_block_stock(str(path), block, fitted_field(block, None), species, appearance,
                              appearance_params, cache_dir=None)
 
 
 def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
-    from .block.io import (
-        read_block,  # block I/O sits beside; imported when a folder is used
-    )
+    from .block.io import read_block_folder  # imported when a folder is used
 
-    block = read_block(path)
+    block = read_block_folder(path)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
     return _real_block_stock(str(path), block, field, species, appearance, appearance_params,
                              cache_dir=None)

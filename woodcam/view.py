@@ -152,8 +152,12 @@ def _load_mesh(mesh_or_path):
                 f"mesh_or_path: no file at {str(path)!r}; pass a .glb/.obj/.ply/.stl file "
                 "written by woodcam (e.g. out/part.glb) or a trimesh.Trimesh"
             )
+        from woodcam.export import load_textured, written_by_woodcam
+
         try:
-            loaded = trimesh.load(path, force="mesh")
+            # woodcam's own GLB/OBJ are metres/Y-up on disk: load_textured returns the block frame
+            loaded = (load_textured(path) if written_by_woodcam(path)
+                      else trimesh.load(path, force="mesh"))
         except Exception as err:  # trimesh raises many types for unreadable files
             raise WoodcamError(
                 f"mesh_or_path: could not read a mesh from {str(path)!r} ({err}); "

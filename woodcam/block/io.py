@@ -346,6 +346,30 @@ def _check_shape(a: np.ndarray, shape, what: str) -> None:
 
 # -- Mokume sample folders -----------------------------------------------------------------------
 
+def read_block_folder(folder, size_mm: tuple[float, float, float] | None = None) -> Block:
+    """Read a block folder of either kind: the one rule every reader of a folder uses.
+
+    A folder with a ``block.json`` manifest (or the manifest's own path) is read by
+    :func:`read_block`; any other folder is read as a Mokume sample folder by
+    :func:`read_mokume`, with cube size ``size_mm`` (default :data:`MOKUME_DEFAULT_SIZE_MM`;
+    ignored for a manifest folder, whose manifest records its size).
+
+    Raises
+    ------
+    WoodcamError
+        When the folder does not exist, or is neither kind (no manifest, no Mokume files).
+    """
+    folder = Path(folder)
+    if folder.name == MANIFEST and folder.is_file():
+        folder = folder.parent
+    if not folder.is_dir():
+        raise WoodcamError(f"folder must be a block folder (with {MANIFEST}) or a Mokume sample "
+                           f"folder; {str(folder)!r} does not exist")
+    if (folder / MANIFEST).is_file():
+        return read_block(folder)
+    return read_mokume(folder, MOKUME_DEFAULT_SIZE_MM if size_mm is None else tuple(size_mm))
+
+
 def read_mokume(folder, size_mm=MOKUME_DEFAULT_SIZE_MM, *, name: str | None = None) -> Block:
     """Read one Mokume sample folder (``X_col.png``, ``X_arl-unet.png``, ... for X = A..F).
 
