@@ -63,7 +63,7 @@ def check_limit(name: str, value: float, what: str, fix: str = "") -> None:
         raise WoodcamError(
             f"{what} needs {value:.4g}, more than the limit {name} = {top:.4g}"
             + (f"; {fix}" if fix else "")
-            + f"; if this is intended, raise the limit with WOODCAM_{name}={value:.0f}")
+            + f"; if this is intended, raise the limit with WOODCAM_{name}={2 * value:.3g}")
 
 
 def check_grid(shape, what: str, *, itemsize: int = 8, fix: str = "") -> None:

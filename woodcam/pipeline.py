@@ -69,16 +69,19 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
 def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                  tolerance_mm: float | None = None, obj: bool = True,
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
-                 obj_up: str = "y") -> PartPreview:
+                 obj_up: str = "y", timeout_s: float | None = None) -> PartPreview:
     """Carve ``source`` (anything :func:`woodcam.cad.load_part` takes) out of ``stock``, bake it
-    and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``)."""
+    and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``).
+
+    A ``.py`` source is trusted code run with your rights; ``timeout_s`` bounds its loading."""
     from .cad import carve, load_part
     from .tolerances import TESSELLATION_TOL_MM
 
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)  # before minutes of work
     result = PartPreview(out_glb.stem)
     with result.stage("load"):
-        part = load_part(source, tolerance_mm=tolerance_mm or TESSELLATION_TOL_MM)
+        part = load_part(source, tolerance_mm=TESSELLATION_TOL_MM if tolerance_mm is None else tolerance_mm,
+                         timeout_s=timeout_s)
     with result.stage("carve"):
         carved = carve(part, stock.size_mm)
     result.warnings += list(carved.warnings)

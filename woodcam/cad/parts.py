@@ -26,6 +26,7 @@ solids that touch or overlap still give one valid manifold.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import runpy
 import sys
@@ -50,8 +51,12 @@ def load_part(
     *,
     tolerance_mm: float = TESSELLATION_TOL_MM,
     angular_tolerance_deg: float = TESSELLATION_ANGLE_DEG,
+    timeout_s: float | None = None,
 ):
     """Turn a part source into one watertight manifold in the block frame (mm).
+
+    A ``.py`` part script is **trusted code**: it runs inside this process with your rights
+    (it can read, write and delete your files). Only load scripts you wrote or have read.
 
     Parameters
     ----------
@@ -68,6 +73,10 @@ def load_part(
     angular_tolerance_deg : float
         Angular tolerance (degrees, in (0, 90]) for tessellating B-rep sources: the largest
         normal jump between neighbouring triangles on a curved face. Ignored for meshes.
+    timeout_s : float, optional
+        Stop loading (running a script, tessellating) after this many seconds with a
+        WoodcamError. POSIX main thread only (``SIGALRM``); it is checked between Python
+        statements, so one long OCCT call finishes before it fires. Not a sandbox.
 
     Returns
     -------
@@ -91,7 +100,47 @@ def load_part(
             f"angular_tolerance_deg must be in (0, 90] degrees, got {angular_tolerance_deg!r}; "
             f"use e.g. {TESSELLATION_ANGLE_DEG}"
         )
-    return _load(source, float(tolerance_mm), math.radians(angular_tolerance_deg), origin="part")
+    if timeout_s is not None and not (isinstance(timeout_s, Real) and math.isfinite(timeout_s)
+                                      and timeout_s > 0):
+        raise WoodcamError(f"timeout_s must be a finite number of seconds > 0 or None; got "
+                           f"{timeout_s!r}")
+    with _time_limit(timeout_s, source):
+        return _load(source, float(tolerance_mm), math.radians(angular_tolerance_deg), origin="part")
+
+
+class _PartTimeout(BaseException):
+    """Raised by the alarm; a BaseException so a script's ``except Exception`` cannot eat it."""
+
+
+@contextlib.contextmanager
+def _time_limit(seconds: float | None, source):
+    """Raise a WoodcamError if the block runs longer than ``seconds`` (SIGALRM timer)."""
+    import signal
+    import threading
+
+    if seconds is None:
+        yield
+        return
+    if not hasattr(signal, "setitimer") or threading.current_thread() is not threading.main_thread():
+        raise WoodcamError("timeout_s needs the main thread of a POSIX process (SIGALRM); "
+                           "run without a timeout here")
+
+    def _alarm(signum, frame):
+        raise _PartTimeout
+
+    old = signal.signal(signal.SIGALRM, _alarm)
+    # fires again every 0.25 s after the deadline: a library that swallowed the first raise
+    # (an import's ``except BaseException``) does not get the script off the hook
+    signal.setitimer(signal.ITIMER_REAL, float(seconds), 0.25)
+    try:
+        yield
+    except _PartTimeout:
+        raise WoodcamError(f"loading the part {str(source)[:200]!r} took longer than the timeout "
+                           f"of {seconds:g} s; raise --timeout or check the script for an endless "
+                           "loop") from None
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
 
 
 # --------------------------------------------------------------------------------- dispatch

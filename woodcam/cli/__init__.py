@@ -105,6 +105,9 @@ def main(argv: list[str] | None = None) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
+            from .options import check_numbers
+
+            check_numbers(args)  # every numeric option finite and in range, before any work
             rc = args.func(args)
         except WoodcamError as err:
             print(f"woodcam: error: {err}", file=sys.stderr)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..errors import WoodcamError
 from .options import BLOCK_SPEC_HELP, add_bake_options, stock_options, write_screenshot
 
 
@@ -21,12 +22,19 @@ def register(subparsers) -> None:
 
     p = subparsers.add_parser("bake", help="carve a part out of a block and bake its wood texture",
                               description="PART is a build123d/cadquery script defining `part`, "
-                              "or a STEP/STL/OBJ/GLB file, modelled in the block frame (mm).")
+                              "or a STEP/STL/OBJ/GLB file, modelled in the block frame (mm). "
+                              "A .py part script is trusted code: it runs with your rights and "
+                              "can read, write or delete your files, so only bake scripts you "
+                              "wrote or have read (--timeout bounds its run time; it is not a "
+                              "sandbox).")
     p.add_argument("part", help="part file (.py script, .step, .stl, .obj, .glb)")
     p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
     p.add_argument("--out", type=Path, required=True, help="output .glb path")
     p.add_argument("--tolerance", type=float, default=None, metavar="MM",
                    help="tessellation chord tolerance for B-rep parts (default 0.05 mm)")
+    p.add_argument("--timeout", type=float, default=None, metavar="S",
+                   help="stop loading the part (running a trusted .py script, tessellating) "
+                   "after S seconds (default: no limit)")
     add_bake_options(p)
     p.set_defaults(func=run_bake)
 
@@ -62,7 +70,7 @@ def run_bake(args: argparse.Namespace) -> int:
     check_outputs(args.out, obj=not args.no_obj, screenshot=args.screenshot or False)  # before work
     stock = open_stock(args.block, **stock_options(args))
     res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
-                       tolerance_mm=args.tolerance, obj=not args.no_obj, screenshot=False,
+                       tolerance_mm=args.tolerance, timeout_s=args.timeout, obj=not args.no_obj, screenshot=False,
                        progress=True, obj_units=args.obj_units, obj_up=args.obj_up)
     write_screenshot(args, res.files, stock)
     print_warnings(res.warnings)
@@ -76,15 +84,39 @@ def run_preview(args: argparse.Namespace) -> int:
     from ..stock import open_stock
     from ..view import preview
 
-    spec = args.block
-    if spec is None and args.mesh.suffix.lower() == ".glb":
-        spec = read_glb_metadata(args.mesh).get("block")
-    stock = open_stock(spec) if spec else None
+    if args.block is not None:
+        stock = open_stock(args.block)
+    elif args.mesh.suffix.lower() == ".glb":
+        stock = stock_from_glb_metadata(read_glb_metadata(args.mesh), args.mesh)
+    else:
+        stock = None
     out = preview(args.mesh, wood=stock.wood if stock else None,
                   size_mm=stock.size_mm if stock else None, screenshot=args.screenshot)
     if out:
         print(f"wrote {out}")
     return 0
+
+
+def stock_from_glb_metadata(meta: dict, glb) -> object | None:
+    """The stock named by a GLB's ``block`` metadata, or None if it names none.
+
+    A GLB is untrusted input: its metadata may only name a built-in block or a log block
+    (``builtin:...``, ``log:...``), never a folder, because opening a folder could fit a field
+    and write a cache for it (issue 15). Pass ``--block FOLDER`` to use a folder yourself.
+    """
+    from ..stock import open_stock
+
+    spec = meta.get("block")
+    if spec is None:
+        return None
+    if not isinstance(spec, str) or len(spec) > 1000:
+        raise WoodcamError(f"the block spec in {str(glb)!r}'s metadata must be a short string; "
+                           f"got a {type(spec).__name__}; pass --block SPEC")
+    if not spec.startswith(("builtin:", "log:")):
+        raise WoodcamError(
+            f"{str(glb)!r}'s metadata names a folder ({spec!r}) as its block; woodcam opens "
+            f"folders only when you name them: pass --block {spec!r} if you trust it")
+    return open_stock(spec)
 
 
 def run_blocks(args: argparse.Namespace) -> int:

@@ -94,19 +94,16 @@ def run(args) -> int:
     from ..toolpath.simulate import simulate
 
     check_outputs(args.out, obj=not args.no_obj, screenshot=args.screenshot or False)  # before work
+    offset = None
+    if args.work_offset:
+        from .options import number_list
+
+        offset = list(number_list(args.work_offset, 3, "--work-offset X,Y,Z", -1e5, 1e5, "mm"))
     stock = open_stock(args.block, **stock_options(args))
     t0 = time.perf_counter()
     program = read_gcode(args.program)
     t_read = time.perf_counter() - t0
     tools = _tools_from_args(args, program)
-    offset = None
-    if args.work_offset:
-        try:
-            offset = [float(v) for v in args.work_offset.split(",")]
-            assert len(offset) == 3
-        except (ValueError, AssertionError) as err:
-            raise WoodcamError(f"--work-offset {args.work_offset!r}: give three numbers X,Y,Z "
-                               "in mm, e.g. 0,0,50") from err
     res = simulate(program, tools, stock.size_mm, resolution_mm=args.resolution,
                    work_offset_mm=offset, progress=False)
     t1 = time.perf_counter()

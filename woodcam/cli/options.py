@@ -6,6 +6,8 @@
 - :func:`add_block_argument` and :func:`open_block`: a block spec on the command line and the
   one resolver behind every command that reads a block (:func:`woodcam.stock.open_block`).
 - :func:`command_group`: a command with sub-commands that several modules extend.
+- :func:`check_numbers` / :data:`RANGES` / :func:`number_list`: every numeric option finite and
+  in range, checked by :func:`woodcam.cli.main` before a command runs.
 
 Nothing heavy is imported at module level (``woodcam --help`` loads this module).
 """
@@ -13,6 +15,7 @@ Nothing heavy is imported at module level (``woodcam --help`` loads this module)
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from ..errors import WoodcamError
@@ -139,3 +142,79 @@ def write_screenshot(args, files: dict, stock) -> None:
     png = out.with_name(out.stem + "_view.png") if args.screenshot is True else Path(args.screenshot)
     preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
     files["png"] = png
+
+
+# -- numeric options: finite and in range, checked once for every command ---------------------
+# woodcam.cli.main calls check_numbers() on the parsed arguments: argparse's float accepts nan
+# and inf, and a value out of range must fail with one line, not a hang, an out-of-memory kill
+# or a silent substitution (``--tolerance 0`` used to become 0.05 without a word).
+
+#: option dest -> (low, high, low_is_open). ``(command, dest)`` keys override a plain ``dest``
+#: for commands where the same option name means another quantity.
+RANGES: dict = {
+    "texels_per_mm": (0.0, 100.0, True),       # 100 texels/mm = 0.01 mm texels, far below a cutter
+    "tolerance": (0.0, 10.0, True),            # tessellation chord, mm
+    "size_mm": (0.0, 10_000.0, True),          # a block side, mm (woodcam.limits.MAX_BLOCK_SIZE_MM)
+    "mesh_tol": (0.0, 10.0, True),             # mm
+    "resolution": (8, 256, False),             # colour-volume cells along the longest side
+    ("gcode", "resolution"): (0.005, 10.0, False),  # stock grid cell, mm (5 um .. 10 mm)
+    "epochs": (1, 100_000, False),
+    "finetune_epochs": (0, 100_000, False),
+    "steps": (1, 100_000_000, False),
+    "count": (1, 1_000_000, False),
+    "face_px": (8, 16_384, False),             # woodcam.limits.MAX_FACE_PX
+    "seed": (0, 2**32 - 1, False),
+    "ring_width": (0.0, 1000.0, True),         # mm per year
+    "px_per_mm": (0.0, 1000.0, True),
+    "supersample": (1, 16, False),
+    "k_stem": (0.0, 1000.0, True),
+    "k_knot": (0.0, 1000.0, True),
+    "alive_darkening": (0.0, 1.0, False),
+    "dead_darkening": (0.0, 1.0, False),
+    "outline_mm": (0.0, 1000.0, False),
+    "timeout": (0.0, 1e7, True),               # seconds
+}
+
+
+def _option(dest: str) -> str:
+    return "--" + dest.replace("_", "-")
+
+
+def _check_value(value, option: str, rng) -> None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return
+    if isinstance(value, float) and not math.isfinite(value):
+        raise WoodcamError(f"{option} must be a finite number; got {value!r}")
+    if rng is None:
+        return
+    lo, hi, lo_open = rng
+    if value < lo or value > hi or (lo_open and value <= lo):
+        raise WoodcamError(f"{option} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}]; got "
+                           f"{value!r}; see 'woodcam COMMAND --help' for its meaning and default")
+
+
+def check_numbers(args: argparse.Namespace) -> None:
+    """Raise a WoodcamError for the first numeric option that is non-finite or out of range."""
+    command = getattr(args, "command", None)
+    for dest, value in vars(args).items():
+        if dest.startswith("_") or value is None:
+            continue
+        rng = RANGES.get((command, dest), RANGES.get(dest))
+        values = value if isinstance(value, (list, tuple)) else [value]
+        for v in values:
+            _check_value(v, _option(dest), rng)
+
+
+def number_list(text: str, n: int, option: str, lo: float = -math.inf, hi: float = math.inf,
+                unit: str = "") -> tuple[float, ...]:
+    """``"a,b,c"`` -> ``n`` finite floats in ``[lo, hi]``, or a WoodcamError naming ``option``."""
+    try:
+        vals = tuple(float(v) for v in str(text).split(","))
+    except ValueError:
+        vals = ()
+    ok = len(vals) == n and all(math.isfinite(v) and lo <= v <= hi for v in vals)
+    if not ok:
+        bounds = "" if (lo, hi) == (-math.inf, math.inf) else f" in [{lo:g}, {hi:g}]"
+        raise WoodcamError(f"{option} takes {n} comma-separated finite numbers{bounds}"
+                           f"{' in ' + unit if unit else ''}; got {text!r}")
+    return vals

@@ -368,7 +368,10 @@ def read_glb_metadata(path) -> dict:
     Parses the GLB header and JSON chunk directly (glTF 2.0 spec, "GLB File Format").
     """
     path = Path(path)
-    data = path.read_bytes()
+    try:
+        data = path.read_bytes()
+    except OSError as err:
+        raise WoodcamError(f"read_glb_metadata: cannot read {str(path)!r} ({err.strerror})") from err
     if len(data) < 20:
         raise WoodcamError(f"read_glb_metadata: {str(path)!r} is too short to be a GLB file")
     magic, version, _length = struct.unpack_from("<III", data, 0)
@@ -378,7 +381,22 @@ def read_glb_metadata(path) -> dict:
             f"read_glb_metadata: {str(path)!r} is not a glTF 2.0 binary (magic {magic:#x}, "
             f"version {version}); pass a .glb written by woodcam.export.export_glb"
         )
-    tree = json.loads(data[20:20 + chunk_len].decode("utf-8"))
+    bad = f"read_glb_metadata: {str(path)!r} has a malformed glTF JSON chunk"
+    if 20 + chunk_len > len(data):
+        raise WoodcamError(f"{bad}: it claims {chunk_len} bytes but the file ends first")
+    try:
+        tree = json.loads(data[20:20 + chunk_len].decode("utf-8"))
+    except (UnicodeDecodeError, ValueError, RecursionError) as err:
+        raise WoodcamError(f"{bad} ({err})") from err
+    if not isinstance(tree, dict):
+        raise WoodcamError(f"{bad}: a JSON object is required, got {type(tree).__name__}")
     scenes = tree.get("scenes") or [{}]
-    scene = scenes[tree.get("scene", 0)]
-    return dict((scene.get("extras") or {}).get(GLB_METADATA_KEY, {}))
+    index = tree.get("scene", 0)
+    if (not isinstance(scenes, list) or isinstance(index, bool) or not isinstance(index, int)
+            or not 0 <= index < len(scenes) or not isinstance(scenes[index], dict)):
+        raise WoodcamError(f"{bad}: scenes/scene do not name a scene object")
+    extras = scenes[index].get("extras") or {}
+    meta = extras.get(GLB_METADATA_KEY, {}) if isinstance(extras, dict) else None
+    if not isinstance(meta, dict):
+        raise WoodcamError(f"{bad}: scene extras.{GLB_METADATA_KEY} must be a JSON object")
+    return dict(meta)

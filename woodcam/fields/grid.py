@@ -78,7 +78,12 @@ class GridField:
             raise WoodcamError(f"lo_mm < hi_mm must be 3-vectors; got {lo_mm!r}, {hi_mm!r}")
         if not spacing_mm > 0:
             raise WoodcamError(f"spacing_mm must be > 0; got {spacing_mm!r}")
-        n = np.ceil((hi - lo) / spacing_mm).astype(int) + 1 + 2 * margin_nodes
+        n_float = np.ceil((hi - lo) / spacing_mm) + 1 + 2 * margin_nodes
+        from ..limits import check_grid  # before allocating: 1e9 mm blocks must not reach numpy
+
+        check_grid(n_float, "baking a field onto a grid", fix="use a coarser spacing_mm or a "
+                   "smaller block")
+        n = n_float.astype(int)
         origin = lo - margin_nodes * spacing_mm
         axes = [origin[i] + spacing_mm * np.arange(n[i]) for i in range(3)]
         pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
@@ -98,9 +103,12 @@ class GridField:
         path = Path(path)
         if path.suffix != ".npz":
             path = path.with_suffix(path.suffix + ".npz")
-        np.savez_compressed(path, years=self.years, origin_mm=self.origin_mm,
-                            spacing_mm=self.spacing_mm, interpolation=self.interpolation,
-                            axis=self.axis)
+        from .._atomic import atomic_path
+
+        with atomic_path(path) as tmp:  # a complete file or none
+            np.savez_compressed(tmp, years=self.years, origin_mm=self.origin_mm,
+                                spacing_mm=self.spacing_mm, interpolation=self.interpolation,
+                                axis=self.axis)
         return path
 
     @classmethod

@@ -41,6 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._atomic import atomic_path, atomic_write, write_text
 from ..errors import WoodcamError, require
 from .radial import laplacian_smoother
 
@@ -123,9 +124,9 @@ class GTFSpec:
         return cls(**d)
 
     def save(self, path) -> Path:
-        path = Path(path)
-        path.write_text(json.dumps(self.to_dict(), indent=2) + "\n")
-        return path
+        from .._atomic import write_text
+
+        return write_text(path, json.dumps(self.to_dict(), indent=2) + "\n")
 
     @classmethod
     def load(cls, path) -> "GTFSpec":
@@ -278,6 +279,44 @@ def load_model(model_dir=None):
 # Training (eq. 3)
 
 
+def _plain(obj):
+    """``obj`` with numpy scalars turned into Python numbers (containers walked, tensors kept), so
+    that ``torch.load(weights_only=True)`` can read it back (the learning-rate schedule yields
+    numpy floats)."""
+    if isinstance(obj, dict):
+        return type(obj)((k, _plain(v)) for k, v in obj.items())
+    if isinstance(obj, (list, tuple)):
+        return type(obj)(_plain(v) for v in obj)
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj
+
+
+def _load_checkpoint(torch, ckpt: Path, spec: GTFSpec) -> dict:
+    """A training checkpoint, loaded with ``weights_only=True``: tensors and plain data only, so a
+    crafted file cannot run code (a pickle that needs anything else is refused)."""
+    import pickle
+
+    try:
+        state = torch.load(ckpt, map_location="cpu", weights_only=True)
+    except (pickle.UnpicklingError, RuntimeError, EOFError, OSError, ValueError,
+            AttributeError, TypeError) as err:
+        raise WoodcamError(
+            f"checkpoint {ckpt} is not a woodcam training checkpoint of tensors and plain data "
+            f"({type(err).__name__}); it was refused, nothing in it was run. Delete it or pass "
+            "resume=False (CLI: --no-resume) to start afresh") from err
+    keys = {"spec", "net", "codes", "opt", "step", "elapsed", "log"}
+    if not isinstance(state, dict) or not keys <= set(state):
+        raise WoodcamError(f"checkpoint {ckpt} lacks the keys {sorted(keys)}; delete it or pass "
+                           "resume=False")
+    if state["spec"] != spec.to_dict():
+        theirs = state["spec"] if isinstance(state["spec"], dict) else {}
+        raise WoodcamError(f"checkpoint {ckpt} was written for another spec; delete it or "
+                           f"pass resume=False (spec differs in "
+                           f"{sorted(k for k in spec.to_dict() if theirs.get(k) != spec.to_dict()[k])})")
+    return state
+
+
 def _lr_scale(step: int, total: int, floor: float) -> float:
     """Cosine decay from 1 to ``floor`` over ``total`` steps (a function of the step alone, so a
     resumed run follows the same schedule)."""
@@ -318,6 +357,9 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
     if total < 0:
         raise WoodcamError(f"steps must be >= 0; got {steps!r}")
     spec.save(out / SPEC_NAME)
+    ckpt = out / _CHECKPOINT_NAME
+    # read (and refuse) a checkpoint before minutes of work building the training set
+    state = _load_checkpoint(torch, ckpt, spec) if resume and ckpt.is_file() else None
 
     pts_np, vals_np = make_training_set(spec)
     pts, vals = torch.from_numpy(pts_np), torch.from_numpy(vals_np)
@@ -329,13 +371,7 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
                             {"params": [codes], "lr": spec.lr_latent}])
     log: list[tuple[int, float, float]] = []
     step, elapsed = 0, 0.0
-    ckpt = out / _CHECKPOINT_NAME
-    if resume and ckpt.is_file():
-        state = torch.load(ckpt, map_location="cpu", weights_only=False)
-        if state["spec"] != spec.to_dict():
-            raise WoodcamError(f"checkpoint {ckpt} was written for another spec; delete it or "
-                               f"pass resume=False (spec differs in "
-                               f"{sorted(k for k in state['spec'] if state['spec'][k] != spec.to_dict().get(k))})")
+    if state is not None:
         net.load_state_dict(state["net"])
         with torch.no_grad():
             codes.copy_(state["codes"])
@@ -343,8 +379,12 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
         step, elapsed, log = state["step"], state["elapsed"], [tuple(r) for r in state["log"]]
 
     def save_checkpoint():
-        torch.save({"spec": spec.to_dict(), "net": net.state_dict(), "codes": codes.detach(),
-                    "opt": opt.state_dict(), "step": step, "elapsed": elapsed, "log": log}, ckpt)
+        # tensors and plain data only (loaded back with weights_only=True); atomic, so a run
+        # killed while saving keeps the previous checkpoint
+        with atomic_path(ckpt) as tmp:
+            torch.save(_plain({"spec": spec.to_dict(), "net": net.state_dict(),
+                               "codes": codes.detach(), "opt": opt.state_dict(), "step": step,
+                               "elapsed": elapsed, "log": [list(r) for r in log]}), tmp)
 
     bar = None
     if progress:
@@ -395,13 +435,14 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
         final_l1 = float(torch.cat(errs).mean())
         final_rel = float(torch.cat(rels).mean())
     state = {k: v.detach().clone() for k, v in net.state_dict().items()}
-    torch.save(state, out / WEIGHTS_NAME)
-    with open(out / LOG_NAME, "w", newline="") as fh:
+    with atomic_path(out / WEIGHTS_NAME) as tmp:
+        torch.save(state, tmp)
+    with atomic_write(out / LOG_NAME, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["step", "l1", "time_s"])
         for s, l, t in log:
             w.writerow([s, f"{l:.6g}", f"{t:.2f}"])
-    (out / "gtf_train_summary.json").write_text(json.dumps(
+    write_text(out / "gtf_train_summary.json", json.dumps(
         {"steps": step, "train_s": round(elapsed, 1), "final_l1": final_l1, "final_rel": final_rel,
          "code_norm_mean": float(codes.detach().norm(dim=1).mean()),
          "code_std": float(codes.detach().std())}, indent=2) + "\n")

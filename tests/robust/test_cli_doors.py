@@ -1,0 +1,50 @@
+"""Every numeric CLI option is finite and in range; output paths fail before any work."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from woodcam.cli import main
+
+BAKE = ["bake", "cad_examples/bowl.py", "--block", "builtin:flat-sawn"]
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["gcode", "toolpaths/vcarve_text.nc", "--tool", "vbit:60:12", "--block", "builtin:flat-sawn",
+      "--out", "OUT/x.glb", "--work-offset", "nan,nan,nan"], r"--work-offset X,Y,Z takes 3 comma-separated finite"),
+    (["gcode", "toolpaths/vcarve_text.nc", "--tool", "vbit:60:12", "--block", "builtin:flat-sawn",
+      "--out", "OUT/x.glb", "--work-offset", "0,0,inf"], r"--work-offset"),
+    (["gcode", "toolpaths/vcarve_text.nc", "--tool", "vbit:60:12", "--block", "builtin:flat-sawn",
+      "--out", "OUT/x.glb", "--resolution", "1e-9"], r"--resolution must be in \[0.005, 10\]"),
+    ([*BAKE, "--out", "OUT/x.glb", "--tolerance", "0"], r"--tolerance must be in \(0, 10\]; got 0.0"),
+    ([*BAKE, "--out", "OUT/x.glb", "--tolerance", "nan"], r"--tolerance must be a finite number"),
+    ([*BAKE, "--out", "OUT/x.glb", "--texels-per-mm", "inf"], r"--texels-per-mm must be a finite"),
+    ([*BAKE, "--out", "OUT/x.glb", "--texels-per-mm", "1e6"], r"--texels-per-mm must be in"),
+    ([*BAKE, "--out", "OUT/x.glb", "--timeout=-1"], r"--timeout must be in \(0"),
+    (["fit", "/nonexistent", "--size-mm", "1e9", "--out", "OUT/f.npz"], r"--size-mm must be in \(0, 10000\]"),
+    (["fit", "/nonexistent", "--size-mm=-inf", "--out", "OUT/f.npz"], r"--size-mm must be a finite"),
+    (["block", "synth", "--count", "0", "--out", "OUT/b"], r"--count must be in \[1,"),
+    (["block", "synth", "--count", "1", "--face-px", "100000000", "--out", "OUT/b"], r"--face-px must be in"),
+    (["train", "gtf", "--steps", "0", "--out", "OUT/t"], r"--steps must be in \[1,"),
+    ([*BAKE, "--out", "OUT/x.stl"], r"--out must end in .glb"),
+    ([*BAKE, "--out", "OUT"], r"--out must end in .glb"),
+    ([*BAKE, "--out", "OUT/dir.glb"], r"is an existing folder"),
+    ([*BAKE, "--out", "OUT/file.txt/x.glb"], r"is a file, not a folder"),
+    ([*BAKE, "--out", "OUT/x.glb", "--screenshot", "OUT/x.jpg"], r"--screenshot must end in .png"),
+    ([*BAKE, "--out", "OUT/objdir/x.glb"], r"the OBJ beside the GLB"),
+])
+def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(__import__("pathlib").Path(__file__).resolve().parents[2])
+    out = tmp_path / "out"
+    (out / "dir.glb").mkdir(parents=True)
+    (out / "file.txt").write_text("")
+    (out / "objdir" / "x.obj").mkdir(parents=True)
+    argv = [a.replace("OUT", str(out)) for a in argv]
+    t0 = time.perf_counter()
+    assert main(argv) == 2
+    assert time.perf_counter() - t0 < 30.0  # refused before any fitting or baking (minutes)
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("woodcam: error: ")
+    assert __import__("re").search(match, err), err
