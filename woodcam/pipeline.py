@@ -46,6 +46,26 @@ class PartPreview:
         self.timings_s[name] = self.timings_s.get(name, 0.0) + time.perf_counter() - t0
 
 
+def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = False,
+                  what: str = "--out") -> Path:
+    """Check every file a preview will write *before* any work: ``out_glb`` ends in ``.glb``,
+    is not a folder, its folder exists (created if missing) and is writable; likewise the
+    ``.obj``/``.mtl``/``.png`` beside it when ``obj``, and the rendered ``*_view.png`` (or the
+    given screenshot path). Returns ``out_glb`` as a Path; raises WoodcamError naming the path."""
+    from ._atomic import check_output_path
+
+    out_glb = check_output_path(out_glb, suffixes=(".glb",), what=what, mkdir=True)
+    if obj:
+        for suffix in (".obj", ".mtl", ".png"):
+            check_output_path(out_glb.with_suffix(suffix), what=f"{what} (the {suffix[1:].upper()} "
+                              "beside the GLB; --no-obj skips it)")
+    if screenshot is True:
+        check_output_path(out_glb.with_name(out_glb.stem + "_view.png"), what=f"{what} (its view PNG)")
+    elif screenshot:
+        check_output_path(screenshot, suffixes=(".png",), what="--screenshot", mkdir=True)
+    return out_glb
+
+
 def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                  tolerance_mm: float | None = None, obj: bool = True,
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
@@ -55,7 +75,7 @@ def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
     from .cad import carve, load_part
     from .tolerances import TESSELLATION_TOL_MM
 
-    out_glb = Path(out_glb)
+    out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)  # before minutes of work
     result = PartPreview(out_glb.stem)
     with result.stage("load"):
         part = load_part(source, tolerance_mm=tolerance_mm or TESSELLATION_TOL_MM)
@@ -76,8 +96,7 @@ def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, ob
     from .bake import bake
     from .export import export_glb, export_obj
 
-    out_glb = Path(out_glb)
-    out_glb.parent.mkdir(parents=True, exist_ok=True)
+    out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
     result = result or PartPreview(out_glb.stem)
     result.volume_mm3 = float(mesh.volume)
     result.triangles = int(len(mesh.faces))

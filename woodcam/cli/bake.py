@@ -55,10 +55,11 @@ def run_demo(args: argparse.Namespace) -> int:
 
 
 def run_bake(args: argparse.Namespace) -> int:
-    from ..pipeline import preview_part
+    from ..pipeline import check_outputs, preview_part
     from ..stock import open_stock
     from . import print_warnings
 
+    check_outputs(args.out, obj=not args.no_obj, screenshot=getattr(args, "screenshot", None) or False)
     stock = open_stock(args.block, **stock_options(args))
     res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
                        tolerance_mm=args.tolerance, obj=not args.no_obj, screenshot=False,

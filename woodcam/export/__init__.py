@@ -36,6 +36,7 @@ from typing import get_args
 
 import numpy as np
 
+from woodcam._atomic import atomic_files, check_output_path, write_bytes
 from woodcam.errors import WoodcamError
 from woodcam.frames import (BLOCK_TO_GLTF, GLTF_ROOT_NODE, OBJ_HEADER, ObjUnits, ObjUp,
                             obj_header_transform, obj_transform)
@@ -181,11 +182,7 @@ def export_glb(mesh, path, metadata: dict | None = None, *,
     from trimesh.exchange.gltf import export_glb as _trimesh_export_glb
 
     _require_textured(mesh, "export_glb")
-    path = Path(path)
-    if path.suffix.lower() != ".glb":
-        raise WoodcamError(
-            f"export_glb: path must end in .glb; got {str(path)!r}; use e.g. 'part.glb'"
-        )
+    path = check_output_path(path, suffixes=(".glb",), what="export_glb: path", mkdir=True)
     payload = {"units": "mm", "frame": "block", "block_to_gltf": BLOCK_TO_GLTF.tolist()}
     if metadata is not None:
         try:
@@ -215,8 +212,7 @@ def export_glb(mesh, path, metadata: dict | None = None, *,
     scene = trimesh.Scene()
     scene.add_geometry(shaded, geom_name="part", node_name="part")
     data = _trimesh_export_glb(scene, include_normals=True, tree_postprocessor=_add_extras)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_bytes(data)
+    write_bytes(path, data)  # atomic: a complete GLB or none
     return path
 
 
@@ -264,11 +260,7 @@ def export_obj(mesh, path, *, units: ObjUnits = "m", up: ObjUp = "y",
     from trimesh.exchange.obj import export_obj as _trimesh_export_obj
 
     _require_textured(mesh, "export_obj")
-    path = Path(path)
-    if path.suffix.lower() != ".obj":
-        raise WoodcamError(
-            f"export_obj: path must end in .obj; got {str(path)!r}; use e.g. 'part.obj'"
-        )
+    path = check_output_path(path, suffixes=(".obj",), what="export_obj: path", mkdir=True)
     if units not in get_args(ObjUnits):
         raise WoodcamError(f"export_obj: units must be one of {get_args(ObjUnits)}; got {units!r}")
     if up not in get_args(ObjUp):
@@ -299,10 +291,13 @@ def export_obj(mesh, path, *, units: ObjUnits = "m", up: ObjUp = "y",
     )
     header = (f"{OBJ_HEADER} units={units} up={up} (block frame: mm, Z up; "
               f"see woodcam.export.export_obj)\n")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(header + text)
-    for name, blob in files.items():
-        (path.parent / name).write_bytes(blob)
+    # OBJ + MTL + PNG as one unit: all renamed into place only once every one is written, the
+    # OBJ (which references the others) last.
+    names = list(files)
+    with atomic_files([path] + [path.parent / n for n in names]) as temps:
+        temps[0].write_text(header + text)
+        for tmp, name in zip(temps[1:], names):
+            tmp.write_bytes(files[name])
     return path
 
 
