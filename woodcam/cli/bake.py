@@ -67,10 +67,11 @@ def run_bake(args: argparse.Namespace) -> int:
     from ..stock import open_stock
     from . import print_warnings
 
-    check_outputs(args.out, obj=not args.no_obj, screenshot=args.screenshot or False)  # before work
+    check_outputs(args.out, obj=not args.no_obj, screenshot=getattr(args, "screenshot", None) or False)
     stock = open_stock(args.block, **stock_options(args))
     res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
-                       tolerance_mm=args.tolerance, timeout_s=args.timeout, obj=not args.no_obj, screenshot=False,
+                       tolerance_mm=args.tolerance, timeout_s=args.timeout, obj=not args.no_obj,
+                       screenshot=False,
                        progress=True, obj_units=args.obj_units, obj_up=args.obj_up)
     write_screenshot(args, res.files, stock)
     print_warnings(res.warnings)
