@@ -15,7 +15,7 @@ import pytest
 import trimesh
 
 from woodcam.cad import load_part
-from woodcam.errors import WoodcamError
+from woodcam.errors import WoodcamError, WoodcamWarning
 from woodcam.tolerances import CARVE_VOLUME_RTOL
 
 #: Relative volume error of a mesh that went through a float32 file format (STL, GLB): vertex
@@ -109,8 +109,10 @@ def test_mesh_with_holes_is_repaired():
     one_missing = trimesh.Trimesh(box.vertices, box.faces[:-1])
     two_missing = trimesh.Trimesh(box.vertices, box.faces[:-2])  # a whole square face gone
     assert not one_missing.is_watertight and not two_missing.is_watertight
-    assert load_part(one_missing).volume() == pytest.approx(1000, rel=1e-12)
-    assert load_part(two_missing).volume() == pytest.approx(1000, rel=1e-12)
+    with pytest.warns(WoodcamWarning, match="1 hole.*capped each hole flat.*1000 mm"):
+        assert load_part(one_missing).volume() == pytest.approx(1000, rel=1e-12)
+    with pytest.warns(WoodcamWarning, match="1 hole.*1000 mm"):
+        assert load_part(two_missing).volume() == pytest.approx(1000, rel=1e-12)
 
 
 def test_open_surface_raises():

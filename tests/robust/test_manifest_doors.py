@@ -180,3 +180,38 @@ def test_mokume_damaged_image(tmp_path):
     (tmp_path / "A_col.png").write_bytes(b"")
     with pytest.raises(WoodcamError, match="cannot decode"):
         read_mokume(tmp_path)
+
+
+@pytest.mark.parametrize("side", range(6))
+def test_stl_missing_a_side_is_capped_flat_and_said(tmp_path, side):
+    """Issue 15: an STL box missing one side came back as an 833 mm^3 solid, silently."""
+    import trimesh
+
+    from woodcam.cad import load_part
+    from woodcam.errors import WoodcamWarning
+
+    box = trimesh.creation.box(extents=(10, 10, 10))
+    normal = np.eye(3)[side // 2] * (1 if side % 2 else -1)
+    on_side = np.flatnonzero(np.all(np.isclose(box.face_normals, normal), axis=1))
+    assert len(on_side) == 2
+    holey = trimesh.Trimesh(box.vertices, np.delete(box.faces, on_side, axis=0))
+    holey.export(tmp_path / "holey.stl")
+    with pytest.warns(WoodcamWarning, match="was not closed: 4 open edges in 1 hole"):
+        solid = load_part(tmp_path / "holey.stl")
+    assert solid.volume() == pytest.approx(1000.0, rel=1e-9)
+
+
+def test_stl_with_a_hole_that_is_not_flat_is_refused(tmp_path):
+    """Two triangles of two different sides missing: a cap is a guess (917 or 1000 mm^3)."""
+    import trimesh
+
+    from woodcam.cad import load_part
+
+    box = trimesh.creation.box(extents=(10, 10, 10))
+    n = box.face_normals
+    a = np.flatnonzero(np.isclose(n[:, 0], -1))[0]
+    b = np.flatnonzero(np.isclose(n[:, 1], -1) & np.isin(box.faces, box.faces[a]).sum(1).astype(bool))
+    b = b[np.isin(box.faces[b], box.faces[a]).sum(1) == 2][0]  # shares an edge with a
+    trimesh.Trimesh(box.vertices, np.delete(box.faces, [a, b], axis=0)).export(tmp_path / "h.stl")
+    with pytest.raises(WoodcamError, match="is not flat"):
+        load_part(tmp_path / "h.stl")

@@ -14,7 +14,6 @@ Limits (:mod:`woodcam.limits`): ``MAX_BLOCK_SIZE_MM``, ``MAX_FACE_PX``, ``MAX_TR
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from pathlib import Path
@@ -25,28 +24,6 @@ from ..frames import FACES
 
 #: Environment variable that lets manifests name files outside their folder (absolute or ``..``).
 ALLOW_OUTSIDE_ENV = "WOODCAM_ALLOW_OUTSIDE_PATHS"
-
-
-def strict_json_loads(text: str, what: str) -> Any:
-    """``json.loads`` that refuses NaN/Infinity and maps every failure to a WoodcamError."""
-    def _no_constant(c):
-        raise ValueError(f"non-finite number {c} is not allowed")
-
-    try:
-        return json.loads(text, parse_constant=_no_constant)
-    except (ValueError, RecursionError) as err:  # JSONDecodeError is a ValueError
-        raise WoodcamError(f"{what} must be valid JSON with finite numbers; {err}") from err
-
-
-def read_json_file(path: Path, what: str) -> Any:
-    """Read and strictly parse a JSON file; unreadable or non-UTF-8 files are WoodcamErrors."""
-    try:
-        text = Path(path).read_bytes().decode("utf-8")
-    except OSError as err:
-        raise WoodcamError(f"{what}: cannot read {str(path)!r} ({err.strerror})") from err
-    except UnicodeDecodeError as err:
-        raise WoodcamError(f"{what}: {str(path)!r} is not UTF-8 text ({err.reason})") from err
-    return strict_json_loads(text, f"{what} {str(path)!r}")
 
 
 def allow_outside_default() -> bool:

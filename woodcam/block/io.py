@@ -140,7 +140,8 @@ def read_block(folder, *, allow_outside: bool | None = None) -> Block:
     file it names must lie inside ``folder`` unless ``allow_outside`` (default: the
     ``WOODCAM_ALLOW_OUTSIDE_PATHS`` environment variable) says this manifest is trusted.
     """
-    from ._schema import check_manifest, read_json_file
+    from .._readers import read_json_file
+    from ._schema import check_manifest
 
     folder = Path(folder)
     path = folder / MANIFEST if folder.is_dir() else folder
@@ -255,7 +256,7 @@ def _write_field(field, folder: Path) -> dict:
 def _read_field(entry, path: Path | None):
     if not entry or not entry.get("saved"):
         return None
-    from ._schema import read_json_file
+    from .._readers import read_json_file
 
     state = read_json_file(path, "true field of the block")
     try:

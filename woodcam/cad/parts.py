@@ -348,8 +348,11 @@ def _manifold_from_trimesh(mesh, origin: str):
     if not keep.all():
         welded.update_faces(keep)
         welded.remove_unreferenced_vertices()
-    if not welded.is_watertight or not welded.is_winding_consistent:
-        trimesh.repair.fill_holes(welded)
+    if not welded.is_watertight:
+        # Closed by flat fans, one per hole, and said so: trimesh's fill_holes turned a box
+        # missing one side into an 833 mm^3 solid instead of 1000 without a word (issue 15).
+        welded = _close_holes(welded, origin)
+    if not welded.is_winding_consistent:
         trimesh.repair.fix_winding(welded)
     if not welded.is_watertight:
         raise WoodcamError(
@@ -360,6 +363,65 @@ def _manifold_from_trimesh(mesh, origin: str):
     if welded.volume < 0:
         welded.invert()
     return _manifold_from_arrays(welded.vertices, welded.faces, origin)
+
+
+def _close_holes(mesh, origin: str):
+    """Close every hole of an open mesh with a fan from the centroid of its boundary loop and
+    warn with what was added; returns a new mesh (the input if it has no boundary loop).
+
+    A fan is exact for a flat hole (a missing box side comes back as the flat side), and the
+    user is told, since no repair can know the part; a hole that is not flat has no obvious cap
+    and is refused.
+    Boundary loops are the connected components of the edges used by one face only; each
+    boundary edge ``a -> b`` (as its face runs it) is capped by the triangle ``(b, a, centroid)``
+    so the caps are wound like their neighbours."""
+    import trimesh
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    counts = np.bincount(mesh.edges_unique_inverse, minlength=len(mesh.edges_unique))
+    edges = np.asarray(mesh.edges)  # directed, as each face runs them
+    boundary = edges[counts[mesh.edges_unique_inverse] == 1]
+    if len(boundary) == 0 or np.any(counts > 2):
+        return mesh  # non-manifold edges: not a hole problem; the caller refuses it
+    n = len(mesh.vertices)
+    graph = coo_matrix((np.ones(len(boundary)), (boundary[:, 0], boundary[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    loops, loop_of_edge = np.unique(label[boundary[:, 0]], return_inverse=True)
+    used = np.unique(boundary)
+    sums = np.zeros((len(loops), 3))
+    np.add.at(sums, np.searchsorted(loops, label[used]), mesh.vertices[used])
+    loop_index = np.searchsorted(loops, label[used])
+    centroids = sums / np.bincount(loop_index)[:, None]
+    for k in range(len(loops)):  # a few holes at most: a loop over holes, not points
+        pts = mesh.vertices[used[loop_index == k]] - centroids[k]
+        extent = float(np.abs(pts).max())
+        if len(pts) > 3 and np.linalg.svd(pts, compute_uv=False)[-1] > 1e-6 * extent * np.sqrt(len(pts)):
+            raise WoodcamError(
+                f"{origin} is not a closed (watertight) mesh: it has {len(boundary)} open edges "
+                f"in {len(loops)} hole(s), and hole {k + 1} ({len(pts)} corners) is not flat, so "
+                "no cap is the obvious one (different caps give different solids); close the "
+                "mesh in your CAD program (export a solid, not surfaces) or repair it (e.g. "
+                "Meshmixer, MeshLab)")
+    caps = np.column_stack([boundary[:, 1], boundary[:, 0], n + loop_of_edge])
+    closed = trimesh.Trimesh(np.vstack([mesh.vertices, centroids]),
+                             np.vstack([mesh.faces, caps]), process=False)
+    tri = closed.vertices[closed.faces]
+    vol = abs(float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum()) / 6)
+    size = float(np.ptp(mesh.vertices, axis=0).max())
+    if vol <= 1e-9 * size**3:  # an open surface capped by itself encloses nothing
+        return mesh
+    if closed.is_watertight:
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        warnings.warn(WoodcamWarning(
+            f"{origin} was not closed: {len(boundary)} open edges in {len(loops)} hole(s); "
+            f"woodcam capped each hole flat ({len(caps)} triangles added), giving a solid of "
+            f"{vol:.6g} mm^3. Check that this is the part you meant, or export a closed solid"),
+            stacklevel=4)
+    return closed
 
 
 def _count_open_edges(mesh) -> int:

@@ -108,8 +108,13 @@ class Knot:
         if np.any(arrs["diameter_mm"] < 0) or not np.all(np.isfinite(r)):
             raise WoodcamError("Knot.diameter_mm must be >= 0 and finite; got a negative value; "
                                "clip the diameter model at 0")
-        if not (self.r_end_mm > 0):
-            raise WoodcamError(f"Knot.r_end_mm must be > 0 mm; got {self.r_end_mm}")
+        bad = [k for k, a in arrs.items() if not np.all(np.isfinite(a))]
+        bad += [k for k in ("z0_mm", "azimuth0_rad", "r_death_mm")
+                if not np.isfinite(getattr(self, k))]
+        if bad:
+            raise WoodcamError(f"Knot: {', '.join(bad)} must be finite; got NaN or inf")
+        if not (0 < self.r_end_mm < np.inf):
+            raise WoodcamError(f"Knot.r_end_mm must be > 0 mm and finite; got {self.r_end_mm}")
         object.__setattr__(self, "r_mm", r)
         for k, v in arrs.items():
             object.__setattr__(self, k, v)
@@ -130,6 +135,8 @@ class Knot:
         for ``A r + B r^2 / 100`` (tests/fields/test_tree_data.py).
         ``r_death < 0.1`` means the branch died at once (treated as 0).
         """
+        if not 2 <= samples <= 100_000:
+            raise WoodcamError(f"Knot.from_model: samples must be in [2, 100000]; got {samples}")
         r_top = float(max(r_end, r_max_mm or 0.0))
         # quadratic spacing: dense near the pith, where sqrt(r) and ln(r) bend most
         r = r_top * np.linspace(0.0, 1.0, samples) ** 2
@@ -218,6 +225,9 @@ class Log:
                                f"got shape {z.shape}; sort the pith samples by height")
         if xy.shape != (len(z), 2):
             raise WoodcamError(f"Log.pith_xy_mm must have shape ({len(z)}, 2); got {xy.shape}")
+        if not (np.all(np.isfinite(z)) and np.all(np.isfinite(xy)) and np.all(np.isfinite(rad))):
+            raise WoodcamError("Log: pith_z_mm, pith_xy_mm and radii_mm must be finite; got NaN "
+                               "or inf")
         if rad.ndim != 2 or rad.shape[0] != len(z) or rad.shape[1] < 4 or np.any(rad <= 0):
             raise WoodcamError(f"Log.radii_mm must be ({len(z)}, a>=4) positive radii; got "
                                f"shape {rad.shape}; give one row of azimuth radii per pith height")
@@ -283,6 +293,8 @@ class Log:
 
     @classmethod
     def from_json(cls, d: dict) -> "Log":
+        if not isinstance(d, dict):
+            raise WoodcamError(f"a log file must hold a JSON object; got {type(d).__name__}")
         if d.get("format") != "woodcam-log":
             raise WoodcamError(f"log file format must be 'woodcam-log'; got {d.get('format')!r}; "
                                "write the file with woodcam.fields.tree_data.write_log")
@@ -293,6 +305,11 @@ class Log:
         except KeyError as err:
             raise WoodcamError(f"log file is missing the key {err.args[0]!r}; it needs "
                                "pith_z_mm, pith_xy_mm and radii_mm") from err
+        except (TypeError, ValueError, IndexError, AttributeError, OverflowError) as err:
+            if isinstance(err, WoodcamError):
+                raise
+            raise WoodcamError(f"log file has a value of the wrong type or shape ({type(err).__name__}: "
+                               f"{err}); numbers and lists of numbers as write_log writes them") from err
 
 
 def simple_log(length_mm: float = 600.0, radius_mm: float = 100.0, knots=(), *,
@@ -343,9 +360,9 @@ def log_from_generated(gen, *, z_step_mm: float = 5.0, azimuths: int = 360,
 
 def write_log(log: Log, path) -> Path:
     """Write ``log`` as a woodcam log file (JSON, mm); returns the path."""
-    path = Path(path)
-    path.write_text(json.dumps(log.to_json()))
-    return path
+    from .._atomic import write_text
+
+    return write_text(path, json.dumps(log.to_json()))
 
 
 def read_log(path) -> Log:
@@ -354,12 +371,9 @@ def read_log(path) -> Log:
     if not path.is_file():
         raise WoodcamError(f"log file {str(path)!r} does not exist; give a path to a JSON file "
                            "written by woodcam (or use the real log: --real)")
-    try:
-        d = json.loads(path.read_text())
-    except json.JSONDecodeError as err:
-        raise WoodcamError(f"log file {str(path)!r} is not valid JSON ({err}); "
-                           "write it with woodcam.fields.tree_data.write_log") from err
-    return Log.from_json(d)
+    from .._readers import read_json_file
+
+    return Log.from_json(read_json_file(path, "log file"))
 
 
 def read_gran1(folder=None, *, centre: bool = True) -> Log:

@@ -43,6 +43,10 @@ import numpy as np
 
 from ..errors import WoodcamError
 
+#: Largest cutter diameter accepted (mm): a 1 m cutter is a typo, and the stock simulation's
+#: footprint of one tool grows with its square.
+MAX_TOOL_DIAMETER_MM = 1000.0
+
 ToolType = Literal["flat", "ball", "bull", "vbit"]
 TOOL_TYPES: tuple[str, ...] = ("flat", "ball", "bull", "vbit")
 
@@ -56,9 +60,12 @@ class Tool:
     kind = "tool"
 
     def __post_init__(self):
-        if not (self.diameter_mm > 0 and math.isfinite(self.diameter_mm)):
-            raise WoodcamError(f"{type(self).__name__}: diameter_mm must be a positive number, "
-                               f"got {self.diameter_mm!r}; give the cutting diameter in mm")
+        d = self.diameter_mm
+        if (isinstance(d, bool) or not isinstance(d, (int, float, np.number))
+                or not (0 < d <= MAX_TOOL_DIAMETER_MM)):
+            raise WoodcamError(f"{type(self).__name__}: diameter_mm must be a positive number in (0, "
+                               f"{MAX_TOOL_DIAMETER_MM:g}] mm, got {d!r}; give the cutting "
+                               "diameter in mm")
 
     @property
     def radius_mm(self) -> float:
@@ -303,11 +310,14 @@ def load_tool_table(path) -> dict[int, Tool]:
     """Read a TOML tool table (module docstring) into ``{tool number: Tool}``."""
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(path.read_bytes().decode("utf-8"))
     except FileNotFoundError as err:
         raise WoodcamError(f"load_tool_table: path={str(path)!r} does not exist; pass a TOML "
                            "tool table") from err
-    except tomllib.TOMLDecodeError as err:
+    except OSError as err:
+        raise WoodcamError(f"load_tool_table: cannot read {str(path)!r} ({err.strerror}); pass "
+                           "a TOML tool table file") from err
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError, RecursionError) as err:
         raise WoodcamError(f"load_tool_table: {path} is not valid TOML ({err}); fix the file"
                            ) from err
     table = data.get("tools")
@@ -321,17 +331,31 @@ def load_tool_table(path) -> dict[int, Tool]:
         except ValueError as err:
             raise WoodcamError(f"load_tool_table: {path}: tool key {key!r} must be the tool "
                                "number, e.g. [tools.1]") from err
-        kind = str(entry.get("type", ""))
-        d = entry.get("diameter_mm")
-        if kind not in TOOL_TYPES or d is None:
+        if not 0 <= number <= 99999:
+            raise WoodcamError(f"load_tool_table: {path}: tool number {key!r} must be in "
+                               "[0, 99999]")
+        if not isinstance(entry, dict):
+            raise WoodcamError(f"load_tool_table: {path}: tools.{key} must be a table "
+                               f"([tools.{key}] with type and diameter_mm), got {entry!r}")
+        kind = entry.get("type")
+        if kind not in TOOL_TYPES or "diameter_mm" not in entry:
             raise WoodcamError(f"load_tool_table: {path}: [tools.{key}] needs type (one of "
                                f"{TOOL_TYPES}) and diameter_mm, got {dict(entry)!r}")
+
+        def num(name: str, key=key, entry=entry) -> float:
+            v = entry.get(name, math.nan)
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise WoodcamError(f"load_tool_table: {path}: [tools.{key}] {name} must be a "
+                                   f"number, got {v!r}")
+            return float(v)
+
+        d = num("diameter_mm")
         if kind == "flat":
-            out[number] = FlatEndMill(float(d))
+            out[number] = FlatEndMill(d)
         elif kind == "ball":
-            out[number] = BallEndMill(float(d))
+            out[number] = BallEndMill(d)
         elif kind == "bull":
-            out[number] = BullNoseMill(float(d), float(entry.get("corner_radius_mm", math.nan)))
+            out[number] = BullNoseMill(d, num("corner_radius_mm"))
         else:
-            out[number] = VBit(float(d), float(entry.get("angle_deg", math.nan)))
+            out[number] = VBit(d, num("angle_deg"))
     return out
