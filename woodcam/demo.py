@@ -6,6 +6,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ._atomic import atomic_path
 from .errors import WoodcamError
 from .pipeline import PartPreview, preview_part
 from .stock import open_stock
@@ -98,5 +99,6 @@ def render_overview(parts: list[PartPreview], png, *, tile_px: tuple[int, int] =
     for t in tiles:
         strip.paste(t, (x, 0))
         x += t.width
-    strip.save(png)
+    with atomic_path(png) as tmp:
+        strip.save(tmp)
     return Path(png)

@@ -28,6 +28,7 @@ import numpy as np
 
 from .block import Block, Face, RingTrace
 from .block.io import write_block
+from ._atomic import write_text
 from .errors import WoodcamError
 from .fields.base import LogFrame, arf, check_points, evaluate, grain_direction
 from .fields.placement import PlacedField
@@ -704,7 +705,7 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
         write_block(block, folder)
         folders.append(folder)
         index["blocks"].append(info)
-    (out_dir / "index.json").write_text(json.dumps(index, indent=1))
+    write_text(out_dir / "index.json", json.dumps(index, indent=1))
     return folders
 
 

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field as dc_field, replace
 
 import numpy as np
 
+from .._atomic import atomic_path
 from ..errors import WoodcamError
 from ..frames import FACE_AXIS, FACE_NORMAL
 from .colormap import ColorMapAppearance
@@ -290,7 +291,8 @@ def side_by_side(results: list[FaceEval], path, title: str = "") -> None:
                 d.text(((i + 1) * col_w + 2, y0 + 1), m, fill=(0, 0, 0))
                 d.text(((i + 1) * col_w + 2, y0 + 12),
                        f"{sc['histogram']:.3f}/{sc['spectrum']:.2f}/{sc['patch']:.3f}", fill=(0, 0, 0))
-    img.save(path)
+    with atomic_path(path) as tmp:  # a complete image or none
+        img.save(tmp)
 
 
 # -- looking at a whole block: parts carved from it ------------------------------------------------

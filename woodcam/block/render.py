@@ -11,6 +11,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._atomic import atomic_path
 from ..errors import WoodcamError
 from ..frames import CrossLayout, FACES, face_image_size_mm, unfold_cross
 from .block import Block
@@ -89,4 +90,5 @@ def save_cross_png(block: Block, path, layer: Layer = "photo", **kwargs) -> None
     """Write :func:`cross_image` of ``block`` to ``path`` as PNG."""
     from PIL import Image
 
-    Image.fromarray(cross_image(block, layer, **kwargs)).save(path)
+    with atomic_path(path) as tmp:
+        Image.fromarray(cross_image(block, layer, **kwargs)).save(tmp)

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._atomic import atomic_path
 from ..errors import WoodcamError
 from .block import Face, RingTrace
 
@@ -59,7 +60,8 @@ def write_traces_svg(face: Face, path, *, photo_href: str | None = None, stroke_
             attrs["data-year"] = str(int(t.year))
         ET.SubElement(group, "polyline", attrs)
     path = Path(path)
-    ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+    with atomic_path(path) as tmp:
+        ET.ElementTree(root).write(tmp, encoding="utf-8", xml_declaration=True)
     return path
 
 

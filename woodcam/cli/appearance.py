@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from .._atomic import write_text
 from .options import add_block_argument, add_size_option, command_group, open_block
 
 
@@ -76,6 +77,6 @@ def run(args) -> int:
         print(f"{block.name}: " + "; ".join(
             f"{m} hist {s[m]['histogram']:.3f} spec {s[m]['spectrum']:.3f} patch {s[m]['patch']:.3f}"
             for m in MODELS if m in s))
-    (args.out / "results.json").write_text(json.dumps(report, indent=1))
+    write_text(args.out / "results.json", json.dumps(report, indent=1))
     print(f"wrote {args.out / 'results.json'} and one PNG per block")
     return 0

@@ -38,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._atomic import atomic_path, write_text
 from ..errors import WoodcamError
 from .tree_data import Knot, Log
 
@@ -118,9 +119,10 @@ def write_maps(log: Log, folder, **kw) -> dict:
     out = {}
     for k, a in maps.items():
         out[k] = folder / MAP_FILES[k]
-        Image.fromarray(a, "RGB").save(out[k])
+        with atomic_path(out[k]) as tmp:
+            Image.fromarray(a, "RGB").save(tmp)
     out["params"] = folder / MAP_FILES["params"]
-    out["params"].write_text(json.dumps(params, indent=1))
+    write_text(out["params"], json.dumps(params, indent=1))
     return out
 
 

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field as dc_field
 
 import numpy as np
 
+from .._atomic import write_text
 from ..errors import WoodcamError, require
 from ..fields.base import evaluate
 from ..frames import check_size
@@ -276,7 +277,7 @@ def benchmark(blocks, methods=("rbf", "radial"), face_sets=None, out_dir=None,
                       + markdown_table(rows, list(methods)))
     result["table"] = "\n\n".join(tables) + "\n"
     if out_dir is not None:
-        (Path(out_dir) / "table.md").write_text(result["table"])
+        write_text(Path(out_dir) / "table.md", result["table"])
     return result
 
 

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._atomic import write_text
 from ..errors import WoodcamError, require
 from ..fields.base import arf
 from ..frames import pixel_to_block
@@ -187,7 +188,7 @@ def leave_one_face_out(block, methods=("rbf", "radial"), out_dir=None, progress=
     if out_dir is not None:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        (out / f"{block.name}_holdout.md").write_text(res["table"])
+        write_text(out / f"{block.name}_holdout.md", res["table"])
         for m in methods:
             plot_holdout(out / f"{block.name}_{m}.png", block, held[m],
                          title=f"{block.name}, {m}: each face predicted from the other five")

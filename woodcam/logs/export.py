@@ -13,6 +13,7 @@ from typing import Literal
 import numpy as np
 import trimesh
 
+from .._atomic import atomic_path, write_bytes
 from ..errors import WoodcamError
 from .generate import GeneratedKnot, GeneratedLog
 
@@ -130,7 +131,7 @@ def export_log_glb(log: GeneratedLog, path, *, surface_alpha: float = 1.0, max_r
         scene.add_geometry(km, node_name="knots", geom_name="knots")
     scene.metadata["extras"] = {"units": "mm", "frame": "log frame, z along the log", "seed": log.seed}
     p.parent.mkdir(parents=True, exist_ok=True)
-    p.write_bytes(scene.export(file_type="glb"))
+    write_bytes(p, scene.export(file_type="glb"))
     return p
 
 
@@ -173,7 +174,8 @@ def heightmap_png(log: GeneratedLog, path, *, mode: Literal["height", "detail"] 
     info.add_text("woodcam:range_mm", f"{lo:.6f} {hi:.6f}")
     info.add_text("woodcam:mode", mode)
     p.parent.mkdir(parents=True, exist_ok=True)
-    Image.fromarray(np.round(img * 65535).astype(np.uint16)).save(p, pnginfo=info)
+    with atomic_path(p) as tmp:
+        Image.fromarray(np.round(img * 65535).astype(np.uint16)).save(tmp, pnginfo=info)
     return p
 
 

@@ -1,0 +1,184 @@
+"""Crash injection: ``woodcam bake`` killed with SIGKILL at random moments.
+
+After every kill, each output file is absent or complete (never truncated), the OBJ exists only
+with its MTL and PNG, and the next run, in the same output folder and with the same
+half-written cache, succeeds without any cleanup. Two concurrent cold-cache runs agree and leave
+one valid cache entry.
+
+The default run kills one quick bake of a built-in block; ``-m slow`` runs the campaign on a
+Mokume cube with a cold cache (``WOODCAM_KILL_POINTS`` kill points, default 50; the figures are
+in DEVELOPERS.md) and the concurrent colour-map and neural runs.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+OUTPUTS = ("part.glb", "part.obj", "part.mtl", "part.png")
+
+
+def _env(cache: Path) -> dict:
+    return dict(os.environ, PYTHONPATH=str(REPO), WOODCAM_CACHE_DIR=str(cache),
+                OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
+
+
+def _box_stl(folder: Path, centre=(25.0, 25.0, 25.0)) -> Path:
+    import trimesh
+
+    path = folder / "box.stl"
+    trimesh.creation.box(extents=(20, 16, 12)).apply_translation(centre).export(path)
+    return path
+
+
+def _bake_cmd(part: Path, block: str, out: Path, texels: float) -> list[str]:
+    return [sys.executable, "-m", "woodcam.cli", "bake", str(part), "--block", block,
+            "--out", str(out / "part.glb"), "--texels-per-mm", f"{texels:g}"]
+
+
+def _check_outputs(out: Path) -> list[str]:
+    """The problems of the files in ``out``: each must be absent or complete."""
+    from PIL import Image
+
+    from woodcam.export import load_textured
+
+    problems = []
+    present = {n for n in OUTPUTS if (out / n).exists()}
+    if "part.glb" in present:
+        try:
+            mesh = load_textured(out / "part.glb")
+            assert len(mesh.faces) > 0
+        except Exception as err:  # noqa: BLE001 - any failure means a partial file
+            problems.append(f"part.glb unreadable: {type(err).__name__}: {err}")
+    if "part.obj" in present:
+        missing = {"part.mtl", "part.png"} - present
+        if missing:
+            problems.append(f"part.obj without {sorted(missing)}")
+        text = (out / "part.obj").read_text()
+        if "mtllib part.mtl" not in text or not text.rstrip().splitlines()[-1].startswith("f "):
+            problems.append("part.obj truncated")
+    if "part.png" in present:
+        try:
+            with Image.open(out / "part.png") as im:
+                im.load()
+        except Exception as err:  # noqa: BLE001
+            problems.append(f"part.png unreadable: {err}")
+    return problems
+
+
+def _kill_then_rerun(cmd, cache, out, kill_after_s: float, timeout_s: float = 900) -> dict:
+    """Start ``cmd``, SIGKILL it after ``kill_after_s`` (if still running), check the outputs,
+    run it again without cleaning anything and check that run."""
+    env = _env(cache)
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+    try:
+        proc.wait(timeout=kill_after_s)
+        killed = False
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+        killed = True
+    after_kill = _check_outputs(out)
+    t0 = time.perf_counter()
+    rerun = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout_s,
+                           check=False)
+    return {"kill_s": round(kill_after_s, 2), "killed": killed, "partial": after_kill,
+            "rerun_rc": rerun.returncode, "rerun_err": rerun.stderr.strip().splitlines()[-1:]
+            if rerun.returncode else [], "rerun_s": round(time.perf_counter() - t0, 1),
+            "after_rerun": _check_outputs(out),
+            "complete": all((out / n).exists() for n in OUTPUTS)}
+
+
+def test_kill_a_quick_bake_then_rerun(tmp_path):
+    """One kill point in the default run: a built-in block, killed mid-run."""
+    part = _box_stl(tmp_path, (50.0, 40.0, 25.0))
+    out = tmp_path / "out"
+    out.mkdir()
+    cmd = _bake_cmd(part, "builtin:flat-sawn", out, 2)
+    t0 = time.perf_counter()
+    subprocess.run(cmd, env=_env(tmp_path / "cal"), check=True, capture_output=True)
+    full_s = time.perf_counter() - t0
+    res = _kill_then_rerun(cmd, tmp_path / "cache", out, 0.8 * full_s)
+    assert res["partial"] == [] and res["rerun_rc"] == 0, res
+    assert res["after_rerun"] == [] and res["complete"], res
+
+
+def _mokume(shared_data) -> str:
+    return str(shared_data / "mokume" / "H11")
+
+
+@pytest.mark.slow
+def test_kill_points_on_a_mokume_bake(shared_data, tmp_path):
+    """The campaign: ``WOODCAM_KILL_POINTS`` random kill points (default 50) on a cold-cache bake
+    of a Mokume cube; 0 partial outputs, 0 broken follow-up runs. Results go to
+    ``$WOODCAM_KILL_LOG`` (JSON lines) when set."""
+    n = int(os.environ.get("WOODCAM_KILL_POINTS", "50"))
+    part = _box_stl(tmp_path)
+    rng = np.random.default_rng(int(os.environ.get("WOODCAM_KILL_SEED", "15")))
+    # calibrate: one cold run gives the span the kill points are drawn from
+    cal = tmp_path / "cal"
+    cal.mkdir()
+    t0 = time.perf_counter()
+    subprocess.run(_bake_cmd(part, _mokume(shared_data), cal, 2), env=_env(tmp_path / "calcache"),
+                   check=True, capture_output=True)
+    cold_s = time.perf_counter() - t0
+    log = os.environ.get("WOODCAM_KILL_LOG")
+    bad = []
+    for i in range(n):
+        out, cache = tmp_path / f"out{i}", tmp_path / f"cache{i}"
+        out.mkdir()
+        res = _kill_then_rerun(_bake_cmd(part, _mokume(shared_data), out, 2), cache, out,
+                               float(rng.uniform(0.02, 1.0)) * cold_s)
+        res.update(i=i, cold_s=round(cold_s, 1))
+        if log:
+            with open(log, "a") as fh:
+                fh.write(json.dumps(res) + "\n")
+        if res["partial"] or res["rerun_rc"] or res["after_rerun"] or not res["complete"]:
+            bad.append(res)
+    assert bad == []
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("appearance", ["colormap", "neural"])
+def test_concurrent_cold_cache_runs_agree(shared_data, tmp_path, appearance):
+    """Two processes open the same Mokume cube with one cold cache at the same time: both
+    succeed, their woods agree, and one valid entry per cache is left (no interleaved file)."""
+    script = f"""
+import json, sys, numpy as np
+from woodcam.stock import open_stock
+kw = {{"appearance": {appearance!r}}}
+if kw["appearance"] == "neural":
+    kw.update(quality="draft", epochs=2, resolution=24)
+s = open_stock({_mokume(shared_data)!r}, **kw)
+p = np.random.default_rng(0).uniform(0, 50, (2000, 3))
+n = np.tile([0.0, 0.0, 1.0], (2000, 1))
+np.save(sys.argv[1], np.concatenate([s.wood.field(p)[:, None], s.wood.color(p, n)], axis=1))
+"""
+    env = _env(tmp_path / "cache")
+    procs = [subprocess.Popen([sys.executable, "-c", script, str(tmp_path / f"r{i}.npy")], env=env,
+                              stderr=subprocess.PIPE, text=True) for i in range(2)]
+    errs = [p.communicate(timeout=1800)[1] for p in procs]
+    assert [p.returncode for p in procs] == [0, 0], errs
+    a, b = np.load(tmp_path / "r0.npy"), np.load(tmp_path / "r1.npy")
+    np.testing.assert_array_equal(a, b)
+    from woodcam.appearance.volumes import ColorVolumes
+    from woodcam.fields.grid import GridField
+
+    fields = sorted((tmp_path / "cache" / "fields").glob("*.npz"))
+    assert len(fields) == 1 and GridField.load(fields[0])
+    leftovers = [p.name for p in (tmp_path / "cache").rglob("*") if ".tmp" in p.name]
+    assert leftovers == []
+    if appearance == "neural":
+        vols = [p for p in (tmp_path / "cache" / "appearance").glob("*.npz")
+                if not p.name.endswith(".weights.npz")]
+        assert len(vols) == 1 and ColorVolumes.load(vols[0]).volumes.size
