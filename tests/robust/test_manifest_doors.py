@@ -215,3 +215,15 @@ def test_stl_with_a_hole_that_is_not_flat_is_refused(tmp_path):
     trimesh.Trimesh(box.vertices, np.delete(box.faces, [a, b], axis=0)).export(tmp_path / "h.stl")
     with pytest.raises(WoodcamError, match="is not flat"):
         load_part(tmp_path / "h.stl")
+
+
+@pytest.mark.parametrize("points, year, match", [
+    ([[0, 0], [1, float("nan")]], 1, "must be finite"),
+    ([[0, 0], [1, 1]], 10**12, "year of a ring trace must be an integer"),
+    ([[0, 0], [1, 1]], 2.5, "year of a ring trace must be an integer"),
+    ([[0, 0], [1, 1]], True, "year of a ring trace must be an integer"),
+])
+def test_ring_trace_checks_its_numbers(points, year, match):
+    with pytest.raises(WoodcamError, match=match):
+        RingTrace(np.array(points, float), year)
+    assert RingTrace(np.zeros((2, 2)), 3.0).year == 3

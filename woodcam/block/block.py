@@ -34,11 +34,28 @@ class RingTrace:
     year: int | None = None
 
     def __post_init__(self):
+        from ..limits import limit
+
         p = np.asarray(self.points_px, dtype=float)
         if p.ndim != 2 or p.shape[1] != 2 or len(p) < 2:
             raise WoodcamError(
                 f"points_px of a ring trace must have shape (k >= 2, 2) as (row, col); got {p.shape}"
             )
+        if not np.all(np.isfinite(p)):
+            raise WoodcamError("points_px of a ring trace must be finite; got NaN or inf")
+        if len(p) > limit("MAX_TRACE_POINTS"):
+            raise WoodcamError(f"a ring trace has {len(p)} points, more than the limit "
+                               f"MAX_TRACE_POINTS = {limit('MAX_TRACE_POINTS'):.0f}; simplify it or "
+                               "raise the limit with WOODCAM_MAX_TRACE_POINTS=N")
+        y = self.year
+        if y is not None:
+            top = limit("MAX_RING_YEAR")
+            whole = isinstance(y, (int, np.integer)) or (isinstance(y, (float, np.floating))
+                                                         and float(y).is_integer())
+            if isinstance(y, bool) or not whole or not -top <= y <= top:
+                raise WoodcamError(f"year of a ring trace must be an integer in [-{top:.0f}, "
+                                   f"{top:.0f}] or None; got {y!r}")
+            object.__setattr__(self, "year", int(y))
         object.__setattr__(self, "points_px", p)
 
 
