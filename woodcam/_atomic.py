@@ -17,6 +17,9 @@ middle of a write never leaves a truncated GLB, a 0-byte OBJ or a half cache beh
   path named (the primary file, e.g. the OBJ that references the others) is renamed *last*, so
   its presence means the whole group is in place. A crash between renames can leave complete
   side files without their primary, never a partial file.
+* :func:`all_or_nothing` -- ``with all_or_nothing(): export_glb(...); export_obj(...)``: every
+  atomic write inside the block is renamed into place only when the whole block succeeded
+  (the first file written, renamed last), so a GLB and its OBJ + MTL + PNG appear as one set.
 * :func:`check_output_path` -- validate an output path *before* the work starts: known suffix,
   not a directory, parent folder exists, is a folder and is writable. Raises
   :class:`~woodcam.errors.WoodcamError` naming the option, the rule, the value and a fix.
@@ -29,6 +32,7 @@ the result is always one writer's complete file.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
 import tempfile
 from collections.abc import Iterable, Iterator
@@ -37,8 +41,8 @@ from typing import IO
 
 from .errors import WoodcamError
 
-__all__ = ["atomic_files", "atomic_path", "atomic_write", "check_output_path", "write_bytes",
-           "write_text"]
+__all__ = ["all_or_nothing", "atomic_files", "atomic_path", "atomic_write", "check_output_path",
+           "write_bytes", "write_text"]
 
 
 def _umask() -> int:
@@ -80,13 +84,56 @@ def _fsync_dir(folder: Path) -> None:
         os.close(fd)
 
 
+#: Renames deferred by an active :func:`all_or_nothing` block: [(tmp, target), ...].
+_PENDING: contextvars.ContextVar[list | None] = contextvars.ContextVar("woodcam_pending", default=None)
+
+
 def _commit(tmp: Path, path: Path, fsync: bool) -> None:
     os.chmod(tmp, _FILE_MODE)  # mkstemp makes 0600; give the file ordinary permissions
     if fsync:
         _fsync_path(tmp)
+    pending = _PENDING.get()
+    if pending is not None:  # inside all_or_nothing(): renamed when the whole block succeeds
+        pending.append((tmp, path))
+        return
     os.replace(tmp, path)
     if fsync:
         _fsync_dir(path.parent)
+
+
+@contextlib.contextmanager
+def all_or_nothing() -> Iterator[None]:
+    """Defer every atomic write made inside the block and rename them together at its end.
+
+    Several writers (e.g. ``export_glb`` then ``export_obj``) become one unit: if anything in
+    the block raises, every temporary file is removed and no target changes; on success the
+    targets are renamed in the order they were written, except the *first* one (the primary
+    file, e.g. the GLB), which is renamed last so its presence means the set is complete.
+    Blocks nest: an inner block joins the outer one.
+    """
+    if _PENDING.get() is not None:
+        yield
+        return
+    pending: list = []
+    token = _PENDING.set(pending)
+    try:
+        yield
+    except BaseException:
+        _PENDING.reset(token)
+        for tmp, _ in pending:
+            _discard(tmp)
+        raise
+    _PENDING.reset(token)
+    order = pending[1:] + pending[:1]
+    try:
+        for tmp, path in order:
+            os.replace(tmp, path)
+    except BaseException:
+        for tmp, _ in order:
+            _discard(tmp)
+        raise
+    for folder in {path.parent for _, path in order}:
+        _fsync_dir(folder)
 
 
 def _discard(tmp: Path) -> None:
@@ -186,15 +233,9 @@ def atomic_files(paths: Iterable, *, fsync: bool = True, mkdir: bool = False) ->
         for tmp, p in zip(temps, targets):
             if not tmp.exists():
                 raise WoodcamError(f"atomic_files: nothing was written for {str(p)!r}")
-            os.chmod(tmp, _FILE_MODE)
-            if fsync:
-                _fsync_path(tmp)
         # side files first, the primary last: its presence means the group is complete
         for tmp, p in list(zip(temps, targets))[1:] + [(temps[0], targets[0])]:
-            os.replace(tmp, p)
-        if fsync:
-            for folder in {p.parent for p in targets}:
-                _fsync_dir(folder)
+            _commit(tmp, p, fsync)
     except BaseException:
         for tmp in temps:
             _discard(tmp)

@@ -109,7 +109,9 @@ def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, ob
     result.warnings += list(getattr(baked, "warnings", []))
     meta = {"block": stock.spec, "size_mm": list(stock.size_mm), **(metadata or {}),
             "texels_per_mm": float(baked.texels_per_mm)}
-    with result.stage("export"):
+    from ._atomic import all_or_nothing
+
+    with result.stage("export"), all_or_nothing():  # GLB + OBJ + MTL + PNG appear as one set
         result.files["glb"] = Path(export_glb(baked.mesh, out_glb, metadata=meta) or out_glb)
         if obj:
             obj_path = out_glb.with_suffix(".obj")

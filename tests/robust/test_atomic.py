@@ -135,3 +135,58 @@ def test_sigkill_mid_write_leaves_old_file_or_nothing(tmp_path):
     assert not target.exists()  # the temp may linger (hidden), the target never appears partial
     write_bytes(target, b"done")  # and the next run just works
     assert target.read_bytes() == b"done"
+
+
+def test_all_or_nothing_defers_every_write(tmp_path):
+    from woodcam._atomic import all_or_nothing
+
+    glb, obj, mtl = tmp_path / "p.glb", tmp_path / "p.obj", tmp_path / "p.mtl"
+    write_bytes(glb, b"old glb")
+    with pytest.raises(OSError, match="png write failed"), all_or_nothing():
+        write_bytes(glb, b"new glb")
+        assert glb.read_bytes() == b"old glb"  # nothing renamed yet
+        with atomic_files([obj, mtl]) as (t_obj, t_mtl):
+            t_obj.write_text("obj")
+            t_mtl.write_text("mtl")
+        raise OSError("png write failed")
+    assert glb.read_bytes() == b"old glb" and not obj.exists() and not mtl.exists()
+    assert _leftovers(tmp_path) == []
+    order = []
+    real_replace = os.replace
+
+    def spy(src, dst):
+        order.append(Path(dst).name)
+        real_replace(src, dst)
+
+    import woodcam._atomic as mod
+    mod.os.replace = spy
+    try:
+        with all_or_nothing():
+            write_bytes(glb, b"new glb")
+            with atomic_files([obj, mtl]) as (t_obj, t_mtl):
+                t_obj.write_text("obj")
+                t_mtl.write_text("mtl")
+    finally:
+        mod.os.replace = real_replace
+    assert order == ["p.mtl", "p.obj", "p.glb"]  # the first written (primary) renamed last
+    assert glb.read_bytes() == b"new glb" and obj.read_text() == "obj"
+
+
+def test_failed_obj_export_leaves_no_new_glb(tmp_path, monkeypatch):
+    """Issue 15: a failed OBJ/PNG write left the GLB behind (plus a traceback)."""
+    import trimesh
+
+    from woodcam import export
+    from woodcam.pipeline import preview_mesh
+    from woodcam.stock import open_stock
+
+    def broken(*args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(export, "export_obj", broken)
+    mesh = trimesh.creation.box(extents=(10, 10, 10))
+    mesh.apply_translation((20, 20, 20))
+    with pytest.raises(OSError, match="No space left"):
+        preview_mesh(mesh, open_stock("builtin:flat-sawn"), tmp_path / "part.glb",
+                     texels_per_mm=1, screenshot=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
