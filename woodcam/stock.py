@@ -7,11 +7,14 @@ A block spec is a string the CLI and GLB metadata carry:
   knotted log, ``LOG`` being ``gran1`` (the CT-measured spruce log of the shared data) or a
   woodcam log file (``.json``); size default 100x80x50 mm, Z along the log.
 - a block folder with a ``block.json`` manifest (real or synthetic): its true field if it has
-  one, otherwise a field fitted to its rings (fit once, cached in the folder).
+  one, otherwise a field fitted to its rings (fit once, cached in the user cache folder).
 - a Mokume sample folder (``A_col.png``, ``A_arl-unet.png``, ... as in the Mokume dataset): a
   cube of ``MOKUME_DEFAULT_SIZE_MM`` (50 mm) whose field is fitted to its ring maps, fit once
-  and cached under ``$WOODCAM_CACHE_DIR`` / ``~/.cache/woodcam`` (the sample folder is left
-  untouched: it is often read-only shared data).
+  and cached.
+
+Fitted fields and neural colour volumes are cached under ``$WOODCAM_CACHE_DIR`` or the user
+cache folder (``$XDG_CACHE_HOME/woodcam``, ``~/.cache/woodcam``), keyed by the block's content:
+block and sample folders are only read, never written (they are often read-only shared data).
 """
 
 from __future__ import annotations
@@ -156,38 +159,38 @@ def _synthetic_stock(spec, field, size_mm, species, description, appearance, par
     return Stock(spec, tuple(size_mm), Wood(field, app), description, meta)
 
 
-def fitted_field(block, folder: Path | None, method: str = "radial"):
+def fitted_field(block, folder: Path | None = None, method: str = "radial"):
     """The growth field fitted to a block's rings, fitted once and cached.
 
-    folder : the block folder: the cache ``<folder>/.woodcam-cache/field_<method>_v<N>.npz`` is
-        reused while it is newer than the block's manifest (delete it, or rewrite the block, to
-        fit again). None (a Mokume sample folder, which is never written to): cached under
-        ``$WOODCAM_CACHE_DIR`` / ``~/.cache/woodcam`` keyed by the block's images and size.
-    ``N`` is :data:`woodcam.inference.fit.FIT_VERSION`, so a changed fitter refits.
+    The cache entry lives in the user cache folder (:func:`woodcam._cache.cache_dir`
+    ``("fields")``), never in the block's own folder (which may be read-only shared data), and is
+    keyed by a digest of everything the fit reads: size, photos, ring maps, traces and knot masks
+    (:func:`~woodcam.appearance.volumes.block_fingerprint`), the method, and
+    :data:`woodcam.inference.fit.FIT_VERSION` with the package version. An edited block is a
+    new entry; an unreadable entry is discarded with a warning and refitted; concurrent first
+    runs fit once (a lock) and share the result.
+
+    folder : the block folder, only named in errors (None for a Mokume sample).
     """
-    from .appearance.neural import default_cache_dir
+    import re
+
+    from . import __version__
+    from ._cache import cache_dir, digest, load_or_build
     from .appearance.volumes import block_fingerprint
     from .fields.grid import GridField
     from .inference import fit_block
     from .inference.fit import FIT_VERSION
 
-    if folder is None:
-        cache = (default_cache_dir().parent / "fields"
-                 / f"{block.name}-{block_fingerprint(block)[:16]}-{method}_v{FIT_VERSION}.npz")
-        fresh = cache.is_file()
-    else:
-        cache = folder / ".woodcam-cache" / f"field_{method}_v{FIT_VERSION}.npz"
-        fresh = cache.is_file() and cache.stat().st_mtime >= (folder / "block.json").stat().st_mtime
-    if fresh:
-        return GridField.load(cache)
     if not any(f.has_rings for f in block.faces.values()):
         raise WoodcamError(
             f"block {folder or block.name} has neither a true field nor traced rings or ring maps "
             "to fit one to; trace rings on at least one face (or use 'woodcam block synth')"
         )
-    field = fit_block(block, method=method)
-    cache.parent.mkdir(parents=True, exist_ok=True)
-    field.save(cache)
+    key = digest(block_fingerprint(block), method, FIT_VERSION, __version__)
+    stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", block.name)[:40] or "block"
+    path = cache_dir("fields") / f"{stem}-{method}-{key}.npz"
+    field, _hit = load_or_build(path, load=GridField.load, build=lambda: fit_block(block, method=method),
+                                save=lambda f, tmp: f.save(tmp), what=f"fitted field of block {block.name!r}")
     return field
 
 
@@ -205,7 +208,7 @@ def _open_block_folder(path: Path, species, appearance, appearance_params) -> St
     block = read_block_folder(path)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
     return _real_block_stock(str(path), block, field, species, appearance, appearance_params,
-                             cache_dir=path / ".woodcam-cache")
+                             cache_dir=None)
 
 
 def _real_block_stock(spec, block, field, species, appearance, appearance_params, cache_dir) -> Stock:

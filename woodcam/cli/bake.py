@@ -55,14 +55,15 @@ def run_demo(args: argparse.Namespace) -> int:
 
 
 def run_bake(args: argparse.Namespace) -> int:
-    from ..pipeline import preview_part
+    from ..pipeline import check_outputs, preview_part
     from ..stock import open_stock
     from . import print_warnings
 
+    check_outputs(args.out, obj=not args.no_obj, screenshot=getattr(args, "screenshot", None) or False)
     stock = open_stock(args.block, **stock_options(args))
     res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
                        tolerance_mm=args.tolerance, obj=not args.no_obj, screenshot=False,
-                       progress=True)
+                       progress=True, obj_units=args.obj_units, obj_up=args.obj_up)
     write_screenshot(args, res.files, stock)
     print_warnings(res.warnings)
     print(f"{res.name}: {res.triangles} triangles, {res.volume_mm3:.0f} mm^3, atlas "

@@ -117,7 +117,8 @@ def run(args) -> int:
             "tools": {str(k): v.spec() for k, v in sorted(tools.items())},
             "resolution_mm": float(np.mean(res.cell_mm))}
     out = preview_mesh(mesh, stock, args.out, texels_per_mm=args.texels_per_mm,
-                       obj=not args.no_obj, screenshot=False, progress=True, metadata=meta)
+                       obj=not args.no_obj, screenshot=False, progress=True, metadata=meta,
+                       obj_units=args.obj_units, obj_up=args.obj_up)
     write_screenshot(args, out.files, stock)
     s = res.stats
     print(f"{args.program.name}: {len(program)} moves read in {t_read:.2f} s, simulated on "

@@ -24,9 +24,14 @@ from ..fields.analytic import AnalyticLogField
 from ..fields.rings import MOKUME_RING_SIGMA_MM
 from .block import synth_block
 from .cut import PATTERNS, SawPattern, cut_block, random_log_placement
-from .dataset import knotted_log_field, synth_benchmark_set, time_synth_block
+from .dataset import (
+           benchmark_set_block,
+           knotted_log_field,
+           synth_benchmark_set,
+           time_synth_block,
+)
 from .spec import PhotoSpec, RingMapSpec, SynthSpec, TraceSpec
 
 __all__ = ["MOKUME_RING_SIGMA_MM", "PATTERNS", "AnalyticLogField", "PhotoSpec", "RingMapSpec",
-           "SawPattern", "SynthSpec", "TraceSpec", "cut_block", "knotted_log_field",
+           "SawPattern", "SynthSpec", "TraceSpec", "benchmark_set_block", "cut_block", "knotted_log_field",
            "random_log_placement", "synth_benchmark_set", "synth_block", "time_synth_block"]
