@@ -7,7 +7,7 @@ from PIL import Image
 
 from woodcam.cli import build_parser
 from woodcam.errors import WoodcamError
-from woodcam.fields import log_render as lr
+from woodcam.logs import render as lr
 from woodcam.fields.knots import KnottedLogField
 from woodcam.fields.tree_data import Knot, simple_log, write_log
 
