@@ -47,7 +47,7 @@ from typing import Literal
 import numpy as np
 
 from ..errors import WoodcamError
-from .base import LogFrame, check_points
+from .base import check_points
 from .tree_data import Log
 
 Backend = Literal["auto", "numpy", "numba"]
