@@ -6,12 +6,12 @@ on its iso-line (:data:`woodcam.tolerances.TRACE_ISO_TOL_YEARS`).
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
 from ..block import RingTrace
 from ..fields.base import evaluate
+from ..fields.rings import iso_lines
 from ..frames import pixel_to_block
 from ..tolerances import TRACE_FD_STEP_PX, TRACE_ISO_TOL_YEARS
 
@@ -48,27 +48,18 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 def _trace_face(field, face, shape, size, g: np.ndarray) -> list[RingTrace]:
     """Clean traces of the integer iso-lines of ``field`` on one face (pixel coordinates).
 
-    Marching squares (contourpy) on ``g``, the field sampled at pixel centres, gives polylines
+    Marching squares (:func:`woodcam.fields.rings.iso_lines`) on ``g``, the field sampled at
+    pixel centres, gives polylines
     within ``[0, n - 1]`` px (half a pixel short of the face edges); :func:`_refine` then moves
     every vertex onto the true iso-line. Vertices that do not converge (a kink of the field,
     e.g. where a knot meets the stem, or a vanishing gradient) or leave the face are dropped and
     the polyline is split there.
     """
-    import contourpy  # marching squares: maintained, C++, a core dependency
-
-    # Ring boundaries are the iso-lines years = 1, 2, ...; years = 0 is the pith itself.
-    lo, hi = max(1, math.ceil(np.nanmin(g))), math.floor(np.nanmax(g))
-    if hi < lo:
+    found = iso_lines(g, first_year=1)  # ring boundaries: years = 1, 2, ...; 0 is the pith
+    if not found:
         return []
-    gen = contourpy.contour_generator(z=g, line_type=contourpy.LineType.Separate)
-    lines, levels = [], []
-    for year in range(lo, hi + 1):
-        for xy in gen.lines(year):
-            if len(xy) >= 2:
-                lines.append(xy[:, ::-1].astype(float))   # contourpy gives (x=col, y=row)
-                levels.append(year)
-    if not lines:
-        return []
+    levels = [year for year, _ in found]
+    lines = [xy for _, xy in found]
     counts = np.array([len(a) for a in lines])
     rc = np.concatenate(lines)
     lev = np.repeat(np.array(levels, float), counts)
