@@ -357,8 +357,15 @@ def test_wood_without_color_and_bad_color_shape_are_rejected():
         def color(self, points_mm, normals):
             return np.full(len(points_mm), 0.5)
 
-    with pytest.raises(WoodcamError, match=r"must return an \(n, 3\) RGB array"):
+    with pytest.raises(WoodcamError, match=r"wood.color must return rgb of shape \(n, 3\)"):
         bake(_box(), Grey(), texels_per_mm=1.0)
+
+    class Bytes:
+        def color(self, points_mm, normals):
+            return np.full((len(points_mm), 3), 200.0)
+
+    with pytest.raises(WoodcamError, match=r"rgb in \[0, 1\].*divide 0..255"):  # was clipped silently
+        bake(_box(), Bytes(), texels_per_mm=1.0)
 
 
 def test_rasteriser_paints_exactly_the_bilinear_footprint_of_its_triangles():

@@ -171,6 +171,8 @@ def bake(
     """
     import trimesh
 
+    from .appearance.wood import wood_colors  # the one check of the colour contract
+
     t_start = time.perf_counter()
     _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals)
     messages: list[str] = []
@@ -214,7 +216,7 @@ def bake(
         else:
             nrm = _apply_affine(normal_map, t, cx, cy)
             nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-12)
-        rgb = _color_checked(wood, points, nrm)
+        rgb = wood_colors(wood, points, nrm)
         atlas[idx] = np.round(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
     atlas = atlas.reshape(img_h, img_w, 3)
     coverage = (tri_of_texel >= 0).reshape(img_h, img_w)
@@ -573,22 +575,6 @@ def _apply_affine(maps, tri, cx, cy) -> np.ndarray:
     ``cx, cy (k, 1)``; (k, d) float64."""
     origin, jac_x, jac_y = maps
     return origin[tri] + jac_x[tri] * cx + jac_y[tri] * cy
-
-
-def _color_checked(wood, points: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """``wood.color(points (k, 3), normals (k, 3))`` checked for shape and finiteness; (k, 3)."""
-    rgb = np.asarray(wood.color(points, normals), dtype=np.float64)
-    if rgb.shape != (len(points), 3):
-        raise WoodcamError(
-            f"bake: wood.color must return an (n, 3) RGB array for n={len(points)} points; got "
-            f"shape {rgb.shape}; fix the appearance's color()"
-        )
-    if not np.all(np.isfinite(rgb)):
-        raise WoodcamError(
-            "bake: wood.color returned NaN or infinite colours; check the appearance and that "
-            "the mesh lies inside the block"
-        )
-    return rgb
 
 
 def _dilate(atlas: np.ndarray, coverage: np.ndarray) -> np.ndarray:

@@ -34,3 +34,26 @@ def test_defaults_are_the_colour_maps_and_shorthands_replace_them():
 def test_bad_settings_are_named(kwargs, message):
     with pytest.raises(WoodcamError, match=message):
         KnotShading(**kwargs)
+
+
+def test_wood_colors_checks_every_wood_in_one_place():
+    """Wood.color and any duck-typed wood go through the same contract check."""
+    from woodcam.appearance import Wood
+    from woodcam.appearance.wood import wood_colors
+
+    class Appearance:
+        def color(self, field, points_mm, normals):
+            return np.full((len(points_mm), 3), 2.0)        # out of range
+
+    p = np.zeros((5, 3))
+    with pytest.raises(WoodcamError, match=r"appearance.color must return rgb in \[0, 1\]"):
+        Wood(lambda q: q[:, 0], Appearance()).color(p, np.ones((5, 3)))
+
+    class Half:
+        def color(self, points_mm, normals):
+            return np.full((len(points_mm), 3), 0.5)
+
+    out = wood_colors(Half(), p, (0.0, 0.0, 1.0))               # one normal for all points
+    assert out.shape == (5, 3) and np.all(out == 0.5)
+    with pytest.raises(WoodcamError, match="wood must have a method color"):
+        wood_colors(object(), p, (0.0, 0.0, 1.0))

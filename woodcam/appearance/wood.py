@@ -9,6 +9,7 @@ import numpy as np
 
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, evaluate
+from ..tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS
 from .colormap import ColorMapAppearance
 
 #: Points per work item when colouring in parallel: big enough to amortise numpy's call
@@ -54,6 +55,10 @@ class Wood:
             Surface points, block frame, mm.
         normals : (n, 3) float
             Unit outward surface normals at those points (block frame).
+
+        The appearance's colours are checked (:func:`check_rgb`: shape, finite, in [0, 1]
+        within :data:`~woodcam.tolerances.COLOR_RANGE_TOL`, then clipped) and computed in
+        chunks on ``threads`` threads.
         """
         p = check_points(points_mm)
         n = np.asarray(normals, dtype=np.float32)
@@ -63,7 +68,8 @@ class Wood:
         starts = range(0, len(p), _CHUNK)
 
         def work(i):
-            out[i:i + _CHUNK] = self.appearance.color(self.field, p[i:i + _CHUNK], n[i:i + _CHUNK])
+            rgb = self.appearance.color(self.field, p[i:i + _CHUNK], n[i:i + _CHUNK])
+            out[i:i + _CHUNK] = check_rgb(rgb, len(p[i:i + _CHUNK]), "appearance.color")
 
         if self.threads == 1 or len(p) <= _CHUNK:
             for i in starts:
@@ -72,3 +78,46 @@ class Wood:
             with ThreadPoolExecutor(self.threads) as pool:
                 list(pool.map(work, starts))
         return out
+
+
+def check_rgb(rgb, n: int, who: str = "wood.color") -> np.ndarray:
+    """The colour contract, checked in one place: ``(n, 3)`` finite, in [0, 1] (within
+    :data:`~woodcam.tolerances.COLOR_RANGE_TOL`, then clipped). Returns float32 ``(n, 3)``."""
+    out = np.asarray(rgb, dtype=np.float32)
+    if out.shape != (n, 3):
+        raise WoodcamError(f"{who} must return rgb of shape (n, 3) = ({n}, 3); got {out.shape}; "
+                           "fix the appearance's color()")
+    if not np.all(np.isfinite(out)):
+        raise WoodcamError(f"{who} returned non-finite colours (NaN or inf); check the appearance "
+                           "and that the points lie inside the block")
+    lo, hi = float(out.min(initial=0.0)), float(out.max(initial=0.0))
+    if lo < -COLOR_RANGE_TOL or hi > 1.0 + COLOR_RANGE_TOL:
+        raise WoodcamError(f"{who} must return rgb in [0, 1]; got values in [{lo:.4g}, {hi:.4g}]; "
+                           "divide 0..255 colours by 255")
+    return np.clip(out, 0.0, 1.0)
+
+
+def wood_colors(wood, points_mm, normals) -> np.ndarray:
+    """``wood.color(points_mm (n, 3), normals (n, 3)) -> rgb (n, 3)`` float32 in [0, 1], checked.
+
+    What every consumer of the seam calls (bake, view, export): a :class:`Wood` checks and
+    batches its appearance itself; any other object with a ``color`` method (a test's analytic
+    wood, a user's) is called in batches of :data:`~woodcam.tolerances.MAX_BATCH_POINTS` and
+    checked by the same :func:`check_rgb`. ``normals`` may be one ``(3,)`` normal for all points.
+    """
+    if wood is None or not callable(getattr(wood, "color", None)):
+        raise WoodcamError("wood must have a method color(points_mm (n, 3), normals (n, 3)) -> "
+                           f"rgb (n, 3); got {type(wood).__name__}; pass a woodcam Wood")
+    p = check_points(points_mm)
+    nrm = np.asarray(normals, dtype=np.float64)
+    if nrm.shape == (3,):
+        nrm = np.broadcast_to(nrm, p.shape)
+    if nrm.shape != p.shape:
+        raise WoodcamError(f"normals must have the shape of points_mm {p.shape} or (3,); got {nrm.shape}")
+    if isinstance(wood, Wood):
+        return wood.color(p, nrm)
+    out = np.empty((len(p), 3), np.float32)
+    for s in range(0, len(p), MAX_BATCH_POINTS):
+        q = p[s:s + MAX_BATCH_POINTS]
+        out[s:s + len(q)] = check_rgb(wood.color(q, np.ascontiguousarray(nrm[s:s + len(q)])), len(q))
+    return out

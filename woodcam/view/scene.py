@@ -42,7 +42,6 @@ from .section import (
     part_triangles,
     plane_basis,
     signed_row_distance,
-    wood_rgb,
 )
 
 #: Default sample spacing (mm) of the wood on a cut plane: finer than a 0.5 mm latewood band.
@@ -352,7 +351,9 @@ def cut_plane_image(
     if section.n_cells == 0:
         return pv.PolyData()
     points = np.clip(np.asarray(section.points, dtype=float), 0.0, size)
-    rgb = wood_rgb(wood, points, normal)
+    from ..appearance.wood import wood_colors
+
+    rgb = wood_colors(wood, points, normal)
     out = pv.PolyData(points, faces=section.faces)
     if in_part is not None:
         out.cell_data["in_part"] = in_part

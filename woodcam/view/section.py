@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import WoodcamError
-from ..tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS, ON_FACE_TOL_MM
+from ..tolerances import ON_FACE_TOL_MM
 
 BOX_EDGES = np.array(
     [[0, 1], [2, 3], [4, 5], [6, 7],   # along X
@@ -148,29 +148,6 @@ def signed_row_distance(seg_uv, su, sv) -> np.ndarray:
     any_hit = np.isfinite(dist)
     out[any_hit] = np.where(left[any_hit] % 2 == 1, dist[any_hit], -dist[any_hit])
     return out
-
-
-def wood_rgb(wood, points_mm: np.ndarray, normal: np.ndarray) -> np.ndarray:
-    """``wood.color`` at ``points_mm (n, 3)`` with a constant normal, checked, in batches."""
-    n = len(points_mm)
-    out = np.empty((n, 3), dtype=float)
-    for start in range(0, n, MAX_BATCH_POINTS):
-        p = points_mm[start:start + MAX_BATCH_POINTS]
-        rgb = np.asarray(wood.color(p, np.broadcast_to(normal, p.shape).copy()), dtype=float)
-        if rgb.shape != p.shape:
-            raise WoodcamError(
-                f"wood.color must return rgb of shape (n, 3) = {p.shape}; got {rgb.shape}"
-            )
-        out[start:start + len(p)] = rgb
-    if not np.all(np.isfinite(out)):
-        raise WoodcamError("wood.color returned non-finite colours (NaN or inf); fix the wood")
-    lo, hi = float(out.min(initial=0.0)), float(out.max(initial=0.0))
-    if lo < -COLOR_RANGE_TOL or hi > 1.0 + COLOR_RANGE_TOL:
-        raise WoodcamError(
-            f"wood.color must return rgb in [0, 1]; got values in [{lo:.4g}, {hi:.4g}]; "
-            "divide 0..255 colours by 255"
-        )
-    return np.clip(out, 0.0, 1.0)
 
 
 def part_triangles(part) -> tuple[np.ndarray, np.ndarray]:
