@@ -254,6 +254,12 @@ def test_placed_field_serialises_only_when_the_log_field_does():
     g = PlacedField.from_dict(json.loads(json.dumps(f.to_dict())))
     p = np.random.default_rng(0).uniform(0, 40, (100, 3))
     assert np.array_equal(f(p), g(p))
+    # files written before the placement became a LogFrame stored (origin_mm, rotation)
+    old = {"log_field": f.to_dict()["log_field"], "origin_mm": f.origin_mm.tolist(),
+           "rotation": f.rotation.tolist()}
+    np.testing.assert_allclose(PlacedField.from_dict(old)(p), f(p), atol=1e-9)
+    np.testing.assert_allclose(PlacedField(f.log_field, f.origin_mm, f.rotation).to_log(p), f.to_log(p),
+                               atol=1e-9)
     with pytest.raises(WoodcamError, match="must be a woodcam class"):
         cut_block(radial_log, SIZE, "rift").to_dict()
 
