@@ -458,3 +458,4 @@ def test_the_82k_triangle_icosphere_that_crashed_xatlas_bakes():
         result = bake(sphere, SmoothWood(), texels_per_mm=1.0)
     assert len(result.mesh.faces) == 81920
     assert result.coverage_mask.mean() > 0.5
+

@@ -81,6 +81,9 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
     p.add_argument("--knot-outline", default=None, metavar="R,G,B",
                    help="colour map: colour of the bark ring round dead knots, each in [0, 1] "
                    "(default 0.16,0.10,0.06)")
+    p.add_argument("--max-atlas", type=int, default=4096, metavar="PX",
+                   help="largest texture side in texels (default 4096, what every GPU takes); "
+                   "a part needing more gets a lower texel density, stated in the summary")
     p.add_argument("--no-obj", action="store_true", help="write only the GLB, not OBJ+MTL+PNG")
     p.add_argument("--obj-units", choices=("m", "mm"), default="m",
                    help="length unit of the OBJ's coordinates (default m, what Blender and most "
