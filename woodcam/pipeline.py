@@ -72,9 +72,13 @@ def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                  tolerance_mm: float | None = None, obj: bool = True,
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
                  obj_up: str = "y", max_triangles: int | None = None,
-                 max_atlas_px: int = 4096) -> PartPreview:
+                 max_atlas_px: int = 4096, place: list[str] | tuple = ()) -> PartPreview:
     """Carve ``source`` (anything :func:`woodcam.cad.load_part` takes) out of ``stock``, bake it
-    and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``)."""
+    and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``).
+
+    ``place`` lists placement operations applied to the loaded part before carving
+    (:mod:`woodcam.cad.place`, e.g. ``["rotate:x:90", "center", "drop"]``); the resulting
+    4 x 4 matrix is recorded in the GLB metadata as ``placement``."""
     from .cad import carve, load_part
     from .tolerances import MAX_PART_TRIANGLES, TESSELLATION_TOL_MM
 
@@ -85,12 +89,19 @@ def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                          max_triangles=max_triangles or MAX_PART_TRIANGLES,
                          report=result.tessellation)
     result.warnings += list(result.tessellation.get("notes", []))
+    metadata = None
+    if place:
+        from .cad.place import place_part
+
+        part, matrix = place_part(part, list(place), stock.size_mm)
+        metadata = {"placement": {"ops": list(place), "matrix": matrix.tolist()}}
     with result.stage("carve"):
         carved = carve(part, stock.size_mm)
     result.warnings += list(carved.warnings)
     return preview_mesh(carved.mesh, stock, out_glb, texels_per_mm=texels_per_mm, obj=obj,
                         screenshot=screenshot, progress=progress, result=result,
-                        obj_units=obj_units, obj_up=obj_up, max_atlas_px=max_atlas_px)
+                        obj_units=obj_units, obj_up=obj_up, max_atlas_px=max_atlas_px,
+                        metadata=metadata)
 
 
 def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, obj: bool = True,

@@ -27,6 +27,12 @@ def register(subparsers) -> None:
     p.add_argument("--out", type=Path, required=True, help="output .glb path")
     p.add_argument("--tolerance", type=float, default=None, metavar="MM",
                    help="tessellation chord tolerance for B-rep parts (default 0.05 mm)")
+    p.add_argument("--place", action="append", default=[], metavar="OP",
+                   help="place the part in the block before carving; repeatable, applied in "
+                   "order: rotate:AXIS:DEG (about the part's centre), translate:X,Y,Z (mm), "
+                   "scale:S, center, drop (onto the bottom face), fit[:MARGIN] (scale into the "
+                   "block, default margin 2 mm). Turn the block instead with a spec ending in "
+                   "~AXIS90 (e.g. builtin:flat-sawn~z90)")
     p.add_argument("--max-triangles", type=int, default=None, metavar="N",
                    help="triangle budget for B-rep parts: above it the part is re-meshed with "
                    "looser tolerances, and the summary says so (default 120000)")
@@ -67,7 +73,8 @@ def run_bake(args: argparse.Namespace) -> int:
     res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
                        tolerance_mm=args.tolerance, obj=not args.no_obj, screenshot=False,
                        progress=True, obj_units=args.obj_units, obj_up=args.obj_up,
-                       max_triangles=args.max_triangles, max_atlas_px=args.max_atlas)
+                       max_triangles=args.max_triangles, max_atlas_px=args.max_atlas,
+                       place=args.place)
     write_screenshot(args, res.files, stock)
     print_warnings(res.warnings)
     tess = res.tessellation
