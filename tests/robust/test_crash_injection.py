@@ -173,7 +173,10 @@ np.save(sys.argv[1], np.concatenate([s.wood.field(p)[:, None], s.wood.color(p, n
     errs = [p.communicate(timeout=1800)[1] for p in procs]
     assert [p.returncode for p in procs] == [0, 0], errs
     a, b = np.load(tmp_path / "r0.npy"), np.load(tmp_path / "r1.npy")
-    np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(a[:, 0], b[:, 0])  # one fitted field, shared
+    # colours: the builder keeps float32 detail in memory, the other reads the cache's float16
+    # copy; they agree far below one 8-bit colour step (1/255)
+    np.testing.assert_allclose(a[:, 1:], b[:, 1:], rtol=0, atol=0.5 / 255)
     from woodcam.appearance.volumes import ColorVolumes
     from woodcam.fields.grid import GridField
 
