@@ -58,8 +58,10 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
 
     out_glb = check_output_path(out_glb, suffixes=(".glb",), what=what, mkdir=True)
     if obj:
-        for suffix in (".obj", ".mtl", ".png"):
-            check_output_path(out_glb.with_suffix(suffix), what=f"{what} (the {suffix[1:].upper()} "
+        for sibling in (out_glb.with_suffix(".obj"), out_glb.with_suffix(".mtl"),
+                        out_glb.with_name(out_glb.stem + "_texture.png")):
+            suffix = sibling.suffix
+            check_output_path(sibling, what=f"{what} (the {suffix[1:].upper()} "
                               "beside the GLB; --no-obj skips it)")
     if screenshot is True:
         check_output_path(out_glb.with_name(out_glb.stem + "_view.png"), what=f"{what} (its view PNG)")
@@ -124,7 +126,14 @@ def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, ob
     result.atlas_px = tuple(baked.atlas.shape[:2])
     result.atlas = baked.summary()
     result.warnings += list(getattr(baked, "warnings", []))
-    meta = {"block": stock.spec, "size_mm": list(stock.size_mm), **(metadata or {}),
+    from .stock import absolute_spec, spec_digest
+
+    meta = {"block": absolute_spec(stock.spec), "block_digest": spec_digest(stock.spec),
+            "size_mm": list(stock.size_mm),
+            "appearance": {"kind": stock.meta.get("appearance", "colormap"),
+                           "species": stock.meta.get("species"),
+                           "params": stock.meta.get("appearance_params", {})},
+            **(metadata or {}),
             "texels_per_mm": float(baked.texels_per_mm)}
     with result.stage("export"):
         result.files["glb"] = Path(export_glb(baked.mesh, out_glb, metadata=meta) or out_glb)

@@ -86,14 +86,10 @@ def run_bake(args: argparse.Namespace) -> int:
 
 
 def run_preview(args: argparse.Namespace) -> int:
-    from ..export import read_glb_metadata
-    from ..stock import open_stock
     from ..view import preview
+    from .options import stock_of_glb
 
-    spec = args.block
-    if spec is None and args.mesh.suffix.lower() == ".glb":
-        spec = read_glb_metadata(args.mesh).get("block")
-    stock = open_stock(spec) if spec else None
+    stock = stock_of_glb(args.mesh, args.block)
     out = preview(args.mesh, wood=stock.wood if stock else None,
                   size_mm=stock.size_mm if stock else None, screenshot=args.screenshot)
     if out:
