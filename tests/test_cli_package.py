@@ -64,3 +64,13 @@ def test_bake_demo_and_gcode_share_the_bake_options():
             "species": "walnut", "appearance": "colormap",
             "knots": KnotShading(alive_darkening=0.2, dead_darkening=0.4)}, name
         assert args.no_obj, name
+
+
+def test_version_prints_the_package_version(capsys):
+    from woodcam import __version__
+    from woodcam.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0
+    assert capsys.readouterr().out.strip() == f"woodcam {__version__}"
