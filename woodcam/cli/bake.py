@@ -82,6 +82,10 @@ def run_bake(args: argparse.Namespace) -> int:
                  " deg)" if tess.get("tolerance_mm") and tess.get("triangles") else "")
     print(f"{res.name}: {res.triangles} triangles{mesh_note}, {res.volume_mm3:.0f} mm^3, "
           f"{res.atlas}; wrote " + ", ".join(map(str, res.files.values())))
+    if res.report:
+        from ..advise import report_text
+
+        print(report_text(res.report, res.name))
     return 0
 
 
