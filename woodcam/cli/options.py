@@ -13,6 +13,7 @@ Nothing heavy is imported at module level (``woodcam --help`` loads this module)
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 from ..errors import WoodcamError
@@ -53,6 +54,28 @@ def open_block(spec, size_mm: float | None = None, face_px: int = 256):
     from ..stock import open_block as _open_block
 
     return _open_block(str(spec), size_mm=size_mm, face_px=face_px)
+
+
+#: A value that looks like numbers ("-14,5,3", "-1e3") is a value, not an option.
+_NEGATIVE_VALUES = re.compile(r"^-[\d.][\d.,eE+-]*$")
+
+
+def allow_negative_values(p: argparse.ArgumentParser) -> None:
+    """Let options of ``p`` take values such as ``-14,5,3`` (argparse takes them for options)."""
+    p._negative_number_matcher = _NEGATIVE_VALUES
+
+
+def vector_mm(text: str) -> tuple[float, float, float]:
+    """``"X,Y,Z"`` -> three finite floats (argparse ``type``)."""
+    import math
+
+    try:
+        vals = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        vals = ()
+    if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
+        raise argparse.ArgumentTypeError(f"expected three finite numbers X,Y,Z; got {text!r}")
+    return vals  # type: ignore[return-value]
 
 
 def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None = 10.0,
