@@ -18,7 +18,7 @@ def test_demo_quick_writes_every_output(tmp_path, capsys):
     assert main(["demo", "--out", str(tmp_path), "--quick"]) == 0
     out = capsys.readouterr().out
     for part in ("bowl", "tray", "lid"):
-        for suffix in (".glb", ".obj", ".mtl", ".png", "_view.png"):
+        for suffix in (".glb", ".obj", ".mtl", "_texture.png", "_view.png"):
             f = tmp_path / f"{part}{suffix}"
             assert f.is_file() and f.stat().st_size > 0, f
         assert part in out

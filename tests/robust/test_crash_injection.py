@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 REPO = Path(__file__).resolve().parents[2]
-OUTPUTS = ("part.glb", "part.obj", "part.mtl", "part.png")
+OUTPUTS = ("part.glb", "part.obj", "part.mtl", "part_texture.png")
 
 
 def _env(cache: Path) -> dict:
@@ -60,18 +60,20 @@ def _check_outputs(out: Path) -> list[str]:
         except Exception as err:  # noqa: BLE001 - any failure means a partial file
             problems.append(f"part.glb unreadable: {type(err).__name__}: {err}")
     if "part.obj" in present:
-        missing = {"part.mtl", "part.png"} - present
+        missing = {"part.mtl", "part_texture.png"} - present
         if missing:
             problems.append(f"part.obj without {sorted(missing)}")
         text = (out / "part.obj").read_text()
         if "mtllib part.mtl" not in text or not text.rstrip().splitlines()[-1].startswith("f "):
             problems.append("part.obj truncated")
-    if "part.png" in present:
+    if "part.mtl" in present and "map_Kd part_texture.png" not in (out / "part.mtl").read_text():
+        problems.append("part.mtl truncated")
+    if "part_texture.png" in present:
         try:
-            with Image.open(out / "part.png") as im:
+            with Image.open(out / "part_texture.png") as im:
                 im.load()
         except Exception as err:  # noqa: BLE001
-            problems.append(f"part.png unreadable: {err}")
+            problems.append(f"part_texture.png unreadable: {err}")
     return problems
 
 

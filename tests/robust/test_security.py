@@ -65,22 +65,51 @@ def test_checkpoint_of_plain_data_resumes(tmp_path):
     assert list(res["step"]) == [10, 20]
 
 
-def test_glb_metadata_never_makes_preview_write(tmp_path, monkeypatch):
-    """Issue 15: a crafted GLB named a folder in its metadata and `preview` fitted a field and
-    wrote a cache into it. A GLB's block spec may only name a built-in or log block."""
-    from woodcam.cli.bake import stock_from_glb_metadata
+def _glb_with(meta: dict, path: Path) -> Path:
+    """A minimal GLB whose JSON chunk holds ``meta`` as woodcam's scene extras."""
+    import json
+    import struct
 
+    body = json.dumps({"asset": {"version": "2.0"}, "scenes": [{"extras": {"woodcam": meta}}]})
+    body = body.encode() + b" " * (-len(body) % 4)
+    path.write_bytes(struct.pack("<III", 0x46546C67, 2, 20 + len(body))
+                     + struct.pack("<II", len(body), 0x4E4F534A) + body)
+    return path
+
+
+@pytest.mark.parametrize("meta, match", [
+    ({"block": "builtin:rift", "appearance": {"kind": "neural", "params": {"cache_dir": "/tmp/x"}}},
+     "params.cache_dir .* is not an accepted appearance parameter"),
+    ({"block": "builtin:rift", "appearance": {"kind": "neural", "params": {"epochs": 10**9}}},
+     "params.epochs .* out of range"),
+    ({"block": "builtin:rift", "appearance": {"params": ["x"]}}, "params must be an object"),
+    ({"block": ["builtin:rift"]}, "must be a string"),
+])
+def test_glb_metadata_cannot_choose_where_or_how_much(tmp_path, meta, match):
+    """Issue 15: a crafted GLB made `preview` fit and write a cache into a folder it names. A
+    GLB's metadata may name its block and appearance, never a cache folder or unbounded work."""
+    from woodcam.cli.options import stock_of_glb
+
+    with pytest.raises(WoodcamError, match=match):
+        stock_of_glb(_glb_with(meta, tmp_path / "x.glb"))
+
+
+def test_glb_naming_a_folder_never_writes_into_it(tmp_path, monkeypatch):
+    from woodcam.block.io import write_block
+    from woodcam.cli.options import stock_of_glb
+    from woodcam.fields.builtin import builtin_block
+    from woodcam.synth import synth_block
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    block = synth_block(builtin_block("flat-sawn").field, (30, 20, 10), face_px=32, seed=0)
+    block.true_field = None
     victim = tmp_path / "victim"
-    victim.mkdir()
-    (victim / "block.json").write_text('{"format": "woodcam-block", "size_mm": [1, 1, 1]}')
-    with pytest.raises(WoodcamError, match="names a folder"):
-        stock_from_glb_metadata({"block": str(victim)}, "part.glb")
-    assert sorted(p.name for p in victim.iterdir()) == ["block.json"]
-    for bad in ({"block": 5}, {"block": ["builtin:flat-sawn"]}, {"block": "x" * 5000}):
-        with pytest.raises(WoodcamError, match="metadata"):
-            stock_from_glb_metadata(bad, "part.glb")
-    assert stock_from_glb_metadata({}, "part.glb") is None
-    assert stock_from_glb_metadata({"block": "builtin:flat-sawn"}, "part.glb").size_mm
+    write_block(block, victim)
+    before = {p: p.stat().st_mtime_ns for p in victim.rglob("*")}
+    stock = stock_of_glb(_glb_with({"block": str(victim)}, tmp_path / "x.glb"))
+    assert stock.size_mm == (30.0, 20.0, 10.0)
+    assert {p: p.stat().st_mtime_ns for p in victim.rglob("*")} == before
+    assert list((tmp_path / "cache" / "fields").glob("*.npz"))
 
 
 @pytest.mark.parametrize("blob", [

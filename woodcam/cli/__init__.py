@@ -64,6 +64,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="woodcam", description="CNC cut preview for solid wood: carve a part out of a "
         "block whose growth rings are known and see the wood on every surface.",
         epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    from .. import __version__
+
+    parser.add_argument("--version", action="version", version=f"woodcam {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMANDS:

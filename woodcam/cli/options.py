@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 from pathlib import Path
 
 from ..errors import WoodcamError
@@ -56,6 +57,28 @@ def open_block(spec, size_mm: float | None = None, face_px: int = 256):
     from ..stock import open_block as _open_block
 
     return _open_block(str(spec), size_mm=size_mm, face_px=face_px)
+
+
+#: A value that looks like numbers ("-14,5,3", "-1e3") is a value, not an option.
+_NEGATIVE_VALUES = re.compile(r"^-[\d.][\d.,eE+-]*$")
+
+
+def allow_negative_values(p: argparse.ArgumentParser) -> None:
+    """Let options of ``p`` take values such as ``-14,5,3`` (argparse takes them for options)."""
+    p._negative_number_matcher = _NEGATIVE_VALUES
+
+
+def vector_mm(text: str) -> tuple[float, float, float]:
+    """``"X,Y,Z"`` -> three finite floats (argparse ``type``)."""
+    import math
+
+    try:
+        vals = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        vals = ()
+    if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
+        raise argparse.ArgumentTypeError(f"expected three finite numbers X,Y,Z; got {text!r}")
+    return vals  # type: ignore[return-value]
 
 
 def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None = 10.0,
@@ -161,6 +184,85 @@ def write_screenshot(args, files: dict, stock) -> None:
     png = out.with_name(out.stem + "_view.png") if args.screenshot is True else Path(args.screenshot)
     preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
     files["png"] = png
+
+
+def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None):
+    """The stock a baked GLB was cut from, as its metadata records it (absolute block spec,
+    content digest, species, appearance and its parameters), or ``block`` when given.
+
+    Returns None for a file that records no block and no ``block`` given (``preview`` then shows
+    the part alone). A recorded block that no longer exists, or whose content changed since the
+    bake, is named in an error or a warning."""
+    import warnings
+
+    from ..errors import WoodcamError, WoodcamWarning
+    from ..export import read_glb_metadata
+    from ..stock import open_stock, spec_digest
+
+    meta = read_glb_metadata(glb) if glb.suffix.lower() == ".glb" and glb.is_file() else {}
+    app = meta.get("appearance") if isinstance(meta.get("appearance"), dict) else {}
+    kwargs = {"species": species or app.get("species"),
+              "appearance": app.get("kind") or "colormap",
+              **_trusted_appearance_params(app.get("params"), glb)}
+    if block:
+        return open_stock(block, **{**kwargs, "species": species or kwargs["species"]})
+    spec = meta.get("block")
+    if not spec:
+        return None
+    if not isinstance(spec, str) or len(spec) > 4096:
+        raise WoodcamError(f"the block spec in {str(glb)!r}'s metadata must be a string; got a "
+                           f"{type(spec).__name__}; pass --block SPEC")
+    base = str(spec).partition("~")[0]
+    if not base.startswith(("builtin:", "log:")) and not Path(base).exists():
+        raise WoodcamError(
+            f"{str(glb)!r} was baked from the block folder {base!r}, which is not there any more; "
+            "pass --block SPEC (the same block, moved) to rebuild its wood")
+    if meta.get("block_digest") and spec_digest(spec) != meta["block_digest"]:
+        warnings.warn(f"the block {spec!r} changed since {glb.name} was baked (its files differ); "
+                      "the wood shown is today's", WoodcamWarning, stacklevel=2)
+    return open_stock(spec, **kwargs)
+
+
+#: Appearance parameters a GLB's metadata may carry, with their rules. A GLB is untrusted input:
+#: it may choose the appearance it was baked with, never unbounded work (issue 15). It never
+#: chooses where anything is written: block folders are only read, caches live in the user
+#: cache folder (woodcam._cache).
+_GLB_APPEARANCE_PARAMS = {
+    "quality": ("draft", "normal", "high"),
+    "epochs": (1, 2000, False),
+    "resolution": (8, 256, False),
+    "knot_darkening_alive": (0.0, 1.0, False),
+    "knot_darkening_dead": (0.0, 1.0, False),
+}
+
+
+def _trusted_appearance_params(params, glb) -> dict:
+    """The appearance parameters of a GLB's metadata, checked (WoodcamError naming the GLB)."""
+    if params is None:
+        return {}
+    if not isinstance(params, dict):
+        raise WoodcamError(f"{str(glb)!r}: metadata appearance.params must be an object; got "
+                           f"{type(params).__name__}")
+    out = {}
+    for key, value in params.items():
+        rule = _GLB_APPEARANCE_PARAMS.get(key)
+        if key == "dead_outline_rgb":
+            ok = (isinstance(value, list) and len(value) == 3
+                  and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                          and 0.0 <= v <= 1.0 for v in value))
+        elif rule is None:
+            ok = False
+        elif isinstance(rule[0], str):
+            ok = value in rule
+        else:
+            ok = (isinstance(value, (int, float)) and not isinstance(value, bool)
+                  and math.isfinite(value) and rule[0] <= value <= rule[1])
+        if not ok:
+            raise WoodcamError(f"{str(glb)!r}: metadata appearance.params.{key} = {value!r} is not "
+                               "an accepted appearance parameter or is out of range; pass "
+                               "--block SPEC (and the bake options) yourself")
+        out[key] = value
+    return out
 
 
 # -- numeric options: finite and in range, checked once for every command ---------------------
