@@ -24,9 +24,10 @@ middle of a write never leaves a truncated GLB, a 0-byte OBJ or a half cache beh
   not a directory, parent folder exists, is a folder and is writable. Raises
   :class:`~woodcam.errors.WoodcamError` naming the option, the rule, the value and a fix.
 
-Temporary names are ``.<name>.<random>.tmp<suffix>`` (hidden, unique per writer), so two
+Temporary names are ``.<name>.<pid>-<random>.tmp<suffix>`` (hidden, unique per writer), so two
 processes writing the same target never share a temporary file; the last ``os.replace`` wins and
-the result is always one writer's complete file.
+the result is always one writer's complete file. A writer killed mid-write leaves its hidden
+temporary behind; the next write of the same target removes it (its process is gone).
 """
 
 from __future__ import annotations
@@ -56,10 +57,33 @@ _FILE_MODE = 0o666 & ~_umask()  # what open() would have given a new file
 
 
 def _temp_in(path: Path) -> Path:
-    """A new, empty, uniquely named temporary file next to ``path`` (same folder)."""
-    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=f".tmp{path.suffix}")
+    """A new, empty, uniquely named temporary file next to ``path`` (same folder), named
+    ``.<name>.<pid>-<random>.tmp<suffix>``; temporaries of the same target left by a process
+    that no longer runs (killed mid-write) are removed first, so crashes leave no litter."""
+    _sweep_orphans(path)
+    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}-",
+                                suffix=f".tmp{path.suffix}")
     os.close(fd)
     return Path(name)
+
+
+def _sweep_orphans(path: Path) -> None:
+    """Delete ``path``'s temporaries whose writing process is gone (best effort)."""
+    prefix, suffix = f".{path.name}.", f".tmp{path.suffix}"
+    try:
+        names = [n for n in os.listdir(path.parent) if n.startswith(prefix) and n.endswith(suffix)]
+    except OSError:
+        return
+    for name in names:
+        pid_text = name[len(prefix):].split("-", 1)[0]
+        if not pid_text.isdigit() or int(pid_text) == os.getpid():
+            continue
+        try:
+            os.kill(int(pid_text), 0)  # signal 0: does the writer still run?
+        except ProcessLookupError:
+            _discard(path.parent / name)
+        except OSError:  # e.g. another user's live process: leave it
+            continue
 
 
 def _fsync_path(path: Path) -> None:

@@ -132,9 +132,10 @@ def test_sigkill_mid_write_leaves_old_file_or_nothing(tmp_path):
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     proc.stdout.close()
-    assert not target.exists()  # the temp may linger (hidden), the target never appears partial
-    write_bytes(target, b"done")  # and the next run just works
-    assert target.read_bytes() == b"done"
+    assert not target.exists()  # the target never appears partial
+    assert len(_leftovers(tmp_path)) == 1  # the killed writer's hidden temporary
+    write_bytes(target, b"done")  # the next run just works, and sweeps the orphan
+    assert target.read_bytes() == b"done" and _leftovers(tmp_path) == []
 
 
 def test_all_or_nothing_defers_every_write(tmp_path):
@@ -190,3 +191,16 @@ def test_failed_obj_export_leaves_no_new_glb(tmp_path, monkeypatch):
         preview_mesh(mesh, open_stock("builtin:flat-sawn"), tmp_path / "part.glb",
                      texels_per_mm=1, screenshot=False)
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_temporaries_of_killed_writers_are_swept(tmp_path):
+    target = tmp_path / "big.bin"
+    proc = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    dead = int(proc.stdout)  # a pid that has exited
+    orphan = tmp_path / f".big.bin.{dead}-abc123.tmp.bin"
+    orphan.write_bytes(b"half")
+    live = tmp_path / f".big.bin.{os.getppid()}-xyz.tmp.bin"  # a running process: kept
+    live.write_bytes(b"busy")
+    write_bytes(target, b"whole")
+    assert not orphan.exists() and live.exists() and target.read_bytes() == b"whole"

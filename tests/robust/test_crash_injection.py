@@ -190,3 +190,39 @@ np.save(sys.argv[1], np.concatenate([s.wood.field(p)[:, None], s.wood.color(p, n
         vols = [p for p in (tmp_path / "cache" / "appearance").glob("*.npz")
                 if not p.name.endswith(".weights.npz")]
         assert len(vols) == 1 and ColorVolumes.load(vols[0]).volumes.size
+
+
+@pytest.mark.slow
+def test_kill_points_on_a_mokume_fit(shared_data, tmp_path):
+    """``woodcam fit`` killed at ``WOODCAM_KILL_POINTS_FIT`` random points (default 10) with a
+    cold cache: its ``--out`` field is absent or loadable, and the rerun succeeds."""
+    from woodcam.fields.grid import GridField
+
+    n = int(os.environ.get("WOODCAM_KILL_POINTS_FIT", "10"))
+    rng = np.random.default_rng(int(os.environ.get("WOODCAM_KILL_SEED", "15")))
+    cmd = [sys.executable, "-m", "woodcam.cli", "fit", _mokume(shared_data), "--out", "OUT"]
+    t0 = time.perf_counter()
+    subprocess.run([c.replace("OUT", str(tmp_path / "cal.npz")) for c in cmd],
+                   env=_env(tmp_path / "calcache"), check=True, capture_output=True)
+    cold_s = time.perf_counter() - t0
+    bad = []
+    for i in range(n):
+        out = tmp_path / f"f{i}.npz"
+        run = [c.replace("OUT", str(out)) for c in cmd]
+        env = _env(tmp_path / f"cache{i}")
+        proc = subprocess.Popen(run, env=env, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL, start_new_session=True)
+        try:
+            proc.wait(timeout=float(rng.uniform(0.02, 0.9)) * cold_s)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+        if out.exists():
+            try:
+                GridField.load(out)
+            except Exception as err:  # noqa: BLE001 - a partial field file
+                bad.append((i, "partial", str(err)))
+        rerun = subprocess.run(run, env=env, capture_output=True, text=True, check=False)
+        if rerun.returncode or not GridField.load(out):
+            bad.append((i, "rerun", rerun.stderr[-300:]))
+    assert bad == []
