@@ -227,3 +227,48 @@ def test_ring_trace_checks_its_numbers(points, year, match):
     with pytest.raises(WoodcamError, match=match):
         RingTrace(np.array(points, float), year)
     assert RingTrace(np.zeros((2, 2)), 3.0).year == 3
+
+
+@pytest.mark.parametrize("toml, match", [
+    ('[tools.1]\ntype = "flat"\ndiameter_mm = "6"\n', r"diameter_mm must be a number"),
+    ('[tools.1]\ntype = "flat"\ndiameter_mm = [6]\n', r"diameter_mm must be a number"),
+    ('[tools]\n1 = 5\n', r"tools.1 must be a table"),
+    ('[tools.1]\ntype = 3\ndiameter_mm = 6\n', r"needs type"),
+    ('[tools.1]\ntype = "flat"\ndiameter_mm = 1e300\n', r"diameter_mm must be a positive number in \(0, 1000\]"),
+    ('[tools.1]\ntype = "flat"\ndiameter_mm = nan\n', r"diameter_mm must be a positive number"),
+    ('[tools.1]\ntype = "vbit"\ndiameter_mm = 6\nangle_deg = true\n', r"angle_deg must be a number"),
+    ('[tools.-3]\ntype = "flat"\ndiameter_mm = 6\n', r"tool number .* must be in \[0, 99999\]"),
+])
+def test_tool_table_types_are_checked(tmp_path, toml, match):
+    from woodcam.toolpath.tools import load_tool_table
+
+    (tmp_path / "t.toml").write_text(toml)
+    with pytest.raises(WoodcamError, match=match):
+        load_tool_table(tmp_path / "t.toml")
+
+
+def test_tool_table_bytes_that_are_not_utf8(tmp_path):
+    from woodcam.toolpath.tools import load_tool_table
+
+    (tmp_path / "t.toml").write_bytes(b'[tools.1]\ntype = "\xff"\n')
+    with pytest.raises(WoodcamError, match="not valid TOML"):
+        load_tool_table(tmp_path / "t.toml")
+
+
+@pytest.mark.parametrize("edit, match", [
+    (lambda d: d.update(pith_z_mm="abc"), r"wrong type or shape"),
+    (lambda d: d.update(radii_mm=[[1, 2]]), r"radii_mm"),
+    (lambda d: d["radii_mm"][0].__setitem__(0, 1e400), r"finite numbers|must be finite"),
+    (lambda d: d["pith_xy_mm"][0].__setitem__(0, None), r"wrong type|must be finite"),
+    (lambda d: d.update(knots=[{"z0_mm": 1}]), r"missing the key"),
+    (lambda d: d.update(knots=[5]), r"wrong type"),
+    (lambda d: d.clear(), r"format must be 'woodcam-log'"),
+])
+def test_log_file_types_are_checked(tmp_path, edit, match):
+    from woodcam.fields.tree_data import read_log, simple_log
+
+    d = simple_log(100.0, 30.0, z_step_mm=20.0, azimuths=6).to_json()
+    edit(d)
+    (tmp_path / "log.json").write_text(json.dumps(d))
+    with pytest.raises(WoodcamError, match=match):
+        read_log(tmp_path / "log.json")
