@@ -294,6 +294,12 @@ RANGES: dict = {
     "dead_darkening": (0.0, 1.0, False),
     "outline_mm": (0.0, 1000.0, False),
     "timeout": (0.0, 1e7, True),               # seconds
+    "max_triangles": (100, 100_000_000, False),  # B-rep budget; 1e8 triangles is ~10 GB
+    "max_atlas": (64, 65_536, False),          # texture side, texels
+    "candidates": (1, 10_000_000, False),      # placement candidates
+    "margin": (0.0, 1000.0, False),            # mm
+    "top": (1, 100_000, False),
+    "voxels": (1000, 50_000_000, False),       # voxels per review colour volume (default 4e5)
 }
 
 
