@@ -6,6 +6,8 @@ A block spec is a string the CLI and GLB metadata carry:
 - ``log:LOG@K`` or ``log:LOG@K:WxDxH``: a block cut tangentially through knot ``K`` of a
   knotted log, ``LOG`` being ``gran1`` (the CT-measured spruce log of the shared data) or a
   woodcam log file (``.json``); size default 100x80x50 mm, Z along the log.
+- ``woodify:PATH/field.npz``: a block cut out of a grown object (``woodcam woodify``); size
+  and position are the placement stored in the file (``--block-size``, ``--block-centre``).
 - a block folder with a ``block.json`` manifest (real or synthetic): its true field if it has
   one, otherwise a field fitted to its rings (fit once, cached in the folder).
 - a Mokume sample folder (``A_col.png``, ``A_arl-unet.png``, ... as in the Mokume dataset): a
@@ -77,6 +79,13 @@ def open_stock(spec: str, *, species: str | None = None,
         field, size_mm, description = _log_block_field(spec)
         return _synthetic_stock(spec, field, size_mm, species or "spruce", description,
                                 appearance, appearance_params)
+    if spec.startswith("woodify:"):
+        from .woodify.field import WoodifiedField
+
+        field = WoodifiedField.load(spec.split(":", 1)[1])
+        return _synthetic_stock(spec, field, field.block_size_mm, species or "oak",
+                                f"block cut from the object grown {field.years_final:g} years "
+                                f"({spec.split(':', 1)[1]})", appearance, appearance_params)
     path = Path(spec)
     if path.is_dir() and (path / "block.json").is_file():
         return _open_block_folder(path, species, appearance, appearance_params)
@@ -84,7 +93,8 @@ def open_stock(spec: str, *, species: str | None = None,
         return _open_mokume_folder(path, species, appearance, appearance_params)
     raise WoodcamError(
         f"block spec {spec!r} is neither 'builtin:NAME' (NAME one of {', '.join(BUILTIN_NAMES)}), "
-        "'log:LOG@KNOT[:WxDxH]', a block folder with a block.json manifest, nor a Mokume sample "
+        "'log:LOG@KNOT[:WxDxH]', 'woodify:PATH/field.npz', a block folder with a block.json "
+        "manifest, nor a Mokume sample "
         "folder (A_col.png, A_arl-unet.png, ...)"
     )
 
@@ -154,7 +164,9 @@ def _open_mokume_folder(path: Path, species, appearance, appearance_params) -> S
 
 
 def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
-    from .block.io import read_block  # block I/O sits beside; imported when a folder is used
+    from .block.io import (
+        read_block,  # block I/O sits beside; imported when a folder is used
+    )
 
     block = read_block(path)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
@@ -178,7 +190,13 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
 
 def _log_block_field(spec: str):
     """``log:LOG@K[:WxDxH]`` -> (block-frame field, size_mm, description)."""
-    from .fields import KnottedLogField, block_at_knot, place_block_in_log, read_gran1, read_log
+    from .fields import (
+        KnottedLogField,
+        block_at_knot,
+        place_block_in_log,
+        read_gran1,
+        read_log,
+    )
 
     body = spec[len("log:"):]
     try:

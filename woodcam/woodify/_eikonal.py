@@ -145,8 +145,7 @@ def _node_update(T, state, i, j, k, g, wx, wy, wz, h, order, slack, nb, nb2, av,
                 if not ok:
                     continue
                 t = _simplex_update(av, bv, ov, tmax, g, wx, wy, wz, slack)
-                if t < best:
-                    best = t
+                best = min(best, t)
     return best
 
 
@@ -194,8 +193,7 @@ def march(T, state, gain, wind, h, order=2, reopen_tol=1e-3, slack_nodes=1.0):  
             t = _node_update(T, state, a, b, c, gi, wind[0, 0, 0, 0], wind[0, 0, 0, 1], wind[0, 0, 0, 2], h, order, slack, nb, nb2, av, bv, ov)
         else:
             t = _node_update(T, state, a, b, c, gi, wind[a, b, c, 0], wind[a, b, c, 1], wind[a, b, c, 2], h, order, slack, nb, nb2, av, bv, ov)
-        if t < T[a, b, c]:
-            T[a, b, c] = t
+        T[a, b, c] = min(T[a, b, c], t)
         heapq.heappush(heap, (T[a, b, c], lin))
     while len(heap) > 0:
         t0, lin = heapq.heappop(heap)

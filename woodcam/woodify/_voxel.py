@@ -133,8 +133,7 @@ def inside_parity(verts, faces, origin, h, shape):  # pragma: no cover - compile
                 s = d0 + d1 + d2
                 x = (d0 * a[0] + d1 * b[0] + d2 * c[0]) / s
                 i = int(np.ceil((x - origin[0]) / h))
-                if i < 0:
-                    i = 0
+                i = max(i, 0)
                 if i <= nx:
                     flips[i, j, k] += 1
     inside = np.zeros((nx, ny, nz), np.bool_)

@@ -152,7 +152,7 @@ class WoodifiedField:
         """Unit fibre directions ``(n, 3)``: ``up`` everywhere (block frame)."""
         return np.broadcast_to(self.axis, check_points(points_mm).shape)
 
-    def placed(self, block_size_mm, block_centre_mm=None, rotation=None) -> "WoodifiedField":
+    def placed(self, block_size_mm, block_centre_mm=None, rotation=None) -> WoodifiedField:
         """The same grown object with a block of ``block_size_mm`` (W, D, H) centred at
         ``block_centre_mm`` (object frame; default the grid's centre)."""
         size = np.asarray(block_size_mm, float)
@@ -171,10 +171,10 @@ class WoodifiedField:
         if path.suffix != ".npz":
             raise WoodcamError(f"path must end in .npz; got {str(path)!r}")
         path.parent.mkdir(parents=True, exist_ok=True)
-        arrays = dict(format=FORMAT, arrival_mm=self.arrival_mm, origin_mm=self.origin_mm,
-                      spacing_mm=self.spacing_mm, speed=json.dumps(self.speed.to_dict()),
-                      years_final=self.years_final, block_origin_mm=self.block_origin_mm,
-                      block_rotation=self.rotation, block_size_mm=np.asarray(self.block_size_mm))
+        arrays = {"format": FORMAT, "arrival_mm": self.arrival_mm, "origin_mm": self.origin_mm,
+                      "spacing_mm": self.spacing_mm, "speed": json.dumps(self.speed.to_dict()),
+                      "years_final": self.years_final, "block_origin_mm": self.block_origin_mm,
+                      "block_rotation": self.rotation, "block_size_mm": np.asarray(self.block_size_mm)}
         if self.obstacle_sdf_mm is not None:
             arrays["obstacle_sdf_mm"] = self.obstacle_sdf_mm
         fd, tmp = tempfile.mkstemp(suffix=".npz", dir=path.parent)
@@ -188,7 +188,7 @@ class WoodifiedField:
         return path
 
     @classmethod
-    def load(cls, path, interpolation: Interpolation = "linear") -> "WoodifiedField":
+    def load(cls, path, interpolation: Interpolation = "linear") -> WoodifiedField:
         """Read a ``field.npz`` written by :meth:`save`."""
         path = Path(path)
         if not path.is_file():

@@ -48,7 +48,7 @@ class VoxelGrid:
     shape: tuple[int, int, int]
 
     @classmethod
-    def around(cls, lo_mm, hi_mm, resolution: int) -> "VoxelGrid":
+    def around(cls, lo_mm, hi_mm, resolution: int) -> VoxelGrid:
         """Grid covering the box ``[lo_mm, hi_mm]`` with ``resolution`` nodes on its longest side."""
         lo, hi = np.asarray(lo_mm, float), np.asarray(hi_mm, float)
         if not (isinstance(resolution, (int, np.integer)) and 16 <= resolution <= 1024):

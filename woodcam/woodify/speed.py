@@ -134,6 +134,6 @@ class GrowthSpeed:
                 "shape": self.shape, "eccentricity": self.eccentricity, "up": list(self.up)}
 
     @classmethod
-    def from_dict(cls, d: dict) -> "GrowthSpeed":
+    def from_dict(cls, d: dict) -> GrowthSpeed:
         return cls(float(d["velocity_mm"]), float(d["time_scale_years"]), float(d["shape"]),
                    float(d["eccentricity"]), tuple(d["up"]))

@@ -62,7 +62,7 @@ def _grad_grids(T: np.ndarray, h: float):
     return [np.asarray(g, np.float32) for g in np.gradient(Tf, h)]
 
 
-def trace_back(front, points_mm, wind=None, step_voxels: float = 0.5):
+def trace_back(front, points_mm, wind=None, step_voxels: float = 0.5, until_mm: float = 0.0):
     """Origins on the input surface of grown points (see module docstring).
 
     Parameters
@@ -74,13 +74,16 @@ def trace_back(front, points_mm, wind=None, step_voxels: float = 0.5):
         Constant direction part ``w`` of the speed (eccentricity).
     step_voxels : float
         Step of the backward integration in voxels.
+    until_mm : float
+        Stop on the front of this pseudo-time instead of the input (``T = 0``): where the
+        points were at an earlier year.
 
     Returns
     -------
     origin_mm : (n, 3) float
         Points on the input surface.
-    tri : (n,) int
-        Input triangle of each origin.
+    tri : (n,) int or None
+        Input triangle of each origin (None when ``until_mm > 0``).
     """
     h = front.grid.spacing_mm
     o = np.asarray(front.grid.origin_mm)
@@ -98,16 +101,18 @@ def trace_back(front, points_mm, wind=None, step_voxels: float = 0.5):
         xa = x[active]
         idx = ((xa - o) / h).T
         t = ndimage.map_coordinates(Tfill, idx, order=1, mode="nearest")
-        done = t <= 0.0
+        done = t <= until_mm + 1e-9
         g = np.stack([ndimage.map_coordinates(gr, idx, order=1, mode="nearest") for gr in grads], 1)
         n = g / np.maximum(np.linalg.norm(g, axis=1, keepdims=True), 1e-12)
         v = n + w
         # do not step past the input surface: at most T / |v . n| along the characteristic
-        s = np.minimum(step, np.maximum(t, 0.0) / np.maximum(np.sum(v * n, 1), 1e-3))
+        s = np.minimum(step, np.maximum(t - until_mm, 0.0) / np.maximum(np.sum(v * n, 1), 1e-3))
         xa = xa - v * s[:, None]
         x[active] = xa
         ai = np.nonzero(active)[0]
         active[ai[done | (s < 1e-6 * h)]] = False
+    if until_mm > 0:
+        return x, None
     # snap to the closest input triangle known on the band nodes, then onto that triangle
     idx = np.clip(np.rint((x - o) / h).astype(int), 0, np.asarray(front.grid.shape) - 1)
     tri = front.input_tri[idx[:, 0], idx[:, 1], idx[:, 2]]
