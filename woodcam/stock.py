@@ -164,9 +164,7 @@ def _open_mokume_folder(path: Path, species, appearance, appearance_params) -> S
 
 
 def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
-    from .block.io import (
-        read_block,  # block I/O sits beside; imported when a folder is used
-    )
+    from .block.io import read_block  # block I/O sits beside; imported when a folder is used
 
     block = read_block(path)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
@@ -190,13 +188,7 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
 
 def _log_block_field(spec: str):
     """``log:LOG@K[:WxDxH]`` -> (block-frame field, size_mm, description)."""
-    from .fields import (
-        KnottedLogField,
-        block_at_knot,
-        place_block_in_log,
-        read_gran1,
-        read_log,
-    )
+    from .fields import KnottedLogField, block_at_knot, place_block_in_log, read_gran1, read_log
 
     body = spec[len("log:"):]
     try:
