@@ -1,0 +1,71 @@
+"""``woodcam woodify`` writes its products, and ``bake --block woodify:...`` carves from them."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from woodcam.cli import main
+from woodcam.errors import WoodcamError
+from woodcam.stock import open_stock
+from woodcam.woodify import WoodifiedField
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def grown_dir(tmp_path_factory):
+    d = tmp_path_factory.mktemp("woodify")
+    trunk = trimesh.creation.cylinder(radius=6.0, height=30.0, sections=32)
+    trunk.export(d / "trunk.stl")
+    out = d / "tree"
+    rc = main(["woodify", str(d / "trunk.stl"), "--years", "8", "--growth", "30",
+               "--eccentricity", "0.2", "--up", "1,0,0", "--resolution", "48", "--crack-years", "2",
+               "--block-size", "100x80x50", "--block-centre", "5,0,0", "--out", str(out)])
+    assert rc == 0
+    return out
+
+
+def test_woodify_writes_field_surfaces_sections_and_bark(grown_dir):
+    for name in ("field.npz", "grown.glb", "section_xz.png", "section_xy.png", "woodify.json",
+                 "surface_y2.stl", "surface_y4.stl", "surface_y6.stl"):
+        assert (grown_dir / name).is_file(), name
+    assert not list(grown_dir.glob("tmp*")), "temporary files left behind"
+    s = trimesh.load(grown_dir / "surface_y4.stl")
+    assert s.is_watertight
+    f = WoodifiedField.load(grown_dir / "field.npz")
+    assert f.block_size_mm == (100.0, 80.0, 50.0)
+    # block centre (5, 0, 0) in the object: the block's centre point is 5 mm off the trunk axis
+    # inside the input (year 0); a block corner lies beyond the final bark (> 8 years)
+    assert f(np.array([[50.0, 40.0, 25.0]]))[0] == 0.0
+    assert f(np.array([[0.0, 0.0, 0.0]]))[0] > 8.0
+    glb = trimesh.load(grown_dir / "grown.glb", force="mesh")
+    assert glb.visual.uv is not None and len(glb.faces) > 100
+    summary = json.loads((grown_dir / "woodify.json").read_text())
+    assert summary["method"] == "offset" and summary["cracks"]["count"] >= 0
+
+
+def test_bake_carves_a_bowl_from_the_grown_wood(grown_dir, tmp_path):
+    spec = f"woodify:{grown_dir / 'field.npz'}"
+    stock = open_stock(spec)
+    assert stock.size_mm == (100.0, 80.0, 50.0)
+    out = tmp_path / "bowl.glb"
+    rc = main(["bake", str(REPO / "cad_examples" / "bowl.py"), "--block", spec, "--out", str(out),
+               "--texels-per-mm", "1.5", "--no-obj"])
+    assert rc == 0 and out.stat().st_size > 10_000
+
+
+def test_cli_errors_are_one_line(tmp_path, capsys):
+    m = trimesh.creation.icosphere(subdivisions=2, radius=5.0)
+    m.export(tmp_path / "ball.stl")
+    assert main(["woodify", str(tmp_path / "ball.stl"), "--years", "0", "--out", str(tmp_path / "o")]) == 2
+    assert "--years must be > 0" in capsys.readouterr().err
+    trimesh.Trimesh(m.vertices, m.faces[:-4]).export(tmp_path / "open.stl")
+    assert main(["woodify", str(tmp_path / "open.stl"), "--years", "3", "--out", str(tmp_path / "o")]) == 2
+    assert "must be watertight" in capsys.readouterr().err
+    with pytest.raises(WoodcamError, match="does not exist"):
+        open_stock(f"woodify:{tmp_path / 'missing.npz'}")
