@@ -10,7 +10,7 @@ import trimesh
 from woodcam.errors import WoodcamError
 from woodcam.woodify import Brush, woodify
 from woodcam.woodify.cracks import growth_stress, separation, simulate_cracks
-from woodcam.woodify.surfaces import barycentric_on, carry
+from woodcam.woodify.surfaces import barycentric_on, carry, trace_back
 
 
 @pytest.fixture(scope="module")
@@ -29,8 +29,7 @@ def _edge_dirs(cs, lateral_half_height=22.0):
 
 def test_hoop_stress_of_a_growing_cylinder_is_circumferential(cylinder):
     mesh = cylinder.surface(4.0)
-    old, _ = __import__("woodcam.woodify.surfaces", fromlist=["x"]).trace_back(
-        cylinder.front, mesh.vertices, until_mm=cylinder.tau(3.0))
+    old, _ = trace_back(cylinder.front, mesh.vertices, until_mm=cylinder.tau(3.0))
     sig = growth_stress(mesh, old)
     c = mesh.triangles_center
     lat = np.abs(c[:, 2]) < 20
@@ -43,7 +42,7 @@ def test_hoop_stress_of_a_growing_cylinder_is_circumferential(cylinder):
     assert np.median(s_hoop) == pytest.approx(expect, rel=0.15)
     assert np.median(np.abs(s_axial)) < 0.1 * expect
     zeta = separation(mesh, sig)
-    w, V = np.linalg.eigh(zeta)
+    _, V = np.linalg.eigh(zeta)
     vl = np.abs(mesh.vertices[:, 2]) < 20
     e = V[vl, :, -1]
     hv = np.stack([-mesh.vertices[vl, 1], mesh.vertices[vl, 0], 0 * mesh.vertices[vl, 0]], 1)
