@@ -178,12 +178,21 @@ def write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=No
         img = getattr(mat, "baseColorTexture", None) or getattr(mat, "image", None)
         image = np.asarray(img.convert("RGB")) if img is not None else None
     if image is None:
-        up = np.asarray(res.speed.up)
+        up = res.field.stem_axis
         c = res.mesh.centroid
-        d = res.mesh.vertices - c
-        radial = np.linalg.norm(d - np.outer(d @ up, up), axis=1)
-        uv = cylindrical_uv(origins, up, c, 2 * np.pi * max(float(radial.mean()), 1e-3))
-        image = bark_image(512, seed)
+
+        def mean_radius(v):
+            d = v - c
+            return max(float(np.linalg.norm(d - np.outer(d @ up, up), axis=1).mean()), 1e-3)
+
+        uv = cylindrical_uv(origins, up, c, 2 * np.pi * mean_radius(res.mesh.vertices))
+        # the carried coordinates stretch with the growth; lay as many bark tiles round the
+        # stem as the grown girth holds, as one picture (so each crack is drawn once)
+        k = max(1, int(round(mean_radius(mesh.vertices) / mean_radius(res.mesh.vertices))))
+        uv = uv * k
+        rows = max(1, int(np.ceil(uv[:, 1].max())))
+        image = np.tile(bark_image(256, seed), (rows, k, 1))
+        uv = uv / np.array([k, rows])
     if crack_render == "material" and len(crack_edges):
         image = paint_cracks(image, uv, crack_edges)
     elif crack_render == "groove" and len(crack_edges):

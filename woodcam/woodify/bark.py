@@ -3,7 +3,7 @@
 Texture coordinates come from where each grown vertex came from on the input surface
 (:func:`woodcam.woodify.surfaces.trace_back`): the input's own UVs when it has them (its image
 stays put while the object grows, seed Fig. 4.6), otherwise cylindrical coordinates of the
-origin round ``up`` (``u`` = angle / 2 pi, ``v`` = height / circumference), so a procedural
+origin round the stem axis (``u`` = angle / 2 pi, ``v`` = height / circumference), so a procedural
 bark image is carried in the same way. Cracks are drawn either into the image along their UV
 paths (``"material"``) or cut into the geometry (``"groove"``, :func:`groove`).
 """
@@ -19,8 +19,22 @@ CrackRender = Literal["groove", "material"]
 CRACK_RENDERS: tuple[str, ...] = ("groove", "material")
 
 
+def stem_axis(mesh) -> np.ndarray:
+    """Unit direction ``(3,)`` of a mesh's longest principal axis (area-weighted surface PCA):
+    the stem of a trunk-like input, round which bark coordinates wrap and fibres run."""
+    c = mesh.triangles_center
+    w = mesh.area_faces
+    mu = (c * w[:, None]).sum(0) / w.sum()
+    d = c - mu
+    cov = (d * w[:, None]).T @ d / w.sum()
+    _, V = np.linalg.eigh(cov)
+    a = V[:, -1]
+    return a if a[np.argmax(np.abs(a))] > 0 else -a
+
+
 def cylindrical_uv(origins_mm, up, centre_mm, circumference_mm: float) -> np.ndarray:
-    """``(n, 2)`` UVs of input-surface points round the axis through ``centre_mm`` along ``up``."""
+    """``(n, 2)`` UVs of input-surface points round the axis through ``centre_mm`` along ``up``
+    (here: the stem axis, not the eccentricity's up)."""
     up = np.asarray(up, float) / np.linalg.norm(up)
     ref = np.array([1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
     e1 = ref - up * (ref @ up)
@@ -47,7 +61,7 @@ def bark_image(size_px: int = 512, seed: int = 0) -> np.ndarray:
     base = np.array([112, 92, 74], float)
     grey = np.array([140, 134, 126], float)
     mix = np.clip(0.5 + 0.25 * plates, 0, 1)[..., None]
-    img = (base * (1 - mix) + grey * mix) * light[..., None] * 1.25
+    img = (base * (1 - mix) + grey * mix) * light[..., None] * 1.5
     return np.clip(img, 0, 255).astype(np.uint8)
 
 
@@ -86,7 +100,7 @@ def textured_mesh(mesh, uv, image):
     return out
 
 
-def paint_cracks(image, uv, edges, width_px: int = 3) -> np.ndarray:
+def paint_cracks(image, uv, edges, width_px: int = 2) -> np.ndarray:
     """Draw crack edges ``(m, 2)`` (vertex indices, with ``uv (n, 2)``) dark into the image."""
     import cv2
 

@@ -218,7 +218,7 @@ def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region
     region : (x, y, z, r) mm, optional
         Only vertices whose origin lies within this sphere (object frame) crack.
     threshold : float, optional
-        Separation eigenvalue that opens a crack; default 1.5 x the median largest eigenvalue
+        Separation eigenvalue that opens a crack; default 2 x the median largest eigenvalue
         of the first simulated year (cracks open where stress concentrates, then spread).
     relief : float in [0, 1]
         Stress kept by the faces round a new crack (0 removes all of it, 1 none).
@@ -293,7 +293,7 @@ def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region
             allowed = np.linalg.norm(origins - c, axis=1) <= float(region[3])
         if thr is None:
             base = np.median(lam[allowed]) if allowed.any() else 0.0
-            thr = 1.5 * float(base) if base > 0 else float(np.max(lam) + 1.0)
+            thr = 2.0 * float(base) if base > 0 else float(np.max(lam) + 1.0)
         heap = [(-lam[v], v) for v in np.nonzero(allowed & (lam > thr) & ~cracked_v)[0]]
         heapq.heapify(heap)
         nbrs = mesh.vertex_neighbors

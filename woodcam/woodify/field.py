@@ -15,11 +15,13 @@ of ``block_size_mm`` is cut anywhere out of the grown object.
 Engulfed obstacles are no wood: :meth:`WoodifiedField.no_wood` is true inside them, and
 :meth:`WoodifiedField.evaluate` reports them as ``dead`` (darkened like dead-knot wood by the
 colour map) with an ``outline`` on the scar round them, so a baked part shows the post.
-Fibres run along ``up`` (the stem of a tree).
+Fibres run along ``stem_axis`` (object frame; by default the input's longest principal axis,
+:func:`woodcam.woodify.bark.stem_axis`).
 
 File ``field.npz`` (written atomically): ``arrival_mm`` float32 (nx, ny, nz), ``origin_mm``,
-``spacing_mm``, ``speed`` (JSON of :class:`GrowthSpeed`), ``years_final``, optional
-``obstacle_sdf_mm`` float32, ``block_origin_mm``, ``block_rotation``, ``block_size_mm``.
+``spacing_mm``, ``speed`` (JSON of :class:`GrowthSpeed`), ``years_final``, ``stem_axis``,
+optional ``obstacle_sdf_mm`` float32, ``block_origin_mm``, ``block_rotation``,
+``block_size_mm``.
 """
 
 from __future__ import annotations
@@ -65,11 +67,14 @@ class WoodifiedField:
         Placement of the block in the object frame (see module docstring); default: the
         identity (block frame = object frame) and the grid's extent.
     interpolation : "linear" (trilinear, default) or "cubic" (C2 B-spline)
+    stem_axis : (3,) float, optional
+        Fibre direction in the object frame; default ``speed.up``.
     """
 
     def __init__(self, arrival_mm, origin_mm, spacing_mm: float, speed: GrowthSpeed,
                  years_final: float, obstacle_sdf_mm=None, block_origin_mm=(0.0, 0.0, 0.0),
-                 rotation=None, block_size_mm=None, interpolation: Interpolation = "linear"):
+                 rotation=None, block_size_mm=None, interpolation: Interpolation = "linear",
+                 stem_axis=None):
         T = np.asarray(arrival_mm, dtype=np.float64)
         if T.ndim != 3 or min(T.shape) < 2:
             raise WoodcamError(f"arrival_mm must be an (nx, ny, nz) grid, each >= 2; got {T.shape}")
@@ -88,6 +93,8 @@ class WoodifiedField:
         self.years_cap = float(speed.years(min(self.t_cap_mm, speed.velocity_mm * (1 - 1e-6))))
         self.obstacle_sdf_mm = None if obstacle_sdf_mm is None else np.asarray(obstacle_sdf_mm, np.float32)
         self.interpolation = interpolation
+        ax = np.asarray(speed.up if stem_axis is None else stem_axis, float).reshape(3)
+        self.stem_axis = ax / np.linalg.norm(ax)
         R = np.eye(3) if rotation is None else np.asarray(rotation, float)
         if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
             raise WoodcamError(f"rotation must be a proper 3x3 rotation matrix; got {R.tolist()}")
@@ -103,8 +110,8 @@ class WoodifiedField:
 
     @property
     def axis(self) -> np.ndarray:
-        """Fibre direction: ``up`` of the growth law, in the block frame."""
-        return self.rotation.T @ np.asarray(self.speed.up)
+        """Fibre direction (the stem axis) in the block frame, (3,)."""
+        return self.rotation.T @ self.stem_axis
 
     def to_object(self, points_mm) -> np.ndarray:
         """Block-frame points ``(n, 3)`` -> object-frame points ``(n, 3)`` (mm)."""
@@ -149,7 +156,7 @@ class WoodifiedField:
         return out
 
     def grain_direction(self, points_mm) -> np.ndarray:
-        """Unit fibre directions ``(n, 3)``: ``up`` everywhere (block frame)."""
+        """Unit fibre directions ``(n, 3)``: the stem axis everywhere (block frame)."""
         return np.broadcast_to(self.axis, check_points(points_mm).shape)
 
     def placed(self, block_size_mm, block_centre_mm=None, rotation=None) -> WoodifiedField:
@@ -163,7 +170,7 @@ class WoodifiedField:
         c = self.origin_mm + extent / 2 if block_centre_mm is None else np.asarray(block_centre_mm, float)
         return WoodifiedField(self.arrival_mm, self.origin_mm, self.spacing_mm, self.speed,
                               self.years_final, self.obstacle_sdf_mm, c - R @ size / 2, R,
-                              tuple(size), self.interpolation)
+                              tuple(size), self.interpolation, self.stem_axis)
 
     def save(self, path) -> Path:
         """Write ``field.npz`` atomically (temp file in the same folder, then ``os.replace``)."""
@@ -174,7 +181,8 @@ class WoodifiedField:
         arrays = {"format": FORMAT, "arrival_mm": self.arrival_mm, "origin_mm": self.origin_mm,
                       "spacing_mm": self.spacing_mm, "speed": json.dumps(self.speed.to_dict()),
                       "years_final": self.years_final, "block_origin_mm": self.block_origin_mm,
-                      "block_rotation": self.rotation, "block_size_mm": np.asarray(self.block_size_mm)}
+                      "block_rotation": self.rotation, "block_size_mm": np.asarray(self.block_size_mm),
+                      "stem_axis": self.stem_axis}
         if self.obstacle_sdf_mm is not None:
             arrays["obstacle_sdf_mm"] = self.obstacle_sdf_mm
         fd, tmp = tempfile.mkstemp(suffix=".npz", dir=path.parent)
@@ -203,6 +211,6 @@ class WoodifiedField:
                            float(z["years_final"]),
                            z["obstacle_sdf_mm"] if "obstacle_sdf_mm" in z.files else None,
                            z["block_origin_mm"], z["block_rotation"], tuple(z["block_size_mm"]),
-                           interpolation)
+                           interpolation, z["stem_axis"])
         except (OSError, KeyError, ValueError) as err:
             raise WoodcamError(f"{path}: not a woodcam woodify field ({FORMAT} .npz): {err}") from err

@@ -168,7 +168,9 @@ def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: 
     front = propagate(mesh, grid, wind=speed.wind, obstacles=obstacles, method=method,
                       stop_mm=tau_end + 2 * _MARGIN_NODES * grid.spacing_mm * gmax, paint=paint_fn)
     t2 = time.perf_counter()
+    from .bark import stem_axis
+
     field = WoodifiedField(front.arrival_mm, grid.origin_mm, grid.spacing_mm, speed, float(years),
-                           front.obstacle_sdf_mm)
+                           front.obstacle_sdf_mm, stem_axis=stem_axis(mesh))
     timings = {"setup_s": t1 - t0, "front_s": t2 - t1, "field_s": time.perf_counter() - t2}
     return Woodification(mesh, speed, float(years), front, field, obstacles, timings)
