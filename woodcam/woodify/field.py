@@ -27,14 +27,13 @@ optional ``obstacle_sdf_mm`` float32, ``block_origin_mm``, ``block_rotation``,
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from pathlib import Path
 from typing import Literal
 
 import numpy as np
 from scipy import ndimage
 
+from .._atomic import atomic_path
 from ..errors import WoodcamError
 from ..fields.base import check_points
 from .speed import GrowthSpeed
@@ -185,14 +184,8 @@ class WoodifiedField:
                       "stem_axis": self.stem_axis}
         if self.obstacle_sdf_mm is not None:
             arrays["obstacle_sdf_mm"] = self.obstacle_sdf_mm
-        fd, tmp = tempfile.mkstemp(suffix=".npz", dir=path.parent)
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                np.savez_compressed(fh, **arrays)
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        with atomic_path(path) as tmp:
+            np.savez_compressed(tmp, **arrays)
         return path
 
     @classmethod

@@ -11,28 +11,26 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
-from .errors import WoodcamError
+from ..errors import WoodcamError
 
 
 def _vec(text: str, option: str, n: int = 3, positive: bool = False) -> tuple[float, ...]:
+    import math
+
     try:
         vals = tuple(float(v) for v in text.replace("x", ",").split(","))
     except ValueError:
         vals = ()
-    if len(vals) != n or not all(np.isfinite(vals)) or (positive and min(vals) <= 0):
+    if len(vals) != n or not all(math.isfinite(v) for v in vals) or (positive and min(vals) <= 0):
         kind = "sizes > 0" if positive else "numbers"
         raise WoodcamError(f"{option} takes {n} comma-separated {kind} (mm); got {text!r}")
     return vals
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
+def register(subparsers) -> argparse.ArgumentParser:
     """Add the ``woodify`` command."""
     p = subparsers.add_parser(
         "woodify", help="grow a mesh like a tree: rings, obstacles, bark and cracks (seed 004)",
@@ -88,6 +86,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def _load_mesh(path: str):
     """(watertight geometry, textured original or None) from a part or mesh file."""
+    import numpy as np
     import trimesh
 
     pth = Path(path)
@@ -104,7 +103,7 @@ def _load_mesh(path: str):
         if textured is not None and len(geom.faces) != len(textured.faces):
             textured = None
         return geom, textured
-    from .cad import load_part
+    from ..cad import load_part
 
     solid = load_part(path)
     m = solid.to_mesh()
@@ -112,17 +111,12 @@ def _load_mesh(path: str):
 
 
 def _atomic(path: Path, write) -> Path:
-    """Call ``write(tmp_path)`` then move the temp file over ``path``."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
-        write(Path(tmp))
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    """Call ``write(tmp_path)`` and move the temporary file onto ``path`` (woodcam._atomic)."""
+    from .._atomic import atomic_path
+
+    with atomic_path(path, mkdir=True) as tmp:
+        write(tmp)
+    return Path(path)
 
 
 def write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=None,
@@ -131,18 +125,19 @@ def write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=No
                   atomic=_atomic, progress=None):
     """Write the products of a :class:`~woodcam.woodify.Woodification` into ``out`` (module
     docstring); returns (files written, summary dict)."""
+    import numpy as np
     from PIL import Image
 
-    from .export import export_glb
-    from .woodify.bark import (
+    from ..export import export_glb
+    from ..woodify.bark import (
         bark_image,
         cylindrical_uv,
         groove,
         paint_cracks,
         textured_mesh,
     )
-    from .woodify.cracks import simulate_cracks
-    from .woodify.surfaces import barycentric_on, carry, section_image
+    from ..woodify.cracks import simulate_cracks
+    from ..woodify.surfaces import barycentric_on, carry, section_image
 
     out = Path(out)
     files = []
@@ -239,9 +234,10 @@ def write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=No
 
 def run(args) -> int:
     """Run a parsed ``woodify`` command; returns the exit status."""
+    import numpy as np
     from tqdm import tqdm
 
-    from .woodify import load_brushes, woodify
+    from ..woodify import load_brushes, woodify
 
     t0 = time.perf_counter()
     if not (np.isfinite(args.years) and args.years > 0):
