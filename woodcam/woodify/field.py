@@ -142,13 +142,13 @@ class WoodifiedField:
         out = {"years": self(p)}
         n = len(p)
         zero = np.zeros(n, np.float32)
-        out["knot"] = zero
         if self.obstacle_sdf_mm is None:
-            out["dead"] = zero
-            out["outline"] = zero
+            out["knot"] = out["dead"] = out["outline"] = zero
         else:
             sd = self._sample(self.obstacle_sdf_mm, self.to_object(p), 1)
-            out["dead"] = (sd < 0).astype(np.float32)
+            # both knot channels: the colour map darkens the obstacle twice, so it reads as
+            # foreign matter, not as a knot
+            out["knot"] = out["dead"] = (sd < 0).astype(np.float32)
             out["outline"] = ((sd >= 0) & (sd < _SCAR_MM)).astype(np.float32)
         if directions:
             out["direction"] = np.broadcast_to(self.axis, p.shape).astype(np.float32)
