@@ -119,3 +119,27 @@ def test_brush_gain_speeds_growth_where_painted():
     assert abs(left[0] - left[1]) < 0.25 * h
     with pytest.raises(WoodcamError, match="brush gain must be > 0"):
         Brush(centre_mm=(0, 0, 0), radius_mm=1.0, gain=0.0)
+
+
+def test_vertex_attribute_gain_is_painted_like_a_brush():
+    m = trimesh.creation.icosphere(subdivisions=4, radius=10.0)
+    gain = np.where(m.vertices[:, 2] > 0, 1.5, 1.0)  # the upper half grows 1.5x as fast
+    r = woodify(m, 10, growth_mm=8.0, resolution=56, vertex_gain=gain)
+    h = r.front.grid.spacing_mm
+    tau = r.tau(10.0)
+    assert r.field.arrival(np.array([[0, 0, 10.0 + 1.5 * tau]]))[0] == pytest.approx(tau, abs=h)
+    assert r.field.arrival(np.array([[0, 0, -10.0 - tau]]))[0] == pytest.approx(tau, abs=0.5 * h)
+
+
+def test_groove_cuts_cracks_into_the_surface(cylinder):
+    from woodcam.woodify.bark import groove
+
+    cs = simulate_cracks(cylinder, [3, 4, 5])
+    width = np.zeros(len(cs.mesh.vertices))
+    width[cs.crack_edges.ravel()] = 1.0
+    cut = groove(cs.mesh, width, 0.5)
+    r0 = np.hypot(*cs.mesh.vertices[:, :2].T)
+    r1 = np.hypot(*cut.vertices[:, :2].T)
+    lat = np.abs(cs.mesh.vertices[:, 2]) < 20
+    on = lat & (width > 0)
+    assert np.all(r1[on] < r0[on] - 0.4) and np.allclose(r1[lat & (width == 0)], r0[lat & (width == 0)])

@@ -43,7 +43,9 @@ def test_woodify_writes_field_surfaces_sections_and_bark(grown_dir):
     # inside the input (year 0); a block corner lies beyond the final bark (> 8 years)
     assert f(np.array([[50.0, 40.0, 25.0]]))[0] == 0.0
     assert f(np.array([[0.0, 0.0, 0.0]]))[0] > 8.0
-    glb = trimesh.load(grown_dir / "grown.glb", force="mesh")
+    from woodcam.export import load_textured
+
+    glb = load_textured(grown_dir / "grown.glb")
     assert glb.visual.uv is not None and len(glb.faces) > 100
     summary = json.loads((grown_dir / "woodify.json").read_text())
     assert summary["method"] == "offset" and summary["cracks"]["count"] >= 0
@@ -69,3 +71,26 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
     assert "must be watertight" in capsys.readouterr().err
     with pytest.raises(WoodcamError, match="does not exist"):
         open_stock(f"woodify:{tmp_path / 'missing.npz'}")
+
+
+def test_input_texture_is_carried_to_the_grown_bark(tmp_path):
+    """A textured input (UV = longitude, latitude) keeps its picture in place: every grown
+    vertex's UV is the UV of the input point straight below it (radial growth of a sphere)."""
+    from PIL import Image
+
+    m = trimesh.creation.icosphere(subdivisions=3, radius=8.0)
+    v = m.vertices / 8.0
+    uv = np.c_[0.5 + np.arctan2(v[:, 1], v[:, 0]) / (2 * np.pi), 0.5 + np.arcsin(v[:, 2]) / np.pi]
+    img = Image.fromarray((np.random.default_rng(0).random((64, 64, 3)) * 255).astype(np.uint8))
+    m.visual = trimesh.visual.TextureVisuals(uv=uv, image=img)
+    m.export(tmp_path / "ball.glb")
+    out = tmp_path / "grown"
+    assert main(["woodify", str(tmp_path / "ball.glb"), "--years", "5", "--growth", "6",
+                 "--resolution", "40", "--cracks", "none", "--out", str(out)]) == 0
+    from woodcam.export import load_textured
+
+    g = load_textured(out / "grown.glb")
+    p = g.vertices / np.linalg.norm(g.vertices, axis=1, keepdims=True)
+    lat = 0.5 + np.arcsin(p[:, 2]) / np.pi
+    # latitude is smooth everywhere (longitude wraps at the seam): compare it
+    assert np.percentile(np.abs(g.visual.uv[:, 1] - lat), 95) < 0.03

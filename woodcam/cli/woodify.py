@@ -94,7 +94,14 @@ def _load_mesh(path: str):
         if not pth.is_file():
             raise WoodcamError(f"part {path!r} does not exist")
         try:
-            loaded = trimesh.load(pth, force="mesh")
+            if pth.suffix.lower() in (".glb", ".gltf", ".obj"):
+                from ..export import load_textured  # undoes woodcam's glTF/OBJ frame
+
+                loaded = load_textured(pth)
+            else:
+                loaded = trimesh.load(pth, force="mesh")
+        except WoodcamError:
+            raise
         except Exception as err:  # trimesh raises many kinds for unreadable files
             raise WoodcamError(f"part {path!r} could not be read as a mesh: {err}") from err
         textured = loaded if getattr(loaded.visual, "uv", None) is not None else None
