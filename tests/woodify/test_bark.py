@@ -143,3 +143,17 @@ def test_groove_cuts_cracks_into_the_surface(cylinder):
     lat = np.abs(cs.mesh.vertices[:, 2]) < 20
     on = lat & (width > 0)
     assert np.all(r1[on] < r0[on] - 0.4) and np.allclose(r1[lat & (width == 0)], r0[lat & (width == 0)])
+
+
+def test_brush_file_round_trip_and_errors(tmp_path):
+    from woodcam.woodify import load_brushes
+
+    p = tmp_path / "brushes.json"
+    p.write_text('{"brushes": [{"centre_mm": [1, 2, 3], "radius_mm": 4, "gain": 1.5, '
+                 '"direction": [0, 0, 2], "strength": 0.25}, {"centre_mm": [0, 0, 0], "radius_mm": 1}]}')
+    a, b = load_brushes(p)
+    assert a == Brush((1, 2, 3), 4.0, 1.5, (0.0, 0.0, 1.0), 0.25) and b.gain == 1.0
+    assert a.weight(np.array([[1.0, 2.0, 3.0], [5.0, 2.0, 3.0]])) == pytest.approx([1.0, np.exp(-0.5)])
+    p.write_text('{"brushes": [{"radius_mm": 4}]}')
+    with pytest.raises(WoodcamError, match="brushes file .* must be JSON like"):
+        load_brushes(p)
