@@ -84,7 +84,8 @@ def _simplex_update(av, bv, ov, tmax, g, wx, wy, wz, slack):  # pragma: no cover
 
 
 @numba.njit(cache=True, nogil=True)
-def _node_update(T, state, i, j, k, g, wx, wy, wz, h, order, slack, nb, nb2, av, bv, ov):  # pragma: no cover - compiled
+def _node_update(T, state, i, j, k, g, wx, wy, wz, h, order, slack, nb, nb2, av, bv, ov,
+                 fix_axis=-1, fix_choice=0):  # pragma: no cover - compiled
     nx, ny, nz = T.shape
     # accepted neighbour values per axis and side (0: at -1, 1: at +1), one and two nodes away
     nb[:] = np.inf  # work buffers passed in: allocating per call dominated the run time
@@ -120,6 +121,10 @@ def _node_update(T, state, i, j, k, g, wx, wy, wz, h, order, slack, nb, nb2, av,
                 if cx == 0 and cy == 0 and cz == 0:
                     continue
                 choice = (cx, cy, cz)
+                # only simplices through the node just accepted can lower the value: the
+                # others were tried when their nodes were accepted
+                if fix_axis >= 0 and choice[fix_axis] != fix_choice:
+                    continue
                 ok = True
                 tmax = -np.inf
                 for d in range(3):
@@ -211,10 +216,13 @@ def march(T, state, gain, wind, h, order=2, reopen_tol=1e-3, slack_nodes=1.0):  
             if st == BLOCKED or st == FIXED:
                 continue
             gi = gain[0, 0, 0] if gconst else gain[a, b, c]
+            # the accepted node sits at -o from (a, b, c): axis fa, choice 1 (-1 side) or 2 (+1)
+            fa = 0 if o[0] != 0 else (1 if o[1] != 0 else 2)
+            fc = 1 if o[fa] > 0 else 2
             if wconst:
-                t = _node_update(T, state, a, b, c, gi, wind[0, 0, 0, 0], wind[0, 0, 0, 1], wind[0, 0, 0, 2], h, order, slack, nb, nb2, av, bv, ov)
+                t = _node_update(T, state, a, b, c, gi, wind[0, 0, 0, 0], wind[0, 0, 0, 1], wind[0, 0, 0, 2], h, order, slack, nb, nb2, av, bv, ov, fa, fc)
             else:
-                t = _node_update(T, state, a, b, c, gi, wind[a, b, c, 0], wind[a, b, c, 1], wind[a, b, c, 2], h, order, slack, nb, nb2, av, bv, ov)
+                t = _node_update(T, state, a, b, c, gi, wind[a, b, c, 0], wind[a, b, c, 1], wind[a, b, c, 2], h, order, slack, nb, nb2, av, bv, ov, fa, fc)
             # an accepted node re-opens when a later neighbour improves it: with anisotropy the
             # characteristic may leave a simplex whose nodes are accepted after it (non-causal
             # for plain fast marching); label-correcting settles it at the same fixed point.
