@@ -76,10 +76,11 @@ def test_field_of_a_20k_triangle_mesh_at_128():
     lo = np.asarray(g.origin_mm)
     pts = lo + rng.random((1_000_000, 3)) * (np.asarray(g.shape) - 1) * g.spacing_mm
     res.field(pts[:1000])
-    t = time.perf_counter()
+    t, tw = time.process_time(), time.perf_counter()
     res.field(pts)
-    dt = time.perf_counter() - t
-    _report("field evaluation", points=len(pts), points_per_s=round(len(pts) / dt), wall_s=round(dt, 3))
+    dt, dw = time.process_time() - t, time.perf_counter() - tw
+    _report("field evaluation", points=len(pts), points_per_cpu_s=round(len(pts) / dt),
+            points_per_wall_s=round(len(pts) / dw), cpu_s=round(dt, 3))
     assert len(pts) / dt > 1e6
 
 

@@ -118,6 +118,10 @@ class WoodifiedField:
         return self.block_origin_mm + np.einsum("ij,kj->ik", p, self.rotation)
 
     def _sample(self, grid, q, order) -> np.ndarray:
+        if order == 1:
+            from ._voxel import trilinear
+
+            return trilinear(grid, self.origin_mm, self.spacing_mm, np.ascontiguousarray(q, float))
         idx = (q - self.origin_mm) / self.spacing_mm
         return ndimage.map_coordinates(grid, idx.T, order=order, mode="nearest", prefilter=False)
 
