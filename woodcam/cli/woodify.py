@@ -49,7 +49,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--shape", type=float, default=2.0, help="Weibull shape c of eq. 4.1 (default 2)")
     p.add_argument("--eccentricity", type=float, default=0.0,
                    help="delta in (-1, 1): speed (1 + delta n.up) (default 0)")
-    p.add_argument("--up", default="0,0,1", metavar="X,Y,Z", help="up direction (default 0,0,1)")
+    p.add_argument("--up", default="0,0,1", metavar="X,Y,Z", help="direction the eccentric growth favours (unit-normalised; default 0,0,1)")
     p.add_argument("--obstacle", type=Path, action="append", default=[], metavar="MESH",
                    help="closed obstacle mesh or part (mm); repeatable")
     p.add_argument("--brushes", type=Path, default=None, metavar="JSON",
@@ -66,7 +66,8 @@ def register(subparsers) -> argparse.ArgumentParser:
                    "object's bounding box")
     p.add_argument("--block-centre", default=None, metavar="X,Y,Z",
                    help="centre of that block in the input's frame (mm); default the grown "
-                   "object's bounding-box centre")
+                   "object's bounding-box centre (write --block-centre=-9,0,35 when the first "
+                   "value is negative)")
     p.add_argument("--cracks", choices=("none", "stress", "vertical", "horizontal", "random"),
                    default="stress", help="bark crack pattern (default stress: natural directions)")
     p.add_argument("--crack-region", default=None, metavar="X,Y,Z,R",
@@ -76,10 +77,11 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--crack-render", choices=("groove", "material"), default="material",
                    help="draw cracks into the bark texture (material, default) or cut them as grooves")
     p.add_argument("--crack-threshold", type=float, default=None,
-                   help="separation eigenvalue that opens a crack (default: automatic)")
+                   help="separation eigenvalue that opens a crack (default 2x the median of the "
+                   "first simulated year)")
     p.add_argument("--relief", type=float, default=0.3,
                    help="stress left next to a new crack, in [0, 1] (0 removes all; default 0.3)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (bark picture, random cracks)")
+    p.add_argument("--seed", type=int, default=0, help="random seed of the bark picture and random cracks (default 0)")
     p.set_defaults(func=run)
     return p
 
@@ -260,7 +262,13 @@ def run(args) -> int:
                   brushes=brushes, resolution=args.resolution, method=args.method)
     steps.update(1)
     if args.surface_years:
-        years = [float(v) for v in args.surface_years.split(",")]
+        try:
+            years = [float(v) for v in args.surface_years.split(",")]
+        except ValueError:
+            years = [-1.0]
+        if not all(0 <= y <= args.years for y in years):
+            raise WoodcamError(f"--surface-years takes comma-separated years in [0, {args.years:g}]; "
+                               f"got {args.surface_years!r}")
     else:
         years = [args.years * k / 4 for k in (1, 2, 3)]
     size = _vec(args.block_size, "--block-size", positive=True) if args.block_size else None
