@@ -94,3 +94,18 @@ def test_input_texture_is_carried_to_the_grown_bark(tmp_path):
     lat = 0.5 + np.arcsin(p[:, 2]) / np.pi
     # latitude is smooth everywhere (longitude wraps at the seam): compare it
     assert np.percentile(np.abs(g.visual.uv[:, 1] - lat), 95) < 0.03
+
+
+def test_ply_vertex_properties_paint_the_growth(tmp_path):
+    """A PLY's per-vertex 'gain' speeds the growth where it is painted (seed sec. 4.2.2)."""
+    m = trimesh.creation.icosphere(subdivisions=3, radius=8.0)
+    m.vertex_attributes["gain"] = np.where(m.vertices[:, 2] > 0, 1.6, 1.0).astype(np.float32)
+    (tmp_path / "ball.ply").write_bytes(trimesh.exchange.ply.export_ply(m, include_attributes=True))
+    out = tmp_path / "grown"
+    assert main(["woodify", str(tmp_path / "ball.ply"), "--years", "5", "--growth", "6",
+                 "--resolution", "40", "--cracks", "none", "--out", str(out)]) == 0
+    f = WoodifiedField.load(out / "field.npz")
+    # block point = object point - block origin (no rotation); 6 mm grown where gain is 1
+    top = f.arrival(np.array([[0, 0, 8 + 6 * 1.6]]) - f.block_origin_mm)
+    bottom = f.arrival(np.array([[0, 0, -8 - 6.0]]) - f.block_origin_mm)
+    assert top[0] == pytest.approx(6.0, abs=1.5) and bottom[0] == pytest.approx(6.0, abs=0.6)

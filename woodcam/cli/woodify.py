@@ -38,7 +38,9 @@ def register(subparsers) -> argparse.ArgumentParser:
         "eccentricity, obstacles, brushes), then write its growth field (usable as --block "
         "woodify:OUT/field.npz), grown surfaces, ring sections and a bark-textured grown.glb. "
         "Lengths in mm, time in years.")
-    p.add_argument("part", help="input: a .py part script, .step, or a closed .stl/.obj/.ply/.glb mesh (mm)")
+    p.add_argument("part", help="input: a .py part script, .step, or a closed .stl/.obj/.ply/.glb mesh "
+                   "(mm); a PLY may paint growth per vertex: properties gain (speed gain) and "
+                   "dir_x, dir_y, dir_z (growth direction, length = strength < 1)")
     p.add_argument("--years", type=float, required=True, help="years to grow (> 0)")
     p.add_argument("--out", type=Path, required=True, help="output folder")
     p.add_argument("--growth", type=float, default=None, metavar="MM",
@@ -100,6 +102,8 @@ def _load_mesh(path: str):
                 from ..export import load_textured  # undoes woodcam's glTF/OBJ frame
 
                 loaded = load_textured(pth)
+            elif pth.suffix.lower() == ".ply":
+                loaded = trimesh.load(pth, force="mesh", process=False)  # keep vertex order
             else:
                 loaded = trimesh.load(pth, force="mesh")
         except WoodcamError:
@@ -107,16 +111,43 @@ def _load_mesh(path: str):
         except Exception as err:  # trimesh raises many kinds for unreadable files
             raise WoodcamError(f"part {path!r} could not be read as a mesh: {err}") from err
         textured = loaded if getattr(loaded.visual, "uv", None) is not None else None
+        paint = _ply_paint(loaded, path)
+        if paint:
+            if not loaded.is_watertight:
+                raise WoodcamError(
+                    f"part {path!r} carries growth attributes per vertex, so it must be watertight "
+                    "as stored (shared vertices), without merging; weld its vertices first")
+            return loaded, None, paint
         geom = trimesh.Trimesh(loaded.vertices, loaded.faces, process=True)
         geom.merge_vertices(merge_tex=True, merge_norm=True)
         if textured is not None and len(geom.faces) != len(textured.faces):
             textured = None
-        return geom, textured
+        return geom, textured, {}
     from ..cad import load_part
 
     solid = load_part(path)
     m = solid.to_mesh()
-    return trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts)), None
+    return trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts)), None, {}
+
+
+def _ply_paint(mesh, path) -> dict:
+    """Painted growth from a PLY's vertex properties: ``gain`` (speed gain > 0) and
+    ``dir_x, dir_y, dir_z`` (growth direction, its length the strength < 1), seed sec. 4.2.2."""
+    import numpy as np
+
+    raw = mesh.metadata.get("_ply_raw", {}).get("vertex", {}).get("data")
+    names = () if raw is None or raw.dtype.names is None else raw.dtype.names
+    out = {}
+    if "gain" in names:
+        out["vertex_gain"] = np.asarray(raw["gain"], float).reshape(-1)
+    if all(k in names for k in ("dir_x", "dir_y", "dir_z")):
+        out["vertex_direction"] = np.stack([np.asarray(raw[k], float).reshape(-1)
+                                            for k in ("dir_x", "dir_y", "dir_z")], axis=1)
+    for k, v in out.items():
+        if len(v) != len(mesh.vertices):
+            raise WoodcamError(f"part {path!r}: vertex property {k} has {len(v)} values for "
+                               f"{len(mesh.vertices)} vertices")
+    return out
 
 
 def _atomic(path: Path, write) -> Path:
@@ -253,13 +284,13 @@ def run(args) -> int:
         raise WoodcamError(f"--years must be > 0 (years to grow); got {args.years:g}")
     up = _vec(args.up, "--up")
     steps = tqdm(total=4, desc="woodify", unit="stage", leave=False)
-    mesh, textured = _load_mesh(args.part)
+    mesh, textured, painted = _load_mesh(args.part)
     obstacles = [_load_mesh(str(o))[0] for o in args.obstacle]
     brushes = load_brushes(args.brushes) if args.brushes else ()
     steps.update(1)
     res = woodify(mesh, args.years, growth_mm=args.growth, time_scale_years=args.time_scale,
                   shape=args.shape, eccentricity=args.eccentricity, up=up, obstacles=obstacles,
-                  brushes=brushes, resolution=args.resolution, method=args.method)
+                  brushes=brushes, resolution=args.resolution, method=args.method, **painted)
     steps.update(1)
     if args.surface_years:
         try:
