@@ -28,6 +28,7 @@ COMMANDS: tuple[str, ...] = (
     "woodcam.cli.gcode",         # gcode
     "woodcam.cli.review",        # review
     "woodcam.cli.place",         # place
+    "woodcam.cli.cache",         # cache info | clear
     "woodcam.cli.block",         # block synth | show
     "woodcam.cli.log",           # log render | maps | export
     "woodcam.cli.fit",           # fit, eval rings
