@@ -64,10 +64,10 @@ def test_bake_carves_a_bowl_from_the_grown_wood(grown_dir, tmp_path):
 def test_cli_errors_are_one_line(tmp_path, capsys):
     m = trimesh.creation.icosphere(subdivisions=2, radius=5.0)
     m.export(tmp_path / "ball.stl")
-    assert main(["woodify", str(tmp_path / "ball.stl"), "--years", "0", "--out", str(tmp_path / "o")]) == 2
+    assert main(["woodify", str(tmp_path / "ball.stl"), "--years", "0", "--out", str(tmp_path / "o")]) == 1
     assert "--years must be > 0" in capsys.readouterr().err
     trimesh.Trimesh(m.vertices, m.faces[:-4]).export(tmp_path / "open.stl")
-    assert main(["woodify", str(tmp_path / "open.stl"), "--years", "3", "--out", str(tmp_path / "o")]) == 2
+    assert main(["woodify", str(tmp_path / "open.stl"), "--years", "3", "--out", str(tmp_path / "o")]) == 1
     assert "must be watertight" in capsys.readouterr().err
     with pytest.raises(WoodcamError, match="does not exist"):
         open_stock(f"woodify:{tmp_path / 'missing.npz'}")
