@@ -159,7 +159,7 @@ def _atomic(path: Path, write) -> Path:
     return Path(path)
 
 
-def write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=None,
+def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=None,
                   block_centre_mm=None, cracks="stress", crack_region=None, crack_years=5,
                   crack_render="material", crack_threshold=None, relief=0.3, seed=0,
                   atomic=_atomic, progress=None):
@@ -305,7 +305,7 @@ def run(args) -> int:
     size = _vec(args.block_size, "--block-size", positive=True) if args.block_size else None
     centre = _vec(args.block_centre, "--block-centre") if args.block_centre else None
     region = _vec(args.crack_region, "--crack-region", n=4) if args.crack_region else None
-    files, summary = write_outputs(
+    files, summary = _write_outputs(
         res, args.out, textured=textured, surface_years=years, block_size_mm=size,
         block_centre_mm=centre, cracks=args.cracks, crack_region=region,
         crack_years=args.crack_years, crack_render=args.crack_render,
