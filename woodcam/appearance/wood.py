@@ -29,6 +29,9 @@ class Wood:
     threads : int or None
         Worker threads for :meth:`color` (numpy releases the GIL in its kernels);
         default: the number of CPU cores.
+
+    A wood made by :meth:`turned` maps its points and normals back to the source block's frame
+    before the field and the appearance see them.
     """
 
     def __init__(self, field, appearance=None, *, threads: int | None = None):
@@ -37,10 +40,65 @@ class Wood:
         self.field = field
         self.appearance = appearance if appearance is not None else ColorMapAppearance()
         self.threads = max(1, threads or os.cpu_count() or 1)
+        #: (R (3, 3), t (3,)) with source point = R^T (p - t), or None (this block's own frame)
+        self._turn: tuple[np.ndarray, np.ndarray] | None = None
+
+    def turned(self, axis: str, quarter_turns: int, size_mm) -> tuple["Wood", tuple]:
+        """The same wood with the block turned ``quarter_turns`` x 90 degrees about the block
+        axis ``axis`` (``"x"``, ``"y"`` or ``"z"``, right hand rule), e.g. to run the grain along
+        another axis under a part that stays put.
+
+        Parameters
+        ----------
+        axis : {"x", "y", "z"}
+        quarter_turns : int
+        size_mm : (3,) float
+            The block's size (W, D, H) before turning.
+
+        Returns
+        -------
+        (Wood, (W', D', H'))
+            The turned wood, in the turned block's frame (origin at its bottom-front-left
+            corner), and the turned block's size.
+        """
+        if axis not in ("x", "y", "z") or int(quarter_turns) != quarter_turns:
+            raise WoodcamError(
+                f"turned: axis must be 'x', 'y' or 'z' and quarter_turns an integer; got "
+                f"axis={axis!r}, quarter_turns={quarter_turns!r}; e.g. turned('z', 1, size)")
+        k = int(quarter_turns) % 4
+        i, j = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}[axis]  # cyclic: e_i -> e_j
+        rot = np.eye(3)
+        for _ in range(k):  # exact integer quarter turns: (e_i, e_j) -> (e_j, -e_i)
+            step = np.eye(3)
+            step[i, i] = step[j, j] = 0.0
+            step[j, i], step[i, j] = 1.0, -1.0
+            rot = step @ rot
+        size = np.asarray(size_mm, dtype=float)
+        corners = np.array(np.meshgrid(*[(0.0, v) for v in size], indexing="ij")).reshape(3, -1).T
+        moved = corners @ rot.T
+        shift = -moved.min(axis=0)
+        out = Wood(self.field, self.appearance, threads=self.threads)
+        inner = self._turn
+        if inner is None:
+            out._turn = (rot, shift)
+        else:  # compose: new -> this wood's frame -> its source
+            r0, t0 = inner
+            out._turn = (rot @ r0, rot @ t0 + shift)
+        new_size = tuple(float(v) for v in np.abs(rot) @ size)
+        return out, new_size
+
+    def _to_source(self, points, normals=None):
+        if self._turn is None:
+            return points, normals
+        rot, shift = self._turn
+        p = ((points - shift) @ rot).astype(points.dtype, copy=False)
+        n = None if normals is None else (normals @ rot).astype(normals.dtype, copy=False)
+        return p, n
 
     def years(self, points_mm) -> np.ndarray:
         """Growth time ``(n,)`` in years at ``points_mm : (n, 3)``."""
-        return evaluate(self.field, points_mm)
+        p, _ = self._to_source(check_points(points_mm))
+        return evaluate(self.field, p)
 
     def arf(self, points_mm) -> np.ndarray:
         """Annual-ring field ``(n,)`` in [0, 1) at ``points_mm`` (eq. 6 of seed 000)."""
@@ -64,6 +122,7 @@ class Wood:
         n = np.asarray(normals, dtype=np.float32)
         if n.shape != p.shape:
             raise WoodcamError(f"normals must have the shape of points_mm {p.shape}; got {n.shape}")
+        p, n = self._to_source(p, n)
         out = np.empty((len(p), 3), np.float32)
         starts = range(0, len(p), _CHUNK)
 

@@ -17,8 +17,9 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 
-BLOCK_SPEC_HELP = ("block spec: builtin:NAME, log:gran1@K[:WxDxH], a block folder (block.json) "
-                   "or a Mokume sample folder (a 50 mm cube unless --size-mm)")
+BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], a block folder "
+                   "(block.json) or a Mokume sample folder (a 50 mm cube unless --size-mm); "
+                   "append ~x90/~y90/~z90 to turn the block under the part")
 
 
 def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction:
@@ -76,6 +77,9 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                    help="training effort of the neural appearance (default normal)")
     p.add_argument("--epochs", type=int, default=None, help="override the neural training epochs")
     add_knot_options(p)
+    p.add_argument("--max-atlas", type=int, default=4096, metavar="PX",
+                   help="largest texture side in texels (default 4096, what every GPU takes); "
+                   "a part needing more gets a lower texel density, stated in the summary")
     p.add_argument("--no-obj", action="store_true", help="write only the GLB, not OBJ+MTL+PNG")
     p.add_argument("--obj-units", choices=("m", "mm"), default="m",
                    help="length unit of the OBJ's coordinates (default m, what Blender and most "
