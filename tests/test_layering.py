@@ -58,6 +58,11 @@ def _imports(path: Path):
                     continue
             else:
                 target = node.module or ""
+                if target == "woodcam":  # "from woodcam import _x": a unit, or the package's API
+                    for alias in node.names:
+                        unit = alias.name in _units_on_disk()
+                        yield node.lineno, f"woodcam.{alias.name}" if unit else "woodcam"
+                    continue
             yield node.lineno, target
         elif isinstance(node, ast.Import):
             for alias in node.names:
