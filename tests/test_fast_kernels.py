@@ -148,12 +148,11 @@ def test_radial_kernel_is_eq_7_to_9():
 
 def test_knot_field_numba_backend_matches_numpy():
     from woodcam.fields.knots import KnottedLogField, available_backends
-    from woodcam.fields.tree_data import log_from_generated
     from woodcam.logs.generate import generate_log
 
     if "numba" not in available_backends():
         pytest.skip("numba backend not available")
-    log = log_from_generated(generate_log(3, length_mm=600.0))
+    log = generate_log(3, length_mm=600.0).to_skeleton()
     a, b = KnottedLogField(log, backend="numpy"), KnottedLogField(log, backend="numba")
     r = RNG.uniform(20, 120, 6000)
     th = RNG.uniform(0, 2 * np.pi, 6000)

@@ -1,10 +1,10 @@
 """Knotted-log growth field: stem and branch strand time fields joined by smooth minima.
 
 Implements the knot model of seed 003 (Wood Knot Editor, after Larsson et al. 2022, "Procedural
-Texturing of Solid Wood with Knots") as a growth-time field over a :class:`~.tree_data.Log`.
+Texturing of Solid Wood with Knots") as a growth-time field over a :class:`~.skeleton.LogSkeleton`.
 
 Frames and units. :class:`KnottedLogField` is evaluated in the LOG frame of
-:mod:`woodcam.fields.tree_data` (mm; ``z`` along the log). Wrap it with :class:`PlacedField`
+:mod:`woodcam.fields.skeleton` (mm; ``z`` along the log). Wrap it with :class:`PlacedField`
 (or :func:`place_block_in_log`) to use it in a block frame. Output is growth time in years,
 0 on the pith, growing outward; ``ring_width_mm`` converts the model's radial "time" to years.
 
@@ -48,7 +48,7 @@ import numpy as np
 
 from ..errors import WoodcamError
 from .base import check_points
-from .tree_data import Log
+from .skeleton import LogSkeleton
 
 Backend = Literal["auto", "numpy", "numba"]
 BACKENDS = ("numpy", "numba")
@@ -233,11 +233,11 @@ class KnottedLogField:
     Calling it: ``field(points_log_mm (n, 3)) -> years (n,)``.
     """
 
-    def __init__(self, log: Log, ring_width_mm: float = 2.0, params: KnotParams | None = None,
+    def __init__(self, log: LogSkeleton, ring_width_mm: float = 2.0, params: KnotParams | None = None,
                  *, surface_smoothing=(11, 5), chunk: int | None = None,
                  table_samples: int = 128, backend: Backend = "auto"):
-        if not isinstance(log, Log):
-            raise WoodcamError(f"log must be a woodcam.fields.tree_data.Log; got "
+        if not isinstance(log, LogSkeleton):
+            raise WoodcamError(f"log must be a woodcam.fields.skeleton.LogSkeleton; got "
                                f"{type(log).__name__}; read one with read_log or read_gran1")
         if not (ring_width_mm > 0):
             raise WoodcamError(f"ring_width_mm must be > 0 mm/year; got {ring_width_mm}; "
@@ -552,7 +552,7 @@ class KnottedLogField:
     def from_dict(cls, d: dict) -> "KnottedLogField":
         # Files written before knot shading moved to appearance/knots.py carry its two settings.
         params = {k: v for k, v in d["params"].items() if k not in _MOVED_TO_SHADING}
-        return cls(Log.from_json(d["log"]), d["ring_width_mm"], KnotParams(**params))
+        return cls(LogSkeleton.from_json(d["log"]), d["ring_width_mm"], KnotParams(**params))
 
 
 #: Former KnotParams settings now in :class:`woodcam.appearance.knots.KnotShading`.
