@@ -112,3 +112,14 @@ def test_the_walk_sees_lazy_imports(tmp_path, monkeypatch):
     monkeypatch.setattr(__import__(__name__), "PACKAGE", fake)
     expected = "woodcam/fields/x.py:2: fields (layer 4) imports woodcam.synth (layer 8)"
     assert _violations() == [expected]
+
+
+def test_no_two_public_classes_share_a_name():
+    """One concept, one name: a public class name is defined once in the package."""
+    where: dict[str, list[str]] = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        for node in ast.parse(path.read_text(), str(path)).body:
+            if isinstance(node, ast.ClassDef) and not node.name.startswith("_"):
+                where.setdefault(node.name, []).append(str(path.relative_to(PACKAGE.parent)))
+    twice = {name: paths for name, paths in where.items() if len(paths) > 1}
+    assert not twice, f"public classes defined more than once: {twice}"
