@@ -435,7 +435,7 @@ def _crashing_layout(original, crash_when):
 
 
 def test_a_native_crash_in_the_unwrap_is_retried_in_pieces(monkeypatch):
-    from woodcam import _xatlas_worker
+    import woodcam._xatlas_worker as _xatlas_worker
 
     mesh = _carved()
     monkeypatch.setattr(_xatlas_worker, "layout",
@@ -450,7 +450,7 @@ def test_a_native_crash_in_the_unwrap_is_retried_in_pieces(monkeypatch):
 
 
 def test_a_unwrap_that_always_crashes_is_one_clear_error(monkeypatch):
-    from woodcam import _xatlas_worker
+    import woodcam._xatlas_worker as _xatlas_worker
 
     monkeypatch.setattr(_xatlas_worker, "layout",
                         _crashing_layout(_xatlas_worker.layout, lambda p: True))

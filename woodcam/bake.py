@@ -391,7 +391,7 @@ def _layout_guarded(verts, faces, pieces, chart_cap, tpm, padding, messages):
     import concurrent.futures as cf
     import multiprocessing as mp
 
-    from woodcam import _xatlas_worker
+    import woodcam._xatlas_worker as _xatlas_worker
 
     if _XATLAS_IN_PROCESS:  # pragma: no cover - debugging aid
         return (*_xatlas_worker.layout(verts, faces, pieces, max_chart_area=chart_cap,
