@@ -21,6 +21,7 @@ from typing import Literal
 import numba
 import numpy as np
 
+from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, grain_direction
 from ..frames import FACE_AXIS, face_pixel_points
@@ -141,7 +142,7 @@ class ColorMapAppearance:
 
     # -- the ramp -------------------------------------------------------------------------------
 
-    def ramp(self, arf_values) -> np.ndarray:
+    def ramp(self, arf_values: ArrayLike) -> np.ndarray:
         """Species colour at ARF values ``(n,)`` -> ``(n, 3)`` float32 (side grain, no noise)."""
         s = self.species
         t = _smoothstep(s.latewood_start, 1.0, np.asarray(arf_values, np.float32))[:, None]
@@ -151,11 +152,11 @@ class ColorMapAppearance:
 
     # -- per-axis colourings ----------------------------------------------------------------------
 
-    def axis_colors(self, field, points_mm) -> np.ndarray:
+    def axis_colors(self, field: GrowthFieldLike, points_mm: ArrayLike) -> np.ndarray:
         """The three per-axis colourings of eq. 10, shape ``(3, n, 3)``: normals X, Y, Z."""
         return self._shade(field, points_mm, None)
 
-    def color(self, field, points_mm, normals) -> np.ndarray:
+    def color(self, field: GrowthFieldLike, points_mm: ArrayLike, normals: ArrayLike) -> np.ndarray:
         """Colour ``(n, 3)`` in [0, 1] of surfaces at ``points_mm`` with unit ``normals``.
 
         The three per-axis colourings blended by eq. 10 (:func:`blend_axis_colors`), computed

@@ -46,6 +46,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._types import ArrayLike
 from ..errors import WoodcamError
 from .base import check_points
 from .skeleton import LogSkeleton
@@ -234,7 +235,7 @@ class KnottedLogField:
     """
 
     def __init__(self, log: LogSkeleton, ring_width_mm: float = 2.0, params: KnotParams | None = None,
-                 *, surface_smoothing=(11, 5), chunk: int | None = None,
+                 *, surface_smoothing: tuple[int, int] = (11, 5), chunk: int | None = None,
                  table_samples: int = 128, backend: Backend = "auto"):
         if not isinstance(log, LogSkeleton):
             raise WoodcamError(f"log must be a woodcam.fields.skeleton.LogSkeleton; got "
@@ -304,27 +305,27 @@ class KnottedLogField:
 
     # -- public API ----------------------------------------------------------------------------
 
-    def __call__(self, points_mm) -> np.ndarray:
+    def __call__(self, points_mm: ArrayLike) -> np.ndarray:
         """Growth time ``years (n,)`` at log-frame points ``points_mm (n, 3)``."""
         return self.evaluate(points_mm)["years"]
 
-    def stem_years(self, points_mm) -> np.ndarray:
+    def stem_years(self, points_mm: ArrayLike) -> np.ndarray:
         """The stem field alone (no knots): ``years (n,)`` at log-frame points (seed eq. 1)."""
         p = check_points(points_mm)
         _, _, ds, _, sp = self._stem(p)
         return ds / sp / self.ring_width_mm
 
-    def knot_features(self, points_mm) -> dict:
+    def knot_features(self, points_mm: ArrayLike) -> dict:
         """``{"knot", "dead", "outline"}``, each ``(n,)`` in 0..1, at log-frame points."""
         out = self.evaluate(points_mm)
         return {k: out[k] for k in ("knot", "dead", "outline")}
 
-    def grain_direction(self, points_mm) -> np.ndarray:
+    def grain_direction(self, points_mm: ArrayLike) -> np.ndarray:
         """Unit fibre directions ``(n, 3)`` (log frame): the pith tangent outside knots, the
         knot axis inside, blended by the knot weight."""
         return self.evaluate(points_mm, directions=True)["direction"]
 
-    def evaluate(self, points_mm, *, directions: bool = False) -> dict:
+    def evaluate(self, points_mm: ArrayLike, *, directions: bool = False) -> dict:
         """Everything at once for log-frame points ``(n, 3)``.
 
         Returns ``years``, ``knot``, ``dead``, ``outline`` (each ``(n,)``) and, with

@@ -22,10 +22,12 @@ by other tools (images, generators) and the parametric real-log knots share one 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._types import ArrayLike
 from ..errors import WoodcamError
 
 #: Samples per knot profile when a knot is built from model coefficients.
@@ -221,13 +223,13 @@ class LogSkeleton:
     def r_max_mm(self) -> float:
         return float(self.radii_mm.max())
 
-    def pith_at(self, z_mm) -> np.ndarray:
+    def pith_at(self, z_mm: ArrayLike) -> np.ndarray:
         """Pith ``(x, y)`` at heights ``z_mm (n,)`` -> ``(n, 2)`` mm (clamped at the ends)."""
         z = np.asarray(z_mm, float)
         return np.stack([np.interp(z, self.pith_z_mm, self.pith_xy_mm[:, 0]),
                          np.interp(z, self.pith_z_mm, self.pith_xy_mm[:, 1])], axis=-1)
 
-    def radius_at(self, z_mm, azimuth_rad) -> np.ndarray:
+    def radius_at(self, z_mm: ArrayLike, azimuth_rad: ArrayLike) -> np.ndarray:
         """Outer radius (mm) at heights ``z_mm (n,)`` and azimuths ``azimuth_rad (n,)``.
 
         Bilinear in (height, azimuth), periodic in azimuth, clamped in height.
@@ -246,7 +248,7 @@ class LogSkeleton:
         r1 = R[iz + 1, ia] * (1 - ta) + R[iz + 1, ia1] * ta
         return r0 * (1 - tz) + r1 * tz
 
-    def knot_point(self, index: int, r_mm) -> np.ndarray:
+    def knot_point(self, index: int, r_mm: ArrayLike) -> np.ndarray:
         """Log-frame points ``(n, 3)`` on knot ``index``'s axis at pith distances ``r_mm (n,)``."""
         k = self.knots[index]
         r = np.atleast_1d(np.asarray(r_mm, float))
@@ -254,7 +256,7 @@ class LogSkeleton:
         p = self.pith_at(z)
         return np.stack([p[:, 0] + r * np.cos(w), p[:, 1] + r * np.sin(w), z], axis=-1)
 
-    def with_knots(self, knots) -> "LogSkeleton":
+    def with_knots(self, knots: Sequence[BranchStrand]) -> "LogSkeleton":
         """The same stem with another set of knots (e.g. none, or the first n)."""
         return LogSkeleton(self.pith_z_mm, self.pith_xy_mm, self.radii_mm, tuple(knots), self.name)
 

@@ -57,6 +57,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._types import ArrayLike
 from ..errors import WoodcamError
 from ..fields.skeleton import KNOT_TABLE_SAMPLES, BranchStrand, LogSkeleton
 from .centreline import Centreline
@@ -330,13 +331,14 @@ class GeneratedLog:
                                         np.maximum(diam, 0.0), end, float(k.death_mm)))
         return LogSkeleton(z, pith, radii, tuple(strands), name)
 
-    def base_radius(self, l_mm, theta_rad) -> np.ndarray:
+    def base_radius(self, l_mm: ArrayLike, theta_rad: ArrayLike) -> np.ndarray:
         """Smooth outer radius ``(n,)`` mm (thickness + base shape, no bumps or grain)."""
         l = np.asarray(l_mm, float).reshape(-1)
         t = np.asarray(theta_rad, float).reshape(-1)
         return self.thickness(l) + self.base.at(l, t)
 
-    def outer_radius(self, l_mm, theta_rad, detail: Literal["full", "base"] = "full") -> np.ndarray:
+    def outer_radius(self, l_mm: ArrayLike, theta_rad: ArrayLike,
+                     detail: Literal["full", "base"] = "full") -> np.ndarray:
         """Outer radius ``(n,)`` mm at ``(l_mm[i], theta_rad[i])``, measured from the centreline.
 
         ``detail="full"`` interpolates the heightmap bilinearly (periodic in azimuth);
@@ -357,7 +359,7 @@ class GeneratedLog:
         h = self.heightmap_mm
         return ((1 - wi) * ((1 - wj) * h[i0, j0] + wj * h[i0, j1]) + wi * ((1 - wj) * h[i1, j0] + wj * h[i1, j1]))
 
-    def centreline_points(self, l_mm) -> np.ndarray:
+    def centreline_points(self, l_mm: ArrayLike) -> np.ndarray:
         """Pith points ``(n, 3)`` in the log frame at heights ``l_mm : (n,)``."""
         return self.centreline.points(l_mm)
 

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._types import PathLike
 from ..errors import WoodcamError
 from ..fields.skeleton import BranchStrand, LogSkeleton
 
@@ -30,14 +31,14 @@ def shared_data_dir() -> Path | None:
     return None
 
 
-def write_log(log: LogSkeleton, path) -> Path:
+def write_log(log: LogSkeleton, path: PathLike) -> Path:
     """Write ``log`` as a woodcam log file (JSON, mm); returns the path."""
     from .._atomic import write_text
 
     return write_text(Path(path), json.dumps(log.to_json()))
 
 
-def read_log(path) -> LogSkeleton:
+def read_log(path: PathLike) -> LogSkeleton:
     """Read a woodcam log file written by :func:`write_log` (or by hand, same keys)."""
     path = Path(path)
     if not path.is_file():
@@ -51,7 +52,7 @@ def read_log(path) -> LogSkeleton:
     return LogSkeleton.from_json(d)
 
 
-def read_gran1(folder=None, *, centre: bool = True) -> LogSkeleton:
+def read_gran1(folder: PathLike | None = None, *, centre: bool = True) -> LogSkeleton:
     """Read the CT-measured Norway spruce log "Gran_1" of ``shared/data/trees/``.
 
     Parameters
