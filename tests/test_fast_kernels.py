@@ -5,7 +5,8 @@ home, so the two cannot drift apart (as the knot shading of the colour map and o
 renderer once did):
 
 - ``appearance.colormap._shade_kernel``: the species ramp (:meth:`ColorMapAppearance.ramp`),
-  :class:`~woodcam.appearance.knots.KnotShading` and eq. 10 (:func:`blend_axis_colors`).
+  :class:`~woodcam.appearance.knots.KnotShading` and eq. 10 (:func:`blend_axis_colors`; both
+  use ``orientation.eq10_weights``, whose numpy reference is in tests/appearance/test_colormap.py).
 - ``appearance.noise`` (``noise_at``, ``_value_noise_kernel``): a numpy value noise below.
 - ``appearance.volumes._detailed_kernel``: trilinear lookups (``_trilinear``) plus the slope.
 - ``fields.radial._radial_kernel``: :meth:`RadialScalingField.radius_scale` (eq. 7-9).

@@ -27,6 +27,7 @@ from ..fields.base import arf, check_points, grain_direction
 from ..frames import FACE_AXIS, face_pixel_points
 from .knots import KnotShading
 from .noise import TABLE, noise_at
+from .orientation import eq10_weights
 
 #: Number of ARF bins of a fitted colour ramp.
 LUT_BINS = 32
@@ -315,7 +316,8 @@ def _field_sample(field, points_mm):
 @numba.njit(nogil=True, fastmath=True, cache=True)
 def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, luts, lut_ok,
                   seed, table, blend, out):  # pragma: no cover - compiled
-    """Per point: ramp, pores and streaks, end grain per axis, knots, and eq. 10 (``blend``).
+    """Per point: ramp, pores and streaks, end grain per axis, knots, and eq. 10 (``blend``, by
+    :func:`~woodcam.appearance.orientation.eq10_weights`, the one implementation).
 
     One compiled pass instead of ~40 numpy array operations with their temporaries, which
     made colour lookup memory-bound. Writes the blend to ``out[0] (n, 3)`` when ``blend``,
@@ -353,12 +355,7 @@ def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, lu
         i0 = min(int(tl), nb - 2)
         fl = tl - i0
         if blend:
-            nx, ny, nz = abs(normals[i, 0]), abs(normals[i, 1]), abs(normals[i, 2])
-            ns = nx + ny + nz
-            if ns > 0:
-                w0, w1, w2 = nx / ns, ny / ns, nz / ns
-            else:
-                w0 = w1 = w2 = 1.0 / 3.0
+            w0, w1, w2 = eq10_weights(normals[i, 0], normals[i, 1], normals[i, 2])
             out[0, i, 0] = 0.0
             out[0, i, 1] = 0.0
             out[0, i, 2] = 0.0
