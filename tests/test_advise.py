@@ -57,3 +57,38 @@ def test_no_orientation_fits_is_a_clear_error(knotty):
         advise_placement(manifold3d.Manifold.cube([120.0, 10.0, 10.0]), knotty, rotations="none")
     with pytest.raises(WoodcamError, match="rotations must be one of"):
         advise_placement(manifold3d.Manifold.cube([10.0, 10.0, 10.0]), knotty, rotations="any")
+
+
+def test_the_part_report_warns_of_short_grain_only_across_the_fibres():
+    import trimesh
+
+    from woodcam.advise import part_report
+
+    stick = trimesh.creation.box((70.0, 10.0, 8.0))
+    stick.apply_translation([50.0, 40.0, 25.0])
+    along = part_report(stick, open_stock("builtin:flat-sawn"))  # fibres along X, like the stick
+    across = part_report(stick, open_stock("builtin:flat-sawn~z90"))  # fibres along Y
+    assert along["volume_mm3"] == pytest.approx(5600.0)
+    assert along["yield"] == pytest.approx(5600.0 / (100 * 80 * 50), abs=1e-4)
+    assert all(r["runout_deg"] < 10 for r in along["regions"])
+    assert not any("short grain" in w for w in along["warnings"])
+    assert all(r["runout_deg"] > 80 for r in across["regions"])
+    assert sum("short grain" in w for w in across["warnings"]) == 3
+    # end grain: the stick's two 10 x 8 ends out of its surface, when fibres run along it
+    ends = 2 * 10 * 8 / (2 * (70 * 10 + 70 * 8 + 10 * 8))
+    assert along["end_grain"] == pytest.approx(ends, abs=0.03)
+
+
+def test_knot_spots_find_the_knots_through_a_surface(knotty):
+    import trimesh
+
+    from woodcam.advise import knot_spots
+
+    box = trimesh.creation.box(knotty.size_mm)
+    box.apply_translation(np.asarray(knotty.size_mm) / 2)
+    spots = knot_spots(box, knotty.wood)
+    assert len(spots) >= 2  # the board through a whorl shows several knots on its faces
+    at = np.array([s["at_mm"] for s in spots])
+    assert (knotty.wood.features(at)["knot"] > 0.5).all()  # every spot sits on knot wood
+    clear = open_stock("builtin:flat-sawn")
+    assert knot_spots(box, clear.wood) == []

@@ -177,7 +177,8 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
         feats = stock.wood.features(points)
         n_pts = len(turned)
         knot = feats["knot"].reshape(len(centres), n_pts) > 0.5
-        pith = feats["years"].reshape(len(centres), n_pts) < PITH_YEARS
+        # inside a knot, years count along the branch: its own pith is knot, not stem pith
+        pith = (feats["years"].reshape(len(centres), n_pts) < PITH_YEARS) & ~knot
         grain = feats["grain"].reshape(len(centres), n_pts, 3)[:, :len(pts)]
         end = np.abs(np.einsum("cij,ij->ci", grain, n_rot)) > math.cos(math.radians(45))
         mean_grain = grain.mean(axis=1)
@@ -232,3 +233,107 @@ def render_advice(advice: PlacementAdvice, part, stock, png, *, top: int = 3):
     titles.append(f"worst: score {worst.score:.2f}\nknots {worst.terms['knots']:.2f} "
                   f"pith {worst.terms['pith']:.2f}")
     return render_side_by_side(meshes, [stock.wood] * len(meshes), stock.size_mm, titles, png)
+
+
+#: A region of a long thin part whose fibres cross its long axis by more than this is short
+#: grain: it breaks along the fibres under a small load.
+SHORT_GRAIN_DEG = 30.0
+#: Regions the part report splits a part into along its long axis.
+REPORT_REGIONS = 3
+
+
+def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
+    """What the wood will do in ``mesh`` (a carved part, block frame, mm) as placed.
+
+    Returns a JSON-able dict: ``volume_mm3``, ``yield`` (part / block volume), the terms of
+    :func:`advise_placement` for this placement (``knots``, ``pith``, ``end_grain``,
+    ``runout``), and ``regions``: the part cut into :data:`REPORT_REGIONS` slabs along its long
+    axis, each with its mean fibre direction, runout angle (degrees) and knot share; plus
+    ``warnings`` in words (short grain, knots or pith on the surface).
+    """
+    rng = np.random.default_rng(seed)
+    pts, nrm = _sample(mesh, samples, rng)
+    depth = np.concatenate([pts] + [pts - d * nrm for d in SUBSURFACE_MM])
+    feats = stock.wood.features(depth)
+    grain = feats["grain"][:len(pts)]
+    knot = feats["knot"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) > 0.5
+    pith = (feats["years"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) < PITH_YEARS) & ~knot
+    evals, evecs = np.linalg.eigh(np.cov((pts - pts.mean(axis=0)).T))
+    long_axis = evecs[:, -1]
+    elongation = float(1.0 - math.sqrt(max(evals[1], 0.0) / max(evals[2], 1e-12)))
+    end = np.abs(np.einsum("ij,ij->i", grain, nrm)) > math.cos(math.radians(45))
+    t = (pts - pts.mean(axis=0)) @ long_axis
+    edges = np.quantile(t, np.linspace(0, 1, REPORT_REGIONS + 1))
+    region = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, REPORT_REGIONS - 1)
+    regions, warnings = [], []
+    names = ("first third", "middle third", "last third")
+    for r in range(REPORT_REGIONS):
+        sel = region == r
+        g = grain[sel].mean(axis=0)
+        g /= max(np.linalg.norm(g), 1e-12)
+        angle = float(np.degrees(np.arccos(min(1.0, abs(float(g @ long_axis))))))
+        k = float(knot[:, sel].mean())
+        regions.append({"region": names[r], "grain": [round(float(v), 4) for v in g],
+                        "runout_deg": round(angle, 1), "knots": round(k, 4)})
+        if elongation > 0.5 and angle > SHORT_GRAIN_DEG:
+            warnings.append(f"short grain in the {names[r]} along the part: fibres cross its "
+                            f"long axis at {angle:.0f} deg (a thin section there may break)")
+    if knot[0].any():
+        warnings.append(f"knots show on {100 * knot[0].mean():.1f} % of the surface")
+    elif knot.any():
+        warnings.append("a knot lies 1-3 mm under the surface (it may show after sanding)")
+    if pith.any():
+        warnings.append(f"the pith (within {PITH_YEARS:g} years) reaches the part: expect checks")
+    volume = float(abs(mesh.volume))
+    block = float(np.prod(stock.size_mm))
+    return {"volume_mm3": round(volume, 1), "yield": round(volume / block, 4),
+            "knots": round(float(knot.mean()), 4), "pith": round(float(pith.mean()), 4),
+            "end_grain": round(float(end.mean()), 4), "elongation": round(elongation, 3),
+            "regions": regions, "warnings": warnings}
+
+
+def report_text(report: dict, name: str) -> str:
+    """The part report as a few lines of text."""
+    lines = [f"{name}: {report['volume_mm3']:.0f} mm^3, yield {100 * report['yield']:.1f} % of "
+             f"the block; end grain {100 * report['end_grain']:.0f} % of the surface; knots "
+             f"{100 * report['knots']:.1f} %, pith {100 * report['pith']:.1f} % of the surface "
+             "and the wood 1-3 mm under it"]
+    for r in report["regions"]:
+        lines.append(f"  {r['region']:<13} grain ({', '.join(f'{v:+.2f}' for v in r['grain'])}) "
+                     f"runout {r['runout_deg']:.0f} deg, knots {100 * r['knots']:.1f} %")
+    lines += [f"  warning: {w}" for w in report["warnings"]]
+    return "\n".join(lines)
+
+
+def knot_spots(mesh, wood, *, samples: int = 20000, link_mm: float = 2.0, seed: int = 0) -> list[dict]:
+    """Where knots come through the surface of ``mesh`` (block frame, mm): one entry per
+    connected patch of knot wood, ``{"kind": "knot", "label": str, "at_mm": [x, y, z]}`` (the
+    patch's centroid, snapped to the nearest surface sample), largest first; for hotspots."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(seed)
+    pts, _ = _sample(mesh, samples, rng)
+    inside = wood.features(pts)["knot"] > 0.5
+    p = pts[inside]
+    if len(p) == 0:
+        return []
+    pairs = cKDTree(p).query_pairs(link_mm, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(p), len(p)))
+    n, label = connected_components(graph, directed=False)
+    area_per_sample = float(mesh.area) / samples
+    spots = []
+    for k in range(n):
+        members = p[label == k]
+        if len(members) < 5:  # a few stray samples: not a visible knot
+            continue
+        centre = members.mean(axis=0)
+        at = members[np.argmin(np.linalg.norm(members - centre, axis=1))]
+        spots.append({"kind": "knot", "at_mm": [round(float(v), 2) for v in at],
+                      "label": f"through the surface, ~{len(members) * area_per_sample:.0f} mm^2",
+                      "_size": len(members)})
+    spots.sort(key=lambda s: -s["_size"])
+    for s in spots:
+        del s["_size"]
+    return spots
