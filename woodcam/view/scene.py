@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._types import ArrayLike, Mesh, PathLike, WoodLike
 from ..errors import WoodcamError, require
 from ..frames import check_size
 from ..tolerances import ON_FACE_TOL_MM
@@ -635,10 +636,10 @@ def build_scene(
 
 
 def preview(
-    mesh_or_path,
+    mesh_or_path: Mesh | PathLike,
     *,
-    wood=None,
-    size_mm=None,
+    wood: WoodLike | None = None,
+    size_mm: ArrayLike | None = None,
     screenshot: str | os.PathLike | None = None,
     window_size: tuple[int, int] = (1280, 960),
     options: SceneOptions | None = None,
