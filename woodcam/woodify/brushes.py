@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import WoodcamError
 
@@ -53,7 +54,7 @@ class Brush:
             raise WoodcamError(f"brush direction must be a non-zero 3-vector; got {self.direction!r}")
         object.__setattr__(self, "direction", tuple(d / np.linalg.norm(d)))
 
-    def weight(self, points_mm) -> np.ndarray:
+    def weight(self, points_mm: ArrayLike) -> np.ndarray:
         """Gaussian fall-off ``(n,)`` in [0, 1] at surface points ``(n, 3)`` (mm)."""
         d2 = np.sum((np.asarray(points_mm, float) - np.asarray(self.centre_mm)) ** 2, axis=-1)
         return np.exp(-0.5 * d2 / self.radius_mm ** 2)

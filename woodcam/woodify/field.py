@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import ndimage
 
 from .._atomic import atomic_path
@@ -70,10 +71,11 @@ class WoodifiedField:
         Fibre direction in the object frame; default ``speed.up``.
     """
 
-    def __init__(self, arrival_mm, origin_mm, spacing_mm: float, speed: GrowthSpeed,
-                 years_final: float, obstacle_sdf_mm=None, block_origin_mm=(0.0, 0.0, 0.0),
-                 rotation=None, block_size_mm=None, interpolation: Interpolation = "linear",
-                 stem_axis=None):
+    def __init__(self, arrival_mm: ArrayLike, origin_mm: ArrayLike, spacing_mm: float,
+                 speed: GrowthSpeed, years_final: float, obstacle_sdf_mm: ArrayLike | None = None,
+                 block_origin_mm: ArrayLike = (0.0, 0.0, 0.0), rotation: ArrayLike | None = None,
+                 block_size_mm: ArrayLike | None = None, interpolation: Interpolation = "linear",
+                 stem_axis: ArrayLike | None = None) -> None:
         T = np.asarray(arrival_mm, dtype=np.float64)
         if T.ndim != 3 or min(T.shape) < 2:
             raise WoodcamError(f"arrival_mm must be an (nx, ny, nz) grid, each >= 2; got {T.shape}")
@@ -112,7 +114,7 @@ class WoodifiedField:
         """Fibre direction (the stem axis) in the block frame, (3,)."""
         return self.rotation.T @ self.stem_axis
 
-    def to_object(self, points_mm) -> np.ndarray:
+    def to_object(self, points_mm: ArrayLike) -> np.ndarray:
         """Block-frame points ``(n, 3)`` -> object-frame points ``(n, 3)`` (mm)."""
         p = check_points(points_mm)
         return self.block_origin_mm + np.einsum("ij,kj->ik", p, self.rotation)
@@ -125,22 +127,22 @@ class WoodifiedField:
         idx = (q - self.origin_mm) / self.spacing_mm
         return ndimage.map_coordinates(grid, idx.T, order=order, mode="nearest", prefilter=False)
 
-    def arrival(self, points_mm) -> np.ndarray:
+    def arrival(self, points_mm: ArrayLike) -> np.ndarray:
         """Interpolated arrival time ``T (n,)`` (mm) at block-frame points."""
         return self._sample(self._coeffs, self.to_object(points_mm), _ORDER[self.interpolation])
 
-    def __call__(self, points_mm) -> np.ndarray:
+    def __call__(self, points_mm: ArrayLike) -> np.ndarray:
         """Growth time ``years (n,)`` at ``points_mm (n, 3)`` (block frame, mm)."""
         T = self.arrival(points_mm).astype(float)
         return np.minimum(self.speed.years(T), self.years_cap)
 
-    def no_wood(self, points_mm) -> np.ndarray:
+    def no_wood(self, points_mm: ArrayLike) -> np.ndarray:
         """``(n,) bool``: inside an engulfed obstacle (no wood there)."""
         if self.obstacle_sdf_mm is None:
             return np.zeros(len(check_points(points_mm)), bool)
         return self._sample(self.obstacle_sdf_mm, self.to_object(points_mm), 1) < 0
 
-    def evaluate(self, points_mm, *, directions: bool = False) -> dict:
+    def evaluate(self, points_mm: ArrayLike, *, directions: bool = False) -> dict:
         """Years with the colour map's knot channels in one pass (see module docstring)."""
         p = check_points(points_mm)
         out = {"years": self(p)}
@@ -158,11 +160,12 @@ class WoodifiedField:
             out["direction"] = np.broadcast_to(self.axis, p.shape).astype(np.float32)
         return out
 
-    def grain_direction(self, points_mm) -> np.ndarray:
+    def grain_direction(self, points_mm: ArrayLike) -> np.ndarray:
         """Unit fibre directions ``(n, 3)``: the stem axis everywhere (block frame)."""
         return np.broadcast_to(self.axis, check_points(points_mm).shape)
 
-    def placed(self, block_size_mm, block_centre_mm=None, rotation=None) -> WoodifiedField:
+    def placed(self, block_size_mm: ArrayLike, block_centre_mm: ArrayLike | None = None,
+               rotation: ArrayLike | None = None) -> WoodifiedField:
         """The same grown object with a block of ``block_size_mm`` (W, D, H) centred at
         ``block_centre_mm`` (object frame; default the grid's centre)."""
         size = np.asarray(block_size_mm, float)
@@ -175,7 +178,7 @@ class WoodifiedField:
                               self.years_final, self.obstacle_sdf_mm, c - R @ size / 2, R,
                               tuple(size), self.interpolation, self.stem_axis)
 
-    def save(self, path) -> Path:
+    def save(self, path: str | Path) -> Path:
         """Write ``field.npz`` atomically (temp file in the same folder, then ``os.replace``)."""
         path = Path(path)
         if path.suffix != ".npz":

@@ -9,17 +9,23 @@ frame, mm; years since the input surface.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import time
 from dataclasses import dataclass
 from dataclasses import field as dc_field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import WoodcamError
 from .brushes import Brush, paint
 from .field import WoodifiedField
 from .front import Front, Method, VoxelGrid, check_watertight, propagate
 from .speed import GrowthSpeed, weibull_cdf
+
+if TYPE_CHECKING:
+    import trimesh
 
 #: Nodes of margin kept between the final grown surface and the grid border.
 _MARGIN_NODES = 4
@@ -57,7 +63,7 @@ class Woodification:
         """Pseudo-time (mm) of ``year``."""
         return float(self.speed.tau(year))
 
-    def surface(self, year: float):
+    def surface(self, year: float) -> "trimesh.Trimesh":
         """The grown surface at ``year`` (0 = the input as voxelised) as a watertight trimesh."""
         from .surfaces import surface_at
 
@@ -65,14 +71,14 @@ class Woodification:
             raise WoodcamError(f"year must lie in [0, {self.years:g}] (the years grown); got {year!r}")
         return surface_at(self.front, self.tau(year))
 
-    def origins(self, points_mm):
+    def origins(self, points_mm: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Origins ``(n, 3)`` on the input surface and their input triangles ``(n,)`` of grown
         points (characteristic back-trace, :func:`woodcam.woodify.surfaces.trace_back`)."""
         from .surfaces import trace_back
 
         return trace_back(self.front, points_mm, wind=self.speed.wind)
 
-    def engulf_year(self, obstacle_index: int = 0, inside_box=None) -> float:
+    def engulf_year(self, obstacle_index: int = 0, inside_box: ArrayLike | None = None) -> float:
         """Year by which the wood has closed round obstacle ``obstacle_index`` within the grid
         (every node touching it is wood): the latest arrival on its boundary, as years.
 

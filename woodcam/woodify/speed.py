@@ -27,6 +27,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import WoodcamError
 
@@ -106,12 +107,12 @@ class GrowthSpeed:
         """``w = delta * up`` (3,): the direction part of the speed ``F = 1 + w . n``."""
         return self.eccentricity * np.asarray(self.up)
 
-    def tau(self, years) -> np.ndarray:
+    def tau(self, years: ArrayLike) -> np.ndarray:
         """Pseudo-time ``tau = v W(t / lambda)`` (mm) reached at ``years``."""
         t = np.asarray(years, dtype=float)
         return self.velocity_mm * weibull_cdf(t / self.time_scale_years, self.shape)
 
-    def years(self, tau_mm) -> np.ndarray:
+    def years(self, tau_mm: ArrayLike) -> np.ndarray:
         """Inverse of :meth:`tau`: growth year ``lambda W^-1(T / v)`` of arrival time ``T`` (mm).
 
         ``T <= 0`` (the input object itself) maps to 0; ``T >= v`` (never reached) to ``inf``.
@@ -119,7 +120,7 @@ class GrowthSpeed:
         q = np.asarray(tau_mm, dtype=float) / self.velocity_mm
         return self.time_scale_years * weibull_cdf_inv(q, self.shape)
 
-    def speed(self, years, normals=None) -> np.ndarray:
+    def speed(self, years: ArrayLike, normals: ArrayLike | None = None) -> np.ndarray:
         """Normal speed ``ds/dt`` (mm/year) at ``years`` for unit ``normals (n, 3)`` (eq. 4.1
         with the eccentric factor); without normals the isotropic speed."""
         lam = self.time_scale_years
