@@ -262,7 +262,8 @@ def _tool_case(data):
 
 @pytest.fixture(scope="module")
 def base_log() -> dict:
-    from woodcam.fields.tree_data import Knot, simple_log
+    from woodcam.fields.skeleton import BranchStrand as Knot
+    from woodcam.fields.skeleton import simple_log
 
     k1 = Knot.from_model(0.05, 0.1, 50.0, 2.0, 0.1, 0.3, 0.05, 40.0, 30.0, samples=16)
     k2 = Knot(20.0, 1.0, [0.0, 10.0, 30.0], [0.0, 1.0, 2.0], [0.0, 0.1, 0.2], [0.0, 5.0, 8.0], 30.0, 40.0)
@@ -270,7 +271,7 @@ def base_log() -> dict:
 
 
 def _log_case(base, data):
-    from woodcam.fields.tree_data import read_log
+    from woodcam.logs.io import read_log
 
     text = json.dumps(_mutate(data, base))
 

@@ -265,7 +265,8 @@ def test_tool_table_bytes_that_are_not_utf8(tmp_path):
     (lambda d: d.clear(), r"format must be 'woodcam-log'"),
 ])
 def test_log_file_types_are_checked(tmp_path, edit, match):
-    from woodcam.fields.tree_data import read_log, simple_log
+    from woodcam.fields.skeleton import simple_log
+    from woodcam.logs.io import read_log
 
     d = simple_log(100.0, 30.0, z_step_mm=20.0, azimuths=6).to_json()
     edit(d)

@@ -60,7 +60,7 @@ def load_part(
     timeout_s: float | None = None,
     max_triangles: int | None = MAX_PART_TRIANGLES,
     report: dict | None = None,
-):
+) -> Any:
     """Turn a part source into one watertight manifold in the block frame (mm).
 
     A ``.py`` part script is **trusted code**: it runs inside this process with your rights
