@@ -6,7 +6,7 @@ import time
 
 import pytest
 
-from woodcam.cli import main
+from woodcam.cli import EXIT_ERROR, main
 
 BAKE = ["bake", "cad_examples/bowl.py", "--block", "builtin:flat-sawn"]
 
@@ -43,7 +43,7 @@ def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monk
     (out / "objdir" / "x.obj").mkdir(parents=True)
     argv = [a.replace("OUT", str(out)) for a in argv]
     t0 = time.perf_counter()
-    assert main(argv) == 2
+    assert main(argv) == EXIT_ERROR
     assert time.perf_counter() - t0 < 30.0  # refused before any fitting or baking (minutes)
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("woodcam: error: ")
