@@ -14,7 +14,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     """Add the ``block`` command (with ``synth`` and ``show``) to an argparse sub-parser set."""
     p = subparsers.add_parser("block", help="synthesise or show blocks (six face photos + rings)")
     p.set_defaults(func=run)          # woodcam.cli dispatches on args.func
-    sub = p.add_subparsers(dest="block_command", required=True, metavar="{synth,show}")
+    sub = p.add_subparsers(dest="block_command", required=True, metavar="{synth,show,from-photos}")
 
     s = sub.add_parser("synth", help="write a reproducible set of synthetic blocks")
     s.add_argument("--count", type=int, required=True, help="number of blocks")
@@ -30,6 +30,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     v.add_argument("--no-traces", action="store_true", help="do not draw traced rings")
     v.add_argument("--size-mm", type=float, default=None,
                    help="cube side (mm) for a Mokume folder (default 50)")
+    from ._cli_rings import add_from_photos
+
+    add_from_photos(sub)
     return p
 
 
@@ -66,6 +69,10 @@ def run(args) -> int:
         save_cross_png(block, args.out, args.layer, traces=not args.no_traces)
         print(f"wrote {args.out}")
         return 0
+    if args.block_command == "from-photos":
+        from ._cli_rings import run_from_photos
+
+        return run_from_photos(args)
     raise AssertionError(args.block_command)  # argparse restricts the choices
 
 

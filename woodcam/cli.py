@@ -12,7 +12,7 @@ from .errors import WoodcamError
 
 #: Modules that add their own subcommands through ``add_parser(subparsers)`` / ``run(args)``.
 _COMMAND_MODULES: tuple[str, ...] = ("woodcam._cli_block", "woodcam._cli_log", "woodcam._cli_appearance", "woodcam._cli_fit",
-                                     "woodcam._cli_train",
+                                     "woodcam._cli_train", "woodcam._cli_rings",
                                      "woodcam.toolpath.cli")
 
 _EPILOG = """\
