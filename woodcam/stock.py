@@ -7,7 +7,9 @@ A block spec is a string the CLI and GLB metadata carry:
   knotted log, ``LOG`` being ``gran1`` (the CT-measured spruce log of the shared data) or a
   woodcam log file (``.json``); size default 100x80x50 mm, Z along the log.
 - a block folder with a ``block.json`` manifest (real or synthetic): its true field if it has
-  one, otherwise a field fitted to its rings (fit once, cached in the folder).
+  one, otherwise a field fitted to its rings (fit once, cached in the folder); a folder of
+  photos only (``woodcam block from-photos``) first gets its rings detected on the photos
+  (:func:`woodcam.detect.block.with_detected_rings`, cached by content in the user cache).
 - a Mokume sample folder (``A_col.png``, ``A_arl-unet.png``, ... as in the Mokume dataset): a
   cube of ``MOKUME_DEFAULT_SIZE_MM`` (50 mm) whose field is fitted to its ring maps, fit once
   and cached under ``$WOODCAM_CACHE_DIR`` / ``~/.cache/woodcam`` (the sample folder is left
@@ -156,7 +158,10 @@ def _open_mokume_folder(path: Path, species, appearance, appearance_params) -> S
 def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
     from .block.io import read_block  # block I/O sits beside; imported when a folder is used
 
-    block = read_block(path)
+    from .detect.block import with_detected_rings
+
+    # A block of photos only: rings detected once, cached by content outside the folder.
+    block = with_detected_rings(read_block(path), progress=True)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
     return _real_block_stock(str(path), block, field, species, appearance, appearance_params,
                              cache_dir=path / ".woodcam-cache")

@@ -218,6 +218,15 @@ def _photos_key(block: Block, rule: str) -> str:
     return h.hexdigest()[:24]
 
 
+def photos_only(block: Block) -> Block:
+    """A copy of ``block`` keeping only its face photos (no traces, ring maps or knot masks):
+    what detection starts from, e.g. to re-detect a Mokume sample."""
+    out = copy.copy(block)
+    out.faces = {n: Face(n, f.shape, photo=f.photo) for n, f in block.faces.items() if f.photo is not None}
+    out.meta = dict(block.meta)
+    return out
+
+
 def needs_detection(block: Block) -> bool:
     """True when no face has rings (traces or a ring map) but some face has a photo."""
     return (not any(f.has_rings for f in block.faces.values())
@@ -265,4 +274,4 @@ def with_detected_rings(block: Block, rule: BoundaryRule = "dark-centre", *, cac
 
 
 __all__ = ["DETECT_VERSION", "detect_block", "detect_cache_dir", "detect_face", "detect_folder",
-           "needs_detection", "user_edited_faces", "with_detected_rings"]
+           "needs_detection", "photos_only", "user_edited_faces", "with_detected_rings"]

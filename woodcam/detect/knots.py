@@ -7,7 +7,8 @@ Data forms: ``photo (h, w, 3) uint8``; the result is ``mask (h, w) bool``, True 
 Method: the luminance smoothed over :data:`KNOT_SMOOTH_MM` (wider than latewood lines, so the
 knot is one blob) is compared with the face's median; pixels darker by
 :data:`KNOT_DARKNESS_MAD` robust deviations (median absolute deviation of the smoothed face) form
-candidate regions. A region is a knot when it is large (:data:`KNOT_MIN_DIAMETER_MM`), compact
+candidate regions; an accepted region's edge is where the smoothed luminance is halfway between
+its dark core (10th percentile) and the face's median. A region is a knot when it is large (:data:`KNOT_MIN_DIAMETER_MM`), compact
 (its fitted ellipse's axis ratio at most :data:`KNOT_MAX_AXIS_RATIO`: latewood bands and dark
 streaks are long and thin), and the rings are disturbed in it: the ring normals found by the
 ring detector point every way there (the knot's own rings circle round its centre), so the
@@ -69,5 +70,9 @@ def detect_knots(photo: np.ndarray, px_per_mm: float, normal_rad: np.ndarray | N
         region = lab == reg.label
         if doubled is not None and abs(doubled[region].mean()) > KNOT_MAX_ORIENTATION_ORDER:
             continue
-        mask |= region
+        # the knot's edge: halfway between its dark core and the face (the blur widens the
+        # candidate region, whose threshold sits near the face's median)
+        core = float(np.percentile(lum[region], 10))
+        edge = ndimage.binary_fill_holes(region & (lum < 0.5 * (core + med)))
+        mask |= edge if edge.any() else region
     return mask

@@ -78,6 +78,10 @@ AMPLITUDE_MIN = 0.25
 EDGE_SCALE_WAVELENGTHS = 0.125
 #: Reach (in ring spacings) of the local vote between the two edge families.
 VOTE_SCALE_WAVELENGTHS = 2.0
+#: Least local amplitude of the ring component, in units of the photo's local RMS contrast
+#: after flattening: white noise reaches 0.04-0.06, the faintest real ring face seen (Mokume
+#: CN03 top, oak) 0.13, synthetic faces 0.4-0.55.
+SIGNAL_MIN = 0.09
 #: Ring pieces shorter than this many local wavelengths are dropped (pores, specks).
 MIN_TRACE_WAVELENGTHS = 1.0
 #: Spacing of trace vertices (px) after resampling the contour lines.
@@ -121,9 +125,16 @@ def luminance(photo: np.ndarray) -> np.ndarray:
 
 
 def _normalise(lum: np.ndarray, sigma: float) -> np.ndarray:
-    """Flatten the illumination and divide by the local RMS contrast (both Gaussian, ``sigma`` px)."""
+    """Flatten the illumination (a fitted quadratic surface, then a Gaussian of ``sigma`` px) and
+    divide by the local RMS contrast (Gaussian, ``sigma`` px). The quadratic takes out lighting
+    gradients and vignetting, which the Gaussian alone leaves as ramps along the borders."""
     from scipy import ndimage
 
+    h, w = lum.shape
+    rr, cc = np.meshgrid(np.linspace(-1, 1, h), np.linspace(-1, 1, w), indexing="ij")
+    basis = np.stack([np.ones_like(rr), rr, cc, rr * rr, rr * cc, cc * cc], axis=-1).reshape(-1, 6)
+    coef = np.linalg.lstsq(basis[::7], lum.reshape(-1)[::7], rcond=None)[0]
+    lum = lum - (basis @ coef).reshape(h, w).astype(np.float32)
     x = lum - ndimage.gaussian_filter(lum, sigma, mode="reflect")
     rms = np.sqrt(ndimage.gaussian_filter(x * x, sigma, mode="reflect"))
     return x / (rms + 1e-3 + 0.05 * float(np.median(rms)))
@@ -175,7 +186,8 @@ def _blur(img: np.ndarray, sigma: float) -> np.ndarray:
 
 
 def _response(x: np.ndarray, wavelengths, n_orient: int):
-    """Blended analytic response ``z (h, w) complex64``, local wavelength, normal angle, coherence.
+    """Blended analytic response ``z (h, w) complex64`` (whitened), local wavelength, normal angle,
+    coherence, and the blend's local amplitude in units of ``x`` (not whitened).
 
     One scale at a time (memory stays at one scale's ``(K, h, w)`` responses)."""
     from scipy import fft
@@ -187,6 +199,7 @@ def _response(x: np.ndarray, wavelengths, n_orient: int):
     rot = np.exp(2j * thetas).astype(np.complex64)[:, None, None]
     total = np.full((h, w), 1e-20, np.float32)
     zb = np.zeros((h, w), np.complex64)
+    amp_raw = np.zeros((h, w), np.float32)
     loglam = np.zeros((h, w), np.float32)
     e_k = np.zeros((n_orient, h, w), np.float32)
     for j, lam in enumerate(wavelengths):
@@ -198,7 +211,8 @@ def _response(x: np.ndarray, wavelengths, n_orient: int):
             energy[k] = _blur(energy[k], sig)
         # Whitening: each scale's energy relative to its face mean, so the strong fine texture
         # (pores, fibres) does not outweigh the ring scale by its raw power alone.
-        band = (float(energy.mean()) + 1e-20)
+        raw_amp = np.sqrt(energy)            # local amplitude in units of x (not whitened)
+        band = float(energy.mean()) + 1e-20
         energy /= band
         z /= np.float32(np.sqrt(band))
         coh = np.abs((energy * rot).sum(axis=0)) / (energy.sum(axis=0) + 1e-20)     # (h, w)
@@ -210,13 +224,15 @@ def _response(x: np.ndarray, wavelengths, n_orient: int):
         wsum = wgt.sum(axis=0)
         total += wsum
         zb += (wgt * z).sum(axis=0)
+        amp_raw += (wgt * raw_amp).sum(axis=0)
         loglam += wsum * np.float32(np.log(lam))
     zb /= total
+    amp_raw /= total
     lam_px = np.exp(loglam / total)
     doubled = (e_k * rot).sum(axis=0) / (e_k.sum(axis=0) + 1e-20)
     coherence = np.abs(doubled).astype(np.float32)
     normal = 0.5 * np.angle(doubled * np.exp(-2j * theta0)) + theta0   # within theta0 +- pi/2
-    return zb.astype(np.complex64), lam_px.astype(np.float32), normal.astype(np.float32), coherence
+    return zb.astype(np.complex64), lam_px.astype(np.float32), normal.astype(np.float32), coherence, amp_raw
 
 
 def _contour_runs(values: np.ndarray, keep: np.ndarray, min_len_px: np.ndarray) -> list[np.ndarray]:
@@ -287,14 +303,15 @@ def _sample(img: np.ndarray, p: np.ndarray) -> np.ndarray:
 
 def ring_map_from_traces(traces, shape, sigma_px: float) -> np.ndarray:
     """``(h, w)`` float32 map ``exp(-(d / sigma_px)^2)`` of the distance ``d`` (px) to the traces
-    (rasterised at their vertices, which are at most :data:`TRACE_STEP_PX` apart)."""
+    (rasterised every half pixel along them)."""
     from scipy import ndimage
 
     h, w = shape
     on = np.zeros(shape, bool)
     for t in traces:
-        r = np.clip(np.round(t.points_px[:, 0]).astype(int), 0, h - 1)
-        c = np.clip(np.round(t.points_px[:, 1]).astype(int), 0, w - 1)
+        p = _resample_polyline(t.points_px, 0.5)
+        r = np.clip(np.round(p[:, 0]).astype(int), 0, h - 1)
+        c = np.clip(np.round(p[:, 1]).astype(int), 0, w - 1)
         on[r, c] = True
     if not on.any():
         return np.zeros(shape, np.float32)
@@ -347,12 +364,12 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     n_scales = max(2, int(np.round(np.log2(hi / lo) * N_SCALES / np.log2(128.0 / 4.5))))
     wavelengths = np.geomspace(lo, hi, n_scales)
     x = _normalise(lum, sigma=hi)
-    z, lam, normal, coherence = _response(x, wavelengths, N_ORIENTATIONS)
+    z, lam, normal, coherence, amp_x = _response(x, wavelengths, N_ORIENTATIONS)
     amp = np.abs(z)
     ref = float(np.percentile(amp, 75)) + 1e-9
     rel_amp = np.clip(amp / ref, 0.0, 1.0)
     confidence = (coherence * rel_amp).astype(np.float32)
-    evidence = (coherence >= COHERENCE_MIN) & (rel_amp >= AMPLITUDE_MIN)
+    evidence = (coherence >= COHERENCE_MIN) & (rel_amp >= AMPLITUDE_MIN) & (amp_x >= SIGNAL_MIN)
     warnings: list[str] = []
     min_len = MIN_TRACE_WAVELENGTHS * lam
     even, odd = z.real, z.imag
