@@ -6,18 +6,32 @@ from pathlib import Path
 
 
 def add_parser(subparsers) -> None:
-    p = subparsers.add_parser("train", help="train a learned model (gtf: the generic neural growth field)")
-    p.add_argument("what", choices=["gtf"], help="which model to train")
+    p = subparsers.add_parser("train", help="train a learned model (gtf: the generic neural growth field; "
+                              "rings: the small ring detector)")
+    p.add_argument("what", choices=["gtf", "rings"], help="which model to train")
     p.add_argument("--spec", type=Path, default=None,
                    help="JSON spec of hyper-parameters (default: the built-in defaults)")
     p.add_argument("--out", type=Path, required=True,
-                   help="folder for gtf_spec.json, gtf.pt, gtf_train_log.csv and the checkpoint")
+                   help="folder for the spec, weights and training log (gtf: gtf_spec.json, gtf.pt, "
+                   "gtf_train_log.csv and the checkpoint; rings: rings_spec.json, rings.pt, rings_train_log.csv)")
     p.add_argument("--steps", type=int, default=None, help="stop after N steps in total (default: spec.steps)")
     p.add_argument("--no-resume", action="store_true", help="start over instead of resuming the checkpoint")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
+    if args.what == "rings":
+        from .detect.learned import RingNetSpec, train_ring_net
+
+        spec = RingNetSpec.load(args.spec) if args.spec is not None else RingNetSpec()
+        if args.steps is not None:
+            from dataclasses import replace
+
+            spec = replace(spec, steps=args.steps)
+        r = train_ring_net(spec, args.out, progress=True)
+        print(f"trained the ring net ({r['params']} parameters) {r['steps']} steps in {r['train_s']:.0f} s; "
+              f"final loss {r['final_loss']:.4f}; wrote {args.out}")
+        return 0
     from .fields.neural import GTFSpec, train_gtf
 
     spec = GTFSpec.load(args.spec) if args.spec is not None else GTFSpec()
