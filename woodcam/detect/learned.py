@@ -217,7 +217,7 @@ def train_ring_net(spec: RingNetSpec, out_dir, *, progress: bool = True) -> dict
         loss.backward()
         opt.step()
         sched.step()
-        v = float(loss)
+        v = float(loss.detach())
         loss_avg = v if loss_avg is None else 0.98 * loss_avg + 0.02 * v
         if step % spec.log_every == 0:
             rows.append({"step": step, "loss": v, "loss_avg": loss_avg, "seconds": time.perf_counter() - t0})
