@@ -21,6 +21,7 @@ _EXPORTS = {
     ".bake": ["BakeResult", "bake"],
     ".block": ["Block", "Face", "RingTrace", "read_block", "read_mokume", "write_block"],
     ".cad": ["CarveResult", "carve", "load_part"],
+    ".detect": ["RingDetection", "detect_rings"],
     ".errors": ["MissingDependencyError", "WoodcamError", "WoodcamWarning"],
     ".export": ["export_glb", "export_obj", "load_textured", "read_glb_metadata"],
     ".fields": ["GridField", "GrowthField", "KnottedLogField", "Log", "LogFrame", "PlacedField",

@@ -68,6 +68,9 @@ def add_parser(subparsers) -> None:
     d.add_argument("--rule", choices=("dark-centre", "sharp-edge"), default="dark-centre",
                    help="ring line on the dark band's centre (default; matches Mokume maps) or on its "
                    "sharp edge (the exact ring boundary of woodcam's synthetic faces)")
+    d.add_argument("--detector", choices=("classical", "learned"), default=None,
+                   help="classical: the weight-free quadrature-filter detector (default); learned: the "
+                   "small net trained by 'woodcam train rings' (woodcam/models/rings.pt)")
     d.add_argument("--no-knots", action="store_true", help="do not detect knot masks")
     d.add_argument("--size-mm", type=float, default=None,
                    help="cube side in mm for a Mokume folder (default 50)")
@@ -84,10 +87,11 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     if args.rings_command == "detect":
-        from .detect.block import detect_folder
+        from .detect.block import DEFAULT_DETECTOR, detect_folder
 
         manifest, msgs = detect_folder(args.block, args.out, rule=args.rule, knots=not args.no_knots,
-                                       size_mm=(args.size_mm,) * 3 if args.size_mm else None, progress=True)
+                                       size_mm=(args.size_mm,) * 3 if args.size_mm else None, progress=True,
+                                       detector=args.detector or DEFAULT_DETECTOR)
         for m in msgs:
             print(f"woodcam: warning: {m}")
         print(f"wrote {manifest.parent} (ring maps, <face>_traces.svg, knot masks)")

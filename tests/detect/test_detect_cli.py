@@ -62,7 +62,7 @@ def test_from_photos_detect_show_and_fit(synth_photos, tmp_path, capsys, monkeyp
         assert (blk / f"{name}_traces.svg").is_file()
         assert f.traces and f.ring_map is not None and f.ring_map.max() > 0.99, name
         assert "knot_mask" not in f.extras
-    rc, out, err = _run(capsys, "rings", "show", blk, "--out", tmp_path / "check.png")
+    rc, _out, err = _run(capsys, "rings", "show", blk, "--out", tmp_path / "check.png")
     assert rc == 0, err
     with Image.open(tmp_path / "check.png") as im:
         assert im.size == (4 * 2 * 160, 3 * 2 * 160)
@@ -76,7 +76,7 @@ def test_corrected_svg_wins_over_detection(synth_photos, tmp_path, capsys):
     svg = blk / "front_traces.svg"
     svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
                    '<path d="M 10.5,20.5 L 150.5,20.5" data-year="3"/></svg>')
-    rc, out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    rc, out, _err = _run(capsys, "rings", "detect", blk, "--out", blk)
     assert rc == 0 and "kept the corrected front_traces.svg" in out
     b = read_block(blk)
     tr = b.faces["front"].traces
@@ -90,7 +90,7 @@ def test_mokume_folder_is_redetected(tmp_path, capsys):
     from .test_detect_rings import _mokume
 
     src = _mokume("H11")
-    rc, out, err = _run(capsys, "rings", "detect", src, "--out", tmp_path / "h11")
+    rc, _out, err = _run(capsys, "rings", "detect", src, "--out", tmp_path / "h11")
     assert rc == 0, err
     b = read_block(tmp_path / "h11")
     assert set(b.faces) == set(FACES)
@@ -117,7 +117,7 @@ def test_bad_photo_folders_give_one_clear_line(synth_photos, tmp_path, capsys):
     Image.fromarray(a).save(d / "right.png")
     rc, out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
     assert rc == 2 and "face 'right'" in err and "over-exposed" in err
-    rc, out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50x0x50", "--out", tmp_path / "o")
+    rc, _out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50x0x50", "--out", tmp_path / "o")
     assert rc == 2 and "--size-mm" in err
 
 
@@ -128,7 +128,7 @@ def test_face_without_rings_is_named(synth_photos, tmp_path, capsys):
     Image.fromarray(np.clip(np.broadcast_to(grad, (160, 160, 3)), 0, 255).astype(np.uint8)).save(d / "bottom.png")
     blk = tmp_path / "blk"
     assert _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", blk)[0] == 0
-    rc, out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    rc, out, _err = _run(capsys, "rings", "detect", blk, "--out", blk)
     assert rc == 0 and "face 'bottom'" in out
     b = read_block(blk)
     assert b.faces["bottom"].ring_map is None or not b.faces["bottom"].traces

@@ -9,7 +9,12 @@ import numpy as np
 import pytest
 
 from woodcam.detect import detect_rings, reference_ridge, ridge_scores
-from woodcam.detect.evaluate import EVAL_SEEDS, score_reference_block, score_synthetic, summary
+from woodcam.detect.evaluate import (
+    EVAL_SEEDS,
+    score_reference_block,
+    score_synthetic,
+    summary,
+)
 from woodcam.detect.score import shifted_half_ring
 from woodcam.errors import WoodcamError
 

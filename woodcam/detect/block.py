@@ -30,6 +30,7 @@ import os
 import tempfile
 import warnings
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 
@@ -42,16 +43,31 @@ from .rings import RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, ring_map_from_
 DETECT_VERSION = 1
 
 
+Detector = Literal["classical", "learned"]
+DETECTORS: tuple[str, ...] = ("classical", "learned")
+#: The default detector, picked by the figures in README ("From photos alone").
+DEFAULT_DETECTOR: Detector = "classical"
+
+
 def detect_face(face: Face, px_per_mm: float, rule: BoundaryRule = "dark-centre",
-                knots: bool = True) -> tuple[Face, list[str]]:
+                knots: bool = True, detector: Detector = DEFAULT_DETECTOR) -> tuple[Face, list[str]]:
     """Detect rings (and knots) on one face with a photo; returns a new Face and warnings.
 
+    ``detector``: ``"classical"`` (:func:`~woodcam.detect.rings.detect_rings` with ``rule``) or
+    ``"learned"`` (:func:`~woodcam.detect.learned.detect_rings_learned`, the committed net).
     The face's existing extras are kept; ``knot_mask`` is replaced by the detected one when
     ``knots`` (an empty mask is not stored).
     """
     if face.photo is None:
         raise WoodcamError(f"face {face.name!r} has no photo to detect rings on; add its photo")
-    det = detect_rings(face.photo, px_per_mm=px_per_mm, rule=rule, name=face.name)
+    if detector not in DETECTORS:
+        raise WoodcamError(f"detector must be one of {', '.join(DETECTORS)}; got {detector!r}")
+    if detector == "learned":
+        from .learned import detect_rings_learned
+
+        det = detect_rings_learned(face.photo, px_per_mm=px_per_mm, name=face.name)
+    else:
+        det = detect_rings(face.photo, px_per_mm=px_per_mm, rule=rule, name=face.name)
     extras = dict(face.extras)
     if knots:
         mask = detect_knots(face.photo, px_per_mm, det.normal_rad)
@@ -64,7 +80,8 @@ def detect_face(face: Face, px_per_mm: float, rule: BoundaryRule = "dark-centre"
 
 
 def detect_block(block: Block, *, rule: BoundaryRule = "dark-centre", knots: bool = True,
-                 faces=None, progress: bool = False) -> tuple[Block, list[str]]:
+                 faces=None, progress: bool = False,
+                 detector: Detector = DEFAULT_DETECTOR) -> tuple[Block, list[str]]:
     """A copy of ``block`` whose faces with photos carry detected rings and knot masks.
 
     ``faces``: only these faces (default all with a photo); the others are copied unchanged.
@@ -82,9 +99,9 @@ def detect_block(block: Block, *, rule: BoundaryRule = "dark-centre", knots: boo
     msgs: list[str] = []
     for name in tqdm(names, desc="detecting rings", unit="face", delay=2.0, disable=not progress):
         px_mm = block.face_pixel_size_mm(name)
-        out.faces[name], w = detect_face(block.faces[name], 1.0 / min(px_mm), rule, knots)
+        out.faces[name], w = detect_face(block.faces[name], 1.0 / min(px_mm), rule, knots, detector)
         msgs += w
-    out.meta["detection"] = {"detector": "classical", "version": DETECT_VERSION, "rule": rule,
+    out.meta["detection"] = {"detector": detector, "version": DETECT_VERSION, "rule": rule,
                              "faces": names}
     return out, msgs
 
@@ -119,7 +136,8 @@ def user_edited_faces(folder) -> dict[str, Path]:
 
 
 def detect_folder(src, out, *, rule: BoundaryRule = "dark-centre", knots: bool = True,
-                  size_mm=None, progress: bool = False) -> tuple[Path, list[str]]:
+                  size_mm=None, progress: bool = False,
+                  detector: Detector = DEFAULT_DETECTOR) -> tuple[Path, list[str]]:
     """Detect rings and knots on a block folder (or a Mokume sample folder, whose U-Net maps are
     ignored and re-detected from its photos) and write the result as a block folder ``out``.
 
@@ -149,7 +167,8 @@ def detect_folder(src, out, *, rule: BoundaryRule = "dark-centre", knots: bool =
     todo = [n for n, f in block.faces.items() if f.photo is not None and n not in edited]
     msgs: list[str] = []
     if todo:
-        block, msgs = detect_block(block, rule=rule, knots=knots, faces=todo, progress=progress)
+        block, msgs = detect_block(block, rule=rule, knots=knots, faces=todo, progress=progress,
+                                   detector=detector)
     else:
         block.meta = dict(block.meta)
     sigma_mm = RING_MAP_SIGMA_MM
@@ -190,7 +209,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = "dark-centre", knots: bool =
         os.replace(tmp, svg)
         m["faces"][name]["traces_svg"] = svg.name
         hashes[name] = _sha256(svg)
-    det = m["meta"].setdefault("detection", {"detector": "classical", "version": DETECT_VERSION, "rule": rule})
+    det = m["meta"].setdefault("detection", {"detector": detector, "version": DETECT_VERSION, "rule": rule})
     det["svg_sha256"] = hashes
     det["user_svg"] = sorted(kept)
     _atomic_json(manifest, m)
@@ -210,7 +229,8 @@ def detect_cache_dir() -> Path:
 
 
 def _photos_key(block: Block, rule: str) -> str:
-    h = hashlib.sha256(json.dumps({"v": DETECT_VERSION, "rule": rule, "size": list(block.size_mm)}).encode())
+    h = hashlib.sha256(json.dumps({"v": DETECT_VERSION, "rule": rule, "detector": DEFAULT_DETECTOR,
+                                   "size": list(block.size_mm)}).encode())
     for name, f in block.faces.items():
         if f.photo is not None:
             h.update(name.encode())
@@ -273,5 +293,5 @@ def with_detected_rings(block: Block, rule: BoundaryRule = "dark-centre", *, cac
     return out
 
 
-__all__ = ["DETECT_VERSION", "detect_block", "detect_cache_dir", "detect_face", "detect_folder",
+__all__ = ["DEFAULT_DETECTOR", "DETECTORS", "DETECT_VERSION", "Detector", "detect_block", "detect_cache_dir", "detect_face", "detect_folder",
            "needs_detection", "photos_only", "user_edited_faces", "with_detected_rings"]

@@ -21,7 +21,8 @@ from __future__ import annotations
 import csv
 import json
 import time
-from dataclasses import asdict, dataclass, fields as dc_fields
+from dataclasses import asdict, dataclass
+from dataclasses import fields as dc_fields
 from pathlib import Path
 
 import numpy as np
@@ -61,7 +62,7 @@ class RingNetSpec:
     log_every: int = 50
 
     @classmethod
-    def load(cls, path) -> "RingNetSpec":
+    def load(cls, path) -> RingNetSpec:
         d = json.loads(Path(path).read_text())
         names = {f.name for f in dc_fields(cls)}
         bad = set(d) - names
@@ -154,7 +155,13 @@ def training_faces(spec: RingNetSpec, progress: bool = False):
     cubes (module docstring). Seeds ``[spec.seed, i]``, disjoint from the evaluation seeds."""
     from tqdm.auto import tqdm
 
-    from ..synth import PATTERNS, cut_block, knotted_log_field, random_log_placement, synth_block
+    from ..synth import (
+        PATTERNS,
+        cut_block,
+        knotted_log_field,
+        random_log_placement,
+        synth_block,
+    )
     from .rings import _normalise, luminance
 
     xs, ys = [], []
@@ -278,8 +285,15 @@ def detect_rings_learned(photo: np.ndarray, *, px_per_mm: float | None = None, n
     """Rings on one face photo by the learned net (module docstring); a RingDetection."""
     from scipy import ndimage
 
-    from .rings import (MIN_RING_AREA, RING_MAP_SIGMA_MM, RingDetection, RingTrace, _contour_runs,
-                        detect_rings, ring_map_from_traces)
+    from .rings import (
+        MIN_RING_AREA,
+        RING_MAP_SIGMA_MM,
+        RingDetection,
+        RingTrace,
+        _contour_runs,
+        detect_rings,
+        ring_map_from_traces,
+    )
 
     base = detect_rings(photo, px_per_mm=px_per_mm, name=name)      # orientation and spacing
     p = ring_probability(photo, models_dir)
