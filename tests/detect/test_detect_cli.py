@@ -50,12 +50,12 @@ def test_from_photos_detect_show_and_fit(synth_photos, tmp_path, capsys, monkeyp
     assert list(b.faces) == list(FACES) and all(f.photo is not None and not f.has_rings for f in b.faces.values())
     # fit on the photo-only folder: detection runs once, cached outside the folder
     before = sorted(p.name for p in blk.iterdir())
-    rc, out, err = _run(capsys, "fit", blk, "--out", tmp_path / "f.npz")
+    rc, _out, err = _run(capsys, "fit", blk, "--out", tmp_path / "f.npz")
     assert rc == 0, err
     assert sorted(p.name for p in blk.iterdir()) == before
     assert len(list((tmp_path / "cache" / "detect").iterdir())) == 1
     # detect into the folder: ring maps, SVG traces read back, knot-free
-    rc, out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
     assert rc == 0, err
     b = read_block(blk)
     for name, f in b.faces.items():
@@ -108,14 +108,14 @@ def test_bad_photo_folders_give_one_clear_line(synth_photos, tmp_path, capsys):
     assert rc == 2 and "face 'top'" in err and "aspect" in err
     d = _copy(synth_photos, tmp_path / "c")
     Image.fromarray(np.full((160, 160, 3), 128, np.uint8)).save(d / "left.png")
-    rc, out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
     assert rc == 2 and "face 'left'" in err and "blank" in err
     d = _copy(synth_photos, tmp_path / "d")
     with Image.open(d / "right.png") as im:
         a = np.asarray(im).copy()
     a[:110] = 255
     Image.fromarray(a).save(d / "right.png")
-    rc, out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
     assert rc == 2 and "face 'right'" in err and "over-exposed" in err
     rc, _out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50x0x50", "--out", tmp_path / "o")
     assert rc == 2 and "--size-mm" in err
