@@ -44,7 +44,7 @@ def _copy(src: Path, dst: Path, skip=()) -> Path:
 def test_from_photos_detect_show_and_fit(synth_photos, tmp_path, capsys, monkeypatch):
     monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
     blk = tmp_path / "blk"
-    rc, out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50x50x50", "--out", blk)
+    rc, _out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50x50x50", "--out", blk)
     assert rc == 0, err
     b = read_block(blk)
     assert list(b.faces) == list(FACES) and all(f.photo is not None and not f.has_rings for f in b.faces.values())
@@ -98,13 +98,13 @@ def test_mokume_folder_is_redetected(tmp_path, capsys):
 
 
 def test_bad_photo_folders_give_one_clear_line(synth_photos, tmp_path, capsys):
-    rc, out, err = _run(capsys, "block", "from-photos", _copy(synth_photos, tmp_path / "a", skip=("back",)),
+    rc, _out, err = _run(capsys, "block", "from-photos", _copy(synth_photos, tmp_path / "a", skip=("back",)),
                         "--size-mm", "50x50x50", "--out", tmp_path / "o")
     assert rc == 2 and "missing face photos: back" in err and err.count("\n") == 1
     d = _copy(synth_photos, tmp_path / "b")
     with Image.open(d / "top.png") as im:
         im.resize((160, 120)).save(d / "top.png")
-    rc, out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
     assert rc == 2 and "face 'top'" in err and "aspect" in err
     d = _copy(synth_photos, tmp_path / "c")
     Image.fromarray(np.full((160, 160, 3), 128, np.uint8)).save(d / "left.png")
