@@ -99,7 +99,7 @@ def summary(results: list[FaceResult], thresholds=SCORE_THRESHOLDS_PX) -> dict:
     return out
 
 
-def score_synthetic(seeds=EVAL_SEEDS, face_px: int = 256, rule: BoundaryRule = "sharp-edge",
+def score_synthetic(seeds=EVAL_SEEDS, face_px: int = 256, rule: BoundaryRule = "dark-centre",
                     detector=None) -> list[FaceResult]:
     """Detect rings on every face of the synthetic cubes of ``seeds``; score against the truth.
 
@@ -120,7 +120,7 @@ def score_synthetic(seeds=EVAL_SEEDS, face_px: int = 256, rule: BoundaryRule = "
     return results
 
 
-def score_reference_block(block, rule: BoundaryRule = "sharp-edge", detector=None) -> list[FaceResult]:
+def score_reference_block(block, rule: BoundaryRule = "dark-centre", detector=None) -> list[FaceResult]:
     """Detect rings on each face of ``block`` that has a photo and a ring map; score against the
     map's ridge (knot masks, grown by the fitter's margin, are left out of both)."""
     from scipy import ndimage
