@@ -23,7 +23,8 @@ _EXPORTS = {
     ".cad": ["CarveResult", "carve", "load_part"],
     ".detect": ["RingDetection", "detect_rings"],
     ".errors": ["MissingDependencyError", "WoodcamError", "WoodcamWarning"],
-    ".export": ["export_glb", "export_obj", "load_textured", "read_glb_metadata"],
+    ".export": ["export_glb", "export_obj", "load_textured", "read_glb_metadata", "crease_normals",
+                  "written_by_woodcam", "BLOCK_TO_GLTF"],
     ".fields": ["GridField", "GrowthField", "KnottedLogField", "Log", "LogFrame", "PlacedField",
                 "RadialScalingField", "arf", "builtin_block", "evaluate", "grain_direction",
                 "read_gran1"],
@@ -36,7 +37,7 @@ _EXPORTS = {
     ".synth": ["cut_block", "synth_block"],
     ".toolpath": ["Program", "SimResult", "Tool", "load_tool_table", "parse_tool_spec",
                   "read_gcode", "simulate"],
-    ".view": ["preview"],
+    ".view": ["SceneOptions", "preview"],
 }
 _WHERE = {name: mod for mod, names in _EXPORTS.items() for name in names}
 

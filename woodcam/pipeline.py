@@ -38,6 +38,9 @@ class PartPreview:
     timings_s: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     meta_block: str = ""
+    tessellation: dict = field(default_factory=dict)
+    atlas: str = ""
+    report: dict = field(default_factory=dict)
 
     @contextmanager
     def stage(self, name: str):
@@ -46,48 +49,114 @@ class PartPreview:
         self.timings_s[name] = self.timings_s.get(name, 0.0) + time.perf_counter() - t0
 
 
+def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = False,
+                  what: str = "--out") -> Path:
+    """Check every file a preview will write *before* any work: ``out_glb`` ends in ``.glb``,
+    is not a folder, its folder exists (created if missing) and is writable; likewise the
+    ``.obj``/``.mtl``/``.png`` beside it when ``obj``, and the rendered ``*_view.png`` (or the
+    given screenshot path). Returns ``out_glb`` as a Path; raises WoodcamError naming the path."""
+    from ._atomic import check_output_path
+
+    out_glb = check_output_path(out_glb, suffixes=(".glb",), what=what, mkdir=True)
+    if obj:
+        for sibling in (out_glb.with_suffix(".obj"), out_glb.with_suffix(".mtl"),
+                        out_glb.with_name(out_glb.stem + "_texture.png")):
+            suffix = sibling.suffix
+            check_output_path(sibling, what=f"{what} (the {suffix[1:].upper()} "
+                              "beside the GLB; --no-obj skips it)")
+    if screenshot is True:
+        check_output_path(out_glb.with_name(out_glb.stem + "_view.png"), what=f"{what} (its view PNG)")
+    elif screenshot:
+        check_output_path(screenshot, suffixes=(".png",), what="--screenshot", mkdir=True)
+    return out_glb
+
+
 def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                  tolerance_mm: float | None = None, obj: bool = True,
-                 screenshot: bool = True, progress: bool = False) -> PartPreview:
+                 screenshot: bool = True, progress: bool = False, obj_units: str = "m",
+                 obj_up: str = "y", max_triangles: int | None = None,
+                 max_atlas_px: int = 4096, place: list[str] | tuple = ()) -> PartPreview:
     """Carve ``source`` (anything :func:`woodcam.cad.load_part` takes) out of ``stock``, bake it
-    and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``)."""
-    from .cad import carve, load_part
-    from .tolerances import TESSELLATION_TOL_MM
+    and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``).
 
-    out_glb = Path(out_glb)
+    ``place`` lists placement operations applied to the loaded part before carving
+    (:mod:`woodcam.cad.place`, e.g. ``["rotate:x:90", "center", "drop"]``); the resulting
+    4 x 4 matrix is recorded in the GLB metadata as ``placement``."""
+    from .cad import carve, load_part
+    from .tolerances import MAX_PART_TRIANGLES, TESSELLATION_TOL_MM
+
+    out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)  # before minutes of work
     result = PartPreview(out_glb.stem)
     with result.stage("load"):
-        part = load_part(source, tolerance_mm=tolerance_mm or TESSELLATION_TOL_MM)
+        part = load_part(source, tolerance_mm=tolerance_mm or TESSELLATION_TOL_MM,
+                         max_triangles=max_triangles or MAX_PART_TRIANGLES,
+                         report=result.tessellation)
+    result.warnings += list(result.tessellation.get("notes", []))
+    metadata = None
+    if place:
+        from .cad.place import place_part
+
+        part, matrix = place_part(part, list(place), stock.size_mm)
+        metadata = {"placement": {"ops": list(place), "matrix": matrix.tolist()}}
     with result.stage("carve"):
         carved = carve(part, stock.size_mm)
     result.warnings += list(carved.warnings)
     return preview_mesh(carved.mesh, stock, out_glb, texels_per_mm=texels_per_mm, obj=obj,
-                        screenshot=screenshot, progress=progress, result=result)
+                        part_report=True,
+                        screenshot=screenshot, progress=progress, result=result,
+                        obj_units=obj_units, obj_up=obj_up, max_atlas_px=max_atlas_px,
+                        metadata=metadata)
 
 
 def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, obj: bool = True,
                  screenshot: bool = True, progress: bool = False,
-                 result: PartPreview | None = None, metadata: dict | None = None) -> PartPreview:
-    """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files."""
+                 result: PartPreview | None = None, metadata: dict | None = None,
+                 obj_units: str = "m", obj_up: str = "y",
+                 max_atlas_px: int = 4096, part_report: bool = False) -> PartPreview:
+    """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files: the GLB
+    in metres, Y up (glTF's convention); the OBJ in ``obj_units`` with ``obj_up`` up."""
     from .bake import bake
     from .export import export_glb, export_obj
 
-    out_glb = Path(out_glb)
-    out_glb.parent.mkdir(parents=True, exist_ok=True)
+    out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
     result = result or PartPreview(out_glb.stem)
     result.volume_mm3 = float(mesh.volume)
     result.triangles = int(len(mesh.faces))
     with result.stage("bake"):
-        baked = bake(mesh, stock.wood, texels_per_mm=texels_per_mm, progress=progress)
+        baked = bake(mesh, stock.wood, texels_per_mm=texels_per_mm, progress=progress,
+                     max_atlas_px=max_atlas_px)
     result.atlas_px = tuple(baked.atlas.shape[:2])
+    result.atlas = baked.summary()
+    if part_report:
+        import json
+
+        from ._atomic import write_bytes
+        from .advise import part_report as _part_report
+        from .advise import report_text
+
+        with result.stage("report"):
+            result.report = _part_report(mesh, stock)
+            stem = out_glb.with_name(out_glb.stem + "_report")
+            write_bytes(stem.with_suffix(".json"), json.dumps(result.report, indent=1).encode())
+            write_bytes(stem.with_suffix(".txt"), (report_text(result.report, out_glb.stem)
+                                                   + "\n").encode())
+        result.files["report"] = stem.with_suffix(".txt")
     result.warnings += list(getattr(baked, "warnings", []))
-    meta = {"block": stock.spec, "size_mm": list(stock.size_mm), **(metadata or {}),
+    from .stock import absolute_spec, spec_digest
+
+    meta = {"block": absolute_spec(stock.spec), "block_digest": spec_digest(stock.spec),
+            "size_mm": list(stock.size_mm),
+            "appearance": {"kind": stock.meta.get("appearance", "colormap"),
+                           "species": stock.meta.get("species"),
+                           "params": stock.meta.get("appearance_params", {})},
+            **(metadata or {}),
             "texels_per_mm": float(baked.texels_per_mm)}
     with result.stage("export"):
         result.files["glb"] = Path(export_glb(baked.mesh, out_glb, metadata=meta) or out_glb)
         if obj:
             obj_path = out_glb.with_suffix(".obj")
-            result.files["obj"] = Path(export_obj(baked.mesh, obj_path) or obj_path)
+            result.files["obj"] = Path(export_obj(baked.mesh, obj_path, units=obj_units,
+                                                           up=obj_up) or obj_path)
     if screenshot:
         from .view import preview
 

@@ -2,18 +2,27 @@
 
 A block spec is a string the CLI and GLB metadata carry:
 
-- ``builtin:NAME``: a built-in synthetic block (``woodcam blocks`` lists them).
+- ``builtin:NAME`` or ``builtin:NAME:WxDxH``: a built-in synthetic block (``woodcam blocks``
+  lists them) of its own size or of ``W x D x H`` mm, cut from the same wood round the same
+  centre (e.g. ``builtin:flat-sawn:300x120x40``).
 - ``log:LOG@K`` or ``log:LOG@K:WxDxH``: a block cut tangentially through knot ``K`` of a
   knotted log, ``LOG`` being ``gran1`` (the CT-measured spruce log of the shared data) or a
   woodcam log file (``.json``); size default 100x80x50 mm, Z along the log.
 - a block folder with a ``block.json`` manifest (real or synthetic): its true field if it has
-  one, otherwise a field fitted to its rings (fit once, cached in the folder); a folder of
-  photos only (``woodcam block from-photos``) first gets its rings detected on the photos
-  (:func:`woodcam.detect.block.with_detected_rings`, cached by content in the user cache).
+  one, otherwise a field fitted to its rings (fit once, cached in the user cache folder); a
+  folder of photos only (``woodcam block from-photos``) first gets its rings detected on the
+  photos (:func:`woodcam.detect.block.with_detected_rings`, cached by content in the user cache).
 - a Mokume sample folder (``A_col.png``, ``A_arl-unet.png``, ... as in the Mokume dataset): a
   cube of ``MOKUME_DEFAULT_SIZE_MM`` (50 mm) whose field is fitted to its ring maps, fit once
-  and cached under ``$WOODCAM_CACHE_DIR`` / ``~/.cache/woodcam`` (the sample folder is left
-  untouched: it is often read-only shared data).
+  and cached.
+
+Any spec may end in turns of the block under the part, ``~AXIS90`` (a multiple of 90 degrees
+about the block axis ``x``, ``y`` or ``z``; chainable, e.g. ``builtin:flat-sawn~z90`` runs the
+grain along Y): the block's size axes swap accordingly and the wood turns with it.
+
+Fitted fields and neural colour volumes are cached under ``$WOODCAM_CACHE_DIR`` or the user
+cache folder (``$XDG_CACHE_HOME/woodcam``, ``~/.cache/woodcam``), keyed by the block's content:
+block and sample folders are only read, never written (they are often read-only shared data).
 """
 
 from __future__ import annotations
@@ -71,24 +80,175 @@ def open_stock(spec: str, *, species: str | None = None,
     """
     if appearance not in ("colormap", "neural"):
         raise WoodcamError(f"appearance must be one of ['colormap', 'neural']; got {appearance!r}")
+    base, turns = _split_turns(spec)
+    stock = _open_base_stock(base, species, appearance, appearance_params)
+    stock.meta["appearance_params"] = {k: (list(v) if isinstance(v, tuple) else v)
+                                       for k, v in appearance_params.items()
+                                       if isinstance(v, (int, float, str, tuple, list))}
+    if not turns:
+        return stock
+    wood, size = stock.wood, stock.size_mm
+    for axis, quarter_turns in turns:
+        wood, size = wood.turned(axis, quarter_turns, size)
+    return Stock(spec, size, wood, stock.description, {**stock.meta, "turns": turns})
+
+
+def absolute_spec(spec: str) -> str:
+    """``spec`` with any folder or log file it names made absolute, so a file that records it
+    (a GLB) reopens the same block from any working folder."""
+    base, sep, turns = str(spec).partition("~")
+    if base.startswith("log:"):
+        source, at, rest = base[len("log:"):].partition("@")
+        if source.lower().endswith(".json"):
+            base = f"log:{Path(source).resolve()}{at}{rest}"
+    elif not base.startswith("builtin:"):
+        base = str(Path(base).resolve())
+    return base + sep + turns
+
+
+def spec_digest(spec: str) -> str:
+    """Content identity of the block ``spec`` names: a digest of every file of a block or sample
+    folder (or of a log file), or of the spec itself for synthetic blocks."""
+    from . import __version__
+    from ._cache import digest
+
+    base = str(spec).partition("~")[0]
+    path = None
+    if base.startswith("log:"):
+        source = base[len("log:"):].partition("@")[0]
+        path = Path(source) if source.lower().endswith(".json") else None
+    elif not base.startswith("builtin:"):
+        path = Path(base)
+    if path is not None and path.is_dir():
+        files = sorted(p for p in path.rglob("*") if p.is_file() and not p.name.startswith("."))
+        return digest([(str(p.relative_to(path)), p) for p in files])
+    if path is not None and path.is_file():
+        return digest(path)
+    return digest(base, __version__)
+
+
+def _split_turns(spec: str) -> tuple[str, list[tuple[str, int]]]:
+    """``"SPEC~z90~x-90"`` -> ``("SPEC", [("z", 1), ("x", -1)])`` (see module docstring)."""
+    base, *parts = str(spec).split("~")
+    turns = []
+    for part in parts:
+        axis, deg = part[:1].lower(), part[1:]
+        try:
+            quarter, rest = divmod(float(deg), 90.0)
+        except ValueError:
+            quarter, rest = 0, 1.0
+        if axis not in ("x", "y", "z") or rest != 0.0:
+            raise WoodcamError(
+                f"block spec {spec!r}: turn '~{part}' must be ~AXIS then a multiple of 90 degrees "
+                "(AXIS x, y or z), e.g. 'builtin:flat-sawn~z90'")
+        turns.append((axis, int(quarter)))
+    return base, turns
+
+
+def _builtin(rest: str):
+    """``NAME`` or ``NAME:WxDxH`` -> ``(BuiltinBlock, field, size_mm)``; a given size cuts a block
+    of that size from the same wood, centred where the built-in block's centre is."""
+    import numpy as np
+
+    name, _, size_text = rest.partition(":")
+    b = builtin_block(name)
+    if not size_text:
+        return b, b.field, tuple(b.size_mm)
+    size = _parse_size(size_text, f"builtin:{rest}")
+    from .fields.placement import PlacedField
+
+    offset = (np.asarray(b.size_mm, dtype=float) - np.asarray(size)) / 2
+    return b, PlacedField(b.field, origin_mm=offset), size
+
+
+def _parse_size(text: str, spec: str) -> tuple[float, float, float]:
+    import math
+
+    try:
+        size = tuple(float(v) for v in text.lower().split("x"))
+    except ValueError:
+        size = ()
+    if len(size) != 3 or not all(math.isfinite(v) and 0 < v <= _MAX_BLOCK_SIDE_MM for v in size):
+        raise WoodcamError(
+            f"block spec {spec!r}: the size must be WxDxH in mm, each > 0 and <= "
+            f"{_MAX_BLOCK_SIDE_MM:g}; got {text!r}, e.g. builtin:flat-sawn:300x120x40")
+    return size
+
+
+#: Largest side (mm) a synthetic block may be given: a woodworker's block, not a building.
+_MAX_BLOCK_SIDE_MM = 5000.0
+
+
+def _open_base_stock(spec: str, species, appearance, appearance_params) -> Stock:
     if spec.startswith("builtin:"):
-        b = builtin_block(spec.split(":", 1)[1])
-        return _synthetic_stock(spec, b.field, b.size_mm, species or b.species, b.description,
+        b, field, size = _builtin(spec.split(":", 1)[1])
+        return _synthetic_stock(spec, field, size, species or b.species, b.description,
                                 appearance, appearance_params)
     if spec.startswith("log:"):
         field, size_mm, description = _log_block_field(spec)
         return _synthetic_stock(spec, field, size_mm, species or "spruce", description,
                                 appearance, appearance_params)
-    path = Path(spec)
-    if path.is_dir() and (path / "block.json").is_file():
+    path = _existing_folder(spec)
+    if (path / "block.json").is_file():
         return _open_block_folder(path, species, appearance, appearance_params)
-    if path.is_dir() and (any(path.glob("?_col.png")) or any(path.glob("?_arl-unet.png"))):
-        return _open_mokume_folder(path, species, appearance, appearance_params)
-    raise WoodcamError(
-        f"block spec {spec!r} is neither 'builtin:NAME' (NAME one of {', '.join(BUILTIN_NAMES)}), "
-        "'log:LOG@KNOT[:WxDxH]', a block folder with a block.json manifest, nor a Mokume sample "
-        "folder (A_col.png, A_arl-unet.png, ...)"
-    )
+    return _open_mokume_folder(path, species, appearance, appearance_params)
+
+
+def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
+    """Resolve a block spec to ``(block, field)``: the one block resolver of every command.
+
+    Parameters
+    ----------
+    spec : str
+        As :func:`open_stock`: ``builtin:NAME`` and ``log:LOG@K[:WxDxH]`` give a synthetic
+        block whose six face photos, ring maps and traces are rendered by
+        :func:`woodcam.synth.synth_block` (seed 0) from the true field; a folder is read by
+        :func:`woodcam.block.io.read_block_folder` (block folder or Mokume sample folder); a
+        folder of photos only gets its rings detected (cached, :mod:`woodcam.detect.block`).
+    size_mm : float, optional
+        Cube side of a Mokume sample folder (its files carry no size; default 50 mm).
+    face_px : int
+        Pixels along the largest face side of a synthetic block's photos.
+
+    Returns
+    -------
+    (Block, field or None)
+        The field is the block's true field where one is known (synthetic blocks, block
+        folders that store one), else None: no field is fitted here.
+    """
+    if spec.startswith(("builtin:", "log:")):
+        from .synth import synth_block
+
+        if spec.startswith("builtin:"):
+            b, field, size = _builtin(spec.split(":", 1)[1])
+            name = b.name if tuple(size) == tuple(b.size_mm) else spec.replace(":", "-")
+        else:
+            field, size, _ = _log_block_field(spec)
+            name = spec.replace(":", "-").replace("/", "_")
+        return synth_block(field, size, face_px=face_px, seed=0, name=name), field
+    from .block.io import read_block_folder
+
+    from .detect.block import with_detected_rings
+
+    block = read_block_folder(_existing_folder(spec),
+                              None if size_mm is None else (float(size_mm),) * 3)
+    # A block of photos only: rings detected once, cached by content outside the folder.
+    block = with_detected_rings(block, progress=True)
+    return block, block.true_field
+
+
+def _existing_folder(spec: str) -> Path:
+    """The folder a non-builtin, non-log spec names, or the error listing every kind of spec."""
+    path = Path(spec)
+    if path.name == "block.json" and path.is_file():
+        path = path.parent
+    if not path.is_dir():
+        raise WoodcamError(
+            f"block spec {spec!r} is neither 'builtin:NAME' (NAME one of "
+            f"{', '.join(BUILTIN_NAMES)}), 'log:LOG@KNOT[:WxDxH]', nor an existing folder: a block "
+            "folder (with block.json) or a Mokume sample folder (A_col.png, A_arl-unet.png, ...)"
+        )
+    return path
 
 
 def _synthetic_stock(spec, field, size_mm, species, description, appearance, params) -> Stock:
@@ -112,59 +272,59 @@ def _synthetic_stock(spec, field, size_mm, species, description, appearance, par
     return Stock(spec, tuple(size_mm), Wood(field, app), description, meta)
 
 
-def fitted_field(block, folder: Path | None, method: str = "radial"):
+def fitted_field(block, folder: Path | None = None, method: str = "radial"):
     """The growth field fitted to a block's rings, fitted once and cached.
 
-    folder : the block folder: the cache ``<folder>/.woodcam-cache/field_<method>_v<N>.npz`` is
-        reused while it is newer than the block's manifest (delete it, or rewrite the block, to
-        fit again). None (a Mokume sample folder, which is never written to): cached under
-        ``$WOODCAM_CACHE_DIR`` / ``~/.cache/woodcam`` keyed by the block's images and size.
-    ``N`` is :data:`woodcam.inference.fit.FIT_VERSION`, so a changed fitter refits.
+    The cache entry lives in the user cache folder (:func:`woodcam._cache.cache_dir`
+    ``("fields")``), never in the block's own folder (which may be read-only shared data), and is
+    keyed by a digest of everything the fit reads: size, photos, ring maps, traces and knot masks
+    (:func:`~woodcam.appearance.volumes.block_fingerprint`), the method, and
+    :data:`woodcam.inference.fit.FIT_VERSION` with the package version. An edited block is a
+    new entry; an unreadable entry is discarded with a warning and refitted; concurrent first
+    runs fit once (a lock) and share the result.
+
+    folder : the block folder, only named in errors (None for a Mokume sample).
     """
-    from .appearance.neural import default_cache_dir
+    import re
+
+    from . import __version__
+    from ._cache import cache_dir, digest, load_or_build
     from .appearance.volumes import block_fingerprint
     from .fields.grid import GridField
     from .inference import fit_block
     from .inference.fit import FIT_VERSION
 
-    if folder is None:
-        cache = (default_cache_dir().parent / "fields"
-                 / f"{block.name}-{block_fingerprint(block)[:16]}-{method}_v{FIT_VERSION}.npz")
-        fresh = cache.is_file()
-    else:
-        cache = folder / ".woodcam-cache" / f"field_{method}_v{FIT_VERSION}.npz"
-        fresh = cache.is_file() and cache.stat().st_mtime >= (folder / "block.json").stat().st_mtime
-    if fresh:
-        return GridField.load(cache)
     if not any(f.has_rings for f in block.faces.values()):
         raise WoodcamError(
             f"block {folder or block.name} has neither a true field nor traced rings or ring maps "
             "to fit one to; trace rings on at least one face (or use 'woodcam block synth')"
         )
-    field = fit_block(block, method=method)
-    cache.parent.mkdir(parents=True, exist_ok=True)
-    field.save(cache)
+    key = digest(block_fingerprint(block), method, FIT_VERSION, __version__)
+    stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", block.name)[:40] or "block"
+    path = cache_dir("fields") / f"{stem}-{method}-{key}.npz"
+    field, _hit = load_or_build(path, load=GridField.load, build=lambda: fit_block(block, method=method),
+                                save=lambda f, tmp: f.save(tmp), what=f"fitted field of block {block.name!r}")
     return field
 
 
 def _open_mokume_folder(path: Path, species, appearance, appearance_params) -> Stock:
-    from .block.io import read_mokume
+    from .block.io import read_block_folder
 
-    block = read_mokume(path)
+    block = read_block_folder(path)
     return _real_block_stock(str(path), block, fitted_field(block, None), species, appearance,
                              appearance_params, cache_dir=None)
 
 
 def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
-    from .block.io import read_block  # block I/O sits beside; imported when a folder is used
+    from .block.io import read_block_folder  # imported when a folder is used
 
     from .detect.block import with_detected_rings
 
     # A block of photos only: rings detected once, cached by content outside the folder.
-    block = with_detected_rings(read_block(path), progress=True)
+    block = with_detected_rings(read_block_folder(path), progress=True)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
     return _real_block_stock(str(path), block, field, species, appearance, appearance_params,
-                             cache_dir=path / ".woodcam-cache")
+                             cache_dir=None)
 
 
 def _real_block_stock(spec, block, field, species, appearance, appearance_params, cache_dir) -> Stock:
@@ -178,12 +338,19 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
         app = ColorMapAppearance.fit_to_block(block, field, species or "oak", **appearance_params)
     else:
         app = ColorMapAppearance(species or "oak", **appearance_params)
-    return Stock(spec, block.size_mm, Wood(field, app), block.name, dict(block.meta))
+    meta = {**dict(block.meta), "appearance": appearance, "species": species or "oak"}
+    return Stock(spec, block.size_mm, Wood(field, app), block.name, meta)
 
 
 def _log_block_field(spec: str):
     """``log:LOG@K[:WxDxH]`` -> (block-frame field, size_mm, description)."""
-    from .fields import KnottedLogField, block_at_knot, place_block_in_log, read_gran1, read_log
+    from .fields import (
+        KnottedLogField,
+        block_at_knot,
+        place_block_in_log,
+        read_gran1,
+        read_log,
+    )
 
     body = spec[len("log:"):]
     try:

@@ -163,3 +163,19 @@ NEURAL_VOLUME_MAE = 0.05
 RING_HISTORY_PRIOR_POINTS = 20.0
 RING_HISTORY_ROUNDS = 3
 RING_HISTORY_MIN_STEP = 1e-3
+
+#: Exported shading normals are averaged over the faces round a vertex whose normals lie within
+#: this angle of each other; a sharper edge keeps two normals (a crease). 30 degrees is the
+#: common CAD/DCC default (Blender's auto-smooth, three.js' toCreasedNormals examples): a
+#: tessellated cylinder (5 degree facets) shades smooth, a box edge (90 degrees) stays sharp.
+CREASE_ANGLE_DEG = 30.0
+
+#: Two exported corners are the same position when they agree to this (mm); the baked mesh is
+#: split at UV seams, so positions, not vertex indices, decide which faces meet at a vertex.
+CREASE_WELD_MM = 1e-6
+
+#: Default triangle budget of a tessellated B-rep part: above it, load_part re-meshes with
+#: looser tolerances and says so. Public STEP parts reached 226k-312k triangles at the fixed
+#: 0.05 mm / 5 deg defaults and took 4-10 min to bake; 120k keeps the demo bowl (~32k) and the
+#: other examples untouched while bounding the unwrap (xatlas is super-linear in chart size).
+MAX_PART_TRIANGLES = 120_000

@@ -14,9 +14,9 @@ def test_detect_rings_speed_256():
     from skimage.filters import sato
 
     from woodcam.detect import detect_rings
-    from woodcam.detect.evaluate import synthetic_faces
+    from woodcam.synth import ring_eval_faces
 
-    faces = [f.photo for f in synthetic_faces(1000)]
+    faces = [f.photo for f in ring_eval_faces(1000)]
     detect_rings(faces[0])                       # warm-up (imports, FFT plans)
     t_det, t_sato, cpu = [], [], []
     for photo in faces:

@@ -25,10 +25,13 @@ def test_spec_round_trip_and_unknown_keys(tmp_path):
 @pytest.mark.slow
 def test_tiny_training_run_is_reproducible(tmp_path):
     from woodcam.detect.learned import ring_probability, train_ring_net
+    from woodcam.synth import ring_training_faces
 
     spec = replace(RingNetSpec(), n_blocks=1, face_px=64, crop_px=32, batch=2, steps=3, log_every=1, width=4)
-    r1 = train_ring_net(spec, tmp_path / "a", progress=False)
-    r2 = train_ring_net(spec, tmp_path / "b", progress=False)
+    x, y = ring_training_faces(spec)
+    assert x.shape == y.shape == (6, 64, 64) and 0 < y.mean() < 0.5
+    r1 = train_ring_net(spec, x, y, tmp_path / "a", progress=False)
+    r2 = train_ring_net(spec, x, y, tmp_path / "b", progress=False)
     assert r1["steps"] == 3 and r1["final_loss"] == pytest.approx(r2["final_loss"], rel=1e-5)
     for name in (SPEC_NAME, WEIGHTS_NAME, "rings_train_log.csv"):
         assert (tmp_path / "a" / name).is_file()

@@ -1,14 +1,13 @@
 """Planar sections through a log and the `woodcam log` command."""
 
-import argparse
 
 import numpy as np
 import pytest
 from PIL import Image
 
-from woodcam import _cli_log
+from woodcam.cli import build_parser
 from woodcam.errors import WoodcamError
-from woodcam.fields import log_render as lr
+from woodcam.logs import render as lr
 from woodcam.fields.knots import KnottedLogField
 from woodcam.fields.tree_data import Knot, simple_log, write_log
 
@@ -62,9 +61,7 @@ def test_disc_background_outside_the_log():
 
 
 def _parse(argv):
-    ap = argparse.ArgumentParser(prog="woodcam")
-    _cli_log.add_parser(ap.add_subparsers(dest="command"))
-    return ap.parse_args(argv)
+    return build_parser().parse_args(argv)
 
 
 def test_cli_renders_a_log_file(tmp_path):
@@ -86,7 +83,14 @@ def test_cli_maps_and_export_round_trip(tmp_path):
     b = _parse(["log", "export", "--maps", str(tmp_path / "maps"), "--out",
                 str(tmp_path / "back.json")])
     assert b.func(b) == 0
-    assert (tmp_path / "back.json").is_file()
+    from woodcam.fields.tree_data import read_log
+
+    log, back = _log(), read_log(tmp_path / "back.json")
+    assert len(back.knots) == len(log.knots) == 1           # the knot survives the maps
+    k, kb = log.knots[0], back.knots[0]
+    assert abs(kb.z0_mm - k.z0_mm) < 3.0 and abs(kb.r_death_mm - k.r_death_mm) < 3.0
+    r = np.array([20.0, 40.0])
+    np.testing.assert_allclose(kb.axis_at(r)[0], k.axis_at(r)[0], atol=3.0)
 
 
 def test_cli_needs_exactly_one_log(tmp_path):

@@ -28,15 +28,15 @@ import numpy as np
 
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, evaluate
+from ..fields.rings import MOKUME_RING_SIGMA_MM, ring_map
 from ..frames import FACE_AXIS, FACE_NORMAL, block_to_pixel, check_size
 from .noise import value_noise
 
 #: In-plane axes (a, b) of the canonical image of each block axis.
 PLANE_AXES: dict[int, tuple[int, int]] = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
 
-#: Width (mm) of the ring lines of Mokume's U-Net ring maps, for ring-map-like images of a
-#: field (the same value as ``woodcam.synth.MOKUME_RING_SIGMA_MM``, which sits above this module).
-RING_MAP_SIGMA_MM = 0.62
+#: Width (mm) of the ring lines of Mokume's U-Net ring maps, for ring-map-like images of a field.
+RING_MAP_SIGMA_MM = MOKUME_RING_SIGMA_MM
 
 #: Largest allowed volume resolution (cells along the longest side): 256^3 x 3 x 3 bytes = 150 MB.
 MAX_RESOLUTION = 256
@@ -120,16 +120,9 @@ class VolumeGrid:
 # -- input channels ----------------------------------------------------------------------------------
 
 def ring_map_like(years_img: np.ndarray, cell_mm: float, sigma_mm: float = RING_MAP_SIGMA_MM) -> np.ndarray:
-    """Mokume-style ring map of growth-time images ``(..., h, w)``: ``exp(-(d / sigma)^2)``.
-
-    ``d = |g - round(g)| / |grad g|`` is the in-image distance (mm) to the nearest ring boundary,
-    to first order (the formula of ``woodcam.synth``'s ring maps, repeated here because synth sits
-    above this module).
-    """
-    g = np.asarray(years_img, np.float64)
-    gr, gc = np.gradient(g, cell_mm, axis=(-2, -1))
-    d = np.abs(g - np.round(g)) / np.maximum(np.hypot(gr, gc), 1e-9)
-    return np.exp(-((d / sigma_mm) ** 2)).astype(np.float32)
+    """Mokume-style ring map of growth-time images ``(..., h, w)`` on cells of ``cell_mm``:
+    :func:`woodcam.fields.rings.ring_map` with the line width in mm."""
+    return ring_map(years_img, sigma_mm, cell_mm)
 
 
 def input_channels(ring: np.ndarray, points_mm: np.ndarray | None, spec) -> np.ndarray:
@@ -295,19 +288,21 @@ class ColorVolumes:
         return idx, w
 
     def save(self, path) -> Path:
+        from .._atomic import atomic_path
+
         path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".tmp.npz")
         extra = {} if not self.has_detail else {"guides": self.guides.astype(np.float16),
                                                  "slopes": self.slopes.astype(np.float16)}
-        np.savez(tmp, volumes=self.volumes, grid=json.dumps(self.grid.to_dict()),
-                 meta=json.dumps(self.meta), **extra)
-        tmp.replace(path)  # atomic: a reader never sees half a cache file
+        # unique temporary + rename: a reader never sees half a file, two writers never mix
+        with atomic_path(path, mkdir=True) as tmp:
+            np.savez(tmp, volumes=self.volumes, grid=json.dumps(self.grid.to_dict()),
+                     meta=json.dumps(self.meta), **extra)
         return path
 
     @classmethod
     def load(cls, path) -> "ColorVolumes":
-        with np.load(path) as z:
+        # our own handle: np.load leaks it when the zip is truncated
+        with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as z:
             g = json.loads(str(z["grid"]))
             detail = {k: z[k] for k in ("guides", "slopes") if k in z.files}
             return cls(VolumeGrid(tuple(g["size_mm"]), g["resolution"]), z["volumes"],
@@ -467,13 +462,18 @@ def field_fingerprint(field, size_mm, n: int = 2048) -> str:
 
 
 def block_fingerprint(block) -> str:
-    """A digest of a block's size and face photos and ring maps."""
-    h = hashlib.sha256(np.asarray(block.size_mm, "<f8").tobytes())
+    """A digest of everything a block's faces hold: its size, and per face the photo, ring map,
+    ring traces (points and years) and extras (knot masks, annotations), so any edit that could
+    change a fit or an appearance changes the digest."""
+    from .._cache import digest
+
+    faces = []
     for name, f in block.faces.items():
-        h.update(name.encode())
-        for a in (f.photo, f.ring_map):
-            h.update(b"-" if a is None else np.ascontiguousarray(a).tobytes())
-    return h.hexdigest()
+        traces = [(t.points_px, -1 if t.year is None else int(t.year)) for t in f.traces]
+        extras = {k: (v if isinstance(v, np.ndarray) else json.dumps(v, sort_keys=True, default=str))
+                  for k, v in f.extras.items()}
+        faces.append((name, list(f.shape), f.photo, f.ring_map, traces, extras))
+    return digest(np.asarray(block.size_mm, "<f8"), faces, length=64)
 
 
 def cache_key(block, field, settings: dict) -> str:

@@ -1,9 +1,8 @@
 """Scoring the ring detector: synthetic faces with known rings, and real faces against reference maps.
 
-- :func:`synthetic_faces` renders face photos of synthetic blocks (:func:`woodcam.synth.synth_block`,
-  random logs and sawing patterns) with the true ring lines known exactly (the integer iso-lines
-  of the true field, refined onto them by Newton steps);
-- :func:`score_synthetic` runs :func:`~woodcam.detect.rings.detect_rings` on them and scores the
+- :func:`score_synthetic` runs :func:`~woodcam.detect.rings.detect_rings` on faces with known
+  rings (:class:`SyntheticFace`, rendered by :func:`woodcam.synth.ring_eval_faces` from synthetic
+  blocks: the true ring lines are the integer iso-lines of the true field) and scores the
   detected ring lines against the true ones (:mod:`woodcam.detect.score`);
 - :func:`score_reference_block` scores every face of a block with ring maps (e.g. a Mokume
   sample, whose U-Net maps are a reference, not truth) beside the chance control.
@@ -16,7 +15,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..frames import FACES
 from .rings import BoundaryRule, detect_rings
 from .score import (
     SCORE_THRESHOLDS_PX,
@@ -42,32 +40,8 @@ class SyntheticFace:
     label: str
 
 
-def synthetic_faces(seed: int, face_px: int = 256, size_mm: float = 50.0,
-                    ring_width_range_mm=(1.5, 6.0), faces=FACES) -> list[SyntheticFace]:
-    """Faces of one synthetic cube of ``size_mm`` drawn from ``np.random.default_rng(seed)``:
-    a random eccentric, lobed log and sawing pattern (:func:`woodcam.synth.random_log_placement`),
-    photos with camera noise, exposure variation, vignetting and lens blur (synth_block defaults).
-    Faces with fewer than two true rings are skipped."""
-    from ..synth import PATTERNS, cut_block, random_log_placement, synth_block
-
-    rng = np.random.default_rng(seed)
-    pattern = PATTERNS[seed % len(PATTERNS)]
-    size = (size_mm,) * 3
-    log, placement = random_log_placement(rng, pattern, size, ring_width_range_mm)
-    field = cut_block(log, size, **placement)
-    block = synth_block(field, size, face_px=face_px, rng=rng, seed=None, faces=faces,
-                        ring_map_faces=(), name=f"synthetic-{seed}")
-    px_mm = block.meta["px_per_mm"]
-    out = []
-    for name, f in block.faces.items():
-        if len(f.traces) < 2:
-            continue
-        truth = np.concatenate([_dense(t.points_px) for t in f.traces])
-        out.append(SyntheticFace(f.photo, truth, px_mm, f"seed {seed} {pattern} {name}"))
-    return out
-
-
-def _dense(p: np.ndarray, step: float = 0.5) -> np.ndarray:
+def dense_polyline(p: np.ndarray, step: float = 0.5) -> np.ndarray:
+    """Points every ``step`` px along a polyline ``(k, 2)`` (row, col), ends kept."""
     seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
     s = np.concatenate([[0.0], np.cumsum(seg)])
     t = np.linspace(0.0, s[-1], max(2, int(np.ceil(s[-1] / step)) + 1))
@@ -99,24 +73,24 @@ def summary(results: list[FaceResult], thresholds=SCORE_THRESHOLDS_PX) -> dict:
     return out
 
 
-def score_synthetic(seeds=EVAL_SEEDS, face_px: int = 256, rule: BoundaryRule = "dark-centre",
+def score_synthetic(faces: list[SyntheticFace], rule: BoundaryRule = "dark-centre",
                     detector=None) -> list[FaceResult]:
-    """Detect rings on every face of the synthetic cubes of ``seeds``; score against the truth.
+    """Detect rings on synthetic ``faces`` (e.g. :func:`woodcam.synth.ring_eval_faces` of
+    :data:`EVAL_SEEDS`); score against their true ring lines.
 
     ``detector``: optional callable ``(photo, px_per_mm) -> RingDetection``; default
     :func:`detect_rings` with ``rule``.
     """
     det_fn = detector or (lambda photo, ppm: detect_rings(photo, px_per_mm=ppm, rule=rule))
     results = []
-    for seed in seeds:
-        for sf in synthetic_faces(seed, face_px):
-            t0 = time.perf_counter()
-            d = det_fn(sf.photo, sf.px_per_mm)
-            dt = time.perf_counter() - t0
-            pts = d.points_px
-            results.append(FaceResult(sf.label, ridge_scores(pts, sf.truth_px),
-                                      ridge_scores(shifted_half_ring(pts, d.normal_rad, d.wavelength_px), sf.truth_px),
-                                      dt, d.warnings))
+    for sf in faces:
+        t0 = time.perf_counter()
+        d = det_fn(sf.photo, sf.px_per_mm)
+        dt = time.perf_counter() - t0
+        pts = d.points_px
+        results.append(FaceResult(sf.label, ridge_scores(pts, sf.truth_px),
+                                  ridge_scores(shifted_half_ring(pts, d.normal_rad, d.wavelength_px), sf.truth_px),
+                                  dt, d.warnings))
     return results
 
 

@@ -7,7 +7,8 @@ the local ring normal (from the classical detector's orientation field), found w
 sub-pixel contour code as the classical detector, so the result is a
 :class:`~woodcam.detect.rings.RingDetection` like the classical one.
 
-Training (:func:`train_ring_net`, ``woodcam train rings``): faces of synthetic cubes (random
+Training (:func:`train_ring_net`, ``woodcam train rings``; the faces come from
+:func:`woodcam.synth.ring_training_faces`, which sits above this package): faces of synthetic cubes (random
 eccentric logs, every sawing pattern, a quarter of them knotted logs of seed 001/003) rendered by
 :func:`woodcam.synth.synth_block`, with photo-style augmentation: colour and exposure, blur,
 noise, JPEG, lighting gradients, dark pores and ray streaks. The target is the exact distance
@@ -150,46 +151,24 @@ def _augment(photo: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return out
 
 
-def training_faces(spec: RingNetSpec, progress: bool = False):
-    """``(inputs (n, h, w) float32, targets (n, h, w) float32)`` from ``spec.n_blocks`` synthetic
-    cubes (module docstring). Seeds ``[spec.seed, i]``, disjoint from the evaluation seeds."""
-    from tqdm.auto import tqdm
+def augment_photo(photo: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Photo-style augmentation (module docstring) of an ``(h, w, 3)`` uint8 face photo."""
+    return _augment(photo, rng)
 
-    from ..synth import (
-        PATTERNS,
-        cut_block,
-        knotted_log_field,
-        random_log_placement,
-        synth_block,
-    )
+
+def net_input(photo: np.ndarray) -> np.ndarray:
+    """``(h, w)`` float32: what the net sees of a photo (flattened, contrast-normalised luminance)."""
     from .rings import _normalise, luminance
 
-    xs, ys = [], []
-    for i in tqdm(range(spec.n_blocks), desc="synthesising faces", unit="block", disable=not progress):
-        rng = np.random.default_rng([spec.seed, i, 7])
-        size = (50.0, 50.0, 50.0)
-        pattern = PATTERNS[i % len(PATTERNS)]
-        log, placement = random_log_placement(rng, pattern, size, (0.8, 6.0))
-        if i % 4 == 3:                     # a knotted log; the block kept inside it
-            log = knotted_log_field(rng, (0.8, 6.0))
-            half_diag = 0.5 * float(np.hypot(size[0], size[1]))
-            r_in = float(getattr(getattr(log, "log", None), "r_min_mm", 100.0)) - half_diag - 5.0
-            if placement["pattern"] != "pith-inside":
-                placement["distance_mm"] = max(half_diag + 2.0, min(placement["distance_mm"], r_in))
-        field = cut_block(log, size, **placement)
-        block = synth_block(field, size, face_px=spec.face_px, rng=rng, seed=None, trace_faces=(),
-                            ring_map_sigma_px=spec.target_sigma_px, ring_map_noise=0.0)
-        for f in block.faces.values():
-            photo = _augment(f.photo, rng)
-            lum = luminance(photo)
-            xs.append(_normalise(lum, sigma=0.5 * max(lum.shape)).astype(np.float32))
-            ys.append(np.nan_to_num(f.ring_map, nan=0.0).astype(np.float32))
-    return np.stack(xs), np.stack(ys)
+    lum = luminance(photo)
+    return _normalise(lum, sigma=0.5 * max(lum.shape)).astype(np.float32)
 
 
-def train_ring_net(spec: RingNetSpec, out_dir, *, progress: bool = True) -> dict:
-    """Train the ring net of ``spec`` from scratch; write ``rings_spec.json``, ``rings.pt`` and
-    ``rings_train_log.csv`` to ``out_dir``. Returns ``{"steps", "train_s", "final_loss", "params"}``."""
+def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, progress: bool = True) -> dict:
+    """Train the ring net of ``spec`` from scratch on inputs ``x (n, h, w)`` (:func:`net_input`)
+    and targets ``y (n, h, w)`` in [0, 1] (made by :func:`woodcam.synth.ring_training_faces`);
+    write ``rings_spec.json``, ``rings.pt`` and ``rings_train_log.csv`` to ``out_dir``.
+    Returns ``{"steps", "train_s", "final_loss", "params"}``."""
     torch = require("torch", "learn", "training the ring net")
     from tqdm.auto import tqdm
 
@@ -198,7 +177,6 @@ def train_ring_net(spec: RingNetSpec, out_dir, *, progress: bool = True) -> dict
     torch.manual_seed(spec.seed)
     torch.set_num_threads(1)           # the machine is shared; one thread also keeps runs repeatable
     rng = np.random.default_rng([spec.seed, 1])
-    x, y = training_faces(spec, progress=progress)
     net = _net(spec)
     n_params = sum(p.numel() for p in net.parameters())
     opt = torch.optim.Adam(net.parameters(), lr=spec.lr)
@@ -269,11 +247,8 @@ def load_ring_net(models_dir=MODELS_DIR):
 def ring_probability(photo: np.ndarray, models_dir=MODELS_DIR) -> np.ndarray:
     """``(h, w)`` float32 in [0, 1]: the net's ring-line probability on a face photo."""
     torch = require("torch", "learn", "the learned ring detector")
-    from .rings import _normalise, luminance
-
-    lum = luminance(photo)
-    h, w = lum.shape
-    x = _normalise(lum, sigma=0.5 * max(h, w)).astype(np.float32)
+    x = net_input(photo)
+    h, w = x.shape
     ph, pw = (-h) % 4, (-w) % 4
     x = np.pad(x, ((0, ph), (0, pw)), mode="reflect")
     with torch.no_grad():

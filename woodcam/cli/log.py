@@ -1,7 +1,6 @@
 """`woodcam log ...`: sections through knotted logs and log-file conversion (CLI glue only).
 
-Hook into ``woodcam/cli.py`` with ``_cli_log.add_parser(subparsers)``; the parser sets
-``func=run``, so the main CLI calls ``args.func(args)``.
+Registered by :mod:`woodcam.cli` through :func:`register`; the parser sets ``func=run``.
 
     woodcam log render [LOG_FILE | --real | --maps DIR] --out DIR [options]
     woodcam log maps   [LOG_FILE | --real] --out DIR        # write the seed's image maps
@@ -10,13 +9,13 @@ Hook into ``woodcam/cli.py`` with ``_cli_log.add_parser(subparsers)``; the parse
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
-from .errors import WoodcamError
+from ..errors import WoodcamError
+from .options import add_knot_options, knot_shading
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
+def register(subparsers) -> None:
     """Add the ``log`` command (with ``render``, ``maps``, ``export``) to ``subparsers``."""
     p = subparsers.add_parser("log", help="knotted logs: render sections, convert log files")
     sub = p.add_subparsers(dest="log_command", required=True)
@@ -43,8 +42,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="also a quarter-sawn section through the pith (knots as spikes)")
     r.add_argument("--k-stem", type=float, default=1.5, help="smoothness k outside knots")
     r.add_argument("--k-knot", type=float, default=5.0, help="smoothness k inside knots")
-    r.add_argument("--alive-darkening", type=float, default=0.35, help="0..1")
-    r.add_argument("--dead-darkening", type=float, default=0.3, help="0..1")
+    add_knot_options(r)
+    r.add_argument("--species", default="spruce",
+                   help="colour preset of the wood (oak, maple, walnut, cherry, pine, spruce; "
+                   "default spruce, the real log's)")
     r.add_argument("--outline-mm", type=float, default=1.0,
                    help="dead-knot outline thickness (mm)")
     r.set_defaults(func=run)
@@ -58,12 +59,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     source(e)
     e.add_argument("--out", required=True, help="output .json path")
     e.set_defaults(func=run)
-    return p
 
 
 def _load(args):
-    from .fields.knot_maps import read_maps
-    from .fields.tree_data import read_gran1, read_log
+    from ..fields.knot_maps import read_maps
+    from ..fields.tree_data import read_gran1, read_log
 
     given = [x for x in (args.log_file, args.real or None, args.maps) if x]
     if len(given) != 1:
@@ -83,22 +83,21 @@ def run(args) -> int:
     log = _load(args)
     out = Path(args.out)
     if args.log_command == "export":
-        from .fields.tree_data import write_log
+        from ..fields.tree_data import write_log
 
         print(write_log(log, out))
         return 0
     if args.log_command == "maps":
-        from .fields.knot_maps import write_maps
+        from ..fields.knot_maps import write_maps
 
         for path in write_maps(log, out).values():
             print(path)
         return 0
-    from .fields import log_render as lr
-    from .fields.knots import KnotParams, KnottedLogField
+    from ..fields.knots import KnotParams, KnottedLogField
+    from ..logs import render as lr
 
-    params = KnotParams(k_stem=args.k_stem, k_knot=args.k_knot,
-                        alive_darkening=args.alive_darkening,
-                        dead_darkening=args.dead_darkening, outline_mm=args.outline_mm)
+    params = KnotParams(k_stem=args.k_stem, k_knot=args.k_knot, outline_mm=args.outline_mm)
+    knots = knot_shading(args)
     field = KnottedLogField(log, ring_width_mm=args.ring_width, params=params)
     secs = lr.default_sections(log, px_per_mm=args.px_per_mm)
     if args.board:
@@ -110,6 +109,7 @@ def run(args) -> int:
         z, az = args.radial
         secs.append(lr.radial_section(log, z, np.radians(az), px_per_mm=args.px_per_mm))
     for s in secs:
-        img = lr.render_section(field, s, supersample=args.supersample)
+        img = lr.render_section(field, s, supersample=args.supersample, species=args.species,
+                                knots=knots)
         print(lr.save_png(img, out / f"{log.name}_{s.name}.png"))
     return 0

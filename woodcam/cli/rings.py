@@ -1,6 +1,6 @@
 """``woodcam rings detect|show`` and ``woodcam block from-photos``: rings and knots from photos.
 
-``woodcam.cli`` calls :func:`add_parser` with its sub-parsers; ``woodcam._cli_block`` adds
+Registered by :mod:`woodcam.cli` through :func:`register`; :mod:`woodcam.cli.block` adds
 ``from-photos`` to the ``block`` command with :func:`add_from_photos`.
 """
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .errors import WoodcamError
+from ..errors import WoodcamError
 
 
 def _size(text: str) -> tuple[float, float, float]:
@@ -40,8 +40,8 @@ def add_from_photos(sub) -> None:
 
 
 def run_from_photos(args) -> int:
-    from .block.io import write_block
-    from .block.photos import MAX_PX_PER_MM, block_from_photos
+    from ..block.io import write_block
+    from ..block.photos import MAX_PX_PER_MM, block_from_photos
 
     block = block_from_photos(args.photos_dir, _size(args.size_mm), partial=args.partial,
                               max_px_per_mm=args.max_px_per_mm or MAX_PX_PER_MM)
@@ -52,7 +52,7 @@ def run_from_photos(args) -> int:
     return 0
 
 
-def add_parser(subparsers) -> None:
+def register(subparsers) -> None:
     """Add the ``rings`` command (``detect``, ``show``)."""
     p = subparsers.add_parser("rings", help="find rings and knots on a block's face photos; draw them")
     p.set_defaults(func=run)
@@ -87,7 +87,7 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     if args.rings_command == "detect":
-        from .detect.block import DEFAULT_DETECTOR, detect_folder
+        from ..detect.block import DEFAULT_DETECTOR, detect_folder
 
         manifest, msgs = detect_folder(args.block, args.out, rule=args.rule, knots=not args.no_knots,
                                        size_mm=(args.size_mm,) * 3 if args.size_mm else None, progress=True,
@@ -100,9 +100,9 @@ def run(args) -> int:
         import numpy as np
         from PIL import Image
 
-        from .block.io import MANIFEST, read_block, read_mokume
-        from .detect.block import with_detected_rings
-        from .detect.show import rings_picture
+        from ..block.io import MANIFEST, read_block, read_mokume
+        from ..detect.block import with_detected_rings
+        from ..detect.show import rings_picture
 
         folder = Path(args.block)
         if not folder.is_dir():

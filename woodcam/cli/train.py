@@ -1,11 +1,13 @@
-"""``woodcam train gtf``: train the generic neural growth-time model (§3.2.2 of seed 000)."""
+"""``woodcam train gtf``: train the generic neural growth-time model (§3.2.2 of seed 000);
+``woodcam train rings``: the small learned ring detector (:mod:`woodcam.detect.learned`)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 
-def add_parser(subparsers) -> None:
+def register(subparsers) -> None:
+    """Add ``train gtf`` and ``train rings``."""
     p = subparsers.add_parser("train", help="train a learned model (gtf: the generic neural growth field; "
                               "rings: the small ring detector)")
     p.add_argument("what", choices=["gtf", "rings"], help="which model to train")
@@ -21,7 +23,7 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     if args.what == "rings":
-        from .detect.learned import RingNetSpec, train_ring_net
+        from ..detect.learned import RingNetSpec, train_ring_net
 
         spec = RingNetSpec.load(args.spec) if args.spec is not None else RingNetSpec()
         if args.steps is not None:
@@ -32,7 +34,7 @@ def run(args) -> int:
         print(f"trained the ring net ({r['params']} parameters) {r['steps']} steps in {r['train_s']:.0f} s; "
               f"final loss {r['final_loss']:.4f}; wrote {args.out}")
         return 0
-    from .fields.neural import GTFSpec, train_gtf
+    from ..fields.neural import GTFSpec, train_gtf
 
     spec = GTFSpec.load(args.spec) if args.spec is not None else GTFSpec()
     r = train_gtf(spec, args.out, steps=args.steps, resume=not args.no_resume, progress=True)

@@ -1,0 +1,124 @@
+"""``woodcam demo``, ``bake``, ``preview`` and ``blocks``: carve a part, bake its wood, look at it."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .options import (BLOCK_SPEC_HELP, add_bake_options, allow_negative_values, stock_options,
+                      vector_mm, write_screenshot)
+
+
+def register(subparsers) -> None:
+    """Add ``demo``, ``bake``, ``preview`` and ``blocks``."""
+    p = subparsers.add_parser("demo", help="carve the example parts out of built-in blocks into --out",
+                              description="Carve, bake, export (GLB, OBJ+MTL+PNG) and render the "
+                              "example parts of cad_examples/ out of built-in synthetic blocks; "
+                              "print stage times.")
+    p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
+    p.add_argument("--quick", action="store_true", help="lower texture resolution (for CI)")
+    add_bake_options(p, texels_default=None, screenshot=False)
+    p.set_defaults(func=run_demo)
+
+    p = subparsers.add_parser("bake", help="carve a part out of a block and bake its wood texture",
+                              description="PART is a build123d/cadquery script defining `part`, "
+                              "or a STEP/STL/OBJ/GLB file, modelled in the block frame (mm).")
+    p.add_argument("part", help="part file (.py script, .step, .stl, .obj, .glb)")
+    p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
+    p.add_argument("--out", type=Path, required=True, help="output .glb path")
+    p.add_argument("--tolerance", type=float, default=None, metavar="MM",
+                   help="tessellation chord tolerance for B-rep parts (default 0.05 mm)")
+    p.add_argument("--place", action="append", default=[], metavar="OP",
+                   help="place the part in the block before carving; repeatable, applied in "
+                   "order: rotate:AXIS:DEG (about the part's centre), translate:X,Y,Z (mm), "
+                   "scale:S, center, drop (onto the bottom face), fit[:MARGIN] (scale into the "
+                   "block, default margin 2 mm). Turn the block instead with a spec ending in "
+                   "~AXIS90 (e.g. builtin:flat-sawn~z90)")
+    p.add_argument("--max-triangles", type=int, default=None, metavar="N",
+                   help="triangle budget for B-rep parts: above it the part is re-meshed with "
+                   "looser tolerances, and the summary says so (default 120000)")
+    add_bake_options(p)
+    p.set_defaults(func=run_bake)
+
+    p = subparsers.add_parser("preview", help="view a baked part (window, or --screenshot PNG)",
+                              description="Open a baked GLB/OBJ in a window with a cut-plane "
+                              "widget that shows the wood inside the block; --screenshot renders "
+                              "off-screen.")
+    p.add_argument("mesh", type=Path, help="baked .glb (or .obj)")
+    p.add_argument("--screenshot", type=Path, default=None, metavar="PNG",
+                   help="render to this PNG instead of opening a window")
+    p.add_argument("--block", default=None,
+                   help="block spec for the cut plane (default: the one stored in the GLB)")
+    p.add_argument("--camera", choices=("iso", "front", "back", "left", "right", "top", "bottom"),
+                   default="iso", help="view direction (default iso: from front-right-above)")
+    p.add_argument("--no-cut", action="store_true",
+                   help="no cut plane: the part alone in its translucent block")
+    p.add_argument("--cut-origin", type=vector_mm, default=None, metavar="X,Y,Z",
+                   help="a point of the cut plane, block frame mm (default the block centre)")
+    p.add_argument("--cut-normal", type=vector_mm, default=None, metavar="X,Y,Z",
+                   help="the cut plane's normal, towards the side cut away (default: the block's "
+                   "longest axis facing the camera)")
+    allow_negative_values(p)
+    p.set_defaults(func=run_preview)
+
+    p = subparsers.add_parser("blocks", help="list the built-in synthetic blocks")
+    p.set_defaults(func=run_blocks)
+
+
+def run_demo(args: argparse.Namespace) -> int:
+    from ..demo import run_demo as demo
+
+    report = demo(args.out, quick=args.quick, texels_per_mm=args.texels_per_mm,
+                  obj=not args.no_obj, **stock_options(args))
+    print(report.summary())
+    return 0
+
+
+def run_bake(args: argparse.Namespace) -> int:
+    from ..pipeline import check_outputs, preview_part
+    from ..stock import open_stock
+    from . import print_warnings
+
+    check_outputs(args.out, obj=not args.no_obj, screenshot=getattr(args, "screenshot", None) or False)
+    stock = open_stock(args.block, **stock_options(args))
+    res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
+                       tolerance_mm=args.tolerance, obj=not args.no_obj, screenshot=False,
+                       progress=True, obj_units=args.obj_units, obj_up=args.obj_up,
+                       max_triangles=args.max_triangles, max_atlas_px=args.max_atlas,
+                       place=args.place)
+    write_screenshot(args, res.files, stock)
+    print_warnings(res.warnings)
+    tess = res.tessellation
+    mesh_note = (f" (meshed at {tess['tolerance_mm']:.3g} mm / {tess['angular_tolerance_deg']:.3g}"
+                 " deg)" if tess.get("tolerance_mm") and tess.get("triangles") else "")
+    print(f"{res.name}: {res.triangles} triangles{mesh_note}, {res.volume_mm3:.0f} mm^3, "
+          f"{res.atlas}; wrote " + ", ".join(map(str, res.files.values())))
+    if res.report:
+        from ..advise import report_text
+
+        print(report_text(res.report, res.name))
+    return 0
+
+
+def run_preview(args: argparse.Namespace) -> int:
+    from ..view import preview
+    from .options import stock_of_glb
+
+    stock = stock_of_glb(args.mesh, args.block)
+    out = preview(args.mesh, wood=stock.wood if stock else None,
+                  size_mm=stock.size_mm if stock else None, screenshot=args.screenshot,
+                  camera=args.camera, cut_plane=not args.no_cut, cut_origin=args.cut_origin,
+                  cut_normal=args.cut_normal)
+    if out:
+        print(f"wrote {out}")
+    return 0
+
+
+def run_blocks(args: argparse.Namespace) -> int:
+    from ..fields.builtin import BUILTIN_NAMES, builtin_block
+
+    for name in BUILTIN_NAMES:
+        b = builtin_block(name)
+        W, D, H = b.size_mm
+        print(f"builtin:{name:<14} {W:g} x {D:g} x {H:g} mm  {b.species:<7} {b.description}")
+    return 0

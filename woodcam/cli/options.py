@@ -1,0 +1,216 @@
+"""Options and arguments several commands share: one definition each.
+
+- :func:`add_bake_options` / :func:`stock_options` / :func:`write_screenshot`: the bake options
+  of ``bake``, ``demo`` and ``gcode`` (texture resolution, species, appearance and its knot
+  colours, OBJ, screenshot), for any later command that bakes too.
+- :func:`add_block_argument` and :func:`open_block`: a block spec on the command line and the
+  one resolver behind every command that reads a block (:func:`woodcam.stock.open_block`).
+- :func:`command_group`: a command with sub-commands that several modules extend.
+
+Nothing heavy is imported at module level (``woodcam --help`` loads this module).
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+from pathlib import Path
+
+from ..errors import WoodcamError
+
+BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], a block folder "
+                   "(block.json) or a Mokume sample folder (a 50 mm cube unless --size-mm); "
+                   "append ~x90/~y90/~z90 to turn the block under the part")
+
+
+def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction:
+    """The sub-commands of command ``name``, created on first call (``kwargs`` go to
+    ``add_parser``), shared by later calls: ``eval rings`` and ``eval appearance`` live in two
+    modules but one ``eval`` group."""
+    groups = subparsers.__dict__.setdefault("_woodcam_groups", {})
+    if name not in groups:
+        p = subparsers.add_parser(name, **kwargs)
+        groups[name] = p.add_subparsers(dest=f"{name}_command", metavar="SUBCOMMAND")
+        groups[name].required = True
+    return groups[name]
+
+
+def add_block_argument(p: argparse.ArgumentParser, *, option: bool = True, nargs=None) -> None:
+    """``--block SPEC`` (required) or, with ``option=False``, a positional ``block``."""
+    if option:
+        p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
+    else:
+        p.add_argument("block", nargs=nargs, help=BLOCK_SPEC_HELP)
+
+
+def add_size_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--size-mm", type=float, default=None, metavar="MM",
+                   help="cube side in mm of a Mokume sample folder (its files carry no size; "
+                   "default 50)")
+
+
+def open_block(spec, size_mm: float | None = None, face_px: int = 256):
+    """``(block, field or None)`` for a block argument: :func:`woodcam.stock.open_block`."""
+    from ..stock import open_block as _open_block
+
+    return _open_block(str(spec), size_mm=size_mm, face_px=face_px)
+
+
+#: A value that looks like numbers ("-14,5,3", "-1e3") is a value, not an option.
+_NEGATIVE_VALUES = re.compile(r"^-[\d.][\d.,eE+-]*$")
+
+
+def allow_negative_values(p: argparse.ArgumentParser) -> None:
+    """Let options of ``p`` take values such as ``-14,5,3`` (argparse takes them for options)."""
+    p._negative_number_matcher = _NEGATIVE_VALUES
+
+
+def vector_mm(text: str) -> tuple[float, float, float]:
+    """``"X,Y,Z"`` -> three finite floats (argparse ``type``)."""
+    import math
+
+    try:
+        vals = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        vals = ()
+    if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
+        raise argparse.ArgumentTypeError(f"expected three finite numbers X,Y,Z; got {text!r}")
+    return vals  # type: ignore[return-value]
+
+
+def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None = 10.0,
+                     species: bool = True, screenshot: bool = True) -> None:
+    """The options of every command that bakes wood onto a mesh (``bake``, ``demo``, ``gcode``).
+
+    texels_default : the ``--texels-per-mm`` default (None: the command picks, e.g. demo's
+        ``--quick``). species : add ``--species``. screenshot : add ``--screenshot [PNG]``.
+    """
+    p.add_argument("--texels-per-mm", type=float, default=texels_default, metavar="T",
+                   help="texture resolution on the surface in texels per mm (default "
+                   + (f"{texels_default:g} = {1 / texels_default:g} mm texels)" if texels_default
+                      else "10, or 4 with --quick)"))
+    if species:
+        p.add_argument("--species", default=None,
+                       help="colour preset (oak, maple, walnut, cherry, pine, spruce); default: "
+                       "the block's")
+    p.add_argument("--appearance", choices=("colormap", "neural"), default="colormap",
+                   help="colormap: fast colour-of-ring model (default); neural: colour volumes "
+                   "learnt from the block's photos per axis (seed 000 sec. 3.3, cached on disk)")
+    p.add_argument("--quality", choices=("draft", "normal", "high"), default=None,
+                   help="training effort of the neural appearance (default normal)")
+    p.add_argument("--epochs", type=int, default=None, help="override the neural training epochs")
+    add_knot_options(p)
+    p.add_argument("--max-atlas", type=int, default=4096, metavar="PX",
+                   help="largest texture side in texels (default 4096, what every GPU takes); "
+                   "a part needing more gets a lower texel density, stated in the summary")
+    p.add_argument("--no-obj", action="store_true", help="write only the GLB, not OBJ+MTL+PNG")
+    p.add_argument("--obj-units", choices=("m", "mm"), default="m",
+                   help="length unit of the OBJ's coordinates (default m, what Blender and most "
+                   "viewers assume; mm for CAM tools). The GLB is always metres, Y up (glTF)")
+    p.add_argument("--obj-up", choices=("y", "z"), default="y",
+                   help="up axis of the OBJ (default y, the OBJ habit; z keeps the block frame)")
+    if screenshot:
+        p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
+                       help="also render the result off-screen to PNG (default name: OUT with "
+                       "_view.png; no display needed)")
+
+
+def add_knot_options(p: argparse.ArgumentParser) -> None:
+    """``--knot-darkening`` and ``--knot-outline``: :class:`woodcam.appearance.knots.KnotShading`
+    on the command line (``bake``, ``demo``, ``gcode``, ``log render``); defaults are its own."""
+    p.add_argument("--knot-darkening", default=None, metavar="ALIVE,DEAD",
+                   help="relative darkening of alive knot wood and the extra darkening of dead "
+                   "knot wood, each in [0, 1] (default 0.25,0.45)")
+    p.add_argument("--knot-outline", default=None, metavar="R,G,B",
+                   help="colour of the bark ring round dead knots, each in [0, 1] "
+                   "(default 0.16,0.10,0.06)")
+
+
+def knot_shading(args):
+    """The :class:`~woodcam.appearance.knots.KnotShading` the knot options ask for."""
+    from ..appearance.knots import KnotShading
+
+    changes = {}
+    if args.knot_darkening is not None:
+        changes["alive_darkening"], changes["dead_darkening"] = floats(
+            args.knot_darkening, 2, "--knot-darkening")
+    if args.knot_outline is not None:
+        changes["outline_rgb"] = floats(args.knot_outline, 3, "--knot-outline")
+    return KnotShading(**changes)
+
+
+def floats(text: str, n: int, option: str) -> tuple[float, ...]:
+    """``"a,b,..."`` -> n floats in [0, 1], or a WoodcamError naming the option."""
+    try:
+        vals = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        vals = ()
+    if len(vals) != n or not all(0.0 <= v <= 1.0 for v in vals):
+        raise WoodcamError(f"{option} takes {n} comma-separated numbers in [0, 1]; got {text!r}")
+    return vals
+
+
+def appearance_params(args) -> dict:
+    """The appearance keywords of :func:`woodcam.stock.open_stock` from the bake options:
+    ``knots`` (a KnotShading) for the colour map, ``quality``/``epochs`` for the neural one."""
+    knots = args.knot_darkening is not None or args.knot_outline is not None
+    if args.appearance != "neural":
+        if args.quality or args.epochs:
+            raise WoodcamError("--quality and --epochs apply to --appearance neural only; "
+                               f"got --appearance {args.appearance}")
+        return {"knots": knot_shading(args)} if knots else {}
+    if knots:
+        raise WoodcamError("--knot-darkening and --knot-outline apply to --appearance colormap "
+                           "only (the neural appearance learns knot colours from the photos)")
+    return {k: v for k, v in (("quality", args.quality), ("epochs", args.epochs)) if v is not None}
+
+
+def stock_options(args) -> dict:
+    """Every keyword of :func:`woodcam.stock.open_stock` the bake options carry."""
+    return {"species": getattr(args, "species", None), "appearance": args.appearance,
+            **appearance_params(args)}
+
+
+def write_screenshot(args, files: dict, stock) -> None:
+    """Render ``files["glb"]`` to ``--screenshot``'s PNG (or OUT_view.png) when asked."""
+    if not getattr(args, "screenshot", None):
+        return
+    from ..view import preview
+
+    out = Path(args.out)
+    png = out.with_name(out.stem + "_view.png") if args.screenshot is True else Path(args.screenshot)
+    preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
+    files["png"] = png
+
+
+def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None):
+    """The stock a baked GLB was cut from, as its metadata records it (absolute block spec,
+    content digest, species, appearance and its parameters), or ``block`` when given.
+
+    Returns None for a file that records no block and no ``block`` given (``preview`` then shows
+    the part alone). A recorded block that no longer exists, or whose content changed since the
+    bake, is named in an error or a warning."""
+    import warnings
+
+    from ..errors import WoodcamError, WoodcamWarning
+    from ..export import read_glb_metadata
+    from ..stock import open_stock, spec_digest
+
+    meta = read_glb_metadata(glb) if glb.suffix.lower() == ".glb" and glb.is_file() else {}
+    app = meta.get("appearance") if isinstance(meta.get("appearance"), dict) else {}
+    kwargs = {"species": species or app.get("species"),
+              "appearance": app.get("kind") or "colormap", **(app.get("params") or {})}
+    if block:
+        return open_stock(block, **{**kwargs, "species": species or kwargs["species"]})
+    spec = meta.get("block")
+    if not spec:
+        return None
+    base = str(spec).partition("~")[0]
+    if not base.startswith(("builtin:", "log:")) and not Path(base).exists():
+        raise WoodcamError(
+            f"{str(glb)!r} was baked from the block folder {base!r}, which is not there any more; "
+            "pass --block SPEC (the same block, moved) to rebuild its wood")
+    if meta.get("block_digest") and spec_digest(spec) != meta["block_digest"]:
+        warnings.warn(f"the block {spec!r} changed since {glb.name} was baked (its files differ); "
+                      "the wood shown is today's", WoodcamWarning, stacklevel=2)
+    return open_stock(spec, **kwargs)
