@@ -59,3 +59,17 @@ def test_missing_weights_are_named(tmp_path):
 
     with pytest.raises(WoodcamError, match="woodcam train rings"):
         load_ring_net(tmp_path)
+
+
+@pytest.mark.slow
+def test_committed_net_on_heldout_synthetic_faces():
+    """Measured (README): F within 2 px 0.99 on the 48 faces of seeds 1000-1007."""
+    from woodcam.detect.evaluate import EVAL_SEEDS, score_synthetic, summary
+    from woodcam.detect.learned import detect_rings_learned
+    from woodcam.synth import ring_eval_faces
+
+    if not (MODELS_DIR / WEIGHTS_NAME).is_file():
+        pytest.skip("no committed ring net (woodcam train rings --out woodcam/models)")
+    faces = [f for s in EVAL_SEEDS[:2] for f in ring_eval_faces(s)]
+    s = summary(score_synthetic(faces, detector=lambda p, ppm: detect_rings_learned(p, px_per_mm=ppm)))
+    assert s["F@2"] >= 0.95 and s["chance F@2"] < 0.2, s
