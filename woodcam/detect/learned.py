@@ -275,8 +275,15 @@ def detect_rings_learned(photo: np.ndarray, *, px_per_mm: float | None = None, n
     p = ring_probability(photo, models_dir)
     pr = ndimage.gaussian_filter(p, 1.0, order=(1, 0))
     pc = ndimage.gaussian_filter(p, 1.0, order=(0, 1))
-    dn = pr * np.sin(base.normal_rad) + pc * np.cos(base.normal_rad)     # slope across the rings
-    polys = _contour_runs(dn, ndimage.gaussian_filter(p, 1.0) >= 0.35, 0.5 * base.wavelength_px)
+    sn, cn = np.sin(base.normal_rad), np.cos(base.normal_rad)
+    dn = pr * sn + pc * cn                                              # slope across the rings
+    # curvature across the rings: the ridge is where the slope is 0 and the curvature negative
+    # (a maximum of p; the slope is 0 in the valleys between rings too)
+    d2 = (ndimage.gaussian_filter(p, 1.0, order=(2, 0)) * sn * sn
+          + 2 * ndimage.gaussian_filter(p, 1.0, order=(1, 1)) * sn * cn
+          + ndimage.gaussian_filter(p, 1.0, order=(0, 2)) * cn * cn)
+    keep = (ndimage.gaussian_filter(p, 1.0) >= 0.35) & (d2 < 0)
+    polys = _contour_runs(dn, keep, 0.5 * base.wavelength_px)
     traces = [RingTrace(q) for q in polys]
     h, w = p.shape
     warnings = []
