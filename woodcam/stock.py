@@ -344,13 +344,8 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
 
 def _log_block_field(spec: str):
     """``log:LOG@K[:WxDxH]`` -> (block-frame field, size_mm, description)."""
-    from .fields import (
-        KnottedLogField,
-        block_at_knot,
-        place_block_in_log,
-        read_gran1,
-        read_log,
-    )
+    from .fields import KnottedLogField, block_at_knot, place_block_in_log
+    from .logs.io import read_gran1, read_log
 
     body = spec[len("log:"):]
     try:
