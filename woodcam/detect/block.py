@@ -15,10 +15,10 @@ in an editor), detecting again keeps that SVG, takes its traces as the face's ri
 the ring map from them; only faces whose SVG is untouched (or missing) are detected afresh.
 
 **Photo-only blocks elsewhere** (``fit``, ``bake``, ``eval``): :func:`with_detected_rings`
-detects the faces that have a photo but no rings, once, and caches the result under the user
-cache (``$WOODCAM_CACHE_DIR/detect`` or platformdirs' user cache ``woodcam/detect``), keyed by a
-hash of the photos, the block size and :data:`DETECT_VERSION`; the user's folder is never
-written to.
+detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
+folder of woodcam's cache (:mod:`woodcam._cache`: ``$WOODCAM_CACHE_DIR`` or platformdirs' user
+cache), one ``.npz`` keyed by a digest of the photos, the block size, the rule, the detector and
+:data:`DETECT_VERSION`; the user's folder is never written to.
 """
 
 from __future__ import annotations
@@ -26,14 +26,14 @@ from __future__ import annotations
 import copy
 import hashlib
 import json
-import os
-import tempfile
 import warnings
 from pathlib import Path
 from typing import Literal
 
 import numpy as np
 
+from .._atomic import atomic_path, write_text
+from .._cache import cache_dir, digest, load_or_build
 from ..block.block import Block, Face
 from ..errors import WoodcamError, WoodcamWarning
 from .knots import detect_knots
@@ -113,10 +113,7 @@ def _sha256(path: Path) -> str:
 
 
 def _atomic_json(path: Path, doc: dict) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        json.dump(doc, fh, indent=1)
-    os.replace(tmp, path)
+    write_text(path, json.dumps(doc, indent=1))
 
 
 def user_edited_faces(folder) -> dict[str, Path]:
@@ -204,9 +201,8 @@ def detect_folder(src, out, *, rule: BoundaryRule = "dark-centre", knots: bool =
             continue
         f = block.faces[name]
         face = Face(name, f.shape, traces=det_traces.get(name, []))
-        tmp = svg.with_name(f".{svg.name}.tmp")
-        write_traces_svg(face, tmp, photo_href=m["faces"][name].get("photo"))
-        os.replace(tmp, svg)
+        with atomic_path(svg) as tmp:
+            write_traces_svg(face, tmp, photo_href=m["faces"][name].get("photo"))
         m["faces"][name]["traces_svg"] = svg.name
         hashes[name] = _sha256(svg)
     det = m["meta"].setdefault("detection", {"detector": detector, "version": DETECT_VERSION, "rule": rule})
@@ -217,26 +213,6 @@ def detect_folder(src, out, *, rule: BoundaryRule = "dark-centre", knots: bool =
 
 
 # -- photo-only blocks for fit / bake / eval --------------------------------------------------------
-
-def detect_cache_dir() -> Path:
-    """``$WOODCAM_CACHE_DIR/detect``, else platformdirs' user cache ``woodcam/detect``."""
-    base = os.environ.get("WOODCAM_CACHE_DIR")
-    if base:
-        return Path(base) / "detect"
-    import platformdirs
-
-    return Path(platformdirs.user_cache_dir("woodcam")) / "detect"
-
-
-def _photos_key(block: Block, rule: str) -> str:
-    h = hashlib.sha256(json.dumps({"v": DETECT_VERSION, "rule": rule, "detector": DEFAULT_DETECTOR,
-                                   "size": list(block.size_mm)}).encode())
-    for name, f in block.faces.items():
-        if f.photo is not None:
-            h.update(name.encode())
-            h.update(np.ascontiguousarray(f.photo).tobytes())
-    return h.hexdigest()[:24]
-
 
 def photos_only(block: Block) -> Block:
     """A copy of ``block`` keeping only its face photos (no traces, ring maps or knot masks):
@@ -253,45 +229,79 @@ def needs_detection(block: Block) -> bool:
             and any(f.photo is not None for f in block.faces.values()))
 
 
+def _detection_key(block: Block, rule: str) -> str:
+    return digest("detect", DETECT_VERSION, rule, DEFAULT_DETECTOR, list(block.size_mm),
+                  {n: f.photo for n, f in block.faces.items() if f.photo is not None})
+
+
+def _save_detection(value, tmp: Path) -> None:
+    """One ``.npz``: per face its traces (vertices and lengths), ring map (uint16) and knot mask."""
+    faces, msgs = value
+    arrays = {"warnings": np.array(json.dumps(msgs))}
+    for n, f in faces.items():
+        pts = [t.points_px for t in f.traces]
+        arrays[f"{n}.points"] = np.concatenate(pts) if pts else np.zeros((0, 2))
+        arrays[f"{n}.lengths"] = np.array([len(q) for q in pts], np.int64)
+        if f.ring_map is not None:
+            arrays[f"{n}.ring_map"] = np.round(np.clip(f.ring_map, 0, 1) * 65535).astype(np.uint16)
+        if "knot_mask" in f.extras:
+            arrays[f"{n}.knot_mask"] = np.asarray(f.extras["knot_mask"], bool)
+    with open(tmp, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
+
+
+def _load_detection(path: Path):
+    from ..block.block import RingTrace
+
+    with np.load(path) as z:
+        msgs = json.loads(str(z["warnings"]))
+        names = sorted({k.split(".")[0] for k in z.files if "." in k})
+        faces = {}
+        for n in names:
+            cuts = np.cumsum(z[f"{n}.lengths"])[:-1]
+            traces = [RingTrace(q) for q in np.split(z[f"{n}.points"], cuts) if len(q) >= 2]
+            rm = z[f"{n}.ring_map"].astype(np.float32) / 65535 if f"{n}.ring_map" in z.files else None
+            extras = {"knot_mask": z[f"{n}.knot_mask"]} if f"{n}.knot_mask" in z.files else {}
+            faces[n] = (traces, rm, extras)
+    return faces, msgs
+
+
 def with_detected_rings(block: Block, rule: BoundaryRule = "dark-centre", *, cache: bool = True,
                         progress: bool = False) -> Block:
     """``block`` itself when it has rings; otherwise a copy with rings and knots detected on its
-    photos, computed once and cached by content (module docstring). Warnings naming faces are
-    issued as :class:`~woodcam.errors.WoodcamWarning`."""
-    from ..block.io import read_block, write_block
-
+    photos, computed once and cached by content (module docstring; :mod:`woodcam._cache`).
+    Warnings naming faces are issued as :class:`~woodcam.errors.WoodcamWarning` each time."""
     if not needs_detection(block):
         return block
-    path = detect_cache_dir() / _photos_key(block, rule)
-    if cache and (path / "block.json").is_file():
-        cached = read_block(path)
-        out = copy.copy(block)
-        out.faces = {n: Face(n, f.shape, photo=block.faces[n].photo, traces=f.traces, ring_map=f.ring_map,
-                             extras={**block.faces[n].extras, **f.extras})
-                     for n, f in cached.faces.items()}
-        out.meta = {**block.meta, "detection": cached.meta.get("detection", {})}
-        for w in cached.meta.get("detection_warnings", []):
-            warnings.warn(w, WoodcamWarning, stacklevel=2)
-        return out
-    out, msgs = detect_block(block, rule=rule, progress=progress)
+
+    def build():
+        out, msgs = detect_block(block, rule=rule, progress=progress)
+        return ({n: f for n, f in out.faces.items() if n in out.meta["detection"]["faces"]}, msgs)
+
+    if cache:
+        path = cache_dir("detect") / f"{block.name}-{_detection_key(block, rule)}.npz"
+        raw, hit = load_or_build(path, load=_load_detection, build=build, save=_save_detection,
+                                 what="ring detection")
+        if not hit:
+            raw = ({n: (f.traces, f.ring_map, {k: v for k, v in f.extras.items() if k == "knot_mask"})
+                    for n, f in raw[0].items()}, raw[1])
+    else:
+        faces, msgs = build()
+        raw = ({n: (f.traces, f.ring_map, {k: v for k, v in f.extras.items() if k == "knot_mask"})
+                for n, f in faces.items()}, msgs)
+    faces, msgs = raw
+    out = copy.copy(block)
+    out.faces = dict(block.faces)
+    for n, (traces, ring_map, extras) in faces.items():
+        f = block.faces[n]
+        out.faces[n] = Face(n, f.shape, photo=f.photo, traces=list(traces), ring_map=ring_map,
+                            extras={**f.extras, **extras})
+    out.meta = {**block.meta, "detection": {"detector": DEFAULT_DETECTOR, "version": DETECT_VERSION,
+                                            "rule": rule, "faces": sorted(faces)}}
     for w in msgs:
         warnings.warn(w, WoodcamWarning, stacklevel=2)
-    if cache:
-        slim = Block(out.size_mm, faces={n: Face(n, f.shape, traces=f.traces, ring_map=f.ring_map,
-                                                 extras={k: v for k, v in f.extras.items() if k == "knot_mask"})
-                                         for n, f in out.faces.items()},
-                     name=out.name, meta={"detection": out.meta["detection"], "detection_warnings": msgs})
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}."))
-        write_block(slim, tmp)
-        try:
-            os.replace(tmp, path)          # atomic publish of the whole folder
-        except OSError:                    # another process published it first
-            import shutil
-
-            shutil.rmtree(tmp, ignore_errors=True)
     return out
 
 
-__all__ = ["DEFAULT_DETECTOR", "DETECTORS", "DETECT_VERSION", "Detector", "detect_block", "detect_cache_dir", "detect_face", "detect_folder",
+__all__ = ["DEFAULT_DETECTOR", "DETECTORS", "DETECT_VERSION", "Detector", "detect_block", "detect_face", "detect_folder",
            "needs_detection", "photos_only", "user_edited_faces", "with_detected_rings"]
