@@ -81,7 +81,7 @@ def register(subparsers) -> None:
                        "Mokume folder is detected first (cached).")
     s.add_argument("block", type=Path, help="block folder (after 'rings detect') or Mokume sample folder")
     s.add_argument("--out", type=Path, required=True, help="PNG to write")
-    s.add_argument("--zoom", type=int, default=2, help="enlargement, whole number (default 2)")
+    s.add_argument("--zoom", type=int, default=2, help="enlargement: picture pixels per face pixel, a whole number (default 2)")
     s.add_argument("--size-mm", type=float, default=None, help="cube side in mm for a Mokume folder (default 50)")
 
 
