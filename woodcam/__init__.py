@@ -38,6 +38,7 @@ _EXPORTS = {
     ".toolpath": ["Program", "SimResult", "Tool", "load_tool_table", "parse_tool_spec",
                   "read_gcode", "simulate"],
     ".view": ["SceneOptions", "preview"],
+    ".woodify": ["Brush", "GrowthSpeed", "Woodification", "WoodifiedField"],  # woodify.woodify()
 }
 _WHERE = {name: mod for mod, names in _EXPORTS.items() for name in names}
 
