@@ -30,7 +30,11 @@ def run(args) -> int:
             from dataclasses import replace
 
             spec = replace(spec, steps=args.steps)
-        r = train_ring_net(spec, args.out, progress=True)
+        from ..synth.rings import ring_training_faces
+
+        # the training faces come from woodcam's own synthesis (synth sits above detect)
+        x, y = ring_training_faces(spec, progress=True)
+        r = train_ring_net(spec, x, y, args.out, progress=True)
         print(f"trained the ring net ({r['params']} parameters) {r['steps']} steps in {r['train_s']:.0f} s; "
               f"final loss {r['final_loss']:.4f}; wrote {args.out}")
         return 0
