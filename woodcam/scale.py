@@ -3,7 +3,8 @@
 :func:`run_many` calls ``fn(key)`` once for every key and keeps one small JSON record per key in
 ``out_dir/records/<key>.json``::
 
-    {"key": "b000042", "status": "ok", "attempts": 1, "seconds": 9.81, "result": {...}}
+    {"key": "b000042", "status": "ok", "attempts": 1, "seconds": 9.81, "cpu_s": 9.6,
+     "result": {...}}
     {"key": "b000043", "status": "failed", "attempts": 3, "seconds": 0.02,
      "error": "ValueError: the message"}
 
@@ -91,16 +92,13 @@ class RunSummary:
 # -- records --------------------------------------------------------------------------------------
 
 def write_json_atomic(path, obj) -> Path:
-    """Write ``obj`` as JSON to ``path`` atomically: a temp file in the same folder, fsync, then
-    ``os.replace``, so a reader (or a run killed half-way) sees the old file or the whole new
-    one, never a part."""
+    """Write ``obj`` as JSON to ``path`` atomically (:func:`woodcam._atomic.write_text`: a hidden
+    temp file in the same folder, fsync, ``os.replace``), so a reader, or a run killed half-way,
+    sees the old file or the whole new one, never a part."""
+    from ._atomic import write_text
+
     path = Path(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "w") as fh:
-        json.dump(obj, fh, separators=(",", ":"), allow_nan=True)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    write_text(path, json.dumps(obj, separators=(",", ":")))
     return path
 
 
@@ -172,20 +170,21 @@ def _attempt(fn: Callable[[str], Any], key: str, retries: int, memory_limit_mb: 
 
     if limit_process:
         _limit_worker(memory_limit_mb)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     error = ""
     for attempt in range(1, retries + 2):
         try:
             with threadpool_limits(1):
                 result = fn(key)
             return {"key": key, "status": "ok", "attempts": attempt,
-                    "seconds": time.perf_counter() - t0, "result": result}
+                    "seconds": time.perf_counter() - t0, "cpu_s": time.process_time() - c0,
+                    "result": result}
         except Exception as err:  # noqa: BLE001 - any task error becomes a failed record
             tb = traceback.extract_tb(err.__traceback__)
             where = f" (at {Path(tb[-1].filename).name}:{tb[-1].lineno})" if tb else ""
             error = f"{type(err).__name__}: {err}{where}"
     return {"key": key, "status": "failed", "attempts": retries + 1,
-            "seconds": time.perf_counter() - t0, "error": error}
+            "seconds": time.perf_counter() - t0, "cpu_s": time.process_time() - c0, "error": error}
 
 
 # -- the driver -----------------------------------------------------------------------------------
@@ -261,7 +260,7 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir, engine: Engine =
     keys = _check_keys(keys)
     out_dir = Path(out_dir)
     (out_dir / RECORDS_DIR).mkdir(parents=True, exist_ok=True)
-    for stale in (out_dir / RECORDS_DIR).glob(".*.tmp"):  # temp files of a killed run
+    for stale in (out_dir / RECORDS_DIR).glob(".*.tmp*"):  # temp files of a killed run
         stale.unlink(missing_ok=True)
     done_before = _finished_keys(out_dir)
     todo = [k for k in keys if k not in done_before]
