@@ -211,7 +211,7 @@ def _check_address(address: str) -> str:
 def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir, engine: Engine = "local",
              address: str | None = None, workers: int | None = None, retries: int = 2, *,
              memory_limit_mb: int | None = DEFAULT_MEMORY_LIMIT_MB, progress: bool = True,
-             desc: str = "tasks") -> RunSummary:
+             connect_timeout_s: float = CONNECT_TIMEOUT_S, desc: str = "tasks") -> RunSummary:
     """Run ``fn(key)`` for every key not already done, writing one record per key.
 
     Parameters
@@ -224,7 +224,8 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir, engine: Engine =
     engine : "local" | "dask"
     address : str, optional
         ``engine="dask"`` only: a running scheduler (``tcp://host:port``); unreachable within
-        :data:`CONNECT_TIMEOUT_S` s gives a :class:`WoodcamError`.
+        ``connect_timeout_s`` (default :data:`CONNECT_TIMEOUT_S`) seconds gives a
+        :class:`WoodcamError`.
     workers : int, optional
         Worker processes (local: default 2, 1 = serial in this process; dask without address:
         default 2). With an address the cluster sets it; passing it is an error.
@@ -266,6 +267,10 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir, engine: Engine =
     todo = [k for k in keys if k not in done_before]
     skipped = len(keys) - len(todo)
 
+    client = cluster = None
+    if todo and engine == "dask":  # connect first: a bad address fails before any progress bar
+        client, cluster = _dask_client(address, workers, memory_limit_mb, connect_timeout_s)
+
     from tqdm.auto import tqdm
 
     bar = tqdm(total=len(keys), initial=skipped, desc=desc, unit="task", smoothing=0.1,
@@ -288,9 +293,13 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir, engine: Engine =
             n_workers = 2 if workers is None else workers
             _run_local(fn, todo, n_workers, retries, memory_limit_mb, finish)
         else:
-            n_workers = _run_dask(fn, todo, address, workers, retries, memory_limit_mb, finish)
+            n_workers = _run_dask(client, fn, todo, retries, finish)
     finally:
         bar.close()
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
     return RunSummary(out_dir, engine, n_workers, len(keys), skipped, counts["ok"],
                       counts["failed"], time.perf_counter() - t0)
 
@@ -321,62 +330,62 @@ def _run_local(fn, todo, n_workers, retries, memory_limit_mb, finish) -> None:
             f"or raise the memory limit") from err
 
 
-def _run_dask(fn, todo, address, workers, retries, memory_limit_mb, finish) -> int:
+def _dask_client(address, workers, memory_limit_mb, connect_timeout_s):
+    """``(client, cluster or None)``: a client of the scheduler at ``address``, or of a new
+    loopback LocalCluster of ``workers`` single-threaded processes."""
     from .errors import require
 
     require("distributed", "scale", "running tasks on Dask")
-    from distributed import Client, LocalCluster, as_completed
+    from distributed import Client, LocalCluster
 
-    cluster = None
     if address is None:
         cluster = LocalCluster(
             n_workers=2 if workers is None else workers, threads_per_worker=1, processes=True,
             host="127.0.0.1", dashboard_address=None,
             memory_limit=f"{memory_limit_mb}MiB" if memory_limit_mb else 0)
-        client = Client(cluster)
-    else:
-        try:
-            client = Client(address, timeout=CONNECT_TIMEOUT_S)
-        except (OSError, TimeoutError) as err:
-            raise WoodcamError(
-                f"address: no Dask scheduler answered at {address} within {CONNECT_TIMEOUT_S:g} s "
-                f"({type(err).__name__}); start one with `dask scheduler` and `dask worker "
-                f"{address}`, or leave --address out to run a local 2-worker cluster") from err
+        return Client(cluster), cluster
     try:
-        n = len(client.scheduler_info(n_workers=-1)["workers"]) if address else (workers or 2)
-        window = max(4 * max(n, 1), 16)  # bounded in-flight futures, so 1e5 keys stay cheap
-        it = iter(todo)
-        pending = as_completed()
+        return Client(address, timeout=connect_timeout_s), None
+    except (OSError, TimeoutError) as err:
+        raise WoodcamError(
+            f"address: no Dask scheduler answered at {address} within {connect_timeout_s:g} s "
+            f"({type(err).__name__}); start one with `dask scheduler` and `dask worker "
+            f"{address}`, or leave --address out to run a local 2-worker cluster") from err
 
-        key_of = {}
 
-        def submit(key):
-            # limit_process: one torch thread (the nanny already sets OMP/BLAS variables to 1);
-            # the memory cap is the nanny's memory_limit, not an rlimit on someone's worker.
-            fut = client.submit(_attempt, fn, key, retries, None, True, pure=False,
-                                key=f"woodcam-{key}-{os.getpid()}-{time.time_ns()}")
-            key_of[fut.key] = key
-            pending.add(fut)
+def _run_dask(client, fn, todo, retries, finish) -> int:
+    """Submit ``todo`` to ``client`` with a bounded window of futures; returns the worker count."""
+    from distributed import as_completed
 
-        for key in [k for _, k in zip(range(window), it)]:
-            submit(key)
-        for fut in pending:
-            key = key_of.pop(fut.key)
-            try:
-                rec = fut.result()
-            except Exception as err:  # noqa: BLE001 - a worker lost (KilledWorker), cancelled
-                rec = {"key": key, "status": "failed", "attempts": 1, "seconds": 0.0,
-                       "error": f"{type(err).__name__}: {err}"}
-            fut.release()
-            finish(rec)
-            nxt = next(it, None)
-            if nxt is not None:
-                submit(nxt)
-        return n
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+    n = len(client.nthreads())
+    window = max(4 * max(n, 1), 16)  # bounded in-flight futures, so 1e5 keys stay cheap
+    it = iter(todo)
+    pending = as_completed()
+    key_of = {}
+
+    def submit(key):
+        # limit_process: one torch thread (the nanny already sets OMP/BLAS variables to 1); the
+        # memory cap is the nanny's memory_limit, not an rlimit on someone else's worker.
+        fut = client.submit(_attempt, fn, key, retries, None, True, pure=False,
+                            key=f"woodcam-{key}-{os.getpid()}-{time.time_ns()}")
+        key_of[fut.key] = key
+        pending.add(fut)
+
+    for key in [k for _, k in zip(range(window), it)]:
+        submit(key)
+    for fut in pending:
+        key = key_of.pop(fut.key)
+        try:
+            rec = fut.result()
+        except Exception as err:  # noqa: BLE001 - a worker lost (KilledWorker), cancelled
+            rec = {"key": key, "status": "failed", "attempts": 1, "seconds": 0.0, "cpu_s": 0.0,
+                   "error": f"{type(err).__name__}: {err}"}
+        fut.release()
+        finish(rec)
+        nxt = next(it, None)
+        if nxt is not None:
+            submit(nxt)
+    return n
 
 
 __all__ = ["DEFAULT_MEMORY_LIMIT_MB", "ENGINES", "Engine", "RECORDS_DIR", "RunSummary",

@@ -157,6 +157,8 @@ def add_engine_options(p: argparse.ArgumentParser) -> None:
                    "process; not with --address)")
     p.add_argument("--memory-limit-mb", type=int, default=None, metavar="MB",
                    help="memory per worker in MiB (default 3072)")
+    p.add_argument("--connect-timeout-s", type=float, default=None, metavar="S",
+                   help="seconds to wait for the scheduler at --address (default 10)")
 
 
 def engine_options(args) -> dict:
@@ -167,4 +169,6 @@ def engine_options(args) -> dict:
            "address": args.address, "workers": args.workers}
     if args.memory_limit_mb is not None:
         out["memory_limit_mb"] = args.memory_limit_mb
+    if args.connect_timeout_s is not None:
+        out["connect_timeout_s"] = args.connect_timeout_s
     return out
