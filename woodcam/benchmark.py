@@ -342,11 +342,13 @@ def _markdown(s: dict, run: dict) -> str:
                       "any year <= 2 mm | coverage 1 mm |", "|---|---|---|---|---|---|"]
             for m, r in rows.items():
                 lines.append(f"| {m} | " + " | ".join(_fmt(r[k]) for k in METRICS) + " |")
-            lines += ["", "Paired Wilcoxon signed-rank tests (two-sided p; mean difference in "
-                      "percentage points):", "",
-                      "| pair | same year 1 mm | same year 2 mm | any year 1 mm | any year 2 mm |",
-                      "|---|---|---|---|---|"]
-            for pair, t in s["tests"][label][kind].items():
+            pairs = s["tests"].get(label, {}).get(kind, {})  # none with a single method
+            if pairs:
+                lines += ["", "Paired Wilcoxon signed-rank tests (two-sided p; mean difference in "
+                          "percentage points):", "",
+                          "| pair | same year 1 mm | same year 2 mm | any year 1 mm | any year 2 mm |",
+                          "|---|---|---|---|---|"]
+            for pair, t in pairs.items():
                 lines.append(f"| {pair} | " + " | ".join(
                     "n/a" if math.isnan(t[k]["p"]) else f"{t[k]['mean_diff']:+.1f}, p = {t[k]['p']:.2g}"
                     for k in ("matched_1", "matched_2", "unmatched_1", "unmatched_2")) + " |")
