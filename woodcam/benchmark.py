@@ -1,4 +1,5 @@
-"""Benchmarks at scale: seed 000's Table 1 on thousands of synthetic blocks, and its report.
+"""Synthetic work at scale: seed 000's Table 1 on thousands of blocks and its report, block sets
+and the neural model's training set, each as many independent tasks of :mod:`woodcam.scale`.
 
 One block is one task, keyed ``b000042`` (index 42), and :func:`bench_block` computes it from
 ``(seed, index, settings)`` alone: the block is drawn from ``np.random.default_rng([seed,
@@ -498,6 +499,55 @@ def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, k
     return summary, index
 
 
+# -- training sets at scale -----------------------------------------------------------------------
+
+#: Fields per shard of a training set: 256 x 1600 points is ~5 MB of float32, a few seconds.
+TRAINING_SHARD_FIELDS = 256
+
+
+def _training_shard_task(key: str, spec: dict, shard_fields: int, out_dir: str) -> dict:
+    """Write shard ``key`` (``shard_0003``) of the training set of ``spec`` as an npz."""
+    from ._atomic import atomic_path
+    from .fields.neural import GTFSpec, make_training_shard
+
+    sp = GTFSpec.from_dict(spec)
+    start = int(key.split("_")[1]) * shard_fields
+    stop = min(start + shard_fields, sp.n_fields)
+    pts, vals = make_training_shard(sp, start, stop)
+    with atomic_path(Path(out_dir) / f"{key}.npz") as tmp:
+        np.savez(tmp, points=pts, values=vals)
+    return {"start": start, "stop": stop}
+
+
+def make_training_set_many(spec, out_dir, *, shard_fields: int = TRAINING_SHARD_FIELDS,
+                           **run_options) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`woodcam.fields.neural.make_training_set` of ``spec`` made in shards of
+    ``shard_fields`` fields, one task each (:func:`woodcam.scale.run_many`; ``run_options`` go
+    there), written to ``out_dir/shard_NNNN.npz`` and concatenated: the same arrays, bit for bit,
+    resumable. With a Dask ``address`` the workers write the shards (a shared disk is needed).
+
+    Returns
+    -------
+    points : (N, M, 3) float32, values : (N, M) float32
+    """
+    from .scale import read_records, run_many
+
+    if not isinstance(shard_fields, int) or shard_fields < 1:
+        raise WoodcamError(f"shard_fields must be an integer >= 1; got {shard_fields!r}")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    n_shards = -(-spec.n_fields // shard_fields)
+    keys = [f"shard_{i:04d}" for i in range(n_shards)]
+    s = run_many(partial(_training_shard_task, spec=spec.to_dict(), shard_fields=shard_fields,
+                         out_dir=str(out.resolve())), keys, out / ".records",
+                 desc="training set shards", **run_options)
+    if s.failed:
+        bad = {k: r.get("error") for k, r in read_records(out / ".records").items() if r["status"] != "ok"}
+        raise WoodcamError(f"{s.failed} training-set shard(s) failed: {bad}; run again to retry them")
+    parts = [np.load(out / f"{k}.npz") for k in keys]
+    return (np.concatenate([p["points"] for p in parts]), np.concatenate([p["values"] for p in parts]))
+
+
 __all__ = ["DEFAULT_METHODS", "DEFAULT_SETTINGS", "METRICS", "PARTIAL_FACES", "bench_block",
            "bench_gallery", "bench_report", "bench_settings", "make_bench_block", "run_bench",
-           "summarise_bench", "write_benchmark_set"]
+           "make_training_set_many", "summarise_bench", "write_benchmark_set"]

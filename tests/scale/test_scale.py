@@ -273,3 +273,30 @@ def test_report_on_a_real_run_writes_tables_and_gallery(tmp_path):
     assert s["gallery"] == [1]  # the knotted block is the worst
     for f in ("report.json", "table1.png", "gallery/b000001_full.png", "gallery/b000001_faces.png"):
         assert (tmp_path / "rep" / f).stat().st_size > 1000, f
+
+
+# -- training sets --------------------------------------------------------------------------------
+
+def test_training_set_in_shards_is_bit_identical_and_trains_the_same(tmp_path):
+    import torch
+
+    from woodcam.benchmark import make_training_set_many
+    from woodcam.cli import main
+    from woodcam.fields.neural import GTFSpec, make_training_set
+
+    spec = GTFSpec(n_fields=40, points_per_field=50, steps=3, batch_fields=8, checkpoint_every=10,
+                   log_every=1)
+    pts, vals = make_training_set_many(spec, tmp_path / "shards", shard_fields=16, engine="local",
+                                       workers=2, progress=False)
+    ref = make_training_set(spec)
+    assert len(list((tmp_path / "shards").glob("shard_*.npz"))) == 3
+    np.testing.assert_array_equal(pts, ref[0])
+    np.testing.assert_array_equal(vals, ref[1])
+    # `woodcam train gtf --engine` trains the same weights as the plain command
+    spec.save(tmp_path / "spec.json")
+    for name, extra in (("plain", []), ("engine", ["--engine", "local", "--workers", "1"])):
+        assert main(["train", "gtf", "--spec", str(tmp_path / "spec.json"), "--out",
+                     str(tmp_path / name), *extra]) == 0
+    a, b = (torch.load(tmp_path / n / "gtf.pt", weights_only=True) for n in ("plain", "engine"))
+    assert all(torch.equal(a[k], b[k]) for k in a)
+    assert (tmp_path / "engine" / "trainset" / "shard_0000.npz").exists()
