@@ -140,27 +140,29 @@ def _finished_keys(out_dir: Path) -> set[str]:
 
 # -- the worker side ------------------------------------------------------------------------------
 
-_worker_ready = False
+_original_soft_as: int | None = None
 
 
 def _limit_worker(memory_limit_mb: int | None) -> None:
-    """Once per worker process: one thread per library, and an address-space cap."""
-    global _worker_ready
-    if _worker_ready:
-        return
+    """In a worker process, before each task: one thread per library, and the address-space
+    cap of this run (set every time: a reused loky worker may have served another run)."""
+    global _original_soft_as
+    import resource
+
     for var in _THREAD_VARS:
         os.environ[var] = "1"
     if "torch" in sys.modules:
         sys.modules["torch"].set_num_threads(1)
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    if _original_soft_as is None:
+        _original_soft_as = soft
+    want = _original_soft_as
     if memory_limit_mb:
-        import resource
-
-        limit = int(memory_limit_mb) * 1024 * 1024
-        soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+        want = int(memory_limit_mb) * 1024 * 1024
         if hard != resource.RLIM_INFINITY:
-            limit = min(limit, hard)
-        resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
-    _worker_ready = True
+            want = min(want, hard)
+    if want != soft:
+        resource.setrlimit(resource.RLIMIT_AS, (want, hard))
 
 
 def _attempt(fn: Callable[[str], Any], key: str, retries: int, memory_limit_mb: int | None,

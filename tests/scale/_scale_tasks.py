@@ -42,3 +42,9 @@ def spin(key: str, n: int) -> dict:
 def where(key: str) -> dict:
     """The process that ran the task (for the separate-cluster test only)."""
     return {"pid": os.getpid(), "value": value_of(key)}
+
+
+def hog(key: str, mb: int) -> dict:
+    """Allocates and touches ``mb`` MiB."""
+    buf = bytearray(mb * 1024 * 1024)
+    return {"n": len(buf)}

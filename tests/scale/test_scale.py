@@ -135,6 +135,20 @@ def test_raising_task_is_retried_then_recorded_failed_and_the_run_goes_on(tmp_pa
     assert (s2.skipped, s2.done, s2.failed) == (5, 0, 1)
 
 
+def test_memory_limit_per_local_worker(tmp_path):
+    s = run_many(partial(tasks.hog, mb=1500), ["k0"], tmp_path / "big", workers=2, retries=0,
+                 memory_limit_mb=1024, progress=False)
+    assert s.failed == 1
+    assert read_records(tmp_path / "big")["k0"]["error"].startswith("MemoryError")
+    s = run_many(partial(tasks.hog, mb=50), ["k0"], tmp_path / "small", workers=2, retries=0,
+                 memory_limit_mb=1024, progress=False)
+    assert s.done == 1
+    # the same (reused) worker processes, a larger limit: the big task fits now
+    s = run_many(partial(tasks.hog, mb=1500), ["k0"], tmp_path / "big2", workers=2, retries=0,
+                 memory_limit_mb=4096, progress=False)
+    assert s.done == 1
+
+
 def test_unreachable_address_is_one_clear_error(tmp_path):
     with pytest.raises(WoodcamError, match=r"address: no Dask scheduler answered at tcp://127\.0\.0\.1:9"):
         run_many(tasks.value_of, ["k1"], tmp_path, engine="dask", address="tcp://127.0.0.1:9",
