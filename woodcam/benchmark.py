@@ -227,17 +227,18 @@ def run_bench(out_dir, blocks: int, seed: int, settings: dict | None = None, *, 
                     desc="bench blocks", **run_options)
 
 
-def bench_gallery(seed: int, index: int, settings: dict, out_dir, *, thumbnail: bool = True) -> list[Path]:
-    """Regenerate block ``index`` from its seed, refit it and draw its cut planes (true rings in
-    black, each method's in colour) to ``out_dir/b000042_<face set>.png``; with ``thumbnail`` also
-    its faces as an unfolded cross ``b000042_faces.png``. Returns the files."""
+def bench_gallery(seed: int, index: int, settings: dict, out_dir, *, planes: bool = True,
+                  thumbnail: bool = True) -> list[Path]:
+    """Regenerate block ``index`` from its seed; with ``planes`` refit it and draw its cut planes
+    (true rings in black, each method's in colour) to ``out_dir/b000042_<face set>.png``; with
+    ``thumbnail`` draw its faces as an unfolded cross ``b000042_faces.png``. Returns the files."""
     from .block.render import save_cross_png
     from .inference.evaluate import plot_planes
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     block, kind, _ = make_bench_block(seed, index, settings)
-    _, _, scores = _fit_all(block, settings, keep_lines=True)
+    _, _, scores = _fit_all(block, settings, keep_lines=True) if planes else (None, None, {})
     files = []
     for label, by_method in scores.items():
         p = out / f"{bench_key(index)}_{label}.png"
@@ -387,6 +388,7 @@ def _plot(s: dict, path: Path) -> Path:
     methods = s["methods"]
     kinds = ("clear", "knotted")
     for ax, label in zip(axes[0], s["face_sets"]):
+        labelled = set()
         for j, (metric, hatch) in enumerate((("matched_1", ""), ("matched_2", "//"))):
             for i, m in enumerate(methods):
                 for k, kind in enumerate(kinds):
@@ -394,8 +396,10 @@ def _plot(s: dict, path: Path) -> Path:
                     if math.isnan(mean):
                         continue
                     x = k * (len(methods) + 1) + i + 0.4 * j
+                    name = f"{m} {'1' if j == 0 else '2'} mm"
                     ax.bar(x, mean, 0.4, color=f"C{i}", hatch=hatch, edgecolor="k", linewidth=0.3,
-                           label=f"{m} {'1' if j == 0 else '2'} mm" if k == 0 else None)
+                           label=None if name in labelled else name)
+                    labelled.add(name)
                     ax.errorbar(x, mean, [[mean - lo], [hi - mean]], color="k", capsize=2, lw=0.8)
         ax.set_xticks([k * (len(methods) + 1) + (len(methods) - 1) / 2 + 0.2 for k in range(len(kinds))])
         ax.set_xticklabels(kinds)
@@ -444,8 +448,8 @@ def bench_report(run_dir, out_dir, *, gallery: int = 3, thumbnails: int = 2, pro
     from tqdm.auto import tqdm
 
     for i in tqdm(picks + [i for i in sample if i not in picks], desc="gallery", unit="block",
-                  disable=not progress):
-        bench_gallery(run["seed"], i, run["settings"], out / "gallery", thumbnail=True)
+                  disable=not progress):  # the worst are refitted; the sample only drawn
+        bench_gallery(run["seed"], i, run["settings"], out / "gallery", planes=i in picks)
     s["gallery"] = picks
     return s
 

@@ -37,6 +37,7 @@ which is retried and then recorded as a failure); Dask workers get the same numb
 from __future__ import annotations
 
 import json
+import logging
 import os
 import re
 import sys
@@ -344,7 +345,10 @@ def _dask_client(address, workers, memory_limit_mb, connect_timeout_s):
         cluster = LocalCluster(
             n_workers=2 if workers is None else workers, threads_per_worker=1, processes=True,
             host="127.0.0.1", dashboard_address=None,
-            memory_limit=f"{memory_limit_mb}MiB" if memory_limit_mb else 0)
+            memory_limit=f"{memory_limit_mb}MiB" if memory_limit_mb else 0,
+            # the cluster's own log lines (and its shutdown races) would bury the progress bar;
+            # a task's errors come back in its record, a lost worker as a failed record
+            silence_logs=logging.CRITICAL)
         return Client(cluster), cluster
     try:
         return Client(address, timeout=connect_timeout_s), None
