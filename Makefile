@@ -9,7 +9,7 @@ BIN    := $(VENV)/bin
 NODE_DIR := .cache/node
 OUT    ?= out
 
-.PHONY: demo test bench slow clean
+.PHONY: demo test lint bench slow clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -35,8 +35,13 @@ $(NODE_DIR)/node_modules/gltf-validator/package.json:
 demo: $(VENV)/.demo-deps
 	$(BIN)/woodcam demo --out $(OUT)
 
+# Lint and type-check the package first (rules in pyproject.toml: [tool.ruff], [tool.mypy]).
+lint: $(VENV)/.dev-deps
+	$(BIN)/ruff check woodcam
+	$(BIN)/mypy
+
 # pytest exits 5 when it collects no test: that is a failure here, not a pass.
-test: $(VENV)/.dev-deps $(NODE_DIR)/node_modules/gltf-validator/package.json
+test: lint $(VENV)/.dev-deps $(NODE_DIR)/node_modules/gltf-validator/package.json
 	$(BIN)/python -m pytest; rc=$$?; \
 	if [ $$rc -eq 5 ]; then echo "make test: pytest collected no tests" >&2; exit 1; fi; exit $$rc
 
