@@ -314,3 +314,21 @@ def test_training_set_in_shards_is_bit_identical_and_trains_the_same(tmp_path):
     a, b = (torch.load(tmp_path / n / "gtf.pt", weights_only=True) for n in ("plain", "engine"))
     assert all(torch.equal(a[k], b[k]) for k in a)
     assert (tmp_path / "engine" / "trainset" / "shard_0000.npz").exists()
+
+
+def test_cli_bench_run_and_report(tmp_path, capsys):
+    from woodcam.cli import main
+
+    run, rep = str(tmp_path / "run"), str(tmp_path / "rep")
+    assert main(["bench", "run", "--blocks", "1", "--seed", "4", "--methods", "radial", "--knotted-fraction",
+                 "0", "--face-px", "64", "--workers", "1", "--quiet", "--out", run]) == 0
+    assert "1 keys: 0 already done, 1 computed, 0 failed" in capsys.readouterr().out
+    assert main(["bench", "run", "--blocks", "1", "--seed", "4", "--methods", "radial", "--knotted-fraction",
+                 "0", "--face-px", "64", "--workers", "1", "--quiet", "--out", run]) == 0
+    assert "1 keys: 1 already done, 0 computed" in capsys.readouterr().out
+    assert main(["bench", "report", run, "--out", rep, "--gallery", "0", "--thumbnails", "0", "--quiet"]) == 0
+    assert "1 blocks (1 clear, 0 knotted); full same year <= 1 mm: radial" in capsys.readouterr().out
+    assert main(["bench", "run", "--blocks", "1", "--methods", "radial,splines", "--out", run]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["woodcam: error: methods must be a comma-separated subset of rbf, radial, neural; "
+                   "got 'radial,splines'"]
