@@ -384,7 +384,7 @@ def _plot(s: dict, path: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, len(s["face_sets"]), figsize=(6 * len(s["face_sets"]), 4), squeeze=False)
+    fig, axes = plt.subplots(1, len(s["face_sets"]), figsize=(6 * len(s["face_sets"]), 4.6), squeeze=False)
     methods = s["methods"]
     kinds = ("clear", "knotted")
     for ax, label in zip(axes[0], s["face_sets"]):
@@ -406,7 +406,7 @@ def _plot(s: dict, path: Path) -> Path:
         ax.set_ylim(0, 100)
         ax.set_ylabel("% ring points within 1 / 2 mm (same year)")
         ax.set_title(f"{label}: mean over blocks, 95 % bootstrap CI")
-        ax.legend(fontsize=7, ncol=2, loc="lower left")
+        ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.08))
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
