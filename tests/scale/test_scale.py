@@ -160,7 +160,9 @@ def test_cli_bad_address_prints_one_line(tmp_path):
                         str(tmp_path), "--engine", "dask", "--address", "tcp://127.0.0.1:9",
                         "--connect-timeout-s", "2"],
                        env=_env(), capture_output=True, text=True, timeout=120)
-    assert r.returncode == 2
+    from woodcam.cli import EXIT_ERROR
+
+    assert r.returncode == EXIT_ERROR
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("woodcam: error: address: no Dask scheduler"), r.stderr
 
@@ -328,7 +330,9 @@ def test_cli_bench_run_and_report(tmp_path, capsys):
     assert "1 keys: 1 already done, 0 computed" in capsys.readouterr().out
     assert main(["bench", "report", run, "--out", rep, "--gallery", "0", "--thumbnails", "0", "--quiet"]) == 0
     assert "1 blocks (1 clear, 0 knotted); full same year <= 1 mm: radial" in capsys.readouterr().out
-    assert main(["bench", "run", "--blocks", "1", "--methods", "radial,splines", "--out", run]) == 2
+    from woodcam.cli import EXIT_ERROR
+
+    assert main(["bench", "run", "--blocks", "1", "--methods", "radial,splines", "--out", run]) == EXIT_ERROR
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["woodcam: error: methods must be a comma-separated subset of rbf, radial, neural; "
                    "got 'radial,splines'"]
