@@ -19,6 +19,7 @@ import importlib
 _EXPORTS = {
     ".appearance": ["SPECIES", "ColorMapAppearance", "Wood"],
     ".bake": ["BakeResult", "bake"],
+    ".benchmark": ["bench_block", "bench_report", "run_bench"],
     ".block": ["Block", "Face", "RingTrace", "read_block", "read_mokume", "write_block"],
     ".cad": ["CarveResult", "carve", "load_part"],
     ".detect": ["RingDetection", "detect_rings"],
@@ -33,6 +34,7 @@ _EXPORTS = {
     ".inference": ["benchmark", "evaluate_fit", "fit_block", "leave_one_face_out"],
     ".logs": ["GeneratedLog", "generate_log", "read_gran1", "read_log", "write_log"],
     ".pipeline": ["PartPreview", "preview_mesh", "preview_part"],
+    ".scale": ["RunSummary", "read_records", "run_many"],
     ".stock": ["Stock", "open_stock"],
     ".synth": ["cut_block", "synth_block"],
     ".toolpath": ["Program", "SimResult", "Tool", "load_tool_table", "parse_tool_spec",

@@ -35,6 +35,7 @@ COMMANDS: tuple[str, ...] = (
     "woodcam.cli.fit",           # fit, eval rings
     "woodcam.cli.appearance",    # eval appearance
     "woodcam.cli.train",         # train gtf | rings
+    "woodcam.cli.bench",         # bench run | report
     "woodcam.cli.woodify",       # woodify
 )
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .options import add_engine_options, engine_options
+
 
 def register(subparsers) -> None:
     """Add ``train gtf`` and ``train rings``."""
@@ -18,6 +20,7 @@ def register(subparsers) -> None:
                    "gtf_train_log.csv and the checkpoint; rings: rings_spec.json, rings.pt, rings_train_log.csv)")
     p.add_argument("--steps", type=int, default=None, help="stop after N steps in total (default: spec.steps)")
     p.add_argument("--no-resume", action="store_true", help="start over instead of resuming the checkpoint")
+    add_engine_options(p)  # with --engine: the training set is made in shards of 256 fields
     p.set_defaults(func=run)
 
 
@@ -41,7 +44,14 @@ def run(args) -> int:
     from ..fields.neural import GTFSpec, train_gtf
 
     spec = GTFSpec.load(args.spec) if args.spec is not None else GTFSpec()
-    r = train_gtf(spec, args.out, steps=args.steps, resume=not args.no_resume, progress=True)
+    training_set = None
+    if args.engine is not None or args.address is not None:
+        # the same training set, made in shards on an engine, kept in OUT/trainset/ (resumable)
+        from ..benchmark import make_training_set_many
+
+        training_set = make_training_set_many(spec, args.out / "trainset", **engine_options(args))
+    r = train_gtf(spec, args.out, steps=args.steps, resume=not args.no_resume, progress=True,
+                  training_set=training_set)
     print(f"trained {int(r['step'][-1]) if len(r['step']) else 0} steps in {r['train_s']:.0f} s; "
           f"final L1 {r['final_l1']:.5f} (normalised units), relative {100 * r['final_rel']:.2f} %; "
           f"wrote {args.out}")
