@@ -31,11 +31,14 @@ import math
 import time
 from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .errors import WoodcamError
+
+if TYPE_CHECKING:
+    from .scale import RunSummary
 
 #: Methods of :func:`woodcam.inference.fit.fit_block` a bench runs by default.
 DEFAULT_METHODS = ("rbf", "radial", "neural")
@@ -192,8 +195,8 @@ def _bench_task(key: str, seed: int, settings: dict) -> dict:
     return bench_block(seed, key_index(key), settings)
 
 
-def run_bench(out_dir, blocks: int, seed: int, settings: dict | None = None, *, start: int = 0,
-              **run_options):
+def run_bench(out_dir: str | Path, blocks: int, seed: int, settings: dict | None = None, *,
+              start: int = 0, **run_options: Any) -> "RunSummary":
     """Bench blocks ``start .. start + blocks - 1`` of ``seed`` into ``out_dir`` (resumable).
 
     ``settings`` override :data:`DEFAULT_SETTINGS` (see :func:`bench_settings`);
@@ -413,7 +416,7 @@ def _plot(s: dict, path: Path) -> Path:
     return path
 
 
-def bench_report(run_dir, out_dir, *, gallery: int = 3, thumbnails: int = 2, progress: bool = True) -> dict:
+def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, thumbnails: int = 2, progress: bool = True) -> dict:
     """Write ``report.md``, ``report.json`` and ``table1.png`` for a bench run folder into
     ``out_dir``, plus a failure gallery: the cut planes of the ``gallery`` worst blocks (same
     year within 1 mm, over all methods and face sets) and face thumbnails of ``thumbnails``

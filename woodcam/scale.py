@@ -107,7 +107,7 @@ def record_path(out_dir, key: str) -> Path:
     return Path(out_dir) / RECORDS_DIR / f"{key}.json"
 
 
-def read_records(out_dir) -> dict[str, dict]:
+def read_records(out_dir: str | Path) -> dict[str, dict]:
     """Every record of a run folder: ``key -> record`` (see the module docstring), sorted by key.
 
     Temp files left by a killed run start with a dot and are not records.
@@ -211,7 +211,7 @@ def _check_address(address: str) -> str:
     return address
 
 
-def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir, engine: Engine = "local",
+def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engine: Engine = "local",
              address: str | None = None, workers: int | None = None, retries: int = 2, *,
              memory_limit_mb: int | None = DEFAULT_MEMORY_LIMIT_MB, progress: bool = True,
              connect_timeout_s: float = CONNECT_TIMEOUT_S, desc: str = "tasks") -> RunSummary:
