@@ -27,8 +27,20 @@ from ..errors import WoodcamError
 #: a 2 mm seam segment bends < 0.2 mm, so 8 points keep chords within ~3 um of the curve.
 _FLATTEN = 8
 
+#: Shortest seam segment (pixels) written to a cut file (see _line_segments).
+_MIN_SEG_PX = 0.5
+
+#: A join between two segments counts as a corner when the tangent turns by more than this
+#: (sine of the angle): seams are C1 in theory, and 1e-5 mm rounding of handles about 0.5 mm
+#: long turns them by < 1e-4.
+_CORNER_SIN = 0.01
+
+#: Points per segment when reading files back for raster checks: a 2 mm seam segment bent to
+#: a 2.5 mm radius then deviates < 0.3 um from its chords, far below a pixel.
+_READ_FLATTEN = 32
+
 #: What a disc of diameter min_piece_mm cannot reach, away from corners, is tolerated when it
-#: lies within this distance (mm) of what it can reach: seams bend no tighter than
+#: is thinner than twice this (mm) everywhere: seams bend no tighter than
 #: min_piece_mm / 2, so only the flattening of curves (chords within ~3 um) and the disc's
 #: polygon (32 segments a quarter: 2.5 mm * (1 - cos(pi / 128)) = 0.8 um) remain; a sliver or
 #: neck thinner than min_piece_mm sticks out by its own length, far more than this.
@@ -60,7 +72,10 @@ class Piece:
 def _line_segments(line, a: float, b: float, ppm: float, axis: str) -> list:
     """Béziers of a seam line from parameter a to b (pixels), in mm; exact for the spline."""
     lo, hi = min(a, b), max(a, b)
-    ks = line.knots[(line.knots > lo + 1e-9) & (line.knots < hi - 1e-9)]
+    # Knots closer than _MIN_SEG_PX to an end are dropped: a sliver segment's handles would be
+    # shorter than the files' rounding and its tangent meaningless. The Hermite cubic over the
+    # merged interval then departs from the spline by far less than a micrometre.
+    ks = line.knots[(line.knots > lo + _MIN_SEG_PX) & (line.knots < hi - _MIN_SEG_PX)]
     ts = np.concatenate([[lo], ks, [hi]])
     segs = []
     for t0, t1 in zip(ts[:-1], ts[1:]):
@@ -161,15 +176,21 @@ def flatten(segs: list, n: int = _FLATTEN) -> np.ndarray:
     return np.concatenate(pts)
 
 
-def _corners(segs: list) -> list[np.ndarray]:
-    """Points where the outline's tangent jumps (segment ends that are not smooth joins)."""
+def _corners(segs: list, orient: float) -> list[tuple[np.ndarray, float]]:
+    """Corners of an outline: ``[(point (2,), interior angle rad)]`` where the tangent jumps;
+    ``orient`` is the sign of the outline's signed area. Convex corners have angle < pi."""
     out = []
     for a, b in zip(segs, segs[1:] + segs[:1]):
         ta = a[-1] - a[-2]
         tb = b[2] - b[1]
         na, nb = np.linalg.norm(ta), np.linalg.norm(tb)
-        if na < 1e-12 or nb < 1e-12 or float(np.dot(ta, tb)) / (na * nb) < 0.9999:
-            out.append(np.asarray(b[1], float))
+        if na < 1e-12 or nb < 1e-12:
+            continue
+        cr = float(ta[0] * tb[1] - ta[1] * tb[0]) / (na * nb)
+        dot = float(np.dot(ta, tb)) / (na * nb)
+        if abs(cr) > _CORNER_SIN or dot < 0:
+            turn = np.arctan2(abs(cr), dot)
+            out.append((np.asarray(b[1], float), np.pi - turn if orient * cr > 0 else np.pi + turn))
     return out
 
 
@@ -180,7 +201,8 @@ def _signed_area(poly: np.ndarray) -> float:
 
 def check_piece(segs: list, min_piece_mm: float, tool_radius_mm: float) -> list[str]:
     """Fabricability problems of one outline (empty list: fine). See module docstring."""
-    from shapely.geometry import Polygon
+    from shapely.geometry import Point, Polygon
+    from shapely.ops import unary_union
 
     problems = []
     poly = flatten(segs)
@@ -188,6 +210,7 @@ def check_piece(segs: list, min_piece_mm: float, tool_radius_mm: float) -> list[
     if not shp.is_valid or shp.area <= 0:
         return ["outline is not a simple closed curve"]
     r = min_piece_mm / 2.0
+    orient = np.sign(_signed_area(poly))
     inner = shp.buffer(-r * (1 - 1e-6))
     if inner.is_empty or inner.geom_type != "Polygon":
         problems.append(f"narrower than min_piece_mm = {min_piece_mm:g} mm (a disc of that "
@@ -200,19 +223,20 @@ def check_piece(segs: list, min_piece_mm: float, tool_radius_mm: float) -> list[
 
         opened = inner.buffer(r * (1 - 1e-6), quad_segs=32)
         lost = shp.difference(opened)
-        corners = [Point(*q) for q in _corners(segs)]
-        parts = getattr(lost, "geoms", [lost])
-
-        def depth(g) -> float:
-            return max(opened.distance(Point(v)) for v in g.exterior.coords)
-
-        thin = [g for g in parts if g.area > 1e-4 and not any(g.distance(c) < 1e-3 for c in corners)
-                and depth(g) > WIDTH_DEPTH_TOL_MM]
-        if thin:
-            problems.append(f"{sum(g.area for g in thin):.2f} mm^2 of it is narrower than "
+        # A disc of radius r cannot reach the tip of a convex corner of interior angle theta:
+        # between straight edges that tip lies within r / tan(theta / 2) of the corner; seams
+        # bending outward next to it (no tighter than r) add at most about another r.
+        # Anything else it cannot reach is narrower than min_piece_mm (a sliver, a tongue).
+        tips = [Point(*q).buffer(r / np.tan(th / 2) + r + WIDTH_DEPTH_TOL_MM)
+                for q, th in _corners(segs, orient) if th < np.pi]
+        reach = opened.union(unary_union(tips)) if tips else opened
+        thin = lost.difference(reach)
+        thin_parts = [g for g in getattr(thin, "geoms", [thin])
+                      if g.area > 1e-4 and not g.buffer(-WIDTH_DEPTH_TOL_MM).is_empty]
+        if thin_parts:
+            problems.append(f"{sum(g.area for g in thin_parts):.2f} mm^2 of it is narrower than "
                             f"min_piece_mm = {min_piece_mm:g} mm away from its corners")
     # Concave bends: orientation sign s = +1 for a counter-clockwise outline in a y-up sense.
-    orient = np.sign(_signed_area(poly))
     worst = np.inf
     t = np.linspace(0, 1, 17)
     for s in segs:
@@ -236,8 +260,7 @@ def check_piece(segs: list, min_piece_mm: float, tool_radius_mm: float) -> list[
         if na < 1e-12 or nb < 1e-12:
             continue
         cr = (ta[0] * tb[1] - ta[1] * tb[0]) / (na * nb)
-        dot = float(np.dot(ta, tb) / (na * nb))
-        if orient * cr < -1e-3 and dot < 0.9999:
+        if orient * cr < -_CORNER_SIN:
             worst = 0.0
     if tool_radius_mm > 0 and worst < CURVATURE_SLACK * tool_radius_mm:
         problems.append(f"concave bend of radius {worst:.2f} mm, tighter than the tool radius "
@@ -259,7 +282,7 @@ def tool_path(segs: list, tool_radius_mm: float) -> np.ndarray:
 
 # -- SVG ------------------------------------------------------------------------------------
 def _fmt(p) -> str:
-    return f"{p[0]:.4f},{p[1]:.4f}"
+    return f"{p[0]:.5f},{p[1]:.5f}"
 
 
 def path_d(segs: list) -> str:
@@ -318,7 +341,7 @@ def read_svg_pieces(path) -> dict[int, np.ndarray]:
                     continue
                 if isinstance(seg, svgelements.Close):
                     continue
-                ts = np.linspace(0, 1, _FLATTEN, endpoint=False)
+                ts = np.linspace(0, 1, _READ_FLATTEN, endpoint=False)
                 pts.extend([(q.x, q.y) for q in (seg.point(t) for t in ts)])
             out[int(str(el.id).split("-", 1)[1])] = np.array(pts)
     return out
@@ -398,7 +421,7 @@ def read_dxf_pieces(path, height_mm: float) -> dict[int, np.ndarray]:
         if not layer.startswith("PIECE_"):
             continue
         pid = int(layer.split("_", 1)[1])
-        v = [(q.x, height_mm - q.y) for q in dpath.make_path(e).flattening(0.005)]
+        v = [(q.x, height_mm - q.y) for q in dpath.make_path(e).flattening(0.0005)]
         pts.setdefault(pid, []).append(v)
     out = {}
     for pid, chains in pts.items():
@@ -413,11 +436,19 @@ def read_dxf_pieces(path, height_mm: float) -> dict[int, np.ndarray]:
 def rasterise(polys: dict[int, np.ndarray], shape_hw, px_per_mm: float) -> np.ndarray:
     """How many outlines cover each pixel centre: ``(h, w)`` int (pixel (r, c) centred at
     ``((c + 0.5), (r + 0.5)) / px_per_mm`` mm)."""
-    from skimage.draw import polygon
+    from skimage.measure import points_in_poly
 
     n = np.zeros(shape_hw, np.int32)
+    h, w = shape_hw
     for poly in polys.values():
         q = poly * px_per_mm - 0.5
-        rr, cc = polygon(q[:, 1], q[:, 0], shape_hw)
-        n[rr, cc] += 1
+        # Exact crossing-number test on the pixel centres of the bounding box (skimage.draw's
+        # polygon is approximate within a fraction of a pixel of the outline).
+        c0, r0 = np.maximum(np.floor(q.min(0)).astype(int), 0)
+        c1, r1 = np.minimum(np.ceil(q.max(0)).astype(int) + 1, (w, h))
+        if c1 <= c0 or r1 <= r0:
+            continue
+        rr, cc = np.mgrid[r0:r1, c0:c1]
+        inside = points_in_poly(np.c_[cc.ravel(), rr.ravel()].astype(float), q).reshape(rr.shape)
+        n[r0:r1, c0:c1] += inside
     return n

@@ -200,8 +200,7 @@ def build_parquetry(targets, veneers: list[Veneer], params: ParquetryParams | No
     src_vals = np.concatenate([g[v.mask] for g, v in zip(grey, sheets)])
     if src_vals.size > 2_000_000:   # the CDF needs no more samples than this
         src_vals = src_vals[np.random.default_rng(0).choice(src_vals.size, 2_000_000, replace=False)]
-    feats = [features(g, params.w_intens, params.w_edge) for g in grey]
-    bank = SheetBank(feats, [v.mask for v in sheets], params.n_rot,
+    bank = SheetBank(grey, [v.mask for v in sheets], params.w_intens, params.w_edge, params.n_rot,
                      kerf_px=params.kerf * params.px_per_mm, mode=params.mode,
                      coarse_factor=params.coarse_factor, top_k=params.top_k,
                      single_use=params.single_use)

@@ -30,7 +30,7 @@ from typing import Literal
 import numpy as np
 
 from ..errors import WoodcamError
-from .features import rotate, rotation_matrix
+from .features import features, rotate, rotation_matrix
 
 MatchMode = Literal["exhaustive", "fast"]
 
@@ -60,16 +60,16 @@ class _Atlas:
 
         self.f = f
         tiles = []                      # (sheet, rot, feats, usable, affine)
-        for i, (F, U) in enumerate(zip(bank.feats, bank.usable)):
-            if f > 1:
-                h, w = F.shape[:2]
-                hc, wc = max(1, h // f), max(1, w // f)
-                Fc = cv2.resize(F, (wc, hc), interpolation=cv2.INTER_AREA)
-                Uc = cv2.resize(U.astype(np.float32), (wc, hc), interpolation=cv2.INTER_AREA) > 1 - 1e-4
-            else:
-                Fc, Uc = F, U
+        for i, (G, U) in enumerate(zip(bank.grey, bank.usable)):
             for j, a in enumerate(bank.angles_deg):
-                Fr, Ur, m = rotate(Fc, Uc, a)
+                # eq. 3: the features of the rotated sheet (not the rotated features)
+                Gr, Ur, m = rotate(G, U, a)
+                Fr = bank.features(Gr)
+                if f > 1:
+                    h, w = Fr.shape[:2]
+                    hc, wc = max(1, h // f), max(1, w // f)
+                    Fr = cv2.resize(_lowpass(Fr, f), (wc, hc), interpolation=cv2.INTER_AREA)
+                    Ur = cv2.resize(Ur.astype(np.float32), (wc, hc), interpolation=cv2.INTER_AREA) > 1 - 1e-4
                 tiles.append((i, j, Fr, Ur, m))
         # Shelf packing, rows about as wide as the square root of the total area.
         pad = 1
@@ -136,11 +136,21 @@ class _Atlas:
         """Mark the pixels of every tile of ``sheet`` whose centres lie in the polygon."""
         for k in self._by_sheet.get(sheet, []):
             _, _, y0, x0, h, w, m = self.tiles[k]
-            # Sheet pixel coords at this level: coarse pixel centre c maps to full f*c + (f-1)/2.
-            p = (poly_sheet_px - (self.f - 1) / 2.0) / self.f
-            q = p @ m[:, :2].T + m[:, 2]
+            # Rotated full-resolution frame, then coarse: full pixel x sits in coarse pixel
+            # (x - (f - 1) / 2) / f.
+            q = poly_sheet_px @ m[:, :2].T + m[:, 2]
+            q = (q - (self.f - 1) / 2.0) / self.f
             rr, cc = _polygon_pixels(q, (h, w))
             self.blocked[y0 + rr, x0 + cc] = 1
+
+
+def _lowpass(F: np.ndarray, f: int) -> np.ndarray:
+    """Gaussian low-pass (sigma f / 2) before downsampling by f: the coarse search compares
+    what survives a misalignment of up to half a coarse pixel, so a texture's fine, periodic
+    detail (latewood lines) does not make the true place look bad at the wrong phase."""
+    import cv2
+
+    return cv2.GaussianBlur(F, (0, 0), f / 2.0, borderType=cv2.BORDER_REPLICATE)
 
 
 def _ssd(image: np.ndarray, template: np.ndarray, sq_sums: np.ndarray | None = None) -> np.ndarray:
@@ -184,8 +194,9 @@ class SheetBank:
 
     Parameters
     ----------
-    feats : list of (h, w, 2) float32 feature maps (eq. 1), one per sheet, working resolution
+    grey : list of (h, w) float32 sheet intensities, working resolution
     usable : list of (h, w) bool
+    w_intens, w_edge : feature weights of eq. 1
     n_rot : number of rotations, angles ``360 k / n_rot`` degrees (eq. 3)
     kerf_px : wood lost round every footprint (pixels): two footprints stay this far apart
     mode : "exhaustive" or "fast"
@@ -194,14 +205,16 @@ class SheetBank:
     single_use : False gives the unconstrained matcher (wood may be reused; an upper bound)
     """
 
-    def __init__(self, feats, usable, n_rot: int = 15, kerf_px: float = 0.0,
+    def __init__(self, grey, usable, w_intens: float = 0.5, w_edge: float = 0.5,
+                 n_rot: int = 15, kerf_px: float = 0.0,
                  mode: MatchMode = "fast", coarse_factor: int = 4, top_k: int = 12,
                  single_use: bool = True, max_atlas_bytes: int = 2_500_000_000):
         if mode not in ("exhaustive", "fast"):
             raise WoodcamError(f"mode must be one of ['exhaustive', 'fast']; got {mode!r}")
         if n_rot < 1:
             raise WoodcamError(f"n_rot must be >= 1; got {n_rot}")
-        self.feats = [np.ascontiguousarray(f, np.float32) for f in feats]
+        self.grey = [np.ascontiguousarray(g, np.float32) for g in grey]
+        self.w_intens, self.w_edge = float(w_intens), float(w_edge)
         self.usable = [np.asarray(u, bool) for u in usable]
         self.taken = [~u for u in self.usable]
         self.angles_deg = [360.0 * k / n_rot for k in range(n_rot)]
@@ -210,14 +223,18 @@ class SheetBank:
         self.f = 1 if mode == "exhaustive" else max(1, int(coarse_factor))
         self.top_k = top_k
         self.single_use = single_use
-        est = sum(f.shape[0] * f.shape[1] for f in self.feats) * n_rot * 2.0 * 13 / self.f ** 2
+        est = sum(g.shape[0] * g.shape[1] for g in self.grey) * n_rot * 2.0 * 13 / self.f ** 2
         if est > max_atlas_bytes:
             raise WoodcamError(
                 f"the {mode} search would hold ~{est / 1e9:.1f} GB of rotated sheets (limit "
                 f"{max_atlas_bytes / 1e9:.1f} GB); use mode 'fast', fewer rotations, or a lower "
                 "working resolution (px_per_mm)")
         self.atlas = _Atlas(self, self.f)
-        self._rot = [[rotation_matrix(f.shape[:2], a) for a in self.angles_deg] for f in self.feats]
+        self._rot = [[rotation_matrix(g.shape[:2], a) for a in self.angles_deg] for g in self.grey]
+
+    def features(self, grey: np.ndarray) -> np.ndarray:
+        """Eq. 1 on a (rotated) sheet intensity: ``(h, w, 2)``."""
+        return features(grey, self.w_intens, self.w_edge)
 
     # -- geometry ---------------------------------------------------------------------------
     def footprint(self, sheet: int, rot: int, x: float, y: float, th: int, tw: int) -> np.ndarray:
@@ -265,15 +282,13 @@ class SheetBank:
         if xb < xa or yb < ya:
             return []
         ww, hh = xb - xa + tw, yb - ya + th
+        roi = self._rotated_features(sheet, rot, xa, ya, ww, hh)
         mr = m.copy()
         mr[:, 2] -= (xa, ya)
-        F = self.feats[sheet]
         free = ~self.taken[sheet] if self.single_use else self.usable[sheet]
         if self.angles_deg[rot] % 360.0 == 0.0:
-            roi = F[ya:ya + hh, xa:xa + ww]
             u = free[ya:ya + hh, xa:xa + ww]
         else:
-            roi = cv2.warpAffine(F, mr, (ww, hh), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
             # Nearest-neighbour: a rotated pixel is free when the sheet pixel it sits on is;
             # the final word is is_free() in the sheet frame.
             u = cv2.warpAffine(free.astype(np.uint8), mr, (ww, hh), flags=cv2.INTER_NEAREST,
@@ -299,7 +314,7 @@ class SheetBank:
                 if not self.single_use or self.is_free(i, self.footprint(i, j, x, y, th, tw)):
                     return Match(i, j, x, y, c)
             return self._fallback(template) if cands else None
-        tc = cv2.resize(template, (max(1, round(tw / f)), max(1, round(th / f))),
+        tc = cv2.resize(_lowpass(template, f), (max(1, tw // f), max(1, th // f)),
                         interpolation=cv2.INTER_AREA)
         any_cands = False
         for k in (self.top_k, self.top_k * 16):
@@ -307,11 +322,10 @@ class SheetBank:
             any_cands = any_cands or bool(cands)
             found: list[tuple[float, int, int, int, int]] = []
             for t, xc, yc, _ in cands:
-                i, j, _, _, hc, wc, _ = self.atlas.tiles[t]
-                _, (H, W) = self._rot[i][j]
-                # Coarse pixel centre X sits at full resolution (X - cx_c) f + cx_f - (f - 1) / 2.
-                xf = int(round((xc - (wc - 1) / 2.0) * f + (W - 1) / 2.0 - (f - 1) / 2.0))
-                yf = int(round((yc - (hc - 1) / 2.0) * f + (H - 1) / 2.0 - (f - 1) / 2.0))
+                i, j = self.atlas.tiles[t][:2]
+                # Coarse tiles are the full rotated canvases downsampled: coarse pixel X
+                # covers full pixels f X .. f X + f - 1.
+                xf, yf = xc * f, yc * f
                 for c, x, y in self.exact_costs(i, j, xf, yf, f + 1, template)[:3]:
                     found.append((c, i, j, x, y))
             found.sort()
@@ -328,7 +342,7 @@ class SheetBank:
         boundary); slow but complete."""
         th, tw = template.shape[:2]
         best = None
-        for i in range(len(self.feats)):
+        for i in range(len(self.grey)):
             for j in range(len(self.angles_deg)):
                 _, (H, W) = self._rot[i][j]
                 r = max(H, W)
@@ -347,8 +361,26 @@ class SheetBank:
         return poly
 
     def patch_pixels(self, m: Match, th: int, tw: int) -> np.ndarray:
-        """The rotated sheet's features under a match, ``(th, tw, 2)`` (for rendering seams)."""
-        return self.warp_window(self.feats[m.sheet], m, th, tw)
+        """The rotated sheet's features under a match, ``(th, tw, 2)`` (for the seams)."""
+        return self._rotated_features(m.sheet, m.rot, m.x, m.y, tw, th)
+
+    def _rotated_features(self, sheet: int, rot: int, x0: int, y0: int, w: int, h: int) -> np.ndarray:
+        """Features (eq. 1) of the window ``[x0, x0 + w) x [y0, y0 + h)`` of the rotated sheet,
+        computed from the rotated intensity with a 1 px margin, so they equal the features of
+        the whole rotated sheet there (the Sobel filter is 3 x 3)."""
+        import cv2
+
+        m, _ = self._rot[sheet][rot]
+        mr = m.copy()
+        mr[:, 2] -= (x0 - 1, y0 - 1)
+        G = self.grey[sheet]
+        if self.angles_deg[rot] % 360.0 == 0.0:
+            # copy with the same replicated border the whole-sheet Sobel would see
+            pad = np.pad(G, 1, mode="edge")
+            g = pad[y0:y0 + h + 2, x0:x0 + w + 2]
+        else:
+            g = cv2.warpAffine(G, mr, (w + 2, h + 2), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
+        return np.ascontiguousarray(self.features(g)[1:-1, 1:-1])
 
     def warp_window(self, image: np.ndarray, m: Match, th: int, tw: int) -> np.ndarray:
         """Any per-sheet image (features, colour) of sheet ``m.sheet`` seen through the

@@ -8,7 +8,9 @@ column ``k - 1`` on its left; *horizontal lines* ``Y_m(x)`` likewise. Each line 
 dynamic programming over the whole panel (eq. 9: the cost of a boundary at b is the error of
 the left patch left of b plus the error of the right patch right of b), with the path moving at
 most one pixel per row (the paper's 6-connected cut). Where four patches overlap the two
-directions are alternated with the other fixed (the paper: two repetitions suffice).
+directions are alternated with the other fixed (the paper: two repetitions suffice); there the
+cuts run straight across, so crossings are near-right-angle corners (woodcam's addition for
+fabricability).
 
 For a router each path is then smoothed (Gaussian, which keeps it inside its band) until its
 radius of curvature is at least the tool radius and half of ``min_piece_mm`` everywhere, and represented by a cubic spline
@@ -82,17 +84,18 @@ def smooth_line(raw: np.ndarray, axis: str, index: int, min_radius_px: float) ->
         if min_radius_px <= 0 or _max_curvature(line) * min_radius_px <= 1.0:
             return line
         sigma *= 1.5
-    # A straight line at the mean always satisfies the bound (and stays in the band).
-    return _line_from(np.full(length, vals.mean()), axis, index, length, raw)
+    # A straight line at the rounded mean always satisfies the bound and stays in the band;
+    # an integer sits on pixel edges, never on the pixel centres the labels are taken at.
+    return _line_from(np.full(length, float(np.round(vals.mean()))), axis, index, length, raw)
 
 
 def straight_line(pos: float, axis: str, index: int, length: int) -> SeamLine:
     return _line_from(np.full(length, float(pos)), axis, index, length, np.full(length, int(round(pos))))
 
 
-def _dp(cost: np.ndarray) -> np.ndarray:
-    """Minimum path through ``cost (K, n, B)`` for K lines at once, moving <= 1 per step:
-    returns ``(K, n)`` int indices into B."""
+def _dp(cost: np.ndarray, frozen: np.ndarray | None = None) -> np.ndarray:
+    """Minimum path through ``cost (K, n, B)`` for K lines at once, moving <= 1 per step
+    (not at all into a step where ``frozen (n,)`` is True): returns ``(K, n)`` indices into B."""
     K, n, B = cost.shape
     acc = cost[:, 0].copy()
     back = np.zeros((K, n, B), np.int8)
@@ -100,6 +103,8 @@ def _dp(cost: np.ndarray) -> np.ndarray:
     for i in range(1, n):
         left = np.concatenate([np.full((K, 1), big), acc[:, :-1]], axis=1)
         right = np.concatenate([acc[:, 1:], np.full((K, 1), big)], axis=1)
+        if frozen is not None and frozen[i]:
+            left = right = np.full_like(acc, big)
         stack = np.stack([left, acc, right], axis=0)
         arg = np.argmin(stack, axis=0)
         back[:, i] = arg.astype(np.int8) - 1
@@ -181,7 +186,14 @@ def cut_seams(p, windows: dict, params, repetitions: int = 2):
             cl = np.concatenate([np.zeros((length, 1)), np.cumsum(eL, axis=1)], axis=1)
             cr = np.concatenate([np.cumsum(eR[:, ::-1], axis=1)[:, ::-1], np.zeros((length, 1))], axis=1)
             cost[li] = cl + cr
-        paths = _dp(cost) + lo
+        # Across the four-patch zones round the crossings the cut runs straight, so every
+        # crossing is a near-right-angle corner (a sharp one would leave a spike narrower than
+        # min_piece_mm); the alternation still chooses where along the band it crosses.
+        frozen = np.zeros(length, bool)
+        n_across = (rows if axis == "v" else cols)
+        for m in range(1, n_across):
+            frozen[max(0, m * c - o - 1):min(length, m * c + o + 1)] = True
+        paths = _dp(cost, frozen) + lo
         return [smooth_line((li + 1) * c + paths[li], axis, li + 1, min_r) for li in range(n_lines)]
 
     for _ in range(repetitions):
