@@ -30,6 +30,7 @@ COMMANDS: tuple[str, ...] = (
     "woodcam.cli.fit",           # fit, eval rings
     "woodcam.cli.appearance",    # eval appearance
     "woodcam.cli.train",         # train gtf
+    "woodcam.cli.parquetry",     # parquetry
 )
 
 #: Old spellings kept working: argv prefix -> its current form.

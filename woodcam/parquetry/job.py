@@ -199,3 +199,53 @@ def write_job(job: ParquetryJob, path) -> Path:
     d["sort_patches_saliency"] = job.params.priority == "saliency"
     d["woodcam"] = {"params": prm, "blocks": job.blocks, "mokume": job.mokume}
     return atomic_write_text(path, json.dumps(d, indent=2))
+
+
+def job_veneers(job: ParquetryJob, progress: bool = False) -> list:
+    """The job's veneer sheets: scans (``dpi / 25.4 * scale`` px/mm), Mokume photos and leaves
+    sliced from woodcam blocks (``{"spec", "sheets", "width_mm", "height_mm", "thickness_mm",
+    "kerf_mm", "axis", "species"}``), resampled later to the working resolution."""
+    from .veneers import MM_PER_INCH, load_scan, mokume_veneers, slice_veneers
+
+    out = []
+    for t in job.scans:
+        if "texture" not in t:
+            raise WoodcamError(f"source_textures entry {t} needs a 'texture' path")
+        if t.get("px_per_mm") is not None:
+            ppm = float(t["px_per_mm"])
+        elif t.get("dpi") is not None:
+            ppm = float(t["dpi"]) / MM_PER_INCH * float(t.get("scale", 1.0))
+        else:
+            raise WoodcamError(f"source texture {t['texture']!r} needs 'dpi' (or 'px_per_mm'); got neither")
+        out.append(load_scan(t["texture"], px_per_mm=ppm, mask=t.get("mask") or None, id=t.get("id")))
+    for m in job.mokume:
+        out += mokume_veneers(m)
+    for b in job.blocks:
+        from ..stock import open_stock
+
+        if "spec" not in b:
+            raise WoodcamError(f"woodcam.blocks entry {b} needs a 'spec' (e.g. builtin:flat-sawn)")
+        stock = open_stock(b["spec"], species=b.get("species"))
+        out += slice_veneers(stock, int(b.get("sheets", 2)),
+                             (float(b.get("width_mm", 600)), float(b.get("height_mm", 400))),
+                             thickness_mm=float(b.get("thickness_mm", 0.6)),
+                             kerf_mm=float(b.get("kerf_mm", 0.4)), px_per_mm=job.params.px_per_mm,
+                             axis=b.get("axis", "y"), progress=progress,
+                             id_prefix=b.get("id") or (stock.spec.replace(":", "-").replace("/", "-").strip("-.")
+                                                       + (f"-{b['species']}" if b.get("species") else "")))
+    return out
+
+
+def job_targets(job: ParquetryJob) -> tuple[list, list[str]]:
+    """The job's target images ``(h, w, 3)`` float RGB and their names (file stems)."""
+    from .veneers import read_image
+
+    imgs, names = [], []
+    for t in job.targets:
+        if "filename" not in t:
+            raise WoodcamError(f"targets entry {t} needs a 'filename'")
+        imgs.append(read_image(t["filename"], "target image"))
+        names.append(Path(t["filename"]).stem)
+    if len(set(names)) != len(names):
+        names = [f"{n}{k}" for k, n in enumerate(names)]
+    return imgs, names
