@@ -12,12 +12,26 @@ import numpy as np
 import pytest
 
 from woodcam.errors import WoodcamError
-from woodcam.parquetry import (ParquetryJob, ParquetryParams, Veneer, build_parquetry, feature_cost,
-                               load_scan, read_job, slice_veneers, write_job)
-from woodcam.parquetry.cutpaths import (check_piece, rasterise, read_dxf_pieces, read_svg_pieces,
-                                        read_svg_segments)
+from woodcam.parquetry import (
+    ParquetryJob,
+    ParquetryParams,
+    Veneer,
+    build_parquetry,
+    feature_cost,
+    load_scan,
+    read_job,
+    slice_veneers,
+    write_job,
+)
+from woodcam.parquetry.cutpaths import (
+    check_piece,
+    rasterise,
+    read_dxf_pieces,
+    read_svg_pieces,
+    read_svg_segments,
+)
 from woodcam.parquetry.features import rotate
-from woodcam.parquetry.output import write_outputs
+from woodcam.parquetry.output import write_parquetry
 
 PPM = 2.0        # working resolution of the small test runs (px/mm)
 
@@ -43,12 +57,12 @@ def finished(sheets, tmp_path_factory):
     prm = ParquetryParams(image_size_mm=70, px_per_mm=PPM)
     run = build_parquetry(target, sheets, prm)
     out = tmp_path_factory.mktemp("parq")
-    res = write_outputs(run, out)
+    res = write_parquetry(run, out)
     return run, out, res
 
 
 def test_run_is_complete_with_seams(finished):
-    run, out, res = finished
+    run, out, _res = finished
     assert run.complete and not run.message
     p = run.panels[0]
     assert p.cells.shape == (5, 5) and p.seams_v is not None and len(p.seams_v) == 4
@@ -70,7 +84,7 @@ def test_single_use_on_every_sheet_from_svg_and_dxf(finished):
         f_svg = out / f"veneer_{v.id}.svg"
         if not f_svg.exists():
             continue
-        W, H = v.size_mm
+        _W, H = v.size_mm
         h, w = v.mask.shape
         for polys in (read_svg_pieces(f_svg), read_dxf_pieces(out / f"veneer_{v.id}.dxf", H)):
             n = rasterise(polys, (h, w), v.px_per_mm)
@@ -163,7 +177,7 @@ def test_crop_of_a_veneer_is_rebuilt_from_that_crop(sheets, mode, patch_mm, rot)
     rgb, mask, _ = rotate(v.rgb, v.mask, angle)
     ys, xs = np.nonzero(mask)
     cy, cx = int(ys.mean()), int(xs.mean())
-    half = int(round(2 * patch_mm * PPM))          # 4 x 4 patches
+    half = round(2 * patch_mm * PPM)          # 4 x 4 patches
     crop = rgb[cy - half:cy + half, cx - half:cx + half]
     assert mask[cy - half:cy + half, cx - half:cx + half].all()
     prm = ParquetryParams(image_size_mm=4 * patch_mm, patch_mm=patch_mm, px_per_mm=PPM, w_hist=0.0,
@@ -199,7 +213,7 @@ def test_running_out_of_wood_stops_with_a_message_and_writes(sheets, tmp_path):
     run = build_parquetry(data.coffee().astype(np.float32) / 255, sheets[:1], prm)
     assert not run.complete
     assert f"placed {len(run.patches)} patches" in run.message
-    res = write_outputs(run, tmp_path, glb=False)
+    res = write_parquetry(run, tmp_path, glb=False)
     assert (tmp_path / "render.png").is_file() and res["summary"]["complete"] is False
     # what was placed still obeys single use
     v = run.veneers[0]

@@ -140,8 +140,14 @@ def run(args) -> int:
 
     from ..errors import WoodcamError
     from ..parquetry.engine import build_parquetry
-    from ..parquetry.job import ParquetryJob, job_targets, job_veneers, read_job, write_job
-    from ..parquetry.output import format_summary, write_outputs
+    from ..parquetry.job import (
+        ParquetryJob,
+        job_targets,
+        job_veneers,
+        read_job,
+        write_job,
+    )
+    from ..parquetry.output import format_summary, write_parquetry
 
     job = read_job(args.config) if args.config else ParquetryJob()
     over = {name: getattr(args, opt) for opt, name in _OPTION_PARAMS.items()
@@ -174,7 +180,7 @@ def run(args) -> int:
     veneers = job_veneers(job, progress=progress)
     run_ = build_parquetry(targets, veneers, job.params, names=names, progress=progress,
                            seams=not args.no_seams)
-    res = write_outputs(run_, args.out, glb=not args.no_glb, progress=progress)
+    res = write_parquetry(run_, args.out, glb=not args.no_glb, progress=progress)
     write_job(job, Path(args.out) / "job.json")
     print(format_summary(res["summary"], res["problems"]))
     print(f"wrote {len(res['files']) + 1} files to {args.out}")

@@ -8,10 +8,18 @@ Layers: :mod:`.veneers` (sheets: scans, slices of a woodcam Wood, Mokume photos)
 :mod:`.output` (the files of a run).
 """
 
-from .engine import Parquetry, ParquetryRun, Patch, build_parquetry, feature_cost, ssim_vs_matched
+from .engine import (
+           Parquetry,
+           ParquetryRun,
+           Patch,
+           build_parquetry,
+           feature_cost,
+           ssim_vs_matched,
+)
 from .job import ParquetryJob, ParquetryParams, read_job, write_job
+from .output import write_parquetry
 from .veneers import Veneer, load_scan, mokume_veneers, slice_veneers
 
 __all__ = ["Parquetry", "ParquetryJob", "ParquetryParams", "ParquetryRun", "Patch", "Veneer",
            "build_parquetry", "feature_cost", "load_scan", "mokume_veneers", "read_job",
-           "slice_veneers", "ssim_vs_matched", "write_job"]
+           "slice_veneers", "ssim_vs_matched", "write_job", "write_parquetry"]

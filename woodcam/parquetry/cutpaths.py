@@ -17,6 +17,7 @@ corners), and no concave stretch of its outline bends tighter than the tool radi
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -78,7 +79,7 @@ def _line_segments(line, a: float, b: float, ppm: float, axis: str) -> list:
     ks = line.knots[(line.knots > lo + _MIN_SEG_PX) & (line.knots < hi - _MIN_SEG_PX)]
     ts = np.concatenate([[lo], ks, [hi]])
     segs = []
-    for t0, t1 in zip(ts[:-1], ts[1:]):
+    for t0, t1 in itertools.pairwise(ts):
         h = t1 - t0
         v0, v1 = float(line(t0)), float(line(t1))
         d0, d1 = float(line.spline(t0, 1)), float(line.spline(t1, 1))
@@ -304,8 +305,8 @@ def svg_document(width_mm: float, height_mm: float, pieces: list[tuple[int, list
     ``engrave`` (piece ids at the centroids)."""
     from shapely.geometry import Polygon
 
-    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width_mm:.3f}mm" height="{height_mm:.3f}mm" '
-           f'viewBox="0 0 {width_mm:.4f} {height_mm:.4f}">', f"<title>{title}</title>"]
+    out = [(f'<svg xmlns="http://www.w3.org/2000/svg" width="{width_mm:.3f}mm" height="{height_mm:.3f}mm" '
+           f'viewBox="0 0 {width_mm:.4f} {height_mm:.4f}">'), f"<title>{title}</title>"]
     if background:
         out.append(background)
     out.append('<g id="cut" fill="none" stroke="#d00" stroke-width="0.2">')

@@ -136,13 +136,13 @@ def prepare_target(rgb: np.ndarray, params: ParquetryParams, source_values: np.n
         rgb = np.repeat(rgb[..., None], 3, axis=2)
     cell = params.patch_px
     h, w = rgb.shape[:2]
-    short_cells = max(1, int(round(params.image_size_mm / params.patch_mm)))
+    short_cells = max(1, round(params.image_size_mm / params.patch_mm))
     scale = short_cells * cell / min(h, w)
     if h <= w:
         rows, cols = short_cells, max(1, int(w * scale + 1e-6) // cell)
     else:
         rows, cols = max(1, int(h * scale + 1e-6) // cell), short_cells
-    nh, nw = int(round(h * scale)), int(round(w * scale))
+    nh, nw = round(h * scale), round(w * scale)
     nh, nw = max(nh, rows * cell), max(nw, cols * cell)
     img = cv2.resize(rgb, (nw, nh), interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_CUBIC)
     y0, x0 = (nh - rows * cell) // 2, (nw - cols * cell) // 2

@@ -64,7 +64,7 @@ def match_histogram(target_grey, source_values, w_hist: float) -> np.ndarray:
     ranks = np.empty_like(order)
     ranks[order] = np.arange(flat.size)
     # Equal grey levels share one quantile (their mean rank), so flat areas stay flat.
-    uniq, inv = np.unique(flat, return_inverse=True)
+    _uniq, inv = np.unique(flat, return_inverse=True)
     mean_rank = np.bincount(inv, weights=ranks) / np.bincount(inv)
     q = (mean_rank[inv] + 0.5) / flat.size
     eq = np.interp(q, (np.arange(s.size) + 0.5) / s.size, s).astype(np.float32)

@@ -72,7 +72,7 @@ class ParquetryParams:
     top_k: int = 12
     single_use: bool = True
 
-    def check(self) -> "ParquetryParams":
+    def check(self) -> ParquetryParams:
         """Validate at the door; returns self."""
         for name in ("w_intens", "w_edge", "w_hist"):
             v = getattr(self, name)
@@ -121,11 +121,11 @@ class ParquetryParams:
 
     @property
     def patch_px(self) -> int:
-        return int(round(self.patch_mm * self.px_per_mm))
+        return round(self.patch_mm * self.px_per_mm)
 
     @property
     def overlap_px(self) -> int:
-        return int(round(self.overlap * self.px_per_mm))
+        return round(self.overlap * self.px_per_mm)
 
 
 # The reference code's keys for Table 1 / sec. 3.2 parameters.

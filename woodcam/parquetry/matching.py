@@ -55,7 +55,7 @@ class Match:
 class _Atlas:
     """All rotated sheets of one pyramid level in one image (see module docstring)."""
 
-    def __init__(self, bank: "SheetBank", f: int):
+    def __init__(self, bank: SheetBank, f: int):
         import cv2
 
         self.f = f

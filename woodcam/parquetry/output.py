@@ -1,4 +1,4 @@
-"""The files of a parquetry run (see :func:`write_outputs`) and its printed summary."""
+"""The files of a parquetry run (see :func:`write_parquetry`) and its printed summary."""
 
 from __future__ import annotations
 
@@ -8,7 +8,14 @@ from pathlib import Path
 import numpy as np
 
 from ._io import atomic_write_png, atomic_write_text
-from .cutpaths import Piece, check_piece, panel_outlines, svg_document, transform_outline, write_dxf
+from .cutpaths import (
+    Piece,
+    check_piece,
+    panel_outlines,
+    svg_document,
+    transform_outline,
+    write_dxf,
+)
 from .engine import ParquetryRun, feature_cost, ssim_vs_matched
 
 #: Thickness (mm) of the board in panel.glb: 0.6 mm veneer on a 1.5 mm birch ply substrate,
@@ -87,7 +94,7 @@ def summary(run: ParquetryRun) -> dict:
     return out
 
 
-def write_outputs(run: ParquetryRun, out_dir, *, glb: bool = True, progress: bool = False) -> dict:
+def write_parquetry(run: ParquetryRun, out_dir, *, glb: bool = True, progress: bool = False) -> dict:
     """Write every file of a run into ``out_dir``; returns ``{"files": [...], "summary": {...},
     "problems": {...}}``.
 

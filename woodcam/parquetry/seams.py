@@ -90,7 +90,7 @@ def smooth_line(raw: np.ndarray, axis: str, index: int, min_radius_px: float) ->
 
 
 def straight_line(pos: float, axis: str, index: int, length: int) -> SeamLine:
-    return _line_from(np.full(length, float(pos)), axis, index, length, np.full(length, int(round(pos))))
+    return _line_from(np.full(length, float(pos)), axis, index, length, np.full(length, round(pos)))
 
 
 def _dp(cost: np.ndarray, frozen: np.ndarray | None = None) -> np.ndarray:

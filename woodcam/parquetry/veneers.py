@@ -58,7 +58,7 @@ class Veneer:
         h, w = self.rgb.shape[:2]
         return w / self.px_per_mm, h / self.px_per_mm
 
-    def resampled(self, px_per_mm: float) -> "Veneer":
+    def resampled(self, px_per_mm: float) -> Veneer:
         """The same sheet at another resolution (area-averaged down, bilinear up)."""
         import cv2
 
@@ -66,7 +66,7 @@ class Veneer:
             return self
         h, w = self.rgb.shape[:2]
         f = px_per_mm / self.px_per_mm
-        nw, nh = max(1, int(round(w * f))), max(1, int(round(h * f)))
+        nw, nh = max(1, round(w * f)), max(1, round(h * f))
         interp = cv2.INTER_AREA if f < 1 else cv2.INTER_LINEAR
         rgb = cv2.resize(self.rgb, (nw, nh), interpolation=interp)
         # A resampled pixel is usable only if all the wood it averages was usable.
@@ -186,7 +186,7 @@ def slice_veneers(stock, n_sheets: int, size_mm: tuple[float, float], *,
     if axis not in ("x", "y", "z"):
         raise WoodcamError(f"axis must be one of ['x', 'y', 'z']; got {axis!r}")
     w_mm, h_mm = size_mm
-    nw, nh = int(round(w_mm * px_per_mm)), int(round(h_mm * px_per_mm))
+    nw, nh = round(w_mm * px_per_mm), round(h_mm * px_per_mm)
     if nw < 1 or nh < 1:
         raise WoodcamError(f"size_mm must give at least one pixel at {px_per_mm} px/mm; got {size_mm}")
     ax = "xyz".index(axis)
