@@ -217,6 +217,7 @@ class SheetBank:
         self.w_intens, self.w_edge = float(w_intens), float(w_edge)
         self.usable = [np.asarray(u, bool) for u in usable]
         self.taken = [~u for u in self.usable]
+        self._unusable = [~u for u in self.usable]
         self.angles_deg = [360.0 * k / n_rot for k in range(n_rot)]
         self.kerf_px = float(kerf_px)
         self.mode = mode
@@ -285,14 +286,16 @@ class SheetBank:
         roi = self._rotated_features(sheet, rot, xa, ya, ww, hh)
         mr = m.copy()
         mr[:, 2] -= (xa, ya)
-        free = ~self.taken[sheet] if self.single_use else self.usable[sheet]
+        # Blocked = taken (which includes unusable wood) or, for the reuse matcher, unusable;
+        # only the window is touched, never the whole sheet.
+        blocked = self.taken[sheet] if self.single_use else self._unusable[sheet]
         if self.angles_deg[rot] % 360.0 == 0.0:
-            u = free[ya:ya + hh, xa:xa + ww]
+            u = ~blocked[ya:ya + hh, xa:xa + ww]
         else:
             # Nearest-neighbour: a rotated pixel is free when the sheet pixel it sits on is;
-            # the final word is is_free() in the sheet frame.
-            u = cv2.warpAffine(free.astype(np.uint8), mr, (ww, hh), flags=cv2.INTER_NEAREST,
-                               borderMode=cv2.BORDER_CONSTANT) > 0
+            # off the sheet counts as blocked. The final word is is_free() in the sheet frame.
+            u = cv2.warpAffine(blocked.view(np.uint8), mr, (ww, hh), flags=cv2.INTER_NEAREST,
+                               borderMode=cv2.BORDER_CONSTANT, borderValue=1) == 0
         cost = _ssd(np.ascontiguousarray(roi), template)
         ii = cv2.integral((~u).astype(np.uint8), sdepth=cv2.CV_32S)
         win = ii[th:, tw:] - ii[:-th, tw:] - ii[th:, :-tw] + ii[:-th, :-tw]
