@@ -5,7 +5,7 @@ degradation (sequential vs interleaved) on one sheet.
 Run as a benchmark (``pytest -m bench tests/bench/test_parquetry_bench.py``) or as a script
 that prints and stores the figures::
 
-    python tests/bench/test_parquetry_bench.py quality|speed|fig14 OUT.json
+    python tests/bench/test_parquetry_bench.py quality|speed|fig14 OUT.json [COARSE_FACTOR | IMAGES]
 
 Timings are CPU seconds of the matching (``time.process_time``), so they are comparable under
 the shared machine's load; wall seconds are stored too.
@@ -151,6 +151,10 @@ def test_fast_mode_within_5_percent_of_exhaustive_on_camera():
 if __name__ == "__main__":
     what, dest = sys.argv[1], Path(sys.argv[2])
     fn = {"quality": quality, "speed": speed, "fig14": fig14}[what]
-    res = fn()
+    extra = {}
+    if len(sys.argv) > 3:
+        extra = ({"coarse_factor": int(sys.argv[3])} if what == "speed"
+                 else {"images": tuple(sys.argv[3].split(","))})
+    res = fn(**extra)
     dest.write_text(json.dumps(res, indent=1))
     print(f"wrote {dest}")

@@ -304,3 +304,27 @@ def test_sheet_smaller_than_one_patch():
     v = Veneer("tiny", np.full((20, 20, 3), 0.5, np.float32), 2.0, np.ones((20, 20), bool))
     with pytest.raises(WoodcamError, match="'tiny' is 10.0 x 10.0 mm, smaller than one patch"):
         build_parquetry(np.zeros((50, 50, 3), np.float32), [v], ParquetryParams(px_per_mm=2.0))
+
+
+def test_adaptive_patches_with_seams_cover_once_and_use_wood_once(tmp_path):
+    """Mixed 14 and 28 mm pieces with seams: the cut files still tile the panel exactly and
+    never share wood."""
+    from skimage import data
+
+    from woodcam.stock import open_stock
+
+    sheets = (slice_veneers(open_stock("builtin:flat-sawn", species="walnut"), 1, (300, 200),
+                            px_per_mm=PPM, id_prefix="w")
+              + slice_veneers(open_stock("builtin:rift", species="maple"), 1, (300, 200),
+                              px_per_mm=PPM, id_prefix="m"))
+    img = data.astronaut()[:256, :256].astype(np.float32) / 255
+    run = build_parquetry(img, sheets, ParquetryParams(image_size_mm=112, px_per_mm=PPM, n_adaptive=1))
+    assert run.complete and {q.cells for q in run.patches} == {1, 2}
+    res = write_parquetry(run, tmp_path, glb=False)
+    assert res["problems"] == {}
+    n = rasterise(read_svg_pieces(tmp_path / "assembly.svg"), run.panels[0].matched.shape, PPM)
+    assert (n == 1).all()
+    for v in run.veneers:
+        f = tmp_path / f"veneer_{v.id}.svg"
+        if f.exists():
+            assert rasterise(read_svg_pieces(f), v.mask.shape, PPM).max() == 1
