@@ -5,7 +5,7 @@ degradation (sequential vs interleaved) on one sheet.
 Run as a benchmark (``pytest -m bench tests/bench/test_parquetry_bench.py``) or as a script
 that prints and stores the figures::
 
-    python tests/bench/test_parquetry_bench.py quality|speed|fig14 OUT.json [COARSE_FACTOR | IMAGES]
+    python tests/bench/test_parquetry_bench.py quality|speed|fig14|exhaustive OUT.json [COARSE_FACTOR | IMAGES]
 
 Timings are CPU seconds of the matching (``time.process_time``), so they are comparable under
 the shared machine's load; wall seconds are stored too.
@@ -65,7 +65,7 @@ def _figures(run, prm):
 
 
 def quality(images=("camera", "astronaut", "coffee", "chelsea"), size_mm=112.0, ppm=2.0,
-            exhaustive=("camera",)):
+            exhaustive=()):
     """Parquetry (fast, and exhaustive for ``exhaustive``) vs baseline vs reuse, per image."""
     import dataclasses
 
@@ -141,16 +141,36 @@ def fig14(size_mm=70.0, ppm=2.0, copies=7):
     return out
 
 
+def exhaustive_vs_fast(size_mm=70.0, ppm=2.0):
+    """Fast vs exhaustive on one workload small enough for the exhaustive search here: a
+    5 x 5-patch camera crop, one 200 x 150 mm leaf of each of six species + 12 Mokume faces."""
+    import dataclasses
+
+    from skimage import data
+
+    from woodcam.parquetry import ParquetryParams, build_parquetry
+
+    sheets = _sheets((200, 150), ppm, leaves=1)
+    img = data.camera()[40:300, 120:380].astype(np.float32) / 255
+    base = ParquetryParams(image_size_mm=size_mm, px_per_mm=ppm)
+    out = {"workload": f"camera crop at {size_mm:g} mm, {len(sheets)} sheets (12 Mokume faces + one "
+           f"200x150 mm leaf of six species), {ppm:g} px/mm, 15 rotations", "runs": {}}
+    for label, prm in (("fast", base), ("exhaustive", dataclasses.replace(base, mode="exhaustive"))):
+        run = build_parquetry([img], sheets, prm, seams=False)
+        out["runs"][label] = _figures(run, prm)
+        print(label, json.dumps(out["runs"][label]), flush=True)
+    return out
+
+
 def test_fast_mode_within_5_percent_of_exhaustive_on_camera():
-    res = quality(images=("camera",), size_mm=70.0)
-    r = res["images"]["camera"]
+    r = exhaustive_vs_fast()["runs"]
     assert r["fast"]["mean_patch_cost_px"] <= 1.05 * r["exhaustive"]["mean_patch_cost_px"]
     assert r["fast"]["cpu_s_per_patch"] < r["exhaustive"]["cpu_s_per_patch"]
 
 
 if __name__ == "__main__":
     what, dest = sys.argv[1], Path(sys.argv[2])
-    fn = {"quality": quality, "speed": speed, "fig14": fig14}[what]
+    fn = {"quality": quality, "speed": speed, "fig14": fig14, "exhaustive": exhaustive_vs_fast}[what]
     extra = {}
     if len(sys.argv) > 3:
         extra = ({"coarse_factor": int(sys.argv[3])} if what == "speed"

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import WoodcamError
+from ..tolerances import PARQUETRY_CORNER_SIN, PARQUETRY_CURVATURE_SLACK, PARQUETRY_WIDTH_TOL_MM
 
 #: Bézier segments are flattened at this many points for areas, offsets and raster checks;
 #: a 2 mm seam segment bends < 0.2 mm, so 8 points keep chords within ~3 um of the curve.
@@ -31,26 +32,9 @@ _FLATTEN = 8
 #: Shortest seam segment (pixels) written to a cut file (see _line_segments).
 _MIN_SEG_PX = 0.5
 
-#: A join between two segments counts as a corner when the tangent turns by more than this
-#: (sine of the angle): seams are C1 in theory, and 1e-5 mm rounding of handles about 0.5 mm
-#: long turns them by < 1e-4.
-_CORNER_SIN = 0.01
-
 #: Points per segment when reading files back for raster checks: a 2 mm seam segment bent to
 #: a 2.5 mm radius then deviates < 0.3 um from its chords, far below a pixel.
 _READ_FLATTEN = 32
-
-#: What a disc of diameter min_piece_mm cannot reach, away from corners, is tolerated when it
-#: is thinner than twice this (mm) everywhere: seams bend no tighter than
-#: min_piece_mm / 2, so only the flattening of curves (chords within ~3 um) and the disc's
-#: polygon (32 segments a quarter: 2.5 mm * (1 - cos(pi / 128)) = 0.8 um) remain; a sliver or
-#: neck thinner than min_piece_mm sticks out by its own length, far more than this.
-WIDTH_DEPTH_TOL_MM = 0.05
-
-#: A concave bend counts as tighter than the tool when its radius is below this fraction of
-#: the tool radius (the seams are smoothed to the full radius; this allows for the sampling
-#: of the curvature check).
-CURVATURE_SLACK = 0.98
 
 
 @dataclass
@@ -189,7 +173,7 @@ def _corners(segs: list, orient: float) -> list[tuple[np.ndarray, float]]:
             continue
         cr = float(ta[0] * tb[1] - ta[1] * tb[0]) / (na * nb)
         dot = float(np.dot(ta, tb)) / (na * nb)
-        if abs(cr) > _CORNER_SIN or dot < 0:
+        if abs(cr) > PARQUETRY_CORNER_SIN or dot < 0:
             turn = np.arctan2(abs(cr), dot)
             out.append((np.asarray(b[1], float), np.pi - turn if orient * cr > 0 else np.pi + turn))
     return out
@@ -228,12 +212,12 @@ def check_piece(segs: list, min_piece_mm: float, tool_radius_mm: float) -> list[
         # between straight edges that tip lies within r / tan(theta / 2) of the corner; seams
         # bending outward next to it (no tighter than r) add at most about another r.
         # Anything else it cannot reach is narrower than min_piece_mm (a sliver, a tongue).
-        tips = [Point(*q).buffer(r / np.tan(th / 2) + r + WIDTH_DEPTH_TOL_MM)
+        tips = [Point(*q).buffer(r / np.tan(th / 2) + r + PARQUETRY_WIDTH_TOL_MM)
                 for q, th in _corners(segs, orient) if th < np.pi]
         reach = opened.union(unary_union(tips)) if tips else opened
         thin = lost.difference(reach)
         thin_parts = [g for g in getattr(thin, "geoms", [thin])
-                      if g.area > 1e-4 and not g.buffer(-WIDTH_DEPTH_TOL_MM).is_empty]
+                      if g.area > 1e-4 and not g.buffer(-PARQUETRY_WIDTH_TOL_MM).is_empty]
         if thin_parts:
             problems.append(f"{sum(g.area for g in thin_parts):.2f} mm^2 of it is narrower than "
                             f"min_piece_mm = {min_piece_mm:g} mm away from its corners")
@@ -261,9 +245,9 @@ def check_piece(segs: list, min_piece_mm: float, tool_radius_mm: float) -> list[
         if na < 1e-12 or nb < 1e-12:
             continue
         cr = (ta[0] * tb[1] - ta[1] * tb[0]) / (na * nb)
-        if orient * cr < -_CORNER_SIN:
+        if orient * cr < -PARQUETRY_CORNER_SIN:
             worst = 0.0
-    if tool_radius_mm > 0 and worst < CURVATURE_SLACK * tool_radius_mm:
+    if tool_radius_mm > 0 and worst < PARQUETRY_CURVATURE_SLACK * tool_radius_mm:
         problems.append(f"concave bend of radius {worst:.2f} mm, tighter than the tool radius "
                         f"{tool_radius_mm:g} mm")
     return problems

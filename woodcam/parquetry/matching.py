@@ -113,6 +113,10 @@ class _Atlas:
             return []
         key = (th, tw)
         if key not in self._sq:
+            # Few template sizes occur (interior patches, clipped ones at the panel's edges);
+            # keep the last two so a large atlas holds at most two extra float32 copies.
+            if len(self._sq) >= 2:
+                self._sq.pop(next(iter(self._sq)))
             self._sq[key] = _window_sums((self.F * self.F).sum(axis=2), th, tw)
         cost = _ssd(self.F, template, self._sq[key])
         ii = cv2.integral(self.blocked, sdepth=cv2.CV_32S)
