@@ -55,6 +55,8 @@ examples:
       --out out/vcarve_text.glb --screenshot
   woodcam eval rings out/blocks/block_0000 --out out/eval
   woodcam eval appearance builtin:knotty --out out/eval_appearance
+  woodcam parquetry eye.png --veneer-from ../shared/data/mokume/CN03 --veneer-from builtin:flat-sawn \\
+      --out out/eye/
 """
 
 
