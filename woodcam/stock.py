@@ -80,12 +80,49 @@ def open_stock(spec: str, *, species: str | None = None,
         raise WoodcamError(f"appearance must be one of ['colormap', 'neural']; got {appearance!r}")
     base, turns = _split_turns(spec)
     stock = _open_base_stock(base, species, appearance, appearance_params)
+    stock.meta["appearance_params"] = {k: (list(v) if isinstance(v, tuple) else v)
+                                       for k, v in appearance_params.items()
+                                       if isinstance(v, (int, float, str, tuple, list))}
     if not turns:
         return stock
     wood, size = stock.wood, stock.size_mm
     for axis, quarter_turns in turns:
         wood, size = wood.turned(axis, quarter_turns, size)
     return Stock(spec, size, wood, stock.description, {**stock.meta, "turns": turns})
+
+
+def absolute_spec(spec: str) -> str:
+    """``spec`` with any folder or log file it names made absolute, so a file that records it
+    (a GLB) reopens the same block from any working folder."""
+    base, sep, turns = str(spec).partition("~")
+    if base.startswith("log:"):
+        source, at, rest = base[len("log:"):].partition("@")
+        if source.lower().endswith(".json"):
+            base = f"log:{Path(source).resolve()}{at}{rest}"
+    elif not base.startswith("builtin:"):
+        base = str(Path(base).resolve())
+    return base + sep + turns
+
+
+def spec_digest(spec: str) -> str:
+    """Content identity of the block ``spec`` names: a digest of every file of a block or sample
+    folder (or of a log file), or of the spec itself for synthetic blocks."""
+    from . import __version__
+    from ._cache import digest
+
+    base = str(spec).partition("~")[0]
+    path = None
+    if base.startswith("log:"):
+        source = base[len("log:"):].partition("@")[0]
+        path = Path(source) if source.lower().endswith(".json") else None
+    elif not base.startswith("builtin:"):
+        path = Path(base)
+    if path is not None and path.is_dir():
+        files = sorted(p for p in path.rglob("*") if p.is_file() and not p.name.startswith("."))
+        return digest([(str(p.relative_to(path)), p) for p in files])
+    if path is not None and path.is_file():
+        return digest(path)
+    return digest(base, __version__)
 
 
 def _split_turns(spec: str) -> tuple[str, list[tuple[str, int]]]:
@@ -291,7 +328,8 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
         app = ColorMapAppearance.fit_to_block(block, field, species or "oak", **appearance_params)
     else:
         app = ColorMapAppearance(species or "oak", **appearance_params)
-    return Stock(spec, block.size_mm, Wood(field, app), block.name, dict(block.meta))
+    meta = {**dict(block.meta), "appearance": appearance, "species": species or "oak"}
+    return Stock(spec, block.size_mm, Wood(field, app), block.name, meta)
 
 
 def _log_block_field(spec: str):

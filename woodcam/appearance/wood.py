@@ -8,7 +8,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from ..errors import WoodcamError
-from ..fields.base import arf, check_points, evaluate
+from ..fields.base import arf, check_points, evaluate, grain_direction
 from ..tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS
 from .colormap import ColorMapAppearance
 
@@ -94,6 +94,30 @@ class Wood:
         p = ((points - shift) @ rot).astype(points.dtype, copy=False)
         n = None if normals is None else (normals @ rot).astype(normals.dtype, copy=False)
         return p, n
+
+    def features(self, points_mm) -> dict:
+        """What a woodworker asks of the wood at ``points_mm (n, 3)`` (block frame, mm).
+
+        Returns
+        -------
+        dict
+            ``years (n,)`` growth time; ``knot (n,)`` in [0, 1], 1 inside a knot (0 for
+            knot-free fields); ``grain (n, 3)`` unit fibre direction, block frame.
+        """
+        p, _ = self._to_source(check_points(points_mm))
+        fn = getattr(self.field, "evaluate", None)
+        if callable(fn):
+            res = fn(p, directions=True)
+            years = np.asarray(res["years"], dtype=float)
+            knot = np.asarray(res.get("knot", np.zeros(len(p))), dtype=float)
+            grain = np.asarray(res["direction"], dtype=float)
+        else:
+            years = evaluate(self.field, p)
+            knot = np.zeros(len(p))
+            grain = np.asarray(grain_direction(self.field, p), dtype=float)
+        if self._turn is not None:
+            grain = grain @ self._turn[0].T  # back into this (turned) block's frame
+        return {"years": years, "knot": knot, "grain": grain}
 
     def years(self, points_mm) -> np.ndarray:
         """Growth time ``(n,)`` in years at ``points_mm : (n, 3)``."""
