@@ -63,6 +63,6 @@ def test_cli_run_writes_everything(scans, capsys):
 ])
 def test_cli_bad_input_is_one_line(scans, capsys, args, message):
     argv = ["parquetry"] + [a.format(d=scans) for a in args] + ["--out", str(scans / "o"), "--quiet"]
-    assert main(argv) == 2
+    assert main(argv) == 1
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and err.startswith("woodcam: error:") and message in err

@@ -64,17 +64,18 @@ def register(subparsers) -> None:
                    help="colour preset for sliced blocks (oak, maple, walnut, cherry, pine, "
                    "spruce); default: the block's own")
     t = p.add_argument_group("parameters (seed 002, Table 1)")
-    t.add_argument("--w-intens", type=float, default=None, help="intensity weight of eq. 1 (default 0.5)")
-    t.add_argument("--w-edge", type=float, default=None, help="Sobel edge weight of eq. 1 (default 0.5)")
+    t.add_argument("--w-intens", type=float, default=None, help="intensity weight of eq. 1, in [0, 1] (default 0.5)")
+    t.add_argument("--w-edge", type=float, default=None, help="Sobel edge weight of eq. 1, in [0, 1] (default 0.5)")
     t.add_argument("--w-hist", type=float, default=None,
-                   help="histogram-matching blend of eq. 2 (default 0.5)")
+                   help="histogram-matching blend of eq. 2, in [0, 1] (default 0.5)")
     t.add_argument("--image-size-mm", type=float, default=None,
                    help="panel's shorter side in mm (default 360)")
     t.add_argument("--patch-mm", type=float, default=None, help="patch side in mm (default 14)")
     t.add_argument("--n-adaptive", type=int, default=None,
                    help="adaptive levels: patches of patch-mm * 2^L split in four (default 0)")
     t.add_argument("--w-adaptive", type=float, default=None,
-                   help="split when w_adaptive * (cost of the four) < cost of one (default 1.2)")
+                   help="cost ratio: split when w_adaptive * (cost of the four) < cost of one "
+                   "(default 1.2)")
     t.add_argument("--n-rot", type=int, default=None, help="rotations of each sheet (default 15)")
     t.add_argument("--priority", choices=("saliency", "center"), default=None,
                    help="patch order: salient first (default) or from the centre out (Fig. 6)")
@@ -135,7 +136,8 @@ def _scan_entry(text: str) -> dict:
 
 
 def run(args) -> int:
-    """Run a parsed ``parquetry`` command; returns the exit status (1 when the wood ran out)."""
+    """Run a parsed ``parquetry`` command; returns the exit status: 0, or
+    :data:`~woodcam.cli.EXIT_CHECKS` when the wood ran out (what was made is written)."""
     import dataclasses
 
     from ..errors import WoodcamError
@@ -184,4 +186,6 @@ def run(args) -> int:
     write_job(job, Path(args.out) / "job.json")
     print(format_summary(res["summary"], res["problems"]))
     print(f"wrote {len(res['files']) + 1} files to {args.out}")
-    return 0 if run_.complete else 1
+    from . import EXIT_CHECKS, EXIT_OK
+
+    return EXIT_OK if run_.complete else EXIT_CHECKS
