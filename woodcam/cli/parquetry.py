@@ -87,6 +87,9 @@ def register(subparsers) -> None:
     f.add_argument("--mode", choices=("fast", "exhaustive"), default=None,
                    help="fast: coarse-to-fine with exact re-ranking (default); exhaustive: every "
                    "position at full resolution")
+    f.add_argument("--coarse-factor", type=int, default=None, metavar="N",
+                   help="fast mode: the first search runs N times coarser than --px-per-mm "
+                   "(default 4; 8 or 16 for large sheets, where it is 5 or 20 times quicker)")
     f.add_argument("--overlap-mm", type=float, default=None,
                    help="patch overlap for seam cutting in mm (default min(patch/4, "
                    "(patch - min-piece)/2) = 3.5); 0 = square pieces")
@@ -107,7 +110,8 @@ def register(subparsers) -> None:
 _OPTION_PARAMS = {"w_intens": "w_intens", "w_edge": "w_edge", "w_hist": "w_hist",
                   "image_size_mm": "image_size_mm", "patch_mm": "patch_mm", "n_adaptive": "n_adaptive",
                   "w_adaptive": "w_adaptive", "n_rot": "n_rot", "priority": "priority", "queue": "queue",
-                  "px_per_mm": "px_per_mm", "mode": "mode", "overlap_mm": "overlap_mm",
+                  "px_per_mm": "px_per_mm", "mode": "mode", "coarse_factor": "coarse_factor",
+                  "overlap_mm": "overlap_mm",
                   "min_piece_mm": "min_piece_mm", "tool_diameter": "tool_diameter_mm",
                   "kerf_mm": "kerf_mm"}
 

@@ -98,6 +98,8 @@ class ParquetryParams:
         if self.px_per_mm <= 0 or self.tool_diameter_mm < 0 or (self.kerf_mm or 0) < 0:
             raise WoodcamError("px_per_mm must be > 0, tool_diameter_mm and kerf_mm >= 0; got "
                                f"{self.px_per_mm}, {self.tool_diameter_mm}, {self.kerf_mm}")
+        if self.coarse_factor < 1 or self.top_k < 1:
+            raise WoodcamError(f"coarse_factor and top_k must be >= 1; got {self.coarse_factor}, {self.top_k}")
         if self.patch_px < 4:
             raise WoodcamError(f"patch_mm * px_per_mm must give at least 4 px; got {self.patch_px}; "
                                "raise px_per_mm")
