@@ -57,7 +57,9 @@ def finished(sheets, tmp_path_factory):
     prm = ParquetryParams(image_size_mm=70, px_per_mm=PPM)
     run = build_parquetry(target, sheets, prm)
     out = tmp_path_factory.mktemp("parq")
-    res = write_parquetry(run, out)
+    from woodcam.export import export_glb
+
+    res = write_parquetry(run, out, glb_writer=export_glb)
     return run, out, res
 
 
@@ -213,7 +215,7 @@ def test_running_out_of_wood_stops_with_a_message_and_writes(sheets, tmp_path):
     run = build_parquetry(data.coffee().astype(np.float32) / 255, sheets[:1], prm)
     assert not run.complete
     assert f"placed {len(run.patches)} patches" in run.message
-    res = write_parquetry(run, tmp_path, glb=False)
+    res = write_parquetry(run, tmp_path)
     assert (tmp_path / "render.png").is_file() and res["summary"]["complete"] is False
     # what was placed still obeys single use
     v = run.veneers[0]
@@ -320,7 +322,7 @@ def test_adaptive_patches_with_seams_cover_once_and_use_wood_once(tmp_path):
     img = data.astronaut()[:256, :256].astype(np.float32) / 255
     run = build_parquetry(img, sheets, ParquetryParams(image_size_mm=112, px_per_mm=PPM, n_adaptive=1))
     assert run.complete and {q.cells for q in run.patches} == {1, 2}
-    res = write_parquetry(run, tmp_path, glb=False)
+    res = write_parquetry(run, tmp_path)
     assert res["problems"] == {}
     n = rasterise(read_svg_pieces(tmp_path / "assembly.svg"), run.panels[0].matched.shape, PPM)
     assert (n == 1).all()

@@ -183,10 +183,15 @@ def run(args) -> int:
                            "--config job with source_textures")
     progress = not args.quiet
     targets, names = job_targets(job)
-    veneers = job_veneers(job, progress=progress)
+    from ..stock import open_stock
+
+    veneers = job_veneers(job, open_stock=open_stock, progress=progress)
     run_ = build_parquetry(targets, veneers, job.params, names=names, progress=progress,
                            seams=not args.no_seams)
-    res = write_parquetry(run_, args.out, glb=not args.no_glb, progress=progress)
+    glb_writer = None
+    if not args.no_glb:
+        from ..export import export_glb as glb_writer
+    res = write_parquetry(run_, args.out, glb_writer=glb_writer, progress=progress)
     write_job(job, Path(args.out) / "job.json")
     print(format_summary(res["summary"], res["problems"]))
     print(f"wrote {len(res['files']) + 1} files to {args.out}")

@@ -44,7 +44,7 @@ class Patch:
 
     def target_to_sheet(self, bank: SheetBank, px_per_mm: float) -> np.ndarray:
         """``(2, 3)`` affine taking panel mm (x, y) to sheet mm (x, y) for this patch."""
-        mat, _ = bank._rot[self.match.sheet][self.match.rot]
+        mat, _ = bank.rotation(self.match.sheet, self.match.rot)
         ainv = np.linalg.inv(mat[:, :2])
         y0, x0 = self.grown[:2]
         # panel px p -> canvas px p - (x0, y0) + (mx, my) -> sheet px ainv (q - t)
@@ -187,7 +187,6 @@ def build_parquetry(targets, veneers: list[Veneer], params: ParquetryParams | No
         raise WoodcamError(f"veneer ids must be unique; got {ids}")
     sheets = [v.resampled(params.px_per_mm) for v in veneers]
     top_cells = 2 ** params.n_adaptive
-    need = params.patch_px * top_cells + 2 * params.overlap_px
     for v in sheets:
         h, w = v.rgb.shape[:2]
         if min(h, w) < params.patch_px + 2 * params.overlap_px:
@@ -195,7 +194,6 @@ def build_parquetry(targets, veneers: list[Veneer], params: ParquetryParams | No
                 f"veneer {v.id!r} is {w / params.px_per_mm:.1f} x {h / params.px_per_mm:.1f} mm, "
                 f"smaller than one patch with its overlap ({(params.patch_px + 2 * params.overlap_px) / params.px_per_mm:g} mm); "
                 "use larger sheets or a smaller patch_mm")
-    del need
     grey = [intensity(v.rgb) for v in sheets]
     src_vals = np.concatenate([g[v.mask] for g, v in zip(grey, sheets)])
     if src_vals.size > 2_000_000:   # the CDF needs no more samples than this

@@ -203,10 +203,14 @@ def write_job(job: ParquetryJob, path) -> Path:
     return atomic_write_text(path, json.dumps(d, indent=2))
 
 
-def job_veneers(job: ParquetryJob, progress: bool = False) -> list:
+def job_veneers(job: ParquetryJob, open_stock=None, progress: bool = False) -> list:
     """The job's veneer sheets: scans (``dpi / 25.4 * scale`` px/mm), Mokume photos and leaves
     sliced from woodcam blocks (``{"spec", "sheets", "width_mm", "height_mm", "thickness_mm",
-    "kerf_mm", "axis", "species"}``), resampled later to the working resolution."""
+    "kerf_mm", "axis", "species"}``), resampled later to the working resolution.
+
+    open_stock : ``open_stock(spec, species=...) -> Stock`` (``woodcam.open_stock``), needed when
+        the job slices blocks; the stock layer sits above this package, so the caller passes it.
+    """
     from .veneers import MM_PER_INCH, load_scan, mokume_veneers, slice_veneers
 
     out = []
@@ -223,8 +227,9 @@ def job_veneers(job: ParquetryJob, progress: bool = False) -> list:
     for m in job.mokume:
         out += mokume_veneers(m)
     for b in job.blocks:
-        from ..stock import open_stock
-
+        if open_stock is None:
+            raise WoodcamError("job_veneers: this job slices blocks; pass open_stock="
+                               "woodcam.open_stock")
         if "spec" not in b:
             raise WoodcamError(f"woodcam.blocks entry {b} needs a 'spec' (e.g. builtin:flat-sawn)")
         stock = open_stock(b["spec"], species=b.get("species"))

@@ -237,6 +237,10 @@ class SheetBank:
         self.atlas = _Atlas(self, self.f)
         self._rot = [[rotation_matrix(g.shape[:2], a) for a in self.angles_deg] for g in self.grey]
 
+    def rotation(self, sheet: int, rot: int) -> tuple[np.ndarray, tuple[int, int]]:
+        """``(affine (2, 3) sheet px -> rotated canvas px, canvas (h, w))`` of a rotation."""
+        return self._rot[sheet][rot]
+
     def features(self, grey: np.ndarray) -> np.ndarray:
         """Eq. 1 on a (rotated) sheet intensity: ``(h, w, 2)``."""
         return features(grey, self.w_intens, self.w_edge)

@@ -94,7 +94,7 @@ def summary(run: ParquetryRun) -> dict:
     return out
 
 
-def write_parquetry(run: ParquetryRun, out_dir, *, glb: bool = True, progress: bool = False) -> dict:
+def write_parquetry(run: ParquetryRun, out_dir, *, glb_writer=None, progress: bool = False) -> dict:
     """Write every file of a run into ``out_dir``; returns ``{"files": [...], "summary": {...},
     "problems": {...}}``.
 
@@ -103,7 +103,9 @@ def write_parquetry(run: ParquetryRun, out_dir, *, glb: bool = True, progress: b
     ``assembly.svg`` (outlines and ids on the panel), ``veneer_<id>.svg`` / ``.dxf`` per sheet
     that gives a piece (cut paths in sheet mm, tool paths, engraved ids), ``result.json``
     (every patch: region, sheet, rotation, anchor, cost; parameters; figures; fabricability),
-    ``panel.glb`` (the panel as a textured board). Several targets get ``_<name>`` suffixes.
+    ``panel.glb`` (the panel as a textured board, when ``glb_writer`` is given: pass
+    ``woodcam.export_glb``, which sits in a sibling layer). Several targets get ``_<name>``
+    suffixes.
     """
     import base64
     import io
@@ -130,10 +132,8 @@ def write_parquetry(run: ParquetryRun, out_dir, *, glb: bool = True, progress: b
         doc = svg_document(W, H, [(q.id, by_id[q.id].outline_panel) for q in p.patches],
                            background=bg, title=f"woodcam parquetry assembly {p.name}")
         files.append(atomic_write_text(out / f"assembly{sfx}.svg", doc))
-        if glb:
-            from ..export import export_glb
-
-            files.append(export_glb(panel_mesh(p.render, ppm), out / f"panel{sfx}.glb",
+        if glb_writer is not None:
+            files.append(glb_writer(panel_mesh(p.render, ppm), out / f"panel{sfx}.glb",
                                     metadata={"kind": "parquetry panel", "units": "mm",
                                               "size_mm": [W, H, PANEL_THICKNESS_MM]}))
     sheets_used = sorted({pc.sheet for pc in pieces})

@@ -167,7 +167,8 @@ def slice_veneers(stock, n_sheets: int, size_mm: tuple[float, float], *,
 
     Parameters
     ----------
-    stock : :class:`woodcam.stock.Stock` or a block spec string (``builtin:NAME``, ``log:...``)
+    stock : :class:`woodcam.stock.Stock` (``woodcam.open_stock(spec)``: the stock layer sits
+        above this package, so the caller opens it)
     n_sheets : int
     size_mm : (width, height) mm of each sheet
     thickness_mm, kerf_mm : leaf thickness and the saw kerf between leaves (mm)
@@ -175,10 +176,9 @@ def slice_veneers(stock, n_sheets: int, size_mm: tuple[float, float], *,
     axis : "x", "y" or "z": the normal of the slicing planes
     start_mm : first plane along ``axis`` (default: the middle of the block)
     """
-    if isinstance(stock, str):
-        from ..stock import open_stock
-
-        stock = open_stock(stock)
+    if not hasattr(stock, "wood") or not hasattr(stock, "size_mm"):
+        raise WoodcamError(f"stock must be a woodcam Stock (woodcam.open_stock(spec)); got "
+                           f"{type(stock).__name__}")
     if n_sheets < 1:
         raise WoodcamError(f"n_sheets must be >= 1; got {n_sheets}")
     if thickness_mm <= 0 or kerf_mm < 0:
