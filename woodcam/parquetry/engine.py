@@ -157,7 +157,7 @@ class _OutOfWood(Exception):
     pass
 
 
-def build_parquetry(targets, veneers: list[Veneer], params: ParquetryParams | None = None, *,
+def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer], params: ParquetryParams | None = None, *,
                     names: list[str] | None = None, progress: bool = False,
                     seams: bool = True) -> ParquetryRun:
     """Rebuild each target from the veneers (seed 002, sec. 3).

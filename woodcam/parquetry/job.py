@@ -154,7 +154,7 @@ class ParquetryJob:
     params: ParquetryParams = field(default_factory=ParquetryParams)
 
 
-def read_job(path) -> ParquetryJob:
+def read_job(path: str | Path) -> ParquetryJob:
     """Read a job file (paper layout + ``"woodcam"`` extras); paths resolved against its folder."""
     p = Path(path)
     try:
@@ -190,7 +190,7 @@ def read_job(path) -> ParquetryJob:
     return ParquetryJob(scans, blocks, mokume, targets, ParquetryParams(**kw).check())
 
 
-def write_job(job: ParquetryJob, path) -> Path:
+def write_job(job: ParquetryJob, path: str | Path) -> Path:
     """Write a job file in the paper's layout (woodcam-only keys under ``"woodcam"``), atomically."""
     from ._io import atomic_write_text
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -94,7 +95,8 @@ def summary(run: ParquetryRun) -> dict:
     return out
 
 
-def write_parquetry(run: ParquetryRun, out_dir, *, glb_writer=None, progress: bool = False) -> dict:
+def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
+                    glb_writer: Callable[..., Path] | None = None, progress: bool = False) -> dict:
     """Write every file of a run into ``out_dir``; returns ``{"files": [...], "summary": {...},
     "problems": {...}}``.
 

@@ -18,11 +18,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
+from typing import Literal, Protocol
 
 import numpy as np
 
 from ..errors import WoodcamError
+
+
+class StockLike(Protocol):
+    """What :func:`slice_veneers` needs of a :class:`woodcam.stock.Stock` (the stock layer sits
+    above this package, so it is described here rather than imported)."""
+
+    spec: str
+    size_mm: tuple[float, float, float]
+    wood: object
 
 MM_PER_INCH = 25.4
 
@@ -104,8 +113,8 @@ def read_image(path, what: str = "image") -> np.ndarray:
     return a
 
 
-def load_scan(path, *, dpi: float | None = None, px_per_mm: float | None = None,
-              mask=None, id: str | None = None) -> Veneer:
+def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | None = None,
+              mask: str | Path | np.ndarray | None = None, id: str | None = None) -> Veneer:
     """A scanned veneer.
 
     Parameters
@@ -132,7 +141,7 @@ def load_scan(path, *, dpi: float | None = None, px_per_mm: float | None = None,
     return _check(Veneer(id or Path(path).stem, rgb, ppm, m, str(path)))
 
 
-def mokume_veneers(folder, size_mm: float = 50.0) -> list[Veneer]:
+def mokume_veneers(folder: str | Path, size_mm: float = 50.0) -> list[Veneer]:
     """The face photos ``A_col.png`` .. ``F_col.png`` of a Mokume sample as veneers.
 
     The cubes are ``size_mm`` on a side (the dataset does not store it; woodcam's Mokume
@@ -151,7 +160,7 @@ def mokume_veneers(folder, size_mm: float = 50.0) -> list[Veneer]:
     return out
 
 
-def slice_veneers(stock, n_sheets: int, size_mm: tuple[float, float], *,
+def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float], *,
                   thickness_mm: float = 0.6, kerf_mm: float = 0.4, px_per_mm: float = 4.0,
                   axis: SliceAxis = "y", start_mm: float | None = None,
                   id_prefix: str | None = None, progress: bool = False) -> list[Veneer]:
