@@ -57,7 +57,25 @@ def test_run_simulates_and_hands_a_watertight_mesh_to_the_pipeline(tmp_path, mon
     W, D, H = seen["stock"].size_mm
     assert mesh.volume == pytest.approx(W * D * H - 3 * (60 * 6 + 3.14159265 * 9), rel=5e-3)
     assert seen["meta"]["tools"] == {"0": "flat:6"}
-    assert "slot.nc: 3 moves" in capsys.readouterr().out
+    assert "slot.nc: 4 moves" in capsys.readouterr().out
+
+
+def test_negative_and_invalid_triples():
+    args = _parse(["p.nc", "--block", "b", "--out", "o.glb", "--work-offset", "-14,5,3",
+                   "--start", "-1.5,-2,30"])
+    assert args.work_offset == (-14.0, 5.0, 3.0) and args.start == (-1.5, -2.0, 30.0)
+    for bad in ("nan,nan,nan", "1,2", "1,inf,3", "a,b,c"):
+        with pytest.raises(SystemExit):
+            _parse(["p.nc", "--block", "b", "--out", "o.glb", "--work-offset", bad])
+
+
+def test_program_without_cuts_is_an_error(tmp_path):
+    prog = tmp_path / "rapids.nc"
+    prog.write_text("G0 X20 Y40 Z2\nG0 X30\nM2\n")
+    args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+                   "--tool", "flat:6"])
+    with pytest.raises(WoodcamError, match="no cutting move"):
+        args.func(args)
 
 
 @pytest.mark.slow

@@ -6,6 +6,8 @@ Registered by ``woodcam.cli`` through ``add_parser(subparsers)`` / ``run(args)``
 from __future__ import annotations
 
 import argparse
+import math
+import re
 import sys
 import time
 from pathlib import Path
@@ -44,8 +46,18 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="tool table file ([tools.N] type/diameter_mm/...)")
     p.add_argument("--resolution", type=float, default=0.1, metavar="MM",
                    help="height-field cell size (default 0.1 mm)")
-    p.add_argument("--work-offset", default=None, metavar="X,Y,Z",
-                   help="block-frame position of G-code zero (default 0,0,H: top-front-left)")
+    p.add_argument("--work-offset", default=None, metavar="X,Y,Z", type=_triple("--work-offset"),
+                   help="block-frame position of G-code zero in mm (default 0,0,H: "
+                   "top-front-left); negative values as --work-offset -14,5,3")
+    p.add_argument("--start", default=None, metavar="X,Y,Z", type=_triple("--start"),
+                   help="machine position (G-code frame, mm) before the first move, also the "
+                   "G28/G30 home (default 0,0,10: 10 mm over the work zero)")
+    p.add_argument("--dialect", choices=("linuxcnc", "grbl", "fanuc"), default="linuxcnc",
+                   help="whose meaning the program has (default linuxcnc): grbl has no "
+                   "parameters or O-words; fanuc reads O1234 program numbers")
+    p.add_argument("--interpreter", choices=("woodcam", "linuxcnc"), default="woodcam",
+                   help="read the program with woodcam's interpreter (default) or with "
+                   "LinuxCNC's own (needs Debian's linuxcnc-uspace)")
     p.add_argument("--mesh-tol", type=float, default=0.01, metavar="MM",
                    help="merge nearly planar regions of the result mesh within this (default "
                    "0.01 mm)")
@@ -56,7 +68,26 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
                    help="also render to PNG (default name: OUT with _view.png)")
     p.set_defaults(func=run)
+    # argparse takes "-14,5,3" for an option; a value that looks like numbers is a value
+    p._negative_number_matcher = _NEGATIVE_VALUES
     return p
+
+
+_NEGATIVE_VALUES = re.compile(r"^-[\d.][\d.,eE+-]*$")
+
+
+def _triple(option: str):
+    """argparse type: ``"X,Y,Z"`` -> three finite floats (mm), or a one-line error."""
+    def parse(text: str) -> tuple[float, float, float]:
+        try:
+            vals = tuple(float(v) for v in text.split(","))
+        except ValueError:
+            vals = ()
+        if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
+            raise argparse.ArgumentTypeError(f"{option} {text!r}: give three finite numbers "
+                                             "X,Y,Z in mm, e.g. 0,0,50")
+        return vals
+    return parse
 
 
 def _tools_from_args(args, program) -> dict:
@@ -100,17 +131,17 @@ def run(args) -> int:
 
     stock = open_stock(args.block, species=args.species)
     t0 = time.perf_counter()
-    program = read_gcode(args.program)
+    program = read_gcode(args.program, start_mm=args.start, dialect=args.dialect,
+                         interpreter=args.interpreter)
     t_read = time.perf_counter() - t0
+    for w in program.warnings:
+        print(f"woodcam: warning: {args.program.name} {w}", file=sys.stderr)
+    if not (program.kind == 1).any():
+        raise WoodcamError(f"woodcam gcode: {args.program} has no cutting move (G1/G2/G3 or a "
+                           "drilling cycle); nothing to simulate. Check that it is the "
+                           "program you meant")
     tools = _tools_from_args(args, program)
-    offset = None
-    if args.work_offset:
-        try:
-            offset = [float(v) for v in args.work_offset.split(",")]
-            assert len(offset) == 3
-        except (ValueError, AssertionError) as err:
-            raise WoodcamError(f"--work-offset {args.work_offset!r}: give three numbers X,Y,Z "
-                               "in mm, e.g. 0,0,50") from err
+    offset = list(args.work_offset) if args.work_offset else None
     res = simulate(program, tools, stock.size_mm, resolution_mm=args.resolution,
                    work_offset_mm=offset, progress=False)
     t1 = time.perf_counter()
