@@ -69,8 +69,11 @@ MM_PER_INCH = 25.4
 _RAPID_DELTA_IN = 0.010
 #: LinuxCNC's eq/ne tolerance.
 _EQ_TOL = 1e-4
-#: LinuxCNC's centre-arc radius tolerances (CENTER_ARC_RADIUS_TOLERANCE_INCH/MM, relative 0.1 %).
-_ARC_ABS_TOL = {"in": 0.00005, "mm": 0.00005 * MM_PER_INCH}
+#: LinuxCNC's centre-arc radius tolerances: CENTER_ARC_RADIUS_TOLERANCE_INCH = 2 * 0.001 * sqrt 2
+#: (inch), _MM = 2 * 0.01 * sqrt 2 (mm), relative 0.1 %; an arc whose end radius differs by
+#: more than 100 x the absolute, or by more than both, is refused (measured against LinuxCNC
+#: 2.9: 0.028 mm on a 10 mm radius is read, 0.029 mm refused).
+_ARC_ABS_TOL = {"in": 2 * 0.001 * math.sqrt(2), "mm": 2 * 0.01 * math.sqrt(2)}
 _ARC_REL_TOL = 0.001
 
 TRAVERSE, FEED, ARC = 0, 1, 2
@@ -114,7 +117,13 @@ _G_REFUSED = {41.0: "cutter radius compensation changes the path", 42.0: "cutter
               "path", 42.1: "cutter radius compensation changes the path",
               93.0: "inverse-time feed is not simulated", 95.0: "feed per revolution is not "
               "simulated", 96.0: "constant surface speed is not simulated"}
-_M_KNOWN = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 30, 48, 49, 50, 51, 52, 53, 60}
+_M_KNOWN = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 30, 48, 49, 50, 51, 52, 53, 60, 61}
+#: M codes that switch I/O or call user programs: read, not simulated, warned about.
+_M_WARN = {19: "spindle orientation", 62: "digital output", 63: "digital output",
+           64: "digital output", 65: "digital output", 66: "wait on input",
+           67: "analog output", 68: "analog output", **{k: "user-defined M code (runs a "
+                                                         "program of the machine)"
+                                                         for k in range(100, 200)}}
 _CS = (54.0, 55.0, 56.0, 57.0, 58.0, 59.0, 59.1, 59.2, 59.3)
 _PLANES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}  # (first, second, normal) axes
 _CENTRE = {17: "ij", 18: "ki", 19: "jk"}
@@ -794,9 +803,13 @@ class Interpreter:
                                f"two {name} G codes on one line", "keep one")
         mset = set()
         for v in ms:
+            if v == math.floor(v) and int(v) in _M_WARN:
+                self.warn(f"M{int(v)} ({_M_WARN[int(v)]}) is not simulated")
+                mset.add(int(v))
+                continue
             if v != math.floor(v) or int(v) not in _M_KNOWN:
                 raise self.err(f"M{v:g}", "unsupported M code (woodcam reads M0-M9, M30, "
-                               "M48-M53, M60)", "remove it or post-process for a 3-axis mill")
+                               "M48-M53, M60, M61; M19, M62-M68 and M100-M199 with a warning)", "remove it or post-process for a 3-axis mill")
             mset.add(int(v))
         if 62 in mset:  # pragma: no cover - not in _M_KNOWN
             pass
@@ -816,6 +829,10 @@ class Interpreter:
             self.spindle = w["s"]
         if "t" in w:
             self.selected = int(w["t"])
+        if 61 in mset:  # M61 Qn: the loaded tool is n, no change
+            if "q" not in w or w["q"] != math.floor(w["q"]) or w["q"] < 0:
+                raise self.err("M61", "M61 needs Q = a tool number", "write M61 Q1")
+            self.tool = self.selected = int(w["q"])
         if 6 in mset:
             self.tool = self.selected
             self.p[5400] = float(self.tool)
@@ -856,6 +873,7 @@ class Interpreter:
         motion_here = [c for c in g if c in _MOTION]
         axis = [a for a in "xyz" if a in w]
         nonmodal = g & _G_GROUPS["non-modal"]
+        self._unused_words(g, mset, w, motion_here, axis)
         if 10.0 in g:
             self.g10(w)
         elif nonmodal & {28.0, 30.0}:
@@ -906,6 +924,28 @@ class Interpreter:
                            "give X/Y/Z with G2/G3")
         if mset & {2, 30}:
             self.ended = True
+
+    def _unused_words(self, g, mset, w, motion_here, axis):
+        """LinuxCNC refuses a P/Q/R/L/H/I/J/K word that no code of the line uses."""
+        eff = motion_here[0] if motion_here else (self.motion if axis else None)
+        uses = {
+            "q": bool(g & {10.0, 64.0}) or eff in (73.0, 83.0) or bool(mset & {61, 66, 67, 68}),
+            "r": 10.0 in g or eff in (2.0, 3.0) or eff in _CYCLES,
+            "p": bool(g & {4.0, 10.0, 64.0}) or eff in (2.0, 3.0, 82.0, 86.0, 89.0)
+            or bool(mset & {50, 51, 52, 53, 62, 63, 64, 65, 66, 67, 68}),
+            "l": 10.0 in g or eff in _CYCLES,
+            "h": 43.0 in g,
+        }
+        for k, used in uses.items():
+            if k in w and not used:
+                raise self.err(f"{k.upper()}{w[k]:g}", f"{k.upper()} word with no G or M code "
+                               "on the line that uses it (LinuxCNC refuses it too)",
+                               "remove it or add the code it belongs to")
+        if eff not in (2.0, 3.0) and not (10.0 in g):
+            for k in "ijk":
+                if k in w:
+                    raise self.err(f"{k.upper()}{w[k]:g}", f"{k.upper()} word with no G2/G3 "
+                                   "to use it", "give X/Y/Z with G2/G3")
 
     # -- non-modal codes --------------------------------------------------------------------
     def g10(self, w):
@@ -1001,7 +1041,7 @@ class Interpreter:
             turns = int(w["p"])
         s1, s2 = self.pos[a1], self.pos[a2]
         e1, e2 = end[a1], end[a2]
-        tol = _ARC_ABS_TOL["in" if self.inch else "mm"] * self.scale
+        tol = _ARC_ABS_TOL["in" if self.inch else "mm"] * self.scale  # mm
         if "r" in w:
             if any(k in w for k in "ijk"):
                 raise self.err(f"R{w['r']:g}", "both R and I/J/K on one arc", "give one form")
@@ -1037,10 +1077,11 @@ class Interpreter:
             r0 = math.hypot(s1 - c1, s2 - c2)
             r1 = math.hypot(e1 - c1, e2 - c2)
             err = abs(r1 - r0)
-            if r0 == 0 or r1 == 0 or err > 100 * tol or (err > tol and err / r0 > _ARC_REL_TOL):
+            if r0 == 0 or r1 == 0 or err > 100 * tol or (err > tol
+                                                          and err / max(r0, r1) > _ARC_REL_TOL):
                 raise self.err(code, f"radius to end of arc {r1:.4f} mm differs from radius "
-                               f"to start {r0:.4f} mm (LinuxCNC's tolerance {tol:g} mm and "
-                               "0.1 %)", "fix the centre (I/J/K) or the end point")
+                               f"to start {r0:.4f} mm (LinuxCNC's tolerance {tol:.4g} mm "
+                               "and 0.1 %)", "fix the centre (I/J/K) or the end point")
         if not all(math.isfinite(v) for v in (c1, c2)):
             raise self.err(code, "arc centre out of range", "fix the arc")
         self.emit(ARC, end, (c1, c2), -turns if cw else turns)
