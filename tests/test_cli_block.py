@@ -5,7 +5,7 @@ import json
 import numpy as np
 from PIL import Image
 
-from woodcam._cli_block import main
+from woodcam.cli import main
 from woodcam.block import read_block
 from woodcam.frames import CrossLayout
 

@@ -617,6 +617,42 @@ def random_log_placement(rng: np.random.Generator, pattern: SawPattern, size_mm,
     return log, placement
 
 
+def benchmark_set_block(seed: int, index: int, *, face_px: int = 512, size_range_mm=(30.0, 80.0),
+                        ring_width_range_mm=(1.5, 6.0),
+                        log_fields: Callable[[np.random.Generator], object] | None = None,
+                        knotted_fraction: float = 0.5,
+                        wood_factory: Callable[[object], object] | None = None,
+                        **synth_kwargs) -> tuple[Block, dict]:
+    """Block ``index`` of the set :func:`synth_benchmark_set` writes for ``seed``, alone.
+
+    Drawn from ``np.random.default_rng([seed, index])`` only, so it is the same block whichever
+    process makes it and whatever else is made. Returns the block and its index entry (name,
+    size, knotted, ring width, placement).
+    """
+    i = int(index)
+    rng = np.random.default_rng([int(seed), i])
+    pattern = PATTERNS[i % len(PATTERNS)]
+    size = tuple(float(v) for v in np.round(rng.uniform(*size_range_mm, size=3) * 2) / 2)
+    log, placement = random_log_placement(rng, pattern, size, ring_width_range_mm)
+    knotted = log_fields is not None and rng.uniform() < knotted_fraction
+    if knotted:
+        log = log_fields(rng)
+        # keep the block inside the knotted log (its outer radius), knots are near the bark
+        half_diag = 0.5 * math.hypot(size[0], size[1])
+        r_in = float(getattr(getattr(log, "log", None), "r_min_mm", 100.0)) - half_diag - 5.0
+        if placement["pattern"] != "pith-inside":
+            placement["distance_mm"] = max(half_diag + 2.0, min(placement["distance_mm"], r_in))
+    field = cut_block(log, size, **placement)
+    name = f"block_{i:04d}"
+    info = {"name": name, "index": i, "size_mm": list(size), "knotted": bool(knotted),
+            "ring_width_mm": log.ring_width_at(placement["distance_mm"]) if not knotted else None,
+            **{k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in placement.items()}}
+    wood = None if wood_factory is None else wood_factory(field)
+    block = synth_block(field, size, wood=wood, face_px=face_px, rng=rng, seed=None, name=name,
+                        meta={"benchmark_seed": int(seed), **info}, **synth_kwargs)
+    return block, info
+
+
 def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
                         size_range_mm=(30.0, 80.0), ring_width_range_mm=(1.5, 6.0),
                         log_fields: Callable[[np.random.Generator], object] | None = None,
@@ -660,27 +696,11 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
     folders = []
     # tqdm's delay keeps the bar hidden for runs shorter than ~2 s.
     for i in tqdm(range(count), desc="synthesising blocks", unit="block", delay=2.0, disable=not progress):
-        rng = np.random.default_rng([int(seed), i])
-        pattern = PATTERNS[i % len(PATTERNS)]
-        size = tuple(float(v) for v in np.round(rng.uniform(*size_range_mm, size=3) * 2) / 2)
-        log, placement = random_log_placement(rng, pattern, size, ring_width_range_mm)
-        knotted = log_fields is not None and rng.uniform() < knotted_fraction
-        if knotted:
-            log = log_fields(rng)
-            # keep the block inside the knotted log (its outer radius), knots are near the bark
-            half_diag = 0.5 * math.hypot(size[0], size[1])
-            r_in = float(getattr(getattr(log, "log", None), "r_min_mm", 100.0)) - half_diag - 5.0
-            if placement["pattern"] != "pith-inside":
-                placement["distance_mm"] = max(half_diag + 2.0, min(placement["distance_mm"], r_in))
-        field = cut_block(log, size, **placement)
-        name = f"block_{i:04d}"
-        info = {"name": name, "index": i, "size_mm": list(size), "knotted": bool(knotted),
-                "ring_width_mm": log.ring_width_at(placement["distance_mm"]) if not knotted else None,
-                **{k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in placement.items()}}
-        wood = None if wood_factory is None else wood_factory(field)
-        block = synth_block(field, size, wood=wood, face_px=face_px, rng=rng, seed=None, name=name,
-                            meta={"benchmark_seed": int(seed), **info}, **synth_kwargs)
-        folder = out_dir / name
+        block, info = benchmark_set_block(
+            seed, i, face_px=face_px, size_range_mm=size_range_mm,
+            ring_width_range_mm=ring_width_range_mm, log_fields=log_fields,
+            knotted_fraction=knotted_fraction, wood_factory=wood_factory, **synth_kwargs)
+        folder = out_dir / info["name"]
         write_block(block, folder)
         folders.append(folder)
         index["blocks"].append(info)

@@ -17,10 +17,9 @@ HERE = Path(__file__).parent
 
 
 def _write(name: str, lines: list[str]) -> None:
-    path = HERE / name
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text("\n".join(lines) + "\n")
-    tmp.replace(path)
+    from woodcam._atomic import write_text
+
+    write_text(HERE / name, "\n".join(lines) + "\n")
 
 
 def raster(name, step, width, depth, seed):
