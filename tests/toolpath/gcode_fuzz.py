@@ -11,11 +11,9 @@ import numpy as np
 
 def _num(rng, v):
     """A number as posts write it: 0-4 decimals, sometimes a trailing '.'."""
-    d = int(rng.integers(0, 5))
-    s = f"{v:.{d}f}"
-    if d == 0 and rng.random() < 0.3:
-        s += "."
-    return s
+    if v == round(v):  # integers as posts write them: 12, 12. or 12.000
+        return rng.choice([f"{v:.0f}", f"{v:.0f}.", f"{v:.3f}"])
+    return f"{v:.{int(rng.integers(3, 6))}f}"  # the values carry at most 3 decimals
 
 
 def _val(rng, v, params):
@@ -24,7 +22,7 @@ def _val(rng, v, params):
     if r < 0.6 or not params:
         return _num(rng, v)
     if r < 0.75:
-        k, pv = params[int(rng.integers(len(params)))]
+        k, pv = list(params.items())[int(rng.integers(len(params)))]
         return f"[#{k} + {v - pv:.6f}]"
     if r < 0.85:
         return f"[{v * 2:.6f} / 2]"
@@ -38,7 +36,7 @@ def program(seed: int, n_lines: int = 30, *, valid_share: float = 0.9) -> str:
     rng = np.random.default_rng(seed)
     out = ["G21 G90 G17", "F600"]
     pos = np.array([0.0, 0.0, 10.0])  # program coordinates (G90, mm, no offsets)
-    params: list[tuple[int, float]] = []
+    params: dict[int, float] = {}
     plane = 17
     for _ in range(n_lines):
         r = rng.random()
@@ -80,7 +78,7 @@ def program(seed: int, n_lines: int = 30, *, valid_share: float = 0.9) -> str:
         elif r < 0.55:
             k = int(rng.integers(1, 40))
             v = round(float(rng.uniform(-50, 50)), 3)
-            params.append((k, v))
+            params[k] = v
             out.append(f"#{k} = {v}")
         elif r < 0.6:
             plane = int(rng.choice([17, 18, 19]))
@@ -94,8 +92,8 @@ def program(seed: int, n_lines: int = 30, *, valid_share: float = 0.9) -> str:
             out.append(f"G17 {ret} {code} X{x} Y{y} Z{z} R{rr}")
             out.append("G80")
             plane = 17
-            pos = np.array([x, y, pos[2] if ret == "G98" else rr])
-            pos[2] = max(pos[2], rr) if ret == "G98" else rr
+            pos = np.array([x, y, round(float(rng.uniform(5, 10)), 3)])
+            out.append(f"G0 Z{pos[2]}")
         elif r < 0.7:  # work offsets / G92 round trip, then an absolute re-position
             choice = rng.integers(4)
             if choice == 0:

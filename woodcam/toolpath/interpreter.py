@@ -818,7 +818,9 @@ class Interpreter:
                 raise self.err(f"{k.upper()}{w[k]:g}", "must be a non-negative integer",
                                f"write {k.upper()}{max(0, round(w[k])):d}" if abs(w[k]) < 1e9
                                else "fix the number")
-        # 3-5. feed, spindle, tool
+        # 3-5. feed mode (LinuxCNC zeroes F on every G93/G94/G95), feed, spindle, tool
+        if g & {93.0, 94.0, 95.0}:
+            self.feed = 0.0
         if "f" in w:
             if w["f"] < 0:
                 raise self.err(f"F{w['f']:g}", "negative feed rate", "give F >= 0")

@@ -193,21 +193,40 @@ def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
     hm = np.full((ny, nx), H, float)
     p0 = program.start_mm + off
     p1 = program.end_mm + off
+    if not (np.isfinite(p0).all() and np.isfinite(p1).all()):
+        bad = int(program.line[np.flatnonzero(~(np.isfinite(p0) & np.isfinite(p1)).all(1))[0]])
+        raise WoodcamError(f"simulate: a move of line {bad} has a non-finite coordinate; "
+                           "every move must have finite start_mm and end_mm")
     issues: dict[tuple[str, int], Issue] = {}
     tool_of = program.tool
     R = np.zeros(len(program))
     for tnum, tool in lookup.items():
         R[tool_of == tnum] = tool.radius_mm
     zmin = np.minimum(p0[:, 2], p1[:, 2])
-    # cell index windows of the swept footprints
-    i0 = np.ceil((np.minimum(p0[:, 0], p1[:, 0]) - R) / dx - 0.5).astype(np.int64)
-    i1 = np.floor((np.maximum(p0[:, 0], p1[:, 0]) + R) / dx - 0.5).astype(np.int64)
-    j0 = np.ceil((np.minimum(p0[:, 1], p1[:, 1]) - R) / dy - 0.5).astype(np.int64)
-    j1 = np.floor((np.maximum(p0[:, 1], p1[:, 1]) + R) / dy - 0.5).astype(np.int64)
-    outside = (i0 < 0) | (j0 < 0) | (i1 >= nx) | (j1 >= ny)
-    i0, j0 = np.maximum(i0, 0), np.maximum(j0, 0)
-    i1, j1 = np.minimum(i1, nx - 1), np.minimum(j1, ny - 1)
-    over = (i1 >= i0) & (j1 >= j0)
+    # cell index windows of the swept footprints, in float first (a move to X1e20 must not
+    # overflow the int64 cast), then clipped to the grid
+    fi0 = np.ceil((np.minimum(p0[:, 0], p1[:, 0]) - R) / dx - 0.5)
+    fi1 = np.floor((np.maximum(p0[:, 0], p1[:, 0]) + R) / dx - 0.5)
+    fj0 = np.ceil((np.minimum(p0[:, 1], p1[:, 1]) - R) / dy - 0.5)
+    fj1 = np.floor((np.maximum(p0[:, 1], p1[:, 1]) + R) / dy - 0.5)
+    outside = (fi0 < 0) | (fj0 < 0) | (fi1 >= nx) | (fj1 >= ny)
+    # Moves reaching far outside the stock are cut to the part that can touch it, so the
+    # float32 kernel works on short coordinates (exact: the rest of the move is outside).
+    far = outside & ((fi0 < -nx) | (fj0 < -ny) | (fi1 >= 2 * nx) | (fj1 >= 2 * ny))
+    inside = np.ones(len(p0), bool)
+    if far.any():
+        pad = R[far] + max(dx, dy)
+        p0[far], p1[far], inside[far] = _clip_segments(
+            p0[far], p1[far], np.stack([-pad, -pad], 1), np.stack([W + pad, D + pad], 1))
+        fi0 = np.ceil((np.minimum(p0[:, 0], p1[:, 0]) - R) / dx - 0.5)
+        fi1 = np.floor((np.maximum(p0[:, 0], p1[:, 0]) + R) / dx - 0.5)
+        fj0 = np.ceil((np.minimum(p0[:, 1], p1[:, 1]) - R) / dy - 0.5)
+        fj1 = np.floor((np.maximum(p0[:, 1], p1[:, 1]) + R) / dy - 0.5)
+    i0 = np.clip(fi0, 0, nx).astype(np.int64)
+    j0 = np.clip(fj0, 0, ny).astype(np.int64)
+    i1 = np.clip(fi1, -1, nx - 1).astype(np.int64)
+    j1 = np.clip(fj1, -1, ny - 1).astype(np.int64)
+    over = (i1 >= i0) & (j1 >= j0) & inside
     below_top = zmin < H - SIM_CONTACT_TOL_MM
     kind, lines = program.kind, program.line
     # a move ending below the bottom (the retract out of it is not reported again)
@@ -263,6 +282,45 @@ def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
     return SimResult(hm, (float(W), float(D), float(H)), (dx, dy), report, stats)
 
 
+def _clip_segments(a, b, lo, hi):
+    """Liang-Barsky: the parts of segments ``a -> b`` ``(n, 3)`` whose XY lies in the boxes
+    ``lo, hi : (n, 2)``; Z follows the segment (clamped to +/-1e9 mm for the float32 kernel).
+    Returns ``(a', b', inside (n,) bool)``.
+
+    Exact rational arithmetic (``fractions``): a move from X-1e20 to X1e20 crosses a 100 mm
+    stock at a parameter 0.5 +/- 1e-18 that floats cannot hold. Only moves reaching far outside
+    the stock come here (absurd programs), so the per-move Python loop is not a hot path.
+    """
+    from fractions import Fraction as F
+
+    na, nb = a.copy(), b.copy()
+    ok = np.ones(len(a), bool)
+    for k in range(len(a)):
+        p = [F(float(v)) for v in a[k]]
+        d = [F(float(v)) - q for v, q in zip(b[k], p)]
+        t0, t1 = F(0), F(1)
+        for ax in (0, 1):
+            for num, den in ((p[ax] - F(float(lo[k, ax])), -d[ax]),
+                             (F(float(hi[k, ax])) - p[ax], d[ax])):
+                if den == 0:
+                    if num < 0:
+                        ok[k] = False
+                    continue
+                r = num / den
+                if den < 0:
+                    t0 = max(t0, r)
+                else:
+                    t1 = min(t1, r)
+        if not ok[k] or t0 > t1:
+            ok[k] = False
+            continue
+        na[k] = [float(q + t0 * e) for q, e in zip(p, d)]
+        nb[k] = [float(q + t1 * e) for q, e in zip(p, d)]
+    np.clip(na[:, 2], -1e9, 1e9, out=na[:, 2])
+    np.clip(nb[:, 2], -1e9, 1e9, out=nb[:, 2])
+    return na, nb, ok
+
+
 def _add(issues, kind, line, message):
     key = (kind, int(line))
     if key not in issues:
@@ -294,7 +352,7 @@ def _sweep_batch(hm, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind, lines, is
     s = np.where(plunge, 0.0, ez / Ls)
     z0 = np.where(plunge, np.minimum(a[:, 2], b[:, 2]), a[:, 2])
     L = np.where(plunge, 0.0, L)
-    col = lambda v: np.asarray(v, f32)[:, None, None]  # noqa: E731
+    col = lambda v: np.asarray(np.clip(v, -1e30, 1e30), f32)[:, None, None]  # noqa: E731
     along = (cx * ux[:, None].astype(f32))[:, None, :] + (cy * uy[:, None].astype(f32))[:, :, None]
     # perpendicular distance directly (rr - along^2 would cancel catastrophically in float32)
     perp = (cx * uy[:, None].astype(f32))[:, None, :] - (cy * ux[:, None].astype(f32))[:, :, None]
