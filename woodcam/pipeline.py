@@ -94,7 +94,6 @@ def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, ob
     """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files: the GLB
     in metres, Y up (glTF's convention); the OBJ in ``obj_units`` with ``obj_up`` up."""
     from .bake import bake
-    from .export import export_glb, export_obj
 
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
     result = result or PartPreview(out_glb.stem)
@@ -102,16 +101,52 @@ def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, ob
     result.triangles = int(len(mesh.faces))
     with result.stage("bake"):
         baked = bake(mesh, stock.wood, texels_per_mm=texels_per_mm, progress=progress)
+    return _write_preview(baked, stock, out_glb, result, obj=obj, screenshot=screenshot,
+                          metadata=metadata, obj_units=obj_units, obj_up=obj_up,
+                          normals="crease")
+
+
+def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
+                        flat_tol_mm: float = 0.01, obj: bool = True, screenshot: bool = False,
+                        metadata: dict | None = None, obj_units: str = "m",
+                        obj_up: str = "y") -> PartPreview:
+    """:func:`preview_mesh` for a simulated stock ``heightmap : (ny, nx)`` (block-frame Z, mm,
+    over the stock's XY): meshed and baked by its own planar charts
+    (:func:`woodcam.bake.bake_heightfield`), no generic unwrap."""
+    import numpy as np
+
+    from .bake import bake_heightfield
+
+    out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
+    result = PartPreview(out_glb.stem)
+    with result.stage("bake"):
+        baked = bake_heightfield(heightmap, stock.size_mm, stock.wood,
+                                 texels_per_mm=texels_per_mm, flat_tol_mm=flat_tol_mm)
+    W, D, H = stock.size_mm
+    cell = W * D / np.asarray(heightmap).size
+    result.volume_mm3 = float(np.asarray(heightmap, float).sum() * cell)
+    result.triangles = int(len(baked.mesh.faces))
+    # the height-field bake sets its shading normals from the grid: no crease computation
+    return _write_preview(baked, stock, out_glb, result, obj=obj, screenshot=screenshot,
+                          metadata=metadata, obj_units=obj_units, obj_up=obj_up,
+                          normals="mesh")
+
+
+def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, obj_units,
+                   obj_up, normals) -> PartPreview:
+    from .export import export_glb, export_obj
+
     result.atlas_px = tuple(baked.atlas.shape[:2])
     result.warnings += list(getattr(baked, "warnings", []))
     meta = {"block": stock.spec, "size_mm": list(stock.size_mm), **(metadata or {}),
             "texels_per_mm": float(baked.texels_per_mm)}
     with result.stage("export"):
-        result.files["glb"] = Path(export_glb(baked.mesh, out_glb, metadata=meta) or out_glb)
+        result.files["glb"] = Path(export_glb(baked.mesh, out_glb, metadata=meta,
+                                              normals=normals) or out_glb)
         if obj:
             obj_path = out_glb.with_suffix(".obj")
             result.files["obj"] = Path(export_obj(baked.mesh, obj_path, units=obj_units,
-                                                           up=obj_up) or obj_path)
+                                                  up=obj_up, normals=normals) or obj_path)
     if screenshot:
         from .view import preview
 

@@ -40,20 +40,20 @@ def test_run_simulates_and_hands_a_watertight_mesh_to_the_pipeline(tmp_path, mon
                                                                    capsys):
     seen = {}
 
-    def fake_preview_mesh(mesh, stock, out_glb, **kw):
-        seen.update(mesh=mesh, stock=stock, meta=kw["metadata"])
-        return woodcam.pipeline.PartPreview("x", files={"glb": Path(out_glb)})
+    def fake_preview(heightmap, stock, out_glb, **kw):
+        seen.update(heightmap=heightmap, stock=stock, meta=kw["metadata"])
+        return woodcam.pipeline.PartPreview("x", files={"glb": Path(out_glb)}, triangles=1)
 
-    monkeypatch.setattr(woodcam.pipeline, "preview_mesh", fake_preview_mesh)
+    monkeypatch.setattr(woodcam.pipeline, "preview_heightfield", fake_preview)
     prog = tmp_path / "slot.nc"
     prog.write_text("G0 X20 Y40 Z2\nG1 Z-3 F300\nX80\nG0 Z2\n")
     args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
                    "--tool", "flat:6", "--resolution", "0.25"])
     assert args.func(args) == 0
-    mesh = seen["mesh"]
-    assert mesh.is_watertight
     W, D, H = seen["stock"].size_mm
-    assert mesh.volume == pytest.approx(W * D * H - 3 * (60 * 6 + 3.14159265 * 9), rel=5e-3)
+    hm = seen["heightmap"]
+    assert (H - hm).sum() * W * D / hm.size == pytest.approx(3 * (60 * 6 + 3.14159265 * 9),
+                                                             rel=5e-3)
     assert seen["meta"]["tools"] == {"0": "flat:6"}
     assert "slot.nc: 4 moves" in capsys.readouterr().out
 

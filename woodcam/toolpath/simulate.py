@@ -151,6 +151,28 @@ def _tool_lookup(program: Program, tools) -> dict[int, Tool]:
     return out
 
 
+def _reuse_freed_memory() -> None:
+    """Keep freed blocks in the heap (glibc ``mallopt``): the batch temporaries (~0.25 MB
+    each) are otherwise handed back to the OS and faulted in again on every batch, which made
+    the first simulation of a process 2x slower (raster benchmark: 2.2 s -> 1.1 s CPU, page
+    faults 1.6 M -> 1.5 k). A no-op where the C library is not glibc."""
+    global _MALLOC_SET
+    if _MALLOC_SET:
+        return
+    _MALLOC_SET = True
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL("libc.so.6")
+        libc.mallopt(-3, 256 << 20)  # M_MMAP_THRESHOLD: blocks below 256 MB from the heap
+        libc.mallopt(-1, 512 << 20)  # M_TRIM_THRESHOLD: keep up to 512 MB of freed heap
+    except (OSError, AttributeError):
+        pass
+
+
+_MALLOC_SET = False
+
+
 def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
              work_offset_mm=None, progress: bool = False) -> SimResult:
     """Remove the swept tools of ``program`` from a ``W x D x H`` stock on a height field.
@@ -181,6 +203,7 @@ def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
     if not resolution_mm > 0:
         raise WoodcamError(f"simulate: resolution_mm must be > 0, got {resolution_mm!r}; "
                            "use e.g. 0.1")
+    _reuse_freed_memory()
     W, D, H = size
     off = np.array([0.0, 0.0, H]) if work_offset_mm is None else np.asarray(work_offset_mm, float)
     nx, ny = max(1, round(W / resolution_mm)), max(1, round(D / resolution_mm))
