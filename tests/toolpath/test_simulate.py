@@ -19,7 +19,7 @@ SIZE = (40.0, 30.0, 12.0)
 
 def test_flat_slot_matches_analytic_volume_and_depth():
     # 6 mm flat end mill, 20 mm slot, 3 mm deep: volume = 3 (20 * 6 + pi 3^2)
-    prog = read_gcode("G0 X10 Y15 Z2\nG1 Z-3 F300\nX30\nG0 Z2\n")
+    prog = read_gcode("G0 X10 Y15 Z2 M3 S12000\nG1 Z-3 F300\nX30\nG0 Z2\n")
     res = simulate(prog, FlatEndMill(6), SIZE, resolution_mm=0.05)
     exact = 3 * (20 * 6 + math.pi * 9)
     assert res.removed_volume_mm3 == pytest.approx(exact, rel=2e-3)
@@ -95,7 +95,7 @@ def test_inch_and_incremental_give_the_same_stock():
 
 
 def test_report_names_lines():
-    text = ("G0 X5 Y5 Z2\n"          # 1
+    text = ("G0 X5 Y5 Z2 M3 S9000\n"  # 1
             "G1 Z-1 F300\n"          # 2
             "G0 X20\n"               # 3 rapid through stock
             "G1 Z-13\n"              # 4 below the bottom (stock is 12 high)
@@ -114,7 +114,7 @@ def test_report_names_lines():
 
 
 def test_rapid_into_an_already_cut_pocket_is_not_reported():
-    text = "G0 X10 Y10 Z2\nG1 Z-3 F300\nX20\nG0 Z2\nG0 X10\nG0 Z-2\nG1 Z-4\nG0 Z2\n"
+    text = "G0 X10 Y10 Z2 M3 S9000\nG1 Z-3 F300\nX20\nG0 Z2\nG0 X10\nG0 Z-2\nG1 Z-4\nG0 Z2\n"
     res = simulate(read_gcode(text), FlatEndMill(4), SIZE)
     assert res.report == []
 
@@ -185,3 +185,12 @@ def test_mesh_of_a_through_cut_stays_closed():
     mesh = res.to_mesh()
     assert mesh.is_watertight
     assert mesh.volume == pytest.approx(np.prod(SIZE) - res.removed_volume_mm3, rel=1e-12)
+
+
+def test_spindle_off_and_tool_without_m6_are_reported_with_lines():
+    prog = read_gcode("G0 X10 Y10 Z2\nG1 Z-2 F300\nM3 S9000\nG1 X20\nM5\nG1 Y20\n"
+                      "T2\nG1 X10\nM2\n")
+    res = simulate(prog, FlatEndMill(4), SIZE)
+    assert {(i.kind, i.line) for i in res.report} == {("spindle_off", 2), ("spindle_off", 6)}
+    assert prog.tool.tolist() == [0] * len(prog)  # T2 without M6: the loaded tool cuts on
+    assert [w for w in prog.warnings if "without M6" in w][0].startswith("line 8:")

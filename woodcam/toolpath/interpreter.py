@@ -226,6 +226,7 @@ class Interpreter:
         self.ended = False
         self.known = [False, False, False]
         self._warned_start = False
+        self._t_warned: set[int] = set()
         self.line_no = 0
 
     # -- helpers ----------------------------------------------------------------------------
@@ -262,6 +263,10 @@ class Interpreter:
             self.warn(f"the first cut starts before the program set {miss}: it starts from "
                       f"the start position X{self.pos[0]:g} Y{self.pos[1]:g} Z{self.pos[2]:g} "
                       "mm (--start)")
+        if kind != TRAVERSE and self.selected != self.tool and self.selected not in self._t_warned:
+            self._t_warned.add(self.selected)
+            self.warn(f"T{self.selected} was selected without M6: the cut goes on with the "
+                      f"loaded tool T{self.tool}, as the controller does")
         feed = self.feed * self.scale
         self.moves.append((kind, self.line_no, tuple(end), centre, rotation, self.plane, feed,
                            self.spindle if self.spindle_on else 0.0, self.tool))

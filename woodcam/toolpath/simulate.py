@@ -53,7 +53,8 @@ from .tools import Tool
 _BATCH_CELLS = 1 << 16
 
 
-IssueKind = Literal["rapid_through_stock", "below_stock_bottom", "cut_outside_stock"]
+IssueKind = Literal["rapid_through_stock", "below_stock_bottom", "cut_outside_stock",
+                    "spindle_off"]
 
 #: Issues of one kind listed one by one before the rest are summarised in one entry.
 MAX_ISSUES_PER_KIND = 12
@@ -79,7 +80,7 @@ def _summarise(issues: dict, move_lines: np.ndarray) -> list[Issue]:
     such as a lone ``F`` word, do not break a run); cap each kind at MAX_ISSUES_PER_KIND."""
     ranks = {int(v): k for k, v in enumerate(np.unique(move_lines))}
     out = []
-    for kind in ("rapid_through_stock", "below_stock_bottom", "cut_outside_stock"):
+    for kind in ("rapid_through_stock", "below_stock_bottom", "cut_outside_stock", "spindle_off"):
         items = sorted((i for (k, _), i in issues.items() if k == kind), key=lambda i: i.line)
         runs: list[list[Issue]] = []
         for it in items:
@@ -261,6 +262,9 @@ def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
         _add(issues, "cut_outside_stock", lines[k],
              f"tool T{tool_of[k]} is below the stock top (z = {zmin[k] - off[2]:.3f} mm) with "
              "its footprint outside the stock")
+    for k in np.flatnonzero(below_top & over & (kind == FEED) & ~(program.spindle_rpm > 0)):
+        _add(issues, "spindle_off", lines[k], "feed move into the stock with the spindle off "
+             "(no M3/M4 with S > 0 before it): the controller would cut with a still tool")
     act = np.flatnonzero(below_top & over)  # program order
     # Runs in program order, broken at tool changes and before/after every rapid that reaches
     # below the stock top: the rapid check must see the stock as cut by all earlier moves.
