@@ -816,6 +816,7 @@ def preview(
     cut_origin=None,
     cut_normal=None,
     resolution_mm: float = SECTION_RESOLUTION_MM,
+    overlay=None,
 ) -> Path | None:
     """Show a textured part inside its translucent block, or write a screenshot of it.
 
@@ -847,6 +848,9 @@ def preview(
     resolution_mm : float
         Sample spacing of the wood on the plane (coarsened for very large sections and, in the
         interactive window, while dragging).
+    overlay : list of (segments (k, 2, 3) mm, colour, width px), optional
+        Line segments drawn over the scene in the block frame (e.g. a toolpath: rapids and
+        feeds in two colours, :func:`woodcam.toolpath.gcode.Program` moves).
 
     Returns
     -------
@@ -894,6 +898,13 @@ def preview(
             max_samples=(SECTION_MAX_SAMPLES_SCREENSHOT if off_screen
                          else SECTION_MAX_SAMPLES_INTERACTIVE),
         )
+        for segments, colour, width in overlay or ():
+            seg = np.asarray(segments, dtype=float).reshape(-1, 2, 3)
+            if len(seg):
+                n = len(seg)
+                cells = np.column_stack([np.full(n, 2), 2 * np.arange(n), 2 * np.arange(n) + 1])
+                plotter.add_mesh(pv.PolyData(seg.reshape(-1, 3), lines=cells.ravel()),
+                                 color=colour, line_width=width, render_lines_as_tubes=False)
         # Translucent block and waste wood over the part: sort them per pixel.
         plotter.enable_depth_peeling()
         plotter.enable_anti_aliasing("ssaa")

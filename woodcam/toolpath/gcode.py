@@ -88,6 +88,29 @@ class Program:
     def moves(self) -> list[Move]:
         return list(self)
 
+    def machining_time_s(self, rapid_mm_min: float = 5000.0) -> dict[int, tuple[float, float]]:
+        """Estimated time per tool: ``{tool: (feed seconds, rapid seconds)}`` from the move
+        lengths (mm), the programmed feeds (mm/min) and ``rapid_mm_min`` for rapids (the
+        machine's rapid rate; no acceleration is modelled, so real jobs take longer)."""
+        if not (math.isfinite(rapid_mm_min) and rapid_mm_min > 0):
+            raise WoodcamError(f"machining_time_s: rapid_mm_min must be > 0, got "
+                               f"{rapid_mm_min!r}; e.g. 5000")
+        length = np.linalg.norm(self.end_mm - self.start_mm, axis=1)
+        feed = self.kind == FEED
+        with np.errstate(divide="ignore"):
+            t = np.where(feed, 60.0 * length / np.maximum(self.feed_mm_min, 1e-9),
+                         60.0 * length / rapid_mm_min)
+        return {int(k): (float(t[feed & (self.tool == k)].sum()),
+                         float(t[~feed & (self.tool == k)].sum()))
+                for k in np.unique(self.tool)}
+
+    def until_line(self, line: int) -> Program:
+        """The moves of source lines ``<= line`` (the simulation scrubbed to that line)."""
+        k = self.line <= int(line)
+        return Program(self.start_mm[k], self.end_mm[k], self.kind[k], self.tool[k],
+                       self.line[k], self.feed_mm_min[k], self.spindle_rpm[k], self.source,
+                       sorted(set(self.tool[k].tolist())), list(self.warnings))
+
     @classmethod
     def from_arrays(cls, start_mm, end_mm, *, kind=FEED, tool=1, line=0, feed_mm_min=1000.0,
                     spindle_rpm=18000.0, source="<arrays>") -> "Program":

@@ -175,7 +175,8 @@ _MALLOC_SET = False
 
 
 def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
-             work_offset_mm=None, progress: bool = False) -> SimResult:
+             work_offset_mm=None, progress: bool = False,
+             initial_heightmap=None) -> SimResult:
     """Remove the swept tools of ``program`` from a ``W x D x H`` stock on a height field.
 
     Parameters
@@ -192,6 +193,9 @@ def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
         Block-frame position of G-code zero; ``None`` means ``(0, 0, H)``.
     progress : bool
         Show a tqdm progress bar over the batches.
+    initial_heightmap : (ny, nx) float | None
+        The stock as an earlier program left it (``SimResult.heightmap`` of the same size and
+        resolution): programs of one job (roughing, then finishing) run in sequence.
 
     Returns
     -------
@@ -214,7 +218,15 @@ def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
     dx, dy = W / nx, D / ny
     lookup = _tool_lookup(program, tools)
     t0 = time.perf_counter()
-    hm = np.full((ny, nx), H, float)
+    if initial_heightmap is None:
+        hm = np.full((ny, nx), H, float)
+    else:
+        hm = np.array(initial_heightmap, float)
+        if hm.shape != (ny, nx) or not np.isfinite(hm).all():
+            raise WoodcamError(f"simulate: initial_heightmap must be a finite ({ny}, {nx}) "
+                               f"array for this stock and resolution, got {hm.shape}; pass the "
+                               "heightmap of an earlier simulate() with the same size_mm and "
+                               "resolution_mm")
     p0 = program.start_mm + off
     p1 = program.end_mm + off
     if not (np.isfinite(p0).all() and np.isfinite(p1).all()):
