@@ -60,10 +60,12 @@ DIALECTS: tuple[str, ...] = ("linuxcnc", "grbl", "fanuc")
 #: LinuxCNC refuses a tenth nested subroutine call ("Too many subroutine levels").
 MAX_CALL_DEPTH = 9
 #: Executed lines before woodcam stops a program as an endless loop (a 35,000-line relief runs
-#: 35,000; loops that engrave text run a few 100,000).
-MAX_BLOCKS = 2_000_000
-#: Canonical moves before woodcam stops (memory guard: ~100 bytes each).
-MAX_MOVES = 5_000_000
+#: 35,000; loops that engrave text a few 10,000): ~10 s of CPU at ~50,000 lines/s.
+MAX_BLOCKS = 500_000
+#: Canonical moves before woodcam stops (the largest public program here has ~67,000).
+MAX_MOVES = 1_000_000
+#: Canned-cycle repeats (L) one block may ask for.
+MAX_CYCLE_REPEATS = 10_000
 MM_PER_INCH = 25.4
 #: LinuxCNC's G73/G83 retract clearance above the previous peck, 0.010 inch.
 _RAPID_DELTA_IN = 0.010
@@ -1116,6 +1118,9 @@ class Interpreter:
         reps = 1
         if "l" in w:
             reps = int(w["l"])
+            if not 1 <= reps <= MAX_CYCLE_REPEATS:
+                raise self.err(f"L{reps}", f"cycle repeats L must be 1-{MAX_CYCLE_REPEATS}",
+                               "fix L")
         if math.isnan(c["r"]) or math.isnan(c["z"]):
             raise self.err(code, "drilling cycle without R and Z", "give R (retract) and Z "
                            "(depth)")
