@@ -122,3 +122,46 @@ def test_waterline_has_no_gouge(tmp_path):
     res, part, over = _check_no_gouge(_gcode(loops), "flat:6", Z)
     assert over.max() <= max(res.cell_mm), f"gouge of {over.max():.3f} mm"
     assert res.removed_volume_mm3 > 1000  # the levels really cut around the dome
+
+
+def _part_solid(Z):
+    """The dome part as a closed solid (the STL's top triangles, walls and a bottom)."""
+    import trimesh
+
+    xs, ys = np.linspace(0, W, NX), np.linspace(0, D, NY)
+    X, Y = np.meshgrid(xs, ys)
+    top = np.c_[X.ravel(), Y.ravel(), Z.ravel()]
+    bot = np.c_[X.ravel(), Y.ravel(), np.zeros(NX * NY)]
+    n = NX * NY
+    a = (np.arange(NY - 1)[:, None] * NX + np.arange(NX - 1)[None, :]).ravel()
+    faces = [np.c_[a, a + 1, a + NX + 1], np.c_[a, a + NX + 1, a + NX],       # top, up
+             np.c_[a, a + NX + 1, a + 1] + n, np.c_[a, a + NX, a + NX + 1] + n]  # bottom
+    ring = np.concatenate([np.arange(NX - 1), (NX - 1) + NX * np.arange(NY - 1),
+                           NX * NY - 1 - np.arange(NX - 1), NX * (NY - 1) - NX * np.arange(NY - 1)])
+    nxt = np.roll(ring, -1)
+    faces += [np.c_[ring, ring + n, nxt + n], np.c_[ring, nxt + n, nxt]]
+    mesh = trimesh.Trimesh(np.vstack([top, bot]), np.vstack(faces), process=False)
+    if mesh.volume < 0:
+        mesh.invert()
+    return mesh
+
+
+def test_deviation_map_is_zero_on_the_machined_part_and_lists_gouges(tmp_path):
+    from woodcam.cad import load_part
+    from woodcam.toolpath.deviation import deviation, deviation_png
+
+    path, Z = _part_stl(tmp_path)
+    solid = load_part(_part_solid(Z))
+    text = _gcode(_drop_cutter_raster(_surface(path), 6.0, 1.0))
+    prog = read_gcode(text, start_mm=(0, 0, H + 5))
+    good = deviation(simulate(prog, parse_tool_spec("ball:6"), (W, D, H), resolution_mm=0.25,
+                              work_offset_mm=(0, 0, 0), track_lines=True), solid)
+    inner = good.difference_mm[8:-8, 8:-8]
+    assert np.median(np.abs(inner)) < 0.05 and good.overcut_mm3 < 0.5 and not good.gouges
+    bad = deviation(simulate(prog, parse_tool_spec("ball:8"), (W, D, H), resolution_mm=0.25,
+                             work_offset_mm=(0, 0, 0), track_lines=True), solid)
+    assert bad.overcut_mm3 > 10 * max(good.overcut_mm3, 0.1) and bad.gouges
+    feed_lines = set(prog.line[prog.kind == 1].tolist())
+    assert {ln for ln, _ in bad.gouges} <= feed_lines
+    png = deviation_png(bad, tmp_path / "dev.png")
+    assert png.stat().st_size > 10_000

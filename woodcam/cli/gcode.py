@@ -78,6 +78,10 @@ def register(subparsers) -> None:
                    "shows a relief without a cut)")
     p.add_argument("--no-overlay", action="store_true",
                    help="leave the toolpath (rapids red, feeds blue) out of the screenshot")
+    p.add_argument("--part", default=None, metavar="PART",
+                   help="design part (STL/STEP/OBJ/GLB or a part script, block frame, mm): "
+                   "report leftover and overcut volumes, gouges by line, and write a "
+                   "deviation map (OUT with _deviation.png)")
     p.add_argument("--strict", action="store_true",
                    help="exit with status 3 when the reader or the simulation warned")
     p.add_argument("--mesh-tol", type=float, default=0.05, metavar="MM",
@@ -189,7 +193,8 @@ def run(args) -> int:
                                "program you meant")
         tools = _tools_from_args(args, program)
         res = simulate(program, tools, stock.size_mm, resolution_mm=args.resolution,
-                       work_offset_mm=offset, progress=False, initial_heightmap=hm)
+                       work_offset_mm=offset, progress=False, initial_heightmap=hm,
+                       track_lines=bool(args.part))
         hm = res.heightmap
         for issue in res.report:
             print(f"woodcam: warning: {path.name} {issue}", file=sys.stderr)
@@ -206,6 +211,19 @@ def run(args) -> int:
                               "machining_time_s": sum(f + r for f, r in times.values())})
         last = (program, res)
     program, res = last
+    if args.part:
+        from ..cad import load_part
+        from ..toolpath.deviation import deviation, deviation_png
+
+        dev = deviation(res, load_part(args.part))
+        png = Path(args.out).with_name(Path(args.out).stem + "_deviation.png")
+        deviation_png(dev, png, title=f"{Path(args.part).name}:\n{dev.summary(gouges=False)}"
+                      + (f", {len(dev.gouges)} gouging lines" if dev.gouges else ""))
+        print(f"deviation from {Path(args.part).name}: {dev.summary()}; map {png}")
+        for ln, d in dev.gouges[:12]:
+            print(f"woodcam: warning: line {ln}: gouge: cuts {d:.3f} mm into the part",
+                  file=sys.stderr)
+        n_warn += len(dev.gouges)
     meta = {"gcode": [m["gcode"] for m in meta_programs] if len(meta_programs) > 1
             else meta_programs[0]["gcode"],
             "tools": {t: v for m in meta_programs for t, v in m["tools"].items()},
