@@ -23,8 +23,10 @@ examples:
       --block builtin:quarter-sawn --out out/pocket.glb
   woodcam gcode prog.nc --tool 1=flat:6.35 --tool 2=ball:3 --block builtin:rift --out out/p.glb
 
-Tool specs (diameters in mm, angles in degrees): flat:D, ball:D, bull:D:CORNER_R, vbit:ANGLE:D;
-prefix N= to give the tool number of the program (T N M6). Work zero defaults to the stock's
+Tool specs (diameters in mm, angles in degrees): flat:D, ball:D, bull:D:CORNER_R, vbit:ANGLE:D,
+snub:ANGLE:D:TIP (engraving cone with a flat tip), chamfer:ANGLE:D:TIP, taperball:D:TIP:TAPER
+(taper per side); prefix N= to give the tool number of the program (T N M6). --tools reads a
+TOML tool table or a CAMotics JSON tool table. Work zero defaults to the stock's
 top-front-left corner (G-code z = 0 on the top face).
 """
 
@@ -46,7 +48,8 @@ def register(subparsers) -> None:
                    "(repeatable; without N= the tools go to the program's tool numbers in "
                    "order of first use)")
     p.add_argument("--tools", type=Path, default=None, metavar="TOML",
-                   help="tool table file ([tools.N] type/diameter_mm/...)")
+                   help="tool table file: TOML ([tools.N] type/diameter_mm/...) or a CAMotics "
+                   "JSON tool table (.json)")
     p.add_argument("--resolution", type=float, default=0.1, metavar="MM",
                    help="height-field cell size (default 0.1 mm)")
     p.add_argument("--work-offset", default=None, metavar="X,Y,Z", type=_triple("--work-offset"),
