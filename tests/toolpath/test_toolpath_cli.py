@@ -137,3 +137,17 @@ def test_machining_time_estimate():
     assert t[2] == pytest.approx((3.0, 0.0))
     with pytest.raises(WoodcamError, match="rapid_mm_min"):
         prog.machining_time_s(0)
+
+
+def test_grid_coarser_than_half_the_stepover_warns(tmp_path, monkeypatch, capsys):
+    _stub_preview(monkeypatch, {})
+    prog = REPO / "toolpaths" / "corpus" / "gen_raster_fine.ngc"  # 0.5 mm step-over
+    assert read_gcode(prog).stepover_mm(0.1) == pytest.approx(0.5, abs=0.01)
+    base = [str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+            "--tool", "1=ball:6", "--strict"]
+    args = _parse([*base, "--resolution", "0.4"])
+    assert args.func(args) == 3
+    assert "coarser than half the step-over (0.5 mm)" in capsys.readouterr().err
+    args = _parse([*base, "--resolution", "0.2"])
+    args.func(args)
+    assert "step-over" not in capsys.readouterr().err

@@ -195,6 +195,12 @@ def run(args) -> int:
                                "drilling cycle); nothing to simulate. Check that it is the "
                                "program you meant")
         tools = _tools_from_args(args, program)
+        step = program.stepover_mm(spacing_mm=args.resolution)
+        if step is not None and args.resolution > step / 2:
+            print(f"woodcam: warning: {path.name}: the grid ({args.resolution:g} mm) is coarser "
+                  f"than half the step-over ({step:.3g} mm): expect aliasing waves; use "
+                  f"--resolution {step / 2:.2g} or finer", file=sys.stderr)
+            n_warn += 1
         res = simulate(program, tools, stock.size_mm, resolution_mm=args.resolution,
                        work_offset_mm=offset, progress=False, initial_heightmap=hm,
                        track_lines=bool(args.part))
