@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -176,3 +177,28 @@ def test_fanuc_program_number_g28_and_g53():
                                              [10, 10, 40], [10, 10, 7], [20, 10, 7],
                                              [20, 10, -1]])
     assert prog.line.tolist() == [2, 3, 4, 4, 6, 7, 8]
+
+
+CORPUS = sorted((Path(__file__).resolve().parents[2] / "toolpaths" / "corpus").glob("*.*[!y]"))
+
+
+@pytest.mark.parametrize("path", CORPUS, ids=lambda p: p.name)
+def test_corpus_programs_simulate_or_fail_with_their_reason(path):
+    """Every corpus program either simulates (finite, something cut) or, for the err_* ones,
+    is refused at the line its header comment names the reason of."""
+    from woodcam.toolpath import parse_tool_spec, simulate
+
+    if path.name.startswith("err_"):
+        reason = path.read_text().splitlines()[0]
+        with pytest.raises(GcodeError) as e:
+            read_gcode(path, dialect="linuxcnc")
+        assert e.value.line > 1, reason
+        return
+    dialect = "fanuc" if path.name.startswith("fanuc") else "linuxcnc"
+    prog = read_gcode(path, dialect=dialect)
+    assert (prog.kind == FEED).any()
+    res = simulate(prog, parse_tool_spec("ball:6"), (120.0, 100.0, 50.0), resolution_mm=0.5,
+                   work_offset_mm=(10.0, 10.0, 50.0))
+    assert np.isfinite(res.heightmap).all()
+    if (prog.end_mm[prog.kind == FEED, 2] < 0).any():  # (two language tests stay above)
+        assert res.removed_volume_mm3 > 0
