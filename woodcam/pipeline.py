@@ -38,6 +38,9 @@ class PartPreview:
     timings_s: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     meta_block: str = ""
+    tessellation: dict = field(default_factory=dict)
+    atlas: str = ""
+    report: dict = field(default_factory=dict)
 
     @contextmanager
     def stage(self, name: str):
@@ -56,8 +59,10 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
 
     out_glb = check_output_path(out_glb, suffixes=(".glb",), what=what, mkdir=True)
     if obj:
-        for suffix in (".obj", ".mtl", ".png"):
-            check_output_path(out_glb.with_suffix(suffix), what=f"{what} (the {suffix[1:].upper()} "
+        for sibling in (out_glb.with_suffix(".obj"), out_glb.with_suffix(".mtl"),
+                        out_glb.with_name(out_glb.stem + "_texture.png")):
+            suffix = sibling.suffix
+            check_output_path(sibling, what=f"{what} (the {suffix[1:].upper()} "
                               "beside the GLB; --no-obj skips it)")
     if screenshot is True:
         check_output_path(out_glb.with_name(out_glb.stem + "_view.png"), what=f"{what} (its view PNG)")
@@ -69,28 +74,45 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
 def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                  tolerance_mm: float | None = None, obj: bool = True,
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
-                 obj_up: str = "y") -> PartPreview:
+                 obj_up: str = "y", max_triangles: int | None = None,
+                 max_atlas_px: int = 4096, place: list[str] | tuple = ()) -> PartPreview:
     """Carve ``source`` (anything :func:`woodcam.cad.load_part` takes) out of ``stock``, bake it
-    and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``)."""
+    and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``).
+
+    ``place`` lists placement operations applied to the loaded part before carving
+    (:mod:`woodcam.cad.place`, e.g. ``["rotate:x:90", "center", "drop"]``); the resulting
+    4 x 4 matrix is recorded in the GLB metadata as ``placement``."""
     from .cad import carve, load_part
-    from .tolerances import TESSELLATION_TOL_MM
+    from .tolerances import MAX_PART_TRIANGLES, TESSELLATION_TOL_MM
 
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)  # before minutes of work
     result = PartPreview(out_glb.stem)
     with result.stage("load"):
-        part = load_part(source, tolerance_mm=tolerance_mm or TESSELLATION_TOL_MM)
+        part = load_part(source, tolerance_mm=tolerance_mm or TESSELLATION_TOL_MM,
+                         max_triangles=max_triangles or MAX_PART_TRIANGLES,
+                         report=result.tessellation)
+    result.warnings += list(result.tessellation.get("notes", []))
+    metadata = None
+    if place:
+        from .cad.place import place_part
+
+        part, matrix = place_part(part, list(place), stock.size_mm)
+        metadata = {"placement": {"ops": list(place), "matrix": matrix.tolist()}}
     with result.stage("carve"):
         carved = carve(part, stock.size_mm)
     result.warnings += list(carved.warnings)
     return preview_mesh(carved.mesh, stock, out_glb, texels_per_mm=texels_per_mm, obj=obj,
+                        part_report=True,
                         screenshot=screenshot, progress=progress, result=result,
-                        obj_units=obj_units, obj_up=obj_up)
+                        obj_units=obj_units, obj_up=obj_up, max_atlas_px=max_atlas_px,
+                        metadata=metadata)
 
 
 def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, obj: bool = True,
                  screenshot: bool = True, progress: bool = False,
                  result: PartPreview | None = None, metadata: dict | None = None,
-                 obj_units: str = "m", obj_up: str = "y") -> PartPreview:
+                 obj_units: str = "m", obj_up: str = "y",
+                 max_atlas_px: int = 4096, part_report: bool = False) -> PartPreview:
     """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files: the GLB
     in metres, Y up (glTF's convention); the OBJ in ``obj_units`` with ``obj_up`` up."""
     from .bake import bake
@@ -100,16 +122,17 @@ def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, ob
     result.volume_mm3 = float(mesh.volume)
     result.triangles = int(len(mesh.faces))
     with result.stage("bake"):
-        baked = bake(mesh, stock.wood, texels_per_mm=texels_per_mm, progress=progress)
+        baked = bake(mesh, stock.wood, texels_per_mm=texels_per_mm, progress=progress,
+                     max_atlas_px=max_atlas_px)
     return _write_preview(baked, stock, out_glb, result, obj=obj, screenshot=screenshot,
                           metadata=metadata, obj_units=obj_units, obj_up=obj_up,
-                          normals="crease")
+                          normals="crease", report_mesh=mesh if part_report else None)
 
 
 def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                         flat_tol_mm: float = 0.01, obj: bool = True, screenshot: bool = False,
                         metadata: dict | None = None, obj_units: str = "m",
-                        obj_up: str = "y") -> PartPreview:
+                        obj_up: str = "y", max_atlas_px: int = 4096) -> PartPreview:
     """:func:`preview_mesh` for a simulated stock ``heightmap : (ny, nx)`` (block-frame Z, mm,
     over the stock's XY): meshed and baked by its own planar charts
     (:func:`woodcam.bake.bake_heightfield`), no generic unwrap."""
@@ -121,7 +144,8 @@ def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: floa
     result = PartPreview(out_glb.stem)
     with result.stage("bake"):
         baked = bake_heightfield(heightmap, stock.size_mm, stock.wood,
-                                 texels_per_mm=texels_per_mm, flat_tol_mm=flat_tol_mm)
+                                 texels_per_mm=texels_per_mm, flat_tol_mm=flat_tol_mm,
+                                 max_atlas_px=max_atlas_px)
     W, D, H = stock.size_mm
     cell = W * D / np.asarray(heightmap).size
     result.volume_mm3 = float(np.asarray(heightmap, float).sum() * cell)
@@ -129,16 +153,42 @@ def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: floa
     # the height-field bake sets its shading normals from the grid: no crease computation
     return _write_preview(baked, stock, out_glb, result, obj=obj, screenshot=screenshot,
                           metadata=metadata, obj_units=obj_units, obj_up=obj_up,
-                          normals="mesh")
+                          normals="mesh", report_mesh=None)
 
 
 def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, obj_units,
-                   obj_up, normals) -> PartPreview:
+                   obj_up, normals, report_mesh) -> PartPreview:
+    """Write the baked mesh's GLB (and OBJ, screenshot, and the part report of
+    ``report_mesh`` when given) with the stock's metadata."""
     from .export import export_glb, export_obj
 
+    mesh = report_mesh
+    part_report = report_mesh is not None
     result.atlas_px = tuple(baked.atlas.shape[:2])
+    result.atlas = baked.summary()
+    if part_report:
+        import json
+
+        from ._atomic import write_bytes
+        from .advise import part_report as _part_report
+        from .advise import report_text
+
+        with result.stage("report"):
+            result.report = _part_report(mesh, stock)
+            stem = out_glb.with_name(out_glb.stem + "_report")
+            write_bytes(stem.with_suffix(".json"), json.dumps(result.report, indent=1).encode())
+            write_bytes(stem.with_suffix(".txt"), (report_text(result.report, out_glb.stem)
+                                                   + "\n").encode())
+        result.files["report"] = stem.with_suffix(".txt")
     result.warnings += list(getattr(baked, "warnings", []))
-    meta = {"block": stock.spec, "size_mm": list(stock.size_mm), **(metadata or {}),
+    from .stock import absolute_spec, spec_digest
+
+    meta = {"block": absolute_spec(stock.spec), "block_digest": spec_digest(stock.spec),
+            "size_mm": list(stock.size_mm),
+            "appearance": {"kind": stock.meta.get("appearance", "colormap"),
+                           "species": stock.meta.get("species"),
+                           "params": stock.meta.get("appearance_params", {})},
+            **(metadata or {}),
             "texels_per_mm": float(baked.texels_per_mm)}
     with result.stage("export"):
         result.files["glb"] = Path(export_glb(baked.mesh, out_glb, metadata=meta,

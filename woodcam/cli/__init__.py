@@ -25,6 +25,8 @@ from ..errors import WoodcamError
 COMMANDS: tuple[str, ...] = (
     "woodcam.cli.bake",          # demo, bake, preview, blocks
     "woodcam.cli.gcode",         # gcode
+    "woodcam.cli.review",        # review
+    "woodcam.cli.place",         # place
     "woodcam.cli.block",         # block synth | show
     "woodcam.cli.log",           # log render | maps | export
     "woodcam.cli.fit",           # fit, eval rings
@@ -62,6 +64,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="woodcam", description="CNC cut preview for solid wood: carve a part out of a "
         "block whose growth rings are known and see the wood on every surface.",
         epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    from .. import __version__
+
+    parser.add_argument("--version", action="version", version=f"woodcam {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMANDS:

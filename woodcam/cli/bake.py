@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .options import BLOCK_SPEC_HELP, add_bake_options, stock_options, write_screenshot
+from .options import (BLOCK_SPEC_HELP, add_bake_options, allow_negative_values, stock_options,
+                      vector_mm, write_screenshot)
 
 
 def register(subparsers) -> None:
@@ -27,6 +28,15 @@ def register(subparsers) -> None:
     p.add_argument("--out", type=Path, required=True, help="output .glb path")
     p.add_argument("--tolerance", type=float, default=None, metavar="MM",
                    help="tessellation chord tolerance for B-rep parts (default 0.05 mm)")
+    p.add_argument("--place", action="append", default=[], metavar="OP",
+                   help="place the part in the block before carving; repeatable, applied in "
+                   "order: rotate:AXIS:DEG (about the part's centre), translate:X,Y,Z (mm), "
+                   "scale:S, center, drop (onto the bottom face), fit[:MARGIN] (scale into the "
+                   "block, default margin 2 mm). Turn the block instead with a spec ending in "
+                   "~AXIS90 (e.g. builtin:flat-sawn~z90)")
+    p.add_argument("--max-triangles", type=int, default=None, metavar="N",
+                   help="triangle budget for B-rep parts: above it the part is re-meshed with "
+                   "looser tolerances, and the summary says so (default 120000)")
     add_bake_options(p)
     p.set_defaults(func=run_bake)
 
@@ -39,6 +49,16 @@ def register(subparsers) -> None:
                    help="render to this PNG instead of opening a window")
     p.add_argument("--block", default=None,
                    help="block spec for the cut plane (default: the one stored in the GLB)")
+    p.add_argument("--camera", choices=("iso", "front", "back", "left", "right", "top", "bottom"),
+                   default="iso", help="view direction (default iso: from front-right-above)")
+    p.add_argument("--no-cut", action="store_true",
+                   help="no cut plane: the part alone in its translucent block")
+    p.add_argument("--cut-origin", type=vector_mm, default=None, metavar="X,Y,Z",
+                   help="a point of the cut plane, block frame mm (default the block centre)")
+    p.add_argument("--cut-normal", type=vector_mm, default=None, metavar="X,Y,Z",
+                   help="the cut plane's normal, towards the side cut away (default: the block's "
+                   "longest axis facing the camera)")
+    allow_negative_values(p)
     p.set_defaults(func=run_preview)
 
     p = subparsers.add_parser("blocks", help="list the built-in synthetic blocks")
@@ -63,25 +83,32 @@ def run_bake(args: argparse.Namespace) -> int:
     stock = open_stock(args.block, **stock_options(args))
     res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
                        tolerance_mm=args.tolerance, obj=not args.no_obj, screenshot=False,
-                       progress=True, obj_units=args.obj_units, obj_up=args.obj_up)
+                       progress=True, obj_units=args.obj_units, obj_up=args.obj_up,
+                       max_triangles=args.max_triangles, max_atlas_px=args.max_atlas,
+                       place=args.place)
     write_screenshot(args, res.files, stock)
     print_warnings(res.warnings)
-    print(f"{res.name}: {res.triangles} triangles, {res.volume_mm3:.0f} mm^3, atlas "
-          f"{res.atlas_px[1]}x{res.atlas_px[0]}; wrote " + ", ".join(map(str, res.files.values())))
+    tess = res.tessellation
+    mesh_note = (f" (meshed at {tess['tolerance_mm']:.3g} mm / {tess['angular_tolerance_deg']:.3g}"
+                 " deg)" if tess.get("tolerance_mm") and tess.get("triangles") else "")
+    print(f"{res.name}: {res.triangles} triangles{mesh_note}, {res.volume_mm3:.0f} mm^3, "
+          f"{res.atlas}; wrote " + ", ".join(map(str, res.files.values())))
+    if res.report:
+        from ..advise import report_text
+
+        print(report_text(res.report, res.name))
     return 0
 
 
 def run_preview(args: argparse.Namespace) -> int:
-    from ..export import read_glb_metadata
-    from ..stock import open_stock
     from ..view import preview
+    from .options import stock_of_glb
 
-    spec = args.block
-    if spec is None and args.mesh.suffix.lower() == ".glb":
-        spec = read_glb_metadata(args.mesh).get("block")
-    stock = open_stock(spec) if spec else None
+    stock = stock_of_glb(args.mesh, args.block)
     out = preview(args.mesh, wood=stock.wood if stock else None,
-                  size_mm=stock.size_mm if stock else None, screenshot=args.screenshot)
+                  size_mm=stock.size_mm if stock else None, screenshot=args.screenshot,
+                  camera=args.camera, cut_plane=not args.no_cut, cut_origin=args.cut_origin,
+                  cut_normal=args.cut_normal)
     if out:
         print(f"wrote {out}")
     return 0

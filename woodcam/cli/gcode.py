@@ -7,13 +7,12 @@ from __future__ import annotations
 
 import argparse
 import math
-import re
 import sys
 import time
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import BLOCK_SPEC_HELP, add_bake_options, stock_options
+from .options import BLOCK_SPEC_HELP, add_bake_options, allow_negative_values, stock_options
 
 _EXAMPLES = """\
 examples:
@@ -93,11 +92,7 @@ def register(subparsers) -> None:
                    "triangles, its volume moves by 0.0006 mm on average)")
     add_bake_options(p)
     p.set_defaults(func=run)
-    # argparse takes "-14,5,3" for an option; a value that looks like numbers is a value
-    p._negative_number_matcher = _NEGATIVE_VALUES
-
-
-_NEGATIVE_VALUES = re.compile(r"^-[\d.][\d.,eE+-]*$")
+    allow_negative_values(p)  # --work-offset -14,5,3
 
 
 def _size(text: str) -> tuple[float, float, float]:
@@ -243,7 +238,8 @@ def run(args) -> int:
     t1 = time.perf_counter()
     out = preview_heightfield(res.heightmap, stock, args.out, texels_per_mm=args.texels_per_mm,
                               flat_tol_mm=args.mesh_tol, obj=not args.no_obj, metadata=meta,
-                              obj_units=args.obj_units, obj_up=args.obj_up)
+                              obj_units=args.obj_units, obj_up=args.obj_up,
+                              max_atlas_px=args.max_atlas)
     t_bake = time.perf_counter() - t1
     if args.screenshot:
         _screenshot(args, out.files, stock, program, offset)

@@ -13,12 +13,14 @@ Nothing heavy is imported at module level (``woodcam --help`` loads this module)
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 from ..errors import WoodcamError
 
-BLOCK_SPEC_HELP = ("block spec: builtin:NAME, log:gran1@K[:WxDxH], a block folder (block.json) "
-                   "or a Mokume sample folder (a 50 mm cube unless --size-mm)")
+BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], a block folder "
+                   "(block.json) or a Mokume sample folder (a 50 mm cube unless --size-mm); "
+                   "append ~x90/~y90/~z90 to turn the block under the part")
 
 
 def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction:
@@ -54,6 +56,28 @@ def open_block(spec, size_mm: float | None = None, face_px: int = 256):
     return _open_block(str(spec), size_mm=size_mm, face_px=face_px)
 
 
+#: A value that looks like numbers ("-14,5,3", "-1e3") is a value, not an option.
+_NEGATIVE_VALUES = re.compile(r"^-[\d.][\d.,eE+-]*$")
+
+
+def allow_negative_values(p: argparse.ArgumentParser) -> None:
+    """Let options of ``p`` take values such as ``-14,5,3`` (argparse takes them for options)."""
+    p._negative_number_matcher = _NEGATIVE_VALUES
+
+
+def vector_mm(text: str) -> tuple[float, float, float]:
+    """``"X,Y,Z"`` -> three finite floats (argparse ``type``)."""
+    import math
+
+    try:
+        vals = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        vals = ()
+    if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
+        raise argparse.ArgumentTypeError(f"expected three finite numbers X,Y,Z; got {text!r}")
+    return vals  # type: ignore[return-value]
+
+
 def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None = 10.0,
                      species: bool = True, screenshot: bool = True) -> None:
     """The options of every command that bakes wood onto a mesh (``bake``, ``demo``, ``gcode``).
@@ -75,12 +99,10 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
     p.add_argument("--quality", choices=("draft", "normal", "high"), default=None,
                    help="training effort of the neural appearance (default normal)")
     p.add_argument("--epochs", type=int, default=None, help="override the neural training epochs")
-    p.add_argument("--knot-darkening", default=None, metavar="ALIVE,DEAD",
-                   help="colour map: relative darkening of alive and dead knot wood, each in "
-                   "[0, 1] (default: woodcam.appearance.knots.KnotShading's)")
-    p.add_argument("--knot-outline", default=None, metavar="R,G,B",
-                   help="colour map: colour of the bark ring round dead knots, each in [0, 1] "
-                   "(default 0.16,0.10,0.06)")
+    add_knot_options(p)
+    p.add_argument("--max-atlas", type=int, default=4096, metavar="PX",
+                   help="largest texture side in texels (default 4096, what every GPU takes); "
+                   "a part needing more gets a lower texel density, stated in the summary")
     p.add_argument("--no-obj", action="store_true", help="write only the GLB, not OBJ+MTL+PNG")
     p.add_argument("--obj-units", choices=("m", "mm"), default="m",
                    help="length unit of the OBJ's coordinates (default m, what Blender and most "
@@ -91,6 +113,30 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
         p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
                        help="also render the result off-screen to PNG (default name: OUT with "
                        "_view.png; no display needed)")
+
+
+def add_knot_options(p: argparse.ArgumentParser) -> None:
+    """``--knot-darkening`` and ``--knot-outline``: :class:`woodcam.appearance.knots.KnotShading`
+    on the command line (``bake``, ``demo``, ``gcode``, ``log render``); defaults are its own."""
+    p.add_argument("--knot-darkening", default=None, metavar="ALIVE,DEAD",
+                   help="relative darkening of alive knot wood and the extra darkening of dead "
+                   "knot wood, each in [0, 1] (default 0.25,0.45)")
+    p.add_argument("--knot-outline", default=None, metavar="R,G,B",
+                   help="colour of the bark ring round dead knots, each in [0, 1] "
+                   "(default 0.16,0.10,0.06)")
+
+
+def knot_shading(args):
+    """The :class:`~woodcam.appearance.knots.KnotShading` the knot options ask for."""
+    from ..appearance.knots import KnotShading
+
+    changes = {}
+    if args.knot_darkening is not None:
+        changes["alive_darkening"], changes["dead_darkening"] = floats(
+            args.knot_darkening, 2, "--knot-darkening")
+    if args.knot_outline is not None:
+        changes["outline_rgb"] = floats(args.knot_outline, 3, "--knot-outline")
+    return KnotShading(**changes)
 
 
 def floats(text: str, n: int, option: str) -> tuple[float, ...]:
@@ -105,18 +151,14 @@ def floats(text: str, n: int, option: str) -> tuple[float, ...]:
 
 
 def appearance_params(args) -> dict:
-    """The appearance keywords of :func:`woodcam.stock.open_stock` from the bake options."""
-    knots = {}
-    if args.knot_darkening is not None:
-        knots["knot_darkening_alive"], knots["knot_darkening_dead"] = floats(
-            args.knot_darkening, 2, "--knot-darkening")
-    if args.knot_outline is not None:
-        knots["dead_outline_rgb"] = floats(args.knot_outline, 3, "--knot-outline")
+    """The appearance keywords of :func:`woodcam.stock.open_stock` from the bake options:
+    ``knots`` (a KnotShading) for the colour map, ``quality``/``epochs`` for the neural one."""
+    knots = args.knot_darkening is not None or args.knot_outline is not None
     if args.appearance != "neural":
         if args.quality or args.epochs:
             raise WoodcamError("--quality and --epochs apply to --appearance neural only; "
                                f"got --appearance {args.appearance}")
-        return knots
+        return {"knots": knot_shading(args)} if knots else {}
     if knots:
         raise WoodcamError("--knot-darkening and --knot-outline apply to --appearance colormap "
                            "only (the neural appearance learns knot colours from the photos)")
@@ -139,3 +181,36 @@ def write_screenshot(args, files: dict, stock) -> None:
     png = out.with_name(out.stem + "_view.png") if args.screenshot is True else Path(args.screenshot)
     preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
     files["png"] = png
+
+
+def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None):
+    """The stock a baked GLB was cut from, as its metadata records it (absolute block spec,
+    content digest, species, appearance and its parameters), or ``block`` when given.
+
+    Returns None for a file that records no block and no ``block`` given (``preview`` then shows
+    the part alone). A recorded block that no longer exists, or whose content changed since the
+    bake, is named in an error or a warning."""
+    import warnings
+
+    from ..errors import WoodcamError, WoodcamWarning
+    from ..export import read_glb_metadata
+    from ..stock import open_stock, spec_digest
+
+    meta = read_glb_metadata(glb) if glb.suffix.lower() == ".glb" and glb.is_file() else {}
+    app = meta.get("appearance") if isinstance(meta.get("appearance"), dict) else {}
+    kwargs = {"species": species or app.get("species"),
+              "appearance": app.get("kind") or "colormap", **(app.get("params") or {})}
+    if block:
+        return open_stock(block, **{**kwargs, "species": species or kwargs["species"]})
+    spec = meta.get("block")
+    if not spec:
+        return None
+    base = str(spec).partition("~")[0]
+    if not base.startswith(("builtin:", "log:")) and not Path(base).exists():
+        raise WoodcamError(
+            f"{str(glb)!r} was baked from the block folder {base!r}, which is not there any more; "
+            "pass --block SPEC (the same block, moved) to rebuild its wood")
+    if meta.get("block_digest") and spec_digest(spec) != meta["block_digest"]:
+        warnings.warn(f"the block {spec!r} changed since {glb.name} was baked (its files differ); "
+                      "the wood shown is today's", WoodcamWarning, stacklevel=2)
+    return open_stock(spec, **kwargs)

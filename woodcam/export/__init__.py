@@ -249,7 +249,7 @@ def _set_buffer_view_targets(tree: dict) -> None:
 
 def export_obj(mesh, path, *, units: ObjUnits = "m", up: ObjUp = "y",
                crease_angle_deg: float | None = None, normals: str = "crease") -> Path:
-    """Write ``mesh`` as ``NAME.obj`` + ``NAME.mtl`` + ``NAME.png`` side by side.
+    """Write ``mesh`` as ``NAME.obj`` + ``NAME.mtl`` + ``NAME_texture.png`` side by side.
 
     Parameters
     ----------
@@ -294,7 +294,9 @@ def export_obj(mesh, path, *, units: ObjUnits = "m", up: ObjUp = "y",
     if hasattr(material, "to_simple"):
         material = material.to_simple()
     material = copy.copy(material)
-    material.name = stem
+    # NAME_texture.png, not NAME.png: a screenshot named after the part must never overwrite
+    # the texture (issue 17: 'woodcam preview bowl.glb --screenshot bowl.png' did)
+    material.name = f"{stem}_texture"
     # Viewers multiply map_Kd by Kd: white keeps the baked colours as baked. Wood is matte.
     material.diffuse = np.array([255, 255, 255, 255], dtype=np.uint8)
     material.ambient = np.array([255, 255, 255, 255], dtype=np.uint8)
