@@ -273,66 +273,49 @@ def bake(
     )
 
 
-def bake_heightfield(heightmap, size_mm, wood, *, texels_per_mm: float = 10.0,
-                     flat_tol_mm: float = 1e-9, max_atlas_px: int = 8192,
-                     progress: bool = False) -> BakeResult:
-    """Bake a height-field stock (:mod:`woodcam.toolpath.simulate`) without a generic unwrap.
-
-    The remaining stock's top is a height field over XY, so it is textured by its own planar
-    parameterisation (:class:`woodcam.toolpath.mesh.HeightfieldCharts`: top, bottom and four
-    walls as six rectangles), flat regions are merged by ``flat_tol_mm``
-    (:func:`woodcam.toolpath.mesh.heightfield_mesh`), and each texel's point and normal come
-    from the grid directly: no xatlas unwrap and no triangle rasterisation (on the 20,000-move
-    raster those were 75 % of the preview's time). ``heightmap : (ny, nx)`` block-frame Z (mm),
-    ``size_mm = (W, D, H)``; ``wood`` as :func:`bake`. The density is lowered (with a warning)
-    so the atlas stays within ``max_atlas_px`` on a side.
-    """
+def bake_charts(mesh, uv_px, size_px, texels, wood, *, texels_per_mm: float,
+                vertex_normals=None, messages=()) -> BakeResult:
+    """Bake ``wood.color`` into an atlas whose charts the caller already knows (no unwrap, no
+    rasterisation): ``mesh`` with per-vertex texel coordinates ``uv_px : (n, 2)`` (x right, y
+    down, pixel corners at integers) in an atlas of ``size_px = (width, height)``, and
+    ``texels``, an iterable of ``(flat texel indices (k,), points_mm (k, 3), normals (k, 3))``
+    giving every chart texel's point and normal. Used for the height-field stock of a G-code
+    preview (:class:`woodcam.toolpath.mesh.HeightfieldCharts`), whose top is textured by its own
+    planar parameterisation. ``vertex_normals`` (optional, (n, 3)) are kept on the result mesh
+    for export; the rest as :func:`bake`."""
     import trimesh
 
-    from .toolpath.mesh import HeightfieldCharts, heightfield_mesh_charts
+    from .appearance.wood import wood_colors  # the one check of the colour contract
 
     t_start = time.perf_counter()
-    if not (np.isfinite(texels_per_mm) and texels_per_mm > 0):
-        raise WoodcamError(f"bake_heightfield: texels_per_mm must be a finite number > 0, got "
-                           f"{texels_per_mm!r}; use e.g. 10")
-    messages: list[str] = []
-    tpm = float(texels_per_mm)
-    side = max(HeightfieldCharts(np.zeros((1, 1)), size_mm, tpm).size_px)
-    if side > max_atlas_px:
-        while side > max_atlas_px:  # the chart padding does not scale: a few rounds
-            tpm *= 0.99 * max_atlas_px / side
-            side = max(HeightfieldCharts(np.zeros((1, 1)), size_mm, tpm).size_px)
-        messages.append(f"bake_heightfield: texels_per_mm lowered from {texels_per_mm:g} to "
-                        f"{tpm:.3g} so the atlas fits {max_atlas_px} px (max_atlas_px)")
     timings: dict[str, float] = {}
-    t0 = time.perf_counter()
-    mesh, uv_px, charts, vnormals = heightfield_mesh_charts(heightmap, size_mm, tpm,
-                                                            flat_tol_mm=flat_tol_mm)
-    timings["mesh"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    w, h = charts.size_px
+    w, h = (int(v) for v in size_px)
     atlas = np.zeros((h * w, 3), np.uint8)
     coverage = np.zeros(h * w, bool)
-    for idx, pts, nrm in charts.texel_points():
+    for idx, pts, nrm in texels:
         for s in range(0, len(idx), MAX_BATCH_POINTS):
             sl = slice(s, s + MAX_BATCH_POINTS)
-            rgb = _color_checked(wood, pts[sl], nrm[sl])
+            rgb = wood_colors(wood, pts[sl], nrm[sl])
             atlas[idx[sl]] = np.round(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
         coverage[idx] = True
     atlas = atlas.reshape(h, w, 3)
     coverage = coverage.reshape(h, w)
-    timings["color"] = time.perf_counter() - t0
+    timings["color"] = time.perf_counter() - t_start
     t0 = time.perf_counter()
     atlas = _dilate(atlas, coverage)
     timings["dilate"] = time.perf_counter() - t0
+    uv_px = np.asarray(uv_px, float)
     uv = np.column_stack([uv_px[:, 0] / w, 1.0 - uv_px[:, 1] / h])
     out = _textured_mesh(trimesh, np.asarray(mesh.vertices), np.asarray(mesh.faces), uv, atlas)
-    out.vertex_normals = vnormals  # exported as is (export normals="mesh")
+    if vertex_normals is not None:
+        out.vertex_normals = vertex_normals  # exported as is (export normals="mesh")
     timings["total"] = time.perf_counter() - t_start
+    messages = list(messages)
     for msg in messages:
         warnings.warn(msg, WoodcamWarning, stacklevel=2)
-    return BakeResult(mesh=out, atlas=atlas, coverage_mask=coverage, texels_per_mm=tpm,
-                      timings=timings, warnings=messages, uv_fill=float(coverage.mean()))
+    return BakeResult(mesh=out, atlas=atlas, coverage_mask=coverage,
+                      texels_per_mm=float(texels_per_mm), timings=timings, warnings=messages,
+                      uv_fill=float(coverage.mean()))
 
 
 # ------------------------------------------------------------------------------------------------

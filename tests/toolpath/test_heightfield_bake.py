@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from woodcam.bake import bake_heightfield
+from woodcam.pipeline import bake_heightfield
 from woodcam.toolpath import parse_tool_spec, read_gcode, simulate
 from woodcam.toolpath.mesh import HeightfieldCharts
 
