@@ -28,13 +28,14 @@ LAYERS: dict[str, int] = {
     "cad": 8, "bake": 8, "export": 8, "toolpath": 8, "synth": 8, "parquetry": 8,
     "view": 9, "review": 9,            # view reads woodcam's own exports
     "stock": 10,                       # block spec -> Stock (synth, inference, appearance)
-    "pipeline": 11, "advise": 11, "demo": 12,
+    "advise": 10,                      # placement advice and part reports (takes a Stock)
+    "pipeline": 11, "demo": 12,
     "scale": 13,                       # runs any of them
     "cli": 14,                         # the command, on top
     "woodcam": 15,                     # the package's lazy re-exports
 }
 #: Data folders (no code).
-DATA = {"models", "data"}
+DATA = {"models", "data", "examples"}  # examples: part scripts (cad_examples/ links here)
 
 
 def _unit(module: str) -> str:

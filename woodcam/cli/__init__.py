@@ -1,4 +1,5 @@
-"""The ``woodcam`` command: parses, calls the API, prints. Errors become one line and exit 2.
+"""The ``woodcam`` command: parses, calls the API, prints. Errors become one line and exit 1
+(usage errors 2, failed checks 3; see :data:`EXIT_ERROR` and the others).
 
 A package with one module per command group. Each module in :data:`COMMANDS` defines
 ``register(subparsers)``, which adds its sub-parser(s) and sets ``func`` on each to the function
@@ -55,7 +56,14 @@ examples:
       --out out/vcarve_text.glb --screenshot
   woodcam eval rings out/blocks/block_0000 --out out/eval
   woodcam eval appearance builtin:knotty --out out/eval_appearance
+
+exit status: 0 done; 1 the work failed (a one-line 'woodcam: error: ...' says why); 2 the
+command line is wrong (usage); 3 the work was done but a check failed (e.g. gcode --strict);
+130 interrupted.
 """
+
+#: Exit statuses (documented in ``woodcam --help`` and the README).
+EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_CHECKS, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -113,10 +121,10 @@ def main(argv: list[str] | None = None) -> int:
             rc = args.func(args)
         except WoodcamError as err:
             print(f"woodcam: error: {err}", file=sys.stderr)
-            return 2
+            return EXIT_ERROR
         except KeyboardInterrupt:
             print("woodcam: interrupted", file=sys.stderr)
-            return 130
+            return EXIT_INTERRUPTED
         finally:
             print_warnings(str(w.message) for w in caught if _is_ours(w))
     return rc
