@@ -79,7 +79,6 @@ def test_raster_20k_moves_throughput_and_ratio_to_manifold():
 
 def _cli_run(tmp_path, src_root, label, extra=()):
     """``woodcam gcode`` of the raster in a fresh process: (CPU s, peak RSS GB, stdout)."""
-    import resource
     import subprocess
     import sys
 
@@ -94,10 +93,12 @@ def _cli_run(tmp_path, src_root, label, extra=()):
             "from woodcam.cli import main; rc = main(sys.argv[1:]); "
             "r = resource.getrusage(resource.RUSAGE_SELF); "
             "print('CPU', r.ru_utime + r.ru_stime, 'RSS', r.ru_maxrss); sys.exit(rc)")
-    out = subprocess.run([sys.executable, "-c", code, "gcode", str(prog), "--block",
+    run = subprocess.run([sys.executable, "-c", code, "gcode", str(prog), "--block",
                           "builtin:flat-sawn", "--out", str(tmp_path / f"{label}.glb"), "--tool",
                           "2=ball:6", "--screenshot", *extra], capture_output=True, text=True,
-                         env={**os.environ, "PYTHONPATH": str(src_root)}, check=True).stdout
+                         env={**os.environ, "PYTHONPATH": str(src_root)})
+    assert run.returncode in (0, 3), run.stderr[-3000:]
+    out = run.stdout
     line = [ln for ln in out.splitlines() if ln.startswith("CPU ")][-1].split()
     return float(line[1]), float(line[3]) / 1e6, out
 
