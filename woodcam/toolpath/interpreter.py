@@ -950,7 +950,7 @@ class Interpreter:
                 raise self.err(f"{k.upper()}{w[k]:g}", f"{k.upper()} word with no G or M code "
                                "on the line that uses it (LinuxCNC refuses it too)",
                                "remove it or add the code it belongs to")
-        if eff not in (2.0, 3.0) and not (10.0 in g):
+        if eff not in (2.0, 3.0) and 10.0 not in g:
             for k in "ijk":
                 if k in w:
                     raise self.err(f"{k.upper()}{w[k]:g}", f"{k.upper()} word with no G2/G3 "
