@@ -117,8 +117,9 @@ def program(seed: int, n_lines: int = 30, *, valid_share: float = 0.9) -> str:
             out.append(rng.choice(["M3 S12000", "M5", "M8", "M9", "T2 M6", "G4 P0.1",
                                    "G61", "G64 P0.01", "(a comment)", "; a comment",
                                    "G43 H2", "G49", "G94"]))
-            if out[-1] == "T2 M6":  # LinuxCNC's preview module forgets a helix's Z at M6
-                out.append(f"G0 Z{pos[2]:.3f}")  # (test_linuxcnc_preview_stale_z_after_m6)
+            if out[-1] == "T2 M6":  # LinuxCNC's preview module forgets arc ends at M6
+                out.append(f"G0 X{pos[0]:.4f} Y{pos[1]:.4f} Z{pos[2]:.4f}")  # (test_linuxcnc_
+                # preview_stale_position_after_m6): every axis stated again
         elif r < 0.8:
             label = int(rng.integers(100, 999))
             out.append(f"o{label} if [#{int(rng.integers(1, 5))} GT 0]")

@@ -125,11 +125,12 @@ def test_interpreter_option_linuxcnc_gives_the_same_program():
         read_gcode("G0 X1\nG1 A3 F100\nM2\n", interpreter="linuxcnc")
 
 
-def test_linuxcnc_preview_stale_z_after_m6(tmp_path):
+def test_linuxcnc_preview_stale_position_after_m6(tmp_path):
     """A known difference, not a woodcam error: after a tool change (a synch point) LinuxCNC's
-    ``gcode`` preview module resumes from the Z before a helical arc, so ``G1 X20`` climbs from
-    Z5 back to Z10; woodcam (and a machine, which reads its real position) stays at Z5. The fuzz
-    generator re-states Z after ``M6`` for this reason."""
+    ``gcode`` preview module resumes from the end of the last straight move, forgetting arcs
+    since (here a helix), so ``G1 X20`` climbs from Z5 back to Z10; woodcam (and a machine,
+    which reads its real position) stays at Z5. The fuzz generator states every axis after
+    ``M6`` for this reason."""
     text = "G0 X0 Y0 Z10\nG2 X10 Y0 I5 J0 Z5 F100\nT2 M6\nG1 X20\nM2\n"
     p = tmp_path / "helix_m6.ngc"
     p.write_text(text)
