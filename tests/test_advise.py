@@ -77,3 +77,18 @@ def test_the_part_report_warns_of_short_grain_only_across_the_fibres():
     # end grain: the stick's two 10 x 8 ends out of its surface, when fibres run along it
     ends = 2 * 10 * 8 / (2 * (70 * 10 + 70 * 8 + 10 * 8))
     assert along["end_grain"] == pytest.approx(ends, abs=0.03)
+
+
+def test_knot_spots_find_the_knots_through_a_surface(knotty):
+    import trimesh
+
+    from woodcam.advise import knot_spots
+
+    box = trimesh.creation.box(knotty.size_mm)
+    box.apply_translation(np.asarray(knotty.size_mm) / 2)
+    spots = knot_spots(box, knotty.wood)
+    assert len(spots) >= 2  # the board through a whorl shows several knots on its faces
+    at = np.array([s["at_mm"] for s in spots])
+    assert (knotty.wood.features(at)["knot"] > 0.5).all()  # every spot sits on knot wood
+    clear = open_stock("builtin:flat-sawn")
+    assert knot_spots(box, clear.wood) == []

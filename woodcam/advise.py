@@ -177,7 +177,8 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
         feats = stock.wood.features(points)
         n_pts = len(turned)
         knot = feats["knot"].reshape(len(centres), n_pts) > 0.5
-        pith = feats["years"].reshape(len(centres), n_pts) < PITH_YEARS
+        # inside a knot, years count along the branch: its own pith is knot, not stem pith
+        pith = (feats["years"].reshape(len(centres), n_pts) < PITH_YEARS) & ~knot
         grain = feats["grain"].reshape(len(centres), n_pts, 3)[:, :len(pts)]
         end = np.abs(np.einsum("cij,ij->ci", grain, n_rot)) > math.cos(math.radians(45))
         mean_grain = grain.mean(axis=1)
@@ -256,7 +257,7 @@ def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
     feats = stock.wood.features(depth)
     grain = feats["grain"][:len(pts)]
     knot = feats["knot"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) > 0.5
-    pith = feats["years"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) < PITH_YEARS
+    pith = (feats["years"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) < PITH_YEARS) & ~knot
     evals, evecs = np.linalg.eigh(np.cov((pts - pts.mean(axis=0)).T))
     long_axis = evecs[:, -1]
     elongation = float(1.0 - math.sqrt(max(evals[1], 0.0) / max(evals[2], 1e-12)))
@@ -302,3 +303,37 @@ def report_text(report: dict, name: str) -> str:
                      f"runout {r['runout_deg']:.0f} deg, knots {100 * r['knots']:.1f} %")
     lines += [f"  warning: {w}" for w in report["warnings"]]
     return "\n".join(lines)
+
+
+def knot_spots(mesh, wood, *, samples: int = 20000, link_mm: float = 2.0, seed: int = 0) -> list[dict]:
+    """Where knots come through the surface of ``mesh`` (block frame, mm): one entry per
+    connected patch of knot wood, ``{"kind": "knot", "label": str, "at_mm": [x, y, z]}`` (the
+    patch's centroid, snapped to the nearest surface sample), largest first; for hotspots."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(seed)
+    pts, _ = _sample(mesh, samples, rng)
+    inside = wood.features(pts)["knot"] > 0.5
+    p = pts[inside]
+    if len(p) == 0:
+        return []
+    pairs = cKDTree(p).query_pairs(link_mm, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(p), len(p)))
+    n, label = connected_components(graph, directed=False)
+    area_per_sample = float(mesh.area) / samples
+    spots = []
+    for k in range(n):
+        members = p[label == k]
+        if len(members) < 5:  # a few stray samples: not a visible knot
+            continue
+        centre = members.mean(axis=0)
+        at = members[np.argmin(np.linalg.norm(members - centre, axis=1))]
+        spots.append({"kind": "knot", "at_mm": [round(float(v), 2) for v in at],
+                      "label": f"through the surface, ~{len(members) * area_per_sample:.0f} mm^2",
+                      "_size": len(members)})
+    spots.sort(key=lambda s: -s["_size"])
+    for s in spots:
+        del s["_size"]
+    return spots

@@ -28,6 +28,7 @@ COMMANDS: tuple[str, ...] = (
     "woodcam.cli.gcode",         # gcode
     "woodcam.cli.review",        # review
     "woodcam.cli.place",         # place
+    "woodcam.cli.cache",         # cache info | clear
     "woodcam.cli.block",         # block synth | show
     "woodcam.cli.log",           # log render | maps | export
     "woodcam.cli.fit",           # fit, eval rings
@@ -85,7 +86,37 @@ def build_parser() -> argparse.ArgumentParser:
                             "woodcam/cli/__init__.py")
         register(sub)
     parser.set_defaults(_commands=sub)
+    _state_defaults(parser)
     return parser
+
+
+def _walk_options(parser: argparse.ArgumentParser):
+    """Every (command path, optional action) of ``parser`` and its sub-commands."""
+    stack: list[tuple[list[str], argparse.ArgumentParser]] = [([], parser)]
+    while stack:
+        path, p = stack.pop()
+        for action in p._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                stack += [([*path, name], sp) for name, sp in action.choices.items()]
+            elif action.option_strings and not isinstance(
+                    action, (argparse._HelpAction, argparse._VersionAction)):
+                yield path, action
+
+
+def _state_defaults(parser: argparse.ArgumentParser) -> None:
+    """Every option's help ends with its default, so no command leaves a user guessing: the
+    help text's own wording when it names one, else the value argparse would use."""
+    for _path, action in _walk_options(parser):
+        text = action.help or ""
+        if action.required or "default" in text.lower() or text == argparse.SUPPRESS:
+            continue
+        if isinstance(action, (argparse._StoreTrueAction, argparse._StoreFalseAction,
+                               argparse._StoreConstAction, argparse._CountAction)):
+            continue  # a switch: off unless given
+        default = action.default
+        shown = ("not set" if default is None or default == [] else
+                 ",".join(map(str, default)) if isinstance(default, (list, tuple)) else str(default))
+        action.help = f"{text} (default: {shown})".strip()
 
 
 def _apply_aliases(argv: list[str], parser: argparse.ArgumentParser) -> list[str]:

@@ -31,15 +31,16 @@ def register(subparsers) -> None:
     source(r)
     r.add_argument("--out", required=True, help="output folder")
     r.add_argument("--ring-width", type=float, default=2.0, help="mm per year (default 2)")
-    r.add_argument("--px-per-mm", type=float, default=2.0, help="resolution (default 2)")
+    r.add_argument("--px-per-mm", type=float, default=2.0, help="resolution in pixels per mm (default 2)")
     r.add_argument("--supersample", type=int, default=2,
                    help="samples per pixel side, averaged (default 2; knot rings alias)")
     r.add_argument("--board", nargs=3, type=float, metavar=("Z_MM", "AZIMUTH_DEG", "OFFSET_MM"),
                    help="tangential board centre height, facing azimuth and distance from "
                         "the pith (default: the board through the most knots at 60 mm)")
-    r.add_argument("--disc", type=float, metavar="Z_MM", help="end-grain disc height")
+    r.add_argument("--disc", type=float, metavar="Z_MM", help="also an end-grain disc at this height along the log, mm")
     r.add_argument("--radial", nargs=2, type=float, metavar=("Z_MM", "AZIMUTH_DEG"),
-                   help="also a quarter-sawn section through the pith (knots as spikes)")
+                   help="also a quarter-sawn section through the pith at height Z_MM (mm) and azimuth "
+                   "AZIMUTH_DEG (degrees); knots show as spikes")
     r.add_argument("--k-stem", type=float, default=1.5, help="smoothness k outside knots")
     r.add_argument("--k-knot", type=float, default=5.0, help="smoothness k inside knots")
     add_knot_options(r)

@@ -42,8 +42,12 @@ def run_review(args: argparse.Namespace) -> int:
     for key in ("texels_per_mm", "gcode", "placement"):
         if key in meta:
             report[key] = meta[key]
-    hotspots = [{"kind": "gcode", "label": str(w.get("message", "")), "at_mm": w["at_mm"]}
-                for w in meta.get("warnings", []) if isinstance(w, dict) and "at_mm" in w]
+    from ..advise import knot_spots
+    from ..export import load_textured
+
+    hotspots = knot_spots(load_textured(args.part), stock.wood)
+    hotspots += [{"kind": "gcode", "label": str(w.get("message", "")), "at_mm": w["at_mm"]}
+                 for w in meta.get("warnings", []) if isinstance(w, dict) and "at_mm" in w]
     photos = None
     if Path(spec).is_dir():  # a block or Mokume folder: show its face photos
         from ..stock import open_block
