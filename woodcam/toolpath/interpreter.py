@@ -177,10 +177,8 @@ def _split_comments(raw: str, no: int) -> tuple[str, list[str]]:
             raise GcodeError(no, ")", "')' without '('", "remove it")
         out.append(c)
         i += 1
-    text = "".join(out)
-    if "<" in text:  # named parameters keep their letters; LinuxCNC drops whitespace in them
-        pass
-    return "".join(text.split()).lower(), msgs
+    # LinuxCNC drops all whitespace and case outside comments, inside #<names> too
+    return "".join("".join(out).split()).lower(), msgs
 
 
 class Interpreter:
@@ -498,8 +496,6 @@ class Interpreter:
             ln = _Line(text, no, msg)
             body = text[1:] if text.startswith("/") else text
             m = re.match(r"(?:n\d+(?:\.\d*)?)?o(<[^>]*>|\d+)([a-z]+)(.*)$", body)
-            if m and self.dialect == "fanuc" and not m.group(2):
-                pass
             if m:
                 label = m.group(1).strip("<>")
                 label = str(int(label)) if label.isdigit() else label
@@ -790,13 +786,10 @@ class Interpreter:
         g: set[float] = set()
         for v in gs:
             c = round(v, 1)
-            if abs(v - c) > 1e-4 or c not in _G_KNOWN:
-                if c in _G_REFUSED:
-                    pass
-                else:
-                    raise self.err(f"G{v:g}", "unsupported G code (woodcam reads the G codes "
-                                   "listed in woodcam.toolpath.interpreter)",
-                                   "post-process the program for a 3-axis mill")
+            if (abs(v - c) > 1e-4 or c not in _G_KNOWN) and c not in _G_REFUSED:
+                raise self.err(f"G{v:g}", "unsupported G code (woodcam reads the G codes "
+                               "listed in woodcam.toolpath.interpreter)",
+                               "post-process the program for a 3-axis mill")
             if c in _G_REFUSED:
                 raise self.err(f"G{v:g}", _G_REFUSED[c], "post-process without it")
             g.add(c)
@@ -818,8 +811,6 @@ class Interpreter:
                 raise self.err(f"M{v:g}", "unsupported M code (woodcam reads M0-M9, M30, "
                                "M48-M53, M60, M61; M19, M62-M68 and M100-M199 with a warning)", "remove it or post-process for a 3-axis mill")
             mset.add(int(v))
-        if 62 in mset:  # pragma: no cover - not in _M_KNOWN
-            pass
         for k in ("t", "l", "h"):
             if k in w and (w[k] != math.floor(w[k]) or w[k] < 0 or w[k] > 1e9):
                 raise self.err(f"{k.upper()}{w[k]:g}", "must be a non-negative integer",
@@ -1104,7 +1095,6 @@ class Interpreter:
         if self.feed <= 0:
             raise self.err(code, "drilling with feed rate 0 (no F yet)", "set F")
         c = self.cyc
-        s = self.scale
         if "r" in w:
             c["r"] = w["r"]
         if "z" in w:
@@ -1176,7 +1166,6 @@ class Interpreter:
             elif self.motion == 89.0:
                 self._cyc(FEED, x, y, clear)
             self._cyc(TRAVERSE, x, y, clear)
-        _ = s
 
     def _cyc(self, kind, x, y, z):
         self.emit(kind, self.to_machine([x, y, z]))
