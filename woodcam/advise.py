@@ -95,6 +95,17 @@ def _orientations(rotations: str) -> list[tuple[list[str], np.ndarray]]:
     return out
 
 
+def _part_mesh(part):
+    """Any part source -> its surface as a ``trimesh.Trimesh`` (block frame, mm)."""
+    import trimesh
+
+    from .cad import load_part
+
+    data = load_part(part).to_mesh()
+    return trimesh.Trimesh(np.asarray(data.vert_properties)[:, :3], np.asarray(data.tri_verts),
+                           process=False)
+
+
 def _sample(mesh, count: int, rng):
     """Area-weighted surface points and normals of ``mesh`` (block frame, mm)."""
     areas = np.asarray(mesh.area_faces, dtype=float)
@@ -131,19 +142,12 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
     seed : int
         Seed of the surface sample.
     """
-    import trimesh
-
-    from .cad import load_part
-
     if not (isinstance(candidates, int) and 1 <= candidates <= 1_000_000):
         raise WoodcamError(f"candidates must be an integer in [1, 1e6]; got {candidates!r}")
     if not (math.isfinite(margin_mm) and margin_mm >= 0):
         raise WoodcamError(f"margin_mm must be a finite number >= 0; got {margin_mm!r}")
     w = {**DEFAULT_WEIGHTS, **(weights or {})}
-    solid = load_part(part)
-    mesh_data = solid.to_mesh()
-    mesh = trimesh.Trimesh(np.asarray(mesh_data.vert_properties)[:, :3],
-                           np.asarray(mesh_data.tri_verts), process=False)
+    mesh = _part_mesh(part)
     rng = np.random.default_rng(seed)
     pts, nrm = _sample(mesh, samples, rng)
     depth_pts = np.concatenate([pts] + [pts - d * nrm for d in SUBSURFACE_MM])
@@ -209,15 +213,9 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
 
 def render_advice(advice: PlacementAdvice, part, stock, png, *, top: int = 3):
     """The ``top`` placements side by side in one PNG (see :mod:`woodcam.view.compare`)."""
-    import trimesh
-
-    from .cad import load_part
     from .view.compare import render_side_by_side
 
-    solid = load_part(part)
-    mesh_data = solid.to_mesh()
-    base = trimesh.Trimesh(np.asarray(mesh_data.vert_properties)[:, :3],
-                           np.asarray(mesh_data.tri_verts), process=False)
+    base = _part_mesh(part)
     meshes, titles = [], []
     for i, p in enumerate(advice.ranked[:top], 1):
         m = base.copy()

@@ -6,11 +6,13 @@ Every front end (``woodcam bake``, ``woodcam demo``, ``woodcam gcode``) runs the
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ._types import Mesh, PathLike
 from .stock import Stock
 
 
@@ -43,7 +45,7 @@ class PartPreview:
     report: dict = field(default_factory=dict)
 
     @contextmanager
-    def stage(self, name: str):
+    def stage(self, name: str) -> Iterator[None]:
         t0 = time.perf_counter()
         yield
         self.timings_s[name] = self.timings_s.get(name, 0.0) + time.perf_counter() - t0
@@ -71,7 +73,7 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
     return out_glb
 
 
-def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
+def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_mm: float = 10.0,
                  tolerance_mm: float | None = None, obj: bool = True,
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
                  obj_up: str = "y", max_triangles: int | None = None,
@@ -108,7 +110,7 @@ def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                         metadata=metadata)
 
 
-def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, obj: bool = True,
+def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: float = 10.0, obj: bool = True,
                  screenshot: bool = True, progress: bool = False,
                  result: PartPreview | None = None, metadata: dict | None = None,
                  obj_units: str = "m", obj_up: str = "y",

@@ -34,6 +34,7 @@ COMMANDS: tuple[str, ...] = (
     "woodcam.cli.fit",           # fit, eval rings
     "woodcam.cli.appearance",    # eval appearance
     "woodcam.cli.train",         # train gtf
+    "woodcam.cli.woodify",       # woodify
 )
 
 #: Old spellings kept working: argv prefix -> its current form.
@@ -44,8 +45,9 @@ ALIASES: dict[tuple[str, ...], tuple[str, ...]] = {
 DEFAULT_SUBCOMMAND: dict[str, str] = {"eval": "rings"}
 
 _EPILOG = """\
-Block specs: 'builtin:NAME' (see 'woodcam blocks'), 'log:gran1@K[:WxDxH]', a block folder with a
-block.json, or a Mokume sample folder (six photos and ring maps of a 50 mm cube).
+Block specs: 'builtin:NAME' (see 'woodcam blocks'), 'log:gran1@K[:WxDxH]', 'woodify:DIR/field.npz'
+(a block cut from a grown object, see 'woodcam woodify'), a block folder with a block.json, or a
+Mokume sample folder (six photos and ring maps of a 50 mm cube).
 Units are millimetres; the block frame has its origin at the bottom-front-left corner,
 X to the right (width), Y away from the viewer (depth), Z up (height).
 
@@ -57,6 +59,7 @@ examples:
       --out out/vcarve_text.glb --screenshot
   woodcam eval rings out/blocks/block_0000 --out out/eval
   woodcam eval appearance builtin:knotty --out out/eval_appearance
+  woodcam woodify trunk.stl --years 40 --eccentricity 0.3 --obstacle post.stl --out out/tree
 
 exit status: 0 done; 1 the work failed (a one-line 'woodcam: error: ...' says why); 2 the
 command line is wrong (usage); 3 the work was done but a check failed (e.g. gcode --strict);

@@ -63,8 +63,8 @@ def register(subparsers) -> None:
 
 
 def _load(args):
-    from ..fields.knot_maps import read_maps
-    from ..fields.tree_data import read_gran1, read_log
+    from ..logs.io import read_gran1, read_log
+    from ..logs.maps import read_maps
 
     given = [x for x in (args.log_file, args.real or None, args.maps) if x]
     if len(given) != 1:
@@ -84,12 +84,12 @@ def run(args) -> int:
     log = _load(args)
     out = Path(args.out)
     if args.log_command == "export":
-        from ..fields.tree_data import write_log
+        from ..logs.io import write_log
 
         print(write_log(log, out))
         return 0
     if args.log_command == "maps":
-        from ..fields.knot_maps import write_maps
+        from ..logs.maps import write_maps
 
         for path in write_maps(log, out).values():
             print(path)

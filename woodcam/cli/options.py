@@ -18,7 +18,8 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 
-BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], a block folder "
+BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], woodify:DIR/field.npz "
+                   "(a block cut from a grown object), a block folder "
                    "(block.json) or a Mokume sample folder (a 50 mm cube unless --size-mm); "
                    "append ~x90/~y90/~z90 to turn the block under the part")
 

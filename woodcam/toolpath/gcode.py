@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from ..tolerances import ARC_CHORD_TOL_MM
 from .interpreter import ARC, MM_PER_INCH, GcodeError, Interpreter
@@ -164,8 +165,9 @@ class Program:
                    full(spindle_rpm, float), source, sorted(set(t.tolist())))
 
 
-def read_gcode(text_or_path, *, chord_tol_mm: float = ARC_CHORD_TOL_MM, start_mm=None,
-               dialect: str = "linuxcnc", interpreter: str = "woodcam") -> Program:
+def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_TOL_MM,
+               start_mm: ArrayLike | None = None, dialect: str = "linuxcnc",
+               interpreter: str = "woodcam") -> Program:
     """Read G-code text or a file path into a :class:`Program` of straight moves (mm).
 
     Parameters

@@ -33,6 +33,7 @@ Tool table (TOML, read with the standard library's ``tomllib``)::
 
 from __future__ import annotations
 
+from typing import Any
 import math
 import tomllib
 from dataclasses import dataclass
@@ -41,6 +42,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 
 ToolType = Literal["flat", "ball", "bull", "vbit", "snub", "chamfer", "taperball"]
@@ -69,7 +71,7 @@ class Tool:
         """Height (mm) of the curved/conical part of the profile above the tip."""
         return float(self.profile(np.array([self.radius_mm]))[0])
 
-    def profile(self, r_mm):
+    def profile(self, r_mm: ArrayLike) -> np.ndarray:
         """Height above the tip (mm) of the tool's lower surface at radius ``r_mm`` (any shape).
 
         ``+inf`` outside the tool (``r > radius_mm``).
@@ -128,7 +130,7 @@ class Tool:
         """Radii where the profile's slope jumps (kept as vertices of :meth:`solid`)."""
         return []
 
-    def solid(self, top_mm: float, segments: int = 64):
+    def solid(self, top_mm: float, segments: int = 64) -> Any:
         """The tool as a ``manifold3d.Manifold``: tip at the origin, up to ``z = top_mm``."""
         from manifold3d import CrossSection, Manifold
 
@@ -397,7 +399,7 @@ def parse_tool_spec(spec: str) -> Tool:
     return VBit(nums[1], angle_deg=nums[0])
 
 
-def load_tool_table(path) -> dict[int, Tool]:
+def load_tool_table(path: PathLike) -> dict[int, Tool]:
     """Read a TOML tool table (module docstring), or a CAMotics JSON tool table
     (:func:`load_camotics_tools`), into ``{tool number: Tool}``."""
     path = Path(path)
@@ -458,7 +460,7 @@ def _number(value, path, key, name) -> float:
 _CAMOTICS_SHAPES = ("cylindrical", "ballnose", "conical", "snubnose")
 
 
-def load_camotics_tools(path) -> dict[int, Tool]:
+def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
     """Read a CAMotics tool table (the ``"tools"`` object of a ``.camotics`` project, or a JSON
     file holding it): ``{"1": {"units": "metric"|"imperial", "shape": "cylindrical"|"ballnose"|
     "conical"|"snubnose", "diameter": D, "length": L, "snub_diameter": d}}``. CAMotics defines a
