@@ -643,7 +643,7 @@ def preview(
     screenshot: str | os.PathLike | None = None,
     window_size: tuple[int, int] = (1280, 960),
     options: SceneOptions | None = None,
-    overlay=None,
+    overlay: list[tuple] | None = None,
     **scene_options,
 ) -> Path | None:
     """Show a textured part inside its translucent block, or write a screenshot of it.
