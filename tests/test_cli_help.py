@@ -13,7 +13,8 @@ UNITS = re.compile(
     r"triangles?|blocks?|steps?|epochs?|workers?|threads?|faces?|points?|rings?|placements?|"
     r"cells?|nodes?|samples?|patches|sheets?|dpi|inch(es)?|times|per mm|in \[|fraction|ratio)\b", re.I)
 #: Numbers that are dimensionless by nature (named by the option itself).
-DIMENSIONLESS = {"--seed", "--k-stem", "--k-knot", "--quality", "--shape", "--eccentricity"}
+DIMENSIONLESS = {"--seed", "--k-stem", "--k-knot", "--quality", "--shape", "--eccentricity",
+                 "--until-line"}  # --until-line: a line number
 
 
 def test_every_option_states_its_default():

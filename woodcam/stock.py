@@ -33,6 +33,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
+import numpy as np
+
 from .appearance import ColorMapAppearance, Wood
 from .errors import WoodcamError
 from .fields.builtin import BUILTIN_NAMES, builtin_block
@@ -59,6 +61,41 @@ class Stock:
     wood: Wood
     description: str = ""
     meta: dict = field(default_factory=dict)
+
+
+class _ShiftedWood:
+    """``wood`` seen from a stock whose corner sits at ``origin_mm`` of the block frame."""
+
+    def __init__(self, wood, origin_mm):
+        self._wood = wood
+        self._origin = np.asarray(origin_mm, float).reshape(1, 3)
+
+    def color(self, points_mm, normals):
+        return self._wood.color(np.asarray(points_mm, float) + self._origin, normals)
+
+    def __getattr__(self, name):  # field, appearance...: the wood's own
+        return getattr(self._wood, name)
+
+
+def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:
+    """A ``W x D x H`` stock cut from ``stock``'s wood with its corner at ``origin_mm`` (block
+    frame, mm): any size and position, not only the built-in blocks' (the wood's growth field
+    is defined everywhere). ``size_mm`` > 0 and ``origin_mm`` finite, in mm."""
+    size = np.asarray(size_mm, float).reshape(-1)
+    origin = np.asarray(origin_mm, float).reshape(-1)
+    if size.shape != (3,) or not (np.isfinite(size).all() and (size > 0).all()):
+        raise WoodcamError(f"resize_stock: size_mm must be three finite numbers > 0 (W, D, H "
+                           f"in mm), got {size_mm!r}; e.g. (167, 208, 25)")
+    if origin.shape != (3,) or not np.isfinite(origin).all():
+        raise WoodcamError(f"resize_stock: origin_mm must be three finite numbers (mm), got "
+                           f"{origin_mm!r}; e.g. (0, 0, 0)")
+    W, D, H = size.tolist()
+    spec = f"{stock.spec}[{W:g}x{D:g}x{H:g}" + (f"@{','.join(f'{v:g}' for v in origin)}]"
+                                                 if origin.any() else "]")
+    wood = _ShiftedWood(stock.wood, origin) if origin.any() else stock.wood
+    return Stock(spec, (W, D, H), wood, stock.description,
+                 {**stock.meta, "parent_size_mm": list(stock.size_mm),
+                  "origin_mm": origin.tolist()})
 
 
 def open_stock(spec: str, *, species: str | None = None,
