@@ -17,6 +17,7 @@ linuxcnc:
 	@if [ -e /usr/bin/rs274 ]; then :; \
 	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
 	  apt-get install -y --no-install-recommends linuxcnc-uspace || \
+	  { apt-get update -qq && apt-get install -y --no-install-recommends linuxcnc-uspace; } || \
 	  echo "linuxcnc-uspace not installable: the LinuxCNC differential tests will be skipped"; \
 	else echo "not root or no apt: the LinuxCNC differential tests will be skipped"; fi
 
