@@ -273,6 +273,51 @@ def bake(
     )
 
 
+def bake_charts(mesh, uv_px, size_px, texels, wood, *, texels_per_mm: float,
+                vertex_normals=None, messages=()) -> BakeResult:
+    """Bake ``wood.color`` into an atlas whose charts the caller already knows (no unwrap, no
+    rasterisation): ``mesh`` with per-vertex texel coordinates ``uv_px : (n, 2)`` (x right, y
+    down, pixel corners at integers) in an atlas of ``size_px = (width, height)``, and
+    ``texels``, an iterable of ``(flat texel indices (k,), points_mm (k, 3), normals (k, 3))``
+    giving every chart texel's point and normal. Used for the height-field stock of a G-code
+    preview (:class:`woodcam.toolpath.mesh.HeightfieldCharts`), whose top is textured by its own
+    planar parameterisation. ``vertex_normals`` (optional, (n, 3)) are kept on the result mesh
+    for export; the rest as :func:`bake`."""
+    import trimesh
+
+    from .appearance.wood import wood_colors  # the one check of the colour contract
+
+    t_start = time.perf_counter()
+    timings: dict[str, float] = {}
+    w, h = (int(v) for v in size_px)
+    atlas = np.zeros((h * w, 3), np.uint8)
+    coverage = np.zeros(h * w, bool)
+    for idx, pts, nrm in texels:
+        for s in range(0, len(idx), MAX_BATCH_POINTS):
+            sl = slice(s, s + MAX_BATCH_POINTS)
+            rgb = wood_colors(wood, pts[sl], nrm[sl])
+            atlas[idx[sl]] = np.round(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
+        coverage[idx] = True
+    atlas = atlas.reshape(h, w, 3)
+    coverage = coverage.reshape(h, w)
+    timings["color"] = time.perf_counter() - t_start
+    t0 = time.perf_counter()
+    atlas = _dilate(atlas, coverage)
+    timings["dilate"] = time.perf_counter() - t0
+    uv_px = np.asarray(uv_px, float)
+    uv = np.column_stack([uv_px[:, 0] / w, 1.0 - uv_px[:, 1] / h])
+    out = _textured_mesh(trimesh, np.asarray(mesh.vertices), np.asarray(mesh.faces), uv, atlas)
+    if vertex_normals is not None:
+        out.vertex_normals = vertex_normals  # exported as is (export normals="mesh")
+    timings["total"] = time.perf_counter() - t_start
+    messages = list(messages)
+    for msg in messages:
+        warnings.warn(msg, WoodcamWarning, stacklevel=2)
+    return BakeResult(mesh=out, atlas=atlas, coverage_mask=coverage,
+                      texels_per_mm=float(texels_per_mm), timings=timings, warnings=messages,
+                      uv_fill=float(coverage.mean()))
+
+
 # ------------------------------------------------------------------------------------------------
 # helpers
 

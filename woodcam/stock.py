@@ -11,7 +11,9 @@ A block spec is a string the CLI and GLB metadata carry:
 - ``woodify:PATH/field.npz``: a block cut out of a grown object (``woodcam woodify``); size
   and position are the placement stored in the file (``--block-size``, ``--block-centre``).
 - a block folder with a ``block.json`` manifest (real or synthetic): its true field if it has
-  one, otherwise a field fitted to its rings (fit once, cached in the user cache folder).
+  one, otherwise a field fitted to its rings (fit once, cached in the user cache folder); a
+  folder of photos only (``woodcam block from-photos``) first gets its rings detected on the
+  photos (:func:`woodcam.detect.block.with_detected_rings`, cached by content in the user cache).
 - a Mokume sample folder (``A_col.png``, ``A_arl-unet.png``, ... as in the Mokume dataset): a
   cube of ``MOKUME_DEFAULT_SIZE_MM`` (50 mm) whose field is fitted to its ring maps, fit once
   and cached.
@@ -30,6 +32,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
+
+import numpy as np
 
 from .appearance import ColorMapAppearance, Wood
 from .errors import WoodcamError
@@ -57,6 +61,41 @@ class Stock:
     wood: Wood
     description: str = ""
     meta: dict = field(default_factory=dict)
+
+
+class _ShiftedWood:
+    """``wood`` seen from a stock whose corner sits at ``origin_mm`` of the block frame."""
+
+    def __init__(self, wood, origin_mm):
+        self._wood = wood
+        self._origin = np.asarray(origin_mm, float).reshape(1, 3)
+
+    def color(self, points_mm, normals):
+        return self._wood.color(np.asarray(points_mm, float) + self._origin, normals)
+
+    def __getattr__(self, name):  # field, appearance...: the wood's own
+        return getattr(self._wood, name)
+
+
+def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:
+    """A ``W x D x H`` stock cut from ``stock``'s wood with its corner at ``origin_mm`` (block
+    frame, mm): any size and position, not only the built-in blocks' (the wood's growth field
+    is defined everywhere). ``size_mm`` > 0 and ``origin_mm`` finite, in mm."""
+    size = np.asarray(size_mm, float).reshape(-1)
+    origin = np.asarray(origin_mm, float).reshape(-1)
+    if size.shape != (3,) or not (np.isfinite(size).all() and (size > 0).all()):
+        raise WoodcamError(f"resize_stock: size_mm must be three finite numbers > 0 (W, D, H "
+                           f"in mm), got {size_mm!r}; e.g. (167, 208, 25)")
+    if origin.shape != (3,) or not np.isfinite(origin).all():
+        raise WoodcamError(f"resize_stock: origin_mm must be three finite numbers (mm), got "
+                           f"{origin_mm!r}; e.g. (0, 0, 0)")
+    W, D, H = size.tolist()
+    spec = f"{stock.spec}[{W:g}x{D:g}x{H:g}" + (f"@{','.join(f'{v:g}' for v in origin)}]"
+                                                 if origin.any() else "]")
+    wood = _ShiftedWood(stock.wood, origin) if origin.any() else stock.wood
+    return Stock(spec, (W, D, H), wood, stock.description,
+                 {**stock.meta, "parent_size_mm": list(stock.size_mm),
+                  "origin_mm": origin.tolist()})
 
 
 def open_stock(spec: str, *, species: str | None = None,
@@ -207,7 +246,8 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         As :func:`open_stock`: ``builtin:NAME`` and ``log:LOG@K[:WxDxH]`` give a synthetic
         block whose six face photos, ring maps and traces are rendered by
         :func:`woodcam.synth.synth_block` (seed 0) from the true field; a folder is read by
-        :func:`woodcam.block.io.read_block_folder` (block folder or Mokume sample folder).
+        :func:`woodcam.block.io.read_block_folder` (block folder or Mokume sample folder); a
+        folder of photos only gets its rings detected (cached, :mod:`woodcam.detect.block`).
     size_mm : float, optional
         Cube side of a Mokume sample folder (its files carry no size; default 50 mm).
     face_px : int
@@ -234,8 +274,12 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         return synth_block(field, size, face_px=face_px, seed=0, name=name), field
     from .block.io import read_block_folder
 
+    from .detect.block import with_detected_rings
+
     block = read_block_folder(_existing_folder(spec),
                               None if size_mm is None else (float(size_mm),) * 3)
+    # A block of photos only: rings detected once, cached by content outside the folder.
+    block = with_detected_rings(block, progress=True)
     return block, block.true_field
 
 
@@ -330,7 +374,10 @@ def _open_mokume_folder(path: Path, species, appearance, appearance_params) -> S
 def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
     from .block.io import read_block_folder  # imported when a folder is used
 
-    block = read_block_folder(path)
+    from .detect.block import with_detected_rings
+
+    # A block of photos only: rings detected once, cached by content outside the folder.
+    block = with_detected_rings(read_block_folder(path), progress=True)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
     return _real_block_stock(str(path), block, field, species, appearance, appearance_params,
                              cache_dir=None)

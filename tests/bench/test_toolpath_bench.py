@@ -75,3 +75,45 @@ def test_raster_20k_moves_throughput_and_ratio_to_manifold():
           f"(wall) {rwall / swall:.0f}x; removed volume differs by {100 * rel:+.3f} %")
     assert abs(rel) < 5e-3
     assert rcpu / scpu > 5
+
+
+def _cli_run(tmp_path, src_root, label, extra=()):
+    """``woodcam gcode`` of the raster in a fresh process: (CPU s, peak RSS GB, stdout)."""
+    import subprocess
+    import sys
+
+    prog = tmp_path / "raster.nc"
+    if not prog.exists():
+        spec = importlib.util.spec_from_file_location("make_samples",
+                                                      REPO / "toolpaths" / "make_samples.py")
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        prog.write_text(mod.relief_raster(100.0, 100.0, stepover=0.5, n_seg=100))
+    code = ("import sys, resource, time; t = time.process_time(); "
+            "from woodcam.cli import main; rc = main(sys.argv[1:]); "
+            "r = resource.getrusage(resource.RUSAGE_SELF); "
+            "print('CPU', r.ru_utime + r.ru_stime, 'RSS', r.ru_maxrss); sys.exit(rc)")
+    run = subprocess.run([sys.executable, "-c", code, "gcode", str(prog), "--block",
+                          "builtin:flat-sawn", "--out", str(tmp_path / f"{label}.glb"), "--tool",
+                          "2=ball:6", "--screenshot", *extra], capture_output=True, text=True,
+                         env={**os.environ, "PYTHONPATH": str(src_root)})
+    assert run.returncode in (0, 3), run.stderr[-3000:]
+    out = run.stdout
+    line = [ln for ln in out.splitlines() if ln.startswith("CPU ")][-1].split()
+    return float(line[1]), float(line[3]) / 1e6, out
+
+
+def test_whole_gcode_preview_of_the_raster(tmp_path):
+    """The whole ``woodcam gcode`` run (read, simulate, mesh, bake, GLB + OBJ, screenshot) of
+    the 20,000-move raster: CPU seconds and peak memory in a fresh process. Set
+    ``WOODCAM_BENCH_BASELINE_SRC`` to the root of an older checkout to time it in the same run
+    (the xatlas preview of issue 18's baseline measured 106 CPU-s and 4.0 GB there)."""
+    cpu, rss, out = _cli_run(tmp_path, REPO, "now")
+    print(f"\nwoodcam gcode raster (this checkout): {cpu:.1f} CPU-s, peak {rss:.2f} GB; load "
+          f"average {os.getloadavg()[0]:.1f}")
+    base = os.environ.get("WOODCAM_BENCH_BASELINE_SRC")
+    if base:
+        bcpu, brss, _ = _cli_run(tmp_path, Path(base), "base")
+        print(f"baseline {base}: {bcpu:.1f} CPU-s, peak {brss:.2f} GB; ratio {bcpu / cpu:.1f}x "
+              f"CPU, {brss / rss:.1f}x memory")
+    assert rss < 2**30 / 1e9  # 1 GiB

@@ -13,10 +13,6 @@ BAKE = ["bake", "cad_examples/bowl.py", "--block", "builtin:flat-sawn"]
 
 @pytest.mark.parametrize("argv, match", [
     (["gcode", "toolpaths/vcarve_text.nc", "--tool", "vbit:60:12", "--block", "builtin:flat-sawn",
-      "--out", "OUT/x.glb", "--work-offset", "nan,nan,nan"], r"--work-offset X,Y,Z takes 3 comma-separated finite"),
-    (["gcode", "toolpaths/vcarve_text.nc", "--tool", "vbit:60:12", "--block", "builtin:flat-sawn",
-      "--out", "OUT/x.glb", "--work-offset", "0,0,inf"], r"--work-offset"),
-    (["gcode", "toolpaths/vcarve_text.nc", "--tool", "vbit:60:12", "--block", "builtin:flat-sawn",
       "--out", "OUT/x.glb", "--resolution", "1e-9"], r"--resolution must be in \[0.005, 10\]"),
     ([*BAKE, "--out", "OUT/x.glb", "--tolerance", "0"], r"--tolerance must be in \(0, 10\]; got 0.0"),
     ([*BAKE, "--out", "OUT/x.glb", "--tolerance", "nan"], r"--tolerance must be a finite number"),
@@ -48,3 +44,13 @@ def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monk
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("woodcam: error: ")
     assert __import__("re").search(match, err), err
+
+
+@pytest.mark.parametrize("value", ["nan,nan,nan", "0,0,inf", "1,2"])
+def test_work_offset_must_be_three_finite_numbers(value, capsys):
+    """Issue 15: `--work-offset nan,nan,nan` exited 0 (and cut nothing)."""
+    with pytest.raises(SystemExit) as exc:
+        main(["gcode", "toolpaths/vcarve_text.nc", "--tool", "vbit:60:12", "--block",
+              "builtin:flat-sawn", "--out", "x.glb", f"--work-offset={value}"])
+    assert exc.value.code == 2
+    assert "finite numbers X,Y,Z" in capsys.readouterr().err

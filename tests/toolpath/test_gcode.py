@@ -3,28 +3,34 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from woodcam.toolpath import GcodeError, read_gcode
-from woodcam.toolpath.gcode import FEED, RAPID
+from woodcam.toolpath.gcode import DEFAULT_START_MM, FEED, RAPID
 
 
 def test_moves_kinds_feeds_lines():
     prog = read_gcode("G21 G90\nT3 M6\nS12000 M3\nG0 X10 Y20 Z5\nG1 Z-2 F300\nX30\n"
                       "Y25 F600\nG0 Z5\nM30\n")
-    np.testing.assert_allclose(prog.end_mm, [[10, 20, -2], [30, 20, -2], [30, 25, -2],
-                                             [30, 25, 5]])
-    assert prog.kind.tolist() == [FEED, FEED, FEED, RAPID]
-    assert prog.line.tolist() == [5, 6, 7, 8]
-    assert prog.feed_mm_min.tolist() == [300, 300, 600, 600]
-    assert prog.tool.tolist() == [3, 3, 3, 3] and prog.tool_numbers == [3]
-    assert prog[1].kind == "feed" and prog[1].spindle_rpm == 12000 and prog[1].line == 6
+    # the first rapid starts at the start position (DEFAULT_START_MM, 10 mm over work zero)
+    np.testing.assert_allclose(prog.start_mm[0], DEFAULT_START_MM)
+    np.testing.assert_allclose(prog.end_mm, [[10, 20, 5], [10, 20, -2], [30, 20, -2],
+                                             [30, 25, -2], [30, 25, 5]])
+    assert prog.kind.tolist() == [RAPID, FEED, FEED, FEED, RAPID]
+    assert prog.line.tolist() == [4, 5, 6, 7, 8]
+    assert prog.feed_mm_min.tolist() == [0, 300, 300, 600, 600]
+    assert prog.tool.tolist() == [3] * 5 and prog.tool_numbers == [3]
+    assert prog[2].kind == "feed" and prog[2].spindle_rpm == 12000 and prog[2].line == 6
+    assert prog.warnings == []
 
 
 def _arc_points(prog):
-    return np.vstack([prog.start_mm[:1], prog.end_mm])
+    """Vertices of the feed moves (the arc) of ``prog``."""
+    f = prog.kind == FEED
+    return np.vstack([prog.start_mm[f][:1], prog.end_mm[f]])
 
 
 @pytest.mark.parametrize("cw", [True, False])
@@ -37,7 +43,7 @@ def test_ij_arc_lies_on_analytic_circle_with_chord_tolerance(cw):
     c = np.array([10.0, 10.0])
     r = np.hypot(*(pts[:, :2] - c).T)
     np.testing.assert_allclose(r, 10.0, atol=1e-12)  # every vertex on the circle
-    mids = 0.5 * (prog.start_mm + prog.end_mm)[:, :2]
+    mids = 0.5 * (prog.start_mm + prog.end_mm)[prog.kind == FEED][:, :2]
     sag = 10.0 - np.hypot(*(mids - c).T)
     assert sag.max() <= tol + 1e-12 and sag.max() > tol / 4  # not absurdly over-refined
     ang = np.unwrap(np.arctan2(*(pts[:, :2] - c).T[::-1]))
@@ -115,17 +121,19 @@ def test_drilling_cycles_expand_to_moves():
 
 
 @pytest.mark.parametrize("text, line, word", [
-    ("G21\nG0 X0 Y0 Z5\nG30 Z0\n", 3, "G30"),
-    ("G0 X0 Y0 Z5\nG1 X1..2 F100\n", 2, ".2"),
+    ("G21\nG0 X0 Y0 Z5\nG38.2 Z0\n", 3, "G38.2"),
+    ("G0 X0 Y0 Z5\nG1 X1..2 F100\n", 2, "."),
     ("G0 X0 Y0 Z5\nG1 A10 F100\n", 2, "A10"),
     ("G0 X0 Y0 Z5\nG1 X10\n", 2, "G1"),              # no feed rate yet
     ("G0 X0 Y0 Z0\nG1 F10\nG2 X10 Y0 I4 J0\n", 3, "G2"),  # radius mismatch
     ("G0 X0 Y0 Z0\nG1 F10\nG2 X0 Y0 R5\n", 3, "R5"),       # R-form full circle
     ("G0 G1 X1 Y1 Z1\n", 1, "G0 G1"),
-    ("G0 X0 (open comment\n", 1, "("),
+    ("G0 X0 (open comment\n", 1, "(open comment"),
     ("G0 X0 Y0 Z0\nM98 P100\n", 2, "M98"),
-    ("G91 G0 X5\n", 1, "X5"),                          # incremental from an unknown position
+    ("G0 X0\nG0 X[1 / [2 - 2]]\n", 2, "1 / 0"),
     ("N7 G0 X0 Y0 Z0\nN8 G1 F10 X1 Y1 Z1 X2\n", 2, "X2"),
+    ("G0 X0\nG41 G1 X10 F100\n", 2, "G41"),           # cutter compensation: refused
+    ("G0 X0\nO1001\n", 2, "o1001"),                   # Fanuc program number, LinuxCNC dialect
 ])
 def test_malformed_and_unsupported_lines_name_line_and_word(text, line, word):
     with pytest.raises(GcodeError, match=rf"line {line}\b.*'{__import__('re').escape(word)}") as e:
@@ -133,33 +141,64 @@ def test_malformed_and_unsupported_lines_name_line_and_word(text, line, word):
     assert e.value.line == line
 
 
-def test_error_shows_n_word():
-    with pytest.raises(GcodeError, match=r"line 2 \(N20\): 'G30'"):
-        read_gcode("N10 G0 X0 Y0 Z0\nN20 G30\n")
-
-
 def test_reads_file(tmp_path):
     p = tmp_path / "a.nc"
-    p.write_text("G0 X0 Y0 Z1\nG1 Z-1 F100\n")
+    p.write_text("G0 X0 Y0 Z1\nG1 Z-1 F100\nM2\n")
     prog = read_gcode(p)
-    assert len(prog) == 1 and prog.source == str(p)
-    assert len(read_gcode(str(p))) == 1
+    assert len(prog) == 2 and prog.source == str(p)
+    assert len(read_gcode(str(p))) == 2
 
 
-def test_comments_block_delete_and_unknown_start():
+def test_comments_block_delete_and_start_position():
     prog = read_gcode("%\n(header)\n; whole-line comment\nN10 G21 G90 G17 (modes) ; units\n"
-                      "G0 Z5\nG0 X10 Y20\n/G1 Z-2 F300\nX30\nM30\nG1 X99\n")
-    # G0 Z5 / G0 X10 Y20 only set the unknown start; block-delete line runs; M30 ends reading
-    np.testing.assert_allclose(prog.start_mm, [[10, 20, 5], [10, 20, -2]])
-    np.testing.assert_allclose(prog.end_mm, [[10, 20, -2], [30, 20, -2]])
-    assert prog.line.tolist() == [7, 8]
+                      "G0 Z5\nG0 X10 Y20\n/G1 Z-2 F300\nX30\nM30\nG1 X99\n",
+                      start_mm=(1, 2, 30))
+    # moves start at start_mm; the block-delete line runs (switch off); M30 ends reading
+    np.testing.assert_allclose(prog.start_mm, [[1, 2, 30], [1, 2, 5], [10, 20, 5], [10, 20, -2]])
+    np.testing.assert_allclose(prog.end_mm, [[1, 2, 5], [10, 20, 5], [10, 20, -2], [30, 20, -2]])
+    assert prog.line.tolist() == [5, 6, 7, 8]
+    assert prog.warnings == []
 
 
-def test_program_number_g28_and_g53_make_axes_unknown():
+def test_cut_before_known_position_warns_with_line():
+    prog = read_gcode("G21 G90\nG1 Z-1 F100\nG1 X10 Y10\nM2\n")
+    assert prog.start_mm[0].tolist() == list(DEFAULT_START_MM)
+    assert len(prog.warnings) == 1 and prog.warnings[0].startswith("line 2:")
+    assert "XY" in prog.warnings[0]
+
+
+def test_fanuc_program_number_g28_and_g53():
     prog = read_gcode("O1001\nG0 X10 Y10 Z5\nG1 Z-1 F100\nG91 G28 Z2\nG90\n"
-                      "G53 G0 Z0\nG0 X20 Y10\nG0 Z5\nG1 Z-1\n")
-    # G28 Z2 (incremental): rapid up 2 mm to the intermediate point, then Z is unknown; the
-    # G53 retract is in machine coordinates; the next moves only re-establish the position
-    np.testing.assert_allclose(prog.start_mm, [[10, 10, 5], [10, 10, -1], [20, 10, 5]])
-    np.testing.assert_allclose(prog.end_mm, [[10, 10, -1], [10, 10, 1], [20, 10, -1]])
-    assert prog.line.tolist() == [3, 4, 9]
+                      "G53 G0 Z7\nG0 X20 Y10\nG1 Z-1\nM30\n", dialect="fanuc",
+                      start_mm=(0, 0, 40))
+    # G28 Z2 (incremental): rapid up 2 mm to the intermediate point, then Z to the home, which
+    # woodcam keeps at the start position; G53 moves in machine coordinates (= G54 here)
+    np.testing.assert_allclose(prog.end_mm, [[10, 10, 5], [10, 10, -1], [10, 10, 1],
+                                             [10, 10, 40], [10, 10, 7], [20, 10, 7],
+                                             [20, 10, -1]])
+    assert prog.line.tolist() == [2, 3, 4, 4, 6, 7, 8]
+
+
+CORPUS = sorted((Path(__file__).resolve().parents[2] / "toolpaths" / "corpus").glob("*.*[!y]"))
+
+
+@pytest.mark.parametrize("path", CORPUS, ids=lambda p: p.name)
+def test_corpus_programs_simulate_or_fail_with_their_reason(path):
+    """Every corpus program either simulates (finite, something cut) or, for the err_* ones,
+    is refused at the line its header comment names the reason of."""
+    from woodcam.toolpath import parse_tool_spec, simulate
+
+    if path.name.startswith("err_"):
+        reason = path.read_text().splitlines()[0]
+        with pytest.raises(GcodeError) as e:
+            read_gcode(path, dialect="linuxcnc")
+        assert e.value.line > 1, reason
+        return
+    dialect = "fanuc" if path.name.startswith("fanuc") else "linuxcnc"
+    prog = read_gcode(path, dialect=dialect)
+    assert (prog.kind == FEED).any()
+    res = simulate(prog, parse_tool_spec("ball:6"), (120.0, 100.0, 50.0), resolution_mm=0.5,
+                   work_offset_mm=(10.0, 10.0, 50.0))
+    assert np.isfinite(res.heightmap).all()
+    if (prog.end_mm[prog.kind == FEED, 2] < 0).any():  # (two language tests stay above)
+        assert res.removed_volume_mm3 > 0

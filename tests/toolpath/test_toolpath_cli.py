@@ -40,22 +40,40 @@ def test_run_simulates_and_hands_a_watertight_mesh_to_the_pipeline(tmp_path, mon
                                                                    capsys):
     seen = {}
 
-    def fake_preview_mesh(mesh, stock, out_glb, **kw):
-        seen.update(mesh=mesh, stock=stock, meta=kw["metadata"])
-        return woodcam.pipeline.PartPreview("x", files={"glb": Path(out_glb)})
+    def fake_preview(heightmap, stock, out_glb, **kw):
+        seen.update(heightmap=heightmap, stock=stock, meta=kw["metadata"])
+        return woodcam.pipeline.PartPreview("x", files={"glb": Path(out_glb)}, triangles=1)
 
-    monkeypatch.setattr(woodcam.pipeline, "preview_mesh", fake_preview_mesh)
+    monkeypatch.setattr(woodcam.pipeline, "preview_heightfield", fake_preview)
     prog = tmp_path / "slot.nc"
     prog.write_text("G0 X20 Y40 Z2\nG1 Z-3 F300\nX80\nG0 Z2\n")
     args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
                    "--tool", "flat:6", "--resolution", "0.25"])
     assert args.func(args) == 0
-    mesh = seen["mesh"]
-    assert mesh.is_watertight
     W, D, H = seen["stock"].size_mm
-    assert mesh.volume == pytest.approx(W * D * H - 3 * (60 * 6 + 3.14159265 * 9), rel=5e-3)
+    hm = seen["heightmap"]
+    assert (H - hm).sum() * W * D / hm.size == pytest.approx(3 * (60 * 6 + 3.14159265 * 9),
+                                                             rel=5e-3)
     assert seen["meta"]["tools"] == {"0": "flat:6"}
-    assert "slot.nc: 3 moves" in capsys.readouterr().out
+    assert "slot.nc: 4 moves" in capsys.readouterr().out
+
+
+def test_negative_and_invalid_triples():
+    args = _parse(["p.nc", "--block", "b", "--out", "o.glb", "--work-offset", "-14,5,3",
+                   "--start", "-1.5,-2,30"])
+    assert args.work_offset == (-14.0, 5.0, 3.0) and args.start == (-1.5, -2.0, 30.0)
+    for bad in ("nan,nan,nan", "1,2", "1,inf,3", "a,b,c"):
+        with pytest.raises(SystemExit):
+            _parse(["p.nc", "--block", "b", "--out", "o.glb", "--work-offset", bad])
+
+
+def test_program_without_cuts_is_an_error(tmp_path):
+    prog = tmp_path / "rapids.nc"
+    prog.write_text("G0 X20 Y40 Z2\nG0 X30\nM2\n")
+    args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+                   "--tool", "flat:6"])
+    with pytest.raises(WoodcamError, match="no cutting move"):
+        args.func(args)
 
 
 @pytest.mark.slow
@@ -70,3 +88,66 @@ def test_gcode_end_to_end_writes_a_baked_glb(tmp_path):
     assert args.func(args) == 0
     meta = read_glb_metadata(out)
     assert meta["block"] == "builtin:flat-sawn" and meta["tools"] == {"0": "ball:6"}
+
+
+def _stub_preview(monkeypatch, seen):
+    def fake_preview(heightmap, stock, out_glb, **kw):
+        seen.update(heightmap=heightmap, stock=stock, meta=kw["metadata"])
+        return woodcam.pipeline.PartPreview("x", files={"glb": Path(out_glb)}, triangles=1)
+
+    monkeypatch.setattr(woodcam.pipeline, "preview_heightfield", fake_preview)
+
+
+def test_programs_in_sequence_until_line_stock_and_strict(tmp_path, monkeypatch, capsys):
+    seen = {}
+    _stub_preview(monkeypatch, seen)
+    rough = tmp_path / "rough.nc"
+    rough.write_text("G0 X20 Y20 Z2 M3 S9000\nG1 Z-3 F600\nX40\nG0 Z2\nM2\n")
+    finish = tmp_path / "finish.nc"
+    finish.write_text("G0 X20 Y30 Z2 M3 S9000\nG1 Z-3 F600\nX40\nG0 Z2\nM2\n")
+    base = ["--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"), "--tool", "flat:6",
+            "--resolution", "0.5", "--stock", "60x50x20", "--stock-origin", "-5,-5,0"]
+    args = _parse([str(rough), str(finish), *base])
+    assert args.func(args) == 0
+    hm = seen["heightmap"]
+    assert seen["stock"].size_mm == (60.0, 50.0, 20.0) and hm.shape == (100, 120)
+    both = (20 - hm).sum() * 0.25
+    assert both == pytest.approx(2 * 3 * (20 * 6 + 3.14159265 * 9), rel=0.02)
+    out = capsys.readouterr().out
+    assert "rough.nc: 4 moves" in out and "finish.nc: 4 moves" in out
+    assert "machining time T0: 0:00:" in out
+    # scrubbed to line 2 of the last program: its slot is only plunged
+    args = _parse([str(rough), str(finish), *base, "--until-line", "2"])
+    assert args.func(args) == 0
+    part = (20 - seen["heightmap"]).sum() * 0.25
+    assert part == pytest.approx(3 * (20 * 6 + 3.14159265 * 9) + 3 * 3.14159265 * 9, rel=0.03)
+    # --strict: a warning (a cut with the spindle off) gives exit status 3
+    off = tmp_path / "off.nc"
+    off.write_text("G0 X20 Y20 Z2\nG1 Z-3 F600\nX40\nG0 Z2\nM2\n")
+    args = _parse([str(off), *base, "--strict"])
+    assert args.func(args) == 3
+    assert "spindle_off" in capsys.readouterr().err
+
+
+def test_machining_time_estimate():
+    prog = read_gcode("G0 X0 Y0 Z10\nG1 X100 F600\nG0 X0\nT2 M6\nG1 Y60 F1200\nM2\n",
+                      start_mm=(0, 0, 10))
+    t = prog.machining_time_s(rapid_mm_min=6000)
+    assert t[0] == pytest.approx((10.0, 1.0))   # 100 mm at 600 mm/min, 100 mm rapid at 6000
+    assert t[2] == pytest.approx((3.0, 0.0))
+    with pytest.raises(WoodcamError, match="rapid_mm_min"):
+        prog.machining_time_s(0)
+
+
+def test_grid_coarser_than_half_the_stepover_warns(tmp_path, monkeypatch, capsys):
+    _stub_preview(monkeypatch, {})
+    prog = REPO / "toolpaths" / "corpus" / "gen_raster_fine.ngc"  # 0.5 mm step-over
+    assert read_gcode(prog).stepover_mm(0.1) == pytest.approx(0.5, abs=0.01)
+    base = [str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+            "--tool", "1=ball:6", "--strict"]
+    args = _parse([*base, "--resolution", "0.4"])
+    assert args.func(args) == 3
+    assert "coarser than half the step-over (0.5 mm)" in capsys.readouterr().err
+    args = _parse([*base, "--resolution", "0.2"])
+    args.func(args)
+    assert "step-over" not in capsys.readouterr().err

@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from woodcam.errors import WoodcamError
-from woodcam.toolpath import (BallEndMill, BullNoseMill, FlatEndMill, VBit, load_tool_table,
+from woodcam.toolpath import (BallEndMill, BullNoseMill, ChamferMill, FlatEndMill,
+                              SnubNoseVBit, TaperedBallMill, VBit, load_camotics_tools,
+                              load_tool_table,
                               parse_tool_spec)
 
 
@@ -61,7 +63,10 @@ def test_load_tool_table(tmp_path):
 
 
 TOOLS = [FlatEndMill(6), BallEndMill(6), BullNoseMill(6, corner_radius_mm=1.5),
-         VBit(8, angle_deg=60), VBit(8, angle_deg=150)]
+         VBit(8, angle_deg=60), VBit(8, angle_deg=150),
+         SnubNoseVBit(6, angle_deg=60, tip_diameter_mm=1.0),
+         ChamferMill(6, angle_deg=90, tip_diameter_mm=2.0),
+         TaperedBallMill(6, tip_diameter_mm=1.5, taper_deg=10)]
 
 
 @pytest.mark.parametrize("tool", TOOLS, ids=lambda t: t.spec())
@@ -82,3 +87,38 @@ def test_sweep_kernel_matches_brute_force_minimum(tool, slope, rng):
     # step * (|slope| + max profile slope on the way); float32 kernel ~1e-6 relative
     np.testing.assert_allclose(env[covered], brute[covered], atol=1e-3 + 3e-4 * abs(slope))
     assert np.all(env[covered] <= brute[covered] + 1e-5)
+
+
+def test_new_profiles_specs_and_tables(tmp_path):
+    snub = parse_tool_spec("snub:60:6:1")
+    assert snub == SnubNoseVBit(6, angle_deg=60, tip_diameter_mm=1)
+    np.testing.assert_allclose(snub.profile([0.0, 0.5, 1.5]), [0, 0, math.sqrt(3)])
+    assert parse_tool_spec("chamfer:90:12:2").profile(4.0) == pytest.approx(3.0)
+    tb = parse_tool_spec("taperball:6:1:10")
+    rt = 0.5 * math.cos(math.radians(10))
+    h = tb.profile(np.array([0.0, rt, 2.0]))
+    assert h[0] == 0 and h[1] == pytest.approx(0.5 - math.sqrt(0.25 - rt * rt))
+    assert h[2] == pytest.approx(h[1] + (2.0 - rt) / math.tan(math.radians(10)))
+    for spec in ("snub:60:6:1", "chamfer:90:12:2", "taperball:6:1:10"):
+        assert parse_tool_spec(spec).spec() == spec
+    with pytest.raises(WoodcamError, match="tip_diameter_mm"):
+        parse_tool_spec("snub:60:6:7")
+    p = tmp_path / "t.toml"
+    p.write_text('[tools.4]\ntype = "taperball"\ndiameter_mm = 6\ntip_diameter_mm = 1\n'
+                 'taper_deg = 10\n[tools.5]\ntype = "snub"\ndiameter_mm = 6\nangle_deg = 60\n'
+                 'tip_diameter_mm = "x"\n')
+    with pytest.raises(WoodcamError, match="must be a number"):
+        load_tool_table(p)
+    # CAMotics: a cone is its diameter and the length of its conical part
+    j = tmp_path / "tools.json"
+    j.write_text('{"tools": {"1": {"units": "imperial", "shape": "cylindrical", '
+                 '"diameter": 0.25, "length": 1}, "2": {"units": "metric", "shape": "conical",'
+                 ' "diameter": 10, "length": 5}, "3": {"shape": "snubnose", "diameter": 6, '
+                 '"snub_diameter": 2, "length": 2}, "4": {"shape": "ballnose", "diameter": 3}}}')
+    tools = load_tool_table(j)
+    assert tools[1] == FlatEndMill(6.35) and tools[4] == BallEndMill(3)
+    assert tools[2] == VBit(10, angle_deg=90)
+    assert tools[3] == SnubNoseVBit(6, angle_deg=90, tip_diameter_mm=2)
+    j.write_text('{"tools": {"1": {"shape": "spheroid", "diameter": 3}}}')
+    with pytest.raises(WoodcamError, match="shape"):
+        load_camotics_tools(j)

@@ -7,14 +7,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .options import add_block_argument, add_size_option, open_block
+from .options import add_block_argument, add_engine_options, add_size_option, engine_options, open_block
 
 
 def register(subparsers) -> None:
-    """Add the ``block`` command (with ``synth`` and ``show``) to an argparse sub-parser set."""
+    """Add the ``block`` command (with ``synth``, ``show`` and ``from-photos``) to an argparse sub-parser set."""
     p = subparsers.add_parser("block", help="synthesise or show blocks (six face photos + rings)")
     p.set_defaults(func=run)          # woodcam.cli dispatches on args.func
-    sub = p.add_subparsers(dest="block_command", required=True, metavar="{synth,show}")
+    sub = p.add_subparsers(dest="block_command", required=True, metavar="{synth,show,from-photos}")
 
     s = sub.add_parser("synth", help="write a reproducible set of synthetic blocks")
     s.add_argument("--count", type=int, required=True, help="number of blocks")
@@ -22,6 +22,7 @@ def register(subparsers) -> None:
     s.add_argument("--out", type=Path, required=True, help="output folder (one sub-folder per block)")
     s.add_argument("--face-px", type=int, default=512, help="pixels along the largest face side")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_engine_options(s)
 
     v = sub.add_parser("show", help="draw a block's faces as one unfolded-cross PNG")
     add_block_argument(v, option=False)
@@ -29,6 +30,10 @@ def register(subparsers) -> None:
     v.add_argument("--layer", choices=("photo", "ring_map", "both"), default="photo")
     v.add_argument("--no-traces", action="store_true", help="do not draw traced rings")
     add_size_option(v)
+
+    from .rings import add_from_photos
+
+    add_from_photos(sub)
 
 
 def run(args) -> int:
@@ -38,6 +43,18 @@ def run(args) -> int:
 
         from ..synth import knotted_log_field, synth_benchmark_set
 
+        if args.engine is not None or args.address is not None:
+            # one task per block: the same blocks, resumable (a record per block), on an engine
+            from ..benchmark import write_benchmark_set
+
+            summary, index = write_benchmark_set(args.out, args.count, args.seed, face_px=args.face_px,
+                                                 progress=not args.quiet, **engine_options(args))
+            knotted = sum(b["knotted"] for b in index["blocks"])
+            print(f"wrote {len(index['blocks'])} blocks to {args.out} ({knotted} knotted; "
+                  f"index.json lists them); {summary.line()}")
+            from . import EXIT_CHECKS
+
+            return 0 if summary.failed == 0 else EXIT_CHECKS  # some blocks failed
         folders = synth_benchmark_set(args.out, args.count, args.seed, face_px=args.face_px,
                                       log_fields=knotted_log_field, progress=not args.quiet)
         index = json.loads((Path(args.out) / "index.json").read_text())
@@ -51,4 +68,8 @@ def run(args) -> int:
         save_cross_png(block, args.out, args.layer, traces=not args.no_traces)
         print(f"wrote {args.out}")
         return 0
+    if args.block_command == "from-photos":
+        from .rings import run_from_photos
+
+        return run_from_photos(args)
     raise AssertionError(args.block_command)  # argparse restricts the choices

@@ -6,7 +6,7 @@
 - :func:`add_block_argument` and :func:`open_block`: a block spec on the command line and the
   one resolver behind every command that reads a block (:func:`woodcam.stock.open_block`).
 - :func:`command_group`: a command with sub-commands that several modules extend.
-- :func:`check_numbers` / :data:`RANGES` / :func:`number_list`: every numeric option finite and
+- :func:`check_numbers` / :data:`RANGES`: every numeric option finite and
   in range, checked by :func:`woodcam.cli.main` before a command runs.
 
 Nothing heavy is imported at module level (``woodcam --help`` loads this module).
@@ -301,6 +301,9 @@ RANGES: dict = {
     "margin": (0.0, 1000.0, False),            # mm
     "top": (1, 100_000, False),
     "voxels": (1000, 50_000_000, False),       # voxels per review colour volume (default 4e5)
+    "workers": (1, 1024, False),
+    "memory_limit_mb": (64, 1_048_576, False),
+    "connect_timeout_s": (0.0, 3600.0, True),
 }
 
 
@@ -333,16 +336,34 @@ def check_numbers(args: argparse.Namespace) -> None:
             _check_value(v, _option(dest), rng)
 
 
-def number_list(text: str, n: int, option: str, lo: float = -math.inf, hi: float = math.inf,
-                unit: str = "") -> tuple[float, ...]:
-    """``"a,b,c"`` -> ``n`` finite floats in ``[lo, hi]``, or a WoodcamError naming ``option``."""
-    try:
-        vals = tuple(float(v) for v in str(text).split(","))
-    except ValueError:
-        vals = ()
-    ok = len(vals) == n and all(math.isfinite(v) and lo <= v <= hi for v in vals)
-    if not ok:
-        bounds = "" if (lo, hi) == (-math.inf, math.inf) else f" in [{lo:g}, {hi:g}]"
-        raise WoodcamError(f"{option} takes {n} comma-separated finite numbers{bounds}"
-                           f"{' in ' + unit if unit else ''}; got {text!r}")
-    return vals
+def add_engine_options(p: argparse.ArgumentParser) -> None:
+    """``--engine``, ``--address``, ``--workers``: where many independent tasks run
+    (:func:`woodcam.scale.run_many`)."""
+    p.add_argument("--engine", choices=("local", "dask"), default=None,
+                   help="run one task per item: local = worker processes on this machine, no "
+                   "services; dask = a Dask cluster (--address) or, without one, a 2-worker "
+                   "cluster on 127.0.0.1. Records are kept per item, so a killed run resumes "
+                   "(default: local)")
+    p.add_argument("--address", default=None, metavar="tcp://HOST:PORT",
+                   help="a running Dask scheduler (with --engine dask; default: none, start a "
+                   "local cluster)")
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="worker processes, each with one thread (default 2; 1 = serial in this "
+                   "process; not with --address)")
+    p.add_argument("--memory-limit-mb", type=int, default=None, metavar="MB",
+                   help="memory per worker in MiB (default 3072)")
+    p.add_argument("--connect-timeout-s", type=float, default=None, metavar="S",
+                   help="seconds to wait for the scheduler at --address (default 10)")
+
+
+def engine_options(args) -> dict:
+    """The keyword arguments of :func:`woodcam.scale.run_many` from :func:`add_engine_options`."""
+    if args.address is not None and args.engine not in (None, "dask"):
+        raise WoodcamError(f"--address needs --engine dask; got --engine {args.engine}")
+    out = {"engine": "dask" if args.address is not None else (args.engine or "local"),
+           "address": args.address, "workers": args.workers}
+    if args.memory_limit_mb is not None:
+        out["memory_limit_mb"] = args.memory_limit_mb
+    if args.connect_timeout_s is not None:
+        out["connect_timeout_s"] = args.connect_timeout_s
+    return out

@@ -141,3 +141,152 @@ def heightfield_mesh(heightmap, size_mm, *, flat_tol_mm: float = 1e-9):
     used[mesh.faces.ravel()] = True
     remap = np.cumsum(used) - 1
     return trimesh.Trimesh(mesh.vertices[used], remap[mesh.faces], process=False)
+
+
+#: Texels between charts of the height-field atlas (the bake's dilation fills them).
+_CHART_PAD_PX = 8
+
+
+class HeightfieldCharts:
+    """Planar texture charts of a height-field stock (its own parameterisation, no unwrap).
+
+    Six charts: the top seen from +Z (texel = XY), the bottom, and the four walls (texel =
+    position along the wall, Z). ``uv_px : (n, 2)`` are the mesh vertices' texel coordinates
+    (x right, y down, pixel corners at integers), ``size_px = (width, height)`` the atlas.
+    :meth:`texel_points` gives every chart texel's block-frame point and normal, exactly on the
+    mesh (the top is the vertex grid's triangles, split as in :func:`heightfield_mesh`).
+    """
+
+    def __init__(self, heightmap, size_mm, texels_per_mm):
+        W, D, H = (float(v) for v in size_mm)
+        self.size_mm = (W, D, H)
+        self.hm = np.asarray(heightmap, float)
+        t = float(texels_per_mm)
+        tw, td, th = (max(1, int(np.ceil(v * t))) for v in (W, D, H))
+        # chart: name -> (origin x, origin y, width px, height px, span u mm, span v mm)
+        pad = _CHART_PAD_PX
+        charts = {}
+        x0 = y0 = pad
+        row_h = 0
+        width = 2 * max(tw, td) + 3 * pad
+        for name, (w, h, su, sv) in {"top": (tw, td, W, D), "bottom": (tw, td, W, D),
+                                     "front": (tw, th, W, H), "back": (tw, th, W, H),
+                                     "left": (td, th, D, H), "right": (td, th, D, H)}.items():
+            if x0 + w + pad > width:
+                x0, y0, row_h = pad, y0 + row_h + pad, 0
+            charts[name] = (x0, y0, w, h, su, sv)
+            x0 += w + pad
+            row_h = max(row_h, h)
+        self.charts = charts
+        self.size_px = (width, y0 + row_h + pad)
+
+    def uv(self, name, u_mm, v_mm):
+        """Texel coordinates of chart ``name`` at ``(u, v)`` mm (v measured downwards)."""
+        x0, y0, w, h, su, sv = self.charts[name]
+        return np.column_stack([x0 + np.asarray(u_mm) * (w / su), y0 + np.asarray(v_mm) * (h / sv)])
+
+    def texel_points(self):
+        """Yield ``(flat texel indices (k,), points_mm (k, 3), normals (k, 3))`` per chart."""
+        W, D, H = self.size_mm
+        width = self.size_px[0]
+        xs, ys, z = _vertex_grid(self.hm, self.size_mm)
+        for name, (x0, y0, w, h, su, sv) in self.charts.items():
+            ii, jj = np.meshgrid(np.arange(w), np.arange(h))
+            u = (ii.ravel() + 0.5) * (su / w)
+            v = (jj.ravel() + 0.5) * (sv / h)
+            idx = (y0 + jj.ravel()) * width + x0 + ii.ravel()
+            n = len(u)
+            nrm = np.zeros((n, 3))
+            if name == "top":
+                zz, nrm = _grid_surface(xs, ys, z, u, D - v)
+                pts = np.column_stack([u, D - v, zz])
+            elif name == "bottom":
+                pts = np.column_stack([u, v, np.zeros(n)])
+                nrm[:, 2] = -1
+            else:
+                zz = H - v
+                pts = {"front": lambda: np.column_stack([u, np.zeros(n), zz]),
+                       "back": lambda: np.column_stack([W - u, np.full(n, D), zz]),
+                       "left": lambda: np.column_stack([np.zeros(n), D - u, zz]),
+                       "right": lambda: np.column_stack([np.full(n, W), u, zz])}[name]()
+                axis, sign = {"front": (1, -1), "back": (1, 1), "left": (0, -1),
+                              "right": (0, 1)}[name]
+                nrm[:, axis] = sign
+            yield idx, pts, nrm
+
+
+def _grid_surface(xs, ys, z, x, y):
+    """Height and unit normal of the vertex grid's triangles (quad split v00-v01-v11 /
+    v00-v11-v10, as :func:`heightfield_mesh`) at points ``x, y : (k,)``."""
+    i = np.clip(np.searchsorted(xs, x, side="right") - 1, 0, len(xs) - 2)
+    j = np.clip(np.searchsorted(ys, y, side="right") - 1, 0, len(ys) - 2)
+    hx, hy = xs[i + 1] - xs[i], ys[j + 1] - ys[j]
+    a, b = (x - xs[i]) / hx, (y - ys[j]) / hy
+    z00, z01 = z[j, i], z[j, i + 1]
+    z10, z11 = z[j + 1, i], z[j + 1, i + 1]
+    upper = a >= b  # triangle v00, v01, v11
+    zz = np.where(upper, z00 + a * (z01 - z00) + b * (z11 - z01),
+                  z00 + b * (z10 - z00) + a * (z11 - z10))
+    gx = np.where(upper, (z01 - z00) / hx, (z11 - z10) / hx)
+    gy = np.where(upper, (z11 - z01) / hy, (z10 - z00) / hy)
+    nrm = np.column_stack([-gx, -gy, np.ones_like(gx)])
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    return zz, nrm
+
+
+def heightfield_mesh_charts(heightmap, size_mm, texels_per_mm, *, flat_tol_mm: float = 1e-9):
+    """:func:`heightfield_mesh` with planar texture charts:
+    ``(mesh, uv_px (n, 2), charts, vertex_normals (n, 3))``.
+
+    Vertices are split where charts meet (top/wall edges, wall corners, bottom), so every
+    vertex has one texel coordinate; the geometry is the same closed surface. The top's shading
+    normals are the grid's central-difference gradient (smooth; at 0.1 mm cells a sharp edge
+    blurs over one cell), the walls' and bottom's their face normals.
+    """
+    import trimesh
+
+    mesh = heightfield_mesh(heightmap, size_mm, flat_tol_mm=flat_tol_mm)
+    charts = HeightfieldCharts(heightmap, size_mm, texels_per_mm)
+    W, D, H = charts.size_mm
+    V = np.asarray(mesh.vertices)
+    F = np.asarray(mesh.faces)
+    fn = np.asarray(mesh.face_normals)
+    # the chart of each face from its normal and position: walls are vertical and on a face
+    c = V[F].mean(axis=1)
+    eps = 1e-9 * max(W, D, H)
+    name = np.full(len(F), "top", dtype=object)
+    vertical = np.abs(fn[:, 2]) < 1e-9
+    name[vertical & (c[:, 1] < eps)] = "front"
+    name[vertical & (c[:, 1] > D - eps)] = "back"
+    name[vertical & (c[:, 0] < eps)] = "left"
+    name[vertical & (c[:, 0] > W - eps)] = "right"
+    bottom = (fn[:, 2] < -0.5) & (np.abs(V[F][:, :, 2]).max(axis=1) < eps)
+    name[bottom] = "bottom"
+    xs, ys, zg = _vertex_grid(np.asarray(heightmap, float), (W, D, H))
+    gy, gx = np.gradient(zg, ys, xs)  # smooth shading normals of the top from the grid
+    verts, uvs, faces, normals = [], [], [], []
+    base = 0
+    axis_normal = {"bottom": (0, 0, -1), "front": (0, -1, 0), "back": (0, 1, 0),
+                   "left": (-1, 0, 0), "right": (1, 0, 0)}
+    for nm in ("top", "bottom", "front", "back", "left", "right"):
+        sel = np.flatnonzero(name == nm)
+        if not len(sel):
+            continue
+        used, inv = np.unique(F[sel].ravel(), return_inverse=True)
+        p = V[used]
+        u, v = {"top": (p[:, 0], D - p[:, 1]), "bottom": (p[:, 0], p[:, 1]),
+                "front": (p[:, 0], H - p[:, 2]), "back": (W - p[:, 0], H - p[:, 2]),
+                "left": (D - p[:, 1], H - p[:, 2]), "right": (p[:, 1], H - p[:, 2])}[nm]
+        verts.append(p)
+        uvs.append(charts.uv(nm, u, v))
+        faces.append(inv.reshape(-1, 3) + base)
+        if nm == "top":
+            i = np.clip(np.searchsorted(xs, p[:, 0]), 0, len(xs) - 1)
+            j = np.clip(np.searchsorted(ys, p[:, 1]), 0, len(ys) - 1)
+            n = np.column_stack([-gx[j, i], -gy[j, i], np.ones(len(p))])
+            normals.append(n / np.linalg.norm(n, axis=1, keepdims=True))
+        else:
+            normals.append(np.broadcast_to(np.array(axis_normal[nm], float), p.shape))
+        base += len(used)
+    out = trimesh.Trimesh(np.vstack(verts), np.vstack(faces), process=False)
+    return out, np.vstack(uvs), charts, np.vstack(normals)

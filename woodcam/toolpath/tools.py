@@ -45,12 +45,13 @@ import numpy as np
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 
+ToolType = Literal["flat", "ball", "bull", "vbit", "snub", "chamfer", "taperball"]
+TOOL_TYPES: tuple[str, ...] = ("flat", "ball", "bull", "vbit", "snub", "chamfer", "taperball")
+
+
 #: Largest cutter diameter accepted (mm): a 1 m cutter is a typo, and the stock simulation's
 #: footprint of one tool grows with its square.
 MAX_TOOL_DIAMETER_MM = 1000.0
-
-ToolType = Literal["flat", "ball", "bull", "vbit"]
-TOOL_TYPES: tuple[str, ...] = ("flat", "ball", "bull", "vbit")
 
 
 @dataclass(frozen=True)
@@ -65,8 +66,8 @@ class Tool:
         d = self.diameter_mm
         if (isinstance(d, bool) or not isinstance(d, (int, float, np.number))
                 or not (0 < d <= MAX_TOOL_DIAMETER_MM)):
-            raise WoodcamError(f"{type(self).__name__}: diameter_mm must be a positive number in (0, "
-                               f"{MAX_TOOL_DIAMETER_MM:g}] mm, got {d!r}; give the cutting "
+            raise WoodcamError(f"{type(self).__name__}: diameter_mm must be a positive number in "
+                               f"(0, {MAX_TOOL_DIAMETER_MM:g}] mm, got {d!r}; give the cutting "
                                "diameter in mm")
 
     @property
@@ -133,6 +134,10 @@ class Tool:
     def spec(self) -> str:
         raise NotImplementedError
 
+    def _kinks(self) -> list[float]:
+        """Radii where the profile's slope jumps (kept as vertices of :meth:`solid`)."""
+        return []
+
     def solid(self, top_mm: float, segments: int = 64) -> Any:
         """The tool as a ``manifold3d.Manifold``: tip at the origin, up to ``z = top_mm``."""
         from manifold3d import CrossSection, Manifold
@@ -141,6 +146,7 @@ class Tool:
         # is inscribed in the convex profile (sagitta < R (1 - cos(pi / 4 / (n - 1))) ~ 0.1 %).
         n = 24
         r = self.radius_mm * np.sin(np.linspace(0.0, 0.5 * np.pi, n))
+        r = np.unique(np.concatenate([r, self._kinks()]))  # a chord across a kink cuts it off
         h = self._h(r)
         top = max(float(top_mm), float(h[-1]) + 1e-3)
         poly = [(0.0, 0.0)] + [(float(a), float(b)) for a, b in zip(r[1:], h[1:])]
@@ -280,7 +286,94 @@ class VBit(Tool):
         return f"vbit:{self.angle_deg:g}:{self.diameter_mm:g}"
 
 
-_SPEC_HELP = "write flat:D, ball:D, bull:D:RC or vbit:ANGLE:D (mm, degrees), e.g. ball:3"
+@dataclass(frozen=True)
+class SnubNoseVBit(Tool):
+    """Engraving cone with a flat tip (snub nose): flat to ``tip_diameter_mm / 2``, then a
+    cone of included angle ``angle_deg``: ``profile(r) = max(r - rt, 0) / tan(angle / 2)``."""
+
+    angle_deg: float = 60.0
+    tip_diameter_mm: float = 0.5
+    kind = "snub"
+
+    def __post_init__(self):
+        super().__post_init__()
+        if not 0 < self.angle_deg < 180:
+            raise WoodcamError(f"{type(self).__name__}: angle_deg (included angle) must be in "
+                               f"(0, 180), got {self.angle_deg!r}; e.g. 60 or 90")
+        if not 0 <= self.tip_diameter_mm < self.diameter_mm:
+            raise WoodcamError(f"{type(self).__name__}: tip_diameter_mm must be in [0, "
+                               f"diameter_mm = {self.diameter_mm:g}), got "
+                               f"{self.tip_diameter_mm!r}")
+
+    @property
+    def _k(self):
+        return 1.0 / math.tan(math.radians(self.angle_deg) / 2)
+
+    def _h(self, r):
+        return self._k * np.maximum(np.asarray(r, float) - 0.5 * self.tip_diameter_mm, 0.0)
+
+    def _dh(self, r):
+        return np.where(np.asarray(r) > 0.5 * self.tip_diameter_mm, self._k, 0.0)
+
+    def _kinks(self):
+        return [0.5 * self.tip_diameter_mm]
+
+    def spec(self):
+        return f"{self.kind}:{self.angle_deg:g}:{self.diameter_mm:g}:{self.tip_diameter_mm:g}"
+
+
+@dataclass(frozen=True)
+class ChamferMill(SnubNoseVBit):
+    """Chamfer mill: the same profile as :class:`SnubNoseVBit` (a cone over a flat tip)."""
+
+    kind = "chamfer"
+
+
+@dataclass(frozen=True)
+class TaperedBallMill(Tool):
+    """Tapered ball nose: a ball of ``tip_diameter_mm`` joined tangentially to a cone whose
+    flanks lean ``taper_deg`` from the axis (per side), up to ``diameter_mm``."""
+
+    tip_diameter_mm: float = 1.0
+    taper_deg: float = 5.0
+    kind = "taperball"
+
+    def __post_init__(self):
+        super().__post_init__()
+        if not 0 < self.tip_diameter_mm <= self.diameter_mm:
+            raise WoodcamError(f"TaperedBallMill: tip_diameter_mm must be in (0, diameter_mm], "
+                               f"got {self.tip_diameter_mm!r}")
+        if not 0 < self.taper_deg < 90:
+            raise WoodcamError(f"TaperedBallMill: taper_deg (per side) must be in (0, 90), got "
+                               f"{self.taper_deg!r}; e.g. 3.6")
+
+    def _parts(self):
+        rb = 0.5 * self.tip_diameter_mm
+        a = math.radians(self.taper_deg)
+        rt = rb * math.cos(a)  # where the sphere's slope equals the flank's, 1 / tan(a)
+        return rb, rt, rb - math.sqrt(rb * rb - rt * rt), 1.0 / math.tan(a)
+
+    def _h(self, r):
+        rb, rt, ht, k = self._parts()
+        r = np.asarray(r, float)
+        ball = rb - np.sqrt(np.maximum(rb * rb - np.minimum(r, rt) ** 2, 0.0))
+        return np.where(r <= rt, ball, ht + k * (r - rt))
+
+    def _dh(self, r):
+        rb, rt, _, k = self._parts()
+        r = np.asarray(r, float)
+        q = np.minimum(r, rt)
+        return np.where(r <= rt, q / np.sqrt(np.maximum(rb * rb - q * q, 1e-30)), k)
+
+    def _kinks(self):
+        return [self._parts()[1]]
+
+    def spec(self):
+        return f"taperball:{self.diameter_mm:g}:{self.tip_diameter_mm:g}:{self.taper_deg:g}"
+
+
+_SPEC_HELP = ("write flat:D, ball:D, bull:D:RC, vbit:ANGLE:D, snub:ANGLE:D:TIP, "
+              "chamfer:ANGLE:D:TIP or taperball:D:TIP:TAPER (mm, degrees), e.g. ball:3")
 
 
 def parse_tool_spec(spec: str) -> Tool:
@@ -292,7 +385,8 @@ def parse_tool_spec(spec: str) -> Tool:
     except ValueError as err:
         raise WoodcamError(f"tool spec {spec!r}: numbers expected after the type; {_SPEC_HELP}"
                            ) from err
-    want = {"flat": 1, "ball": 1, "bull": 2, "vbit": 2}
+    want = {"flat": 1, "ball": 1, "bull": 2, "vbit": 2, "snub": 3, "chamfer": 3,
+            "taperball": 3}
     if kind not in want:
         raise WoodcamError(f"tool spec {spec!r}: type must be one of {TOOL_TYPES}, got "
                            f"{kind!r}; {_SPEC_HELP}")
@@ -305,12 +399,20 @@ def parse_tool_spec(spec: str) -> Tool:
         return BallEndMill(nums[0])
     if kind == "bull":
         return BullNoseMill(nums[0], corner_radius_mm=nums[1])
+    if kind in ("snub", "chamfer"):
+        cls = SnubNoseVBit if kind == "snub" else ChamferMill
+        return cls(nums[1], angle_deg=nums[0], tip_diameter_mm=nums[2])
+    if kind == "taperball":
+        return TaperedBallMill(nums[0], tip_diameter_mm=nums[1], taper_deg=nums[2])
     return VBit(nums[1], angle_deg=nums[0])
 
 
 def load_tool_table(path: PathLike) -> dict[int, Tool]:
-    """Read a TOML tool table (module docstring) into ``{tool number: Tool}``."""
+    """Read a TOML tool table (module docstring), or a CAMotics JSON tool table
+    (:func:`load_camotics_tools`), into ``{tool number: Tool}``."""
     path = Path(path)
+    if path.suffix.lower() in (".json", ".camotics"):
+        return load_camotics_tools(path)
     try:
         data = tomllib.loads(path.read_bytes().decode("utf-8"))
     except FileNotFoundError as err:
@@ -340,17 +442,11 @@ def load_tool_table(path: PathLike) -> dict[int, Tool]:
             raise WoodcamError(f"load_tool_table: {path}: tools.{key} must be a table "
                                f"([tools.{key}] with type and diameter_mm), got {entry!r}")
         kind = entry.get("type")
-        if kind not in TOOL_TYPES or "diameter_mm" not in entry:
+        d = entry.get("diameter_mm")
+        if kind not in TOOL_TYPES or d is None:
             raise WoodcamError(f"load_tool_table: {path}: [tools.{key}] needs type (one of "
                                f"{TOOL_TYPES}) and diameter_mm, got {dict(entry)!r}")
-
-        def num(name: str, key=key, entry=entry) -> float:
-            v = entry.get(name, math.nan)
-            if isinstance(v, bool) or not isinstance(v, (int, float)):
-                raise WoodcamError(f"load_tool_table: {path}: [tools.{key}] {name} must be a "
-                                   f"number, got {v!r}")
-            return float(v)
-
+        num = lambda k: _number(entry.get(k, math.nan), path, key, k)  # noqa: E731
         d = num("diameter_mm")
         if kind == "flat":
             out[number] = FlatEndMill(d)
@@ -358,6 +454,76 @@ def load_tool_table(path: PathLike) -> dict[int, Tool]:
             out[number] = BallEndMill(d)
         elif kind == "bull":
             out[number] = BullNoseMill(d, num("corner_radius_mm"))
+        elif kind in ("snub", "chamfer"):
+            cls = SnubNoseVBit if kind == "snub" else ChamferMill
+            out[number] = cls(d, angle_deg=num("angle_deg"),
+                              tip_diameter_mm=num("tip_diameter_mm"))
+        elif kind == "taperball":
+            out[number] = TaperedBallMill(d, tip_diameter_mm=num("tip_diameter_mm"),
+                                          taper_deg=num("taper_deg"))
         else:
             out[number] = VBit(d, num("angle_deg"))
+    return out
+
+
+def _number(value, path, key, name) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise WoodcamError(f"load_tool_table: {path}: [tools.{key}] {name} must be a number, "
+                           f"got {value!r}")
+    return float(value)
+
+
+#: CAMotics tool shapes and the woodcam tool they are.
+_CAMOTICS_SHAPES = ("cylindrical", "ballnose", "conical", "snubnose")
+
+
+def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
+    """Read a CAMotics tool table (the ``"tools"`` object of a ``.camotics`` project, or a JSON
+    file holding it): ``{"1": {"units": "metric"|"imperial", "shape": "cylindrical"|"ballnose"|
+    "conical"|"snubnose", "diameter": D, "length": L, "snub_diameter": d}}``. CAMotics defines a
+    cone by its diameter and the length of its conical part: included angle
+    ``2 atan((D - d) / 2 / L)``. Lengths in the table's units; woodcam's tools in mm."""
+    import json
+
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text())
+    except FileNotFoundError as err:
+        raise WoodcamError(f"load_camotics_tools: path={str(path)!r} does not exist") from err
+    except json.JSONDecodeError as err:
+        raise WoodcamError(f"load_camotics_tools: {path} is not valid JSON ({err})") from err
+    table = data.get("tools", data) if isinstance(data, dict) else None
+    if not isinstance(table, dict) or not table:
+        raise WoodcamError(f"load_camotics_tools: {path} has no tools; expected "
+                           '{"tools": {"1": {"shape": "cylindrical", "diameter": 6.35, ...}}}')
+    out: dict[int, Tool] = {}
+    for key, e in table.items():
+        if not isinstance(e, dict) or not str(key).isdigit():
+            raise WoodcamError(f"load_camotics_tools: {path}: tool {key!r} must be a number "
+                               "with an object of shape/diameter/length")
+        units = e.get("units", "metric")
+        if units not in ("metric", "imperial"):
+            raise WoodcamError(f"load_camotics_tools: {path}: tool {key}: units must be "
+                               f"metric or imperial, got {units!r}")
+        scale = 25.4 if units == "imperial" else 1.0
+        shape = str(e.get("shape", "")).lower()
+        if shape not in _CAMOTICS_SHAPES:
+            raise WoodcamError(f"load_camotics_tools: {path}: tool {key}: shape {shape!r} is "
+                               f"not one of {_CAMOTICS_SHAPES}")
+        num = lambda k, default=math.nan: _number(e.get(k, default), path, key, k) * scale  # noqa: E731
+        d = num("diameter")
+        if shape == "cylindrical":
+            tool: Tool = FlatEndMill(d)
+        elif shape == "ballnose":
+            tool = BallEndMill(d)
+        else:
+            tip = num("snub_diameter", 0.0) if shape == "snubnose" else 0.0
+            length = num("length")
+            if not length > 0:
+                raise WoodcamError(f"load_camotics_tools: {path}: tool {key}: a {shape} tool "
+                                   f"needs length > 0 (the cone's height), got {length!r}")
+            angle = 2 * math.degrees(math.atan((d - tip) / 2 / length))
+            tool = SnubNoseVBit(d, angle_deg=angle, tip_diameter_mm=tip) if tip > 0 else \
+                VBit(d, angle_deg=angle)
+        out[int(key)] = tool
     return out

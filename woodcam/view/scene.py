@@ -643,6 +643,7 @@ def preview(
     screenshot: str | os.PathLike | None = None,
     window_size: tuple[int, int] = (1280, 960),
     options: SceneOptions | None = None,
+    overlay: list[tuple] | None = None,
     **scene_options,
 ) -> Path | None:
     """Show a textured part inside its translucent block, or write a screenshot of it.
@@ -664,6 +665,9 @@ def preview(
         How to draw (cut plane, camera, background, initial cut, resolution);
         ``**scene_options`` (any :class:`SceneOptions` field, e.g. ``camera="top"``,
         ``cut_plane=False``) replace its fields.
+    overlay : list of (segments (k, 2, 3) mm, colour, width px), optional
+        Line segments drawn over the scene in the block frame (e.g. a toolpath: rapids and
+        feeds in two colours, :func:`woodcam.toolpath.gcode.Program` moves).
 
     Returns
     -------
@@ -705,6 +709,13 @@ def preview(
                          title="woodcam preview")
     try:
         build_scene(plotter, mesh, wood=wood, size_mm=size_mm, widget=not off_screen, options=opt)
+        for segments, colour, width in overlay or ():
+            seg = np.asarray(segments, dtype=float).reshape(-1, 2, 3)
+            if len(seg):
+                n = len(seg)
+                cells = np.column_stack([np.full(n, 2), 2 * np.arange(n), 2 * np.arange(n) + 1])
+                plotter.add_mesh(pv.PolyData(seg.reshape(-1, 3), lines=cells.ravel()),
+                                 color=colour, line_width=width, render_lines_as_tubes=False)
         # Translucent block and waste wood over the part: sort them per pixel.
         plotter.enable_depth_peeling()
         plotter.enable_anti_aliasing("ssaa")

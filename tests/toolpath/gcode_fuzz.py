@@ -1,0 +1,133 @@
+"""Random G-code programs for the differential test against LinuxCNC and the fuzzing of the
+reader (issue 15): seeded, reproducible, mostly valid (so they exercise geometry, not only
+refusals) with a share of refusals (bad arcs, bad words, division by zero...)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def _num(rng, v):
+    """A number as posts write it: 0-4 decimals, sometimes a trailing '.'."""
+    if v == round(v):  # integers as posts write them: 12, 12. or 12.000
+        return rng.choice([f"{v:.0f}", f"{v:.0f}.", f"{v:.3f}"])
+    return f"{v:.{int(rng.integers(3, 6))}f}"  # the values carry at most 3 decimals
+
+
+def _val(rng, v, params):
+    """``v`` as a number or an expression that evaluates to it (LinuxCNC syntax)."""
+    r = rng.random()
+    if r < 0.6 or not params:
+        return _num(rng, v)
+    if r < 0.75:
+        k, pv = list(params.items())[int(rng.integers(len(params)))]
+        return f"[#{k} + {v - pv:.6f}]"
+    if r < 0.85:
+        return f"[{v * 2:.6f} / 2]"
+    if r < 0.93:
+        return f"[{v - 3:.6f} + 1 * 3]"
+    return f"[{abs(v):.6f} * {'-1' if v < 0 else '1'}]"
+
+
+def program(seed: int, n_lines: int = 30, *, valid_share: float = 0.9) -> str:
+    """One random program of about ``n_lines`` blocks, ending with M2."""
+    rng = np.random.default_rng(seed)
+    out = ["G21 G90 G17", "F600"]
+    pos = np.array([0.0, 0.0, 10.0])  # program coordinates (G90, mm, no offsets)
+    params: dict[int, float] = {}
+    plane = 17
+    for _ in range(n_lines):
+        r = rng.random()
+        if r < 0.25:
+            tgt = pos.copy()
+            axes = [a for a in range(3) if rng.random() < 0.6] or [int(rng.integers(3))]
+            for a in axes:
+                tgt[a] = round(float(rng.uniform(-20, 80)), 3)
+            words = " ".join(f"{'XYZ'[a]}{_val(rng, tgt[a], params)}" for a in axes)
+            out.append(f"G{int(rng.integers(0, 2))} {words}")
+            pos = tgt
+        elif r < 0.45:  # arc in the current plane with a valid centre
+            a1, a2 = {17: (0, 1), 18: (2, 0), 19: (1, 2)}[plane]
+            names = {17: "IJ", 18: "KI", 19: "JK"}[plane]
+            rad = float(rng.uniform(0.5, 30))
+            ang0 = float(rng.uniform(0, 2 * math.pi))
+            c = (pos[a1] - rad * math.cos(ang0), pos[a2] - rad * math.sin(ang0))
+            ang1 = float(rng.uniform(0, 2 * math.pi))
+            end = pos.copy()
+            end[a1] = round(c[0] + rad * math.cos(ang1), 4)
+            end[a2] = round(c[1] + rad * math.sin(ang1), 4)
+            off = (round(c[0] - pos[a1], 4), round(c[1] - pos[a2], 4))
+            code = "G2" if rng.random() < 0.5 else "G3"
+            ax = "XYZ"
+            words = f"{ax[a1]}{end[a1]:.4f} {ax[a2]}{end[a2]:.4f}"
+            if rng.random() < 0.3:  # helix
+                an = 3 - a1 - a2
+                end[an] = round(float(pos[an] - rng.uniform(0, 3)), 3)
+                words += f" {ax[an]}{end[an]:.3f}"
+            if rng.random() < 0.3:
+                rr = math.hypot(end[a1] - pos[a1], end[a2] - pos[a2])
+                out.append(f"{code} {words} R{(rad if rng.random() < 0.5 else -rad):.4f}"
+                           if rr > 1e-3 else f"{code} {words} {names[0]}{off[0]} "
+                           f"{names[1]}{off[1]}")
+            else:
+                p = f" P{int(rng.integers(2, 4))}" if rng.random() < 0.1 else ""
+                out.append(f"{code} {words} {names[0]}{off[0]} {names[1]}{off[1]}{p}")
+            pos = end
+        elif r < 0.55:
+            k = int(rng.integers(1, 40))
+            v = round(float(rng.uniform(-50, 50)), 3)
+            params[k] = v
+            out.append(f"#{k} = {v}")
+        elif r < 0.6:
+            plane = int(rng.choice([17, 18, 19]))
+            out.append(f"G{plane}")
+        elif r < 0.66:  # drilling cycle at an absolute point in G17
+            x, y = (round(float(v), 2) for v in rng.uniform(0, 80, 2))
+            rr = round(float(rng.uniform(0.5, 5)), 2)
+            z = round(float(rng.uniform(-15, -1)), 2)
+            code = rng.choice(["G81", "G82 P0.1", "G83 Q2.5", "G73 Q1.5", "G85", "G89 P0.2"])
+            ret = rng.choice(["G98", "G99"])
+            out.append(f"G17 {ret} {code} X{x} Y{y} Z{z} R{rr}")
+            out.append("G80")
+            plane = 17
+            pos = np.array([x, y, round(float(rng.uniform(5, 10)), 3)])
+            out.append(f"G0 Z{pos[2]}")
+        elif r < 0.7:  # work offsets / G92 round trip, then an absolute re-position
+            choice = rng.integers(4)
+            if choice == 0:
+                n = int(rng.integers(1, 10))
+                out.append(f"G10 L2 P{n} X{rng.uniform(-10, 10):.3f} Y{rng.uniform(-10, 10):.3f}")
+            elif choice == 1:
+                out.append(rng.choice(["G54", "G55", "G56", "G57", "G58", "G59", "G59.1",
+                                       "G59.2", "G59.3"]))
+            elif choice == 2:
+                out.append(f"G92 X{rng.uniform(-5, 5):.3f}")
+            else:
+                out.append(rng.choice(["G92.1", "G92.2", "G92.3"]))
+            pos = np.round(rng.uniform(0, 60, 3), 3)
+            out.append(f"G0 X{pos[0]} Y{pos[1]} Z{pos[2]}")
+        elif r < 0.74:
+            out.append(rng.choice(["G91 G0 X5 Y-3", "G91 G1 Z-1.5", "G91 G1 X-2.5 Y2.5"]))
+            out.append("G90")
+            pos = pos + {"G91 G0 X5 Y-3": [5, -3, 0], "G91 G1 Z-1.5": [0, 0, -1.5],
+                         "G91 G1 X-2.5 Y2.5": [-2.5, 2.5, 0]}[out[-2]]
+        elif r < 0.78:
+            out.append(rng.choice(["M3 S12000", "M5", "M8", "M9", "T2 M6", "G4 P0.1",
+                                   "G61", "G64 P0.01", "(a comment)", "; a comment",
+                                   "G43 H2", "G49", "G94"]))
+            if out[-1] == "T2 M6":  # LinuxCNC's preview module forgets arc ends at M6
+                out.append(f"G0 X{pos[0]:.4f} Y{pos[1]:.4f} Z{pos[2]:.4f}")  # (test_linuxcnc_
+                # preview_stale_position_after_m6): every axis stated again
+        elif r < 0.8:
+            label = int(rng.integers(100, 999))
+            out.append(f"o{label} if [#{int(rng.integers(1, 5))} GT 0]")
+            out.append(f"G0 Z{pos[2]:.3f}")
+            out.append(f"o{label} endif")
+        if rng.random() > valid_share:  # a fault: refusal expected from both interpreters
+            out.append(rng.choice(["G1 X[1/0]", "G2 X10 Y0 I1 J0", "G1 A5", "G1 X1 X2",
+                                   "G0 X1 R5", "#<undefined_name_x>=[#<nope>]", "G1 X1 Q-2",
+                                   "G83 X1 Y1 Z-3 R1 Q0", "G1 X[SQRT[-1]]", "M123"]))
+    out.append("M2")
+    return "\n".join(out) + "\n"

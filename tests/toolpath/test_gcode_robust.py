@@ -1,0 +1,136 @@
+"""Hostile G-code (issue 15): every input ends in a WoodcamError naming the line or in a valid,
+finite result, never another exception and never a hang; huge numbers cut what they say."""
+
+from __future__ import annotations
+
+import math
+import signal
+from contextlib import contextmanager
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from woodcam.errors import WoodcamError
+from woodcam.toolpath import GcodeError, parse_tool_spec, read_gcode, simulate
+from woodcam.toolpath.gcode import MAX_CHORDS_PER_ARC
+
+from .gcode_fuzz import program
+
+BIG = "1" + "0" * 20        # 1e20 as G-code writes it (no exponents in G-code)
+DIGITS_400 = "9" * 400      # overflows a float: must be a clear error, not inf
+
+
+@contextmanager
+def _deadline(seconds: float):
+    """Fail instead of hanging: ``seconds`` of this process's CPU time (SIGVTALRM; CPU, not
+    wall time, so a loaded machine does not fail the test; the tests run in the main thread)."""
+    def boom(*_):
+        raise TimeoutError(f"over {seconds} s of CPU")
+    old = signal.signal(signal.SIGVTALRM, boom)
+    signal.setitimer(signal.ITIMER_VIRTUAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_VIRTUAL, 0)
+        signal.signal(signal.SIGVTALRM, old)
+
+
+@pytest.mark.parametrize("text, rule", [
+    ("G0 X0 Y0 Z5\nG83 X1 Y1 Z-3 R1 Q0 F100\nM2\n", "peck depth Q must be > 0"),
+    ("G0 X0 Y0 Z5\nG83 X1 Y1 Z-3 R1 Q0.0000001 F100\nM2\n", "pecks in one hole"),
+    (f"G0 X0 Y0 Z0\nG2 X0 Y0 I{'1' + '0' * 9} J0 F100\nM2\n", "chords"),
+    (f"G0 X0 Y0 Z0\nG2 X0 Y0 I{'1' + '0' * 15} J0 F100\nM2\n", "chords"),
+    (f"N{DIGITS_400} G0 X1\nM2\n", "out of range"),
+    (f"T{DIGITS_400} M6\nM2\n", "out of range"),
+    ("G0 X0 Y0 Z5\nG91 G81 X1 Z-1 R-1 L1000000 F100\nM2\n", "cycle repeats"),
+    ("o1 repeat [1000000]\nG0 X1\nG0 X2\no1 endrepeat\nM2\n", "endless loop"),
+    (f"G0 X0 Y0\nG2 X1 Y0 R{DIGITS_400} F100\nM2\n", "out of range"),
+    (f"G0 X[{DIGITS_400[:300]} * {DIGITS_400[:300]}]\nM2\n", "out of range"),
+    ("G1.04 X1 F100\nM2\n", "unsupported G code"),
+    ("T12.6 M6\nM2\n", "non-negative integer"),
+    ("G0 X[0/0]\nM2\n", "division by zero"),
+])
+def test_hostile_numbers_are_errors_with_the_line(text, rule):
+    with _deadline(10), pytest.raises(GcodeError, match=rule):
+        read_gcode(text)
+
+
+def test_large_but_sane_arc_is_chorded_within_the_limit():
+    prog = read_gcode("G0 X0 Y0 Z0\nG2 X2000 Y0 I1000 J0 F100\nM2\n")  # a 1 m radius half circle
+    assert 100 < len(prog) < MAX_CHORDS_PER_ARC
+
+
+@pytest.mark.parametrize("text, volume", [
+    # a 6 mm slot 3 mm deep across the whole 100 mm stock, from X-1e20 to X1e20
+    (f"G0 X-{BIG} Y40 Z5\nG1 Z-3 F100\nG1 X{BIG}\nG0 Z5\nM2\n", 100 * 6 * 3),
+    # the same slot diagonally through the corner: a 3 mm band, 4.24 mm legs
+    (f"G0 X{BIG} Y-{BIG} Z5\nG1 Z-3 F100\nG1 X-{BIG} Y{BIG}\nM2\n", 9 * 3),
+    # a plunge from Z1e300 to Z-1e300 bores through the whole stock
+    (f"G0 X50 Y40 Z1{'0' * 300}\nG1 Z-1{'0' * 300} F100\nM2\n", math.pi * 9 * 50),
+])
+def test_moves_far_outside_the_stock_cut_what_they_say(text, volume):
+    res = simulate(read_gcode(text), parse_tool_spec("flat:6"), (100, 80, 50),
+                   resolution_mm=0.1)
+    assert res.removed_volume_mm3 == pytest.approx(volume, rel=0.01)
+    assert res.report  # the moves outside the stock are reported
+
+
+def _check(text):
+    """The invariant: a WoodcamError, or a program of finite moves that simulates."""
+    try:
+        prog = read_gcode(text)
+    except WoodcamError:
+        return "error"
+    for arr in (prog.start_mm, prog.end_mm, prog.feed_mm_min, prog.spindle_rpm):
+        assert np.isfinite(arr).all()
+    if 0 < len(prog) <= 50_000:  # the simulation of long programs is tested on its own
+        res = simulate(prog, parse_tool_spec("ball:6"), (40, 30, 20), resolution_mm=1.0)
+        assert np.isfinite(res.heightmap).all()
+    return "read"
+
+
+_WORDS = st.sampled_from(
+    ["G0", "G1", "G2", "G3", "G17", "G18", "G19", "G20", "G21", "G28", "G30", "G53", "G54",
+     "G59.3", "G80", "G81", "G83", "G73", "G90", "G91", "G90.1", "G91.1", "G92", "G92.1",
+     "G10 L2 P1", "G10 L20 P2", "G43 H1", "G4 P1", "M2", "M3", "M5", "M6", "T1", "F100",
+     "X", "Y", "Z", "I", "J", "K", "R", "Q", "P", "L", "#1=", "#<a>=", "#<_g>=", "o1 sub",
+     "o1 endsub", "o1 call", "o2 if", "o2 endif", "o3 while", "o3 endwhile", "o4 repeat",
+     "o4 endrepeat", "o3 break", "(c)", ";", "/", "%", "N10", "[", "]", "+", "-", "*", "/",
+     "**", "mod", "eq", "and", "sin[", "atan[", "]/[", "sqrt[", "#1", "#<a>", "##1"])
+_NUMS = st.one_of(st.integers(-10**6, 10**6).map(str),
+                  st.floats(-1e6, 1e6, allow_nan=False).map(lambda v: f"{v:.4f}"),
+                  st.sampled_from(["0", "-0", ".5", "5.", DIGITS_400, BIG, "1" + "0" * 15]))
+_TOKENS = st.one_of(_WORDS, _NUMS)
+_LINE = st.lists(_TOKENS, max_size=8).map(" ".join)
+_PROGRAM = st.lists(_LINE, max_size=15).map("\n".join)
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck))
+@given(_PROGRAM)
+def test_fuzzed_token_programs_keep_the_invariant(text):
+    with _deadline(10):
+        _check(text)
+
+
+def test_fuzzed_structured_programs_keep_the_invariant():
+    outcomes = [_check(program(seed, valid_share=0.98)) for seed in range(60)]
+    assert outcomes.count("read") >= 20  # mostly real geometry, not only refusals
+
+
+@pytest.mark.slow
+@settings(max_examples=20_000, deadline=None, suppress_health_check=list(HealthCheck))
+@given(_PROGRAM)
+def test_fuzz_campaign_token_programs(text):
+    with _deadline(10):
+        _check(text)
+
+
+@pytest.mark.slow
+def test_fuzz_campaign_structured_programs():
+    outcomes = []
+    for seed in range(5000, 7000):
+        with _deadline(10):
+            outcomes.append(_check(program(seed, n_lines=60, valid_share=0.99)))
+    print(f"structured fuzz: {outcomes.count('read')} read, {outcomes.count('error')} refused")

@@ -1,0 +1,200 @@
+"""The RS274/NGC language against LinuxCNC's documented semantics (LinuxCNC 2.9 manual,
+"G-code overview" and "O codes"; the expected numbers are the documented results)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from woodcam.errors import WoodcamError
+from woodcam.toolpath import GcodeError, read_gcode
+from woodcam.toolpath.interpreter import MAX_CALL_DEPTH, Interpreter
+
+
+def _ends(text, **kw):
+    """End points of the canonical moves of ``text`` started at the origin."""
+    moves, _ = Interpreter(text, start_mm=(0, 0, 0), **kw).run()
+    return [m[2] for m in moves]
+
+
+def _x(expr):
+    return _ends(f"G0 X[{expr}] Y1\nM2\n")[0][0]
+
+
+def test_end_of_line_assignment_rule():
+    # manual: "#3 = 15 ... #3 = 6 G1 X#3" moves to X15, and #3 is 6 afterwards
+    ends = _ends("#3 = 15\n#3 = 6 G0 X#3\nG0 Y#3\n#1=1 #2=[#1+1]\nG0 Z#2\nM2\n")
+    assert ends[0][0] == 15 and ends[1][1] == 6
+    assert ends[2][2] == 1  # #2 = [#1 + 1] read the old #1 (0) on the same line
+
+
+@pytest.mark.parametrize("expr, value", [
+    ("atan[1]/[-1]", 135.0),          # the manual's example: two-argument arctangent
+    ("2 ** 3 ** 2", 64.0),            # left to right
+    ("1 + 2 * 3 ** 2", 19.0),         # ** over * over +
+    ("10 - 4 - 3", 3.0),
+    ("3 eq 3 + 4", 0.0),              # + binds tighter than eq
+    ("1 eq 1.00001", 1.0),            # eq within LinuxCNC's 1e-4
+    ("[1 lt 2] and [3 ge 3]", 1.0),
+    ("0 or 0", 0.0), ("3 xor 0", 1.0), ("3 xor 4", 0.0), ("2 ne 2", 0.0), ("2 gt 1", 1.0),
+    ("-7 mod 3", 2.0), ("10 mod -3", 1.0),   # mod is never negative (LinuxCNC)
+    ("round[-2.5]", -3.0), ("round[2.5]", 3.0), ("fix[-2.5]", -3.0), ("fup[-2.5]", -2.0),
+    ("sqrt[16] + abs[-2]", 6.0), ("exp[ln[7]]", 7.0), ("sin[30] * 2", 1.0),
+    ("acos[0]", 90.0), ("asin[1]", 90.0), ("tan[45]", 1.0), ("cos[180]", -1.0),
+    ("-[2 * 3]", -6.0), ("- - 2", 2.0),
+])
+def test_expressions(expr, value):
+    assert _x(expr) == pytest.approx(value, abs=1e-12)
+
+
+@pytest.mark.parametrize("expr, rule", [
+    ("1 / 0", "division by zero"), ("sqrt[-1]", "negative"), ("ln[0]", "logarithm"),
+    ("acos[2]", "outside"), ("[-8] ** 0.5", "non-integer power"), ("1 mod 0", "mod by zero"),
+    ("atan[1]", "two arguments"), ("1 +", "bad value"), ("1 % 2", "operator"),
+])
+def test_expression_errors(expr, rule):
+    with pytest.raises(GcodeError, match=rule):
+        _x(expr)
+
+
+def test_parameters_numbered_named_global_indirect():
+    text = ("#<a> = 1\n#<_bb> = 2\n#10 = 20\n#20 = 7\n#<Spaced Name> = 4\n"
+            "o5 sub\n#<a> = 100\n#<_bb> = 30\n#1 = 55\nG0 X#<a> Y#<_bb> Z#1\no5 endsub\n"
+            "G0 X#<a> Y#<_bb> Z5\no5 call [1] [2]\nG0 X#<a> Y#<_bb> Z#1\n"
+            "G0 X##10 Y#[10 + 10] Z#<spacedname>\nM2\n")
+    ends = _ends(text)
+    assert ends[0] == (1, 2, 5)
+    assert ends[1] == (100, 30, 55)            # the sub sees its own #<a>, #1 = 55 local
+    assert ends[2] == (1, 30, 0)               # locals restored, global kept, #1 back to 0
+    assert ends[3] == (7, 7, 4)                # ##10 = #20; names lose case and spaces
+
+
+def test_named_parameter_errors():
+    with pytest.raises(GcodeError, match=r"#<nope> not defined"):
+        _ends("G0 X#<nope>\nM2\n")
+    with pytest.raises(GcodeError, match=r"read-only"):
+        _ends("#<_x> = 3\nM2\n")
+    with pytest.raises(GcodeError, match=r"out of range"):
+        _ends("G0 X#6000\nM2\n")
+    assert _ends("G0 X5\nG0 Y#<_x>\nM2\n")[1] == (5, 5, 0)  # system parameter: current X
+
+
+def test_nested_calls_return_values_and_recursion_limit():
+    text = ("o<sq> sub\no<sq> return [#1 * #1]\no<sq> endsub\n"
+            "o<sum> sub\no<sq> call [#1]\n#<s> = #<_value>\no<sq> call [#2]\n"
+            "o<sum> return [#<s> + #<_value>]\no<sum> endsub\n"
+            "o<sum> call [3] [4]\nG0 X#<_value>\no<sq> call [2]\nG0 Y#<_value>\nM2\n")
+    ends = _ends(text)
+    assert ends[0][0] == 25 and ends[1][1] == 4
+    # a sub that ends without a value resets #<_value> to 0 (LinuxCNC)
+    assert _ends("o1 sub\no1 endsub\n#<_value> = 9\no1 call\nG0 X[#<_value> + 1]\nM2\n")[0][0] == 1
+    deep = "o1 sub\no2 if [#1 lt {n}]\no1 call [#1 + 1]\no2 endif\nG0 X#1\no1 endsub\n" \
+           "o1 call [1]\nM2\n"
+    assert len(_ends(deep.format(n=MAX_CALL_DEPTH))) == MAX_CALL_DEPTH
+    with pytest.raises(GcodeError, match="nested subroutine calls") as e:
+        _ends(deep.format(n=MAX_CALL_DEPTH + 1))
+    assert e.value.line == 3
+
+
+def test_loops_if_while_do_repeat_break_continue():
+    text = ("#1 = 0\no1 while [#1 lt 20]\n#1 = [#1 + 1]\no2 if [[#1 mod 3] eq 0]\n"
+            "o1 continue\no2 endif\no3 if [#1 gt 8]\no1 break\no3 endif\nG0 X#1\n"
+            "o1 endwhile\no4 repeat [3]\nG0 Y[#1 + 1]\n#1 = [#1 + 1]\no4 endrepeat\n"
+            "#2 = 0\no5 do\n#2 = [#2 + 2]\nG0 Z#2\no5 while [#2 lt 0]\n"
+            "o6 if [#1 eq 0]\nG0 X100\no6 elseif [#1 eq 13]\nG0 X200\no6 else\nG0 X300\n"
+            "o6 endif\nM2\n")
+    ends = _ends(text)
+    assert [e[0] for e in ends[:6]] == [1, 2, 4, 5, 7, 8]   # 3, 6, 9 skipped; break at 10
+    assert [e[1] for e in ends[6:9]] == [11, 12, 13]        # repeat 3 times
+    assert ends[9][2] == 2                                  # do ... while runs once
+    assert ends[10][0] == 200                               # elseif taken
+
+
+def test_endless_loop_is_stopped():
+    with pytest.raises(GcodeError, match="endless loop"):
+        Interpreter("o1 while [1]\no1 endwhile\nM2\n", max_blocks=10_000).run()
+
+
+def test_o_word_structure_errors():
+    with pytest.raises(GcodeError, match="never closed") as e:
+        _ends("G0 X1\no1 if [1]\nG0 X2\nM2\n")
+    assert e.value.line == 2
+    with pytest.raises(GcodeError, match="without a matching"):
+        _ends("o1 while [0]\no2 endwhile\nM2\n")
+    with pytest.raises(GcodeError, match="not defined in this file"):
+        _ends("o<elsewhere> call\nM2\n")
+
+
+def test_work_offsets_g10_g5x_g92():
+    # (expected values checked against LinuxCNC 2.9's own interpreter)
+    ends = _ends("G0 X1 Y1 Z1\nG10 L20 P1 X0\nG0 X2\nG10 L2 P2 X10 Y10\nG55 G0 X1 Y1\n"
+                 "G92 X0 Y0\nG0 X1\nG92.1\nG0 X1\nG92 X5\nG92.2\nG0 X1\nG92.3\nG0 X1\n"
+                 "G54\nG0 X0 Y0\nG59.3 G0 X0\nM2\n")
+    # (G92.2 G0 X1 repeats the previous point: no move)
+    assert [e[:2] for e in ends] == [(1, 1), (3, 1), (11, 11), (12, 11), (11, 11), (7, 11),
+                                     (-3, 0), (-4, 0)]
+    assert _ends("G10 L2 P9 X1 Y2 Z3\nG59.3 G0 X0 Y0 Z0\nM2\n")[0] == (1, 2, 3)
+    with pytest.raises(GcodeError, match="G10 L2 and G10 L20"):
+        _ends("G10 L1 P1 Z5\nM2\n")
+
+
+def test_units_incremental_g53_g28():
+    assert _ends("G20 G0 X1\nG91 G0 X1\nG90 G21 G0 Y3\nM2\n") == [
+        (25.4, 0, 0), (50.8, 0, 0), (50.8, 3, 0)]
+    moves, _ = Interpreter("G10 L2 P1 X5\nG54 G0 X1\nG53 G0 X1\nG28\nM2\n",
+                           start_mm=(0, 0, 30)).run()
+    assert [m[2] for m in moves] == [(6, 0, 30), (1, 0, 30), (0, 0, 30)]
+
+
+def test_arcs_r_form_turns_and_planes():
+    moves, _ = Interpreter("G0 X0 Y0 Z0\nG2 X10 R5 F100\nG3 X0 R-5\n"
+                           "G17 G91 G2 X10 Y0 I5 J0 P2\nG18 G90 G2 X20 Z0 I5 K0\n"
+                           "G19 G3 Y10 Z0 J5 K0\nG2 J3\nM2\n",
+                           start_mm=(0, 0, 0)).run()
+    arcs = [m for m in moves if m[0] == 2]
+    assert [(a[3], a[4], a[5]) for a in arcs[:2]] == [((5.0, 0.0), -1, 17), ((5.0, 0.0), 1, 17)]
+    assert arcs[2][2] == (10, 0, 0) and arcs[2][3] == (5, 0) and arcs[2][4] == -2
+    assert arcs[3][3] == (0, 15) and arcs[3][5] == 18         # (Z, X) centre in G18
+    assert arcs[4][3] == (5, 0) and arcs[4][5] == 19          # (Y, Z) centre in G19
+    assert arcs[5][2] == arcs[4][2] and arcs[5][4] == -1      # G2 I3: a full circle here
+    # LinuxCNC's radius tolerance: 0.028 mm on a 10 mm radius is read, 0.029 mm refused
+    _ends("G0 X0 Y0\nG2 X20.028 Y0 I10 J0 F100\nM2\n")
+    with pytest.raises(GcodeError, match="radius to end of arc"):
+        _ends("G0 X0 Y0\nG2 X20.029 Y0 I10 J0 F100\nM2\n")
+
+
+def test_canned_cycles_retract_planes():
+    # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
+    ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")
+    assert ends == [(0, 0, 10), (1, 1, 10), (1, 1, 2), (1, 1, -2), (1, 1, 2), (2, 1, 2), (2, 1, -2),
+                    (2, 1, 2), (3, 1, 10), (3, 1, 2), (3, 1, -2), (3, 1, 10)]
+    # G83 pecks retract to R and come back 0.254 mm (0.010 inch) above the last depth
+    ends = _ends("G0 X0 Y0 Z5\nG83 X1 Y1 Z-3 R1 Q1 F100\nG80\nM2\n")
+    assert [round(e[2], 6) for e in ends] == [5, 5, 1, 0, 1, 0.254, -1, 1, -0.746, -2, 1,
+                                              -1.746, -3, 1]
+
+
+def test_dialects():
+    safety = "G00 G17 G21 G40 G49 G80 G90\nG0 X1 Y1 Z5\nG1 Z-1 F100\n"
+    for d in ("linuxcnc", "fanuc", "grbl"):
+        assert len(read_gcode(safety + "M30\n", dialect=d)) == 2
+    with pytest.raises(GcodeError, match="grbl has no parameters"):
+        read_gcode("#1 = 3\nG0 X#1\n", dialect="grbl")
+    with pytest.raises(GcodeError, match="grbl has no O-word"):
+        read_gcode("o1 sub\no1 endsub\n", dialect="grbl")
+    assert len(read_gcode("O0042\n" + safety, dialect="fanuc")) == 2
+    # a missing program end is a warning in LinuxCNC's dialect only
+    assert any("without M2" in w for w in read_gcode(safety).warnings)
+    assert read_gcode(safety, dialect="grbl").warnings == []
+    with pytest.raises(WoodcamError, match="dialect"):
+        read_gcode(safety, dialect="haas")
+
+
+def test_words_no_code_uses_are_refused_and_io_warned():
+    for line, word in (("G1 X1 Q2 F100", "Q2"), ("G0 X1 R3", "R3"), ("G1 X1 P5 F100", "P5"),
+                       ("G0 X1 L2", "L2"), ("G0 X1 H1", "H1"), ("G0 X1 I2", "I2")):
+        with pytest.raises(GcodeError, match=word):
+            _ends(line + "\nM2\n")
+    prog = read_gcode("G0 X1 Y0 Z0\nM64 P1\nM101\nG1 X2 F100\nM2\n")
+    assert [w.split(":")[0] for w in prog.warnings] == ["line 2", "line 3"]

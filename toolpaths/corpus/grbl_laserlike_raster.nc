@@ -1,0 +1,18 @@
+; GRBL style raster, semicolon comments
+G21 G90
+G0 X0 Y0 Z5 ; start
+M3 S12000
+G0 X5 Y5
+G1 Z-0.3 F300
+G1 X45 F1500
+G1 Y5.5
+G1 X5
+G1 Y6
+G1 X45
+G1 Y6.5
+G1 X5
+G1 Y7
+G1 X45
+G0 Z5
+M5
+M2

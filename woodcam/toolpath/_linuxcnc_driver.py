@@ -1,0 +1,166 @@
+"""Runs LinuxCNC's own RS274/NGC interpreter (Debian ``linuxcnc-uspace``'s ``gcode`` module,
+the one its AXIS preview uses) on G-code files and prints canonical moves as JSON.
+
+Run by :mod:`woodcam.toolpath.linuxcnc` with Debian's ``/usr/bin/python3`` (the module is built
+for it, not for woodcam's virtualenv); never imported by woodcam. Input (stdin, JSON):
+``{"files": [path, ...], "start_mm": [x, y, z], "timeout_s": t}``; output (stdout, JSON): one
+``{"moves": [...], "error": null | [line, message], "result": code}`` per file, moves as
+woodcam's canonical tuples ``[kind, line, [x, y, z], [c1, c2] | null, rotation, plane]`` in the
+machine frame, mm, tool tip (LinuxCNC's canon reports program coordinates before the G5x/G92
+offsets and without the tool length offset; they are added back here as AXIS does).
+"""
+
+import ctypes
+import json
+import os
+import sys
+import tempfile
+import time
+
+MM = 25.4
+_PLANE = {1: 17, 2: 19, 3: 18}  # CANON_PLANE_XY, YZ, XZ -> G17, G19, G18
+# first/second axis (x=0, y=1, z=2) of an arc in each canon plane; the third is the normal
+_AXES = {1: (0, 1, 2), 2: (1, 2, 0), 3: (2, 0, 1)}
+
+
+def _tool_table():
+    """LinuxCNC 2.9 keeps its tool table in a memory map created by the running machine's task;
+    without one, a T word crashes the interpreter. Create it here with tools 1-99 of zero
+    length (woodcam measures tools from the tip)."""
+    os.environ["HOME"] = tempfile.mkdtemp(prefix="woodcam-lcnc-")
+    lib = ctypes.CDLL("libtooldata.so.0")
+    buf = ctypes.create_string_buffer(1 << 20)
+    lib._Z17tool_mmap_creatorPK13EMC_TOOL_STATi(buf, 0)
+    lib._Z13tooldata_initb(ctypes.c_bool(False))
+    lib._Z14tooldata_resetv()
+
+    class _Tool(ctypes.Structure):
+        _fields_ = [("toolno", ctypes.c_int), ("pocketno", ctypes.c_int),
+                    ("offset", ctypes.c_double * 9), ("diameter", ctypes.c_double),
+                    ("frontangle", ctypes.c_double), ("backangle", ctypes.c_double),
+                    ("orientation", ctypes.c_int)]
+
+    for i in range(100):
+        lib._Z12tooldata_put16CANON_TOOL_TABLEi(
+            _Tool(i if i else -1, i, (ctypes.c_double * 9)(), 0.0, 0.0, 0.0, 0), i)
+    lib._Z23tooldata_last_index_seti(99)
+
+
+class _Canon:
+    def __init__(self, param_file, deadline):
+        self.parameter_file = param_file
+        self.deadline = deadline
+        self.moves = []
+        self.line = 0
+        self.plane = 1
+        self.g5x = [0.0] * 3
+        self.g92 = [0.0] * 3
+        self.tlo = [0.0] * 3
+        self.rot = 0.0
+
+    def __getattr__(self, name):  # every other canon call has no effect on the moves
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return lambda *a: None
+
+    def next_line(self, st):
+        self.line = st.sequence_number
+
+    def get_external_angular_units(self):
+        return 1.0
+
+    def get_external_length_units(self):
+        return 1 / MM
+
+    def get_axis_mask(self):
+        return 7
+
+    def get_block_delete(self):
+        return 0
+
+    def check_abort(self):
+        return time.time() > self.deadline
+
+    def get_tool(self, n):
+        return (n,) + (0.0,) * 12 + (0,)
+
+    def set_g5x_offset(self, index, x, y, z, *rest):
+        self.g5x = [x * MM, y * MM, z * MM]
+
+    def set_g92_offset(self, x, y, z, *rest):
+        self.g92 = [x * MM, y * MM, z * MM]
+
+    def set_xy_rotation(self, theta):
+        self.rot = theta
+
+    def tool_offset(self, x, y, z, *rest):
+        self.tlo = [x * MM, y * MM, z * MM]
+
+    def set_plane(self, plane):
+        self.plane = plane
+
+    def _mach(self, p):
+        return [v * MM + a + b + t for v, a, b, t in zip(p, self.g5x, self.g92, self.tlo)]
+
+    def straight_traverse(self, x, y, z, *rest):
+        self.moves.append([0, self.line, self._mach((x, y, z)), None, 0, 17])
+
+    def straight_feed(self, x, y, z, *rest):
+        self.moves.append([1, self.line, self._mach((x, y, z)), None, 0, 17])
+
+    def arc_feed(self, e1, e2, c1, c2, rot, en, *rest):
+        a1, a2, an = _AXES[self.plane]
+        end = [0.0] * 3
+        end[a1], end[a2], end[an] = e1, e2, en
+        end = self._mach(end)
+        off = [a + b + t for a, b, t in zip(self.g5x, self.g92, self.tlo)]
+        centre = [c1 * MM + off[a1], c2 * MM + off[a2]]
+        self.moves.append([2, self.line, end, centre, int(rot), _PLANE[self.plane]])
+
+    def rigid_tap(self, x, y, z, *rest):
+        self.moves.append([1, self.line, self._mach((x, y, z)), None, 0, 17])
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))  # woodcam's own gcode.py lives here
+    sys.path[:] = [p for p in sys.path if os.path.abspath(p or ".") != here]
+    import gcode
+
+    job = json.load(sys.stdin)
+    result_fd = os.dup(1)
+    os.dup2(2, 1)  # the interpreter prints debugging lines to stdout: send them to stderr
+    _tool_table()
+    work = tempfile.mkdtemp(prefix="woodcam-lcnc-")
+    ini = os.path.join(work, "sim.ini")
+    var = os.path.join(work, "sim.var")
+    with open(ini, "w") as f:
+        f.write("[RS274NGC]\nPARAMETER_FILE = sim.var\n[TRAJ]\nLINEAR_UNITS = mm\n"
+                "SPINDLES = 1\n")
+    os.environ["INI_FILE_NAME"] = ini
+    sx, sy, sz = job["start_mm"]
+    out = []
+    for path in job["files"]:
+        with open(var, "w") as f:  # G28/G30 homes at the start position, as woodcam does
+            for base in (5161, 5181):  # (the parameter file holds inches)
+                for i, v in enumerate((sx, sy, sz)):
+                    f.write(f"{base + i}\t{v / MM:.15f}\n")
+            f.write("5220\t1.000000\n")
+        canon = _Canon(var, time.time() + job.get("timeout_s", 10.0))
+        init = ["G21", "G90", f"G53 G0 X{sx:.12f} Y{sy:.12f} Z{sz:.12f}"]
+        t0, c0 = time.perf_counter(), time.process_time()
+        try:
+            result, seq = gcode.parse(path, canon, init, "")
+            err = [seq, gcode.strerror(result)] if result > gcode.MIN_ERROR else None
+        except KeyboardInterrupt:  # check_abort() said the time is up
+            result, err = -2, [canon.line, "aborted: over the time limit"]
+        except Exception as e:  # noqa: BLE001 - LinuxCNC raises plain RuntimeError
+            result, err = -1, [0, f"{type(e).__name__}: {e}"]
+        moves = [m for m in canon.moves if m[1] > 0]  # line 0: the init codes
+        out.append({"moves": moves, "error": err, "result": result,
+                    "seconds": time.perf_counter() - t0, "cpu_seconds": time.process_time() - c0})
+    with os.fdopen(result_fd, "w") as f:
+        json.dump(out, f)
+
+
+if __name__ == "__main__":
+    main()

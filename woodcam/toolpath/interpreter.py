@@ -1,0 +1,1171 @@
+"""The RS274/NGC language as LinuxCNC 2.9 runs it: program text -> canonical moves.
+
+What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
+--------------------------------------------------------------------
+- numbered parameters ``#1``-``#5601`` (``#1``-``#30`` local to a subroutine call), named local
+  ``#<name>`` and global ``#<_name>`` parameters, indirect ``##1`` / ``#[1+2]``; system
+  parameters: coordinate systems ``#5221``... (G54 at 5221, each next one 20 higher), G92
+  ``#5210``-``#5213``, G28/G30 homes ``#5161``/``#5181``, ``#5220`` (active system),
+  ``#5400`` (tool), ``#<_value>`` (last return value);
+- expressions ``[...]`` with ``** * / mod + - eq ne gt ge lt le and or xor`` (LinuxCNC's six
+  precedence levels, all left-associative; ``eq``/``ne`` within 1e-4 as LinuxCNC),
+  unary minus, functions ``sin cos tan asin acos atan[a]/[b] sqrt abs round fix fup exp ln
+  exists`` (degrees);
+- parameter assignments take effect after the whole line was read (``#1=6 G0 X#1`` moves to the
+  old ``#1``);
+- O-words: ``sub/endsub/call/return``, ``if/elseif/else/endif``, ``while/endwhile``,
+  ``do/while``, ``repeat/endrepeat``, ``break``, ``continue``; at most
+  :data:`MAX_CALL_DEPTH` nested calls (LinuxCNC's limit) and :data:`MAX_BLOCKS` executed lines
+  (woodcam's guard against endless loops);
+- ``G0 G1 G2 G3`` (I/J/K and R arcs in the three planes, ``P`` turns), ``G4``, ``G10 L2/L20``,
+  ``G17-G19``, ``G20/G21``, ``G28/G28.1/G30/G30.1``, ``G40``, ``G43/G43.1/G49`` (woodcam tools
+  are measured from the tip, so tool length offsets do not move the tip), ``G53``,
+  ``G54-G59.3``, ``G61/G61.1/G64``, ``G73 G81 G82 G83 G85 G86 G89`` with ``G98/G99`` and ``L``,
+  ``G80``, ``G90/G91``, ``G90.1/G91.1``, ``G92/G92.1/G92.2/G92.3``, ``G94``, ``G97``;
+  ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60``; ``F S T N``; ``( )``/``;`` comments,
+  ``(msg,...)``, block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters.
+
+Everything else is an error naming the line and the word; what is read but has no effect on the
+cut is silent, what is read and could matter but is not simulated is a warning with its line.
+
+Dialects: ``linuxcnc`` (the default) is the reference. ``grbl`` has no parameters, expressions
+or O-words (they are errors there), needs no ``M2``. ``fanuc`` reads ``O1234`` program-number
+lines and allows ``G80`` beside a motion code (Fanuc keeps canned cycles in their own group, as
+in the ``G00 G80 G40 G49`` safety line); LinuxCNC 2.9 also accepts that line.
+
+Output: canonical moves in the machine (``G53``) frame, millimetres, tool tip; with all offsets
+at their defaults (zero) the machine frame is the G54 work frame. A canonical move is
+``(kind, line, end (3,), centre (2,) | None, rotation, plane, feed_mm_min, spindle_rpm, tool)``:
+``kind`` 0 = traverse, 1 = feed, 2 = arc (``centre`` in the plane's first/second axes,
+``rotation`` = +/-turns, + counter-clockwise, as LinuxCNC's ``ARC_FEED``).
+
+Why hand-written: no maintained PyPI package interprets this language. ``pygcode`` (0.2.1,
+2017, unmaintained) and ``gcodeparser`` parse words but have no parameters, expressions or
+O-word control flow; LinuxCNC's own interpreter is C++ inside the ``linuxcnc-uspace`` Debian
+package (not on PyPI) and is used as the test oracle and as ``--interpreter linuxcnc``
+(:mod:`woodcam.toolpath.linuxcnc`).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import Literal
+
+from ..errors import WoodcamError
+
+Dialect = Literal["linuxcnc", "grbl", "fanuc"]
+DIALECTS: tuple[str, ...] = ("linuxcnc", "grbl", "fanuc")
+
+#: LinuxCNC refuses a tenth nested subroutine call ("Too many subroutine levels").
+MAX_CALL_DEPTH = 9
+#: Executed lines before woodcam stops a program as an endless loop (a 35,000-line relief runs
+#: 35,000; loops that engrave text a few 10,000): ~10 s of CPU at ~50,000 lines/s.
+MAX_BLOCKS = 500_000
+#: Canonical moves before woodcam stops (the largest public program here has ~67,000).
+MAX_MOVES = 1_000_000
+#: Canned-cycle repeats (L) one block may ask for.
+MAX_CYCLE_REPEATS = 10_000
+MM_PER_INCH = 25.4
+#: LinuxCNC's G73/G83 retract clearance above the previous peck, 0.010 inch.
+_RAPID_DELTA_IN = 0.010
+#: LinuxCNC's eq/ne tolerance.
+_EQ_TOL = 1e-4
+#: LinuxCNC's centre-arc radius tolerances: CENTER_ARC_RADIUS_TOLERANCE_INCH = 2 * 0.001 * sqrt 2
+#: (inch), _MM = 2 * 0.01 * sqrt 2 (mm), relative 0.1 %; an arc whose end radius differs by
+#: more than 100 x the absolute, or by more than both, is refused (measured against LinuxCNC
+#: 2.9: 0.028 mm on a 10 mm radius is read, 0.029 mm refused).
+_ARC_ABS_TOL = {"in": 2 * 0.001 * math.sqrt(2), "mm": 2 * 0.01 * math.sqrt(2)}
+_ARC_REL_TOL = 0.001
+
+TRAVERSE, FEED, ARC = 0, 1, 2
+
+
+class GcodeError(WoodcamError):
+    """A G-code line that woodcam refuses; ``line`` is the 1-based source line."""
+
+    def __init__(self, line: int, word: str, rule: str, fix: str):
+        super().__init__(f"G-code line {line}: {word!r}: {rule}; {fix}")
+        self.line = line
+        self.word = word
+        self.rule = rule
+
+
+# ------------------------------------------------------------------------------------------
+# words
+_NUM = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
+_NAME = re.compile(r"<([^>]*)>")
+_FUNCS = ("atan", "asin", "acos", "abs", "cos", "sin", "tan", "sqrt", "round", "fix", "fup",
+          "exp", "ln", "exists")
+_BINOPS = (("**", 6), ("*", 5), ("/", 5), ("mod", 5), ("+", 4), ("-", 4), ("eq", 3), ("ne", 3),
+           ("gt", 3), ("ge", 3), ("lt", 3), ("le", 3), ("and", 2), ("or", 2), ("xor", 2))
+_OKEYS = ("sub", "endsub", "call", "return", "if", "elseif", "else", "endif", "while",
+          "endwhile", "do", "repeat", "endrepeat", "break", "continue")
+_LETTERS = set("fgmnstxyzijkrpqlh")  # the words a 3-axis mill program may carry
+_MOTION = {0.0, 1.0, 2.0, 3.0, 73.0, 80.0, 81.0, 82.0, 83.0, 85.0, 86.0, 89.0}
+_CYCLES = {73.0, 81.0, 82.0, 83.0, 85.0, 86.0, 89.0}
+_G_GROUPS = {
+    "motion": _MOTION, "plane": {17.0, 18.0, 19.0}, "distance": {90.0, 91.0},
+    "arc distance": {90.1, 91.1}, "feed mode": {93.0, 94.0, 95.0}, "units": {20.0, 21.0},
+    "cutter radius compensation": {40.0, 41.0, 42.0, 41.1, 42.1},
+    "tool length offset": {43.0, 43.1, 49.0}, "retract": {98.0, 99.0},
+    "coordinate system": {54.0, 55.0, 56.0, 57.0, 58.0, 59.0, 59.1, 59.2, 59.3},
+    "path control": {61.0, 61.1, 64.0}, "spindle mode": {96.0, 97.0},
+    "non-modal": {4.0, 10.0, 28.0, 28.1, 30.0, 30.1, 53.0, 92.0, 92.1, 92.2, 92.3},
+}
+_G_KNOWN = set().union(*_G_GROUPS.values())
+_G_REFUSED = {41.0: "cutter radius compensation changes the path", 42.0: "cutter radius "
+              "compensation changes the path", 41.1: "cutter radius compensation changes the "
+              "path", 42.1: "cutter radius compensation changes the path",
+              93.0: "inverse-time feed is not simulated", 95.0: "feed per revolution is not "
+              "simulated", 96.0: "constant surface speed is not simulated"}
+_M_KNOWN = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 30, 48, 49, 50, 51, 52, 53, 60, 61}
+#: M codes that switch I/O or call user programs: read, not simulated, warned about.
+_M_WARN = {19: "spindle orientation", 62: "digital output", 63: "digital output",
+           64: "digital output", 65: "digital output", 66: "wait on input",
+           67: "analog output", 68: "analog output", **{k: "user-defined M code (runs a "
+                                                         "program of the machine)"
+                                                         for k in range(100, 200)}}
+_CS = (54.0, 55.0, 56.0, 57.0, 58.0, 59.0, 59.1, 59.2, 59.3)
+_PLANES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}  # (first, second, normal) axes
+_CENTRE = {17: "ij", 18: "ki", 19: "jk"}
+
+
+def _cs_base(n: int) -> int:
+    """First parameter of coordinate system ``n`` (1 = G54 ... 9 = G59.3): 5221 + 20 (n-1)."""
+    return 5221 + 20 * (n - 1)
+
+
+#: LinuxCNC 2.9's predefined read-only named parameters that woodcam knows.
+_READ_ONLY = {"_x", "_y", "_z", "_a", "_b", "_c", "_u", "_v", "_w", "_metric", "_imperial",
+              "_absolute", "_incremental", "_feed", "_rpm", "_current_tool", "_selected_tool",
+              "_line", "_coord_system"}
+
+
+class _Line:
+    """A source line after comments are taken out: lowercase, no whitespace (LinuxCNC's
+    normalisation), the 1-based line number and the messages of its comments."""
+
+    __slots__ = ("text", "no", "msg", "okey", "olabel", "oexpr")
+
+    def __init__(self, text, no, msg):
+        self.text, self.no, self.msg = text, no, msg
+        self.okey = self.olabel = self.oexpr = None
+
+
+def _split_comments(raw: str, no: int) -> tuple[str, list[str]]:
+    msgs = []
+    out = []
+    i = 0
+    while i < len(raw):
+        c = raw[i]
+        if c == ";":
+            break
+        if c == "(":
+            j = raw.find(")", i + 1)
+            if j < 0:
+                raise GcodeError(no, raw[i:], "unclosed comment", "close it with ')'")
+            body = raw[i + 1:j]
+            if "(" in body:
+                raise GcodeError(no, raw[i:j + 1], "nested comment", "remove the inner '('")
+            low = body.strip().lower()
+            if low.startswith("msg,"):
+                msgs.append(body.strip()[4:].strip())
+            i = j + 1
+            continue
+        if c == ")":
+            raise GcodeError(no, ")", "')' without '('", "remove it")
+        out.append(c)
+        i += 1
+    # LinuxCNC drops all whitespace and case outside comments, inside #<names> too
+    return "".join("".join(out).split()).lower(), msgs
+
+
+class Interpreter:
+    """Runs one program; see the module docstring. ``run()`` returns ``(moves, warnings)``."""
+
+    def __init__(self, text: str, *, dialect: Dialect = "linuxcnc", start_mm=(0.0, 0.0, 0.0),
+                 params: dict[int, float] | None = None, max_blocks: int = MAX_BLOCKS,
+                 max_moves: int = MAX_MOVES):
+        if dialect not in DIALECTS:
+            raise WoodcamError(f"dialect must be one of {DIALECTS}, got {dialect!r}")
+        self.dialect = dialect
+        self.max_blocks, self.max_moves = int(max_blocks), int(max_moves)
+        self.src = text.splitlines()
+        self.pos = [float(v) for v in start_mm]  # machine frame, mm
+        self.p: dict[int, float] = {}
+        for k in range(5161, 5164):
+            self.p[k] = self.pos[k - 5161]
+        for k in range(5181, 5184):
+            self.p[k] = self.pos[k - 5181]
+        self.p[5220] = 1.0
+        if params:
+            self.p.update({int(k): float(v) for k, v in params.items()})
+        self.globals: dict[str, float] = {}
+        self.locals: dict[str, float] = {}
+        self.moves: list = []
+        self.warnings: list[tuple[int, str]] = []
+        self.messages: list[tuple[int, str]] = []
+        # modal state
+        self.inch = False
+        self.incremental = False
+        self.arc_incremental = True
+        self.plane = 17
+        self.motion: float | None = 0.0 if dialect != "linuxcnc" else None
+        self.retract_old_z = False  # LinuxCNC starts in G99 (retract to R)
+        self.feed = 0.0  # program units / min
+        self.spindle = 0.0
+        self.spindle_on = False
+        self.tool = 0
+        self.selected = 0
+        self.cs = int(self.p[5220])
+        self.g5x = [self.p.get(_cs_base(self.cs) + i, 0.0) for i in range(3)]
+        self.g92 = [self.p.get(5211 + i, 0.0) for i in range(3)] if self.p.get(5210) else [0.0] * 3
+        self.cycle_il: float | None = None
+        self.cyc = {"r": math.nan, "z": math.nan, "q": math.nan, "p": 0.0, "l": 1}
+        self.ended = False
+        self.known = [False, False, False]
+        self._warned_start = False
+        self._t_warned: set[int] = set()
+        self.line_no = 0
+
+    # -- helpers ----------------------------------------------------------------------------
+    def err(self, word, rule, fix):
+        return GcodeError(self.line_no, word, rule, fix)
+
+    def warn(self, msg):
+        self.warnings.append((self.line_no, msg))
+
+    @property
+    def scale(self):
+        return MM_PER_INCH if self.inch else 1.0
+
+    def to_machine(self, prog):
+        """Program (work) coordinates in program units -> machine frame mm (LinuxCNC: work +
+        G92 + G5x)."""
+        s = self.scale
+        return [v * s + o + g for v, o, g in zip(prog, self.g5x, self.g92)]
+
+    def to_program(self, mach):
+        s = self.scale
+        return [(v - o - g) / s for v, o, g in zip(mach, self.g5x, self.g92)]
+
+    def emit(self, kind, end, centre=None, rotation=0):
+        if len(self.moves) >= self.max_moves:
+            raise self.err("program", f"more than {self.max_moves} moves (woodcam's memory "
+                           "guard)", "split the program or raise max_moves")
+        if kind == TRAVERSE or kind == FEED:
+            if list(end) == self.pos:
+                return  # zero-length: nothing to simulate (LinuxCNC emits some)
+        if kind != TRAVERSE and not self._warned_start and not all(self.known):
+            self._warned_start = True
+            miss = "".join(a for a, k in zip("XYZ", self.known) if not k).upper()
+            self.warn(f"the first cut starts before the program set {miss}: it starts from "
+                      f"the start position X{self.pos[0]:g} Y{self.pos[1]:g} Z{self.pos[2]:g} "
+                      "mm (--start)")
+        if kind != TRAVERSE and self.selected != self.tool and self.selected not in self._t_warned:
+            self._t_warned.add(self.selected)
+            self.warn(f"T{self.selected} was selected without M6: the cut goes on with the "
+                      f"loaded tool T{self.tool}, as the controller does")
+        feed = self.feed * self.scale
+        self.moves.append((kind, self.line_no, tuple(end), centre, rotation, self.plane, feed,
+                           self.spindle if self.spindle_on else 0.0, self.tool))
+        self.pos = list(end)
+
+    # -- parameters -------------------------------------------------------------------------
+    def get_num(self, n: float, word: str) -> float:
+        k = self._param_index(n, word)
+        return self.p.get(k, 0.0)
+
+    def _param_index(self, n, word):
+        k = round(n)
+        if abs(n - k) > 1e-4 or not 1 <= k <= 5601:
+            raise self.err(word, f"parameter number {n:g} out of range (1-5601, integer)",
+                           "use #1 ... #5601")
+        return k
+
+    def get_named(self, name, word):
+        if name in _READ_ONLY:
+            return self._system(name)
+        d = self.globals if name.startswith("_") else self.locals
+        if name in d:
+            return d[name]
+        if name == "_value":
+            return 0.0
+        raise self.err(word, f"named parameter #<{name}> not defined",
+                       "assign it before reading it")
+
+    def _system(self, name):
+        prog = self.to_program(self.pos)
+        return {"_x": prog[0], "_y": prog[1], "_z": prog[2], "_metric": float(not self.inch),
+                "_imperial": float(self.inch), "_absolute": float(not self.incremental),
+                "_incremental": float(self.incremental), "_feed": self.feed,
+                "_rpm": self.spindle, "_current_tool": float(self.tool),
+                "_selected_tool": float(self.selected), "_line": float(self.line_no),
+                "_coord_system": float(540 + 10 * (self.cs - 1))}.get(name, 0.0)
+
+    # -- expression reader ------------------------------------------------------------------
+    # Works on the normalised line text ``s`` with an index; returns (value, next index).
+    def value(self, s: str, i: int):
+        if i >= len(s):
+            raise self.err(s, "a value is missing at the end of the line", "complete the word")
+        c = s[i]
+        if c == "[":
+            v, i = self.expr(s, i + 1)
+            if i >= len(s) or s[i] != "]":
+                raise self.err(s, "expression without closing ']'", "close it")
+            return v, i + 1
+        if c == "#":
+            return self.param_value(s, i)
+        if c.isdigit() or c == "." or (c in "+-" and i + 1 < len(s)
+                                       and (s[i + 1].isdigit() or s[i + 1] == ".")):
+            m = _NUM.match(s, i)
+            if not m:
+                raise self.err(s[i:i + 8], "bad number", "write digits with one '.'")
+            v = float(m.group(0))
+            if not math.isfinite(v):
+                raise self.err(m.group(0)[:20] + "...", "number out of range",
+                               "use a number below 1e308")
+            return v, m.end()
+        if c == "-":
+            v, i = self.value(s, i + 1)
+            return -v, i
+        if c == "+":
+            return self.value(s, i + 1)
+        if c.isalpha():
+            for f in _FUNCS:
+                if s.startswith(f, i):
+                    return self.func(f, s, i + len(f))
+        raise self.err(s[i:i + 10], "bad value (a number, #parameter, [expression] or "
+                       "function)", "fix the word")
+
+    def param_value(self, s, i):
+        if s.startswith("#<", i):
+            m = _NAME.match(s, i + 1)
+            if not m:
+                raise self.err(s[i:], "named parameter without '>'", "write #<name>")
+            return self.get_named(m.group(1), s[i:m.end()]), m.end()
+        n, j = self.value(s, i + 1)
+        return self.get_num(n, s[i:j]), j
+
+    def func(self, f, s, i):
+        if i >= len(s) or s[i] != "[":
+            raise self.err(f, f"function {f} without '[' argument", f"write {f}[...]")
+        if f == "exists":
+            m = re.compile(r"\[#<([^>]*)>\]").match(s, i)
+            if not m:
+                raise self.err(s[i:], "exists needs [#<name>]", "write exists[#<name>]")
+            name = m.group(1)
+            d = self.globals if name.startswith("_") else self.locals
+            return float(name in d), m.end()
+        a, i = self.value(s, i)
+        w = f"{f}[{a:g}]"
+        if f == "atan":
+            if not s.startswith("/[", i):
+                raise self.err(w, "atan needs two arguments, atan[y]/[x]", "write atan[y]/[x]")
+            b, i = self.value(s, i + 1)
+            return math.degrees(math.atan2(a, b)), i
+        try:
+            if f == "sin":
+                v = math.sin(math.radians(a))
+            elif f == "cos":
+                v = math.cos(math.radians(a))
+            elif f == "tan":
+                v = math.tan(math.radians(a))
+            elif f == "asin":
+                if abs(a) > 1:
+                    raise self.err(w, "asin argument outside [-1, 1]", "fix the argument")
+                v = math.degrees(math.asin(a))
+            elif f == "acos":
+                if abs(a) > 1:
+                    raise self.err(w, "acos argument outside [-1, 1]", "fix the argument")
+                v = math.degrees(math.acos(a))
+            elif f == "sqrt":
+                if a < 0:
+                    raise self.err(w, "square root of a negative number", "fix the argument")
+                v = math.sqrt(a)
+            elif f == "abs":
+                v = abs(a)
+            elif f == "round":  # half away from zero, as LinuxCNC
+                v = math.copysign(math.floor(abs(a) + 0.5), a)
+            elif f == "fix":
+                v = float(math.floor(a))
+            elif f == "fup":
+                v = float(math.ceil(a))
+            elif f == "exp":
+                v = math.exp(a)
+            else:  # ln
+                if a <= 0:
+                    raise self.err(w, "logarithm of a number <= 0", "fix the argument")
+                v = math.log(a)
+        except OverflowError:
+            v = math.inf
+        if not math.isfinite(v):
+            raise self.err(w, "result out of range", "use smaller numbers")
+        return v, i
+
+    def expr(self, s, i):
+        """Inside ``[`` ... up to (not past) the closing ``]``: precedence climbing."""
+        return self._binary(s, i, 0)
+
+    def _binary(self, s, i, min_prec):
+        left, i = self.value(s, i)
+        while i < len(s) and s[i] != "]":
+            for op, prec in _BINOPS:
+                if s.startswith(op, i):
+                    break
+            else:
+                raise self.err(s[i:i + 6], "unknown operator in expression",
+                               "use ** * / mod + - eq ne gt ge lt le and or xor")
+            if prec <= min_prec:
+                return left, i
+            # left-associative: the right operand binds only tighter operators
+            right, i = self._binary(s, i + len(op), prec)
+            left = self._apply(op, left, right)
+        return left, i
+
+    def _apply(self, op, a, b):
+        w = f"{a:g} {op} {b:g}"
+        try:
+            if op == "**":
+                if a < 0 and b != math.floor(b):
+                    raise self.err(w, "negative number to a non-integer power", "fix it")
+                if a == 0 and b < 0:
+                    raise self.err(w, "zero to a negative power", "fix it")
+                v = math.pow(a, b)
+            elif op == "*":
+                v = a * b
+            elif op == "/":
+                if b == 0:
+                    raise self.err(w, "division by zero", "fix the divisor")
+                v = a / b
+            elif op == "mod":
+                if b == 0:
+                    raise self.err(w, "mod by zero", "fix the divisor")
+                v = math.fmod(a, b)
+                if v < 0:
+                    v += abs(b)
+            elif op == "+":
+                v = a + b
+            elif op == "-":
+                v = a - b
+            elif op == "eq":
+                v = float(abs(a - b) < _EQ_TOL)
+            elif op == "ne":
+                v = float(abs(a - b) >= _EQ_TOL)
+            elif op == "gt":
+                v = float(a > b)
+            elif op == "ge":
+                v = float(a >= b)
+            elif op == "lt":
+                v = float(a < b)
+            elif op == "le":
+                v = float(a <= b)
+            elif op == "and":
+                v = float(a != 0 and b != 0)
+            elif op == "or":
+                v = float(a != 0 or b != 0)
+            else:
+                v = float((a != 0) != (b != 0))
+        except OverflowError:
+            v = math.inf
+        if not math.isfinite(v):
+            raise self.err(w, "result out of range", "use smaller numbers")
+        return v
+
+    # -- program structure ------------------------------------------------------------------
+    def _prepare(self):
+        """Normalise every line and match the O-word structure once (LinuxCNC matches by label:
+        ``o100 if`` ... ``o100 endif``)."""
+        lines: list[_Line] = []
+        percent = False
+        first = True
+        for no, raw in enumerate(self.src, start=1):
+            self.line_no = no
+            text, msg = _split_comments(raw, no)
+            if first and (text or msg):
+                first = False
+                if text == "%":
+                    percent = True
+                    continue
+            if text == "%":
+                if percent:
+                    lines.append(_Line("%", no, msg))
+                    break
+                continue
+            ln = _Line(text, no, msg)
+            body = text[1:] if text.startswith("/") else text
+            m = re.match(r"(?:n\d+(?:\.\d*)?)?o(<[^>]*>|\d+)([a-z]+)(.*)$", body)
+            if m:
+                label = m.group(1).strip("<>")
+                label = str(int(label)) if label.isdigit() else label
+                key, rest = m.group(2), m.group(3)
+                for k in sorted(_OKEYS, key=len, reverse=True):
+                    if key.startswith(k):
+                        rest = key[len(k):] + rest
+                        key = k
+                        break
+                else:
+                    raise GcodeError(no, text, f"unknown O-word command {key!r}",
+                                   "use sub, endsub, call, return, if, elseif, else, endif, "
+                                   "while, endwhile, do, repeat, endrepeat, break, continue")
+                if self.dialect == "grbl":
+                    raise GcodeError(no, text, "grbl has no O-word subroutines or loops",
+                                   "use --dialect linuxcnc")
+                ln.okey, ln.olabel, ln.oexpr = key, label, rest
+            elif re.match(r"(?:n\d+)?o\d+$", body):
+                if self.dialect == "fanuc":  # O1234: Fanuc program number
+                    continue
+                raise GcodeError(no, text, "O-word without a command (LinuxCNC reads O only as "
+                               "sub/call/if/while...; Fanuc's O1234 program number needs "
+                               "--dialect fanuc)", "remove it or pass --dialect fanuc")
+            lines.append(ln)
+        self.lines = lines
+        self.percent = percent
+        # match structure
+        self.match: dict[int, int] = {}   # opener index -> closer index (and back)
+        self.branches: dict[int, list[int]] = {}  # if index -> [elseif/else..., endif]
+        self.owner: dict[int, int] = {}  # break/continue/elseif/else/return index -> opener
+        self.subs: dict[str, int] = {}
+        stack: list[tuple[str, str, int]] = []
+        for idx, ln in enumerate(lines):
+            k = ln.okey
+            if k is None:
+                continue
+            self.line_no = ln.no
+            if k == "while" and stack and stack[-1][0] == "do" and stack[-1][1] == ln.olabel:
+                _, _, op = stack.pop()
+                self.match[op], self.match[idx] = idx, op
+                ln.okey = "dowhile"
+            elif k in ("sub", "if", "while", "do", "repeat"):
+                if k == "sub":
+                    if any(s[0] == "sub" for s in stack):
+                        raise GcodeError(ln.no, f"o{ln.olabel} sub", "subroutine defined inside "
+                                       "another", "move it out")
+                    self.subs[ln.olabel] = idx
+                stack.append((k, ln.olabel, idx))
+                if k == "if":
+                    self.branches[idx] = []
+            elif k in ("endsub", "endif", "endwhile", "endrepeat"):
+                want = {"endsub": "sub", "endif": "if", "endwhile": "while",
+                        "endrepeat": "repeat"}[k]
+                if not stack or stack[-1][0] != want or stack[-1][1] != ln.olabel:
+                    raise GcodeError(ln.no, f"o{ln.olabel} {k}", f"{k} without a matching "
+                                   f"o{ln.olabel} {want}", "match the O-word labels")
+                _, _, op = stack.pop()
+                self.match[op], self.match[idx] = idx, op
+                if k == "endif":
+                    self.branches[op].append(idx)
+            elif k in ("elseif", "else"):
+                if not stack or stack[-1][0] != "if" or stack[-1][1] != ln.olabel:
+                    raise GcodeError(ln.no, f"o{ln.olabel} {k}", f"{k} without o{ln.olabel} if",
+                                   "match the O-word labels")
+                self.branches[stack[-1][2]].append(idx)
+                self.owner[idx] = stack[-1][2]
+            elif k in ("break", "continue"):
+                loop = next((s for s in reversed(stack) if s[1] == ln.olabel
+                             and s[0] in ("while", "do", "repeat")), None)
+                if loop is None:
+                    raise GcodeError(ln.no, f"o{ln.olabel} {k}", f"{k} outside an o{ln.olabel} "
+                                   "loop", "match the O-word labels")
+                self.owner[idx] = loop[2]
+            elif k == "return":
+                sub = next((s for s in reversed(stack) if s[0] == "sub"), None)
+                if sub is None:
+                    raise GcodeError(ln.no, f"o{ln.olabel} return", "return outside a "
+                                   "subroutine", "use M2 to end the program")
+                self.owner[idx] = sub[2]
+        if stack:
+            k, label, idx = stack[-1]
+            raise GcodeError(lines[idx].no, f"o{label} {k}", f"o{label} {k} is never closed",
+                           "close it")
+
+    def run(self):
+        self._prepare()
+        lines = self.lines
+        frames: list[tuple] = []  # (return index, saved #1-#30, saved locals, sub index)
+        repeat_left: dict[int, int] = {}
+        pc = 0
+        blocks = 0
+        n = len(lines)
+        while pc < n:
+            ln = lines[pc]
+            self.line_no = ln.no
+            blocks += 1
+            if blocks > self.max_blocks:
+                raise self.err("program", f"more than {self.max_blocks} lines executed (an "
+                               "endless loop?)", "check the loop conditions")
+            for m in ln.msg:
+                self.messages.append((ln.no, m))
+            k = ln.okey
+            if k is None:
+                if ln.text == "%":
+                    self.ended = True
+                    break
+                if ln.text:
+                    self.block(ln.text)
+                    if self.ended:
+                        break
+                pc += 1
+                continue
+            if k == "sub":
+                pc = self.match[pc] + 1
+            elif k == "call":
+                if len(frames) >= MAX_CALL_DEPTH:
+                    raise self.err(f"o{ln.olabel} call", f"more than {MAX_CALL_DEPTH} nested "
+                                   "subroutine calls (LinuxCNC's limit)", "reduce the nesting")
+                if ln.olabel not in self.subs:
+                    raise self.err(f"o{ln.olabel} call", f"subroutine o{ln.olabel} is not "
+                                   "defined in this file (woodcam reads one file; LinuxCNC "
+                                   "would search its SUBROUTINE_PATH)",
+                                   "define it in the program")
+                args = self._call_args(ln.oexpr)
+                saved = {i: self.p.get(i, 0.0) for i in range(1, 31)}
+                frames.append((pc + 1, saved, self.locals, self.subs[ln.olabel]))
+                self.locals = {}
+                for i in range(1, 31):
+                    self.p[i] = args[i - 1] if i <= len(args) else 0.0
+                pc = self.subs[ln.olabel] + 1
+            elif k in ("endsub", "return"):
+                v = self._cond(ln)[0] if k == "return" and ln.oexpr else None
+                self.globals["_value"] = 0.0 if v is None else v  # LinuxCNC: 0 without a value
+                self.globals["_value_returned"] = float(v is not None)
+                if not frames:  # a sub body reached without a call: LinuxCNC skips it
+                    pc = (self.match[pc] if k == "endsub" else self.match[self.owner[pc]]) + 1
+                    continue
+                ret, saved, loc, _ = frames.pop()
+                self.p.update(saved)
+                self.locals = loc
+                pc = ret
+            elif k == "if":
+                pc = self._if(pc)
+            elif k in ("elseif", "else"):  # reached the end of a taken branch
+                pc = self.branches[self.owner[pc]][-1] + 1
+            elif k == "endif":
+                pc += 1
+            elif k == "while":
+                v, _ = self._cond(ln)
+                pc = pc + 1 if v != 0 else self.match[pc] + 1
+            elif k == "endwhile":
+                pc = self.match[pc]
+            elif k == "do":
+                pc += 1
+            elif k == "dowhile":
+                v, _ = self._cond(ln)
+                pc = self.match[pc] + 1 if v != 0 else pc + 1
+            elif k == "repeat":
+                if pc not in repeat_left:
+                    v, _ = self._cond(ln)
+                    repeat_left[pc] = int(round(v))
+                if repeat_left[pc] > 0:
+                    repeat_left[pc] -= 1
+                    pc += 1
+                else:
+                    del repeat_left[pc]
+                    pc = self.match[pc] + 1
+            elif k == "endrepeat":
+                pc = self.match[pc]
+            elif k == "break":
+                op = self.owner[pc]
+                repeat_left.pop(op, None)
+                pc = self.match[op] + 1
+            elif k == "continue":
+                op = self.owner[pc]
+                pc = op if lines[op].okey in ("while", "repeat") else self.match[op]
+            else:  # pragma: no cover - _prepare only lets the keys above through
+                raise self.err(k, "unknown O-word", "fix it")
+        if not self.ended:
+            if self.dialect == "linuxcnc":
+                self.warn("the file ends without M2, M30 or '%' (LinuxCNC stops here with "
+                          "'File ended with no percent sign or program end')")
+        return self.moves, self.warnings
+
+    def _cond(self, ln):
+        s = ln.oexpr
+        if not s.startswith("["):
+            raise self.err(f"o{ln.olabel} {ln.okey}{s}", f"{ln.okey} needs a [condition]",
+                           f"write o{ln.olabel} {ln.okey} [...]")
+        v, i = self.value(s, 0)
+        if s[i:]:
+            raise self.err(s[i:], "text after the condition", "remove it")
+        return v, i
+
+    def _call_args(self, s):
+        args = []
+        i = 0
+        while i < len(s):
+            if s[i] != "[":
+                raise self.err(s[i:], "subroutine arguments must each be in [ ]", "write [1] [2]")
+            v, i = self.value(s, i)
+            args.append(v)
+        if len(args) > 30:
+            raise self.err(s[:20], "more than 30 subroutine arguments", "pass at most 30")
+        return args
+
+    def _if(self, pc):
+        chain = [pc] + self.branches[pc]
+        for b in chain[:-1]:
+            ln = self.lines[b]
+            if ln.okey == "else":
+                return b + 1
+            v, _ = self._cond(ln)
+            if v != 0:
+                return b + 1
+        return chain[-1] + 1
+
+    # -- one block --------------------------------------------------------------------------
+    def block(self, s: str):
+        if s.startswith("/"):
+            s = s[1:]  # block delete switch off (LinuxCNC's default): the line runs
+        words: dict[str, float] = {}
+        gs: list[float] = []
+        ms: list[int] = []
+        pending: list[tuple] = []
+        i = 0
+        n = len(s)
+        while i < n:
+            c = s[i]
+            if c == "#":
+                if self.dialect == "grbl":
+                    raise self.err(s, "grbl has no parameters", "use --dialect linuxcnc")
+                if s.startswith("#<", i):
+                    m = _NAME.match(s, i + 1)
+                    if not m:
+                        raise self.err(s[i:], "named parameter without '>'", "write #<name>")
+                    ref, j = ("n", m.group(1)), m.end()
+                else:
+                    v, j = self.value(s, i + 1)
+                    ref = ("i", self._param_index(v, s[i:j]))
+                if j >= n or s[j] != "=":
+                    raise self.err(s[i:j + 1], "parameter on its own must be an assignment",
+                                   "write #1=value")
+                v, i = self.value(s, j + 1)
+                pending.append((ref, v))
+                continue
+            if c == "[" or c.isdigit():
+                raise self.err(s[i:i + 10], "a value without a letter", "write a word like X1")
+            letter = c
+            if letter not in _LETTERS:
+                if not c.isalpha():
+                    raise self.err(c, f"bad character {c!r} (a word is a letter and a value)",
+                                   "fix or remove it")
+                try:
+                    tok = f"{c.upper()}{self.value(s, i + 1)[0]:g}"
+                except GcodeError:
+                    tok = c.upper()
+                raise self.err(tok, f"unsupported word {letter.upper()} (woodcam simulates a "
+                               "3-axis mill: no A/B/C/U/V/W axes or other letters)",
+                               "post-process for 3 axes")
+            if self.dialect == "grbl" and i + 1 < n and s[i + 1] in "[#":
+                raise self.err(s[i:i + 6], "grbl has no expressions or parameters",
+                               "use --dialect linuxcnc")
+            v, i = self.value(s, i + 1)
+            if letter == "g":
+                gs.append(v)
+            elif letter == "m":
+                ms.append(v)
+            elif letter == "n":
+                continue
+            else:
+                if letter in words:
+                    raise self.err(f"{letter.upper()}{v:g}", f"word {letter.upper()} twice on "
+                                   "one line", "keep one")
+                words[letter] = v
+        for ref, v in pending:  # the end-of-line assignment rule
+            if ref[0] == "n" and ref[1] in _READ_ONLY:
+                raise self.err(f"#<{ref[1]}>", f"#<{ref[1]}> is a read-only system parameter",
+                               "use another name")
+            if ref[0] == "n":
+                (self.globals if ref[1].startswith("_") else self.locals)[ref[1]] = v
+            else:
+                self.p[ref[1]] = v
+        if gs or ms or words:
+            self.execute(gs, ms, words)
+
+    def execute(self, gs, ms, w):
+        g: set[float] = set()
+        for v in gs:
+            c = round(v, 1)
+            if (abs(v - c) > 1e-4 or c not in _G_KNOWN) and c not in _G_REFUSED:
+                raise self.err(f"G{v:g}", "unsupported G code (woodcam reads the G codes "
+                               "listed in woodcam.toolpath.interpreter)",
+                               "post-process the program for a 3-axis mill")
+            if c in _G_REFUSED:
+                raise self.err(f"G{v:g}", _G_REFUSED[c], "post-process without it")
+            g.add(c)
+        for name, codes in _G_GROUPS.items():
+            hit = g & codes
+            if len(hit) > 1:
+                if name == "motion" and hit & {80.0} and len(hit) == 2:
+                    g.discard(80.0)  # G0 G80: LinuxCNC 2.9 and Fanuc take the motion code
+                    continue
+                raise self.err(" ".join(f"G{c:g}" for c in sorted(hit)),
+                               f"two {name} G codes on one line", "keep one")
+        mset = set()
+        for v in ms:
+            if v == math.floor(v) and int(v) in _M_WARN:
+                self.warn(f"M{int(v)} ({_M_WARN[int(v)]}) is not simulated")
+                mset.add(int(v))
+                continue
+            if v != math.floor(v) or int(v) not in _M_KNOWN:
+                raise self.err(f"M{v:g}", "unsupported M code (woodcam reads M0-M9, M30, "
+                               "M48-M53, M60, M61; M19, M62-M68 and M100-M199 with a warning)", "remove it or post-process for a 3-axis mill")
+            mset.add(int(v))
+        for k in ("t", "l", "h"):
+            if k in w and (w[k] != math.floor(w[k]) or w[k] < 0 or w[k] > 1e9):
+                raise self.err(f"{k.upper()}{w[k]:g}", "must be a non-negative integer",
+                               f"write {k.upper()}{max(0, round(w[k])):d}" if abs(w[k]) < 1e9
+                               else "fix the number")
+        # 3-5. feed mode (LinuxCNC zeroes F on every G93/G94/G95), feed, spindle, tool
+        if g & {93.0, 94.0, 95.0}:
+            self.feed = 0.0
+        if "f" in w:
+            if w["f"] < 0:
+                raise self.err(f"F{w['f']:g}", "negative feed rate", "give F >= 0")
+            self.feed = w["f"]
+        if "s" in w:
+            if w["s"] < 0:
+                raise self.err(f"S{w['s']:g}", "negative spindle speed", "give S >= 0")
+            self.spindle = w["s"]
+        if "t" in w:
+            self.selected = int(w["t"])
+        if 61 in mset:  # M61 Qn: the loaded tool is n, no change
+            if "q" not in w or w["q"] != math.floor(w["q"]) or w["q"] < 0:
+                raise self.err("M61", "M61 needs Q = a tool number", "write M61 Q1")
+            self.tool = self.selected = int(w["q"])
+        if 6 in mset:
+            self.tool = self.selected
+            self.p[5400] = float(self.tool)
+        if mset & {3, 4}:
+            self.spindle_on = True
+        if 5 in mset:
+            self.spindle_on = False
+        if 4.0 in g:
+            if "p" not in w or w["p"] < 0:
+                raise self.err("G4", "dwell needs P >= 0 (seconds)", "write G4 P0.5")
+        for c in (17, 18, 19):
+            if float(c) in g:
+                self.plane = c
+        if 20.0 in g:
+            self.inch = True
+        if 21.0 in g:
+            self.inch = False
+        if 43.0 in g and "h" not in w:
+            self.warn("G43 without H uses the loaded tool's length; woodcam measures tools "
+                      "from the tip, so tool lengths do not move the cut")
+        for c in _CS:
+            if c in g:
+                self.cs = _CS.index(c) + 1
+                self.p[5220] = float(self.cs)
+                self.g5x = [self.p.get(_cs_base(self.cs) + i, 0.0) for i in range(3)]
+        if 90.0 in g:
+            self.incremental = False
+        if 91.0 in g:
+            self.incremental = True
+        if 90.1 in g:
+            self.arc_incremental = False
+        if 91.1 in g:
+            self.arc_incremental = True
+        if 98.0 in g:
+            self.retract_old_z = True
+        if 99.0 in g:
+            self.retract_old_z = False
+        motion_here = [c for c in g if c in _MOTION]
+        axis = [a for a in "xyz" if a in w]
+        nonmodal = g & _G_GROUPS["non-modal"]
+        self._unused_words(g, mset, w, motion_here, axis)
+        if 10.0 in g:
+            self.g10(w)
+        elif nonmodal & {28.0, 30.0}:
+            self.home(30.0 if 30.0 in g else 28.0, w)
+        elif nonmodal & {28.1, 30.1}:
+            base = 5161 if 28.1 in g else 5181
+            for i in range(3):
+                self.p[base + i] = self.pos[i]
+        elif 92.0 in g:
+            if not axis:
+                raise self.err("G92", "G92 needs axis words", "write G92 X0 Y0 Z0")
+            for i, a in enumerate("xyz"):
+                if a in w:
+                    # G92 makes the current point read w[a]: offset = pos - g5x - value
+                    self.g92[i] = self.pos[i] - self.g5x[i] - w[a] * self.scale
+                    self.p[5211 + i] = self.g92[i] / self.scale
+            self.p[5210] = 1.0
+        elif 92.1 in g or 92.2 in g:
+            self.g92 = [0.0] * 3
+            if 92.1 in g:
+                for i in range(3):
+                    self.p[5211 + i] = 0.0
+                self.p[5210] = 0.0
+        elif 92.3 in g:
+            self.g92 = [self.p.get(5211 + i, 0.0) * self.scale for i in range(3)]
+        if nonmodal & {10.0, 28.0, 30.0, 92.0}:
+            axis = []  # the axis words belonged to the non-modal code
+        if motion_here:
+            self.motion = motion_here[0] if motion_here[0] != 80.0 else None
+        if self.motion not in _CYCLES:
+            self.cycle_il = None
+        if 53.0 in g:
+            if self.motion not in (0.0, 1.0) or not axis:
+                raise self.err("G53", "G53 needs G0 or G1 and axis words", "write G53 G0 Z0")
+            if self.incremental:
+                raise self.err("G53", "G53 in incremental mode (G91)", "use G90")
+        full_circle = (bool(motion_here) and self.motion in (2.0, 3.0) and not axis
+                       and any(k in w for k in "ijk"))  # LinuxCNC: G2 I5 is a full circle
+        if axis or full_circle or (motion_here and self.motion in _CYCLES):
+            if self.motion is None:
+                raise self.err("".join(f"{a.upper()}{w[a]:g}" for a in axis),
+                               "axis words without a motion mode (G80 cancelled it)",
+                               "start the line with G0 or G1")
+            self.move(w, axis, 53.0 in g)
+        elif any(k in w for k in "ijkr") and not (self.motion in _CYCLES and "r" in w):
+            k = next(k for k in "ijkr" if k in w)
+            raise self.err(f"{k.upper()}{w[k]:g}", "arc words without an end point",
+                           "give X/Y/Z with G2/G3")
+        if mset & {2, 30}:
+            self.ended = True
+
+    def _unused_words(self, g, mset, w, motion_here, axis):
+        """LinuxCNC refuses a P/Q/R/L/H/I/J/K word that no code of the line uses."""
+        eff = motion_here[0] if motion_here else (self.motion if axis else None)
+        uses = {
+            "q": bool(g & {10.0, 64.0}) or eff in (73.0, 83.0) or bool(mset & {61, 66, 67, 68}),
+            "r": 10.0 in g or eff in (2.0, 3.0) or eff in _CYCLES,
+            "p": bool(g & {4.0, 10.0, 64.0}) or eff in (2.0, 3.0, 82.0, 86.0, 89.0)
+            or bool(mset & {50, 51, 52, 53, 62, 63, 64, 65, 66, 67, 68}),
+            "l": 10.0 in g or eff in _CYCLES,
+            "h": 43.0 in g,
+        }
+        for k, used in uses.items():
+            if k in w and not used:
+                raise self.err(f"{k.upper()}{w[k]:g}", f"{k.upper()} word with no G or M code "
+                               "on the line that uses it (LinuxCNC refuses it too)",
+                               "remove it or add the code it belongs to")
+        if eff not in (2.0, 3.0) and 10.0 not in g:
+            for k in "ijk":
+                if k in w:
+                    raise self.err(f"{k.upper()}{w[k]:g}", f"{k.upper()} word with no G2/G3 "
+                                   "to use it", "give X/Y/Z with G2/G3")
+
+    # -- non-modal codes --------------------------------------------------------------------
+    def g10(self, w):
+        ln = w.get("l")
+        if ln not in (2.0, 20.0):
+            raise self.err(f"G10 L{ln:g}" if ln is not None else "G10", "woodcam reads G10 L2 "
+                           "and G10 L20 (work offsets); tool tables come from --tools",
+                           "remove it")
+        p = w.get("p", 0.0)
+        if p != math.floor(p) or not 0 <= p <= 9:
+            raise self.err(f"P{p:g}", "G10 P must be 0 (active) or 1-9 (G54-G59.3)",
+                           "fix P")
+        if "r" in w and w["r"] != 0:
+            raise self.err(f"R{w['r']:g}", "G10 L2 R (rotated coordinate systems) is not "
+                           "simulated", "remove the rotation")
+        n = int(p) or self.cs
+        base = _cs_base(n)
+        for i, a in enumerate("xyz"):
+            if a not in w:
+                continue
+            if ln == 2.0:
+                val = w[a] * self.scale
+            else:  # L20: the current point shall read w[a] in system n
+                val = self.pos[i] - self.g92[i] - w[a] * self.scale
+            self.p[base + i] = val / self.scale
+            if n == self.cs:
+                self.g5x[i] = val
+
+    def home(self, code, w):
+        """G28/G30: rapid through the (optional) intermediate point to the stored home
+        (#5161-#5163 / #5181-#5183, machine frame; woodcam stores its start position there)."""
+        base = 5161 if code == 28.0 else 5181
+        axis = [a for a in "xyz" if a in w]
+        if axis:
+            self.emit(TRAVERSE, self._target(w, axis))
+        idx = [i for i, a in enumerate("xyz") if a in w] if axis else [0, 1, 2]
+        end = list(self.pos)
+        for i in idx:
+            end[i] = self.p.get(base + i, 0.0) * self.scale
+            self.known[i] = True
+        self.emit(TRAVERSE, end)
+
+    # -- motion -----------------------------------------------------------------------------
+    def _target(self, w, axis, machine=False):
+        if machine:
+            end = list(self.pos)
+            for i, a in enumerate("xyz"):
+                if a in w:
+                    end[i] = w[a] * self.scale
+            return end
+        prog = self.to_program(self.pos)
+        for i, a in enumerate("xyz"):
+            if a in w:
+                prog[i] = prog[i] + w[a] if self.incremental else w[a]
+        end = self.to_machine(prog)
+        for i, a in enumerate("xyz"):  # untouched axes stay bit-exact
+            if a not in w:
+                end[i] = self.pos[i]
+        return end
+
+    def move(self, w, axis, machine):
+        mode = self.motion
+        for i, a in enumerate("xyz"):
+            if a in axis and not self.incremental:
+                self.known[i] = True
+        if mode in _CYCLES:
+            return self.cycle(w)
+        if mode in (1.0, 2.0, 3.0) and self.feed <= 0:
+            raise self.err(f"G{mode:g}", "feed move with feed rate 0 (no F yet)",
+                           "set F before cutting")
+        end = self._target(w, axis, machine)
+        if mode in (0.0, 1.0):
+            if any(k in w for k in "ijk") or ("r" in w):
+                k = next(k for k in "ijkr" if k in w)
+                raise self.err(f"{k.upper()}{w[k]:g}", "arc word on a straight move",
+                               "use G2/G3 for arcs")
+            self.emit(TRAVERSE if mode == 0.0 else FEED, end)
+            return
+        self.arc(w, end, cw=(mode == 2.0))
+
+    def arc(self, w, end, cw):
+        a1, a2, an = _PLANES[self.plane]
+        names = _CENTRE[self.plane]
+        code = f"G{2 if cw else 3}"
+        for k in set("ijk") - set(names):
+            if k in w:
+                raise self.err(f"{k.upper()}{w[k]:g}", f"centre word {k.upper()} is not in "
+                               f"plane G{self.plane}", f"use {names.upper()} or change plane")
+        turns = 1
+        if "p" in w:
+            if w["p"] != math.floor(w["p"]) or w["p"] < 1:
+                raise self.err(f"P{w['p']:g}", "arc turns P must be an integer >= 1", "fix P")
+            turns = int(w["p"])
+        s1, s2 = self.pos[a1], self.pos[a2]
+        e1, e2 = end[a1], end[a2]
+        tol = _ARC_ABS_TOL["in" if self.inch else "mm"] * self.scale  # mm
+        if "r" in w:
+            if any(k in w for k in "ijk"):
+                raise self.err(f"R{w['r']:g}", "both R and I/J/K on one arc", "give one form")
+            r = w["r"] * self.scale
+            d1, d2 = e1 - s1, e2 - s2
+            dist = math.hypot(d1, d2)
+            if dist == 0:
+                raise self.err(f"R{w['r']:g}", "R-form arc with end = start (a full circle has "
+                               "no unique centre)", "use the I/J/K form for full circles")
+            half = dist / 2
+            if abs(r) < half - tol:
+                raise self.err(f"R{w['r']:g}", f"arc radius {abs(r):g} mm too small to reach "
+                               f"the end point (half chord {half:g} mm)", "fix R or the end")
+            h = math.sqrt(max(r * r - half * half, 0.0)) / dist
+            # centre on the right of start->end for G2 with R > 0 (LinuxCNC/grbl convention)
+            if cw == (r > 0):
+                h = -h
+            c1, c2 = s1 + d1 / 2 - h * d2, s2 + d2 / 2 + h * d1
+        else:
+            if not any(k in w for k in names):
+                raise self.err(code, f"arc needs R or {names.upper()}", "give the arc centre")
+            o1 = w.get(names[0], 0.0) * self.scale
+            o2 = w.get(names[1], 0.0) * self.scale
+            if self.arc_incremental:
+                c1, c2 = s1 + o1, s2 + o2
+            else:  # G90.1: centre in program coordinates
+                prog_c = [0.0, 0.0, 0.0]
+                prog_c[a1] = w.get(names[0], 0.0)
+                prog_c[a2] = w.get(names[1], 0.0)
+                mc = self.to_machine(prog_c)
+                c1 = mc[a1] if names[0] in w else s1
+                c2 = mc[a2] if names[1] in w else s2
+            r0 = math.hypot(s1 - c1, s2 - c2)
+            r1 = math.hypot(e1 - c1, e2 - c2)
+            err = abs(r1 - r0)
+            if r0 == 0 or r1 == 0 or err > 100 * tol or (err > tol
+                                                          and err / max(r0, r1) > _ARC_REL_TOL):
+                raise self.err(code, f"radius to end of arc {r1:.4f} mm differs from radius "
+                               f"to start {r0:.4f} mm (LinuxCNC's tolerance {tol:.4g} mm "
+                               "and 0.1 %)", "fix the centre (I/J/K) or the end point")
+        if not all(math.isfinite(v) for v in (c1, c2)):
+            raise self.err(code, "arc centre out of range", "fix the arc")
+        self.emit(ARC, end, (c1, c2), -turns if cw else turns)
+
+    def cycle(self, w):
+        """Canned drilling cycles as LinuxCNC's convert_cycle expands them (G17, XY plane)."""
+        code = f"G{self.motion:g}"
+        if self.plane != 17:
+            raise self.err(code, "drilling cycles are simulated in plane G17 only",
+                           "switch to G17")
+        if self.feed <= 0:
+            raise self.err(code, "drilling with feed rate 0 (no F yet)", "set F")
+        c = self.cyc
+        if "r" in w:
+            c["r"] = w["r"]
+        if "z" in w:
+            c["z"] = w["z"]
+        if "q" in w:
+            if w["q"] <= 0:
+                raise self.err(f"Q{w['q']:g}", "peck depth Q must be > 0", "give Q > 0")
+            c["q"] = w["q"]
+        if "p" in w:
+            c["p"] = w["p"]
+        reps = 1
+        if "l" in w:
+            reps = int(w["l"])
+            if not 1 <= reps <= MAX_CYCLE_REPEATS:
+                raise self.err(f"L{reps}", f"cycle repeats L must be 1-{MAX_CYCLE_REPEATS}",
+                               "fix L")
+        if math.isnan(c["r"]) or math.isnan(c["z"]):
+            raise self.err(code, "drilling cycle without R and Z", "give R (retract) and Z "
+                           "(depth)")
+        if self.motion in (73.0, 83.0) and math.isnan(c["q"]):
+            raise self.err(code, f"{code} needs a peck depth Q", "give Q > 0")
+        prog = self.to_program(self.pos)
+        cur_z = prog[2]
+        if self.cycle_il is None:  # LinuxCNC's "initial level": Z where the cycles began
+            self.cycle_il = cur_z
+        if self.incremental:
+            r = cur_z + c["r"]
+            bottom = r + c["z"]
+        else:
+            r, bottom = c["r"], c["z"]
+        if bottom > r:
+            raise self.err(code, f"cycle bottom Z {bottom:g} is above the retract plane R "
+                           f"{r:g}", "fix Z or R")
+        delta = c["q"]
+        if self.motion in (73.0, 83.0) and (r - bottom) / delta > 100_000:
+            raise self.err(f"Q{delta:g}", f"{(r - bottom) / delta:.3g} pecks in one hole (more "
+                           "than 100,000)", "give a larger Q")
+        rapid_delta = _RAPID_DELTA_IN * (1.0 if self.inch else MM_PER_INCH)
+        x, y = prog[0], prog[1]
+        old_z = self.cycle_il if self.retract_old_z else cur_z
+        if cur_z < r:  # preliminary move up to the R plane
+            self._cyc(TRAVERSE, x, y, r)
+        old_z = max(old_z, r)
+        clear = old_z if self.retract_old_z else r
+        for _ in range(reps):
+            if self.incremental:
+                x += w.get("x", 0.0)
+                y += w.get("y", 0.0)
+            else:
+                x, y = w.get("x", x), w.get("y", y)
+            self._cyc(TRAVERSE, x, y, old_z)
+            self._cyc(TRAVERSE, x, y, r)
+            if self.motion == 83.0:
+                depth = r - delta
+                while depth > bottom:
+                    self._cyc(FEED, x, y, depth)
+                    self._cyc(TRAVERSE, x, y, r)
+                    self._cyc(TRAVERSE, x, y, depth + rapid_delta)
+                    depth -= delta
+            elif self.motion == 73.0:
+                depth = r - delta
+                while depth > bottom:
+                    self._cyc(FEED, x, y, depth)
+                    self._cyc(TRAVERSE, x, y, depth + rapid_delta)
+                    depth -= delta
+            self._cyc(FEED, x, y, bottom)
+            if self.motion == 85.0:  # LinuxCNC: G85 feeds out to R, G89 to the clearance
+                self._cyc(FEED, x, y, r)
+            elif self.motion == 89.0:
+                self._cyc(FEED, x, y, clear)
+            self._cyc(TRAVERSE, x, y, clear)
+
+    def _cyc(self, kind, x, y, z):
+        self.emit(kind, self.to_machine([x, y, z]))

@@ -1,0 +1,118 @@
+"""LinuxCNC's own interpreter as an oracle and as ``--interpreter linuxcnc``.
+
+Debian's ``linuxcnc-uspace`` package ships LinuxCNC's RS274/NGC interpreter as the Python module
+``gcode`` built for Debian's ``/usr/bin/python3`` (not woodcam's virtualenv), so it runs in a
+subprocess (:mod:`._linuxcnc_driver`) and its canonical moves come back as JSON. Canonical moves
+are compared with woodcam's by :func:`compare_canonical` (end points and arc centres within
+``tol_mm``, same kinds, rotations, planes and source lines).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import os
+import subprocess
+import tempfile
+from pathlib import Path
+
+from ..errors import WoodcamError
+from .interpreter import GcodeError
+
+#: Debian's interpreter, for which the ``gcode`` module is built.
+LINUXCNC_PYTHON = "/usr/bin/python3"
+_DRIVER = Path(__file__).with_name("_linuxcnc_driver.py")
+#: LinuxCNC's message for a file without M2/M30/%: woodcam reads that as a warning.
+NO_END = "File ended with no percent sign or program end"
+
+
+@functools.lru_cache(maxsize=1)
+def linuxcnc_missing() -> str | None:
+    """``None`` when LinuxCNC's interpreter can run here, else the reason it cannot."""
+    if not os.path.exists(LINUXCNC_PYTHON):
+        return f"{LINUXCNC_PYTHON} not found (install Debian's linuxcnc-uspace)"
+    r = subprocess.run([LINUXCNC_PYTHON, "-I", "-c", "import gcode"], capture_output=True,
+                       text=True, timeout=60)
+    if r.returncode:
+        return ("LinuxCNC's python module 'gcode' is not importable by /usr/bin/python3 "
+                "(apt-get install linuxcnc-uspace): " + r.stderr.strip().splitlines()[-1:][0]
+                if r.stderr.strip() else "import gcode failed")
+    return None
+
+
+def run_batch(paths, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 10.0) -> list[dict]:
+    """Run LinuxCNC's interpreter on each file of ``paths`` in one subprocess.
+
+    Returns one dict per file: ``moves`` (canonical ``[kind, line, end, centre, rotation,
+    plane]``, machine frame mm), ``error`` (``None`` or ``[line, message]``), ``seconds``.
+    """
+    why = linuxcnc_missing()
+    if why:
+        raise WoodcamError(f"--interpreter linuxcnc: {why}; or use --interpreter woodcam")
+    job = {"files": [str(Path(p).resolve()) for p in paths], "start_mm": list(start_mm),
+           "timeout_s": float(timeout_s)}
+    r = subprocess.run([LINUXCNC_PYTHON, "-I", str(_DRIVER)], input=json.dumps(job),
+                       capture_output=True, text=True,
+                       timeout=timeout_s * max(1, len(job["files"])) + 60)
+    if r.returncode:
+        if len(job["files"]) > 1:  # one program crashed the interpreter: run them one by one
+            return [run_batch([p], start_mm=start_mm, timeout_s=timeout_s)[0] for p in paths]
+        return [{"moves": [], "error": [0, f"LinuxCNC's interpreter crashed (exit "
+                                           f"{r.returncode})"], "seconds": 0.0}]
+    return json.loads(r.stdout)
+
+
+def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.0):
+    """LinuxCNC's canonical moves of program ``text`` in woodcam's canonical form
+    (:mod:`.interpreter`): ``(moves, warnings)``; a refusal raises :class:`GcodeError` with
+    LinuxCNC's message and line."""
+    with tempfile.TemporaryDirectory(prefix="woodcam-lcnc-") as d:
+        p = Path(d) / "program.ngc"
+        p.write_text(text)
+        res = run_batch([p], start_mm=start_mm, timeout_s=timeout_s)[0]
+    warnings = []
+    if res["error"]:
+        line, msg = res["error"]
+        if msg != NO_END:
+            raise GcodeError(int(line), "LinuxCNC", msg, "fix the line (LinuxCNC's own "
+                             "interpreter refused it)")
+        warnings.append((int(line), msg))
+    moves = [(k, ln, tuple(e), tuple(c) if c else None, rot, plane, 0.0, 0.0, 0)
+             for k, ln, e, c, rot, plane in res["moves"]]
+    return moves, warnings
+
+
+def canonical(moves, start_mm) -> list[tuple]:
+    """Comparable canonical moves: ``(kind, line, end (3,), centre | None, rotation, plane)``
+    with zero-length straight moves dropped (LinuxCNC emits some, woodcam none)."""
+    out = []
+    pos = tuple(float(v) for v in start_mm)
+    for m in moves:
+        kind, line, end, centre, rot, plane = m[:6]
+        end = tuple(float(v) for v in end)
+        if kind != 2 and max(abs(a - b) for a, b in zip(end, pos)) < 1e-9:
+            continue
+        out.append((int(kind), int(line), end, tuple(centre) if centre else None,
+                    int(rot) if kind == 2 else 0, int(plane) if kind == 2 else 17))
+        pos = end
+    return out
+
+
+def compare_canonical(a, b, tol_mm: float = 1e-6) -> str | None:
+    """``None`` when the canonical move lists agree within ``tol_mm``, else the first
+    difference in words."""
+    if len(a) != len(b):
+        for i, (x, y) in enumerate(zip(a, b)):
+            d = compare_canonical([x], [y], tol_mm)
+            if d:
+                return f"move {i}: {d}"
+        return f"{len(a)} moves against {len(b)}; first extra: {(a if len(a) > len(b) else b)[min(len(a), len(b))]}"
+    for i, (x, y) in enumerate(zip(a, b)):
+        if x[0] != y[0] or x[1] != y[1] or x[4] != y[4] or x[5] != y[5]:
+            return f"move {i}: {x} against {y}"
+        if max(abs(p - q) for p, q in zip(x[2], y[2])) > tol_mm:
+            return f"move {i} (line {x[1]}): end {x[2]} against {y[2]}"
+        if (x[3] is None) != (y[3] is None) or (x[3] is not None and max(
+                abs(p - q) for p, q in zip(x[3], y[3])) > tol_mm):
+            return f"move {i} (line {x[1]}): centre {x[3]} against {y[3]}"
+    return None
