@@ -40,10 +40,12 @@ def add_parser(subparsers) -> None:
     p = subparsers.add_parser("fit", help="infer a block's growth field from its traced faces")
     p.add_argument("block_dir", type=Path, help="block folder (manifest, face images, traces) or a "
                    "Mokume sample folder")
-    p.add_argument("--method", choices=METHODS, default="radial",
+    p.add_argument("--method", choices=METHODS, default="evidence",
                    help="rbf: seed 000's RBF baseline (unlabelled rings numbered by the radial fit); "
-                   "neural: seed 000's eq. 5 with the generic neural field (needs torch); radial "
-                   "(default): our pith axis, ring-width shape and growth history by least squares")
+                   "neural: seed 000's eq. 5 with the generic neural field (needs torch); radial: "
+                   "our pith axis, ring-width shape and growth history by least squares; evidence "
+                   "(default): radial pith hypotheses, RBF and radial + residual, chosen by how well "
+                   "each predicts the faces it was not fitted to (warns when they contradict it)")
     p.add_argument("--faces", default=None, help="comma-separated faces to use (default: all)")
     p.add_argument("--size-mm", type=float, default=None,
                    help="cube side in mm for a Mokume sample folder (its files carry no size)")
@@ -87,6 +89,8 @@ def run_fit(args) -> int:
     path = field.save(args.out)
     print(f"wrote {path} ({args.method} fit of {block.name}, grid {field.years.shape}, "
           f"{field.spacing_mm[0]:g} mm)")
+    if field.meta.get("message"):
+        print(field.meta["message"])
     return 0
 
 

@@ -110,7 +110,7 @@ def _synthetic_stock(spec, field, size_mm, species, description, appearance, par
     return Stock(spec, tuple(size_mm), Wood(field, app), description, meta)
 
 
-def fitted_field(block, folder: Path | None, method: str = "radial"):
+def fitted_field(block, folder: Path | None, method: str = "evidence"):
     """The growth field fitted to a block's rings, fitted once and cached.
 
     folder : the block folder: the cache ``<folder>/.woodcam-cache/field_<method>_v<N>.npz`` is

@@ -463,7 +463,7 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
                 mislabel_fraction: float = 0.0, unlabelled_fraction: float = 0.0,
                 photo_noise: float = 0.012, photo_variation: float = 0.03, photo_blur_px: float = 0.6,
                 ring_map_sigma_px: float | None = None, ring_map_noise: float = 0.02,
-                seed: int = 0, rng: np.random.Generator | None = None,
+                knot_masks: bool = True, seed: int = 0, rng: np.random.Generator | None = None,
                 name: str = "synthetic", meta: dict | None = None) -> Block:
     """Render a synthetic :class:`Block` from a growth field placed in the block frame.
 
@@ -499,6 +499,8 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
         Ring-map line width ``sigma`` (px) of ``exp(-(d / sigma)^2)`` and additive noise std.
         Default sigma: :data:`MOKUME_RING_SIGMA_MM` times ``px_per_mm``, the width of the
         Mokume U-Net maps.
+    knot_masks : for a field with ``knot_features`` (knotted logs), mark each face's knot wood
+        (weight > 0.5) in ``extras["knot_mask"]``, as the knot masks of Mokume's H11.
     seed, rng
         ``rng`` if given, else ``np.random.default_rng(seed)``; the same seed gives the same block.
 
@@ -568,7 +570,11 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
                 traces = [RingTrace(t.points_px, None if u[i, 1] < unlabelled_fraction
                                     else t.year + int(sign[i]) if u[i, 0] < mislabel_fraction else t.year)
                           for i, t in enumerate(traces)]
-        out[face] = Face(face, shape, photo=photo, traces=traces, ring_map=ring_map)
+        extras = {}
+        if knot_masks and hasattr(field, "knot_features"):
+            # as a tracer (or the knot detector) marks the knots on a photo: knot wood
+            extras["knot_mask"] = (np.asarray(field.knot_features(pts)["knot"]) > 0.5).reshape(shape)
+        out[face] = Face(face, shape, photo=photo, traces=traces, ring_map=ring_map, extras=extras)
 
     settings = {
         "generator": "woodcam.synth.synth_block", "seed": seed,
@@ -579,6 +585,7 @@ def synth_block(field, size_mm, *, wood=None, px_per_mm: float | None = None, fa
         "mislabel_fraction": mislabel_fraction, "unlabelled_fraction": unlabelled_fraction,
         "photo_noise": photo_noise, "photo_variation": photo_variation, "photo_blur_px": photo_blur_px,
         "ring_map_sigma_px": ring_map_sigma_px, "ring_map_noise": ring_map_noise,
+        "knot_masks": bool(knot_masks),
     }
     return Block(tuple(size), faces=out, true_field=field, name=name, meta={**settings, **(meta or {})})
 
@@ -632,9 +639,9 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
     Parameters
     ----------
     log_fields : callable ``rng -> log-frame field``, optional
-        Factory of knotted log fields (pith on log ``z``). When given, a block is knotted with
-        probability ``knotted_fraction``. TODO(knots/logs): pass the knotted log generator from
-        ``woodcam.logs`` here once it exists; until then every block is knot-free.
+        Factory of knotted log fields (pith on log ``z``, e.g. :func:`knotted_log_field`). When
+        given, a block is knotted with probability ``knotted_fraction``, and a knotted block is
+        cut with a knot crossing it (:func:`knot_crosses` on the true field, asserted).
     wood_factory : callable ``block-frame field -> wood``, optional
         Appearance for each block (e.g. ``lambda f: woodcam.appearance.Wood(f, ...)``); default
         the built-in colour map.
@@ -667,12 +674,9 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
         knotted = log_fields is not None and rng.uniform() < knotted_fraction
         if knotted:
             log = log_fields(rng)
-            # keep the block inside the knotted log (its outer radius), knots are near the bark
-            half_diag = 0.5 * math.hypot(size[0], size[1])
-            r_in = float(getattr(getattr(log, "log", None), "r_min_mm", 100.0)) - half_diag - 5.0
-            if placement["pattern"] != "pith-inside":
-                placement["distance_mm"] = max(half_diag + 2.0, min(placement["distance_mm"], r_in))
-        field = cut_block(log, size, **placement)
+            field, placement = _place_through_knot(rng, log, placement, size)
+        else:
+            field = cut_block(log, size, **placement)
         name = f"block_{i:04d}"
         info = {"name": name, "index": i, "size_mm": list(size), "knotted": bool(knotted),
                 "ring_width_mm": log.ring_width_at(placement["distance_mm"]) if not knotted else None,
@@ -686,6 +690,56 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
         index["blocks"].append(info)
     (out_dir / "index.json").write_text(json.dumps(index, indent=1))
     return folders
+
+
+def knot_crosses(field, size_mm, n: int = 12) -> bool:
+    """True when a knot of ``field`` (block frame, with ``knot_features``) crosses the block:
+    some point of an ``n^3`` grid over it has knot weight > 0.5 (inside the knot wood)."""
+    if not hasattr(field, "knot_features"):
+        return False
+    size = check_size(size_mm)
+    axes = [np.linspace(0.0, s, n) for s in size]
+    pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    return bool(np.any(np.asarray(field.knot_features(pts)["knot"]) > 0.5))
+
+
+def _place_through_knot(rng: np.random.Generator, log_field, placement: dict, size, tries: int = 60):
+    """Move ``placement`` (kwargs of :func:`cut_block`) so that a knot of ``log_field`` crosses
+    the block: its centre on a random knot's strand, at a random pith distance between the
+    block's half diagonal and the knot's end (pith-inside: at the knot's base on the pith).
+
+    Returns ``(block-frame field, placement)``; checked with :func:`knot_crosses` (asserted from
+    the true field), raising :class:`WoodcamError` when no knot of the log reaches a block.
+    """
+    log = log_field.log
+    W, D, _ = size
+    half_diag = 0.5 * math.hypot(W, D)
+    r_out = float(log.r_min_mm) - half_diag - 5.0  # the whole block inside the log
+    inside = placement["pattern"] == "pith-inside"
+    for _ in range(tries):
+        k = int(rng.integers(len(log.knots)))
+        kn = log.knots[k]
+        if inside:
+            r = float(placement["distance_mm"])
+            p = log.knot_point(k, [max(r, 2.0)])[0]
+        else:
+            lo, hi = half_diag + 2.0, min(float(kn.r_end_mm), r_out)
+            if hi <= lo:
+                continue
+            p = log.knot_point(k, [rng.uniform(lo, hi)])[0]
+            r = float(math.hypot(p[0], p[1]))  # cut_block measures from the log's z axis
+            if r <= half_diag + 1.0:
+                continue
+        moved = dict(placement, distance_mm=r, height_mm=float(p[2]),
+                     azimuth_deg=math.degrees(math.atan2(p[1], p[0])))
+        try:
+            field = cut_block(log_field, size, **moved)
+        except WoodcamError:  # the curved pith put the block on the wrong side of it
+            continue
+        if knot_crosses(field, size):
+            return field, moved
+    raise WoodcamError(f"no knot of this log crosses a {W:g} x {D:g} mm block after {tries} tries; "
+                       f"use a smaller block or a log with longer knots")
 
 
 def knotted_log_field(rng: np.random.Generator, ring_width_range_mm=(1.5, 6.0), *,

@@ -163,3 +163,36 @@ NEURAL_VOLUME_MAE = 0.05
 RING_HISTORY_PRIOR_POINTS = 20.0
 RING_HISTORY_ROUNDS = 3
 RING_HISTORY_MIN_STEP = 1e-3
+
+#: Evidence-based choice of a fit (``woodcam.inference.evidence``, issue 12 part 1).
+#: A face takes part in leave-one-face-out only with at least this many ring points: fewer
+#: (a face crossed by one short ring) scores by chance.
+EVIDENCE_MIN_FACE_POINTS = 20
+
+#: Held-out points scored per face (a fixed random subset): 400 points give a share to about
+#: +-2.5 % (binomial std at 50 %), finer than the differences between hypotheses that matter.
+EVIDENCE_MAX_HELD_POINTS = 400
+
+#: Ring points of the RBF hypotheses (full and held-in fits): the dense solve is O(n^3), and
+#: 1000 points (one every ~2-4 mm of ring on a traced 50 mm cube) keep each refit near 0.1 s.
+EVIDENCE_RBF_POINTS = 1000
+
+#: Smoothing of the residual RBF per point (scipy's ``smoothing`` is summed over points): the
+#: residual is meant to carry distortions a few mm wide, not each trace's jitter.
+EVIDENCE_RESIDUAL_SMOOTHING = 1e-3
+
+#: A chosen fit is flagged "contradicted" when some held-out face has fewer of its ring points
+#: within 2 mm of the predicted ring line than this (percent): the issue's bar for a block.
+EVIDENCE_MIN_FACE_SHARE_2MM = 80.0
+
+#: Hypotheses whose mean held-out score is within this many percent points of the best are
+#: "accepted": their spread is the fit's per-point uncertainty.
+EVIDENCE_ACCEPT_MARGIN = 5.0
+
+#: Uncertainty added per mm from the nearest observed face (years/mm): a prior, not a
+#: measurement; 0.02 makes the middle of a 50 mm block seen from one face half a ring unsure.
+EVIDENCE_UNSEEN_YEARS_PER_MM = 0.02
+
+#: Grid spacing (mm) on which the hypotheses' spread is sampled before interpolation to the
+#: bake grid: the spread is smooth over several mm, and the RBF hypotheses are slow to evaluate.
+EVIDENCE_SPREAD_SPACING_MM = 4.0

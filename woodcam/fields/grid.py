@@ -37,6 +37,11 @@ class GridField:
     spacing_mm : float or (3,) float
         Node spacing along X, Y, Z.
     interpolation : "cubic" or "linear"
+    uncertainty : (nx, ny, nz) float, optional
+        How unsure a fit is of the growth time at the nodes, years (e.g. the spread of the
+        hypotheses a fit could not tell apart); read with :meth:`uncertainty_years`.
+    meta : dict
+        Plain-JSON facts about how the field was made (fit method, evidence, warnings).
     """
 
     years: np.ndarray
@@ -44,6 +49,8 @@ class GridField:
     spacing_mm: tuple[float, float, float]
     interpolation: Interpolation = "cubic"
     axis: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    uncertainty: np.ndarray | None = dc_field(default=None, repr=False, compare=False)
+    meta: dict = dc_field(default_factory=dict, repr=False, compare=False)
     _coeffs: np.ndarray = dc_field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -58,6 +65,12 @@ class GridField:
         object.__setattr__(self, "years", g)
         object.__setattr__(self, "spacing_mm", tuple(sp))
         object.__setattr__(self, "origin_mm", tuple(np.asarray(self.origin_mm, float)))
+        if self.uncertainty is not None:
+            u = np.asarray(self.uncertainty, dtype=float)
+            if u.shape != g.shape or not np.all(np.isfinite(u)):
+                raise WoodcamError(f"uncertainty must be a finite grid shaped like years {g.shape}; "
+                                   f"got shape {u.shape}")
+            object.__setattr__(self, "uncertainty", u)
         order = _ORDER[self.interpolation]
         coeffs = ndimage.spline_filter(g, order=order, mode="nearest") if order > 1 else g
         object.__setattr__(self, "_coeffs", coeffs)
@@ -90,22 +103,47 @@ class GridField:
         return ndimage.map_coordinates(self._coeffs, idx.T, order=_ORDER[self.interpolation],
                                        mode="nearest", prefilter=False)
 
+    def uncertainty_years(self, points_mm) -> np.ndarray:
+        """``(n,)`` years of uncertainty at ``points_mm (n, 3)`` (linear interpolation of
+        :attr:`uncertainty`; zeros when the field carries none)."""
+        p = check_points(points_mm)
+        if self.uncertainty is None:
+            return np.zeros(len(p))
+        idx = (p - np.asarray(self.origin_mm)) / np.asarray(self.spacing_mm)
+        return ndimage.map_coordinates(self.uncertainty, idx.T, order=1, mode="nearest")
+
     def save(self, path) -> Path:
         """Write the grid to an ``.npz`` file; :meth:`load` restores it exactly."""
         path = Path(path)
         if path.suffix != ".npz":
             path = path.with_suffix(path.suffix + ".npz")
-        np.savez_compressed(path, years=self.years, origin_mm=self.origin_mm,
-                            spacing_mm=self.spacing_mm, interpolation=self.interpolation,
-                            axis=self.axis)
+        import json
+        import os
+        import tempfile
+
+        extra = {} if self.uncertainty is None else {"uncertainty": self.uncertainty}
+        fd, tmp = tempfile.mkstemp(suffix=".npz", dir=path.parent)
+        os.close(fd)
+        try:  # atomic: a reader never sees half a file
+            np.savez_compressed(tmp, years=self.years, origin_mm=self.origin_mm,
+                                spacing_mm=self.spacing_mm, interpolation=self.interpolation,
+                                axis=self.axis, meta=json.dumps(self.meta), **extra)
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.remove(tmp)
         return path
 
     @classmethod
     def load(cls, path) -> "GridField":
         try:
+            import json
+
             with np.load(Path(path)) as z:
+                meta = json.loads(str(z["meta"])) if "meta" in z.files else {}
+                unc = z["uncertainty"] if "uncertainty" in z.files else None
                 return cls(z["years"], tuple(z["origin_mm"]), tuple(z["spacing_mm"]),
-                           str(z["interpolation"]), tuple(z["axis"]))
+                           str(z["interpolation"]), tuple(z["axis"]), unc, meta)
         except (OSError, KeyError, ValueError) as err:
             raise WoodcamError(f"{path}: not a woodcam grid field (.npz with 'years', "
                                f"'origin_mm', 'spacing_mm'): {err}") from err

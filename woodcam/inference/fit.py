@@ -4,27 +4,34 @@ from __future__ import annotations
 
 from typing import Literal, get_args
 
+import numpy as np
+
 from ..errors import WoodcamError
 from .baked import bake
 from .observations import gather_observations
 from .radial import fit_radial, number_observations
 from .rbf import fit_rbf
 
-Method = Literal["rbf", "radial", "neural"]
+Method = Literal["evidence", "rbf", "radial", "neural"]
 METHODS: tuple[str, ...] = get_args(Method)
 
 #: Bumped whenever a fitter changes what it returns for the same block, so fields cached by
-#: :func:`woodcam.stock.fitted_field` are refitted (2: growth history, knot masks, year-free neural).
-FIT_VERSION = 2
+#: :func:`woodcam.stock.fitted_field` are refitted (2: growth history, knot masks, year-free neural;
+#: 3: the evidence-chosen default, uncertainty and fit facts saved with the grid).
+FIT_VERSION = 3
 
 
-def fit_block(block, method: Method = "radial", faces=None, baked: bool = True):
+def fit_block(block, method: Method = "evidence", faces=None, baked: bool = True):
     """Infer a block's growth field from the rings on its faces.
 
     Parameters
     ----------
     block : woodcam.block.Block
-    method : "rbf" (seed 000's baseline: thin-plate RBF of labelled ring points; unlabelled rings
+    method : "evidence" (the default: several hypotheses, radial pith basins, RBF and a radial
+        stem with a residual, chosen by how well each predicts the faces it was not fitted to;
+        a choice the held-out faces contradict raises a WoodcamWarning and is flagged in
+        ``field.meta``; the baked grid carries the per-point ``uncertainty``, see
+        :mod:`woodcam.inference.evidence`) or "rbf" (seed 000's baseline: thin-plate RBF of labelled ring points; unlabelled rings
         are numbered by the radial fit first) or "radial"
         (ours: pith axis + smooth inverse ring width by least squares; also numbers unlabelled
         traces and ring maps) or "neural" (seed 000's eq. 5: the packaged generic neural GTF,
@@ -46,6 +53,12 @@ def fit_block(block, method: Method = "radial", faces=None, baked: bool = True):
 
         return fit_neural(block, faces=faces)  # always baked to a grid (the net is slow)
     obs = gather_observations(block, faces)
+    if method == "evidence":
+        from .evidence import bake_evidence, fit_evidence
+
+        ev = fit_evidence(obs, block.size_mm)
+        used = sorted({int(i) for i in np.unique(obs.face)})
+        return bake_evidence(ev, block.size_mm, used) if baked else ev
     if method == "rbf":
         if not obs.labelled:  # the seed's RBF needs years: number the rings as the radial fit does
             obs = number_observations(obs, fit_radial(obs, block.size_mm))
