@@ -67,7 +67,8 @@ def test_errors_are_one_clean_line(argv, message, tmp_path):
 
 def test_knot_flags_reach_the_colour_map(tmp_path):
     """--knot-darkening 0,0 leaves knot wood as light as the stem's; 0.9,0.9 makes it dark."""
-    from woodcam.cli import _appearance_params, build_parser
+    from woodcam.cli import build_parser
+    from woodcam.cli.options import appearance_params as _appearance_params
     from woodcam.stock import open_stock
 
     base = ["bake", "x.py", "--block", "builtin:knotty", "--out", "x.glb"]

@@ -1,22 +1,19 @@
-"""``woodcam train gtf`` (module woodcam._cli_train; the lead registers it in woodcam.cli)."""
+"""``woodcam train gtf`` (woodcam.cli.train) through the CLI's parser."""
 
 from __future__ import annotations
 
-import argparse
 import csv
 
 import pytest
 
 pytest.importorskip("torch")
 
-from woodcam import _cli_train  # noqa: E402
+from woodcam.cli import build_parser  # noqa: E402
 from woodcam.fields.neural import GTFSpec  # noqa: E402
 
 
 def _parse(argv):
-    parser = argparse.ArgumentParser(prog="woodcam")
-    _cli_train.add_parser(parser.add_subparsers(dest="command"))
-    return parser.parse_args(argv)
+    return build_parser().parse_args(argv)
 
 
 def test_train_gtf_cli_writes_spec_weights_log_and_resumes(tmp_path, capsys):
@@ -36,6 +33,8 @@ def test_train_gtf_cli_writes_spec_weights_log_and_resumes(tmp_path, capsys):
         assert [int(r["step"]) for r in csv.DictReader(fh)] == [10, 20, 30]
 
 
-def test_train_rejects_unknown_model(tmp_path):
-    with pytest.raises(SystemExit):
+def test_train_rejects_unknown_model(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
         _parse(["train", "sdf", "--out", str(tmp_path)])
+    assert exc.value.code == 2  # argparse's usage error, naming the bad choice and the good one
+    assert "invalid choice: 'sdf'" in capsys.readouterr().err

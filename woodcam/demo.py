@@ -50,12 +50,16 @@ class DemoReport:
 
 
 def run_demo(out_dir, *, quick: bool = False, texels_per_mm: float | None = None,
-             progress: bool = True, appearance: str = "colormap") -> DemoReport:
+             progress: bool = True, appearance: str = "colormap", species: str | None = None,
+             obj: bool = True, **appearance_params) -> DemoReport:
     """Carve, bake, export and render every part of :data:`DEMO_PARTS` into ``out_dir``.
 
     ``quick`` lowers the texel density (4 texels/mm instead of 10) for CI. ``appearance`` is
     ``"colormap"`` (fast, default) or ``"neural"`` (colour volumes learnt from each built-in
-    block's rendered photos, cached; ``quick`` uses the "draft" quality).
+    block's rendered photos, cached; ``quick`` uses the "draft" quality). ``species``
+    overrides every block's colour preset; ``obj`` writes OBJ+MTL+PNG beside each GLB;
+    ``appearance_params`` go to :func:`~woodcam.stock.open_stock` (knot colours, or the neural
+    ``quality``/``epochs``).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -63,13 +67,13 @@ def run_demo(out_dir, *, quick: bool = False, texels_per_mm: float | None = None
     report = DemoReport()
     t0 = time.perf_counter()
     for script, spec in DEMO_PARTS:
+        params = dict(appearance_params)
         if appearance == "neural":
-            stock = open_stock(spec, appearance="neural", quality="draft" if quick else "normal",
-                               progress=progress)
-        else:
-            stock = open_stock(spec, appearance=appearance)
+            params.setdefault("quality", "draft" if quick else "normal")
+            params["progress"] = progress
+        stock = open_stock(spec, appearance=appearance, species=species, **params)
         res = preview_part(examples_dir() / script, stock, out / f"{Path(script).stem}.glb",
-                           texels_per_mm=tpm, progress=progress)
+                           texels_per_mm=tpm, obj=obj, progress=progress)
         res.meta_block = spec
         report.parts.append(res)
     report.overview = render_overview(report.parts, out / "demo.png")

@@ -222,3 +222,55 @@ def unfold_cross(images: dict, size_mm, background=0) -> np.ndarray:
         r0, c0 = layout.origin[face]
         out[r0:r0 + want[0], c0:c0 + want[1]] = im
     return out
+
+
+# ------------------------------------------------------------------ frames of exported files
+
+#: Block frame (mm, Z up) -> glTF scene (m, Y up): ``p_gltf = BLOCK_TO_GLTF @ [p_mm, 1]``.
+#: Block +X (width, right) stays +X, block +Z (up) becomes +Y, block +Y (away from the viewer)
+#: becomes -Z (glTF cameras look down -Z, so -Z is "away"). Right-handed (determinant > 0).
+BLOCK_TO_GLTF = np.array([[1e-3, 0.0, 0.0, 0.0],
+                          [0.0, 0.0, 1e-3, 0.0],
+                          [0.0, -1e-3, 0.0, 0.0],
+                          [0.0, 0.0, 0.0, 1.0]])
+
+#: Name of the GLB root node that carries :data:`BLOCK_TO_GLTF` above the block-frame mesh.
+GLTF_ROOT_NODE = "woodcam_block_frame"
+
+#: First-line marker of an OBJ written by woodcam: ``# woodcam: units=m up=y ...``.
+OBJ_HEADER = "# woodcam:"
+
+ObjUnits = Literal["mm", "m"]
+ObjUp = Literal["z", "y"]
+
+
+def obj_transform(units: str, up: str) -> np.ndarray:
+    """4x4 block frame (mm, Z up) -> OBJ file coordinates written with ``units`` and ``up``."""
+    if units not in get_args(ObjUnits) or up not in get_args(ObjUp):
+        raise WoodcamError(
+            f"obj_transform: units must be one of {get_args(ObjUnits)} and up one of "
+            f"{get_args(ObjUp)}; got units={units!r}, up={up!r}"
+        )
+    scale = 1e-3 if units == "m" else 1.0
+    rot = BLOCK_TO_GLTF[:3, :3] * 1e3 if up == "y" else np.eye(3)
+    out = np.eye(4)
+    out[:3, :3] = rot * scale
+    return out
+
+
+def obj_header_transform(path) -> np.ndarray | None:
+    """The :func:`obj_transform` recorded in a woodcam OBJ's first line, or None for an OBJ
+    written by anything else."""
+    with open(path, "r", errors="replace") as fh:
+        first = fh.readline()
+    if not first.startswith(OBJ_HEADER):
+        return None
+    fields = dict(item.split("=", 1) for item in first[len(OBJ_HEADER):].split() if "=" in item)
+    units, up = fields.get("units"), fields.get("up")
+    if units not in get_args(ObjUnits) or up not in get_args(ObjUp):
+        raise WoodcamError(
+            f"{str(path)!r} has a malformed woodcam header {first.strip()!r}; expected e.g. "
+            "'# woodcam: units=m up=y'; re-export it with woodcam.export.export_obj"
+        )
+    return obj_transform(units, up)
+

@@ -46,15 +46,36 @@ class PartPreview:
         self.timings_s[name] = self.timings_s.get(name, 0.0) + time.perf_counter() - t0
 
 
+def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = False,
+                  what: str = "--out") -> Path:
+    """Check every file a preview will write *before* any work: ``out_glb`` ends in ``.glb``,
+    is not a folder, its folder exists (created if missing) and is writable; likewise the
+    ``.obj``/``.mtl``/``.png`` beside it when ``obj``, and the rendered ``*_view.png`` (or the
+    given screenshot path). Returns ``out_glb`` as a Path; raises WoodcamError naming the path."""
+    from ._atomic import check_output_path
+
+    out_glb = check_output_path(out_glb, suffixes=(".glb",), what=what, mkdir=True)
+    if obj:
+        for suffix in (".obj", ".mtl", ".png"):
+            check_output_path(out_glb.with_suffix(suffix), what=f"{what} (the {suffix[1:].upper()} "
+                              "beside the GLB; --no-obj skips it)")
+    if screenshot is True:
+        check_output_path(out_glb.with_name(out_glb.stem + "_view.png"), what=f"{what} (its view PNG)")
+    elif screenshot:
+        check_output_path(screenshot, suffixes=(".png",), what="--screenshot", mkdir=True)
+    return out_glb
+
+
 def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                  tolerance_mm: float | None = None, obj: bool = True,
-                 screenshot: bool = True, progress: bool = False) -> PartPreview:
+                 screenshot: bool = True, progress: bool = False, obj_units: str = "m",
+                 obj_up: str = "y") -> PartPreview:
     """Carve ``source`` (anything :func:`woodcam.cad.load_part` takes) out of ``stock``, bake it
     and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``)."""
     from .cad import carve, load_part
     from .tolerances import TESSELLATION_TOL_MM
 
-    out_glb = Path(out_glb)
+    out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)  # before minutes of work
     result = PartPreview(out_glb.stem)
     with result.stage("load"):
         part = load_part(source, tolerance_mm=tolerance_mm or TESSELLATION_TOL_MM)
@@ -62,18 +83,20 @@ def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
         carved = carve(part, stock.size_mm)
     result.warnings += list(carved.warnings)
     return preview_mesh(carved.mesh, stock, out_glb, texels_per_mm=texels_per_mm, obj=obj,
-                        screenshot=screenshot, progress=progress, result=result)
+                        screenshot=screenshot, progress=progress, result=result,
+                        obj_units=obj_units, obj_up=obj_up)
 
 
 def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, obj: bool = True,
                  screenshot: bool = True, progress: bool = False,
-                 result: PartPreview | None = None, metadata: dict | None = None) -> PartPreview:
-    """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files."""
+                 result: PartPreview | None = None, metadata: dict | None = None,
+                 obj_units: str = "m", obj_up: str = "y") -> PartPreview:
+    """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files: the GLB
+    in metres, Y up (glTF's convention); the OBJ in ``obj_units`` with ``obj_up`` up."""
     from .bake import bake
     from .export import export_glb, export_obj
 
-    out_glb = Path(out_glb)
-    out_glb.parent.mkdir(parents=True, exist_ok=True)
+    out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
     result = result or PartPreview(out_glb.stem)
     result.volume_mm3 = float(mesh.volume)
     result.triangles = int(len(mesh.faces))
@@ -87,7 +110,8 @@ def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, ob
         result.files["glb"] = Path(export_glb(baked.mesh, out_glb, metadata=meta) or out_glb)
         if obj:
             obj_path = out_glb.with_suffix(".obj")
-            result.files["obj"] = Path(export_obj(baked.mesh, obj_path) or obj_path)
+            result.files["obj"] = Path(export_obj(baked.mesh, obj_path, units=obj_units,
+                                                           up=obj_up) or obj_path)
     if screenshot:
         from .view import preview
 

@@ -7,11 +7,14 @@ A block spec is a string the CLI and GLB metadata carry:
   knotted log, ``LOG`` being ``gran1`` (the CT-measured spruce log of the shared data) or a
   woodcam log file (``.json``); size default 100x80x50 mm, Z along the log.
 - a block folder with a ``block.json`` manifest (real or synthetic): its true field if it has
-  one, otherwise a field fitted to its rings (fit once, cached in the folder).
+  one, otherwise a field fitted to its rings (fit once, cached in the user cache folder).
 - a Mokume sample folder (``A_col.png``, ``A_arl-unet.png``, ... as in the Mokume dataset): a
   cube of ``MOKUME_DEFAULT_SIZE_MM`` (50 mm) whose field is fitted to its ring maps, fit once
-  and cached under ``$WOODCAM_CACHE_DIR`` / ``~/.cache/woodcam`` (the sample folder is left
-  untouched: it is often read-only shared data).
+  and cached.
+
+Fitted fields and neural colour volumes are cached under ``$WOODCAM_CACHE_DIR`` or the user
+cache folder (``$XDG_CACHE_HOME/woodcam``, ``~/.cache/woodcam``), keyed by the block's content:
+block and sample folders are only read, never written (they are often read-only shared data).
 """
 
 from __future__ import annotations
@@ -77,16 +80,62 @@ def open_stock(spec: str, *, species: str | None = None,
         field, size_mm, description = _log_block_field(spec)
         return _synthetic_stock(spec, field, size_mm, species or "spruce", description,
                                 appearance, appearance_params)
-    path = Path(spec)
-    if path.is_dir() and (path / "block.json").is_file():
+    path = _existing_folder(spec)
+    if (path / "block.json").is_file():
         return _open_block_folder(path, species, appearance, appearance_params)
-    if path.is_dir() and (any(path.glob("?_col.png")) or any(path.glob("?_arl-unet.png"))):
-        return _open_mokume_folder(path, species, appearance, appearance_params)
-    raise WoodcamError(
-        f"block spec {spec!r} is neither 'builtin:NAME' (NAME one of {', '.join(BUILTIN_NAMES)}), "
-        "'log:LOG@KNOT[:WxDxH]', a block folder with a block.json manifest, nor a Mokume sample "
-        "folder (A_col.png, A_arl-unet.png, ...)"
-    )
+    return _open_mokume_folder(path, species, appearance, appearance_params)
+
+
+def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
+    """Resolve a block spec to ``(block, field)``: the one block resolver of every command.
+
+    Parameters
+    ----------
+    spec : str
+        As :func:`open_stock`: ``builtin:NAME`` and ``log:LOG@K[:WxDxH]`` give a synthetic
+        block whose six face photos, ring maps and traces are rendered by
+        :func:`woodcam.synth.synth_block` (seed 0) from the true field; a folder is read by
+        :func:`woodcam.block.io.read_block_folder` (block folder or Mokume sample folder).
+    size_mm : float, optional
+        Cube side of a Mokume sample folder (its files carry no size; default 50 mm).
+    face_px : int
+        Pixels along the largest face side of a synthetic block's photos.
+
+    Returns
+    -------
+    (Block, field or None)
+        The field is the block's true field where one is known (synthetic blocks, block
+        folders that store one), else None: no field is fitted here.
+    """
+    if spec.startswith(("builtin:", "log:")):
+        from .synth import synth_block
+
+        if spec.startswith("builtin:"):
+            b = builtin_block(spec.split(":", 1)[1])
+            field, size, name = b.field, b.size_mm, b.name
+        else:
+            field, size, _ = _log_block_field(spec)
+            name = spec.replace(":", "-").replace("/", "_")
+        return synth_block(field, size, face_px=face_px, seed=0, name=name), field
+    from .block.io import read_block_folder
+
+    block = read_block_folder(_existing_folder(spec),
+                              None if size_mm is None else (float(size_mm),) * 3)
+    return block, block.true_field
+
+
+def _existing_folder(spec: str) -> Path:
+    """The folder a non-builtin, non-log spec names, or the error listing every kind of spec."""
+    path = Path(spec)
+    if path.name == "block.json" and path.is_file():
+        path = path.parent
+    if not path.is_dir():
+        raise WoodcamError(
+            f"block spec {spec!r} is neither 'builtin:NAME' (NAME one of "
+            f"{', '.join(BUILTIN_NAMES)}), 'log:LOG@KNOT[:WxDxH]', nor an existing folder: a block "
+            "folder (with block.json) or a Mokume sample folder (A_col.png, A_arl-unet.png, ...)"
+        )
+    return path
 
 
 def _synthetic_stock(spec, field, size_mm, species, description, appearance, params) -> Stock:
@@ -110,56 +159,56 @@ def _synthetic_stock(spec, field, size_mm, species, description, appearance, par
     return Stock(spec, tuple(size_mm), Wood(field, app), description, meta)
 
 
-def fitted_field(block, folder: Path | None, method: str = "evidence"):
+def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
     """The growth field fitted to a block's rings, fitted once and cached.
 
-    folder : the block folder: the cache ``<folder>/.woodcam-cache/field_<method>_v<N>.npz`` is
-        reused while it is newer than the block's manifest (delete it, or rewrite the block, to
-        fit again). None (a Mokume sample folder, which is never written to): cached under
-        ``$WOODCAM_CACHE_DIR`` / ``~/.cache/woodcam`` keyed by the block's images and size.
-    ``N`` is :data:`woodcam.inference.fit.FIT_VERSION`, so a changed fitter refits.
+    The cache entry lives in the user cache folder (:func:`woodcam._cache.cache_dir`
+    ``("fields")``), never in the block's own folder (which may be read-only shared data), and is
+    keyed by a digest of everything the fit reads: size, photos, ring maps, traces and knot masks
+    (:func:`~woodcam.appearance.volumes.block_fingerprint`), the method, and
+    :data:`woodcam.inference.fit.FIT_VERSION` with the package version. An edited block is a
+    new entry; an unreadable entry is discarded with a warning and refitted; concurrent first
+    runs fit once (a lock) and share the result.
+
+    folder : the block folder, only named in errors (None for a Mokume sample).
     """
-    from .appearance.neural import default_cache_dir
+    import re
+
+    from . import __version__
+    from ._cache import cache_dir, digest, load_or_build
     from .appearance.volumes import block_fingerprint
     from .fields.grid import GridField
     from .inference import fit_block
     from .inference.fit import FIT_VERSION
 
-    if folder is None:
-        cache = (default_cache_dir().parent / "fields"
-                 / f"{block.name}-{block_fingerprint(block)[:16]}-{method}_v{FIT_VERSION}.npz")
-        fresh = cache.is_file()
-    else:
-        cache = folder / ".woodcam-cache" / f"field_{method}_v{FIT_VERSION}.npz"
-        fresh = cache.is_file() and cache.stat().st_mtime >= (folder / "block.json").stat().st_mtime
-    if fresh:
-        return GridField.load(cache)
     if not any(f.has_rings for f in block.faces.values()):
         raise WoodcamError(
             f"block {folder or block.name} has neither a true field nor traced rings or ring maps "
             "to fit one to; trace rings on at least one face (or use 'woodcam block synth')"
         )
-    field = fit_block(block, method=method)
-    cache.parent.mkdir(parents=True, exist_ok=True)
-    field.save(cache)
+    key = digest(block_fingerprint(block), method, FIT_VERSION, __version__)
+    stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", block.name)[:40] or "block"
+    path = cache_dir("fields") / f"{stem}-{method}-{key}.npz"
+    field, _hit = load_or_build(path, load=GridField.load, build=lambda: fit_block(block, method=method),
+                                save=lambda f, tmp: f.save(tmp), what=f"fitted field of block {block.name!r}")
     return field
 
 
 def _open_mokume_folder(path: Path, species, appearance, appearance_params) -> Stock:
-    from .block.io import read_mokume
+    from .block.io import read_block_folder
 
-    block = read_mokume(path)
+    block = read_block_folder(path)
     return _real_block_stock(str(path), block, fitted_field(block, None), species, appearance,
                              appearance_params, cache_dir=None)
 
 
 def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
-    from .block.io import read_block  # block I/O sits beside; imported when a folder is used
+    from .block.io import read_block_folder  # imported when a folder is used
 
-    block = read_block(path)
+    block = read_block_folder(path)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
     return _real_block_stock(str(path), block, field, species, appearance, appearance_params,
-                             cache_dir=path / ".woodcam-cache")
+                             cache_dir=None)
 
 
 def _real_block_stock(spec, block, field, species, appearance, appearance_params, cache_dir) -> Stock:
@@ -178,7 +227,13 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
 
 def _log_block_field(spec: str):
     """``log:LOG@K[:WxDxH]`` -> (block-frame field, size_mm, description)."""
-    from .fields import KnottedLogField, block_at_knot, place_block_in_log, read_gran1, read_log
+    from .fields import (
+        KnottedLogField,
+        block_at_knot,
+        place_block_in_log,
+        read_gran1,
+        read_log,
+    )
 
     body = spec[len("log:"):]
     try:

@@ -624,6 +624,39 @@ def random_log_placement(rng: np.random.Generator, pattern: SawPattern, size_mm,
     return log, placement
 
 
+def benchmark_set_block(seed: int, index: int, *, face_px: int = 512, size_range_mm=(30.0, 80.0),
+                        ring_width_range_mm=(1.5, 6.0),
+                        log_fields: Callable[[np.random.Generator], object] | None = None,
+                        knotted_fraction: float = 0.5,
+                        wood_factory: Callable[[object], object] | None = None,
+                        **synth_kwargs) -> tuple[Block, dict]:
+    """Block ``index`` of the set :func:`synth_benchmark_set` writes for ``seed``, alone.
+
+    Drawn from ``np.random.default_rng([seed, index])`` only, so it is the same block whichever
+    process makes it and whatever else is made. Returns the block and its index entry (name,
+    size, knotted, ring width, placement).
+    """
+    i = int(index)
+    rng = np.random.default_rng([int(seed), i])
+    pattern = PATTERNS[i % len(PATTERNS)]
+    size = tuple(float(v) for v in np.round(rng.uniform(*size_range_mm, size=3) * 2) / 2)
+    log, placement = random_log_placement(rng, pattern, size, ring_width_range_mm)
+    knotted = log_fields is not None and rng.uniform() < knotted_fraction
+    if knotted:
+        log = log_fields(rng)
+        field, placement = _place_through_knot(rng, log, placement, size)
+    else:
+        field = cut_block(log, size, **placement)
+    name = f"block_{i:04d}"
+    info = {"name": name, "index": i, "size_mm": list(size), "knotted": bool(knotted),
+            "ring_width_mm": log.ring_width_at(placement["distance_mm"]) if not knotted else None,
+            **{k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in placement.items()}}
+    wood = None if wood_factory is None else wood_factory(field)
+    block = synth_block(field, size, wood=wood, face_px=face_px, rng=rng, seed=None, name=name,
+                        meta={"benchmark_seed": int(seed), **info}, **synth_kwargs)
+    return block, info
+
+
 def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
                         size_range_mm=(30.0, 80.0), ring_width_range_mm=(1.5, 6.0),
                         log_fields: Callable[[np.random.Generator], object] | None = None,
@@ -667,24 +700,11 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
     folders = []
     # tqdm's delay keeps the bar hidden for runs shorter than ~2 s.
     for i in tqdm(range(count), desc="synthesising blocks", unit="block", delay=2.0, disable=not progress):
-        rng = np.random.default_rng([int(seed), i])
-        pattern = PATTERNS[i % len(PATTERNS)]
-        size = tuple(float(v) for v in np.round(rng.uniform(*size_range_mm, size=3) * 2) / 2)
-        log, placement = random_log_placement(rng, pattern, size, ring_width_range_mm)
-        knotted = log_fields is not None and rng.uniform() < knotted_fraction
-        if knotted:
-            log = log_fields(rng)
-            field, placement = _place_through_knot(rng, log, placement, size)
-        else:
-            field = cut_block(log, size, **placement)
-        name = f"block_{i:04d}"
-        info = {"name": name, "index": i, "size_mm": list(size), "knotted": bool(knotted),
-                "ring_width_mm": log.ring_width_at(placement["distance_mm"]) if not knotted else None,
-                **{k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in placement.items()}}
-        wood = None if wood_factory is None else wood_factory(field)
-        block = synth_block(field, size, wood=wood, face_px=face_px, rng=rng, seed=None, name=name,
-                            meta={"benchmark_seed": int(seed), **info}, **synth_kwargs)
-        folder = out_dir / name
+        block, info = benchmark_set_block(
+            seed, i, face_px=face_px, size_range_mm=size_range_mm,
+            ring_width_range_mm=ring_width_range_mm, log_fields=log_fields,
+            knotted_fraction=knotted_fraction, wood_factory=wood_factory, **synth_kwargs)
+        folder = out_dir / info["name"]
         write_block(block, folder)
         folders.append(folder)
         index["blocks"].append(info)
@@ -711,10 +731,15 @@ def _place_through_knot(rng: np.random.Generator, log_field, placement: dict, si
     Returns ``(block-frame field, placement)``; checked with :func:`knot_crosses` (asserted from
     the true field), raising :class:`WoodcamError` when no knot of the log reaches a block.
     """
-    log = log_field.log
+    log = getattr(log_field, "log", None)
+    if log is None or not getattr(log, "knots", None):
+        raise WoodcamError(f"log_fields must return a knotted log field with knots (a .log with "
+                           f".knots, e.g. knotted_log_field); got {type(log_field).__name__}")
     W, D, _ = size
     half_diag = 0.5 * math.hypot(W, D)
-    r_out = float(log.r_min_mm) - half_diag - 5.0  # the whole block inside the log
+    # the whole block inside the log where it is thick enough; a log too thin for the block
+    # (a big block from a small generated log) keeps its field beyond the bark
+    r_out = max(float(log.r_min_mm) - half_diag - 5.0, half_diag + 12.0)
     inside = placement["pattern"] == "pith-inside"
     for _ in range(tries):
         k = int(rng.integers(len(log.knots)))
@@ -723,13 +748,14 @@ def _place_through_knot(rng: np.random.Generator, log_field, placement: dict, si
             r = float(placement["distance_mm"])
             p = log.knot_point(k, [max(r, 2.0)])[0]
         else:
-            lo, hi = half_diag + 2.0, min(float(kn.r_end_mm), r_out)
+            # block centre at pith distance r_c; the knot reaches its inner half when it ends
+            # beyond the block's innermost side (r_c - min(W, D) / 2)
+            lo, hi = half_diag + 2.0, min(float(kn.r_end_mm) + 0.5 * min(W, D) - 3.0, r_out)
             if hi <= lo:
                 continue
-            p = log.knot_point(k, [rng.uniform(lo, hi)])[0]
-            r = float(math.hypot(p[0], p[1]))  # cut_block measures from the log's z axis
-            if r <= half_diag + 1.0:
-                continue
+            r_c = rng.uniform(lo, hi)
+            p = log.knot_point(k, [min(r_c, float(kn.r_end_mm) - 2.0)])[0]
+            r = max(r_c, half_diag + 1.0)  # cut_block measures from the log's z axis
         moved = dict(placement, distance_mm=r, height_mm=float(p[2]),
                      azimuth_deg=math.degrees(math.atan2(p[1], p[0])))
         try:

@@ -164,6 +164,16 @@ RING_HISTORY_PRIOR_POINTS = 20.0
 RING_HISTORY_ROUNDS = 3
 RING_HISTORY_MIN_STEP = 1e-3
 
+#: Exported shading normals are averaged over the faces round a vertex whose normals lie within
+#: this angle of each other; a sharper edge keeps two normals (a crease). 30 degrees is the
+#: common CAD/DCC default (Blender's auto-smooth, three.js' toCreasedNormals examples): a
+#: tessellated cylinder (5 degree facets) shades smooth, a box edge (90 degrees) stays sharp.
+CREASE_ANGLE_DEG = 30.0
+
+#: Two exported corners are the same position when they agree to this (mm); the baked mesh is
+#: split at UV seams, so positions, not vertex indices, decide which faces meet at a vertex.
+CREASE_WELD_MM = 1e-6
+
 #: Evidence-based choice of a fit (``woodcam.inference.evidence``, issue 12 part 1).
 #: A face takes part in leave-one-face-out only with at least this many ring points: fewer
 #: (a face crossed by one short ring) scores by chance.

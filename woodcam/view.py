@@ -152,8 +152,12 @@ def _load_mesh(mesh_or_path):
                 f"mesh_or_path: no file at {str(path)!r}; pass a .glb/.obj/.ply/.stl file "
                 "written by woodcam (e.g. out/part.glb) or a trimesh.Trimesh"
             )
+        from woodcam.export import load_textured, written_by_woodcam
+
         try:
-            loaded = trimesh.load(path, force="mesh")
+            # woodcam's own GLB/OBJ are metres/Y-up on disk: load_textured returns the block frame
+            loaded = (load_textured(path) if written_by_woodcam(path)
+                      else trimesh.load(path, force="mesh"))
         except Exception as err:  # trimesh raises many types for unreadable files
             raise WoodcamError(
                 f"mesh_or_path: could not read a mesh from {str(path)!r} ({err}); "
@@ -861,6 +865,10 @@ def preview(
         raise WoodcamError(
             f"screenshot must be a .png path; got {str(screenshot)!r}; e.g. out/part.png"
         )
+    if screenshot is not None:  # before any rendering: not a folder, folder writable
+        from ._atomic import check_output_path
+
+        check_output_path(screenshot, what="screenshot", mkdir=True)
     if screenshot is None and not _display_available():
         raise WoodcamError(
             "preview: an interactive window needs a display, but neither DISPLAY nor "
@@ -890,9 +898,11 @@ def preview(
         plotter.enable_depth_peeling()
         plotter.enable_anti_aliasing("ssaa")
         if off_screen:
+            from ._atomic import atomic_path
+
             path = Path(screenshot)
-            path.parent.mkdir(parents=True, exist_ok=True)
-            plotter.screenshot(str(path))
+            with atomic_path(path, mkdir=True) as tmp:  # complete PNG or none
+                plotter.screenshot(str(tmp))
             return path
         plotter.add_axes()
         plotter.show()

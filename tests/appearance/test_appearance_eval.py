@@ -1,6 +1,5 @@
 """Appearance evaluation: the image measures against known answers; leave-one-face-out runs."""
 
-import argparse
 
 import numpy as np
 import pytest
@@ -92,16 +91,14 @@ def test_leave_one_face_out_needs_two_photos():
         leave_one_face_out(one, lambda p: p[:, 0], progress=False)
 
 
-def test_cli_parser_wires_run():
-    from woodcam import _cli_appearance
+def test_cli_parser_wires_run(capsys, tmp_path):
+    from woodcam.cli import appearance, build_parser, main
 
-    p = argparse.ArgumentParser()
-    sub = p.add_subparsers(dest="command")
-    _cli_appearance.add_parser(sub)
-    a = p.parse_args(["eval-appearance", "builtin:rift", "--out", "x", "--quality", "draft", "--epochs", "2"])
-    assert a.func is _cli_appearance.run and a.epochs == 2 and a.quality == "draft"
-    with pytest.raises(WoodcamError, match="block must be builtin:NAME"):
-        _cli_appearance.load_eval_block("/nonexistent/folder")
+    a = build_parser().parse_args(["eval", "appearance", "builtin:rift", "--out", "x", "--quality",
+                                   "draft", "--epochs", "2"])
+    assert a.func is appearance.run and a.epochs == 2 and a.quality == "draft"
+    assert main(["eval-appearance", "/nonexistent/folder", "--out", str(tmp_path)]) == 2  # old name
+    assert "is neither 'builtin:NAME'" in capsys.readouterr().err
 
 
 @pytest.mark.slow

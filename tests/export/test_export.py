@@ -45,14 +45,105 @@ def _same_texture(loaded, result):
     np.testing.assert_array_equal(np.asarray(image.convert("RGB")), result.atlas)
 
 
-def test_glb_reloads_with_texture_uv_and_vertex_count(baked, tmp_path):
+def _corners(mesh):
+    """Per-corner positions (f, 3, 3) and uv (f, 3, 2): what survives a crease split."""
+    return (np.asarray(mesh.vertices)[mesh.faces], np.asarray(mesh.visual.uv)[mesh.faces])
+
+
+def test_glb_reloads_with_texture_and_the_same_corners(baked, tmp_path):
     path = export_glb(baked.mesh, tmp_path / "part.glb")
     loaded = load_textured(path)
-    assert len(loaded.vertices) == len(baked.mesh.vertices)
     assert len(loaded.faces) == len(baked.mesh.faces)
-    np.testing.assert_allclose(loaded.vertices, baked.mesh.vertices, atol=1e-4)  # float32 file
-    np.testing.assert_allclose(loaded.visual.uv, baked.mesh.visual.uv, atol=1e-6)
+    # crease splitting only adds vertices (box edges, hole rim): never fewer than baked
+    assert len(loaded.vertices) >= len(baked.mesh.vertices)
+    got, want = _corners(loaded), _corners(baked.mesh)
+    np.testing.assert_allclose(got[0], want[0], atol=1e-4)  # float32 file, block frame mm
+    np.testing.assert_allclose(got[1], want[1], atol=1e-6)
     _same_texture(loaded, baked)
+
+
+def _gltf_world(path):
+    """World-space vertices (m) and normals of a GLB, read independently with pygltflib."""
+    pygltflib = pytest.importorskip("pygltflib")
+    gltf = pygltflib.GLTF2().load_binary(str(path))
+    blob = gltf.binary_blob()
+
+    def accessor(i, width):
+        acc = gltf.accessors[i]
+        view = gltf.bufferViews[acc.bufferView]
+        start = (view.byteOffset or 0) + (acc.byteOffset or 0)
+        return np.frombuffer(blob, np.float32, acc.count * width, start).reshape(-1, width)
+
+    def local(node):
+        if node.matrix:
+            return np.asarray(node.matrix, dtype=np.float64).reshape(4, 4).T
+        return np.eye(4)
+
+    scene = gltf.scenes[gltf.scene or 0]
+    (root,) = scene.nodes
+    (child,) = gltf.nodes[root].children
+    world = local(gltf.nodes[root]) @ local(gltf.nodes[child])
+    prim = gltf.meshes[gltf.nodes[child].mesh].primitives[0]
+    pos = accessor(prim.attributes.POSITION, 3).astype(np.float64)
+    nrm = accessor(prim.attributes.NORMAL, 3).astype(np.float64)
+    pos_w = pos @ world[:3, :3].T + world[:3, 3]
+    rot = world[:3, :3] / np.cbrt(np.linalg.det(world[:3, :3]))
+    return gltf, pos_w, nrm @ rot.T, nrm
+
+
+def test_glb_is_metres_and_y_up_for_every_viewer(baked, tmp_path):
+    """The 30 x 20 x 16 mm block-frame part is 0.030 m wide (X), 0.016 m tall (+Y) and 0.020 m
+    deep (towards -Z, away from the viewer) in the glTF scene."""
+    path = export_glb(baked.mesh, tmp_path / "part.glb")
+    gltf, pos, nrm_world, nrm = _gltf_world(path)
+    lo, hi = pos.min(axis=0), pos.max(axis=0)
+    np.testing.assert_allclose(hi - lo, [0.030, 0.016, 0.020], atol=1e-6)
+    np.testing.assert_allclose(lo, [0.0, 0.0, -0.020], atol=1e-6)  # bottom at y = 0
+    # normals present, unit, and the top face's normal points up (+Y) in the world
+    np.testing.assert_allclose(np.linalg.norm(nrm, axis=1), 1.0, atol=1e-5)
+    top = pos[:, 1] > 0.016 - 1e-6
+    assert top.any() and np.all(nrm_world[top & (np.abs(nrm_world[:, 1]) > 0.5), 1] > 0.99)
+    sampler = gltf.samplers[gltf.textures[0].sampler]
+    assert sampler.wrapS == sampler.wrapT == 33071  # clamp to edge
+    assert read_glb_metadata(path)["block_to_gltf"][1] == [0.0, 0.0, 0.001, 0.0]
+
+
+def test_crease_normals_split_sharp_edges_and_smooth_flat_ones():
+    from woodcam.export import crease_normals
+
+    box = trimesh.creation.box((10.0, 10.0, 10.0))
+    split = crease_normals(box)  # 90 degree edges: every corner takes its face's normal
+    np.testing.assert_allclose(split.vertex_normals[split.faces],
+                               np.repeat(box.face_normals[:, None], 3, axis=1), atol=1e-12)
+    assert len(split.vertices) == 24
+    smooth = crease_normals(box, 180.0)  # everything smooth: 8 corners, diagonal normals
+    assert len(smooth.vertices) == 8
+    np.testing.assert_allclose(np.abs(smooth.vertex_normals), 1 / np.sqrt(3), atol=1e-12)
+    cyl = trimesh.creation.cylinder(radius=5.0, height=10.0, sections=64)
+    c = crease_normals(cyl)
+    side = np.abs(c.vertex_normals[:, 2]) < 0.5
+    radial = c.vertices[side, :2] / np.linalg.norm(c.vertices[side, :2], axis=1, keepdims=True)
+    np.testing.assert_allclose(c.vertex_normals[side, :2], radial, atol=1e-3)  # smooth sides
+    np.testing.assert_allclose(np.abs(c.vertex_normals[~side, 2]), 1.0, atol=1e-12)  # flat caps
+    with pytest.raises(WoodcamError, match="crease_angle_deg must be in"):
+        crease_normals(box, -1.0)
+
+
+@pytest.mark.parametrize(("units", "up", "scale", "height_axis"),
+                         [("m", "y", 1e-3, 1), ("mm", "z", 1.0, 2), ("mm", "y", 1.0, 1)])
+def test_obj_units_and_up_axis_round_trip(baked, tmp_path, units, up, scale, height_axis):
+    path = export_obj(baked.mesh, tmp_path / f"p_{units}_{up}.obj", units=units, up=up)
+    text = path.read_text()
+    assert text.splitlines()[0].startswith(f"# woodcam: units={units} up={up}")
+    v = np.array([[float(x) for x in line.split()[1:4]] for line in text.splitlines()
+                  if line.startswith("v ")])
+    assert np.ptp(v[:, height_axis]) == pytest.approx(16.0 * scale, rel=1e-6)
+    assert v[:, height_axis].min() == pytest.approx(0.0, abs=1e-9)
+    vn = np.array([[float(x) for x in line.split()[1:4]] for line in text.splitlines()
+                   if line.startswith("vn ")])
+    np.testing.assert_allclose(np.linalg.norm(vn, axis=1), 1.0, atol=1e-6)
+    loaded = load_textured(path)  # back in the block frame, mm
+    np.testing.assert_allclose(_corners(loaded)[0], _corners(baked.mesh)[0], atol=1e-6)
 
 
 def test_obj_writes_obj_mtl_png_named_after_the_obj_and_reloads(baked, tmp_path):
@@ -63,9 +154,8 @@ def test_obj_writes_obj_mtl_png_named_after_the_obj_and_reloads(baked, tmp_path)
     assert "map_Kd bowl.png" in mtl
     assert "Kd 1.00000000 1.00000000 1.00000000" in mtl  # texture not darkened by Kd
     loaded = load_textured(path)
-    assert len(loaded.vertices) == len(baked.mesh.vertices)
     assert len(loaded.faces) == len(baked.mesh.faces)
-    np.testing.assert_allclose(loaded.visual.uv, baked.mesh.visual.uv, atol=1e-7)
+    np.testing.assert_allclose(_corners(loaded)[1], _corners(baked.mesh)[1], atol=1e-7)
     _same_texture(loaded, baked)
     # the caller's mesh keeps its own material name
     assert baked.mesh.visual.material.name == "wood"
@@ -76,11 +166,17 @@ def test_glb_keeps_seam_free_smooth_normals(tmp_path):
     result = bake(sphere, _Wood(), texels_per_mm=2.0, normals="smooth")
     path = export_glb(result.mesh, tmp_path / "sphere.glb")
     loaded = load_textured(path)
-    expected = sphere.vertex_normals[result.vertex_map]
-    np.testing.assert_allclose(loaded.vertex_normals, expected, atol=1e-5)
     # on a sphere the smooth normal is the radial direction, also across UV seams
     radial = loaded.vertices / np.linalg.norm(loaded.vertices, axis=1, keepdims=True)
     assert np.min(np.sum(loaded.vertex_normals * radial, axis=1)) > 0.99
+    # no shading seam: every copy of a position (split by xatlas) carries the same normal
+    keys = np.round(loaded.vertices, 4)
+    _, inverse = np.unique(keys, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    mean = np.zeros((inverse.max() + 1, 3))
+    np.add.at(mean, inverse, loaded.vertex_normals)
+    mean /= np.linalg.norm(mean, axis=1, keepdims=True)
+    assert np.max(np.linalg.norm(loaded.vertex_normals - mean[inverse], axis=1)) < 1e-5
 
 
 def test_glb_metadata_round_trip(baked, tmp_path):
@@ -90,7 +186,7 @@ def test_glb_metadata_round_trip(baked, tmp_path):
     assert got["block"] == meta["block"] and got["field"] == meta["field"]
     assert got["units"] == "mm"
     plain = export_glb(baked.mesh, tmp_path / "plain.glb")
-    assert read_glb_metadata(plain) == {"units": "mm", "frame": "block"}
+    assert set(read_glb_metadata(plain)) == {"units", "frame", "block_to_gltf"}
 
 
 def test_export_errors_are_clear(baked, tmp_path):
@@ -142,3 +238,17 @@ def test_glb_passes_the_khronos_validator(baked, tmp_path, normals):
     assert issues["numWarnings"] == 0, issues["messages"]
     info = report["info"]
     assert info["materialCount"] == 1 and info["hasTextures"]
+
+
+@pytest.mark.parametrize("suffix", [".glb", ".obj"])
+def test_an_exported_part_reloads_as_a_part_in_the_block_frame(baked, tmp_path, suffix):
+    """Re-baking an exported GLB/OBJ (metres, Y up on disk) carves the same solid in the block."""
+    from woodcam.cad import load_part
+
+    path = (export_glb(baked.mesh, tmp_path / "p.glb") if suffix == ".glb"
+            else export_obj(baked.mesh, tmp_path / "p.obj"))
+    solid = load_part(path)
+    lo, hi = np.asarray(solid.bounding_box()).reshape(2, 3)
+    np.testing.assert_allclose(lo, [0.0, 0.0, 0.0], atol=1e-3)
+    np.testing.assert_allclose(hi, [30.0, 20.0, 16.0], atol=1e-3)
+    assert solid.volume() == pytest.approx(baked.mesh.volume, rel=1e-3)

@@ -1,12 +1,11 @@
 """Planar sections through a log and the `woodcam log` command."""
 
-import argparse
 
 import numpy as np
 import pytest
 from PIL import Image
 
-from woodcam import _cli_log
+from woodcam.cli import build_parser
 from woodcam.errors import WoodcamError
 from woodcam.fields import log_render as lr
 from woodcam.fields.knots import KnottedLogField
@@ -62,9 +61,7 @@ def test_disc_background_outside_the_log():
 
 
 def _parse(argv):
-    ap = argparse.ArgumentParser(prog="woodcam")
-    _cli_log.add_parser(ap.add_subparsers(dest="command"))
-    return ap.parse_args(argv)
+    return build_parser().parse_args(argv)
 
 
 def test_cli_renders_a_log_file(tmp_path):

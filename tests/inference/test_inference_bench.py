@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from _eq79_blocks import make_block, random_field
-from woodcam._cli_fit import PARTIAL_FACES
+from woodcam.cli.fit import PARTIAL_FACES
 from woodcam.inference import benchmark
 
 N_BLOCKS = 8

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 import pytest
@@ -10,15 +9,14 @@ import pytest
 import woodcam.pipeline
 from woodcam.errors import WoodcamError
 from woodcam.toolpath import BallEndMill, FlatEndMill, read_gcode
-from woodcam.toolpath.cli import _tools_from_args, add_parser
+from woodcam.cli import build_parser
+from woodcam.cli.gcode import _tools_from_args
 
 REPO = Path(__file__).resolve().parents[2]
 
 
 def _parse(argv):
-    parser = argparse.ArgumentParser()
-    add_parser(parser.add_subparsers(dest="command"))
-    return parser.parse_args(["gcode", *argv])
+    return build_parser().parse_args(["gcode", *argv])
 
 
 def test_tool_arguments():

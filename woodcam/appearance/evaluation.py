@@ -1,4 +1,4 @@
-"""Leave-one-face-out evaluation of appearance models (``woodcam eval-appearance``).
+"""Leave-one-face-out evaluation of appearance models (``woodcam eval appearance``).
 
 For each face with a photo: train without it, synthesise it from its ring image (the field's
 ARF, or for a real block without a fitted field its ring map), and compare with its photo, for

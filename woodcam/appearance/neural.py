@@ -13,7 +13,6 @@ with a :class:`AppearanceFallbackWarning`, when the block has no photos to learn
 from __future__ import annotations
 
 import json
-import os
 import re
 import time
 import warnings
@@ -52,9 +51,11 @@ class AppearanceFallbackWarning(WoodcamWarning):
 
 
 def default_cache_dir() -> Path:
-    """``$WOODCAM_CACHE_DIR/appearance`` or ``~/.cache/woodcam/appearance``."""
-    base = os.environ.get("WOODCAM_CACHE_DIR")
-    return (Path(base) if base else Path.home() / ".cache" / "woodcam") / "appearance"
+    """``$WOODCAM_CACHE_DIR/appearance`` or the user cache folder's ``appearance`` (platformdirs,
+    honouring ``$XDG_CACHE_HOME``): see :mod:`woodcam._cache`."""
+    from .._cache import cache_dir
+
+    return cache_dir("appearance")
 
 
 @dataclass
@@ -113,7 +114,7 @@ class NeuralAppearance:
                 out[idx] += w[idx, k:k + 1] * vols.sample(p[idx], k, guide(k, idx))
         return out
 
-    def agnostic(self, index: int = 2) -> "NeuralAppearance":
+    def agnostic(self, index: int = 2) -> NeuralAppearance:
         """The same block seen through one volume for every normal (default ``RGB_XY``)."""
         v = self.volumes
         cut = slice(index, index + 1)
@@ -239,15 +240,44 @@ def fit_neural_appearance(block, field=None, *, resolution: int = 128, quality: 
     settings = {"version": CACHE_VERSION, "grid": grid.to_dict(), "spec": spec.to_dict(),
                 "orientation": orientation, "source": source, "detail": bool(detail)}
     key = cache_key(block, field, settings)
-    path = None
-    if cache_dir is not False:
-        stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", block.name)[:40] or "block"
-        path = Path(cache_dir or default_cache_dir()) / f"{stem}-{key}.npz"
-        if path.is_file():
-            vols = ColorVolumes.load(path)
-            vols.meta["cache"] = "hit"
-            vols.meta["cache_path"] = str(path)
-            return NeuralAppearance(vols)
+    if cache_dir is False:
+        return NeuralAppearance(_build_volumes(block, field, grid, spec, settings, key, orientation,
+                                               source, detail, progress, threads, None))
+    from .._cache import load_or_build
+
+    stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", block.name)[:40] or "block"
+    path = Path(cache_dir or default_cache_dir()) / f"{stem}-{key}.npz"
+    built: dict = {}
+
+    def build():
+        vols = _build_volumes(block, field, grid, spec, settings, key, orientation, source, detail,
+                              progress, threads, path)
+        built["nets"] = vols.meta.pop("_nets")
+        return vols
+
+    def save(vols, tmp):
+        # the weights first, then the volumes: the volumes' entry exists only when both do
+        _save_nets(path.with_name(path.stem + ".weights.npz"), built["nets"])
+        vols.save(tmp)
+
+    vols, hit = load_or_build(path, load=_load_volumes, build=build, save=save,
+                              what=f"neural appearance of block {block.name!r}")
+    if hit:
+        vols.meta["cache"] = "hit"
+    vols.meta["cache_path"] = str(path)
+    return NeuralAppearance(vols)
+
+
+def _load_volumes(path: Path) -> ColorVolumes:
+    vols = ColorVolumes.load(path)
+    if path.stem.rsplit("-", 1)[-1] != vols.meta.get("key"):
+        raise WoodcamError(f"{path}: holds volumes of key {vols.meta.get('key')!r}, not of its name")
+    return vols
+
+
+def _build_volumes(block, field, grid, spec, settings, key, orientation, source, detail, progress,
+                   threads, path) -> ColorVolumes:
+    """Train the translation networks and translate the field's volume (the expensive part)."""
     t0 = time.perf_counter()
     trained = train_axis_networks(block, grid, spec, field=field, source=source,
                                   orientation=orientation, progress=progress, threads=threads)
@@ -267,12 +297,9 @@ def fit_neural_appearance(block, field=None, *, resolution: int = 128, quality: 
             "train_s": round(t1 - t0, 3), "apply_s": round(t2 - t1, 3), "detail_s": round(t3 - t2, 3),
             "net_train_s": [round(n.train_seconds, 3) for n in nets],
             "net_final_l1": [round(n.final_l1, 5) for n in nets], "notes": trained["notes"]}
-    out = ColorVolumes(grid, vols, meta, guides, slopes)
     if path is not None:
-        out.meta["cache_path"] = str(path)
-        out.save(path)
-        _save_nets(path.with_name(path.stem + ".weights.npz"), nets)
-    return NeuralAppearance(out)
+        meta["_nets"] = nets  # handed to the cache writer, not stored in the file
+    return ColorVolumes(grid, vols, meta, guides, slopes)
 
 
 def _save_nets(path: Path, nets) -> None:
@@ -282,12 +309,15 @@ def _save_nets(path: Path, nets) -> None:
         for k, v in st.pop("weights").items():
             arrays[f"net{i}/{k}"] = v
         heads.append(st)
-    np.savez(path, header=json.dumps(heads), **arrays)
+    from .._atomic import atomic_path
+
+    with atomic_path(path, mkdir=True) as tmp:
+        np.savez(tmp, header=json.dumps(heads), **arrays)
 
 
 def load_nets(path) -> list[TranslationNet]:
     """The translation networks saved next to cached volumes (``*.weights.npz``)."""
-    with np.load(path) as z:
+    with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as z:
         heads = json.loads(str(z["header"]))
         out = []
         for i, st in enumerate(heads):

@@ -295,19 +295,21 @@ class ColorVolumes:
         return idx, w
 
     def save(self, path) -> Path:
+        from .._atomic import atomic_path
+
         path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".tmp.npz")
         extra = {} if not self.has_detail else {"guides": self.guides.astype(np.float16),
                                                  "slopes": self.slopes.astype(np.float16)}
-        np.savez(tmp, volumes=self.volumes, grid=json.dumps(self.grid.to_dict()),
-                 meta=json.dumps(self.meta), **extra)
-        tmp.replace(path)  # atomic: a reader never sees half a cache file
+        # unique temporary + rename: a reader never sees half a file, two writers never mix
+        with atomic_path(path, mkdir=True) as tmp:
+            np.savez(tmp, volumes=self.volumes, grid=json.dumps(self.grid.to_dict()),
+                     meta=json.dumps(self.meta), **extra)
         return path
 
     @classmethod
     def load(cls, path) -> "ColorVolumes":
-        with np.load(path) as z:
+        # our own handle: np.load leaks it when the zip is truncated
+        with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as z:
             g = json.loads(str(z["grid"]))
             detail = {k: z[k] for k in ("guides", "slopes") if k in z.files}
             return cls(VolumeGrid(tuple(g["size_mm"]), g["resolution"]), z["volumes"],
@@ -467,13 +469,18 @@ def field_fingerprint(field, size_mm, n: int = 2048) -> str:
 
 
 def block_fingerprint(block) -> str:
-    """A digest of a block's size and face photos and ring maps."""
-    h = hashlib.sha256(np.asarray(block.size_mm, "<f8").tobytes())
+    """A digest of everything a block's faces hold: its size, and per face the photo, ring map,
+    ring traces (points and years) and extras (knot masks, annotations), so any edit that could
+    change a fit or an appearance changes the digest."""
+    from .._cache import digest
+
+    faces = []
     for name, f in block.faces.items():
-        h.update(name.encode())
-        for a in (f.photo, f.ring_map):
-            h.update(b"-" if a is None else np.ascontiguousarray(a).tobytes())
-    return h.hexdigest()
+        traces = [(t.points_px, -1 if t.year is None else int(t.year)) for t in f.traces]
+        extras = {k: (v if isinstance(v, np.ndarray) else json.dumps(v, sort_keys=True, default=str))
+                  for k, v in f.extras.items()}
+        faces.append((name, list(f.shape), f.photo, f.ring_map, traces, extras))
+    return digest(np.asarray(block.size_mm, "<f8"), faces, length=64)
 
 
 def cache_key(block, field, settings: dict) -> str:

@@ -51,6 +51,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._atomic import atomic_path, write_text
 from ..errors import WoodcamError
 from ..fields.state import field_from_state, field_to_state, field_type, jsonable
 from ..frames import FACES, MOKUME_LETTER
@@ -126,58 +127,63 @@ def write_block(block: Block, folder, *, ring_map_bits: Literal[8, 16] = 16,
         "size_mm": list(block.size_mm), "meta": jsonable(block.meta, "block.meta"),
         "faces": faces, "true_field": _write_field(block.true_field, folder),
     }
-    manifest_path.write_text(json.dumps(manifest, indent=1))
+    write_text(manifest_path, json.dumps(manifest, indent=1))  # last: images are in place
     return manifest_path
 
 
-def read_block(folder) -> Block:
+def read_block(folder, *, allow_outside: bool | None = None) -> Block:
     """Read a block folder written by :func:`write_block` (or made by hand for a real block).
 
     Faces missing from the manifest are absent from the block; ``true_field`` is None unless the
-    manifest says it was saved and its class can be restored.
+    manifest says it was saved and its class can be restored. The manifest is checked at the
+    door (:func:`woodcam.block._schema.check_manifest`: types, ranges, finite numbers) and every
+    file it names must lie inside ``folder`` unless ``allow_outside`` (default: the
+    ``WOODCAM_ALLOW_OUTSIDE_PATHS`` environment variable) says this manifest is trusted.
     """
+    from ._schema import check_manifest, read_json_file
+
     folder = Path(folder)
     path = folder / MANIFEST if folder.is_dir() else folder
     folder = path.parent
-    if not path.exists():
+    if not path.is_file():
         raise WoodcamError(
             f"folder {str(folder)!r} must hold a {MANIFEST} manifest; none found. "
             "Use read_mokume() for a Mokume sample folder"
         )
-    try:
-        m = json.loads(path.read_text())
-    except json.JSONDecodeError as err:
-        raise WoodcamError(f"{str(path)!r} must be valid JSON; {err}") from err
-    if m.get("format") != FORMAT:
-        raise WoodcamError(f"{str(path)!r} must have \"format\": \"{FORMAT}\"; got {m.get('format')!r}")
+    m = check_manifest(read_json_file(path, "block manifest"), folder, str(path), allow_outside)
+    files = m["_paths"]
     faces = {}
     for name, entry in m.get("faces", {}).items():
-        shape = tuple(entry["shape"])
+        shape = tuple(int(v) for v in entry["shape"])
         photo = ring_map = None
         if entry.get("photo"):
-            photo = _read_png(folder / entry["photo"], f"photo of face {name!r}")
-            if photo.ndim == 2:
-                photo = np.repeat(photo[..., None], 3, axis=2)
-            photo = photo[..., :3].astype(np.uint8, copy=False)
+            photo = _photo_rgb8(_read_png(files[f"faces.{name}.photo"], f"photo of face {name!r}"))
             _check_shape(photo, shape, f"photo of face {name!r} ({entry['photo']})")
         if entry.get("ring_map"):
-            bits = int(entry.get("ring_map_bits", 8))
-            raw = _read_png(folder / entry["ring_map"], f"ring map of face {name!r}")
+            raw = _read_png(files[f"faces.{name}.ring_map"], f"ring map of face {name!r}")
+            bits = int(entry.get("ring_map_bits", 16 if raw.dtype == np.uint16 else 8))
             if raw.ndim == 3:
                 raw = raw[..., 0]
             _check_shape(raw, shape, f"ring map of face {name!r} ({entry['ring_map']})")
+            if raw.size and int(raw.max()) > 2 ** bits - 1:
+                raise WoodcamError(
+                    f"ring map of face {name!r} ({entry['ring_map']}) holds values up to "
+                    f"{int(raw.max())}, more than ring_map_bits = {bits} allows; set "
+                    f"\"ring_map_bits\": 16 for a 16-bit PNG")
             ring_map = (raw.astype(np.float64) / (2 ** bits - 1)).astype(np.float32)
         traces = [RingTrace(np.asarray(t["points_px"], dtype=float), t.get("year"))
                   for t in entry.get("traces", [])]
         if entry.get("traces_svg"):
             from .svg import read_traces_svg
 
-            traces += read_traces_svg(folder / entry["traces_svg"], shape)
-        extras = {k: _read_extra(folder, v, shape, f"extras[{k!r}] of face {name!r}")
+            traces += read_traces_svg(files[f"faces.{name}.traces_svg"], shape)
+        extras = {k: _read_extra(files.get(f"faces.{name}.extras.{k}.png"), v, shape,
+                                 f"extras[{k!r}] of face {name!r}")
                   for k, v in entry.get("extras", {}).items()}
         faces[name] = Face(name, shape, photo=photo, traces=traces, ring_map=ring_map, extras=extras)
     return Block(
-        tuple(m["size_mm"]), faces=faces, true_field=_read_field(m.get("true_field"), folder),
+        tuple(float(v) for v in m["size_mm"]), faces=faces,
+        true_field=_read_field(m.get("true_field"), files.get("true_field.file")),
         name=m.get("name", folder.name), meta=m.get("meta", {}),
     )
 
@@ -211,9 +217,9 @@ def _write_extra(folder: Path, face: str, key: str, value) -> dict:
     return {"json": jsonable(value, f"extras[{key!r}] of face {face!r}")}
 
 
-def _read_extra(folder: Path, entry: dict, shape, what: str):
+def _read_extra(png: Path | None, entry: dict, shape, what: str):
     if "png" in entry:
-        a = _read_png(folder / entry["png"], what)
+        a = _read_png(png, what)
         _check_shape(a, shape, what)
         if entry.get("dtype") == "bool":
             return a > 127
@@ -242,15 +248,23 @@ def _write_field(field, folder: Path) -> dict:
         if target.exists():
             target.unlink()
         return {"saved": False, "type": kind, "reason": f"to_dict() failed: {err}"}
-    target.write_text(json.dumps(state))
+    write_text(target, json.dumps(state))
     return {"saved": True, "type": kind, "file": target.name}
 
 
-def _read_field(entry, folder: Path):
+def _read_field(entry, path: Path | None):
     if not entry or not entry.get("saved"):
         return None
-    state = json.loads((folder / entry["file"]).read_text())
-    return field_from_state({"type": entry["type"], "state": state})
+    from ._schema import read_json_file
+
+    state = read_json_file(path, "true field of the block")
+    try:
+        return field_from_state({"type": entry["type"], "state": state})
+    except (KeyError, TypeError, ValueError, IndexError, AttributeError) as err:
+        if isinstance(err, WoodcamError):
+            raise
+        raise WoodcamError(f"true field {str(path)!r} does not hold a valid {entry['type']} "
+                           f"({type(err).__name__}: {err}); rewrite the block or drop the file") from err
 
 
 # -- images ---------------------------------------------------------------------------------------
@@ -262,24 +276,64 @@ def _write_png(path: Path, a: np.ndarray) -> None:
     if a.dtype == np.uint16:
         if a.ndim != 2:
             raise WoodcamError(f"16-bit PNGs must be single-channel; got shape {a.shape} for {path.name}")
-        Image.fromarray(a).save(path)  # PIL picks mode I;16 for 2-D uint16
+        img = Image.fromarray(a)  # PIL picks mode I;16 for 2-D uint16
     else:
-        Image.fromarray(np.ascontiguousarray(a)).save(path)
+        img = Image.fromarray(np.ascontiguousarray(a))
+    with atomic_path(path) as tmp:  # a complete PNG or none
+        img.save(tmp, format="PNG")
 
 
 def _read_png(path: Path, what: str) -> np.ndarray:
     from PIL import Image
 
-    if not path.exists():
+    from ..limits import limit
+
+    if not path.is_file():
         raise WoodcamError(f"{what}: image file {str(path)!r} is listed but missing")
-    with Image.open(path) as im:
-        if im.mode in ("I;16", "I;16B", "I;16L"):
-            return np.asarray(im).astype(np.uint16)
-        if im.mode == "I":
-            return np.asarray(im).astype(np.uint16)
-        if im.mode in ("P", "LA", "RGBA", "CMYK", "1"):
-            im = im.convert("RGB" if im.mode in ("P", "RGBA", "CMYK") else "L")
-        return np.asarray(im)
+    try:
+        with Image.open(path) as im:
+            if im.width * im.height > limit("MAX_IMAGE_PIXELS"):
+                raise WoodcamError(
+                    f"{what}: {str(path)!r} is {im.width}x{im.height} px, more than the limit "
+                    f"MAX_IMAGE_PIXELS = {limit('MAX_IMAGE_PIXELS'):.0f}; downscale it, or raise "
+                    "the limit with WOODCAM_MAX_IMAGE_PIXELS=N")
+            im.load()  # decode now: a truncated file fails here, inside the try
+            return _image_array(im)
+    except WoodcamError:
+        raise
+    except (OSError, SyntaxError, ValueError, Image.DecompressionBombError) as err:
+        # PIL raises UnidentifiedImageError (an OSError) for 0-byte/unknown files, OSError for
+        # truncated data, SyntaxError/ValueError for some malformed headers
+        raise WoodcamError(f"{what}: cannot decode the image {str(path)!r} ({err}); the file "
+                           "is damaged or not an image: re-export it as PNG") from err
+
+
+def _photo_rgb8(a: np.ndarray) -> np.ndarray:
+    """A decoded photo as (rows, cols, 3) uint8: grey repeated to RGB, 16-bit scaled by 1/257
+    (65535 -> 255) rather than wrapped modulo 256."""
+    if a.dtype == np.uint16:
+        a = np.round(a / 257.0).astype(np.uint8)
+    if a.ndim == 2:
+        a = np.repeat(a[..., None], 3, axis=2)
+    return a[..., :3].astype(np.uint8, copy=False)
+
+
+def _image_array(im) -> np.ndarray:
+    """A decoded PIL image as uint8 (8-bit modes) or uint16 (16-bit modes, values kept)."""
+    if im.mode in ("I;16", "I;16B", "I;16L", "I;16N"):
+        return np.asarray(im).astype(np.uint16)
+    if im.mode == "I":
+        a = np.asarray(im)
+        if a.size and (a.min() < 0 or a.max() > 65535):
+            raise WoodcamError(f"32-bit integer image with values outside 0..65535 "
+                               f"({a.min()}..{a.max()}); save it as 8- or 16-bit")
+        return a.astype(np.uint16)
+    if im.mode in ("RGB;16", "RGBA;16") or im.mode.startswith(("F", "RGBa")):
+        raise WoodcamError(f"image mode {im.mode} is not supported; save it as 8- or 16-bit PNG")
+    if im.mode not in ("L", "RGB"):
+        im = im.convert("RGB" if im.mode in ("P", "RGBA", "CMYK", "YCbCr", "LAB", "HSV", "PA")
+                        else "L")
+    return np.asarray(im)
 
 
 def _check_shape(a: np.ndarray, shape, what: str) -> None:
@@ -291,6 +345,30 @@ def _check_shape(a: np.ndarray, shape, what: str) -> None:
 
 
 # -- Mokume sample folders -----------------------------------------------------------------------
+
+def read_block_folder(folder, size_mm: tuple[float, float, float] | None = None) -> Block:
+    """Read a block folder of either kind: the one rule every reader of a folder uses.
+
+    A folder with a ``block.json`` manifest (or the manifest's own path) is read by
+    :func:`read_block`; any other folder is read as a Mokume sample folder by
+    :func:`read_mokume`, with cube size ``size_mm`` (default :data:`MOKUME_DEFAULT_SIZE_MM`;
+    ignored for a manifest folder, whose manifest records its size).
+
+    Raises
+    ------
+    WoodcamError
+        When the folder does not exist, or is neither kind (no manifest, no Mokume files).
+    """
+    folder = Path(folder)
+    if folder.name == MANIFEST and folder.is_file():
+        folder = folder.parent
+    if not folder.is_dir():
+        raise WoodcamError(f"folder must be a block folder (with {MANIFEST}) or a Mokume sample "
+                           f"folder; {str(folder)!r} does not exist")
+    if (folder / MANIFEST).is_file():
+        return read_block(folder)
+    return read_mokume(folder, MOKUME_DEFAULT_SIZE_MM if size_mm is None else tuple(size_mm))
+
 
 def read_mokume(folder, size_mm=MOKUME_DEFAULT_SIZE_MM, *, name: str | None = None) -> Block:
     """Read one Mokume sample folder (``X_col.png``, ``X_arl-unet.png``, ... for X = A..F).
@@ -339,9 +417,7 @@ def read_mokume(folder, size_mm=MOKUME_DEFAULT_SIZE_MM, *, name: str | None = No
         photo = ring_map = None
         extras = {}
         if "col" in images:
-            a = images["col"]
-            photo = np.repeat(a[..., None], 3, axis=2) if a.ndim == 2 else a[..., :3]
-            photo = photo.astype(np.uint8, copy=False)
+            photo = _photo_rgb8(images["col"])
         if "arl-unet" in images:
             a = images["arl-unet"]
             a = a[..., 0] if a.ndim == 3 else a

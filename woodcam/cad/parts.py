@@ -243,7 +243,21 @@ def _load_mesh_file(path: Path):
             f"{origin} could not be read as {path.suffix.upper().lstrip('.')} "
             f"({type(err).__name__}: {err}); check that it is a mesh file and re-export it"
         ) from err
+    _undo_woodcam_export_frame(scene, path)
     return _manifold_from_scene(scene, origin)
+
+
+def _undo_woodcam_export_frame(scene, path: Path) -> None:
+    """A GLB/OBJ written by woodcam is metres and Y up on disk (glTF/OBJ conventions); put it
+    back in the block frame (mm, Z up) so re-baking an exported part lands where it was cut."""
+    from woodcam.frames import GLTF_ROOT_NODE, obj_header_transform
+
+    if GLTF_ROOT_NODE in scene.graph.nodes:
+        scene.graph.update(frame_to=GLTF_ROOT_NODE, matrix=np.eye(4))
+    elif path.suffix.lower() == ".obj":
+        recorded = obj_header_transform(path)
+        if recorded is not None:
+            scene.apply_transform(np.linalg.inv(recorded))
 
 
 # --------------------------------------------------------------------------------- meshes

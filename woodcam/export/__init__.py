@@ -2,10 +2,20 @@
 
 Data form
 ---------
-Meshes are ``trimesh.Trimesh`` in the block frame, millimetres, with ``TextureVisuals`` (uv in
-trimesh/OBJ convention, origin bottom-left; see :mod:`woodcam.bake`). Both formats are written by
-trimesh's exporters; glTF has no unit field and is metres by convention, so the numbers are
-written unchanged (mm) and ``woodcam`` metadata says ``"units": "mm"``.
+Meshes are ``trimesh.Trimesh`` in the block frame, millimetres, Z up, with ``TextureVisuals``
+(uv in trimesh/OBJ convention, origin bottom-left; see :mod:`woodcam.bake`). Both formats are
+written by trimesh's exporters and follow their consumers' conventions:
+
+* **GLB** (glTF 2.0 is metres, +Y up, +Z towards the viewer): the vertex buffer keeps the block
+  frame in mm and one root node carries :data:`BLOCK_TO_GLTF` (scale 1/1000 and the rotation
+  block ``(x, y, z)`` -> glTF ``(x, z, -y)``), so Blender, three.js and every other viewer show
+  the part upright at its real size, and the block frame stays exactly recoverable (the matrix
+  is also recorded in the metadata). The texture has an explicit clamp-to-edge sampler.
+* **OBJ** has no unit or axis field: ``units`` (``"m"`` default, what Blender and most DCC tools
+  assume) and ``up`` (``"y"`` default, the OBJ habit) are chosen by the caller and written in a
+  ``# woodcam:`` header comment that :func:`load_textured` reads back.
+* **Normals**: smooth shading normals split at a crease angle (:data:`woodcam.tolerances.
+  CREASE_ANGLE_DEG`, 30 deg): corners whose faces meet at a sharper edge get their own vertex.
 
 Metadata
 --------
@@ -19,12 +29,17 @@ from __future__ import annotations
 
 import copy
 import json
+import math
 import struct
 from pathlib import Path
+from typing import get_args
 
 import numpy as np
 
+from woodcam._atomic import atomic_files, check_output_path, write_bytes
 from woodcam.errors import WoodcamError
+from woodcam.frames import (BLOCK_TO_GLTF, GLTF_ROOT_NODE, OBJ_HEADER, ObjUnits, ObjUp,
+                            obj_header_transform, obj_transform)
 
 #: Key under the glTF scene ``extras`` that holds woodcam's metadata.
 GLB_METADATA_KEY = "woodcam"
@@ -33,6 +48,10 @@ _GLB_MAGIC = 0x46546C67  # b"glTF" little-endian
 _GLB_CHUNK_JSON = 0x4E4F534A  # b"JSON"
 _GL_ARRAY_BUFFER = 34962
 _GL_ELEMENT_ARRAY_BUFFER = 34963
+_GL_LINEAR = 9729
+_GL_LINEAR_MIPMAP_LINEAR = 9987
+_GL_CLAMP_TO_EDGE = 33071
+
 
 
 def _require_textured(mesh, func: str):
@@ -47,8 +66,99 @@ def _require_textured(mesh, func: str):
         )
 
 
-def export_glb(mesh, path, metadata: dict | None = None) -> Path:
-    """Write ``mesh`` as a binary glTF with its texture embedded.
+def crease_normals(mesh, crease_angle_deg: float | None = None):
+    """Split ``mesh``'s vertices where faces meet at an edge sharper than the crease angle and
+    give every vertex a smooth shading normal.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+        Triangle mesh (mm); its texture (``visual.uv`` + material) is carried over.
+    crease_angle_deg : float or None
+        Faces round a position whose normals differ by less than this share a normal (their
+        area-weighted mean); default :data:`woodcam.tolerances.CREASE_ANGLE_DEG`.
+
+    Returns
+    -------
+    trimesh.Trimesh
+        Same triangles and corner positions/uv in the same face order, vertices split where a
+        corner needs another normal, ``vertex_normals (m, 3)`` unit.
+
+    Notes
+    -----
+    Positions, not vertex indices, decide which faces meet (the baked mesh is split at UV seams,
+    and a seam must not become a shading seam). Vectorised: a sparse corner x corner matrix of
+    "same position and within the crease angle" times the angle-weighted face normals.
+    """
+    import trimesh
+    from scipy import sparse
+
+    from woodcam.tolerances import CREASE_ANGLE_DEG, CREASE_WELD_MM
+
+    angle = CREASE_ANGLE_DEG if crease_angle_deg is None else float(crease_angle_deg)
+    if not (math.isfinite(angle) and 0.0 <= angle <= 180.0):
+        raise WoodcamError(
+            f"crease_normals: crease_angle_deg must be in [0, 180]; got {crease_angle_deg!r}; "
+            "use e.g. 30 (0 = flat shading, 180 = smooth everywhere)"
+        )
+    verts = np.asarray(mesh.vertices, dtype=np.float64)
+    faces = np.asarray(mesh.faces, dtype=np.int64)
+    n_faces = len(faces)
+    corners = faces.reshape(-1)
+    face_of_corner = np.repeat(np.arange(n_faces), 3)
+    cross = np.cross(verts[faces[:, 1]] - verts[faces[:, 0]], verts[faces[:, 2]] - verts[faces[:, 0]])
+    area2 = np.linalg.norm(cross, axis=1)
+    unit = cross / np.maximum(area2, 1e-300)[:, None]
+    # position id of every corner (welded at CREASE_WELD_MM)
+    keys = np.round(verts / CREASE_WELD_MM).astype(np.int64)
+    _, pos_of_vertex = np.unique(keys, axis=0, return_inverse=True)
+    pos = pos_of_vertex.reshape(-1)[corners]
+    n_corners = len(corners)
+    incidence = sparse.csr_matrix((np.ones(n_corners), (np.arange(n_corners), pos)),
+                                  shape=(n_corners, int(pos.max()) + 1))
+    same = (incidence @ incidence.T).tocoo()
+    a, b = same.row, same.col
+    cos = np.einsum("ij,ij->i", unit[face_of_corner[a]], unit[face_of_corner[b]])
+    keep = cos >= math.cos(math.radians(angle)) - 1e-12
+    a, b = a[keep], b[keep]
+    # Angle-weighted normals (Thuerrner & Wuethrich 1998): each neighbour corner weighs its
+    # face's normal by its own corner angle, so the result does not depend on how a flat
+    # region happens to be triangulated (area weights tilt a box corner towards the face
+    # that has two triangles there).
+    tri = verts[faces]
+    e1 = np.roll(tri, -1, axis=1) - tri
+    e2 = np.roll(tri, 1, axis=1) - tri
+    cos_corner = np.einsum("fij,fij->fi", e1, e2) / np.maximum(
+        np.linalg.norm(e1, axis=2) * np.linalg.norm(e2, axis=2), 1e-300)
+    corner_angle = np.arccos(np.clip(cos_corner, -1.0, 1.0)).reshape(-1)
+    weighted = unit[face_of_corner] * corner_angle[:, None]
+    normal = np.zeros((n_corners, 3))
+    for k in range(3):
+        normal[:, k] = np.bincount(a, weights=weighted[b, k], minlength=n_corners)
+    length = np.linalg.norm(normal, axis=1)
+    degenerate = length < 1e-300
+    normal[degenerate] = unit[face_of_corner[degenerate]]
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+    # one output vertex per (input vertex, normal)
+    qn = np.round(normal * 1e6).astype(np.int64)
+    table = np.column_stack([corners, qn])
+    _, first, new_index = np.unique(table, axis=0, return_index=True, return_inverse=True)
+    new_index = new_index.reshape(-1)
+    src = corners[first]
+    out_visual = None
+    visual = getattr(mesh, "visual", None)
+    if getattr(visual, "kind", None) == "texture" and getattr(visual, "uv", None) is not None:
+        out_visual = trimesh.visual.TextureVisuals(uv=np.asarray(visual.uv)[src],
+                                                   material=visual.material)
+    out = trimesh.Trimesh(vertices=verts[src], faces=new_index.reshape(-1, 3), visual=out_visual,
+                          process=False)
+    out.vertex_normals = normal[first]
+    return out
+
+
+def export_glb(mesh, path, metadata: dict | None = None, *,
+               crease_angle_deg: float | None = None) -> Path:
+    """Write ``mesh`` as a binary glTF (metres, Y up) with its texture embedded.
 
     Parameters
     ----------
@@ -58,22 +168,22 @@ def export_glb(mesh, path, metadata: dict | None = None) -> Path:
         Output ``.glb`` file; parent folders are created.
     metadata : dict or None
         JSON-serialisable data stored as ``scenes[0].extras["woodcam"]``.
+    crease_angle_deg : float or None
+        Shading normals: smooth across edges flatter than this, split at sharper ones (default
+        :data:`woodcam.tolerances.CREASE_ANGLE_DEG`); see :func:`crease_normals`.
 
     Returns
     -------
     Path
-        The written file.
+        The written file. Its scene has one root node ``woodcam_block_frame`` with matrix
+        :data:`BLOCK_TO_GLTF` above the mesh node (vertices in block-frame mm).
     """
     import trimesh
     from trimesh.exchange.gltf import export_glb as _trimesh_export_glb
 
     _require_textured(mesh, "export_glb")
-    path = Path(path)
-    if path.suffix.lower() != ".glb":
-        raise WoodcamError(
-            f"export_glb: path must end in .glb; got {str(path)!r}; use e.g. 'part.glb'"
-        )
-    payload = {"units": "mm", "frame": "block"}
+    path = check_output_path(path, suffixes=(".glb",), what="export_glb: path", mkdir=True)
+    payload = {"units": "mm", "frame": "block", "block_to_gltf": BLOCK_TO_GLTF.tolist()}
     if metadata is not None:
         try:
             payload.update(json.loads(json.dumps(metadata)))
@@ -87,13 +197,22 @@ def export_glb(mesh, path, metadata: dict | None = None) -> Path:
         scene = tree["scenes"][tree.get("scene", 0)]
         extras = scene.setdefault("extras", {})
         extras[GLB_METADATA_KEY] = payload
+        nodes = tree.setdefault("nodes", [])
+        nodes.append({"name": GLTF_ROOT_NODE, "children": list(scene.get("nodes", [])),
+                      # glTF matrices are column-major
+                      "matrix": [float(v) for v in BLOCK_TO_GLTF.T.reshape(-1)]})
+        scene["nodes"] = [len(nodes) - 1]
+        tree["samplers"] = [{"magFilter": _GL_LINEAR, "minFilter": _GL_LINEAR_MIPMAP_LINEAR,
+                             "wrapS": _GL_CLAMP_TO_EDGE, "wrapT": _GL_CLAMP_TO_EDGE}]
+        for texture in tree.get("textures", []):
+            texture["sampler"] = 0
         _set_buffer_view_targets(tree)
 
+    shaded = crease_normals(mesh, crease_angle_deg)
     scene = trimesh.Scene()
-    scene.add_geometry(mesh, geom_name="part", node_name="part")
-    data = _trimesh_export_glb(scene, tree_postprocessor=_add_extras)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_bytes(data)
+    scene.add_geometry(shaded, geom_name="part", node_name="part")
+    data = _trimesh_export_glb(scene, include_normals=True, tree_postprocessor=_add_extras)
+    write_bytes(path, data)  # atomic: a complete GLB or none
     return path
 
 
@@ -113,7 +232,8 @@ def _set_buffer_view_targets(tree: dict) -> None:
                     views[view]["target"] = target
 
 
-def export_obj(mesh, path) -> Path:
+def export_obj(mesh, path, *, units: ObjUnits = "m", up: ObjUp = "y",
+               crease_angle_deg: float | None = None) -> Path:
     """Write ``mesh`` as ``NAME.obj`` + ``NAME.mtl`` + ``NAME.png`` side by side.
 
     Parameters
@@ -122,24 +242,37 @@ def export_obj(mesh, path) -> Path:
         Textured mesh, mm, block frame.
     path : str or Path
         Output ``.obj`` file; the material library and texture take its stem.
+    units : {"m", "mm"}
+        Length unit of the written coordinates. OBJ has no unit field; ``"m"`` (default) is what
+        Blender and most viewers assume, ``"mm"`` what CAM tools and slicers assume.
+    up : {"y", "z"}
+        Up axis of the written coordinates: ``"y"`` (default, the OBJ habit: block ``(x, y, z)``
+        is written as ``(x, z, -y)``) or ``"z"`` (the block frame unchanged).
+    crease_angle_deg : float or None
+        Shading normals (``vn``) split at sharper edges; see :func:`crease_normals`.
 
     Returns
     -------
     Path
-        The written ``.obj`` file.
+        The written ``.obj`` file. Its first line records units and up axis
+        (``# woodcam: units=m up=y``) so :func:`load_textured` returns the block frame.
     """
     from trimesh.exchange.obj import export_obj as _trimesh_export_obj
 
     _require_textured(mesh, "export_obj")
-    path = Path(path)
-    if path.suffix.lower() != ".obj":
-        raise WoodcamError(
-            f"export_obj: path must end in .obj; got {str(path)!r}; use e.g. 'part.obj'"
-        )
+    path = check_output_path(path, suffixes=(".obj",), what="export_obj: path", mkdir=True)
+    if units not in get_args(ObjUnits):
+        raise WoodcamError(f"export_obj: units must be one of {get_args(ObjUnits)}; got {units!r}")
+    if up not in get_args(ObjUp):
+        raise WoodcamError(f"export_obj: up must be one of {get_args(ObjUp)}; got {up!r}")
     stem = path.stem
-    # trimesh names the image after the material: a shallow copy named after the file gives
-    # NAME.png without touching the caller's mesh.
-    out = mesh.copy(include_cache=False) if hasattr(mesh, "copy") else copy.copy(mesh)
+    # trimesh names the image after the material: a copy named after the file gives NAME.png
+    # without touching the caller's mesh.
+    out = crease_normals(mesh, crease_angle_deg)
+    normals = np.asarray(out.vertex_normals, dtype=np.float64)
+    transform = obj_transform(units, up)
+    out.vertices = np.asarray(out.vertices) @ transform[:3, :3].T
+    out.vertex_normals = normals @ transform[:3, :3].T / np.linalg.norm(transform[:3, 0])
     material = out.visual.material
     if hasattr(material, "to_simple"):
         material = material.to_simple()
@@ -153,17 +286,25 @@ def export_obj(mesh, path) -> Path:
         material.image.format = "PNG"
     out.visual.material = material
     text, files = _trimesh_export_obj(
-        out, include_texture=True, return_texture=True, mtl_name=f"{stem}.mtl"
+        out, include_normals=True, include_texture=True, return_texture=True,
+        mtl_name=f"{stem}.mtl", digits=9
     )
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text)
-    for name, blob in files.items():
-        (path.parent / name).write_bytes(blob)
+    header = (f"{OBJ_HEADER} units={units} up={up} (block frame: mm, Z up; "
+              f"see woodcam.export.export_obj)\n")
+    # OBJ + MTL + PNG as one unit: all renamed into place only once every one is written, the
+    # OBJ (which references the others) last.
+    names = list(files)
+    with atomic_files([path] + [path.parent / n for n in names]) as temps:
+        temps[0].write_text(header + text)
+        for tmp, name in zip(temps[1:], names):
+            tmp.write_bytes(files[name])
     return path
 
 
 def load_textured(path):
-    """Load a GLB or OBJ written by this module as ONE textured ``trimesh.Trimesh``.
+    """Load a GLB or OBJ written by this module as ONE textured ``trimesh.Trimesh`` in the block
+    frame (mm, Z up): the GLB root transform and the OBJ's recorded units/up axis are undone.
+    Other files come back as their node transforms place them.
 
     Vertices are not merged (``process=False``), so the vertex count is the exported one.
 
@@ -178,6 +319,14 @@ def load_textured(path):
     if not path.is_file():
         raise WoodcamError(f"load_textured: no file at {str(path)!r}; check the path")
     loaded = trimesh.load(path, process=False, maintain_order=True)
+    if path.suffix.lower() == ".obj" and not isinstance(loaded, trimesh.Scene):
+        recorded = obj_header_transform(path)
+        if recorded is not None:
+            inverse = np.linalg.inv(recorded)
+            normals = np.asarray(loaded.vertex_normals, dtype=np.float64)
+            loaded.vertices = np.asarray(loaded.vertices) @ inverse[:3, :3].T
+            loaded.vertex_normals = normals @ inverse[:3, :3].T / np.linalg.norm(inverse[:3, 0])
+        return loaded
     if isinstance(loaded, trimesh.Scene):
         geoms = list(loaded.geometry.values())
         if len(geoms) != 1:
@@ -187,12 +336,30 @@ def load_textured(path):
             )
         node = loaded.graph.nodes_geometry[0]
         transform = loaded.graph[node][0]
-        if np.allclose(transform, np.eye(4)):
-            # files written here: keep the geometry as stored, with its NORMAL attribute
+        if np.allclose(transform, np.eye(4)) or (
+                path.suffix.lower() == ".glb" and np.allclose(transform, BLOCK_TO_GLTF)
+                and read_glb_metadata(path).get("frame") == "block"):
+            # files written here: the vertex buffer is the block frame (mm); keep it as stored,
+            # with its NORMAL attribute
             loaded = geoms[0]
         else:  # someone else's file with a node transform: bake it into the vertices
             loaded = loaded.to_mesh()
     return loaded
+
+
+def written_by_woodcam(path) -> bool:
+    """True for a GLB or OBJ written by :func:`export_glb` / :func:`export_obj` (then
+    :func:`load_textured` returns it in the block frame); False for any other file."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".glb":
+            return read_glb_metadata(path).get("frame") == "block"
+        if suffix == ".obj":
+            return obj_header_transform(path) is not None
+    except (OSError, WoodcamError, ValueError):
+        return False
+    return False
 
 
 def read_glb_metadata(path) -> dict:

@@ -10,6 +10,7 @@ always computed from the interpolated growth time, never interpolated itself.
 
 from __future__ import annotations
 
+import zipfile
 from dataclasses import dataclass, field as dc_field
 from pathlib import Path
 from typing import Literal
@@ -60,8 +61,10 @@ class GridField:
         if self.interpolation not in _ORDER:
             raise WoodcamError(f"interpolation must be one of {list(_ORDER)}; got {self.interpolation!r}")
         sp = np.broadcast_to(np.asarray(self.spacing_mm, dtype=float), (3,))
-        if np.any(sp <= 0):
-            raise WoodcamError(f"spacing_mm must be > 0; got {self.spacing_mm!r}")
+        if not np.all(np.isfinite(sp) & (sp > 0)):
+            raise WoodcamError(f"spacing_mm must be finite and > 0; got {self.spacing_mm!r}")
+        if not np.all(np.isfinite(np.asarray(self.origin_mm, float))):
+            raise WoodcamError(f"origin_mm must be finite; got {self.origin_mm!r}")
         object.__setattr__(self, "years", g)
         object.__setattr__(self, "spacing_mm", tuple(sp))
         object.__setattr__(self, "origin_mm", tuple(np.asarray(self.origin_mm, float)))
@@ -77,7 +80,7 @@ class GridField:
 
     @classmethod
     def bake(cls, field, lo_mm, hi_mm, spacing_mm: float = 2.0, *, margin_nodes: int = 2,
-             interpolation: Interpolation = "cubic") -> "GridField":
+             interpolation: Interpolation = "cubic") -> GridField:
         """Sample ``field`` on a grid covering the box ``[lo_mm, hi_mm]`` plus a margin.
 
         The margin keeps the spline's border handling away from the box, so interpolation
@@ -118,32 +121,27 @@ class GridField:
         if path.suffix != ".npz":
             path = path.with_suffix(path.suffix + ".npz")
         import json
-        import os
-        import tempfile
+
+        from .._atomic import atomic_write
 
         extra = {} if self.uncertainty is None else {"uncertainty": self.uncertainty}
-        fd, tmp = tempfile.mkstemp(suffix=".npz", dir=path.parent)
-        os.close(fd)
-        try:  # atomic: a reader never sees half a file
-            np.savez_compressed(tmp, years=self.years, origin_mm=self.origin_mm,
+        with atomic_write(path) as fh:  # a reader never sees half a file
+            np.savez_compressed(fh, years=self.years, origin_mm=self.origin_mm,
                                 spacing_mm=self.spacing_mm, interpolation=self.interpolation,
                                 axis=self.axis, meta=json.dumps(self.meta), **extra)
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.remove(tmp)
         return path
 
     @classmethod
-    def load(cls, path) -> "GridField":
+    def load(cls, path) -> GridField:
         try:
             import json
 
-            with np.load(Path(path)) as z:
+            # our own handle: np.load leaks it when the zip is truncated
+            with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as z:
                 meta = json.loads(str(z["meta"])) if "meta" in z.files else {}
                 unc = z["uncertainty"] if "uncertainty" in z.files else None
                 return cls(z["years"], tuple(z["origin_mm"]), tuple(z["spacing_mm"]),
                            str(z["interpolation"]), tuple(z["axis"]), unc, meta)
-        except (OSError, KeyError, ValueError) as err:
+        except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile) as err:
             raise WoodcamError(f"{path}: not a woodcam grid field (.npz with 'years', "
                                f"'origin_mm', 'spacing_mm'): {err}") from err

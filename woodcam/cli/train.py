@@ -5,7 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 
-def add_parser(subparsers) -> None:
+def register(subparsers) -> None:
+    """Add ``train gtf``."""
     p = subparsers.add_parser("train", help="train a learned model (gtf: the generic neural growth field)")
     p.add_argument("what", choices=["gtf"], help="which model to train")
     p.add_argument("--spec", type=Path, default=None,
@@ -18,7 +19,7 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    from .fields.neural import GTFSpec, train_gtf
+    from ..fields.neural import GTFSpec, train_gtf
 
     spec = GTFSpec.load(args.spec) if args.spec is not None else GTFSpec()
     r = train_gtf(spec, args.out, steps=args.steps, resume=not args.no_resume, progress=True)

@@ -1,7 +1,6 @@
 """`woodcam log ...`: sections through knotted logs and log-file conversion (CLI glue only).
 
-Hook into ``woodcam/cli.py`` with ``_cli_log.add_parser(subparsers)``; the parser sets
-``func=run``, so the main CLI calls ``args.func(args)``.
+Registered by :mod:`woodcam.cli` through :func:`register`; the parser sets ``func=run``.
 
     woodcam log render [LOG_FILE | --real | --maps DIR] --out DIR [options]
     woodcam log maps   [LOG_FILE | --real] --out DIR        # write the seed's image maps
@@ -10,13 +9,12 @@ Hook into ``woodcam/cli.py`` with ``_cli_log.add_parser(subparsers)``; the parse
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
-from .errors import WoodcamError
+from ..errors import WoodcamError
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
+def register(subparsers) -> None:
     """Add the ``log`` command (with ``render``, ``maps``, ``export``) to ``subparsers``."""
     p = subparsers.add_parser("log", help="knotted logs: render sections, convert log files")
     sub = p.add_subparsers(dest="log_command", required=True)
@@ -58,12 +56,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     source(e)
     e.add_argument("--out", required=True, help="output .json path")
     e.set_defaults(func=run)
-    return p
 
 
 def _load(args):
-    from .fields.knot_maps import read_maps
-    from .fields.tree_data import read_gran1, read_log
+    from ..fields.knot_maps import read_maps
+    from ..fields.tree_data import read_gran1, read_log
 
     given = [x for x in (args.log_file, args.real or None, args.maps) if x]
     if len(given) != 1:
@@ -83,18 +80,18 @@ def run(args) -> int:
     log = _load(args)
     out = Path(args.out)
     if args.log_command == "export":
-        from .fields.tree_data import write_log
+        from ..fields.tree_data import write_log
 
         print(write_log(log, out))
         return 0
     if args.log_command == "maps":
-        from .fields.knot_maps import write_maps
+        from ..fields.knot_maps import write_maps
 
         for path in write_maps(log, out).values():
             print(path)
         return 0
-    from .fields import log_render as lr
-    from .fields.knots import KnotParams, KnottedLogField
+    from ..fields import log_render as lr
+    from ..fields.knots import KnotParams, KnottedLogField
 
     params = KnotParams(k_stem=args.k_stem, k_knot=args.k_knot,
                         alive_darkening=args.alive_darkening,

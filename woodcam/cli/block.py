@@ -1,16 +1,16 @@
 """``woodcam block ...``: synthesise a benchmark set of blocks, draw a block as an unfolded cross.
 
-``woodcam.cli`` calls :func:`add_parser` with its sub-parsers and :func:`run` with the parsed
-arguments when ``args.command == "block"``.
+Registered by :mod:`woodcam.cli` through :func:`register`; each sub-parser's ``func`` is :func:`run`.
 """
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
+from .options import add_block_argument, add_size_option, open_block
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
+
+def register(subparsers) -> None:
     """Add the ``block`` command (with ``synth`` and ``show``) to an argparse sub-parser set."""
     p = subparsers.add_parser("block", help="synthesise or show blocks (six face photos + rings)")
     p.set_defaults(func=run)          # woodcam.cli dispatches on args.func
@@ -38,13 +38,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="MIN,MAX block side in mm, each side uniform in it (default 30,80)")
 
     v = sub.add_parser("show", help="draw a block's faces as one unfolded-cross PNG")
-    v.add_argument("folder", type=Path, help="block folder (block.json) or Mokume sample folder")
+    add_block_argument(v, option=False)
     v.add_argument("--out", type=Path, required=True, help="PNG to write")
     v.add_argument("--layer", choices=("photo", "ring_map", "both"), default="photo")
     v.add_argument("--no-traces", action="store_true", help="do not draw traced rings")
-    v.add_argument("--size-mm", type=float, default=None,
-                   help="cube side (mm) for a Mokume folder (default 50)")
-    return p
+    add_size_option(v)
 
 
 def run(args) -> int:
@@ -52,9 +50,8 @@ def run(args) -> int:
     if args.block_command == "synth":
         import json
 
-        from .synth import knotted_log_field, synth_benchmark_set
-
-        from .errors import WoodcamError
+        from ..errors import WoodcamError
+        from ..synth import knotted_log_field, synth_benchmark_set
 
         try:
             lo, hi = (float(v) for v in args.size_range_mm.split(","))
@@ -79,44 +76,10 @@ def run(args) -> int:
         print(f"wrote {len(folders)} blocks to {args.out} ({knotted} knotted; index.json lists them)")
         return 0
     if args.block_command == "show":
-        from .block.io import MANIFEST, MOKUME_DEFAULT_SIZE_MM, read_block, read_mokume
-        from .block.render import save_cross_png
+        from ..block.render import save_cross_png
 
-        from .errors import WoodcamError
-
-        folder = Path(args.folder)
-        if not folder.exists():
-            raise WoodcamError(
-                f"folder must be a block folder (with {MANIFEST}) or a Mokume sample folder; "
-                f"{str(folder)!r} does not exist"
-            )
-        if (folder / MANIFEST).exists() or folder.name == MANIFEST:
-            block = read_block(folder)
-        else:
-            s = args.size_mm
-            block = read_mokume(folder, MOKUME_DEFAULT_SIZE_MM if s is None else (s, s, s))
+        block, _ = open_block(args.block, args.size_mm)
         save_cross_png(block, args.out, args.layer, traces=not args.no_traces)
         print(f"wrote {args.out}")
         return 0
     raise AssertionError(args.block_command)  # argparse restricts the choices
-
-
-def main(argv=None) -> int:
-    """Stand-alone entry (``python -m woodcam._cli_block block ...``) until ``woodcam.cli`` wires it."""
-    from .errors import WoodcamError
-
-    parser = argparse.ArgumentParser(prog="woodcam")
-    sub = parser.add_subparsers(dest="command", required=True)
-    add_parser(sub)
-    args = parser.parse_args(argv)
-    try:
-        return args.func(args)        # as woodcam.cli dispatches
-    except WoodcamError as err:
-        import sys
-
-        print(f"woodcam: error: {err}", file=sys.stderr)
-        return 2
-
-
-if __name__ == "__main__":  # pragma: no cover
-    raise SystemExit(main())

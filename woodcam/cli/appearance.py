@@ -1,76 +1,63 @@
-"""``woodcam eval-appearance``: leave-one-face-out evaluation of the appearance models.
+"""``woodcam eval appearance``: leave-one-face-out evaluation of the appearance models.
 
-``woodcam.cli`` calls :func:`add_parser` with its sub-parsers; the parsed ``args.func`` is
-:func:`run`. Each BLOCK is ``builtin:NAME`` (its face photos rendered by ``woodcam.synth`` with
-the synthetic wood, so no appearance model is judged on its own renderings), a Mokume sample
-folder (ring maps are the networks' input: no fitted field is needed) or a block folder
-(its true field if it has one, else its ring maps).
+Registered by :mod:`woodcam.cli` through :func:`register` (the old ``eval-appearance`` spelling
+is an alias). Each BLOCK is resolved by :func:`woodcam.stock.open_block`: ``builtin:NAME`` (its
+face photos rendered by ``woodcam.synth`` with the synthetic wood, so no appearance model is
+judged on its own renderings), a Mokume sample folder (ring maps are the networks' input: no
+fitted field is needed) or a block folder (its true field if it has one, else its ring maps).
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 from pathlib import Path
 
+from .options import add_block_argument, add_size_option, command_group, open_block
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
-    """Add the ``eval-appearance`` command."""
-    p = subparsers.add_parser(
-        "eval-appearance", help="leave-one-face-out test of the neural vs colour-map appearance",
+
+def register(subparsers) -> None:
+    """Add ``eval appearance``."""
+    evals = command_group(subparsers, "eval", help="score fitted rings (eval rings) or "
+                          "appearance models (eval appearance)")
+    p = evals.add_parser(
+        "appearance", help="leave-one-face-out test of the neural vs colour-map appearance",
         description="Hold out each face in turn, learn the appearance from the others, synthesise "
         "the held-out face from its rings and compare it with its photo (colour histogram, "
         "power spectrum and patch-statistics distances; lower is better). Writes a side-by-side "
         "PNG per block and results.json.")
-    p.add_argument("blocks", nargs="+", help="builtin:NAME, a Mokume sample folder or a block folder")
+    add_block_argument(p, option=False, nargs="+")
     p.add_argument("--out", type=Path, required=True, help="output folder")
-    p.add_argument("--size-mm", type=float, default=None, help="cube side (mm) of Mokume folders (default 50)")
+    add_size_option(p)
     p.add_argument("--resolution", type=int, default=128, help="grid cells along the longest side (default 128)")
-    p.add_argument("--quality", choices=("draft", "normal", "high"), default="normal")
+    p.add_argument("--quality", choices=("draft", "normal", "high"), default="normal",
+                   help="training effort of the neural appearance (default normal)")
     p.add_argument("--epochs", type=int, default=None, help="training epochs (overrides --quality's)")
     p.add_argument("--finetune-epochs", type=int, default=None, metavar="N",
                    help="per-axis networks fine-tuned N epochs from the all-faces network "
                    "(default 2; 0 trains each axis from scratch, as seed 000 does)")
     p.add_argument("--augment", action="store_true",
                    help="train on randomly mirrored patches too (measured on H11/CN03: no better)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--end-grain", default=None, metavar="FACES",
                    help="comma-separated end-grain faces (default: from the field; unknown without one)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.set_defaults(func=run)
-    return p
-
-
-def load_eval_block(spec: str, size_mm: float | None = None, face_px: int = 256):
-    """``(block, field)`` for a BLOCK argument (see module docstring); field may be None."""
-    from .block.io import MANIFEST, MOKUME_DEFAULT_SIZE_MM, read_block, read_mokume
-    from .errors import WoodcamError
-
-    if spec.startswith("builtin:"):
-        from .fields.builtin import builtin_block
-        from .synth import synth_block
-
-        b = builtin_block(spec.split(":", 1)[1])
-        return synth_block(b.field, b.size_mm, face_px=face_px, seed=0, name=b.name), b.field
-    path = Path(spec)
-    if (path / MANIFEST).is_file():
-        block = read_block(path)
-        return block, block.true_field
-    if path.is_dir() and any(path.glob("?_col.png")):
-        size = (size_mm,) * 3 if size_mm else MOKUME_DEFAULT_SIZE_MM
-        return read_mokume(path, size), None
-    raise WoodcamError(f"block must be builtin:NAME, a block folder or a Mokume folder; got {spec!r}")
 
 
 def run(args) -> int:
-    """Run ``eval-appearance``; returns the exit status."""
-    from .appearance.evaluation import MODELS, leave_one_face_out, side_by_side, summarise
-    from .frames import check_face
+    """Run ``eval appearance``; returns the exit status."""
+    from ..appearance.evaluation import (
+        MODELS,
+        leave_one_face_out,
+        side_by_side,
+        summarise,
+    )
+    from ..frames import check_face
 
     args.out.mkdir(parents=True, exist_ok=True)
     report = {}
-    for spec in args.blocks:
-        block, field = load_eval_block(spec, args.size_mm)
+    for spec in args.block:
+        block, field = open_block(spec, args.size_mm)
         end_grain = None
         if args.end_grain:
             eg = {check_face(f.strip()) for f in args.end_grain.split(",")}

@@ -1,6 +1,6 @@
 """``woodcam gcode``: G-code + tools -> simulated stock -> baked wood preview (GLB, PNG).
 
-Registered by ``woodcam.cli`` through ``add_parser(subparsers)`` / ``run(args)``.
+Registered by :mod:`woodcam.cli` through :func:`register`; the parser's ``func`` is :func:`run`.
 """
 
 from __future__ import annotations
@@ -11,6 +11,7 @@ import time
 from pathlib import Path
 
 from ..errors import WoodcamError
+from .options import BLOCK_SPEC_HELP, add_bake_options, stock_options, write_screenshot
 
 _EXAMPLES = """\
 examples:
@@ -26,7 +27,7 @@ top-front-left corner (G-code z = 0 on the top face).
 """
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
+def register(subparsers) -> None:
     """Add the ``gcode`` subcommand to ``subparsers`` (an argparse sub-parsers action)."""
     p = subparsers.add_parser(
         "gcode", help="simulate a G-code program on a block and bake the carved wood",
@@ -34,7 +35,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "height field, mesh the remaining stock and bake its wood texture.",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("program", type=Path, help="G-code file (.nc, .gcode, .ngc, .tap)")
-    p.add_argument("--block", required=True, help="block spec: builtin:NAME or a block folder")
+    p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
     p.add_argument("--out", type=Path, required=True, help="output .glb path")
     p.add_argument("--tool", action="append", default=[], metavar="[N=]SPEC",
                    help="a tool, e.g. flat:6.35, ball:3, bull:6:1, vbit:60:12, 2=ball:3 "
@@ -49,18 +50,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--mesh-tol", type=float, default=0.01, metavar="MM",
                    help="merge nearly planar regions of the result mesh within this (default "
                    "0.01 mm)")
-    p.add_argument("--texels-per-mm", type=float, default=10.0, metavar="T",
-                   help="texture resolution on the surface (default 10 = 0.1 mm texels)")
-    p.add_argument("--species", default=None, help="colour preset; default: the block's")
-    p.add_argument("--no-obj", action="store_true", help="write only the GLB, not OBJ+MTL+PNG")
-    p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
-                   help="also render to PNG (default name: OUT with _view.png)")
+    add_bake_options(p)
     p.set_defaults(func=run)
-    return p
 
 
 def _tools_from_args(args, program) -> dict:
-    from .tools import load_tool_table, parse_tool_spec
+    from ..toolpath.tools import load_tool_table, parse_tool_spec
 
     tools = dict(load_tool_table(args.tools)) if args.tools else {}
     unnumbered = []
@@ -95,10 +90,10 @@ def run(args) -> int:
 
     from ..pipeline import preview_mesh
     from ..stock import open_stock
-    from .gcode import read_gcode
-    from .simulate import simulate
+    from ..toolpath.gcode import read_gcode
+    from ..toolpath.simulate import simulate
 
-    stock = open_stock(args.block, species=args.species)
+    stock = open_stock(args.block, **stock_options(args))
     t0 = time.perf_counter()
     program = read_gcode(args.program)
     t_read = time.perf_counter() - t0
@@ -122,14 +117,9 @@ def run(args) -> int:
             "tools": {str(k): v.spec() for k, v in sorted(tools.items())},
             "resolution_mm": float(np.mean(res.cell_mm))}
     out = preview_mesh(mesh, stock, args.out, texels_per_mm=args.texels_per_mm,
-                       obj=not args.no_obj, screenshot=False, progress=True, metadata=meta)
-    if args.screenshot:
-        from ..view import preview
-
-        png = (args.out.with_name(args.out.stem + "_view.png") if args.screenshot is True
-               else Path(args.screenshot))
-        preview(out.files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
-        out.files["png"] = png
+                       obj=not args.no_obj, screenshot=False, progress=True, metadata=meta,
+                       obj_units=args.obj_units, obj_up=args.obj_up)
+    write_screenshot(args, out.files, stock)
     s = res.stats
     print(f"{args.program.name}: {len(program)} moves read in {t_read:.2f} s, simulated on "
           f"{s['grid'][1]}x{s['grid'][0]} cells in {s['wall_s']:.2f} s "

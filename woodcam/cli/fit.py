@@ -1,59 +1,48 @@
-"""``woodcam fit`` and ``woodcam eval``: infer a block's growth field; score fits on cut planes.
+"""``woodcam fit`` and ``woodcam eval rings``: infer a block's growth field; score ring fits.
 
-Wire into ``woodcam/cli.py`` with ``_cli_fit.add_parser(subparsers)``; each subparser sets
-``func`` to the function that runs it.
+Registered by :mod:`woodcam.cli` through :func:`register`; each sub-parser sets ``func``.
 """
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
-from .errors import WoodcamError
+from ..errors import WoodcamError
+from .options import add_block_argument, add_size_option, command_group, open_block
 
 #: Faces used for "partial annotation": three faces meeting at the front-top-left corner, half
 #: of the block's surface (seed 000, section 4.3 traces "half of the block only").
 PARTIAL_FACES = ("front", "top", "left")
 
 
-def _read_block(path, size_mm: float | None = None):
-    """A block folder (block.json) or a Mokume sample folder (A_col.png ...; cube of size_mm)."""
-    from .block.io import read_block, read_mokume
-
-    path = Path(path)
-    if not path.exists():
-        raise WoodcamError(f"block folder {str(path)!r} does not exist; pass a block folder or a "
-                           f"Mokume sample folder")
-    if path.is_dir() and not (path / "block.json").exists() and any(path.glob("A_*.png")):
-        return read_mokume(path) if size_mm is None else read_mokume(path, (size_mm,) * 3)
-    return read_block(path)
+#: The fitting methods of :data:`woodcam.inference.fit.METHODS`, spelled out here so that
+#: ``woodcam --help`` need not import the fitters (numpy, scipy); a test keeps the two equal.
+METHODS = ("evidence", "rbf", "radial", "neural")
 
 
 def _faces(text):
     return None if text in (None, "", "all") else [f.strip() for f in text.split(",") if f.strip()]
 
 
-def add_parser(subparsers) -> None:
-    """Add the ``fit`` and ``eval`` subcommands to an argparse ``subparsers`` object."""
-    from .inference.fit import METHODS
-
+def register(subparsers) -> None:
+    """Add ``fit`` and ``eval rings`` (``eval DIRS`` still means ``eval rings DIRS``)."""
     p = subparsers.add_parser("fit", help="infer a block's growth field from its traced faces")
-    p.add_argument("block_dir", type=Path, help="block folder (manifest, face images, traces) or a "
-                   "Mokume sample folder")
-    p.add_argument("--method", choices=METHODS, default="evidence",
+    add_block_argument(p, option=False)
+    p.add_argument("--method", default="evidence", metavar="{" + ",".join(METHODS) + "}",
                    help="rbf: seed 000's RBF baseline (unlabelled rings numbered by the radial fit); "
                    "neural: seed 000's eq. 5 with the generic neural field (needs torch); radial: "
                    "our pith axis, ring-width shape and growth history by least squares; evidence "
                    "(default): radial pith hypotheses, RBF and radial + residual, chosen by how well "
                    "each predicts the faces it was not fitted to (warns when they contradict it)")
     p.add_argument("--faces", default=None, help="comma-separated faces to use (default: all)")
-    p.add_argument("--size-mm", type=float, default=None,
-                   help="cube side in mm for a Mokume sample folder (its files carry no size)")
+    add_size_option(p)
     p.add_argument("--out", type=Path, required=True, help="field file to write (.npz grid)")
     p.set_defaults(func=run_fit)
 
-    e = subparsers.add_parser(
-        "eval", help="score fits on interior cut planes (seed 000, Table 1) or, for real blocks, "
+    evals = command_group(subparsers, "eval", help="score fitted rings (eval rings) or "
+                          "appearance models (eval appearance)")
+    e = evals.add_parser(
+        "rings", help="score fits on interior cut planes (seed 000, Table 1) or, for real blocks, "
         "by predicting each face from the others",
         description="Blocks with a known true field (synthetic blocks, or --truth) are scored like "
         "seed 000's Table 1: share of predicted ring-line points within 1 / 2 mm of the true line "
@@ -62,10 +51,8 @@ def add_parser(subparsers) -> None:
         "scored leave-one-face-out: each face with a ring map is predicted from the others and "
         "its ring-map ridge compared with the predicted ring lines (share within 1, 2 and 5 px, "
         "both ways).")
-    e.add_argument("block_dirs", type=Path, nargs="+",
-                   help="block folders or Mokume sample folders")
-    e.add_argument("--size-mm", type=float, default=None,
-                   help="cube side in mm for Mokume sample folders (default 50)")
+    add_block_argument(e, option=False, nargs="+")
+    add_size_option(e)
     e.add_argument("--truth", type=Path, nargs="*", default=None,
                    help="true field files (.npz), one per block; default: each block's own")
     e.add_argument("--methods", default="rbf,radial",
@@ -76,15 +63,11 @@ def add_parser(subparsers) -> None:
     e.set_defaults(func=run_eval)
 
 
-def run(args) -> int:
-    """Run the subcommand chosen by :func:`add_parser`; returns the exit status."""
-    return args.func(args)
-
-
 def run_fit(args) -> int:
-    from .inference.fit import fit_block
+    from ..inference.fit import fit_block
 
-    block = _read_block(args.block_dir, args.size_mm)
+    _check_methods([args.method], "--method")
+    block, _ = open_block(args.block, args.size_mm)
     field = fit_block(block, args.method, faces=_faces(args.faces))
     path = field.save(args.out)
     print(f"wrote {path} ({args.method} fit of {block.name}, grid {field.years.shape}, "
@@ -95,15 +78,12 @@ def run_fit(args) -> int:
 
 
 def run_eval(args) -> int:
-    from .fields.grid import GridField
-    from .inference.evaluate import benchmark
-    from .inference.fit import METHODS
+    from ..fields.grid import GridField
+    from ..inference.evaluate import benchmark
 
     methods = _faces(args.methods) or ["rbf", "radial"]
-    bad = [m for m in methods if m not in METHODS]
-    if bad:
-        raise WoodcamError(f"--methods must be from {', '.join(METHODS)}; got {bad}")
-    blocks = [_read_block(p, args.size_mm) for p in args.block_dirs]
+    _check_methods(methods, "--methods")
+    blocks = [open_block(p, args.size_mm)[0] for p in args.block]
     if args.truth:
         if len(args.truth) != len(blocks):
             raise WoodcamError(
@@ -121,7 +101,7 @@ def run_eval(args) -> int:
         print(res["table"])
         print(f"wrote {Path(args.out) / 'table.md'} and cut-plane images")
     if real:
-        from .inference.holdout import leave_one_face_out
+        from ..inference.holdout import leave_one_face_out
 
         for b in real:
             print(f"{b.name}: no true field; scoring each face predicted from the others")
@@ -129,3 +109,9 @@ def run_eval(args) -> int:
             print(res["table"])
         print(f"wrote {Path(args.out)}/<block>_holdout.md and <block>_<method>.png")
     return 0
+
+
+def _check_methods(methods, option: str) -> None:
+    bad = [m for m in methods if m not in METHODS]
+    if bad:
+        raise WoodcamError(f"{option} must be from {', '.join(METHODS)}; got {bad}")

@@ -1,0 +1,137 @@
+"""Atomic output: complete or absent, never partial; output paths checked before work."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from woodcam._atomic import (
+    atomic_files,
+    atomic_path,
+    atomic_write,
+    check_output_path,
+    write_bytes,
+    write_text,
+)
+from woodcam.errors import WoodcamError
+
+
+def _leftovers(folder: Path) -> list[str]:
+    return sorted(p.name for p in folder.iterdir() if ".tmp" in p.name)
+
+
+def test_atomic_write_replaces_and_leaves_no_temp(tmp_path):
+    target = tmp_path / "a.txt"
+    target.write_text("old")
+    write_text(target, "new")
+    assert target.read_text() == "new"
+    assert _leftovers(tmp_path) == []
+    # ordinary permissions, not mkstemp's 0600
+    assert target.stat().st_mode & 0o044 == 0o044 & ~_current_umask()
+
+
+def _current_umask() -> int:
+    m = os.umask(0o022)
+    os.umask(m)
+    return m
+
+
+def test_atomic_write_error_keeps_old_file(tmp_path):
+    target = tmp_path / "a.bin"
+    write_bytes(target, b"old")
+    with pytest.raises(RuntimeError, match="boom"), atomic_write(target, "wb") as fh:
+        fh.write(b"half")
+        raise RuntimeError("boom")
+    assert target.read_bytes() == b"old"
+    assert _leftovers(tmp_path) == []
+
+
+def test_atomic_path_keeps_suffix_for_numpy(tmp_path):
+    target = tmp_path / "c.npz"
+    with atomic_path(target) as tmp:
+        assert tmp.suffix == ".npz" and tmp.parent == tmp_path
+        np.savez(tmp, a=np.arange(3))
+    assert np.load(target)["a"].tolist() == [0, 1, 2]
+    assert _leftovers(tmp_path) == []
+
+
+def test_atomic_files_all_or_nothing(tmp_path):
+    obj, mtl, png = tmp_path / "p.obj", tmp_path / "p.mtl", tmp_path / "p.png"
+    with (pytest.raises(OSError, match="disk full"),
+          atomic_files([obj, mtl, png]) as (t_obj, t_mtl, _t_png)):
+        t_obj.write_text("obj")
+        t_mtl.write_text("mtl")
+        raise OSError("disk full")  # the PNG write fails
+    assert list(tmp_path.iterdir()) == []
+    with atomic_files([obj, mtl, png]) as (t_obj, t_mtl, t_png):
+        t_obj.write_text("obj")
+        t_mtl.write_text("mtl")
+        t_png.write_bytes(b"png")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["p.mtl", "p.obj", "p.png"]
+
+
+def test_atomic_files_rejects_duplicate_targets(tmp_path):
+    with pytest.raises(WoodcamError, match="distinct"), atomic_files([tmp_path / "a", tmp_path / "a"]):
+        pass
+
+
+def test_unique_temp_names_for_concurrent_writers(tmp_path):
+    target = tmp_path / "x.bin"
+    with atomic_path(target) as t1, atomic_path(target) as t2:
+        assert t1 != t2
+        t1.write_bytes(b"1" * 10)
+        t2.write_bytes(b"2" * 10)
+    assert target.read_bytes() in (b"1" * 10, b"2" * 10)
+
+
+@pytest.mark.parametrize("case, match", [
+    ("suffix", "must end in .glb or .obj"),
+    ("dir", "is an existing folder"),
+    ("noparent", "does not exist"),
+    ("parentfile", "is a file, not a folder"),
+])
+def test_check_output_path(tmp_path, case, match):
+    (tmp_path / "d.glb").mkdir()
+    (tmp_path / "f").write_text("")
+    path = {"suffix": tmp_path / "a.stl", "dir": tmp_path / "d.glb",
+            "noparent": tmp_path / "missing" / "a.glb", "parentfile": tmp_path / "f" / "a.glb"}[case]
+    with pytest.raises(WoodcamError, match=match):
+        check_output_path(path, suffixes=(".glb", ".obj"))
+    assert check_output_path(tmp_path / "ok.GLB", suffixes=(".glb",)) == tmp_path / "ok.GLB"
+
+
+def test_check_output_path_unwritable():
+    ro = Path("/proc/self")  # read-only even for root
+    with pytest.raises(WoodcamError, match="not writable"):
+        check_output_path(ro / "a.glb", suffixes=(".glb",))
+
+
+def test_sigkill_mid_write_leaves_old_file_or_nothing(tmp_path):
+    """A writer killed half-way through leaves the previous complete file, never a partial."""
+    target = tmp_path / "big.bin"
+    script = textwrap.dedent(f"""
+        import sys, time
+        from woodcam._atomic import atomic_write
+        with atomic_write({str(target)!r}, "wb") as fh:
+            fh.write(b"x" * 1000)
+            fh.flush()
+            print("ready", flush=True)
+            time.sleep(60)
+            fh.write(b"y")
+    """)
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[2]))
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, env=env)
+    assert proc.stdout.readline().strip() == b"ready"
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    proc.stdout.close()
+    assert not target.exists()  # the temp may linger (hidden), the target never appears partial
+    write_bytes(target, b"done")  # and the next run just works
+    assert target.read_bytes() == b"done"

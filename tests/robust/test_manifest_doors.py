@@ -1,0 +1,182 @@
+"""block.json, images and true-field files are checked at the door: WoodcamError, never a traceback."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from woodcam.block import Block, Face, RingTrace
+from woodcam.block.io import read_block, write_block
+from woodcam.errors import WoodcamError
+
+
+def _block() -> Block:
+    rng = np.random.default_rng(1)
+    face = Face("top", (16, 20), photo=rng.integers(0, 256, (16, 20, 3), dtype=np.uint8),
+                ring_map=rng.uniform(0, 1, (16, 20)).astype(np.float32),
+                traces=[RingTrace(np.array([[1.0, 1.0], [5.0, 9.0], [8.0, 15.0]]), year=3)],
+                extras={"knot_mask": rng.uniform(size=(16, 20)) > 0.8})
+    return Block((30.0, 20.0, 10.0), faces={"top": face}, name="small")
+
+
+@pytest.fixture
+def folder(tmp_path) -> Path:
+    write_block(_block(), tmp_path / "blk")
+    return tmp_path / "blk"
+
+
+def _edit(folder: Path, fn) -> None:
+    p = folder / "block.json"
+    m = json.loads(p.read_text())
+    fn(m)
+    p.write_text(json.dumps(m))
+
+
+def test_valid_folder_round_trips(folder):
+    b = read_block(folder)
+    assert b.size_mm == (30.0, 20.0, 10.0)
+    np.testing.assert_array_equal(b.faces["top"].photo, _block().faces["top"].photo)
+
+
+@pytest.mark.parametrize("edit, match", [
+    (lambda m: m.update(size_mm=[30, "20", 10]), r"size_mm\[1\] must be a number"),
+    (lambda m: m.update(size_mm=[30, 20]), r'"size_mm" must be \[W, D, H\]'),
+    (lambda m: m.pop("size_mm"), r'"size_mm" is required'),
+    (lambda m: m.update(size_mm=[30, 20, -1]), r"size_mm\[2\] must be in \(0"),
+    (lambda m: m.update(size_mm=[30, 20, 1e9]), r"size_mm\[2\] must be in \(0, 10000\]"),
+    (lambda m: m.update(faces=[]), r'"faces" must be a JSON object'),
+    (lambda m: m["faces"].update(sideways={"shape": [2, 2]}), r"must be one of"),
+    (lambda m: m["faces"]["top"].update(shape=[16]), r"faces.top.shape must be \[n_rows, n_cols\]"),
+    (lambda m: m["faces"]["top"].update(shape=[16, 0]), r"shape\[1\] must be an integer in \[1,"),
+    (lambda m: m["faces"]["top"].update(shape=[16, 1e12]), r"shape\[1\] must be an integer in"),
+    (lambda m: m["faces"]["top"].update(ring_map_bits=0), r"ring_map_bits must be 8 or 16"),
+    (lambda m: m["faces"]["top"].update(ring_map_bits=True), r"ring_map_bits must be 8 or 16"),
+    (lambda m: m["faces"]["top"]["traces"][0].update(year=1e12), r"traces\[0\].year must be an integer in"),
+    (lambda m: m["faces"]["top"]["traces"][0].update(year="3"), r"traces\[0\].year must be an integer"),
+    (lambda m: m["faces"]["top"]["traces"][0].update(year=2.5), r"year must be an integer"),
+    (lambda m: m["faces"]["top"]["traces"][0]["points_px"][1].__setitem__(0, 1e9), r"points_px\[1\]\[0\] \(row\) must be in"),
+    (lambda m: m["faces"]["top"]["traces"][0].update(points_px=[[1, 2]]), r"at least 2 points"),
+    (lambda m: m["faces"]["top"]["traces"][0].update(points_px=[[1, 2], [3]]), r"must be \[row, col\]"),
+    (lambda m: m["faces"]["top"]["traces"][0].pop("points_px"), r"points_px is required"),
+    (lambda m: m["faces"]["top"].update(traces={}), r"traces must be a JSON list"),
+    (lambda m: m["faces"]["top"].update(photo=3), r"photo must be a string or null"),
+    (lambda m: m["faces"]["top"]["extras"]["knot_mask"].update(dtype="float64"), r"dtype must be bool, uint8"),
+    (lambda m: m["faces"]["top"]["extras"].update(note=5), r"extras.note must be a JSON object"),
+    (lambda m: m.update(true_field={"saved": True, "type": "os:system", "file": "x.json"}), r"must name a woodcam class"),
+    (lambda m: m.update(format="other"), r'"format" must be "woodcam-block"'),
+    (lambda m: m.update(version=99), r'"version" must be an integer in \[1, 1\]'),
+])
+def test_bad_manifest_is_a_woodcam_error(folder, edit, match):
+    _edit(folder, edit)
+    with pytest.raises(WoodcamError, match=match):
+        read_block(folder)
+
+
+@pytest.mark.parametrize("text, match", [
+    ('{"format": "woodcam-block", "size_mm": [NaN, 1, 1]}', "finite numbers"),
+    ('{"format": "woodcam-block", "size_mm": [Infinity, 1, 1]}', "finite numbers"),
+    ('{"format": "woodcam-block", "size_mm": [1e999, 1, 1]}', "must be a finite number"),
+    ('[' * 100000, "valid JSON"),
+    ('{"format": ', "valid JSON"),
+    ('"just a string"', "must be a JSON object"),
+])
+def test_bad_json_is_a_woodcam_error(tmp_path, text, match):
+    (tmp_path / "block.json").write_text(text)
+    with pytest.raises(WoodcamError, match=match):
+        read_block(tmp_path)
+
+
+def test_non_utf8_manifest(tmp_path):
+    (tmp_path / "block.json").write_bytes(b'{"format": "\xff"}')
+    with pytest.raises(WoodcamError, match="not UTF-8"):
+        read_block(tmp_path)
+
+
+# -- file references stay inside the folder --------------------------------------------------------
+
+def test_absolute_and_parent_paths_are_refused_unless_trusted(folder, tmp_path, monkeypatch):
+    """Issue 15: block.json accepted absolute paths and '../' (a PNG outside the folder was baked
+    into a texture)."""
+    outside = tmp_path / "secret.png"
+    Image.fromarray(np.full((16, 20, 3), 7, np.uint8)).save(outside)
+    for ref in (str(outside), "../secret.png"):
+        _edit(folder, lambda m, ref=ref: m["faces"]["top"].update(photo=ref))
+        with pytest.raises(WoodcamError, match="points outside the block folder"):
+            read_block(folder)
+    assert read_block(folder, allow_outside=True).faces["top"].photo.max() == 7
+    monkeypatch.setenv("WOODCAM_ALLOW_OUTSIDE_PATHS", "1")
+    assert read_block(folder).faces["top"].photo.max() == 7
+
+
+def test_symlink_leading_out_is_refused(folder, tmp_path):
+    outside = tmp_path / "secret.png"
+    Image.fromarray(np.zeros((16, 20, 3), np.uint8)).save(outside)
+    os.symlink(outside, folder / "link.png")
+    _edit(folder, lambda m: m["faces"]["top"].update(photo="link.png"))
+    with pytest.raises(WoodcamError, match="link leading outside"):
+        read_block(folder)
+
+
+def test_true_field_file_outside_is_refused(folder):
+    _edit(folder, lambda m: m.update(true_field={"saved": True, "type": "woodcam.fields:X",
+                                                 "file": "/etc/passwd"}))
+    with pytest.raises(WoodcamError, match="points outside"):
+        read_block(folder)
+
+
+def test_bad_true_field_state_is_a_woodcam_error(folder):
+    (folder / "tf.json").write_text('{"nonsense": 1}')
+    _edit(folder, lambda m: m.update(true_field={
+        "saved": True, "type": "woodcam.fields.radial:RadialScalingField", "file": "tf.json"}))
+    with pytest.raises(WoodcamError, match="true field"):
+        read_block(folder)
+
+
+# -- images ------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("damage", ["empty", "truncated", "text", "missing"])
+def test_damaged_images_are_a_woodcam_error(folder, damage):
+    png = folder / "top_photo.png"
+    data = png.read_bytes()
+    if damage == "missing":
+        png.unlink()
+    else:
+        png.write_bytes({"empty": b"", "truncated": data[: len(data) // 2],
+                         "text": b"not an image at all"}[damage])
+    with pytest.raises(WoodcamError, match="cannot decode the image|listed but missing"):
+        read_block(folder)
+
+
+def test_sixteen_bit_photo_is_scaled_not_wrapped(folder):
+    """Issue 15: 16-bit photos wrapped to 8 bits (value % 256)."""
+    grey = np.full((16, 20), 32896, np.uint16)  # 128 * 257: mid grey
+    grey[0, 0], grey[0, 1] = 65535, 256         # white; and a dark value that wraps to 0
+    Image.fromarray(grey).save(folder / "top_photo.png")
+    photo = read_block(folder).faces["top"].photo
+    assert photo.dtype == np.uint8 and photo.shape == (16, 20, 3)
+    assert photo[5, 5, 0] == 128 and photo[0, 0, 0] == 255 and photo[0, 1, 0] == 1
+
+
+def test_sixteen_bit_ring_map_with_8_bit_label_is_refused(folder):
+    _edit(folder, lambda m: m["faces"]["top"].update(ring_map_bits=8))
+    with pytest.raises(WoodcamError, match="more than ring_map_bits = 8 allows"):
+        read_block(folder)
+
+
+def test_oversized_image_is_refused_before_decoding(folder, monkeypatch):
+    monkeypatch.setenv("WOODCAM_MAX_IMAGE_PIXELS", "100")
+    with pytest.raises(WoodcamError, match="WOODCAM_MAX_IMAGE_PIXELS"):
+        read_block(folder)
+
+
+def test_mokume_damaged_image(tmp_path):
+    from woodcam.block.io import read_mokume
+
+    (tmp_path / "A_col.png").write_bytes(b"")
+    with pytest.raises(WoodcamError, match="cannot decode"):
+        read_mokume(tmp_path)

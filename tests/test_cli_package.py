@@ -1,0 +1,65 @@
+"""The ``woodcam`` command as a package: one registration convention, a light ``--help``."""
+
+import pkgutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import woodcam.cli as cli
+
+REPO = Path(__file__).resolve().parents[1]
+HEAVY = ("numpy", "scipy", "numba", "torch", "trimesh", "PIL", "pyvista", "cv2", "skimage")
+
+
+def test_help_imports_nothing_heavy():
+    """``woodcam --help`` (every command registered) loads no numeric or CAD library."""
+    code = ("import sys\nfrom woodcam.cli import main\ntry:\n    main(['--help'])\n"
+            "except SystemExit:\n    pass\n"
+            f"print(sorted({{m.split('.')[0] for m in sys.modules}} & set({HEAVY!r})))")
+    res = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True,
+                         env={"PYTHONPATH": str(REPO), "PATH": "/usr/bin:/bin"})
+    assert res.returncode == 0, res.stderr
+    assert "eval" in res.stdout and "gcode" in res.stdout
+    assert res.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_every_command_module_is_registered_once_and_lives_in_the_package():
+    here = {m.name for m in pkgutil.iter_modules(cli.__path__) if m.name not in ("options", "__main__")}
+    assert sorted(f"woodcam.cli.{n}" for n in here) == sorted(cli.COMMANDS)
+    for name in cli.COMMANDS:
+        assert callable(getattr(__import__(name, fromlist=["register"]), "register")), name
+
+
+def test_fit_methods_match_the_fitters():
+    from woodcam.cli.fit import METHODS
+    from woodcam.inference.fit import METHODS as FITTERS
+
+    assert tuple(METHODS) == tuple(FITTERS)
+
+
+@pytest.mark.parametrize("argv, command, sub", [
+    (["eval-appearance", "builtin:rift", "--out", "x"], "eval", "appearance"),
+    (["eval", "some/folder", "--out", "x"], "eval", "rings"),
+    (["eval", "rings", "some/folder", "--out", "x"], "eval", "rings"),
+    (["eval", "appearance", "builtin:rift", "--out", "x"], "eval", "appearance"),
+])
+def test_old_spellings_reach_the_new_commands(argv, command, sub):
+    parser = cli.build_parser()
+    args = parser.parse_args(cli._apply_aliases(argv, parser))
+    assert args.command == command and args.eval_command == sub
+
+
+def test_bake_demo_and_gcode_share_the_bake_options():
+    parser = cli.build_parser()
+    common = ["--species", "walnut", "--knot-darkening", "0.2,0.4", "--no-obj"]
+    runs = {"bake": ["bake", "p.py", "--block", "builtin:rift", "--out", "o.glb", *common],
+            "demo": ["demo", *common],
+            "gcode": ["gcode", "p.nc", "--block", "builtin:rift", "--out", "o.glb", *common]}
+    for name, argv in runs.items():
+        args = parser.parse_args(argv)
+        assert cli.options.stock_options(args) == {
+            "species": "walnut", "appearance": "colormap", "knot_darkening_alive": 0.2,
+            "knot_darkening_dead": 0.4}, name
+        assert args.no_obj, name

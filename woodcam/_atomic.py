@@ -1,0 +1,253 @@
+"""Atomic file output: a file is either complete or absent, never half-written.
+
+Every file woodcam writes goes through this module, so Ctrl-C, ``kill -9`` or a full disk in the
+middle of a write never leaves a truncated GLB, a 0-byte OBJ or a half cache behind:
+
+* :func:`atomic_write` -- ``with atomic_write(path, "wb") as fh: fh.write(...)``. Writes a unique
+  temporary file in the *target folder* (same file system, so the final rename is atomic), fsyncs
+  it and ``os.replace``\\ s it onto ``path``. On an exception the temporary file is removed and the
+  old ``path`` (if any) is untouched.
+* :func:`atomic_path` -- the same for libraries that want a path rather than a file object
+  (``np.savez``, ``PIL.Image.save``, ``torch.save``): ``with atomic_path(p) as tmp: np.savez(tmp,
+  ...)``. The temporary path keeps ``p``'s suffix, so libraries that pick a format from it (or
+  append ``.npz``) behave.
+* :func:`write_bytes` / :func:`write_text` -- one-liners over :func:`atomic_write`.
+* :func:`atomic_files` -- several files that belong together (OBJ + MTL + PNG, GLB + side files):
+  all are written to temporaries first and renamed only when every one succeeded; the *first*
+  path named (the primary file, e.g. the OBJ that references the others) is renamed *last*, so
+  its presence means the whole group is in place. A crash between renames can leave complete
+  side files without their primary, never a partial file.
+* :func:`check_output_path` -- validate an output path *before* the work starts: known suffix,
+  not a directory, parent folder exists, is a folder and is writable. Raises
+  :class:`~woodcam.errors.WoodcamError` naming the option, the rule, the value and a fix.
+
+Temporary names are ``.<name>.<random>.tmp<suffix>`` (hidden, unique per writer), so two
+processes writing the same target never share a temporary file; the last ``os.replace`` wins and
+the result is always one writer's complete file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import IO
+
+from .errors import WoodcamError
+
+__all__ = ["atomic_files", "atomic_path", "atomic_write", "check_output_path", "write_bytes",
+           "write_text"]
+
+
+def _umask() -> int:
+    # os.umask can only be read by setting it; done once at import (single-threaded then).
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+_FILE_MODE = 0o666 & ~_umask()  # what open() would have given a new file
+
+
+def _temp_in(path: Path) -> Path:
+    """A new, empty, uniquely named temporary file next to ``path`` (same folder)."""
+    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=f".tmp{path.suffix}")
+    os.close(fd)
+    return Path(name)
+
+
+def _fsync_path(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _fsync_dir(folder: Path) -> None:
+    """Make a rename durable (POSIX); silently skipped where folders cannot be opened."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _commit(tmp: Path, path: Path, fsync: bool) -> None:
+    os.chmod(tmp, _FILE_MODE)  # mkstemp makes 0600; give the file ordinary permissions
+    if fsync:
+        _fsync_path(tmp)
+    os.replace(tmp, path)
+    if fsync:
+        _fsync_dir(path.parent)
+
+
+def _discard(tmp: Path) -> None:
+    with contextlib.suppress(OSError):
+        tmp.unlink()
+
+
+@contextlib.contextmanager
+def atomic_path(path, *, fsync: bool = True, mkdir: bool = False) -> Iterator[Path]:
+    """Yield a temporary path next to ``path``; on success it replaces ``path`` atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        The final file.
+    fsync : bool
+        Flush the data to disk before the rename (default True; off only for scratch files).
+    mkdir : bool
+        Create missing parent folders first (default False: a missing folder is an error).
+
+    The temporary file exists (empty) when the block starts; writers may overwrite it. If the
+    block raises, or the writer wrote nothing under that name, nothing is renamed.
+    """
+    path = Path(path)
+    if mkdir:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = _temp_in(path)
+    try:
+        yield tmp
+        if not tmp.exists():
+            raise WoodcamError(f"atomic_path: the writer for {str(path)!r} wrote no file at "
+                               f"{str(tmp)!r}; write to the yielded path exactly")
+        _commit(tmp, path, fsync)
+    except BaseException:
+        _discard(tmp)
+        raise
+
+
+@contextlib.contextmanager
+def atomic_write(path, mode: str = "wb", *, fsync: bool = True, mkdir: bool = False,
+                 encoding: str | None = None, newline: str | None = None) -> Iterator[IO]:
+    """Open a temporary file next to ``path`` for writing; replace ``path`` with it on success.
+
+    ``mode`` is ``"w"``/``"wb"`` (``"x"`` modes are not supported: the rename overwrites).
+    ``encoding`` defaults to UTF-8 for text. See :func:`atomic_path` for ``fsync`` and ``mkdir``.
+    """
+    if mode not in ("w", "wb", "wt"):
+        raise WoodcamError(f"atomic_write: mode must be 'w' or 'wb'; got {mode!r}")
+    if "b" not in mode and encoding is None:
+        encoding = "utf-8"
+    with (atomic_path(path, fsync=False, mkdir=mkdir) as tmp,
+          open(tmp, mode, encoding=encoding, newline=newline) as fh):
+        yield fh
+        fh.flush()
+        if fsync:
+            os.fsync(fh.fileno())
+    if fsync:
+        _fsync_dir(Path(path).parent)
+
+
+def write_bytes(path, data: bytes, **kwargs) -> Path:
+    """Atomically write ``data`` to ``path``; returns ``Path(path)``."""
+    with atomic_write(path, "wb", **kwargs) as fh:
+        fh.write(data)
+    return Path(path)
+
+
+def write_text(path, text: str, **kwargs) -> Path:
+    """Atomically write ``text`` (UTF-8) to ``path``; returns ``Path(path)``."""
+    with atomic_write(path, "w", **kwargs) as fh:
+        fh.write(text)
+    return Path(path)
+
+
+@contextlib.contextmanager
+def atomic_files(paths: Iterable, *, fsync: bool = True, mkdir: bool = False) -> Iterator[list[Path]]:
+    """Write several files as one unit: yields one temporary path per target, in order.
+
+    All temporaries are renamed only after the block finished without error; the first target
+    (the primary file) is renamed last. On an error every temporary is removed and no target is
+    touched. Example::
+
+        with atomic_files([obj, mtl, png]) as (t_obj, t_mtl, t_png):
+            t_obj.write_text(text); t_mtl.write_bytes(...); t_png.write_bytes(...)
+    """
+    targets = [Path(p) for p in paths]
+    if len({p.resolve() for p in targets}) != len(targets):
+        raise WoodcamError(f"atomic_files: targets must be distinct; got {[str(p) for p in targets]}")
+    if mkdir:
+        for p in targets:
+            p.parent.mkdir(parents=True, exist_ok=True)
+    temps: list[Path] = []
+    try:
+        for p in targets:
+            temps.append(_temp_in(p))
+        yield list(temps)
+        for tmp, p in zip(temps, targets):
+            if not tmp.exists():
+                raise WoodcamError(f"atomic_files: nothing was written for {str(p)!r}")
+            os.chmod(tmp, _FILE_MODE)
+            if fsync:
+                _fsync_path(tmp)
+        # side files first, the primary last: its presence means the group is complete
+        for tmp, p in list(zip(temps, targets))[1:] + [(temps[0], targets[0])]:
+            os.replace(tmp, p)
+        if fsync:
+            for folder in {p.parent for p in targets}:
+                _fsync_dir(folder)
+    except BaseException:
+        for tmp in temps:
+            _discard(tmp)
+        raise
+
+
+def check_output_path(path, *, suffixes: Iterable[str] | None = None, what: str = "--out",
+                      mkdir: bool = False) -> Path:
+    """Check that ``path`` can be written *before* any work starts; return it as a ``Path``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output file the caller will write.
+    suffixes : iterable of str, optional
+        Allowed suffixes, lower case with the dot (``(".glb", ".obj")``); None accepts any.
+    what : str
+        The option or argument name used in the error (``"--out"``, ``"export_glb: path"``).
+    mkdir : bool
+        Create a missing parent folder (default False: it must exist).
+
+    Raises
+    ------
+    WoodcamError
+        Unknown suffix, ``path`` is a folder, the parent is missing or is a file, or the parent
+        folder (or an existing ``path``) is not writable.
+    """
+    path = Path(path)
+    if suffixes is not None:
+        allowed = tuple(s.lower() for s in suffixes)
+        if path.suffix.lower() not in allowed:
+            raise WoodcamError(f"{what} must end in {' or '.join(allowed)}; got {str(path)!r}; "
+                               f"give a file name such as 'part{allowed[0]}'")
+    if path.is_dir():
+        raise WoodcamError(f"{what}: {str(path)!r} is an existing folder, not a file; "
+                           f"give a file name inside it, e.g. '{path / ('part' + path.suffix)}'")
+    parent = path.parent
+    if mkdir and not parent.exists():
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise WoodcamError(f"{what}: cannot create the folder {str(parent)!r} ({err.strerror}); "
+                               "choose an output folder you can write to") from err
+    if not parent.exists():
+        raise WoodcamError(f"{what}: the folder {str(parent)!r} of {str(path)!r} does not exist; "
+                           "create it first or choose another output path")
+    if not parent.is_dir():
+        raise WoodcamError(f"{what}: {str(parent)!r} (the parent of {str(path)!r}) is a file, not "
+                           "a folder; choose another output path")
+    try:  # a real probe: os.access() says yes to root even on read-only mounts
+        probe = _temp_in(path)
+    except OSError as err:
+        raise WoodcamError(f"{what}: the folder {str(parent)!r} is not writable ({err.strerror}); "
+                           "choose an output folder you can write to") from err
+    _discard(probe)
+    return path

@@ -1,0 +1,180 @@
+"""On-disk caches that heal: content-keyed, self-repairing, safe for concurrent writers.
+
+Where caches live: ``$WOODCAM_CACHE_DIR`` if set, else the user cache folder of
+:mod:`platformdirs` (``$XDG_CACHE_HOME/woodcam``, by default ``~/.cache/woodcam`` on Linux),
+never inside a user's block or sample folder (those may be read-only shared data).
+
+How an entry is found: its file name holds :func:`digest` of *every* input that changes the
+result (image and mask pixels, traces, settings, the producing code's version), never a
+modification time, so an edited ring map or knot mask is a different entry.
+
+What :func:`load_or_build` guarantees:
+
+* an entry that fails to load (truncated by a crash, corrupted, written by an incompatible
+  version) is deleted with a :class:`CacheWarning` and rebuilt;
+* entries are written atomically (:mod:`woodcam._atomic`): unique temporary name + rename, so a
+  reader never sees half a file and two writers never interleave;
+* concurrent builders of the *same* entry take an advisory lock (``fcntl.flock`` on
+  ``<entry>.lock``): the second waits, then loads what the first built instead of repeating
+  minutes of work. The kernel drops the lock when a holder dies, so a killed run never leaves a
+  stale lock behind.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import os
+import warnings
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any, TypeVar
+
+import numpy as np
+
+from ._atomic import atomic_path
+from .errors import WoodcamError, WoodcamWarning
+
+__all__ = ["CacheWarning", "cache_dir", "cache_root", "digest", "file_lock", "load_or_build"]
+
+T = TypeVar("T")
+
+
+class CacheWarning(WoodcamWarning):
+    """A cache entry could not be read and was discarded; it is rebuilt (nothing to do)."""
+
+
+def cache_root() -> Path:
+    """``$WOODCAM_CACHE_DIR``, else platformdirs' user cache folder for woodcam (honours
+    ``$XDG_CACHE_HOME`` on Linux)."""
+    base = os.environ.get("WOODCAM_CACHE_DIR")
+    if base:
+        return Path(base).expanduser()
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("woodcam", appauthor=False))
+
+
+def cache_dir(kind: str) -> Path:
+    """The folder of one kind of cache entry (``"fields"``, ``"appearance"``, ...); not created."""
+    return cache_root() / kind
+
+
+def _feed(h, obj: Any) -> None:
+    """Feed ``obj`` to the hash unambiguously: type tag, length, content (arrays by dtype, shape
+    and bytes; dicts by sorted key)."""
+    if obj is None:
+        h.update(b"N")
+    elif isinstance(obj, (bool, int, float, str)):
+        b = repr(obj).encode() if not isinstance(obj, str) else obj.encode()
+        h.update(b"S" if isinstance(obj, str) else type(obj).__name__.encode()[:1])
+        h.update(len(b).to_bytes(8, "little") + b)
+    elif isinstance(obj, (bytes, bytearray, memoryview)):
+        b = bytes(obj)
+        h.update(b"B" + len(b).to_bytes(8, "little") + b)
+    elif isinstance(obj, np.ndarray) or np.isscalar(obj):
+        a = np.ascontiguousarray(obj)
+        h.update(b"A" + a.dtype.str.encode() + repr(a.shape).encode())
+        h.update(a.tobytes())
+    elif isinstance(obj, dict):
+        h.update(b"D" + len(obj).to_bytes(8, "little"))
+        for k in sorted(obj, key=str):
+            _feed(h, str(k))
+            _feed(h, obj[k])
+    elif isinstance(obj, (list, tuple)):
+        h.update(b"L" + len(obj).to_bytes(8, "little"))
+        for v in obj:
+            _feed(h, v)
+    elif isinstance(obj, Path):
+        _feed(h, obj.read_bytes())
+    else:
+        raise WoodcamError(f"digest: cannot hash a {type(obj).__name__}; pass arrays, numbers, "
+                           "strings, bytes, lists or dicts")
+
+
+def digest(*parts: Any, length: int = 24) -> str:
+    """Hex SHA-256 (first ``length`` characters) of ``parts``: arrays, numbers, strings, bytes,
+    ``Path`` (the file's *content*), and lists/dicts of these."""
+    h = hashlib.sha256()
+    _feed(h, list(parts))
+    return h.hexdigest()[:length]
+
+
+@contextlib.contextmanager
+def file_lock(path) -> Iterator[None]:
+    """Hold an exclusive advisory lock on ``<path>.lock`` (waits for other holders).
+
+    POSIX only; elsewhere it does nothing (atomic writes still keep entries whole)."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - Windows
+        yield
+        return
+    lock = Path(str(path) + ".lock")
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing releases the lock
+
+
+def _try_load(path: Path, load: Callable[[Path], T], what: str) -> tuple[bool, T | None]:
+    if not path.is_file():
+        return False, None
+    try:
+        return True, load(path)
+    except Exception as err:  # noqa: BLE001 - any failure to read a cache entry means "rebuild"
+        warnings.warn(CacheWarning(
+            f"{what}: discarded the unreadable cache entry {str(path)!r} "
+            f"({type(err).__name__}: {err}); rebuilding it"), stacklevel=3)
+        with contextlib.suppress(OSError):
+            path.unlink()
+        return False, None
+
+
+def load_or_build(path, *, load: Callable[[Path], T], build: Callable[[], T],
+                  save: Callable[[T, Path], Any], what: str = "cache") -> tuple[T, bool]:
+    """Return ``(value, hit)``: the cached value at ``path``, or a freshly built and saved one.
+
+    Parameters
+    ----------
+    path : Path
+        The entry's file; its name should hold :func:`digest` of the inputs.
+    load : ``path -> value``; any exception means the entry is broken (discarded, rebuilt).
+    build : ``() -> value``, the expensive work.
+    save : ``(value, tmp_path) -> ...``, writes the value to the temporary path it is given
+        (renamed onto ``path`` afterwards). A failed save (e.g. a read-only cache folder) warns
+        and still returns the value.
+    what : str
+        Names the cache in warnings.
+    """
+    path = Path(path)
+    ok, value = _try_load(path, load, what)
+    if ok:
+        return value, True
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        lock = file_lock(path)
+        lock.__enter__()
+    except OSError as err:  # cache folder not writable: work without the cache
+        warnings.warn(CacheWarning(f"{what}: cannot use the cache folder {str(path.parent)!r} "
+                                   f"({err.strerror}); set WOODCAM_CACHE_DIR to a writable "
+                                   "folder to keep results"), stacklevel=2)
+        return build(), False
+    try:
+        ok, value = _try_load(path, load, what)  # another process may have built it meanwhile
+        if ok:
+            return value, True
+        value = build()
+        try:
+            with atomic_path(path) as tmp:
+                save(value, tmp)
+        except OSError as err:
+            warnings.warn(CacheWarning(f"{what}: could not write the cache entry {str(path)!r} "
+                                       f"({err}); the result is used but not kept"), stacklevel=2)
+        return value, False
+    finally:
+        lock.__exit__(None, None, None)
+

@@ -1,0 +1,122 @@
+"""The ``woodcam`` command: parses, calls the API, prints. Errors become one line and exit 2.
+
+A package with one module per command group. Each module in :data:`COMMANDS` defines
+``register(subparsers)``, which adds its sub-parser(s) and sets ``func`` on each to the function
+that runs the parsed arguments and returns the exit status. To add a command: write one module
+here and add one line to :data:`COMMANDS`. Command modules import nothing heavy at module level
+(numpy, scipy, numba, torch load inside the ``run`` functions), so ``woodcam --help`` stays fast;
+``tests/test_cli_package.py`` checks both rules.
+
+Shared pieces live in :mod:`woodcam.cli.options`: the bake options (``bake``, ``demo``,
+``gcode``), the block argument and its resolver, and :func:`~woodcam.cli.options.command_group`
+for commands with sub-commands that several modules extend (``eval rings``, ``eval appearance``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+import warnings
+
+from ..errors import WoodcamError
+
+#: The command modules, in the order their commands appear in ``woodcam --help``.
+COMMANDS: tuple[str, ...] = (
+    "woodcam.cli.bake",          # demo, bake, preview, blocks
+    "woodcam.cli.gcode",         # gcode
+    "woodcam.cli.block",         # block synth | show
+    "woodcam.cli.log",           # log render | maps | export
+    "woodcam.cli.fit",           # fit, eval rings
+    "woodcam.cli.appearance",    # eval appearance
+    "woodcam.cli.train",         # train gtf
+)
+
+#: Old spellings kept working: argv prefix -> its current form.
+ALIASES: dict[tuple[str, ...], tuple[str, ...]] = {
+    ("eval-appearance",): ("eval", "appearance"),
+}
+#: Command groups whose old form took no sub-command: ``eval DIRS`` means ``eval rings DIRS``.
+DEFAULT_SUBCOMMAND: dict[str, str] = {"eval": "rings"}
+
+_EPILOG = """\
+Block specs: 'builtin:NAME' (see 'woodcam blocks'), 'log:gran1@K[:WxDxH]', a block folder with a
+block.json, or a Mokume sample folder (six photos and ring maps of a 50 mm cube).
+Units are millimetres; the block frame has its origin at the bottom-front-left corner,
+X to the right (width), Y away from the viewer (depth), Z up (height).
+
+examples:
+  woodcam demo --out out/
+  woodcam bake cad_examples/bowl.py --block builtin:flat-sawn --out out/bowl.glb
+  woodcam preview out/bowl.glb --screenshot out/bowl.png
+  woodcam gcode toolpaths/vcarve_text.nc --tool vbit:60:12 --block builtin:flat-sawn \\
+      --out out/vcarve_text.glb --screenshot
+  woodcam eval rings out/blocks/block_0000 --out out/eval
+  woodcam eval appearance builtin:knotty --out out/eval_appearance
+"""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The whole ``woodcam`` parser: every module of :data:`COMMANDS` registers its commands."""
+    parser = argparse.ArgumentParser(
+        prog="woodcam", description="CNC cut preview for solid wood: carve a part out of a "
+        "block whose growth rings are known and see the wood on every surface.",
+        epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    for name in COMMANDS:
+        module = importlib.import_module(name)
+        register = getattr(module, "register", None)
+        if register is None:  # a contributor's mistake, not a user's: say the convention
+            raise TypeError(f"command module {name} must define register(subparsers); see "
+                            "woodcam/cli/__init__.py")
+        register(sub)
+    parser.set_defaults(_commands=sub)
+    return parser
+
+
+def _apply_aliases(argv: list[str], parser: argparse.ArgumentParser) -> list[str]:
+    for old, new in ALIASES.items():
+        if tuple(argv[:len(old)]) == old:
+            argv = [*new, *argv[len(old):]]
+    if len(argv) >= 2 and argv[0] in DEFAULT_SUBCOMMAND and not argv[1].startswith("-"):
+        group = parser.get_default("_commands").choices[argv[0]]
+        subs = next(a for a in group._actions if isinstance(a, argparse._SubParsersAction))
+        if argv[1] not in subs.choices:
+            argv = [argv[0], DEFAULT_SUBCOMMAND[argv[0]], *argv[1:]]
+    return argv
+
+
+_printed: set[str] = set()
+
+
+def print_warnings(items) -> None:
+    """Print each warning once, even when it arrives both as a Python warning and in a report."""
+    for w in items:
+        if w not in _printed:
+            _printed.add(w)
+            print(f"woodcam: warning: {w}", file=sys.stderr)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``woodcam`` console script; returns the exit status."""
+    parser = build_parser()
+    args = parser.parse_args(_apply_aliases(list(sys.argv[1:] if argv is None else argv), parser))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            rc = args.func(args)
+        except WoodcamError as err:
+            print(f"woodcam: error: {err}", file=sys.stderr)
+            return 2
+        except KeyboardInterrupt:
+            print("woodcam: interrupted", file=sys.stderr)
+            return 130
+        finally:
+            print_warnings(str(w.message) for w in caught if _is_ours(w))
+    return rc
+
+
+def _is_ours(w) -> bool:
+    """Warnings woodcam raised itself (its warning classes live in woodcam modules)."""
+    return getattr(w.category, "__module__", "").startswith("woodcam")

@@ -1,0 +1,97 @@
+"""``woodcam demo``, ``bake``, ``preview`` and ``blocks``: carve a part, bake its wood, look at it."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .options import BLOCK_SPEC_HELP, add_bake_options, stock_options, write_screenshot
+
+
+def register(subparsers) -> None:
+    """Add ``demo``, ``bake``, ``preview`` and ``blocks``."""
+    p = subparsers.add_parser("demo", help="carve the example parts out of built-in blocks into --out",
+                              description="Carve, bake, export (GLB, OBJ+MTL+PNG) and render the "
+                              "example parts of cad_examples/ out of built-in synthetic blocks; "
+                              "print stage times.")
+    p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
+    p.add_argument("--quick", action="store_true", help="lower texture resolution (for CI)")
+    add_bake_options(p, texels_default=None, screenshot=False)
+    p.set_defaults(func=run_demo)
+
+    p = subparsers.add_parser("bake", help="carve a part out of a block and bake its wood texture",
+                              description="PART is a build123d/cadquery script defining `part`, "
+                              "or a STEP/STL/OBJ/GLB file, modelled in the block frame (mm).")
+    p.add_argument("part", help="part file (.py script, .step, .stl, .obj, .glb)")
+    p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
+    p.add_argument("--out", type=Path, required=True, help="output .glb path")
+    p.add_argument("--tolerance", type=float, default=None, metavar="MM",
+                   help="tessellation chord tolerance for B-rep parts (default 0.05 mm)")
+    add_bake_options(p)
+    p.set_defaults(func=run_bake)
+
+    p = subparsers.add_parser("preview", help="view a baked part (window, or --screenshot PNG)",
+                              description="Open a baked GLB/OBJ in a window with a cut-plane "
+                              "widget that shows the wood inside the block; --screenshot renders "
+                              "off-screen.")
+    p.add_argument("mesh", type=Path, help="baked .glb (or .obj)")
+    p.add_argument("--screenshot", type=Path, default=None, metavar="PNG",
+                   help="render to this PNG instead of opening a window")
+    p.add_argument("--block", default=None,
+                   help="block spec for the cut plane (default: the one stored in the GLB)")
+    p.set_defaults(func=run_preview)
+
+    p = subparsers.add_parser("blocks", help="list the built-in synthetic blocks")
+    p.set_defaults(func=run_blocks)
+
+
+def run_demo(args: argparse.Namespace) -> int:
+    from ..demo import run_demo as demo
+
+    report = demo(args.out, quick=args.quick, texels_per_mm=args.texels_per_mm,
+                  obj=not args.no_obj, **stock_options(args))
+    print(report.summary())
+    return 0
+
+
+def run_bake(args: argparse.Namespace) -> int:
+    from ..pipeline import check_outputs, preview_part
+    from ..stock import open_stock
+    from . import print_warnings
+
+    check_outputs(args.out, obj=not args.no_obj, screenshot=getattr(args, "screenshot", None) or False)
+    stock = open_stock(args.block, **stock_options(args))
+    res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
+                       tolerance_mm=args.tolerance, obj=not args.no_obj, screenshot=False,
+                       progress=True, obj_units=args.obj_units, obj_up=args.obj_up)
+    write_screenshot(args, res.files, stock)
+    print_warnings(res.warnings)
+    print(f"{res.name}: {res.triangles} triangles, {res.volume_mm3:.0f} mm^3, atlas "
+          f"{res.atlas_px[1]}x{res.atlas_px[0]}; wrote " + ", ".join(map(str, res.files.values())))
+    return 0
+
+
+def run_preview(args: argparse.Namespace) -> int:
+    from ..export import read_glb_metadata
+    from ..stock import open_stock
+    from ..view import preview
+
+    spec = args.block
+    if spec is None and args.mesh.suffix.lower() == ".glb":
+        spec = read_glb_metadata(args.mesh).get("block")
+    stock = open_stock(spec) if spec else None
+    out = preview(args.mesh, wood=stock.wood if stock else None,
+                  size_mm=stock.size_mm if stock else None, screenshot=args.screenshot)
+    if out:
+        print(f"wrote {out}")
+    return 0
+
+
+def run_blocks(args: argparse.Namespace) -> int:
+    from ..fields.builtin import BUILTIN_NAMES, builtin_block
+
+    for name in BUILTIN_NAMES:
+        b = builtin_block(name)
+        W, D, H = b.size_mm
+        print(f"builtin:{name:<14} {W:g} x {D:g} x {H:g} mm  {b.species:<7} {b.description}")
+    return 0

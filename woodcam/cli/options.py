@@ -1,0 +1,141 @@
+"""Options and arguments several commands share: one definition each.
+
+- :func:`add_bake_options` / :func:`stock_options` / :func:`write_screenshot`: the bake options
+  of ``bake``, ``demo`` and ``gcode`` (texture resolution, species, appearance and its knot
+  colours, OBJ, screenshot), for any later command that bakes too.
+- :func:`add_block_argument` and :func:`open_block`: a block spec on the command line and the
+  one resolver behind every command that reads a block (:func:`woodcam.stock.open_block`).
+- :func:`command_group`: a command with sub-commands that several modules extend.
+
+Nothing heavy is imported at module level (``woodcam --help`` loads this module).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..errors import WoodcamError
+
+BLOCK_SPEC_HELP = ("block spec: builtin:NAME, log:gran1@K[:WxDxH], a block folder (block.json) "
+                   "or a Mokume sample folder (a 50 mm cube unless --size-mm)")
+
+
+def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction:
+    """The sub-commands of command ``name``, created on first call (``kwargs`` go to
+    ``add_parser``), shared by later calls: ``eval rings`` and ``eval appearance`` live in two
+    modules but one ``eval`` group."""
+    groups = subparsers.__dict__.setdefault("_woodcam_groups", {})
+    if name not in groups:
+        p = subparsers.add_parser(name, **kwargs)
+        groups[name] = p.add_subparsers(dest=f"{name}_command", metavar="SUBCOMMAND")
+        groups[name].required = True
+    return groups[name]
+
+
+def add_block_argument(p: argparse.ArgumentParser, *, option: bool = True, nargs=None) -> None:
+    """``--block SPEC`` (required) or, with ``option=False``, a positional ``block``."""
+    if option:
+        p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
+    else:
+        p.add_argument("block", nargs=nargs, help=BLOCK_SPEC_HELP)
+
+
+def add_size_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--size-mm", type=float, default=None, metavar="MM",
+                   help="cube side in mm of a Mokume sample folder (its files carry no size; "
+                   "default 50)")
+
+
+def open_block(spec, size_mm: float | None = None, face_px: int = 256):
+    """``(block, field or None)`` for a block argument: :func:`woodcam.stock.open_block`."""
+    from ..stock import open_block as _open_block
+
+    return _open_block(str(spec), size_mm=size_mm, face_px=face_px)
+
+
+def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None = 10.0,
+                     species: bool = True, screenshot: bool = True) -> None:
+    """The options of every command that bakes wood onto a mesh (``bake``, ``demo``, ``gcode``).
+
+    texels_default : the ``--texels-per-mm`` default (None: the command picks, e.g. demo's
+        ``--quick``). species : add ``--species``. screenshot : add ``--screenshot [PNG]``.
+    """
+    p.add_argument("--texels-per-mm", type=float, default=texels_default, metavar="T",
+                   help="texture resolution on the surface in texels per mm (default "
+                   + (f"{texels_default:g} = {1 / texels_default:g} mm texels)" if texels_default
+                      else "10, or 4 with --quick)"))
+    if species:
+        p.add_argument("--species", default=None,
+                       help="colour preset (oak, maple, walnut, cherry, pine, spruce); default: "
+                       "the block's")
+    p.add_argument("--appearance", choices=("colormap", "neural"), default="colormap",
+                   help="colormap: fast colour-of-ring model (default); neural: colour volumes "
+                   "learnt from the block's photos per axis (seed 000 sec. 3.3, cached on disk)")
+    p.add_argument("--quality", choices=("draft", "normal", "high"), default=None,
+                   help="training effort of the neural appearance (default normal)")
+    p.add_argument("--epochs", type=int, default=None, help="override the neural training epochs")
+    p.add_argument("--knot-darkening", default=None, metavar="ALIVE,DEAD",
+                   help="colour map: relative darkening of alive and dead knot wood, each in "
+                   "[0, 1] (default: woodcam.appearance.knots.KnotShading's)")
+    p.add_argument("--knot-outline", default=None, metavar="R,G,B",
+                   help="colour map: colour of the bark ring round dead knots, each in [0, 1] "
+                   "(default 0.16,0.10,0.06)")
+    p.add_argument("--no-obj", action="store_true", help="write only the GLB, not OBJ+MTL+PNG")
+    p.add_argument("--obj-units", choices=("m", "mm"), default="m",
+                   help="length unit of the OBJ's coordinates (default m, what Blender and most "
+                   "viewers assume; mm for CAM tools). The GLB is always metres, Y up (glTF)")
+    p.add_argument("--obj-up", choices=("y", "z"), default="y",
+                   help="up axis of the OBJ (default y, the OBJ habit; z keeps the block frame)")
+    if screenshot:
+        p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
+                       help="also render the result off-screen to PNG (default name: OUT with "
+                       "_view.png; no display needed)")
+
+
+def floats(text: str, n: int, option: str) -> tuple[float, ...]:
+    """``"a,b,..."`` -> n floats in [0, 1], or a WoodcamError naming the option."""
+    try:
+        vals = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        vals = ()
+    if len(vals) != n or not all(0.0 <= v <= 1.0 for v in vals):
+        raise WoodcamError(f"{option} takes {n} comma-separated numbers in [0, 1]; got {text!r}")
+    return vals
+
+
+def appearance_params(args) -> dict:
+    """The appearance keywords of :func:`woodcam.stock.open_stock` from the bake options."""
+    knots = {}
+    if args.knot_darkening is not None:
+        knots["knot_darkening_alive"], knots["knot_darkening_dead"] = floats(
+            args.knot_darkening, 2, "--knot-darkening")
+    if args.knot_outline is not None:
+        knots["dead_outline_rgb"] = floats(args.knot_outline, 3, "--knot-outline")
+    if args.appearance != "neural":
+        if args.quality or args.epochs:
+            raise WoodcamError("--quality and --epochs apply to --appearance neural only; "
+                               f"got --appearance {args.appearance}")
+        return knots
+    if knots:
+        raise WoodcamError("--knot-darkening and --knot-outline apply to --appearance colormap "
+                           "only (the neural appearance learns knot colours from the photos)")
+    return {k: v for k, v in (("quality", args.quality), ("epochs", args.epochs)) if v is not None}
+
+
+def stock_options(args) -> dict:
+    """Every keyword of :func:`woodcam.stock.open_stock` the bake options carry."""
+    return {"species": getattr(args, "species", None), "appearance": args.appearance,
+            **appearance_params(args)}
+
+
+def write_screenshot(args, files: dict, stock) -> None:
+    """Render ``files["glb"]`` to ``--screenshot``'s PNG (or OUT_view.png) when asked."""
+    if not getattr(args, "screenshot", None):
+        return
+    from ..view import preview
+
+    out = Path(args.out)
+    png = out.with_name(out.stem + "_view.png") if args.screenshot is True else Path(args.screenshot)
+    preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
+    files["png"] = png

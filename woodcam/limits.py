@@ -1,0 +1,73 @@
+"""Resource limits: guards that stop one absurd number from hanging or exhausting the machine.
+
+Each limit has a reason and can be raised for one run with an environment variable
+``WOODCAM_<NAME>`` (e.g. ``WOODCAM_MAX_GRID_CELLS=400000000``); the error that a guard raises
+names the limit, the value asked for and that variable. :func:`limit` reads the effective value.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+from .errors import WoodcamError
+
+#: Longest block side (mm). 10 m is longer than any sawn log; 1e9 mm is a typo, not a block.
+MAX_BLOCK_SIZE_MM = 10_000.0
+
+#: Pixels along one side of a face image. 16384 px is 0.003 mm/px on a 50 mm face, far past
+#: any photo; beyond it decoding alone needs gigabytes.
+MAX_FACE_PX = 16_384
+
+#: Total pixels of one image file we decode (PIL's own bomb guard is 179 Mpx): 16384^2.
+MAX_IMAGE_PIXELS = 16_384 * 16_384
+
+#: Points of one ring trace. A hand trace has hundreds; a detector's a few thousand per ring.
+MAX_TRACE_POINTS = 1_000_000
+
+#: Largest |year| label of a ring. The oldest known trees are ~5000 years old.
+MAX_RING_YEAR = 10_000
+
+#: Nodes of one 3-D grid (fitted field, colour volume, stock height field) = 8 bytes each in
+#: float64: 200 M nodes are 1.6 GB, about the most one step may hold on a 16 GB laptop.
+MAX_GRID_CELLS = 200_000_000
+
+#: Bytes one array allocation may ask for before we refuse (estimated ahead of allocating).
+MAX_ALLOC_BYTES = 4 * 1024**3
+
+_DEFAULTS = {name: value for name, value in globals().items() if name.startswith("MAX_")}
+
+
+def limit(name: str) -> float:
+    """The effective value of limit ``name`` (``"MAX_GRID_CELLS"``): ``$WOODCAM_<NAME>`` if set
+    to a positive finite number, else the default above."""
+    if name not in _DEFAULTS:
+        raise WoodcamError(f"limit: unknown limit {name!r}; one of {', '.join(sorted(_DEFAULTS))}")
+    raw = os.environ.get(f"WOODCAM_{name}")
+    if raw is None:
+        return _DEFAULTS[name]
+    try:
+        value = float(raw)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise WoodcamError(f"WOODCAM_{name} must be a positive number; got {raw!r}")
+    return type(_DEFAULTS[name])(value)
+
+
+def check_limit(name: str, value: float, what: str, fix: str = "") -> None:
+    """Raise a WoodcamError if ``value`` exceeds limit ``name``, naming ``what`` needs it, the
+    limit, and how to raise it."""
+    top = limit(name)
+    if not value <= top:  # also refuses NaN
+        raise WoodcamError(
+            f"{what} needs {value:.4g}, more than the limit {name} = {top:.4g}"
+            + (f"; {fix}" if fix else "")
+            + f"; if this is intended, raise the limit with WOODCAM_{name}={value:.0f}")
+
+
+def check_grid(shape, what: str, *, itemsize: int = 8, fix: str = "") -> None:
+    """Guard a grid allocation of ``shape`` (cells) before it happens: cell count and bytes."""
+    cells = math.prod(float(s) for s in shape)
+    check_limit("MAX_GRID_CELLS", cells, f"{what} (a {'x'.join(f'{s:.0f}' for s in shape)} grid)", fix)
+    check_limit("MAX_ALLOC_BYTES", cells * itemsize, f"{what} (memory, bytes)", fix)

@@ -1,0 +1,384 @@
+"""Running many independent tasks: local processes by default, a Dask cluster when asked.
+
+:func:`run_many` calls ``fn(key)`` once for every key and keeps one small JSON record per key in
+``out_dir/records/<key>.json``::
+
+    {"key": "b000042", "status": "ok", "attempts": 1, "seconds": 9.81, "result": {...}}
+    {"key": "b000043", "status": "failed", "attempts": 3, "seconds": 0.02,
+     "error": "ValueError: the message"}
+
+A record is written atomically (a temp file in the same folder, then ``os.replace``), by the
+process that drives the run, as each task finishes; so after a ``kill -9`` every record on disk
+is whole, and running the same call again skips every key that has an ``ok`` record (failed keys
+are tried again). ``fn`` must be picklable (a module-level function or a ``functools.partial``
+of one) and its result JSON-serialisable; its result must depend on the key alone (and the
+settings bound into ``fn``), never on the engine, the worker or the order, so that a run is
+reproducible and resumable: that is the caller's contract, which :mod:`woodcam.benchmark` keeps
+by drawing everything from ``np.random.default_rng([seed, index])``.
+
+Engines (:data:`ENGINES`):
+
+- ``"local"`` (default): joblib's loky process pool on this machine, no services; ``workers=1``
+  runs in this process (the serial baseline).
+- ``"dask"``: Dask ``distributed``. With ``address`` (``tcp://host:8786``) the run goes to that
+  scheduler, as on a real cluster (start it with ``dask scheduler`` and ``dask worker ADDRESS``);
+  records are still written here, so the workers need no shared disk. Without ``address`` a
+  ``LocalCluster`` of ``workers`` (default 2) single-threaded worker processes on 127.0.0.1 is
+  started for the run and closed after it.
+
+Every worker runs one task at a time with one BLAS / OpenMP / torch / numba thread: tasks are the
+unit of parallelism, and on a shared machine nested threads only contend. Each local worker is
+bounded to ``memory_limit_mb`` of address space (a task going past it gets a ``MemoryError``,
+which is retried and then recorded as a failure); Dask workers get the same number as their
+``memory_limit`` (the nanny restarts a worker beyond it).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import sys
+import time
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Iterable, Literal, get_args
+
+from .errors import WoodcamError
+
+Engine = Literal["local", "dask"]
+ENGINES: tuple[str, ...] = get_args(Engine)
+
+#: Sub-folder of a run folder holding one ``<key>.json`` record per task.
+RECORDS_DIR = "records"
+
+#: A key becomes a file name: letters, digits, ``_ . -``, not starting with a dot.
+_KEY_RE = re.compile(r"^[A-Za-z0-9_-][A-Za-z0-9_.-]{0,199}$")
+
+#: Address space (MiB) a local worker may map by default: a woodcam bench task peaks near 1 GiB
+#: (torch + numba + a fitted grid), and 8 engineers share 24 GB here, 3 GiB each at most.
+DEFAULT_MEMORY_LIMIT_MB = 3072
+
+#: Seconds to wait for a Dask scheduler before calling its address unreachable.
+CONNECT_TIMEOUT_S = 10.0
+
+#: Environment variables that cap the thread pools of BLAS, OpenMP (torch), numba and numexpr;
+#: set in each worker before those libraries load, and enforced at run time by threadpoolctl.
+_THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
+                "VECLIB_MAXIMUM_THREADS", "NUMBA_NUM_THREADS", "NUMEXPR_NUM_THREADS")
+
+
+@dataclass(frozen=True)
+class RunSummary:
+    """What :func:`run_many` did: counts of keys and the wall time (s) of this call."""
+
+    out_dir: Path
+    engine: str
+    workers: int
+    total: int
+    skipped: int
+    done: int
+    failed: int
+    wall_s: float
+
+    def line(self) -> str:
+        return (f"{self.total} keys: {self.skipped} already done, {self.done} computed, "
+                f"{self.failed} failed; {self.wall_s:.1f} s on {self.engine} with "
+                f"{self.workers} worker(s); records in {self.out_dir / RECORDS_DIR}")
+
+
+# -- records --------------------------------------------------------------------------------------
+
+def write_json_atomic(path, obj) -> Path:
+    """Write ``obj`` as JSON to ``path`` atomically: a temp file in the same folder, fsync, then
+    ``os.replace``, so a reader (or a run killed half-way) sees the old file or the whole new
+    one, never a part."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    with open(tmp, "w") as fh:
+        json.dump(obj, fh, separators=(",", ":"), allow_nan=True)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+    return path
+
+
+def record_path(out_dir, key: str) -> Path:
+    return Path(out_dir) / RECORDS_DIR / f"{key}.json"
+
+
+def read_records(out_dir) -> dict[str, dict]:
+    """Every record of a run folder: ``key -> record`` (see the module docstring), sorted by key.
+
+    Temp files left by a killed run start with a dot and are not records.
+    """
+    folder = Path(out_dir) / RECORDS_DIR
+    if not folder.is_dir():
+        raise WoodcamError(f"out_dir must be a run folder with a {RECORDS_DIR}/ sub-folder; "
+                           f"{str(out_dir)!r} has none (run `woodcam bench run --out DIR` first)")
+    out = {}
+    for p in sorted(folder.glob("[!.]*.json")):
+        try:
+            rec = json.loads(p.read_text())
+        except ValueError as err:  # never happens with atomic writes; say so if it does
+            raise WoodcamError(f"record {p} is not valid JSON ({err}); delete it and re-run "
+                               f"to recompute that key") from err
+        out[rec["key"]] = rec
+    return out
+
+
+def _finished_keys(out_dir: Path) -> set[str]:
+    folder = out_dir / RECORDS_DIR
+    done = set()
+    for p in folder.glob("[!.]*.json"):
+        try:
+            if json.loads(p.read_text()).get("status") == "ok":
+                done.add(p.stem)
+        except ValueError:
+            continue  # treat as not done; it is overwritten
+    return done
+
+
+# -- the worker side ------------------------------------------------------------------------------
+
+_worker_ready = False
+
+
+def _limit_worker(memory_limit_mb: int | None) -> None:
+    """Once per worker process: one thread per library, and an address-space cap."""
+    global _worker_ready
+    if _worker_ready:
+        return
+    for var in _THREAD_VARS:
+        os.environ[var] = "1"
+    if "torch" in sys.modules:
+        sys.modules["torch"].set_num_threads(1)
+    if memory_limit_mb:
+        import resource
+
+        limit = int(memory_limit_mb) * 1024 * 1024
+        soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+        if hard != resource.RLIM_INFINITY:
+            limit = min(limit, hard)
+        resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
+    _worker_ready = True
+
+
+def _attempt(fn: Callable[[str], Any], key: str, retries: int, memory_limit_mb: int | None,
+             limit_process: bool) -> dict:
+    """Run ``fn(key)`` up to ``1 + retries`` times; return the record (never raises)."""
+    from threadpoolctl import threadpool_limits
+
+    if limit_process:
+        _limit_worker(memory_limit_mb)
+    t0 = time.perf_counter()
+    error = ""
+    for attempt in range(1, retries + 2):
+        try:
+            with threadpool_limits(1):
+                result = fn(key)
+            return {"key": key, "status": "ok", "attempts": attempt,
+                    "seconds": time.perf_counter() - t0, "result": result}
+        except Exception as err:  # noqa: BLE001 - any task error becomes a failed record
+            tb = traceback.extract_tb(err.__traceback__)
+            where = f" (at {Path(tb[-1].filename).name}:{tb[-1].lineno})" if tb else ""
+            error = f"{type(err).__name__}: {err}{where}"
+    return {"key": key, "status": "failed", "attempts": retries + 1,
+            "seconds": time.perf_counter() - t0, "error": error}
+
+
+# -- the driver -----------------------------------------------------------------------------------
+
+def _check_keys(keys: Iterable) -> list[str]:
+    keys = [str(k) for k in keys]
+    bad = [k for k in keys if not _KEY_RE.match(k)]
+    if bad:
+        raise WoodcamError(f"keys must be file-name safe (letters, digits, '_', '.', '-', not "
+                           f"starting with '.', at most 200 characters); got {bad[0]!r}")
+    if len(set(keys)) != len(keys):
+        dup = next(k for k in keys if keys.count(k) > 1)
+        raise WoodcamError(f"keys must be unique; {dup!r} appears more than once")
+    return keys
+
+
+def _check_address(address: str) -> str:
+    if not re.match(r"^(tcp|tls|inproc|ucx|ws|wss)://[^\s/]+$", address):
+        raise WoodcamError(f"address must be a Dask scheduler address like tcp://HOST:8786; got "
+                           f"{address!r}")
+    return address
+
+
+def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir, engine: Engine = "local",
+             address: str | None = None, workers: int | None = None, retries: int = 2, *,
+             memory_limit_mb: int | None = DEFAULT_MEMORY_LIMIT_MB, progress: bool = True,
+             desc: str = "tasks") -> RunSummary:
+    """Run ``fn(key)`` for every key not already done, writing one record per key.
+
+    Parameters
+    ----------
+    fn : callable ``key (str) -> JSON-serialisable``
+        Picklable; deterministic in its key (see the module docstring).
+    keys : iterable of str
+        File-name safe, unique; records are ``out_dir/records/<key>.json``.
+    out_dir : folder (created)
+    engine : "local" | "dask"
+    address : str, optional
+        ``engine="dask"`` only: a running scheduler (``tcp://host:port``); unreachable within
+        :data:`CONNECT_TIMEOUT_S` s gives a :class:`WoodcamError`.
+    workers : int, optional
+        Worker processes (local: default 2, 1 = serial in this process; dask without address:
+        default 2). With an address the cluster sets it; passing it is an error.
+    retries : int
+        Extra attempts of a task that raises, before its failed record is written.
+    memory_limit_mb : int or None
+        Per worker (MiB): an address-space cap of each local worker process, the
+        ``memory_limit`` of each LocalCluster worker. None: no cap.
+    progress : bool
+        A tqdm bar with rate and ETA on stderr.
+
+    Returns
+    -------
+    RunSummary
+    """
+    if engine not in ENGINES:
+        raise WoodcamError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
+    if not isinstance(retries, int) or retries < 0:
+        raise WoodcamError(f"retries must be an integer >= 0; got {retries!r}")
+    if workers is not None and (not isinstance(workers, int) or workers < 1):
+        raise WoodcamError(f"workers must be an integer >= 1; got {workers!r}")
+    if memory_limit_mb is not None and memory_limit_mb < 256:
+        raise WoodcamError(f"memory_limit_mb must be >= 256 MiB (a Python worker alone needs "
+                           f"~100 MiB) or None; got {memory_limit_mb!r}")
+    if address is not None:
+        if engine != "dask":
+            raise WoodcamError(f"address applies to engine='dask' only; got engine={engine!r} "
+                               f"with address={address!r}")
+        _check_address(address)
+        if workers is not None:
+            raise WoodcamError(f"workers cannot be set with an address: the cluster at {address} "
+                               f"has its own workers; got workers={workers!r}")
+    keys = _check_keys(keys)
+    out_dir = Path(out_dir)
+    (out_dir / RECORDS_DIR).mkdir(parents=True, exist_ok=True)
+    for stale in (out_dir / RECORDS_DIR).glob(".*.tmp"):  # temp files of a killed run
+        stale.unlink(missing_ok=True)
+    done_before = _finished_keys(out_dir)
+    todo = [k for k in keys if k not in done_before]
+    skipped = len(keys) - len(todo)
+
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=len(keys), initial=skipped, desc=desc, unit="task", smoothing=0.1,
+               disable=not progress, dynamic_ncols=True)
+    counts = {"ok": 0, "failed": 0}
+
+    def finish(rec: dict) -> None:
+        write_json_atomic(record_path(out_dir, rec["key"]), rec)
+        counts[rec["status"]] += 1
+        bar.update(1)
+        if counts["failed"]:
+            bar.set_postfix(failed=counts["failed"])
+
+    t0 = time.perf_counter()
+    n_workers = 0
+    try:
+        if not todo:
+            n_workers = 0
+        elif engine == "local":
+            n_workers = 2 if workers is None else workers
+            _run_local(fn, todo, n_workers, retries, memory_limit_mb, finish)
+        else:
+            n_workers = _run_dask(fn, todo, address, workers, retries, memory_limit_mb, finish)
+    finally:
+        bar.close()
+    return RunSummary(out_dir, engine, n_workers, len(keys), skipped, counts["ok"],
+                      counts["failed"], time.perf_counter() - t0)
+
+
+def _run_local(fn, todo, n_workers, retries, memory_limit_mb, finish) -> None:
+    if n_workers == 1:  # the serial baseline: this process, no pool, no cap on the caller
+        from threadpoolctl import threadpool_limits
+
+        with threadpool_limits(1):
+            for key in todo:
+                finish(_attempt(fn, key, retries, None, False))
+        return
+    from joblib import Parallel, delayed, parallel_config
+    from joblib.externals.loky.process_executor import TerminatedWorkerError
+
+    # inner_max_num_threads=1 sets the thread variables (BLAS, OpenMP, numba) in each worker
+    # before it imports anything; generator_unordered hands results back as they finish.
+    try:
+        with parallel_config(backend="loky", inner_max_num_threads=1):
+            for rec in Parallel(n_jobs=n_workers, return_as="generator_unordered", batch_size=1,
+                                pre_dispatch=f"{2 * n_workers}")(
+                    delayed(_attempt)(fn, key, retries, memory_limit_mb, True) for key in todo):
+                finish(rec)
+    except TerminatedWorkerError as err:
+        raise WoodcamError(
+            f"a local worker process died ({str(err).splitlines()[0]}); the records written so "
+            f"far are kept: run the same command again to resume, or lower the worker count "
+            f"or raise the memory limit") from err
+
+
+def _run_dask(fn, todo, address, workers, retries, memory_limit_mb, finish) -> int:
+    from .errors import require
+
+    require("distributed", "scale", "running tasks on Dask")
+    from distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    if address is None:
+        cluster = LocalCluster(
+            n_workers=2 if workers is None else workers, threads_per_worker=1, processes=True,
+            host="127.0.0.1", dashboard_address=None,
+            memory_limit=f"{memory_limit_mb}MiB" if memory_limit_mb else 0)
+        client = Client(cluster)
+    else:
+        try:
+            client = Client(address, timeout=CONNECT_TIMEOUT_S)
+        except (OSError, TimeoutError) as err:
+            raise WoodcamError(
+                f"address: no Dask scheduler answered at {address} within {CONNECT_TIMEOUT_S:g} s "
+                f"({type(err).__name__}); start one with `dask scheduler` and `dask worker "
+                f"{address}`, or leave --address out to run a local 2-worker cluster") from err
+    try:
+        n = len(client.scheduler_info(n_workers=-1)["workers"]) if address else (workers or 2)
+        window = max(4 * max(n, 1), 16)  # bounded in-flight futures, so 1e5 keys stay cheap
+        it = iter(todo)
+        pending = as_completed()
+
+        key_of = {}
+
+        def submit(key):
+            # limit_process: one torch thread (the nanny already sets OMP/BLAS variables to 1);
+            # the memory cap is the nanny's memory_limit, not an rlimit on someone's worker.
+            fut = client.submit(_attempt, fn, key, retries, None, True, pure=False,
+                                key=f"woodcam-{key}-{os.getpid()}-{time.time_ns()}")
+            key_of[fut.key] = key
+            pending.add(fut)
+
+        for key in [k for _, k in zip(range(window), it)]:
+            submit(key)
+        for fut in pending:
+            key = key_of.pop(fut.key)
+            try:
+                rec = fut.result()
+            except Exception as err:  # noqa: BLE001 - a worker lost (KilledWorker), cancelled
+                rec = {"key": key, "status": "failed", "attempts": 1, "seconds": 0.0,
+                       "error": f"{type(err).__name__}: {err}"}
+            fut.release()
+            finish(rec)
+            nxt = next(it, None)
+            if nxt is not None:
+                submit(nxt)
+        return n
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+__all__ = ["DEFAULT_MEMORY_LIMIT_MB", "ENGINES", "Engine", "RECORDS_DIR", "RunSummary",
+           "read_records", "record_path", "run_many", "write_json_atomic"]
