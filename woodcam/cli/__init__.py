@@ -28,6 +28,7 @@ COMMANDS: tuple[str, ...] = (
     "woodcam.cli.block",         # block synth | show
     "woodcam.cli.log",           # log render | maps | export
     "woodcam.cli.fit",           # fit, eval rings
+    "woodcam.cli.eval_bench",    # eval realistic
     "woodcam.cli.appearance",    # eval appearance
     "woodcam.cli.train",         # train gtf
 )
