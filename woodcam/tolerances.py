@@ -206,3 +206,14 @@ EVIDENCE_UNSEEN_YEARS_PER_MM = 0.02
 #: Grid spacing (mm) on which the hypotheses' spread is sampled before interpolation to the
 #: bake grid: the spread is smooth over several mm, and the RBF hypotheses are slow to evaluate.
 EVIDENCE_SPREAD_SPACING_MM = 4.0
+
+#: Knot-mask regions smaller than this (pixels) are not knot exits (speckle of a detector).
+KNOT_MIN_AREA_PX = 12
+
+#: Two knot exits on different faces are one branch when the line joining them makes more than
+#: this angle with the stem axis: branches leave the stem at 50-90 degrees (seed 001's logs).
+KNOT_PAIR_MIN_ANGLE_DEG = 40.0
+
+#: ... and smaller than this share of the largest region on the same face (H11's grown mask of
+#: face C has a 150 px bud beside its 21 000 px knot).
+KNOT_MIN_AREA_SHARE = 0.1

@@ -83,7 +83,7 @@ def test_fit_block_evidence_grid_carries_meta_and_uncertainty(block, tmp_path):
     assert 0 < confidence(far)[0] < confidence(near)[0] <= 1
     loaded = GridField.load(grid.save(tmp_path / "f.npz"))
     assert loaded.meta == grid.meta
-    np.testing.assert_allclose(loaded.uncertainty, grid.uncertainty)
+    np.testing.assert_allclose(loaded.layers["uncertainty"], grid.layers["uncertainty"])
     acc = evaluate_fit(block.true_field, grid, block.size_mm, pixel_mm=0.25)[0]
     assert acc["matched_1"] > 90.0
 

@@ -302,7 +302,7 @@ def confidence(uncertainty: np.ndarray) -> np.ndarray:
     return np.exp(-(np.asarray(uncertainty, float) / 0.5) ** 2)
 
 
-def bake_evidence(ev: EvidenceFit, size_mm, faces):
+def bake_evidence(ev: EvidenceFit, size_mm, faces, strands=()):
     """Bake the chosen field to a :class:`~woodcam.fields.GridField` carrying the per-node
     :func:`uncertainty_years` and the evidence (chosen hypothesis, scores, flags) in ``meta``.
 
@@ -327,12 +327,19 @@ def bake_evidence(ev: EvidenceFit, size_mm, faces):
         cs = ev.uncertainty_years(coarse).reshape([len(a) for a in cax])
         spread = ndimage.map_coordinates(cs, ((nodes - lo) / step).T, order=1, mode="nearest")
     unc = spread + EVIDENCE_UNSEEN_YEARS_PER_MM * distance_to_faces_mm(nodes, size_mm, faces)
+    layers = {"uncertainty": unc.reshape(shape)}
+    if strands:  # knots fitted into the field (part 3): their darkening weight as a layer
+        from ..fields.knot_strands import strands_to_meta
+
+        layers["knot"] = np.asarray(ev.field.knot_features(nodes)["knot"]).reshape(shape)
     meta = {"method": "evidence", "chosen": ev.chosen, "contradicted": ev.contradicted,
             "unverified": ev.unverified, "accepted": list(ev.accepted), "message": ev.message,
             "faces": [FACES[i] for i in faces],
             "scores": {n: {k: round(float(v), 2) for k, v in sc.items()} for n, sc in ev.scores.items()}}
+    if strands:
+        meta["knots"] = strands_to_meta(strands)
     return GridField(grid.years, grid.origin_mm, grid.spacing_mm, grid.interpolation, grid.axis,
-                     unc.reshape(shape), meta)
+                     layers, meta)
 
 
 __all__ = ["CANDIDATES", "EvidenceFit", "Hypothesis", "bake_evidence", "choose", "confidence",

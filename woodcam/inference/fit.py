@@ -56,9 +56,12 @@ def fit_block(block, method: Method = "evidence", faces=None, baked: bool = True
     if method == "evidence":
         from .evidence import bake_evidence, fit_evidence
 
+        from .knots import with_knots
+
         ev = fit_evidence(obs, block.size_mm)
+        ev.field, strands = with_knots(block, ev.field, faces)  # knots from the masks (part 3)
         used = sorted({int(i) for i in np.unique(obs.face)})
-        return bake_evidence(ev, block.size_mm, used) if baked else ev
+        return bake_evidence(ev, block.size_mm, used, strands) if baked else ev
     if method == "rbf":
         if not obs.labelled:  # the seed's RBF needs years: number the rings as the radial fit does
             obs = number_observations(obs, fit_radial(obs, block.size_mm))
