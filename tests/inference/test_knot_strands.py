@@ -102,3 +102,17 @@ def test_h11_knot_appears_where_its_photos_show_it(shared_data, tmp_path):
         face = b.faces[name]
         pts = face_pixel_points(name, face.shape, b.size_mm).reshape(-1, 3)
         assert grid.knot_features(pts)["knot"].mean() < 0.05
+
+
+def test_grid_with_a_knot_layer_answers_the_colour_maps_questions(tmp_path):
+    from woodcam.fields.grid import GridField
+
+    years = np.random.default_rng(0).uniform(0, 5, (6, 6, 6))
+    knot = np.zeros_like(years)
+    knot[2:4, 2:4, 2:4] = 1.0
+    plain = GridField(years, (0, 0, 0), 1.0)
+    assert not hasattr(plain, "knot_features") and not hasattr(plain, "evaluate")
+    g = GridField.load(GridField(years, (0, 0, 0), 1.0, layers={"knot": knot}).save(tmp_path / "k.npz"))
+    out = g.evaluate(np.array([[2.5, 2.5, 2.5], [0.0, 0.0, 0.0]]), directions=True)
+    np.testing.assert_allclose(out["knot"], [1.0, 0.0])
+    assert out["direction"].shape == (2, 3) and np.allclose(out["years"], g([[2.5, 2.5, 2.5], [0, 0, 0]]))

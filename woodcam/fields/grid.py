@@ -126,12 +126,21 @@ class GridField:
         return ndimage.map_coordinates(self.layers[name], idx.T, order=1, mode="nearest")
 
     def __getattr__(self, name):
-        # knot_features exists only with a "knot" layer (appearances ask hasattr)
-        if name == "knot_features" and "knot" in self.__dict__.get("layers", {}):
+        # knot_features and evaluate (what the colour map asks of knotted fields) exist only
+        # with a "knot" layer: appearances test hasattr
+        if name in ("knot_features", "evaluate") and "knot" in self.__dict__.get("layers", {}):
             def knot_features(points_mm):
                 k = np.clip(self.layer("knot", points_mm), 0.0, 1.0)
                 return {"knot": k, "dead": np.zeros_like(k), "outline": np.zeros_like(k)}
-            return knot_features
+
+            def evaluate(points_mm, *, directions: bool = False):
+                from .base import grain_direction
+
+                out = {"years": self(points_mm), **knot_features(points_mm)}
+                if directions:
+                    out["direction"] = grain_direction(self, points_mm)
+                return out
+            return knot_features if name == "knot_features" else evaluate
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     def save(self, path) -> Path:
