@@ -104,6 +104,11 @@ def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, ob
         baked = bake(mesh, stock.wood, texels_per_mm=texels_per_mm, progress=progress)
     result.atlas_px = tuple(baked.atlas.shape[:2])
     result.warnings += list(getattr(baked, "warnings", []))
+    from .inference.evidence import uncertainty_report
+
+    line = uncertainty_report(stock.wood.field, mesh.vertices, stock.size_mm, result.name)
+    if line:  # a fitted field says where its rings are a guess (issue 12 part 5)
+        result.warnings.append(line)
     meta = {"block": stock.spec, "size_mm": list(stock.size_mm), **(metadata or {}),
             "texels_per_mm": float(baked.texels_per_mm)}
     with result.stage("export"):

@@ -7,8 +7,8 @@ from _eq79_blocks import make_block, random_field
 from woodcam.errors import WoodcamError, WoodcamWarning
 from woodcam.fields.grid import GridField
 from woodcam.inference import evaluate_fit, fit_block, gather_observations
-from woodcam.inference.evidence import (Hypothesis, choose, confidence, fit_evidence, holdout_evidence,
-                                        radial_recipe)
+from woodcam.inference.evidence import (ConfidenceWood, Hypothesis, choose, confidence, fit_evidence,
+                                        holdout_evidence, radial_recipe, uncertainty_report)
 from woodcam.inference.radial import RadialField, _smoothest_coefficients, fit_radial
 
 
@@ -86,6 +86,18 @@ def test_fit_block_evidence_grid_carries_meta_and_uncertainty(block, tmp_path):
     np.testing.assert_allclose(loaded.layers["uncertainty"], grid.layers["uncertainty"])
     acc = evaluate_fit(block.true_field, grid, block.size_mm, pixel_mm=0.25)[0]
     assert acc["matched_1"] > 90.0
+    # the bake report line: a part in the unseen back-right-bottom corner is the uncertain one,
+    # and the face to photograph is one the fit did not see
+    corner = np.random.default_rng(1).uniform(0.7, 1.0, (500, 3)) * size
+    corner[:, 2] = size[2] - corner[:, 2]  # bottom
+    line = uncertainty_report(grid, corner, size, "bowl")
+    assert "uncertain" in line and any(f"photograph the {f} face" in line for f in ("bottom", "right", "back"))
+    near_seen = np.random.default_rng(2).uniform(0.0, 0.05, (500, 3)) * size
+    near_seen[:, 2] = size[2] - near_seen[:, 2]
+    assert "well constrained" in uncertainty_report(grid, near_seen, size, "lid")
+    assert uncertainty_report(block.true_field, corner, size) is None
+    rgb = ConfidenceWood(grid).color(np.concatenate([corner[:1], near_seen[:1]]))
+    assert rgb[0, 0] > rgb[1, 0] and rgb[0, 1] < rgb[1, 1]  # redder where less sure
 
 
 def test_candidates_are_checked(obs, block):

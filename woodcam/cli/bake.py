@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..errors import WoodcamError
 from .options import BLOCK_SPEC_HELP, add_bake_options, stock_options, write_screenshot
 
 
@@ -39,6 +40,10 @@ def register(subparsers) -> None:
                    help="render to this PNG instead of opening a window")
     p.add_argument("--block", default=None,
                    help="block spec for the cut plane (default: the one stored in the GLB)")
+    p.add_argument("--confidence", action="store_true",
+                   help="colour the part by the fit's per-point confidence (red 0, yellow 0.5, green "
+                   "1; spread of the accepted hypotheses and distance from observed faces) "
+                   "instead of its wood")
     p.set_defaults(func=run_preview)
 
     p = subparsers.add_parser("blocks", help="list the built-in synthetic blocks")
@@ -80,7 +85,15 @@ def run_preview(args: argparse.Namespace) -> int:
     if spec is None and args.mesh.suffix.lower() == ".glb":
         spec = read_glb_metadata(args.mesh).get("block")
     stock = open_stock(spec) if spec else None
-    out = preview(args.mesh, wood=stock.wood if stock else None,
+    wood = stock.wood if stock else None
+    if args.confidence:
+        from ..inference.evidence import ConfidenceWood
+
+        if stock is None or "uncertainty" not in (getattr(stock.wood.field, "layers", {}) or {}):
+            raise WoodcamError("--confidence needs a block whose field was fitted (a block folder "
+                               "without a true field, or a Mokume folder); pass --block")
+        wood = ConfidenceWood(stock.wood.field)
+    out = preview(args.mesh, wood=wood,
                   size_mm=stock.size_mm if stock else None, screenshot=args.screenshot)
     if out:
         print(f"wrote {out}")

@@ -63,8 +63,8 @@ def run(args) -> int:
         if args.jitter_mm < 0 or args.dropout_chunk_mm <= 0:
             raise WoodcamError(f"--jitter-mm must be >= 0 and --dropout-chunk-mm > 0; got "
                                f"{args.jitter_mm:g} and {args.dropout_chunk_mm:g}")
-        noise = dict(trace_jitter_mm=args.jitter_mm, trace_dropout=args.dropout,
-                     trace_dropout_chunk_mm=args.dropout_chunk_mm, mislabel_fraction=args.mislabel)
+        noise = {"trace_jitter_mm": args.jitter_mm, "trace_dropout": args.dropout,
+                 "trace_dropout_chunk_mm": args.dropout_chunk_mm, "mislabel_fraction": args.mislabel}
         if args.ring_maps_only:
             noise["trace_faces"] = []
         folders = synth_benchmark_set(args.out, args.count, args.seed, face_px=args.face_px,

@@ -11,7 +11,8 @@ always computed from the interpolated growth time, never interpolated itself.
 from __future__ import annotations
 
 import zipfile
-from dataclasses import dataclass, field as dc_field
+from dataclasses import dataclass
+from dataclasses import field as dc_field
 from pathlib import Path
 from typing import Literal
 

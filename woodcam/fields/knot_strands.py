@@ -122,7 +122,6 @@ class StemWithKnots:
         """``knot`` (0..1 darkening weight: 1 inside a knot), ``dead`` and ``outline`` (0: alive
         knots only), each ``(n,)``, as :meth:`woodcam.fields.KnottedLogField.knot_features`."""
         p = check_points(points_mm)
-        gs = np.asarray(self.stem(p), float)
         knot = np.zeros(len(p))
         for table in self._tables:
             d, R, _, _ = self._geometry(p, table)

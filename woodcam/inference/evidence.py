@@ -30,20 +30,36 @@ in-sample radial fit and every hypothesis is fitted and scored on those numbers.
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, field as dc_field
-from typing import Callable
+from collections.abc import Callable
+from dataclasses import dataclass
+from dataclasses import field as dc_field
 
 import numpy as np
 
 from ..errors import WoodcamError, WoodcamWarning
 from ..frames import FACES
-from ..tolerances import (EVIDENCE_ACCEPT_MARGIN, EVIDENCE_MAX_HELD_POINTS, EVIDENCE_MIN_FACE_POINTS,
-                          EVIDENCE_MIN_FACE_SHARE_2MM, EVIDENCE_RBF_POINTS, EVIDENCE_RESIDUAL_SMOOTHING,
-                          EVIDENCE_SPREAD_SPACING_MM, EVIDENCE_UNSEEN_YEARS_PER_MM)
+from ..tolerances import (
+    EVIDENCE_ACCEPT_MARGIN,
+    EVIDENCE_MAX_HELD_POINTS,
+    EVIDENCE_MIN_FACE_POINTS,
+    EVIDENCE_MIN_FACE_SHARE_2MM,
+    EVIDENCE_RBF_POINTS,
+    EVIDENCE_RESIDUAL_SMOOTHING,
+    EVIDENCE_SPREAD_SPACING_MM,
+    EVIDENCE_UNSEEN_YEARS_PER_MM,
+)
 from .observations import RingObservations
-from .radial import (RadialField, _fit_growth_history, _one_blas_thread, _smoothest_coefficients,
-                     fit_radial_hypotheses)
+from .radial import (
+    RadialField,
+    _fit_growth_history,
+    _one_blas_thread,
+    _smoothest_coefficients,
+    fit_radial_hypotheses,
+)
 from .rbf import fit_rbf
+
+#: Mean confidence over a part above which the bake report calls its rings well constrained.
+CONFIDENT_MEAN = 0.8
 
 #: Finite-difference step (mm) of the growth-time gradient that turns a year error into mm.
 _GRAD_STEP_MM = 0.25
@@ -342,6 +358,54 @@ def bake_evidence(ev: EvidenceFit, size_mm, faces, strands=()):
                      layers, meta)
 
 
-__all__ = ["CANDIDATES", "EvidenceFit", "Hypothesis", "bake_evidence", "choose", "confidence",
+_THIRDS = (("left", "middle", "right"), ("front", "middle", "back"), ("bottom", "middle", "top"))
+
+
+def uncertainty_report(field, points_mm, size_mm, what: str = "part") -> str | None:
+    """One line on where a fit's rings are a guess (issue 12 part 5), or None when ``field``
+    carries no uncertainty (a true field, a plain fit).
+
+    points_mm : (n, 3) points of the part (block frame), e.g. its mesh vertices. The part is
+    cut in thirds along each block axis; the third with the lowest mean :func:`confidence` is
+    named, with the unobserved face nearest to it to photograph (``field.meta["faces"]``).
+    """
+    layers = getattr(field, "layers", {}) or {}
+    if "uncertainty" not in layers or not len(points_mm):
+        return None
+    p = np.asarray(points_mm, float)
+    conf = confidence(field.uncertainty_years(p))
+    if conf.mean() >= CONFIDENT_MEAN:
+        return f"the rings of this {what} are well constrained (mean confidence {conf.mean():.2f})"
+    size = np.asarray(size_mm, float)
+    worst = None
+    for ax in range(3):
+        third = np.clip((p[:, ax] / size[ax] * 3).astype(int), 0, 2)
+        for t in range(3):
+            sel = third == t
+            if sel.mean() >= 0.05 and (worst is None or conf[sel].mean() < worst[0]):
+                worst = (float(conf[sel].mean()), ax, t, p[sel].mean(axis=0))
+    c, ax, t, centre = worst
+    seen = set((getattr(field, "meta", {}) or {}).get("faces", []))
+    unseen = [f for f in FACES if f not in seen] or list(FACES)
+    face = min(unseen, key=lambda f: distance_to_faces_mm(centre[None], size, [FACES.index(f)])[0])
+    place = "middle" if t == 1 else _THIRDS[ax][t]
+    axis_word = ("left-right", "front-back", "bottom-top")[ax]
+    return (f"the rings in the {place} third ({axis_word}) of this {what} are uncertain "
+            f"(confidence {c:.2f}, whole {what} {conf.mean():.2f}): photograph the {face} face")
+
+
+class ConfidenceWood:
+    """A stand-in for a ``Wood`` that colours surfaces by the fit's :func:`confidence`
+    (red 0 -> yellow 0.5 -> green 1): the ``--confidence`` overlay of ``woodcam preview``."""
+
+    def __init__(self, field):
+        self.field = field
+
+    def color(self, points_mm, normals=None) -> np.ndarray:
+        c = confidence(self.field.uncertainty_years(np.asarray(points_mm, float)))
+        return np.stack([np.clip(2 - 2 * c, 0, 1), np.clip(2 * c, 0, 1), np.full_like(c, 0.1)], axis=1)
+
+
+__all__ = ["CANDIDATES", "ConfidenceWood", "EvidenceFit", "Hypothesis", "bake_evidence", "choose", "confidence",
            "distance_to_faces_mm", "face_score", "fit_evidence", "holdout_evidence", "radial_recipe",
-           "uncertainty_years"]
+           "uncertainty_report", "uncertainty_years"]

@@ -55,7 +55,6 @@ def fit_block(block, method: Method = "evidence", faces=None, baked: bool = True
     obs = gather_observations(block, faces)
     if method == "evidence":
         from .evidence import bake_evidence, fit_evidence
-
         from .knots import with_knots
 
         ev = fit_evidence(obs, block.size_mm)

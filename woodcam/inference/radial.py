@@ -527,7 +527,7 @@ def _finish_radial(obs, size_mm, found, K, M, ridge, max_relabel_rounds, seed, h
     if labelled_in:
         field = found[0]
     else:
-        shape_field, levels, groups = found
+        shape_field = found[0]
         # Levels of every group from the fitted shape (groups not in the fitting subset too).
         n = obs.n_groups
         lev = _group_medians(shape_field(obs.points_mm), obs.group, n)
