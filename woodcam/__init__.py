@@ -19,6 +19,7 @@ import importlib
 _EXPORTS = {
     ".appearance": ["SPECIES", "ColorMapAppearance", "Wood"],
     ".bake": ["BakeResult", "bake"],
+    ".benchmark": ["score_block"],
     ".block": ["Block", "Face", "RingTrace", "read_block", "read_mokume", "write_block"],
     ".cad": ["CarveResult", "carve", "load_part"],
     ".errors": ["MissingDependencyError", "WoodcamError", "WoodcamWarning"],
@@ -29,7 +30,8 @@ _EXPORTS = {
                 "read_gran1"],
     ".frames": ["FACES", "FACE_NORMAL", "MOKUME_LETTER", "block_to_pixel", "pixel_to_block",
                 "unfold_cross"],
-    ".inference": ["benchmark", "evaluate_fit", "fit_block", "leave_one_face_out"],
+    ".inference": ["EvidenceFit", "benchmark", "evaluate_fit", "fit_block", "fit_evidence",
+                   "leave_one_face_out"],
     ".logs": ["GeneratedLog", "generate_log"],
     ".pipeline": ["PartPreview", "preview_mesh", "preview_part"],
     ".stock": ["Stock", "open_stock"],
