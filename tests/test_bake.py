@@ -31,7 +31,7 @@ import pytest
 import trimesh
 
 from woodcam.bake import bake
-from woodcam.errors import WoodcamError
+from woodcam.errors import WoodcamError, WoodcamWarning
 
 # Smooth test appearance: rgb_j = 0.5 + A sin(d_j . p / L + phase_j) + B n_j, in [0.1, 0.9].
 _A = 0.25
@@ -357,8 +357,15 @@ def test_wood_without_color_and_bad_color_shape_are_rejected():
         def color(self, points_mm, normals):
             return np.full(len(points_mm), 0.5)
 
-    with pytest.raises(WoodcamError, match=r"must return an \(n, 3\) RGB array"):
+    with pytest.raises(WoodcamError, match=r"wood.color must return rgb of shape \(n, 3\)"):
         bake(_box(), Grey(), texels_per_mm=1.0)
+
+    class Bytes:
+        def color(self, points_mm, normals):
+            return np.full((len(points_mm), 3), 200.0)
+
+    with pytest.raises(WoodcamError, match=r"rgb in \[0, 1\].*divide 0..255"):  # was clipped silently
+        bake(_box(), Bytes(), texels_per_mm=1.0)
 
 
 def test_rasteriser_paints_exactly_the_bilinear_footprint_of_its_triangles():
@@ -412,3 +419,50 @@ def test_rasteriser_paints_exactly_the_bilinear_footprint_of_its_triangles():
     assert dist.max() <= 1.02 + step
     # and the footprint is not degenerate: most painted texels are truly needed
     assert painted.sum() <= need.sum() * 1.1
+
+
+def _crashing_layout(original, crash_when):
+    """A stand-in for the xatlas worker that dies natively (SIGSEGV) when ``crash_when(pieces)``."""
+    import os
+    import signal
+
+    def layout(verts, faces, pieces, **kw):
+        if crash_when(pieces):
+            os.kill(os.getpid(), signal.SIGSEGV)
+        return original(verts, faces, pieces, **kw)
+
+    return layout
+
+
+def test_a_native_crash_in_the_unwrap_is_retried_in_pieces(monkeypatch):
+    import woodcam._xatlas_worker as _xatlas_worker
+
+    mesh = _carved()
+    monkeypatch.setattr(_xatlas_worker, "layout",
+                        _crashing_layout(_xatlas_worker.layout, lambda p: len(p) == 1))
+    with pytest.warns(WoodcamWarning, match="xatlas crashed unwrapping the surface in 1 piece"):
+        result = bake(mesh, SmoothWood(), texels_per_mm=3.0)
+    # the two-piece atlas is as exact as a one-piece one
+    err, bound, _ = _check_against_wood(result.mesh, result.atlas, mesh, "face",
+                                        np.random.default_rng(5), coverage=result.coverage_mask)
+    assert err <= bound
+    np.testing.assert_array_equal(result.vertex_map.max() < len(mesh.vertices), True)
+
+
+def test_a_unwrap_that_always_crashes_is_one_clear_error(monkeypatch):
+    import woodcam._xatlas_worker as _xatlas_worker
+
+    monkeypatch.setattr(_xatlas_worker, "layout",
+                        _crashing_layout(_xatlas_worker.layout, lambda p: True))
+    with pytest.raises(WoodcamError, match=r"xatlas crashed \(native fault\).*up to 8 pieces"):
+        bake(_box(), SmoothWood(), texels_per_mm=2.0)
+
+
+def test_the_82k_triangle_icosphere_that_crashed_xatlas_bakes():
+    """Regression: xatlas segfaults on this closed sphere in one piece (issue 16)."""
+    sphere = trimesh.creation.icosphere(subdivisions=6, radius=40.0)
+    with pytest.warns(WoodcamWarning, match="xatlas crashed"):
+        result = bake(sphere, SmoothWood(), texels_per_mm=1.0)
+    assert len(result.mesh.faces) == 81920
+    assert result.coverage_mask.mean() > 0.5
+

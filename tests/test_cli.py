@@ -67,6 +67,7 @@ def test_errors_are_one_clean_line(argv, message, tmp_path):
 
 def test_knot_flags_reach_the_colour_map(tmp_path):
     """--knot-darkening 0,0 leaves knot wood as light as the stem's; 0.9,0.9 makes it dark."""
+    from woodcam.appearance.knots import KnotShading
     from woodcam.cli import build_parser
     from woodcam.cli.options import appearance_params as _appearance_params
     from woodcam.stock import open_stock
@@ -74,9 +75,8 @@ def test_knot_flags_reach_the_colour_map(tmp_path):
     base = ["bake", "x.py", "--block", "builtin:knotty", "--out", "x.glb"]
     args = build_parser().parse_args(base + ["--knot-darkening", "0.9,0.8", "--knot-outline", "0,0.5,1"])
     params = _appearance_params(args)
-    assert params == {"knot_darkening_alive": 0.9, "knot_darkening_dead": 0.8,
-                      "dead_outline_rgb": (0.0, 0.5, 1.0)}
-    wood_light = open_stock("builtin:knotty", knot_darkening_alive=0.0, knot_darkening_dead=0.0).wood
+    assert params == {"knots": KnotShading(0.9, 0.8, (0.0, 0.5, 1.0))}
+    wood_light = open_stock("builtin:knotty", knots=KnotShading(0.0, 0.0)).wood
     stock = open_stock("builtin:knotty", **params)
     wood_dark, field = stock.wood, stock.wood.field
     pts = np.random.default_rng(0).uniform((0, 0, 0), stock.size_mm, (20000, 3))

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 import woodcam.cli as cli
+from woodcam.appearance.knots import KnotShading
 
 REPO = Path(__file__).resolve().parents[1]
 HEAVY = ("numpy", "scipy", "numba", "torch", "trimesh", "PIL", "pyvista", "cv2", "skimage")
@@ -60,6 +61,6 @@ def test_bake_demo_and_gcode_share_the_bake_options():
     for name, argv in runs.items():
         args = parser.parse_args(argv)
         assert cli.options.stock_options(args) == {
-            "species": "walnut", "appearance": "colormap", "knot_darkening_alive": 0.2,
-            "knot_darkening_dead": 0.4}, name
+            "species": "walnut", "appearance": "colormap",
+            "knots": KnotShading(alive_darkening=0.2, dead_darkening=0.4)}, name
         assert args.no_obj, name

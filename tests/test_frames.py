@@ -36,6 +36,15 @@ def test_points_lie_on_the_face_plane(face):
     assert np.all(p >= 0) and np.all(p <= np.asarray(SIZE))
 
 
+@pytest.mark.parametrize("face", FACES)
+def test_face_pixel_points_are_pixel_to_block_of_every_pixel(face):
+    """The broadcast (affine) form equals the per-pixel map at every pixel centre."""
+    shape = SHAPES[face]
+    r, c = np.meshgrid(np.arange(shape[0]), np.arange(shape[1]), indexing="ij")
+    np.testing.assert_allclose(face_pixel_points(face, shape, SIZE),
+                               pixel_to_block(face, r, c, shape, SIZE), atol=1e-12)
+
+
 def test_table_corners():
     """Pixel (0, 0) is the top-left seen from outside; spot-check the conventions table."""
     W, D, H = SIZE

@@ -9,8 +9,9 @@ from woodcam.block import Face
 from woodcam.errors import WoodcamError
 from woodcam.fields import evaluate
 from woodcam.frames import FACES, CrossLayout, face_pixel_points, pixel_to_block
+from woodcam.fields import PlacedField
 from woodcam.synth import (
-    PATTERNS, AnalyticLogField, PlacedField, cut_block, synth_benchmark_set, synth_block,
+    PATTERNS, AnalyticLogField, cut_block, synth_benchmark_set, synth_block,
 )
 
 RING_MM = 2.5
@@ -209,8 +210,10 @@ def test_face_shapes_follow_cross_layout_and_bad_knobs_raise():
     block = synth_block(cut_block(radial_log, SIZE, "rift"), SIZE, px_per_mm=2.0)
     layout = CrossLayout(SIZE, 2.0)
     assert {n: f.shape for n, f in block.faces.items()} == {n: layout.face_shape(n) for n in FACES}
-    with pytest.raises(WoodcamError, match="trace_dropout must be a fraction"):
+    with pytest.raises(WoodcamError, match=r"trace_dropout \(traces.dropout\) must be a fraction"):
         synth_block(radial_log, SIZE, trace_dropout=1.5)
+    with pytest.raises(WoodcamError, match="unknown keyword 'trace_drop'"):
+        synth_block(radial_log, SIZE, trace_drop=0.5)
     with pytest.raises(WoodcamError, match="face must be one of"):
         synth_block(radial_log, SIZE, faces=["side"])
     with pytest.raises(WoodcamError, match="photo of face 'front' must have shape"):
@@ -252,6 +255,12 @@ def test_placed_field_serialises_only_when_the_log_field_does():
     g = PlacedField.from_dict(json.loads(json.dumps(f.to_dict())))
     p = np.random.default_rng(0).uniform(0, 40, (100, 3))
     assert np.array_equal(f(p), g(p))
+    # files written before the placement became a LogFrame stored (origin_mm, rotation)
+    old = {"log_field": f.to_dict()["log_field"], "origin_mm": f.origin_mm.tolist(),
+           "rotation": f.rotation.tolist()}
+    np.testing.assert_allclose(PlacedField.from_dict(old)(p), f(p), atol=1e-9)
+    np.testing.assert_allclose(PlacedField(f.log_field, f.origin_mm, f.rotation).to_log(p), f.to_log(p),
+                               atol=1e-9)
     with pytest.raises(WoodcamError, match="must be a woodcam class"):
         cut_block(radial_log, SIZE, "rift").to_dict()
 
@@ -277,3 +286,30 @@ def test_benchmark_set_with_knotted_logs(tmp_path):
         for t in face.traces:
             p = pixel_to_block(face.name, t.points_px[:, 0], t.points_px[:, 1], face.shape, block.size_mm)
             np.testing.assert_allclose(block.true_field(p), t.year, atol=1e-3)
+
+
+def test_synth_spec_round_trips_through_json_and_matches_the_flat_keywords(tmp_path):
+    from woodcam.synth import PhotoSpec, SynthSpec, TraceSpec
+
+    spec = SynthSpec(face_px=48, faces=("front", "top"), trace_faces=("top",), seed=3,
+                     photo=PhotoSpec(noise=0.0, variation=0.0, blur_px=0.0),
+                     traces=TraceSpec(jitter_mm=0.1, unlabelled_fraction=0.5))
+    again = SynthSpec.load(spec.save(tmp_path / "spec.json"))
+    assert again == spec and json.loads((tmp_path / "spec.json").read_text())["traces"]["jitter_mm"] == 0.1
+    with pytest.raises(WoodcamError, match=r"synth spec has unknown keys \['colour'\]"):
+        SynthSpec.from_dict({**spec.to_dict(), "colour": 1})
+    field = cut_block(radial_log, SIZE, "rift")
+    by_spec = synth_block(field, SIZE, spec)
+    by_keywords = synth_block(field, SIZE, face_px=48, faces=["front", "top"], trace_faces=["top"],
+                              seed=3, photo_noise=0.0, photo_variation=0.0, photo_blur_px=0.0,
+                              trace_jitter_mm=0.1, unlabelled_fraction=0.5)
+    assert sorted(by_spec.faces) == ["front", "top"] and by_spec.meta == by_keywords.meta
+    for name in by_spec.faces:
+        a, b = by_spec.faces[name], by_keywords.faces[name]
+        assert np.array_equal(a.photo, b.photo)
+        assert [(t.year, t.points_px.tolist()) for t in a.traces] == \
+            [(t.year, t.points_px.tolist()) for t in b.traces]
+    assert by_spec.faces["top"].traces and not by_spec.faces["front"].traces
+    assert any(t.year is None for t in by_spec.faces["top"].traces)
+    # keywords override a spec's settings
+    assert synth_block(field, SIZE, spec, seed=4).meta["seed"] == 4

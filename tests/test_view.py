@@ -17,6 +17,8 @@ from PIL import Image  # noqa: E402
 from woodcam.errors import WoodcamError  # noqa: E402
 from woodcam.tolerances import ON_FACE_TOL_MM  # noqa: E402
 from woodcam import view  # noqa: E402
+import woodcam.view.camera  # noqa: E402,F401
+import woodcam.view.scene  # noqa: E402,F401
 from woodcam.view import (  # noqa: E402
     OUTLINE_ACTOR, PART_ACTOR, SECTION_ACTOR, WASTE_ACTOR, CutPlaneCallback, block_outline,
     build_scene, cut_plane_image, mesh_to_pyvista, preview,
@@ -355,7 +357,7 @@ def test_cut_plane_callback_clip_hides_the_part_on_the_normal_side():
         part, texture = mesh_to_pyvista(_textured_box())
         callback = CutPlaneCallback(plotter, part, texture)   # no wood: clipping only
         assert callback((1.0, 0.0, 0.0), (50.0, 40.0, 20.0)) is None
-        view._set_camera(plotter, "top", (0, SIZE[0], 0, SIZE[1], 0, SIZE[2]))
+        view.camera.set_camera(plotter, "top", (0, SIZE[0], 0, SIZE[1], 0, SIZE[2]))
         img = plotter.screenshot(return_img=True).astype(int)
     finally:
         plotter.close()
@@ -414,10 +416,10 @@ def test_interactive_scene_without_wood_clips_only():
 
 def test_default_cut_normal_faces_the_camera_along_the_longest_axis():
     size = np.asarray(SIZE)
-    np.testing.assert_array_equal(view._default_cut_normal("iso", size), [1, 0, 0])
-    np.testing.assert_array_equal(view._default_cut_normal("iso", size[[2, 1, 0]]), [0, 0, 1])
-    np.testing.assert_array_equal(view._default_cut_normal("front", size), [0, -1, 0])
-    np.testing.assert_array_equal(view._default_cut_normal("top", size), [0, 0, 1])
+    np.testing.assert_array_equal(view.camera.default_cut_normal("iso", size), [1, 0, 0])
+    np.testing.assert_array_equal(view.camera.default_cut_normal("iso", size[[2, 1, 0]]), [0, 0, 1])
+    np.testing.assert_array_equal(view.camera.default_cut_normal("front", size), [0, -1, 0])
+    np.testing.assert_array_equal(view.camera.default_cut_normal("top", size), [0, 0, 1])
 
 
 # ---------------------------------------------------------------------------- conversion
@@ -481,7 +483,7 @@ def test_preview_rejects_bad_meshes(tmp_path):
 
 
 def test_interactive_without_display_says_use_screenshot(monkeypatch):
-    monkeypatch.setattr(view.sys, "platform", "linux")
+    monkeypatch.setattr(view.scene.sys, "platform", "linux")
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     with pytest.raises(WoodcamError, match="needs a display.*--screenshot"):

@@ -38,7 +38,7 @@ _EXPORTS = {
     ".synth": ["cut_block", "synth_block"],
     ".toolpath": ["Program", "SimResult", "Tool", "load_tool_table", "parse_tool_spec",
                   "read_gcode", "simulate"],
-    ".view": ["preview"],
+    ".view": ["SceneOptions", "preview"],
 }
 _WHERE = {name: mod for mod, names in _EXPORTS.items() for name in names}
 

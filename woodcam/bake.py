@@ -63,11 +63,20 @@ NormalsMode = Literal["face", "smooth"]
 #: spheres and carved boxes); used only to predict the atlas side before unwrapping.
 _PACK_EFFICIENCY = 0.6
 
-#: Upper bound on faces per xatlas chart, via ``ChartOptions.max_chart_area``. xatlas' chart
-#: growing is super-linear in chart size: a 20k-triangle sphere unwraps in ~4-7 s as 6 charts and
-#: in ~1.2 s with this cap (~120 charts). More charts means more seams, which the conservative
-#: rasterisation and the dilation make invisible.
-_MAX_CHART_FACES = 256
+#: Upper bound on the area of one xatlas chart as a fraction of the surface area, via
+#: ``ChartOptions.max_chart_area`` (0: no cap). Measured UV fill / xatlas CPU-s at 10 texels/mm
+#: (bowl 32k triangles; lid 12k; 20k icosphere): uncapped 0.59 / 4.0, 0.57 / 0.9, 0.61 / 2.3;
+#: cap 1/32 0.39 / 2.4, 0.50 / 1.2, 0.55 / 0.8; the earlier cap of 256 x the median face
+#: made CAD parts (triangle areas vary by orders of magnitude) into ~1,100 sliver charts
+#: filling 0.15. Fill is what the texel budget buys, so no cap; the triangle budget of
+#: load_part bounds the unwrap time instead.
+_CHART_AREA_FRACTION = 0.0
+
+#: xatlas ``ChartOptions.max_iterations``: one pass of chart growing (see above).
+_CHART_ITERATIONS = 0
+
+#: Run xatlas in this process (no crash guard); for debugging only.
+_XATLAS_IN_PROCESS = False
 
 #: When xatlas' packed atlas overshoots ``max_atlas_px`` by a factor down to this, the layout is
 #: scaled down instead of re-unwrapped: chart gaps shrink from ``padding_px`` to at worst
@@ -122,6 +131,8 @@ class BakeResult:
         Human-readable messages about anything the baker changed from what was asked.
     vertex_map : (m,) int
         Index of the input vertex each output vertex came from.
+    uv_fill : float
+        Share of the atlas covered by the triangles' texel-space area (packing efficiency).
     """
 
     mesh: Any
@@ -131,6 +142,19 @@ class BakeResult:
     timings: dict[str, float]
     warnings: list[str] = field(default_factory=list)
     vertex_map: np.ndarray | None = None
+    uv_fill: float = 0.0
+
+    @property
+    def gpu_bytes(self) -> int:
+        """GPU memory of the texture as an RGBA8 image with its mip chain (x 4/3)."""
+        h, w = self.atlas.shape[:2]
+        return int(h * w * 4 * 4 / 3)
+
+    def summary(self) -> str:
+        """One line: atlas size, fill, texel density and GPU memory."""
+        h, w = self.atlas.shape[:2]
+        return (f"atlas {w}x{h}, UV fill {100 * self.uv_fill:.0f} %, "
+                f"{self.texels_per_mm:.3g} texels/mm, GPU {self.gpu_bytes / 2**20:.0f} MiB")
 
 
 def bake(
@@ -170,6 +194,8 @@ def bake(
     BakeResult
     """
     import trimesh
+
+    from .appearance.wood import wood_colors  # the one check of the colour contract
 
     t_start = time.perf_counter()
     _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals)
@@ -214,7 +240,7 @@ def bake(
         else:
             nrm = _apply_affine(normal_map, t, cx, cy)
             nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-12)
-        rgb = _color_checked(wood, points, nrm)
+        rgb = wood_colors(wood, points, nrm)
         atlas[idx] = np.round(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
     atlas = atlas.reshape(img_h, img_w, 3)
     coverage = (tri_of_texel >= 0).reshape(img_h, img_w)
@@ -243,6 +269,7 @@ def bake(
         timings=timings,
         warnings=messages,
         vertex_map=vmap,
+        uv_fill=_uv_fill(xy, faces, img_w, img_h),
     )
 
 
@@ -295,8 +322,6 @@ def _unwrap(mesh, tpm: float, max_px: int, padding: int, messages: list[str]):
     Returns ``vmap (m,) int``, ``faces (f, 3) int``, ``xy (m, 2) float64`` texel coordinates,
     atlas ``width``, ``height`` (texels) and the density used (texels / mm).
     """
-    import xatlas
-
     # The image side is later rounded up to a multiple of _ATLAS_SIZE_MULTIPLE: stay below.
     max_px = max_px // _ATLAS_SIZE_MULTIPLE * _ATLAS_SIZE_MULTIPLE
     verts = np.ascontiguousarray(mesh.vertices, dtype=np.float32)
@@ -308,22 +333,12 @@ def _unwrap(mesh, tpm: float, max_px: int, padding: int, messages: list[str]):
     predicted = math.sqrt(area * tpm * tpm / _PACK_EFFICIENCY) + 2 * padding
     if predicted > max_px:
         tpm = tpm * (max_px - 2 * padding) / (predicted - 2 * padding) * 0.97
-    face_area = np.asarray(mesh.area_faces, dtype=np.float64)
-    max_chart_area = float(_MAX_CHART_FACES * np.median(face_area))
+    chart_cap = _chart_area_cap(mesh)
+    pieces = [np.arange(len(faces_in))]
 
     for _attempt in range(4):
-        atlas = xatlas.Atlas()
-        atlas.add_mesh(verts, faces_in)
-        chart_options = xatlas.ChartOptions()
-        chart_options.max_iterations = 0  # one pass of chart growing; see _MAX_CHART_FACES
-        chart_options.max_chart_area = max_chart_area
-        pack_options = xatlas.PackOptions()
-        pack_options.resolution = 0  # single atlas, size decided by texels_per_unit
-        pack_options.texels_per_unit = float(tpm)
-        pack_options.padding = int(padding)
-        pack_options.bilinear = True
-        atlas.generate(chart_options, pack_options)
-        width, height = int(atlas.width), int(atlas.height)
+        vmap, faces, uv, width, height, pieces = _layout_guarded(
+            verts, faces_in, pieces, chart_cap, tpm, padding, messages)
         scale = max_px / max(width, height)
         if scale >= _MIN_RESCALE and scale * padding >= _MIN_PADDING_PX:
             break
@@ -333,9 +348,6 @@ def _unwrap(mesh, tpm: float, max_px: int, padding: int, messages: list[str]):
             f"bake: could not fit the atlas into max_atlas_px={max_px} (last {width}x{height} at "
             f"{tpm:.3g} texels/mm); raise max_atlas_px or lower texels_per_mm"
         )
-    if atlas.atlas_count != 1:  # pragma: no cover - resolution=0 always gives one atlas
-        raise WoodcamError(f"bake: xatlas made {atlas.atlas_count} atlases; expected 1")
-    vmap, faces, uv = atlas[0]
     # xatlas-python normalises by the atlas size; back to texel coordinates (float64).
     xy = np.asarray(uv, dtype=np.float64) * np.array([width, height], dtype=np.float64)
     if scale < 1.0:
@@ -351,6 +363,63 @@ def _unwrap(mesh, tpm: float, max_px: int, padding: int, messages: list[str]):
             f"max_atlas_px={max_px}; raise max_atlas_px for finer texels"
         )
     return vmap.astype(np.int64), faces.astype(np.int64), xy, width, height, float(tpm)
+
+
+def _uv_fill(xy: np.ndarray, faces: np.ndarray, width: int, height: int) -> float:
+    """Texel-space triangle area over the atlas area."""
+    p = xy[faces]
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    return float(0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]).sum() / (width * height))
+
+
+def _chart_area_cap(mesh) -> float:
+    """xatlas ``max_chart_area`` (mm^2, 0: none) for ``mesh``: :data:`_CHART_AREA_FRACTION`."""
+    return float(_CHART_AREA_FRACTION * float(mesh.area))
+
+
+def _split_pieces(verts: np.ndarray, faces: np.ndarray, n: int) -> list[np.ndarray]:
+    """``n`` pieces of about equal face count, cut across the longest axis of the surface."""
+    centres = verts[faces].mean(axis=1)
+    axis = int(np.argmax(np.ptp(centres, axis=0)))
+    return [np.sort(p) for p in np.array_split(np.argsort(centres[:, axis], kind="stable"), n)]
+
+
+def _layout_guarded(verts, faces, pieces, chart_cap, tpm, padding, messages):
+    """:func:`woodcam._xatlas_worker.layout` in a worker process. When xatlas dies natively
+    (segfault), retry with the surface cut into 2, 4, 8 pieces (seams are invisible after the
+    conservative rasterisation and dilation); if every try dies, one clear error."""
+    import concurrent.futures as cf
+    import multiprocessing as mp
+
+    import woodcam._xatlas_worker as _xatlas_worker
+
+    if _XATLAS_IN_PROCESS:  # pragma: no cover - debugging aid
+        return (*_xatlas_worker.layout(verts, faces, pieces, max_chart_area=chart_cap,
+                                       max_iterations=_CHART_ITERATIONS, texels_per_mm=tpm,
+                                       padding=padding), pieces)
+    # fork: the worker needs no fresh interpreter (spawn/forkserver re-import the caller's
+    # __main__, which re-runs a user's script that has no ``if __name__ == "__main__"`` guard),
+    # and it runs only xatlas' own threads and numpy, none of the parent's thread pools.
+    context = mp.get_context("fork")
+    tries = [pieces] + [_split_pieces(verts, faces, n) for n in (2, 4, 8) if n > len(pieces)]
+    for attempt in tries:
+        with cf.ProcessPoolExecutor(max_workers=1, mp_context=context) as pool:
+            job = pool.submit(_xatlas_worker.run_layout, verts, faces, attempt,
+                              max_chart_area=chart_cap, max_iterations=_CHART_ITERATIONS,
+                              texels_per_mm=float(tpm), padding=int(padding))
+            try:
+                return (*job.result(), attempt)
+            except cf.process.BrokenProcessPool:
+                messages.append(
+                    f"bake: xatlas crashed unwrapping the surface in {len(attempt)} piece(s); "
+                    f"retried in {2 * len(attempt)} pieces")
+            except RuntimeError as err:
+                raise WoodcamError(f"bake: the UV unwrap failed ({err})") from err
+    raise WoodcamError(
+        f"bake: xatlas crashed (native fault) unwrapping this {len(faces)}-triangle surface, "
+        f"also when cut into up to {len(tries[-1])} pieces; simplify or re-mesh the part "
+        "(e.g. trimesh simplify_quadric_decimation, or a coarser --tolerance)"
+    )
 
 
 def _triangle_frames(xy: np.ndarray, faces: np.ndarray):
@@ -573,22 +642,6 @@ def _apply_affine(maps, tri, cx, cy) -> np.ndarray:
     ``cx, cy (k, 1)``; (k, d) float64."""
     origin, jac_x, jac_y = maps
     return origin[tri] + jac_x[tri] * cx + jac_y[tri] * cy
-
-
-def _color_checked(wood, points: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """``wood.color(points (k, 3), normals (k, 3))`` checked for shape and finiteness; (k, 3)."""
-    rgb = np.asarray(wood.color(points, normals), dtype=np.float64)
-    if rgb.shape != (len(points), 3):
-        raise WoodcamError(
-            f"bake: wood.color must return an (n, 3) RGB array for n={len(points)} points; got "
-            f"shape {rgb.shape}; fix the appearance's color()"
-        )
-    if not np.all(np.isfinite(rgb)):
-        raise WoodcamError(
-            "bake: wood.color returned NaN or infinite colours; check the appearance and that "
-            "the mesh lies inside the block"
-        )
-    return rgb
 
 
 def _dilate(atlas: np.ndarray, coverage: np.ndarray) -> np.ndarray:

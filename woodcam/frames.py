@@ -151,8 +151,15 @@ def block_to_pixel(face: str, points_mm, image_shape, size_mm) -> tuple[np.ndarr
 def face_pixel_points(face: str, image_shape, size_mm) -> np.ndarray:
     """Block points (mm) of every pixel centre of a face image, shape ``(n_rows, n_cols, 3)``."""
     n_rows, n_cols = _check_shape(image_shape)
-    r, c = np.meshgrid(np.arange(n_rows), np.arange(n_cols), indexing="ij")
-    return pixel_to_block(face, r, c, (n_rows, n_cols), size_mm)
+    # The map is affine in (row, col): the origin and two steps, broadcast (a BLAS matmul of
+    # (n, 2) x (2, 3) is slow); tests/test_frames.py checks it against pixel_to_block.
+    shape = (n_rows, n_cols)
+    p0 = pixel_to_block(face, 0.0, 0.0, shape, size_mm)
+    dr = pixel_to_block(face, 1.0, 0.0, shape, size_mm) - p0
+    dc = pixel_to_block(face, 0.0, 1.0, shape, size_mm) - p0
+    r = np.arange(n_rows, dtype=float)[:, None, None]
+    c = np.arange(n_cols, dtype=float)[None, :, None]
+    return p0 + r * dr + c * dc
 
 
 def _check_shape(image_shape) -> tuple[int, int]:

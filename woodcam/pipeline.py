@@ -38,6 +38,8 @@ class PartPreview:
     timings_s: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     meta_block: str = ""
+    tessellation: dict = field(default_factory=dict)
+    atlas: str = ""
 
     @contextmanager
     def stage(self, name: str):
@@ -69,28 +71,44 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
 def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                  tolerance_mm: float | None = None, obj: bool = True,
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
-                 obj_up: str = "y") -> PartPreview:
+                 obj_up: str = "y", max_triangles: int | None = None,
+                 max_atlas_px: int = 4096, place: list[str] | tuple = ()) -> PartPreview:
     """Carve ``source`` (anything :func:`woodcam.cad.load_part` takes) out of ``stock``, bake it
-    and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``)."""
+    and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``).
+
+    ``place`` lists placement operations applied to the loaded part before carving
+    (:mod:`woodcam.cad.place`, e.g. ``["rotate:x:90", "center", "drop"]``); the resulting
+    4 x 4 matrix is recorded in the GLB metadata as ``placement``."""
     from .cad import carve, load_part
-    from .tolerances import TESSELLATION_TOL_MM
+    from .tolerances import MAX_PART_TRIANGLES, TESSELLATION_TOL_MM
 
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)  # before minutes of work
     result = PartPreview(out_glb.stem)
     with result.stage("load"):
-        part = load_part(source, tolerance_mm=tolerance_mm or TESSELLATION_TOL_MM)
+        part = load_part(source, tolerance_mm=tolerance_mm or TESSELLATION_TOL_MM,
+                         max_triangles=max_triangles or MAX_PART_TRIANGLES,
+                         report=result.tessellation)
+    result.warnings += list(result.tessellation.get("notes", []))
+    metadata = None
+    if place:
+        from .cad.place import place_part
+
+        part, matrix = place_part(part, list(place), stock.size_mm)
+        metadata = {"placement": {"ops": list(place), "matrix": matrix.tolist()}}
     with result.stage("carve"):
         carved = carve(part, stock.size_mm)
     result.warnings += list(carved.warnings)
     return preview_mesh(carved.mesh, stock, out_glb, texels_per_mm=texels_per_mm, obj=obj,
                         screenshot=screenshot, progress=progress, result=result,
-                        obj_units=obj_units, obj_up=obj_up)
+                        obj_units=obj_units, obj_up=obj_up, max_atlas_px=max_atlas_px,
+                        metadata=metadata)
 
 
 def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, obj: bool = True,
                  screenshot: bool = True, progress: bool = False,
                  result: PartPreview | None = None, metadata: dict | None = None,
-                 obj_units: str = "m", obj_up: str = "y") -> PartPreview:
+                 obj_units: str = "m", obj_up: str = "y",
+                 max_atlas_px: int = 4096) -> PartPreview:
     """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files: the GLB
     in metres, Y up (glTF's convention); the OBJ in ``obj_units`` with ``obj_up`` up."""
     from .bake import bake
@@ -101,8 +119,10 @@ def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, ob
     result.volume_mm3 = float(mesh.volume)
     result.triangles = int(len(mesh.faces))
     with result.stage("bake"):
-        baked = bake(mesh, stock.wood, texels_per_mm=texels_per_mm, progress=progress)
+        baked = bake(mesh, stock.wood, texels_per_mm=texels_per_mm, progress=progress,
+                     max_atlas_px=max_atlas_px)
     result.atlas_px = tuple(baked.atlas.shape[:2])
+    result.atlas = baked.summary()
     result.warnings += list(getattr(baked, "warnings", []))
     from .inference.evidence import uncertainty_report
 

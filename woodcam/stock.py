@@ -2,7 +2,9 @@
 
 A block spec is a string the CLI and GLB metadata carry:
 
-- ``builtin:NAME``: a built-in synthetic block (``woodcam blocks`` lists them).
+- ``builtin:NAME`` or ``builtin:NAME:WxDxH``: a built-in synthetic block (``woodcam blocks``
+  lists them) of its own size or of ``W x D x H`` mm, cut from the same wood round the same
+  centre (e.g. ``builtin:flat-sawn:300x120x40``).
 - ``log:LOG@K`` or ``log:LOG@K:WxDxH``: a block cut tangentially through knot ``K`` of a
   knotted log, ``LOG`` being ``gran1`` (the CT-measured spruce log of the shared data) or a
   woodcam log file (``.json``); size default 100x80x50 mm, Z along the log.
@@ -11,6 +13,10 @@ A block spec is a string the CLI and GLB metadata carry:
 - a Mokume sample folder (``A_col.png``, ``A_arl-unet.png``, ... as in the Mokume dataset): a
   cube of ``MOKUME_DEFAULT_SIZE_MM`` (50 mm) whose field is fitted to its ring maps, fit once
   and cached.
+
+Any spec may end in turns of the block under the part, ``~AXIS90`` (a multiple of 90 degrees
+about the block axis ``x``, ``y`` or ``z``; chainable, e.g. ``builtin:flat-sawn~z90`` runs the
+grain along Y): the block's size axes swap accordingly and the wood turns with it.
 
 Fitted fields and neural colour volumes are cached under ``$WOODCAM_CACHE_DIR`` or the user
 cache folder (``$XDG_CACHE_HOME/woodcam``, ``~/.cache/woodcam``), keyed by the block's content:
@@ -72,9 +78,72 @@ def open_stock(spec: str, *, species: str | None = None,
     """
     if appearance not in ("colormap", "neural"):
         raise WoodcamError(f"appearance must be one of ['colormap', 'neural']; got {appearance!r}")
+    base, turns = _split_turns(spec)
+    stock = _open_base_stock(base, species, appearance, appearance_params)
+    if not turns:
+        return stock
+    wood, size = stock.wood, stock.size_mm
+    for axis, quarter_turns in turns:
+        wood, size = wood.turned(axis, quarter_turns, size)
+    return Stock(spec, size, wood, stock.description, {**stock.meta, "turns": turns})
+
+
+def _split_turns(spec: str) -> tuple[str, list[tuple[str, int]]]:
+    """``"SPEC~z90~x-90"`` -> ``("SPEC", [("z", 1), ("x", -1)])`` (see module docstring)."""
+    base, *parts = str(spec).split("~")
+    turns = []
+    for part in parts:
+        axis, deg = part[:1].lower(), part[1:]
+        try:
+            quarter, rest = divmod(float(deg), 90.0)
+        except ValueError:
+            quarter, rest = 0, 1.0
+        if axis not in ("x", "y", "z") or rest != 0.0:
+            raise WoodcamError(
+                f"block spec {spec!r}: turn '~{part}' must be ~AXIS then a multiple of 90 degrees "
+                "(AXIS x, y or z), e.g. 'builtin:flat-sawn~z90'")
+        turns.append((axis, int(quarter)))
+    return base, turns
+
+
+def _builtin(rest: str):
+    """``NAME`` or ``NAME:WxDxH`` -> ``(BuiltinBlock, field, size_mm)``; a given size cuts a block
+    of that size from the same wood, centred where the built-in block's centre is."""
+    import numpy as np
+
+    name, _, size_text = rest.partition(":")
+    b = builtin_block(name)
+    if not size_text:
+        return b, b.field, tuple(b.size_mm)
+    size = _parse_size(size_text, f"builtin:{rest}")
+    from .fields.placement import PlacedField
+
+    offset = (np.asarray(b.size_mm, dtype=float) - np.asarray(size)) / 2
+    return b, PlacedField(b.field, origin_mm=offset), size
+
+
+def _parse_size(text: str, spec: str) -> tuple[float, float, float]:
+    import math
+
+    try:
+        size = tuple(float(v) for v in text.lower().split("x"))
+    except ValueError:
+        size = ()
+    if len(size) != 3 or not all(math.isfinite(v) and 0 < v <= _MAX_BLOCK_SIDE_MM for v in size):
+        raise WoodcamError(
+            f"block spec {spec!r}: the size must be WxDxH in mm, each > 0 and <= "
+            f"{_MAX_BLOCK_SIDE_MM:g}; got {text!r}, e.g. builtin:flat-sawn:300x120x40")
+    return size
+
+
+#: Largest side (mm) a synthetic block may be given: a woodworker's block, not a building.
+_MAX_BLOCK_SIDE_MM = 5000.0
+
+
+def _open_base_stock(spec: str, species, appearance, appearance_params) -> Stock:
     if spec.startswith("builtin:"):
-        b = builtin_block(spec.split(":", 1)[1])
-        return _synthetic_stock(spec, b.field, b.size_mm, species or b.species, b.description,
+        b, field, size = _builtin(spec.split(":", 1)[1])
+        return _synthetic_stock(spec, field, size, species or b.species, b.description,
                                 appearance, appearance_params)
     if spec.startswith("log:"):
         field, size_mm, description = _log_block_field(spec)
@@ -111,8 +180,8 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         from .synth import synth_block
 
         if spec.startswith("builtin:"):
-            b = builtin_block(spec.split(":", 1)[1])
-            field, size, name = b.field, b.size_mm, b.name
+            b, field, size = _builtin(spec.split(":", 1)[1])
+            name = b.name if tuple(size) == tuple(b.size_mm) else spec.replace(":", "-")
         else:
             field, size, _ = _log_block_field(spec)
             name = spec.replace(":", "-").replace("/", "_")

@@ -174,6 +174,12 @@ CREASE_ANGLE_DEG = 30.0
 #: split at UV seams, so positions, not vertex indices, decide which faces meet at a vertex.
 CREASE_WELD_MM = 1e-6
 
+#: Default triangle budget of a tessellated B-rep part: above it, load_part re-meshes with
+#: looser tolerances and says so. Public STEP parts reached 226k-312k triangles at the fixed
+#: 0.05 mm / 5 deg defaults and took 4-10 min to bake; 120k keeps the demo bowl (~32k) and the
+#: other examples untouched while bounding the unwrap (xatlas is super-linear in chart size).
+MAX_PART_TRIANGLES = 120_000
+
 #: Evidence-based choice of a fit (``woodcam.inference.evidence``, issue 12 part 1).
 #: A face takes part in leave-one-face-out only with at least this many ring points: fewer
 #: (a face crossed by one short ring) scores by chance.

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from woodcam.fields import log_render as lr
+from woodcam.logs import render as lr
 from woodcam.fields.knots import KnottedLogField, block_at_knot, place_block_in_log
 from woodcam.fields.tree_data import read_gran1
 

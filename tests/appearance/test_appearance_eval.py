@@ -57,6 +57,18 @@ def _tiny_eval_block():
     return synth_block(b.field, b.size_mm, face_px=64, seed=0, name="tiny"), b.field
 
 
+def _assert_predictions_resemble_the_photo(r):
+    """Every model's prediction is close to the held-out photo in colour (histogram and mean
+    absolute difference) and far closer than a black image would be; its scores are its own."""
+    black = histogram_distance(np.zeros_like(r.photo), r.photo)
+    assert black > 0.4                                   # the photo is not dark itself
+    for m in MODELS:
+        pred = np.asarray(r.predictions[m], float)
+        assert r.scores[m]["histogram"] == pytest.approx(histogram_distance(pred, r.photo), abs=1e-6)
+        assert r.scores[m]["histogram"] < 0.25 * black, (m, r.face, r.scores[m])
+        assert np.mean(np.abs(pred - r.photo)) < 0.15, (m, r.face)
+
+
 def test_leave_one_face_out_runs_all_models(tmp_path):
     block, field = _tiny_eval_block()
     res = leave_one_face_out(block, field, resolution=40, quality="draft", epochs=1,
@@ -69,6 +81,7 @@ def test_leave_one_face_out_runs_all_models(tmp_path):
         for m in MODELS:
             assert r.predictions[m].shape == r.photo.shape
             assert set(r.scores[m]) == {"histogram", "spectrum", "patch", "l1"}
+        _assert_predictions_resemble_the_photo(r)
     s = summarise(res)
     assert s["end_grain"]["faces"] == ["top"] and s["side_grain"]["faces"] == ["front"]
     side_by_side(res, tmp_path / "sbs.png", title="tiny")
@@ -83,6 +96,7 @@ def test_leave_one_face_out_on_ring_maps_without_a_field():
     res = leave_one_face_out(block, None, resolution=40, quality="draft", epochs=1, faces=["left"],
                              progress=False)
     assert res[0].end_grain is None and set(res[0].predictions) == set(MODELS)
+    _assert_predictions_resemble_the_photo(res[0])
 
 
 def test_leave_one_face_out_needs_two_photos():

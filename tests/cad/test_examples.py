@@ -118,3 +118,20 @@ def test_tray_runs_standalone_into_the_current_directory(tmp_path, cq):
     namespace = runpy.run_path(str(EXAMPLES_DIR / "tray.py"), run_name="__test__")
     assert load_part(out).volume() == pytest.approx(
         _brep_volume(namespace["part"]), rel=CARVE_VOLUME_RTOL)
+
+
+class _FlatWood:
+    def color(self, points_mm, normals):
+        return np.full(points_mm.shape, 0.5)
+
+
+@pytest.mark.slow  # bakes every example at the default 10 texels/mm (~10 CPU-s)
+def test_example_bakes_with_half_the_atlas_filled(example):
+    """Issue 16: charts capped at 256 x the median face filled 7-15 % of the atlas on curved CAD
+    parts (a 90 mm cup silently dropped from 10 to 3.7 texels/mm); the bar is 50 %."""
+    from woodcam.bake import bake
+
+    name, _, result = example
+    baked = bake(result.mesh, _FlatWood(), texels_per_mm=10.0)
+    assert baked.uv_fill >= 0.5, f"{name}: {baked.summary()}"
+    assert baked.texels_per_mm == pytest.approx(10.0), f"{name}: density lowered"

@@ -293,3 +293,26 @@ def test_bad_files_raise_clear_errors(tmp_path, name, content, pattern):
 def test_missing_file_raises(tmp_path):
     with pytest.raises(WoodcamError, match="does not exist"):
         load_part(tmp_path / "nowhere.stl")
+
+
+def test_triangle_budget_remeshes_looser_and_says_so(bd):
+    """A finely meshed torus (46k triangles at 0.01 mm) is re-meshed under a 20k budget; the
+    volume stays within the looser chord tolerance of the exact 2 pi^2 R r^2."""
+    torus = bd.Pos(30, 30, 30) * bd.Torus(20, 6)
+    exact = 2 * math.pi ** 2 * 20 * 6 ** 2
+    free: dict = {}
+    load_part(torus, tolerance_mm=0.01, max_triangles=None, report=free)
+    assert free["triangles"] > 40_000 and free["notes"] == []
+    budget: dict = {}
+    solid = load_part(torus, tolerance_mm=0.01, max_triangles=20_000, report=budget)
+    assert budget["triangles"] <= 20_000
+    assert budget["tolerance_mm"] > 0.01
+    assert "exceeded max_triangles=20000; re-meshed to" in budget["notes"][0]
+    # chord error shrinks the inscribed mesh: at most area x tolerance below the exact volume
+    area = 4 * math.pi ** 2 * 20 * 6
+    assert exact - area * budget["tolerance_mm"] <= solid.volume() <= exact
+    tight: dict = {}
+    load_part(torus, tolerance_mm=0.01, max_triangles=500, report=tight)
+    assert "still over" in tight["notes"][0]
+    with pytest.raises(WoodcamError, match="max_triangles must be an integer >= 100"):
+        load_part(torus, max_triangles=5)

@@ -5,9 +5,9 @@ import pytest
 from scipy import ndimage
 
 from woodcam.errors import WoodcamError
-from woodcam.fields import log_render as lr
+from woodcam.logs import render as lr
 from woodcam.fields.knots import (KnotParams, KnottedLogField, PlacedField, available_backends,
-                                  knot_shading, place_block_in_log, power_smooth_min,
+                                  place_block_in_log, power_smooth_min,
                                   smoothing_amount)
 from woodcam.fields.tree_data import Knot, simple_log
 
@@ -236,21 +236,11 @@ def test_placed_field_from_log_frame():
     assert pf(p)[0] == pytest.approx(100.0 / 2.0)
 
 
-def test_knot_shading():
-    rgb = np.full((4, 3), 0.8)
-    feats = {"knot": np.array([0.0, 1.0, 1.0, 0.0]), "dead": np.array([0.0, 0.0, 1.0, 0.0]),
-             "outline": np.array([0.0, 0.0, 0.0, 1.0])}
-    out = knot_shading(rgb, feats, alive_darkening=0.5, dead_darkening=0.5,
-                       outline_rgb=(0.1, 0.1, 0.1))
-    assert np.allclose(out[0], 0.8) and np.allclose(out[1], 0.4)
-    assert np.allclose(out[2], 0.2) and np.allclose(out[3], 0.1)
-
-
 def test_params_are_checked():
     with pytest.raises(WoodcamError, match="k_knot"):
         KnotParams(k_knot=0.0)
-    with pytest.raises(WoodcamError, match="alive_darkening"):
-        KnotParams(alive_darkening=2.0)
+    with pytest.raises(WoodcamError, match="butterfly must be in"):
+        KnotParams(butterfly=2.0)
     with pytest.raises(WoodcamError, match="ring_width_mm"):
         KnottedLogField(simple_log(), ring_width_mm=0)
     with pytest.raises(WoodcamError, match="backend"):

@@ -46,11 +46,21 @@ def test_round_trip_of_the_real_log(gran1, tmp_path):
     assert params["n_knots"] == 108
     _check_round_trip(gran1, back, params)
     # the field of the decoded log: same rings away from the knots up to quantisation
+    # (measured: clear wood 0.07 / 0.24 / 0.89 years at the 50th / 90th / 99th percentile; in
+    # and near knots the 8-bit knot axes move knot edges by a millimetre, and a point that
+    # changes sides jumps by decades: the tail is knots, asserted separately)
     f, g = KnottedLogField(gran1), KnottedLogField(back)
     rng = np.random.default_rng(0)
     p = rng.uniform([-100, -100, 100], [100, 100, 3800], (5000, 3))
-    d = np.abs(f(p) - g(p))
-    assert np.median(d) < 0.5                       # years, ring width 2 mm
+    ef, eg = f.evaluate(p), g.evaluate(p)
+    d = np.abs(ef["years"] - eg["years"])
+    clear = (ef["knot"] < 0.01) & (eg["knot"] < 0.01)
+    assert clear.mean() > 0.95
+    p50, p90, p99 = np.percentile(d[clear], [50, 90, 99])
+    assert p50 < 0.1 and p90 < 0.3 and p99 < 1.0, (p50, p90, p99)   # years, ring width 2 mm
+    assert np.percentile(d, 95) < 0.5
+    ka, kb = ef["knot"] > 0.5, eg["knot"] > 0.5
+    assert ka.sum() >= 30 and (ka & kb).sum() >= 0.6 * ka.sum()      # knots stay where they were
 
 
 def test_round_trip_in_memory_and_clockwise_columns(gran1):

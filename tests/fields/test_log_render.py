@@ -7,7 +7,7 @@ from PIL import Image
 
 from woodcam.cli import build_parser
 from woodcam.errors import WoodcamError
-from woodcam.fields import log_render as lr
+from woodcam.logs import render as lr
 from woodcam.fields.knots import KnottedLogField
 from woodcam.fields.tree_data import Knot, simple_log, write_log
 
@@ -83,7 +83,14 @@ def test_cli_maps_and_export_round_trip(tmp_path):
     b = _parse(["log", "export", "--maps", str(tmp_path / "maps"), "--out",
                 str(tmp_path / "back.json")])
     assert b.func(b) == 0
-    assert (tmp_path / "back.json").is_file()
+    from woodcam.fields.tree_data import read_log
+
+    log, back = _log(), read_log(tmp_path / "back.json")
+    assert len(back.knots) == len(log.knots) == 1           # the knot survives the maps
+    k, kb = log.knots[0], back.knots[0]
+    assert abs(kb.z0_mm - k.z0_mm) < 3.0 and abs(kb.r_death_mm - k.r_death_mm) < 3.0
+    r = np.array([20.0, 40.0])
+    np.testing.assert_allclose(kb.axis_at(r)[0], k.axis_at(r)[0], atol=3.0)
 
 
 def test_cli_needs_exactly_one_log(tmp_path):

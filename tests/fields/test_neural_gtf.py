@@ -138,7 +138,31 @@ def test_packaged_model():
     assert (MODELS_DIR / WEIGHTS_NAME).stat().st_size < 2_000_000
     summary = json.loads((MODELS_DIR / "gtf_train_summary.json").read_text())
     assert summary["steps"] == spec.steps
-    assert summary["final_l1"] < 0.01  # normalised units: ~1 % of the domain radius
+    # The figure itself, recomputed rather than read: on fields the model never saw (another
+    # seed), a latent code fitted with the weights frozen reproduces the field to ~0.1 % of the
+    # domain radius (measured 0.0008-0.0012; the training log says 0.0010).
+    from dataclasses import replace
+
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)  # tiny batches: threads only contend on a shared machine
+    pts, vals = make_training_set(replace(spec, seed=99, n_fields=4, points_per_field=300))
+    P, V = torch.tensor(pts), torch.tensor(vals)
+    for w in net.parameters():
+        w.requires_grad_(False)
+    codes = torch.zeros(4, 1, spec.latent_dim, requires_grad=True)
+    opt = torch.optim.Adam([codes], lr=0.05)
+    try:
+        for _ in range(120):
+            opt.zero_grad()
+            (net(codes, P) - V).abs().mean().backward()
+            opt.step()
+        with torch.no_grad():
+            fitted = (net(codes, P) - V).abs().mean(dim=1).numpy()
+            mean_field = (net(torch.zeros_like(codes), P) - V).abs().mean(dim=1).numpy()
+    finally:
+        torch.set_num_threads(threads)
+    assert np.all(fitted < 0.005), fitted          # normalised units
+    assert np.all(fitted < 0.1 * mean_field), (fitted, mean_field)
     # c = 0 decodes a plausible member of the family: 0 on the pith, ~rho elsewhere
     p = torch.tensor([[0.0, 0.0, 0.0], [0.5, 0.0, 0.0], [0.0, -0.8, 0.5]])
     out = net(torch.zeros(spec.latent_dim), p).numpy()

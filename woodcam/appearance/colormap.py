@@ -15,7 +15,7 @@ both sRGB and the model only interpolates between observed colours).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import InitVar, dataclass, replace
 from typing import Literal
 
 import numba
@@ -24,6 +24,7 @@ import numpy as np
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, grain_direction
 from ..frames import FACE_AXIS, face_pixel_points
+from .knots import KnotShading
 from .noise import TABLE, noise_at
 
 #: Number of ARF bins of a fitted colour ramp.
@@ -106,23 +107,32 @@ class ColorMapAppearance:
     axis_luts : (3, LUT_BINS, 3) float or None
         Fitted colour over ARF for surfaces normal to X, Y, Z (block frame); ``None`` uses the
         species ramp with end-grain darkening. Rows with NaN fall back to the species ramp.
-    knot_darkening_alive, knot_darkening_dead : float
-        Relative darkening of alive and dead knot wood (fields that report ``knot_features``).
-    dead_outline_rgb : (3,) float
-        Colour of the bark ring around dead knots.
+    knots : KnotShading
+        How knot wood is coloured on fields that report knot features
+        (:mod:`woodcam.appearance.knots`: one shading for every renderer).
     seed : int
         Noise seed.
+    knot_darkening_alive, knot_darkening_dead, dead_outline_rgb : optional
+        Shorthands that replace those settings of ``knots`` (the CLI's ``--knot-darkening``
+        and ``--knot-outline``).
     """
 
     species: Species | str = "oak"
     axis_luts: np.ndarray | None = None
-    knot_darkening_alive: float = 0.25
-    knot_darkening_dead: float = 0.45
-    dead_outline_rgb: tuple[float, float, float] = (0.16, 0.10, 0.06)
+    knots: KnotShading = KnotShading()
     seed: int = 0
+    knot_darkening_alive: InitVar[float | None] = None
+    knot_darkening_dead: InitVar[float | None] = None
+    dead_outline_rgb: InitVar[tuple[float, float, float] | None] = None
 
-    def __post_init__(self):
+    def __post_init__(self, knot_darkening_alive=None, knot_darkening_dead=None,
+                      dead_outline_rgb=None):
         object.__setattr__(self, "species", get_species(self.species))
+        changes = {k: v for k, v in (("alive_darkening", knot_darkening_alive),
+                                     ("dead_darkening", knot_darkening_dead),
+                                     ("outline_rgb", dead_outline_rgb)) if v is not None}
+        if changes:
+            object.__setattr__(self, "knots", replace(self.knots, **changes))
         if self.axis_luts is not None:
             luts = np.asarray(self.axis_luts, dtype=np.float32)
             if luts.shape != (3, LUT_BINS, 3):
@@ -169,9 +179,9 @@ class ColorMapAppearance:
         out = np.empty((1 if blend else 3, n, 3), np.float32)
         params = np.array([s.latewood_start, s.pore_contrast, float(s.ring_porous), s.pore_across_mm,
                            s.pore_along_mm, s.streak_contrast, s.endgrain_darkening,
-                           s.endgrain_roughness, self.knot_darkening_alive,
-                           self.knot_darkening_dead], np.float32)
-        colours = np.array([s.earlywood_rgb, s.latewood_rgb, self.dead_outline_rgb], np.float32)
+                           s.endgrain_roughness, self.knots.alive_darkening,
+                           self.knots.dead_darkening], np.float32)
+        colours = np.array([s.earlywood_rgb, s.latewood_rgb, self.knots.outline_rgb], np.float32)
         _shade_kernel(arf(years).astype(np.float32), np.ascontiguousarray(grain, np.float32),
                       p.astype(np.float32), normals if blend else np.zeros((1, 3), np.float32),
                       knot, dead, outline, params, colours, np.nan_to_num(luts).astype(np.float32),
@@ -334,7 +344,7 @@ def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, lu
                           table, seed + 1)
         shade = (1.0 + streak_c * streak) * (1.0 - pore_c * pores)
         rough = noise_at(2.0 * px * inv_a, 2.0 * py * inv_a, 2.0 * pz * inv_a, table, seed + 2)
-        # knot wood darker, dead-knot outline drawn over (as fields.knots.knot_shading)
+        # knot wood darker, dead-knot outline drawn over (KnotShading.apply, appearance/knots.py)
         kfac = (1.0 - dark_alive * knot[i]) * (1.0 - dark_dead * dead[i])
         ol = outline[i]
         # lut position (bin centres) for fitted ramps

@@ -28,15 +28,15 @@ import numpy as np
 
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, evaluate
+from ..fields.rings import MOKUME_RING_SIGMA_MM, ring_map
 from ..frames import FACE_AXIS, FACE_NORMAL, block_to_pixel, check_size
 from .noise import value_noise
 
 #: In-plane axes (a, b) of the canonical image of each block axis.
 PLANE_AXES: dict[int, tuple[int, int]] = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
 
-#: Width (mm) of the ring lines of Mokume's U-Net ring maps, for ring-map-like images of a
-#: field (the same value as ``woodcam.synth.MOKUME_RING_SIGMA_MM``, which sits above this module).
-RING_MAP_SIGMA_MM = 0.62
+#: Width (mm) of the ring lines of Mokume's U-Net ring maps, for ring-map-like images of a field.
+RING_MAP_SIGMA_MM = MOKUME_RING_SIGMA_MM
 
 #: Largest allowed volume resolution (cells along the longest side): 256^3 x 3 x 3 bytes = 150 MB.
 MAX_RESOLUTION = 256
@@ -120,16 +120,9 @@ class VolumeGrid:
 # -- input channels ----------------------------------------------------------------------------------
 
 def ring_map_like(years_img: np.ndarray, cell_mm: float, sigma_mm: float = RING_MAP_SIGMA_MM) -> np.ndarray:
-    """Mokume-style ring map of growth-time images ``(..., h, w)``: ``exp(-(d / sigma)^2)``.
-
-    ``d = |g - round(g)| / |grad g|`` is the in-image distance (mm) to the nearest ring boundary,
-    to first order (the formula of ``woodcam.synth``'s ring maps, repeated here because synth sits
-    above this module).
-    """
-    g = np.asarray(years_img, np.float64)
-    gr, gc = np.gradient(g, cell_mm, axis=(-2, -1))
-    d = np.abs(g - np.round(g)) / np.maximum(np.hypot(gr, gc), 1e-9)
-    return np.exp(-((d / sigma_mm) ** 2)).astype(np.float32)
+    """Mokume-style ring map of growth-time images ``(..., h, w)`` on cells of ``cell_mm``:
+    :func:`woodcam.fields.rings.ring_map` with the line width in mm."""
+    return ring_map(years_img, sigma_mm, cell_mm)
 
 
 def input_channels(ring: np.ndarray, points_mm: np.ndarray | None, spec) -> np.ndarray:

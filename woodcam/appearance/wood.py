@@ -9,6 +9,7 @@ import numpy as np
 
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, evaluate
+from ..tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS
 from .colormap import ColorMapAppearance
 
 #: Points per work item when colouring in parallel: big enough to amortise numpy's call
@@ -28,6 +29,9 @@ class Wood:
     threads : int or None
         Worker threads for :meth:`color` (numpy releases the GIL in its kernels);
         default: the number of CPU cores.
+
+    A wood made by :meth:`turned` maps its points and normals back to the source block's frame
+    before the field and the appearance see them.
     """
 
     def __init__(self, field, appearance=None, *, threads: int | None = None):
@@ -36,10 +40,65 @@ class Wood:
         self.field = field
         self.appearance = appearance if appearance is not None else ColorMapAppearance()
         self.threads = max(1, threads or os.cpu_count() or 1)
+        #: (R (3, 3), t (3,)) with source point = R^T (p - t), or None (this block's own frame)
+        self._turn: tuple[np.ndarray, np.ndarray] | None = None
+
+    def turned(self, axis: str, quarter_turns: int, size_mm) -> tuple["Wood", tuple]:
+        """The same wood with the block turned ``quarter_turns`` x 90 degrees about the block
+        axis ``axis`` (``"x"``, ``"y"`` or ``"z"``, right hand rule), e.g. to run the grain along
+        another axis under a part that stays put.
+
+        Parameters
+        ----------
+        axis : {"x", "y", "z"}
+        quarter_turns : int
+        size_mm : (3,) float
+            The block's size (W, D, H) before turning.
+
+        Returns
+        -------
+        (Wood, (W', D', H'))
+            The turned wood, in the turned block's frame (origin at its bottom-front-left
+            corner), and the turned block's size.
+        """
+        if axis not in ("x", "y", "z") or int(quarter_turns) != quarter_turns:
+            raise WoodcamError(
+                f"turned: axis must be 'x', 'y' or 'z' and quarter_turns an integer; got "
+                f"axis={axis!r}, quarter_turns={quarter_turns!r}; e.g. turned('z', 1, size)")
+        k = int(quarter_turns) % 4
+        i, j = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}[axis]  # cyclic: e_i -> e_j
+        rot = np.eye(3)
+        for _ in range(k):  # exact integer quarter turns: (e_i, e_j) -> (e_j, -e_i)
+            step = np.eye(3)
+            step[i, i] = step[j, j] = 0.0
+            step[j, i], step[i, j] = 1.0, -1.0
+            rot = step @ rot
+        size = np.asarray(size_mm, dtype=float)
+        corners = np.array(np.meshgrid(*[(0.0, v) for v in size], indexing="ij")).reshape(3, -1).T
+        moved = corners @ rot.T
+        shift = -moved.min(axis=0)
+        out = Wood(self.field, self.appearance, threads=self.threads)
+        inner = self._turn
+        if inner is None:
+            out._turn = (rot, shift)
+        else:  # compose: new -> this wood's frame -> its source
+            r0, t0 = inner
+            out._turn = (rot @ r0, rot @ t0 + shift)
+        new_size = tuple(float(v) for v in np.abs(rot) @ size)
+        return out, new_size
+
+    def _to_source(self, points, normals=None):
+        if self._turn is None:
+            return points, normals
+        rot, shift = self._turn
+        p = ((points - shift) @ rot).astype(points.dtype, copy=False)
+        n = None if normals is None else (normals @ rot).astype(normals.dtype, copy=False)
+        return p, n
 
     def years(self, points_mm) -> np.ndarray:
         """Growth time ``(n,)`` in years at ``points_mm : (n, 3)``."""
-        return evaluate(self.field, points_mm)
+        p, _ = self._to_source(check_points(points_mm))
+        return evaluate(self.field, p)
 
     def arf(self, points_mm) -> np.ndarray:
         """Annual-ring field ``(n,)`` in [0, 1) at ``points_mm`` (eq. 6 of seed 000)."""
@@ -54,16 +113,22 @@ class Wood:
             Surface points, block frame, mm.
         normals : (n, 3) float
             Unit outward surface normals at those points (block frame).
+
+        The appearance's colours are checked (:func:`check_rgb`: shape, finite, in [0, 1]
+        within :data:`~woodcam.tolerances.COLOR_RANGE_TOL`, then clipped) and computed in
+        chunks on ``threads`` threads.
         """
         p = check_points(points_mm)
         n = np.asarray(normals, dtype=np.float32)
         if n.shape != p.shape:
             raise WoodcamError(f"normals must have the shape of points_mm {p.shape}; got {n.shape}")
+        p, n = self._to_source(p, n)
         out = np.empty((len(p), 3), np.float32)
         starts = range(0, len(p), _CHUNK)
 
         def work(i):
-            out[i:i + _CHUNK] = self.appearance.color(self.field, p[i:i + _CHUNK], n[i:i + _CHUNK])
+            rgb = self.appearance.color(self.field, p[i:i + _CHUNK], n[i:i + _CHUNK])
+            out[i:i + _CHUNK] = check_rgb(rgb, len(p[i:i + _CHUNK]), "appearance.color")
 
         if self.threads == 1 or len(p) <= _CHUNK:
             for i in starts:
@@ -72,3 +137,46 @@ class Wood:
             with ThreadPoolExecutor(self.threads) as pool:
                 list(pool.map(work, starts))
         return out
+
+
+def check_rgb(rgb, n: int, who: str = "wood.color") -> np.ndarray:
+    """The colour contract, checked in one place: ``(n, 3)`` finite, in [0, 1] (within
+    :data:`~woodcam.tolerances.COLOR_RANGE_TOL`, then clipped). Returns float32 ``(n, 3)``."""
+    out = np.asarray(rgb, dtype=np.float32)
+    if out.shape != (n, 3):
+        raise WoodcamError(f"{who} must return rgb of shape (n, 3) = ({n}, 3); got {out.shape}; "
+                           "fix the appearance's color()")
+    if not np.all(np.isfinite(out)):
+        raise WoodcamError(f"{who} returned non-finite colours (NaN or inf); check the appearance "
+                           "and that the points lie inside the block")
+    lo, hi = float(out.min(initial=0.0)), float(out.max(initial=0.0))
+    if lo < -COLOR_RANGE_TOL or hi > 1.0 + COLOR_RANGE_TOL:
+        raise WoodcamError(f"{who} must return rgb in [0, 1]; got values in [{lo:.4g}, {hi:.4g}]; "
+                           "divide 0..255 colours by 255")
+    return np.clip(out, 0.0, 1.0)
+
+
+def wood_colors(wood, points_mm, normals) -> np.ndarray:
+    """``wood.color(points_mm (n, 3), normals (n, 3)) -> rgb (n, 3)`` float32 in [0, 1], checked.
+
+    What every consumer of the seam calls (bake, view, export): a :class:`Wood` checks and
+    batches its appearance itself; any other object with a ``color`` method (a test's analytic
+    wood, a user's) is called in batches of :data:`~woodcam.tolerances.MAX_BATCH_POINTS` and
+    checked by the same :func:`check_rgb`. ``normals`` may be one ``(3,)`` normal for all points.
+    """
+    if wood is None or not callable(getattr(wood, "color", None)):
+        raise WoodcamError("wood must have a method color(points_mm (n, 3), normals (n, 3)) -> "
+                           f"rgb (n, 3); got {type(wood).__name__}; pass a woodcam Wood")
+    p = check_points(points_mm)
+    nrm = np.asarray(normals, dtype=np.float64)
+    if nrm.shape == (3,):
+        nrm = np.broadcast_to(nrm, p.shape)
+    if nrm.shape != p.shape:
+        raise WoodcamError(f"normals must have the shape of points_mm {p.shape} or (3,); got {nrm.shape}")
+    if isinstance(wood, Wood):
+        return wood.color(p, nrm)
+    out = np.empty((len(p), 3), np.float32)
+    for s in range(0, len(p), MAX_BATCH_POINTS):
+        q = p[s:s + MAX_BATCH_POINTS]
+        out[s:s + len(q)] = check_rgb(wood.color(q, np.ascontiguousarray(nrm[s:s + len(q)])), len(q))
+    return out

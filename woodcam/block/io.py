@@ -53,7 +53,7 @@ import numpy as np
 
 from .._atomic import atomic_path, write_text
 from ..errors import WoodcamError
-from ..fields.state import field_from_state, field_to_state, field_type, jsonable
+from ..fields.state import field_from_state, field_type, jsonable
 from ..frames import FACES, MOKUME_LETTER
 from ..tolerances import KNOT_POINT_MAX_PX, KNOT_REGION_SMOOTH_PX
 from .block import Block, Face, RingTrace

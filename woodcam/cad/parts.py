@@ -29,14 +29,20 @@ from __future__ import annotations
 import math
 import runpy
 import sys
-from numbers import Real
+from dataclasses import dataclass, field
+from numbers import Integral, Real
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import WoodcamError, require
-from ..tolerances import TESSELLATION_ANGLE_DEG, TESSELLATION_TOL_MM
+from ..tolerances import MAX_PART_TRIANGLES, TESSELLATION_ANGLE_DEG, TESSELLATION_TOL_MM
+
+#: Re-meshing rounds of the triangle budget, and the loosest angular tolerance it goes to
+#: (below the 30 degree crease angle of the exported normals, so curved faces stay smooth).
+_BUDGET_TRIES = 3
+_MAX_BUDGET_ANGLE_DEG = 20.0
 
 #: File suffixes :func:`load_part` reads, by kind.
 STEP_SUFFIXES = (".step", ".stp")
@@ -50,6 +56,8 @@ def load_part(
     *,
     tolerance_mm: float = TESSELLATION_TOL_MM,
     angular_tolerance_deg: float = TESSELLATION_ANGLE_DEG,
+    max_triangles: int | None = MAX_PART_TRIANGLES,
+    report: dict | None = None,
 ):
     """Turn a part source into one watertight manifold in the block frame (mm).
 
@@ -68,6 +76,12 @@ def load_part(
     angular_tolerance_deg : float
         Angular tolerance (degrees, in (0, 90]) for tessellating B-rep sources: the largest
         normal jump between neighbouring triangles on a curved face. Ignored for meshes.
+    max_triangles : int or None
+        Triangle budget for B-rep sources (default :data:`woodcam.tolerances.MAX_PART_TRIANGLES`):
+        above it the part is re-meshed with looser tolerances (stated in ``report["notes"]``);
+        None meshes at the given tolerances whatever the count.
+    report : dict or None
+        Filled with the tolerances used, the triangle count and notes about re-meshing.
 
     Returns
     -------
@@ -91,13 +105,18 @@ def load_part(
             f"angular_tolerance_deg must be in (0, 90] degrees, got {angular_tolerance_deg!r}; "
             f"use e.g. {TESSELLATION_ANGLE_DEG}"
         )
-    return _load(source, float(tolerance_mm), math.radians(angular_tolerance_deg), origin="part")
+    tess = _Tessellation(float(tolerance_mm), math.radians(angular_tolerance_deg),
+                         _check_budget(max_triangles))
+    solid = _load(source, tess, origin="part")
+    if report is not None:
+        report.update(tess.report())
+    return solid
 
 
 # --------------------------------------------------------------------------------- dispatch
 
 
-def _load(source: Any, tol_mm: float, ang_rad: float, origin: str):
+def _load(source: Any, tess: "_Tessellation", origin: str):
     """Dispatch on the source's type; ``origin`` names the source in error messages."""
     import manifold3d
     import trimesh
@@ -114,12 +133,12 @@ def _load(source: Any, tol_mm: float, ang_rad: float, origin: str):
     if isinstance(source, trimesh.Scene):
         return _manifold_from_scene(source, origin)
     if isinstance(source, (str, Path)):
-        return _load_path(Path(source), tol_mm, ang_rad)
+        return _load_path(Path(source), tess)
 
     if isinstance(source, (list, tuple)):  # incl. build123d ShapeList: union of the items
         if not source:
             raise WoodcamError(f"{origin} is an empty {type(source).__name__}; pass a solid")
-        return _union([_load(item, tol_mm, ang_rad, f"{origin}[{i}]")
+        return _union([_load(item, tess, f"{origin}[{i}]")
                        for i, item in enumerate(source)], origin)
 
     # the CAD kernels are only imported when the object already comes from one of them
@@ -127,9 +146,9 @@ def _load(source: Any, tol_mm: float, ang_rad: float, origin: str):
     if module.startswith("build123d"):
         bd = require("build123d", "cad", "loading build123d parts")
         if isinstance(source, bd.Shape):  # Part, Solid, Compound, ...
-            return _manifold_from_topods(source.wrapped, tol_mm, ang_rad, origin)
+            return _manifold_from_topods(source.wrapped, tess, origin)
         if isinstance(source, bd.BuildPart):
-            return _load(source.part, tol_mm, ang_rad, f"{origin} (BuildPart.part)")
+            return _load(source.part, tess, f"{origin} (BuildPart.part)")
     if module.startswith("cadquery"):
         cq = require("cadquery", "cad", "loading cadquery parts")
         if isinstance(source, cq.Workplane):  # every Shape on the stack
@@ -139,12 +158,12 @@ def _load(source: Any, tol_mm: float, ang_rad: float, origin: str):
                     f"{origin}: the cadquery Workplane holds no shape (its stack is "
                     f"{source.vals()!r}); build a solid first, e.g. .box(...) or .extrude(...)"
                 )
-            return _union([_manifold_from_topods(s, tol_mm, ang_rad, origin) for s in shapes],
+            return _union([_manifold_from_topods(s, tess, origin) for s in shapes],
                           origin)
         if isinstance(source, cq.Shape):
-            return _manifold_from_topods(source.wrapped, tol_mm, ang_rad, origin)
+            return _manifold_from_topods(source.wrapped, tess, origin)
     if module.startswith("OCP") and hasattr(source, "ShapeType"):  # raw TopoDS_Shape
-        return _manifold_from_topods(source, tol_mm, ang_rad, origin)
+        return _manifold_from_topods(source, tess, origin)
 
     raise WoodcamError(
         f"{origin}: cannot use an object of type {type(source).__module__}."
@@ -154,7 +173,7 @@ def _load(source: Any, tol_mm: float, ang_rad: float, origin: str):
     )
 
 
-def _load_path(path: Path, tol_mm: float, ang_rad: float):
+def _load_path(path: Path, tess: "_Tessellation"):
     """Read a part file; the suffix picks the reader."""
     suffix = path.suffix.lower()
     if suffix not in SUPPORTED_SUFFIXES:
@@ -168,13 +187,13 @@ def _load_path(path: Path, tol_mm: float, ang_rad: float):
             f"part file {str(path)!r} does not exist or is not a file; check the path"
         )
     if suffix in SCRIPT_SUFFIXES:
-        return _load_script(path, tol_mm, ang_rad)
+        return _load_script(path, tess)
     if suffix in STEP_SUFFIXES:
-        return _load_step(path, tol_mm, ang_rad)
+        return _load_step(path, tess)
     return _load_mesh_file(path)
 
 
-def _load_script(path: Path, tol_mm: float, ang_rad: float):
+def _load_script(path: Path, tess: "_Tessellation"):
     """Run a part script (``runpy``, not as ``__main__``) and load its module-level ``part``."""
     folder = str(path.resolve().parent)
     sys.path.insert(0, folder)  # like `python script.py`: helpers next to the script import
@@ -206,10 +225,10 @@ def _load_script(path: Path, tol_mm: float, ang_rad: float):
             f"{origin} is a path ({str(part)!r}), but a script must define the part itself; "
             f"load the file in the script (e.g. build123d import_step) or pass the path directly"
         )
-    return _load(part, tol_mm, ang_rad, origin=origin)
+    return _load(part, tess, origin=origin)
 
 
-def _load_step(path: Path, tol_mm: float, ang_rad: float):
+def _load_step(path: Path, tess: "_Tessellation"):
     """Read a STEP file with OpenCascade (lengths converted to mm by the reader)."""
     require("OCP", "cad", "reading STEP parts")
     from OCP.IFSelect import IFSelect_RetDone
@@ -228,7 +247,7 @@ def _load_step(path: Path, tol_mm: float, ang_rad: float):
         raise WoodcamError(
             f"part file {str(path)!r} holds no shape; re-export the part as a solid"
         )
-    return _manifold_from_topods(shape, tol_mm, ang_rad, origin=f"STEP file {str(path)!r}")
+    return _manifold_from_topods(shape, tess, origin=f"STEP file {str(path)!r}")
 
 
 def _load_mesh_file(path: Path):
@@ -369,7 +388,7 @@ def _union(solids: list, origin: str):
 # --------------------------------------------------------------------------------- B-reps
 
 
-def _manifold_from_topods(shape, tol_mm: float, ang_rad: float, origin: str):
+def _manifold_from_topods(shape, tess: "_Tessellation", origin: str):
     """Tessellate an OpenCascade ``TopoDS_Shape`` solid by solid and union the pieces."""
     require("OCP", "cad", "tessellating B-rep parts")
     from OCP.TopAbs import TopAbs_SOLID
@@ -387,12 +406,8 @@ def _manifold_from_topods(shape, tol_mm: float, ang_rad: float, origin: str):
             f"{origin} contains no solid (only faces, wires or an empty compound); extrude, "
             f"revolve or thicken it into a solid"
         )
-    pieces = []
-    for solid in solids:
-        vertices, faces = _tessellate_solid(solid, tol_mm, ang_rad)
-        if len(faces) == 0:
-            raise WoodcamError(f"{origin} has a solid that tessellates to no triangles")
-        pieces.append(_manifold_from_trimesh(_trimesh(vertices, faces), origin))
+    meshes = tess.mesh_solids(solids, origin)
+    pieces = [_manifold_from_trimesh(_trimesh(v, f), origin) for v, f in meshes]
     return _union(pieces, origin)
 
 
@@ -400,6 +415,65 @@ def _trimesh(vertices, faces):
     import trimesh
 
     return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+
+
+@dataclass
+class _Tessellation:
+    """Tessellation settings of one :func:`load_part` call and what they produced.
+
+    ``mesh_solids`` meshes B-rep solids at ``tol_mm`` / ``ang_rad``; when the triangles exceed
+    ``max_triangles`` it re-meshes with both tolerances loosened by the overshoot (chord error
+    falls with the square of the triangle count along a curve, so loosening by the ratio lands
+    near the budget) and says so in :meth:`report`."""
+
+    tol_mm: float
+    ang_rad: float
+    max_triangles: int | None
+    triangles: int = 0
+    tries: int = 0
+    notes: list = field(default_factory=list)
+
+    def mesh_solids(self, solids, origin: str):
+        first = None
+        for _ in range(_BUDGET_TRIES + 1):
+            self.tries += 1
+            meshes = [_tessellate_solid(solid, self.tol_mm, self.ang_rad) for solid in solids]
+            for _vertices, faces in meshes:
+                if len(faces) == 0:
+                    raise WoodcamError(f"{origin} has a solid that tessellates to no triangles")
+            count = sum(len(f) for _v, f in meshes)
+            first = first or (count, self.tol_mm, math.degrees(self.ang_rad))
+            if self.max_triangles is None or count <= self.max_triangles or self.tries > _BUDGET_TRIES:
+                break
+            ratio = count / self.max_triangles
+            self.tol_mm *= ratio
+            self.ang_rad = min(math.radians(_MAX_BUDGET_ANGLE_DEG), self.ang_rad * math.sqrt(ratio))
+        if self.tries > 1:
+            self.notes.append(
+                f"{origin}: {first[0]} triangles at {first[1]:.3g} mm / {first[2]:.3g} deg "
+                f"exceeded max_triangles={self.max_triangles}; re-meshed to {count} triangles at "
+                f"{self.tol_mm:.3g} mm / {math.degrees(self.ang_rad):.3g} deg"
+                + ("" if count <= self.max_triangles else
+                   " (still over: the angular tolerance stops at "
+                   f"{_MAX_BUDGET_ANGLE_DEG:g} deg; raise --max-triangles or simplify the part)"))
+        self.triangles += count
+        return meshes
+
+    def report(self) -> dict:
+        return {"tolerance_mm": self.tol_mm, "angular_tolerance_deg": math.degrees(self.ang_rad),
+                "triangles": self.triangles, "max_triangles": self.max_triangles,
+                "notes": list(self.notes)}
+
+
+def _check_budget(max_triangles):
+    if max_triangles is None:
+        return None
+    if not (isinstance(max_triangles, Integral) and max_triangles >= 100):
+        raise WoodcamError(
+            f"max_triangles must be an integer >= 100 or None; got {max_triangles!r}; use e.g. "
+            f"{MAX_PART_TRIANGLES}"
+        )
+    return int(max_triangles)
 
 
 def _tessellate_solid(solid, tol_mm: float, ang_rad: float):

@@ -25,6 +25,7 @@ from ..errors import WoodcamError
 COMMANDS: tuple[str, ...] = (
     "woodcam.cli.bake",          # demo, bake, preview, blocks
     "woodcam.cli.gcode",         # gcode
+    "woodcam.cli.review",        # review
     "woodcam.cli.block",         # block synth | show
     "woodcam.cli.log",           # log render | maps | export
     "woodcam.cli.fit",           # fit, eval rings

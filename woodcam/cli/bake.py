@@ -28,6 +28,15 @@ def register(subparsers) -> None:
     p.add_argument("--out", type=Path, required=True, help="output .glb path")
     p.add_argument("--tolerance", type=float, default=None, metavar="MM",
                    help="tessellation chord tolerance for B-rep parts (default 0.05 mm)")
+    p.add_argument("--place", action="append", default=[], metavar="OP",
+                   help="place the part in the block before carving; repeatable, applied in "
+                   "order: rotate:AXIS:DEG (about the part's centre), translate:X,Y,Z (mm), "
+                   "scale:S, center, drop (onto the bottom face), fit[:MARGIN] (scale into the "
+                   "block, default margin 2 mm). Turn the block instead with a spec ending in "
+                   "~AXIS90 (e.g. builtin:flat-sawn~z90)")
+    p.add_argument("--max-triangles", type=int, default=None, metavar="N",
+                   help="triangle budget for B-rep parts: above it the part is re-meshed with "
+                   "looser tolerances, and the summary says so (default 120000)")
     add_bake_options(p)
     p.set_defaults(func=run_bake)
 
@@ -68,11 +77,16 @@ def run_bake(args: argparse.Namespace) -> int:
     stock = open_stock(args.block, **stock_options(args))
     res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
                        tolerance_mm=args.tolerance, obj=not args.no_obj, screenshot=False,
-                       progress=True, obj_units=args.obj_units, obj_up=args.obj_up)
+                       progress=True, obj_units=args.obj_units, obj_up=args.obj_up,
+                       max_triangles=args.max_triangles, max_atlas_px=args.max_atlas,
+                       place=args.place)
     write_screenshot(args, res.files, stock)
     print_warnings(res.warnings)
-    print(f"{res.name}: {res.triangles} triangles, {res.volume_mm3:.0f} mm^3, atlas "
-          f"{res.atlas_px[1]}x{res.atlas_px[0]}; wrote " + ", ".join(map(str, res.files.values())))
+    tess = res.tessellation
+    mesh_note = (f" (meshed at {tess['tolerance_mm']:.3g} mm / {tess['angular_tolerance_deg']:.3g}"
+                 " deg)" if tess.get("tolerance_mm") and tess.get("triangles") else "")
+    print(f"{res.name}: {res.triangles} triangles{mesh_note}, {res.volume_mm3:.0f} mm^3, "
+          f"{res.atlas}; wrote " + ", ".join(map(str, res.files.values())))
     return 0
 
 

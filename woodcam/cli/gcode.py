@@ -118,7 +118,7 @@ def run(args) -> int:
             "resolution_mm": float(np.mean(res.cell_mm))}
     out = preview_mesh(mesh, stock, args.out, texels_per_mm=args.texels_per_mm,
                        obj=not args.no_obj, screenshot=False, progress=True, metadata=meta,
-                       obj_units=args.obj_units, obj_up=args.obj_up)
+                       obj_units=args.obj_units, obj_up=args.obj_up, max_atlas_px=args.max_atlas)
     write_screenshot(args, out.files, stock)
     s = res.stats
     print(f"{args.program.name}: {len(program)} moves read in {t_read:.2f} s, simulated on "

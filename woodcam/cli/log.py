@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
+from .options import add_knot_options, knot_shading
 
 
 def register(subparsers) -> None:
@@ -41,8 +42,10 @@ def register(subparsers) -> None:
                    help="also a quarter-sawn section through the pith (knots as spikes)")
     r.add_argument("--k-stem", type=float, default=1.5, help="smoothness k outside knots")
     r.add_argument("--k-knot", type=float, default=5.0, help="smoothness k inside knots")
-    r.add_argument("--alive-darkening", type=float, default=0.35, help="0..1")
-    r.add_argument("--dead-darkening", type=float, default=0.3, help="0..1")
+    add_knot_options(r)
+    r.add_argument("--species", default="spruce",
+                   help="colour preset of the wood (oak, maple, walnut, cherry, pine, spruce; "
+                   "default spruce, the real log's)")
     r.add_argument("--outline-mm", type=float, default=1.0,
                    help="dead-knot outline thickness (mm)")
     r.set_defaults(func=run)
@@ -90,12 +93,11 @@ def run(args) -> int:
         for path in write_maps(log, out).values():
             print(path)
         return 0
-    from ..fields import log_render as lr
     from ..fields.knots import KnotParams, KnottedLogField
+    from ..logs import render as lr
 
-    params = KnotParams(k_stem=args.k_stem, k_knot=args.k_knot,
-                        alive_darkening=args.alive_darkening,
-                        dead_darkening=args.dead_darkening, outline_mm=args.outline_mm)
+    params = KnotParams(k_stem=args.k_stem, k_knot=args.k_knot, outline_mm=args.outline_mm)
+    knots = knot_shading(args)
     field = KnottedLogField(log, ring_width_mm=args.ring_width, params=params)
     secs = lr.default_sections(log, px_per_mm=args.px_per_mm)
     if args.board:
@@ -107,6 +109,7 @@ def run(args) -> int:
         z, az = args.radial
         secs.append(lr.radial_section(log, z, np.radians(az), px_per_mm=args.px_per_mm))
     for s in secs:
-        img = lr.render_section(field, s, supersample=args.supersample)
+        img = lr.render_section(field, s, supersample=args.supersample, species=args.species,
+                                knots=knots)
         print(lr.save_png(img, out / f"{log.name}_{s.name}.png"))
     return 0

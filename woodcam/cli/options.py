@@ -17,8 +17,9 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 
-BLOCK_SPEC_HELP = ("block spec: builtin:NAME, log:gran1@K[:WxDxH], a block folder (block.json) "
-                   "or a Mokume sample folder (a 50 mm cube unless --size-mm)")
+BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], a block folder "
+                   "(block.json) or a Mokume sample folder (a 50 mm cube unless --size-mm); "
+                   "append ~x90/~y90/~z90 to turn the block under the part")
 
 
 def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction:
@@ -75,12 +76,10 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
     p.add_argument("--quality", choices=("draft", "normal", "high"), default=None,
                    help="training effort of the neural appearance (default normal)")
     p.add_argument("--epochs", type=int, default=None, help="override the neural training epochs")
-    p.add_argument("--knot-darkening", default=None, metavar="ALIVE,DEAD",
-                   help="colour map: relative darkening of alive and dead knot wood, each in "
-                   "[0, 1] (default: woodcam.appearance.knots.KnotShading's)")
-    p.add_argument("--knot-outline", default=None, metavar="R,G,B",
-                   help="colour map: colour of the bark ring round dead knots, each in [0, 1] "
-                   "(default 0.16,0.10,0.06)")
+    add_knot_options(p)
+    p.add_argument("--max-atlas", type=int, default=4096, metavar="PX",
+                   help="largest texture side in texels (default 4096, what every GPU takes); "
+                   "a part needing more gets a lower texel density, stated in the summary")
     p.add_argument("--no-obj", action="store_true", help="write only the GLB, not OBJ+MTL+PNG")
     p.add_argument("--obj-units", choices=("m", "mm"), default="m",
                    help="length unit of the OBJ's coordinates (default m, what Blender and most "
@@ -91,6 +90,30 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
         p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
                        help="also render the result off-screen to PNG (default name: OUT with "
                        "_view.png; no display needed)")
+
+
+def add_knot_options(p: argparse.ArgumentParser) -> None:
+    """``--knot-darkening`` and ``--knot-outline``: :class:`woodcam.appearance.knots.KnotShading`
+    on the command line (``bake``, ``demo``, ``gcode``, ``log render``); defaults are its own."""
+    p.add_argument("--knot-darkening", default=None, metavar="ALIVE,DEAD",
+                   help="relative darkening of alive knot wood and the extra darkening of dead "
+                   "knot wood, each in [0, 1] (default 0.25,0.45)")
+    p.add_argument("--knot-outline", default=None, metavar="R,G,B",
+                   help="colour of the bark ring round dead knots, each in [0, 1] "
+                   "(default 0.16,0.10,0.06)")
+
+
+def knot_shading(args):
+    """The :class:`~woodcam.appearance.knots.KnotShading` the knot options ask for."""
+    from ..appearance.knots import KnotShading
+
+    changes = {}
+    if args.knot_darkening is not None:
+        changes["alive_darkening"], changes["dead_darkening"] = floats(
+            args.knot_darkening, 2, "--knot-darkening")
+    if args.knot_outline is not None:
+        changes["outline_rgb"] = floats(args.knot_outline, 3, "--knot-outline")
+    return KnotShading(**changes)
 
 
 def floats(text: str, n: int, option: str) -> tuple[float, ...]:
@@ -105,18 +128,14 @@ def floats(text: str, n: int, option: str) -> tuple[float, ...]:
 
 
 def appearance_params(args) -> dict:
-    """The appearance keywords of :func:`woodcam.stock.open_stock` from the bake options."""
-    knots = {}
-    if args.knot_darkening is not None:
-        knots["knot_darkening_alive"], knots["knot_darkening_dead"] = floats(
-            args.knot_darkening, 2, "--knot-darkening")
-    if args.knot_outline is not None:
-        knots["dead_outline_rgb"] = floats(args.knot_outline, 3, "--knot-outline")
+    """The appearance keywords of :func:`woodcam.stock.open_stock` from the bake options:
+    ``knots`` (a KnotShading) for the colour map, ``quality``/``epochs`` for the neural one."""
+    knots = args.knot_darkening is not None or args.knot_outline is not None
     if args.appearance != "neural":
         if args.quality or args.epochs:
             raise WoodcamError("--quality and --epochs apply to --appearance neural only; "
                                f"got --appearance {args.appearance}")
-        return knots
+        return {"knots": knot_shading(args)} if knots else {}
     if knots:
         raise WoodcamError("--knot-darkening and --knot-outline apply to --appearance colormap "
                            "only (the neural appearance learns knot colours from the photos)")

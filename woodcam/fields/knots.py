@@ -47,7 +47,7 @@ from typing import Literal
 import numpy as np
 
 from ..errors import WoodcamError
-from .base import LogFrame, check_points
+from .base import check_points
 from .tree_data import Log
 
 Backend = Literal["auto", "numpy", "numba"]
@@ -80,7 +80,8 @@ _T_EPS = 1e-9
 
 @dataclass(frozen=True)
 class KnotParams:
-    """Parameters of the knot model and of knot rendering (defaults: the seed's shader).
+    """Parameters of the knot model (defaults: the seed's shader). How knots are coloured is
+    :class:`woodcam.appearance.knots.KnotShading`.
 
     The seed's shader works in times normalised by the log's minimum radius (~100 mm for its
     log); its constants are given here in mm of stem radius (shader value x 100 mm).
@@ -110,9 +111,6 @@ class KnotParams:
         smoothing fades out from ``range_d0_mm + range_k0 d_s`` to there.
     knot_noise : float
         Relative amplitude of the knot-radius irregularity around the knot axis.
-    alive_darkening, dead_darkening : float
-        0..1 darkening of alive knot wood and the extra darkening of dead knot wood
-        (used by :func:`knot_shading`).
     outline_mm : float
         Thickness of the dark outline (bark ring) of dead knots, mm across the knot.
     knot_edge_sharpness : float
@@ -133,8 +131,6 @@ class KnotParams:
     range_d1_mm: float = 20.0
     range_k1: float = 1.0
     knot_noise: float = 0.08
-    alive_darkening: float = 0.35
-    dead_darkening: float = 0.3
     outline_mm: float = 1.0
     knot_edge_sharpness: float = 14.0
 
@@ -148,10 +144,8 @@ class KnotParams:
             raise WoodcamError("KnotParams ranges need range_d1_mm > range_d0_mm >= 0 and "
                                f"range_k1 >= range_k0 >= 0; got d0={self.range_d0_mm}, "
                                f"d1={self.range_d1_mm}, k0={self.range_k0}, k1={self.range_k1}")
-        for name in ("alive_darkening", "dead_darkening", "butterfly"):
-            v = getattr(self, name)
-            if not (0 <= v <= 1):
-                raise WoodcamError(f"KnotParams.{name} must be in [0, 1]; got {v}")
+        if not (0 <= self.butterfly <= 1):
+            raise WoodcamError(f"KnotParams.butterfly must be in [0, 1]; got {self.butterfly}")
         if not self.death_band_mm > 0:
             raise WoodcamError(f"KnotParams.death_band_mm must be > 0; got {self.death_band_mm}")
         if self.outline_mm < 0:
@@ -556,7 +550,13 @@ class KnottedLogField:
 
     @classmethod
     def from_dict(cls, d: dict) -> "KnottedLogField":
-        return cls(Log.from_json(d["log"]), d["ring_width_mm"], KnotParams(**d["params"]))
+        # Files written before knot shading moved to appearance/knots.py carry its two settings.
+        params = {k: v for k, v in d["params"].items() if k not in _MOVED_TO_SHADING}
+        return cls(Log.from_json(d["log"]), d["ring_width_mm"], KnotParams(**params))
+
+
+#: Former KnotParams settings now in :class:`woodcam.appearance.knots.KnotShading`.
+_MOVED_TO_SHADING = ("alive_darkening", "dead_darkening")
 
 
 from .placement import PlacedField, place_block_in_log  # noqa: E402,F401  (re-exported)
@@ -587,31 +587,3 @@ def block_at_knot(log, knot_index: int, size_mm, *, front_r_mm: float | None = N
     return origin, R
 
 
-# ---------------------------------------------------------------------------------------------
-# appearance hook
-
-def knot_shading(rgb, features: dict, *, alive_darkening: float = 0.35,
-                 dead_darkening: float = 0.3, outline_rgb=(0.22, 0.14, 0.08)) -> np.ndarray:
-    """Darken knot wood and draw dead-knot outlines (seed Sec. 4.3, user parameters 1.4.1).
-
-    Parameters
-    ----------
-    rgb : (n, 3) float in 0..1
-        Base wood colour (e.g. a colour map of the ARF).
-    features : dict
-        ``knot``, ``dead``, ``outline`` arrays ``(n,)`` in 0..1 (see
-        :meth:`KnottedLogField.knot_features`).
-    alive_darkening, dead_darkening : float
-        0..1: ``rgb *= (1 - alive_darkening knot) (1 - dead_darkening dead)``.
-    outline_rgb : (3,) float
-        Colour blended in with weight ``outline``.
-
-    Returns ``(n, 3)`` float in 0..1.
-    """
-    c = np.asarray(rgb, float)
-    kn = np.asarray(features["knot"], float)[:, None]
-    dd = np.asarray(features["dead"], float)[:, None]
-    ol = np.asarray(features["outline"], float)[:, None]
-    c = c * (1.0 - alive_darkening * kn) * (1.0 - dead_darkening * dd)
-    c = c * (1.0 - ol) + np.asarray(outline_rgb, float)[None, :] * ol
-    return np.clip(c, 0.0, 1.0)

@@ -5,6 +5,10 @@ sits at ``origin_mm + rotation @ p`` in the log frame (mm). ``rotation (3, 3)`` 
 (orthonormal, det +1); its columns are the block's X, Y, Z axes in the log frame. Fibre
 directions, knot features and the one-pass ``evaluate`` of knotted fields are forwarded, with
 directions rotated back into the block frame.
+
+The placement itself is a :class:`~woodcam.fields.base.LogFrame`, the one rigid-placement type
+(the radial family places its log the same way): ``PlacedField`` is a log-frame field plus a
+``LogFrame``, and only keeps ``(origin_mm, rotation)`` as a second way to state it.
 """
 
 from __future__ import annotations
@@ -32,14 +36,29 @@ class PlacedField:
         if o.shape != (3,):
             raise WoodcamError(f"origin_mm must be a 3-vector (mm, log frame); got {o.shape}")
         self.log_field = log_field
-        self.origin_mm = o
-        self.rotation = R
+        # rows of R are the log's axes in block coordinates; the pith passes through the block
+        # point that maps to the log origin: origin + R p = 0
+        self.frame = LogFrame(tuple(-(R.T @ o)), tuple(R[2]), tuple(R[0]))
 
     @classmethod
     def from_log_frame(cls, log_field, frame: LogFrame) -> "PlacedField":
         """Place with a :class:`LogFrame` (the log's frame given in the block frame)."""
-        R = frame.rotation  # rows: log axes in block coordinates = the block -> log matrix
-        return cls(log_field, -(R @ np.asarray(frame.pith_point_mm, float)), R)
+        if not callable(log_field):
+            raise WoodcamError(
+                f"log_field must be callable (n, 3) mm -> years; got {type(log_field).__name__}")
+        out = cls.__new__(cls)
+        out.log_field, out.frame = log_field, frame
+        return out
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """(3, 3): block point ``p`` sits at ``origin_mm + rotation @ p`` in the log frame."""
+        return self.frame.rotation
+
+    @property
+    def origin_mm(self) -> np.ndarray:
+        """(3,) mm: where the block origin sits in the log frame."""
+        return -(self.frame.rotation @ np.asarray(self.frame.pith_point_mm, float))
 
     @property
     def axis(self) -> np.ndarray:
@@ -48,11 +67,10 @@ class PlacedField:
 
     def to_log(self, points_mm) -> np.ndarray:
         """Block-frame points ``(n, 3)`` -> log-frame points ``(n, 3)`` (mm)."""
-        # einsum rather than ``@``: for (n, 3) x (3, 3) the BLAS call is several times slower.
-        return self.origin_mm + np.einsum("ij,kj->ik", check_points(points_mm), self.rotation)
+        return self.frame.to_log(points_mm)
 
     def _to_block_dirs(self, d) -> np.ndarray:
-        return np.einsum("ij,jk->ik", np.asarray(d, float), self.rotation)
+        return self.frame.direction_to_block(d)
 
     def __call__(self, points_mm) -> np.ndarray:
         return np.asarray(self.log_field(self.to_log(points_mm)), dtype=float)
@@ -81,12 +99,21 @@ class PlacedField:
         raise AttributeError(name)
 
     def to_dict(self) -> dict:
-        return {"log_field": field_to_state(self.log_field), "origin_mm": self.origin_mm.tolist(),
-                "rotation": self.rotation.tolist()}
+        f = self.frame
+        return {"log_field": field_to_state(self.log_field),
+                "frame": {"pith_point_mm": [float(v) for v in f.pith_point_mm],
+                          "axis": [float(v) for v in f.axis],
+                          "reference": None if f.reference is None else [float(v) for v in f.reference]}}
 
     @classmethod
     def from_dict(cls, d: dict) -> "PlacedField":
-        return cls(field_from_state(d["log_field"]), d["origin_mm"], d["rotation"])
+        log_field = field_from_state(d["log_field"])
+        if "frame" not in d:  # written before the placement became a LogFrame
+            return cls(log_field, d["origin_mm"], d["rotation"])
+        f = d["frame"]
+        ref = f.get("reference")
+        return cls.from_log_frame(log_field, LogFrame(tuple(f["pith_point_mm"]), tuple(f["axis"]),
+                                                      None if ref is None else tuple(ref)))
 
 
 def place_block_in_log(log_field, origin_mm, rotation=None) -> PlacedField:

@@ -59,9 +59,14 @@ def field_to_state(field) -> dict:
     return {"type": kind, "state": jsonable(field.to_dict(), f"{kind}.to_dict()")}
 
 
+#: Classes that moved, under the names older saved files carry (read without importing the old,
+#: higher module: ``fields`` never imports ``synth``).
+_MOVED = {"woodcam.synth:AnalyticLogField": "woodcam.fields.analytic:AnalyticLogField"}
+
+
 def field_from_state(d: dict):
     """Inverse of :func:`field_to_state`."""
-    kind = d["type"]
+    kind = _MOVED.get(d["type"], d["type"])
     module, _, qualname = kind.partition(":")
     if not module.startswith("woodcam."):
         raise WoodcamError(f"field type must be a woodcam class; got {kind!r}")

@@ -23,7 +23,7 @@ from ..errors import WoodcamError, require
 from ..fields.base import evaluate
 from ..frames import check_size
 from ..tolerances import EVAL_PIXEL_MM, EVAL_THRESHOLDS_MM
-from .observations import _resample_polyline
+from ..fields.rings import ring_lines as _ring_lines
 
 
 @dataclass(frozen=True)
@@ -92,29 +92,15 @@ def sample_plane(plane: CutPlane, size_mm, pixel_mm: float = EVAL_PIXEL_MM) -> P
 
 
 def ring_lines(years_img: np.ndarray, inside: np.ndarray, pixel_mm: float, step_mm: float):
-    """Integer iso-lines of a growth-time image, resampled every ``step_mm``.
+    """Integer iso-lines of a growth-time image, resampled every ``step_mm``
+    (:func:`woodcam.fields.rings.ring_lines`).
 
     Returns
     -------
     points : (m, 2) float, plane coordinates in mm (row, col) * pixel_mm
     years : (m,) int, the year of the line each point is on
     """
-    import contourpy  # marching squares; a core dependency
-    z = np.ma.masked_array(years_img, ~inside)
-    gen = contourpy.contour_generator(z=z, line_type=contourpy.LineType.Separate)
-    vals = years_img[inside]
-    pts, yrs = [], []
-    if vals.size:
-        for year in range(int(np.ceil(vals.min())), int(np.floor(vals.max())) + 1):
-            for line in gen.lines(year):
-                if len(line) < 2:
-                    continue
-                p = _resample_polyline(line[:, ::-1] * pixel_mm, step_mm)
-                pts.append(p)
-                yrs.append(np.full(len(p), year))
-    if not pts:
-        return np.empty((0, 2)), np.empty(0, int)
-    return np.concatenate(pts), np.concatenate(yrs)
+    return _ring_lines(years_img, step_mm, inside=inside, spacing=pixel_mm)
 
 
 def _nearest_distance(query, qyears, ref, ryears, match_years: bool) -> np.ndarray:

@@ -27,10 +27,11 @@ import numpy as np
 
 from ..errors import WoodcamError, require
 from ..fields.base import arf
-from ..frames import pixel_to_block
+from ..fields.rings import ring_lines
+from ..frames import face_pixel_points
 from ..tolerances import HOLDOUT_LINE_STEP_PX, HOLDOUT_THRESHOLDS_PX, RING_MAP_THRESHOLD
 from .fit import fit_block
-from .observations import _pixel_index, _resample_polyline, knot_exclusion
+from .observations import _pixel_index, knot_exclusion
 
 #: Labels in results: the in-sample fit (all faces), and the chance control: every held-out
 #: prediction moved by half a ring (right spacing and direction, rings where none are).
@@ -78,32 +79,22 @@ def ridge_pixels(ring_map: np.ndarray, threshold: float = RING_MAP_THRESHOLD,
 
 def face_years(field, face: str, shape, size_mm) -> np.ndarray:
     """Growth time ``(h, w)`` of ``field`` at the pixel centres of a face image of ``shape``."""
-    rows, cols = np.meshgrid(np.arange(shape[0]), np.arange(shape[1]), indexing="ij")
-    pts = pixel_to_block(face, rows, cols, shape, size_mm).reshape(-1, 3)
+    pts = face_pixel_points(face, shape, size_mm).reshape(-1, 3)
     return np.asarray(field(pts), float).reshape(shape)
 
 
 def ring_lines_px(years_img: np.ndarray, step_px: float = HOLDOUT_LINE_STEP_PX,
                   exclude: np.ndarray | None = None) -> np.ndarray:
-    """Points ``(m, 2)`` (row, col) every ``step_px`` along the integer iso-lines of ``years_img``.
+    """Points ``(m, 2)`` (row, col) every ``step_px`` along the integer iso-lines of ``years_img``
+    (:func:`woodcam.fields.rings.ring_lines`).
 
     exclude : optional (h, w) bool; line points in those pixels are dropped.
     """
-    import contourpy
-
     y = np.asarray(years_img, float)
     if not np.isfinite(y).all():
         raise WoodcamError("the fitted growth time is not finite on the face; refit the block")
-    gen = contourpy.contour_generator(z=y, line_type="Separate")
-    out = []
-    for level in np.arange(np.ceil(y.min()), np.floor(y.max()) + 1):
-        for line in gen.lines(float(level)):
-            if len(line) >= 2:
-                out.append(_resample_polyline(line[:, ::-1], step_px))  # (x, y) -> (row, col)
-    if not out:
-        return np.zeros((0, 2))
-    pts = np.concatenate(out)
-    if exclude is not None:
+    pts, _ = ring_lines(y, step_px)
+    if exclude is not None and len(pts):
         pts = pts[~exclude[_pixel_index(pts[:, 0], y.shape[0]), _pixel_index(pts[:, 1], y.shape[1])]]
     return pts
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import WoodcamError
+from ..fields.rings import resample_polyline
 from ..frames import FACES, check_face, face_image_size_mm, pixel_to_block
 from ..tolerances import (FACE_PIXEL_ASPECT_RTOL, KNOT_MASK_MARGIN_MM, RING_MAP_THRESHOLD,
                           TRACE_SAMPLE_STEP_MM)
@@ -40,16 +41,6 @@ class RingObservations:
         m = np.asarray(mask)
         _, g = np.unique(self.group[m], return_inverse=True)
         return RingObservations(self.points_mm[m], self.years[m], g, self.face[m])
-
-
-def _resample_polyline(p: np.ndarray, step: float) -> np.ndarray:
-    """Points every ``step`` along a polyline ``(k, d)`` (ends kept); vectorised by interpolation."""
-    seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
-    s = np.concatenate([[0.0], np.cumsum(seg)])
-    if s[-1] <= 0:
-        return p[:1]
-    t = np.linspace(0.0, s[-1], max(2, int(np.ceil(s[-1] / step)) + 1))
-    return np.stack([np.interp(t, s, p[:, i]) for i in range(p.shape[1])], axis=1)
 
 
 def knot_exclusion(face, pixel_mm: float) -> np.ndarray | None:
@@ -133,7 +124,7 @@ def gather_observations(block, faces=None, step_mm: float = TRACE_SAMPLE_STEP_MM
         if f.traces:
             polys = [(t.points_px, t.year) for t in f.traces]
             px_step = step_mm / max(min(dr, dc), 1e-12)
-            polys = [(_resample_polyline(p, px_step), y) for p, y in polys]
+            polys = [(resample_polyline(p, px_step), y) for p, y in polys]
             if excl is not None:  # traced knot rings, or stem rings bent round the knot
                 polys = [(p[~excl[_pixel_index(p[:, 0], f.shape[0]), _pixel_index(p[:, 1], f.shape[1])]], y)
                          for p, y in polys]

@@ -1,4 +1,4 @@
-"""pyvista preview of a textured part inside its block: interactive window, cut plane, screenshot.
+"""pyvista scene of a textured part inside its block: interactive window, cut plane, screenshot.
 
 Data form. The part is a ``trimesh.Trimesh`` in the block frame (mm, ``docs/conventions.md``:
 origin bottom-front-left, ``+X`` width ``W``, ``+Y`` depth ``D``, ``+Z`` up ``H``), usually with
@@ -26,30 +26,23 @@ from __future__ import annotations
 
 import os
 import sys
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
-from typing import Literal, get_args
 
 import numpy as np
 
-from .errors import WoodcamError, require
-from .frames import check_size
-from .tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS, ON_FACE_TOL_MM
-
-Camera = Literal["iso", "top", "front", "back", "left", "right", "bottom"]
-CAMERAS: tuple[str, ...] = get_args(Camera)
-
-#: Direction from the focal point to the camera and the camera's up vector, block frame.
-#: "iso" looks from front-right-above (the viewer stands at -Y, conventions.md). "top" has +Y
-#: up in the picture and "bottom" has -Y up, so both show their face as its face image does.
-_CAMERA_VIEW: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
-    "iso": ((1.0, -1.0, 1.0), (0.0, 0.0, 1.0)),
-    "top": ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0)),
-    "bottom": ((0.0, 0.0, -1.0), (0.0, -1.0, 0.0)),
-    "front": ((0.0, -1.0, 0.0), (0.0, 0.0, 1.0)),
-    "back": ((0.0, 1.0, 0.0), (0.0, 0.0, 1.0)),
-    "left": ((-1.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
-    "right": ((1.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
-}
+from ..errors import WoodcamError, require
+from ..frames import check_size
+from ..tolerances import ON_FACE_TOL_MM
+from .camera import Camera, check_camera, default_cut_normal, set_camera
+from .section import (
+    box_section_uv,
+    check_vector,
+    cut_segments,
+    part_triangles,
+    plane_basis,
+    signed_row_distance,
+)
 
 #: Default sample spacing (mm) of the wood on a cut plane: finer than a 0.5 mm latewood band.
 SECTION_RESOLUTION_MM = 0.25
@@ -85,43 +78,11 @@ WASTE_ACTOR = "woodcam-section-waste"
 OUTLINE_ACTOR = "woodcam-section-outline"
 
 # The 12 edges of a box as pairs of corner indices; corner k has bits (x, y, z) = k's bits.
-_BOX_EDGES = np.array(
-    [[0, 1], [2, 3], [4, 5], [6, 7],   # along X
-     [0, 2], [1, 3], [4, 6], [5, 7],   # along Y
-     [0, 4], [1, 5], [2, 6], [3, 7]]   # along Z
-)
-
-
 def _pyvista():
     return require("pyvista", "view", "the preview")
 
 
 # ---------------------------------------------------------------------------- input checks
-
-
-def _check_vector(value, name: str, *, unit: bool) -> np.ndarray:
-    try:
-        v = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as err:
-        raise WoodcamError(f"{name} must be three numbers (x, y, z); got {value!r}") from err
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
-        raise WoodcamError(f"{name} must be three finite numbers (x, y, z); got {value!r}")
-    if unit:
-        n = float(np.linalg.norm(v))
-        if n < 1e-12:
-            raise WoodcamError(
-                f"{name} must be a non-zero direction; got {value!r}; e.g. {name}=(1, 0, 0)"
-            )
-        v = v / n
-    return v
-
-
-def _check_camera(camera: str) -> str:
-    if camera not in _CAMERA_VIEW:
-        raise WoodcamError(
-            f"camera must be one of {', '.join(CAMERAS)}; got {camera!r}"
-        )
-    return camera
 
 
 def _check_wood(wood):
@@ -259,42 +220,6 @@ def block_outline(size_mm):
     return box, edges
 
 
-def _plane_basis(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Unit in-plane axes ``(u, v)`` with ``u x v = normal``.
-
-    ``u`` is the block axis after the normal's dominant axis, projected onto the plane, so a
-    plane normal to a block axis gets block axes as ``u, v`` and its sample grid covers the
-    box's section exactly (no clipping needed).
-    """
-    k = int(np.argmax(np.abs(normal)))
-    a = np.zeros(3)
-    a[(k + 1) % 3] = 1.0
-    u = a - np.dot(a, normal) * normal
-    u /= np.linalg.norm(u)
-    v = np.cross(normal, u)
-    return u, v
-
-
-def _box_section_uv(size: np.ndarray, origin: np.ndarray, normal: np.ndarray, u, v):
-    """In-plane ``(u, v)`` coordinates (mm, relative to ``origin``) of the plane-box polygon.
-
-    The vertices are where the plane crosses the box's 12 edges (corners on the plane count).
-    Returns an ``(m, 2)`` array, ``m = 0`` when the plane misses the box.
-    """
-    bits = (np.arange(8)[:, None] >> np.arange(3)[None, :]) & 1
-    corners = bits * size                                       # (8, 3) mm
-    dist = (corners - origin) @ normal                           # (8,) signed distance, mm
-    on = np.abs(dist) <= ON_FACE_TOL_MM
-    pts = [corners[on]]
-    d0, d1 = dist[_BOX_EDGES[:, 0]], dist[_BOX_EDGES[:, 1]]
-    cross = (d0 * d1 < 0) & ~on[_BOX_EDGES[:, 0]] & ~on[_BOX_EDGES[:, 1]]
-    t = d0[cross] / (d0[cross] - d1[cross])
-    c0, c1 = corners[_BOX_EDGES[cross, 0]], corners[_BOX_EDGES[cross, 1]]
-    pts.append(c0 + t[:, None] * (c1 - c0))
-    p = np.concatenate(pts) - origin
-    return np.stack([p @ u, p @ v], axis=1)
-
-
 def _grid_polydata(pv, origin, u, v, u_range, v_range, n_u: int, n_v: int):
     """A regular quad grid of ``n_u x n_v`` points spanning the ranges along ``u`` and ``v``."""
     su = np.linspace(u_range[0], u_range[1], n_u)
@@ -306,113 +231,6 @@ def _grid_polydata(pv, origin, u, v, u_range, v_range, n_u: int, n_v: int):
         [idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], axis=-1
     ).reshape(-1, 4)
     return pv.PolyData.from_regular_faces(points, quads)
-
-
-def _wood_rgb(wood, points_mm: np.ndarray, normal: np.ndarray) -> np.ndarray:
-    """``wood.color`` at ``points_mm (n, 3)`` with a constant normal, checked, in batches."""
-    n = len(points_mm)
-    out = np.empty((n, 3), dtype=float)
-    for start in range(0, n, MAX_BATCH_POINTS):
-        p = points_mm[start:start + MAX_BATCH_POINTS]
-        rgb = np.asarray(wood.color(p, np.broadcast_to(normal, p.shape).copy()), dtype=float)
-        if rgb.shape != p.shape:
-            raise WoodcamError(
-                f"wood.color must return rgb of shape (n, 3) = {p.shape}; got {rgb.shape}"
-            )
-        out[start:start + len(p)] = rgb
-    if not np.all(np.isfinite(out)):
-        raise WoodcamError("wood.color returned non-finite colours (NaN or inf); fix the wood")
-    lo, hi = float(out.min(initial=0.0)), float(out.max(initial=0.0))
-    if lo < -COLOR_RANGE_TOL or hi > 1.0 + COLOR_RANGE_TOL:
-        raise WoodcamError(
-            f"wood.color must return rgb in [0, 1]; got values in [{lo:.4g}, {hi:.4g}]; "
-            "divide 0..255 colours by 255"
-        )
-    return np.clip(out, 0.0, 1.0)
-
-
-def _part_triangles(part) -> tuple[np.ndarray, np.ndarray]:
-    """``(points (n, 3) float mm, triangles (m, 3) int)`` of a part: pyvista, trimesh or a pair."""
-    if isinstance(part, tuple) and len(part) == 2:
-        return np.asarray(part[0], dtype=float), np.asarray(part[1], dtype=np.int64)
-    if hasattr(part, "vertices") and hasattr(part, "faces") and not hasattr(part, "n_cells"):
-        return np.asarray(part.vertices, dtype=float), np.asarray(part.faces, dtype=np.int64)
-    if not part.is_all_triangles:
-        part = part.triangulate()
-    return np.asarray(part.points, dtype=float), np.asarray(part.regular_faces, dtype=np.int64)
-
-
-def _cut_segments(points, triangles, origin, normal) -> np.ndarray:
-    """Where a plane cuts a triangle mesh: segments ``(k, 2, 3)``, block frame mm.
-
-    Vertices are classed above (``d > 0``) or not; a triangle with both classes is cut along
-    its two edges whose ends differ, so a vertex on the plane never yields a degenerate
-    crossing.
-    """
-    d = (points - origin) @ normal                               # (n,) mm
-    above = d > 0
-    n_above = (above[triangles[:, 0]].astype(np.uint8) + above[triangles[:, 1]]
-               + above[triangles[:, 2]])                         # (m,) column adds: fast
-    tri = triangles[(n_above == 1) | (n_above == 2)]
-    if len(tri) == 0:
-        return np.empty((0, 2, 3))
-    # Each edge runs from its vertex above the plane to the other one, so the two triangles
-    # sharing an edge compute the same crossing bit for bit (the scan lines rely on it).
-    e0, e1 = tri, np.roll(tri, -1, axis=1)                       # (k, 3) corner -> next
-    a_idx = np.where(above[e0], e0, e1)
-    b_idx = np.where(above[e0], e1, e0)
-    da, db = d[a_idx], d[b_idx]
-    differs = above[a_idx] != above[b_idx]                       # exactly two per triangle
-    w = np.where(differs, da / np.where(differs, da - db, 1.0), 0.0)
-    pa, pb = points[a_idx], points[b_idx]                        # (k, 3, 3)
-    cross = pa + w[..., None] * (pb - pa)
-    return cross[differs].reshape(-1, 2, 3)
-
-
-def _signed_row_distance(seg_uv, su, sv) -> np.ndarray:
-    """Signed distance (mm) along ``u`` from grid points to a closed outline, > 0 inside.
-
-    The grid is ``su (n_u,) x sv (n_v,)`` (row ``j`` is ``v = sv[j]``). Each row is a scan
-    line: the outline's crossings with it, sorted, give inside (odd count to the left) and the
-    distance to the nearest crossing. Rows with no crossing are outside. Returns
-    ``(n_u, n_v)``. Exact along ``u``; between rows a clip interpolates, so the outline is
-    placed within one row spacing where it runs nearly along ``u``.
-    """
-    n_u, n_v = len(su), len(sv)
-    far = float(su[-1] - su[0]) + 1.0
-    out = np.full((n_u, n_v), -far)
-    if len(seg_uv) == 0:
-        return out
-    v1, v2 = seg_uv[:, 0, 1], seg_uv[:, 1, 1]
-    dv = (sv[-1] - sv[0]) / (n_v - 1)
-    lo_j = np.floor((np.minimum(v1, v2) - sv[0]) / dv).astype(np.int64) - 1
-    hi_j = np.ceil((np.maximum(v1, v2) - sv[0]) / dv).astype(np.int64) + 1
-    lo_j, hi_j = lo_j.clip(0, n_v - 1), hi_j.clip(0, n_v - 1)
-    count = np.maximum(hi_j - lo_j + 1, 0)
-    seg = np.repeat(np.arange(len(seg_uv)), count)               # candidate (segment, row)
-    row = lo_j[seg] + (np.arange(len(seg)) - np.repeat(np.cumsum(count) - count, count))
-    vj = sv[row]
-    a, b = seg_uv[seg, 0], seg_uv[seg, 1]
-    hit = (a[:, 1] <= vj) != (b[:, 1] <= vj)                     # half-open: no double count
-    seg, row, vj, a, b = seg[hit], row[hit], vj[hit], a[hit], b[hit]
-    uc = a[:, 0] + (vj - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
-    uc = np.clip(uc, su[0] - 1.0, su[-1] + 1.0)                  # keeps the order in the row
-    span = float(su[-1] - su[0]) + 3.0
-    key = np.sort(row * span + (uc - su[0] + 1.0))               # rows apart, sorted by u
-    grid_row = np.broadcast_to(np.arange(n_v), (n_u, n_v))
-    grid_key = grid_row * span + (su[:, None] - su[0] + 1.0)
-    first = np.searchsorted(key, np.arange(n_v) * span)          # (n_v,) row starts
-    last = np.searchsorted(key, (np.arange(n_v) + 1) * span)     # (n_v,) row ends
-    k = np.searchsorted(key, grid_key)                           # (n_u, n_v)
-    left = k - first[None, :]                                    # crossings left of the point
-    has_left = k > first[None, :]
-    has_right = k < last[None, :]
-    d_left = np.where(has_left, grid_key - key[np.maximum(k - 1, 0)], np.inf)
-    d_right = np.where(has_right, key[np.minimum(k, len(key) - 1)] - grid_key, np.inf)
-    dist = np.minimum(d_left, d_right)
-    any_hit = np.isfinite(dist)
-    out[any_hit] = np.where(left[any_hit] % 2 == 1, dist[any_hit], -dist[any_hit])
-    return out
 
 
 def cut_plane_image(
@@ -467,8 +285,8 @@ def cut_plane_image(
     if wood is None:
         raise WoodcamError("wood: cut_plane_image needs a wood to colour the plane; got None")
     size = check_size(size_mm)
-    origin = _check_vector(origin, "origin", unit=False)
-    normal = _check_vector(normal, "normal", unit=True)
+    origin = check_vector(origin, "origin", unit=False)
+    normal = check_vector(normal, "normal", unit=True)
     if not (isinstance(resolution_mm, (int, float)) and np.isfinite(resolution_mm)
             and resolution_mm > 0):
         raise WoodcamError(
@@ -480,8 +298,8 @@ def cut_plane_image(
             f"max_samples must be an integer >= 16 or None; got {max_samples!r}; e.g. 60000"
         )
 
-    u, v = _plane_basis(normal)
-    poly_uv = _box_section_uv(size, origin, normal, u, v)
+    u, v = plane_basis(normal)
+    poly_uv = box_section_uv(size, origin, normal, u, v)
     if len(poly_uv) < 3:
         return pv.PolyData()
     lo, hi = poly_uv.min(axis=0), poly_uv.max(axis=0)
@@ -500,11 +318,11 @@ def cut_plane_image(
     section = _grid_polydata(pv, origin, u, v, (lo[0], hi[0]), (lo[1], hi[1]), n_u, n_v)
     segments = None
     if part is not None:
-        segments = _cut_segments(*_part_triangles(part), origin, normal)
+        segments = cut_segments(*part_triangles(part), origin, normal)
         ends = segments - origin
         seg_uv = np.stack([ends @ u, ends @ v], axis=-1)         # (k, 2, 2) mm
         su, sv = np.linspace(lo[0], hi[0], n_u), np.linspace(lo[1], hi[1], n_v)
-        section.point_data["part_mm"] = _signed_row_distance(seg_uv, su, sv).reshape(-1)
+        section.point_data["part_mm"] = signed_row_distance(seg_uv, su, sv).reshape(-1)
 
     # Clip to the box by the face planes the grid actually crosses (none when the normal is
     # a block axis: the grid rectangle is then the section itself).
@@ -533,7 +351,9 @@ def cut_plane_image(
     if section.n_cells == 0:
         return pv.PolyData()
     points = np.clip(np.asarray(section.points, dtype=float), 0.0, size)
-    rgb = _wood_rgb(wood, points, normal)
+    from ..appearance.wood import wood_colors
+
+    rgb = wood_colors(wood, points, normal)
     out = pv.PolyData(points, faces=section.faces)
     if in_part is not None:
         out.cell_data["in_part"] = in_part
@@ -622,15 +442,15 @@ class CutPlaneCallback:
         self.max_samples = max_samples
         self.section = None
         self.shown = {}
-        self._triangles = _part_triangles(part)                  # (points, triangles), once
+        self._triangles = part_triangles(part)                  # (points, triangles), once
         self.clip_plane = vtkPlane()
         self.part_actor = _add_part(plotter, part, texture)
         self.part_actor.mapper.AddClippingPlane(self.clip_plane)
 
     def __call__(self, normal, origin):
         """Move the cut to the plane; returns the section polydata (None without a wood)."""
-        normal = _check_vector(normal, "normal", unit=True)
-        origin = _check_vector(origin, "origin", unit=False)
+        normal = check_vector(normal, "normal", unit=True)
+        origin = check_vector(origin, "origin", unit=False)
         # vtkPlane clipping keeps points with plane_normal . (x - origin) >= 0.
         self.clip_plane.SetOrigin(*origin)
         self.clip_plane.SetNormal(*(-normal))
@@ -667,54 +487,6 @@ class CutPlaneCallback:
         return section
 
 
-def _default_cut_normal(camera: str, size: np.ndarray) -> np.ndarray:
-    """The block's longest axis, among those facing the camera, signed toward the camera."""
-    view = np.asarray(_CAMERA_VIEW[camera][0])
-    facing = np.abs(view) > 1e-9
-    k = int(np.argmax(np.where(facing, size, -np.inf)))
-    n = np.zeros(3)
-    n[k] = np.sign(view[k])
-    return n
-
-
-#: Fraction of the picture's half-width and half-height the framed block may fill.
-_FRAME_FILL = 0.92
-
-
-def _set_camera(plotter, camera: str, bounds) -> None:
-    """Look along the camera's direction and frame the box ``bounds`` tightly.
-
-    pyvista's ``reset_camera`` frames the bounding sphere, which leaves a flat block small in
-    the picture; here the eight corners are projected and the distance and focal point chosen
-    so that they fill :data:`_FRAME_FILL` of the picture (perspective, vertical view angle of
-    the camera, the window's aspect ratio).
-    """
-    direction, up = (np.asarray(a, dtype=float) for a in _CAMERA_VIEW[camera])
-    b = np.asarray(bounds, dtype=float).reshape(3, 2)
-    direction = direction / np.linalg.norm(direction)
-    right = np.cross(up, direction)
-    right /= np.linalg.norm(right)
-    up = np.cross(direction, right)
-    bits = (np.arange(8)[:, None] >> np.arange(3)[None, :]) & 1
-    corners = b[:, 0] + bits * (b[:, 1] - b[:, 0])               # (8, 3) mm
-    width, height = plotter.window_size
-    tan_y = np.tan(np.radians(plotter.camera.view_angle) / 2.0) * _FRAME_FILL
-    tan_x = tan_y * width / height
-    focal = b.mean(axis=1)
-    for _ in range(4):  # distance from the extents, then recentre; converges in a few steps
-        q = corners - focal
-        along = q @ direction                                    # towards the camera, mm
-        x, y = q @ right, q @ up
-        dist = float(np.max(along + np.maximum(np.abs(x) / tan_x, np.abs(y) / tan_y)))
-        depth = dist - along                                     # (8,) > 0
-        sx, sy = x / depth, y / depth                            # tangents on the picture
-        shift_x = 0.5 * (sx.max() + sx.min()) * dist
-        shift_y = 0.5 * (sy.max() + sy.min()) * dist
-        focal = focal + shift_x * right + shift_y * up
-    plotter.camera_position = [tuple(focal + dist * direction), tuple(focal), tuple(up)]
-    plotter.reset_camera_clipping_range()
-
-
 def _display_available() -> bool:
     if sys.platform.startswith("linux"):
         return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
@@ -732,20 +504,76 @@ def _prefer_egl_off_screen() -> None:
         os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"
 
 
+@dataclass(frozen=True)
+class SceneOptions:
+    """How the scene is drawn: the keywords :func:`preview` and :func:`build_scene` share.
+
+    Attributes
+    ----------
+    cut_plane : bool
+        Interactive: add a plane widget that clips the part and shows the wood on the plane as
+        it is dragged (without a wood it only clips the part). Screenshot with a wood: show one
+        cut plane at ``cut_origin`` / ``cut_normal``.
+    camera : "iso" | "top" | "front" | "back" | "left" | "right" | "bottom"
+        View direction; "iso" looks from front-right-above.
+    background : colour
+        Any colour pyvista accepts ("white", "#202020", (r, g, b) in 0..1).
+    cut_origin, cut_normal : (3,) float mm / direction, optional
+        The initial cut plane; default the block centre and the block's longest axis facing
+        the camera, signed toward it (the part's half on the camera side is cut away, so the
+        plane shows its inside wood). The normal is normalised here.
+    resolution_mm : float
+        Sample spacing of the wood on the plane, mm (coarsened for very large sections).
+    max_samples : int, optional
+        Cap on wood samples per section (see :func:`cut_plane_image`); default
+        :data:`SECTION_MAX_SAMPLES_INTERACTIVE` with the plane widget (it redraws while
+        dragged), else :data:`SECTION_MAX_SAMPLES_SCREENSHOT`.
+    """
+
+    cut_plane: bool = True
+    camera: Camera = "iso"
+    background: object = "white"
+    cut_origin: tuple[float, float, float] | None = None
+    cut_normal: tuple[float, float, float] | None = None
+    resolution_mm: float = SECTION_RESOLUTION_MM
+    max_samples: int | None = None
+
+    def __post_init__(self) -> None:
+        check_camera(self.camera)
+        if self.cut_origin is not None:
+            object.__setattr__(self, "cut_origin",
+                               tuple(check_vector(self.cut_origin, "cut_origin", unit=False)))
+        if self.cut_normal is not None:
+            object.__setattr__(self, "cut_normal",
+                               tuple(check_vector(self.cut_normal, "cut_normal", unit=True)))
+
+    @classmethod
+    def merged(cls, options: SceneOptions | None, keywords: dict) -> SceneOptions:
+        """``options`` (default: all defaults) with ``keywords`` replacing fields by name."""
+        names = {f.name for f in fields(cls)}
+        unknown = sorted(set(keywords) - names)
+        if unknown:
+            raise WoodcamError(f"unknown scene option(s) {unknown}; the options are "
+                               f"{sorted(names)} (woodcam.view.SceneOptions)")
+        base = options if options is not None else cls()
+        return replace(base, **keywords) if keywords else base
+
+    def samples_cap(self, widget: bool) -> int:
+        """The section's sample cap for a widget (interactive) or a one-off (screenshot) cut."""
+        if self.max_samples is not None:
+            return self.max_samples
+        return SECTION_MAX_SAMPLES_INTERACTIVE if widget else SECTION_MAX_SAMPLES_SCREENSHOT
+
+
 def build_scene(
     plotter,
     mesh_or_path,
     *,
     wood=None,
     size_mm=None,
-    cut_plane: bool = True,
     widget: bool = False,
-    camera: Camera = "iso",
-    background="white",
-    cut_origin=None,
-    cut_normal=None,
-    resolution_mm: float = SECTION_RESOLUTION_MM,
-    max_samples: int | None = SECTION_MAX_SAMPLES_SCREENSHOT,
+    options: SceneOptions | None = None,
+    **scene_options,
 ) -> CutPlaneCallback | None:
     """Fill a pyvista plotter with the part, the block and the cut plane; frame the camera.
 
@@ -759,8 +587,9 @@ def build_scene(
         With ``cut_plane``: add the interactive plane widget (bounded by the block), whose
         callback redraws the cut as it is dragged. Without ``widget`` the cut is drawn once at
         ``cut_origin`` / ``cut_normal``, and only when a wood is given.
-    max_samples : int or None
-        Cap on wood samples per section (see :func:`cut_plane_image`).
+    options : SceneOptions, optional
+        How to draw; ``**scene_options`` (any :class:`SceneOptions` field, e.g.
+        ``camera="top"``) replace its fields.
     Other parameters as in :func:`preview`.
 
     Returns
@@ -768,25 +597,27 @@ def build_scene(
     CutPlaneCallback or None
         The cut-plane callback when a cut is shown, else None.
     """
+    opt = SceneOptions.merged(options, scene_options)
     _check_wood(wood)
-    camera = _check_camera(camera)
+    camera, cut_origin, cut_normal = opt.camera, opt.cut_origin, opt.cut_normal
     size = None if size_mm is None else check_size(size_mm)
     _check_size_with_wood(wood, size)
     part, texture = mesh_to_pyvista(mesh_or_path)
     bounds = (0.0, size[0], 0.0, size[1], 0.0, size[2]) if size is not None else part.bounds
     b = np.asarray(bounds, dtype=float).reshape(3, 2)
     origin = (b.mean(axis=1) if cut_origin is None
-              else _check_vector(cut_origin, "cut_origin", unit=False))
-    normal = (_default_cut_normal(camera, b[:, 1] - b[:, 0]) if cut_normal is None
-              else _check_vector(cut_normal, "cut_normal", unit=True))
+              else check_vector(cut_origin, "cut_origin", unit=False))
+    normal = (default_cut_normal(camera, b[:, 1] - b[:, 0]) if cut_normal is None
+              else check_vector(cut_normal, "cut_normal", unit=True))
 
-    plotter.set_background(background)
+    plotter.set_background(opt.background)
     if size is not None:
         _add_block(plotter, size)
     callback = None
-    if cut_plane and (widget or wood is not None):
+    if opt.cut_plane and (widget or wood is not None):
         callback = CutPlaneCallback(plotter, part, texture, wood, size,
-                                    resolution_mm=resolution_mm, max_samples=max_samples)
+                                    resolution_mm=opt.resolution_mm,
+                                    max_samples=opt.samples_cap(widget))
         if widget:
             # The widget calls back once now, then at every move ("always": as it is dragged).
             plotter.add_plane_widget(callback, normal=normal, origin=origin, bounds=bounds,
@@ -799,7 +630,7 @@ def build_scene(
     # Frame the block and the part together (a part sticking out of its block stays in view).
     frame = np.stack([np.minimum(b[:, 0], np.asarray(part.bounds).reshape(3, 2)[:, 0]),
                       np.maximum(b[:, 1], np.asarray(part.bounds).reshape(3, 2)[:, 1])], axis=1)
-    _set_camera(plotter, camera, frame.ravel())
+    set_camera(plotter, camera, frame.ravel())
     return callback
 
 
@@ -810,12 +641,8 @@ def preview(
     size_mm=None,
     screenshot: str | os.PathLike | None = None,
     window_size: tuple[int, int] = (1280, 960),
-    cut_plane: bool = True,
-    camera: Camera = "iso",
-    background="white",
-    cut_origin=None,
-    cut_normal=None,
-    resolution_mm: float = SECTION_RESOLUTION_MM,
+    options: SceneOptions | None = None,
+    **scene_options,
 ) -> Path | None:
     """Show a textured part inside its translucent block, or write a screenshot of it.
 
@@ -832,21 +659,10 @@ def preview(
         Render off-screen (no display needed) and write this PNG; parent folders are created.
         Without it an interactive window opens (needs a display).
     window_size : (width, height) pixels
-    cut_plane : bool
-        Interactive: add a plane widget that clips the part and shows the wood on the plane as
-        it is dragged (without a wood it only clips the part). Screenshot with a wood: show one
-        cut plane at ``cut_origin`` / ``cut_normal``.
-    camera : "iso" | "top" | "front" | "back" | "left" | "right" | "bottom"
-        View direction; "iso" looks from front-right-above.
-    background : colour
-        Any colour pyvista accepts ("white", "#202020", (r, g, b) in 0..1).
-    cut_origin, cut_normal : (3,) float, optional
-        The initial cut plane; default the block centre and the block's longest axis facing
-        the camera, signed toward it (the part's half on the camera side is cut away, so the
-        plane shows its inside wood).
-    resolution_mm : float
-        Sample spacing of the wood on the plane (coarsened for very large sections and, in the
-        interactive window, while dragging).
+    options : SceneOptions, optional
+        How to draw (cut plane, camera, background, initial cut, resolution);
+        ``**scene_options`` (any :class:`SceneOptions` field, e.g. ``camera="top"``,
+        ``cut_plane=False``) replace its fields.
 
     Returns
     -------
@@ -866,7 +682,7 @@ def preview(
             f"screenshot must be a .png path; got {str(screenshot)!r}; e.g. out/part.png"
         )
     if screenshot is not None:  # before any rendering: not a folder, folder writable
-        from ._atomic import check_output_path
+        from .._atomic import check_output_path
 
         check_output_path(screenshot, what="screenshot", mkdir=True)
     if screenshot is None and not _display_available():
@@ -876,8 +692,8 @@ def preview(
             "(CLI: woodcam preview PART --screenshot part.png)"
         )
     # Check the mesh and options before a window opens.
+    opt = SceneOptions.merged(options, scene_options)
     _check_wood(wood)
-    _check_camera(camera)
     _check_size_with_wood(wood, None if size_mm is None else check_size(size_mm))
     mesh = _load_mesh(mesh_or_path)
 
@@ -887,18 +703,12 @@ def preview(
     plotter = pv.Plotter(off_screen=off_screen, window_size=window_size,
                          title="woodcam preview")
     try:
-        build_scene(
-            plotter, mesh, wood=wood, size_mm=size_mm, cut_plane=cut_plane,
-            widget=not off_screen, camera=camera, background=background,
-            cut_origin=cut_origin, cut_normal=cut_normal, resolution_mm=resolution_mm,
-            max_samples=(SECTION_MAX_SAMPLES_SCREENSHOT if off_screen
-                         else SECTION_MAX_SAMPLES_INTERACTIVE),
-        )
+        build_scene(plotter, mesh, wood=wood, size_mm=size_mm, widget=not off_screen, options=opt)
         # Translucent block and waste wood over the part: sort them per pixel.
         plotter.enable_depth_peeling()
         plotter.enable_anti_aliasing("ssaa")
         if off_screen:
-            from ._atomic import atomic_path
+            from .._atomic import atomic_path
 
             path = Path(screenshot)
             with atomic_path(path, mkdir=True) as tmp:  # complete PNG or none

@@ -5,9 +5,11 @@ A section is a rectangle in the log frame (mm): ``origin`` (its corner at pixel 
 (width, height)`` and a resolution in pixels per mm. Pixel ``(row i, col j)`` samples the point
 ``origin + (j + 0.5) / ppm * u + (i + 0.5) / ppm * v`` (pixel centres).
 
-Colours: a simple annual-ring colour map (earlywood -> latewood along ``ARF = (years mod 1)^2``,
-eq. 6 of seed 000) with :func:`~.knots.knot_shading`; points outside the log's outer surface get
-``background``. Functions return ``(rows, cols, 3) uint8`` arrays; only :func:`save_png` writes.
+Colours: the colour map's species ramp (:meth:`woodcam.appearance.ColorMapAppearance.ramp` of
+``ARF = (years mod 1)^2``, eq. 6 of seed 000; spruce by default, the species of the real log)
+with :class:`woodcam.appearance.knots.KnotShading`, the shading every renderer uses; points
+outside the log's outer surface get ``background``. Functions return ``(rows, cols, 3) uint8``
+arrays; only :func:`save_png` writes.
 """
 
 from __future__ import annotations
@@ -17,14 +19,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..appearance.colormap import ColorMapAppearance, Species
+from ..appearance.knots import KnotShading
 from ..errors import WoodcamError
-from .base import arf
-from .knots import KnottedLogField, knot_shading
-from .tree_data import Log
+from ..fields.base import arf
+from ..fields.knots import KnottedLogField
+from ..fields.tree_data import Log
 
-#: Spruce colours (0..1 RGB): pale earlywood, orange-brown latewood.
-EARLYWOOD_RGB = (0.93, 0.83, 0.64)
-LATEWOOD_RGB = (0.74, 0.53, 0.30)
 BACKGROUND_RGB = (0.16, 0.16, 0.16)
 
 
@@ -130,21 +131,17 @@ def busiest_board(log: Log, *, offset_mm: float = 60.0, length_mm: float = 600.0
     return best
 
 
-def colour_years(years, features=None, *, alive_darkening=0.35, dead_darkening=0.3,
-                 earlywood_rgb=EARLYWOOD_RGB, latewood_rgb=LATEWOOD_RGB) -> np.ndarray:
-    """Simple ARF colour map ``(n,) years -> (n, 3)`` float RGB, with knot shading."""
-    a = arf(years)[:, None]
-    e = np.asarray(earlywood_rgb, float)
-    late = np.asarray(latewood_rgb, float)
-    rgb = e + (late - e) * a
+def colour_years(years, features=None, *, species: Species | str = "spruce",
+                 knots: KnotShading = KnotShading()) -> np.ndarray:
+    """Colour ``(n,) years -> (n, 3)`` float RGB: the species ramp of the ARF, knots shaded."""
+    rgb = ColorMapAppearance(species).ramp(arf(np.asarray(years, float))).astype(float)
     if features is not None:
-        rgb = knot_shading(rgb, features, alive_darkening=alive_darkening,
-                           dead_darkening=dead_darkening)
+        rgb = knots.apply(rgb, features)
     return rgb
 
 
 def render_section(field: KnottedLogField, section: Section, *, background=BACKGROUND_RGB,
-                   alive_darkening: float | None = None, dead_darkening: float | None = None,
+                   species: Species | str = "spruce", knots: KnotShading = KnotShading(),
                    supersample: int = 1) -> np.ndarray:
     """Colour image ``(rows, cols, 3) uint8`` of ``field`` on ``section``.
 
@@ -157,19 +154,15 @@ def render_section(field: KnottedLogField, section: Section, *, background=BACKG
         ppm = section.px_per_mm
         fine = Section(section.origin_mm, section.u, section.v, (cols / ppm, rows / ppm),
                        ppm * s, section.name)
-        img = render_section(field, fine, background=background,
-                             alive_darkening=alive_darkening,
-                             dead_darkening=dead_darkening).astype(float)
+        img = render_section(field, fine, background=background, species=species,
+                             knots=knots).astype(float)
         img = img.reshape(rows, s, cols, s, 3).mean(axis=(1, 3))
         return (img + 0.5).astype(np.uint8)
     pts = section.points()
     shp = pts.shape[:2]
     p = pts.reshape(-1, 3)
     out = field.evaluate(p)
-    P = field.params
-    alive = P.alive_darkening if alive_darkening is None else alive_darkening
-    dead = P.dead_darkening if dead_darkening is None else dead_darkening
-    rgb = colour_years(out["years"], out, alive_darkening=alive, dead_darkening=dead)
+    rgb = colour_years(out["years"], out, species=species, knots=knots)
     rel = p[:, :2] - field.log.pith_at(p[:, 2])
     outside = np.hypot(rel[:, 0], rel[:, 1]) > field.log.radius_at(
         p[:, 2], np.arctan2(rel[:, 1], rel[:, 0]))
@@ -179,12 +172,14 @@ def render_section(field: KnottedLogField, section: Section, *, background=BACKG
 
 
 def save_png(image: np.ndarray, path) -> Path:
-    """Write a ``(rows, cols, 3) uint8`` image as PNG."""
+    """Write a ``(rows, cols, 3) uint8`` image as PNG (atomically: a complete file or none)."""
     from PIL import Image
 
+    from .._atomic import atomic_path
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    Image.fromarray(np.asarray(image, np.uint8)).save(path)
+    with atomic_path(path, mkdir=True) as tmp:
+        Image.fromarray(np.asarray(image, np.uint8)).save(tmp, format="PNG")
     return path
 
 

@@ -1,0 +1,77 @@
+"""Placing foreign parts (--place) and sized / turned blocks (issue 16 part 5)."""
+
+from __future__ import annotations
+
+import manifold3d
+import numpy as np
+import pytest
+
+from woodcam.cad.place import place_part
+from woodcam.errors import WoodcamError
+from woodcam.stock import open_stock
+
+
+def _bounds(solid):
+    return np.asarray(solid.bounding_box()).reshape(2, 3)
+
+
+def test_rotate_center_drop_place_a_box_exactly():
+    box = manifold3d.Manifold.cube([10.0, 20.0, 30.0]).translate([-50.0, 7.0, 3.0])
+    placed, matrix = place_part(box, ["rotate:x:90", "center", "drop"], (100.0, 80.0, 50.0))
+    lo, hi = _bounds(placed)
+    np.testing.assert_allclose(hi - lo, [10.0, 30.0, 20.0], atol=1e-9)  # y and z swapped
+    np.testing.assert_allclose((lo + hi)[:2] / 2, [50.0, 40.0], atol=1e-9)  # centred in x, y
+    assert lo[2] == pytest.approx(0.0, abs=1e-9)  # resting on the bottom face
+    assert placed.volume() == pytest.approx(6000.0)
+    np.testing.assert_allclose(np.linalg.det(matrix[:3, :3]), 1.0)
+
+
+def test_fit_scales_into_the_block_with_the_margin():
+    big = manifold3d.Manifold.cube([400.0, 100.0, 100.0])
+    placed, matrix = place_part(big, ["fit:5"], (100.0, 80.0, 50.0))
+    lo, hi = _bounds(placed)
+    np.testing.assert_allclose(lo[0], 5.0, atol=1e-9)
+    np.testing.assert_allclose(hi[0], 95.0, atol=1e-9)  # the long side sets the scale: 90/400
+    assert np.all(lo >= 5.0 - 1e-9) and np.all(hi <= np.array([95.0, 75.0, 45.0]) + 1e-9)
+    assert matrix[0, 0] == pytest.approx(90.0 / 400.0)
+
+
+@pytest.mark.parametrize(("ops", "match"), [
+    (["rotate:w:90"], "rotate:AXIS:DEG"), (["translate:1,2"], "translate:X,Y,Z"),
+    (["scale:-1"], "scale must be > 0"), (["spin"], "is not a placement operation"),
+    (["translate:1,nan,2"], "not a finite number"), (["fit:60"], "leaves no room")])
+def test_bad_placements_are_clear_errors(ops, match):
+    with pytest.raises(WoodcamError, match=match):
+        place_part(manifold3d.Manifold.cube([1.0, 1.0, 1.0]), ops, (100.0, 80.0, 50.0))
+
+
+def test_a_sized_builtin_block_is_the_same_wood_round_the_same_centre():
+    small = open_stock("builtin:flat-sawn")
+    big = open_stock("builtin:flat-sawn:300x120x40")
+    assert big.size_mm == (300.0, 120.0, 40.0)
+    rng = np.random.default_rng(0)
+    offsets = rng.uniform(-20.0, 20.0, (200, 3))
+    a = small.wood.years(np.asarray(small.size_mm) / 2 + offsets)
+    b = big.wood.years(np.asarray(big.size_mm) / 2 + offsets)
+    np.testing.assert_allclose(a, b, atol=1e-9)
+    with pytest.raises(WoodcamError, match="the size must be WxDxH"):
+        open_stock("builtin:flat-sawn:300x0x40")
+
+
+def test_turning_the_block_turns_its_wood():
+    plain = open_stock("builtin:flat-sawn")
+    turned = open_stock("builtin:flat-sawn~z90")
+    W, D, H = plain.size_mm
+    assert turned.size_mm == (D, W, H)
+    # a quarter turn about z (right hand): old (x, y, z) sits at new (D - y, x, z)
+    rng = np.random.default_rng(1)
+    p = rng.uniform([0, 0, 0], plain.size_mm, (300, 3))
+    q = np.column_stack([D - p[:, 1], p[:, 0], p[:, 2]])
+    np.testing.assert_allclose(turned.wood.years(q), plain.wood.years(p), atol=1e-9)
+    n = np.tile([1.0, 0.0, 0.0], (len(p), 1))  # +x in the old block is +y in the turned one
+    np.testing.assert_allclose(turned.wood.color(q, n[:, [1, 0, 2]]), plain.wood.color(p, n),
+                               atol=1e-6)
+    full = open_stock("builtin:flat-sawn~z90~z90~z90~z90")
+    np.testing.assert_allclose(full.wood.years(p), plain.wood.years(p), atol=1e-9)
+    with pytest.raises(WoodcamError, match="multiple of 90 degrees"):
+        open_stock("builtin:flat-sawn~z45")

@@ -1,0 +1,131 @@
+"""Placing a part in the block: a short list of operations, applied in order, as one rigid (or
+uniformly scaled) transform of the block frame.
+
+Data form
+---------
+A placement is a sequence of operation strings, as given to ``--place`` (repeatable):
+
+=====================  ==========================================================================
+``rotate:AXIS:DEG``    rotate about the block axis ``x``, ``y`` or ``z`` through the centre of the
+                       part's bounding box, ``DEG`` degrees (right hand rule)
+``translate:X,Y,Z``    move by ``(X, Y, Z)`` mm
+``scale:S``            scale uniformly by ``S`` (> 0) about the bounding-box centre
+``center``             move the bounding-box centre to the block centre
+``drop``               move down so the part rests on the block's bottom face (min z = 0)
+``fit[:MARGIN]``       scale uniformly (down or up) so the bounding box fits the block with
+                       ``MARGIN`` mm (default 2) on every side, and centre it
+=====================  ==========================================================================
+
+:func:`place_part` returns the placed solid and the 4 x 4 matrix (block frame, mm) that maps the
+part as loaded to the part as placed; bakes record it so the placement can be reproduced.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..errors import WoodcamError
+
+#: Default margin (mm) ``fit`` keeps to every block face.
+FIT_MARGIN_MM = 2.0
+
+_AXES = {"x": 0, "y": 1, "z": 2}
+
+_HELP = ("rotate:AXIS:DEG, translate:X,Y,Z, scale:S, center, drop or fit[:MARGIN] (e.g. "
+         "--place rotate:x:90 --place center --place drop)")
+
+
+def _rotation(axis: int, deg: float) -> np.ndarray:
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    i, j = [k for k in range(3) if k != axis]
+    r = np.eye(3)
+    r[i, i], r[i, j], r[j, i], r[j, j] = c, -s, s, c
+    return r
+
+
+def _about(centre: np.ndarray, linear: np.ndarray) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, :3] = linear
+    m[:3, 3] = centre - linear @ centre
+    return m
+
+
+def _translate(offset) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, 3] = offset
+    return m
+
+
+def _number(text: str, op: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise WoodcamError(f"--place {op!r}: {text!r} is not a finite number; use {_HELP}")
+    return value
+
+
+def placement_matrix(ops: Sequence[str], bounds_mm, size_mm) -> np.ndarray:
+    """The 4 x 4 transform (block frame, mm) of the operations ``ops`` applied in order to a
+    part whose bounding box is ``bounds_mm (2, 3)``, in a block of ``size_mm (3,)``."""
+    lo, hi = (np.asarray(b, dtype=float) for b in np.asarray(bounds_mm, dtype=float))
+    size = np.asarray(size_mm, dtype=float)
+    total = np.eye(4)
+    for op in ops:
+        name, _, arg = str(op).strip().partition(":")
+        name = name.lower()
+        centre = (lo + hi) / 2
+        if name == "rotate":
+            axis, _, deg = arg.partition(":")
+            if axis.lower() not in _AXES or not deg:
+                raise WoodcamError(f"--place {op!r}: expected rotate:AXIS:DEG with AXIS x, y or z; "
+                                   f"use {_HELP}")
+            step = _about(centre, _rotation(_AXES[axis.lower()], _number(deg, op)))
+        elif name == "translate":
+            parts = arg.split(",")
+            if len(parts) != 3:
+                raise WoodcamError(f"--place {op!r}: expected translate:X,Y,Z in mm; use {_HELP}")
+            step = _translate([_number(p, op) for p in parts])
+        elif name == "scale":
+            factor = _number(arg, op)
+            if factor <= 0:
+                raise WoodcamError(f"--place {op!r}: the scale must be > 0; got {factor:g}")
+            step = _about(centre, np.eye(3) * factor)
+        elif name == "center" and not arg:
+            step = _translate(size / 2 - centre)
+        elif name == "drop" and not arg:
+            step = _translate([0.0, 0.0, -lo[2]])
+        elif name == "fit":
+            margin = _number(arg, op) if arg else FIT_MARGIN_MM
+            room = size - 2 * margin
+            if margin < 0 or np.any(room <= 0):
+                raise WoodcamError(f"--place {op!r}: a margin of {margin:g} mm leaves no room in the "
+                                   f"{'x'.join(f'{v:g}' for v in size)} mm block")
+            factor = float(np.min(room / np.maximum(hi - lo, 1e-12)))
+            step = _translate(size / 2 - centre) @ _about(centre, np.eye(3) * factor)
+        else:
+            raise WoodcamError(f"--place {op!r} is not a placement operation; use {_HELP}")
+        total = step @ total
+        corners = np.array(np.meshgrid(*zip(lo, hi), indexing="ij")).reshape(3, -1).T
+        moved = corners @ step[:3, :3].T + step[:3, 3]
+        lo, hi = moved.min(axis=0), moved.max(axis=0)
+    return total
+
+
+def place_part(solid, ops: Sequence[str], size_mm):
+    """Apply the placement ``ops`` to ``solid`` (a ``manifold3d.Manifold``, block frame, mm).
+
+    Returns
+    -------
+    (manifold3d.Manifold, (4, 4) float)
+        The placed solid and the transform applied.
+    """
+    if not ops:
+        return solid, np.eye(4)
+    bounds = np.asarray(solid.bounding_box(), dtype=float).reshape(2, 3)
+    matrix = placement_matrix(ops, bounds, size_mm)
+    return solid.transform(matrix[:3, :].tolist()), matrix

@@ -1,0 +1,58 @@
+"""``woodcam review``: one self-contained HTML page to review a baked part in any browser."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .options import BLOCK_SPEC_HELP
+
+
+def register(subparsers) -> None:
+    """Add ``review``."""
+    p = subparsers.add_parser(
+        "review", help="write a one-file review page (3-D view, live section of the wood, "
+        "measurement, photos, report) of a baked GLB",
+        description="Write ONE offline HTML file (no network, opens from disk in any browser "
+        "with WebGL 2): the part, orbit/pan/zoom and front/top/iso views, a section plane whose "
+        "cut face shows the wood inside the block, two-click measurement in mm, the block's face "
+        "photos and the bake report, knot and G-code hotspots; printable as a shop sheet.")
+    p.add_argument("part", type=Path, help="baked .glb (from woodcam bake or woodcam gcode)")
+    p.add_argument("--block", default=None,
+                   help=BLOCK_SPEC_HELP + " (default: the one stored in the GLB)")
+    p.add_argument("--out", type=Path, required=True, help="output .html file")
+    p.add_argument("--voxels", type=int, default=None, metavar="N",
+                   help="voxels of each of the three colour volumes behind the section cap "
+                   "(default 400000: ~1 mm voxels on a 100x80x50 mm block, page ~2-3 MB)")
+    p.set_defaults(func=run_review)
+
+
+def run_review(args: argparse.Namespace) -> int:
+    from ..errors import WoodcamError
+    from ..export import read_glb_metadata
+    from ..review import VOLUME_VOXELS, write_review
+    from ..stock import open_stock
+
+    meta = read_glb_metadata(args.part) if args.part.is_file() else {}
+    spec = args.block or meta.get("block")
+    if not spec:
+        raise WoodcamError(f"review: {str(args.part)!r} records no block spec; pass --block SPEC")
+    stock = open_stock(spec)
+    report = {"block spec": spec, "species": stock.meta.get("species", "")}
+    for key in ("texels_per_mm", "gcode", "placement"):
+        if key in meta:
+            report[key] = meta[key]
+    hotspots = [{"kind": "gcode", "label": str(w.get("message", "")), "at_mm": w["at_mm"]}
+                for w in meta.get("warnings", []) if isinstance(w, dict) and "at_mm" in w]
+    photos = None
+    if Path(spec).is_dir():  # a block or Mokume folder: show its face photos
+        from ..stock import open_block
+
+        block, _ = open_block(spec)
+        photos = {face: f.photo for face, f in block.faces.items()
+                  if getattr(f, "photo", None) is not None}
+    out = write_review(args.part, args.out, wood=stock.wood, size_mm=stock.size_mm,
+                       report=report, photos=photos, hotspots=hotspots,
+                       voxels=args.voxels or VOLUME_VOXELS)
+    print(f"wrote {out} ({out.stat().st_size / 2**20:.1f} MiB)")
+    return 0

@@ -1,0 +1,217 @@
+"""The one-file review page: a baked part in a three.js viewer with a live section plane whose
+cap shows the real wood inside, views, measurement, face photos, the bake report and hotspots.
+
+Data form
+---------
+:func:`write_review` writes ONE self-contained HTML file (works from ``file://``, no network):
+
+* the viewer: ``viewer.bundle.js`` beside this module, made by ``make review-bundle`` from
+  ``viewer_src.js`` and three.js (npm, version in :data:`THREE_VERSION`) with esbuild; it is
+  committed with three.js' licence (``THREE_LICENSE``) so installs need no npm;
+* the part: the GLB (metres, Y up, as exported) base64-encoded;
+* the wood inside: three colour volumes over the block, one per cut axis (``Wood.color`` at
+  voxel centres with the normal of that axis, eq. 10 of seed 000 depends on it), each a PNG of
+  tiled z slices; the cap shader samples them trilinearly, so the cap shows ``Wood.color`` up
+  to the voxel size (:func:`volume_cell_mm`);
+* the report (block, size, placement, texel density and anything the caller adds), the block's
+  face photos where it has them, and hotspots (knots, G-code warnings) with positions in mm.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import WoodcamError
+
+_HERE = Path(__file__).resolve().parent
+#: three.js version the committed bundle was built from (``make review-bundle``).
+THREE_VERSION = "0.187.0"
+#: Voxels per colour volume (one per cut axis): three volumes of this many RGB voxels keep the
+#: page near 2 MB (PNG-compressed) with ~1 mm voxels on a 100 x 80 x 50 mm block.
+VOLUME_VOXELS = 400_000
+
+
+def volume_cell_mm(size_mm, voxels: int = VOLUME_VOXELS) -> float:
+    """Edge (mm) of the cubic voxels of a colour volume over a block of ``size_mm (3,)``."""
+    return float(np.cbrt(np.prod(np.asarray(size_mm, dtype=float)) / voxels))
+
+
+def colour_volume(wood, size_mm, axis: str, cell_mm: float) -> np.ndarray:
+    """``Wood.color`` at the voxel centres ``(i + 0.5) * size / n`` of the block, normal = +axis.
+
+    Returns
+    -------
+    (nz, ny, nx, 3) uint8
+        sRGB colours, z-major (the cap samples them at block point p as p / size).
+    """
+    size = np.asarray(size_mm, dtype=float)
+    shape = np.maximum(1, np.ceil(size / cell_mm).astype(int))
+    axes = [(np.arange(n) + 0.5) * s / n for n, s in zip(shape, size)]
+    z, y, x = np.meshgrid(axes[2], axes[1], axes[0], indexing="ij")
+    points = np.column_stack([x.ravel(), y.ravel(), z.ravel()])
+    normals = np.zeros_like(points)
+    normals[:, "xyz".index(axis)] = 1.0
+    rgb = np.asarray(wood.color(points, normals), dtype=np.float64)
+    return np.round(np.clip(rgb, 0.0, 1.0) * 255).astype(np.uint8).reshape(*shape[::-1], 3)
+
+
+def _tiled_png(volume: np.ndarray) -> tuple[str, int]:
+    """(nz, ny, nx, 3) -> a PNG data URL of the z slices tiled ``tiles`` across, and ``tiles``."""
+    from PIL import Image
+
+    nz, ny, nx, _ = volume.shape
+    tiles = max(1, min(nz, int(math.ceil(math.sqrt(nz * ny / nx)))))
+    rows = int(math.ceil(nz / tiles))
+    sheet = np.zeros((rows * ny, tiles * nx, 3), dtype=np.uint8)
+    for k in range(nz):  # one copy per slice (nz ~ 50-100), not per voxel
+        r, c = divmod(k, tiles)
+        sheet[r * ny:(r + 1) * ny, c * nx:(c + 1) * nx] = volume[k]
+    buf = io.BytesIO()
+    Image.fromarray(sheet).save(buf, format="PNG", optimize=True)
+    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii"), tiles
+
+
+def _photo_urls(photos: dict | None) -> dict:
+    """face -> small JPEG data URL of each face photo (longest side 320 px)."""
+    from PIL import Image
+
+    out = {}
+    for face, image in (photos or {}).items():
+        img = Image.fromarray(np.asarray(image)) if not isinstance(image, Image.Image) else image
+        img = img.convert("RGB")
+        img.thumbnail((320, 320))
+        buf = io.BytesIO()
+        img.save(buf, format="JPEG", quality=80)
+        out[face] = "data:image/jpeg;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
+    return out
+
+
+def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
+                 report: dict | None = None, photos: dict | None = None,
+                 hotspots: list[dict] | None = None, voxels: int = VOLUME_VOXELS) -> Path:
+    """Write the review page of a baked part.
+
+    Parameters
+    ----------
+    glb_path : path
+        A GLB written by :func:`woodcam.export.export_glb` (metres, Y up).
+    out_html : path
+        The ``.html`` file to write (atomically).
+    wood : Wood
+        The block's wood (``color(points_mm, normals)``), for the section cap.
+    size_mm : (3,) float
+        Block size (W, D, H) in mm.
+    title : str, optional
+        Page title (default: the GLB's stem).
+    report : dict, optional
+        Key/value lines shown in the side panel and the printed shop sheet.
+    photos : dict face -> (h, w, 3) uint8 image, optional
+        The block's face photos, shown in the side panel.
+    hotspots : list of dict, optional
+        ``{"kind": "knot" | "gcode", "label": str, "at_mm": [x, y, z]}``, block frame.
+    voxels : int
+        Voxels per colour volume (see :data:`VOLUME_VOXELS`).
+    """
+    from .._atomic import check_output_path, write_bytes
+
+    glb_path = Path(glb_path)
+    if not glb_path.is_file() or glb_path.suffix.lower() != ".glb":
+        raise WoodcamError(
+            f"review: the part must be an existing .glb file written by woodcam bake; got "
+            f"{str(glb_path)!r}")
+    out_html = check_output_path(out_html, suffixes=(".html",), what="review --out", mkdir=True)
+    bundle = _HERE / "viewer.bundle.js"
+    if not bundle.is_file():
+        raise WoodcamError(
+            f"review: the viewer bundle {bundle} is missing; rebuild it with 'make review-bundle'")
+    if not (isinstance(voxels, int) and 1_000 <= voxels <= 8_000_000):
+        raise WoodcamError(f"review: voxels must be an integer in [1000, 8e6]; got {voxels!r}")
+    size = [float(v) for v in size_mm]
+    cell = volume_cell_mm(size, voxels)
+    volumes = {}
+    for axis in "xyz":
+        vol = colour_volume(wood, size, axis, cell)
+        png, tiles = _tiled_png(vol)
+        volumes[axis] = {"png": png, "tiles": tiles, "shape": [vol.shape[2], vol.shape[1], vol.shape[0]]}
+    data = {
+        "title": title or glb_path.stem,
+        "block": {"size_mm": size, "voxel_mm": cell},
+        "report": {str(k): v for k, v in (report or {}).items()},
+        "hotspots": hotspots or [],
+        "photos": _photo_urls(photos),
+        "volumes": volumes,
+    }
+    page = _page(data, base64.b64encode(glb_path.read_bytes()).decode("ascii"),
+                 bundle.read_text(encoding="utf-8"))
+    write_bytes(out_html, page.encode("utf-8"))
+    return out_html
+
+
+def _page(data: dict, glb_b64: str, bundle: str) -> str:
+    title = html.escape(data["title"])
+    report_rows = "".join(
+        f"<tr><th>{html.escape(k)}</th><td>{html.escape(v if isinstance(v, str) else json.dumps(v))}</td></tr>"
+        for k, v in data["report"].items())
+    photos = "".join(
+        f'<figure><img src="{url}" alt="face {html.escape(face)}"><figcaption>{html.escape(face)}'
+        "</figcaption></figure>" for face, url in data["photos"].items())
+    W, D, H = data["block"]["size_mm"]
+    # JSON inside <script>: "</" must not close the element
+    payload = json.dumps(data).replace("</", "<\\/")
+    licence = (_HERE / "THREE_LICENSE").read_text(encoding="utf-8") if (_HERE / "THREE_LICENSE").is_file() else ""
+    return f"""<!doctype html>
+<html lang="en"><head><meta charset="utf-8"><title>{title}</title>
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<style>
+ html, body {{ margin: 0; height: 100%; font: 14px system-ui, sans-serif; color: #222; }}
+ #wrap {{ display: flex; height: 100%; }}
+ #view {{ flex: 1; min-width: 0; height: 100%; display: block; }}
+ #panel {{ width: 320px; overflow: auto; padding: 10px 14px; background: #f6f3ee;
+          border-left: 1px solid #ccc; }}
+ #panel h1 {{ font-size: 17px; margin: 4px 0 8px; }}
+ #panel h2 {{ font-size: 14px; margin: 14px 0 4px; }}
+ #panel table {{ border-collapse: collapse; width: 100%; font-size: 12px; }}
+ #panel th {{ text-align: left; padding-right: 6px; vertical-align: top; }}
+ figure {{ display: inline-block; margin: 2px; }} figure img {{ width: 90px; }}
+ figcaption {{ font-size: 11px; text-align: center; }}
+ #snapshot {{ display: none; }}
+ body.bare #panel {{ display: none; }}
+ @media print {{ #view, button, .ui {{ display: none !important; }}
+   #snapshot {{ display: block; width: 100%; }} #wrap {{ display: block; }}
+   #panel {{ width: auto; border: 0; background: none; }} }}
+</style></head>
+<body><div id="wrap"><canvas id="view"></canvas>
+<div id="panel"><h1>{title}</h1>
+<div class="ui"><b>View</b>
+ <button data-view="front">front</button><button data-view="top">top</button>
+ <button data-view="left">left</button><button data-view="iso">iso</button>
+ <label><input type="checkbox" id="ortho"> orthographic</label></div>
+<h2>Section</h2><div class="ui">
+ <label><input type="checkbox" id="cut-on"> cut</label>
+ <select id="cut-axis"><option>x</option><option>y</option><option>z</option></select>
+ <input type="range" id="cut-pos" min="0" step="0.1" style="width:150px"> <span id="cut-label"></span>
+ <p style="font-size:12px">The cut face shows the wood inside the block
+ (Wood.color on {data['block']['voxel_mm']:.2f} mm voxels).</p></div>
+<h2>Measure</h2><div class="ui"><label><input type="checkbox" id="measure"> two clicks on the
+ part</label><div id="measurement"></div></div>
+<h2>Block and bake</h2><table><tr><th>block</th><td>{W:g} x {D:g} x {H:g} mm</td></tr>{report_rows}</table>
+<h2>Hotspots</h2><ul id="hotspots"></ul>
+<h2>Face photos</h2><div>{photos or '<i>none</i>'}</div>
+<p><button id="print">print shop sheet</button> <span id="status">loading</span></p>
+<img id="snapshot" alt="view"><div id="probe" hidden></div>
+</div></div>
+<script type="application/json" id="woodcam-data">{payload}</script>
+<script type="text/plain" id="woodcam-glb">{glb_b64}</script>
+<script>if (new URLSearchParams(location.hash.slice(1)).has('bare')) document.body.classList.add('bare');</script>
+<!-- three.js r{THREE_VERSION[2:5]} (MIT licence below), bundled with the woodcam viewer by esbuild.
+{html.escape(licence)}-->
+<script>{bundle}</script>
+</body></html>
+"""

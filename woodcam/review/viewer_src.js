@@ -1,0 +1,285 @@
+// woodcam review page viewer: three.js scene of a baked part with a section plane whose cap
+// shows the wood inside (a 3-D texture of Wood.color evaluated by woodcam), views, a two-click
+// measurement in mm, hotspots and a printable shop sheet.
+//
+// Bundled with three.js by esbuild (`make review-bundle`) into viewer.bundle.js, which the page
+// inlines: the page works from file:// with no network. Data comes from the page's
+// <script type="application/json" id="woodcam-data"> (see woodcam/review/__init__.py).
+//
+// Frames: the GLB scene is glTF (metres, Y up; its root node carries BLOCK_TO_GLTF). Block
+// coordinates (mm, Z up) are p_block = (1000 x, -1000 z, 1000 y) of a world point (x, y, z).
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+
+const data = JSON.parse(document.getElementById('woodcam-data').textContent);
+const params = new URLSearchParams(location.hash.slice(1));
+const [W, D, H] = data.block.size_mm;
+const status = document.getElementById('status');
+
+function worldOfBlock(x, y, z) { return new THREE.Vector3(x / 1000, z / 1000, -y / 1000); }
+function blockOfWorld(p) { return [p.x * 1000, -p.z * 1000, p.y * 1000]; }
+
+const canvas = document.getElementById('view');
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: !params.has('bare'), stencil: true,
+                                           preserveDrawingBuffer: true });
+renderer.localClippingEnabled = true;
+renderer.setPixelRatio(1);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(params.has('bare') ? 0x000000 : 0xe8e4dc);
+scene.add(new THREE.HemisphereLight(0xffffff, 0x776655, 1.6));
+const sun = new THREE.DirectionalLight(0xffffff, 1.8);
+sun.position.set(0.3, 0.6, 0.5);
+scene.add(sun);
+
+const centre = worldOfBlock(W / 2, D / 2, H / 2);
+const span = Math.hypot(W, D, H) / 1000;
+const persp = new THREE.PerspectiveCamera(35, 1, span / 100, span * 20);
+const ortho = new THREE.OrthographicCamera(-1, 1, 1, -1, -span * 10, span * 10);
+let camera = params.has('ortho') ? ortho : persp;
+const controls = new OrbitControls(camera, canvas);
+controls.target.copy(centre);
+
+function resize() {
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  renderer.setSize(w, h, false);
+  persp.aspect = w / h;
+  persp.updateProjectionMatrix();
+  setOrthoFrame(w / h);
+}
+
+let orthoHalf = span / 2;
+function setOrthoFrame(aspect) {
+  ortho.left = -orthoHalf * aspect; ortho.right = orthoHalf * aspect;
+  ortho.top = orthoHalf; ortho.bottom = -orthoHalf;
+  ortho.updateProjectionMatrix();
+}
+
+// Views: front looks along block +Y, top down block -Z, iso from front-right-above.
+const VIEWS = {
+  front: [0, -1, 0], back: [0, 1, 0], left: [-1, 0, 0], right: [1, 0, 0], top: [0, 0, 1],
+  iso: [1, -1, 0.8],
+};
+function setView(name) {
+  const d = VIEWS[name] || VIEWS.iso;
+  const dir = worldOfBlock(d[0], d[1], d[2]).normalize();
+  for (const cam of [persp, ortho]) {
+    cam.position.copy(centre).addScaledVector(dir, span * 1.8);
+    cam.up.set(0, name === 'top' ? 0 : 1, name === 'top' ? -1 : 0);
+    cam.lookAt(centre);
+  }
+  controls.target.copy(centre);
+  if (name === 'front') {
+    // front, orthographic: the block's front face fills the frame exactly (W x H mm)
+    orthoHalf = H / 2000;
+  }
+  resize();
+}
+
+// ---- the wood inside: three 3-D textures (one per cut axis, colour for that normal) ----------
+function loadVolume(vol) {
+  return new Promise((resolve) => {
+    const img = new Image();
+    img.onload = () => {
+      const c = document.createElement('canvas');
+      c.width = img.width; c.height = img.height;
+      const g = c.getContext('2d');
+      g.drawImage(img, 0, 0);
+      const px = g.getImageData(0, 0, img.width, img.height).data;
+      const [nx, ny, nz] = vol.shape;  // x fastest; tiles of z slices, vol.tiles across
+      const out = new Uint8Array(nx * ny * nz * 4);
+      for (let k = 0; k < nz; k++) {
+        const tx = (k % vol.tiles) * nx, ty = Math.floor(k / vol.tiles) * ny;
+        for (let j = 0; j < ny; j++) {
+          const src = ((ty + j) * img.width + tx) * 4, dst = (k * ny + j) * nx * 4;
+          out.set(px.subarray(src, src + nx * 4), dst);
+        }
+      }
+      const tex = new THREE.Data3DTexture(out, nx, ny, nz);
+      tex.format = THREE.RGBAFormat;
+      tex.minFilter = tex.magFilter = THREE.LinearFilter;
+      tex.wrapS = tex.wrapT = tex.wrapR = THREE.ClampToEdgeWrapping;
+      tex.unpackAlignment = 1;
+      tex.needsUpdate = true;
+      resolve(tex);
+    };
+    img.src = vol.png;
+  });
+}
+
+const capVertex = `
+  out vec3 vBlock;
+  void main() {
+    vec4 w = modelMatrix * vec4(position, 1.0);
+    vBlock = vec3(w.x * 1000.0, -w.z * 1000.0, w.y * 1000.0);
+    gl_Position = projectionMatrix * viewMatrix * w;
+  }`;
+// Texel centres sit at (i + 0.5) * cell: the texture coordinate of block point p is p / size.
+const capFragment = `
+  precision highp sampler3D;
+  uniform sampler3D wood;
+  uniform vec3 size;
+  in vec3 vBlock;
+  out vec4 colour;
+  void main() { colour = vec4(texture(wood, clamp(vBlock / size, 0.0, 1.0)).rgb, 1.0); }`;
+
+const cut = { axis: params.get('cut')?.split(':')[0] || 'y',
+              pos: parseFloat(params.get('cut')?.split(':')[1] ?? String(D / 2)),
+              on: params.get('cut') !== 'off' };
+const plane = new THREE.Plane();
+let capMesh = null, textures = {}, part = null;
+const stencilGroup = new THREE.Group();
+scene.add(stencilGroup);
+
+function updatePlane() {
+  // keep the block side beyond the cut (larger coordinate) visible; the normal of the cap
+  // faces the viewer (towards smaller coordinates)
+  const n = { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, -1] }[cut.axis];
+  const p = { x: [cut.pos, 0, 0], y: [0, cut.pos, 0], z: [0, 0, cut.pos] }[cut.axis];
+  const nw = worldOfBlock(...n).normalize();
+  plane.setFromNormalAndCoplanarPoint(nw, worldOfBlock(...p));
+  if (capMesh) {
+    capMesh.material.uniforms.wood.value = textures[cut.axis];
+    capMesh.position.copy(worldOfBlock(...p));
+    capMesh.lookAt(capMesh.position.clone().sub(nw));
+    capMesh.visible = cut.on;
+  }
+  if (part) part.traverse((o) => { if (o.material) o.material.clippingPlanes = cut.on ? [plane] : []; });
+  stencilGroup.visible = cut.on;
+}
+
+function buildCap() {
+  const size = Math.hypot(W, D, H) * 2 / 1000;
+  const mat = new THREE.ShaderMaterial({
+    glslVersion: THREE.GLSL3, vertexShader: capVertex, fragmentShader: capFragment,
+    uniforms: { wood: { value: null }, size: { value: new THREE.Vector3(W, D, H) } },
+    stencilWrite: true, stencilRef: 0, stencilFunc: THREE.NotEqualStencilFunc,
+    stencilFail: THREE.ReplaceStencilOp, stencilZFail: THREE.ReplaceStencilOp,
+    stencilZPass: THREE.ReplaceStencilOp, side: THREE.DoubleSide,
+  });
+  capMesh = new THREE.Mesh(new THREE.PlaneGeometry(size, size), mat);
+  capMesh.renderOrder = 2;
+  capMesh.onAfterRender = (r) => r.clearStencil();
+  scene.add(capMesh);
+}
+
+// three.js' stencil capping: back faces add, front faces subtract, so the stencil is non-zero
+// exactly where the cut plane lies inside the closed part.
+function stencilFor(geometry, matrixWorld) {
+  const base = { depthWrite: false, depthTest: false, colorWrite: false, stencilWrite: true,
+                 stencilFunc: THREE.AlwaysStencilFunc, clippingPlanes: [plane] };
+  const back = new THREE.MeshBasicMaterial({ ...base, side: THREE.BackSide,
+    stencilFail: THREE.IncrementWrapStencilOp, stencilZFail: THREE.IncrementWrapStencilOp,
+    stencilZPass: THREE.IncrementWrapStencilOp });
+  const front = new THREE.MeshBasicMaterial({ ...base, side: THREE.FrontSide,
+    stencilFail: THREE.DecrementWrapStencilOp, stencilZFail: THREE.DecrementWrapStencilOp,
+    stencilZPass: THREE.DecrementWrapStencilOp });
+  for (const m of [back, front]) {
+    const mesh = new THREE.Mesh(geometry, m);
+    mesh.matrixAutoUpdate = false;
+    mesh.matrix.copy(matrixWorld);
+    mesh.renderOrder = 1;
+    stencilGroup.add(mesh);
+  }
+}
+
+// ---- measurement and hotspots --------------------------------------------------------------
+const raycaster = new THREE.Raycaster();
+const picks = [];
+const marks = new THREE.Group();
+scene.add(marks);
+function onClick(ev) {
+  if (!part || !document.getElementById('measure').checked) return;
+  const r = canvas.getBoundingClientRect();
+  const ndc = new THREE.Vector2(((ev.clientX - r.left) / r.width) * 2 - 1,
+                                -((ev.clientY - r.top) / r.height) * 2 + 1);
+  raycaster.setFromCamera(ndc, camera);
+  const hit = raycaster.intersectObject(part, true).find((h) => !cut.on || plane.distanceToPoint(h.point) >= 0);
+  if (!hit) return;
+  picks.push(hit.point.clone());
+  const dot = new THREE.Mesh(new THREE.SphereGeometry(span / 150), new THREE.MeshBasicMaterial({ color: 0xd01010 }));
+  dot.position.copy(hit.point);
+  marks.add(dot);
+  if (picks.length === 2) {
+    const mm = picks[0].distanceTo(picks[1]) * 1000;
+    const [a, b] = picks.map(blockOfWorld);
+    document.getElementById('measurement').textContent =
+      `${mm.toFixed(2)} mm between (${a.map((v) => v.toFixed(1)).join(', ')}) and ` +
+      `(${b.map((v) => v.toFixed(1)).join(', ')}) mm`;
+    marks.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(picks),
+                             new THREE.LineBasicMaterial({ color: 0xd01010 })));
+    picks.length = 0;
+  } else if (marks.children.length > 3) {
+    marks.clear();
+    marks.add(dot);
+  }
+}
+
+function addHotspots() {
+  const list = document.getElementById('hotspots');
+  for (const h of data.hotspots || []) {
+    const m = new THREE.Mesh(new THREE.SphereGeometry(span / 120),
+                             new THREE.MeshBasicMaterial({ color: h.kind === 'knot' ? 0x3050ff : 0xff8800,
+                                                           depthTest: false }));
+    m.position.copy(worldOfBlock(...h.at_mm));
+    m.renderOrder = 3;
+    scene.add(m);
+    const li = document.createElement('li');
+    li.textContent = `${h.kind}: ${h.label} at (${h.at_mm.map((v) => v.toFixed(1)).join(', ')}) mm`;
+    list.appendChild(li);
+  }
+}
+
+// ---- UI ------------------------------------------------------------------------------------
+function bindUi() {
+  for (const b of document.querySelectorAll('[data-view]')) b.onclick = () => setView(b.dataset.view);
+  document.getElementById('ortho').onchange = (e) => {
+    camera = e.target.checked ? ortho : persp;
+    controls.object = camera;
+  };
+  const axis = document.getElementById('cut-axis'), pos = document.getElementById('cut-pos');
+  const on = document.getElementById('cut-on'), label = document.getElementById('cut-label');
+  const limits = { x: W, y: D, z: H };
+  const sync = () => {
+    pos.max = limits[cut.axis]; pos.value = cut.pos;
+    label.textContent = `${cut.axis} = ${cut.pos.toFixed(1)} mm`;
+  };
+  axis.value = cut.axis; on.checked = cut.on; sync();
+  axis.onchange = () => { cut.axis = axis.value; cut.pos = limits[cut.axis] / 2; sync(); updatePlane(); };
+  pos.oninput = () => { cut.pos = parseFloat(pos.value); sync(); updatePlane(); };
+  on.onchange = () => { cut.on = on.checked; updatePlane(); };
+  document.getElementById('print').onclick = () => {
+    document.getElementById('snapshot').src = canvas.toDataURL('image/png');
+    window.print();
+  };
+  canvas.addEventListener('click', onClick);
+}
+
+async function main() {
+  for (const ax of ['x', 'y', 'z']) textures[ax] = await loadVolume(data.volumes[ax]);
+  buildCap();
+  const glb = Uint8Array.from(atob(document.getElementById('woodcam-glb').textContent.trim()),
+                              (c) => c.charCodeAt(0));
+  const gltf = await new Promise((ok, fail) => new GLTFLoader().parse(glb.buffer, '', ok, fail));
+  part = gltf.scene;
+  scene.add(part);
+  part.updateMatrixWorld(true);
+  part.traverse((o) => { if (o.isMesh) stencilFor(o.geometry, o.matrixWorld); });
+  const box = new THREE.Box3().setFromObject(part);
+  const probe = document.getElementById('probe');
+  probe.dataset.bboxMin = box.min.toArray().join(',');
+  probe.dataset.bboxMax = box.max.toArray().join(',');
+  let normals = 0;
+  part.traverse((o) => { if (o.isMesh && o.geometry.attributes.normal) normals += 1; });
+  probe.dataset.meshesWithNormals = String(normals);
+  addHotspots();
+  if (!params.has('bare')) bindUi();
+  setView(params.get('view') || 'iso');
+  updatePlane();
+  window.addEventListener('resize', resize);
+  renderer.setAnimationLoop(() => { controls.update(); renderer.render(scene, camera); });
+  status.textContent = 'ready';
+  document.title = `${data.title}: ready`;
+}
+
+main().catch((err) => { status.textContent = `error: ${err}`; document.title = `error: ${err}`; });

@@ -1,0 +1,135 @@
+"""Reproducible sets of synthetic blocks on disk (``woodcam block synth``)."""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from ..block import Block
+from ..block.io import write_block
+from ..errors import WoodcamError
+from ..fields.analytic import AnalyticLogField
+from .block import synth_block
+from .cut import PATTERNS, cut_block, random_log_placement
+from .degradation import _check_fraction
+
+
+def benchmark_set_block(seed: int, index: int, *, face_px: int = 512, size_range_mm=(30.0, 80.0),
+                        ring_width_range_mm=(1.5, 6.0),
+                        log_fields: Callable[[np.random.Generator], object] | None = None,
+                        knotted_fraction: float = 0.5,
+                        wood_factory: Callable[[object], object] | None = None,
+                        **synth_kwargs) -> tuple[Block, dict]:
+    """Block ``index`` of the set :func:`synth_benchmark_set` writes for ``seed``, alone.
+
+    Drawn from ``np.random.default_rng([seed, index])`` only, so it is the same block whichever
+    process makes it and whatever else is made. Returns the block and its index entry (name,
+    size, knotted, ring width, placement).
+    """
+    i = int(index)
+    rng = np.random.default_rng([int(seed), i])
+    pattern = PATTERNS[i % len(PATTERNS)]
+    size = tuple(float(v) for v in np.round(rng.uniform(*size_range_mm, size=3) * 2) / 2)
+    log, placement = random_log_placement(rng, pattern, size, ring_width_range_mm)
+    knotted = log_fields is not None and rng.uniform() < knotted_fraction
+    if knotted:
+        log = log_fields(rng)
+        # keep the block inside the knotted log (its outer radius), knots are near the bark
+        half_diag = 0.5 * math.hypot(size[0], size[1])
+        r_in = float(getattr(getattr(log, "log", None), "r_min_mm", 100.0)) - half_diag - 5.0
+        if placement["pattern"] != "pith-inside":
+            placement["distance_mm"] = max(half_diag + 2.0, min(placement["distance_mm"], r_in))
+    field = cut_block(log, size, **placement)
+    name = f"block_{i:04d}"
+    info = {"name": name, "index": i, "size_mm": list(size), "knotted": bool(knotted),
+            "ring_width_mm": log.ring_width_at(placement["distance_mm"]) if not knotted else None,
+            **{k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in placement.items()}}
+    wood = None if wood_factory is None else wood_factory(field)
+    block = synth_block(field, size, wood=wood, face_px=face_px, rng=rng, seed=None, name=name,
+                        meta={"benchmark_seed": int(seed), **info}, **synth_kwargs)
+    return block, info
+
+
+def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
+                        size_range_mm=(30.0, 80.0), ring_width_range_mm=(1.5, 6.0),
+                        log_fields: Callable[[np.random.Generator], object] | None = None,
+                        knotted_fraction: float = 0.5, wood_factory: Callable[[object], object] | None = None,
+                        progress: bool = True, **synth_kwargs) -> list[Path]:
+    """Write ``count`` synthetic blocks to ``out_dir/block_0000`` ... plus ``out_dir/index.json``.
+
+    Block ``i`` is drawn from ``np.random.default_rng([seed, i])`` alone, so any block of a set
+    can be regenerated without the others and the set is reproducible. Sawing patterns cycle
+    through :data:`PATTERNS`; each side is uniform in ``size_range_mm`` (0.5 mm steps); ring
+    width at the block is log-uniform in ``ring_width_range_mm``.
+
+    Parameters
+    ----------
+    log_fields : callable ``rng -> log-frame field``, optional
+        Factory of knotted log fields (pith on log ``z``). When given, a block is knotted with
+        probability ``knotted_fraction``. TODO(knots/logs): pass the knotted log generator from
+        ``woodcam.logs`` here once it exists; until then every block is knot-free.
+    wood_factory : callable ``block-frame field -> wood``, optional
+        Appearance for each block (e.g. ``lambda f: woodcam.appearance.Wood(f, ...)``); default
+        the built-in colour map.
+    synth_kwargs
+        Passed to :func:`synth_block` (e.g. ``trace_dropout``); default clean full annotation.
+
+    Returns
+    -------
+    list of Path
+        The block folders, in order.
+    """
+    from tqdm.auto import tqdm
+
+    if count < 1:
+        raise WoodcamError(f"count must be >= 1; got {count!r}")
+    _check_fraction("knotted_fraction", knotted_fraction)
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    index = {"format": "woodcam-benchmark", "version": 1, "seed": int(seed), "count": int(count),
+             "face_px": int(face_px), "size_range_mm": list(size_range_mm),
+             "ring_width_range_mm": list(ring_width_range_mm),
+             "knotted_available": log_fields is not None, "blocks": []}
+    folders = []
+    # tqdm's delay keeps the bar hidden for runs shorter than ~2 s.
+    for i in tqdm(range(count), desc="synthesising blocks", unit="block", delay=2.0, disable=not progress):
+        block, info = benchmark_set_block(
+            seed, i, face_px=face_px, size_range_mm=size_range_mm,
+            ring_width_range_mm=ring_width_range_mm, log_fields=log_fields,
+            knotted_fraction=knotted_fraction, wood_factory=wood_factory, **synth_kwargs)
+        folder = out_dir / info["name"]
+        write_block(block, folder)
+        folders.append(folder)
+        index["blocks"].append(info)
+    (out_dir / "index.json").write_text(json.dumps(index, indent=1))
+    return folders
+
+
+def knotted_log_field(rng: np.random.Generator, ring_width_range_mm=(1.5, 6.0), *,
+                      length_mm: float = 1200.0):
+    """A knotted log field (log frame) from the log generator of seed 001 (``woodcam.logs``),
+    turned into the stem + knot field of seed 003; ring width log-uniform in the range.
+    The factory :func:`synth_benchmark_set` takes as ``log_fields``."""
+    from ..fields import KnottedLogField, log_from_generated
+    from ..logs import generate_log
+
+    gen = generate_log(int(rng.integers(1 << 31)), length_mm=length_mm)
+    width = math.exp(rng.uniform(*np.log(ring_width_range_mm)))
+    return KnottedLogField(log_from_generated(gen), ring_width_mm=width)
+
+
+def time_synth_block(face_px: int = 512, repeats: int = 1) -> float:
+    """Seconds to synthesise one cube block with six ``face_px``-square faces (built-in colour)."""
+    log = AnalyticLogField(ring_width_mm=3.0, width_slope_per_mm=0.001, eccentricity=0.1, lobe_amplitude=0.02)
+    field = cut_block(log, (50, 50, 50), "rift")
+    best = math.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        synth_block(field, (50, 50, 50), face_px=face_px, seed=0)
+        best = min(best, time.perf_counter() - t0)
+    return best

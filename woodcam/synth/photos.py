@@ -1,0 +1,91 @@
+"""Face photos of a synthetic block: the built-in wood colour and the camera that photographs it."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..fields.base import arf, check_points, evaluate, grain_direction
+
+_EARLYWOOD = np.array([0.88, 0.73, 0.56])
+_LATEWOOD = np.array([0.66, 0.45, 0.27])
+
+
+class _BuiltinWood:
+    """Built-in appearance (used when no ``wood`` is given): ``color(points_mm, normals)``.
+
+    Earlywood -> latewood by the field's ARF (eq. 6 of seed 000) with a smooth latewood band
+    over about the last 30 % of each ring, a per-ring tone, end grain (|fibre . normal| near 1)
+    a little darker, and a fibre texture: smooth 3-D noise stretched along the fibres
+    (``_FIBRE_SCALES_MM``: streaks on side grain, pores on end grain). All random parts are
+    drawn once per block, so the six faces agree where they meet.
+    """
+
+    #: (across-fibre, along-fibre) noise scales (mm) and weights of the fibre texture octaves.
+    _FIBRE_SCALES_MM = ((0.22, 6.0, 0.6), (0.9, 25.0, 0.4))
+    _FIBRE_AMPLITUDE = 0.05
+
+    def __init__(self, field, rng: np.random.Generator, lattice: int = 64):
+        self.field = field
+        self.phase = rng.uniform(0, 2 * np.pi)
+        self.lattice = [rng.standard_normal((lattice,) * 3).astype(np.float32) for _ in self._FIBRE_SCALES_MM]
+        self.offsets = rng.uniform(0, lattice, (len(self._FIBRE_SCALES_MM), 3))
+
+    def _fibre_texture(self, p: np.ndarray, fib: np.ndarray) -> np.ndarray:
+        from scipy.ndimage import map_coordinates
+
+        along = (p * fib).sum(1, keepdims=True)
+        tex = np.zeros(len(p))
+        for (l_across, l_along, w), grid, off in zip(self._FIBRE_SCALES_MM, self.lattice, self.offsets):
+            # stretched coordinates: 1 cell = l_across across the fibres, l_along along them
+            q = p / l_across - (1.0 / l_across - 1.0 / l_along) * along * fib + off
+            tex += w * map_coordinates(grid, q.T, order=1, mode="grid-wrap")
+        return tex
+
+    def color(self, points_mm, normals, years=None, years_per_px=None) -> np.ndarray:
+        """rgb ``(n, 3)`` in [0, 1] at ``points_mm (n, 3)`` with outward ``normals (n, 3)``.
+
+        ``years (n,)`` may be passed when already evaluated; ``years_per_px (n,)``, the growth
+        time spanned by one pixel, anti-aliases the latewood -> earlywood step at each ring
+        boundary (a box filter: the step becomes a one-pixel ramp).
+        """
+        p = check_points(points_mm)
+        years = evaluate(self.field, p) if years is None else years
+        fib = np.asarray(grain_direction(self.field, p), dtype=float)
+        end_grain = np.abs((fib * np.asarray(normals, float)).sum(1))
+        a = arf(years)                                  # (years mod 1)^2
+        x = np.clip((a - 0.3) / 0.5, 0.0, 1.0)         # latewood band: about the last 30 % of a ring
+        late = x * x * (3.0 - 2.0 * x)                  # smoothstep
+        if years_per_px is not None:
+            frac = years - np.floor(years)
+            w = np.maximum(np.asarray(years_per_px, float), 1e-6)
+            # box filter of the pixel [frac - w/2, frac + w/2] across the step at the boundary:
+            # the part past it is earlywood (late = 0), the part before a ring's start is the
+            # previous ring's latewood (late ~ 1)
+            before = np.clip((1.0 - frac) / w + 0.5, 0.0, 1.0)
+            prev = np.clip(0.5 - frac / w, 0.0, 1.0)
+            late = late * before * (1.0 - prev) + prev
+        ring = np.floor(years)
+        tone = 1.0 + 0.04 * np.sin(ring * 2.399 + self.phase)   # per-ring brightness
+        tex = 1.0 + self._FIBRE_AMPLITUDE * self._fibre_texture(p, fib)
+        rgb = _EARLYWOOD + late[:, None] * (_LATEWOOD - _EARLYWOOD)
+        rgb = rgb * (tone * tex * (1.0 - 0.15 * end_grain))[:, None]
+        return np.clip(rgb, 0.0, 1.0)
+
+
+def _camera(rgb: np.ndarray, rng: np.random.Generator, noise: float, variation: float,
+            blur_px: float = 0.0) -> np.ndarray:
+    """Photograph an ``(h, w, 3)`` float image: lens blur (Gaussian, ``blur_px``), exposure and
+    white balance, vignetting, sensor noise; returns uint8."""
+    from scipy.ndimage import gaussian_filter
+
+    h, w, _ = rgb.shape
+    out = gaussian_filter(rgb, (blur_px, blur_px, 0), mode="nearest") if blur_px > 0 else rgb
+    if variation > 0:
+        gain = 1.0 + variation * rng.standard_normal() + variation * 0.3 * rng.standard_normal(3)
+        rr, cc = np.meshgrid(np.linspace(-1, 1, h), np.linspace(-1, 1, w), indexing="ij")
+        centre = rng.uniform(-0.3, 0.3, 2)
+        vignette = 1.0 - 2.0 * variation * rng.uniform(0.5, 1.5) * ((rr - centre[0]) ** 2 + (cc - centre[1]) ** 2) / 2
+        out = out * gain * vignette[..., None]
+    if noise > 0:
+        out = out + noise * rng.standard_normal(out.shape)
+    return np.clip(np.round(out * 255.0), 0, 255).astype(np.uint8)
