@@ -33,6 +33,11 @@ def test_knot_is_the_cylinder_and_leaves_the_stem_alone_beyond_smoothing():
     # concentric at the core: the knot time grows with distance from the strand axis
     core = np.array([[20.0 + r, 5.0, 20.0] for r in (0.0, 1.0, 2.0, 3.0)])
     assert np.all(np.diff(f(core)) > 0)
+    # seed 003: the knot holds every ring since the pith, b = (d / R) g: 0 on its axis, and
+    # with the stem's spacing only (dense=False) it keeps the stem's ring width
+    np.testing.assert_allclose(f(core[2:3]), 0.5 * plane_stem(core[2:3]), rtol=0.05)
+    sparse = StemWithKnots(plane_stem, [strand], smoothing_years=1.0, dense=False)
+    assert sparse(core[:1])[0] > 5.0 and f(core[:1])[0] < 0.5
     k = f.knot_features(p)["knot"]
     assert np.all(k[d < 3.8] == 1) and np.all(k[d > 4.2] == 0)
 

@@ -76,10 +76,15 @@ class StemWithKnots:
     """``years(p)``: a stem field with knot strands joined in (module docstring).
 
     stem : ``(n, 3) mm -> (n,) years``; strands : list of :class:`KnotStrand`.
+    dense : the knot's ring density ``G`` is ``max(G, g(S) / R)`` where ``g(S) > 0``: with growth
+        time counted from the pith (woodcam's convention) the knot then holds every ring since
+        the pith and its time is ``b = (d / R) g(p)``, seed 003's ``t_b = d t_s / R``. False keeps
+        the stem's ring spacing inside the knot.
     """
 
-    def __init__(self, stem, strands, smoothing_years: float = KNOT_SMOOTH_YEARS):
+    def __init__(self, stem, strands, smoothing_years: float = KNOT_SMOOTH_YEARS, dense: bool = True):
         self.stem = stem
+        self.dense = bool(dense)
         self.strands = list(strands)
         self.k = float(smoothing_years)
         self.axis = getattr(stem, "axis", (0.0, 0.0, 1.0))
@@ -107,6 +112,8 @@ class StemWithKnots:
 
     def _knot_time(self, p, g, table):
         d, R, G, gS = self._geometry(p, table)
+        if self.dense:  # seed 003: the knot holds every ring since the pith
+            G = np.where(gS > 0, np.maximum(G, gS / R), G)
         inside = gS + (d / R) * (g - gS) - (R - d) * G
         return np.where(d < R, inside, g + (d - R) * G)
 

@@ -17,8 +17,8 @@ METHODS: tuple[str, ...] = get_args(Method)
 
 #: Bumped whenever a fitter changes what it returns for the same block, so fields cached by
 #: :func:`woodcam.stock.fitted_field` are refitted (2: growth history, knot masks, year-free neural;
-#: 3: the evidence-chosen default, uncertainty and fit facts saved with the grid).
-FIT_VERSION = 3
+#: 3: the evidence-chosen default, uncertainty and fit facts saved with the grid; 4: dense knots).
+FIT_VERSION = 4
 
 
 def fit_block(block, method: Method = "evidence", faces=None, baked: bool = True):
