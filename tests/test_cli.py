@@ -18,7 +18,7 @@ def test_demo_quick_writes_every_output(tmp_path, capsys):
     assert main(["demo", "--out", str(tmp_path), "--quick"]) == 0
     out = capsys.readouterr().out
     for part in ("bowl", "tray", "lid"):
-        for suffix in (".glb", ".obj", ".mtl", ".png", "_view.png"):
+        for suffix in (".glb", ".obj", ".mtl", "_texture.png", "_view.png"):
             f = tmp_path / f"{part}{suffix}"
             assert f.is_file() and f.stat().st_size > 0, f
         assert part in out
@@ -59,7 +59,7 @@ def test_bake_and_preview_from_the_command_line(tmp_path, capsys):
 def test_errors_are_one_clean_line(argv, message, tmp_path):
     res = subprocess.run([sys.executable, "-m", "woodcam.cli", *argv], cwd=REPO,
                          capture_output=True, text=True)
-    assert res.returncode == 2
+    assert res.returncode == 1  # a runtime error; 2 is for usage errors
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("woodcam: error:") and message in lines[0]
     assert "Traceback" not in res.stderr

@@ -33,13 +33,13 @@ def test_block_synth_then_show(tmp_path, capsys):
 
 
 def test_block_errors_are_one_line(tmp_path, capsys):
-    assert main(["block", "show", str(tmp_path), "--out", str(tmp_path / "x.png")]) == 2
+    assert main(["block", "show", str(tmp_path), "--out", str(tmp_path / "x.png")]) == 1
     err = capsys.readouterr().err
     assert err.startswith("woodcam: error: folder") and "Mokume files" in err and err.count("\n") == 1
 
 
 def test_show_of_a_missing_folder_says_what_it_wants(tmp_path, capsys):
-    assert main(["block", "show", str(tmp_path / "nope"), "--out", str(tmp_path / "x.png")]) == 2
+    assert main(["block", "show", str(tmp_path / "nope"), "--out", str(tmp_path / "x.png")]) == 1
     assert "block folder (with block.json) or a Mokume sample folder" in capsys.readouterr().err
 
 

@@ -64,3 +64,25 @@ def test_bake_demo_and_gcode_share_the_bake_options():
             "species": "walnut", "appearance": "colormap",
             "knots": KnotShading(alive_darkening=0.2, dead_darkening=0.4)}, name
         assert args.no_obj, name
+
+
+def test_version_prints_the_package_version(capsys):
+    from woodcam import __version__
+    from woodcam.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0
+    assert capsys.readouterr().out.strip() == f"woodcam {__version__}"
+
+
+def test_preview_takes_negative_vectors_and_view_flags():
+    from woodcam.cli import build_parser
+
+    args = build_parser().parse_args(["preview", "x.glb", "--cut-normal", "-1,0,0",
+                                      "--cut-origin", "-14,5.5,3", "--camera", "top", "--no-cut"])
+    assert args.cut_normal == (-1.0, 0.0, 0.0) and args.cut_origin == (-14.0, 5.5, 3.0)
+    assert args.camera == "top" and args.no_cut
+    with pytest.raises(SystemExit) as exc:
+        build_parser().parse_args(["preview", "x.glb", "--cut-normal", "1,nan,0"])
+    assert exc.value.code == 2

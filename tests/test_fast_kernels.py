@@ -5,7 +5,8 @@ home, so the two cannot drift apart (as the knot shading of the colour map and o
 renderer once did):
 
 - ``appearance.colormap._shade_kernel``: the species ramp (:meth:`ColorMapAppearance.ramp`),
-  :class:`~woodcam.appearance.knots.KnotShading` and eq. 10 (:func:`blend_axis_colors`).
+  :class:`~woodcam.appearance.knots.KnotShading` and eq. 10 (:func:`blend_axis_colors`; both
+  use ``orientation.eq10_weights``, whose numpy reference is in tests/appearance/test_colormap.py).
 - ``appearance.noise`` (``noise_at``, ``_value_noise_kernel``): a numpy value noise below.
 - ``appearance.volumes._detailed_kernel``: trilinear lookups (``_trilinear``) plus the slope.
 - ``fields.radial._radial_kernel``: :meth:`RadialScalingField.radius_scale` (eq. 7-9).
@@ -148,12 +149,11 @@ def test_radial_kernel_is_eq_7_to_9():
 
 def test_knot_field_numba_backend_matches_numpy():
     from woodcam.fields.knots import KnottedLogField, available_backends
-    from woodcam.fields.tree_data import log_from_generated
     from woodcam.logs.generate import generate_log
 
     if "numba" not in available_backends():
         pytest.skip("numba backend not available")
-    log = log_from_generated(generate_log(3, length_mm=600.0))
+    log = generate_log(3, length_mm=600.0).to_skeleton()
     a, b = KnottedLogField(log, backend="numpy"), KnottedLogField(log, backend="numba")
     r = RNG.uniform(20, 120, 6000)
     th = RNG.uniform(0, 2 * np.pi, 6000)

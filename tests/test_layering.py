@@ -14,7 +14,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "woodcam"
 #: Layer of each unit: a unit may import units of strictly lower layers only.
 LAYERS: dict[str, int] = {
     # foundations: errors, tolerances, limits, atomic writes, content-keyed caches
-    "errors": 0, "tolerances": 0, "limits": 1, "_atomic": 1, "_cache": 2,
+    "errors": 0, "tolerances": 0, "_types": 0, "limits": 1, "_atomic": 1, "_cache": 2,
     "_xatlas_worker": 1,               # xatlas in a worker process (numpy + xatlas only)
     "frames": 3,                       # block frame, faces, pixel <-> block
     "fields": 4,                       # growth fields behind one protocol
@@ -28,13 +28,14 @@ LAYERS: dict[str, int] = {
     "cad": 8, "bake": 8, "export": 8, "toolpath": 8, "synth": 8, "parquetry": 8,
     "view": 9, "review": 9,            # view reads woodcam's own exports
     "stock": 10,                       # block spec -> Stock (synth, inference, appearance)
+    "advise": 10,                      # placement advice and part reports (takes a Stock)
     "pipeline": 11, "demo": 12,
     "scale": 13,                       # runs any of them
     "cli": 14,                         # the command, on top
     "woodcam": 15,                     # the package's lazy re-exports
 }
 #: Data folders (no code).
-DATA = {"models", "data"}
+DATA = {"models", "data", "examples"}  # examples: part scripts (cad_examples/ links here)
 
 
 def _unit(module: str) -> str:
@@ -58,6 +59,11 @@ def _imports(path: Path):
                     continue
             else:
                 target = node.module or ""
+                if target == "woodcam":  # "from woodcam import _x": a unit, or the package's API
+                    for alias in node.names:
+                        unit = alias.name in _units_on_disk()
+                        yield node.lineno, f"woodcam.{alias.name}" if unit else "woodcam"
+                    continue
             yield node.lineno, target
         elif isinstance(node, ast.Import):
             for alias in node.names:
@@ -107,3 +113,14 @@ def test_the_walk_sees_lazy_imports(tmp_path, monkeypatch):
     monkeypatch.setattr(__import__(__name__), "PACKAGE", fake)
     expected = "woodcam/fields/x.py:2: fields (layer 4) imports woodcam.synth (layer 8)"
     assert _violations() == [expected]
+
+
+def test_no_two_public_classes_share_a_name():
+    """One concept, one name: a public class name is defined once in the package."""
+    where: dict[str, list[str]] = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        for node in ast.parse(path.read_text(), str(path)).body:
+            if isinstance(node, ast.ClassDef) and not node.name.startswith("_"):
+                where.setdefault(node.name, []).append(str(path.relative_to(PACKAGE.parent)))
+    twice = {name: paths for name, paths in where.items() if len(paths) > 1}
+    assert not twice, f"public classes defined more than once: {twice}"

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from woodcam.errors import WoodcamError
-from woodcam.fields import block_at_knot, read_gran1
+from woodcam.fields import block_at_knot
+from woodcam.logs import read_gran1
 from woodcam.stock import open_stock
 
 

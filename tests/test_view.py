@@ -517,3 +517,33 @@ def test_cut_plane_rejects_bad_arguments():
         cut_plane_image(PositionWood(), SIZE, (50, 40, 20), (1, 0, 0), max_samples=2)
     with pytest.raises(WoodcamError, match="origin must be three finite"):
         cut_plane_image(PositionWood(), SIZE, (50, np.nan, 20), (1, 0, 0))
+
+
+def test_window_keys_switch_views_and_toggle_the_block(tmp_path):
+    """The interactive window's keys, driven off screen through pyvista's key callbacks."""
+    pv = pytest.importorskip("pyvista")
+    import trimesh
+
+    from woodcam.view.scene import KEY_HELP, add_view_keys, build_scene
+
+    box = trimesh.creation.box((40.0, 30.0, 20.0))
+    box.apply_translation([50.0, 40.0, 25.0])
+    plotter = pv.Plotter(off_screen=True, window_size=(320, 240))
+    try:
+        build_scene(plotter, box, size_mm=(100.0, 80.0, 50.0), widget=False)
+        add_view_keys(plotter, (100.0, 80.0, 50.0))
+        keys = plotter.iren._key_press_event_callbacks
+        keys["2"][-1]()  # top: the camera straight above the block's centre
+        pos, focal = np.asarray(plotter.camera.position), np.asarray(plotter.camera.focal_point)
+        assert np.allclose((pos - focal)[:2], 0.0, atol=1e-6) and pos[2] > focal[2]
+        keys["1"][-1]()  # front: looking along +Y
+        d = np.asarray(plotter.camera.focal_point) - np.asarray(plotter.camera.position)
+        assert d[1] > 0 and np.allclose(d[[0, 2]], 0.0, atol=1e-6)
+        keys["o"][-1]()
+        assert plotter.camera.parallel_projection
+        assert plotter.actors["woodcam-block"].GetVisibility()
+        keys["h"][-1]()
+        assert not plotter.actors["woodcam-block"].GetVisibility()
+        assert "1 front" in KEY_HELP and "woodcam-keys" in plotter.actors
+    finally:
+        plotter.close()

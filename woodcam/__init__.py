@@ -25,20 +25,21 @@ _EXPORTS = {
     ".errors": ["MissingDependencyError", "WoodcamError", "WoodcamWarning"],
     ".export": ["export_glb", "export_obj", "load_textured", "read_glb_metadata", "crease_normals",
                   "written_by_woodcam", "BLOCK_TO_GLTF"],
-    ".fields": ["GridField", "GrowthField", "KnottedLogField", "Log", "LogFrame", "PlacedField",
-                "RadialScalingField", "arf", "builtin_block", "evaluate", "grain_direction",
-                "read_gran1"],
+    ".fields": ["GridField", "GrowthField", "KnottedLogField", "LogFrame", "LogSkeleton",
+                "PlacedField", "RadialScalingField", "arf", "builtin_block", "evaluate",
+                "grain_direction"],
     ".frames": ["FACES", "FACE_NORMAL", "MOKUME_LETTER", "block_to_pixel", "pixel_to_block",
                 "unfold_cross"],
     ".inference": ["EvidenceFit", "benchmark", "evaluate_fit", "fit_block", "fit_evidence",
                    "leave_one_face_out"],
-    ".logs": ["GeneratedLog", "generate_log"],
+    ".logs": ["GeneratedLog", "generate_log", "read_gran1", "read_log", "write_log"],
     ".pipeline": ["PartPreview", "preview_mesh", "preview_part"],
     ".stock": ["Stock", "open_stock"],
     ".synth": ["cut_block", "synth_block"],
     ".toolpath": ["Program", "SimResult", "Tool", "load_tool_table", "parse_tool_spec",
                   "read_gcode", "simulate"],
     ".view": ["SceneOptions", "preview"],
+    ".woodify": ["Brush", "GrowthSpeed", "Woodification", "WoodifiedField"],  # woodify.woodify()
 }
 _WHERE = {name: mod for mod, names in _EXPORTS.items() for name in names}
 

@@ -171,10 +171,70 @@ def load_or_build(path, *, load: Callable[[Path], T], build: Callable[[], T],
         try:
             with atomic_path(path) as tmp:
                 save(value, tmp)
+            prune(keep=path)
         except OSError as err:
             warnings.warn(CacheWarning(f"{what}: could not write the cache entry {str(path)!r} "
                                        f"({err}); the result is used but not kept"), stacklevel=2)
         return value, False
     finally:
         lock.__exit__(None, None, None)
+
+
+#: Default size limit of the whole cache (bytes); ``$WOODCAM_CACHE_MAX_MB`` overrides it. Fitted
+#: fields are ~1-10 MB and neural colour volumes ~70 MB each, so 2 GB keeps a few dozen blocks.
+DEFAULT_CACHE_MAX_BYTES = 2 * 2**30
+
+
+def cache_max_bytes() -> int:
+    """The cache's size limit: ``$WOODCAM_CACHE_MAX_MB`` (MiB) or :data:`DEFAULT_CACHE_MAX_BYTES`."""
+    text = os.environ.get("WOODCAM_CACHE_MAX_MB")
+    if not text:
+        return DEFAULT_CACHE_MAX_BYTES
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not (value > 0 and value < 1e9):
+        raise WoodcamError(f"WOODCAM_CACHE_MAX_MB must be a number of MiB > 0; got {text!r}; "
+                           "e.g. export WOODCAM_CACHE_MAX_MB=4096")
+    return int(value * 2**20)
+
+
+def entries(kind: str | None = None) -> list[Path]:
+    """Cache entry files (lock files left out), of one ``kind`` or all, oldest use first."""
+    root = cache_dir(kind) if kind else cache_root()
+    if not root.is_dir():
+        return []
+    files = [p for p in root.rglob("*") if p.is_file() and p.suffix != ".lock"]
+    return sorted(files, key=lambda p: max(p.stat().st_atime, p.stat().st_mtime))
+
+
+def prune(max_bytes: int | None = None, *, keep: Path | None = None) -> int:
+    """Delete the least recently used entries until the cache fits ``max_bytes`` (default
+    :func:`cache_max_bytes`); ``keep`` is never deleted. Returns the bytes freed."""
+    limit = cache_max_bytes() if max_bytes is None else int(max_bytes)
+    files = entries()
+    total = sum(p.stat().st_size for p in files)
+    freed = 0
+    for p in files:
+        if total - freed <= limit:
+            break
+        if keep is not None and p == keep:
+            continue
+        size = p.stat().st_size
+        with contextlib.suppress(OSError):
+            p.unlink()
+            freed += size
+    return freed
+
+
+def clear(kind: str | None = None) -> tuple[int, int]:
+    """Delete every cache entry (of one ``kind``); returns (files, bytes) deleted."""
+    n = size = 0
+    for p in entries(kind):
+        with contextlib.suppress(OSError):
+            b = p.stat().st_size
+            p.unlink()
+            n, size = n + 1, size + b
+    return n, size
 

@@ -19,10 +19,11 @@ DEMO_PARTS: tuple[tuple[str, str], ...] = (
 
 
 def examples_dir() -> Path:
-    """The repository's ``cad_examples/`` folder (next to the package)."""
-    d = Path(__file__).resolve().parents[1] / "cad_examples"
+    """The example part scripts, installed with the package (``woodcam/examples``; the
+    repository's ``cad_examples/`` is a link to it)."""
+    d = Path(__file__).resolve().parent / "examples"
     if not d.is_dir():
-        raise WoodcamError(f"cad_examples/ not found at {d}; run the demo from a woodcam checkout")
+        raise WoodcamError(f"the example parts are missing from {d}; reinstall woodcam")
     return d
 
 

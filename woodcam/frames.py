@@ -15,6 +15,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from ._types import ArrayLike
 from .errors import WoodcamError
 
 FaceName = Literal["front", "top", "left", "bottom", "right", "back"]
@@ -105,7 +106,8 @@ def uv_to_block(face: str, u, v, size_mm) -> np.ndarray:
     return np.einsum("...j,kj->...k", uv, A) + b  # einsum: see LogFrame.to_log
 
 
-def pixel_to_block(face: str, rows, cols, image_shape, size_mm) -> np.ndarray:
+def pixel_to_block(face: str, rows: ArrayLike, cols: ArrayLike, image_shape: ArrayLike,
+                   size_mm: ArrayLike) -> np.ndarray:
     """Map continuous pixel coordinates of a face image to block points (mm).
 
     Parameters
@@ -126,7 +128,8 @@ def pixel_to_block(face: str, rows, cols, image_shape, size_mm) -> np.ndarray:
     return uv_to_block(face, u, v, size_mm)
 
 
-def block_to_pixel(face: str, points_mm, image_shape, size_mm) -> tuple[np.ndarray, np.ndarray]:
+def block_to_pixel(face: str, points_mm: ArrayLike, image_shape: ArrayLike,
+                   size_mm: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Inverse of :func:`pixel_to_block`: project block points onto a face image.
 
     The coordinate normal to the face is ignored (orthographic projection along the normal).
@@ -206,7 +209,7 @@ class CrossLayout:
         return 2 * D + H, 2 * D + 2 * W
 
 
-def unfold_cross(images: dict, size_mm, background=0) -> np.ndarray:
+def unfold_cross(images: dict, size_mm: ArrayLike, background: float | ArrayLike = 0) -> np.ndarray:
     """Lay six face images (dict face -> (h, w[, c]) array) out as one unfolded-cross image.
 
     All images must share one pixel density; faces that are absent stay ``background``.

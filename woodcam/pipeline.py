@@ -6,11 +6,13 @@ Every front end (``woodcam bake``, ``woodcam demo``, ``woodcam gcode``) runs the
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ._types import Mesh, PathLike
 from .stock import Stock
 
 
@@ -40,9 +42,10 @@ class PartPreview:
     meta_block: str = ""
     tessellation: dict = field(default_factory=dict)
     atlas: str = ""
+    report: dict = field(default_factory=dict)
 
     @contextmanager
-    def stage(self, name: str):
+    def stage(self, name: str) -> Iterator[None]:
         t0 = time.perf_counter()
         yield
         self.timings_s[name] = self.timings_s.get(name, 0.0) + time.perf_counter() - t0
@@ -58,8 +61,10 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
 
     out_glb = check_output_path(out_glb, suffixes=(".glb",), what=what, mkdir=True)
     if obj:
-        for suffix in (".obj", ".mtl", ".png"):
-            check_output_path(out_glb.with_suffix(suffix), what=f"{what} (the {suffix[1:].upper()} "
+        for sibling in (out_glb.with_suffix(".obj"), out_glb.with_suffix(".mtl"),
+                        out_glb.with_name(out_glb.stem + "_texture.png")):
+            suffix = sibling.suffix
+            check_output_path(sibling, what=f"{what} (the {suffix[1:].upper()} "
                               "beside the GLB; --no-obj skips it)")
     if screenshot is True:
         check_output_path(out_glb.with_name(out_glb.stem + "_view.png"), what=f"{what} (its view PNG)")
@@ -68,7 +73,7 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
     return out_glb
 
 
-def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
+def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_mm: float = 10.0,
                  tolerance_mm: float | None = None, obj: bool = True,
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
                  obj_up: str = "y", max_triangles: int | None = None,
@@ -99,16 +104,17 @@ def preview_part(source, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
         carved = carve(part, stock.size_mm)
     result.warnings += list(carved.warnings)
     return preview_mesh(carved.mesh, stock, out_glb, texels_per_mm=texels_per_mm, obj=obj,
+                        part_report=True,
                         screenshot=screenshot, progress=progress, result=result,
                         obj_units=obj_units, obj_up=obj_up, max_atlas_px=max_atlas_px,
                         metadata=metadata)
 
 
-def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, obj: bool = True,
+def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: float = 10.0, obj: bool = True,
                  screenshot: bool = True, progress: bool = False,
                  result: PartPreview | None = None, metadata: dict | None = None,
                  obj_units: str = "m", obj_up: str = "y",
-                 max_atlas_px: int = 4096) -> PartPreview:
+                 max_atlas_px: int = 4096, part_report: bool = False) -> PartPreview:
     """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files: the GLB
     in metres, Y up (glTF's convention); the OBJ in ``obj_units`` with ``obj_up`` up."""
     from .bake import bake
@@ -123,13 +129,36 @@ def preview_mesh(mesh, stock: Stock, out_glb, *, texels_per_mm: float = 10.0, ob
                      max_atlas_px=max_atlas_px)
     result.atlas_px = tuple(baked.atlas.shape[:2])
     result.atlas = baked.summary()
-    result.warnings += list(getattr(baked, "warnings", []))
     from .inference.evidence import uncertainty_report
 
-    line = uncertainty_report(stock.wood.field, mesh.vertices, stock.size_mm, result.name)
-    if line:  # a fitted field says where its rings are a guess (issue 12 part 5)
-        result.warnings.append(line)
-    meta = {"block": stock.spec, "size_mm": list(stock.size_mm), **(metadata or {}),
+    rings_line = uncertainty_report(stock.wood.field, mesh.vertices, stock.size_mm, result.name)
+    if rings_line:  # a fitted field says where its rings are a guess (issue 12 part 5)
+        result.warnings.append(rings_line)
+    if part_report:
+        import json
+
+        from ._atomic import write_bytes
+        from .advise import part_report as _part_report
+        from .advise import report_text
+
+        with result.stage("report"):
+            result.report = _part_report(mesh, stock)
+            if rings_line:
+                result.report.setdefault("warnings", []).append(rings_line)
+            stem = out_glb.with_name(out_glb.stem + "_report")
+            write_bytes(stem.with_suffix(".json"), json.dumps(result.report, indent=1).encode())
+            write_bytes(stem.with_suffix(".txt"), (report_text(result.report, out_glb.stem)
+                                                   + "\n").encode())
+        result.files["report"] = stem.with_suffix(".txt")
+    result.warnings += list(getattr(baked, "warnings", []))
+    from .stock import absolute_spec, spec_digest
+
+    meta = {"block": absolute_spec(stock.spec), "block_digest": spec_digest(stock.spec),
+            "size_mm": list(stock.size_mm),
+            "appearance": {"kind": stock.meta.get("appearance", "colormap"),
+                           "species": stock.meta.get("species"),
+                           "params": stock.meta.get("appearance_params", {})},
+            **(metadata or {}),
             "texels_per_mm": float(baked.texels_per_mm)}
     with result.stage("export"):
         result.files["glb"] = Path(export_glb(baked.mesh, out_glb, metadata=meta) or out_glb)

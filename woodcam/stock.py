@@ -8,6 +8,8 @@ A block spec is a string the CLI and GLB metadata carry:
 - ``log:LOG@K`` or ``log:LOG@K:WxDxH``: a block cut tangentially through knot ``K`` of a
   knotted log, ``LOG`` being ``gran1`` (the CT-measured spruce log of the shared data) or a
   woodcam log file (``.json``); size default 100x80x50 mm, Z along the log.
+- ``woodify:PATH/field.npz``: a block cut out of a grown object (``woodcam woodify``); size
+  and position are the placement stored in the file (``--block-size``, ``--block-centre``).
 - a block folder with a ``block.json`` manifest (real or synthetic): its true field if it has
   one, otherwise a field fitted to its rings (fit once, cached in the user cache folder).
 - a Mokume sample folder (``A_col.png``, ``A_arl-unet.png``, ... as in the Mokume dataset): a
@@ -80,12 +82,49 @@ def open_stock(spec: str, *, species: str | None = None,
         raise WoodcamError(f"appearance must be one of ['colormap', 'neural']; got {appearance!r}")
     base, turns = _split_turns(spec)
     stock = _open_base_stock(base, species, appearance, appearance_params)
+    stock.meta["appearance_params"] = {k: (list(v) if isinstance(v, tuple) else v)
+                                       for k, v in appearance_params.items()
+                                       if isinstance(v, (int, float, str, tuple, list))}
     if not turns:
         return stock
     wood, size = stock.wood, stock.size_mm
     for axis, quarter_turns in turns:
         wood, size = wood.turned(axis, quarter_turns, size)
     return Stock(spec, size, wood, stock.description, {**stock.meta, "turns": turns})
+
+
+def absolute_spec(spec: str) -> str:
+    """``spec`` with any folder or log file it names made absolute, so a file that records it
+    (a GLB) reopens the same block from any working folder."""
+    base, sep, turns = str(spec).partition("~")
+    if base.startswith("log:"):
+        source, at, rest = base[len("log:"):].partition("@")
+        if source.lower().endswith(".json"):
+            base = f"log:{Path(source).resolve()}{at}{rest}"
+    elif not base.startswith("builtin:"):
+        base = str(Path(base).resolve())
+    return base + sep + turns
+
+
+def spec_digest(spec: str) -> str:
+    """Content identity of the block ``spec`` names: a digest of every file of a block or sample
+    folder (or of a log file), or of the spec itself for synthetic blocks."""
+    from . import __version__
+    from ._cache import digest
+
+    base = str(spec).partition("~")[0]
+    path = None
+    if base.startswith("log:"):
+        source = base[len("log:"):].partition("@")[0]
+        path = Path(source) if source.lower().endswith(".json") else None
+    elif not base.startswith("builtin:"):
+        path = Path(base)
+    if path is not None and path.is_dir():
+        files = sorted(p for p in path.rglob("*") if p.is_file() and not p.name.startswith("."))
+        return digest([(str(p.relative_to(path)), p) for p in files])
+    if path is not None and path.is_file():
+        return digest(path)
+    return digest(base, __version__)
 
 
 def _split_turns(spec: str) -> tuple[str, list[tuple[str, int]]]:
@@ -149,6 +188,10 @@ def _open_base_stock(spec: str, species, appearance, appearance_params) -> Stock
         field, size_mm, description = _log_block_field(spec)
         return _synthetic_stock(spec, field, size_mm, species or "spruce", description,
                                 appearance, appearance_params)
+    if spec.startswith("woodify:"):
+        field, size_mm, description = _woodify_field(spec)
+        return _synthetic_stock(spec, field, size_mm, species or "oak", description,
+                                appearance, appearance_params)
     path = _existing_folder(spec)
     if (path / "block.json").is_file():
         return _open_block_folder(path, species, appearance, appearance_params)
@@ -176,12 +219,15 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         The field is the block's true field where one is known (synthetic blocks, block
         folders that store one), else None: no field is fitted here.
     """
-    if spec.startswith(("builtin:", "log:")):
+    if spec.startswith(("builtin:", "log:", "woodify:")):
         from .synth import synth_block
 
         if spec.startswith("builtin:"):
             b, field, size = _builtin(spec.split(":", 1)[1])
             name = b.name if tuple(size) == tuple(b.size_mm) else spec.replace(":", "-")
+        elif spec.startswith("woodify:"):
+            field, size, _ = _woodify_field(spec)
+            name = "woodify-" + Path(spec.split(":", 1)[1]).parent.name
         else:
             field, size, _ = _log_block_field(spec)
             name = spec.replace(":", "-").replace("/", "_")
@@ -193,6 +239,15 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
     return block, block.true_field
 
 
+def _woodify_field(spec: str):
+    """``woodify:PATH/field.npz`` -> (field, size_mm, description): the block stored in it."""
+    from .woodify.field import WoodifiedField
+
+    path = spec.split(":", 1)[1]
+    field = WoodifiedField.load(path)
+    return field, field.block_size_mm, f"block cut from an object grown {field.years_final:g} years ({path})"
+
+
 def _existing_folder(spec: str) -> Path:
     """The folder a non-builtin, non-log spec names, or the error listing every kind of spec."""
     path = Path(spec)
@@ -201,7 +256,8 @@ def _existing_folder(spec: str) -> Path:
     if not path.is_dir():
         raise WoodcamError(
             f"block spec {spec!r} is neither 'builtin:NAME' (NAME one of "
-            f"{', '.join(BUILTIN_NAMES)}), 'log:LOG@KNOT[:WxDxH]', nor an existing folder: a block "
+            f"{', '.join(BUILTIN_NAMES)}), 'log:LOG@KNOT[:WxDxH]', 'woodify:PATH/field.npz', nor an "
+            "existing folder: a block "
             "folder (with block.json) or a Mokume sample folder (A_col.png, A_arl-unet.png, ...)"
         )
     return path
@@ -291,18 +347,14 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
         app = ColorMapAppearance.fit_to_block(block, field, species or "oak", **appearance_params)
     else:
         app = ColorMapAppearance(species or "oak", **appearance_params)
-    return Stock(spec, block.size_mm, Wood(field, app), block.name, dict(block.meta))
+    meta = {**dict(block.meta), "appearance": appearance, "species": species or "oak"}
+    return Stock(spec, block.size_mm, Wood(field, app), block.name, meta)
 
 
 def _log_block_field(spec: str):
     """``log:LOG@K[:WxDxH]`` -> (block-frame field, size_mm, description)."""
-    from .fields import (
-        KnottedLogField,
-        block_at_knot,
-        place_block_in_log,
-        read_gran1,
-        read_log,
-    )
+    from .fields import KnottedLogField, block_at_knot, place_block_in_log
+    from .logs.io import read_gran1, read_log
 
     body = spec[len("log:"):]
     try:

@@ -164,6 +164,17 @@ RING_HISTORY_PRIOR_POINTS = 20.0
 RING_HISTORY_ROUNDS = 3
 RING_HISTORY_MIN_STEP = 1e-3
 
+#: Nodes either side of a mesh where woodify rasterises exact distances (and closest points).
+#: 2 covers the first layer of nodes outside the input in every direction (distance <= sqrt(3)
+#: nodes) with a node to spare, which both fast marchers start from.
+WOODIFY_BAND_NODES = 2
+
+#: Clearance (voxels) the grown solid keeps from obstacles. The signed distance of a convex
+#: obstacle is convex, so its linear interpolation between two nodes crosses zero slightly
+#: INSIDE the obstacle (by the sagitta, h^2 / 8a for a rod of radius a: 0.04 h at a = 3 h);
+#: 0.1 voxel keeps every marching-cubes vertex outside rods thicker than ~1.5 voxels.
+WOODIFY_OBSTACLE_CLEARANCE_VOXELS = 0.1
+
 #: Exported shading normals are averaged over the faces round a vertex whose normals lie within
 #: this angle of each other; a sharper edge keeps two normals (a crease). 30 degrees is the
 #: common CAD/DCC default (Blender's auto-smooth, three.js' toCreasedNormals examples): a

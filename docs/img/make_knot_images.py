@@ -10,7 +10,7 @@ from PIL import Image
 
 from woodcam.logs import render as lr
 from woodcam.fields.knots import KnottedLogField, block_at_knot, place_block_in_log
-from woodcam.fields.tree_data import read_gran1
+from woodcam.logs.io import read_gran1
 
 OUT = Path(__file__).parent
 

@@ -111,7 +111,7 @@ def test_cli_parser_wires_run(capsys, tmp_path):
     a = build_parser().parse_args(["eval", "appearance", "builtin:rift", "--out", "x", "--quality",
                                    "draft", "--epochs", "2"])
     assert a.func is appearance.run and a.epochs == 2 and a.quality == "draft"
-    assert main(["eval-appearance", "/nonexistent/folder", "--out", str(tmp_path)]) == 2  # old name
+    assert main(["eval-appearance", "/nonexistent/folder", "--out", str(tmp_path)]) == 1  # old name
     assert "is neither 'builtin:NAME'" in capsys.readouterr().err
 
 

@@ -149,9 +149,9 @@ def test_obj_units_and_up_axis_round_trip(baked, tmp_path, units, up, scale, hei
 def test_obj_writes_obj_mtl_png_named_after_the_obj_and_reloads(baked, tmp_path):
     path = export_obj(baked.mesh, tmp_path / "sub" / "bowl.obj")
     names = sorted(p.name for p in path.parent.iterdir())
-    assert names == ["bowl.mtl", "bowl.obj", "bowl.png"]
+    assert names == ["bowl.mtl", "bowl.obj", "bowl_texture.png"]  # never bowl.png: screenshots
     mtl = (path.parent / "bowl.mtl").read_text()
-    assert "map_Kd bowl.png" in mtl
+    assert "map_Kd bowl_texture.png" in mtl
     assert "Kd 1.00000000 1.00000000 1.00000000" in mtl  # texture not darkened by Kd
     loaded = load_textured(path)
     assert len(loaded.faces) == len(baked.mesh.faces)

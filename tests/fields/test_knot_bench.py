@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from woodcam.fields.knots import KnottedLogField, available_backends
-from woodcam.fields.tree_data import Knot, simple_log
+from woodcam.fields.skeleton import BranchStrand, simple_log
 
 pytestmark = pytest.mark.bench
 
@@ -65,7 +65,7 @@ def test_scaling_with_number_of_knots(gran1, backend):
     # a dense synthetic log: 4 x the real knot density (432 knots on 4 m) -> per-point cost
     # follows the knots near a point, not the total
     rng = np.random.default_rng(2)
-    dense = [Knot.from_model(0.2, -0.05, z, 0.1, -0.2, w, 0.01, 130.0, 90.0)
+    dense = [BranchStrand.from_model(0.2, -0.05, z, 0.1, -0.2, w, 0.01, 130.0, 90.0)
              for z, w in zip(rng.uniform(0, 3990, 432), rng.uniform(0, 2 * np.pi, 432))]
     rows.append((432, _rate(KnottedLogField(simple_log(3990, 135, dense), backend=backend), p,
                             cpu=True)))

@@ -5,18 +5,24 @@ import pytest
 from scipy import ndimage
 
 from woodcam.errors import WoodcamError
+from woodcam.fields.knots import (
+    KnotParams,
+    KnottedLogField,
+    PlacedField,
+    available_backends,
+    place_block_in_log,
+    power_smooth_min,
+    smoothing_amount,
+)
+from woodcam.fields.skeleton import BranchStrand, simple_log
 from woodcam.logs import render as lr
-from woodcam.fields.knots import (KnotParams, KnottedLogField, PlacedField, available_backends,
-                                  place_block_in_log, power_smooth_min,
-                                  smoothing_amount)
-from woodcam.fields.tree_data import Knot, simple_log
 
 BACKENDS = available_backends()
 
 
 def _knot(z0=300.0, r_death=150.0, az=0.0, r_end=100.0):
     # horizontal, untwisted knot; diameter 0.25 r (radius 12.5 % of the pith distance)
-    return Knot.from_model(0.25, 0.0, z0, 0.0, 0.0, az, 0.0, r_end, r_death)
+    return BranchStrand.from_model(0.25, 0.0, z0, 0.0, 0.0, az, 0.0, r_end, r_death)
 
 
 # -- smooth minimum -------------------------------------------------------------------------
@@ -249,11 +255,11 @@ def test_params_are_checked():
 
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_irregular_pith_samples(backend):
-    from woodcam.fields.tree_data import Log
+    from woodcam.fields.skeleton import LogSkeleton
 
     z = np.array([0.0, 5.0, 20.0, 60.0, 100.0])
     xy = np.stack([0.1 * z, np.zeros_like(z)], 1)          # a leaning, straight pith
-    log = Log(z, xy, np.full((5, 8), 80.0))
+    log = LogSkeleton(z, xy, np.full((5, 8), 80.0))
     f = KnottedLogField(log, ring_width_mm=2.0, backend=backend)
     rng = np.random.default_rng(6)
     p = rng.uniform([-60, -60, 0], [60, 60, 100], (2000, 3))

@@ -4,16 +4,23 @@ import numpy as np
 import pytest
 
 from woodcam.errors import WoodcamError
-from woodcam.logs.fit import (_load_gran_knots, fit_gran_knots, fit_knot, gran_knot_diameter,
-                              params_to_unconstrained, sample_gran_knot_points, unconstrained_to_params)
-from woodcam.logs.knot import Knot, KnotParams
+from woodcam.logs.fit import (
+    _load_gran_knots,
+    fit_gran_knots,
+    fit_knot,
+    gran_knot_diameter,
+    params_to_unconstrained,
+    sample_gran_knot_points,
+    unconstrained_to_params,
+)
+from woodcam.logs.knot import Knot, KnotShape
 
 # Knots whose tube never bends more sharply than its own radius (there the points of a
 # cross-section fall inside the knot and cannot all be surface points).
 TRUE_KNOTS = [
-    (KnotParams(0.0, -50.0, 0.8, 25.0, 0.3, 0.35, 6.0, 0.7, 0.3), 1.0),
-    (KnotParams(0.0, 300.0, 1.0, 90.0, 0.8, 0.6, 15.0, 0.2, 0.8), -2.5),
-    (KnotParams(0.0, 1200.0, 1.25, 60.0, 0.45, 0.7, 10.0, 0.5, 0.5), 3.0),
+    (KnotShape(0.0, -50.0, 0.8, 25.0, 0.3, 0.35, 6.0, 0.7, 0.3), 1.0),
+    (KnotShape(0.0, 300.0, 1.0, 90.0, 0.8, 0.6, 15.0, 0.2, 0.8), -2.5),
+    (KnotShape(0.0, 1200.0, 1.25, 60.0, 0.45, 0.7, 10.0, 0.5, 0.5), 3.0),
 ]
 
 #: Recovery tolerances from noise-free points: lengths in mm, ratios absolute. psi0 (the radius
@@ -35,7 +42,7 @@ def test_fit_recovers_noise_free_synthetic_knots(params, theta):
 
 
 def test_fit_recovers_an_offset_knot_given_its_reference_azimuth():
-    params = KnotParams(3.0, 40.0, 1.1, 50.0, 0.5, 0.65, 8.0, 0.5, 0.5)
+    params = KnotShape(3.0, 40.0, 1.1, 50.0, 0.5, 0.65, 8.0, 0.5, 0.5)
     pts = Knot(params, 0.7).surface_points(np.linspace(3.0, 110.0, 30), 16)
     fit = fit_knot(pts, theta_mean_rad=0.7)
     assert fit.rmse_mm < 0.01

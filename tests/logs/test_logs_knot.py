@@ -4,8 +4,16 @@ import numpy as np
 import pytest
 
 from woodcam.errors import WoodcamError
-from woodcam.logs.knot import (MAX_INCLINE, Knot, KnotParams, growth_curve, growth_curve_slope,
-                               radius_coefficients, to_slr, trajectory_coefficients)
+from woodcam.logs.knot import (
+    MAX_INCLINE,
+    Knot,
+    KnotShape,
+    growth_curve,
+    growth_curve_slope,
+    radius_coefficients,
+    to_slr,
+    trajectory_coefficients,
+)
 
 RATIOS = np.linspace(0.0, 1.0, 6)
 
@@ -50,7 +58,7 @@ def test_radius_constraints_hold_for_every_ratio(psi0, psi1):
 
 
 def test_knot_radius_equals_r_max_at_rho_max_and_delta_l_is_the_rise():
-    p = KnotParams(0.0, 100.0, 1.2, 40.0, 0.6, 0.7, 12.0, 0.4, 0.5)
+    p = KnotShape(0.0, 100.0, 1.2, 40.0, 0.6, 0.7, 12.0, 0.4, 0.5)
     k = Knot(p)
     np.testing.assert_allclose(k.radius(np.array([40.0])), 12.0, rtol=1e-9)
     np.testing.assert_allclose(k.height(np.array([40.0])) - 100.0, k.delta_l_mm(), rtol=1e-12)
@@ -58,18 +66,18 @@ def test_knot_radius_equals_r_max_at_rho_max_and_delta_l_is_the_rise():
 
 def test_arc_length_of_a_straight_knot_is_exact():
     # phi0 = 0 (start incline = end incline) and phi1 = 0.75: straight line at 40 degrees
-    k = Knot(KnotParams(0.0, 0.0, 1.0, 30.0, 0.0, 0.75, 5.0, 0.5, 0.5))
+    k = Knot(KnotShape(0.0, 0.0, 1.0, 30.0, 0.0, 0.75, 5.0, 0.5, 0.5))
     slope = np.tan(0.5 * MAX_INCLINE)
     np.testing.assert_allclose(k.arc_length(np.array([50.0])), 50.0 * np.sqrt(1 + slope**2), rtol=1e-9)
 
 
 def test_surface_points_lie_on_the_surface():
-    k = Knot(KnotParams(1.5, 10.0, 1.3, 35.0, 0.5, 0.6, 9.0, 0.3, 0.6), theta_mean_rad=2.0)
+    k = Knot(KnotShape(1.5, 10.0, 1.3, 35.0, 0.5, 0.6, 9.0, 0.3, 0.6), theta_mean_rad=2.0)
     pts = k.surface_points(np.linspace(5, 120, 20), 16)
     slr, _ = to_slr(pts, 2.0)
     assert np.abs(k.surface_residuals(slr)).max() < 1e-4
     # points on a bigger ellipse are outside by the difference in radius along the ray
-    k2 = Knot(KnotParams(1.5, 10.0, 1.3, 35.0, 0.5, 0.6, 9.0 * 1.1, 0.3, 0.6), theta_mean_rad=2.0)
+    k2 = Knot(KnotShape(1.5, 10.0, 1.3, 35.0, 0.5, 0.6, 9.0 * 1.1, 0.3, 0.6), theta_mean_rad=2.0)
     assert np.all(k.surface_residuals(to_slr(k2.surface_points(np.linspace(60, 120, 5), 16), 2.0)[0]) > 0)
 
 
@@ -82,8 +90,8 @@ def test_to_slr_uses_the_circular_mean_across_the_seam():
 
 def test_invalid_parameters_are_refused():
     with pytest.raises(WoodcamError, match="phi0 is an incline ratio"):
-        KnotParams(0, 0, 1, 10, 1.5, 0.5, 3, 0.5, 0.5)
+        KnotShape(0, 0, 1, 10, 1.5, 0.5, 3, 0.5, 0.5)
     with pytest.raises(WoodcamError, match="rho_max_mm must be a finite number > 0"):
-        KnotParams(0, 0, 1, -10, 0.5, 0.5, 3, 0.5, 0.5)
+        KnotShape(0, 0, 1, -10, 0.5, 0.5, 3, 0.5, 0.5)
     with pytest.raises(WoodcamError, match="must have 9 entries"):
-        KnotParams.from_array([1, 2, 3])
+        KnotShape.from_array([1, 2, 3])

@@ -33,7 +33,7 @@ PAGE_BUDGET_BYTES = 3 * 2**20
 _CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--use-angle=swiftshader",
                    "--enable-unsafe-swiftshader", "--disable-background-networking",
                    "--disable-component-update", "--disable-sync", "--no-first-run",
-                   "--virtual-time-budget=20000"]
+                   "--virtual-time-budget=60000"]
 
 
 def _chromium() -> str:

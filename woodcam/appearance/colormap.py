@@ -21,11 +21,13 @@ from typing import Literal
 import numba
 import numpy as np
 
+from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, grain_direction
 from ..frames import FACE_AXIS, face_pixel_points
 from .knots import KnotShading
 from .noise import TABLE, noise_at
+from .orientation import eq10_weights
 
 #: Number of ARF bins of a fitted colour ramp.
 LUT_BINS = 32
@@ -141,7 +143,7 @@ class ColorMapAppearance:
 
     # -- the ramp -------------------------------------------------------------------------------
 
-    def ramp(self, arf_values) -> np.ndarray:
+    def ramp(self, arf_values: ArrayLike) -> np.ndarray:
         """Species colour at ARF values ``(n,)`` -> ``(n, 3)`` float32 (side grain, no noise)."""
         s = self.species
         t = _smoothstep(s.latewood_start, 1.0, np.asarray(arf_values, np.float32))[:, None]
@@ -151,11 +153,11 @@ class ColorMapAppearance:
 
     # -- per-axis colourings ----------------------------------------------------------------------
 
-    def axis_colors(self, field, points_mm) -> np.ndarray:
+    def axis_colors(self, field: GrowthFieldLike, points_mm: ArrayLike) -> np.ndarray:
         """The three per-axis colourings of eq. 10, shape ``(3, n, 3)``: normals X, Y, Z."""
         return self._shade(field, points_mm, None)
 
-    def color(self, field, points_mm, normals) -> np.ndarray:
+    def color(self, field: GrowthFieldLike, points_mm: ArrayLike, normals: ArrayLike) -> np.ndarray:
         """Colour ``(n, 3)`` in [0, 1] of surfaces at ``points_mm`` with unit ``normals``.
 
         The three per-axis colourings blended by eq. 10 (:func:`blend_axis_colors`), computed
@@ -314,7 +316,8 @@ def _field_sample(field, points_mm):
 @numba.njit(nogil=True, fastmath=True, cache=True)
 def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, luts, lut_ok,
                   seed, table, blend, out):  # pragma: no cover - compiled
-    """Per point: ramp, pores and streaks, end grain per axis, knots, and eq. 10 (``blend``).
+    """Per point: ramp, pores and streaks, end grain per axis, knots, and eq. 10 (``blend``, by
+    :func:`~woodcam.appearance.orientation.eq10_weights`, the one implementation).
 
     One compiled pass instead of ~40 numpy array operations with their temporaries, which
     made colour lookup memory-bound. Writes the blend to ``out[0] (n, 3)`` when ``blend``,
@@ -352,12 +355,7 @@ def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, lu
         i0 = min(int(tl), nb - 2)
         fl = tl - i0
         if blend:
-            nx, ny, nz = abs(normals[i, 0]), abs(normals[i, 1]), abs(normals[i, 2])
-            ns = nx + ny + nz
-            if ns > 0:
-                w0, w1, w2 = nx / ns, ny / ns, nz / ns
-            else:
-                w0 = w1 = w2 = 1.0 / 3.0
+            w0, w1, w2 = eq10_weights(normals[i, 0], normals[i, 1], normals[i, 2])
             out[0, i, 0] = 0.0
             out[0, i, 1] = 0.0
             out[0, i, 2] = 0.0

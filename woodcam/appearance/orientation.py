@@ -7,13 +7,34 @@ frame. A surface with normal ``n`` gets
     RGB = (|n_z| RGB_XY + |n_x| RGB_YZ + |n_y| RGB_ZX) / (|n_x| + |n_y| + |n_z|)   (eq. 10)
 
 so an axis-aligned surface shows exactly one colouring.
+
+:func:`eq10_weights` is the one implementation of the weights: :func:`axis_weights` (and so
+:func:`blend_axis_colors`) and the colour map's compiled kernel both call it.
 """
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from ..errors import WoodcamError
+
+
+@numba.njit(cache=True, inline="always")
+def eq10_weights(nx, ny, nz):  # pragma: no cover - compiled
+    """Eq. 10 weights ``(w_x, w_y, w_z)`` of one normal: ``|n_k| / sum |n|``; equal thirds for a
+    zero normal (a degenerate triangle) rather than a division by zero."""
+    ax, ay, az = abs(nx), abs(ny), abs(nz)
+    s = ax + ay + az
+    if s > 0:
+        return ax / s, ay / s, az / s
+    return 1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0
+
+
+@numba.njit(nogil=True, cache=True)
+def _weights_kernel(n, out):  # pragma: no cover - compiled
+    for i in range(n.shape[0]):
+        out[i, 0], out[i, 1], out[i, 2] = eq10_weights(n[i, 0], n[i, 1], n[i, 2])
 
 
 def axis_weights(normals) -> np.ndarray:
@@ -23,11 +44,12 @@ def axis_weights(normals) -> np.ndarray:
     (column 0 = ``RGB_YZ``, 1 = ``RGB_ZX``, 2 = ``RGB_XY``); rows sum to 1. A zero normal
     (degenerate triangle) gets equal weights rather than a division by zero.
     """
-    n = np.abs(np.asarray(normals, dtype=np.float32))
+    n = np.ascontiguousarray(normals, dtype=np.float32)
     if n.ndim != 2 or n.shape[1] != 3:
         raise WoodcamError(f"normals must have shape (n, 3); got {n.shape}")
-    s = n.sum(axis=1, keepdims=True)
-    return np.where(s > 0, n / np.where(s > 0, s, 1), np.float32(1.0 / 3.0))
+    out = np.empty(n.shape, np.float32)
+    _weights_kernel(n, out)
+    return out
 
 
 def blend_axis_colors(rgb_yz, rgb_zx, rgb_xy, normals) -> np.ndarray:

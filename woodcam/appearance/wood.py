@@ -7,8 +7,9 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from .._types import AppearanceLike, ArrayLike, GrowthFieldLike, WoodLike
 from ..errors import WoodcamError
-from ..fields.base import arf, check_points, evaluate
+from ..fields.base import arf, check_points, evaluate, grain_direction
 from ..tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS
 from .colormap import ColorMapAppearance
 
@@ -34,7 +35,7 @@ class Wood:
     before the field and the appearance see them.
     """
 
-    def __init__(self, field, appearance=None, *, threads: int | None = None):
+    def __init__(self, field: GrowthFieldLike, appearance: AppearanceLike | None = None, *, threads: int | None = None):
         if not callable(field):
             raise WoodcamError(f"field must be callable as field(points_mm) -> years; got {type(field).__name__}")
         self.field = field
@@ -43,7 +44,7 @@ class Wood:
         #: (R (3, 3), t (3,)) with source point = R^T (p - t), or None (this block's own frame)
         self._turn: tuple[np.ndarray, np.ndarray] | None = None
 
-    def turned(self, axis: str, quarter_turns: int, size_mm) -> tuple["Wood", tuple]:
+    def turned(self, axis: str, quarter_turns: int, size_mm: ArrayLike) -> tuple["Wood", tuple]:
         """The same wood with the block turned ``quarter_turns`` x 90 degrees about the block
         axis ``axis`` (``"x"``, ``"y"`` or ``"z"``, right hand rule), e.g. to run the grain along
         another axis under a part that stays put.
@@ -95,16 +96,40 @@ class Wood:
         n = None if normals is None else (normals @ rot).astype(normals.dtype, copy=False)
         return p, n
 
-    def years(self, points_mm) -> np.ndarray:
+    def features(self, points_mm: ArrayLike) -> dict:
+        """What a woodworker asks of the wood at ``points_mm (n, 3)`` (block frame, mm).
+
+        Returns
+        -------
+        dict
+            ``years (n,)`` growth time; ``knot (n,)`` in [0, 1], 1 inside a knot (0 for
+            knot-free fields); ``grain (n, 3)`` unit fibre direction, block frame.
+        """
+        p, _ = self._to_source(check_points(points_mm))
+        fn = getattr(self.field, "evaluate", None)
+        if callable(fn):
+            res = fn(p, directions=True)
+            years = np.asarray(res["years"], dtype=float)
+            knot = np.asarray(res.get("knot", np.zeros(len(p))), dtype=float)
+            grain = np.asarray(res["direction"], dtype=float)
+        else:
+            years = evaluate(self.field, p)
+            knot = np.zeros(len(p))
+            grain = np.asarray(grain_direction(self.field, p), dtype=float)
+        if self._turn is not None:
+            grain = grain @ self._turn[0].T  # back into this (turned) block's frame
+        return {"years": years, "knot": knot, "grain": grain}
+
+    def years(self, points_mm: ArrayLike) -> np.ndarray:
         """Growth time ``(n,)`` in years at ``points_mm : (n, 3)``."""
         p, _ = self._to_source(check_points(points_mm))
         return evaluate(self.field, p)
 
-    def arf(self, points_mm) -> np.ndarray:
+    def arf(self, points_mm: ArrayLike) -> np.ndarray:
         """Annual-ring field ``(n,)`` in [0, 1) at ``points_mm`` (eq. 6 of seed 000)."""
         return arf(self.years(points_mm))
 
-    def color(self, points_mm, normals) -> np.ndarray:
+    def color(self, points_mm: ArrayLike, normals: ArrayLike) -> np.ndarray:
         """Surface colour ``rgb : (n, 3)`` float32 in [0, 1].
 
         Parameters
@@ -156,7 +181,7 @@ def check_rgb(rgb, n: int, who: str = "wood.color") -> np.ndarray:
     return np.clip(out, 0.0, 1.0)
 
 
-def wood_colors(wood, points_mm, normals) -> np.ndarray:
+def wood_colors(wood: WoodLike, points_mm: ArrayLike, normals: ArrayLike) -> np.ndarray:
     """``wood.color(points_mm (n, 3), normals (n, 3)) -> rgb (n, 3)`` float32 in [0, 1], checked.
 
     What every consumer of the seam calls (bake, view, export): a :class:`Wood` checks and

@@ -51,6 +51,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._types import ArrayLike, PathLike
 from .._atomic import atomic_path, write_text
 from ..errors import WoodcamError
 from ..fields.state import field_from_state, field_type, jsonable
@@ -70,7 +71,7 @@ MOKUME_DEFAULT_SIZE_MM = (50.0, 50.0, 50.0)
 
 # -- woodcam manifest folders --------------------------------------------------------------------
 
-def write_block(block: Block, folder, *, ring_map_bits: Literal[8, 16] = 16,
+def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16] = 16,
                 overwrite: bool = True) -> Path:
     """Write ``block`` to ``folder`` as ``block.json`` plus PNG images (see module docstring).
 
@@ -131,7 +132,7 @@ def write_block(block: Block, folder, *, ring_map_bits: Literal[8, 16] = 16,
     return manifest_path
 
 
-def read_block(folder, *, allow_outside: bool | None = None) -> Block:
+def read_block(folder: PathLike, *, allow_outside: bool | None = None) -> Block:
     """Read a block folder written by :func:`write_block` (or made by hand for a real block).
 
     Faces missing from the manifest are absent from the block; ``true_field`` is None unless the
@@ -346,7 +347,7 @@ def _check_shape(a: np.ndarray, shape, what: str) -> None:
 
 # -- Mokume sample folders -----------------------------------------------------------------------
 
-def read_block_folder(folder, size_mm: tuple[float, float, float] | None = None) -> Block:
+def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | None = None) -> Block:
     """Read a block folder of either kind: the one rule every reader of a folder uses.
 
     A folder with a ``block.json`` manifest (or the manifest's own path) is read by
@@ -370,7 +371,7 @@ def read_block_folder(folder, size_mm: tuple[float, float, float] | None = None)
     return read_mokume(folder, MOKUME_DEFAULT_SIZE_MM if size_mm is None else tuple(size_mm))
 
 
-def read_mokume(folder, size_mm=MOKUME_DEFAULT_SIZE_MM, *, name: str | None = None) -> Block:
+def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *, name: str | None = None) -> Block:
     """Read one Mokume sample folder (``X_col.png``, ``X_arl-unet.png``, ... for X = A..F).
 
     Parameters

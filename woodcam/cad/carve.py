@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from .._types import ArrayLike
 from ..errors import WoodcamError, WoodcamWarning
 from ..frames import check_size
 from ..tolerances import OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG, TESSELLATION_TOL_MM
@@ -59,7 +60,7 @@ class CarveResult:
 
 def carve(
     part: Any,
-    size_mm,
+    size_mm: ArrayLike,
     *,
     tolerance_mm: float = TESSELLATION_TOL_MM,
     angular_tolerance_deg: float = TESSELLATION_ANGLE_DEG,

@@ -58,7 +58,7 @@ def load_part(
     angular_tolerance_deg: float = TESSELLATION_ANGLE_DEG,
     max_triangles: int | None = MAX_PART_TRIANGLES,
     report: dict | None = None,
-):
+) -> Any:
     """Turn a part source into one watertight manifold in the block frame (mm).
 
     Parameters

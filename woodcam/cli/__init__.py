@@ -1,4 +1,5 @@
-"""The ``woodcam`` command: parses, calls the API, prints. Errors become one line and exit 2.
+"""The ``woodcam`` command: parses, calls the API, prints. Errors become one line and exit 1
+(usage errors 2, failed checks 3; see :data:`EXIT_ERROR` and the others).
 
 A package with one module per command group. Each module in :data:`COMMANDS` defines
 ``register(subparsers)``, which adds its sub-parser(s) and sets ``func`` on each to the function
@@ -26,12 +27,15 @@ COMMANDS: tuple[str, ...] = (
     "woodcam.cli.bake",          # demo, bake, preview, blocks
     "woodcam.cli.gcode",         # gcode
     "woodcam.cli.review",        # review
+    "woodcam.cli.place",         # place
+    "woodcam.cli.cache",         # cache info | clear
     "woodcam.cli.block",         # block synth | show
     "woodcam.cli.log",           # log render | maps | export
     "woodcam.cli.fit",           # fit, eval rings
     "woodcam.cli.eval_bench",    # eval realistic
     "woodcam.cli.appearance",    # eval appearance
     "woodcam.cli.train",         # train gtf
+    "woodcam.cli.woodify",       # woodify
 )
 
 #: Old spellings kept working: argv prefix -> its current form.
@@ -42,8 +46,9 @@ ALIASES: dict[tuple[str, ...], tuple[str, ...]] = {
 DEFAULT_SUBCOMMAND: dict[str, str] = {"eval": "rings"}
 
 _EPILOG = """\
-Block specs: 'builtin:NAME' (see 'woodcam blocks'), 'log:gran1@K[:WxDxH]', a block folder with a
-block.json, or a Mokume sample folder (six photos and ring maps of a 50 mm cube).
+Block specs: 'builtin:NAME' (see 'woodcam blocks'), 'log:gran1@K[:WxDxH]', 'woodify:DIR/field.npz'
+(a block cut from a grown object, see 'woodcam woodify'), a block folder with a block.json, or a
+Mokume sample folder (six photos and ring maps of a 50 mm cube).
 Units are millimetres; the block frame has its origin at the bottom-front-left corner,
 X to the right (width), Y away from the viewer (depth), Z up (height).
 
@@ -55,7 +60,15 @@ examples:
       --out out/vcarve_text.glb --screenshot
   woodcam eval rings out/blocks/block_0000 --out out/eval
   woodcam eval appearance builtin:knotty --out out/eval_appearance
+  woodcam woodify trunk.stl --years 40 --eccentricity 0.3 --obstacle post.stl --out out/tree
+
+exit status: 0 done; 1 the work failed (a one-line 'woodcam: error: ...' says why); 2 the
+command line is wrong (usage); 3 the work was done but a check failed (e.g. gcode --strict);
+130 interrupted.
 """
+
+#: Exit statuses (documented in ``woodcam --help`` and the README).
+EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_CHECKS, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -64,6 +77,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="woodcam", description="CNC cut preview for solid wood: carve a part out of a "
         "block whose growth rings are known and see the wood on every surface.",
         epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    from .. import __version__
+
+    parser.add_argument("--version", action="version", version=f"woodcam {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMANDS:
@@ -74,7 +90,37 @@ def build_parser() -> argparse.ArgumentParser:
                             "woodcam/cli/__init__.py")
         register(sub)
     parser.set_defaults(_commands=sub)
+    _state_defaults(parser)
     return parser
+
+
+def _walk_options(parser: argparse.ArgumentParser):
+    """Every (command path, optional action) of ``parser`` and its sub-commands."""
+    stack: list[tuple[list[str], argparse.ArgumentParser]] = [([], parser)]
+    while stack:
+        path, p = stack.pop()
+        for action in p._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                stack += [([*path, name], sp) for name, sp in action.choices.items()]
+            elif action.option_strings and not isinstance(
+                    action, (argparse._HelpAction, argparse._VersionAction)):
+                yield path, action
+
+
+def _state_defaults(parser: argparse.ArgumentParser) -> None:
+    """Every option's help ends with its default, so no command leaves a user guessing: the
+    help text's own wording when it names one, else the value argparse would use."""
+    for _path, action in _walk_options(parser):
+        text = action.help or ""
+        if action.required or "default" in text.lower() or text == argparse.SUPPRESS:
+            continue
+        if isinstance(action, (argparse._StoreTrueAction, argparse._StoreFalseAction,
+                               argparse._StoreConstAction, argparse._CountAction)):
+            continue  # a switch: off unless given
+        default = action.default
+        shown = ("not set" if default is None or default == [] else
+                 ",".join(map(str, default)) if isinstance(default, (list, tuple)) else str(default))
+        action.help = f"{text} (default: {shown})".strip()
 
 
 def _apply_aliases(argv: list[str], parser: argparse.ArgumentParser) -> list[str]:
@@ -110,10 +156,10 @@ def main(argv: list[str] | None = None) -> int:
             rc = args.func(args)
         except WoodcamError as err:
             print(f"woodcam: error: {err}", file=sys.stderr)
-            return 2
+            return EXIT_ERROR
         except KeyboardInterrupt:
             print("woodcam: interrupted", file=sys.stderr)
-            return 130
+            return EXIT_INTERRUPTED
         finally:
             print_warnings(str(w.message) for w in caught if _is_ours(w))
     return rc

@@ -6,7 +6,8 @@ import argparse
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import BLOCK_SPEC_HELP, add_bake_options, stock_options, write_screenshot
+from .options import (BLOCK_SPEC_HELP, add_bake_options, allow_negative_values, stock_options,
+                      vector_mm, write_screenshot)
 
 
 def register(subparsers) -> None:
@@ -49,6 +50,16 @@ def register(subparsers) -> None:
                    help="render to this PNG instead of opening a window")
     p.add_argument("--block", default=None,
                    help="block spec for the cut plane (default: the one stored in the GLB)")
+    p.add_argument("--camera", choices=("iso", "front", "back", "left", "right", "top", "bottom"),
+                   default="iso", help="view direction (default iso: from front-right-above)")
+    p.add_argument("--no-cut", action="store_true",
+                   help="no cut plane: the part alone in its translucent block")
+    p.add_argument("--cut-origin", type=vector_mm, default=None, metavar="X,Y,Z",
+                   help="a point of the cut plane, block frame mm (default the block centre)")
+    p.add_argument("--cut-normal", type=vector_mm, default=None, metavar="X,Y,Z",
+                   help="the cut plane's normal, towards the side cut away (default: the block's "
+                   "longest axis facing the camera)")
+    allow_negative_values(p)
     p.add_argument("--confidence", action="store_true",
                    help="colour the part by the fit's per-point confidence (red 0, yellow 0.5, green "
                    "1; spread of the accepted hypotheses and distance from observed faces) "
@@ -87,14 +98,22 @@ def run_bake(args: argparse.Namespace) -> int:
                  " deg)" if tess.get("tolerance_mm") and tess.get("triangles") else "")
     print(f"{res.name}: {res.triangles} triangles{mesh_note}, {res.volume_mm3:.0f} mm^3, "
           f"{res.atlas}; wrote " + ", ".join(map(str, res.files.values())))
+    if res.report:
+        from ..advise import report_text
+
+        print(report_text(res.report, res.name))
     return 0
 
 
 def run_preview(args: argparse.Namespace) -> int:
-    from ..export import read_glb_metadata
-    from ..stock import open_stock
     from ..view import preview
+    from .options import stock_of_glb
 
+    stock = stock_of_glb(args.mesh, args.block)
+    out = preview(args.mesh, wood=stock.wood if stock else None,
+                  size_mm=stock.size_mm if stock else None, screenshot=args.screenshot,
+                  camera=args.camera, cut_plane=not args.no_cut, cut_origin=args.cut_origin,
+                  cut_normal=args.cut_normal)
     spec = args.block
     if spec is None and args.mesh.suffix.lower() == ".glb":
         spec = read_glb_metadata(args.mesh).get("block")

@@ -31,15 +31,16 @@ def register(subparsers) -> None:
     source(r)
     r.add_argument("--out", required=True, help="output folder")
     r.add_argument("--ring-width", type=float, default=2.0, help="mm per year (default 2)")
-    r.add_argument("--px-per-mm", type=float, default=2.0, help="resolution (default 2)")
+    r.add_argument("--px-per-mm", type=float, default=2.0, help="resolution in pixels per mm (default 2)")
     r.add_argument("--supersample", type=int, default=2,
                    help="samples per pixel side, averaged (default 2; knot rings alias)")
     r.add_argument("--board", nargs=3, type=float, metavar=("Z_MM", "AZIMUTH_DEG", "OFFSET_MM"),
                    help="tangential board centre height, facing azimuth and distance from "
                         "the pith (default: the board through the most knots at 60 mm)")
-    r.add_argument("--disc", type=float, metavar="Z_MM", help="end-grain disc height")
+    r.add_argument("--disc", type=float, metavar="Z_MM", help="also an end-grain disc at this height along the log, mm")
     r.add_argument("--radial", nargs=2, type=float, metavar=("Z_MM", "AZIMUTH_DEG"),
-                   help="also a quarter-sawn section through the pith (knots as spikes)")
+                   help="also a quarter-sawn section through the pith at height Z_MM (mm) and azimuth "
+                   "AZIMUTH_DEG (degrees); knots show as spikes")
     r.add_argument("--k-stem", type=float, default=1.5, help="smoothness k outside knots")
     r.add_argument("--k-knot", type=float, default=5.0, help="smoothness k inside knots")
     add_knot_options(r)
@@ -62,8 +63,8 @@ def register(subparsers) -> None:
 
 
 def _load(args):
-    from ..fields.knot_maps import read_maps
-    from ..fields.tree_data import read_gran1, read_log
+    from ..logs.io import read_gran1, read_log
+    from ..logs.maps import read_maps
 
     given = [x for x in (args.log_file, args.real or None, args.maps) if x]
     if len(given) != 1:
@@ -83,12 +84,12 @@ def run(args) -> int:
     log = _load(args)
     out = Path(args.out)
     if args.log_command == "export":
-        from ..fields.tree_data import write_log
+        from ..logs.io import write_log
 
         print(write_log(log, out))
         return 0
     if args.log_command == "maps":
-        from ..fields.knot_maps import write_maps
+        from ..logs.maps import write_maps
 
         for path in write_maps(log, out).values():
             print(path)

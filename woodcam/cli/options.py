@@ -13,11 +13,13 @@ Nothing heavy is imported at module level (``woodcam --help`` loads this module)
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 from ..errors import WoodcamError
 
-BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], a block folder "
+BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], woodify:DIR/field.npz "
+                   "(a block cut from a grown object), a block folder "
                    "(block.json) or a Mokume sample folder (a 50 mm cube unless --size-mm); "
                    "append ~x90/~y90/~z90 to turn the block under the part")
 
@@ -53,6 +55,28 @@ def open_block(spec, size_mm: float | None = None, face_px: int = 256):
     from ..stock import open_block as _open_block
 
     return _open_block(str(spec), size_mm=size_mm, face_px=face_px)
+
+
+#: A value that looks like numbers ("-14,5,3", "-1e3") is a value, not an option.
+_NEGATIVE_VALUES = re.compile(r"^-[\d.][\d.,eE+-]*$")
+
+
+def allow_negative_values(p: argparse.ArgumentParser) -> None:
+    """Let options of ``p`` take values such as ``-14,5,3`` (argparse takes them for options)."""
+    p._negative_number_matcher = _NEGATIVE_VALUES
+
+
+def vector_mm(text: str) -> tuple[float, float, float]:
+    """``"X,Y,Z"`` -> three finite floats (argparse ``type``)."""
+    import math
+
+    try:
+        vals = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        vals = ()
+    if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
+        raise argparse.ArgumentTypeError(f"expected three finite numbers X,Y,Z; got {text!r}")
+    return vals  # type: ignore[return-value]
 
 
 def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None = 10.0,
@@ -158,3 +182,36 @@ def write_screenshot(args, files: dict, stock) -> None:
     png = out.with_name(out.stem + "_view.png") if args.screenshot is True else Path(args.screenshot)
     preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
     files["png"] = png
+
+
+def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None):
+    """The stock a baked GLB was cut from, as its metadata records it (absolute block spec,
+    content digest, species, appearance and its parameters), or ``block`` when given.
+
+    Returns None for a file that records no block and no ``block`` given (``preview`` then shows
+    the part alone). A recorded block that no longer exists, or whose content changed since the
+    bake, is named in an error or a warning."""
+    import warnings
+
+    from ..errors import WoodcamError, WoodcamWarning
+    from ..export import read_glb_metadata
+    from ..stock import open_stock, spec_digest
+
+    meta = read_glb_metadata(glb) if glb.suffix.lower() == ".glb" and glb.is_file() else {}
+    app = meta.get("appearance") if isinstance(meta.get("appearance"), dict) else {}
+    kwargs = {"species": species or app.get("species"),
+              "appearance": app.get("kind") or "colormap", **(app.get("params") or {})}
+    if block:
+        return open_stock(block, **{**kwargs, "species": species or kwargs["species"]})
+    spec = meta.get("block")
+    if not spec:
+        return None
+    base = str(spec).partition("~")[0]
+    if not base.startswith(("builtin:", "log:")) and not Path(base).exists():
+        raise WoodcamError(
+            f"{str(glb)!r} was baked from the block folder {base!r}, which is not there any more; "
+            "pass --block SPEC (the same block, moved) to rebuild its wood")
+    if meta.get("block_digest") and spec_digest(spec) != meta["block_digest"]:
+        warnings.warn(f"the block {spec!r} changed since {glb.name} was baked (its files differ); "
+                      "the wood shown is today's", WoodcamWarning, stacklevel=2)
+    return open_stock(spec, **kwargs)

@@ -31,19 +31,23 @@ def run_review(args: argparse.Namespace) -> int:
     from ..errors import WoodcamError
     from ..export import read_glb_metadata
     from ..review import VOLUME_VOXELS, write_review
-    from ..stock import open_stock
+    from .options import stock_of_glb
 
     meta = read_glb_metadata(args.part) if args.part.is_file() else {}
-    spec = args.block or meta.get("block")
-    if not spec:
+    stock = stock_of_glb(args.part, args.block)
+    if stock is None:
         raise WoodcamError(f"review: {str(args.part)!r} records no block spec; pass --block SPEC")
-    stock = open_stock(spec)
+    spec = stock.spec
     report = {"block spec": spec, "species": stock.meta.get("species", "")}
     for key in ("texels_per_mm", "gcode", "placement"):
         if key in meta:
             report[key] = meta[key]
-    hotspots = [{"kind": "gcode", "label": str(w.get("message", "")), "at_mm": w["at_mm"]}
-                for w in meta.get("warnings", []) if isinstance(w, dict) and "at_mm" in w]
+    from ..advise import knot_spots
+    from ..export import load_textured
+
+    hotspots = knot_spots(load_textured(args.part), stock.wood)
+    hotspots += [{"kind": "gcode", "label": str(w.get("message", "")), "at_mm": w["at_mm"]}
+                 for w in meta.get("warnings", []) if isinstance(w, dict) and "at_mm" in w]
     photos = None
     if Path(spec).is_dir():  # a block or Mokume folder: show its face photos
         from ..stock import open_block

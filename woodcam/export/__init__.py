@@ -27,6 +27,8 @@ back without trimesh by parsing the GLB's JSON chunk.
 
 from __future__ import annotations
 
+from .._types import Mesh, PathLike
+
 import copy
 import json
 import math
@@ -66,7 +68,7 @@ def _require_textured(mesh, func: str):
         )
 
 
-def crease_normals(mesh, crease_angle_deg: float | None = None):
+def crease_normals(mesh: Mesh, crease_angle_deg: float | None = None) -> Mesh:
     """Split ``mesh``'s vertices where faces meet at an edge sharper than the crease angle and
     give every vertex a smooth shading normal.
 
@@ -156,7 +158,7 @@ def crease_normals(mesh, crease_angle_deg: float | None = None):
     return out
 
 
-def export_glb(mesh, path, metadata: dict | None = None, *,
+def export_glb(mesh: Mesh, path: PathLike, metadata: dict | None = None, *,
                crease_angle_deg: float | None = None) -> Path:
     """Write ``mesh`` as a binary glTF (metres, Y up) with its texture embedded.
 
@@ -232,9 +234,9 @@ def _set_buffer_view_targets(tree: dict) -> None:
                     views[view]["target"] = target
 
 
-def export_obj(mesh, path, *, units: ObjUnits = "m", up: ObjUp = "y",
+def export_obj(mesh: Mesh, path: PathLike, *, units: ObjUnits = "m", up: ObjUp = "y",
                crease_angle_deg: float | None = None) -> Path:
-    """Write ``mesh`` as ``NAME.obj`` + ``NAME.mtl`` + ``NAME.png`` side by side.
+    """Write ``mesh`` as ``NAME.obj`` + ``NAME.mtl`` + ``NAME_texture.png`` side by side.
 
     Parameters
     ----------
@@ -277,7 +279,9 @@ def export_obj(mesh, path, *, units: ObjUnits = "m", up: ObjUp = "y",
     if hasattr(material, "to_simple"):
         material = material.to_simple()
     material = copy.copy(material)
-    material.name = stem
+    # NAME_texture.png, not NAME.png: a screenshot named after the part must never overwrite
+    # the texture (issue 17: 'woodcam preview bowl.glb --screenshot bowl.png' did)
+    material.name = f"{stem}_texture"
     # Viewers multiply map_Kd by Kd: white keeps the baked colours as baked. Wood is matte.
     material.diffuse = np.array([255, 255, 255, 255], dtype=np.uint8)
     material.ambient = np.array([255, 255, 255, 255], dtype=np.uint8)
@@ -301,7 +305,7 @@ def export_obj(mesh, path, *, units: ObjUnits = "m", up: ObjUp = "y",
     return path
 
 
-def load_textured(path):
+def load_textured(path: PathLike) -> Mesh:
     """Load a GLB or OBJ written by this module as ONE textured ``trimesh.Trimesh`` in the block
     frame (mm, Z up): the GLB root transform and the OBJ's recorded units/up axis are undone.
     Other files come back as their node transforms place them.
@@ -347,7 +351,7 @@ def load_textured(path):
     return loaded
 
 
-def written_by_woodcam(path) -> bool:
+def written_by_woodcam(path: PathLike) -> bool:
     """True for a GLB or OBJ written by :func:`export_glb` / :func:`export_obj` (then
     :func:`load_textured` returns it in the block frame); False for any other file."""
     path = Path(path)
@@ -362,7 +366,7 @@ def written_by_woodcam(path) -> bool:
     return False
 
 
-def read_glb_metadata(path) -> dict:
+def read_glb_metadata(path: PathLike) -> dict:
     """Return the ``woodcam`` metadata stored by :func:`export_glb` (``{}`` if none).
 
     Parses the GLB header and JSON chunk directly (glTF 2.0 spec, "GLB File Format").

@@ -18,6 +18,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..tolerances import MAX_BATCH_POINTS
 
@@ -37,7 +38,7 @@ def check_points(points_mm, name: str = "points_mm") -> np.ndarray:
     return p
 
 
-def evaluate(field, points_mm, batch: int = MAX_BATCH_POINTS) -> np.ndarray:
+def evaluate(field: GrowthFieldLike, points_mm: ArrayLike, batch: int = MAX_BATCH_POINTS) -> np.ndarray:
     """Evaluate ``field`` on ``(n, 3)`` points in bounded batches; returns ``years : (n,)``."""
     p = check_points(points_mm)
     if len(p) <= batch:
@@ -48,7 +49,7 @@ def evaluate(field, points_mm, batch: int = MAX_BATCH_POINTS) -> np.ndarray:
     return out
 
 
-def arf(years) -> np.ndarray:
+def arf(years: ArrayLike) -> np.ndarray:
     """Annual-ring field from growth time: ``(years mod 1)^2`` (eq. 6 of seed 000).
 
     Always apply it to a (possibly interpolated) growth time, never interpolate its output:
@@ -58,7 +59,7 @@ def arf(years) -> np.ndarray:
     return np.mod(g, 1.0) ** 2
 
 
-def grain_direction(field, points_mm) -> np.ndarray:
+def grain_direction(field: GrowthFieldLike, points_mm: ArrayLike) -> np.ndarray:
     """Unit fibre directions ``(n, 3)`` of ``field`` at ``points_mm`` (see module docstring)."""
     p = check_points(points_mm)
     fn = getattr(field, "grain_direction", None)
@@ -117,18 +118,18 @@ class LogFrame:
         """(3, 3) matrix whose rows are the log frame's x, y, z axes in the block frame."""
         return self._rot
 
-    def to_log(self, points_mm) -> np.ndarray:
+    def to_log(self, points_mm: ArrayLike) -> np.ndarray:
         """Block-frame points ``(n, 3)`` -> log-frame points ``(n, 3)`` (mm)."""
         p = check_points(points_mm)
         # einsum, not ``@``: OpenBLAS threading makes an (n, 3) x (3, 3) product up to 30x
         # slower on a busy 2-core machine, and this runs for every texel.
         return np.einsum("ij,kj->ik", p - np.asarray(self.pith_point_mm, float), self._rot)
 
-    def to_block(self, points_log_mm) -> np.ndarray:
+    def to_block(self, points_log_mm: ArrayLike) -> np.ndarray:
         """Log-frame points ``(n, 3)`` -> block-frame points ``(n, 3)`` (mm)."""
         p = check_points(points_log_mm, "points_log_mm")
         return np.einsum("ij,jk->ik", p, self._rot) + np.asarray(self.pith_point_mm, float)
 
-    def direction_to_block(self, dirs_log) -> np.ndarray:
+    def direction_to_block(self, dirs_log: ArrayLike) -> np.ndarray:
         """Rotate log-frame direction vectors ``(n, 3)`` into the block frame."""
         return np.einsum("ij,jk->ik", np.asarray(dirs_log, dtype=float), self._rot)

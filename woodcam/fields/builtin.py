@@ -63,12 +63,12 @@ BUILTIN_NAMES: tuple[str, ...] = tuple(_SPECS) + ("knotty",)
 def _knotty_block() -> BuiltinBlock:
     """A 100 x 80 x 50 mm board (Z along the log) through a whorl of a straight synthetic log."""
     from .knots import KnottedLogField, block_at_knot, place_block_in_log
-    from .tree_data import Knot, simple_log
+    from .skeleton import BranchStrand, simple_log
 
     r = np.linspace(0.0, 160.0, 33)
     knots = []
     for i, (az_deg, death_mm) in enumerate([(0.0, 200.0), (28.0, 45.0), (150.0, 200.0), (260.0, 60.0)]):
-        knots.append(Knot(
+        knots.append(BranchStrand(
             z0_mm=300.0 + 6.0 * i, azimuth0_rad=np.radians(az_deg), r_mm=r,
             rise_mm=22.0 * np.sqrt(r / 10.0) * 0.6, twist_rad=0.0 * r,
             diameter_mm=np.minimum(3.0 + 0.16 * r, 24.0), r_end_mm=150.0, r_death_mm=death_mm))

@@ -19,6 +19,7 @@ from typing import Literal
 import numpy as np
 from scipy import ndimage
 
+from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from .base import check_points, evaluate
 
@@ -105,7 +106,7 @@ class GridField:
         axis = tuple(np.asarray(getattr(field, "axis", (0.0, 0.0, 1.0)), float))
         return cls(years, tuple(origin), (spacing_mm,) * 3, interpolation, axis)
 
-    def __call__(self, points_mm) -> np.ndarray:
+    def __call__(self, points_mm: ArrayLike) -> np.ndarray:
         """Interpolated growth time ``years : (n,)`` at ``points_mm : (n, 3)``."""
         p = check_points(points_mm)
         idx = (p - np.asarray(self.origin_mm)) / np.asarray(self.spacing_mm)
@@ -144,7 +145,7 @@ class GridField:
             return knot_features if name == "knot_features" else evaluate
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
-    def save(self, path) -> Path:
+    def save(self, path: PathLike) -> Path:
         """Write the grid to an ``.npz`` file; :meth:`load` restores it exactly."""
         path = Path(path)
         if path.suffix != ".npz":

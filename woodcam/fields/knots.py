@@ -1,10 +1,10 @@
 """Knotted-log growth field: stem and branch strand time fields joined by smooth minima.
 
 Implements the knot model of seed 003 (Wood Knot Editor, after Larsson et al. 2022, "Procedural
-Texturing of Solid Wood with Knots") as a growth-time field over a :class:`~.tree_data.Log`.
+Texturing of Solid Wood with Knots") as a growth-time field over a :class:`~.skeleton.LogSkeleton`.
 
 Frames and units. :class:`KnottedLogField` is evaluated in the LOG frame of
-:mod:`woodcam.fields.tree_data` (mm; ``z`` along the log). Wrap it with :class:`PlacedField`
+:mod:`woodcam.fields.skeleton` (mm; ``z`` along the log). Wrap it with :class:`PlacedField`
 (or :func:`place_block_in_log`) to use it in a block frame. Output is growth time in years,
 0 on the pith, growing outward; ``ring_width_mm`` converts the model's radial "time" to years.
 
@@ -46,9 +46,10 @@ from typing import Literal
 
 import numpy as np
 
+from .._types import ArrayLike
 from ..errors import WoodcamError
 from .base import check_points
-from .tree_data import Log
+from .skeleton import LogSkeleton
 
 Backend = Literal["auto", "numpy", "numba"]
 BACKENDS = ("numpy", "numba")
@@ -233,11 +234,11 @@ class KnottedLogField:
     Calling it: ``field(points_log_mm (n, 3)) -> years (n,)``.
     """
 
-    def __init__(self, log: Log, ring_width_mm: float = 2.0, params: KnotParams | None = None,
-                 *, surface_smoothing=(11, 5), chunk: int | None = None,
+    def __init__(self, log: LogSkeleton, ring_width_mm: float = 2.0, params: KnotParams | None = None,
+                 *, surface_smoothing: tuple[int, int] = (11, 5), chunk: int | None = None,
                  table_samples: int = 128, backend: Backend = "auto"):
-        if not isinstance(log, Log):
-            raise WoodcamError(f"log must be a woodcam.fields.tree_data.Log; got "
+        if not isinstance(log, LogSkeleton):
+            raise WoodcamError(f"log must be a woodcam.fields.skeleton.LogSkeleton; got "
                                f"{type(log).__name__}; read one with read_log or read_gran1")
         if not (ring_width_mm > 0):
             raise WoodcamError(f"ring_width_mm must be > 0 mm/year; got {ring_width_mm}; "
@@ -304,27 +305,27 @@ class KnottedLogField:
 
     # -- public API ----------------------------------------------------------------------------
 
-    def __call__(self, points_mm) -> np.ndarray:
+    def __call__(self, points_mm: ArrayLike) -> np.ndarray:
         """Growth time ``years (n,)`` at log-frame points ``points_mm (n, 3)``."""
         return self.evaluate(points_mm)["years"]
 
-    def stem_years(self, points_mm) -> np.ndarray:
+    def stem_years(self, points_mm: ArrayLike) -> np.ndarray:
         """The stem field alone (no knots): ``years (n,)`` at log-frame points (seed eq. 1)."""
         p = check_points(points_mm)
         _, _, ds, _, sp = self._stem(p)
         return ds / sp / self.ring_width_mm
 
-    def knot_features(self, points_mm) -> dict:
+    def knot_features(self, points_mm: ArrayLike) -> dict:
         """``{"knot", "dead", "outline"}``, each ``(n,)`` in 0..1, at log-frame points."""
         out = self.evaluate(points_mm)
         return {k: out[k] for k in ("knot", "dead", "outline")}
 
-    def grain_direction(self, points_mm) -> np.ndarray:
+    def grain_direction(self, points_mm: ArrayLike) -> np.ndarray:
         """Unit fibre directions ``(n, 3)`` (log frame): the pith tangent outside knots, the
         knot axis inside, blended by the knot weight."""
         return self.evaluate(points_mm, directions=True)["direction"]
 
-    def evaluate(self, points_mm, *, directions: bool = False) -> dict:
+    def evaluate(self, points_mm: ArrayLike, *, directions: bool = False) -> dict:
         """Everything at once for log-frame points ``(n, 3)``.
 
         Returns ``years``, ``knot``, ``dead``, ``outline`` (each ``(n,)``) and, with
@@ -552,7 +553,7 @@ class KnottedLogField:
     def from_dict(cls, d: dict) -> "KnottedLogField":
         # Files written before knot shading moved to appearance/knots.py carry its two settings.
         params = {k: v for k, v in d["params"].items() if k not in _MOVED_TO_SHADING}
-        return cls(Log.from_json(d["log"]), d["ring_width_mm"], KnotParams(**params))
+        return cls(LogSkeleton.from_json(d["log"]), d["ring_width_mm"], KnotParams(**params))
 
 
 #: Former KnotParams settings now in :class:`woodcam.appearance.knots.KnotShading`.

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from .base import LogFrame, check_points, grain_direction
 from .state import field_from_state, field_to_state
@@ -23,7 +24,8 @@ from .state import field_from_state, field_to_state
 class PlacedField:
     """A log-frame growth field in block coordinates (see module docstring)."""
 
-    def __init__(self, log_field, origin_mm=(0.0, 0.0, 0.0), rotation=None):
+    def __init__(self, log_field: GrowthFieldLike, origin_mm: ArrayLike = (0.0, 0.0, 0.0),
+                 rotation: ArrayLike | None = None):
         if not callable(log_field):
             raise WoodcamError(
                 f"log_field must be callable (n, 3) mm -> years; got {type(log_field).__name__}")
@@ -65,17 +67,17 @@ class PlacedField:
         """The log's z axis (the pith direction of a straight log) in the block frame, (3,)."""
         return self.rotation[2].copy()
 
-    def to_log(self, points_mm) -> np.ndarray:
+    def to_log(self, points_mm: ArrayLike) -> np.ndarray:
         """Block-frame points ``(n, 3)`` -> log-frame points ``(n, 3)`` (mm)."""
         return self.frame.to_log(points_mm)
 
     def _to_block_dirs(self, d) -> np.ndarray:
         return self.frame.direction_to_block(d)
 
-    def __call__(self, points_mm) -> np.ndarray:
+    def __call__(self, points_mm: ArrayLike) -> np.ndarray:
         return np.asarray(self.log_field(self.to_log(points_mm)), dtype=float)
 
-    def grain_direction(self, points_mm) -> np.ndarray:
+    def grain_direction(self, points_mm: ArrayLike) -> np.ndarray:
         """Unit fibre directions ``(n, 3)`` in the block frame."""
         p = check_points(points_mm)
         if not callable(getattr(self.log_field, "grain_direction", None)):

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from .._types import ArrayLike
 from ..errors import WoodcamError
 from ..tolerances import MIN_RADIUS_SCALE
 from .base import LogFrame, check_points
@@ -89,7 +90,7 @@ class RadiusFunction:
         vals = np.clip(rng.normal(1.0, sigma, n_constraints), 0.5, 1.5)
         return cls.from_constraints(vals, m)
 
-    def __call__(self, phi) -> np.ndarray:
+    def __call__(self, phi: ArrayLike) -> np.ndarray:
         """Evaluate at angles ``phi`` (radians, any shape)."""
         s = self.samples
         m = len(s)
@@ -137,13 +138,13 @@ class RadialScalingField:
         """Pith direction in the block frame, (3,) unit."""
         return self.frame.rotation[2]
 
-    def radius_scale(self, phi, zeta) -> np.ndarray:
+    def radius_scale(self, phi: ArrayLike, zeta: ArrayLike) -> np.ndarray:
         """``r'(phi, zeta)`` of eq. 9, ``zeta`` clamped to [-1, 1]."""
         w = (np.clip(zeta, -1.0, 1.0) + 1.0) * 0.5
         r = (1.0 - w) * self.r_minus(phi) + w * self.r_plus(phi)
         return np.maximum(r, MIN_RADIUS_SCALE)
 
-    def __call__(self, points_mm) -> np.ndarray:
+    def __call__(self, points_mm: ArrayLike) -> np.ndarray:
         """Growth time ``years : (n,)`` at ``points_mm : (n, 3)`` (block frame, mm)."""
         p = np.ascontiguousarray(check_points(points_mm))
         f = self.frame
@@ -152,7 +153,7 @@ class RadialScalingField:
                               float(self.ring_width_mm), float(self.age_offset_years),
                               MIN_RADIUS_SCALE)
 
-    def grain_direction(self, points_mm) -> np.ndarray:
+    def grain_direction(self, points_mm: ArrayLike) -> np.ndarray:
         """Fibres run along the straight pith: the axis at every point, (n, 3)."""
         return np.broadcast_to(self.axis, check_points(points_mm).shape)
 

@@ -15,15 +15,21 @@ Cut planes are given by a block-frame point and a normal; each is sampled on a s
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 from dataclasses import dataclass, field as dc_field
 
 import numpy as np
 
+from .._types import ArrayLike, GrowthFieldLike, PathLike
 from ..errors import WoodcamError, require
 from ..fields.base import evaluate
 from ..frames import check_size
 from ..tolerances import EVAL_PIXEL_MM, EVAL_THRESHOLDS_MM
 from ..fields.rings import ring_lines as _ring_lines
+
+if TYPE_CHECKING:
+    from ..block import Block
 
 
 @dataclass(frozen=True)
@@ -174,8 +180,9 @@ def summarise(scores: list[PlaneScore], thresholds=EVAL_THRESHOLDS_MM) -> dict:
     return out
 
 
-def evaluate_fit(true_field, fitted_field, size_mm, planes=DEFAULT_PLANES,
-                 pixel_mm: float = EVAL_PIXEL_MM, keep_lines: bool = False):
+def evaluate_fit(true_field: GrowthFieldLike, fitted_field: GrowthFieldLike, size_mm: ArrayLike,
+                 planes: Sequence[CutPlane] = DEFAULT_PLANES, pixel_mm: float = EVAL_PIXEL_MM,
+                 keep_lines: bool = False) -> dict:
     """Table-1 accuracy of ``fitted_field`` against ``true_field`` on ``planes`` of a block.
 
     Returns
@@ -201,8 +208,10 @@ def evaluate_fits(true_field, fitted: dict, size_mm, planes=DEFAULT_PLANES,
     return {name: (summarise(sc), sc) for name, sc in out.items()}
 
 
-def benchmark(blocks, methods=("rbf", "radial"), face_sets=None, out_dir=None,
-              planes=DEFAULT_PLANES, pixel_mm: float = EVAL_PIXEL_MM, progress=None) -> dict:
+def benchmark(blocks: Sequence[Block], methods: Sequence[str] = ("rbf", "radial"),
+              face_sets: dict[str, Sequence[str] | None] | None = None, out_dir: PathLike | None = None,
+              planes: Sequence[CutPlane] = DEFAULT_PLANES, pixel_mm: float = EVAL_PIXEL_MM,
+              progress: Callable[[str], object] | None = None) -> dict:
     """Fit every block with every method and face set, score them on the cut planes.
 
     Parameters

@@ -2,15 +2,20 @@
 
 from __future__ import annotations
 
-from typing import Literal, get_args
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Literal, get_args
 
 import numpy as np
 
+from .._types import GrowthFieldLike
 from ..errors import WoodcamError
 from .baked import bake
 from .observations import gather_observations
 from .radial import fit_radial, number_observations
 from .rbf import fit_rbf
+
+if TYPE_CHECKING:
+    from ..block import Block
 
 Method = Literal["evidence", "rbf", "radial", "neural"]
 METHODS: tuple[str, ...] = get_args(Method)
@@ -21,7 +26,8 @@ METHODS: tuple[str, ...] = get_args(Method)
 FIT_VERSION = 4
 
 
-def fit_block(block, method: Method = "evidence", faces=None, baked: bool = True):
+def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
+              baked: bool = True) -> GrowthFieldLike:
     """Infer a block's growth field from the rings on its faces.
 
     Parameters

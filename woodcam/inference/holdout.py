@@ -19,12 +19,15 @@ own noise allows, and the held-out predictions moved by half a ring give the cha
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from .._types import PathLike
 from ..errors import WoodcamError, require
 from ..fields.base import arf
 from ..fields.rings import ring_lines
@@ -32,6 +35,9 @@ from ..frames import face_pixel_points
 from ..tolerances import HOLDOUT_LINE_STEP_PX, HOLDOUT_THRESHOLDS_PX, RING_MAP_THRESHOLD
 from .fit import fit_block
 from .observations import _pixel_index, knot_exclusion
+
+if TYPE_CHECKING:
+    from ..block import Block
 
 #: Labels in results: the in-sample fit (all faces), and the chance control: every held-out
 #: prediction moved by half a ring (right spacing and direction, rings where none are).
@@ -152,7 +158,9 @@ def _score(face: str, years: np.ndarray, ridge: np.ndarray, excl, thresholds) ->
     return FaceScore(face, shares, len(ridge), len(lines), years, ridge, lines)
 
 
-def leave_one_face_out(block, methods=("rbf", "radial"), out_dir=None, progress=None) -> dict:
+def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
+                       out_dir: PathLike | None = None,
+                       progress: Callable[[str], object] | None = None) -> dict:
     """Fit ``block`` on all faces but one for each face with a ring map, score the held-out face.
 
     Parameters

@@ -25,7 +25,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..errors import WoodcamError
-from .knot import MAX_INCLINE, Knot, KnotParams, to_slr
+from .knot import MAX_INCLINE, Knot, KnotShape, to_slr
 
 _LOGIT_CLIP = 30.0  # only guards exp() overflow; sigmoid(30) is 1 to double precision
 _INIT_LOGIT = 1.5  # start LM with ratios in [0.18, 0.82], where the sigmoid still has slope
@@ -40,7 +40,7 @@ def _sigmoid(z):
     return 1.0 / (1.0 + np.exp(-np.clip(z, -_LOGIT_CLIP, _LOGIT_CLIP)))
 
 
-def params_to_unconstrained(params: KnotParams) -> np.ndarray:
+def params_to_unconstrained(params: KnotShape) -> np.ndarray:
     """(9,) unconstrained vector: ``s0, l0, log gamma, log rho_max, logit phi0, logit phi1,
     log r_max, logit psi0, logit psi1`` (the coordinates generation and fitting work in)."""
     p = params
@@ -48,10 +48,10 @@ def params_to_unconstrained(params: KnotParams) -> np.ndarray:
                      _logit(p.phi1), np.log(p.r_max_mm), _logit(p.psi0), _logit(p.psi1)])
 
 
-def unconstrained_to_params(z) -> KnotParams:
+def unconstrained_to_params(z) -> KnotShape:
     """Inverse of :func:`params_to_unconstrained`; any finite ``z : (9,)`` gives a valid knot."""
     z = np.asarray(z, dtype=float)
-    return KnotParams(float(z[0]), float(z[1]), float(np.exp(np.clip(z[2], -5, 5))),
+    return KnotShape(float(z[0]), float(z[1]), float(np.exp(np.clip(z[2], -5, 5))),
                       float(np.exp(np.clip(z[3], -10, 10))), float(_sigmoid(z[4])), float(_sigmoid(z[5])),
                       float(np.exp(np.clip(z[6], -10, 10))), float(_sigmoid(z[7])), float(_sigmoid(z[8])))
 
@@ -180,7 +180,7 @@ def _load_gran_knots(path) -> np.ndarray:
 def gran_knot_diameter(row, r_mm) -> np.ndarray:
     """Knot diameter (mm) of a ``Gran_1`` knot row at distance ``r_mm : (n,)`` from the pith.
 
-    The same model as :meth:`woodcam.fields.tree_data.Knot.from_model`: ``d = A r^(1 + B)``,
+    The same model as :meth:`woodcam.fields.skeleton.BranchStrand.from_model`: ``d = A r^(1 + B)``,
     the form whose knot sizes agree best with the bark bumps where knots exit the measured
     log (see ``docs/knots.md``). Clipped below at 0.5 mm.
     """

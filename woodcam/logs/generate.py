@@ -57,10 +57,12 @@ from typing import Literal
 
 import numpy as np
 
+from .._types import ArrayLike
 from ..errors import WoodcamError
+from ..fields.skeleton import KNOT_TABLE_SAMPLES, BranchStrand, LogSkeleton
 from .centreline import Centreline
 from .fit import unconstrained_to_params
-from .knot import Knot, KnotParams
+from .knot import Knot, KnotShape
 from .surface import SurfaceBase, SurfaceKnot, Thickness, add_surface_knots, gabor_noise, heightmap_axes
 
 #: Order of the generated knot parameters (unconstrained; ``l0`` comes from the whorl).
@@ -127,7 +129,7 @@ def knot_stats_from_fits(params, whorl, *, shrink: float = 0.5, logit_clip: floa
     Parameters
     ----------
     params : (n, 9) float
-        :class:`KnotParams` vectors (e.g. from :func:`.fit.fit_knot`).
+        :class:`KnotShape` vectors (e.g. from :func:`.fit.fit_knot`).
     whorl : (n,) int
         Whorl index of each knot (:func:`group_whorls`).
     shrink : float
@@ -144,7 +146,7 @@ def knot_stats_from_fits(params, whorl, *, shrink: float = 0.5, logit_clip: floa
 
     P = np.asarray(params, dtype=float)
     w = np.asarray(whorl, dtype=int)
-    z = np.array([params_to_unconstrained(KnotParams.from_array(p)) for p in P])
+    z = np.array([params_to_unconstrained(KnotShape.from_array(p)) for p in P])
     z = np.delete(z, 1, axis=1)  # drop l0: it comes from the whorl height
     z[:, [3, 4, 6, 7]] = np.clip(z[:, [3, 4, 6, 7]], -logit_clip, logit_clip)
     ids = np.unique(w)
@@ -299,13 +301,44 @@ class GeneratedLog:
         """Heights ``(n_l,)`` mm and azimuths ``(n_theta,)`` rad of :attr:`heightmap_mm`."""
         return heightmap_axes(self.length_mm, *self.heightmap_mm.shape)
 
-    def base_radius(self, l_mm, theta_rad) -> np.ndarray:
+    def to_skeleton(self, *, z_step_mm: float = 5.0, azimuths: int = 360,
+                    samples: int = KNOT_TABLE_SAMPLES, name: str = "generated") -> LogSkeleton:
+        """This log as the knot field's input (:class:`woodcam.fields.skeleton.LogSkeleton`).
+
+        The pith is sampled every ``z_step_mm``, the outer radius on ``azimuths`` directions,
+        each knot's axis and diameter on ``samples`` pith distances (denser near the pith).
+        The knot model there is round: a knot's diameter is that of the circle of equal area,
+        ``2 radius sqrt(gamma)`` (``gamma``: vertical over horizontal semi-axis). Both share the
+        log frame (``z`` along the log, azimuth counter-clockwise from ``+x``, mm).
+        """
+        L = float(self.length_mm)
+        z = np.arange(0.0, L + 0.5 * z_step_mm, z_step_mm)
+        z[-1] = min(z[-1], L)
+        pith = np.asarray(self.centreline_points(z), float)[:, :2]
+        th = 2 * np.pi * np.arange(azimuths) / azimuths
+        zz, tt = np.meshgrid(z, th, indexing="ij")
+        radii = np.asarray(self.outer_radius(zz.ravel(), tt.ravel()), float).reshape(zz.shape)
+        strands = []
+        for k in self.knots:
+            end = float(k.end_mm)
+            r = max(end, 1.0) * np.linspace(0.0, 1.0, samples) ** 2
+            rho = np.maximum(r, 1e-6)
+            hgt = np.asarray(k.height(rho), float)
+            az = np.asarray(k.azimuth(rho), float)
+            diam = 2.0 * np.asarray(k.radius(rho), float) * np.sqrt(max(float(k.knot.params.gamma), 0.0))
+            diam[0] = 0.0
+            strands.append(BranchStrand(float(hgt[0]), float(az[0]), r, hgt - hgt[0], az - az[0],
+                                        np.maximum(diam, 0.0), end, float(k.death_mm)))
+        return LogSkeleton(z, pith, radii, tuple(strands), name)
+
+    def base_radius(self, l_mm: ArrayLike, theta_rad: ArrayLike) -> np.ndarray:
         """Smooth outer radius ``(n,)`` mm (thickness + base shape, no bumps or grain)."""
         l = np.asarray(l_mm, float).reshape(-1)
         t = np.asarray(theta_rad, float).reshape(-1)
         return self.thickness(l) + self.base.at(l, t)
 
-    def outer_radius(self, l_mm, theta_rad, detail: Literal["full", "base"] = "full") -> np.ndarray:
+    def outer_radius(self, l_mm: ArrayLike, theta_rad: ArrayLike,
+                     detail: Literal["full", "base"] = "full") -> np.ndarray:
         """Outer radius ``(n,)`` mm at ``(l_mm[i], theta_rad[i])``, measured from the centreline.
 
         ``detail="full"`` interpolates the heightmap bilinearly (periodic in azimuth);
@@ -326,7 +359,7 @@ class GeneratedLog:
         h = self.heightmap_mm
         return ((1 - wi) * ((1 - wj) * h[i0, j0] + wj * h[i0, j1]) + wi * ((1 - wj) * h[i1, j0] + wj * h[i1, j1]))
 
-    def centreline_points(self, l_mm) -> np.ndarray:
+    def centreline_points(self, l_mm: ArrayLike) -> np.ndarray:
         """Pith points ``(n, 3)`` in the log frame at heights ``l_mm : (n,)``."""
         return self.centreline.points(l_mm)
 

@@ -32,7 +32,7 @@ available, so this is our own derivation with the same two constraints):
   ``psi0`` in [0, 1] maps the start slope ``L_r + alpha_r E_r / c_max`` between its concave
   minimum ``E_r = 2`` and ``E_r = MAX_RADIUS_EXPONENT``.
 
-The nine parameters (:class:`KnotParams`): ``s0, l0, gamma, rho_max, phi0, phi1, r_max, psi0,
+The nine parameters (:class:`KnotShape`): ``s0, l0, gamma, rho_max, phi0, phi1, r_max, psi0,
 psi1``. ``theta_mean`` is not a parameter: it is the mean azimuth of the knot's points.
 Eq. 5 as printed mixes ``c`` and ``rho``; we use ``c`` throughout, as its text says.
 """
@@ -65,7 +65,7 @@ PARAM_NAMES = ("s0_mm", "l0_mm", "gamma", "rho_max_mm", "phi0", "phi1", "r_max_m
 
 
 @dataclass(frozen=True)
-class KnotParams:
+class KnotShape:
     """The nine knot parameters of seed 001 §3.2 (lengths in mm, ratios in [0, 1]).
 
     Attributes
@@ -104,7 +104,7 @@ class KnotParams:
         return np.array(astuple(self), dtype=float)
 
     @classmethod
-    def from_array(cls, a) -> "KnotParams":
+    def from_array(cls, a) -> "KnotShape":
         a = np.asarray(a, dtype=float).reshape(-1)
         if a.shape != (9,):
             raise WoodcamError(f"knot parameter vector must have 9 entries {PARAM_NAMES}; got shape {a.shape}")
@@ -153,16 +153,16 @@ def radius_coefficients(r_max, psi0, psi1, c_max):
 
 @dataclass(frozen=True)
 class Knot:
-    """One knot: :class:`KnotParams` plus its mean azimuth, evaluated in log-centric coordinates.
+    """One knot: :class:`KnotShape` plus its mean azimuth, evaluated in log-centric coordinates.
 
     Attributes
     ----------
-    params : KnotParams
+    params : KnotShape
     theta_mean_rad : float
         Mean azimuth of the knot (rad), the origin of its arc-length coordinate ``s`` (eq. 1).
     """
 
-    params: KnotParams
+    params: KnotShape
     theta_mean_rad: float = 0.0
 
     # -- trajectory -----------------------------------------------------------------------
@@ -217,7 +217,7 @@ class Knot:
     def radius(self, rho_mm) -> np.ndarray:
         """Horizontal knot radius (mm, along ``s``) at distance ``rho_mm : (n,)`` from the pith.
 
-        The vertical semi-axis is ``gamma`` times this (:attr:`KnotParams.gamma`).
+        The vertical semi-axis is ``gamma`` times this (:attr:`KnotShape.gamma`).
         """
         return self.radius_at_length(self.arc_length(rho_mm))
 
@@ -310,4 +310,4 @@ def to_slr(points_lcs, theta_mean_rad: float | None = None):
 
 def param_field_names() -> tuple[str, ...]:
     """Names of the nine parameters, in vector order."""
-    return tuple(f.name for f in fields(KnotParams))
+    return tuple(f.name for f in fields(KnotShape))

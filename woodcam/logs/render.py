@@ -24,7 +24,7 @@ from ..appearance.knots import KnotShading
 from ..errors import WoodcamError
 from ..fields.base import arf
 from ..fields.knots import KnottedLogField
-from ..fields.tree_data import Log
+from ..fields.skeleton import LogSkeleton
 
 BACKGROUND_RGB = (0.16, 0.16, 0.16)
 
@@ -53,7 +53,7 @@ class Section:
         return o + j[None, :, None] * u + i[:, None, None] * v
 
 
-def end_grain_disc(log: Log, z_mm: float, *, px_per_mm: float = 2.0, margin_mm: float = 5.0
+def end_grain_disc(log: LogSkeleton, z_mm: float, *, px_per_mm: float = 2.0, margin_mm: float = 5.0
                    ) -> Section:
     """Horizontal section at height ``z_mm`` covering the whole log cross-section, seen from
     above (``+x`` to the right, ``+y`` up in the image)."""
@@ -66,7 +66,7 @@ def end_grain_disc(log: Log, z_mm: float, *, px_per_mm: float = 2.0, margin_mm: 
                    f"disc_z{z_mm:.0f}")
 
 
-def tangential_board(log: Log, z_center_mm: float, azimuth_rad: float, offset_mm: float, *,
+def tangential_board(log: LogSkeleton, z_center_mm: float, azimuth_rad: float, offset_mm: float, *,
                      length_mm: float = 600.0, width_mm: float = 120.0,
                      px_per_mm: float = 2.0) -> Section:
     """Face of a flat-sawn board: a plane parallel to the log axis at ``offset_mm`` from the
@@ -81,7 +81,7 @@ def tangential_board(log: Log, z_center_mm: float, azimuth_rad: float, offset_mm
                    f"board_z{z_center_mm:.0f}_az{np.degrees(azimuth_rad):.0f}_off{offset_mm:.0f}")
 
 
-def radial_section(log: Log, z_center_mm: float, azimuth_rad: float, *,
+def radial_section(log: LogSkeleton, z_center_mm: float, azimuth_rad: float, *,
                    length_mm: float = 300.0, px_per_mm: float = 2.0,
                    margin_mm: float = 5.0) -> Section:
     """Quarter-sawn face: the plane through the pith (at ``z_center_mm``) containing the
@@ -96,7 +96,7 @@ def radial_section(log: Log, z_center_mm: float, azimuth_rad: float, *,
                    f"radial_z{z_center_mm:.0f}_az{np.degrees(azimuth_rad):.0f}")
 
 
-def busiest_board(log: Log, *, offset_mm: float = 60.0, length_mm: float = 600.0,
+def busiest_board(log: LogSkeleton, *, offset_mm: float = 60.0, length_mm: float = 600.0,
                   width_mm: float = 120.0, step_deg: float = 10.0, step_mm: float = 50.0):
     """The (z_center, azimuth) of the tangential board that cuts the most knots (knot axes
     crossing the board plane inside its rectangle), found by a coarse scan; returns
@@ -183,7 +183,7 @@ def save_png(image: np.ndarray, path) -> Path:
     return path
 
 
-def default_sections(log: Log, *, px_per_mm: float = 2.0) -> list[Section]:
+def default_sections(log: LogSkeleton, *, px_per_mm: float = 2.0) -> list[Section]:
     """A tangential board through the most knots and an end-grain disc through the log's
     biggest whorl (the height where most knot axes pass 50 mm from the pith, +-12 mm)."""
     zc, az, _ = busiest_board(log)

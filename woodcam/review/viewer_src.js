@@ -123,9 +123,11 @@ const capFragment = `
   out vec4 colour;
   void main() { colour = vec4(texture(wood, clamp(vBlock / size, 0.0, 1.0)).rgb, 1.0); }`;
 
-const cut = { axis: params.get('cut')?.split(':')[0] || 'y',
-              pos: parseFloat(params.get('cut')?.split(':')[1] ?? String(D / 2)),
-              on: params.get('cut') !== 'off' };
+// #cut=AXIS:MM sets the cut, #cut=off starts without one (default: y through the middle)
+const cutArg = (params.get('cut') || '').split(':');
+const cut = { axis: ['x', 'y', 'z'].includes(cutArg[0]) ? cutArg[0] : 'y',
+              pos: cutArg.length > 1 ? parseFloat(cutArg[1]) : D / 2,
+              on: cutArg[0] !== 'off' };
 const plane = new THREE.Plane();
 let capMesh = null, textures = {}, part = null;
 const stencilGroup = new THREE.Group();

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._types import ArrayLike, GrowthFieldLike, WoodLike
 from ..block import Block, Face
 from ..errors import WoodcamError
 from ..fields.base import evaluate
@@ -21,7 +22,8 @@ from .spec import SynthSpec
 from .traces import _trace_face
 
 
-def synth_block(field, size_mm, spec: SynthSpec | None = None, *, wood=None,
+def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | None = None, *,
+                wood: WoodLike | None = None,
                 rng: np.random.Generator | None = None, name: str = "synthetic",
                 meta: dict | None = None, knot_masks: bool = True, **settings) -> Block:
     """Render a synthetic :class:`Block` from a growth field placed in the block frame.

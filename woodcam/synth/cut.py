@@ -7,6 +7,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..fields.analytic import AnalyticLogField
 from ..fields.base import LogFrame
@@ -41,7 +42,8 @@ def _pith_hits_box(point, direction, size) -> bool:
     return lo <= hi
 
 
-def cut_block(log_field, size_mm, pattern: SawPattern = "flat-sawn", *, distance_mm: float | None = None,
+def cut_block(log_field: GrowthFieldLike, size_mm: ArrayLike, pattern: SawPattern = "flat-sawn", *,
+              distance_mm: float | None = None,
               azimuth_deg: float = 0.0, height_mm: float = 0.0, angle_deg: float | None = None,
               tilt_deg: float = 0.0, log_frame: LogFrame | None = None) -> PlacedField:
     """Cut a block of ``size_mm`` out of a log: return the log's field in the block frame.

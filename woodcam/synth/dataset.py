@@ -112,12 +112,12 @@ def knotted_log_field(rng: np.random.Generator, ring_width_range_mm=(1.5, 6.0), 
     """A knotted log field (log frame) from the log generator of seed 001 (``woodcam.logs``),
     turned into the stem + knot field of seed 003; ring width log-uniform in the range.
     The factory :func:`synth_benchmark_set` takes as ``log_fields``."""
-    from ..fields import KnottedLogField, log_from_generated
+    from ..fields import KnottedLogField
     from ..logs import generate_log
 
     gen = generate_log(int(rng.integers(1 << 31)), length_mm=length_mm)
     width = math.exp(rng.uniform(*np.log(ring_width_range_mm)))
-    return KnottedLogField(log_from_generated(gen), ring_width_mm=width)
+    return KnottedLogField(gen.to_skeleton(), ring_width_mm=width)
 
 
 def time_synth_block(face_px: int = 512, repeats: int = 1) -> float:

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..appearance.colormap import get_species
 from ..fields.base import arf, check_points, evaluate, grain_direction
 
-_EARLYWOOD = np.array([0.88, 0.73, 0.56])
-_LATEWOOD = np.array([0.66, 0.45, 0.27])
+#: Species whose earlywood/latewood colours the built-in photos use (the one colour table,
+#: :data:`woodcam.appearance.SPECIES`).
+BUILTIN_PHOTO_SPECIES = "pine"
 
 
 class _BuiltinWood:
@@ -24,7 +26,11 @@ class _BuiltinWood:
     _FIBRE_SCALES_MM = ((0.22, 6.0, 0.6), (0.9, 25.0, 0.4))
     _FIBRE_AMPLITUDE = 0.05
 
-    def __init__(self, field, rng: np.random.Generator, lattice: int = 64):
+    def __init__(self, field, rng: np.random.Generator, lattice: int = 64,
+                 species: str = BUILTIN_PHOTO_SPECIES):
+        s = get_species(species)
+        self.earlywood = np.asarray(s.earlywood_rgb, float)
+        self.latewood = np.asarray(s.latewood_rgb, float)
         self.field = field
         self.phase = rng.uniform(0, 2 * np.pi)
         self.lattice = [rng.standard_normal((lattice,) * 3).astype(np.float32) for _ in self._FIBRE_SCALES_MM]
@@ -67,7 +73,7 @@ class _BuiltinWood:
         ring = np.floor(years)
         tone = 1.0 + 0.04 * np.sin(ring * 2.399 + self.phase)   # per-ring brightness
         tex = 1.0 + self._FIBRE_AMPLITUDE * self._fibre_texture(p, fib)
-        rgb = _EARLYWOOD + late[:, None] * (_LATEWOOD - _EARLYWOOD)
+        rgb = self.earlywood + late[:, None] * (self.latewood - self.earlywood)
         rgb = rgb * (tone * tex * (1.0 - 0.15 * end_grain))[:, None]
         return np.clip(rgb, 0.0, 1.0)
 

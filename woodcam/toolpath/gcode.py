@@ -43,6 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from ..tolerances import ARC_CHORD_TOL_MM, ARC_RADIUS_MISMATCH_MM
 
@@ -149,8 +150,8 @@ def _fmt(letter: str, value: float) -> str:
     return f"{letter}{value:g}"
 
 
-def read_gcode(text_or_path, *, chord_tol_mm: float = ARC_CHORD_TOL_MM,
-               start_mm=None) -> Program:
+def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_TOL_MM,
+               start_mm: ArrayLike | None = None) -> Program:
     """Read G-code text or a file path into a :class:`Program` of straight moves (mm).
 
     Parameters

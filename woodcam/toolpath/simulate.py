@@ -43,6 +43,7 @@ from typing import Literal, Mapping
 
 import numpy as np
 
+from .._types import ArrayLike, Mesh
 from ..errors import WoodcamError
 from ..tolerances import SIM_CONTACT_TOL_MM
 from .gcode import FEED, RAPID, Program
@@ -119,7 +120,7 @@ class SimResult:
         """Removed volume (mm^3), midpoint rule over the cells."""
         return float((self.size_mm[2] - self.heightmap).sum() * self.cell_mm[0] * self.cell_mm[1])
 
-    def to_mesh(self, *, flat_tol_mm: float = 1e-9):
+    def to_mesh(self, *, flat_tol_mm: float = 1e-9) -> Mesh:
         """Watertight ``trimesh.Trimesh`` of the remaining stock in the block frame (mm).
 
         See :func:`woodcam.toolpath.mesh.heightfield_mesh`; ``flat_tol_mm`` is how far from
@@ -151,8 +152,8 @@ def _tool_lookup(program: Program, tools) -> dict[int, Tool]:
     return out
 
 
-def simulate(program: Program, tools, size_mm, *, resolution_mm: float = 0.1,
-             work_offset_mm=None, progress: bool = False) -> SimResult:
+def simulate(program: Program, tools: Mapping[int, Tool], size_mm: ArrayLike, *, resolution_mm: float = 0.1,
+             work_offset_mm: ArrayLike | None = None, progress: bool = False) -> SimResult:
     """Remove the swept tools of ``program`` from a ``W x D x H`` stock on a height field.
 
     Parameters

@@ -33,6 +33,7 @@ Tool table (TOML, read with the standard library's ``tomllib``)::
 
 from __future__ import annotations
 
+from typing import Any
 import math
 import tomllib
 from dataclasses import dataclass
@@ -41,6 +42,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 
 ToolType = Literal["flat", "ball", "bull", "vbit"]
@@ -69,7 +71,7 @@ class Tool:
         """Height (mm) of the curved/conical part of the profile above the tip."""
         return float(self.profile(np.array([self.radius_mm]))[0])
 
-    def profile(self, r_mm):
+    def profile(self, r_mm: ArrayLike) -> np.ndarray:
         """Height above the tip (mm) of the tool's lower surface at radius ``r_mm`` (any shape).
 
         ``+inf`` outside the tool (``r > radius_mm``).
@@ -124,7 +126,7 @@ class Tool:
     def spec(self) -> str:
         raise NotImplementedError
 
-    def solid(self, top_mm: float, segments: int = 64):
+    def solid(self, top_mm: float, segments: int = 64) -> Any:
         """The tool as a ``manifold3d.Manifold``: tip at the origin, up to ``z = top_mm``."""
         from manifold3d import CrossSection, Manifold
 
@@ -299,7 +301,7 @@ def parse_tool_spec(spec: str) -> Tool:
     return VBit(nums[1], angle_deg=nums[0])
 
 
-def load_tool_table(path) -> dict[int, Tool]:
+def load_tool_table(path: PathLike) -> dict[int, Tool]:
     """Read a TOML tool table (module docstring) into ``{tool number: Tool}``."""
     path = Path(path)
     try:

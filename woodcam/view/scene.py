@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._types import ArrayLike, Mesh, PathLike, WoodLike
 from ..errors import WoodcamError, require
 from ..frames import check_size
 from ..tolerances import ON_FACE_TOL_MM
@@ -635,10 +636,10 @@ def build_scene(
 
 
 def preview(
-    mesh_or_path,
+    mesh_or_path: Mesh | PathLike,
     *,
-    wood=None,
-    size_mm=None,
+    wood: WoodLike | None = None,
+    size_mm: ArrayLike | None = None,
     screenshot: str | os.PathLike | None = None,
     window_size: tuple[int, int] = (1280, 960),
     options: SceneOptions | None = None,
@@ -715,7 +716,45 @@ def preview(
                 plotter.screenshot(str(tmp))
             return path
         plotter.add_axes()
+        add_view_keys(plotter, size_mm if size_mm is not None else mesh.bounds.T.ravel()[1::2])
         plotter.show()
         return None
     finally:
         plotter.close()
+
+
+#: Keys of the interactive window (shown in its corner): view presets and toggles.
+VIEW_KEYS = {"1": "front", "2": "top", "3": "left", "4": "right", "5": "iso"}
+KEY_HELP = ("keys: 1 front  2 top  3 left  4 right  5 iso  o orthographic  h hide block  "
+            "c cut face  r reset  q quit")
+
+
+def add_view_keys(plotter, size_mm) -> None:
+    """Key bindings and their on-screen help for the interactive window: view presets
+    (:data:`VIEW_KEYS`), ``o`` orthographic on/off, ``h`` block and waste wood on/off, ``c`` the
+    cut face (section, waste, outline) on/off."""
+    W, D, H = (float(v) for v in size_mm)
+    bounds = (0.0, W, 0.0, D, 0.0, H)
+
+    def view(name):
+        return lambda: (set_camera(plotter, name, bounds), plotter.render())
+
+    def toggle(*names):
+        def flip():
+            actors = [plotter.actors[n] for n in names if n in plotter.actors]
+            visible = not all(a.GetVisibility() for a in actors) if actors else True
+            for a in actors:
+                a.SetVisibility(visible)
+            plotter.render()
+        return flip
+
+    def ortho():
+        plotter.camera.parallel_projection = not plotter.camera.parallel_projection
+        plotter.render()
+
+    for key, name in VIEW_KEYS.items():
+        plotter.add_key_event(key, view(name))
+    plotter.add_key_event("o", ortho)
+    plotter.add_key_event("h", toggle("woodcam-block", "woodcam-block-edges", WASTE_ACTOR))
+    plotter.add_key_event("c", toggle(SECTION_ACTOR, WASTE_ACTOR, OUTLINE_ACTOR))
+    plotter.add_text(KEY_HELP, position="lower_left", font_size=9, name="woodcam-keys")

@@ -1,7 +1,7 @@
 """The seed's image encoding of a log: stem map and knot height / orientation / state maps.
 
 Seed 003 ("input tree log data") stores a log in four 8-bit RGB images plus a few numbers, so
-tools can exchange logs as pictures. :func:`write_maps` writes a :class:`~.tree_data.Log` in that
+tools can exchange logs as pictures. :func:`write_maps` writes a :class:`~woodcam.fields.skeleton.LogSkeleton` in that
 form, :func:`read_maps` reads it back (or maps made by another tool with the same layout).
 
 Layout (``h`` = log length, ``r_min``/``r_max`` = smallest/largest outer radius, all mm; values
@@ -28,7 +28,7 @@ four numbers) plus woodcam's ``z_start_mm``, ``pith_mid_xy_mm``, ``diameter_max_
 
 8-bit quantisation limits precision: a step is ``h/255`` in start height (15.7 mm for a 4 m
 log), ``r_min/255`` in pith offset, rise and fall, ``2 pi/255`` in start azimuth. The woodcam log
-file (JSON, :func:`~.tree_data.write_log`) is the lossless format.
+file (JSON, :func:`~woodcam.logs.io.write_log`) is the lossless format.
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import WoodcamError
-from .tree_data import Knot, Log
+from ..fields.skeleton import BranchStrand, LogSkeleton
 
 MAP_FILES = {"stem": "stem_map.png", "height": "knot_height_map.png",
              "orientation": "knot_orientation_map.png", "state": "knot_state_map.png",
@@ -60,7 +60,7 @@ def _dq(v, lo, hi):
     return lo + np.asarray(v, float) / 255.0 * (hi - lo)
 
 
-def encode_maps(log: Log, *, stem_shape=(512, 128), knot_columns: int = 128,
+def encode_maps(log: LogSkeleton, *, stem_shape=(512, 128), knot_columns: int = 128,
                 row_height: int = 1, clockwise: bool = False) -> tuple[dict, dict]:
     """The four maps as ``uint8 (rows, cols, 3)`` arrays and the parameter dict."""
     rows, cols = stem_shape
@@ -107,7 +107,7 @@ def encode_maps(log: Log, *, stem_shape=(512, 128), knot_columns: int = 128,
     return {k: v.astype(np.uint8) for k, v in maps.items()}, params
 
 
-def write_maps(log: Log, folder, **kw) -> dict:
+def write_maps(log: LogSkeleton, folder, **kw) -> dict:
     """Write the maps of :func:`encode_maps` as PNGs plus ``map_params.json`` into ``folder``;
     returns ``{name: path}``."""
     from PIL import Image
@@ -124,7 +124,7 @@ def write_maps(log: Log, folder, **kw) -> dict:
     return out
 
 
-def decode_maps(maps: dict, params: dict) -> Log:
+def decode_maps(maps: dict, params: dict) -> LogSkeleton:
     """A :class:`Log` from map arrays (``uint8 (rows, cols, 3)``) and the parameter dict.
 
     ``params`` needs the seed's ``r_min_mm``, ``r_max_mm``, ``height_mm`` (a list
@@ -182,12 +182,12 @@ def decode_maps(maps: dict, params: dict) -> Log:
             diam[0] = 0.0
         rise = rise - rise[0]
         tw = tw - tw[0]
-        knots.append(Knot(float(z0), float(w0), d, rise, tw, diam, max(r_end, d[1]),
+        knots.append(BranchStrand(float(z0), float(w0), d, rise, tw, diam, max(r_end, d[1]),
                           float(r_death)))
-    return Log(z, pxy, radii, tuple(knots), str(params.get("name", "log")))
+    return LogSkeleton(z, pxy, radii, tuple(knots), str(params.get("name", "log")))
 
 
-def read_maps(folder) -> Log:
+def read_maps(folder) -> LogSkeleton:
     """Read the maps written by :func:`write_maps` (same file names) from ``folder``."""
     from PIL import Image
 

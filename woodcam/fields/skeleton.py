@@ -1,10 +1,10 @@
-"""Log descriptions for the knot model: pith curve, outer surface and knots, all in mm.
+"""The knot field's input: a log's skeleton (pith curve, outer surface, branch strands), in mm.
 
 The knot model of seed 003 (Wood Knot Editor, after Larsson et al. 2022) takes a tree log's
 "internal grafting skeleton" as input: the pith curve, the outer stem surface and one strand per
-branch. This module holds that description (:class:`Log`, :class:`Knot`), reads the CT-measured
-Norway spruce log of ``shared/data/trees/`` (:func:`read_gran1`) and reads/writes the woodcam log
-file (JSON, :func:`read_log` / :func:`write_log`).
+branch. This module holds only that description (:class:`LogSkeleton`, :class:`BranchStrand`);
+reading and writing logs (the CT-measured spruce log, woodcam log files, the seed's image maps)
+and the generator's logs live in :mod:`woodcam.logs`, which sits above ``fields``.
 
 Log frame (mm): ``z`` runs along the log from its butt end (``z = 0``) to ``length_mm``; ``x, y``
 are horizontal. Azimuths ``omega`` (radians) are measured counter-clockwise from ``+x`` about
@@ -22,13 +22,12 @@ by other tools (images, generators) and the parametric real-log knots share one 
 
 from __future__ import annotations
 
-import json
-import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
+from .._types import ArrayLike
 from ..errors import WoodcamError
 
 #: Samples per knot profile when a knot is built from model coefficients.
@@ -39,22 +38,8 @@ KNOT_TABLE_SAMPLES = 96
 _R_FLOOR_MM = 1.0
 
 
-def shared_data_dir() -> Path | None:
-    """The shared reference-data folder (``$WOODCAM_SHARED_DATA`` or ``<repo>/../shared/data``).
-
-    Returns ``None`` when neither exists (a user's machine): callers then skip or ask for a path.
-    """
-    env = os.environ.get("WOODCAM_SHARED_DATA")
-    cands = [Path(env)] if env else []
-    cands.append(Path(__file__).resolve().parents[3] / "shared" / "data")
-    for c in cands:
-        if c.is_dir():
-            return c
-    return None
-
-
 @dataclass(frozen=True, eq=False)
-class Knot:
+class BranchStrand:
     """One branch strand of a log (see the module docstring for the geometry).
 
     Parameters
@@ -98,25 +83,25 @@ class Knot:
             a = np.asarray(getattr(self, name), float)
             if a.shape != r.shape:
                 raise WoodcamError(
-                    f"Knot.{name} must have the shape of r_mm {r.shape}; got {a.shape}; "
+                    f"BranchStrand.{name} must have the shape of r_mm {r.shape}; got {a.shape}; "
                     "tabulate all three profiles on the same pith distances")
             arrs[name] = a
         if r.ndim != 1 or len(r) < 2 or r[0] != 0.0 or np.any(np.diff(r) <= 0):
             raise WoodcamError(
-                f"Knot.r_mm must be 1-D, start at 0 and strictly increase; got {r[:4]}...; "
+                f"BranchStrand.r_mm must be 1-D, start at 0 and strictly increase; got {r[:4]}...; "
                 "sample the profiles from the pith outward")
         if np.any(arrs["diameter_mm"] < 0) or not np.all(np.isfinite(r)):
-            raise WoodcamError("Knot.diameter_mm must be >= 0 and finite; got a negative value; "
+            raise WoodcamError("BranchStrand.diameter_mm must be >= 0 and finite; got a negative value; "
                                "clip the diameter model at 0")
         if not (self.r_end_mm > 0):
-            raise WoodcamError(f"Knot.r_end_mm must be > 0 mm; got {self.r_end_mm}")
+            raise WoodcamError(f"BranchStrand.r_end_mm must be > 0 mm; got {self.r_end_mm}")
         object.__setattr__(self, "r_mm", r)
         for k, v in arrs.items():
             object.__setattr__(self, k, v)
 
     @classmethod
     def from_model(cls, A, B, z0, D, E, w0, G, r_end, r_death, *, r_max_mm=None,
-                   samples: int = KNOT_TABLE_SAMPLES) -> "Knot":
+                   samples: int = KNOT_TABLE_SAMPLES) -> "BranchStrand":
         """A knot from one row ``[A, B, z0, D, E, w0, G, r_end, r_death]`` of the real log.
 
         Height at pith distance ``r``: ``z0 + D sqrt(r) + E r``; azimuth ``w0 + G ln r``;
@@ -127,7 +112,7 @@ class Knot:
         within the knots' length; ``A r + B r^2 / 100`` reaches 64 mm in a 125 mm-radius log.
         Independent check: the width of the bumps that knots leave on the measured bark spreads
         around ``A r^(1+B)`` at ``r_end`` by 0.33 (std of log ratio, 12 clear bumps) against 0.51
-        for ``A r + B r^2 / 100`` (tests/fields/test_tree_data.py).
+        for ``A r + B r^2 / 100`` (tests/fields/test_skeleton.py).
         ``r_death < 0.1`` means the branch died at once (treated as 0).
         """
         r_top = float(max(r_end, r_max_mm or 0.0))
@@ -167,7 +152,7 @@ class Knot:
         return d
 
     @classmethod
-    def from_json(cls, d: dict) -> "Knot":
+    def from_json(cls, d: dict) -> "BranchStrand":
         try:
             if "model" in d:
                 m = d["model"]
@@ -187,7 +172,7 @@ class Knot:
 
 
 @dataclass(frozen=True, eq=False)
-class Log:
+class LogSkeleton:
     """A tree log: pith curve, outer surface and knots (log frame, mm; module docstring).
 
     Parameters
@@ -238,13 +223,13 @@ class Log:
     def r_max_mm(self) -> float:
         return float(self.radii_mm.max())
 
-    def pith_at(self, z_mm) -> np.ndarray:
+    def pith_at(self, z_mm: ArrayLike) -> np.ndarray:
         """Pith ``(x, y)`` at heights ``z_mm (n,)`` -> ``(n, 2)`` mm (clamped at the ends)."""
         z = np.asarray(z_mm, float)
         return np.stack([np.interp(z, self.pith_z_mm, self.pith_xy_mm[:, 0]),
                          np.interp(z, self.pith_z_mm, self.pith_xy_mm[:, 1])], axis=-1)
 
-    def radius_at(self, z_mm, azimuth_rad) -> np.ndarray:
+    def radius_at(self, z_mm: ArrayLike, azimuth_rad: ArrayLike) -> np.ndarray:
         """Outer radius (mm) at heights ``z_mm (n,)`` and azimuths ``azimuth_rad (n,)``.
 
         Bilinear in (height, azimuth), periodic in azimuth, clamped in height.
@@ -263,7 +248,7 @@ class Log:
         r1 = R[iz + 1, ia] * (1 - ta) + R[iz + 1, ia1] * ta
         return r0 * (1 - tz) + r1 * tz
 
-    def knot_point(self, index: int, r_mm) -> np.ndarray:
+    def knot_point(self, index: int, r_mm: ArrayLike) -> np.ndarray:
         """Log-frame points ``(n, 3)`` on knot ``index``'s axis at pith distances ``r_mm (n,)``."""
         k = self.knots[index]
         r = np.atleast_1d(np.asarray(r_mm, float))
@@ -271,9 +256,9 @@ class Log:
         p = self.pith_at(z)
         return np.stack([p[:, 0] + r * np.cos(w), p[:, 1] + r * np.sin(w), z], axis=-1)
 
-    def with_knots(self, knots) -> "Log":
+    def with_knots(self, knots: Sequence[BranchStrand]) -> "LogSkeleton":
         """The same stem with another set of knots (e.g. none, or the first n)."""
-        return Log(self.pith_z_mm, self.pith_xy_mm, self.radii_mm, tuple(knots), self.name)
+        return LogSkeleton(self.pith_z_mm, self.pith_xy_mm, self.radii_mm, tuple(knots), self.name)
 
     def to_json(self) -> dict:
         return {"format": "woodcam-log", "version": 1, "units": "mm", "name": self.name,
@@ -282,13 +267,13 @@ class Log:
                 "radii_mm": self.radii_mm.tolist(), "knots": [k.to_json() for k in self.knots]}
 
     @classmethod
-    def from_json(cls, d: dict) -> "Log":
+    def from_json(cls, d: dict) -> "LogSkeleton":
         if d.get("format") != "woodcam-log":
             raise WoodcamError(f"log file format must be 'woodcam-log'; got {d.get('format')!r}; "
-                               "write the file with woodcam.fields.tree_data.write_log")
+                               "write the file with woodcam.logs.write_log")
         try:
             return cls(d["pith_z_mm"], d["pith_xy_mm"], d["radii_mm"],
-                       tuple(Knot.from_json(k) for k in d.get("knots", [])),
+                       tuple(BranchStrand.from_json(k) for k in d.get("knots", [])),
                        d.get("name", "log"))
         except KeyError as err:
             raise WoodcamError(f"log file is missing the key {err.args[0]!r}; it needs "
@@ -296,111 +281,11 @@ class Log:
 
 
 def simple_log(length_mm: float = 600.0, radius_mm: float = 100.0, knots=(), *,
-               z_step_mm: float = 10.0, azimuths: int = 36, name: str = "simple") -> Log:
+               z_step_mm: float = 10.0, azimuths: int = 36, name: str = "simple") -> LogSkeleton:
     """A straight cylindrical log (pith on the ``z`` axis, constant radius) with ``knots``:
     the analytic test case and a starting point for hand-made logs."""
     if not (length_mm > 0 and radius_mm > 0):
         raise WoodcamError(f"length_mm and radius_mm must be > 0; got {length_mm}, {radius_mm}")
     z = np.arange(0.0, length_mm + 0.5 * z_step_mm, z_step_mm)
-    return Log(z, np.zeros((len(z), 2)), np.full((len(z), azimuths), float(radius_mm)),
+    return LogSkeleton(z, np.zeros((len(z), 2)), np.full((len(z), azimuths), float(radius_mm)),
                tuple(knots), name)
-
-
-def log_from_generated(gen, *, z_step_mm: float = 5.0, azimuths: int = 360,
-                       samples: int = KNOT_TABLE_SAMPLES, name: str = "generated") -> Log:
-    """Convert a synthetic log of :mod:`woodcam.logs.generate` (``GeneratedLog``) to a
-    :class:`Log`, by duck typing (``fields`` may not import ``logs``, which sits above it).
-
-    Uses ``gen.length_mm``, ``gen.centreline_points(z) -> (n, 3)``,
-    ``gen.outer_radius(z, theta) -> (n,)`` and, per knot ``k`` of ``gen.knots``:
-    ``k.height(rho)``, ``k.azimuth(rho)``, ``k.radius(rho)`` (horizontal semi-axis),
-    ``k.knot.params.gamma`` (vertical / horizontal semi-axis; the knot model here is round, so
-    the diameter is that of the circle of equal area, ``2 radius sqrt(gamma)``), ``k.end_mm``
-    and ``k.death_mm``. Both modules share the log frame (``z`` along the log, azimuth
-    counter-clockwise from ``+x``, mm).
-    """
-    L = float(gen.length_mm)
-    z = np.arange(0.0, L + 0.5 * z_step_mm, z_step_mm)
-    z[-1] = min(z[-1], L)
-    pith = np.asarray(gen.centreline_points(z), float)[:, :2]
-    th = 2 * np.pi * np.arange(azimuths) / azimuths
-    zz, tt = np.meshgrid(z, th, indexing="ij")
-    radii = np.asarray(gen.outer_radius(zz.ravel(), tt.ravel()), float).reshape(zz.shape)
-    knots = []
-    for k in gen.knots:
-        end = float(k.end_mm)
-        r = max(end, 1.0) * np.linspace(0.0, 1.0, samples) ** 2
-        rho = np.maximum(r, 1e-6)
-        hgt = np.asarray(k.height(rho), float)
-        az = np.asarray(k.azimuth(rho), float)
-        gamma = float(getattr(getattr(k.knot, "params", None), "gamma", 1.0))
-        diam = 2.0 * np.asarray(k.radius(rho), float) * np.sqrt(max(gamma, 0.0))
-        diam[0] = 0.0
-        knots.append(Knot(float(hgt[0]), float(az[0]), r, hgt - hgt[0], az - az[0],
-                          np.maximum(diam, 0.0), end, float(k.death_mm)))
-    return Log(z, pith, radii, tuple(knots), name)
-
-
-def write_log(log: Log, path) -> Path:
-    """Write ``log`` as a woodcam log file (JSON, mm); returns the path."""
-    path = Path(path)
-    path.write_text(json.dumps(log.to_json()))
-    return path
-
-
-def read_log(path) -> Log:
-    """Read a woodcam log file written by :func:`write_log` (or by hand, same keys)."""
-    path = Path(path)
-    if not path.is_file():
-        raise WoodcamError(f"log file {str(path)!r} does not exist; give a path to a JSON file "
-                           "written by woodcam (or use the real log: --real)")
-    try:
-        d = json.loads(path.read_text())
-    except json.JSONDecodeError as err:
-        raise WoodcamError(f"log file {str(path)!r} is not valid JSON ({err}); "
-                           "write it with woodcam.fields.tree_data.write_log") from err
-    return Log.from_json(d)
-
-
-def read_gran1(folder=None, *, centre: bool = True) -> Log:
-    """Read the CT-measured Norway spruce log "Gran_1" of ``shared/data/trees/``.
-
-    Parameters
-    ----------
-    folder : path or None
-        Folder with ``Gran_1_pith.json``, ``Gran_1_radii.json``, ``Gran_1_knots.json``;
-        default ``<shared data>/trees``.
-    centre : bool
-        Shift ``x, y`` so the pith at mid-length is at the origin (as the seed's stem map does).
-
-    Notes
-    -----
-    Azimuth convention of the radii, checked against the data: a knot's axis at its end
-    distance ``r_end`` lands on the measured outer surface (median |r_end - R| = 1.6 mm over
-    the 98 knots ending beyond 100 mm) only when radii column ``j`` is read at azimuth
-    ``-j`` degrees; counter-clockwise ``+j`` gives 4.0 mm and the seed shader's
-    ``atan(x, y)`` reading 6.6 mm. The radii are therefore flipped to this module's
-    counter-clockwise convention. The knot coefficients are in radians and mm.
-    """
-    if folder is None:
-        base = shared_data_dir()
-        if base is None:
-            raise WoodcamError("the real log needs the shared data folder; set "
-                               "WOODCAM_SHARED_DATA=/path/to/shared/data or pass folder=")
-        folder = base / "trees"
-    folder = Path(folder)
-    try:
-        pith = np.asarray(json.loads((folder / "Gran_1_pith.json").read_text()), float)
-        radii = np.asarray(json.loads((folder / "Gran_1_radii.json").read_text()), float)
-        rows = np.asarray(json.loads((folder / "Gran_1_knots.json").read_text()), float)
-    except FileNotFoundError as err:
-        raise WoodcamError(f"folder {str(folder)!r} lacks {Path(err.filename).name}; point it at "
-                           "shared/data/trees") from err
-    xy = pith[:, :2].copy()
-    if centre:
-        xy -= xy[len(xy) // 2]
-    a = radii.shape[1]
-    radii_ccw = radii[:, (-np.arange(a)) % a]  # column j (ccw +j deg) <- data column -j
-    r_max = float(radii.max())
-    knots = tuple(Knot.from_model(*row, r_max_mm=r_max) for row in rows)
-    return Log(pith[:, 2], xy, radii_ccw, knots, "Gran_1")

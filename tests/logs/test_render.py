@@ -7,13 +7,14 @@ from PIL import Image
 
 from woodcam.cli import build_parser
 from woodcam.errors import WoodcamError
-from woodcam.logs import render as lr
 from woodcam.fields.knots import KnottedLogField
-from woodcam.fields.tree_data import Knot, simple_log, write_log
+from woodcam.fields.skeleton import BranchStrand, simple_log
+from woodcam.logs import render as lr
+from woodcam.logs.io import write_log
 
 
 def _log():
-    k = Knot.from_model(0.25, 0.0, 300.0, 0.0, 0.0, 0.0, 0.0, 100.0, 45.0)   # dies at 45 mm
+    k = BranchStrand.from_model(0.25, 0.0, 300.0, 0.0, 0.0, 0.0, 0.0, 100.0, 45.0)   # dies at 45 mm
     return simple_log(knots=[k])
 
 
@@ -83,7 +84,7 @@ def test_cli_maps_and_export_round_trip(tmp_path):
     b = _parse(["log", "export", "--maps", str(tmp_path / "maps"), "--out",
                 str(tmp_path / "back.json")])
     assert b.func(b) == 0
-    from woodcam.fields.tree_data import read_log
+    from woodcam.logs.io import read_log
 
     log, back = _log(), read_log(tmp_path / "back.json")
     assert len(back.knots) == len(log.knots) == 1           # the knot survives the maps

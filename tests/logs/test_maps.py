@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from woodcam.errors import WoodcamError
-from woodcam.fields.knot_maps import decode_maps, encode_maps, read_maps, write_maps
 from woodcam.fields.knots import KnottedLogField
+from woodcam.logs.maps import decode_maps, encode_maps, read_maps, write_maps
 
 
 def _check_round_trip(log, back, params):

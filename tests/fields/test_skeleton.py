@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from woodcam.errors import WoodcamError
-from woodcam.fields.tree_data import Knot, Log, read_log, simple_log, write_log
+from woodcam.fields.skeleton import BranchStrand, LogSkeleton, simple_log
+from woodcam.logs.io import read_log, write_log
 
 
 def test_gran1_matches_the_readme_figures(gran1):
@@ -40,7 +41,7 @@ def test_gran1_knot_diameters_are_plausible_spruce_knots(gran1):
 
 
 def test_knot_from_model_follows_the_readme_formulas():
-    k = Knot.from_model(0.2, -0.05, 500.0, 0.3, -0.1, 1.0, 0.05, 120.0, 80.0)
+    k = BranchStrand.from_model(0.2, -0.05, 500.0, 0.3, -0.1, 1.0, 0.05, 120.0, 80.0)
     r = np.array([1.0, 25.0, 64.0, 100.0])
     z, w = k.axis_at(r)
     assert np.allclose(z, 500 + 0.3 * np.sqrt(r) - 0.1 * r, atol=0.02)
@@ -49,7 +50,7 @@ def test_knot_from_model_follows_the_readme_formulas():
 
 
 def test_log_file_round_trip_is_exact(tmp_path, gran1):
-    table_knot = Knot(100.0, 0.5, [0, 50, 100], [0, 5, 12], [0, 0.1, 0.15], [0, 8, 14],
+    table_knot = BranchStrand(100.0, 0.5, [0, 50, 100], [0, 5, 12], [0, 0.1, 0.15], [0, 8, 14],
                       90.0, 60.0)
     log = gran1.with_knots(gran1.knots[:5] + (table_knot,))
     back = read_log(write_log(log, tmp_path / "log.json"))
@@ -71,9 +72,9 @@ def test_bad_inputs_name_the_rule(tmp_path):
     with pytest.raises(WoodcamError, match="woodcam-log"):
         read_log(tmp_path / "x.json")
     with pytest.raises(WoodcamError, match="start at 0"):
-        Knot(0, 0, [1, 2], [0, 0], [0, 0], [0, 1], 10, 5)
+        BranchStrand(0, 0, [1, 2], [0, 0], [0, 0], [0, 1], 10, 5)
     with pytest.raises(WoodcamError, match="radii_mm"):
-        Log([0, 10], [[0, 0], [0, 0]], [[1.0] * 3, [1.0] * 3])
+        LogSkeleton([0, 10], [[0, 0], [0, 0]], [[1.0] * 3, [1.0] * 3])
     with pytest.raises(WoodcamError, match="length_mm"):
         simple_log(-1)
 
@@ -115,29 +116,22 @@ def test_diameter_model_against_the_bark_bumps(gran1):
     assert spread_pow < 0.75 * spread_quad            # 0.33 vs 0.51
 
 
-def test_log_from_generated_duck_typed():
-    """The adapter for woodcam.logs' GeneratedLog, on a stand-in with the same interface."""
-    from types import SimpleNamespace
+def test_generated_log_converts_itself_to_a_skeleton():
+    """GeneratedLog.to_skeleton: the generator's log as the knot field's input."""
+    from woodcam.logs import generate_log
 
-    from woodcam.fields.tree_data import log_from_generated
-
-    knot = SimpleNamespace(
-        height=lambda rho: 500.0 + 0.2 * np.asarray(rho),
-        azimuth=lambda rho: np.full(np.shape(rho), 1.0),
-        radius=lambda rho: 0.1 * np.asarray(rho),
-        knot=SimpleNamespace(params=SimpleNamespace(gamma=0.81)),
-        end_mm=110.0, death_mm=70.0)
-    gen = SimpleNamespace(
-        length_mm=1000.0,
-        centreline_points=lambda z: np.stack([0.01 * z, np.zeros_like(z), z], 1),
-        outer_radius=lambda z, t: 120.0 + 2.0 * np.cos(t),
-        knots=(knot,))
-    log = log_from_generated(gen, z_step_mm=10.0, azimuths=90)
-    assert log.length_mm == 1000.0 and log.radii_mm.shape == (101, 90)
-    assert log.radius_at([300.0], [0.0])[0] == pytest.approx(122.0)
-    assert np.allclose(log.pith_at([400.0]), [[4.0, 0.0]])
-    k = log.knots[0]
-    z, w = k.axis_at([50.0])
-    assert z[0] == pytest.approx(510.0) and w[0] == pytest.approx(1.0)
-    assert k.diameter_at([50.0])[0] == pytest.approx(2 * 5.0 * 0.9)   # equal-area circle
-    assert (k.r_end_mm, k.r_death_mm) == (110.0, 70.0)
+    gen = generate_log(5, length_mm=800.0)
+    log = gen.to_skeleton(z_step_mm=10.0, azimuths=90)
+    assert isinstance(log, LogSkeleton) and log.length_mm == pytest.approx(800.0)
+    assert log.radii_mm.shape == (81, 90)
+    z = np.array([100.0, 400.0])
+    np.testing.assert_allclose(log.pith_at(z), np.asarray(gen.centreline_points(z))[:, :2], atol=1e-9)
+    np.testing.assert_allclose(log.radius_at(z, [0.0, 0.0]), gen.outer_radius(z, np.zeros(2)), rtol=1e-9)
+    assert len(log.knots) == len(gen.knots) > 0
+    k, g = log.knots[0], gen.knots[0]
+    rho = np.array([20.0, 0.5 * g.end_mm])
+    np.testing.assert_allclose(k.axis_at(rho)[0], g.height(rho), atol=0.5)
+    # the round knot of the field has the area of the generator's elliptic one
+    np.testing.assert_allclose(k.diameter_at(rho), 2 * g.radius(rho) * np.sqrt(g.knot.params.gamma),
+                               rtol=0.02)
+    assert (k.r_end_mm, k.r_death_mm) == (float(g.end_mm), float(g.death_mm))

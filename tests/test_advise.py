@@ -1,0 +1,94 @@
+"""Placement advice (woodcam place): knots avoided, long thin parts along the grain."""
+
+from __future__ import annotations
+
+import manifold3d
+import numpy as np
+import pytest
+
+from woodcam.advise import advise_placement
+from woodcam.cad.place import place_part
+from woodcam.errors import WoodcamError
+from woodcam.stock import open_stock
+
+
+@pytest.fixture(scope="module")
+def knotty():
+    return open_stock("builtin:knotty")
+
+
+def test_a_small_part_is_moved_off_the_knots(knotty):
+    part = manifold3d.Manifold.cube([24.0, 18.0, 10.0])
+    advice = advise_placement(part, knotty, rotations="z90", candidates=300)
+    best, worst = advice.ranked[0], advice.ranked[-1]
+    assert worst.terms["knots"] > 0.05  # the block has knots where a part could go
+    assert best.terms["knots"] == 0.0
+    # check the advice independently: the placed solid, sampled through its whole volume
+    placed, _ = place_part(part, best.ops, knotty.size_mm)
+    lo, hi = np.asarray(placed.bounding_box()).reshape(2, 3)
+    grid = np.stack(np.meshgrid(*[np.linspace(a + 0.2, b - 0.2, 12) for a, b in zip(lo, hi)],
+                                indexing="ij"), axis=-1).reshape(-1, 3)
+    assert knotty.wood.features(grid)["knot"].max() < 0.5
+    bad, _ = place_part(part, worst.ops, knotty.size_mm)
+    lo, hi = np.asarray(bad.bounding_box()).reshape(2, 3)
+    grid = np.stack(np.meshgrid(*[np.linspace(a + 0.2, b - 0.2, 12) for a, b in zip(lo, hi)],
+                                indexing="ij"), axis=-1).reshape(-1, 3)
+    assert knotty.wood.features(grid)["knot"].max() > 0.5
+
+
+def test_a_long_thin_part_is_turned_along_the_grain():
+    """The flat-sawn block turned a quarter about z runs its fibres along Y: a 60 mm stick
+    modelled along X must be turned to run along Y."""
+    stock = open_stock("builtin:flat-sawn~z90")
+    stick = manifold3d.Manifold.cube([60.0, 8.0, 8.0])
+    advice = advise_placement(stick, stock, rotations="z90", candidates=200)
+    best = advice.ranked[0]
+    assert best.ops[0] in ("rotate:z:90", "rotate:z:270")
+    axis = best.matrix[:3, :3] @ np.array([1.0, 0.0, 0.0])
+    centre = best.matrix[:3, 3]
+    grain = stock.wood.features(centre[None])["grain"][0]
+    runout_deg = np.degrees(np.arccos(abs(axis @ grain)))
+    assert runout_deg < 10.0  # the builtin's fibres dip 4 degrees: the stick follows them
+    assert advice.ranked[-1].terms["runout"] > 0.7  # across the grain, the worst
+
+
+def test_no_orientation_fits_is_a_clear_error(knotty):
+    with pytest.raises(WoodcamError, match="fits the 100x80x50 mm block in none"):
+        advise_placement(manifold3d.Manifold.cube([120.0, 10.0, 10.0]), knotty, rotations="none")
+    with pytest.raises(WoodcamError, match="rotations must be one of"):
+        advise_placement(manifold3d.Manifold.cube([10.0, 10.0, 10.0]), knotty, rotations="any")
+
+
+def test_the_part_report_warns_of_short_grain_only_across_the_fibres():
+    import trimesh
+
+    from woodcam.advise import part_report
+
+    stick = trimesh.creation.box((70.0, 10.0, 8.0))
+    stick.apply_translation([50.0, 40.0, 25.0])
+    along = part_report(stick, open_stock("builtin:flat-sawn"))  # fibres along X, like the stick
+    across = part_report(stick, open_stock("builtin:flat-sawn~z90"))  # fibres along Y
+    assert along["volume_mm3"] == pytest.approx(5600.0)
+    assert along["yield"] == pytest.approx(5600.0 / (100 * 80 * 50), abs=1e-4)
+    assert all(r["runout_deg"] < 10 for r in along["regions"])
+    assert not any("short grain" in w for w in along["warnings"])
+    assert all(r["runout_deg"] > 80 for r in across["regions"])
+    assert sum("short grain" in w for w in across["warnings"]) == 3
+    # end grain: the stick's two 10 x 8 ends out of its surface, when fibres run along it
+    ends = 2 * 10 * 8 / (2 * (70 * 10 + 70 * 8 + 10 * 8))
+    assert along["end_grain"] == pytest.approx(ends, abs=0.03)
+
+
+def test_knot_spots_find_the_knots_through_a_surface(knotty):
+    import trimesh
+
+    from woodcam.advise import knot_spots
+
+    box = trimesh.creation.box(knotty.size_mm)
+    box.apply_translation(np.asarray(knotty.size_mm) / 2)
+    spots = knot_spots(box, knotty.wood)
+    assert len(spots) >= 2  # the board through a whorl shows several knots on its faces
+    at = np.array([s["at_mm"] for s in spots])
+    assert (knotty.wood.features(at)["knot"] > 0.5).all()  # every spot sits on knot wood
+    clear = open_stock("builtin:flat-sawn")
+    assert knot_spots(box, clear.wood) == []

@@ -1,0 +1,29 @@
+"""woodcam cache: the user cache folder (XDG_CACHE_HOME), a size limit, info and clear."""
+
+from __future__ import annotations
+
+import os
+import time
+
+from woodcam._cache import cache_root, load_or_build, prune
+from woodcam.cli import main
+
+
+def test_cache_follows_xdg_and_keeps_under_its_limit(tmp_path, monkeypatch, capsys):
+    monkeypatch.delenv("WOODCAM_CACHE_DIR", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert cache_root() == tmp_path / "xdg" / "woodcam"
+    monkeypatch.setenv("WOODCAM_CACHE_MAX_MB", "1")  # 1 MiB: room for two 400 KiB entries
+    for i in range(4):
+        load_or_build(cache_root() / "fields" / f"e{i}.bin", load=lambda p: p.read_bytes(),
+                      build=lambda: os.urandom(400 * 1024),
+                      save=lambda v, p: p.write_bytes(v))
+        time.sleep(0.01)
+    names = sorted(p.name for p in (cache_root() / "fields").glob("*.bin"))
+    assert names == ["e2.bin", "e3.bin"]  # the least recently used went first
+    assert main(["cache", "info"]) == 0
+    assert "2 entries" in capsys.readouterr().out
+    assert main(["cache", "clear"]) == 0
+    assert "deleted 2 entries" in capsys.readouterr().out
+    assert list((cache_root() / "fields").glob("*.bin")) == []
+    assert prune(0) == 0

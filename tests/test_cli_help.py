@@ -1,0 +1,34 @@
+"""Every option of every command states its default, and every numeric option its unit."""
+
+from __future__ import annotations
+
+import argparse
+import re
+
+from woodcam.cli import _walk_options, build_parser
+
+#: Words that name a unit or what a number counts.
+UNITS = re.compile(
+    r"\b(mm|mm\^3|deg|degrees?|px|pixels?|texels?|years?|seconds?|s|%|MiB|GiB|voxels?|"
+    r"triangles?|blocks?|steps?|epochs?|workers?|threads?|faces?|points?|rings?|placements?|"
+    r"cells?|samples?|patches|sheets?|dpi|inch(es)?|times|per mm|in \[|fraction|ratio)\b", re.I)
+#: Numbers that are dimensionless by nature (named by the option itself).
+DIMENSIONLESS = {"--seed", "--k-stem", "--k-knot", "--quality"}
+
+
+def test_every_option_states_its_default():
+    missing = []
+    for path, action in _walk_options(build_parser()):
+        flag = isinstance(action, (argparse._StoreTrueAction, argparse._StoreFalseAction,
+                                   argparse._StoreConstAction, argparse._CountAction))
+        if not (flag or action.required or "default" in (action.help or "").lower()):
+            missing.append(f"{' '.join(path)} {action.option_strings[-1]}")
+    assert not missing, missing
+
+
+def test_every_numeric_option_names_its_unit():
+    missing = [f"{' '.join(path)} {a.option_strings[-1]}: {a.help!r}"
+               for path, a in _walk_options(build_parser())
+               if a.type in (int, float) and a.option_strings[-1] not in DIMENSIONLESS
+               and not UNITS.search(a.help or "")]
+    assert not missing, missing

@@ -1,0 +1,159 @@
+"""Bark: cracks from hoop stress run along a growing cylinder; texture and attributes carried from
+the input stay put; brushes speed growth up where painted."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from woodcam.errors import WoodcamError
+from woodcam.woodify import Brush, woodify
+from woodcam.woodify.cracks import growth_stress, separation, simulate_cracks
+from woodcam.woodify.surfaces import barycentric_on, carry, trace_back
+
+
+@pytest.fixture(scope="module")
+def cylinder():
+    cyl = trimesh.creation.cylinder(radius=8.0, height=60.0, sections=64)
+    return woodify(cyl, 5, growth_mm=6.0, resolution=64)
+
+
+def _edge_dirs(cs, lateral_half_height=22.0):
+    v = cs.mesh.vertices
+    e = v[cs.crack_edges[:, 1]] - v[cs.crack_edges[:, 0]]
+    e /= np.linalg.norm(e, axis=1, keepdims=True)
+    mid = v[cs.crack_edges].mean(1)
+    return e[np.abs(mid[:, 2]) < lateral_half_height]
+
+
+def test_hoop_stress_of_a_growing_cylinder_is_circumferential(cylinder):
+    mesh = cylinder.surface(4.0)
+    old, _ = trace_back(cylinder.front, mesh.vertices, until_mm=cylinder.tau(3.0))
+    sig = growth_stress(mesh, old)
+    c = mesh.triangles_center
+    lat = np.abs(c[:, 2]) < 20
+    hoop = np.stack([-c[:, 1], c[:, 0], np.zeros(len(c))], 1)
+    hoop /= np.linalg.norm(hoop, axis=1, keepdims=True)
+    s_hoop = np.einsum("fi,fij,fj->f", hoop, sig, hoop)[lat]
+    s_axial = sig[lat, 2, 2]
+    r3, r4 = 8.0 + cylinder.tau(3.0), 8.0 + cylinder.tau(4.0)
+    expect = 0.5 * ((r4 / r3) ** 2 - 1)  # Green-type stretch of the circumference
+    assert np.median(s_hoop) == pytest.approx(expect, rel=0.15)
+    assert np.median(np.abs(s_axial)) < 0.1 * expect
+    zeta = separation(mesh, sig)
+    _, V = np.linalg.eigh(zeta)
+    vl = np.abs(mesh.vertices[:, 2]) < 20
+    e = V[vl, :, -1]
+    hv = np.stack([-mesh.vertices[vl, 1], mesh.vertices[vl, 0], 0 * mesh.vertices[vl, 0]], 1)
+    hv /= np.linalg.norm(hv, axis=1, keepdims=True)
+    assert np.median(np.abs(np.sum(e * hv, 1))) > 0.95  # opening across the circumference
+
+
+def test_cracks_of_a_growing_cylinder_run_along_its_axis(cylinder):
+    cs = simulate_cracks(cylinder, [1, 2, 3, 4, 5])
+    lat = np.abs(cs.crack_points[:, 2]) < 22
+    assert lat.sum() >= 10
+    assert np.mean(np.abs(cs.crack_directions[lat, 2])) > 0.95
+    e = _edge_dirs(cs)
+    assert len(e) > 20 and np.mean(np.abs(e[:, 2])) > 0.9
+    # cracks carried year to year: the last year's mesh still has cracks inserted earlier
+    assert cs.log[0]["cracks"] > 0 and len(cs.crack_edges) > cs.log[-1]["cracks"]
+
+
+def test_crack_patterns_steer_the_direction(cylinder):
+    horiz = _edge_dirs(simulate_cracks(cylinder, [3, 4, 5], pattern="horizontal"))
+    assert len(horiz) > 20 and np.mean(np.abs(horiz[:, 2])) < 0.1
+    rand = _edge_dirs(simulate_cracks(cylinder, [3, 4, 5], pattern="random", seed=1))
+    assert 0.2 < np.mean(np.abs(rand[:, 2])) < 0.8
+    region = simulate_cracks(cylinder, [3, 4, 5], region=(8.0, 0.0, 10.0, 6.0))
+    pts = region.crack_points
+    assert len(pts) > 0 and np.all(np.linalg.norm(pts - [8 + cylinder.tau(5.0), 0, 10], axis=1) < 6 + 4 * cylinder.front.grid.spacing_mm + 3)
+
+
+def test_relief_zero_opens_fewer_cracks_than_one(cylinder):
+    few = simulate_cracks(cylinder, [3, 4, 5], relief=0.0)
+    many = simulate_cracks(cylinder, [3, 4, 5], relief=1.0)
+    assert sum(x["cracks"] for x in few.log) < sum(x["cracks"] for x in many.log)
+    with pytest.raises(WoodcamError, match="relief must lie in"):
+        simulate_cracks(cylinder, [3, 4], relief=1.5)
+
+
+def test_texture_coordinates_stay_put_while_growing():
+    """A vertex attribute (here the input's own coordinates) carried to the grown surface is
+    the point the growth came from: for a sphere, the radial projection."""
+    m = trimesh.creation.icosphere(subdivisions=4, radius=10.0)
+    r = woodify(m, 10, growth_mm=10.0, resolution=56)
+    s = r.surface(10.0)
+    origins, tri = r.origins(s.vertices)
+    _, bary = barycentric_on(m, origins, tri)
+    carried = carry(m, m.vertices, tri, bary)
+    radial = 10.0 * s.vertices / np.linalg.norm(s.vertices, axis=1, keepdims=True)
+    h = r.front.grid.spacing_mm
+    assert np.percentile(np.linalg.norm(carried - radial, axis=1), 95) < 0.5 * h
+    # eccentric: the characteristic is no longer radial, but origins still lie on the input
+    r2 = woodify(m, 10, growth_mm=10.0, resolution=56, eccentricity=0.3)
+    o2, _ = r2.origins(r2.surface(10.0).vertices)
+    assert np.abs(np.linalg.norm(o2, axis=1) - 10.0).max() < 0.5 * h
+
+
+def test_brush_gain_speeds_growth_where_painted():
+    m = trimesh.creation.icosphere(subdivisions=4, radius=10.0)
+    brush = Brush(centre_mm=(10.0, 0.0, 0.0), radius_mm=3.0, gain=1.8)
+    r = woodify(m, 10, growth_mm=8.0, resolution=56, brushes=[brush])
+    f = r.field
+    tau = r.tau(10.0)
+    # under the brush centre the front moved 1.8x as far (gain is 1.8 there), far from it 1x
+    h = r.front.grid.spacing_mm
+    assert f.arrival(np.array([[10.0 + 1.8 * tau, 0, 0]]))[0] == pytest.approx(tau, abs=1.5 * h)
+    assert f.arrival(np.array([[-10.0 - tau, 0, 0]]))[0] == pytest.approx(tau, abs=0.5 * h)
+    # a direction brush bends the growth: strength towards +Z on the +X side
+    bend = Brush(centre_mm=(10.0, 0.0, 0.0), radius_mm=3.0, direction=(0, 0, 1), strength=0.5)
+    r2 = woodify(m, 10, growth_mm=8.0, resolution=56, brushes=[bend])
+    assert r2.front.method == "anisotropic"
+    top = r2.field.arrival(np.array([[17.0, 0, 4.0]]))[0]
+    bottom = r2.field.arrival(np.array([[17.0, 0, -4.0]]))[0]
+    assert top < bottom - 0.5 * h
+    # and it bends only where painted: on the -X side the growth stays symmetric
+    left = r2.field.arrival(np.array([[-17.0, 0, 4.0], [-17.0, 0, -4.0]]))
+    assert abs(left[0] - left[1]) < 0.25 * h
+    with pytest.raises(WoodcamError, match="brush gain must be > 0"):
+        Brush(centre_mm=(0, 0, 0), radius_mm=1.0, gain=0.0)
+
+
+def test_vertex_attribute_gain_is_painted_like_a_brush():
+    m = trimesh.creation.icosphere(subdivisions=4, radius=10.0)
+    gain = np.where(m.vertices[:, 2] > 0, 1.5, 1.0)  # the upper half grows 1.5x as fast
+    r = woodify(m, 10, growth_mm=8.0, resolution=56, vertex_gain=gain)
+    h = r.front.grid.spacing_mm
+    tau = r.tau(10.0)
+    assert r.field.arrival(np.array([[0, 0, 10.0 + 1.5 * tau]]))[0] == pytest.approx(tau, abs=h)
+    assert r.field.arrival(np.array([[0, 0, -10.0 - tau]]))[0] == pytest.approx(tau, abs=0.5 * h)
+
+
+def test_groove_cuts_cracks_into_the_surface(cylinder):
+    from woodcam.woodify.bark import groove
+
+    cs = simulate_cracks(cylinder, [3, 4, 5])
+    width = np.zeros(len(cs.mesh.vertices))
+    width[cs.crack_edges.ravel()] = 1.0
+    cut = groove(cs.mesh, width, 0.5)
+    r0 = np.hypot(*cs.mesh.vertices[:, :2].T)
+    r1 = np.hypot(*cut.vertices[:, :2].T)
+    lat = np.abs(cs.mesh.vertices[:, 2]) < 20
+    on = lat & (width > 0)
+    assert np.all(r1[on] < r0[on] - 0.4) and np.allclose(r1[lat & (width == 0)], r0[lat & (width == 0)])
+
+
+def test_brush_file_round_trip_and_errors(tmp_path):
+    from woodcam.woodify import load_brushes
+
+    p = tmp_path / "brushes.json"
+    p.write_text('{"brushes": [{"centre_mm": [1, 2, 3], "radius_mm": 4, "gain": 1.5, '
+                 '"direction": [0, 0, 2], "strength": 0.25}, {"centre_mm": [0, 0, 0], "radius_mm": 1}]}')
+    a, b = load_brushes(p)
+    assert a == Brush((1, 2, 3), 4.0, 1.5, (0.0, 0.0, 1.0), 0.25) and b.gain == 1.0
+    assert a.weight(np.array([[1.0, 2.0, 3.0], [5.0, 2.0, 3.0]])) == pytest.approx([1.0, np.exp(-0.5)])
+    p.write_text('{"brushes": [{"radius_mm": 4}]}')
+    with pytest.raises(WoodcamError, match="brushes file .* must be JSON like"):
+        load_brushes(p)

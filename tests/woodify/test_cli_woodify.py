@@ -1,0 +1,111 @@
+"""``woodcam woodify`` writes its products, and ``bake --block woodify:...`` carves from them."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from woodcam.cli import main
+from woodcam.errors import WoodcamError
+from woodcam.stock import open_stock
+from woodcam.woodify import WoodifiedField
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def grown_dir(tmp_path_factory):
+    d = tmp_path_factory.mktemp("woodify")
+    trunk = trimesh.creation.cylinder(radius=6.0, height=30.0, sections=32)
+    trunk.export(d / "trunk.stl")
+    out = d / "tree"
+    rc = main(["woodify", str(d / "trunk.stl"), "--years", "8", "--growth", "30",
+               "--eccentricity", "0.2", "--up", "1,0,0", "--resolution", "48", "--crack-years", "2",
+               "--block-size", "100x80x50", "--block-centre", "5,0,0", "--out", str(out)])
+    assert rc == 0
+    return out
+
+
+def test_woodify_writes_field_surfaces_sections_and_bark(grown_dir):
+    for name in ("field.npz", "grown.glb", "section_xz.png", "section_xy.png", "woodify.json",
+                 "surface_y2.stl", "surface_y4.stl", "surface_y6.stl"):
+        assert (grown_dir / name).is_file(), name
+    assert not list(grown_dir.glob("tmp*")), "temporary files left behind"
+    s = trimesh.load(grown_dir / "surface_y4.stl")
+    assert s.is_watertight
+    f = WoodifiedField.load(grown_dir / "field.npz")
+    assert f.block_size_mm == (100.0, 80.0, 50.0)
+    # block centre (5, 0, 0) in the object: the block's centre point is 5 mm off the trunk axis
+    # inside the input (year 0); a block corner lies beyond the final bark (> 8 years)
+    assert f(np.array([[50.0, 40.0, 25.0]]))[0] == 0.0
+    assert f(np.array([[0.0, 0.0, 0.0]]))[0] > 8.0
+    from woodcam.export import load_textured
+
+    glb = load_textured(grown_dir / "grown.glb")
+    assert glb.visual.uv is not None and len(glb.faces) > 100
+    summary = json.loads((grown_dir / "woodify.json").read_text())
+    assert summary["method"] == "offset" and summary["cracks"]["count"] >= 0
+
+
+def test_bake_carves_a_bowl_from_the_grown_wood(grown_dir, tmp_path):
+    spec = f"woodify:{grown_dir / 'field.npz'}"
+    stock = open_stock(spec)
+    assert stock.size_mm == (100.0, 80.0, 50.0)
+    out = tmp_path / "bowl.glb"
+    rc = main(["bake", str(REPO / "cad_examples" / "bowl.py"), "--block", spec, "--out", str(out),
+               "--texels-per-mm", "1.5", "--no-obj"])
+    assert rc == 0 and out.stat().st_size > 10_000
+
+
+def test_cli_errors_are_one_line(tmp_path, capsys):
+    m = trimesh.creation.icosphere(subdivisions=2, radius=5.0)
+    m.export(tmp_path / "ball.stl")
+    assert main(["woodify", str(tmp_path / "ball.stl"), "--years", "0", "--out", str(tmp_path / "o")]) == 1
+    assert "--years must be > 0" in capsys.readouterr().err
+    trimesh.Trimesh(m.vertices, m.faces[:-4]).export(tmp_path / "open.stl")
+    assert main(["woodify", str(tmp_path / "open.stl"), "--years", "3", "--out", str(tmp_path / "o")]) == 1
+    assert "must be watertight" in capsys.readouterr().err
+    with pytest.raises(WoodcamError, match="does not exist"):
+        open_stock(f"woodify:{tmp_path / 'missing.npz'}")
+
+
+def test_input_texture_is_carried_to_the_grown_bark(tmp_path):
+    """A textured input (UV = longitude, latitude) keeps its picture in place: every grown
+    vertex's UV is the UV of the input point straight below it (radial growth of a sphere)."""
+    from PIL import Image
+
+    m = trimesh.creation.icosphere(subdivisions=3, radius=8.0)
+    v = m.vertices / 8.0
+    uv = np.c_[0.5 + np.arctan2(v[:, 1], v[:, 0]) / (2 * np.pi), 0.5 + np.arcsin(v[:, 2]) / np.pi]
+    img = Image.fromarray((np.random.default_rng(0).random((64, 64, 3)) * 255).astype(np.uint8))
+    m.visual = trimesh.visual.TextureVisuals(uv=uv, image=img)
+    m.export(tmp_path / "ball.glb")
+    out = tmp_path / "grown"
+    assert main(["woodify", str(tmp_path / "ball.glb"), "--years", "5", "--growth", "6",
+                 "--resolution", "40", "--cracks", "none", "--out", str(out)]) == 0
+    from woodcam.export import load_textured
+
+    g = load_textured(out / "grown.glb")
+    p = g.vertices / np.linalg.norm(g.vertices, axis=1, keepdims=True)
+    lat = 0.5 + np.arcsin(p[:, 2]) / np.pi
+    # latitude is smooth everywhere (longitude wraps at the seam): compare it
+    assert np.percentile(np.abs(g.visual.uv[:, 1] - lat), 95) < 0.03
+
+
+def test_ply_vertex_properties_paint_the_growth(tmp_path):
+    """A PLY's per-vertex 'gain' speeds the growth where it is painted (seed sec. 4.2.2)."""
+    m = trimesh.creation.icosphere(subdivisions=3, radius=8.0)
+    m.vertex_attributes["gain"] = np.where(m.vertices[:, 2] > 0, 1.6, 1.0).astype(np.float32)
+    (tmp_path / "ball.ply").write_bytes(trimesh.exchange.ply.export_ply(m, include_attributes=True))
+    out = tmp_path / "grown"
+    assert main(["woodify", str(tmp_path / "ball.ply"), "--years", "5", "--growth", "6",
+                 "--resolution", "40", "--cracks", "none", "--out", str(out)]) == 0
+    f = WoodifiedField.load(out / "field.npz")
+    # block point = object point - block origin (no rotation); 6 mm grown where gain is 1
+    top = f.arrival(np.array([[0, 0, 8 + 6 * 1.6]]) - f.block_origin_mm)
+    bottom = f.arrival(np.array([[0, 0, -8 - 6.0]]) - f.block_origin_mm)
+    assert top[0] == pytest.approx(6.0, abs=1.5) and bottom[0] == pytest.approx(6.0, abs=0.6)

@@ -1,0 +1,173 @@
+"""Woodification growth against analytic answers: Weibull time, spheres, eccentric offsets,
+merging fronts, a closing torus hole, and the growth field's mapping."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from woodcam.errors import WoodcamError
+from woodcam.woodify import GrowthSpeed, VoxelGrid, propagate, sphere_arrival, woodify
+from woodcam.woodify.front import offset_arrival
+from woodcam.woodify.speed import weibull_cdf, weibull_cdf_inv, weibull_speed
+
+
+def _fit_sphere(points):
+    """Least-squares sphere through points: (centre (3,), radius)."""
+    A = np.c_[2 * points, np.ones(len(points))]
+    b = np.sum(points ** 2, axis=1)
+    sol, *_ = np.linalg.lstsq(A, b, rcond=None)
+    c = sol[:3]
+    return c, float(np.sqrt(sol[3] + c @ c))
+
+
+def test_weibull_cdf_is_the_integral_of_eq_4_1_and_inverts():
+    u = np.linspace(0.05, 3, 3001)  # from 0.05: the c < 1 density is singular at 0
+    for c in (0.7, 1.0, 2.0, 3.0):
+        s = weibull_speed(u, c)
+        integral = np.concatenate([[0], np.cumsum(0.5 * (s[1:] + s[:-1]) * np.diff(u))])
+        assert np.allclose(weibull_cdf(u, c) - weibull_cdf(0.05, c), integral, atol=1e-4)
+        assert np.allclose(weibull_cdf_inv(weibull_cdf(u, c), c), u, rtol=1e-6)
+
+
+def test_growth_speed_separates_time():
+    sp = GrowthSpeed(velocity_mm=20.0, time_scale_years=30.0, shape=2.0, eccentricity=0.3)
+    t = np.array([0.0, 1.0, 10.0, 40.0])
+    assert np.allclose(sp.years(sp.tau(t)), t)
+    assert sp.years(-1.0) == 0.0 and np.isinf(sp.years(20.0))
+    # ds/dt of tau is the speed of eq. 4.1 (times the scales)
+    e = 1e-4
+    assert np.allclose((sp.tau(t[1:] + e) - sp.tau(t[1:] - e)) / (2 * e), sp.speed(t[1:]), rtol=1e-5)
+    up = np.array([[0.0, 0.0, 1.0]])
+    assert np.isclose(sp.speed(10.0, up)[0], 1.3 * sp.speed(10.0))
+
+
+@pytest.mark.parametrize("method", ["fmm", "anisotropic"])
+def test_sphere_grows_to_r0_plus_v_w_t(method):
+    m = trimesh.creation.icosphere(subdivisions=4, radius=10.0)
+    r = woodify(m, 10, growth_mm=12.0, resolution=56, method=method)
+    h = r.front.grid.spacing_mm
+    for year in (3.0, 10.0):
+        s = r.surface(year)
+        assert s.is_watertight
+        rad = np.linalg.norm(s.vertices, axis=1)
+        expect = 10.0 + r.speed.velocity_mm * weibull_cdf(year / r.speed.time_scale_years, 2.0)
+        assert np.abs(rad - expect).max() < 0.5 * h, (year, rad.min(), rad.max(), expect)
+
+
+@pytest.mark.parametrize("method", ["offset", "anisotropic"])
+def test_eccentric_sphere_centre_moves_by_delta_tau(method):
+    m = trimesh.creation.icosphere(subdivisions=4, radius=8.0)
+    up = np.array([0.6, 0.0, 0.8])
+    r = woodify(m, 20, growth_mm=14.0, resolution=56, eccentricity=0.4, up=up, method=method)
+    h = r.front.grid.spacing_mm
+    for year in (8.0, 20.0):
+        tau = r.tau(year)
+        s = r.surface(year)
+        c, rad = _fit_sphere(s.vertices)
+        assert np.linalg.norm(c - 0.4 * tau * up) < 0.5 * h, (c, 0.4 * tau * up)
+        assert abs(rad - (8.0 + tau)) < 0.5 * h
+        # every vertex on the exact offset (|x - c - w tau| = r0 + tau)
+        T = sphere_arrival(s.vertices, (0, 0, 0), 8.0, 0.4 * up)
+        assert np.abs(T - tau).max() < 0.5 * h
+
+
+def test_eccentric_front_of_a_box_is_the_shifted_offset():
+    """Any shape: the grid solvers against the exact offset by bisection on a box."""
+    half = np.array([10.0, 6.0, 4.0])
+    box = trimesh.creation.box(2 * half)
+
+    def box_distance(p):  # exact distance outside an axis-aligned box
+        return np.linalg.norm(np.maximum(np.abs(p) - half, 0.0), axis=1)
+
+    w = np.array([0.0, 0.25, 0.25])
+    grid = VoxelGrid.around((-25, -25, -25), (25, 25, 25), 48)
+    rng = np.random.default_rng(3)
+    pts = rng.uniform(-20, 20, (400, 3))
+    pts = pts[box_distance(pts) > 0.5]
+    exact = offset_arrival(box_distance, pts, w)
+    keep = exact < 15.0  # x - w T stays inside the grid (woodify sizes its grid so)
+    pts, exact = pts[keep], exact[keep]
+    for method in ("offset", "anisotropic"):
+        f = propagate(box, grid, wind=w, method=method)
+        idx = grid.to_index(pts).T
+        from scipy import ndimage
+
+        T = ndimage.map_coordinates(f.arrival_mm, idx, order=1)
+        err = np.abs(T - exact) / grid.spacing_mm
+        # corners of the box are rounded by the offset; interpolation adds ~1/4 voxel there
+        assert np.percentile(err, 95) < 0.5 and err.max() < 1.0, (method, err.max())
+
+
+def test_two_spheres_merge_into_one_component():
+    a = trimesh.creation.icosphere(subdivisions=3, radius=6.0)
+    b = a.copy()
+    b.apply_translation((20.0, 0, 0))
+    both = trimesh.util.concatenate([a, b])
+    r = woodify(both, 10, growth_mm=8.0, resolution=64)
+    h = r.front.grid.spacing_mm
+    merge_tau = 20.0 / 2 - 6.0  # the fronts meet half way
+    year_merge = float(r.speed.years(merge_tau))
+    before = r.surface(float(r.speed.years(merge_tau - 1.5 * h)))
+    after = r.surface(float(r.speed.years(merge_tau + 1.5 * h)))
+    assert len(before.split(only_watertight=False)) == 2
+    assert len(after.split(only_watertight=False)) == 1
+    assert 0 < year_merge < 10
+
+
+def test_torus_hole_closes_at_the_predicted_year():
+    R, rr = 12.0, 4.0
+    torus = trimesh.creation.torus(major_radius=R, minor_radius=rr, major_sections=64, minor_sections=32)
+    r = woodify(torus, 10, growth_mm=12.0, resolution=64)
+    h = r.front.grid.spacing_mm
+    close_tau = R - rr  # the hole's centre is R - r from the tube
+    t_pred = float(r.speed.years(close_tau))
+
+    def genus(mesh):
+        return (2 - mesh.euler_number) // 2
+
+    before = r.surface(float(r.speed.years(close_tau - 1.5 * h)))
+    after = r.surface(float(r.speed.years(close_tau + 1.5 * h)))
+    assert genus(before) == 1 and genus(after) == 0
+    # the field says the same: the centre of the hole grows in at t_pred. The arrival time has
+    # a cone-shaped peak there (fronts meeting from all round), which trilinear interpolation
+    # between nodes up to sqrt(3)/2 voxels away cuts by up to that much.
+    t_centre = r.field(np.zeros((1, 3)))[0]
+    assert r.speed.years(close_tau - 0.9 * h) < t_centre <= t_pred
+
+
+def test_field_is_the_arrival_time_mapping_monotone_and_agrees_with_surfaces():
+    m = trimesh.creation.capsule(height=20.0, radius=5.0)
+    r = woodify(m, 30, growth_mm=10.0, resolution=48, time_scale_years=25.0)
+    g = r.front.grid
+    nodes = g.nodes()
+    T = r.front.arrival_mm.ravel()
+    ok = np.isfinite(T) & (T < r.speed.velocity_mm * 0.999)
+    expect = np.where(T[ok] <= 0, 0.0, 25.0 * weibull_cdf_inv(T[ok] / r.speed.velocity_mm))
+    assert np.allclose(r.field(nodes[ok]), expect, rtol=1e-5, atol=1e-4)
+    # monotone outward along rays from the axis
+    d = np.array([[1.0, 0.3, 0.2]]) / np.linalg.norm([1.0, 0.3, 0.2])
+    s = np.linspace(0, 14, 200)[:, None]
+    y = r.field(s * d)
+    assert np.all(np.diff(y) >= -1e-9) and y[0] == 0.0 and y[-1] > 25
+    # ring lines (integer years) pass through the grown surfaces of those years
+    for year in (5.0, 20.0):
+        surf = r.surface(year)
+        assert np.abs(r.field(surf.vertices) - year).max() < 1e-3
+
+
+def test_errors_are_clear():
+    m = trimesh.creation.icosphere(subdivisions=2, radius=5.0)
+    with pytest.raises(WoodcamError, match="years must be a number > 0"):
+        woodify(m, 0)
+    with pytest.raises(WoodcamError, match="years must be a number > 0"):
+        woodify(m, -3)
+    open_mesh = trimesh.Trimesh(m.vertices, m.faces[:-3])
+    with pytest.raises(WoodcamError, match="must be watertight"):
+        woodify(open_mesh, 5)
+    big = trimesh.creation.box((40.0, 40.0, 40.0))
+    with pytest.raises(WoodcamError, match="contain the whole input"):
+        woodify(m, 5, obstacles=[big], resolution=32)
+    with pytest.raises(WoodcamError, match="eccentricity must lie in"):
+        woodify(m, 5, eccentricity=1.2)

@@ -1,0 +1,98 @@
+"""Woodify benchmarks (``-m bench``): the issue's figures with a same-run baseline.
+
+Times are CPU seconds of this process (``time.process_time``), which the shared machine's load
+inflates less than wall clock; the baseline is scikit-fmm's ``travel_time`` alone on the same
+grid in the same run. Printed as one JSON line per figure.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+
+import numpy as np
+import pytest
+import trimesh
+
+from woodcam.woodify import woodify
+from woodcam.woodify.cracks import simulate_cracks
+
+pytestmark = pytest.mark.bench
+
+
+def _tree_mesh(target_faces: int = 20_000):
+    """A trunk with two branches (manifold union), refined to about ``target_faces`` triangles."""
+    import manifold3d as m3
+
+    trunk = m3.Manifold.cylinder(80.0, 9.0, 7.0, 48).translate((0, 0, -40))
+    b1 = m3.Manifold.cylinder(40.0, 4.0, 2.5, 32).rotate((0, 50, 0)).translate((0, 0, -5))
+    b2 = m3.Manifold.cylinder(35.0, 3.5, 2.0, 32).rotate((-45, 0, 30)).translate((0, 0, 15))
+    solid = trunk + b1 + b2
+    mesh = solid.to_mesh()
+    tm = trimesh.Trimesh(mesh.vert_properties[:, :3], mesh.tri_verts)
+    while len(tm.faces) < target_faces:
+        tm = tm.subdivide()
+    return tm
+
+
+def _report(name, **values):
+    load = os.getloadavg()[0]
+    print(json.dumps({"figure": name, "load_1min": round(load, 2), **values}))
+
+
+def test_field_of_a_20k_triangle_mesh_at_128():
+    import skfmm
+
+    mesh = _tree_mesh()
+    nf = len(mesh.faces)
+    t = time.process_time()
+    res = woodify(mesh, 40, growth_mm=20.0, resolution=128)
+    t_woodify = time.process_time() - t
+    g = res.front.grid
+    # baseline: scikit-fmm alone on the same grid (a sphere's level set as input)
+    phi = np.linalg.norm(g.nodes() - mesh.centroid, axis=1).reshape(g.shape) - 10.0
+    t = time.process_time()
+    skfmm.travel_time(phi, np.ones_like(phi), dx=float(g.spacing_mm))
+    t_skfmm = time.process_time() - t
+    _report("field 40 years, isotropic", triangles=nf, grid=list(g.shape), method=res.front.method,
+            woodify_cpu_s=round(t_woodify, 2), skfmm_alone_cpu_s=round(t_skfmm, 2),
+            ratio=round(t_woodify / t_skfmm, 2))
+    t = time.process_time()
+    ecc = woodify(mesh, 40, growth_mm=20.0, resolution=128, eccentricity=0.3)
+    t_ecc = time.process_time() - t
+    _report("field 40 years, eccentric", method=ecc.front.method, cpu_s=round(t_ecc, 2),
+            ratio_to_skfmm=round(t_ecc / t_skfmm, 2))
+    post = trimesh.creation.cylinder(radius=3.0, height=200.0, sections=32)
+    post.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (1, 0, 0)))
+    post.apply_translation((20.0, 0.0, 0.0))
+    t = time.process_time()
+    obs = woodify(mesh, 40, growth_mm=20.0, resolution=128, eccentricity=0.3, obstacles=[post])
+    t_obs = time.process_time() - t
+    _report("field 40 years, eccentric + obstacle", method=obs.front.method, cpu_s=round(t_obs, 2),
+            ratio_to_skfmm=round(t_obs / t_skfmm, 2))
+    # field evaluation: 1M random points in the grown object's box
+    rng = np.random.default_rng(0)
+    lo = np.asarray(g.origin_mm)
+    pts = lo + rng.random((1_000_000, 3)) * (np.asarray(g.shape) - 1) * g.spacing_mm
+    res.field(pts[:1000])
+    t, tw = time.process_time(), time.perf_counter()
+    res.field(pts)
+    dt, dw = time.process_time() - t, time.perf_counter() - tw
+    _report("field evaluation", points=len(pts), points_per_cpu_s=round(len(pts) / dt),
+            points_per_wall_s=round(len(pts) / dw), cpu_s=round(dt, 3))
+    assert len(pts) / dt > 1e6
+
+
+def test_whole_run_with_cracks_and_surfaces_at_5_years():
+    mesh = _tree_mesh()
+    t = time.process_time()
+    res = woodify(mesh, 5, growth_mm=6.0, resolution=128)
+    cs = simulate_cracks(res, [0, 1, 2, 3, 4, 5])
+    surfaces = [res.surface(y) for y in (1.0, 2.0, 3.0, 4.0)]
+    dt = time.process_time() - t
+    _report("whole run 5 years with cracks and surfaces", triangles=len(mesh.faces),
+            grid=list(res.front.grid.shape), final_vertices=len(cs.mesh.vertices),
+            cracks=int(sum(x["cracks"] for x in cs.log)), cpu_s=round(dt, 2),
+            timings=res.timings)
+    assert all(s.is_watertight for s in surfaces)

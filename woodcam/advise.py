@@ -1,0 +1,337 @@
+"""Placement advice: where in this block should the part go?
+
+Searches placements of a part in a block -- the rotations the user allows times translations
+on a grid over every position where the part's bounding box fits -- and ranks them by what a
+woodworker cares about, each term reported on its own (all in [0, 1], lower is better):
+
+``knots``      share of the part's surface (and the wood 1 and 3 mm under it) inside a knot
+``pith``       share of the same points within :data:`PITH_YEARS` of the pith (the pith
+               splits and checks as it dries)
+``end_grain``  share of the surface area whose normal is within 45 degrees of the fibres:
+               end grain finishes darker and rougher
+``runout``     for long thin parts only: the angle between the part's long axis and the mean
+               fibre direction over 90 degrees, times the part's elongation (short grain
+               across a thin section is where it breaks)
+
+``score`` is their weighted sum (:data:`DEFAULT_WEIGHTS`). Every candidate is scored from the
+same sample of surface points (area-weighted) evaluated through :meth:`Wood.features`, all
+candidates of one rotation in one vectorised batch.
+
+The winning transform is expressed as ``--place`` operations (:mod:`woodcam.cad.place`):
+``rotate:AXIS:DEG`` steps and one ``translate:X,Y,Z``, so ``woodcam bake --place ...`` reproduces
+it.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import WoodcamError
+
+#: Points within this many years of the pith count as pith (juvenile wood and the pith itself).
+PITH_YEARS = 2.0
+#: Depths (mm) under the surface sampled besides the surface itself: a knot 1-3 mm under a
+#: visible face shows after sanding or finishing cuts.
+SUBSURFACE_MM = (1.0, 3.0)
+#: Weights of the terms in ``score``; knots and pith matter most to a woodworker.
+DEFAULT_WEIGHTS = {"knots": 4.0, "pith": 3.0, "end_grain": 1.0, "runout": 2.0}
+#: Allowed rotation sets: none, quarter turns about z, or all 24 axis-aligned orientations.
+ROTATION_SETS = ("none", "z90", "all90")
+
+
+@dataclass
+class Placement:
+    """One candidate: its ``--place`` operations, transform and scores."""
+
+    ops: list[str]
+    matrix: np.ndarray
+    terms: dict[str, float]
+    score: float
+
+
+@dataclass
+class PlacementAdvice:
+    """What :func:`advise_placement` returns: candidates ranked best first."""
+
+    ranked: list[Placement]
+    candidates: int
+    elongation: float
+    weights: dict[str, float] = field(default_factory=dict)
+
+    def table(self, top: int = 5) -> str:
+        """The top placements as text, one line each, with every term."""
+        lines = [f"{'rank':>4} {'score':>6} {'knots':>6} {'pith':>6} {'end':>6} {'runout':>6}  place"]
+        for i, p in enumerate(self.ranked[:top], 1):
+            t = p.terms
+            lines.append(f"{i:>4} {p.score:6.3f} {t['knots']:6.3f} {t['pith']:6.3f} "
+                         f"{t['end_grain']:6.3f} {t['runout']:6.3f}  "
+                         + " ".join(f"--place {o}" for o in p.ops))
+        return "\n".join(lines)
+
+
+def _orientations(rotations: str) -> list[tuple[list[str], np.ndarray]]:
+    """(ops, 3x3 matrix) of every allowed orientation, duplicates removed."""
+    from .cad.place import _rotation
+
+    if rotations not in ROTATION_SETS:
+        raise WoodcamError(f"rotations must be one of {ROTATION_SETS}; got {rotations!r}")
+    if rotations == "none":
+        return [([], np.eye(3))]
+    if rotations == "z90":
+        return [([f"rotate:z:{90 * k}"] if k else [], _rotation(2, 90.0 * k)) for k in range(4)]
+    seen, out = set(), []
+    for ax, ay, az in itertools.product(range(4), repeat=3):
+        m = _rotation(2, 90.0 * az) @ _rotation(1, 90.0 * ay) @ _rotation(0, 90.0 * ax)
+        key = tuple(np.round(m).astype(int).ravel())
+        if key in seen:
+            continue
+        seen.add(key)
+        ops = [f"rotate:{a}:{90 * k}" for a, k in (("x", ax), ("y", ay), ("z", az)) if k]
+        out.append((ops, m))
+    return out
+
+
+def _part_mesh(part):
+    """Any part source -> its surface as a ``trimesh.Trimesh`` (block frame, mm)."""
+    import trimesh
+
+    from .cad import load_part
+
+    data = load_part(part).to_mesh()
+    return trimesh.Trimesh(np.asarray(data.vert_properties)[:, :3], np.asarray(data.tri_verts),
+                           process=False)
+
+
+def _sample(mesh, count: int, rng):
+    """Area-weighted surface points and normals of ``mesh`` (block frame, mm)."""
+    areas = np.asarray(mesh.area_faces, dtype=float)
+    tri = rng.choice(len(areas), size=count, p=areas / areas.sum())
+    u, v = rng.random(count), rng.random(count)
+    flip = u + v > 1
+    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+    corners = np.asarray(mesh.vertices)[np.asarray(mesh.faces)[tri]]
+    points = corners[:, 0] + u[:, None] * (corners[:, 1] - corners[:, 0]) \
+        + v[:, None] * (corners[:, 2] - corners[:, 0])
+    return points, np.asarray(mesh.face_normals)[tri]
+
+
+def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1000,
+                     margin_mm: float = 1.0, samples: int = 1500,
+                     weights: dict[str, float] | None = None, seed: int = 0) -> PlacementAdvice:
+    """Rank placements of ``part`` in ``stock`` (see module docstring).
+
+    Parameters
+    ----------
+    part : manifold3d.Manifold or any source :func:`woodcam.cad.load_part` takes
+        The part as modelled (block frame, mm); its position is only the starting point.
+    stock : woodcam.stock.Stock
+    rotations : {"none", "z90", "all90"}
+        Orientations to try (about the part's bounding-box centre).
+    candidates : int
+        About how many placements to score in all (split over the orientations).
+    margin_mm : float
+        Smallest distance kept between the part's bounding box and the block faces.
+    samples : int
+        Surface points per candidate (each also sampled 1 and 3 mm under the surface).
+    weights : dict, optional
+        Term weights; default :data:`DEFAULT_WEIGHTS`.
+    seed : int
+        Seed of the surface sample.
+    """
+    if not (isinstance(candidates, int) and 1 <= candidates <= 1_000_000):
+        raise WoodcamError(f"candidates must be an integer in [1, 1e6]; got {candidates!r}")
+    if not (math.isfinite(margin_mm) and margin_mm >= 0):
+        raise WoodcamError(f"margin_mm must be a finite number >= 0; got {margin_mm!r}")
+    w = {**DEFAULT_WEIGHTS, **(weights or {})}
+    mesh = _part_mesh(part)
+    rng = np.random.default_rng(seed)
+    pts, nrm = _sample(mesh, samples, rng)
+    depth_pts = np.concatenate([pts] + [pts - d * nrm for d in SUBSURFACE_MM])
+    lo, hi = mesh.bounds
+    centre = (lo + hi) / 2
+    # the part's long axis and how long-and-thin it is (principal axes of the surface sample)
+    evals, evecs = np.linalg.eigh(np.cov((pts - pts.mean(axis=0)).T))
+    long_axis = evecs[:, -1]
+    elongation = float(1.0 - math.sqrt(max(evals[1], 0.0) / max(evals[2], 1e-12)))
+    size = np.asarray(stock.size_mm, dtype=float)
+    orients = _orientations(rotations)
+    per = max(1, candidates // len(orients))
+    ranked: list[Placement] = []
+    for ops, rot in orients:
+        local = depth_pts - centre
+        ext = np.abs(rot) @ (hi - lo)  # rotated bounding-box extent
+        room = size - 2 * margin_mm - ext
+        if np.any(room < -1e-9):
+            continue  # this orientation does not fit
+        # translation grid: about `per` positions spread over the free room
+        free_axes = room > 1e-9
+        k = max(1, int(round(per ** (1.0 / max(1, free_axes.sum())))))
+        grids = [np.linspace(margin_mm + e / 2, margin_mm + e / 2 + r, k) if f else
+                 np.array([margin_mm + e / 2 + max(r, 0.0) / 2])
+                 for e, r, f in zip(ext, room, free_axes)]
+        centres = np.stack(np.meshgrid(*grids, indexing="ij"), axis=-1).reshape(-1, 3)
+        turned = local @ rot.T
+        n_rot = nrm @ rot.T
+        axis_rot = rot @ long_axis
+        points = (turned[None] + centres[:, None]).reshape(-1, 3)
+        feats = stock.wood.features(points)
+        n_pts = len(turned)
+        knot = feats["knot"].reshape(len(centres), n_pts) > 0.5
+        # inside a knot, years count along the branch: its own pith is knot, not stem pith
+        pith = (feats["years"].reshape(len(centres), n_pts) < PITH_YEARS) & ~knot
+        grain = feats["grain"].reshape(len(centres), n_pts, 3)[:, :len(pts)]
+        end = np.abs(np.einsum("cij,ij->ci", grain, n_rot)) > math.cos(math.radians(45))
+        mean_grain = grain.mean(axis=1)
+        mean_grain /= np.maximum(np.linalg.norm(mean_grain, axis=1, keepdims=True), 1e-12)
+        runout = np.degrees(np.arccos(np.clip(np.abs(mean_grain @ axis_rot), 0, 1))) / 90.0
+        terms = {"knots": knot.mean(axis=1), "pith": pith.mean(axis=1),
+                 "end_grain": end.mean(axis=1), "runout": runout * elongation}
+        score = sum(w[name] * value for name, value in terms.items())
+        for i, c in enumerate(centres):
+            move = c - rot @ centre  # p -> rot (p - centre) + c
+            matrix = np.eye(4)
+            matrix[:3, :3], matrix[:3, 3] = rot, move
+            # rotations act about the bounding-box centre; then one translation lands it
+            shift = c - centre
+            ranked.append(Placement(
+                ops=[*ops, "translate:" + ",".join(f"{v:.3f}" for v in shift)],
+                matrix=matrix, terms={n: float(v[i]) for n, v in terms.items()},
+                score=float(score[i])))
+    if not ranked:
+        raise WoodcamError(
+            f"advise_placement: the part ({'x'.join(f'{v:.1f}' for v in hi - lo)} mm) fits the "
+            f"{'x'.join(f'{v:g}' for v in size)} mm block in none of the '{rotations}' "
+            f"orientations with a {margin_mm:g} mm margin; allow more rotations, a smaller margin "
+            "or a bigger block")
+    ranked.sort(key=lambda p: p.score)
+    return PlacementAdvice(ranked, len(ranked), elongation, w)
+
+
+def render_advice(advice: PlacementAdvice, part, stock, png, *, top: int = 3):
+    """The ``top`` placements side by side in one PNG (see :mod:`woodcam.view.compare`)."""
+    from .view.compare import render_side_by_side
+
+    base = _part_mesh(part)
+    meshes, titles = [], []
+    for i, p in enumerate(advice.ranked[:top], 1):
+        m = base.copy()
+        m.apply_transform(p.matrix)
+        meshes.append(m)
+        t = p.terms
+        titles.append(f"#{i} score {p.score:.2f}\nknots {t['knots']:.2f} pith {t['pith']:.2f}\n"
+                      f"end grain {t['end_grain']:.2f} runout {t['runout']:.2f}")
+    worst = advice.ranked[-1]
+    m = base.copy()
+    m.apply_transform(worst.matrix)
+    meshes.append(m)
+    titles.append(f"worst: score {worst.score:.2f}\nknots {worst.terms['knots']:.2f} "
+                  f"pith {worst.terms['pith']:.2f}")
+    return render_side_by_side(meshes, [stock.wood] * len(meshes), stock.size_mm, titles, png)
+
+
+#: A region of a long thin part whose fibres cross its long axis by more than this is short
+#: grain: it breaks along the fibres under a small load.
+SHORT_GRAIN_DEG = 30.0
+#: Regions the part report splits a part into along its long axis.
+REPORT_REGIONS = 3
+
+
+def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
+    """What the wood will do in ``mesh`` (a carved part, block frame, mm) as placed.
+
+    Returns a JSON-able dict: ``volume_mm3``, ``yield`` (part / block volume), the terms of
+    :func:`advise_placement` for this placement (``knots``, ``pith``, ``end_grain``,
+    ``runout``), and ``regions``: the part cut into :data:`REPORT_REGIONS` slabs along its long
+    axis, each with its mean fibre direction, runout angle (degrees) and knot share; plus
+    ``warnings`` in words (short grain, knots or pith on the surface).
+    """
+    rng = np.random.default_rng(seed)
+    pts, nrm = _sample(mesh, samples, rng)
+    depth = np.concatenate([pts] + [pts - d * nrm for d in SUBSURFACE_MM])
+    feats = stock.wood.features(depth)
+    grain = feats["grain"][:len(pts)]
+    knot = feats["knot"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) > 0.5
+    pith = (feats["years"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) < PITH_YEARS) & ~knot
+    evals, evecs = np.linalg.eigh(np.cov((pts - pts.mean(axis=0)).T))
+    long_axis = evecs[:, -1]
+    elongation = float(1.0 - math.sqrt(max(evals[1], 0.0) / max(evals[2], 1e-12)))
+    end = np.abs(np.einsum("ij,ij->i", grain, nrm)) > math.cos(math.radians(45))
+    t = (pts - pts.mean(axis=0)) @ long_axis
+    edges = np.quantile(t, np.linspace(0, 1, REPORT_REGIONS + 1))
+    region = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, REPORT_REGIONS - 1)
+    regions, warnings = [], []
+    names = ("first third", "middle third", "last third")
+    for r in range(REPORT_REGIONS):
+        sel = region == r
+        g = grain[sel].mean(axis=0)
+        g /= max(np.linalg.norm(g), 1e-12)
+        angle = float(np.degrees(np.arccos(min(1.0, abs(float(g @ long_axis))))))
+        k = float(knot[:, sel].mean())
+        regions.append({"region": names[r], "grain": [round(float(v), 4) for v in g],
+                        "runout_deg": round(angle, 1), "knots": round(k, 4)})
+        if elongation > 0.5 and angle > SHORT_GRAIN_DEG:
+            warnings.append(f"short grain in the {names[r]} along the part: fibres cross its "
+                            f"long axis at {angle:.0f} deg (a thin section there may break)")
+    if knot[0].any():
+        warnings.append(f"knots show on {100 * knot[0].mean():.1f} % of the surface")
+    elif knot.any():
+        warnings.append("a knot lies 1-3 mm under the surface (it may show after sanding)")
+    if pith.any():
+        warnings.append(f"the pith (within {PITH_YEARS:g} years) reaches the part: expect checks")
+    volume = float(abs(mesh.volume))
+    block = float(np.prod(stock.size_mm))
+    return {"volume_mm3": round(volume, 1), "yield": round(volume / block, 4),
+            "knots": round(float(knot.mean()), 4), "pith": round(float(pith.mean()), 4),
+            "end_grain": round(float(end.mean()), 4), "elongation": round(elongation, 3),
+            "regions": regions, "warnings": warnings}
+
+
+def report_text(report: dict, name: str) -> str:
+    """The part report as a few lines of text."""
+    lines = [f"{name}: {report['volume_mm3']:.0f} mm^3, yield {100 * report['yield']:.1f} % of "
+             f"the block; end grain {100 * report['end_grain']:.0f} % of the surface; knots "
+             f"{100 * report['knots']:.1f} %, pith {100 * report['pith']:.1f} % of the surface "
+             "and the wood 1-3 mm under it"]
+    for r in report["regions"]:
+        lines.append(f"  {r['region']:<13} grain ({', '.join(f'{v:+.2f}' for v in r['grain'])}) "
+                     f"runout {r['runout_deg']:.0f} deg, knots {100 * r['knots']:.1f} %")
+    lines += [f"  warning: {w}" for w in report["warnings"]]
+    return "\n".join(lines)
+
+
+def knot_spots(mesh, wood, *, samples: int = 20000, link_mm: float = 2.0, seed: int = 0) -> list[dict]:
+    """Where knots come through the surface of ``mesh`` (block frame, mm): one entry per
+    connected patch of knot wood, ``{"kind": "knot", "label": str, "at_mm": [x, y, z]}`` (the
+    patch's centroid, snapped to the nearest surface sample), largest first; for hotspots."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(seed)
+    pts, _ = _sample(mesh, samples, rng)
+    inside = wood.features(pts)["knot"] > 0.5
+    p = pts[inside]
+    if len(p) == 0:
+        return []
+    pairs = cKDTree(p).query_pairs(link_mm, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(p), len(p)))
+    n, label = connected_components(graph, directed=False)
+    area_per_sample = float(mesh.area) / samples
+    spots = []
+    for k in range(n):
+        members = p[label == k]
+        if len(members) < 5:  # a few stray samples: not a visible knot
+            continue
+        centre = members.mean(axis=0)
+        at = members[np.argmin(np.linalg.norm(members - centre, axis=1))]
+        spots.append({"kind": "knot", "at_mm": [round(float(v), 2) for v in at],
+                      "label": f"through the surface, ~{len(members) * area_per_sample:.0f} mm^2",
+                      "_size": len(members)})
+    spots.sort(key=lambda s: -s["_size"])
+    for s in spots:
+        del s["_size"]
+    return spots

@@ -1,0 +1,47 @@
+"""``woodcam cache``: where the caches are, how big, and clearing them."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(subparsers) -> None:
+    """Add ``cache info`` and ``cache clear``."""
+    p = subparsers.add_parser(
+        "cache", help="show or clear woodcam's caches (fitted fields, colour volumes)",
+        description="woodcam caches fitted growth fields and neural colour volumes under "
+        "$WOODCAM_CACHE_DIR or the user cache folder ($XDG_CACHE_HOME/woodcam, ~/.cache/woodcam), "
+        "keyed by content; the least recently used entries are dropped above "
+        "$WOODCAM_CACHE_MAX_MB (default 2048 MiB).")
+    sub = p.add_subparsers(dest="cache_command", metavar="ACTION")
+    sub.required = True
+    info = sub.add_parser("info", help="where the cache is and how much it holds")
+    info.set_defaults(func=run_info)
+    clear = sub.add_parser("clear", help="delete cache entries (they are rebuilt when needed)")
+    clear.add_argument("--kind", default=None,
+                       help="only this kind of entry, e.g. fields or appearance (default: all)")
+    clear.set_defaults(func=run_clear)
+
+
+def run_info(args: argparse.Namespace) -> int:
+    from .._cache import cache_max_bytes, cache_root, entries
+
+    files = entries()
+    kinds: dict[str, list[int]] = {}
+    for f in files:
+        kind = f.relative_to(cache_root()).parts[0]
+        kinds.setdefault(kind, []).append(f.stat().st_size)
+    total = sum(sum(v) for v in kinds.values())
+    print(f"{cache_root()}: {len(files)} entries, {total / 2**20:.1f} MiB of "
+          f"{cache_max_bytes() / 2**20:.0f} MiB allowed")
+    for kind, sizes in sorted(kinds.items()):
+        print(f"  {kind:<12} {len(sizes):5d} entries {sum(sizes) / 2**20:10.1f} MiB")
+    return 0
+
+
+def run_clear(args: argparse.Namespace) -> int:
+    from .._cache import cache_root, clear
+
+    n, size = clear(args.kind)
+    print(f"deleted {n} entries ({size / 2**20:.1f} MiB) from {cache_root()}")
+    return 0

@@ -1,0 +1,56 @@
+"""``woodcam place``: where in this block should the part go?"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .options import BLOCK_SPEC_HELP
+
+
+def register(subparsers) -> None:
+    """Add ``place``."""
+    p = subparsers.add_parser(
+        "place", help="rank placements of a part in a block by knots, pith, end grain, runout",
+        description="Search placements of PART in the block (the rotations allowed x positions "
+        "where it fits) and rank them by what a woodworker cares about, each term reported "
+        "separately (knots and pith on or just under the surface, end grain on the surface, "
+        "grain runout along a long thin part). Writes OUT/placements.png (the best placements "
+        "and the worst side by side) and OUT/placements.json; prints the table with the "
+        "--place options that reproduce each placement in woodcam bake.")
+    p.add_argument("part", help="part file (.py script, .step, .stl, .obj, .glb), block frame, mm")
+    p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
+    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--rotations", choices=("none", "z90", "all90"), default="z90",
+                   help="orientations to try: none, quarter turns about z (default), or all 24 "
+                   "axis-aligned ones")
+    p.add_argument("--candidates", type=int, default=1000, metavar="N",
+                   help="about how many placements to score (default 1000)")
+    p.add_argument("--margin", type=float, default=1.0, metavar="MM",
+                   help="distance kept from the block faces (default 1 mm)")
+    p.add_argument("--top", type=int, default=3, metavar="K",
+                   help="placements shown in the picture and table (default 3)")
+    p.set_defaults(func=run_place)
+
+
+def run_place(args: argparse.Namespace) -> int:
+    import json
+
+    from .._atomic import check_output_path, write_bytes
+    from ..advise import advise_placement, render_advice
+    from ..stock import open_stock
+
+    out = Path(args.out)
+    check_output_path(out / "placements.json", suffixes=(".json",), what="--out", mkdir=True)
+    stock = open_stock(args.block)
+    advice = advise_placement(args.part, stock, rotations=args.rotations,
+                              candidates=args.candidates, margin_mm=args.margin)
+    print(advice.table(args.top))
+    record = {"block": args.block, "part": str(args.part), "candidates": advice.candidates,
+              "weights": advice.weights, "elongation": advice.elongation,
+              "ranked": [{"ops": p.ops, "score": p.score, **p.terms,
+                          "matrix": p.matrix.tolist()} for p in advice.ranked[:max(args.top, 10)]]}
+    write_bytes(out / "placements.json", json.dumps(record, indent=1).encode())
+    png = render_advice(advice, args.part, stock, out / "placements.png", top=args.top)
+    print(f"scored {advice.candidates} placements; wrote {png} and {out / 'placements.json'}")
+    return 0

@@ -1,0 +1,323 @@
+"""``woodcam woodify``: grow a mesh like a tree and write its field, surfaces, sections and bark.
+
+Writes into ``--out``: ``field.npz`` (the grown object's growth field; a block spec
+``woodify:OUT/field.npz`` for ``bake``/``gcode``/``preview``), ``grown.glb`` (final surface,
+bark-textured, with cracks), ``surface_yNN.stl`` (watertight grown surfaces at chosen years),
+``section_xz.png`` / ``section_xy.png`` (ring sections through the block centre, seed Fig. 5.1)
+and ``woodify.json`` (parameters, grid, solver, timings). Every file is written atomically.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+from ..errors import WoodcamError
+
+
+def _vec(text: str, option: str, n: int = 3, positive: bool = False) -> tuple[float, ...]:
+    import math
+
+    try:
+        vals = tuple(float(v) for v in text.replace("x", ",").split(","))
+    except ValueError:
+        vals = ()
+    if len(vals) != n or not all(math.isfinite(v) for v in vals) or (positive and min(vals) <= 0):
+        kind = "sizes > 0" if positive else "numbers"
+        raise WoodcamError(f"{option} takes {n} comma-separated {kind} (mm); got {text!r}")
+    return vals
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    """Add the ``woodify`` command."""
+    p = subparsers.add_parser(
+        "woodify", help="grow a mesh like a tree: rings, obstacles, bark and cracks (seed 004)",
+        description="Grow a watertight part or mesh outward year by year (Weibull speed, "
+        "eccentricity, obstacles, brushes), then write its growth field (usable as --block "
+        "woodify:OUT/field.npz), grown surfaces, ring sections and a bark-textured grown.glb. "
+        "Lengths in mm, time in years.")
+    p.add_argument("part", help="input: a .py part script, .step, or a closed .stl/.obj/.ply/.glb mesh "
+                   "(mm); a PLY may paint growth per vertex: properties gain (speed gain) and "
+                   "dir_x, dir_y, dir_z (growth direction, length = strength < 1)")
+    p.add_argument("--years", type=float, required=True, help="years to grow (> 0)")
+    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--growth", type=float, default=None, metavar="MM",
+                   help="how far a flat surface grows in --years (mm); default a quarter of the "
+                   "input's largest side")
+    p.add_argument("--time-scale", type=float, default=None, metavar="YEARS",
+                   help="Weibull time scale lambda (years); default --years")
+    p.add_argument("--shape", type=float, default=2.0, help="Weibull shape c of eq. 4.1 (default 2)")
+    p.add_argument("--eccentricity", type=float, default=0.0,
+                   help="delta in (-1, 1): speed (1 + delta n.up) (default 0)")
+    p.add_argument("--up", default="0,0,1", metavar="X,Y,Z", help="direction the eccentric growth favours (unit-normalised; default 0,0,1)")
+    p.add_argument("--obstacle", type=Path, action="append", default=[], metavar="MESH",
+                   help="closed obstacle mesh or part (mm); repeatable")
+    p.add_argument("--brushes", type=Path, default=None, metavar="JSON",
+                   help="growth brushes (centre_mm, radius_mm, gain, direction, strength)")
+    p.add_argument("--resolution", type=int, default=128,
+                   help="grid nodes along the longest side (default 128)")
+    p.add_argument("--method", choices=("auto", "fmm", "offset", "anisotropic"), default="auto",
+                   help="front solver (default auto: fmm if isotropic, offset for eccentricity "
+                   "without obstacles, anisotropic otherwise)")
+    p.add_argument("--surface-years", default=None, metavar="Y1,Y2,..",
+                   help="also write watertight surfaces at these years (default: quarters of --years)")
+    p.add_argument("--block-size", default=None, metavar="WxDxH",
+                   help="size of the block cut from the grown object (mm); default the grown "
+                   "object's bounding box")
+    p.add_argument("--block-centre", default=None, metavar="X,Y,Z",
+                   help="centre of that block in the input's frame (mm); default the grown "
+                   "object's bounding-box centre (write --block-centre=-9,0,35 when the first "
+                   "value is negative)")
+    p.add_argument("--cracks", choices=("none", "stress", "vertical", "horizontal", "random"),
+                   default="stress", help="bark crack pattern (default stress: natural directions)")
+    p.add_argument("--crack-region", default=None, metavar="X,Y,Z,R",
+                   help="only crack within this sphere (mm)")
+    p.add_argument("--crack-years", type=int, default=5,
+                   help="last years simulated for cracks (default 5)")
+    p.add_argument("--crack-render", choices=("groove", "material"), default="material",
+                   help="draw cracks into the bark texture (material, default) or cut them as grooves")
+    p.add_argument("--crack-threshold", type=float, default=None,
+                   help="separation eigenvalue that opens a crack (default 2x the median of the "
+                   "first simulated year)")
+    p.add_argument("--relief", type=float, default=0.3,
+                   help="stress left next to a new crack, in [0, 1] (0 removes all; default 0.3)")
+    p.add_argument("--seed", type=int, default=0, help="random seed of the bark picture and random cracks (default 0)")
+    p.set_defaults(func=run)
+    return p
+
+
+def _load_mesh(path: str):
+    """(watertight geometry, textured original or None) from a part or mesh file."""
+    import numpy as np
+    import trimesh
+
+    pth = Path(path)
+    if pth.suffix.lower() in (".stl", ".obj", ".ply", ".glb", ".gltf", ".off"):
+        if not pth.is_file():
+            raise WoodcamError(f"part {path!r} does not exist")
+        try:
+            if pth.suffix.lower() in (".glb", ".gltf", ".obj"):
+                from ..export import load_textured  # undoes woodcam's glTF/OBJ frame
+
+                loaded = load_textured(pth)
+            elif pth.suffix.lower() == ".ply":
+                loaded = trimesh.load(pth, force="mesh", process=False)  # keep vertex order
+            else:
+                loaded = trimesh.load(pth, force="mesh")
+        except WoodcamError:
+            raise
+        except Exception as err:  # trimesh raises many kinds for unreadable files
+            raise WoodcamError(f"part {path!r} could not be read as a mesh: {err}") from err
+        textured = loaded if getattr(loaded.visual, "uv", None) is not None else None
+        paint = _ply_paint(loaded, path)
+        if paint:
+            if not loaded.is_watertight:
+                raise WoodcamError(
+                    f"part {path!r} carries growth attributes per vertex, so it must be watertight "
+                    "as stored (shared vertices), without merging; weld its vertices first")
+            return loaded, None, paint
+        geom = trimesh.Trimesh(loaded.vertices, loaded.faces, process=True)
+        geom.merge_vertices(merge_tex=True, merge_norm=True)
+        if textured is not None and len(geom.faces) != len(textured.faces):
+            textured = None
+        return geom, textured, {}
+    from ..cad import load_part
+
+    solid = load_part(path)
+    m = solid.to_mesh()
+    return trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts)), None, {}
+
+
+def _ply_paint(mesh, path) -> dict:
+    """Painted growth from a PLY's vertex properties: ``gain`` (speed gain > 0) and
+    ``dir_x, dir_y, dir_z`` (growth direction, its length the strength < 1), seed sec. 4.2.2."""
+    import numpy as np
+
+    raw = mesh.metadata.get("_ply_raw", {}).get("vertex", {}).get("data")
+    names = () if raw is None or raw.dtype.names is None else raw.dtype.names
+    out = {}
+    if "gain" in names:
+        out["vertex_gain"] = np.asarray(raw["gain"], float).reshape(-1)
+    if all(k in names for k in ("dir_x", "dir_y", "dir_z")):
+        out["vertex_direction"] = np.stack([np.asarray(raw[k], float).reshape(-1)
+                                            for k in ("dir_x", "dir_y", "dir_z")], axis=1)
+    for k, v in out.items():
+        if len(v) != len(mesh.vertices):
+            raise WoodcamError(f"part {path!r}: vertex property {k} has {len(v)} values for "
+                               f"{len(mesh.vertices)} vertices")
+    return out
+
+
+def _atomic(path: Path, write) -> Path:
+    """Call ``write(tmp_path)`` and move the temporary file onto ``path`` (woodcam._atomic)."""
+    from .._atomic import atomic_path
+
+    with atomic_path(path, mkdir=True) as tmp:
+        write(tmp)
+    return Path(path)
+
+
+def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=None,
+                  block_centre_mm=None, cracks="stress", crack_region=None, crack_years=5,
+                  crack_render="material", crack_threshold=None, relief=0.3, seed=0,
+                  atomic=_atomic, progress=None):
+    """Write the products of a :class:`~woodcam.woodify.Woodification` into ``out`` (module
+    docstring); returns (files written, summary dict)."""
+    import numpy as np
+    from PIL import Image
+
+    from ..export import export_glb
+    from ..woodify.bark import (
+        bark_image,
+        cylindrical_uv,
+        groove,
+        paint_cracks,
+        textured_mesh,
+    )
+    from ..woodify.cracks import simulate_cracks
+    from ..woodify.surfaces import barycentric_on, carry, section_image
+
+    out = Path(out)
+    files = []
+    Y = res.years
+    summary = {"years": Y, "speed": res.speed.to_dict(), "method": res.front.method,
+               "grid": {"shape": list(res.front.grid.shape), "spacing_mm": res.front.grid.spacing_mm,
+                        "origin_mm": list(res.front.grid.origin_mm)},
+               "timings": dict(res.timings)}
+    t = time.perf_counter()
+    crack_edges = np.zeros((0, 2), int)
+    if cracks != "none":
+        n = max(int(crack_years), 1)
+        ys = [max(Y - n + k, 0.0) for k in range(n + 1)]
+        ys = sorted(set(ys))
+        cs = simulate_cracks(res, ys, pattern=cracks, region=crack_region, threshold=crack_threshold,
+                             relief=relief, seed=seed)
+        mesh, origins, tri = cs.mesh, cs.origins_mm, cs.tri
+        crack_edges = cs.crack_edges
+        summary["cracks"] = {"pattern": cracks, "log": cs.log, "count": len(cs.crack_directions),
+                             "render": crack_render}
+    else:
+        mesh = res.surface(Y)
+        origins, tri = res.origins(mesh.vertices)
+    summary["timings"]["cracks_s" if cracks != "none" else "surface_s"] = time.perf_counter() - t
+    if progress:
+        progress()
+    # persistent texture: the input's own UVs and image, else cylindrical bark coordinates
+    image = None
+    if textured is not None:
+        _, bary = barycentric_on(textured, origins, tri)
+        uv = carry(textured, textured.visual.uv, tri, bary)
+        mat = textured.visual.material
+        img = getattr(mat, "baseColorTexture", None) or getattr(mat, "image", None)
+        image = np.asarray(img.convert("RGB")) if img is not None else None
+    if image is None:
+        up = res.field.stem_axis
+        c = res.mesh.centroid
+
+        def mean_radius(v):
+            d = v - c
+            return max(float(np.linalg.norm(d - np.outer(d @ up, up), axis=1).mean()), 1e-3)
+
+        uv = cylindrical_uv(origins, up, c, 2 * np.pi * mean_radius(res.mesh.vertices))
+        # the carried coordinates stretch with the growth; lay as many bark tiles round the
+        # stem as the grown girth holds, as one picture (so each crack is drawn once)
+        k = max(1, int(round(mean_radius(mesh.vertices) / mean_radius(res.mesh.vertices))))
+        uv = uv * k
+        rows = max(1, int(np.ceil(uv[:, 1].max())))
+        image = np.tile(bark_image(256, seed), (rows, k, 1))
+        uv = uv / np.array([k, rows])
+    if crack_render == "material" and len(crack_edges):
+        image = paint_cracks(image, uv, crack_edges)
+    elif crack_render == "groove" and len(crack_edges):
+        width = np.zeros(len(mesh.vertices))
+        width[crack_edges.ravel()] = 1.0
+        mesh = groove(mesh, width, 0.6 * res.front.grid.spacing_mm)
+    bark = textured_mesh(mesh, uv, image)
+    files.append(atomic(out / "grown.glb", lambda p: export_glb(bark, p, metadata={
+        "woodify": {"years": Y, "speed": res.speed.to_dict()}})))
+    # the block cut from the grown object: default its bounding box
+    lo, hi = mesh.bounds
+    size = tuple(hi - lo) if block_size_mm is None else tuple(block_size_mm)
+    centre = tuple((lo + hi) / 2) if block_centre_mm is None else tuple(block_centre_mm)
+    placed = res.field.placed(size, centre)
+    files.append(placed.save(out / "field.npz"))
+    summary["block"] = {"size_mm": list(size), "centre_mm": list(centre)}
+    for y in surface_years:
+        surf = res.surface(float(y))
+        files.append(atomic(out / f"surface_y{float(y):g}.stl", lambda p, s=surf: s.export(p)))
+    if progress:
+        progress()
+    # ring sections through the block centre (seed Fig. 5.1)
+    g = res.front.grid
+    ext = (np.asarray(g.shape) - 1) * g.spacing_mm
+    o = np.asarray(g.origin_mm)
+    cc = np.asarray(centre)
+    px = 640
+    f = res.field
+
+    def inside(p):
+        return f.arrival(p) <= 0
+
+    for name, (a, b) in {"xz": (0, 2), "xy": (0, 1)}.items():
+        origin = cc.copy()
+        origin[a], origin[b] = o[a], o[b]
+        u = np.zeros(3)
+        v = np.zeros(3)
+        u[a], v[b] = ext[a], ext[b]
+        rows = max(int(px * ext[b] / ext[a]), 16)
+        img = section_image(f, f.no_wood, inside, origin, u, v, (rows, px), years_final=Y)
+        files.append(atomic(out / f"section_{name}.png", lambda p, im=img: Image.fromarray(im).save(p, format="PNG")))
+    return files, summary
+
+
+def run(args) -> int:
+    """Run a parsed ``woodify`` command; returns the exit status."""
+    import numpy as np
+    from tqdm import tqdm
+
+    from ..woodify import load_brushes, woodify
+
+    t0 = time.perf_counter()
+    if not (np.isfinite(args.years) and args.years > 0):
+        raise WoodcamError(f"--years must be > 0 (years to grow); got {args.years:g}")
+    up = _vec(args.up, "--up")
+    steps = tqdm(total=4, desc="woodify", unit="stage", leave=False)
+    mesh, textured, painted = _load_mesh(args.part)
+    obstacles = [_load_mesh(str(o))[0] for o in args.obstacle]
+    brushes = load_brushes(args.brushes) if args.brushes else ()
+    steps.update(1)
+    res = woodify(mesh, args.years, growth_mm=args.growth, time_scale_years=args.time_scale,
+                  shape=args.shape, eccentricity=args.eccentricity, up=up, obstacles=obstacles,
+                  brushes=brushes, resolution=args.resolution, method=args.method, **painted)
+    steps.update(1)
+    if args.surface_years:
+        try:
+            years = [float(v) for v in args.surface_years.split(",")]
+        except ValueError:
+            years = [-1.0]
+        if not all(0 <= y <= args.years for y in years):
+            raise WoodcamError(f"--surface-years takes comma-separated years in [0, {args.years:g}]; "
+                               f"got {args.surface_years!r}")
+    else:
+        years = [args.years * k / 4 for k in (1, 2, 3)]
+    size = _vec(args.block_size, "--block-size", positive=True) if args.block_size else None
+    centre = _vec(args.block_centre, "--block-centre") if args.block_centre else None
+    region = _vec(args.crack_region, "--crack-region", n=4) if args.crack_region else None
+    files, summary = _write_outputs(
+        res, args.out, textured=textured, surface_years=years, block_size_mm=size,
+        block_centre_mm=centre, cracks=args.cracks, crack_region=region,
+        crack_years=args.crack_years, crack_render=args.crack_render,
+        crack_threshold=args.crack_threshold, relief=args.relief, seed=args.seed,
+        atomic=_atomic, progress=lambda: steps.update(1))
+    steps.close()
+    summary["total_s"] = time.perf_counter() - t0
+    summary["input"] = str(args.part)
+    _atomic(Path(args.out) / "woodify.json",
+            lambda p: p.write_text(json.dumps(summary, indent=1, default=float)))
+    print(f"grew {args.part} for {args.years:g} years on a {'x'.join(map(str, res.front.grid.shape))} "
+          f"grid ({res.front.method}, {summary['total_s']:.1f} s); wrote "
+          + ", ".join(str(f) for f in files))
+    print(f"carve from it with: woodcam bake PART --block woodify:{Path(args.out) / 'field.npz'} --out PART.glb")
+    return 0

@@ -1,0 +1,53 @@
+"""Several placements of one part side by side, off screen: each part coloured by the wood it
+would be cut from (``Wood.color`` at its vertices), inside its block's outline."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+#: Longest triangle edge (mm) of the rendered surface: its vertex colours show rings ~2 mm wide.
+_EDGE_MM = 0.7
+
+
+def render_side_by_side(meshes, woods, size_mm, titles, png, *, panel_px: int = 420) -> Path:
+    """Render ``meshes[i]`` (trimesh, block frame, mm) coloured by ``woods[i].color`` at its
+    vertices in panel ``i`` of one PNG, with the block outline and ``titles[i]`` above it."""
+    from ..errors import require
+    from .scene import _prefer_egl_off_screen
+
+    pv = require("pyvista", "view", "rendering placement pictures")
+    import trimesh
+    from .._atomic import atomic_path
+
+    _prefer_egl_off_screen()
+    n = len(meshes)
+    plotter = pv.Plotter(off_screen=True, shape=(1, n), window_size=(panel_px * n, panel_px),
+                         border=False)
+    try:
+        W, D, H = (float(v) for v in size_mm)
+        for i, (mesh, wood, title) in enumerate(zip(meshes, woods, titles)):
+            plotter.subplot(0, i)
+            # vertex colours need vertices about every EDGE_MM: split long CAD triangles
+            verts, tris = trimesh.remesh.subdivide_to_size(
+                np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces), _EDGE_MM,
+                max_iter=12)
+            fine = trimesh.Trimesh(verts, tris, process=False)
+            rgb = wood.color(verts, np.asarray(fine.vertex_normals, dtype=float))
+            faces = np.column_stack([np.full(len(tris), 3), tris]).ravel()
+            surf = pv.PolyData(verts, faces)
+            surf["rgb"] = (np.clip(rgb, 0, 1) * 255).astype(np.uint8)
+            plotter.add_mesh(surf, scalars="rgb", rgb=True, smooth_shading=False)
+            plotter.add_mesh(pv.Box(bounds=(0, W, 0, D, 0, H)).outline(), color="black",
+                             line_width=2)
+            plotter.add_text(title, font_size=10, position="upper_left")
+            plotter.camera_position = [(W * 1.6, -D * 1.9, H * 2.6), (W / 2, D / 2, H / 2),
+                                       (0, 0, 1)]
+        path = Path(png)
+        with atomic_path(path, mkdir=True) as tmp:
+            plotter.screenshot(str(tmp))
+        return path
+    finally:
+        plotter.close()

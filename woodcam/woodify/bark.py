@@ -1,0 +1,124 @@
+"""Bark on a grown surface: texture coordinates carried from the input, a bark image, cracks.
+
+Texture coordinates come from where each grown vertex came from on the input surface
+(:func:`woodcam.woodify.surfaces.trace_back`): the input's own UVs when it has them (its image
+stays put while the object grows, seed Fig. 4.6), otherwise cylindrical coordinates of the
+origin round the stem axis (``u`` = angle / 2 pi, ``v`` = height / circumference), so a procedural
+bark image is carried in the same way. Cracks are drawn either into the image along their UV
+paths (``"material"``) or cut into the geometry (``"groove"``, :func:`groove`).
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from scipy import ndimage
+
+CrackRender = Literal["groove", "material"]
+CRACK_RENDERS: tuple[str, ...] = ("groove", "material")
+
+
+def stem_axis(mesh) -> np.ndarray:
+    """Unit direction ``(3,)`` of a mesh's longest principal axis (area-weighted surface PCA):
+    the stem of a trunk-like input, round which bark coordinates wrap and fibres run."""
+    c = mesh.triangles_center
+    w = mesh.area_faces
+    mu = (c * w[:, None]).sum(0) / w.sum()
+    d = c - mu
+    cov = (d * w[:, None]).T @ d / w.sum()
+    _, V = np.linalg.eigh(cov)
+    a = V[:, -1]
+    return a if a[np.argmax(np.abs(a))] > 0 else -a
+
+
+def cylindrical_uv(origins_mm, up, centre_mm, circumference_mm: float) -> np.ndarray:
+    """``(n, 2)`` UVs of input-surface points round the axis through ``centre_mm`` along ``up``
+    (here: the stem axis, not the eccentricity's up)."""
+    up = np.asarray(up, float) / np.linalg.norm(up)
+    ref = np.array([1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    e1 = ref - up * (ref @ up)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(up, e1)
+    d = np.asarray(origins_mm, float) - np.asarray(centre_mm, float)
+    u = (np.arctan2(d @ e2, d @ e1) / (2 * np.pi)) % 1.0
+    v = (d @ up) / circumference_mm
+    return np.stack([u, v - np.floor(v.min())], axis=1)
+
+
+def bark_image(size_px: int = 512, seed: int = 0) -> np.ndarray:
+    """A tileable procedural bark picture ``(size, size, 3) uint8``: plates between vertical furrows."""
+    rng = np.random.default_rng(seed)
+    n = size_px
+    noise = rng.standard_normal((n, n))
+    # stretched along v (rows): long plates and furrows running up the stem
+    plates = ndimage.gaussian_filter(noise, (n / 24, n / 160), mode="wrap")
+    fine = ndimage.gaussian_filter(rng.standard_normal((n, n)), (n / 128, n / 512), mode="wrap")
+    plates = (plates - plates.mean()) / (plates.std() + 1e-9)
+    fine = (fine - fine.mean()) / (fine.std() + 1e-9)
+    furrow = np.clip(-plates - 0.3, 0, None)  # deep furrows where the plate field is low
+    light = np.clip(0.65 + 0.12 * fine - 0.35 * np.tanh(furrow), 0, 1)
+    base = np.array([112, 92, 74], float)
+    grey = np.array([140, 134, 126], float)
+    mix = np.clip(0.5 + 0.25 * plates, 0, 1)[..., None]
+    img = (base * (1 - mix) + grey * mix) * light[..., None] * 1.5
+    return np.clip(img, 0, 255).astype(np.uint8)
+
+
+def textured_mesh(mesh, uv, image):
+    """A copy of ``mesh`` with ``uv (n_vertices, 2)`` and ``image`` as its texture.
+
+    Triangles whose ``u`` jumps across the wrap (``u`` near 0 and 1) get their own vertex copies
+    with ``u + 1``, so the picture does not smear round the stem.
+    """
+    import trimesh
+    from PIL import Image
+
+    uv = np.asarray(uv, float)
+    faces = mesh.faces.copy()
+    fu = uv[faces, 0]
+    seam = (fu.max(1) - fu.min(1)) > 0.5
+    verts = [mesh.vertices]
+    uvs = [uv]
+    if seam.any():
+        corners = faces[seam]
+        low = uv[corners, 0] < 0.5
+        new = corners[low]
+        start = len(mesh.vertices)
+        verts.append(mesh.vertices[new])
+        uvs.append(uv[new] + np.array([1.0, 0.0]))
+        sub = faces[seam]
+        sub[low] = start + np.arange(len(new))
+        faces[seam] = sub
+    V = np.concatenate(verts)
+    UV = np.concatenate(uvs)
+    material = trimesh.visual.material.PBRMaterial(
+        baseColorTexture=Image.fromarray(np.asarray(image, np.uint8)), roughnessFactor=0.95,
+        metallicFactor=0.0)
+    out = trimesh.Trimesh(V, faces, process=False,
+                          visual=trimesh.visual.TextureVisuals(uv=UV, material=material))
+    return out
+
+
+def paint_cracks(image, uv, edges, width_px: int = 2) -> np.ndarray:
+    """Draw crack edges ``(m, 2)`` (vertex indices, with ``uv (n, 2)``) dark into the image."""
+    import cv2
+
+    img = np.array(image, np.uint8, copy=True)
+    h, w = img.shape[:2]
+    a = uv[edges[:, 0]]
+    b = uv[edges[:, 1]]
+    ok = np.abs(a[:, 0] - b[:, 0]) < 0.5  # skip the wrap
+    for p, q in zip(a[ok], b[ok]):
+        # texture repeats: draw in the wrapped tile (v measured from the image bottom)
+        pp = (int((p[0] % 1) * w), int((1 - p[1] % 1) * h))
+        qq = (int(pp[0] + (q[0] - p[0]) * w), int(pp[1] - (q[1] - p[1]) * h))
+        cv2.line(img, pp, qq, (28, 20, 14), width_px, lineType=cv2.LINE_AA)
+    return img
+
+
+def groove(mesh, crack_weight, depth_mm: float):
+    """Cut cracks into the geometry: vertices move inward by ``depth_mm * crack_weight``."""
+    out = mesh.copy()
+    out.vertices = mesh.vertices - mesh.vertex_normals * (depth_mm * np.asarray(crack_weight))[:, None]
+    return out

@@ -1,0 +1,370 @@
+"""Bark cracks from the stress of growing (seed 004 sec. 4.4), carried from year to year.
+
+Each simulated year has its grown surface (marching cubes). For every vertex its position a
+year earlier is found by tracing the growth back (:func:`~woodcam.woodify.surfaces.trace_back`
+with ``until_mm``), so each triangle has a deformation gradient ``F`` (2 x 2 in its plane)
+from last year's shape to this year's. Bark does not grow with the wood, so the stretch
+accumulates as stress, per triangle (sec. 4.4.1):
+
+    sigma += E3 (F F^T - I) / 2 E3^T           (3 x 3, E3 = the triangle's in-plane basis)
+
+The stress splits into its tensile and compressive parts (positive and negative
+eigenvalues); each triangle pushes its corners with forces ``f = area sigma grad N_i`` (``N_i``
+the barycentric shape function of corner ``i``), split the same way, and each vertex gets the
+separation tensor (O'Brien & Hodgins' form of the seed's ``zeta``):
+
+    zeta = 1/2 (sum m(f+) - sum m(f-)),        m(a) = a a^T / |a|
+
+Vertices enter a priority queue keyed by the largest eigenvalue of ``zeta`` (sec. 4.4.2);
+while the top exceeds the threshold a crack is inserted there: it runs through the vertex
+perpendicular to the eigenvector (in the tangent plane) along the mesh edges that follow that
+direction best, for a length that grows with the excess (edges play the seed's "merge a crack
+that is too close to an edge"). The stress of the faces round a new crack is multiplied by the
+relief factor (0 removes it, 1 keeps it) and those vertices re-enter the queue. Relaxation
+(sec. 4.4.3) diffuses the remaining stress between neighbouring faces each year. Cracks and
+stress are carried to the next year's mesh through the vertices' origins on the input (the
+seed's coupling, sec. 4.6), and an existing crack widens as the bark keeps stretching.
+
+Patterns: ``"stress"`` (crack along the direction the stress gives), ``"vertical"`` /
+``"horizontal"`` (along / across ``up``), ``"random"`` (a random direction per vertex); the
+largest eigenvalue decides where and when in every pattern, and each can be limited to a
+region.
+"""
+
+from __future__ import annotations
+
+import heapq
+from dataclasses import dataclass
+from dataclasses import field as dc_field
+from typing import Literal
+
+import numpy as np
+
+from ..errors import WoodcamError
+
+Pattern = Literal["stress", "vertical", "horizontal", "random"]
+PATTERNS: tuple[str, ...] = ("stress", "vertical", "horizontal", "random")
+
+
+@dataclass
+class CrackedSurface:
+    """The grown surface of the last simulated year with its cracks.
+
+    Attributes
+    ----------
+    mesh : trimesh.Trimesh
+        Watertight surface, object frame, mm.
+    origins_mm : (n, 3) float
+        Origin of each vertex on the input surface.
+    tri : (n,) int
+        Input triangle of each origin.
+    crack_edges : (m, 2) int
+        Mesh edges (vertex pairs) that are cracked.
+    crack_width : (n,) float
+        Per-vertex crack opening in [0, 1] (0 = no crack).
+    crack_directions : (k, 3) float
+        Unit direction of every crack inserted (all years), with ``crack_points (k, 3)``.
+    stress : (f, 3, 3) float
+        Remaining per-triangle stress.
+    threshold : float
+        The eigenvalue that opened cracks.
+    log : list of dict
+        Per year: cracks inserted, largest eigenvalue.
+    """
+
+    mesh: object
+    origins_mm: np.ndarray
+    tri: np.ndarray
+    crack_edges: np.ndarray
+    crack_width: np.ndarray
+    crack_directions: np.ndarray
+    crack_points: np.ndarray
+    stress: np.ndarray
+    threshold: float
+    log: list = dc_field(default_factory=list)
+
+
+def _frames(mesh):
+    """Per-face orthonormal in-plane basis ``(f, 3, 2)`` and unit normal ``(f, 3)``."""
+    tri = mesh.triangles
+    u = tri[:, 1] - tri[:, 0]
+    v = tri[:, 2] - tri[:, 0]
+    e1 = u / np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-12)
+    n = np.cross(u, v)
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+    e2 = np.cross(n, e1)
+    return np.stack([e1, e2], axis=2), n
+
+
+def growth_stress(mesh, prev_positions) -> np.ndarray:
+    """Per-face stress ``(f, 3, 3)`` of the stretch from ``prev_positions (n, 3)`` to ``mesh``."""
+    E, _ = _frames(mesh)
+    cur = mesh.vertices[mesh.faces]
+    old = np.asarray(prev_positions)[mesh.faces]
+    # edge matrices in the current face frame (2 x 2): columns are edges 01 and 02
+    dc = np.stack([cur[:, 1] - cur[:, 0], cur[:, 2] - cur[:, 0]], axis=2)
+    do = np.stack([old[:, 1] - old[:, 0], old[:, 2] - old[:, 0]], axis=2)
+    Xc = np.einsum("fdk,fde->fke", E, dc)
+    # the old edges in their own plane: project onto the old face's frame
+    Eo = _frames_of(old)
+    Xo = np.einsum("fdk,fde->fke", Eo, do)
+    det = np.linalg.det(Xo)
+    good = np.abs(det) > 1e-12 * np.maximum(np.abs(np.linalg.det(Xc)), 1e-30)
+    F = np.zeros_like(Xc)
+    F[good] = Xc[good] @ np.linalg.inv(Xo[good])
+    # align the old frame's rotation away: the left stretch F F^T is rotation-free
+    B = F @ np.swapaxes(F, 1, 2)
+    S2 = 0.5 * (B - np.eye(2))
+    S2[~good] = 0.0
+    return np.einsum("fik,fkl,fjl->fij", E, S2, E)
+
+
+def _frames_of(tri):
+    u = tri[:, 1] - tri[:, 0]
+    v = tri[:, 2] - tri[:, 0]
+    e1 = u / np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-12)
+    n = np.cross(u, v)
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+    return np.stack([e1, np.cross(n, e1)], axis=2)
+
+
+def _split(sig):
+    """Tensile and compressive parts ``(f, 3, 3)`` of symmetric tensors."""
+    w, V = np.linalg.eigh(sig)
+    pos = np.einsum("fik,fk,fjk->fij", V, np.maximum(w, 0), V)
+    neg = np.einsum("fik,fk,fjk->fij", V, np.minimum(w, 0), V)
+    return pos, neg
+
+
+def separation(mesh, stress) -> np.ndarray:
+    """Per-vertex separation tensor ``(n, 3, 3)`` from per-face stress (module docstring)."""
+    tri = mesh.triangles
+    area = mesh.area_faces
+    _, nrm = _frames(mesh)
+    pos, neg = _split(stress)
+    zeta = np.zeros((len(mesh.vertices), 3, 3))
+    for i in range(3):
+        a, b = tri[:, (i + 1) % 3], tri[:, (i + 2) % 3]
+        edge = b - a
+        # grad N_i: in-plane, perpendicular to the opposite edge, towards corner i, |.| = 1/height
+        g = np.cross(nrm, edge)
+        g /= np.maximum(2 * area, 1e-18)[:, None]
+        for part, sign in ((pos, 1.0), (neg, -1.0)):
+            f = area[:, None] * np.einsum("fij,fj->fi", part, g)
+            mag = np.linalg.norm(f, axis=1)
+            m = np.einsum("fi,fj->fij", f, f) / np.maximum(mag, 1e-18)[:, None, None]
+            np.add.at(zeta, mesh.faces[:, i], 0.5 * sign * m)
+    return zeta
+
+
+def _crack_frame(zeta, normals, pattern, up, rng):
+    """Largest eigenvalue ``(n,)`` and crack direction ``(n, 3)`` per vertex for a pattern."""
+    n = normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+    w, V = np.linalg.eigh(zeta)
+    lam = w[:, -1]
+    if pattern == "stress":
+        d = np.cross(n, V[:, :, -1])
+    else:
+        if pattern in ("vertical", "horizontal"):
+            upv = np.broadcast_to(np.asarray(up, float), n.shape)
+            along = upv - n * np.sum(upv * n, 1, keepdims=True)  # up in the tangent plane
+            d = along if pattern == "vertical" else np.cross(n, along)
+        else:
+            r = rng.standard_normal(n.shape)
+            d = r - n * np.sum(r * n, 1, keepdims=True)
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)
+    return lam, d
+
+
+def _walk(mesh, neighbours, start, direction, length_mm, cracked_edges):
+    """Follow mesh edges from ``start`` along ``direction`` for ``length_mm``; returns vertices."""
+    path = [start]
+    v = start
+    travelled = 0.0
+    d = direction
+    while travelled < length_mm:
+        nb = neighbours[v]
+        if not nb:
+            break
+        vec = mesh.vertices[nb] - mesh.vertices[v]
+        ln = np.linalg.norm(vec, axis=1)
+        cos = (vec @ d) / np.maximum(ln, 1e-12)
+        k = int(np.argmax(cos))
+        if cos[k] < 0.6:
+            break
+        nxt = nb[k]
+        cracked_edges.add((min(v, nxt), max(v, nxt)))
+        travelled += ln[k]
+        # keep the direction but let it follow the surface
+        d = vec[k] / ln[k] * 0.3 + d * 0.7
+        d /= np.linalg.norm(d)
+        v = nxt
+        path.append(v)
+    return path
+
+
+def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region=None,
+                    threshold: float | None = None, relief: float = 0.3, diffusion: float = 0.25,
+                    crack_length_voxels: float = 6.0, spacing_voxels: float = 3.0,
+                    seed: int = 0) -> CrackedSurface:
+    """Crack the bark over the grown surfaces of ``years`` (increasing; the first is a start).
+
+    Parameters
+    ----------
+    woodification : Woodification
+    years : sequence of float
+        Years simulated, e.g. ``[35, 36, 37, 38, 39, 40]``; stress accumulates from the first.
+    pattern : "stress", "vertical", "horizontal" or "random"
+    region : (x, y, z, r) mm, optional
+        Only vertices whose origin lies within this sphere (object frame) crack.
+    threshold : float, optional
+        Separation eigenvalue that opens a crack; default 2 x the median largest eigenvalue
+        of the first simulated year (cracks open where stress concentrates, then spread).
+    relief : float in [0, 1]
+        Stress kept by the faces round a new crack (0 removes all of it, 1 none).
+    diffusion : float in [0, 1)
+        Share of the difference to the neighbours' mean stress moved per relaxation step.
+    crack_length_voxels : float
+        Length of a crack at the threshold, in voxels; longer with more excess.
+    spacing_voxels : float
+        Reach of the relief round a new crack (mesh rings of about a voxel): no second crack
+        opens that close while the relief holds.
+    seed : int
+    """
+    from scipy.spatial import cKDTree
+
+    from .surfaces import trace_back
+
+    if pattern not in PATTERNS:
+        raise WoodcamError(f"pattern must be one of {list(PATTERNS)}; got {pattern!r}")
+    if not 0.0 <= relief <= 1.0:
+        raise WoodcamError(f"relief must lie in [0, 1] (0 removes the stress, 1 keeps it); got {relief!r}")
+    if not 0.0 <= diffusion < 1.0:
+        raise WoodcamError(f"diffusion must lie in [0, 1); got {diffusion!r}")
+    ys = [float(y) for y in years]
+    if len(ys) < 2 or np.any(np.diff(ys) <= 0) or ys[0] < 0 or ys[-1] > woodification.years:
+        raise WoodcamError(f"years must be >= 2 increasing years within [0, {woodification.years:g}]; got {years!r}")
+    rng = np.random.default_rng(seed)
+    wd = woodification
+    h = wd.front.grid.spacing_mm
+    up = np.asarray(wd.speed.up)
+    prev = None
+    thr = threshold
+    log = []
+    directions, points = [], []
+    for k in range(1, len(ys)):
+        mesh = wd.surface(ys[k])
+        origins, tri = wd.origins(mesh.vertices)
+        old_pos, _ = trace_back(wd.front, mesh.vertices, wind=wd.speed.wind,
+                                until_mm=wd.tau(ys[k - 1]))
+        stress = growth_stress(mesh, old_pos)
+        width = np.zeros(len(mesh.vertices))
+        cracked_edges: set = set()
+        if prev is not None:
+            # carry last year's stress (per face, by face-centre origin) and cracks (per vertex)
+            fo = origins[mesh.faces].mean(1)
+            _, j = cKDTree(prev.origins_mm[prev.mesh.faces].mean(1)).query(fo)
+            stress = stress + prev.stress[j]
+            # each old crack edge maps to the new vertices nearest its ends' origins, rejoined
+            # along the new edges (the seed's coupling through unique vertex identities)
+            _, ja = cKDTree(origins).query(prev.origins_mm[prev.crack_edges[:, 0]])
+            _, jb = cKDTree(origins).query(prev.origins_mm[prev.crack_edges[:, 1]])
+            nbrs = mesh.vertex_neighbors
+            old_w = np.maximum(prev.crack_width[prev.crack_edges[:, 0]],
+                               prev.crack_width[prev.crack_edges[:, 1]])
+            for a, b, wo in zip(ja, jb, old_w):
+                if a == b:
+                    continue
+                seg = mesh.vertices[b] - mesh.vertices[a]
+                ln = float(np.linalg.norm(seg))
+                path = _walk(mesh, nbrs, int(a), seg / ln, ln * 0.99, cracked_edges)
+                width[path] = np.maximum(width[path], wo)
+        # an open crack keeps widening while the bark stretches, and carries no stress across
+        cracked_v = width > 0
+        if cracked_v.any():
+            width = np.where(cracked_v, np.minimum(width + 0.25, 1.0), 0.0)
+            on_crack = cracked_v[mesh.faces].any(1)
+            stress[on_crack] *= relief
+        zeta = separation(mesh, stress)
+        lam, d = _crack_frame(zeta, mesh.vertex_normals, pattern, up, rng)
+        allowed = np.ones(len(lam), bool)
+        if region is not None:
+            c = np.asarray(region[:3], float)
+            allowed = np.linalg.norm(origins - c, axis=1) <= float(region[3])
+        if thr is None:
+            base = np.median(lam[allowed]) if allowed.any() else 0.0
+            thr = 2.0 * float(base) if base > 0 else float(np.max(lam) + 1.0)
+        heap = [(-lam[v], v) for v in np.nonzero(allowed & (lam > thr) & ~cracked_v)[0]]
+        heapq.heapify(heap)
+        nbrs = mesh.vertex_neighbors
+        vf = mesh.vertex_faces
+        inserted = 0
+        current = lam.copy()
+        while heap:
+            neg, v = heapq.heappop(heap)
+            if -neg != current[v] or current[v] <= thr or width[v] > 0:
+                continue
+            length = crack_length_voxels * h * min(current[v] / thr, 3.0)
+            path = _walk(mesh, nbrs, v, d[v], length / 2, cracked_edges)[::-1][:-1]
+            path += _walk(mesh, nbrs, v, -d[v], length / 2, cracked_edges)
+            if len(path) < 2:
+                current[v] = -np.inf
+                continue
+            inserted += 1
+            directions.append(d[v])
+            points.append(mesh.vertices[v])
+            path = np.asarray(path)
+            width[path] = np.maximum(width[path], 0.25)
+            # relief: the faces round the crack keep only `relief` of their stress
+            ring = set(path.tolist())
+            for _ in range(max(1, round(spacing_voxels))):
+                ring |= {b for a in list(ring) for b in nbrs[a]}
+            ring = np.fromiter(ring, int)
+            faces = np.unique(vf[ring])
+            faces = faces[faces >= 0]
+            stress[faces] *= relief
+            z = separation_local(mesh, stress, ring)
+            lam_r, d_r = _crack_frame(z, mesh.vertex_normals[ring], pattern, up, rng)
+            current[ring] = lam_r
+            d[ring] = d_r
+            for a, la in zip(ring, lam_r):
+                if la > thr and allowed[a] and width[a] == 0:
+                    heapq.heappush(heap, (-la, a))
+        stress = _diffuse(mesh, stress, diffusion)
+        log.append({"year": ys[k], "cracks": inserted, "max_eigenvalue": float(np.max(lam)),
+                    "threshold": thr})
+        edges = np.array(sorted(cracked_edges), int).reshape(-1, 2)
+        prev = CrackedSurface(mesh, origins, tri, edges, width, np.zeros((0, 3)), np.zeros((0, 3)),
+                              stress, thr, log)
+    prev.crack_directions = np.asarray(directions).reshape(-1, 3)
+    prev.crack_points = np.asarray(points).reshape(-1, 3)
+    return prev
+
+
+def separation_local(mesh, stress, vertices) -> np.ndarray:
+    """Separation tensors ``(k, 3, 3)`` of some vertices (recomputed after a relief)."""
+    vf = mesh.vertex_faces[vertices]
+    faces = np.unique(vf[vf >= 0])
+    sub = mesh.submesh([faces], append=True, repair=False)
+    # map the wanted vertices into the submesh by position (submesh renumbers)
+    from scipy.spatial import cKDTree
+
+    z = separation(sub, stress[faces])
+    _, j = cKDTree(sub.vertices).query(mesh.vertices[vertices])
+    return z[j]
+
+
+def _diffuse(mesh, stress, rate: float, steps: int = 2):
+    """Relaxation: move stress towards the mean of the edge-neighbouring faces."""
+    if rate <= 0:
+        return stress
+    adj = mesh.face_adjacency
+    s = stress.copy()
+    count = np.bincount(adj.ravel(), minlength=len(s)).astype(float)
+    for _ in range(steps):
+        acc = np.zeros_like(s)
+        np.add.at(acc, adj[:, 0], s[adj[:, 1]])
+        np.add.at(acc, adj[:, 1], s[adj[:, 0]])
+        mean = acc / np.maximum(count, 1)[:, None, None]
+        s = s + rate * (mean - s)
+    return s

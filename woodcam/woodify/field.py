@@ -1,0 +1,216 @@
+"""The grown object's growth field: years at any point of a block cut out of it.
+
+:class:`WoodifiedField` stores the front's arrival time ``T`` (mm of pseudo-time) on the
+woodify grid and maps it to years by the separation of time (:mod:`woodcam.woodify.speed`):
+``years = lambda W^-1(T / v)``. It interpolates ``T``, not years: ``T`` is a distance-like,
+Lipschitz function, while years have an infinite slope where ``W`` saturates, and the
+integer-year iso-surfaces (the rings) then coincide with the grown surfaces of those years.
+Years are 0 inside the input object (the "core", which the seed does not grow) and are capped
+at the last year the march reached beyond the final surface.
+
+Placement: block-frame points ``p`` (mm, docs/conventions.md) sit at
+``block_origin_mm + rotation @ p`` in the object frame (the input mesh's frame, mm), so a block
+of ``block_size_mm`` is cut anywhere out of the grown object.
+
+Engulfed obstacles are no wood: :meth:`WoodifiedField.no_wood` is true inside them, and
+:meth:`WoodifiedField.evaluate` reports them as ``dead`` (darkened like dead-knot wood by the
+colour map) with an ``outline`` on the scar round them, so a baked part shows the post.
+Fibres run along ``stem_axis`` (object frame; by default the input's longest principal axis,
+:func:`woodcam.woodify.bark.stem_axis`).
+
+File ``field.npz`` (written atomically): ``arrival_mm`` float32 (nx, ny, nz), ``origin_mm``,
+``spacing_mm``, ``speed`` (JSON of :class:`GrowthSpeed`), ``years_final``, ``stem_axis``,
+optional ``obstacle_sdf_mm`` float32, ``block_origin_mm``, ``block_rotation``,
+``block_size_mm``.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy import ndimage
+
+from .._atomic import atomic_path
+from ..errors import WoodcamError
+from ..fields.base import check_points
+from .speed import GrowthSpeed
+
+Interpolation = Literal["linear", "cubic"]
+_ORDER = {"linear": 1, "cubic": 3}
+FORMAT = "woodcam-woodify-field-1"
+
+#: Width (mm) of the scar line drawn round an engulfed obstacle in ``evaluate``'s ``outline``.
+_SCAR_MM = 0.8
+
+
+class WoodifiedField:
+    """Growth time (years) of a grown object at block-frame points (see module docstring).
+
+    Parameters
+    ----------
+    arrival_mm : (nx, ny, nz) float
+        Front arrival time on grid nodes (mm); non-finite entries (never reached) are capped.
+    origin_mm : (3,) float
+        Object-frame position of node (0, 0, 0).
+    spacing_mm : float
+        Node spacing (mm).
+    speed : GrowthSpeed
+    years_final : float
+        The last simulated year (for reports; the field answers beyond it).
+    obstacle_sdf_mm : (nx, ny, nz) float, optional
+        Signed distance to obstacles (negative inside) on the same nodes.
+    block_origin_mm, rotation, block_size_mm :
+        Placement of the block in the object frame (see module docstring); default: the
+        identity (block frame = object frame) and the grid's extent.
+    interpolation : "linear" (trilinear, default) or "cubic" (C2 B-spline)
+    stem_axis : (3,) float, optional
+        Fibre direction in the object frame; default ``speed.up``.
+    """
+
+    def __init__(self, arrival_mm: ArrayLike, origin_mm: ArrayLike, spacing_mm: float,
+                 speed: GrowthSpeed, years_final: float, obstacle_sdf_mm: ArrayLike | None = None,
+                 block_origin_mm: ArrayLike = (0.0, 0.0, 0.0), rotation: ArrayLike | None = None,
+                 block_size_mm: ArrayLike | None = None, interpolation: Interpolation = "linear",
+                 stem_axis: ArrayLike | None = None) -> None:
+        T = np.asarray(arrival_mm, dtype=np.float64)
+        if T.ndim != 3 or min(T.shape) < 2:
+            raise WoodcamError(f"arrival_mm must be an (nx, ny, nz) grid, each >= 2; got {T.shape}")
+        if interpolation not in _ORDER:
+            raise WoodcamError(f"interpolation must be one of {list(_ORDER)}; got {interpolation!r}")
+        finite = np.isfinite(T)
+        if not finite.any():
+            raise WoodcamError("arrival_mm has no finite value; the front never started")
+        self.t_cap_mm = float(T[finite].max())
+        self.arrival_mm = np.where(finite, T, self.t_cap_mm).astype(np.float32)
+        self.origin_mm = np.asarray(origin_mm, float).reshape(3)
+        self.spacing_mm = float(spacing_mm)
+        self.speed = speed
+        self.years_final = float(years_final)
+        # beyond the velocity scale the front never arrives (W < 1): cap where W = 1 - 1e-6
+        self.years_cap = float(speed.years(min(self.t_cap_mm, speed.velocity_mm * (1 - 1e-6))))
+        self.obstacle_sdf_mm = None if obstacle_sdf_mm is None else np.asarray(obstacle_sdf_mm, np.float32)
+        self.interpolation = interpolation
+        ax = np.asarray(speed.up if stem_axis is None else stem_axis, float).reshape(3)
+        self.stem_axis = ax / np.linalg.norm(ax)
+        R = np.eye(3) if rotation is None else np.asarray(rotation, float)
+        if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
+            raise WoodcamError(f"rotation must be a proper 3x3 rotation matrix; got {R.tolist()}")
+        self.rotation = R
+        self.block_origin_mm = np.asarray(block_origin_mm, float).reshape(3)
+        extent = (np.asarray(self.arrival_mm.shape) - 1) * self.spacing_mm
+        self.block_size_mm = tuple(float(v) for v in (extent if block_size_mm is None else block_size_mm))
+        if len(self.block_size_mm) != 3 or min(self.block_size_mm) <= 0:
+            raise WoodcamError(f"block_size_mm must be three sizes > 0 (W, D, H mm); got {block_size_mm!r}")
+        order = _ORDER[interpolation]
+        self._coeffs = (ndimage.spline_filter(self.arrival_mm, order=order, mode="nearest",
+                                              output=np.float32) if order > 1 else self.arrival_mm)
+
+    @property
+    def axis(self) -> np.ndarray:
+        """Fibre direction (the stem axis) in the block frame, (3,)."""
+        return self.rotation.T @ self.stem_axis
+
+    def to_object(self, points_mm: ArrayLike) -> np.ndarray:
+        """Block-frame points ``(n, 3)`` -> object-frame points ``(n, 3)`` (mm)."""
+        p = check_points(points_mm)
+        return self.block_origin_mm + np.einsum("ij,kj->ik", p, self.rotation)
+
+    def _sample(self, grid, q, order) -> np.ndarray:
+        if order == 1:
+            from ._voxel import trilinear
+
+            return trilinear(grid, self.origin_mm, self.spacing_mm, np.ascontiguousarray(q, float))
+        idx = (q - self.origin_mm) / self.spacing_mm
+        return ndimage.map_coordinates(grid, idx.T, order=order, mode="nearest", prefilter=False)
+
+    def arrival(self, points_mm: ArrayLike) -> np.ndarray:
+        """Interpolated arrival time ``T (n,)`` (mm) at block-frame points."""
+        return self._sample(self._coeffs, self.to_object(points_mm), _ORDER[self.interpolation])
+
+    def __call__(self, points_mm: ArrayLike) -> np.ndarray:
+        """Growth time ``years (n,)`` at ``points_mm (n, 3)`` (block frame, mm)."""
+        T = self.arrival(points_mm).astype(float)
+        return np.minimum(self.speed.years(T), self.years_cap)
+
+    def no_wood(self, points_mm: ArrayLike) -> np.ndarray:
+        """``(n,) bool``: inside an engulfed obstacle (no wood there)."""
+        if self.obstacle_sdf_mm is None:
+            return np.zeros(len(check_points(points_mm)), bool)
+        return self._sample(self.obstacle_sdf_mm, self.to_object(points_mm), 1) < 0
+
+    def evaluate(self, points_mm: ArrayLike, *, directions: bool = False) -> dict:
+        """Years with the colour map's knot channels in one pass (see module docstring)."""
+        p = check_points(points_mm)
+        out = {"years": self(p)}
+        n = len(p)
+        zero = np.zeros(n, np.float32)
+        if self.obstacle_sdf_mm is None:
+            out["knot"] = out["dead"] = out["outline"] = zero
+        else:
+            sd = self._sample(self.obstacle_sdf_mm, self.to_object(p), 1)
+            # both knot channels: the colour map darkens the obstacle twice, so it reads as
+            # foreign matter, not as a knot
+            out["knot"] = out["dead"] = (sd < 0).astype(np.float32)
+            out["outline"] = ((sd >= 0) & (sd < _SCAR_MM)).astype(np.float32)
+        if directions:
+            out["direction"] = np.broadcast_to(self.axis, p.shape).astype(np.float32)
+        return out
+
+    def grain_direction(self, points_mm: ArrayLike) -> np.ndarray:
+        """Unit fibre directions ``(n, 3)``: the stem axis everywhere (block frame)."""
+        return np.broadcast_to(self.axis, check_points(points_mm).shape)
+
+    def placed(self, block_size_mm: ArrayLike, block_centre_mm: ArrayLike | None = None,
+               rotation: ArrayLike | None = None) -> WoodifiedField:
+        """The same grown object with a block of ``block_size_mm`` (W, D, H) centred at
+        ``block_centre_mm`` (object frame; default the grid's centre)."""
+        size = np.asarray(block_size_mm, float)
+        if size.shape != (3,) or np.any(~(size > 0)):
+            raise WoodcamError(f"block_size_mm must be three sizes > 0 (W, D, H mm); got {block_size_mm!r}")
+        R = np.eye(3) if rotation is None else np.asarray(rotation, float)
+        extent = (np.asarray(self.arrival_mm.shape) - 1) * self.spacing_mm
+        c = self.origin_mm + extent / 2 if block_centre_mm is None else np.asarray(block_centre_mm, float)
+        return WoodifiedField(self.arrival_mm, self.origin_mm, self.spacing_mm, self.speed,
+                              self.years_final, self.obstacle_sdf_mm, c - R @ size / 2, R,
+                              tuple(size), self.interpolation, self.stem_axis)
+
+    def save(self, path: str | Path) -> Path:
+        """Write ``field.npz`` atomically (temp file in the same folder, then ``os.replace``)."""
+        path = Path(path)
+        if path.suffix != ".npz":
+            raise WoodcamError(f"path must end in .npz; got {str(path)!r}")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        arrays = {"format": FORMAT, "arrival_mm": self.arrival_mm, "origin_mm": self.origin_mm,
+                      "spacing_mm": self.spacing_mm, "speed": json.dumps(self.speed.to_dict()),
+                      "years_final": self.years_final, "block_origin_mm": self.block_origin_mm,
+                      "block_rotation": self.rotation, "block_size_mm": np.asarray(self.block_size_mm),
+                      "stem_axis": self.stem_axis}
+        if self.obstacle_sdf_mm is not None:
+            arrays["obstacle_sdf_mm"] = self.obstacle_sdf_mm
+        with atomic_path(path) as tmp:
+            np.savez_compressed(tmp, **arrays)
+        return path
+
+    @classmethod
+    def load(cls, path, interpolation: Interpolation = "linear") -> WoodifiedField:
+        """Read a ``field.npz`` written by :meth:`save`."""
+        path = Path(path)
+        if not path.is_file():
+            raise WoodcamError(f"woodify field {str(path)!r} does not exist; write one with "
+                               "'woodcam woodify MESH --out DIR' (it writes DIR/field.npz)")
+        try:
+            with np.load(path) as z:
+                if str(z["format"]) != FORMAT:
+                    raise ValueError(f"format {z['format']!s}")
+                return cls(z["arrival_mm"], z["origin_mm"], float(z["spacing_mm"]),
+                           GrowthSpeed.from_dict(json.loads(str(z["speed"]))),
+                           float(z["years_final"]),
+                           z["obstacle_sdf_mm"] if "obstacle_sdf_mm" in z.files else None,
+                           z["block_origin_mm"], z["block_rotation"], tuple(z["block_size_mm"]),
+                           interpolation, z["stem_axis"])
+        except (OSError, KeyError, ValueError) as err:
+            raise WoodcamError(f"{path}: not a woodcam woodify field ({FORMAT} .npz): {err}") from err

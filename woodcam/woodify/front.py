@@ -1,0 +1,351 @@
+"""Front propagation on a voxel grid: arrival time ``T(x)`` (mm of pseudo-time) of the growth front.
+
+The growing surface of seed 004 (a deformable simplicial complex moved along its normals,
+sec. 4.1) is replaced here by the arrival time of the front on grid nodes: the solid at
+pseudo-time ``tau`` is ``{T <= tau}``. Topology changes (fronts merging, holes closing, seed
+Fig. 5.5) need no special handling: the level set of a single-valued ``T`` changes topology by
+itself. ``T`` solves ``g(x) (|grad T| + w(x) . grad T) = 1`` outside the input (see
+:mod:`woodcam.woodify.speed`); inside the input ``T = -distance`` (<= 0, year 0).
+
+Solvers (``method``):
+
+- ``"fmm"``: scikit-fmm's second-order fast marching (``travel_time``), isotropic only
+  (``w = 0``; any gain ``g``); obstacles are masked nodes.
+- ``"anisotropic"``: woodcam's compiled fast marching (:mod:`._eikonal`) for the eccentric /
+  brushed case ``w != 0``, first order; no library solves this one.
+- ``"offset"``: exact for a constant wind without obstacles or gain: the eccentric front at
+  ``T`` is the input offset by ``T`` and shifted by ``w T``, so ``T(x)`` is the root of
+  ``D(x - w T) = T`` with ``D`` the (scikit-fmm) distance to the input; solved by fixed-point
+  iteration (a contraction with rate ``|w|``) on the interpolated ``D``.
+- ``"auto"`` (default): ``"fmm"`` when the wind is zero everywhere; ``"offset"`` for a constant
+  wind with no obstacles and no gain; else ``"anisotropic"``.
+
+Measured accuracy and speed are in DEVELOPERS.md (woodify section) and the benchmark test.
+
+Grid convention: nodes at ``origin_mm + (i, j, k) * spacing_mm``, arrays ``[x, y, z]``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from ..errors import WoodcamError
+from ..tolerances import WOODIFY_BAND_NODES, WOODIFY_OBSTACLE_CLEARANCE_VOXELS
+
+Method = Literal["auto", "fmm", "offset", "anisotropic"]
+METHODS: tuple[str, ...] = ("auto", "fmm", "offset", "anisotropic")
+
+
+@dataclass(frozen=True)
+class VoxelGrid:
+    """A regular grid of nodes: ``origin_mm (3,)``, cubic ``spacing_mm``, ``shape (nx, ny, nz)``."""
+
+    origin_mm: tuple[float, float, float]
+    spacing_mm: float
+    shape: tuple[int, int, int]
+
+    @classmethod
+    def around(cls, lo_mm, hi_mm, resolution: int) -> VoxelGrid:
+        """Grid covering the box ``[lo_mm, hi_mm]`` with ``resolution`` nodes on its longest side."""
+        lo, hi = np.asarray(lo_mm, float), np.asarray(hi_mm, float)
+        if not (isinstance(resolution, (int, np.integer)) and 16 <= resolution <= 1024):
+            raise WoodcamError(
+                f"resolution must be an integer number of grid nodes in [16, 1024]; got "
+                f"{resolution!r}; 128 is a good default")
+        h = float(np.max(hi - lo)) / (resolution - 1)
+        shape = tuple(int(np.ceil((hi[d] - lo[d]) / h)) + 1 for d in range(3))
+        return cls(tuple(lo), h, shape)
+
+    def axes(self) -> list[np.ndarray]:
+        """Node coordinates (mm) along X, Y, Z."""
+        return [self.origin_mm[d] + self.spacing_mm * np.arange(self.shape[d]) for d in range(3)]
+
+    def nodes(self) -> np.ndarray:
+        """All node positions ``(nx * ny * nz, 3)`` mm, C order."""
+        return np.stack(np.meshgrid(*self.axes(), indexing="ij"), axis=-1).reshape(-1, 3)
+
+    def to_index(self, points_mm) -> np.ndarray:
+        """Fractional node indices ``(n, 3)`` of points (mm)."""
+        return (np.asarray(points_mm, float) - np.asarray(self.origin_mm)) / self.spacing_mm
+
+
+@dataclass
+class Front:
+    """Arrival time of the growth front on a grid and what was rasterised to get it.
+
+    Attributes
+    ----------
+    grid : VoxelGrid
+    arrival_mm : (nx, ny, nz) float64
+        ``T``: pseudo-time (mm) at which the front reaches each node; ``-distance`` inside the
+        input; ``inf`` where it never arrives (sealed by obstacles, or beyond ``stop_mm``);
+        on obstacle nodes the value of the nearest wood node (so the field stays continuous).
+    inside : (nx, ny, nz) bool
+        Nodes inside the input mesh.
+    obstacle : (nx, ny, nz) bool
+        Nodes inside an obstacle (no wood there).
+    obstacle_sdf_mm : (nx, ny, nz) float32 or None
+        Signed distance to the obstacles (negative inside), exact within the band.
+    input_closest_mm : (nx, ny, nz, 3) float32
+        Closest point on the input surface, valid where ``input_tri >= 0`` (the band).
+    input_tri : (nx, ny, nz) int32
+        The input triangle of that closest point, -1 beyond the band.
+    method : str
+        The solver used.
+    """
+
+    grid: VoxelGrid
+    arrival_mm: np.ndarray
+    inside: np.ndarray
+    obstacle: np.ndarray
+    obstacle_sdf_mm: np.ndarray | None
+    input_closest_mm: np.ndarray
+    input_tri: np.ndarray
+    method: str
+
+
+def check_watertight(mesh, name: str):
+    """Return ``mesh`` as a trimesh if it is a closed, consistently oriented volume, else raise."""
+    import trimesh
+
+    if not isinstance(mesh, trimesh.Trimesh):
+        raise WoodcamError(f"{name} must be a trimesh.Trimesh; got {type(mesh).__name__}")
+    if len(mesh.faces) == 0:
+        raise WoodcamError(f"{name} has no triangles; give a closed (watertight) mesh")
+    if not mesh.is_watertight:
+        raise WoodcamError(
+            f"{name} must be watertight (every edge shared by exactly two triangles) so its inside "
+            f"is defined; this one has {len(mesh.faces)} triangles and open or non-manifold "
+            "edges; repair it first (e.g. trimesh.repair.fill_holes, or export a closed solid)")
+    return mesh
+
+
+def _rasterise(mesh, grid: VoxelGrid, band: int):
+    from ._voxel import band_distance, inside_parity
+
+    v = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
+    f = np.ascontiguousarray(mesh.faces, dtype=np.int64)
+    o = np.asarray(grid.origin_mm, np.float64)
+    shape = np.asarray(grid.shape, np.int64)
+    dist, closest, tri = band_distance(v, f, o, grid.spacing_mm, shape, band)
+    inside = inside_parity(v, f, o, grid.spacing_mm, shape)
+    return dist, closest, tri, inside
+
+
+def propagate(mesh, grid: VoxelGrid, *, wind=None, gain=None, obstacles=(), method: Method = "auto",
+              stop_mm: float = np.inf, paint=None) -> Front:
+    """Arrival time of the front grown from ``mesh`` (see module docstring).
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+        Watertight input, block frame, mm.
+    grid : VoxelGrid
+    wind : (3,) or (nx, ny, nz, 3) float, optional
+        Direction part ``w`` of the normal speed ``g (1 + w . n)``; ``|w| < 1``.
+    gain : float or (nx, ny, nz) float, optional
+        Speed gain ``g > 0`` (brushes); default 1.
+    obstacles : sequence of trimesh.Trimesh
+        Watertight obstacles: the front stops on contact and wraps round them.
+    method : "auto", "fmm" or "anisotropic"
+    stop_mm : float
+        March only up to this pseudo-time (mm); later nodes stay ``inf``.
+    paint : callable, optional
+        ``paint(origin_mm (m, 3), tri (m,)) -> (gain (m,), wind (m, 3))`` evaluated at each
+        node's closest input-surface point (brushes, :func:`woodcam.woodify.brushes.paint`);
+        multiplies ``gain`` and adds to ``wind``.
+    """
+    if method not in METHODS:
+        raise WoodcamError(f"method must be one of {list(METHODS)}; got {method!r}")
+    mesh = check_watertight(mesh, "mesh")
+    h = grid.spacing_mm
+    dist, closest, tri, inside = _rasterise(mesh, grid, WOODIFY_BAND_NODES)
+    obstacle = np.zeros(grid.shape, bool)
+    obst_sdf = None
+    if obstacles:
+        import trimesh
+
+        obs = [check_watertight(o, f"obstacles[{i}]") for i, o in enumerate(obstacles)]
+        allobs = trimesh.util.concatenate(obs) if len(obs) > 1 else obs[0]
+        od, _, _, oin = _rasterise(allobs, grid, WOODIFY_BAND_NODES)
+        far = WOODIFY_BAND_NODES * h
+        obst_sdf = np.where(oin, -np.minimum(od, far), np.minimum(od, far)).astype(np.float32)
+        # The grown solid keeps a small clearance from obstacles: the linearly interpolated
+        # distance of a convex obstacle crosses zero slightly inside it (tolerances.py).
+        obstacle = obst_sdf < WOODIFY_OBSTACLE_CLEARANCE_VOXELS * h
+        if not np.any(inside & ~obstacle):
+            raise WoodcamError(
+                "obstacles must leave part of the input outside them; the obstacle(s) contain "
+                f"the whole input mesh ({len(mesh.faces)} triangles), so nothing can grow; "
+                "move or shrink the obstacle")
+        inside &= ~obstacle
+    if not np.any(inside):
+        raise WoodcamError(
+            "mesh must enclose at least one grid node; it is smaller than the grid spacing "
+            f"{h:.3g} mm; raise the resolution or scale the mesh up")
+    w = np.zeros(3) if wind is None else np.asarray(wind, float)
+    if w.shape not in ((3,), grid.shape + (3,)):
+        raise WoodcamError(f"wind must have shape (3,) or {grid.shape + (3,)}; got {w.shape}")
+    if np.max(np.linalg.norm(w.reshape(-1, 3), axis=1)) >= 1.0:
+        raise WoodcamError("wind (eccentricity plus brushed directions) must have |w| < 1 so every "
+                           "normal keeps growing; lower the eccentricity or the brush strengths")
+    g = np.ones(()) if gain is None else np.asarray(gain, float)
+    if g.shape not in ((), grid.shape) or np.any(~(g > 0)):
+        raise WoodcamError(f"gain must be > 0, a scalar or of shape {grid.shape}; got shape {g.shape}")
+    if paint is not None:
+        from scipy import ndimage
+
+        # each node takes the paint of its closest input point: that of the nearest band node
+        _, near = ndimage.distance_transform_edt(tri < 0, return_indices=True)
+        near = tuple(near)
+        pg, pw = paint(closest[near].reshape(-1, 3).astype(float), tri[near].reshape(-1))
+        g = g * np.asarray(pg, float).reshape(grid.shape)
+        w = w + np.asarray(pw, float).reshape(grid.shape + (3,))
+        if np.max(np.linalg.norm(w.reshape(-1, 3), axis=1)) >= 1.0:
+            raise WoodcamError("eccentricity plus brushed strengths must stay below 1 everywhere "
+                               "so every normal keeps growing; lower them")
+    isotropic = not np.any(w)
+    constant = w.ndim == 1 and g.ndim == 0 and float(g) == 1.0 and not obstacles
+    if method == "auto":
+        method = "fmm" if isotropic else ("offset" if constant else "anisotropic")
+    if method == "offset" and not constant:
+        raise WoodcamError("method 'offset' is exact only for a constant wind (eccentricity) "
+                           "without obstacles or brushed gain; use method 'anisotropic' or 'auto'")
+    if method == "fmm" and not isotropic:
+        raise WoodcamError("method 'fmm' (scikit-fmm) solves the isotropic case only; with "
+                           "eccentricity or brushed directions use method 'anisotropic' or 'auto'")
+    d_in = np.where(np.isfinite(dist), dist, WOODIFY_BAND_NODES * h)
+    if method == "fmm":
+        T = _fmm(d_in, inside, obstacle, g, h, stop_mm)
+    elif method == "offset":
+        T = _offset(d_in, inside, w, grid, stop_mm)
+    else:
+        T = _anisotropic(d_in, closest, inside, obstacle, g, w, grid, stop_mm)
+    T[inside] = -d_in[inside]
+    if obstacles:
+        T = _fill_obstacle(T, obstacle)
+    return Front(grid, T, inside, obstacle, obst_sdf, closest, tri, method)
+
+
+def _fmm(d_in, inside, obstacle, g, h, stop_mm):
+    import skfmm
+
+    phi = np.where(inside, -d_in, d_in)
+    phi = np.ma.MaskedArray(phi, obstacle)
+    speed = np.broadcast_to(g, phi.shape).astype(float)
+    narrow = float(stop_mm) if np.isfinite(stop_mm) else 0.0
+    t = skfmm.travel_time(phi, speed, dx=float(h), order=2, narrow=narrow)
+    if np.ma.isMaskedArray(t):
+        return np.ma.filled(t.astype(float), np.inf)
+    return np.asarray(t, float)
+
+
+def _offset(d_in, inside, w, grid, stop_mm):
+    from scipy import ndimage
+
+    h = grid.spacing_mm
+    reach = stop_mm / (1.0 - np.linalg.norm(w)) if np.isfinite(stop_mm) else 0.0
+    D = _fmm(d_in, inside, np.zeros_like(inside), np.ones(()), h, reach)
+    D = np.where(inside, -d_in, D)
+    D = np.where(np.isfinite(D), D, np.nanmax(np.where(np.isfinite(D), D, np.nan)))
+    out = ~inside
+    x = np.stack(np.nonzero(out), axis=1).astype(float)  # node indices
+    T = D[out]
+    shift = np.asarray(w, float) / h  # index units per mm of T
+    for _ in range(200):
+        Tn = ndimage.map_coordinates(D, (x - T[:, None] * shift).T, order=1, mode="nearest")
+        done = np.max(np.abs(Tn - T)) < 1e-6 * h
+        T = Tn
+        if done:
+            break
+    res = np.full(grid.shape, np.inf)
+    res[out] = T
+    if np.isfinite(stop_mm):
+        res[res > stop_mm] = np.inf
+    return res
+
+
+def _anisotropic(d_in, closest, inside, obstacle, g, w, grid, stop_mm):
+    from ._eikonal import BLOCKED, FAR, FIXED, march
+
+    h = grid.spacing_mm
+    T = np.full(grid.shape, np.inf)
+    state = np.full(grid.shape, FAR, np.int8)
+    state[obstacle] = BLOCKED
+    state[inside] = FIXED
+    T[inside] = -d_in[inside]
+    # first layer: outside nodes next to an inside node start from the exact distance d along
+    # the outward normal n, reached after d / (g (1 + w . n)).
+    near = np.zeros_like(inside)
+    for ax in range(3):
+        for s in (1, -1):
+            near |= np.roll(inside, s, axis=ax)
+    first = near & ~inside & ~obstacle
+    idx = np.nonzero(first)
+    p = np.stack([grid.origin_mm[d] + h * idx[d] for d in range(3)], axis=1)
+    dvec = p - closest[idx].astype(float)
+    d = np.linalg.norm(dvec, axis=1)
+    n = dvec / np.maximum(d, 1e-12)[:, None]
+    wl = w if w.ndim == 1 else w[idx]
+    gl = g if g.ndim == 0 else g[idx]
+    T[idx] = d / (gl * (1.0 + np.sum(n * wl, axis=-1)))
+    state[idx] = FIXED
+    gain = np.asarray(g, float).reshape((1, 1, 1) if g.ndim == 0 else g.shape)
+    wind = np.asarray(w, float).reshape((1, 1, 1, 3) if w.ndim == 1 else w.shape)
+    march(T, state, np.ascontiguousarray(gain), np.ascontiguousarray(wind), float(h))
+    if np.isfinite(stop_mm):
+        T[T > stop_mm] = np.inf
+    return T
+
+
+def _fill_obstacle(T, obstacle):
+    """Give obstacle nodes the arrival time of the nearest wood node (continuous field there)."""
+    from scipy import ndimage
+
+    _, idx = ndimage.distance_transform_edt(obstacle, return_distances=True, return_indices=True)
+    out = T.copy()
+    out[obstacle] = T[tuple(i[obstacle] for i in idx)]
+    return out
+
+
+def sphere_arrival(points_mm, centre_mm, radius_mm: float, wind=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """Exact arrival time (mm) of the front grown from a sphere with normal speed ``1 + w . n``.
+
+    The eccentric front at pseudo-time ``T`` is the sphere offset by ``T`` and shifted by
+    ``w T`` (Minkowski sum with a ball of radius ``T`` centred at ``w T``), so ``T`` solves
+    ``|x - c - w T| = r0 + T``: a quadratic. Negative inside the input sphere (``-distance``).
+    """
+    p = np.asarray(points_mm, float) - np.asarray(centre_mm, float)
+    w = np.asarray(wind, float)
+    # (1 - |w|^2) T^2 + 2 (r0 + p.w) T + r0^2 - |p|^2 = 0
+    a = 1.0 - w @ w
+    b = 2.0 * (radius_mm + p @ w)
+    c = radius_mm ** 2 - np.einsum("ij,ij->i", p, p)
+    t = (-b + np.sqrt(np.maximum(b * b - 4 * a * c, 0.0))) / (2 * a)
+    r = np.linalg.norm(p, axis=1)
+    return np.where(r < radius_mm, r - radius_mm, t)
+
+
+def offset_arrival(distance, points_mm, wind=(0.0, 0.0, 0.0), iterations: int = 50) -> np.ndarray:
+    """Exact arrival time (mm) of the unobstructed front from any closed shape, by bisection.
+
+    Without obstacles the front at ``T`` is the input offset by ``T`` and shifted by ``w T``,
+    so ``T(x)`` is the root of ``dist(x - w T) = T`` (the left side minus ``T`` falls strictly
+    for ``|w| < 1``). ``distance(points (n, 3)) -> (n,)`` is the exact distance to the shape
+    (positive outside), e.g. the closed form of a box; ``points_mm (n, 3)`` lie outside it.
+    A check for the grid solvers.
+    """
+    p = np.asarray(points_mm, float)
+    w = np.asarray(wind, float)
+    d0 = np.asarray(distance(p), float)
+    lo = d0 / (1.0 + np.linalg.norm(w))
+    hi = d0 / (1.0 - np.linalg.norm(w)) + 1e-12
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        beyond = np.asarray(distance(p - mid[:, None] * w), float) > mid
+        lo = np.where(beyond, mid, lo)
+        hi = np.where(beyond, hi, mid)
+    return 0.5 * (lo + hi)

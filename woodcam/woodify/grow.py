@@ -1,0 +1,182 @@
+"""Woodification of a watertight mesh: grow it for some years and keep everything it became.
+
+:func:`woodify` sizes a grid round the input and its final growth, propagates the front once
+(:mod:`.front`) and returns a :class:`Woodification`: the growth field of the grown object
+(:class:`~woodcam.woodify.field.WoodifiedField`), grown surfaces at any year, origins of grown
+points on the input (persistent texturing) and ring sections. Object frame = the input mesh's
+frame, mm; years since the input surface.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import time
+from dataclasses import dataclass
+from dataclasses import field as dc_field
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import WoodcamError
+from .brushes import Brush, paint
+from .field import WoodifiedField
+from .front import Front, Method, VoxelGrid, check_watertight, propagate
+from .speed import GrowthSpeed, weibull_cdf
+
+if TYPE_CHECKING:
+    import trimesh
+
+#: Nodes of margin kept between the final grown surface and the grid border.
+_MARGIN_NODES = 4
+
+
+@dataclass
+class Woodification:
+    """Everything a woodification run produced (see module docstring).
+
+    Attributes
+    ----------
+    mesh : trimesh.Trimesh
+        The input, object frame, mm.
+    speed : GrowthSpeed
+    years : float
+        Years grown.
+    front : Front
+    field : WoodifiedField
+        Years at object-frame points (identity placement; :meth:`WoodifiedField.placed` cuts a
+        block).
+    obstacles : list of trimesh.Trimesh
+    timings : dict
+        Seconds per stage (wall clock).
+    """
+
+    mesh: object
+    speed: GrowthSpeed
+    years: float
+    front: Front
+    field: WoodifiedField
+    obstacles: list = dc_field(default_factory=list)
+    timings: dict = dc_field(default_factory=dict)
+
+    def tau(self, year: float) -> float:
+        """Pseudo-time (mm) of ``year``."""
+        return float(self.speed.tau(year))
+
+    def surface(self, year: float) -> "trimesh.Trimesh":
+        """The grown surface at ``year`` (0 = the input as voxelised) as a watertight trimesh."""
+        from .surfaces import surface_at
+
+        if not (np.isfinite(year) and 0 <= year <= self.years):
+            raise WoodcamError(f"year must lie in [0, {self.years:g}] (the years grown); got {year!r}")
+        return surface_at(self.front, self.tau(year))
+
+    def origins(self, points_mm: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """Origins ``(n, 3)`` on the input surface and their input triangles ``(n,)`` of grown
+        points (characteristic back-trace, :func:`woodcam.woodify.surfaces.trace_back`)."""
+        from .surfaces import trace_back
+
+        return trace_back(self.front, points_mm, wind=self.speed.wind)
+
+    def engulf_year(self, obstacle_index: int = 0, inside_box: ArrayLike | None = None) -> float:
+        """Year by which the wood has closed round obstacle ``obstacle_index`` within the grid
+        (every node touching it is wood): the latest arrival on its boundary, as years.
+
+        ``inside_box`` ``(lo (3,), hi (3,))`` mm limits the check to part of the obstacle (a post
+        that sticks out of the tree is engulfed only where the tree is)."""
+        from ._voxel import inside_parity
+
+        g = self.front.grid
+        o = self.obstacles[obstacle_index]
+        mine = inside_parity(np.asarray(o.vertices, float), np.asarray(o.faces, np.int64),
+                             np.asarray(g.origin_mm, float), g.spacing_mm, np.asarray(g.shape))
+        from scipy import ndimage
+
+        rim = ndimage.binary_dilation(mine) & ~self.front.obstacle
+        if inside_box is not None:
+            lo, hi = (np.asarray(v, float) for v in inside_box)
+            pts = g.nodes().reshape(g.shape + (3,))
+            rim &= np.all((pts >= lo) & (pts <= hi), axis=-1)
+        if not rim.any():
+            raise WoodcamError(f"obstacle {obstacle_index} touches no wood node in the grid")
+        return float(self.speed.years(np.max(self.front.arrival_mm[rim])))
+
+
+def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: float | None = None,
+            time_scale_years: float | None = None, shape: float = 2.0, eccentricity: float = 0.0,
+            up=(0.0, 0.0, 1.0), obstacles=(), brushes: tuple[Brush, ...] | list = (),
+            vertex_gain=None, vertex_direction=None, resolution: int = 128,
+            method: Method = "auto") -> Woodification:
+    """Grow a watertight ``mesh`` for ``years`` (seed 004 ch. 4 on a voxel grid).
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+        Watertight input, mm.
+    years : float
+        Years to grow, > 0.
+    growth_mm : float, optional
+        How far a flat surface grows in ``years`` (mm); sets the velocity scale
+        ``v = growth_mm / W(years / time_scale_years)``. Default: a quarter of the input's
+        largest side. Give either this or ``velocity_mm``.
+    velocity_mm : float, optional
+        The Weibull velocity scale ``v`` (mm) directly.
+    time_scale_years : float, optional
+        ``lambda`` of the Weibull law; default ``years`` (growth slowing towards the end).
+    shape, eccentricity, up :
+        See :class:`~woodcam.woodify.speed.GrowthSpeed`.
+    obstacles : sequence of trimesh.Trimesh
+        Watertight obstacles (mm); the front stops on contact, wraps round and engulfs them.
+    brushes, vertex_gain, vertex_direction :
+        User-defined growth (:mod:`woodcam.woodify.brushes`).
+    resolution : int
+        Grid nodes along the longest side of the grown object's box.
+    method : "auto", "fmm", "offset" or "anisotropic" (:mod:`woodcam.woodify.front`)
+    """
+    t0 = time.perf_counter()
+    if not (isinstance(years, (int, float, np.integer, np.floating)) and np.isfinite(years) and years > 0):
+        raise WoodcamError(f"years must be a number > 0 (years to grow); got {years!r}; e.g. 40")
+    mesh = check_watertight(mesh, "mesh")
+    lam = float(years) if time_scale_years is None else float(time_scale_years)
+    if growth_mm is not None and velocity_mm is not None:
+        raise WoodcamError("give growth_mm or velocity_mm, not both")
+    lo, hi = mesh.bounds
+    if velocity_mm is None:
+        g_mm = 0.25 * float(np.max(hi - lo)) if growth_mm is None else float(growth_mm)
+        if not (np.isfinite(g_mm) and g_mm > 0):
+            raise WoodcamError(f"growth_mm must be > 0 (mm grown in `years`); got {growth_mm!r}")
+        if not lam > 0:
+            raise WoodcamError(f"time_scale_years must be > 0; got {time_scale_years!r}")
+        velocity_mm = g_mm / float(weibull_cdf(years / lam, shape))
+    speed = GrowthSpeed(float(velocity_mm), lam, shape, float(eccentricity), tuple(up))
+    tau_end = float(speed.tau(years))
+    strokes = list(brushes)
+    gmax = float(np.prod([max(b.gain, 1.0) for b in strokes])) if strokes else 1.0
+    if vertex_gain is not None:
+        gmax *= float(np.max(vertex_gain))
+    wmax = abs(speed.eccentricity) + sum(b.strength for b in strokes)
+    if vertex_direction is not None:
+        wmax += float(np.max(np.linalg.norm(np.asarray(vertex_direction, float), axis=1)))
+    if wmax >= 1.0:
+        raise WoodcamError(f"eccentricity plus brush strengths must stay below 1; got {wmax:.3g}")
+    reach = tau_end * gmax * (1.0 + wmax)
+    ext = float(np.max(hi - lo)) + 2 * reach
+    h_est = ext / (resolution - 1 - 2 * _MARGIN_NODES)
+    pad = reach + _MARGIN_NODES * h_est
+    grid = VoxelGrid.around(lo - pad, hi + pad, resolution)
+    obstacles = [check_watertight(o, f"obstacles[{i}]") for i, o in enumerate(obstacles)]
+    paint_fn = None
+    if strokes or vertex_gain is not None or vertex_direction is not None:
+        def paint_fn(origin, tri):
+            return paint(origin, strokes, vertex_gain=vertex_gain,
+                         vertex_direction=vertex_direction, mesh=mesh, tri=tri)
+    t1 = time.perf_counter()
+    front = propagate(mesh, grid, wind=speed.wind, obstacles=obstacles, method=method,
+                      stop_mm=tau_end + 2 * _MARGIN_NODES * grid.spacing_mm * gmax, paint=paint_fn)
+    t2 = time.perf_counter()
+    from .bark import stem_axis
+
+    field = WoodifiedField(front.arrival_mm, grid.origin_mm, grid.spacing_mm, speed, float(years),
+                           front.obstacle_sdf_mm, stem_axis=stem_axis(mesh))
+    timings = {"setup_s": t1 - t0, "front_s": t2 - t1, "field_s": time.perf_counter() - t2}
+    return Woodification(mesh, speed, float(years), front, field, obstacles, timings)

@@ -1,0 +1,140 @@
+"""Growth speed of the woodification model (seed 004, sec. 4.2) and the separation of time.
+
+The seed moves every surface point along its normal with speed (eq. 4.1)
+
+    s(t) = c t^(c-1) exp(-t^c)                                    (Weibull density, shape c)
+
+and, with eccentricity (sec. 4.2.1), ``s_e(t, x) = (1 + delta n . up) s(t)``. woodcam adds a
+velocity scale ``v`` (mm) and a time scale ``lambda`` (years): a point moves with normal speed
+
+    ds/dt = v / lambda * s(t / lambda) * g(x) * (1 + w(x) . n)
+
+where ``g`` is a speed gain (1 unless brushed, sec. 4.2.2) and ``w = delta * up`` (+ brushed
+directions). The time part separates from the space part: with the pseudo-time
+
+    tau(t) = v * W(t / lambda),        W(u) = 1 - exp(-u^c)       (the Weibull CDF)
+
+the front at year ``t`` is the front at ``tau`` of the time-independent problem whose normal
+speed is ``F(x, n) = g(x) (1 + w(x) . n)`` (units: mm of pseudo-time per mm). Its arrival time
+``T(x)`` (mm) solves the eikonal equation ``g (|grad T| + w . grad T) = 1`` and the growth year
+of ``x`` is ``t = lambda * W^-1(T(x) / v)``. A sphere of radius r0 grows to ``r0 + tau(t)``;
+with eccentricity its centre moves by ``delta * tau(t)`` along ``up``; it never grows beyond
+``r0 + v`` (W < 1): ``v`` is the asymptotic total growth.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import WoodcamError
+
+
+def weibull_speed(u, shape: float = 2.0) -> np.ndarray:
+    """Eq. 4.1: ``s(u) = c u^(c-1) exp(-u^c)`` for ``u >= 0`` (dimensionless time)."""
+    u = np.maximum(np.asarray(u, dtype=float), 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = shape * u ** (shape - 1.0) * np.exp(-u ** shape)
+    return np.where(u > 0, s, shape if shape == 1.0 else (np.inf if shape < 1 else 0.0))
+
+
+def weibull_cdf(u, shape: float = 2.0) -> np.ndarray:
+    """``W(u) = 1 - exp(-u^c)`` for ``u >= 0``: the integral of eq. 4.1 from 0 to ``u``."""
+    u = np.maximum(np.asarray(u, dtype=float), 0.0)
+    return -np.expm1(-u ** shape)
+
+
+def weibull_cdf_inv(q, shape: float = 2.0) -> np.ndarray:
+    """``W^-1(q) = (-ln(1 - q))^(1/c)`` for ``q`` in [0, 1); ``inf`` for ``q >= 1``."""
+    q = np.clip(np.asarray(q, dtype=float), 0.0, 1.0)
+    with np.errstate(divide="ignore"):
+        return (-np.log1p(-q)) ** (1.0 / shape)
+
+
+def _unit3(v, name: str) -> np.ndarray:
+    a = np.asarray(v, dtype=float)
+    n = float(np.linalg.norm(a)) if a.shape == (3,) else 0.0
+    if a.shape != (3,) or not np.isfinite(n) or n < 1e-12:
+        raise WoodcamError(f"{name} must be a non-zero 3-vector; got {v!r}; e.g. (0, 0, 1)")
+    return a / n
+
+
+@dataclass(frozen=True)
+class GrowthSpeed:
+    """The growth law: Weibull time part (eq. 4.1) and eccentric direction part (sec. 4.2.1).
+
+    Parameters
+    ----------
+    velocity_mm : float
+        Velocity scale ``v`` (mm): the total growth as ``t -> inf``; after ``t`` years a flat
+        surface has moved ``v * W(t / time_scale_years)``.
+    time_scale_years : float
+        Time scale ``lambda`` (years) of the Weibull law; the growth peaks near
+        ``lambda * ((c - 1) / c)^(1/c)`` (0.71 lambda for c = 2).
+    shape : float
+        Weibull shape ``c > 0`` (seed default 2).
+    eccentricity : float
+        ``delta`` in ``(-1, 1)``: speed ``(1 + delta n . up)``; positive grows faster on the
+        side facing ``up`` (tension wood), negative away from it (compression wood).
+    up : (3,) float
+        The direction ``y-hat`` of the seed (normalised here); block frame, default +Z.
+    """
+
+    velocity_mm: float
+    time_scale_years: float
+    shape: float = 2.0
+    eccentricity: float = 0.0
+    up: tuple[float, float, float] = (0.0, 0.0, 1.0)
+
+    def __post_init__(self):
+        if not (np.isfinite(self.velocity_mm) and self.velocity_mm > 0):
+            raise WoodcamError(f"velocity_mm must be > 0 (mm of total growth); got {self.velocity_mm!r}")
+        if not (np.isfinite(self.time_scale_years) and self.time_scale_years > 0):
+            raise WoodcamError(
+                f"time_scale_years must be > 0 (years); got {self.time_scale_years!r}")
+        if not (np.isfinite(self.shape) and self.shape > 0):
+            raise WoodcamError(f"shape (Weibull c) must be > 0; got {self.shape!r}; the seed uses 2")
+        if not -1.0 < self.eccentricity < 1.0:
+            raise WoodcamError(
+                f"eccentricity must lie in (-1, 1) so every normal keeps growing; got "
+                f"{self.eccentricity!r}; try 0.3")
+        object.__setattr__(self, "up", tuple(_unit3(self.up, "up")))
+
+    @property
+    def wind(self) -> np.ndarray:
+        """``w = delta * up`` (3,): the direction part of the speed ``F = 1 + w . n``."""
+        return self.eccentricity * np.asarray(self.up)
+
+    def tau(self, years: ArrayLike) -> np.ndarray:
+        """Pseudo-time ``tau = v W(t / lambda)`` (mm) reached at ``years``."""
+        t = np.asarray(years, dtype=float)
+        return self.velocity_mm * weibull_cdf(t / self.time_scale_years, self.shape)
+
+    def years(self, tau_mm: ArrayLike) -> np.ndarray:
+        """Inverse of :meth:`tau`: growth year ``lambda W^-1(T / v)`` of arrival time ``T`` (mm).
+
+        ``T <= 0`` (the input object itself) maps to 0; ``T >= v`` (never reached) to ``inf``.
+        """
+        q = np.asarray(tau_mm, dtype=float) / self.velocity_mm
+        return self.time_scale_years * weibull_cdf_inv(q, self.shape)
+
+    def speed(self, years: ArrayLike, normals: ArrayLike | None = None) -> np.ndarray:
+        """Normal speed ``ds/dt`` (mm/year) at ``years`` for unit ``normals (n, 3)`` (eq. 4.1
+        with the eccentric factor); without normals the isotropic speed."""
+        lam = self.time_scale_years
+        s = self.velocity_mm / lam * weibull_speed(np.asarray(years, float) / lam, self.shape)
+        if normals is None:
+            return s
+        n = np.asarray(normals, dtype=float)
+        return s * (1.0 + n @ self.wind)
+
+    def to_dict(self) -> dict:
+        return {"velocity_mm": self.velocity_mm, "time_scale_years": self.time_scale_years,
+                "shape": self.shape, "eccentricity": self.eccentricity, "up": list(self.up)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> GrowthSpeed:
+        return cls(float(d["velocity_mm"]), float(d["time_scale_years"]), float(d["shape"]),
+                   float(d["eccentricity"]), tuple(d["up"]))
