@@ -110,14 +110,6 @@ def run_preview(args: argparse.Namespace) -> int:
     from .options import stock_of_glb
 
     stock = stock_of_glb(args.mesh, args.block)
-    out = preview(args.mesh, wood=stock.wood if stock else None,
-                  size_mm=stock.size_mm if stock else None, screenshot=args.screenshot,
-                  camera=args.camera, cut_plane=not args.no_cut, cut_origin=args.cut_origin,
-                  cut_normal=args.cut_normal)
-    spec = args.block
-    if spec is None and args.mesh.suffix.lower() == ".glb":
-        spec = read_glb_metadata(args.mesh).get("block")
-    stock = open_stock(spec) if spec else None
     wood = stock.wood if stock else None
     if args.confidence:
         from ..inference.evidence import ConfidenceWood
@@ -127,7 +119,9 @@ def run_preview(args: argparse.Namespace) -> int:
                                "without a true field, or a Mokume folder); pass --block")
         wood = ConfidenceWood(stock.wood.field)
     out = preview(args.mesh, wood=wood,
-                  size_mm=stock.size_mm if stock else None, screenshot=args.screenshot)
+                  size_mm=stock.size_mm if stock else None, screenshot=args.screenshot,
+                  camera=args.camera, cut_plane=not args.no_cut, cut_origin=args.cut_origin,
+                  cut_normal=args.cut_normal)
     if out:
         print(f"wrote {out}")
     return 0
