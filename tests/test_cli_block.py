@@ -63,5 +63,7 @@ def test_block_synth_noise_options(tmp_path):
     b = read_block(maps / "block_0000")
     assert all(not f.traces and f.ring_map is not None for f in b.faces.values())
     assert json.loads((maps / "index.json").read_text())["count"] == 1
+    from woodcam.cli import EXIT_ERROR
+
     assert main(["block", "synth", "--count", "1", "--out", str(tmp_path / "x"),
-                 "--size-range-mm", "80,30"]) == 2
+                 "--size-range-mm", "80,30"]) == EXIT_ERROR
