@@ -11,9 +11,9 @@ from woodcam.cli import _walk_options, build_parser
 UNITS = re.compile(
     r"\b(mm|mm\^3|deg|degrees?|px|pixels?|texels?|years?|seconds?|s|%|MiB|GiB|voxels?|"
     r"triangles?|blocks?|steps?|epochs?|workers?|threads?|faces?|points?|rings?|placements?|"
-    r"cells?|samples?|patches|sheets?|dpi|inch(es)?|times|per mm|in \[|fraction|ratio)\b", re.I)
+    r"cells?|nodes?|samples?|patches|sheets?|dpi|inch(es)?|times|per mm|in \[|fraction|ratio)\b", re.I)
 #: Numbers that are dimensionless by nature (named by the option itself).
-DIMENSIONLESS = {"--seed", "--k-stem", "--k-knot", "--quality"}
+DIMENSIONLESS = {"--seed", "--k-stem", "--k-knot", "--quality", "--shape", "--eccentricity"}
 
 
 def test_every_option_states_its_default():

@@ -31,8 +31,9 @@ LAYERS: dict[str, int] = {
     "advise": 10,                      # placement advice and part reports (takes a Stock)
     "pipeline": 11, "demo": 12,
     "scale": 13,                       # runs any of them
-    "cli": 14,                         # the command, on top
-    "woodcam": 15,                     # the package's lazy re-exports
+    "benchmark": 14,                   # bench tasks and reports, run by scale
+    "cli": 15,                         # the command, on top
+    "woodcam": 16,                     # the package's lazy re-exports
 }
 #: Data folders (no code).
 DATA = {"models", "data", "examples"}  # examples: part scripts (cad_examples/ links here)

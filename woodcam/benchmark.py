@@ -1,194 +1,560 @@
-"""The ring-inference benchmark that tells the truth (issue 12, part 6): per-block scoring.
+"""Synthetic work at scale: seed 000's Table 1 on thousands of blocks and its report, block sets
+and the neural model's training set, each as many independent tasks of :mod:`woodcam.scale`.
 
-One task = one block of the realistic generator (:func:`woodcam.synth.benchmark_set_block`:
-blocks of 30-80 mm cut from eccentric, lobed analytic logs or from knotted generated logs with a
-knot crossing the block), one trace scenario and one face set, fitted by several methods and
-scored on interior cut planes (seed 000's Table 1 metric, :mod:`woodcam.inference.evaluate`).
-:func:`score_block` is that task: a pure function of its arguments (the block is regenerated
-from ``(seed, index)``), so a runner (:mod:`woodcam.scale`) can spread tasks over processes and
-resume them. :func:`summarise` pools the records by scenario, face set and kind (clear /
-knotted / eq. 7-9) with the mean, a 95 % bootstrap interval of the mean and the worst block.
+One block is one task, keyed ``b000042`` (index 42), and :func:`bench_block` computes it from
+``(seed, index, settings)`` alone: the block is drawn from ``np.random.default_rng([seed,
+index])``, fitted by every method on every face set, and scored on the interior cut planes of
+:mod:`woodcam.inference.evaluate` against its true growth field. A record keeps the seed, the
+index, the block's parameters and the metrics (percentages), never the face images: a block is
+regenerated from its seed when a picture is wanted (:func:`bench_gallery`).
 
-Scenarios (:data:`SCENARIOS`): ``clean`` traces on the integer iso-lines; ``noisy`` traces with
-0.3 mm jitter, 20 % of the ring length dropped in 10 mm pieces and 3 % of the traces mislabelled
-by +-1 year (issue 12's realistic set); ``ring-maps`` no traces, ring maps only (unlabelled, as
-Mokume's cubes). Face sets: ``full`` (six faces) and ``three`` (front, top, left).
+Blocks (50 mm cubes by default) are of two kinds, half each by default:
 
-The ``eq79`` kind is the sanity row: eq. 7-9 fields of seed 000 (50 mm cubes, pith axis within
-20 degrees of a block axis, 0-60 mm from the centre) through the same scenarios.
+- ``clear``: a knot-free analytic log (eccentric, lobed, ring width log-uniform in the range)
+  sawn flat, quarter, rift or through the pith (:func:`woodcam.synth.random_log_placement`);
+- ``knotted``: a log of the log generator (seed 001) through the knot field (seed 003), the
+  block's front face cut through a knot that reaches past the block's depth (the setting of
+  ``tests/inference/test_inference_bench.py``), each face's knots marked in
+  ``extras["knot_mask"]`` as a tracer would.
+
+Faces are rendered by :func:`woodcam.synth.synth_block` (traces on the integer iso-lines, optional
+jitter / dropout). Face sets: ``full`` (six faces) and ``partial`` (front, top, left: three faces
+meeting at a corner). :func:`run_bench` runs many blocks through :func:`woodcam.scale.run_many`;
+:func:`bench_report` turns the records into Table-1 figures with bootstrap confidence intervals
+over blocks and paired Wilcoxon signed-rank tests between methods.
 """
 
 from __future__ import annotations
 
+import json
+import math
 import time
-from typing import Literal, get_args
+from functools import partial
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .errors import WoodcamError
 
-Scenario = Literal["clean", "noisy", "ring-maps"]
-SCENARIOS: dict[str, dict] = {
-    "clean": {},
-    "noisy": {"trace_jitter_mm": 0.3, "trace_dropout": 0.2, "trace_dropout_chunk_mm": 10.0,
-              "mislabel_fraction": 0.03},
-    "ring-maps": {"trace_faces": []},
+if TYPE_CHECKING:
+    from .scale import RunSummary
+
+#: Methods of :func:`woodcam.inference.fit.fit_block` a bench runs by default.
+DEFAULT_METHODS = ("rbf", "radial", "neural")
+
+#: Three faces meeting at a corner: half the surface (the partial annotation of Table 1).
+PARTIAL_FACES = ("front", "top", "left")
+
+#: Settings of a bench run (JSON); every record of a run folder was made with the same ones.
+DEFAULT_SETTINGS: dict[str, Any] = {
+    "methods": list(DEFAULT_METHODS),
+    "face_sets": {"full": None, "partial": list(PARTIAL_FACES)},
+    "knotted_fraction": 0.5,
+    "size_mm": [50.0, 50.0, 50.0],
+    "ring_width_range_mm": [2.0, 5.0],
+    "face_px": 256,            # 5.12 px/mm on a 50 mm cube, as the Table-1 bench test's 5 px/mm
+    "trace_jitter_mm": 0.0,
+    "trace_dropout": 0.0,
 }
-FaceSet = Literal["full", "three"]
-FACE_SETS: dict[str, list | None] = {"full": None, "three": ["front", "top", "left"]}
-Kind = Literal["realistic", "eq79"]
-KINDS: tuple[str, ...] = get_args(Kind)
 
-#: Cut-plane sampling (mm) of the benchmark: 5x finer than the 1 mm threshold (the default
-#: 0.1 mm costs 4x the time for changes below 0.5 % on the blocks tried).
-BENCH_PIXEL_MM = 0.2
+#: Metric names of a record (percent; see :func:`woodcam.inference.evaluate.summarise`):
+#: same-year ("matched") and any-year ("unmatched") hits within 1 and 2 mm, and coverage.
+METRICS = ("matched_1", "matched_2", "unmatched_1", "unmatched_2", "coverage_1")
 
+#: Bootstrap resamples for the confidence intervals (95 %, percentile method): with 2000 the
+#: Monte-Carlo error of a 2.5 % quantile is ~0.3 % of the interval's width.
+BOOTSTRAP_RESAMPLES = 2000
 
-def eq79_field(rng: np.random.Generator, size_mm=(50.0, 50.0, 50.0)):
-    """An eq. 7-9 field of seed 000 (:class:`woodcam.fields.radial.RadialScalingField`): rings
-    2-5 mm, pith axis tilted <= 20 degrees from a random block axis, 0-60 mm from the centre."""
-    from .fields.base import LogFrame
-    from .fields.radial import RadialScalingField
-
-    size = np.asarray(size_mm, float)
-    base = np.eye(3)[rng.integers(3)]
-    tilt = np.deg2rad(rng.uniform(0, 20))
-    perp = np.cross(base, rng.normal(size=3))
-    perp /= np.linalg.norm(perp)
-    axis = np.cos(tilt) * base + np.sin(tilt) * perp
-    off = np.cross(axis, rng.normal(size=3))
-    off /= np.linalg.norm(off)
-    pith = size / 2 + off * rng.uniform(0, 60) + axis * rng.uniform(-20, 20)
-    return RadialScalingField.random(LogFrame(tuple(pith), tuple(axis)), rng.uniform(2, 5), rng)
+RUN_MANIFEST = "run.json"
 
 
-def make_block(seed: int, index: int, scenario: Scenario = "noisy", kind: Kind = "realistic",
-               face_px: int = 256, knotted_fraction: float = 0.5):
-    """The benchmark block ``(seed, index)`` of ``kind`` under ``scenario``; returns
-    ``(Block, info dict)`` (info: name, size, knotted, pattern ...)."""
-    from .synth import benchmark_set_block, knotted_log_field, synth_block
-
-    if scenario not in SCENARIOS:
-        raise WoodcamError(f"scenario must be one of {', '.join(SCENARIOS)}; got {scenario!r}")
-    if kind == "realistic":
-        return benchmark_set_block(seed, index, face_px=face_px, log_fields=knotted_log_field,
-                                   knotted_fraction=knotted_fraction, **SCENARIOS[scenario])
-    if kind == "eq79":
-        rng = np.random.default_rng([int(seed), int(index), 79])
-        size = (50.0, 50.0, 50.0)
-        name = f"eq79_{index:04d}"
-        block = synth_block(eq79_field(rng, size), size, face_px=face_px, rng=rng, seed=None, name=name,
-                            **SCENARIOS[scenario])
-        return block, {"name": name, "index": int(index), "size_mm": list(size), "knotted": False,
-                       "pattern": "eq79"}
-    raise WoodcamError(f"kind must be one of {', '.join(KINDS)}; got {kind!r}")
+def bench_key(index: int) -> str:
+    return f"b{int(index):06d}"
 
 
-def score_block(seed: int, index: int, methods=("rbf", "radial", "evidence"),
-                scenario: Scenario = "noisy", face_set: FaceSet = "full", kind: Kind = "realistic",
-                face_px: int = 256, pixel_mm: float = BENCH_PIXEL_MM, planes=None,
-                keep_lines: bool = False) -> dict:
-    """Fit benchmark block ``(seed, index)`` with every method and score it on cut planes.
+def key_index(key: str) -> int:
+    return int(key[1:])
+
+
+def bench_settings(**overrides) -> dict:
+    """:data:`DEFAULT_SETTINGS` with ``overrides`` checked: unknown names and bad values raise."""
+    from .inference.fit import METHODS
+    from .frames import check_face
+
+    unknown = set(overrides) - set(DEFAULT_SETTINGS)
+    if unknown:
+        raise WoodcamError(f"bench settings: unknown {sorted(unknown)}; known: {sorted(DEFAULT_SETTINGS)}")
+    s = json.loads(json.dumps({**DEFAULT_SETTINGS, **{k: v for k, v in overrides.items() if v is not None}}))
+    if isinstance(s["methods"], str):
+        s["methods"] = [m.strip() for m in s["methods"].split(",") if m.strip()]
+    bad = [m for m in s["methods"] if m not in METHODS]
+    if bad or not s["methods"]:
+        raise WoodcamError(f"methods must be a comma-separated subset of {', '.join(METHODS)}; got "
+                           f"{','.join(s['methods'])!r}")
+    for faces in s["face_sets"].values():
+        for f in faces or ():
+            check_face(f)
+    if not 0.0 <= s["knotted_fraction"] <= 1.0:
+        raise WoodcamError(f"knotted_fraction must be in [0, 1]; got {s['knotted_fraction']!r}")
+    if not (isinstance(s["face_px"], int) and s["face_px"] >= 32):
+        raise WoodcamError(f"face_px must be an integer >= 32 pixels; got {s['face_px']!r}")
+    if s["trace_jitter_mm"] < 0 or not 0.0 <= s["trace_dropout"] <= 1.0:
+        raise WoodcamError(f"trace_jitter_mm must be >= 0 mm and trace_dropout in [0, 1]; got "
+                           f"{s['trace_jitter_mm']!r}, {s['trace_dropout']!r}")
+    return s
+
+
+# -- one block ------------------------------------------------------------------------------------
+
+def _knotted_field(rng: np.random.Generator, size_mm, ring_width_range_mm):
+    """A knotted log and a block whose front face is cut through one of its knots."""
+    from .fields import block_at_knot, place_block_in_log
+    from .synth import knotted_log_field
+
+    for _ in range(20):  # a generated log nearly always has a long knot; draw again if not
+        log_field = knotted_log_field(rng, tuple(ring_width_range_mm), length_mm=1200.0)
+        log = log_field.log
+        long_enough = [k for k, kn in enumerate(log.knots)
+                       if kn.r_end_mm > size_mm[1] + 15.0 and 150.0 < kn.z0_mm < 1050.0]
+        if long_enough:
+            k = int(rng.choice(long_enough))
+            field = place_block_in_log(log_field, *block_at_knot(log, k, size_mm))
+            return field, {"knot_index": k, "ring_width_mm": float(log_field.ring_width_mm)}
+    raise WoodcamError("no generated log had a knot reaching past the block's depth in 20 draws; "
+                       f"use a smaller block than {tuple(size_mm)} mm")
+
+
+def make_bench_block(seed: int, index: int, settings: dict):
+    """Block ``index`` of bench ``seed``: ``(Block with true_field, kind, params)``."""
+    from .frames import face_pixel_points
+    from .synth import PATTERNS, cut_block, random_log_placement, synth_block
+
+    rng = np.random.default_rng([int(seed), int(index)])
+    size = tuple(float(v) for v in settings["size_mm"])
+    knotted = bool(rng.uniform() < settings["knotted_fraction"])
+    if knotted:
+        field, params = _knotted_field(rng, size, settings["ring_width_range_mm"])
+    else:
+        pattern = PATTERNS[int(rng.integers(len(PATTERNS)))]
+        log, placement = random_log_placement(rng, pattern, size, tuple(settings["ring_width_range_mm"]))
+        field = cut_block(log, size, **placement)
+        params = {**placement, "log": log.to_dict(),
+                  "ring_width_mm": log.ring_width_at(placement["distance_mm"])}
+    block = synth_block(field, size, face_px=settings["face_px"], rng=rng, seed=None,
+                        name=bench_key(index), trace_jitter_mm=settings["trace_jitter_mm"],
+                        trace_dropout=settings["trace_dropout"])
+    if knotted:  # the tracer marks knots; the fitters leave them out (KNOT_MASK_MARGIN_MM)
+        for name, face in block.faces.items():
+            pts = face_pixel_points(name, face.shape, size).reshape(-1, 3)
+            face.extras["knot_mask"] = (field.knot_features(pts)["knot"] > 0.5).reshape(face.shape)
+    params = {k: (float(v) if isinstance(v, (np.floating, float)) else v) for k, v in params.items()}
+    return block, ("knotted" if knotted else "clear"), params
+
+
+def _fit_all(block, settings, keep_lines: bool = False):
+    from .inference.evaluate import evaluate_fits
+    from .inference.fit import fit_block
+
+    metrics, timing, scores = {}, {}, {}
+    for label, faces in settings["face_sets"].items():
+        fields, metrics[label], timing[label] = {}, {}, {}
+        for m in settings["methods"]:
+            t0 = time.perf_counter()
+            try:
+                fields[m] = fit_block(block, m, faces=faces)
+            except WoodcamError as err:  # the method cannot fit this block: a result, not a crash
+                metrics[label][m] = {"error": str(err)}
+            timing[label][m] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        scored = evaluate_fits(block.true_field, fields, block.size_mm, keep_lines=keep_lines)
+        timing[label]["score"] = time.perf_counter() - t0
+        for m, (summary, sc) in scored.items():
+            metrics[label][m] = {k: float(v) for k, v in summary.items()}
+            scores.setdefault(label, {})[m] = sc
+    return metrics, timing, scores
+
+
+def bench_block(seed: int, index: int, settings: dict) -> dict:
+    """Table-1 metrics of every method on block ``index`` of bench ``seed`` (the task of a run).
+
+    Depends on ``(seed, index, settings)`` only. Returns a JSON-able dict: ``seed``, ``index``,
+    ``kind`` ("clear" | "knotted"), ``params`` (the block's log and placement), ``metrics``
+    (face set -> method -> :data:`METRICS` percentages and ``n_points``, or ``{"error": msg}``
+    when the method refused the block) and ``timing`` (seconds; not deterministic).
+    """
+    t0 = time.perf_counter()
+    block, kind, params = make_bench_block(seed, index, settings)
+    synth_s = time.perf_counter() - t0
+    metrics, timing, _ = _fit_all(block, settings)
+    return {"seed": int(seed), "index": int(index), "kind": kind, "params": params,
+            "metrics": metrics, "timing": {"synth_s": synth_s, **timing}}
+
+
+def _bench_task(key: str, seed: int, settings: dict) -> dict:
+    return bench_block(seed, key_index(key), settings)
+
+
+def run_bench(out_dir: str | Path, blocks: int, seed: int, settings: dict | None = None, *,
+              start: int = 0, **run_options: Any) -> "RunSummary":
+    """Bench blocks ``start .. start + blocks - 1`` of ``seed`` into ``out_dir`` (resumable).
+
+    ``settings`` override :data:`DEFAULT_SETTINGS` (see :func:`bench_settings`);
+    ``run_options`` go to :func:`woodcam.scale.run_many` (``engine``, ``address``, ``workers``,
+    ``retries``, ``memory_limit_mb``, ``progress``, ``connect_timeout_s``).
+
+    ``out_dir/run.json`` holds the seed and settings; running again into the same folder with the
+    same seed and settings computes only the blocks without a record, and a different seed or
+    settings is refused (a run folder holds one experiment). Returns the
+    :class:`woodcam.scale.RunSummary`.
+    """
+    from .scale import run_many, write_json_atomic
+
+    if not isinstance(blocks, int) or blocks < 1:
+        raise WoodcamError(f"blocks must be an integer >= 1; got {blocks!r}")
+    settings = bench_settings() if settings is None else bench_settings(**settings)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    manifest = {"format": "woodcam-bench-run", "version": 1, "seed": int(seed), "settings": settings}
+    mpath = out / RUN_MANIFEST
+    if mpath.exists():
+        old = json.loads(mpath.read_text())
+        if {k: old.get(k) for k in manifest} != manifest:
+            raise WoodcamError(f"out_dir {str(out)!r} holds a bench run with another seed or settings "
+                               f"(seed {old.get('seed')}); resume it with the same options or pick a "
+                               f"new --out")
+    else:
+        write_json_atomic(mpath, manifest)
+    keys = [bench_key(i) for i in range(start, start + blocks)]
+    return run_many(partial(_bench_task, seed=int(seed), settings=settings), keys, out,
+                    desc="bench blocks", **run_options)
+
+
+def bench_gallery(seed: int, index: int, settings: dict, out_dir, *, planes: bool = True,
+                  thumbnail: bool = True) -> list[Path]:
+    """Regenerate block ``index`` from its seed; with ``planes`` refit it and draw its cut planes
+    (true rings in black, each method's in colour) to ``out_dir/b000042_<face set>.png``; with
+    ``thumbnail`` draw its faces as an unfolded cross ``b000042_faces.png``. Returns the files."""
+    from .block.render import save_cross_png
+    from .inference.evaluate import plot_planes
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    block, kind, _ = make_bench_block(seed, index, settings)
+    _, _, scores = _fit_all(block, settings, keep_lines=True) if planes else (None, None, {})
+    files = []
+    for label, by_method in scores.items():
+        p = out / f"{bench_key(index)}_{label}.png"
+        plot_planes(p, by_method, title=f"{bench_key(index)} ({kind}, {label}): black = true rings, "
+                    "colour = fitted")
+        files.append(p)
+    if thumbnail:
+        p = out / f"{bench_key(index)}_faces.png"
+        save_cross_png(block, p, "photo", traces=True)
+        files.append(p)
+    return files
+
+
+# -- the report -----------------------------------------------------------------------------------
+
+def _ci(values: np.ndarray, rng_seed: int = 0) -> tuple[float, float, float]:
+    """Mean and 95 % percentile-bootstrap interval of the mean over blocks."""
+    from scipy.stats import bootstrap
+
+    v = np.asarray(values, float)
+    if len(v) == 0:
+        return math.nan, math.nan, math.nan
+    if len(v) < 2 or np.ptp(v) == 0:
+        return float(v.mean()), float(v.mean()), float(v.mean())
+    r = bootstrap((v,), np.mean, n_resamples=BOOTSTRAP_RESAMPLES, method="percentile",
+                  confidence_level=0.95, random_state=np.random.default_rng(rng_seed))
+    return float(v.mean()), float(r.confidence_interval.low), float(r.confidence_interval.high)
+
+
+def _paired(a: np.ndarray, b: np.ndarray) -> dict:
+    """Wilcoxon signed-rank test of paired per-block values (two-sided), mean difference a - b."""
+    from scipy.stats import wilcoxon
+
+    d = np.asarray(a, float) - np.asarray(b, float)
+    if len(d) == 0:
+        return {"n": 0, "mean_diff": math.nan, "p": math.nan}
+    if not np.any(d != 0):
+        return {"n": int(len(d)), "mean_diff": 0.0, "p": 1.0}
+    return {"n": int(len(d)), "mean_diff": float(d.mean()), "p": float(wilcoxon(a, b).pvalue)}
+
+
+def summarise_bench(records: dict) -> dict:
+    """Table-1 statistics of a run's records (see :func:`bench_report`), as a JSON-able dict."""
+    ok = [r["result"] for r in records.values() if r["status"] == "ok"]
+    failed = [{"key": r["key"], "error": r.get("error", "")} for r in records.values() if r["status"] != "ok"]
+    if not ok:
+        raise WoodcamError("the run folder has no finished block records; run `woodcam bench run` first")
+    face_sets = list(ok[0]["metrics"])
+    methods = list(ok[0]["metrics"][face_sets[0]])
+    table, tests, worst, refused = {}, {}, {}, []
+    for label in face_sets:
+        for kind in ("all", "clear", "knotted"):
+            rows = [r for r in ok if kind == "all" or r["kind"] == kind]
+            # paired statistics use the blocks every method fitted
+            rows_all = [r for r in rows if all("error" not in r["metrics"][label][m] for m in methods)]
+            for m in methods:
+                vals = {k: np.array([r["metrics"][label][m][k] for r in rows_all]) for k in METRICS}
+                table.setdefault(label, {}).setdefault(kind, {})[m] = {
+                    "n": len(rows_all), **{k: _ci(v, rng_seed=i) for i, (k, v) in enumerate(vals.items())}}
+            for i, a in enumerate(methods):
+                for b in methods[i + 1:]:
+                    tests.setdefault(label, {}).setdefault(kind, {})[f"{a} vs {b}"] = {
+                        k: _paired([r["metrics"][label][a][k] for r in rows_all],
+                                   [r["metrics"][label][b][k] for r in rows_all])
+                        for k in ("matched_1", "matched_2", "unmatched_1", "unmatched_2")}
+        for m in methods:
+            scored = [(r["metrics"][label][m]["matched_1"], r["index"], r["kind"]) for r in ok
+                      if "error" not in r["metrics"][label][m]]
+            worst.setdefault(label, {})[m] = [{"index": i, "kind": k, "matched_1": v}
+                                              for v, i, k in sorted(scored)[:5]]
+            refused += [{"index": r["index"], "face_set": label, "method": m,
+                         "error": r["metrics"][label][m]["error"]} for r in ok
+                        if "error" in r["metrics"][label][m]]
+    # CPU seconds of the task in its worker (wall seconds on a shared machine overstate it)
+    seconds = np.array([rec.get("cpu_s", rec["seconds"]) for rec in records.values() if rec["status"] == "ok"])
+    return {"blocks": len(ok), "clear": sum(r["kind"] == "clear" for r in ok),
+            "knotted": sum(r["kind"] == "knotted" for r in ok), "failed": failed, "refused": refused,
+            "methods": methods, "face_sets": face_sets, "table": table, "tests": tests, "worst": worst,
+            "task_s_mean": float(seconds.mean()), "task_s_median": float(np.median(seconds)),
+            "cpu_hours_per_1e5": float(seconds.mean() * 1e5 / 3600.0)}
+
+
+def _fmt(ci) -> str:
+    m, lo, hi = ci
+    return "n/a" if math.isnan(m) else f"{m:.1f} [{lo:.1f}, {hi:.1f}]"
+
+
+def _markdown(s: dict, run: dict) -> str:
+    lines = [f"# woodcam bench report: seed {run['seed']}, {s['blocks']} blocks "
+             f"({s['clear']} clear, {s['knotted']} knotted)", "",
+             "Per-block percentages of ring-line points on seven interior cut planes (seed 000, "
+             "Table 1): *same year* counts a predicted ring point within the threshold of the true "
+             "ring of the same year, *any year* of any true ring. Each cell is the mean over blocks "
+             f"with its 95 % bootstrap interval ({BOOTSTRAP_RESAMPLES} resamples, percentile).", ""]
+    for label in s["face_sets"]:
+        faces = run["settings"]["face_sets"][label]
+        lines += [f"## {label} ({'all six faces' if faces is None else ', '.join(faces)})", ""]
+        for kind in ("all", "clear", "knotted"):
+            rows = s["table"][label][kind]
+            n = next(iter(rows.values()))["n"]
+            lines += [f"### {kind} blocks (n = {n})", "",
+                      "| method | same year <= 1 mm | same year <= 2 mm | any year <= 1 mm | "
+                      "any year <= 2 mm | coverage 1 mm |", "|---|---|---|---|---|---|"]
+            for m, r in rows.items():
+                lines.append(f"| {m} | " + " | ".join(_fmt(r[k]) for k in METRICS) + " |")
+            pairs = s["tests"].get(label, {}).get(kind, {})  # none with a single method
+            if pairs:
+                lines += ["", "Paired Wilcoxon signed-rank tests (two-sided p; mean difference in "
+                          "percentage points):", "",
+                          "| pair | same year 1 mm | same year 2 mm | any year 1 mm | any year 2 mm |",
+                          "|---|---|---|---|---|"]
+            for pair, t in pairs.items():
+                lines.append(f"| {pair} | " + " | ".join(
+                    "n/a" if math.isnan(t[k]["p"]) else f"{t[k]['mean_diff']:+.1f}, p = {t[k]['p']:.2g}"
+                    for k in ("matched_1", "matched_2", "unmatched_1", "unmatched_2")) + " |")
+            lines.append("")
+        lines += ["### worst blocks (same year <= 1 mm)", ""]
+        for m, rows in s["worst"][label].items():
+            lines.append(f"- {m}: " + ", ".join(f"{bench_key(w['index'])} ({w['kind']}) "
+                                               f"{w['matched_1']:.1f} %" for w in rows))
+        lines.append("")
+    lines += ["## cost", "", f"Task CPU time: mean {s['task_s_mean']:.1f} s, median "
+              f"{s['task_s_median']:.1f} s per block (one worker, one thread); 10^5 blocks = "
+              f"{s['cpu_hours_per_1e5']:.0f} CPU-hours, about {s['cpu_hours_per_1e5'] / 100:.1f} h "
+              f"on 100 cores, {s['cpu_hours_per_1e5'] / 1000:.2f} h on 1000.", ""]
+    if s["failed"]:
+        lines += [f"## failed tasks ({len(s['failed'])})", ""]
+        lines += [f"- {f['key']}: {f['error']}" for f in s["failed"][:50]]
+        lines.append("")
+    if s["refused"]:
+        lines += [f"## blocks a method refused ({len(s['refused'])}; left out of that face set's "
+                  "paired statistics)", ""]
+        lines += [f"- {bench_key(r['index'])} {r['face_set']} {r['method']}: {r['error']}"
+                  for r in s["refused"][:50]]
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _plot(s: dict, path: Path) -> Path:
+    from .errors import require
+
+    matplotlib = require("matplotlib", "view", "drawing the bench report")
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(s["face_sets"]), figsize=(6 * len(s["face_sets"]), 4.6), squeeze=False)
+    methods = s["methods"]
+    kinds = ("clear", "knotted")
+    for ax, label in zip(axes[0], s["face_sets"]):
+        labelled = set()
+        for j, (metric, hatch) in enumerate((("matched_1", ""), ("matched_2", "//"))):
+            for i, m in enumerate(methods):
+                for k, kind in enumerate(kinds):
+                    mean, lo, hi = s["table"][label][kind][m][metric]
+                    if math.isnan(mean):
+                        continue
+                    x = k * (len(methods) + 1) + i + 0.4 * j
+                    name = f"{m} {'1' if j == 0 else '2'} mm"
+                    ax.bar(x, mean, 0.4, color=f"C{i}", hatch=hatch, edgecolor="k", linewidth=0.3,
+                           label=None if name in labelled else name)
+                    labelled.add(name)
+                    ax.errorbar(x, mean, [[mean - lo], [hi - mean]], color="k", capsize=2, lw=0.8)
+        ax.set_xticks([k * (len(methods) + 1) + (len(methods) - 1) / 2 + 0.2 for k in range(len(kinds))])
+        ax.set_xticklabels(kinds)
+        ax.set_ylim(0, 100)
+        ax.set_ylabel("% ring points within 1 / 2 mm (same year)")
+        ax.set_title(f"{label}: mean over blocks, 95 % bootstrap CI")
+        ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.08))
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, thumbnails: int = 2, progress: bool = True) -> dict:
+    """Write ``report.md``, ``report.json`` and ``table1.png`` for a bench run folder into
+    ``out_dir``, plus a failure gallery: the cut planes of the ``gallery`` worst blocks (same
+    year within 1 mm, over all methods and face sets) and face thumbnails of ``thumbnails``
+    blocks of each kind, all regenerated from the seed. Returns the summary dict."""
+    from .scale import read_records, write_json_atomic
+
+    run_dir, out = Path(run_dir), Path(out_dir)
+    mpath = run_dir / RUN_MANIFEST
+    if not mpath.is_file():
+        raise WoodcamError(f"run_dir must be a bench run folder with {RUN_MANIFEST}; {str(run_dir)!r} "
+                           f"has none (make one with `woodcam bench run --out DIR`)")
+    run = json.loads(mpath.read_text())
+    s = summarise_bench(read_records(run_dir))
+    out.mkdir(parents=True, exist_ok=True)
+    write_json_atomic(out / "report.json", {"seed": run["seed"], "settings": run["settings"], **s})
+    tmp = out / ".report.md.tmp"
+    tmp.write_text(_markdown(s, run))
+    tmp.replace(out / "report.md")
+    _plot(s, out / "table1.png")
+    # the gallery: worst distinct blocks first, then a sample of each kind as thumbnails
+    worst = sorted({(w["matched_1"], w["index"]) for label in s["worst"] for rows in s["worst"][label].values()
+                    for w in rows})
+    picks = []
+    for _, i in worst:
+        if i not in picks and len(picks) < gallery:
+            picks.append(i)
+    records = read_records(run_dir)
+    sample = []
+    for kind in ("clear", "knotted"):
+        sample += [r["result"]["index"] for r in records.values()
+                   if r["status"] == "ok" and r["result"]["kind"] == kind][:thumbnails]
+    from tqdm.auto import tqdm
+
+    for i in tqdm(picks + [i for i in sample if i not in picks], desc="gallery", unit="block",
+                  disable=not progress):  # the worst are refitted; the sample only drawn
+        bench_gallery(run["seed"], i, run["settings"], out / "gallery", planes=i in picks)
+    s["gallery"] = picks
+    return s
+
+
+# -- synthetic block sets at scale ----------------------------------------------------------------
+
+def _synth_set_task(key: str, seed: int, out_dir: str, face_px: int, knotted: bool) -> dict:
+    """Write block ``key`` (``block_0042``) of set ``seed`` to ``out_dir/key`` atomically."""
+    import os
+    import shutil
+
+    from .block.io import write_block
+    from .synth import benchmark_set_block, knotted_log_field
+
+    index = int(key.split("_")[1])
+    block, info = benchmark_set_block(seed, index, face_px=face_px,
+                                      log_fields=knotted_log_field if knotted else None)
+    final = Path(out_dir) / key
+    tmp = Path(out_dir) / f".{key}.{os.getpid()}.tmp"
+    shutil.rmtree(tmp, ignore_errors=True)
+    write_block(block, tmp)
+    if final.exists():  # a folder from an earlier run without its record: replace it whole
+        shutil.rmtree(final)
+    os.replace(tmp, final)
+    return info
+
+
+def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, knotted: bool = True,
+                        **run_options):
+    """:func:`woodcam.synth.synth_benchmark_set` with the knotted generator, one task per block on
+    an engine (the same blocks, bit for bit), resumable; writes ``index.json`` at the end.
+    With a Dask ``address`` the workers write the block folders, so they need ``out_dir`` on a
+    shared disk. ``run_options`` go to :func:`woodcam.scale.run_many`. Returns
+    ``(RunSummary, index dict)``."""
+    from .scale import read_records, run_many, write_json_atomic
+
+    if not isinstance(count, int) or count < 1:
+        raise WoodcamError(f"count must be an integer >= 1; got {count!r}")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    keys = [f"block_{i:04d}" for i in range(count)]
+    summary = run_many(partial(_synth_set_task, seed=int(seed), out_dir=str(out.resolve()),
+                               face_px=int(face_px), knotted=bool(knotted)),
+                       keys, out / ".synth", desc="synthesising blocks", **run_options)
+    recs = read_records(out / ".synth")
+    index = {"format": "woodcam-benchmark", "version": 1, "seed": int(seed), "count": int(count),
+             "face_px": int(face_px), "size_range_mm": [30.0, 80.0], "ring_width_range_mm": [1.5, 6.0],
+             "knotted_available": bool(knotted),
+             "blocks": [recs[k]["result"] for k in keys if k in recs and recs[k]["status"] == "ok"]}
+    write_json_atomic(out / "index.json", index)
+    return summary, index
+
+
+# -- training sets at scale -----------------------------------------------------------------------
+
+#: Fields per shard of a training set: 256 x 1600 points is ~5 MB of float32, a few seconds.
+TRAINING_SHARD_FIELDS = 256
+
+
+def _training_shard_task(key: str, spec: dict, shard_fields: int, out_dir: str) -> dict:
+    """Write shard ``key`` (``shard_0003``) of the training set of ``spec`` as an npz."""
+    from ._atomic import atomic_path
+    from .fields.neural import GTFSpec, make_training_shard
+
+    sp = GTFSpec.from_dict(spec)
+    start = int(key.split("_")[1]) * shard_fields
+    stop = min(start + shard_fields, sp.n_fields)
+    pts, vals = make_training_shard(sp, start, stop)
+    with atomic_path(Path(out_dir) / f"{key}.npz") as tmp:
+        np.savez(tmp, points=pts, values=vals)
+    return {"start": start, "stop": stop}
+
+
+def make_training_set_many(spec, out_dir, *, shard_fields: int = TRAINING_SHARD_FIELDS,
+                           **run_options) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`woodcam.fields.neural.make_training_set` of ``spec`` made in shards of
+    ``shard_fields`` fields, one task each (:func:`woodcam.scale.run_many`; ``run_options`` go
+    there), written to ``out_dir/shard_NNNN.npz`` and concatenated: the same arrays, bit for bit,
+    resumable. With a Dask ``address`` the workers write the shards (a shared disk is needed).
 
     Returns
     -------
-    dict (plain JSON unless ``keep_lines``): ``seed``, ``index``, ``name``, ``kind``
-    ("clear" / "knotted" / "eq79"), ``scenario``, ``faces``, ``size_mm``, ``pattern`` and per
-    method ``{matched_1, matched_2, unmatched_1, unmatched_2, coverage_1, fit_s}`` (percent,
-    seconds); the evidence method adds ``chosen`` and ``contradicted``. With ``keep_lines``,
-    ``"planes"``: method -> list of PlaneScore for :func:`woodcam.inference.evaluate.plot_planes`.
+    points : (N, M, 3) float32, values : (N, M) float32
     """
-    import warnings
+    from .scale import read_records, run_many
 
-    from .errors import WoodcamWarning
-    from .inference.evaluate import DEFAULT_PLANES, evaluate_fits
-    from .inference.fit import METHODS, fit_block
-
-    bad = [m for m in methods if m not in METHODS]
-    if bad:
-        raise WoodcamError(f"methods must be from {', '.join(METHODS)}; got {bad}")
-    if face_set not in FACE_SETS:
-        raise WoodcamError(f"face_set must be one of {', '.join(FACE_SETS)}; got {face_set!r}")
-    block, info = make_block(seed, index, scenario, kind, face_px)
-    faces = FACE_SETS[face_set]
-    fields, times = {}, {}
-    for m in methods:
-        t0 = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", WoodcamWarning)  # recorded below instead
-            fields[m] = fit_block(block, m, faces=faces)
-        times[m] = time.perf_counter() - t0
-    scored = evaluate_fits(block.true_field, fields, block.size_mm,
-                           DEFAULT_PLANES if planes is None else planes, pixel_mm, keep_lines=keep_lines)
-    row = {"seed": int(seed), "index": int(index), "name": info["name"],
-           "kind": "eq79" if kind == "eq79" else ("knotted" if info["knotted"] else "clear"),
-           "scenario": scenario, "faces": face_set, "size_mm": [float(v) for v in info["size_mm"]],
-           "pattern": info.get("pattern")}
-    for m in methods:
-        row[m] = {k: float(v) for k, v in scored[m][0].items() if k != "n_points"}
-        row[m]["fit_s"] = float(times[m])
-        meta = getattr(fields[m], "meta", {}) or {}
-        if "chosen" in meta:
-            row[m]["chosen"] = meta["chosen"]
-            row[m]["contradicted"] = bool(meta["contradicted"])
-    if keep_lines:
-        row["planes"] = {m: scored[m][1] for m in methods}
-    return row
+    if not isinstance(shard_fields, int) or shard_fields < 1:
+        raise WoodcamError(f"shard_fields must be an integer >= 1; got {shard_fields!r}")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    n_shards = -(-spec.n_fields // shard_fields)
+    keys = [f"shard_{i:04d}" for i in range(n_shards)]
+    s = run_many(partial(_training_shard_task, spec=spec.to_dict(), shard_fields=shard_fields,
+                         out_dir=str(out.resolve())), keys, out / ".records",
+                 desc="training set shards", **run_options)
+    if s.failed:
+        bad = {k: r.get("error") for k, r in read_records(out / ".records").items() if r["status"] != "ok"}
+        raise WoodcamError(f"{s.failed} training-set shard(s) failed: {bad}; run again to retry them")
+    parts = [np.load(out / f"{k}.npz") for k in keys]
+    return (np.concatenate([p["points"] for p in parts]), np.concatenate([p["values"] for p in parts]))
 
 
-def bootstrap_ci(values, n: int = 2000, seed: int = 0) -> tuple[float, float]:
-    """95 % percentile-bootstrap interval of the mean of ``values`` (a few blocks: wide)."""
-    v = np.asarray(values, float)
-    if len(v) < 2:
-        return (float(v.mean()), float(v.mean())) if len(v) else (float("nan"), float("nan"))
-    means = v[np.random.default_rng(seed).integers(0, len(v), (n, len(v)))].mean(axis=1)
-    return float(np.percentile(means, 2.5)), float(np.percentile(means, 97.5))
-
-
-def summarise(rows: list[dict], methods) -> list[dict]:
-    """Pool ``rows`` of :func:`score_block` by (scenario, faces, kind), also "all" kinds but
-    eq79: for each method the mean, 95 % bootstrap interval and worst block of matched 1 / 2 mm,
-    and the median fit time. Returns one dict per group."""
-    groups: dict[tuple, list] = {}
-    for r in rows:
-        groups.setdefault((r["scenario"], r["faces"], r["kind"]), []).append(r)
-        if r["kind"] != "eq79":
-            groups.setdefault((r["scenario"], r["faces"], "clear + knotted"), []).append(r)
-    out = []
-    for (scen, faces, kind), rs in sorted(groups.items()):
-        g = {"scenario": scen, "faces": faces, "kind": kind, "n": len(rs)}
-        for m in methods:
-            s = {}
-            for col in ("matched_1", "matched_2"):
-                v = [r[m][col] for r in rs]
-                s[col] = float(np.mean(v))
-                s[col + "_ci"] = bootstrap_ci(v)
-                s[col + "_worst"] = float(np.min(v))
-                s[col + "_worst_block"] = rs[int(np.argmin(v))]["name"]
-            s["fit_s_median"] = float(np.median([r[m]["fit_s"] for r in rs]))
-            g[m] = s
-        out.append(g)
-    return out
-
-
-def markdown(summary: list[dict], methods) -> str:
-    """The main table: one row per group, per method ``mean [CI] / worst`` within 1 and 2 mm."""
-    head = ["scenario", "faces", "blocks", "n"]
-    for m in methods:
-        head += [f"{m} ≤1 mm mean [95% CI]", f"{m} ≤2 mm mean [95% CI]", f"{m} worst ≤1/≤2 mm"]
-    head += [f"{m} fit s (median)" for m in methods]
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    for g in summary:
-        cells = [g["scenario"], g["faces"], g["kind"], str(g["n"])]
-        for m in methods:
-            s = g[m]
-            cells += [f"{s['matched_1']:.1f} [{s['matched_1_ci'][0]:.0f}–{s['matched_1_ci'][1]:.0f}]",
-                      f"{s['matched_2']:.1f} [{s['matched_2_ci'][0]:.0f}–{s['matched_2_ci'][1]:.0f}]",
-                      f"{s['matched_1_worst']:.1f} / {s['matched_2_worst']:.1f} ({s['matched_2_worst_block']})"]
-        cells += [f"{g[m]['fit_s_median']:.1f}" for m in methods]
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
-
-
-__all__ = ["BENCH_PIXEL_MM", "FACE_SETS", "KINDS", "SCENARIOS", "bootstrap_ci", "eq79_field",
-           "make_block", "markdown", "score_block", "summarise"]
+__all__ = ["DEFAULT_METHODS", "DEFAULT_SETTINGS", "METRICS", "PARTIAL_FACES", "bench_block",
+           "bench_gallery", "bench_report", "bench_settings", "make_bench_block", "run_bench",
+           "make_training_set_many", "summarise_bench", "write_benchmark_set"]

@@ -3,7 +3,8 @@
 :func:`run_many` calls ``fn(key)`` once for every key and keeps one small JSON record per key in
 ``out_dir/records/<key>.json``::
 
-    {"key": "b000042", "status": "ok", "attempts": 1, "seconds": 9.81, "result": {...}}
+    {"key": "b000042", "status": "ok", "attempts": 1, "seconds": 9.81, "cpu_s": 9.6,
+     "result": {...}}
     {"key": "b000043", "status": "failed", "attempts": 3, "seconds": 0.02,
      "error": "ValueError: the message"}
 
@@ -36,6 +37,7 @@ which is retried and then recorded as a failure); Dask workers get the same numb
 from __future__ import annotations
 
 import json
+import logging
 import os
 import re
 import sys
@@ -91,16 +93,13 @@ class RunSummary:
 # -- records --------------------------------------------------------------------------------------
 
 def write_json_atomic(path, obj) -> Path:
-    """Write ``obj`` as JSON to ``path`` atomically: a temp file in the same folder, fsync, then
-    ``os.replace``, so a reader (or a run killed half-way) sees the old file or the whole new
-    one, never a part."""
+    """Write ``obj`` as JSON to ``path`` atomically (:func:`woodcam._atomic.write_text`: a hidden
+    temp file in the same folder, fsync, ``os.replace``), so a reader, or a run killed half-way,
+    sees the old file or the whole new one, never a part."""
+    from ._atomic import write_text
+
     path = Path(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "w") as fh:
-        json.dump(obj, fh, separators=(",", ":"), allow_nan=True)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    write_text(path, json.dumps(obj, separators=(",", ":")))
     return path
 
 
@@ -108,7 +107,7 @@ def record_path(out_dir, key: str) -> Path:
     return Path(out_dir) / RECORDS_DIR / f"{key}.json"
 
 
-def read_records(out_dir) -> dict[str, dict]:
+def read_records(out_dir: str | Path) -> dict[str, dict]:
     """Every record of a run folder: ``key -> record`` (see the module docstring), sorted by key.
 
     Temp files left by a killed run start with a dot and are not records.
@@ -142,27 +141,29 @@ def _finished_keys(out_dir: Path) -> set[str]:
 
 # -- the worker side ------------------------------------------------------------------------------
 
-_worker_ready = False
+_original_soft_as: int | None = None
 
 
 def _limit_worker(memory_limit_mb: int | None) -> None:
-    """Once per worker process: one thread per library, and an address-space cap."""
-    global _worker_ready
-    if _worker_ready:
-        return
+    """In a worker process, before each task: one thread per library, and the address-space
+    cap of this run (set every time: a reused loky worker may have served another run)."""
+    global _original_soft_as
+    import resource
+
     for var in _THREAD_VARS:
         os.environ[var] = "1"
     if "torch" in sys.modules:
         sys.modules["torch"].set_num_threads(1)
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    if _original_soft_as is None:
+        _original_soft_as = soft
+    want = _original_soft_as
     if memory_limit_mb:
-        import resource
-
-        limit = int(memory_limit_mb) * 1024 * 1024
-        soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+        want = int(memory_limit_mb) * 1024 * 1024
         if hard != resource.RLIM_INFINITY:
-            limit = min(limit, hard)
-        resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
-    _worker_ready = True
+            want = min(want, hard)
+    if want != soft:
+        resource.setrlimit(resource.RLIMIT_AS, (want, hard))
 
 
 def _attempt(fn: Callable[[str], Any], key: str, retries: int, memory_limit_mb: int | None,
@@ -172,20 +173,21 @@ def _attempt(fn: Callable[[str], Any], key: str, retries: int, memory_limit_mb: 
 
     if limit_process:
         _limit_worker(memory_limit_mb)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     error = ""
     for attempt in range(1, retries + 2):
         try:
             with threadpool_limits(1):
                 result = fn(key)
             return {"key": key, "status": "ok", "attempts": attempt,
-                    "seconds": time.perf_counter() - t0, "result": result}
+                    "seconds": time.perf_counter() - t0, "cpu_s": time.process_time() - c0,
+                    "result": result}
         except Exception as err:  # noqa: BLE001 - any task error becomes a failed record
             tb = traceback.extract_tb(err.__traceback__)
             where = f" (at {Path(tb[-1].filename).name}:{tb[-1].lineno})" if tb else ""
             error = f"{type(err).__name__}: {err}{where}"
     return {"key": key, "status": "failed", "attempts": retries + 1,
-            "seconds": time.perf_counter() - t0, "error": error}
+            "seconds": time.perf_counter() - t0, "cpu_s": time.process_time() - c0, "error": error}
 
 
 # -- the driver -----------------------------------------------------------------------------------
@@ -209,10 +211,10 @@ def _check_address(address: str) -> str:
     return address
 
 
-def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir, engine: Engine = "local",
+def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engine: Engine = "local",
              address: str | None = None, workers: int | None = None, retries: int = 2, *,
              memory_limit_mb: int | None = DEFAULT_MEMORY_LIMIT_MB, progress: bool = True,
-             desc: str = "tasks") -> RunSummary:
+             connect_timeout_s: float = CONNECT_TIMEOUT_S, desc: str = "tasks") -> RunSummary:
     """Run ``fn(key)`` for every key not already done, writing one record per key.
 
     Parameters
@@ -225,7 +227,8 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir, engine: Engine =
     engine : "local" | "dask"
     address : str, optional
         ``engine="dask"`` only: a running scheduler (``tcp://host:port``); unreachable within
-        :data:`CONNECT_TIMEOUT_S` s gives a :class:`WoodcamError`.
+        ``connect_timeout_s`` (default :data:`CONNECT_TIMEOUT_S`) seconds gives a
+        :class:`WoodcamError`.
     workers : int, optional
         Worker processes (local: default 2, 1 = serial in this process; dask without address:
         default 2). With an address the cluster sets it; passing it is an error.
@@ -261,11 +264,15 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir, engine: Engine =
     keys = _check_keys(keys)
     out_dir = Path(out_dir)
     (out_dir / RECORDS_DIR).mkdir(parents=True, exist_ok=True)
-    for stale in (out_dir / RECORDS_DIR).glob(".*.tmp"):  # temp files of a killed run
+    for stale in (out_dir / RECORDS_DIR).glob(".*.tmp*"):  # temp files of a killed run
         stale.unlink(missing_ok=True)
     done_before = _finished_keys(out_dir)
     todo = [k for k in keys if k not in done_before]
     skipped = len(keys) - len(todo)
+
+    client = cluster = None
+    if todo and engine == "dask":  # connect first: a bad address fails before any progress bar
+        client, cluster = _dask_client(address, workers, memory_limit_mb, connect_timeout_s)
 
     from tqdm.auto import tqdm
 
@@ -289,9 +296,13 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir, engine: Engine =
             n_workers = 2 if workers is None else workers
             _run_local(fn, todo, n_workers, retries, memory_limit_mb, finish)
         else:
-            n_workers = _run_dask(fn, todo, address, workers, retries, memory_limit_mb, finish)
+            n_workers = _run_dask(client, fn, todo, retries, finish)
     finally:
         bar.close()
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
     return RunSummary(out_dir, engine, n_workers, len(keys), skipped, counts["ok"],
                       counts["failed"], time.perf_counter() - t0)
 
@@ -322,62 +333,65 @@ def _run_local(fn, todo, n_workers, retries, memory_limit_mb, finish) -> None:
             f"or raise the memory limit") from err
 
 
-def _run_dask(fn, todo, address, workers, retries, memory_limit_mb, finish) -> int:
+def _dask_client(address, workers, memory_limit_mb, connect_timeout_s):
+    """``(client, cluster or None)``: a client of the scheduler at ``address``, or of a new
+    loopback LocalCluster of ``workers`` single-threaded processes."""
     from .errors import require
 
     require("distributed", "scale", "running tasks on Dask")
-    from distributed import Client, LocalCluster, as_completed
+    from distributed import Client, LocalCluster
 
-    cluster = None
     if address is None:
         cluster = LocalCluster(
             n_workers=2 if workers is None else workers, threads_per_worker=1, processes=True,
             host="127.0.0.1", dashboard_address=None,
-            memory_limit=f"{memory_limit_mb}MiB" if memory_limit_mb else 0)
-        client = Client(cluster)
-    else:
-        try:
-            client = Client(address, timeout=CONNECT_TIMEOUT_S)
-        except (OSError, TimeoutError) as err:
-            raise WoodcamError(
-                f"address: no Dask scheduler answered at {address} within {CONNECT_TIMEOUT_S:g} s "
-                f"({type(err).__name__}); start one with `dask scheduler` and `dask worker "
-                f"{address}`, or leave --address out to run a local 2-worker cluster") from err
+            memory_limit=f"{memory_limit_mb}MiB" if memory_limit_mb else 0,
+            # the cluster's own log lines (and its shutdown races) would bury the progress bar;
+            # a task's errors come back in its record, a lost worker as a failed record
+            silence_logs=logging.CRITICAL)
+        return Client(cluster), cluster
     try:
-        n = len(client.scheduler_info(n_workers=-1)["workers"]) if address else (workers or 2)
-        window = max(4 * max(n, 1), 16)  # bounded in-flight futures, so 1e5 keys stay cheap
-        it = iter(todo)
-        pending = as_completed()
+        return Client(address, timeout=connect_timeout_s), None
+    except (OSError, TimeoutError) as err:
+        raise WoodcamError(
+            f"address: no Dask scheduler answered at {address} within {connect_timeout_s:g} s "
+            f"({type(err).__name__}); start one with `dask scheduler` and `dask worker "
+            f"{address}`, or leave --address out to run a local 2-worker cluster") from err
 
-        key_of = {}
 
-        def submit(key):
-            # limit_process: one torch thread (the nanny already sets OMP/BLAS variables to 1);
-            # the memory cap is the nanny's memory_limit, not an rlimit on someone's worker.
-            fut = client.submit(_attempt, fn, key, retries, None, True, pure=False,
-                                key=f"woodcam-{key}-{os.getpid()}-{time.time_ns()}")
-            key_of[fut.key] = key
-            pending.add(fut)
+def _run_dask(client, fn, todo, retries, finish) -> int:
+    """Submit ``todo`` to ``client`` with a bounded window of futures; returns the worker count."""
+    from distributed import as_completed
 
-        for key in [k for _, k in zip(range(window), it)]:
-            submit(key)
-        for fut in pending:
-            key = key_of.pop(fut.key)
-            try:
-                rec = fut.result()
-            except Exception as err:  # noqa: BLE001 - a worker lost (KilledWorker), cancelled
-                rec = {"key": key, "status": "failed", "attempts": 1, "seconds": 0.0,
-                       "error": f"{type(err).__name__}: {err}"}
-            fut.release()
-            finish(rec)
-            nxt = next(it, None)
-            if nxt is not None:
-                submit(nxt)
-        return n
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+    n = len(client.nthreads())
+    window = max(4 * max(n, 1), 16)  # bounded in-flight futures, so 1e5 keys stay cheap
+    it = iter(todo)
+    pending = as_completed()
+    key_of = {}
+
+    def submit(key):
+        # limit_process: one torch thread (the nanny already sets OMP/BLAS variables to 1); the
+        # memory cap is the nanny's memory_limit, not an rlimit on someone else's worker.
+        fut = client.submit(_attempt, fn, key, retries, None, True, pure=False,
+                            key=f"woodcam-{key}-{os.getpid()}-{time.time_ns()}")
+        key_of[fut.key] = key
+        pending.add(fut)
+
+    for key in [k for _, k in zip(range(window), it)]:
+        submit(key)
+    for fut in pending:
+        key = key_of.pop(fut.key)
+        try:
+            rec = fut.result()
+        except Exception as err:  # noqa: BLE001 - a worker lost (KilledWorker), cancelled
+            rec = {"key": key, "status": "failed", "attempts": 1, "seconds": 0.0, "cpu_s": 0.0,
+                   "error": f"{type(err).__name__}: {err}"}
+        fut.release()
+        finish(rec)
+        nxt = next(it, None)
+        if nxt is not None:
+            submit(nxt)
+    return n
 
 
 __all__ = ["DEFAULT_MEMORY_LIMIT_MB", "ENGINES", "Engine", "RECORDS_DIR", "RunSummary",

@@ -11,7 +11,9 @@ A block spec is a string the CLI and GLB metadata carry:
 - ``woodify:PATH/field.npz``: a block cut out of a grown object (``woodcam woodify``); size
   and position are the placement stored in the file (``--block-size``, ``--block-centre``).
 - a block folder with a ``block.json`` manifest (real or synthetic): its true field if it has
-  one, otherwise a field fitted to its rings (fit once, cached in the user cache folder).
+  one, otherwise a field fitted to its rings (fit once, cached in the user cache folder); a
+  folder of photos only (``woodcam block from-photos``) first gets its rings detected on the
+  photos (:func:`woodcam.detect.block.with_detected_rings`, cached by content in the user cache).
 - a Mokume sample folder (``A_col.png``, ``A_arl-unet.png``, ... as in the Mokume dataset): a
   cube of ``MOKUME_DEFAULT_SIZE_MM`` (50 mm) whose field is fitted to its ring maps, fit once
   and cached.
@@ -207,7 +209,8 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         As :func:`open_stock`: ``builtin:NAME`` and ``log:LOG@K[:WxDxH]`` give a synthetic
         block whose six face photos, ring maps and traces are rendered by
         :func:`woodcam.synth.synth_block` (seed 0) from the true field; a folder is read by
-        :func:`woodcam.block.io.read_block_folder` (block folder or Mokume sample folder).
+        :func:`woodcam.block.io.read_block_folder` (block folder or Mokume sample folder); a
+        folder of photos only gets its rings detected (cached, :mod:`woodcam.detect.block`).
     size_mm : float, optional
         Cube side of a Mokume sample folder (its files carry no size; default 50 mm).
     face_px : int
@@ -234,8 +237,12 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         return synth_block(field, size, face_px=face_px, seed=0, name=name), field
     from .block.io import read_block_folder
 
+    from .detect.block import with_detected_rings
+
     block = read_block_folder(_existing_folder(spec),
                               None if size_mm is None else (float(size_mm),) * 3)
+    # A block of photos only: rings detected once, cached by content outside the folder.
+    block = with_detected_rings(block, progress=True)
     return block, block.true_field
 
 
@@ -330,7 +337,10 @@ def _open_mokume_folder(path: Path, species, appearance, appearance_params) -> S
 def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
     from .block.io import read_block_folder  # imported when a folder is used
 
-    block = read_block_folder(path)
+    from .detect.block import with_detected_rings
+
+    # A block of photos only: rings detected once, cached by content outside the folder.
+    block = with_detected_rings(read_block_folder(path), progress=True)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
     return _real_block_stock(str(path), block, field, species, appearance, appearance_params,
                              cache_dir=None)

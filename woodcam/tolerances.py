@@ -191,6 +191,24 @@ CREASE_WELD_MM = 1e-6
 #: other examples untouched while bounding the unwrap (xatlas is super-linear in chart size).
 MAX_PART_TRIANGLES = 120_000
 
+
+#: Parquetry cut files: a join between two segments counts as a corner when the tangent turns by more than this
+#: (sine of the angle): seams are C1 in theory, and 1e-5 mm rounding of handles about 0.5 mm
+#: long turns them by < 1e-4.
+PARQUETRY_CORNER_SIN = 0.01
+
+#: Parquetry cut files: what a disc of diameter min_piece_mm cannot reach, away from corners, is tolerated when it
+#: is thinner than twice this (mm) everywhere: seams bend no tighter than
+#: min_piece_mm / 2, so only the flattening of curves (chords within ~3 um) and the disc's
+#: polygon (32 segments a quarter: 2.5 mm * (1 - cos(pi / 128)) = 0.8 um) remain; a sliver or
+#: neck thinner than min_piece_mm sticks out by its own length, far more than this.
+PARQUETRY_WIDTH_TOL_MM = 0.05
+
+#: Parquetry cut files: a concave bend counts as tighter than the tool when its radius is below this fraction of
+#: the tool radius (the seams are smoothed to the full radius; this allows for the sampling
+#: of the curvature check).
+PARQUETRY_CURVATURE_SLACK = 0.98
+
 #: Evidence-based choice of a fit (``woodcam.inference.evidence``, issue 12 part 1).
 #: A face takes part in leave-one-face-out only with at least this many ring points: fewer
 #: (a face crossed by one short ring) scores by chance.

@@ -29,13 +29,16 @@ COMMANDS: tuple[str, ...] = (
     "woodcam.cli.review",        # review
     "woodcam.cli.place",         # place
     "woodcam.cli.cache",         # cache info | clear
-    "woodcam.cli.block",         # block synth | show
+    "woodcam.cli.block",         # block synth | show | from-photos
+    "woodcam.cli.rings",         # rings detect | show
     "woodcam.cli.log",           # log render | maps | export
     "woodcam.cli.fit",           # fit, eval rings
     "woodcam.cli.eval_bench",    # eval realistic
     "woodcam.cli.appearance",    # eval appearance
-    "woodcam.cli.train",         # train gtf
+    "woodcam.cli.train",         # train gtf | rings
+    "woodcam.cli.bench",         # bench run | report
     "woodcam.cli.woodify",       # woodify
+    "woodcam.cli.parquetry",     # parquetry
 )
 
 #: Old spellings kept working: argv prefix -> its current form.
@@ -61,6 +64,8 @@ examples:
   woodcam eval rings out/blocks/block_0000 --out out/eval
   woodcam eval appearance builtin:knotty --out out/eval_appearance
   woodcam woodify trunk.stl --years 40 --eccentricity 0.3 --obstacle post.stl --out out/tree
+  woodcam parquetry eye.png --veneer-from ../shared/data/mokume/CN03 --veneer-from builtin:flat-sawn \\
+      --out out/eye/
 
 exit status: 0 done; 1 the work failed (a one-line 'woodcam: error: ...' says why); 2 the
 command line is wrong (usage); 3 the work was done but a check failed (e.g. gcode --strict);

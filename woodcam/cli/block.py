@@ -7,14 +7,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .options import add_block_argument, add_size_option, open_block
+from .options import add_block_argument, add_engine_options, add_size_option, engine_options, open_block
 
 
 def register(subparsers) -> None:
-    """Add the ``block`` command (with ``synth`` and ``show``) to an argparse sub-parser set."""
+    """Add the ``block`` command (with ``synth``, ``show`` and ``from-photos``) to an argparse sub-parser set."""
     p = subparsers.add_parser("block", help="synthesise or show blocks (six face photos + rings)")
     p.set_defaults(func=run)          # woodcam.cli dispatches on args.func
-    sub = p.add_subparsers(dest="block_command", required=True, metavar="{synth,show}")
+    sub = p.add_subparsers(dest="block_command", required=True, metavar="{synth,show,from-photos}")
 
     s = sub.add_parser("synth", help="write a reproducible set of synthetic blocks")
     s.add_argument("--count", type=int, required=True, help="number of blocks")
@@ -36,6 +36,7 @@ def register(subparsers) -> None:
                    help="share of blocks cut from knotted logs, each with a knot crossing it (default 0.5)")
     s.add_argument("--size-range-mm", default="30,80",
                    help="MIN,MAX block side in mm, each side uniform in it (default 30,80)")
+    add_engine_options(s)
 
     v = sub.add_parser("show", help="draw a block's faces as one unfolded-cross PNG")
     add_block_argument(v, option=False)
@@ -43,6 +44,10 @@ def register(subparsers) -> None:
     v.add_argument("--layer", choices=("photo", "ring_map", "both"), default="photo")
     v.add_argument("--no-traces", action="store_true", help="do not draw traced rings")
     add_size_option(v)
+
+    from .rings import add_from_photos
+
+    add_from_photos(sub)
 
 
 def run(args) -> int:
@@ -67,6 +72,24 @@ def run(args) -> int:
                  "trace_dropout_chunk_mm": args.dropout_chunk_mm, "mislabel_fraction": args.mislabel}
         if args.ring_maps_only:
             noise["trace_faces"] = []
+        if (args.engine is not None or args.address is not None) and (
+                args.jitter_mm or args.dropout or args.mislabel or args.ring_maps_only or args.knotted_fraction != 0.5
+                or args.size_range_mm != "30,80"):
+            raise WoodcamError("--engine/--address write the default set only; drop --jitter-mm, "
+                               "--dropout, --mislabel, --ring-maps-only, --knotted-fraction and "
+                               "--size-range-mm, or run without an engine")
+        if args.engine is not None or args.address is not None:
+            # one task per block: the same blocks, resumable (a record per block), on an engine
+            from ..benchmark import write_benchmark_set
+
+            summary, index = write_benchmark_set(args.out, args.count, args.seed, face_px=args.face_px,
+                                                 progress=not args.quiet, **engine_options(args))
+            knotted = sum(b["knotted"] for b in index["blocks"])
+            print(f"wrote {len(index['blocks'])} blocks to {args.out} ({knotted} knotted; "
+                  f"index.json lists them); {summary.line()}")
+            from . import EXIT_CHECKS
+
+            return 0 if summary.failed == 0 else EXIT_CHECKS  # some blocks failed
         folders = synth_benchmark_set(args.out, args.count, args.seed, face_px=args.face_px,
                                       size_range_mm=(lo, hi), log_fields=knotted_log_field,
                                       knotted_fraction=args.knotted_fraction,
@@ -82,4 +105,8 @@ def run(args) -> int:
         save_cross_png(block, args.out, args.layer, traces=not args.no_traces)
         print(f"wrote {args.out}")
         return 0
+    if args.block_command == "from-photos":
+        from .rings import run_from_photos
+
+        return run_from_photos(args)
     raise AssertionError(args.block_command)  # argparse restricts the choices

@@ -50,7 +50,7 @@ def run_realistic(args) -> int:
     from tqdm.auto import tqdm
 
     from .._atomic import write_text
-    from ..benchmark import FACE_SETS, SCENARIOS, markdown, score_block, summarise
+    from ..bench_realistic import FACE_SETS, SCENARIOS, markdown, score_block, summarise
 
     methods, scenarios, faces = _list(args.methods), _list(args.scenarios), _list(args.faces)
     for name, got, allowed in (("--scenarios", scenarios, SCENARIOS), ("--faces", faces, FACE_SETS)):

@@ -59,6 +59,9 @@ def register(subparsers) -> None:
                    help=f"comma list of {', '.join(METHODS)} (default rbf,radial)")
     e.add_argument("--partial-faces", default=",".join(PARTIAL_FACES),
                    help="faces of the partial-annotation run ('none' to skip it)")
+    e.add_argument("--detect", action="store_true",
+                   help="real blocks: fit from rings detected on the photos (woodcam.detect) and score "
+                   "against the block's own ring maps (e.g. the Mokume U-Net maps) as the reference")
     e.add_argument("--out", type=Path, required=True, help="folder for table.md and cut-plane PNGs")
     e.set_defaults(func=run_eval)
 
@@ -105,7 +108,14 @@ def run_eval(args) -> int:
 
         for b in real:
             print(f"{b.name}: no true field; scoring each face predicted from the others")
-            res = leave_one_face_out(b, methods, out_dir=args.out, progress=print)
+            fit_on, ref = b, None
+            if args.detect:
+                from ..detect.block import photos_only, with_detected_rings
+
+                fit_on, ref = with_detected_rings(photos_only(b), progress=True), b
+                fit_on.name = f"{b.name}-detected"
+                print(f"{b.name}: fitting from rings detected on its photos, scored against its own maps")
+            res = leave_one_face_out(fit_on, methods, out_dir=args.out, progress=print, reference=ref)
             print(res["table"])
         print(f"wrote {Path(args.out)}/<block>_holdout.md and <block>_<method>.png")
     return 0

@@ -215,3 +215,36 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
         warnings.warn(f"the block {spec!r} changed since {glb.name} was baked (its files differ); "
                       "the wood shown is today's", WoodcamWarning, stacklevel=2)
     return open_stock(spec, **kwargs)
+
+
+def add_engine_options(p: argparse.ArgumentParser) -> None:
+    """``--engine``, ``--address``, ``--workers``: where many independent tasks run
+    (:func:`woodcam.scale.run_many`)."""
+    p.add_argument("--engine", choices=("local", "dask"), default=None,
+                   help="run one task per item: local = worker processes on this machine, no "
+                   "services; dask = a Dask cluster (--address) or, without one, a 2-worker "
+                   "cluster on 127.0.0.1. Records are kept per item, so a killed run resumes "
+                   "(default: local)")
+    p.add_argument("--address", default=None, metavar="tcp://HOST:PORT",
+                   help="a running Dask scheduler (with --engine dask; default: none, start a "
+                   "local cluster)")
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="worker processes, each with one thread (default 2; 1 = serial in this "
+                   "process; not with --address)")
+    p.add_argument("--memory-limit-mb", type=int, default=None, metavar="MB",
+                   help="memory per worker in MiB (default 3072)")
+    p.add_argument("--connect-timeout-s", type=float, default=None, metavar="S",
+                   help="seconds to wait for the scheduler at --address (default 10)")
+
+
+def engine_options(args) -> dict:
+    """The keyword arguments of :func:`woodcam.scale.run_many` from :func:`add_engine_options`."""
+    if args.address is not None and args.engine not in (None, "dask"):
+        raise WoodcamError(f"--address needs --engine dask; got --engine {args.engine}")
+    out = {"engine": "dask" if args.address is not None else (args.engine or "local"),
+           "address": args.address, "workers": args.workers}
+    if args.memory_limit_mb is not None:
+        out["memory_limit_mb"] = args.memory_limit_mb
+    if args.connect_timeout_s is not None:
+        out["connect_timeout_s"] = args.connect_timeout_s
+    return out

@@ -1,28 +1,57 @@
-"""``woodcam train gtf``: train the generic neural growth-time model (§3.2.2 of seed 000)."""
+"""``woodcam train gtf``: train the generic neural growth-time model (§3.2.2 of seed 000);
+``woodcam train rings``: the small learned ring detector (:mod:`woodcam.detect.learned`)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from .options import add_engine_options, engine_options
+
 
 def register(subparsers) -> None:
-    """Add ``train gtf``."""
-    p = subparsers.add_parser("train", help="train a learned model (gtf: the generic neural growth field)")
-    p.add_argument("what", choices=["gtf"], help="which model to train")
+    """Add ``train gtf`` and ``train rings``."""
+    p = subparsers.add_parser("train", help="train a learned model (gtf: the generic neural growth field; "
+                              "rings: the small ring detector)")
+    p.add_argument("what", choices=["gtf", "rings"], help="which model to train")
     p.add_argument("--spec", type=Path, default=None,
                    help="JSON spec of hyper-parameters (default: the built-in defaults)")
     p.add_argument("--out", type=Path, required=True,
-                   help="folder for gtf_spec.json, gtf.pt, gtf_train_log.csv and the checkpoint")
+                   help="folder for the spec, weights and training log (gtf: gtf_spec.json, gtf.pt, "
+                   "gtf_train_log.csv and the checkpoint; rings: rings_spec.json, rings.pt, rings_train_log.csv)")
     p.add_argument("--steps", type=int, default=None, help="stop after N steps in total (default: spec.steps)")
     p.add_argument("--no-resume", action="store_true", help="start over instead of resuming the checkpoint")
+    add_engine_options(p)  # with --engine: the training set is made in shards of 256 fields
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
+    if args.what == "rings":
+        from ..detect.learned import RingNetSpec, train_ring_net
+
+        spec = RingNetSpec.load(args.spec) if args.spec is not None else RingNetSpec()
+        if args.steps is not None:
+            from dataclasses import replace
+
+            spec = replace(spec, steps=args.steps)
+        from ..synth.rings import ring_training_faces
+
+        # the training faces come from woodcam's own synthesis (synth sits above detect)
+        x, y = ring_training_faces(spec, progress=True)
+        r = train_ring_net(spec, x, y, args.out, progress=True)
+        print(f"trained the ring net ({r['params']} parameters) {r['steps']} steps in {r['train_s']:.0f} s; "
+              f"final loss {r['final_loss']:.4f}; wrote {args.out}")
+        return 0
     from ..fields.neural import GTFSpec, train_gtf
 
     spec = GTFSpec.load(args.spec) if args.spec is not None else GTFSpec()
-    r = train_gtf(spec, args.out, steps=args.steps, resume=not args.no_resume, progress=True)
+    training_set = None
+    if args.engine is not None or args.address is not None:
+        # the same training set, made in shards on an engine, kept in OUT/trainset/ (resumable)
+        from ..benchmark import make_training_set_many
+
+        training_set = make_training_set_many(spec, args.out / "trainset", **engine_options(args))
+    r = train_gtf(spec, args.out, steps=args.steps, resume=not args.no_resume, progress=True,
+                  training_set=training_set)
     print(f"trained {int(r['step'][-1]) if len(r['step']) else 0} steps in {r['train_s']:.0f} s; "
           f"final L1 {r['final_l1']:.5f} (normalised units), relative {100 * r['final_rel']:.2f} %; "
           f"wrote {args.out}")

@@ -181,11 +181,26 @@ def family_gtf(points: np.ndarray, r_minus: np.ndarray, r_plus: np.ndarray) -> n
 
 def make_training_set(spec: GTFSpec) -> tuple[np.ndarray, np.ndarray]:
     """Sample the training pairs of §3.2.5: ``points (N, M, 3)`` and ``values (N, M)``, float32."""
-    rng = np.random.default_rng([spec.seed, 1])
+    return make_training_shard(spec, 0, spec.n_fields)
+
+
+def make_training_shard(spec: GTFSpec, start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
+    """Fields ``start .. stop - 1`` of :func:`make_training_set`, bit for bit, computed alone.
+
+    The radius functions of all ``N`` fields are drawn (``2 N N_c`` normals, cheap; the normal
+    sampler uses a variable number of raw draws, so it cannot be skipped), then the generator is
+    advanced past the ``3 M start`` uniforms of the earlier fields (a uniform double takes exactly
+    one 64-bit draw of PCG64), so shards can be made in parallel and concatenated.
+    """
     n, mp = spec.n_fields, spec.points_per_field
+    if not 0 <= start < stop <= n:
+        raise WoodcamError(f"shard must satisfy 0 <= start < stop <= n_fields = {n}; got {start}..{stop}")
+    rng = np.random.default_rng([spec.seed, 1])
     r_minus = random_radius_samples(rng, n, spec.n_constraints, spec.constraint_sigma, spec.radius_samples)
     r_plus = random_radius_samples(rng, n, spec.n_constraints, spec.constraint_sigma, spec.radius_samples)
-    pts = rng.uniform(-1.0, 1.0, (n, mp, 3))
+    r_minus, r_plus = r_minus[start:stop], r_plus[start:stop]
+    rng.bit_generator.advance(3 * mp * start)
+    pts = rng.uniform(-1.0, 1.0, (stop - start, mp, 3))
     n_pith = int(round(spec.pith_fraction * mp))
     pts[:, :n_pith, :2] *= 0.1  # [-0.1, 0.1]^2 x [-1, 1] near the pith
     vals = family_gtf(pts, r_minus, r_plus)
@@ -286,7 +301,8 @@ def _lr_scale(step: int, total: int, floor: float) -> float:
 
 
 def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool = True,
-              progress: bool = True, threads: int = 1) -> dict:
+              progress: bool = True, threads: int = 1,
+              training_set: tuple[np.ndarray, np.ndarray] | None = None) -> dict:
     """Train the generic model (eq. 3) and write spec, weights and log into ``out_dir``.
 
     A checkpoint (network, latent codes, optimiser, log) is written every
@@ -302,6 +318,9 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
     threads : int
         torch CPU threads. 1 by default: the mini-batch matrices are small, and on a shared
         machine two OpenMP threads contending with other processes ran 5-40x slower than one.
+    training_set : (points (N, M, 3), values (N, M)) float32, optional
+        :func:`make_training_set` of ``spec`` made elsewhere (e.g. in shards on many workers
+        by :func:`woodcam.benchmark.make_training_set_many`); default: made here.
 
     Returns
     -------
@@ -319,7 +338,14 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
         raise WoodcamError(f"steps must be >= 0; got {steps!r}")
     spec.save(out / SPEC_NAME)
 
-    pts_np, vals_np = make_training_set(spec)
+    if training_set is None:
+        pts_np, vals_np = make_training_set(spec)
+    else:
+        pts_np, vals_np = (np.asarray(a, np.float32) for a in training_set)
+        want = (spec.n_fields, spec.points_per_field)
+        if pts_np.shape != want + (3,) or vals_np.shape != want:
+            raise WoodcamError(f"training_set must be points {want + (3,)} and values {want} for "
+                               f"this spec; got {pts_np.shape} and {vals_np.shape}")
     pts, vals = torch.from_numpy(pts_np), torch.from_numpy(vals_np)
     net = build_model(spec)
     gen = torch.Generator().manual_seed(spec.seed + 7)

@@ -160,12 +160,17 @@ def _score(face: str, years: np.ndarray, ridge: np.ndarray, excl, thresholds) ->
 
 def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
                        out_dir: PathLike | None = None,
-                       progress: Callable[[str], object] | None = None) -> dict:
+                       progress: Callable[[str], object] | None = None,
+                       reference: Block | None = None) -> dict:
     """Fit ``block`` on all faces but one for each face with a ring map, score the held-out face.
 
     Parameters
     ----------
     block : woodcam.block.Block with ring maps on at least two faces.
+    reference : woodcam.block.Block, optional
+        Score against this block's ring maps (and knot masks) instead of ``block``'s own: e.g.
+        ``block`` holds rings detected on the photos (:mod:`woodcam.detect`) and ``reference``
+        the Mokume maps of the same cube.
     methods : fitting methods (:data:`woodcam.inference.fit.METHODS`).
     out_dir : folder for ``{block}_{method}.png`` (per face: photo, ring map, predicted ARF,
         overlay of ridge and predicted lines) and ``{block}_holdout.md``; None writes nothing.
@@ -177,11 +182,13 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
     FaceScore``;
     ``"fit_s"``: method -> mean held-out fit seconds; ``"table"``: markdown text.
     """
-    faces = [n for n, f in block.faces.items() if f.ring_map is not None]
+    ref_block = block if reference is None else reference
+    faces = [n for n, f in block.faces.items() if f.has_rings and n in ref_block.faces
+             and ref_block.faces[n].ring_map is not None]
     if len(faces) < 2:
         raise WoodcamError(f"block {block.name!r} has ring maps on {faces}; leave-one-face-out needs "
                            f"at least two faces with ring maps")
-    refs = {face: _face_reference(block, face) for face in faces}
+    refs = {face: _face_reference(ref_block, face) for face in faces}
     held = {m: [] for m in methods}
     control = {m: [] for m in methods}
     straight = {m: [] for m in methods}

@@ -16,6 +16,8 @@ iso-surfaces and ``ARF = (GTF mod 1)^2`` (eq. 6 of seed 000).
   (:mod:`~woodcam.synth.degradation`), all set by a :class:`SynthSpec`
   (:mod:`~woodcam.synth.spec`, JSON round trips).
 - :mod:`~woodcam.synth.dataset`: :func:`synth_benchmark_set` writes a reproducible set to disk.
+- :mod:`~woodcam.synth.rings`: faces with known rings for the ring detector (evaluation and
+  training data of :mod:`woodcam.detect`).
 
 It sits above ``block/``, ``logs/`` and ``appearance/``: none of those imports it.
 """
@@ -30,8 +32,10 @@ from .dataset import (
            synth_benchmark_set,
            time_synth_block,
 )
+from .rings import ring_eval_faces, ring_training_faces
 from .spec import PhotoSpec, RingMapSpec, SynthSpec, TraceSpec
 
 __all__ = ["MOKUME_RING_SIGMA_MM", "PATTERNS", "AnalyticLogField", "PhotoSpec", "RingMapSpec",
-           "SawPattern", "SynthSpec", "TraceSpec", "benchmark_set_block", "cut_block", "knot_crosses", "knotted_log_field",
-           "random_log_placement", "synth_benchmark_set", "synth_block", "time_synth_block"]
+           "SawPattern", "SynthSpec", "TraceSpec", "benchmark_set_block", "cut_block", "knot_crosses",
+           "knotted_log_field", "random_log_placement", "ring_eval_faces", "ring_training_faces",
+           "synth_benchmark_set", "synth_block", "time_synth_block"]

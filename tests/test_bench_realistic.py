@@ -1,10 +1,10 @@
-"""woodcam.benchmark: the per-block scoring task of the ring benchmark and its summary."""
+"""woodcam.bench_realistic: the per-block scoring task of the ring benchmark and its summary."""
 
 import json
 
 import pytest
 
-from woodcam.benchmark import bootstrap_ci, make_block, markdown, score_block, summarise
+from woodcam.bench_realistic import bootstrap_ci, make_block, markdown, score_block, summarise
 from woodcam.errors import WoodcamError
 from woodcam.inference.evaluate import DEFAULT_PLANES
 

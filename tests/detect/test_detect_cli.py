@@ -1,0 +1,134 @@
+"""``woodcam block from-photos``, ``woodcam rings detect|show`` and photo-only blocks in ``fit``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from woodcam.block import read_block
+from woodcam.cli import EXIT_ERROR, main
+from woodcam.frames import FACES
+
+
+@pytest.fixture(scope="module")
+def synth_photos(tmp_path_factory) -> Path:
+    """Six 160 px face photos of a synthetic rift-sawn 50 mm cube, named front.png ..."""
+    from woodcam.synth import AnalyticLogField, cut_block, synth_block
+
+    field = cut_block(AnalyticLogField(ring_width_mm=3.0, eccentricity=0.05), (50, 50, 50), "rift")
+    block = synth_block(field, (50, 50, 50), face_px=160, seed=4, ring_map_faces=())
+    folder = tmp_path_factory.mktemp("photos")
+    for name, f in block.faces.items():
+        Image.fromarray(f.photo).save(folder / f"{name}.png")
+    return folder
+
+
+def _run(capsys, *argv) -> tuple[int, str, str]:
+    rc = main([str(a) for a in argv])
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+def _copy(src: Path, dst: Path, skip=()) -> Path:
+    dst.mkdir()
+    for p in src.iterdir():
+        if p.stem not in skip:
+            (dst / p.name).write_bytes(p.read_bytes())
+    return dst
+
+
+def test_from_photos_detect_show_and_fit(synth_photos, tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    blk = tmp_path / "blk"
+    rc, _out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50x50x50", "--out", blk)
+    assert rc == 0, err
+    b = read_block(blk)
+    assert list(b.faces) == list(FACES) and all(f.photo is not None and not f.has_rings for f in b.faces.values())
+    # fit on the photo-only folder: detection runs once, cached outside the folder
+    before = sorted(p.name for p in blk.iterdir())
+    rc, _out, err = _run(capsys, "fit", blk, "--out", tmp_path / "f.npz")
+    assert rc == 0, err
+    assert sorted(p.name for p in blk.iterdir()) == before
+    assert len(list((tmp_path / "cache" / "detect").glob("*.npz"))) == 1
+    # detect into the folder: ring maps, SVG traces read back, knot-free
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0, err
+    b = read_block(blk)
+    for name, f in b.faces.items():
+        assert (blk / f"{name}_traces.svg").is_file()
+        assert f.traces and f.ring_map is not None and f.ring_map.max() > 0.99, name
+        assert "knot_mask" not in f.extras
+    rc, _out, err = _run(capsys, "rings", "show", blk, "--out", tmp_path / "check.png")
+    assert rc == 0, err
+    with Image.open(tmp_path / "check.png") as im:
+        assert im.size == (4 * 2 * 160, 3 * 2 * 160)
+
+
+def test_corrected_svg_wins_over_detection(synth_photos, tmp_path, capsys):
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
+    assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 0
+    # the user redraws the front face's rings as one straight line (Inkscape writes paths)
+    svg = blk / "front_traces.svg"
+    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
+                   '<path d="M 10.5,20.5 L 150.5,20.5" data-year="3"/></svg>')
+    rc, out, _err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and "kept the corrected front_traces.svg" in out
+    b = read_block(blk)
+    tr = b.faces["front"].traces
+    assert len(tr) == 1 and tr[0].year == 3 and np.allclose(tr[0].points_px, [[20, 10], [20, 150]])
+    assert b.faces["front"].ring_map[20, 80] > 0.99 and b.faces["front"].ring_map[60, 80] < 0.01
+    assert len(b.faces["top"].traces) > 1            # the other faces are detected again
+    assert json.loads((blk / "block.json").read_text())["meta"]["detection"]["user_svg"] == ["front"]
+
+
+def test_mokume_folder_is_redetected(tmp_path, capsys):
+    from .test_detect_rings import _mokume
+
+    src = _mokume("H11")
+    rc, _out, err = _run(capsys, "rings", "detect", src, "--out", tmp_path / "h11")
+    assert rc == 0, err
+    b = read_block(tmp_path / "h11")
+    assert set(b.faces) == set(FACES)
+    assert {n for n, f in b.faces.items() if "knot_mask" in f.extras} >= {"left", "back"}
+
+
+def test_bad_photo_folders_give_one_clear_line(synth_photos, tmp_path, capsys):
+    rc, _out, err = _run(capsys, "block", "from-photos", _copy(synth_photos, tmp_path / "a", skip=("back",)),
+                        "--size-mm", "50x50x50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and "missing face photos: back" in err and err.count("\n") == 1
+    d = _copy(synth_photos, tmp_path / "b")
+    with Image.open(d / "top.png") as im:
+        im.resize((160, 120)).save(d / "top.png")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and "face 'top'" in err and "aspect" in err
+    d = _copy(synth_photos, tmp_path / "c")
+    Image.fromarray(np.full((160, 160, 3), 128, np.uint8)).save(d / "left.png")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and "face 'left'" in err and "blank" in err
+    d = _copy(synth_photos, tmp_path / "d")
+    with Image.open(d / "right.png") as im:
+        a = np.asarray(im).copy()
+    a[:110] = 255
+    Image.fromarray(a).save(d / "right.png")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and "face 'right'" in err and "over-exposed" in err
+    rc, _out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50x0x50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and "--size-mm" in err
+
+
+def test_face_without_rings_is_named(synth_photos, tmp_path, capsys):
+    d = _copy(synth_photos, tmp_path / "p")
+    rng = np.random.default_rng(0)
+    grad = np.linspace(90, 170, 160)[None, :, None] + 4 * rng.standard_normal((160, 160, 3))
+    Image.fromarray(np.clip(np.broadcast_to(grad, (160, 160, 3)), 0, 255).astype(np.uint8)).save(d / "bottom.png")
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", blk)[0] == 0
+    rc, out, _err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and "face 'bottom'" in out
+    b = read_block(blk)
+    assert b.faces["bottom"].ring_map is None or not b.faces["bottom"].traces

@@ -1,0 +1,156 @@
+"""The classical ring detector on analytic faces, synthetic faces with known rings, and real faces."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from woodcam.detect import detect_rings, reference_ridge, ridge_scores
+from woodcam.detect.evaluate import (
+    EVAL_SEEDS,
+    score_reference_block,
+    score_synthetic,
+    summary,
+)
+from woodcam.detect.score import shifted_half_ring
+from woodcam.errors import WoodcamError
+
+
+def _mokume(sample: str) -> Path:
+    root = Path(os.environ.get("WOODCAM_SHARED_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
+    folder = root / "mokume" / sample
+    if not folder.is_dir():
+        pytest.skip(f"Mokume sample {sample} not found under {root} (set WOODCAM_SHARED_DATA)")
+    return folder
+
+
+def _faces(seeds):
+    from woodcam.synth import ring_eval_faces
+
+    return [f for s in seeds for f in ring_eval_faces(s)]
+
+
+def _line_face(spacing=14.0, angle_deg=20.0, n=192, seed=0, width=1.8, contrast=0.25):
+    """Dark Gaussian lines every ``spacing`` px across the normal at ``angle_deg``; returns the
+    photo and the exact line positions sampled densely, (m, 2) (row, col)."""
+    rng = np.random.default_rng(seed)
+    a = np.radians(angle_deg)
+    rr, cc = np.meshgrid(np.arange(n, dtype=float), np.arange(n, dtype=float), indexing="ij")
+    s = rr * np.sin(a) + cc * np.cos(a)                       # coordinate along the normal
+    d = (s - spacing * np.round(s / spacing))                 # signed distance to the nearest line
+    lum = 0.7 - contrast * np.exp(-(d / width) ** 2) + 0.02 * rng.standard_normal((n, n))
+    photo = np.clip(np.repeat(lum[..., None], 3, axis=2) * 255, 0, 255).astype(np.uint8)
+    truth = np.argwhere(np.abs(d) < 0.5).astype(float)
+    return photo, truth
+
+
+def test_parallel_lines_found_within_a_pixel():
+    photo, truth = _line_face()
+    det = detect_rings(photo, rule="dark-centre")
+    sc = ridge_scores(det.points_px, truth, thresholds=(1.0, 2.0))
+    assert sc.f[1.0] >= 0.9 and sc.f[2.0] >= 0.95, sc
+    # the chance control (half a ring off) is far below
+    ch = ridge_scores(shifted_half_ring(det.points_px, det.normal_rad, det.wavelength_px), truth, thresholds=(2.0,))
+    assert ch.f[2.0] < 0.2
+    # local spacing and orientation recovered away from the border
+    inner = (slice(40, -40), slice(40, -40))
+    assert np.median(det.wavelength_px[inner]) == pytest.approx(14.0, rel=0.1)
+    n = det.normal_rad[inner]
+    assert np.degrees(np.abs(np.angle(np.exp(2j * (n - np.radians(20.0)))))).mean() / 2 < 3.0
+    assert not det.warnings
+
+
+def test_blank_and_noise_faces_warn_and_find_little():
+    rng = np.random.default_rng(3)
+    blank = np.full((128, 128, 3), 180, np.uint8)
+    det = detect_rings(blank, name="top")
+    assert not det.traces and det.warnings and "'top'" in det.warnings[0]
+    assert not det.ring_map.any()
+    # isotropic pores (dark dots) and white noise: no coherent rings
+    pores = np.full((160, 160), 0.7)
+    idx = rng.integers(0, 160, size=(600, 2))
+    pores[idx[:, 0], idx[:, 1]] = 0.3
+    pores += 0.03 * rng.standard_normal(pores.shape)
+    photo = np.clip(np.repeat(pores[..., None], 3, axis=2) * 255, 0, 255).astype(np.uint8)
+    det = detect_rings(photo, name="left")
+    assert det.warnings and "'left'" in det.warnings[0]
+    assert det.evidence.mean() < 0.15
+
+
+def test_bad_arguments_are_refused():
+    with pytest.raises(WoodcamError, match="rule must be one of"):
+        detect_rings(np.zeros((64, 64, 3), np.uint8), rule="middle")
+    with pytest.raises(WoodcamError, match="at least 16x16"):
+        detect_rings(np.zeros((8, 8, 3), np.uint8))
+    with pytest.raises(WoodcamError, match="photo must be"):
+        detect_rings(np.zeros((64, 64, 2), np.uint8))
+
+
+def test_scores_are_exact_on_a_known_case():
+    ref = np.array([[10, c] for c in range(20)])
+    det = np.array([[11.0, c] for c in range(10)] + [[30.0, c] for c in range(10)])   # half right
+    sc = ridge_scores(det, ref, thresholds=(2.0,))
+    # precision: the 10 points on row 11; recall: ref columns 0..10 (col 10 is 1 px from (11, 9),
+    # col 11 is sqrt(5) px away)
+    assert sc.precision[2.0] == 0.5 and sc.recall[2.0] == 0.55
+    assert sc.f[2.0] == pytest.approx(2 * 0.5 * 0.55 / 1.05)
+    assert ridge_scores(np.zeros((0, 2)), ref).f[2.0] == 0.0
+    ring_map = np.zeros((40, 40), np.float32)
+    ring_map[9:12, 5:30] = 1.0
+    ridge = reference_ridge(ring_map)
+    assert np.all(np.abs(ridge[:, 0] - 10) <= 1) and 20 <= len(ridge) <= 25   # skeleton ends may bend
+
+
+#: Bars on the held-out synthetic seeds (sharp-edge rule, the synthetic faces' ring boundary).
+#: Measured (README): mean F within 2 px 0.867 over the 48 faces of seeds 1000-1007 (goal 0.90,
+#: not reached: wide earlywood on flat-sawn faces lets fibre streaks through), 0.78 on seed
+#: 1000's six faces alone.
+SYNTH_BAR_F2_ALL = 0.84
+SYNTH_BAR_F2_FIRST = 0.72
+
+
+def test_synthetic_faces_first_heldout_seed():
+    res = score_synthetic(_faces(EVAL_SEEDS[:1]), rule="sharp-edge")
+    s = summary(res)
+    assert len(res) >= 4
+    assert s["F@2"] >= SYNTH_BAR_F2_FIRST, s
+    assert s["chance F@2"] < 0.2
+
+
+@pytest.mark.slow
+def test_synthetic_faces_all_heldout_seeds():
+    faces = _faces(EVAL_SEEDS)
+    res = score_synthetic(faces, rule="sharp-edge")
+    s = summary(res)
+    assert s["F@2"] >= SYNTH_BAR_F2_ALL and s["F@5"] >= 0.87, s
+    # the default rule puts rings on the latewood centre: off by ~15 % of a ring here, so
+    # within 5 px but not 2 px (README)
+    d = summary(score_synthetic(faces, rule="dark-centre"))
+    assert d["F@5"] >= 0.80, d
+
+
+#: Real faces against the Mokume U-Net maps (a reference, not truth). Measured (README): H11
+#: mean F 0.58 / 0.72 within 2 / 5 px, chance 0.07 / 0.27; the bars sit below with margin.
+H11_BAR = {2.0: 0.50, 5.0: 0.65}
+
+
+def test_h11_faces_against_the_mokume_maps():
+    from woodcam.block.io import read_mokume
+
+    res = score_reference_block(read_mokume(_mokume("H11")))
+    s = summary(res)
+    assert len(res) == 6
+    assert s["F@2"] >= H11_BAR[2.0] and s["F@5"] >= H11_BAR[5.0], s
+    assert s["F@2"] > 3 * s["chance F@2"]
+
+
+@pytest.mark.slow
+def test_cn03_faces_against_the_mokume_maps():
+    from woodcam.block.io import read_mokume
+
+    s = summary(score_reference_block(read_mokume(_mokume("CN03"))))
+    assert s["F@2"] >= 0.25 and s["F@5"] >= 0.5, s
+    assert s["F@2"] > 2 * s["chance F@2"]

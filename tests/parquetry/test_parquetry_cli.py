@@ -1,0 +1,68 @@
+"""``woodcam parquetry``: a small end-to-end run from scans and a job file, and one-line errors."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from woodcam.cli import main
+
+
+@pytest.fixture
+def scans(tmp_path):
+    """Two synthetic 'scans' at 50.8 dpi (2 px/mm): light and dark striped wood, one masked."""
+    rng = np.random.default_rng(3)
+    yy, xx = np.mgrid[0:240, 0:320]
+    for name, base in (("light", 200), ("dark", 90)):
+        stripes = 25 * np.sin(xx / 3.0 + 0.3 * np.sin(yy / 17.0)) + rng.normal(0, 4, xx.shape)
+        g = np.clip(base + stripes, 0, 255).astype(np.uint8)
+        Image.fromarray(np.stack([g, (g * 0.8).astype(np.uint8), (g * 0.6).astype(np.uint8)], 2)).save(
+            tmp_path / f"{name}.png")
+    mask = np.full((240, 320), 255, np.uint8)
+    mask[:, :20] = 0                              # a clamp mark along one edge
+    Image.fromarray(mask).save(tmp_path / "dark_mask.png")
+    from skimage import data
+
+    Image.fromarray(data.coffee()).save(tmp_path / "coffee.png")
+    return tmp_path
+
+
+def test_cli_run_writes_everything(scans, capsys):
+    out = scans / "out"
+    rc = main(["parquetry", str(scans / "coffee.png"), "--veneer", f"{scans / 'light.png'}:50.8",
+               "--veneer", f"{scans / 'dark.png'}:2px/mm:{scans / 'dark_mask.png'}",
+               "--image-size-mm", "56", "--px-per-mm", "2", "--out", str(out), "--quiet"])
+    text = capsys.readouterr().out
+    assert rc == 0, text
+    assert "feature cost/px" in text and "0 pieces with problems" in text
+    for name in ("render.png", "baseline.png", "target_matched.png", "assembly.svg", "panel.glb",
+                 "result.json", "job.json", "veneer_light.svg", "veneer_light.dxf"):
+        assert (out / name).is_file(), name
+    result = json.loads((out / "result.json").read_text())
+    assert result["summary"]["complete"] and len(result["patches"]) == 6 * 4
+    # the job file written reruns the same job
+    job = json.loads((out / "job.json").read_text())
+    assert job["num_source_rotations"] == 15 and len(job["source_textures"]) == 2
+    out2 = scans / "out2"
+    assert main(["parquetry", "--config", str(out / "job.json"), "--out", str(out2), "--quiet",
+                 "--no-glb"]) == 0
+    again = json.loads((out2 / "result.json").read_text())
+    assert [p["anchor_px"] for p in again["patches"]] == [p["anchor_px"] for p in result["patches"]]
+
+
+@pytest.mark.parametrize("args, message", [
+    (["{d}/nope.png", "--veneer", "{d}/light.png"], "cannot be read as an image"),
+    (["{d}/coffee.png", "--veneer", "{d}/light.png:300:{d}/coffee.png"], "mask must have the image's size"),
+    (["{d}/coffee.png", "--veneer", "{d}/light.png", "--patch-mm", "4"], "patch_mm must be at least min_piece_mm"),
+    (["{d}/coffee.png", "--veneer", "{d}/light.png:2000"], "smaller than one patch"),
+    (["{d}/coffee.png"], "parquetry needs veneers"),
+    (["{d}/coffee.png", "--veneer", "{d}/light.png:abc"], "resolution must be DPI"),
+])
+def test_cli_bad_input_is_one_line(scans, capsys, args, message):
+    argv = ["parquetry"] + [a.format(d=scans) for a in args] + ["--out", str(scans / "o"), "--quiet"]
+    assert main(argv) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith("woodcam: error:") and message in err

@@ -1,0 +1,200 @@
+"""``woodcam parquetry``: a target image rebuilt from veneers of real wood, with cut files.
+
+Registered by :mod:`woodcam.cli` through :func:`register`; the sub-parser's ``func`` is
+:func:`run`. Seed 002 (Iseringhausen et al., "Computational Parquetry"); defaults are its
+Table 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+_EPILOG = """\
+veneer sources (any number, mixed):
+  --veneer SCAN.png[:DPI]            a scanned veneer at DPI (default 300); SCAN.png:4px/mm for
+                                     px/mm; SCAN.png:300:MASK.png adds a usable-wood mask
+  --veneer-from MOKUME_FOLDER        the six face photos of a Mokume sample (50 mm cube faces)
+  --veneer-from BLOCK_SPEC           leaves sliced from a woodcam block or log (builtin:NAME,
+                                     log:gran1@K, a block folder): --sheets of --sheet-size mm,
+                                     --leaf-thickness + --saw-kerf apart, book-matched
+
+examples:
+  woodcam parquetry eye.png --veneer walnut.png:300 --veneer oak.png:300:oak_mask.png --out out/eye/
+  woodcam parquetry eye.png --veneer-from ../shared/data/mokume/CN03 --veneer-from log:gran1@52 --out out/eye/
+  woodcam parquetry --config job.json --out out/eye/
+
+writes render.png, baseline.png, target_matched.png, assembly.svg, veneer_<id>.svg/.dxf,
+result.json, panel.glb and job.json (the run as a job file) into --out.
+"""
+
+
+def register(subparsers) -> None:
+    """Add the ``parquetry`` command."""
+    p = subparsers.add_parser(
+        "parquetry", help="rebuild a target image from veneers (cut files for a CNC router)",
+        description="Computational parquetry (seed 002): cut a target image into patches, find "
+        "each on the veneer sheets (intensity + edge features, 15 rotations, every piece of wood "
+        "used once), cut seams, and write the panel, the cut files and a report.",
+        epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.set_defaults(func=run)
+    p.add_argument("target", nargs="*", type=Path, help="target image(s); several are queued "
+                   "together on the same wood (--queue)")
+    p.add_argument("--config", type=Path, default=None, metavar="JOB.json",
+                   help="a job file in the paper's layout (source_textures, targets, Table 1 keys); "
+                   "options given here override it")
+    p.add_argument("--out", type=Path, required=True, help="output folder")
+    v = p.add_argument_group("veneers")
+    v.add_argument("--veneer", action="append", default=[], metavar="SCAN[:DPI][:MASK]",
+                   help="scanned veneer image (repeatable); resolution in dpi (default 300) or "
+                   "'Npx/mm'")
+    v.add_argument("--veneer-from", action="append", default=[], metavar="SPEC",
+                   help="Mokume sample folder, or block spec to slice leaves from (repeatable)")
+    v.add_argument("--sheets", type=int, default=2, help="leaves per --veneer-from block (default 2)")
+    v.add_argument("--sheet-size", default="600x400", metavar="WxH",
+                   help="size of each sliced leaf in mm (default 600x400)")
+    v.add_argument("--leaf-thickness", type=float, default=0.6, metavar="MM",
+                   help="sliced leaf thickness in mm (default 0.6)")
+    v.add_argument("--saw-kerf", type=float, default=0.4, metavar="MM",
+                   help="wood lost between sliced leaves in mm (default 0.4)")
+    v.add_argument("--slice-axis", choices=("x", "y", "z"), default="y",
+                   help="normal of the slicing planes in the block frame (default y: leaves "
+                   "parallel to the front face)")
+    v.add_argument("--species", default=None,
+                   help="colour preset for sliced blocks (oak, maple, walnut, cherry, pine, "
+                   "spruce); default: the block's own")
+    t = p.add_argument_group("parameters (seed 002, Table 1)")
+    t.add_argument("--w-intens", type=float, default=None, help="intensity weight of eq. 1, in [0, 1] (default 0.5)")
+    t.add_argument("--w-edge", type=float, default=None, help="Sobel edge weight of eq. 1, in [0, 1] (default 0.5)")
+    t.add_argument("--w-hist", type=float, default=None,
+                   help="histogram-matching blend of eq. 2, in [0, 1] (default 0.5)")
+    t.add_argument("--image-size-mm", type=float, default=None,
+                   help="panel's shorter side in mm (default 360)")
+    t.add_argument("--patch-mm", type=float, default=None, help="patch side in mm (default 14)")
+    t.add_argument("--n-adaptive", type=int, default=None,
+                   help="adaptive levels: patches of patch-mm * 2^L split in four (default 0)")
+    t.add_argument("--w-adaptive", type=float, default=None,
+                   help="cost ratio: split when w_adaptive * (cost of the four) < cost of one "
+                   "(default 1.2)")
+    t.add_argument("--n-rot", type=int, default=None, help="rotations of each sheet (default 15)")
+    t.add_argument("--priority", choices=("saliency", "center"), default=None,
+                   help="patch order: salient first (default) or from the centre out (Fig. 6)")
+    t.add_argument("--queue", choices=("interleaved", "sequential"), default=None,
+                   help="several targets: interleaved by priority (default) or one after the other")
+    f = p.add_argument_group("matching and fabrication")
+    f.add_argument("--px-per-mm", type=float, default=None,
+                   help="working resolution of matching and render.png (default 4 px/mm)")
+    f.add_argument("--mode", choices=("fast", "exhaustive"), default=None,
+                   help="fast: coarse-to-fine with exact re-ranking (default); exhaustive: every "
+                   "position at full resolution")
+    f.add_argument("--coarse-factor", type=int, default=None, metavar="N",
+                   help="fast mode: the first search runs N times coarser than --px-per-mm "
+                   "(default 4; 8 or 16 for large sheets, where it is 5 or 20 times quicker)")
+    f.add_argument("--overlap-mm", type=float, default=None,
+                   help="patch overlap for seam cutting in mm (default min(patch/4, "
+                   "(patch - min-piece)/2) = 3.5); 0 = square pieces")
+    f.add_argument("--no-seams", action="store_true", help="square pieces, no seam optimisation")
+    f.add_argument("--min-piece-mm", type=float, default=None,
+                   help="narrowest piece in mm (default 5, the paper's bound)")
+    f.add_argument("--tool-diameter", type=float, default=None, metavar="MM",
+                   help="router bit diameter in mm: concave bends >= its radius, tool paths offset "
+                   "by it (default 2)")
+    f.add_argument("--kerf-mm", type=float, default=None,
+                   help="wood lost between pieces on a sheet in mm (default: the tool diameter)")
+    f.add_argument("--reuse-wood", action="store_true",
+                   help="let pieces overlap on the sheets (an upper bound on quality; not cuttable)")
+    f.add_argument("--no-glb", action="store_true", help="do not write panel.glb")
+    f.add_argument("--quiet", action="store_true", help="no progress bars")
+
+
+_OPTION_PARAMS = {"w_intens": "w_intens", "w_edge": "w_edge", "w_hist": "w_hist",
+                  "image_size_mm": "image_size_mm", "patch_mm": "patch_mm", "n_adaptive": "n_adaptive",
+                  "w_adaptive": "w_adaptive", "n_rot": "n_rot", "priority": "priority", "queue": "queue",
+                  "px_per_mm": "px_per_mm", "mode": "mode", "coarse_factor": "coarse_factor",
+                  "overlap_mm": "overlap_mm",
+                  "min_piece_mm": "min_piece_mm", "tool_diameter": "tool_diameter_mm",
+                  "kerf_mm": "kerf_mm"}
+
+
+def _scan_entry(text: str) -> dict:
+    from ..errors import WoodcamError
+
+    parts = text.split(":")
+    entry = {"texture": parts[0], "dpi": 300.0, "id": Path(parts[0]).stem}
+    if len(parts) > 3:
+        raise WoodcamError(f"--veneer takes SCAN[:DPI][:MASK]; got {text!r}")
+    if len(parts) >= 2 and parts[1]:
+        res = parts[1].lower()
+        try:
+            if res.endswith("px/mm"):
+                entry.pop("dpi")
+                entry["px_per_mm"] = float(res[:-5])
+            else:
+                entry["dpi"] = float(res)
+        except ValueError as err:
+            raise WoodcamError(f"--veneer resolution must be DPI (e.g. 300) or Npx/mm (e.g. 4px/mm); "
+                               f"got {parts[1]!r}") from err
+    if len(parts) == 3:
+        entry["mask"] = parts[2]
+    return entry
+
+
+def run(args) -> int:
+    """Run a parsed ``parquetry`` command; returns the exit status: 0, or
+    :data:`~woodcam.cli.EXIT_CHECKS` when the wood ran out (what was made is written)."""
+    import dataclasses
+
+    from ..errors import WoodcamError
+    from ..parquetry.engine import build_parquetry
+    from ..parquetry.job import (
+        ParquetryJob,
+        job_targets,
+        job_veneers,
+        read_job,
+        write_job,
+    )
+    from ..parquetry.output import format_summary, write_parquetry
+
+    job = read_job(args.config) if args.config else ParquetryJob()
+    over = {name: getattr(args, opt) for opt, name in _OPTION_PARAMS.items()
+            if getattr(args, opt) is not None}
+    if args.reuse_wood:
+        over["single_use"] = False
+    job.params = dataclasses.replace(job.params, **over).check()
+    if args.target:
+        job.targets = [{"filename": str(t), "scale": 1.0} for t in args.target]
+    job.scans = job.scans + [_scan_entry(s) for s in args.veneer]
+    try:
+        w, h = (float(x) for x in args.sheet_size.lower().split("x"))
+    except ValueError as err:
+        raise WoodcamError(f"--sheet-size must read WxH in mm (e.g. 600x400); got {args.sheet_size!r}") from err
+    for spec in args.veneer_from:
+        sp = Path(spec)
+        if sp.is_dir() and any(sp.glob("?_col.png")):
+            job.mokume.append(str(sp))
+        else:
+            job.blocks.append({"spec": spec, "sheets": args.sheets, "width_mm": w, "height_mm": h,
+                               "thickness_mm": args.leaf_thickness, "kerf_mm": args.saw_kerf,
+                               "axis": args.slice_axis, "species": args.species})
+    if not job.targets:
+        raise WoodcamError("parquetry needs a target image (TARGET or a --config job with targets)")
+    if not (job.scans or job.mokume or job.blocks):
+        raise WoodcamError("parquetry needs veneers: --veneer SCAN[:DPI], --veneer-from SPEC, or a "
+                           "--config job with source_textures")
+    progress = not args.quiet
+    targets, names = job_targets(job)
+    from ..stock import open_stock
+
+    veneers = job_veneers(job, open_stock=open_stock, progress=progress)
+    run_ = build_parquetry(targets, veneers, job.params, names=names, progress=progress,
+                           seams=not args.no_seams)
+    glb_writer = None
+    if not args.no_glb:
+        from ..export import export_glb as glb_writer
+    res = write_parquetry(run_, args.out, glb_writer=glb_writer, progress=progress)
+    write_job(job, Path(args.out) / "job.json")
+    print(format_summary(res["summary"], res["problems"]))
+    print(f"wrote {len(res['files']) + 1} files to {args.out}")
+    from . import EXIT_CHECKS, EXIT_OK
+
+    return EXIT_OK if run_.complete else EXIT_CHECKS

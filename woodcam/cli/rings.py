@@ -1,0 +1,130 @@
+"""``woodcam rings detect|show`` and ``woodcam block from-photos``: rings and knots from photos.
+
+Registered by :mod:`woodcam.cli` through :func:`register`; :mod:`woodcam.cli.block` adds
+``from-photos`` to the ``block`` command with :func:`add_from_photos`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import WoodcamError
+
+
+def _size(text: str) -> tuple[float, float, float]:
+    try:
+        vals = tuple(float(v) for v in text.lower().replace("×", "x").split("x"))
+    except ValueError:
+        vals = ()
+    if len(vals) == 1:
+        vals = vals * 3
+    if len(vals) != 3 or min(vals) <= 0:
+        raise WoodcamError(f"--size-mm takes WxDxH in mm (e.g. 50x50x50) or one side of a cube; got {text!r}")
+    return vals
+
+
+def add_from_photos(sub) -> None:
+    """Add ``from-photos`` to the ``block`` command's sub-parsers."""
+    p = sub.add_parser("from-photos", help="make a block folder from six face photos",
+                       description="Read six face photos named front.jpg, top.jpg, left.jpg, bottom.jpg, "
+                       "right.jpg, back.jpg (or A..F / Mokume A_col.png ...), each cropped to its face and "
+                       "seen from outside; check them against --size-mm; write a block folder with the "
+                       "photos. Then run 'woodcam rings detect'.")
+    p.add_argument("photos_dir", type=Path, help="folder with the six face photos")
+    p.add_argument("--size-mm", required=True, help="block size WxDxH in mm (width x depth x height), "
+                   "or one number for a cube")
+    p.add_argument("--out", type=Path, required=True, help="block folder to write (created)")
+    p.add_argument("--partial", action="store_true", help="accept fewer than six faces (default: all six)")
+    p.add_argument("--max-px-per-mm", type=float, default=None,
+                   help="upper image density of the stored faces, px/mm (default 10)")
+
+
+def run_from_photos(args) -> int:
+    from ..block.io import write_block
+    from ..block.photos import MAX_PX_PER_MM, block_from_photos
+
+    block = block_from_photos(args.photos_dir, _size(args.size_mm), partial=args.partial,
+                              max_px_per_mm=args.max_px_per_mm or MAX_PX_PER_MM)
+    write_block(block, args.out)
+    shapes = ", ".join(f"{n} {f.shape[1]}x{f.shape[0]}" for n, f in block.faces.items())
+    print(f"wrote {args.out} ({len(block.faces)} faces at {block.meta['px_per_mm']:.2f} px/mm: {shapes}); "
+          f"next: woodcam rings detect {args.out} --out {args.out}")
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add the ``rings`` command (``detect``, ``show``)."""
+    p = subparsers.add_parser("rings", help="find rings and knots on a block's face photos; draw them")
+    p.set_defaults(func=run)
+    sub = p.add_subparsers(dest="rings_command", required=True, metavar="{detect,show}")
+
+    d = sub.add_parser("detect", help="detect rings and knots on every face photo of a block",
+                       description="Writes per face a ring map (<face>_ring_map.png), the ring traces as "
+                       "SVG over the photo (<face>_traces.svg, editable in Inkscape: a corrected SVG is "
+                       "kept and wins over detection next time) and knot masks. BLOCK is a block "
+                       "folder or a Mokume sample folder (its U-Net maps are ignored: re-detected).")
+    d.add_argument("block", type=Path, help="block folder (block.json) or Mokume sample folder")
+    d.add_argument("--out", type=Path, required=True, help="block folder to write (may be BLOCK itself)")
+    d.add_argument("--rule", choices=("dark-centre", "sharp-edge"), default="dark-centre",
+                   help="ring line on the dark band's centre (default; matches Mokume maps) or on its "
+                   "sharp edge (the exact ring boundary of woodcam's synthetic faces)")
+    d.add_argument("--detector", choices=("classical", "learned"), default=None,
+                   help="classical: the weight-free quadrature-filter detector (default); learned: the "
+                   "small net trained by 'woodcam train rings' (woodcam/models/rings.pt)")
+    d.add_argument("--no-knots", action="store_true", help="do not detect knot masks")
+    d.add_argument("--size-mm", type=float, default=None,
+                   help="cube side in mm for a Mokume folder (default 50)")
+
+    s = sub.add_parser("show", help="draw each face photo with the rings and knots found on it",
+                       description="Unfolded cross of the face photos (2x) with ring traces (red), knot "
+                       "outlines (yellow) and, for a Mokume folder, the U-Net map's ridge (cyan). A "
+                       "Mokume folder is detected first (cached).")
+    s.add_argument("block", type=Path, help="block folder (after 'rings detect') or Mokume sample folder")
+    s.add_argument("--out", type=Path, required=True, help="PNG to write")
+    s.add_argument("--zoom", type=int, default=2, help="enlargement: picture pixels per face pixel, a whole number (default 2)")
+    s.add_argument("--size-mm", type=float, default=None, help="cube side in mm for a Mokume folder (default 50)")
+
+
+def run(args) -> int:
+    if args.rings_command == "detect":
+        from ..detect.block import DEFAULT_DETECTOR, detect_folder
+
+        manifest, msgs = detect_folder(args.block, args.out, rule=args.rule, knots=not args.no_knots,
+                                       size_mm=(args.size_mm,) * 3 if args.size_mm else None, progress=True,
+                                       detector=args.detector or DEFAULT_DETECTOR)
+        for m in msgs:
+            print(f"woodcam: warning: {m}")
+        print(f"wrote {manifest.parent} (ring maps, <face>_traces.svg, knot masks)")
+        return 0
+    if args.rings_command == "show":
+        import numpy as np
+        from PIL import Image
+
+        from ..block.io import MANIFEST, read_block, read_mokume
+        from ..detect.block import with_detected_rings
+        from ..detect.show import rings_picture
+
+        folder = Path(args.block)
+        if not folder.is_dir():
+            raise WoodcamError(f"block folder {str(folder)!r} does not exist")
+        refs = None
+        if (folder / MANIFEST).exists():
+            block = read_block(folder)
+            if not any(f.has_rings for f in block.faces.values()):
+                raise WoodcamError(f"block {str(folder)!r} has no rings yet; run 'woodcam rings detect "
+                                   f"{folder} --out {folder}' first")
+        else:
+            mok = read_mokume(folder, (args.size_mm or 50.0,) * 3)
+            refs = {n: f.ring_map for n, f in mok.faces.items() if f.ring_map is not None}
+            for f in mok.faces.values():
+                f.ring_map, f.traces = None, []
+                f.extras.pop("knot_mask", None)
+            block = with_detected_rings(mok, progress=True)
+        pic = rings_picture(block, zoom=args.zoom, references=refs)
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = args.out.with_name(f".{args.out.name}.tmp.png")
+        Image.fromarray(np.asarray(pic)).save(tmp)
+        tmp.replace(args.out)
+        print(f"wrote {args.out}")
+        return 0
+    raise AssertionError(args.rings_command)

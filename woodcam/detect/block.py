@@ -1,0 +1,307 @@
+"""Rings and knots detected on every face of a block, written beside its photos, cached by content.
+
+A block's faces after detection carry (pixels of each face image, ``docs/conventions.md``):
+
+- ``traces``: the detected ring boundaries, unlabelled, sub-pixel polylines; in a block folder
+  they live in ``<face>_traces.svg`` (one unit per pixel, drawn over ``<face>_photo.png``, editable
+  in Inkscape) named by the manifest's ``"traces_svg"``, which :func:`woodcam.block.read_block`
+  reads back;
+- ``ring_map``: ``(h, w)`` float32 drawn from those traces (Mokume-like line width);
+- ``extras["knot_mask"]``: ``(h, w)`` bool from :func:`woodcam.detect.knots.detect_knots`.
+
+**A user's SVG wins.** The manifest records the SHA-256 of each SVG the detector wrote
+(``meta["detection"]["svg_sha256"]``). When a face's SVG no longer matches (someone corrected it
+in an editor), detecting again keeps that SVG, takes its traces as the face's rings and redraws
+the ring map from them; only faces whose SVG is untouched (or missing) are detected afresh.
+
+**Photo-only blocks elsewhere** (``fit``, ``bake``, ``eval``): :func:`with_detected_rings`
+detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
+folder of woodcam's cache (:mod:`woodcam._cache`: ``$WOODCAM_CACHE_DIR`` or platformdirs' user
+cache), one ``.npz`` keyed by a digest of the photos, the block size, the rule, the detector and
+:data:`DETECT_VERSION`; the user's folder is never written to.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import warnings
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from .._atomic import atomic_path, write_text
+from .._cache import cache_dir, digest, load_or_build
+from ..block.block import Block, Face
+from ..errors import WoodcamError, WoodcamWarning
+from .knots import detect_knots
+from .rings import RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, ring_map_from_traces
+
+#: Bumped whenever detection results change, so cached detections are recomputed.
+DETECT_VERSION = 1
+
+
+Detector = Literal["classical", "learned"]
+DETECTORS: tuple[str, ...] = ("classical", "learned")
+#: The default detector, picked by the figures in README ("From photos alone").
+DEFAULT_DETECTOR: Detector = "classical"
+
+
+def detect_face(face: Face, px_per_mm: float, rule: BoundaryRule = "dark-centre",
+                knots: bool = True, detector: Detector = DEFAULT_DETECTOR) -> tuple[Face, list[str]]:
+    """Detect rings (and knots) on one face with a photo; returns a new Face and warnings.
+
+    ``detector``: ``"classical"`` (:func:`~woodcam.detect.rings.detect_rings` with ``rule``) or
+    ``"learned"`` (:func:`~woodcam.detect.learned.detect_rings_learned`, the committed net).
+    The face's existing extras are kept; ``knot_mask`` is replaced by the detected one when
+    ``knots`` (an empty mask is not stored).
+    """
+    if face.photo is None:
+        raise WoodcamError(f"face {face.name!r} has no photo to detect rings on; add its photo")
+    if detector not in DETECTORS:
+        raise WoodcamError(f"detector must be one of {', '.join(DETECTORS)}; got {detector!r}")
+    if detector == "learned":
+        from .learned import detect_rings_learned
+
+        det = detect_rings_learned(face.photo, px_per_mm=px_per_mm, name=face.name)
+    else:
+        det = detect_rings(face.photo, px_per_mm=px_per_mm, rule=rule, name=face.name)
+    extras = dict(face.extras)
+    if knots:
+        mask = detect_knots(face.photo, px_per_mm, det.normal_rad)
+        extras.pop("knot_mask", None)
+        if mask.any():
+            extras["knot_mask"] = mask
+    ring_map = det.ring_map if det.traces else None
+    return Face(face.name, face.shape, photo=face.photo, traces=list(det.traces), ring_map=ring_map,
+                extras=extras), list(det.warnings)
+
+
+def detect_block(block: Block, *, rule: BoundaryRule = "dark-centre", knots: bool = True,
+                 faces=None, progress: bool = False,
+                 detector: Detector = DEFAULT_DETECTOR) -> tuple[Block, list[str]]:
+    """A copy of ``block`` whose faces with photos carry detected rings and knot masks.
+
+    ``faces``: only these faces (default all with a photo); the others are copied unchanged.
+    Returns the block and the warnings (each names its face).
+    """
+    from tqdm.auto import tqdm
+
+    out = copy.copy(block)
+    out.faces = dict(block.faces)
+    out.meta = dict(block.meta)
+    names = [n for n, f in block.faces.items() if f.photo is not None and (faces is None or n in faces)]
+    if not names:
+        raise WoodcamError(f"block {block.name!r} has no face photos to detect rings on; "
+                           f"make the block with 'woodcam block from-photos'")
+    msgs: list[str] = []
+    for name in tqdm(names, desc="detecting rings", unit="face", delay=2.0, disable=not progress):
+        px_mm = block.face_pixel_size_mm(name)
+        out.faces[name], w = detect_face(block.faces[name], 1.0 / min(px_mm), rule, knots, detector)
+        msgs += w
+    out.meta["detection"] = {"detector": detector, "version": DETECT_VERSION, "rule": rule,
+                             "faces": names}
+    return out, msgs
+
+
+# -- block folders ---------------------------------------------------------------------------------
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _atomic_json(path: Path, doc: dict) -> None:
+    write_text(path, json.dumps(doc, indent=1))
+
+
+def user_edited_faces(folder) -> dict[str, Path]:
+    """Faces of a block folder whose ``<face>_traces.svg`` differs from what the detector wrote
+    (a user corrected it) -> the SVG path."""
+    from ..block.io import MANIFEST
+
+    folder = Path(folder)
+    m = json.loads((folder / MANIFEST).read_text())
+    written = m.get("meta", {}).get("detection", {}).get("svg_sha256", {})
+    out = {}
+    for name, entry in m.get("faces", {}).items():
+        svg = entry.get("traces_svg")
+        if svg and (folder / svg).is_file() and _sha256(folder / svg) != written.get(name):
+            out[name] = folder / svg
+    return out
+
+
+def detect_folder(src, out, *, rule: BoundaryRule = "dark-centre", knots: bool = True,
+                  size_mm=None, progress: bool = False,
+                  detector: Detector = DEFAULT_DETECTOR) -> tuple[Path, list[str]]:
+    """Detect rings and knots on a block folder (or a Mokume sample folder, whose U-Net maps are
+    ignored and re-detected from its photos) and write the result as a block folder ``out``.
+
+    Faces whose SVG a user corrected (module docstring) keep it: their rings come from it.
+    ``out`` may be ``src`` itself. Returns the manifest path and the warnings.
+    """
+    from ..block.io import MANIFEST, read_block, read_mokume, write_block
+    from ..block.svg import read_traces_svg, write_traces_svg
+
+    src, out = Path(src), Path(out)
+    if not src.is_dir():
+        raise WoodcamError(f"block folder {str(src)!r} does not exist; pass a block folder made by "
+                           f"'woodcam block from-photos' or a Mokume sample folder")
+    mokume = not (src / MANIFEST).exists() and any(src.glob("A_*.png"))
+    if mokume:
+        block = read_mokume(src, size_mm or (50.0, 50.0, 50.0))
+        for f in block.faces.values():     # re-detect from the photos alone
+            f.ring_map, f.traces = None, []
+            f.extras.pop("knot_mask", None)
+        edited = {}
+    else:
+        if not (src / MANIFEST).exists():
+            raise WoodcamError(f"folder {str(src)!r} must hold a {MANIFEST} (a block folder) or Mokume "
+                               f"files (A_col.png ...); found neither")
+        block = read_block(src)
+        edited = user_edited_faces(src)
+    todo = [n for n, f in block.faces.items() if f.photo is not None and n not in edited]
+    msgs: list[str] = []
+    if todo:
+        block, msgs = detect_block(block, rule=rule, knots=knots, faces=todo, progress=progress,
+                                   detector=detector)
+    else:
+        block.meta = dict(block.meta)
+    sigma_mm = RING_MAP_SIGMA_MM
+    kept = {}
+    for name, svg in edited.items():
+        f = block.faces[name]
+        traces = read_traces_svg(svg, f.shape)
+        px = 1.0 / min(block.face_pixel_size_mm(name))
+        ring_map = ring_map_from_traces(traces, f.shape, sigma_mm * px) if traces else None
+        block.faces[name] = Face(name, f.shape, photo=f.photo, traces=[], ring_map=ring_map, extras=f.extras)
+        kept[name] = traces
+        msgs.append(f"face {name!r}: kept the corrected {svg.name} ({len(traces)} traces); "
+                    f"it wins over detection")
+    for name, f in block.faces.items():
+        if f.photo is not None and not f.traces and name not in kept:
+            msgs.append(f"face {name!r}: no rings found; the face is left without a ring map "
+                        f"(trace its rings in {name}_traces.svg if it has some)")
+    det_traces = {n: f.traces for n, f in block.faces.items()}
+    # The traces live in the SVGs (read back by read_block), not twice in the manifest.
+    for f in block.faces.values():
+        f.traces = []
+    out.mkdir(parents=True, exist_ok=True)
+    if out.resolve() != src.resolve():
+        for name, svg in edited.items():     # carry the user's SVG over unchanged
+            (out / svg.name).write_bytes(svg.read_bytes())
+    manifest = write_block(block, out)
+    m = json.loads(manifest.read_text())
+    hashes = {}
+    for name in block.faces:
+        svg = out / f"{name}_traces.svg"
+        if name in kept:
+            m["faces"][name]["traces_svg"] = svg.name
+            continue
+        f = block.faces[name]
+        face = Face(name, f.shape, traces=det_traces.get(name, []))
+        with atomic_path(svg) as tmp:
+            write_traces_svg(face, tmp, photo_href=m["faces"][name].get("photo"))
+        m["faces"][name]["traces_svg"] = svg.name
+        hashes[name] = _sha256(svg)
+    det = m["meta"].setdefault("detection", {"detector": detector, "version": DETECT_VERSION, "rule": rule})
+    det["svg_sha256"] = hashes
+    det["user_svg"] = sorted(kept)
+    _atomic_json(manifest, m)
+    return manifest, msgs
+
+
+# -- photo-only blocks for fit / bake / eval --------------------------------------------------------
+
+def photos_only(block: Block) -> Block:
+    """A copy of ``block`` keeping only its face photos (no traces, ring maps or knot masks):
+    what detection starts from, e.g. to re-detect a Mokume sample."""
+    out = copy.copy(block)
+    out.faces = {n: Face(n, f.shape, photo=f.photo) for n, f in block.faces.items() if f.photo is not None}
+    out.meta = dict(block.meta)
+    return out
+
+
+def needs_detection(block: Block) -> bool:
+    """True when no face has rings (traces or a ring map) but some face has a photo."""
+    return (not any(f.has_rings for f in block.faces.values())
+            and any(f.photo is not None for f in block.faces.values()))
+
+
+def _detection_key(block: Block, rule: str) -> str:
+    return digest("detect", DETECT_VERSION, rule, DEFAULT_DETECTOR, list(block.size_mm),
+                  {n: f.photo for n, f in block.faces.items() if f.photo is not None})
+
+
+def _save_detection(value, tmp: Path) -> None:
+    """One ``.npz``: per face its traces (vertices and lengths), ring map (uint16) and knot mask."""
+    faces, msgs = value
+    arrays = {"warnings": np.array(json.dumps(msgs))}
+    for n, f in faces.items():
+        pts = [t.points_px for t in f.traces]
+        arrays[f"{n}.points"] = np.concatenate(pts) if pts else np.zeros((0, 2))
+        arrays[f"{n}.lengths"] = np.array([len(q) for q in pts], np.int64)
+        if f.ring_map is not None:
+            arrays[f"{n}.ring_map"] = np.round(np.clip(f.ring_map, 0, 1) * 65535).astype(np.uint16)
+        if "knot_mask" in f.extras:
+            arrays[f"{n}.knot_mask"] = np.asarray(f.extras["knot_mask"], bool)
+    with open(tmp, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
+
+
+def _load_detection(path: Path):
+    from ..block.block import RingTrace
+
+    with np.load(path) as z:
+        msgs = json.loads(str(z["warnings"]))
+        names = sorted({k.split(".")[0] for k in z.files if "." in k})
+        faces = {}
+        for n in names:
+            cuts = np.cumsum(z[f"{n}.lengths"])[:-1]
+            traces = [RingTrace(q) for q in np.split(z[f"{n}.points"], cuts) if len(q) >= 2]
+            rm = z[f"{n}.ring_map"].astype(np.float32) / 65535 if f"{n}.ring_map" in z.files else None
+            extras = {"knot_mask": z[f"{n}.knot_mask"]} if f"{n}.knot_mask" in z.files else {}
+            faces[n] = (traces, rm, extras)
+    return faces, msgs
+
+
+def with_detected_rings(block: Block, rule: BoundaryRule = "dark-centre", *, cache: bool = True,
+                        progress: bool = False) -> Block:
+    """``block`` itself when it has rings; otherwise a copy with rings and knots detected on its
+    photos, computed once and cached by content (module docstring; :mod:`woodcam._cache`).
+    Warnings naming faces are issued as :class:`~woodcam.errors.WoodcamWarning` each time."""
+    if not needs_detection(block):
+        return block
+
+    def build():
+        out, msgs = detect_block(block, rule=rule, progress=progress)
+        return ({n: f for n, f in out.faces.items() if n in out.meta["detection"]["faces"]}, msgs)
+
+    if cache:
+        path = cache_dir("detect") / f"{block.name}-{_detection_key(block, rule)}.npz"
+        raw, hit = load_or_build(path, load=_load_detection, build=build, save=_save_detection,
+                                 what="ring detection")
+        if not hit:
+            raw = ({n: (f.traces, f.ring_map, {k: v for k, v in f.extras.items() if k == "knot_mask"})
+                    for n, f in raw[0].items()}, raw[1])
+    else:
+        faces, msgs = build()
+        raw = ({n: (f.traces, f.ring_map, {k: v for k, v in f.extras.items() if k == "knot_mask"})
+                for n, f in faces.items()}, msgs)
+    faces, msgs = raw
+    out = copy.copy(block)
+    out.faces = dict(block.faces)
+    for n, (traces, ring_map, extras) in faces.items():
+        f = block.faces[n]
+        out.faces[n] = Face(n, f.shape, photo=f.photo, traces=list(traces), ring_map=ring_map,
+                            extras={**f.extras, **extras})
+    out.meta = {**block.meta, "detection": {"detector": DEFAULT_DETECTOR, "version": DETECT_VERSION,
+                                            "rule": rule, "faces": sorted(faces)}}
+    for w in msgs:
+        warnings.warn(w, WoodcamWarning, stacklevel=2)
+    return out
+
+
+__all__ = ["DEFAULT_DETECTOR", "DETECTORS", "DETECT_VERSION", "Detector", "detect_block", "detect_face", "detect_folder",
+           "needs_detection", "photos_only", "user_edited_faces", "with_detected_rings"]

@@ -1,0 +1,294 @@
+"""The small learned ring detector: a tiny U-Net trained from scratch on woodcam's own synthetic faces.
+
+Input: the flattened, contrast-normalised luminance of a face photo (:func:`woodcam.detect.rings._normalise`,
+``(h, w)`` float, the same as the classical detector sees). Output: ``(h, w)`` probability that a
+pixel lies within about a pixel of a ring boundary. Ring lines are the ridge of that map across
+the local ring normal (from the classical detector's orientation field), found with the same
+sub-pixel contour code as the classical detector, so the result is a
+:class:`~woodcam.detect.rings.RingDetection` like the classical one.
+
+Training (:func:`train_ring_net`, ``woodcam train rings``; the faces come from
+:func:`woodcam.synth.ring_training_faces`, which sits above this package): faces of synthetic cubes (random
+eccentric logs, every sawing pattern, a quarter of them knotted logs of seed 001/003) rendered by
+:func:`woodcam.synth.synth_block`, with photo-style augmentation: colour and exposure, blur,
+noise, JPEG, lighting gradients, dark pores and ray streaks. The target is the exact distance
+to the true ring lines (the integer iso-lines of the true field), ``exp(-(d / sigma)^2)``.
+Everything is seeded by :attr:`RingNetSpec.seed`; the spec, the weights and a CSV log are
+written together. The committed model lives in ``woodcam/models/rings.*``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import time
+from dataclasses import asdict, dataclass
+from dataclasses import fields as dc_fields
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import WoodcamError, require
+
+MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
+SPEC_NAME = "rings_spec.json"
+WEIGHTS_NAME = "rings.pt"
+LOG_NAME = "rings_train_log.csv"
+
+
+@dataclass(frozen=True)
+class RingNetSpec:
+    """Every hyper-parameter of the ring net and its training run (JSON round trip).
+
+    Attributes
+    ----------
+    seed : seeds the synthetic blocks, the augmentation, the weights and the batches.
+    n_blocks, face_px : training cubes (six faces each) and their face size (px).
+    target_sigma_px : width of the target line ``exp(-(d / sigma)^2)``.
+    width : channels of the first level (doubled per level, three levels).
+    crop_px, batch, steps, lr : training crops, batch size, Adam steps and learning rate (cosine decay).
+    max_train_s : stop after this many seconds of training (the machine is shared).
+    """
+
+    seed: int = 0
+    n_blocks: int = 8
+    face_px: int = 192
+    target_sigma_px: float = 1.2
+    width: int = 8
+    crop_px: int = 64
+    batch: int = 8
+    steps: int = 1500
+    lr: float = 2e-3
+    max_train_s: float = 660.0
+    log_every: int = 25
+
+    @classmethod
+    def load(cls, path) -> RingNetSpec:
+        d = json.loads(Path(path).read_text())
+        names = {f.name for f in dc_fields(cls)}
+        bad = set(d) - names
+        if bad:
+            raise WoodcamError(f"ring net spec {str(path)!r} has unknown keys {sorted(bad)}; allowed: {sorted(names)}")
+        return cls(**d)
+
+    def save(self, path) -> None:
+        Path(path).write_text(json.dumps(asdict(self), indent=1))
+
+
+def _net(spec: RingNetSpec):
+    torch = require("torch", "learn", "the learned ring detector")
+    nn = torch.nn
+
+    def block(i, o):
+        return nn.Sequential(nn.Conv2d(i, o, 3, padding=1), nn.BatchNorm2d(o), nn.ReLU(inplace=True),
+                             nn.Conv2d(o, o, 3, padding=1), nn.BatchNorm2d(o), nn.ReLU(inplace=True))
+
+    class RingUNet(nn.Module):
+        """Three-level U-Net, ``(b, 1, h, w)`` -> logits ``(b, 1, h, w)``; h, w multiples of 4."""
+
+        def __init__(self, w: int):
+            super().__init__()
+            self.e1, self.e2, self.e3 = block(1, w), block(w, 2 * w), block(2 * w, 4 * w)
+            self.up2, self.d2 = nn.ConvTranspose2d(4 * w, 2 * w, 2, stride=2), block(4 * w, 2 * w)
+            self.up1, self.d1 = nn.ConvTranspose2d(2 * w, w, 2, stride=2), block(2 * w, w)
+            self.out = nn.Conv2d(w, 1, 1)
+            self.pool = nn.MaxPool2d(2)
+
+        def forward(self, x):
+            a = self.e1(x)
+            b = self.e2(self.pool(a))
+            c = self.e3(self.pool(b))
+            b = self.d2(torch.cat([self.up2(c), b], 1))
+            a = self.d1(torch.cat([self.up1(b), a], 1))
+            return self.out(a)
+
+    return RingUNet(spec.width)
+
+
+# -- training data ------------------------------------------------------------------------------------
+
+def _augment(photo: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Photo-style augmentation of an ``(h, w, 3)`` uint8 face: colour and exposure, lighting
+    gradient, pores and ray streaks, blur, noise, JPEG."""
+    import io
+
+    from PIL import Image
+    from scipy import ndimage
+
+    h, w, _ = photo.shape
+    a = photo.astype(np.float32) / 255.0
+    a = a * rng.uniform(0.6, 1.3) * rng.uniform(0.85, 1.15, 3)                 # exposure, white balance
+    a = (a - a.mean()) * rng.uniform(0.5, 1.5) + a.mean()                       # contrast
+    rr, cc = np.meshgrid(np.linspace(-1, 1, h), np.linspace(-1, 1, w), indexing="ij")
+    g = 1 + rng.uniform(-0.25, 0.25) * rr + rng.uniform(-0.25, 0.25) * cc - rng.uniform(0, 0.3) * (rr ** 2 + cc ** 2) / 2
+    a = a * g[..., None]
+    if rng.uniform() < 0.6:                                                     # pores: dark specks
+        n = int(rng.uniform(0.002, 0.02) * h * w)
+        idx = rng.integers(0, [h, w], size=(n, 2))
+        dark = np.zeros((h, w), np.float32)
+        dark[idx[:, 0], idx[:, 1]] = rng.uniform(0.2, 0.6, n)
+        dark = ndimage.gaussian_filter(dark, rng.uniform(0.5, 1.2)) * 3
+        a = a * (1 - np.clip(dark, 0, 0.7))[..., None]
+    if rng.uniform() < 0.4:                                                     # rays: short streaks
+        streak = np.zeros((h, w), np.float32)
+        n = int(rng.uniform(10, 60))
+        idx = rng.integers(0, [h, w], size=(n, 2))
+        streak[idx[:, 0], idx[:, 1]] = 1
+        ang = rng.uniform(0, 180)
+        k = np.zeros((15, 15), np.float32)
+        k[7, :] = 1
+        k = ndimage.rotate(k, ang, reshape=False, order=1)
+        streak = ndimage.convolve(streak, k / k.sum())
+        a = a * (1 + rng.uniform(-0.3, 0.3) * np.clip(streak * 8, 0, 1))[..., None]
+    if rng.uniform() < 0.5:
+        a = ndimage.gaussian_filter(a, (rng.uniform(0.3, 1.5),) * 2 + (0,))
+    a = a + rng.uniform(0, 0.03) * rng.standard_normal(a.shape).astype(np.float32)
+    out = np.clip(a * 255, 0, 255).astype(np.uint8)
+    if rng.uniform() < 0.5:
+        buf = io.BytesIO()
+        Image.fromarray(out).save(buf, format="JPEG", quality=int(rng.integers(40, 95)))
+        out = np.asarray(Image.open(buf).convert("RGB"))
+    return out
+
+
+def augment_photo(photo: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Photo-style augmentation (module docstring) of an ``(h, w, 3)`` uint8 face photo."""
+    return _augment(photo, rng)
+
+
+def net_input(photo: np.ndarray) -> np.ndarray:
+    """``(h, w)`` float32: what the net sees of a photo (flattened, contrast-normalised luminance)."""
+    from .rings import _normalise, luminance
+
+    lum = luminance(photo)
+    return _normalise(lum, sigma=0.5 * max(lum.shape)).astype(np.float32)
+
+
+def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, progress: bool = True) -> dict:
+    """Train the ring net of ``spec`` from scratch on inputs ``x (n, h, w)`` (:func:`net_input`)
+    and targets ``y (n, h, w)`` in [0, 1] (made by :func:`woodcam.synth.ring_training_faces`);
+    write ``rings_spec.json``, ``rings.pt`` and ``rings_train_log.csv`` to ``out_dir``.
+    Returns ``{"steps", "train_s", "final_loss", "params"}``."""
+    torch = require("torch", "learn", "training the ring net")
+    from tqdm.auto import tqdm
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    torch.manual_seed(spec.seed)
+    torch.set_num_threads(1)           # the machine is shared; one thread also keeps runs repeatable
+    rng = np.random.default_rng([spec.seed, 1])
+    net = _net(spec)
+    n_params = sum(p.numel() for p in net.parameters())
+    opt = torch.optim.Adam(net.parameters(), lr=spec.lr)
+    sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, spec.steps, eta_min=spec.lr * 0.05)
+    pos_weight = torch.tensor(float((1 - y.mean()) / max(y.mean(), 1e-6)) ** 0.5)
+    loss_fn = torch.nn.BCEWithLogitsLoss(pos_weight=pos_weight)
+    n, h, w = x.shape
+    c = spec.crop_px
+    t0 = time.perf_counter()
+    rows, loss_avg, step = [], None, 0
+    bar = tqdm(range(spec.steps), desc="training ring net", unit="step", disable=not progress)
+    for step in bar:
+        idx = rng.integers(0, n, spec.batch)
+        r0 = rng.integers(0, h - c + 1, spec.batch)
+        c0 = rng.integers(0, w - c + 1, spec.batch)
+        xb = np.stack([x[i, a:a + c, b:b + c] for i, a, b in zip(idx, r0, c0)])
+        yb = np.stack([y[i, a:a + c, b:b + c] for i, a, b in zip(idx, r0, c0)])
+        flip = rng.integers(0, 4)
+        xb, yb = np.rot90(xb, flip, axes=(1, 2)), np.rot90(yb, flip, axes=(1, 2))
+        xt = torch.from_numpy(np.ascontiguousarray(xb)[:, None])
+        yt = torch.from_numpy(np.ascontiguousarray(yb)[:, None])
+        loss = loss_fn(net(xt), yt)
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+        sched.step()
+        v = float(loss.detach())
+        loss_avg = v if loss_avg is None else 0.98 * loss_avg + 0.02 * v
+        if step % spec.log_every == 0:
+            rows.append({"step": step, "loss": v, "loss_avg": loss_avg, "seconds": time.perf_counter() - t0})
+            bar.set_postfix(loss=f"{loss_avg:.4f}")
+        if time.perf_counter() - t0 > spec.max_train_s:
+            break
+    train_s = time.perf_counter() - t0
+    spec.save(out / SPEC_NAME)
+    tmp = out / f".{WEIGHTS_NAME}.tmp"
+    torch.save({k: v.detach().clone() for k, v in net.state_dict().items()}, tmp)
+    tmp.replace(out / WEIGHTS_NAME)
+    with open(out / LOG_NAME, "w", newline="") as fh:
+        wr = csv.DictWriter(fh, ["step", "loss", "loss_avg", "seconds"])
+        wr.writeheader()
+        wr.writerows(rows)
+    return {"steps": step + 1, "train_s": train_s, "final_loss": loss_avg, "params": n_params}
+
+
+# -- inference ---------------------------------------------------------------------------------------
+
+_CACHE: dict = {}
+
+
+def load_ring_net(models_dir=MODELS_DIR):
+    """The trained net (eval mode) from ``models_dir``; cached per folder."""
+    torch = require("torch", "learn", "the learned ring detector")
+    key = str(Path(models_dir).resolve())
+    if key not in _CACHE:
+        path = Path(models_dir) / WEIGHTS_NAME
+        if not path.is_file():
+            raise WoodcamError(f"no trained ring net at {str(path)!r}; train one with "
+                               f"'woodcam train rings --out {models_dir}'")
+        spec = RingNetSpec.load(Path(models_dir) / SPEC_NAME)
+        net = _net(spec)
+        net.load_state_dict(torch.load(path, map_location="cpu", weights_only=True))
+        net.eval()
+        _CACHE[key] = net
+    return _CACHE[key]
+
+
+def ring_probability(photo: np.ndarray, models_dir=MODELS_DIR) -> np.ndarray:
+    """``(h, w)`` float32 in [0, 1]: the net's ring-line probability on a face photo."""
+    torch = require("torch", "learn", "the learned ring detector")
+    x = net_input(photo)
+    h, w = x.shape
+    ph, pw = (-h) % 4, (-w) % 4
+    x = np.pad(x, ((0, ph), (0, pw)), mode="reflect")
+    with torch.no_grad():
+        p = torch.sigmoid(load_ring_net(models_dir)(torch.from_numpy(x)[None, None]))[0, 0].numpy()
+    return p[:h, :w].astype(np.float32)
+
+
+def detect_rings_learned(photo: np.ndarray, *, px_per_mm: float | None = None, name: str = "face",
+                         models_dir=MODELS_DIR):
+    """Rings on one face photo by the learned net (module docstring); a RingDetection."""
+    from scipy import ndimage
+
+    from .rings import (
+        MIN_RING_AREA,
+        RING_MAP_SIGMA_MM,
+        RingDetection,
+        RingTrace,
+        _contour_runs,
+        detect_rings,
+        ring_map_from_traces,
+    )
+
+    base = detect_rings(photo, px_per_mm=px_per_mm, name=name)      # orientation and spacing
+    p = ring_probability(photo, models_dir)
+    pr = ndimage.gaussian_filter(p, 1.0, order=(1, 0))
+    pc = ndimage.gaussian_filter(p, 1.0, order=(0, 1))
+    sn, cn = np.sin(base.normal_rad), np.cos(base.normal_rad)
+    dn = pr * sn + pc * cn                                              # slope across the rings
+    # curvature across the rings: the ridge is where the slope is 0 and the curvature negative
+    # (a maximum of p; the slope is 0 in the valleys between rings too)
+    d2 = (ndimage.gaussian_filter(p, 1.0, order=(2, 0)) * sn * sn
+          + 2 * ndimage.gaussian_filter(p, 1.0, order=(1, 1)) * sn * cn
+          + ndimage.gaussian_filter(p, 1.0, order=(0, 2)) * cn * cn)
+    keep = (ndimage.gaussian_filter(p, 1.0) >= 0.35) & (d2 < 0)
+    polys = _contour_runs(dn, keep, 0.5 * base.wavelength_px)
+    traces = [RingTrace(q) for q in polys]
+    h, w = p.shape
+    warnings = []
+    if float((p > 0.35).mean()) < 0.02 * MIN_RING_AREA or not traces:
+        warnings.append(f"face {name!r}: the learned detector found no rings; check the photo")
+    sigma_px = RING_MAP_SIGMA_MM * (px_per_mm if px_per_mm else 256 / 50.0)
+    return RingDetection(traces, ring_map_from_traces(traces, (h, w), sigma_px), base.normal_rad,
+                         base.wavelength_px, p, p > 0.35, "learned", warnings)

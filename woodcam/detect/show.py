@@ -1,0 +1,59 @@
+"""The check picture of a detection: every face's photo with the rings and knots found on it.
+
+Faces are laid out as the unfolded cross of ``docs/conventions.md`` (left | front | right | back,
+top above front, bottom below front), enlarged ``zoom`` times so one-pixel lines stay visible.
+Drawn on each photo: the ring traces (red), the knot masks' outlines (yellow) and, when a
+reference ring map is given (e.g. Mokume's U-Net map), its ridge (cyan dots).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import WoodcamError
+from ..frames import unfold_cross
+
+TRACE_RGB = (230, 30, 30)
+KNOT_RGB = (255, 220, 0)
+REFERENCE_RGB = (0, 230, 255)
+
+
+def face_picture(face, zoom: int = 2, reference_map: np.ndarray | None = None) -> np.ndarray:
+    """``(h * zoom, w * zoom, 3)`` uint8: one face's photo with its traces, knots and reference."""
+    from PIL import Image, ImageDraw
+    from scipy import ndimage
+
+    from .score import reference_ridge
+
+    h, w = face.shape
+    base = face.photo if face.photo is not None else np.full((h, w, 3), 40, np.uint8)
+    im = Image.fromarray(np.asarray(base, np.uint8)).resize((w * zoom, h * zoom), Image.NEAREST)
+    a = np.asarray(im).copy()
+    if reference_map is not None:
+        rr, cc = reference_ridge(reference_map).T
+        a[rr * zoom + zoom // 2, cc * zoom + zoom // 2] = REFERENCE_RGB
+    mask = face.extras.get("knot_mask")
+    if mask is not None and np.any(mask):
+        big = np.kron(np.asarray(mask, np.uint8), np.ones((zoom, zoom), np.uint8)).astype(bool)
+        edge = big & ~ndimage.binary_erosion(big, iterations=max(1, zoom // 2))
+        a[edge] = KNOT_RGB
+    im = Image.fromarray(a)
+    draw = ImageDraw.Draw(im)
+    for t in face.traces:
+        xy = ((t.points_px[:, ::-1] + 0.5) * zoom).ravel().tolist()
+        draw.line(xy, fill=TRACE_RGB, width=max(1, zoom // 2))
+    return np.asarray(im)
+
+
+def rings_picture(block, zoom: int = 2, references: dict | None = None) -> np.ndarray:
+    """The unfolded cross of :func:`face_picture` of every face of ``block`` (uint8 RGB).
+
+    ``references``: optional face -> reference ring map ``(h, w)`` drawn as its ridge.
+    """
+    if not block.faces:
+        raise WoodcamError(f"block {block.name!r} has no faces to show")
+    if zoom < 1:
+        raise WoodcamError(f"zoom must be a whole number >= 1; got {zoom!r}")
+    refs = references or {}
+    images = {n: face_picture(f, zoom, refs.get(n)) for n, f in block.faces.items()}
+    return unfold_cross(images, block.size_mm, background=24)

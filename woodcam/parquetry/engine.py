@@ -1,0 +1,343 @@
+"""The parquetry pipeline of seed 002 (sec. 3.2-3.4): targets cut into patches, each matched on
+the veneer sheets under single use, seams cut, the panel rendered.
+
+Target images are resampled to the working resolution ``px_per_mm``; panel pixel ``(r, c)``
+covers ``[c, c + 1] x [r, r + 1] / px_per_mm`` mm (x right, y down, origin top-left, as SVG).
+The panel is an integer number of the finest cells (``patch_mm``): its short side is rounded
+to whole cells (Table 1: 360 mm -> 26 x 14 = 364 mm), the long side cropped centrally.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import WoodcamError
+from .features import edge, features, intensity, match_histogram
+from .job import ParquetryParams
+from .matching import Match, SheetBank
+from .veneers import Veneer
+
+
+@dataclass
+class Patch:
+    """One placed patch.
+
+    id : unique over all targets of a run (engraved on the pieces)
+    target : index of its target
+    row, col, cells : its square in finest cells (top-left cell, side in cells)
+    grown : ``(y0, x0, y1, x1)`` panel pixels of the matched window (square + overlap, clipped)
+    match : sheet, rotation, anchor and SSD of eq. 4
+    cost_px : ``match.cost`` per pixel of the window
+    """
+
+    id: int
+    target: int
+    row: int
+    col: int
+    cells: int
+    grown: tuple[int, int, int, int]
+    match: Match
+    cost_px: float
+
+    def target_to_sheet(self, bank: SheetBank, px_per_mm: float) -> np.ndarray:
+        """``(2, 3)`` affine taking panel mm (x, y) to sheet mm (x, y) for this patch."""
+        mat, _ = bank.rotation(self.match.sheet, self.match.rot)
+        ainv = np.linalg.inv(mat[:, :2])
+        y0, x0 = self.grown[:2]
+        # panel px p -> canvas px p - (x0, y0) + (mx, my) -> sheet px ainv (q - t)
+        off = np.array([self.match.x - x0, self.match.y - y0], float)
+        lin = ainv
+        # mm: p = m ppm - 0.5 ; sheet_mm = (sheet_px + 0.5) / ppm
+        tr = ainv @ (off - 0.5 - mat[:, 2]) + 0.5
+        out = np.empty((2, 3))
+        out[:, :2] = lin
+        out[:, 2] = tr / px_per_mm
+        return out
+
+
+@dataclass
+class Parquetry:
+    """One assembled target.
+
+    target_rgb : (H, W, 3) float32 the target cropped and resampled to the panel
+    matched : (H, W) float32 the histogram-matched target intensity (eq. 2)
+    target_feats : (H, W, 2) float32 its features (eq. 1 with eq. 2's intensity)
+    cells : (rows, cols) int: patch id of every finest cell, -1 where none was placed
+    labels : (H, W) int: patch id of every panel pixel after the seams, -1 where none
+    render, baseline : (H, W, 3) float32 the panel in wood, and each piece's mean colour
+    seams_v, seams_h : seam curves (see :mod:`woodcam.parquetry.seams`) or None
+    """
+
+    index: int
+    name: str
+    target_rgb: np.ndarray
+    matched: np.ndarray
+    target_feats: np.ndarray
+    cell_px: int
+    cells: np.ndarray
+    patches: list[Patch] = field(default_factory=list)
+    labels: np.ndarray | None = None
+    render: np.ndarray | None = None
+    baseline: np.ndarray | None = None
+    seams_v: list | None = None
+    seams_h: list | None = None
+
+    @property
+    def size_mm(self) -> tuple[float, float]:
+        return self.cells.shape[1] * self.cell_px, self.cells.shape[0] * self.cell_px
+
+    @property
+    def complete(self) -> bool:
+        return bool((self.cells >= 0).all())
+
+
+@dataclass
+class ParquetryRun:
+    """Everything a run made: the targets' panels, the sheets, the bank (consumed wood), timing."""
+
+    params: ParquetryParams
+    veneers: list[Veneer]
+    bank: SheetBank
+    panels: list[Parquetry]
+    patches: list[Patch]
+    placed: int
+    planned: int
+    message: str
+    match_seconds: float
+    cpu_seconds: float
+
+    @property
+    def complete(self) -> bool:
+        return self.placed == self.planned
+
+
+def saliency(grey: np.ndarray) -> np.ndarray:
+    """Fine-grained centre-surround saliency ``(h, w)`` (after Montabone & Soto 2010, the
+    paper's choice): the sum over scales of |I - Gaussian_sigma(I)|."""
+    import cv2
+
+    g = np.asarray(grey, np.float32)
+    s = np.zeros_like(g)
+    for sigma in (1.0, 2.0, 4.0, 8.0):
+        s += np.abs(g - cv2.GaussianBlur(g, (0, 0), sigma))
+    return s
+
+
+def prepare_target(rgb: np.ndarray, params: ParquetryParams, source_values: np.ndarray,
+                   index: int = 0, name: str = "target") -> Parquetry:
+    """Crop/resample a target to whole cells, histogram-match it (eq. 2), compute eq. 1."""
+    import cv2
+
+    rgb = np.asarray(rgb, np.float32)
+    if rgb.ndim == 2:
+        rgb = np.repeat(rgb[..., None], 3, axis=2)
+    cell = params.patch_px
+    h, w = rgb.shape[:2]
+    short_cells = max(1, round(params.image_size_mm / params.patch_mm))
+    scale = short_cells * cell / min(h, w)
+    if h <= w:
+        rows, cols = short_cells, max(1, int(w * scale + 1e-6) // cell)
+    else:
+        rows, cols = max(1, int(h * scale + 1e-6) // cell), short_cells
+    nh, nw = round(h * scale), round(w * scale)
+    nh, nw = max(nh, rows * cell), max(nw, cols * cell)
+    img = cv2.resize(rgb, (nw, nh), interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_CUBIC)
+    y0, x0 = (nh - rows * cell) // 2, (nw - cols * cell) // 2
+    img = np.clip(img[y0:y0 + rows * cell, x0:x0 + cols * cell], 0, 1).astype(np.float32)
+    grey = intensity(img)
+    matched = match_histogram(grey, source_values, params.w_hist)
+    f = np.stack([params.w_intens * matched, params.w_edge * edge(grey)], axis=-1).astype(np.float32)
+    return Parquetry(index, name, img, matched, f, cell, np.full((rows, cols), -1, np.int64))
+
+
+class _OutOfWood(Exception):
+    pass
+
+
+def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer], params: ParquetryParams | None = None, *,
+                    names: list[str] | None = None, progress: bool = False,
+                    seams: bool = True) -> ParquetryRun:
+    """Rebuild each target from the veneers (seed 002, sec. 3).
+
+    Parameters
+    ----------
+    targets : list of (h, w, 3) float RGB in [0, 1] (or one array)
+    veneers : list of :class:`Veneer` (any resolution; resampled to ``params.px_per_mm``)
+    params : :class:`ParquetryParams` (Table 1 defaults)
+    progress : tqdm bar over the patches
+    seams : cut optimal seams in the overlaps (eq. 8-9); False keeps square patches
+
+    Returns
+    -------
+    ParquetryRun ; when the wood runs out, ``complete`` is False, ``message`` says how many
+    patches were placed, and the panels hold what was made (unplaced cells are -1).
+    """
+    params = (params or ParquetryParams()).check()
+    if isinstance(targets, np.ndarray):
+        targets = [targets]
+    if not targets:
+        raise WoodcamError("targets must hold at least one image; got none")
+    if not veneers:
+        raise WoodcamError("veneers must hold at least one sheet; got none (pass --veneer or --veneer-from)")
+    ids = [v.id for v in veneers]
+    if len(set(ids)) != len(ids):
+        raise WoodcamError(f"veneer ids must be unique; got {ids}")
+    sheets = [v.resampled(params.px_per_mm) for v in veneers]
+    top_cells = 2 ** params.n_adaptive
+    for v in sheets:
+        h, w = v.rgb.shape[:2]
+        if min(h, w) < params.patch_px + 2 * params.overlap_px:
+            raise WoodcamError(
+                f"veneer {v.id!r} is {w / params.px_per_mm:.1f} x {h / params.px_per_mm:.1f} mm, "
+                f"smaller than one patch with its overlap ({(params.patch_px + 2 * params.overlap_px) / params.px_per_mm:g} mm); "
+                "use larger sheets or a smaller patch_mm")
+    grey = [intensity(v.rgb) for v in sheets]
+    src_vals = np.concatenate([g[v.mask] for g, v in zip(grey, sheets)])
+    if src_vals.size > 2_000_000:   # the CDF needs no more samples than this
+        src_vals = src_vals[np.random.default_rng(0).choice(src_vals.size, 2_000_000, replace=False)]
+    bank = SheetBank(grey, [v.mask for v in sheets], params.w_intens, params.w_edge, params.n_rot,
+                     kerf_px=params.kerf * params.px_per_mm, mode=params.mode,
+                     coarse_factor=params.coarse_factor, top_k=params.top_k,
+                     single_use=params.single_use)
+    names = names or [f"target{k}" for k in range(len(targets))]
+    panels = [prepare_target(t, params, src_vals, k, names[k]) for k, t in enumerate(targets)]
+
+    # Priority queue (sec. 3.3, Fig. 6): top-level squares of 2**n_adaptive cells.
+    queue = []
+    for p in panels:
+        rows, cols = p.cells.shape
+        sal = saliency(p.matched)
+        cy, cx = rows * p.cell_px / 2.0, cols * p.cell_px / 2.0
+        for r in range(0, rows, top_cells):
+            for c in range(0, cols, top_cells):
+                n = min(top_cells, rows - r, cols - c)
+                y0, x0 = r * p.cell_px, c * p.cell_px
+                y1, x1 = y0 + n * p.cell_px, x0 + n * p.cell_px
+                if params.priority == "saliency":
+                    key = -float(sal[y0:y1, x0:x1].mean())
+                else:
+                    key = float(np.hypot((y0 + y1) / 2 - cy, (x0 + x1) / 2 - cx))
+                queue.append(((p.index, key) if params.queue == "sequential" else (key, p.index),
+                              p.index, r, c, n))
+    queue.sort(key=lambda q: q[0])
+    planned_cells = sum(p.cells.size for p in panels)
+
+    o = params.overlap_px
+    patches: list[Patch] = []
+
+    def window(p: Parquetry, r: int, c: int, n: int):
+        H, W = p.matched.shape
+        y0, x0 = r * p.cell_px - o, c * p.cell_px - o
+        y1, x1 = (r + n) * p.cell_px + o, (c + n) * p.cell_px + o
+        return max(0, y0), max(0, x0), min(H, y1), min(W, x1)
+
+    def place(p: Parquetry, r: int, c: int, n: int) -> None:
+        g = window(p, r, c, n)
+        tmpl = np.ascontiguousarray(p.target_feats[g[0]:g[2], g[1]:g[3]])
+        m = bank.best(tmpl)
+        if n > 1 and n % 2 == 0:
+            h2 = n // 2
+            kids = [(r + dr, c + dc) for dr in (0, h2) for dc in (0, h2)]
+            tot = area = 0.0
+            ok = True
+            for kr, kc in kids:
+                kg = window(p, kr, kc, h2)
+                km = bank.best(np.ascontiguousarray(p.target_feats[kg[0]:kg[2], kg[1]:kg[3]]))
+                if km is None:
+                    ok = False
+                    break
+                a = (kg[2] - kg[0]) * (kg[3] - kg[1])
+                tot += km.cost
+                area += a
+            parent_px = (g[2] - g[0]) * (g[3] - g[1])
+            # Split when the four are better by more than w_adaptive (sec. 3.3, Fig. 11).
+            if ok and (m is None or params.w_adaptive * tot / area < m.cost / parent_px):
+                for kr, kc in kids:
+                    place(p, kr, kc, h2)
+                return
+        if m is None:
+            raise _OutOfWood
+        th, tw = tmpl.shape[:2]
+        bank.take(m, th, tw)
+        pid = len(patches)
+        patches.append(Patch(pid, p.index, r, c, n, g, m, m.cost / (th * tw)))
+        p.patches.append(patches[-1])
+        p.cells[r:r + n, c:c + n] = pid
+
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=planned_cells, desc="matching patches", unit="cell")
+    t0, c0 = time.perf_counter(), time.process_time()
+    message = ""
+    try:
+        for _, t, r, c, n in queue:
+            before = len(patches)
+            place(panels[t], r, c, n)
+            if bar is not None:
+                bar.update(sum(q.cells ** 2 for q in patches[before:]))
+    except _OutOfWood:
+        placed = sum(int((p.cells >= 0).sum()) for p in panels)
+        message = (f"the veneers ran out of free wood: placed {len(patches)} patches covering "
+                   f"{placed} of {planned_cells} cells; the rest of the panel is left empty. "
+                   "Add veneer sheets or use fewer/larger patches")
+    finally:
+        if bar is not None:
+            bar.close()
+    match_s, cpu_s = time.perf_counter() - t0, time.process_time() - c0
+    placed_cells = sum(int((p.cells >= 0).sum()) for p in panels)
+    for p in panels:
+        finish_panel(p, patches, bank, sheets, params, seams=seams)
+    return ParquetryRun(params, sheets, bank, panels, patches, placed_cells, planned_cells,
+                        message, match_s, cpu_s)
+
+
+def finish_panel(p: Parquetry, patches: list[Patch], bank: SheetBank, sheets: list[Veneer],
+                 params: ParquetryParams, seams: bool = True) -> None:
+    """Seams (eq. 8-9) when the panel is complete, then labels, render and baseline."""
+    from .seams import cut_seams, straight_labels
+
+    H, W = p.matched.shape
+    windows = {q.id: (q.grown, bank.patch_pixels(q.match, q.grown[2] - q.grown[0], q.grown[3] - q.grown[1]))
+               for q in p.patches}
+    if seams and p.complete and params.overlap_px > 0:
+        p.labels, p.seams_v, p.seams_h = cut_seams(p, windows, params)
+    else:
+        p.labels = straight_labels(p)
+    render = np.zeros((H, W, 3), np.float32)
+    for q in p.patches:
+        (y0, x0, y1, x1) = q.grown
+        col = bank.warp_window(sheets[q.match.sheet].rgb, q.match, y1 - y0, x1 - x0)
+        sel = p.labels[y0:y1, x0:x1] == q.id
+        render[y0:y1, x0:x1][sel] = col[sel]
+    p.render = render
+    base = np.zeros_like(render)
+    lab = p.labels.ravel()
+    ok = lab >= 0
+    if ok.any():
+        n = int(lab.max()) + 1
+        cnt = np.bincount(lab[ok], minlength=n)
+        flat = render.reshape(-1, 3)
+        means = np.stack([np.bincount(lab[ok], weights=flat[ok, k], minlength=n) for k in range(3)], 1)
+        means /= np.maximum(cnt, 1)[:, None]
+        base.reshape(-1, 3)[ok] = means[lab[ok]]
+    p.baseline = base
+
+
+def feature_cost(p: Parquetry, image: np.ndarray, params: ParquetryParams) -> float:
+    """Eq. 8 per pixel: mean over the panel of ``|F(R) - F(I_T)|^2`` with ``F`` of eq. 1 (the
+    target's intensity histogram-matched, eq. 2). ``image (H, W, 3)`` is a render or baseline."""
+    g = intensity(image)
+    f = features(g, params.w_intens, params.w_edge)
+    return float(((f - p.target_feats) ** 2).sum(axis=2).mean())
+
+
+def ssim_vs_matched(p: Parquetry, image: np.ndarray) -> float:
+    """SSIM (scikit-image) between an image's intensity and the matched target (eq. 2)."""
+    from skimage.metrics import structural_similarity
+
+    return float(structural_similarity(intensity(image), p.matched, data_range=1.0))

@@ -1,0 +1,258 @@
+"""Parquetry parameters (seed 002, Table 1) and the job file of the paper's reference code.
+
+The job layout is WoodPixel's JSON::
+
+    {"source_textures": [{"texture": "scan.jpg", "mask": "mask.png", "id": "oak", "scale": 1.0,
+                          "dpi": 300.0}],
+     "targets": [{"filename": "eye.png", "scale": 1.0, "dpi": 300.0}],
+     "num_source_rotations": 15, "patch_levels": 0, "patch_quality_factor": 1.2,
+     "weight_intensity": 0.5, "weight_sobel": 0.5, "histogram_matching": 0.5,
+     "sort_patches_saliency": true, ...}
+
+with woodcam's own keys (Table 1 names in mm, fabrication, veneers sliced from blocks) under
+``"woodcam"``. Relative paths are relative to the job file. A texture's resolution is
+``dpi / 25.4 * scale`` px/mm.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+from typing import Literal
+
+from ..errors import WoodcamError
+
+Priority = Literal["saliency", "center"]
+QueueOrder = Literal["interleaved", "sequential"]
+
+
+@dataclass
+class ParquetryParams:
+    """Every knob of a parquetry run; defaults are the paper's Table 1 where it has one.
+
+    w_intens, w_edge : feature weights of eq. 1 (Table 1: 0.5, 0.5)
+    w_hist : histogram-matching blend of eq. 2 (Table 1: 0.5)
+    image_size_mm : the panel's shorter side (Table 1: 360 mm)
+    patch_mm : smallest patch side (Table 1: 14 mm)
+    n_adaptive, w_adaptive : adaptive levels and quality factor (Table 1: 0, 1.2); a patch of
+        side ``patch_mm * 2**L`` splits into four when ``w_adaptive * (sum of their costs)`` is
+        below its own cost
+    n_rot : rotated copies of each sheet (sec. 3.2: 15)
+    priority : "saliency" (fine-grained centre-surround saliency) or "center" (Fig. 6)
+    queue : several targets "interleaved" by saliency or "sequential" (Fig. 14)
+    px_per_mm : working resolution of sheets and target for matching
+    overlap_mm : how far patches grow into their neighbours for seam cutting (eq. 8-9); None:
+        ``min(patch_mm / 4, (patch_mm - min_piece_mm) / 2)``, which keeps every fragment at
+        least ``min_piece_mm`` wide by construction; 0: square patches, no seams
+    min_piece_mm : narrowest fragment that can be cut and handled (the paper's 5 mm bound)
+    tool_diameter_mm : router bit; concave corners are at least its radius
+    kerf_mm : wood lost between two pieces on a sheet (default: the tool diameter)
+    mode : "fast" (coarse-to-fine, exact re-ranking) or "exhaustive"
+    coarse_factor, top_k : the fast mode's pyramid factor and re-ranked candidates
+    """
+
+    w_intens: float = 0.5
+    w_edge: float = 0.5
+    w_hist: float = 0.5
+    image_size_mm: float = 360.0
+    patch_mm: float = 14.0
+    n_adaptive: int = 0
+    w_adaptive: float = 1.2
+    n_rot: int = 15
+    priority: Priority = "saliency"
+    queue: QueueOrder = "interleaved"
+    px_per_mm: float = 4.0
+    overlap_mm: float | None = None
+    min_piece_mm: float = 5.0
+    tool_diameter_mm: float = 2.0
+    kerf_mm: float | None = None
+    mode: Literal["fast", "exhaustive"] = "fast"
+    coarse_factor: int = 4
+    top_k: int = 12
+    single_use: bool = True
+
+    def check(self) -> ParquetryParams:
+        """Validate at the door; returns self."""
+        for name in ("w_intens", "w_edge", "w_hist"):
+            v = getattr(self, name)
+            if not 0.0 <= v <= 1.0:
+                raise WoodcamError(f"{name} must be in [0, 1] (eq. 1-2 of seed 002); got {v}")
+        if self.w_intens + self.w_edge <= 0:
+            raise WoodcamError("w_intens + w_edge must be > 0; both are 0, nothing would be matched")
+        if self.patch_mm < self.min_piece_mm:
+            raise WoodcamError(
+                f"patch_mm must be at least min_piece_mm = {self.min_piece_mm:g} mm (the smallest "
+                f"piece that can be cut and assembled); got {self.patch_mm:g} mm; use a larger "
+                "--patch-mm or lower --min-piece-mm")
+        if self.image_size_mm < self.patch_mm:
+            raise WoodcamError(f"image_size_mm must be >= patch_mm ({self.patch_mm:g}); got {self.image_size_mm:g}")
+        if self.n_adaptive < 0 or self.w_adaptive <= 0:
+            raise WoodcamError(f"n_adaptive must be >= 0 and w_adaptive > 0; got {self.n_adaptive}, {self.w_adaptive}")
+        if self.priority not in ("saliency", "center"):
+            raise WoodcamError(f"priority must be one of ['saliency', 'center']; got {self.priority!r}")
+        if self.queue not in ("interleaved", "sequential"):
+            raise WoodcamError(f"queue must be one of ['interleaved', 'sequential']; got {self.queue!r}")
+        if self.mode not in ("fast", "exhaustive"):
+            raise WoodcamError(f"mode must be one of ['fast', 'exhaustive']; got {self.mode!r}")
+        if self.px_per_mm <= 0 or self.tool_diameter_mm < 0 or (self.kerf_mm or 0) < 0:
+            raise WoodcamError("px_per_mm must be > 0, tool_diameter_mm and kerf_mm >= 0; got "
+                               f"{self.px_per_mm}, {self.tool_diameter_mm}, {self.kerf_mm}")
+        if self.coarse_factor < 1 or self.top_k < 1:
+            raise WoodcamError(f"coarse_factor and top_k must be >= 1; got {self.coarse_factor}, {self.top_k}")
+        if self.patch_px < 4:
+            raise WoodcamError(f"patch_mm * px_per_mm must give at least 4 px; got {self.patch_px}; "
+                               "raise px_per_mm")
+        o = self.overlap
+        if o < 0 or 2 * o > self.patch_mm - self.min_piece_mm + 1e-9:
+            raise WoodcamError(
+                f"overlap_mm must be in [0, (patch_mm - min_piece_mm) / 2 = "
+                f"{(self.patch_mm - self.min_piece_mm) / 2:g}] so fragments stay >= min_piece_mm wide; got {o:g}")
+        return self
+
+    @property
+    def overlap(self) -> float:
+        """Overlap in mm (see ``overlap_mm``)."""
+        if self.overlap_mm is not None:
+            return float(self.overlap_mm)
+        return max(0.0, min(self.patch_mm / 4.0, (self.patch_mm - self.min_piece_mm) / 2.0))
+
+    @property
+    def kerf(self) -> float:
+        return self.tool_diameter_mm if self.kerf_mm is None else float(self.kerf_mm)
+
+    @property
+    def patch_px(self) -> int:
+        return round(self.patch_mm * self.px_per_mm)
+
+    @property
+    def overlap_px(self) -> int:
+        return round(self.overlap * self.px_per_mm)
+
+
+# The reference code's keys for Table 1 / sec. 3.2 parameters.
+_PAPER_KEYS = {"num_source_rotations": "n_rot", "patch_levels": "n_adaptive",
+               "patch_quality_factor": "w_adaptive", "weight_intensity": "w_intens",
+               "weight_sobel": "w_edge", "histogram_matching": "w_hist"}
+
+
+@dataclass
+class ParquetryJob:
+    """A job: veneer sources, targets and parameters.
+
+    scans : ``[{"texture", "mask", "id", "scale", "dpi"}]`` as in the paper's layout (paths)
+    blocks : ``[{"spec", "sheets", "width_mm", "height_mm", "thickness_mm", "kerf_mm", "axis"}]``
+        veneers sliced from woodcam blocks / logs (woodcam's extension)
+    mokume : Mokume sample folders used as veneers (their face photos)
+    targets : ``[{"filename", "scale", "dpi"}]``
+    """
+
+    scans: list[dict] = field(default_factory=list)
+    blocks: list[dict] = field(default_factory=list)
+    mokume: list[str] = field(default_factory=list)
+    targets: list[dict] = field(default_factory=list)
+    params: ParquetryParams = field(default_factory=ParquetryParams)
+
+
+def read_job(path: str | Path) -> ParquetryJob:
+    """Read a job file (paper layout + ``"woodcam"`` extras); paths resolved against its folder."""
+    p = Path(path)
+    try:
+        d = json.loads(p.read_text())
+    except (OSError, ValueError) as err:
+        raise WoodcamError(f"job file {str(p)!r} cannot be read as JSON ({err}); pass a "
+                           "WoodPixel-style job (source_textures, targets, ...)") from err
+    if not isinstance(d, dict) or "targets" not in d:
+        raise WoodcamError(f"job file {str(p)!r} must be a JSON object with 'targets' (and "
+                           "'source_textures' or woodcam.blocks); see woodcam.parquetry.job")
+    base = p.parent
+    names = {f.name for f in fields(ParquetryParams)}
+    kw = {}
+    for k, v in d.items():
+        if k in _PAPER_KEYS:
+            kw[_PAPER_KEYS[k]] = v
+        elif k == "sort_patches_saliency":
+            kw["priority"] = "saliency" if v else "center"
+    extra = d.get("woodcam", {}) or {}
+    for k, v in extra.get("params", {}).items():
+        if k not in names:
+            raise WoodcamError(f"job file key woodcam.params.{k} is unknown; known: {sorted(names)}")
+        kw[k] = v
+
+    def _abs(s):
+        return str((base / s).resolve()) if s else s
+
+    scans = [dict(t, texture=_abs(t["texture"]), mask=_abs(t.get("mask")))
+             for t in d.get("source_textures", [])]
+    targets = [dict(t, filename=_abs(t["filename"])) for t in d["targets"]]
+    blocks = list(extra.get("blocks", []))
+    mokume = [_abs(m) for m in extra.get("mokume", [])]
+    return ParquetryJob(scans, blocks, mokume, targets, ParquetryParams(**kw).check())
+
+
+def write_job(job: ParquetryJob, path: str | Path) -> Path:
+    """Write a job file in the paper's layout (woodcam-only keys under ``"woodcam"``), atomically."""
+    from ._io import atomic_write_text
+
+    prm = asdict(job.params)
+    d = {"source_textures": job.scans, "targets": job.targets}
+    for k, name in _PAPER_KEYS.items():
+        d[k] = prm[name]
+    d["sort_patches_saliency"] = job.params.priority == "saliency"
+    d["woodcam"] = {"params": prm, "blocks": job.blocks, "mokume": job.mokume}
+    return atomic_write_text(path, json.dumps(d, indent=2))
+
+
+def job_veneers(job: ParquetryJob, open_stock=None, progress: bool = False) -> list:
+    """The job's veneer sheets: scans (``dpi / 25.4 * scale`` px/mm), Mokume photos and leaves
+    sliced from woodcam blocks (``{"spec", "sheets", "width_mm", "height_mm", "thickness_mm",
+    "kerf_mm", "axis", "species"}``), resampled later to the working resolution.
+
+    open_stock : ``open_stock(spec, species=...) -> Stock`` (``woodcam.open_stock``), needed when
+        the job slices blocks; the stock layer sits above this package, so the caller passes it.
+    """
+    from .veneers import MM_PER_INCH, load_scan, mokume_veneers, slice_veneers
+
+    out = []
+    for t in job.scans:
+        if "texture" not in t:
+            raise WoodcamError(f"source_textures entry {t} needs a 'texture' path")
+        if t.get("px_per_mm") is not None:
+            ppm = float(t["px_per_mm"])
+        elif t.get("dpi") is not None:
+            ppm = float(t["dpi"]) / MM_PER_INCH * float(t.get("scale", 1.0))
+        else:
+            raise WoodcamError(f"source texture {t['texture']!r} needs 'dpi' (or 'px_per_mm'); got neither")
+        out.append(load_scan(t["texture"], px_per_mm=ppm, mask=t.get("mask") or None, id=t.get("id")))
+    for m in job.mokume:
+        out += mokume_veneers(m)
+    for b in job.blocks:
+        if open_stock is None:
+            raise WoodcamError("job_veneers: this job slices blocks; pass open_stock="
+                               "woodcam.open_stock")
+        if "spec" not in b:
+            raise WoodcamError(f"woodcam.blocks entry {b} needs a 'spec' (e.g. builtin:flat-sawn)")
+        stock = open_stock(b["spec"], species=b.get("species"))
+        out += slice_veneers(stock, int(b.get("sheets", 2)),
+                             (float(b.get("width_mm", 600)), float(b.get("height_mm", 400))),
+                             thickness_mm=float(b.get("thickness_mm", 0.6)),
+                             kerf_mm=float(b.get("kerf_mm", 0.4)), px_per_mm=job.params.px_per_mm,
+                             axis=b.get("axis", "y"), progress=progress,
+                             id_prefix=b.get("id") or (stock.spec.replace(":", "-").replace("/", "-").strip("-.")
+                                                       + (f"-{b['species']}" if b.get("species") else "")))
+    return out
+
+
+def job_targets(job: ParquetryJob) -> tuple[list, list[str]]:
+    """The job's target images ``(h, w, 3)`` float RGB and their names (file stems)."""
+    from .veneers import read_image
+
+    imgs, names = [], []
+    for t in job.targets:
+        if "filename" not in t:
+            raise WoodcamError(f"targets entry {t} needs a 'filename'")
+        imgs.append(read_image(t["filename"], "target image"))
+        names.append(Path(t["filename"]).stem)
+    if len(set(names)) != len(names):
+        names = [f"{n}{k}" for k, n in enumerate(names)]
+    return imgs, names

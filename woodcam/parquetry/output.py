@@ -1,0 +1,191 @@
+"""The files of a parquetry run (see :func:`write_parquetry`) and its printed summary."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from ._io import atomic_write_png, atomic_write_text
+from .cutpaths import (
+    Piece,
+    check_piece,
+    panel_outlines,
+    svg_document,
+    transform_outline,
+    write_dxf,
+)
+from .engine import ParquetryRun, feature_cost, ssim_vs_matched
+
+#: Thickness (mm) of the board in panel.glb: 0.6 mm veneer on a 1.5 mm birch ply substrate,
+#: the build-up of seed 002 sec. 3.1.
+PANEL_THICKNESS_MM = 2.1
+
+
+def run_pieces(run: ParquetryRun) -> list[Piece]:
+    """Every placed patch as a :class:`Piece` with outlines and fabricability problems."""
+    ppm = run.params.px_per_mm
+    pieces = []
+    for p in run.panels:
+        outlines = panel_outlines(p, ppm)
+        for q in p.patches:
+            segs = outlines[q.id]
+            sheet = transform_outline(segs, q.target_to_sheet(run.bank, ppm))
+            pc = Piece(q.id, q.match.sheet, segs, sheet)
+            pc.problems = check_piece(segs, run.params.min_piece_mm, run.params.tool_diameter_mm / 2)
+            pieces.append(pc)
+    return pieces
+
+
+def _suffix(run: ParquetryRun, k: int) -> str:
+    return "" if len(run.panels) == 1 else f"_{run.panels[k].name}"
+
+
+def panel_mesh(render: np.ndarray, px_per_mm: float, thickness_mm: float = PANEL_THICKNESS_MM):
+    """The panel as a thin textured board (trimesh): top face (z = thickness) shows ``render``;
+    x right, y away (the panel's top edge at y = height), z up, mm."""
+    import trimesh
+    from PIL import Image
+
+    h, w = render.shape[:2]
+    W, H, T = w / px_per_mm, h / px_per_mm, thickness_mm
+    # Six faces with their own vertices, so the top carries the image and the sides the
+    # colour of the nearest edge pixel column (u, v clamped to the image border).
+    quads = {
+        "top": ([(0, 0, T), (W, 0, T), (W, H, T), (0, H, T)], [(0, 0), (1, 0), (1, 1), (0, 1)]),
+        "bottom": ([(0, 0, 0), (0, H, 0), (W, H, 0), (W, 0, 0)], [(0, 0), (0, 1), (1, 1), (1, 0)]),
+        "front": ([(0, 0, 0), (W, 0, 0), (W, 0, T), (0, 0, T)], [(0, 0), (1, 0), (1, 0), (0, 0)]),
+        "back": ([(W, H, 0), (0, H, 0), (0, H, T), (W, H, T)], [(1, 1), (0, 1), (0, 1), (1, 1)]),
+        "left": ([(0, H, 0), (0, 0, 0), (0, 0, T), (0, H, T)], [(0, 1), (0, 0), (0, 0), (0, 1)]),
+        "right": ([(W, 0, 0), (W, H, 0), (W, H, T), (W, 0, T)], [(1, 0), (1, 1), (1, 1), (1, 0)]),
+    }
+    verts, uvs, faces = [], [], []
+    for corners, uv in quads.values():
+        b = len(verts)
+        verts += corners
+        uvs += uv
+        faces += [(b, b + 1, b + 2), (b, b + 2, b + 3)]
+    img = Image.fromarray((np.clip(render, 0, 1) * 255 + 0.5).astype(np.uint8))
+    mat = trimesh.visual.material.PBRMaterial(baseColorTexture=img, metallicFactor=0.0,
+                                              roughnessFactor=0.8)
+    vis = trimesh.visual.TextureVisuals(uv=np.array(uvs, float), material=mat)
+    return trimesh.Trimesh(np.array(verts, float), np.array(faces), visual=vis, process=False)
+
+
+def summary(run: ParquetryRun) -> dict:
+    """The figures printed and stored in result.json."""
+    prm = run.params
+    out = {"placed_cells": run.placed, "planned_cells": run.planned, "patches": len(run.patches),
+           "complete": run.complete, "message": run.message,
+           "match_seconds": round(run.match_seconds, 3), "match_cpu_seconds": round(run.cpu_seconds, 3),
+           "seconds_per_patch": round(run.match_seconds / max(1, len(run.patches)), 4),
+           "panels": []}
+    for p in run.panels:
+        ok = p.labels >= 0
+        d = {"name": p.name, "size_mm": [p.cells.shape[1] * prm.patch_mm, p.cells.shape[0] * prm.patch_mm],
+             "cells": list(p.cells.shape), "patches": len(p.patches)}
+        if ok.all():
+            d.update(feature_cost=feature_cost(p, p.render, prm),
+                     feature_cost_baseline=feature_cost(p, p.baseline, prm),
+                     ssim=ssim_vs_matched(p, p.render), ssim_baseline=ssim_vs_matched(p, p.baseline),
+                     mean_patch_cost_px=float(np.mean([q.cost_px for q in p.patches])))
+        out["panels"].append(d)
+    return out
+
+
+def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
+                    glb_writer: Callable[..., Path] | None = None, progress: bool = False) -> dict:
+    """Write every file of a run into ``out_dir``; returns ``{"files": [...], "summary": {...},
+    "problems": {...}}``.
+
+    Files: ``render.png`` (the panel in wood), ``baseline.png`` (each piece's mean colour, the
+    paper's Fig. 8 baseline), ``target_matched.png`` (the histogram-matched target, eq. 2),
+    ``assembly.svg`` (outlines and ids on the panel), ``veneer_<id>.svg`` / ``.dxf`` per sheet
+    that gives a piece (cut paths in sheet mm, tool paths, engraved ids), ``result.json``
+    (every patch: region, sheet, rotation, anchor, cost; parameters; figures; fabricability),
+    ``panel.glb`` (the panel as a textured board, when ``glb_writer`` is given: pass
+    ``woodcam.export_glb``, which sits in a sibling layer). Several targets get ``_<name>``
+    suffixes.
+    """
+    import base64
+    import io
+
+    from PIL import Image
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    prm = run.params
+    ppm = prm.px_per_mm
+    files = []
+    pieces = run_pieces(run)
+    by_id = {pc.id: pc for pc in pieces}
+    for k, p in enumerate(run.panels):
+        sfx = _suffix(run, k)
+        files.append(atomic_write_png(out / f"render{sfx}.png", p.render))
+        files.append(atomic_write_png(out / f"baseline{sfx}.png", p.baseline))
+        files.append(atomic_write_png(out / f"target_matched{sfx}.png", np.repeat(p.matched[..., None], 3, 2)))
+        W, H = p.matched.shape[1] / ppm, p.matched.shape[0] / ppm
+        buf = io.BytesIO()
+        Image.fromarray((np.clip(p.render, 0, 1) * 255 + 0.5).astype(np.uint8)).save(buf, format="PNG")
+        bg = (f'<image x="0" y="0" width="{W:.3f}" height="{H:.3f}" preserveAspectRatio="none" '
+              f'href="data:image/png;base64,{base64.b64encode(buf.getvalue()).decode()}"/>')
+        doc = svg_document(W, H, [(q.id, by_id[q.id].outline_panel) for q in p.patches],
+                           background=bg, title=f"woodcam parquetry assembly {p.name}")
+        files.append(atomic_write_text(out / f"assembly{sfx}.svg", doc))
+        if glb_writer is not None:
+            files.append(glb_writer(panel_mesh(p.render, ppm), out / f"panel{sfx}.glb",
+                                    metadata={"kind": "parquetry panel", "units": "mm",
+                                              "size_mm": [W, H, PANEL_THICKNESS_MM]}))
+    sheets_used = sorted({pc.sheet for pc in pieces})
+    it = sheets_used
+    if progress and len(sheets_used) > 1:
+        from tqdm import tqdm
+
+        it = tqdm(sheets_used, desc="writing cut files", unit="sheet")
+    for i in it:
+        v = run.veneers[i]
+        W, H = v.size_mm
+        mine = [(pc.id, pc.outline_sheet) for pc in pieces if pc.sheet == i]
+        files.append(atomic_write_text(out / f"veneer_{v.id}.svg",
+                                       svg_document(W, H, mine, prm.tool_diameter_mm / 2,
+                                                    title=f"woodcam veneer {v.id}")))
+        files.append(write_dxf(out / f"veneer_{v.id}.dxf", H, mine, prm.tool_diameter_mm / 2))
+    summ = summary(run)
+    problems = {pc.id: pc.problems for pc in pieces if pc.problems}
+    result = {
+        "params": {**prm.__dict__, "overlap_mm_used": prm.overlap, "kerf_mm_used": prm.kerf},
+        "summary": summ,
+        "veneers": [{"id": v.id, "source": v.source, "size_mm": list(v.size_mm),
+                     "px_per_mm": v.px_per_mm, "file_svg": f"veneer_{v.id}.svg"} for v in run.veneers],
+        "patches": [{"id": q.id, "target": q.target, "row": q.row, "col": q.col, "cells": q.cells,
+                     "region_mm": [q.col * prm.patch_mm, q.row * prm.patch_mm, q.cells * prm.patch_mm],
+                     "sheet": run.veneers[q.match.sheet].id, "rotation_deg": run.bank.angles_deg[q.match.rot],
+                     "anchor_px": [q.match.x, q.match.y], "cost": q.match.cost, "cost_px": q.cost_px,
+                     "panel_to_sheet_mm": q.target_to_sheet(run.bank, ppm).tolist()}
+                    for q in run.patches],
+        "fabricability": {"pieces": len(pieces), "problems": problems},
+    }
+    files.append(atomic_write_text(out / "result.json", json.dumps(result, indent=1, default=float)))
+    return {"files": [str(f) for f in files], "summary": summ, "problems": problems}
+
+
+def format_summary(summ: dict, problems: dict) -> str:
+    """The lines ``woodcam parquetry`` prints."""
+    lines = []
+    for d in summ["panels"]:
+        line = (f"{d['name']}: {d['cells'][1]} x {d['cells'][0]} cells, {d['size_mm'][0]:g} x "
+                f"{d['size_mm'][1]:g} mm, {d['patches']} patches")
+        if "feature_cost" in d:
+            line += (f"; feature cost/px {d['feature_cost']:.5f} (mean-colour baseline "
+                     f"{d['feature_cost_baseline']:.5f}), SSIM {d['ssim']:.3f} (baseline "
+                     f"{d['ssim_baseline']:.3f})")
+        lines.append(line)
+    lines.append(f"matching: {summ['match_seconds']:.1f} s wall, {summ['match_cpu_seconds']:.1f} CPU-s, "
+                 f"{summ['seconds_per_patch']:.3f} s per patch")
+    lines.append(f"fabricability: {len(problems)} pieces with problems"
+                 + ("" if not problems else " (listed in result.json)"))
+    if summ["message"]:
+        lines.append(summ["message"])
+    return "\n".join(lines)

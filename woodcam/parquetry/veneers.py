@@ -1,0 +1,235 @@
+"""Veneer sheets: the wood a parquetry is cut from (seed 002, sec. 3.1).
+
+A :class:`Veneer` is a flat sheet seen from its show face: ``rgb (h, w, 3)`` float32 in [0, 1],
+``mask (h, w)`` bool (True = usable wood), ``px_per_mm``. Sheet frame: x to the right, y down
+(as in SVG), millimetres, origin at the sheet's top-left corner; pixel ``(r, c)`` covers
+``[c, c + 1] x [r, r + 1] / px_per_mm``.
+
+Three sources:
+
+- :func:`load_scan`: a scanned veneer (image + dpi or px/mm + optional mask image);
+- :func:`slice_veneers`: leaves sliced from any woodcam block spec or log (``Wood.color`` on a
+  sequence of parallel planes at a pitch of thickness + kerf), every other leaf turned over so
+  neighbours are book-matched;
+- :func:`mokume_veneers`: the six face photos of a Mokume sample folder.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal, Protocol
+
+import numpy as np
+
+from ..errors import WoodcamError
+
+
+class StockLike(Protocol):
+    """What :func:`slice_veneers` needs of a :class:`woodcam.stock.Stock` (the stock layer sits
+    above this package, so it is described here rather than imported)."""
+
+    spec: str
+    size_mm: tuple[float, float, float]
+    wood: object
+
+MM_PER_INCH = 25.4
+
+SliceAxis = Literal["x", "y", "z"]
+
+
+@dataclass
+class Veneer:
+    """One veneer sheet.
+
+    Attributes
+    ----------
+    id : str
+        Unique name; engraved on the cut files (``veneer_<id>.svg``).
+    rgb : (h, w, 3) float32
+        Show-face colour in [0, 1], row 0 at the top of the sheet.
+    px_per_mm : float
+    mask : (h, w) bool
+        True where the wood may be used (no background, cracks, screw holes).
+    source : str
+        Where it came from (file path, block spec + plane), for result.json.
+    """
+
+    id: str
+    rgb: np.ndarray
+    px_per_mm: float
+    mask: np.ndarray
+    source: str = ""
+
+    @property
+    def size_mm(self) -> tuple[float, float]:
+        """``(width, height)`` of the sheet in mm."""
+        h, w = self.rgb.shape[:2]
+        return w / self.px_per_mm, h / self.px_per_mm
+
+    def resampled(self, px_per_mm: float) -> Veneer:
+        """The same sheet at another resolution (area-averaged down, bilinear up)."""
+        import cv2
+
+        if abs(px_per_mm - self.px_per_mm) < 1e-9 * px_per_mm:
+            return self
+        h, w = self.rgb.shape[:2]
+        f = px_per_mm / self.px_per_mm
+        nw, nh = max(1, round(w * f)), max(1, round(h * f))
+        interp = cv2.INTER_AREA if f < 1 else cv2.INTER_LINEAR
+        rgb = cv2.resize(self.rgb, (nw, nh), interpolation=interp)
+        # A resampled pixel is usable only if all the wood it averages was usable.
+        m = cv2.resize(self.mask.astype(np.float32), (nw, nh), interpolation=interp) > 1 - 1e-4
+        return Veneer(self.id, np.clip(rgb, 0, 1).astype(np.float32), px_per_mm, m, self.source)
+
+
+def _check(v: Veneer) -> Veneer:
+    if v.rgb.ndim != 3 or v.rgb.shape[2] != 3:
+        raise WoodcamError(f"veneer {v.id!r}: rgb must be (h, w, 3); got shape {v.rgb.shape}")
+    if v.mask.shape != v.rgb.shape[:2]:
+        raise WoodcamError(
+            f"veneer {v.id!r}: the mask must have the image's size {v.rgb.shape[1]}x{v.rgb.shape[0]} "
+            f"px; got {v.mask.shape[1]}x{v.mask.shape[0]} px; resample the mask to the scan")
+    if not np.isfinite(v.px_per_mm) or v.px_per_mm <= 0:
+        raise WoodcamError(f"veneer {v.id!r}: px_per_mm must be > 0; got {v.px_per_mm}")
+    if not v.mask.any():
+        raise WoodcamError(f"veneer {v.id!r} has zero usable wood (its mask is empty); "
+                           "check the mask (white = usable wood)")
+    return v
+
+
+def read_image(path, what: str = "image") -> np.ndarray:
+    """Read an image file as ``(h, w, 3)`` float32 RGB in [0, 1] (grey is repeated)."""
+    from PIL import Image, UnidentifiedImageError
+
+    p = Path(path)
+    try:
+        with Image.open(p) as im:
+            im.load()
+            a = np.asarray(im.convert("RGB"), np.float32) / 255.0
+    except (OSError, UnidentifiedImageError) as err:
+        raise WoodcamError(f"{what} {str(p)!r} cannot be read as an image ({err.__class__.__name__}); "
+                           "pass a PNG, JPEG or TIFF file") from err
+    return a
+
+
+def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | None = None,
+              mask: str | Path | np.ndarray | None = None, id: str | None = None) -> Veneer:
+    """A scanned veneer.
+
+    Parameters
+    ----------
+    path : image file (PNG/JPEG/TIFF)
+    dpi, px_per_mm : float
+        Scan resolution; exactly one of them (``px_per_mm = dpi / 25.4``).
+    mask : image file or ``(h, w)`` bool array, optional
+        Usable wood (white / True); must have the scan's size. Default: the whole sheet.
+    id : str, optional
+        Default: the file's stem.
+    """
+    if (dpi is None) == (px_per_mm is None):
+        raise WoodcamError(f"scan {str(path)!r}: give exactly one of dpi or px_per_mm; got "
+                           f"dpi={dpi}, px_per_mm={px_per_mm} (e.g. SCAN.png:300 for 300 dpi)")
+    ppm = float(px_per_mm) if px_per_mm is not None else float(dpi) / MM_PER_INCH
+    rgb = read_image(path, "veneer scan")
+    if mask is None:
+        m = np.ones(rgb.shape[:2], bool)
+    elif isinstance(mask, np.ndarray):
+        m = mask.astype(bool)
+    else:
+        m = read_image(mask, "veneer mask").mean(axis=2) > 0.5
+    return _check(Veneer(id or Path(path).stem, rgb, ppm, m, str(path)))
+
+
+def mokume_veneers(folder: str | Path, size_mm: float = 50.0) -> list[Veneer]:
+    """The face photos ``A_col.png`` .. ``F_col.png`` of a Mokume sample as veneers.
+
+    The cubes are ``size_mm`` on a side (the dataset does not store it; woodcam's Mokume
+    default is 50 mm), so a 256 px photo is ``256 / size_mm`` px/mm.
+    """
+    folder = Path(folder)
+    files = sorted(folder.glob("?_col.png"))
+    if not files:
+        raise WoodcamError(f"Mokume folder {str(folder)!r} holds no face photos (A_col.png .. "
+                           "F_col.png); pass a Mokume sample folder")
+    out = []
+    for f in files:
+        rgb = read_image(f, "Mokume photo")
+        out.append(_check(Veneer(f"{folder.name}-{f.name[0]}", rgb, rgb.shape[1] / size_mm,
+                                 np.ones(rgb.shape[:2], bool), str(f))))
+    return out
+
+
+def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float], *,
+                  thickness_mm: float = 0.6, kerf_mm: float = 0.4, px_per_mm: float = 4.0,
+                  axis: SliceAxis = "y", start_mm: float | None = None,
+                  id_prefix: str | None = None, progress: bool = False) -> list[Veneer]:
+    """Leaves sliced from a woodcam block or log, coloured by its ``Wood``.
+
+    Leaf ``k`` is the slab between ``s_k = start + k (thickness + kerf)`` and ``s_k + thickness``
+    along ``axis`` (block frame). Even leaves show the face at ``s_k`` (looking along +axis),
+    odd leaves are turned over and show the face at ``s_k + thickness`` mirrored left-right:
+    neighbours are book-matched, as a veneer slicer's leaves are laid out. The sheet covers
+    ``size_mm = (width, height)`` mm of the plane starting at the block's origin corner; the
+    wood's field is defined beyond the block's faces, so a sheet may be larger than the block
+    (it is then the veneer of a larger flitch of the same tree).
+
+    Parameters
+    ----------
+    stock : :class:`woodcam.stock.Stock` (``woodcam.open_stock(spec)``: the stock layer sits
+        above this package, so the caller opens it)
+    n_sheets : int
+    size_mm : (width, height) mm of each sheet
+    thickness_mm, kerf_mm : leaf thickness and the saw kerf between leaves (mm)
+    px_per_mm : sheet resolution
+    axis : "x", "y" or "z": the normal of the slicing planes
+    start_mm : first plane along ``axis`` (default: the middle of the block)
+    """
+    if not hasattr(stock, "wood") or not hasattr(stock, "size_mm"):
+        raise WoodcamError(f"stock must be a woodcam Stock (woodcam.open_stock(spec)); got "
+                           f"{type(stock).__name__}")
+    if n_sheets < 1:
+        raise WoodcamError(f"n_sheets must be >= 1; got {n_sheets}")
+    if thickness_mm <= 0 or kerf_mm < 0:
+        raise WoodcamError(f"thickness_mm must be > 0 and kerf_mm >= 0; got {thickness_mm}, {kerf_mm}")
+    if axis not in ("x", "y", "z"):
+        raise WoodcamError(f"axis must be one of ['x', 'y', 'z']; got {axis!r}")
+    w_mm, h_mm = size_mm
+    nw, nh = round(w_mm * px_per_mm), round(h_mm * px_per_mm)
+    if nw < 1 or nh < 1:
+        raise WoodcamError(f"size_mm must give at least one pixel at {px_per_mm} px/mm; got {size_mm}")
+    ax = "xyz".index(axis)
+    # In-plane directions: sheet x (right) and sheet y (down) as block axes, chosen so the
+    # sheet reads like the block face with that normal in docs/conventions.md.
+    right, down_axis = {0: (1, 2), 1: (0, 2), 2: (0, 1)}[ax]
+    pitch = thickness_mm + kerf_mm
+    start = stock.size_mm[ax] / 2.0 if start_mm is None else float(start_mm)
+    u = (np.arange(nw) + 0.5) / px_per_mm
+    v = (np.arange(nh) + 0.5) / px_per_mm
+    uu, vv = np.meshgrid(u, v)
+    top = stock.size_mm[down_axis] if down_axis == 2 else 0.0
+    prefix = id_prefix or stock.spec.replace(":", "-").replace("/", "-").strip("-.")
+    sheets = []
+    it = range(n_sheets)
+    if progress:
+        from tqdm import tqdm
+
+        it = tqdm(it, desc="slicing veneers", unit="sheet")
+    for k in it:
+        turned = k % 2 == 1
+        s = start + k * pitch + (thickness_mm if turned else 0.0)
+        pts = np.empty((nh * nw, 3), np.float64)
+        pts[:, ax] = s
+        pts[:, right] = uu.ravel()
+        # Z grows up while sheet rows grow down; other axes run with the rows.
+        pts[:, down_axis] = (top - vv.ravel()) if down_axis == 2 else vv.ravel()
+        normals = np.zeros_like(pts)
+        normals[:, ax] = 1.0 if turned else -1.0
+        rgb = stock.wood.color(pts, normals).reshape(nh, nw, 3)
+        if turned:
+            rgb = rgb[:, ::-1]
+        sheets.append(_check(Veneer(f"{prefix}-{k:02d}", np.ascontiguousarray(rgb, np.float32),
+                                    float(px_per_mm), np.ones((nh, nw), bool),
+                                    f"{stock.spec} leaf {k} at {axis}={s:g} mm"
+                                    + (" (turned over)" if turned else ""))))
+    return sheets
