@@ -41,3 +41,29 @@ def test_block_errors_are_one_line(tmp_path, capsys):
 def test_show_of_a_missing_folder_says_what_it_wants(tmp_path, capsys):
     assert main(["block", "show", str(tmp_path / "nope"), "--out", str(tmp_path / "x.png")]) == 1
     assert "block folder (with block.json) or a Mokume sample folder" in capsys.readouterr().err
+
+
+def test_block_synth_noise_options(tmp_path):
+    """The benchmark's noise knobs reach the blocks: jitter/dropout/mislabels in the settings,
+    ring maps only leaves no traces; bad ranges are refused with one line."""
+    import json
+
+    from woodcam.block.io import read_block
+
+    out = tmp_path / "noisy"
+    assert main(["block", "synth", "--count", "1", "--seed", "3", "--out", str(out), "--face-px", "40",
+                 "--quiet", "--jitter-mm", "0.3", "--dropout", "0.2", "--mislabel", "0.03",
+                 "--knotted-fraction", "0"]) == 0
+    b = read_block(out / "block_0000")
+    assert b.meta["trace_jitter_mm"] == 0.3 and b.meta["trace_dropout"] == 0.2
+    assert b.meta["mislabel_fraction"] == 0.03 and not b.meta["knotted"]
+    maps = tmp_path / "maps"
+    assert main(["block", "synth", "--count", "1", "--seed", "3", "--out", str(maps), "--face-px", "40",
+                 "--quiet", "--ring-maps-only", "--knotted-fraction", "0"]) == 0
+    b = read_block(maps / "block_0000")
+    assert all(not f.traces and f.ring_map is not None for f in b.faces.values())
+    assert json.loads((maps / "index.json").read_text())["count"] == 1
+    from woodcam.cli import EXIT_ERROR
+
+    assert main(["block", "synth", "--count", "1", "--out", str(tmp_path / "x"),
+                 "--size-range-mm", "80,30"]) == EXIT_ERROR

@@ -33,6 +33,7 @@ LAYERS: dict[str, int] = {
     "pipeline": 11, "demo": 12,
     "scale": 13,                       # runs any of them
     "benchmark": 14,                   # bench tasks and reports, run by scale
+    "bench_realistic": 14,             # realistic-generator scoring per block (issue 12)
     "cli": 15,                         # the command, on top
     "woodcam": 16,                     # the package's lazy re-exports
 }

@@ -51,7 +51,7 @@ def test_block_folder_without_truth_is_fitted_once_and_cached(tmp_path, monkeypa
     write_block(block, tmp_path / "b")
     before = sorted(p.name for p in (tmp_path / "b").rglob("*"))
     s = open_stock(str(tmp_path / "b"))
-    (cache,) = (tmp_path / "cache" / "fields").glob("*-radial-*.npz")
+    (cache,) = (tmp_path / "cache" / "fields").glob("*-evidence-*.npz")
     assert sorted(p.name for p in (tmp_path / "b").rglob("*")) == before
     p = np.random.default_rng(0).uniform(0, 1, (5000, 3)) * (50, 40, 30)
     # Clean traces of an eq. 7-9 field: the fit is within 0.05 years (0.15 mm at 3 mm rings).

@@ -243,10 +243,11 @@ def test_benchmark_set_uses_knotted_log_factory(tmp_path):
         calls.append(1)
         return AnalyticLogField(ring_width_mm=3.0)
 
-    synth_benchmark_set(tmp_path, 4, seed=0, face_px=24, progress=False, log_fields=knotted,
-                        knotted_fraction=1.0)
-    index = json.loads((tmp_path / "index.json").read_text())
-    assert len(calls) == 4 and all(b["knotted"] for b in index["blocks"])
+    # a block labelled knotted must have a knot crossing it: a factory without knots is refused
+    with pytest.raises(WoodcamError, match="knotted log field with knots"):
+        synth_benchmark_set(tmp_path, 4, seed=0, face_px=24, progress=False, log_fields=knotted,
+                            knotted_fraction=1.0)
+    assert calls
 
 
 def test_placed_field_serialises_only_when_the_log_field_does():
@@ -275,6 +276,12 @@ def test_benchmark_set_with_knotted_logs(tmp_path):
                                   knotted_fraction=1.0, progress=False)
     block = read_block(folders[0])
     assert block.meta["knotted"] and block.true_field is not None
+    # the knot crosses the block (from the true field), and each face marks its knot wood
+    from woodcam.synth import knot_crosses
+
+    assert knot_crosses(block.true_field, block.size_mm)
+    masks = [f.extras.get("knot_mask") for f in block.faces.values()]
+    assert any(m is not None and m.any() for m in masks)
     for face in block.faces.values():
         for t in face.traces:
             p = pixel_to_block(face.name, t.points_px[:, 0], t.points_px[:, 1], face.shape, block.size_mm)

@@ -19,6 +19,7 @@ import importlib
 _EXPORTS = {
     ".appearance": ["SPECIES", "ColorMapAppearance", "Wood"],
     ".bake": ["BakeResult", "bake"],
+    ".bench_realistic": ["score_block"],
     ".benchmark": ["bench_block", "bench_report", "run_bench"],
     ".block": ["Block", "Face", "RingTrace", "read_block", "read_mokume", "write_block"],
     ".cad": ["CarveResult", "carve", "load_part"],
@@ -31,7 +32,8 @@ _EXPORTS = {
                 "grain_direction"],
     ".frames": ["FACES", "FACE_NORMAL", "MOKUME_LETTER", "block_to_pixel", "pixel_to_block",
                 "unfold_cross"],
-    ".inference": ["benchmark", "evaluate_fit", "fit_block", "leave_one_face_out"],
+    ".inference": ["EvidenceFit", "benchmark", "evaluate_fit", "fit_block", "fit_evidence",
+                   "leave_one_face_out"],
     ".logs": ["GeneratedLog", "generate_log", "read_gran1", "read_log", "write_log"],
     ".parquetry": ["ParquetryJob", "ParquetryParams", "ParquetryRun", "Veneer", "build_parquetry",
                    "load_scan", "mokume_veneers", "read_job", "slice_veneers", "write_job",

@@ -210,6 +210,11 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
     part_report = report_mesh is not None
     result.atlas_px = tuple(baked.atlas.shape[:2])
     result.atlas = baked.summary()
+    from .inference.evidence import uncertainty_report
+
+    rings_line = uncertainty_report(stock.wood.field, mesh.vertices, stock.size_mm, result.name)
+    if rings_line:  # a fitted field says where its rings are a guess (issue 12 part 5)
+        result.warnings.append(rings_line)
     if part_report:
         import json
 
@@ -219,6 +224,8 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
 
         with result.stage("report"):
             result.report = _part_report(mesh, stock)
+            if rings_line:
+                result.report.setdefault("warnings", []).append(rings_line)
             stem = out_glb.with_name(out_glb.stem + "_report")
             write_bytes(stem.with_suffix(".json"), json.dumps(result.report, indent=1).encode())
             write_bytes(stem.with_suffix(".txt"), (report_text(result.report, out_glb.stem)

@@ -328,7 +328,7 @@ def _synthetic_stock(spec, field, size_mm, species, description, appearance, par
     return Stock(spec, tuple(size_mm), Wood(field, app), description, meta)
 
 
-def fitted_field(block, folder: Path | None = None, method: str = "radial"):
+def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
     """The growth field fitted to a block's rings, fitted once and cached.
 
     The cache entry lives in the user cache folder (:func:`woodcam._cache.cache_dir`

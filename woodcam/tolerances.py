@@ -208,3 +208,47 @@ PARQUETRY_WIDTH_TOL_MM = 0.05
 #: the tool radius (the seams are smoothed to the full radius; this allows for the sampling
 #: of the curvature check).
 PARQUETRY_CURVATURE_SLACK = 0.98
+
+#: Evidence-based choice of a fit (``woodcam.inference.evidence``, issue 12 part 1).
+#: A face takes part in leave-one-face-out only with at least this many ring points: fewer
+#: (a face crossed by one short ring) scores by chance.
+EVIDENCE_MIN_FACE_POINTS = 20
+
+#: Held-out points scored per face (a fixed random subset): 400 points give a share to about
+#: +-2.5 % (binomial std at 50 %), finer than the differences between hypotheses that matter.
+EVIDENCE_MAX_HELD_POINTS = 400
+
+#: Ring points of the RBF hypotheses (full and held-in fits): the dense solve is O(n^3), and
+#: 1000 points (one every ~2-4 mm of ring on a traced 50 mm cube) keep each refit near 0.1 s.
+EVIDENCE_RBF_POINTS = 1000
+
+#: Smoothing of the residual RBF per point (scipy's ``smoothing`` is summed over points): the
+#: residual is meant to carry distortions a few mm wide, not each trace's jitter.
+EVIDENCE_RESIDUAL_SMOOTHING = 1e-3
+
+#: A chosen fit is flagged "contradicted" when some held-out face has fewer of its ring points
+#: within 2 mm of the predicted ring line than this (percent): the issue's bar for a block.
+EVIDENCE_MIN_FACE_SHARE_2MM = 80.0
+
+#: Hypotheses whose mean held-out score is within this many percent points of the best are
+#: "accepted": their spread is the fit's per-point uncertainty.
+EVIDENCE_ACCEPT_MARGIN = 5.0
+
+#: Uncertainty added per mm from the nearest observed face (years/mm): a prior, not a
+#: measurement; 0.02 makes the middle of a 50 mm block seen from one face half a ring unsure.
+EVIDENCE_UNSEEN_YEARS_PER_MM = 0.02
+
+#: Grid spacing (mm) on which the hypotheses' spread is sampled before interpolation to the
+#: bake grid: the spread is smooth over several mm, and the RBF hypotheses are slow to evaluate.
+EVIDENCE_SPREAD_SPACING_MM = 4.0
+
+#: Knot-mask regions smaller than this (pixels) are not knot exits (speckle of a detector).
+KNOT_MIN_AREA_PX = 12
+
+#: Two knot exits on different faces are one branch when the line joining them makes more than
+#: this angle with the stem axis: branches leave the stem at 50-90 degrees (seed 001's logs).
+KNOT_PAIR_MIN_ANGLE_DEG = 40.0
+
+#: ... and smaller than this share of the largest region on the same face (H11's grown mask of
+#: face C has a 150 px bud beside its 21 000 px knot).
+KNOT_MIN_AREA_SHARE = 0.1

@@ -52,7 +52,7 @@ def test_eval_writes_table_and_images(block_dir, tmp_path):
 
 def test_cli_errors(block_dir, tmp_path):
     folder, truth, _ = block_dir
-    with pytest.raises(WoodcamError, match=r"--method must be from rbf, radial, neural; got \['magic'\]"):
+    with pytest.raises(WoodcamError, match=r"--method must be from evidence, rbf, radial, neural; got \['magic'\]"):
         run(_parse(["fit", str(folder), "--method", "magic", "--out", str(tmp_path / "x.npz")]))
     with pytest.raises(WoodcamError, match="--truth needs one field file per block"):
         run(_parse(["eval", "rings", str(folder), str(folder), "--truth", str(truth), "--out", str(tmp_path)]))

@@ -9,7 +9,8 @@ from woodcam.errors import WoodcamError
 from woodcam.frames import face_pixel_points
 from woodcam.inference import gather_observations
 from woodcam.inference.holdout import (
-    CONTROL, face_years, leave_one_face_out, ridge_pixels, ring_lines_px, score_face,
+    CONTROL, STRAIGHT, face_years, leave_one_face_out, ridge_pixels, ring_lines_px, score_face,
+    straight_rings,
 )
 
 
@@ -75,8 +76,21 @@ def test_leave_one_face_out_predicts_held_out_synthetic_faces(mapped, tmp_path):
     assert min(s.shares["ridge_2"] for s in held) >= 75
     # the chance control (every prediction moved half a ring) falls far below
     assert np.mean([s.shares["ridge_2"] for s in res[CONTROL]["radial"]]) < 40
+    # the straight-ring control (right orientation and spacing, best phase) is reported and,
+    # on the curved rings of an eq. 7-9 field, beaten by the held-out prediction
+    straight = np.mean([s.shares["ridge_2"] for s in res[STRAIGHT]["radial"]])
+    assert straight < np.mean([s.shares["ridge_2"] for s in held]) - 10
     assert (tmp_path / "eq79_radial.png").stat().st_size > 10_000
     assert "mean, held out" in (tmp_path / "eq79_holdout.md").read_text()
+    assert STRAIGHT in (tmp_path / "eq79_holdout.md").read_text()
+
+
+def test_straight_rings_is_the_mean_plane():
+    r, c = np.meshgrid(np.arange(20.0), np.arange(30.0), indexing="ij")
+    plane = 0.3 + 0.1 * r - 0.05 * c
+    np.testing.assert_allclose(straight_rings(plane), plane, atol=1e-9)
+    bent = plane + 0.2 * np.sin(c / 5)
+    assert np.abs(straight_rings(bent) - plane).max() < 0.2
 
 
 def test_holdout_errors(mapped):

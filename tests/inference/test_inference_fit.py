@@ -118,7 +118,7 @@ def test_bad_inputs_give_clear_errors(field):
         fit_block(one, "radial", faces=["front", "side"])
     with pytest.raises(WoodcamError, match=r"faces \['left'\] are not on block"):
         fit_block(one, "radial", faces=["left"])
-    with pytest.raises(WoodcamError, match="method must be one of rbf, radial"):
+    with pytest.raises(WoodcamError, match="method must be one of evidence, rbf, radial"):
         fit_block(one, "magic")
     squashed = Block((50, 50, 50), {"front": Face("front", (100, 50), traces=[
         RingTrace(np.array([[10.0, 5.0], [90.0, 40.0]]), 3)])})

@@ -334,5 +334,5 @@ def test_cli_bench_run_and_report(tmp_path, capsys):
 
     assert main(["bench", "run", "--blocks", "1", "--methods", "radial,splines", "--out", run]) == EXIT_ERROR
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["woodcam: error: methods must be a comma-separated subset of rbf, radial, neural; "
+    assert err == ["woodcam: error: methods must be a comma-separated subset of evidence, rbf, radial, neural; "
                    "got 'radial,splines'"]

@@ -33,6 +33,7 @@ COMMANDS: tuple[str, ...] = (
     "woodcam.cli.rings",         # rings detect | show
     "woodcam.cli.log",           # log render | maps | export
     "woodcam.cli.fit",           # fit, eval rings
+    "woodcam.cli.eval_bench",    # eval realistic
     "woodcam.cli.appearance",    # eval appearance
     "woodcam.cli.train",         # train gtf | rings
     "woodcam.cli.bench",         # bench run | report

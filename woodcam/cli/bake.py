@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..errors import WoodcamError
 from .options import (BLOCK_SPEC_HELP, add_bake_options, allow_negative_values, stock_options,
                       vector_mm, write_screenshot)
 
@@ -66,6 +67,10 @@ def register(subparsers) -> None:
                    help="the cut plane's normal, towards the side cut away (default: the block's "
                    "longest axis facing the camera)")
     allow_negative_values(p)
+    p.add_argument("--confidence", action="store_true",
+                   help="colour the part by the fit's per-point confidence (red 0, yellow 0.5, green "
+                   "1; spread of the accepted hypotheses and distance from observed faces) "
+                   "instead of its wood")
     p.set_defaults(func=run_preview)
 
     p = subparsers.add_parser("blocks", help="list the built-in synthetic blocks")
@@ -112,7 +117,15 @@ def run_preview(args: argparse.Namespace) -> int:
     from .options import stock_of_glb
 
     stock = stock_of_glb(args.mesh, args.block)
-    out = preview(args.mesh, wood=stock.wood if stock else None,
+    wood = stock.wood if stock else None
+    if args.confidence:
+        from ..inference.evidence import ConfidenceWood
+
+        if stock is None or "uncertainty" not in (getattr(stock.wood.field, "layers", {}) or {}):
+            raise WoodcamError("--confidence needs a block whose field was fitted (a block folder "
+                               "without a true field, or a Mokume folder); pass --block")
+        wood = ConfidenceWood(stock.wood.field)
+    out = preview(args.mesh, wood=wood,
                   size_mm=stock.size_mm if stock else None, screenshot=args.screenshot,
                   camera=args.camera, cut_plane=not args.no_cut, cut_origin=args.cut_origin,
                   cut_normal=args.cut_normal)

@@ -22,6 +22,20 @@ def register(subparsers) -> None:
     s.add_argument("--out", type=Path, required=True, help="output folder (one sub-folder per block)")
     s.add_argument("--face-px", type=int, default=512, help="pixels along the largest face side")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
+    s.add_argument("--jitter-mm", type=float, default=0.0,
+                   help="std (mm) of the traces' perpendicular jitter, smoothed over 1 mm (default 0)")
+    s.add_argument("--dropout", type=float, default=0.0,
+                   help="fraction of trace length removed, in pieces of --dropout-chunk-mm (default 0)")
+    s.add_argument("--dropout-chunk-mm", type=float, default=10.0,
+                   help="length (mm) of each removed trace piece (default 10)")
+    s.add_argument("--mislabel", type=float, default=0.0,
+                   help="fraction of traces whose year is off by +-1 (default 0)")
+    s.add_argument("--ring-maps-only", action="store_true",
+                   help="no traces: faces carry ring maps only (unlabelled rings, as Mokume's cubes)")
+    s.add_argument("--knotted-fraction", type=float, default=0.5,
+                   help="share of blocks cut from knotted logs, each with a knot crossing it (default 0.5)")
+    s.add_argument("--size-range-mm", default="30,80",
+                   help="MIN,MAX block side in mm, each side uniform in it (default 30,80)")
     add_engine_options(s)
 
     v = sub.add_parser("show", help="draw a block's faces as one unfolded-cross PNG")
@@ -41,8 +55,29 @@ def run(args) -> int:
     if args.block_command == "synth":
         import json
 
+        from ..errors import WoodcamError
         from ..synth import knotted_log_field, synth_benchmark_set
 
+        try:
+            lo, hi = (float(v) for v in args.size_range_mm.split(","))
+        except ValueError:
+            raise WoodcamError(f"--size-range-mm must be MIN,MAX in mm, e.g. 30,80; got "
+                               f"{args.size_range_mm!r}") from None
+        if not 0 < lo <= hi:
+            raise WoodcamError(f"--size-range-mm needs 0 < MIN <= MAX; got {lo:g},{hi:g}")
+        if args.jitter_mm < 0 or args.dropout_chunk_mm <= 0:
+            raise WoodcamError(f"--jitter-mm must be >= 0 and --dropout-chunk-mm > 0; got "
+                               f"{args.jitter_mm:g} and {args.dropout_chunk_mm:g}")
+        noise = {"trace_jitter_mm": args.jitter_mm, "trace_dropout": args.dropout,
+                 "trace_dropout_chunk_mm": args.dropout_chunk_mm, "mislabel_fraction": args.mislabel}
+        if args.ring_maps_only:
+            noise["trace_faces"] = []
+        if (args.engine is not None or args.address is not None) and (
+                args.jitter_mm or args.dropout or args.mislabel or args.ring_maps_only or args.knotted_fraction != 0.5
+                or args.size_range_mm != "30,80"):
+            raise WoodcamError("--engine/--address write the default set only; drop --jitter-mm, "
+                               "--dropout, --mislabel, --ring-maps-only, --knotted-fraction and "
+                               "--size-range-mm, or run without an engine")
         if args.engine is not None or args.address is not None:
             # one task per block: the same blocks, resumable (a record per block), on an engine
             from ..benchmark import write_benchmark_set
@@ -56,7 +91,9 @@ def run(args) -> int:
 
             return 0 if summary.failed == 0 else EXIT_CHECKS  # some blocks failed
         folders = synth_benchmark_set(args.out, args.count, args.seed, face_px=args.face_px,
-                                      log_fields=knotted_log_field, progress=not args.quiet)
+                                      size_range_mm=(lo, hi), log_fields=knotted_log_field,
+                                      knotted_fraction=args.knotted_fraction,
+                                      progress=not args.quiet, **noise)
         index = json.loads((Path(args.out) / "index.json").read_text())
         knotted = sum(b["knotted"] for b in index["blocks"])
         print(f"wrote {len(folders)} blocks to {args.out} ({knotted} knotted; index.json lists them)")

@@ -17,7 +17,7 @@ PARTIAL_FACES = ("front", "top", "left")
 
 #: The fitting methods of :data:`woodcam.inference.fit.METHODS`, spelled out here so that
 #: ``woodcam --help`` need not import the fitters (numpy, scipy); a test keeps the two equal.
-METHODS = ("rbf", "radial", "neural")
+METHODS = ("evidence", "rbf", "radial", "neural")
 
 
 def _faces(text):
@@ -28,10 +28,12 @@ def register(subparsers) -> None:
     """Add ``fit`` and ``eval rings`` (``eval DIRS`` still means ``eval rings DIRS``)."""
     p = subparsers.add_parser("fit", help="infer a block's growth field from its traced faces")
     add_block_argument(p, option=False)
-    p.add_argument("--method", default="radial", metavar="{" + ",".join(METHODS) + "}",
+    p.add_argument("--method", default="evidence", metavar="{" + ",".join(METHODS) + "}",
                    help="rbf: seed 000's RBF baseline (unlabelled rings numbered by the radial fit); "
-                   "neural: seed 000's eq. 5 with the generic neural field (needs torch); radial "
-                   "(default): our pith axis, ring-width shape and growth history by least squares")
+                   "neural: seed 000's eq. 5 with the generic neural field (needs torch); radial: "
+                   "our pith axis, ring-width shape and growth history by least squares; evidence "
+                   "(default): radial pith hypotheses, RBF and radial + residual, chosen by how well "
+                   "each predicts the faces it was not fitted to (warns when they contradict it)")
     p.add_argument("--faces", default=None, help="comma-separated faces to use (default: all)")
     add_size_option(p)
     p.add_argument("--out", type=Path, required=True, help="field file to write (.npz grid)")
@@ -73,6 +75,8 @@ def run_fit(args) -> int:
     path = field.save(args.out)
     print(f"wrote {path} ({args.method} fit of {block.name}, grid {field.years.shape}, "
           f"{field.spacing_mm[0]:g} mm)")
+    if field.meta.get("message"):
+        print(field.meta["message"])
     return 0
 
 

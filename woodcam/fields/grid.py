@@ -11,7 +11,8 @@ always computed from the interpolated growth time, never interpolated itself.
 from __future__ import annotations
 
 import zipfile
-from dataclasses import dataclass, field as dc_field
+from dataclasses import dataclass
+from dataclasses import field as dc_field
 from pathlib import Path
 from typing import Literal
 
@@ -39,6 +40,14 @@ class GridField:
     spacing_mm : float or (3,) float
         Node spacing along X, Y, Z.
     interpolation : "cubic" or "linear"
+    layers : dict name -> (nx, ny, nz) float, optional
+        Further quantities on the same nodes, read by linear interpolation:
+        ``"uncertainty"`` (years; how unsure a fit is of the growth time there, e.g. the spread
+        of the hypotheses it could not tell apart; :meth:`uncertainty_years`) and ``"knot"``
+        (0..1 knot darkening weight of knots fitted into the field; :meth:`knot_features`,
+        present only with that layer, as appearances test ``hasattr(field, "knot_features")``).
+    meta : dict
+        Plain-JSON facts about how the field was made (fit method, evidence, warnings).
     """
 
     years: np.ndarray
@@ -46,6 +55,8 @@ class GridField:
     spacing_mm: tuple[float, float, float]
     interpolation: Interpolation = "cubic"
     axis: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    layers: dict = dc_field(default_factory=dict, repr=False, compare=False)
+    meta: dict = dc_field(default_factory=dict, repr=False, compare=False)
     _coeffs: np.ndarray = dc_field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -62,6 +73,14 @@ class GridField:
         object.__setattr__(self, "years", g)
         object.__setattr__(self, "spacing_mm", tuple(sp))
         object.__setattr__(self, "origin_mm", tuple(np.asarray(self.origin_mm, float)))
+        layers = {}
+        for name, v in dict(self.layers).items():
+            u = np.asarray(v, dtype=float)
+            if u.shape != g.shape or not np.all(np.isfinite(u)):
+                raise WoodcamError(f"layer {name!r} must be a finite grid shaped like years {g.shape}; "
+                                   f"got shape {u.shape}")
+            layers[str(name)] = u
+        object.__setattr__(self, "layers", layers)
         order = _ORDER[self.interpolation]
         coeffs = ndimage.spline_filter(g, order=order, mode="nearest") if order > 1 else g
         object.__setattr__(self, "_coeffs", coeffs)
@@ -99,26 +118,65 @@ class GridField:
         return ndimage.map_coordinates(self._coeffs, idx.T, order=_ORDER[self.interpolation],
                                        mode="nearest", prefilter=False)
 
+    def uncertainty_years(self, points_mm: ArrayLike) -> np.ndarray:
+        """``(n,)`` years of uncertainty at ``points_mm (n, 3)`` (linear interpolation of
+        :attr:`uncertainty`; zeros when the field carries none)."""
+        return self.layer("uncertainty", points_mm)
+
+    def layer(self, name: str, points_mm: ArrayLike) -> np.ndarray:
+        """``(n,)`` linear interpolation of layer ``name`` at ``points_mm (n, 3)`` (zeros when
+        the field has no such layer)."""
+        p = check_points(points_mm)
+        if name not in self.layers:
+            return np.zeros(len(p))
+        idx = (p - np.asarray(self.origin_mm)) / np.asarray(self.spacing_mm)
+        return ndimage.map_coordinates(self.layers[name], idx.T, order=1, mode="nearest")
+
+    def __getattr__(self, name):
+        # knot_features and evaluate (what the colour map asks of knotted fields) exist only
+        # with a "knot" layer: appearances test hasattr
+        if name in ("knot_features", "evaluate") and "knot" in self.__dict__.get("layers", {}):
+            def knot_features(points_mm):
+                k = np.clip(self.layer("knot", points_mm), 0.0, 1.0)
+                return {"knot": k, "dead": np.zeros_like(k), "outline": np.zeros_like(k)}
+
+            def evaluate(points_mm, *, directions: bool = False):
+                from .base import grain_direction
+
+                out = {"years": self(points_mm), **knot_features(points_mm)}
+                if directions:
+                    out["direction"] = grain_direction(self, points_mm)
+                return out
+            return knot_features if name == "knot_features" else evaluate
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
     def save(self, path: PathLike) -> Path:
         """Write the grid to an ``.npz`` file; :meth:`load` restores it exactly."""
         path = Path(path)
         if path.suffix != ".npz":
             path = path.with_suffix(path.suffix + ".npz")
-        from .._atomic import atomic_path
+        import json
 
-        with atomic_path(path) as tmp:  # a complete file or none
-            np.savez_compressed(tmp, years=self.years, origin_mm=self.origin_mm,
+        from .._atomic import atomic_write
+
+        extra = {f"layer_{k}": v for k, v in self.layers.items()}
+        with atomic_write(path) as fh:  # a reader never sees half a file
+            np.savez_compressed(fh, years=self.years, origin_mm=self.origin_mm,
                                 spacing_mm=self.spacing_mm, interpolation=self.interpolation,
-                                axis=self.axis)
+                                axis=self.axis, meta=json.dumps(self.meta), **extra)
         return path
 
     @classmethod
     def load(cls, path) -> GridField:
         try:
+            import json
+
             # our own handle: np.load leaks it when the zip is truncated
             with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as z:
+                meta = json.loads(str(z["meta"])) if "meta" in z.files else {}
+                layers = {k[len("layer_"):]: z[k] for k in z.files if k.startswith("layer_")}
                 return cls(z["years"], tuple(z["origin_mm"]), tuple(z["spacing_mm"]),
-                           str(z["interpolation"]), tuple(z["axis"]))
+                           str(z["interpolation"]), tuple(z["axis"]), layers, meta)
         except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile) as err:
             raise WoodcamError(f"{path}: not a woodcam grid field (.npz with 'years', "
                                f"'origin_mm', 'spacing_mm'): {err}") from err

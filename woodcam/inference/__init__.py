@@ -1,6 +1,8 @@
 """Fitting a growth field to a block's ring annotations, and measuring it (seed 000, Table 1).
 
-- :func:`fit_block` ``(block, method, faces) -> field``: ``"rbf"`` is the seed's baseline,
+- :func:`fit_block` ``(block, method, faces) -> field``: ``"evidence"`` (the default) fits
+  several hypotheses and keeps the one the held-out faces support (:mod:`.evidence`, with knots
+  from the knot masks, :mod:`.knots`); ``"rbf"`` is the seed's baseline,
   ``"radial"`` our least-squares fit of a pith axis and a smooth inverse ring width.
   ``"neural"`` the seed's eq. 5 fit of the generic neural field (labelled traces, or ring maps
   with a year-free loss).
@@ -11,6 +13,7 @@
 """
 
 from .baked import bake
+from .evidence import EvidenceFit, fit_evidence
 from .evaluate import DEFAULT_PLANES, CutPlane, benchmark, evaluate_fit, evaluate_fits
 from .fit import METHODS, Method, fit_block
 from .holdout import leave_one_face_out, score_face
@@ -19,8 +22,8 @@ from .radial import RadialField, fit_radial, number_observations
 from .rbf import fit_rbf
 
 __all__ = [
-    "CutPlane", "DEFAULT_PLANES", "METHODS", "Method", "RadialField",
-    "RingObservations", "bake", "benchmark", "evaluate_fit", "evaluate_fits", "fit_block",
+    "CutPlane", "DEFAULT_PLANES", "EvidenceFit", "METHODS", "Method", "RadialField",
+    "RingObservations", "bake", "benchmark", "evaluate_fit", "evaluate_fits", "fit_block", "fit_evidence",
     "fit_radial", "fit_rbf", "gather_observations", "leave_one_face_out", "number_observations",
     "score_face",
 ]

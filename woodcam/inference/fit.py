@@ -5,6 +5,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Literal, get_args
 
+import numpy as np
+
 from .._types import GrowthFieldLike
 from ..errors import WoodcamError
 from .baked import bake
@@ -15,22 +17,27 @@ from .rbf import fit_rbf
 if TYPE_CHECKING:
     from ..block import Block
 
-Method = Literal["rbf", "radial", "neural"]
+Method = Literal["evidence", "rbf", "radial", "neural"]
 METHODS: tuple[str, ...] = get_args(Method)
 
 #: Bumped whenever a fitter changes what it returns for the same block, so fields cached by
-#: :func:`woodcam.stock.fitted_field` are refitted (2: growth history, knot masks, year-free neural).
-FIT_VERSION = 2
+#: :func:`woodcam.stock.fitted_field` are refitted (2: growth history, knot masks, year-free neural;
+#: 3: the evidence-chosen default, uncertainty and fit facts saved with the grid; 4: dense knots).
+FIT_VERSION = 4
 
 
-def fit_block(block: Block, method: Method = "radial", faces: Sequence[str] | None = None,
+def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
               baked: bool = True) -> GrowthFieldLike:
     """Infer a block's growth field from the rings on its faces.
 
     Parameters
     ----------
     block : woodcam.block.Block
-    method : "rbf" (seed 000's baseline: thin-plate RBF of labelled ring points; unlabelled rings
+    method : "evidence" (the default: several hypotheses, radial pith basins, RBF and a radial
+        stem with a residual, chosen by how well each predicts the faces it was not fitted to;
+        a choice the held-out faces contradict raises a WoodcamWarning and is flagged in
+        ``field.meta``; the baked grid carries the per-point ``uncertainty``, see
+        :mod:`woodcam.inference.evidence`) or "rbf" (seed 000's baseline: thin-plate RBF of labelled ring points; unlabelled rings
         are numbered by the radial fit first) or "radial"
         (ours: pith axis + smooth inverse ring width by least squares; also numbers unlabelled
         traces and ring maps) or "neural" (seed 000's eq. 5: the packaged generic neural GTF,
@@ -52,6 +59,14 @@ def fit_block(block: Block, method: Method = "radial", faces: Sequence[str] | No
 
         return fit_neural(block, faces=faces)  # always baked to a grid (the net is slow)
     obs = gather_observations(block, faces)
+    if method == "evidence":
+        from .evidence import bake_evidence, fit_evidence
+        from .knots import with_knots
+
+        ev = fit_evidence(obs, block.size_mm)
+        ev.field, strands = with_knots(block, ev.field, faces)  # knots from the masks (part 3)
+        used = sorted({int(i) for i in np.unique(obs.face)})
+        return bake_evidence(ev, block.size_mm, used, strands) if baked else ev
     if method == "rbf":
         if not obs.labelled:  # the seed's RBF needs years: number the rings as the radial fit does
             obs = number_observations(obs, fit_radial(obs, block.size_mm))

@@ -44,6 +44,29 @@ if TYPE_CHECKING:
 #: prediction moved by half a ring (right spacing and direction, rings where none are).
 ALL_FACES = "all faces"
 CONTROL = "held out, moved half a ring (chance)"
+#: Issue 12 part 7: straight parallel rings with the held-out prediction's mean orientation and
+#: spacing on the face, at the best of :data:`STRAIGHT_PHASES` phases (so it is phase-free):
+#: what a fit scores by getting only orientation and spacing right.
+STRAIGHT = "straight rings, same orientation and spacing, best phase"
+STRAIGHT_PHASES = 10
+
+
+def straight_rings(years: np.ndarray) -> np.ndarray:
+    """The least-squares plane ``a + b row + c col`` through a face's growth time ``(h, w)``:
+    straight parallel rings with its mean orientation and spacing."""
+    h, w = years.shape
+    r, c = np.meshgrid(np.arange(h, dtype=float), np.arange(w, dtype=float), indexing="ij")
+    X = np.stack([np.ones(r.size), r.ravel(), c.ravel()], axis=1)
+    coef = np.linalg.lstsq(X, years.ravel(), rcond=None)[0]
+    return (X @ coef).reshape(h, w)
+
+
+def _straight_score(face, years, ridge, excl, thresholds) -> FaceScore:
+    """The :data:`STRAIGHT` control of one face: the best phase by ridge pixels within 2 px."""
+    plane = straight_rings(years)
+    scores = [_score(face, plane + ph, ridge, excl, thresholds)
+              for ph in np.arange(STRAIGHT_PHASES) / STRAIGHT_PHASES]
+    return max(scores, key=lambda sc: sc.shares.get("ridge_2", 0.0))
 
 
 def ridge_pixels(ring_map: np.ndarray, threshold: float = RING_MAP_THRESHOLD,
@@ -169,6 +192,7 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
     refs = {face: _face_reference(ref_block, face) for face in faces}
     held = {m: [] for m in methods}
     control = {m: [] for m in methods}
+    straight = {m: [] for m in methods}
     insample = {m: [] for m in methods}
     times = {m: [] for m in methods}
     for m in methods:
@@ -182,13 +206,14 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
             years = face_years(fit, face, shape, block.size_mm)
             held[m].append(_score(face, years, ridge, excl, HOLDOUT_THRESHOLDS_PX))
             control[m].append(_score(face, years + 0.5, ridge, excl, HOLDOUT_THRESHOLDS_PX))
+            straight[m].append(_straight_score(face, years, ridge, excl, HOLDOUT_THRESHOLDS_PX))
             insample[m].append(_score(face, face_years(full, face, shape, block.size_mm), ridge, excl,
                                       HOLDOUT_THRESHOLDS_PX))
             if progress:
                 s = held[m][-1].shares
                 progress(f"{block.name} {m} hold out {face}: ridge {s['ridge_1']:.0f}/{s['ridge_2']:.0f}%, "
                          f"line {s['line_1']:.0f}/{s['line_2']:.0f}% ({times[m][-1]:.1f} s)")
-    res = {"held_out": held, CONTROL: control, ALL_FACES: insample,
+    res = {"held_out": held, CONTROL: control, STRAIGHT: straight, ALL_FACES: insample,
            "fit_s": {m: float(np.mean(t)) for m, t in times.items()}}
     res["table"] = holdout_table(block.name, res, list(methods))
     if out_dir is not None:
@@ -218,7 +243,10 @@ def holdout_table(name: str, res: dict, methods: list[str], thresholds=HOLDOUT_T
     for i, sc in enumerate(held[methods[0]]):
         lines.append(row(sc.face, {m: held[m][i].shares for m in methods}))
     for label, part in (("**mean, held out**", held), (f"mean, {CONTROL}", res[CONTROL]),
+                        (f"mean, {STRAIGHT}", res[STRAIGHT]) if STRAIGHT in res else (None, None),
                         (f"mean, {ALL_FACES} (in-sample)", res[ALL_FACES])):
+        if label is None:
+            continue
         lines.append(row(label, {m: {k: float(np.mean([s.shares[k] for s in part[m]])) for k in keys}
                                  for m in methods}))
     lines.append("")
@@ -270,5 +298,6 @@ def plot_holdout(path, block, scores: list[FaceScore], title: str = ""):
     return path
 
 
-__all__ = ["ALL_FACES", "CONTROL", "FaceScore", "face_years", "holdout_table",
-           "leave_one_face_out", "plot_holdout", "ridge_pixels", "ring_lines_px", "score_face"]
+__all__ = ["ALL_FACES", "CONTROL", "STRAIGHT", "FaceScore", "face_years", "holdout_table",
+           "leave_one_face_out", "plot_holdout", "ridge_pixels", "ring_lines_px", "score_face",
+           "straight_rings"]

@@ -269,8 +269,12 @@ def _refine(prob: _Problem, pith, d, max_nfev: int):
 def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: float,
                        n_directions: int = 120, n_search: int = 600, n_fit: int = 2000,
                        n_starts: int = 6, coarse_K: int = 2, n_final: int = 2, n_grid_directions: int = 20,
-                       pith_grid: int = 9, seed: int = 0):
+                       pith_grid: int = 9, seed: int = 0, n_basins: int = 0):
     """Search + refine the pith axis; returns ``(RadialField, levels or None, group ids used)``.
+
+    n_basins : 0 returns the best fit as above; ``n >= 1`` returns a list of such triples, the
+        ``n`` best distinct axis basins finished at full order, best (lowest cost) first: the
+        pith hypotheses that :mod:`woodcam.inference.evidence` judges by held-out faces.
 
     For labelled observations the returned field is the final least-squares fit. For unlabelled
     ones, ``levels`` are the fitted per-group values of ``rho * s`` (mm-like units, the field's
@@ -326,11 +330,29 @@ def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: fl
     fine = _Problem(obs.points_mm[i_f], obs.years[i_f] if labelled else None, g_f, centre, z_scale, K, M, ridge)
     # The low-order ranking can put the true basin second (seen with three faces traced), so
     # the best n_final basins are finished at full order and compared there.
-    finals = [_refine(fine, p, d, max_nfev=60) for p, d, _ in refined[:n_final]]
-    pith, d, _ = min(finals, key=lambda r: r[2])
-    _, coef, offset, levels = fine.solve(pith, d)
-    field = RadialField(pith, _frame(d)[0], z_scale, K, M, coef, float(offset))
-    return field, levels, (obs.group[i_f] if not labelled else None)
+    finals = [_refine(fine, p, d, max_nfev=60) for p, d, _ in refined[:max(n_final, n_basins + 1)]]
+    finals.sort(key=lambda r: r[2])
+    distinct = []  # basins that refined into the same axis are one hypothesis
+    for r in finals:
+        if all(not _same_axis(r[0], r[1], o[0], o[1], centre) for o in distinct):
+            distinct.append(r)
+    out = []
+    for pith, d, _ in distinct[:max(1, n_basins)]:
+        _, coef, offset, levels = fine.solve(pith, d)
+        out.append((RadialField(pith, _frame(d)[0], z_scale, K, M, coef, float(offset)), levels,
+                    (obs.group[i_f] if not labelled else None)))
+    return out if n_basins else out[0]
+
+
+def _same_axis(p1, d1, p2, d2, centre, angle_deg: float = 3.0, offset_mm: float = 2.0) -> bool:
+    """True when two pith lines agree within ``angle_deg`` and pass within ``offset_mm`` of each
+    other at the block centre."""
+    d1, d2 = d1 / np.linalg.norm(d1), d2 / np.linalg.norm(d2)
+    if abs(d1 @ d2) < np.cos(np.deg2rad(angle_deg)):
+        return False
+    q1 = p1 + d1 * ((centre - p1) @ d1)  # point of each line nearest the centre
+    q2 = p2 + d2 * ((centre - p2) @ d2)
+    return bool(np.linalg.norm(q1 - q2) < offset_mm)
 
 
 def ring_spacing_mm(obs: RingObservations) -> float:
@@ -464,11 +486,48 @@ def _one_blas_thread():
 
 
 def _fit_radial(obs, size_mm, K, M, ridge, max_relabel_rounds, seed, history, search) -> RadialField:
+    found = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, **search)
+    return _finish_radial(obs, size_mm, found, K, M, ridge, max_relabel_rounds, seed, history)[0]
+
+
+def fit_radial_hypotheses(obs: RingObservations, size_mm, n_basins: int = 3, K: int = 12, M: int = 1,
+                          ridge: float = 1e-8, max_relabel_rounds: int = 2, seed: int = 0,
+                          history: bool = True, **search) -> tuple[list[RadialField], RingObservations]:
+    """Radial fits from the ``n_basins`` best distinct pith-axis basins (pith hypotheses).
+
+    The first is :func:`fit_radial`'s answer (lowest in-sample cost). Unlabelled rings are
+    numbered once, by that first fit, and every other basin is fitted to the same numbers, so
+    the hypotheses differ in their stem, not in their ring numbering.
+
+    Returns
+    -------
+    fields : list of RadialField, best in-sample first (fewer when the search found fewer basins)
+    numbered : the observations with the years the fits used (relabelled traces corrected)
+    """
+    with _one_blas_thread():
+        found = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, n_basins=n_basins, **search)
+        first, numbered = _finish_radial(obs, size_mm, found[0], K, M, ridge, max_relabel_rounds, seed, history)
+        fields = [first]
+        for shape_field, _, _ in found[1:]:
+            if obs.labelled:  # its own mislabel correction, not the first hypothesis'
+                f, _ = _finish_radial(obs, size_mm, (shape_field, None, None), K, M, ridge,
+                                      max_relabel_rounds, seed, history)
+            else:  # coefficients in level units: refit to the shared numbers, no renumbering
+                start = _refit_labelled(numbered, size_mm, shape_field, ridge, seed=seed)
+                f, _ = _finish_radial(numbered, size_mm, (start, None, None), K, M, ridge,
+                                      max_relabel_rounds, seed, history, relabel=False)
+            fields.append(f)
+    return fields, numbered
+
+
+def _finish_radial(obs, size_mm, found, K, M, ridge, max_relabel_rounds, seed, history, relabel=True):
+    """Number (unlabelled), relabel, smooth and warp the axis fit ``found`` (a triple of
+    :func:`fit_axis_and_shape`); returns ``(field, observations with the years used)``."""
     labelled_in = obs.labelled
     if labelled_in:
-        field, _, _ = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, **search)
+        field = found[0]
     else:
-        shape_field, levels, groups = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, **search)
+        shape_field = found[0]
         # Levels of every group from the fitted shape (groups not in the fitting subset too).
         n = obs.n_groups
         lev = _group_medians(shape_field(obs.points_mm), obs.group, n)
@@ -480,7 +539,7 @@ def _fit_radial(obs, size_mm, K, M, ridge, max_relabel_rounds, seed, history, se
                             shape_field.coef * k, a)
         field = _refit_labelled(obs, size_mm, start, ridge, seed=seed)
     numbered = not labelled_in
-    for _ in range(max_relabel_rounds):
+    for _ in range(max_relabel_rounds if relabel else 0):
         obs, changed = _relabel(obs, field)
         if not changed:
             break
@@ -496,7 +555,8 @@ def _fit_radial(obs, size_mm, K, M, ridge, max_relabel_rounds, seed, history, se
         if field.history_levels is not None:
             field.history_levels = field.history_levels - shift
             field.history_years = field.history_years - shift
-    return field
+        obs = RingObservations(obs.points_mm, obs.years - shift, obs.group, obs.face)
+    return field, obs
 
 
 #: Ridge strengths tried on the final fit (relative units of :meth:`_Problem.solve`'s penalty).

@@ -25,7 +25,7 @@ It sits above ``block/``, ``logs/`` and ``appearance/``: none of those imports i
 from ..fields.analytic import AnalyticLogField
 from ..fields.rings import MOKUME_RING_SIGMA_MM
 from .block import synth_block
-from .cut import PATTERNS, SawPattern, cut_block, random_log_placement
+from .cut import PATTERNS, SawPattern, cut_block, knot_crosses, random_log_placement
 from .dataset import (
            benchmark_set_block,
            knotted_log_field,
@@ -36,6 +36,6 @@ from .rings import ring_eval_faces, ring_training_faces
 from .spec import PhotoSpec, RingMapSpec, SynthSpec, TraceSpec
 
 __all__ = ["MOKUME_RING_SIGMA_MM", "PATTERNS", "AnalyticLogField", "PhotoSpec", "RingMapSpec",
-           "SawPattern", "SynthSpec", "TraceSpec", "benchmark_set_block", "cut_block", "knotted_log_field",
-           "random_log_placement", "ring_eval_faces", "ring_training_faces", "synth_benchmark_set",
-           "synth_block", "time_synth_block"]
+           "SawPattern", "SynthSpec", "TraceSpec", "benchmark_set_block", "cut_block", "knot_crosses",
+           "knotted_log_field", "random_log_placement", "ring_eval_faces", "ring_training_faces",
+           "synth_benchmark_set", "synth_block", "time_synth_block"]

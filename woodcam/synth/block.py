@@ -25,7 +25,7 @@ from .traces import _trace_face
 def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | None = None, *,
                 wood: WoodLike | None = None,
                 rng: np.random.Generator | None = None, name: str = "synthetic",
-                meta: dict | None = None, **settings) -> Block:
+                meta: dict | None = None, knot_masks: bool = True, **settings) -> Block:
     """Render a synthetic :class:`Block` from a growth field placed in the block frame.
 
     Parameters
@@ -48,6 +48,8 @@ def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | No
         Used instead of ``np.random.default_rng(spec.seed)``.
     name, meta
         Block name and extra metadata.
+    knot_masks : for a field with ``knot_features`` (knotted logs), mark each face's knot wood
+        (weight > 0.5) in ``extras["knot_mask"]``, as the knot masks of Mokume's H11.
 
     Returns
     -------
@@ -110,7 +112,11 @@ def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | No
                 traces = _jitter(traces, px_mm, tr.jitter_mm, tr.jitter_corr_mm, rng)
             if tr.mislabel_fraction > 0 or tr.unlabelled_fraction > 0:
                 traces = _mislabel(traces, tr.mislabel_fraction, tr.unlabelled_fraction, rng)
-        out[face] = Face(face, shape, photo=photo, traces=traces, ring_map=rmap)
+        extras = {}
+        if knot_masks and hasattr(field, "knot_features"):
+            # as a tracer (or the knot detector) marks the knots on a photo: knot wood
+            extras["knot_mask"] = (np.asarray(field.knot_features(pts)["knot"]) > 0.5).reshape(shape)
+        out[face] = Face(face, shape, photo=photo, traces=traces, ring_map=rmap, extras=extras)
 
     flat = spec.flat()
     settings_meta = {

@@ -149,3 +149,59 @@ def random_log_placement(rng: np.random.Generator, pattern: SawPattern, size_mm,
                                                     else rng.uniform(-10, 10)),
     }
     return log, placement
+
+
+def knot_crosses(field, size_mm, n: int = 12) -> bool:
+    """True when a knot of ``field`` (block frame, with ``knot_features``) crosses the block:
+    some point of an ``n^3`` grid over it has knot weight > 0.5 (inside the knot wood)."""
+    if not hasattr(field, "knot_features"):
+        return False
+    size = check_size(size_mm)
+    axes = [np.linspace(0.0, s, n) for s in size]
+    pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    return bool(np.any(np.asarray(field.knot_features(pts)["knot"]) > 0.5))
+
+
+def _place_through_knot(rng: np.random.Generator, log_field, placement: dict, size, tries: int = 60):
+    """Move ``placement`` (kwargs of :func:`cut_block`) so that a knot of ``log_field`` crosses
+    the block: its centre on a random knot's strand, at a random pith distance between the
+    block's half diagonal and the knot's end (pith-inside: at the knot's base on the pith).
+
+    Returns ``(block-frame field, placement)``; checked with :func:`knot_crosses` (asserted from
+    the true field), raising :class:`WoodcamError` when no knot of the log reaches a block.
+    """
+    log = getattr(log_field, "log", None)
+    if log is None or not getattr(log, "knots", None):
+        raise WoodcamError(f"log_fields must return a knotted log field with knots (a .log with "
+                           f".knots, e.g. knotted_log_field); got {type(log_field).__name__}")
+    W, D, _ = size
+    half_diag = 0.5 * math.hypot(W, D)
+    # the whole block inside the log where it is thick enough; a log too thin for the block
+    # (a big block from a small generated log) keeps its field beyond the bark
+    r_out = max(float(log.r_min_mm) - half_diag - 5.0, half_diag + 12.0)
+    inside = placement["pattern"] == "pith-inside"
+    for _ in range(tries):
+        k = int(rng.integers(len(log.knots)))
+        kn = log.knots[k]
+        if inside:
+            r = float(placement["distance_mm"])
+            p = log.knot_point(k, [max(r, 2.0)])[0]
+        else:
+            # block centre at pith distance r_c; the knot reaches its inner half when it ends
+            # beyond the block's innermost side (r_c - min(W, D) / 2)
+            lo, hi = half_diag + 2.0, min(float(kn.r_end_mm) + 0.5 * min(W, D) - 3.0, r_out)
+            if hi <= lo:
+                continue
+            r_c = rng.uniform(lo, hi)
+            p = log.knot_point(k, [min(r_c, float(kn.r_end_mm) - 2.0)])[0]
+            r = max(r_c, half_diag + 1.0)  # cut_block measures from the log's z axis
+        moved = dict(placement, distance_mm=r, height_mm=float(p[2]),
+                     azimuth_deg=math.degrees(math.atan2(p[1], p[0])))
+        try:
+            field = cut_block(log_field, size, **moved)
+        except WoodcamError:  # the curved pith put the block on the wrong side of it
+            continue
+        if knot_crosses(field, size):
+            return field, moved
+    raise WoodcamError(f"no knot of this log crosses a {W:g} x {D:g} mm block after {tries} tries; "
+                       f"use a smaller block or a log with longer knots")

@@ -16,7 +16,7 @@ from ..block.io import write_block
 from ..errors import WoodcamError
 from ..fields.analytic import AnalyticLogField
 from .block import synth_block
-from .cut import PATTERNS, cut_block, random_log_placement
+from .cut import PATTERNS, _place_through_knot, cut_block, random_log_placement
 from .degradation import _check_fraction
 
 
@@ -40,12 +40,9 @@ def benchmark_set_block(seed: int, index: int, *, face_px: int = 512, size_range
     knotted = log_fields is not None and rng.uniform() < knotted_fraction
     if knotted:
         log = log_fields(rng)
-        # keep the block inside the knotted log (its outer radius), knots are near the bark
-        half_diag = 0.5 * math.hypot(size[0], size[1])
-        r_in = float(getattr(getattr(log, "log", None), "r_min_mm", 100.0)) - half_diag - 5.0
-        if placement["pattern"] != "pith-inside":
-            placement["distance_mm"] = max(half_diag + 2.0, min(placement["distance_mm"], r_in))
-    field = cut_block(log, size, **placement)
+        field, placement = _place_through_knot(rng, log, placement, size)
+    else:
+        field = cut_block(log, size, **placement)
     name = f"block_{i:04d}"
     info = {"name": name, "index": i, "size_mm": list(size), "knotted": bool(knotted),
             "ring_width_mm": log.ring_width_at(placement["distance_mm"]) if not knotted else None,
@@ -72,8 +69,8 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
     ----------
     log_fields : callable ``rng -> log-frame field``, optional
         Factory of knotted log fields (pith on log ``z``). When given, a block is knotted with
-        probability ``knotted_fraction``. TODO(knots/logs): pass the knotted log generator from
-        ``woodcam.logs`` here once it exists; until then every block is knot-free.
+        probability ``knotted_fraction``, and a knotted block is cut with a knot crossing it
+        (:func:`~woodcam.synth.cut.knot_crosses` on the true field, asserted).
     wood_factory : callable ``block-frame field -> wood``, optional
         Appearance for each block (e.g. ``lambda f: woodcam.appearance.Wood(f, ...)``); default
         the built-in colour map.

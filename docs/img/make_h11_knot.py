@@ -1,0 +1,38 @@
+"""Redraw docs/img/h11_knot_bake.png: H11's photos above the evidence fit's colour-map bake of the
+same faces (the knot fitted from the knot masks of faces C and F).
+
+Run from the repository root: ``python docs/img/make_h11_knot.py`` (needs ../shared/data).
+"""
+
+import warnings
+from pathlib import Path
+
+import matplotlib
+import numpy as np
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from woodcam.block.io import read_mokume  # noqa: E402
+from woodcam.frames import FACE_NORMAL, face_pixel_points  # noqa: E402
+from woodcam.stock import open_stock  # noqa: E402
+
+FOLDER = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "mokume" / "H11"
+warnings.simplefilter("ignore")
+stock = open_stock(str(FOLDER))
+block = read_mokume(FOLDER)
+faces = ("left", "back", "front", "top")
+fig, ax = plt.subplots(2, len(faces), figsize=(3 * len(faces), 6))
+for c, f in enumerate(faces):
+    face = block.faces[f]
+    pts = face_pixel_points(f, face.shape, block.size_mm).reshape(-1, 3)
+    n = np.broadcast_to(np.asarray(FACE_NORMAL[f], float), pts.shape)
+    rgb = np.clip(stock.wood.color(pts, n), 0, 1).reshape(face.shape + (3,))
+    ax[0, c].imshow(face.photo)
+    ax[0, c].set_title(f"{f} photo")
+    ax[1, c].imshow(rgb)
+    ax[1, c].set_title(f"{f} baked (evidence fit)")
+    for a in ax[:, c]:
+        a.axis("off")
+plt.tight_layout()
+plt.savefig(Path(__file__).with_name("h11_knot_bake.png"), dpi=60)

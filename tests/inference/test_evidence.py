@@ -1,0 +1,105 @@
+"""Issue 12 part 1: hypotheses chosen by leave-one-face-out evidence; flags; uncertainty."""
+
+import numpy as np
+import pytest
+
+from _eq79_blocks import make_block, random_field
+from woodcam.errors import WoodcamError, WoodcamWarning
+from woodcam.fields.grid import GridField
+from woodcam.inference import evaluate_fit, fit_block, gather_observations
+from woodcam.inference.evidence import (ConfidenceWood, Hypothesis, choose, confidence, fit_evidence,
+                                        holdout_evidence, radial_recipe, uncertainty_report)
+from woodcam.inference.radial import RadialField, _smoothest_coefficients, fit_radial
+
+
+@pytest.fixture(scope="module")
+def block():
+    rng = np.random.default_rng(7)
+    return make_block(random_field(rng), px_per_mm=3.0, rng=rng)
+
+
+@pytest.fixture(scope="module")
+def obs(block):
+    return gather_observations(block)
+
+
+def _planted(obs, good: RadialField, tilt_deg: float = 25.0) -> RadialField:
+    """A wrong pith hypothesis: the good axis tilted, its shape least-squares fitted to every
+    face, so it reproduces the faces it was fitted to about as well as it can."""
+    d = good.axis / np.linalg.norm(good.axis)
+    perp = np.cross(d, [0.3, 0.5, 0.8])
+    perp /= np.linalg.norm(perp)
+    t = np.deg2rad(tilt_deg)
+    wrong = RadialField(good.pith_mm + 8 * perp, np.cos(t) * d + np.sin(t) * perp, good.z_scale_mm,
+                        good.K, good.M, good.coef, good.offset)
+    return _smoothest_coefficients(obs, wrong, 0)
+
+
+def test_planted_wrong_hypothesis_is_rejected_by_held_out_faces(block, obs):
+    good = fit_radial(obs, block.size_mm)
+    wrong = _planted(obs, good)
+    hyps = [Hypothesis("planted", wrong, radial_recipe(wrong)), Hypothesis("radial", good, radial_recipe(good))]
+    ev = holdout_evidence(hyps, obs)
+    res = choose(hyps, ev)
+    assert res.chosen == "radial"           # chosen although the planted one is listed first
+    assert res.scores["radial"]["mean"] > 90.0
+    assert res.scores["planted"]["mean"] < res.scores["radial"]["mean"] - 30.0
+    assert not res.contradicted
+    # the planted field alone is not returned silently: the held-out faces contradict it
+    alone = choose(hyps[:1], holdout_evidence(hyps[:1], obs))
+    assert alone.contradicted and "CONTRADICTED" in alone.message
+    # and the truth agrees with the evidence
+    acc_good = evaluate_fit(block.true_field, good, block.size_mm, pixel_mm=0.25)[0]["matched_2"]
+    acc_wrong = evaluate_fit(block.true_field, wrong, block.size_mm, pixel_mm=0.25)[0]["matched_2"]
+    assert acc_good > acc_wrong + 20
+
+
+def test_fit_evidence_with_a_planted_extra_hypothesis(block, obs):
+    good = fit_radial(obs, block.size_mm)
+    wrong = _planted(obs, good)
+    res = fit_evidence(obs, block.size_mm, n_basins=2, extra=[Hypothesis("planted", wrong, radial_recipe(wrong))])
+    assert res.chosen != "planted"
+    assert "planted" not in res.accepted
+    assert res.scores[res.chosen]["mean"] > 90.0
+
+
+def test_one_face_is_unverified_and_warns(block):
+    one = gather_observations(block, ["front"])
+    with pytest.warns(WoodcamWarning, match="only one face"):
+        res = fit_evidence(one, block.size_mm, n_basins=1, candidates=("radial",))
+    assert res.unverified and res.chosen == "radial"
+
+
+def test_fit_block_evidence_grid_carries_meta_and_uncertainty(block, tmp_path):
+    grid = fit_block(block, "evidence", faces=["front", "top", "left"])
+    assert isinstance(grid, GridField)
+    assert grid.meta["method"] == "evidence" and grid.meta["chosen"] in grid.meta["scores"]
+    assert grid.meta["faces"] == ["front", "top", "left"]
+    # uncertainty grows away from the observed faces: the back-bottom-right corner is unseen
+    size = np.asarray(block.size_mm)
+    near = grid.uncertainty_years([[1.0, 1.0, size[2] - 1]])
+    far = grid.uncertainty_years([[size[0] - 1, size[1] - 1, 1.0]])
+    assert far[0] > near[0] + 0.5
+    assert 0 < confidence(far)[0] < confidence(near)[0] <= 1
+    loaded = GridField.load(grid.save(tmp_path / "f.npz"))
+    assert loaded.meta == grid.meta
+    np.testing.assert_allclose(loaded.layers["uncertainty"], grid.layers["uncertainty"])
+    acc = evaluate_fit(block.true_field, grid, block.size_mm, pixel_mm=0.25)[0]
+    assert acc["matched_1"] > 90.0
+    # the bake report line: a part in the unseen back-right-bottom corner is the uncertain one,
+    # and the face to photograph is one the fit did not see
+    corner = np.random.default_rng(1).uniform(0.7, 1.0, (500, 3)) * size
+    corner[:, 2] = size[2] - corner[:, 2]  # bottom
+    line = uncertainty_report(grid, corner, size, "bowl")
+    assert "uncertain" in line and any(f"photograph the {f} face" in line for f in ("bottom", "right", "back"))
+    near_seen = np.random.default_rng(2).uniform(0.0, 0.05, (500, 3)) * size
+    near_seen[:, 2] = size[2] - near_seen[:, 2]
+    assert "well constrained" in uncertainty_report(grid, near_seen, size, "lid")
+    assert uncertainty_report(block.true_field, corner, size) is None
+    rgb = ConfidenceWood(grid).color(np.concatenate([corner[:1], near_seen[:1]]))
+    assert rgb[0, 0] > rgb[1, 0] and rgb[0, 1] < rgb[1, 1]  # redder where less sure
+
+
+def test_candidates_are_checked(obs, block):
+    with pytest.raises(WoodcamError, match="candidates must include 'radial'"):
+        fit_evidence(obs, block.size_mm, candidates=("rbf",))

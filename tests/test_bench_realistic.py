@@ -1,0 +1,41 @@
+"""woodcam.bench_realistic: the per-block scoring task of the ring benchmark and its summary."""
+
+import json
+
+import pytest
+
+from woodcam.bench_realistic import bootstrap_ci, make_block, markdown, score_block, summarise
+from woodcam.errors import WoodcamError
+from woodcam.inference.evaluate import DEFAULT_PLANES
+
+
+def test_score_block_is_plain_json_and_scores_the_sanity_row():
+    row = score_block(3, 0, ("radial",), "clean", "full", kind="eq79", face_px=64,
+                      planes=DEFAULT_PLANES[:2], pixel_mm=0.25)
+    json.dumps(row)  # records must be plain JSON for a runner
+    assert row["kind"] == "eq79" and row["faces"] == "full" and row["scenario"] == "clean"
+    # an eq. 7-9 block with clean traces on six faces is the radial model's own family
+    assert row["radial"]["matched_1"] > 95 and row["radial"]["fit_s"] > 0
+    # the task is a pure function of (seed, index): the block is regenerated identically
+    (a, _), (b, _) = make_block(3, 0, "clean", "eq79", 32), make_block(3, 0, "clean", "eq79", 32)
+    assert a.faces["front"].traces[0].year == b.faces["front"].traces[0].year
+    assert (a.faces["front"].traces[0].points_px == b.faces["front"].traces[0].points_px).all()
+    rows = [row, dict(row, name="other", radial=dict(row["radial"], matched_2=50.0))]
+    (g,) = summarise(rows, ["radial"])
+    assert g["n"] == 2 and g["radial"]["matched_2_worst"] == 50.0
+    assert g["radial"]["matched_2_worst_block"] == "other"
+    assert "| clean | full | eq79 | 2 |" in markdown([g], ["radial"])
+
+
+def test_bootstrap_interval_brackets_the_mean():
+    lo, hi = bootstrap_ci([80.0, 90.0, 100.0, 70.0])
+    assert lo < 85.0 < hi and 70 <= lo and hi <= 100
+
+
+def test_bad_options_are_named():
+    with pytest.raises(WoodcamError, match="scenario must be one of"):
+        score_block(1, 0, ("radial",), "foggy")
+    with pytest.raises(WoodcamError, match="methods must be from"):
+        score_block(1, 0, ("magic",))
+    with pytest.raises(WoodcamError, match="face_set must be one of"):
+        score_block(1, 0, ("radial",), "clean", "two")

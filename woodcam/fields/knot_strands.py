@@ -1,0 +1,156 @@
+"""Knot strands inside a fitted stem field (issue 12 part 3; seed 003's knot model, simplified).
+
+A fitted stem field (any ``(n, 3) mm -> years`` in the block frame: a radial fit, an RBF, a baked
+grid) has no pith distance or age origin one can trust, so seed 003's times "from the pith" are
+replaced by the stem's own growth time:
+
+- the strand point of a point ``p`` is its nearest point ``S`` on the strand, at distance ``d``;
+  ``R`` is the knot radius there and ``G`` the stem's ring density (years/mm) at ``S``;
+- inside the knot (``d < R``) its time is ``b = g(S) + (d / R) (g(p) - g(S)) - (R - d) G``:
+  concentric rings round the strand at its core with the stem's ring spacing, turning into the
+  stem's time on the knot surface ``d = R`` (seed 003: ``t_b = t_s`` at the measured diameter);
+  ``b <= g(p)`` inside for any stem (``|g(p) - g(S)| <= d G``), so the knot is exactly the
+  cylinder ``d < R``; outside, ``b = g(p) + (d - R) G`` leaves the stem in charge.
+  (Seed 003 takes the strand point "at the same pith distance", which needs a fitted pith a
+  knot strand is radial to; a fitted stem of a real block is not that exact.)
+- stem and knot join by a smooth minimum. Seed 003's power smooth minimum (its eq. 2) needs
+  times from the pith; this one is the polynomial smooth minimum
+  ``min(a, b) - h^2 k / 4, h = max(k - |a - b|, 0) / k`` with ``k`` in years, which bends the
+  stem's rings round the knot within about ``k`` rings of its surface.
+
+Alive knots only (a mask does not say whether the knot died; dead-knot outlines are not drawn).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from ..errors import WoodcamError
+from .base import check_points
+
+#: Smoothing ``k`` (years) of the stem-knot smooth minimum: rings bend round a knot within about
+#: one ring of its surface, as on H11's faces C and F (looked at).
+KNOT_SMOOTH_YEARS = 1.0
+
+#: Width (mm) over which the knot darkening weight falls from 1 to 0 across the knot surface.
+KNOT_EDGE_MM = 0.3
+
+_SAMPLES = 256
+
+
+@dataclass(frozen=True)
+class KnotStrand:
+    """A straight branch strand through a block, block frame mm.
+
+    start_mm, end_mm : (3,) its ends (beyond the block); radius_start_mm, radius_end_mm : knot
+    radius at the ends, linear in between; dead : False (alive) - kept for seed 003's model.
+    """
+
+    start_mm: tuple
+    end_mm: tuple
+    radius_start_mm: float
+    radius_end_mm: float
+    dead: bool = False
+
+    def __post_init__(self):
+        if min(self.radius_start_mm, self.radius_end_mm) <= 0:
+            raise WoodcamError(f"knot radii must be > 0 mm; got {self.radius_start_mm}, {self.radius_end_mm}")
+        if np.allclose(self.start_mm, self.end_mm):
+            raise WoodcamError("a knot strand needs two different ends")
+
+    def samples(self, n: int = _SAMPLES):
+        """Points ``(n, 3)`` and radii ``(n,)`` along the strand."""
+        t = np.linspace(0.0, 1.0, n)[:, None]
+        a, b = np.asarray(self.start_mm, float), np.asarray(self.end_mm, float)
+        return a + t * (b - a), self.radius_start_mm + t[:, 0] * (self.radius_end_mm - self.radius_start_mm)
+
+
+def _smin(a, b, k):
+    h = np.maximum(k - np.abs(a - b), 0.0) / k
+    return np.minimum(a, b) - h * h * k / 4.0
+
+
+class StemWithKnots:
+    """``years(p)``: a stem field with knot strands joined in (module docstring).
+
+    stem : ``(n, 3) mm -> (n,) years``; strands : list of :class:`KnotStrand`.
+    dense : the knot's ring density ``G`` is ``max(G, g(S) / R)`` where ``g(S) > 0``: with growth
+        time counted from the pith (woodcam's convention) the knot then holds every ring since
+        the pith and its time is ``b = (d / R) g(p)``, seed 003's ``t_b = d t_s / R``. False keeps
+        the stem's ring spacing inside the knot.
+    """
+
+    def __init__(self, stem, strands, smoothing_years: float = KNOT_SMOOTH_YEARS, dense: bool = True):
+        self.stem = stem
+        self.dense = bool(dense)
+        self.strands = list(strands)
+        self.k = float(smoothing_years)
+        self.axis = getattr(stem, "axis", (0.0, 0.0, 1.0))
+        self._tables = [self._table(s) for s in self.strands]
+
+    def _table(self, strand: KnotStrand):
+        pts, rad = strand.samples()
+        h = 0.25
+        offs = np.concatenate([np.eye(3), -np.eye(3)]) * h
+        g = np.asarray(self.stem(np.concatenate([pts + o for o in offs])), float).reshape(6, len(pts))
+        dens = np.linalg.norm((g[:3] - g[3:]).T, axis=1) / (2 * h)
+        gs = np.asarray(self.stem(pts), float)
+        a, b = np.asarray(strand.start_mm, float), np.asarray(strand.end_mm, float)
+        return a, b - a, rad, gs, np.maximum(dens, 1e-3)
+
+    @staticmethod
+    def _geometry(p: np.ndarray, table):
+        """``d``, ``R``, ``G`` and the stem time at the strand point of each point."""
+        a, v, rad, gs, dens = table
+        t = np.clip((p - a) @ v / (v @ v), 0.0, 1.0)
+        d = np.linalg.norm(p - (a + t[:, None] * v), axis=1)
+        s = t * (len(rad) - 1)
+        return d, np.interp(s, np.arange(len(rad)), rad), np.interp(s, np.arange(len(rad)), dens), \
+            np.interp(s, np.arange(len(rad)), gs)
+
+    def _knot_time(self, p, g, table):
+        d, R, G, gS = self._geometry(p, table)
+        if self.dense:  # seed 003: the knot holds every ring since the pith
+            G = np.where(gS > 0, np.maximum(G, gS / R), G)
+        inside = gS + (d / R) * (g - gS) - (R - d) * G
+        return np.where(d < R, inside, g + (d - R) * G)
+
+    def __call__(self, points_mm) -> np.ndarray:
+        p = check_points(points_mm)
+        gs = np.asarray(self.stem(p), float)
+        out = gs.copy()
+        for table in self._tables:
+            out = _smin(out, self._knot_time(p, gs, table), self.k)
+        return out
+
+    def knot_features(self, points_mm) -> dict:
+        """``knot`` (0..1 darkening weight: 1 inside a knot), ``dead`` and ``outline`` (0: alive
+        knots only), each ``(n,)``, as :meth:`woodcam.fields.KnottedLogField.knot_features`."""
+        p = check_points(points_mm)
+        knot = np.zeros(len(p))
+        for table in self._tables:
+            d, R, _, _ = self._geometry(p, table)
+            knot = np.maximum(knot, np.clip((R - d) / KNOT_EDGE_MM + 0.5, 0.0, 1.0))
+        zeros = np.zeros(len(p))
+        return {"knot": knot, "dead": zeros, "outline": zeros}
+
+    def grain_direction(self, points_mm) -> np.ndarray:
+        p = check_points(points_mm)
+        a = np.asarray(self.axis, float)
+        return np.broadcast_to(a / np.linalg.norm(a), p.shape).copy()
+
+
+def strands_to_meta(strands) -> list[dict]:
+    """Plain-JSON list of strands (kept in a baked grid's ``meta["knots"]``)."""
+    return [{k: (list(map(float, v)) if isinstance(v, (tuple, list, np.ndarray)) else v)
+             for k, v in asdict(s).items()} for s in strands]
+
+
+def strands_from_meta(items) -> list[KnotStrand]:
+    return [KnotStrand(tuple(d["start_mm"]), tuple(d["end_mm"]), float(d["radius_start_mm"]),
+                       float(d["radius_end_mm"]), bool(d.get("dead", False))) for d in items]
+
+
+__all__ = ["KNOT_SMOOTH_YEARS", "KnotStrand", "StemWithKnots", "strands_from_meta", "strands_to_meta"]

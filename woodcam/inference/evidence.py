@@ -1,0 +1,413 @@
+"""Never collapse: fit several hypotheses and choose by leave-one-face-out evidence (issue 12, part 1).
+
+Each fitter fails on different blocks (the radial fit takes a knot for the pith, or folds its
+rings where three faces leave it a wedge of azimuths; RBF is smooth but cannot extrapolate), and a
+fit's own residual cannot tell: every wrong hypothesis reproduces the faces it was fitted to. The
+faces it was *not* fitted to can. So:
+
+1. Hypotheses: the radial fit from its best distinct pith-axis basins
+   (:func:`~.radial.fit_radial_hypotheses`), a thin-plate RBF of the (numbered) ring points
+   (seed 000's baseline), and the best radial stem plus a smoothed RBF of its residual
+   (part 4's small-scale distortion, seed 000 Fig. 16b).
+2. Evidence: for each observed face ``f`` every hypothesis' *recipe* is refitted on the other
+   faces and predicts ``f``'s ring points. A radial hypothesis keeps its pith axis (the
+   hypothesis) and refits its ring-width shape and growth history; RBF and the residual are
+   refitted outright. A held-out point's error is its distance (mm) to the predicted ring line of
+   its year, ``|g(p) - year| / |grad g(p)|`` (first order; the metric of seed 000's Table 1
+   measured on the faces); a face's score is the mean of the shares within 1 and 2 mm.
+3. Choice: the hypothesis with the best mean held-out score. The fit is flagged ``contradicted``
+   (and a :class:`~woodcam.errors.WoodcamWarning` is raised) when even the chosen hypothesis
+   predicts some observed face badly (:data:`~woodcam.tolerances.EVIDENCE_MIN_FACE_SHARE_2MM`),
+   and ``unverified`` when fewer than two faces carry rings (nothing to hold out).
+4. Confidence (part 5): the spread (years) of the hypotheses whose evidence is close to the
+   best one's, per point (:meth:`EvidenceFit.uncertainty_years`).
+
+Years: labelled traces are scored against their labels (a few mislabelled traces cost a few
+points of share, equally for every hypothesis); unlabelled rings are numbered once by the best
+in-sample radial fit and every hypothesis is fitted and scored on those numbers.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+from dataclasses import field as dc_field
+
+import numpy as np
+
+from .._types import ArrayLike
+
+from ..errors import WoodcamError, WoodcamWarning
+from ..frames import FACES
+from ..tolerances import (
+    EVIDENCE_ACCEPT_MARGIN,
+    EVIDENCE_MAX_HELD_POINTS,
+    EVIDENCE_MIN_FACE_POINTS,
+    EVIDENCE_MIN_FACE_SHARE_2MM,
+    EVIDENCE_RBF_POINTS,
+    EVIDENCE_RESIDUAL_SMOOTHING,
+    EVIDENCE_SPREAD_SPACING_MM,
+    EVIDENCE_UNSEEN_YEARS_PER_MM,
+)
+from .observations import RingObservations
+from .radial import (
+    RadialField,
+    _fit_growth_history,
+    _one_blas_thread,
+    _smoothest_coefficients,
+    fit_radial_hypotheses,
+)
+from .rbf import fit_rbf
+
+#: Mean confidence over a part above which the bake report calls its rings well constrained.
+CONFIDENT_MEAN = 0.8
+
+#: Finite-difference step (mm) of the growth-time gradient that turns a year error into mm.
+_GRAD_STEP_MM = 0.25
+
+
+@dataclass
+class Hypothesis:
+    """One candidate field and how to refit it on a subset of the observations.
+
+    field : ``(n, 3) mm -> (n,) years``, fitted on every observed face
+    refit : ``RingObservations -> field``, the same recipe on fewer faces
+    """
+
+    name: str
+    field: Callable
+    refit: Callable
+
+
+@dataclass
+class EvidenceFit:
+    """The chosen field with the evidence behind it.
+
+    Attributes
+    ----------
+    field : the chosen hypothesis' field, fitted on every observed face
+    chosen : its name
+    scores : hypothesis name -> {face name -> held-out score, percent}; ``"mean"`` their mean
+    contradicted : True when the chosen field predicts some held-out face below
+        :data:`EVIDENCE_MIN_FACE_SHARE_2MM` within 2 mm (the fit is then a guess there)
+    unverified : True when fewer than two faces carry rings (nothing could be held out)
+    accepted : names of the hypotheses whose evidence is within :data:`EVIDENCE_ACCEPT_MARGIN`
+        of the chosen one's (they define the confidence)
+    message : one line for the user
+    """
+
+    field: Callable
+    chosen: str
+    scores: dict
+    contradicted: bool
+    unverified: bool
+    accepted: list
+    message: str
+    hypotheses: dict = dc_field(default_factory=dict, repr=False)
+
+    def __call__(self, points_mm: ArrayLike) -> np.ndarray:
+        return self.field(points_mm)
+
+    @property
+    def axis(self):
+        return getattr(self.field, "axis", (0.0, 0.0, 1.0))
+
+    def uncertainty_years(self, points_mm: ArrayLike) -> np.ndarray:
+        """``(n,)`` years: standard deviation of the accepted hypotheses' growth time at
+        ``points_mm (n, 3)`` (0 where they agree, or where only one was accepted)."""
+        p = np.asarray(points_mm, float)
+        if len(self.accepted) < 2:
+            return np.zeros(len(p))
+        return np.std(np.stack([self.hypotheses[n](p) for n in self.accepted]), axis=0)
+
+
+def _years_error_mm(field, points: np.ndarray, years: np.ndarray) -> np.ndarray:
+    """Distance (mm, first order) from each point to ``field``'s ring line of its year."""
+    h = _GRAD_STEP_MM
+    offs = np.concatenate([np.eye(3), -np.eye(3)]) * h
+    allp = np.concatenate([points] + [points + o for o in offs])
+    g = np.asarray(field(allp), float).reshape(7, len(points))
+    grad = (g[1:4] - g[4:7]).T / (2 * h)
+    return np.abs(g[0] - years) / np.maximum(np.linalg.norm(grad, axis=1), 1e-6)
+
+
+def face_score(err_mm: np.ndarray) -> float:
+    """Held-out score of one face, percent: mean of the shares of points within 1 and 2 mm."""
+    if not len(err_mm):
+        return 0.0
+    return float(50.0 * (np.mean(err_mm <= 1.0) + np.mean(err_mm <= 2.0)))
+
+
+def _held_out_faces(obs: RingObservations) -> list[int]:
+    ids, counts = np.unique(obs.face, return_counts=True)
+    return [int(i) for i, c in zip(ids, counts) if c >= EVIDENCE_MIN_FACE_POINTS]
+
+
+def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: int = 0) -> dict:
+    """Leave-one-face-out score of every hypothesis on every face with enough ring points.
+
+    Returns name -> {face name -> {"score": percent, "share_2mm": percent}}; empty dicts when
+    fewer than two faces have rings.
+    """
+    faces = _held_out_faces(obs)
+    out = {h.name: {} for h in hypotheses}
+    if len(faces) < 2:
+        return out
+    rng = np.random.default_rng(seed)
+    for f in faces:
+        held = obs.face == f
+        rest = obs.subset(~held)
+        idx = np.flatnonzero(held)
+        if len(idx) > EVIDENCE_MAX_HELD_POINTS:
+            idx = np.sort(rng.choice(idx, EVIDENCE_MAX_HELD_POINTS, replace=False))
+        pts, yrs = obs.points_mm[idx], obs.years[idx]
+        for h in hypotheses:
+            try:
+                fitted = h.refit(rest)
+                err = _years_error_mm(fitted, pts, yrs)
+            except (WoodcamError, np.linalg.LinAlgError, ValueError):
+                err = np.full(len(pts), np.inf)  # a recipe that cannot refit has no evidence
+            out[h.name][FACES[f]] = {"score": face_score(err), "share_2mm": float(100 * np.mean(err <= 2.0))}
+    return out
+
+
+def choose(hypotheses: list[Hypothesis], evidence: dict) -> EvidenceFit:
+    """Pick the hypothesis with the best mean held-out score (the first on ties or without
+    evidence); flag the result when the evidence contradicts it (see :class:`EvidenceFit`)."""
+    names = [h.name for h in hypotheses]
+    by_name = {h.name: h for h in hypotheses}
+    scores = {}
+    for n in names:
+        per = {face: v["score"] for face, v in evidence[n].items()}
+        per["mean"] = float(np.mean(list(per.values()))) if per else float("nan")
+        scores[n] = per
+    unverified = not evidence[names[0]]
+    if unverified:
+        best = names[0]
+        accepted = [best]
+        contradicted = False
+        msg = (f"{best}: only one face carries rings, so no face could be held out to check the "
+               f"fit; trace or photograph a second face")
+    else:
+        best = max(names, key=lambda n: scores[n]["mean"])  # max keeps the first on ties
+        accepted = [n for n in names if scores[n]["mean"] >= scores[best]["mean"] - EVIDENCE_ACCEPT_MARGIN]
+        bad = {face: v["share_2mm"] for face, v in evidence[best].items()
+               if v["share_2mm"] < EVIDENCE_MIN_FACE_SHARE_2MM}
+        contradicted = bool(bad)
+        msg = (f"chose {best} (held-out score {scores[best]['mean']:.1f} %; "
+               + ", ".join(f"{n} {scores[n]['mean']:.1f}" for n in names if n != best) + ")")
+        if contradicted:
+            msg += ("; CONTRADICTED by held-out faces " + ", ".join(
+                f"{face} ({v:.0f} % within 2 mm)" for face, v in bad.items())
+                + ": the inside is a guess there; trace more rings or another face")
+    fields = {n: by_name[n].field for n in names}
+    return EvidenceFit(by_name[best].field, best, scores, contradicted, unverified, accepted, msg, fields)
+
+
+def radial_recipe(field: RadialField, seed: int = 0) -> Callable:
+    """Refit a radial hypothesis on other observations with its pith axis kept (the hypothesis)
+    and its ring-width shape and growth history refitted."""
+    def refit(obs: RingObservations):
+        f = _smoothest_coefficients(obs, field, seed)
+        return _fit_growth_history(obs, f, seed) if field.history_levels is not None else f
+    return refit
+
+
+def _rbf_recipe(max_points: int) -> Callable:
+    return lambda obs: fit_rbf(obs, max_points=max_points)
+
+
+class _StemPlusResidual:
+    """``stem(p) + residual(p)``: a smooth stem and a smoothed RBF of what it leaves (part 4)."""
+
+    def __init__(self, stem, residual):
+        self.stem, self.residual = stem, residual
+        self.axis = getattr(stem, "axis", (0.0, 0.0, 1.0))
+
+    def __call__(self, points_mm):
+        p = np.asarray(points_mm, float)
+        return self.stem(p) + self.residual(p)
+
+
+def _residual_recipe(stem_recipe: Callable, max_points: int) -> Callable:
+    def refit(obs: RingObservations):
+        from scipy.interpolate import RBFInterpolator
+
+        from .rbf import thin_out
+
+        stem = stem_recipe(obs)
+        i = thin_out(len(obs.points_mm), max_points)
+        pts = obs.points_mm[i]
+        _, uniq = np.unique(np.round(pts, 6), axis=0, return_index=True)
+        res = obs.years[i][uniq] - stem(pts[uniq])
+        rbf = RBFInterpolator(pts[uniq], res, kernel="thin_plate_spline",
+                              smoothing=EVIDENCE_RESIDUAL_SMOOTHING * len(uniq))
+        return _StemPlusResidual(stem, rbf)
+    return refit
+
+
+Candidate = str
+#: Hypothesis families :func:`fit_evidence` can try.
+CANDIDATES: tuple[Candidate, ...] = ("radial", "rbf", "residual")
+
+
+def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
+                 candidates: tuple[str, ...] = CANDIDATES, seed: int = 0, extra: list[Hypothesis] | None = None,
+                 warn: bool = True) -> EvidenceFit:
+    """Fit the hypotheses and choose by leave-one-face-out evidence (module docstring).
+
+    Parameters
+    ----------
+    obs : ring observations (labelled or not) of a block, block frame mm
+    size_mm : (3,) block size
+    n_basins : pith-axis basins of the radial fit to try as hypotheses
+    candidates : hypothesis families, from :data:`CANDIDATES`
+    extra : further hypotheses to judge with the others (e.g. a planted one in a test)
+    warn : emit a :class:`~woodcam.errors.WoodcamWarning` when the choice is contradicted
+
+    Returns
+    -------
+    EvidenceFit
+    """
+    bad = [c for c in candidates if c not in CANDIDATES]
+    if bad or "radial" not in candidates:
+        raise WoodcamError(f"candidates must include 'radial' and come from {CANDIDATES}; got {list(candidates)}")
+    with _one_blas_thread():
+        radials, numbered = fit_radial_hypotheses(obs, size_mm, n_basins=n_basins, seed=seed)
+        hyps = [Hypothesis("radial" if i == 0 else f"radial basin {i + 1}", f, radial_recipe(f, seed))
+                for i, f in enumerate(radials)]
+        if "rbf" in candidates:
+            rec = _rbf_recipe(EVIDENCE_RBF_POINTS)
+            hyps.append(Hypothesis("rbf", rec(numbered), rec))
+        if "residual" in candidates:
+            rec = _residual_recipe(radial_recipe(radials[0], seed), EVIDENCE_RBF_POINTS)
+            hyps.append(Hypothesis("radial + residual", rec(numbered), rec))
+        hyps += list(extra or [])
+        result = choose(hyps, holdout_evidence(hyps, numbered, seed))
+    if warn and (result.contradicted or result.unverified):
+        warnings.warn(result.message, WoodcamWarning, stacklevel=2)
+    return result
+
+
+def distance_to_faces_mm(points_mm, size_mm, faces) -> np.ndarray:
+    """``(n,)`` mm from each block point to the nearest of the block faces ``faces`` (indices
+    into :data:`~woodcam.frames.FACES`); inf when ``faces`` is empty."""
+    from ..frames import FACE_NORMAL
+
+    p = np.asarray(points_mm, float)
+    size = np.asarray(size_mm, float)
+    d = np.full(len(p), np.inf)
+    for i in faces:
+        n = np.asarray(FACE_NORMAL[FACES[i]], float)
+        ax = int(np.argmax(np.abs(n)))
+        dist = size[ax] - p[:, ax] if n[ax] > 0 else p[:, ax]
+        d = np.minimum(d, np.abs(dist))
+    return d
+
+
+def uncertainty_years(ev: EvidenceFit, points_mm, size_mm, faces) -> np.ndarray:
+    """Per-point uncertainty (years) of an evidence fit, issue 12 part 5: the spread of the
+    accepted hypotheses plus :data:`EVIDENCE_UNSEEN_YEARS_PER_MM` per mm from the nearest
+    observed face (what no face shows is a guess even when the hypotheses agree)."""
+    p = np.asarray(points_mm, float)
+    return ev.uncertainty_years(p) + EVIDENCE_UNSEEN_YEARS_PER_MM * distance_to_faces_mm(p, size_mm, faces)
+
+
+def confidence(uncertainty: np.ndarray) -> np.ndarray:
+    """Confidence in ``[0, 1]`` from an uncertainty in years: ``exp(-(u / 0.5)^2)``; half a year
+    of doubt (rings there may be where gaps are) gives 0.37."""
+    return np.exp(-(np.asarray(uncertainty, float) / 0.5) ** 2)
+
+
+def bake_evidence(ev: EvidenceFit, size_mm, faces, strands=()):
+    """Bake the chosen field to a :class:`~woodcam.fields.GridField` carrying the per-node
+    :func:`uncertainty_years` and the evidence (chosen hypothesis, scores, flags) in ``meta``.
+
+    The hypotheses' spread is sampled on a grid of :data:`EVIDENCE_SPREAD_SPACING_MM` and
+    interpolated to the bake nodes (it is smooth; the RBF hypotheses are slow to evaluate).
+    """
+    from scipy import ndimage
+
+    from ..fields.grid import GridField
+    from .baked import bake
+
+    grid = bake(ev.field, size_mm)
+    shape = grid.years.shape
+    axes = [grid.origin_mm[i] + grid.spacing_mm[i] * np.arange(shape[i]) for i in range(3)]
+    nodes = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    spread = np.zeros(len(nodes))
+    if len(ev.accepted) > 1:
+        step = EVIDENCE_SPREAD_SPACING_MM
+        lo, hi = np.asarray(grid.origin_mm), nodes.max(axis=0)
+        cax = [np.arange(lo[i], hi[i] + step, step) for i in range(3)]
+        coarse = np.stack(np.meshgrid(*cax, indexing="ij"), axis=-1).reshape(-1, 3)
+        cs = ev.uncertainty_years(coarse).reshape([len(a) for a in cax])
+        spread = ndimage.map_coordinates(cs, ((nodes - lo) / step).T, order=1, mode="nearest")
+    unc = spread + EVIDENCE_UNSEEN_YEARS_PER_MM * distance_to_faces_mm(nodes, size_mm, faces)
+    layers = {"uncertainty": unc.reshape(shape)}
+    if strands:  # knots fitted into the field (part 3): their darkening weight as a layer
+        from ..fields.knot_strands import strands_to_meta
+
+        layers["knot"] = np.asarray(ev.field.knot_features(nodes)["knot"]).reshape(shape)
+    meta = {"method": "evidence", "chosen": ev.chosen, "contradicted": ev.contradicted,
+            "unverified": ev.unverified, "accepted": list(ev.accepted), "message": ev.message,
+            "faces": [FACES[i] for i in faces],
+            "scores": {n: {k: round(float(v), 2) for k, v in sc.items()} for n, sc in ev.scores.items()}}
+    if strands:
+        meta["knots"] = strands_to_meta(strands)
+    return GridField(grid.years, grid.origin_mm, grid.spacing_mm, grid.interpolation, grid.axis,
+                     layers, meta)
+
+
+_THIRDS = (("left", "middle", "right"), ("front", "middle", "back"), ("bottom", "middle", "top"))
+
+
+def uncertainty_report(field, points_mm, size_mm, what: str = "part") -> str | None:
+    """One line on where a fit's rings are a guess (issue 12 part 5), or None when ``field``
+    carries no uncertainty (a true field, a plain fit).
+
+    points_mm : (n, 3) points of the part (block frame), e.g. its mesh vertices. The part is
+    cut in thirds along each block axis; the third with the lowest mean :func:`confidence` is
+    named, with the unobserved face nearest to it to photograph (``field.meta["faces"]``).
+    """
+    layers = getattr(field, "layers", {}) or {}
+    if "uncertainty" not in layers or not len(points_mm):
+        return None
+    p = np.asarray(points_mm, float)
+    conf = confidence(field.uncertainty_years(p))
+    if conf.mean() >= CONFIDENT_MEAN:
+        return f"the rings of this {what} are well constrained (mean confidence {conf.mean():.2f})"
+    size = np.asarray(size_mm, float)
+    worst = None
+    for ax in range(3):
+        third = np.clip((p[:, ax] / size[ax] * 3).astype(int), 0, 2)
+        for t in range(3):
+            sel = third == t
+            if sel.mean() >= 0.05 and (worst is None or conf[sel].mean() < worst[0]):
+                worst = (float(conf[sel].mean()), ax, t, p[sel].mean(axis=0))
+    c, ax, t, centre = worst
+    seen = set((getattr(field, "meta", {}) or {}).get("faces", []))
+    unseen = [f for f in FACES if f not in seen] or list(FACES)
+    face = min(unseen, key=lambda f: distance_to_faces_mm(centre[None], size, [FACES.index(f)])[0])
+    place = "middle" if t == 1 else _THIRDS[ax][t]
+    axis_word = ("left-right", "front-back", "bottom-top")[ax]
+    return (f"the rings in the {place} third ({axis_word}) of this {what} are uncertain "
+            f"(confidence {c:.2f}, whole {what} {conf.mean():.2f}): photograph the {face} face")
+
+
+class ConfidenceWood:
+    """A stand-in for a ``Wood`` that colours surfaces by the fit's :func:`confidence`
+    (red 0 -> yellow 0.5 -> green 1): the ``--confidence`` overlay of ``woodcam preview``."""
+
+    def __init__(self, field):
+        self.field = field
+
+    def color(self, points_mm, normals=None) -> np.ndarray:
+        c = confidence(self.field.uncertainty_years(np.asarray(points_mm, float)))
+        return np.stack([np.clip(2 - 2 * c, 0, 1), np.clip(2 * c, 0, 1), np.full_like(c, 0.1)], axis=1)
+
+
+__all__ = ["CANDIDATES", "ConfidenceWood", "EvidenceFit", "Hypothesis", "bake_evidence", "choose", "confidence",
+           "distance_to_faces_mm", "face_score", "fit_evidence", "holdout_evidence", "radial_recipe",
+           "uncertainty_report", "uncertainty_years"]
