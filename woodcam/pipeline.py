@@ -212,7 +212,8 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
     result.atlas = baked.summary()
     from .inference.evidence import uncertainty_report
 
-    rings_line = uncertainty_report(stock.wood.field, mesh.vertices, stock.size_mm, result.name)
+    surface = mesh if mesh is not None else baked.mesh  # the part, else what was baked
+    rings_line = uncertainty_report(stock.wood.field, surface.vertices, stock.size_mm, result.name)
     if rings_line:  # a fitted field says where its rings are a guess (issue 12 part 5)
         result.warnings.append(rings_line)
     if part_report:
