@@ -78,7 +78,7 @@ def test_mokume_folder_is_a_stock_with_a_cached_fitted_field(shared_data, tmp_pa
     before = sorted(p.name for p in folder.iterdir())
     s = open_stock(str(folder))
     assert s.size_mm == (50.0, 50.0, 50.0) and s.spec == str(folder)
-    cached = list((tmp_path / "fields").glob("CN03-radial-*.npz"))
+    cached = list((tmp_path / "fields").glob("CN03-evidence-*.npz"))  # the default fit
     assert len(cached) == 1
     assert sorted(p.name for p in folder.iterdir()) == before
     # The field puts whole years on the ring map's lines of the top face (within a fifth of a

@@ -226,3 +226,21 @@ def test_kill_points_on_a_mokume_fit(shared_data, tmp_path):
         if rerun.returncode or not GridField.load(out):
             bad.append((i, "rerun", rerun.stderr[-300:]))
     assert bad == []
+
+
+def test_kill_a_gcode_preview_then_rerun(tmp_path):
+    """Issue 15 part 6 for ``woodcam gcode``: killed mid-run, no partial output; the rerun,
+    with nothing cleaned, completes (the same all-or-nothing export as bake)."""
+    repo = Path(__file__).resolve().parents[2]
+    out = tmp_path / "out"
+    out.mkdir()
+    cmd = [sys.executable, "-m", "woodcam.cli", "gcode", str(repo / "toolpaths" / "pocket_islands.nc"),
+           "--tools", str(repo / "toolpaths" / "tools.toml"), "--block", "builtin:flat-sawn",
+           "--out", str(out / "part.glb"), "--texels-per-mm", "2"]
+    t0 = time.perf_counter()
+    subprocess.run(cmd, env=_env(tmp_path / "cal"), check=True, capture_output=True, cwd=repo)
+    full_s = time.perf_counter() - t0
+    for share in (0.5, 0.9):
+        res = _kill_then_rerun(cmd, tmp_path / "cache", out, share * full_s)
+        assert res["partial"] == [] and res["rerun_rc"] == 0, res
+        assert res["after_rerun"] == [] and res["complete"], res
