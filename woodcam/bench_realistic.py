@@ -53,19 +53,9 @@ BENCH_PIXEL_MM = 0.2
 def eq79_field(rng: np.random.Generator, size_mm=(50.0, 50.0, 50.0)):
     """An eq. 7-9 field of seed 000 (:class:`woodcam.fields.radial.RadialScalingField`): rings
     2-5 mm, pith axis tilted <= 20 degrees from a random block axis, 0-60 mm from the centre."""
-    from .fields.base import LogFrame
-    from .fields.radial import RadialScalingField
+    from .fields.radial import RadialScalingField, random_log_frame
 
-    size = np.asarray(size_mm, float)
-    base = np.eye(3)[rng.integers(3)]
-    tilt = np.deg2rad(rng.uniform(0, 20))
-    perp = np.cross(base, rng.normal(size=3))
-    perp /= np.linalg.norm(perp)
-    axis = np.cos(tilt) * base + np.sin(tilt) * perp
-    off = np.cross(axis, rng.normal(size=3))
-    off /= np.linalg.norm(off)
-    pith = size / 2 + off * rng.uniform(0, 60) + axis * rng.uniform(-20, 20)
-    return RadialScalingField.random(LogFrame(tuple(pith), tuple(axis)), rng.uniform(2, 5), rng)
+    return RadialScalingField.random(random_log_frame(rng, size_mm), rng.uniform(2, 5), rng)
 
 
 def make_block(seed: int, index: int, scenario: Scenario = "noisy", kind: Kind = "realistic",

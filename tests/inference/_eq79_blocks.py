@@ -14,6 +14,7 @@ from scipy.interpolate import CubicSpline
 
 from woodcam.block import Block, Face, RingTrace
 from woodcam.fields import LogFrame
+from woodcam.fields.radial import random_log_frame
 from woodcam.frames import FACES, face_image_size_mm, face_pixel_points
 
 
@@ -44,16 +45,7 @@ def _radius_function(rng, n_c: int = 15):
 def random_field(rng, size_mm=(50.0, 50.0, 50.0)) -> Eq79Field:
     """An eq. 7-9 field: rings 2-5 mm wide, pith axis tilted <= 20 deg from a random block axis,
     passing 0-60 mm from the block centre (so often outside the block)."""
-    size = np.asarray(size_mm, float)
-    base = np.eye(3)[rng.integers(3)]
-    tilt = np.deg2rad(rng.uniform(0, 20))
-    perp = np.cross(base, rng.normal(size=3))
-    perp /= np.linalg.norm(perp)
-    axis = np.cos(tilt) * base + np.sin(tilt) * perp
-    off = np.cross(axis, rng.normal(size=3))
-    off /= np.linalg.norm(off)
-    pith = size / 2 + off * rng.uniform(0, 60) + axis * rng.uniform(-20, 20)
-    frame = LogFrame(tuple(pith), tuple(axis))
+    frame = random_log_frame(rng, size_mm)
     return Eq79Field(frame, rng.uniform(2, 5), 50.0, _radius_function(rng), _radius_function(rng))
 
 

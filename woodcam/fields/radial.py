@@ -101,6 +101,22 @@ class RadiusFunction:
         return s[i0] * (1.0 - f) + s[(i0 + 1) % m] * f
 
 
+def random_log_frame(rng: np.random.Generator, size_mm: ArrayLike = (50.0, 50.0, 50.0)) -> LogFrame:
+    """A pith axis for the eq. 7-9 benchmark family of seed 000: tilted <= 20 degrees from a
+    random block axis, passing 0-60 mm from the centre of a block of ``size_mm`` (so often
+    outside it). Draws from ``rng`` in a fixed order (benchmarks and tests rely on it)."""
+    size = np.asarray(size_mm, float)
+    base = np.eye(3)[rng.integers(3)]
+    tilt = np.deg2rad(rng.uniform(0, 20))
+    perp = np.cross(base, rng.normal(size=3))
+    perp /= np.linalg.norm(perp)
+    axis = np.cos(tilt) * base + np.sin(tilt) * perp
+    off = np.cross(axis, rng.normal(size=3))
+    off /= np.linalg.norm(off)
+    pith = size / 2 + off * rng.uniform(0, 60) + axis * rng.uniform(-20, 20)
+    return LogFrame(tuple(pith), tuple(axis))
+
+
 @dataclass(frozen=True)
 class RadialScalingField:
     """Growth-time field of eq. 7-9 of seed 000, in mm and years, placed by a rigid transform.
