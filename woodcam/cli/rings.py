@@ -65,9 +65,10 @@ def register(subparsers) -> None:
                        "folder or a Mokume sample folder (its U-Net maps are ignored: re-detected).")
     d.add_argument("block", type=Path, help="block folder (block.json) or Mokume sample folder")
     d.add_argument("--out", type=Path, required=True, help="block folder to write (may be BLOCK itself)")
-    d.add_argument("--rule", choices=("dark-centre", "sharp-edge"), default="dark-centre",
-                   help="ring line on the dark band's centre (default; matches Mokume maps) or on its "
-                   "sharp edge (the exact ring boundary of woodcam's synthetic faces)")
+    d.add_argument("--rule", choices=("dark-line", "sharp-edge", "dark-centre"), default="dark-line",
+                   help="ring line on the darkest line of each dark band (default: the latewood's end, "
+                   "where the Mokume maps put it), on the band's sharper edge, or on the band's centre "
+                   "(the filter's phase alone)")
     d.add_argument("--detector", choices=("classical", "learned"), default=None,
                    help="classical: the weight-free quadrature-filter detector (default); learned: the "
                    "small net trained by 'woodcam train rings' (woodcam/models/rings.pt)")

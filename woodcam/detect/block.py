@@ -37,7 +37,7 @@ from .._cache import cache_dir, digest, load_or_build
 from ..block.block import Block, Face
 from ..errors import WoodcamError, WoodcamWarning
 from .knots import detect_knots
-from .rings import RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, ring_map_from_traces
+from .rings import DEFAULT_RULE, RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, ring_map_from_traces
 
 #: Bumped whenever detection results change, so cached detections are recomputed.
 DETECT_VERSION = 1
@@ -49,7 +49,7 @@ DETECTORS: tuple[str, ...] = ("classical", "learned")
 DEFAULT_DETECTOR: Detector = "classical"
 
 
-def detect_face(face: Face, px_per_mm: float, rule: BoundaryRule = "dark-centre",
+def detect_face(face: Face, px_per_mm: float, rule: BoundaryRule = DEFAULT_RULE,
                 knots: bool = True, detector: Detector = DEFAULT_DETECTOR) -> tuple[Face, list[str]]:
     """Detect rings (and knots) on one face with a photo; returns a new Face and warnings.
 
@@ -79,7 +79,7 @@ def detect_face(face: Face, px_per_mm: float, rule: BoundaryRule = "dark-centre"
                 extras=extras), list(det.warnings)
 
 
-def detect_block(block: Block, *, rule: BoundaryRule = "dark-centre", knots: bool = True,
+def detect_block(block: Block, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = True,
                  faces=None, progress: bool = False,
                  detector: Detector = DEFAULT_DETECTOR) -> tuple[Block, list[str]]:
     """A copy of ``block`` whose faces with photos carry detected rings and knot masks.
@@ -132,7 +132,7 @@ def user_edited_faces(folder) -> dict[str, Path]:
     return out
 
 
-def detect_folder(src, out, *, rule: BoundaryRule = "dark-centre", knots: bool = True,
+def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = True,
                   size_mm=None, progress: bool = False,
                   detector: Detector = DEFAULT_DETECTOR) -> tuple[Path, list[str]]:
     """Detect rings and knots on a block folder (or a Mokume sample folder, whose U-Net maps are
@@ -266,7 +266,7 @@ def _load_detection(path: Path):
     return faces, msgs
 
 
-def with_detected_rings(block: Block, rule: BoundaryRule = "dark-centre", *, cache: bool = True,
+def with_detected_rings(block: Block, rule: BoundaryRule = DEFAULT_RULE, *, cache: bool = True,
                         progress: bool = False) -> Block:
     """``block`` itself when it has rings; otherwise a copy with rings and knots detected on its
     photos, computed once and cached by content (module docstring; :mod:`woodcam._cache`).

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .rings import BoundaryRule, detect_rings
+from .rings import DEFAULT_RULE, BoundaryRule, detect_rings
 from .score import (
     SCORE_THRESHOLDS_PX,
     RidgeScore,
@@ -73,7 +73,7 @@ def summary(results: list[FaceResult], thresholds=SCORE_THRESHOLDS_PX) -> dict:
     return out
 
 
-def score_synthetic(faces: list[SyntheticFace], rule: BoundaryRule = "dark-centre",
+def score_synthetic(faces: list[SyntheticFace], rule: BoundaryRule = DEFAULT_RULE,
                     detector=None) -> list[FaceResult]:
     """Detect rings on synthetic ``faces`` (e.g. :func:`woodcam.synth.ring_eval_faces` of
     :data:`EVAL_SEEDS`); score against their true ring lines.
@@ -94,7 +94,7 @@ def score_synthetic(faces: list[SyntheticFace], rule: BoundaryRule = "dark-centr
     return results
 
 
-def score_reference_block(block, rule: BoundaryRule = "dark-centre", detector=None) -> list[FaceResult]:
+def score_reference_block(block, rule: BoundaryRule = DEFAULT_RULE, detector=None) -> list[FaceResult]:
     """Detect rings on each face of ``block`` that has a photo and a ring map; score against the
     map's ridge (knot masks, grown by the fitter's margin, are left out of both)."""
     from scipy import ndimage

@@ -51,8 +51,10 @@ import numpy as np
 from ..block.block import RingTrace
 from ..errors import WoodcamError
 
-BoundaryRule = Literal["sharp-edge", "dark-centre"]
-BOUNDARY_RULES: tuple[str, ...] = ("sharp-edge", "dark-centre")
+BoundaryRule = Literal["dark-line", "sharp-edge", "dark-centre"]
+BOUNDARY_RULES: tuple[str, ...] = ("dark-line", "sharp-edge", "dark-centre")
+#: The rule the detector uses unless told (module docstring, step 5).
+DEFAULT_RULE: BoundaryRule = "dark-line"
 
 #: Ring spacings (px) the filter bank looks for. 4.5 px is above the pore / fibre texture of the
 #: Mokume faces (pores 2-3 px apart on 256 px faces of a 50 mm cube); 64 px is a quarter of such a
@@ -61,8 +63,10 @@ WAVELENGTH_RANGE_PX = (4.5, 128.0)
 #: Ring spacings (mm) looked for when the image density is known: 0.88 mm is 4.5 px on the
 #: Mokume faces (5.12 px/mm), 25 mm the widest rings of fast-grown softwood.
 RING_SPACING_RANGE_MM = (0.88, 25.0)
-#: Filters per octave of wavelength, and orientations over the half plane.
-N_SCALES = 8
+#: Filter scales per octave of wavelength (half an octave apart: a ring's spectral peak spans
+#: about three of them, so its prominence over its neighbours shows), and orientations over
+#: the half plane.
+SCALES_PER_OCTAVE = 2
 N_ORIENTATIONS = 8
 #: Angular std of each filter (radians): overlapping neighbours (spacing pi/8 = 0.39).
 ANGULAR_SIGMA_RAD = 0.30
@@ -70,13 +74,24 @@ ANGULAR_SIGMA_RAD = 0.30
 RADIAL_SIGMA_LN = 0.40
 #: Energy smoothing (in wavelengths of each filter) before the local choice of filter.
 ENERGY_SMOOTH_WAVELENGTHS = 0.8
+#: Smoothing (in wavelengths of each scale) of the band energy whose spectral peak picks the
+#: ring scale: two ring spacings hold enough periods to show a peak.
+PERIOD_SMOOTH_WAVELENGTHS = 2.0
 #: Gates: a pixel is ring evidence when coherence >= COHERENCE_MIN and the blended amplitude is
 #: at least AMPLITUDE_MIN of the face's 75th-percentile amplitude.
 COHERENCE_MIN = 0.35
 AMPLITUDE_MIN = 0.25
-#: Scale (in ring spacings) of the gradient that decides which edge of a dark band is the sharp one.
-EDGE_SCALE_WAVELENGTHS = 0.125
-#: Reach (in ring spacings) of the local vote between the two edge families.
+#: Fine scale (px) of the luminance on which a ring line is placed: a latewood line is 2-4 px
+#: wide on 256 px faces of a 50 mm cube; 1 px keeps it apart from its neighbours.
+SNAP_SIGMA_PX = 1.0
+#: How far (in local ring spacings, each way) a band centre may move to its ring line.
+SNAP_REACH_WAVELENGTHS = 0.33
+#: Half length (px) of the stretch along the ring over which the profile across it is averaged
+#: (pores and ray flecks are shorter than it; the ring bends little over it).
+SNAP_ALONG_PX = 3
+#: Median window (vertices) of the moves along a trace: one pore cannot pull a line aside.
+SNAP_MEDIAN_VERTICES = 5
+#: Reach (in ring spacings) of the local vote between the two edges for ``"sharp-edge"``.
 VOTE_SCALE_WAVELENGTHS = 2.0
 #: Least local amplitude of the ring component, in units of the photo's local RMS contrast
 #: after flattening: white noise reaches 0.04-0.06, the faintest real ring face seen (Mokume
@@ -186,53 +201,59 @@ def _blur(img: np.ndarray, sigma: float) -> np.ndarray:
 
 
 def _response(x: np.ndarray, wavelengths, n_orient: int):
-    """Blended analytic response ``z (h, w) complex64`` (whitened), local wavelength, normal angle,
-    coherence, and the blend's local amplitude in units of ``x`` (not whitened).
+    """Blended analytic response ``z (h, w) complex64``, local wavelength (px), normal angle,
+    coherence, and the blend's local amplitude in units of ``x``.
 
-    One scale at a time (memory stays at one scale's ``(K, h, w)`` responses)."""
+    Per scale ``j``: the orientations are blended with weights ``E_jk^2`` (the steered response
+    of that scale), and the scale's band energy ``S_j`` is smoothed over
+    :data:`PERIOD_SMOOTH_WAVELENGTHS` of its own spacing. Frequency gating: rings are periodic,
+    so their band energy peaks at the ring spacing, while pores, fibres, rays, figure and
+    lighting are broadband (power falling or rising smoothly with scale). A scale's weight is
+    its log spectral prominence ``P_j = ln S_j - (ln S_{j-1} + ln S_{j+1}) / 2`` (0 for a power
+    law, about 1.4 for a pure tone with this bank; the end scales cannot show a peak) times its
+    orientation coherence, squared. Scales blend with those weights, each normalised by its
+    local band amplitude ``sqrt(S_j)``."""
     from scipy import fft
 
     h, w = x.shape
+    n_scales = len(wavelengths)
     theta0 = dominant_normal(x)
     bank, thetas = _bank(x.shape, theta0, wavelengths, n_orient)
     spec = fft.fft2(x.astype(np.float32), workers=-1)
     rot = np.exp(2j * thetas).astype(np.complex64)[:, None, None]
-    total = np.full((h, w), 1e-20, np.float32)
-    zb = np.zeros((h, w), np.complex64)
-    amp_raw = np.zeros((h, w), np.float32)
-    loglam = np.zeros((h, w), np.float32)
-    e_k = np.zeros((n_orient, h, w), np.float32)
+    band = np.zeros((n_scales, h, w), np.float32)        # S_j
+    coh = np.zeros((n_scales, h, w), np.float32)
+    zj = np.zeros((n_scales, h, w), np.complex64)
+    amp = np.zeros((n_scales, h, w), np.float32)
+    dbl = np.zeros((n_scales, h, w), np.complex64)       # unit doubled-angle normal per scale
     for j, lam in enumerate(wavelengths):
         # (K, h, w) analytic responses of this scale (2x: the one-sided spectrum)
         z = fft.ifft2(2.0 * spec[None] * bank[j], axes=(-2, -1), workers=-1).astype(np.complex64)
         energy = z.real ** 2 + z.imag ** 2
-        sig = ENERGY_SMOOTH_WAVELENGTHS * float(lam)
         for k in range(n_orient):
-            energy[k] = _blur(energy[k], sig)
-        # Whitening: each scale's energy relative to its face mean, so the strong fine texture
-        # (pores, fibres) does not outweigh the ring scale by its raw power alone.
-        raw_amp = np.sqrt(energy)            # local amplitude in units of x (not whitened)
-        band = float(energy.mean()) + 1e-20
-        energy /= band
-        z /= np.float32(np.sqrt(band))
-        coh = np.abs((energy * rot).sum(axis=0)) / (energy.sum(axis=0) + 1e-20)     # (h, w)
-        # Weights: whitened energy times the scale's orientation coherence, squared: the
-        # oriented, locally strongest band wins (isotropic pores have low coherence).
-        energy *= coh[None]
-        e_k += energy
+            energy[k] = _blur(energy[k], ENERGY_SMOOTH_WAVELENGTHS * float(lam))
+        esum = energy.sum(axis=0) + 1e-20
+        d = (energy * rot).sum(axis=0) / esum
+        coh[j] = np.abs(d)
+        dbl[j] = d / (coh[j] + 1e-20)
         wgt = energy * energy
-        wsum = wgt.sum(axis=0)
-        total += wsum
-        zb += (wgt * z).sum(axis=0)
-        amp_raw += (wgt * raw_amp).sum(axis=0)
-        loglam += wsum * np.float32(np.log(lam))
-    zb /= total
-    amp_raw /= total
-    lam_px = np.exp(loglam / total)
-    doubled = (e_k * rot).sum(axis=0) / (e_k.sum(axis=0) + 1e-20)
-    coherence = np.abs(doubled).astype(np.float32)
+        wsum = wgt.sum(axis=0) + 1e-20
+        zj[j] = (wgt * z).sum(axis=0) / wsum
+        amp[j] = np.sqrt((wgt * energy).sum(axis=0) / wsum)
+        band[j] = _blur(esum, PERIOD_SMOOTH_WAVELENGTHS * float(lam))
+    log_band = np.log(band + 1e-20)
+    prominence = np.zeros_like(band)
+    prominence[1:-1] = np.clip(log_band[1:-1] - 0.5 * (log_band[:-2] + log_band[2:]), 0.0, None)
+    wgt = (prominence * coh) ** 2
+    total = wgt.sum(axis=0) + 1e-20
+    zb = (wgt * zj / np.sqrt(band + 1e-20)).sum(axis=0) / total
+    lam_px = np.exp((wgt * np.log(np.asarray(wavelengths, np.float32))[:, None, None]).sum(axis=0) / total)
+    amp_raw = (wgt * amp).sum(axis=0) / total
+    coherence = (wgt * coh).sum(axis=0) / total
+    doubled = (wgt * coh * dbl).sum(axis=0)
     normal = 0.5 * np.angle(doubled * np.exp(-2j * theta0)) + theta0   # within theta0 +- pi/2
-    return zb.astype(np.complex64), lam_px.astype(np.float32), normal.astype(np.float32), coherence, amp_raw
+    return (zb.astype(np.complex64), lam_px.astype(np.float32), normal.astype(np.float32),
+            coherence.astype(np.float32), amp_raw.astype(np.float32))
 
 
 def _contour_runs(values: np.ndarray, keep: np.ndarray, min_len_px: np.ndarray) -> list[np.ndarray]:
@@ -276,23 +297,83 @@ def _resample_polyline(p: np.ndarray, step: float) -> np.ndarray:
     return np.stack([np.interp(t, s, p[:, 0]), np.interp(t, s, p[:, 1])], axis=1)
 
 
-def _local_mean(polys, img: np.ndarray, sigma: float) -> np.ndarray:
-    """``(h, w)`` Gaussian-weighted mean of ``img`` sampled at the polylines' vertices (0 where
-    none are near): how steep one edge family is around each pixel."""
-    import cv2
+def _profiles(img: np.ndarray, points: np.ndarray, n_rc: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """``(n, m)`` values of ``img (h, w)`` at ``points (n, 2) + offsets (n, m) * n_rc (n, 2)``
+    (bilinear), each averaged over +-:data:`SNAP_ALONG_PX` along the ring (the normal turned)."""
+    from scipy import ndimage
 
-    h, w = img.shape
-    total = np.zeros((h, w), np.float32)
-    count = np.zeros((h, w), np.float32)
-    if polys:
-        p = np.concatenate(polys)
-        r = np.clip(np.round(p[:, 0]).astype(int), 0, h - 1)
-        c = np.clip(np.round(p[:, 1]).astype(int), 0, w - 1)
-        np.add.at(total, (r, c), _sample(img, p).astype(np.float32))
+    acc = np.zeros(offsets.shape, np.float64)
+    for u in range(-SNAP_ALONG_PX, SNAP_ALONG_PX + 1):
+        q0 = points[:, :1] + offsets * n_rc[:, :1] - u * n_rc[:, 1:]
+        q1 = points[:, 1:] + offsets * n_rc[:, 1:] + u * n_rc[:, :1]
+        acc += ndimage.map_coordinates(img, [q0.ravel(), q1.ravel()], order=1, mode="nearest").reshape(offsets.shape)
+    return acc / (2 * SNAP_ALONG_PX + 1)
+
+
+def _parabolic(values: np.ndarray, i: np.ndarray) -> np.ndarray:
+    """Sub-sample position ``i + d`` of the extreme of ``values (n, m)`` at indices ``i (n,)``."""
+    rows = np.arange(len(values))
+    i = np.clip(i, 1, values.shape[1] - 2)
+    y0, y1, y2 = values[rows, i - 1], values[rows, i], values[rows, i + 1]
+    den = y0 - 2 * y1 + y2
+    safe = np.where(np.abs(den) > 1e-12, den, 1.0)
+    return i + np.clip(np.where(np.abs(den) > 1e-12, 0.5 * (y0 - y2) / safe, 0.0), -1.0, 1.0)
+
+
+def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rule: str) -> list:
+    """Move band-centre polylines (the fundamental's phase pi) onto the ring line of ``rule``.
+
+    ``"dark-line"``: the darkest line of the band (the minimum across the ring of the luminance
+    at :data:`SNAP_SIGMA_PX`, averaged along it); ``"sharp-edge"``: the steeper of the band's two
+    edges (extremes of the derivative across the ring), voted locally. Moves are looked for
+    within :data:`SNAP_REACH_WAVELENGTHS` of a spacing, refined by a parabola through the
+    extreme and median-filtered along each trace."""
+    from scipy import ndimage
+
+    if not polys:
+        return polys
+    h, w = lum.shape
+    p = np.concatenate(polys)
+    owner = np.repeat(np.arange(len(polys)), [len(q) for q in polys])
+    r = np.clip(np.round(p[:, 0]).astype(int), 0, h - 1)
+    c = np.clip(np.round(p[:, 1]).astype(int), 0, w - 1)
+    n_rc = np.stack([np.sin(normal[r, c]), np.cos(normal[r, c])], axis=1)
+    t = np.linspace(-SNAP_REACH_WAVELENGTHS, SNAP_REACH_WAVELENGTHS, 41)
+    offsets = t[None, :] * lam[r, c][:, None]
+    step = offsets[:, 1] - offsets[:, 0]
+    if rule == "dark-line":
+        prof = _profiles(ndimage.gaussian_filter(lum, SNAP_SIGMA_PX), p, n_rc, offsets)
+        move = (_parabolic(prof, np.argmin(prof, axis=1)) - (len(t) - 1) / 2) * step
+    else:
+        gr = ndimage.gaussian_filter(lum, SNAP_SIGMA_PX, order=(1, 0))
+        gc = ndimage.gaussian_filter(lum, SNAP_SIGMA_PX, order=(0, 1))
+        g = (_profiles(gr, p, n_rc, offsets) * n_rc[:, :1] + _profiles(gc, p, n_rc, offsets) * n_rc[:, 1:])
+        mid = (len(t) - 1) // 2
+        falling = np.where(np.arange(len(t)) <= mid, -g, -np.inf)      # into the band
+        rising = np.where(np.arange(len(t)) >= mid, g, -np.inf)        # out of it
+        i_f, i_r = np.argmax(falling, axis=1), np.argmax(rising, axis=1)
+        rows = np.arange(len(p))
+        steep_f, steep_r = falling[rows, i_f], rising[rows, i_r]
+        # which edge is sharp can change within a face (the pith inside it, a knot): vote over
+        # about two ring spacings with the mean steepness of each edge there
+        sigma = VOTE_SCALE_WAVELENGTHS * float(np.median(lam[r, c]))
+        count = np.zeros((h, w), np.float32)
         np.add.at(count, (r, c), 1.0)
-    total = cv2.GaussianBlur(total, (0, 0), sigma, borderType=cv2.BORDER_REFLECT)
-    count = cv2.GaussianBlur(count, (0, 0), sigma, borderType=cv2.BORDER_REFLECT)
-    return total / (count + 1e-3)
+        count = ndimage.gaussian_filter(count, sigma) + 1e-6
+        votes = []
+        for vals in (steep_f, steep_r):
+            acc = np.zeros((h, w), np.float32)
+            np.add.at(acc, (r, c), vals.astype(np.float32))
+            votes.append((ndimage.gaussian_filter(acc, sigma) / count)[r, c])
+        pos = np.where(votes[0] > votes[1], _parabolic(-g, i_f), _parabolic(g, i_r))
+        move = (pos - (len(t) - 1) / 2) * step
+    out = []
+    for k, q in enumerate(polys):
+        mk = move[owner == k]
+        if len(mk) >= SNAP_MEDIAN_VERTICES:
+            mk = ndimage.median_filter(mk, SNAP_MEDIAN_VERTICES, mode="nearest")
+        out.append(q + mk[:, None] * n_rc[owner == k])
+    return out
 
 
 def _sample(img: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -319,7 +400,7 @@ def ring_map_from_traces(traces, shape, sigma_px: float) -> np.ndarray:
     return np.exp(-(d / max(sigma_px, 1e-6)) ** 2).astype(np.float32)
 
 
-def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: BoundaryRule = "dark-centre",
+def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: BoundaryRule = DEFAULT_RULE,
                  wavelength_range_px: tuple[float, float] | None = None,
                  name: str = "face") -> RingDetection:
     """Find the annual-ring boundaries on one face photo (module docstring: the method).
@@ -361,8 +442,8 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     if not 2.0 <= lo < hi:
         raise WoodcamError(f"wavelength_range_px must be (min, max) with 2 <= min < max; got {wavelength_range_px!r}")
     hi = max(min(hi, 0.5 * max(h, w)), 1.5 * lo)
-    n_scales = max(2, int(np.round(np.log2(hi / lo) * N_SCALES / np.log2(128.0 / 4.5))))
-    wavelengths = np.geomspace(lo, hi, n_scales)
+    n_scales = max(3, int(np.round(np.log2(hi / lo) * SCALES_PER_OCTAVE)) + 1)
+    wavelengths = lo * 2.0 ** (np.arange(n_scales) / SCALES_PER_OCTAVE)
     x = _normalise(lum, sigma=hi)
     z, lam, normal, coherence, amp_x = _response(x, wavelengths, N_ORIENTATIONS)
     amp = np.abs(z)
@@ -373,30 +454,10 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     warnings: list[str] = []
     min_len = MIN_TRACE_WAVELENGTHS * lam
     even, odd = z.real, z.imag
-    if rule == "dark-centre":
-        polys = _contour_runs(odd, evidence & (even < 0), min_len)
-    else:
-        # the two edge families of the dark bands: phase +pi/2 (odd > 0) and -pi/2 (odd < 0)
-        from scipy import ndimage
-
-        # Edge steepness at an eighth of the ring spacing: finer scales see the pores and
-        # fibres (whose gradients are everywhere), coarser ones blur both edges alike.
-        sg = max(1.0, EDGE_SCALE_WAVELENGTHS * float(np.median(lam)))
-        grad = np.hypot(ndimage.gaussian_filter(lum, sg, order=(1, 0)),
-                        ndimage.gaussian_filter(lum, sg, order=(0, 1)))
-        fams = [_contour_runs(even, evidence & (s * odd > 0), min_len) for s in (1.0, -1.0)]
-        # Which family is sharp can change within a face (the pith inside it, or a knot): vote
-        # locally, over about two ring spacings, with each family's mean steepness there.
-        vote_sigma = VOTE_SCALE_WAVELENGTHS * float(np.median(lam))
-        steep = [_local_mean(f, grad, vote_sigma) for f in fams]
-        polys = []
-        for i, fam in enumerate(fams):
-            mine, other = steep[i], steep[1 - i]
-            for p in fam:
-                r = np.clip(np.round(p[:, 0]).astype(int), 0, h - 1)
-                c = np.clip(np.round(p[:, 1]).astype(int), 0, w - 1)
-                if np.mean(mine[r, c] > other[r, c]) > 0.5:
-                    polys.append(p)
+    # band centres: phase pi of the blended response (odd part 0 where the even part is < 0)
+    polys = _contour_runs(odd, evidence & (even < 0), min_len)
+    if rule != "dark-centre":
+        polys = _snap(lum, polys, normal, lam, rule)
     traces = [RingTrace(p) for p in polys]
     share = float(evidence.mean())
     if share < MIN_RING_AREA or not traces:

@@ -78,6 +78,77 @@ class _BuiltinWood:
         return np.clip(rgb, 0.0, 1.0)
 
 
+class _RealisticWood(_BuiltinWood):
+    """Face colour closer to the real Mokume photos than :class:`_BuiltinWood` (the ring
+    detector's realistic evaluation and training faces, :func:`woodcam.synth.ring_eval_faces`).
+
+    What the real faces show and the built-in colour lacks:
+
+    - ``"softwood"`` (spruce, H11): the latewood is a narrow dark line, 10-25 % of a ring, whose
+      density rises to the ring boundary and drops there at once, so the darkest line of a ring
+      *is* its boundary; faint rings (contrast drawn per ring) beside strong ones;
+    - ``"ring-porous"`` (oak, CN03): a dark band of large earlywood pores starts at the ring
+      boundary (sharp) and fades over 15-30 % of the ring; the pores are specks (pore noise,
+      stretched along the fibres), the latewood between is lighter;
+    - both: rays (thin streaks across the rings, a little lighter) and a broad figure (a slow
+      colour drift across the face) and a stronger lighting gradient than the camera's vignette.
+    """
+
+    def __init__(self, field, rng: np.random.Generator, style: str = "softwood", lattice: int = 64):
+        super().__init__(field, rng, lattice=lattice,
+                         species="oak" if style == "ring-porous" else BUILTIN_PHOTO_SPECIES)
+        self.style = style
+        self.band = rng.uniform(0.10, 0.25) if style == "softwood" else rng.uniform(0.15, 0.30)
+        self.ring_contrast = rng.uniform(0.35, 1.0, 4096)       # per ring: faint and strong rings
+        self.pores = rng.standard_normal((lattice,) * 3).astype(np.float32)
+        self.rays = rng.standard_normal((lattice,) * 3).astype(np.float32)
+        self.figure = rng.standard_normal((8,) * 3).astype(np.float32)
+        self.ray_strength = rng.uniform(0.0, 0.08)
+        self.figure_strength = rng.uniform(0.0, 0.12)
+
+    def _noise(self, grid, q) -> np.ndarray:
+        from scipy.ndimage import map_coordinates
+
+        return map_coordinates(grid, q.T, order=1, mode="grid-wrap")
+
+    def color(self, points_mm, normals, years=None, years_per_px=None) -> np.ndarray:
+        p = check_points(points_mm)
+        years = evaluate(self.field, p) if years is None else years
+        fib = np.asarray(grain_direction(self.field, p), dtype=float)
+        end_grain = np.abs((fib * np.asarray(normals, float)).sum(1))
+        frac = years - np.floor(years)
+        ring = np.floor(years).astype(np.int64)
+        k = self.ring_contrast[np.mod(ring, len(self.ring_contrast))]
+        w = np.maximum(np.asarray(years_per_px, float), 1e-6) if years_per_px is not None else np.full(len(p), 1e-6)
+        along = (p * fib).sum(1, keepdims=True)
+        if self.style == "softwood":
+            # latewood: density rising over the last `band` of the ring, darkest at its boundary;
+            # the step at the boundary anti-aliased over one pixel (box filter of the pixel)
+            x = np.clip((frac - (1.0 - self.band)) / self.band, 0.0, 1.0)
+            before = np.clip((1.0 - frac) / w + 0.5, 0.0, 1.0)
+            prev = np.clip(0.5 - frac / w, 0.0, 1.0)
+            dark = x ** 1.5 * before * (1.0 - prev) + prev
+            dark = dark * k
+        else:
+            # earlywood pore band: from the boundary (sharp) fading over `band` of the ring
+            after = np.clip(frac / w + 0.5, 0.0, 1.0)             # anti-aliased start
+            fade = np.exp(-np.clip(frac, 0, None) / self.band)
+            q = p / 0.35 - (1.0 / 0.35 - 1.0 / 1.5) * along * fib + 7.0
+            pores = np.clip(0.6 + 0.8 * self._noise(self.pores, q), 0.0, 1.5)   # specks
+            dark = np.clip(after * fade * pores, 0.0, 1.2) * k
+        # rays: thin streaks across the rings (radial plates: long along the fibre and the ray,
+        # thin across); a little lighter
+        qr = p / 0.25 - (1.0 / 0.25 - 1.0 / 3.0) * along * fib + 3.0
+        rays = np.clip(self._noise(self.rays, qr) - 1.2, 0.0, None)
+        figure = self._noise(self.figure, p / 20.0 + 1.0)
+        ring_tone = 1.0 + 0.04 * np.sin(ring * 2.399 + self.phase)
+        tex = 1.0 + self._FIBRE_AMPLITUDE * self._fibre_texture(p, fib)
+        rgb = self.earlywood + dark[:, None] * (self.latewood - self.earlywood)
+        shade = ring_tone * tex * (1.0 - 0.15 * end_grain) * (1.0 + self.ray_strength * rays) \
+            * (1.0 + self.figure_strength * figure)
+        return np.clip(rgb * shade[:, None], 0.0, 1.0)
+
+
 def _camera(rgb: np.ndarray, rng: np.random.Generator, noise: float, variation: float,
             blur_px: float = 0.0) -> np.ndarray:
     """Photograph an ``(h, w, 3)`` float image: lens blur (Gaussian, ``blur_px``), exposure and

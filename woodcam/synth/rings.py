@@ -9,22 +9,32 @@ may not import ``synth`` (``tests/test_layering.py``).
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import numpy as np
 
+from ..errors import WoodcamError
 from ..frames import FACES
 from .block import synth_block
 from .cut import PATTERNS, cut_block, random_log_placement
 from .dataset import knotted_log_field
+from .photos import _RealisticWood
+
+
+FaceStyle = Literal["plain", "realistic"]
 
 
 def ring_eval_faces(seed: int, face_px: int = 256, size_mm: float = 50.0,
-                    ring_width_range_mm=(1.5, 6.0), faces=FACES) -> list:
+                    ring_width_range_mm=(1.5, 6.0), faces=FACES, style: FaceStyle = "plain") -> list:
     """Faces of one synthetic cube of ``size_mm`` drawn from ``np.random.default_rng(seed)``, as
     :class:`woodcam.detect.evaluate.SyntheticFace` (photo, true ring points every 0.5 px): a random
     eccentric, lobed log and sawing pattern, photos with camera noise, exposure variation,
     vignetting and lens blur (the synth defaults). Faces with fewer than two true rings are
-    skipped."""
+    skipped.
+
+    ``style``: ``"plain"``, the built-in wood colour (a smooth latewood ramp over the last 45 %
+    of each ring); ``"realistic"``, :class:`woodcam.synth.photos._RealisticWood` (narrow softwood
+    latewood or ring-porous oak, drawn by the seed's parity; rays, figure, faint rings)."""
     from ..detect.evaluate import SyntheticFace, dense_polyline
 
     rng = np.random.default_rng(seed)
@@ -32,15 +42,20 @@ def ring_eval_faces(seed: int, face_px: int = 256, size_mm: float = 50.0,
     size = (size_mm,) * 3
     log, placement = random_log_placement(rng, pattern, size, ring_width_range_mm)
     field = cut_block(log, size, **placement)
+    if style not in ("plain", "realistic"):
+        raise WoodcamError(f"style must be 'plain' or 'realistic'; got {style!r}")
+    wood = None
+    if style == "realistic":
+        wood = _RealisticWood(field, rng, "ring-porous" if seed % 2 else "softwood")
     block = synth_block(field, size, face_px=face_px, rng=rng, seed=None, faces=faces,
-                        ring_map_faces=(), name=f"synthetic-{seed}")
+                        ring_map_faces=(), name=f"synthetic-{seed}", wood=wood)
     px_mm = block.meta["px_per_mm"]
     out = []
     for name, f in block.faces.items():
         if len(f.traces) < 2:
             continue
         truth = np.concatenate([dense_polyline(t.points_px) for t in f.traces])
-        out.append(SyntheticFace(f.photo, truth, px_mm, f"seed {seed} {pattern} {name}"))
+        out.append(SyntheticFace(f.photo, truth, px_mm, f"seed {seed} {pattern} {style} {name}"))
     return out
 
 
