@@ -40,7 +40,7 @@ from .knots import detect_knots
 from .rings import DEFAULT_RULE, RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, ring_map_from_traces
 
 #: Bumped whenever detection results change, so cached detections are recomputed.
-DETECT_VERSION = 1
+DETECT_VERSION = 2
 
 
 Detector = Literal["classical", "learned"]

@@ -18,27 +18,35 @@ use curved Gabor filters; this is the classical quadrature-filter version of tha
    RMS), so exposure gradients and vignetting do not move the rings.
 2. A bank of log-Gabor quadrature filters (Field 1987), one-sided in the Fourier plane so each
    response ``z_jk = e + i o`` is analytic: ``G_jk(f, a) = exp(-ln(f / f_j)^2 / (2 ln(s_r)^2))
-   exp(-d(a, theta_k)^2 / (2 s_a^2))`` for wavelengths ``1 / f_j`` between
+   exp(-d(a, theta_k)^2 / (2 s_a^2))`` for wavelengths ``1 / f_j`` half an octave apart between
    :data:`WAVELENGTH_RANGE_PX` and orientations ``theta_k`` spanning the half plane centred on the
    face's dominant ring normal (so the odd parts agree in sign across the bank).
-3. Adaptation to the local orientation and frequency: the responses are blended with weights
-   ``E_jk^2 / sum E^2`` of their locally smoothed energies ``E_jk = G_sigma * |z_jk|^2``: the
-   steered response of the filter matched to the local ring (a straight, not curved, kernel:
-   the angular bandwidth absorbs the ring curvature within a kernel's reach).
-4. Gating: orientation coherence ``|sum_k E_k e^{2 i theta_k}| / sum_k E_k`` (pores and rays
-   are isotropic or cross the rings: low coherence), relative amplitude against the face's
-   median, and wavelengths outside the bank (pore texture, 2-3 px) never respond.
-5. Ring boundaries at phase extremes of the blended response. The dark band of a ring (latewood
-   in softwood; the earlywood pore band in ring-porous oak) has a sharp edge on the ring
-   boundary side and a gradual one on the other; both edges sit at phase +-pi/2 (``e = 0``).
-   The contour ``e = 0`` (sub-pixel, linear interpolation between pixel centres) split by the sign
-   of ``o`` gives both edge families; the one whose fine-scale gradient is steeper is the ring
-   boundary (:data:`BoundaryRule` ``"sharp-edge"``); ``"dark-centre"`` (the default) returns the
-   band centres (``o = 0`` where ``e < 0``) instead. The default follows the real reference: the
-   Mokume U-Net maps (trained on people's annotations of real wood) put the ring on the dark
-   latewood line, and on real softwood that line is 2-4 px wide, so centre and boundary differ by
-   less than the 2 px tolerance; on the synthetic faces, whose latewood band is 30 % of a ring,
-   ``"sharp-edge"`` matches their exact iso-lines (figures in README).
+3. Adaptation to the local orientation (steering): per scale, the orientations are blended
+   with weights ``E_jk^2`` of their locally smoothed energies ``E_jk = G_sigma * |z_jk|^2`` (a
+   straight, not curved, kernel: the angular bandwidth absorbs the ring curvature within a
+   kernel's reach).
+4. Frequency gating: rings are periodic, so their band energy peaks at the ring spacing,
+   while pores, fibres, rays, oak figure and lighting are broadband. Each scale is weighted by
+   its log spectral prominence over its two neighbours (0 for any power law) times its
+   orientation coherence ``|sum_k E_k e^{2 i theta_k}| / sum_k E_k`` (pores are isotropic, rays
+   cross the rings). Gates: coherence, relative amplitude against the face's 75th percentile,
+   and the amplitude over the flattened photo's local contrast.
+5. Ring lines. The band centres (phase pi of the blended response: ``o = 0`` where ``e < 0``)
+   are sub-pixel contours (linear interpolation between pixel centres); the phase unwrapped over
+   the evidence region orders them across the face (:attr:`RingDetection.ring_order`). Each
+   centre line is then moved, across the ring by at most a third of a spacing, onto the ring
+   line of the :data:`BoundaryRule`:
+
+   - ``"dark-line"`` (default): the darkest line of the band, at 1 px scale, averaged along the
+     ring. This is where the Mokume U-Net maps (trained on people's annotations of real wood)
+     put a ring: the mean luminance profile across their ridges has its minimum on the ridge on
+     all 12 faces of CN03 and H11 (spruce: the narrow latewood line; oak: the dark first rows of
+     earlywood pores next to the boundary). In softwood latewood density peaks at the ring
+     boundary, so this is the boundary to within its 2-4 px width.
+   - ``"sharp-edge"``: the steeper of the band's two edges (voted locally, so a pith inside the
+     face is handled): the exact ring boundary of woodcam's plain synthetic faces, whose
+     latewood ramps over 45 % of a ring and whose darkest line is therefore not the boundary.
+   - ``"dark-centre"``: the band centre itself (the filter's phase alone).
 """
 
 from __future__ import annotations
@@ -77,6 +85,9 @@ ENERGY_SMOOTH_WAVELENGTHS = 0.8
 #: Smoothing (in wavelengths of each scale) of the band energy whose spectral peak picks the
 #: ring scale: two ring spacings hold enough periods to show a peak.
 PERIOD_SMOOTH_WAVELENGTHS = 2.0
+#: Least coherence-weighted peak height (natural log of band energy) for a pixel to count as
+#: showing a spectral peak; below it the spectrum's bend picks the scale (``_response``).
+PEAK_MIN = 0.02
 #: Gates: a pixel is ring evidence when coherence >= COHERENCE_MIN and the blended amplitude is
 #: at least AMPLITUDE_MIN of the face's 75th-percentile amplitude.
 COHERENCE_MIN = 0.35
@@ -119,6 +130,13 @@ class RingDetection:
     evidence: np.ndarray          # (h, w) bool, the gated ring-evidence region
     rule: str
     warnings: list[str] = field(default_factory=list)
+    #: (h, w) float32: the response's phase unwrapped over the evidence region, in rings
+    #: (cycles), 0 on the first band centre found; NaN outside the evidence. It grows by one
+    #: per ring along the face's dominant normal, so it orders the rings across the face.
+    order_map: np.ndarray | None = None
+    #: Per trace, its ring's place in that order (an integer, relative to this face only: the
+    #: same ring on two faces gets unrelated numbers, so these are not years).
+    ring_order: list[int] = field(default_factory=list)
 
     @property
     def points_px(self) -> np.ndarray:
@@ -209,9 +227,10 @@ def _response(x: np.ndarray, wavelengths, n_orient: int):
     :data:`PERIOD_SMOOTH_WAVELENGTHS` of its own spacing. Frequency gating: rings are periodic,
     so their band energy peaks at the ring spacing, while pores, fibres, rays, figure and
     lighting are broadband (power falling or rising smoothly with scale). A scale's weight is
-    its log spectral prominence ``P_j = ln S_j - (ln S_{j-1} + ln S_{j+1}) / 2`` (0 for a power
-    law, about 1.4 for a pure tone with this bank; the end scales cannot show a peak) times its
-    orientation coherence, squared. Scales blend with those weights, each normalised by its
+    its log spectral peak height ``P_j = min(ln S_j - ln S_{j-1}, ln S_j - ln S_{j+1})`` (0 unless
+    a local maximum; the end scales cannot show one; where no scale peaks, the bend
+    ``ln S_j - (ln S_{j-1} + ln S_{j+1}) / 2``, 0 for a power law) times its orientation
+    coherence, squared. Scales blend with those weights, each normalised by its
     local band amplitude ``sqrt(S_j)``."""
     from scipy import fft
 
@@ -243,17 +262,73 @@ def _response(x: np.ndarray, wavelengths, n_orient: int):
         band[j] = _blur(esum, PERIOD_SMOOTH_WAVELENGTHS * float(lam))
     log_band = np.log(band + 1e-20)
     prominence = np.zeros_like(band)
-    prominence[1:-1] = np.clip(log_band[1:-1] - 0.5 * (log_band[:-2] + log_band[2:]), 0.0, None)
+    # a peak: the scale's band energy above both neighbours' (by the smaller margin); where no
+    # scale shows one (a knot's tangle, too few periods), the bend (concavity) of the log
+    # spectrum instead, so such regions keep a response rather than none
+    peak = np.clip(np.minimum(log_band[1:-1] - log_band[:-2], log_band[1:-1] - log_band[2:]), 0.0, None)
+    bend = np.clip(log_band[1:-1] - 0.5 * (log_band[:-2] + log_band[2:]), 0.0, None)
+    has_peak = (peak * coh[1:-1]).max(axis=0) > PEAK_MIN
+    prominence[1:-1] = np.where(has_peak[None], peak, bend)
     wgt = (prominence * coh) ** 2
     total = wgt.sum(axis=0) + 1e-20
     zb = (wgt * zj / np.sqrt(band + 1e-20)).sum(axis=0) / total
     lam_px = np.exp((wgt * np.log(np.asarray(wavelengths, np.float32))[:, None, None]).sum(axis=0) / total)
     amp_raw = (wgt * amp).sum(axis=0) / total
     coherence = (wgt * coh).sum(axis=0) / total
+    lam_px = _instantaneous_wavelength(zb, lam_px, wavelengths)
     doubled = (wgt * coh * dbl).sum(axis=0)
     normal = 0.5 * np.angle(doubled * np.exp(-2j * theta0)) + theta0   # within theta0 +- pi/2
     return (zb.astype(np.complex64), lam_px.astype(np.float32), normal.astype(np.float32),
             coherence.astype(np.float32), amp_raw.astype(np.float32))
+
+
+def _ring_order(z: np.ndarray, evidence: np.ndarray, polys: list) -> tuple[np.ndarray, list[int]]:
+    """The order map (``RingDetection.order_map``) and each band-centre polyline's place in it.
+
+    The phase of the analytic response rises by 2 pi per ring along the filters' common
+    direction; unwrapped over the evidence region (skimage's reliability-sorted unwrapping,
+    Herraez et al. 2002) it numbers the rings consistently across the face wherever the region
+    is connected. Band centres sit at phase pi (mod 2 pi), so a polyline's order is the
+    median of ``(phase - pi) / 2 pi`` on it, rounded."""
+    from skimage.restoration import unwrap_phase
+
+    h, w = z.shape
+    order = np.full((h, w), np.nan, np.float32)
+    if not evidence.any():
+        return order, [0] * len(polys)
+    wrapped = np.ma.masked_array(np.angle(z), mask=~evidence)
+    un = np.asarray(unwrap_phase(wrapped).filled(np.nan), np.float64)
+    cycles = (un - np.pi) / (2 * np.pi)
+    out = []
+    for p in polys:
+        r = np.clip(np.round(p[:, 0]).astype(int), 0, h - 1)
+        c = np.clip(np.round(p[:, 1]).astype(int), 0, w - 1)
+        v = cycles[r, c]
+        out.append(float(np.nanmedian(v)) if np.isfinite(v).any() else np.nan)
+    base = np.nanmin(out) if np.isfinite(out).any() else 0.0
+    base = np.floor(base + 0.5)
+    order[evidence] = (cycles[evidence] - base).astype(np.float32)
+    return order, [int(np.round(o - base)) if np.isfinite(o) else 0 for o in out]
+
+
+def _instantaneous_wavelength(z: np.ndarray, lam_scale: np.ndarray, wavelengths) -> np.ndarray:
+    """``(h, w)`` local ring spacing (px) from the blended response's phase gradient,
+    ``2 pi / |grad phase|`` with ``grad phase = Im(conj(z) grad z) / |z|^2`` (the instantaneous
+    frequency), averaged with weights ``|z|^2`` over about one spacing; the scale blend's
+    spacing ``lam_scale`` where the response is too weak. Finer than the bank's half-octave
+    steps, whose weighted mean is pulled toward whichever neighbour of the true spacing has
+    the larger weight."""
+    gz_r, gz_c = np.gradient(z)
+    mag2 = (z.real ** 2 + z.imag ** 2).astype(np.float32)
+    fr = np.imag(np.conj(z) * gz_r).astype(np.float32)
+    fc = np.imag(np.conj(z) * gz_c).astype(np.float32)
+    sig = float(np.median(lam_scale))
+    den = _blur(mag2, sig) + 1e-12
+    freq = np.hypot(_blur(fr, sig), _blur(fc, sig)) / den                # rad / px
+    lam = 2 * np.pi / np.maximum(freq, 1e-6)
+    weak = den < 0.05 * float(np.median(den))
+    lam = np.where(weak, lam_scale, lam)
+    return np.clip(lam, float(wavelengths[0]), float(wavelengths[-1])).astype(np.float32)
 
 
 def _contour_runs(values: np.ndarray, keep: np.ndarray, min_len_px: np.ndarray) -> list[np.ndarray]:
@@ -456,6 +531,7 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     even, odd = z.real, z.imag
     # band centres: phase pi of the blended response (odd part 0 where the even part is < 0)
     polys = _contour_runs(odd, evidence & (even < 0), min_len)
+    order_map, ring_order = _ring_order(z, evidence, polys)
     if rule != "dark-centre":
         polys = _snap(lum, polys, normal, lam, rule)
     traces = [RingTrace(p) for p in polys]
@@ -467,4 +543,5 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
             f"with 'woodcam rings show' and trace the rings by hand (SVG) if needed")
     sigma_px = RING_MAP_SIGMA_MM * (px_per_mm if px_per_mm else 256 / 50.0)
     ring_map = ring_map_from_traces(traces, (h, w), sigma_px)
-    return RingDetection(traces, ring_map, normal, lam, confidence, evidence, rule, warnings)
+    return RingDetection(traces, ring_map, normal, lam, confidence, evidence, rule, warnings,
+                         order_map, ring_order)
