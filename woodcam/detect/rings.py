@@ -244,7 +244,7 @@ def _response(x: np.ndarray, wavelengths, n_orient: int):
     coh = np.zeros((n_scales, h, w), np.float32)
     zj = np.zeros((n_scales, h, w), np.complex64)
     amp = np.zeros((n_scales, h, w), np.float32)
-    dbl = np.zeros((n_scales, h, w), np.complex64)       # unit doubled-angle normal per scale
+    orient = np.zeros((h, w), np.complex64)               # doubled-angle normal, all scales
     for j, lam in enumerate(wavelengths):
         # (K, h, w) analytic responses of this scale (2x: the one-sided spectrum)
         z = fft.ifft2(2.0 * spec[None] * bank[j], axes=(-2, -1), workers=-1).astype(np.complex64)
@@ -254,7 +254,9 @@ def _response(x: np.ndarray, wavelengths, n_orient: int):
         esum = energy.sum(axis=0) + 1e-20
         d = (energy * rot).sum(axis=0) / esum
         coh[j] = np.abs(d)
-        dbl[j] = d / (coh[j] + 1e-20)
+        # the orientation is read from every scale (whitened, coherence-weighted), not only
+        # the ring scale: inside a knot the finer scales see its own rings circle round
+        orient += (esum / float(esum.mean())) * coh[j] * d
         wgt = energy * energy
         wsum = wgt.sum(axis=0) + 1e-20
         zj[j] = (wgt * z).sum(axis=0) / wsum
@@ -276,8 +278,7 @@ def _response(x: np.ndarray, wavelengths, n_orient: int):
     amp_raw = (wgt * amp).sum(axis=0) / total
     coherence = (wgt * coh).sum(axis=0) / total
     lam_px = _instantaneous_wavelength(zb, lam_px, wavelengths)
-    doubled = (wgt * coh * dbl).sum(axis=0)
-    normal = 0.5 * np.angle(doubled * np.exp(-2j * theta0)) + theta0   # within theta0 +- pi/2
+    normal = 0.5 * np.angle(orient * np.exp(-2j * theta0)) + theta0   # within theta0 +- pi/2
     return (zb.astype(np.complex64), lam_px.astype(np.float32), normal.astype(np.float32),
             coherence.astype(np.float32), amp_raw.astype(np.float32))
 
