@@ -100,6 +100,13 @@ SNAP_REACH_WAVELENGTHS = 0.33
 #: Half length (px) of the stretch along the ring over which the profile across it is averaged
 #: (pores and ray flecks are shorter than it; the ring bends little over it).
 SNAP_ALONG_PX = 3
+#: Vertices (1 px apart) of a trace whose profiles across the ring are averaged before the
+#: ring line is placed on them (``_along_traces``).
+SNAP_TRACE_VERTICES = 9
+#: Faint rings (``_faint_lines``): the scale (px) of the valley detector, and the least valley
+#: depth, relative to the median depth on the rings the band centres found.
+VALLEY_SIGMA_PX = 1.5
+VALLEY_REL = 0.5
 #: Median window (vertices) of the moves along a trace: one pore cannot pull a line aside.
 SNAP_MEDIAN_VERTICES = 5
 #: Reach (in ring spacings) of the local vote between the two edges for ``"sharp-edge"``.
@@ -386,6 +393,56 @@ def _profiles(img: np.ndarray, points: np.ndarray, n_rc: np.ndarray, offsets: np
     return acc / (2 * SNAP_ALONG_PX + 1)
 
 
+def _faint_lines(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray,
+                 evidence: np.ndarray, min_len: np.ndarray) -> list:
+    """Dark lines the band centres missed: a ring fainter than its neighbours (the spectral
+    peak may then sit at two ring spacings, one band centre per pair). Valleys of the
+    luminance across the ring (second derivative along the normal, ``n^T H n`` at
+    :data:`VALLEY_SIGMA_PX`, > 0 on a dark line) at least :data:`VALLEY_REL` as deep as the
+    median on the lines already found, in the evidence region, farther than a quarter spacing
+    from every found line: the sub-pixel zero contour of the valley's derivative along the
+    normal (its crest), as for the band centres."""
+    from scipy import ndimage
+
+    rel = VALLEY_REL
+    h, w = lum.shape
+    sg = VALLEY_SIGMA_PX
+    n_r, n_c = np.sin(normal), np.cos(normal)
+    hrr = ndimage.gaussian_filter(lum, sg, order=(2, 0))
+    hcc = ndimage.gaussian_filter(lum, sg, order=(0, 2))
+    hrc = ndimage.gaussian_filter(lum, sg, order=(1, 1))
+    depth = n_r * n_r * hrr + 2 * n_r * n_c * hrc + n_c * n_c * hcc          # > 0 in a valley
+    gr, gc = np.gradient(depth)
+    crest = gr * n_r + gc * n_c                                               # 0 on the crest
+    p = np.concatenate(polys)
+    r = np.clip(np.round(p[:, 0]).astype(int), 0, h - 1)
+    c = np.clip(np.round(p[:, 1]).astype(int), 0, w - 1)
+    found = float(np.median(_sample(depth, p)))
+    if not found > 0:
+        return []
+    on = np.zeros((h, w), bool)
+    on[r, c] = True
+    far = ndimage.distance_transform_edt(~on) > np.maximum(0.25 * lam, 2.0)
+    keep = evidence & far & (depth >= rel * found)
+    return _contour_runs(crest, keep, min_len)
+
+
+def _along_traces(prof: np.ndarray, owner: np.ndarray) -> np.ndarray:
+    """``prof (n, m)`` averaged over :data:`SNAP_TRACE_VERTICES` consecutive vertices of the same
+    trace (``owner (n,)``, vertices 1 px apart, traces contiguous): a ring line is continuous,
+    so one trace's moves come from the profile of a stretch of it, not of one vertex."""
+    from scipy import ndimage
+
+    win = SNAP_TRACE_VERTICES
+    if win <= 1:
+        return prof
+    out = np.empty_like(prof)
+    cuts = np.flatnonzero(np.diff(owner)) + 1
+    for a, b in zip(np.concatenate([[0], cuts]), np.concatenate([cuts, [len(owner)]])):
+        out[a:b] = ndimage.uniform_filter1d(prof[a:b], min(win, b - a), axis=0, mode="nearest")
+    return out
+
+
 def _parabolic(values: np.ndarray, i: np.ndarray) -> np.ndarray:
     """Sub-sample position ``i + d`` of the extreme of ``values (n, m)`` at indices ``i (n,)``."""
     rows = np.arange(len(values))
@@ -418,12 +475,13 @@ def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rul
     offsets = t[None, :] * lam[r, c][:, None]
     step = offsets[:, 1] - offsets[:, 0]
     if rule == "dark-line":
-        prof = _profiles(ndimage.gaussian_filter(lum, SNAP_SIGMA_PX), p, n_rc, offsets)
+        prof = _along_traces(_profiles(ndimage.gaussian_filter(lum, SNAP_SIGMA_PX), p, n_rc, offsets), owner)
         move = (_parabolic(prof, np.argmin(prof, axis=1)) - (len(t) - 1) / 2) * step
     else:
         gr = ndimage.gaussian_filter(lum, SNAP_SIGMA_PX, order=(1, 0))
         gc = ndimage.gaussian_filter(lum, SNAP_SIGMA_PX, order=(0, 1))
-        g = (_profiles(gr, p, n_rc, offsets) * n_rc[:, :1] + _profiles(gc, p, n_rc, offsets) * n_rc[:, 1:])
+        g = _along_traces(_profiles(gr, p, n_rc, offsets) * n_rc[:, :1]
+                          + _profiles(gc, p, n_rc, offsets) * n_rc[:, 1:], owner)
         mid = (len(t) - 1) // 2
         falling = np.where(np.arange(len(t)) <= mid, -g, -np.inf)      # into the band
         rising = np.where(np.arange(len(t)) >= mid, g, -np.inf)        # out of it
@@ -535,6 +593,8 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     order_map, ring_order = _ring_order(z, evidence, polys)
     if rule != "dark-centre":
         polys = _snap(lum, polys, normal, lam, rule)
+    if rule == "dark-line" and polys and VALLEY_REL > 0:
+        polys = polys + _faint_lines(lum, polys, normal, lam, evidence, min_len)
     traces = [RingTrace(p) for p in polys]
     share = float(evidence.mean())
     if share < MIN_RING_AREA or not traces:
