@@ -107,6 +107,9 @@ SNAP_TRACE_VERTICES = 9
 #: depth, relative to the median depth on the rings the band centres found.
 VALLEY_SIGMA_PX = 1.5
 VALLEY_REL = 0.5
+#: Largest change (px) of the move between neighbouring vertices (1 px apart) of a trace; a
+#: larger one is a jump to another line and the trace is cut there.
+SNAP_JUMP_PX = 1.0
 #: Median window (vertices) of the moves along a trace: one pore cannot pull a line aside.
 SNAP_MEDIAN_VERTICES = 5
 #: Reach (in ring spacings) of the local vote between the two edges for ``"sharp-edge"``.
@@ -506,7 +509,13 @@ def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rul
         mk = move[owner == k]
         if len(mk) >= SNAP_MEDIAN_VERTICES:
             mk = ndimage.median_filter(mk, SNAP_MEDIAN_VERTICES, mode="nearest")
-        out.append(q + mk[:, None] * n_rc[owner == k])
+        moved = q + mk[:, None] * n_rc[owner == k]
+        # where the line jumps to another dark line (two within reach), cut it there: the jump
+        # itself would be a piece of "ring" running across the rings
+        cuts = np.flatnonzero(np.abs(np.diff(mk)) > SNAP_JUMP_PX) + 1
+        for piece in np.split(moved, cuts):
+            if len(piece) >= 3:
+                out.append(piece)
     return out
 
 
