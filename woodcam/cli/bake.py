@@ -6,8 +6,8 @@ import argparse
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import (BLOCK_SPEC_HELP, add_bake_options, allow_negative_values, stock_options,
-                      vector_mm, write_screenshot)
+from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, allow_negative_values,
+                      stock_options, vector_mm, write_screenshot)
 
 
 def register(subparsers) -> None:
@@ -16,7 +16,8 @@ def register(subparsers) -> None:
                               description="Carve, bake, export (GLB, OBJ+MTL+PNG) and render the "
                               "example parts of cad_examples/ out of built-in synthetic blocks; "
                               "print stage times.")
-    p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
+    add_out_option(p, "per example part a GLB, OBJ+MTL+texture PNG, view PNG and part report",
+                   default=Path("out"))
     p.add_argument("--quick", action="store_true", help="lower texture resolution (for CI)")
     add_bake_options(p, texels_default=None, screenshot=False)
     p.set_defaults(func=run_demo)
@@ -30,7 +31,9 @@ def register(subparsers) -> None:
                               "sandbox).")
     p.add_argument("part", help="part file (.py script, .step, .stl, .obj, .glb)")
     p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
-    p.add_argument("--out", type=Path, required=True, help="output .glb path")
+    add_out_option(p, "the baked part; beside it PART.obj/.mtl, PART_texture.png, the "
+                   "part report PART_report.txt/.json and, with --screenshot, PART_view.png",
+                   suffixes=(".glb",))
     p.add_argument("--tolerance", type=float, default=None, metavar="MM",
                    help="tessellation chord tolerance for B-rep parts (default 0.05 mm)")
     p.add_argument("--timeout", type=float, default=None, metavar="S",

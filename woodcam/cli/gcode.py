@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import BLOCK_SPEC_HELP, add_bake_options, allow_negative_values, stock_options
+from .options import BLOCK_SPEC_HELP, add_bake_options, add_out_option, allow_negative_values, stock_options
 
 _EXAMPLES = """\
 examples:
@@ -41,7 +41,8 @@ def register(subparsers) -> None:
                    help="G-code file(s) (.nc, .gcode, .ngc, .tap); several files of one job "
                    "(e.g. roughing then finishing) are simulated in sequence on the same stock")
     p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
-    p.add_argument("--out", type=Path, required=True, help="output .glb path")
+    add_out_option(p, "the carved stock; beside it OUT.obj/.mtl, OUT_texture.png and, "
+                   "with --screenshot, OUT_view.png", suffixes=(".glb",))
     p.add_argument("--tool", action="append", default=[], metavar="[N=]SPEC",
                    help="a tool, e.g. flat:6.35, ball:3, bull:6:1, vbit:60:12, 2=ball:3 "
                    "(repeatable; without N= the tools go to the program's tool numbers in "

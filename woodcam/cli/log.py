@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_knot_options, knot_shading
+from .options import add_knot_options, add_out_option, knot_shading
 
 
 def register(subparsers) -> None:
@@ -29,7 +29,7 @@ def register(subparsers) -> None:
 
     r = sub.add_parser("render", help="PNG sections: a tangential board and an end-grain disc")
     source(r)
-    r.add_argument("--out", required=True, help="output folder")
+    add_out_option(r, "one PNG per section")
     r.add_argument("--ring-width", type=float, default=2.0, help="mm per year (default 2)")
     r.add_argument("--px-per-mm", type=float, default=2.0, help="resolution in pixels per mm (default 2)")
     r.add_argument("--supersample", type=int, default=2,
@@ -53,12 +53,12 @@ def register(subparsers) -> None:
 
     m = sub.add_parser("maps", help="write the seed's image maps of a log")
     source(m)
-    m.add_argument("--out", required=True, help="output folder")
+    add_out_option(m, "the seed's image maps (PNG)")
     m.set_defaults(func=run)
 
     e = sub.add_parser("export", help="write a log as a woodcam log file (JSON)")
     source(e)
-    e.add_argument("--out", required=True, help="output .json path")
+    add_out_option(e, "the woodcam log file", suffixes=(".json",))
     e.set_defaults(func=run)
 
 

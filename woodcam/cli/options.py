@@ -8,6 +8,9 @@
 - :func:`command_group`: a command with sub-commands that several modules extend.
 - :func:`check_numbers` / :data:`RANGES`: every numeric option finite and
   in range, checked by :func:`woodcam.cli.main` before a command runs.
+- :func:`add_out_option` / :func:`check_out` / :data:`OUT_RULE`: the one ``--out`` rule of
+  every command (a file when the path ends in a known file suffix, a folder otherwise),
+  checked by :func:`woodcam.cli.main` before a command runs.
 
 Nothing heavy is imported at module level (``woodcam --help`` loads this module).
 """
@@ -25,6 +28,61 @@ BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], 
                    "(a block cut from a grown object), a block folder "
                    "(block.json) or a Mokume sample folder (a 50 mm cube unless --size-mm); "
                    "append ~x90/~y90/~z90 to turn the block under the part")
+
+
+# -- --out: one rule for every command ---------------------------------------------------------
+#: Suffixes that make an ``--out`` path a FILE; any other path names a FOLDER.
+FILE_SUFFIXES: frozenset[str] = frozenset({
+    ".glb", ".gltf", ".obj", ".stl", ".png", ".jpg", ".jpeg", ".svg", ".dxf", ".html", ".json",
+    ".npz", ".pt", ".md", ".csv", ".txt", ".nc", ".zip"})
+
+#: The rule as ``woodcam --help`` and the README state it.
+OUT_RULE = ("--out is a FILE when it ends in a file suffix (.glb, .png, .json, .html, .npz, ...) "
+            "and a FOLDER otherwise (created when missing). Each command takes one of the two, "
+            "says which and what it writes in its --out help, and refuses the other kind "
+            "before any work (exit 2).")
+
+
+def add_out_option(p: argparse.ArgumentParser, writes: str, *, suffixes: tuple[str, ...] = (),
+                   default: Path | None = None) -> None:
+    """``--out`` under :data:`OUT_RULE`: a FILE ending in one of ``suffixes``, or (no
+    ``suffixes``) a FOLDER. ``writes`` says what the command writes there; ``default`` makes
+    the option optional. :func:`check_out` applies the rule before the command runs."""
+    assert all(s in FILE_SUFFIXES for s in suffixes), suffixes  # a contributor's mistake
+    kind = f"FILE ending in {' or '.join(suffixes)}" if suffixes else "FOLDER (created)"
+    p.add_argument("--out", type=Path, required=default is None, default=default,
+                   metavar="FILE" if suffixes else "DIR", help=f"output {kind}: {writes}"
+                   + (f" (default {default}{'' if suffixes else '/'})" if default else ""))
+    p.set_defaults(_out_suffixes=tuple(suffixes))
+
+
+def check_out(args: argparse.Namespace) -> None:
+    """Refuse an ``--out`` that breaks :data:`OUT_RULE` for this command, before any work:
+    a UsageError (exit 2) naming the command, what it wants, the value and a fix."""
+    from ..errors import UsageError
+
+    suffixes = getattr(args, "_out_suffixes", None)
+    out = getattr(args, "out", None)
+    if suffixes is None or out is None:
+        return
+    out = Path(out)
+    suffix = out.suffix.lower()
+    command = " ".join(str(getattr(args, k)) for k in vars(args)
+                       if k == "command" or k.endswith("_command")
+                       if getattr(args, k) is not None)
+    if suffixes:
+        if out.is_dir() or suffix not in FILE_SUFFIXES:
+            raise UsageError(f"--out of 'woodcam {command}' is a FILE ending in "
+                             f"{' or '.join(suffixes)}; got {str(out)!r}, a folder; give a file "
+                             f"name such as {str(out / ('part' + suffixes[0]))!r}")
+        if suffix not in suffixes:
+            raise UsageError(f"--out of 'woodcam {command}' must end in {' or '.join(suffixes)}; "
+                             f"got {str(out)!r}; give e.g. {str(out.with_suffix(suffixes[0]))!r}")
+    elif suffix in FILE_SUFFIXES or out.is_file():
+        what = "an existing file" if out.is_file() else f"a file name ({suffix})"
+        raise UsageError(f"--out of 'woodcam {command}' is a FOLDER (it writes several files); "
+                         f"got {str(out)!r}, {what}; give a folder such as "
+                         f"{str(out.with_name(out.stem + '_out' if out.is_file() else out.stem))!r}")
 
 
 def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction:

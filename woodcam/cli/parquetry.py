@@ -10,6 +10,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from .options import add_out_option
+
 _EPILOG = """\
 veneer sources (any number, mixed):
   --veneer SCAN.png[:DPI]            a scanned veneer at DPI (default 300); SCAN.png:4px/mm for
@@ -43,7 +45,7 @@ def register(subparsers) -> None:
     p.add_argument("--config", type=Path, default=None, metavar="JOB.json",
                    help="a job file in the paper's layout (source_textures, targets, Table 1 keys); "
                    "options given here override it")
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    add_out_option(p, "cut paths (SVG/DXF), panel.png, result.json, panel.glb and job.json")
     v = p.add_argument_group("veneers")
     v.add_argument("--veneer", action="append", default=[], metavar="SCAN[:DPI][:MASK]",
                    help="scanned veneer image (repeatable); resolution in dpi (default 300) or "

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .options import BLOCK_SPEC_HELP
+from .options import BLOCK_SPEC_HELP, add_out_option
 
 
 def register(subparsers) -> None:
@@ -20,7 +20,7 @@ def register(subparsers) -> None:
         "--place options that reproduce each placement in woodcam bake.")
     p.add_argument("part", help="part file (.py script, .step, .stl, .obj, .glb), block frame, mm")
     p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    add_out_option(p, "placements.png and placements.json")
     p.add_argument("--rotations", choices=("none", "z90", "all90"), default="z90",
                    help="orientations to try: none, quarter turns about z (default), or all 24 "
                    "axis-aligned ones")
