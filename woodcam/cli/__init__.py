@@ -161,9 +161,10 @@ def main(argv: list[str] | None = None) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            from .options import check_numbers, check_out
+            from .options import check_numbers, check_out, lengths_to_mm
 
             check_out(args)  # the --out rule, before any work
+            lengths_to_mm(args, parser)  # --units inch: every length in mm from here on
             check_numbers(args)  # every numeric option finite and in range, before any work
             rc = args.func(args)
         except UsageError as err:

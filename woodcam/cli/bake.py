@@ -6,8 +6,10 @@ import argparse
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, allow_negative_values,
-                      stock_options, vector_mm, write_screenshot)
+from ..units import fmt_volume
+from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
+                      allow_negative_values, stock_options, vector_mm,
+                      write_screenshot)
 
 
 def register(subparsers) -> None:
@@ -48,6 +50,7 @@ def register(subparsers) -> None:
     p.add_argument("--max-triangles", type=int, default=None, metavar="N",
                    help="triangle budget for B-rep parts: above it the part is re-meshed with "
                    "looser tolerances, and the summary says so (default 120000)")
+    add_units_option(p)
     add_bake_options(p)
     p.set_defaults(func=run_bake)
 
@@ -70,6 +73,7 @@ def register(subparsers) -> None:
                    help="the cut plane's normal, towards the side cut away (default: the block's "
                    "longest axis facing the camera)")
     allow_negative_values(p)
+    add_units_option(p)
     p.add_argument("--confidence", action="store_true",
                    help="colour the part by the fit's per-point confidence (red 0, yellow 0.5, green "
                    "1; spread of the accepted hypotheses and distance from observed faces) "
@@ -106,12 +110,13 @@ def run_bake(args: argparse.Namespace) -> int:
     tess = res.tessellation
     mesh_note = (f" (meshed at {tess['tolerance_mm']:.3g} mm / {tess['angular_tolerance_deg']:.3g}"
                  " deg)" if tess.get("tolerance_mm") and tess.get("triangles") else "")
-    print(f"{res.name}: {res.triangles} triangles{mesh_note}, {res.volume_mm3:.0f} mm^3, "
+    print(f"{res.name}: {res.triangles} triangles{mesh_note}, "
+          f"{fmt_volume(res.volume_mm3, args.units)}, "
           f"{res.atlas}; wrote " + ", ".join(map(str, res.files.values())))
     if res.report:
         from ..advise import report_text
 
-        print(report_text(res.report, res.name))
+        print(report_text(res.report, res.name, units=args.units))
     return 0
 
 

@@ -12,7 +12,9 @@ import time
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import BLOCK_SPEC_HELP, add_bake_options, add_out_option, allow_negative_values, stock_options
+from ..units import fmt_volume
+from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
+                      allow_negative_values, stock_options)
 
 _EXAMPLES = """\
 examples:
@@ -91,6 +93,7 @@ def register(subparsers) -> None:
                    help="merge nearly planar regions of the result mesh within this (default "
                    "0.05 mm: the 20,000-move raster's mesh shrinks from 2.0 M to 0.44 M "
                    "triangles, its volume moves by 0.0006 mm on average)")
+    add_units_option(p)
     add_bake_options(p)
     p.set_defaults(func=run)
     allow_negative_values(p)  # --work-offset -14,5,3
@@ -208,7 +211,7 @@ def run(args) -> int:
         s = res.stats
         print(f"{path.name}: {len(program)} moves read in {t_read:.2f} s, simulated on "
               f"{s['grid'][1]}x{s['grid'][0]} cells in {s['wall_s']:.2f} s "
-              f"({s['moves_per_s']:.0f} moves/s), removed {res.removed_volume_mm3:.0f} mm^3, "
+              f"({s['moves_per_s']:.0f} moves/s), removed {fmt_volume(res.removed_volume_mm3, args.units)}, "
               f"{len(res.report)} issue(s); machining time " + ", ".join(
                   f"T{t}: {_hms(f + r)} ({_hms(f)} feeding)" for t, (f, r) in times.items()))
         meta_programs.append({"gcode": str(path),

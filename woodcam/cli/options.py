@@ -11,6 +11,8 @@
 - :func:`add_out_option` / :func:`check_out` / :data:`OUT_RULE`: the one ``--out`` rule of
   every command (a file when the path ends in a known file suffix, a folder otherwise),
   checked by :func:`woodcam.cli.main` before a command runs.
+- :func:`add_units_option` / :func:`lengths_to_mm`: ``--units mm|inch``, the lengths of a
+  command line read in it (:data:`LENGTH_OPTIONS`); summaries print with :mod:`woodcam.units`.
 
 Nothing heavy is imported at module level (``woodcam --help`` loads this module).
 """
@@ -23,6 +25,7 @@ import re
 from pathlib import Path
 
 from ..errors import WoodcamError
+from ..units import MM_PER_UNIT
 
 BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], woodify:DIR/field.npz "
                    "(a block cut from a grown object), a block folder "
@@ -83,6 +86,106 @@ def check_out(args: argparse.Namespace) -> None:
         raise UsageError(f"--out of 'woodcam {command}' is a FOLDER (it writes several files); "
                          f"got {str(out)!r}, {what}; give a folder such as "
                          f"{str(out.with_name(out.stem + '_out' if out.is_file() else out.stem))!r}")
+
+
+# -- --units: lengths on the command line and in printed summaries ------------------------------
+#: ``(command, option dest)`` -> how the value holds lengths: "number" (float), "vector" (a
+#: tuple of floats), "spec" (a block spec's :WxDxH size), "place" (``--place`` operations:
+#: translate:X,Y,Z and fit:MARGIN), "tools" (``--tool`` specs: diameters, corner radii, tips;
+#: angles stay degrees). ``--rapid-rate`` reads unit/min. Options whose name carries a unit
+#: (``--texels-per-mm``, ``--size-mm``) keep it; files stay mm.
+LENGTH_OPTIONS: dict[tuple[str, str], str] = {
+    ("bake", "block"): "spec", ("bake", "tolerance"): "number", ("bake", "place"): "place",
+    ("place", "block"): "spec", ("place", "margin"): "number",
+    ("preview", "block"): "spec", ("preview", "cut_origin"): "vector",
+    ("review", "block"): "spec",
+    ("gcode", "block"): "spec", ("gcode", "resolution"): "number",
+    ("gcode", "work_offset"): "vector", ("gcode", "start"): "vector",
+    ("gcode", "stock"): "vector", ("gcode", "stock_origin"): "vector",
+    ("gcode", "rapid_rate"): "number", ("gcode", "mesh_tol"): "number",
+    ("gcode", "tool"): "tools",
+}
+
+#: Positions of the lengths among a tool spec's numbers (``vbit:ANGLE:D`` -> D only).
+_TOOL_LENGTHS = {"flat": (0,), "ball": (0,), "bull": (0, 1), "vbit": (1,), "snub": (1, 2),
+                 "chamfer": (1, 2), "taperball": (0, 1)}
+_SPEC_SIZE = re.compile(r"^((?:builtin|log):[^~]*:)([^:~]+)(~.*)?$")
+
+
+def add_units_option(p: argparse.ArgumentParser) -> None:
+    """``--units mm|inch`` for a command whose lengths :data:`LENGTH_OPTIONS` lists."""
+    p.add_argument("--units", choices=("mm", "inch"), default="mm",
+                   help="unit of the lengths on this command line (block spec sizes, offsets, "
+                   "tolerances, tool diameters, --place translate/fit) and of the printed "
+                   "summary; options named in mm (--texels-per-mm, --size-mm) and files "
+                   "written (GLB, JSON, reports on disk) stay mm (default mm)")
+
+
+def _num(v: float) -> str:
+    return f"{v:.12g}"
+
+
+def _scaled_numbers(text: str, sep: str, k: float, where=None) -> str:
+    """``text``'s ``sep``-separated numbers times ``k`` (only positions ``where``); a
+    non-number is left as written for the command's own check to name."""
+    parts = text.split(sep)
+    out = []
+    for i, part in enumerate(parts):
+        try:
+            out.append(_num(float(part) * k) if where is None or i in where else part)
+        except ValueError:
+            out.append(part)
+    return sep.join(out)
+
+
+def _value_to_mm(kind: str, value, k: float):
+    if kind == "number":
+        return value * k
+    if kind == "vector":
+        return tuple(v * k for v in value)
+    if kind == "spec":
+        m = _SPEC_SIZE.match(str(value))
+        if not m:
+            return value
+        return m.group(1) + _scaled_numbers(m.group(2).lower(), "x", k) + (m.group(3) or "")
+    if kind == "place":
+        return [place_op_in(op, k) for op in value]
+    if kind == "tools":
+        out = []
+        for item in value:
+            num, eq, spec = item.rpartition("=")
+            kind_, _, nums = spec.partition(":")
+            out.append(num + eq + kind_ + ":" + _scaled_numbers(
+                nums, ":", k, _TOOL_LENGTHS.get(kind_.strip().lower(), ())))
+        return out
+    raise ValueError(kind)  # pragma: no cover - LENGTH_OPTIONS holds only the kinds above
+
+
+def place_op_in(op: str, k: float) -> str:
+    """A ``--place`` operation with its lengths (translate:X,Y,Z, fit:MARGIN) times ``k``."""
+    name, _, arg = op.partition(":")
+    if name.lower() == "translate":
+        return f"{name}:{_scaled_numbers(arg, ',', k)}"
+    if name.lower() == "fit" and arg:
+        return f"{name}:{_scaled_numbers(arg, ',', k)}"
+    return op
+
+
+def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> None:
+    """Convert, in place, every length of ``args`` given in ``--units`` to millimetres (what
+    everything below the CLI takes); called by :func:`woodcam.cli.main` before the range checks.
+    Defaults are millimetres already (the help states them in mm) and are left alone: argparse
+    stores a default as the very object of the parser, a typed value as a new one."""
+    units = getattr(args, "units", None)
+    if units in (None, "mm"):
+        return
+    k = MM_PER_UNIT[units]
+    command = getattr(args, "command", None)
+    sub = parser.get_default("_commands").choices[command]
+    for (cmd, dest), kind in LENGTH_OPTIONS.items():
+        value = getattr(args, dest, None)
+        if cmd == command and value is not None and value is not sub.get_default(dest):
+            setattr(args, dest, _value_to_mm(kind, value, k))
 
 
 def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction:

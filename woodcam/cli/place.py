@@ -5,7 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .options import BLOCK_SPEC_HELP, add_out_option
+from ..units import MM_PER_UNIT
+from .options import (BLOCK_SPEC_HELP, add_out_option, add_units_option,
+                      place_op_in)
 
 
 def register(subparsers) -> None:
@@ -30,6 +32,7 @@ def register(subparsers) -> None:
                    help="distance kept from the block faces (default 1 mm)")
     p.add_argument("--top", type=int, default=3, metavar="K",
                    help="placements shown in the picture and table (default 3)")
+    add_units_option(p)
     p.set_defaults(func=run_place)
 
 
@@ -45,7 +48,7 @@ def run_place(args: argparse.Namespace) -> int:
     stock = open_stock(args.block)
     advice = advise_placement(args.part, stock, rotations=args.rotations,
                               candidates=args.candidates, margin_mm=args.margin)
-    print(advice.table(args.top))
+    print(advice.table(args.top, ops=lambda op: place_op_in(op, 1 / MM_PER_UNIT[args.units])))
     record = {"block": args.block, "part": str(args.part), "candidates": advice.candidates,
               "weights": advice.weights, "elongation": advice.elongation,
               "ranked": [{"ops": p.ops, "score": p.score, **p.terms,

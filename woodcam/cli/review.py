@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .options import BLOCK_SPEC_HELP, add_out_option
+from .options import BLOCK_SPEC_HELP, add_out_option, add_units_option
 
 
 def register(subparsers) -> None:
@@ -24,6 +24,7 @@ def register(subparsers) -> None:
     p.add_argument("--voxels", type=int, default=None, metavar="N",
                    help="voxels of each of the three colour volumes behind the section cap "
                    "(default 400000: ~1 mm voxels on a 100x80x50 mm block, page ~2-3 MB)")
+    add_units_option(p)
     p.set_defaults(func=run_review)
 
 
