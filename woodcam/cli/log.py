@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_knot_options, add_out_option, knot_shading
+from .options import SPECIES_HELP, add_knot_options, add_out_option, knot_shading
 
 
 def register(subparsers) -> None:
@@ -45,8 +45,7 @@ def register(subparsers) -> None:
     r.add_argument("--k-knot", type=float, default=5.0, help="smoothness k inside knots")
     add_knot_options(r)
     r.add_argument("--species", default="spruce",
-                   help="colour preset of the wood (oak, maple, walnut, cherry, pine, spruce; "
-                   "default spruce, the real log's)")
+                   help=SPECIES_HELP + " (default spruce, the real log's)")
     r.add_argument("--outline-mm", type=float, default=1.0,
                    help="dead-knot outline thickness (mm)")
     r.set_defaults(func=run)

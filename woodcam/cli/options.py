@@ -27,6 +27,13 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import MM_PER_UNIT
 
+#: The --species presets (woodcam.appearance.SPECIES, listed here so that --help imports no
+#: numba; tests/appearance/test_species.py checks the two agree). README: "Species presets".
+SPECIES_HELP = ("colour preset: cited (README 'Species presets'): red-oak, white-oak, black-walnut, "
+                "black-cherry, white-ash, sassafras, black-willow, buckeye, ponderosa-pine, "
+                "western-larch, douglas-fir, engelmann-spruce; legacy, uncited: oak, maple, "
+                "walnut, cherry, pine, spruce")
+
 BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], woodify:DIR/field.npz "
                    "(a block cut from a grown object), a block folder "
                    "(block.json) or a Mokume sample folder (a 50 mm cube unless --size-mm); "
@@ -256,8 +263,7 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                       else "10, or 4 with --quick)"))
     if species:
         p.add_argument("--species", default=None,
-                       help="colour preset (oak, maple, walnut, cherry, pine, spruce); default: "
-                       "the block's")
+                       help=SPECIES_HELP + " (default: the block's)")
     p.add_argument("--appearance", choices=("colormap", "neural"), default="colormap",
                    help="colormap: fast colour-of-ring model (default); neural: colour volumes "
                    "learnt from the block's photos per axis (seed 000 sec. 3.3, cached on disk)")

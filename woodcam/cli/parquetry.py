@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .options import add_out_option
+from .options import SPECIES_HELP, add_out_option
 
 _EPILOG = """\
 veneer sources (any number, mixed):
@@ -63,8 +63,7 @@ def register(subparsers) -> None:
                    help="normal of the slicing planes in the block frame (default y: leaves "
                    "parallel to the front face)")
     v.add_argument("--species", default=None,
-                   help="colour preset for sliced blocks (oak, maple, walnut, cherry, pine, "
-                   "spruce); default: the block's own")
+                   help=SPECIES_HELP + " (default: the block's own)")
     t = p.add_argument_group("parameters (seed 002, Table 1)")
     t.add_argument("--w-intens", type=float, default=None, help="intensity weight of eq. 1, in [0, 1] (default 0.5)")
     t.add_argument("--w-edge", type=float, default=None, help="Sobel edge weight of eq. 1, in [0, 1] (default 0.5)")
