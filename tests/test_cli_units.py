@@ -114,3 +114,28 @@ def test_gcode_in_inches_cuts_what_the_mm_run_cuts(tmp_path, monkeypatch, capsys
     removed_mm3 = float(out_mm.split("removed ")[1].split(" mm^3")[0])
     removed_in3 = float(out_inch.split("removed ")[1].split(" in^3")[0])
     assert removed_in3 == pytest.approx(removed_mm3 / 25.4 ** 3, rel=1e-3)
+
+
+def test_place_in_inches_ranks_what_the_mm_run_ranks_and_prints_inches(tmp_path, capsys):
+    """End to end: the same placements, their JSON in mm, the printed --place in inches."""
+    import json
+
+    import trimesh
+
+    part = tmp_path / "block.stl"
+    trimesh.creation.box((24.0, 18.0, 10.0)).apply_translation((12, 9, 5)).export(part)
+    common = ["place", str(part), "--candidates", "60", "--top", "2"]
+    assert main([*common, "--units", "inch", "--block", "builtin:knotty:4x3x2", "--margin",
+                 "0.05", "--out", str(tmp_path / "in")]) == 0
+    out_inch = capsys.readouterr().out
+    assert main([*common, "--block", "builtin:knotty:101.6x76.2x50.8", "--margin", "1.27",
+                 "--out", str(tmp_path / "mm")]) == 0
+    out_mm = capsys.readouterr().out
+    rec = {u: json.loads((tmp_path / u / "placements.json").read_text()) for u in ("in", "mm")}
+    assert [r["ops"] for r in rec["in"]["ranked"]] == [r["ops"] for r in rec["mm"]["ranked"]]
+    best = rec["mm"]["ranked"][0]["ops"]
+    move = next(op for op in best if op.startswith("translate:"))
+    mm = [float(v) for v in move.split(":")[1].split(",")]
+    assert f"--place {move}" in out_mm
+    printed = out_inch.split("--place translate:")[1].split()[0]
+    assert [float(v) for v in printed.split(",")] == pytest.approx([v / 25.4 for v in mm])

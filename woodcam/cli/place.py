@@ -48,7 +48,8 @@ def run_place(args: argparse.Namespace) -> int:
     stock = open_stock(args.block)
     advice = advise_placement(args.part, stock, rotations=args.rotations,
                               candidates=args.candidates, margin_mm=args.margin)
-    print(advice.table(args.top, ops=lambda op: place_op_in(op, 1 / MM_PER_UNIT[args.units])))
+    k = 1 / MM_PER_UNIT[args.units]
+    print(advice.table(args.top, op_text=str if k == 1 else (lambda op: place_op_in(op, k))))
     record = {"block": args.block, "part": str(args.part), "candidates": advice.candidates,
               "weights": advice.weights, "elongation": advice.elongation,
               "ranked": [{"ops": p.ops, "score": p.score, **p.terms,
