@@ -50,7 +50,7 @@ def register(subparsers) -> None:
     p.add_argument("--max-triangles", type=int, default=None, metavar="N",
                    help="triangle budget for B-rep parts: above it the part is re-meshed with "
                    "looser tolerances, and the summary says so (default 120000)")
-    add_units_option(p)
+    add_units_option(p, "bake")
     add_bake_options(p)
     p.set_defaults(func=run_bake)
 
@@ -73,7 +73,7 @@ def register(subparsers) -> None:
                    help="the cut plane's normal, towards the side cut away (default: the block's "
                    "longest axis facing the camera)")
     allow_negative_values(p)
-    add_units_option(p)
+    add_units_option(p, "preview")
     p.add_argument("--confidence", action="store_true",
                    help="colour the part by the fit's per-point confidence (red 0, yellow 0.5, green "
                    "1; spread of the accepted hypotheses and distance from observed faces) "

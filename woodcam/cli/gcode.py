@@ -93,7 +93,7 @@ def register(subparsers) -> None:
                    help="merge nearly planar regions of the result mesh within this (default "
                    "0.05 mm: the 20,000-move raster's mesh shrinks from 2.0 M to 0.44 M "
                    "triangles, its volume moves by 0.0006 mm on average)")
-    add_units_option(p)
+    add_units_option(p, "gcode")
     add_bake_options(p)
     p.set_defaults(func=run)
     allow_negative_values(p)  # --work-offset -14,5,3

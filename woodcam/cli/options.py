@@ -97,7 +97,7 @@ def check_out(args: argparse.Namespace) -> None:
 
 # -- --units: lengths on the command line and in printed summaries ------------------------------
 #: ``(command, option dest)`` -> how the value holds lengths: "number" (float), "vector" (a
-#: tuple of floats), "spec" (a block spec's :WxDxH size), "place" (``--place`` operations:
+#: tuple of floats), "sizes" / "csv" (a text "WxDxH" / "X,Y,Z,R" of lengths), "spec" (a block spec's :WxDxH size), "place" (``--place`` operations:
 #: translate:X,Y,Z and fit:MARGIN), "tools" (``--tool`` specs: diameters, corner radii, tips;
 #: angles stay degrees). ``--rapid-rate`` reads unit/min. Options whose name carries a unit
 #: (``--texels-per-mm``, ``--size-mm``) keep it; files stay mm.
@@ -111,6 +111,10 @@ LENGTH_OPTIONS: dict[tuple[str, str], str] = {
     ("gcode", "stock"): "vector", ("gcode", "stock_origin"): "vector",
     ("gcode", "rapid_rate"): "number", ("gcode", "mesh_tol"): "number",
     ("gcode", "tool"): "tools",
+    ("woodify", "growth"): "number", ("woodify", "block_size"): "sizes",
+    ("woodify", "block_centre"): "csv", ("woodify", "crack_region"): "csv",
+    ("parquetry", "sheet_size"): "sizes", ("parquetry", "leaf_thickness"): "number",
+    ("parquetry", "saw_kerf"): "number", ("parquetry", "tool_diameter"): "number",
 }
 
 #: Positions of the lengths among a tool spec's numbers (``vbit:ANGLE:D`` -> D only).
@@ -119,13 +123,22 @@ _TOOL_LENGTHS = {"flat": (0,), "ball": (0,), "bull": (0, 1), "vbit": (1,), "snub
 _SPEC_SIZE = re.compile(r"^((?:builtin|log):[^~]*:)([^:~]+)(~.*)?$")
 
 
-def add_units_option(p: argparse.ArgumentParser) -> None:
-    """``--units mm|inch`` for a command whose lengths :data:`LENGTH_OPTIONS` lists."""
+#: Commands whose printed summary (volumes, suggested --place options) follows --units.
+_SUMMARY_IN_UNITS = {"bake", "gcode", "place"}
+
+
+def add_units_option(p: argparse.ArgumentParser, command: str) -> None:
+    """``--units mm|inch`` for ``command``; its help names the options :data:`LENGTH_OPTIONS`
+    converts for that command."""
+    names = [("a block spec's WxDxH" if d == "block" else _option(d))
+             for (c, d) in LENGTH_OPTIONS if c == command]
+    assert names, command  # a contributor's mistake: list the command's lengths first
     p.add_argument("--units", choices=("mm", "inch"), default="mm",
-                   help="unit of the lengths on this command line (block spec sizes, offsets, "
-                   "tolerances, tool diameters, --place translate/fit) and of the printed "
-                   "summary; options named in mm (--texels-per-mm, --size-mm) and files "
-                   "written (GLB, JSON, reports on disk) stay mm (default mm)")
+                   help=f"unit of {', '.join(names)}"
+                   + (" and of the printed summary" if command in _SUMMARY_IN_UNITS else "")
+                   + "; options "
+                   "named in mm (--texels-per-mm, --size-mm, ...), defaults and the files "
+                   "written stay mm (default mm)")
 
 
 def _num(v: float) -> str:
@@ -150,6 +163,9 @@ def _value_to_mm(kind: str, value, k: float):
         return value * k
     if kind == "vector":
         return tuple(v * k for v in value)
+    if kind in ("sizes", "csv"):
+        return _scaled_numbers(str(value).lower() if kind == "sizes" else str(value),
+                               "x" if kind == "sizes" else ",", k)
     if kind == "spec":
         m = _SPEC_SIZE.match(str(value))
         if not m:

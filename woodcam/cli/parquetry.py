@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .options import SPECIES_HELP, add_out_option
+from .options import SPECIES_HELP, add_out_option, add_units_option
 
 _EPILOG = """\
 veneer sources (any number, mixed):
@@ -62,6 +62,7 @@ def register(subparsers) -> None:
     v.add_argument("--slice-axis", choices=("x", "y", "z"), default="y",
                    help="normal of the slicing planes in the block frame (default y: leaves "
                    "parallel to the front face)")
+    add_units_option(v, "parquetry")
     v.add_argument("--species", default=None,
                    help=SPECIES_HELP + " (default: the block's own)")
     t = p.add_argument_group("parameters (seed 002, Table 1)")

@@ -32,7 +32,7 @@ def register(subparsers) -> None:
                    help="distance kept from the block faces (default 1 mm)")
     p.add_argument("--top", type=int, default=3, metavar="K",
                    help="placements shown in the picture and table (default 3)")
-    add_units_option(p)
+    add_units_option(p, "place")
     p.set_defaults(func=run_place)
 
 

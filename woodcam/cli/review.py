@@ -24,7 +24,7 @@ def register(subparsers) -> None:
     p.add_argument("--voxels", type=int, default=None, metavar="N",
                    help="voxels of each of the three colour volumes behind the section cap "
                    "(default 400000: ~1 mm voxels on a 100x80x50 mm block, page ~2-3 MB)")
-    add_units_option(p)
+    add_units_option(p, "review")
     p.set_defaults(func=run_review)
 
 

@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_out_option
+from .options import add_out_option, add_units_option
 
 
 def _vec(text: str, option: str, n: int = 3, positive: bool = False) -> tuple[float, ...]:
@@ -75,6 +75,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                    default="stress", help="bark crack pattern (default stress: natural directions)")
     p.add_argument("--crack-region", default=None, metavar="X,Y,Z,R",
                    help="only crack within this sphere (mm)")
+    add_units_option(p, "woodify")
     p.add_argument("--crack-years", type=int, default=5,
                    help="last years simulated for cracks (default 5)")
     p.add_argument("--crack-render", choices=("groove", "material"), default="material",
