@@ -97,9 +97,9 @@ def check_out(args: argparse.Namespace) -> None:
 
 # -- --units: lengths on the command line and in printed summaries ------------------------------
 #: ``(command, option dest)`` -> how the value holds lengths: "number" (float), "vector" (a
-#: tuple of floats), "sizes" / "csv" (a text "WxDxH" / "X,Y,Z,R" of lengths), "spec" (a block spec's :WxDxH size), "place" (``--place`` operations:
-#: translate:X,Y,Z and fit:MARGIN), "tools" (``--tool`` specs: diameters, corner radii, tips;
-#: angles stay degrees). ``--rapid-rate`` reads unit/min. Options whose name carries a unit
+#: tuple of floats), "sizes" / "csv" (a text "WxDxH" / "X,Y,Z,R" of lengths), "spec" (a block
+#: spec's :WxDxH size), "place" (``--place`` operations: translate:X,Y,Z and fit:MARGIN),
+#: "tools" (``--tool`` specs: diameters, corner radii, tips; angles stay degrees). ``--rapid-rate`` reads unit/min. Options whose name carries a unit
 #: (``--texels-per-mm``, ``--size-mm``) keep it; files stay mm.
 LENGTH_OPTIONS: dict[tuple[str, str], str] = {
     ("bake", "block"): "spec", ("bake", "tolerance"): "number", ("bake", "place"): "place",
@@ -177,7 +177,10 @@ def _value_to_mm(kind: str, value, k: float):
         out = []
         for item in value:
             num, eq, spec = item.rpartition("=")
-            kind_, _, nums = spec.partition(":")
+            kind_, colon, nums = spec.partition(":")
+            if not colon:  # no numbers: left for the tool parser to name
+                out.append(item)
+                continue
             out.append(num + eq + kind_ + ":" + _scaled_numbers(
                 nums, ":", k, _TOOL_LENGTHS.get(kind_.strip().lower(), ())))
         return out
