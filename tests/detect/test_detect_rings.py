@@ -201,3 +201,31 @@ def test_cn03_faces_against_the_mokume_maps():
     s = summary(score_reference_block(read_mokume(_mokume("CN03"))))
     assert s["F@2"] >= CN03_BAR[2.0] and s["F@5"] >= CN03_BAR[5.0], s
     assert s["F@2"] > 2 * s["chance F@2"]
+
+
+def test_realistic_softwood_faces_are_darkest_on_their_ring_boundary():
+    """The realistic generator's claim: narrow softwood latewood is darkest at the ring boundary
+    (the true line, within 1 px), as on the real spruce faces (a latewood band widened to half
+    a ring and darkening early fails this)."""
+    from scipy import ndimage
+
+    from woodcam.detect.rings import luminance
+    from woodcam.synth import ring_eval_faces
+
+    def darkest_offset(face):
+        det = detect_rings(face.photo, px_per_mm=face.px_per_mm, rule="dark-centre")
+        p = face.truth_px[::3]
+        r = np.clip(np.round(p[:, 0]).astype(int), 0, face.photo.shape[0] - 1)
+        c = np.clip(np.round(p[:, 1]).astype(int), 0, face.photo.shape[1] - 1)
+        n = np.stack([np.sin(det.normal_rad[r, c]), np.cos(det.normal_rad[r, c])], axis=1)
+        t = np.arange(-6, 7)
+        q = p[:, None, :] + t[None, :, None] * n[:, None, :]
+        lum = ndimage.gaussian_filter(luminance(face.photo), 1.0)
+        prof = ndimage.map_coordinates(lum, [q[..., 0].ravel(), q[..., 1].ravel()], order=1).reshape(len(p), -1)
+        return abs(t[np.argmin(prof.mean(axis=0))])
+
+    real = ring_eval_faces(2, style="realistic", faces=("front", "top"))     # even seed: softwood
+    assert all("realistic" in f.label for f in real)
+    assert max(darkest_offset(f) for f in real) <= 1
+    with pytest.raises(WoodcamError, match="style must be"):
+        ring_eval_faces(2, style="photo")
