@@ -143,9 +143,12 @@ def test_scores_are_exact_on_a_known_case():
 
 
 #: Bars on the held-out synthetic seeds (sharp-edge rule, the plain synthetic faces' ring
-#: boundary). Measured (README): see SYNTH_MEASURED.
-SYNTH_BAR_F2_ALL = 0.88
+#: boundary); the goal is 0.90 within 2 px.
+#: Plain faces, seeds 1000-1007: F within 2 / 5 px 0.925 / 0.943; seed 1000 alone 0.85.
+SYNTH_BAR_F2_ALL = 0.90
 SYNTH_BAR_F2_FIRST = 0.80
+#: Realistic faces (seeds 1000-1003, sharp-edge): F within 5 px 0.72.
+REALISTIC_BAR_F5 = 0.66
 
 
 def test_synthetic_faces_first_heldout_seed():
@@ -161,7 +164,7 @@ def test_synthetic_faces_all_heldout_seeds():
     faces = _faces(EVAL_SEEDS)
     res = score_synthetic(faces, rule="sharp-edge")
     s = summary(res)
-    assert s["F@2"] >= SYNTH_BAR_F2_ALL and s["F@5"] >= 0.87, s
+    assert s["F@2"] >= SYNTH_BAR_F2_ALL and s["F@5"] >= 0.90, s
     # the band centre is off by ~15 % of a ring here, so within 5 px but not 2 px (README)
     d = summary(score_synthetic(faces, rule="dark-centre"))
     assert d["F@5"] >= 0.80, d
@@ -169,10 +172,11 @@ def test_synthetic_faces_all_heldout_seeds():
 
 @pytest.mark.slow
 def test_realistic_synthetic_faces_all_heldout_seeds():
-    """Narrow softwood latewood and ring-porous oak with rays and figure (README figures)."""
+    """Narrow softwood latewood and ring-porous oak with rays and figure (README figures:
+    seeds 1000-1003, sharp-edge F within 2 / 5 px 0.63 / 0.72, chance 0.08 / 0.43)."""
     from woodcam.synth import ring_eval_faces
 
-    faces = [f for s in EVAL_SEEDS for f in ring_eval_faces(s, style="realistic")]
+    faces = [f for s in EVAL_SEEDS[:4] for f in ring_eval_faces(s, style="realistic")]
     s = summary(score_synthetic(faces, rule="sharp-edge"))
     assert s["F@5"] >= REALISTIC_BAR_F5 and s["F@2"] > 2 * s["chance F@2"], s
 
