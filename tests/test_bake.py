@@ -25,6 +25,7 @@ can double the 3D offset at chart corners. ``A / L * s_max * sqrt(2)`` alone is 
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -441,7 +442,7 @@ def test_a_native_crash_in_the_unwrap_is_retried_in_pieces(monkeypatch):
     monkeypatch.setattr(_xatlas_worker, "layout",
                         _crashing_layout(_xatlas_worker.layout, lambda p: len(p) == 1))
     with pytest.warns(WoodcamWarning, match="xatlas crashed unwrapping the surface in 1 piece"):
-        result = bake(mesh, SmoothWood(), texels_per_mm=3.0)
+        result = bake(mesh, SmoothWood(), texels_per_mm=3.0, unwrap="xatlas")
     # the two-piece atlas is as exact as a one-piece one
     err, bound, _ = _check_against_wood(result.mesh, result.atlas, mesh, "face",
                                         np.random.default_rng(5), coverage=result.coverage_mask)
@@ -455,14 +456,77 @@ def test_a_unwrap_that_always_crashes_is_one_clear_error(monkeypatch):
     monkeypatch.setattr(_xatlas_worker, "layout",
                         _crashing_layout(_xatlas_worker.layout, lambda p: True))
     with pytest.raises(WoodcamError, match=r"xatlas crashed \(native fault\).*up to 8 pieces"):
-        bake(_box(), SmoothWood(), texels_per_mm=2.0)
+        bake(_box(), SmoothWood(), texels_per_mm=2.0, unwrap="xatlas")
 
 
 def test_the_82k_triangle_icosphere_that_crashed_xatlas_bakes():
     """Regression: xatlas segfaults on this closed sphere in one piece (issue 16)."""
     sphere = trimesh.creation.icosphere(subdivisions=6, radius=40.0)
     with pytest.warns(WoodcamWarning, match="xatlas crashed"):
-        result = bake(sphere, SmoothWood(), texels_per_mm=1.0)
+        result = bake(sphere, SmoothWood(), texels_per_mm=1.0, unwrap="xatlas")
     assert len(result.mesh.faces) == 81920
     assert result.coverage_mask.mean() > 0.5
 
+
+
+def test_the_82k_triangle_icosphere_bakes_with_projected_charts_without_a_crash():
+    """The default unwrap (woodcam's projected charts, xatlas only packs) never reaches the
+    xatlas charting that segfaults on this sphere, and honours the density on every face."""
+    sphere = trimesh.creation.icosphere(subdivisions=6, radius=40.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", WoodcamWarning)  # no crash-and-retry message
+        result = bake(sphere, SmoothWood(), texels_per_mm=4.0)
+    assert len(result.mesh.faces) == 81920
+    assert result.density_stretch > 1.0  # projected charts were used
+    assert result.uv_fill >= 0.5
+    mm_per_texel = _texel_jacobians(result.mesh, result.atlas.shape,
+                                    np.asarray(result.mesh.vertices))
+    assert mm_per_texel.max() <= 1.0 / result.texels_per_mm * (1 + 1e-3)
+
+
+def _helicoid(turns: float, pitch_mm: float = 2.0):
+    """An open helical ramp (r 10..30 mm) whose normals all lie within ~6 degrees of +Z; with
+    more than one turn its projection on the XY plane covers the same ground twice."""
+    n_a, n_r = int(96 * turns), 4
+    a = np.linspace(0.0, 2 * np.pi * turns, n_a + 1)
+    r = np.linspace(10.0, 30.0, n_r + 1)
+    aa, rr = np.meshgrid(a, r, indexing="ij")
+    verts = np.column_stack([rr.ravel() * np.cos(aa.ravel()), rr.ravel() * np.sin(aa.ravel()),
+                             pitch_mm * aa.ravel() / (2 * np.pi)])
+    idx = np.arange(len(verts)).reshape(n_a + 1, n_r + 1)
+    q = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], axis=-1).reshape(-1, 4)
+    faces = np.vstack([q[:, [0, 2, 1]], q[:, [0, 3, 2]]])
+    return trimesh.Trimesh(verts, faces, process=False)
+
+
+@pytest.mark.parametrize("turns, folds", [(0.8, False), (1.5, True)])
+def test_projected_charts_that_fold_over_themselves_are_left_to_xatlas(turns, folds):
+    from woodcam.bake import _projected_charts
+
+    ramp = _helicoid(turns)
+    assert (_projected_charts(ramp) is None) == folds
+    result = bake(ramp, SmoothWood(), texels_per_mm=2.0)
+    assert (result.density_stretch == 1.0) == folds  # xatlas' charts: exact density
+    if not folds:  # (xatlas' own atlas of the folded ramp misses the bound too: not ours)
+        err, bound, _ = _check_against_wood(result.mesh, result.atlas, ramp, "face",
+                                            np.random.default_rng(7),
+                                            coverage=result.coverage_mask)
+        assert err <= bound
+
+
+def test_a_native_crash_while_packing_projected_charts_falls_back_to_xatlas(monkeypatch):
+    import os
+    import signal
+
+    import woodcam._xatlas_worker as _xatlas_worker
+
+    def crash(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGSEGV)
+
+    monkeypatch.setattr(_xatlas_worker, "pack", crash)
+    mesh = _sphere()
+    result = bake(mesh, SmoothWood(), texels_per_mm=4.0)
+    assert result.density_stretch == 1.0
+    err, bound, _ = _check_against_wood(result.mesh, result.atlas, mesh, "face",
+                                        np.random.default_rng(8), coverage=result.coverage_mask)
+    assert err <= bound
