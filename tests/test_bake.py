@@ -371,7 +371,7 @@ def test_wood_without_color_and_bad_color_shape_are_rejected():
 
 def test_rasteriser_paints_exactly_the_bilinear_footprint_of_its_triangles():
     """Unit check of the conservative rasteriser against dense sampling, on compact triangles,
-    big ones and long slivers (both the grouped and the tiled path): every texel that bilinear
+    big ones and long slivers (the row-span walk of every shape): every texel that bilinear
     sampling at a point of a triangle reads is painted, and nothing farther than the footprint
     (L-inf 1 texel + the 0.02 margin) from every triangle is."""
     from scipy.spatial import cKDTree
@@ -379,9 +379,9 @@ def test_rasteriser_paints_exactly_the_bilinear_footprint_of_its_triangles():
     from woodcam.bake import _rasterise
 
     xy = np.array([
-        [2.3, 2.7], [9.1, 3.2], [4.4, 8.9],            # compact (grouped path)
-        [12.2, 3.0], [45.1, 5.5], [12.9, 4.1],         # long sliver (tiled path)
-        [6.0, 14.0], [40.0, 18.0], [20.0, 44.0],       # big triangle (tiled path)
+        [2.3, 2.7], [9.1, 3.2], [4.4, 8.9],            # compact
+        [12.2, 3.0], [45.1, 5.5], [12.9, 4.1],         # long sliver
+        [6.0, 14.0], [40.0, 18.0], [20.0, 44.0],       # big triangle
         [44.5, 30.2], [46.0, 44.7], [44.9, 30.3],      # thin, nearly vertical sliver
     ])
     faces = np.arange(len(xy)).reshape(-1, 3)
