@@ -32,7 +32,9 @@ def register(subparsers) -> None:
     p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
     p.add_argument("--out", type=Path, required=True, help="output .glb path")
     p.add_argument("--tolerance", type=float, default=None, metavar="MM",
-                   help="tessellation chord tolerance for B-rep parts (default 0.05 mm)")
+                   help="tessellation chord tolerance for B-rep parts, mm (default: scaled to "
+                   "the part and the texel, min(a quarter texel, 0.1 %% of the part's bounding-box "
+                   "diagonal): 0.025 mm for the demo bowl at 10 texels/mm)")
     p.add_argument("--timeout", type=float, default=None, metavar="S",
                    help="stop loading the part (running a trusted .py script, tessellating) "
                    "after S seconds (default: no limit)")
@@ -101,8 +103,13 @@ def run_bake(args: argparse.Namespace) -> int:
     write_screenshot(args, res.files, stock)
     print_warnings(res.warnings)
     tess = res.tessellation
-    mesh_note = (f" (meshed at {tess['tolerance_mm']:.3g} mm / {tess['angular_tolerance_deg']:.3g}"
-                 " deg)" if tess.get("tolerance_mm") and tess.get("triangles") else "")
+    mesh_note = ""
+    if tess.get("tolerance_mm") and tess.get("triangles"):
+        rule = tess.get("tolerance_rule", "")
+        mesh_note = (f" (meshed at {tess['tolerance_mm']:.3g} mm / "
+                     f"{tess['angular_tolerance_deg']:.3g} deg"
+                     + (f", {rule}" if rule.startswith("auto") else "")
+                     + f"; budget {tess.get('max_triangles')} triangles)")
     print(f"{res.name}: {res.triangles} triangles{mesh_note}, {res.volume_mm3:.0f} mm^3, "
           f"{res.atlas}; wrote " + ", ".join(map(str, res.files.values())))
     if res.report:
