@@ -62,8 +62,10 @@ class _DevTools:
         self._from_r, from_w = os.pipe()
 
         def _child_fds():  # runs in the child: the pipes become its fds 3 and 4
-            os.dup2(to_r, 3)
+            os.dup2(to_r, 3)  # (to_r < from_w: pipes take the lowest free descriptors)
             os.dup2(from_w, 4)
+            os.set_inheritable(3, True)  # dup2(3, 3) is a no-op that keeps close-on-exec
+            os.set_inheritable(4, True)
 
         self._log = tmp_path / "chromium.log"
         with open(self._log, "wb") as log:
