@@ -530,3 +530,17 @@ def test_a_native_crash_while_packing_projected_charts_falls_back_to_xatlas(monk
     err, bound, _ = _check_against_wood(result.mesh, result.atlas, mesh, "face",
                                         np.random.default_rng(8), coverage=result.coverage_mask)
     assert err <= bound
+
+
+def test_a_zero_area_face_does_not_break_the_projected_charts():
+    """Regression: a degenerate triangle alone in its chart had no mean normal (NaN uv)."""
+    box = _box()
+    verts = np.vstack([box.vertices, box.vertices[:1] + [0.0, 0.0, 1e-3]])
+    faces = np.vstack([box.faces, [[0, 0, len(box.vertices)]]])
+    mesh = trimesh.Trimesh(verts, faces, process=False)
+    result = bake(mesh, SmoothWood(), texels_per_mm=4.0)
+    assert np.isfinite(np.asarray(result.mesh.visual.uv)).all()
+    keep = np.arange(len(box.faces))
+    err, bound, _ = _check_against_wood(result.mesh.submesh([keep], append=True), result.atlas,
+                                        box, "face", np.random.default_rng(9))
+    assert err <= bound

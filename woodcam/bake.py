@@ -520,7 +520,10 @@ def _projected_charts(mesh):
     n_charts, chart = connected_components(graph, directed=False)
     mean = np.zeros((n_charts, 3))
     np.add.at(mean, chart, cross)  # area-weighted (|cross| = 2 x area)
-    mean /= np.maximum(np.linalg.norm(mean, axis=1, keepdims=True), 1e-300)
+    length = np.linalg.norm(mean, axis=1, keepdims=True)
+    axis = np.zeros((n_charts, 3))
+    axis[chart] = _cone_directions()[cone]  # a chart of zero-area faces only: its cone's axis
+    mean = np.where(length > 0, mean / np.where(length > 0, length, 1.0), axis)
     cos = np.einsum("ij,ij->i", normal, mean[chart])
     min_cos = np.ones(n_charts)
     np.minimum.at(min_cos, chart[valid], cos[valid])
