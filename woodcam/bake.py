@@ -24,19 +24,21 @@ OBJ viewers both sample texel (r, c) at the same surface point.
 
 Pipeline (each step timed in :attr:`BakeResult.timings`)
 --------------------------------------------------------
-1. ``unwrap``: xatlas charts + packing at ``texels_per_unit = texels_per_mm`` (the mesh is in mm,
-   so one xatlas "unit" is a millimetre), one atlas, charts ``padding_px`` texels apart.
-2. ``rasterise``: every triangle is rasterised conservatively in texel space: triangles are
-   grouped by bounding-box size and each group is tested as one broadcast numpy array
-   (triangles x rows x cols) of edge functions (no per-texel Python loop). A texel is painted
+1. ``unwrap``: charts made here (faces grouped by normal cone, projected flat, scaled so no
+   face gets fewer texels per mm than asked; :func:`_projected_charts`), or xatlas' own charts
+   where those fold or fragment; xatlas packs them at ``texels_per_unit = texels_per_mm`` (the
+   mesh is in mm, so one xatlas "unit" is a millimetre), one atlas, charts ``padding_px``
+   texels apart, in a worker process (a native crash never takes the caller down).
+2. ``rasterise``: every triangle is rasterised conservatively in texel space by a numba kernel
+   that walks the rows of its footprint (:mod:`woodcam._raster`). A texel is painted
    when its centre lies within L-infinity distance 1 (+ a 0.02 texel margin) of the triangle,
    which covers every texel bilinear sampling at any point of the triangle can read. A texel
    whose centre lies inside a triangle takes that triangle; a texel only in border rings takes the
    nearest triangle and the triangle's affine map is extrapolated to it (a point in the
    triangle's plane at most ~1.5 texels outside it).
 3. ``color``: 3D point and normal of every painted texel -> ``wood.color`` in bounded batches.
-4. ``dilate``: every unpainted texel takes the colour of its nearest painted texel (exact
-   Euclidean distance transform), so no mip level ever averages in black.
+4. ``dilate``: every unpainted texel takes the colour of a nearest painted texel (OpenCV's
+   labelled chamfer distance transform), so no mip level ever averages in black.
 """
 
 from __future__ import annotations
