@@ -544,3 +544,22 @@ def test_a_zero_area_face_does_not_break_the_projected_charts():
     err, bound, _ = _check_against_wood(result.mesh.submesh([keep], append=True), result.atlas,
                                         box, "face", np.random.default_rng(9))
     assert err <= bound
+
+
+def test_fragmented_projected_charts_of_a_noisy_mesh_fall_back_to_xatlas(monkeypatch):
+    """A scanned-looking sphere (0.3 mm noise on its vertices): its normals jump between cones, the
+    projected charts fragment and pack poorly, so xatlas' charts are made too and kept when
+    fuller; a clean sphere keeps the projected charts."""
+    import woodcam.bake as bake_module
+
+    rng = np.random.default_rng(3)
+    noisy = trimesh.creation.icosphere(subdivisions=4, radius=30.0)
+    noisy.vertices += rng.normal(scale=0.3, size=noisy.vertices.shape)
+    assert bake_module._projected_charts(noisy)[4] > bake_module._MAX_SMALL_CHART_AREA
+    auto = bake(noisy, SmoothWood(), texels_per_mm=4.0)
+    monkeypatch.setattr(bake_module, "_MIN_PROJECTED_FILL", 0.0)  # projected charts only
+    projected = bake(noisy, SmoothWood(), texels_per_mm=4.0)
+    assert projected.density_stretch > 1.0 and projected.uv_fill < 0.4
+    assert auto.density_stretch == 1.0 and auto.uv_fill > projected.uv_fill
+    clean = trimesh.creation.icosphere(subdivisions=4, radius=30.0)
+    assert bake_module._projected_charts(clean)[4] == 0.0

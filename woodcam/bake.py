@@ -62,10 +62,16 @@ from woodcam.tolerances import (
 NormalsMode = Literal["face", "smooth"]
 UnwrapMode = Literal["auto", "xatlas"]
 
-#: When projected charts (:func:`_projected_charts`) pack with a UV fill below this, xatlas'
-#: own charts are made too and the fuller atlas kept: the normals of a noisy or scanned mesh
-#: jump between cones and fragment the charts. The example parts pack at 0.53-0.80.
+#: When projected charts (:func:`_projected_charts`) pack with a UV fill below this AND they
+#: are fragmented (more than _MAX_SMALL_CHART_AREA of the surface in charts of fewer than
+#: _SMALL_CHART_FACES faces), xatlas' own charts are made too and the fuller atlas kept: the
+#: normals of a noisy or scanned mesh jump between cones (a noisy icosphere: 0.93 of its area in
+#: such charts; the examples <= 0.1, the linuxcnc meshes 0.03-0.5). A low fill of large charts
+#: is the padding's share at a low density, which xatlas' charts pay too (the 52k bowl at 2
+#: texels/mm: 0.37 against 0.38, for 7 CPU-s more), so it does not call xatlas.
 _MIN_PROJECTED_FILL = 0.4
+_SMALL_CHART_FACES = 20
+_MAX_SMALL_CHART_AREA = 0.2
 
 #: Centroids each triangle tests for lying inside it in the fold check of projected charts
 #: (its own and its ~3-12 neighbours come first; a second layer's centroid inside it is among
@@ -407,7 +413,7 @@ def _unwrap(mesh, tpm: float, max_px: int, padding: int, messages: list[str],
         if charts is not None:
             vmap, faces, uv, width, height = packed
             fill = _uv_fill(uv * [width, height], faces, width, height)
-            if fill < _MIN_PROJECTED_FILL:  # fragmented charts (noisy normals): try xatlas'
+            if fill < _MIN_PROJECTED_FILL and charts[4] > _MAX_SMALL_CHART_AREA:  # noisy normals
                 other = _layout_guarded(verts, faces_in, pieces, chart_cap, tpm, padding,
                                         messages)
                 if _uv_fill(other[2] * other[3:5], other[1], *other[3:5]) > fill:
@@ -451,7 +457,7 @@ def _pack_guarded(charts, tpm: float, padding: int):
 
     import woodcam._xatlas_worker as _xatlas_worker
 
-    uv_mm, chart_faces, corner_vertex, _ = charts
+    uv_mm, chart_faces, corner_vertex = charts[:3]
     kwargs = {"texels_per_mm": float(tpm), "padding": int(padding)}
     if _XATLAS_IN_PROCESS:  # pragma: no cover - debugging aid
         out = _xatlas_worker.pack(uv_mm, chart_faces, **kwargs)
@@ -501,8 +507,9 @@ def _projected_charts(mesh):
     below 1 / cos(55 deg) and in practice 1 / 0.82.
 
     Returns ``(uv_mm (k, 2) float32, chart_faces (f, 3) int, corner_vertex (k,) int,
-    mean_stretch float)`` with one uv vertex per chart corner, or None when a chart folds over
-    itself (e.g. a helical ramp), left to xatlas.
+    mean_stretch float, fragmented float)`` with one uv vertex per chart corner (fragmented: the
+    area share in charts of fewer than _SMALL_CHART_FACES faces), or None when a chart folds
+    over itself (e.g. a helical ramp), left to xatlas.
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -556,8 +563,12 @@ def _projected_charts(mesh):
     cols = math.ceil(math.sqrt(n_charts))
     origin = np.column_stack([np.arange(n_charts) % cols, np.arange(n_charts) // cols]) * cell
     uv = uv - lo[c_chart] + origin[c_chart]
-    stretch = float(np.sum(double_area / min_cos[chart] ** 2 * cos) / max(double_area.sum(), 1e-300))
-    return uv.astype(np.float32), chart_faces, c_vertex.astype(np.int64), math.sqrt(stretch)
+    total = max(float(double_area.sum()), 1e-300)
+    stretch = float(np.sum(double_area / min_cos[chart] ** 2 * cos) / total)
+    small = np.bincount(chart, minlength=n_charts)[chart] < _SMALL_CHART_FACES
+    fragmented = float(double_area[small].sum() / total)
+    return (uv.astype(np.float32), chart_faces, c_vertex.astype(np.int64), math.sqrt(stretch),
+            fragmented)
 
 
 def _charts_fold(uv: np.ndarray, faces: np.ndarray, chart: np.ndarray) -> bool:
