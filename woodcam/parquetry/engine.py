@@ -201,7 +201,8 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     bank = SheetBank(grey, [v.mask for v in sheets], params.w_intens, params.w_edge, params.n_rot,
                      kerf_px=params.kerf * params.px_per_mm, mode=params.mode,
                      coarse_factor=params.coarse_factor, top_k=params.top_k,
-                     single_use=params.single_use)
+                     single_use=params.single_use, w_struct=params.w_struct,
+                     rerank=params.rerank)
     names = names or [f"target{k}" for k in range(len(targets))]
     panels = [prepare_target(t, params, src_vals, k, names[k]) for k, t in enumerate(targets)]
 

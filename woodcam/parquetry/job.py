@@ -50,6 +50,9 @@ class ParquetryParams:
     kerf_mm : wood lost between two pieces on a sheet (default: the tool diameter)
     mode : "fast" (coarse-to-fine, exact re-ranking) or "exhaustive"
     coarse_factor, top_k : the fast mode's pyramid factor and re-ranked candidates
+    w_struct : weight of the structural term (SSIM's contrast-structure, 7 x 7 windows) that
+        re-ranks the ``rerank`` cheapest free candidates of eq. 4 (woodcam's addition; 0: eq. 4
+        alone)
     """
 
     w_intens: float = 0.5
@@ -71,6 +74,8 @@ class ParquetryParams:
     coarse_factor: int = 4
     top_k: int = 12
     single_use: bool = True
+    w_struct: float = 0.0
+    rerank: int = 16
 
     def check(self) -> ParquetryParams:
         """Validate at the door; returns self."""
@@ -98,6 +103,8 @@ class ParquetryParams:
         if self.px_per_mm <= 0 or self.tool_diameter_mm < 0 or (self.kerf_mm or 0) < 0:
             raise WoodcamError("px_per_mm must be > 0, tool_diameter_mm and kerf_mm >= 0; got "
                                f"{self.px_per_mm}, {self.tool_diameter_mm}, {self.kerf_mm}")
+        if self.w_struct < 0 or self.rerank < 1:
+            raise WoodcamError(f"w_struct must be >= 0 and rerank >= 1; got {self.w_struct}, {self.rerank}")
         if self.coarse_factor < 1 or self.top_k < 1:
             raise WoodcamError(f"coarse_factor and top_k must be >= 1; got {self.coarse_factor}, {self.top_k}")
         if self.patch_px < 4:
