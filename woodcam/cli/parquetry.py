@@ -89,7 +89,8 @@ def register(subparsers) -> None:
                    "position at full resolution")
     f.add_argument("--coarse-factor", type=int, default=None, metavar="N",
                    help="fast mode: the first search runs N times coarser than --px-per-mm "
-                   "(default 4; 8 or 16 for large sheets, where it is 5 or 20 times quicker)")
+                   "(default: auto, the smallest of 4, 8, 16 whose coarse search holds <= 4.5 M px; "
+                   "16 for four 600x400 mm sheets at 4 px/mm)")
     f.add_argument("--overlap-mm", type=float, default=None,
                    help="patch overlap for seam cutting in mm (default min(patch/4, "
                    "(patch - min-piece)/2) = 3.5); 0 = square pieces")

@@ -260,7 +260,7 @@ class SheetBank:
                  n_rot: int = 15, kerf_px: float = 0.0,
                  mode: MatchMode = "fast", coarse_factor: int = 4, top_k: int = 12,
                  single_use: bool = True, max_atlas_bytes: int = 2_500_000_000,
-                 w_struct: float = 0.0, rerank: int = 16):
+                 w_struct: float = 0.0, rerank: int = 8):
         if mode not in ("exhaustive", "fast"):
             raise WoodcamError(f"mode must be one of ['exhaustive', 'fast']; got {mode!r}")
         if n_rot < 1:
@@ -385,8 +385,7 @@ class SheetBank:
         tc = cv2.resize(_lowpass(template, f), (max(1, tw // f), max(1, th // f)),
                         interpolation=cv2.INTER_AREA)
         any_cands = False
-        k0 = self.top_k if self.w_struct <= 0 else max(self.top_k, 2 * self.rerank)
-        for k in (k0, k0 * 16):
+        for k in (self.top_k, self.top_k * 16):
             cands = self.atlas.search(tc, k)
             any_cands = any_cands or bool(cands)
             found: list[tuple[float, int, int, int, int]] = []
