@@ -90,6 +90,8 @@ def summary(run: ParquetryRun) -> dict:
             d.update(feature_cost=feature_cost(p, p.render, prm),
                      feature_cost_baseline=feature_cost(p, p.baseline, prm),
                      ssim=ssim_vs_matched(p, p.render), ssim_baseline=ssim_vs_matched(p, p.baseline),
+                     ssim_1mm=ssim_vs_matched(p, p.render, round(prm.px_per_mm)),
+                     ssim_1mm_baseline=ssim_vs_matched(p, p.baseline, round(prm.px_per_mm)),
                      mean_patch_cost_px=float(np.mean([q.cost_px for q in p.patches])))
         out["panels"].append(d)
     return out
@@ -181,7 +183,8 @@ def format_summary(summ: dict, problems: dict) -> str:
         if "feature_cost" in d:
             line += (f"; feature cost/px {d['feature_cost']:.5f} (mean-colour baseline "
                      f"{d['feature_cost_baseline']:.5f}), SSIM {d['ssim']:.3f} (baseline "
-                     f"{d['ssim_baseline']:.3f})")
+                     f"{d['ssim_baseline']:.3f}), at 1 mm pixels {d['ssim_1mm']:.3f} (baseline "
+                     f"{d['ssim_1mm_baseline']:.3f})")
         lines.append(line)
     lines.append(f"matching: {summ['match_seconds']:.1f} s wall, {summ['match_cpu_seconds']:.1f} CPU-s, "
                  f"{summ['seconds_per_patch']:.3f} s per patch")
