@@ -83,7 +83,7 @@ class ParquetryParams:
     top_k: int = 12
     single_use: bool = True
     w_struct: float = 0.02
-    rerank: int = 8
+    rerank: int = 4
 
     def check(self) -> ParquetryParams:
         """Validate at the door; returns self."""

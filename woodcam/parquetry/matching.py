@@ -121,9 +121,18 @@ class _Atlas:
             return []
         base = self._base(th, tw)
         cc = None
+        oh, ow = self.shape[0] - th + 1, self.shape[1] - tw + 1
         for ch in range(self.shape[2]):
-            r = cv2.matchTemplate(self._chan[ch], np.ascontiguousarray(template[..., ch]), cv2.TM_CCORR)
-            cc = r if cc is None else cv2.add(cc, r, dst=cc)
+            t = np.ascontiguousarray(template[..., ch], np.float32)
+            if max(th, tw) <= _DIRECT_MAX:
+                # filter2D correlates directly (anchored top-left it is TM_CCORR on the valid
+                # part); for the coarse search's few-pixel templates that is ~2.7 times quicker
+                # than matchTemplate's DFT path.
+                r = cv2.filter2D(self._chan[ch], cv2.CV_32F, t, anchor=(0, 0),
+                                 borderType=cv2.BORDER_CONSTANT)[:oh, :ow]
+            else:
+                r = cv2.matchTemplate(self._chan[ch], t, cv2.TM_CCORR)
+            cc = r.copy() if cc is None else cv2.add(cc, r)
         # SSD = sum S^2 - 2 sum S T + sum T^2 (eq. 4); base carries sum S^2 and +inf where the
         # window touches used or unusable wood, so no mask has to be applied per search.
         cost = cv2.scaleAdd(cc, -2.0, base)
@@ -193,6 +202,11 @@ class _Atlas:
             sub[win > 0] = np.inf
 
 
+#: Largest template side (px) correlated directly by filter2D rather than matchTemplate
+#: (measured on a 1261 x 1598 atlas: 5 px 5.5 vs 14.9 ms, 10 px on par, 21 px 2 times slower).
+_DIRECT_MAX = 7
+
+
 def _lowpass(F: np.ndarray, f: int) -> np.ndarray:
     """Gaussian low-pass (sigma f / 2) before downsampling by f: the coarse search compares
     what survives a misalignment of up to half a coarse pixel, so a texture's fine, periodic
@@ -260,7 +274,7 @@ class SheetBank:
                  n_rot: int = 15, kerf_px: float = 0.0,
                  mode: MatchMode = "fast", coarse_factor: int = 4, top_k: int = 12,
                  single_use: bool = True, max_atlas_bytes: int = 2_500_000_000,
-                 w_struct: float = 0.0, rerank: int = 8):
+                 w_struct: float = 0.0, rerank: int = 4):
         if mode not in ("exhaustive", "fast"):
             raise WoodcamError(f"mode must be one of ['exhaustive', 'fast']; got {mode!r}")
         if n_rot < 1:
