@@ -207,3 +207,10 @@ if __name__ == "__main__":
     res = fn(**extra)
     dest.write_text(json.dumps(res, indent=1))
     print(f"wrote {dest}")
+
+
+def test_fast_mode_within_5_percent_of_exhaustive_at_4_px_per_mm():
+    """The issue's resolution; the coarse factor the issue's sheets get automatically (16)."""
+    r = exhaustive_vs_fast_4ppm(factors=(16,))["runs"]
+    assert r["fast_f16"]["mean_patch_cost_px"] <= 1.05 * r["exhaustive"]["mean_patch_cost_px"]
+    assert r["fast_f16"]["cpu_s_per_patch"] < 0.1 * r["exhaustive"]["cpu_s_per_patch"]
