@@ -398,12 +398,13 @@ class SheetBank:
             return self._fallback(template) if cands else None
         tc = cv2.resize(_lowpass(template, f), (max(1, tw // f), max(1, th // f)),
                         interpolation=cv2.INTER_AREA)
-        any_cands = False
-        for k in (self.top_k, self.top_k * 16):
-            cands = self.atlas.search(tc, k)
-            any_cands = any_cands or bool(cands)
+        # One coarse search ranks 16 top_k anchors; they are re-ranked exactly top_k at a time,
+        # and the next batch is looked at only when every candidate of this one collides with
+        # used wood (late in a run, where the cheapest wood is gone).
+        cands = self.atlas.search(tc, self.top_k * 16)
+        for b in range(0, len(cands), self.top_k):
             found: list[tuple[float, int, int, int, int]] = []
-            for t, xc, yc, _ in cands:
+            for t, xc, yc, _ in cands[b:b + self.top_k]:
                 i, j = self.atlas.tiles[t][:2]
                 # Coarse tiles are the full rotated canvases downsampled: coarse pixel X
                 # covers full pixels f X .. f X + f - 1.
@@ -414,9 +415,7 @@ class SheetBank:
             m = self._choose(template, found)
             if m is not None:
                 return m
-            if not cands:
-                break
-        return self._fallback(template) if any_cands else None
+        return self._fallback(template) if cands else None
 
     def _choose(self, template: np.ndarray, found: list) -> Match | None:
         """The candidate to take from ``found = [(cost, sheet, rot, x, y)]`` (sorted by cost).
