@@ -338,7 +338,7 @@ def test_planted_violation_is_repaired_and_files_pass(sheets, tmp_path):
     parsed back; every panel pixel is still covered exactly once."""
     from skimage import data
 
-    from woodcam.parquetry.engine import render_panel, repair_fabricability
+    from woodcam.parquetry.engine import _render_panel, repair_fabricability
     from woodcam.parquetry.output import run_pieces
     from woodcam.parquetry.seams import _line_from, labels_from_lines
 
@@ -356,7 +356,7 @@ def test_planted_violation_is_repaired_and_files_pass(sheets, tmp_path):
     vals = vals + 6.0 * (np.abs(y - 8) < 2) - 6.0 * (np.abs(y - 16) < 2) + 6.0 * (np.abs(y - 24) < 2)
     p.seams_v[0] = _line_from(vals, "v", 1, H, line.raw)
     p.labels = labels_from_lines(p, p.seams_v, p.seams_h)
-    render_panel(p, run.bank, run.veneers)
+    _render_panel(p, run.bank, run.veneers)
     planted = {pc.id: pc.problems for pc in run_pieces(run) if pc.problems}
     assert planted and any("concave" in m for v in planted.values() for m in v), planted
 

@@ -316,10 +316,10 @@ def finish_panel(p: Parquetry, patches: list[Patch], bank: SheetBank, sheets: li
         p.labels, p.seams_v, p.seams_h = cut_seams(p, windows, params)
     else:
         p.labels = straight_labels(p)
-    render_panel(p, bank, sheets)
+    _render_panel(p, bank, sheets)
 
 
-def render_panel(p: Parquetry, bank: SheetBank, sheets: list[Veneer]) -> None:
+def _render_panel(p: Parquetry, bank: SheetBank, sheets: list[Veneer]) -> None:
     """``p.render`` (each pixel the wood of its label's patch) and ``p.baseline`` (each piece
     its mean colour, the paper's Fig. 8 baseline) from ``p.labels``."""
     H, W = p.matched.shape
@@ -380,7 +380,7 @@ def repair_fabricability(run: ParquetryRun, max_rounds: int = 4) -> dict[int, st
                         p.seams_h[m - 1] = straight_line(m * p.cell_px, "h", m, W)
                 done[q.id] = "seams straightened (" + "; ".join(bad[q.id]) + ")"
         p.labels = labels_from_lines(p, p.seams_v, p.seams_h)
-        render_panel(p, run.bank, run.veneers)
+        _render_panel(p, run.bank, run.veneers)
     run.repaired.update(done)
     return done
 
