@@ -101,8 +101,9 @@ class _Atlas:
         self.shape = self.F.shape
         del self.F
         self._base_cache: dict[tuple[int, int], np.ndarray] = {}
-        # Cached anchor maps (float32, one per template size) held to ~4 atlas copies.
-        self._max_cached = 4
+        # Cached anchor maps (float32, one per template size: interior, edge and corner
+        # patches) held to 4 atlas-sized copies, 2 for a large (exhaustive) atlas.
+        self._max_cached = 4 if H * W <= 20_000_000 else 2
         self._by_sheet: dict[int, list[int]] = {}
         for k, t in enumerate(self.tiles):
             self._by_sheet.setdefault(t[0], []).append(k)
