@@ -5,7 +5,7 @@ degradation (sequential vs interleaved) on one sheet.
 Run as a benchmark (``pytest -m bench tests/bench/test_parquetry_bench.py``) or as a script
 that prints and stores the figures::
 
-    python tests/bench/test_parquetry_bench.py quality|speed|fig14|exhaustive|exhaustive4 OUT.json [COARSE_FACTOR | IMAGES]
+    python tests/bench/test_parquetry_bench.py quality|speed|fig14|exhaustive|exhaustive4|full OUT.json [COARSE_FACTOR | IMAGES | OUT_DIR]
 
 Timings are CPU seconds of the matching (``time.process_time``), so they are comparable under
 the shared machine's load; wall seconds are stored too.
@@ -190,6 +190,37 @@ def exhaustive_vs_fast_4ppm(size_mm=70.0, ppm=4.0, factors=(4, 8, 16)):
     return out
 
 
+def full_workload(out_dir=None, runs=("fast", "eq4_only", "reuse")):
+    """The issue's workload: ``camera`` at 360 mm (676 patches of 14 mm), one 600 x 400 mm leaf
+    each of walnut, maple, oak and cherry sliced from builtin blocks + the 12 Mokume face
+    photos, 4 px/mm, 15 rotations, seams; the fast run's files are written to ``out_dir``."""
+    import dataclasses
+
+    from skimage import data
+
+    from woodcam.parquetry import ParquetryParams, build_parquetry, write_parquetry
+
+    sheets = _sheets((600, 400), 4.0, leaves=1, mokume=True, n_species=4)
+    img = data.camera().astype(np.float32) / 255
+    base = ParquetryParams()
+    variants = {"fast": base, "eq4_only": dataclasses.replace(base, w_struct=0.0),
+                "reuse": dataclasses.replace(base, single_use=False)}
+    out = {"workload": "camera at 360 mm, 14 mm patches, four 600x400 mm leaves (walnut, maple, "
+           "oak, cherry) + 12 Mokume face photos, 4 px/mm, 15 rotations, seams", "runs": {}}
+    for label in runs:
+        prm = variants[label]
+        t = time.process_time()
+        run = build_parquetry([img], sheets, prm)
+        d = _figures(run, prm)
+        d.update(total_cpu_s=time.process_time() - t, coarse_factor=run.bank.f,
+                 repaired=len(run.repaired))
+        if label == "fast" and out_dir is not None:
+            d["problems_left"] = len(write_parquetry(run, out_dir)["problems"])
+        out["runs"][label] = d
+        print(label, json.dumps(d), flush=True)
+    return out
+
+
 def test_fast_mode_within_5_percent_of_exhaustive_on_camera():
     r = exhaustive_vs_fast()["runs"]
     assert r["fast"]["mean_patch_cost_px"] <= 1.05 * r["exhaustive"]["mean_patch_cost_px"]
@@ -199,10 +230,11 @@ def test_fast_mode_within_5_percent_of_exhaustive_on_camera():
 if __name__ == "__main__":
     what, dest = sys.argv[1], Path(sys.argv[2])
     fn = {"quality": quality, "speed": speed, "fig14": fig14, "exhaustive": exhaustive_vs_fast,
-          "exhaustive4": exhaustive_vs_fast_4ppm}[what]
+          "exhaustive4": exhaustive_vs_fast_4ppm, "full": full_workload}[what]
     extra = {}
     if len(sys.argv) > 3:
         extra = ({"coarse_factor": int(sys.argv[3])} if what == "speed"
+                 else {"out_dir": sys.argv[3]} if what == "full"
                  else {"images": tuple(sys.argv[3].split(","))})
     res = fn(**extra)
     dest.write_text(json.dumps(res, indent=1))
