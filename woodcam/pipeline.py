@@ -87,12 +87,12 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
     4 x 4 matrix is recorded in the GLB metadata as ``placement``. A ``.py`` source is trusted
     code run with your rights; ``timeout_s`` bounds its loading."""
     from .cad import carve, load_part
-    from .tolerances import MAX_PART_TRIANGLES, TESSELLATION_TOL_MM
+    from .tolerances import MAX_PART_TRIANGLES
 
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)  # before minutes of work
     result = PartPreview(out_glb.stem)
     with result.stage("load"):
-        part = load_part(source, tolerance_mm=TESSELLATION_TOL_MM if tolerance_mm is None else tolerance_mm,
+        part = load_part(source, tolerance_mm=tolerance_mm, texels_per_mm=texels_per_mm,
                          timeout_s=timeout_s,
                          max_triangles=max_triangles or MAX_PART_TRIANGLES,
                          report=result.tessellation)

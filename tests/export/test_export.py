@@ -252,3 +252,31 @@ def test_an_exported_part_reloads_as_a_part_in_the_block_frame(baked, tmp_path, 
     np.testing.assert_allclose(lo, [0.0, 0.0, 0.0], atol=1e-3)
     np.testing.assert_allclose(hi, [30.0, 20.0, 16.0], atol=1e-3)
     assert solid.volume() == pytest.approx(baked.mesh.volume, rel=1e-3)
+
+
+def test_glb_and_obj_share_one_png_encoding_of_the_atlas(tmp_path, monkeypatch):
+    """Issue 16: the PNG was encoded twice (GLB, then OBJ) at zlib level 6. Now once: both
+    files hold the same bytes, which decode to the baked atlas."""
+    from PIL import Image
+
+    import woodcam.export as export
+
+    block = trimesh.creation.box((12.0, 10.0, 8.0))
+    block.apply_translation([6.0, 5.0, 4.0])
+    result = bake(block, _Wood(), texels_per_mm=2.5)  # its own atlas: not cached yet
+    encodings = []
+    original = Image.Image.save
+
+    def counting_save(self, fp, format=None, **params):
+        if str(format).upper() == "PNG":
+            encodings.append(params)
+        return original(self, fp, format=format, **params)
+
+    monkeypatch.setattr(Image.Image, "save", counting_save)
+    glb = export_glb(result.mesh, tmp_path / "part.glb")
+    export_obj(result.mesh, tmp_path / "part.obj")
+    assert encodings == [{"compress_level": export._PNG_COMPRESS_LEVEL}]
+    png = (tmp_path / "part_texture.png").read_bytes()
+    assert png in glb.read_bytes()  # the GLB's image buffer is the same PNG
+    np.testing.assert_array_equal(np.asarray(Image.open(tmp_path / "part_texture.png")),
+                                  result.atlas)

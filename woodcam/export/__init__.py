@@ -54,6 +54,53 @@ _GL_LINEAR = 9729
 _GL_LINEAR_MIPMAP_LINEAR = 9987
 _GL_CLAMP_TO_EDGE = 33071
 
+#: zlib level of the texture PNG: level 1 encodes the bowl's 2k^2 atlas in 0.21 CPU-s (3.2 MB),
+#: PIL's default 6 in 0.76-0.96 s (2.9 MB); the GLB and the OBJ's PNG share one encoding.
+_PNG_COMPRESS_LEVEL = 1
+
+#: The last texture encoded: {content digest: PNG bytes} (one entry; export_glb and export_obj
+#: of the same baked mesh encode it once).
+_PNG_CACHE: dict[bytes, bytes] = {}
+
+
+
+def _png_bytes(image) -> bytes:
+    """``image`` (PIL) as PNG bytes at :data:`_PNG_COMPRESS_LEVEL`, cached by content."""
+    import hashlib
+    import io
+
+    digest = hashlib.blake2b(image.tobytes(), digest_size=20)
+    digest.update(f"{image.mode} {image.size}".encode())
+    key = digest.digest()
+    if key not in _PNG_CACHE:
+        buffer = io.BytesIO()
+        image.save(buffer, format="PNG", compress_level=_PNG_COMPRESS_LEVEL)
+        _PNG_CACHE.clear()
+        _PNG_CACHE[key] = buffer.getvalue()
+    return _PNG_CACHE[key]
+
+
+def _with_encoded_texture(mesh, attribute: str):
+    """Point ``mesh.visual.material.<attribute>`` (a COPY of the material) at a copy of its image
+    whose ``save(..., format="PNG")`` writes :func:`_png_bytes`: trimesh's GLB and OBJ exporters
+    each call ``image.save`` and would encode the same atlas again at zlib level 6."""
+    material = copy.copy(mesh.visual.material)
+    image = getattr(material, attribute, None)
+    if image is None or not hasattr(image, "tobytes"):
+        return
+    data = _png_bytes(image)
+    encoded = image.copy()
+    encoded.format = None
+
+    def save(fp, format=None, **params):
+        if str(format).upper() != "PNG" or params:
+            return type(image).save(encoded, fp, format=format, **params)
+        fp.write(data)
+        return None
+
+    encoded.save = save
+    setattr(material, attribute, encoded)
+    mesh.visual.material = material
 
 
 def _require_textured(mesh, func: str):
@@ -214,6 +261,7 @@ def export_glb(mesh: Mesh, path: PathLike, metadata: dict | None = None, *,
         _set_buffer_view_targets(tree)
 
     shaded = _shaded(mesh, crease_angle_deg, normals, "export_glb")
+    _with_encoded_texture(shaded, "baseColorTexture")
     scene = trimesh.Scene()
     scene.add_geometry(shaded, geom_name="part", node_name="part")
     data = _trimesh_export_glb(scene, include_normals=True, tree_postprocessor=_add_extras)
@@ -303,9 +351,8 @@ def export_obj(mesh: Mesh, path: PathLike, *, units: ObjUnits = "m", up: ObjUp =
     material.diffuse = np.array([255, 255, 255, 255], dtype=np.uint8)
     material.ambient = np.array([255, 255, 255, 255], dtype=np.uint8)
     material.specular = np.array([20, 20, 20, 255], dtype=np.uint8)
-    if material.image is not None and material.image.format is None:
-        material.image.format = "PNG"
     out.visual.material = material
+    _with_encoded_texture(out, "image")
     text, files = _trimesh_export_obj(
         out, include_normals=True, include_texture=True, return_texture=True,
         mtl_name=f"{stem}.mtl", digits=9
