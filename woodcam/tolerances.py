@@ -67,6 +67,15 @@ TRACE_SAMPLE_STEP_MM = 0.5
 #: bright on ring boundaries; 0.5 is the natural mid-point of a soft boundary map).
 RING_MAP_THRESHOLD = 0.5
 
+#: Ring-map skeleton pixels where the bright band is wider than this factor times the face's
+#: median band width are blobs, not ring lines (the U-Net paints rings 3-8 px wide; where it is
+#: unsure, e.g. H11's face A, it paints 20-40 px blocks over several rings). Per face, so a face
+#: whose rings are all wide bands (CN03's face A, median 14 px) keeps them.
+RING_MAP_MAX_WIDTH_FACTOR = 2.5
+
+#: Ring-map skeleton pieces shorter than this (px) are spurs of the thinning, not rings.
+RING_MAP_MIN_PIECE_PX = 6
+
 #: Ring-map pixels within this distance (mm) of a face's knot mask (``extras["knot_mask"]``) are
 #: not ring observations: the ring detector fires on the knot's own rings and the stem's rings
 #: bend around the knot, neither of which the stem's growth field describes. On H11 the bent
@@ -222,6 +231,17 @@ EVIDENCE_MAX_HELD_POINTS = 400
 #: 1000 points (one every ~2-4 mm of ring on a traced 50 mm cube) keep each refit near 0.1 s.
 EVIDENCE_RBF_POINTS = 1000
 
+#: Year-free held-out scoring of unlabelled rings (:func:`woodcam.inference.evidence._ring_line_shares`):
+#: the predicted ring lines are traced on a grid of this pitch (mm) over the held-out face (the
+#: iso-lines are interpolated within a cell, so 0.4 mm places them to ~0.05 mm on smooth fields),
+#: scored at these tolerances (mm: 2.5 and 5 px of a Mokume cube's 0.2 mm pixels, well under
+#: the 2-4 mm ring widths, so a line half a ring off misses), and predicted lines farther than
+#: the reach (mm) from every ring point of the face are left out (the face shows no ring there:
+#: a knot's margin, a gap in the ring map).
+EVIDENCE_LINE_GRID_MM = 0.4
+EVIDENCE_LINE_TOLERANCES_MM = (0.5, 1.0)
+EVIDENCE_LINE_REACH_MM = 3.0
+
 #: Smoothing of the residual RBF per point (scipy's ``smoothing`` is summed over points): the
 #: residual is meant to carry distortions a few mm wide, not each trace's jitter.
 EVIDENCE_RESIDUAL_SMOOTHING = 1e-3
@@ -252,3 +272,16 @@ KNOT_PAIR_MIN_ANGLE_DEG = 40.0
 #: ... and smaller than this share of the largest region on the same face (H11's grown mask of
 #: face C has a 150 px bud beside its 21 000 px knot).
 KNOT_MIN_AREA_SHARE = 0.1
+
+#: Dead-knot test of a knot exit (:func:`woodcam.inference.knots.exit_is_dead`): the boundary
+#: is cut into this many angular sectors around the exit's centroid...
+DEAD_KNOT_SECTORS = 16
+#: ... each compares three bands of signed distance (mm, negative inside the mask): the bark
+#: ring just inside the boundary, the knot wood further in, the stem wood just outside (a
+#: dead knot's bark ring is ~0.5 mm a side in woodcam's generator and in seed 003) ...
+DEAD_KNOT_BANDS_MM = ((-0.5, 0.0), (-1.2, -0.6), (0.2, 0.8))
+#: ... and the exit is dead when at least this share of the sectors is darker in the ring
+#: band than on both sides. Measured (16 sectors): synthetic dead knots 15+ mm past their death
+#: 0.75-1.0, alive knots 0.0-0.19, H11's knot on C and F 0.0; a knot a few mm past its death,
+#: whose bark ring the generator is still blending in, 0.0-0.19 (alive to this test).
+DEAD_KNOT_MIN_OUTLINED = 0.5
