@@ -231,17 +231,6 @@ EVIDENCE_MAX_HELD_POINTS = 400
 #: 1000 points (one every ~2-4 mm of ring on a traced 50 mm cube) keep each refit near 0.1 s.
 EVIDENCE_RBF_POINTS = 1000
 
-#: Year-free held-out scoring of unlabelled rings (:func:`woodcam.inference.evidence._ring_line_shares`):
-#: the predicted ring lines are traced on a grid of this pitch (mm) over the held-out face (the
-#: iso-lines are interpolated within a cell, so 0.4 mm places them to ~0.05 mm on smooth fields),
-#: scored at these tolerances (mm: 2.5 and 5 px of a Mokume cube's 0.2 mm pixels, well under
-#: the 2-4 mm ring widths, so a line half a ring off misses), and predicted lines farther than
-#: the reach (mm) from every ring point of the face are left out (the face shows no ring there:
-#: a knot's margin, a gap in the ring map).
-EVIDENCE_LINE_GRID_MM = 0.4
-EVIDENCE_LINE_TOLERANCES_MM = (0.5, 1.0)
-EVIDENCE_LINE_REACH_MM = 3.0
-
 #: Smoothing of the residual RBF per point (scipy's ``smoothing`` is summed over points): the
 #: residual is meant to carry distortions a few mm wide, not each trace's jitter.
 EVIDENCE_RESIDUAL_SMOOTHING = 1e-3

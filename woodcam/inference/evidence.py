@@ -349,7 +349,11 @@ def bake_evidence(ev: EvidenceFit, size_mm, faces, strands=()):
     if strands:  # knots fitted into the field (part 3): their darkening weight as a layer
         from ..fields.knot_strands import strands_to_meta
 
-        layers["knot"] = np.asarray(ev.field.knot_features(nodes)["knot"]).reshape(shape)
+        feats = ev.field.knot_features(nodes)
+        layers["knot"] = np.asarray(feats["knot"]).reshape(shape)
+        if any(s.dead for s in strands):  # dead knots: their flag and bark ring for the colour map
+            layers["dead"] = np.asarray(feats["dead"]).reshape(shape)
+            layers["outline"] = np.asarray(feats["outline"]).reshape(shape)
     meta = {"method": "evidence", "chosen": ev.chosen, "contradicted": ev.contradicted,
             "unverified": ev.unverified, "accepted": list(ev.accepted), "message": ev.message,
             "faces": [FACES[i] for i in faces],
