@@ -274,3 +274,8 @@ DEAD_KNOT_BANDS_MM = ((-0.5, 0.0), (-1.2, -0.6), (0.2, 0.8))
 #: 0.75-1.0, alive knots 0.0-0.19, H11's knot on C and F 0.0; a knot a few mm past its death,
 #: whose bark ring the generator is still blending in, 0.0-0.19 (alive to this test).
 DEAD_KNOT_MIN_OUTLINED = 0.5
+
+#: Longest step (image pixels) between the points a curved SVG ring trace (cubic, quadratic,
+#: arc) is sampled at. A circular arc of radius r sampled every s pixels strays s^2 / (8 r) from
+#: its chord: 0.003 px for s = 0.5 and a ring of radius 10 px, far below a ring map's 1 px.
+SVG_CURVE_STEP_PX = 0.5

@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import command_group
+from .options import add_out_option, command_group
 
 
 def _list(text: str) -> list[str]:
@@ -44,7 +44,7 @@ def register(subparsers) -> None:
                    help="draw the evidence fit's per-point confidence under its ring lines in the "
                    "cut-plane PNGs (red unsure, green sure; implies --plots); the confidence table "
                    "in table.md is written either way (default off)")
-    r.add_argument("--out", type=Path, required=True, help="folder for table.md and records.json")
+    add_out_option(r, "table.md, records.json and cut-plane PNGs")
     r.set_defaults(func=run_realistic)
 
 
