@@ -102,6 +102,13 @@ def test_dead_knot_is_read_from_its_bark_ring(r_death_mm, dead):
     assert exit_is_dead(np.zeros((8, 8)), np.zeros((8, 8), bool), 0.2) == (False, 0.0)
 
 
+def test_knot_halo_marks_the_knot_and_one_radius_round_it():
+    """Where the bake's uncertainty rises round a fitted knot (its rings are a model's guess)."""
+    f = StemWithKnots(plane_stem, [KnotStrand((20.0, -10.0, 20.0), (20.0, 50.0, 20.0), 4.0, 4.0)])
+    pts = np.array([[20.0, 5.0, 20.0 + r] for r in (0.0, 3.9, 6.0, 8.0, 12.0)])
+    np.testing.assert_allclose(f.knot_halo(pts), [1.0, 1.0, 0.5, 0.0, 0.0])
+
+
 def test_strand_errors():
     with pytest.raises(WoodcamError, match="knot radii must be > 0"):
         KnotStrand((0, 0, 0), (1, 0, 0), 0.0, 1.0)

@@ -161,6 +161,16 @@ class StemWithKnots:
                 outline = np.maximum(outline, ((d < R) & (d > R - DEAD_KNOT_OUTLINE_MM)).astype(float))
         return {"knot": knot, "dead": dead, "outline": outline}
 
+    def knot_halo(self, points_mm) -> np.ndarray:
+        """``(n,)`` in 0..1: 1 inside a knot, falling linearly to 0 one knot radius beyond its
+        surface (where a fitted knot's rings and the stem's bend round it are guessed)."""
+        p = check_points(points_mm)
+        halo = np.zeros(len(p))
+        for table in self._tables:
+            d, R, _, _ = self._geometry(p, table)
+            halo = np.maximum(halo, np.clip(2.0 - d / R, 0.0, 1.0))
+        return halo
+
     def grain_direction(self, points_mm) -> np.ndarray:
         p = check_points(points_mm)
         a = np.asarray(self.axis, float)
