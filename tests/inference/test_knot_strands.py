@@ -157,8 +157,13 @@ def test_h11_knot_appears_where_its_photos_show_it(shared_data, tmp_path):
     from woodcam.fields.grid import GridField
     from woodcam.inference import fit_block
 
+    import warnings
+
+    from woodcam.errors import WoodcamWarning
+
     b = read_mokume(shared_data / "mokume" / "H11")
-    with pytest.warns(Warning):
+    with warnings.catch_warnings():  # contradicted or not (ring maps read as lines: not any more)
+        warnings.simplefilter("ignore", WoodcamWarning)
         grid = fit_block(b, "evidence")
     grid = GridField.load(grid.save(tmp_path / "h11.npz"))
     assert len(grid.meta["knots"]) == 1 and hasattr(grid, "knot_features")
@@ -168,7 +173,9 @@ def test_h11_knot_appears_where_its_photos_show_it(shared_data, tmp_path):
         k = (grid.knot_features(pts)["knot"] > 0.5).reshape(face.shape)
         m = face.extras["knot_mask"]
         iou = (k & m).sum() / (k | m).sum()
+        print(f"H11 {name}: knot IoU {iou:.2f}, dead {grid.meta['knots'][0]['dead']}")
         assert iou > 0.7, (name, iou)
+    assert grid.meta["knots"][0]["dead"] is False  # H11's knot is intergrown: no bark ring
     # nowhere near the other faces' middles
     for name in ("front", "top"):
         face = b.faces[name]
