@@ -147,9 +147,9 @@ def test_real_cubes_leave_one_face_out(shared_data, tmp_path):
     control (the same predictions moved half a ring), not near 100 %."""
     from woodcam.block.io import read_mokume
 
-    # Measured within 2 px (issue 12, ring maps read as one-pixel ring lines): CN03 17.8 vs
-    # chance 1.7 % (10x; straight rings with an oracle phase 27 %), H11 13.9 vs 12.1 % (1.15x,
-    # the issue's 2x NOT reached: its held-out faces are predicted at chance, README).
+    # Measured within 2 px (issue 12, ring maps read as one-pixel ring lines): CN03 18.3 vs
+    # chance 2.8 % (6.5x; straight rings with an oracle phase 26.9 %), H11 21.1 vs 16.4 %
+    # (1.29x, the issue's 2x NOT reached: its held-out faces are predicted near chance, README).
     bars = {"CN03": 2.0, "H11": 1.1}
     for name, bar in bars.items():
         b = read_mokume(shared_data / "mokume" / name)

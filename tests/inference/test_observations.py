@@ -32,10 +32,10 @@ def test_ring_map_groups_are_one_ring_each():
         # the blob and the bridge, so two rings were one group, one year, to the fit)
         assert np.ptp(c) < 3.0, (g, c.min(), c.max())
         assert np.min(np.abs(np.subtract.outer(RING_COLS, np.median(c)))) < 1.5
-    # the rings are lines thinned to one pixel, sampled about every 0.5 mm along them
+    # the rings are lines thinned to one pixel, sampled about every 0.25 mm along them
     assert np.all(np.min(np.abs(np.subtract.outer(col, RING_COLS)), axis=1) <= 1.5)
     per_mm = len(obs.points_mm) / (len(RING_COLS) * 50.0)
-    assert 1.0 < per_mm < 2.5, per_mm
+    assert 2.5 < per_mm < 4.5, per_mm
     # every ring is still seen (the blob's rows are dropped, the rest of rings 50 and 80 kept)
     seen = {c for c in RING_COLS if np.any(np.abs(col - c) <= 1.5)}
     assert seen == set(RING_COLS)
