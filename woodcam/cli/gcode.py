@@ -242,7 +242,7 @@ def run(args) -> int:
                               max_atlas_px=args.max_atlas)
     t_bake = time.perf_counter() - t1
     if args.screenshot:
-        _screenshot(args, out.files, stock, program, offset)
+        _screenshot(args, out.files, stock, program, offset, out.view_mesh)
     print(f"meshed and baked {out.triangles} triangles in {t_bake:.2f} s; wrote "
           + ", ".join(map(str, out.files.values())))
     return 3 if args.strict and n_warn else 0
@@ -254,7 +254,7 @@ def _hms(seconds: float) -> str:
     return f"{h}:{m:02d}:{s:02d}"
 
 
-def _screenshot(args, files: dict, stock, program, offset) -> None:
+def _screenshot(args, files: dict, stock, program, offset, view_mesh=None) -> None:
     """Render the GLB with the toolpath over it (rapids red, feeds blue), block frame."""
     import numpy as np
 
@@ -268,6 +268,6 @@ def _screenshot(args, files: dict, stock, program, offset) -> None:
         seg = np.stack([program.start_mm + off, program.end_mm + off], axis=1)
         feed = program.kind == 1
         overlay = [(seg[~feed], "red", 1.0), (seg[feed], "royalblue", 1.0)]
-    preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png,
+    preview(view_mesh if view_mesh is not None else files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png,
             camera=args.camera, cut_plane=args.camera != "top", overlay=overlay)
     files["png"] = png
