@@ -46,6 +46,9 @@ class PartPreview:
     #: a light textured mesh for screenshots (the height-field preview's coarser grid over the
     #: same atlas), or None: draw the written GLB
     view_mesh: object = None
+    #: the height-field preview's top chart of the atlas ((h, w, 3) uint8, row 0 at Y = D):
+    #: the stock seen from +Z (:func:`woodcam.view.topview.top_view`)
+    top_texels: object = None
 
     @contextmanager
     def stage(self, name: str) -> Iterator[None]:
@@ -163,6 +166,11 @@ def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: floa
     with result.stage("view mesh"):
         result.view_mesh = _heightfield_view_mesh(heightmap, stock.size_mm, baked,
                                                   flat_tol_mm=flat_tol_mm)
+    from .toolpath.mesh import HeightfieldCharts
+
+    x0, y0, w, h, _, _ = HeightfieldCharts(np.zeros((1, 1)), stock.size_mm,
+                                           baked.texels_per_mm).charts["top"]
+    result.top_texels = baked.atlas[y0:y0 + h, x0:x0 + w]
     if screenshot:
         from .view import preview
 

@@ -242,7 +242,7 @@ def run(args) -> int:
                               max_atlas_px=args.max_atlas)
     t_bake = time.perf_counter() - t1
     if args.screenshot:
-        _screenshot(args, out.files, stock, program, offset, out.view_mesh)
+        _screenshot(args, out.files, stock, program, offset, out, res.heightmap)
     print(f"meshed and baked {out.triangles} triangles in {t_bake:.2f} s; wrote "
           + ", ".join(map(str, out.files.values())))
     return 3 if args.strict and n_warn else 0
@@ -254,8 +254,10 @@ def _hms(seconds: float) -> str:
     return f"{h}:{m:02d}:{s:02d}"
 
 
-def _screenshot(args, files: dict, stock, program, offset, view_mesh=None) -> None:
-    """Render the GLB with the toolpath over it (rapids red, feeds blue), block frame."""
+def _screenshot(args, files: dict, stock, program, offset, made=None, heightmap=None) -> None:
+    """Render the stock with the toolpath over it (rapids red, feeds blue), block frame: the
+    top view with numpy from the atlas (``made``: the preview's :class:`PartPreview`), other
+    views with VTK from its light view mesh (or the written GLB)."""
     import numpy as np
 
     from ..view import preview
@@ -268,6 +270,13 @@ def _screenshot(args, files: dict, stock, program, offset, view_mesh=None) -> No
         seg = np.stack([program.start_mm + off, program.end_mm + off], axis=1)
         feed = program.kind == 1
         overlay = [(seg[~feed], "red", 1.0), (seg[feed], "royalblue", 1.0)]
-    preview(view_mesh if view_mesh is not None else files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png,
-            camera=args.camera, cut_plane=args.camera != "top", overlay=overlay)
+    if args.camera == "top" and made is not None and made.top_texels is not None:
+        # seen from +Z the stock is its atlas's top chart: drawn with numpy, no VTK
+        from ..view.topview import write_top_view
+
+        write_top_view(png, heightmap, stock.size_mm, made.top_texels, overlay=overlay)
+    else:
+        preview(made.view_mesh if made is not None and made.view_mesh is not None
+                else files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png,
+                camera=args.camera, cut_plane=args.camera != "top", overlay=overlay)
     files["png"] = png
