@@ -45,7 +45,8 @@ def register(subparsers) -> None:
     p.add_argument("--tool", action="append", default=[], metavar="[N=]SPEC",
                    help="a tool, e.g. flat:6.35, ball:3, bull:6:1, vbit:60:12, 2=ball:3 "
                    "(repeatable; without N= the tools go to the program's tool numbers in "
-                   "order of first use)")
+                   "order of first use); reach in mm for the flute/shank/holder checks as "
+                   "flat:6:flute=22:shank=6:stickout=30:holder=35")
     p.add_argument("--tools", type=Path, default=None, metavar="TOML",
                    help="tool table file: TOML ([tools.N] type/diameter_mm/...) or a CAMotics "
                    "JSON tool table (.json)")
@@ -127,7 +128,7 @@ def _tools_from_args(args, program) -> dict:
     tools = dict(load_tool_table(args.tools)) if args.tools else {}
     unnumbered = []
     for item in args.tool:
-        if "=" in item:
+        if "=" in item.split(":", 1)[0]:  # N=SPEC (a spec's own key=value parts follow ':')
             num, spec = item.split("=", 1)
             try:
                 tools[int(num)] = parse_tool_spec(spec)
