@@ -79,6 +79,10 @@ def register(subparsers) -> None:
     p.add_argument("--camera", choices=("iso", "top", "front", "back", "left", "right"),
                    default="iso", help="screenshot view (default iso with a cut plane; top "
                    "shows a relief without a cut)")
+    p.add_argument("--view", action="store_true",
+                   help="after writing the files, open a window (needs a display) with the "
+                   "stock, the toolpath and a slider that scrubs the simulation to any line "
+                   "of the (last) program")
     p.add_argument("--no-overlay", action="store_true",
                    help="leave the toolpath (rapids red, feeds blue) out of the screenshot")
     p.add_argument("--part", default=None, metavar="PART",
@@ -169,6 +173,10 @@ def run(args) -> int:
         raise WoodcamError(f"--rapid-rate {args.rapid_rate}: give a rate > 0 in mm/min, e.g. "
                            "5000")
     check_outputs(args.out, obj=not args.no_obj, screenshot=args.screenshot or False)
+    if args.view:
+        from ..view.scrub import check_display
+
+        check_display()
     stock = open_stock(args.block, **stock_options(args))
     if args.stock or args.stock_origin:
         stock = resize_stock(stock, args.stock or stock.size_mm, args.stock_origin or (0, 0, 0))
@@ -176,7 +184,9 @@ def run(args) -> int:
     n_warn = 0
     hm = None
     meta_programs, last = [], None
+    hm_before = None  # the stock the last program starts from (the window's slider)
     for k, path in enumerate(args.program):
+        hm_before = hm
         t0 = time.perf_counter()
         program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
                              interpreter=args.interpreter)
@@ -246,6 +256,13 @@ def run(args) -> int:
         _screenshot(args, out.files, stock, program, offset, out, res.heightmap)
     print(f"meshed and baked {out.triangles} triangles in {t_bake:.2f} s; wrote "
           + ", ".join(map(str, out.files.values())))
+    if args.view:
+        from ..view.scrub import gcode_window
+
+        full = read_gcode(args.program[-1], start_mm=args.start, dialect=args.dialect,
+                          interpreter=args.interpreter) if args.until_line else program
+        gcode_window(full, tools, stock, work_offset_mm=offset, resolution_mm=args.resolution,
+                     initial_heightmap=hm_before, until_line=args.until_line)
     return 3 if args.strict and n_warn else 0
 
 

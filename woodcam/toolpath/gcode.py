@@ -148,7 +148,14 @@ class Program:
 
     def until_line(self, line: int) -> Program:
         """The moves of source lines ``<= line`` (the simulation scrubbed to that line)."""
-        k = self.line <= int(line)
+        return self.lines_between(None, line)
+
+    def lines_between(self, after: int | None, until: int) -> Program:
+        """The moves of source lines ``after < line <= until`` (``after=None``: from the
+        start): the next stretch when a simulation is scrubbed forward."""
+        k = self.line <= int(until)
+        if after is not None:
+            k &= self.line > int(after)
         return Program(self.start_mm[k], self.end_mm[k], self.kind[k], self.tool[k],
                        self.line[k], self.feed_mm_min[k], self.spindle_rpm[k], self.source,
                        sorted(set(self.tool[k].tolist())), list(self.warnings))
