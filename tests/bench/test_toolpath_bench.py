@@ -117,3 +117,32 @@ def test_whole_gcode_preview_of_the_raster(tmp_path):
         print(f"baseline {base}: {bcpu:.1f} CPU-s, peak {brss:.2f} GB; ratio {bcpu / cpu:.1f}x "
               f"CPU, {brss / rss:.1f}x memory")
     assert rss < 2**30 / 1e9  # 1 GiB
+
+
+def test_interpreter_lines_per_cpu_second_vs_linuxcnc(tmp_path):
+    """Reading speed (source lines per CPU second) of woodcam's interpreter and of LinuxCNC's
+    own (Debian ``linuxcnc-uspace``, its ``gcode`` module with a canon that records moves, as
+    the oracle test runs it) on the same 20,500-line raster, in the same run."""
+    from woodcam.toolpath.interpreter import Interpreter
+    from woodcam.toolpath.linuxcnc import linuxcnc_missing, run_batch
+
+    why = linuxcnc_missing()
+    if why:
+        pytest.skip(why)
+    spec = importlib.util.spec_from_file_location("make_samples",
+                                                  REPO / "toolpaths" / "make_samples.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    text = mod.relief_raster(100.0, 100.0, stepover=0.5, n_seg=100)
+    path = tmp_path / "raster.ngc"
+    path.write_text(text)
+    n = len(text.splitlines())
+    c = time.process_time()
+    moves, _ = Interpreter(text, start_mm=(0.0, 0.0, 10.0)).run()
+    ours = time.process_time() - c
+    res = run_batch([path])[0]
+    assert res["error"] is None and len(res["moves"]) - len(moves) in (0, 1)  # + its start
+    theirs = res["cpu_seconds"]
+    print(f"\ninterpreter on {n} lines: woodcam {n / ours:,.0f} lines/CPU-s, LinuxCNC "
+          f"{n / theirs:,.0f} lines/CPU-s; woodcam/LinuxCNC = {theirs / ours:.2f}x; load "
+          f"{os.getloadavg()[0]:.1f}")
