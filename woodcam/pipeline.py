@@ -143,10 +143,13 @@ def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: 
 def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                         flat_tol_mm: float = 0.01, obj: bool = True, screenshot: bool = False,
                         metadata: dict | None = None, obj_units: str = "m",
-                        obj_up: str = "y", max_atlas_px: int = 4096) -> PartPreview:
+                        obj_up: str = "y", max_atlas_px: int = 4096,
+                        view_mesh: bool = False) -> PartPreview:
     """:func:`preview_mesh` for a simulated stock ``heightmap : (ny, nx)`` (block-frame Z, mm,
     over the stock's XY): meshed and baked by its own planar charts
-    (:func:`woodcam.bake.bake_heightfield`), no generic unwrap."""
+    (:func:`woodcam.bake.bake_heightfield`), no generic unwrap. ``view_mesh``: also make the
+    light mesh a VTK screenshot draws (``PartPreview.view_mesh``; made anyway for
+    ``screenshot``)."""
     import numpy as np
 
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
@@ -163,9 +166,10 @@ def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: floa
     result = _write_preview(baked, stock, out_glb, result, obj=obj, screenshot=False,
                             metadata=metadata, obj_units=obj_units, obj_up=obj_up,
                             normals="mesh", report_mesh=None)
-    with result.stage("view mesh"):
-        result.view_mesh = _heightfield_view_mesh(heightmap, stock.size_mm, baked,
-                                                  flat_tol_mm=flat_tol_mm)
+    if view_mesh or screenshot:
+        with result.stage("view mesh"):
+            result.view_mesh = _heightfield_view_mesh(heightmap, stock.size_mm, baked,
+                                                      flat_tol_mm=flat_tol_mm)
     from .toolpath.mesh import HeightfieldCharts
 
     x0, y0, w, h, _, _ = HeightfieldCharts(np.zeros((1, 1)), stock.size_mm,

@@ -250,7 +250,8 @@ def run(args) -> int:
     out = preview_heightfield(res.heightmap, stock, args.out, texels_per_mm=args.texels_per_mm,
                               flat_tol_mm=args.mesh_tol, obj=not args.no_obj, metadata=meta,
                               obj_units=args.obj_units, obj_up=args.obj_up,
-                              max_atlas_px=args.max_atlas)
+                              max_atlas_px=args.max_atlas,
+                              view_mesh=bool(args.screenshot) and args.camera != "top")
     t_bake = time.perf_counter() - t1
     if args.screenshot:
         _screenshot(args, out.files, stock, program, offset, out, res.heightmap)
