@@ -39,8 +39,9 @@ def panel_height(x, y):
     return np.maximum(np.where(inset < 12.0, border, field), np.minimum(rosette, H - 0.5))
 
 
-def panel_stl(path, step_mm: float = 2.0) -> Path:
-    """The panel's top surface, triangulated every ``step_mm``, as an STL at ``path``."""
+def panel_stl(path, step_mm: float = 2.0, *, solid: bool = False) -> Path:
+    """The panel's top surface, triangulated every ``step_mm``, as an STL at ``path``;
+    ``solid``: closed by four walls and a bottom at Z = 0 (the design part for ``--part``)."""
     import trimesh
 
     nx, ny = int(round(W / step_mm)) + 1, int(round(D / step_mm)) + 1
@@ -48,7 +49,20 @@ def panel_stl(path, step_mm: float = 2.0) -> Path:
     Z = panel_height(X, Y)
     a = (np.arange(ny - 1)[:, None] * nx + np.arange(nx - 1)[None, :]).ravel()
     faces = np.concatenate([np.c_[a, a + 1, a + nx + 1], np.c_[a, a + nx + 1, a + nx]])
-    trimesh.Trimesh(np.c_[X.ravel(), Y.ravel(), Z.ravel()], faces).export(path)
+    verts = np.c_[X.ravel(), Y.ravel(), Z.ravel()]
+    if solid:  # boundary ring (counter-clockwise from above), its copy at Z = 0, a bottom fan
+        vid = np.arange(nx * ny).reshape(ny, nx)
+        ring = np.concatenate([vid[0, :-1], vid[:-1, -1], vid[-1, :0:-1], vid[:0:-1, 0]])
+        n, base = len(ring), len(verts)
+        low = base + np.arange(n)
+        verts = np.vstack([verts, np.c_[verts[ring, :2], np.zeros(n)], [[W / 2, D / 2, 0]]])
+        nr, nl = np.roll(ring, -1), np.roll(low, -1)
+        faces = np.vstack([faces, np.c_[low, nl, nr], np.c_[low, nr, ring],
+                           np.c_[np.full(n, base + n), nl, low]])
+    mesh = trimesh.Trimesh(verts, faces)
+    if solid:
+        assert mesh.is_watertight and mesh.volume > 0
+    mesh.export(path)
     return Path(path)
 
 
@@ -85,8 +99,10 @@ def relief_job(stl_path, *, ball_d: float = 3.0, stepover: float = 0.5,
 
 
 if __name__ == "__main__":
-    folder = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
+    folder = Path(sys.argv[1] if len(sys.argv) > 1 and sys.argv[1][0] != "-" else ".")
     folder.mkdir(parents=True, exist_ok=True)
     stl = panel_stl(folder / "relief_panel.stl")
-    (folder / "relief_panel.ngc").write_text(relief_job(stl))
-    print(f"wrote {stl} and {folder / 'relief_panel.ngc'}")
+    part = panel_stl(folder / "relief_panel_part.stl", solid=True)
+    if "--part-only" not in sys.argv:
+        (folder / "relief_panel.ngc").write_text(relief_job(stl))
+    print(f"wrote {stl}, {part} and {folder / 'relief_panel.ngc'}")

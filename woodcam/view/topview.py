@@ -20,6 +20,7 @@ _AMBIENT = 0.35
 #: Overlay colours (RGB 0-255) and opacity: rapids red, feeds blue, as the VTK overlay.
 _COLOURS = {"red": (220, 30, 30), "royalblue": (65, 105, 225)}
 _OVERLAY_ALPHA = 0.55
+_OVERLAY_COVER = 0.08
 
 
 def top_view(heightmap, size_mm, top_texels, *, overlay=None,
@@ -99,7 +100,10 @@ def _draw_segments(img, seg, colour, width, scale, D, ox, oy) -> None:
             py = np.floor(pts[:, 1]).astype(int) + dy
             ok = (px >= 0) & (px < w) & (py >= 0) & (py < h)
             hit[py[ok], px[ok]] = True
-    img[hit] = (1 - _OVERLAY_ALPHA) * img[hit] + _OVERLAY_ALPHA * rgb
+    # a dense raster (passes a few pixels apart) would hide the surface: fade it so the lines
+    # cover about _OVERLAY_COVER of the picture's ink at most
+    alpha = _OVERLAY_ALPHA * min(1.0, _OVERLAY_COVER / max(hit.mean(), 1e-9))
+    img[hit] = (1 - alpha) * img[hit] + alpha * rgb
 
 
 def write_top_view(path, heightmap, size_mm, top_texels, **kwargs):
