@@ -95,11 +95,12 @@ def obj_body(vertices, uv, normals, faces, *, decimals: int = 9) -> bytes:
     :func:`woodcam.bake.bake` meshes do), so each face corner is ``i/i/i`` (1-based);
     ``faces : (m, 3)`` int. Coordinates carry ``decimals`` fraction digits; ``vt`` and ``vn``
     carry 9 (unit range)."""
-    parts = [_join(b"v ", *_number_fields(vertices, decimals), b" ")]
-    if uv is not None:
-        parts.append(_join(b"vt ", *_number_fields(uv, 9), b" "))
-    if normals is not None:
-        parts.append(_join(b"vn ", *_number_fields(normals, 9), b" "))
+    parts = []
+    for prefix, values, digits in ((b"v ", vertices, decimals), (b"vt ", uv, 9),
+                                   (b"vn ", normals, 9)):
+        if values is not None:
+            chars, keep = _number_fields(values, digits)
+            parts.append(_join(prefix, chars, keep, b" "))
     chars, keep = _int_fields(np.asarray(faces, np.int64) + 1)  # (m, 3, w)
     if uv is not None and normals is not None:
         copies, sep = 3, b"/"  # a/a/a
