@@ -261,3 +261,8 @@ KNOT_PAIR_MIN_ANGLE_DEG = 40.0
 #: ... and smaller than this share of the largest region on the same face (H11's grown mask of
 #: face C has a 150 px bud beside its 21 000 px knot).
 KNOT_MIN_AREA_SHARE = 0.1
+
+#: Longest step (image pixels) between the points a curved SVG ring trace (cubic, quadratic,
+#: arc) is sampled at. A circular arc of radius r sampled every s pixels strays s^2 / (8 r) from
+#: its chord: 0.003 px for s = 0.5 and a ring of radius 10 px, far below a ring map's 1 px.
+SVG_CURVE_STEP_PX = 0.5
