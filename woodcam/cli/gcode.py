@@ -48,8 +48,9 @@ def register(subparsers) -> None:
     p.add_argument("--tool", action="append", default=[], metavar="[N=]SPEC",
                    help="a tool, e.g. flat:6.35, ball:3, bull:6:1, vbit:60:12, 2=ball:3 "
                    "(repeatable; without N= the tools go to the program's tool numbers in "
-                   "order of first use); reach in mm for the flute/shank/holder checks as "
-                   "flat:6:flute=22:shank=6:stickout=30:holder=35")
+                   "order of first use); the reach for the flute/shank/holder checks as "
+                   "flat:6:flute=22:shank=6:stickout=30:holder=35 (lengths in --units, "
+                   "default mm)")
     p.add_argument("--tools", type=Path, default=None, metavar="TOML",
                    help="tool table file: TOML ([tools.N] type/diameter_mm/...) or a CAMotics "
                    "JSON tool table (.json)")
@@ -81,7 +82,7 @@ def register(subparsers) -> None:
                    "mm/min)")
     p.add_argument("--camera", choices=("iso", "top", "front", "back", "left", "right"),
                    default="iso", help="screenshot view (default iso with a cut plane; top "
-                   "shows a relief without a cut)")
+                   "shows a relief without a cut, drawn from the baked texture without VTK)")
     p.add_argument("--view", action="store_true",
                    help="after writing the files, open a window (needs a display) with the "
                    "stock, the toolpath and a slider that scrubs the simulation to any line "
