@@ -17,9 +17,11 @@ cutter rubbing a wall (``shank_collision``); the holder gives ``holder_collision
 
 The stock a move meets is the stock every earlier move left, so the check replays the program
 in order on its own coarse grid (:data:`woodcam.tolerances.REACH_GRID_MM`), cutting each move's
-swept tool with the same closed-form kernel as the simulation (:meth:`Tool._sweep`). It runs only
-for tools with reach data; the per-move Python work is a few numpy operations on the move's
-window (the holder's radius at a coarse cell, not the fine grid).
+swept tool with the same batched kernel as the simulation. Cuts are applied in batches: a move
+whose window holds nothing as high as its shank or holder even before the pending cuts (the
+stock only goes down) needs no check, so only the moves near tall stock flush the batch and
+are checked one by one. It runs only for tools with reach data (20,000-move raster: +0.3 CPU-s
+when nothing comes near, +2.4 CPU-s with 5 mm of flute that touches often).
 """
 
 from __future__ import annotations
@@ -52,6 +54,12 @@ def reach_issues(p0, p1, tool_of, lookup, lines, size_mm, initial_heightmap=None
         fj = np.minimum((yc / D * fine.shape[0]).astype(int), fine.shape[0] - 1)
         hm = fine[np.ix_(fj, fi)].copy()
     out = []
+    pending: list[int] = []  # moves whose cut is not applied yet (applied in batches)
+
+    def flush():
+        _cut_batch(hm, pending, p0, p1, tool_of, lookup, dx, dy)
+        pending.clear()
+
     for k in range(len(p0)):
         a, b = p0[k], p1[k]
         if min(a[2], b[2]) >= H or (b[2] > a[2] and a[0] == b[0] and a[1] == b[1]):
@@ -64,11 +72,19 @@ def reach_issues(p0, p1, tool_of, lookup, lines, size_mm, initial_heightmap=None
         if win is None:
             continue
         js, is_ = win
+        lowest = min(a[2], b[2])
+        # the stock only ever goes down: if nothing in the window stands above the lowest
+        # part even before the pending cuts, nothing does after them (no check needed)
+        if all(lowest + bottom >= float(hm[js, is_].max()) - REACH_TOL_MM
+               for _, _, bottom in parts):
+            pending.append(k)
+            continue
+        flush()
         cur = hm[js, is_]
         along, d2, L, s, z0 = _frame(a, b, xc[is_], yc[js])
         top = float(cur.max())
         for name, r, bottom in parts:
-            if min(a[2], b[2]) + bottom >= top - REACH_TOL_MM:
+            if lowest + bottom >= top - REACH_TOL_MM:
                 continue  # nothing in the window stands that high
             # a shank as wide as the cutter runs along the wall the flutes just cut: one
             # coarse cell wider sees that wall (a slot deeper than the flutes)
@@ -91,12 +107,44 @@ def reach_issues(p0, p1, tool_of, lookup, lines, size_mm, initial_heightmap=None
                 out.append(("shank_collision", int(lines[k]),
                             f"the {2 * r:g} mm shank meets the stock {e:.2f} mm above the "
                             f"flutes ({bottom:g} mm)"))
-        # then this move cuts the coarse stock (the simulation's kernel at the coarse cells)
-        env = tool._sweep(along[None], d2[None], np.array([[[s]]]), np.array([[[L]]]),
-                          np.array([[[z0]]]))[0]
-        np.minimum(cur, env, out=cur)
-        hm[js, is_] = cur
+        pending.append(k)  # then this move cuts the coarse stock
+    flush()
     return out
+
+
+def _cut_batch(hm, moves, p0, p1, tool_of, lookup, dx, dy) -> None:
+    """Cut ``moves`` (indices, any order: the stock is a minimum over moves) from the coarse
+    ``hm`` with the simulation's own batched kernel, one tool at a time."""
+    from .gcode import FEED
+    from .simulate import _BATCH_CELLS, _sweep_batch
+
+    if not moves:
+        return
+    ny, nx = hm.shape
+    idx = np.asarray(moves)
+    for t in np.unique(tool_of[idx]):
+        sel = idx[tool_of[idx] == t]
+        tool = lookup[int(t)]
+        R = tool.radius_mm
+        a, b = p0[sel], p1[sel]
+        i0 = np.clip(np.ceil((np.minimum(a[:, 0], b[:, 0]) - R) / dx - 0.5), 0, nx).astype(int)
+        i1 = np.clip(np.floor((np.maximum(a[:, 0], b[:, 0]) + R) / dx - 0.5), -1,
+                     nx - 1).astype(int)
+        j0 = np.clip(np.ceil((np.minimum(a[:, 1], b[:, 1]) - R) / dy - 0.5), 0, ny).astype(int)
+        j1 = np.clip(np.floor((np.maximum(a[:, 1], b[:, 1]) + R) / dy - 0.5), -1,
+                     ny - 1).astype(int)
+        ok = (i1 >= i0) & (j1 >= j0)
+        sel, a, b, i0, i1, j0, j1 = sel[ok], a[ok], b[ok], i0[ok], i1[ok], j0[ok], j1[ok]
+        if not len(sel):
+            continue
+        wy = int((j1 - j0).max()) + 1
+        wx = int((i1 - i0).max()) + 1
+        per = max(1, _BATCH_CELLS // (wy * wx))
+        kinds = np.full(len(sel), FEED, np.uint8)  # rapids cut too; their report is simulate's
+        for st in range(0, len(sel), per):
+            q = slice(st, st + per)
+            _sweep_batch(hm, None, tool, a[q], b[q], i0[q], j0[q], i1[q], j1[q], wy, wx, dx,
+                         dy, kinds[q], sel[q], {})
 
 
 def _window(a, b, r, dx, dy, nx, ny):
