@@ -88,3 +88,29 @@ def test_gcode_view_without_a_display_fails_before_any_work(tmp_path, monkeypatc
     with pytest.raises(WoodcamError, match="needs a display"):
         args.func(args)
     assert not (tmp_path / "o.glb").exists()
+
+
+def test_gcode_view_hands_the_whole_last_program_and_its_start_stock(tmp_path, monkeypatch):
+    """``woodcam gcode A B --until-line 4 --view``: the window gets all of B (the slider can
+    go past line 4), the stock A left as its start, and starts at line 4."""
+    import woodcam.view.scrub as scrub
+    from tests.toolpath.test_toolpath_cli import _parse, _stub_preview
+
+    seen: dict = {}
+    _stub_preview(monkeypatch, {})
+    monkeypatch.setattr(scrub, "check_display", lambda: None)
+    monkeypatch.setattr(scrub, "gcode_window", lambda program, tools, stock, **kw:
+                        seen.update(program=program, kw=kw))
+    first = tmp_path / "a.nc"
+    first.write_text("M3 S9000 F600\nG0 X30 Y30 Z2\nG1 Z-3\nG1 X50\nG0 Z2\nM2\n")
+    second = tmp_path / "b.nc"
+    second.write_text(PROG)
+    args = _parse([str(first), str(second), "--block", "builtin:flat-sawn", "--out",
+                   str(tmp_path / "o.glb"), "--tool", "flat:6", "--resolution", "0.5",
+                   "--stock", "60x40x20", "--until-line", "4", "--view"])
+    assert args.func(args) == 0
+    assert int(seen["program"].line.max()) == 13 and seen["kw"]["until_line"] == 4
+    start = seen["kw"]["initial_heightmap"]
+    want = simulate(read_gcode(first.read_text()), parse_tool_spec("flat:6"), (60, 40, 20),
+                    resolution_mm=0.5).heightmap
+    np.testing.assert_array_equal(start, want)
