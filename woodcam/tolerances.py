@@ -71,6 +71,15 @@ ARC_RADIUS_MISMATCH_MM = 0.01
 #: ~1e-5 mm round-off at 100 mm, and a CAM clearance plane sits >= 0.5 mm above the stock.
 SIM_CONTACT_TOL_MM = 1e-4
 
+#: Cell size (mm) of the reach check's own replay of a program (flute length, shank and holder
+#: against the stock, :mod:`woodcam.toolpath.reach`): a shank or holder meeting the stock is a
+#: millimetre-scale question, and a coarse grid keeps a 20 mm holder's window at ~80 x 80 cells.
+REACH_GRID_MM = 0.5
+
+#: Stock standing less than this (mm) above a shank or holder is not reported: the coarse
+#: replay samples cell centres, and a CAM post's clearance is >= 0.1 mm.
+REACH_TOL_MM = 0.05
+
 #: Grid step (mm) of a baked growth field. Growth time is smooth (a cone only at the pith), so
 #: a 1 mm grid with cubic splines keeps ring lines within ~0.02 mm of the field it samples for
 #: rings >= 2 mm wide, while a 50 mm cube costs only ~150k evaluations of the fitted field.

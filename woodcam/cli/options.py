@@ -176,13 +176,23 @@ def _value_to_mm(kind: str, value, k: float):
     if kind == "tools":
         out = []
         for item in value:
-            num, eq, spec = item.rpartition("=")
+            head, eq, rest = item.partition("=")
+            # N=SPEC; a spec's own reach parts (flat:6:flute=22) are key=value after a ':'
+            num, spec = (head + eq, rest) if eq and ":" not in head else ("", item)
             kind_, colon, nums = spec.partition(":")
             if not colon:  # no numbers: left for the tool parser to name
                 out.append(item)
                 continue
-            out.append(num + eq + kind_ + ":" + _scaled_numbers(
-                nums, ":", k, _TOOL_LENGTHS.get(kind_.strip().lower(), ())))
+            where = _TOOL_LENGTHS.get(kind_.strip().lower(), ())
+            parts, pos = [], 0
+            for part in nums.split(":"):
+                key, is_kv, val = part.partition("=")
+                if is_kv:  # reach (flute=, shank=, stickout=, holder=): all lengths
+                    parts.append(key + "=" + _scaled_numbers(val, ":", k))
+                else:
+                    parts.append(_scaled_numbers(part, ":", k, (0,) if pos in where else ()))
+                    pos += 1
+            out.append(num + kind_ + ":" + ":".join(parts))
         return out
     raise ValueError(kind)  # pragma: no cover - LENGTH_OPTIONS holds only the kinds above
 
