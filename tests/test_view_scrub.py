@@ -106,7 +106,7 @@ def test_gcode_view_hands_the_whole_last_program_and_its_start_stock(tmp_path, m
     second = tmp_path / "b.nc"
     second.write_text(PROG)
     args = _parse([str(first), str(second), "--block", "builtin:flat-sawn", "--out",
-                   str(tmp_path / "o.glb"), "--tool", "flat:6", "--resolution", "0.5",
+                   str(tmp_path / "o.glb"), "--tool", "flat:6", "--cell-size", "0.5",
                    "--stock", "60x40x20", "--until-line", "4", "--view"])
     assert args.func(args) == 0
     assert int(seen["program"].line.max()) == 13 and seen["kw"]["until_line"] == 4

@@ -82,7 +82,7 @@ def test_strict_fails_on_a_reach_warning(tmp_path, monkeypatch, capsys):
     prog = tmp_path / "slot.nc"
     prog.write_text(SLOT)
     base = [str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
-            "--resolution", "0.5", "--stock", "60x40x20", "--strict"]
+            "--cell-size", "0.5", "--stock", "60x40x20", "--strict"]
     args = _parse([*base, "--tool", "flat:6:flute=15"])
     assert args.func(args) == 0
     args = _parse([*base, "--tool", "flat:6:flute=10"])

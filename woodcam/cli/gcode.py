@@ -14,7 +14,7 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import fmt_volume
 from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
-                      allow_negative_values, stock_options)
+                      allow_negative_values, stock_options, vector_type)
 
 _EXAMPLES = """\
 examples:
@@ -54,12 +54,15 @@ def register(subparsers) -> None:
     p.add_argument("--tools", type=Path, default=None, metavar="TOML",
                    help="tool table file: TOML ([tools.N] type/diameter_mm/...) or a CAMotics "
                    "JSON tool table (.json)")
-    p.add_argument("--resolution", type=float, default=0.1, metavar="MM",
-                   help="height-field cell size (default 0.1 mm)")
-    p.add_argument("--work-offset", default=None, metavar="X,Y,Z", type=_triple("--work-offset"),
+    # --cell-size, not --resolution: elsewhere --resolution is a cell COUNT (issue 17); the old
+    # spelling still parses
+    p.add_argument("--cell-size", "--resolution", dest="cell_size", type=float, default=0.1,
+                   metavar="LEN", help="height-field cell size, a length in --units (default "
+                   "0.1 mm; the old spelling --resolution still works)")
+    p.add_argument("--work-offset", default=None, metavar="X,Y,Z", type=vector_type("--work-offset"),
                    help="block-frame position of G-code zero in mm (default 0,0,H: "
                    "top-front-left); negative values as --work-offset -14,5,3")
-    p.add_argument("--start", default=None, metavar="X,Y,Z", type=_triple("--start"),
+    p.add_argument("--start", default=None, metavar="X,Y,Z", type=vector_type("--start"),
                    help="machine position (G-code frame, mm) before the first move, also the "
                    "G28/G30 home (default 0,0,10: 10 mm over the work zero)")
     p.add_argument("--dialect", choices=("linuxcnc", "grbl", "fanuc"), default="linuxcnc",
@@ -72,7 +75,7 @@ def register(subparsers) -> None:
                    help="stock size in mm cut from the block's wood (default: the block's "
                    "own size), e.g. 167x208x25")
     p.add_argument("--stock-origin", default=None, metavar="X,Y,Z",
-                   type=_triple("--stock-origin"),
+                   type=vector_type("--stock-origin"),
                    help="block-frame position (mm) of the --stock's corner in the block's wood "
                    "(default 0,0,0)")
     p.add_argument("--until-line", type=int, default=None, metavar="N",
@@ -115,20 +118,6 @@ def _size(text: str) -> tuple[float, float, float]:
         raise argparse.ArgumentTypeError(f"--stock {text!r}: give WxDxH in mm, three finite "
                                          "numbers > 0, e.g. 167x208x25")
     return vals
-
-
-def _triple(option: str):
-    """argparse type: ``"X,Y,Z"`` -> three finite floats (mm), or a one-line error."""
-    def parse(text: str) -> tuple[float, float, float]:
-        try:
-            vals = tuple(float(v) for v in text.split(","))
-        except ValueError:
-            vals = ()
-        if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
-            raise argparse.ArgumentTypeError(f"{option} {text!r}: give three finite numbers "
-                                             "X,Y,Z in mm, e.g. 0,0,50")
-        return vals
-    return parse
 
 
 def _tools_from_args(args, program) -> dict:
@@ -206,13 +195,13 @@ def run(args) -> int:
                                "drilling cycle); nothing to simulate. Check that it is the "
                                "program you meant")
         tools = _tools_from_args(args, program)
-        step = program.stepover_mm(spacing_mm=args.resolution)
-        if step is not None and args.resolution > step / 2:
-            print(f"woodcam: warning: {path.name}: the grid ({args.resolution:g} mm) is coarser "
+        step = program.stepover_mm(spacing_mm=args.cell_size)
+        if step is not None and args.cell_size > step / 2:
+            print(f"woodcam: warning: {path.name}: the grid ({args.cell_size:g} mm) is coarser "
                   f"than half the step-over ({step:.3g} mm): expect aliasing waves; use "
-                  f"--resolution {step / 2:.2g} or finer", file=sys.stderr)
+                  f"--cell-size {step / 2:.2g} or finer", file=sys.stderr)
             n_warn += 1
-        res = simulate(program, tools, stock.size_mm, resolution_mm=args.resolution,
+        res = simulate(program, tools, stock.size_mm, resolution_mm=args.cell_size,
                        work_offset_mm=offset, progress=False, initial_heightmap=hm,
                        track_lines=bool(args.part))
         hm = res.heightmap
@@ -267,7 +256,7 @@ def run(args) -> int:
 
         full = read_gcode(args.program[-1], start_mm=args.start, dialect=args.dialect,
                           interpreter=args.interpreter) if args.until_line else program
-        gcode_window(full, tools, stock, work_offset_mm=offset, resolution_mm=args.resolution,
+        gcode_window(full, tools, stock, work_offset_mm=offset, resolution_mm=args.cell_size,
                      initial_heightmap=hm_before, until_line=args.until_line)
     return 3 if args.strict and n_warn else 0
 
