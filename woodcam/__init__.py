@@ -22,7 +22,7 @@ _EXPORTS = {
     ".bench_realistic": ["score_block"],
     ".benchmark": ["bench_block", "bench_report", "run_bench"],
     ".block": ["Block", "Face", "RingTrace", "read_block", "read_mokume", "write_block"],
-    ".cad": ["CarveResult", "carve", "load_part"],
+    ".cad": ["CarveResult", "auto_tolerance_mm", "carve", "load_part"],
     ".detect": ["RingDetection", "detect_rings"],
     ".errors": ["MissingDependencyError", "UsageError", "WoodcamError", "WoodcamWarning"],
     ".export": ["export_glb", "export_obj", "load_textured", "read_glb_metadata", "crease_normals",
