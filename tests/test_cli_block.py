@@ -67,3 +67,33 @@ def test_block_synth_noise_options(tmp_path):
 
     assert main(["block", "synth", "--count", "1", "--out", str(tmp_path / "x"),
                  "--size-range-mm", "80,30"]) == EXIT_ERROR
+
+
+def test_block_synth_noise_options_on_an_engine_write_the_same_blocks(tmp_path, capsys):
+    """`block synth --engine` takes the benchmark's noise flags (issue 12 part 6) and writes
+    the same noisy blocks, byte for byte, as the plain command; a bad fraction is refused at the
+    door with one line."""
+    from woodcam.cli import EXIT_ERROR
+
+    flags = ["--count", "2", "--seed", "7", "--face-px", "40", "--quiet", "--jitter-mm", "0.3",
+             "--dropout", "0.2", "--mislabel", "0.1", "--knotted-fraction", "0", "--size-range-mm", "30,40"]
+    plain, eng = tmp_path / "plain", tmp_path / "engine"
+    assert main(["block", "synth", *flags, "--out", str(plain)]) == 0
+    assert main(["block", "synth", *flags, "--out", str(eng), "--engine", "local", "--workers", "1"]) == 0
+    for name in ("block_0000", "block_0001"):
+        files = sorted(p.relative_to(plain / name) for p in (plain / name).rglob("*") if p.is_file())
+        assert files
+        for rel in files:
+            assert (plain / name / rel).read_bytes() == (eng / name / rel).read_bytes(), (name, rel)
+        b = read_block(eng / name)
+        assert b.meta["trace_jitter_mm"] == 0.3 and b.meta["mislabel_fraction"] == 0.1
+        assert all(30 <= s <= 40 for s in b.size_mm)
+    maps = tmp_path / "maps"
+    assert main(["block", "synth", "--count", "1", "--seed", "7", "--face-px", "40", "--quiet",
+                 "--ring-maps-only", "--out", str(maps), "--engine", "local", "--workers", "1"]) == 0
+    assert all(not f.traces and f.ring_map is not None for f in read_block(maps / "block_0000").faces.values())
+    capsys.readouterr()
+    assert main(["block", "synth", "--count", "1", "--out", str(tmp_path / "bad"), "--engine", "local",
+                 "--dropout", "1.5"]) == EXIT_ERROR
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["woodcam: error: trace_dropout must be a fraction in [0, 1]; got 1.5"]

@@ -293,7 +293,7 @@ def bake(
 
 
 def bake_charts(mesh, uv_px, size_px, texels, wood, *, texels_per_mm: float,
-                vertex_normals=None, messages=()) -> BakeResult:
+                vertex_normals=None, messages=(), fill_gutters=None) -> BakeResult:
     """Bake ``wood.color`` into an atlas whose charts the caller already knows (no unwrap, no
     rasterisation): ``mesh`` with per-vertex texel coordinates ``uv_px : (n, 2)`` (x right, y
     down, pixel corners at integers) in an atlas of ``size_px = (width, height)``, and
@@ -301,7 +301,9 @@ def bake_charts(mesh, uv_px, size_px, texels, wood, *, texels_per_mm: float,
     giving every chart texel's point and normal. Used for the height-field stock of a G-code
     preview (:class:`woodcam.toolpath.mesh.HeightfieldCharts`), whose top is textured by its own
     planar parameterisation. ``vertex_normals`` (optional, (n, 3)) are kept on the result mesh
-    for export; the rest as :func:`bake`."""
+    for export; ``fill_gutters(atlas, coverage) -> atlas`` (optional) paints the texels outside
+    the charts when the caller knows a cheaper way than the nearest-texel transform (the
+    height field's rectangles); the rest as :func:`bake`."""
     import trimesh
 
     from .appearance.wood import wood_colors  # the one check of the colour contract
@@ -321,7 +323,7 @@ def bake_charts(mesh, uv_px, size_px, texels, wood, *, texels_per_mm: float,
     coverage = coverage.reshape(h, w)
     timings["color"] = time.perf_counter() - t_start
     t0 = time.perf_counter()
-    atlas = _dilate(atlas, coverage)
+    atlas = fill_gutters(atlas, coverage) if fill_gutters is not None else _dilate(atlas, coverage)
     timings["dilate"] = time.perf_counter() - t0
     uv_px = np.asarray(uv_px, float)
     uv = np.column_stack([uv_px[:, 0] / w, 1.0 - uv_px[:, 1] / h])

@@ -186,5 +186,34 @@ def markdown(summary: list[dict], methods) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["BENCH_PIXEL_MM", "FACE_SETS", "KINDS", "SCENARIOS", "bootstrap_ci", "eq79_field",
-           "make_block", "markdown", "score_block", "summarise"]
+def confidence_markdown(rows: list[dict], methods) -> str:
+    """The confidence summary (issue 12 part 5) of the methods whose fits carry one (the
+    evidence fit): per scenario and face set, the mean confidence on the predicted ring lines,
+    the share of confident points and the within-2 mm share of confident vs unsure points
+    (:func:`woodcam.inference.evaluate.confidence_summary`, pooled as a mean over blocks).
+    Empty when no method carries a confidence."""
+    with_conf = [m for m in methods if any("confidence_mean" in r.get(m, {}) for r in rows)]
+    if not with_conf:
+        return ""
+    head = ["scenario", "faces", "method", "n", "mean confidence", "confident points %",
+            "≤2 mm, confident", "≤2 mm, unsure"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    groups: dict[tuple, list] = {}
+    for r in rows:
+        groups.setdefault((r["scenario"], r["faces"]), []).append(r)
+    for (scen, faces), rs in sorted(groups.items()):
+        for m in with_conf:
+            vals = [r[m] for r in rs if "confidence_mean" in r.get(m, {})]
+
+            def mean(key, vals=vals):
+                v = np.array([x[key] for x in vals], float)
+                return f"{np.nanmean(v):.1f}" if np.isfinite(v).any() else "–"
+            lines.append("| " + " | ".join([scen, faces, m, str(len(vals)),
+                                            f"{np.mean([x['confidence_mean'] for x in vals]):.2f}",
+                                            mean("confident_share"), mean("matched_2_confident"),
+                                            mean("matched_2_unsure")]) + " |")
+    return "\n".join(lines) + "\n"
+
+
+__all__ = ["BENCH_PIXEL_MM", "FACE_SETS", "KINDS", "SCENARIOS", "bootstrap_ci", "confidence_markdown",
+           "eq79_field", "make_block", "markdown", "score_block", "summarise"]

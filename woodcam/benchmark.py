@@ -459,8 +459,11 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
 
 # -- synthetic block sets at scale ----------------------------------------------------------------
 
-def _synth_set_task(key: str, seed: int, out_dir: str, face_px: int, knotted: bool) -> dict:
-    """Write block ``key`` (``block_0042``) of set ``seed`` to ``out_dir/key`` atomically."""
+def _synth_set_task(key: str, seed: int, out_dir: str, face_px: int, knotted: bool,
+                    block_options: dict | None = None) -> dict:
+    """Write block ``key`` (``block_0042``) of set ``seed`` to ``out_dir/key`` atomically;
+    ``block_options`` go to :func:`woodcam.synth.benchmark_set_block` (sizes, knotted share,
+    trace noise)."""
     import os
     import shutil
 
@@ -468,8 +471,11 @@ def _synth_set_task(key: str, seed: int, out_dir: str, face_px: int, knotted: bo
     from .synth import benchmark_set_block, knotted_log_field
 
     index = int(key.split("_")[1])
+    opts = dict(block_options or {})
+    if "size_range_mm" in opts:
+        opts["size_range_mm"] = tuple(opts["size_range_mm"])
     block, info = benchmark_set_block(seed, index, face_px=face_px,
-                                      log_fields=knotted_log_field if knotted else None)
+                                      log_fields=knotted_log_field if knotted else None, **opts)
     final = Path(out_dir) / key
     tmp = Path(out_dir) / f".{key}.{os.getpid()}.tmp"
     shutil.rmtree(tmp, ignore_errors=True)
@@ -480,27 +486,47 @@ def _synth_set_task(key: str, seed: int, out_dir: str, face_px: int, knotted: bo
     return info
 
 
+#: Options of :func:`write_benchmark_set`'s ``block_options`` (those of
+#: :func:`woodcam.synth.benchmark_set_block` and :func:`woodcam.synth.synth_block` that the
+#: benchmark varies: ``woodcam block synth``'s flags).
+BLOCK_OPTIONS = ("size_range_mm", "knotted_fraction", "trace_jitter_mm", "trace_dropout",
+                 "trace_dropout_chunk_mm", "mislabel_fraction", "trace_faces")
+
+
 def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, knotted: bool = True,
-                        **run_options):
+                        block_options: dict | None = None, **run_options):
     """:func:`woodcam.synth.synth_benchmark_set` with the knotted generator, one task per block on
     an engine (the same blocks, bit for bit), resumable; writes ``index.json`` at the end.
-    With a Dask ``address`` the workers write the block folders, so they need ``out_dir`` on a
-    shared disk. ``run_options`` go to :func:`woodcam.scale.run_many`. Returns
-    ``(RunSummary, index dict)``."""
+    ``block_options`` (names in :data:`BLOCK_OPTIONS`: sizes, knotted share, trace noise as
+    ``woodcam block synth`` takes them) are passed to every block, so a noisy set is the same
+    on every engine as without one. With a Dask ``address`` the workers write the block folders,
+    so they need ``out_dir`` on a shared disk. ``run_options`` go to
+    :func:`woodcam.scale.run_many`. Returns ``(RunSummary, index dict)``."""
     from .scale import read_records, run_many, write_json_atomic
 
     if not isinstance(count, int) or count < 1:
         raise WoodcamError(f"count must be an integer >= 1; got {count!r}")
+    opts = dict(block_options or {})
+    bad = sorted(set(opts) - set(BLOCK_OPTIONS))
+    if bad:
+        raise WoodcamError(f"block_options must be among {', '.join(BLOCK_OPTIONS)}; got {bad}")
+    from .synth.degradation import _check_fraction
+
+    for name in ("knotted_fraction", "trace_dropout", "mislabel_fraction"):
+        if name in opts:  # at the door, not once per failing task
+            _check_fraction(name, opts[name])
+    if "size_range_mm" in opts:  # JSON-friendly in the task's arguments
+        opts["size_range_mm"] = [float(v) for v in opts["size_range_mm"]]
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     keys = [f"block_{i:04d}" for i in range(count)]
     summary = run_many(partial(_synth_set_task, seed=int(seed), out_dir=str(out.resolve()),
-                               face_px=int(face_px), knotted=bool(knotted)),
+                               face_px=int(face_px), knotted=bool(knotted), block_options=opts),
                        keys, out / ".synth", desc="synthesising blocks", **run_options)
     recs = read_records(out / ".synth")
     index = {"format": "woodcam-benchmark", "version": 1, "seed": int(seed), "count": int(count),
-             "face_px": int(face_px), "size_range_mm": [30.0, 80.0], "ring_width_range_mm": [1.5, 6.0],
-             "knotted_available": bool(knotted),
+             "face_px": int(face_px), "size_range_mm": opts.get("size_range_mm", [30.0, 80.0]),
+             "ring_width_range_mm": [1.5, 6.0], "knotted_available": bool(knotted),
              "blocks": [recs[k]["result"] for k in keys if k in recs and recs[k]["status"] == "ok"]}
     write_json_atomic(out / "index.json", index)
     return summary, index

@@ -71,6 +71,15 @@ ARC_RADIUS_MISMATCH_MM = 0.01
 #: ~1e-5 mm round-off at 100 mm, and a CAM clearance plane sits >= 0.5 mm above the stock.
 SIM_CONTACT_TOL_MM = 1e-4
 
+#: Cell size (mm) of the reach check's own replay of a program (flute length, shank and holder
+#: against the stock, :mod:`woodcam.toolpath.reach`): a shank or holder meeting the stock is a
+#: millimetre-scale question, and a coarse grid keeps a 20 mm holder's window at ~80 x 80 cells.
+REACH_GRID_MM = 0.5
+
+#: Stock standing less than this (mm) above a shank or holder is not reported: the coarse
+#: replay samples cell centres, and a CAM post's clearance is >= 0.1 mm.
+REACH_TOL_MM = 0.05
+
 #: Grid step (mm) of a baked growth field. Growth time is smooth (a cone only at the pith), so
 #: a 1 mm grid with cubic splines keeps ring lines within ~0.02 mm of the field it samples for
 #: rings >= 2 mm wide, while a 50 mm cube costs only ~150k evaluations of the fitted field.
@@ -87,6 +96,15 @@ TRACE_SAMPLE_STEP_MM = 0.5
 #: Grey level at or above which a ring-map pixel counts as a ring pixel (maps are in [0, 1],
 #: bright on ring boundaries; 0.5 is the natural mid-point of a soft boundary map).
 RING_MAP_THRESHOLD = 0.5
+
+#: Ring-map skeleton pixels where the bright band is wider than this factor times the face's
+#: median band width are blobs, not ring lines (the U-Net paints rings 3-8 px wide; where it is
+#: unsure, e.g. H11's face A, it paints 20-40 px blocks over several rings). Per face, so a face
+#: whose rings are all wide bands (CN03's face A, median 14 px) keeps them.
+RING_MAP_MAX_WIDTH_FACTOR = 2.5
+
+#: Ring-map skeleton pieces shorter than this (px) are spurs of the thinning, not rings.
+RING_MAP_MIN_PIECE_PX = 6
 
 #: Ring-map pixels within this distance (mm) of a face's knot mask (``extras["knot_mask"]``) are
 #: not ring observations: the ring detector fires on the knot's own rings and the stem's rings
@@ -259,6 +277,14 @@ EVIDENCE_ACCEPT_MARGIN = 5.0
 #: measurement; 0.02 makes the middle of a 50 mm block seen from one face half a ring unsure.
 EVIDENCE_UNSEEN_YEARS_PER_MM = 0.02
 
+#: Uncertainty (years) added inside a fitted knot, fading to 0 one knot radius beyond it
+#: (:meth:`woodcam.fields.knot_strands.StemWithKnots.knot_halo`): the knot's own rings and
+#: the stem's bend round it come from a model fitted to the masks, not from traced rings.
+#: Measured on dev seed 9101 (4 blocks, noisy, six faces): without it the confident and unsure
+#: ring lines were equally right (95.3 vs 95.8 % within 2 mm), the misses sitting round the
+#: knots; with it 98.4 vs 92.6 % (72 % of the line points confident, was 92 %).
+EVIDENCE_KNOT_UNCERTAINTY_YEARS = 1.0
+
 #: Grid spacing (mm) on which the hypotheses' spread is sampled before interpolation to the
 #: bake grid: the spread is smooth over several mm, and the RBF hypotheses are slow to evaluate.
 EVIDENCE_SPREAD_SPACING_MM = 4.0
@@ -273,6 +299,19 @@ KNOT_PAIR_MIN_ANGLE_DEG = 40.0
 #: ... and smaller than this share of the largest region on the same face (H11's grown mask of
 #: face C has a 150 px bud beside its 21 000 px knot).
 KNOT_MIN_AREA_SHARE = 0.1
+
+#: Dead-knot test of a knot exit (:func:`woodcam.inference.knots.exit_is_dead`): the boundary
+#: is cut into this many angular sectors around the exit's centroid...
+DEAD_KNOT_SECTORS = 16
+#: ... each compares three bands of signed distance (mm, negative inside the mask): the bark
+#: ring just inside the boundary, the knot wood further in, the stem wood just outside (a
+#: dead knot's bark ring is ~0.5 mm a side in woodcam's generator and in seed 003) ...
+DEAD_KNOT_BANDS_MM = ((-0.5, 0.0), (-1.2, -0.6), (0.2, 0.8))
+#: ... and the exit is dead when at least this share of the sectors is darker in the ring
+#: band than on both sides. Measured (16 sectors): synthetic dead knots 15+ mm past their death
+#: 0.75-1.0, alive knots 0.0-0.19, H11's knot on C and F 0.0; a knot a few mm past its death,
+#: whose bark ring the generator is still blending in, 0.0-0.19 (alive to this test).
+DEAD_KNOT_MIN_OUTLINED = 0.5
 
 #: Longest step (image pixels) between the points a curved SVG ring trace (cubic, quadratic,
 #: arc) is sampled at. A circular arc of radius r sampled every s pixels strays s^2 / (8 r) from

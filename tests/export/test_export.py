@@ -280,3 +280,34 @@ def test_glb_and_obj_share_one_png_encoding_of_the_atlas(tmp_path, monkeypatch):
     assert png in glb.read_bytes()  # the GLB's image buffer is the same PNG
     np.testing.assert_array_equal(np.asarray(Image.open(tmp_path / "part_texture.png")),
                                   result.atlas)
+
+
+def test_bulk_obj_text_matches_python_formatting_and_round_trips():
+    """The vectorised OBJ writer prints every number as Python's fixed-point format would
+    (within the last digit's rounding) and every face corner as 1-based ``i/i/i``."""
+    from woodcam.export._obj_text import obj_body
+
+    rng = np.random.default_rng(7)
+    v = rng.normal(size=(500, 3)) * [1.0, 250.0, 1e-3]
+    v[:3] = [[-0.0, 0.0, 4e-10], [123.456789, -0.5, 7.0], [-1e-10, 99999.25, -3.0]]
+    uv, vn = rng.random((500, 2)), rng.normal(size=(500, 3))
+    f = rng.integers(0, 500, size=(800, 3))
+    f[0] = [0, 9, 99]
+    text = obj_body(v, uv, vn, f, decimals=6).decode()
+    lines = text.splitlines()
+    vl = [ln.split()[1:] for ln in lines if ln.startswith("v ")]
+    assert vl[1] == ["123.456789", "-0.500000", "7.000000"]
+    assert vl[0] == ["0.000000", "0.000000", "0.000000"] and vl[2][0] == "0.000000"
+    np.testing.assert_allclose(np.array(vl, float), v, atol=0.51e-6, rtol=0)
+    for want, got in zip(v[3:].ravel(), np.array(vl[3:]).ravel()):
+        py = f"{want:.6f}"
+        assert got == py or abs(float(got) - want) <= 0.51e-6, (got, py)
+    np.testing.assert_allclose(np.array([ln.split()[1:] for ln in lines if ln.startswith("vt ")],
+                                        float), uv, atol=0.51e-9, rtol=0)
+    fl = [ln.split()[1:] for ln in lines if ln.startswith("f ")]
+    assert fl[0] == ["1/1/1", "10/10/10", "100/100/100"]
+    np.testing.assert_array_equal(np.array([[c.split("/") for c in r] for r in fl], int),
+                                  np.repeat(f[:, :, None] + 1, 3, axis=2))
+    assert obj_body(v[:3], None, vn[:3], np.array([[0, 1, 0]])).decode().endswith(
+        "f 1//1 2//2 1//1\n")
+    assert obj_body(v[:3], None, None, np.array([[0, 1, 2]])).decode().endswith("f 1 2 3\n")

@@ -50,6 +50,29 @@ def test_eval_writes_table_and_images(block_dir, tmp_path):
     assert len(list(out.glob("*.png"))) == 1
 
 
+@pytest.mark.slow
+def test_eval_confidence_overlay_and_summary(block_dir, tmp_path):
+    """`eval rings --confidence` (issue 12 part 5): the evidence fit's confidence drawn under its
+    lines, and the table summarises it for the evidence fit only (three faces traced: the
+    unseen half of the block is less sure than the seen one)."""
+    from PIL import Image
+
+    folder, truth, _ = block_dir
+    out = tmp_path / "conf"
+    assert main(["eval", "rings", str(folder), "--truth", str(truth), "--methods", "radial,evidence",
+                 "--partial-faces", "front,top,left", "--confidence", "--out", str(out)]) == 0
+    table = (out / "table.md").read_text()
+    assert "Confidence on the predicted ring lines" in table
+    rows = [r for r in table.splitlines() if "| evidence |" in r and not r.startswith("| **mean**")]
+    assert len(rows) == 2 and not any("| radial |" in r for r in table.splitlines() if "confiden" in r)
+    full, partial = ([float(c) for c in r.strip("|").split("|")[2:4]] for r in rows)
+    assert 0 <= partial[0] < full[0] <= 1  # mean confidence: three faces leave more unsure
+    (png,) = out.glob("*_partial.png")
+    img = np.asarray(Image.open(png).convert("RGB"), float) / 255
+    # the red-yellow-green confidence image is under the evidence row: strongly red or green pixels
+    assert np.mean((np.abs(img[..., 0] - img[..., 1]) > 0.4) & (img[..., 2] < 0.4)) > 0.01
+
+
 def test_cli_errors(block_dir, tmp_path):
     folder, truth, _ = block_dir
     with pytest.raises(WoodcamError, match=r"--method must be from evidence, rbf, radial, neural; got \['magic'\]"):

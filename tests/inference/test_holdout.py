@@ -140,21 +140,21 @@ def test_mokume_knot_point_grows_to_the_knot(shared_data):
 
 
 @pytest.mark.slow
+@pytest.mark.filterwarnings("ignore::woodcam.errors.WoodcamWarning")  # H11's folds are flagged contradicted
 def test_real_cubes_leave_one_face_out(shared_data, tmp_path):
-    """H11 and CN03 from their ring maps: each face predicted from the other five. Real rings
-    wiggle and bend round knots, so the bar is the chance control (a ring line every ~15-25 px
-    puts ~10-25 % of ridge pixels within 2 px by luck), not near 100 %."""
+    """H11 and CN03 from their ring maps: each face predicted from the other five by the
+    default (evidence) fit. Real rings wiggle and bend round knots, so the bar is the chance
+    control (the same predictions moved half a ring), not near 100 %."""
     from woodcam.block.io import read_mokume
 
-    for name in ("CN03", "H11"):
+    # Measured within 2 px (issue 12, ring maps read as one-pixel ring lines): CN03 18.3 vs
+    # chance 2.8 % (6.5x; straight rings with an oracle phase 26.9 %), H11 21.1 vs 16.4 %
+    # (1.29x, the issue's 2x NOT reached: its held-out faces are predicted near chance, README).
+    bars = {"CN03": 2.0, "H11": 1.1}
+    for name, bar in bars.items():
         b = read_mokume(shared_data / "mokume" / name)
-        res = leave_one_face_out(b, ("radial",), out_dir=tmp_path, progress=print)
+        res = leave_one_face_out(b, ("evidence",), out_dir=tmp_path, progress=print)
         print(res["table"])
-        held = res["held_out"]["radial"]
-        # Better than the same predictions moved by half a ring (a prediction with the right
-        # ring spacing and direction but no knowledge of where the rings are).
-        ok = np.mean([s.shares["ridge_2"] for s in held])
-        shifted = np.mean([s.shares["ridge_2"] for s in res[CONTROL]["radial"]])
-        # Measured within 2 px: CN03 11.2 vs 9.0 %, H11 26.8 vs 21.5 % (ratios 1.24, 1.25): real
-        # faces are predicted only a little better than chance at this scale (see README).
-        assert ok > 1.1 * shifted, (name, ok, shifted)
+        ok = np.mean([s.shares["ridge_2"] for s in res["held_out"]["evidence"]])
+        shifted = np.mean([s.shares["ridge_2"] for s in res[CONTROL]["evidence"]])
+        assert ok > bar * shifted, (name, ok, shifted)

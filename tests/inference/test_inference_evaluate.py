@@ -60,3 +60,42 @@ def test_eq79_helper_is_exact_on_its_own_field():
     f = random_field(np.random.default_rng(5))
     s, _ = evaluate_fit(f, f, (50, 50, 50), planes=PLANE, pixel_mm=0.25)
     assert s["matched_1"] == 100
+
+
+class _HalfWrong:
+    """A fit that is exact where x < 25 mm and 1.5 rings (3 mm) off beyond, with an
+    uncertainty layer that knows it: 0 years where x < 25, 2 years beyond."""
+
+    layers = {"uncertainty": None}
+
+    def __call__(self, p):
+        return _Cylinder()(p) + np.where(p[:, 0] < 25, 0.0, 1.5)
+
+    def uncertainty_years(self, p):
+        return np.where(np.asarray(p)[:, 0] < 25, 0.0, 2.0)
+
+
+def test_confidence_summary_splits_right_and_wrong_lines(tmp_path):
+    """The eval's confidence summary (issue 12 parts 5-6) on a fit whose uncertainty marks
+    exactly its wrong half: confident lines on the truth, unsure ones 3 mm off their year's
+    true line; the picture is drawn."""
+    from woodcam.inference.evaluate import confidence_summary, plot_planes
+
+    s, scores = evaluate_fit(_Cylinder(), _HalfWrong(), (50, 50, 50), planes=PLANE, pixel_mm=0.2,
+                             keep_lines=True)
+    assert 40 < s["confident_share"] < 60, s
+    assert s["confidence_mean"] == pytest.approx(s["confident_share"] / 100, abs=0.02)
+    # (a few % of the confident points lie on the iso-lines the fit's jump at x = 25 draws)
+    assert s["matched_2_confident"] > 95 and s["matched_2_unsure"] < 5, s
+    sc = scores[0]
+    assert sc.confidence.shape == sc.d_matched.shape
+    sure, unsure = sc.confidence == 1.0, sc.confidence < 0.01   # parallel to the line points' errors
+    assert np.mean(sc.d_matched[sure] <= 2.0) > 0.95 and np.mean(sc.d_matched[unsure] > 2.0) > 0.95
+    img = sc.confidence_img
+    assert img.shape == sc.confidence_img.shape and np.nanmin(img) < 0.01 and np.nanmax(img) == 1.0
+    # a plain fit carries no confidence: no keys, nothing drawn
+    s2, sc2 = evaluate_fit(_Cylinder(), _Cylinder(), (50, 50, 50), planes=PLANE, pixel_mm=0.2)
+    assert "confidence_mean" not in s2 and sc2[0].confidence is None
+    assert confidence_summary(np.array([1.0, 0.0]), np.array([0.1, 3.0]))["matched_2_unsure"] == 0
+    png = plot_planes(tmp_path / "c.png", {"evidence": scores}, confidence=True)
+    assert png.stat().st_size > 1000

@@ -9,7 +9,7 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
 from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
-                      allow_negative_values, stock_options, vector_mm,
+                      allow_negative_values, stock_options, vector_type,
                       write_screenshot)
 
 
@@ -62,17 +62,19 @@ def register(subparsers) -> None:
                               "widget that shows the wood inside the block; --screenshot renders "
                               "off-screen.")
     p.add_argument("mesh", type=Path, help="baked .glb (or .obj)")
-    p.add_argument("--screenshot", type=Path, default=None, metavar="PNG",
-                   help="render to this PNG instead of opening a window")
+    # the same [PNG] form as bake's and gcode's --screenshot (issue 17)
+    p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
+                   help="render off-screen to this PNG instead of opening a window (default "
+                   "name: MESH with _view.png)")
     p.add_argument("--block", default=None,
                    help="block spec for the cut plane (default: the one stored in the GLB)")
     p.add_argument("--camera", choices=("iso", "front", "back", "left", "right", "top", "bottom"),
                    default="iso", help="view direction (default iso: from front-right-above)")
     p.add_argument("--no-cut", action="store_true",
                    help="no cut plane: the part alone in its translucent block")
-    p.add_argument("--cut-origin", type=vector_mm, default=None, metavar="X,Y,Z",
+    p.add_argument("--cut-origin", type=vector_type("--cut-origin"), default=None, metavar="X,Y,Z",
                    help="a point of the cut plane, block frame mm (default the block centre)")
-    p.add_argument("--cut-normal", type=vector_mm, default=None, metavar="X,Y,Z",
+    p.add_argument("--cut-normal", type=vector_type("--cut-normal"), default=None, metavar="X,Y,Z",
                    help="the cut plane's normal, towards the side cut away (default: the block's "
                    "longest axis facing the camera)")
     allow_negative_values(p)
@@ -147,8 +149,12 @@ def run_preview(args: argparse.Namespace) -> int:
             raise WoodcamError("--confidence needs a block whose field was fitted (a block folder "
                                "without a true field, or a Mokume folder); pass --block")
         wood = ConfidenceWood(stock.wood.field)
+    shot = args.screenshot
+    if shot is True:
+        shot = args.mesh.with_name(args.mesh.stem + "_view.png")
     out = preview(args.mesh, wood=wood,
-                  size_mm=stock.size_mm if stock else None, screenshot=args.screenshot,
+                  size_mm=stock.size_mm if stock else None,
+                  screenshot=None if shot is None else Path(shot),
                   camera=args.camera, cut_plane=not args.no_cut, cut_origin=args.cut_origin,
                   cut_normal=args.cut_normal)
     if out:

@@ -72,18 +72,15 @@ def run(args) -> int:
                  "trace_dropout_chunk_mm": args.dropout_chunk_mm, "mislabel_fraction": args.mislabel}
         if args.ring_maps_only:
             noise["trace_faces"] = []
-        if (args.engine is not None or args.address is not None) and (
-                args.jitter_mm or args.dropout or args.mislabel or args.ring_maps_only or args.knotted_fraction != 0.5
-                or args.size_range_mm != "30,80"):
-            raise WoodcamError("--engine/--address write the default set only; drop --jitter-mm, "
-                               "--dropout, --mislabel, --ring-maps-only, --knotted-fraction and "
-                               "--size-range-mm, or run without an engine")
         if args.engine is not None or args.address is not None:
-            # one task per block: the same blocks, resumable (a record per block), on an engine
+            # one task per block: the same blocks as without an engine (noise included),
+            # resumable (a record per block), on an engine
             from ..benchmark import write_benchmark_set
 
+            opts = {"size_range_mm": (lo, hi), "knotted_fraction": args.knotted_fraction, **noise}
             summary, index = write_benchmark_set(args.out, args.count, args.seed, face_px=args.face_px,
-                                                 progress=not args.quiet, **engine_options(args))
+                                                 block_options=opts, progress=not args.quiet,
+                                                 **engine_options(args))
             knotted = sum(b["knotted"] for b in index["blocks"])
             print(f"wrote {len(index['blocks'])} blocks to {args.out} ({knotted} knotted; "
                   f"index.json lists them); {summary.line()}")

@@ -40,6 +40,10 @@ def register(subparsers) -> None:
                    help="eq. 7-9 sanity blocks per scenario and face set (default 2; 0 skips)")
     r.add_argument("--face-px", type=int, default=256, help="face image pixels along the largest side (default 256)")
     r.add_argument("--plots", action="store_true", help="also write cut-plane PNGs per block")
+    r.add_argument("--confidence", action="store_true",
+                   help="draw the evidence fit's per-point confidence under its ring lines in the "
+                   "cut-plane PNGs (red unsure, green sure; implies --plots); the confidence table "
+                   "in table.md is written either way (default off)")
     add_out_option(r, "table.md, records.json and cut-plane PNGs")
     r.set_defaults(func=run_realistic)
 
@@ -50,7 +54,7 @@ def run_realistic(args) -> int:
     from tqdm.auto import tqdm
 
     from .._atomic import write_text
-    from ..bench_realistic import FACE_SETS, SCENARIOS, markdown, score_block, summarise
+    from ..bench_realistic import FACE_SETS, SCENARIOS, confidence_markdown, markdown, score_block, summarise
 
     methods, scenarios, faces = _list(args.methods), _list(args.scenarios), _list(args.faces)
     for name, got, allowed in (("--scenarios", scenarios, SCENARIOS), ("--faces", faces, FACE_SETS)):
@@ -64,18 +68,24 @@ def run_realistic(args) -> int:
     tasks = [(kind, i, s, f) for s in scenarios for f in faces
              for kind, n in (("realistic", args.count), ("eq79", args.eq79)) for i in range(n)]
     rows = []
+    plots = args.plots or args.confidence
     for kind, i, s, f in tqdm(tasks, desc="benchmark blocks", unit="block"):
-        row = score_block(args.seed, i, methods, s, f, kind, face_px=args.face_px, keep_lines=args.plots)
-        if args.plots:
+        row = score_block(args.seed, i, methods, s, f, kind, face_px=args.face_px, keep_lines=plots)
+        if plots:
             from ..inference.evaluate import plot_planes
 
             plot_planes(out / f"{row['name']}_{s}_{f}.png", row.pop("planes"),
-                        title=f"{row['name']} ({row['kind']}, {s}, {f}): black = true rings")
+                        title=f"{row['name']} ({row['kind']}, {s}, {f}): black = true rings",
+                        confidence=args.confidence)
         rows.append(row)
         tqdm.write(f"{row['name']} {row['kind']} {s} {f}: " + ", ".join(
             f"{m} {row[m]['matched_1']:.0f}/{row[m]['matched_2']:.0f}% {row[m]['fit_s']:.1f}s" for m in methods))
         write_text(out / "records.json", json.dumps(rows, indent=1))
     table = markdown(summarise(rows, methods), methods)
+    conf = confidence_markdown(rows, methods)
+    if conf:
+        table += ("\nConfidence of the fits that carry one, on their predicted ring lines (a "
+                  "point is confident at >= 0.5):\n\n" + conf)
     write_text(out / "table.md", f"seed {args.seed}, {args.count} blocks per row, methods "
                f"{', '.join(methods)}: matched ring lines within 1 / 2 mm on 7 cut planes\n\n" + table)
     print(table)

@@ -62,6 +62,10 @@ def register(subparsers) -> None:
     e.add_argument("--detect", action="store_true",
                    help="real blocks: fit from rings detected on the photos (woodcam.detect) and score "
                    "against the block's own ring maps (e.g. the Mokume U-Net maps) as the reference")
+    e.add_argument("--confidence", action="store_true",
+                   help="draw the evidence fit's per-point confidence under its ring lines in the "
+                   "cut-plane PNGs (red unsure, green sure); table.md summarises it either way "
+                   "(default off)")
     add_out_option(e, "table.md and cut-plane PNGs")
     e.set_defaults(func=run_eval)
 
@@ -100,7 +104,7 @@ def run_eval(args) -> int:
         sets = {"full": None}
         if args.partial_faces.lower() != "none":
             sets["partial"] = _faces(args.partial_faces)
-        res = benchmark(known, methods, sets, out_dir=args.out, progress=print)
+        res = benchmark(known, methods, sets, out_dir=args.out, progress=print, confidence=args.confidence)
         print(res["table"])
         print(f"wrote {Path(args.out) / 'table.md'} and cut-plane images")
     if real:

@@ -324,46 +324,43 @@ def export_obj(mesh: Mesh, path: PathLike, *, units: ObjUnits = "m", up: ObjUp =
         The written ``.obj`` file. Its first line records units and up axis
         (``# woodcam: units=m up=y``) so :func:`load_textured` returns the block frame.
     """
-    from trimesh.exchange.obj import export_obj as _trimesh_export_obj
-
     _require_textured(mesh, "export_obj")
     path = check_output_path(path, suffixes=(".obj",), what="export_obj: path", mkdir=True)
     if units not in get_args(ObjUnits):
         raise WoodcamError(f"export_obj: units must be one of {get_args(ObjUnits)}; got {units!r}")
     if up not in get_args(ObjUp):
         raise WoodcamError(f"export_obj: up must be one of {get_args(ObjUp)}; got {up!r}")
+    from ._obj_text import obj_body
+
     stem = path.stem
-    # trimesh names the image after the material: a copy named after the file gives NAME.png
-    # without touching the caller's mesh.
     out = _shaded(mesh, crease_angle_deg, normals, "export_obj")
-    normals = np.asarray(out.vertex_normals, dtype=np.float64)
     transform = obj_transform(units, up)
-    out.vertices = np.asarray(out.vertices) @ transform[:3, :3].T
-    out.vertex_normals = normals @ transform[:3, :3].T / np.linalg.norm(transform[:3, 0])
+    verts = np.asarray(out.vertices, np.float64) @ transform[:3, :3].T
+    vn = (np.asarray(out.vertex_normals, np.float64) @ transform[:3, :3].T
+          / np.linalg.norm(transform[:3, 0]))
     material = out.visual.material
-    if hasattr(material, "to_simple"):
-        material = material.to_simple()
-    material = copy.copy(material)
+    image = getattr(material, "image", None) or getattr(material, "baseColorTexture", None)
     # NAME_texture.png, not NAME.png: a screenshot named after the part must never overwrite
     # the texture (issue 17: 'woodcam preview bowl.glb --screenshot bowl.png' did)
-    material.name = f"{stem}_texture"
+    tex = f"{stem}_texture"
     # Viewers multiply map_Kd by Kd: white keeps the baked colours as baked. Wood is matte.
-    material.diffuse = np.array([255, 255, 255, 255], dtype=np.uint8)
-    material.ambient = np.array([255, 255, 255, 255], dtype=np.uint8)
-    material.specular = np.array([20, 20, 20, 255], dtype=np.uint8)
-    out.visual.material = material
-    _with_encoded_texture(out, "image")
-    text, files = _trimesh_export_obj(
-        out, include_normals=True, include_texture=True, return_texture=True,
-        mtl_name=f"{stem}.mtl", digits=9
-    )
+    mtl = (f"newmtl {tex}\nKa 1.00000000 1.00000000 1.00000000\nKd 1.00000000 1.00000000 "
+           f"1.00000000\nKs 0.07843137 0.07843137 0.07843137\nNs 1.00000000\n")
+    files = {}
+    if image is not None:
+        mtl += f"map_Kd {tex}.png\n"
+        files[f"{tex}.png"] = _png_bytes(image)
+    files[f"{stem}.mtl"] = mtl.encode()
     header = (f"{OBJ_HEADER} units={units} up={up} (block frame: mm, Z up; "
-              f"see woodcam.export.export_obj)\n")
+              f"see woodcam.export.export_obj)\nmtllib {stem}.mtl\nusemtl {tex}\n")
+    # millimetre digits: 1e-9 m = 1e-6 mm either way
+    body = obj_body(verts, np.asarray(out.visual.uv, np.float64), vn, np.asarray(out.faces),
+                    decimals=9 if units == "m" else 6)
     # OBJ + MTL + PNG as one unit: all renamed into place only once every one is written, the
     # OBJ (which references the others) last.
     names = list(files)
     with atomic_files([path] + [path.parent / n for n in names]) as temps:
-        temps[0].write_text(header + text)
+        temps[0].write_bytes(header.encode() + body)
         for tmp, name in zip(temps[1:], names):
             tmp.write_bytes(files[name])
     return path

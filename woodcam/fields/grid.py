@@ -138,7 +138,9 @@ class GridField:
         if name in ("knot_features", "evaluate") and "knot" in self.__dict__.get("layers", {}):
             def knot_features(points_mm):
                 k = np.clip(self.layer("knot", points_mm), 0.0, 1.0)
-                return {"knot": k, "dead": np.zeros_like(k), "outline": np.zeros_like(k)}
+                # "dead" / "outline" layers (dead knots) read as zeros when absent
+                return {"knot": k, "dead": np.clip(self.layer("dead", points_mm), 0.0, 1.0),
+                        "outline": np.clip(self.layer("outline", points_mm), 0.0, 1.0)}
 
             def evaluate(points_mm, *, directions: bool = False):
                 from .base import grain_direction

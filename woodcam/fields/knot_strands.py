@@ -18,7 +18,15 @@ replaced by the stem's own growth time:
   ``min(a, b) - h^2 k / 4, h = max(k - |a - b|, 0) / k`` with ``k`` in years, which bends the
   stem's rings round the knot within about ``k`` rings of its surface.
 
-Alive knots only (a mask does not say whether the knot died; dead-knot outlines are not drawn).
+Dead knots (seed 003, Sec. 4.2.2): past its death a branch stops growing and the stem grows
+round it without ring continuity, leaving a bark ring (dark outline) at the knot surface. Seed
+003 scales the amount of smoothing ``delta = smin - min`` by a factor ``f`` that turns negative
+past the death (eq. 5: ``delta' = f delta``); a dead strand here takes
+``f =`` :data:`DEAD_KNOT_SMOOTHING_FACTOR` everywhere along it (the stem's rings are pushed
+away from the knot instead of bending into it, so they break at its surface), and its
+:meth:`StemWithKnots.knot_features` report ``dead`` inside and an ``outline`` shell of
+:data:`DEAD_KNOT_OUTLINE_MM` at the surface. Which strands are dead is read from the photos
+(:func:`woodcam.inference.knots.exit_is_dead`).
 """
 
 from __future__ import annotations
@@ -37,6 +45,14 @@ KNOT_SMOOTH_YEARS = 1.0
 #: Width (mm) over which the knot darkening weight falls from 1 to 0 across the knot surface.
 KNOT_EDGE_MM = 0.3
 
+#: Seed 003's smoothing factor ``f`` (eq. 5) of a dead knot: negative inverts the smooth
+#: minimum, so the stem's rings break at the knot surface instead of flowing into it.
+DEAD_KNOT_SMOOTHING_FACTOR = -1.0
+
+#: Thickness (mm) of a dead knot's bark ring (``outline``) inside its surface: seed 003's
+#: outline parameter; woodcam's log generator draws 1 mm across the knot, 0.5 mm a side.
+DEAD_KNOT_OUTLINE_MM = 0.5
+
 _SAMPLES = 256
 
 
@@ -45,7 +61,8 @@ class KnotStrand:
     """A straight branch strand through a block, block frame mm.
 
     start_mm, end_mm : (3,) its ends (beyond the block); radius_start_mm, radius_end_mm : knot
-    radius at the ends, linear in between; dead : False (alive) - kept for seed 003's model.
+    radius at the ends, linear in between; dead : True for a dead knot (seed 003: no ring
+    continuity with the stem, a bark ring at its surface; module docstring).
     """
 
     start_mm: tuple
@@ -67,9 +84,11 @@ class KnotStrand:
         return a + t * (b - a), self.radius_start_mm + t[:, 0] * (self.radius_end_mm - self.radius_start_mm)
 
 
-def _smin(a, b, k):
+def _smin(a, b, k, f: float = 1.0):
+    """Polynomial smooth minimum with its amount of smoothing scaled by ``f`` (seed 003 eq. 5:
+    ``min + f delta``; ``f = 1`` the plain smooth minimum, negative inverts it)."""
     h = np.maximum(k - np.abs(a - b), 0.0) / k
-    return np.minimum(a, b) - h * h * k / 4.0
+    return np.minimum(a, b) - f * h * h * k / 4.0
 
 
 class StemWithKnots:
@@ -121,20 +140,36 @@ class StemWithKnots:
         p = check_points(points_mm)
         gs = np.asarray(self.stem(p), float)
         out = gs.copy()
-        for table in self._tables:
-            out = _smin(out, self._knot_time(p, gs, table), self.k)
+        for strand, table in zip(self.strands, self._tables):
+            out = _smin(out, self._knot_time(p, gs, table), self.k,
+                        DEAD_KNOT_SMOOTHING_FACTOR if strand.dead else 1.0)
         return out
 
     def knot_features(self, points_mm) -> dict:
-        """``knot`` (0..1 darkening weight: 1 inside a knot), ``dead`` and ``outline`` (0: alive
-        knots only), each ``(n,)``, as :meth:`woodcam.fields.KnottedLogField.knot_features`."""
+        """``knot`` (0..1 darkening weight: 1 inside a knot), ``dead`` (the knot weight of dead
+        strands) and ``outline`` (1 in a dead knot's bark ring, the :data:`DEAD_KNOT_OUTLINE_MM`
+        shell inside its surface), each ``(n,)``, as
+        :meth:`woodcam.fields.KnottedLogField.knot_features`."""
         p = check_points(points_mm)
-        knot = np.zeros(len(p))
+        knot, dead, outline = np.zeros(len(p)), np.zeros(len(p)), np.zeros(len(p))
+        for strand, table in zip(self.strands, self._tables):
+            d, R, _, _ = self._geometry(p, table)
+            k = np.clip((R - d) / KNOT_EDGE_MM + 0.5, 0.0, 1.0)
+            knot = np.maximum(knot, k)
+            if strand.dead:
+                dead = np.maximum(dead, k)
+                outline = np.maximum(outline, ((d < R) & (d > R - DEAD_KNOT_OUTLINE_MM)).astype(float))
+        return {"knot": knot, "dead": dead, "outline": outline}
+
+    def knot_halo(self, points_mm) -> np.ndarray:
+        """``(n,)`` in 0..1: 1 inside a knot, falling linearly to 0 one knot radius beyond its
+        surface (where a fitted knot's rings and the stem's bend round it are guessed)."""
+        p = check_points(points_mm)
+        halo = np.zeros(len(p))
         for table in self._tables:
             d, R, _, _ = self._geometry(p, table)
-            knot = np.maximum(knot, np.clip((R - d) / KNOT_EDGE_MM + 0.5, 0.0, 1.0))
-        zeros = np.zeros(len(p))
-        return {"knot": knot, "dead": zeros, "outline": zeros}
+            halo = np.maximum(halo, np.clip(2.0 - d / R, 0.0, 1.0))
+        return halo
 
     def grain_direction(self, points_mm) -> np.ndarray:
         p = check_points(points_mm)
@@ -153,4 +188,4 @@ def strands_from_meta(items) -> list[KnotStrand]:
                        float(d["radius_end_mm"]), bool(d.get("dead", False))) for d in items]
 
 
-__all__ = ["KNOT_SMOOTH_YEARS", "KnotStrand", "StemWithKnots", "strands_from_meta", "strands_to_meta"]
+__all__ = ["DEAD_KNOT_OUTLINE_MM", "DEAD_KNOT_SMOOTHING_FACTOR", "KNOT_SMOOTH_YEARS", "KnotStrand", "StemWithKnots", "strands_from_meta", "strands_to_meta"]

@@ -134,6 +134,12 @@ class PlaneScore:
     d_unmatched: np.ndarray
     d_coverage: np.ndarray
     lines: dict = dc_field(default_factory=dict, repr=False)
+    #: (m,) confidence in [0, 1] of the fit at its predicted-line points (parallel to
+    #: ``d_matched``), or None when the fit carries no uncertainty (issue 12 part 5)
+    confidence: np.ndarray | None = dc_field(default=None, repr=False)
+    #: (nr, nc) confidence image of the plane (NaN outside the block), kept with ``keep_lines``
+    confidence_img: np.ndarray | None = dc_field(default=None, repr=False)
+    pixel_mm: float = EVAL_PIXEL_MM     # grid step of ``confidence_img``
 
 
 def score_plane(true_field, fitted_field, sample: PlaneSample, step_mm: float | None = None,
@@ -153,7 +159,32 @@ def score_plane(true_field, fitted_field, sample: PlaneSample, step_mm: float | 
     )
     if keep_lines:
         s.lines = {"true": (tp, ty), "fit": (pp, py)}
+    if _has_uncertainty(fitted_field):
+        from .evidence import confidence
+
+        s.confidence = confidence(fitted_field.uncertainty_years(_plane_points(sample, pp)))
+        if keep_lines:
+            img = np.full(sample.inside.shape, np.nan)
+            img[sample.inside] = confidence(fitted_field.uncertainty_years(sample.points_mm[sample.inside]))
+            s.confidence_img, s.pixel_mm = img, sample.pixel_mm
     return s
+
+
+def _has_uncertainty(field) -> bool:
+    """True when ``field`` carries a per-point uncertainty (an evidence fit's baked grid)."""
+    layers = getattr(field, "layers", None)
+    return bool(layers) and "uncertainty" in layers and callable(getattr(field, "uncertainty_years", None))
+
+
+def _plane_points(sample: PlaneSample, plane_mm: np.ndarray) -> np.ndarray:
+    """Block points ``(m, 3)`` of plane coordinates ``(m, 2)`` mm (row, col) of ``sample``
+    (the sample grid is affine in its indices)."""
+    p = sample.points_mm
+    o = p[0, 0]
+    dr = p[1, 0] - o if p.shape[0] > 1 else np.zeros(3)
+    dc = p[0, 1] - o if p.shape[1] > 1 else np.zeros(3)
+    ij = np.asarray(plane_mm, float).reshape(-1, 2) / sample.pixel_mm
+    return o + ij[:, :1] * dr + ij[:, 1:] * dc
 
 
 def plane_lines(field, sample: PlaneSample, step_mm: float | None = None):
@@ -178,7 +209,31 @@ def summarise(scores: list[PlaneScore], thresholds=EVAL_THRESHOLDS_MM) -> dict:
         out[f"matched_{t:g}"] = 100.0 * np.mean(dm <= t) if len(dm) else 0.0
         out[f"unmatched_{t:g}"] = 100.0 * np.mean(du <= t) if len(du) else 0.0
     out["coverage_1"] = 100.0 * np.mean(dc <= 1.0) if len(dc) else 0.0
+    if scores and all(s.confidence is not None for s in scores):
+        out.update(confidence_summary(np.concatenate([s.confidence for s in scores]), dm))
     return out
+
+
+#: A predicted-line point is "confident" at or above this :func:`~.evidence.confidence`
+#: (an uncertainty of about 0.4 year): the split of :func:`confidence_summary`.
+CONFIDENT_AT = 0.5
+
+
+def confidence_summary(conf: np.ndarray, d_matched: np.ndarray) -> dict:
+    """Does the fit know where it is wrong? ``conf (m,)`` confidence and ``d_matched (m,)`` mm
+    error of the same predicted-line points. Returns ``confidence_mean``, ``confident_share``
+    (percent of points with confidence >= :data:`CONFIDENT_AT`) and ``matched_2_confident`` /
+    ``matched_2_unsure`` (percent within 2 mm among those points and the others; NaN for an
+    empty side): a useful confidence has the first well above the second."""
+    conf, d = np.asarray(conf, float), np.asarray(d_matched, float)
+    sure = conf >= CONFIDENT_AT
+
+    def share(sel):
+        return float(100.0 * np.mean(d[sel] <= 2.0)) if sel.any() else float("nan")
+
+    return {"confidence_mean": float(conf.mean()) if len(conf) else float("nan"),
+            "confident_share": float(100.0 * sure.mean()) if len(conf) else float("nan"),
+            "matched_2_confident": share(sure), "matched_2_unsure": share(~sure)}
 
 
 def evaluate_fit(true_field: GrowthFieldLike, fitted_field: GrowthFieldLike, size_mm: ArrayLike,
@@ -212,7 +267,7 @@ def evaluate_fits(true_field, fitted: dict, size_mm, planes=DEFAULT_PLANES,
 def benchmark(blocks: Sequence[Block], methods: Sequence[str] = ("rbf", "radial"),
               face_sets: dict[str, Sequence[str] | None] | None = None, out_dir: PathLike | None = None,
               planes: Sequence[CutPlane] = DEFAULT_PLANES, pixel_mm: float = EVAL_PIXEL_MM,
-              progress: Callable[[str], object] | None = None) -> dict:
+              progress: Callable[[str], object] | None = None, confidence: bool = False) -> dict:
     """Fit every block with every method and face set, score them on the cut planes.
 
     Parameters
@@ -223,6 +278,9 @@ def benchmark(blocks: Sequence[Block], methods: Sequence[str] = ("rbf", "radial"
     out_dir : folder for ``table.md`` and one PNG per block and face set (predicted vs true
         ring lines on every plane); nothing is written when None.
     progress : optional callable taking one line of text per fit.
+    confidence : draw the fits' per-point confidence under their lines in the PNGs
+        (:func:`plot_planes`); the table gets the confidence summary of the methods whose fits
+        carry one (:func:`confidence_summary`) either way.
 
     Returns
     -------
@@ -261,25 +319,29 @@ def benchmark(blocks: Sequence[Block], methods: Sequence[str] = ("rbf", "radial"
             if out_dir is not None:
                 Path(out_dir).mkdir(parents=True, exist_ok=True)
                 plot_planes(Path(out_dir) / f"{b.name}_{label}.png", {m: scored[m][1] for m in methods},
-                            title=f"{b.name} ({label}): black = true rings, colour = fitted")
+                            title=f"{b.name} ({label}): black = true rings, colour = fitted",
+                            confidence=confidence)
         mean = {"name": "**mean**"}
         for m in methods:
             keys = rows[0][m].keys()
-            mean[m] = {k: float(np.mean([r[m][k] for r in rows])) for k in keys}
+            mean[m] = {k: _finite_mean([r[m][k] for r in rows]) for k in keys}
         rows.append(mean)
         result[label] = rows
         tables.append(f"### {label} ({'all faces' if faces is None else ', '.join(faces)})\n\n"
-                      + markdown_table(rows, list(methods)))
+                      + markdown_table(rows, list(methods)) + _confidence_table(rows, list(methods)))
     result["table"] = "\n\n".join(tables) + "\n"
     if out_dir is not None:
         write_text(Path(out_dir) / "table.md", result["table"])
     return result
 
 
-def plot_planes(path, scores_by_method: dict, title: str = ""):
+def plot_planes(path, scores_by_method: dict, title: str = "", confidence: bool = False):
     """Save a PNG: for each plane, true ring lines (black) under each method's lines (colour).
 
     scores_by_method : dict method -> list of PlaneScore made with ``keep_lines=True``.
+    confidence : draw each fit's confidence under its lines where it carries one (red unsure,
+        yellow, green sure: as ``woodcam preview --confidence``), with the within-2 mm shares of
+        its confident and unsure line points in the title.
     """
     matplotlib = require("matplotlib", "view", "drawing cut-plane ring images")
     matplotlib.use("Agg")
@@ -295,10 +357,18 @@ def plot_planes(path, scores_by_method: dict, title: str = ""):
             ax = axes[r, c]
             tp, _ = s.lines["true"]
             pp, _ = s.lines["fit"]
+            label = ""
+            if confidence and s.confidence_img is not None:
+                h, w = s.confidence_img.shape  # extent in plane mm, so the lines sit on it
+                ax.imshow(s.confidence_img, cmap="RdYlGn", vmin=0, vmax=1, interpolation="nearest",
+                          extent=(0, (w - 1) * s.pixel_mm, (h - 1) * s.pixel_mm, 0))
+                cs = confidence_summary(s.confidence, s.d_matched)
+                label = (f"\nsure {cs['confident_share']:.0f}%: {cs['matched_2_confident']:.0f}% / "
+                         f"unsure {cs['matched_2_unsure']:.0f}% <2mm")
             ax.plot(tp[:, 1], tp[:, 0], ",", color="k", alpha=0.6)
             ax.plot(pp[:, 1], pp[:, 0], ",", color=colours[r % len(colours)])
             ok = np.mean(s.d_matched <= 1.0) * 100 if len(s.d_matched) else 0.0
-            ax.set_title(f"{m} {s.plane}\n{ok:.0f}% <1mm", fontsize=8)
+            ax.set_title(f"{m} {s.plane}\n{ok:.0f}% <1mm{label}", fontsize=8)
             ax.set_aspect("equal")
             ax.invert_yaxis()
             ax.set_xticks([])
@@ -309,6 +379,29 @@ def plot_planes(path, scores_by_method: dict, title: str = ""):
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def _finite_mean(values) -> float:
+    """Mean of the finite values (NaN when none: e.g. no unsure points on any block)."""
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    return float(v.mean()) if len(v) else float("nan")
+
+
+def _confidence_table(rows: list[dict], methods: list[str]) -> str:
+    """Markdown lines of :func:`confidence_summary` per block for the methods that carry one."""
+    with_conf = [m for m in methods if "confidence_mean" in rows[0][m]]
+    if not with_conf:
+        return ""
+    head = ["block", "method", "mean confidence", "confident points %", "≤2 mm, confident", "≤2 mm, unsure"]
+    lines = ["", "", "Confidence on the predicted ring lines (confident at >= "
+             f"{CONFIDENT_AT:g}):", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for row in rows:
+        for m in with_conf:
+            c = row[m]
+            lines.append(f"| {row['name']} | {m} | {c['confidence_mean']:.2f} | {c['confident_share']:.1f} | "
+                         f"{c['matched_2_confident']:.1f} | {c['matched_2_unsure']:.1f} |")
+    return "\n".join(lines)
 
 
 def markdown_table(rows: list[dict], methods: list[str], thresholds=EVAL_THRESHOLDS_MM) -> str:

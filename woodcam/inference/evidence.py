@@ -42,6 +42,7 @@ from ..errors import WoodcamError, WoodcamWarning
 from ..frames import FACES
 from ..tolerances import (
     EVIDENCE_ACCEPT_MARGIN,
+    EVIDENCE_KNOT_UNCERTAINTY_YEARS,
     EVIDENCE_MAX_HELD_POINTS,
     EVIDENCE_MIN_FACE_POINTS,
     EVIDENCE_MIN_FACE_SHARE_2MM,
@@ -345,11 +346,17 @@ def bake_evidence(ev: EvidenceFit, size_mm, faces, strands=()):
         cs = ev.uncertainty_years(coarse).reshape([len(a) for a in cax])
         spread = ndimage.map_coordinates(cs, ((nodes - lo) / step).T, order=1, mode="nearest")
     unc = spread + EVIDENCE_UNSEEN_YEARS_PER_MM * distance_to_faces_mm(nodes, size_mm, faces)
+    if strands:  # a fitted knot's rings are a model's guess: no face pins their years
+        unc = unc + EVIDENCE_KNOT_UNCERTAINTY_YEARS * ev.field.knot_halo(nodes)
     layers = {"uncertainty": unc.reshape(shape)}
     if strands:  # knots fitted into the field (part 3): their darkening weight as a layer
         from ..fields.knot_strands import strands_to_meta
 
-        layers["knot"] = np.asarray(ev.field.knot_features(nodes)["knot"]).reshape(shape)
+        feats = ev.field.knot_features(nodes)
+        layers["knot"] = np.asarray(feats["knot"]).reshape(shape)
+        if any(s.dead for s in strands):  # dead knots: their flag and bark ring for the colour map
+            layers["dead"] = np.asarray(feats["dead"]).reshape(shape)
+            layers["outline"] = np.asarray(feats["outline"]).reshape(shape)
     meta = {"method": "evidence", "chosen": ev.chosen, "contradicted": ev.contradicted,
             "unverified": ev.unverified, "accepted": list(ev.accepted), "message": ev.message,
             "faces": [FACES[i] for i in faces],

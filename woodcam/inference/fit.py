@@ -22,8 +22,9 @@ METHODS: tuple[str, ...] = get_args(Method)
 
 #: Bumped whenever a fitter changes what it returns for the same block, so fields cached by
 #: :func:`woodcam.stock.fitted_field` are refitted (2: growth history, knot masks, year-free neural;
-#: 3: the evidence-chosen default, uncertainty and fit facts saved with the grid; 4: dense knots).
-FIT_VERSION = 4
+#: 3: the evidence-chosen default, uncertainty and fit facts saved with the grid; 4: dense knots;
+#: 5: ring maps read as one-pixel lines, dead knots, uncertainty round knots).
+FIT_VERSION = 5
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,

@@ -15,8 +15,8 @@ import numpy as np
 from ..errors import WoodcamError
 from ..fields.rings import resample_polyline
 from ..frames import FACES, check_face, face_image_size_mm, pixel_to_block
-from ..tolerances import (FACE_PIXEL_ASPECT_RTOL, KNOT_MASK_MARGIN_MM, RING_MAP_THRESHOLD,
-                          TRACE_SAMPLE_STEP_MM)
+from ..tolerances import (FACE_PIXEL_ASPECT_RTOL, KNOT_MASK_MARGIN_MM, RING_MAP_MAX_WIDTH_FACTOR,
+                          RING_MAP_MIN_PIECE_PX, RING_MAP_THRESHOLD, TRACE_SAMPLE_STEP_MM)
 
 
 @dataclass
@@ -62,14 +62,33 @@ def _pixel_index(coord: np.ndarray, n: int) -> np.ndarray:
 
 
 def _ring_map_components(ring_map: np.ndarray, threshold: float, exclude=None):
-    """Connected bright components of a ring map -> list of ``(k, 2)`` pixel (row, col) arrays;
-    ``exclude``: optional (h, w) bool of pixels to leave out."""
+    """Ring lines of a ring map -> list of ``(k, 2)`` pixel (row, col) arrays, one per ring piece;
+    ``exclude``: optional (h, w) bool of pixels to leave out.
+
+    The bright pixels are thinned to their one-pixel skeleton (a ring boundary is a line, not
+    the 3-8 px band the U-Net paints), skeleton pixels where the band is wider than
+    :data:`~woodcam.tolerances.RING_MAP_MAX_WIDTH_FACTOR` times the face's median band width are
+    dropped (blobs where the map is unsure: H11's face A has 20-40 px blocks spanning several
+    rings), and the skeleton is cut at its junctions, where two rings touch: a connected bright
+    component is one group, i.e. one ring, to the fit, so one that bridges rings forces them to
+    one year (on H11 such blobs halved the numbered ring count).
+    """
     from scipy import ndimage
+    from skimage import morphology
 
     mask = np.asarray(ring_map, float) >= threshold
     if exclude is not None:
         mask &= ~exclude
-    lab, n = ndimage.label(mask, structure=np.ones((3, 3)))
+    if not mask.any():
+        return []
+    width = 2.0 * ndimage.distance_transform_edt(mask)
+    skel = morphology.skeletonize(mask)
+    if skel.any():
+        skel &= width <= RING_MAP_MAX_WIDTH_FACTOR * np.median(width[skel])
+    neighbours = ndimage.convolve(skel.astype(np.int32), np.ones((3, 3), np.int32), mode="constant") - 1
+    junction = skel & (neighbours > 2)
+    skel &= ~ndimage.binary_dilation(junction, structure=np.ones((3, 3)))
+    lab, n = ndimage.label(skel, structure=np.ones((3, 3)))
     if n == 0:
         return []
     rows, cols = np.nonzero(lab)
@@ -77,7 +96,7 @@ def _ring_map_components(ring_map: np.ndarray, threshold: float, exclude=None):
     order = np.argsort(ids, kind="stable")
     splits = np.flatnonzero(np.diff(ids[order])) + 1
     comps = np.split(np.stack([rows[order], cols[order]], axis=1).astype(float), splits)
-    return [c for c in comps if len(c) >= 3]
+    return [c for c in comps if len(c) >= RING_MAP_MIN_PIECE_PX]
 
 
 def gather_observations(block, faces=None, step_mm: float = TRACE_SAMPLE_STEP_MM,
@@ -132,9 +151,10 @@ def gather_observations(block, faces=None, step_mm: float = TRACE_SAMPLE_STEP_MM
         elif f.ring_map is not None:
             comps = _ring_map_components(f.ring_map, ring_map_threshold, excl)
             stride = max(1, int(round(step_mm / max(min(dr, dc), 1e-12))))
-            # Ring-map components are pixel blobs a few pixels thick; keep every stride-th
-            # pixel of each so their density matches resampled traces.
-            polys = [(c[::stride * 2] if len(c) > 4 * stride else c, None) for c in comps]
+            # one-pixel ring lines, kept every half step (0.25 mm): twice the traces' density,
+            # about what the old blob sampling gave, which the neural fit's year-free gap term
+            # (midpoints between neighbouring rings) was tuned on
+            polys = [(c[::max(1, stride // 2)] if len(c) > 4 * stride else c, None) for c in comps]
         else:
             continue
         for p, year in polys:
