@@ -252,3 +252,28 @@ KNOT_PAIR_MIN_ANGLE_DEG = 40.0
 #: ... and smaller than this share of the largest region on the same face (H11's grown mask of
 #: face C has a 150 px bud beside its 21 000 px knot).
 KNOT_MIN_AREA_SHARE = 0.1
+
+#: Stem model (``woodcam.inference.stem``, issue 12 part 2). Its priors are Gaussian, weighted
+#: as if every fitted ring point carried them with this misfit (years): about the rms misfit of
+#: jittered traces (0.3 mm on 1.5-6 mm rings), so a prior one standard deviation off costs as
+#: much as the traces' own noise.
+STEM_PRIOR_YEARS = 0.3
+
+#: Standard deviation (degrees) of the pith's tilt from the nearest block axis: sawn wood has
+#: its grain along the board (slope of grain of a few degrees; the benchmark draws N(0, 2)
+#: clipped at 6 for logs, up to 20 for the eq. 7-9 family). Without it, three faces let a
+#: pith 45 degrees off fit as well as the true one (seed 21 dev blocks).
+STEM_TILT_PRIOR_DEG = 8.0
+
+#: Standard deviation (mm) of the centreline's sagitta over half the block diagonal: generated
+#: logs bend by a few mm over 100 mm at most.
+STEM_CURVE_PRIOR_MM = 3.0
+
+#: Prior standard deviations of the stem's ring-density terms, as fractions of the mean ring
+#: density: azimuthal harmonic k (eccentricity, lobes, speed per azimuth) STEM_HARMONIC_SD / k;
+#: change along the stem over half the diagonal STEM_AXIAL_SD; ring width over rho_0 (the
+#: ``rho`` powers) STEM_RADIAL_SD. The generator's logs stay inside them (eccentricity <= 0.15,
+#: lobes <= 0.025, width slope <= 0.003 / mm over ~100 mm).
+STEM_HARMONIC_SD = 0.15
+STEM_AXIAL_SD = 0.2
+STEM_RADIAL_SD = 0.3
