@@ -266,8 +266,9 @@ STEM_PRIOR_YEARS = 0.3
 STEM_TILT_PRIOR_DEG = 8.0
 
 #: Standard deviation (mm) of the centreline's sagitta over half the block diagonal: generated
-#: logs bend by a few mm over 100 mm at most.
-STEM_CURVE_PRIOR_MM = 3.0
+#: logs bend by < 0.6 mm over 45 mm (eight logs: median 0.1 mm); 6 mm lets a crooked stem
+#: (sagitta 2 mm over 30 mm, tests) bend without letting three noisy faces bend every pith.
+STEM_CURVE_PRIOR_MM = 6.0
 
 #: Prior standard deviations of the stem's ring-density terms, as fractions of the mean ring
 #: density: azimuthal harmonic k (eccentricity, lobes, speed per azimuth) STEM_HARMONIC_SD / k;

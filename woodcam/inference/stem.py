@@ -253,8 +253,9 @@ def _starts(prob: _StemProblem, obs: RingObservations, sel: np.ndarray, size, n_
 
 def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | None = None,
              K: int = 4, M: int = 1, P: int = 2, tilt_prior_deg: float = STEM_TILT_PRIOR_DEG,
-             curve_prior_mm: float = STEM_CURVE_PRIOR_MM, n_search: int = 600,
-             n_fit: int = 1500, n_starts: int = 2, seed: int = 0, history: bool = True) -> StemField:
+             curve_prior_mm: float = STEM_CURVE_PRIOR_MM, n_search: int = 500,
+             n_fit: int = 1000, n_starts: int = 2, n_final: int = 2, seed: int = 0,
+             history: bool = True) -> StemField:
     """Fit the stem model (module docstring) to labelled ring observations of a block.
 
     The result depends on ``obs`` and the arguments only (no other face's data enters it), so
@@ -270,7 +271,8 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
     tilt_prior_deg : standard deviation (degrees) of the pith's tilt from its base axis
     curve_prior_mm : standard deviation (mm) of the centreline's sagitta over half the diagonal
     n_search, n_fit : points used for the start search and the refinement (fixed random subsets)
-    n_starts : starts refined per base axis
+    n_starts : starts refined at low order per base axis
+    n_final : of those, the cheapest finished at full order
 
     Returns
     -------
@@ -302,14 +304,19 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
         return _StemProblem(obs.points_mm[idx], obs.years[idx], centre, _frame(d0), L, k, m, P, rho0,
                             _prior_sd(k, m, P, rho0, density), tp, curve_prior_mm)
 
-    best = None
+    # every axis' cheapest starts, refined at low order; the best n_final finished at full order
+    coarse = []
     for d0 in _base_axes(size, base_axes):
-        coarse = problem(i_s, d0, min(K, 2), 0)
-        for _, th in _starts(coarse, obs, i_s, size, n_starts):
-            th, _ = _refine(coarse, th, 30)
-            th, cost = _refine(problem(i_f, d0, K, M), th, 40)
-            if best is None or cost < best[0]:
-                best = (cost, th, d0)
+        prob = problem(i_s, d0, min(K, 2), 0)
+        for _, th in _starts(prob, obs, i_s, size, n_starts):
+            th, cost = _refine(prob, th, 20)
+            coarse.append((cost, th, d0))
+    coarse.sort(key=lambda c: c[0])
+    best = None
+    for _, th, d0 in coarse[:n_final]:
+        th, cost = _refine(problem(i_f, d0, K, M), th, 30)
+        if best is None or cost < best[0]:
+            best = (cost, th, d0)
     _, th, d0 = best
     prob = problem(np.arange(n), d0, K, M)
     curve = prob.curve_of(th)
