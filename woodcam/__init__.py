@@ -24,7 +24,7 @@ _EXPORTS = {
     ".block": ["Block", "Face", "RingTrace", "read_block", "read_mokume", "write_block"],
     ".cad": ["CarveResult", "carve", "load_part"],
     ".detect": ["RingDetection", "detect_rings"],
-    ".errors": ["MissingDependencyError", "WoodcamError", "WoodcamWarning"],
+    ".errors": ["MissingDependencyError", "UsageError", "WoodcamError", "WoodcamWarning"],
     ".export": ["export_glb", "export_obj", "load_textured", "read_glb_metadata", "crease_normals",
                   "written_by_woodcam", "BLOCK_TO_GLTF"],
     ".fields": ["GridField", "GrowthField", "KnottedLogField", "LogFrame", "LogSkeleton",

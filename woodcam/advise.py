@@ -26,11 +26,13 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .errors import WoodcamError
+from .units import Units, fmt_volume
 
 #: Points within this many years of the pith count as pith (juvenile wood and the pith itself).
 PITH_YEARS = 2.0
@@ -62,14 +64,15 @@ class PlacementAdvice:
     elongation: float
     weights: dict[str, float] = field(default_factory=dict)
 
-    def table(self, top: int = 5) -> str:
-        """The top placements as text, one line each, with every term."""
+    def table(self, top: int = 5, op_text: Callable[[str], str] = str) -> str:
+        """The top placements as text, one line each, with every term; ``op_text`` writes each
+        --place operation (e.g. its lengths in the user's unit)."""
         lines = [f"{'rank':>4} {'score':>6} {'knots':>6} {'pith':>6} {'end':>6} {'runout':>6}  place"]
         for i, p in enumerate(self.ranked[:top], 1):
             t = p.terms
             lines.append(f"{i:>4} {p.score:6.3f} {t['knots']:6.3f} {t['pith']:6.3f} "
                          f"{t['end_grain']:6.3f} {t['runout']:6.3f}  "
-                         + " ".join(f"--place {o}" for o in p.ops))
+                         + " ".join(f"--place {op_text(o)}" for o in p.ops))
         return "\n".join(lines)
 
 
@@ -290,9 +293,9 @@ def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
             "regions": regions, "warnings": warnings}
 
 
-def report_text(report: dict, name: str) -> str:
-    """The part report as a few lines of text."""
-    lines = [f"{name}: {report['volume_mm3']:.0f} mm^3, yield {100 * report['yield']:.1f} % of "
+def report_text(report: dict, name: str, units: Units = "mm") -> str:
+    """The part report as a few lines of text; the volume in ``units``^3."""
+    lines = [f"{name}: {fmt_volume(report['volume_mm3'], units)}, yield {100 * report['yield']:.1f} % of "
              f"the block; end grain {100 * report['end_grain']:.0f} % of the surface; knots "
              f"{100 * report['knots']:.1f} %, pith {100 * report['pith']:.1f} % of the surface "
              "and the wood 1-3 mm under it"]

@@ -11,6 +11,11 @@ class WoodcamError(ValueError):
     """Base class of the errors a user can cause and fix (bad input, bad option, missing extra)."""
 
 
+class UsageError(WoodcamError):
+    """The command line itself is wrong (an ``--out`` that breaks the output rule, options that
+    contradict each other): caught before any work; the CLI exits 2, like argparse."""
+
+
 class MissingDependencyError(WoodcamError, ImportError):
     """An optional dependency is not installed; the message gives the install command."""
 

@@ -278,3 +278,8 @@ STEM_CURVE_PRIOR_MM = 6.0
 STEM_HARMONIC_SD = 0.15
 STEM_AXIAL_SD = 0.2
 STEM_RADIAL_SD = 0.3
+
+#: Longest step (image pixels) between the points a curved SVG ring trace (cubic, quadratic,
+#: arc) is sampled at. A circular arc of radius r sampled every s pixels strays s^2 / (8 r) from
+#: its chord: 0.003 px for s = 0.5 and a ring of radius 10 px, far below a ring map's 1 px.
+SVG_CURVE_STEP_PX = 0.5

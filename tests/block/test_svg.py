@@ -45,11 +45,7 @@ def test_editor_style_svg(tmp_path):
     np.testing.assert_allclose(traces[2].points_px, [[0.5, 5.5], [0.5, 7.5]])
 
 
-def test_curves_and_bad_files_are_refused(tmp_path):
-    (tmp_path / "c.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 10 10">'
-                                    '<path d="M 0 0 C 1 1 2 2 3 3"/></svg>')
-    with pytest.raises(WoodcamError, match="command 'C' .*Flatten Beziers"):
-        read_traces_svg(tmp_path / "c.svg", (10, 10))
+def test_bad_files_are_refused(tmp_path):
     (tmp_path / "bad.svg").write_text("<svg")
     with pytest.raises(WoodcamError, match="must be a readable SVG"):
         read_traces_svg(tmp_path / "bad.svg", (10, 10))
@@ -57,6 +53,69 @@ def test_curves_and_bad_files_are_refused(tmp_path):
                                     '<polyline data-year="x" points="0,0 1,1"/></svg>')
     with pytest.raises(WoodcamError, match="data-year must be an integer"):
         read_traces_svg(tmp_path / "y.svg", (10, 10))
+
+
+#: What Inkscape writes for a 60 x 40 mm face drawn over its photo: width/height in mm, a
+#: viewBox of 10 user units per mm, sodipodi/inkscape metadata, layers with transforms and
+#: curved strokes (cubic, quadratic, arc), a marker path in <defs> and a frame that is no trace.
+INKSCAPE_SVG = """<?xml version="1.0" encoding="UTF-8" standalone="no"?>
+<svg xmlns="http://www.w3.org/2000/svg" xmlns:svg="http://www.w3.org/2000/svg"
+   xmlns:xlink="http://www.w3.org/1999/xlink"
+   xmlns:sodipodi="http://sodipodi.sourceforge.net/DTD/sodipodi-0.dtd"
+   xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape"
+   width="60mm" height="40mm" viewBox="0 0 600 400" version="1.1" id="svg8"
+   inkscape:version="1.2.2 (b0a8486541, 2022-12-01)" sodipodi:docname="front_traces.svg">
+  <sodipodi:namedview id="namedview1" pagecolor="#ffffff" inkscape:document-units="mm"
+     inkscape:zoom="2" inkscape:current-layer="layer2"/>
+  <defs id="defs2"><path id="marker-arrow" d="M 0,0 L 50,50"/></defs>
+  <g inkscape:groupmode="layer" id="layer0" inkscape:label="photo" sodipodi:insensitive="true">
+    <image xlink:href="front_photo.png" x="0" y="0" width="600" height="400" id="image1"/>
+    <rect x="0" y="0" width="600" height="400" style="fill:none;stroke:#000" id="frame"/>
+  </g>
+  <g inkscape:groupmode="layer" id="layer1" inkscape:label="2019" transform="translate(100,50)">
+    <path inkscape:label="year-4" sodipodi:nodetypes="cc" style="fill:none;stroke:#e6194b"
+       d="M 0,0 C 100,0 200,100 200,200" id="path101"/>
+    <path id="path102" d="m 0,300 q 100,-100 200,0" style="fill:none;stroke:#3cb44b"/>
+    <g id="g7" transform="translate(300,200)">
+      <path data-year="9" d="M 100,0 A 100,100 0 0 1 0,100" id="path103"/>
+    </g>
+  </g>
+  <g inkscape:groupmode="layer" id="layer2" inkscape:label="turned"
+     transform="matrix(0,1,-1,0,600,0)">
+    <polyline id="year-11" points="10,20 30,20"/>
+  </g>
+</svg>
+"""
+
+
+def _face_mm(t):
+    """Face millimetres (x from the left, y down from the top) of a trace on the 2 px/mm image."""
+    return (t.points_px[:, ::-1] + 0.5) / 2.0
+
+
+def test_inkscape_svg_with_curves_transforms_and_mm_units(tmp_path):
+    (tmp_path / "front_traces.svg").write_text(INKSCAPE_SVG)
+    traces = read_traces_svg(tmp_path / "front_traces.svg", (80, 120))  # 60 x 40 mm at 2 px/mm
+    assert [t.year for t in traces] == [4, None, 9, 11]  # the layer label "2019" is not its strokes' year
+    cubic, quad, arc, turned = (_face_mm(t) for t in traces)
+    # cubic in the layer translated by (100, 50) user units = (10, 5) mm: its Bezier formula
+    t = np.linspace(0, 1, 2001)[:, None]
+    ctrl = np.array([[0, 0], [100, 0], [200, 100], [200, 200]]) / 10 + [10, 5]
+    bez = ((1 - t) ** 3 * ctrl[0] + 3 * (1 - t) ** 2 * t * ctrl[1] + 3 * (1 - t) * t ** 2 * ctrl[2]
+           + t ** 3 * ctrl[3])
+    np.testing.assert_allclose(cubic[[0, -1]], [[10, 5], [30, 25]], atol=1e-9)
+    assert np.linalg.norm(cubic[:, None] - bez[None], axis=2).min(1).max() < 0.01
+    assert np.diff(cubic, axis=0).__abs__().max() <= 0.25 + 1e-9  # sampled every 0.5 px or finer
+    # relative quadratic: from (0, 300) to (200, 300) with control (100, 200): y(x) is a parabola
+    x = quad[:, 0] - 10
+    np.testing.assert_allclose(quad[:, 1], 5 + 30 - 20 * (x / 20) * (1 - x / 20), atol=1e-9)
+    np.testing.assert_allclose(quad[[0, -1], 0], [10, 30], atol=1e-9)
+    # arc of radius 10 mm about (100 + 300, 50 + 200) user units = (40, 25) mm, a quarter turn
+    np.testing.assert_allclose(np.hypot(*(arc - [40, 25]).T), 10.0, atol=1e-9)
+    np.testing.assert_allclose(arc[[0, -1]], [[50, 25], [40, 35]], atol=1e-9)
+    assert len(arc) > 30  # a 15.7 mm arc = 31 px: a curve, not its chord
+    # the rotated layer: (x, y) -> (600 - y, x) user units
+    np.testing.assert_allclose(turned, [[58, 1], [58, 3]], atol=1e-9)
 
 
 def test_face_traces_written_in_pixel_units(tmp_path):

@@ -6,7 +6,7 @@ import time
 
 import pytest
 
-from woodcam.cli import EXIT_ERROR, main
+from woodcam.cli import EXIT_ERROR, EXIT_USAGE, main
 
 BAKE = ["bake", "cad_examples/bowl.py", "--block", "builtin:flat-sawn"]
 
@@ -24,9 +24,9 @@ BAKE = ["bake", "cad_examples/bowl.py", "--block", "builtin:flat-sawn"]
     (["block", "synth", "--count", "0", "--out", "OUT/b"], r"--count must be in \[1,"),
     (["block", "synth", "--count", "1", "--face-px", "100000000", "--out", "OUT/b"], r"--face-px must be in"),
     (["train", "gtf", "--steps", "0", "--out", "OUT/t"], r"--steps must be in \[1,"),
-    ([*BAKE, "--out", "OUT/x.stl"], r"--out must end in .glb"),
-    ([*BAKE, "--out", "OUT"], r"--out must end in .glb"),
-    ([*BAKE, "--out", "OUT/dir.glb"], r"is an existing folder"),
+    ([*BAKE, "--out", "OUT/x.stl"], r"--out of 'woodcam bake' must end in .glb"),  # usage: exit 2
+    ([*BAKE, "--out", "OUT"], r"--out of 'woodcam bake' is a FILE ending in .glb; got .*a folder"),
+    ([*BAKE, "--out", "OUT/dir.glb"], r"is a FILE ending in .glb; got .*dir.glb', a folder"),
     ([*BAKE, "--out", "OUT/file.txt/x.glb"], r"is a file, not a folder"),
     ([*BAKE, "--out", "OUT/x.glb", "--screenshot", "OUT/x.jpg"], r"--screenshot must end in .png"),
     ([*BAKE, "--out", "OUT/objdir/x.glb"], r"the OBJ beside the GLB"),
@@ -39,7 +39,7 @@ def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monk
     (out / "objdir" / "x.obj").mkdir(parents=True)
     argv = [a.replace("OUT", str(out)) for a in argv]
     t0 = time.perf_counter()
-    assert main(argv) == EXIT_ERROR
+    assert main(argv) == (EXIT_USAGE if "--out of" in match or "is a FILE" in match else EXIT_ERROR)
     assert time.perf_counter() - t0 < 30.0  # refused before any fitting or baking (minutes)
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("woodcam: error: ")

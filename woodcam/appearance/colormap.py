@@ -72,10 +72,46 @@ class Species:
     streak_contrast: float = 0.06
     endgrain_darkening: float = 0.3
     endgrain_roughness: float = 0.15
+    source: str = ""
 
 
-#: Species presets; colours read off photographs of planed boards.
-SPECIES: dict[str, Species] = {
+#: sRGB centroids (0-255) of the ISCC-NBS colour names the cited presets use, as tabulated by
+#: P. Centore, "sRGB centroids for the ISCC-NBS colour system" (2016),
+#: https://munsellcolourscienceforpainters.com/ISCCNBS/ISCCNBSSystem.html (Illuminant C, the
+#: ISCC-NBS standard). Quoted, not fitted: a written colour name becomes one of these numbers.
+ISCC_NBS_SRGB: dict[str, tuple[int, int, int]] = {
+    "light reddish brown": (172, 122, 115), "moderate reddish brown": (125, 66, 59),
+    "dark reddish brown": (70, 29, 30), "light brown": (173, 124, 99),
+    "moderate brown": (114, 74, 56), "dark brown": (68, 33, 18),
+    "grayish brown": (103, 79, 72), "dark grayish brown": (62, 44, 40),
+    "moderate yellowish brown": (136, 102, 72), "dark yellowish brown": (80, 52, 26),
+    "yellowish white": (238, 223, 218), "yellowish gray": (198, 185, 177),
+    "pinkish white": (239, 221, 229), "pinkish gray": (199, 182, 189),
+    "moderate reddish orange": (205, 105, 82), "moderate red": (177, 73, 85),
+}
+
+#: The quotes below were read in the 2010 edition's chapter 2 as reproduced page by page at
+#: https://issuhub.com/view/index/5801 (pages 20-29); the black cherry and white ash sentences
+#: as reproduced at woodworkdetails.com and cocolumber.com (the same Handbook wording).
+_HANDBOOK = ("Forest Products Laboratory (2010), Wood Handbook - Wood as an Engineering Material, "
+             "FPL-GTR-190, ch. 2 (Wiemann), https://www.fpl.fs.usda.gov/documnts/fplgtr/fplgtr190/"
+             "chapter_02.pdf")
+
+
+def _cited(name: str, early: str, late: str, like: str, source: str) -> Species:
+    """A preset whose earlywood and latewood colours are the ISCC-NBS centroids of the colour
+    names its ``source`` gives (the lighter named colour for earlywood, the darker for latewood;
+    a single named colour gets the ISCC-NBS name one lightness step darker for latewood). The
+    texture parameters (pores, streaks, end grain) are those of the legacy preset ``like`` of the
+    same anatomical group (ring-porous, diffuse-porous, softwood): no source gives them."""
+    rgb = {k: tuple(v / 255.0 for v in ISCC_NBS_SRGB[k]) for k in (early, late)}
+    return replace(_LEGACY[like], name=name, earlywood_rgb=rgb[early], latewood_rgb=rgb[late],
+                   source=f"{source}; colours: ISCC-NBS '{early}' / '{late}' (Centore 2016)")
+
+
+#: The first six presets; their colours were read off photographs that are not recorded, so
+#: they carry no citable source. Kept because blocks and tests name them.
+_LEGACY: dict[str, Species] = {
     "oak": Species("oak", (0.80, 0.64, 0.44), (0.56, 0.40, 0.24), 0.5, 0.35, True, 0.3, 5.0, 0.07),
     "maple": Species("maple", (0.93, 0.84, 0.70), (0.82, 0.68, 0.50), 0.7, 0.06, False, 0.15, 4.0, 0.05),
     "walnut": Species("walnut", (0.52, 0.36, 0.25), (0.33, 0.21, 0.14), 0.55, 0.15, False, 0.25, 6.0, 0.08),
@@ -83,6 +119,43 @@ SPECIES: dict[str, Species] = {
     "pine": Species("pine", (0.93, 0.80, 0.58), (0.72, 0.48, 0.25), 0.45, 0.04, False, 0.2, 8.0, 0.05, 0.25),
     "spruce": Species("spruce", (0.94, 0.86, 0.70), (0.78, 0.60, 0.40), 0.5, 0.03, False, 0.2, 8.0, 0.04, 0.25),
 }
+_LEGACY = {k: replace(v, source="legacy: colours read off photographs of planed boards that are "
+                      "not recorded (no citable source)") for k, v in _LEGACY.items()}
+
+#: Presets whose colours come from a published description, each quoted in ``source``.
+_CITED: dict[str, Species] = {s.name: s for s in (
+    _cited("red-oak", "moderate reddish brown", "dark reddish brown", "oak",
+           f"red oak group: 'The heartwood is brown with a tinge of red.' {_HANDBOOK}"),
+    _cited("white-oak", "grayish brown", "dark grayish brown", "oak",
+           f"white oak group: 'The heartwood is generally grayish brown.' {_HANDBOOK}"),
+    _cited("black-walnut", "light brown", "dark brown", "walnut",
+           f"'The heartwood of black walnut varies from light to dark brown' {_HANDBOOK}"),
+    _cited("black-cherry", "light reddish brown", "dark reddish brown", "cherry",
+           f"'The heartwood of black cherry varies from light to dark reddish brown' {_HANDBOOK}"),
+    _cited("white-ash", "moderate brown", "dark brown", "oak",
+           f"'Heartwood of commercial white ash is brown' {_HANDBOOK}"),
+    _cited("sassafras", "grayish brown", "dark brown", "oak",
+           f"'heartwood varies from dull grayish brown to dark brown' {_HANDBOOK}"),
+    _cited("black-willow", "light reddish brown", "grayish brown", "walnut",
+           f"'The heartwood of black willow is grayish brown or light reddish brown' {_HANDBOOK}"),
+    _cited("buckeye", "yellowish white", "yellowish gray", "maple",
+           f"'the creamy or yellowish white heartwood' {_HANDBOOK}"),
+    _cited("ponderosa-pine", "light reddish brown", "moderate reddish brown", "pine",
+           f"'The heartwood of ponderosa pine is light reddish brown' {_HANDBOOK}"),
+    _cited("western-larch", "moderate yellowish brown", "dark yellowish brown", "pine",
+           f"'The heartwood of western larch is yellowish brown' {_HANDBOOK}"),
+    _cited("douglas-fir", "moderate reddish orange", "moderate red", "pine",
+           "'The heartwood is orange red to red or sometimes yellowish.' US Navy, Naval "
+           "Facilities Engineering Command, Wood Protection, NAVFAC MO-312, sec. 3, "
+           "http://navalfacilities.tpub.com/mo312/mo3120059.htm"),
+    _cited("engelmann-spruce", "pinkish white", "pinkish gray", "spruce",
+           "'The heartwood of Engelmann spruce is nearly white with a slight tinge of red.' "
+           "Biermann, C.J. (1996), Handbook of Pulping and Papermaking, 2nd ed., Academic Press, "
+           "ch. 26, p. 565"),
+)}
+
+#: Every species preset: the legacy six and the cited ones (README, "Species presets").
+SPECIES: dict[str, Species] = {**_LEGACY, **_CITED}
 
 
 def get_species(species) -> Species:

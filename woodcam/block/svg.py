@@ -5,13 +5,14 @@ top-left pixel corner, one unit per pixel when written by :func:`write_traces_sv
 vertex at continuous pixel ``(row, col)`` (pixel centres at integers, as in
 :mod:`woodcam.block.block`) sits at SVG ``(x, y) = (col + 0.5, row + 0.5)``.
 
-Reading accepts what editors write for straight strokes: ``<polyline>``, ``<polygon>``,
-``<line>`` and ``<path>`` with ``M L H V Z`` commands (absolute or relative), under groups with
-``translate`` / ``scale`` / ``matrix`` / ``rotate`` transforms. A stroke's year comes from a
-``data-year`` attribute, or an ``id`` / ``inkscape:label`` such as ``year-12`` or ``12``;
-otherwise the trace is unlabelled. Curves (``C S Q T A``) are refused with a fix: draw with
-straight segments, or flatten the path in the editor (Inkscape: Extensions > Modify Path >
-Flatten Beziers).
+Reading goes through svgelements (a maintained SVG library), so whatever an editor writes lands
+where it is drawn: ``<path>`` (every command, curves ``C S Q T A`` included, sampled every
+:data:`~woodcam.tolerances.SVG_CURVE_STEP_PX` image pixels), ``<polyline>``, ``<polygon>`` and
+``<line>``; transforms on the shapes and on the layer groups around them; ``width``/``height``
+in any unit (``mm``, ``in``, ``px``) with or without a ``viewBox``. The drawing's width and
+height are mapped onto the face image. A stroke's year comes from its own ``data-year``
+attribute, or an ``id`` / ``inkscape:label`` such as ``year-12`` or ``12``; otherwise the trace
+is unlabelled (a layer's label is not a year of the strokes in it).
 """
 
 from __future__ import annotations
@@ -68,71 +69,72 @@ def write_traces_svg(face: Face, path, *, photo_href: str | None = None, stroke_
 def read_traces_svg(path, shape) -> list[RingTrace]:
     """Read ring traces drawn over a face image of ``shape = (rows, cols)`` pixels.
 
-    The SVG's ``viewBox`` (or ``width``/``height``) is mapped onto the image, so an SVG drawn
-    at another scale still lands on the right pixels.
+    The SVG's drawing area (``width``/``height`` in any unit, through its ``viewBox``) is
+    mapped onto the image, so an SVG drawn at another scale or in mm still lands on the right
+    pixels.
 
     Returns
     -------
     list of RingTrace
-        Points as continuous pixel ``(row, col)``; strokes with fewer than two points are
-        skipped.
+        Points as continuous pixel ``(row, col)``, in document order; strokes with fewer than
+        two points are skipped.
     """
+    import svgelements
+
     try:
-        root = ET.parse(path).getroot()
-    except (ET.ParseError, OSError) as err:
+        svg = svgelements.SVG.parse(str(path), reify=True)
+    except (ET.ParseError, OSError, ValueError) as err:
         raise WoodcamError(f"{str(path)!r} must be a readable SVG file; {err}") from err
     rows, cols = int(shape[0]), int(shape[1])
-    vb = root.get("viewBox")
-    if vb:
-        x0, y0, w, h = (float(v) for v in re.split(r"[\s,]+", vb.strip()))
-    else:
-        x0 = y0 = 0.0
-        w, h = _length(root.get("width"), cols), _length(root.get("height"), rows)
-    # SVG user units -> pixel (col, row): col = (x - x0) * cols / w - 0.5
-    to_px = np.array([[cols / w, 0, -x0 * cols / w], [0, rows / h, -y0 * rows / h], [0, 0, 1]])
+    if not (svg.width and svg.height and svg.width > 0 and svg.height > 0):
+        raise WoodcamError(f"{str(path)!r} has no drawing size: give the <svg> a viewBox or a "
+                           "width and height")
+    scale = np.array([cols / svg.width, rows / svg.height])  # document units -> image pixels
     traces: list[RingTrace] = []
-    _walk(root, to_px, traces)
+    for el in svg.elements():
+        if not isinstance(el, (svgelements.Path, svgelements.Polyline, svgelements.SimpleLine)):
+            continue  # Polygon is a Polyline; rects, circles, images and text are no traces
+        year = _year(el.values.get("attributes", {}))
+        path_ = el if isinstance(el, svgelements.Path) else svgelements.Path(el)
+        for xy in _polylines(path_, scale):
+            if len(xy) >= 2:
+                px = xy * scale
+                traces.append(RingTrace(np.stack([px[:, 1] - 0.5, px[:, 0] - 0.5], axis=1), year))
     return traces
 
 
-def _length(value, default: float) -> float:
-    if not value:
-        return float(default)
-    m = re.match(r"\s*([-+0-9.eE]+)", value)
-    return float(m.group(1)) if m else float(default)
+def _polylines(path, scale: np.ndarray) -> list[np.ndarray]:
+    """``(k, 2)`` document-unit polylines of an svgelements Path: one per subpath, curves
+    sampled every :data:`~woodcam.tolerances.SVG_CURVE_STEP_PX` image pixels or finer."""
+    import svgelements
+
+    from ..tolerances import SVG_CURVE_STEP_PX
+
+    lines: list[np.ndarray] = []
+    cur: list[np.ndarray] = []
+    for seg in path:
+        if isinstance(seg, svgelements.Move):
+            if len(cur) >= 2:
+                lines.append(np.vstack(cur))
+            cur = [np.array([[seg.end.x, seg.end.y]])]
+            continue
+        if not cur:  # a segment before any move (svgelements starts paths with one)
+            cur = [np.array([[seg.start.x, seg.start.y]])]
+        if isinstance(seg, (svgelements.Line, svgelements.Close)):
+            cur.append(np.array([[seg.end.x, seg.end.y]]))
+        else:  # CubicBezier, QuadraticBezier, Arc: sample along the curve
+            length_px = seg.length(error=1e-6) * float(scale.max())
+            n = max(2, int(math.ceil(length_px / SVG_CURVE_STEP_PX)) + 1)
+            cur.append(np.asarray(seg.npoint(np.linspace(0.0, 1.0, n)), float)[1:])
+    if len(cur) >= 2:
+        lines.append(np.vstack(cur))
+    return lines
 
 
-def _local(tag: str) -> str:
-    return tag.rsplit("}", 1)[-1]
-
-
-def _transform(text: str | None) -> np.ndarray:
-    """3x3 affine matrix of an SVG ``transform`` attribute."""
-    m = np.eye(3)
-    if not text:
-        return m
-    for name, args in re.findall(r"(\w+)\s*\(([^)]*)\)", text):
-        a = [float(v) for v in re.split(r"[\s,]+", args.strip()) if v]
-        if name == "translate":
-            t = np.array([[1, 0, a[0]], [0, 1, a[1] if len(a) > 1 else 0.0], [0, 0, 1]])
-        elif name == "scale":
-            t = np.diag([a[0], a[1] if len(a) > 1 else a[0], 1.0])
-        elif name == "matrix":
-            t = np.array([[a[0], a[2], a[4]], [a[1], a[3], a[5]], [0, 0, 1]])
-        elif name == "rotate":
-            c, s = math.cos(math.radians(a[0])), math.sin(math.radians(a[0]))
-            t = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-            if len(a) == 3:
-                t = _transform(f"translate({a[1]},{a[2]})") @ t @ _transform(f"translate({-a[1]},{-a[2]})")
-        else:
-            raise WoodcamError(f"SVG transform {name!r} is not supported; use translate, scale, matrix or rotate")
-        m = m @ t
-    return m
-
-
-def _year(el) -> int | None:
+def _year(attributes: dict) -> int | None:
+    """The year an element's own attributes give it (``data-year``, ``inkscape:label``, ``id``)."""
     for key in ("data-year", _INKSCAPE_LABEL, "id"):
-        v = el.get(key)
+        v = attributes.get(key)
         if v is None:
             continue
         m = re.fullmatch(r"\s*(?:year[-_ ]?)?(-?\d+)\s*", v, flags=re.IGNORECASE)
@@ -141,82 +143,3 @@ def _year(el) -> int | None:
         if key == "data-year":
             raise WoodcamError(f"data-year must be an integer; got {v!r}")
     return None
-
-
-def _numbers(text: str) -> list[float]:
-    return [float(v) for v in re.findall(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?", text or "")]
-
-
-def _path_points(d: str) -> list[np.ndarray]:
-    """Polylines ``(k, 2)`` (x, y) of an SVG path made of straight segments."""
-    tokens = re.findall(r"[A-Za-z]|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?", d)
-    lines, cur, pos, start, cmd, i = [], [], np.zeros(2), np.zeros(2), None, 0
-    while i < len(tokens):
-        tok = tokens[i]
-        if tok.isalpha():
-            cmd = tok
-            i += 1
-            if cmd in "Zz":
-                if cur:
-                    cur.append(start.copy())
-                    lines.append(np.array(cur))
-                    cur = []
-                pos = start.copy()
-                continue
-            if cmd.upper() not in "MLHV":
-                raise WoodcamError(
-                    f"SVG path command {cmd!r} (a curve) is not supported for ring traces; draw "
-                    "with straight segments or flatten the path (Inkscape: Extensions > Modify "
-                    "Path > Flatten Beziers)"
-                )
-            continue
-        if cmd is None:
-            raise WoodcamError(f"SVG path data must start with a command; got {d[:20]!r}")
-        rel = cmd.islower()
-        c = cmd.upper()
-        if c in "ML":
-            xy = np.array([float(tokens[i]), float(tokens[i + 1])])
-            i += 2
-            pos = pos + xy if rel else xy
-            if c == "M":
-                if len(cur) >= 2:
-                    lines.append(np.array(cur))
-                cur, start = [pos.copy()], pos.copy()
-                cmd = "l" if rel else "L"          # implicit lineto after a moveto
-                continue
-        else:  # H or V
-            v = float(tokens[i])
-            i += 1
-            k = 0 if c == "H" else 1
-            pos = pos.copy()
-            pos[k] = pos[k] + v if rel else v
-        cur.append(pos.copy())
-    if len(cur) >= 2:
-        lines.append(np.array(cur))
-    return lines
-
-
-def _walk(el, m: np.ndarray, out: list[RingTrace]) -> None:
-    m = m @ _transform(el.get("transform"))
-    tag = _local(el.tag)
-    polylines: list[np.ndarray] = []
-    if tag in ("polyline", "polygon"):
-        v = _numbers(el.get("points"))
-        p = np.array(v[: len(v) // 2 * 2]).reshape(-1, 2)
-        polylines = [np.vstack([p, p[:1]]) if tag == "polygon" and len(p) else p]
-    elif tag == "line":
-        polylines = [np.array([[float(el.get(k, 0)) for k in ("x1", "y1")],
-                               [float(el.get(k, 0)) for k in ("x2", "y2")]])]
-    elif tag == "path":
-        polylines = _path_points(el.get("d", ""))
-    elif tag in ("image", "defs", "metadata", "title", "desc"):
-        return
-    if polylines:
-        year = _year(el)
-        for p in polylines:
-            if len(p) < 2:
-                continue
-            xy = p @ m[:2, :2].T + m[:2, 2]
-            out.append(RingTrace(np.stack([xy[:, 1] - 0.5, xy[:, 0] - 0.5], axis=1), year))
-    for child in el:
-        _walk(child, m, out)

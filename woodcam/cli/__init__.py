@@ -18,9 +18,11 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+import textwrap
 import warnings
 
-from ..errors import WoodcamError
+from ..errors import UsageError, WoodcamError
+from .options import OUT_RULE
 
 #: The command modules, in the order their commands appear in ``woodcam --help``.
 COMMANDS: tuple[str, ...] = (
@@ -81,7 +83,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="woodcam", description="CNC cut preview for solid wood: carve a part out of a "
         "block whose growth rings are known and see the wood on every surface.",
-        epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+        epilog=_EPILOG + "\n" + textwrap.fill("output: " + OUT_RULE, 95) + "\n",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
     from .. import __version__
 
     parser.add_argument("--version", action="version", version=f"woodcam {__version__}")
@@ -158,10 +161,15 @@ def main(argv: list[str] | None = None) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            from .options import check_numbers
+            from .options import check_numbers, check_out, lengths_to_mm
 
+            check_out(args)  # the --out rule, before any work
+            lengths_to_mm(args, parser)  # --units inch: every length in mm from here on
             check_numbers(args)  # every numeric option finite and in range, before any work
             rc = args.func(args)
+        except UsageError as err:
+            print(f"woodcam: error: {err}", file=sys.stderr)
+            return EXIT_USAGE
         except WoodcamError as err:
             print(f"woodcam: error: {err}", file=sys.stderr)
             return EXIT_ERROR

@@ -10,10 +10,9 @@ fitted field is needed) or a block folder (its true field if it has one, else it
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 from .._atomic import write_text
-from .options import add_block_argument, add_size_option, command_group, open_block
+from .options import add_block_argument, add_out_option, add_size_option, command_group, open_block
 
 
 def register(subparsers) -> None:
@@ -27,7 +26,7 @@ def register(subparsers) -> None:
         "power spectrum and patch-statistics distances; lower is better). Writes a side-by-side "
         "PNG per block and results.json.")
     add_block_argument(p, option=False, nargs="+")
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    add_out_option(p, "results.json and one side-by-side PNG per block")
     add_size_option(p)
     p.add_argument("--resolution", type=int, default=128, help="grid cells along the longest side (default 128)")
     p.add_argument("--quality", choices=("draft", "normal", "high"), default="normal",

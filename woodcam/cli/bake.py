@@ -6,8 +6,10 @@ import argparse
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import (BLOCK_SPEC_HELP, add_bake_options, allow_negative_values, stock_options,
-                      vector_mm, write_screenshot)
+from ..units import fmt_volume
+from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
+                      allow_negative_values, stock_options, vector_mm,
+                      write_screenshot)
 
 
 def register(subparsers) -> None:
@@ -16,7 +18,8 @@ def register(subparsers) -> None:
                               description="Carve, bake, export (GLB, OBJ+MTL+PNG) and render the "
                               "example parts of cad_examples/ out of built-in synthetic blocks; "
                               "print stage times.")
-    p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
+    add_out_option(p, "per example part a GLB, OBJ+MTL+texture PNG, view PNG and part report",
+                   default=Path("out"))
     p.add_argument("--quick", action="store_true", help="lower texture resolution (for CI)")
     add_bake_options(p, texels_default=None, screenshot=False)
     p.set_defaults(func=run_demo)
@@ -30,7 +33,9 @@ def register(subparsers) -> None:
                               "sandbox).")
     p.add_argument("part", help="part file (.py script, .step, .stl, .obj, .glb)")
     p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
-    p.add_argument("--out", type=Path, required=True, help="output .glb path")
+    add_out_option(p, "the baked part; beside it PART.obj/.mtl, PART_texture.png, the "
+                   "part report PART_report.txt/.json and, with --screenshot, PART_view.png",
+                   suffixes=(".glb",))
     p.add_argument("--tolerance", type=float, default=None, metavar="MM",
                    help="tessellation chord tolerance for B-rep parts (default 0.05 mm)")
     p.add_argument("--timeout", type=float, default=None, metavar="S",
@@ -45,6 +50,7 @@ def register(subparsers) -> None:
     p.add_argument("--max-triangles", type=int, default=None, metavar="N",
                    help="triangle budget for B-rep parts: above it the part is re-meshed with "
                    "looser tolerances, and the summary says so (default 120000)")
+    add_units_option(p, "bake")
     add_bake_options(p)
     p.set_defaults(func=run_bake)
 
@@ -67,6 +73,7 @@ def register(subparsers) -> None:
                    help="the cut plane's normal, towards the side cut away (default: the block's "
                    "longest axis facing the camera)")
     allow_negative_values(p)
+    add_units_option(p, "preview")
     p.add_argument("--confidence", action="store_true",
                    help="colour the part by the fit's per-point confidence (red 0, yellow 0.5, green "
                    "1; spread of the accepted hypotheses and distance from observed faces) "
@@ -103,12 +110,13 @@ def run_bake(args: argparse.Namespace) -> int:
     tess = res.tessellation
     mesh_note = (f" (meshed at {tess['tolerance_mm']:.3g} mm / {tess['angular_tolerance_deg']:.3g}"
                  " deg)" if tess.get("tolerance_mm") and tess.get("triangles") else "")
-    print(f"{res.name}: {res.triangles} triangles{mesh_note}, {res.volume_mm3:.0f} mm^3, "
+    print(f"{res.name}: {res.triangles} triangles{mesh_note}, "
+          f"{fmt_volume(res.volume_mm3, args.units)}, "
           f"{res.atlas}; wrote " + ", ".join(map(str, res.files.values())))
     if res.report:
         from ..advise import report_text
 
-        print(report_text(res.report, res.name))
+        print(report_text(res.report, res.name, units=args.units))
     return 0
 
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .options import add_engine_options, engine_options
+from .options import add_engine_options, add_out_option, engine_options
 
 
 def register(subparsers) -> None:
@@ -28,7 +28,7 @@ def register(subparsers) -> None:
     r.add_argument("--seed", type=int, default=0, help="seed of the block set (default 0)")
     r.add_argument("--methods", default="rbf,radial,neural",
                    help="comma-separated fitting methods (default rbf,radial,neural)")
-    r.add_argument("--out", type=Path, required=True, help="run folder: run.json + records/")
+    add_out_option(r, "the run: run.json and records/ (rerun to resume)")
     r.add_argument("--knotted-fraction", type=float, default=None, metavar="F",
                    help="share of knotted blocks in [0, 1] (default 0.5)")
     r.add_argument("--face-px", type=int, default=None, metavar="PX",
@@ -47,7 +47,7 @@ def register(subparsers) -> None:
                        description="Reads a run folder; writes report.md, report.json, table1.png "
                        "and gallery/ (worst blocks and sample faces, regenerated from the seed).")
     t.add_argument("run_dir", type=Path, help="a folder written by `woodcam bench run`")
-    t.add_argument("--out", type=Path, required=True, help="report folder")
+    add_out_option(t, "report.md, report.json, table1.png and gallery/")
     t.add_argument("--gallery", type=int, default=3, metavar="N",
                    help="worst blocks to redraw (default 3; each is refitted, ~40 CPU-s)")
     t.add_argument("--thumbnails", type=int, default=2, metavar="N",

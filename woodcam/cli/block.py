@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .options import add_block_argument, add_engine_options, add_size_option, engine_options, open_block
+from .options import add_block_argument, add_engine_options, add_out_option, add_size_option, engine_options, open_block
 
 
 def register(subparsers) -> None:
@@ -19,7 +19,7 @@ def register(subparsers) -> None:
     s = sub.add_parser("synth", help="write a reproducible set of synthetic blocks")
     s.add_argument("--count", type=int, required=True, help="number of blocks")
     s.add_argument("--seed", type=int, default=0, help="random seed (same seed, same set)")
-    s.add_argument("--out", type=Path, required=True, help="output folder (one sub-folder per block)")
+    add_out_option(s, "one block sub-folder per block and index.json")
     s.add_argument("--face-px", type=int, default=512, help="pixels along the largest face side")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--jitter-mm", type=float, default=0.0,
@@ -40,7 +40,7 @@ def register(subparsers) -> None:
 
     v = sub.add_parser("show", help="draw a block's faces as one unfolded-cross PNG")
     add_block_argument(v, option=False)
-    v.add_argument("--out", type=Path, required=True, help="PNG to write")
+    add_out_option(v, "the unfolded faces with a cut layer", suffixes=(".png",))
     v.add_argument("--layer", choices=("photo", "ring_map", "both"), default="photo")
     v.add_argument("--no-traces", action="store_true", help="do not draw traced rings")
     add_size_option(v)

@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import command_group
+from .options import add_out_option, command_group
 
 
 def _list(text: str) -> list[str]:
@@ -40,7 +40,7 @@ def register(subparsers) -> None:
                    help="eq. 7-9 sanity blocks per scenario and face set (default 2; 0 skips)")
     r.add_argument("--face-px", type=int, default=256, help="face image pixels along the largest side (default 256)")
     r.add_argument("--plots", action="store_true", help="also write cut-plane PNGs per block")
-    r.add_argument("--out", type=Path, required=True, help="folder for table.md and records.json")
+    add_out_option(r, "table.md, records.json and cut-plane PNGs")
     r.set_defaults(func=run_realistic)
 
 

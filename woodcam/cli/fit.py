@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_block_argument, add_size_option, command_group, open_block
+from .options import add_block_argument, add_out_option, add_size_option, command_group, open_block
 
 #: Faces used for "partial annotation": three faces meeting at the front-top-left corner, half
 #: of the block's surface (seed 000, section 4.3 traces "half of the block only").
@@ -36,7 +36,7 @@ def register(subparsers) -> None:
                    "each predicts the faces it was not fitted to (warns when they contradict it)")
     p.add_argument("--faces", default=None, help="comma-separated faces to use (default: all)")
     add_size_option(p)
-    p.add_argument("--out", type=Path, required=True, help="field file to write (.npz grid)")
+    add_out_option(p, "the fitted field as a grid", suffixes=(".npz",))
     p.set_defaults(func=run_fit)
 
     evals = command_group(subparsers, "eval", help="score fitted rings (eval rings) or "
@@ -62,7 +62,7 @@ def register(subparsers) -> None:
     e.add_argument("--detect", action="store_true",
                    help="real blocks: fit from rings detected on the photos (woodcam.detect) and score "
                    "against the block's own ring maps (e.g. the Mokume U-Net maps) as the reference")
-    e.add_argument("--out", type=Path, required=True, help="folder for table.md and cut-plane PNGs")
+    add_out_option(e, "table.md and cut-plane PNGs")
     e.set_defaults(func=run_eval)
 
 

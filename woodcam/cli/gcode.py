@@ -12,7 +12,9 @@ import time
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import BLOCK_SPEC_HELP, add_bake_options, allow_negative_values, stock_options
+from ..units import fmt_volume
+from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
+                      allow_negative_values, stock_options)
 
 _EXAMPLES = """\
 examples:
@@ -41,7 +43,8 @@ def register(subparsers) -> None:
                    help="G-code file(s) (.nc, .gcode, .ngc, .tap); several files of one job "
                    "(e.g. roughing then finishing) are simulated in sequence on the same stock")
     p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
-    p.add_argument("--out", type=Path, required=True, help="output .glb path")
+    add_out_option(p, "the carved stock; beside it OUT.obj/.mtl, OUT_texture.png and, "
+                   "with --screenshot, OUT_view.png", suffixes=(".glb",))
     p.add_argument("--tool", action="append", default=[], metavar="[N=]SPEC",
                    help="a tool, e.g. flat:6.35, ball:3, bull:6:1, vbit:60:12, 2=ball:3 "
                    "(repeatable; without N= the tools go to the program's tool numbers in "
@@ -90,6 +93,7 @@ def register(subparsers) -> None:
                    help="merge nearly planar regions of the result mesh within this (default "
                    "0.05 mm: the 20,000-move raster's mesh shrinks from 2.0 M to 0.44 M "
                    "triangles, its volume moves by 0.0006 mm on average)")
+    add_units_option(p, "gcode")
     add_bake_options(p)
     p.set_defaults(func=run)
     allow_negative_values(p)  # --work-offset -14,5,3
@@ -207,7 +211,7 @@ def run(args) -> int:
         s = res.stats
         print(f"{path.name}: {len(program)} moves read in {t_read:.2f} s, simulated on "
               f"{s['grid'][1]}x{s['grid'][0]} cells in {s['wall_s']:.2f} s "
-              f"({s['moves_per_s']:.0f} moves/s), removed {res.removed_volume_mm3:.0f} mm^3, "
+              f"({s['moves_per_s']:.0f} moves/s), removed {fmt_volume(res.removed_volume_mm3, args.units)}, "
               f"{len(res.report)} issue(s); machining time " + ", ".join(
                   f"T{t}: {_hms(f + r)} ({_hms(f)} feeding)" for t, (f, r) in times.items()))
         meta_programs.append({"gcode": str(path),

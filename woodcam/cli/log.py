@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_knot_options, knot_shading
+from .options import SPECIES_HELP, add_knot_options, add_out_option, knot_shading
 
 
 def register(subparsers) -> None:
@@ -29,7 +29,7 @@ def register(subparsers) -> None:
 
     r = sub.add_parser("render", help="PNG sections: a tangential board and an end-grain disc")
     source(r)
-    r.add_argument("--out", required=True, help="output folder")
+    add_out_option(r, "one PNG per section")
     r.add_argument("--ring-width", type=float, default=2.0, help="mm per year (default 2)")
     r.add_argument("--px-per-mm", type=float, default=2.0, help="resolution in pixels per mm (default 2)")
     r.add_argument("--supersample", type=int, default=2,
@@ -45,20 +45,19 @@ def register(subparsers) -> None:
     r.add_argument("--k-knot", type=float, default=5.0, help="smoothness k inside knots")
     add_knot_options(r)
     r.add_argument("--species", default="spruce",
-                   help="colour preset of the wood (oak, maple, walnut, cherry, pine, spruce; "
-                   "default spruce, the real log's)")
+                   help=SPECIES_HELP + " (default spruce, the real log's)")
     r.add_argument("--outline-mm", type=float, default=1.0,
                    help="dead-knot outline thickness (mm)")
     r.set_defaults(func=run)
 
     m = sub.add_parser("maps", help="write the seed's image maps of a log")
     source(m)
-    m.add_argument("--out", required=True, help="output folder")
+    add_out_option(m, "the seed's image maps (PNG)")
     m.set_defaults(func=run)
 
     e = sub.add_parser("export", help="write a log as a woodcam log file (JSON)")
     source(e)
-    e.add_argument("--out", required=True, help="output .json path")
+    add_out_option(e, "the woodcam log file", suffixes=(".json",))
     e.set_defaults(func=run)
 
 

@@ -8,6 +8,11 @@
 - :func:`command_group`: a command with sub-commands that several modules extend.
 - :func:`check_numbers` / :data:`RANGES`: every numeric option finite and
   in range, checked by :func:`woodcam.cli.main` before a command runs.
+- :func:`add_out_option` / :func:`check_out` / :data:`OUT_RULE`: the one ``--out`` rule of
+  every command (a file when the path ends in a known file suffix, a folder otherwise),
+  checked by :func:`woodcam.cli.main` before a command runs.
+- :func:`add_units_option` / :func:`lengths_to_mm`: ``--units mm|inch``, the lengths of a
+  command line read in it (:data:`LENGTH_OPTIONS`); summaries print with :mod:`woodcam.units`.
 
 Nothing heavy is imported at module level (``woodcam --help`` loads this module).
 """
@@ -20,11 +25,193 @@ import re
 from pathlib import Path
 
 from ..errors import WoodcamError
+from ..units import MM_PER_UNIT
+
+#: The --species presets (woodcam.appearance.SPECIES, listed here so that --help imports no
+#: numba; tests/appearance/test_species.py checks the two agree). README: "Species presets".
+SPECIES_HELP = ("colour preset: cited (README 'Species presets'): red-oak, white-oak, black-walnut, "
+                "black-cherry, white-ash, sassafras, black-willow, buckeye, ponderosa-pine, "
+                "western-larch, douglas-fir, engelmann-spruce; legacy, uncited: oak, maple, "
+                "walnut, cherry, pine, spruce")
 
 BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], woodify:DIR/field.npz "
                    "(a block cut from a grown object), a block folder "
                    "(block.json) or a Mokume sample folder (a 50 mm cube unless --size-mm); "
                    "append ~x90/~y90/~z90 to turn the block under the part")
+
+
+# -- --out: one rule for every command ---------------------------------------------------------
+#: Suffixes that make an ``--out`` path a FILE; any other path names a FOLDER.
+FILE_SUFFIXES: frozenset[str] = frozenset({
+    ".glb", ".gltf", ".obj", ".stl", ".png", ".jpg", ".jpeg", ".svg", ".dxf", ".html", ".json",
+    ".npz", ".pt", ".md", ".csv", ".txt", ".nc", ".zip"})
+
+#: The rule as ``woodcam --help`` and the README state it.
+OUT_RULE = ("--out is a FILE when it ends in a file suffix (.glb, .png, .json, .html, .npz, ...) "
+            "and a FOLDER otherwise (created when missing). Each command takes one of the two, "
+            "says which and what it writes in its --out help, and refuses the other kind "
+            "before any work (exit 2).")
+
+
+def add_out_option(p: argparse.ArgumentParser, writes: str, *, suffixes: tuple[str, ...] = (),
+                   default: Path | None = None) -> None:
+    """``--out`` under :data:`OUT_RULE`: a FILE ending in one of ``suffixes``, or (no
+    ``suffixes``) a FOLDER. ``writes`` says what the command writes there; ``default`` makes
+    the option optional. :func:`check_out` applies the rule before the command runs."""
+    assert all(s in FILE_SUFFIXES for s in suffixes), suffixes  # a contributor's mistake
+    kind = f"FILE ending in {' or '.join(suffixes)}" if suffixes else "FOLDER (created)"
+    p.add_argument("--out", type=Path, required=default is None, default=default,
+                   metavar="FILE" if suffixes else "DIR", help=f"output {kind}: {writes}"
+                   + (f" (default {default}{'' if suffixes else '/'})" if default else ""))
+    p.set_defaults(_out_suffixes=tuple(suffixes))
+
+
+def check_out(args: argparse.Namespace) -> None:
+    """Refuse an ``--out`` that breaks :data:`OUT_RULE` for this command, before any work:
+    a UsageError (exit 2) naming the command, what it wants, the value and a fix."""
+    from ..errors import UsageError
+
+    suffixes = getattr(args, "_out_suffixes", None)
+    out = getattr(args, "out", None)
+    if suffixes is None or out is None:
+        return
+    out = Path(out)
+    suffix = out.suffix.lower()
+    command = " ".join(str(getattr(args, k)) for k in vars(args)
+                       if k == "command" or k.endswith("_command")
+                       if getattr(args, k) is not None)
+    if suffixes:
+        if out.is_dir() or suffix not in FILE_SUFFIXES:
+            raise UsageError(f"--out of 'woodcam {command}' is a FILE ending in "
+                             f"{' or '.join(suffixes)}; got {str(out)!r}, a folder; give a file "
+                             f"name such as {str(out / ('part' + suffixes[0]))!r}")
+        if suffix not in suffixes:
+            raise UsageError(f"--out of 'woodcam {command}' must end in {' or '.join(suffixes)}; "
+                             f"got {str(out)!r}; give e.g. {str(out.with_suffix(suffixes[0]))!r}")
+    elif suffix in FILE_SUFFIXES or out.is_file():
+        what = "an existing file" if out.is_file() else f"a file name ({suffix})"
+        raise UsageError(f"--out of 'woodcam {command}' is a FOLDER (it writes several files); "
+                         f"got {str(out)!r}, {what}; give a folder such as "
+                         f"{str(out.with_name(out.stem + '_out' if out.is_file() else out.stem))!r}")
+
+
+# -- --units: lengths on the command line and in printed summaries ------------------------------
+#: ``(command, option dest)`` -> how the value holds lengths: "number" (float), "vector" (a
+#: tuple of floats), "sizes" / "csv" (a text "WxDxH" / "X,Y,Z,R" of lengths), "spec" (a block
+#: spec's :WxDxH size), "place" (``--place`` operations: translate:X,Y,Z and fit:MARGIN),
+#: "tools" (``--tool`` specs: diameters, corner radii, tips; angles stay degrees). ``--rapid-rate`` reads unit/min. Options whose name carries a unit
+#: (``--texels-per-mm``, ``--size-mm``) keep it; files stay mm.
+LENGTH_OPTIONS: dict[tuple[str, str], str] = {
+    ("bake", "block"): "spec", ("bake", "tolerance"): "number", ("bake", "place"): "place",
+    ("place", "block"): "spec", ("place", "margin"): "number",
+    ("preview", "block"): "spec", ("preview", "cut_origin"): "vector",
+    ("review", "block"): "spec",
+    ("gcode", "block"): "spec", ("gcode", "resolution"): "number",
+    ("gcode", "work_offset"): "vector", ("gcode", "start"): "vector",
+    ("gcode", "stock"): "vector", ("gcode", "stock_origin"): "vector",
+    ("gcode", "rapid_rate"): "number", ("gcode", "mesh_tol"): "number",
+    ("gcode", "tool"): "tools",
+    ("woodify", "growth"): "number", ("woodify", "block_size"): "sizes",
+    ("woodify", "block_centre"): "csv", ("woodify", "crack_region"): "csv",
+    ("parquetry", "sheet_size"): "sizes", ("parquetry", "leaf_thickness"): "number",
+    ("parquetry", "saw_kerf"): "number", ("parquetry", "tool_diameter"): "number",
+}
+
+#: Positions of the lengths among a tool spec's numbers (``vbit:ANGLE:D`` -> D only).
+_TOOL_LENGTHS = {"flat": (0,), "ball": (0,), "bull": (0, 1), "vbit": (1,), "snub": (1, 2),
+                 "chamfer": (1, 2), "taperball": (0, 1)}
+_SPEC_SIZE = re.compile(r"^((?:builtin|log):[^~]*:)([^:~]+)(~.*)?$")
+
+
+#: Commands whose printed summary (volumes, suggested --place options) follows --units.
+_SUMMARY_IN_UNITS = {"bake", "gcode", "place"}
+
+
+def add_units_option(p: argparse.ArgumentParser, command: str) -> None:
+    """``--units mm|inch`` for ``command``; its help names the options :data:`LENGTH_OPTIONS`
+    converts for that command."""
+    names = [("a block spec's WxDxH" if d == "block" else _option(d))
+             for (c, d) in LENGTH_OPTIONS if c == command]
+    assert names, command  # a contributor's mistake: list the command's lengths first
+    p.add_argument("--units", choices=("mm", "inch"), default="mm",
+                   help=f"unit of {', '.join(names)}"
+                   + (" and of the printed summary" if command in _SUMMARY_IN_UNITS else "")
+                   + "; options "
+                   "named in mm (--texels-per-mm, --size-mm, ...), defaults and the files "
+                   "written stay mm (default mm)")
+
+
+def _num(v: float) -> str:
+    return f"{v:.12g}"
+
+
+def _scaled_numbers(text: str, sep: str, k: float, where=None) -> str:
+    """``text``'s ``sep``-separated numbers times ``k`` (only positions ``where``); a
+    non-number is left as written for the command's own check to name."""
+    parts = text.split(sep)
+    out = []
+    for i, part in enumerate(parts):
+        try:
+            out.append(_num(float(part) * k) if where is None or i in where else part)
+        except ValueError:
+            out.append(part)
+    return sep.join(out)
+
+
+def _value_to_mm(kind: str, value, k: float):
+    if kind == "number":
+        return value * k
+    if kind == "vector":
+        return tuple(v * k for v in value)
+    if kind in ("sizes", "csv"):
+        return _scaled_numbers(str(value).lower() if kind == "sizes" else str(value),
+                               "x" if kind == "sizes" else ",", k)
+    if kind == "spec":
+        m = _SPEC_SIZE.match(str(value))
+        if not m:
+            return value
+        return m.group(1) + _scaled_numbers(m.group(2).lower(), "x", k) + (m.group(3) or "")
+    if kind == "place":
+        return [place_op_in(op, k) for op in value]
+    if kind == "tools":
+        out = []
+        for item in value:
+            num, eq, spec = item.rpartition("=")
+            kind_, colon, nums = spec.partition(":")
+            if not colon:  # no numbers: left for the tool parser to name
+                out.append(item)
+                continue
+            out.append(num + eq + kind_ + ":" + _scaled_numbers(
+                nums, ":", k, _TOOL_LENGTHS.get(kind_.strip().lower(), ())))
+        return out
+    raise ValueError(kind)  # pragma: no cover - LENGTH_OPTIONS holds only the kinds above
+
+
+def place_op_in(op: str, k: float) -> str:
+    """A ``--place`` operation with its lengths (translate:X,Y,Z, fit:MARGIN) times ``k``."""
+    name, _, arg = op.partition(":")
+    if name.lower() == "translate":
+        return f"{name}:{_scaled_numbers(arg, ',', k)}"
+    if name.lower() == "fit" and arg:
+        return f"{name}:{_scaled_numbers(arg, ',', k)}"
+    return op
+
+
+def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> None:
+    """Convert, in place, every length of ``args`` given in ``--units`` to millimetres (what
+    everything below the CLI takes); called by :func:`woodcam.cli.main` before the range checks.
+    Defaults are millimetres already (the help states them in mm) and are left alone: argparse
+    stores a default as the very object of the parser, a typed value as a new one."""
+    units = getattr(args, "units", None)
+    if units in (None, "mm"):
+        return
+    k = MM_PER_UNIT[units]
+    command = getattr(args, "command", None)
+    sub = parser.get_default("_commands").choices[command]
+    for (cmd, dest), kind in LENGTH_OPTIONS.items():
+        value = getattr(args, dest, None)
+        if cmd == command and value is not None and value is not sub.get_default(dest):
+            setattr(args, dest, _value_to_mm(kind, value, k))
 
 
 def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction:
@@ -95,8 +282,7 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                       else "10, or 4 with --quick)"))
     if species:
         p.add_argument("--species", default=None,
-                       help="colour preset (oak, maple, walnut, cherry, pine, spruce); default: "
-                       "the block's")
+                       help=SPECIES_HELP + " (default: the block's)")
     p.add_argument("--appearance", choices=("colormap", "neural"), default="colormap",
                    help="colormap: fast colour-of-ring model (default); neural: colour volumes "
                    "learnt from the block's photos per axis (seed 000 sec. 3.3, cached on disk)")

@@ -10,6 +10,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from .options import SPECIES_HELP, add_out_option, add_units_option
+
 _EPILOG = """\
 veneer sources (any number, mixed):
   --veneer SCAN.png[:DPI]            a scanned veneer at DPI (default 300); SCAN.png:4px/mm for
@@ -43,7 +45,7 @@ def register(subparsers) -> None:
     p.add_argument("--config", type=Path, default=None, metavar="JOB.json",
                    help="a job file in the paper's layout (source_textures, targets, Table 1 keys); "
                    "options given here override it")
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    add_out_option(p, "cut paths (SVG/DXF), panel.png, result.json, panel.glb and job.json")
     v = p.add_argument_group("veneers")
     v.add_argument("--veneer", action="append", default=[], metavar="SCAN[:DPI][:MASK]",
                    help="scanned veneer image (repeatable); resolution in dpi (default 300) or "
@@ -60,9 +62,9 @@ def register(subparsers) -> None:
     v.add_argument("--slice-axis", choices=("x", "y", "z"), default="y",
                    help="normal of the slicing planes in the block frame (default y: leaves "
                    "parallel to the front face)")
+    add_units_option(v, "parquetry")
     v.add_argument("--species", default=None,
-                   help="colour preset for sliced blocks (oak, maple, walnut, cherry, pine, "
-                   "spruce); default: the block's own")
+                   help=SPECIES_HELP + " (default: the block's own)")
     t = p.add_argument_group("parameters (seed 002, Table 1)")
     t.add_argument("--w-intens", type=float, default=None, help="intensity weight of eq. 1, in [0, 1] (default 0.5)")
     t.add_argument("--w-edge", type=float, default=None, help="Sobel edge weight of eq. 1, in [0, 1] (default 0.5)")

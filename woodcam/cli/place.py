@@ -5,7 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .options import BLOCK_SPEC_HELP
+from ..units import MM_PER_UNIT
+from .options import (BLOCK_SPEC_HELP, add_out_option, add_units_option,
+                      place_op_in)
 
 
 def register(subparsers) -> None:
@@ -20,7 +22,7 @@ def register(subparsers) -> None:
         "--place options that reproduce each placement in woodcam bake.")
     p.add_argument("part", help="part file (.py script, .step, .stl, .obj, .glb), block frame, mm")
     p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    add_out_option(p, "placements.png and placements.json")
     p.add_argument("--rotations", choices=("none", "z90", "all90"), default="z90",
                    help="orientations to try: none, quarter turns about z (default), or all 24 "
                    "axis-aligned ones")
@@ -30,6 +32,7 @@ def register(subparsers) -> None:
                    help="distance kept from the block faces (default 1 mm)")
     p.add_argument("--top", type=int, default=3, metavar="K",
                    help="placements shown in the picture and table (default 3)")
+    add_units_option(p, "place")
     p.set_defaults(func=run_place)
 
 
@@ -45,7 +48,8 @@ def run_place(args: argparse.Namespace) -> int:
     stock = open_stock(args.block)
     advice = advise_placement(args.part, stock, rotations=args.rotations,
                               candidates=args.candidates, margin_mm=args.margin)
-    print(advice.table(args.top))
+    k = 1 / MM_PER_UNIT[args.units]
+    print(advice.table(args.top, op_text=str if k == 1 else (lambda op: place_op_in(op, k))))
     record = {"block": args.block, "part": str(args.part), "candidates": advice.candidates,
               "weights": advice.weights, "elongation": advice.elongation,
               "ranked": [{"ops": p.ops, "score": p.score, **p.terms,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .options import BLOCK_SPEC_HELP
+from .options import BLOCK_SPEC_HELP, add_out_option, add_units_option
 
 
 def register(subparsers) -> None:
@@ -20,10 +20,11 @@ def register(subparsers) -> None:
     p.add_argument("part", type=Path, help="baked .glb (from woodcam bake or woodcam gcode)")
     p.add_argument("--block", default=None,
                    help=BLOCK_SPEC_HELP + " (default: the one stored in the GLB)")
-    p.add_argument("--out", type=Path, required=True, help="output .html file")
+    add_out_option(p, "one self-contained page", suffixes=(".html",))
     p.add_argument("--voxels", type=int, default=None, metavar="N",
                    help="voxels of each of the three colour volumes behind the section cap "
                    "(default 400000: ~1 mm voxels on a 100x80x50 mm block, page ~2-3 MB)")
+    add_units_option(p, "review")
     p.set_defaults(func=run_review)
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
+from .options import add_out_option
 
 
 def _size(text: str) -> tuple[float, float, float]:
@@ -33,7 +34,7 @@ def add_from_photos(sub) -> None:
     p.add_argument("photos_dir", type=Path, help="folder with the six face photos")
     p.add_argument("--size-mm", required=True, help="block size WxDxH in mm (width x depth x height), "
                    "or one number for a cube")
-    p.add_argument("--out", type=Path, required=True, help="block folder to write (created)")
+    add_out_option(p, "the block folder: block.json and the face photos")
     p.add_argument("--partial", action="store_true", help="accept fewer than six faces (default: all six)")
     p.add_argument("--max-px-per-mm", type=float, default=None,
                    help="upper image density of the stored faces, px/mm (default 10)")
@@ -64,7 +65,8 @@ def register(subparsers) -> None:
                        "kept and wins over detection next time) and knot masks. BLOCK is a block "
                        "folder or a Mokume sample folder (its U-Net maps are ignored: re-detected).")
     d.add_argument("block", type=Path, help="block folder (block.json) or Mokume sample folder")
-    d.add_argument("--out", type=Path, required=True, help="block folder to write (may be BLOCK itself)")
+    add_out_option(d, "the block folder with ring maps, SVG traces and knot masks (may be "
+                   "BLOCK itself)")
     d.add_argument("--rule", choices=("dark-centre", "sharp-edge"), default="dark-centre",
                    help="ring line on the dark band's centre (default; matches Mokume maps) or on its "
                    "sharp edge (the exact ring boundary of woodcam's synthetic faces)")
@@ -80,7 +82,7 @@ def register(subparsers) -> None:
                        "outlines (yellow) and, for a Mokume folder, the U-Net map's ridge (cyan). A "
                        "Mokume folder is detected first (cached).")
     s.add_argument("block", type=Path, help="block folder (after 'rings detect') or Mokume sample folder")
-    s.add_argument("--out", type=Path, required=True, help="PNG to write")
+    add_out_option(s, "the photos with the rings and knots found", suffixes=(".png",))
     s.add_argument("--zoom", type=int, default=2, help="enlargement: picture pixels per face pixel, a whole number (default 2)")
     s.add_argument("--size-mm", type=float, default=None, help="cube side in mm for a Mokume folder (default 50)")
 

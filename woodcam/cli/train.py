@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .options import add_engine_options, engine_options
+from .options import add_engine_options, add_out_option, engine_options
 
 
 def register(subparsers) -> None:
@@ -15,9 +15,9 @@ def register(subparsers) -> None:
     p.add_argument("what", choices=["gtf", "rings"], help="which model to train")
     p.add_argument("--spec", type=Path, default=None,
                    help="JSON spec of hyper-parameters (default: the built-in defaults)")
-    p.add_argument("--out", type=Path, required=True,
-                   help="folder for the spec, weights and training log (gtf: gtf_spec.json, gtf.pt, "
-                   "gtf_train_log.csv and the checkpoint; rings: rings_spec.json, rings.pt, rings_train_log.csv)")
+    add_out_option(p, "the spec, weights and training log (gtf: gtf_spec.json, gtf.pt, "
+                   "gtf_train_log.csv and the checkpoint; rings: rings_spec.json, rings.pt, "
+                   "rings_train_log.csv)")
     p.add_argument("--steps", type=int, default=None, help="stop after N steps in total (default: spec.steps)")
     p.add_argument("--no-resume", action="store_true", help="start over instead of resuming the checkpoint")
     add_engine_options(p)  # with --engine: the training set is made in shards of 256 fields

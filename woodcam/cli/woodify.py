@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 from ..errors import WoodcamError
+from .options import add_out_option, add_units_option
 
 
 def _vec(text: str, option: str, n: int = 3, positive: bool = False) -> tuple[float, ...]:
@@ -42,7 +43,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                    "(mm); a PLY may paint growth per vertex: properties gain (speed gain) and "
                    "dir_x, dir_y, dir_z (growth direction, length = strength < 1)")
     p.add_argument("--years", type=float, required=True, help="years to grow (> 0)")
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    add_out_option(p, "field.npz, grown.glb, surfaces and section PNGs, woodify.json")
     p.add_argument("--growth", type=float, default=None, metavar="MM",
                    help="how far a flat surface grows in --years (mm); default a quarter of the "
                    "input's largest side")
@@ -74,6 +75,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                    default="stress", help="bark crack pattern (default stress: natural directions)")
     p.add_argument("--crack-region", default=None, metavar="X,Y,Z,R",
                    help="only crack within this sphere (mm)")
+    add_units_option(p, "woodify")
     p.add_argument("--crack-years", type=int, default=5,
                    help="last years simulated for cracks (default 5)")
     p.add_argument("--crack-render", choices=("groove", "material"), default="material",

@@ -1,0 +1,92 @@
+"""The one ``--out`` rule (woodcam.cli.options.OUT_RULE), checked for EVERY command: a path with a
+file suffix is a file, anything else a folder; the wrong kind or suffix is refused before any
+work with one line and exit 2."""
+
+from __future__ import annotations
+
+import argparse
+
+import pytest
+
+from woodcam.cli import EXIT_USAGE, build_parser, main
+from woodcam.cli.options import FILE_SUFFIXES, OUT_RULE, check_out
+from woodcam.errors import UsageError
+
+
+def _commands_with_out():
+    """(command path, parser) for every (sub-)command that has an --out option."""
+    stack = [([], build_parser())]
+    while stack:
+        path, p = stack.pop()
+        for action in p._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                stack += [([*path, name], sp) for name, sp in action.choices.items()
+                          if name not in ("eval-appearance",)]
+            elif "--out" in action.option_strings:
+                yield path, p
+
+
+COMMANDS = sorted(_commands_with_out(), key=lambda c: c[0])
+
+
+def _argv(path, p, out):
+    """A command line for ``path`` with every required argument filled by a dummy value (the
+    --out rule runs before anything reads them)."""
+    argv = list(path)
+    for a in p._actions:
+        if a.option_strings and (not a.required or "--out" in a.option_strings):
+            continue
+        if isinstance(a, (argparse._HelpAction, argparse._SubParsersAction)):
+            continue
+        value = (a.choices[0] if a.choices else "1" if a.type in (int, float)
+                 else "does-not-exist")
+        argv += ([a.option_strings[-1]] if a.option_strings else []) + [str(value)]
+    return argv + ["--out", str(out)]
+
+
+def test_every_command_with_out_declares_its_kind():
+    assert len(COMMANDS) >= 20, [c[0] for c in COMMANDS]
+    for path, p in COMMANDS:
+        suffixes = p.get_default("_out_suffixes")
+        assert suffixes is not None, f"woodcam {' '.join(path)}: --out must use add_out_option"
+        assert set(suffixes) <= FILE_SUFFIXES
+        out = next(a for a in p._actions if "--out" in a.option_strings)
+        assert ("FILE ending in" if suffixes else "FOLDER") in out.help, (path, out.help)
+
+
+@pytest.mark.parametrize("path,p", COMMANDS, ids=[" ".join(c[0]) for c in COMMANDS])
+def test_wrong_kind_is_refused_before_work(path, p, tmp_path, capsys):
+    suffixes = p.get_default("_out_suffixes")
+    wrong = tmp_path / ("a_folder" if suffixes else "result.png")
+    capsys.readouterr()
+    assert main(_argv(path, p, wrong)) == EXIT_USAGE
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"woodcam: error: --out of 'woodcam {' '.join(path)}'"), err
+    assert ("is a FILE" if suffixes else "is a FOLDER") in err[0]
+    assert not wrong.exists() and list(tmp_path.iterdir()) == []  # nothing was done
+    right = tmp_path / ("x" + suffixes[0] if suffixes else "x_folder")
+    check_out(build_parser().parse_args(_argv(path, p, right)))  # the right kind passes
+
+
+def test_file_command_refuses_wrong_suffix_and_existing_folder(tmp_path, capsys):
+    assert main(["bake", "x.py", "--block", "builtin:flat-sawn", "--out",
+                 str(tmp_path / "bowl.obj")]) == EXIT_USAGE
+    assert "must end in .glb" in capsys.readouterr().err
+    folder = tmp_path / "bowl.glb"
+    folder.mkdir()
+    with pytest.raises(UsageError, match="is a FILE ending in .glb; got .*a folder"):
+        check_out(build_parser().parse_args(["bake", "x.py", "--block", "b", "--out", str(folder)]))
+
+
+def test_folder_command_refuses_an_existing_file(tmp_path):
+    f = tmp_path / "place_here"
+    f.write_text("")
+    with pytest.raises(UsageError, match="is a FOLDER .*an existing file"):
+        check_out(build_parser().parse_args(["place", "p.py", "--block", "b", "--out", str(f)]))
+
+
+def test_rule_is_in_the_main_help(capsys):
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert " ".join(OUT_RULE.split()) in text

@@ -1,0 +1,150 @@
+"""``--units inch``: every length of a command line read in inches gives what the same lengths in
+millimetres give (2 in == 50.8 mm); defaults stay mm; summaries print in the unit."""
+
+from __future__ import annotations
+
+import pytest
+
+import woodcam.pipeline
+from woodcam.cli import build_parser, main
+from woodcam.cli.options import LENGTH_OPTIONS, lengths_to_mm, place_op_in
+from woodcam.units import MM_PER_UNIT, fmt_length, fmt_volume
+
+#: The same command line twice: lengths in inches, and the very same lengths in mm.
+PAIRS = {
+    "bake": (["p.py", "--block", "builtin:flat-sawn:4x3x1~z90", "--out", "x.glb", "--tolerance",
+              "0.002", "--place", "rotate:z:90", "--place", "translate:1,-0.5,0", "--place",
+              "fit:0.1"],
+             ["p.py", "--block", "builtin:flat-sawn:101.6x76.2x25.4~z90", "--out", "x.glb",
+              "--tolerance", "0.0508", "--place", "rotate:z:90", "--place",
+              "translate:25.4,-12.7,0", "--place", "fit:2.54"]),
+    "place": (["p.py", "--block", "log:gran1@52:6x2x1.5", "--out", "d", "--margin", "0.125"],
+              ["p.py", "--block", "log:gran1@52:152.4x50.8x38.1", "--out", "d", "--margin",
+               "3.175"]),
+    "preview": (["x.glb", "--block", "builtin:knotty:2x2x2", "--cut-origin", "1,-0.5,0.25"],
+                ["x.glb", "--block", "builtin:knotty:50.8x50.8x50.8", "--cut-origin",
+                 "25.4,-12.7,6.35"]),
+    "review": (["x.glb", "--block", "builtin:rift:2x2x1", "--out", "r.html"],
+               ["x.glb", "--block", "builtin:rift:50.8x50.8x25.4", "--out", "r.html"]),
+    "woodify": (["p.stl", "--years", "5", "--out", "d", "--growth", "0.5", "--block-size",
+                 "4x3x2", "--block-centre=-1,0,0.5", "--crack-region", "0,0,1,0.25"],
+                ["p.stl", "--years", "5", "--out", "d", "--growth", "12.7", "--block-size",
+                 "101.6x76.2x50.8", "--block-centre=-25.4,0,12.7", "--crack-region",
+                 "0,0,25.4,6.35"]),
+    "parquetry": (["eye.png", "--out", "d", "--sheet-size", "24x16", "--leaf-thickness",
+                   "0.025", "--saw-kerf", "0.015", "--tool-diameter", "0.125"],
+                  ["eye.png", "--out", "d", "--sheet-size", "609.6x406.4", "--leaf-thickness",
+                   "0.635", "--saw-kerf", "0.381", "--tool-diameter", "3.175"]),
+    "gcode": (["p.nc", "--block", "builtin:flat-sawn:4x3x1", "--out", "x.glb", "--tool",
+               "2=vbit:60:0.5", "--tool", "bull:0.25:0.05", "--tool", "snub:90:0.5:0.1",
+               "--work-offset", "-1,0,0.5", "--start", "0,0,0.4", "--stock", "2x2x1",
+               "--stock-origin", "0.5,0.5,0", "--resolution", "0.004", "--rapid-rate", "200",
+               "--mesh-tol", "0.001"],
+              ["p.nc", "--block", "builtin:flat-sawn:101.6x76.2x25.4", "--out", "x.glb", "--tool",
+               "2=vbit:60:12.7", "--tool", "bull:6.35:1.27", "--tool", "snub:90:12.7:2.54",
+               "--work-offset", "-25.4,0,12.7", "--start", "0,0,10.16", "--stock",
+               "50.8x50.8x25.4", "--stock-origin", "12.7,12.7,0", "--resolution", "0.1016",
+               "--rapid-rate", "5080", "--mesh-tol", "0.0254"]),
+}
+
+
+def _parsed(command, argv, units):
+    parser = build_parser()
+    args = parser.parse_args([command, *argv, "--units", units])
+    lengths_to_mm(args, parser)
+    return args
+
+
+def _same(a, b):
+    if isinstance(a, (tuple, list)) and a and isinstance(a[0], float):
+        return a == pytest.approx(b, rel=1e-12)
+    if isinstance(a, float):
+        return a == pytest.approx(b, rel=1e-12)
+    return a == b
+
+
+@pytest.mark.parametrize("command", sorted(PAIRS))
+def test_inch_command_line_equals_the_mm_one(command):
+    inch, mm = PAIRS[command]
+    a, b = _parsed(command, inch, "inch"), _parsed(command, mm, "mm")
+    dests = [d for (c, d) in LENGTH_OPTIONS if c == command]
+    assert dests and all(getattr(a, d) is not None for d in dests), "every length is exercised"
+    for dest in dests:
+        assert _same(getattr(a, dest), getattr(b, dest)), (dest, getattr(a, dest), getattr(b, dest))
+
+
+def test_every_length_option_exists_and_its_command_has_units():
+    parser = build_parser()
+    commands = parser.get_default("_commands").choices
+    for command, dest in LENGTH_OPTIONS:
+        dests = {a.dest for a in commands[command]._actions}
+        assert {dest, "units"} <= dests, (command, dest)
+
+
+def test_defaults_stay_millimetres():
+    a = _parsed("gcode", ["p.nc", "--block", "b", "--out", "x.glb"], "inch")
+    assert (a.resolution, a.mesh_tol, a.rapid_rate) == (0.1, 0.05, 5000.0)
+    a = _parsed("place", ["p.py", "--block", "b", "--out", "d"], "inch")
+    assert a.margin == 1.0 and a.block == "b"  # a folder spec has no size to convert
+
+
+def test_place_ops_round_trip_and_printing():
+    k = MM_PER_UNIT["inch"]
+    for op in ("translate:25.4,-12.7,0", "fit:2.54", "rotate:x:90", "scale:2", "center", "drop"):
+        assert place_op_in(place_op_in(op, 1 / k), k) == op
+    assert place_op_in("translate:25.4,-12.7,0", 1 / k) == "translate:1,-0.5,0"
+    assert place_op_in("rotate:z:25.4", 1 / k) == "rotate:z:25.4"  # degrees are no length
+    assert fmt_length(50.8, "inch") == "2 in" and fmt_length(50.8) == "50.8 mm"
+    assert fmt_volume(25.4 ** 3 * 2, "inch") == "2 in^3" and fmt_volume(1234.4) == "1234 mm^3"
+
+
+def test_gcode_in_inches_cuts_what_the_mm_run_cuts(tmp_path, monkeypatch, capsys):
+    """End to end through main(): the simulated stock of the inch command line is the mm one's."""
+    seen = []
+
+    def fake_preview(heightmap, stock, out_glb, **kw):
+        seen.append((heightmap.copy(), tuple(stock.size_mm)))
+        return woodcam.pipeline.PartPreview("x", files={"glb": out_glb}, triangles=1)
+
+    monkeypatch.setattr(woodcam.pipeline, "preview_heightfield", fake_preview)
+    prog = tmp_path / "slot.nc"
+    prog.write_text("G21\nG0 X20 Y40 Z2\nG1 Z-3 F300\nX80\nG0 Z2\n")  # the program itself in mm
+    common = [str(prog), "--out", str(tmp_path / "o.glb")]
+    assert main(["gcode", *common, "--units", "inch", "--block", "builtin:flat-sawn:4x3x1",
+                 "--tool", "flat:0.25", "--resolution", "0.01", "--work-offset", "0,0,1"]) == 0
+    out_inch = capsys.readouterr().out
+    assert main(["gcode", *common, "--block", "builtin:flat-sawn:101.6x76.2x25.4",
+                 "--tool", "flat:6.35", "--resolution", "0.254", "--work-offset", "0,0,25.4"]) == 0
+    out_mm = capsys.readouterr().out
+    (hm_in, size_in), (hm_mm, size_mm) = seen
+    assert size_in == pytest.approx(size_mm) and size_mm == pytest.approx((101.6, 76.2, 25.4))
+    assert hm_in.shape == hm_mm.shape and (hm_in == hm_mm).all()
+    assert (hm_mm < 25.4 - 2.9).any()  # the slot was cut, 3 mm deep
+    removed_mm3 = float(out_mm.split("removed ")[1].split(" mm^3")[0])
+    removed_in3 = float(out_inch.split("removed ")[1].split(" in^3")[0])
+    assert removed_in3 == pytest.approx(removed_mm3 / 25.4 ** 3, rel=1e-3)
+
+
+def test_place_in_inches_ranks_what_the_mm_run_ranks_and_prints_inches(tmp_path, capsys):
+    """End to end: the same placements, their JSON in mm, the printed --place in inches."""
+    import json
+
+    import trimesh
+
+    part = tmp_path / "block.stl"
+    trimesh.creation.box((24.0, 18.0, 10.0)).apply_translation((12, 9, 5)).export(part)
+    common = ["place", str(part), "--candidates", "60", "--top", "2"]
+    assert main([*common, "--units", "inch", "--block", "builtin:knotty:4x3x2", "--margin",
+                 "0.05", "--out", str(tmp_path / "in")]) == 0
+    out_inch = capsys.readouterr().out
+    assert main([*common, "--block", "builtin:knotty:101.6x76.2x50.8", "--margin", "1.27",
+                 "--out", str(tmp_path / "mm")]) == 0
+    out_mm = capsys.readouterr().out
+    rec = {u: json.loads((tmp_path / u / "placements.json").read_text()) for u in ("in", "mm")}
+    assert [r["ops"] for r in rec["in"]["ranked"]] == [r["ops"] for r in rec["mm"]["ranked"]]
+    best = rec["mm"]["ranked"][0]["ops"]
+    move = next(op for op in best if op.startswith("translate:"))
+    mm = [float(v) for v in move.split(":")[1].split(",")]
+    assert f"--place {move}" in out_mm
+    printed = out_inch.split("--place translate:")[1].split()[0]
+    assert [float(v) for v in printed.split(",")] == pytest.approx([v / 25.4 for v in mm])

@@ -1,0 +1,28 @@
+"""Lengths in the user's unit: millimetres inside, ``mm`` or ``inch`` at the door.
+
+Everything below the command line takes and returns millimetres (``docs/conventions.md``);
+``woodcam --units inch`` converts the lengths a user types (``woodcam.cli.options``) and prints
+summaries with :func:`fmt_length` / :func:`fmt_volume`. Files written stay in millimetres.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+Units = Literal["mm", "inch"]
+#: Millimetres per unit (the inch is exactly 25.4 mm since 1959).
+MM_PER_UNIT: dict[str, float] = {"mm": 1.0, "inch": 25.4}
+_SYMBOL = {"mm": "mm", "inch": "in"}
+
+
+def fmt_length(mm: float, units: Units = "mm", digits: int = 3) -> str:
+    """A length given in mm, printed in ``units`` with its symbol:
+    ``fmt_length(50.8, "inch") == "2 in"``."""
+    return f"{mm / MM_PER_UNIT[units]:.{digits}g} {_SYMBOL[units]}"
+
+
+def fmt_volume(mm3: float, units: Units = "mm") -> str:
+    """A volume given in mm^3, printed in ``units``^3: ``"1234 mm^3"`` or ``"0.07531 in^3"``."""
+    if units == "mm":
+        return f"{mm3:.0f} mm^3"
+    return f"{mm3 / MM_PER_UNIT[units] ** 3:.4g} {_SYMBOL[units]}^3"
