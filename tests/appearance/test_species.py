@@ -68,3 +68,14 @@ def test_the_species_help_lists_every_preset():
 
     listed = set(re.findall(r"[a-z]+(?:-[a-z]+)*", SPECIES_HELP.split(":", 1)[1]))
     assert set(SPECIES) <= listed, set(SPECIES) - listed
+
+
+def test_woodcam_species_lists_every_preset_with_its_source(capsys):
+    from woodcam.cli import main
+
+    assert main(["species"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split()[0] for line in lines] == list(SPECIES)
+    walnut = next(line for line in lines if line.startswith("black-walnut "))
+    assert "earlywood #ad7c63 latewood #442112" in walnut  # ISCC-NBS light / dark brown
+    assert "Wood Handbook" in walnut

@@ -1,4 +1,5 @@
-"""``woodcam demo``, ``bake``, ``preview`` and ``blocks``: carve a part, bake its wood, look at it."""
+"""``woodcam demo``, ``bake``, ``preview``, ``blocks`` and ``species``: carve a part, bake its
+wood, look at it."""
 
 from __future__ import annotations
 
@@ -6,14 +7,14 @@ import argparse
 from pathlib import Path
 
 from ..errors import WoodcamError
-from ..units import fmt_volume
+from ..units import fmt_length, fmt_volume
 from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
                       allow_negative_values, stock_options, vector_mm,
                       write_screenshot)
 
 
 def register(subparsers) -> None:
-    """Add ``demo``, ``bake``, ``preview`` and ``blocks``."""
+    """Add ``demo``, ``bake``, ``preview``, ``blocks`` and ``species``."""
     p = subparsers.add_parser("demo", help="carve the example parts out of built-in blocks into --out",
                               description="Carve, bake, export (GLB, OBJ+MTL+PNG) and render the "
                               "example parts of cad_examples/ out of built-in synthetic blocks; "
@@ -83,6 +84,9 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("blocks", help="list the built-in synthetic blocks")
     p.set_defaults(func=run_blocks)
 
+    p = subparsers.add_parser("species", help="list the --species colour presets and their sources")
+    p.set_defaults(func=run_species)
+
 
 def run_demo(args: argparse.Namespace) -> int:
     from ..demo import run_demo as demo
@@ -108,8 +112,9 @@ def run_bake(args: argparse.Namespace) -> int:
     write_screenshot(args, res.files, stock)
     print_warnings(res.warnings)
     tess = res.tessellation
-    mesh_note = (f" (meshed at {tess['tolerance_mm']:.3g} mm / {tess['angular_tolerance_deg']:.3g}"
-                 " deg)" if tess.get("tolerance_mm") and tess.get("triangles") else "")
+    mesh_note = (f" (meshed at {fmt_length(tess['tolerance_mm'], args.units)} / "
+                 f"{tess['angular_tolerance_deg']:.3g} deg)"
+                 if tess.get("tolerance_mm") and tess.get("triangles") else "")
     print(f"{res.name}: {res.triangles} triangles{mesh_note}, "
           f"{fmt_volume(res.volume_mm3, args.units)}, "
           f"{res.atlas}; wrote " + ", ".join(map(str, res.files.values())))
@@ -139,6 +144,16 @@ def run_preview(args: argparse.Namespace) -> int:
                   cut_normal=args.cut_normal)
     if out:
         print(f"wrote {out}")
+    return 0
+
+
+def run_species(args: argparse.Namespace) -> int:
+    from ..appearance import SPECIES
+
+    for name, s in SPECIES.items():
+        early, late = ("#" + "".join(f"{round(255 * v):02x}" for v in rgb)
+                       for rgb in (s.earlywood_rgb, s.latewood_rgb))
+        print(f"{name:<17} earlywood {early} latewood {late}  {s.source}")
     return 0
 
 
