@@ -25,6 +25,7 @@ can double the 3D offset at chart corners. ``A / L * s_max * sqrt(2)`` alone is 
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -370,7 +371,7 @@ def test_wood_without_color_and_bad_color_shape_are_rejected():
 
 def test_rasteriser_paints_exactly_the_bilinear_footprint_of_its_triangles():
     """Unit check of the conservative rasteriser against dense sampling, on compact triangles,
-    big ones and long slivers (both the grouped and the tiled path): every texel that bilinear
+    big ones and long slivers (the row-span walk of every shape): every texel that bilinear
     sampling at a point of a triangle reads is painted, and nothing farther than the footprint
     (L-inf 1 texel + the 0.02 margin) from every triangle is."""
     from scipy.spatial import cKDTree
@@ -378,9 +379,9 @@ def test_rasteriser_paints_exactly_the_bilinear_footprint_of_its_triangles():
     from woodcam.bake import _rasterise
 
     xy = np.array([
-        [2.3, 2.7], [9.1, 3.2], [4.4, 8.9],            # compact (grouped path)
-        [12.2, 3.0], [45.1, 5.5], [12.9, 4.1],         # long sliver (tiled path)
-        [6.0, 14.0], [40.0, 18.0], [20.0, 44.0],       # big triangle (tiled path)
+        [2.3, 2.7], [9.1, 3.2], [4.4, 8.9],            # compact
+        [12.2, 3.0], [45.1, 5.5], [12.9, 4.1],         # long sliver
+        [6.0, 14.0], [40.0, 18.0], [20.0, 44.0],       # big triangle
         [44.5, 30.2], [46.0, 44.7], [44.9, 30.3],      # thin, nearly vertical sliver
     ])
     faces = np.arange(len(xy)).reshape(-1, 3)
@@ -441,7 +442,7 @@ def test_a_native_crash_in_the_unwrap_is_retried_in_pieces(monkeypatch):
     monkeypatch.setattr(_xatlas_worker, "layout",
                         _crashing_layout(_xatlas_worker.layout, lambda p: len(p) == 1))
     with pytest.warns(WoodcamWarning, match="xatlas crashed unwrapping the surface in 1 piece"):
-        result = bake(mesh, SmoothWood(), texels_per_mm=3.0)
+        result = bake(mesh, SmoothWood(), texels_per_mm=3.0, unwrap="xatlas")
     # the two-piece atlas is as exact as a one-piece one
     err, bound, _ = _check_against_wood(result.mesh, result.atlas, mesh, "face",
                                         np.random.default_rng(5), coverage=result.coverage_mask)
@@ -455,14 +456,110 @@ def test_a_unwrap_that_always_crashes_is_one_clear_error(monkeypatch):
     monkeypatch.setattr(_xatlas_worker, "layout",
                         _crashing_layout(_xatlas_worker.layout, lambda p: True))
     with pytest.raises(WoodcamError, match=r"xatlas crashed \(native fault\).*up to 8 pieces"):
-        bake(_box(), SmoothWood(), texels_per_mm=2.0)
+        bake(_box(), SmoothWood(), texels_per_mm=2.0, unwrap="xatlas")
 
 
 def test_the_82k_triangle_icosphere_that_crashed_xatlas_bakes():
     """Regression: xatlas segfaults on this closed sphere in one piece (issue 16)."""
     sphere = trimesh.creation.icosphere(subdivisions=6, radius=40.0)
     with pytest.warns(WoodcamWarning, match="xatlas crashed"):
-        result = bake(sphere, SmoothWood(), texels_per_mm=1.0)
+        result = bake(sphere, SmoothWood(), texels_per_mm=1.0, unwrap="xatlas")
     assert len(result.mesh.faces) == 81920
     assert result.coverage_mask.mean() > 0.5
 
+
+
+def test_the_82k_triangle_icosphere_bakes_with_projected_charts_without_a_crash():
+    """The default unwrap (woodcam's projected charts, xatlas only packs) never reaches the
+    xatlas charting that segfaults on this sphere, and honours the density on every face."""
+    sphere = trimesh.creation.icosphere(subdivisions=6, radius=40.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", WoodcamWarning)  # no crash-and-retry message
+        result = bake(sphere, SmoothWood(), texels_per_mm=4.0)
+    assert len(result.mesh.faces) == 81920
+    assert result.density_stretch > 1.0  # projected charts were used
+    assert result.uv_fill >= 0.5
+    mm_per_texel = _texel_jacobians(result.mesh, result.atlas.shape,
+                                    np.asarray(result.mesh.vertices))
+    assert mm_per_texel.max() <= 1.0 / result.texels_per_mm * (1 + 1e-3)
+
+
+def _helicoid(turns: float, pitch_mm: float = 2.0):
+    """An open helical ramp (r 10..30 mm) whose normals all lie within ~6 degrees of +Z; with
+    more than one turn its projection on the XY plane covers the same ground twice."""
+    n_a, n_r = int(96 * turns), 4
+    a = np.linspace(0.0, 2 * np.pi * turns, n_a + 1)
+    r = np.linspace(10.0, 30.0, n_r + 1)
+    aa, rr = np.meshgrid(a, r, indexing="ij")
+    verts = np.column_stack([rr.ravel() * np.cos(aa.ravel()), rr.ravel() * np.sin(aa.ravel()),
+                             pitch_mm * aa.ravel() / (2 * np.pi)])
+    idx = np.arange(len(verts)).reshape(n_a + 1, n_r + 1)
+    q = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], axis=-1).reshape(-1, 4)
+    faces = np.vstack([q[:, [0, 2, 1]], q[:, [0, 3, 2]]])
+    return trimesh.Trimesh(verts, faces, process=False)
+
+
+@pytest.mark.parametrize("turns, folds", [(0.8, False), (1.5, True)])
+def test_projected_charts_that_fold_over_themselves_are_left_to_xatlas(turns, folds):
+    from woodcam.bake import _projected_charts
+
+    ramp = _helicoid(turns)
+    assert (_projected_charts(ramp) is None) == folds
+    result = bake(ramp, SmoothWood(), texels_per_mm=2.0)
+    assert (result.density_stretch == 1.0) == folds  # xatlas' charts: exact density
+    if not folds:  # (xatlas' own atlas of the folded ramp misses the bound too: not ours)
+        err, bound, _ = _check_against_wood(result.mesh, result.atlas, ramp, "face",
+                                            np.random.default_rng(7),
+                                            coverage=result.coverage_mask)
+        assert err <= bound
+
+
+def test_a_native_crash_while_packing_projected_charts_falls_back_to_xatlas(monkeypatch):
+    import os
+    import signal
+
+    import woodcam._xatlas_worker as _xatlas_worker
+
+    def crash(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGSEGV)
+
+    monkeypatch.setattr(_xatlas_worker, "pack", crash)
+    mesh = _sphere()
+    result = bake(mesh, SmoothWood(), texels_per_mm=4.0)
+    assert result.density_stretch == 1.0
+    err, bound, _ = _check_against_wood(result.mesh, result.atlas, mesh, "face",
+                                        np.random.default_rng(8), coverage=result.coverage_mask)
+    assert err <= bound
+
+
+def test_a_zero_area_face_does_not_break_the_projected_charts():
+    """Regression: a degenerate triangle alone in its chart had no mean normal (NaN uv)."""
+    box = _box()
+    verts = np.vstack([box.vertices, box.vertices[:1] + [0.0, 0.0, 1e-3]])
+    faces = np.vstack([box.faces, [[0, 0, len(box.vertices)]]])
+    mesh = trimesh.Trimesh(verts, faces, process=False)
+    result = bake(mesh, SmoothWood(), texels_per_mm=4.0)
+    assert np.isfinite(np.asarray(result.mesh.visual.uv)).all()
+    keep = np.arange(len(box.faces))
+    err, bound, _ = _check_against_wood(result.mesh.submesh([keep], append=True), result.atlas,
+                                        box, "face", np.random.default_rng(9))
+    assert err <= bound
+
+
+def test_fragmented_projected_charts_of_a_noisy_mesh_fall_back_to_xatlas(monkeypatch):
+    """A scanned-looking sphere (0.3 mm noise on its vertices): its normals jump between cones, the
+    projected charts fragment and pack poorly, so xatlas' charts are made too and kept when
+    fuller; a clean sphere keeps the projected charts."""
+    import woodcam.bake as bake_module
+
+    rng = np.random.default_rng(3)
+    noisy = trimesh.creation.icosphere(subdivisions=4, radius=30.0)
+    noisy.vertices += rng.normal(scale=0.3, size=noisy.vertices.shape)
+    assert bake_module._projected_charts(noisy)[4] > bake_module._MAX_SMALL_CHART_AREA
+    auto = bake(noisy, SmoothWood(), texels_per_mm=4.0)
+    monkeypatch.setattr(bake_module, "_MIN_PROJECTED_FILL", 0.0)  # projected charts only
+    projected = bake(noisy, SmoothWood(), texels_per_mm=4.0)
+    assert projected.density_stretch > 1.0 and projected.uv_fill < 0.4
+    assert auto.density_stretch == 1.0 and auto.uv_fill > projected.uv_fill
+    clean = trimesh.creation.icosphere(subdivisions=4, radius=30.0)
+    assert bake_module._projected_charts(clean)[4] == 0.0

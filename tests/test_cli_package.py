@@ -86,3 +86,51 @@ def test_preview_takes_negative_vectors_and_view_flags():
     with pytest.raises(SystemExit) as exc:
         build_parser().parse_args(["preview", "x.glb", "--cut-normal", "1,nan,0"])
     assert exc.value.code == 2
+
+
+def _commands():
+    """{command: its argparse parser} for every sub-command (nested ones included)."""
+    import argparse
+
+    out, todo = {}, [("", cli.build_parser())]
+    while todo:
+        name, parser = todo.pop()
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                todo += [(f"{name} {sub}".strip(), p) for sub, p in action.choices.items()]
+        out[name] = parser
+    return out
+
+
+def test_one_option_name_means_one_thing_across_commands():
+    """Issue 17: '--resolution is mm in one command and a cell count in another'. Every
+    --resolution is now a cell count (int); gcode's stock grid is --cell-size, a length (the old
+    spelling still parses to it)."""
+    seen = {}
+    for name, parser in _commands().items():
+        for action in parser._actions:
+            if "--resolution" in action.option_strings and action.dest == "resolution":
+                seen[name] = action.type
+    assert seen and set(seen.values()) == {int}, seen
+    gcode = _commands()["gcode"]
+    base = ["p.nc", "--block", "builtin:flat-sawn", "--out", "o.glb"]
+    assert gcode.parse_args([*base, "--resolution", "0.25"]).cell_size == 0.25
+    assert gcode.parse_args([*base, "--cell-size", "0.5"]).cell_size == 0.5
+
+
+def test_preview_screenshot_takes_an_optional_name_like_bake_and_gcode(tmp_path, monkeypatch):
+    """``--screenshot`` alone names the PNG after the input (MESH_view.png), as in bake/gcode."""
+    import woodcam.view as view
+
+    got = []
+    monkeypatch.setattr(view, "preview", lambda mesh, **kw: got.append(kw["screenshot"]))
+    glb = tmp_path / "bowl.glb"
+    glb.write_bytes(b"")
+    monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block: None)
+    assert cli.main(["preview", str(glb), "--screenshot"]) == 0
+    assert cli.main(["preview", str(glb), "--screenshot", str(tmp_path / "x.png")]) == 0
+    assert got == [tmp_path / "bowl_view.png", tmp_path / "x.png"]
+    for name, parser in _commands().items():
+        for action in parser._actions:
+            if "--screenshot" in action.option_strings:
+                assert action.nargs == "?", name

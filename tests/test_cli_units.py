@@ -37,13 +37,15 @@ PAIRS = {
                    "0.635", "--saw-kerf", "0.381", "--tool-diameter", "3.175"]),
     "gcode": (["p.nc", "--block", "builtin:flat-sawn:4x3x1", "--out", "x.glb", "--tool",
                "2=vbit:60:0.5", "--tool", "bull:0.25:0.05", "--tool", "snub:90:0.5:0.1",
+               "--tool", "3=flat:0.25:flute=1:stickout=1.5:holder=1",
                "--work-offset", "-1,0,0.5", "--start", "0,0,0.4", "--stock", "2x2x1",
-               "--stock-origin", "0.5,0.5,0", "--resolution", "0.004", "--rapid-rate", "200",
+               "--stock-origin", "0.5,0.5,0", "--cell-size", "0.004", "--rapid-rate", "200",
                "--mesh-tol", "0.001"],
               ["p.nc", "--block", "builtin:flat-sawn:101.6x76.2x25.4", "--out", "x.glb", "--tool",
                "2=vbit:60:12.7", "--tool", "bull:6.35:1.27", "--tool", "snub:90:12.7:2.54",
+               "--tool", "3=flat:6.35:flute=25.4:stickout=38.1:holder=25.4",
                "--work-offset", "-25.4,0,12.7", "--start", "0,0,10.16", "--stock",
-               "50.8x50.8x25.4", "--stock-origin", "12.7,12.7,0", "--resolution", "0.1016",
+               "50.8x50.8x25.4", "--stock-origin", "12.7,12.7,0", "--cell-size", "0.1016",
                "--rapid-rate", "5080", "--mesh-tol", "0.0254"]),
 }
 
@@ -83,7 +85,7 @@ def test_every_length_option_exists_and_its_command_has_units():
 
 def test_defaults_stay_millimetres():
     a = _parsed("gcode", ["p.nc", "--block", "b", "--out", "x.glb"], "inch")
-    assert (a.resolution, a.mesh_tol, a.rapid_rate) == (0.1, 0.05, 5000.0)
+    assert (a.cell_size, a.mesh_tol, a.rapid_rate) == (0.1, 0.05, 5000.0)
     a = _parsed("place", ["p.py", "--block", "b", "--out", "d"], "inch")
     assert a.margin == 1.0 and a.block == "b"  # a folder spec has no size to convert
 
@@ -111,10 +113,10 @@ def test_gcode_in_inches_cuts_what_the_mm_run_cuts(tmp_path, monkeypatch, capsys
     prog.write_text("G21\nG0 X20 Y40 Z2\nG1 Z-3 F300\nX80\nG0 Z2\n")  # the program itself in mm
     common = [str(prog), "--out", str(tmp_path / "o.glb")]
     assert main(["gcode", *common, "--units", "inch", "--block", "builtin:flat-sawn:4x3x1",
-                 "--tool", "flat:0.25", "--resolution", "0.01", "--work-offset", "0,0,1"]) == 0
+                 "--tool", "flat:0.25", "--cell-size", "0.01", "--work-offset", "0,0,1"]) == 0
     out_inch = capsys.readouterr().out
     assert main(["gcode", *common, "--block", "builtin:flat-sawn:101.6x76.2x25.4",
-                 "--tool", "flat:6.35", "--resolution", "0.254", "--work-offset", "0,0,25.4"]) == 0
+                 "--tool", "flat:6.35", "--cell-size", "0.254", "--work-offset", "0,0,25.4"]) == 0
     out_mm = capsys.readouterr().out
     (hm_in, size_in), (hm_mm, size_mm) = seen
     assert size_in == pytest.approx(size_mm) and size_mm == pytest.approx((101.6, 76.2, 25.4))

@@ -16,7 +16,9 @@ LAYERS: dict[str, int] = {
     # foundations: errors, tolerances, limits, atomic writes, content-keyed caches
     "errors": 0, "tolerances": 0, "_types": 0, "units": 0, "limits": 1, "_atomic": 1, "_cache": 2,
     "_readers": 1,                     # strict JSON of untrusted files (errors only)
+    "_threads": 1,                     # BLAS thread limits for small linear algebra
     "_xatlas_worker": 1,               # xatlas in a worker process (numpy + xatlas only)
+    "_raster": 1,                      # numba rasteriser of the bake (numpy + numba only)
     "frames": 3,                       # block frame, faces, pixel <-> block
     "fields": 4,                       # growth fields behind one protocol
     "block": 5,                        # Block, its faces, readers/writers (stores fields)

@@ -74,6 +74,38 @@ def layout(verts: np.ndarray, faces: np.ndarray, pieces: list[np.ndarray], *,
             int(atlas.height))
 
 
+def pack(uv_mm: np.ndarray, faces: np.ndarray, *, texels_per_mm: float, padding: int):
+    """Pack charts whose parameterisation the caller made (no xatlas charting): ``uv_mm (k, 2)``
+    float32 chart coordinates in mm (one vertex per chart corner; faces of different charts
+    share no vertex) and ``faces (f, 3)`` uint32 into them. xatlas takes every UV island as one
+    chart, rotates and packs it at ``texels_per_mm`` with ``padding`` texels between charts.
+
+    Returns ``vmap (m,)`` (uv vertex of every output vertex), ``out_faces (f, 3)`` in the input
+    face order, ``uv (m, 2)`` normalised by the atlas size, ``width``, ``height``.
+    """
+    import xatlas
+
+    atlas = xatlas.Atlas()
+    atlas.add_uv_mesh(np.ascontiguousarray(uv_mm, dtype=np.float32),
+                      np.ascontiguousarray(faces, dtype=np.uint32))
+    pack_options = xatlas.PackOptions()
+    pack_options.resolution = 0
+    pack_options.texels_per_unit = float(texels_per_mm)
+    pack_options.padding = int(padding)
+    pack_options.bilinear = True
+    atlas.generate(xatlas.ChartOptions(), pack_options)
+    if atlas.atlas_count != 1:
+        raise RuntimeError(f"xatlas made {atlas.atlas_count} atlases; expected 1")
+    vmapping, indices, uv = atlas[0]
+    return (np.asarray(vmapping, dtype=np.int64), np.asarray(indices, dtype=np.int64),
+            np.asarray(uv, dtype=np.float64), int(atlas.width), int(atlas.height))
+
+
+def run_pack(*args, **kwargs):
+    """What the worker runs for :func:`pack` (looked up when called, as :func:`run_layout`)."""
+    return pack(*args, **kwargs)
+
+
 def run_layout(*args, **kwargs):
     """What the worker process runs: :func:`layout`, looked up when called (so a test can put a
     crashing stand-in in its place before the worker is forked)."""

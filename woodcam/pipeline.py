@@ -43,6 +43,12 @@ class PartPreview:
     tessellation: dict = field(default_factory=dict)
     atlas: str = ""
     report: dict = field(default_factory=dict)
+    #: a light textured mesh for screenshots (the height-field preview's coarser grid over the
+    #: same atlas), or None: draw the written GLB
+    view_mesh: object = None
+    #: the height-field preview's top chart of the atlas ((h, w, 3) uint8, row 0 at Y = D):
+    #: the stock seen from +Z (:func:`woodcam.view.topview.top_view`)
+    top_texels: object = None
 
     @contextmanager
     def stage(self, name: str) -> Iterator[None]:
@@ -87,12 +93,12 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
     4 x 4 matrix is recorded in the GLB metadata as ``placement``. A ``.py`` source is trusted
     code run with your rights; ``timeout_s`` bounds its loading."""
     from .cad import carve, load_part
-    from .tolerances import MAX_PART_TRIANGLES, TESSELLATION_TOL_MM
+    from .tolerances import MAX_PART_TRIANGLES
 
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)  # before minutes of work
     result = PartPreview(out_glb.stem)
     with result.stage("load"):
-        part = load_part(source, tolerance_mm=TESSELLATION_TOL_MM if tolerance_mm is None else tolerance_mm,
+        part = load_part(source, tolerance_mm=tolerance_mm, texels_per_mm=texels_per_mm,
                          timeout_s=timeout_s,
                          max_triangles=max_triangles or MAX_PART_TRIANGLES,
                          report=result.tessellation)
@@ -137,10 +143,13 @@ def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: 
 def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                         flat_tol_mm: float = 0.01, obj: bool = True, screenshot: bool = False,
                         metadata: dict | None = None, obj_units: str = "m",
-                        obj_up: str = "y", max_atlas_px: int = 4096) -> PartPreview:
+                        obj_up: str = "y", max_atlas_px: int = 4096,
+                        view_mesh: bool = False) -> PartPreview:
     """:func:`preview_mesh` for a simulated stock ``heightmap : (ny, nx)`` (block-frame Z, mm,
     over the stock's XY): meshed and baked by its own planar charts
-    (:func:`woodcam.bake.bake_heightfield`), no generic unwrap."""
+    (:func:`woodcam.bake.bake_heightfield`), no generic unwrap. ``view_mesh``: also make the
+    light mesh a VTK screenshot draws (``PartPreview.view_mesh``; made anyway for
+    ``screenshot``)."""
     import numpy as np
 
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
@@ -154,9 +163,63 @@ def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: floa
     result.volume_mm3 = float(np.asarray(heightmap, float).sum() * cell)
     result.triangles = int(len(baked.mesh.faces))
     # the height-field bake sets its shading normals from the grid: no crease computation
-    return _write_preview(baked, stock, out_glb, result, obj=obj, screenshot=screenshot,
-                          metadata=metadata, obj_units=obj_units, obj_up=obj_up,
-                          normals="mesh", report_mesh=None)
+    result = _write_preview(baked, stock, out_glb, result, obj=obj, screenshot=False,
+                            metadata=metadata, obj_units=obj_units, obj_up=obj_up,
+                            normals="mesh", report_mesh=None)
+    if view_mesh or screenshot:
+        with result.stage("view mesh"):
+            result.view_mesh = _heightfield_view_mesh(heightmap, stock.size_mm, baked,
+                                                      flat_tol_mm=flat_tol_mm)
+    from .toolpath.mesh import HeightfieldCharts
+
+    x0, y0, w, h, _, _ = HeightfieldCharts(np.zeros((1, 1)), stock.size_mm,
+                                           baked.texels_per_mm).charts["top"]
+    result.top_texels = baked.atlas[y0:y0 + h, x0:x0 + w]
+    if screenshot:
+        from .view import preview
+
+        png = out_glb.with_name(out_glb.stem + "_view.png")
+        with result.stage("render"):
+            preview(result.view_mesh, wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
+        result.files["png"] = png
+    return result
+
+
+#: Longest side, in cells, of the grid a height-field screenshot draws: a 1280-pixel view of
+#: the whole stock shows about this many cells across, so a finer grid only costs render time
+#: (the 20,000-move raster's 1000 x 800 grid: 397,000 triangles -> ~70,000, 2x faster render).
+VIEW_GRID_CELLS = 400
+
+
+def _heightfield_view_mesh(heightmap, size_mm, baked, *, flat_tol_mm: float):
+    """The height field meshed at most :data:`VIEW_GRID_CELLS` cells across (block means),
+    textured by the full-resolution ``baked`` atlas: the charts depend only on the stock size
+    and texel density, so the coarse mesh's texel coordinates point into the same atlas."""
+    import math
+
+    import numpy as np
+    import trimesh
+
+    from .bake import _textured_mesh
+    from .toolpath.mesh import heightfield_mesh_charts
+
+    hm = np.asarray(heightmap, float)
+    k = math.ceil(max(hm.shape) / VIEW_GRID_CELLS)
+    if k <= 1:
+        return baked.mesh
+    ny, nx = (-(-n // k) for n in hm.shape)
+    pad = np.pad(hm, ((0, ny * k - hm.shape[0]), (0, nx * k - hm.shape[1])), mode="edge")
+    coarse = pad.reshape(ny, k, nx, k).mean(axis=(1, 3))
+    mesh, uv_px, charts, vn = heightfield_mesh_charts(coarse, size_mm, baked.texels_per_mm,
+                                                      flat_tol_mm=flat_tol_mm)
+    h, w = baked.atlas.shape[:2]
+    if tuple(charts.size_px) != (w, h):  # pragma: no cover - one layout for one size/density
+        return baked.mesh
+    uv = np.column_stack([uv_px[:, 0] / w, 1.0 - uv_px[:, 1] / h])
+    out = _textured_mesh(trimesh, np.asarray(mesh.vertices), np.asarray(mesh.faces), uv,
+                         baked.atlas)
+    out.vertex_normals = vn
+    return out
 
 
 def bake_heightfield(heightmap, size_mm, wood, *, texels_per_mm: float = 10.0,
@@ -197,7 +260,8 @@ def bake_heightfield(heightmap, size_mm, wood, *, texels_per_mm: float = 10.0,
     mesh, uv_px, charts, vnormals = heightfield_mesh_charts(heightmap, size_mm, tpm,
                                                             flat_tol_mm=flat_tol_mm)
     return bake_charts(mesh, uv_px, charts.size_px, charts.texel_points(), wood,
-                       texels_per_mm=tpm, vertex_normals=vnormals, messages=messages)
+                       texels_per_mm=tpm, vertex_normals=vnormals, messages=messages,
+                       fill_gutters=charts.fill_gutters)
 
 
 def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, obj_units,

@@ -3,11 +3,32 @@
 Kept in one place so a test or a module never invents its own magic number.
 """
 
-#: Chord tolerance (mm) when tessellating B-rep parts. 0.05 mm is below what a 0.1 mm
-#: texel or a CNC finishing pass resolves, and keeps a 70 mm bowl around 10-30k triangles.
+#: Chord tolerance (mm) when tessellating B-rep parts at an explicit 0.1 mm texel. 0.05 mm is
+#: below what a 0.1 mm texel or a CNC finishing pass resolves, and keeps a 70 mm bowl around
+#: 20-30k triangles. By default the tolerance follows the part and the texel instead
+#: (:func:`woodcam.cad.parts.auto_tolerance_mm`).
 TESSELLATION_TOL_MM = 0.05
 
+#: Default chord tolerance as a fraction of the texel (1 / texels_per_mm). OpenCascade meets its
+#: linear deflection at its own sample points only: between them the mesh lies up to 2.1 x
+#: deeper (measured at edge midpoints of spheres, r 5-200 mm), so a quarter texel keeps the
+#: chord error at about half a texel: no texel samples the wood off the part by more than half
+#: its size. (The demo bowl: 0.025 mm, 52k triangles; half a texel gave 32k.)
+TESSELLATION_TEXEL_FRACTION = 0.25
+
+#: Default chord tolerance as a fraction of the part's bounding-box diagonal: a small part is
+#: meshed finer than the texel asks (a 17 mm knob at 0.017 mm), so its silhouette stays within
+#: ~1/500 of its size (with OpenCascade's overshoot: about a pixel of a 500-pixel view).
+TESSELLATION_REL_TOL = 1e-3
+
+#: Smallest default chord tolerance (mm): below the OCCT modelling tolerance (1e-7 m) scale
+#: nothing changes but the triangle count.
+TESSELLATION_MIN_TOL_MM = 0.002
+
 #: Angular tolerance (degrees) for tessellation: curved walls keep at most this normal jump.
+#: Not raised to 10 degrees although that halves the triangles of fillets and small holes (lid
+#: 12.3k -> 3.8k, bowl 31.8k -> 22.5k): a small sphere (r 8-15 mm) then loses 0.5 % of its
+#: volume, beyond CARVE_VOLUME_RTOL; 5 degrees loses 0.13 %.
 TESSELLATION_ANGLE_DEG = 5.0
 
 #: Relative volume error we accept between a carved mesh and an analytic volume. It is set by
@@ -49,6 +70,15 @@ ARC_RADIUS_MISMATCH_MM = 0.01
 #: simulation reports rapids through stock and cuts outside it: the float32 sweep kernel has
 #: ~1e-5 mm round-off at 100 mm, and a CAM clearance plane sits >= 0.5 mm above the stock.
 SIM_CONTACT_TOL_MM = 1e-4
+
+#: Cell size (mm) of the reach check's own replay of a program (flute length, shank and holder
+#: against the stock, :mod:`woodcam.toolpath.reach`): a shank or holder meeting the stock is a
+#: millimetre-scale question, and a coarse grid keeps a 20 mm holder's window at ~80 x 80 cells.
+REACH_GRID_MM = 0.5
+
+#: Stock standing less than this (mm) above a shank or holder is not reported: the coarse
+#: replay samples cell centres, and a CAM post's clearance is >= 0.1 mm.
+REACH_TOL_MM = 0.05
 
 #: Grid step (mm) of a baked growth field. Growth time is smooth (a cone only at the pith), so
 #: a 1 mm grid with cubic splines keeps ring lines within ~0.02 mm of the field it samples for

@@ -5,7 +5,7 @@ degradation (sequential vs interleaved) on one sheet.
 Run as a benchmark (``pytest -m bench tests/bench/test_parquetry_bench.py``) or as a script
 that prints and stores the figures::
 
-    python tests/bench/test_parquetry_bench.py quality|speed|fig14|exhaustive OUT.json [COARSE_FACTOR | IMAGES]
+    python tests/bench/test_parquetry_bench.py quality|speed|fig14|exhaustive|exhaustive4|full OUT.json [COARSE_FACTOR | IMAGES | OUT_DIR]
 
 Timings are CPU seconds of the matching (``time.process_time``), so they are comparable under
 the shared machine's load; wall seconds are stored too.
@@ -59,8 +59,10 @@ def _figures(run, prm):
          "cpu_s_per_patch": run.cpu_seconds / max(1, len(run.patches)),
          "mean_patch_cost_px": float(np.mean([q.cost_px for q in run.patches]))}
     if run.complete:
+        k = round(prm.px_per_mm)
         d.update(feature_cost=feature_cost(p, p.render, prm), feature_cost_baseline=feature_cost(p, p.baseline, prm),
-                 ssim=ssim_vs_matched(p, p.render), ssim_baseline=ssim_vs_matched(p, p.baseline))
+                 ssim=ssim_vs_matched(p, p.render), ssim_baseline=ssim_vs_matched(p, p.baseline),
+                 ssim_1mm=ssim_vs_matched(p, p.render, k), ssim_1mm_baseline=ssim_vs_matched(p, p.baseline, k))
     return d
 
 
@@ -81,7 +83,8 @@ def quality(images=("camera", "astronaut", "coffee", "chelsea"), size_mm=112.0, 
         img = getattr(data, name)().astype(np.float32) / 255
         base = ParquetryParams(image_size_mm=size_mm, px_per_mm=ppm)
         res = {}
-        runs = [("fast", base), ("reuse", dataclasses.replace(base, single_use=False))]
+        runs = [("fast", base), ("fast_eq4_only", dataclasses.replace(base, w_struct=0.0)),
+                ("reuse", dataclasses.replace(base, single_use=False))]
         if name in exhaustive:
             runs.insert(1, ("exhaustive", dataclasses.replace(base, mode="exhaustive")))
         for label, prm in runs:
@@ -92,7 +95,7 @@ def quality(images=("camera", "astronaut", "coffee", "chelsea"), size_mm=112.0, 
     return out
 
 
-def speed(size_mm=70.0, ppm=4.0, sheet=(600, 400), coarse_factor=8, top_k=12):
+def speed(size_mm=70.0, ppm=4.0, sheet=(600, 400), coarse_factor=None, top_k=12):
     """The issue's sheets (four 600 x 400 mm at 4 px/mm, 15 rotations), fast mode, square
     patches (seams are not part of the per-patch matching time). The time per patch depends on
     the wood searched, not on the target's size, so a 70 mm crop of the target (25 patches)
@@ -110,8 +113,8 @@ def speed(size_mm=70.0, ppm=4.0, sheet=(600, 400), coarse_factor=8, top_k=12):
     run = build_parquetry([img], sheets, prm, seams=False, progress=True)
     out = {"workload": f"camera crop at {size_mm:g} mm, 14 mm patches, {len(sheets)} sheets {sheet[0]}x{sheet[1]} mm "
            f"at {ppm:g} px/mm (2 walnut + 2 maple leaves sliced from builtin blocks), 15 rotations, "
-           f"coarse factor {coarse_factor}, top_k {top_k}",
-           "atlas_px": int(run.bank.atlas.blocked.size),
+           f"coarse factor {run.bank.f}, top_k {top_k}",
+           "atlas_px": int(run.bank.atlas.blocked.size), "coarse_factor": run.bank.f,
            "fast": _figures(run, prm), "fast_total_cpu_s": time.process_time() - t}
     print(json.dumps(out), flush=True)
     return out
@@ -162,6 +165,62 @@ def exhaustive_vs_fast(size_mm=70.0, ppm=2.0):
     return out
 
 
+def exhaustive_vs_fast_4ppm(size_mm=70.0, ppm=4.0, factors=(4, 8, 16)):
+    """Fast (several coarse factors) vs exhaustive at the issue's resolution (4 px/mm, 14 mm
+    patches, 15 rotations) on wood the exhaustive atlas can hold on this machine: one
+    300 x 200 mm leaf each of walnut and maple (the issue's four 600 x 400 mm sheets would
+    need ~6 GB for it)."""
+    import dataclasses
+
+    from skimage import data
+
+    from woodcam.parquetry import ParquetryParams, build_parquetry
+
+    sheets = _sheets((300, 200), ppm, leaves=1, mokume=False, n_species=2)
+    img = data.camera()[40:300, 120:380].astype(np.float32) / 255
+    base = ParquetryParams(image_size_mm=size_mm, px_per_mm=ppm)
+    out = {"workload": f"camera crop at {size_mm:g} mm (25 patches of 14 mm), one 300x200 mm leaf "
+           f"each of walnut and maple at {ppm:g} px/mm, 15 rotations, square patches", "runs": {}}
+    runs = [("exhaustive", dataclasses.replace(base, mode="exhaustive"))]
+    runs += [(f"fast_f{f}", dataclasses.replace(base, coarse_factor=f)) for f in factors]
+    for label, prm in runs:
+        run = build_parquetry([img], sheets, prm, seams=False)
+        out["runs"][label] = _figures(run, prm)
+        print(label, json.dumps(out["runs"][label]), flush=True)
+    return out
+
+
+def full_workload(out_dir=None, runs=("fast", "eq4_only", "reuse")):
+    """The issue's workload: ``camera`` at 360 mm (676 patches of 14 mm), one 600 x 400 mm leaf
+    each of walnut, maple, oak and cherry sliced from builtin blocks + the 12 Mokume face
+    photos, 4 px/mm, 15 rotations, seams; the fast run's files are written to ``out_dir``."""
+    import dataclasses
+
+    from skimage import data
+
+    from woodcam.parquetry import ParquetryParams, build_parquetry, write_parquetry
+
+    sheets = _sheets((600, 400), 4.0, leaves=1, mokume=True, n_species=4)
+    img = data.camera().astype(np.float32) / 255
+    base = ParquetryParams()
+    variants = {"fast": base, "eq4_only": dataclasses.replace(base, w_struct=0.0),
+                "reuse": dataclasses.replace(base, single_use=False)}
+    out = {"workload": "camera at 360 mm, 14 mm patches, four 600x400 mm leaves (walnut, maple, "
+           "oak, cherry) + 12 Mokume face photos, 4 px/mm, 15 rotations, seams", "runs": {}}
+    for label in runs:
+        prm = variants[label]
+        t = time.process_time()
+        run = build_parquetry([img], sheets, prm)
+        d = _figures(run, prm)
+        d.update(total_cpu_s=time.process_time() - t, coarse_factor=run.bank.f,
+                 repaired=len(run.repaired))
+        if label == "fast" and out_dir is not None:
+            d["problems_left"] = len(write_parquetry(run, out_dir)["problems"])
+        out["runs"][label] = d
+        print(label, json.dumps(d), flush=True)
+    return out
+
+
 def test_fast_mode_within_5_percent_of_exhaustive_on_camera():
     r = exhaustive_vs_fast()["runs"]
     assert r["fast"]["mean_patch_cost_px"] <= 1.05 * r["exhaustive"]["mean_patch_cost_px"]
@@ -170,11 +229,20 @@ def test_fast_mode_within_5_percent_of_exhaustive_on_camera():
 
 if __name__ == "__main__":
     what, dest = sys.argv[1], Path(sys.argv[2])
-    fn = {"quality": quality, "speed": speed, "fig14": fig14, "exhaustive": exhaustive_vs_fast}[what]
+    fn = {"quality": quality, "speed": speed, "fig14": fig14, "exhaustive": exhaustive_vs_fast,
+          "exhaustive4": exhaustive_vs_fast_4ppm, "full": full_workload}[what]
     extra = {}
     if len(sys.argv) > 3:
         extra = ({"coarse_factor": int(sys.argv[3])} if what == "speed"
+                 else {"out_dir": sys.argv[3]} if what == "full"
                  else {"images": tuple(sys.argv[3].split(","))})
     res = fn(**extra)
     dest.write_text(json.dumps(res, indent=1))
     print(f"wrote {dest}")
+
+
+def test_fast_mode_within_5_percent_of_exhaustive_at_4_px_per_mm():
+    """The issue's resolution; the coarse factor the issue's sheets get automatically (16)."""
+    r = exhaustive_vs_fast_4ppm(factors=(16,))["runs"]
+    assert r["fast_f16"]["mean_patch_cost_px"] <= 1.05 * r["exhaustive"]["mean_patch_cost_px"]
+    assert r["fast_f16"]["cpu_s_per_patch"] < 0.1 * r["exhaustive"]["cpu_s_per_patch"]

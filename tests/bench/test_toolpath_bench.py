@@ -111,9 +111,72 @@ def test_whole_gcode_preview_of_the_raster(tmp_path):
     cpu, rss, out = _cli_run(tmp_path, REPO, "now")
     print(f"\nwoodcam gcode raster (this checkout): {cpu:.1f} CPU-s, peak {rss:.2f} GB; load "
           f"average {os.getloadavg()[0]:.1f}")
+    tcpu, trss, _ = _cli_run(tmp_path, REPO, "top", ("--camera", "top"))
+    print(f"the same with --camera top (numpy view, no VTK): {tcpu:.1f} CPU-s, peak "
+          f"{trss:.2f} GB")
     base = os.environ.get("WOODCAM_BENCH_BASELINE_SRC")
     if base:
         bcpu, brss, _ = _cli_run(tmp_path, Path(base), "base")
         print(f"baseline {base}: {bcpu:.1f} CPU-s, peak {brss:.2f} GB; ratio {bcpu / cpu:.1f}x "
               f"CPU, {brss / rss:.1f}x memory")
     assert rss < 2**30 / 1e9  # 1 GiB
+
+
+def test_interpreter_lines_per_cpu_second_vs_linuxcnc(tmp_path):
+    """Reading speed (source lines per CPU second) of woodcam's interpreter and of LinuxCNC's
+    own (Debian ``linuxcnc-uspace``, its ``gcode`` module with a canon that records moves, as
+    the oracle test runs it) on the same 20,500-line raster, in the same run."""
+    from woodcam.toolpath.interpreter import Interpreter
+    from woodcam.toolpath.linuxcnc import linuxcnc_missing, run_batch
+
+    why = linuxcnc_missing()
+    if why:
+        pytest.skip(why)
+    spec = importlib.util.spec_from_file_location("make_samples",
+                                                  REPO / "toolpaths" / "make_samples.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    text = mod.relief_raster(100.0, 100.0, stepover=0.5, n_seg=100)
+    path = tmp_path / "raster.ngc"
+    path.write_text(text)
+    n = len(text.splitlines())
+    c = time.process_time()
+    moves, _ = Interpreter(text, start_mm=(0.0, 0.0, 10.0)).run()
+    ours = time.process_time() - c
+    res = run_batch([path])[0]
+    assert res["error"] is None and len(res["moves"]) - len(moves) in (0, 1)  # + its start
+    theirs = res["cpu_seconds"]
+    print(f"\ninterpreter on {n} lines: woodcam {n / ours:,.0f} lines/CPU-s, LinuxCNC "
+          f"{n / theirs:,.0f} lines/CPU-s; woodcam/LinuxCNC = {theirs / ours:.2f}x; load "
+          f"{os.getloadavg()[0]:.1f}")
+
+
+def test_relief_job_167x208_end_to_end(tmp_path):
+    """A real-sized job: the 167 x 208 mm relief panel finished by a 70,000-move OpenCAMLib
+    raster (``toolpaths/make_relief_job.py``; generating it takes OpenCAMLib ~2 minutes), read,
+    simulated at 0.1 mm, meshed, baked (the atlas is reduced to fit 4096 px, with a message),
+    exported and drawn from the top, in a fresh process: CPU seconds and peak memory."""
+    import subprocess
+    import sys
+
+    pytest.importorskip("opencamlib", reason="opencamlib (dev extra) is not installed")
+    gen = subprocess.run([sys.executable, str(REPO / "toolpaths" / "make_relief_job.py"),
+                          str(tmp_path)], capture_output=True, text=True,
+                         env={**os.environ, "PYTHONPATH": str(REPO)})
+    assert gen.returncode == 0, gen.stderr[-2000:]
+    code = ("import sys, resource; from woodcam.cli import main; rc = main(sys.argv[1:]); "
+            "r = resource.getrusage(resource.RUSAGE_SELF); "
+            "print('CPU', r.ru_utime + r.ru_stime, 'RSS', r.ru_maxrss); sys.exit(rc)")
+    for camera in ("top", "iso"):
+        run = subprocess.run([sys.executable, "-c", code, "gcode",
+                              str(tmp_path / "relief_panel.ngc"), "--block", "builtin:flat-sawn",
+                              "--stock", "167x208x25", "--tool", "1=ball:3", "--out",
+                              str(tmp_path / f"panel_{camera}.glb"), "--screenshot", "--camera",
+                              camera], capture_output=True, text=True,
+                             env={**os.environ, "PYTHONPATH": str(REPO)})
+        assert run.returncode == 0, run.stderr[-3000:]
+        assert "texels_per_mm lowered from 10 to" in run.stderr  # the atlas fits, and says so
+        line = [ln for ln in run.stdout.splitlines() if ln.startswith("CPU ")][-1].split()
+        moves = [ln for ln in run.stdout.splitlines() if "moves read" in ln][0]
+        print(f"\n--camera {camera}: {moves}\n  {float(line[1]):.1f} CPU-s, peak "
+              f"{float(line[3]) / 1e6:.2f} GB; load {os.getloadavg()[0]:.1f}")

@@ -318,3 +318,61 @@ def test_triangle_budget_remeshes_looser_and_says_so(bd):
     assert "still over" in tight["notes"][0]
     with pytest.raises(WoodcamError, match="max_triangles must be an integer >= 100"):
         load_part(torus, max_triangles=5)
+
+
+def _chord_depth(solid, radius):
+    """Largest depth (mm) of a triangle edge's midpoint below the surface of a sphere of
+    ``radius`` centred at the origin: the mesh's chord error, sampled."""
+    mesh = solid.to_mesh()
+    tri = np.asarray(mesh.vert_properties)[:, :3][np.asarray(mesh.tri_verts)]
+    mids = np.concatenate([(tri[:, i] + tri[:, (i + 1) % 3]) / 2 for i in range(3)])
+    return float((radius - np.linalg.norm(mids, axis=1)).max())
+
+
+def test_default_tolerance_scales_with_part_size_and_texel_size(bd):
+    """Issue 16: the chord tolerance follows the part (0.1 % of its diagonal) and the texel (a
+    quarter of it), and the mesh keeps well under a texel: edge midpoints of a sphere lie within
+    half a texel of its surface (OpenCascade overshoots its nominal deflection up to ~2 x)."""
+    from woodcam.cad.parts import auto_tolerance_mm
+
+    cases = [  # radius mm, texels/mm, expected tolerance
+        (5.0, 10.0, 1e-3 * math.sqrt(3) * 10.0),      # small part: size-bound, 0.017 mm
+        (100.0, 10.0, 0.025),                          # large part: texel-bound
+        (100.0, 2.0, 0.125),                           # coarser texels: looser
+    ]
+    depths = []
+    for radius, tpm, expected in cases:
+        report: dict = {}
+        solid = load_part(bd.Sphere(radius=radius), texels_per_mm=tpm, report=report)
+        assert report["tolerance_mm"] == pytest.approx(expected, rel=1e-6)
+        assert report["tolerance_mm"] == pytest.approx(
+            auto_tolerance_mm(2 * math.sqrt(3) * radius, tpm), rel=1e-6)
+        assert report["tolerance_rule"].startswith("auto: min(")
+        depth = _chord_depth(solid, radius)
+        assert 0 < depth <= 0.55 / tpm  # well under one texel
+        assert depth <= 2.2 * report["tolerance_mm"]
+        depths.append(depth)
+    # on the large sphere the chord, not the 5-degree angle, bounds the facets: 5 x coarser
+    # texels give facets at least 2.5 x deeper
+    assert depths[2] > 2.5 * depths[1]
+    given: dict = {}
+    load_part(bd.Sphere(radius=5.0), tolerance_mm=0.2, report=given)
+    assert given["tolerance_mm"] == 0.2 and given["tolerance_rule"] == "given"
+    with pytest.raises(WoodcamError, match="texels_per_mm must be a finite number > 0"):
+        load_part(bd.Sphere(radius=5.0), texels_per_mm=0)
+
+
+def test_a_large_part_stays_under_the_triangle_budget(bd):
+    """A 200 mm sphere at 10 texels/mm meshes to 40k triangles at the texel-bound 0.025 mm:
+    re-meshed under a 12k budget, and the report says so; at 1 texel/mm (0.25 mm) it fits.
+    (The default budget of 120k triangles is reached by a ~0.6 m sphere: 8 s to mesh.)"""
+    sphere = bd.Sphere(radius=100.0)
+    fine: dict = {}
+    load_part(sphere, max_triangles=12_000, report=fine)
+    assert fine["triangles"] <= 12_000 and fine["max_triangles"] == 12_000
+    assert "exceeded max_triangles=12000; re-meshed to" in fine["notes"][0]
+    assert fine["tolerance_mm"] > 0.025
+    coarse: dict = {}
+    load_part(sphere, texels_per_mm=1.0, max_triangles=12_000, report=coarse)
+    assert coarse["notes"] == [] and coarse["triangles"] <= 12_000
+    assert coarse["tolerance_mm"] == pytest.approx(0.25)

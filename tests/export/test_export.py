@@ -252,3 +252,62 @@ def test_an_exported_part_reloads_as_a_part_in_the_block_frame(baked, tmp_path, 
     np.testing.assert_allclose(lo, [0.0, 0.0, 0.0], atol=1e-3)
     np.testing.assert_allclose(hi, [30.0, 20.0, 16.0], atol=1e-3)
     assert solid.volume() == pytest.approx(baked.mesh.volume, rel=1e-3)
+
+
+def test_glb_and_obj_share_one_png_encoding_of_the_atlas(tmp_path, monkeypatch):
+    """Issue 16: the PNG was encoded twice (GLB, then OBJ) at zlib level 6. Now once: both
+    files hold the same bytes, which decode to the baked atlas."""
+    from PIL import Image
+
+    import woodcam.export as export
+
+    block = trimesh.creation.box((12.0, 10.0, 8.0))
+    block.apply_translation([6.0, 5.0, 4.0])
+    result = bake(block, _Wood(), texels_per_mm=2.5)  # its own atlas: not cached yet
+    encodings = []
+    original = Image.Image.save
+
+    def counting_save(self, fp, format=None, **params):
+        if str(format).upper() == "PNG":
+            encodings.append(params)
+        return original(self, fp, format=format, **params)
+
+    monkeypatch.setattr(Image.Image, "save", counting_save)
+    glb = export_glb(result.mesh, tmp_path / "part.glb")
+    export_obj(result.mesh, tmp_path / "part.obj")
+    assert encodings == [{"compress_level": export._PNG_COMPRESS_LEVEL}]
+    png = (tmp_path / "part_texture.png").read_bytes()
+    assert png in glb.read_bytes()  # the GLB's image buffer is the same PNG
+    np.testing.assert_array_equal(np.asarray(Image.open(tmp_path / "part_texture.png")),
+                                  result.atlas)
+
+
+def test_bulk_obj_text_matches_python_formatting_and_round_trips():
+    """The vectorised OBJ writer prints every number as Python's fixed-point format would
+    (within the last digit's rounding) and every face corner as 1-based ``i/i/i``."""
+    from woodcam.export._obj_text import obj_body
+
+    rng = np.random.default_rng(7)
+    v = rng.normal(size=(500, 3)) * [1.0, 250.0, 1e-3]
+    v[:3] = [[-0.0, 0.0, 4e-10], [123.456789, -0.5, 7.0], [-1e-10, 99999.25, -3.0]]
+    uv, vn = rng.random((500, 2)), rng.normal(size=(500, 3))
+    f = rng.integers(0, 500, size=(800, 3))
+    f[0] = [0, 9, 99]
+    text = obj_body(v, uv, vn, f, decimals=6).decode()
+    lines = text.splitlines()
+    vl = [ln.split()[1:] for ln in lines if ln.startswith("v ")]
+    assert vl[1] == ["123.456789", "-0.500000", "7.000000"]
+    assert vl[0] == ["0.000000", "0.000000", "0.000000"] and vl[2][0] == "0.000000"
+    np.testing.assert_allclose(np.array(vl, float), v, atol=0.51e-6, rtol=0)
+    for want, got in zip(v[3:].ravel(), np.array(vl[3:]).ravel()):
+        py = f"{want:.6f}"
+        assert got == py or abs(float(got) - want) <= 0.51e-6, (got, py)
+    np.testing.assert_allclose(np.array([ln.split()[1:] for ln in lines if ln.startswith("vt ")],
+                                        float), uv, atol=0.51e-9, rtol=0)
+    fl = [ln.split()[1:] for ln in lines if ln.startswith("f ")]
+    assert fl[0] == ["1/1/1", "10/10/10", "100/100/100"]
+    np.testing.assert_array_equal(np.array([[c.split("/") for c in r] for r in fl], int),
+                                  np.repeat(f[:, :, None] + 1, 3, axis=2))
+    assert obj_body(v[:3], None, vn[:3], np.array([[0, 1, 0]])).decode().endswith(
+        "f 1//1 2//2 1//1\n")
+    assert obj_body(v[:3], None, None, np.array([[0, 1, 2]])).decode().endswith("f 1 2 3\n")

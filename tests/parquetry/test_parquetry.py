@@ -330,3 +330,48 @@ def test_adaptive_patches_with_seams_cover_once_and_use_wood_once(tmp_path):
         f = tmp_path / f"veneer_{v.id}.svg"
         if f.exists():
             assert rasterise(read_svg_pieces(f), v.mask.shape, PPM).max() == 1
+
+
+def test_planted_violation_is_repaired_and_files_pass(sheets, tmp_path):
+    """A seam given a sharp zig-zag (bends far tighter than the 1 mm tool radius) is caught by
+    the checker, repaired by straightening, and the written files then pass the checks when
+    parsed back; every panel pixel is still covered exactly once."""
+    from skimage import data
+
+    from woodcam.parquetry.engine import _render_panel, repair_fabricability
+    from woodcam.parquetry.output import run_pieces
+    from woodcam.parquetry.seams import _line_from, labels_from_lines
+
+    target = data.camera()[40:300, 120:380].astype(np.float32) / 255.0
+    prm = ParquetryParams(image_size_mm=42, px_per_mm=PPM)
+    run = build_parquetry(target, sheets, prm, repair=False)
+    p = run.panels[0]
+    assert run.complete and p.seams_v is not None
+    assert all(not pc.problems for pc in run_pieces(run))
+    H = p.matched.shape[0]
+    line = p.seams_v[0]
+    vals = line(np.arange(H) + 0.5)
+    # zig-zag of +-6 px on three of the spline's knots (every 8 px) in the first row of cells
+    y = np.arange(H) + 0.5
+    vals = vals + 6.0 * (np.abs(y - 8) < 2) - 6.0 * (np.abs(y - 16) < 2) + 6.0 * (np.abs(y - 24) < 2)
+    p.seams_v[0] = _line_from(vals, "v", 1, H, line.raw)
+    p.labels = labels_from_lines(p, p.seams_v, p.seams_h)
+    _render_panel(p, run.bank, run.veneers)
+    planted = {pc.id: pc.problems for pc in run_pieces(run) if pc.problems}
+    assert planted and any("concave" in m for v in planted.values() for m in v), planted
+
+    repaired = repair_fabricability(run)
+    assert set(planted) <= set(repaired)
+    res = write_parquetry(run, tmp_path)
+    assert res["problems"] == {}
+    assert json.loads((tmp_path / "result.json").read_text())["fabricability"]["repaired"]
+    checked = 0
+    for v in run.veneers:
+        f = tmp_path / f"veneer_{v.id}.svg"
+        if f.exists():
+            for segs in read_svg_segments(f).values():
+                assert check_piece(segs, prm.min_piece_mm, prm.tool_diameter_mm / 2) == []
+                checked += 1
+    assert checked == len(run.patches)
+    n = rasterise(read_svg_pieces(tmp_path / "assembly.svg"), p.matched.shape, PPM)
+    assert (n == 1).all()

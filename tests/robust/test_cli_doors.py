@@ -13,7 +13,7 @@ BAKE = ["bake", "cad_examples/bowl.py", "--block", "builtin:flat-sawn"]
 
 @pytest.mark.parametrize("argv, match", [
     (["gcode", "toolpaths/vcarve_text.nc", "--tool", "vbit:60:12", "--block", "builtin:flat-sawn",
-      "--out", "OUT/x.glb", "--resolution", "1e-9"], r"--resolution must be in \[0.005, 10\]"),
+      "--out", "OUT/x.glb", "--resolution", "1e-9"], r"--cell-size must be in \[0.005, 10\]"),
     ([*BAKE, "--out", "OUT/x.glb", "--tolerance", "0"], r"--tolerance must be in \(0, 10\]; got 0.0"),
     ([*BAKE, "--out", "OUT/x.glb", "--tolerance", "nan"], r"--tolerance must be a finite number"),
     ([*BAKE, "--out", "OUT/x.glb", "--texels-per-mm", "inf"], r"--texels-per-mm must be a finite"),

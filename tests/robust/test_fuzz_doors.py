@@ -311,7 +311,7 @@ def _glb_case(data):
 
 CLI_CASES = [
     (["bake", "part.py", "--block", "builtin:rift", "--out", "x.glb"], ["--texels-per-mm", "--tolerance", "--timeout"]),
-    (["gcode", "p.nc", "--block", "builtin:rift", "--out", "x.glb"], ["--resolution", "--mesh-tol", "--texels-per-mm"]),
+    (["gcode", "p.nc", "--block", "builtin:rift", "--out", "x.glb"], ["--cell-size", "--mesh-tol", "--texels-per-mm"]),
     (["fit", "blk", "--out", "f.npz"], ["--size-mm"]),
     (["block", "synth", "--out", "o"], ["--count", "--seed", "--face-px"]),
     (["train", "gtf", "--out", "o"], ["--steps"]),

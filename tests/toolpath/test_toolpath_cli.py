@@ -48,7 +48,7 @@ def test_run_simulates_and_hands_a_watertight_mesh_to_the_pipeline(tmp_path, mon
     prog = tmp_path / "slot.nc"
     prog.write_text("G0 X20 Y40 Z2\nG1 Z-3 F300\nX80\nG0 Z2\n")
     args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
-                   "--tool", "flat:6", "--resolution", "0.25"])
+                   "--tool", "flat:6", "--cell-size", "0.25"])
     assert args.func(args) == 0
     W, D, H = seen["stock"].size_mm
     hm = seen["heightmap"]
@@ -84,7 +84,7 @@ def test_gcode_end_to_end_writes_a_baked_glb(tmp_path):
     prog.write_text("G0 X20 Y40 Z2\nG1 Z-3 F300\nX80\nG0 Z2\n")
     out = tmp_path / "slot.glb"
     args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out", str(out), "--tool",
-                   "ball:6", "--resolution", "0.25", "--texels-per-mm", "2", "--no-obj"])
+                   "ball:6", "--cell-size", "0.25", "--texels-per-mm", "2", "--no-obj"])
     assert args.func(args) == 0
     meta = read_glb_metadata(out)
     assert meta["block"] == "builtin:flat-sawn" and meta["tools"] == {"0": "ball:6"}
@@ -106,7 +106,7 @@ def test_programs_in_sequence_until_line_stock_and_strict(tmp_path, monkeypatch,
     finish = tmp_path / "finish.nc"
     finish.write_text("G0 X20 Y30 Z2 M3 S9000\nG1 Z-3 F600\nX40\nG0 Z2\nM2\n")
     base = ["--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"), "--tool", "flat:6",
-            "--resolution", "0.5", "--stock", "60x50x20", "--stock-origin", "-5,-5,0"]
+            "--cell-size", "0.5", "--stock", "60x50x20", "--stock-origin", "-5,-5,0"]
     args = _parse([str(rough), str(finish), *base])
     assert args.func(args) == 0
     hm = seen["heightmap"]
@@ -145,9 +145,9 @@ def test_grid_coarser_than_half_the_stepover_warns(tmp_path, monkeypatch, capsys
     assert read_gcode(prog).stepover_mm(0.1) == pytest.approx(0.5, abs=0.01)
     base = [str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
             "--tool", "1=ball:6", "--strict"]
-    args = _parse([*base, "--resolution", "0.4"])
+    args = _parse([*base, "--cell-size", "0.4"])
     assert args.func(args) == 3
     assert "coarser than half the step-over (0.5 mm)" in capsys.readouterr().err
-    args = _parse([*base, "--resolution", "0.2"])
+    args = _parse([*base, "--cell-size", "0.2"])
     args.func(args)
     assert "step-over" not in capsys.readouterr().err

@@ -116,7 +116,8 @@ def test_new_profiles_specs_and_tables(tmp_path):
                  ' "diameter": 10, "length": 5}, "3": {"shape": "snubnose", "diameter": 6, '
                  '"snub_diameter": 2, "length": 2}, "4": {"shape": "ballnose", "diameter": 3}}}')
     tools = load_tool_table(j)
-    assert tools[1] == FlatEndMill(6.35) and tools[4] == BallEndMill(3)
+    # a cylindrical tool's length is its cutting (flute) length: 1 inch
+    assert tools[1] == FlatEndMill(6.35, flute_length_mm=25.4) and tools[4] == BallEndMill(3)
     assert tools[2] == VBit(10, angle_deg=90)
     assert tools[3] == SnubNoseVBit(6, angle_deg=90, tip_diameter_mm=2)
     j.write_text('{"tools": {"1": {"shape": "spheroid", "diameter": 3}}}')

@@ -6,6 +6,6 @@ intersects it with the block ``[0, W] x [0, D] x [0, H]``.
 """
 
 from .carve import CarveResult, carve
-from .parts import SUPPORTED_SUFFIXES, load_part
+from .parts import SUPPORTED_SUFFIXES, auto_tolerance_mm, load_part
 
-__all__ = ["CarveResult", "SUPPORTED_SUFFIXES", "carve", "load_part"]
+__all__ = ["CarveResult", "SUPPORTED_SUFFIXES", "auto_tolerance_mm", "carve", "load_part"]

@@ -20,7 +20,7 @@ import numpy as np
 from .._types import ArrayLike
 from ..errors import WoodcamError, WoodcamWarning
 from ..frames import check_size
-from ..tolerances import OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG, TESSELLATION_TOL_MM
+from ..tolerances import OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG
 from .parts import load_part
 
 
@@ -62,7 +62,7 @@ def carve(
     part: Any,
     size_mm: ArrayLike,
     *,
-    tolerance_mm: float = TESSELLATION_TOL_MM,
+    tolerance_mm: float | None = None,
     angular_tolerance_deg: float = TESSELLATION_ANGLE_DEG,
 ) -> CarveResult:
     """Carve ``part`` out of the block ``[0, W] x [0, D] x [0, H]`` (block frame, mm).
@@ -74,7 +74,7 @@ def carve(
         using the tolerances below.
     size_mm : (3,) sequence of float
         Block size ``(W, D, H)`` in mm, each finite and > 0.
-    tolerance_mm, angular_tolerance_deg : float
+    tolerance_mm, angular_tolerance_deg : float (tolerance_mm None: scaled to the part)
         Tessellation tolerances passed to :func:`load_part` for B-rep sources.
 
     Returns

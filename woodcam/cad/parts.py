@@ -38,7 +38,18 @@ from typing import Any
 import numpy as np
 
 from ..errors import WoodcamError, require
-from ..tolerances import MAX_PART_TRIANGLES, TESSELLATION_ANGLE_DEG, TESSELLATION_TOL_MM
+from ..tolerances import (
+    MAX_PART_TRIANGLES,
+    TESSELLATION_ANGLE_DEG,
+    TESSELLATION_MIN_TOL_MM,
+    TESSELLATION_REL_TOL,
+    TESSELLATION_TEXEL_FRACTION,
+    TESSELLATION_TOL_MM,
+)
+
+#: Texel density (texels per mm) the default tessellation assumes when load_part is not told
+#: the bake's: woodcam bake's default.
+_DEFAULT_TEXELS_PER_MM = 10.0
 
 #: Re-meshing rounds of the triangle budget, and the loosest angular tolerance it goes to
 #: (below the 30 degree crease angle of the exported normals, so curved faces stay smooth).
@@ -52,14 +63,26 @@ SCRIPT_SUFFIXES = (".py",)
 SUPPORTED_SUFFIXES = STEP_SUFFIXES + MESH_SUFFIXES + SCRIPT_SUFFIXES
 
 
+def auto_tolerance_mm(diagonal_mm: float, texels_per_mm: float = _DEFAULT_TEXELS_PER_MM) -> float:
+    """Default chord tolerance (mm) for a part whose bounding-box diagonal is ``diagonal_mm``,
+    baked at ``texels_per_mm``: ``min(TESSELLATION_TEXEL_FRACTION / texels_per_mm,
+    TESSELLATION_REL_TOL * diagonal_mm)``, at least ``TESSELLATION_MIN_TOL_MM``: well under a
+    texel, and finer still on small parts (reasons in :mod:`woodcam.tolerances`). The 113 mm
+    demo bowl at 10 texels/mm: 0.025 mm; a 17 mm knob: 0.017 mm; a 2 m table top at 2
+    texels/mm: 0.125 mm."""
+    texel_limit = TESSELLATION_TEXEL_FRACTION / float(texels_per_mm)
+    return max(TESSELLATION_MIN_TOL_MM, min(texel_limit, TESSELLATION_REL_TOL * float(diagonal_mm)))
+
+
 def load_part(
     source: Any,
     *,
-    tolerance_mm: float = TESSELLATION_TOL_MM,
+    tolerance_mm: float | None = None,
     angular_tolerance_deg: float = TESSELLATION_ANGLE_DEG,
     timeout_s: float | None = None,
     max_triangles: int | None = MAX_PART_TRIANGLES,
     report: dict | None = None,
+    texels_per_mm: float = _DEFAULT_TEXELS_PER_MM,
 ) -> Any:
     """Turn a part source into one watertight manifold in the block frame (mm).
 
@@ -75,9 +98,10 @@ def load_part(
         (run with ``runpy`` under the name ``"__woodcam_part__"``, so its
         ``if __name__ == "__main__":`` block does not run; its folder is on ``sys.path``
         meanwhile so it can import helpers next to it).
-    tolerance_mm : float
+    tolerance_mm : float or None
         Chord tolerance (mm, > 0) for tessellating B-rep sources: the largest distance between
-        the true surface and its triangles. Ignored for mesh sources.
+        the true surface and its triangles. None (default): :func:`auto_tolerance_mm` of each
+        B-rep's bounding-box diagonal and ``texels_per_mm``. Ignored for mesh sources.
     angular_tolerance_deg : float
         Angular tolerance (degrees, in (0, 90]) for tessellating B-rep sources: the largest
         normal jump between neighbouring triangles on a curved face. Ignored for meshes.
@@ -90,7 +114,11 @@ def load_part(
         above it the part is re-meshed with looser tolerances (stated in ``report["notes"]``);
         None meshes at the given tolerances whatever the count.
     report : dict or None
-        Filled with the tolerances used, the triangle count and notes about re-meshing.
+        Filled with the tolerances used (``tolerance_mm``, ``angular_tolerance_deg``, and
+        ``tolerance_rule``: how the chord tolerance was chosen), the triangle count, the
+        budget and notes about re-meshing.
+    texels_per_mm : float
+        Texel density of the bake the part is meant for (> 0); sets the default tolerance.
 
     Returns
     -------
@@ -104,11 +132,16 @@ def load_part(
         or does not define ``part``, empty geometry, or a mesh that is not a closed solid even
         after repair (hole filling, normal fixing).
     """
-    if not (isinstance(tolerance_mm, Real) and math.isfinite(tolerance_mm) and tolerance_mm > 0):
+    if tolerance_mm is not None and not (isinstance(tolerance_mm, Real)
+                                         and math.isfinite(tolerance_mm) and tolerance_mm > 0):
         raise WoodcamError(
-            f"tolerance_mm must be a finite number > 0 (chord tolerance in mm), got "
-            f"{tolerance_mm!r}; use e.g. {TESSELLATION_TOL_MM}"
+            f"tolerance_mm must be a finite number > 0 (chord tolerance in mm) or None (scaled "
+            f"to the part and the texel), got {tolerance_mm!r}; use e.g. {TESSELLATION_TOL_MM}"
         )
+    if not (isinstance(texels_per_mm, Real) and math.isfinite(texels_per_mm)
+            and texels_per_mm > 0):
+        raise WoodcamError(f"texels_per_mm must be a finite number > 0 (the bake's texel "
+                           f"density), got {texels_per_mm!r}; use e.g. 10")
     if not (isinstance(angular_tolerance_deg, Real) and 0 < angular_tolerance_deg <= 90):
         raise WoodcamError(
             f"angular_tolerance_deg must be in (0, 90] degrees, got {angular_tolerance_deg!r}; "
@@ -118,8 +151,9 @@ def load_part(
                                       and timeout_s > 0):
         raise WoodcamError(f"timeout_s must be a finite number of seconds > 0 or None; got "
                            f"{timeout_s!r}")
-    tess = _Tessellation(float(tolerance_mm), math.radians(angular_tolerance_deg),
-                         _check_budget(max_triangles))
+    tess = _Tessellation(None if tolerance_mm is None else float(tolerance_mm),
+                         math.radians(angular_tolerance_deg), _check_budget(max_triangles),
+                         texels_per_mm=float(texels_per_mm))
     with _time_limit(timeout_s, source):
         solid = _load(source, tess, origin="part")
     if report is not None:
@@ -537,33 +571,51 @@ class _Tessellation:
     falls with the square of the triangle count along a curve, so loosening by the ratio lands
     near the budget) and says so in :meth:`report`."""
 
-    tol_mm: float
+    tol_mm: float | None  # None: auto_tolerance_mm of each B-rep
     ang_rad: float
     max_triangles: int | None
+    texels_per_mm: float = _DEFAULT_TEXELS_PER_MM
     triangles: int = 0
     tries: int = 0
     notes: list = field(default_factory=list)
+    used_tol_mm: float = 0.0
+    used_ang_rad: float = 0.0
+    rule: str = ""
 
     def mesh_solids(self, solids, origin: str):
+        if self.tol_mm is None:
+            diagonal = _diagonal_mm(solids)
+            tol_mm = auto_tolerance_mm(diagonal, self.texels_per_mm)
+            self.rule = (f"auto: min({TESSELLATION_TEXEL_FRACTION:g} texel = "
+                         f"{TESSELLATION_TEXEL_FRACTION / self.texels_per_mm:.3g} mm, "
+                         f"{TESSELLATION_REL_TOL:g} x the {diagonal:.4g} mm diagonal = "
+                         f"{TESSELLATION_REL_TOL * diagonal:.3g} mm)")
+        else:
+            tol_mm = self.tol_mm
+            self.rule = "given"
+        ang_rad = self.ang_rad
         first = None
+        tries = 0
         for _ in range(_BUDGET_TRIES + 1):
+            tries += 1
             self.tries += 1
-            meshes = [_tessellate_solid(solid, self.tol_mm, self.ang_rad) for solid in solids]
+            meshes = [_tessellate_solid(solid, tol_mm, ang_rad) for solid in solids]
             for _vertices, faces in meshes:
                 if len(faces) == 0:
                     raise WoodcamError(f"{origin} has a solid that tessellates to no triangles")
             count = sum(len(f) for _v, f in meshes)
-            first = first or (count, self.tol_mm, math.degrees(self.ang_rad))
-            if self.max_triangles is None or count <= self.max_triangles or self.tries > _BUDGET_TRIES:
+            first = first or (count, tol_mm, math.degrees(ang_rad))
+            if self.max_triangles is None or count <= self.max_triangles or tries > _BUDGET_TRIES:
                 break
             ratio = count / self.max_triangles
-            self.tol_mm *= ratio
-            self.ang_rad = min(math.radians(_MAX_BUDGET_ANGLE_DEG), self.ang_rad * math.sqrt(ratio))
-        if self.tries > 1:
+            tol_mm *= ratio
+            ang_rad = min(math.radians(_MAX_BUDGET_ANGLE_DEG), ang_rad * math.sqrt(ratio))
+        self.used_tol_mm, self.used_ang_rad = tol_mm, ang_rad
+        if tries > 1:
             self.notes.append(
                 f"{origin}: {first[0]} triangles at {first[1]:.3g} mm / {first[2]:.3g} deg "
                 f"exceeded max_triangles={self.max_triangles}; re-meshed to {count} triangles at "
-                f"{self.tol_mm:.3g} mm / {math.degrees(self.ang_rad):.3g} deg"
+                f"{tol_mm:.3g} mm / {math.degrees(ang_rad):.3g} deg"
                 + ("" if count <= self.max_triangles else
                    " (still over: the angular tolerance stops at "
                    f"{_MAX_BUDGET_ANGLE_DEG:g} deg; raise --max-triangles or simplify the part)"))
@@ -571,9 +623,27 @@ class _Tessellation:
         return meshes
 
     def report(self) -> dict:
-        return {"tolerance_mm": self.tol_mm, "angular_tolerance_deg": math.degrees(self.ang_rad),
+        meshed = self.triangles > 0
+        return {"tolerance_mm": self.used_tol_mm if meshed else self.tol_mm,
+                "angular_tolerance_deg": math.degrees(self.used_ang_rad if meshed
+                                                      else self.ang_rad),
+                "tolerance_rule": self.rule, "texels_per_mm": self.texels_per_mm,
                 "triangles": self.triangles, "max_triangles": self.max_triangles,
                 "notes": list(self.notes)}
+
+
+def _diagonal_mm(solids) -> float:
+    """Bounding-box diagonal (mm) of OpenCascade solids (exact box, not the control points)."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    box = Bnd_Box()
+    for solid in solids:
+        BRepBndLib.AddOptimal_s(solid, box, False, False)
+    if box.IsVoid():
+        return 0.0
+    x0, y0, z0, x1, y1, z1 = box.Get()
+    return math.sqrt((x1 - x0) ** 2 + (y1 - y0) ** 2 + (z1 - z0) ** 2)
 
 
 def _check_budget(max_triangles):

@@ -9,7 +9,7 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
 from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
-                      allow_negative_values, stock_options, vector_mm,
+                      allow_negative_values, stock_options, vector_type,
                       write_screenshot)
 
 
@@ -38,7 +38,9 @@ def register(subparsers) -> None:
                    "part report PART_report.txt/.json and, with --screenshot, PART_view.png",
                    suffixes=(".glb",))
     p.add_argument("--tolerance", type=float, default=None, metavar="MM",
-                   help="tessellation chord tolerance for B-rep parts (default 0.05 mm)")
+                   help="tessellation chord tolerance for B-rep parts, mm (default: scaled to "
+                   "the part and the texel, min(a quarter texel, 0.1 %% of the part's bounding-box "
+                   "diagonal): 0.025 mm for the demo bowl at 10 texels/mm)")
     p.add_argument("--timeout", type=float, default=None, metavar="S",
                    help="stop loading the part (running a trusted .py script, tessellating) "
                    "after S seconds (default: no limit)")
@@ -60,17 +62,19 @@ def register(subparsers) -> None:
                               "widget that shows the wood inside the block; --screenshot renders "
                               "off-screen.")
     p.add_argument("mesh", type=Path, help="baked .glb (or .obj)")
-    p.add_argument("--screenshot", type=Path, default=None, metavar="PNG",
-                   help="render to this PNG instead of opening a window")
+    # the same [PNG] form as bake's and gcode's --screenshot (issue 17)
+    p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
+                   help="render off-screen to this PNG instead of opening a window (default "
+                   "name: MESH with _view.png)")
     p.add_argument("--block", default=None,
                    help="block spec for the cut plane (default: the one stored in the GLB)")
     p.add_argument("--camera", choices=("iso", "front", "back", "left", "right", "top", "bottom"),
                    default="iso", help="view direction (default iso: from front-right-above)")
     p.add_argument("--no-cut", action="store_true",
                    help="no cut plane: the part alone in its translucent block")
-    p.add_argument("--cut-origin", type=vector_mm, default=None, metavar="X,Y,Z",
+    p.add_argument("--cut-origin", type=vector_type("--cut-origin"), default=None, metavar="X,Y,Z",
                    help="a point of the cut plane, block frame mm (default the block centre)")
-    p.add_argument("--cut-normal", type=vector_mm, default=None, metavar="X,Y,Z",
+    p.add_argument("--cut-normal", type=vector_type("--cut-normal"), default=None, metavar="X,Y,Z",
                    help="the cut plane's normal, towards the side cut away (default: the block's "
                    "longest axis facing the camera)")
     allow_negative_values(p)
@@ -112,9 +116,16 @@ def run_bake(args: argparse.Namespace) -> int:
     write_screenshot(args, res.files, stock)
     print_warnings(res.warnings)
     tess = res.tessellation
-    mesh_note = (f" (meshed at {fmt_length(tess['tolerance_mm'], args.units)} / "
-                 f"{tess['angular_tolerance_deg']:.3g} deg)"
-                 if tess.get("tolerance_mm") and tess.get("triangles") else "")
+    mesh_note = ""
+    if tess.get("tolerance_mm") and tess.get("triangles"):
+        from ..tolerances import TESSELLATION_REL_TOL, TESSELLATION_TEXEL_FRACTION
+
+        auto = str(tess.get("tolerance_rule", "")).startswith("auto")
+        mesh_note = (f" (meshed at {fmt_length(tess['tolerance_mm'], args.units)} / "
+                     f"{tess['angular_tolerance_deg']:.3g} deg"
+                     + (f", scaled: min({TESSELLATION_TEXEL_FRACTION:g} texel, "
+                        f"{100 * TESSELLATION_REL_TOL:g} % of the part's diagonal)" if auto else "")
+                     + f"; budget {tess.get('max_triangles')} triangles)")
     print(f"{res.name}: {res.triangles} triangles{mesh_note}, "
           f"{fmt_volume(res.volume_mm3, args.units)}, "
           f"{res.atlas}; wrote " + ", ".join(map(str, res.files.values())))
@@ -138,8 +149,12 @@ def run_preview(args: argparse.Namespace) -> int:
             raise WoodcamError("--confidence needs a block whose field was fitted (a block folder "
                                "without a true field, or a Mokume folder); pass --block")
         wood = ConfidenceWood(stock.wood.field)
+    shot = args.screenshot
+    if shot is True:
+        shot = args.mesh.with_name(args.mesh.stem + "_view.png")
     out = preview(args.mesh, wood=wood,
-                  size_mm=stock.size_mm if stock else None, screenshot=args.screenshot,
+                  size_mm=stock.size_mm if stock else None,
+                  screenshot=None if shot is None else Path(shot),
                   camera=args.camera, cut_plane=not args.no_cut, cut_origin=args.cut_origin,
                   cut_normal=args.cut_normal)
     if out:

@@ -14,7 +14,7 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import fmt_volume
 from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
-                      allow_negative_values, stock_options)
+                      allow_negative_values, stock_options, vector_type)
 
 _EXAMPLES = """\
 examples:
@@ -48,16 +48,21 @@ def register(subparsers) -> None:
     p.add_argument("--tool", action="append", default=[], metavar="[N=]SPEC",
                    help="a tool, e.g. flat:6.35, ball:3, bull:6:1, vbit:60:12, 2=ball:3 "
                    "(repeatable; without N= the tools go to the program's tool numbers in "
-                   "order of first use)")
+                   "order of first use); the reach for the flute/shank/holder checks as "
+                   "flat:6:flute=22:shank=6:stickout=30:holder=35 (lengths in --units, "
+                   "default mm)")
     p.add_argument("--tools", type=Path, default=None, metavar="TOML",
                    help="tool table file: TOML ([tools.N] type/diameter_mm/...) or a CAMotics "
                    "JSON tool table (.json)")
-    p.add_argument("--resolution", type=float, default=0.1, metavar="MM",
-                   help="height-field cell size (default 0.1 mm)")
-    p.add_argument("--work-offset", default=None, metavar="X,Y,Z", type=_triple("--work-offset"),
+    # --cell-size, not --resolution: elsewhere --resolution is a cell COUNT (issue 17); the old
+    # spelling still parses
+    p.add_argument("--cell-size", "--resolution", dest="cell_size", type=float, default=0.1,
+                   metavar="LEN", help="height-field cell size, a length in --units (default "
+                   "0.1 mm; the old spelling --resolution still works)")
+    p.add_argument("--work-offset", default=None, metavar="X,Y,Z", type=vector_type("--work-offset"),
                    help="block-frame position of G-code zero in mm (default 0,0,H: "
                    "top-front-left); negative values as --work-offset -14,5,3")
-    p.add_argument("--start", default=None, metavar="X,Y,Z", type=_triple("--start"),
+    p.add_argument("--start", default=None, metavar="X,Y,Z", type=vector_type("--start"),
                    help="machine position (G-code frame, mm) before the first move, also the "
                    "G28/G30 home (default 0,0,10: 10 mm over the work zero)")
     p.add_argument("--dialect", choices=("linuxcnc", "grbl", "fanuc"), default="linuxcnc",
@@ -70,7 +75,7 @@ def register(subparsers) -> None:
                    help="stock size in mm cut from the block's wood (default: the block's "
                    "own size), e.g. 167x208x25")
     p.add_argument("--stock-origin", default=None, metavar="X,Y,Z",
-                   type=_triple("--stock-origin"),
+                   type=vector_type("--stock-origin"),
                    help="block-frame position (mm) of the --stock's corner in the block's wood "
                    "(default 0,0,0)")
     p.add_argument("--until-line", type=int, default=None, metavar="N",
@@ -80,7 +85,11 @@ def register(subparsers) -> None:
                    "mm/min)")
     p.add_argument("--camera", choices=("iso", "top", "front", "back", "left", "right"),
                    default="iso", help="screenshot view (default iso with a cut plane; top "
-                   "shows a relief without a cut)")
+                   "shows a relief without a cut, drawn from the baked texture without VTK)")
+    p.add_argument("--view", action="store_true",
+                   help="after writing the files, open a window (needs a display) with the "
+                   "stock, the toolpath and a slider that scrubs the simulation to any line "
+                   "of the (last) program")
     p.add_argument("--no-overlay", action="store_true",
                    help="leave the toolpath (rapids red, feeds blue) out of the screenshot")
     p.add_argument("--part", default=None, metavar="PART",
@@ -111,27 +120,13 @@ def _size(text: str) -> tuple[float, float, float]:
     return vals
 
 
-def _triple(option: str):
-    """argparse type: ``"X,Y,Z"`` -> three finite floats (mm), or a one-line error."""
-    def parse(text: str) -> tuple[float, float, float]:
-        try:
-            vals = tuple(float(v) for v in text.split(","))
-        except ValueError:
-            vals = ()
-        if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
-            raise argparse.ArgumentTypeError(f"{option} {text!r}: give three finite numbers "
-                                             "X,Y,Z in mm, e.g. 0,0,50")
-        return vals
-    return parse
-
-
 def _tools_from_args(args, program) -> dict:
     from ..toolpath.tools import load_tool_table, parse_tool_spec
 
     tools = dict(load_tool_table(args.tools)) if args.tools else {}
     unnumbered = []
     for item in args.tool:
-        if "=" in item:
+        if "=" in item.split(":", 1)[0]:  # N=SPEC (a spec's own key=value parts follow ':')
             num, spec = item.split("=", 1)
             try:
                 tools[int(num)] = parse_tool_spec(spec)
@@ -172,6 +167,10 @@ def run(args) -> int:
         raise WoodcamError(f"--rapid-rate {args.rapid_rate}: give a rate > 0 in mm/min, e.g. "
                            "5000")
     check_outputs(args.out, obj=not args.no_obj, screenshot=args.screenshot or False)
+    if args.view:
+        from ..view.scrub import check_display
+
+        check_display()
     stock = open_stock(args.block, **stock_options(args))
     if args.stock or args.stock_origin:
         stock = resize_stock(stock, args.stock or stock.size_mm, args.stock_origin or (0, 0, 0))
@@ -179,7 +178,9 @@ def run(args) -> int:
     n_warn = 0
     hm = None
     meta_programs, last = [], None
+    hm_before = None  # the stock the last program starts from (the window's slider)
     for k, path in enumerate(args.program):
+        hm_before = hm
         t0 = time.perf_counter()
         program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
                              interpreter=args.interpreter)
@@ -194,13 +195,13 @@ def run(args) -> int:
                                "drilling cycle); nothing to simulate. Check that it is the "
                                "program you meant")
         tools = _tools_from_args(args, program)
-        step = program.stepover_mm(spacing_mm=args.resolution)
-        if step is not None and args.resolution > step / 2:
-            print(f"woodcam: warning: {path.name}: the grid ({args.resolution:g} mm) is coarser "
+        step = program.stepover_mm(spacing_mm=args.cell_size)
+        if step is not None and args.cell_size > step / 2:
+            print(f"woodcam: warning: {path.name}: the grid ({args.cell_size:g} mm) is coarser "
                   f"than half the step-over ({step:.3g} mm): expect aliasing waves; use "
-                  f"--resolution {step / 2:.2g} or finer", file=sys.stderr)
+                  f"--cell-size {step / 2:.2g} or finer", file=sys.stderr)
             n_warn += 1
-        res = simulate(program, tools, stock.size_mm, resolution_mm=args.resolution,
+        res = simulate(program, tools, stock.size_mm, resolution_mm=args.cell_size,
                        work_offset_mm=offset, progress=False, initial_heightmap=hm,
                        track_lines=bool(args.part))
         hm = res.heightmap
@@ -243,12 +244,20 @@ def run(args) -> int:
     out = preview_heightfield(res.heightmap, stock, args.out, texels_per_mm=args.texels_per_mm,
                               flat_tol_mm=args.mesh_tol, obj=not args.no_obj, metadata=meta,
                               obj_units=args.obj_units, obj_up=args.obj_up,
-                              max_atlas_px=args.max_atlas)
+                              max_atlas_px=args.max_atlas,
+                              view_mesh=bool(args.screenshot) and args.camera != "top")
     t_bake = time.perf_counter() - t1
     if args.screenshot:
-        _screenshot(args, out.files, stock, program, offset)
+        _screenshot(args, out.files, stock, program, offset, out, res.heightmap)
     print(f"meshed and baked {out.triangles} triangles in {t_bake:.2f} s; wrote "
           + ", ".join(map(str, out.files.values())))
+    if args.view:
+        from ..view.scrub import gcode_window
+
+        full = read_gcode(args.program[-1], start_mm=args.start, dialect=args.dialect,
+                          interpreter=args.interpreter) if args.until_line else program
+        gcode_window(full, tools, stock, work_offset_mm=offset, resolution_mm=args.cell_size,
+                     initial_heightmap=hm_before, until_line=args.until_line)
     return 3 if args.strict and n_warn else 0
 
 
@@ -258,8 +267,10 @@ def _hms(seconds: float) -> str:
     return f"{h}:{m:02d}:{s:02d}"
 
 
-def _screenshot(args, files: dict, stock, program, offset) -> None:
-    """Render the GLB with the toolpath over it (rapids red, feeds blue), block frame."""
+def _screenshot(args, files: dict, stock, program, offset, made=None, heightmap=None) -> None:
+    """Render the stock with the toolpath over it (rapids red, feeds blue), block frame: the
+    top view with numpy from the atlas (``made``: the preview's :class:`PartPreview`), other
+    views with VTK from its light view mesh (or the written GLB)."""
     import numpy as np
 
     from ..view import preview
@@ -272,6 +283,13 @@ def _screenshot(args, files: dict, stock, program, offset) -> None:
         seg = np.stack([program.start_mm + off, program.end_mm + off], axis=1)
         feed = program.kind == 1
         overlay = [(seg[~feed], "red", 1.0), (seg[feed], "royalblue", 1.0)]
-    preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png,
-            camera=args.camera, cut_plane=args.camera != "top", overlay=overlay)
+    if args.camera == "top" and made is not None and made.top_texels is not None:
+        # seen from +Z the stock is its atlas's top chart: drawn with numpy, no VTK
+        from ..view.topview import write_top_view
+
+        write_top_view(png, heightmap, stock.size_mm, made.top_texels, overlay=overlay)
+    else:
+        preview(made.view_mesh if made is not None and made.view_mesh is not None
+                else files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png,
+                camera=args.camera, cut_plane=args.camera != "top", overlay=overlay)
     files["png"] = png

@@ -106,7 +106,7 @@ LENGTH_OPTIONS: dict[tuple[str, str], str] = {
     ("place", "block"): "spec", ("place", "margin"): "number",
     ("preview", "block"): "spec", ("preview", "cut_origin"): "vector",
     ("review", "block"): "spec",
-    ("gcode", "block"): "spec", ("gcode", "resolution"): "number",
+    ("gcode", "block"): "spec", ("gcode", "cell_size"): "number",
     ("gcode", "work_offset"): "vector", ("gcode", "start"): "vector",
     ("gcode", "stock"): "vector", ("gcode", "stock_origin"): "vector",
     ("gcode", "rapid_rate"): "number", ("gcode", "mesh_tol"): "number",
@@ -176,13 +176,23 @@ def _value_to_mm(kind: str, value, k: float):
     if kind == "tools":
         out = []
         for item in value:
-            num, eq, spec = item.rpartition("=")
+            head, eq, rest = item.partition("=")
+            # N=SPEC; a spec's own reach parts (flat:6:flute=22) are key=value after a ':'
+            num, spec = (head + eq, rest) if eq and ":" not in head else ("", item)
             kind_, colon, nums = spec.partition(":")
             if not colon:  # no numbers: left for the tool parser to name
                 out.append(item)
                 continue
-            out.append(num + eq + kind_ + ":" + _scaled_numbers(
-                nums, ":", k, _TOOL_LENGTHS.get(kind_.strip().lower(), ())))
+            where = _TOOL_LENGTHS.get(kind_.strip().lower(), ())
+            parts, pos = [], 0
+            for part in nums.split(":"):
+                key, is_kv, val = part.partition("=")
+                if is_kv:  # reach (flute=, shank=, stickout=, holder=): all lengths
+                    parts.append(key + "=" + _scaled_numbers(val, ":", k))
+                else:
+                    parts.append(_scaled_numbers(part, ":", k, (0,) if pos in where else ()))
+                    pos += 1
+            out.append(num + kind_ + ":" + ":".join(parts))
         return out
     raise ValueError(kind)  # pragma: no cover - LENGTH_OPTIONS holds only the kinds above
 
@@ -256,17 +266,21 @@ def allow_negative_values(p: argparse.ArgumentParser) -> None:
     p._negative_number_matcher = _NEGATIVE_VALUES
 
 
-def vector_mm(text: str) -> tuple[float, float, float]:
-    """``"X,Y,Z"`` -> three finite floats (argparse ``type``)."""
+def vector_type(option: str):
+    """argparse ``type`` for ``option``: ``"X,Y,Z"`` -> three finite floats, or a one-line error
+    naming the option (negative values parse as values: see :func:`allow_negative_values`)."""
     import math
 
-    try:
-        vals = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        vals = ()
-    if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
-        raise argparse.ArgumentTypeError(f"expected three finite numbers X,Y,Z; got {text!r}")
-    return vals  # type: ignore[return-value]
+    def parse(text: str) -> tuple[float, float, float]:
+        try:
+            vals = tuple(float(v) for v in text.split(","))
+        except ValueError:
+            vals = ()
+        if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
+            raise argparse.ArgumentTypeError(f"{option} {text!r}: give three finite numbers "
+                                             "X,Y,Z, e.g. 0,0,50")
+        return vals  # type: ignore[return-value]
+    return parse
 
 
 def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None = 10.0,
@@ -465,7 +479,7 @@ RANGES: dict = {
     "size_mm": (0.0, 10_000.0, True),          # a block side, mm (woodcam.limits.MAX_BLOCK_SIZE_MM)
     "mesh_tol": (0.0, 10.0, True),             # mm
     "resolution": (8, 256, False),             # colour-volume cells along the longest side
-    ("gcode", "resolution"): (0.005, 10.0, False),  # stock grid cell, mm (5 um .. 10 mm)
+    ("gcode", "cell_size"): (0.005, 10.0, False),  # stock grid cell, mm (5 um .. 10 mm)
     "epochs": (1, 100_000, False),
     "finetune_epochs": (0, 100_000, False),
     "steps": (1, 100_000_000, False),

@@ -91,7 +91,11 @@ def register(subparsers) -> None:
                    "position at full resolution")
     f.add_argument("--coarse-factor", type=int, default=None, metavar="N",
                    help="fast mode: the first search runs N times coarser than --px-per-mm "
-                   "(default 4; 8 or 16 for large sheets, where it is 5 or 20 times quicker)")
+                   "(default: auto, the smallest of 4, 8, 16 whose coarse search holds <= 4.5 M px; "
+                   "16 for four 600x400 mm sheets at 4 px/mm)")
+    f.add_argument("--w-struct", type=float, default=None, metavar="W",
+                   help="weight of the structural re-rank of the cheapest candidates (SSIM's "
+                   "contrast-structure on 7 x 7 px windows, unitless; default 0.02; 0 = eq. 4 alone)")
     f.add_argument("--overlap-mm", type=float, default=None,
                    help="patch overlap for seam cutting in mm (default min(patch/4, "
                    "(patch - min-piece)/2) = 3.5); 0 = square pieces")
@@ -113,6 +117,7 @@ _OPTION_PARAMS = {"w_intens": "w_intens", "w_edge": "w_edge", "w_hist": "w_hist"
                   "image_size_mm": "image_size_mm", "patch_mm": "patch_mm", "n_adaptive": "n_adaptive",
                   "w_adaptive": "w_adaptive", "n_rot": "n_rot", "priority": "priority", "queue": "queue",
                   "px_per_mm": "px_per_mm", "mode": "mode", "coarse_factor": "coarse_factor",
+                  "w_struct": "w_struct",
                   "overlap_mm": "overlap_mm",
                   "min_piece_mm": "min_piece_mm", "tool_diameter": "tool_diameter_mm",
                   "kerf_mm": "kerf_mm"}

@@ -47,7 +47,10 @@ def laplacian_smoother(n_constraints: int, m: int = 360) -> np.ndarray:
     a = np.zeros((m, n_constraints))
     a[idx, np.arange(n_constraints)] = 1.0
     if len(free):
-        a[free] = -np.linalg.lstsq(lap[:, free], lap[:, idx], rcond=None)[0]
+        from .._threads import one_blas_thread
+
+        with one_blas_thread():  # a small system: threads only spin (woodcam._threads)
+            a[free] = -np.linalg.lstsq(lap[:, free], lap[:, idx], rcond=None)[0]
     a.setflags(write=False)
     return a
 

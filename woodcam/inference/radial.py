@@ -473,16 +473,11 @@ def fit_radial(obs: RingObservations, size_mm, K: int = 12, M: int = 1, ridge: f
 
 
 def _one_blas_thread():
-    """Limit BLAS to one thread: the systems here are small (<= 2000 x 180) and on a busy
-    2-core machine OpenBLAS' threads spin against each other; measured 40x slower (0.2 s vs
-    5 ms per normal-equation solve). threadpoolctl is optional: without it nothing is limited."""
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # pragma: no cover - depends on the environment
-        import contextlib
+    """BLAS on one thread: the systems here are small (<= 2000 x 180); see
+    :mod:`woodcam._threads`."""
+    from .._threads import one_blas_thread
 
-        return contextlib.nullcontext()
-    return threadpool_limits(1, user_api="blas")
+    return one_blas_thread()
 
 
 def _fit_radial(obs, size_mm, K, M, ridge, max_relabel_rounds, seed, history, search) -> RadialField:

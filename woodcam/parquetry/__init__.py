@@ -14,6 +14,7 @@ from .engine import (
            Patch,
            build_parquetry,
            feature_cost,
+           repair_fabricability,
            ssim_vs_matched,
 )
 from .job import ParquetryJob, ParquetryParams, read_job, write_job
@@ -22,4 +23,5 @@ from .veneers import Veneer, load_scan, mokume_veneers, slice_veneers
 
 __all__ = ["Parquetry", "ParquetryJob", "ParquetryParams", "ParquetryRun", "Patch", "Veneer",
            "build_parquetry", "feature_cost", "load_scan", "mokume_veneers", "read_job",
+           "repair_fabricability",
            "slice_veneers", "ssim_vs_matched", "write_job", "write_parquetry"]

@@ -108,6 +108,7 @@ class ParquetryRun:
     message: str
     match_seconds: float
     cpu_seconds: float
+    repaired: dict[int, str] = field(default_factory=dict)
 
     @property
     def complete(self) -> bool:
@@ -159,7 +160,7 @@ class _OutOfWood(Exception):
 
 def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer], params: ParquetryParams | None = None, *,
                     names: list[str] | None = None, progress: bool = False,
-                    seams: bool = True) -> ParquetryRun:
+                    seams: bool = True, repair: bool = True) -> ParquetryRun:
     """Rebuild each target from the veneers (seed 002, sec. 3).
 
     Parameters
@@ -169,6 +170,8 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     params : :class:`ParquetryParams` (Table 1 defaults)
     progress : tqdm bar over the patches
     seams : cut optimal seams in the overlaps (eq. 8-9); False keeps square patches
+    repair : straighten the seams round pieces a router cannot cut (see
+        :func:`repair_fabricability`); False leaves them to be reported
 
     Returns
     -------
@@ -200,8 +203,10 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
         src_vals = src_vals[np.random.default_rng(0).choice(src_vals.size, 2_000_000, replace=False)]
     bank = SheetBank(grey, [v.mask for v in sheets], params.w_intens, params.w_edge, params.n_rot,
                      kerf_px=params.kerf * params.px_per_mm, mode=params.mode,
-                     coarse_factor=params.coarse_factor, top_k=params.top_k,
-                     single_use=params.single_use)
+                     coarse_factor=params.coarse_factor_for(sum(g.size for g in grey)),
+                     top_k=params.top_k,
+                     single_use=params.single_use, w_struct=params.w_struct,
+                     rerank=params.rerank)
     names = names or [f"target{k}" for k in range(len(targets))]
     panels = [prepare_target(t, params, src_vals, k, names[k]) for k, t in enumerate(targets)]
 
@@ -292,8 +297,11 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     placed_cells = sum(int((p.cells >= 0).sum()) for p in panels)
     for p in panels:
         finish_panel(p, patches, bank, sheets, params, seams=seams)
-    return ParquetryRun(params, sheets, bank, panels, patches, placed_cells, planned_cells,
-                        message, match_s, cpu_s)
+    run = ParquetryRun(params, sheets, bank, panels, patches, placed_cells, planned_cells,
+                       message, match_s, cpu_s)
+    if repair:
+        repair_fabricability(run)
+    return run
 
 
 def finish_panel(p: Parquetry, patches: list[Patch], bank: SheetBank, sheets: list[Veneer],
@@ -308,6 +316,13 @@ def finish_panel(p: Parquetry, patches: list[Patch], bank: SheetBank, sheets: li
         p.labels, p.seams_v, p.seams_h = cut_seams(p, windows, params)
     else:
         p.labels = straight_labels(p)
+    _render_panel(p, bank, sheets)
+
+
+def _render_panel(p: Parquetry, bank: SheetBank, sheets: list[Veneer]) -> None:
+    """``p.render`` (each pixel the wood of its label's patch) and ``p.baseline`` (each piece
+    its mean colour, the paper's Fig. 8 baseline) from ``p.labels``."""
+    H, W = p.matched.shape
     render = np.zeros((H, W, 3), np.float32)
     for q in p.patches:
         (y0, x0, y1, x1) = q.grown
@@ -328,6 +343,48 @@ def finish_panel(p: Parquetry, patches: list[Patch], bank: SheetBank, sheets: li
     p.baseline = base
 
 
+def repair_fabricability(run: ParquetryRun, max_rounds: int = 4) -> dict[int, str]:
+    """Repair the pieces that fail the router checks (:func:`~.cutpaths.check_piece`).
+
+    A seam bounding a failing piece (a bend tighter than the tool radius, a part narrower than
+    ``min_piece_mm``) is replaced by the straight grid line it was cut in; a piece bounded by
+    straight lines is its patch's square (at least ``patch_mm >= min_piece_mm`` wide, convex
+    right-angle corners), so the repair always ends. The straight line lies in every grown
+    window it crosses, so the wood under it was matched and is consumed already (single use
+    is unchanged); labels, render and baseline are redone. Returns ``{piece id: what was
+    done}`` (also merged into ``run.repaired``); the files written afterwards are checked again by :func:`write_parquetry`.
+    """
+    from .cutpaths import check_piece, panel_outlines
+    from .seams import labels_from_lines, straight_line
+
+    prm = run.params
+    done: dict[int, str] = {}
+    for p in run.panels:
+        if p.seams_v is None or p.seams_h is None:
+            continue            # square pieces: fabricable by construction
+        H, W = p.matched.shape
+        for _ in range(max_rounds):
+            outlines = panel_outlines(p, prm.px_per_mm)
+            bad = {q.id: check_piece(outlines[q.id], prm.min_piece_mm, prm.tool_diameter_mm / 2)
+                   for q in p.patches}
+            bad = {k: v for k, v in bad.items() if v}
+            if not bad:
+                break
+            rows, cols = p.cells.shape
+            for q in (q for q in p.patches if q.id in bad):
+                for k in (q.col, q.col + q.cells):
+                    if 0 < k < cols:
+                        p.seams_v[k - 1] = straight_line(k * p.cell_px, "v", k, H)
+                for m in (q.row, q.row + q.cells):
+                    if 0 < m < rows:
+                        p.seams_h[m - 1] = straight_line(m * p.cell_px, "h", m, W)
+                done[q.id] = "seams straightened (" + "; ".join(bad[q.id]) + ")"
+        p.labels = labels_from_lines(p, p.seams_v, p.seams_h)
+        _render_panel(p, run.bank, run.veneers)
+    run.repaired.update(done)
+    return done
+
+
 def feature_cost(p: Parquetry, image: np.ndarray, params: ParquetryParams) -> float:
     """Eq. 8 per pixel: mean over the panel of ``|F(R) - F(I_T)|^2`` with ``F`` of eq. 1 (the
     target's intensity histogram-matched, eq. 2). ``image (H, W, 3)`` is a render or baseline."""
@@ -336,8 +393,18 @@ def feature_cost(p: Parquetry, image: np.ndarray, params: ParquetryParams) -> fl
     return float(((f - p.target_feats) ** 2).sum(axis=2).mean())
 
 
-def ssim_vs_matched(p: Parquetry, image: np.ndarray) -> float:
-    """SSIM (scikit-image) between an image's intensity and the matched target (eq. 2)."""
+def ssim_vs_matched(p: Parquetry, image: np.ndarray, downsample: int = 1) -> float:
+    """SSIM (scikit-image: 7 x 7 windows, grey, data range 1) between an image's intensity and
+    the matched target (eq. 2), both ``(H, W)`` at the working resolution, or first
+    area-averaged by ``downsample`` (``round(px_per_mm)`` gives 1 mm pixels, 7 mm windows:
+    structure at half a patch rather than the wood's sub-millimetre grain)."""
+    import cv2
     from skimage.metrics import structural_similarity
 
-    return float(structural_similarity(intensity(image), p.matched, data_range=1.0))
+    a, b = intensity(image), p.matched
+    if downsample > 1:
+        h, w = b.shape
+        size = (max(7, w // downsample), max(7, h // downsample))
+        a = cv2.resize(a, size, interpolation=cv2.INTER_AREA)
+        b = cv2.resize(b, size, interpolation=cv2.INTER_AREA)
+    return float(structural_similarity(a, b, data_range=1.0))

@@ -24,6 +24,10 @@ from typing import Literal
 from ..errors import WoodcamError
 
 Priority = Literal["saliency", "center"]
+
+#: Largest coarse search (pixels over all sheets and rotations) the automatic coarse factor
+#: allows: one such search (two feature channels) takes ~0.03 CPU-s on the 2-core machine.
+AUTO_COARSE_PX = 4_500_000
 QueueOrder = Literal["interleaved", "sequential"]
 
 
@@ -49,7 +53,14 @@ class ParquetryParams:
     tool_diameter_mm : router bit; concave corners are at least its radius
     kerf_mm : wood lost between two pieces on a sheet (default: the tool diameter)
     mode : "fast" (coarse-to-fine, exact re-ranking) or "exhaustive"
-    coarse_factor, top_k : the fast mode's pyramid factor and re-ranked candidates
+    coarse_factor, top_k : the fast mode's pyramid factor and re-ranked candidates; None
+        chooses the smallest of 4, 8, 16 whose coarse search holds at most
+        ``AUTO_COARSE_PX`` pixels (the four 600 x 400 mm sheets at 4 px/mm of the issue's
+        workload get 16)
+    w_struct : weight of the structural term (SSIM's contrast-structure, 7 x 7 windows) that
+        re-ranks the ``rerank`` cheapest distinct free candidates of eq. 4 (woodcam's addition;
+        0: eq. 4 alone). 0.02 raised SSIM by 0.01-0.02 on the skimage targets at an unchanged
+        feature cost (tests/bench/test_parquetry_bench.py)
     """
 
     w_intens: float = 0.5
@@ -68,9 +79,11 @@ class ParquetryParams:
     tool_diameter_mm: float = 2.0
     kerf_mm: float | None = None
     mode: Literal["fast", "exhaustive"] = "fast"
-    coarse_factor: int = 4
+    coarse_factor: int | None = None
     top_k: int = 12
     single_use: bool = True
+    w_struct: float = 0.02
+    rerank: int = 4
 
     def check(self) -> ParquetryParams:
         """Validate at the door; returns self."""
@@ -98,7 +111,9 @@ class ParquetryParams:
         if self.px_per_mm <= 0 or self.tool_diameter_mm < 0 or (self.kerf_mm or 0) < 0:
             raise WoodcamError("px_per_mm must be > 0, tool_diameter_mm and kerf_mm >= 0; got "
                                f"{self.px_per_mm}, {self.tool_diameter_mm}, {self.kerf_mm}")
-        if self.coarse_factor < 1 or self.top_k < 1:
+        if self.w_struct < 0 or self.rerank < 1:
+            raise WoodcamError(f"w_struct must be >= 0 and rerank >= 1; got {self.w_struct}, {self.rerank}")
+        if (self.coarse_factor is not None and self.coarse_factor < 1) or self.top_k < 1:
             raise WoodcamError(f"coarse_factor and top_k must be >= 1; got {self.coarse_factor}, {self.top_k}")
         if self.patch_px < 4:
             raise WoodcamError(f"patch_mm * px_per_mm must give at least 4 px; got {self.patch_px}; "
@@ -116,6 +131,15 @@ class ParquetryParams:
         if self.overlap_mm is not None:
             return float(self.overlap_mm)
         return max(0.0, min(self.patch_mm / 4.0, (self.patch_mm - self.min_piece_mm) / 2.0))
+
+    def coarse_factor_for(self, sheet_px: int) -> int:
+        """The fast mode's coarse factor for sheets of ``sheet_px`` pixels in all (working
+        resolution, unrotated): ``coarse_factor`` when set, else automatic (see above)."""
+        if self.coarse_factor is not None:
+            return int(self.coarse_factor)
+        # rotated canvases are ~1.5 times the sheet's area on average over the angles
+        total = 1.5 * sheet_px * self.n_rot
+        return next((f for f in (4, 8) if total / f ** 2 <= AUTO_COARSE_PX), 16)
 
     @property
     def kerf(self) -> float:

@@ -78,7 +78,7 @@ def summary(run: ParquetryRun) -> dict:
     """The figures printed and stored in result.json."""
     prm = run.params
     out = {"placed_cells": run.placed, "planned_cells": run.planned, "patches": len(run.patches),
-           "complete": run.complete, "message": run.message,
+           "complete": run.complete, "message": run.message, "repaired_pieces": len(run.repaired),
            "match_seconds": round(run.match_seconds, 3), "match_cpu_seconds": round(run.cpu_seconds, 3),
            "seconds_per_patch": round(run.match_seconds / max(1, len(run.patches)), 4),
            "panels": []}
@@ -90,6 +90,8 @@ def summary(run: ParquetryRun) -> dict:
             d.update(feature_cost=feature_cost(p, p.render, prm),
                      feature_cost_baseline=feature_cost(p, p.baseline, prm),
                      ssim=ssim_vs_matched(p, p.render), ssim_baseline=ssim_vs_matched(p, p.baseline),
+                     ssim_1mm=ssim_vs_matched(p, p.render, round(prm.px_per_mm)),
+                     ssim_1mm_baseline=ssim_vs_matched(p, p.baseline, round(prm.px_per_mm)),
                      mean_patch_cost_px=float(np.mean([q.cost_px for q in p.patches])))
         out["panels"].append(d)
     return out
@@ -165,7 +167,8 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
                      "anchor_px": [q.match.x, q.match.y], "cost": q.match.cost, "cost_px": q.cost_px,
                      "panel_to_sheet_mm": q.target_to_sheet(run.bank, ppm).tolist()}
                     for q in run.patches],
-        "fabricability": {"pieces": len(pieces), "problems": problems},
+        "fabricability": {"pieces": len(pieces), "problems": problems,
+                          "repaired": {str(k): v for k, v in run.repaired.items()}},
     }
     files.append(atomic_write_text(out / "result.json", json.dumps(result, indent=1, default=float)))
     return {"files": [str(f) for f in files], "summary": summ, "problems": problems}
@@ -180,11 +183,13 @@ def format_summary(summ: dict, problems: dict) -> str:
         if "feature_cost" in d:
             line += (f"; feature cost/px {d['feature_cost']:.5f} (mean-colour baseline "
                      f"{d['feature_cost_baseline']:.5f}), SSIM {d['ssim']:.3f} (baseline "
-                     f"{d['ssim_baseline']:.3f})")
+                     f"{d['ssim_baseline']:.3f}), at 1 mm pixels {d['ssim_1mm']:.3f} (baseline "
+                     f"{d['ssim_1mm_baseline']:.3f})")
         lines.append(line)
     lines.append(f"matching: {summ['match_seconds']:.1f} s wall, {summ['match_cpu_seconds']:.1f} CPU-s, "
                  f"{summ['seconds_per_patch']:.3f} s per patch")
-    lines.append(f"fabricability: {len(problems)} pieces with problems"
+    lines.append(f"fabricability: {summ.get('repaired_pieces', 0)} pieces repaired (seams "
+                 f"straightened), {len(problems)} pieces with problems left"
                  + ("" if not problems else " (listed in result.json)"))
     if summ["message"]:
         lines.append(summ["message"])

@@ -125,7 +125,8 @@ class Program:
         if len(pts) < 4:
             return None
         k = min(48, len(pts))
-        # The median over 20,000 query points (fixed seed) is as good as over all of them.
+        # The median over 4,000 query points (fixed seed) is as good as over all of them
+        # (20,000 gave the same step-over on the corpus at 5x the cost).
         # Distances are lateral: across the query's XY direction (plunges have none and are
         # left out), so passes stacked at the same XY (depth levels) do not count.
         xy = pts[:, :2]
@@ -134,7 +135,7 @@ class Program:
         has_dir = np.flatnonzero(lxy[seg] > 1e-9)
         if not len(has_dir):
             return None
-        q = np.random.default_rng(0).choice(has_dir, min(len(has_dir), 20_000), replace=False)
+        q = np.random.default_rng(0).choice(has_dir, min(len(has_dir), 4_000), replace=False)
         u = dxy[seg[q]] / lxy[seg[q]][:, None]
         dist, idx = cKDTree(xy).query(xy[q], k=k)
         rel = xy[np.minimum(idx, len(xy) - 1)] - xy[q][:, None, :]
@@ -147,7 +148,14 @@ class Program:
 
     def until_line(self, line: int) -> Program:
         """The moves of source lines ``<= line`` (the simulation scrubbed to that line)."""
-        k = self.line <= int(line)
+        return self.lines_between(None, line)
+
+    def lines_between(self, after: int | None, until: int) -> Program:
+        """The moves of source lines ``after < line <= until`` (``after=None``: from the
+        start): the next stretch when a simulation is scrubbed forward."""
+        k = self.line <= int(until)
+        if after is not None:
+            k &= self.line > int(after)
         return Program(self.start_mm[k], self.end_mm[k], self.kind[k], self.tool[k],
                        self.line[k], self.feed_mm_min[k], self.spindle_rpm[k], self.source,
                        sorted(set(self.tool[k].tolist())), list(self.warnings))

@@ -94,6 +94,11 @@ class GcodeError(WoodcamError):
 # ------------------------------------------------------------------------------------------
 # words
 _NUM = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
+_OWORD = re.compile(r"(?:n\d+(?:\.\d*)?)?o(<[^>]*>|\d+)([a-z]+)(.*)$")
+_ONUMBER = re.compile(r"(?:n\d+)?o\d+$")
+#: Words of a plain move line ("X12.5 Z-1.2 F900" in G0/G1): :meth:`Interpreter.execute`
+#: runs them on a short path (the raster lines of a relief program are nearly all such lines).
+_PLAIN_WORDS = frozenset("xyzf")
 _NAME = re.compile(r"<([^>]*)>")
 _FUNCS = ("atan", "asin", "acos", "abs", "cos", "sin", "tan", "sqrt", "round", "fix", "fup",
           "exp", "ln", "exists")
@@ -154,6 +159,8 @@ class _Line:
 
 
 def _split_comments(raw: str, no: int) -> tuple[str, list[str]]:
+    if "(" not in raw and ")" not in raw and ";" not in raw:  # most lines: no comment
+        return "".join(raw.split()).lower(), []
     msgs = []
     out = []
     i = 0
@@ -495,7 +502,7 @@ class Interpreter:
                 continue
             ln = _Line(text, no, msg)
             body = text[1:] if text.startswith("/") else text
-            m = re.match(r"(?:n\d+(?:\.\d*)?)?o(<[^>]*>|\d+)([a-z]+)(.*)$", body)
+            m = _OWORD.match(body) if "o" in body else None
             if m:
                 label = m.group(1).strip("<>")
                 label = str(int(label)) if label.isdigit() else label
@@ -513,7 +520,7 @@ class Interpreter:
                     raise GcodeError(no, text, "grbl has no O-word subroutines or loops",
                                    "use --dialect linuxcnc")
                 ln.okey, ln.olabel, ln.oexpr = key, label, rest
-            elif re.match(r"(?:n\d+)?o\d+$", body):
+            elif m is None and "o" in body and _ONUMBER.match(body):
                 if self.dialect == "fanuc":  # O1234: Fanuc program number
                     continue
                 raise GcodeError(no, text, "O-word without a command (LinuxCNC reads O only as "
@@ -783,6 +790,17 @@ class Interpreter:
             self.execute(gs, ms, words)
 
     def execute(self, gs, ms, w):
+        if (not gs and not ms and self.motion in (0.0, 1.0) and _PLAIN_WORDS.issuperset(w)):
+            # short path, same effect as below: only feed and axis words in G0/G1
+            if "f" in w:
+                if w["f"] < 0:
+                    raise self.err(f"F{w['f']:g}", "negative feed rate", "give F >= 0")
+                self.feed = w["f"]
+            self.cycle_il = None
+            axis = [a for a in "xyz" if a in w]
+            if axis:
+                self.move(w, axis, False)
+            return
         g: set[float] = set()
         for v in gs:
             c = round(v, 1)

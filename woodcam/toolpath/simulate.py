@@ -47,6 +47,7 @@ from .._types import ArrayLike, Mesh
 from ..errors import WoodcamError
 from ..tolerances import SIM_CONTACT_TOL_MM
 from .gcode import FEED, RAPID, Program
+from .reach import REACH_KINDS, reach_issues
 from .tools import Tool
 
 #: Cells evaluated per vectorised batch: ~20 float32 temporaries of 64k cells stay in L2/L3
@@ -55,7 +56,7 @@ _BATCH_CELLS = 1 << 16
 
 
 IssueKind = Literal["rapid_through_stock", "below_stock_bottom", "cut_outside_stock",
-                    "spindle_off"]
+                    "spindle_off", "deeper_than_flute", "shank_collision", "holder_collision"]
 
 #: Issues of one kind listed one by one before the rest are summarised in one entry.
 MAX_ISSUES_PER_KIND = 12
@@ -81,7 +82,8 @@ def _summarise(issues: dict, move_lines: np.ndarray) -> list[Issue]:
     such as a lone ``F`` word, do not break a run); cap each kind at MAX_ISSUES_PER_KIND."""
     ranks = {int(v): k for k, v in enumerate(np.unique(move_lines))}
     out = []
-    for kind in ("rapid_through_stock", "below_stock_bottom", "cut_outside_stock", "spindle_off"):
+    for kind in ("rapid_through_stock", "below_stock_bottom", "cut_outside_stock", "spindle_off",
+                 *REACH_KINDS):
         items = sorted((i for (k, _), i in issues.items() if k == kind), key=lambda i: i.line)
         runs: list[list[Issue]] = []
         for it in items:
@@ -284,6 +286,10 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     for k in np.flatnonzero(below_top & over & (kind == FEED) & ~(program.spindle_rpm > 0)):
         _add(issues, "spindle_off", lines[k], "feed move into the stock with the spindle off "
              "(no M3/M4 with S > 0 before it): the controller would cut with a still tool")
+    # tools with reach data: the stock each move meets must not reach the shank or holder
+    for rkind, rline, message in reach_issues(p0, p1, tool_of, lookup, lines, size,
+                                              initial_heightmap):
+        _add(issues, rkind, rline, message)
     act = np.flatnonzero(below_top & over)  # program order
     # Runs in program order, broken at tool changes and before/after every rapid that reaches
     # below the stock top: the rapid check must see the stock as cut by all earlier moves.

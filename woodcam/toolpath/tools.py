@@ -15,6 +15,9 @@ Specs (all lengths are diameters in mm, angles the included angle in degrees)::
     ball:3           ball end mill, 3 mm diameter
     bull:6:1         bull nose, 6 mm diameter, 1 mm corner radius
     vbit:60:12       V-bit, 60 deg included angle, 12 mm diameter
+    flat:6:flute=22:stickout=30:holder=35
+                     reach (optional, mm): flute length, shank diameter (shank=, default
+                     the cutter's), tip-to-holder stick-out and holder diameter
 
 Tool table (TOML, read with the standard library's ``tomllib``)::
 
@@ -29,6 +32,10 @@ Tool table (TOML, read with the standard library's ``tomllib``)::
     type = "bull"
     diameter_mm = 6
     corner_radius_mm = 1
+    flute_length_mm = 18       # optional reach: warned where the stock is deeper than the
+    shank_diameter_mm = 6      # flutes or touches the shank or the holder
+    stickout_mm = 30
+    holder_diameter_mm = 35
 """
 
 from __future__ import annotations
@@ -36,7 +43,7 @@ from __future__ import annotations
 from typing import Any
 import math
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
 
@@ -54,11 +61,27 @@ TOOL_TYPES: tuple[str, ...] = ("flat", "ball", "bull", "vbit", "snub", "chamfer"
 MAX_TOOL_DIAMETER_MM = 1000.0
 
 
+#: The reach fields of a tool (keyword-only, all optional, mm) and their spec/TOML names.
+REACH_FIELDS = {"flute": "flute_length_mm", "shank": "shank_diameter_mm",
+                "stickout": "stickout_mm", "holder": "holder_diameter_mm"}
+
+
 @dataclass(frozen=True)
 class Tool:
-    """Base class: a tool of ``diameter_mm`` whose lower surface is :meth:`profile`."""
+    """Base class: a tool of ``diameter_mm`` whose lower surface is :meth:`profile`.
+
+    Reach (optional, keyword-only, mm): ``flute_length_mm`` how high above the tip the tool
+    cuts; above it the tool is a non-cutting shank of ``shank_diameter_mm`` (default: the
+    cutting diameter) up to ``stickout_mm`` (tip to the holder's face), where a holder (collet
+    nut, chuck) of ``holder_diameter_mm`` begins. :func:`woodcam.toolpath.simulate` warns where
+    the stock reaches above the flutes or into the shank or holder (:meth:`reach_parts`).
+    """
 
     diameter_mm: float
+    flute_length_mm: float | None = field(default=None, kw_only=True)
+    shank_diameter_mm: float | None = field(default=None, kw_only=True)
+    stickout_mm: float | None = field(default=None, kw_only=True)
+    holder_diameter_mm: float | None = field(default=None, kw_only=True)
 
     kind = "tool"
 
@@ -69,6 +92,43 @@ class Tool:
             raise WoodcamError(f"{type(self).__name__}: diameter_mm must be a positive number in "
                                f"(0, {MAX_TOOL_DIAMETER_MM:g}] mm, got {d!r}; give the cutting "
                                "diameter in mm")
+        for name in REACH_FIELDS.values():
+            v = getattr(self, name)
+            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float, np.number))
+                                  or not 0 < v <= 10 * MAX_TOOL_DIAMETER_MM):
+                raise WoodcamError(f"{type(self).__name__}: {name} must be None or a positive "
+                                   f"number of mm, got {v!r}")
+        fl, so = self.flute_length_mm, self.stickout_mm
+        if fl is not None and so is not None and so < fl:
+            raise WoodcamError(f"{type(self).__name__}: stickout_mm={so:g} (tip to holder) is "
+                               f"shorter than flute_length_mm={fl:g}; the holder would cover "
+                               "the flutes")
+        if (self.holder_diameter_mm is None) != (so is None):
+            raise WoodcamError(f"{type(self).__name__}: holder_diameter_mm and stickout_mm go "
+                               f"together (the holder's size and where it starts above the "
+                               f"tip); got {self.holder_diameter_mm!r} and {so!r}")
+
+    def with_reach(self, **reach) -> "Tool":
+        """This tool with reach fields replaced, e.g. ``with_reach(flute_length_mm=22)``."""
+        return replace(self, **reach)
+
+    def reach_parts(self) -> list[tuple[str, float, float]]:
+        """The non-cutting parts as ``(name, radius_mm, bottom above the tip mm)``: the shank
+        above the flutes (when ``flute_length_mm`` is known) and the holder (when
+        ``stickout_mm``/``holder_diameter_mm`` are); empty when the tool carries no reach."""
+        parts = []
+        if self.flute_length_mm is not None:
+            # a neck thinner than the cutter passes where the flutes cut: its own radius
+            shank = self.shank_diameter_mm or self.diameter_mm
+            parts.append(("shank", 0.5 * float(shank), float(self.flute_length_mm)))
+        if self.stickout_mm is not None and self.holder_diameter_mm is not None:
+            parts.append(("holder", 0.5 * float(self.holder_diameter_mm),
+                          float(self.stickout_mm)))
+        return parts
+
+    def _reach_spec(self) -> str:
+        return "".join(f":{key}={getattr(self, name):g}" for key, name in REACH_FIELDS.items()
+                       if getattr(self, name) is not None)
 
     @property
     def radius_mm(self) -> float:
@@ -176,7 +236,7 @@ class FlatEndMill(Tool):
         return np.where((d2 <= R * R) & (lo <= hi), z0 + s * t, np.inf)
 
     def spec(self):
-        return f"flat:{self.diameter_mm:g}"
+        return f"flat:{self.diameter_mm:g}" + self._reach_spec()
 
     def solid(self, top_mm, segments=64):
         from manifold3d import Manifold
@@ -212,7 +272,7 @@ class BallEndMill(Tool):
         return np.where(q >= 0, env, np.inf)
 
     def spec(self):
-        return f"ball:{self.diameter_mm:g}"
+        return f"ball:{self.diameter_mm:g}" + self._reach_spec()
 
 
 @dataclass(frozen=True)
@@ -240,7 +300,7 @@ class BullNoseMill(Tool):
         return q / np.sqrt(np.maximum(rc * rc - q * q, 1e-30))
 
     def spec(self):
-        return f"bull:{self.diameter_mm:g}:{self.corner_radius_mm:g}"
+        return f"bull:{self.diameter_mm:g}:{self.corner_radius_mm:g}" + self._reach_spec()
 
 
 @dataclass(frozen=True)
@@ -283,7 +343,7 @@ class VBit(Tool):
         return np.where(ok, env, np.inf)
 
     def spec(self):
-        return f"vbit:{self.angle_deg:g}:{self.diameter_mm:g}"
+        return f"vbit:{self.angle_deg:g}:{self.diameter_mm:g}" + self._reach_spec()
 
 
 @dataclass(frozen=True)
@@ -319,7 +379,7 @@ class SnubNoseVBit(Tool):
         return [0.5 * self.tip_diameter_mm]
 
     def spec(self):
-        return f"{self.kind}:{self.angle_deg:g}:{self.diameter_mm:g}:{self.tip_diameter_mm:g}"
+        return f"{self.kind}:{self.angle_deg:g}:{self.diameter_mm:g}:{self.tip_diameter_mm:g}" + self._reach_spec()
 
 
 @dataclass(frozen=True)
@@ -369,17 +429,30 @@ class TaperedBallMill(Tool):
         return [self._parts()[1]]
 
     def spec(self):
-        return f"taperball:{self.diameter_mm:g}:{self.tip_diameter_mm:g}:{self.taper_deg:g}"
+        return f"taperball:{self.diameter_mm:g}:{self.tip_diameter_mm:g}:{self.taper_deg:g}" + self._reach_spec()
 
 
 _SPEC_HELP = ("write flat:D, ball:D, bull:D:RC, vbit:ANGLE:D, snub:ANGLE:D:TIP, "
-              "chamfer:ANGLE:D:TIP or taperball:D:TIP:TAPER (mm, degrees), e.g. ball:3")
+              "chamfer:ANGLE:D:TIP or taperball:D:TIP:TAPER (mm, degrees), e.g. ball:3; "
+              "reach as :flute=L:shank=D:stickout=L:holder=D")
 
 
 def parse_tool_spec(spec: str) -> Tool:
     """Parse a tool spec such as ``flat:6.35``, ``ball:3``, ``bull:6:1``, ``vbit:60:12``."""
     parts = str(spec).strip().lower().split(":")
     kind = parts[0]
+    reach: dict[str, float] = {}
+    for item in [p for p in parts[1:] if "=" in p]:
+        key, _, val = item.partition("=")
+        if key not in REACH_FIELDS:
+            raise WoodcamError(f"tool spec {spec!r}: {key!r} is not one of {list(REACH_FIELDS)} "
+                               f"(e.g. flat:6:flute=22:stickout=30:holder=35); {_SPEC_HELP}")
+        try:
+            reach[REACH_FIELDS[key]] = float(val)
+        except ValueError as err:
+            raise WoodcamError(f"tool spec {spec!r}: {key}= needs a number of mm, got {val!r}"
+                               ) from err
+    parts = [p for p in parts if "=" not in p]
     try:
         nums = [float(p) for p in parts[1:]]
     except ValueError as err:
@@ -394,17 +467,17 @@ def parse_tool_spec(spec: str) -> Tool:
         raise WoodcamError(f"tool spec {spec!r}: {kind} takes {want[kind]} number(s), got "
                            f"{len(nums)}; {_SPEC_HELP}")
     if kind == "flat":
-        return FlatEndMill(nums[0])
+        return FlatEndMill(nums[0], **reach)
     if kind == "ball":
-        return BallEndMill(nums[0])
+        return BallEndMill(nums[0], **reach)
     if kind == "bull":
-        return BullNoseMill(nums[0], corner_radius_mm=nums[1])
+        return BullNoseMill(nums[0], corner_radius_mm=nums[1], **reach)
     if kind in ("snub", "chamfer"):
         cls = SnubNoseVBit if kind == "snub" else ChamferMill
-        return cls(nums[1], angle_deg=nums[0], tip_diameter_mm=nums[2])
+        return cls(nums[1], angle_deg=nums[0], tip_diameter_mm=nums[2], **reach)
     if kind == "taperball":
-        return TaperedBallMill(nums[0], tip_diameter_mm=nums[1], taper_deg=nums[2])
-    return VBit(nums[1], angle_deg=nums[0])
+        return TaperedBallMill(nums[0], tip_diameter_mm=nums[1], taper_deg=nums[2], **reach)
+    return VBit(nums[1], angle_deg=nums[0], **reach)
 
 
 def load_tool_table(path: PathLike) -> dict[int, Tool]:
@@ -448,21 +521,22 @@ def load_tool_table(path: PathLike) -> dict[int, Tool]:
                                f"{TOOL_TYPES}) and diameter_mm, got {dict(entry)!r}")
         num = lambda k: _number(entry.get(k, math.nan), path, key, k)  # noqa: E731
         d = num("diameter_mm")
+        reach = {name: num(name) for name in REACH_FIELDS.values() if name in entry}
         if kind == "flat":
-            out[number] = FlatEndMill(d)
+            tool: Tool = FlatEndMill(d)
         elif kind == "ball":
-            out[number] = BallEndMill(d)
+            tool = BallEndMill(d)
         elif kind == "bull":
-            out[number] = BullNoseMill(d, num("corner_radius_mm"))
+            tool = BullNoseMill(d, num("corner_radius_mm"))
         elif kind in ("snub", "chamfer"):
             cls = SnubNoseVBit if kind == "snub" else ChamferMill
-            out[number] = cls(d, angle_deg=num("angle_deg"),
-                              tip_diameter_mm=num("tip_diameter_mm"))
+            tool = cls(d, angle_deg=num("angle_deg"), tip_diameter_mm=num("tip_diameter_mm"))
         elif kind == "taperball":
-            out[number] = TaperedBallMill(d, tip_diameter_mm=num("tip_diameter_mm"),
-                                          taper_deg=num("taper_deg"))
+            tool = TaperedBallMill(d, tip_diameter_mm=num("tip_diameter_mm"),
+                                   taper_deg=num("taper_deg"))
         else:
-            out[number] = VBit(d, num("angle_deg"))
+            tool = VBit(d, num("angle_deg"))
+        out[number] = tool.with_reach(**reach) if reach else tool
     return out
 
 
@@ -512,10 +586,13 @@ def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
                                f"not one of {_CAMOTICS_SHAPES}")
         num = lambda k, default=math.nan: _number(e.get(k, default), path, key, k) * scale  # noqa: E731
         d = num("diameter")
+        # CAMotics' "length" of a cylindrical or ball-nose tool is its cutting length
+        flute = num("length", 0.0)
+        reach = {"flute_length_mm": flute} if flute > 0 else {}
         if shape == "cylindrical":
-            tool: Tool = FlatEndMill(d)
+            tool: Tool = FlatEndMill(d, **reach)
         elif shape == "ballnose":
-            tool = BallEndMill(d)
+            tool = BallEndMill(d, **reach)
         else:
             tip = num("snub_diameter", 0.0) if shape == "snubnose" else 0.0
             length = num("length")

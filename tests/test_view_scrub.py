@@ -1,0 +1,116 @@
+"""The G-code window's line slider (woodcam.view.scrub), driven off screen through its
+callback as the view-key tests drive the keys."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from woodcam.errors import WoodcamError
+from woodcam.toolpath import parse_tool_spec, read_gcode, simulate
+
+pv = pytest.importorskip("pyvista")
+
+
+class _Wood:
+    def color(self, points_mm, normals):
+        return np.full((len(points_mm), 3), 0.6)
+
+
+class _Stock:
+    size_mm = (60.0, 40.0, 20.0)
+    wood = _Wood()
+
+
+# three 20 mm slots, one per line pair: 5 mm deep each, 6 mm flat
+PROG = ("M3 S9000 F600\nG0 X10 Y10 Z2\nG1 Z-5\nG1 X30\nG0 Z2\nG0 Y20\nG1 Z-5\nG1 X10\n"
+        "G0 Z2\nG0 Y30\nG1 Z-5\nG1 X30\nG0 Z2\nM2\n")
+
+
+def _removed(hm, res=0.5):
+    return float((20.0 - hm).sum() * res * res)
+
+
+def test_the_slider_scrubs_the_stock_to_any_line_forward_and_back():
+    from woodcam.view.scrub import (DONE_ACTORS, STOCK_ACTOR, TIP_ACTOR, TODO_ACTOR,
+                                    gcode_window)
+
+    prog = read_gcode(PROG)
+    tool = parse_tool_spec("flat:6")
+    plotter, cb = gcode_window(prog, tool, _Stock(), resolution_mm=0.5, off_screen=True,
+                               window_size=(320, 240))
+    try:
+        slider = plotter.widgets.slider_widgets[0]
+        rep = slider.GetRepresentation()
+        assert (rep.GetMinimumValue(), rep.GetMaximumValue()) == (2, 13)
+        assert cb.line == 13 and STOCK_ACTOR in plotter.actors
+        one = _removed(simulate(prog.until_line(4), tool, _Stock.size_mm,
+                                resolution_mm=0.5).heightmap)
+        for line, slots in ((4, 1), (12, 3), (8, 2), (3, None)):
+            cb(line)
+            want = simulate(prog.until_line(line), tool, _Stock.size_mm, resolution_mm=0.5)
+            np.testing.assert_array_equal(cb.heightmap, want.heightmap)
+            if slots:
+                assert _removed(cb.heightmap) == pytest.approx(slots * one, rel=1e-6)
+        cb(8)  # the tool tip sits at the end of line 8's move (X10 Y20 Z-5 -> block Z 15)
+        tip = np.asarray(plotter.actors[TIP_ACTOR].GetMapper().GetInput().center)
+        np.testing.assert_allclose(tip, (10.0, 20.0, 15.0), atol=1e-6)
+        assert DONE_ACTORS[0] in plotter.actors and TODO_ACTOR in plotter.actors
+        cb(13)
+        assert TODO_ACTOR not in plotter.actors
+        img = plotter.screenshot(return_img=True)
+        assert img.shape[:2] == (240, 320) and img.std() > 5  # something drawn
+    finally:
+        plotter.close()
+
+
+def test_a_window_without_a_display_is_a_clear_error(monkeypatch):
+    import woodcam.view.scene as scene
+    from woodcam.view.scrub import gcode_window
+
+    monkeypatch.setattr(scene.sys, "platform", "linux")
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    with pytest.raises(WoodcamError, match="needs a display"):
+        gcode_window(read_gcode(PROG), parse_tool_spec("flat:6"), _Stock())
+
+
+def test_gcode_view_without_a_display_fails_before_any_work(tmp_path, monkeypatch):
+    from woodcam.cli import build_parser
+
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setattr("woodcam.view.scene.sys.platform", "linux")
+    prog = tmp_path / "p.nc"
+    prog.write_text(PROG)
+    args = build_parser().parse_args(["gcode", str(prog), "--block", "builtin:rift", "--out",
+                                      str(tmp_path / "o.glb"), "--tool", "flat:6", "--view"])
+    with pytest.raises(WoodcamError, match="needs a display"):
+        args.func(args)
+    assert not (tmp_path / "o.glb").exists()
+
+
+def test_gcode_view_hands_the_whole_last_program_and_its_start_stock(tmp_path, monkeypatch):
+    """``woodcam gcode A B --until-line 4 --view``: the window gets all of B (the slider can
+    go past line 4), the stock A left as its start, and starts at line 4."""
+    import woodcam.view.scrub as scrub
+    from tests.toolpath.test_toolpath_cli import _parse, _stub_preview
+
+    seen: dict = {}
+    _stub_preview(monkeypatch, {})
+    monkeypatch.setattr(scrub, "check_display", lambda: None)
+    monkeypatch.setattr(scrub, "gcode_window", lambda program, tools, stock, **kw:
+                        seen.update(program=program, kw=kw))
+    first = tmp_path / "a.nc"
+    first.write_text("M3 S9000 F600\nG0 X30 Y30 Z2\nG1 Z-3\nG1 X50\nG0 Z2\nM2\n")
+    second = tmp_path / "b.nc"
+    second.write_text(PROG)
+    args = _parse([str(first), str(second), "--block", "builtin:flat-sawn", "--out",
+                   str(tmp_path / "o.glb"), "--tool", "flat:6", "--cell-size", "0.5",
+                   "--stock", "60x40x20", "--until-line", "4", "--view"])
+    assert args.func(args) == 0
+    assert int(seen["program"].line.max()) == 13 and seen["kw"]["until_line"] == 4
+    start = seen["kw"]["initial_heightmap"]
+    want = simulate(read_gcode(first.read_text()), parse_tool_spec("flat:6"), (60, 40, 20),
+                    resolution_mm=0.5).heightmap
+    np.testing.assert_array_equal(start, want)

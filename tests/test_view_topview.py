@@ -1,0 +1,53 @@
+"""The numpy top view of a height-field stock (woodcam.view.topview): no VTK."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from woodcam.errors import WoodcamError
+from woodcam.view.topview import top_view, write_top_view
+
+
+def test_a_flat_stock_shows_its_texture_unshaded_inside_a_white_margin():
+    tex = np.zeros((40, 60, 3), np.uint8)
+    tex[:20] = (200, 100, 50)   # the back half (row 0 is Y = D)
+    tex[20:] = (50, 100, 200)
+    img = top_view(np.full((8, 12), 5.0), (60.0, 40.0, 10.0), tex, window_size=(160, 120),
+                   margin_px=20)
+    assert img.shape == (120, 160, 3)
+    # 60 x 40 mm fitted in 120 x 80 px: 2 px/mm, centred
+    assert (img[:20] == 255).all() and (img[:, :20] == 255).all()
+    np.testing.assert_array_equal(img[30, 80], (200, 100, 50))  # back: upper half of the image
+    np.testing.assert_array_equal(img[90, 80], (50, 100, 200))
+
+
+def test_slopes_facing_the_light_are_brighter_and_segments_are_drawn():
+    hm = np.tile(np.linspace(0, 10, 50), (40, 1))  # rises to +X: faces -X, the light
+    tex = np.full((40, 50, 3), 150, np.uint8)
+    img = top_view(hm, (50.0, 40.0, 10.0), tex, window_size=(100, 80), margin_px=0).astype(int)
+    flat = top_view(np.zeros((40, 50)), (50.0, 40.0, 10.0), tex, window_size=(100, 80),
+                    margin_px=0).astype(int)
+    assert img[40, 50, 0] > flat[40, 50, 0] == 150
+    down = top_view(hm[:, ::-1], (50.0, 40.0, 10.0), tex, window_size=(100, 80), margin_px=0)
+    assert down[40, 50, 0] < 150  # the falling slope faces away from the light
+    seg = np.array([[[0.0, 20.0, 1.0], [50.0, 20.0, 1.0]]])  # Y = 20 mm: the middle row
+    lined = top_view(np.zeros((40, 50)), (50.0, 40.0, 10.0), tex, window_size=(100, 80),
+                     margin_px=0, overlay=[(seg, "red", 1.0)])
+    assert (lined[40, 5:95, 0] > lined[40, 5:95, 2] + 50).all()  # red across the middle row
+    np.testing.assert_array_equal(lined[10], flat[10])
+
+
+def test_top_view_png_and_errors(tmp_path):
+    tex = np.full((4, 4, 3), 90, np.uint8)
+    path = write_top_view(tmp_path / "t.png", np.zeros((4, 4)), (4.0, 4.0, 1.0), tex,
+                          window_size=(64, 64))
+    from PIL import Image
+
+    with Image.open(path) as im:
+        assert im.size == (64, 64)
+    with pytest.raises(WoodcamError, match="heightmap must be"):
+        top_view(np.zeros(4), (4.0, 4.0, 1.0), tex)
+    with pytest.raises(WoodcamError, match="overlay colour"):
+        top_view(np.zeros((4, 4)), (4.0, 4.0, 1.0), tex,
+                 overlay=[(np.zeros((1, 2, 3)), "mauve", 1.0)])

@@ -1,0 +1,173 @@
+"""The G-code window: the simulated stock with its toolpath, and a slider that scrubs the
+simulation to any source line.
+
+:class:`ScrubCallback` is what the slider calls with a line number: it simulates the program up
+to that line (forward from the last state when the slider moves forward, from the start stock
+when it moves back: the height field only ever loses material), meshes the height field at the
+window's grid (:data:`woodcam.pipeline.VIEW_GRID_CELLS` cells across, block means), colours
+its vertices with the wood, and replaces the stock actor; the toolpath is drawn done (blue
+feeds, red rapids) up to the line and grey after it, with the tool tip marked. Everything but
+the window itself runs off screen, so the tests drive the callback directly.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import WoodcamError
+
+#: Actor names of the G-code window.
+STOCK_ACTOR = "woodcam-gcode-stock"
+DONE_ACTORS = ("woodcam-path-feeds", "woodcam-path-rapids")
+TODO_ACTOR = "woodcam-path-todo"
+TIP_ACTOR = "woodcam-tool-tip"
+#: Cells across the stock mesh of the window (a 1280-pixel window shows about this many).
+WINDOW_GRID_CELLS = 400
+
+
+class ScrubCallback:
+    """Slider callback: ``callback(line)`` shows the stock as simulated up to source ``line``.
+
+    ``program`` (a :class:`woodcam.toolpath.Program`), ``tools`` as
+    :func:`woodcam.toolpath.simulate` takes them, the ``stock`` (size and wood), the G-code
+    zero's block-frame position ``work_offset_mm`` and the simulation's ``resolution_mm``;
+    ``initial_heightmap`` is the stock earlier programs of the job left. After a call,
+    :attr:`line` is the line shown and :attr:`heightmap` its stock.
+    """
+
+    def __init__(self, plotter, program, tools, stock, *, work_offset_mm=None,
+                 resolution_mm: float = 0.1, initial_heightmap=None):
+        if not len(program):
+            raise WoodcamError("ScrubCallback: the program has no moves; nothing to scrub")
+        self.plotter = plotter
+        self.program = program
+        self.tools = tools
+        self.size_mm = tuple(float(v) for v in stock.size_mm)
+        self.wood = stock.wood
+        self.offset = (np.array([0.0, 0.0, self.size_mm[2]]) if work_offset_mm is None
+                       else np.asarray(work_offset_mm, float))
+        self.resolution_mm = float(resolution_mm)
+        self.start = initial_heightmap
+        self.line: int | None = None
+        self.heightmap = None
+        seg = np.stack([program.start_mm + self.offset, program.end_mm + self.offset], axis=1)
+        self._seg = seg
+        self.first_line, self.last_line = int(program.line.min()), int(program.line.max())
+
+    def __call__(self, value) -> None:
+        from ..toolpath.simulate import simulate
+
+        line = int(round(float(value)))
+        line = min(max(line, self.first_line), self.last_line)
+        forward = self.line is not None and line >= self.line
+        moves = self.program.lines_between(self.line if forward else None, line)
+        hm = self.heightmap if forward else self.start
+        if len(moves):
+            hm = simulate(moves, self.tools, self.size_mm, resolution_mm=self.resolution_mm,
+                          work_offset_mm=self.offset, initial_heightmap=hm).heightmap
+        elif hm is None:
+            nx = max(1, round(self.size_mm[0] / self.resolution_mm))
+            ny = max(1, round(self.size_mm[1] / self.resolution_mm))
+            hm = np.full((ny, nx), self.size_mm[2])
+        self.heightmap, self.line = hm, line
+        self._draw()
+
+    def _draw(self) -> None:
+        import pyvista as pv
+
+        p = self.plotter
+        p.add_mesh(_stock_polydata(pv, self.heightmap, self.size_mm, self.wood), scalars="rgb",
+                   rgb=True, name=STOCK_ACTOR, smooth_shading=False, ambient=0.3,
+                   diffuse=0.7, specular=0.05)
+        done = self.program.line <= self.line
+        feed = self.program.kind == 1
+        for name, sel, colour in ((DONE_ACTORS[0], done & feed, "royalblue"),
+                                  (DONE_ACTORS[1], done & ~feed, "red"),
+                                  (TODO_ACTOR, ~done, "lightgrey")):
+            if sel.any():
+                p.add_mesh(_lines(pv, self._seg[sel]), color=colour, line_width=1.0,
+                           name=name, opacity=1.0 if name != TODO_ACTOR else 0.5)
+            else:
+                p.remove_actor(name)
+        k = np.flatnonzero(done)
+        if len(k):
+            tip = self._seg[k[-1], 1]
+            p.add_mesh(pv.Sphere(radius=0.01 * max(self.size_mm), center=tip), color="orange",
+                       name=TIP_ACTOR)
+        else:
+            p.remove_actor(TIP_ACTOR)
+
+
+def _lines(pv, seg):
+    n = len(seg)
+    cells = np.column_stack([np.full(n, 2), 2 * np.arange(n), 2 * np.arange(n) + 1])
+    return pv.PolyData(seg.reshape(-1, 3), lines=cells.ravel())
+
+
+def _stock_polydata(pv, heightmap, size_mm, wood):
+    """The stock below ``heightmap`` meshed at :data:`WINDOW_GRID_CELLS` cells across, its
+    vertices coloured by ``wood`` (point array ``"rgb"``, uint8)."""
+    from ..toolpath.mesh import heightfield_mesh
+
+    hm = np.asarray(heightmap, float)
+    k = max(1, math.ceil(max(hm.shape) / WINDOW_GRID_CELLS))
+    if k > 1:
+        ny, nx = (-(-n // k) for n in hm.shape)
+        pad = np.pad(hm, ((0, ny * k - hm.shape[0]), (0, nx * k - hm.shape[1])), mode="edge")
+        hm = pad.reshape(ny, k, nx, k).mean(axis=(1, 3))
+    # no planar merging: vertex colours interpolated over a merged fan would draw stars
+    mesh = heightfield_mesh(hm, size_mm, flat_tol_mm=-1.0)
+    v = np.asarray(mesh.vertices)
+    rgb = np.asarray(wood.color(v, np.asarray(mesh.vertex_normals)), float)
+    faces = np.column_stack([np.full(len(mesh.faces), 3), mesh.faces]).ravel()
+    poly = pv.PolyData(v, faces)
+    poly.point_data["rgb"] = np.round(np.clip(rgb, 0, 1) * 255).astype(np.uint8)
+    return poly
+
+
+def add_line_slider(plotter, callback: ScrubCallback, *, value: int | None = None):
+    """Add the slider (source line, first to last) that drives ``callback``; it is called once
+    now with ``value`` (default: the last line)."""
+    start = callback.last_line if value is None else int(value)
+    return plotter.add_slider_widget(
+        callback, rng=[callback.first_line, callback.last_line], value=start,
+        title="G-code line", pointa=(0.25, 0.92), pointb=(0.95, 0.92), fmt="%.0f",
+        style="modern", interaction_event="end")
+
+
+def check_display() -> None:
+    """Raise a :class:`WoodcamError` when no window can open (no display): before the work."""
+    from .scene import _display_available
+
+    if not _display_available():
+        raise WoodcamError("woodcam gcode --view: the window needs a display, but neither "
+                           "DISPLAY nor WAYLAND_DISPLAY is set; render a picture instead with "
+                           "--screenshot (and --until-line N for a scrubbed frame)")
+
+
+def gcode_window(program, tools, stock, *, work_offset_mm=None, resolution_mm: float = 0.1,
+                 initial_heightmap=None, until_line: int | None = None,
+                 window_size: tuple[int, int] = (1280, 960), off_screen: bool = False):
+    """Open the G-code window (stock, toolpath, line slider, view keys); returns
+    ``(plotter, callback)`` after it closes. ``off_screen`` builds it without showing (tests
+    drive the :class:`ScrubCallback` as the slider would)."""
+    from .camera import set_camera
+    from .scene import _pyvista, add_view_keys
+
+    pv = _pyvista()
+    if not off_screen:
+        check_display()
+    plotter = pv.Plotter(off_screen=off_screen, window_size=window_size,
+                         title="woodcam gcode")
+    callback = ScrubCallback(plotter, program, tools, stock, work_offset_mm=work_offset_mm,
+                             resolution_mm=resolution_mm, initial_heightmap=initial_heightmap)
+    add_line_slider(plotter, callback, value=until_line)
+    W, D, H = callback.size_mm
+    set_camera(plotter, "iso", (0.0, W, 0.0, D, 0.0, H))
+    add_view_keys(plotter, callback.size_mm)
+    plotter.add_axes()
+    if not off_screen:
+        plotter.show()
+    return plotter, callback
