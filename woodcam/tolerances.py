@@ -313,6 +313,32 @@ DEAD_KNOT_BANDS_MM = ((-0.5, 0.0), (-1.2, -0.6), (0.2, 0.8))
 #: whose bark ring the generator is still blending in, 0.0-0.19 (alive to this test).
 DEAD_KNOT_MIN_OUTLINED = 0.5
 
+#: Stem model (``woodcam.inference.stem``, issue 12 part 2). Its priors are Gaussian, weighted
+#: as if every fitted ring point carried them with this misfit (years): about the rms misfit of
+#: jittered traces (0.3 mm on 1.5-6 mm rings), so a prior one standard deviation off costs as
+#: much as the traces' own noise.
+STEM_PRIOR_YEARS = 0.3
+
+#: Standard deviation (degrees) of the pith's tilt from the nearest block axis: sawn wood has
+#: its grain along the board (slope of grain of a few degrees; the benchmark draws N(0, 2)
+#: clipped at 6 for logs, up to 20 for the eq. 7-9 family). Without it, three faces let a
+#: pith 45 degrees off fit as well as the true one (seed 21 dev blocks).
+STEM_TILT_PRIOR_DEG = 8.0
+
+#: Standard deviation (mm) of the centreline's sagitta over half the block diagonal: generated
+#: logs bend by < 0.6 mm over 45 mm (eight logs: median 0.1 mm); 6 mm lets a crooked stem
+#: (sagitta 2 mm over 30 mm, tests) bend without letting three noisy faces bend every pith.
+STEM_CURVE_PRIOR_MM = 6.0
+
+#: Prior standard deviations of the stem's ring-density terms, as fractions of the mean ring
+#: density: azimuthal harmonic k (eccentricity, lobes, speed per azimuth) STEM_HARMONIC_SD / k;
+#: change along the stem over half the diagonal STEM_AXIAL_SD; ring width over rho_0 (the
+#: ``rho`` powers) STEM_RADIAL_SD. The generator's logs stay inside them (eccentricity <= 0.15,
+#: lobes <= 0.025, width slope <= 0.003 / mm over ~100 mm).
+STEM_HARMONIC_SD = 0.15
+STEM_AXIAL_SD = 0.2
+STEM_RADIAL_SD = 0.3
+
 #: Longest step (image pixels) between the points a curved SVG ring trace (cubic, quadratic,
 #: arc) is sampled at. A circular arc of radius r sampled every s pixels strays s^2 / (8 r) from
 #: its chord: 0.003 px for s = 0.5 and a ring of radius 10 px, far below a ring map's 1 px.

@@ -3,7 +3,9 @@
 - :func:`fit_block` ``(block, method, faces) -> field``: ``"evidence"`` (the default) fits
   several hypotheses and keeps the one the held-out faces support (:mod:`.evidence`, with knots
   from the knot masks, :mod:`.knots`); ``"rbf"`` is the seed's baseline,
-  ``"radial"`` our least-squares fit of a pith axis and a smooth inverse ring width.
+  ``"radial"`` our least-squares fit of a pith axis and a smooth inverse ring width;
+  :func:`fit_stem` the stem model (curved pith near a block axis, ring density by direction,
+  height and year: :mod:`.stem`), one of the evidence fit's hypotheses.
   ``"neural"`` the seed's eq. 5 fit of the generic neural field (labelled traces, or ring maps
   with a year-free loss).
 - :func:`evaluate_fit` / :func:`benchmark`: share of predicted ring-line points within 1 / 2 mm
@@ -20,10 +22,11 @@ from .holdout import leave_one_face_out, score_face
 from .observations import RingObservations, gather_observations
 from .radial import RadialField, fit_radial, number_observations
 from .rbf import fit_rbf
+from .stem import StemField, fit_stem
 
 __all__ = [
     "CutPlane", "DEFAULT_PLANES", "EvidenceFit", "METHODS", "Method", "RadialField",
-    "RingObservations", "bake", "benchmark", "evaluate_fit", "evaluate_fits", "fit_block", "fit_evidence",
-    "fit_radial", "fit_rbf", "gather_observations", "leave_one_face_out", "number_observations",
+    "RingObservations", "StemField", "bake", "benchmark", "evaluate_fit", "evaluate_fits", "fit_block", "fit_evidence",
+    "fit_radial", "fit_rbf", "fit_stem", "gather_observations", "leave_one_face_out", "number_observations",
     "score_face",
 ]

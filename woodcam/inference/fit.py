@@ -23,8 +23,9 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: Bumped whenever a fitter changes what it returns for the same block, so fields cached by
 #: :func:`woodcam.stock.fitted_field` are refitted (2: growth history, knot masks, year-free neural;
 #: 3: the evidence-chosen default, uncertainty and fit facts saved with the grid; 4: dense knots;
-#: 5: ring maps read as one-pixel lines, dead knots, uncertainty round knots).
-FIT_VERSION = 5
+#: 5: ring maps read as one-pixel lines, dead knots, uncertainty round knots; 6: the stem
+#: hypothesis and per-fold pith refits in the evidence fit).
+FIT_VERSION = 6
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
@@ -34,8 +35,8 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
     Parameters
     ----------
     block : woodcam.block.Block
-    method : "evidence" (the default: several hypotheses, radial pith basins, RBF and a radial
-        stem with a residual, chosen by how well each predicts the faces it was not fitted to;
+    method : "evidence" (the default: several hypotheses, radial pith basins, RBF, a radial
+        stem with a residual and the stem model of :mod:`woodcam.inference.stem`, chosen by how well each predicts the faces it was not fitted to;
         a choice the held-out faces contradict raises a WoodcamWarning and is flagged in
         ``field.meta``; the baked grid carries the per-point ``uncertainty``, see
         :mod:`woodcam.inference.evidence`) or "rbf" (seed 000's baseline: thin-plate RBF of labelled ring points; unlabelled rings
