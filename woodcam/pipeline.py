@@ -176,12 +176,7 @@ def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: floa
                                            baked.texels_per_mm).charts["top"]
     result.top_texels = baked.atlas[y0:y0 + h, x0:x0 + w]
     if screenshot:
-        from .view import preview
-
-        png = out_glb.with_name(out_glb.stem + "_view.png")
-        with result.stage("render"):
-            preview(result.view_mesh, wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
-        result.files["png"] = png
+        _render_screenshot(result.view_mesh, stock, out_glb, result)
     return result
 
 
@@ -316,10 +311,15 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
             result.files["obj"] = Path(export_obj(baked.mesh, obj_path, units=obj_units,
                                                   up=obj_up, normals=normals) or obj_path)
     if screenshot:
-        from .view import preview
-
-        png = out_glb.with_name(out_glb.stem + "_view.png")
-        with result.stage("render"):
-            preview(baked.mesh, wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
-        result.files["png"] = png
+        _render_screenshot(baked.mesh, stock, out_glb, result)
     return result
+
+
+def _render_screenshot(mesh, stock: Stock, out_glb: Path, result: PartPreview) -> None:
+    """Render ``mesh`` in ``stock`` off-screen to OUT_view.png beside ``out_glb``."""
+    from .view import preview
+
+    png = out_glb.with_name(out_glb.stem + "_view.png")
+    with result.stage("render"):
+        preview(mesh, wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
+    result.files["png"] = png
