@@ -57,6 +57,16 @@ class PartPreview:
         self.timings_s[name] = self.timings_s.get(name, 0.0) + time.perf_counter() - t0
 
 
+def screenshot_path(screenshot: bool | str | Path | None, beside: Path) -> Path | None:
+    """Where ``--screenshot`` writes: ``None`` when not asked, NAME_view.png beside ``beside``
+    (the GLB or mesh) when given without a name, else the name given."""
+    if not screenshot:
+        return None
+    if screenshot is True:
+        return beside.with_name(beside.stem + "_view.png")
+    return Path(screenshot)
+
+
 def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = False,
                   what: str = "--out") -> Path:
     """Check every file a preview will write *before* any work: ``out_glb`` ends in ``.glb``,
@@ -73,7 +83,7 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
             check_output_path(sibling, what=f"{what} (the {suffix[1:].upper()} "
                               "beside the GLB; --no-obj skips it)")
     if screenshot is True:
-        check_output_path(out_glb.with_name(out_glb.stem + "_view.png"), what=f"{what} (its view PNG)")
+        check_output_path(screenshot_path(True, out_glb), what=f"{what} (its view PNG)")
     elif screenshot:
         check_output_path(screenshot, suffixes=(".png",), what="--screenshot", mkdir=True)
     return out_glb
@@ -304,11 +314,16 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
     from ._atomic import all_or_nothing
 
     with result.stage("export"), all_or_nothing():  # GLB + OBJ + MTL + PNG appear as one set
-        result.files["glb"] = Path(export_glb(baked.mesh, out_glb, metadata=meta,
+        shaded = baked.mesh
+        if obj and normals == "crease":  # split the crease normals once for both files
+            from .export import crease_normals
+
+            shaded, normals = crease_normals(baked.mesh), "mesh"
+        result.files["glb"] = Path(export_glb(shaded, out_glb, metadata=meta,
                                               normals=normals) or out_glb)
         if obj:
             obj_path = out_glb.with_suffix(".obj")
-            result.files["obj"] = Path(export_obj(baked.mesh, obj_path, units=obj_units,
+            result.files["obj"] = Path(export_obj(shaded, obj_path, units=obj_units,
                                                   up=obj_up, normals=normals) or obj_path)
     if screenshot:
         _render_screenshot(baked.mesh, stock, out_glb, result)
@@ -319,7 +334,7 @@ def _render_screenshot(mesh, stock: Stock, out_glb: Path, result: PartPreview) -
     """Render ``mesh`` in ``stock`` off-screen to OUT_view.png beside ``out_glb``."""
     from .view import preview
 
-    png = out_glb.with_name(out_glb.stem + "_view.png")
+    png = screenshot_path(True, out_glb)
     with result.stage("render"):
         preview(mesh, wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
     result.files["png"] = png

@@ -66,13 +66,17 @@ def test_corpus_agrees_with_linuxcnc():
     assert agree == len(CORPUS)
 
 
+def _written(tmp_path, texts: list[str]) -> list:
+    """The fuzzed programs as files fuzz0.ngc, fuzz1.ngc, ... (what the oracle reads)."""
+    paths = [tmp_path / f"fuzz{i}.ngc" for i in range(len(texts))]
+    for p, t in zip(paths, texts):
+        p.write_text(t)
+    return paths
+
+
 def test_fuzzed_programs_agree_with_linuxcnc(tmp_path):
     texts = [program(seed) for seed in range(120)]
-    paths = []
-    for i, t in enumerate(texts):
-        p = tmp_path / f"fuzz{i}.ngc"
-        p.write_text(t)
-        paths.append(p)
+    paths = _written(tmp_path, texts)
     agree, bad = _differences(paths, texts)
     assert not bad, bad[:3]
 
@@ -80,11 +84,7 @@ def test_fuzzed_programs_agree_with_linuxcnc(tmp_path):
 @pytest.mark.slow
 def test_fuzzed_campaign_agrees_with_linuxcnc(tmp_path):
     texts = [program(seed, n_lines=40) for seed in range(1000, 3000)]
-    paths = []
-    for i, t in enumerate(texts):
-        p = tmp_path / f"fuzz{i}.ngc"
-        p.write_text(t)
-        paths.append(p)
+    paths = _written(tmp_path, texts)
     agree, bad = _differences(paths, texts)
     print(f"fuzz campaign: {agree} of {len(paths)} agree with LinuxCNC")
     assert not bad, bad[:3]

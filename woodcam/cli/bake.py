@@ -149,12 +149,10 @@ def run_preview(args: argparse.Namespace) -> int:
             raise WoodcamError("--confidence needs a block whose field was fitted (a block folder "
                                "without a true field, or a Mokume folder); pass --block")
         wood = ConfidenceWood(stock.wood.field)
-    shot = args.screenshot
-    if shot is True:
-        shot = args.mesh.with_name(args.mesh.stem + "_view.png")
-    out = preview(args.mesh, wood=wood,
-                  size_mm=stock.size_mm if stock else None,
-                  screenshot=None if shot is None else Path(shot),
+    from ..pipeline import screenshot_path
+
+    out = preview(args.mesh, wood=wood, size_mm=stock.size_mm if stock else None,
+                  screenshot=screenshot_path(args.screenshot, args.mesh),
                   camera=args.camera, cut_plane=not args.no_cut, cut_origin=args.cut_origin,
                   cut_normal=args.cut_normal)
     if out:

@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_out_option, command_group
+from .options import add_confidence_option, add_out_option, command_group
 
 
 def _list(text: str) -> list[str]:
@@ -40,10 +40,7 @@ def register(subparsers) -> None:
                    help="eq. 7-9 sanity blocks per scenario and face set (default 2; 0 skips)")
     r.add_argument("--face-px", type=int, default=256, help="face image pixels along the largest side (default 256)")
     r.add_argument("--plots", action="store_true", help="also write cut-plane PNGs per block")
-    r.add_argument("--confidence", action="store_true",
-                   help="draw the evidence fit's per-point confidence under its ring lines in the "
-                   "cut-plane PNGs (red unsure, green sure; implies --plots); the confidence table "
-                   "in table.md is written either way (default off)")
+    add_confidence_option(r, "; implies --plots")
     add_out_option(r, "table.md, records.json and cut-plane PNGs")
     r.set_defaults(func=run_realistic)
 

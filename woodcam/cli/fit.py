@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_block_argument, add_out_option, add_size_option, command_group, open_block
+from .options import add_block_argument, add_confidence_option, add_out_option, add_size_option, command_group, open_block
 
 #: Faces used for "partial annotation": three faces meeting at the front-top-left corner, half
 #: of the block's surface (seed 000, section 4.3 traces "half of the block only").
@@ -62,10 +62,7 @@ def register(subparsers) -> None:
     e.add_argument("--detect", action="store_true",
                    help="real blocks: fit from rings detected on the photos (woodcam.detect) and score "
                    "against the block's own ring maps (e.g. the Mokume U-Net maps) as the reference")
-    e.add_argument("--confidence", action="store_true",
-                   help="draw the evidence fit's per-point confidence under its ring lines in the "
-                   "cut-plane PNGs (red unsure, green sure); table.md summarises it either way "
-                   "(default off)")
+    add_confidence_option(e)
     add_out_option(e, "table.md and cut-plane PNGs")
     e.set_defaults(func=run_eval)
 

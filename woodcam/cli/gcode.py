@@ -273,10 +273,11 @@ def _screenshot(args, files: dict, stock, program, offset, made=None, heightmap=
     views with VTK from its light view mesh (or the written GLB)."""
     import numpy as np
 
+    from ..pipeline import screenshot_path
     from ..view import preview
 
     out = Path(args.out)
-    png = out.with_name(out.stem + "_view.png") if args.screenshot is True else Path(args.screenshot)
+    png = screenshot_path(args.screenshot, out)
     overlay = None
     if not args.no_overlay and len(program):
         off = np.asarray(offset if offset else (0.0, 0.0, stock.size_mm[2]), float)

@@ -379,10 +379,10 @@ def write_screenshot(args, files: dict, stock) -> None:
     """Render ``files["glb"]`` to ``--screenshot``'s PNG (or OUT_view.png) when asked."""
     if not getattr(args, "screenshot", None):
         return
+    from ..pipeline import screenshot_path
     from ..view import preview
 
-    out = Path(args.out)
-    png = out.with_name(out.stem + "_view.png") if args.screenshot is True else Path(args.screenshot)
+    png = screenshot_path(args.screenshot, Path(args.out))
     preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
     files["png"] = png
 
@@ -534,6 +534,15 @@ def check_numbers(args: argparse.Namespace) -> None:
         values = value if isinstance(value, (list, tuple)) else [value]
         for v in values:
             _check_value(v, _option(dest), rng)
+
+
+def add_confidence_option(p: argparse.ArgumentParser, note: str = "") -> None:
+    """``--confidence`` of ``eval rings`` / ``eval realistic``: the evidence fit's per-point
+    confidence drawn on the cut planes; ``note`` adds what else it implies."""
+    p.add_argument("--confidence", action="store_true",
+                   help="draw the evidence fit's per-point confidence under its ring lines in the "
+                   f"cut-plane PNGs (red unsure, green sure{note}); table.md summarises it either "
+                   "way (default off)")
 
 
 def add_engine_options(p: argparse.ArgumentParser) -> None:

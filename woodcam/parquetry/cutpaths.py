@@ -161,21 +161,27 @@ def flatten(segs: list, n: int = _FLATTEN) -> np.ndarray:
     return np.concatenate(pts)
 
 
-def _corners(segs: list, orient: float) -> list[tuple[np.ndarray, float]]:
-    """Corners of an outline: ``[(point (2,), interior angle rad)]`` where the tangent jumps;
-    ``orient`` is the sign of the outline's signed area. Convex corners have angle < pi."""
-    out = []
+def _turns(segs: list):
+    """Each joint between consecutive segments of a closed outline: ``(point (2,), sin, cos)``
+    of the turn from the end tangent of one segment to the start tangent of the next
+    (joints with a degenerate tangent are skipped)."""
     for a, b in zip(segs, segs[1:] + segs[:1]):
         ta = a[-1] - a[-2]
         tb = b[2] - b[1]
         na, nb = np.linalg.norm(ta), np.linalg.norm(tb)
         if na < 1e-12 or nb < 1e-12:
             continue
-        cr = float(ta[0] * tb[1] - ta[1] * tb[0]) / (na * nb)
-        dot = float(np.dot(ta, tb)) / (na * nb)
+        yield b[1], float(ta[0] * tb[1] - ta[1] * tb[0]) / (na * nb), float(np.dot(ta, tb)) / (na * nb)
+
+
+def _corners(segs: list, orient: float) -> list[tuple[np.ndarray, float]]:
+    """Corners of an outline: ``[(point (2,), interior angle rad)]`` where the tangent jumps;
+    ``orient`` is the sign of the outline's signed area. Convex corners have angle < pi."""
+    out = []
+    for point, cr, dot in _turns(segs):
         if abs(cr) > PARQUETRY_CORNER_SIN or dot < 0:
             turn = np.arctan2(abs(cr), dot)
-            out.append((np.asarray(b[1], float), np.pi - turn if orient * cr > 0 else np.pi + turn))
+            out.append((np.asarray(point, float), np.pi - turn if orient * cr > 0 else np.pi + turn))
     return out
 
 
@@ -238,15 +244,8 @@ def check_piece(segs: list, min_piece_mm: float, tool_radius_mm: float) -> list[
         if concave.any():
             worst = min(worst, float(1.0 / np.max(np.abs(k[concave]))) if np.max(np.abs(k[concave])) > 0 else np.inf)
     # Corners between segments: a concave corner (turning against the outline) is a violation.
-    for a, b in zip(segs, segs[1:] + segs[:1]):
-        ta = a[-1] - a[-2]
-        tb = b[2] - b[1]
-        na, nb = np.linalg.norm(ta), np.linalg.norm(tb)
-        if na < 1e-12 or nb < 1e-12:
-            continue
-        cr = (ta[0] * tb[1] - ta[1] * tb[0]) / (na * nb)
-        if orient * cr < -PARQUETRY_CORNER_SIN:
-            worst = 0.0
+    if any(orient * cr < -PARQUETRY_CORNER_SIN for _, cr, _ in _turns(segs)):
+        worst = 0.0
     if tool_radius_mm > 0 and worst < PARQUETRY_CURVATURE_SLACK * tool_radius_mm:
         problems.append(f"concave bend of radius {worst:.2f} mm, tighter than the tool radius "
                         f"{tool_radius_mm:g} mm")
