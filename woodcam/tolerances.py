@@ -296,6 +296,17 @@ KNOT_MIN_AREA_PX = 12
 #: this angle with the stem axis: branches leave the stem at 50-90 degrees (seed 001's logs).
 KNOT_PAIR_MIN_ANGLE_DEG = 40.0
 
+#: A knot seen at one exit runs into the block down the stem's year gradient (toward the pith)
+#: only where that direction enters through the exit's face at less than ~78 degrees from its
+#: normal (cos 0.2); more grazing, the fitted stem's gradient there is not the knot's direction
+#: (a knot exits a face it crosses, so it cannot run along it) and the face normal is used.
+KNOT_MIN_ENTRY_COS = 0.2
+
+#: Two exits are one branch only when the stem's years along the line between them do not dip
+#: more than this (years) below both exits': a dip is the pith, and a branch grows out from the
+#: pith on one side only (half a ring: more than a trace's mislabel or a fit's wobble).
+KNOT_PITH_YEARS = 0.5
+
 #: ... and smaller than this share of the largest region on the same face (H11's grown mask of
 #: face C has a 150 px bud beside its 21 000 px knot).
 KNOT_MIN_AREA_SHARE = 0.1

@@ -195,3 +195,56 @@ def test_grid_with_a_knot_layer_answers_the_colour_maps_questions(tmp_path):
     out = g.evaluate(np.array([[2.5, 2.5, 2.5], [0.0, 0.0, 0.0]]), directions=True)
     np.testing.assert_allclose(out["knot"], [1.0, 0.0])
     assert out["direction"].shape == (2, 3) and np.allclose(out["years"], g([[2.5, 2.5, 2.5], [0, 0, 0]]))
+
+
+def radial_stem(points):
+    """Round rings 2 mm apart about a pith along Z through the middle of the 40 mm cube."""
+    p = np.asarray(points, float)
+    return np.hypot(p[:, 0] - 20.0, p[:, 1] - 20.0) / 2.0
+
+
+radial_stem.axis = (0.0, 0.0, 1.0)
+
+
+def _masks_of(truth) -> Block:
+    """A 40 mm cube whose faces mark where ``truth``'s knots cross them."""
+    from woodcam.frames import face_image_size_mm
+
+    faces = {}
+    for name in ("front", "top", "left", "bottom", "right", "back"):
+        h, w = face_image_size_mm(name, SIZE)
+        shape = (int(h * 4), int(w * 4))
+        pts = face_pixel_points(name, shape, SIZE).reshape(-1, 3)
+        faces[name] = Face(name, shape, extras={"knot_mask": (truth.knot_features(pts)["knot"] > 0.5).reshape(shape)})
+    return Block(SIZE, faces, name="whorl")
+
+
+def test_branches_on_both_sides_of_a_pith_inside_the_block_start_at_the_pith():
+    """A pith through the block and two branches out of it, 90 degrees apart (a whorl), each
+    leaving through one face (right, back): two branches, not one strand joining their exits
+    across the stem. Each fitted strand runs from its exit down the stem's years to the pith
+    (not past it), is marked a guess (``pinned=False``) and keeps the stem's ring spacing, so
+    the fitted knots are where the true ones are (known answer: the true strands' volume)."""
+    pith = (20.0, 20.0, 20.0)
+    true = [KnotStrand(pith, (62.0, 20.0, 24.0), 3.0, 3.0), KnotStrand(pith, (20.0, 62.0, 16.0), 3.0, 3.0)]
+    truth = StemWithKnots(radial_stem, true)
+    block = _masks_of(truth)
+    assert sorted(e["face"] for e in knot_exits(block)) == ["back", "right"]
+    fits = fit_knot_strands(block, radial_stem)
+    assert len(fits) == 2 and not any(s.pinned for s in fits)
+    for s in fits:
+        u = np.subtract(s.end_mm, s.start_mm) / np.linalg.norm(np.subtract(s.end_mm, s.start_mm))
+        best = max(abs(u @ (np.subtract(t.end_mm, t.start_mm) / np.linalg.norm(np.subtract(t.end_mm, t.start_mm))))
+                   for t in true)
+        assert best > np.cos(np.deg2rad(8)), best
+        assert np.hypot(s.end_mm[0] - 20.0, s.end_mm[1] - 20.0) < 2.0, s.end_mm  # ends at the pith
+    p = np.random.default_rng(1).uniform(0, 40, (40000, 3))
+    k_true = truth.knot_features(p)["knot"] > 0.5
+    fitted = StemWithKnots(radial_stem, fits)
+    k_fit = fitted.knot_features(p)["knot"] > 0.5
+    assert (k_true & k_fit).sum() / (k_true | k_fit).sum() > 0.6
+    # a guessed strand keeps the stem's ring spacing: no years far below the stem's inside it
+    assert np.all(fitted(p) > radial_stem(p) - 3.0 * 1.0)
+    # a pinned strand (two exits) holds every ring since the pith (seed 003)
+    pinned = StemWithKnots(radial_stem, [KnotStrand(pith, (62.0, 20.0, 24.0), 3.0, 3.0)])
+    assert pinned(np.array([[35.0, 20.0, 21.4]]))[0] < 1.0

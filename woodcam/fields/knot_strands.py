@@ -62,7 +62,10 @@ class KnotStrand:
 
     start_mm, end_mm : (3,) its ends (beyond the block); radius_start_mm, radius_end_mm : knot
     radius at the ends, linear in between; dead : True for a dead knot (seed 003: no ring
-    continuity with the stem, a bark ring at its surface; module docstring).
+    continuity with the stem, a bark ring at its surface; module docstring); pinned : True when
+    two face exits pin the line (its place is measured), False for a strand guessed from one
+    exit (its direction is the stem's, toward the pith: :func:`woodcam.inference.knots.
+    fit_knot_strands`).
     """
 
     start_mm: tuple
@@ -70,6 +73,7 @@ class KnotStrand:
     radius_start_mm: float
     radius_end_mm: float
     dead: bool = False
+    pinned: bool = True
 
     def __post_init__(self):
         if min(self.radius_start_mm, self.radius_end_mm) <= 0:
@@ -97,8 +101,11 @@ class StemWithKnots:
     stem : ``(n, 3) mm -> (n,) years``; strands : list of :class:`KnotStrand`.
     dense : the knot's ring density ``G`` is ``max(G, g(S) / R)`` where ``g(S) > 0``: with growth
         time counted from the pith (woodcam's convention) the knot then holds every ring since
-        the pith and its time is ``b = (d / R) g(p)``, seed 003's ``t_b = d t_s / R``. False keeps
-        the stem's ring spacing inside the knot.
+        the pith and its time is ``b = (d / R) g(p)``, seed 003's ``t_b = d t_s / R``. Only for
+        :attr:`KnotStrand.pinned` strands: a strand guessed from one exit is a few mm off its
+        knot, and dense rings a few mm off write wrong years over the whole cylinder (dev seed
+        21: fitted one-exit strands lowered the cut-plane score, keeping the stem's spacing
+        did not), so it keeps the stem's spacing. False keeps it for every strand.
     """
 
     def __init__(self, stem, strands, smoothing_years: float = KNOT_SMOOTH_YEARS, dense: bool = True):
@@ -117,12 +124,12 @@ class StemWithKnots:
         dens = np.linalg.norm((g[:3] - g[3:]).T, axis=1) / (2 * h)
         gs = np.asarray(self.stem(pts), float)
         a, b = np.asarray(strand.start_mm, float), np.asarray(strand.end_mm, float)
-        return a, b - a, rad, gs, np.maximum(dens, 1e-3)
+        return a, b - a, rad, gs, np.maximum(dens, 1e-3), self.dense and strand.pinned
 
     @staticmethod
     def _geometry(p: np.ndarray, table):
         """``d``, ``R``, ``G`` and the stem time at the strand point of each point."""
-        a, v, rad, gs, dens = table
+        a, v, rad, gs, dens, _ = table
         t = np.clip((p - a) @ v / (v @ v), 0.0, 1.0)
         d = np.linalg.norm(p - (a + t[:, None] * v), axis=1)
         s = t * (len(rad) - 1)
@@ -131,7 +138,7 @@ class StemWithKnots:
 
     def _knot_time(self, p, g, table):
         d, R, G, gS = self._geometry(p, table)
-        if self.dense:  # seed 003: the knot holds every ring since the pith
+        if table[-1]:  # seed 003: the knot holds every ring since the pith
             G = np.where(gS > 0, np.maximum(G, gS / R), G)
         inside = gS + (d / R) * (g - gS) - (R - d) * G
         return np.where(d < R, inside, g + (d - R) * G)
@@ -185,7 +192,8 @@ def strands_to_meta(strands) -> list[dict]:
 
 def strands_from_meta(items) -> list[KnotStrand]:
     return [KnotStrand(tuple(d["start_mm"]), tuple(d["end_mm"]), float(d["radius_start_mm"]),
-                       float(d["radius_end_mm"]), bool(d.get("dead", False))) for d in items]
+                       float(d["radius_end_mm"]), bool(d.get("dead", False)), bool(d.get("pinned", True)))
+            for d in items]
 
 
 __all__ = ["DEAD_KNOT_OUTLINE_MM", "DEAD_KNOT_SMOOTHING_FACTOR", "KNOT_SMOOTH_YEARS", "KnotStrand", "StemWithKnots", "strands_from_meta", "strands_to_meta"]

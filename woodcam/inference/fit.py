@@ -24,8 +24,9 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: :func:`woodcam.stock.fitted_field` are refitted (2: growth history, knot masks, year-free neural;
 #: 3: the evidence-chosen default, uncertainty and fit facts saved with the grid; 4: dense knots;
 #: 5: ring maps read as one-pixel lines, dead knots, uncertainty round knots; 6: the stem
-#: hypothesis and per-fold pith refits in the evidence fit).
-FIT_VERSION = 6
+#: hypothesis and per-fold pith refits in the evidence fit; 7: knot strands end at the pith, one-exit
+#: strands run toward it and keep the stem's ring spacing).
+FIT_VERSION = 7
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,

@@ -5,9 +5,14 @@ centroid (block frame) and equivalent radius ``sqrt(area / pi)``. A branch runs 
 (seed 003: from the pith outward, nearly perpendicular to it), so two exits on different faces
 whose joining line makes more than :data:`~woodcam.tolerances.KNOT_PAIR_MIN_ANGLE_DEG` with the
 stem's axis are one knot, the nearest pairs first (H11: faces C and F). A strand is the line
-through its exits, extended across the block, with the radius linear between the exits' radii.
-An unpaired exit gets a strand into the block along the face's inward normal made perpendicular
-to the stem axis, with its own radius. The strands join the stem field through
+through its exits, extended across the block but not past the pith (the least stem years along
+the line: a branch starts there; two exits with the pith between them are two branches), with
+the radius linear between the exits' radii.
+An unpaired exit gets a strand into the block down the stem's year gradient (toward the pith,
+where a branch starts), ending at the pith, with its own radius; where that gradient does not
+enter the block through the face, along the face's inward normal made perpendicular to the
+stem axis. Its place is a guess (``pinned=False``): it keeps the stem's ring spacing inside
+(:class:`~woodcam.fields.knot_strands.StemWithKnots`). The strands join the stem field through
 :class:`woodcam.fields.knot_strands.StemWithKnots`.
 
 Alive or dead (seed 003) is read from the face photo at each exit (:func:`exit_is_dead`): a dead
@@ -24,7 +29,8 @@ import numpy as np
 from ..fields.knot_strands import KnotStrand, StemWithKnots
 from ..frames import FACE_NORMAL, pixel_to_block
 from ..tolerances import (DEAD_KNOT_BANDS_MM, DEAD_KNOT_MIN_OUTLINED, DEAD_KNOT_SECTORS, KNOT_MIN_AREA_PX,
-                          KNOT_MIN_AREA_SHARE, KNOT_PAIR_MIN_ANGLE_DEG)
+                          KNOT_MIN_AREA_SHARE, KNOT_MIN_ENTRY_COS, KNOT_PAIR_MIN_ANGLE_DEG,
+                          KNOT_PITH_YEARS)
 
 
 def exit_is_dead(photo, region, pixel_mm: float) -> tuple[bool, float]:
@@ -91,6 +97,27 @@ def knot_exits(block, faces=None) -> list[dict]:
     return out
 
 
+#: Samples along a paired strand's line where the stem's years are looked at.
+_LINE_SAMPLES = 256
+
+
+def _toward_pith(stem, point_mm, inward, length: float):
+    """``(direction (3,), reach mm)`` of a branch seen at one exit: it grew from the pith out
+    along the stem's radial direction, so into the block it runs down the stem's year gradient,
+    ``-grad g`` (finite differences, 0.5 mm), and ends at the pith, ``g / |grad g|`` away
+    (at most ``length``). ``(None, length)`` where that direction does not enter the block
+    through the face (``inward`` (3,), its inward normal) or the gradient vanishes."""
+    h = 0.5
+    p = np.asarray(point_mm, float)
+    offs = np.concatenate([np.eye(3), -np.eye(3)]) * h
+    g = np.asarray(stem(np.concatenate([p[None], p + offs])), float)
+    grad = (g[1:4] - g[4:7]) / (2 * h)
+    norm = float(np.linalg.norm(grad))
+    if not np.isfinite(norm) or norm < 1e-6 or -(grad @ inward) / norm < KNOT_MIN_ENTRY_COS:
+        return None, length
+    return -grad / norm, float(np.clip(g[0] / norm + 1.0, 5.0, length)) if np.isfinite(g[0]) else length
+
+
 def fit_knot_strands(block, stem, faces=None) -> list[KnotStrand]:
     """Strands of the knots whose exits the masks show (module docstring)."""
     exits = knot_exits(block, faces)
@@ -112,25 +139,41 @@ def fit_knot_strands(block, stem, faces=None) -> list[KnotStrand]:
     for dist, i, j in sorted(pairs):
         if i in used or j in used:
             continue
-        used |= {i, j}
         a, b = exits[i], exits[j]
         u = (b["centre_mm"] - a["centre_mm"]) / dist
+        # the line's stem years: a branch grows out of the pith, so it ends where they are least
+        t = np.linspace(-length, dist + length, _LINE_SAMPLES)
+        g = np.asarray(stem(a["centre_mm"] + t[:, None] * u), float)
+        between = (t >= 0) & (t <= dist)
+        if not np.all(np.isfinite(g)) or \
+                g[between].min() < min(g[between][0], g[between][-1]) - KNOT_PITH_YEARS:
+            continue  # the pith lies between the exits: two branches, not one
+        used |= {i, j}
+        lo_t, hi_t = -length, dist + length
+        if g[between][0] <= g[between][-1]:  # the pith is beyond exit a: start there
+            lo_t = float(t[t <= 0][np.argmin(g[t <= 0])]) - 1.0
+        else:
+            hi_t = float(t[t >= dist][np.argmin(g[t >= dist])]) + 1.0
         # an oblique strand cuts a face in an ellipse of area pi R^2 / |cos(incidence)|
         ra, rb = (e["radius_mm"] * np.sqrt(max(abs(u @ np.asarray(FACE_NORMAL[e["face"]], float)), 0.2))
                   for e in (a, b))
         slope = (rb - ra) / dist
         lo, hi = 0.5 * min(ra, rb), 2.0 * max(ra, rb)
-        strands.append(KnotStrand(tuple(a["centre_mm"] - u * length), tuple(b["centre_mm"] + u * length),
-                                  float(np.clip(ra - slope * length, lo, hi)),
-                                  float(np.clip(rb + slope * length, lo, hi)), dead=a["dead"] and b["dead"]))
+        strands.append(KnotStrand(tuple(a["centre_mm"] + u * lo_t), tuple(a["centre_mm"] + u * hi_t),
+                                  float(np.clip(ra + slope * lo_t, lo, hi)),
+                                  float(np.clip(ra + slope * hi_t, lo, hi)), dead=a["dead"] and b["dead"]))
     for k, e in enumerate(exits):
         if k in used:
             continue
         n = -np.asarray(FACE_NORMAL[e["face"]], float)  # into the block
-        d = n - axis * (n @ axis)
-        d = d / np.linalg.norm(d) if np.linalg.norm(d) > 0.3 else n
-        strands.append(KnotStrand(tuple(e["centre_mm"] - 2.0 * d), tuple(e["centre_mm"] + length * d),
-                                  e["radius_mm"], e["radius_mm"], dead=e["dead"]))
+        d, reach = _toward_pith(stem, e["centre_mm"] + n, n, length)
+        if d is None:  # the stem gives no usable direction here: the face normal, across the stem
+            d = n - axis * (n @ axis)
+            d = d / np.linalg.norm(d) if np.linalg.norm(d) > 0.3 else n
+        # the exit's area is an ellipse of pi R^2 / |cos(incidence)| on an oblique face
+        r = e["radius_mm"] * np.sqrt(max(abs(d @ n), 0.2))
+        strands.append(KnotStrand(tuple(e["centre_mm"] - 2.0 * d), tuple(e["centre_mm"] + reach * d),
+                                  r, r, dead=e["dead"], pinned=False))
     return strands
 
 
