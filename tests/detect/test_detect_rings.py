@@ -78,6 +78,30 @@ def test_dark_line_rule_sits_on_the_lines_and_rings_are_ordered():
     assert np.nanmax(det.order_map) - np.nanmin(det.order_map) == pytest.approx(len(order), abs=1.5)
 
 
+def test_pieces_of_one_ring_share_its_id():
+    """Lines broken by a 10 px band of pore-like noise across them: the detector finds each line
+    in pieces, and the phase links the pieces of one line (one RingTrace.ring id, one growth
+    time for the fitter) and keeps the lines apart (without the link each piece was a ring of
+    its own to the fitter, and on Mokume CN03 the pieces were numbered as extra rings)."""
+    photo, _ = _line_face()
+    n, a, spacing = photo.shape[0], np.radians(20.0), 14.0
+    rr, cc = np.meshgrid(np.arange(n, dtype=float), np.arange(n, dtype=float), indexing="ij")
+    along = -rr * np.cos(a) + cc * np.sin(a)
+    gap = np.abs(along - np.median(along)) < 5.0
+    noise = 150 + 60 * np.random.default_rng(1).standard_normal(int(gap.sum()))
+    photo[gap] = np.clip(noise, 0, 255).astype(np.uint8)[:, None]
+    det = detect_rings(photo)
+    line = [int(np.round(np.mean(t.points_px @ [np.sin(a), np.cos(a)]) / spacing)) for t in det.traces]
+    ids = [t.ring for t in det.traces]
+    assert None not in ids
+    assert len(det.traces) >= len(set(line)) + 10          # broken: more pieces than lines
+    by_id = {k: {ln for ln, i in zip(line, ids) if i == k} for k in set(ids)}
+    by_line = {ln: {i for ln2, i in zip(line, ids) if ln2 == ln} for ln in set(line)}
+    assert all(len(v) == 1 for v in by_id.values()), by_id       # an id is one line
+    assert all(len(v) == 1 for v in by_line.values()), by_line   # a line is one id
+    assert len(set(ids)) == len(set(line)) >= 12
+
+
 def test_dark_line_and_sharp_edge_rules_on_a_skewed_band():
     """A dark band that darkens slowly and ends sharply (plain synthetic latewood): the
     sharp-edge rule finds the step, the dark-line rule the darkest line just before it."""

@@ -120,6 +120,11 @@ VOTE_SCALE_WAVELENGTHS = 2.0
 SIGNAL_MIN = 0.09
 #: Ring pieces shorter than this many local wavelengths are dropped (pores, specks).
 MIN_TRACE_WAVELENGTHS = 1.0
+#: Longest gap (in local ring spacings) between the ends of two pieces that the phase says are one
+#: ring for them to be linked as one ring (``_ring_ids``): a pore cluster, ray fleck or shake
+#: breaks a ring over a spacing or two; farther apart, an unwrapping error around a knot could
+#: give two rings one order.
+LINK_GAP_WAVELENGTHS = 3.0
 #: Spacing of trace vertices (px) after resampling the contour lines.
 TRACE_STEP_PX = 1.0
 #: Share of the face that must be ring evidence; below it the face has "no rings".
@@ -144,9 +149,11 @@ class RingDetection:
     #: (cycles), 0 on the first band centre found; NaN outside the evidence. It grows by one
     #: per ring along the face's dominant normal, so it orders the rings across the face.
     order_map: np.ndarray | None = None
-    #: Per trace, its ring's place in that order (an integer, relative to this face only: the
-    #: same ring on two faces gets unrelated numbers, so these are not years).
-    ring_order: list[int] = field(default_factory=list)
+    #: Per trace, its ring's place in that order (an integer for a band centre, ``k + 1/2`` for a
+    #: faint ring found between two; relative to this face only: the same ring on two faces
+    #: gets unrelated numbers, so these are not years). Traces of one ring also share their
+    #: ``RingTrace.ring`` id (order within one connected evidence region).
+    ring_order: list[float] = field(default_factory=list)
 
     @property
     def points_px(self) -> np.ndarray:
@@ -293,8 +300,9 @@ def _response(x: np.ndarray, wavelengths, n_orient: int):
             coherence.astype(np.float32), amp_raw.astype(np.float32))
 
 
-def _ring_order(z: np.ndarray, evidence: np.ndarray, polys: list) -> tuple[np.ndarray, list[int]]:
-    """The order map (``RingDetection.order_map``) and each band-centre polyline's place in it.
+def _ring_order(z: np.ndarray, evidence: np.ndarray, polys: list) -> tuple[np.ndarray, list[float]]:
+    """The order map (``RingDetection.order_map``) and each band-centre polyline's place in it
+    (an integer, NaN for a polyline off the evidence region).
 
     The phase of the analytic response rises by 2 pi per ring along the filters' common
     direction; unwrapped over the evidence region (skimage's reliability-sorted unwrapping,
@@ -319,7 +327,77 @@ def _ring_order(z: np.ndarray, evidence: np.ndarray, polys: list) -> tuple[np.nd
     base = np.nanmin(out) if np.isfinite(out).any() else 0.0
     base = np.floor(base + 0.5)
     order[evidence] = (cycles[evidence] - base).astype(np.float32)
-    return order, [int(np.round(o - base)) if np.isfinite(o) else 0 for o in out]
+    return order, [float(np.round(o - base)) if np.isfinite(o) else np.nan for o in out]
+
+
+def _faint_order(order_map: np.ndarray, q: np.ndarray) -> float:
+    """Place ``k + 1/2`` in the ring order of a faint line ``q (k, 2)`` found between the band
+    centres ``k`` and ``k + 1`` (NaN off the evidence region)."""
+    h, w = order_map.shape
+    v = order_map[np.clip(np.round(q[:, 0]).astype(int), 0, h - 1), np.clip(np.round(q[:, 1]).astype(int), 0, w - 1)]
+    return float(np.floor(np.nanmedian(v))) + 0.5 if np.isfinite(v).any() else np.nan
+
+
+def _ring_ids(polys: list, ring_order: list[float], evidence: np.ndarray, order_map: np.ndarray,
+              lam: np.ndarray) -> list[int | None]:
+    """Per piece, the face-local id of the ring it belongs to (:attr:`RingTrace.ring`).
+
+    Why: a ring broken by a pore band, a ray fleck or a jump of the line is still one growth
+    time; handed to the fitter as separate pieces, each gets a level of its own, and on Mokume
+    CN03 (oak) the pieces were then numbered as extra rings. Two pieces are linked when the
+    phase says they are one ring: the same place in the ring order within one connected
+    evidence region (the phase is unwrapped per region), an end of one within
+    :data:`LINK_GAP_WAVELENGTHS` ring spacings of an end of the other, and the unwrapped order
+    along the straight gap between those ends within half a ring of theirs (no other ring
+    crosses it). Only nearby pieces: around a knot or a fork the unwrapped phase can give two
+    far-apart rings the same order. Linked pieces (transitively) share an id; a piece with no
+    order (off the evidence) gets None.
+    """
+    from scipy import ndimage
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = len(polys)
+    if not n:
+        return []
+    h, w = evidence.shape
+    lab, _ = ndimage.label(evidence)
+
+    def pix(q):
+        return (np.clip(np.round(q[:, 0]).astype(int), 0, h - 1), np.clip(np.round(q[:, 1]).astype(int), 0, w - 1))
+
+    keys: list = []
+    for q, o in zip(polys, ring_order):
+        region = lab[pix(q)]
+        region = region[region > 0]
+        keys.append(None if not np.isfinite(o) or not len(region)
+                    else (int(np.bincount(region).argmax()), int(round(2 * o))))
+    ends = [np.stack([q[0], q[-1]]) for q in polys]
+    t = np.linspace(0.0, 1.0, 9)[:, None]
+    rows, cols = [], []
+    by_key: dict = {}
+    for i, k in enumerate(keys):
+        if k is not None:
+            by_key.setdefault(k, []).append(i)
+    for k, members in by_key.items():
+        o = k[1] / 2.0
+        for ai, i in enumerate(members):
+            for j in members[ai + 1:]:
+                d = np.linalg.norm(ends[i][:, None] - ends[j][None], axis=-1)
+                a, b = np.unravel_index(int(np.argmin(d)), d.shape)
+                p, q = ends[i][a], ends[j][b]
+                if d[a, b] > LINK_GAP_WAVELENGTHS * float(lam[pix(((p + q) / 2)[None])][0]):
+                    continue
+                v = order_map[pix(p + t * (q - p))]
+                v = v[np.isfinite(v)]
+                if len(v) and np.max(np.abs(v - o)) > 0.5:
+                    continue
+                rows.append(i)
+                cols.append(j)
+    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
+    _, comp = connected_components(graph, directed=False)
+    ids = {c: i for i, c in enumerate(sorted({int(comp[i]) for i in range(n) if keys[i] is not None}))}
+    return [None if keys[i] is None else ids[int(comp[i])] for i in range(n)]
 
 
 def _instantaneous_wavelength(z: np.ndarray, lam_scale: np.ndarray, wavelengths) -> np.ndarray:
@@ -456,8 +534,10 @@ def _parabolic(values: np.ndarray, i: np.ndarray) -> np.ndarray:
     return i + np.clip(np.where(np.abs(den) > 1e-12, 0.5 * (y0 - y2) / safe, 0.0), -1.0, 1.0)
 
 
-def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rule: str) -> list:
-    """Move band-centre polylines (the fundamental's phase pi) onto the ring line of ``rule``.
+def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rule: str) -> tuple[list, list[int]]:
+    """Move band-centre polylines (the fundamental's phase pi) onto the ring line of ``rule``;
+    returns the moved pieces and, per piece, the index of the polyline it came from (a polyline
+    cut at a jump gives several).
 
     ``"dark-line"``: the darkest line of the band (the minimum across the ring of the luminance
     at :data:`SNAP_SIGMA_PX`, averaged along it); ``"sharp-edge"``: the steeper of the band's two
@@ -467,7 +547,7 @@ def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rul
     from scipy import ndimage
 
     if not polys:
-        return polys
+        return polys, []
     h, w = lum.shape
     p = np.concatenate(polys)
     owner = np.repeat(np.arange(len(polys)), [len(q) for q in polys])
@@ -504,7 +584,7 @@ def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rul
             votes.append((ndimage.gaussian_filter(acc, sigma) / count)[r, c])
         pos = np.where(votes[0] > votes[1], _parabolic(-g, i_f), _parabolic(g, i_r))
         move = (pos - (len(t) - 1) / 2) * step
-    out = []
+    out, src = [], []
     for k, q in enumerate(polys):
         mk = move[owner == k]
         if len(mk) >= SNAP_MEDIAN_VERTICES:
@@ -516,7 +596,8 @@ def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rul
         for piece in np.split(moved, cuts):
             if len(piece) >= 3:
                 out.append(piece)
-    return out
+                src.append(k)
+    return out, src
 
 
 def _sample(img: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -599,12 +680,19 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     even, odd = z.real, z.imag
     # band centres: phase pi of the blended response (odd part 0 where the even part is < 0)
     polys = _contour_runs(odd, evidence & (even < 0), min_len)
-    order_map, ring_order = _ring_order(z, evidence, polys)
+    order_map, centre_order = _ring_order(z, evidence, polys)
+    src = list(range(len(polys)))
     if rule != "dark-centre":
-        polys = _snap(lum, polys, normal, lam, rule)
+        polys, src = _snap(lum, polys, normal, lam, rule)
+    ring_order = [float(centre_order[k]) for k in src]
     if rule == "dark-line" and polys and VALLEY_REL > 0:
-        polys = polys + _faint_lines(lum, polys, normal, lam, evidence, min_len)
-    traces = [RingTrace(p) for p in polys]
+        faint = _faint_lines(lum, polys, normal, lam, evidence, min_len)
+        polys = polys + faint
+        # a faint ring lies between two band centres: order k + 1/2
+        ring_order += [_faint_order(order_map, q) for q in faint]
+    ring_ids = _ring_ids(polys, ring_order, evidence, order_map, lam)
+    ring_order = [o if np.isfinite(o) else 0.0 for o in ring_order]
+    traces = [RingTrace(p, ring=k) for p, k in zip(polys, ring_ids)]
     share = float(evidence.mean())
     if share < MIN_RING_AREA or not traces:
         warnings.append(
