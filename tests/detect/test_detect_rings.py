@@ -102,6 +102,36 @@ def test_pieces_of_one_ring_share_its_id():
     assert len(set(ids)) == len(set(line)) >= 12
 
 
+def test_ring_links_need_one_order_one_region_and_a_short_gap():
+    """``_ring_ids`` on a known order map (vertical rings 14 px apart, order = col / 14): pieces
+    are one ring only with the same place in the order, in one evidence region, across a gap of
+    at most LINK_GAP_WAVELENGTHS spacings; faint lines (after the band centres) link only to
+    faint lines at the same place, not to any between the same two band centres."""
+    from woodcam.detect.rings import LINK_GAP_WAVELENGTHS, _ring_ids
+
+    n, lam = 400, 14.0
+    order_map = np.tile(np.arange(n, dtype=np.float32) / lam, (n, 1))
+    evidence = np.ones((n, n), bool)
+    evidence[165:175] = False                         # two regions: rows < 165 and > 175
+
+    def piece(col, r0, r1):
+        return np.stack([np.arange(r0, r1, dtype=float), np.full(r1 - r0, float(col))], axis=1)
+
+    far = int(220 + LINK_GAP_WAVELENGTHS * lam + 20)
+    polys = [piece(28, 0, 40), piece(28, 60, 100),    # A, B: one ring across a 20 px gap
+             piece(28, 130, 160),                     # H: and on across 30 px
+             piece(42, 0, 40),                        # D: the next ring
+             piece(28, 180, 220),                     # I: past the evidence gap, 20 px from H
+             piece(28, far, far + 30),                # C: I's order and region, too far
+             piece(33, 0, 40), piece(38, 45, 80),     # faint E, F: between rings 2 and 3, apart
+             piece(33, 50, 90)]                       # faint G: E's line
+    order = [2.0, 2.0, 2.0, 3.0, 2.0, 2.0, 33 / lam, 38 / lam, 33 / lam]
+    ids = _ring_ids(polys, order, evidence, order_map, np.full((n, n), lam, np.float32), n_centre=6)
+    a, b, h, d, i, c, e, f, g = ids
+    assert a == b == h and e == g and None not in ids
+    assert len({a, c, d, i, e, f}) == 6
+
+
 def test_dark_line_and_sharp_edge_rules_on_a_skewed_band():
     """A dark band that darkens slowly and ends sharply (plain synthetic latewood): the
     sharp-edge rule finds the step, the dark-line rule the darkest line just before it."""

@@ -125,6 +125,9 @@ MIN_TRACE_WAVELENGTHS = 1.0
 #: breaks a ring over a spacing or two; farther apart, an unwrapping error around a knot could
 #: give two rings one order.
 LINK_GAP_WAVELENGTHS = 3.0
+#: Largest difference (in rings) of two pieces' places in the ring order for them to be one ring:
+#: band centres sit on whole numbers (same number or not), faint lines where they lie between.
+LINK_ORDER_TOL = 0.25
 #: Spacing of trace vertices (px) after resampling the contour lines.
 TRACE_STEP_PX = 1.0
 #: Share of the face that must be ring evidence; below it the face has "no rings".
@@ -330,32 +333,39 @@ def _ring_order(z: np.ndarray, evidence: np.ndarray, polys: list) -> tuple[np.nd
     return order, [float(np.round(o - base)) if np.isfinite(o) else np.nan for o in out]
 
 
-def _faint_order(order_map: np.ndarray, q: np.ndarray) -> float:
-    """Place ``k + 1/2`` in the ring order of a faint line ``q (k, 2)`` found between the band
-    centres ``k`` and ``k + 1`` (NaN off the evidence region)."""
+def _piece_order(order_map: np.ndarray, q: np.ndarray) -> float:
+    """Median of the order map on a polyline ``q (k, 2)``: its place in the ring order, read
+    where it lies (NaN off the evidence region)."""
     h, w = order_map.shape
     v = order_map[np.clip(np.round(q[:, 0]).astype(int), 0, h - 1), np.clip(np.round(q[:, 1]).astype(int), 0, w - 1)]
-    return float(np.floor(np.nanmedian(v))) + 0.5 if np.isfinite(v).any() else np.nan
+    return float(np.nanmedian(v)) if np.isfinite(v).any() else np.nan
 
 
-def _ring_ids(polys: list, ring_order: list[float], evidence: np.ndarray, order_map: np.ndarray,
-              lam: np.ndarray) -> list[int | None]:
+def _ring_ids(polys: list, order: list[float], evidence: np.ndarray, order_map: np.ndarray,
+              lam: np.ndarray, n_centre: int) -> list[int | None]:
     """Per piece, the face-local id of the ring it belongs to (:attr:`RingTrace.ring`).
+
+    ``order``: per piece its place in the ring order (the band centre's integer for a piece of
+    one, where it lies in the order map for a faint line; NaN for none). The first
+    ``n_centre`` pieces come from band centres, the rest are faint lines; a faint line is
+    linked to faint lines only (it lies off every band centre's line by construction).
 
     Why: a ring broken by a pore band, a ray fleck or a jump of the line is still one growth
     time; handed to the fitter as separate pieces, each gets a level of its own, and on Mokume
     CN03 (oak) the pieces were then numbered as extra rings. Two pieces are linked when the
-    phase says they are one ring: the same place in the ring order within one connected
-    evidence region (the phase is unwrapped per region), an end of one within
-    :data:`LINK_GAP_WAVELENGTHS` ring spacings of an end of the other, and the unwrapped order
-    along the straight gap between those ends within half a ring of theirs (no other ring
-    crosses it). Only nearby pieces: around a knot or a fork the unwrapped phase can give two
-    far-apart rings the same order. Linked pieces (transitively) share an id; a piece with no
-    order (off the evidence) gets None.
+    phase says they are one ring: places in the ring order within :data:`LINK_ORDER_TOL` of
+    each other, in one connected evidence region (the phase is unwrapped per region), an end of
+    one within :data:`LINK_GAP_WAVELENGTHS` ring spacings of an end of the other (any two such
+    ends, not only the nearest), and the
+    unwrapped order along the straight gap between those ends within half a ring of theirs (no
+    other ring crosses it). Only nearby pieces: around a knot or a fork the unwrapped phase can
+    give two far-apart rings the same order. Linked pieces (transitively) share an id; a piece
+    with no order (off the evidence) gets None.
     """
     from scipy import ndimage
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
 
     n = len(polys)
     if not n:
@@ -366,38 +376,37 @@ def _ring_ids(polys: list, ring_order: list[float], evidence: np.ndarray, order_
     def pix(q):
         return (np.clip(np.round(q[:, 0]).astype(int), 0, h - 1), np.clip(np.round(q[:, 1]).astype(int), 0, w - 1))
 
-    keys: list = []
-    for q, o in zip(polys, ring_order):
-        region = lab[pix(q)]
-        region = region[region > 0]
-        keys.append(None if not np.isfinite(o) or not len(region)
-                    else (int(np.bincount(region).argmax()), int(round(2 * o))))
-    ends = [np.stack([q[0], q[-1]]) for q in polys]
+    region = np.zeros(n, int)
+    for i, q in enumerate(polys):
+        r = lab[pix(q)]
+        r = r[r > 0]
+        region[i] = np.bincount(r).argmax() if len(r) and np.isfinite(order[i]) else 0
+    o = np.asarray(order, float)
+    faint = np.arange(n) >= n_centre
+    ends = np.concatenate([np.stack([q[0], q[-1]]) for q in polys])          # (2n, 2): piece e // 2
+    piece = np.arange(2 * n) // 2
+    reach = LINK_GAP_WAVELENGTHS * lam[pix(ends)]
+    # candidate end pairs within the largest reach (a k-d tree: faces may hold thousands of pieces)
+    pairs = cKDTree(ends).query_pairs(float(reach.max()), output_type="ndarray")
+    ea, eb = pairs[:, 0], pairs[:, 1]
+    pa, pb = piece[ea], piece[eb]
+    gap = np.linalg.norm(ends[ea] - ends[eb], axis=1)
+    ok = ((pa != pb) & (region[pa] == region[pb]) & (region[pa] > 0) & (faint[pa] == faint[pb])
+          & (np.abs(o[pa] - o[pb]) <= LINK_ORDER_TOL) & (gap <= np.minimum(reach[ea], reach[eb])))
     t = np.linspace(0.0, 1.0, 9)[:, None]
     rows, cols = [], []
-    by_key: dict = {}
-    for i, k in enumerate(keys):
-        if k is not None:
-            by_key.setdefault(k, []).append(i)
-    for k, members in by_key.items():
-        o = k[1] / 2.0
-        for ai, i in enumerate(members):
-            for j in members[ai + 1:]:
-                d = np.linalg.norm(ends[i][:, None] - ends[j][None], axis=-1)
-                a, b = np.unravel_index(int(np.argmin(d)), d.shape)
-                p, q = ends[i][a], ends[j][b]
-                if d[a, b] > LINK_GAP_WAVELENGTHS * float(lam[pix(((p + q) / 2)[None])][0]):
-                    continue
-                v = order_map[pix(p + t * (q - p))]
-                v = v[np.isfinite(v)]
-                if len(v) and np.max(np.abs(v - o)) > 0.5:
-                    continue
-                rows.append(i)
-                cols.append(j)
+    for e, f in zip(ea[ok], eb[ok]):         # few candidates: a short loop
+        v = order_map[pix(ends[e] + t * (ends[f] - ends[e]))]
+        v = v[np.isfinite(v)]
+        if len(v) and np.max(np.abs(v - (o[piece[e]] + o[piece[f]]) / 2)) > 0.5:
+            continue
+        rows.append(piece[e])
+        cols.append(piece[f])
     graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
     _, comp = connected_components(graph, directed=False)
-    ids = {c: i for i, c in enumerate(sorted({int(comp[i]) for i in range(n) if keys[i] is not None}))}
-    return [None if keys[i] is None else ids[int(comp[i])] for i in range(n)]
+    has = region > 0
+    ids = {c: m for m, c in enumerate(sorted({int(comp[k]) for k in range(n) if has[k]}))}
+    return [int(ids[int(comp[k])]) if has[k] else None for k in range(n)]
 
 
 def _instantaneous_wavelength(z: np.ndarray, lam_scale: np.ndarray, wavelengths) -> np.ndarray:
@@ -688,9 +697,14 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     if rule == "dark-line" and polys and VALLEY_REL > 0:
         faint = _faint_lines(lum, polys, normal, lam, evidence, min_len)
         polys = polys + faint
-        # a faint ring lies between two band centres: order k + 1/2
-        ring_order += [_faint_order(order_map, q) for q in faint]
-    ring_ids = _ring_ids(polys, ring_order, evidence, order_map, lam)
+        # a faint ring lies between two band centres: linked by where it lies in the order,
+        # reported as k + 1/2
+        faint_at = [_piece_order(order_map, q) for q in faint]
+        ring_order += [float(np.floor(o)) + 0.5 for o in faint_at]
+    else:
+        faint_at = []
+    n_centre = len(polys) - len(faint_at)
+    ring_ids = _ring_ids(polys, ring_order[:n_centre] + faint_at, evidence, order_map, lam, n_centre)
     ring_order = [o if np.isfinite(o) else 0.0 for o in ring_order]
     traces = [RingTrace(p, ring=k) for p, k in zip(polys, ring_ids)]
     share = float(evidence.mean())
