@@ -355,8 +355,7 @@ def _ring_ids(polys: list, order: list[float], evidence: np.ndarray, order_map: 
     CN03 (oak) the pieces were then numbered as extra rings. Two pieces are linked when the
     phase says they are one ring: places in the ring order within :data:`LINK_ORDER_TOL` of
     each other, in one connected evidence region (the phase is unwrapped per region), an end of
-    one within :data:`LINK_GAP_WAVELENGTHS` ring spacings of an end of the other (any two such
-    ends, not only the nearest), and the
+    one within :data:`LINK_GAP_WAVELENGTHS` ring spacings of the nearest end of the other, and the
     unwrapped order along the straight gap between those ends within half a ring of theirs (no
     other ring crosses it). Only nearby pieces: around a knot or a fork the unwrapped phase can
     give two far-apart rings the same order. Linked pieces (transitively) share an id; a piece
@@ -391,7 +390,15 @@ def _ring_ids(polys: list, order: list[float], evidence: np.ndarray, order_map: 
     ea, eb = pairs[:, 0], pairs[:, 1]
     pa, pb = piece[ea], piece[eb]
     gap = np.linalg.norm(ends[ea] - ends[eb], axis=1)
-    ok = ((pa != pb) & (region[pa] == region[pb]) & (region[pa] > 0) & (faint[pa] == faint[pb])
+    # per pair of pieces only their nearest ends: that gap is where one would continue into
+    # the other, so the test is made there; if the phase says another ring crosses it, other
+    # end pairs do not make them one ring (allowing any pair flipped H11's fit from 5-15 rings
+    # a face to 1-5)
+    first = np.lexsort((gap, np.maximum(pa, pb), np.minimum(pa, pb)))
+    key = np.minimum(pa, pb)[first] * (n + 1) + np.maximum(pa, pb)[first]
+    nearest = np.zeros(len(gap), bool)
+    nearest[first[np.r_[True, key[1:] != key[:-1]]]] = True
+    ok = (nearest & (pa != pb) & (region[pa] == region[pb]) & (region[pa] > 0) & (faint[pa] == faint[pb])
           & (np.abs(o[pa] - o[pb]) <= LINK_ORDER_TOL) & (gap <= np.minimum(reach[ea], reach[eb])))
     t = np.linspace(0.0, 1.0, 9)[:, None]
     rows, cols = [], []
