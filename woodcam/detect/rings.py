@@ -47,6 +47,11 @@ use curved Gabor filters; this is the classical quadrature-filter version of tha
      face is handled): the exact ring boundary of woodcam's plain synthetic faces, whose
      latewood ramps over 45 % of a ring and whose darkest line is therefore not the boundary.
    - ``"dark-centre"``: the band centre itself (the filter's phase alone).
+
+6. Ring pieces. A ring broken by pores, a ray fleck, a knot or a jump of its line comes out in
+   pieces; the phase links the pieces of one ring (``_ring_ids``: same place in the order, one
+   evidence region, a short gap no other ring crosses) and they share ``RingTrace.ring``, so
+   the fitter gives them one growth time instead of numbering each as a ring of its own.
 """
 
 from __future__ import annotations
