@@ -8,11 +8,8 @@ faces it was *not* fitted to can. So:
 1. Hypotheses: the radial fit from its best distinct pith-axis basins
    (:func:`~.radial.fit_radial_hypotheses`), a thin-plate RBF of the (numbered) ring points
    (seed 000's baseline), the best radial stem plus a smoothed RBF of its residual
-   (part 4's small-scale distortion, seed 000 Fig. 16b), the stem model of part 2
-   (:mod:`.stem`: a curved pith near a block axis, ring density by direction, height and year)
-   and the stem plus a smoothed RBF of its residual (a knot bends the stem's rings far beyond
-   its own wood, which the stem family cannot follow: on dev seed 21 the same logs without
-   their knots score 99 % within 1 mm from three faces, with them 53-63 %).
+   (part 4's small-scale distortion, seed 000 Fig. 16b), and the stem model of part 2
+   (:mod:`.stem`: a curved pith near a block axis, ring density by direction, height and year).
 2. Evidence: for each observed face ``f`` every hypothesis' *recipe* is refitted on the other
    faces and predicts ``f``'s ring points. Every recipe sees the fold's faces only: a radial
    hypothesis refits its pith axis by descending from its own axis (the hypothesis names the
