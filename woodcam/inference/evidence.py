@@ -239,13 +239,7 @@ def stem_recipe(size_mm: ArrayLike, seed: int = 0) -> Callable:
     """The stem fit (:func:`~.stem.fit_stem`) from scratch: it sees only the fold's faces."""
     from .stem import fit_stem
 
-    last: dict = {}  # the fold just refitted: the stem + residual hypothesis reuses it
-
-    def refit(obs: RingObservations):
-        if last.get("obs") is not obs:
-            last.update(obs=obs, field=fit_stem(obs, size_mm, seed=seed))
-        return last["field"]
-    return refit
+    return lambda obs: fit_stem(obs, size_mm, seed=seed)
 
 
 def _rbf_recipe(max_points: int) -> Callable:
@@ -316,12 +310,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
             try:
                 hyps.append(Hypothesis("stem", rec(numbered), rec))
             except WoodcamError:  # too few rings for the stem: the others still compete
-                rec = None
-            if rec is not None and "residual" in candidates:
-                # a knot bends the stem's rings far beyond its own wood (dev seed 21: the same
-                # logs without their knots score 99 % from three faces, with them 53-63 %)
-                res_rec = _residual_recipe(rec, EVIDENCE_RBF_POINTS)  # shares the stem's fold fits
-                hyps.append(Hypothesis("stem + residual", res_rec(numbered), res_rec))
+                pass
         if "rbf" in candidates:
             rec = _rbf_recipe(EVIDENCE_RBF_POINTS)
             hyps.append(Hypothesis("rbf", rec(numbered), rec))
