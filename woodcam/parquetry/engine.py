@@ -232,6 +232,7 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
 
     o = params.overlap_px
     patches: list[Patch] = []
+    contexts = [bank.target_context(p.target_feats) for p in panels]
 
     def window(p: Parquetry, r: int, c: int, n: int):
         H, W = p.matched.shape
@@ -242,7 +243,8 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     def place(p: Parquetry, r: int, c: int, n: int) -> None:
         g = window(p, r, c, n)
         tmpl = np.ascontiguousarray(p.target_feats[g[0]:g[2], g[1]:g[3]])
-        m = bank.best(tmpl)
+        ctx = contexts[p.index]
+        m = bank.best(tmpl, None if ctx is None else (ctx, g[0], g[1]))
         if n > 1 and n % 2 == 0:
             h2 = n // 2
             kids = [(r + dr, c + dc) for dr in (0, h2) for dc in (0, h2)]
@@ -250,7 +252,8 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
             ok = True
             for kr, kc in kids:
                 kg = window(p, kr, kc, h2)
-                km = bank.best(np.ascontiguousarray(p.target_feats[kg[0]:kg[2], kg[1]:kg[3]]))
+                km = bank.best(np.ascontiguousarray(p.target_feats[kg[0]:kg[2], kg[1]:kg[3]]),
+                               None if ctx is None else (ctx, kg[0], kg[1]))
                 if km is None:
                     ok = False
                     break
