@@ -4,7 +4,7 @@ triangle rasteriser, a deferred shading pass and a depth-tested line drawer.
 Written by hand because the one renderer installed (VTK, through pyvista) costs ~1 s of imports
 and ~2 s of off-screen rendering for one picture of a 1.6 M-triangle height field, more than the
 whole simulation; a z-buffer over the height field's own grid needs no mesh at all. This module
-imports only numpy and numba.
+imports only numpy, numba and the height field's surface (:mod:`woodcam.toolpath._surface`).
 
 Conventions. ``cam : (16,) float64`` = camera position (3), right (3), up (3), forward (3, unit,
 into the scene), focal length ``f`` in pixels, principal point ``(cx, cy)`` px, near distance
@@ -29,52 +29,9 @@ import math
 import numba
 import numpy as np
 
+from ..toolpath._surface import surface_point, vertex_x, vertex_z
+
 TOP, BOTTOM, FRONT, BACK, LEFT, RIGHT = range(6)
-
-
-@numba.njit(inline="always")
-def _vx(i, nxv, W):
-    """X (mm) of vertex column ``i`` of the height field's vertex grid."""
-    if i <= 0:
-        return 0.0
-    if i >= nxv - 1:
-        return W
-    return (i - 0.5) * W / (nxv - 2)
-
-
-@numba.njit(inline="always")
-def _vz(hm, j, i):
-    """Z (mm) of vertex ``(j, i)``: the nearest cell's height (border vertices copy theirs)."""
-    ny, nx = hm.shape
-    return hm[min(max(j - 1, 0), ny - 1), min(max(i - 1, 0), nx - 1)]
-
-
-@numba.njit(nogil=True, cache=True)
-def surface_z(hm, W, D, x, y):
-    """Height (mm) of the height field's triangulated surface at block-frame ``(x, y)``."""
-    ny, nx = hm.shape
-    nyv, nxv = ny + 2, nx + 2
-    dx, dy = W / nx, D / ny
-    i = min(max(int(math.floor(x / dx + 0.5)), 0), nxv - 2)
-    j = min(max(int(math.floor(y / dy + 0.5)), 0), nyv - 2)
-    x0, x1 = _vx(i, nxv, W), _vx(i + 1, nxv, W)
-    y0, y1 = _vx(j, nyv, D), _vx(j + 1, nyv, D)
-    a = min(max((x - x0) / (x1 - x0), 0.0), 1.0)
-    b = min(max((y - y0) / (y1 - y0), 0.0), 1.0)
-    z00, z01 = _vz(hm, j, i), _vz(hm, j, i + 1)
-    z10, z11 = _vz(hm, j + 1, i), _vz(hm, j + 1, i + 1)
-    if a >= b:  # triangle v00, v01, v11
-        return z00 + a * (z01 - z00) + b * (z11 - z01)
-    return z00 + b * (z10 - z00) + a * (z11 - z10)
-
-
-@numba.njit(nogil=True, cache=True)
-def surface_z_many(hm, W, D, x, y):
-    """:func:`surface_z` at points ``x, y : (k,)`` -> ``(k,)`` mm."""
-    out = np.empty(x.shape[0])
-    for k in range(x.shape[0]):
-        out[k] = surface_z(hm, W, D, x[k], y[k])
-    return out
 
 
 @numba.njit(inline="always")
@@ -163,11 +120,11 @@ def draw_heightfield(hm, W, D, cam, clip, w, h, depth, pos, sid):
     ny, nx = hm.shape
     nyv, nxv = ny + 2, nx + 2
     for j in range(nyv - 1):
-        y0, y1 = _vx(j, nyv, D), _vx(j + 1, nyv, D)
+        y0, y1 = vertex_x(j, nyv, D), vertex_x(j + 1, nyv, D)
         for i in range(nxv - 1):
-            x0, x1 = _vx(i, nxv, W), _vx(i + 1, nxv, W)
-            z00, z01 = _vz(hm, j, i), _vz(hm, j, i + 1)
-            z10, z11 = _vz(hm, j + 1, i), _vz(hm, j + 1, i + 1)
+            x0, x1 = vertex_x(i, nxv, W), vertex_x(i + 1, nxv, W)
+            z00, z01 = vertex_z(hm, j, i), vertex_z(hm, j, i + 1)
+            z10, z11 = vertex_z(hm, j + 1, i), vertex_z(hm, j + 1, i + 1)
             _triangle(cam, clip, w, h, depth, pos, sid, TOP,
                       x0, y0, z00, x1, y0, z01, x1, y1, z11)
             _triangle(cam, clip, w, h, depth, pos, sid, TOP,
@@ -249,6 +206,7 @@ def shade(depth, pos, sid, w, h, cam, hm, size, atlas, charts, lights, material,
     col = np.empty(3)
     nrm = np.empty(3)
     sec = np.empty(3)
+    scratch = np.empty(3)
     for r in range(h):
         for c in range(w):
             k = r * w + c
@@ -316,11 +274,11 @@ def shade(depth, pos, sid, w, h, cam, hm, size, atlas, charts, lights, material,
                         if (-1e-9 <= qx <= W + 1e-9 and -1e-9 <= qy <= D + 1e-9
                                 and -1e-9 <= qz <= H + 1e-9):
                             if section_axis == 0:
-                                su, sv, inside = qy, qz, qz <= surface_z(hm, W, D, qx, qy)
+                                su, sv, inside = qy, qz, qz <= surface_point(hm, W, D, qx, qy, scratch)
                             elif section_axis == 1:
-                                su, sv, inside = qx, qz, qz <= surface_z(hm, W, D, qx, qy)
+                                su, sv, inside = qx, qz, qz <= surface_point(hm, W, D, qx, qy, scratch)
                             else:
-                                su, sv, inside = qx, qy, surface_z(hm, W, D, qx, qy) >= qz
+                                su, sv, inside = qx, qy, surface_point(hm, W, D, qx, qy, scratch) >= qz
                             nv, nu = section.shape[0], section.shape[1]
                             _bilinear(section, 0, 0, nu, nv,
                                       su / section_span[0] * (nu - 1) + 0.5,

@@ -112,7 +112,7 @@ def _section(wood, hm, size, normal, origin):
     """The wood on the cut plane: ``(axis, at_mm, colours (nv, nu, 3) float32 0..255, span
     (2,) mm, outline segments (k, 2, 3) mm)``."""
     from ..appearance.wood import wood_colors
-    from ._zbuffer import surface_z_many
+    from ..toolpath._surface import surface_points
     from .scene import SECTION_MAX_SAMPLES_SCREENSHOT, SECTION_RESOLUTION_MM
 
     axis = int(np.argmax(np.abs(normal)))
@@ -132,7 +132,7 @@ def _section(wood, hm, size, normal, origin):
         u = np.linspace(0, span[0], n)
         xy = np.zeros((n, 2))
         xy[:, axis], xy[:, a] = at, u
-        z = surface_z_many(np.ascontiguousarray(hm, float), W, D, xy[:, 0], xy[:, 1])
+        z, _ = surface_points(np.ascontiguousarray(hm, float), W, D, xy[:, 0], xy[:, 1])
         p = np.zeros((n, 3))
         p[:, :2], p[:, 2] = xy, z
         ends = [p[:-1], p[1:]]
