@@ -87,10 +87,10 @@ def _face_rows(faces, copies, sep, out):
     return p
 
 
-def _number_block(prefix: bytes, values, decimals: int) -> bytes:
+def _number_block(prefix: bytes, values, decimals: int) -> memoryview:
     v = np.ascontiguousarray(values, np.float64)
     if v.size == 0:
-        return b""
+        return memoryview(b"")
     big = float(np.abs(v).max(initial=0.0))
     while decimals > 0 and big * 10.0 ** decimals >= 2.0 ** 62:  # int64 fixed point
         decimals -= 1
@@ -98,21 +98,22 @@ def _number_block(prefix: bytes, values, decimals: int) -> bytes:
     n, k = v.shape
     out = np.empty(n * (len(prefix) + k * (digits + 3 + decimals) + 1), np.uint8)
     end = _fixed_rows(v, decimals, np.frombuffer(prefix, np.uint8), out)
-    return out[:end].tobytes()
+    return memoryview(out)[:end]
 
 
-def obj_body(vertices, uv, normals, faces, *, decimals: int = 9) -> bytes:
-    """``v``, ``vt``, ``vn`` and ``f`` lines of one textured mesh.
+def obj_blocks(vertices, uv, normals, faces, *, decimals: int = 9):
+    """Yield the ``v``, ``vt``, ``vn`` and ``f`` lines of one textured mesh as byte blocks
+    (memoryviews, written to a file one by one: the 1.4 M-triangle relief's OBJ text is ~150 MB,
+    never joined in memory).
 
     ``vertices, normals : (n, 3)``, ``uv : (n, 2)`` share one index per vertex (as
     :func:`woodcam.bake.bake` meshes do), so each face corner is ``i/i/i`` (1-based);
     ``faces : (m, 3)`` int. Coordinates carry ``decimals`` fraction digits; ``vt`` and ``vn``
     carry 9 (unit range)."""
-    parts = []
     for prefix, values, digits in ((b"v ", vertices, decimals), (b"vt ", uv, 9),
                                    (b"vn ", normals, 9)):
         if values is not None:
-            parts.append(_number_block(prefix, values, digits))
+            yield _number_block(prefix, values, digits)
     if uv is not None and normals is not None:
         copies, sep = 3, b"/"  # a/a/a
     elif uv is not None:
@@ -128,5 +129,10 @@ def obj_body(vertices, uv, normals, faces, *, decimals: int = 9) -> bytes:
                        np.uint8)
         end = _face_rows(f, copies, np.frombuffer(sep, np.uint8) if sep else
                          np.zeros(0, np.uint8), out)
-        parts.append(out[:end].tobytes())
-    return b"".join(parts)
+        yield memoryview(out)[:end]
+
+
+def obj_body(vertices, uv, normals, faces, *, decimals: int = 9) -> bytes:
+    """:func:`obj_blocks` joined into one ``bytes``."""
+    return b"".join(bytes(b) for b in obj_blocks(vertices, uv, normals, faces,
+                                                  decimals=decimals))

@@ -86,3 +86,21 @@ def top_chart_points(hm, W, D, w, h):
             pts[k, 1] = y
             pts[k, 2] = surface_point(hm, W, D, x, y, nrm[k])
     return pts, nrm
+
+
+@numba.njit(nogil=True, cache=True)
+def quad_faces(covered, nxv, out):
+    """The two triangles (v00, v01, v11) and (v00, v11, v10) of every quad ``(j, i)`` of the
+    vertex grid not ``covered : (nyv - 1, nxv - 1) bool`` by a merged block, as flat vertex-grid
+    indices into ``out : (2 k, 3)``, row by row."""
+    t = 0
+    for j in range(covered.shape[0]):
+        for i in range(covered.shape[1]):
+            if covered[j, i]:
+                continue
+            v00 = j * nxv + i
+            v10 = v00 + nxv
+            out[t, 0], out[t, 1], out[t, 2] = v00, v00 + 1, v10 + 1
+            out[t + 1, 0], out[t + 1, 1], out[t + 1, 2] = v00, v10 + 1, v10
+            t += 2
+    return t
