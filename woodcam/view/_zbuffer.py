@@ -46,18 +46,18 @@ def _project(cam, x, y, z):
 
 
 @numba.njit(nogil=True)
-def _triangle(cam, clip, w, h, depth, pos, sid, s,
-              ax, ay, az, bx, by, bz, qx, qy, qz):
-    """Draw one triangle (block-frame corners a, b, q) of surface ``s`` into the buffers;
-    fragments on the positive side of the plane ``clip = (nx, ny, nz, d)`` (n . p > d) are
-    dropped (a cutaway), as are those behind the near distance."""
-    sx0, sy0, z0 = _project(cam, ax, ay, az)
-    sx1, sy1, z1 = _project(cam, bx, by, bz)
-    sx2, sy2, z2 = _project(cam, qx, qy, qz)
+def _triangle(cam, clip, w, h, depth, pos, sid, s, ax, ay, az, bx, by, bz, qx, qy, qz,
+              sx0, sy0, z0, sx1, sy1, z1, sx2, sy2, z2):
+    """Draw one triangle (block-frame corners a, b, q, projected to ``(sx, sy, z)`` by
+    :func:`_project`) of surface ``s`` into the buffers. Triangles facing away from the camera
+    are skipped: the stock is closed with outward, counter-clockwise faces, and where the cut
+    opens it the opaque section covers its inside. Fragments on the positive side of the plane
+    ``clip = (nx, ny, nz, d)`` (n . p > d) are dropped (a cutaway), as are triangles with a
+    corner behind the near distance."""
     if z0 <= 0.0 or z1 <= 0.0 or z2 <= 0.0:
         return
     area = (sx1 - sx0) * (sy2 - sy0) - (sy1 - sy0) * (sx2 - sx0)
-    if abs(area) < 1e-12:
+    if area > -1e-12:  # facing away (y grows downwards: front faces have area < 0) or edge-on
         return
     c0 = max(0, int(math.ceil(min(sx0, sx1, sx2) - 0.5)))
     c1 = min(w - 1, int(math.floor(max(sx0, sx1, sx2) - 0.5)))
@@ -116,29 +116,47 @@ def _triangle(cam, clip, w, h, depth, pos, sid, s,
 @numba.njit(nogil=True, cache=True)
 def draw_heightfield(hm, W, D, cam, clip, w, h, depth, pos, sid):
     """Rasterise the height field's top surface (surface :data:`TOP`): its ``(ny + 1) x
-    (nx + 1)`` vertex-grid quads as two triangles each."""
+    (nx + 1)`` vertex-grid quads as two triangles each, every vertex projected once (two rows
+    of projections kept)."""
     ny, nx = hm.shape
     nyv, nxv = ny + 2, nx + 2
-    for j in range(nyv - 1):
-        y0, y1 = vertex_x(j, nyv, D), vertex_x(j + 1, nyv, D)
-        for i in range(nxv - 1):
-            x0, x1 = vertex_x(i, nxv, W), vertex_x(i + 1, nxv, W)
-            z00, z01 = vertex_z(hm, j, i), vertex_z(hm, j, i + 1)
-            z10, z11 = vertex_z(hm, j + 1, i), vertex_z(hm, j + 1, i + 1)
-            _triangle(cam, clip, w, h, depth, pos, sid, TOP,
-                      x0, y0, z00, x1, y0, z01, x1, y1, z11)
-            _triangle(cam, clip, w, h, depth, pos, sid, TOP,
-                      x0, y0, z00, x1, y1, z11, x0, y1, z10)
+    prev = np.empty((nxv, 3))
+    cur = np.empty((nxv, 3))
+    for j in range(nyv):
+        y1 = vertex_x(j, nyv, D)
+        for i in range(nxv):
+            cur[i, 0], cur[i, 1], cur[i, 2] = _project(cam, vertex_x(i, nxv, W), y1,
+                                                       vertex_z(hm, j, i))
+        if j > 0:
+            y0 = vertex_x(j - 1, nyv, D)
+            for i in range(nxv - 1):
+                x0, x1 = vertex_x(i, nxv, W), vertex_x(i + 1, nxv, W)
+                z00, z01 = vertex_z(hm, j - 1, i), vertex_z(hm, j - 1, i + 1)
+                z10, z11 = vertex_z(hm, j, i), vertex_z(hm, j, i + 1)
+                _triangle(cam, clip, w, h, depth, pos, sid, TOP,
+                          x0, y0, z00, x1, y0, z01, x1, y1, z11,
+                          prev[i, 0], prev[i, 1], prev[i, 2], prev[i + 1, 0], prev[i + 1, 1],
+                          prev[i + 1, 2], cur[i + 1, 0], cur[i + 1, 1], cur[i + 1, 2])
+                _triangle(cam, clip, w, h, depth, pos, sid, TOP,
+                          x0, y0, z00, x1, y1, z11, x0, y1, z10,
+                          prev[i, 0], prev[i, 1], prev[i, 2], cur[i + 1, 0], cur[i + 1, 1],
+                          cur[i + 1, 2], cur[i, 0], cur[i, 1], cur[i, 2])
+        prev, cur = cur, prev
 
 
 @numba.njit(nogil=True, cache=True)
 def draw_triangles(tri, surface, cam, clip, w, h, depth, pos, sid):
-    """Rasterise triangles ``tri : (m, 3, 3)`` (block frame, mm) of surfaces
-    ``surface : (m,) int``."""
+    """Rasterise triangles ``tri : (m, 3, 3)`` (block frame, mm; counter-clockwise seen from
+    outside) of surfaces ``surface : (m,) int``."""
     for t in range(tri.shape[0]):
-        _triangle(cam, clip, w, h, depth, pos, sid, surface[t],
-                  tri[t, 0, 0], tri[t, 0, 1], tri[t, 0, 2], tri[t, 1, 0], tri[t, 1, 1],
-                  tri[t, 1, 2], tri[t, 2, 0], tri[t, 2, 1], tri[t, 2, 2])
+        ax, ay, az = tri[t, 0, 0], tri[t, 0, 1], tri[t, 0, 2]
+        bx, by, bz = tri[t, 1, 0], tri[t, 1, 1], tri[t, 1, 2]
+        qx, qy, qz = tri[t, 2, 0], tri[t, 2, 1], tri[t, 2, 2]
+        sx0, sy0, z0 = _project(cam, ax, ay, az)
+        sx1, sy1, z1 = _project(cam, bx, by, bz)
+        sx2, sy2, z2 = _project(cam, qx, qy, qz)
+        _triangle(cam, clip, w, h, depth, pos, sid, surface[t], ax, ay, az, bx, by, bz,
+                  qx, qy, qz, sx0, sy0, z0, sx1, sy1, z1, sx2, sy2, z2)
 
 
 @numba.njit(inline="always")

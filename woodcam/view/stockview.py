@@ -105,7 +105,14 @@ def _walls(hm, size):
     tris.append(np.array([[[0, 0, 0], [W, 0, 0], [W, D, 0]], [[0, 0, 0], [W, D, 0], [0, D, 0]]],
                          float))
     ids.append(np.full(2, BOTTOM))
-    return np.ascontiguousarray(np.vstack(tris)), np.concatenate(ids).astype(np.int64)
+    tri, sid = np.vstack(tris), np.concatenate(ids).astype(np.int64)
+    # counter-clockwise seen from outside (the rasteriser skips faces turned away)
+    outward = np.array([[0, 0, 1], [0, 0, -1], [0, -1, 0], [0, 1, 0], [-1, 0, 0],
+                        [1, 0, 0]], float)[sid]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    flip = np.einsum("ij,ij->i", n, outward) < 0
+    tri[flip] = tri[flip][:, [0, 2, 1]]
+    return np.ascontiguousarray(tri), sid
 
 
 def _section(wood, hm, size, normal, origin):
