@@ -142,3 +142,28 @@ def test_it_frames_the_stock_as_the_vtk_screenshot_does(bowl, tmp_path):
     assert (a & b_).sum() / (a | b_).sum() > 0.95
     both = a & b_
     assert np.median(np.abs(vtk[both] - ours[both]).max(axis=-1)) < 25
+
+
+def test_preview_heightfield_draws_its_screenshot_without_vtk(tmp_path, bowl, monkeypatch):
+    """``preview_heightfield(screenshot=True)`` writes NAME_view.png from the atlas it baked
+    (pyvista is never asked for) and keeps the atlas and its charts on the result."""
+    import sys
+
+    from PIL import Image
+
+    from woodcam.pipeline import preview_heightfield
+    from woodcam.stock import open_stock
+
+    hm, _, _ = bowl
+    monkeypatch.setitem(sys.modules, "pyvista", None)  # an import of it would fail
+    stock = open_stock("builtin:flat-sawn")
+    stock_hm = hm - H + stock.size_mm[2]  # the bowl on the block's top
+    res = preview_heightfield(stock_hm, stock, tmp_path / "s.glb", texels_per_mm=2.0, obj=False,
+                              screenshot=True)
+    assert res.files["png"] == tmp_path / "s_view.png"
+    with Image.open(res.files["png"]) as im:
+        assert im.size == (1280, 960)
+        img = np.asarray(im.convert("RGB"))
+    assert (img.min(axis=-1) < 200).mean() > 0.1  # the stock is drawn, not a white picture
+    top = res.chart_texels("top")
+    assert top.shape[:2] == (int(np.ceil(stock.size_mm[1] * 2)), int(np.ceil(stock.size_mm[0] * 2)))
