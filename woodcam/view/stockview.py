@@ -154,7 +154,8 @@ def _section(wood, hm, size, normal, origin):
 def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, charts: dict, *,
                wood: WoodLike | None = None, camera: Camera = "iso",
                overlay: list[tuple] | None = None, window_size: tuple[int, int] = (1280, 960),
-               supersample: int = 2, background=(255, 255, 255)) -> np.ndarray:
+               supersample: int = 2,
+               background: tuple[float, float, float] = (255, 255, 255)) -> np.ndarray:
     """The stock seen from ``camera``: an ``(h, w, 3) uint8`` image (module docstring).
 
     Parameters
@@ -177,6 +178,8 @@ def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, ch
     window_size : (width, height) px
     supersample : int
         Render at this many times the size and average down (1 = no anti-aliasing).
+    background : (3,) float
+        RGB 0..255 where no stock, block or section is seen.
     """
     from . import _zbuffer as zb
     from .scene import BLOCK_COLOR, BLOCK_EDGE_COLOR, BLOCK_OPACITY, OUTLINE_COLOR, WASTE_OPACITY
