@@ -137,3 +137,20 @@ def test_real_block_manifest_may_name_an_svg(tmp_path):
     t = read_block(tmp_path).faces["top"].traces
     assert len(t) == 1 and t[0].year == 11
     np.testing.assert_allclose(t[0].points_px, [[2, 3], [4, 25]], atol=1e-12)
+
+
+def test_ring_ids_round_trip_and_bad_ones_are_refused(tmp_path):
+    """The detector's face-local ring ids (pieces of one ring) survive the SVG; a bad
+    ``data-ring`` is one clear error naming the attribute."""
+    line = np.stack([np.full(5, 3.0), np.arange(5.0)], axis=1)
+    face = Face("front", (20, 20), traces=[RingTrace(line, ring=4), RingTrace(line + [6, 0], ring=4),
+                                           RingTrace(line + [12, 0])])
+    back = read_traces_svg(write_traces_svg(face, tmp_path / "f.svg"), face.shape)
+    assert [t.ring for t in back] == [4, 4, None]
+    bad = tmp_path / "bad.svg"
+    bad.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="20" height="20">'
+                   '<polyline data-ring="x1" points="0,0 5,5"/></svg>')
+    with pytest.raises(WoodcamError, match="data-ring must be a non-negative integer"):
+        read_traces_svg(bad, (20, 20))
+    with pytest.raises(WoodcamError, match="ring of a ring trace must be a non-negative integer"):
+        RingTrace(line, ring=-1)

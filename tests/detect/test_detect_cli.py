@@ -54,6 +54,14 @@ def test_from_photos_detect_show_and_fit(synth_photos, tmp_path, capsys, monkeyp
     assert rc == 0, err
     assert sorted(p.name for p in blk.iterdir()) == before
     assert len(list((tmp_path / "cache" / "detect").glob("*.npz"))) == 1
+    # the cached detection keeps which pieces are one ring (RingTrace.ring)
+    from woodcam.detect.block import with_detected_rings
+
+    fresh = with_detected_rings(read_block(blk), cache=False)
+    cached = with_detected_rings(read_block(blk))
+    for name in FACES:
+        rings = [t.ring for t in fresh.faces[name].traces]
+        assert [t.ring for t in cached.faces[name].traces] == rings and None not in rings, name
     # detect into the folder: ring maps, SVG traces read back, knot-free
     rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
     assert rc == 0, err
@@ -61,6 +69,7 @@ def test_from_photos_detect_show_and_fit(synth_photos, tmp_path, capsys, monkeyp
     for name, f in b.faces.items():
         assert (blk / f"{name}_traces.svg").is_file()
         assert f.traces and f.ring_map is not None and f.ring_map.max() > 0.99, name
+        assert [t.ring for t in f.traces] == [t.ring for t in fresh.faces[name].traces], name
         assert "knot_mask" not in f.extras
     rc, _out, err = _run(capsys, "rings", "show", blk, "--out", tmp_path / "check.png")
     assert rc == 0, err

@@ -78,6 +78,60 @@ def test_dark_line_rule_sits_on_the_lines_and_rings_are_ordered():
     assert np.nanmax(det.order_map) - np.nanmin(det.order_map) == pytest.approx(len(order), abs=1.5)
 
 
+def test_pieces_of_one_ring_share_its_id():
+    """Lines broken by a 10 px band of pore-like noise across them: the detector finds each line
+    in pieces, and the phase links the pieces of one line (one RingTrace.ring id, one growth
+    time for the fitter) and keeps the lines apart (without the link each piece was a ring of
+    its own to the fitter, and on Mokume CN03 the pieces were numbered as extra rings)."""
+    photo, _ = _line_face()
+    n, a, spacing = photo.shape[0], np.radians(20.0), 14.0
+    rr, cc = np.meshgrid(np.arange(n, dtype=float), np.arange(n, dtype=float), indexing="ij")
+    along = -rr * np.cos(a) + cc * np.sin(a)
+    gap = np.abs(along - np.median(along)) < 5.0
+    noise = 150 + 60 * np.random.default_rng(1).standard_normal(int(gap.sum()))
+    photo[gap] = np.clip(noise, 0, 255).astype(np.uint8)[:, None]
+    det = detect_rings(photo)
+    line = [int(np.round(np.mean(t.points_px @ [np.sin(a), np.cos(a)]) / spacing)) for t in det.traces]
+    ids = [t.ring for t in det.traces]
+    assert None not in ids
+    assert len(det.traces) >= len(set(line)) + 10          # broken: more pieces than lines
+    by_id = {k: {ln for ln, i in zip(line, ids) if i == k} for k in set(ids)}
+    by_line = {ln: {i for ln2, i in zip(line, ids) if ln2 == ln} for ln in set(line)}
+    assert all(len(v) == 1 for v in by_id.values()), by_id       # an id is one line
+    assert all(len(v) == 1 for v in by_line.values()), by_line   # a line is one id
+    assert len(set(ids)) == len(set(line)) >= 12
+
+
+def test_ring_links_need_one_order_one_region_and_a_short_gap():
+    """``_ring_ids`` on a known order map (vertical rings 14 px apart, order = col / 14): pieces
+    are one ring only with the same place in the order, in one evidence region, across a gap of
+    at most LINK_GAP_WAVELENGTHS spacings; faint lines (after the band centres) link only to
+    faint lines at the same place, not to any between the same two band centres."""
+    from woodcam.detect.rings import LINK_GAP_WAVELENGTHS, _ring_ids
+
+    n, lam = 400, 14.0
+    order_map = np.tile(np.arange(n, dtype=np.float32) / lam, (n, 1))
+    evidence = np.ones((n, n), bool)
+    evidence[165:175] = False                         # two regions: rows < 165 and > 175
+
+    def piece(col, r0, r1):
+        return np.stack([np.arange(r0, r1, dtype=float), np.full(r1 - r0, float(col))], axis=1)
+
+    far = int(220 + LINK_GAP_WAVELENGTHS * lam + 20)
+    polys = [piece(28, 0, 40), piece(28, 60, 100),    # A, B: one ring across a 20 px gap
+             piece(28, 130, 160),                     # H: and on across 30 px
+             piece(42, 0, 40),                        # D: the next ring
+             piece(28, 180, 220),                     # I: past the evidence gap, 20 px from H
+             piece(28, far, far + 30),                # C: I's order and region, too far
+             piece(33, 0, 40), piece(38, 45, 80),     # faint E, F: between rings 2 and 3, apart
+             piece(33, 50, 90)]                       # faint G: E's line
+    order = [2.0, 2.0, 2.0, 3.0, 2.0, 2.0, 33 / lam, 38 / lam, 33 / lam]
+    ids = _ring_ids(polys, order, evidence, order_map, np.full((n, n), lam, np.float32), n_centre=6)
+    a, b, h, d, i, c, e, f, g = ids
+    assert a == b == h and e == g and None not in ids
+    assert len({a, c, d, i, e, f}) == 6
+
+
 def test_dark_line_and_sharp_edge_rules_on_a_skewed_band():
     """A dark band that darkens slowly and ends sharply (plain synthetic latewood): the
     sharp-edge rule finds the step, the dark-line rule the darkest line just before it."""

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from woodcam.block import Block, Face
+from woodcam.block import Block, Face, RingTrace
 from woodcam.frames import FACES
 from woodcam.inference.observations import gather_observations
 
@@ -39,3 +39,26 @@ def test_ring_map_groups_are_one_ring_each():
     # every ring is still seen (the blob's rows are dropped, the rest of rings 50 and 80 kept)
     seen = {c for c in RING_COLS if np.any(np.abs(col - c) <= 1.5)}
     assert seen == set(RING_COLS)
+
+
+def test_unlabelled_pieces_of_one_ring_are_one_group():
+    """Traces sharing a ``ring`` id on a face (the detector's pieces of one ring) are one group,
+    so the fitter gives them one growth time; other traces, labelled ones and the same id on
+    another face stay apart."""
+    col = np.linspace(0, 40, 41)
+
+    def piece(row, c0, c1, year=None, ring=None):
+        c = col[(col >= c0) & (col <= c1)]
+        return RingTrace(np.stack([np.full(len(c), float(row)), c], axis=1), year, ring)
+
+    front = Face("front", (200, 200), traces=[piece(10, 0, 15, ring=0), piece(10, 25, 40, ring=0),
+                                              piece(30, 0, 40, ring=1), piece(50, 0, 40)])
+    top = Face("top", (200, 200), traces=[piece(10, 0, 40, ring=0), piece(30, 0, 40, ring=0)])
+    obs = gather_observations(Block((50.0, 50.0, 50.0), {"front": front, "top": top}))
+    fr = obs.face == FACES.index("front")
+    rows = np.round(50.0 - obs.points_mm[fr, 2] / 0.25 - 0.5)       # front: block z = (h - row) * px
+    groups = {int(r): set(obs.group[fr][rows == r]) for r in np.unique(rows)}
+    assert [len(g) for g in groups.values()] == [1, 1, 1]           # each ring one group
+    assert len(set().union(*groups.values())) == 3                  # three rings, three groups
+    assert len(np.unique(obs.group[~fr])) == 1                      # id 0 on top: its own group
+    assert not set(obs.group[~fr]) & set(obs.group[fr])

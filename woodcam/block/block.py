@@ -28,10 +28,16 @@ class RingTrace:
         Polyline vertices as continuous pixel coordinates ``(row, col)``.
     year : int or None
         Growth year of the ring boundary (the integer iso-line ``GTF = year``), if labelled.
+    ring : int or None
+        Which ring of its face the trace is a piece of, when known without a year: pieces of one
+        ring broken by a pore band, a knot or a gap share it (the ring detector links them by
+        its phase order, :mod:`woodcam.detect.rings`), so the fitter gives them one growth time.
+        An id relative to its face only (not a year, not comparable across faces).
     """
 
     points_px: np.ndarray
     year: int | None = None
+    ring: int | None = None
 
     def __post_init__(self):
         from ..limits import limit
@@ -56,6 +62,12 @@ class RingTrace:
                 raise WoodcamError(f"year of a ring trace must be an integer in [-{top:.0f}, "
                                    f"{top:.0f}] or None; got {y!r}")
             object.__setattr__(self, "year", int(y))
+        k = self.ring
+        if k is not None:
+            if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 0:
+                raise WoodcamError(f"ring of a ring trace must be a non-negative integer id or None; "
+                                   f"got {k!r}")
+            object.__setattr__(self, "ring", int(k))
         object.__setattr__(self, "points_px", p)
 
 

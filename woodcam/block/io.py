@@ -15,7 +15,8 @@ Manifest (``"format": "woodcam-block"``, ``"version": 1``)::
                          "photo": "front_photo.png" | null,
                          "ring_map": "front_ring_map.png" | null,
                          "ring_map_bits": 16 | 8,
-                         "traces": [{"year": int | null, "points_px": [[row, col], ...]}, ...],
+                         "traces": [{"year": int | null, "points_px": [[row, col], ...],
+                                     "ring": int (optional)}, ...],
                          "traces_svg": "front_traces.svg",    (optional, read only: see below)
                          "extras": {"knot_mask": {"png": "front_knot_mask.png", "dtype": "bool"},
                                     "note": {"json": ...}}},
@@ -115,7 +116,8 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
             entry["ring_map_bits"] = int(ring_map_bits)
             _write_png(folder / entry["ring_map"], _quantise(face.ring_map, ring_map_bits, name))
         entry["traces"] = [
-            {"year": None if t.year is None else int(t.year), "points_px": t.points_px.tolist()}
+            {"year": None if t.year is None else int(t.year), "points_px": t.points_px.tolist(),
+             **({} if t.ring is None else {"ring": int(t.ring)})}
             for t in face.traces
         ]
         extras = {}
@@ -173,7 +175,7 @@ def read_block(folder: PathLike, *, allow_outside: bool | None = None) -> Block:
                     f"{int(raw.max())}, more than ring_map_bits = {bits} allows; set "
                     f"\"ring_map_bits\": 16 for a 16-bit PNG")
             ring_map = (raw.astype(np.float64) / (2 ** bits - 1)).astype(np.float32)
-        traces = [RingTrace(np.asarray(t["points_px"], dtype=float), t.get("year"))
+        traces = [RingTrace(np.asarray(t["points_px"], dtype=float), t.get("year"), t.get("ring"))
                   for t in entry.get("traces", [])]
         if entry.get("traces_svg"):
             from .svg import read_traces_svg

@@ -12,7 +12,9 @@ where it is drawn: ``<path>`` (every command, curves ``C S Q T A`` included, sam
 in any unit (``mm``, ``in``, ``px``) with or without a ``viewBox``. The drawing's width and
 height are mapped onto the face image. A stroke's year comes from its own ``data-year``
 attribute, or an ``id`` / ``inkscape:label`` such as ``year-12`` or ``12``; otherwise the trace
-is unlabelled (a layer's label is not a year of the strokes in it).
+is unlabelled (a layer's label is not a year of the strokes in it). A stroke's ``data-ring``
+(written by the ring detector: pieces of one ring share it, see :class:`RingTrace`) is kept;
+give a redrawn piece the same ``data-ring`` as the rest of its ring, or delete the attribute.
 """
 
 from __future__ import annotations
@@ -59,6 +61,8 @@ def write_traces_svg(face: Face, path, *, photo_href: str | None = None, stroke_
                  "stroke": "#ffffff" if t.year is None else _PALETTE[t.year % len(_PALETTE)]}
         if t.year is not None:
             attrs["data-year"] = str(int(t.year))
+        if t.ring is not None:
+            attrs["data-ring"] = str(int(t.ring))
         ET.SubElement(group, "polyline", attrs)
     path = Path(path)
     with atomic_path(path) as tmp:
@@ -95,11 +99,12 @@ def read_traces_svg(path, shape) -> list[RingTrace]:
         if not isinstance(el, (svgelements.Path, svgelements.Polyline, svgelements.SimpleLine)):
             continue  # Polygon is a Polyline; rects, circles, images and text are no traces
         year = _year(el.values.get("attributes", {}))
+        ring = _ring(el.values.get("attributes", {}))
         path_ = el if isinstance(el, svgelements.Path) else svgelements.Path(el)
         for xy in _polylines(path_, scale):
             if len(xy) >= 2:
                 px = xy * scale
-                traces.append(RingTrace(np.stack([px[:, 1] - 0.5, px[:, 0] - 0.5], axis=1), year))
+                traces.append(RingTrace(np.stack([px[:, 1] - 0.5, px[:, 0] - 0.5], axis=1), year, ring))
     return traces
 
 
@@ -129,6 +134,17 @@ def _polylines(path, scale: np.ndarray) -> list[np.ndarray]:
     if len(cur) >= 2:
         lines.append(np.vstack(cur))
     return lines
+
+
+def _ring(attributes: dict) -> int | None:
+    """The face-local ring id of an element's ``data-ring`` attribute (:class:`RingTrace`)."""
+    v = attributes.get("data-ring")
+    if v is None:
+        return None
+    if not re.fullmatch(r"\s*\d+\s*", v):
+        raise WoodcamError(f"data-ring must be a non-negative integer (the ring a piece belongs to); "
+                           f"got {v!r}: fix or delete the attribute")
+    return int(v)
 
 
 def _year(attributes: dict) -> int | None:

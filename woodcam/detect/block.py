@@ -39,8 +39,9 @@ from ..errors import WoodcamError, WoodcamWarning
 from .knots import detect_knots
 from .rings import DEFAULT_RULE, RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, ring_map_from_traces
 
-#: Bumped whenever detection results change, so cached detections are recomputed.
-DETECT_VERSION = 2
+#: Bumped whenever detection results change, so cached detections are recomputed (3: traces
+#: carry their face-local ring id, ``RingTrace.ring``).
+DETECT_VERSION = 3
 
 
 Detector = Literal["classical", "learned"]
@@ -235,13 +236,14 @@ def _detection_key(block: Block, rule: str) -> str:
 
 
 def _save_detection(value, tmp: Path) -> None:
-    """One ``.npz``: per face its traces (vertices and lengths), ring map (uint16) and knot mask."""
+    """One ``.npz``: per face its traces (vertices, lengths and ring ids, -1 for none), ring map (uint16) and knot mask."""
     faces, msgs = value
     arrays = {"warnings": np.array(json.dumps(msgs))}
     for n, f in faces.items():
         pts = [t.points_px for t in f.traces]
         arrays[f"{n}.points"] = np.concatenate(pts) if pts else np.zeros((0, 2))
         arrays[f"{n}.lengths"] = np.array([len(q) for q in pts], np.int64)
+        arrays[f"{n}.rings"] = np.array([-1 if t.ring is None else t.ring for t in f.traces], np.int64)
         if f.ring_map is not None:
             arrays[f"{n}.ring_map"] = np.round(np.clip(f.ring_map, 0, 1) * 65535).astype(np.uint16)
         if "knot_mask" in f.extras:
@@ -259,7 +261,9 @@ def _load_detection(path: Path):
         faces = {}
         for n in names:
             cuts = np.cumsum(z[f"{n}.lengths"])[:-1]
-            traces = [RingTrace(q) for q in np.split(z[f"{n}.points"], cuts) if len(q) >= 2]
+            rings = z[f"{n}.rings"] if f"{n}.rings" in z.files else np.full(len(z[f"{n}.lengths"]), -1)
+            traces = [RingTrace(q, ring=None if k < 0 else int(k))
+                      for q, k in zip(np.split(z[f"{n}.points"], cuts), rings) if len(q) >= 2]
             rm = z[f"{n}.ring_map"].astype(np.float32) / 65535 if f"{n}.ring_map" in z.files else None
             extras = {"knot_mask": z[f"{n}.knot_mask"]} if f"{n}.knot_mask" in z.files else {}
             faces[n] = (traces, rm, extras)

@@ -47,6 +47,11 @@ use curved Gabor filters; this is the classical quadrature-filter version of tha
      face is handled): the exact ring boundary of woodcam's plain synthetic faces, whose
      latewood ramps over 45 % of a ring and whose darkest line is therefore not the boundary.
    - ``"dark-centre"``: the band centre itself (the filter's phase alone).
+
+6. Ring pieces. A ring broken by pores, a ray fleck, a knot or a jump of its line comes out in
+   pieces; the phase links the pieces of one ring (``_ring_ids``: same place in the order, one
+   evidence region, a short gap no other ring crosses) and they share ``RingTrace.ring``, so
+   the fitter gives them one growth time instead of numbering each as a ring of its own.
 """
 
 from __future__ import annotations
@@ -120,6 +125,14 @@ VOTE_SCALE_WAVELENGTHS = 2.0
 SIGNAL_MIN = 0.09
 #: Ring pieces shorter than this many local wavelengths are dropped (pores, specks).
 MIN_TRACE_WAVELENGTHS = 1.0
+#: Longest gap (in local ring spacings) between the ends of two pieces that the phase says are one
+#: ring for them to be linked as one ring (``_ring_ids``): a pore cluster, ray fleck or shake
+#: breaks a ring over a spacing or two; farther apart, an unwrapping error around a knot could
+#: give two rings one order.
+LINK_GAP_WAVELENGTHS = 3.0
+#: Largest difference (in rings) of two pieces' places in the ring order for them to be one ring:
+#: band centres sit on whole numbers (same number or not), faint lines where they lie between.
+LINK_ORDER_TOL = 0.25
 #: Spacing of trace vertices (px) after resampling the contour lines.
 TRACE_STEP_PX = 1.0
 #: Share of the face that must be ring evidence; below it the face has "no rings".
@@ -144,9 +157,11 @@ class RingDetection:
     #: (cycles), 0 on the first band centre found; NaN outside the evidence. It grows by one
     #: per ring along the face's dominant normal, so it orders the rings across the face.
     order_map: np.ndarray | None = None
-    #: Per trace, its ring's place in that order (an integer, relative to this face only: the
-    #: same ring on two faces gets unrelated numbers, so these are not years).
-    ring_order: list[int] = field(default_factory=list)
+    #: Per trace, its ring's place in that order (an integer for a band centre, ``k + 1/2`` for a
+    #: faint ring found between two; relative to this face only: the same ring on two faces
+    #: gets unrelated numbers, so these are not years). Traces of one ring also share their
+    #: ``RingTrace.ring`` id (order within one connected evidence region).
+    ring_order: list[float] = field(default_factory=list)
 
     @property
     def points_px(self) -> np.ndarray:
@@ -293,8 +308,9 @@ def _response(x: np.ndarray, wavelengths, n_orient: int):
             coherence.astype(np.float32), amp_raw.astype(np.float32))
 
 
-def _ring_order(z: np.ndarray, evidence: np.ndarray, polys: list) -> tuple[np.ndarray, list[int]]:
-    """The order map (``RingDetection.order_map``) and each band-centre polyline's place in it.
+def _ring_order(z: np.ndarray, evidence: np.ndarray, polys: list) -> tuple[np.ndarray, list[float]]:
+    """The order map (``RingDetection.order_map``) and each band-centre polyline's place in it
+    (an integer, NaN for a polyline off the evidence region).
 
     The phase of the analytic response rises by 2 pi per ring along the filters' common
     direction; unwrapped over the evidence region (skimage's reliability-sorted unwrapping,
@@ -319,7 +335,90 @@ def _ring_order(z: np.ndarray, evidence: np.ndarray, polys: list) -> tuple[np.nd
     base = np.nanmin(out) if np.isfinite(out).any() else 0.0
     base = np.floor(base + 0.5)
     order[evidence] = (cycles[evidence] - base).astype(np.float32)
-    return order, [int(np.round(o - base)) if np.isfinite(o) else 0 for o in out]
+    return order, [float(np.round(o - base)) if np.isfinite(o) else np.nan for o in out]
+
+
+def _piece_order(order_map: np.ndarray, q: np.ndarray) -> float:
+    """Median of the order map on a polyline ``q (k, 2)``: its place in the ring order, read
+    where it lies (NaN off the evidence region)."""
+    h, w = order_map.shape
+    v = order_map[np.clip(np.round(q[:, 0]).astype(int), 0, h - 1), np.clip(np.round(q[:, 1]).astype(int), 0, w - 1)]
+    return float(np.nanmedian(v)) if np.isfinite(v).any() else np.nan
+
+
+def _ring_ids(polys: list, order: list[float], evidence: np.ndarray, order_map: np.ndarray,
+              lam: np.ndarray, n_centre: int) -> list[int | None]:
+    """Per piece, the face-local id of the ring it belongs to (:attr:`RingTrace.ring`).
+
+    ``order``: per piece its place in the ring order (the band centre's integer for a piece of
+    one, where it lies in the order map for a faint line; NaN for none). The first
+    ``n_centre`` pieces come from band centres, the rest are faint lines; a faint line is
+    linked to faint lines only (it lies off every band centre's line by construction).
+
+    Why: a ring broken by a pore band, a ray fleck or a jump of the line is still one growth
+    time; handed to the fitter as separate pieces, each gets a level of its own, and on Mokume
+    CN03 (oak) the pieces were then numbered as extra rings. Two pieces are linked when the
+    phase says they are one ring: places in the ring order within :data:`LINK_ORDER_TOL` of
+    each other, in one connected evidence region (the phase is unwrapped per region), an end of
+    one within :data:`LINK_GAP_WAVELENGTHS` ring spacings of the nearest end of the other, and the
+    unwrapped order along the straight gap between those ends within half a ring of theirs (no
+    other ring crosses it). Only nearby pieces: around a knot or a fork the unwrapped phase can
+    give two far-apart rings the same order. Linked pieces (transitively) share an id; a piece
+    with no order (off the evidence) gets None.
+    """
+    from scipy import ndimage
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    n = len(polys)
+    if not n:
+        return []
+    h, w = evidence.shape
+    lab, _ = ndimage.label(evidence)
+
+    def pix(q):
+        return (np.clip(np.round(q[:, 0]).astype(int), 0, h - 1), np.clip(np.round(q[:, 1]).astype(int), 0, w - 1))
+
+    region = np.zeros(n, int)
+    for i, q in enumerate(polys):
+        r = lab[pix(q)]
+        r = r[r > 0]
+        region[i] = np.bincount(r).argmax() if len(r) and np.isfinite(order[i]) else 0
+    o = np.asarray(order, float)
+    faint = np.arange(n) >= n_centre
+    ends = np.concatenate([np.stack([q[0], q[-1]]) for q in polys])          # (2n, 2): piece e // 2
+    piece = np.arange(2 * n) // 2
+    reach = LINK_GAP_WAVELENGTHS * lam[pix(ends)]
+    # candidate end pairs within the largest reach (a k-d tree: faces may hold thousands of pieces)
+    pairs = cKDTree(ends).query_pairs(float(reach.max()), output_type="ndarray")
+    ea, eb = pairs[:, 0], pairs[:, 1]
+    pa, pb = piece[ea], piece[eb]
+    gap = np.linalg.norm(ends[ea] - ends[eb], axis=1)
+    # per pair of pieces only their nearest ends: that gap is where one would continue into
+    # the other, so the test is made there; if the phase says another ring crosses it, other
+    # end pairs do not make them one ring (allowing any pair flipped H11's fit from 5-15 rings
+    # a face to 1-5)
+    first = np.lexsort((gap, np.maximum(pa, pb), np.minimum(pa, pb)))
+    key = np.minimum(pa, pb)[first] * (n + 1) + np.maximum(pa, pb)[first]
+    nearest = np.zeros(len(gap), bool)
+    nearest[first[np.r_[True, key[1:] != key[:-1]]]] = True
+    ok = (nearest & (pa != pb) & (region[pa] == region[pb]) & (region[pa] > 0) & (faint[pa] == faint[pb])
+          & (np.abs(o[pa] - o[pb]) <= LINK_ORDER_TOL) & (gap <= np.minimum(reach[ea], reach[eb])))
+    t = np.linspace(0.0, 1.0, 9)[:, None]
+    rows, cols = [], []
+    for e, f in zip(ea[ok], eb[ok]):         # few candidates: a short loop
+        v = order_map[pix(ends[e] + t * (ends[f] - ends[e]))]
+        v = v[np.isfinite(v)]
+        if len(v) and np.max(np.abs(v - (o[piece[e]] + o[piece[f]]) / 2)) > 0.5:
+            continue
+        rows.append(piece[e])
+        cols.append(piece[f])
+    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
+    _, comp = connected_components(graph, directed=False)
+    has = region > 0
+    ids = {c: m for m, c in enumerate(sorted({int(comp[k]) for k in range(n) if has[k]}))}
+    return [int(ids[int(comp[k])]) if has[k] else None for k in range(n)]
 
 
 def _instantaneous_wavelength(z: np.ndarray, lam_scale: np.ndarray, wavelengths) -> np.ndarray:
@@ -456,8 +555,10 @@ def _parabolic(values: np.ndarray, i: np.ndarray) -> np.ndarray:
     return i + np.clip(np.where(np.abs(den) > 1e-12, 0.5 * (y0 - y2) / safe, 0.0), -1.0, 1.0)
 
 
-def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rule: str) -> list:
-    """Move band-centre polylines (the fundamental's phase pi) onto the ring line of ``rule``.
+def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rule: str) -> tuple[list, list[int]]:
+    """Move band-centre polylines (the fundamental's phase pi) onto the ring line of ``rule``;
+    returns the moved pieces and, per piece, the index of the polyline it came from (a polyline
+    cut at a jump gives several).
 
     ``"dark-line"``: the darkest line of the band (the minimum across the ring of the luminance
     at :data:`SNAP_SIGMA_PX`, averaged along it); ``"sharp-edge"``: the steeper of the band's two
@@ -467,7 +568,7 @@ def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rul
     from scipy import ndimage
 
     if not polys:
-        return polys
+        return polys, []
     h, w = lum.shape
     p = np.concatenate(polys)
     owner = np.repeat(np.arange(len(polys)), [len(q) for q in polys])
@@ -504,7 +605,7 @@ def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rul
             votes.append((ndimage.gaussian_filter(acc, sigma) / count)[r, c])
         pos = np.where(votes[0] > votes[1], _parabolic(-g, i_f), _parabolic(g, i_r))
         move = (pos - (len(t) - 1) / 2) * step
-    out = []
+    out, src = [], []
     for k, q in enumerate(polys):
         mk = move[owner == k]
         if len(mk) >= SNAP_MEDIAN_VERTICES:
@@ -516,7 +617,8 @@ def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rul
         for piece in np.split(moved, cuts):
             if len(piece) >= 3:
                 out.append(piece)
-    return out
+                src.append(k)
+    return out, src
 
 
 def _sample(img: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -599,12 +701,24 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     even, odd = z.real, z.imag
     # band centres: phase pi of the blended response (odd part 0 where the even part is < 0)
     polys = _contour_runs(odd, evidence & (even < 0), min_len)
-    order_map, ring_order = _ring_order(z, evidence, polys)
+    order_map, centre_order = _ring_order(z, evidence, polys)
+    src = list(range(len(polys)))
     if rule != "dark-centre":
-        polys = _snap(lum, polys, normal, lam, rule)
+        polys, src = _snap(lum, polys, normal, lam, rule)
+    ring_order = [float(centre_order[k]) for k in src]
     if rule == "dark-line" and polys and VALLEY_REL > 0:
-        polys = polys + _faint_lines(lum, polys, normal, lam, evidence, min_len)
-    traces = [RingTrace(p) for p in polys]
+        faint = _faint_lines(lum, polys, normal, lam, evidence, min_len)
+        polys = polys + faint
+        # a faint ring lies between two band centres: linked by where it lies in the order,
+        # reported as k + 1/2
+        faint_at = [_piece_order(order_map, q) for q in faint]
+        ring_order += [float(np.floor(o)) + 0.5 for o in faint_at]
+    else:
+        faint_at = []
+    n_centre = len(polys) - len(faint_at)
+    ring_ids = _ring_ids(polys, ring_order[:n_centre] + faint_at, evidence, order_map, lam, n_centre)
+    ring_order = [o if np.isfinite(o) else 0.0 for o in ring_order]
+    traces = [RingTrace(p, ring=k) for p, k in zip(polys, ring_ids)]
     share = float(evidence.mean())
     if share < MIN_RING_AREA or not traces:
         warnings.append(

@@ -2,7 +2,9 @@
 
 Faces are laid out as the unfolded cross of ``docs/conventions.md`` (left | front | right | back,
 top above front, bottom below front), enlarged ``zoom`` times so one-pixel lines stay visible.
-Drawn on each photo: the ring traces (red), the knot masks' outlines (yellow) and, when a
+Drawn on each photo: the ring traces (red; pieces the detector linked into one ring,
+``RingTrace.ring``, share one of :data:`RING_RGBS`, neighbouring ids differ, so a wrong link
+shows as a colour jumping between lines), the knot masks' outlines (yellow) and, when a
 reference ring map is given (e.g. Mokume's U-Net map), its ridge (cyan dots).
 """
 
@@ -14,6 +16,9 @@ from ..errors import WoodcamError
 from ..frames import unfold_cross
 
 TRACE_RGB = (230, 30, 30)
+#: Colours of linked ring pieces, by ring id (cycled): warm, apart from the knot yellow and the
+#: reference cyan.
+RING_RGBS = ((230, 30, 30), (255, 140, 0), (255, 60, 200), (255, 255, 255))
 KNOT_RGB = (255, 220, 0)
 REFERENCE_RGB = (0, 230, 255)
 
@@ -41,7 +46,8 @@ def face_picture(face, zoom: int = 2, reference_map: np.ndarray | None = None) -
     draw = ImageDraw.Draw(im)
     for t in face.traces:
         xy = ((t.points_px[:, ::-1] + 0.5) * zoom).ravel().tolist()
-        draw.line(xy, fill=TRACE_RGB, width=max(1, zoom // 2))
+        rgb = TRACE_RGB if t.ring is None else RING_RGBS[t.ring % len(RING_RGBS)]
+        draw.line(xy, fill=rgb, width=max(1, zoom // 2))
     return np.asarray(im)
 
 

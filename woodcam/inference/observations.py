@@ -1,8 +1,9 @@
 """Ring observations of a block gathered for fitting: points on ring boundaries, block frame.
 
 Each observation is a point ``points_mm : (n, 3)`` on a ring boundary (an integer iso-surface of
-the growth field), grouped by ``group : (n,) int`` (one group per traced polyline or per
-connected ring-map component: all points of a group lie on one ring) with ``years : (n,) float``
+the growth field), grouped by ``group : (n,) int`` (one group per traced polyline, per set of unlabelled
+pieces of one ring of a face that share a ``RingTrace.ring`` id, or per connected ring-map
+component: all points of a group lie on one ring) with ``years : (n,) float``
 (NaN where unlabelled). ``face : (n,) int`` indexes :data:`woodcam.frames.FACES`.
 """
 
@@ -141,28 +142,37 @@ def gather_observations(block, faces=None, step_mm: float = TRACE_SAMPLE_STEP_MM
             )
         excl = knot_exclusion(f, min(dr, dc))
         if f.traces:
-            polys = [(t.points_px, t.year) for t in f.traces]
+            polys = [(t.points_px, t.year, t.ring) for t in f.traces]
             px_step = step_mm / max(min(dr, dc), 1e-12)
-            polys = [(resample_polyline(p, px_step), y) for p, y in polys]
+            polys = [(resample_polyline(p, px_step), y, k) for p, y, k in polys]
             if excl is not None:  # traced knot rings, or stem rings bent round the knot
-                polys = [(p[~excl[_pixel_index(p[:, 0], f.shape[0]), _pixel_index(p[:, 1], f.shape[1])]], y)
-                         for p, y in polys]
-                polys = [(p, y) for p, y in polys if len(p)]
+                polys = [(p[~excl[_pixel_index(p[:, 0], f.shape[0]), _pixel_index(p[:, 1], f.shape[1])]], y, k)
+                         for p, y, k in polys]
+                polys = [(p, y, k) for p, y, k in polys if len(p)]
         elif f.ring_map is not None:
             comps = _ring_map_components(f.ring_map, ring_map_threshold, excl)
             stride = max(1, int(round(step_mm / max(min(dr, dc), 1e-12))))
             # one-pixel ring lines, kept every half step (0.25 mm): twice the traces' density,
             # about what the old blob sampling gave, which the neural fit's year-free gap term
             # (midpoints between neighbouring rings) was tuned on
-            polys = [(c[::max(1, stride // 2)] if len(c) > 4 * stride else c, None) for c in comps]
+            polys = [(c[::max(1, stride // 2)] if len(c) > 4 * stride else c, None, None) for c in comps]
         else:
             continue
-        for p, year in polys:
+        # unlabelled pieces of one ring of this face (RingTrace.ring) are one group: one level
+        ring_group: dict[int, int] = {}
+        for p, year, ring in polys:
+            if year is None and ring is not None:
+                if ring not in ring_group:
+                    ring_group[ring] = g
+                    g += 1
+                gi = ring_group[ring]
+            else:
+                gi = g
+                g += 1
             pts.append(pixel_to_block(name, p[:, 0], p[:, 1], f.shape, block.size_mm))
             yrs.append(np.full(len(p), np.nan if year is None else float(year)))
-            grp.append(np.full(len(p), g))
+            grp.append(np.full(len(p), gi))
             fc.append(np.full(len(p), FACES.index(name)))
-            g += 1
     if not pts:
         raise WoodcamError(
             f"block {block.name!r} has no ring traces or ring-map rings on faces {names}; "
