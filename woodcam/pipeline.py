@@ -11,9 +11,13 @@ import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ._types import Mesh, PathLike
 from .stock import Stock
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 @dataclass
@@ -43,12 +47,17 @@ class PartPreview:
     tessellation: dict = field(default_factory=dict)
     atlas: str = ""
     report: dict = field(default_factory=dict)
-    #: a light textured mesh for screenshots (the height-field preview's coarser grid over the
-    #: same atlas), or None: draw the written GLB
-    view_mesh: object = None
-    #: the height-field preview's top chart of the atlas ((h, w, 3) uint8, row 0 at Y = D):
-    #: the stock seen from +Z (:func:`woodcam.view.topview.top_view`)
-    top_texels: object = None
+    #: a height-field preview's baked atlas ((h, w, 3) uint8) and its charts (name -> (x0, y0,
+    #: width, height, span u mm, span v mm) px, :class:`woodcam.toolpath.mesh.HeightfieldCharts`):
+    #: what :func:`woodcam.view.stockview.stock_view` and the top view draw; None otherwise
+    texture: object = None
+    charts: object = None
+
+    def chart_texels(self, name: str) -> np.ndarray:
+        """The ``(h, w, 3) uint8`` texels of chart ``name`` ("top": the stock seen from +Z, row
+        0 at Y = D) of a height-field preview's atlas."""
+        x0, y0, w, h = (int(v) for v in self.charts[name][:4])
+        return self.texture[y0:y0 + h, x0:x0 + w]
 
     @contextmanager
     def stage(self, name: str) -> Iterator[None]:
@@ -153,13 +162,12 @@ def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: 
 def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                         flat_tol_mm: float = 0.01, obj: bool = True, screenshot: bool = False,
                         metadata: dict | None = None, obj_units: str = "m",
-                        obj_up: str = "y", max_atlas_px: int = 4096,
-                        view_mesh: bool = False) -> PartPreview:
+                        obj_up: str = "y", max_atlas_px: int = 4096) -> PartPreview:
     """:func:`preview_mesh` for a simulated stock ``heightmap : (ny, nx)`` (block-frame Z, mm,
     over the stock's XY): meshed and baked by its own planar charts
-    (:func:`woodcam.bake.bake_heightfield`), no generic unwrap. ``view_mesh``: also make the
-    light mesh a VTK screenshot draws (``PartPreview.view_mesh``; made anyway for
-    ``screenshot``)."""
+    (:func:`woodcam.bake.bake_heightfield`), no generic unwrap. The result keeps the atlas and
+    its charts (``texture``, ``charts``) for views drawn from them; ``screenshot`` draws the
+    iso view with :func:`woodcam.view.stockview.write_stock_view` (no VTK)."""
     import numpy as np
 
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
@@ -176,55 +184,20 @@ def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: floa
     result = _write_preview(baked, stock, out_glb, result, obj=obj, screenshot=False,
                             metadata=metadata, obj_units=obj_units, obj_up=obj_up,
                             normals="mesh", report_mesh=None)
-    if view_mesh or screenshot:
-        with result.stage("view mesh"):
-            result.view_mesh = _heightfield_view_mesh(heightmap, stock.size_mm, baked,
-                                                      flat_tol_mm=flat_tol_mm)
     from .toolpath.mesh import HeightfieldCharts
 
-    x0, y0, w, h, _, _ = HeightfieldCharts(np.zeros((1, 1)), stock.size_mm,
-                                           baked.texels_per_mm).charts["top"]
-    result.top_texels = baked.atlas[y0:y0 + h, x0:x0 + w]
+    result.texture = baked.atlas
+    result.charts = HeightfieldCharts(np.zeros((1, 1)), stock.size_mm,
+                                      baked.texels_per_mm).charts
     if screenshot:
-        _render_screenshot(result.view_mesh, stock, out_glb, result)
+        from .view.stockview import write_stock_view
+
+        png = screenshot_path(True, out_glb)
+        with result.stage("render"):
+            write_stock_view(png, heightmap, stock.size_mm, result.texture, result.charts,
+                             wood=stock.wood)
+        result.files["png"] = png
     return result
-
-
-#: Longest side, in cells, of the grid a height-field screenshot draws: a 1280-pixel view of
-#: the whole stock shows about this many cells across, so a finer grid only costs render time
-#: (the 20,000-move raster's 1000 x 800 grid: 397,000 triangles -> ~70,000, 2x faster render).
-VIEW_GRID_CELLS = 400
-
-
-def _heightfield_view_mesh(heightmap, size_mm, baked, *, flat_tol_mm: float):
-    """The height field meshed at most :data:`VIEW_GRID_CELLS` cells across (block means),
-    textured by the full-resolution ``baked`` atlas: the charts depend only on the stock size
-    and texel density, so the coarse mesh's texel coordinates point into the same atlas."""
-    import math
-
-    import numpy as np
-    import trimesh
-
-    from .bake import _textured_mesh
-    from .toolpath.mesh import heightfield_mesh_charts
-
-    hm = np.asarray(heightmap, float)
-    k = math.ceil(max(hm.shape) / VIEW_GRID_CELLS)
-    if k <= 1:
-        return baked.mesh
-    ny, nx = (-(-n // k) for n in hm.shape)
-    pad = np.pad(hm, ((0, ny * k - hm.shape[0]), (0, nx * k - hm.shape[1])), mode="edge")
-    coarse = pad.reshape(ny, k, nx, k).mean(axis=(1, 3))
-    mesh, uv_px, charts, vn = heightfield_mesh_charts(coarse, size_mm, baked.texels_per_mm,
-                                                      flat_tol_mm=flat_tol_mm)
-    h, w = baked.atlas.shape[:2]
-    if tuple(charts.size_px) != (w, h):  # pragma: no cover - one layout for one size/density
-        return baked.mesh
-    uv = np.column_stack([uv_px[:, 0] / w, 1.0 - uv_px[:, 1] / h])
-    out = _textured_mesh(trimesh, np.asarray(mesh.vertices), np.asarray(mesh.faces), uv,
-                         baked.atlas)
-    out.vertex_normals = vn
-    return out
 
 
 def bake_heightfield(heightmap, size_mm, wood, *, texels_per_mm: float = 10.0,

@@ -13,6 +13,7 @@ the shared machine's load; wall seconds are stored too.
 
 from __future__ import annotations
 
+import functools
 import json
 import sys
 import time
@@ -60,14 +61,24 @@ def _figures(run, prm):
          "mean_patch_cost_px": float(np.mean([q.cost_px for q in run.patches]))}
     if run.complete:
         k = round(prm.px_per_mm)
-        d.update(feature_cost=feature_cost(p, p.render, prm), feature_cost_baseline=feature_cost(p, p.baseline, prm),
-                 ssim=ssim_vs_matched(p, p.render), ssim_baseline=ssim_vs_matched(p, p.baseline),
-                 ssim_1mm=ssim_vs_matched(p, p.render, k), ssim_1mm_baseline=ssim_vs_matched(p, p.baseline, k))
+        # Two baselines: the paper's (Fig. 8: each piece of the *result* in its mean colour,
+        # p.baseline) and an oracle that no wood gives, each piece in the *target's* mean
+        # (matched) intensity: it shows how much of the error is tone rather than structure.
+        lab = p.labels.ravel()
+        tmean = np.bincount(lab, p.matched.ravel()) / np.maximum(np.bincount(lab), 1)
+        oracle = np.repeat(tmean[lab].reshape(p.labels.shape)[..., None], 3, axis=2).astype(np.float32)
+        for key, im in (("", p.render), ("_baseline", p.baseline), ("_oracle_target_mean", oracle)):
+            d["feature_cost" + key] = feature_cost(p, im, prm)
+            d["ssim" + key] = ssim_vs_matched(p, im)
+            d["ssim_1mm" + key] = ssim_vs_matched(p, im, k)
+            d["feature_cost_native" + key] = feature_cost(p, im, prm, "native")
+            d["ssim_native" + key] = ssim_vs_matched(p, im, grid="native")
+        d["native_px"] = list(p.native_shape)
     return d
 
 
 def quality(images=("camera", "astronaut", "coffee", "chelsea"), size_mm=112.0, ppm=2.0,
-            exhaustive=()):
+            exhaustive=(), variants=("fast", "fast_eq4_only", "reuse")):
     """Parquetry (fast, and exhaustive for ``exhaustive``) vs baseline vs reuse, per image."""
     import dataclasses
 
@@ -87,6 +98,7 @@ def quality(images=("camera", "astronaut", "coffee", "chelsea"), size_mm=112.0, 
                 ("reuse", dataclasses.replace(base, single_use=False))]
         if name in exhaustive:
             runs.insert(1, ("exhaustive", dataclasses.replace(base, mode="exhaustive")))
+        runs = [r for r in runs if r[0] in variants or r[0] == "exhaustive"]
         for label, prm in runs:
             run = build_parquetry([img], sheets, prm)
             res[label] = _figures(run, prm)
@@ -219,6 +231,39 @@ def full_workload(out_dir=None, runs=("fast", "eq4_only", "reuse")):
         out["runs"][label] = d
         print(label, json.dumps(d), flush=True)
     return out
+
+
+@functools.lru_cache(maxsize=1)
+def _full_fast():
+    return full_workload(runs=("fast",))["runs"]["fast"]
+
+
+def test_quality_bar_on_the_skimage_targets():
+    """The issue's bar on real targets nobody here made (112 mm panels at 2 px/mm, where the
+    512 px images carry 4.6 px/mm, finer than the working grid): the render beats the paper's
+    mean-colour baseline on eq. 8 and on SSIM at 1 mm pixels, on all four."""
+    r = quality(variants=("fast",))["images"]
+    for name, res in r.items():
+        f = res["fast"]
+        assert f["feature_cost"] < f["feature_cost_baseline"], name
+        assert f["ssim_1mm"] > f["ssim_1mm_baseline"], name
+
+
+def test_quality_on_the_full_workload_on_the_targets_own_pixels():
+    """The issue's workload (camera at 360 mm: 512 px over 364 mm, 1.4 px/mm): on the target's
+    own 512 x 512 pixels the render beats the mean-colour baseline on eq. 8 (at the working
+    0.25 mm pixels it does not: see the README)."""
+    f = _full_fast()
+    assert f["complete"] and f["native_px"] == [512, 512]
+    assert f["feature_cost_native"] < f["feature_cost_native_baseline"]
+
+
+@pytest.mark.xfail(strict=True, reason="not met: at 1.4 px/mm of target every veneer here has "
+                   "grain (std 0.03-0.05 in 5 mm windows, far above SSIM's C2 = 0.03^2) where "
+                   "the camera is flat, which a flat colour does not; see README")
+def test_full_workload_beats_the_baseline_on_ssim():
+    f = _full_fast()
+    assert f["ssim"] > f["ssim_baseline"] and f["ssim_native"] > f["ssim_native_baseline"]
 
 
 def test_fast_mode_within_5_percent_of_exhaustive_on_camera():

@@ -96,7 +96,9 @@ def _cli_run(tmp_path, src_root, label, extra=()):
     run = subprocess.run([sys.executable, "-c", code, "gcode", str(prog), "--block",
                           "builtin:flat-sawn", "--out", str(tmp_path / f"{label}.glb"), "--tool",
                           "2=ball:6", "--screenshot", *extra], capture_output=True, text=True,
-                         env={**os.environ, "PYTHONPATH": str(src_root)})
+                         # cwd: "python -c" puts the working folder first on sys.path, which
+                         # would shadow src_root with the checkout pytest runs in
+                         cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(src_root)})
     assert run.returncode in (0, 3), run.stderr[-3000:]
     out = run.stdout
     line = [ln for ln in out.splitlines() if ln.startswith("CPU ")][-1].split()
@@ -105,21 +107,24 @@ def _cli_run(tmp_path, src_root, label, extra=()):
 
 def test_whole_gcode_preview_of_the_raster(tmp_path):
     """The whole ``woodcam gcode`` run (read, simulate, mesh, bake, GLB + OBJ, screenshot) of
-    the 20,000-move raster: CPU seconds and peak memory in a fresh process. Set
-    ``WOODCAM_BENCH_BASELINE_SRC`` to the root of an older checkout to time it in the same run
-    (the xatlas preview of issue 18's baseline measured 106 CPU-s and 4.0 GB there)."""
+    the 20,000-move raster: CPU seconds and peak memory in a fresh process, with the default
+    iso screenshot (numba z-buffer, :mod:`woodcam.view.stockview`) and ``--camera top``. Set
+    ``WOODCAM_BENCH_BASELINE_SRC`` to the root of an older checkout to run it in the same
+    session and report the ratios (the time goal, 5 CPU-s, is reported, not asserted: the
+    machine's load moves it; issue 18's xatlas baseline measured 106 CPU-s and 4.0 GB)."""
     cpu, rss, out = _cli_run(tmp_path, REPO, "now")
     print(f"\nwoodcam gcode raster (this checkout): {cpu:.1f} CPU-s, peak {rss:.2f} GB; load "
           f"average {os.getloadavg()[0]:.1f}")
     tcpu, trss, _ = _cli_run(tmp_path, REPO, "top", ("--camera", "top"))
-    print(f"the same with --camera top (numpy view, no VTK): {tcpu:.1f} CPU-s, peak "
-          f"{trss:.2f} GB")
+    print(f"the same with --camera top: {tcpu:.1f} CPU-s, peak {trss:.2f} GB")
     base = os.environ.get("WOODCAM_BENCH_BASELINE_SRC")
     if base:
         bcpu, brss, _ = _cli_run(tmp_path, Path(base), "base")
-        print(f"baseline {base}: {bcpu:.1f} CPU-s, peak {brss:.2f} GB; ratio {bcpu / cpu:.1f}x "
-              f"CPU, {brss / rss:.1f}x memory")
-    assert rss < 2**30 / 1e9  # 1 GiB
+        btcpu, btrss, _ = _cli_run(tmp_path, Path(base), "base_top", ("--camera", "top"))
+        print(f"baseline {base}: iso {bcpu:.1f} CPU-s, peak {brss:.2f} GB (ratio {bcpu / cpu:.1f}x "
+              f"CPU, {brss / rss:.1f}x memory); top {btcpu:.1f} CPU-s, peak {btrss:.2f} GB "
+              f"(ratio {btcpu / tcpu:.1f}x CPU, {btrss / trss:.1f}x memory)")
+    assert max(rss, trss) * 1e6 < 2**20  # ru_maxrss KiB: under 1 GiB
 
 
 def test_interpreter_lines_per_cpu_second_vs_linuxcnc(tmp_path):
@@ -154,8 +159,9 @@ def test_interpreter_lines_per_cpu_second_vs_linuxcnc(tmp_path):
 def test_relief_job_167x208_end_to_end(tmp_path):
     """A real-sized job: the 167 x 208 mm relief panel finished by a 70,000-move OpenCAMLib
     raster (``toolpaths/make_relief_job.py``; generating it takes OpenCAMLib ~2 minutes), read,
-    simulated at 0.1 mm, meshed, baked (the atlas is reduced to fit 4096 px, with a message),
-    exported and drawn from the top, in a fresh process: CPU seconds and peak memory."""
+    simulated at 0.1 mm, meshed, baked at 10 texels/mm (the walls and bottom at lower density
+    keep the atlas within 4096 px), exported and drawn from the top and iso, in a fresh
+    process: CPU seconds and peak memory (under 1 GiB)."""
     import subprocess
     import sys
 
@@ -175,8 +181,9 @@ def test_relief_job_167x208_end_to_end(tmp_path):
                               camera], capture_output=True, text=True,
                              env={**os.environ, "PYTHONPATH": str(REPO)})
         assert run.returncode == 0, run.stderr[-3000:]
-        assert "texels_per_mm lowered from 10 to" in run.stderr  # the atlas fits, and says so
+        assert "texels_per_mm lowered" not in run.stderr  # 10 texels/mm fit in 4096 px
         line = [ln for ln in run.stdout.splitlines() if ln.startswith("CPU ")][-1].split()
         moves = [ln for ln in run.stdout.splitlines() if "moves read" in ln][0]
         print(f"\n--camera {camera}: {moves}\n  {float(line[1]):.1f} CPU-s, peak "
               f"{float(line[3]) / 1e6:.2f} GB; load {os.getloadavg()[0]:.1f}")
+        assert float(line[3]) * 1024 < 2**30  # ru_maxrss is in KiB: under 1 GiB

@@ -208,6 +208,82 @@ def test_render_beats_mean_colour_baseline_on_feature_cost(finished):
     assert feature_cost(p, p.render, run.params) < feature_cost(p, p.baseline, run.params)
 
 
+def test_sliced_leaf_pixels_are_the_mean_of_their_point_samples():
+    """supersample=s: each pixel is the mean of the s x s point samples inside it, i.e. the
+    s-times finer single-sample leaf averaged over s x s blocks (also on the turned leaf)."""
+    from woodcam.stock import open_stock
+
+    st = open_stock("builtin:flat-sawn", species="walnut")
+    coarse = slice_veneers(st, 2, (30, 20), px_per_mm=2.0, supersample=3)
+    fine = slice_veneers(st, 2, (30, 20), px_per_mm=6.0, supersample=1)
+    for c, f in zip(coarse, fine):
+        blocks = f.rgb.reshape(40, 3, 60, 3, 3).mean(axis=(1, 3))
+        assert np.abs(c.rgb - blocks).max() < 1e-5
+    # point samples alias the latewood lines into stair-steps: more Sobel energy than averaged
+    from woodcam.parquetry.features import edge, intensity
+
+    single = slice_veneers(st, 1, (60, 40), px_per_mm=4.0, supersample=1)[0]
+    averaged = slice_veneers(st, 1, (60, 40), px_per_mm=4.0)[0]
+    e1, e3 = (float((edge(intensity(v.rgb)) ** 2).mean()) for v in (single, averaged))
+    assert e3 < 0.9 * e1
+    with pytest.raises(WoodcamError, match="supersample must be in"):
+        slice_veneers(st, 1, (30, 20), supersample=0)
+
+
+def test_coarse_search_prefers_calm_wood_for_a_flat_target():
+    """Two sheets of the same mean tone, one flat and one with 2 px grain that the coarse
+    low-pass removes entirely: for a flat target the fast search's coarse stage ranks the calm
+    sheet first (its detail-amplitude channel), and the exact choice is the calm sheet."""
+    from woodcam.parquetry.matching import SheetBank, _coarse
+
+    calm = np.full((96, 96), 0.5, np.float32)
+    grain = np.full((96, 384), 0.5, np.float32)
+    grain[:, ::2] += 0.1
+    grain[:, 1::2] -= 0.1
+    bank = SheetBank([grain, calm], [np.ones(grain.shape, bool), np.ones(calm.shape, bool)],
+                     n_rot=1, mode="fast", coarse_factor=4, top_k=2)
+    tmpl = bank.features(np.full((28, 28), 0.5, np.float32))
+    cands = bank.atlas.search(_coarse(tmpl, 4), 50)
+    assert bank.atlas.tiles[cands[0][0]][0] == 1
+    by_sheet = {}
+    for t, _x, _y, c in cands:
+        by_sheet.setdefault(bank.atlas.tiles[t][0], c)
+    # the grained sheet's coarse cost carries its detail energy (0.5^2 (0.1^2 + edge^2) per px)
+    assert 1 in by_sheet and by_sheet.get(0, np.inf) > by_sheet[1] + 1e-3
+    m = bank.best(tmpl)
+    assert m.sheet == 1 and m.cost < 1e-6
+
+
+def test_metrics_on_the_target_native_grid(sheets):
+    """A 64 px target on a 70 mm panel at 2 px/mm (140 px) carries 0.9 px/mm: the "native"
+    metrics compare on its own 64 x 64 pixels, where the matched target against itself scores
+    SSIM 1, and fall back to the working grid for a target finer than that grid."""
+    import cv2
+    from skimage import data
+
+    from woodcam.parquetry import ssim_vs_matched
+
+    small = cv2.resize(data.camera()[40:300, 120:380], (64, 64), interpolation=cv2.INTER_AREA)
+    prm = ParquetryParams(image_size_mm=70, px_per_mm=PPM)
+    run = build_parquetry(small.astype(np.float32) / 255, sheets, prm, seams=False)
+    p = run.panels[0]
+    assert p.matched.shape == (140, 140) and p.native_shape == (64, 64)
+    grey = np.repeat(p.matched[..., None], 3, axis=2)
+    assert ssim_vs_matched(p, grey, grid="native") > 0.999
+    # detail finer than the target's pixels (a 2 px checker of +-0.05) is averaged away there:
+    # it adds less than a tenth of what it adds on the working grid
+    checker = grey + 0.05 * (((np.indices((140, 140)).sum(0) % 2) * 2 - 1)[..., None])
+    added = [feature_cost(p, checker, prm, g) - feature_cost(p, grey, prm, g) for g in ("native", "working")]
+    assert 0 <= added[0] < 0.1 * added[1]
+    with pytest.raises(WoodcamError, match="grid must be one of"):
+        feature_cost(p, grey, prm, "print")
+    # a target finer than the working grid: native is the working grid
+    fine = build_parquetry(data.camera()[:256, :256].astype(np.float32) / 255, sheets,
+                           ParquetryParams(image_size_mm=28, px_per_mm=PPM), seams=False)
+    q = fine.panels[0]
+    assert ssim_vs_matched(q, q.render, grid="native") == ssim_vs_matched(q, q.render)
+
+
 def test_running_out_of_wood_stops_with_a_message_and_writes(sheets, tmp_path):
     from skimage import data
 

@@ -81,26 +81,3 @@ def test_gutters_are_the_nearest_chart_texel_within_half_the_gap(sim):
     np.testing.assert_array_equal(b.atlas[ring], exact[ring])
     np.testing.assert_array_equal(b.atlas[cov], raw[cov])
     assert not (b.atlas == 0).all(axis=-1).any()  # no black texel left anywhere
-
-
-def test_the_view_mesh_is_coarser_and_samples_the_same_atlas(sim, monkeypatch):
-    """The screenshot's mesh: at most VIEW_GRID_CELLS cells across, texel coordinates into
-    the full bake's atlas that still land on each vertex's own colour."""
-    import woodcam.pipeline as pl
-
-    monkeypatch.setattr(pl, "VIEW_GRID_CELLS", 40)
-    b = bake_heightfield(sim.heightmap, sim.size_mm, _CoordWood(), texels_per_mm=4.0)
-    view = pl._heightfield_view_mesh(sim.heightmap, sim.size_mm, b, flat_tol_mm=0.01)
-    assert len(view.faces) < len(b.mesh.faces) / 4
-    assert view.visual.material.baseColorTexture is b.mesh.visual.material.baseColorTexture \
-        or np.array_equal(np.asarray(view.visual.material.baseColorTexture), b.atlas)
-    h, w = b.atlas.shape[:2]
-    uv = np.asarray(view.visual.uv)
-    px = np.clip((uv[:, 0] * w).astype(int), 0, w - 1)
-    py = np.clip(((1 - uv[:, 1]) * h).astype(int), 0, h - 1)
-    err_xy = np.abs(b.atlas[py, px][:, :2] / 255.0 - np.asarray(view.vertices)[:, :2]
-                    / np.array([W, D])) * np.array([W, D])
-    assert np.percentile(err_xy, 99) < 0.3  # within a texel (0.25 mm) in XY
-    vol = view.copy()
-    vol.merge_vertices(merge_tex=True, merge_norm=True)
-    assert vol.is_watertight

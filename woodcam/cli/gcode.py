@@ -85,7 +85,8 @@ def register(subparsers) -> None:
                    "mm/min)")
     p.add_argument("--camera", choices=("iso", "top", "front", "back", "left", "right"),
                    default="iso", help="screenshot view (default iso with a cut plane; top "
-                   "shows a relief without a cut, drawn from the baked texture without VTK)")
+                   "shows a relief without a cut; all drawn from the baked texture without "
+                   "VTK)")
     p.add_argument("--view", action="store_true",
                    help="after writing the files, open a window (needs a display) with the "
                    "stock, the toolpath and a slider that scrubs the simulation to any line "
@@ -244,8 +245,7 @@ def run(args) -> int:
     out = preview_heightfield(res.heightmap, stock, args.out, texels_per_mm=args.texels_per_mm,
                               flat_tol_mm=args.mesh_tol, obj=not args.no_obj, metadata=meta,
                               obj_units=args.obj_units, obj_up=args.obj_up,
-                              max_atlas_px=args.max_atlas,
-                              view_mesh=bool(args.screenshot) and args.camera != "top")
+                              max_atlas_px=args.max_atlas)
     t_bake = time.perf_counter() - t1
     if args.screenshot:
         _screenshot(args, out.files, stock, program, offset, out, res.heightmap)
@@ -267,14 +267,14 @@ def _hms(seconds: float) -> str:
     return f"{h}:{m:02d}:{s:02d}"
 
 
-def _screenshot(args, files: dict, stock, program, offset, made=None, heightmap=None) -> None:
-    """Render the stock with the toolpath over it (rapids red, feeds blue), block frame: the
-    top view with numpy from the atlas (``made``: the preview's :class:`PartPreview`), other
-    views with VTK from its light view mesh (or the written GLB)."""
+def _screenshot(args, files: dict, stock, program, offset, made, heightmap) -> None:
+    """Render the stock with the toolpath over it (rapids red, feeds blue), block frame, from
+    the preview's atlas (``made``: its :class:`PartPreview`), without VTK: the top view
+    orthographic with numpy, the other views in perspective with the cut plane
+    (:func:`woodcam.view.stockview.stock_view`)."""
     import numpy as np
 
     from ..pipeline import screenshot_path
-    from ..view import preview
 
     out = Path(args.out)
     png = screenshot_path(args.screenshot, out)
@@ -284,13 +284,14 @@ def _screenshot(args, files: dict, stock, program, offset, made=None, heightmap=
         seg = np.stack([program.start_mm + off, program.end_mm + off], axis=1)
         feed = program.kind == 1
         overlay = [(seg[~feed], "red", 1.0), (seg[feed], "royalblue", 1.0)]
-    if args.camera == "top" and made is not None and made.top_texels is not None:
-        # seen from +Z the stock is its atlas's top chart: drawn with numpy, no VTK
+    if args.camera == "top":
+        # seen from +Z the stock is its atlas's top chart: drawn with numpy
         from ..view.topview import write_top_view
 
-        write_top_view(png, heightmap, stock.size_mm, made.top_texels, overlay=overlay)
+        write_top_view(png, heightmap, stock.size_mm, made.chart_texels("top"), overlay=overlay)
     else:
-        preview(made.view_mesh if made is not None and made.view_mesh is not None
-                else files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png,
-                camera=args.camera, cut_plane=args.camera != "top", overlay=overlay)
+        from ..view.stockview import write_stock_view
+
+        write_stock_view(png, heightmap, stock.size_mm, made.texture, made.charts,
+                         wood=stock.wood, camera=args.camera, overlay=overlay)
     files["png"] = png

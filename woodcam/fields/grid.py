@@ -17,7 +17,6 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-from scipy import ndimage
 
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
@@ -82,6 +81,8 @@ class GridField:
             layers[str(name)] = u
         object.__setattr__(self, "layers", layers)
         order = _ORDER[self.interpolation]
+        from scipy import ndimage  # here: importing it costs 0.3 s every CLI run pays
+
         coeffs = ndimage.spline_filter(g, order=order, mode="nearest") if order > 1 else g
         object.__setattr__(self, "_coeffs", coeffs)
 
@@ -115,6 +116,8 @@ class GridField:
         """Interpolated growth time ``years : (n,)`` at ``points_mm : (n, 3)``."""
         p = check_points(points_mm)
         idx = (p - np.asarray(self.origin_mm)) / np.asarray(self.spacing_mm)
+        from scipy import ndimage
+
         return ndimage.map_coordinates(self._coeffs, idx.T, order=_ORDER[self.interpolation],
                                        mode="nearest", prefilter=False)
 
@@ -130,6 +133,8 @@ class GridField:
         if name not in self.layers:
             return np.zeros(len(p))
         idx = (p - np.asarray(self.origin_mm)) / np.asarray(self.spacing_mm)
+        from scipy import ndimage
+
         return ndimage.map_coordinates(self.layers[name], idx.T, order=1, mode="nearest")
 
     def __getattr__(self, name):

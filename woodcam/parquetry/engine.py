@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
@@ -69,6 +70,8 @@ class Parquetry:
     labels : (H, W) int: patch id of every panel pixel after the seams, -1 where none
     render, baseline : (H, W, 3) float32 the panel in wood, and each piece's mean colour
     seams_v, seams_h : seam curves (see :mod:`woodcam.parquetry.seams`) or None
+    native_shape : (h, w) the panel in the target image's own pixels (what it was resampled
+        from): the finest grid on which the target carries information
     """
 
     index: int
@@ -84,6 +87,7 @@ class Parquetry:
     baseline: np.ndarray | None = None
     seams_v: list | None = None
     seams_h: list | None = None
+    native_shape: tuple[int, int] | None = None
 
     @property
     def size_mm(self) -> tuple[float, float]:
@@ -151,7 +155,9 @@ def prepare_target(rgb: np.ndarray, params: ParquetryParams, source_values: np.n
     grey = intensity(img)
     matched = match_histogram(grey, source_values, params.w_hist)
     f = np.stack([params.w_intens * matched, params.w_edge * edge(grey)], axis=-1).astype(np.float32)
-    return Parquetry(index, name, img, matched, f, cell, np.full((rows, cols), -1, np.int64))
+    native = (max(1, round(rows * cell / scale)), max(1, round(cols * cell / scale)))
+    return Parquetry(index, name, img, matched, f, cell, np.full((rows, cols), -1, np.int64),
+                     native_shape=native)
 
 
 class _OutOfWood(Exception):
@@ -232,6 +238,7 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
 
     o = params.overlap_px
     patches: list[Patch] = []
+    contexts = [bank.target_context(p.target_feats) for p in panels]
 
     def window(p: Parquetry, r: int, c: int, n: int):
         H, W = p.matched.shape
@@ -242,7 +249,8 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     def place(p: Parquetry, r: int, c: int, n: int) -> None:
         g = window(p, r, c, n)
         tmpl = np.ascontiguousarray(p.target_feats[g[0]:g[2], g[1]:g[3]])
-        m = bank.best(tmpl)
+        ctx = contexts[p.index]
+        m = bank.best(tmpl, None if ctx is None else (ctx, g[0], g[1]))
         if n > 1 and n % 2 == 0:
             h2 = n // 2
             kids = [(r + dr, c + dc) for dr in (0, h2) for dc in (0, h2)]
@@ -250,7 +258,8 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
             ok = True
             for kr, kc in kids:
                 kg = window(p, kr, kc, h2)
-                km = bank.best(np.ascontiguousarray(p.target_feats[kg[0]:kg[2], kg[1]:kg[3]]))
+                km = bank.best(np.ascontiguousarray(p.target_feats[kg[0]:kg[2], kg[1]:kg[3]]),
+                               None if ctx is None else (ctx, kg[0], kg[1]))
                 if km is None:
                     ok = False
                     break
@@ -385,26 +394,64 @@ def repair_fabricability(run: ParquetryRun, max_rounds: int = 4) -> dict[int, st
     return done
 
 
-def feature_cost(p: Parquetry, image: np.ndarray, params: ParquetryParams) -> float:
+#: Where the metrics below compare: at the working resolution (``px_per_mm``) or on the
+#: target image's own pixel grid (``Parquetry.native_shape``).
+MetricGrid = Literal["working", "native"]
+
+
+def _native(p: Parquetry, grid: MetricGrid) -> tuple[int, int] | None:
+    """The ``(h, w)`` to area-average to for ``grid``, or None to stay at the working
+    resolution (also when the target is as fine as the working grid or finer)."""
+    if grid not in ("working", "native"):
+        raise WoodcamError(f"grid must be one of ['working', 'native']; got {grid!r}")
+    H, W = p.matched.shape
+    if grid == "working" or p.native_shape is None or p.native_shape[0] >= H:
+        return None
+    return p.native_shape
+
+
+def _area(a: np.ndarray, shape: tuple[int, int] | None) -> np.ndarray:
+    import cv2
+
+    if shape is None:
+        return np.asarray(a, np.float32)
+    return cv2.resize(np.asarray(a, np.float32), (shape[1], shape[0]), interpolation=cv2.INTER_AREA)
+
+
+def feature_cost(p: Parquetry, image: np.ndarray, params: ParquetryParams,
+                 grid: MetricGrid = "working") -> float:
     """Eq. 8 per pixel: mean over the panel of ``|F(R) - F(I_T)|^2`` with ``F`` of eq. 1 (the
-    target's intensity histogram-matched, eq. 2). ``image (H, W, 3)`` is a render or baseline."""
-    g = intensity(image)
+    target's intensity histogram-matched, eq. 2). ``image (H, W, 3)`` is a render or baseline.
+
+    grid : "working" compares at ``px_per_mm`` with the target's features of the matching;
+        "native" area-averages image and target to the target image's own pixels first (the
+        target says nothing finer than those; wood detail below them is neither asked for
+        nor forbidden) and takes eq. 1 there.
+    """
+    shape = _native(p, grid)
+    g = _area(intensity(image), shape)
     f = features(g, params.w_intens, params.w_edge)
-    return float(((f - p.target_feats) ** 2).sum(axis=2).mean())
+    if shape is None:
+        t = p.target_feats
+    else:
+        t = np.stack([params.w_intens * _area(p.matched, shape),
+                      params.w_edge * edge(_area(intensity(p.target_rgb), shape))], axis=-1)
+    return float(((f - t) ** 2).sum(axis=2).mean())
 
 
-def ssim_vs_matched(p: Parquetry, image: np.ndarray, downsample: int = 1) -> float:
+def ssim_vs_matched(p: Parquetry, image: np.ndarray, downsample: int = 1,
+                    grid: MetricGrid = "working") -> float:
     """SSIM (scikit-image: 7 x 7 windows, grey, data range 1) between an image's intensity and
     the matched target (eq. 2), both ``(H, W)`` at the working resolution, or first
     area-averaged by ``downsample`` (``round(px_per_mm)`` gives 1 mm pixels, 7 mm windows:
-    structure at half a patch rather than the wood's sub-millimetre grain)."""
-    import cv2
+    structure at half a patch rather than the wood's sub-millimetre grain), or with
+    ``grid="native"`` to the target image's own pixels (``downsample`` then unused)."""
     from skimage.metrics import structural_similarity
 
     a, b = intensity(image), p.matched
-    if downsample > 1:
+    shape = _native(p, grid)
+    if shape is None and downsample > 1:
         h, w = b.shape
-        size = (max(7, w // downsample), max(7, h // downsample))
-        a = cv2.resize(a, size, interpolation=cv2.INTER_AREA)
-        b = cv2.resize(b, size, interpolation=cv2.INTER_AREA)
+        shape = (max(7, h // downsample), max(7, w // downsample))
+    a, b = _area(a, shape), _area(b, shape)
     return float(structural_similarity(a, b, data_range=1.0))

@@ -66,10 +66,10 @@ class _Atlas:
                 Gr, Ur, m = rotate(G, U, a)
                 Fr = bank.features(Gr)
                 if f > 1:
-                    h, w = Fr.shape[:2]
-                    hc, wc = max(1, h // f), max(1, w // f)
-                    Fr = cv2.resize(_lowpass(Fr, f), (wc, hc), interpolation=cv2.INTER_AREA)
-                    Ur = cv2.resize(Ur.astype(np.float32), (wc, hc), interpolation=cv2.INTER_AREA) > 1 - 1e-4
+                    Fr = _coarse(Fr, f)
+                    hc, wc = Fr.shape[:2]
+                    Ur = cv2.resize(Ur[:hc * f, :wc * f].astype(np.float32), (wc, hc),
+                                    interpolation=cv2.INTER_AREA) > 1 - 1e-4
                 tiles.append((i, j, Fr, Ur, m))
         # Shelf packing, rows about as wide as the square root of the total area.
         pad = 1
@@ -85,7 +85,7 @@ class _Atlas:
             x += w + pad
             row_h = max(row_h, h)
         H, W = y + row_h + 2 * pad, width + pad
-        self.F = np.zeros((H, W, 2), np.float32)
+        self.F = np.zeros((H, W, tiles[0][2].shape[2]), np.float32)
         self.blocked = np.ones((H, W), np.uint8)
         self.tile_id = np.full((H, W), -1, np.int32)
         self.tiles = []                 # (sheet, rot, y0, x0, h, w, affine sheet->tile)
@@ -95,6 +95,7 @@ class _Atlas:
             self.blocked[y0:y0 + h, x0:x0 + w] = ~Ur
             self.tile_id[y0:y0 + h, x0:x0 + w] = k
             self.tiles.append((i, j, y0, x0, h, w, m))
+        self._origins = np.array([t[2:4] for t in self.tiles], np.int64).reshape(-1, 2)
         # One contiguous plane per channel (what matchTemplate wants), the stacked copy freed.
         self._chan = [np.ascontiguousarray(self.F[..., c]) for c in range(self.F.shape[2])]
         self._f2 = (self.F * self.F).sum(axis=2)
@@ -102,8 +103,8 @@ class _Atlas:
         del self.F
         self._base_cache: dict[tuple[int, int], np.ndarray] = {}
         # Cached anchor maps (float32, one per template size: interior, edge and corner
-        # patches) held to 4 atlas-sized copies, 2 for a large (exhaustive) atlas.
-        self._max_cached = 4 if H * W <= 20_000_000 else 2
+        # patches, and their trimmed coarse templates) held to ~200 MB, 2 to 8 copies.
+        self._max_cached = int(np.clip(200_000_000 // (4 * H * W), 2, 8))
         self._by_sheet: dict[int, list[int]] = {}
         for k, t in enumerate(self.tiles):
             self._by_sheet.setdefault(t[0], []).append(k)
@@ -113,12 +114,20 @@ class _Atlas:
         return (sum(c.nbytes for c in self._chan) + self._f2.nbytes + self.blocked.nbytes + self.tile_id.nbytes
                 + sum(b.nbytes for b in self._base_cache.values()))
 
-    def search(self, template: np.ndarray, k: int) -> list[tuple[int, int, int, float]]:
-        """The ``k`` best valid anchors: ``[(tile, x_in_tile, y_in_tile, cost), ...]`` sorted."""
+    def search(self, template: np.ndarray, k: int,
+               trim: tuple[int, int, int, int] = (0, 0, 0, 0)) -> list[tuple[int, int, int, float]]:
+        """The ``k`` best valid anchors: ``[(tile, x_in_tile, y_in_tile, cost), ...]`` sorted.
+        ``template (th, tw, c)`` has the atlas' channels (at a coarse level: :func:`_coarse`).
+
+        trim : ``(top, left, bottom, right)`` pixels cut off a window of ``(th + top + bottom,
+            tw + left + right)``: the cost is the trimmed template's, the anchors and the
+            free-wood test are the whole window's."""
         import cv2
 
         th, tw = template.shape[:2]
-        if th > self.shape[0] or tw > self.shape[1]:
+        ty, tx, by, bx = trim
+        thf, twf = th + ty + by, tw + tx + bx
+        if thf > self.shape[0] or twf > self.shape[1]:
             return []
         base = self._base(th, tw)
         cc = None
@@ -133,25 +142,28 @@ class _Atlas:
                                  borderType=cv2.BORDER_CONSTANT)[:oh, :ow]
             else:
                 r = cv2.matchTemplate(self._chan[ch], t, cv2.TM_CCORR)
-            cc = r.copy() if cc is None else cv2.add(cc, r)
+            # the first output is a fresh array (a view of one), so it is summed into in place
+            cc = r if cc is None else cv2.add(cc, r, dst=cc)
         # SSD = sum S^2 - 2 sum S T + sum T^2 (eq. 4); base carries sum S^2 and +inf where the
         # window touches used or unusable wood, so no mask has to be applied per search.
         cost = cv2.scaleAdd(cc, -2.0, base)
+        if thf != th or twf != tw:
+            # whole-window anchor a scores the trimmed template at a + (ty, tx); it is valid
+            # only where the whole window is free
+            ohf, owf = self.shape[0] - thf + 1, self.shape[1] - twf + 1
+            cost = cost[ty:ty + ohf, tx:tx + owf].copy()
+            cost[np.isinf(self._base(thf, twf))] = np.inf
         flat = cost.ravel()
-        k = min(k, flat.size)
-        sel = np.argpartition(flat, k - 1)[:k] if k < flat.size else np.arange(flat.size)
-        sel = sel[np.isfinite(flat[sel])]
+        sel = _smallest(flat, k)
         if sel.size == 0:
             return []
         tsum = float((template.astype(np.float64) ** 2).sum())
         sel = sel[np.argsort(flat[sel], kind="stable")]
-        out = []
-        for n, c in zip(sel.tolist(), flat[sel].tolist()):
-            ya, xa = divmod(int(n), cost.shape[1])
-            t = int(self.tile_id[ya, xa])
-            _, _, y0, x0, *_ = self.tiles[t]
-            out.append((t, xa - x0, ya - y0, max(0.0, c + tsum)))
-        return out
+        ya, xa = np.divmod(sel, cost.shape[1])
+        t = self.tile_id[ya, xa]
+        org = self._origins[t]
+        return list(zip(t.tolist(), (xa - org[:, 1]).tolist(), (ya - org[:, 0]).tolist(),
+                        np.maximum(flat[sel].astype(np.float64) + tsum, 0.0).tolist()))
 
     def _base(self, th: int, tw: int) -> np.ndarray:
         """Windowed sum of S^2 per anchor for a ``(th, tw)`` template, +inf where the window
@@ -215,6 +227,91 @@ def _lowpass(F: np.ndarray, f: int) -> np.ndarray:
     import cv2
 
     return cv2.GaussianBlur(F, (0, 0), f / 2.0, borderType=cv2.BORDER_REPLICATE)
+
+
+def _smallest(flat: np.ndarray, k: int) -> np.ndarray:
+    """Indices of the ``k`` smallest finite values of ``flat`` (unordered; fewer when fewer are
+    finite). Exact: a threshold from a strided sample (every 64th value) selects a superset of
+    about 4 k values, and only those are partitioned; argpartition of the whole coarse map
+    (a million values and more) was a fifth of the time per patch."""
+    k = min(k, flat.size)
+    step = 64
+    if flat.size > 64 * step * k // 16:
+        sample = flat[::step]
+        q = min(sample.size - 1, max(1, 4 * k // step))
+        thr = np.partition(sample, q)[q]
+        if np.isfinite(thr):
+            cand = np.flatnonzero(flat <= thr)
+            if cand.size >= k:
+                sub = flat[cand]
+                return cand[np.argpartition(sub, k - 1)[:k]] if cand.size > k else cand
+    sel = np.argpartition(flat, k - 1)[:k] if k < flat.size else np.arange(flat.size)
+    return sel[np.isfinite(flat[sel])]
+
+
+def _distinct(cands: list[tuple[int, int, int, float]]) -> list[tuple[int, int, int, float]]:
+    """Coarse candidates ``[(tile, x, y, cost)]`` (sorted) less those next to a better one in
+    the same tile (Chebyshev distance 1): the exact re-ranking round a coarse anchor already
+    covers half a coarse pixel and more either side, so a neighbour adds nothing, and in
+    periodic grain a few minima's neighbours would otherwise fill the whole batch."""
+    kept: list[tuple[int, int, int, float]] = []
+    seen: set[tuple[int, int, int]] = set()
+    for c in cands:
+        t, x, y, _ = c
+        if (t, x, y) in seen:
+            continue
+        kept.append(c)
+        seen.update((t, x + dx, y + dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1))
+    return kept
+
+
+def _coarse(F: np.ndarray, f: int) -> np.ndarray:
+    """Features ``F (h, w, c)`` low-passed and downsampled by ``f`` (see :func:`_lowpass`),
+    with one more channel, the *detail amplitude* per coarse pixel: ``(h // f, w // f, c + 1)``.
+    See :func:`_lowpass_energy` and :func:`_downsample`."""
+    return _downsample(_lowpass_energy(F, f), f)
+
+
+def _lowpass_energy(F: np.ndarray, f: int) -> np.ndarray:
+    """``[G(F), G(|F|^2)]`` as ``(h, w, c + 1)`` float32: the Gaussian low-pass of
+    :func:`_lowpass` of the features and of their energy, at full resolution (one blur)."""
+    import cv2
+
+    F = F if F.ndim == 3 else F[..., None]
+    chans = [np.ascontiguousarray(F[..., k], np.float32) for k in range(F.shape[2])]
+    energy = chans[0] * chans[0]
+    for ch in chans[1:]:
+        energy += ch * ch
+    out = _lowpass(cv2.merge([*chans, energy]), f)
+    return out.reshape(*F.shape[:2], F.shape[2] + 1)
+
+
+def _downsample(L: np.ndarray, f: int) -> np.ndarray:
+    """Coarse features from :func:`_lowpass_energy`'s ``L (h, w, c + 1)``: the low-passed
+    channels and the detail amplitude ``sqrt(G(|F|^2) - |G(F)|^2)`` (the RMS of what the
+    low-pass removes), area-averaged over whole ``f x f`` blocks: ``(h // f, w // f, c + 1)``.
+
+    SSD splits into the coarse images' SSD and the detail's, and by Cauchy-Schwarz the
+    detail's is at least ``f^2 (a_S - a_T)^2`` per coarse pixel, with equality where wood and
+    target carry the same detail in phase (a crop of the wood itself). Leaving it out ranks a
+    finely grained piece of wood as good as a calm one of the same mean tone, so a flat target
+    region got grain wherever calm wood was not among the few candidates re-ranked exactly.
+    The local variance under the Gaussian is as phase-robust as the coarse features (a box
+    over each coarse pixel would depend on where the grid falls).
+    """
+    import cv2
+
+    h, w, c1 = L.shape
+    hc, wc = max(1, h // f), max(1, w // f)
+    # Cropped to whole coarse pixels first, so coarse pixel X covers exactly full pixels
+    # f X .. f X + f - 1 (a plain resize to w // f stretches the grid by up to f pixels over
+    # the width, a phase error that grows across the sheet).
+    both = cv2.resize(np.ascontiguousarray(L[:hc * f, :wc * f]), (wc, hc),
+                      interpolation=cv2.INTER_AREA).reshape(hc, wc, c1)
+    lo = both[..., :c1 - 1]
+    var = both[..., c1 - 1] - (lo * lo).sum(axis=2)
+    both[..., c1 - 1] = np.sqrt(np.maximum(var, 0.0))
+    return both
 
 
 def _ssd(image: np.ndarray, template: np.ndarray, sq_sums: np.ndarray | None = None) -> np.ndarray:
@@ -384,11 +481,22 @@ class SheetBank:
         return [(float(c), int(x), int(y)) for c, x, y in
                 zip(flat[sel].tolist(), (xs + xa).tolist(), (ys + ya).tolist())]
 
-    def best(self, template: np.ndarray) -> Match | None:
-        """The best valid placement of ``template (th, tw, 2)`` (eq. 4), or None when no free
-        wood holds it. Does not consume; call :meth:`take` to commit."""
-        import cv2
+    def target_context(self, feats: np.ndarray) -> np.ndarray | None:
+        """The fast search's low-pass of a whole target's features ``(H, W, 2)`` (None in the
+        exhaustive mode), for :meth:`best`'s ``context``."""
+        return None if self.f == 1 else _lowpass_energy(feats, self.f)
 
+    def best(self, template: np.ndarray,
+             context: tuple[np.ndarray, int, int] | None = None) -> Match | None:
+        """The best valid placement of ``template (th, tw, 2)`` (eq. 4), or None when no free
+        wood holds it. Does not consume; call :meth:`take` to commit.
+
+        context : ``(target_context(target feats), y0, x0)`` where the template was cut from
+            the target (fast mode): its coarse version is then low-passed with the target
+            round it, as every sheet is, rather than with its border replicated, which made
+            the outer ring of coarse pixels (a third to a half of a template) disagree even
+            with the very wood the target was cut from.
+        """
         th, tw = template.shape[:2]
         f = self.f
         if f == 1:
@@ -397,12 +505,24 @@ class SheetBank:
             if m is not None:
                 return m
             return self._fallback(template) if cands else None
-        tc = cv2.resize(_lowpass(template, f), (max(1, tw // f), max(1, th // f)),
-                        interpolation=cv2.INTER_AREA)
-        # One coarse search ranks 16 top_k anchors; they are re-ranked exactly top_k at a time,
-        # and the next batch is looked at only when every candidate of this one collides with
-        # used wood (late in a run, where the cheapest wood is gone).
-        cands = self.atlas.search(tc, self.top_k * 16)
+        trim = (0, 0, 0, 0)
+        if context is not None:
+            L, y0, x0 = context
+            tc = _downsample(L[y0:y0 + th, x0:x0 + tw], f)
+            # Where the window meets the target's own edge there is no context: the outer
+            # coarse pixels there (the Gaussian reaches 0.75 f past the edge, less than one
+            # coarse pixel) are left out of the coarse cost (not of the free-wood test).
+            H, W = L.shape[:2]
+            t = (int(y0 == 0), int(x0 == 0), int(y0 + th >= H), int(x0 + tw >= W))
+            if tc.shape[0] > t[0] + t[2] and tc.shape[1] > t[1] + t[3]:
+                trim = t
+                tc = np.ascontiguousarray(tc[t[0]:tc.shape[0] - t[2], t[1]:tc.shape[1] - t[3]])
+        else:
+            tc = _coarse(template, f)
+        # One coarse search ranks 16 top_k distinct anchors (of its 32 top_k best); they are
+        # re-ranked exactly top_k at a time, and the next batch is looked at only when every candidate of this one
+        # collides with used wood (late in a run, where the cheapest wood is gone).
+        cands = _distinct(self.atlas.search(tc, self.top_k * 32, trim))[:self.top_k * 16]
         for b in range(0, len(cands), self.top_k):
             found: list[tuple[float, int, int, int, int]] = []
             for t, xc, yc, _ in cands[b:b + self.top_k]:

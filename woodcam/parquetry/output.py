@@ -92,6 +92,11 @@ def summary(run: ParquetryRun) -> dict:
                      ssim=ssim_vs_matched(p, p.render), ssim_baseline=ssim_vs_matched(p, p.baseline),
                      ssim_1mm=ssim_vs_matched(p, p.render, round(prm.px_per_mm)),
                      ssim_1mm_baseline=ssim_vs_matched(p, p.baseline, round(prm.px_per_mm)),
+                     native_px=list(p.native_shape or p.matched.shape),
+                     feature_cost_native=feature_cost(p, p.render, prm, "native"),
+                     feature_cost_native_baseline=feature_cost(p, p.baseline, prm, "native"),
+                     ssim_native=ssim_vs_matched(p, p.render, grid="native"),
+                     ssim_native_baseline=ssim_vs_matched(p, p.baseline, grid="native"),
                      mean_patch_cost_px=float(np.mean([q.cost_px for q in p.patches])))
         out["panels"].append(d)
     return out
@@ -184,7 +189,10 @@ def format_summary(summ: dict, problems: dict) -> str:
             line += (f"; feature cost/px {d['feature_cost']:.5f} (mean-colour baseline "
                      f"{d['feature_cost_baseline']:.5f}), SSIM {d['ssim']:.3f} (baseline "
                      f"{d['ssim_baseline']:.3f}), at 1 mm pixels {d['ssim_1mm']:.3f} (baseline "
-                     f"{d['ssim_1mm_baseline']:.3f})")
+                     f"{d['ssim_1mm_baseline']:.3f}); on the target's own "
+                     f"{d['native_px'][1]} x {d['native_px'][0]} pixels feature cost "
+                     f"{d['feature_cost_native']:.5f} (baseline {d['feature_cost_native_baseline']:.5f}), "
+                     f"SSIM {d['ssim_native']:.3f} (baseline {d['ssim_native_baseline']:.3f})")
         lines.append(line)
     lines.append(f"matching: {summ['match_seconds']:.1f} s wall, {summ['match_cpu_seconds']:.1f} CPU-s, "
                  f"{summ['seconds_per_patch']:.3f} s per patch")

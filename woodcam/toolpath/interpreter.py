@@ -99,6 +99,11 @@ _ONUMBER = re.compile(r"(?:n\d+)?o\d+$")
 #: Words of a plain move line ("X12.5 Z-1.2 F900" in G0/G1): :meth:`Interpreter.execute`
 #: runs them on a short path (the raster lines of a relief program are nearly all such lines).
 _PLAIN_WORDS = frozenset("xyzf")
+#: A line of nothing but X/Y/Z/F words with plain numbers (most lines of a CAM program): read
+#: by one regex instead of the character loop (same numbers as _NUM; anything else, a repeated
+#: word included, takes the general path and its errors).
+_PLAIN_LINE = re.compile(r"(?:[xyzf][+-]?(?:\d+\.?\d*|\.\d+))+")
+_PLAIN_WORD = re.compile(r"([xyzf])([+-]?(?:\d+\.?\d*|\.\d+))")
 _NAME = re.compile(r"<([^>]*)>")
 _FUNCS = ("atan", "asin", "acos", "abs", "cos", "sin", "tan", "sqrt", "round", "fix", "fup",
           "exp", "ln", "exists")
@@ -724,6 +729,12 @@ class Interpreter:
     def block(self, s: str):
         if s.startswith("/"):
             s = s[1:]  # block delete switch off (LinuxCNC's default): the line runs
+        if _PLAIN_LINE.fullmatch(s):
+            pairs = _PLAIN_WORD.findall(s)
+            plain = {a: float(v) for a, v in pairs}
+            if len(plain) == len(pairs) and all(map(math.isfinite, plain.values())):
+                self.execute((), (), plain)
+                return
         words: dict[str, float] = {}
         gs: list[float] = []
         ms: list[int] = []
@@ -1013,6 +1024,15 @@ class Interpreter:
             for i, a in enumerate("xyz"):
                 if a in w:
                     end[i] = w[a] * self.scale
+            return end
+        if (not self.incremental and not self.inch and not any(self.g5x)
+                and not any(self.g92)):
+            # absolute mm without offsets (most programs): the general path's arithmetic is
+            # the identity here, so this gives the same numbers bit for bit
+            end = list(self.pos)
+            for i, a in enumerate("xyz"):
+                if a in w:
+                    end[i] = w[a] + 0.0  # as the general path: -0.0 becomes 0.0
             return end
         prog = self.to_program(self.pos)
         for i, a in enumerate("xyz"):

@@ -59,31 +59,22 @@ def _planar_levels(z, tol):
     return levels
 
 
-def heightfield_mesh(heightmap, size_mm, *, flat_tol_mm: float = 1e-9):
-    """Watertight ``trimesh.Trimesh`` (block frame, mm) of the stock below ``heightmap``.
+#: Order of the faces :func:`_heightfield_arrays` emits, one contiguous run per chart.
+_CHART_ORDER = ("top", "front", "right", "back", "left", "bottom")
 
-    Parameters
-    ----------
-    heightmap : (ny, nx) float
-        Top of the stock at the cell centres, block-frame Z in mm (see
-        :mod:`woodcam.toolpath.simulate`), values in ``[0, H]``.
-    size_mm : (3,) float
-        Stock size ``(W, D, H)``.
-    flat_tol_mm : float
-        Planarity tolerance for merging quads (module docstring). Larger values merge gently
-        curved regions too, moving the surface by at most about this much per level.
-    """
-    import trimesh
 
-    hm = np.asarray(heightmap, float)
-    if hm.ndim != 2 or min(hm.shape) < 1:
-        raise WoodcamError(f"heightfield_mesh: heightmap must be (ny, nx), got {hm.shape}")
+def _heightfield_arrays(hm, size_mm, flat_tol_mm):
+    """The closed surface of :func:`heightfield_mesh` as arrays, built without trimesh and
+    with few full-grid temporaries (the 167 x 208 mm relief's 3.5 M-vertex grid took 490 MB
+    through trimesh): ``(vertices (n, 3) float64, faces (m, 3) int64, grid_index (n,) int64,
+    runs)``. ``grid_index`` is each vertex's flat index into the ``(ny + 2) x (nx + 2)``
+    vertex grid (``-1`` for the bottom ring and centre); ``runs`` maps each name of
+    :data:`_CHART_ORDER` to its face range ``(start, stop)``."""
+    from ._surface import quad_faces
+
     xs, ys, z = _vertex_grid(hm, size_mm)
     nyv, nxv = z.shape
-    vid = np.arange(nyv * nxv).reshape(nyv, nxv)
-    X, Y = np.meshgrid(xs, ys)
-    verts = [np.column_stack([X.ravel(), Y.ravel(), z.ravel()])]
-    faces = []
+    fans = []
 
     # quadtree over the uniform interior (between cell centres); the half-cell border quads
     # (non-uniform spacing) stay plain quads. Interior vertex (j, i) is grid vertex (j+1, i+1).
@@ -105,54 +96,112 @@ def heightfield_mesh(heightmap, size_mm, *, flat_tol_mm: float = 1e-9):
         # perimeter, counter-clockwise seen from +Z (row index grows with Y)
         pj = np.concatenate([np.zeros(s, int), r, np.full(s, s), s - r])
         pi = np.concatenate([r, np.full(s, s), s - r, np.zeros(s, int)])
-        J = 1 + bj[:, None] * s + pj[None, :]
-        I = 1 + bi[:, None] * s + pi[None, :]
-        ring = vid[J, I]
-        centre = vid[1 + bj * s + s // 2, 1 + bi * s + s // 2]
+        ring = (1 + bj[:, None] * s + pj[None, :]) * nxv + 1 + bi[:, None] * s + pi[None, :]
+        centre = (1 + bj * s + s // 2) * nxv + 1 + bi * s + s // 2
         nxt = np.roll(ring, -1, axis=1)
-        faces.append(np.stack([np.broadcast_to(centre[:, None], ring.shape), ring, nxt],
-                              axis=-1).reshape(-1, 3))
-    qj, qi = np.nonzero(~covered)
-    v00, v01 = vid[qj, qi], vid[qj, qi + 1]
-    v10, v11 = vid[qj + 1, qi], vid[qj + 1, qi + 1]
-    faces.append(np.column_stack([v00, v01, v11]))
-    faces.append(np.column_stack([v00, v11, v10]))
+        fans.append(np.stack([np.broadcast_to(centre[:, None], ring.shape), ring, nxt],
+                             axis=-1).reshape(-1, 3))
+    n_fan = sum(len(f) for f in fans)
+    n_quads = int(covered.size - np.count_nonzero(covered))
 
-    # walls and bottom
+    # walls (quad strips from the boundary vertices down to their copies at Z = 0), wall by
+    # wall, then the bottom fan
     bj_ = np.concatenate([np.zeros(nxv - 1, int), np.arange(nyv - 1), np.full(nxv - 1, nyv - 1),
                           np.arange(nyv - 1, 0, -1)])
     bi_ = np.concatenate([np.arange(nxv - 1), np.full(nyv - 1, nxv - 1), np.arange(nxv - 1, 0, -1),
                           np.zeros(nyv - 1, int)])
-    top = vid[bj_, bi_]
+    top = bj_ * nxv + bi_
     base = nyv * nxv
     P = len(top)
     bot = base + np.arange(P)
-    verts.append(np.column_stack([xs[bi_], ys[bj_], np.zeros(P)]))
     centre = base + P
-    W, D, _ = size_mm
-    verts.append(np.array([[W / 2, D / 2, 0.0]]))
     tq, bq = np.roll(top, -1), np.roll(bot, -1)
-    faces.append(np.column_stack([bot, bq, tq]))
-    faces.append(np.column_stack([bot, tq, top]))
-    faces.append(np.column_stack([np.full(P, centre), bq, bot]))
-    mesh = trimesh.Trimesh(np.vstack(verts), np.vstack(faces), process=False)
-    # drop vertices no face uses (interior of merged blocks) without merging coincident ones
-    used = np.zeros(len(mesh.vertices), bool)
-    used[mesh.faces.ravel()] = True
+    n_top = n_fan + 2 * n_quads
+    faces = np.empty((n_top + 3 * P, 3), np.int64)
+    at = 0
+    for f in fans:
+        faces[at:at + len(f)] = f
+        at += len(f)
+    quad_faces(covered, nxv, faces[at:n_top])
+    runs = {"top": (0, n_top)}
+    at = n_top
+    walls = np.cumsum([0, nxv - 1, nyv - 1, nxv - 1, nyv - 1])
+    for name, lo, hi in zip(("front", "right", "back", "left"), walls[:-1], walls[1:]):
+        k = hi - lo
+        faces[at:at + k] = np.column_stack([bot[lo:hi], bq[lo:hi], tq[lo:hi]])
+        faces[at + k:at + 2 * k] = np.column_stack([bot[lo:hi], tq[lo:hi], top[lo:hi]])
+        runs[name] = (at, at + 2 * k)
+        at += 2 * k
+    faces[at:] = np.column_stack([np.full(P, centre), bq, bot])
+    runs["bottom"] = (at, at + P)
+
+    # keep only the vertices some face uses (the interiors of merged blocks go), renumbered
+    used = np.zeros(base + P + 1, bool)
+    used[faces.ravel()] = True
+    keep = np.flatnonzero(used)
     remap = np.cumsum(used) - 1
-    return trimesh.Trimesh(mesh.vertices[used], remap[mesh.faces], process=False)
+    np.take(remap, faces, out=faces)
+    del remap, used
+    grid = keep[keep < base]
+    W, D, _ = size_mm
+    verts = np.empty((len(keep), 3))
+    g = len(grid)
+    verts[:g, 0] = xs[grid % nxv]
+    verts[:g, 1] = ys[grid // nxv]
+    verts[:g, 2] = z.ravel()[grid]
+    extra = keep[g:] - base  # bottom ring (0 .. P-1) and the centre (P)
+    ring = extra < P
+    verts[g:, 0] = np.where(ring, xs[bi_[np.minimum(extra, P - 1)]], W / 2)
+    verts[g:, 1] = np.where(ring, ys[bj_[np.minimum(extra, P - 1)]], D / 2)
+    verts[g:, 2] = 0.0
+    grid_index = np.full(len(keep), -1, np.int64)
+    grid_index[:g] = grid
+    return verts, faces, grid_index, runs
+
+
+def heightfield_mesh(heightmap, size_mm, *, flat_tol_mm: float = 1e-9):
+    """Watertight ``trimesh.Trimesh`` (block frame, mm) of the stock below ``heightmap``.
+
+    Parameters
+    ----------
+    heightmap : (ny, nx) float
+        Top of the stock at the cell centres, block-frame Z in mm (see
+        :mod:`woodcam.toolpath.simulate`), values in ``[0, H]``.
+    size_mm : (3,) float
+        Stock size ``(W, D, H)``.
+    flat_tol_mm : float
+        Planarity tolerance for merging quads (module docstring). Larger values merge gently
+        curved regions too, moving the surface by at most about this much per level.
+    """
+    import trimesh
+
+    hm = np.asarray(heightmap, float)
+    if hm.ndim != 2 or min(hm.shape) < 1:
+        raise WoodcamError(f"heightfield_mesh: heightmap must be (ny, nx), got {hm.shape}")
+    verts, faces, _, _ = _heightfield_arrays(hm, size_mm, flat_tol_mm)
+    return trimesh.Trimesh(verts, faces, process=False)
 
 
 #: Texels between charts of the height-field atlas (the bake's dilation fills them).
 _CHART_PAD_PX = 8
 
+#: Texel density of the walls and of the bottom as a share of the top's (per axis). The top is
+#: where the toolpath left its detail and what every view looks at; the walls are the sawn
+#: block's flat faces (a quarter of the texels at 0.5: 0.2 mm texels at the default 10 per mm,
+#: still several per latewood band), and the bottom is seen only when the model is turned over.
+#: On the 100 x 80 x 30 mm raster this cuts the wood colour lookups from 2.7 M to 1.1 M.
+WALL_TEXEL_SHARE = 0.5
+BOTTOM_TEXEL_SHARE = 0.25
+
 
 class HeightfieldCharts:
     """Planar texture charts of a height-field stock (its own parameterisation, no unwrap).
 
-    Six charts: the top seen from +Z (texel = XY), the bottom, and the four walls (texel =
-    position along the wall, Z). ``uv_px : (n, 2)`` are the mesh vertices' texel coordinates
-    (x right, y down, pixel corners at integers), ``size_px = (width, height)`` the atlas.
+    Six charts: the top seen from +Z (texel = XY) at ``texels_per_mm``, the bottom (at
+    :data:`BOTTOM_TEXEL_SHARE` of it) and the four walls (texel = position along the wall, Z;
+    at :data:`WALL_TEXEL_SHARE`). The top sits at the atlas's top-left corner, the others in
+    columns to its right. ``uv_px : (n, 2)`` are the mesh vertices' texel coordinates (x right,
+    y down, pixel corners at integers), ``size_px = (width, height)`` the atlas.
     :meth:`texel_points` gives every chart texel's block-frame point and normal, exactly on the
     mesh (the top is the vertex grid's triangles, split as in :func:`heightfield_mesh`).
     """
@@ -162,23 +211,34 @@ class HeightfieldCharts:
         self.size_mm = (W, D, H)
         self.hm = np.asarray(heightmap, float)
         t = float(texels_per_mm)
-        tw, td, th = (max(1, int(np.ceil(v * t))) for v in (W, D, H))
+
+        def px(mm, share):
+            return max(1, int(np.ceil(mm * t * share)))
+
+        wall, bottom = WALL_TEXEL_SHARE, BOTTOM_TEXEL_SHARE
         # chart: name -> (origin x, origin y, width px, height px, span u mm, span v mm)
+        sizes = {"top": (px(W, 1), px(D, 1), W, D),
+                 "bottom": (px(W, bottom), px(D, bottom), W, D),
+                 "front": (px(W, wall), px(H, wall), W, H), "back": (px(W, wall), px(H, wall), W, H),
+                 "left": (px(D, wall), px(H, wall), D, H), "right": (px(D, wall), px(H, wall), D, H)}
         pad = _CHART_PAD_PX
-        charts = {}
-        x0 = y0 = pad
-        row_h = 0
-        width = 2 * max(tw, td) + 3 * pad
-        for name, (w, h, su, sv) in {"top": (tw, td, W, D), "bottom": (tw, td, W, D),
-                                     "front": (tw, th, W, H), "back": (tw, th, W, H),
-                                     "left": (td, th, D, H), "right": (td, th, D, H)}.items():
-            if x0 + w + pad > width:
-                x0, y0, row_h = pad, y0 + row_h + pad, 0
+        tw, th = sizes["top"][:2]
+        charts = {"top": (pad, pad, tw, th, W, D)}
+        # the others top to bottom in columns right of the top, a new column when one would
+        # grow taller than the top (or the tallest chart)
+        limit = max(th, max(h for _, h, _, _ in sizes.values()))
+        x0, y0, col_w = pad + tw + pad, pad, 0
+        for name, (w, h, su, sv) in sizes.items():
+            if name == "top":
+                continue
+            if y0 > pad and y0 + h > pad + limit:
+                x0, y0, col_w = x0 + col_w + pad, pad, 0
             charts[name] = (x0, y0, w, h, su, sv)
-            x0 += w + pad
-            row_h = max(row_h, h)
+            y0 += h + pad
+            col_w = max(col_w, w)
         self.charts = charts
-        self.size_px = (width, y0 + row_h + pad)
+        self.size_px = (max(c[0] + c[2] for c in charts.values()) + pad,
+                        max(c[1] + c[3] for c in charts.values()) + pad)
 
     def fill_gutters(self, atlas, coverage):
         """Paint the texels outside the charts of ``atlas : (h, w, 3)``: a ring of half the
@@ -214,7 +274,6 @@ class HeightfieldCharts:
         """Yield ``(flat texel indices (k,), points_mm (k, 3), normals (k, 3))`` per chart."""
         W, D, H = self.size_mm
         width = self.size_px[0]
-        xs, ys, z = _vertex_grid(self.hm, self.size_mm)
         for name, (x0, y0, w, h, su, sv) in self.charts.items():
             ii, jj = np.meshgrid(np.arange(w), np.arange(h))
             u = (ii.ravel() + 0.5) * (su / w)
@@ -223,13 +282,9 @@ class HeightfieldCharts:
             n = len(u)
             nrm = np.zeros((n, 3))
             if name == "top":
-                # the grid cell of a texel depends on its column (x) and row (y) alone:
-                # locate w + h coordinates, not w * h points
-                col = np.clip(np.searchsorted(xs, u[:w], side="right") - 1, 0, len(xs) - 2)
-                row = np.clip(np.searchsorted(ys, D - v[::w], side="right") - 1, 0, len(ys) - 2)
-                zz, nrm = _grid_surface(xs, ys, z, u, D - v, i=np.tile(col, h),
-                                        j=np.repeat(row, w))
-                pts = np.column_stack([u, D - v, zz])
+                from ._surface import top_chart_points
+
+                pts, nrm = top_chart_points(np.ascontiguousarray(self.hm, float), W, D, w, h)
             elif name == "bottom":
                 pts = np.column_stack([u, v, np.zeros(n)])
                 nrm[:, 2] = -1
@@ -245,28 +300,6 @@ class HeightfieldCharts:
             yield idx, pts, nrm
 
 
-def _grid_surface(xs, ys, z, x, y, *, i=None, j=None):
-    """Height and unit normal of the vertex grid's triangles (quad split v00-v01-v11 /
-    v00-v11-v10, as :func:`heightfield_mesh`) at points ``x, y : (k,)``; ``i, j : (k,)`` the
-    points' grid cells when the caller knows them."""
-    if i is None:
-        i = np.clip(np.searchsorted(xs, x, side="right") - 1, 0, len(xs) - 2)
-    if j is None:
-        j = np.clip(np.searchsorted(ys, y, side="right") - 1, 0, len(ys) - 2)
-    hx, hy = xs[i + 1] - xs[i], ys[j + 1] - ys[j]
-    a, b = (x - xs[i]) / hx, (y - ys[j]) / hy
-    z00, z01 = z[j, i], z[j, i + 1]
-    z10, z11 = z[j + 1, i], z[j + 1, i + 1]
-    upper = a >= b  # triangle v00, v01, v11
-    zz = np.where(upper, z00 + a * (z01 - z00) + b * (z11 - z01),
-                  z00 + b * (z10 - z00) + a * (z11 - z10))
-    gx = np.where(upper, (z01 - z00) / hx, (z11 - z10) / hx)
-    gy = np.where(upper, (z11 - z01) / hy, (z10 - z00) / hy)
-    nrm = np.column_stack([-gx, -gy, np.ones_like(gx)])
-    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
-    return zz, nrm
-
-
 def heightfield_mesh_charts(heightmap, size_mm, texels_per_mm, *, flat_tol_mm: float = 1e-9):
     """:func:`heightfield_mesh` with planar texture charts:
     ``(mesh, uv_px (n, 2), charts, vertex_normals (n, 3))``.
@@ -278,57 +311,48 @@ def heightfield_mesh_charts(heightmap, size_mm, texels_per_mm, *, flat_tol_mm: f
     """
     import trimesh
 
-    mesh = heightfield_mesh(heightmap, size_mm, flat_tol_mm=flat_tol_mm)
-    charts = HeightfieldCharts(heightmap, size_mm, texels_per_mm)
+    hm = np.asarray(heightmap, float)
+    if hm.ndim != 2 or min(hm.shape) < 1:
+        raise WoodcamError(f"heightfield_mesh_charts: heightmap must be (ny, nx), got {hm.shape}")
+    V, F, grid_index, runs = _heightfield_arrays(hm, size_mm, flat_tol_mm)
+    charts = HeightfieldCharts(hm, size_mm, texels_per_mm)
     W, D, H = charts.size_mm
-    V = np.asarray(mesh.vertices)
-    F = np.asarray(mesh.faces)
-    fn = np.asarray(mesh.face_normals)
-    # the chart of each face from its normal and position: walls are vertical and on a face
-    c = V[F].mean(axis=1)
-    eps = 1e-9 * max(W, D, H)
-    names = ("top", "bottom", "front", "back", "left", "right")
-    code = np.zeros(len(F), np.int8)  # index into names
-    vertical = np.abs(fn[:, 2]) < 1e-9
-    code[vertical & (c[:, 1] < eps)] = 2
-    code[vertical & (c[:, 1] > D - eps)] = 3
-    code[vertical & (c[:, 0] < eps)] = 4
-    code[vertical & (c[:, 0] > W - eps)] = 5
-    bottom = (fn[:, 2] < -0.5) & (np.abs(V[F][:, :, 2]).max(axis=1) < eps)
-    code[bottom] = 1
-    xs, ys, zg = _vertex_grid(np.asarray(heightmap, float), (W, D, H))
-    gy, gx = np.gradient(zg, ys, xs)  # smooth shading normals of the top from the grid
-    verts, uvs, faces, normals = [], [], [], []
-    base = 0
+    xs, ys, zg = _vertex_grid(hm, (W, D, H))
+    nxv = len(xs)
     axis_normal = {"bottom": (0, 0, -1), "front": (0, -1, 0), "back": (0, 1, 0),
                    "left": (-1, 0, 0), "right": (1, 0, 0)}
-    order = np.argsort(code, kind="stable")
-    bounds = np.searchsorted(code[order], np.arange(len(names) + 1))
+    parts = []
     remap = np.full(len(V), -1, np.int64)
-    for ci, nm in enumerate(names):
-        sel = order[bounds[ci]: bounds[ci + 1]]
-        if not len(sel):
+    for nm in _CHART_ORDER:
+        lo, hi = runs[nm]
+        if hi <= lo:
             continue
-        fc = F[sel]
+        fc = F[lo:hi]
         # this chart's own copy of its vertices, in index order (O(n), no sort)
         used_mask = np.zeros(len(V), bool)
         used_mask[fc.ravel()] = True
         used = np.flatnonzero(used_mask)
+        del used_mask
         remap[used] = np.arange(len(used))
         p = V[used]
         u, v = {"top": (p[:, 0], D - p[:, 1]), "bottom": (p[:, 0], p[:, 1]),
                 "front": (p[:, 0], H - p[:, 2]), "back": (W - p[:, 0], H - p[:, 2]),
                 "left": (D - p[:, 1], H - p[:, 2]), "right": (p[:, 1], H - p[:, 2])}[nm]
-        verts.append(p)
-        uvs.append(charts.uv(nm, u, v))
-        faces.append(remap[fc] + base)
         if nm == "top":
-            i = np.clip(np.searchsorted(xs, p[:, 0]), 0, len(xs) - 1)
-            j = np.clip(np.searchsorted(ys, p[:, 1]), 0, len(ys) - 1)
-            n = np.column_stack([-gx[j, i], -gy[j, i], np.ones(len(p))])
-            normals.append(n / np.linalg.norm(n, axis=1, keepdims=True))
+            # smooth shading normals from the grid's central differences at each vertex
+            g = grid_index[used]
+            j, i = g // nxv, g % nxv
+            jm, jp = np.maximum(j - 1, 0), np.minimum(j + 1, len(ys) - 1)
+            im, ip = np.maximum(i - 1, 0), np.minimum(i + 1, nxv - 1)
+            gx = (zg[j, ip] - zg[j, im]) / (xs[ip] - xs[im])
+            gy = (zg[jp, i] - zg[jm, i]) / (ys[jp] - ys[jm])
+            n = np.column_stack([-gx, -gy, np.ones(len(p))])
+            n /= np.linalg.norm(n, axis=1, keepdims=True)
         else:
-            normals.append(np.broadcast_to(np.array(axis_normal[nm], float), p.shape))
-        base += len(used)
-    out = trimesh.Trimesh(np.vstack(verts), np.vstack(faces), process=False)
-    return out, np.vstack(uvs), charts, np.vstack(normals)
+            n = np.broadcast_to(np.array(axis_normal[nm], float), p.shape)
+        parts.append((p, charts.uv(nm, u, v), remap[fc], n))
+    base = np.cumsum([0] + [len(q[0]) for q in parts])
+    out = trimesh.Trimesh(np.vstack([q[0] for q in parts]),
+                          np.vstack([q[2] + b for q, b in zip(parts, base)]), process=False)
+    return (out, np.vstack([q[1] for q in parts]), charts,
+            np.vstack([np.asarray(q[3]) for q in parts]))

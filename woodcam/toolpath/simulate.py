@@ -48,11 +48,14 @@ from ..errors import WoodcamError
 from ..tolerances import SIM_CONTACT_TOL_MM
 from .gcode import FEED, RAPID, Program
 from .reach import REACH_KINDS, reach_issues
-from .tools import Tool
+from .tools import BallEndMill, FlatEndMill, Tool
 
 #: Cells evaluated per vectorised batch: ~20 float32 temporaries of 64k cells stay in L2/L3
 #: cache (measured 1.4x faster than 1M-cell batches on the raster benchmark).
 _BATCH_CELLS = 1 << 16
+#: Tools whose swept envelope :mod:`woodcam.toolpath._sweep` computes in closed form (exact
+#: types: a subclass may change the profile).
+_CLOSED_FORM = {BallEndMill: 0, FlatEndMill: 1}
 
 
 IssueKind = Literal["rapid_through_stock", "below_stock_bottom", "cut_outside_stock",
@@ -395,6 +398,20 @@ def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind,
     wy, wx = min(wy, ny), min(wx, nx)
     js = np.clip(j0, 0, ny - wy)
     is_ = np.clip(i0, 0, nx - wx)
+    closed = _CLOSED_FORM.get(type(tool))
+    if closed is not None:  # ball / flat: one compiled pass, no window temporaries
+        from ._sweep import sweep_update
+
+        depth = np.empty(n)
+        track = line_map is not None
+        cells = sweep_update(hm, line_map if track else np.zeros((1, 1), np.int64), track,
+                             closed, float(tool.radius_mm), np.ascontiguousarray(a, float),
+                             np.ascontiguousarray(b, float), js, is_, wy, wx, dx, dy,
+                             np.asarray(lines, np.int64), depth)
+        for k in np.flatnonzero((kind == RAPID) & (depth > SIM_CONTACT_TOL_MM)):
+            _add(issues, "rapid_through_stock", lines[k],
+                 f"rapid move (G0) cuts up to {depth[k]:.3f} mm into the stock")
+        return int(cells)
     f32 = np.float32
     cx = ((is_[:, None] + np.arange(wx)[None, :] + 0.5) * dx - a[:, 0, None]).astype(f32)
     cy = ((js[:, None] + np.arange(wy)[None, :] + 0.5) * dy - a[:, 1, None]).astype(f32)

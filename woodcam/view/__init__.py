@@ -5,6 +5,8 @@
 - :mod:`woodcam.view.camera`: named view directions and tight framing.
 - :mod:`woodcam.view.scene`: pyvista scene (part, block, cut plane), :class:`SceneOptions`,
   :func:`build_scene`, :func:`preview` (window or off-screen screenshot).
+- :mod:`woodcam.view.stockview` / :mod:`woodcam.view.topview`: screenshots of a simulated
+  height-field stock without VTK (numba z-buffer in perspective; numpy from above).
 """
 
 from .camera import CAMERAS, Camera

@@ -51,14 +51,16 @@ def default_cut_normal(camera: str, size: np.ndarray) -> np.ndarray:
 _FRAME_FILL = 0.92
 
 
-def set_camera(plotter, camera: str, bounds) -> None:
-    """Look along the camera's direction and frame the box ``bounds`` tightly.
+def frame_camera(camera: str, bounds, window_size=(1280, 960), view_angle_deg: float = 30.0):
+    """Camera that looks along ``camera``'s direction and frames the box ``bounds`` tightly:
+    ``(position (3,), focal point (3,), view up (3,))``, block frame, mm.
 
     pyvista's ``reset_camera`` frames the bounding sphere, which leaves a flat block small in
     the picture; here the eight corners are projected and the distance and focal point chosen
-    so that they fill :data:`_FRAME_FILL` of the picture (perspective, vertical view angle of
-    the camera, the window's aspect ratio).
+    so that they fill :data:`_FRAME_FILL` of the picture (perspective, vertical view angle
+    ``view_angle_deg``, the window's aspect ratio ``window_size = (width, height)`` px).
     """
+    check_camera(camera)
     direction, up = (np.asarray(a, dtype=float) for a in _CAMERA_VIEW[camera])
     b = np.asarray(bounds, dtype=float).reshape(3, 2)
     direction = direction / np.linalg.norm(direction)
@@ -67,8 +69,8 @@ def set_camera(plotter, camera: str, bounds) -> None:
     up = np.cross(direction, right)
     bits = (np.arange(8)[:, None] >> np.arange(3)[None, :]) & 1
     corners = b[:, 0] + bits * (b[:, 1] - b[:, 0])               # (8, 3) mm
-    width, height = plotter.window_size
-    tan_y = np.tan(np.radians(plotter.camera.view_angle) / 2.0) * _FRAME_FILL
+    width, height = window_size
+    tan_y = np.tan(np.radians(view_angle_deg) / 2.0) * _FRAME_FILL
     tan_x = tan_y * width / height
     focal = b.mean(axis=1)
     for _ in range(4):  # distance from the extents, then recentre; converges in a few steps
@@ -81,5 +83,13 @@ def set_camera(plotter, camera: str, bounds) -> None:
         shift_x = 0.5 * (sx.max() + sx.min()) * dist
         shift_y = 0.5 * (sy.max() + sy.min()) * dist
         focal = focal + shift_x * right + shift_y * up
-    plotter.camera_position = [tuple(focal + dist * direction), tuple(focal), tuple(up)]
+    return focal + dist * direction, focal, up
+
+
+def set_camera(plotter, camera: str, bounds) -> None:
+    """Look along the camera's direction and frame the box ``bounds`` tightly
+    (:func:`frame_camera` with the plotter's window size and view angle)."""
+    position, focal, up = frame_camera(camera, bounds, plotter.window_size,
+                                       plotter.camera.view_angle)
+    plotter.camera_position = [tuple(position), tuple(focal), tuple(up)]
     plotter.reset_camera_clipping_range()

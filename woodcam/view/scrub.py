@@ -4,7 +4,7 @@ simulation to any source line.
 :class:`ScrubCallback` is what the slider calls with a line number: it simulates the program up
 to that line (forward from the last state when the slider moves forward, from the start stock
 when it moves back: the height field only ever loses material), meshes the height field at the
-window's grid (:data:`woodcam.pipeline.VIEW_GRID_CELLS` cells across, block means), colours
+window's grid (:data:`WINDOW_GRID_CELLS` cells across, block means), colours
 its vertices with the wood, and replaces the stock actor; the toolpath is drawn done (blue
 feeds, red rapids) up to the line and grey after it, with the tool tip marked. Everything but
 the window itself runs off screen, so the tests drive the callback directly.

@@ -5,7 +5,7 @@ Seen from +Z, a height-field stock is its top chart: the baked atlas's top chart
 of the surface at its XY, so the view is that image, shaded by the surface normal from the
 height field's gradient (Lambert, light from the upper left, flat = the baked colour), with the
 toolpath drawn over it. It costs ~0.1 s where an off-screen VTK render of the same stock costs
-seconds (import, scene, render); the iso and side views stay with :func:`woodcam.view.preview`.
+seconds (import, scene, render); the perspective views are :mod:`woodcam.view.stockview`'s.
 """
 
 from __future__ import annotations

@@ -1,0 +1,169 @@
+"""The numba view of a height-field stock (woodcam.view.stockview): no VTK, same picture."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from woodcam.errors import WoodcamError
+from woodcam.pipeline import bake_heightfield
+from woodcam.toolpath.mesh import HeightfieldCharts
+from woodcam.view.scene import BLOCK_COLOR, BLOCK_OPACITY
+from woodcam.view.stockview import _camera_array, stock_view, write_stock_view
+
+W, D, H = 40.0, 30.0, 20.0
+WIN = (320, 240)
+
+
+class _CoordWood:
+    """Colour = the point's block-frame position scaled to [0, 1]: pixels say what they show."""
+
+    def color(self, points_mm, normals):
+        return np.clip(np.asarray(points_mm) / np.array([W, D, H]), 0, 1)
+
+
+def _pixel(points_mm, camera="iso"):
+    """Picture pixel (row, col) of block-frame points, from the view's own camera."""
+    cam = _camera_array(camera, np.array([W, D, H]), WIN, 1)
+    q = np.atleast_2d(points_mm) - cam[:3]
+    x, y, z = q @ cam[3:6], q @ cam[6:9], q @ cam[9:12]
+    return (np.floor(cam[14] - cam[12] * y / z).astype(int),
+            np.floor(cam[13] + cam[12] * x / z).astype(int))
+
+
+@pytest.fixture(scope="module")
+def bowl():
+    """A stock with a spherical bowl (radius 12 mm, 8 mm deep) at (15, 15), baked by
+    position."""
+    ny, nx = 60, 80
+    x = (np.arange(nx) + 0.5) * W / nx
+    y = (np.arange(ny) + 0.5) * D / ny
+    X, Y = np.meshgrid(x, y)
+    r2 = (X - 15) ** 2 + (Y - 15) ** 2
+    hm = np.where(r2 < 12 ** 2, np.maximum(H - 8, H + 4 - np.sqrt(np.maximum(0, 256 - r2))), H)
+    hm = np.minimum(hm, H)
+    b = bake_heightfield(hm, (W, D, H), _CoordWood(), texels_per_mm=4.0)
+    charts = HeightfieldCharts(np.zeros((1, 1)), (W, D, H), b.texels_per_mm).charts
+    return hm, b.atlas, charts
+
+
+def test_each_face_shows_its_own_chart_at_its_own_place(bowl):
+    """Top, walls and the bowl, iso camera, no cut: the colour at a projected point is the
+    point's own texel, lit (the light scales all channels alike, the specular adds white)."""
+    hm, atlas, charts = bowl
+    img = stock_view(hm, (W, D, H), atlas, charts, window_size=WIN).astype(float)
+    # top, front wall, right wall, top, and the bowl's far wall (z from the bowl's sphere)
+    for p in ([32.0, 22.0, H], [30.0, 0.0, 8.0], [W, 20.0, 10.0], [36.0, 8.0, H],
+              [15.0, 25.0, H + 4 - np.sqrt(256 - 100)]):
+        r, c = _pixel(p)
+        rgb = img[r[0], c[0]]
+        want = 255 * np.array(p) / np.array([W, D, H])
+        # rgb = light * texel + specular (white, the same in every channel): fit both
+        (light, spec), *_ = np.linalg.lstsq(np.column_stack([want, np.ones(3)]), rgb, rcond=None)
+        assert 0.5 < light < 1.3 and spec >= -3
+        np.testing.assert_allclose(light * want + spec, rgb, atol=6)
+
+
+def test_the_cut_plane_shows_the_wood_inside_unlit(bowl):
+    """With a wood, the camera's half is cut away at X = W / 2: a point of the plane inside the
+    stock shows the wood's own colour there (unlit), a point of the top beyond the plane is
+    gone."""
+    hm, atlas, charts = bowl
+    img = stock_view(hm, (W, D, H), atlas, charts, wood=_CoordWood(),
+                     window_size=WIN).astype(float)
+    whole = stock_view(hm, (W, D, H), atlas, charts, window_size=WIN).astype(float)
+    p = np.array([W / 2, 22.0, 6.0])
+    r, c = _pixel(p)
+    # seen through the block's translucent near face, as in the VTK picture
+    tint = BLOCK_OPACITY * 255 * np.asarray(BLOCK_COLOR)
+    np.testing.assert_allclose(img[r[0], c[0]],
+                               (1 - BLOCK_OPACITY) * 255 * p / np.array([W, D, H]) + tint,
+                               atol=3)
+    r, c = _pixel([34.0, 25.0, H])  # on the removed half's top
+    assert np.abs(img[r[0], c[0]] - whole[r[0], c[0]]).max() > 10
+
+
+def test_toolpath_lines_over_the_stock_show_and_lines_on_it_hide(bowl):
+    hm, atlas, charts = bowl
+    flat = np.full_like(hm, H)
+    plain = stock_view(flat, (W, D, H), atlas, charts, window_size=WIN, supersample=1)
+    above = np.array([[[5.0, 15.0, H + 3], [35.0, 15.0, H + 3]]])
+    on = np.array([[[5.0, 15.0, H], [35.0, 15.0, H]]])
+    img = stock_view(flat, (W, D, H), atlas, charts, window_size=WIN, supersample=1,
+                     overlay=[(above, "red", 1.0), (on, (0, 0, 255), 1.0)])
+    r, c = _pixel([20.0, 15.0, H + 3])
+    assert tuple(img[r[0], c[0]]) == (255, 0, 0)
+    r, c = _pixel([20.0, 15.0, H])
+    diff = np.abs(img.astype(int) - plain).max(axis=-1)
+    assert diff[r[0] - 1:r[0] + 2, c[0] - 1:c[0] + 2].max() == 0  # hidden in the surface
+
+
+def test_png_and_errors(tmp_path, bowl):
+    hm, atlas, charts = bowl
+    path = write_stock_view(tmp_path / "v.png", hm, (W, D, H), atlas, charts, window_size=WIN,
+                            camera="front")
+    from PIL import Image
+
+    with Image.open(path) as im:
+        assert im.size == WIN
+    with pytest.raises(WoodcamError, match="heightmap must be"):
+        stock_view(hm[0], (W, D, H), atlas, charts)
+    with pytest.raises(WoodcamError, match="charts lacks"):
+        stock_view(hm, (W, D, H), atlas, {"top": charts["top"]})
+    with pytest.raises(WoodcamError, match="overlay colour"):
+        stock_view(hm, (W, D, H), atlas, charts, window_size=WIN,
+                   overlay=[(np.zeros((1, 2, 3)), "mauve", 1.0)])
+    with pytest.raises(WoodcamError, match="supersample"):
+        stock_view(hm, (W, D, H), atlas, charts, supersample=0)
+    with pytest.raises(WoodcamError, match="camera must be"):
+        stock_view(hm, (W, D, H), atlas, charts, camera="up")
+
+
+def test_it_frames_the_stock_as_the_vtk_screenshot_does(bowl, tmp_path):
+    """The same stock drawn by VTK (:func:`woodcam.view.preview` of the baked mesh, cut plane)
+    and here: the silhouettes (non-white pixels) agree and the colours are close."""
+    pytest.importorskip("pyvista")
+    from PIL import Image
+
+    from woodcam.view import preview
+
+    hm, atlas, charts = bowl
+    b = bake_heightfield(hm, (W, D, H), _CoordWood(), texels_per_mm=4.0)
+    png = tmp_path / "vtk.png"
+    try:
+        preview(b.mesh, wood=_CoordWood(), size_mm=(W, D, H), screenshot=png,
+                window_size=WIN)
+    except Exception as err:  # no EGL/OSMesa on this machine
+        pytest.skip(f"VTK cannot render off screen here: {err}")
+    vtk = np.asarray(Image.open(png).convert("RGB")).astype(int)
+    ours = stock_view(hm, (W, D, H), atlas, charts, wood=_CoordWood(),
+                      window_size=WIN).astype(int)
+    a, b_ = vtk.min(axis=-1) < 245, ours.min(axis=-1) < 245
+    assert (a & b_).sum() / (a | b_).sum() > 0.95
+    both = a & b_
+    assert np.median(np.abs(vtk[both] - ours[both]).max(axis=-1)) < 25
+
+
+def test_preview_heightfield_draws_its_screenshot_without_vtk(tmp_path, bowl, monkeypatch):
+    """``preview_heightfield(screenshot=True)`` writes NAME_view.png from the atlas it baked
+    (pyvista is never asked for) and keeps the atlas and its charts on the result."""
+    import sys
+
+    from PIL import Image
+
+    from woodcam.pipeline import preview_heightfield
+    from woodcam.stock import open_stock
+
+    hm, _, _ = bowl
+    monkeypatch.setitem(sys.modules, "pyvista", None)  # an import of it would fail
+    stock = open_stock("builtin:flat-sawn")
+    stock_hm = hm - H + stock.size_mm[2]  # the bowl on the block's top
+    res = preview_heightfield(stock_hm, stock, tmp_path / "s.glb", texels_per_mm=2.0, obj=False,
+                              screenshot=True)
+    assert res.files["png"] == tmp_path / "s_view.png"
+    with Image.open(res.files["png"]) as im:
+        assert im.size == (1280, 960)
+        img = np.asarray(im.convert("RGB"))
+    assert (img.min(axis=-1) < 200).mean() > 0.1  # the stock is drawn, not a white picture
+    top = res.chart_texels("top")
+    assert top.shape[:2] == (int(np.ceil(stock.size_mm[1] * 2)), int(np.ceil(stock.size_mm[0] * 2)))
