@@ -109,6 +109,45 @@ def test_fit_to_photos_recovers_per_axis_colour_of_arf():
     np.testing.assert_allclose(fitted, truth, atol=0.3 / 64 + 1 / 255 + 1e-3)
 
 
+class _KnottedAxisZ:
+    """AXIS_Z whose knot features are 1 inside a 6 mm ball at ``KNOT_AT`` (a stand-in knot)."""
+
+    def __call__(self, p):
+        return AXIS_Z(p)
+
+    def knot_features(self, p):
+        inside = np.linalg.norm(np.asarray(p, float) - KNOT_AT, axis=1) < 6.0
+        return {"knot": inside.astype(float)}
+
+
+KNOT_AT = np.array([30.0, 0.0, 20.0])     # on the front face (y = 0) of the 60x50x40 block
+
+
+@pytest.mark.parametrize("by", ["knot_mask", "field"])
+def test_fit_learns_the_ring_colours_from_clear_wood_only(by):
+    """Bug seen on the real spruce cube H11: knot pixels (dark, with rings of their own) were
+    binned by the stem's ARF, so a face with a knot gave a ramp darkened and flattened (its
+    ring contrast even changed sign). A dark knot painted on the front photo, known from the
+    face's knot mask or from the field's knot features, must leave the fitted ramp at the
+    truth."""
+    centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
+    truth = np.tile(np.stack([0.8 - 0.3 * centres, 0.6 - 0.25 * centres, 0.4 - 0.2 * centres], 1),
+                    (3, 1, 1))
+    block = _render_block(AXIS_Z, truth)
+    front = block.faces["front"]
+    pts = face_pixel_points("front", front.shape, block.size_mm).reshape(-1, 3)
+    knot = _KnottedAxisZ().knot_features(pts)["knot"].reshape(front.shape) > 0.5
+    assert knot.mean() > 0.03
+    front.photo[knot] = (60, 35, 20)                    # knot wood: dark brown
+    if by == "knot_mask":
+        front.extras["knot_mask"] = knot
+        field = AXIS_Z
+    else:
+        field = _KnottedAxisZ()
+    fitted = ColorMapAppearance.fit_to_block(block, field, anchor="field").axis_luts
+    np.testing.assert_allclose(fitted, truth, atol=0.3 / 64 + 1 / 255 + 1e-3)
+
+
 def test_fit_with_only_some_faces_keeps_species_ramp_elsewhere():
     centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
     truth = np.tile(np.stack([0.5 + 0 * centres] * 3, 1), (3, 1, 1))

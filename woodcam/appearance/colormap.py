@@ -37,6 +37,11 @@ LUT_BINS = 32
 #: cubes (rings 15-30 px apart), so each ring is registered mostly by itself and its neighbours.
 RING_REGISTRATION_BLUR_PX_PER_SIDE = 12.0
 
+#: Knot feature (0 = stem wood, 1 = inside a knot) below which a photo pixel counts as clear
+#: stem wood when a colour ramp is fitted: the knot's smooth-minimum blend reaches a few
+#: per cent a little outside its surface, where the stem's rings are already bent round it.
+KNOT_FREE_BELOW = 0.05
+
 RampAnchor = Literal["auto", "field", "ring_map"]
 
 
@@ -330,14 +335,34 @@ def _field_lut(faces, field, size_mm, centres, register: bool = False) -> np.nda
         g = np.asarray(field(pts), float)
         if register:
             g = _registered_years(face, g.reshape(face.shape)).ravel()
-        b = np.minimum((arf(g) * LUT_BINS).astype(int), LUT_BINS - 1)
-        rgb = face.photo.reshape(-1, 3).astype(float) / 255.0
+        clear = _clear_wood(face, field, pts)
+        b = np.minimum((arf(g[clear]) * LUT_BINS).astype(int), LUT_BINS - 1)
+        rgb = face.photo.reshape(-1, 3)[clear].astype(float) / 255.0
         counts += np.bincount(b, minlength=LUT_BINS)
         for c in range(3):
             sums[:, c] += np.bincount(b, rgb[:, c], minlength=LUT_BINS)
+    if not counts.any():
+        return np.full((LUT_BINS, 3), np.nan)
     ok = counts > 0
     mean = sums[ok] / counts[ok, None]
     return np.stack([np.interp(centres, centres[ok], mean[:, c]) for c in range(3)], axis=1)
+
+
+def _clear_wood(face, field, points_mm) -> np.ndarray:
+    """``(n,)`` bool over ``face``'s pixels: True off any knot, by the face's ``knot_mask`` and
+    the field's own knot features where it reports them. The ramp is the colour of the stem's
+    rings; knot wood is dark and has its own rings (a knot's ARF runs round its strand), so
+    binning it by the stem's ARF only adds a dark cast spread over every bin (the ring contrast
+    of H11's knotted faces halved and even changed sign), and the renderer darkens knots again
+    on top (:class:`~woodcam.appearance.knots.KnotShading`)."""
+    clear = np.ones(len(points_mm), bool)
+    mask = face.extras.get("knot_mask")
+    if mask is not None and np.shape(mask) == tuple(face.shape):
+        clear &= ~np.asarray(mask, bool).ravel()
+    features = getattr(field, "knot_features", None)
+    if callable(features):
+        clear &= np.asarray(features(points_mm)["knot"], float) < KNOT_FREE_BELOW
+    return clear
 
 
 def _registered_years(face, years: np.ndarray) -> np.ndarray:
