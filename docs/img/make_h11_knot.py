@@ -1,9 +1,11 @@
 """Redraw docs/img/h11_knot_bake.png: H11's photos above the evidence fit's colour-map bake of the
 same faces (the knot fitted from the knot masks of faces C and F).
 
-Run from the repository root: ``python docs/img/make_h11_knot.py`` (needs ../shared/data).
+Run from the repository root: ``python docs/img/make_h11_knot.py`` (needs ../shared/data or
+``$WOODCAM_SHARED_DATA``).
 """
 
+import os
 import warnings
 from pathlib import Path
 
@@ -17,9 +19,12 @@ from woodcam.block.io import read_mokume  # noqa: E402
 from woodcam.frames import FACE_NORMAL, face_pixel_points  # noqa: E402
 from woodcam.stock import open_stock  # noqa: E402
 
-FOLDER = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "mokume" / "H11"
+FOLDER = Path(os.environ.get("WOODCAM_SHARED_DATA",
+                             Path(__file__).resolve().parents[3] / "shared" / "data")) / "mokume" / "H11"
 warnings.simplefilter("ignore")
-stock = open_stock(str(FOLDER))
+# H11 is a softwood (shared data README; spruce): the Mokume files name no species, and the
+# default preset (oak) would lay oak's ring-porous pores and streaks over the fitted rings.
+stock = open_stock(str(FOLDER), species="spruce")
 block = read_mokume(FOLDER)
 faces = ("left", "back", "front", "top")
 fig, ax = plt.subplots(2, len(faces), figsize=(3 * len(faces), 6))
