@@ -150,3 +150,32 @@ def test_place_in_inches_ranks_what_the_mm_run_ranks_and_prints_inches(tmp_path,
     assert f"--place {move}" in out_mm
     printed = out_inch.split("--place translate:")[1].split()[0]
     assert [float(v) for v in printed.split(",")] == pytest.approx([v / 25.4 for v in mm])
+
+
+def test_gcode_deviation_and_gouges_print_in_inches(tmp_path, monkeypatch, capsys):
+    """With ``--part`` and ``--units inch`` the deviation line and the gouge warnings are in
+    inches (the map file stays in mm); the same run in mm prints the same amounts in mm."""
+    import trimesh
+
+    monkeypatch.setattr(woodcam.pipeline, "preview_heightfield",
+                        lambda hm, stock, out, **kw: woodcam.pipeline.PartPreview(
+                            "x", files={"glb": out}, triangles=1))
+    part = tmp_path / "part.stl"  # the whole 101.6 x 76.2 x 25.4 mm block: every cut gouges
+    trimesh.creation.box(extents=(101.6, 76.2, 25.4)).apply_translation(
+        (50.8, 38.1, 12.7)).export(part)
+    prog = tmp_path / "slot.nc"
+    prog.write_text("G21\nG0 X20 Y40 Z2\nG1 Z-2.54 F300\nX80\nG0 Z2\n")
+    common = [str(prog), "--out", str(tmp_path / "o.glb"), "--part", str(part)]
+    main(["gcode", *common, "--units", "inch", "--block", "builtin:flat-sawn:4x3x1",
+          "--tool", "flat:0.25", "--cell-size", "0.01", "--work-offset", "0,0,1"])
+    inch = capsys.readouterr()
+    main(["gcode", *common, "--block", "builtin:flat-sawn:101.6x76.2x25.4",
+          "--tool", "flat:6.35", "--cell-size", "0.254", "--work-offset", "0,0,25.4"])
+    mm = capsys.readouterr()
+    overcut_in = float(inch.out.split("overcut ")[1].split(" in^3")[0])
+    overcut_mm = float(mm.out.split("overcut ")[1].split(" mm^3")[0])
+    assert overcut_mm > 1000 and overcut_in == pytest.approx(overcut_mm / 25.4 ** 3, rel=1e-2)
+    depth_in = float(inch.err.split("gouge: cuts ")[1].split(" in ")[0])
+    depth_mm = float(mm.err.split("gouge: cuts ")[1].split(" mm ")[0])
+    assert depth_mm == pytest.approx(2.54, abs=0.01) and depth_in == pytest.approx(0.1, abs=1e-3)
+    assert " mm" not in inch.out.split("deviation from")[1].split("; map")[0]

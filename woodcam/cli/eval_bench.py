@@ -25,7 +25,7 @@ def register(subparsers) -> None:
         description="Regenerates blocks INDEX = 0..COUNT-1 of the realistic generator for SEED "
         "(woodcam.synth.benchmark_set_block; half knotted, each with a knot crossing it), fits "
         "each with every method and scores matched ring lines within 1 / 2 mm on seven interior "
-        "cut planes. The table gives per scenario, face set and kind the mean with a 95 %% "
+        "cut planes. The table gives per scenario, face set and kind the mean with a 95 % "
         "bootstrap interval and the worst block; eq. 7-9 blocks are the sanity row. Per-block "
         "records go to OUT/records.json (woodcam.benchmark.score_block).")
     r.add_argument("--seed", type=int, required=True,

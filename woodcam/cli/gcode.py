@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 from ..errors import WoodcamError
-from ..units import fmt_volume
+from ..units import MM_PER_UNIT, fmt_length, fmt_volume
 from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
                       allow_negative_values, stock_options, vector_type)
 
@@ -198,9 +198,10 @@ def run(args) -> int:
         tools = _tools_from_args(args, program)
         step = program.stepover_mm(spacing_mm=args.cell_size)
         if step is not None and args.cell_size > step / 2:
-            print(f"woodcam: warning: {path.name}: the grid ({args.cell_size:g} mm) is coarser "
-                  f"than half the step-over ({step:.3g} mm): expect aliasing waves; use "
-                  f"--cell-size {step / 2:.2g} or finer", file=sys.stderr)
+            print(f"woodcam: warning: {path.name}: the grid ({fmt_length(args.cell_size, args.units)}) "
+                  f"is coarser than half the step-over ({fmt_length(step, args.units)}): expect "
+                  f"aliasing waves; use --cell-size {step / 2 / MM_PER_UNIT[args.units]:.2g} or finer",
+                  file=sys.stderr)
             n_warn += 1
         res = simulate(program, tools, stock.size_mm, resolution_mm=args.cell_size,
                        work_offset_mm=offset, progress=False, initial_heightmap=hm,
@@ -229,10 +230,11 @@ def run(args) -> int:
         png = Path(args.out).with_name(Path(args.out).stem + "_deviation.png")
         deviation_png(dev, png, title=f"{Path(args.part).name}:\n{dev.summary(gouges=False)}"
                       + (f", {len(dev.gouges)} gouging lines" if dev.gouges else ""))
-        print(f"deviation from {Path(args.part).name}: {dev.summary()}; map {png}")
+        print(f"deviation from {Path(args.part).name}: {dev.summary(units=args.units)}; "
+              f"map {png} (in mm)")
         for ln, d in dev.gouges[:12]:
-            print(f"woodcam: warning: line {ln}: gouge: cuts {d:.3f} mm into the part",
-                  file=sys.stderr)
+            print(f"woodcam: warning: line {ln}: gouge: cuts {fmt_length(d, args.units, 4)} "
+                  "into the part", file=sys.stderr)
         n_warn += len(dev.gouges)
     meta = {"gcode": [m["gcode"] for m in meta_programs] if len(meta_programs) > 1
             else meta_programs[0]["gcode"],

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import WoodcamError
 from ..tolerances import SIM_CONTACT_TOL_MM
+from ..units import Units, fmt_length, fmt_volume
 
 
 @dataclass
@@ -33,13 +34,27 @@ class Deviation:
     overcut_mm3: float
     gouges: list[tuple[int, float]] = field(default_factory=list)
 
-    def summary(self, gouges: bool = True) -> str:
-        worst = ", ".join(f"line {ln} ({d:.3f} mm)" for ln, d in self.gouges[:5])
-        return (f"leftover {self.leftover_mm3:.0f} mm^3 (max {max(self.difference_mm.max(), 0):.3f}"
-                f" mm), overcut {self.overcut_mm3:.1f} mm^3 (max "
-                f"{max(-self.difference_mm.min(), 0):.3f} mm)"
+    def summary(self, gouges: bool = True, units: Units = "mm") -> str:
+        """One line: leftover and overcut volumes with their deepest points and, with
+        ``gouges``, the five deepest gouging lines; lengths and volumes in ``units``."""
+        worst = ", ".join(f"line {ln} ({_length(d, units)})" for ln, d in self.gouges[:5])
+        return (f"leftover {_volume(self.leftover_mm3, units, 0)} (max "
+                f"{_length(max(self.difference_mm.max(), 0), units)}), overcut "
+                f"{_volume(self.overcut_mm3, units, 1)} (max "
+                f"{_length(max(-self.difference_mm.min(), 0), units)})"
                 + (f"; gouges at {worst}" + (" ..." if len(self.gouges) > 5 else "")
                    if self.gouges and gouges else ""))
+
+
+def _length(mm: float, units: Units) -> str:
+    """Depths to the micrometre in mm (``0.085 mm``), four significant digits in inches."""
+    return f"{mm:.3f} mm" if units == "mm" else fmt_length(mm, units, 4)
+
+
+def _volume(mm3: float, units: Units, decimals: int) -> str:
+    """Volumes to ``decimals`` in mm^3 (a 0.6 mm^3 overcut must not print as 1), else
+    :func:`~woodcam.units.fmt_volume`."""
+    return f"{mm3:.{decimals}f} mm^3" if units == "mm" else fmt_volume(mm3, units)
 
 
 def deviation(result, part, *, tol_mm: float = SIM_CONTACT_TOL_MM * 100) -> Deviation:
