@@ -85,19 +85,20 @@ def test_threads_give_identical_colours(rng):
 
 
 def _render_block(field, luts, size=(60.0, 50.0, 40.0), px_per_mm=2.0):
-    """Faces coloured exactly by a known colour-of-ARF function per block axis."""
+    """Faces coloured exactly by a known colour-of-ring-phase function (``luts`` at the phase
+    bin centres, phase = years mod 1 = sqrt(ARF)) per block axis."""
     faces = {}
     for f in FACES:
         h, w = face_image_size_mm(f, size)
         shape = (round(h * px_per_mm), round(w * px_per_mm))
-        a = arf(field(face_pixel_points(f, shape, size).reshape(-1, 3)))
+        a = np.sqrt(arf(field(face_pixel_points(f, shape, size).reshape(-1, 3))))
         k = int(np.flatnonzero(FACE_NORMAL[f])[0])
         rgb = np.stack([np.interp(a, (np.arange(LUT_BINS) + 0.5) / LUT_BINS, luts[k, :, c]) for c in range(3)], 1)
         faces[f] = Face(f, shape, photo=np.round(rgb * 255).astype(np.uint8).reshape(shape + (3,)))
     return Block(size, faces)
 
 
-def test_fit_to_photos_recovers_per_axis_colour_of_arf():
+def test_fit_to_photos_recovers_per_axis_colour_of_ring_phase():
     centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
     truth = np.stack([
         np.stack([0.8 - 0.3 * centres, 0.6 - 0.25 * centres, 0.4 - 0.2 * centres], 1) * s
@@ -251,3 +252,39 @@ def test_register_ring_phase_moves_a_fitted_fields_rings_onto_the_ring_map():
     assert np.abs(reg - true).max() < 0.5                     # no ring skipped
     # A map without lines leaves the field as it is.
     np.testing.assert_array_equal(register_ring_phase(off, np.zeros(face.shape), 5.0), off)
+
+
+def test_a_latewood_band_across_the_whole_year_is_fitted_and_rendered_sharp(rng):
+    """Bug seen on H11: registered on a ring map, whose lines sit on the dark latewood band, a
+    photo's latewood straddles the whole year (phase 0.94-1 and 0-0.06). Binned by the ARF
+    (= phase^2), the first bin spans phase 0-0.18 and averaged that half of the band with
+    earlywood. Binned by phase, both halves come back dark, fitted and rendered."""
+    from dataclasses import replace
+
+    from woodcam.appearance import get_species
+
+    dark, light = np.array([0.45, 0.35, 0.25]), np.array([0.85, 0.75, 0.6])
+
+    def truth(phase):
+        band = np.minimum(phase, 1 - phase) < 0.06
+        return np.where(band[:, None], dark, light)
+
+    size, px = (60.0, 50.0, 40.0), 4.0
+    faces = {}
+    for f in FACES:
+        h, w = face_image_size_mm(f, size)
+        shape = (round(h * px), round(w * px))
+        phase = np.mod(AXIS_Z(face_pixel_points(f, shape, size).reshape(-1, 3)), 1.0)
+        faces[f] = Face(f, shape, photo=np.round(truth(phase) * 255).astype(np.uint8).reshape(shape + (3,)))
+    app = ColorMapAppearance.fit_to_block(Block(size, faces), AXIS_Z, anchor="field")
+    for k in range(3):
+        np.testing.assert_allclose(app.axis_luts[k, [0, 1, -2, -1]], np.tile(dark, (4, 1)), atol=0.03)
+        np.testing.assert_allclose(app.axis_luts[k, 4:-4], np.tile(light, (LUT_BINS - 8, 1)), atol=0.01)
+    plain = replace(get_species("spruce"), pore_contrast=0.0, streak_contrast=0.0,
+                    endgrain_roughness=0.0)
+    wood = Wood(AXIS_Z, replace(app, species=plain))
+    p = rng.uniform(0, 40, (20000, 3))
+    phase = np.mod(AXIS_Z(p), 1.0)
+    rgb = wood.color(p, np.tile([0.0, -1.0, 0.0], (len(p), 1)))
+    inner = np.minimum(phase, 1 - phase) < 0.04          # inside the band, off its edges
+    np.testing.assert_allclose(rgb[inner].mean(0), dark, atol=0.03)

@@ -29,7 +29,11 @@ from .knots import KnotShading
 from .noise import TABLE, noise_at
 from .orientation import eq10_weights
 
-#: Number of ARF bins of a fitted colour ramp.
+#: Number of ring-phase bins of a fitted colour ramp (equal steps of ``years mod 1``, i.e. of
+#: ``sqrt(ARF)``). Binned by phase, not by the ARF: the ARF squares the phase, so its first bin
+#: would span 0.18 of a ring, and a photo's latewood band that straddles the whole year (as it
+#: does once the phase is registered on a ring map, whose lines sit on the dark band) would be
+#: averaged with earlywood there: H11's baked latewood lines came out a third fainter.
 LUT_BINS = 32
 
 #: Window (Gaussian sigma, pixels of a 256-pixel face side) over which the offset between a
@@ -185,7 +189,8 @@ class ColorMapAppearance:
     ----------
     species : Species or preset name
     axis_luts : (3, LUT_BINS, 3) float or None
-        Fitted colour over ARF for surfaces normal to X, Y, Z (block frame); ``None`` uses the
+        Fitted colour over the ring phase ``years mod 1`` (= sqrt(ARF)) in :data:`LUT_BINS`
+        equal bins, for surfaces normal to X, Y, Z (block frame); ``None`` uses the
         species ramp with end-grain darkening. Rows with NaN fall back to the species ramp.
     knots : KnotShading
         How knot wood is coloured on fields that report knot features
@@ -273,12 +278,14 @@ class ColorMapAppearance:
     @classmethod
     def fit_to_block(cls, block, field, species="oak", *, anchor: RampAnchor = "auto",
                      **kwargs) -> "ColorMapAppearance":
-        """Fit per-axis colour ramps (colour as a function of ARF) to a block's face photos.
+        """Fit per-axis colour ramps (colour as a function of the ring phase ``years mod 1``,
+        i.e. of sqrt(ARF)) to a block's face photos, from clear wood only (knots left out,
+        :func:`_clear_wood`).
 
-        ``anchor="field"``: for every face with a photo, the ARF of ``field`` at each pixel
-        centre is binned into :data:`LUT_BINS` bins and the mean photo colour per bin is taken;
-        both faces of an axis are pooled. Bins no pixel falls in are filled by linear
-        interpolation along the ARF. Right when ``field`` puts its rings exactly on the photos'
+        ``anchor="field"``: for every face with a photo, the ring phase of ``field`` at each
+        pixel centre is binned into :data:`LUT_BINS` equal bins and the mean photo colour per
+        bin is taken; both faces of an axis are pooled. Bins no pixel falls in are filled by
+        linear interpolation along the phase. Right when ``field`` puts its rings exactly on the photos'
         rings (a block's true field).
 
         ``anchor="ring_map"``: the same, after moving the field's ring phase on each face onto
@@ -325,7 +332,7 @@ class ColorMapAppearance:
 
 
 def _field_lut(faces, field, size_mm, centres, register: bool = False) -> np.ndarray:
-    """Mean photo colour per ARF bin of ``field`` over ``faces`` ``(LUT_BINS, 3)``; with
+    """Mean photo colour per ring-phase bin of ``field`` over ``faces`` ``(LUT_BINS, 3)``; with
     ``register``, the field's ring phase is first moved onto each face's ring map
     (:func:`_registered_years`)."""
     sums = np.zeros((LUT_BINS, 3))
@@ -336,7 +343,7 @@ def _field_lut(faces, field, size_mm, centres, register: bool = False) -> np.nda
         if register:
             g = _registered_years(face, g.reshape(face.shape)).ravel()
         clear = _clear_wood(face, field, pts)
-        b = np.minimum((arf(g[clear]) * LUT_BINS).astype(int), LUT_BINS - 1)
+        b = np.minimum((np.mod(g[clear], 1.0) * LUT_BINS).astype(int), LUT_BINS - 1)
         rgb = face.photo.reshape(-1, 3)[clear].astype(float) / 255.0
         counts += np.bincount(b, minlength=LUT_BINS)
         for c in range(3):
@@ -448,8 +455,9 @@ def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, lu
         # knot wood darker, dead-knot outline drawn over (KnotShading.apply, appearance/knots.py)
         kfac = (1.0 - dark_alive * knot[i]) * (1.0 - dark_dead * dead[i])
         ol = outline[i]
-        # lut position (bin centres) for fitted ramps
-        tl = min(max(a[i] * nb - 0.5, 0.0), nb - 1.0)
+        # lut position (bin centres) for fitted ramps: bins of the ring phase sqrt(ARF); clamped
+        # at both ends (not wrapped), so a true field's latewood -> earlywood step stays sharp
+        tl = min(max(np.sqrt(a[i]) * nb - 0.5, 0.0), nb - 1.0)
         i0 = min(int(tl), nb - 2)
         fl = tl - i0
         if blend:
