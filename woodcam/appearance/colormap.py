@@ -7,7 +7,9 @@ the fibres cuts them across, and end grain is darker (open cell ends trap light)
 than side grain. Pores and fibre streaks come from one solid noise stretched along the grain,
 so a side-grain surface shows them as streaks and an end-grain surface as dots, as in real
 wood. When a block has face photos, the colour ramps are fitted to them per block axis
-(:meth:`ColorMapAppearance.fit_to_block`), so end-grain darkening comes from the photos.
+(:meth:`ColorMapAppearance.fit_to_block`), so end-grain darkening comes from the photos; a
+fitted ramp is looked up by the ring phase ``years mod 1`` (= sqrt(ARF), :data:`LUT_BINS`) and
+learned from clear wood only (knots would darken every ring position).
 
 Colours are linear floats in [0, 1] (sRGB values, no gamma handling: photos and textures are
 both sRGB and the model only interpolates between observed colours).
