@@ -292,6 +292,10 @@ EVIDENCE_SPREAD_SPACING_MM = 4.0
 #: Knot-mask regions smaller than this (pixels) are not knot exits (speckle of a detector).
 KNOT_MIN_AREA_PX = 12
 
+#: ... and smaller than this share of the largest region on the same face (H11's grown mask of
+#: face C has a 150 px bud beside its 21 000 px knot).
+KNOT_MIN_AREA_SHARE = 0.1
+
 #: Two knot exits on different faces are one branch when the line joining them makes more than
 #: this angle with the stem axis: branches leave the stem at 50-90 degrees (seed 001's logs).
 KNOT_PAIR_MIN_ANGLE_DEG = 40.0
@@ -306,10 +310,6 @@ KNOT_MIN_ENTRY_COS = 0.2
 #: more than this (years) below both exits': a dip is the pith, and a branch grows out from the
 #: pith on one side only (half a ring: more than a trace's mislabel or a fit's wobble).
 KNOT_PITH_YEARS = 0.5
-
-#: ... and smaller than this share of the largest region on the same face (H11's grown mask of
-#: face C has a 150 px bud beside its 21 000 px knot).
-KNOT_MIN_AREA_SHARE = 0.1
 
 #: Dead-knot test of a knot exit (:func:`woodcam.inference.knots.exit_is_dead`): the boundary
 #: is cut into this many angular sectors around the exit's centroid...
