@@ -576,7 +576,6 @@ class _Tessellation:
     max_triangles: int | None
     texels_per_mm: float = _DEFAULT_TEXELS_PER_MM
     triangles: int = 0
-    tries: int = 0
     notes: list = field(default_factory=list)
     used_tol_mm: float = 0.0
     used_ang_rad: float = 0.0
@@ -598,7 +597,6 @@ class _Tessellation:
         tries = 0
         for _ in range(_BUDGET_TRIES + 1):
             tries += 1
-            self.tries += 1
             meshes = [_tessellate_solid(solid, tol_mm, ang_rad) for solid in solids]
             for _vertices, faces in meshes:
                 if len(faces) == 0:

@@ -186,6 +186,7 @@ def run(args) -> int:
         program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
                              interpreter=args.interpreter)
         t_read = time.perf_counter() - t0
+        full = program  # the whole last program, for the window's slider
         if args.until_line is not None and k == len(args.program) - 1:
             program = program.until_line(args.until_line)
         for w in program.warnings:
@@ -224,7 +225,7 @@ def run(args) -> int:
     program, res = last
     if args.part:
         from ..cad import load_part
-        from ..toolpath.deviation import deviation, deviation_png
+        from ..toolpath.deviation import deviation, deviation_png, fmt_depth
 
         dev = deviation(res, load_part(args.part))
         png = Path(args.out).with_name(Path(args.out).stem + "_deviation.png")
@@ -233,7 +234,7 @@ def run(args) -> int:
         print(f"deviation from {Path(args.part).name}: {dev.summary(units=args.units)}; "
               f"map {png} (in mm)")
         for ln, d in dev.gouges[:12]:
-            print(f"woodcam: warning: line {ln}: gouge: cuts {fmt_length(d, args.units, 4)} "
+            print(f"woodcam: warning: line {ln}: gouge: cuts {fmt_depth(d, args.units)} "
                   "into the part", file=sys.stderr)
         n_warn += len(dev.gouges)
     meta = {"gcode": [m["gcode"] for m in meta_programs] if len(meta_programs) > 1
@@ -250,14 +251,12 @@ def run(args) -> int:
                               max_atlas_px=args.max_atlas)
     t_bake = time.perf_counter() - t1
     if args.screenshot:
-        _screenshot(args, out.files, stock, program, offset, out, res.heightmap)
+        _screenshot(args, stock, program, offset, out, res.heightmap)
     print(f"meshed and baked {out.triangles} triangles in {t_bake:.2f} s; wrote "
           + ", ".join(map(str, out.files.values())))
     if args.view:
         from ..view.scrub import gcode_window
 
-        full = read_gcode(args.program[-1], start_mm=args.start, dialect=args.dialect,
-                          interpreter=args.interpreter) if args.until_line else program
         gcode_window(full, tools, stock, work_offset_mm=offset, resolution_mm=args.cell_size,
                      initial_heightmap=hm_before, until_line=args.until_line)
     return 3 if args.strict and n_warn else 0
@@ -269,7 +268,7 @@ def _hms(seconds: float) -> str:
     return f"{h}:{m:02d}:{s:02d}"
 
 
-def _screenshot(args, files: dict, stock, program, offset, made, heightmap) -> None:
+def _screenshot(args, stock, program, offset, made, heightmap) -> None:
     """Render the stock with the toolpath over it (rapids red, feeds blue), block frame, from
     the preview's atlas (``made``: its :class:`PartPreview`), without VTK: the top view
     orthographic with numpy, the other views in perspective with the cut plane
@@ -296,4 +295,4 @@ def _screenshot(args, files: dict, stock, program, offset, made, heightmap) -> N
 
         write_stock_view(png, heightmap, stock.size_mm, made.texture, made.charts,
                          wood=stock.wood, camera=args.camera, overlay=overlay)
-    files["png"] = png
+    made.files["png"] = png

@@ -326,12 +326,7 @@ def _ring_order(z: np.ndarray, evidence: np.ndarray, polys: list) -> tuple[np.nd
     wrapped = np.ma.masked_array(np.angle(z), mask=~evidence)
     un = np.asarray(unwrap_phase(wrapped).filled(np.nan), np.float64)
     cycles = (un - np.pi) / (2 * np.pi)
-    out = []
-    for p in polys:
-        r = np.clip(np.round(p[:, 0]).astype(int), 0, h - 1)
-        c = np.clip(np.round(p[:, 1]).astype(int), 0, w - 1)
-        v = cycles[r, c]
-        out.append(float(np.nanmedian(v)) if np.isfinite(v).any() else np.nan)
+    out = [_piece_order(cycles, p) for p in polys]
     base = np.nanmin(out) if np.isfinite(out).any() else 0.0
     base = np.floor(base + 0.5)
     order[evidence] = (cycles[evidence] - base).astype(np.float32)
@@ -656,7 +651,7 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     px_per_mm : float, optional
         Image density; sets the ring map's line width (:data:`RING_MAP_SIGMA_MM`). Default: a
         256 px face of a 50 mm cube (5.12 px/mm), as the Mokume samples.
-    rule : "sharp-edge" | "dark-centre"
+    rule : one of :data:`BOUNDARY_RULES` (default :data:`DEFAULT_RULE`, "dark-line")
         Which phase extreme is the ring boundary (module docstring, step 5).
     wavelength_range_px : (min, max), optional
         Ring spacings the bank covers, px. Default :data:`RING_SPACING_RANGE_MM` at

@@ -82,8 +82,9 @@ def _png_bytes(image) -> bytes:
 
 def _with_encoded_texture(mesh, attribute: str):
     """Point ``mesh.visual.material.<attribute>`` (a COPY of the material) at a copy of its image
-    whose ``save(..., format="PNG")`` writes :func:`_png_bytes`: trimesh's GLB and OBJ exporters
-    each call ``image.save`` and would encode the same atlas again at zlib level 6."""
+    whose ``save(..., format="PNG")`` writes :func:`_png_bytes`: trimesh's GLB exporter calls
+    ``image.save`` and would encode the atlas again at zlib level 6 (the OBJ writer takes
+    :func:`_png_bytes` itself)."""
     material = copy.copy(mesh.visual.material)
     image = getattr(material, attribute, None)
     if image is None or not hasattr(image, "tobytes"):

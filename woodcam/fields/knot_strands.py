@@ -36,7 +36,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..errors import WoodcamError
-from .base import check_points
+from .base import central_gradient, check_points
 
 #: Smoothing ``k`` (years) of the stem-knot smooth minimum: rings bend round a knot within about
 #: one ring of its surface, as on H11's faces C and F (looked at).
@@ -118,27 +118,24 @@ class StemWithKnots:
 
     def _table(self, strand: KnotStrand):
         pts, rad = strand.samples()
-        h = 0.25
-        offs = np.concatenate([np.eye(3), -np.eye(3)]) * h
-        g = np.asarray(self.stem(np.concatenate([pts + o for o in offs])), float).reshape(6, len(pts))
-        dens = np.linalg.norm((g[:3] - g[3:]).T, axis=1) / (2 * h)
-        gs = np.asarray(self.stem(pts), float)
+        gs, grad = central_gradient(self.stem, pts, 0.25)
+        dens = np.linalg.norm(grad, axis=1)
         a, b = np.asarray(strand.start_mm, float), np.asarray(strand.end_mm, float)
-        return a, b - a, rad, gs, np.maximum(dens, 1e-3), self.dense and strand.pinned
+        return a, b - a, rad, gs, np.maximum(dens, 1e-3)
 
     @staticmethod
     def _geometry(p: np.ndarray, table):
         """``d``, ``R``, ``G`` and the stem time at the strand point of each point."""
-        a, v, rad, gs, dens, _ = table
+        a, v, rad, gs, dens = table
         t = np.clip((p - a) @ v / (v @ v), 0.0, 1.0)
         d = np.linalg.norm(p - (a + t[:, None] * v), axis=1)
         s = t * (len(rad) - 1)
         return d, np.interp(s, np.arange(len(rad)), rad), np.interp(s, np.arange(len(rad)), dens), \
             np.interp(s, np.arange(len(rad)), gs)
 
-    def _knot_time(self, p, g, table):
+    def _knot_time(self, p, g, table, dense: bool):
         d, R, G, gS = self._geometry(p, table)
-        if table[-1]:  # seed 003: the knot holds every ring since the pith
+        if dense:  # seed 003: the knot holds every ring since the pith
             G = np.where(gS > 0, np.maximum(G, gS / R), G)
         inside = gS + (d / R) * (g - gS) - (R - d) * G
         return np.where(d < R, inside, g + (d - R) * G)
@@ -148,7 +145,7 @@ class StemWithKnots:
         gs = np.asarray(self.stem(p), float)
         out = gs.copy()
         for strand, table in zip(self.strands, self._tables):
-            out = _smin(out, self._knot_time(p, gs, table), self.k,
+            out = _smin(out, self._knot_time(p, gs, table, self.dense and strand.pinned), self.k,
                         DEAD_KNOT_SMOOTHING_FACTOR if strand.dead else 1.0)
         return out
 

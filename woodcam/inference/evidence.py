@@ -43,6 +43,7 @@ import numpy as np
 from .._types import ArrayLike
 
 from ..errors import WoodcamError, WoodcamWarning
+from ..fields.base import central_gradient
 from ..frames import FACES
 from ..tolerances import (
     EVIDENCE_ACCEPT_MARGIN,
@@ -130,12 +131,8 @@ class EvidenceFit:
 
 def _years_error_mm(field, points: np.ndarray, years: np.ndarray) -> np.ndarray:
     """Distance (mm, first order) from each point to ``field``'s ring line of its year."""
-    h = _GRAD_STEP_MM
-    offs = np.concatenate([np.eye(3), -np.eye(3)]) * h
-    allp = np.concatenate([points] + [points + o for o in offs])
-    g = np.asarray(field(allp), float).reshape(7, len(points))
-    grad = (g[1:4] - g[4:7]).T / (2 * h)
-    return np.abs(g[0] - years) / np.maximum(np.linalg.norm(grad, axis=1), 1e-6)
+    g, grad = central_gradient(field, points, _GRAD_STEP_MM)
+    return np.abs(g - years) / np.maximum(np.linalg.norm(grad, axis=1), 1e-6)
 
 
 def face_score(err_mm: np.ndarray) -> float:

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..fields.base import central_gradient
 from ..fields.knot_strands import KnotStrand, StemWithKnots
 from ..frames import FACE_NORMAL, pixel_to_block
 from ..tolerances import (DEAD_KNOT_BANDS_MM, DEAD_KNOT_MIN_OUTLINED, DEAD_KNOT_SECTORS, KNOT_MIN_AREA_PX,
@@ -107,15 +108,12 @@ def _toward_pith(stem, point_mm, inward, length: float):
     ``-grad g`` (finite differences, 0.5 mm), and ends at the pith, ``g / |grad g|`` away
     (at most ``length``). ``(None, length)`` where that direction does not enter the block
     through the face (``inward`` (3,), its inward normal) or the gradient vanishes."""
-    h = 0.5
-    p = np.asarray(point_mm, float)
-    offs = np.concatenate([np.eye(3), -np.eye(3)]) * h
-    g = np.asarray(stem(np.concatenate([p[None], p + offs])), float)
-    grad = (g[1:4] - g[4:7]) / (2 * h)
+    g0, grads = central_gradient(stem, point_mm, 0.5)
+    g, grad = float(g0[0]), grads[0]
     norm = float(np.linalg.norm(grad))
     if not np.isfinite(norm) or norm < 1e-6 or -(grad @ inward) / norm < KNOT_MIN_ENTRY_COS:
         return None, length
-    return -grad / norm, float(np.clip(g[0] / norm + 1.0, 5.0, length)) if np.isfinite(g[0]) else length
+    return -grad / norm, float(np.clip(g / norm + 1.0, 5.0, length)) if np.isfinite(g) else length
 
 
 def fit_knot_strands(block, stem, faces=None) -> list[KnotStrand]:

@@ -4,8 +4,8 @@ The surface is the vertex grid of :mod:`woodcam.toolpath.mesh`: ``hm : (ny, nx)`
 Z (mm) at the cell centres over ``[0, W] x [0, D]``, plus a border row and column on the
 stock's faces carrying the nearest cell's height; each quad is split v00-v01-v11 /
 v00-v11-v10. Used for the top chart's texel points (the bake) and by the stock view
-(:mod:`woodcam.view._zbuffer`), where numpy's version (:func:`woodcam.toolpath.mesh._grid_surface`)
-cost ~0.5 s per million points in temporaries. This module imports only numpy and numba.
+(:mod:`woodcam.view._zbuffer`), where the numpy version it replaced cost ~0.5 s per million
+points in temporaries. This module imports only numpy and numba.
 """
 
 from __future__ import annotations

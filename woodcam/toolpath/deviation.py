@@ -37,16 +37,16 @@ class Deviation:
     def summary(self, gouges: bool = True, units: Units = "mm") -> str:
         """One line: leftover and overcut volumes with their deepest points and, with
         ``gouges``, the five deepest gouging lines; lengths and volumes in ``units``."""
-        worst = ", ".join(f"line {ln} ({_length(d, units)})" for ln, d in self.gouges[:5])
+        worst = ", ".join(f"line {ln} ({fmt_depth(d, units)})" for ln, d in self.gouges[:5])
         return (f"leftover {_volume(self.leftover_mm3, units, 0)} (max "
-                f"{_length(max(self.difference_mm.max(), 0), units)}), overcut "
+                f"{fmt_depth(max(self.difference_mm.max(), 0), units)}), overcut "
                 f"{_volume(self.overcut_mm3, units, 1)} (max "
-                f"{_length(max(-self.difference_mm.min(), 0), units)})"
+                f"{fmt_depth(max(-self.difference_mm.min(), 0), units)})"
                 + (f"; gouges at {worst}" + (" ..." if len(self.gouges) > 5 else "")
                    if self.gouges and gouges else ""))
 
 
-def _length(mm: float, units: Units) -> str:
+def fmt_depth(mm: float, units: Units = "mm") -> str:
     """Depths to the micrometre in mm (``0.085 mm``), four significant digits in inches."""
     return f"{mm:.3f} mm" if units == "mm" else fmt_length(mm, units, 4)
 
