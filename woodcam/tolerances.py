@@ -269,6 +269,13 @@ EVIDENCE_RESIDUAL_SMOOTHING = 1e-3
 #: within 2 mm of the predicted ring line than this (percent): the issue's bar for a block.
 EVIDENCE_MIN_FACE_SHARE_2MM = 80.0
 
+#: Unlabelled rings are numbered by the lowest-cost pith basin whose neighbour-step consistency
+#: (share of neighbouring rings one year apart, :func:`woodcam.inference.radial.step_consistency`)
+#: is within this of the best basin's. Good numberings of the real cubes and synthetic blocks
+#: differ among themselves by < 0.08 (unlinked pieces of one ring make steps of 0 that vary with
+#: the basin); wrong ones are 0.3-0.6 lower (H11's tilted and merged folds).
+NUMBERING_STEP_MARGIN = 0.1
+
 #: Hypotheses whose mean held-out score is within this many percent points of the best are
 #: "accepted": their spread is the fit's per-point uncertainty.
 EVIDENCE_ACCEPT_MARGIN = 5.0

@@ -42,7 +42,7 @@ import numpy as np
 
 from ..errors import WoodcamError
 from ..fields.base import check_points
-from ..tolerances import RING_HISTORY_MIN_STEP, RING_HISTORY_PRIOR_POINTS, RING_HISTORY_ROUNDS
+from ..tolerances import NUMBERING_STEP_MARGIN, RING_HISTORY_MIN_STEP, RING_HISTORY_PRIOR_POINTS, RING_HISTORY_ROUNDS
 from .observations import RingObservations
 
 
@@ -297,7 +297,9 @@ def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: fl
     coarse = _Problem(obs.points_mm[i_s], obs.years[i_s] if labelled else None, g_s, centre, z_scale,
                       min(K, coarse_K), min(M, 1), ridge)
     starts = []
-    for d in _hemisphere(n_directions):
+    # The block axes first: sawn wood's grain runs near one (the stem model's tilt prior), and
+    # the spiral may miss them by a few degrees, which a ring-count-consistent basin needs.
+    for d in np.concatenate([np.eye(3), _hemisphere(n_directions)]):
         pith = _circle_pith(coarse.points, coarse.years, coarse.group, d, centre)
         starts.append((_cost(coarse, pith, d), pith, d))
     starts.sort(key=lambda s: s[0])
@@ -324,13 +326,22 @@ def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: fl
             chosen.append(c)
         if len(chosen) == n_starts:
             break
+    if n_basins:  # pith hypotheses: the best start near a block axis is always one of them
+        near = [c for c in starts if np.max(np.abs(c[2])) >= np.cos(np.deg2rad(10))]
+        if near and all(abs(near[0][2] @ o[2]) < np.cos(np.deg2rad(10)) for o in chosen):
+            chosen.append(near[0])
     refined = [_refine(mid, p, d, max_nfev=30) for _, p, d in chosen]
     refined.sort(key=lambda r: r[2])
     i_f, g_f = take(n_fit)
     fine = _Problem(obs.points_mm[i_f], obs.years[i_f] if labelled else None, g_f, centre, z_scale, K, M, ridge)
     # The low-order ranking can put the true basin second (seen with three faces traced), so
     # the best n_final basins are finished at full order and compared there.
-    finals = [_refine(fine, p, d, max_nfev=60) for p, d, _ in refined[:max(n_final, n_basins + 1)]]
+    pick = refined[:max(n_final, n_basins + 1)]
+    if n_basins:  # ... and the best refined axis near a block axis (a real block's likely grain)
+        axial = [r for r in refined if np.max(np.abs(r[1])) >= np.cos(np.deg2rad(_AXIAL_DEG))]
+        if axial and not any(r is axial[0] for r in pick):
+            pick.append(axial[0])
+    finals = [_refine(fine, p, d, max_nfev=60) for p, d, _ in pick]
     finals.sort(key=lambda r: r[2])
     distinct = []  # basins that refined into the same axis are one hypothesis
     for r in finals:
@@ -353,6 +364,76 @@ def _same_axis(p1, d1, p2, d2, centre, angle_deg: float = 3.0, offset_mm: float 
     q1 = p1 + d1 * ((centre - p1) @ d1)  # point of each line nearest the centre
     q2 = p2 + d2 * ((centre - p2) @ d2)
     return bool(np.linalg.norm(q1 - q2) < offset_mm)
+
+
+#: A refined pith axis within this angle (degrees) of a block axis is "near a block axis": one
+#: such basin is always kept as a pith hypothesis (sawn blocks are cut along the grain, give or
+#: take the 10-20 degrees of spiral grain and a leaning stem).
+_AXIAL_DEG = 20.0
+
+
+def step_consistency(obs: RingObservations, n_points: int = 4000, seed: int = 0) -> float:
+    """Share (0-1) of ring points whose nearest point on *another* ring of the same face is
+    exactly one year away: a year-free check of a numbering on the faces it numbers.
+
+    Neighbouring rings on a face are consecutive years (a ring the map missed makes a step of
+    2, pieces of one ring left unlinked a step of 0). A numbering from a wrong pith axis counts
+    rings that are not there (steps of 2-3 between neighbours: H11 with its top face held out,
+    56 % of steps >= 2) or merges neighbours into one year (steps of 0: 93 % on another fold),
+    while the in-sample cost of the level fit cannot tell (each ring has a free level).
+
+    obs : numbered observations (``years`` per point, ``group`` per ring piece, ``face``).
+    n_points : ring points sampled (spread over the faces by their share of points).
+    """
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(seed)
+    n = len(obs.points_mm)
+    hits = total = 0
+    for f in np.unique(obs.face):
+        on = np.flatnonzero(obs.face == f)
+        if len(np.unique(obs.group[on])) < 2:
+            continue
+        pts, grp, yrs = obs.points_mm[on], obs.group[on], obs.years[on]
+        s = rng.choice(len(on), min(len(on), max(1, n_points * len(on) // n)), replace=False)
+        k = min(len(on), _STEP_NEIGHBOURS)
+        _, ii = cKDTree(pts).query(pts[s], k=k)
+        other = grp[ii] != grp[s][:, None]
+        ok = other.any(axis=1)
+        first = ii[np.arange(len(s)), np.argmax(other, axis=1)]
+        step = np.abs(yrs[first] - yrs[s])[ok]
+        hits += int(np.count_nonzero(step == 1))
+        total += len(step)
+    return hits / total if total else 0.0
+
+
+#: Neighbours searched for the nearest point of another ring (ring points are 0.5 mm apart;
+#: 64 reach ~16 mm along a ring, past any ring spacing).
+_STEP_NEIGHBOURS = 64
+
+
+def _initial_numbering(obs: RingObservations, shape_field: RadialField) -> RingObservations:
+    """The years :func:`_finish_radial` starts from for an unlabelled axis fit."""
+    n = obs.n_groups
+    lev = _group_medians(shape_field(obs.points_mm), obs.group, n)
+    wts = np.bincount(obs.group, minlength=n).astype(float)
+    k, a = number_rings(lev, wts, ring_spacing_mm(obs))
+    years = np.round(k * lev + a)
+    return RingObservations(obs.points_mm, years[obs.group], obs.group, obs.face)
+
+
+def _by_numbering(obs: RingObservations, found: list) -> list:
+    """Axis fits ``found`` (lowest in-sample cost first) reordered so the first numbers the
+    rings consistently: the lowest-cost basin whose :func:`step_consistency` is within
+    :data:`~woodcam.tolerances.NUMBERING_STEP_MARGIN` of the best basin's. With unlabelled
+    rings every basin fits its own free ring levels, so its in-sample cost says little about
+    its numbering; the faces' neighbouring rings do (issue 12: H11's bistable folds)."""
+    if obs.labelled or len(found) < 2:
+        return found
+    cons = [step_consistency(_initial_numbering(obs, f[0])) for f in found]
+    best = max(cons)
+    good = [f for f, c in zip(found, cons) if c >= best - NUMBERING_STEP_MARGIN]
+    return good + [f for f in found if not any(f is g for g in good)]
 
 
 def ring_spacing_mm(obs: RingObservations) -> float:
@@ -480,8 +561,16 @@ def _one_blas_thread():
     return one_blas_thread()
 
 
+#: Pith-axis basins whose numberings :func:`fit_radial` compares for unlabelled rings.
+_NUMBERING_BASINS = 3
+
+
 def _fit_radial(obs, size_mm, K, M, ridge, max_relabel_rounds, seed, history, search) -> RadialField:
-    found = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, **search)
+    if obs.labelled:
+        found = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, **search)
+    else:  # unlabelled: the basin that numbers the rings consistently (:func:`_by_numbering`)
+        found = _by_numbering(obs, fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed,
+                                                      n_basins=_NUMBERING_BASINS, **search))[0]
     return _finish_radial(obs, size_mm, found, K, M, ridge, max_relabel_rounds, seed, history)[0]
 
 
@@ -500,7 +589,8 @@ def fit_radial_hypotheses(obs: RingObservations, size_mm, n_basins: int = 3, K: 
     numbered : the observations with the years the fits used (relabelled traces corrected)
     """
     with _one_blas_thread():
-        found = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, n_basins=n_basins, **search)
+        found = _by_numbering(obs, fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, n_basins=n_basins,
+                                                      **search))
         first, numbered = _finish_radial(obs, size_mm, found[0], K, M, ridge, max_relabel_rounds, seed, history)
         fields = [first]
         for shape_field, _, _ in found[1:]:
