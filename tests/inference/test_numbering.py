@@ -44,8 +44,28 @@ def test_a_planted_wrong_basin_loses_the_numbering(truth_and_obs):
     wrong = RadialField(np.array([25.0, 25.0, 25.0]), d / np.linalg.norm(d), 43.3, 2, 1,
                         np.zeros(10), 0.0)
     wrong.coef[0] = 1.0  # rings per mm: concentric about the wrong axis
-    assert step_consistency(_initial_numbering(obs, wrong)) < 0.6
+    assert step_consistency(_initial_numbering(obs, wrong)[0]) < 0.6
     order = _by_numbering(obs, [(wrong, None, None), good])
     assert order[0] is good
     # a consistent lowest-cost basin keeps its place (the in-sample cost breaks near-ties)
     assert _by_numbering(obs, [good, (wrong, None, None)])[0] is good
+
+
+def test_a_wrong_ring_scale_is_replaced_by_a_consistent_one(truth_and_obs, monkeypatch):
+    """The alignment's ring scale is planted wrong (twice the rings: every other integer a
+    ring that is not there); the other alignment peaks are tried and the one numbering
+    neighbouring rings one year apart wins."""
+    import woodcam.inference.radial as radial
+
+    field, obs = truth_and_obs
+    shape = lambda p: field(p) * field.w  # noqa: E731  (levels in mm, as a basin's shape fit)
+    right, k, _ = _initial_numbering(obs, shape)
+    assert step_consistency(right) > 0.9
+    honest = radial.number_rings
+    monkeypatch.setattr(radial, "number_rings", lambda *a: (2 * honest(*a)[0], honest(*a)[1]))
+    num, k2, _ = _initial_numbering(obs, shape)
+    assert abs(k2 - k) < 0.05 * k
+    assert step_consistency(num) > 0.9
+    # and with no other peak to try, the planted scale would have stood
+    monkeypatch.setattr(radial, "_alignment_peaks", lambda *a: [])
+    assert step_consistency(_initial_numbering(obs, shape)[0]) < 0.1

@@ -25,8 +25,9 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: 3: the evidence-chosen default, uncertainty and fit facts saved with the grid; 4: dense knots;
 #: 5: ring maps read as one-pixel lines, dead knots, uncertainty round knots; 6: the stem
 #: hypothesis and per-fold pith refits in the evidence fit; 7: knot strands end at the pith, one-exit
-#: strands run toward it and keep the stem's ring spacing).
-FIT_VERSION = 7
+#: strands run toward it and keep the stem's ring spacing; 8: unlabelled rings numbered by the pith
+#: basin whose numbering makes neighbouring rings one year apart).
+FIT_VERSION = 8
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,

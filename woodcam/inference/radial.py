@@ -412,14 +412,48 @@ def step_consistency(obs: RingObservations, n_points: int = 4000, seed: int = 0)
 _STEP_NEIGHBOURS = 64
 
 
-def _initial_numbering(obs: RingObservations, shape_field: RadialField) -> RingObservations:
-    """The years :func:`_finish_radial` starts from for an unlabelled axis fit."""
+def _initial_numbering(obs: RingObservations, shape_field) -> tuple[RingObservations, float, float]:
+    """Number an unlabelled axis fit's rings: ``(numbered observations, k, a)`` with years
+    ``round(k * level + a)`` per ring group (``level`` = the group's median of ``shape_field``).
+
+    :func:`number_rings` picks the ring scale ``k`` by how well the levels align with integers,
+    which is ambiguous where the faces' rings are irregular (H11: a count of 23 rings across a
+    face showing 14). Every other clear alignment peak is tried too, and the one whose
+    numbering makes neighbouring rings one year apart (:func:`step_consistency`) is taken,
+    :func:`number_rings`' own choice unless another beats it by more than
+    :data:`~woodcam.tolerances.NUMBERING_STEP_MARGIN`.
+    """
     n = obs.n_groups
     lev = _group_medians(shape_field(obs.points_mm), obs.group, n)
     wts = np.bincount(obs.group, minlength=n).astype(float)
-    k, a = number_rings(lev, wts, ring_spacing_mm(obs))
-    years = np.round(k * lev + a)
-    return RingObservations(obs.points_mm, years[obs.group], obs.group, obs.face)
+    spacing = ring_spacing_mm(obs)
+    cands = [number_rings(lev, wts, spacing)] + _alignment_peaks(lev, wts, spacing)
+    best = None
+    for j, (k, a) in enumerate(cands):
+        years = np.round(k * lev + a)
+        num = RingObservations(obs.points_mm, years[obs.group], obs.group, obs.face)
+        c = step_consistency(num) - (NUMBERING_STEP_MARGIN if j else 0.0)
+        if best is None or c > best[0]:
+            best = (c, num, k, a)
+    return best[1], best[2], best[3]
+
+
+def _alignment_peaks(levels: np.ndarray, weights: np.ndarray, spacing_mm: float,
+                     min_share: float = 0.5) -> list[tuple[float, float]]:
+    """``(k, a)`` at every local maximum of :func:`number_rings`' alignment that reaches
+    ``min_share`` of the best: the other ring scales the levels could mean."""
+    ks, z = _alignment(levels, weights, spacing_mm)
+    score = np.abs(z)
+    inner = (score[1:-1] >= score[:-2]) & (score[1:-1] >= score[2:]) & (score[1:-1] >= min_share * score.max())
+    idx = np.flatnonzero(inner) + 1
+    return [(float(ks[i]), float(np.mod(-np.angle(z[i]) / (2 * np.pi), 1.0))) for i in idx]
+
+
+def _alignment(levels: np.ndarray, weights: np.ndarray, spacing_mm: float):
+    """Ring scales ``ks`` searched by :func:`number_rings` and the alignment ``z(k)`` (complex)."""
+    ks = np.linspace(0.4 / spacing_mm, 2.5 / spacing_mm, 2000)
+    w = weights / weights.sum()
+    return ks, np.exp(2j * np.pi * np.outer(ks, levels)) @ w
 
 
 def _by_numbering(obs: RingObservations, found: list) -> list:
@@ -430,7 +464,7 @@ def _by_numbering(obs: RingObservations, found: list) -> list:
     its numbering; the faces' neighbouring rings do (issue 12: H11's bistable folds)."""
     if obs.labelled or len(found) < 2:
         return found
-    cons = [step_consistency(_initial_numbering(obs, f[0])) for f in found]
+    cons = [step_consistency(_initial_numbering(obs, f[0])[0]) for f in found]
     best = max(cons)
     good = [f for f, c in zip(found, cons) if c >= best - NUMBERING_STEP_MARGIN]
     return good + [f for f in found if not any(f is g for g in good)]
@@ -476,9 +510,7 @@ def number_rings(levels: np.ndarray, weights: np.ndarray, spacing_mm: float):
     k : float, years per level unit
     a : float in [0, 1), the phase: ``years = k * level + a``
     """
-    ks = np.linspace(0.4 / spacing_mm, 2.5 / spacing_mm, 2000)
-    w = weights / weights.sum()
-    z = np.exp(2j * np.pi * np.outer(ks, levels)) @ w
+    ks, z = _alignment(levels, weights, spacing_mm)
     score = np.abs(z)
     first = int(np.flatnonzero(score >= 0.9 * score.max())[0])
     # climb to the local maximum of that first peak
@@ -614,12 +646,7 @@ def _finish_radial(obs, size_mm, found, K, M, ridge, max_relabel_rounds, seed, h
     else:
         shape_field = found[0]
         # Levels of every group from the fitted shape (groups not in the fitting subset too).
-        n = obs.n_groups
-        lev = _group_medians(shape_field(obs.points_mm), obs.group, n)
-        wts = np.bincount(obs.group, minlength=n).astype(float)
-        k, a = number_rings(lev, wts, ring_spacing_mm(obs))
-        years = np.round(k * lev + a)
-        obs = RingObservations(obs.points_mm, years[obs.group], obs.group, obs.face)
+        obs, k, a = _initial_numbering(obs, shape_field)
         start = RadialField(shape_field.pith_mm, shape_field.axis, shape_field.z_scale_mm, K, M,
                             shape_field.coef * k, a)
         field = _refit_labelled(obs, size_mm, start, ridge, seed=seed)
