@@ -69,3 +69,20 @@ def test_a_wrong_ring_scale_is_replaced_by_a_consistent_one(truth_and_obs, monke
     # and with no other peak to try, the planted scale would have stood
     monkeypatch.setattr(radial, "_alignment_peaks", lambda *a: [])
     assert step_consistency(_initial_numbering(obs, shape)[0]) < 0.1
+
+
+@pytest.mark.slow
+def test_h11_folds_number_neighbouring_rings_one_year_apart(shared_data):
+    """H11 from its ring maps, the right face held out: the lowest-cost pith basin merged
+    neighbouring rings into one year (93 % of steps 0, the fold's rings numbered 0-4 across a
+    face showing 10), and every hypothesis was fitted to those numbers. The numbering now
+    comes from a basin whose neighbouring rings are one year apart."""
+    from woodcam.block.io import read_mokume
+    from woodcam.inference.radial import fit_radial_hypotheses
+
+    b = read_mokume(shared_data / "mokume" / "H11")
+    obs = gather_observations(b, [f for f in b.faces if f != "right"])
+    _, numbered = fit_radial_hypotheses(obs, b.size_mm)
+    assert step_consistency(numbered) > 0.5
+    spans = [np.ptp(numbered.years[numbered.face == f]) for f in np.unique(numbered.face)]
+    assert min(spans) >= 3 and np.median(spans) >= 6, spans  # the maps show 4-14 rings a face
