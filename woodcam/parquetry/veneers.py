@@ -232,7 +232,7 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
 
         def colour(u_mm, v_mm, s=s, turned=turned):
             """``Wood.color`` at sheet points ``(u, v)`` mm (1-d arrays) of plane ``s``:
-            ``(n, 3)`` float32, evaluated ~1 M points at a time (memory ~100 MB)."""
+            ``(n, 3)`` float32, evaluated :data:`_SAMPLES_PER_CALL` points at a time."""
             out = np.empty((u_mm.size, 3), np.float32)
             normal = np.zeros(3)
             normal[ax] = 1.0 if turned else -1.0
