@@ -280,9 +280,10 @@ EVIDENCE_MIN_FACE_SHARE_2MM = 80.0
 
 #: Unlabelled rings are numbered by the lowest-cost pith basin whose neighbour-step consistency
 #: (share of neighbouring rings one year apart, :func:`woodcam.inference.radial.step_consistency`)
-#: is within this of the best basin's. Good numberings of the real cubes and synthetic blocks
-#: differ among themselves by < 0.08 (unlinked pieces of one ring make steps of 0 that vary with
-#: the basin); wrong ones are 0.3-0.6 lower (H11's tilted and merged folds).
+#: is within this of the best basin's. Good numberings of H11's ring maps score 0.60-0.73
+#: (unlinked pieces of one ring make steps of 0, more or fewer with the basin), the wrong ones
+#: seen 0.05-0.42 (H11's tilted and merged folds), a clean synthetic block's > 0.9. Set before
+#: the runs on detected rings, and not retuned on them.
 NUMBERING_STEP_MARGIN = 0.1
 
 #: Hypotheses whose mean held-out score is within this many percent points of the best are
