@@ -40,8 +40,9 @@ from .knots import detect_knots
 from .rings import DEFAULT_RULE, RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, ring_map_from_traces
 
 #: Bumped whenever detection results change, so cached detections are recomputed (3: traces
-#: carry their face-local ring id, ``RingTrace.ring``).
-DETECT_VERSION = 3
+#: carry their face-local ring id, ``RingTrace.ring``; 4: the curved Gabor response and the
+#: ``dark-edge`` rule by default).
+DETECT_VERSION = 4
 
 
 Detector = Literal["classical", "learned"]
