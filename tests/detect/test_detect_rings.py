@@ -195,8 +195,8 @@ def test_scores_are_exact_on_a_known_case():
     assert np.all(np.abs(ridge[:, 0] - 10) <= 1) and 20 <= len(ridge) <= 25   # skeleton ends may bend
 
 
-#: Bars on the held-out synthetic seeds (the default rule, dark-edge); the goal is 0.90 within
-#: 2 px. Plain faces, seeds 1000-1007 (README): F within 2 / 5 px 0.94 / 0.98; seed 1000 alone 0.89.
+#: Bars on the held-out synthetic seeds (the default: curved Gabor, dark-edge rule); the goal is
+#: 0.90 within 2 px. Plain faces, seeds 1000-1007 (README): F within 2 / 5 px 0.930 / 0.962.
 SYNTH_BAR_F2_ALL = 0.90
 SYNTH_BAR_F2_FIRST = 0.80
 #: Realistic faces (seeds 1000-1003, sharp-edge): F within 5 px 0.72.
@@ -219,7 +219,7 @@ def test_synthetic_faces_all_heldout_seeds():
     e = summary(score_synthetic(faces, rule="sharp-edge"))
     assert e["F@2"] >= SYNTH_BAR_F2_ALL, e
     # the darkest line sits inside the plain faces' flat latewood plateau, before the boundary:
-    # within 5 px but not 2 px (README: 0.36 / 0.89)
+    # within 5 px but not 2 px (README: 0.358 / 0.894)
     d = summary(score_synthetic(faces, rule="dark-line"))
     assert d["F@5"] >= 0.85 and d["F@2"] < 0.6, d
 
@@ -235,9 +235,9 @@ def test_realistic_synthetic_faces_all_heldout_seeds():
     assert s["F@5"] >= REALISTIC_BAR_F5 and s["F@2"] > 2 * s["chance F@2"], s
 
 
-#: Real faces against the Mokume U-Net maps (a reference, not truth), default rule. Measured
-#: (README): H11 mean F 0.57 / 0.69 within 2 / 5 px (chance 0.09 / 0.24), CN03 0.30 / 0.70
-#: (chance 0.02 / 0.08); the bars sit below with margin.
+#: Real faces against the Mokume U-Net maps (a reference, not truth), the default detector.
+#: Measured (README): H11 mean F 0.56 / 0.70 within 2 / 5 px (chance 0.10 / 0.27), CN03 0.31 /
+#: 0.69 (chance 0.02 / 0.08); the bars sit below with margin.
 H11_BAR = {2.0: 0.50, 5.0: 0.63}
 CN03_BAR = {2.0: 0.25, 5.0: 0.63}
 

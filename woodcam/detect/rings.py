@@ -28,9 +28,10 @@ Gabor adapted to both):
    (from the blend's phase gradient), coherence and amplitude.
 3b. The curved Gabor (:mod:`woodcam.detect.curved`): with that normal and spacing, a 1-D complex
    Gabor across the ring at every pixel's own orientation and frequency, averaged with a Gaussian
-   along the ring's curve (the streamline of the ring tangents through the pixel). With
-   ``curved=True`` its phase, not the bank's, places and orders the rings; off by default
-   (:data:`CURVED_GABOR` says why).
+   along the ring's curve (the streamline of the ring tangents through the pixel). Its phase,
+   not the bank's, places and orders the rings wherever the two agree within
+   :data:`CURVED_AGREE_RAD` (on by default, :data:`CURVED_GABOR`; ``curved=False`` for the
+   bank's alone).
 4. Frequency gating: rings are periodic, so their band energy peaks at the ring spacing,
    while pores, fibres, rays, oak figure and lighting are broadband. Each scale is weighted by
    its log spectral prominence over its two neighbours (0 for any power law) times its
@@ -154,10 +155,15 @@ LINK_GAP_WAVELENGTHS = 3.0
 #: band centres sit on whole numbers (same number or not), faint lines where they lie between.
 LINK_ORDER_TOL = 0.25
 #: Use the curved Gabor response (:mod:`woodcam.detect.curved`) for the ring phase by default.
-#: Off: on the synthetic development seeds it gained about 0.01 F within 2 px (README), and with
-#: it a band of noise across the rings (``tests/detect/test_detect_rings.py``) bends the
-#: orientation field round it, so the curves there hook and the pieces of one ring no longer link.
-CURVED_GABOR = False
+CURVED_GABOR = True
+#: Largest phase difference (radians) between the curved and the bank's straight response at
+#: a pixel for the curved one to be used there; elsewhere the bank's is kept. The curved Gabor
+#: trusts the orientation field, and a band of noise across the rings turns that field by 20
+#: degrees or more over ~50 px round it: there the two disagree, the curves hook, and without
+#: this check the pieces of one ring stopped linking (``test_pieces_of_one_ring_share_its_id``:
+#: 17 lines -> 51-55 ring ids). Chosen on the development seeds 0-3 (dark-edge, F within 2 px
+#: plain / realistic): pi/3 0.923 / 0.723, 0.5 rad 0.906 / 0.718, no check 0.911 / 0.728.
+CURVED_AGREE_RAD = float(np.pi / 3)
 #: Spacing of trace vertices (px) after resampling the contour lines.
 TRACE_STEP_PX = 1.0
 #: Share of the face that must be ring evidence; below it the face has "no rings".
@@ -726,7 +732,7 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
         The face's name, used in warnings.
     curved : bool, optional
         Place and order the rings by the curved Gabor's phase (module docstring, step 3b);
-        default :data:`CURVED_GABOR` (off).
+        default :data:`CURVED_GABOR` (on).
 
     Returns
     -------
@@ -762,7 +768,14 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     if CURVED_GABOR if curved is None else curved:
         from .curved import curved_gabor
 
-        z = curved_gabor(x, normal, lam, coherence)
+        zc = curved_gabor(x, normal, lam, coherence)
+        # where the two disagree the orientation field is not to be trusted (CURVED_AGREE_RAD);
+        # the curved phase with the bank's amplitude elsewhere
+        if CURVED_AGREE_RAD < np.pi:
+            agree = np.abs(np.angle(zc * np.conj(z))) <= CURVED_AGREE_RAD
+            z = np.where(agree, zc * (np.abs(z) / (np.abs(zc) + 1e-6)), z).astype(np.complex64)
+        else:
+            z = zc
     ref = float(np.percentile(amp, 75)) + 1e-9
     rel_amp = np.clip(amp / ref, 0.0, 1.0)
     confidence = (coherence * rel_amp).astype(np.float32)
