@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from woodcam.detect import detect_rings, ridge_scores
-from woodcam.detect.curved import curved_gabor, streamline_average
+from woodcam.detect.curved import across_gabor, curved_gabor, streamline_average
 
 
 def _circles(n=160, centre=(-20.0, 80.0)):
@@ -53,6 +53,10 @@ def test_curved_gabor_phase_is_pi_on_the_dark_line_at_the_local_spacing():
     keep = inner & (rad > 50)
     assert np.abs(err[keep]).mean() < 0.15, np.abs(err[keep]).mean()
     assert np.median(np.abs(z[keep])) == pytest.approx(1.0, abs=0.15)
+    # frequency adapted: the Gabor across the ring passes the whole pattern's amplitude at every
+    # spacing (one tuned to the median spacing passes a few per cent at 8 and 20 px)
+    q = np.abs(across_gabor(x, normal, lam))[keep]
+    assert np.percentile(q, 5) > 0.8 and np.median(q) == pytest.approx(1.0, abs=0.1), (np.percentile(q, 5), np.median(q))
 
 
 def test_detect_rings_with_the_curved_gabor_finds_curved_rings():

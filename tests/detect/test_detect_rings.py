@@ -195,8 +195,8 @@ def test_scores_are_exact_on_a_known_case():
     assert np.all(np.abs(ridge[:, 0] - 10) <= 1) and 20 <= len(ridge) <= 25   # skeleton ends may bend
 
 
-#: Bars on the held-out synthetic seeds (the default: curved Gabor, dark-edge rule); the goal is
-#: 0.90 within 2 px. Plain faces, seeds 1000-1007 (README): F within 2 / 5 px 0.930 / 0.962.
+#: Bars on the held-out synthetic seeds (the default: dark-edge rule, straight bank); the goal is
+#: 0.90 within 2 px. Plain faces, seeds 1000-1007 (README): F within 2 / 5 px 0.915 / 0.945.
 SYNTH_BAR_F2_ALL = 0.90
 SYNTH_BAR_F2_FIRST = 0.80
 #: Realistic faces (seeds 1000-1003, sharp-edge): F within 5 px 0.72.
@@ -236,8 +236,8 @@ def test_realistic_synthetic_faces_all_heldout_seeds():
 
 
 #: Real faces against the Mokume U-Net maps (a reference, not truth), the default detector.
-#: Measured (README): H11 mean F 0.56 / 0.70 within 2 / 5 px (chance 0.10 / 0.27), CN03 0.31 /
-#: 0.69 (chance 0.02 / 0.08); the bars sit below with margin.
+#: Measured (README): H11 mean F 0.56 / 0.70 within 2 / 5 px (chance 0.10 / 0.25), CN03 0.29 /
+#: 0.67 (chance 0.02 / 0.07); the bars sit below with margin.
 H11_BAR = {2.0: 0.50, 5.0: 0.63}
 CN03_BAR = {2.0: 0.25, 5.0: 0.63}
 
