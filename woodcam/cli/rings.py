@@ -67,10 +67,11 @@ def register(subparsers) -> None:
     d.add_argument("block", type=Path, help="block folder (block.json) or Mokume sample folder")
     add_out_option(d, "the block folder with ring maps, SVG traces and knot masks (may be "
                    "BLOCK itself)")
-    d.add_argument("--rule", choices=("dark-line", "sharp-edge", "dark-centre"), default="dark-line",
-                   help="ring line on the darkest line of each dark band (default: the latewood's end, "
-                   "where the Mokume maps put it), on the band's sharper edge, or on the band's centre "
-                   "(the filter's phase alone)")
+    d.add_argument("--rule", choices=("dark-edge", "dark-line", "sharp-edge", "dark-centre"),
+                   default="dark-edge",
+                   help="ring line at the end of each dark band's darkest stretch on its sharp side "
+                   "(default: the ring boundary), on the darkest line (where the Mokume maps put "
+                   "it), on the band's sharper edge, or on the band's centre (the filter's phase alone)")
     d.add_argument("--detector", choices=("classical", "learned"), default=None,
                    help="classical: the weight-free quadrature-filter detector (default); learned: the "
                    "small net trained by 'woodcam train rings' (woodcam/models/rings.pt)")

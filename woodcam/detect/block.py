@@ -40,8 +40,10 @@ from .knots import detect_knots
 from .rings import DEFAULT_RULE, RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, ring_map_from_traces
 
 #: Bumped whenever detection results change, so cached detections are recomputed (3: traces
-#: carry their face-local ring id, ``RingTrace.ring``).
-DETECT_VERSION = 3
+#: carry their face-local ring id, ``RingTrace.ring``; 4: the curved Gabor response and the
+#: ``dark-edge`` rule by default; 5: the curved Gabor opt-in, after caches of 4 were written
+#: with it on).
+DETECT_VERSION = 5
 
 
 Detector = Literal["classical", "learned"]
