@@ -25,8 +25,9 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: 3: the evidence-chosen default, uncertainty and fit facts saved with the grid; 4: dense knots;
 #: 5: ring maps read as one-pixel lines, dead knots, uncertainty round knots; 6: the stem
 #: hypothesis and per-fold pith refits in the evidence fit; 7: knot strands end at the pith, one-exit
-#: strands run toward it and keep the stem's ring spacing).
-FIT_VERSION = 7
+#: strands run toward it and keep the stem's ring spacing; 8: the stem with its pinned knots' bend
+#: (seed 003's join) as an evidence hypothesis).
+FIT_VERSION = 8
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
@@ -63,11 +64,19 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         return fit_neural(block, faces=faces)  # always baked to a grid (the net is slow)
     obs = gather_observations(block, faces)
     if method == "evidence":
+        from ..fields.knot_strands import StemWithKnots
         from .evidence import bake_evidence, fit_evidence
-        from .knots import with_knots
+        from .knots import knot_exits, knotted_stem_recipe, with_knots
 
-        ev = fit_evidence(obs, block.size_mm)
-        ev.field, strands = with_knots(block, ev.field, faces)  # knots from the masks (part 3)
+        exits = knot_exits(block, faces)
+        # the stem with the rings bent round its pinned knots competes as one more hypothesis
+        pinnable = len({e["face"] for e in exits}) >= 2  # a strand is pinned by exits on two faces
+        recipes = {"stem + knot bend": knotted_stem_recipe(block.size_mm, exits)} if pinnable else None
+        ev = fit_evidence(obs, block.size_mm, recipes=recipes)
+        if isinstance(ev.field, StemWithKnots):  # the chosen field holds its knots already
+            strands = ev.field.strands
+        else:
+            ev.field, strands = with_knots(block, ev.field, faces)  # knots from the masks (part 3)
         used = sorted({int(i) for i in np.unique(obs.face)})
         return bake_evidence(ev, block.size_mm, used, strands) if baked else ev
     if method == "rbf":
