@@ -125,14 +125,14 @@ class StemWithKnots:
     """
 
     def __init__(self, stem, strands, smoothing_years: float = KNOT_SMOOTH_YEARS, dense: bool = True,
-                 bend: KnotParams | None = None):
+                 bend: KnotParams | None = None, bend_guessed: bool = False):
         self.stem = stem
         self.dense = bool(dense)
         self.strands = list(strands)
         self.k = float(smoothing_years)
         self.axis = getattr(stem, "axis", (0.0, 0.0, 1.0))
         self._tables = [self._table(s) for s in self.strands]
-        self.bend = bend
+        self.bend, self.bend_guessed = bend, bool(bend_guessed)
         if bend is not None:
             if not hasattr(stem, "pith_distance_mm"):
                 raise WoodcamError("bend needs a stem with a pith (pith_distance_mm), e.g. a "
@@ -173,7 +173,7 @@ class StemWithKnots:
         inv2 = np.zeros(len(p))
         total = np.zeros(len(p))
         for strand, table in zip(self.strands, self._tables):
-            if not strand.pinned:  # a guessed strand marks its knot but bends nothing
+            if not (strand.pinned or self.bend_guessed):  # a guessed strand marks its knot only
                 continue
             d, R, _, _ = self._geometry(p, table)
             q = d / R

@@ -66,12 +66,10 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
     if method == "evidence":
         from ..fields.knot_strands import StemWithKnots
         from .evidence import bake_evidence, fit_evidence
-        from .knots import knot_exits, knotted_stem_recipe, with_knots
+        from .knots import knot_bend_recipes, knot_exits, with_knots
 
-        exits = knot_exits(block, faces)
-        # the stem with the rings bent round its pinned knots competes as one more hypothesis
-        pinnable = len({e["face"] for e in exits}) >= 2  # a strand is pinned by exits on two faces
-        recipes = {"stem + knot bend": knotted_stem_recipe(block.size_mm, exits)} if pinnable else None
+        # the stem with the rings bent round its knots competes as more hypotheses
+        recipes = knot_bend_recipes(block.size_mm, knot_exits(block, faces))
         ev = fit_evidence(obs, block.size_mm, recipes=recipes)
         if isinstance(ev.field, StemWithKnots):  # the chosen field holds its knots already
             strands = ev.field.strands

@@ -181,40 +181,43 @@ def strands_from_exits(exits: list[dict], stem, size_mm) -> list[KnotStrand]:
     return strands
 
 
-def fit_knotted_stem(obs, size_mm, exits: list[dict], rounds: int = KNOT_BEND_ROUNDS, seed: int = 0):
-    """The stem model with the rings bent round its pinned knots (seed 003's join), fitted
-    jointly: ``StemWithKnots(stem, strands, bend=KnotParams())`` or the plain stem when no exit
-    pair pins a strand.
+def fit_knotted_stem(obs, size_mm, exits: list[dict], rounds: int = KNOT_BEND_ROUNDS, seed: int = 0,
+                     guessed: bool = False, stem=None):
+    """The stem model with the rings bent round its knots (seed 003's join), fitted jointly:
+    ``StemWithKnots(stem, strands, bend=KnotParams())``, or the plain stem when no strand bends.
 
     obs : labelled ring observations (block frame, mm); size_mm : (3,) block size; exits : the
-    block's knot exits (:func:`knot_exits`, from the masks).
+    block's knot exits (:func:`knot_exits`, from the masks); guessed : also bend round strands
+    guessed from one exit (``pinned=False``); stem : the plain :func:`~.stem.fit_stem` of
+    ``obs`` when already fitted.
 
     A knot lowers the growth time of the stem round it far beyond its surface (seed 003's power
-    smooth minimum with its distance ranges: several years at twice the knot radius), so the
-    faces' rings near an exit are bent and a stem fitted to them is bent too. Fixed point:
-    fit the stem, place the strands in it, and refit the stem to the years minus the bend the
-    knots put there (``fit_stem(offset_years=...)``), ``rounds`` times (dev seed 21, six noisy
-    faces, within 1 mm: 0 rounds 40 / 29 / 36 %, 1 round 97 / 53 / 97 %, 2 rounds 99 / 68 /
-    98 %, 4 rounds 99 / 74 / 98 % on blocks 1 / 9 / 10).
+    smooth minimum with its distance ranges: about a year at twice the knot radius, 15 years
+    from the pith), so the faces' rings near an exit are bent and a stem fitted to them is
+    bent too. Fixed point: fit the stem, place the strands in it, and refit the stem to the
+    years minus the bend the knots put there (``fit_stem(offset_years=..., init=...)``),
+    ``rounds`` times (dev seed 21, six noisy faces, within 1 mm: 0 rounds 40 / 29 / 36 %, 1
+    round 97 / 53 / 97 %, 2 rounds 99 / 68 / 98 %, 4 rounds 99 / 74 / 98 % on blocks 1 / 9 / 10).
 
-    Only strands pinned by two exits bend the rings: a one-exit strand is a guess a few mm off
-    its knot, and its bend then writes wrong years over a wide region (dev seed 21: three
-    faces, block 10 44 -> 24 %, six faces block 5 88 -> 53 % within 1 mm). The others are kept
-    for the knot's look (:meth:`StemWithKnots.knot_features`) without bending. A dead strand
-    bends as an alive one: the branch was alive from the pith to its death, which the exits do
-    not show, and the bend comes from that inner part (its inversion past death is left out).
+    By default only strands pinned by two exits bend the rings: a one-exit strand is a guess a
+    few mm off its knot, and its bend then writes wrong years over a wide region (dev seed 21,
+    three faces: block 10 45 -> 25 %, block 5 86 -> 43 % within 1 mm; but block 7 63 -> 66 %):
+    ``guessed=True`` is a separate hypothesis the held-out faces judge. Strands that do not
+    bend are kept for the knot's look (:meth:`StemWithKnots.knot_features`). A dead strand bends
+    as an alive one: the branch was alive from the pith to its death, which the exits do not
+    show, and the bend comes from that inner part (its inversion past death is left out).
     """
     from .stem import fit_stem
 
-    stem = fit_stem(obs, size_mm, seed=seed)
+    stem = fit_stem(obs, size_mm, seed=seed) if stem is None else stem
     plain, field = stem, stem
     for r in range(rounds + 1):
         if np.mean(stem(obs.points_mm) <= stem.pith_years()) > KNOT_BEND_MAX_BEFORE_PITH:
             return plain  # times are not "from the pith" in this stem: no bend to speak of
         strands = strands_from_exits(exits, stem, size_mm)
-        if not any(s.pinned for s in strands):
+        if not any(s.pinned or guessed for s in strands):
             return plain
-        field = StemWithKnots(stem, strands, bend=KnotParams())
+        field = StemWithKnots(stem, strands, bend=KnotParams(), bend_guessed=guessed)
         if r == rounds:
             break
         off = field(obs.points_mm) - stem(obs.points_mm)
@@ -222,10 +225,28 @@ def fit_knotted_stem(obs, size_mm, exits: list[dict], rounds: int = KNOT_BEND_RO
     return field
 
 
-def knotted_stem_recipe(size_mm, exits: list[dict], seed: int = 0):
-    """``RingObservations -> field``: :func:`fit_knotted_stem` from scratch on the given rings
-    (the exits come from the masks, not from the rings a fold holds out)."""
-    return lambda obs: fit_knotted_stem(obs, size_mm, exits, seed=seed)
+def knot_bend_recipes(size_mm, exits: list[dict], seed: int = 0) -> dict:
+    """Evidence hypotheses of the knots' bend, name -> ``RingObservations -> field``
+    (:func:`fit_knotted_stem` from scratch on the given rings; the exits come from the masks,
+    not from the rings a fold holds out): ``"stem + knot bend"`` (pinned strands; exits on two
+    faces needed) and ``"stem + guessed knot bend"`` (every strand). They share the plain stem
+    fit of each fold."""
+    from .stem import fit_stem
+
+    last: dict = {}
+
+    def plain(obs):
+        if last.get("obs") is not obs:
+            last.update(obs=obs, stem=fit_stem(obs, size_mm, seed=seed))
+        return last["stem"]
+
+    out = {}
+    if len({e["face"] for e in exits}) >= 2:  # a strand is pinned by exits on two faces
+        out["stem + knot bend"] = lambda obs: fit_knotted_stem(obs, size_mm, exits, seed=seed, stem=plain(obs))
+    if exits:
+        out["stem + guessed knot bend"] = lambda obs: fit_knotted_stem(obs, size_mm, exits, seed=seed,
+                                                                      guessed=True, stem=plain(obs))
+    return out
 
 
 def with_knots(block, stem, faces=None):
@@ -234,5 +255,5 @@ def with_knots(block, stem, faces=None):
     return (StemWithKnots(stem, strands) if strands else stem), strands
 
 
-__all__ = ["exit_is_dead", "fit_knot_strands", "fit_knotted_stem", "knot_exits", "knotted_stem_recipe",
+__all__ = ["exit_is_dead", "fit_knot_strands", "fit_knotted_stem", "knot_bend_recipes", "knot_exits",
            "strands_from_exits", "with_knots"]
