@@ -525,7 +525,9 @@ def test_a_native_crash_while_packing_projected_charts_falls_back_to_xatlas(monk
 
     monkeypatch.setattr(_xatlas_worker, "pack", crash)
     mesh = _sphere()
-    result = bake(mesh, SmoothWood(), texels_per_mm=4.0)
+    with pytest.warns(WoodcamWarning, match="xatlas crashed packing the projected UV charts"):
+        result = bake(mesh, SmoothWood(), texels_per_mm=4.0)
+    assert any("crashed packing" in m for m in result.warnings)  # in the bake's report too
     assert result.density_stretch == 1.0
     err, bound, _ = _check_against_wood(result.mesh, result.atlas, mesh, "face",
                                         np.random.default_rng(8), coverage=result.coverage_mask)

@@ -114,3 +114,33 @@ def test_gcode_view_hands_the_whole_last_program_and_its_start_stock(tmp_path, m
     want = simulate(read_gcode(first.read_text()), parse_tool_spec("flat:6"), (60, 40, 20),
                     resolution_mm=0.5).heightmap
     np.testing.assert_array_equal(start, want)
+    # and the stock at line 4 it opens on, simulated once by the CLI (not again in the window)
+    at4 = simulate(read_gcode(PROG).until_line(4), parse_tool_spec("flat:6"), (60, 40, 20),
+                   resolution_mm=0.5, initial_heightmap=want).heightmap
+    np.testing.assert_array_equal(seen["kw"]["heightmap"], at4)
+
+
+def test_the_window_opens_on_the_stock_it_is_given_without_simulating_again(monkeypatch):
+    import importlib
+
+    from woodcam.view.scrub import gcode_window
+
+    sim = importlib.import_module("woodcam.toolpath.simulate")  # the package's name is the function
+
+    prog = read_gcode(PROG)
+    tool = parse_tool_spec("flat:6")
+    at8 = simulate(prog.until_line(8), tool, _Stock.size_mm, resolution_mm=0.5).heightmap
+    calls = []
+    real = sim.simulate
+    monkeypatch.setattr(sim, "simulate", lambda *a, **kw: calls.append(1) or real(*a, **kw))
+    plotter, cb = gcode_window(prog, tool, _Stock(), resolution_mm=0.5, off_screen=True,
+                               window_size=(160, 120), until_line=8, heightmap=at8)
+    try:
+        assert cb.line == 8 and not calls
+        np.testing.assert_array_equal(cb.heightmap, at8)
+        cb(12)  # forward from the given stock: only lines 9-12 are simulated
+        assert len(calls) == 1
+        want = simulate(prog.until_line(12), tool, _Stock.size_mm, resolution_mm=0.5)
+        np.testing.assert_array_equal(cb.heightmap, want.heightmap)
+    finally:
+        plotter.close()

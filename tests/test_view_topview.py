@@ -51,3 +51,18 @@ def test_top_view_png_and_errors(tmp_path):
     with pytest.raises(WoodcamError, match="overlay colour"):
         top_view(np.zeros((4, 4)), (4.0, 4.0, 1.0), tex,
                  overlay=[(np.zeros((1, 2, 3)), "mauve", 1.0)])
+
+
+def test_the_toolpath_reds_and_blues_are_the_stock_views_and_the_vtk_previews():
+    """One set of overlay colours (woodcam.view.scene.OVERLAY_COLORS, VTK's values of the
+    names): a sparse line is blended over the texture at the overlay opacity."""
+    from woodcam.view.topview import _OVERLAY_ALPHA
+
+    tex = np.full((40, 50, 3), 150, np.uint8)
+    seg = np.array([[[0.0, 20.0, 1.0], [50.0, 20.0, 1.0]]])
+    for name, rgb in (("red", (255, 0, 0)), ("royalblue", (65, 105, 225))):
+        img = top_view(np.zeros((40, 50)), (50.0, 40.0, 10.0), tex, window_size=(100, 80),
+                       margin_px=0, overlay=[(seg, name, 1.0)])
+        want = np.round((1 - _OVERLAY_ALPHA) * np.float32(150)
+                        + _OVERLAY_ALPHA * np.asarray(rgb, np.float32))
+        np.testing.assert_allclose(img[40, 50], want, atol=1)

@@ -409,7 +409,7 @@ def _unwrap(mesh, tpm: float, max_px: int, padding: int, messages: list[str],
 
     for _attempt in range(4):
         if charts is not None:
-            packed = _pack_guarded(charts, tpm, padding)
+            packed = _pack_guarded(charts, tpm, padding, messages)
             if packed is None:  # xatlas died packing: chart with xatlas instead
                 charts, stretch = None, 1.0
         if charts is not None:
@@ -451,26 +451,20 @@ def _unwrap(mesh, tpm: float, max_px: int, padding: int, messages: list[str],
             float(stretch))
 
 
-def _pack_guarded(charts, tpm: float, padding: int):
+def _pack_guarded(charts, tpm: float, padding: int, messages: list[str]):
     """:func:`woodcam._xatlas_worker.pack` of :func:`_projected_charts` in a worker process
-    (as :func:`_layout_guarded`); vmap mapped back to input vertices. None if xatlas crashed."""
-    import concurrent.futures as cf
-    import multiprocessing as mp
-
-    import woodcam._xatlas_worker as _xatlas_worker
-
+    (:func:`_run_guarded`); vmap mapped back to input vertices. None, with a message saying
+    so, if xatlas crashed (the caller then charts with xatlas)."""
     uv_mm, chart_faces, corner_vertex = charts[:3]
-    kwargs = {"texels_per_mm": float(tpm), "padding": int(padding)}
-    if _XATLAS_IN_PROCESS:  # pragma: no cover - debugging aid
-        out = _xatlas_worker.pack(uv_mm, chart_faces, **kwargs)
-    else:
-        with cf.ProcessPoolExecutor(max_workers=1, mp_context=mp.get_context("fork")) as pool:
-            try:
-                out = pool.submit(_xatlas_worker.run_pack, uv_mm, chart_faces, **kwargs).result()
-            except cf.process.BrokenProcessPool:
-                return None
-            except RuntimeError as err:
-                raise WoodcamError(f"bake: packing the UV charts failed ({err})") from err
+    try:
+        out = _run_guarded("pack", uv_mm, chart_faces, texels_per_mm=float(tpm),
+                           padding=int(padding))
+    except _WorkerCrashed:
+        messages.append("bake: xatlas crashed packing the projected UV charts; unwrapped with "
+                        "xatlas' own charts instead (exact density, slower)")
+        return None
+    except RuntimeError as err:
+        raise WoodcamError(f"bake: packing the UV charts failed ({err})") from err
     vmap, faces, uv, width, height = out
     return corner_vertex[vmap], faces, uv, width, height
 
@@ -611,37 +605,52 @@ def _split_pieces(verts: np.ndarray, faces: np.ndarray, n: int) -> list[np.ndarr
     return [np.sort(p) for p in np.array_split(np.argsort(centres[:, axis], kind="stable"), n)]
 
 
-def _layout_guarded(verts, faces, pieces, chart_cap, tpm, padding, messages):
-    """:func:`woodcam._xatlas_worker.layout` in a worker process. When xatlas dies natively
-    (segfault), retry with the surface cut into 2, 4, 8 pieces (seams are invisible after the
-    conservative rasterisation and dilation); if every try dies, one clear error."""
+class _WorkerCrashed(Exception):
+    """The xatlas worker process died natively (segfault): :func:`_run_guarded`."""
+
+
+def _run_guarded(name: str, *args, **kwargs):
+    """``woodcam._xatlas_worker.<name>(*args, **kwargs)`` (``name``: ``"layout"`` or
+    ``"pack"``) in a worker process, so a native crash in xatlas never takes the caller down:
+    its result, :class:`_WorkerCrashed` when the worker died, and a ``RuntimeError`` of the
+    worker (e.g. xatlas made several atlases) raised as is."""
     import concurrent.futures as cf
     import multiprocessing as mp
 
     import woodcam._xatlas_worker as _xatlas_worker
 
     if _XATLAS_IN_PROCESS:  # pragma: no cover - debugging aid
-        return (*_xatlas_worker.layout(verts, faces, pieces, max_chart_area=chart_cap,
-                                       max_iterations=_CHART_ITERATIONS, texels_per_mm=tpm,
-                                       padding=padding), pieces)
+        return getattr(_xatlas_worker, name)(*args, **kwargs)
     # fork: the worker needs no fresh interpreter (spawn/forkserver re-import the caller's
     # __main__, which re-runs a user's script that has no ``if __name__ == "__main__"`` guard),
     # and it runs only xatlas' own threads and numpy, none of the parent's thread pools.
-    context = mp.get_context("fork")
+    # ``run_<name>`` looks ``<name>`` up when called, so a test's crashing stand-in is what the
+    # forked worker runs.
+    with cf.ProcessPoolExecutor(max_workers=1, mp_context=mp.get_context("fork")) as pool:
+        job = pool.submit(getattr(_xatlas_worker, f"run_{name}"), *args, **kwargs)
+        try:
+            return job.result()
+        except cf.process.BrokenProcessPool as err:
+            raise _WorkerCrashed(name) from err
+
+
+def _layout_guarded(verts, faces, pieces, chart_cap, tpm, padding, messages):
+    """:func:`woodcam._xatlas_worker.layout` in a worker process (:func:`_run_guarded`). When
+    xatlas dies natively (segfault), retry with the surface cut into 2, 4, 8 pieces (seams are
+    invisible after the conservative rasterisation and dilation); if every try dies, one clear
+    error."""
     tries = [pieces] + [_split_pieces(verts, faces, n) for n in (2, 4, 8) if n > len(pieces)]
     for attempt in tries:
-        with cf.ProcessPoolExecutor(max_workers=1, mp_context=context) as pool:
-            job = pool.submit(_xatlas_worker.run_layout, verts, faces, attempt,
-                              max_chart_area=chart_cap, max_iterations=_CHART_ITERATIONS,
-                              texels_per_mm=float(tpm), padding=int(padding))
-            try:
-                return (*job.result(), attempt)
-            except cf.process.BrokenProcessPool:
-                messages.append(
-                    f"bake: xatlas crashed unwrapping the surface in {len(attempt)} piece(s); "
-                    f"retried in {2 * len(attempt)} pieces")
-            except RuntimeError as err:
-                raise WoodcamError(f"bake: the UV unwrap failed ({err})") from err
+        try:
+            return (*_run_guarded("layout", verts, faces, attempt, max_chart_area=chart_cap,
+                                  max_iterations=_CHART_ITERATIONS, texels_per_mm=float(tpm),
+                                  padding=int(padding)), attempt)
+        except _WorkerCrashed:
+            messages.append(
+                f"bake: xatlas crashed unwrapping the surface in {len(attempt)} piece(s); "
+                f"retried in {2 * len(attempt)} pieces")
+        except RuntimeError as err:
+            raise WoodcamError(f"bake: the UV unwrap failed ({err})") from err
     raise WoodcamError(
         f"bake: xatlas crashed (native fault) unwrapping this {len(faces)}-triangle surface, "
         f"also when cut into up to {len(tries[-1])} pieces; simplify or re-mesh the part "

@@ -288,3 +288,40 @@ def test_a_latewood_band_across_the_whole_year_is_fitted_and_rendered_sharp(rng)
     rgb = wood.color(p, np.tile([0.0, -1.0, 0.0], (len(p), 1)))
     inner = np.minimum(phase, 1 - phase) < 0.04          # inside the band, off its edges
     np.testing.assert_allclose(rgb[inner].mean(0), dark, atol=0.03)
+
+
+class _EvaluatingKnottedAxisZ(_KnottedAxisZ):
+    """:class:`_KnottedAxisZ` that also answers ``evaluate`` (as the knotted log fields do),
+    counting which of its entry points the fit calls."""
+
+    def __init__(self):
+        self.calls: list[str] = []
+
+    def __call__(self, p):
+        self.calls.append("call")
+        return super().__call__(p)
+
+    def knot_features(self, p):
+        self.calls.append("knot_features")
+        return super().knot_features(p)
+
+    def evaluate(self, p, *, directions=False):
+        self.calls.append("evaluate")
+        return {"years": AXIS_Z(p), **super().knot_features(p)}
+
+
+def test_the_fit_samples_a_knotted_field_once_per_face():
+    """A field with ``evaluate`` gives years and knot weights in one pass of its knot model;
+    the fit uses it instead of calling the field and its knot features separately, and still
+    leaves the knot out of the ramps."""
+    centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
+    truth = np.tile(np.stack([0.8 - 0.3 * centres, 0.6 - 0.25 * centres, 0.4 - 0.2 * centres], 1),
+                    (3, 1, 1))
+    block = _render_block(AXIS_Z, truth)
+    front = block.faces["front"]
+    pts = face_pixel_points("front", front.shape, block.size_mm).reshape(-1, 3)
+    front.photo[_KnottedAxisZ().knot_features(pts)["knot"].reshape(front.shape) > 0.5] = (60, 35, 20)
+    field = _EvaluatingKnottedAxisZ()
+    fitted = ColorMapAppearance.fit_to_block(block, field, anchor="field").axis_luts
+    np.testing.assert_allclose(fitted, truth, atol=0.3 / 64 + 1 / 255 + 1e-3)
+    assert field.calls == ["evaluate"] * len(block.faces)

@@ -341,10 +341,10 @@ def _field_lut(faces, field, size_mm, centres, register: bool = False) -> np.nda
     counts = np.zeros(LUT_BINS)
     for face in faces:
         pts = face_pixel_points(face.name, face.shape, size_mm).reshape(-1, 3)
-        g = np.asarray(field(pts), float)
+        g, knot = _years_and_knots(field, pts)
         if register:
             g = _registered_years(face, g.reshape(face.shape)).ravel()
-        clear = _clear_wood(face, field, pts)
+        clear = _clear_wood(face, knot, len(pts))
         b = np.minimum((np.mod(g[clear], 1.0) * LUT_BINS).astype(int), LUT_BINS - 1)
         rgb = face.photo.reshape(-1, 3)[clear].astype(float) / 255.0
         counts += np.bincount(b, minlength=LUT_BINS)
@@ -357,20 +357,36 @@ def _field_lut(faces, field, size_mm, centres, register: bool = False) -> np.nda
     return np.stack([np.interp(centres, centres[ok], mean[:, c]) for c in range(3)], axis=1)
 
 
-def _clear_wood(face, field, points_mm) -> np.ndarray:
-    """``(n,)`` bool over ``face``'s pixels: True off any knot, by the face's ``knot_mask`` and
-    the field's own knot features where it reports them. The ramp is the colour of the stem's
+def _years_and_knots(field, points_mm):
+    """``(years (n,), knot (n,) or None)`` of ``field`` at ``points_mm (n, 3)``: the growth
+    time and, where the field has ``knot_features``, its knot weights. A knotted field that
+    also answers ``evaluate`` gives both from one pass of its knot model (its ``__call__`` and
+    ``knot_features`` are each a whole pass). A field with ``evaluate`` but no
+    ``knot_features`` (a woodified field's obstacles) reports no knots here."""
+    features = getattr(field, "knot_features", None)
+    if not callable(features):
+        return np.asarray(field(points_mm), float), None
+    evaluate = getattr(field, "evaluate", None)
+    if callable(evaluate):
+        out = evaluate(points_mm)
+        return np.asarray(out["years"], float), np.asarray(out["knot"], float)
+    return np.asarray(field(points_mm), float), np.asarray(features(points_mm)["knot"], float)
+
+
+def _clear_wood(face, knot, n: int) -> np.ndarray:
+    """``(n,)`` bool over ``face``'s ``n`` pixels: True off any knot, by the face's
+    ``knot_mask`` and the field's own knot weights ``knot (n,)`` where it reports them (else
+    None; :func:`_years_and_knots`). The ramp is the colour of the stem's
     rings; knot wood is dark and has its own rings (a knot's ARF runs round its strand), so
     binning it by the stem's ARF only adds a dark cast spread over every bin (the ring contrast
     of H11's knotted faces halved and even changed sign), and the renderer darkens knots again
     on top (:class:`~woodcam.appearance.knots.KnotShading`)."""
-    clear = np.ones(len(points_mm), bool)
+    clear = np.ones(n, bool)
     mask = face.extras.get("knot_mask")
     if mask is not None and np.shape(mask) == tuple(face.shape):
         clear &= ~np.asarray(mask, bool).ravel()
-    features = getattr(field, "knot_features", None)
-    if callable(features):
-        clear &= np.asarray(features(points_mm)["knot"], float) < KNOT_FREE_BELOW
+    if knot is not None:
+        clear &= knot < KNOT_FREE_BELOW
     return clear
 
 

@@ -258,7 +258,8 @@ def run(args) -> int:
         from ..view.scrub import gcode_window
 
         gcode_window(full, tools, stock, work_offset_mm=offset, resolution_mm=args.cell_size,
-                     initial_heightmap=hm_before, until_line=args.until_line)
+                     initial_heightmap=hm_before, until_line=args.until_line,
+                     heightmap=res.heightmap)  # the stock it opens on: simulated already
     return 3 if args.strict and n_warn else 0
 
 

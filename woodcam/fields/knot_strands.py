@@ -147,14 +147,22 @@ class StemWithKnots:
         return a, b - a, rad, gs, np.maximum(dens, 1e-3)
 
     @staticmethod
-    def _geometry(p: np.ndarray, table):
-        """``d``, ``R``, ``G`` and the stem time at the strand point of each point."""
-        a, v, rad, gs, dens = table
+    def _distance(p: np.ndarray, table):
+        """``d``, ``R`` and the strand sample position ``s`` of each point's strand point: all
+        that :meth:`knot_features` and :meth:`knot_halo` need (the two interpolations more of
+        :meth:`_geometry` were ~45 % of its cost)."""
+        a, v, rad, _, _ = table
         t = np.clip((p - a) @ v / (v @ v), 0.0, 1.0)
         d = np.linalg.norm(p - (a + t[:, None] * v), axis=1)
         s = t * (len(rad) - 1)
-        return d, np.interp(s, np.arange(len(rad)), rad), np.interp(s, np.arange(len(rad)), dens), \
-            np.interp(s, np.arange(len(rad)), gs)
+        return d, np.interp(s, np.arange(len(rad)), rad), s
+
+    @staticmethod
+    def _geometry(p: np.ndarray, table):
+        """``d``, ``R``, ``G`` and the stem time at the strand point of each point."""
+        d, R, s = StemWithKnots._distance(p, table)
+        _, _, rad, gs, dens = table
+        return d, R, np.interp(s, np.arange(len(rad)), dens), np.interp(s, np.arange(len(rad)), gs)
 
     def _knot_time(self, p, g, table, dense: bool):
         d, R, G, gS = self._geometry(p, table)
@@ -213,7 +221,7 @@ class StemWithKnots:
         p = check_points(points_mm)
         knot, dead, outline = np.zeros(len(p)), np.zeros(len(p)), np.zeros(len(p))
         for strand, table in zip(self.strands, self._tables):
-            d, R, _, _ = self._geometry(p, table)
+            d, R, _ = self._distance(p, table)
             k = np.clip((R - d) / KNOT_EDGE_MM + 0.5, 0.0, 1.0)
             knot = np.maximum(knot, k)
             if strand.dead:
@@ -227,7 +235,7 @@ class StemWithKnots:
         p = check_points(points_mm)
         halo = np.zeros(len(p))
         for table in self._tables:
-            d, R, _, _ = self._geometry(p, table)
+            d, R, _ = self._distance(p, table)
             halo = np.maximum(halo, np.clip(2.0 - d / R, 0.0, 1.0))
         return halo
 

@@ -60,18 +60,22 @@ def reach_issues(p0, p1, tool_of, lookup, lines, size_mm, initial_heightmap=None
         _cut_batch(hm, pending, p0, p1, tool_of, lookup, dx, dy)
         pending.clear()
 
+    # every move's window of cells within its tool's widest part (+ one cell), all at once
+    reach = np.zeros(len(p0))
+    for t, tool in lookup.items():
+        reach[tool_of == t] = max([tool.radius_mm] + [r for _, r, _ in parts_of[t]]) + max(dx, dy)
+    fi0, fi1, fj0, fj1 = _cell_window(p0, p1, reach, dx, dy)
+    wi0, wi1 = np.clip(fi0, 0, nx).astype(int), np.clip(fi1, -1, nx - 1).astype(int)
+    wj0, wj1 = np.clip(fj0, 0, ny).astype(int), np.clip(fj1, -1, ny - 1).astype(int)
     for k in range(len(p0)):
         a, b = p0[k], p1[k]
         if min(a[2], b[2]) >= H or (b[2] > a[2] and a[0] == b[0] and a[1] == b[1]):
             continue  # above the stock, or a straight retract (its start ended the last move)
-        tool = lookup[int(tool_of[k])]
+        if wi1[k] < wi0[k] or wj1[k] < wj0[k]:
+            continue  # the move's window misses the stock
+        R = lookup[int(tool_of[k])].radius_mm
         parts = parts_of[int(tool_of[k])]
-        R = tool.radius_mm
-        reach = max([R] + [r for _, r, _ in parts]) + max(dx, dy)
-        win = _window(a, b, reach, dx, dy, nx, ny)
-        if win is None:
-            continue
-        js, is_ = win
+        js, is_ = slice(wj0[k], wj1[k] + 1), slice(wi0[k], wi1[k] + 1)
         lowest = min(a[2], b[2])
         # the stock only ever goes down: if nothing in the window stands above the lowest
         # part even before the pending cuts, nothing does after them (no check needed)
@@ -127,12 +131,9 @@ def _cut_batch(hm, moves, p0, p1, tool_of, lookup, dx, dy) -> None:
         tool = lookup[int(t)]
         R = tool.radius_mm
         a, b = p0[sel], p1[sel]
-        i0 = np.clip(np.ceil((np.minimum(a[:, 0], b[:, 0]) - R) / dx - 0.5), 0, nx).astype(int)
-        i1 = np.clip(np.floor((np.maximum(a[:, 0], b[:, 0]) + R) / dx - 0.5), -1,
-                     nx - 1).astype(int)
-        j0 = np.clip(np.ceil((np.minimum(a[:, 1], b[:, 1]) - R) / dy - 0.5), 0, ny).astype(int)
-        j1 = np.clip(np.floor((np.maximum(a[:, 1], b[:, 1]) + R) / dy - 0.5), -1,
-                     ny - 1).astype(int)
+        fi0, fi1, fj0, fj1 = _cell_window(a, b, R, dx, dy)
+        i0, i1 = np.clip(fi0, 0, nx).astype(int), np.clip(fi1, -1, nx - 1).astype(int)
+        j0, j1 = np.clip(fj0, 0, ny).astype(int), np.clip(fj1, -1, ny - 1).astype(int)
         ok = (i1 >= i0) & (j1 >= j0)
         sel, a, b, i0, i1, j0, j1 = sel[ok], a[ok], b[ok], i0[ok], i1[ok], j0[ok], j1[ok]
         if not len(sel):
@@ -147,15 +148,18 @@ def _cut_batch(hm, moves, p0, p1, tool_of, lookup, dx, dy) -> None:
                          dy, kinds[q], sel[q], {})
 
 
-def _window(a, b, r, dx, dy, nx, ny):
-    """Row/column slices of the cells within ``r`` of the XY segment's bounding box."""
-    i0 = max(0, int(np.ceil((min(a[0], b[0]) - r) / dx - 0.5)))
-    i1 = min(nx - 1, int(np.floor((max(a[0], b[0]) + r) / dx - 0.5)))
-    j0 = max(0, int(np.ceil((min(a[1], b[1]) - r) / dy - 0.5)))
-    j1 = min(ny - 1, int(np.floor((max(a[1], b[1]) + r) / dy - 0.5)))
-    if i1 < i0 or j1 < j0:
-        return None
-    return slice(j0, j1 + 1), slice(i0, i1 + 1)
+def _cell_window(p0, p1, r, dx, dy):
+    """Cell-index window ``(i0, i1, j0, j1)`` (floats, unclipped: a move to X1e20 must not
+    overflow an int cast) of the cells of a ``dx x dy`` mm grid (centres at ``((i + 0.5) dx,
+    (j + 0.5) dy)``) that lie within ``r`` mm of the XY bounding box of each move
+    ``p0 -> p1 : (n, 3)`` or ``(3,)`` mm (``r`` a number or ``(n,)``):
+    ``i0 = ceil((min x - r) / dx - 0.5)``, ``i1 = floor((max x + r) / dx - 0.5)``, and so on in
+    y. The one formula of the simulation's and the reach check's windows."""
+    x0, x1, y0, y1 = p0[..., 0], p1[..., 0], p0[..., 1], p1[..., 1]
+    return (np.ceil((np.minimum(x0, x1) - r) / dx - 0.5),
+            np.floor((np.maximum(x0, x1) + r) / dx - 0.5),
+            np.ceil((np.minimum(y0, y1) - r) / dy - 0.5),
+            np.floor((np.maximum(y0, y1) + r) / dy - 0.5))
 
 
 def _frame(a, b, x, y):

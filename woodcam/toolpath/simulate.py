@@ -47,7 +47,7 @@ from .._types import ArrayLike, Mesh
 from ..errors import WoodcamError
 from ..tolerances import SIM_CONTACT_TOL_MM
 from .gcode import FEED, RAPID, Program
-from .reach import REACH_KINDS, reach_issues
+from .reach import REACH_KINDS, _cell_window, reach_issues
 from .tools import BallEndMill, FlatEndMill, Tool
 
 #: Cells evaluated per vectorised batch: ~20 float32 temporaries of 64k cells stay in L2/L3
@@ -253,10 +253,7 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     zmin = np.minimum(p0[:, 2], p1[:, 2])
     # cell index windows of the swept footprints, in float first (a move to X1e20 must not
     # overflow the int64 cast), then clipped to the grid
-    fi0 = np.ceil((np.minimum(p0[:, 0], p1[:, 0]) - R) / dx - 0.5)
-    fi1 = np.floor((np.maximum(p0[:, 0], p1[:, 0]) + R) / dx - 0.5)
-    fj0 = np.ceil((np.minimum(p0[:, 1], p1[:, 1]) - R) / dy - 0.5)
-    fj1 = np.floor((np.maximum(p0[:, 1], p1[:, 1]) + R) / dy - 0.5)
+    fi0, fi1, fj0, fj1 = _cell_window(p0, p1, R, dx, dy)
     outside = (fi0 < 0) | (fj0 < 0) | (fi1 >= nx) | (fj1 >= ny)
     # Moves reaching far outside the stock are cut to the part that can touch it, so the
     # float32 kernel works on short coordinates (exact: the rest of the move is outside).
@@ -266,10 +263,7 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
         pad = R[far] + max(dx, dy)
         p0[far], p1[far], inside[far] = _clip_segments(
             p0[far], p1[far], np.stack([-pad, -pad], 1), np.stack([W + pad, D + pad], 1))
-        fi0 = np.ceil((np.minimum(p0[:, 0], p1[:, 0]) - R) / dx - 0.5)
-        fi1 = np.floor((np.maximum(p0[:, 0], p1[:, 0]) + R) / dx - 0.5)
-        fj0 = np.ceil((np.minimum(p0[:, 1], p1[:, 1]) - R) / dy - 0.5)
-        fj1 = np.floor((np.maximum(p0[:, 1], p1[:, 1]) + R) / dy - 0.5)
+        fi0, fi1, fj0, fj1 = _cell_window(p0, p1, R, dx, dy)
     i0 = np.clip(fi0, 0, nx).astype(np.int64)
     j0 = np.clip(fj0, 0, ny).astype(np.int64)
     i1 = np.clip(fi1, -1, nx - 1).astype(np.int64)

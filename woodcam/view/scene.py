@@ -68,6 +68,11 @@ UNTEXTURED_PART_COLOR = (0.78, 0.62, 0.42)
 #: the part stays readable while the part's far half shows through it.
 WASTE_OPACITY = 0.3
 
+#: Overlay colours (RGB 0..255) by the names the CLI gives them (rapids red, feeds royalblue):
+#: VTK's own values of those names, so the numpy views (:mod:`woodcam.view.topview`,
+#: :mod:`woodcam.view.stockview`) draw the toolpath as this preview does.
+OVERLAY_COLORS = {"red": (255, 0, 0), "royalblue": (65, 105, 225)}
+
 #: Colour and width (pixels) of the part's outline drawn on the cut plane.
 OUTLINE_COLOR = (0.20, 0.12, 0.06)
 OUTLINE_WIDTH = 3.0

@@ -33,12 +33,15 @@ class ScrubCallback:
     ``program`` (a :class:`woodcam.toolpath.Program`), ``tools`` as
     :func:`woodcam.toolpath.simulate` takes them, the ``stock`` (size and wood), the G-code
     zero's block-frame position ``work_offset_mm`` and the simulation's ``resolution_mm``;
-    ``initial_heightmap`` is the stock earlier programs of the job left. After a call,
-    :attr:`line` is the line shown and :attr:`heightmap` its stock.
+    ``initial_heightmap`` is the stock earlier programs of the job left; ``heightmap``, when
+    given, the stock already simulated up to source line ``line`` (the last line when None; the
+    CLI has it), so a first call at that line draws it without simulating the program again.
+    After a call, :attr:`line` is the line shown and :attr:`heightmap` its stock.
     """
 
     def __init__(self, plotter, program, tools, stock, *, work_offset_mm=None,
-                 resolution_mm: float = 0.1, initial_heightmap=None):
+                 resolution_mm: float = 0.1, initial_heightmap=None, heightmap=None,
+                 line: int | None = None):
         if not len(program):
             raise WoodcamError("ScrubCallback: the program has no moves; nothing to scrub")
         self.plotter = plotter
@@ -55,6 +58,9 @@ class ScrubCallback:
         seg = np.stack([program.start_mm + self.offset, program.end_mm + self.offset], axis=1)
         self._seg = seg
         self.first_line, self.last_line = int(program.line.min()), int(program.line.max())
+        if heightmap is not None:  # the stock at ``line`` (lines past the last: the last's)
+            self.heightmap = np.asarray(heightmap, float)
+            self.line = self.last_line if line is None else min(int(line), self.last_line)
 
     def __call__(self, value) -> None:
         from ..toolpath.simulate import simulate
@@ -148,11 +154,13 @@ def check_display() -> None:
 
 
 def gcode_window(program, tools, stock, *, work_offset_mm=None, resolution_mm: float = 0.1,
-                 initial_heightmap=None, until_line: int | None = None,
+                 initial_heightmap=None, until_line: int | None = None, heightmap=None,
                  window_size: tuple[int, int] = (1280, 960), off_screen: bool = False):
-    """Open the G-code window (stock, toolpath, line slider, view keys); returns
-    ``(plotter, callback)`` after it closes. ``off_screen`` builds it without showing (tests
-    drive the :class:`ScrubCallback` as the slider would)."""
+    """Open the G-code window (stock, toolpath, line slider, view keys) at ``until_line`` (the
+    last line when None); returns ``(plotter, callback)`` after it closes. ``heightmap``: the
+    stock already simulated up to ``until_line``, shown first without simulating again
+    (:class:`ScrubCallback`). ``off_screen`` builds it without showing (tests drive the
+    :class:`ScrubCallback` as the slider would)."""
     from .camera import set_camera
     from .scene import _pyvista, add_view_keys
 
@@ -162,7 +170,8 @@ def gcode_window(program, tools, stock, *, work_offset_mm=None, resolution_mm: f
     plotter = pv.Plotter(off_screen=off_screen, window_size=window_size,
                          title="woodcam gcode")
     callback = ScrubCallback(plotter, program, tools, stock, work_offset_mm=work_offset_mm,
-                             resolution_mm=resolution_mm, initial_heightmap=initial_heightmap)
+                             resolution_mm=resolution_mm, initial_heightmap=initial_heightmap,
+                             heightmap=heightmap, line=until_line)
     add_line_slider(plotter, callback, value=until_line)
     W, D, H = callback.size_mm
     set_camera(plotter, "iso", (0.0, W, 0.0, D, 0.0, H))

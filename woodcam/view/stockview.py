@@ -37,8 +37,6 @@ _LIGHT_KIT = ((50.0, 10.0, 0.75), (-75.0, -10.0, 0.25), (0.0, 110.0, 0.75 / 3.5)
               (0.0, -110.0, 0.75 / 3.5), (0.0, 0.0, 0.125))
 #: The stock's material as the preview sets it: ambient, diffuse, specular, specular power.
 _MATERIAL = np.array([0.25, 0.8, 0.15, 20.0])
-#: Overlay colours (RGB 0-255) by the names the CLI gives them.
-_COLOURS = {"red": (255, 0, 0), "royalblue": (65, 105, 225)}
 #: A toolpath line is drawn where it lies this far (mm) in front of the surface: lines on the
 #: surface (a finishing pass's tip path) stay hidden, as VTK's depth test hides them (a line's
 #: dots land up to a pixel, ~0.05 mm, beside it, where a slope is higher or lower).
@@ -182,7 +180,8 @@ def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, ch
         RGB 0..255 where no stock, block or section is seen.
     """
     from . import _zbuffer as zb
-    from .scene import BLOCK_COLOR, BLOCK_EDGE_COLOR, BLOCK_OPACITY, OUTLINE_COLOR, WASTE_OPACITY
+    from .scene import (BLOCK_COLOR, BLOCK_EDGE_COLOR, BLOCK_OPACITY, OUTLINE_COLOR,
+                        OVERLAY_COLORS, WASTE_OPACITY)
 
     hm = np.ascontiguousarray(heightmap, dtype=np.float64)
     size = check_size(size_mm)
@@ -237,10 +236,10 @@ def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, ch
     if outline is not None and len(outline):
         lines.append((outline, 255 * np.asarray(OUTLINE_COLOR), 3, _EDGE_BIAS_MM))
     for segments, colour, width in overlay or ():
-        rgb = np.asarray(_COLOURS.get(colour, (np.nan,)) if isinstance(colour, str) else colour,
+        rgb = np.asarray(OVERLAY_COLORS.get(colour, (np.nan,)) if isinstance(colour, str) else colour,
                          float)
         if rgb.shape != (3,) or not np.isfinite(rgb).all():
-            raise WoodcamError(f"stock_view: overlay colour must be one of {sorted(_COLOURS)} or "
+            raise WoodcamError(f"stock_view: overlay colour must be one of {sorted(OVERLAY_COLORS)} or "
                                f"an RGB triple; got {colour!r}")
         lines.append((np.asarray(segments, float).reshape(-1, 2, 3), rgb,
                       max(1, int(round(float(width)))), _LINE_BIAS_MM))

@@ -17,8 +17,7 @@ from ..errors import WoodcamError
 #: Direction towards the light (block frame), upper left and above; and the ambient share.
 _LIGHT = np.array([-0.4, 0.4, 1.0]) / np.linalg.norm([-0.4, 0.4, 1.0])
 _AMBIENT = 0.35
-#: Overlay colours (RGB 0-255) and opacity: rapids red, feeds blue, as the VTK overlay.
-_COLOURS = {"red": (220, 30, 30), "royalblue": (65, 105, 225)}
+#: Overlay opacity (colours: :data:`woodcam.view.scene.OVERLAY_COLORS`, as the VTK overlay).
 _OVERLAY_ALPHA = 0.55
 _OVERLAY_COVER = 0.08
 
@@ -77,12 +76,14 @@ def top_view(heightmap, size_mm, top_texels, *, overlay=None,
 
 def _draw_segments(img, seg, colour, width, scale, D, ox, oy) -> None:
     """Blend XY segments (mm) into ``img`` as dots every half pixel, ``width`` px wide."""
+    from .scene import OVERLAY_COLORS
+
     if not len(seg):
         return
-    rgb = np.asarray(_COLOURS.get(colour, (np.nan,)) if isinstance(colour, str) else colour,
+    rgb = np.asarray(OVERLAY_COLORS.get(colour, (np.nan,)) if isinstance(colour, str) else colour,
                      np.float32)
     if rgb.shape != (3,) or not np.isfinite(rgb).all():
-        raise WoodcamError(f"top_view: overlay colour must be one of {sorted(_COLOURS)} or an "
+        raise WoodcamError(f"top_view: overlay colour must be one of {sorted(OVERLAY_COLORS)} or an "
                            f"RGB triple; got {colour!r}")
     p0 = np.column_stack([ox + seg[:, 0, 0] * scale, oy + (D - seg[:, 0, 1]) * scale])
     p1 = np.column_stack([ox + seg[:, 1, 0] * scale, oy + (D - seg[:, 1, 1]) * scale])
