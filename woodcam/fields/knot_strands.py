@@ -183,7 +183,7 @@ class StemWithKnots:
         for strand, table in zip(self.strands, self._tables):
             if not (strand.pinned or self.bend_guessed):  # a guessed strand marks its knot only
                 continue
-            d, R, _, _ = self._geometry(p, table)
+            d, R, _ = self._distance(p, table)
             q = d / R
             tb = ts * q  # seed 003: t_b = |P - S| / (rho v_s), rho = R / r: the knot's rings scaled
             tD = ds * (1.0 - q)  # t_s - t_b in mm of stem radius
