@@ -24,8 +24,12 @@ dead; a strand alive at one exit and dead at the other is kept alive: one flag p
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
 import numpy as np
 
+from .._types import ArrayLike
 from ..fields.base import central_gradient
 from ..fields.knot_strands import KnotStrand, StemWithKnots
 from ..fields.knots import KnotParams
@@ -33,6 +37,10 @@ from ..frames import FACE_NORMAL, pixel_to_block
 from ..tolerances import (DEAD_KNOT_BANDS_MM, DEAD_KNOT_MIN_OUTLINED, DEAD_KNOT_SECTORS, KNOT_MIN_AREA_PX,
                           KNOT_BEND_MAX_BEFORE_PITH, KNOT_BEND_ROUNDS, KNOT_MIN_AREA_SHARE, KNOT_MIN_ENTRY_COS,
                           KNOT_PAIR_MIN_ANGLE_DEG, KNOT_PITH_YEARS)
+
+if TYPE_CHECKING:
+    from .observations import RingObservations
+    from .stem import StemField
 
 
 def exit_is_dead(photo, region, pixel_mm: float) -> tuple[bool, float]:
@@ -122,7 +130,7 @@ def fit_knot_strands(block, stem, faces=None) -> list[KnotStrand]:
     return strands_from_exits(knot_exits(block, faces), stem, block.size_mm)
 
 
-def strands_from_exits(exits: list[dict], stem, size_mm) -> list[KnotStrand]:
+def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike) -> list[KnotStrand]:
     """Strands of the knot ``exits`` (:func:`knot_exits`) in ``stem``, a block of ``size_mm``
     (module docstring)."""
     if not exits:
@@ -181,8 +189,9 @@ def strands_from_exits(exits: list[dict], stem, size_mm) -> list[KnotStrand]:
     return strands
 
 
-def fit_knotted_stem(obs, size_mm, exits: list[dict], rounds: int = KNOT_BEND_ROUNDS, seed: int = 0,
-                     guessed: bool = False, stem=None):
+def fit_knotted_stem(obs: RingObservations, size_mm: ArrayLike, exits: list[dict],
+                     rounds: int = KNOT_BEND_ROUNDS, seed: int = 0, guessed: bool = False,
+                     stem: StemField | None = None) -> StemWithKnots | StemField:
     """The stem model with the rings bent round its knots (seed 003's join), fitted jointly:
     ``StemWithKnots(stem, strands, bend=KnotParams())``, or the plain stem when no strand bends.
 
@@ -225,7 +234,7 @@ def fit_knotted_stem(obs, size_mm, exits: list[dict], rounds: int = KNOT_BEND_RO
     return field
 
 
-def knot_bend_recipes(size_mm, exits: list[dict], seed: int = 0) -> dict:
+def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0) -> dict[str, Callable]:
     """Evidence hypotheses of the knots' bend, name -> ``RingObservations -> field``
     (:func:`fit_knotted_stem` from scratch on the given rings; the exits come from the masks,
     not from the rings a fold holds out): ``"stem + knot bend"`` (pinned strands; exits on two
