@@ -69,8 +69,8 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         from .knots import knot_bend_recipes, knot_exits, with_knots
 
         # the stem with the rings bent round its knots competes as more hypotheses
-        recipes = knot_bend_recipes(block.size_mm, knot_exits(block, faces))
-        ev = fit_evidence(obs, block.size_mm, recipes=recipes)
+        stem, recipes = knot_bend_recipes(block.size_mm, knot_exits(block, faces))
+        ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem)
         if isinstance(ev.field, StemWithKnots):  # the chosen field holds its knots already
             strands = ev.field.strands
         else:

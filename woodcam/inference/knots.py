@@ -234,12 +234,16 @@ def fit_knotted_stem(obs: RingObservations, size_mm: ArrayLike, exits: list[dict
     return field
 
 
-def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0) -> dict[str, Callable]:
-    """Evidence hypotheses of the knots' bend, name -> ``RingObservations -> field``
-    (:func:`fit_knotted_stem` from scratch on the given rings; the exits come from the masks,
-    not from the rings a fold holds out): ``"stem + knot bend"`` (pinned strands; exits on two
-    faces needed) and ``"stem + guessed knot bend"`` (every strand). They share the plain stem
-    fit of each fold."""
+def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0) -> tuple[Callable, dict[str, Callable]]:
+    """Evidence hypotheses of the knots' bend: ``(stem, recipes)``.
+
+    ``recipes``, name -> ``RingObservations -> field``, is :func:`fit_knotted_stem` from scratch
+    on the given rings (the exits come from the masks, not from the rings a fold holds out):
+    ``"stem + knot bend"`` (pinned strands; exits on two faces needed) and ``"stem + guessed
+    knot bend"`` (every strand). ``stem`` is the plain stem's recipe (:func:`~.stem.fit_stem`)
+    remembering its last fit: passed as the evidence fit's stem hypothesis
+    (:func:`~.evidence.fit_evidence`'s ``stem``), each fold's stem is fitted once for all three.
+    """
     from .stem import fit_stem
 
     last: dict = {}
@@ -255,7 +259,7 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0) -> d
     if exits:
         out["stem + guessed knot bend"] = lambda obs: fit_knotted_stem(obs, size_mm, exits, seed=seed,
                                                                       guessed=True, stem=plain(obs))
-    return out
+    return plain, out
 
 
 def with_knots(block, stem, faces=None):
