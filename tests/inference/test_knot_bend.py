@@ -87,21 +87,3 @@ def test_joint_fit_recovers_the_bend_that_a_plain_stem_misses(bent_block):
     j, p = sc["joint"][0]["matched_1"], sc["plain"][0]["matched_1"]
     assert j >= 90.0, (j, p)
     assert j >= p + 15.0, (j, p)
-
-
-def test_a_handicapped_hypothesis_must_win_by_its_margin():
-    """``choose(..., handicap)``: a knot-bend hypothesis is chosen only when its held-out score
-    beats the others' by the handicap (KNOT_BEND_MIN_GAIN in fit_block); the scores themselves
-    are reported unchanged."""
-    from woodcam.inference.evidence import Hypothesis, choose
-
-    hyps = [Hypothesis("stem", lambda p: p[:, 0], None), Hypothesis("stem + knot bend", lambda p: p[:, 1], None)]
-
-    def evidence(bend_score):
-        return {"stem": {"front": {"score": 80.0, "share_2mm": 90.0}},
-                "stem + knot bend": {"front": {"score": bend_score, "share_2mm": 95.0}}}
-
-    assert choose(hyps, evidence(86.0)).chosen == "stem + knot bend"
-    small = choose(hyps, evidence(86.0), {"stem + knot bend": 10.0})
-    assert small.chosen == "stem" and small.scores["stem + knot bend"]["mean"] == 86.0
-    assert choose(hyps, evidence(91.0), {"stem + knot bend": 10.0}).chosen == "stem + knot bend"
