@@ -323,13 +323,6 @@ KNOT_BEND_ROUNDS = 3
 #: seed 21 block 1 with its back face held out diverged to 40-108 years of "bend".
 KNOT_BEND_MAX_BEFORE_PITH = 0.02
 
-#: Held-out score points (:func:`woodcam.inference.evidence.face_score`) a knot-bend hypothesis
-#: must win by over the plain ones to be chosen: it adds seed 003's join with the log
-#: generator's parameters, which real wood need not follow. On the real spruce cube H11 one fold
-#: (bottom held out) chose it by 6.3 points and the face it had not seen got worse: H11's held-out
-#: faces fell from 1.21x to 1.05x chance within 2 px. Dev seed 21's six-face wins were >= 10.4.
-KNOT_BEND_MIN_GAIN = 10.0
-
 #: Dead-knot test of a knot exit (:func:`woodcam.inference.knots.exit_is_dead`): the boundary
 #: is cut into this many angular sectors around the exit's centroid...
 DEAD_KNOT_SECTORS = 16

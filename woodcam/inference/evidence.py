@@ -175,10 +175,9 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
     return out
 
 
-def choose(hypotheses: list[Hypothesis], evidence: dict, handicap: dict[str, float] | None = None) -> EvidenceFit:
+def choose(hypotheses: list[Hypothesis], evidence: dict) -> EvidenceFit:
     """Pick the hypothesis with the best mean held-out score (the first on ties or without
-    evidence); flag the result when the evidence contradicts it (see :class:`EvidenceFit`).
-    ``handicap``: name -> score points a hypothesis must win by to be chosen."""
+    evidence); flag the result when the evidence contradicts it (see :class:`EvidenceFit`)."""
     names = [h.name for h in hypotheses]
     by_name = {h.name: h for h in hypotheses}
     scores = {}
@@ -194,8 +193,7 @@ def choose(hypotheses: list[Hypothesis], evidence: dict, handicap: dict[str, flo
         msg = (f"{best}: only one face carries rings, so no face could be held out to check the "
                f"fit; trace or photograph a second face")
     else:
-        hc = handicap or {}
-        best = max(names, key=lambda n: scores[n]["mean"] - hc.get(n, 0.0))  # max keeps the first on ties
+        best = max(names, key=lambda n: scores[n]["mean"])  # max keeps the first on ties
         accepted = [n for n in names if scores[n]["mean"] >= scores[best]["mean"] - EVIDENCE_ACCEPT_MARGIN]
         bad = {face: v["share_2mm"] for face, v in evidence[best].items()
                if v["share_2mm"] < EVIDENCE_MIN_FACE_SHARE_2MM}
@@ -282,7 +280,7 @@ CANDIDATES: tuple[Candidate, ...] = ("radial", "rbf", "residual", "stem")
 def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                  candidates: tuple[str, ...] = CANDIDATES, seed: int = 0, extra: list[Hypothesis] | None = None,
                  warn: bool = True, recipes: dict[str, Callable] | None = None,
-                 stem: Callable | None = None, recipe_handicap: float = 0.0) -> EvidenceFit:
+                 stem: Callable | None = None) -> EvidenceFit:
     """Fit the hypotheses and choose by leave-one-face-out evidence (module docstring).
 
     Parameters
@@ -297,7 +295,6 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         :func:`woodcam.inference.knots.knot_bend_recipes`); a recipe that cannot fit is left out
     stem : the stem hypothesis' recipe (default :func:`stem_recipe`): one that remembers its
         last fit lets ``recipes`` built on the same stem fit reuse it in every fold
-    recipe_handicap : held-out score points a ``recipes`` hypothesis must win by to be chosen
     warn : emit a :class:`~woodcam.errors.WoodcamWarning` when the choice is contradicted
 
     Returns
@@ -329,8 +326,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
             except WoodcamError:  # too few rings for it: the others still compete
                 pass
         hyps += list(extra or [])
-        result = choose(hyps, holdout_evidence(hyps, numbered, seed),
-                        {name: recipe_handicap for name in (recipes or {})})
+        result = choose(hyps, holdout_evidence(hyps, numbered, seed))
     if warn and (result.contradicted or result.unverified):
         warnings.warn(result.message, WoodcamWarning, stacklevel=2)
     return result

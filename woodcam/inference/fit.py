@@ -9,7 +9,6 @@ import numpy as np
 
 from .._types import GrowthFieldLike
 from ..errors import WoodcamError
-from ..tolerances import KNOT_BEND_MIN_GAIN
 from .baked import bake
 from .observations import gather_observations
 from .radial import fit_radial, number_observations
@@ -71,7 +70,7 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
 
         # the stem with the rings bent round its knots competes as more hypotheses
         stem, recipes = knot_bend_recipes(block.size_mm, knot_exits(block, faces))
-        ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem, recipe_handicap=KNOT_BEND_MIN_GAIN)
+        ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem)
         if isinstance(ev.field, StemWithKnots):  # the chosen field holds its knots already
             strands = ev.field.strands
         else:
