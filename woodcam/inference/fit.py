@@ -25,13 +25,12 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: 3: the evidence-chosen default, uncertainty and fit facts saved with the grid; 4: dense knots;
 #: 5: ring maps read as one-pixel lines, dead knots, uncertainty round knots; 6: the stem
 #: hypothesis and per-fold pith refits in the evidence fit; 7: knot strands end at the pith, one-exit
-#: strands run toward it and keep the stem's ring spacing; 8: the stem with its pinned knots' bend
-#: (seed 003's join) as an evidence hypothesis).
-FIT_VERSION = 8
+#: strands run toward it and keep the stem's ring spacing).
+FIT_VERSION = 7
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
-              baked: bool = True) -> GrowthFieldLike:
+              baked: bool = True, knot_bend: bool = False) -> GrowthFieldLike:
     """Infer a block's growth field from the rings on its faces.
 
     Parameters
@@ -51,6 +50,11 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
     faces : list of face names / Mokume letters, optional; default every face of the block.
     baked : return the field baked to a 1 mm grid (:class:`woodcam.fields.GridField`, fast,
         saveable with ``.save(path)``) rather than the raw fitted callable.
+    knot_bend : evidence only: the stem with its knots' ring bend (seed 003's join fitted with
+        the stem, :func:`woodcam.inference.knots.fit_knotted_stem`) competes as two more
+        hypotheses. Off by default: on synthetic knotted blocks it helps with six faces and not
+        with three, and on the real cube H11 it lowered the held-out faces from 1.21x to 1.05x
+        chance (README).
 
     Returns
     -------
@@ -69,7 +73,7 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         from .knots import knot_bend_recipes, knot_exits, with_knots
 
         # the stem with the rings bent round its knots competes as more hypotheses
-        stem, recipes = knot_bend_recipes(block.size_mm, knot_exits(block, faces))
+        stem, recipes = knot_bend_recipes(block.size_mm, knot_exits(block, faces)) if knot_bend else (None, None)
         ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem)
         if isinstance(ev.field, StemWithKnots):  # the chosen field holds its knots already
             strands = ev.field.strands
