@@ -87,3 +87,23 @@ def test_joint_fit_recovers_the_bend_that_a_plain_stem_misses(bent_block):
     j, p = sc["joint"][0]["matched_1"], sc["plain"][0]["matched_1"]
     assert j >= 90.0, (j, p)
     assert j >= p + 15.0, (j, p)
+
+
+@pytest.mark.slow
+def test_fit_block_with_knot_bend_chooses_and_bakes_it(bent_block):
+    """``fit_block(knot_bend=True)``: the bend hypothesis competes in the evidence fit, wins on
+    a block bent by seed 003's join, and bakes with its knot (strands in ``meta``, knot layer)."""
+    import warnings
+
+    from woodcam.errors import WoodcamWarning
+    from woodcam.inference import fit_block
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", WoodcamWarning)
+        grid = fit_block(bent_block, knot_bend=True)
+        plain = fit_block(bent_block, baked=False)
+    assert grid.meta["chosen"] == "stem + knot bend", grid.meta["scores"]
+    assert grid.meta["knots"][0]["pinned"] and grid.layers["knot"].max() == 1.0
+    assert "stem + knot bend" not in plain.scores  # off by default
+    sc = evaluate_fits(bent_block.true_field, {"bend": grid}, bent_block.size_mm, pixel_mm=0.4)
+    assert sc["bend"][0]["matched_1"] >= 90.0
