@@ -88,6 +88,25 @@ class Parquetry:
     seams_v: list | None = None
     seams_h: list | None = None
     native_shape: tuple[int, int] | None = None
+    # The target side of the metrics on another grid, ``{key: array}``, computed once per
+    # panel (the summary asks for the render's and the baseline's figures on the same grid).
+    _metric_targets: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def metric_target(self, what: Literal["matched", "features"], shape: tuple[int, int] | None,
+                      w_intens: float = 0.5, w_edge: float = 0.5) -> np.ndarray:
+        """The matched target ``(h, w)`` or its eq. 1 features ``(h, w, 2)``, area-averaged to
+        ``shape`` (None: the working grid, as matched); cached per panel."""
+        key = (what, shape, w_intens, w_edge) if what == "features" else (what, shape)
+        if key not in self._metric_targets:
+            if what == "matched":
+                val = _area(self.matched, shape)
+            elif shape is None:
+                val = self.target_feats
+            else:
+                val = np.stack([w_intens * _area(self.matched, shape),
+                                w_edge * edge(_area(intensity(self.target_rgb), shape))], axis=-1)
+            self._metric_targets[key] = val
+        return self._metric_targets[key]
 
     @property
     def size_mm(self) -> tuple[float, float]:
@@ -431,11 +450,7 @@ def feature_cost(p: Parquetry, image: np.ndarray, params: ParquetryParams,
     shape = _native(p, grid)
     g = _area(intensity(image), shape)
     f = features(g, params.w_intens, params.w_edge)
-    if shape is None:
-        t = p.target_feats
-    else:
-        t = np.stack([params.w_intens * _area(p.matched, shape),
-                      params.w_edge * edge(_area(intensity(p.target_rgb), shape))], axis=-1)
+    t = p.metric_target("features", shape, params.w_intens, params.w_edge)
     return float(((f - t) ** 2).sum(axis=2).mean())
 
 
@@ -453,5 +468,5 @@ def ssim_vs_matched(p: Parquetry, image: np.ndarray, downsample: int = 1,
     if shape is None and downsample > 1:
         h, w = b.shape
         shape = (max(7, h // downsample), max(7, w // downsample))
-    a, b = _area(a, shape), _area(b, shape)
+    a, b = _area(a, shape), p.metric_target("matched", shape)
     return float(structural_similarity(a, b, data_range=1.0))

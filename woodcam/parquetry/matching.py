@@ -473,9 +473,7 @@ class SheetBank:
         win = ii[th:, tw:] - ii[:-th, tw:] - ii[th:, :-tw] + ii[:-th, :-tw]
         cost[win != 0] = np.inf
         flat = cost.ravel()
-        n = min(keep, flat.size) if keep else flat.size
-        sel = np.argpartition(flat, n - 1)[:n] if n < flat.size else np.arange(flat.size)
-        sel = sel[np.isfinite(flat[sel])]
+        sel = _smallest(flat, keep or flat.size)
         sel = sel[np.argsort(flat[sel], kind="stable")]
         ys, xs = np.divmod(sel, cost.shape[1])
         return [(float(c), int(x), int(y)) for c, x, y in
