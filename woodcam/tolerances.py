@@ -328,6 +328,18 @@ KNOT_MIN_ENTRY_COS = 0.2
 #: pith on one side only (half a ring: more than a trace's mislabel or a fit's wobble).
 KNOT_PITH_YEARS = 0.5
 
+#: Rounds of the joint stem + knot-bend fit (:func:`woodcam.inference.knots.fit_knotted_stem`):
+#: each refits the stem to the years less the bend its knots put there. Dev seed 21, six noisy
+#: faces, blocks 1 / 9 / 10 within 1 mm: 1 round 97 / 53 / 97 %, 2 rounds 99 / 68 / 98 %, 4
+#: rounds 99 / 74 / 98 %; a warm-started round costs about a quarter of a stem fit.
+KNOT_BEND_ROUNDS = 3
+
+#: The joint fit keeps the plain stem when more than this share of the rings have a growth time
+#: at or below the fitted pith's: seed 003's bend is a share of the time since the pith, which
+#: such a stem (its "pith" beyond the rings' far side, density negative) does not give; dev
+#: seed 21 block 1 with its back face held out diverged to 40-108 years of "bend".
+KNOT_BEND_MAX_BEFORE_PITH = 0.02
+
 #: Dead-knot test of a knot exit (:func:`woodcam.inference.knots.exit_is_dead`): the boundary
 #: is cut into this many angular sectors around the exit's centroid...
 DEAD_KNOT_SECTORS = 16

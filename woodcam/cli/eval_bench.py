@@ -40,6 +40,8 @@ def register(subparsers) -> None:
                    help="eq. 7-9 sanity blocks per scenario and face set (default 2; 0 skips)")
     r.add_argument("--face-px", type=int, default=256, help="face image pixels along the largest side (default 256)")
     r.add_argument("--plots", action="store_true", help="also write cut-plane PNGs per block")
+    r.add_argument("--knot-bend", action="store_true",
+                   help="the evidence fit also tries the stem with its knots' ring bend (default off)")
     add_confidence_option(r, "; implies --plots")
     add_out_option(r, "table.md, records.json and cut-plane PNGs")
     r.set_defaults(func=run_realistic)
@@ -67,7 +69,8 @@ def run_realistic(args) -> int:
     rows = []
     plots = args.plots or args.confidence
     for kind, i, s, f in tqdm(tasks, desc="benchmark blocks", unit="block"):
-        row = score_block(args.seed, i, methods, s, f, kind, face_px=args.face_px, keep_lines=plots)
+        row = score_block(args.seed, i, methods, s, f, kind, face_px=args.face_px, keep_lines=plots,
+                          knot_bend=args.knot_bend)
         if plots:
             from ..inference.evaluate import plot_planes
 

@@ -18,6 +18,21 @@ replaced by the stem's own growth time:
   ``min(a, b) - h^2 k / 4, h = max(k - |a - b|, 0) / k`` with ``k`` in years, which bends the
   stem's rings round the knot within about ``k`` rings of its surface.
 
+The bend (``bend=`` a :class:`~woodcam.fields.knots.KnotParams`, a stem with a pith such as
+:class:`woodcam.inference.stem.StemField`): seed 003's own join instead, as the log generator
+(:class:`~woodcam.fields.knots.KnottedLogField`) has it, with times counted from the stem's pith
+``t_s = g(p) - g(pith)`` (years; the power smooth minimum is homogeneous, so years serve as well
+as the seed's mm): ``t_b = t_s d / R`` (eq. 1 with ``rho = R / r``: the knot holds every ring
+since the pith), ``delta = smin(t_s, t_b, k) - min(t_s, t_b)`` (eqs. 2-3) with the adaptive
+``k`` over ``t_s - t_b = rho_s (1 - d / R)`` mm (``rho_s`` the pith distance), faded over the
+distance range ``range_d0 + range_k0 rho_s .. range_d1 + range_k1 rho_s`` and joined as eq. 6.
+The power smooth minimum lowers the stem's time by a share of itself (18 % at ``d = 2R``, 5 %
+at ``5R`` for ``k = 1.5``), so the rings bend round a knot over many rings, not one. Only
+:attr:`KnotStrand.pinned` strands bend the rings (the others only mark their knot), and a
+dead strand bends as an alive one (the exits show a branch dead at the surface, not where
+it died; the bend comes from its alive inner part). Fitted jointly with the stem by
+:func:`woodcam.inference.knots.fit_knotted_stem`.
+
 Dead knots (seed 003, Sec. 4.2.2): past its death a branch stops growing and the stem grows
 round it without ring continuity, leaving a bark ring (dark outline) at the knot surface. Seed
 003 scales the amount of smoothing ``delta = smin - min`` by a factor ``f`` that turns negative
@@ -37,6 +52,7 @@ import numpy as np
 
 from ..errors import WoodcamError
 from .base import central_gradient, check_points
+from .knots import _T_EPS, KnotParams, smoothing_amount
 
 #: Smoothing ``k`` (years) of the stem-knot smooth minimum: rings bend round a knot within about
 #: one ring of its surface, as on H11's faces C and F (looked at).
@@ -108,13 +124,20 @@ class StemWithKnots:
         did not), so it keeps the stem's spacing. False keeps it for every strand.
     """
 
-    def __init__(self, stem, strands, smoothing_years: float = KNOT_SMOOTH_YEARS, dense: bool = True):
+    def __init__(self, stem, strands, smoothing_years: float = KNOT_SMOOTH_YEARS, dense: bool = True,
+                 bend: KnotParams | None = None, bend_guessed: bool = False):
         self.stem = stem
         self.dense = bool(dense)
         self.strands = list(strands)
         self.k = float(smoothing_years)
         self.axis = getattr(stem, "axis", (0.0, 0.0, 1.0))
         self._tables = [self._table(s) for s in self.strands]
+        self.bend, self.bend_guessed = bend, bool(bend_guessed)
+        if bend is not None:
+            if not hasattr(stem, "pith_distance_mm"):
+                raise WoodcamError("bend needs a stem with a pith (pith_distance_mm), e.g. a "
+                                   f"woodcam.inference.stem.StemField; got {type(stem).__name__}")
+            self._pith_years = float(stem.pith_years())
 
     def _table(self, strand: KnotStrand):
         pts, rad = strand.samples()
@@ -148,9 +171,42 @@ class StemWithKnots:
         inside = gS + (d / R) * (g - gS) - (R - d) * G
         return np.where(d < R, inside, g + (d - R) * G)
 
+    def _bent(self, p, gs):
+        """Seed 003's join (module docstring, "bend"): ``min(t_s, t_b..) + sum delta_i`` with
+        times counted from the stem's pith, each knot's ``delta`` faded over its distance range."""
+        P = self.bend
+        ds = np.asarray(self.stem.pith_distance_mm(p), float)
+        ts = np.maximum(gs - self._pith_years, _T_EPS)  # before the pith's time: no bend (below)
+        tbm = np.full(len(p), np.inf)
+        inv2 = np.zeros(len(p))
+        total = np.zeros(len(p))
+        for strand, table in zip(self.strands, self._tables):
+            if not (strand.pinned or self.bend_guessed):  # a guessed strand marks its knot only
+                continue
+            d, R, _ = self._distance(p, table)
+            q = d / R
+            tb = ts * q  # seed 003: t_b = |P - S| / (rho v_s), rho = R / r: the knot's rings scaled
+            tD = ds * (1.0 - q)  # t_s - t_b in mm of stem radius
+            kk = 0.5 * (P.k_knot - P.k_stem) * tD / (P.k_transition_mm + np.abs(tD)) + 0.5 * (P.k_knot + P.k_stem)
+            delta = smoothing_amount(ts, tb, kk)
+            r0, r1 = P.range_d0_mm + P.range_k0 * ds, P.range_d1_mm + P.range_k1 * ds
+            inr = d < r1
+            delta = np.where(inr, delta * (1.0 - np.clip((d - r0) / (r1 - r0), 0.0, 1.0)), 0.0)
+            tb = np.where(inr, tb, np.inf)
+            tbm = np.minimum(tbm, tb)
+            inv2 += 1.0 / np.maximum(tb, _T_EPS) ** 2
+            total += delta
+        with np.errstate(divide="ignore"):
+            soft = np.where(inv2 > 0, 1.0 / np.sqrt(inv2), np.inf)
+        w = np.clip((ts - soft) / ts, 0.0, 1.0)  # inside a knot its own rings, unsmoothed
+        w = w * w * (3.0 - 2.0 * w)
+        return gs + (np.minimum(ts, tbm) + (1.0 - w) * total - ts)
+
     def __call__(self, points_mm) -> np.ndarray:
         p = check_points(points_mm)
         gs = np.asarray(self.stem(p), float)
+        if self.bend is not None:
+            return self._bent(p, gs)
         out = gs.copy()
         for strand, table in zip(self.strands, self._tables):
             out = _smin(out, self._knot_time(p, gs, table, self.dense and strand.pinned), self.k,

@@ -279,7 +279,8 @@ CANDIDATES: tuple[Candidate, ...] = ("radial", "rbf", "residual", "stem")
 
 def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                  candidates: tuple[str, ...] = CANDIDATES, seed: int = 0, extra: list[Hypothesis] | None = None,
-                 warn: bool = True) -> EvidenceFit:
+                 warn: bool = True, recipes: dict[str, Callable] | None = None,
+                 stem: Callable | None = None) -> EvidenceFit:
     """Fit the hypotheses and choose by leave-one-face-out evidence (module docstring).
 
     Parameters
@@ -289,6 +290,11 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     n_basins : pith-axis basins of the radial fit to try as hypotheses
     candidates : hypothesis families, from :data:`CANDIDATES`
     extra : further hypotheses to judge with the others (e.g. a planted one in a test)
+    recipes : further hypotheses as recipes, name -> ``RingObservations -> field``, fitted on
+        the numbered rings here (e.g. the stem with its knots' bend,
+        :func:`woodcam.inference.knots.knot_bend_recipes`); a recipe that cannot fit is left out
+    stem : the stem hypothesis' recipe (default :func:`stem_recipe`): one that remembers its
+        last fit lets ``recipes`` built on the same stem fit reuse it in every fold
     warn : emit a :class:`~woodcam.errors.WoodcamWarning` when the choice is contradicted
 
     Returns
@@ -303,7 +309,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         hyps = [Hypothesis("radial" if i == 0 else f"radial basin {i + 1}", f, radial_recipe(f, seed, size_mm))
                 for i, f in enumerate(radials)]
         if "stem" in candidates:
-            rec = stem_recipe(size_mm, seed)
+            rec = stem_recipe(size_mm, seed) if stem is None else stem
             try:
                 hyps.append(Hypothesis("stem", rec(numbered), rec))
             except WoodcamError:  # too few rings for the stem: the others still compete
@@ -314,6 +320,11 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         if "residual" in candidates:
             rec = _residual_recipe(hyps[0].refit, EVIDENCE_RBF_POINTS)  # shares radial's fold fits
             hyps.append(Hypothesis("radial + residual", rec(numbered), rec))
+        for name, rec in (recipes or {}).items():
+            try:
+                hyps.append(Hypothesis(name, rec(numbered), rec))
+            except WoodcamError:  # too few rings for it: the others still compete
+                pass
         hyps += list(extra or [])
         result = choose(hyps, holdout_evidence(hyps, numbered, seed))
     if warn and (result.contradicted or result.unverified):

@@ -31,7 +31,7 @@ FIT_VERSION = 8
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
-              baked: bool = True) -> GrowthFieldLike:
+              baked: bool = True, knot_bend: bool = False) -> GrowthFieldLike:
     """Infer a block's growth field from the rings on its faces.
 
     Parameters
@@ -51,6 +51,11 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
     faces : list of face names / Mokume letters, optional; default every face of the block.
     baked : return the field baked to a 1 mm grid (:class:`woodcam.fields.GridField`, fast,
         saveable with ``.save(path)``) rather than the raw fitted callable.
+    knot_bend : evidence only: the stem with its knots' ring bend (seed 003's join fitted with
+        the stem, :func:`woodcam.inference.knots.fit_knotted_stem`) competes as two more
+        hypotheses. Off by default: on synthetic knotted blocks it helps with six faces and not
+        with three, and on the real cube H11 it lowered the held-out faces from 1.21x to 1.05x
+        chance (README).
 
     Returns
     -------
@@ -64,11 +69,17 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         return fit_neural(block, faces=faces)  # always baked to a grid (the net is slow)
     obs = gather_observations(block, faces)
     if method == "evidence":
+        from ..fields.knot_strands import StemWithKnots
         from .evidence import bake_evidence, fit_evidence
-        from .knots import with_knots
+        from .knots import knot_bend_recipes, knot_exits, with_knots
 
-        ev = fit_evidence(obs, block.size_mm)
-        ev.field, strands = with_knots(block, ev.field, faces)  # knots from the masks (part 3)
+        # the stem with the rings bent round its knots competes as more hypotheses
+        stem, recipes = knot_bend_recipes(block.size_mm, knot_exits(block, faces)) if knot_bend else (None, None)
+        ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem)
+        if isinstance(ev.field, StemWithKnots):  # the chosen field holds its knots already
+            strands = ev.field.strands
+        else:
+            ev.field, strands = with_knots(block, ev.field, faces)  # knots from the masks (part 3)
         used = sorted({int(i) for i in np.unique(obs.face)})
         return bake_evidence(ev, block.size_mm, used, strands) if baked else ev
     if method == "rbf":

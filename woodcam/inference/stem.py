@@ -100,6 +100,16 @@ class StemField:
         v = d + (self.curve[0, 1] * b1 + self.curve[1, 1] * b2) / self.half_length_mm
         return v / np.linalg.norm(v)
 
+    def pith_distance_mm(self, points_mm: ArrayLike) -> np.ndarray:
+        """``(n,)`` mm: distance ``rho`` of each point from the pith in its cross-section."""
+        p = check_points(points_mm)
+        return _polar(p, self.centre_mm, _frame(self.base_axis), self.half_length_mm, self.curve)[0]
+
+    def pith_years(self) -> float:
+        """The growth time on the pith (``rho = 0``): the origin of times "from the pith"."""
+        g = np.array([self.offset])
+        return float(g[0] if self.history_levels is None else _warp(g, self.history_levels, self.history_years)[0])
+
     def linear(self, points_mm: ArrayLike) -> np.ndarray:
         """``g(p)``, the years before the growth-history warp, ``(n,)``."""
         p = check_points(points_mm)
@@ -251,11 +261,36 @@ def _starts(prob: _StemProblem, obs: RingObservations, sel: np.ndarray, size, n_
     return kept
 
 
+#: Ring spacings (mm) of recent observation sets, keyed by their content (points, ring groups,
+#: faces): the joint stem + knot-bend fit refits the stem on the same rings several times per
+#: fold, and the spacing was a quarter of each warm-started refit's time.
+_SPACING_CACHE: dict[str, float] = {}
+_SPACING_CACHE_SIZE = 16
+
+
+def _ring_spacing_mm(obs: RingObservations) -> float:
+    """:func:`.radial.ring_spacing_mm` of ``obs``, remembered by content."""
+    import hashlib
+
+    from .radial import ring_spacing_mm
+
+    h = hashlib.blake2b(digest_size=16)
+    for a in (obs.points_mm, obs.group, obs.face):
+        h.update(np.ascontiguousarray(a).tobytes())
+    key = h.hexdigest()
+    if key not in _SPACING_CACHE:
+        if len(_SPACING_CACHE) >= _SPACING_CACHE_SIZE:
+            _SPACING_CACHE.pop(next(iter(_SPACING_CACHE)))  # the oldest
+        _SPACING_CACHE[key] = ring_spacing_mm(obs)
+    return _SPACING_CACHE[key]
+
+
 def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | None = None,
              K: int = 4, M: int = 1, P: int = 2, tilt_prior_deg: float = STEM_TILT_PRIOR_DEG,
              curve_prior_mm: float = STEM_CURVE_PRIOR_MM, n_search: int = 500,
              n_fit: int = 1000, n_starts: int = 2, n_final: int = 2, seed: int = 0,
-             history: bool = True) -> StemField:
+             history: bool = True, offset_years: ArrayLike | None = None,
+             init: StemField | None = None) -> StemField:
     """Fit the stem model (module docstring) to labelled ring observations of a block.
 
     The result depends on ``obs`` and the arguments only (no other face's data enters it), so
@@ -273,13 +308,16 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
     n_search, n_fit : points used for the start search and the refinement (fixed random subsets)
     n_starts : starts refined at low order per base axis
     n_final : of those, the cheapest finished at full order
+    offset_years : (n,) years per observation the stem does not explain (e.g. the bend a knot
+        puts into the rings round it: :func:`woodcam.inference.knots.fit_knotted_stem`): the stem
+        is fitted to ``obs.years - offset_years``; default none
+    init : a stem fitted to nearly the same targets: its base axis and centreline are the one
+        start, refined at full order (no start search; about 4x cheaper)
 
     Returns
     -------
     StemField
     """
-    from .radial import ring_spacing_mm
-
     if not obs.labelled:
         raise WoodcamError("fit_stem needs year-labelled rings; number unlabelled rings first "
                            "(woodcam.inference.radial.number_observations or fit_evidence)")
@@ -288,25 +326,30 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
                            f"points on {len(np.unique(obs.years))} rings: trace more rings")
     if not (tilt_prior_deg > 0 and curve_prior_mm > 0):
         raise WoodcamError(f"tilt_prior_deg and curve_prior_mm must be > 0; got {tilt_prior_deg}, {curve_prior_mm}")
+    n = len(obs.points_mm)
+    off = np.zeros(n) if offset_years is None else np.asarray(offset_years, float).reshape(-1)
+    if off.shape != (n,) or not np.all(np.isfinite(off)):
+        raise WoodcamError(f"offset_years must be {n} finite years, one per observation; got shape {off.shape}")
     size = np.asarray(size_mm, float)
     centre = size / 2
     L = float(np.linalg.norm(size) / 2)
     rng = np.random.default_rng(seed)
-    n = len(obs.points_mm)
     i_s = np.sort(rng.choice(n, n_search, replace=False)) if n > n_search else np.arange(n)
     i_f = np.sort(rng.choice(n, n_fit, replace=False)) if n > n_fit else np.arange(n)
     tp = np.tan(np.deg2rad(min(tilt_prior_deg, 89.0)))
     # rings per mm: the ring spacing seen on the faces is >= the true width (oblique cuts)
-    density = 1.0 / ring_spacing_mm(obs)
+    density = 1.0 / _ring_spacing_mm(obs)
     rho0 = float(np.median(np.linalg.norm(obs.points_mm - centre, axis=1))) + L
 
     def problem(idx, d0, k, m):
-        return _StemProblem(obs.points_mm[idx], obs.years[idx], centre, _frame(d0), L, k, m, P, rho0,
+        return _StemProblem(obs.points_mm[idx], obs.years[idx] - off[idx], centre, _frame(d0), L, k, m, P, rho0,
                             _prior_sd(k, m, P, rho0, density), tp, curve_prior_mm)
 
     # every axis' cheapest starts, refined at low order; the best n_final finished at full order
     coarse = []
-    for d0 in _base_axes(size, base_axes):
+    if init is not None:  # warm start: one start, the given centreline
+        coarse.append((0.0, np.asarray(init.curve, float).T.reshape(-1), np.asarray(init.base_axis, float)))
+    for d0 in (_base_axes(size, base_axes) if init is None else []):
         prob = problem(i_s, d0, min(K, 2), 0)
         for _, th in _starts(prob, obs, i_s, size, n_starts):
             th, cost = _refine(prob, th, 20)
@@ -321,10 +364,10 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
     prob = problem(np.arange(n), d0, K, M)
     curve = prob.curve_of(th)
     obs = _relabel(obs, prob, curve)
-    prob.years = obs.years
+    prob.years = obs.years - off
     field = _coefficients(prob, curve, StemField(centre, d0, L, curve, K, M, P, np.zeros(0), np.zeros(0), rho0))
     if history:
-        field = _growth_history(obs, prob, field)
+        field = _growth_history(obs, prob, field, off)
     return field
 
 
@@ -347,9 +390,11 @@ def _coefficients(prob: _StemProblem, curve, f: StemField, targets=None) -> Stem
                      sol[f.P:], sol[1:f.P], f.rho0_mm, float(sol[0]))
 
 
-def _growth_history(obs: RingObservations, prob: _StemProblem, f: StemField) -> StemField:
+def _growth_history(obs: RingObservations, prob: _StemProblem, f: StemField, off: np.ndarray) -> StemField:
     """The year-to-year ring width ``h``: as :func:`.radial._fit_growth_history` (levels per
-    year shrunk to the year, made increasing, alternated with the coefficients)."""
+    year shrunk to the year, made increasing, alternated with the coefficients). ``off`` (n,):
+    the years the stem does not explain; ``h`` has slope about 1, so a point of year ``y`` sits
+    at the level ``h^-1(y) - off``."""
     from scipy.optimize import isotonic_regression
 
     years, idx, counts = np.unique(obs.years, return_inverse=True, return_counts=True)
@@ -357,12 +402,12 @@ def _growth_history(obs: RingObservations, prob: _StemProblem, f: StemField) -> 
         return f
 
     def levels(g: StemField) -> np.ndarray:
-        med = _group_medians(g.linear(obs.points_mm), idx, len(years))
+        med = _group_medians(g.linear(obs.points_mm) + off, idx, len(years))
         lev = (counts * med + RING_HISTORY_PRIOR_POINTS * years) / (counts + RING_HISTORY_PRIOR_POINTS)
         return isotonic_regression(lev, weights=counts).x + np.arange(len(years)) * RING_HISTORY_MIN_STEP
 
     for _ in range(RING_HISTORY_ROUNDS):
-        f = _coefficients(prob, f.curve, f, targets=levels(f)[idx])
+        f = _coefficients(prob, f.curve, f, targets=levels(f)[idx] - off)
     f.history_levels, f.history_years = levels(f), years.astype(float)
     return f
 
