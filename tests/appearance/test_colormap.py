@@ -124,6 +124,15 @@ class _KnottedAxisZ:
 KNOT_AT = np.array([30.0, 0.0, 20.0])     # on the front face (y = 0) of the 60x50x40 block
 
 
+def _clear_ramp_block():
+    """``(truth (3, LUT_BINS, 3), block)``: linear dark-going ramps per axis and the axis-Z block
+    rendered with them."""
+    centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
+    truth = np.tile(np.stack([0.8 - 0.3 * centres, 0.6 - 0.25 * centres, 0.4 - 0.2 * centres], 1),
+                    (3, 1, 1))
+    return truth, _render_block(AXIS_Z, truth)
+
+
 @pytest.mark.parametrize("by", ["knot_mask", "field"])
 def test_fit_learns_the_ring_colours_from_clear_wood_only(by):
     """Bug seen on the real spruce cube H11: knot pixels (dark, with rings of their own) were
@@ -131,10 +140,7 @@ def test_fit_learns_the_ring_colours_from_clear_wood_only(by):
     ring contrast even changed sign). A dark knot painted on the front photo, known from the
     face's knot mask or from the field's knot features, must leave the fitted ramp at the
     truth."""
-    centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
-    truth = np.tile(np.stack([0.8 - 0.3 * centres, 0.6 - 0.25 * centres, 0.4 - 0.2 * centres], 1),
-                    (3, 1, 1))
-    block = _render_block(AXIS_Z, truth)
+    truth, block = _clear_ramp_block()
     front = block.faces["front"]
     pts = face_pixel_points("front", front.shape, block.size_mm).reshape(-1, 3)
     knot = _KnottedAxisZ().knot_features(pts)["knot"].reshape(front.shape) > 0.5
@@ -314,10 +320,7 @@ def test_the_fit_samples_a_knotted_field_once_per_face():
     """A field with ``evaluate`` gives years and knot weights in one pass of its knot model;
     the fit uses it instead of calling the field and its knot features separately, and still
     leaves the knot out of the ramps."""
-    centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
-    truth = np.tile(np.stack([0.8 - 0.3 * centres, 0.6 - 0.25 * centres, 0.4 - 0.2 * centres], 1),
-                    (3, 1, 1))
-    block = _render_block(AXIS_Z, truth)
+    truth, block = _clear_ramp_block()
     front = block.faces["front"]
     pts = face_pixel_points("front", front.shape, block.size_mm).reshape(-1, 3)
     front.photo[_KnottedAxisZ().knot_features(pts)["knot"].reshape(front.shape) > 0.5] = (60, 35, 20)
