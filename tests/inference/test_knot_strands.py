@@ -248,3 +248,23 @@ def test_branches_on_both_sides_of_a_pith_inside_the_block_start_at_the_pith():
     # a pinned strand (two exits) holds every ring since the pith (seed 003)
     pinned = StemWithKnots(radial_stem, [KnotStrand(pith, (62.0, 20.0, 24.0), 3.0, 3.0)])
     assert pinned(np.array([[35.0, 20.0, 21.4]]))[0] < 1.0
+
+
+def test_bake_carries_the_knot_layers_and_more_uncertainty_round_the_knot():
+    """bake_evidence's layers from one pass of the strands (``knot_layers``): the knot weight
+    inside the strand, and the uncertainty raised by EVIDENCE_KNOT_UNCERTAINTY_YEARS there
+    over a node as far from the observed faces but beyond the knot's halo."""
+    from woodcam.inference.evidence import EvidenceFit, bake_evidence
+    from woodcam.tolerances import EVIDENCE_KNOT_UNCERTAINTY_YEARS
+
+    strand = KnotStrand((20.0, -10.0, 20.0), (20.0, 50.0, 20.0), 4.0, 4.0)  # along Y
+    field = StemWithKnots(plane_stem, [strand])
+    ev = EvidenceFit(field, "stem", {}, False, False, ["stem"], "")
+    grid = bake_evidence(ev, SIZE, [0, 1, 2, 3, 4, 5], [strand])
+    # both 10 mm from the nearest face; the second 10 mm (2.5 radii) from the strand's axis
+    at_knot, off_knot = np.array([[20.0, 10.0, 20.0]]), np.array([[10.0, 20.0, 20.0]])
+    unc = grid.layers["uncertainty"]
+    knot = grid.layers["knot"]
+    idx = lambda p: tuple(np.round((p[0] - grid.origin_mm) / grid.spacing_mm).astype(int))  # noqa: E731
+    assert knot[idx(at_knot)] == 1.0 and knot[idx(off_knot)] == 0.0
+    np.testing.assert_allclose(unc[idx(at_knot)] - unc[idx(off_knot)], EVIDENCE_KNOT_UNCERTAINTY_YEARS)

@@ -218,26 +218,30 @@ class StemWithKnots:
         strands) and ``outline`` (1 in a dead knot's bark ring, the :data:`DEAD_KNOT_OUTLINE_MM`
         shell inside its surface), each ``(n,)``, as
         :meth:`woodcam.fields.KnottedLogField.knot_features`."""
-        p = check_points(points_mm)
-        knot, dead, outline = np.zeros(len(p)), np.zeros(len(p)), np.zeros(len(p))
-        for strand, table in zip(self.strands, self._tables):
-            d, R, _ = self._distance(p, table)
-            k = np.clip((R - d) / KNOT_EDGE_MM + 0.5, 0.0, 1.0)
-            knot = np.maximum(knot, k)
-            if strand.dead:
-                dead = np.maximum(dead, k)
-                outline = np.maximum(outline, ((d < R) & (d > R - DEAD_KNOT_OUTLINE_MM)).astype(float))
-        return {"knot": knot, "dead": dead, "outline": outline}
+        layers = self.knot_layers(points_mm)
+        del layers["halo"]
+        return layers
 
     def knot_halo(self, points_mm) -> np.ndarray:
         """``(n,)`` in 0..1: 1 inside a knot, falling linearly to 0 one knot radius beyond its
         surface (where a fitted knot's rings and the stem's bend round it are guessed)."""
+        return self.knot_layers(points_mm)["halo"]
+
+    def knot_layers(self, points_mm) -> dict:
+        """:meth:`knot_features` and ``halo`` (:meth:`knot_halo`), each ``(n,)``, from one pass
+        over the strands (a bake needs all four at every node; each is cheap once the distance
+        to the strand is known, which is most of the cost)."""
         p = check_points(points_mm)
-        halo = np.zeros(len(p))
-        for table in self._tables:
+        knot, dead, outline, halo = (np.zeros(len(p)) for _ in range(4))
+        for strand, table in zip(self.strands, self._tables):
             d, R, _ = self._distance(p, table)
+            k = np.clip((R - d) / KNOT_EDGE_MM + 0.5, 0.0, 1.0)
+            knot = np.maximum(knot, k)
             halo = np.maximum(halo, np.clip(2.0 - d / R, 0.0, 1.0))
-        return halo
+            if strand.dead:
+                dead = np.maximum(dead, k)
+                outline = np.maximum(outline, ((d < R) & (d > R - DEAD_KNOT_OUTLINE_MM)).astype(float))
+        return {"knot": knot, "dead": dead, "outline": outline, "halo": halo}
 
     def grain_direction(self, points_mm) -> np.ndarray:
         p = check_points(points_mm)

@@ -387,13 +387,13 @@ def bake_evidence(ev: EvidenceFit, size_mm, faces, strands=()):
         cs = ev.uncertainty_years(coarse).reshape([len(a) for a in cax])
         spread = ndimage.map_coordinates(cs, ((nodes - lo) / step).T, order=1, mode="nearest")
     unc = spread + EVIDENCE_UNSEEN_YEARS_PER_MM * distance_to_faces_mm(nodes, size_mm, faces)
+    feats = ev.field.knot_layers(nodes) if strands else {}  # halo and knot weights: one pass
     if strands:  # a fitted knot's rings are a model's guess: no face pins their years
-        unc = unc + EVIDENCE_KNOT_UNCERTAINTY_YEARS * ev.field.knot_halo(nodes)
+        unc = unc + EVIDENCE_KNOT_UNCERTAINTY_YEARS * feats["halo"]
     layers = {"uncertainty": unc.reshape(shape)}
     if strands:  # knots fitted into the field (part 3): their darkening weight as a layer
         from ..fields.knot_strands import strands_to_meta
 
-        feats = ev.field.knot_features(nodes)
         layers["knot"] = np.asarray(feats["knot"]).reshape(shape)
         if any(s.dead for s in strands):  # dead knots: their flag and bark ring for the colour map
             layers["dead"] = np.asarray(feats["dead"]).reshape(shape)
