@@ -59,11 +59,11 @@ def test_a_wrong_ring_scale_is_replaced_by_a_consistent_one(truth_and_obs, monke
 
     field, obs = truth_and_obs
     shape = lambda p: field(p) * field.w  # noqa: E731  (levels in mm, as a basin's shape fit)
-    right, k, _ = _initial_numbering(obs, shape)
+    right, k, _, _ = _initial_numbering(obs, shape)
     assert step_consistency(right) > 0.9
     honest = radial.number_rings
     monkeypatch.setattr(radial, "number_rings", lambda *a: (2 * honest(*a)[0], honest(*a)[1]))
-    num, k2, _ = _initial_numbering(obs, shape)
+    num, k2, _, _ = _initial_numbering(obs, shape)
     assert abs(k2 - k) < 0.05 * k
     assert step_consistency(num) > 0.9
     # and with no other peak to try, the planted scale would have stood

@@ -412,9 +412,10 @@ def step_consistency(obs: RingObservations, n_points: int = 4000, seed: int = 0)
 _STEP_NEIGHBOURS = 64
 
 
-def _initial_numbering(obs: RingObservations, shape_field) -> tuple[RingObservations, float, float]:
-    """Number an unlabelled axis fit's rings: ``(numbered observations, k, a)`` with years
-    ``round(k * level + a)`` per ring group (``level`` = the group's median of ``shape_field``).
+def _initial_numbering(obs: RingObservations, shape_field) -> tuple[RingObservations, float, float, float]:
+    """Number an unlabelled axis fit's rings: ``(numbered observations, k, a, consistency)``
+    with years ``round(k * level + a)`` per ring group (``level`` = the group's median of
+    ``shape_field``) and the numbering's :func:`step_consistency`.
 
     :func:`number_rings` picks the ring scale ``k`` by how well the levels align with integers,
     which is ambiguous where the faces' rings are irregular (H11: a count of 23 rings across a
@@ -432,10 +433,10 @@ def _initial_numbering(obs: RingObservations, shape_field) -> tuple[RingObservat
     for j, (k, a) in enumerate(cands):
         years = np.round(k * lev + a)
         num = RingObservations(obs.points_mm, years[obs.group], obs.group, obs.face)
-        c = step_consistency(num) - (NUMBERING_STEP_MARGIN if j else 0.0)
-        if best is None or c > best[0]:
-            best = (c, num, k, a)
-    return best[1], best[2], best[3]
+        c = step_consistency(num)
+        if best is None or c - (NUMBERING_STEP_MARGIN if j else 0.0) > best[0]:
+            best = (c - (NUMBERING_STEP_MARGIN if j else 0.0), num, k, a, c)
+    return best[1], best[2], best[3], best[4]
 
 
 def _alignment_peaks(levels: np.ndarray, weights: np.ndarray, spacing_mm: float,
@@ -464,10 +465,18 @@ def _by_numbering(obs: RingObservations, found: list) -> list:
     its numbering; the faces' neighbouring rings do (issue 12: H11's bistable folds)."""
     if obs.labelled or len(found) < 2:
         return found
-    cons = [step_consistency(_initial_numbering(obs, f[0])[0]) for f in found]
+    cons = [_initial_numbering(obs, f[0])[3] for f in found]
     best = max(cons)
     good = [f for f, c in zip(found, cons) if c >= best - NUMBERING_STEP_MARGIN]
     return good + [f for f in found if not any(f is g for g in good)]
+
+
+#: Ring spacings (mm) of recent observation sets, keyed by their content (points, ring groups,
+#: faces; not the years, which numbering changes): the numbering compares several pith basins
+#: on the same rings and the joint stem + knot-bend fit refits the stem on them several times
+#: per fold; the spacing was a quarter of each warm-started stem refit's time.
+_SPACING_CACHE: dict[str, float] = {}
+_SPACING_CACHE_SIZE = 16
 
 
 def ring_spacing_mm(obs: RingObservations) -> float:
@@ -475,7 +484,23 @@ def ring_spacing_mm(obs: RingObservations) -> float:
 
     This is the ring width seen on the faces (>= the true radial width where a face cuts rings
     obliquely, twice it across a missing ring), used only to bracket the ring-width search.
+    Remembered by content (:data:`_SPACING_CACHE`).
     """
+    import hashlib
+
+    h = hashlib.blake2b(digest_size=16)
+    for a in (obs.points_mm, obs.group, obs.face):
+        h.update(np.ascontiguousarray(a).tobytes())
+    key = h.hexdigest()
+    if key not in _SPACING_CACHE:
+        if len(_SPACING_CACHE) >= _SPACING_CACHE_SIZE:
+            _SPACING_CACHE.pop(next(iter(_SPACING_CACHE)))  # the oldest
+        _SPACING_CACHE[key] = _ring_spacing(obs)
+    return _SPACING_CACHE[key]
+
+
+def _ring_spacing(obs: RingObservations) -> float:
+    """:func:`ring_spacing_mm`, computed."""
     from scipy.spatial import cKDTree
 
     dists = []
@@ -646,7 +671,7 @@ def _finish_radial(obs, size_mm, found, K, M, ridge, max_relabel_rounds, seed, h
     else:
         shape_field = found[0]
         # Levels of every group from the fitted shape (groups not in the fitting subset too).
-        obs, k, a = _initial_numbering(obs, shape_field)
+        obs, k, a, _ = _initial_numbering(obs, shape_field)
         start = RadialField(shape_field.pith_mm, shape_field.axis, shape_field.z_scale_mm, K, M,
                             shape_field.coef * k, a)
         field = _refit_labelled(obs, size_mm, start, ridge, seed=seed)

@@ -53,7 +53,7 @@ from ..tolerances import (RING_HISTORY_MIN_STEP, RING_HISTORY_PRIOR_POINTS, RING
                           STEM_AXIAL_SD, STEM_CURVE_PRIOR_MM, STEM_HARMONIC_SD, STEM_PRIOR_YEARS,
                           STEM_RADIAL_SD, STEM_TILT_PRIOR_DEG)
 from .observations import RingObservations
-from .radial import _circle_pith, _frame, _group_medians, _lstsq, _warp
+from .radial import _circle_pith, _frame, _group_medians, _lstsq, _warp, ring_spacing_mm
 
 
 @dataclass
@@ -261,30 +261,6 @@ def _starts(prob: _StemProblem, obs: RingObservations, sel: np.ndarray, size, n_
     return kept
 
 
-#: Ring spacings (mm) of recent observation sets, keyed by their content (points, ring groups,
-#: faces): the joint stem + knot-bend fit refits the stem on the same rings several times per
-#: fold, and the spacing was a quarter of each warm-started refit's time.
-_SPACING_CACHE: dict[str, float] = {}
-_SPACING_CACHE_SIZE = 16
-
-
-def _ring_spacing_mm(obs: RingObservations) -> float:
-    """:func:`.radial.ring_spacing_mm` of ``obs``, remembered by content."""
-    import hashlib
-
-    from .radial import ring_spacing_mm
-
-    h = hashlib.blake2b(digest_size=16)
-    for a in (obs.points_mm, obs.group, obs.face):
-        h.update(np.ascontiguousarray(a).tobytes())
-    key = h.hexdigest()
-    if key not in _SPACING_CACHE:
-        if len(_SPACING_CACHE) >= _SPACING_CACHE_SIZE:
-            _SPACING_CACHE.pop(next(iter(_SPACING_CACHE)))  # the oldest
-        _SPACING_CACHE[key] = ring_spacing_mm(obs)
-    return _SPACING_CACHE[key]
-
-
 def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | None = None,
              K: int = 4, M: int = 1, P: int = 2, tilt_prior_deg: float = STEM_TILT_PRIOR_DEG,
              curve_prior_mm: float = STEM_CURVE_PRIOR_MM, n_search: int = 500,
@@ -338,7 +314,7 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
     i_f = np.sort(rng.choice(n, n_fit, replace=False)) if n > n_fit else np.arange(n)
     tp = np.tan(np.deg2rad(min(tilt_prior_deg, 89.0)))
     # rings per mm: the ring spacing seen on the faces is >= the true width (oblique cuts)
-    density = 1.0 / _ring_spacing_mm(obs)
+    density = 1.0 / ring_spacing_mm(obs)
     rho0 = float(np.median(np.linalg.norm(obs.points_mm - centre, axis=1))) + L
 
     def problem(idx, d0, k, m):
