@@ -83,7 +83,7 @@ def make_block(seed: int, index: int, scenario: Scenario = "noisy", kind: Kind =
 def score_block(seed: int, index: int, methods: tuple[str, ...] | list[str] = ("rbf", "radial", "evidence"),
                 scenario: Scenario = "noisy", face_set: FaceSet = "full", kind: Kind = "realistic",
                 face_px: int = 256, pixel_mm: float = BENCH_PIXEL_MM, planes: tuple | None = None,
-                keep_lines: bool = False, knot_bend: bool = False) -> dict:
+                keep_lines: bool = False, knot_bend: bool = True) -> dict:
     """Fit benchmark block ``(seed, index)`` with every method and score it on cut planes.
 
     Returns
@@ -93,7 +93,7 @@ def score_block(seed: int, index: int, methods: tuple[str, ...] | list[str] = ("
     method ``{matched_1, matched_2, unmatched_1, unmatched_2, coverage_1, fit_s, fit_cpu_s}``
     (percent, wall and CPU seconds); the evidence method adds ``chosen`` and ``contradicted``. With ``keep_lines``,
     ``"planes"``: method -> list of PlaneScore for :func:`woodcam.inference.evaluate.plot_planes`.
-    ``knot_bend``: the evidence fit's knot-bend hypotheses (:func:`woodcam.inference.fit_block`).
+    ``knot_bend``: the evidence fit's knot-bend hypotheses (:func:`woodcam.inference.fit_block`; on by default).
     """
     import warnings
 

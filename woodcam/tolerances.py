@@ -290,6 +290,13 @@ NUMBERING_STEP_MARGIN = 0.1
 #: "accepted": their spread is the fit's per-point uncertainty.
 EVIDENCE_ACCEPT_MARGIN = 5.0
 
+#: A refinement hypothesis (the knots' ring bend on the stem) competes only while its base's
+#: mean held-out score is within this many percent points of the best plain hypothesis'
+#: (:func:`woodcam.inference.evidence.choose`). H11's fold without its bottom face: stem 19.8
+#: points below the best, its bend won and predicted the face below chance. Dev seed 9101, six
+#: noisy faces, knotted blocks: the stems under bends that help are 0-7.2 points below the best.
+EVIDENCE_REFINE_BASE_MARGIN = 10.0
+
 #: Uncertainty added per mm from the nearest observed face (years/mm): a prior, not a
 #: measurement; 0.02 makes the middle of a 50 mm block seen from one face half a ring unsure.
 EVIDENCE_UNSEEN_YEARS_PER_MM = 0.02

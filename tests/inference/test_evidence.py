@@ -56,6 +56,26 @@ def test_planted_wrong_hypothesis_is_rejected_by_held_out_faces(block, obs):
     assert acc_good > acc_wrong + 20
 
 
+def test_a_refinement_competes_only_while_the_evidence_keeps_its_base(block, obs):
+    """``Hypothesis.refines`` (the knots' bend refines the stem): a refinement whose base the
+    held-out faces reject (the planted tilted axis, > 30 points below the best) is set aside
+    even when it scores best itself; on a base the evidence keeps it competes as any other.
+    Checked by breaking it: without the set-aside the first choice is the refinement."""
+    good = fit_radial(obs, block.size_mm)
+    wrong = _planted(obs, good)
+    hyps = [Hypothesis("radial", good, radial_recipe(good)), Hypothesis("planted", wrong, radial_recipe(wrong))]
+    ev = holdout_evidence(hyps, obs)
+    ev["refined"] = {f: {"score": v["score"] + 1.0, "share_2mm": v["share_2mm"]} for f, v in ev["radial"].items()}
+    on_wrong = hyps + [Hypothesis("refined", good, radial_recipe(good), refines="planted")]
+    res = choose(on_wrong, ev)
+    assert res.chosen == "radial" and "refined set aside" in res.message, res.message
+    assert "refined" not in res.accepted
+    on_good = hyps + [Hypothesis("refined", good, radial_recipe(good), refines="radial")]
+    assert choose(on_good, ev).chosen == "refined"
+    missing = hyps + [Hypothesis("refined", good, radial_recipe(good), refines="stem")]  # no such base
+    assert choose(missing, ev).chosen == "radial"
+
+
 def test_fit_evidence_with_a_planted_extra_hypothesis(block, obs):
     good = fit_radial(obs, block.size_mm)
     wrong = _planted(obs, good)

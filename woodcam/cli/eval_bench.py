@@ -40,8 +40,9 @@ def register(subparsers) -> None:
                    help="eq. 7-9 sanity blocks per scenario and face set (default 2; 0 skips)")
     r.add_argument("--face-px", type=int, default=256, help="face image pixels along the largest side (default 256)")
     r.add_argument("--plots", action="store_true", help="also write cut-plane PNGs per block")
-    r.add_argument("--knot-bend", action="store_true",
-                   help="the evidence fit also tries the stem with its knots' ring bend (default off)")
+    r.add_argument("--no-knot-bend", dest="knot_bend", action="store_false",
+                   help="leave the stem with its knots' ring bend out of the evidence fit's hypotheses "
+                        "(default: it competes wherever a face shows a knot)")
     add_confidence_option(r, "; implies --plots")
     add_out_option(r, "table.md, records.json and cut-plane PNGs")
     r.set_defaults(func=run_realistic)

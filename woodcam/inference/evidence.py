@@ -52,6 +52,7 @@ from ..tolerances import (
     EVIDENCE_MIN_FACE_POINTS,
     EVIDENCE_MIN_FACE_SHARE_2MM,
     EVIDENCE_RBF_POINTS,
+    EVIDENCE_REFINE_BASE_MARGIN,
     EVIDENCE_RESIDUAL_SMOOTHING,
     EVIDENCE_SPREAD_SPACING_MM,
     EVIDENCE_UNSEEN_YEARS_PER_MM,
@@ -80,11 +81,15 @@ class Hypothesis:
 
     field : ``(n, 3) mm -> (n,) years``, fitted on every observed face
     refit : ``RingObservations -> field``, the same recipe on fewer faces
+    refines : name of the hypothesis this one adds a term to (the knots' ring bend refines
+        ``"stem"``), or None; a refinement is chosen only while the evidence keeps its base
+        (:func:`choose`)
     """
 
     name: str
     field: Callable
     refit: Callable
+    refines: str | None = None
 
 
 @dataclass
@@ -175,9 +180,37 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
     return out
 
 
+def _set_aside(hypotheses: list[Hypothesis], scores: dict) -> dict[str, str]:
+    """Refinements the evidence does not let compete: name -> why.
+
+    A refinement (``Hypothesis.refines``) adds a term to its base, and the term is flexible: the
+    knots' ring bend moves a stem's years by several rings over a knot's reach. Where the base
+    itself is rejected by the held-out faces, a refinement that wins does so by bending a wrong
+    stem onto the faces it was fitted to, not by the term it names (H11 with its bottom face held
+    out: the stem 37 %, the stem bent round the knot 63 %, the best plain hypothesis 57 %; the
+    bent stem then predicts the bottom face below chance). So a refinement competes only while
+    its base's mean held-out score is within :data:`EVIDENCE_REFINE_BASE_MARGIN` of the best
+    hypothesis that refines nothing.
+    """
+    plain = [h.name for h in hypotheses if h.refines is None]
+    if not plain:
+        return {}
+    best = max(scores[n]["mean"] for n in plain)
+    out = {}
+    for h in hypotheses:
+        if h.refines is None:
+            continue
+        base = scores.get(h.refines, {}).get("mean", float("nan"))
+        if not base >= best - EVIDENCE_REFINE_BASE_MARGIN:  # also when the base is missing (nan)
+            out[h.name] = (f"its base {h.refines} scores {base:.1f} %, more than "
+                           f"{EVIDENCE_REFINE_BASE_MARGIN:.0f} points below the best ({best:.1f} %)")
+    return out
+
+
 def choose(hypotheses: list[Hypothesis], evidence: dict) -> EvidenceFit:
     """Pick the hypothesis with the best mean held-out score (the first on ties or without
-    evidence); flag the result when the evidence contradicts it (see :class:`EvidenceFit`)."""
+    evidence), leaving out refinements whose base the evidence rejects (:func:`_set_aside`);
+    flag the result when the evidence contradicts it (see :class:`EvidenceFit`)."""
     names = [h.name for h in hypotheses]
     by_name = {h.name: h for h in hypotheses}
     scores = {}
@@ -193,13 +226,16 @@ def choose(hypotheses: list[Hypothesis], evidence: dict) -> EvidenceFit:
         msg = (f"{best}: only one face carries rings, so no face could be held out to check the "
                f"fit; trace or photograph a second face")
     else:
-        best = max(names, key=lambda n: scores[n]["mean"])  # max keeps the first on ties
-        accepted = [n for n in names if scores[n]["mean"] >= scores[best]["mean"] - EVIDENCE_ACCEPT_MARGIN]
+        aside = _set_aside(hypotheses, scores)
+        competing = [n for n in names if n not in aside]
+        best = max(competing, key=lambda n: scores[n]["mean"])  # max keeps the first on ties
+        accepted = [n for n in competing if scores[n]["mean"] >= scores[best]["mean"] - EVIDENCE_ACCEPT_MARGIN]
         bad = {face: v["share_2mm"] for face, v in evidence[best].items()
                if v["share_2mm"] < EVIDENCE_MIN_FACE_SHARE_2MM}
         contradicted = bool(bad)
         msg = (f"chose {best} (held-out score {scores[best]['mean']:.1f} %; "
                + ", ".join(f"{n} {scores[n]['mean']:.1f}" for n in names if n != best) + ")")
+        msg += "".join(f"; {n} set aside: {why}" for n, why in aside.items())
         if contradicted:
             msg += ("; CONTRADICTED by held-out faces " + ", ".join(
                 f"{face} ({v:.0f} % within 2 mm)" for face, v in bad.items())
@@ -280,7 +316,7 @@ CANDIDATES: tuple[Candidate, ...] = ("radial", "rbf", "residual", "stem")
 def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                  candidates: tuple[str, ...] = CANDIDATES, seed: int = 0, extra: list[Hypothesis] | None = None,
                  warn: bool = True, recipes: dict[str, Callable] | None = None,
-                 stem: Callable | None = None) -> EvidenceFit:
+                 stem: Callable | None = None, refines: dict[str, str] | None = None) -> EvidenceFit:
     """Fit the hypotheses and choose by leave-one-face-out evidence (module docstring).
 
     Parameters
@@ -293,6 +329,8 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     recipes : further hypotheses as recipes, name -> ``RingObservations -> field``, fitted on
         the numbered rings here (e.g. the stem with its knots' bend,
         :func:`woodcam.inference.knots.knot_bend_recipes`); a recipe that cannot fit is left out
+    refines : recipe name -> the hypothesis it refines (:attr:`Hypothesis.refines`; the knots'
+        bend refines ``"stem"``)
     stem : the stem hypothesis' recipe (default :func:`stem_recipe`): one that remembers its
         last fit lets ``recipes`` built on the same stem fit reuse it in every fold
     warn : emit a :class:`~woodcam.errors.WoodcamWarning` when the choice is contradicted
@@ -322,7 +360,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
             hyps.append(Hypothesis("radial + residual", rec(numbered), rec))
         for name, rec in (recipes or {}).items():
             try:
-                hyps.append(Hypothesis(name, rec(numbered), rec))
+                hyps.append(Hypothesis(name, rec(numbered), rec, (refines or {}).get(name)))
             except WoodcamError:  # too few rings for it: the others still compete
                 pass
         hyps += list(extra or [])

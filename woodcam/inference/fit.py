@@ -26,12 +26,13 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: 5: ring maps read as one-pixel lines, dead knots, uncertainty round knots; 6: the stem
 #: hypothesis and per-fold pith refits in the evidence fit; 7: knot strands end at the pith, one-exit
 #: strands run toward it and keep the stem's ring spacing; 8: unlabelled rings numbered by the pith
-#: basin whose numbering makes neighbouring rings one year apart).
-FIT_VERSION = 8
+#: basin whose numbering makes neighbouring rings one year apart; 9: the knots' ring bend on by
+#: default, competing while the evidence keeps its stem).
+FIT_VERSION = 9
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
-              baked: bool = True, knot_bend: bool = False) -> GrowthFieldLike:
+              baked: bool = True, knot_bend: bool = True) -> GrowthFieldLike:
     """Infer a block's growth field from the rings on its faces.
 
     Parameters
@@ -53,10 +54,11 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         saveable with ``.save(path)``) rather than the raw fitted callable.
     knot_bend : evidence only: the stem with its knots' ring bend (seed 003's join fitted with
         the stem, :func:`woodcam.inference.knots.fit_knotted_stem`) competes as two more
-        hypotheses. Off by default: on synthetic knotted blocks it helps with six faces and not
-        with three, and on the real cube H11 it lowered the held-out faces from 1.21x to 1.05x
-        chance (README).
-
+        hypotheses wherever the faces show knot exits. They refine the stem: they compete only
+        while the held-out faces keep the plain stem within
+        :data:`~woodcam.tolerances.EVIDENCE_REFINE_BASE_MARGIN` of the best hypothesis
+        (:func:`woodcam.inference.evidence.choose`), which keeps H11's held-out faces where
+        they were without the bend (README). ``False`` leaves them out.
     Returns
     -------
     field : callable ``(n, 3) mm -> (n,) years`` in the block frame.
@@ -75,7 +77,8 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
 
         # the stem with the rings bent round its knots competes as more hypotheses
         stem, recipes = knot_bend_recipes(block.size_mm, knot_exits(block, faces)) if knot_bend else (None, None)
-        ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem)
+        ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem,
+                          refines=dict.fromkeys(recipes or {}, "stem"))
         if isinstance(ev.field, StemWithKnots):  # the chosen field holds its knots already
             strands = ev.field.strands
         else:

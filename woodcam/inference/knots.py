@@ -216,22 +216,29 @@ def fit_knotted_stem(obs: RingObservations, size_mm: ArrayLike, exits: list[dict
     as an alive one: the branch was alive from the pith to its death, which the exits do not
     show, and the bend comes from that inner part (its inversion past death is left out).
     """
+    return _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem)[0]
+
+
+def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem):
+    """:func:`fit_knotted_stem` and whether every round placed pinned strands only (then the
+    fit with ``guessed=True`` would make the very same steps)."""
     from .stem import fit_stem
 
     stem = fit_stem(obs, size_mm, seed=seed) if stem is None else stem
-    plain, field = stem, stem
+    plain, field, only_pinned = stem, stem, True
     for r in range(rounds + 1):
         if np.mean(stem(obs.points_mm) <= stem.pith_years()) > KNOT_BEND_MAX_BEFORE_PITH:
-            return plain  # times are not "from the pith" in this stem: no bend to speak of
+            return plain, False  # times are not "from the pith" in this stem: no bend to speak of
         strands = strands_from_exits(exits, stem, size_mm)
+        only_pinned &= all(s.pinned for s in strands)
         if not any(s.pinned or guessed for s in strands):
-            return plain
+            return plain, False
         field = StemWithKnots(stem, strands, bend=KnotParams(), bend_guessed=guessed)
         if r == rounds:
             break
         off = field(obs.points_mm) - stem(obs.points_mm)
         stem = fit_stem(obs, size_mm, seed=seed, offset_years=off, init=stem)
-    return field
+    return field, only_pinned
 
 
 def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0) -> tuple[Callable, dict[str, Callable]]:
@@ -253,12 +260,24 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0) -> t
             last.update(obs=obs, stem=fit_stem(obs, size_mm, seed=seed))
         return last["stem"]
 
+    bent: dict = {}
+
+    def pinned(obs):
+        if bent.get("obs") is not obs:
+            field, same = _fit_knotted_stem(obs, size_mm, exits, KNOT_BEND_ROUNDS, seed, False, plain(obs))
+            bent.update(obs=obs, field=field, same=same)
+        return bent["field"]
+
+    def guessed(obs):
+        if bent.get("obs") is obs and bent["same"]:  # no strand was a guess: the same fit
+            return bent["field"]
+        return fit_knotted_stem(obs, size_mm, exits, seed=seed, guessed=True, stem=plain(obs))
+
     out = {}
     if len({e["face"] for e in exits}) >= 2:  # a strand is pinned by exits on two faces
-        out["stem + knot bend"] = lambda obs: fit_knotted_stem(obs, size_mm, exits, seed=seed, stem=plain(obs))
+        out["stem + knot bend"] = pinned
     if exits:
-        out["stem + guessed knot bend"] = lambda obs: fit_knotted_stem(obs, size_mm, exits, seed=seed,
-                                                                      guessed=True, stem=plain(obs))
+        out["stem + guessed knot bend"] = guessed
     return plain, out
 
 
