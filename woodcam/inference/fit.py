@@ -53,12 +53,13 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
     baked : return the field baked to a 1 mm grid (:class:`woodcam.fields.GridField`, fast,
         saveable with ``.save(path)``) rather than the raw fitted callable.
     knot_bend : evidence only: the stem with its knots' ring bend (seed 003's join fitted with
-        the stem, :func:`woodcam.inference.knots.fit_knotted_stem`) competes as two more
-        hypotheses wherever the faces show knot exits. They refine the stem: they compete only
-        while the held-out faces keep the plain stem within
+        the stem, :func:`woodcam.inference.knots.fit_knotted_stem`) competes as one more
+        hypothesis wherever exits on two faces pin a knot's strand (a strand guessed from one
+        exit is not offered: :func:`woodcam.inference.knots.knot_bend_recipes`). It refines
+        the stem: it competes only while the held-out faces keep the plain stem within
         :data:`~woodcam.tolerances.EVIDENCE_REFINE_BASE_MARGIN` of the best hypothesis
         (:func:`woodcam.inference.evidence.choose`), which keeps H11's held-out faces where
-        they were without the bend (README). ``False`` leaves them out.
+        they were without the bend (README). ``False`` leaves it out.
     Returns
     -------
     field : callable ``(n, 3) mm -> (n,) years`` in the block frame.

@@ -241,13 +241,19 @@ def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem):
     return field, only_pinned
 
 
-def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0) -> tuple[Callable, dict[str, Callable]]:
+def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0,
+                      guessed: bool = False) -> tuple[Callable, dict[str, Callable]]:
     """Evidence hypotheses of the knots' bend: ``(stem, recipes)``.
 
     ``recipes``, name -> ``RingObservations -> field``, is :func:`fit_knotted_stem` from scratch
     on the given rings (the exits come from the masks, not from the rings a fold holds out):
-    ``"stem + knot bend"`` (pinned strands; exits on two faces needed) and ``"stem + guessed
-    knot bend"`` (every strand). ``stem`` is the plain stem's recipe (:func:`~.stem.fit_stem`)
+    ``"stem + knot bend"`` (pinned strands; exits on two faces needed) and, with ``guessed``,
+    ``"stem + guessed knot bend"`` (every strand). The guessed one is left out by default
+    (:func:`~.fit.fit_block` does not offer it): a strand guessed from one exit is a few mm to
+    cm off its knot, and with three faces, where most knots show one exit, its bend lost more
+    than it gained (seed 61297, three noisy faces, knotted: 52.4 -> 50.0 % within 1 mm; dev seed
+    9101 block 0: 60.9 -> 51.3); with six faces it was never needed (dev seeds 9101 and 21: the
+    same choices and scores without it). ``stem`` is the plain stem's recipe (:func:`~.stem.fit_stem`)
     remembering its last fit: passed as the evidence fit's stem hypothesis
     (:func:`~.evidence.fit_evidence`'s ``stem``), each fold's stem is fitted once for all three.
     """
@@ -268,7 +274,7 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0) -> t
             bent.update(obs=obs, field=field, same=same)
         return bent["field"]
 
-    def guessed(obs):
+    def bent_guessed(obs):
         if bent.get("obs") is obs and bent["same"]:  # no strand was a guess: the same fit
             return bent["field"]
         return fit_knotted_stem(obs, size_mm, exits, seed=seed, guessed=True, stem=plain(obs))
@@ -276,8 +282,8 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0) -> t
     out = {}
     if len({e["face"] for e in exits}) >= 2:  # a strand is pinned by exits on two faces
         out["stem + knot bend"] = pinned
-    if exits:
-        out["stem + guessed knot bend"] = guessed
+    if exits and guessed:
+        out["stem + guessed knot bend"] = bent_guessed
     return plain, out
 
 
