@@ -14,7 +14,8 @@ faces it was *not* fitted to can. So:
    faces and predicts ``f``'s ring points. Every recipe sees the fold's faces only: a radial
    hypothesis refits its pith axis by descending from its own axis (the hypothesis names the
    basin, the fold's faces place the axis in it) and then its shape and growth history; the
-   stem, RBF and the residual are refitted outright. (The first version kept the radial axis
+   stem likewise descends from its all-faces centreline (:func:`stem_recipe`); RBF and the
+   residual are refitted outright. (The first version kept the radial axis
    fitted on all faces, so the held-out face shaped the axis it was scored on and radial
    hypotheses looked better than they were.) A held-out point's error is its distance (mm) to the predicted ring line of
    its year, ``|g(p) - year| / |grad g(p)|`` (first order; the metric of seed 000's Table 1
@@ -269,10 +270,26 @@ _FOLD_POINTS = 1000
 
 
 def stem_recipe(size_mm: ArrayLike, seed: int = 0) -> Callable:
-    """The stem fit (:func:`~.stem.fit_stem`) from scratch: it sees only the fold's faces."""
+    """The stem fit (:func:`~.stem.fit_stem`) as a recipe that remembers its last fit (the
+    knots' bend refines the same fold's stem) and warm-starts every later fit from its first
+    one. The first observations it is given are all the faces' (:func:`fit_evidence` fits every
+    hypothesis on them before the folds), so the stem hypothesis names its pith's basin as a
+    radial hypothesis names its axis', and each fold's faces place the centreline in that basin
+    by a local descent (``fit_stem(init=)``: no start search, about 4x cheaper). Measured
+    against the fold fits from scratch: dev seed 9101 blocks 0 and 8 (six noisy faces) the same
+    held-out scores to 0.01 % and 2 CPU-s less per block; H11's six folds the same choices,
+    every held-out score within 0.3 points, 10-30 % less CPU."""
     from .stem import fit_stem
 
-    return lambda obs: fit_stem(obs, size_mm, seed=seed)
+    last: dict = {}
+
+    def refit(obs: RingObservations):
+        if last.get("obs") is not obs:
+            f = fit_stem(obs, size_mm, seed=seed, init=last.get("first"))
+            last.setdefault("first", f)
+            last.update(obs=obs, stem=f)
+        return last["stem"]
+    return refit
 
 
 def _rbf_recipe(max_points: int) -> Callable:

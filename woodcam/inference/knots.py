@@ -255,16 +255,11 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0,
     9101 block 0: 60.9 -> 51.3); with six faces it was never needed (dev seeds 9101 and 21: the
     same choices and scores without it). ``stem`` is the plain stem's recipe (:func:`~.stem.fit_stem`)
     remembering its last fit: passed as the evidence fit's stem hypothesis
-    (:func:`~.evidence.fit_evidence`'s ``stem``), each fold's stem is fitted once for all three.
+    (:func:`~.evidence.fit_evidence`'s ``stem``), each fold's stem is fitted once for all of them.
     """
-    from .stem import fit_stem
+    from .evidence import stem_recipe
 
-    last: dict = {}
-
-    def plain(obs):
-        if last.get("obs") is not obs:
-            last.update(obs=obs, stem=fit_stem(obs, size_mm, seed=seed))
-        return last["stem"]
+    plain = stem_recipe(size_mm, seed)  # remembers its last fit: one stem per fold for all
 
     bent: dict = {}
 
