@@ -42,7 +42,7 @@ def register(subparsers) -> None:
     r.add_argument("--plots", action="store_true", help="also write cut-plane PNGs per block")
     r.add_argument("--no-knot-bend", dest="knot_bend", action="store_false",
                    help="leave the stem with its knots' ring bend out of the evidence fit's hypotheses "
-                        "(default: it competes wherever a face shows a knot)")
+                        "(default: it competes wherever knot exits on two faces pin a knot)")
     add_confidence_option(r, "; implies --plots")
     add_out_option(r, "table.md, records.json and cut-plane PNGs")
     r.set_defaults(func=run_realistic)
