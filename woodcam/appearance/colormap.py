@@ -216,6 +216,15 @@ class ColorMapAppearance:
         darkened by ``knots.alive_darkening`` (the photos' knots carry their own darkness and
         rings); dead knots are still darkened and outlined by ``knots``. ``None`` or NaN: the
         darkening of ``knots``.
+    axis_exposure : (3, 2, 3) float or None
+        Colour gain of the fitted ramps at the low and high face of each axis (block frame,
+        per RGB channel), linearly interpolated along the axis between ``exposure_span_mm``
+        and held beyond: the photos of opposite faces differ in exposure or wood colour (H11:
+        clear-wood luminance 0.76 on top, 0.66 on the bottom), which one ramp per axis cannot
+        show. Applies to axes with a fitted ramp; ``None``: gain 1.
+    exposure_span_mm : (3, 2) float or None
+        Coordinates (mm, block frame) of the low and high face of each axis, where
+        ``axis_exposure``'s two gains hold; required with it.
     knots : KnotShading
         How knot wood is coloured on fields that report knot features
         (:mod:`woodcam.appearance.knots`: one shading for every renderer).
@@ -229,6 +238,8 @@ class ColorMapAppearance:
     species: Species | str = "oak"
     axis_luts: np.ndarray | None = None
     knot_lut: np.ndarray | None = None
+    axis_exposure: np.ndarray | None = None
+    exposure_span_mm: np.ndarray | None = None
     knots: KnotShading = KnotShading()
     seed: int = 0
     knot_darkening_alive: InitVar[float | None] = None
@@ -253,6 +264,20 @@ class ColorMapAppearance:
             if lut.shape != (LUT_BINS, 3):
                 raise WoodcamError(f"knot_lut must have shape ({LUT_BINS}, 3); got {lut.shape}")
             object.__setattr__(self, "knot_lut", lut)
+        if (self.axis_exposure is None) != (self.exposure_span_mm is None):
+            raise WoodcamError("axis_exposure and exposure_span_mm go together; got one without the "
+                               "other: give both (ColorMapAppearance.fit_to_block fits them) or neither")
+        if self.axis_exposure is not None:
+            gains = np.asarray(self.axis_exposure, dtype=np.float32)
+            span = np.asarray(self.exposure_span_mm, dtype=np.float32)
+            if gains.shape != (3, 2, 3) or span.shape != (3, 2):
+                raise WoodcamError(f"axis_exposure must have shape (3, 2, 3) and exposure_span_mm (3, 2); "
+                                   f"got {gains.shape} and {span.shape}")
+            if not (np.all(np.isfinite(gains)) and np.all(gains >= 0) and np.all(np.isfinite(span))):
+                raise WoodcamError("axis_exposure must hold finite gains >= 0 and exposure_span_mm finite "
+                                   f"coordinates; got {gains.tolist()} and {span.tolist()}")
+            object.__setattr__(self, "axis_exposure", gains)
+            object.__setattr__(self, "exposure_span_mm", span)
 
     # -- the ramp -------------------------------------------------------------------------------
 
@@ -292,6 +317,10 @@ class ColorMapAppearance:
         lut_ok = np.array([np.all(np.isfinite(luts[k])) for k in range(3)])
         knot_lut = self.knot_lut if self.knot_lut is not None else np.full((LUT_BINS, 3), np.nan, np.float32)
         knot_lut_ok = bool(np.all(np.isfinite(knot_lut)))
+        if self.axis_exposure is not None and self.exposure_span_mm is not None:
+            gains, span = self.axis_exposure, self.exposure_span_mm
+        else:
+            gains, span = np.ones((3, 2, 3), np.float32), np.zeros((3, 2), np.float32)
         blend = normals is not None
         out = np.empty((1 if blend else 3, n, 3), np.float32)
         params = np.array([s.latewood_start, s.pore_contrast, float(s.ring_porous), s.pore_across_mm,
@@ -303,7 +332,7 @@ class ColorMapAppearance:
                       p.astype(np.float32), normals if blend else np.zeros((1, 3), np.float32),
                       knot, dead, outline, params, colours, np.nan_to_num(luts).astype(np.float32),
                       lut_ok, np.nan_to_num(knot_lut).astype(np.float32), knot_lut_ok,
-                      np.int64(self.seed), TABLE, blend, out)
+                      gains, span, np.int64(self.seed), TABLE, blend, out)
         return out[0] if blend else out
 
     # -- fitting to photos ------------------------------------------------------------------------
@@ -345,6 +374,8 @@ class ColorMapAppearance:
         centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
         true_field = field is getattr(block, "true_field", None)
         knot_phase, knot_rgb, knot_ring, knot_registered = [], [], [], False
+        exposure = np.ones((3, 2, 3))
+        span = np.array([[0.0, float(v)] for v in block.size_mm])
         for k in range(3):
             faces = [f for f in photo_faces if FACE_AXIS[f.name] == k]
             if not faces:
@@ -357,7 +388,9 @@ class ColorMapAppearance:
                     f"{[f.name for f in faces if f.ring_map is None]} of block {block.name!r} have none; "
                     "use anchor='field'"
                 )
-            luts[k], kp, kr, kb = _field_lut(faces, field, block.size_mm, centres, register=use_maps)
+            luts[k], kp, kr, kb, gains = _field_lut(faces, field, block.size_mm, centres, register=use_maps)
+            for coord, gain in gains:  # the face at 0 (low) or at the block's size (high)
+                exposure[k, int(coord > span[k, 1] / 2)] = gain
             knot_phase.append(kp)
             knot_rgb.append(kr)
             knot_ring.append(kb)
@@ -369,7 +402,8 @@ class ColorMapAppearance:
                                  np.concatenate(knot_rgb or [np.zeros((0, 3))]),
                                  np.concatenate(knot_ring or [np.zeros((0, 3))]), luts, species,
                                  centres, matched=knot_registered)
-        return cls(species=species, axis_luts=luts, knot_lut=knot_lut, **kwargs)
+        fitted_exposure = {"axis_exposure": exposure, "exposure_span_mm": span} if np.any(exposure != 1.0) else {}
+        return cls(species=species, axis_luts=luts, knot_lut=knot_lut, **{**fitted_exposure, **kwargs})
 
     def with_params(self, **changes) -> "ColorMapAppearance":
         """Copy with some parameters changed."""
@@ -380,9 +414,12 @@ def _field_lut(faces, field, size_mm, centres, register: bool = False):
     """Mean photo colour per ring-phase bin of ``field`` over ``faces``, from clear wood
     (:func:`_clear_wood`), and the knot wood seen on them.
 
-    Returns ``(lut (LUT_BINS, 3), knot_phase (m,), knot_rgb (m, 3), knot_ring (m, 3))``: the
-    stem ramp, and the ring phase, photo colour and ring-scale part of the photo colour of the
-    ``m`` knot pixels (:func:`_knot_core`), for :func:`_knot_lut`. With ``register``, the field's
+    Returns ``(lut (LUT_BINS, 3), knot_phase (m,), knot_rgb (m, 3), knot_ring (m, 3),
+    exposure)``: the stem ramp; the ring phase, photo colour and ring-scale part of the photo
+    colour of the ``m`` knot pixels (:func:`_knot_core`), for :func:`_knot_lut`; and with
+    ``register``, each face's ``(coordinate along the axis in mm, gain (3,))``, its clear
+    wood's mean photo colour over the mean the ramp gives the same pixels (empty without
+    ``register``: a true field's photos are the ramp's own, gain 1). With ``register``, the field's
     ring phase is first moved onto each face's ring map (:func:`_registered_years`), and the
     ring-scale part is the photo band-passed at :data:`RING_BAND_PX_PER_SIDE` (zeros without
     ``register``), and the axis takes the ring shape of its face with the strongest rings
@@ -416,8 +453,16 @@ def _field_lut(faces, field, size_mm, centres, register: bool = False):
     counts = sum(f[1] for f in per_face)
     if register and len(per_face) > 1 and counts.all():
         sums = _pooled_ring_shape(per_face) * counts[:, None]
-    return (_binned_lut(sums, counts, centres), np.concatenate(knot_phase), np.concatenate(knot_rgb),
-            np.concatenate(knot_ring))
+    lut = _binned_lut(sums, counts, centres)
+    exposure = []
+    if register and np.isfinite(lut).all():
+        for face, (s, c) in zip(faces, per_face):
+            if c.any():
+                model = (c @ lut) / c.sum()
+                coord = float(face_pixel_points(face.name, (1, 1), size_mm)[0, 0, FACE_AXIS[face.name]])
+                exposure.append((coord, (s.sum(axis=0) / c.sum()) / np.maximum(model, 1e-6)))
+    return (lut, np.concatenate(knot_phase), np.concatenate(knot_rgb), np.concatenate(knot_ring),
+            exposure)
 
 
 def _pooled_ring_shape(per_face) -> np.ndarray:
@@ -604,7 +649,7 @@ def _field_sample(field, points_mm):
 
 @numba.njit(nogil=True, fastmath=True, cache=True)
 def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, luts, lut_ok,
-                  knot_lut, knot_lut_ok, seed, table, blend, out):  # pragma: no cover - compiled
+                  knot_lut, knot_lut_ok, gains, span, seed, table, blend, out):  # pragma: no cover - compiled
     """Per point: ramp, pores and streaks, end grain per axis, knots, and eq. 10 (``blend``, by
     :func:`~woodcam.appearance.orientation.eq10_weights`, the one implementation).
 
@@ -653,6 +698,9 @@ def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, lu
         for k in range(3):
             g = abs(grain[i, k])  # 1 where a plane normal to axis k cuts the fibres across
             f = shade * (1.0 + eg_rough * g * rough) * kfac
+            # exposure of the fitted ramp between the axis's two faces (gain 1 with none fitted)
+            width = span[k, 1] - span[k, 0]
+            u = 0.0 if width == 0.0 else min(max((p[i, k] - span[k, 0]) / width, 0.0), 1.0)
             for c in range(3):
                 if lut_ok[k]:
                     v = luts[k, i0, c] * (1.0 - fl) + luts[k, i0 + 1, c] * fl
@@ -661,6 +709,8 @@ def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, lu
                 if knot_lut_ok:
                     kv = knot_lut[i0, c] * (1.0 - fl) + knot_lut[i0 + 1, c] * fl
                     v = v * (1.0 - knot[i]) + kv * knot[i]
+                if lut_ok[k]:
+                    v = v * (gains[k, 0, c] * (1.0 - u) + gains[k, 1, c] * u)
                 v = v * f
                 v = v * (1.0 - ol) + colours[2, c] * ol
                 col[c] = min(max(v, 0.0), 1.0)
