@@ -532,7 +532,7 @@ def _knot_lut(phase, rgb, ring, stem_luts, species, centres, matched: bool) -> n
     spec = np.fft.rfft(profile)
     spec[KNOT_PROFILE_HARMONICS + 1:] = 0.0  # the ring profile's shape, not its bin noise
     order = np.argsort(np.fft.irfft(spec, n=LUT_BINS), kind="stable")
-    ring = ring - ring.mean(axis=0)  # (a knot's rim is darker than the stem the blur mixes in)
+    ring = ring - ring.mean(axis=0)  # (near a knot's rim the wide blur mixes in the lighter stem)
     groups = np.array_split(np.argsort(ring @ luma, kind="stable"), LUT_BINS)
     lut = np.empty((LUT_BINS, 3))
     lut[order] = rgb.mean(axis=0) + np.stack([ring[g].mean(axis=0) for g in groups])
