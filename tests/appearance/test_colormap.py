@@ -426,6 +426,9 @@ def test_a_knot_is_baked_in_the_colours_and_rings_of_the_photos_knot():
     assert (knot & steady).sum() > 500
     np.testing.assert_allclose(baked[knot & steady], photo[knot & steady], atol=1.5 / 255)
     np.testing.assert_allclose(baked[~knot & steady], photo[~knot & steady], atol=1.5 / 255)
+    # a darkening asked for (the CLI's --knot-darkening) replaces the photos' knot colour
+    asked = ColorMapAppearance.fit_to_block(block, field, "spruce", anchor="field", knot_lut=None)
+    assert asked.knot_lut is None
 
 
 def test_a_fitted_knot_draws_the_photos_knot_contrast_where_its_rings_miss_the_photos():
