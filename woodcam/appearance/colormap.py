@@ -360,6 +360,12 @@ class ColorMapAppearance:
         photo faces lack ring maps, else ``"ring_map"`` (per axis), as the neural appearance
         chooses its source. Axes without photos keep the species ramp. Raises if no face has
         a photo.
+
+        With the ring-map anchor the axis's ring shape comes from its face with the strongest
+        rings (:func:`_pooled_ring_shape`: a face whose fitted rings miss its photo's bins
+        flat) and each face's exposure is fitted (``axis_exposure``). Where the field reports
+        knots, knot wood gets a ramp of its own (``knot_lut``, :func:`_knot_lut`) from the
+        photos' knot pixels; ``knot_lut=None`` keeps the ``knots`` darkening instead.
         """
         if anchor not in ("auto", "field", "ring_map"):
             raise WoodcamError(f"anchor must be one of auto, field, ring_map; got {anchor!r}")
@@ -414,16 +420,17 @@ def _field_lut(faces, field, size_mm, centres, register: bool = False):
     """Mean photo colour per ring-phase bin of ``field`` over ``faces``, from clear wood
     (:func:`_clear_wood`), and the knot wood seen on them.
 
+    With ``register`` (a fitted field), the field's ring phase is first moved onto each face's
+    ring map (:func:`_registered_years`), the axis takes the ring shape of its face with the
+    strongest rings (:func:`_pooled_ring_shape`), and each face gets an exposure gain.
+
     Returns ``(lut (LUT_BINS, 3), knot_phase (m,), knot_rgb (m, 3), knot_ring (m, 3),
-    exposure)``: the stem ramp; the ring phase, photo colour and ring-scale part of the photo
-    colour of the ``m`` knot pixels (:func:`_knot_core`), for :func:`_knot_lut`; and with
-    ``register``, each face's ``(coordinate along the axis in mm, gain (3,))``, its clear
-    wood's mean photo colour over the mean the ramp gives the same pixels (empty without
-    ``register``: a true field's photos are the ramp's own, gain 1). With ``register``, the field's
-    ring phase is first moved onto each face's ring map (:func:`_registered_years`), and the
-    ring-scale part is the photo band-passed at :data:`RING_BAND_PX_PER_SIDE` (zeros without
-    ``register``), and the axis takes the ring shape of its face with the strongest rings
-    (:func:`_pooled_ring_shape`).
+    exposure)``: the stem ramp; for the ``m`` knot pixels (:func:`_knot_core`), their ring
+    phase, photo colour and ring-scale part of it (the photo band-passed at
+    :data:`RING_BAND_PX_PER_SIDE`; zeros without ``register``), for :func:`_knot_lut`; and
+    each face's ``(coordinate along the axis in mm, gain (3,))``: its clear wood's mean photo
+    colour over the mean the ramp gives the same pixels (empty without ``register``: a true
+    field's photos are the ramp's own).
     """
     from scipy import ndimage
 
