@@ -9,7 +9,7 @@ from woodcam.errors import WoodcamError
 from woodcam.frames import face_pixel_points
 from woodcam.inference import gather_observations
 from woodcam.inference.holdout import (
-    CONTROL, STRAIGHT, face_years, leave_one_face_out, ridge_pixels, ring_lines_px, score_face,
+    BEST_PHASE, CONTROL, STRAIGHT, STRAIGHT_OWN, face_years, leave_one_face_out, ridge_pixels, ring_lines_px, score_face,
     straight_rings,
 )
 
@@ -83,6 +83,14 @@ def test_leave_one_face_out_predicts_held_out_synthetic_faces(mapped, tmp_path):
     assert (tmp_path / "eq79_radial.png").stat().st_size > 10_000
     assert "mean, held out" in (tmp_path / "eq79_holdout.md").read_text()
     assert STRAIGHT in (tmp_path / "eq79_holdout.md").read_text()
+    # the like-for-like rows: the prediction with the straight control's oracle phase is at
+    # least as good as without it (phase 0 is one of the choices), and the straight rings at
+    # the prediction's own phase no better than at their best phase
+    for fit, best, own, st in zip(held, res[BEST_PHASE]["radial"], res[STRAIGHT_OWN]["radial"],
+                                  res[STRAIGHT]["radial"]):
+        assert best.shares["ridge_2"] >= fit.shares["ridge_2"]
+        assert own.shares["ridge_2"] <= st.shares["ridge_2"]
+    assert BEST_PHASE in (tmp_path / "eq79_holdout.md").read_text()
 
 
 def test_straight_rings_is_the_mean_plane():
