@@ -309,7 +309,7 @@ def _regional_hypotheses(hyps: list[Hypothesis], numbered: RingObservations, siz
 def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                  candidates: tuple[str, ...] = DEFAULT_CANDIDATES, seed: int = 0, extra: list[Hypothesis] | None = None,
                  warn: bool = True, recipes: dict[str, Callable] | None = None,
-                 stem: Callable | None = None) -> EvidenceFit:
+                 stem: Callable | None = None, regional_residual: bool = False) -> EvidenceFit:
     """Fit the hypotheses and choose by leave-one-face-out evidence (module docstring).
 
     Parameters
@@ -325,6 +325,9 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     stem : the stem hypothesis' recipe (default :func:`stem_recipe`): one that remembers its
         last fit lets ``recipes`` built on the same stem fit reuse it in every fold
     warn : emit a :class:`~woodcam.errors.WoodcamWarning` when the choice is contradicted
+    regional_residual : add a residual kept per region (:mod:`.residual`) to the *chosen*
+        field after the choice (the ``"regional"`` candidate instead lets the residual compete
+        as hypotheses)
 
     Returns
     -------
@@ -358,6 +361,12 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                 pass
         hyps += list(extra or [])
         result = choose(hyps, holdout_evidence(hyps, numbered, seed))
+        if regional_residual:
+            from .residual import FieldPlusResidual, fit_regional_residual
+
+            res = fit_regional_residual(numbered, result.field, size_mm)
+            if res.kept:
+                result.field = FieldPlusResidual(result.field, res)
     if warn and (result.contradicted or result.unverified):
         warnings.warn(result.message, WoodcamWarning, stacklevel=2)
     return result
