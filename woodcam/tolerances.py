@@ -274,28 +274,6 @@ EVIDENCE_RBF_POINTS = 1000
 #: residual is meant to carry distortions a few mm wide, not each trace's jitter.
 EVIDENCE_RESIDUAL_SMOOTHING = 1e-3
 
-#: Regional residual on top of a smooth fit (``woodcam.inference.residual``, issue 12 part 4).
-#: Nodes per block axis of its trilinear grid: 4 puts them ~15-20 mm apart on a 50-60 mm cube,
-#: the scale of a bulge or of CN03's figure waves; a finer grid has nodes no face reaches.
-RESIDUAL_NODES = 4
-#: Weight per ring point of the squared second differences of the node values (years^2), and
-#: of the node values themselves (pulls regions no ring reaches to 0). Chosen on a synthetic
-#: curved stem with a 0.3-year, 45 mm wave (held-out score 87.1 -> 91.1 %): 10x these kept
-#: +1.5 points of it, 100x +0.7; the per-region gate, not these, is what rejects noise.
-RESIDUAL_SMOOTHNESS = 0.0005
-RESIDUAL_RIDGE = 0.0001
-#: Huber scale (years) of the residual fit: a mislabelled ring (1 year off) is down-weighted.
-RESIDUAL_HUBER_YEARS = 0.25
-#: A region's residual is kept when it moves the held-out ring points of that region closer to
-#: their ring lines by at least this much on average (mm): on a clear synthetic stem traced
-#: with 0.1 mm jitter 0.05 mm still kept 4-7 of 64 regions per fold (the stem's own 0.1-0.2 mm
-#: misfit), 0.1 mm 0-3; on the 0.3-year wave 0.1 mm keeps the whole gain of 0.05 mm.
-RESIDUAL_MIN_GAIN_MM = 0.1
-#: ... and by at least this share of their mean error without it.
-RESIDUAL_MIN_GAIN_SHARE = 0.1
-#: Held-out points a region needs before its gain counts (and a face needs to be held out).
-RESIDUAL_MIN_POINTS = 20
-
 #: A chosen fit is flagged "contradicted" when some held-out face has fewer of its ring points
 #: within 2 mm of the predicted ring line than this (percent): the issue's bar for a block.
 EVIDENCE_MIN_FACE_SHARE_2MM = 80.0

@@ -272,44 +272,15 @@ def _residual_recipe(stem_recipe: Callable, max_points: int) -> Callable:
     return refit
 
 
-def _remember_last(recipe: Callable) -> Callable:
-    """``recipe`` that returns its last field again when called with the same observations
-    object (the evidence loop refits every hypothesis on one fold's observations in turn, so a
-    hypothesis built on another's field shares its fold fit)."""
-    last: dict = {}
-
-    def refit(obs: RingObservations):
-        if last.get("obs") is not obs:
-            last.update(obs=obs, field=recipe(obs))
-        return last["field"]
-    return refit
-
-
 Candidate = str
-#: Hypothesis families :func:`fit_evidence` can try ("regional": the stem and the best radial
-#: basin each plus a residual kept per region, :mod:`.residual`, issue 12 part 4).
-CANDIDATES: tuple[Candidate, ...] = ("radial", "rbf", "residual", "stem", "regional")
-#: The families tried by default.
-DEFAULT_CANDIDATES: tuple[Candidate, ...] = ("radial", "rbf", "residual", "stem")
-
-
-def _regional_hypotheses(hyps: list[Hypothesis], numbered: RingObservations, size_mm) -> list[Hypothesis]:
-    """"<base> + regional residual" on the best radial basin and on the stem (part 4): the base's
-    own recipe is reused, so the residual hypothesis refits only its residual in each fold."""
-    from .residual import regional_residual_recipe
-
-    out = []
-    for h in hyps:
-        if h.name in ("radial", "stem"):
-            rec = regional_residual_recipe(h.refit, size_mm)
-            out.append(Hypothesis(f"{h.name} + regional residual", rec(numbered), rec))
-    return out
+#: Hypothesis families :func:`fit_evidence` can try.
+CANDIDATES: tuple[Candidate, ...] = ("radial", "rbf", "residual", "stem")
 
 
 def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
-                 candidates: tuple[str, ...] = DEFAULT_CANDIDATES, seed: int = 0, extra: list[Hypothesis] | None = None,
+                 candidates: tuple[str, ...] = CANDIDATES, seed: int = 0, extra: list[Hypothesis] | None = None,
                  warn: bool = True, recipes: dict[str, Callable] | None = None,
-                 stem: Callable | None = None, regional_residual: bool = False) -> EvidenceFit:
+                 stem: Callable | None = None) -> EvidenceFit:
     """Fit the hypotheses and choose by leave-one-face-out evidence (module docstring).
 
     Parameters
@@ -317,7 +288,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     obs : ring observations (labelled or not) of a block, block frame mm
     size_mm : (3,) block size
     n_basins : pith-axis basins of the radial fit to try as hypotheses
-    candidates : hypothesis families, from :data:`CANDIDATES` (default :data:`DEFAULT_CANDIDATES`)
+    candidates : hypothesis families, from :data:`CANDIDATES`
     extra : further hypotheses to judge with the others (e.g. a planted one in a test)
     recipes : further hypotheses as recipes, name -> ``RingObservations -> field``, fitted on
         the numbered rings here (e.g. the stem with its knots' bend,
@@ -325,9 +296,6 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     stem : the stem hypothesis' recipe (default :func:`stem_recipe`): one that remembers its
         last fit lets ``recipes`` built on the same stem fit reuse it in every fold
     warn : emit a :class:`~woodcam.errors.WoodcamWarning` when the choice is contradicted
-    regional_residual : add a residual kept per region (:mod:`.residual`) to the *chosen*
-        field after the choice (the ``"regional"`` candidate instead lets the residual compete
-        as hypotheses)
 
     Returns
     -------
@@ -341,13 +309,11 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         hyps = [Hypothesis("radial" if i == 0 else f"radial basin {i + 1}", f, radial_recipe(f, seed, size_mm))
                 for i, f in enumerate(radials)]
         if "stem" in candidates:
-            rec = _remember_last(stem_recipe(size_mm, seed) if stem is None else stem)
+            rec = stem_recipe(size_mm, seed) if stem is None else stem
             try:
                 hyps.append(Hypothesis("stem", rec(numbered), rec))
             except WoodcamError:  # too few rings for the stem: the others still compete
                 pass
-        if "regional" in candidates:
-            hyps += _regional_hypotheses(hyps, numbered, size_mm)
         if "rbf" in candidates:
             rec = _rbf_recipe(EVIDENCE_RBF_POINTS)
             hyps.append(Hypothesis("rbf", rec(numbered), rec))
@@ -361,12 +327,6 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                 pass
         hyps += list(extra or [])
         result = choose(hyps, holdout_evidence(hyps, numbered, seed))
-        if regional_residual:
-            from .residual import FieldPlusResidual, fit_regional_residual
-
-            res = fit_regional_residual(numbered, result.field, size_mm)
-            if res.kept:
-                result.field = FieldPlusResidual(result.field, res)
     if warn and (result.contradicted or result.unverified):
         warnings.warn(result.message, WoodcamWarning, stacklevel=2)
     return result
