@@ -483,6 +483,6 @@ class ConfidenceWood:
         return np.stack([np.clip(2 - 2 * c, 0, 1), np.clip(2 * c, 0, 1), np.full_like(c, 0.1)], axis=1)
 
 
-__all__ = ["CANDIDATES", "ConfidenceWood", "EvidenceFit", "Hypothesis", "bake_evidence", "choose", "confidence",
-           "distance_to_faces_mm", "face_score", "fit_evidence", "holdout_evidence", "radial_recipe",
+__all__ = ["CANDIDATES", "ConfidenceWood", "EvidenceFit", "Hypothesis", "bake_evidence", "blend_accepted", "choose",
+           "confidence", "distance_to_faces_mm", "face_score", "fit_evidence", "holdout_evidence", "radial_recipe",
            "stem_recipe", "uncertainty_report", "uncertainty_years"]
