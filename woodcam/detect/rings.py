@@ -154,9 +154,13 @@ LINK_GAP_WAVELENGTHS = 3.0
 #: band centres sit on whole numbers (same number or not), faint lines where they lie between.
 LINK_ORDER_TOL = 0.25
 #: Use the curved Gabor response (:mod:`woodcam.detect.curved`) for the ring phase by default.
-#: Off: it gains 0.01-0.02 F on the synthetic and real faces (README), but the radial fit from
-#: H11's detected rings then counts 2.1-2.8 times the rings the Mokume maps' fit counts (0.81
-#: without it; ``tests/detect/test_detect_downstream.py``), a regression not yet understood.
+#: Off (``woodcam rings detect --curved`` turns it on): it gains 0.01-0.02 F on the synthetic and
+#: real faces (README), costs ~1.5x the CPU, and moves the downstream fits both ways (in-sample
+#: loss H11 13.1 -> 11.0, CN03 12.5 -> 18.9 points within 2 px). With the fitter of FIT_VERSION 7
+#: the radial fit from H11's curved rings counted 2.1-2.8 times the Mokume maps' rings: its
+#: numbering took its ring scale from the wrong alignment peak; since every clear peak is tried
+#: and the one whose neighbouring rings are one year apart kept (FIT_VERSION 8), it counts
+#: 1.05-1.35 times (``tests/detect/test_detect_downstream.py`` runs H11 both ways).
 CURVED_GABOR = False
 #: Largest phase difference (radians) between the curved and the bank's straight response at
 #: a pixel for the curved one to be used there; elsewhere the bank's is kept. The curved Gabor
