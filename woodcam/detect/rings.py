@@ -687,8 +687,12 @@ def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rul
         # where the line jumps to another dark line (two within reach), cut it there: the jump
         # itself would be a piece of "ring" running across the rings
         cuts = np.flatnonzero(np.abs(np.diff(mk)) > SNAP_JUMP_PX) + 1
-        for piece in np.split(moved, cuts):
-            if len(piece) >= 3:
+        lam_k = lam[r[owner == k], c[owner == k]]
+        for piece, lam_p in zip(np.split(moved, cuts), np.split(lam_k, cuts)):
+            # the cuts make new pieces: they obey the least length the contour runs did
+            # (MIN_TRACE_WAVELENGTHS), else a band snapped to pore streaks leaves specks
+            if len(piece) >= 3 and (np.sum(np.hypot(*np.diff(piece, axis=0).T))
+                                    >= MIN_TRACE_WAVELENGTHS * float(np.median(lam_p))):
                 out.append(piece)
                 src.append(k)
     return out, src
