@@ -155,12 +155,14 @@ LINK_GAP_WAVELENGTHS = 3.0
 LINK_ORDER_TOL = 0.25
 #: Use the curved Gabor response (:mod:`woodcam.detect.curved`) for the ring phase by default.
 #: Off (``woodcam rings detect --curved`` turns it on): it gains 0.01-0.02 F on the synthetic and
-#: real faces (README), costs ~1.5x the CPU, and moves the downstream fits both ways (in-sample
-#: loss H11 13.1 -> 11.0, CN03 12.5 -> 18.9 points within 2 px). With the fitter of FIT_VERSION 7
+#: real faces (README), costs ~1.5x the CPU, and moved the downstream fits both ways (in-sample
+#: loss H11 13.1 -> 11.0, CN03 12.5 -> 18.9 points within 2 px, DETECT_VERSION 5). With the fitter of FIT_VERSION 7
 #: the radial fit from H11's curved rings counted 2.1-2.8 times the Mokume maps' rings: its
 #: numbering took its ring scale from the wrong alignment peak; since every clear peak is tried
-#: and the one whose neighbouring rings are one year apart kept (FIT_VERSION 8), it counts
-#: 1.05-1.35 times (``tests/detect/test_detect_downstream.py`` runs H11 both ways).
+#: and the one whose neighbouring rings are one year apart kept (FIT_VERSION 8), it counted
+#: 1.05-1.35 times; with speck pieces dropped after the snap (DETECT_VERSION 6) 0.37-0.89
+#: (median 0.75, below ``tests/detect/test_detect_downstream.py``'s 0.8), though its in-sample
+#: loss is then the lowest measured (H11 6.9 / 9.9, CN03 8.7 / 5.1 within 2 / 5 px).
 CURVED_GABOR = False
 #: Largest phase difference (radians) between the curved and the bank's straight response at
 #: a pixel for the curved one to be used there; elsewhere the bank's is kept. The curved Gabor
