@@ -40,8 +40,10 @@ def _sheets(size_mm, ppm, leaves=2, mokume=True, n_species=6, blocks=None):
             if (root / name).is_dir():
                 out += mokume_veneers(root / name)
     for spec, sp in (blocks or SPECIES_BLOCKS[:n_species]):
-        stock = _fast_grown(sp) if spec == FAST_GROWN else open_stock(spec, species=sp)
-        out += slice_veneers(stock, leaves, size_mm, px_per_mm=ppm, id_prefix=sp)
+        if spec == FAST_GROWN:
+            out += slice_veneers(_fast_grown(sp), leaves, size_mm, px_per_mm=ppm, id_prefix=f"{sp}-fast")
+        else:
+            out += slice_veneers(open_stock(spec, species=sp), leaves, size_mm, px_per_mm=ppm, id_prefix=sp)
     return out
 
 
