@@ -62,7 +62,7 @@ def test_bake_demo_and_gcode_share_the_bake_options():
         args = parser.parse_args(argv)
         assert cli.options.stock_options(args) == {
             "species": "walnut", "appearance": "colormap",
-            "knots": KnotShading(alive_darkening=0.2, dead_darkening=0.4)}, name
+            "knots": KnotShading(alive_darkening=0.2, dead_darkening=0.4), "knot_lut": None}, name
         assert args.no_obj, name
 
 

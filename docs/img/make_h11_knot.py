@@ -3,7 +3,10 @@ same faces (the knot fitted from the knot masks of faces C and F), and the fitte
 lines (integer growth times) drawn on the photos: what the colour map has to show.
 
 Run from the repository root: ``python docs/img/make_h11_knot.py`` (needs ../shared/data or
-``$WOODCAM_SHARED_DATA``).
+``$WOODCAM_SHARED_DATA``). It also prints, per face, how the bake compares with the photo:
+the correlation of their ring-scale luminance (Gaussian band 1.5-8 px: where the rings fall),
+the bake's ring-scale contrast over the photo's, the mean colour difference, and on the knot's
+faces the knot's luminance difference and ring-scale contrast ratio (mask eroded by 8 px).
 """
 
 import os
@@ -15,6 +18,8 @@ import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+
+from scipy import ndimage  # noqa: E402
 
 from woodcam.block.io import read_mokume  # noqa: E402
 from woodcam.frames import FACE_NORMAL, face_pixel_points  # noqa: E402
@@ -49,3 +54,26 @@ for c, f in enumerate(faces):
         a.axis("off")
 plt.tight_layout()
 plt.savefig(Path(__file__).with_name("h11_knot_bake.png"), dpi=60)
+
+LUMA = np.array([0.299, 0.587, 0.114])
+
+
+def _band(im, lo=1.5, hi=8.0):
+    return ndimage.gaussian_filter(im, lo) - ndimage.gaussian_filter(im, hi)
+
+
+for f, face in block.faces.items():
+    pts = face_pixel_points(f, face.shape, block.size_mm).reshape(-1, 3)
+    n = np.broadcast_to(np.asarray(FACE_NORMAL[f], float), pts.shape)
+    rgb = np.clip(stock.wood.color(pts, n), 0, 1).reshape(face.shape + (3,))
+    photo = face.photo / 255.0
+    lb, lp = rgb @ LUMA, photo @ LUMA
+    bb, bp = _band(lb), _band(lp)
+    line = (f"{f:6s} ring corr {np.corrcoef(bb.ravel(), bp.ravel())[0, 1]:5.2f}  contrast {bb.std() / bp.std():4.2f}"
+            f"  mean colour diff {np.round(rgb.reshape(-1, 3).mean(0) - photo.reshape(-1, 3).mean(0), 3)}")
+    if "knot_mask" in face.extras:
+        core = ndimage.binary_erosion(np.asarray(face.extras["knot_mask"], bool), iterations=8)
+        kb, kp = _band(lb, 1.0, 6.0), _band(lp, 1.0, 6.0)
+        line += (f"  knot: luminance diff {lb[core].mean() - lp[core].mean():+.3f}"
+                 f" ring contrast {kb[core].std() / kp[core].std():4.2f}")
+    print(line)

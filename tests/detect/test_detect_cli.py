@@ -141,3 +141,28 @@ def test_face_without_rings_is_named(synth_photos, tmp_path, capsys):
     assert rc == 0 and "face 'bottom'" in out
     b = read_block(blk)
     assert b.faces["bottom"].ring_map is None or not b.faces["bottom"].traces
+
+
+def test_curved_option_reaches_the_detector(synth_photos, tmp_path, capsys):
+    """``rings detect --curved``: the traces written are those of ``detect_rings(curved=True)``
+    (which differ from the straight bank's on this face), and the manifest says so."""
+    from woodcam.detect.rings import detect_rings
+
+    blk = tmp_path / "blk"
+    rc, _out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50x50x50", "--out", blk)
+    assert rc == 0, err
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk, "--curved", "--no-knots")
+    assert rc == 0, err
+    b = read_block(blk)
+    assert json.loads((blk / "block.json").read_text())["meta"]["detection"]["curved"] is True
+    face = b.faces["top"]
+    px_mm = 1.0 / min(b.face_pixel_size_mm("top"))
+    curved = detect_rings(face.photo, px_per_mm=px_mm, curved=True).traces
+    straight = detect_rings(face.photo, px_per_mm=px_mm, curved=False).traces
+    got = np.concatenate([t.points_px for t in face.traces])
+    want = np.concatenate([t.points_px for t in curved])
+    assert got.shape == want.shape and np.allclose(got, want, atol=0.01)
+    other = np.concatenate([t.points_px for t in straight])
+    assert other.shape != want.shape or not np.allclose(other, want, atol=0.01)
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", tmp_path / "x", "--curved", "--detector", "learned")
+    assert rc != 0 and "curved" in err and err.count("\n") == 1, err

@@ -111,3 +111,20 @@ def test_fit_block_evidence_grid_carries_meta_and_uncertainty(block, tmp_path):
 def test_candidates_are_checked(obs, block):
     with pytest.raises(WoodcamError, match="candidates must include 'radial'"):
         fit_evidence(obs, block.size_mm, candidates=("rbf",))
+
+
+def test_blend_accepted_is_the_mean_of_the_accepted_hypotheses():
+    from woodcam.inference.evidence import blend_accepted
+
+    p = np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]])
+    a, b_, c = (lambda q: q[:, 0]), (lambda q: q[:, 1] + 1.0), (lambda q: 100.0 * q[:, 2])
+    hyps = [Hypothesis("a", a, None), Hypothesis("b", b_, None), Hypothesis("c", c, None)]
+    ev = {"a": {"front": {"score": 90.0, "share_2mm": 90.0}}, "b": {"front": {"score": 87.0, "share_2mm": 87.0}},
+          "c": {"front": {"score": 40.0, "share_2mm": 40.0}}}
+    res = blend_accepted(choose(hyps, ev))
+    assert res.chosen == "a" and res.accepted == ["a", "b"]
+    # b is within EVIDENCE_ACCEPT_MARGIN of a and blended in, c (50 points behind) is not
+    np.testing.assert_allclose(res(p), (p[:, 0] + p[:, 1] + 1.0) / 2)
+    assert "blended with b" in res.message
+    alone = blend_accepted(choose(hyps[:1], {"a": ev["a"]}))
+    np.testing.assert_allclose(alone(p), p[:, 0])

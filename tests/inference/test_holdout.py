@@ -9,7 +9,7 @@ from woodcam.errors import WoodcamError
 from woodcam.frames import face_pixel_points
 from woodcam.inference import gather_observations
 from woodcam.inference.holdout import (
-    CONTROL, STRAIGHT, face_years, leave_one_face_out, ridge_pixels, ring_lines_px, score_face,
+    BEST_PHASE, CONTROL, STRAIGHT, STRAIGHT_OWN, face_years, leave_one_face_out, ridge_pixels, ring_lines_px, score_face,
     straight_rings,
 )
 
@@ -83,6 +83,14 @@ def test_leave_one_face_out_predicts_held_out_synthetic_faces(mapped, tmp_path):
     assert (tmp_path / "eq79_radial.png").stat().st_size > 10_000
     assert "mean, held out" in (tmp_path / "eq79_holdout.md").read_text()
     assert STRAIGHT in (tmp_path / "eq79_holdout.md").read_text()
+    # the like-for-like rows: the prediction with the straight control's oracle phase is at
+    # least as good as without it (phase 0 is one of the choices), and the straight rings at
+    # the prediction's own phase no better than at their best phase
+    for fit, best, own, st in zip(held, res[BEST_PHASE]["radial"], res[STRAIGHT_OWN]["radial"],
+                                  res[STRAIGHT]["radial"]):
+        assert best.shares["ridge_2"] >= fit.shares["ridge_2"]
+        assert own.shares["ridge_2"] <= st.shares["ridge_2"]
+    assert BEST_PHASE in (tmp_path / "eq79_holdout.md").read_text()
 
 
 def test_straight_rings_is_the_mean_plane():
@@ -152,6 +160,7 @@ def test_real_cubes_leave_one_face_out(shared_data, tmp_path):
     # with an oracle phase 25.6 %), H11 19.1 vs 12.0 % (1.59x; main before it 1.21x, which
     # fails this bar; the 2x is NOT reached and neither cube beats the straight rings).
     bars = {"CN03": 5.0, "H11": 1.4}
+    like_for_like = {"CN03": 1.15, "H11": 1.0}
     for name, bar in bars.items():
         b = read_mokume(shared_data / "mokume" / name)
         res = leave_one_face_out(b, ("evidence",), out_dir=tmp_path, progress=print)
@@ -159,3 +168,10 @@ def test_real_cubes_leave_one_face_out(shared_data, tmp_path):
         ok = np.mean([s.shares["ridge_2"] for s in res["held_out"]["evidence"]])
         shifted = np.mean([s.shares["ridge_2"] for s in res[CONTROL]["evidence"]])
         assert ok > bar * shifted, (name, ok, shifted)
+        # Part 7, like for like (README): the straight-ring control takes its phase from the
+        # held-out map, so the prediction is compared at that phase too, and the straight rings
+        # at the prediction's own phase. Measured within 2 px: H11 21.1 vs 20.3 and 19.1 vs
+        # 15.9, CN03 31.6 vs 25.6 and 21.5 vs 19.0.
+        mean2 = lambda key: np.mean([s.shares["ridge_2"] for s in res[key]["evidence"]])  # noqa: E731
+        assert mean2(BEST_PHASE) > like_for_like[name] * mean2(STRAIGHT), (name, mean2(BEST_PHASE), mean2(STRAIGHT))
+        assert ok > 1.1 * mean2(STRAIGHT_OWN), (name, ok, mean2(STRAIGHT_OWN))

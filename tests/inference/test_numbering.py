@@ -45,10 +45,12 @@ def test_a_planted_wrong_basin_loses_the_numbering(truth_and_obs):
                         np.zeros(10), 0.0)
     wrong.coef[0] = 1.0  # rings per mm: concentric about the wrong axis
     assert step_consistency(_initial_numbering(obs, wrong)[0]) < 0.6
-    order = _by_numbering(obs, [(wrong, None, None), good])
+    order, num = _by_numbering(obs, [(wrong, None, None), good])
     assert order[0] is good
+    # the chosen basin's numbering comes back with it (not computed twice)
+    assert np.array_equal(num[0].years, _initial_numbering(obs, good[0])[0].years)
     # a consistent lowest-cost basin keeps its place (the in-sample cost breaks near-ties)
-    assert _by_numbering(obs, [good, (wrong, None, None)])[0] is good
+    assert _by_numbering(obs, [good, (wrong, None, None)])[0][0] is good
 
 
 def test_a_wrong_ring_scale_is_replaced_by_a_consistent_one(truth_and_obs, monkeypatch):

@@ -48,6 +48,21 @@ RING_REGISTRATION_BLUR_PX_PER_SIDE = 12.0
 #: per cent a little outside its surface, where the stem's rings are already bent round it.
 KNOT_FREE_BELOW = 0.05
 
+#: Knot feature above which a photo pixel counts as knot wood when the knot's own colour ramp
+#: is fitted (:func:`_field_lut`): the core of the knot, away from the smooth-minimum blend
+#: where stem and knot rings mix.
+KNOT_CORE_ABOVE = 0.5
+
+#: Ring scale of a face photo (Gaussian sigmas, pixels of a 256-pixel face side): the photo
+#: blurred by the first minus blurred by the second is its ring-scale part (H11's rings are
+#: 6-30 px apart; the first removes pixel noise, the second the slow shading of a face or a
+#: knot). Used for a fitted field's knot ramp (:func:`_knot_lut`).
+RING_BAND_PX_PER_SIDE = (1.0, 6.0)
+
+#: Ring-phase harmonics of the stem ramp that give a fitted field's knot ramp its profile
+#: (:func:`_knot_lut`): the shape of a ring (where the latewood is), not the ramp's bin noise.
+KNOT_PROFILE_HARMONICS = 2
+
 RampAnchor = Literal["auto", "field", "ring_map"]
 
 
@@ -194,6 +209,22 @@ class ColorMapAppearance:
         Fitted colour over the ring phase ``years mod 1`` (= sqrt(ARF)) in :data:`LUT_BINS`
         equal bins, for surfaces normal to X, Y, Z (block frame); ``None`` uses the
         species ramp with end-grain darkening. Rows with NaN fall back to the species ramp.
+    knot_lut : (LUT_BINS, 3) float or None
+        Fitted colour of knot wood over the knot's own ring phase (the field's years inside a
+        knot run round its strand), any surface orientation. Where given, knot wood takes this
+        colour, blended with the stem's by the field's knot weight, instead of the stem colour
+        darkened by ``knots.alive_darkening`` (the photos' knots carry their own darkness and
+        rings); dead knots are still darkened and outlined by ``knots``. ``None`` or NaN: the
+        darkening of ``knots``.
+    axis_exposure : (3, 2, 3) float or None
+        Colour gain of the fitted ramps at the low and high face of each axis (block frame,
+        per RGB channel), linearly interpolated along the axis between ``exposure_span_mm``
+        and held beyond: the photos of opposite faces differ in exposure or wood colour (H11:
+        clear-wood luminance 0.76 on top, 0.66 on the bottom), which one ramp per axis cannot
+        show. Applies to axes with a fitted ramp; ``None``: gain 1.
+    exposure_span_mm : (3, 2) float or None
+        Coordinates (mm, block frame) of the low and high face of each axis, where
+        ``axis_exposure``'s two gains hold; required with it.
     knots : KnotShading
         How knot wood is coloured on fields that report knot features
         (:mod:`woodcam.appearance.knots`: one shading for every renderer).
@@ -206,6 +237,9 @@ class ColorMapAppearance:
 
     species: Species | str = "oak"
     axis_luts: np.ndarray | None = None
+    knot_lut: np.ndarray | None = None
+    axis_exposure: np.ndarray | None = None
+    exposure_span_mm: np.ndarray | None = None
     knots: KnotShading = KnotShading()
     seed: int = 0
     knot_darkening_alive: InitVar[float | None] = None
@@ -225,6 +259,25 @@ class ColorMapAppearance:
             if luts.shape != (3, LUT_BINS, 3):
                 raise WoodcamError(f"axis_luts must have shape (3, {LUT_BINS}, 3); got {luts.shape}")
             object.__setattr__(self, "axis_luts", luts)
+        if self.knot_lut is not None:
+            lut = np.asarray(self.knot_lut, dtype=np.float32)
+            if lut.shape != (LUT_BINS, 3):
+                raise WoodcamError(f"knot_lut must have shape ({LUT_BINS}, 3); got {lut.shape}")
+            object.__setattr__(self, "knot_lut", lut)
+        if (self.axis_exposure is None) != (self.exposure_span_mm is None):
+            raise WoodcamError("axis_exposure and exposure_span_mm go together; got one without the "
+                               "other: give both (ColorMapAppearance.fit_to_block fits them) or neither")
+        if self.axis_exposure is not None:
+            gains = np.asarray(self.axis_exposure, dtype=np.float32)
+            span = np.asarray(self.exposure_span_mm, dtype=np.float32)
+            if gains.shape != (3, 2, 3) or span.shape != (3, 2):
+                raise WoodcamError(f"axis_exposure must have shape (3, 2, 3) and exposure_span_mm (3, 2); "
+                                   f"got {gains.shape} and {span.shape}")
+            if not (np.all(np.isfinite(gains)) and np.all(gains >= 0) and np.all(np.isfinite(span))):
+                raise WoodcamError("axis_exposure must hold finite gains >= 0 and exposure_span_mm finite "
+                                   f"coordinates; got {gains.tolist()} and {span.tolist()}")
+            object.__setattr__(self, "axis_exposure", gains)
+            object.__setattr__(self, "exposure_span_mm", span)
 
     # -- the ramp -------------------------------------------------------------------------------
 
@@ -262,6 +315,12 @@ class ColorMapAppearance:
             knot, dead, outline = (np.asarray(knots[k], np.float32) for k in ("knot", "dead", "outline"))
         luts = self.axis_luts if self.axis_luts is not None else np.full((3, LUT_BINS, 3), np.nan, np.float32)
         lut_ok = np.array([np.all(np.isfinite(luts[k])) for k in range(3)])
+        knot_lut = self.knot_lut if self.knot_lut is not None else np.full((LUT_BINS, 3), np.nan, np.float32)
+        knot_lut_ok = bool(np.all(np.isfinite(knot_lut)))
+        if self.axis_exposure is not None and self.exposure_span_mm is not None:
+            gains, span = self.axis_exposure, self.exposure_span_mm
+        else:
+            gains, span = np.ones((3, 2, 3), np.float32), np.zeros((3, 2), np.float32)
         blend = normals is not None
         out = np.empty((1 if blend else 3, n, 3), np.float32)
         params = np.array([s.latewood_start, s.pore_contrast, float(s.ring_porous), s.pore_across_mm,
@@ -272,7 +331,8 @@ class ColorMapAppearance:
         _shade_kernel(arf(years).astype(np.float32), np.ascontiguousarray(grain, np.float32),
                       p.astype(np.float32), normals if blend else np.zeros((1, 3), np.float32),
                       knot, dead, outline, params, colours, np.nan_to_num(luts).astype(np.float32),
-                      lut_ok, np.int64(self.seed), TABLE, blend, out)
+                      lut_ok, np.nan_to_num(knot_lut).astype(np.float32), knot_lut_ok,
+                      gains, span, np.int64(self.seed), TABLE, blend, out)
         return out[0] if blend else out
 
     # -- fitting to photos ------------------------------------------------------------------------
@@ -300,6 +360,12 @@ class ColorMapAppearance:
         photo faces lack ring maps, else ``"ring_map"`` (per axis), as the neural appearance
         chooses its source. Axes without photos keep the species ramp. Raises if no face has
         a photo.
+
+        With the ring-map anchor the axis's ring shape comes from its face with the strongest
+        rings (:func:`_pooled_ring_shape`: a face whose fitted rings miss its photo's bins
+        flat) and each face's exposure is fitted (``axis_exposure``). Where the field reports
+        knots, knot wood gets a ramp of its own (``knot_lut``, :func:`_knot_lut`) from the
+        photos' knot pixels; ``knot_lut=None`` keeps the ``knots`` darkening instead.
         """
         if anchor not in ("auto", "field", "ring_map"):
             raise WoodcamError(f"anchor must be one of auto, field, ring_map; got {anchor!r}")
@@ -313,6 +379,9 @@ class ColorMapAppearance:
         luts = np.full((3, LUT_BINS, 3), np.nan)
         centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
         true_field = field is getattr(block, "true_field", None)
+        knot_phase, knot_rgb, knot_ring, knot_registered = [], [], [], False
+        exposure = np.ones((3, 2, 3))
+        span = np.array([[0.0, float(v)] for v in block.size_mm])
         for k in range(3):
             faces = [f for f in photo_faces if FACE_AXIS[f.name] == k]
             if not faces:
@@ -325,36 +394,186 @@ class ColorMapAppearance:
                     f"{[f.name for f in faces if f.ring_map is None]} of block {block.name!r} have none; "
                     "use anchor='field'"
                 )
-            luts[k] = _field_lut(faces, field, block.size_mm, centres, register=use_maps)
-        return cls(species=species, axis_luts=luts, **kwargs)
+            luts[k], kp, kr, kb, gains = _field_lut(faces, field, block.size_mm, centres, register=use_maps)
+            for coord, gain in gains:  # the face at 0 (low) or at the block's size (high)
+                exposure[k, int(coord > span[k, 1] / 2)] = gain
+            knot_phase.append(kp)
+            knot_rgb.append(kr)
+            knot_ring.append(kb)
+            knot_registered |= use_maps and len(kp) > 0
+        if "knot_lut" in kwargs:  # the caller's own knot ramp (None: the KnotShading darkening)
+            knot_lut = kwargs.pop("knot_lut")
+        else:
+            knot_lut = _knot_lut(np.concatenate(knot_phase or [np.zeros(0)]),
+                                 np.concatenate(knot_rgb or [np.zeros((0, 3))]),
+                                 np.concatenate(knot_ring or [np.zeros((0, 3))]), luts, species,
+                                 centres, matched=knot_registered)
+        fitted_exposure = {"axis_exposure": exposure, "exposure_span_mm": span} if np.any(exposure != 1.0) else {}
+        return cls(species=species, axis_luts=luts, knot_lut=knot_lut, **{**fitted_exposure, **kwargs})
 
     def with_params(self, **changes) -> "ColorMapAppearance":
         """Copy with some parameters changed."""
         return replace(self, **changes)
 
 
-def _field_lut(faces, field, size_mm, centres, register: bool = False) -> np.ndarray:
-    """Mean photo colour per ring-phase bin of ``field`` over ``faces`` ``(LUT_BINS, 3)``; with
-    ``register``, the field's ring phase is first moved onto each face's ring map
-    (:func:`_registered_years`)."""
-    sums = np.zeros((LUT_BINS, 3))
-    counts = np.zeros(LUT_BINS)
+def _field_lut(faces, field, size_mm, centres, register: bool = False):
+    """Mean photo colour per ring-phase bin of ``field`` over ``faces``, from clear wood
+    (:func:`_clear_wood`), and the knot wood seen on them.
+
+    With ``register`` (a fitted field), the field's ring phase is first moved onto each face's
+    ring map (:func:`_registered_years`), the axis takes the ring shape of its face with the
+    strongest rings (:func:`_pooled_ring_shape`), and each face gets an exposure gain.
+
+    Returns ``(lut (LUT_BINS, 3), knot_phase (m,), knot_rgb (m, 3), knot_ring (m, 3),
+    exposure)``: the stem ramp; for the ``m`` knot pixels (:func:`_knot_core`), their ring
+    phase, photo colour and ring-scale part of it (the photo band-passed at
+    :data:`RING_BAND_PX_PER_SIDE`; zeros without ``register``), for :func:`_knot_lut`; and
+    each face's ``(coordinate along the axis in mm, gain (3,))``: its clear wood's mean photo
+    colour over the mean the ramp gives the same pixels (empty without ``register``: a true
+    field's photos are the ramp's own).
+    """
+    from scipy import ndimage
+
+    per_face = []  # (sums, counts) of each face's clear wood per ring-phase bin
+    knot_phase, knot_rgb, knot_ring = [np.zeros(0)], [np.zeros((0, 3))], [np.zeros((0, 3))]
     for face in faces:
         pts = face_pixel_points(face.name, face.shape, size_mm).reshape(-1, 3)
         g, knot = _years_and_knots(field, pts)
         if register:
             g = _registered_years(face, g.reshape(face.shape)).ravel()
+        phase = np.mod(g, 1.0)
         clear = _clear_wood(face, knot, len(pts))
-        b = np.minimum((np.mod(g[clear], 1.0) * LUT_BINS).astype(int), LUT_BINS - 1)
-        rgb = face.photo.reshape(-1, 3)[clear].astype(float) / 255.0
-        counts += np.bincount(b, minlength=LUT_BINS)
-        for c in range(3):
-            sums[:, c] += np.bincount(b, rgb[:, c], minlength=LUT_BINS)
+        rgb = face.photo.reshape(-1, 3).astype(float) / 255.0
+        per_face.append(_binned(phase[clear], rgb[clear]))
+        if knot is not None:
+            core = _knot_core(face, knot)
+            ring = np.zeros((int(core.sum()), 3))
+            if register and core.any():
+                px = max(face.shape) / 256.0
+                photo = face.photo.astype(float) / 255.0
+                fine, coarse = (ndimage.gaussian_filter(photo, (q * px, q * px, 0)) for q in RING_BAND_PX_PER_SIDE)
+                ring = (fine - coarse).reshape(-1, 3)[core]
+            knot_phase.append(phase[core])
+            knot_rgb.append(rgb[core])
+            knot_ring.append(ring)
+    sums = sum(f[0] for f in per_face)
+    counts = sum(f[1] for f in per_face)
+    if register and len(per_face) > 1 and counts.all():
+        sums = _pooled_ring_shape(per_face) * counts[:, None]
+    lut = _binned_lut(sums, counts, centres)
+    exposure = []
+    if register and np.isfinite(lut).all():
+        for face, (s, c) in zip(faces, per_face):
+            if c.any():
+                model = (c @ lut) / c.sum()
+                coord = float(face_pixel_points(face.name, (1, 1), size_mm)[0, 0, FACE_AXIS[face.name]])
+                exposure.append((coord, (s.sum(axis=0) / c.sum()) / np.maximum(model, 1e-6)))
+    return (lut, np.concatenate(knot_phase), np.concatenate(knot_rgb), np.concatenate(knot_ring),
+            exposure)
+
+
+def _pooled_ring_shape(per_face) -> np.ndarray:
+    """One ramp ``(LUT_BINS, 3)`` from the faces of an axis, each given as ``(sums (LUT_BINS, 3),
+    counts (LUT_BINS,))`` of its clear-wood colours per ring-phase bin: the ring shape (colour
+    less the face's mean) of the face with the strongest rings (rms of the shape's luminance
+    over its pixels), on the mean colour of all the faces' pixels.
+
+    Why: a face's registered phase still sits off its photo's rings, the more so where the
+    fitted field misses them, and binned colours average towards the face's mean the further
+    off it is: the face with the strongest ring shape is the one whose phase is least off.
+    Pooled by pixel count, a face whose rings the field misses (H11's knotted faces C and F:
+    their photos' rings sweep round the knot) averaged the other face's rings away, and the
+    side faces baked nearly plain (H11's X ramp: 0.03 of luminance from ring to ring where its
+    clear face alone shows 0.05). A least-squares blend of the faces' shapes (each damped by a
+    gain of its own) drew 0.150 of luminance from ring to ring where the best face alone draws
+    0.175, on a synthetic block whose two faces are off by different amounts
+    (tests/appearance/test_colormap.py, the ring-map test).
+    """
+    luma = np.array([0.299, 0.587, 0.114])
+    total = sum(s for s, _ in per_face)
+    n = sum(c for _, c in per_face)
+    best, best_amp = None, -1.0
+    for s, c in per_face:
+        if not c.any():
+            continue
+        d = s / np.maximum(c, 1.0)[:, None] - s.sum(axis=0) / c.sum()
+        amp = float(np.sum(c * (d @ luma) ** 2) / c.sum())
+        if amp > best_amp:
+            best, best_amp = d, amp
+    if best is None or not n.all():
+        return total / np.maximum(n, 1.0)[:, None]
+    return total.sum(axis=0) / n.sum() + best
+
+
+def _knot_lut(phase, rgb, ring, stem_luts, species, centres, matched: bool) -> np.ndarray | None:
+    """Colour of knot wood over its ring phase ``(LUT_BINS, 3)`` from the knot pixels' ring
+    ``phase (m,)``, photo colour ``rgb (m, 3)`` and its ring-scale part ``ring (m, 3)``
+    (:func:`_field_lut`); None without knot pixels.
+
+    ``matched=False`` (the field's phase is the photo's: a true field): the mean colour per
+    phase bin, as the stem ramp.
+
+    ``matched=True`` (a fitted field): inside a knot the fitted rings do not sit on the photo's
+    (H11: a knot fitted from its masks has its own ring count and centre; the ring maps have no
+    lines there to register on), so the binned colour is the knot's mean in every bin: one flat
+    dark ellipse. The knot's rings are instead drawn with the photos' own ring contrast at the
+    stem's ring profile: the knot pixels sorted by the luminance of their ring-scale part are
+    split into ``LUT_BINS`` equal groups, and the ``j``-th darkest group's mean ring part, added
+    to the knots' mean colour, goes to the ``j``-th darkest bin of the stem ramp (a branch lays
+    down earlywood and latewood as the stem does). The knot's colour and ring contrast are the
+    photos'; where its rings fall is the field's. (The ring-scale part, not the whole colour:
+    the knots' slow shading from rim to centre is no ring contrast, and drew rings twice as
+    strong as H11's photos.)
+    """
+    if len(phase) == 0:
+        return None
+    if not matched:
+        sums, counts = _binned(phase, rgb)
+        return _binned_lut(sums, counts, centres)
+    luma = np.array([0.299, 0.587, 0.114])
+    ok = [k for k in range(3) if np.isfinite(stem_luts[k]).all()]
+    if ok:
+        profile = np.mean([stem_luts[k] @ luma for k in ok], axis=0)
+    else:
+        profile = ColorMapAppearance(species).ramp(centres ** 2) @ luma
+    spec = np.fft.rfft(profile)
+    spec[KNOT_PROFILE_HARMONICS + 1:] = 0.0  # the ring profile's shape, not its bin noise
+    order = np.argsort(np.fft.irfft(spec, n=LUT_BINS), kind="stable")
+    ring = ring - ring.mean(axis=0)  # (near a knot's rim the wide blur mixes in the lighter stem)
+    groups = np.array_split(np.argsort(ring @ luma, kind="stable"), LUT_BINS)
+    lut = np.empty((LUT_BINS, 3))
+    lut[order] = rgb.mean(axis=0) + np.stack([ring[g].mean(axis=0) for g in groups])
+    return np.clip(lut, 0.0, 1.0)
+
+
+def _binned(phase, rgb):
+    """``(sums (LUT_BINS, c), counts (LUT_BINS,))`` of colours ``rgb (m, c)`` per ring-phase
+    bin of ``phase (m,)`` (years mod 1)."""
+    b = np.minimum((np.mod(phase, 1.0) * LUT_BINS).astype(int), LUT_BINS - 1)
+    counts = np.bincount(b, minlength=LUT_BINS).astype(float)
+    sums = np.stack([np.bincount(b, rgb[:, c], minlength=LUT_BINS) for c in range(rgb.shape[1])], axis=1)
+    return sums, counts
+
+
+def _binned_lut(sums, counts, centres) -> np.ndarray:
+    """``(LUT_BINS, 3)`` mean colour per bin; empty bins linearly interpolated along the phase,
+    all NaN when no bin has a pixel."""
     if not counts.any():
         return np.full((LUT_BINS, 3), np.nan)
     ok = counts > 0
     mean = sums[ok] / counts[ok, None]
     return np.stack([np.interp(centres, centres[ok], mean[:, c]) for c in range(3)], axis=1)
+
+
+def _knot_core(face, knot) -> np.ndarray:
+    """``(n,)`` bool: knot wood of ``face``'s pixels for the knot ramp, the field's knot weight
+    ``knot (n,)`` above :data:`KNOT_CORE_ABOVE`, within the face's ``knot_mask`` where it has one
+    (a fitted knot may reach past the photo's knot)."""
+    core = knot > KNOT_CORE_ABOVE
+    mask = face.extras.get("knot_mask")
+    if mask is not None and np.shape(mask) == tuple(face.shape):
+        core &= np.asarray(mask, bool).ravel()
+    return core
 
 
 def _years_and_knots(field, points_mm):
@@ -438,7 +657,7 @@ def _field_sample(field, points_mm):
 
 @numba.njit(nogil=True, fastmath=True, cache=True)
 def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, luts, lut_ok,
-                  seed, table, blend, out):  # pragma: no cover - compiled
+                  knot_lut, knot_lut_ok, gains, span, seed, table, blend, out):  # pragma: no cover - compiled
     """Per point: ramp, pores and streaks, end grain per axis, knots, and eq. 10 (``blend``, by
     :func:`~woodcam.appearance.orientation.eq10_weights`, the one implementation).
 
@@ -471,7 +690,8 @@ def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, lu
         shade = (1.0 + streak_c * streak) * (1.0 - pore_c * pores)
         rough = noise_at(2.0 * px * inv_a, 2.0 * py * inv_a, 2.0 * pz * inv_a, table, seed + 2)
         # knot wood darker, dead-knot outline drawn over (KnotShading.apply, appearance/knots.py)
-        kfac = (1.0 - dark_alive * knot[i]) * (1.0 - dark_dead * dead[i])
+        # (a fitted knot ramp already has the knot's darkness: only dead knots darken further)
+        kfac = (1.0 - (0.0 if knot_lut_ok else dark_alive * knot[i])) * (1.0 - dark_dead * dead[i])
         ol = outline[i]
         # lut position (bin centres) for fitted ramps: bins of the ring phase sqrt(ARF); clamped
         # at both ends (not wrapped), so a true field's latewood -> earlywood step stays sharp
@@ -486,11 +706,19 @@ def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, lu
         for k in range(3):
             g = abs(grain[i, k])  # 1 where a plane normal to axis k cuts the fibres across
             f = shade * (1.0 + eg_rough * g * rough) * kfac
+            # exposure of the fitted ramp between the axis's two faces (gain 1 with none fitted)
+            width = span[k, 1] - span[k, 0]
+            u = 0.0 if width == 0.0 else min(max((p[i, k] - span[k, 0]) / width, 0.0), 1.0)
             for c in range(3):
                 if lut_ok[k]:
                     v = luts[k, i0, c] * (1.0 - fl) + luts[k, i0 + 1, c] * fl
                 else:
                     v = (colours[0, c] + t * (colours[1, c] - colours[0, c])) * (1.0 - eg_dark * g * g)
+                if knot_lut_ok:
+                    kv = knot_lut[i0, c] * (1.0 - fl) + knot_lut[i0 + 1, c] * fl
+                    v = v * (1.0 - knot[i]) + kv * knot[i]
+                if lut_ok[k]:
+                    v = v * (gains[k, 0, c] * (1.0 - u) + gains[k, 1, c] * u)
                 v = v * f
                 v = v * (1.0 - ol) + colours[2, c] * ol
                 col[c] = min(max(v, 0.0), 1.0)

@@ -324,7 +324,8 @@ def add_knot_options(p: argparse.ArgumentParser) -> None:
     on the command line (``bake``, ``demo``, ``gcode``, ``log render``); defaults are its own."""
     p.add_argument("--knot-darkening", default=None, metavar="ALIVE,DEAD",
                    help="relative darkening of alive knot wood and the extra darkening of dead "
-                   "knot wood, each in [0, 1] (default 0.25,0.45)")
+                   "knot wood, each in [0, 1] (default 0.25,0.45; without it, a colour map fitted "
+                   "to photos of a knot colours knot wood as the photos do)")
     p.add_argument("--knot-outline", default=None, metavar="R,G,B",
                    help="colour of the bark ring round dead knots, each in [0, 1] "
                    "(default 0.16,0.10,0.06)")
@@ -362,7 +363,10 @@ def appearance_params(args) -> dict:
         if args.quality or args.epochs:
             raise WoodcamError("--quality and --epochs apply to --appearance neural only; "
                                f"got --appearance {args.appearance}")
-        return {"knots": knot_shading(args)} if knots else {}
+        if not knots:
+            return {}
+        # a darkening asked for replaces the knot colour a colour map would fit to the photos
+        return {"knots": knot_shading(args), **({"knot_lut": None} if args.knot_darkening is not None else {})}
     if knots:
         raise WoodcamError("--knot-darkening and --knot-outline apply to --appearance colormap "
                            "only (the neural appearance learns knot colours from the photos)")

@@ -75,6 +75,9 @@ def register(subparsers) -> None:
     d.add_argument("--detector", choices=("classical", "learned"), default=None,
                    help="classical: the weight-free quadrature-filter detector (default); learned: the "
                    "small net trained by 'woodcam train rings' (woodcam/models/rings.pt)")
+    d.add_argument("--curved", action="store_true",
+                   help="classical detector: place and order the rings by a Gabor filter that follows "
+                   "each ring's curve (slower; default: off, the straight filter bank)")
     d.add_argument("--no-knots", action="store_true", help="do not detect knot masks")
     d.add_argument("--size-mm", type=float, default=None,
                    help="cube side in mm for a Mokume folder (default 50)")
@@ -95,7 +98,7 @@ def run(args) -> int:
 
         manifest, msgs = detect_folder(args.block, args.out, rule=args.rule, knots=not args.no_knots,
                                        size_mm=(args.size_mm,) * 3 if args.size_mm else None, progress=True,
-                                       detector=args.detector or DEFAULT_DETECTOR)
+                                       detector=args.detector or DEFAULT_DETECTOR, curved=True if args.curved else None)
         for m in msgs:
             print(f"woodcam: warning: {m}")
         print(f"wrote {manifest.parent} (ring maps, <face>_traces.svg, knot masks)")

@@ -42,8 +42,8 @@ from .rings import DEFAULT_RULE, RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, 
 #: Bumped whenever detection results change, so cached detections are recomputed (3: traces
 #: carry their face-local ring id, ``RingTrace.ring``; 4: the curved Gabor response and the
 #: ``dark-edge`` rule by default; 5: the curved Gabor opt-in, after caches of 4 were written
-#: with it on).
-DETECT_VERSION = 5
+#: with it on; 6: pieces cut at a snap jump shorter than a ring spacing dropped).
+DETECT_VERSION = 6
 
 
 Detector = Literal["classical", "learned"]
@@ -52,12 +52,22 @@ DETECTORS: tuple[str, ...] = ("classical", "learned")
 DEFAULT_DETECTOR: Detector = "classical"
 
 
+def _curved(curved: bool | None) -> bool:
+    """Whether the classical detector uses the curved Gabor (``None``: the module default)."""
+    from . import rings
+
+    return rings.CURVED_GABOR if curved is None else bool(curved)
+
+
 def detect_face(face: Face, px_per_mm: float, rule: BoundaryRule = DEFAULT_RULE,
-                knots: bool = True, detector: Detector = DEFAULT_DETECTOR) -> tuple[Face, list[str]]:
+                knots: bool = True, detector: Detector = DEFAULT_DETECTOR,
+                curved: bool | None = None) -> tuple[Face, list[str]]:
     """Detect rings (and knots) on one face with a photo; returns a new Face and warnings.
 
     ``detector``: ``"classical"`` (:func:`~woodcam.detect.rings.detect_rings` with ``rule``) or
     ``"learned"`` (:func:`~woodcam.detect.learned.detect_rings_learned`, the committed net).
+    ``curved``: the classical detector places and orders the rings by the curved Gabor's phase
+    (:mod:`woodcam.detect.curved`); default (None) :data:`~woodcam.detect.rings.CURVED_GABOR`, off.
     The face's existing extras are kept; ``knot_mask`` is replaced by the detected one when
     ``knots`` (an empty mask is not stored).
     """
@@ -65,12 +75,15 @@ def detect_face(face: Face, px_per_mm: float, rule: BoundaryRule = DEFAULT_RULE,
         raise WoodcamError(f"face {face.name!r} has no photo to detect rings on; add its photo")
     if detector not in DETECTORS:
         raise WoodcamError(f"detector must be one of {', '.join(DETECTORS)}; got {detector!r}")
+    if curved and detector != "classical":
+        raise WoodcamError(f"curved=True is an option of the classical detector; got detector={detector!r}: "
+                           f"drop curved or use detector='classical'")
     if detector == "learned":
         from .learned import detect_rings_learned
 
         det = detect_rings_learned(face.photo, px_per_mm=px_per_mm, name=face.name)
     else:
-        det = detect_rings(face.photo, px_per_mm=px_per_mm, rule=rule, name=face.name)
+        det = detect_rings(face.photo, px_per_mm=px_per_mm, rule=rule, name=face.name, curved=curved)
     extras = dict(face.extras)
     if knots:
         mask = detect_knots(face.photo, px_per_mm, det.normal_rad)
@@ -84,10 +97,11 @@ def detect_face(face: Face, px_per_mm: float, rule: BoundaryRule = DEFAULT_RULE,
 
 def detect_block(block: Block, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = True,
                  faces=None, progress: bool = False,
-                 detector: Detector = DEFAULT_DETECTOR) -> tuple[Block, list[str]]:
+                 detector: Detector = DEFAULT_DETECTOR, curved: bool | None = None) -> tuple[Block, list[str]]:
     """A copy of ``block`` whose faces with photos carry detected rings and knot masks.
 
     ``faces``: only these faces (default all with a photo); the others are copied unchanged.
+    ``curved``: as :func:`detect_face`.
     Returns the block and the warnings (each names its face).
     """
     from tqdm.auto import tqdm
@@ -102,10 +116,10 @@ def detect_block(block: Block, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool
     msgs: list[str] = []
     for name in tqdm(names, desc="detecting rings", unit="face", delay=2.0, disable=not progress):
         px_mm = block.face_pixel_size_mm(name)
-        out.faces[name], w = detect_face(block.faces[name], 1.0 / min(px_mm), rule, knots, detector)
+        out.faces[name], w = detect_face(block.faces[name], 1.0 / min(px_mm), rule, knots, detector, curved)
         msgs += w
     out.meta["detection"] = {"detector": detector, "version": DETECT_VERSION, "rule": rule,
-                             "faces": names}
+                             "curved": _curved(curved), "faces": names}
     return out, msgs
 
 
@@ -137,12 +151,13 @@ def user_edited_faces(folder) -> dict[str, Path]:
 
 def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = True,
                   size_mm=None, progress: bool = False,
-                  detector: Detector = DEFAULT_DETECTOR) -> tuple[Path, list[str]]:
+                  detector: Detector = DEFAULT_DETECTOR, curved: bool | None = None) -> tuple[Path, list[str]]:
     """Detect rings and knots on a block folder (or a Mokume sample folder, whose U-Net maps are
     ignored and re-detected from its photos) and write the result as a block folder ``out``.
 
     Faces whose SVG a user corrected (module docstring) keep it: their rings come from it.
-    ``out`` may be ``src`` itself. Returns the manifest path and the warnings.
+    ``out`` may be ``src`` itself. ``curved``: as :func:`detect_face`. Returns the manifest path
+    and the warnings.
     """
     from ..block.io import MANIFEST, read_block, read_mokume, write_block
     from ..block.svg import read_traces_svg, write_traces_svg
@@ -168,7 +183,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     msgs: list[str] = []
     if todo:
         block, msgs = detect_block(block, rule=rule, knots=knots, faces=todo, progress=progress,
-                                   detector=detector)
+                                   detector=detector, curved=curved)
     else:
         block.meta = dict(block.meta)
     sigma_mm = RING_MAP_SIGMA_MM
@@ -208,7 +223,8 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
             write_traces_svg(face, tmp, photo_href=m["faces"][name].get("photo"))
         m["faces"][name]["traces_svg"] = svg.name
         hashes[name] = _sha256(svg)
-    det = m["meta"].setdefault("detection", {"detector": detector, "version": DETECT_VERSION, "rule": rule})
+    det = m["meta"].setdefault("detection", {"detector": detector, "version": DETECT_VERSION, "rule": rule,
+                                              "curved": _curved(curved)})
     det["svg_sha256"] = hashes
     det["user_svg"] = sorted(kept)
     _atomic_json(manifest, m)
@@ -233,7 +249,7 @@ def needs_detection(block: Block) -> bool:
 
 
 def _detection_key(block: Block, rule: str) -> str:
-    return digest("detect", DETECT_VERSION, rule, DEFAULT_DETECTOR, list(block.size_mm),
+    return digest("detect", DETECT_VERSION, rule, _curved(None), DEFAULT_DETECTOR, list(block.size_mm),
                   {n: f.photo for n, f in block.faces.items() if f.photo is not None})
 
 

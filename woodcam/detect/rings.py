@@ -154,9 +154,15 @@ LINK_GAP_WAVELENGTHS = 3.0
 #: band centres sit on whole numbers (same number or not), faint lines where they lie between.
 LINK_ORDER_TOL = 0.25
 #: Use the curved Gabor response (:mod:`woodcam.detect.curved`) for the ring phase by default.
-#: Off: it gains 0.01-0.02 F on the synthetic and real faces (README), but the radial fit from
-#: H11's detected rings then counts 2.1-2.8 times the rings the Mokume maps' fit counts (0.81
-#: without it; ``tests/detect/test_detect_downstream.py``), a regression not yet understood.
+#: Off (``woodcam rings detect --curved`` turns it on): it gains 0.01-0.02 F on the synthetic and
+#: real faces (README), costs ~1.5x the CPU, and moved the downstream fits both ways (in-sample
+#: loss H11 13.1 -> 11.0, CN03 12.5 -> 18.9 points within 2 px, DETECT_VERSION 5). With the fitter of FIT_VERSION 7
+#: the radial fit from H11's curved rings counted 2.1-2.8 times the Mokume maps' rings: its
+#: numbering took its ring scale from the wrong alignment peak; since every clear peak is tried
+#: and the one whose neighbouring rings are one year apart kept (FIT_VERSION 8), it counted
+#: 1.05-1.35 times; with speck pieces dropped after the snap (DETECT_VERSION 6) 0.37-0.89
+#: (median 0.75, below ``tests/detect/test_detect_downstream.py``'s 0.8), though its in-sample
+#: loss is then the lowest measured (H11 6.9 / 9.9, CN03 8.7 / 5.1 within 2 / 5 px).
 CURVED_GABOR = False
 #: Largest phase difference (radians) between the curved and the bank's straight response at
 #: a pixel for the curved one to be used there; elsewhere the bank's is kept. The curved Gabor
@@ -683,8 +689,12 @@ def _snap(lum: np.ndarray, polys: list, normal: np.ndarray, lam: np.ndarray, rul
         # where the line jumps to another dark line (two within reach), cut it there: the jump
         # itself would be a piece of "ring" running across the rings
         cuts = np.flatnonzero(np.abs(np.diff(mk)) > SNAP_JUMP_PX) + 1
-        for piece in np.split(moved, cuts):
-            if len(piece) >= 3:
+        lam_k = lam[r[owner == k], c[owner == k]]
+        for piece, lam_p in zip(np.split(moved, cuts), np.split(lam_k, cuts)):
+            # the cuts make new pieces: they obey the least length the contour runs did
+            # (MIN_TRACE_WAVELENGTHS), else a band snapped to pore streaks leaves specks
+            if len(piece) >= 3 and (np.sum(np.hypot(*np.diff(piece, axis=0).T))
+                                    >= MIN_TRACE_WAVELENGTHS * float(np.median(lam_p))):
                 out.append(piece)
                 src.append(k)
     return out, src

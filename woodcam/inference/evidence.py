@@ -272,6 +272,30 @@ def _residual_recipe(stem_recipe: Callable, max_points: int) -> Callable:
     return refit
 
 
+class _Blend:
+    """Mean growth time of several fields (the accepted hypotheses): ``(n, 3) mm -> (n,) years``.
+    All are fitted to the same numbered rings, so their years agree in meaning; the mean is the
+    evidence's average over the hypotheses it cannot tell apart."""
+
+    def __init__(self, fields: list[Callable], axis):
+        self.fields, self.axis = list(fields), axis
+
+    def __call__(self, points_mm):
+        p = np.asarray(points_mm, float)
+        return np.mean([np.asarray(f(p), float) for f in self.fields], axis=0)
+
+
+def blend_accepted(ev: EvidenceFit) -> EvidenceFit:
+    """``ev`` with its field replaced by the mean of its accepted hypotheses' fields (those
+    within :data:`EVIDENCE_ACCEPT_MARGIN` of the best held-out score); unchanged with one, or
+    when one of them holds knot strands (the knots are joined into the chosen field alone)."""
+    if len(ev.accepted) < 2 or any(hasattr(ev.hypotheses[n], "strands") for n in ev.accepted):
+        return ev
+    ev.field = _Blend([ev.hypotheses[n] for n in ev.accepted], getattr(ev.field, "axis", (0.0, 0.0, 1.0)))
+    ev.message += "; blended with " + ", ".join(n for n in ev.accepted if n != ev.chosen)
+    return ev
+
+
 Candidate = str
 #: Hypothesis families :func:`fit_evidence` can try.
 CANDIDATES: tuple[Candidate, ...] = ("radial", "rbf", "residual", "stem")
@@ -280,7 +304,7 @@ CANDIDATES: tuple[Candidate, ...] = ("radial", "rbf", "residual", "stem")
 def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                  candidates: tuple[str, ...] = CANDIDATES, seed: int = 0, extra: list[Hypothesis] | None = None,
                  warn: bool = True, recipes: dict[str, Callable] | None = None,
-                 stem: Callable | None = None) -> EvidenceFit:
+                 stem: Callable | None = None, blend: bool = False) -> EvidenceFit:
     """Fit the hypotheses and choose by leave-one-face-out evidence (module docstring).
 
     Parameters
@@ -296,6 +320,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     stem : the stem hypothesis' recipe (default :func:`stem_recipe`): one that remembers its
         last fit lets ``recipes`` built on the same stem fit reuse it in every fold
     warn : emit a :class:`~woodcam.errors.WoodcamWarning` when the choice is contradicted
+    blend : return the mean of the accepted hypotheses (:func:`blend_accepted`) as the field
 
     Returns
     -------
@@ -327,6 +352,8 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                 pass
         hyps += list(extra or [])
         result = choose(hyps, holdout_evidence(hyps, numbered, seed))
+        if blend:
+            result = blend_accepted(result)
     if warn and (result.contradicted or result.unverified):
         warnings.warn(result.message, WoodcamWarning, stacklevel=2)
     return result
@@ -456,6 +483,6 @@ class ConfidenceWood:
         return np.stack([np.clip(2 - 2 * c, 0, 1), np.clip(2 * c, 0, 1), np.full_like(c, 0.1)], axis=1)
 
 
-__all__ = ["CANDIDATES", "ConfidenceWood", "EvidenceFit", "Hypothesis", "bake_evidence", "choose", "confidence",
-           "distance_to_faces_mm", "face_score", "fit_evidence", "holdout_evidence", "radial_recipe",
+__all__ = ["CANDIDATES", "ConfidenceWood", "EvidenceFit", "Hypothesis", "bake_evidence", "blend_accepted", "choose",
+           "confidence", "distance_to_faces_mm", "face_score", "fit_evidence", "holdout_evidence", "radial_recipe",
            "stem_recipe", "uncertainty_report", "uncertainty_years"]

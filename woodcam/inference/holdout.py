@@ -45,9 +45,16 @@ if TYPE_CHECKING:
 ALL_FACES = "all faces"
 CONTROL = "held out, moved half a ring (chance)"
 #: Issue 12 part 7: straight parallel rings with the held-out prediction's mean orientation and
-#: spacing on the face, at the best of :data:`STRAIGHT_PHASES` phases (so it is phase-free):
-#: what a fit scores by getting only orientation and spacing right.
+#: spacing on the face (the least-squares plane of its growth time: fitted from the other faces,
+#: like the prediction), at the best of :data:`STRAIGHT_PHASES` phases *chosen by the held-out
+#: ring map itself* (so it is phase-free): what a fit scores by getting only orientation and
+#: spacing right, with the phase given. A fit gets no such choice, so two more rows make the
+#: comparison like for like: :data:`BEST_PHASE` (the prediction with the same choice of phase)
+#: and :data:`STRAIGHT_OWN` (the straight rings at the prediction's own phase, the plane
+#: unshifted).
 STRAIGHT = "straight rings, same orientation and spacing, best phase"
+BEST_PHASE = "held out, best phase (as the straight rings)"
+STRAIGHT_OWN = "straight rings at the prediction's own phase"
 STRAIGHT_PHASES = 10
 
 
@@ -61,12 +68,17 @@ def straight_rings(years: np.ndarray) -> np.ndarray:
     return (X @ coef).reshape(h, w)
 
 
-def _straight_score(face, years, ridge, excl, thresholds) -> FaceScore:
-    """The :data:`STRAIGHT` control of one face: the best phase by ridge pixels within 2 px."""
-    plane = straight_rings(years)
-    scores = [_score(face, plane + ph, ridge, excl, thresholds)
+def _best_phase_score(face, years, ridge, excl, thresholds) -> FaceScore:
+    """``years`` shifted by the best of :data:`STRAIGHT_PHASES` phases, judged by the face's own
+    ridge pixels within 2 px (the oracle phase of the :data:`STRAIGHT` control)."""
+    scores = [_score(face, years + ph, ridge, excl, thresholds)
               for ph in np.arange(STRAIGHT_PHASES) / STRAIGHT_PHASES]
     return max(scores, key=lambda sc: sc.shares.get("ridge_2", 0.0))
+
+
+def _straight_score(face, years, ridge, excl, thresholds) -> FaceScore:
+    """The :data:`STRAIGHT` control of one face: the best phase by ridge pixels within 2 px."""
+    return _best_phase_score(face, straight_rings(years), ridge, excl, thresholds)
 
 
 def ridge_pixels(ring_map: np.ndarray, threshold: float = RING_MAP_THRESHOLD,
@@ -179,8 +191,8 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
 
     Returns
     -------
-    dict with ``"held_out"``, :data:`CONTROL` and ``"all faces"``: each ``method -> list of
-    FaceScore``;
+    dict with ``"held_out"``, :data:`CONTROL`, :data:`STRAIGHT`, :data:`BEST_PHASE`,
+    :data:`STRAIGHT_OWN` and ``"all faces"``: each ``method -> list of FaceScore``;
     ``"fit_s"``: method -> mean held-out fit seconds; ``"table"``: markdown text.
     """
     ref_block = block if reference is None else reference
@@ -193,6 +205,8 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
     held = {m: [] for m in methods}
     control = {m: [] for m in methods}
     straight = {m: [] for m in methods}
+    best_phase = {m: [] for m in methods}
+    straight_own = {m: [] for m in methods}
     insample = {m: [] for m in methods}
     times = {m: [] for m in methods}
     for m in methods:
@@ -207,13 +221,16 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
             held[m].append(_score(face, years, ridge, excl, HOLDOUT_THRESHOLDS_PX))
             control[m].append(_score(face, years + 0.5, ridge, excl, HOLDOUT_THRESHOLDS_PX))
             straight[m].append(_straight_score(face, years, ridge, excl, HOLDOUT_THRESHOLDS_PX))
+            best_phase[m].append(_best_phase_score(face, years, ridge, excl, HOLDOUT_THRESHOLDS_PX))
+            straight_own[m].append(_score(face, straight_rings(years), ridge, excl, HOLDOUT_THRESHOLDS_PX))
             insample[m].append(_score(face, face_years(full, face, shape, block.size_mm), ridge, excl,
                                       HOLDOUT_THRESHOLDS_PX))
             if progress:
                 s = held[m][-1].shares
                 progress(f"{block.name} {m} hold out {face}: ridge {s['ridge_1']:.0f}/{s['ridge_2']:.0f}%, "
                          f"line {s['line_1']:.0f}/{s['line_2']:.0f}% ({times[m][-1]:.1f} s)")
-    res = {"held_out": held, CONTROL: control, STRAIGHT: straight, ALL_FACES: insample,
+    res = {"held_out": held, CONTROL: control, STRAIGHT: straight, BEST_PHASE: best_phase,
+           STRAIGHT_OWN: straight_own, ALL_FACES: insample,
            "fit_s": {m: float(np.mean(t)) for m, t in times.items()}}
     res["table"] = holdout_table(block.name, res, list(methods))
     if out_dir is not None:
@@ -244,6 +261,8 @@ def holdout_table(name: str, res: dict, methods: list[str], thresholds=HOLDOUT_T
         lines.append(row(sc.face, {m: held[m][i].shares for m in methods}))
     for label, part in (("**mean, held out**", held), (f"mean, {CONTROL}", res[CONTROL]),
                         (f"mean, {STRAIGHT}", res[STRAIGHT]) if STRAIGHT in res else (None, None),
+                        (f"mean, {BEST_PHASE}", res[BEST_PHASE]) if BEST_PHASE in res else (None, None),
+                        (f"mean, {STRAIGHT_OWN}", res[STRAIGHT_OWN]) if STRAIGHT_OWN in res else (None, None),
                         (f"mean, {ALL_FACES} (in-sample)", res[ALL_FACES])):
         if label is None:
             continue
@@ -298,6 +317,6 @@ def plot_holdout(path, block, scores: list[FaceScore], title: str = ""):
     return path
 
 
-__all__ = ["ALL_FACES", "CONTROL", "STRAIGHT", "FaceScore", "face_years", "holdout_table",
+__all__ = ["ALL_FACES", "BEST_PHASE", "CONTROL", "STRAIGHT", "STRAIGHT_OWN", "FaceScore", "face_years", "holdout_table",
            "leave_one_face_out", "plot_holdout", "ridge_pixels", "ring_lines_px", "score_face",
            "straight_rings"]

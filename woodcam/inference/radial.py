@@ -457,18 +457,24 @@ def _alignment(levels: np.ndarray, weights: np.ndarray, spacing_mm: float):
     return ks, np.exp(2j * np.pi * np.outer(ks, levels)) @ w
 
 
-def _by_numbering(obs: RingObservations, found: list) -> list:
+def _by_numbering(obs: RingObservations, found: list) -> tuple[list, tuple | None]:
     """Axis fits ``found`` (lowest in-sample cost first) reordered so the first numbers the
     rings consistently: the lowest-cost basin whose :func:`step_consistency` is within
     :data:`~woodcam.tolerances.NUMBERING_STEP_MARGIN` of the best basin's. With unlabelled
     rings every basin fits its own free ring levels, so its in-sample cost says little about
-    its numbering; the faces' neighbouring rings do (issue 12: H11's bistable folds)."""
+    its numbering; the faces' neighbouring rings do (issue 12: H11's bistable folds).
+
+    Returns ``(reordered fits, the first one's _initial_numbering)``; the numbering is None
+    where none was computed (labelled rings, a single basin), and is handed to
+    :func:`_finish_radial` so the chosen basin is not numbered twice.
+    """
     if obs.labelled or len(found) < 2:
-        return found
-    cons = [_initial_numbering(obs, f[0])[3] for f in found]
-    best = max(cons)
-    good = [f for f, c in zip(found, cons) if c >= best - NUMBERING_STEP_MARGIN]
-    return good + [f for f in found if not any(f is g for g in good)]
+        return found, None
+    nums = [_initial_numbering(obs, f[0]) for f in found]
+    best = max(n[3] for n in nums)
+    good = [i for i, n in enumerate(nums) if n[3] >= best - NUMBERING_STEP_MARGIN]
+    order = good + [i for i in range(len(found)) if i not in good]
+    return [found[i] for i in order], nums[order[0]]
 
 
 #: Ring spacings (mm) of recent observation sets, keyed by their content (points, ring groups,
@@ -626,8 +632,10 @@ def _fit_radial(obs, size_mm, K, M, ridge, max_relabel_rounds, seed, history, se
     if obs.labelled:
         found = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, **search)
     else:  # unlabelled: the basin that numbers the rings consistently (:func:`_by_numbering`)
-        found = _by_numbering(obs, fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed,
-                                                      n_basins=_NUMBERING_BASINS, **search))[0]
+        ordered, numbering = _by_numbering(obs, fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed,
+                                                                   n_basins=_NUMBERING_BASINS, **search))
+        return _finish_radial(obs, size_mm, ordered[0], K, M, ridge, max_relabel_rounds, seed, history,
+                              numbering=numbering)[0]
     return _finish_radial(obs, size_mm, found, K, M, ridge, max_relabel_rounds, seed, history)[0]
 
 
@@ -646,9 +654,10 @@ def fit_radial_hypotheses(obs: RingObservations, size_mm, n_basins: int = 3, K: 
     numbered : the observations with the years the fits used (relabelled traces corrected)
     """
     with _one_blas_thread():
-        found = _by_numbering(obs, fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, n_basins=n_basins,
-                                                      **search))
-        first, numbered = _finish_radial(obs, size_mm, found[0], K, M, ridge, max_relabel_rounds, seed, history)
+        found, numbering = _by_numbering(obs, fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed,
+                                                                 n_basins=n_basins, **search))
+        first, numbered = _finish_radial(obs, size_mm, found[0], K, M, ridge, max_relabel_rounds, seed, history,
+                                         numbering=numbering)
         fields = [first]
         for shape_field, _, _ in found[1:]:
             if obs.labelled:  # its own mislabel correction, not the first hypothesis'
@@ -662,16 +671,20 @@ def fit_radial_hypotheses(obs: RingObservations, size_mm, n_basins: int = 3, K: 
     return fields, numbered
 
 
-def _finish_radial(obs, size_mm, found, K, M, ridge, max_relabel_rounds, seed, history, relabel=True):
+def _finish_radial(obs, size_mm, found, K, M, ridge, max_relabel_rounds, seed, history, relabel=True,
+                   numbering=None):
     """Number (unlabelled), relabel, smooth and warp the axis fit ``found`` (a triple of
-    :func:`fit_axis_and_shape`); returns ``(field, observations with the years used)``."""
+    :func:`fit_axis_and_shape`); returns ``(field, observations with the years used)``.
+
+    numbering : ``_initial_numbering(obs, found[0])`` where the caller has it already
+        (:func:`_by_numbering`), else None to compute it here."""
     labelled_in = obs.labelled
     if labelled_in:
         field = found[0]
     else:
         shape_field = found[0]
         # Levels of every group from the fitted shape (groups not in the fitting subset too).
-        obs, k, a, _ = _initial_numbering(obs, shape_field)
+        obs, k, a, _ = numbering if numbering is not None else _initial_numbering(obs, shape_field)
         start = RadialField(shape_field.pith_mm, shape_field.axis, shape_field.z_scale_mm, K, M,
                             shape_field.coef * k, a)
         field = _refit_labelled(obs, size_mm, start, ridge, seed=seed)
