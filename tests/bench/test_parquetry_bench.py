@@ -5,7 +5,7 @@ degradation (sequential vs interleaved) on one sheet.
 Run as a benchmark (``pytest -m bench tests/bench/test_parquetry_bench.py``) or as a script
 that prints and stores the figures::
 
-    python tests/bench/test_parquetry_bench.py quality|speed|fig14|exhaustive|exhaustive4|full OUT.json [COARSE_FACTOR | IMAGES | OUT_DIR]
+    python tests/bench/test_parquetry_bench.py quality|speed|fig14|exhaustive|exhaustive4|full|calm OUT.json [COARSE_FACTOR | IMAGES | OUT_DIR] [OUT_DIR]
 
 Timings are CPU seconds of the matching (``time.process_time``), so they are comparable under
 the shared machine's load; wall seconds are stored too.
@@ -40,8 +40,34 @@ def _sheets(size_mm, ppm, leaves=2, mokume=True, n_species=6, blocks=None):
             if (root / name).is_dir():
                 out += mokume_veneers(root / name)
     for spec, sp in (blocks or SPECIES_BLOCKS[:n_species]):
-        out += slice_veneers(open_stock(spec, species=sp), leaves, size_mm, px_per_mm=ppm, id_prefix=sp)
+        if spec == FAST_GROWN:
+            out += slice_veneers(_fast_grown(sp), leaves, size_mm, px_per_mm=ppm, id_prefix=f"{sp}-fast")
+        else:
+            out += slice_veneers(open_stock(spec, species=sp), leaves, size_mm, px_per_mm=ppm, id_prefix=sp)
     return out
+
+
+#: A flitch from a fast-grown tree, the calm wood a parquetry maker keeps for plain areas:
+#: growth rings FAST_GROWN_RING_MM wide (plantation-grown growth; an assumption, no measured
+#: tree), the pith 300 mm in front of the flitch, so its leaves (y planes, 500 mm from the pith)
+#: are flat-sawn with bands of even earlywood tens of mm wide.
+FAST_GROWN = "fast-grown"
+FAST_GROWN_RING_MM = 10.0
+
+
+def _fast_grown(species, ring_mm=FAST_GROWN_RING_MM):
+    """The fast-grown flitch (600 x 400 x 50 mm, pith along X at y = -300, z = 25 mm) in the
+    colours of ``species``: a radial-scaling field (seed 000, eq. 7-9) as the built-in blocks
+    have, with wider rings."""
+    from woodcam.appearance import ColorMapAppearance, Wood
+    from woodcam.fields.base import LogFrame
+    from woodcam.fields.radial import RadialScalingField
+    from woodcam.stock import Stock
+
+    frame = LogFrame((0.0, -300.0, 25.0), (1.0, 0.0, 0.0))
+    field = RadialScalingField.random(frame, ring_mm, np.random.default_rng(5), sigma=0.06,
+                                      half_length_mm=200.0)
+    return Stock(f"{FAST_GROWN}-{species}", (600.0, 400.0, 50.0), Wood(field, ColorMapAppearance(species)))
 
 
 #: Six colour presets on four grain layouts: a continuum of tones from walnut to maple (two
@@ -245,6 +271,32 @@ def full_workload(out_dir=None, runs=("fast", "eq4_only", "reuse")):
     return out
 
 
+def calm_wood(images=("moon", "immunohistochemistry"), out_dir=None):
+    """The SSIM attempt with calm wood (README, "calm wood"): the full workload's settings on
+    a pool of the six SPECIES_BLOCKS leaves + four fast-grown leaves (walnut, maple, oak,
+    cherry; FAST_GROWN_RING_MM rings) + the 12 Mokume photos, 600 x 400 mm leaves at 4 px/mm.
+    Developed on targets outside the bar's four (skimage ``moon``, ``immunohistochemistry``,
+    ``clock``); pass ``camera,astronaut,coffee,chelsea`` to measure the bar's targets."""
+    from skimage import data
+
+    from woodcam.parquetry import ParquetryParams, build_parquetry, write_parquetry
+
+    blocks = SPECIES_BLOCKS + tuple((FAST_GROWN, sp) for sp in ("walnut", "maple", "oak", "cherry"))
+    sheets = _sheets((600, 400), 4.0, leaves=1, mokume=True, blocks=blocks)
+    out = {"workload": "skimage targets at 360 mm, 14 mm patches, one 600x400 mm leaf of each of the six "
+           "SPECIES_BLOCKS + four fast-grown leaves (10 mm rings) + 12 Mokume face photos, "
+           "4 px/mm, 15 rotations, seams", "images": {}}
+    for name in images:
+        img = getattr(data, name)().astype(np.float32) / 255
+        prm = ParquetryParams()
+        run = build_parquetry([img], sheets, prm)
+        out["images"][name] = d = _figures(run, prm)
+        if out_dir is not None:
+            write_parquetry(run, Path(out_dir) / name)
+        print(name, json.dumps(d), flush=True)
+    return out
+
+
 @functools.lru_cache(maxsize=1)
 def _full_fast():
     return full_workload(runs=("fast",))["runs"]["fast"]
@@ -273,7 +325,8 @@ def test_quality_on_the_full_workload_on_the_targets_own_pixels():
 @pytest.mark.xfail(strict=True, reason="not met: at 1.4 px/mm of target every veneer here has "
                    "grain (std 0.02-0.05 in 5 mm windows, far above SSIM's C2 = 0.03^2) where "
                    "the camera is flat (41 % of cells), which a flat colour does not; even the "
-                   "same wood blurred at 1 mm only ties on the native grid; see README")
+                   "same wood blurred at 1 mm only ties on the native grid, and calm fast-grown "
+                   "leaves (calm_wood) only halve the gap (0.548 vs 0.610); see README")
 def test_full_workload_beats_the_baseline_on_ssim():
     f = _full_fast()
     assert f["ssim"] > f["ssim_baseline"] and f["ssim_native"] > f["ssim_native_baseline"]
@@ -288,11 +341,13 @@ def test_fast_mode_within_5_percent_of_exhaustive_on_camera():
 if __name__ == "__main__":
     what, dest = sys.argv[1], Path(sys.argv[2])
     fn = {"quality": quality, "speed": speed, "fig14": fig14, "exhaustive": exhaustive_vs_fast,
-          "exhaustive4": exhaustive_vs_fast_4ppm, "full": full_workload}[what]
+          "exhaustive4": exhaustive_vs_fast_4ppm, "full": full_workload, "calm": calm_wood}[what]
     extra = {}
     if len(sys.argv) > 3:
         extra = ({"coarse_factor": int(sys.argv[3])} if what == "speed"
                  else {"out_dir": sys.argv[3]} if what == "full"
+                 else {"images": tuple(sys.argv[3].split(",")), "out_dir": (sys.argv[4:] or [None])[0]}
+                 if what == "calm"
                  else {"images": tuple(sys.argv[3].split(","))})
     res = fn(**extra)
     dest.write_text(json.dumps(res, indent=1))
