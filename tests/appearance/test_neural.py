@@ -24,7 +24,7 @@ from woodcam.block import Block, Face
 from woodcam.errors import WoodcamError
 from woodcam.fields import LogFrame, arf
 from woodcam.fields.radial import RadialScalingField
-from woodcam.frames import FACE_AXIS, FACES, face_pixel_points
+from woodcam.frames import FACE_AXIS, FACES
 from woodcam.synth import synth_block
 from woodcam.tolerances import NEURAL_FACE_MAE, NEURAL_VOLUME_MAE
 
