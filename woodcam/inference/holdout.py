@@ -76,11 +76,6 @@ def _best_phase_score(face, years, ridge, excl, thresholds) -> FaceScore:
     return max(scores, key=lambda sc: sc.shares.get("ridge_2", 0.0))
 
 
-def _straight_score(face, years, ridge, excl, thresholds) -> FaceScore:
-    """The :data:`STRAIGHT` control of one face: the best phase by ridge pixels within 2 px."""
-    return _best_phase_score(face, straight_rings(years), ridge, excl, thresholds)
-
-
 def ridge_pixels(ring_map: np.ndarray, threshold: float = RING_MAP_THRESHOLD,
                  exclude: np.ndarray | None = None) -> np.ndarray:
     """Ridge of a ring map: ``(k, 2)`` int pixel ``(row, col)`` of the skeleton of its ring pixels.
@@ -220,9 +215,10 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
             years = face_years(fit, face, shape, block.size_mm)
             held[m].append(_score(face, years, ridge, excl, HOLDOUT_THRESHOLDS_PX))
             control[m].append(_score(face, years + 0.5, ridge, excl, HOLDOUT_THRESHOLDS_PX))
-            straight[m].append(_straight_score(face, years, ridge, excl, HOLDOUT_THRESHOLDS_PX))
+            plane = straight_rings(years)  # the STRAIGHT control at its best phase and at the prediction's own
+            straight[m].append(_best_phase_score(face, plane, ridge, excl, HOLDOUT_THRESHOLDS_PX))
             best_phase[m].append(_best_phase_score(face, years, ridge, excl, HOLDOUT_THRESHOLDS_PX))
-            straight_own[m].append(_score(face, straight_rings(years), ridge, excl, HOLDOUT_THRESHOLDS_PX))
+            straight_own[m].append(_score(face, plane, ridge, excl, HOLDOUT_THRESHOLDS_PX))
             insample[m].append(_score(face, face_years(full, face, shape, block.size_mm), ridge, excl,
                                       HOLDOUT_THRESHOLDS_PX))
             if progress:
