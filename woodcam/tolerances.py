@@ -335,6 +335,32 @@ KNOT_MIN_ENTRY_COS = 0.2
 #: pith on one side only (half a ring: more than a trace's mislabel or a fit's wobble).
 KNOT_PITH_YEARS = 0.5
 
+#: Spacing (mm) at which the knot masks are sampled for a knot's cone fit
+#: (:func:`woodcam.inference.knots._fit_cone`): knots are 2-20 mm across, so a 3 mm exit still
+#: has ~30 samples, and a 80 mm face ~6400.
+KNOT_CONE_SAMPLE_MM = 1.0
+
+#: Width (mm) of the logistic edge of the cone fit's inside-ness: about two mask samples, so
+#: a sample's vote is smooth across the mask's pixel edge and its jagged outline.
+KNOT_CONE_EDGE_MM = 1.0
+
+#: Knot-free samples this far (mm) beyond twice the starting radius of the starting cone are
+#: left out of its fit: they cannot pull it, and leaving them out keeps the fit fast.
+KNOT_CONE_REACH_MM = 8.0
+
+#: Function evaluations of one start of a knot's cone fit (8 parameters): the fits on dev
+#: seed 7777 settle within ~30.
+KNOT_CONE_MAX_NFEV = 40
+
+#: Smallest knot radius (mm) a fitted cone gives anywhere along its strand (a branch at the
+#: pith is a few mm thick; seed 001's logs start at 2-6 mm).
+KNOT_CONE_MIN_RADIUS_MM = 1.0
+
+#: Exits on two faces whose mask samples come this close (mm) across the edge between the faces
+#: are one knot end (a knot cut by a block edge): two sample spacings, so a mask that reaches
+#: the edge on both sides always touches.
+KNOT_END_TOUCH_MM = 2.0 * KNOT_CONE_SAMPLE_MM
+
 #: Rounds of the joint stem + knot-bend fit (:func:`woodcam.inference.knots.fit_knotted_stem`):
 #: each refits the stem to the years less the bend its knots put there. Dev seed 21, six noisy
 #: faces, blocks 1 / 9 / 10 within 1 mm: 1 round 97 / 53 / 97 %, 2 rounds 99 / 68 / 98 %, 4

@@ -27,8 +27,9 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: hypothesis and per-fold pith refits in the evidence fit; 7: knot strands end at the pith, one-exit
 #: strands run toward it and keep the stem's ring spacing; 8: unlabelled rings numbered by the pith
 #: basin whose numbering makes neighbouring rings one year apart; 9: the knots' ring bend on by
-#: default, competing while the evidence keeps its stem).
-FIT_VERSION = 9
+#: default, competing while the evidence keeps its stem; 10: knot strands are the cones fitted
+#: to the face masks, exits touching across a block edge one knot end).
+FIT_VERSION = 10
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,

@@ -34,9 +34,10 @@ from ..fields.base import central_gradient
 from ..fields.knot_strands import KnotStrand, StemWithKnots
 from ..fields.knots import KnotParams
 from ..frames import FACE_NORMAL, pixel_to_block
-from ..tolerances import (DEAD_KNOT_BANDS_MM, DEAD_KNOT_MIN_OUTLINED, DEAD_KNOT_SECTORS, KNOT_MIN_AREA_PX,
-                          KNOT_BEND_MAX_BEFORE_PITH, KNOT_BEND_ROUNDS, KNOT_MIN_AREA_SHARE, KNOT_MIN_ENTRY_COS,
-                          KNOT_PAIR_MIN_ANGLE_DEG, KNOT_PITH_YEARS)
+from ..tolerances import (DEAD_KNOT_BANDS_MM, DEAD_KNOT_MIN_OUTLINED, DEAD_KNOT_SECTORS, KNOT_BEND_MAX_BEFORE_PITH,
+                          KNOT_BEND_ROUNDS, KNOT_CONE_EDGE_MM, KNOT_CONE_MAX_NFEV, KNOT_CONE_MIN_RADIUS_MM,
+                          KNOT_CONE_REACH_MM, KNOT_CONE_SAMPLE_MM, KNOT_END_TOUCH_MM, KNOT_MIN_AREA_PX, KNOT_MIN_AREA_SHARE,
+                          KNOT_MIN_ENTRY_COS, KNOT_PAIR_MIN_ANGLE_DEG, KNOT_PITH_YEARS)
 
 if TYPE_CHECKING:
     from .observations import RingObservations
@@ -82,16 +83,29 @@ def exit_is_dead(photo, region, pixel_mm: float) -> tuple[bool, float]:
 
 def knot_exits(block, faces=None) -> list[dict]:
     """Knot exits on ``faces`` (default all): ``{"face", "centre_mm" (3,), "radius_mm", "dead",
-    "outlined"}`` (:func:`exit_is_dead` on the face photo; alive without a photo)."""
+    "outlined", "surface", "pixels"}`` (:func:`exit_is_dead` on the face photo; alive without a
+    photo). ``surface`` is shared by all exits: ``(points_mm (n, 3), knot (n,) bool)``, the
+    masks of every face given one (knot-free faces too), sampled every
+    :data:`~woodcam.tolerances.KNOT_CONE_SAMPLE_MM`; ``pixels`` (m,) int indexes the exit's own
+    samples in it (:func:`_fit_cone` fits a strand's cone to them)."""
     from scipy import ndimage
 
     out = []
+    pts, flags, regions = [], [], []  # the sampled surface and, per exit, its sampled region
     for name in (list(block.faces) if faces is None else faces):
         f = block.faces.get(name)
         mask = None if f is None else f.extras.get("knot_mask")
-        if mask is None or not np.any(mask):
+        if mask is None:
             continue
+        m = np.asarray(mask, bool)
         px = min(block.face_pixel_size_mm(name))
+        step = max(1, int(round(KNOT_CONE_SAMPLE_MM / px)))
+        rows, cols = np.mgrid[step // 2:m.shape[0]:step, step // 2:m.shape[1]:step]
+        base = sum(len(q) for q in pts)
+        pts.append(pixel_to_block(name, rows.ravel(), cols.ravel(), f.shape, block.size_mm))
+        flags.append(m[rows, cols].ravel())
+        if not m.any():
+            continue
         lab, n = ndimage.label(np.asarray(mask, bool))
         areas = np.bincount(lab.ravel())[1:]
         for i in range(1, n + 1):
@@ -104,11 +118,87 @@ def knot_exits(block, faces=None) -> list[dict]:
             dead, share = exit_is_dead(f.photo, region, px) if f.photo is not None else (False, 0.0)
             out.append({"face": name, "centre_mm": c, "radius_mm": float(np.sqrt(len(rr) / np.pi) * px),
                         "dead": dead, "outlined": share})
+            regions.append(base + np.flatnonzero(region[rows, cols].ravel()))
+    surface = (np.concatenate(pts), np.concatenate(flags)) if pts else (np.zeros((0, 3)), np.zeros(0, bool))
+    for e, idx in zip(out, regions):
+        e.update(surface=surface, pixels=idx)
     return out
 
 
 #: Samples along a paired strand's line where the stem's years are looked at.
 _LINE_SAMPLES = 256
+
+
+def _cone_margin(points, c, u, rc, slope):
+    """``R(t) - d`` (mm, > 0 inside) of ``points (n, 3)`` for the cone round the line through
+    ``c`` along unit ``u`` with radius ``rc + slope t`` at ``t = (p - c) . u``."""
+    q = points - c
+    t = q @ u
+    d = np.linalg.norm(q - t[:, None] * u, axis=1)
+    return np.maximum(rc + slope * t, KNOT_CONE_MIN_RADIUS_MM) - d
+
+
+def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False):
+    """A knot's cone fitted to the knot masks of every face: ``(c (3,), u (3,), rc, slope,
+    cost)``; ``u0`` (3,) or (k, 3) starting directions, the fit of least cost kept; ``outward``:
+    each ``u0`` points away from the pith and the radius may not shrink along it.
+
+    A branch is a cone round its strand (seed 001/003: its diameter grows along it), so its
+    exits are where that cone cuts the block's faces. The cone is fitted to the sampled face
+    masks ``surface = (points (n, 3), knot (n,) bool)`` (:func:`knot_exits`): its ``positive``
+    samples (the exits of this knot, index array) inside, every knot-free sample of every
+    masked face outside (a face without a mask says nothing), other knots' samples (``ignore``)
+    left out; least squares of a logistic inside-ness (width
+    :data:`~woodcam.tolerances.KNOT_CONE_EDGE_MM`), every sample weighted alike (balancing the
+    few knot samples against the many clear ones widened the cone by 1-3 mm).
+    Starts from the line through ``c0`` along ``u0`` with radius ``r0`` (the exits' centres and
+    mean radius). Why: the exits' centroids and areas alone misplace a strand whose exits are
+    cut by a block edge or split over two faces, and its bend and rings then land off the knot
+    (dev seed 7777 block 2: the true strand takes the bend's cut planes from 26 to 94 % within
+    1 mm; scipy has no cone fit, so it is written here)."""
+    from scipy.optimize import least_squares
+
+    pts, knot = surface
+    keep = np.ones(len(pts), bool)
+    keep[ignore] = False
+    keep[positive] = True
+    label = np.zeros(len(pts))
+    label[positive] = 1.0
+    # only samples near the starting cone can move it (speed: faces are ~10^4 samples each)
+    near = keep & (np.linalg.norm(pts - c0, axis=1) < np.ptp(pts[positive], axis=0).max() + 2.0 * r0
+                   + KNOT_CONE_REACH_MM)
+    near &= label.astype(bool) | ~knot
+    P, y = pts[near], label[near]
+    w = 1.0 / np.sqrt(max(len(y), 1))  # every sample alike: the misfit is the area misclassified
+
+    def residuals(x):
+        u = x[3:6] / np.linalg.norm(x[3:6])
+        m = _cone_margin(P, x[:3], u, x[6], x[7]) / KNOT_CONE_EDGE_MM
+        inside = 0.5 * (1.0 + np.tanh(0.5 * m))  # logistic, overflow-free
+        gauge = [(x[:3] - c0) @ u, np.linalg.norm(x[3:6]) - 1.0]  # c slides along u; |u| free
+        return np.concatenate([w * (inside - y), gauge])
+
+    best = None
+    # outward: the knot thickens away from the pith (seed 003: its radius grows with time)
+    bounds = ([-np.inf] * 7 + [0.0], [np.inf] * 8) if outward else (-np.inf, np.inf)
+    for u_start in np.atleast_2d(u0):  # several starting directions: the least misfit wins
+        x0 = np.concatenate([c0, u_start, [r0, 0.0]])
+        fit = least_squares(residuals, x0, x_scale=np.array([5, 5, 5, 0.2, 0.2, 0.2, 1.0, 0.05]),
+                            max_nfev=KNOT_CONE_MAX_NFEV, bounds=bounds)
+        if best is None or fit.cost < best[0].cost:
+            best = fit, u_start
+    x, u_start = best[0].x, best[1]
+    u = x[3:6] / np.linalg.norm(x[3:6])
+    sign = np.sign(u @ u_start) or 1.0  # keep the starting sense (exit to exit)
+    return x[:3], u * sign, float(x[6]), float(x[7]) * sign, float(best[0].cost)
+
+
+def _pith_first(stem, point_mm, u, length: float) -> bool:
+    """Is the pith (the least stem years) behind ``point_mm (3,)`` along ``u (3,)``, within
+    ``length`` mm either way (the sense a branch grows out along)?"""
+    t = np.linspace(-length, length, _LINE_SAMPLES)
+    g = np.asarray(stem(point_mm + t[:, None] * u), float)
+    return bool(np.nanargmin(np.where(np.isfinite(g), g, np.inf)) < _LINE_SAMPLES // 2) if np.isfinite(g).any() else True
 
 
 def _toward_pith(stem, point_mm, inward, length: float):
@@ -130,50 +220,143 @@ def fit_knot_strands(block, stem, faces=None) -> list[KnotStrand]:
     return strands_from_exits(knot_exits(block, faces), stem, block.size_mm)
 
 
-def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike) -> list[KnotStrand]:
+def _ends(exits, cones: bool) -> list[list[int]]:
+    """Exits grouped into knot ends: exits on two faces whose mask samples touch across the
+    block edge between them are one cross-section of a knot cut by that edge (one end, not two
+    knots: dev seed 7777 block 2 enters by its front and left faces at one corner and leaves by
+    its right and back faces at the opposite one). Without ``cones`` (or mask samples) every
+    exit is its own end."""
+    parent = list(range(len(exits)))
+
+    def root(k):
+        while parent[k] != k:
+            k = parent[k]
+        return k
+
+    if cones and exits and "surface" in exits[0]:
+        from scipy.spatial import cKDTree
+
+        pts = exits[0]["surface"][0]
+        trees = [cKDTree(pts[e["pixels"]]) if len(e["pixels"]) else None for e in exits]
+        for i in range(len(exits)):
+            for j in range(i + 1, len(exits)):
+                if exits[i]["face"] == exits[j]["face"] or trees[i] is None or trees[j] is None:
+                    continue
+                if trees[i].sparse_distance_matrix(trees[j], KNOT_END_TOUCH_MM).nnz:
+                    parent[root(j)] = root(i)
+    groups: dict[int, list[int]] = {}
+    for k in range(len(exits)):
+        groups.setdefault(root(k), []).append(k)
+    return list(groups.values())
+
+
+def _end_centre(exits, end) -> np.ndarray:
+    """(3,) mm: the middle of a knot end's mask samples (its exits' centre when it has none)."""
+    if "surface" in exits[end[0]]:
+        idx = np.concatenate([exits[k]["pixels"] for k in end])
+        if len(idx):
+            return exits[end[0]]["surface"][0][idx].mean(axis=0)
+    return np.mean([exits[k]["centre_mm"] for k in end], axis=0)
+
+
+def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
+                       cones: bool = True) -> list[KnotStrand]:
     """Strands of the knot ``exits`` (:func:`knot_exits`) in ``stem``, a block of ``size_mm``
-    (module docstring)."""
+    (module docstring). ``cones``: exits touching across a block edge are one knot end
+    (:func:`_ends`), and a paired strand's line and radius are its cone fitted to the face masks
+    (:func:`_fit_cone`; exits from :func:`knot_exits` carry the samples); False: the line
+    through two exits' centroids with radii from their areas."""
     if not exits:
         return []
     axis = np.asarray(getattr(stem, "axis", (0.0, 0.0, 1.0)), float)
     axis /= np.linalg.norm(axis)
     length = float(np.linalg.norm(size_mm))
+    ends = _ends(exits, cones)
+    centres = [_end_centre(exits, e) for e in ends]
     pairs = []
-    for i in range(len(exits)):
-        for j in range(i + 1, len(exits)):
-            if exits[i]["face"] == exits[j]["face"]:
+    for i in range(len(ends)):
+        for j in range(i + 1, len(ends)):
+            if {exits[k]["face"] for k in ends[i]} & {exits[k]["face"] for k in ends[j]}:
                 continue
-            v = exits[j]["centre_mm"] - exits[i]["centre_mm"]
+            v = centres[j] - centres[i]
             dist = float(np.linalg.norm(v))
             if dist > 0 and abs(v @ axis) / dist < np.cos(np.deg2rad(KNOT_PAIR_MIN_ANGLE_DEG)):
                 pairs.append((dist, i, j))
-    used, strands = set(), []
-    for dist, i, j in sorted(pairs):
-        if i in used or j in used:
-            continue
-        a, b = exits[i], exits[j]
-        u = (b["centre_mm"] - a["centre_mm"]) / dist
+    surface = exits[0].get("surface") if cones else None
+
+    def place(group, anchors, starts, single=False):
+        """The strand of exits ``group``: its line starts along each of ``starts (k, 3)``
+        through the middle of ``anchors (m, 3)`` (mm), whose extent along it is where the exits
+        lie; None where the pith lies between them, or (``single``: the exits of one end) where
+        the line is not long across the end or runs along the stem."""
+        c0 = anchors.mean(axis=0)
+        u, cone = starts[0], None
+        if surface is not None:  # the strand of the cone the masks show
+            others = [k for k in range(len(exits)) if k not in group]
+            cone = _fit_cone(surface, np.concatenate([exits[k]["pixels"] for k in group]),
+                             np.concatenate([exits[k]["pixels"] for k in others]) if others else np.zeros(0, int),
+                             c0, starts, float(np.mean([exits[k]["radius_mm"] for k in group])))
+            c0, u = cone[0], cone[1]
+            if _pith_first(stem, c0, u, length) == (cone[3] < 0):  # thinner away from the pith
+                cone = _fit_cone(surface, np.concatenate([exits[k]["pixels"] for k in group]),
+                                 np.concatenate([exits[k]["pixels"] for k in others]) if others
+                                 else np.zeros(0, int), c0, -u if cone[3] < 0 else u, cone[2], outward=True)
+                c0, u = cone[0], cone[1]
+        tt = (anchors - c0) @ u
+        start, dist = c0 + tt.min() * u, float(np.ptp(tt))
+        if dist <= 0 or (single and (cone is None or dist < 1.5 * max(cone[2], KNOT_CONE_MIN_RADIUS_MM) or
+                                     abs(u @ axis) > np.cos(np.deg2rad(KNOT_PAIR_MIN_ANGLE_DEG)))):
+            return None
         # the line's stem years: a branch grows out of the pith, so it ends where they are least
         t = np.linspace(-length, dist + length, _LINE_SAMPLES)
-        g = np.asarray(stem(a["centre_mm"] + t[:, None] * u), float)
+        g = np.asarray(stem(start + t[:, None] * u), float)
         between = (t >= 0) & (t <= dist)
         if not np.all(np.isfinite(g)) or \
                 g[between].min() < min(g[between][0], g[between][-1]) - KNOT_PITH_YEARS:
-            continue  # the pith lies between the exits: two branches, not one
-        used |= {i, j}
+            return None  # the pith lies between the exits: two branches, not one
         lo_t, hi_t = -length, dist + length
-        if g[between][0] <= g[between][-1]:  # the pith is beyond exit a: start there
+        if g[between][0] <= g[between][-1]:  # the pith is beyond the first end: start there
             lo_t = float(t[t <= 0][np.argmin(g[t <= 0])]) - 1.0
         else:
             hi_t = float(t[t >= dist][np.argmin(g[t >= dist])]) + 1.0
-        # an oblique strand cuts a face in an ellipse of area pi R^2 / |cos(incidence)|
-        ra, rb = (e["radius_mm"] * np.sqrt(max(abs(u @ np.asarray(FACE_NORMAL[e["face"]], float)), 0.2))
-                  for e in (a, b))
-        slope = (rb - ra) / dist
-        lo, hi = 0.5 * min(ra, rb), 2.0 * max(ra, rb)
-        strands.append(KnotStrand(tuple(a["centre_mm"] + u * lo_t), tuple(a["centre_mm"] + u * hi_t),
-                                  float(np.clip(ra + slope * lo_t, lo, hi)),
-                                  float(np.clip(ra + slope * hi_t, lo, hi)), dead=a["dead"] and b["dead"]))
+        if cone is not None:  # the fitted cone's radius along the strand
+            ra, slope = cone[2] + cone[3] * ((start - cone[0]) @ u), cone[3]
+            lo, hi = KNOT_CONE_MIN_RADIUS_MM, 2.0 * max(exits[k]["radius_mm"] for k in group)
+        else:
+            # an oblique strand cuts a face in an ellipse of area pi R^2 / |cos(incidence)|
+            ra, rb = (exits[k]["radius_mm"] * np.sqrt(max(abs(u @ np.asarray(FACE_NORMAL[exits[k]["face"]], float)),
+                                                          0.2)) for k in (group[0], group[-1]))
+            slope = (rb - ra) / dist
+            lo, hi = 0.5 * min(ra, rb), 2.0 * max(ra, rb)
+        return KnotStrand(tuple(start + u * lo_t), tuple(start + u * hi_t),
+                          float(np.clip(ra + slope * lo_t, lo, hi)), float(np.clip(ra + slope * hi_t, lo, hi)),
+                          dead=all(exits[k]["dead"] for k in group))
+
+    used_ends, strands = set(), []
+    for dist, i, j in sorted(pairs):
+        if i in used_ends or j in used_ends:
+            continue
+        strand = place(ends[i] + ends[j], np.stack([centres[i], centres[j]]), ((centres[j] - centres[i]) / dist)[None])
+        if strand is not None:
+            used_ends |= {i, j}
+            strands.append(strand)
+    for i, end in enumerate(ends):
+        # an unpaired end over two or more faces is a knot cut by a block edge or corner: the
+        # cone that cuts both faces as the masks show is its strand, started along the samples'
+        # principal axes and down the stem's year gradient (toward the pith)
+        if i in used_ends or surface is None or len({exits[k]["face"] for k in end}) < 2:
+            continue
+        samples = surface[0][np.concatenate([exits[k]["pixels"] for k in end])]
+        starts = list(np.linalg.svd(samples - samples.mean(axis=0), full_matrices=False)[2])
+        n = -np.asarray(FACE_NORMAL[exits[end[0]]["face"]], float)
+        d, _ = _toward_pith(stem, exits[end[0]]["centre_mm"] + n, n, length)
+        if d is not None:
+            starts.append(d)
+        strand = place(end, samples, np.array(starts), single=True)
+        if strand is not None:
+            used_ends.add(i)
+            strands.append(strand)
+    used = {k for e in used_ends for k in ends[e]}
     for k, e in enumerate(exits):
         if k in used:
             continue
