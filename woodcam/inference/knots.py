@@ -320,8 +320,15 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
         else:
             hi_t = float(t[t >= dist][np.argmin(g[t >= dist])]) + 1.0
         if cone is not None:  # the fitted cone's radius along the strand
-            ra, slope = cone[2] + cone[3] * ((start - cone[0]) @ u), cone[3]
+            # kept exact in the middle of the exits; its slope only as far as keeps both far
+            # ends within [lo, hi] (clipping each end alone would tilt the radius in the block)
             lo, hi = KNOT_CONE_MIN_RADIUS_MM, 2.0 * max(exits[k]["radius_mm"] for k in group)
+            tm = 0.5 * dist
+            r_mid = float(np.clip(cone[2] + cone[3] * ((start + tm * u - cone[0]) @ u), lo, hi))
+            back, ahead = tm - lo_t, hi_t - tm  # > 0: the strand's ends behind and ahead
+            slope = float(np.clip(cone[3], -min((hi - r_mid) / back, (r_mid - lo) / ahead),
+                                  min((r_mid - lo) / back, (hi - r_mid) / ahead)))
+            ra = r_mid - slope * tm
         else:
             # an oblique strand cuts a face in an ellipse of area pi R^2 / |cos(incidence)|
             ra, rb = (exits[k]["radius_mm"] * np.sqrt(max(abs(u @ np.asarray(FACE_NORMAL[exits[k]["face"]], float)),
