@@ -92,9 +92,10 @@ def test_the_cone_strand_lets_the_bend_predict_the_inside(corner_block):
 def test_a_cone_bend_the_rings_do_not_show_is_rejected(corner_block):
     """Planted wrong: the corner knot's masks on a block whose rings are not bent (the same
     stem without the knot). The cone strand is pinned and its bend competes, but the held-out
-    faces reject it and the default fit keeps a plain hypothesis. Checked by breaking it: with
-    the refinements given a 10-point head start in :func:`woodcam.inference.evidence.choose`,
-    the bend is chosen and this test fails."""
+    faces reject it (89.1 against 100 % for every plain hypothesis when written) and the default
+    fit keeps a plain hypothesis. Checked by breaking it: with refinements always preferred in
+    :func:`woodcam.inference.evidence.choose` (a 100-point head start) the bend is chosen and
+    this test fails (a 10-point head start still rejects it)."""
     from woodcam.inference import fit_block
 
     plain = synth_block(corner_stem(), SIZE, face_px=128, seed=5)
