@@ -89,11 +89,12 @@ def exit_is_dead(photo, region, pixel_mm: float) -> tuple[bool, float]:
 
 def knot_exits(block, faces=None) -> list[dict]:
     """Knot exits on ``faces`` (default all): ``{"face", "centre_mm" (3,), "radius_mm", "dead",
-    "outlined", "surface", "pixels"}`` (:func:`exit_is_dead` on the face photo; alive without a
-    photo). ``surface`` is shared by all exits: ``(points_mm (n, 3), knot (n,) bool)``, the
-    masks of every face given one (knot-free faces too), sampled every
+    "outlined", "surface", "pixels", "cone_memo"}`` (:func:`exit_is_dead` on the face photo;
+    alive without a photo). ``surface`` is shared by all exits: ``(points_mm (n, 3), knot (n,)
+    bool)``, the masks of every face given one (knot-free faces too), sampled every
     :data:`~woodcam.tolerances.KNOT_CONE_SAMPLE_MM`; ``pixels`` (m,) int indexes the exit's own
-    samples in it (:func:`_fit_cone` fits a strand's cone to them)."""
+    samples in it (:func:`_fit_cone` fits a strand's cone to them); ``cone_memo`` (shared dict)
+    keeps those fits, which depend on the masks and their start only."""
     from scipy import ndimage
 
     out = []
@@ -126,8 +127,9 @@ def knot_exits(block, faces=None) -> list[dict]:
                         "dead": dead, "outlined": share})
             regions.append(base + np.flatnonzero(region[rows, cols].ravel()))
     surface = (np.concatenate(pts), np.concatenate(flags)) if pts else (np.zeros((0, 3)), np.zeros(0, bool))
+    memo: dict = {}  # cone fits of these masks: the bend refits its strands every round and fold
     for e, idx in zip(out, regions):
-        e.update(surface=surface, pixels=idx)
+        e.update(surface=surface, pixels=idx, cone_memo=memo)
     return out
 
 
@@ -142,6 +144,17 @@ def _cone_margin(points, c, u, rc, slope):
     t = q @ u
     d = np.linalg.norm(q - t[:, None] * u, axis=1)
     return np.maximum(rc + slope * t, KNOT_CONE_MIN_RADIUS_MM) - d
+
+
+def _memo_cone(memo, surface, positive, ignore, c0, u0, r0, outward: bool = False):
+    """:func:`_fit_cone`, remembered in ``memo`` (a dict, or None) by all of its arguments."""
+    if memo is None:
+        return _fit_cone(surface, positive, ignore, c0, u0, r0, outward)
+    key = (np.asarray(positive).tobytes(), np.asarray(ignore).tobytes(), np.asarray(c0, float).tobytes(),
+           np.asarray(u0, float).tobytes(), float(r0), bool(outward))
+    if key not in memo:
+        memo[key] = _fit_cone(surface, positive, ignore, c0, u0, r0, outward)
+    return memo[key]
 
 
 def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False):
@@ -289,6 +302,7 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
             if dist > 0 and abs(v @ axis) / dist < np.cos(np.deg2rad(KNOT_PAIR_MIN_ANGLE_DEG)):
                 pairs.append((dist, i, j))
     surface = exits[0].get("surface") if cones else None
+    memo = exits[0].get("cone_memo")
 
     def place(group, anchors, starts, single=False):
         """The strand of exits ``group``: its line starts along each of ``starts (k, 3)``
@@ -299,12 +313,12 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
         u, cone = starts[0], None
         if surface is not None:  # the strand of the cone the masks show
             others = [k for k in range(len(exits)) if k not in group]
-            cone = _fit_cone(surface, np.concatenate([exits[k]["pixels"] for k in group]),
-                             np.concatenate([exits[k]["pixels"] for k in others]) if others else np.zeros(0, int),
-                             c0, starts, float(np.mean([exits[k]["radius_mm"] for k in group])))
+            cone = _memo_cone(memo, surface, np.concatenate([exits[k]["pixels"] for k in group]),
+                              np.concatenate([exits[k]["pixels"] for k in others]) if others else np.zeros(0, int),
+                              c0, starts, float(np.mean([exits[k]["radius_mm"] for k in group])))
             c0, u = cone[0], cone[1]
             if _pith_first(stem, c0, u, length) == (cone[3] < 0):  # thinner away from the pith
-                cone = _fit_cone(surface, np.concatenate([exits[k]["pixels"] for k in group]),
+                cone = _memo_cone(memo, surface, np.concatenate([exits[k]["pixels"] for k in group]),
                                  np.concatenate([exits[k]["pixels"] for k in others]) if others
                                  else np.zeros(0, int), c0, -u if cone[3] < 0 else u, cone[2], outward=True)
                 c0, u = cone[0], cone[1]
