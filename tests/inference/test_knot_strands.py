@@ -151,8 +151,9 @@ def test_oblique_branch_through_two_faces_is_recovered_from_its_masks():
 @pytest.mark.slow
 def test_h11_knot_appears_where_its_photos_show_it(shared_data, tmp_path):
     """The real spruce cube H11: its knot exits through faces C (left) and F (back); the fitted
-    field's knot overlaps the given knot masks there (IoU measured 0.82 / 0.86) and the baked
-    grid carries it for the colour map."""
+    field's knot overlaps the given knot masks there (IoU measured 0.82 / 0.86 with the strand
+    through the exits' centroids, 0.91 / 0.91 with the cone fitted to the masks, FIT_VERSION 10)
+    and the baked grid carries it for the colour map."""
     from woodcam.block.io import read_mokume
     from woodcam.fields.grid import GridField
     from woodcam.inference import fit_block
@@ -174,7 +175,7 @@ def test_h11_knot_appears_where_its_photos_show_it(shared_data, tmp_path):
         m = face.extras["knot_mask"]
         iou = (k & m).sum() / (k | m).sum()
         print(f"H11 {name}: knot IoU {iou:.2f}, dead {grid.meta['knots'][0]['dead']}")
-        assert iou > 0.7, (name, iou)
+        assert iou > 0.85, (name, iou)  # the centroid strand's 0.82 on face C fails this
     assert grid.meta["knots"][0]["dead"] is False  # H11's knot is intergrown: no bark ring
     # nowhere near the other faces' middles
     for name in ("front", "top"):
