@@ -61,10 +61,9 @@ from ..tolerances import (
 from .observations import RingObservations
 from .radial import (
     RadialField,
-    _fit_growth_history,
     _one_blas_thread,
     _refit_labelled,
-    _smoothest_coefficients,
+    _smooth_with_history,
     fit_radial_hypotheses,
 )
 from .rbf import fit_rbf
@@ -253,8 +252,7 @@ def radial_recipe(field: RadialField, seed: int = 0, size_mm: ArrayLike | None =
     version, kept for the test that shows it)."""
     def refit(obs: RingObservations):
         f = field if size_mm is None else _refit_labelled(obs, size_mm, field, 1e-8, n_fit=_FOLD_POINTS, seed=seed)
-        f = _smoothest_coefficients(obs, f, seed)
-        return _fit_growth_history(obs, f, seed) if field.history_levels is not None else f
+        return _smooth_with_history(obs, f, seed, field.history_levels is not None)
     return _remembering_last_fold(refit)  # the residual hypothesis reuses the fold's stem
 
 

@@ -48,13 +48,19 @@ from .observations import RingObservations
 
 # -- the field --------------------------------------------------------------------------------
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.cross`` of two 3-vectors, the same products and differences (bit for bit) without
+    its axis handling, which cost ~0.1 ms a call: the fits build a frame per residual call."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
 def _frame(direction) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     d = np.asarray(direction, float)
     d = d / np.linalg.norm(d)
     helper = np.eye(3)[int(np.argmin(np.abs(d)))]
-    e1 = np.cross(d, helper)
+    e1 = _cross(d, helper)
     e1 /= np.linalg.norm(e1)
-    return d, e1, np.cross(d, e1)
+    return d, e1, _cross(d, e1)
 
 
 def _design(points, pith, d, e1, e2, z_scale, K: int, M: int):
@@ -237,10 +243,12 @@ def _lstsq(lhs: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     ridge-regularised, and LAPACK's SVD-based lstsq was 50x slower on them (profiled)."""
     from scipy.linalg import cho_factor, cho_solve
 
-    AtA = lhs.T @ lhs
-    AtA[np.diag_indices_from(AtA)] += 1e-10 * (np.trace(AtA) / len(AtA) + 1e-30)
+    AtA, Atb = lhs.T @ lhs, lhs.T @ rhs
+    AtA.flat[::len(AtA) + 1] += 1e-10 * (np.trace(AtA) / len(AtA) + 1e-30)
+    if not (np.isfinite(AtA).all() and np.isfinite(Atb).all()):  # scipy's own check, done once
+        raise ValueError("array must not contain infs or NaNs")
     try:
-        return cho_solve(cho_factor(AtA), lhs.T @ rhs)
+        return cho_solve(cho_factor(AtA, check_finite=False), Atb, check_finite=False)
     except np.linalg.LinAlgError:
         return np.linalg.lstsq(lhs, rhs, rcond=None)[0]
 
@@ -694,9 +702,7 @@ def _finish_radial(obs, size_mm, found, K, M, ridge, max_relabel_rounds, seed, h
         if not changed:
             break
         field = _refit_labelled(obs, size_mm, field, ridge, seed=seed)
-    field = _smoothest_coefficients(obs, field, seed)
-    if history:
-        field = _fit_growth_history(obs, field, seed)
+    field = _smooth_with_history(obs, field, seed, history)
     if numbered:
         # Our own numbering: pick the integer age offset that puts the pith at year ~0 (seed
         # eq. 5 fits an integer offset too); rings are unchanged by it.
@@ -717,8 +723,43 @@ _FINAL_RIDGES = (1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3)
 _FINAL_RSS_FACTOR = 1.05
 
 
+class _AxisDesign:
+    """The radial model's linear system at one fixed axis (pith and direction) over ``obs``:
+    :func:`_smoothest_coefficients` and every round of :func:`_fit_growth_history` solve at the
+    same axis, so its design is built once per fit instead of once per round (the same arrays,
+    so the same results bit for bit).
+
+    ``X``, ``w``, ``XtX``: the ridge problem of :func:`_smoothest_coefficients` on its fixed
+    random subset ``i`` of ``n_fit`` points; :meth:`linear` is ``field.linear(obs.points_mm)``
+    for a field on this axis."""
+
+    def __init__(self, obs: RingObservations, field: RadialField, seed: int, n_fit: int = 3000):
+        rng = np.random.default_rng(seed + 2)
+        n = len(obs.points_mm)
+        self.i = np.sort(rng.choice(n, n_fit, replace=False)) if n > n_fit else np.arange(n)
+        self.obs, self.pith, self.axis = obs, np.asarray(field.pith_mm), np.asarray(field.axis)
+        self.frame = _frame(field.axis)
+        rho, B = _design(obs.points_mm[self.i], field.pith_mm, *self.frame, field.z_scale_mm, field.K, field.M)
+        self.X = np.concatenate([np.ones((len(rho), 1)), rho[:, None] * B], axis=1)
+        self.w = np.concatenate([[0.0], _penalty_weights(field.K, field.M)]) * np.median(rho)
+        self.XtX = self.X.T @ self.X
+        self._all: tuple | None = None
+
+    def fits(self, obs: RingObservations, field: RadialField) -> bool:
+        """Whether this is the system of ``obs`` at ``field``'s axis."""
+        return obs is self.obs and bool(np.array_equal(field.pith_mm, self.pith) and np.array_equal(field.axis, self.axis))
+
+    def linear(self, field: RadialField) -> np.ndarray:
+        """``(n,)`` ``field.linear(obs.points_mm)`` with the design at every point built once."""
+        if self._all is None:
+            self._all = _design(check_points(self.obs.points_mm), field.pith_mm, *self.frame, field.z_scale_mm,
+                                field.K, field.M)
+        rho, B = self._all
+        return field.offset + rho * (B @ field.coef)
+
+
 def _smoothest_coefficients(obs: RingObservations, field: RadialField, seed: int,
-                            n_fit: int = 3000, targets=None) -> RadialField:
+                            n_fit: int = 3000, targets=None, system: _AxisDesign | None = None) -> RadialField:
     """Re-solve the coefficients at the fitted axis with the strongest ridge the traces allow.
 
     Why: with jittered traces on only some faces, a weak ridge lets the high azimuthal
@@ -729,17 +770,13 @@ def _smoothest_coefficients(obs: RingObservations, field: RadialField, seed: int
     squares is within :data:`_FINAL_RSS_FACTOR` of the least-smoothed one.
 
     targets : (n,) values the linear model is fitted to (default ``obs.years``).
+    system : the :class:`_AxisDesign` of ``obs`` at ``field``'s axis when already built.
     """
-    rng = np.random.default_rng(seed + 2)
-    n = len(obs.points_mm)
-    i = np.sort(rng.choice(n, n_fit, replace=False)) if n > n_fit else np.arange(n)
-    pts = obs.points_mm[i]
-    yrs = (obs.years if targets is None else np.asarray(targets, float))[i]
-    d, e1, e2 = _frame(field.axis)
-    rho, B = _design(pts, field.pith_mm, d, e1, e2, field.z_scale_mm, field.K, field.M)
-    X = np.concatenate([np.ones((len(pts), 1)), rho[:, None] * B], axis=1)
-    w = np.concatenate([[0.0], _penalty_weights(field.K, field.M)]) * np.median(rho)
-    XtX, Xty = X.T @ X, X.T @ yrs
+    if system is None or not system.fits(obs, field):
+        system = _AxisDesign(obs, field, seed, n_fit)
+    X, w, XtX = system.X, system.w, system.XtX
+    yrs = (obs.years if targets is None else np.asarray(targets, float))[system.i]
+    Xty = X.T @ yrs
     fits = []
     for ridge in _FINAL_RIDGES:
         A = XtX + np.diag(ridge * len(X) * w ** 2)
@@ -756,7 +793,16 @@ def _smoothest_coefficients(obs: RingObservations, field: RadialField, seed: int
     return RadialField(field.pith_mm, field.axis, field.z_scale_mm, field.K, field.M, sol[1:], float(sol[0]))
 
 
-def _fit_growth_history(obs: RingObservations, field: RadialField, seed: int) -> RadialField:
+def _smooth_with_history(obs: RingObservations, field: RadialField, seed: int, history: bool) -> RadialField:
+    """:func:`_smoothest_coefficients`, then (``history``) :func:`_fit_growth_history`, at
+    ``field``'s axis: one :class:`_AxisDesign` for all their solves."""
+    system = _AxisDesign(obs, field, seed)
+    field = _smoothest_coefficients(obs, field, seed, system=system)
+    return _fit_growth_history(obs, field, seed, system=system) if history else field
+
+
+def _fit_growth_history(obs: RingObservations, field: RadialField, seed: int,
+                        system: _AxisDesign | None = None) -> RadialField:
     """Add the tree's growth history: ``years = h(offset + rho * s)`` with ``h`` monotone
     through one level per observed year (:func:`_warp`).
 
@@ -769,20 +815,24 @@ def _fit_growth_history(obs: RingObservations, field: RadialField, seed: int) ->
     is the median of the linear model on that ring's points, shrunk towards the year itself by
     :data:`RING_HISTORY_PRIOR_POINTS` (a ring seen on a few points stays near the mean width) and
     made increasing (scipy's isotonic regression); then ``s`` is refitted to those levels.
+    ``system``: the :class:`_AxisDesign` at ``field``'s axis when already built (every round
+    solves at that axis).
     """
     from scipy.optimize import isotonic_regression
 
     years, idx, counts = np.unique(obs.years, return_inverse=True, return_counts=True)
     if len(years) < 3:
         return field
+    if system is None or not system.fits(obs, field):
+        system = _AxisDesign(obs, field, seed)
 
     def levels(f: RadialField) -> np.ndarray:
-        med = _group_medians(f.linear(obs.points_mm), idx, len(years))  # one per year
+        med = _group_medians(system.linear(f), idx, len(years))  # one per year
         lev = (counts * med + RING_HISTORY_PRIOR_POINTS * years) / (counts + RING_HISTORY_PRIOR_POINTS)
         # strictly increasing for the interpolation
         return isotonic_regression(lev, weights=counts).x + np.arange(len(years)) * RING_HISTORY_MIN_STEP
 
     for _ in range(RING_HISTORY_ROUNDS):
-        field = _smoothest_coefficients(obs, field, seed, targets=levels(field)[idx])
+        field = _smoothest_coefficients(obs, field, seed, targets=levels(field)[idx], system=system)
     field.history_levels, field.history_years = levels(field), years.astype(float)
     return field
