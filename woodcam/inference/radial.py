@@ -63,16 +63,37 @@ def _frame(direction) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return d, e1, _cross(d, e1)
 
 
-def _design(points, pith, d, e1, e2, z_scale, K: int, M: int):
-    """rho (n,) and the basis ``trig_k(phi) zeta^m`` (n, (2K+1)(M+1)) at ``points`` (n, 3)."""
+def _trig_powers(phi: np.ndarray, t: np.ndarray, K: int, M: int, out: np.ndarray | None = None) -> np.ndarray:
+    """``(n, (2K+1)(M+1))``: ``trig_k(phi) t^m`` with ``trig = 1, cos(k phi).., sin(k phi)..``
+    (``k = 1..K``), ``m = 0..M`` fastest; ``phi, t`` ``(n,)``. Written into ``out`` (a view of
+    that shape) when given.
+
+    Every residual call of the axis and stem searches builds this basis. The products are the
+    same ``trig * t**m`` as a broadcast ``trig[:, :, None] * t**m[:, None, :]``, bit for bit, but
+    each power is written in place: the broadcast's inner loop of length ``M + 1`` cost as much
+    as the cosines (profiled), and the angles ``k phi`` are formed once for both. (Not
+    computed as powers of ``exp(i phi)``: that moved results by 1e-15, which the searches'
+    finite differences turned into reordered radial basins on a dev block.)"""
+    n = len(phi)
+    B = np.empty((n, 2 * K + 1, M + 1)) if out is None else out.reshape(n, 2 * K + 1, M + 1)
+    trig = B[:, :, 0]  # m = 0: t**0 is 1, so trig itself
+    trig[:, 0] = 1.0
+    kphi = phi[:, None] * np.arange(1, K + 1)
+    # contiguous in and out, as before: numpy's SIMD cos/sin need not match its strided loop
+    trig[:, 1:K + 1], trig[:, K + 1:] = np.cos(kphi), np.sin(kphi)
+    tp = t[:, None] ** np.arange(M + 1)  # the same powers as before (t**1 is t exactly)
+    for m in range(1, M + 1):
+        np.multiply(trig, tp[:, m:m + 1], out=B[:, :, m])
+    return B.reshape(n, -1)
+
+
+def _design(points, pith, d, e1, e2, z_scale, K: int, M: int, out: np.ndarray | None = None):
+    """rho (n,) and the basis ``trig_k(phi) zeta^m`` (n, (2K+1)(M+1)) at ``points`` (n, 3)
+    (:func:`_trig_powers`, into ``out`` when given)."""
     q = points - pith
     a1, a2, z = q @ e1, q @ e2, (q @ d) / z_scale
     rho = np.hypot(a1, a2)
-    phi = np.arctan2(a2, a1)
-    k = np.arange(1, K + 1)
-    trig = np.concatenate([np.ones((len(q), 1)), np.cos(np.outer(phi, k)), np.sin(np.outer(phi, k))], axis=1)
-    zp = z[:, None] ** np.arange(M + 1)
-    return rho, (trig[:, :, None] * zp[:, None, :]).reshape(len(q), -1)
+    return rho, _trig_powers(np.arctan2(a2, a1), z, K, M, out)
 
 
 def _penalty_weights(K: int, M: int) -> np.ndarray:
@@ -179,15 +200,18 @@ class _Problem:
         """Inner linear problem; returns (residuals incl. penalty rows, coef, offset, levels)."""
         dd, e1, e2 = _frame(d)
         rho, B = _design(self.points, pith, dd, e1, e2, self.z_scale, self.K, self.M)
-        A = rho[:, None] * B
-        pen = np.sqrt(self.ridge * len(A)) * _penalty_weights(self.K, self.M) * np.median(rho)
+        n, p = B.shape
+        pen = np.sqrt(self.ridge * n) * _penalty_weights(self.K, self.M) * np.median(rho)
         if self.years is not None:
-            X = np.concatenate([np.ones((len(A), 1)), A], axis=1)
-            P = np.concatenate([np.zeros((len(pen), 1)), np.diag(pen)], axis=1)
-            lhs = np.concatenate([X, P])
-            rhs = np.concatenate([self.years, np.zeros(len(pen))])
+            # [[1, rho B], [0, diag(pen)]] written in place: the same matrix as stacking them
+            lhs = np.zeros((n + p, p + 1))
+            lhs[:n, 0] = 1.0
+            np.multiply(rho[:, None], B, out=lhs[:n, 1:])
+            lhs[np.arange(n, n + p), np.arange(1, p + 1)] = pen
+            rhs = np.concatenate([self.years, np.zeros(p)])
             sol = _lstsq(lhs, rhs)
             return lhs @ sol - rhs, sol[1:], sol[0], None
+        A = rho[:, None] * B
         # Unlabelled: rho * B c = t_g with mean(B c) = 1 over the data: c = c0 + Z y.
         bbar = B.mean(axis=0)
         c0 = bbar / (bbar @ bbar)
@@ -240,17 +264,26 @@ def _circle_pith(points, years, group, d, centre):
 
 def _lstsq(lhs: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """Least squares by the normal equations: the systems here are tall (n >> p <= ~150) and
-    ridge-regularised, and LAPACK's SVD-based lstsq was 50x slower on them (profiled)."""
-    from scipy.linalg import cho_factor, cho_solve
+    ridge-regularised, and LAPACK's SVD-based lstsq was 50x slower on them (profiled).
+
+    The Cholesky factor and solve are LAPACK's ``potrf``/``potrs``, called as
+    ``scipy.linalg.cho_factor``/``cho_solve`` call them (upper factor), without their wrappers'
+    per-call checks (a third of the cost on these small systems; finiteness is checked once)."""
+    from scipy.linalg import get_lapack_funcs
 
     AtA, Atb = lhs.T @ lhs, lhs.T @ rhs
     AtA.flat[::len(AtA) + 1] += 1e-10 * (np.trace(AtA) / len(AtA) + 1e-30)
-    if not (np.isfinite(AtA).all() and np.isfinite(Atb).all()):  # scipy's own check, done once
+    if not (np.isfinite(AtA).all() and np.isfinite(Atb).all()):  # as scipy's check_finite
         raise ValueError("array must not contain infs or NaNs")
-    try:
-        return cho_solve(cho_factor(AtA, check_finite=False), Atb, check_finite=False)
-    except np.linalg.LinAlgError:
+    potrf, potrs = get_lapack_funcs(("potrf", "potrs"), (AtA,))
+    c, info = potrf(AtA, lower=False, overwrite_a=True, clean=False)
+    if info > 0:  # not positive definite (cho_factor's LinAlgError)
         return np.linalg.lstsq(lhs, rhs, rcond=None)[0]
+    if info == 0:
+        x, info = potrs(c, Atb, lower=False, overwrite_b=False)
+    if info != 0:
+        raise ValueError(f"LAPACK reported an illegal argument ({info}) in the normal equations")
+    return x
 
 
 def _cost(prob: _Problem, pith, d) -> float:

@@ -54,7 +54,7 @@ from ..tolerances import (RING_HISTORY_MIN_STEP, RING_HISTORY_PRIOR_POINTS, RING
                           STEM_AXIAL_SD, STEM_CURVE_PRIOR_MM, STEM_HARMONIC_SD, STEM_PRIOR_YEARS,
                           STEM_RADIAL_SD, STEM_TILT_PRIOR_DEG)
 from .observations import RingObservations
-from .radial import _circle_pith, _frame, _group_medians, _lstsq, _warp, ring_spacing_mm
+from .radial import _circle_pith, _frame, _group_medians, _lstsq, _trig_powers, _warp, ring_spacing_mm
 
 
 @dataclass
@@ -148,12 +148,11 @@ def _design(points, centre, frame, L, curve, K, M, P, rho0):
     """``(n, 1 + (P - 1) + (2K+1)(M+1))``: columns ``1, (rho/rho0)^2..P, rho trig_k(phi) tau^m``."""
     x1, x2, tau = _cross_section(points, centre, frame, L, curve)
     rho = np.hypot(x1, x2)
-    phi = np.arctan2(x2, x1)
-    k = np.arange(1, K + 1)
-    trig = np.concatenate([np.ones((len(rho), 1)), np.cos(np.outer(phi, k)), np.sin(np.outer(phi, k))], axis=1)
-    B = (trig[:, :, None] * (tau[:, None] ** np.arange(M + 1))[:, None, :]).reshape(len(rho), -1)
-    pows = (rho / rho0)[:, None] ** np.arange(2, P + 1)
-    return np.concatenate([np.ones((len(rho), 1)), pows, rho[:, None] * B], axis=1)
+    X = np.empty((len(rho), P + (2 * K + 1) * (M + 1)))  # the columns written in place
+    X[:, 0] = 1.0
+    X[:, 1:P] = (rho / rho0)[:, None] ** np.arange(2, P + 1)
+    np.multiply(rho[:, None], _trig_powers(np.arctan2(x2, x1), tau, K, M), out=X[:, P:])
+    return X
 
 
 def _prior_sd(K, M, P, rho0, density) -> np.ndarray:
