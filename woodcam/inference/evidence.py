@@ -315,15 +315,15 @@ def _residual_recipe(stem_recipe: Callable, max_points: int) -> Callable:
     def refit(obs: RingObservations):
         from scipy.interpolate import RBFInterpolator
 
-        from .rbf import thin_out
+        from .rbf import thin_out, thin_plate_field
 
         stem = stem_recipe(obs)
         i = thin_out(len(obs.points_mm), max_points)
         pts = obs.points_mm[i]
         _, uniq = np.unique(np.round(pts, 6), axis=0, return_index=True)
         res = obs.years[i][uniq] - stem(pts[uniq])
-        rbf = RBFInterpolator(pts[uniq], res, kernel="thin_plate_spline",
-                              smoothing=EVIDENCE_RESIDUAL_SMOOTHING * len(uniq))
+        rbf = thin_plate_field(RBFInterpolator(pts[uniq], res, kernel="thin_plate_spline",
+                                               smoothing=EVIDENCE_RESIDUAL_SMOOTHING * len(uniq)))
         return _StemPlusResidual(stem, rbf)
     return refit
 
@@ -455,6 +455,11 @@ def bake_evidence(ev: EvidenceFit, size_mm, faces, strands=()):
     The hypotheses' spread is sampled on a grid of :data:`EVIDENCE_SPREAD_SPACING_MM` and
     interpolated to the bake nodes (it is smooth; the RBF hypotheses are slow to evaluate).
     """
+    with _one_blas_thread():  # many small products: BLAS threads only spin on a busy machine
+        return _bake_evidence(ev, size_mm, faces, strands)
+
+
+def _bake_evidence(ev: EvidenceFit, size_mm, faces, strands):
     from scipy import ndimage
 
     from ..fields.grid import GridField
