@@ -105,7 +105,7 @@ def straightforward(monkeypatch):
         m.setattr(radial._AxisDesign, "linear", lambda self, field: field.linear(self.obs.points_mm))
         m.setattr(stem._StemProblem, "design", lambda self, curve: _stem_design_ref(
             self.points, self.centre, self.frame, self.L, curve, self.K, self.M, self.P, self.rho0))
-        m.setattr(rbf, "thin_plate_field", lambda r: r)
+        m.setattr(rbf, "_thin_plate_field", lambda r: r)
         yield
 
 
@@ -147,12 +147,12 @@ def test_thin_plate_field_matches_scipys_evaluation():
     centres = rng.uniform(0, 60, (400, 3))
     values = np.sin(centres[:, 0] / 7) + centres[:, 2] / 10
     scipy_rbf = RBFInterpolator(centres, values, kernel="thin_plate_spline", smoothing=0.3)
-    fast = rbf.thin_plate_field(scipy_rbf)
+    fast = rbf._thin_plate_field(scipy_rbf)
     assert isinstance(fast, rbf._ThinPlate)
     x = np.concatenate([rng.uniform(-5, 65, (3000, 3)), centres[:50]])  # incl. the centres (r = 0)
     np.testing.assert_allclose(fast(x), scipy_rbf(x), rtol=0, atol=1e-9)
     other = RBFInterpolator(centres, values, kernel="cubic")
-    assert rbf.thin_plate_field(other) is other  # only the thin-plate spline has the fast path
+    assert rbf._thin_plate_field(other) is other  # only the thin-plate spline has the fast path
 
 
 # -- the whole fit ----------------------------------------------------------------------------

@@ -315,14 +315,14 @@ def _residual_recipe(stem_recipe: Callable, max_points: int) -> Callable:
     def refit(obs: RingObservations):
         from scipy.interpolate import RBFInterpolator
 
-        from .rbf import thin_out, thin_plate_field
+        from .rbf import thin_out, _thin_plate_field
 
         stem = stem_recipe(obs)
         i = thin_out(len(obs.points_mm), max_points)
         pts = obs.points_mm[i]
         _, uniq = np.unique(np.round(pts, 6), axis=0, return_index=True)
         res = obs.years[i][uniq] - stem(pts[uniq])
-        rbf = thin_plate_field(RBFInterpolator(pts[uniq], res, kernel="thin_plate_spline",
+        rbf = _thin_plate_field(RBFInterpolator(pts[uniq], res, kernel="thin_plate_spline",
                                                smoothing=EVIDENCE_RESIDUAL_SMOOTHING * len(uniq)))
         return _StemPlusResidual(stem, rbf)
     return refit

@@ -44,7 +44,7 @@ def fit_rbf(obs: RingObservations, kernel: str = "thin_plate_spline", smoothing:
     pts, yrs = obs.points_mm[i], obs.years[i]
     # Duplicate points (a ring traced twice) make the interpolation matrix singular.
     _, uniq = np.unique(np.round(pts, 6), axis=0, return_index=True)
-    return thin_plate_field(RBFInterpolator(pts[uniq], yrs[uniq], kernel=kernel, smoothing=smoothing))
+    return _thin_plate_field(RBFInterpolator(pts[uniq], yrs[uniq], kernel=kernel, smoothing=smoothing))
 
 
 #: Evaluation points per block of :class:`_ThinPlate` (a 256 x 2500 kernel block is 5 MB).
@@ -61,7 +61,7 @@ class _ThinPlate:
     matrix product about the centres' mean, ``r^2 log r = r^2 log(r^2) / 2`` takes one log, and
     blocks of :data:`_TPS_CHUNK` points stay in cache. Written by hand because no library
     evaluates scipy's fitted coefficients faster; it reads them from the interpolator
-    (``y``, ``_coeffs``, ``_shift``, ``_scale``: :func:`thin_plate_field` checks they are there).
+    (``y``, ``_coeffs``, ``_shift``, ``_scale``: :func:`_thin_plate_field` checks they are there).
     Values agree with scipy's to ~1e-11 years (rounding of the expanded distance; checked in
     ``tests/inference/test_fit_speed.py``).
     """
@@ -100,7 +100,7 @@ class _ThinPlate:
             out[i:i + _TPS_CHUNK] = k @ self._w + self._tail[0] + xs @ self._tail[1:]
 
 
-def thin_plate_field(rbf):
+def _thin_plate_field(rbf):
     """``rbf`` (a fitted :class:`scipy.interpolate.RBFInterpolator`) as a field evaluated by
     :class:`_ThinPlate` when it is the thin-plate spline with a degree-1 tail and one value
     per point fitted on all points (what :func:`fit_rbf` and the evidence fit's residual make);
