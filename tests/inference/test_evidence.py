@@ -183,3 +183,21 @@ def test_blend_away_from_faces_keeps_the_chosen_field_on_the_faces():
 def test_blend_mode_is_checked(obs, block):
     with pytest.raises(WoodcamError, match="blend must be one of away_from_faces"):
         fit_evidence(obs, block.size_mm, blend=True)
+
+
+def test_the_blend_is_judged_by_the_folds_own_predictions():
+    """The default blend is used only where the leave-one-face-out evidence prefers it: its
+    score per face comes from the mean of its members' fold predictions (growth time and
+    gradient at the held-out points), not from its members' scores."""
+    from woodcam.inference.evidence import _blend_evidence
+
+    y = np.arange(10.0)
+    grad = np.tile([1.0, 0.0, 0.0], (10, 1))  # 1 year per mm
+    pred = {("a", "front"): (y + 1.5, grad, y), ("b", "front"): (y - 1.5, grad, y),  # each 1.5 mm off
+            ("a", "top"): (y + 1.5, grad, y), ("b", "top"): (y + 1.5, grad, y)}
+    sc = _blend_evidence(["a", "b"], pred)
+    assert sc["front"] == 100.0  # the errors cancel: within 1 mm
+    assert sc["top"] == 50.0     # the same error twice: within 2 mm, not 1
+    assert sc["mean"] == 75.0
+    del pred[("b", "top")]       # a member that could not refit a fold: no evidence there
+    assert _blend_evidence(["a", "b"], pred)["top"] == 0.0

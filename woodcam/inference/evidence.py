@@ -137,9 +137,8 @@ class EvidenceFit:
         return np.std(np.stack([self.hypotheses[n](p) for n in self.accepted]), axis=0)
 
 
-def _years_error_mm(field, points: np.ndarray, years: np.ndarray) -> np.ndarray:
-    """Distance (mm, first order) from each point to ``field``'s ring line of its year."""
-    g, grad = central_gradient(field, points, _GRAD_STEP_MM)
+def _error_mm(g: np.ndarray, grad: np.ndarray, years: np.ndarray) -> np.ndarray:
+    """``|g - years| / |grad g|``: growth time ``g (k,)`` with gradient ``grad (k, 3)`` (years/mm)."""
     return np.abs(g - years) / np.maximum(np.linalg.norm(grad, axis=1), 1e-6)
 
 
@@ -155,8 +154,13 @@ def _held_out_faces(obs: RingObservations) -> list[int]:
     return [int(i) for i, c in zip(ids, counts) if c >= EVIDENCE_MIN_FACE_POINTS]
 
 
-def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: int = 0) -> dict:
+def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: int = 0,
+                     predictions: dict | None = None) -> dict:
     """Leave-one-face-out score of every hypothesis on every face with enough ring points.
+
+    predictions : optional dict, filled with ``(name, face name) -> (g (k,), grad (k, 3),
+        years (k,))``: each fold's growth time and its gradient at the held-out ring points and
+        their years (what a blend of the hypotheses is scored from, :func:`_blend_evidence`).
 
     Returns name -> {face name -> {"score": percent, "share_2mm": percent}}; empty dicts when
     fewer than two faces have rings.
@@ -176,7 +180,10 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
         for h in hypotheses:
             try:
                 fitted = h.refit(rest)
-                err = _years_error_mm(fitted, pts, yrs)
+                g, grad = central_gradient(fitted, pts, _GRAD_STEP_MM)
+                err = _error_mm(g, grad, yrs)
+                if predictions is not None:
+                    predictions[(h.name, FACES[f])] = (g, grad, yrs)
             except (WoodcamError, np.linalg.LinAlgError, ValueError):
                 err = np.full(len(pts), np.inf)  # a recipe that cannot refit has no evidence
             out[h.name][FACES[f]] = {"score": face_score(err), "share_2mm": float(100 * np.mean(err <= 2.0))}
@@ -366,6 +373,25 @@ class _BlendAwayFromFaces:
         return g
 
 
+def _blend_evidence(names: list[str], predictions: dict) -> dict[str, float]:
+    """Held-out score of the mean of the hypotheses ``names`` per face (and ``"mean"``), from
+    the folds' predictions :func:`holdout_evidence` kept: each fold's mean growth time and mean
+    gradient at the held-out points, so the blend is judged by the same leave-one-face-out
+    evidence as its members, at no extra fit."""
+    faces = sorted({face for (n, face) in predictions if n in names})
+    per = {}
+    for face in faces:
+        got = [predictions.get((n, face)) for n in names]
+        if any(x is None for x in got):  # a member could not refit this fold: no evidence
+            per[face] = 0.0
+            continue
+        g = np.mean([x[0] for x in got], axis=0)
+        grad = np.mean([x[1] for x in got], axis=0)
+        per[face] = face_score(_error_mm(g, grad, got[0][2]))
+    per["mean"] = float(np.mean(list(per.values()))) if per else float("nan")
+    return per
+
+
 def _blend_members(ev: EvidenceFit) -> list[Callable] | None:
     """The accepted hypotheses' fields to average, or None when there is nothing to blend: one
     accepted, or the chosen one holds knot strands (its knots are joined into it alone)."""
@@ -409,7 +435,7 @@ def blend_away_from_faces(ev: EvidenceFit, size_mm: ArrayLike, faces,
 
 
 #: Where :func:`fit_evidence` blends the accepted hypotheses: deeper than
-#: :data:`EVIDENCE_BLEND_DEPTH_MM` from the observed faces (the default), everywhere, or nowhere.
+#: :data:`EVIDENCE_BLEND_DEPTH_MM` from the observed faces, everywhere, or nowhere (the default).
 BlendMode = Literal["away_from_faces", "everywhere", "none"]
 BLEND_MODES: tuple[str, ...] = get_args(BlendMode)
 
@@ -423,7 +449,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                  candidates: tuple[str, ...] = CANDIDATES, seed: int = 0, extra: list[Hypothesis] | None = None,
                  warn: bool = True, recipes: dict[str, Callable] | None = None,
                  stem: Callable | None = None, refines: dict[str, str] | None = None,
-                 blend: BlendMode = "away_from_faces") -> EvidenceFit:
+                 blend: BlendMode = "none") -> EvidenceFit:
     """Fit the hypotheses and choose by leave-one-face-out evidence (module docstring).
 
     Parameters
@@ -441,9 +467,12 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     stem : the stem hypothesis' recipe (default :func:`stem_recipe`): one that remembers its
         last fit lets ``recipes`` built on the same stem fit reuse it in every fold
     warn : emit a :class:`~woodcam.errors.WoodcamWarning` when the choice is contradicted
-    blend : "away_from_faces" keeps the chosen field on the observed faces and blends the
-        accepted hypotheses deeper (:func:`blend_away_from_faces`); "everywhere" returns their
-        mean (:func:`blend_accepted`); "none" the chosen hypothesis alone
+    blend : "none" (the default) the chosen hypothesis alone; "away_from_faces" keeps it on the
+        observed faces and, where the leave-one-face-out evidence scores the accepted
+        hypotheses' mean above it (:func:`_blend_evidence`), blends them deeper than
+        :data:`EVIDENCE_BLEND_DEPTH_MM` (:func:`blend_away_from_faces`; real cubes: H11 2.08x
+        chance held out, but CN03's oracle-phase straight-ring margin falls, README);
+        "everywhere" their mean everywhere (:func:`blend_accepted`)
 
     Returns
     -------
@@ -476,11 +505,19 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
             except WoodcamError:  # too few rings for it: the others still compete
                 pass
         hyps += list(extra or [])
-        result = choose(hyps, holdout_evidence(hyps, numbered, seed))
+        predictions: dict = {}
+        result = choose(hyps, holdout_evidence(hyps, numbered, seed, predictions))
         if blend == "everywhere":
             result = blend_accepted(result)
-        elif blend == "away_from_faces":
-            result = blend_away_from_faces(result, size_mm, sorted({int(i) for i in np.unique(obs.face)}))
+        elif blend == "away_from_faces" and len(result.accepted) > 1:
+            # the mean is a hypothesis of its own: used only where the evidence prefers it
+            mixed = _blend_evidence(result.accepted, predictions)
+            best = result.scores[result.chosen]["mean"]
+            if mixed["mean"] > best:
+                result = blend_away_from_faces(result, size_mm, sorted({int(i) for i in np.unique(obs.face)}))
+            else:
+                result.message += (f"; not blended: the accepted hypotheses' mean scores "
+                                   f"{mixed['mean']:.1f} %, not above {result.chosen}")
     if warn and (result.contradicted or result.unverified):
         warnings.warn(result.message, WoodcamWarning, stacklevel=2)
     return result

@@ -27,9 +27,8 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: hypothesis and per-fold pith refits in the evidence fit; 7: knot strands end at the pith, one-exit
 #: strands run toward it and keep the stem's ring spacing; 8: unlabelled rings numbered by the pith
 #: basin whose numbering makes neighbouring rings one year apart; 9: the knots' ring bend on by
-#: default, competing while the evidence keeps its stem; 10: deeper than 2 mm from the observed
-#: faces the accepted hypotheses are blended).
-FIT_VERSION = 10
+#: default, competing while the evidence keeps its stem).
+FIT_VERSION = 9
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
@@ -41,9 +40,6 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
     block : woodcam.block.Block
     method : "evidence" (the default: several hypotheses, radial pith basins, RBF, a radial
         stem with a residual and the stem model of :mod:`woodcam.inference.stem`, chosen by how well each predicts the faces it was not fitted to;
-        deeper than :data:`~woodcam.tolerances.EVIDENCE_BLEND_DEPTH_MM` from the observed faces
-        the hypotheses the evidence cannot tell apart are averaged
-        (:func:`woodcam.inference.evidence.blend_away_from_faces`);
         a choice the held-out faces contradict raises a WoodcamWarning and is flagged in
         ``field.meta``; the baked grid carries the per-point ``uncertainty``, see
         :mod:`woodcam.inference.evidence`) or "rbf" (seed 000's baseline: thin-plate RBF of labelled ring points; unlabelled rings
