@@ -59,7 +59,7 @@ def test_a_knot_cut_by_two_edges_is_one_strand_on_its_cone(corner_block):
     exits = knot_exits(corner_block)
     assert sorted(e["face"] for e in exits) == ["back", "front", "left", "right"]
     stem = corner_stem()
-    (fit,) = strands_from_exits(exits, stem, SIZE)
+    (fit,) = strands_from_exits(exits, stem, SIZE, cones=True)
     assert fit.pinned and _angle_deg(fit, STRAND) < 3.0
     # radius where the true strand crosses the block's middle, x = y = 20
     a, b = np.asarray(fit.start_mm), np.asarray(fit.end_mm)
@@ -73,13 +73,13 @@ def test_a_knot_cut_by_two_edges_is_one_strand_on_its_cone(corner_block):
 def test_the_cone_strand_lets_the_bend_predict_the_inside(corner_block):
     """The joint stem + bend fit from the faces' rings: with the cone's strand it predicts the
     inside within 1 mm on >= 90 % of the ring lines; with the exits' centroids paired (the
-    strands of the test above) it does not. Checked by breaking it: with ``cones=False`` as the
-    default this test fails."""
+    strands of the test above) it does not. Checked by breaking it: with ``cones=False`` passed
+    this test fails."""
     b = corner_block
     exits = knot_exits(b)
     obs = gather_observations(b)
     stem = fit_stem(obs, b.size_mm)
-    joint = fit_knotted_stem(obs, b.size_mm, exits, stem=stem)
+    joint = fit_knotted_stem(obs, b.size_mm, exits, stem=stem, cones=True)
     assert isinstance(joint, StemWithKnots) and len(joint.strands) == 1
     old = StemWithKnots(stem, strands_from_exits(exits, stem, b.size_mm, cones=False), bend=KnotParams())
     sc = evaluate_fits(b.true_field, {"cone": joint, "old": old, "stem": stem}, b.size_mm, pixel_mm=0.4)
@@ -92,8 +92,8 @@ def test_the_cone_strand_lets_the_bend_predict_the_inside(corner_block):
 def test_a_cone_bend_the_rings_do_not_show_is_rejected(corner_block):
     """Planted wrong: the corner knot's masks on a block whose rings are not bent (the same
     stem without the knot). The cone strand is pinned and its bend competes, but the held-out
-    faces reject it (89.1 against 100 % for every plain hypothesis when written) and the default
-    fit keeps a plain hypothesis. Checked by breaking it: with refinements always preferred in
+    faces reject it (89.1 against 100 % for every plain hypothesis when written) and the fit
+    (``knot_cones=True``) keeps a plain hypothesis. Checked by breaking it: with refinements always preferred in
     :func:`woodcam.inference.evidence.choose` (a 100-point head start) the bend is chosen and
     this test fails (a 10-point head start still rejects it)."""
     from woodcam.inference import fit_block
@@ -104,7 +104,7 @@ def test_a_cone_bend_the_rings_do_not_show_is_rejected(corner_block):
             plain.faces[name].extras["knot_mask"] = f.extras["knot_mask"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", WoodcamWarning)
-        ev = fit_block(plain, baked=False)
+        ev = fit_block(plain, baked=False, knot_cones=True)
     assert "stem + knot bend" in ev.scores  # it competed (the cone pins a strand) ...
     assert "knot bend" not in ev.chosen, ev.message  # ... and lost
     assert ev.scores["stem + knot bend"]["mean"] < ev.scores["stem"]["mean"] - 2.0, ev.scores

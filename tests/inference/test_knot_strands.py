@@ -149,11 +149,13 @@ def test_oblique_branch_through_two_faces_is_recovered_from_its_masks():
 
 
 @pytest.mark.slow
-def test_h11_knot_appears_where_its_photos_show_it(shared_data, tmp_path):
+@pytest.mark.parametrize("cones, bar", [(False, 0.7), (True, 0.85)])
+def test_h11_knot_appears_where_its_photos_show_it(shared_data, tmp_path, cones, bar):
     """The real spruce cube H11: its knot exits through faces C (left) and F (back); the fitted
     field's knot overlaps the given knot masks there (IoU measured 0.82 / 0.86 with the strand
-    through the exits' centroids, 0.91 / 0.91 with the cone fitted to the masks, FIT_VERSION 10)
-    and the baked grid carries it for the colour map."""
+    through the exits' centroids, the default; 0.91 / 0.91 with the cone fitted to the masks,
+    ``knot_cones=True``, whose bar 0.85 the centroid strand's 0.82 on face C fails) and the
+    baked grid carries it for the colour map."""
     from woodcam.block.io import read_mokume
     from woodcam.fields.grid import GridField
     from woodcam.inference import fit_block
@@ -165,7 +167,7 @@ def test_h11_knot_appears_where_its_photos_show_it(shared_data, tmp_path):
     b = read_mokume(shared_data / "mokume" / "H11")
     with warnings.catch_warnings():  # contradicted or not (ring maps read as lines: not any more)
         warnings.simplefilter("ignore", WoodcamWarning)
-        grid = fit_block(b, "evidence")
+        grid = fit_block(b, "evidence", knot_cones=cones)
     grid = GridField.load(grid.save(tmp_path / "h11.npz"))
     assert len(grid.meta["knots"]) == 1 and hasattr(grid, "knot_features")
     for name in ("left", "back"):
@@ -175,7 +177,7 @@ def test_h11_knot_appears_where_its_photos_show_it(shared_data, tmp_path):
         m = face.extras["knot_mask"]
         iou = (k & m).sum() / (k | m).sum()
         print(f"H11 {name}: knot IoU {iou:.2f}, dead {grid.meta['knots'][0]['dead']}")
-        assert iou > 0.85, (name, iou)  # the centroid strand's 0.82 on face C fails this
+        assert iou > bar, (name, iou)
     assert grid.meta["knots"][0]["dead"] is False  # H11's knot is intergrown: no bark ring
     # nowhere near the other faces' middles
     for name in ("front", "top"):

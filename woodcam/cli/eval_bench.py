@@ -43,6 +43,9 @@ def register(subparsers) -> None:
     r.add_argument("--no-knot-bend", dest="knot_bend", action="store_false",
                    help="leave the stem with its knots' ring bend out of the evidence fit's hypotheses "
                         "(default: it competes wherever knot exits on two faces pin a knot)")
+    r.add_argument("--knot-cones", action="store_true",
+                   help="knot strands and radii from the cones fitted to every face's knot mask "
+                        "(default off: better on knotted synthetic blocks, worse on H11's held-out faces)")
     add_confidence_option(r, "; implies --plots")
     add_out_option(r, "table.md, records.json and cut-plane PNGs")
     r.set_defaults(func=run_realistic)
@@ -71,7 +74,7 @@ def run_realistic(args) -> int:
     plots = args.plots or args.confidence
     for kind, i, s, f in tqdm(tasks, desc="benchmark blocks", unit="block"):
         row = score_block(args.seed, i, methods, s, f, kind, face_px=args.face_px, keep_lines=plots,
-                          knot_bend=args.knot_bend)
+                          knot_bend=args.knot_bend, knot_cones=args.knot_cones)
         if plots:
             from ..inference.evaluate import plot_planes
 
