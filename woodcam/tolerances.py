@@ -290,6 +290,16 @@ NUMBERING_STEP_MARGIN = 0.1
 #: "accepted": their spread is the fit's per-point uncertainty.
 EVIDENCE_ACCEPT_MARGIN = 5.0
 
+#: Depth (mm) from the nearest observed face over which the evidence fit passes from the chosen
+#: hypothesis (on the faces) to the mean of the accepted ones (deeper): the held-out evidence
+#: scores ring points within 1 and 2 mm, so within 2 mm of a face the faces pin the chosen fit,
+#: and deeper the hypotheses the evidence cannot tell apart are averaged
+#: (:func:`woodcam.inference.evidence.blend_away_from_faces`, opt-in). Real cubes,
+#: leave-one-face-out, blended in every fold (no evidence gate): 1 / 2 / 5 mm gave H11
+#: 2.16 / 2.17 / 1.94x chance within 2 px, CN03 12.9 / 13.1 / 13.4x; 2 / 5 / 10 mm with the gate:
+#: H11 2.16 / 1.94 / 1.78x, CN03 19.2 / 18.1 / 17.0x (offline, from cached fold fits).
+EVIDENCE_BLEND_DEPTH_MM = 2.0
+
 #: A refinement hypothesis (the knots' ring bend on the stem) competes only while its base's
 #: mean held-out score is within this many percent points of the best plain hypothesis'
 #: (:func:`woodcam.inference.evidence.choose`). H11's fold without its bottom face: stem 19.8

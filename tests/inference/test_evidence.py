@@ -148,3 +148,56 @@ def test_blend_accepted_is_the_mean_of_the_accepted_hypotheses():
     assert "blended with b" in res.message
     alone = blend_accepted(choose(hyps[:1], {"a": ev["a"]}))
     np.testing.assert_allclose(alone(p), p[:, 0])
+
+
+def test_blend_away_from_faces_keeps_the_chosen_field_on_the_faces():
+    """The default blend (issue 12 part 7): on an observed face the chosen hypothesis alone (the
+    in-sample fit is untouched), deeper than EVIDENCE_BLEND_DEPTH_MM the mean of the accepted
+    ones, linear in between; a face that was not observed is 'deep' like the inside."""
+    from woodcam.frames import FACES
+    from woodcam.inference.evidence import blend_away_from_faces
+    from woodcam.tolerances import EVIDENCE_BLEND_DEPTH_MM as D
+
+    a, b_, c = (lambda q: q[:, 0]), (lambda q: q[:, 1] + 1.0), (lambda q: 100.0 * q[:, 2])
+    hyps = [Hypothesis("a", a, None), Hypothesis("b", b_, None), Hypothesis("c", c, None)]
+    ev = {"a": {"front": {"score": 90.0, "share_2mm": 90.0}}, "b": {"front": {"score": 87.0, "share_2mm": 87.0}},
+          "c": {"front": {"score": 40.0, "share_2mm": 40.0}}}
+    size = (50.0, 40.0, 30.0)
+    seen = [FACES.index("bottom"), FACES.index("left")]  # z = 0 and x = 0
+    res = blend_away_from_faces(choose(hyps, ev), size, seen)
+    z = np.array([0.0, D / 4, D / 2, D, 15.0, 30.0])  # 30: on the top face, not observed
+    p = np.stack([np.full(len(z), 20.0), np.full(len(z), 7.0), z], axis=1)
+    w = np.array([0.0, 0.25, 0.5, 1.0, 1.0, 1.0])
+    mean = (p[:, 0] + p[:, 1] + 1.0) / 2  # c is 50 points behind: not accepted, not blended
+    np.testing.assert_allclose(res(p), p[:, 0] + w * (mean - p[:, 0]))
+    on_left = np.array([[0.0, 7.0, 15.0]])
+    np.testing.assert_allclose(res(on_left), on_left[:, 0])
+    assert "blended with b" in res.message
+    # a chosen field holding knot strands keeps its knots alone: no blend
+    knotted = lambda q: q[:, 0]  # noqa: E731
+    knotted.strands = ()
+    kept = blend_away_from_faces(choose([Hypothesis("a", knotted, None)] + hyps[1:], ev), size, seen)
+    np.testing.assert_allclose(kept(p), p[:, 0])
+
+
+def test_blend_mode_is_checked(obs, block):
+    with pytest.raises(WoodcamError, match="blend must be one of away_from_faces"):
+        fit_evidence(obs, block.size_mm, blend=True)
+
+
+def test_the_blend_is_judged_by_the_folds_own_predictions():
+    """The default blend is used only where the leave-one-face-out evidence prefers it: its
+    score per face comes from the mean of its members' fold predictions (growth time and
+    gradient at the held-out points), not from its members' scores."""
+    from woodcam.inference.evidence import _blend_evidence
+
+    y = np.arange(10.0)
+    grad = np.tile([1.0, 0.0, 0.0], (10, 1))  # 1 year per mm
+    pred = {("a", "front"): (y + 1.5, grad, y), ("b", "front"): (y - 1.5, grad, y),  # each 1.5 mm off
+            ("a", "top"): (y + 1.5, grad, y), ("b", "top"): (y + 1.5, grad, y)}
+    sc = _blend_evidence(["a", "b"], pred)
+    assert sc["front"] == 100.0  # the errors cancel: within 1 mm
+    assert sc["top"] == 50.0     # the same error twice: within 2 mm, not 1
+    assert sc["mean"] == 75.0
+    del pred[("b", "top")]       # a member that could not refit a fold: no evidence there
+    assert _blend_evidence(["a", "b"], pred)["top"] == 0.0

@@ -24,5 +24,8 @@ def bake(field, size_mm, spacing_mm: float = BAKE_SPACING_MM, margin_mm: float =
     size = check_size(size_mm)
     if not spacing_mm > 0:
         raise WoodcamError(f"spacing_mm must be > 0; got {spacing_mm!r}")
-    return GridField.bake(field, (0.0, 0.0, 0.0), tuple(size), spacing_mm,
-                          margin_nodes=max(1, math.ceil(margin_mm / spacing_mm)))
+    from .._threads import one_blas_thread
+
+    with one_blas_thread():  # the fields' products are small per batch: BLAS threads only spin
+        return GridField.bake(field, (0.0, 0.0, 0.0), tuple(size), spacing_mm,
+                              margin_nodes=max(1, math.ceil(margin_mm / spacing_mm)))

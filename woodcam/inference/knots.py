@@ -227,7 +227,8 @@ def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem):
     stem = fit_stem(obs, size_mm, seed=seed) if stem is None else stem
     plain, field, only_pinned = stem, stem, True
     for r in range(rounds + 1):
-        if np.mean(stem(obs.points_mm) <= stem.pith_years()) > KNOT_BEND_MAX_BEFORE_PITH:
+        g = stem(obs.points_mm)  # once per round: the check here and the bend's offset below
+        if np.mean(g <= stem.pith_years()) > KNOT_BEND_MAX_BEFORE_PITH:
             return plain, False  # times are not "from the pith" in this stem: no bend to speak of
         strands = strands_from_exits(exits, stem, size_mm)
         only_pinned &= all(s.pinned for s in strands)
@@ -236,7 +237,7 @@ def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem):
         field = StemWithKnots(stem, strands, bend=KnotParams(), bend_guessed=guessed)
         if r == rounds:
             break
-        off = field(obs.points_mm) - stem(obs.points_mm)
+        off = field(obs.points_mm) - g
         stem = fit_stem(obs, size_mm, seed=seed, offset_years=off, init=stem)
     return field, only_pinned
 

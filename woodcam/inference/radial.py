@@ -48,25 +48,52 @@ from .observations import RingObservations
 
 # -- the field --------------------------------------------------------------------------------
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.cross`` of two 3-vectors, the same products and differences (bit for bit) without
+    its axis handling, which cost ~0.1 ms a call: the fits build a frame per residual call."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
 def _frame(direction) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     d = np.asarray(direction, float)
     d = d / np.linalg.norm(d)
     helper = np.eye(3)[int(np.argmin(np.abs(d)))]
-    e1 = np.cross(d, helper)
+    e1 = _cross(d, helper)
     e1 /= np.linalg.norm(e1)
-    return d, e1, np.cross(d, e1)
+    return d, e1, _cross(d, e1)
 
 
-def _design(points, pith, d, e1, e2, z_scale, K: int, M: int):
-    """rho (n,) and the basis ``trig_k(phi) zeta^m`` (n, (2K+1)(M+1)) at ``points`` (n, 3)."""
+def _trig_powers(phi: np.ndarray, t: np.ndarray, K: int, M: int, out: np.ndarray | None = None) -> np.ndarray:
+    """``(n, (2K+1)(M+1))``: ``trig_k(phi) t^m`` with ``trig = 1, cos(k phi).., sin(k phi)..``
+    (``k = 1..K``), ``m = 0..M`` fastest; ``phi, t`` ``(n,)``. Written into ``out`` (a view of
+    that shape) when given.
+
+    Every residual call of the axis and stem searches builds this basis. The products are the
+    same ``trig * t**m`` as a broadcast ``trig[:, :, None] * t**m[:, None, :]``, bit for bit, but
+    each power is written in place: the broadcast's inner loop of length ``M + 1`` cost as much
+    as the cosines (profiled), and the angles ``k phi`` are formed once for both. (Not
+    computed as powers of ``exp(i phi)``: that moved results by 1e-15, which the searches'
+    finite differences turned into reordered radial basins on a dev block.)"""
+    n = len(phi)
+    B = np.empty((n, 2 * K + 1, M + 1)) if out is None else out.reshape(n, 2 * K + 1, M + 1)
+    trig = B[:, :, 0]  # m = 0: t**0 is 1, so trig itself
+    trig[:, 0] = 1.0
+    kphi = phi[:, None] * np.arange(1, K + 1)
+    # contiguous in and out, as before: numpy's SIMD cos/sin need not match its strided loop
+    trig[:, 1:K + 1], trig[:, K + 1:] = np.cos(kphi), np.sin(kphi)
+    tp = t[:, None] ** np.arange(M + 1)  # the same powers as before (t**1 is t exactly)
+    for m in range(1, M + 1):
+        np.multiply(trig, tp[:, m:m + 1], out=B[:, :, m])
+    return B.reshape(n, -1)
+
+
+def _design(points, pith, d, e1, e2, z_scale, K: int, M: int, out: np.ndarray | None = None):
+    """rho (n,) and the basis ``trig_k(phi) zeta^m`` (n, (2K+1)(M+1)) at ``points`` (n, 3)
+    (:func:`_trig_powers`, into ``out`` when given)."""
     q = points - pith
     a1, a2, z = q @ e1, q @ e2, (q @ d) / z_scale
     rho = np.hypot(a1, a2)
-    phi = np.arctan2(a2, a1)
-    k = np.arange(1, K + 1)
-    trig = np.concatenate([np.ones((len(q), 1)), np.cos(np.outer(phi, k)), np.sin(np.outer(phi, k))], axis=1)
-    zp = z[:, None] ** np.arange(M + 1)
-    return rho, (trig[:, :, None] * zp[:, None, :]).reshape(len(q), -1)
+    return rho, _trig_powers(np.arctan2(a2, a1), z, K, M, out)
 
 
 def _penalty_weights(K: int, M: int) -> np.ndarray:
@@ -173,15 +200,18 @@ class _Problem:
         """Inner linear problem; returns (residuals incl. penalty rows, coef, offset, levels)."""
         dd, e1, e2 = _frame(d)
         rho, B = _design(self.points, pith, dd, e1, e2, self.z_scale, self.K, self.M)
-        A = rho[:, None] * B
-        pen = np.sqrt(self.ridge * len(A)) * _penalty_weights(self.K, self.M) * np.median(rho)
+        n, p = B.shape
+        pen = np.sqrt(self.ridge * n) * _penalty_weights(self.K, self.M) * np.median(rho)
         if self.years is not None:
-            X = np.concatenate([np.ones((len(A), 1)), A], axis=1)
-            P = np.concatenate([np.zeros((len(pen), 1)), np.diag(pen)], axis=1)
-            lhs = np.concatenate([X, P])
-            rhs = np.concatenate([self.years, np.zeros(len(pen))])
+            # [[1, rho B], [0, diag(pen)]] written in place: the same matrix as stacking them
+            lhs = np.zeros((n + p, p + 1))
+            lhs[:n, 0] = 1.0
+            np.multiply(rho[:, None], B, out=lhs[:n, 1:])
+            lhs[np.arange(n, n + p), np.arange(1, p + 1)] = pen
+            rhs = np.concatenate([self.years, np.zeros(p)])
             sol = _lstsq(lhs, rhs)
             return lhs @ sol - rhs, sol[1:], sol[0], None
+        A = rho[:, None] * B
         # Unlabelled: rho * B c = t_g with mean(B c) = 1 over the data: c = c0 + Z y.
         bbar = B.mean(axis=0)
         c0 = bbar / (bbar @ bbar)
@@ -234,15 +264,26 @@ def _circle_pith(points, years, group, d, centre):
 
 def _lstsq(lhs: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """Least squares by the normal equations: the systems here are tall (n >> p <= ~150) and
-    ridge-regularised, and LAPACK's SVD-based lstsq was 50x slower on them (profiled)."""
-    from scipy.linalg import cho_factor, cho_solve
+    ridge-regularised, and LAPACK's SVD-based lstsq was 50x slower on them (profiled).
 
-    AtA = lhs.T @ lhs
-    AtA[np.diag_indices_from(AtA)] += 1e-10 * (np.trace(AtA) / len(AtA) + 1e-30)
-    try:
-        return cho_solve(cho_factor(AtA), lhs.T @ rhs)
-    except np.linalg.LinAlgError:
+    The Cholesky factor and solve are LAPACK's ``potrf``/``potrs``, called as
+    ``scipy.linalg.cho_factor``/``cho_solve`` call them (upper factor), without their wrappers'
+    per-call checks (a third of the cost on these small systems; finiteness is checked once)."""
+    from scipy.linalg import get_lapack_funcs
+
+    AtA, Atb = lhs.T @ lhs, lhs.T @ rhs
+    AtA.flat[::len(AtA) + 1] += 1e-10 * (np.trace(AtA) / len(AtA) + 1e-30)
+    if not (np.isfinite(AtA).all() and np.isfinite(Atb).all()):  # as scipy's check_finite
+        raise ValueError("array must not contain infs or NaNs")
+    potrf, potrs = get_lapack_funcs(("potrf", "potrs"), (AtA,))
+    c, info = potrf(AtA, lower=False, overwrite_a=True, clean=False)
+    if info > 0:  # not positive definite (cho_factor's LinAlgError)
         return np.linalg.lstsq(lhs, rhs, rcond=None)[0]
+    if info == 0:
+        x, info = potrs(c, Atb, lower=False, overwrite_b=False)
+    if info != 0:
+        raise ValueError(f"LAPACK reported an illegal argument ({info}) in the normal equations")
+    return x
 
 
 def _cost(prob: _Problem, pith, d) -> float:
@@ -694,9 +735,7 @@ def _finish_radial(obs, size_mm, found, K, M, ridge, max_relabel_rounds, seed, h
         if not changed:
             break
         field = _refit_labelled(obs, size_mm, field, ridge, seed=seed)
-    field = _smoothest_coefficients(obs, field, seed)
-    if history:
-        field = _fit_growth_history(obs, field, seed)
+    field = _smooth_with_history(obs, field, seed, history)
     if numbered:
         # Our own numbering: pick the integer age offset that puts the pith at year ~0 (seed
         # eq. 5 fits an integer offset too); rings are unchanged by it.
@@ -717,8 +756,43 @@ _FINAL_RIDGES = (1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3)
 _FINAL_RSS_FACTOR = 1.05
 
 
+class _AxisDesign:
+    """The radial model's linear system at one fixed axis (pith and direction) over ``obs``:
+    :func:`_smoothest_coefficients` and every round of :func:`_fit_growth_history` solve at the
+    same axis, so its design is built once per fit instead of once per round (the same arrays,
+    so the same results bit for bit).
+
+    ``X``, ``w``, ``XtX``: the ridge problem of :func:`_smoothest_coefficients` on its fixed
+    random subset ``i`` of ``n_fit`` points; :meth:`linear` is ``field.linear(obs.points_mm)``
+    for a field on this axis."""
+
+    def __init__(self, obs: RingObservations, field: RadialField, seed: int, n_fit: int = 3000):
+        rng = np.random.default_rng(seed + 2)
+        n = len(obs.points_mm)
+        self.i = np.sort(rng.choice(n, n_fit, replace=False)) if n > n_fit else np.arange(n)
+        self.obs, self.pith, self.axis = obs, np.asarray(field.pith_mm), np.asarray(field.axis)
+        self.frame = _frame(field.axis)
+        rho, B = _design(obs.points_mm[self.i], field.pith_mm, *self.frame, field.z_scale_mm, field.K, field.M)
+        self.X = np.concatenate([np.ones((len(rho), 1)), rho[:, None] * B], axis=1)
+        self.w = np.concatenate([[0.0], _penalty_weights(field.K, field.M)]) * np.median(rho)
+        self.XtX = self.X.T @ self.X
+        self._all: tuple | None = None
+
+    def fits(self, obs: RingObservations, field: RadialField) -> bool:
+        """Whether this is the system of ``obs`` at ``field``'s axis."""
+        return obs is self.obs and bool(np.array_equal(field.pith_mm, self.pith) and np.array_equal(field.axis, self.axis))
+
+    def linear(self, field: RadialField) -> np.ndarray:
+        """``(n,)`` ``field.linear(obs.points_mm)`` with the design at every point built once."""
+        if self._all is None:
+            self._all = _design(check_points(self.obs.points_mm), field.pith_mm, *self.frame, field.z_scale_mm,
+                                field.K, field.M)
+        rho, B = self._all
+        return field.offset + rho * (B @ field.coef)
+
+
 def _smoothest_coefficients(obs: RingObservations, field: RadialField, seed: int,
-                            n_fit: int = 3000, targets=None) -> RadialField:
+                            n_fit: int = 3000, targets=None, system: _AxisDesign | None = None) -> RadialField:
     """Re-solve the coefficients at the fitted axis with the strongest ridge the traces allow.
 
     Why: with jittered traces on only some faces, a weak ridge lets the high azimuthal
@@ -729,17 +803,13 @@ def _smoothest_coefficients(obs: RingObservations, field: RadialField, seed: int
     squares is within :data:`_FINAL_RSS_FACTOR` of the least-smoothed one.
 
     targets : (n,) values the linear model is fitted to (default ``obs.years``).
+    system : the :class:`_AxisDesign` of ``obs`` at ``field``'s axis when already built.
     """
-    rng = np.random.default_rng(seed + 2)
-    n = len(obs.points_mm)
-    i = np.sort(rng.choice(n, n_fit, replace=False)) if n > n_fit else np.arange(n)
-    pts = obs.points_mm[i]
-    yrs = (obs.years if targets is None else np.asarray(targets, float))[i]
-    d, e1, e2 = _frame(field.axis)
-    rho, B = _design(pts, field.pith_mm, d, e1, e2, field.z_scale_mm, field.K, field.M)
-    X = np.concatenate([np.ones((len(pts), 1)), rho[:, None] * B], axis=1)
-    w = np.concatenate([[0.0], _penalty_weights(field.K, field.M)]) * np.median(rho)
-    XtX, Xty = X.T @ X, X.T @ yrs
+    if system is None or not system.fits(obs, field):
+        system = _AxisDesign(obs, field, seed, n_fit)
+    X, w, XtX = system.X, system.w, system.XtX
+    yrs = (obs.years if targets is None else np.asarray(targets, float))[system.i]
+    Xty = X.T @ yrs
     fits = []
     for ridge in _FINAL_RIDGES:
         A = XtX + np.diag(ridge * len(X) * w ** 2)
@@ -756,7 +826,16 @@ def _smoothest_coefficients(obs: RingObservations, field: RadialField, seed: int
     return RadialField(field.pith_mm, field.axis, field.z_scale_mm, field.K, field.M, sol[1:], float(sol[0]))
 
 
-def _fit_growth_history(obs: RingObservations, field: RadialField, seed: int) -> RadialField:
+def _smooth_with_history(obs: RingObservations, field: RadialField, seed: int, history: bool) -> RadialField:
+    """:func:`_smoothest_coefficients`, then (``history``) :func:`_fit_growth_history`, at
+    ``field``'s axis: one :class:`_AxisDesign` for all their solves."""
+    system = _AxisDesign(obs, field, seed)
+    field = _smoothest_coefficients(obs, field, seed, system=system)
+    return _fit_growth_history(obs, field, seed, system=system) if history else field
+
+
+def _fit_growth_history(obs: RingObservations, field: RadialField, seed: int,
+                        system: _AxisDesign | None = None) -> RadialField:
     """Add the tree's growth history: ``years = h(offset + rho * s)`` with ``h`` monotone
     through one level per observed year (:func:`_warp`).
 
@@ -769,20 +848,24 @@ def _fit_growth_history(obs: RingObservations, field: RadialField, seed: int) ->
     is the median of the linear model on that ring's points, shrunk towards the year itself by
     :data:`RING_HISTORY_PRIOR_POINTS` (a ring seen on a few points stays near the mean width) and
     made increasing (scipy's isotonic regression); then ``s`` is refitted to those levels.
+    ``system``: the :class:`_AxisDesign` at ``field``'s axis when already built (every round
+    solves at that axis).
     """
     from scipy.optimize import isotonic_regression
 
     years, idx, counts = np.unique(obs.years, return_inverse=True, return_counts=True)
     if len(years) < 3:
         return field
+    if system is None or not system.fits(obs, field):
+        system = _AxisDesign(obs, field, seed)
 
     def levels(f: RadialField) -> np.ndarray:
-        med = _group_medians(f.linear(obs.points_mm), idx, len(years))  # one per year
+        med = _group_medians(system.linear(f), idx, len(years))  # one per year
         lev = (counts * med + RING_HISTORY_PRIOR_POINTS * years) / (counts + RING_HISTORY_PRIOR_POINTS)
         # strictly increasing for the interpolation
         return isotonic_regression(lev, weights=counts).x + np.arange(len(years)) * RING_HISTORY_MIN_STEP
 
     for _ in range(RING_HISTORY_ROUNDS):
-        field = _smoothest_coefficients(obs, field, seed, targets=levels(field)[idx])
+        field = _smoothest_coefficients(obs, field, seed, targets=levels(field)[idx], system=system)
     field.history_levels, field.history_years = levels(field), years.astype(float)
     return field

@@ -43,6 +43,7 @@ growth history is fitted. Labelled observations only (:mod:`.evidence` numbers u
 from __future__ import annotations
 
 from dataclasses import dataclass
+from dataclasses import field as dc_field
 
 import numpy as np
 
@@ -53,7 +54,7 @@ from ..tolerances import (RING_HISTORY_MIN_STEP, RING_HISTORY_PRIOR_POINTS, RING
                           STEM_AXIAL_SD, STEM_CURVE_PRIOR_MM, STEM_HARMONIC_SD, STEM_PRIOR_YEARS,
                           STEM_RADIAL_SD, STEM_TILT_PRIOR_DEG)
 from .observations import RingObservations
-from .radial import _circle_pith, _frame, _group_medians, _lstsq, _warp, ring_spacing_mm
+from .radial import _circle_pith, _frame, _group_medians, _lstsq, _trig_powers, _warp, ring_spacing_mm
 
 
 @dataclass
@@ -103,7 +104,8 @@ class StemField:
     def pith_distance_mm(self, points_mm: ArrayLike) -> np.ndarray:
         """``(n,)`` mm: distance ``rho`` of each point from the pith in its cross-section."""
         p = check_points(points_mm)
-        return _polar(p, self.centre_mm, _frame(self.base_axis), self.half_length_mm, self.curve)[0]
+        x1, x2, _ = _cross_section(p, self.centre_mm, _frame(self.base_axis), self.half_length_mm, self.curve)
+        return np.hypot(x1, x2)
 
     def pith_years(self) -> float:
         """The growth time on the pith (``rho = 0``): the origin of times "from the pith"."""
@@ -132,25 +134,25 @@ class StemField:
         return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
-def _polar(points, centre, frame, L, curve):
-    """``rho, phi, tau`` of ``points (n, 3)`` about the centreline ``curve (2, 3)``."""
+def _cross_section(points, centre, frame, L, curve):
+    """``x1, x2, tau``: the coordinates of ``points (n, 3)`` in their cross-section about the
+    centreline ``curve (2, 3)`` (along ``b1, b2``) and their height ``tau``."""
     d, b1, b2 = frame
     q = points - centre
     tau = (q @ d) / L
     pw = tau[:, None] ** np.arange(3)
-    x1 = q @ b1 - pw @ curve[0]
-    x2 = q @ b2 - pw @ curve[1]
-    return np.hypot(x1, x2), np.arctan2(x2, x1), tau
+    return q @ b1 - pw @ curve[0], q @ b2 - pw @ curve[1], tau
 
 
 def _design(points, centre, frame, L, curve, K, M, P, rho0):
     """``(n, 1 + (P - 1) + (2K+1)(M+1))``: columns ``1, (rho/rho0)^2..P, rho trig_k(phi) tau^m``."""
-    rho, phi, tau = _polar(points, centre, frame, L, curve)
-    k = np.arange(1, K + 1)
-    trig = np.concatenate([np.ones((len(rho), 1)), np.cos(np.outer(phi, k)), np.sin(np.outer(phi, k))], axis=1)
-    B = (trig[:, :, None] * (tau[:, None] ** np.arange(M + 1))[:, None, :]).reshape(len(rho), -1)
-    pows = (rho / rho0)[:, None] ** np.arange(2, P + 1)
-    return np.concatenate([np.ones((len(rho), 1)), pows, rho[:, None] * B], axis=1)
+    x1, x2, tau = _cross_section(points, centre, frame, L, curve)
+    rho = np.hypot(x1, x2)
+    X = np.empty((len(rho), P + (2 * K + 1) * (M + 1)))  # the columns written in place
+    X[:, 0] = 1.0
+    X[:, 1:P] = (rho / rho0)[:, None] ** np.arange(2, P + 1)
+    np.multiply(rho[:, None], _trig_powers(np.arctan2(x2, x1), tau, K, M), out=X[:, P:])
+    return X
 
 
 def _prior_sd(K, M, P, rho0, density) -> np.ndarray:
@@ -183,13 +185,25 @@ class _StemProblem:
     prior_sd: np.ndarray  # per design column, see _prior_sd
     tilt_prior: float     # tan of the tilt prior's standard deviation (inf: none)
     curve_prior_mm: float
+    # the last centreline's design, keyed by its bytes: after the search, the relabelling, the
+    # coefficients and every growth-history round solve at one centreline (copies made for
+    # other targets share it: same points)
+    _last: dict = dc_field(default_factory=dict, repr=False)
 
     def curve_of(self, theta) -> np.ndarray:
         # theta = (u0, v0, u1, v1, u2, v2)
         return np.array([[theta[0], theta[2], theta[4]], [theta[1], theta[3], theta[5]]])
 
+    def design(self, curve) -> np.ndarray:
+        """:func:`_design` of the points about ``curve``, built once per centreline in a row."""
+        key = np.asarray(curve, float).tobytes()
+        if self._last.get("key") != key:
+            self._last.update(key=key, X=_design(self.points, self.centre, self.frame, self.L, curve, self.K,
+                                                 self.M, self.P, self.rho0))
+        return self._last["X"]
+
     def solve(self, curve):
-        X = _design(self.points, self.centre, self.frame, self.L, curve, self.K, self.M, self.P, self.rho0)
+        X = self.design(curve)
         pen = STEM_PRIOR_YEARS * np.sqrt(len(X)) / self.prior_sd
         lhs = np.concatenate([X, np.diag(pen)])
         rhs = np.concatenate([self.years, np.zeros(len(pen))])
@@ -377,8 +391,11 @@ def _growth_history(obs: RingObservations, prob: _StemProblem, f: StemField, off
     if len(years) < 3:
         return f
 
+    def linear(g: StemField) -> np.ndarray:  # g.linear(obs.points_mm), on the problem's cached design
+        return g.offset + prob.design(g.curve)[:, 1:] @ np.concatenate([g.rho_coef, g.coef])
+
     def levels(g: StemField) -> np.ndarray:
-        med = _group_medians(g.linear(obs.points_mm) + off, idx, len(years))
+        med = _group_medians(linear(g) + off, idx, len(years))
         lev = (counts * med + RING_HISTORY_PRIOR_POINTS * years) / (counts + RING_HISTORY_PRIOR_POINTS)
         return isotonic_regression(lev, weights=counts).x + np.arange(len(years)) * RING_HISTORY_MIN_STEP
 
