@@ -33,7 +33,7 @@ def _in_sample(fit_on, ref):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("sample, min_line_5", [("CN03", 45.0), ("H11", 38.0)])
+@pytest.mark.parametrize("sample, min_line_5", [("CN03", 45.0), ("H11", 46.0)])
 def test_detected_rings_are_numbered_like_the_mokume_maps(sample, min_line_5):
     """Pieces of one ring are one ring to the fitter (RingTrace.ring): the fit from detected
     rings counts about as many rings across each face as the fit from the Mokume maps. When
@@ -41,7 +41,8 @@ def test_detected_rings_are_numbered_like_the_mokume_maps(sample, min_line_5):
     maps' fit counts 4-12 (median ratio 5.7), and its in-sample line share within 5 px was
     31.7 % (maps: 71.6 %); with the pieces linked: ratio ~0.95, 53 %. H11: pieces 2.0 (two to
     three times the maps' count on three faces), linked ~1.0 (0.57-1.15), 39.7 %; with speck
-    pieces dropped after the snap (DETECT_VERSION 6) 0.77-1.00, 42.9 %. The curved Gabor
+    pieces dropped after the snap (DETECT_VERSION 6) 0.77-1.00, 42.9 %; with pieces lying side by
+    side never linked (DETECT_VERSION 7) 0.94-0.99, 50.5 % (CN03 67.3 %), hence H11's bar of 46 %. The curved Gabor
     (opt-in) does not pass on H11: 0.37-0.89, median 0.75 (README)."""
     ref = read_mokume(_mokume(sample), (50.0, 50.0, 50.0))
     with warnings.catch_warnings():     # faces with little ring evidence are named; not tested here

@@ -131,6 +131,28 @@ def test_ring_links_need_one_order_one_region_and_a_short_gap():
     assert len({a, c, d, i, e, f}) == 6
 
 
+def test_pieces_beside_each_other_are_not_one_ring():
+    """A ring never runs beside itself: two pieces the order map calls one ring (a faint ring
+    between them skipped by the phase, as on H11's right face, where one id covered 9 pieces of 5
+    rings) are refused when they lie side by side, 8 px apart across the ring and overlapping
+    30 px along it; the pieces of one ring that follow each other along it are still linked,
+    also when the next piece starts off by a pixel (a line cut where it jumped)."""
+    from woodcam.detect.rings import _ring_ids
+
+    n, lam = 200, 14.0
+    order_map = np.zeros((n, n), np.float32)          # one order everywhere: the phase skipped
+    evidence = np.ones((n, n), bool)
+
+    def piece(col, r0, r1):
+        return np.stack([np.arange(r0, r1, dtype=float), np.full(r1 - r0, float(col))], axis=1)
+
+    polys = [piece(50, 10, 60), piece(58, 30, 90),   # A, B: beside each other, overlapping
+             piece(100, 10, 60), piece(101, 62, 110)]  # C, D: end to end, D a pixel aside
+    ids = _ring_ids(polys, [0.0] * 4, evidence, order_map, np.full((n, n), lam, np.float32), n_centre=4)
+    a, b, c, d = ids
+    assert c == d and a != b, ids
+
+
 def test_dark_line_and_sharp_edge_rules_on_a_skewed_band():
     """A dark band that darkens slowly and ends sharply (plain synthetic latewood): the
     sharp-edge rule finds the step, the dark-line rule the darkest line just before it."""

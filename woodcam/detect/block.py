@@ -42,8 +42,9 @@ from .rings import DEFAULT_RULE, RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, 
 #: Bumped whenever detection results change, so cached detections are recomputed (3: traces
 #: carry their face-local ring id, ``RingTrace.ring``; 4: the curved Gabor response and the
 #: ``dark-edge`` rule by default; 5: the curved Gabor opt-in, after caches of 4 were written
-#: with it on; 6: pieces cut at a snap jump shorter than a ring spacing dropped).
-DETECT_VERSION = 6
+#: with it on; 6: pieces cut at a snap jump shorter than a ring spacing dropped; 7: pieces lying
+#: side by side never linked as one ring).
+DETECT_VERSION = 7
 
 
 Detector = Literal["classical", "learned"]

@@ -153,6 +153,11 @@ LINK_GAP_WAVELENGTHS = 3.0
 #: Largest difference (in rings) of two pieces' places in the ring order for them to be one ring:
 #: band centres sit on whole numbers (same number or not), faint lines where they lie between.
 LINK_ORDER_TOL = 0.25
+#: Least number of vertices (1 px apart) of one piece lying beside another (their nearest vertex
+#: of it away from its ends) for a link between the two to be refused (``_side_by_side``): 3 px
+#: of overlap along the ring, more than the kink of a line cut where it jumped. Added after H11's
+#: right face gave one ring id to 9 pieces of 5 rings (DETECT_VERSION 7).
+SIDE_BY_SIDE_VERTICES = 3
 #: Use the curved Gabor response (:mod:`woodcam.detect.curved`) for the ring phase by default.
 #: Off (``woodcam rings detect --curved`` turns it on): it gains 0.01-0.02 F on the synthetic and
 #: real faces (README), costs ~1.5x the CPU, and moved the downstream fits both ways (in-sample
@@ -396,8 +401,10 @@ def _ring_ids(polys: list, order: list[float], evidence: np.ndarray, order_map: 
     each other, in one connected evidence region (the phase is unwrapped per region), an end of
     one within :data:`LINK_GAP_WAVELENGTHS` ring spacings of the nearest end of the other, and the
     unwrapped order along the straight gap between those ends within half a ring of theirs (no
-    other ring crosses it). Only nearby pieces: around a knot or a fork the unwrapped phase can
-    give two far-apart rings the same order. Linked pieces (transitively) share an id; a piece
+    other ring crosses it), and the two not running beside each other (``_side_by_side``: the
+    unwrapped phase can give neighbouring rings one order where a ring is faint or missing).
+    Only nearby pieces: around a knot or a fork the unwrapped phase can give two far-apart rings
+    the same order. Linked pieces (transitively) share an id; a piece
     with no order (off the evidence) gets None.
     """
     from scipy import ndimage
@@ -446,6 +453,8 @@ def _ring_ids(polys: list, order: list[float], evidence: np.ndarray, order_map: 
         v = v[np.isfinite(v)]
         if len(v) and np.max(np.abs(v - (o[piece[e]] + o[piece[f]]) / 2)) > 0.5:
             continue
+        if _side_by_side(polys[piece[e]], polys[piece[f]]):
+            continue
         rows.append(piece[e])
         cols.append(piece[f])
     graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
@@ -453,6 +462,23 @@ def _ring_ids(polys: list, order: list[float], evidence: np.ndarray, order_map: 
     has = region > 0
     ids = {c: m for m, c in enumerate(sorted({int(comp[k]) for k in range(n) if has[k]}))}
     return [int(ids[int(comp[k])]) if has[k] else None for k in range(n)]
+
+
+def _side_by_side(p: np.ndarray, q: np.ndarray) -> bool:
+    """True when polylines ``p (k, 2)`` and ``q (l, 2)`` (row, col; vertices ~1 px apart) run
+    beside each other: at least :data:`SIDE_BY_SIDE_VERTICES` vertices of one have their nearest
+    vertex of the other away from its ends (two vertices in from each). Pieces of one ring
+    follow each other along it, so each one's nearest vertices of the other are at its end; a
+    ring never runs beside itself, so two such pieces are two rings whatever the phase says."""
+    from scipy.spatial import cKDTree
+
+    for a, b in ((p, q), (q, p)):
+        if len(a) < 5:
+            continue
+        i = cKDTree(a).query(b)[1]
+        if np.count_nonzero((i >= 2) & (i <= len(a) - 3)) >= SIDE_BY_SIDE_VERTICES:
+            return True
+    return False
 
 
 def _instantaneous_wavelength(z: np.ndarray, lam_scale: np.ndarray, wavelengths) -> np.ndarray:
