@@ -1,6 +1,6 @@
 """Regenerate docs/img/knot_cone_7777.png: cut planes of dev seed 7777 block 2 (six noisy
-faces), the plain stem, the stem bent round strands through the exits' centroids (before
-FIT_VERSION 10) and round the cones fitted to the knot masks (now).
+faces), the plain stem, the stem bent round strands through the exits' centroids (the default)
+and round the cones fitted to the knot masks (opt-in, ``knot_cones=True``).
 
     python docs/img/make_knot_cone.py
 """
@@ -25,14 +25,9 @@ def main():
     obs = gather_observations(block)
     stem = fit_stem(obs, block.size_mm)
     exits = K.knot_exits(block)
-    orig = K.strands_from_exits
-    K.strands_from_exits = lambda e, s, z, cones=True: orig(e, s, z, cones=False)
-    try:
-        old, _ = K._fit_knotted_stem(obs, block.size_mm, exits, K.KNOT_BEND_ROUNDS, 0, False, stem)
-    finally:
-        K.strands_from_exits = orig
-    new, _ = K._fit_knotted_stem(obs, block.size_mm, exits, K.KNOT_BEND_ROUNDS, 0, False, stem)
-    fields = {"stem (chosen before)": stem, "bend, centroid strands": old, "bend, cone strands (chosen now)": new}
+    old = K.fit_knotted_stem(obs, block.size_mm, exits, stem=stem)
+    new = K.fit_knotted_stem(obs, block.size_mm, exits, stem=stem, cones=True)
+    fields = {"stem (chosen by default)": stem, "bend, centroid strands": old, "bend, cone strands": new}
     sc = evaluate_fits(block.true_field, fields, block.size_mm, DEFAULT_PLANES, BENCH_PIXEL_MM, keep_lines=True)
     for k, v in sc.items():
         print(f"{k}: {v[0]['matched_1']:.1f} / {v[0]['matched_2']:.1f} % within 1 / 2 mm")
