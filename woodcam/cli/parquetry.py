@@ -95,7 +95,8 @@ def register(subparsers) -> None:
                    "16 for four 600x400 mm sheets at 4 px/mm)")
     f.add_argument("--w-struct", type=float, default=None, metavar="W",
                    help="weight of the structural re-rank of the cheapest candidates (SSIM's "
-                   "contrast-structure on 7 x 7 px windows, unitless; default 0.02; 0 = eq. 4 alone)")
+                   "contrast-structure on 7 x 7 windows of the target image's own pixels, unitless; "
+                   "default 0.02; 0 = eq. 4 alone)")
     f.add_argument("--overlap-mm", type=float, default=None,
                    help="patch overlap for seam cutting in mm (default min(patch/4, "
                    "(patch - min-piece)/2) = 3.5); 0 = square pieces")

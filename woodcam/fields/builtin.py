@@ -12,6 +12,11 @@ of seed 000 whose radius functions come from a fixed seed, so the truth is known
   from the heart): concentric rings on top and bottom, end grain there.
 - ``knotty``: a tangential board from a synthetic spruce log with a whorl of branches (the
   knot model of seed 003): an alive knot through the front face and a dead one beside it.
+- ``fast-grown``: a flitch of a fast-grown (plantation) tree, 10 mm rings, the pith 500 mm
+  behind its middle plane, along X: its front-parallel leaves are flat-sawn with even bands
+  tens of mm wide, the calm wood a parquetry maker keeps for plain areas (``woodcam
+  parquetry --veneer-from builtin:fast-grown``). The ring width is an assumption (no measured
+  tree), at the wide end of plantation growth.
 """
 
 from __future__ import annotations
@@ -54,6 +59,8 @@ _SPECS = {
              "rift-sawn board, rings at about 45 deg on the end faces"),
     "pith-inside": ((54.0, 43.0, 0.0), (0.03, -0.02, 1.0), 3.5, "pine", 4,
                     "turning blank with the pith inside, vertical"),
+    "fast-grown": ((0.0, -460.0, 25.0), (1.0, 0.0, 0.0), 10.0, "maple", 5,
+                   "fast-grown flitch, 10 mm rings, pith 500 mm behind: calm flat-sawn leaves"),
 }
 
 #: Names of the built-in blocks.

@@ -258,6 +258,9 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     o = params.overlap_px
     patches: list[Patch] = []
     contexts = [bank.target_context(p.target_feats) for p in panels]
+    # working pixels per target-image pixel, for the structural re-rank (SheetBank.best)
+    struct_px = [max(1.0, p.matched.shape[0] / p.native_shape[0]) if p.native_shape else 1.0
+                 for p in panels]
 
     def window(p: Parquetry, r: int, c: int, n: int):
         H, W = p.matched.shape
@@ -269,7 +272,7 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
         g = window(p, r, c, n)
         tmpl = np.ascontiguousarray(p.target_feats[g[0]:g[2], g[1]:g[3]])
         ctx = contexts[p.index]
-        m = bank.best(tmpl, None if ctx is None else (ctx, g[0], g[1]))
+        m = bank.best(tmpl, None if ctx is None else (ctx, g[0], g[1]), struct_px[p.index])
         if n > 1 and n % 2 == 0:
             h2 = n // 2
             kids = [(r + dr, c + dc) for dr in (0, h2) for dc in (0, h2)]
@@ -278,7 +281,7 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
             for kr, kc in kids:
                 kg = window(p, kr, kc, h2)
                 km = bank.best(np.ascontiguousarray(p.target_feats[kg[0]:kg[2], kg[1]:kg[3]]),
-                               None if ctx is None else (ctx, kg[0], kg[1]))
+                               None if ctx is None else (ctx, kg[0], kg[1]), struct_px[p.index])
                 if km is None:
                     ok = False
                     break

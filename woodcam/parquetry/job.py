@@ -57,9 +57,9 @@ class ParquetryParams:
         chooses the smallest of 4, 8, 16 whose coarse search holds at most
         ``AUTO_COARSE_PX`` pixels (the four 600 x 400 mm sheets at 4 px/mm of the issue's
         workload get 16)
-    w_struct : weight of the structural term (SSIM's contrast-structure, 7 x 7 windows) that
-        re-ranks the ``rerank`` cheapest distinct free candidates of eq. 4 (woodcam's addition;
-        0: eq. 4 alone). 0.02 raised SSIM by 0.01-0.02 on the skimage targets at an unchanged
+    w_struct : weight of the structural term (SSIM's contrast-structure, 7 x 7 windows of the
+        target image's own pixels, the wood area-averaged to them) that re-ranks the ``rerank``
+        cheapest distinct free candidates of eq. 4 (woodcam's addition; 0: eq. 4 alone). 0.02 raised SSIM by 0.01-0.02 on the skimage targets at an unchanged
         feature cost (tests/bench/test_parquetry_bench.py)
     """
 

@@ -485,7 +485,8 @@ class SheetBank:
         return None if self.f == 1 else _lowpass_energy(feats, self.f)
 
     def best(self, template: np.ndarray,
-             context: tuple[np.ndarray, int, int] | None = None) -> Match | None:
+             context: tuple[np.ndarray, int, int] | None = None,
+             struct_px: float = 1.0) -> Match | None:
         """The best valid placement of ``template (th, tw, 2)`` (eq. 4), or None when no free
         wood holds it. Does not consume; call :meth:`take` to commit.
 
@@ -494,12 +495,17 @@ class SheetBank:
             round it, as every sheet is, rather than with its border replicated, which made
             the outer ring of coarse pixels (a third to a half of a template) disagree even
             with the very wood the target was cut from.
+        struct_px : working pixels per pixel of the target image (> 1 when the target was
+            enlarged to the working grid): the structural re-rank (:meth:`_choose`) looks at
+            the wood on the target's own pixels, the finest grid on which the target says
+            whether it is flat.
         """
         th, tw = template.shape[:2]
         f = self.f
         if f == 1:
             cands = self.atlas.search(template, self.top_k * 8)
-            m = self._choose(template, [(c, *self.atlas.tiles[t][:2], x, y) for t, x, y, c in cands])
+            m = self._choose(template, [(c, *self.atlas.tiles[t][:2], x, y) for t, x, y, c in cands],
+                             struct_px)
             if m is not None:
                 return m
             return self._fallback(template) if cands else None
@@ -531,12 +537,12 @@ class SheetBank:
                 for c, x, y in self.exact_costs(i, j, xf, yf, self.radius, template, keep=3):
                     found.append((c, i, j, x, y))
             found.sort()
-            m = self._choose(template, found)
+            m = self._choose(template, found, struct_px)
             if m is not None:
                 return m
         return self._fallback(template) if cands else None
 
-    def _choose(self, template: np.ndarray, found: list) -> Match | None:
+    def _choose(self, template: np.ndarray, found: list, struct_px: float = 1.0) -> Match | None:
         """The candidate to take from ``found = [(cost, sheet, rot, x, y)]`` (sorted by cost).
 
         With ``w_struct == 0`` the cheapest free one (eq. 4). Otherwise the first
@@ -545,6 +551,7 @@ class SheetBank:
         SSIM (Wang et al. 2004) between the wood's intensity and the target's (eq. 2): SSD
         weighs a tone error and a grain of the same amplitude alike, whereas the eye (and SSIM)
         forgives a slightly wrong tone far sooner than grain running where the target is flat.
+        Both intensities are first area-averaged by ``struct_px`` (see :meth:`best`).
         """
         th, tw = template.shape[:2]
         free = []
@@ -561,7 +568,7 @@ class SheetBank:
             return free[0] if free else None
         gt = template[..., 0] / self.w_intens
         score = [m.cost / (th * tw) + self.w_struct * _structure_penalty(
-            self._rotated_grey(m.sheet, m.rot, m.x, m.y, tw, th), gt) for m in free]
+            self._rotated_grey(m.sheet, m.rot, m.x, m.y, tw, th), gt, struct_px) for m in free]
         return free[int(np.argmin(score))]
 
     def _fallback(self, template: np.ndarray) -> Match | None:
@@ -643,15 +650,21 @@ _SSIM_WIN = 7
 _SSIM_C2 = (0.03 * 1.0) ** 2
 
 
-def _structure_penalty(gs: np.ndarray, gt: np.ndarray) -> float:
+def _structure_penalty(gs: np.ndarray, gt: np.ndarray, scale: float = 1.0) -> float:
     """Mean of ``1 - cs`` over 7 x 7 box windows of two ``(h, w)`` intensities, where
     ``cs = (2 cov + C2) / (var_s + var_t + C2)`` is SSIM's contrast-structure term: 0 when the
     wood's grain follows the target's structure, up to 1 (2 for anti-correlation) when the wood
-    is textured where the target is flat."""
+    is textured where the target is flat. ``scale > 1`` area-averages both by that factor
+    first (the target image's own pixels; at least 7 x 7 of them are kept)."""
     import cv2
 
     k = (_SSIM_WIN, _SSIM_WIN)
     a, b = np.asarray(gs, np.float32), np.asarray(gt, np.float32)
+    if scale > 1.0:
+        h, w = a.shape
+        size = (max(_SSIM_WIN, round(w / scale)), max(_SSIM_WIN, round(h / scale)))
+        a = cv2.resize(a, size, interpolation=cv2.INTER_AREA)
+        b = cv2.resize(b, size, interpolation=cv2.INTER_AREA)
     ma, mb = cv2.blur(a, k), cv2.blur(b, k)
     va = cv2.blur(a * a, k) - ma * ma
     vb = cv2.blur(b * b, k) - mb * mb
