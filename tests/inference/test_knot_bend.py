@@ -13,23 +13,15 @@ from woodcam.inference.observations import gather_observations
 from woodcam.inference.stem import StemField, fit_stem
 from woodcam.synth import synth_block
 
+from _stems import round_stem
+
 SIZE = (40.0, 40.0, 40.0)
 
 
 def true_stem(density: float = 1 / 3.0) -> StemField:
     """Round rings ``density`` per mm about a straight pith along Z through (-25, 20, z), outside
     the block's left face; years 0 on the pith."""
-    K, M, P = 2, 0, 2
-    coef = np.zeros((2 * K + 1) * (M + 1))
-    coef[0] = density
-    c = np.asarray(SIZE) / 2
-    f = StemField(c, np.array([0.0, 0.0, 1.0]), float(np.linalg.norm(SIZE) / 2), np.zeros((2, 3)), K, M, P,
-                  coef, np.zeros(P - 1), 50.0, 0.0)
-    # move the pith to (-25, 20): the centreline offset in the stem's own (b1, b2) frame
-    d, b1, b2 = __import__("woodcam.inference.radial", fromlist=["_frame"])._frame(f.base_axis)
-    off = np.array([-25.0, 20.0, 0.0]) - c
-    f.curve = np.array([[off @ b1, 0, 0], [off @ b2, 0, 0]], float)
-    return f
+    return round_stem((-25.0, 20.0), SIZE, density)
 
 
 def test_bend_is_seed_003s_share_of_the_time_since_the_pith():

@@ -14,9 +14,10 @@ from woodcam.fields.knots import KnotParams
 from woodcam.inference.evaluate import evaluate_fits
 from woodcam.inference.knots import fit_knotted_stem, knot_exits, strands_from_exits
 from woodcam.inference.observations import gather_observations
-from woodcam.inference.radial import _frame
 from woodcam.inference.stem import StemField, fit_stem
 from woodcam.synth import synth_block
+
+from _stems import round_stem
 
 SIZE = (40.0, 40.0, 40.0)
 #: a branch from the pith at (-20, -20) diagonally across the block: its cone is cut by the
@@ -27,16 +28,7 @@ STRAND = KnotStrand((-20.0, -20.0, 17.0), (80.0, 80.0, 23.0), 3.0, 6.0)
 def corner_stem(density: float = 1 / 3.0) -> StemField:
     """Round rings ``density`` per mm about a straight pith along Z through (-20, -20, z),
     outside the block's front-left edge; years 0 on the pith."""
-    K, M, P = 2, 0, 2
-    coef = np.zeros((2 * K + 1) * (M + 1))
-    coef[0] = density
-    c = np.asarray(SIZE) / 2
-    f = StemField(c, np.array([0.0, 0.0, 1.0]), float(np.linalg.norm(SIZE) / 2), np.zeros((2, 3)), K, M, P,
-                  coef, np.zeros(P - 1), 50.0, 0.0)
-    _, b1, b2 = _frame(f.base_axis)
-    off = np.array([-20.0, -20.0, 0.0]) - c
-    f.curve = np.array([[off @ b1, 0, 0], [off @ b2, 0, 0]], float)
-    return f
+    return round_stem((-20.0, -20.0), SIZE, density)
 
 
 @pytest.fixture(scope="module")
