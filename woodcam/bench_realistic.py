@@ -83,7 +83,7 @@ def make_block(seed: int, index: int, scenario: Scenario = "noisy", kind: Kind =
 def score_block(seed: int, index: int, methods: tuple[str, ...] | list[str] = ("rbf", "radial", "evidence"),
                 scenario: Scenario = "noisy", face_set: FaceSet = "full", kind: Kind = "realistic",
                 face_px: int = 256, pixel_mm: float = BENCH_PIXEL_MM, planes: tuple | None = None,
-                keep_lines: bool = False, knot_bend: bool = True, knot_cones: bool = False) -> dict:
+                keep_lines: bool = False, knot_bend: bool = True, knot_cones: bool = True) -> dict:
     """Fit benchmark block ``(seed, index)`` with every method and score it on cut planes.
 
     Returns
@@ -94,7 +94,7 @@ def score_block(seed: int, index: int, methods: tuple[str, ...] | list[str] = ("
     (percent, wall and CPU seconds); the evidence method adds ``chosen`` and ``contradicted``. With ``keep_lines``,
     ``"planes"``: method -> list of PlaneScore for :func:`woodcam.inference.evaluate.plot_planes`.
     ``knot_bend``, ``knot_cones``: the evidence fit's knot-bend hypotheses and cone strands
-    (:func:`woodcam.inference.fit_block`; the bend on, the cones off by default).
+    (:func:`woodcam.inference.fit_block`; both on by default).
     """
     import warnings
 

@@ -304,8 +304,19 @@ EVIDENCE_BLEND_DEPTH_MM = 2.0
 #: mean held-out score is within this many percent points of the best plain hypothesis'
 #: (:func:`woodcam.inference.evidence.choose`). H11's fold without its bottom face: stem 19.8
 #: points below the best, its bend won and predicted the face below chance. Dev seed 9101, six
-#: noisy faces, knotted blocks: the stems under bends that help are 0-7.2 points below the best.
-EVIDENCE_REFINE_BASE_MARGIN = 10.0
+#: noisy faces, knotted blocks: the stems under bends that help are 0-7.2 points below the best;
+#: dev seed 63311 block 1, six faces: 12.4 below, its cone bend 13.1 above the best plain
+#: hypothesis and 94.5 / 98.1 % within 1 / 2 mm on the cut planes (the plain one chosen at 10
+#: points: 36.9 / 54.6). 15 since :data:`EVIDENCE_REFINE_GAIN_MARGIN` guards the choice too.
+EVIDENCE_REFINE_BASE_MARGIN = 15.0
+
+#: A refinement is chosen only when its mean held-out score beats every plain hypothesis' by
+#: more than this many percent points (:func:`woodcam.inference.evidence.choose`): hypotheses
+#: closer than :data:`EVIDENCE_ACCEPT_MARGIN` are ones the evidence cannot tell apart, and then
+#: the field without the extra term is kept. H11's fold without its right face, knot cones on:
+#: the bend 52.1 against the best plain hypothesis 48.9 (+3.2), and it predicted the right face
+#: at 0.3 % within 2 px (the plain one 24.9 %); bends that help on dev seed 63311 win by 6-27.
+EVIDENCE_REFINE_GAIN_MARGIN = EVIDENCE_ACCEPT_MARGIN
 
 #: Uncertainty added per mm from the nearest observed face (years/mm): a prior, not a
 #: measurement; 0.02 makes the middle of a 50 mm block seen from one face half a ring unsure.

@@ -43,9 +43,9 @@ def register(subparsers) -> None:
     r.add_argument("--no-knot-bend", dest="knot_bend", action="store_false",
                    help="leave the stem with its knots' ring bend out of the evidence fit's hypotheses "
                         "(default: it competes wherever knot exits on two faces pin a knot)")
-    r.add_argument("--knot-cones", action="store_true",
-                   help="knot strands and radii from the cones fitted to every face's knot mask "
-                        "(default off: better on knotted synthetic blocks, worse on H11's held-out faces)")
+    r.add_argument("--no-knot-cones", dest="knot_cones", action="store_false",
+                   help="knot strands from the exits' centroids and areas, as before FIT_VERSION 10 "
+                        "(default: the cones fitted to every face's knot mask)")
     add_confidence_option(r, "; implies --plots")
     add_out_option(r, "table.md, records.json and cut-plane PNGs")
     r.set_defaults(func=run_realistic)
