@@ -1,6 +1,6 @@
 """Regenerate docs/img/knot_cone_7777.png: cut planes of dev seed 7777 block 2 (six noisy
-faces), the plain stem, the stem bent round strands through the exits' centroids (the default)
-and round the cones fitted to the knot masks (opt-in, ``knot_cones=True``).
+faces), the plain stem, the stem bent round strands through the exits' centroids (before FIT_VERSION 10)
+and round the cones fitted to the knot masks (the default fit's strands since FIT_VERSION 10).
 
     python docs/img/make_knot_cone.py
 """
@@ -27,7 +27,7 @@ def main():
     exits = K.knot_exits(block)
     old = K.fit_knotted_stem(obs, block.size_mm, exits, stem=stem)
     new = K.fit_knotted_stem(obs, block.size_mm, exits, stem=stem, cones=True)
-    fields = {"stem (chosen by default)": stem, "bend, centroid strands": old, "bend, cone strands": new}
+    fields = {"plain stem": stem, "bend, centroid strands": old, "bend, cone strands": new}
     sc = evaluate_fits(block.true_field, fields, block.size_mm, DEFAULT_PLANES, BENCH_PIXEL_MM, keep_lines=True)
     for k, v in sc.items():
         print(f"{k}: {v[0]['matched_1']:.1f} / {v[0]['matched_2']:.1f} % within 1 / 2 mm")

@@ -85,7 +85,7 @@ def test_a_cone_bend_the_rings_do_not_show_is_rejected(corner_block):
     """Planted wrong: the corner knot's masks on a block whose rings are not bent (the same
     stem without the knot). The cone strand is pinned and its bend competes, but the held-out
     faces reject it (89.1 against 100 % for every plain hypothesis when written) and the fit
-    (``knot_cones=True``) keeps a plain hypothesis. Checked by breaking it: with refinements always preferred in
+    (``knot_cones=True``, the default) keeps a plain hypothesis. Checked by breaking it: with refinements always preferred in
     :func:`woodcam.inference.evidence.choose` (a 100-point head start) the bend is chosen and
     this test fails (a 10-point head start still rejects it)."""
     from woodcam.inference import fit_block
@@ -96,7 +96,7 @@ def test_a_cone_bend_the_rings_do_not_show_is_rejected(corner_block):
             plain.faces[name].extras["knot_mask"] = f.extras["knot_mask"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", WoodcamWarning)
-        ev = fit_block(plain, baked=False, knot_cones=True)
+        ev = fit_block(plain, baked=False)
     assert "stem + knot bend" in ev.scores  # it competed (the cone pins a strand) ...
     assert "knot bend" not in ev.chosen, ev.message  # ... and lost
     assert ev.scores["stem + knot bend"]["mean"] < ev.scores["stem"]["mean"] - 2.0, ev.scores

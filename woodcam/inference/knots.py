@@ -286,8 +286,9 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
     (module docstring). ``cones``: exits touching across a block edge are one knot end
     (:func:`_ends`), and a paired strand's line and radius are its cone fitted to the face masks
     (:func:`_fit_cone`; exits from :func:`knot_exits` carry the samples); False: the line
-    through two exits' centroids with radii from their areas (the default: with the cones, H11's
-    leave-one-face-out fell from 1.59 to 1.04 x chance within 2 px, README)."""
+    through two exits' centroids with radii from their areas (what
+    :func:`~.fit.fit_block` ``(knot_cones=False)`` uses; the fit's default is the cones since
+    FIT_VERSION 10)."""
     if not exits:
         return []
     axis = np.asarray(getattr(stem, "axis", (0.0, 0.0, 1.0)), float)
