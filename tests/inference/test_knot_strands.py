@@ -153,7 +153,7 @@ def test_oblique_branch_through_two_faces_is_recovered_from_its_masks():
 def test_h11_knot_appears_where_its_photos_show_it(shared_data, tmp_path, cones, bar):
     """The real spruce cube H11: its knot exits through faces C (left) and F (back); the fitted
     field's knot overlaps the given knot masks there (IoU measured 0.91 / 0.91 with the cone
-    fitted to the masks, the default since FIT_VERSION 10; 0.82 / 0.86 with the strand through
+    fitted to the masks, the default since FIT_VERSION 10; 0.81 / 0.85 with the strand through
     the exits' centroids, ``knot_cones=False``, which fails the default's bar 0.85 on face C)
     and the baked grid carries it for the colour map."""
     from woodcam.block.io import read_mokume
