@@ -86,7 +86,7 @@ class Hypothesis:
     refit : ``RingObservations -> field``, the same recipe on fewer faces
     refines : name of the hypothesis this one adds a term to (the knots' ring bend refines
         ``"stem"``), or None; a refinement is chosen only while the evidence keeps its base
-        (:func:`choose`)
+        and it beats every plain hypothesis clearly (:func:`choose`)
     """
 
     name: str
@@ -230,7 +230,8 @@ def _set_aside(hypotheses: list[Hypothesis], scores: dict) -> dict[str, str]:
 
 def choose(hypotheses: list[Hypothesis], evidence: dict) -> EvidenceFit:
     """Pick the hypothesis with the best mean held-out score (the first on ties or without
-    evidence), leaving out refinements whose base the evidence rejects (:func:`_set_aside`);
+    evidence), leaving out refinements whose base the evidence rejects or that do not beat
+    every plain hypothesis by more than :data:`EVIDENCE_REFINE_GAIN_MARGIN` (:func:`_set_aside`);
     flag the result when the evidence contradicts it (see :class:`EvidenceFit`)."""
     names = [h.name for h in hypotheses]
     by_name = {h.name: h for h in hypotheses}

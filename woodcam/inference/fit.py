@@ -59,7 +59,9 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         hypothesis wherever exits on two faces pin a knot's strand (a strand guessed from one
         exit is not offered: :func:`woodcam.inference.knots.knot_bend_recipes`). It refines
         the stem: it competes only while the held-out faces keep the plain stem within
-        :data:`~woodcam.tolerances.EVIDENCE_REFINE_BASE_MARGIN` of the best hypothesis
+        :data:`~woodcam.tolerances.EVIDENCE_REFINE_BASE_MARGIN` of the best hypothesis, and
+        is chosen only when it beats every plain hypothesis by more than
+        :data:`~woodcam.tolerances.EVIDENCE_REFINE_GAIN_MARGIN`
         (:func:`woodcam.inference.evidence.choose`), which keeps H11's held-out faces where
         they were without the bend (README). ``False`` leaves it out.
     knot_cones : evidence only (default True): each knot's strand and radius are the cone fitted
