@@ -117,3 +117,14 @@ def test_training_styles_are_checked():
     with pytest.raises(WoodcamError, match="style must be one of"):
         RingNetSpec(style="photoreal")
     assert RingNetSpec.load(MODELS_DIR / SPEC_NAME).style in ("plain", "realistic", "mixed")
+
+
+def test_realistic_training_faces_share_the_plain_targets():
+    """``style``: the same cube's faces in another colour; the target stays the true boundary."""
+    from woodcam.synth import ring_training_faces
+
+    plain = replace(RingNetSpec(), n_blocks=1, face_px=48)
+    xp, yp = ring_training_faces(plain)
+    xr, yr = ring_training_faces(replace(plain, style="realistic"))
+    np.testing.assert_array_equal(yp, yr)
+    assert np.abs(xp - xr).mean() > 0.05
