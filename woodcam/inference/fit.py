@@ -33,7 +33,8 @@ FIT_VERSION = 9
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
-              baked: bool = True, knot_bend: bool = True, knot_cones: bool = False) -> GrowthFieldLike:
+              baked: bool = True, knot_bend: bool = True, knot_cones: bool = False,
+              residual: bool = False) -> GrowthFieldLike:
     """Infer a block's growth field from the rings on its faces.
 
     Parameters
@@ -67,6 +68,10 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         within 1 / 2 mm: six faces 62.0 / 76.3 -> 66.3 / 81.5, three faces 41.6 / 61.2 -> 46.4 /
         65.7; H11's knot IoU 0.82 / 0.86 -> 0.91 / 0.91; but H11's held-out faces fall from 1.59
         to 1.04 x chance (one fold chooses the cone bend), so it is not the default (README).
+    residual : evidence only, opt-in: the small-scale residual of issue 12 part 4
+        (``fit_evidence(residual=True)``), a smooth correction near the faces on top of the
+        chosen field, kept only where leave-one-face-out says it predicts; the grid's
+        ``meta["residual"]`` says whether it was kept and why (README).
     Returns
     -------
     field : callable ``(n, 3) mm -> (n,) years`` in the block frame.
@@ -87,8 +92,8 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         stem, recipes = (knot_bend_recipes(block.size_mm, knot_exits(block, faces), cones=knot_cones)
                          if knot_bend else (None, None))
         ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem,
-                          refines=dict.fromkeys(recipes or {}, "stem"))
-        if isinstance(ev.field, StemWithKnots):  # the chosen field holds its knots already
+                          refines=dict.fromkeys(recipes or {}, "stem"), residual=residual)
+        if isinstance(getattr(ev.field, "base", ev.field), StemWithKnots):  # it holds its knots already
             strands = ev.field.strands
         else:
             ev.field, strands = with_knots(block, ev.field, faces, knot_cones)  # knots from the masks (part 3)
