@@ -15,6 +15,7 @@ leave-one-face-out fold and keeps it only when the held-out faces score higher w
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 
 import numpy as np
@@ -30,6 +31,22 @@ from .rbf import thin_out
 #: Reweighting rounds of the Huber fit (the second barely moves after the first).
 _IRLS_ROUNDS = 2
 
+#: Relative residual of the conjugate-gradient solve: coefficients to ~1e-7 years of a direct
+#: solve (an 80 x 60 x 70 mm block: 4242 coefficients, 0.02 s against SuperLU's 0.4-1.3 s).
+_CG_RTOL = 1e-8
+
+
+def _solve_spd(A, b, x0):
+    """``A x = b`` for the sparse symmetric positive definite normal equations: conjugate
+    gradients with a Jacobi preconditioner (the penalty's ridge keeps ``A`` well conditioned),
+    a direct solve if it does not converge."""
+    from scipy.sparse.linalg import LinearOperator, cg, spsolve
+
+    d = A.diagonal()
+    M = LinearOperator(A.shape, matvec=lambda v: v / d)
+    x, info = cg(A, b, x0=x0, M=M, rtol=_CG_RTOL, maxiter=10 * A.shape[0])
+    return x if info == 0 else spsolve(A.tocsc(), b)
+
 
 def _difference_penalty(n: int, order: int):
     """``D^T D`` of the ``order``-th differences of ``n`` coefficients, sparse ``(n, n)``."""
@@ -43,6 +60,7 @@ def _difference_penalty(n: int, order: int):
     return (d.T @ d).tocsr()
 
 
+@functools.lru_cache(maxsize=32)
 def _face_penalty(nu: int, nv: int, ridge: float, slope: float, curvature: float):
     """Penalty ``(nu nv, nu nv)`` of one face's coefficients (C order, as ``NdBSpline``'s)."""
     from scipy import sparse
@@ -74,7 +92,6 @@ def fit_face_residual(obs: RingObservations, base: Callable, size_mm: ArrayLike,
     """
     from scipy import sparse
     from scipy.interpolate import NdBSpline
-    from scipy.sparse.linalg import spsolve
 
     size = np.asarray(size_mm, float)
     keep = thin_out(len(obs.points_mm), max_points, seed)
@@ -107,7 +124,7 @@ def fit_face_residual(obs: RingObservations, base: Callable, size_mm: ArrayLike,
     coef = np.zeros(J.shape[1])
     for _ in range(_IRLS_ROUNDS + 1):
         Jw = (sparse.diags_array(w) @ J).T.tocsr()
-        coef = spsolve((Jw @ J + pen).tocsc(), Jw @ res)
+        coef = _solve_spd((Jw @ J + pen).tocsr(), Jw @ res, coef)
         err = np.abs(J @ coef - res)
         w = w_data * np.minimum(1.0, RESIDUAL_HUBER_YEARS / np.maximum(err, 1e-12))
     coefs, at = {}, 0
