@@ -110,3 +110,10 @@ def test_residual_refuses_the_everywhere_blend(wavy_block):
     obs = gather_observations(wavy_block, ["front", "top"])
     with pytest.raises(WoodcamError, match="residual=True needs blend"):
         fit_evidence(obs, SIZE, residual=True, blend="everywhere")
+
+
+def test_fit_face_residual_needs_years(wavy_block):
+    obs = gather_observations(wavy_block, ["front"])
+    obs.years[:] = np.nan  # unnumbered ring-map rings
+    with pytest.raises(WoodcamError, match="obs must hold ring points with years"):
+        fit_face_residual(obs, wavy_block.true_field.stem, SIZE)

@@ -21,6 +21,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .._types import ArrayLike
+from ..errors import WoodcamError
 from ..fields.residual import FaceResidual, face_geometry, face_knots
 from ..frames import FACE_AXIS, FACES
 from ..tolerances import (RESIDUAL_CURVATURE, RESIDUAL_DEPTH_MM, RESIDUAL_HUBER_YEARS, RESIDUAL_MAX_POINTS,
@@ -98,6 +99,10 @@ def fit_face_residual(obs: RingObservations, base: Callable, size_mm: ArrayLike,
     p, face_of = obs.points_mm[keep], obs.face[keep]
     res = obs.years[keep] - np.asarray(base(p), float)
     ok = np.isfinite(res)
+    if not ok.any():
+        raise WoodcamError(f"obs must hold ring points with years to fit a residual to; got {len(obs.years)} points "
+                           "and none with a finite year and base value; number unlabelled rings first "
+                           "(woodcam.inference.radial.number_observations)")
     p, face_of, res = p[ok], face_of[ok], res[ok]
     # each face's points weigh one per knot cell of that face in all
     w_data = np.zeros(len(p))
