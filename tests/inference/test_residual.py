@@ -117,3 +117,13 @@ def test_fit_face_residual_needs_years(wavy_block):
     obs.years[:] = np.nan  # unnumbered ring-map rings
     with pytest.raises(WoodcamError, match="obs must hold ring points with years"):
         fit_face_residual(obs, wavy_block.true_field.stem, SIZE)
+
+
+def test_fit_face_residual_with_points_on_part_of_one_face(wavy_block):
+    """Points that reach only some of a face's B-splines (one corner of one face observed, as a
+    fold of a three-face block may leave) still give every face its full coefficient grid."""
+    obs = gather_observations(wavy_block, ["front"])
+    corner = obs.subset((obs.points_mm[:, 0] < 20) & (obs.points_mm[:, 2] < 20))
+    res = fit_face_residual(corner, wavy_block.true_field.stem, SIZE)
+    assert all(c.shape == (20, 20) for c in res.coefs.values())  # 17 intervals of 3 mm + 3
+    assert np.isfinite(res(corner.points_mm)).all()

@@ -121,6 +121,8 @@ def fit_face_residual(obs: RingObservations, base: Callable, size_mm: ArrayLike,
         wt = np.exp(-(d / depth_mm) ** 2)
         wt[wt < 1e-6] = 0.0
         dm = NdBSpline.design_matrix(uv, knots, 3)
+        # scipy sizes the matrix by the last basis function the points touch: give it every one
+        dm = sparse.csr_array((dm.data, dm.indices, dm.indptr), shape=(len(uv), nu * nv))
         blocks.append(sparse.diags_array(wt) @ dm)
         pens.append(_face_penalty(nu, nv, RESIDUAL_RIDGE, RESIDUAL_SLOPE, RESIDUAL_CURVATURE))
     J = sparse.hstack(blocks, format="csr")
