@@ -82,7 +82,7 @@ class FaceResidual:
                 continue
             d, uv = face_geometry(p, self.size_mm, face)
             w = self.weight(d)
-            near = w > _MIN_WEIGHT  # deep points: no face's residual reaches them
+            near = w > _MIN_WEIGHT  # deep points: no face's residual reaches them (nor its fit)
             if near.any():
                 out[near] += w[near] * self._splines[face](uv[near])
         return out

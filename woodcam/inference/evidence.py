@@ -24,7 +24,11 @@ faces it was *not* fitted to can. So:
    (and a :class:`~woodcam.errors.WoodcamWarning` is raised) when even the chosen hypothesis
    predicts some observed face badly (:data:`~woodcam.tolerances.EVIDENCE_MIN_FACE_SHARE_2MM`),
    and ``unverified`` when fewer than two faces carry rings (nothing to hold out).
-4. Confidence (part 5): the spread (years) of the hypotheses whose evidence is close to the
+4. Small-scale residual (part 4, opt-in ``residual=True``): a smooth correction near the faces
+   on top of the chosen field (:mod:`.residual`), refitted in every fold on that fold's fit of
+   the chosen hypothesis and kept only when the held-out faces score higher with it
+   (:func:`residual_evidence`).
+5. Confidence (part 5): the spread (years) of the hypotheses whose evidence is close to the
    best one's, per point (:meth:`EvidenceFit.uncertainty_years`).
 
 Years: labelled traces are scored against their labels (a few mislabelled traces cost a few
