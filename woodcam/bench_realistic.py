@@ -83,7 +83,8 @@ def make_block(seed: int, index: int, scenario: Scenario = "noisy", kind: Kind =
 def score_block(seed: int, index: int, methods: tuple[str, ...] | list[str] = ("rbf", "radial", "evidence"),
                 scenario: Scenario = "noisy", face_set: FaceSet = "full", kind: Kind = "realistic",
                 face_px: int = 256, pixel_mm: float = BENCH_PIXEL_MM, planes: tuple | None = None,
-                keep_lines: bool = False, knot_bend: bool = True, knot_cones: bool = True) -> dict:
+                keep_lines: bool = False, knot_bend: bool = True, knot_cones: bool = True,
+                residual: bool = False) -> dict:
     """Fit benchmark block ``(seed, index)`` with every method and score it on cut planes.
 
     Returns
@@ -94,7 +95,8 @@ def score_block(seed: int, index: int, methods: tuple[str, ...] | list[str] = ("
     (percent, wall and CPU seconds); the evidence method adds ``chosen`` and ``contradicted``. With ``keep_lines``,
     ``"planes"``: method -> list of PlaneScore for :func:`woodcam.inference.evaluate.plot_planes`.
     ``knot_bend``, ``knot_cones``: the evidence fit's knot-bend hypotheses and cone strands
-    (:func:`woodcam.inference.fit_block`; both on by default).
+    (:func:`woodcam.inference.fit_block`; both on by default); ``residual``: its small-scale
+    residual (issue 12 part 4, off by default).
     """
     import warnings
 
@@ -114,7 +116,8 @@ def score_block(seed: int, index: int, methods: tuple[str, ...] | list[str] = ("
         t0, c0 = time.perf_counter(), time.process_time()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", WoodcamWarning)  # recorded below instead
-            fields[m] = fit_block(block, m, faces=faces, knot_bend=knot_bend, knot_cones=knot_cones)
+            fields[m] = fit_block(block, m, faces=faces, knot_bend=knot_bend, knot_cones=knot_cones,
+                                  residual=residual)
         times[m], cpu[m] = time.perf_counter() - t0, time.process_time() - c0
     scored = evaluate_fits(block.true_field, fields, block.size_mm,
                            DEFAULT_PLANES if planes is None else planes, pixel_mm, keep_lines=keep_lines)

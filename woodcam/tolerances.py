@@ -274,6 +274,49 @@ EVIDENCE_RBF_POINTS = 1000
 #: residual is meant to carry distortions a few mm wide, not each trace's jitter.
 EVIDENCE_RESIDUAL_SMOOTHING = 1e-3
 
+#: Small-scale distortion (issue 12 part 4, :mod:`woodcam.fields.residual`,
+#: :func:`woodcam.inference.residual.fit_face_residual`): knot spacing (mm) of each face's
+#: residual B-spline. A cubic B-spline follows a wave down to about three knot intervals, so
+#: 3 mm keeps waves of 10 mm (the shortest of the issue's wavy figure, seed 000 Fig. 16b) and
+#: leaves out a trace's jitter between neighbouring rings (2-5 mm apart).
+RESIDUAL_SPACING_MM = 3.0
+
+#: Depth (mm) of the residual's Gaussian fall-off from a face: a quarter of a 20 mm wave, so what
+#: one face shows of a wave is carried onto its neighbour's edge zone (where leave-one-face-out
+#: can check it) but not guessed deep inside, where no face pins it (0.02 of it at 2 depths).
+RESIDUAL_DEPTH_MM = 5.0
+
+#: Penalties of the residual's B-spline coefficients, relative to the data (each face's ring
+#: points weigh as much in all as one point per knot cell): ridge (pulls unobserved parts to 0:
+#: with the slope term, what an observed face shows of the residual dies out over
+#: sqrt(slope / ridge) = 2.2 knot intervals onto a face it does not see), slope (first
+#: differences) and curvature (second differences, P-spline style). A 10 / 20 mm wave keeps
+#: about 0.6 / 0.85 of its amplitude on an observed face: the residual is strongly damped, and
+#: leave-one-face-out decides whether it stays.
+RESIDUAL_RIDGE = 0.02
+RESIDUAL_SLOPE = 0.1
+RESIDUAL_CURVATURE = 0.02
+
+#: Huber threshold (years) of the residual's robust fit (two reweighting rounds): a trace
+#: labelled one year off (the noisy benchmark's 3 %) or a ring piece numbered one year off is a
+#: whole-ring residual, and a wave of the issue's 0.5-1 ring is carried by many points, not one
+#: trace.
+RESIDUAL_HUBER_YEARS = 0.25
+
+#: Ring points the residual is fitted to (a fixed random subset): 4000 keep a face's wave
+#: sampled every ~1 mm of ring on a 50 mm cube and the sparse solve near 0.1 s.
+RESIDUAL_MAX_POINTS = 4000
+
+#: The residual is kept only when, with it fitted on the other faces in each fold, the held-out
+#: faces' mean score (:func:`woodcam.inference.evidence.face_score`, percent) rises by at least
+#: this (about one binomial std of a 400-point share at 90 %: a gain the held-out points show,
+#: not their sampling) ...
+RESIDUAL_MIN_GAIN = 1.0
+
+#: ... and no held-out face's score falls by more than this (two binomial std at 50 % of 400
+#: points): a residual that helps some faces by misleading another is not kept.
+RESIDUAL_MAX_FACE_LOSS = 5.0
+
 #: A chosen fit is flagged "contradicted" when some held-out face has fewer of its ring points
 #: within 2 mm of the predicted ring line than this (percent): the issue's bar for a block.
 EVIDENCE_MIN_FACE_SHARE_2MM = 80.0

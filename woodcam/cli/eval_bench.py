@@ -46,6 +46,9 @@ def register(subparsers) -> None:
     r.add_argument("--no-knot-cones", dest="knot_cones", action="store_false",
                    help="knot strands from the exits' centroids and areas, as before FIT_VERSION 10 "
                         "(default: the cones fitted to every face's knot mask)")
+    r.add_argument("--residual", action="store_true",
+                   help="try the evidence fit's small-scale residual (a smooth correction within a few "
+                        "mm of the faces, kept only where leave-one-face-out says it predicts; default off)")
     add_confidence_option(r, "; implies --plots")
     add_out_option(r, "table.md, records.json and cut-plane PNGs")
     r.set_defaults(func=run_realistic)
@@ -74,7 +77,7 @@ def run_realistic(args) -> int:
     plots = args.plots or args.confidence
     for kind, i, s, f in tqdm(tasks, desc="benchmark blocks", unit="block"):
         row = score_block(args.seed, i, methods, s, f, kind, face_px=args.face_px, keep_lines=plots,
-                          knot_bend=args.knot_bend, knot_cones=args.knot_cones)
+                          knot_bend=args.knot_bend, knot_cones=args.knot_cones, residual=args.residual)
         if plots:
             from ..inference.evaluate import plot_planes
 

@@ -11,12 +11,13 @@ from .grid import GridField
 from .knots import KnotParams, KnottedLogField, block_at_knot
 from .placement import PlacedField, place_block_in_log
 from .radial import RadialScalingField, RadiusFunction
+from .residual import FaceResidual, ResidualField
 from .skeleton import BranchStrand, LogSkeleton, simple_log
 from .state import field_from_state, field_to_state
 
 __all__ = [
-    "AnalyticLogField", "BUILTIN_NAMES", "BranchStrand", "GridField", "GrowthField", "KnotParams",
+    "AnalyticLogField", "BUILTIN_NAMES", "BranchStrand", "FaceResidual", "GridField", "GrowthField", "KnotParams",
     "KnottedLogField", "LogFrame", "LogSkeleton", "PlacedField", "RadialScalingField",
-    "RadiusFunction", "arf", "block_at_knot", "builtin_block", "check_points", "evaluate",
+    "RadiusFunction", "ResidualField", "arf", "block_at_knot", "builtin_block", "check_points", "evaluate",
     "field_from_state", "field_to_state", "grain_direction", "place_block_in_log", "simple_log",
 ]

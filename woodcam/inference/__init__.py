@@ -22,11 +22,12 @@ from .holdout import leave_one_face_out, score_face
 from .observations import RingObservations, gather_observations
 from .radial import RadialField, fit_radial, number_observations
 from .rbf import fit_rbf
+from .residual import fit_face_residual
 from .stem import StemField, fit_stem
 
 __all__ = [
     "CutPlane", "DEFAULT_PLANES", "EvidenceFit", "METHODS", "Method", "RadialField",
     "RingObservations", "StemField", "bake", "benchmark", "evaluate_fit", "evaluate_fits", "fit_block", "fit_evidence",
-    "fit_radial", "fit_rbf", "fit_stem", "gather_observations", "leave_one_face_out", "number_observations",
+    "fit_face_residual", "fit_radial", "fit_rbf", "fit_stem", "gather_observations", "leave_one_face_out", "number_observations",
     "score_face",
 ]

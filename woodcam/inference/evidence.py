@@ -24,7 +24,11 @@ faces it was *not* fitted to can. So:
    (and a :class:`~woodcam.errors.WoodcamWarning` is raised) when even the chosen hypothesis
    predicts some observed face badly (:data:`~woodcam.tolerances.EVIDENCE_MIN_FACE_SHARE_2MM`),
    and ``unverified`` when fewer than two faces carry rings (nothing to hold out).
-4. Confidence (part 5): the spread (years) of the hypotheses whose evidence is close to the
+4. Small-scale residual (part 4, opt-in ``residual=True``): a smooth correction near the faces
+   on top of the chosen field (:mod:`.residual`), refitted in every fold on that fold's fit of
+   the chosen hypothesis and kept only when the held-out faces score higher with it
+   (:func:`residual_evidence`).
+5. Confidence (part 5): the spread (years) of the hypotheses whose evidence is close to the
    best one's, per point (:meth:`EvidenceFit.uncertainty_years`).
 
 Years: labelled traces are scored against their labels (a few mislabelled traces cost a few
@@ -46,6 +50,7 @@ from .._types import ArrayLike
 
 from ..errors import WoodcamError, WoodcamWarning
 from ..fields.base import central_gradient
+from ..fields.residual import ResidualField
 from ..frames import FACES
 from ..tolerances import (
     EVIDENCE_ACCEPT_MARGIN,
@@ -60,6 +65,8 @@ from ..tolerances import (
     EVIDENCE_RESIDUAL_SMOOTHING,
     EVIDENCE_SPREAD_SPACING_MM,
     EVIDENCE_UNSEEN_YEARS_PER_MM,
+    RESIDUAL_MAX_FACE_LOSS,
+    RESIDUAL_MIN_GAIN,
 )
 from .observations import RingObservations
 from .radial import (
@@ -110,6 +117,8 @@ class EvidenceFit:
     accepted : names of the hypotheses whose evidence is within :data:`EVIDENCE_ACCEPT_MARGIN`
         of the chosen one's (they define the confidence)
     message : one line for the user
+    residual : with ``fit_evidence(residual=True)``, the small-scale residual's evidence
+        (:func:`residual_evidence`: ``"kept"``, ``"gain"``, per-face scores without and with it)
     """
 
     field: Callable
@@ -120,6 +129,8 @@ class EvidenceFit:
     accepted: list
     message: str
     hypotheses: dict = dc_field(default_factory=dict, repr=False)
+    #: the small-scale residual's evidence (:func:`residual_evidence`) when it was tried, else None
+    residual: dict | None = None
 
     def __call__(self, points_mm: ArrayLike) -> np.ndarray:
         return self.field(points_mm)
@@ -155,12 +166,14 @@ def _held_out_faces(obs: RingObservations) -> list[int]:
 
 
 def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: int = 0,
-                     predictions: dict | None = None) -> dict:
+                     predictions: dict | None = None, fold_fields: dict | None = None) -> dict:
     """Leave-one-face-out score of every hypothesis on every face with enough ring points.
 
     predictions : optional dict, filled with ``(name, face name) -> (g (k,), grad (k, 3),
         years (k,))``: each fold's growth time and its gradient at the held-out ring points and
         their years (what a blend of the hypotheses is scored from, :func:`_blend_evidence`).
+    fold_fields : optional dict, filled with ``(name, face name) -> field``: each fold's fit
+        (what the residual is refitted on in each fold, :func:`residual_evidence`).
 
     Returns name -> {face name -> {"score": percent, "share_2mm": percent}}; empty dicts when
     fewer than two faces have rings.
@@ -180,6 +193,8 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
         for h in hypotheses:
             try:
                 fitted = h.refit(rest)
+                if fold_fields is not None:
+                    fold_fields[(h.name, FACES[f])] = fitted
                 g, grad = central_gradient(fitted, pts, _GRAD_STEP_MM)
                 err = _error_mm(g, grad, yrs)
                 if predictions is not None:
@@ -321,18 +336,6 @@ def _rbf_recipe(max_points: int) -> Callable:
     return lambda obs: fit_rbf(obs, max_points=max_points)
 
 
-class _StemPlusResidual:
-    """``stem(p) + residual(p)``: a smooth stem and a smoothed RBF of what it leaves (part 4)."""
-
-    def __init__(self, stem, residual):
-        self.stem, self.residual = stem, residual
-        self.axis = getattr(stem, "axis", (0.0, 0.0, 1.0))
-
-    def __call__(self, points_mm):
-        p = np.asarray(points_mm, float)
-        return self.stem(p) + self.residual(p)
-
-
 def _residual_recipe(stem_recipe: Callable, max_points: int) -> Callable:
     def refit(obs: RingObservations):
         from scipy.interpolate import RBFInterpolator
@@ -346,8 +349,78 @@ def _residual_recipe(stem_recipe: Callable, max_points: int) -> Callable:
         res = obs.years[i][uniq] - stem(pts[uniq])
         rbf = _thin_plate_field(RBFInterpolator(pts[uniq], res, kernel="thin_plate_spline",
                                                smoothing=EVIDENCE_RESIDUAL_SMOOTHING * len(uniq)))
-        return _StemPlusResidual(stem, rbf)
+        return ResidualField(stem, rbf)  # a smoothed RBF of what the radial stem leaves
     return refit
+
+
+def residual_evidence(obs: RingObservations, chosen: str, fold_fields: dict, size_mm: ArrayLike,
+                      seed: int = 0) -> dict:
+    """Leave-one-face-out evidence for the small-scale residual (issue 12 part 4) on top of the
+    chosen hypothesis ``chosen``.
+
+    For each held-out face the residual (:func:`~.residual.fit_face_residual`) is fitted on the
+    other faces to what that fold's fit of ``chosen`` (``fold_fields``, from
+    :func:`holdout_evidence`) leaves, and the held-out face is scored without and with it on the
+    same points. The rule is global with a per-face guard: it is ``"kept"`` when the mean score
+    rises by at least :data:`RESIDUAL_MIN_GAIN` points and no face falls by more than
+    :data:`RESIDUAL_MAX_FACE_LOSS`.
+
+    Returns ``{"kept": bool, "gain": mean gain (points), "without": {face: score},
+    "with": {face: score}, "why": one line}``.
+    """
+    from .residual import fit_face_residual
+
+    rng = np.random.default_rng(seed)
+    without, with_ = {}, {}
+    for f in _held_out_faces(obs):
+        base = fold_fields.get((chosen, FACES[f]))
+        held = obs.face == f
+        idx = np.flatnonzero(held)
+        if len(idx) > EVIDENCE_MAX_HELD_POINTS:  # the same draw as holdout_evidence's
+            idx = np.sort(rng.choice(idx, EVIDENCE_MAX_HELD_POINTS, replace=False))
+        if base is None:  # the chosen recipe could not refit this fold: no evidence either way
+            continue
+        pts, yrs = obs.points_mm[idx], obs.years[idx]
+        g, grad = central_gradient(base, pts, _GRAD_STEP_MM)
+        res = fit_face_residual(obs.subset(~held), base, size_mm, seed=seed)
+        rg, rgrad = central_gradient(res, pts, _GRAD_STEP_MM)
+        without[FACES[f]] = face_score(_error_mm(g, grad, yrs))
+        with_[FACES[f]] = face_score(_error_mm(g + rg, grad + rgrad, yrs))
+    if not without:
+        return {"kept": False, "gain": 0.0, "without": without, "with": with_,
+                "why": "no face could be held out to check it"}
+    gains = {k: with_[k] - without[k] for k in without}
+    gain = float(np.mean(list(gains.values())))
+    worst = min(gains, key=gains.get)
+    kept = gain >= RESIDUAL_MIN_GAIN and gains[worst] >= -RESIDUAL_MAX_FACE_LOSS
+    if kept:
+        why = f"held-out faces {gain:+.1f} points with it"
+    elif gain < RESIDUAL_MIN_GAIN:
+        why = f"held-out faces {gain:+.1f} points with it, below the {RESIDUAL_MIN_GAIN:g} needed"
+    else:
+        why = (f"held-out faces {gain:+.1f} points with it, but {worst} {gains[worst]:+.1f}, "
+               f"more than {RESIDUAL_MAX_FACE_LOSS:g} down")
+    return {"kept": bool(kept), "gain": gain, "without": without, "with": with_, "why": why}
+
+
+def add_residual(ev: EvidenceFit, obs: RingObservations, size_mm: ArrayLike, fold_fields: dict,
+                 seed: int = 0) -> EvidenceFit:
+    """``ev`` with the small-scale residual added to its field where the leave-one-face-out
+    evidence keeps it (:func:`residual_evidence`), else ``ev``'s field untouched; either way
+    ``ev.residual`` holds the evidence and ``ev.message`` says what was done."""
+    from .residual import fit_face_residual
+
+    if ev.unverified:
+        ev.residual = {"kept": False, "gain": 0.0, "without": {}, "with": {},
+                       "why": "no face could be held out to check it"}
+    else:
+        ev.residual = residual_evidence(obs, ev.chosen, fold_fields, size_mm, seed)
+    if ev.residual["kept"]:
+        ev.field = ResidualField(ev.field, fit_face_residual(obs, ev.field, size_mm, seed=seed))
+        ev.message += f"; small-scale residual kept ({ev.residual['why']})"
+    else:
+        ev.message += f"; small-scale residual not kept ({ev.residual['why']})"
+    return ev
 
 
 class _Blend:
@@ -460,7 +533,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                  candidates: tuple[str, ...] = CANDIDATES, seed: int = 0, extra: list[Hypothesis] | None = None,
                  warn: bool = True, recipes: dict[str, Callable] | None = None,
                  stem: Callable | None = None, refines: dict[str, str] | None = None,
-                 blend: BlendMode = "none") -> EvidenceFit:
+                 blend: BlendMode = "none", residual: bool = False) -> EvidenceFit:
     """Fit the hypotheses and choose by leave-one-face-out evidence (module docstring).
 
     Parameters
@@ -484,6 +557,11 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         :data:`EVIDENCE_BLEND_DEPTH_MM` (:func:`blend_away_from_faces`; real cubes: H11 2.08x
         chance held out, but CN03's oracle-phase straight-ring margin falls, README);
         "everywhere" their mean everywhere (:func:`blend_accepted`)
+    residual : try the small-scale residual (issue 12 part 4, :func:`add_residual`): a smooth
+        correction near the faces (:class:`~woodcam.fields.residual.FaceResidual`) on top of the
+        chosen field, kept only where refitted in each fold it raises the held-out faces' score
+        (:func:`residual_evidence`); applied before an ``"away_from_faces"`` blend, refused with
+        ``"everywhere"`` (the mean of the hypotheses replaces the field it was judged on)
 
     Returns
     -------
@@ -491,6 +569,9 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     """
     if blend not in BLEND_MODES:
         raise WoodcamError(f"blend must be one of {', '.join(BLEND_MODES)}; got {blend!r}")
+    if residual and blend == "everywhere":
+        raise WoodcamError("residual=True needs blend 'none' or 'away_from_faces'; got blend='everywhere', "
+                           "whose mean of the hypotheses replaces the field the residual is judged on")
     bad = [c for c in candidates if c not in CANDIDATES]
     if bad or "radial" not in candidates:
         raise WoodcamError(f"candidates must include 'radial' and come from {CANDIDATES}; got {list(candidates)}")
@@ -517,7 +598,10 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                 pass
         hyps += list(extra or [])
         predictions: dict = {}
-        result = choose(hyps, holdout_evidence(hyps, numbered, seed, predictions))
+        folds: dict | None = {} if residual else None
+        result = choose(hyps, holdout_evidence(hyps, numbered, seed, predictions, folds))
+        if residual:
+            result = add_residual(result, numbered, size_mm, folds, seed)
         if blend == "everywhere":
             result = blend_accepted(result)
         elif blend == "away_from_faces" and len(result.accepted) > 1:
@@ -611,6 +695,9 @@ def _bake_evidence(ev: EvidenceFit, size_mm, faces, strands):
             "scores": {n: {k: round(float(v), 2) for k, v in sc.items()} for n, sc in ev.scores.items()}}
     if strands:
         meta["knots"] = strands_to_meta(strands)
+    if ev.residual is not None:  # the small-scale residual's evidence (part 4), kept or not
+        meta["residual"] = {"kept": ev.residual["kept"], "gain": round(ev.residual["gain"], 2),
+                            "why": ev.residual["why"]}
     return GridField(grid.years, grid.origin_mm, grid.spacing_mm, grid.interpolation, grid.axis,
                      layers, meta)
 
@@ -663,7 +750,9 @@ class ConfidenceWood:
         return np.stack([np.clip(2 - 2 * c, 0, 1), np.clip(2 * c, 0, 1), np.full_like(c, 0.1)], axis=1)
 
 
-__all__ = ["BLEND_MODES", "CANDIDATES", "BlendMode", "ConfidenceWood", "EvidenceFit", "Hypothesis", "bake_evidence",
+__all__ = ["BLEND_MODES", "CANDIDATES", "BlendMode", "ConfidenceWood", "EvidenceFit", "Hypothesis", "add_residual",
+           "bake_evidence",
            "blend_accepted", "blend_away_from_faces", "choose",
            "confidence", "distance_to_faces_mm", "face_score", "fit_evidence", "holdout_evidence", "radial_recipe",
+           "residual_evidence",
            "stem_recipe", "uncertainty_report", "uncertainty_years"]

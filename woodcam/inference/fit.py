@@ -34,7 +34,8 @@ FIT_VERSION = 10
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
-              baked: bool = True, knot_bend: bool = True, knot_cones: bool = True) -> GrowthFieldLike:
+              baked: bool = True, knot_bend: bool = True, knot_cones: bool = True,
+              residual: bool = False) -> GrowthFieldLike:
     """Infer a block's growth field from the rings on its faces.
 
     Parameters
@@ -73,6 +74,10 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         chosen only when it beats every plain hypothesis by more than
         :data:`~woodcam.tolerances.EVIDENCE_REFINE_GAIN_MARGIN` (without that rule one of H11's
         folds chose it and the held-out faces fell from 1.59 to 1.04 x chance; README).
+    residual : evidence only, opt-in: the small-scale residual of issue 12 part 4
+        (``fit_evidence(residual=True)``), a smooth correction near the faces on top of the
+        chosen field, kept only where leave-one-face-out says it predicts; the grid's
+        ``meta["residual"]`` says whether it was kept and why (README).
     Returns
     -------
     field : callable ``(n, 3) mm -> (n,) years`` in the block frame.
@@ -93,8 +98,8 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         stem, recipes = (knot_bend_recipes(block.size_mm, knot_exits(block, faces), cones=knot_cones)
                          if knot_bend else (None, None))
         ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem,
-                          refines=dict.fromkeys(recipes or {}, "stem"))
-        if isinstance(ev.field, StemWithKnots):  # the chosen field holds its knots already
+                          refines=dict.fromkeys(recipes or {}, "stem"), residual=residual)
+        if isinstance(getattr(ev.field, "base", ev.field), StemWithKnots):  # it holds its knots already
             strands = ev.field.strands
         else:
             ev.field, strands = with_knots(block, ev.field, faces, knot_cones)  # knots from the masks (part 3)
