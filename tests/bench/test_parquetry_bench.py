@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import functools
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -72,7 +73,9 @@ def _figures(run, prm):
     d = {"patches": len(run.patches), "complete": run.complete,
          "cpu_s": run.cpu_seconds, "wall_s": run.match_seconds,
          "cpu_s_per_patch": run.cpu_seconds / max(1, len(run.patches)),
-         "mean_patch_cost_px": float(np.mean([q.cost_px for q in run.patches]))}
+         "mean_patch_cost_px": float(np.mean([q.cost_px for q in run.patches])),
+         "dead_anchors": run.bank.dead_anchors, "fallback_scans": run.bank.fallback_scans,
+         "load_avg_1min": os.getloadavg()[0]}
     if run.complete:
         k = round(prm.px_per_mm)
         # Two baselines: the paper's (Fig. 8: each piece of the *result* in its mean colour,

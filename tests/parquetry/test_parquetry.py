@@ -295,6 +295,38 @@ def test_coarse_search_prefers_calm_wood_for_a_flat_target():
 
 
 
+def test_used_wood_slivers_do_not_send_the_search_to_the_exact_scan():
+    """A flat target drains the one flat region of a sheet (the rest is a tone lighter). The
+    coarse map's used wood is optimistic, so the slivers left between used pieces stay its
+    cheapest anchors; every one of them is dead at full resolution. They are remembered once
+    and never re-ranked again, so the exact scan of every rotation (seconds per patch on the
+    issue's sheets: coffee ran for 20 CPU-min) runs only for the last call, when the wood is
+    gone, and the run still stops only when no free window is left anywhere."""
+    import cv2
+
+    from woodcam.parquetry.matching import SheetBank
+
+    rng = np.random.default_rng(0)
+    g = 0.5 + 0.01 * cv2.GaussianBlur(rng.standard_normal((300, 900)).astype(np.float32), (0, 0), 3)
+    g[:, 300:] += 0.1
+    bank = SheetBank([g], [np.ones(g.shape, bool)], n_rot=15, kerf_px=4, mode="fast",
+                     coarse_factor=8, top_k=1)
+    tmpl = bank.features(np.full((40, 40), 0.5, np.float32))
+    placed = 0
+    while (m := bank.best(tmpl)) is not None:
+        bank.take(m, 40, 40)
+        placed += 1
+    assert placed > 60 and bank.dead_anchors > 50
+    # without the memory: 24 exact scans (14 CPU-s); forgotten between calls: 20 re-ranks a patch
+    assert bank.fallback_scans <= 1
+    assert bank.exact_reranks < 5 * placed
+    for j in range(len(bank.angles_deg)):
+        _, (h, w) = bank.rotation(0, j)
+        r = max(h, w)
+        assert not any(bank.is_free(0, bank.footprint(0, j, x, y, 40, 40))
+                       for _, x, y in bank.exact_costs(0, j, r, r, r, tmpl)), j
+
+
 def test_fast_grown_leaves_are_calmer_than_quarter_sawn():
     """``builtin:fast-grown`` (10 mm rings, flat-sawn 500 mm from the pith) is the calm veneer
     source: against a flat target at 0.7 mm pixels (the camera's at 360 mm) its maple leaf costs

@@ -115,13 +115,16 @@ class _Atlas:
                 + sum(b.nbytes for b in self._base_cache.values()))
 
     def search(self, template: np.ndarray, k: int,
-               trim: tuple[int, int, int, int] = (0, 0, 0, 0)) -> list[tuple[int, int, int, float]]:
+               trim: tuple[int, int, int, int] = (0, 0, 0, 0),
+               exclude: tuple[np.ndarray, np.ndarray] | None = None) -> list[tuple[int, int, int, float]]:
         """The ``k`` best valid anchors: ``[(tile, x_in_tile, y_in_tile, cost), ...]`` sorted.
         ``template (th, tw, c)`` has the atlas' channels (at a coarse level: :func:`_coarse`).
 
         trim : ``(top, left, bottom, right)`` pixels cut off a window of ``(th + top + bottom,
             tw + left + right)``: the cost is the trimmed template's, the anchors and the
-            free-wood test are the whole window's."""
+            free-wood test are the whole window's.
+        exclude : ``(rows, cols)`` atlas anchors (of the whole window) left out, e.g. those
+            known to hold no free window (see :meth:`SheetBank.best`)."""
         import cv2
 
         th, tw = template.shape[:2]
@@ -153,6 +156,8 @@ class _Atlas:
             ohf, owf = self.shape[0] - thf + 1, self.shape[1] - twf + 1
             cost = cost[ty:ty + ohf, tx:tx + owf].copy()
             cost[np.isinf(self._base(thf, twf))] = np.inf
+        if exclude is not None and exclude[0].size:
+            cost[exclude] = np.inf
         flat = cost.ravel()
         sel = _smallest(flat, k)
         if sel.size == 0:
@@ -350,6 +355,28 @@ def _polygon_pixels(poly_xy: np.ndarray, shape) -> tuple[np.ndarray, np.ndarray]
     return polygon(poly_xy[:, 1], poly_xy[:, 0], shape)
 
 
+class _Anchors:
+    """A growing set of atlas anchors ``(row, col)`` with its ``(rows, cols)`` index arrays,
+    extended rather than rebuilt (thousands may pile up late in a run)."""
+
+    def __init__(self) -> None:
+        self._new: list[tuple[int, int]] = []
+        self._arr = (np.zeros(0, np.intp), np.zeros(0, np.intp))
+
+    def append(self, rc: tuple[int, int]) -> None:
+        self._new.append(rc)
+
+    def __len__(self) -> int:
+        return self._arr[0].size + len(self._new)
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._new:
+            add = np.array(self._new, np.intp).reshape(-1, 2)
+            self._arr = (np.concatenate([self._arr[0], add[:, 0]]), np.concatenate([self._arr[1], add[:, 1]]))
+            self._new = []
+        return self._arr
+
+
 class SheetBank:
     """Veneer features, rotations and the consumed-wood state (see module docstring).
 
@@ -399,6 +426,13 @@ class SheetBank:
                 f"{max_atlas_bytes / 1e9:.1f} GB); use mode 'fast', fewer rotations, or a lower "
                 "working resolution (px_per_mm)")
         self.atlas = _Atlas(self, self.f)
+        # Coarse anchors known to hold no free window, per full template size (see best());
+        # how many were found, how many coarse anchors were re-ranked exactly, and how often
+        # the exact scan of every rotation ran (the slow path: tests count it).
+        self._dead: dict[tuple[int, int], _Anchors] = {}
+        self.dead_anchors = 0
+        self.fallback_scans = 0
+        self.exact_reranks = 0
         self._rot = [[rotation_matrix(g.shape[:2], a) for a in self.angles_deg] for g in self.grey]
 
     def rotation(self, sheet: int, rot: int) -> tuple[np.ndarray, tuple[int, int]]:
@@ -523,24 +557,66 @@ class SheetBank:
                 tc = np.ascontiguousarray(tc[t[0]:tc.shape[0] - t[2], t[1]:tc.shape[1] - t[3]])
         else:
             tc = _coarse(template, f)
-        # One coarse search ranks 16 top_k distinct anchors (of its 32 top_k best); they are
-        # re-ranked exactly top_k at a time, and the next batch is looked at only when every candidate of this one
-        # collides with used wood (late in a run, where the cheapest wood is gone).
-        cands = _distinct(self.atlas.search(tc, self.top_k * 32, trim))[:self.top_k * 16]
-        for b in range(0, len(cands), self.top_k):
-            found: list[tuple[float, int, int, int, int]] = []
-            for t, xc, yc, _ in cands[b:b + self.top_k]:
-                i, j = self.atlas.tiles[t][:2]
-                # Coarse tiles are the full rotated canvases downsampled: coarse pixel X
-                # covers full pixels f X .. f X + f - 1.
-                xf, yf = xc * f, yc * f
-                for c, x, y in self.exact_costs(i, j, xf, yf, self.radius, template, keep=3):
-                    found.append((c, i, j, x, y))
-            found.sort()
-            m = self._choose(template, found, struct_px)
-            if m is not None:
-                return m
-        return self._fallback(template) if cands else None
+        # A coarse search ranks 16 top_k distinct anchors (of its 32 top_k best); they are
+        # re-ranked exactly top_k at a time, and the next batch is looked at only when every
+        # candidate of this one collides with used wood (late in a run, where the cheapest wood
+        # is gone). The coarse map's used wood is optimistic (a coarse pixel is blocked when its
+        # centre is), so slivers between used pieces look free there: an anchor whose exact
+        # windows are all taken is remembered as dead for this template size (wood is only ever
+        # consumed, so it stays dead) and left out of every later search, and the search is
+        # run again until a free window turns up or no coarse anchor is left. Without that
+        # memory, a target with wide flat areas (coffee) drew the same dead slivers patch after
+        # patch and fell through to the exact scan of every rotation (minutes per patch).
+        dead = self._dead.setdefault((th, tw), _Anchors())
+        searched = False
+        while True:
+            cands = _distinct(self.atlas.search(tc, self.top_k * 32, trim, dead.arrays()))[:self.top_k * 16]
+            if not cands:
+                break
+            searched = True
+            for b in range(0, len(cands), self.top_k):
+                m = self._rerank_batch(template, cands[b:b + self.top_k], dead, struct_px)
+                if m is not None:
+                    return m
+        return self._fallback(template) if searched or len(dead) else None
+
+    def _rerank_batch(self, template: np.ndarray, batch: list[tuple[int, int, int, float]],
+                      dead: _Anchors, struct_px: float) -> Match | None:
+        """Exact re-ranking of coarse anchors ``batch = [(tile, x, y, cost)]`` (see
+        :meth:`best`); anchors with no free window are appended to ``dead`` (atlas rows, cols)."""
+        th, tw = template.shape[:2]
+        f = self.f
+        found: list[tuple[float, int, int, int, int]] = []
+        live = []
+        for t, xc, yc, _ in batch:
+            i, j, y0, x0 = self.atlas.tiles[t][:4]
+            # Coarse tiles are the full rotated canvases downsampled: coarse pixel X covers
+            # full pixels f X .. f X + f - 1.
+            ex = self.exact_costs(i, j, xc * f, yc * f, self.radius, template, keep=3)
+            self.exact_reranks += 1
+            if not ex:
+                dead.append((y0 + yc, x0 + xc))
+                self.dead_anchors += 1
+                continue
+            live.append((t, xc, yc, i, j, y0, x0))
+            found += [(c, i, j, x, y) for c, x, y in ex]
+        found.sort()
+        m = self._choose(template, found, struct_px)
+        if m is not None or not self.single_use:
+            return m
+        # Every anchor's three best windows collide: its other windows may not, and an anchor
+        # is dead only when none of them is free.
+        more = []
+        for t, xc, yc, i, j, y0, x0 in live:
+            ex = self.exact_costs(i, j, xc * f, yc * f, self.radius, template)
+            hit = next(((c, i, j, x, y) for c, x, y in ex[3:]
+                        if self.is_free(i, self.footprint(i, j, x, y, th, tw))), None)
+            if hit is None:
+                dead.append((y0 + yc, x0 + xc))
+                self.dead_anchors += 1
+            else:
+                more.append(hit)
+        return self._choose(template, sorted(more), struct_px)
 
     def _choose(self, template: np.ndarray, found: list, struct_px: float = 1.0) -> Match | None:
         """The candidate to take from ``found = [(cost, sheet, rot, x, y)]`` (sorted by cost).
@@ -572,21 +648,31 @@ class SheetBank:
         return free[int(np.argmin(score))]
 
     def _fallback(self, template: np.ndarray) -> Match | None:
-        """Exact scan of every rotation for a free anchor when the ranked candidates all
-        collide with used wood (rare: only when the atlas' blocked pixels are optimistic at a
-        boundary); slow but complete."""
+        """Exact scan of every rotation for the cheapest free anchor, when no coarse anchor is
+        left (the coarse map's usable wood is conservative: a window at the very edge of the
+        usable wood may only be seen here); complete. Counted in ``fallback_scans``.
+
+        Per rotation, only anchors whose window is free in the rotated used-wood mask are
+        costed, cheapest first, and only as many as it takes to find one that
+        :meth:`is_free` accepts."""
+        self.fallback_scans += 1
         th, tw = template.shape[:2]
         best = None
         for i in range(len(self.grey)):
             for j in range(len(self.angles_deg)):
                 _, (H, W) = self._rot[i][j]
                 r = max(H, W)
-                for c, x, y in self.exact_costs(i, j, r, r, r, template):
-                    if best is not None and c >= best.cost:
+                keep = 8
+                while True:
+                    ex = self.exact_costs(i, j, r, r, r, template, keep=keep)
+                    hit = next(((c, x, y) for c, x, y in ex
+                                if (best is None or c < best.cost)
+                                and self.is_free(i, self.footprint(i, j, x, y, th, tw))), None)
+                    if hit is not None:
+                        best = Match(i, j, hit[1], hit[2], hit[0])
+                    if hit is not None or len(ex) < keep or (best is not None and ex[-1][0] >= best.cost):
                         break
-                    if self.is_free(i, self.footprint(i, j, x, y, th, tw)):
-                        best = Match(i, j, x, y, c)
-                        break
+                    keep *= 8
         return best
 
     def take(self, m: Match, th: int, tw: int) -> np.ndarray:
