@@ -295,6 +295,35 @@ def test_coarse_search_prefers_calm_wood_for_a_flat_target():
 
 
 
+def test_detail_weight_scales_the_coarse_cost_of_grain_and_flat_fraction():
+    """The coarse SSD with the detail channel weighted w is sum_c w_c (S_c - T_c)^2: against a
+    flat template, calm and grained wood of the same low-passed tone differ only in the
+    detail channel, so their cost gap grows exactly w times; the flat share is 1 for a flat
+    target and 0 for one with contrast in every window."""
+    from woodcam.parquetry.matching import SheetBank, _coarse, _flat_fraction
+
+    calm = np.full((96, 96), 0.5, np.float32)
+    grain = np.full((96, 384), 0.5, np.float32)
+    grain[:, ::2] += 0.1
+    grain[:, 1::2] -= 0.1
+    bank = SheetBank([grain, calm], [np.ones(grain.shape, bool), np.ones(calm.shape, bool)],
+                     n_rot=1, mode="fast", coarse_factor=4, top_k=2)
+    tc = _coarse(bank.features(np.full((28, 28), 0.5, np.float32)), 4)
+
+    def gap(w):
+        best = {}
+        for t, _x, _y, c in bank.atlas.search(tc, 400, detail_weight=w):
+            best.setdefault(bank.atlas.tiles[t][0], c)
+        return best[0] - best[1]
+
+    assert gap(1.0) > 1e-3
+    assert gap(3.0) == pytest.approx(3.0 * gap(1.0), rel=1e-3)
+    assert _flat_fraction(np.full((28, 28), 0.4, np.float32)) == 1.0
+    checker = (np.indices((28, 28)).sum(0) % 2).astype(np.float32)
+    assert _flat_fraction(checker) == 0.0
+    assert _flat_fraction(np.kron(checker, np.ones((4, 4), np.float32)), 4.0) == 0.0
+
+
 def test_used_wood_slivers_do_not_send_the_search_to_the_exact_scan():
     """A flat target drains the one flat region of a sheet (the rest is a tone lighter). The
     coarse map's used wood is optimistic, so the slivers left between used pieces stay its

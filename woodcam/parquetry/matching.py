@@ -102,6 +102,7 @@ class _Atlas:
         self.shape = self.F.shape
         del self.F
         self._base_cache: dict[tuple[int, int], np.ndarray] = {}
+        self._dsum_cache: dict[tuple[int, int], np.ndarray] = {}
         # Cached anchor maps (float32, one per template size: interior, edge and corner
         # patches, and their trimmed coarse templates) held to ~200 MB, 2 to 8 copies.
         self._max_cached = int(np.clip(200_000_000 // (4 * H * W), 2, 8))
@@ -112,11 +113,13 @@ class _Atlas:
     @property
     def nbytes(self) -> int:
         return (sum(c.nbytes for c in self._chan) + self._f2.nbytes + self.blocked.nbytes + self.tile_id.nbytes
-                + sum(b.nbytes for b in self._base_cache.values()))
+                + sum(b.nbytes for b in self._base_cache.values())
+                + sum(b.nbytes for b in self._dsum_cache.values()))
 
     def search(self, template: np.ndarray, k: int,
                trim: tuple[int, int, int, int] = (0, 0, 0, 0),
-               exclude: tuple[np.ndarray, np.ndarray] | None = None) -> list[tuple[int, int, int, float]]:
+               exclude: tuple[np.ndarray, np.ndarray] | None = None,
+               detail_weight: float = 1.0) -> list[tuple[int, int, int, float]]:
         """The ``k`` best valid anchors: ``[(tile, x_in_tile, y_in_tile, cost), ...]`` sorted.
         ``template (th, tw, c)`` has the atlas' channels (at a coarse level: :func:`_coarse`).
 
@@ -124,7 +127,10 @@ class _Atlas:
             tw + left + right)``: the cost is the trimmed template's, the anchors and the
             free-wood test are the whole window's.
         exclude : ``(rows, cols)`` atlas anchors (of the whole window) left out, e.g. those
-            known to hold no free window (see :meth:`SheetBank.best`)."""
+            known to hold no free window (see :meth:`SheetBank.best`).
+        detail_weight : weight of the coarse level's detail-amplitude channel (the last one,
+            see :func:`_downsample`) in the SSD; above 1 a textured window costs more against
+            a calm template (see :meth:`SheetBank.best`)."""
         import cv2
 
         th, tw = template.shape[:2]
@@ -135,8 +141,11 @@ class _Atlas:
         base = self._base(th, tw)
         cc = None
         oh, ow = self.shape[0] - th + 1, self.shape[1] - tw + 1
+        wd = float(detail_weight) if self.f > 1 else 1.0
         for ch in range(self.shape[2]):
             t = np.ascontiguousarray(template[..., ch], np.float32)
+            if ch == self.shape[2] - 1 and wd != 1.0:
+                t = t * np.float32(wd)
             if max(th, tw) <= _DIRECT_MAX:
                 # filter2D correlates directly (anchored top-left it is TM_CCORR on the valid
                 # part); for the coarse search's few-pixel templates that is ~2.7 times quicker
@@ -150,6 +159,9 @@ class _Atlas:
         # SSD = sum S^2 - 2 sum S T + sum T^2 (eq. 4); base carries sum S^2 and +inf where the
         # window touches used or unusable wood, so no mask has to be applied per search.
         cost = cv2.scaleAdd(cc, -2.0, base)
+        if wd != 1.0:
+            # sum_c w_c (S_c - T_c)^2: base holds the detail channel's S^2 once
+            cost = cv2.scaleAdd(self._detail_sums(th, tw), wd - 1.0, cost)
         if thf != th or twf != tw:
             # whole-window anchor a scores the trimmed template at a + (ty, tx); it is valid
             # only where the whole window is free
@@ -162,13 +174,27 @@ class _Atlas:
         sel = _smallest(flat, k)
         if sel.size == 0:
             return []
-        tsum = float((template.astype(np.float64) ** 2).sum())
+        t2 = (template.astype(np.float64) ** 2).sum(axis=(0, 1))
+        if wd != 1.0:
+            t2[-1] *= wd
+        tsum = float(t2.sum())
         sel = sel[np.argsort(flat[sel], kind="stable")]
         ya, xa = np.divmod(sel, cost.shape[1])
         t = self.tile_id[ya, xa]
         org = self._origins[t]
         return list(zip(t.tolist(), (xa - org[:, 1]).tolist(), (ya - org[:, 0]).tolist(),
                         np.maximum(flat[sel].astype(np.float64) + tsum, 0.0).tolist()))
+
+    def _detail_sums(self, th: int, tw: int) -> np.ndarray:
+        """Windowed sum of the detail channel's square per anchor for a ``(th, tw)``
+        template (no blocking: :meth:`_base` carries that); cached per size."""
+        key = (th, tw)
+        if key not in self._dsum_cache:
+            while len(self._dsum_cache) >= self._max_cached:
+                self._dsum_cache.pop(next(iter(self._dsum_cache)))
+            d = self._chan[-1]
+            self._dsum_cache[key] = _window_sums(d * d, th, tw)
+        return self._dsum_cache[key]
 
     def _base(self, th: int, tw: int) -> np.ndarray:
         """Windowed sum of S^2 per anchor for a ``(th, tw)`` template, +inf where the window
@@ -393,13 +419,17 @@ class SheetBank:
     single_use : False gives the unconstrained matcher (wood may be reused; an upper bound)
     w_struct, rerank : structural re-ranking of the ``rerank`` cheapest free candidates (see
         :meth:`_choose`); 0 picks by eq. 4 alone
+    flat_detail, flat_rerank : where the template's target is flat (:func:`_flat_fraction`),
+        the coarse detail channel's weight and the number re-ranked rise towards these
+        (1.0 and ``rerank``: off; see :meth:`best`)
     """
 
     def __init__(self, grey, usable, w_intens: float = 0.5, w_edge: float = 0.5,
                  n_rot: int = 15, kerf_px: float = 0.0,
                  mode: MatchMode = "fast", coarse_factor: int = 4, top_k: int = 12,
                  single_use: bool = True, max_atlas_bytes: int = 2_500_000_000,
-                 w_struct: float = 0.0, rerank: int = 4):
+                 w_struct: float = 0.0, rerank: int = 4, flat_detail: float = 1.0,
+                 flat_rerank: int | None = None):
         if mode not in ("exhaustive", "fast"):
             raise WoodcamError(f"mode must be one of ['exhaustive', 'fast']; got {mode!r}")
         if n_rot < 1:
@@ -419,6 +449,8 @@ class SheetBank:
         self.top_k = top_k
         self.single_use = single_use
         self.w_struct, self.rerank = float(w_struct), max(1, int(rerank))
+        self.flat_detail = float(flat_detail)
+        self.flat_rerank = max(self.rerank, int(flat_rerank or 0))
         est = sum(g.shape[0] * g.shape[1] for g in self.grey) * n_rot * 2.0 * 13 / self.f ** 2
         if est > max_atlas_bytes:
             raise WoodcamError(
@@ -567,21 +599,30 @@ class SheetBank:
         # run again until a free window turns up or no coarse anchor is left. Without that
         # memory, a target with wide flat areas (coffee) drew the same dead slivers patch after
         # patch and fell through to the exact scan of every rotation (minutes per patch).
+        # Where the target is flat, grain of any visible amplitude costs SSIM its contrast-
+        # structure term, which eq. 4 weighs no more than a slightly wrong tone: the coarse
+        # search weighs the wood's detail amplitude more there and more candidates are
+        # re-ranked structurally (both in proportion to the share of flat windows; off by default).
+        wd, nr = 1.0, self.rerank
+        if (self.flat_detail != 1.0 or self.flat_rerank > self.rerank) and self.w_intens > 0:
+            flat = _flat_fraction(template[..., 0] / self.w_intens, struct_px)
+            wd = 1.0 + (self.flat_detail - 1.0) * flat
+            nr = round(self.rerank + max(0, self.flat_rerank - self.rerank) * flat)
         dead = self._dead.setdefault((th, tw), _Anchors())
         searched = False
         while True:
-            cands = _distinct(self.atlas.search(tc, self.top_k * 32, trim, dead.arrays()))[:self.top_k * 16]
+            cands = _distinct(self.atlas.search(tc, self.top_k * 32, trim, dead.arrays(), wd))[:self.top_k * 16]
             if not cands:
                 break
             searched = True
             for b in range(0, len(cands), self.top_k):
-                m = self._rerank_batch(template, cands[b:b + self.top_k], dead, struct_px)
+                m = self._rerank_batch(template, cands[b:b + self.top_k], dead, struct_px, nr)
                 if m is not None:
                     return m
         return self._fallback(template) if searched or len(dead) else None
 
     def _rerank_batch(self, template: np.ndarray, batch: list[tuple[int, int, int, float]],
-                      dead: _Anchors, struct_px: float) -> Match | None:
+                      dead: _Anchors, struct_px: float, rerank: int | None = None) -> Match | None:
         """Exact re-ranking of coarse anchors ``batch = [(tile, x, y, cost)]`` (see
         :meth:`best`); anchors with no free window are appended to ``dead`` (atlas rows, cols)."""
         th, tw = template.shape[:2]
@@ -601,7 +642,7 @@ class SheetBank:
             live.append((t, xc, yc, i, j, y0, x0))
             found += [(c, i, j, x, y) for c, x, y in ex]
         found.sort()
-        m = self._choose(template, found, struct_px)
+        m = self._choose(template, found, struct_px, rerank)
         if m is not None or not self.single_use:
             return m
         # Every anchor's three best windows collide: its other windows may not, and an anchor
@@ -616,9 +657,10 @@ class SheetBank:
                 self.dead_anchors += 1
             else:
                 more.append(hit)
-        return self._choose(template, sorted(more), struct_px)
+        return self._choose(template, sorted(more), struct_px, rerank)
 
-    def _choose(self, template: np.ndarray, found: list, struct_px: float = 1.0) -> Match | None:
+    def _choose(self, template: np.ndarray, found: list, struct_px: float = 1.0,
+                rerank: int | None = None) -> Match | None:
         """The candidate to take from ``found = [(cost, sheet, rot, x, y)]`` (sorted by cost).
 
         With ``w_struct == 0`` the cheapest free one (eq. 4). Otherwise the first
@@ -638,7 +680,7 @@ class SheetBank:
                 continue    # the same bit of wood shifted a pixel or two: nothing new to rank
             if not self.single_use or self.is_free(i, self.footprint(i, j, x, y, th, tw)):
                 free.append(Match(i, j, x, y, c))
-                if self.w_struct <= 0 or self.w_intens <= 0 or len(free) >= self.rerank:
+                if self.w_struct <= 0 or self.w_intens <= 0 or len(free) >= (rerank or self.rerank):
                     break
         if len(free) <= 1:
             return free[0] if free else None
@@ -736,6 +778,32 @@ _SSIM_WIN = 7
 _SSIM_C2 = (0.03 * 1.0) ** 2
 
 
+def _native_grey(g: np.ndarray, scale: float) -> np.ndarray:
+    """An intensity ``(h, w)`` area-averaged by ``scale`` (the target image's own pixels; at
+    least 7 x 7 of them kept), float32; unchanged for ``scale <= 1``."""
+    import cv2
+
+    a = np.asarray(g, np.float32)
+    if scale > 1.0:
+        h, w = a.shape
+        size = (max(_SSIM_WIN, round(w / scale)), max(_SSIM_WIN, round(h / scale)))
+        a = cv2.resize(a, size, interpolation=cv2.INTER_AREA)
+    return a
+
+
+def _flat_fraction(gt: np.ndarray, scale: float = 1.0) -> float:
+    """Share of the 7 x 7 windows of a target intensity ``gt (h, w)`` (on the target image's
+    own pixels, see :func:`_native_grey`) whose variance is below SSIM's C2: where grain of
+    any visible amplitude costs SSIM its contrast-structure term."""
+    import cv2
+
+    k = (_SSIM_WIN, _SSIM_WIN)
+    b = _native_grey(gt, scale)
+    mb = cv2.blur(b, k)
+    vb = cv2.blur(b * b, k) - mb * mb
+    return float(np.mean(vb < _SSIM_C2))
+
+
 def _structure_penalty(gs: np.ndarray, gt: np.ndarray, scale: float = 1.0) -> float:
     """Mean of ``1 - cs`` over 7 x 7 box windows of two ``(h, w)`` intensities, where
     ``cs = (2 cov + C2) / (var_s + var_t + C2)`` is SSIM's contrast-structure term: 0 when the
@@ -745,12 +813,7 @@ def _structure_penalty(gs: np.ndarray, gt: np.ndarray, scale: float = 1.0) -> fl
     import cv2
 
     k = (_SSIM_WIN, _SSIM_WIN)
-    a, b = np.asarray(gs, np.float32), np.asarray(gt, np.float32)
-    if scale > 1.0:
-        h, w = a.shape
-        size = (max(_SSIM_WIN, round(w / scale)), max(_SSIM_WIN, round(h / scale)))
-        a = cv2.resize(a, size, interpolation=cv2.INTER_AREA)
-        b = cv2.resize(b, size, interpolation=cv2.INTER_AREA)
+    a, b = _native_grey(gs, scale), _native_grey(gt, scale)
     ma, mb = cv2.blur(a, k), cv2.blur(b, k)
     va = cv2.blur(a * a, k) - ma * ma
     vb = cv2.blur(b * b, k) - mb * mb
