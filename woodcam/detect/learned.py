@@ -25,6 +25,7 @@ import time
 from dataclasses import asdict, dataclass
 from dataclasses import fields as dc_fields
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 
@@ -34,6 +35,8 @@ MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
 SPEC_NAME = "rings_spec.json"
 WEIGHTS_NAME = "rings.pt"
 LOG_NAME = "rings_train_log.csv"
+#: Colours of the training faces (:attr:`RingNetSpec.style`).
+TRAINING_STYLES = ("plain", "realistic", "mixed")
 
 
 @dataclass(frozen=True)
@@ -48,6 +51,12 @@ class RingNetSpec:
     width : channels of the first level (doubled per level, three levels).
     crop_px, batch, steps, lr : training crops, batch size, Adam steps and learning rate (cosine decay).
     max_train_s : stop after this many seconds of training (the machine is shared).
+    style : the training faces' colour (:data:`TRAINING_STYLES`): ``"plain"``, woodcam's built-in
+        wood colour (a broad latewood band ending in a step at the boundary); ``"realistic"``,
+        :class:`woodcam.synth.photos._RealisticWood` (narrow softwood latewood darkest at the
+        boundary, or ring-porous oak whose pore band starts at it; rays, figure, faint rings),
+        softwood and oak on alternate cubes; ``"mixed"``: every third cube plain, the others
+        realistic. The target is the true ring boundary on every style.
     """
 
     seed: int = 0
@@ -61,6 +70,12 @@ class RingNetSpec:
     lr: float = 2e-3
     max_train_s: float = 660.0
     log_every: int = 25
+    style: str = "plain"
+
+    def __post_init__(self) -> None:
+        if self.style not in TRAINING_STYLES:
+            raise WoodcamError(f"ring net spec style must be one of {', '.join(TRAINING_STYLES)}; "
+                               f"got {self.style!r}")
 
     @classmethod
     def load(cls, path) -> RingNetSpec:
@@ -251,14 +266,61 @@ def ring_probability(photo: np.ndarray, models_dir=MODELS_DIR) -> np.ndarray:
     h, w = x.shape
     ph, pw = (-h) % 4, (-w) % 4
     x = np.pad(x, ((0, ph), (0, pw)), mode="reflect")
-    with torch.no_grad():
-        p = torch.sigmoid(load_ring_net(models_dir)(torch.from_numpy(x)[None, None]))[0, 0].numpy()
+    net = load_ring_net(models_dir)
+    # one thread: the net is small, and on a 256 px face torch's two threads spent 0.69 CPU-s
+    # where one spends 0.15 (the budget is 1 CPU-s per face for the whole detector)
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        with torch.no_grad():
+            p = torch.sigmoid(net(torch.from_numpy(x)[None, None]))[0, 0].numpy()
+    finally:
+        torch.set_num_threads(threads)
     return p[:h, :w].astype(np.float32)
 
 
+#: How the learned detector places its ring lines (:func:`detect_rings_learned`).
+LearnedMode = Literal["snap", "ridge"]
+LEARNED_MODES: tuple[str, ...] = ("snap", "ridge")
+#: Net probability below which a snapped line is dropped (``"snap"``): the net sees no ring
+#: boundary within reach of the classical line.
+SNAP_MIN_PROBABILITY = 0.2
+
+
+def _snap_to_net(p: np.ndarray, base, min_p: float = SNAP_MIN_PROBABILITY):
+    """``"snap"``: the classical detector's ring pieces (``base``, a RingDetection) moved across
+    the ring onto the net's ridge (the maximum of ``p (h, w)`` within
+    :data:`~woodcam.detect.rings.SNAP_REACH_WAVELENGTHS` of a spacing, profiles averaged along
+    the ring, median-filtered along each piece, cut where the line jumps; the classical
+    ``_snap`` with the net's probability in place of the darkness), keeping each piece's ring id
+    and order; stretches whose ridge probability is below ``min_p`` are dropped. Returns
+    ``(traces, ring_order)``."""
+    from .rings import MIN_TRACE_WAVELENGTHS, RingTrace, _sample, _snap
+
+    polys = [t.points_px for t in base.traces]
+    if not polys:
+        return [], []
+    moved, src = _snap(-p, polys, base.normal_rad, base.wavelength_px, "dark-line")
+    traces, order = [], []
+    for q, k in zip(moved, src):
+        on = _sample(p, q) >= min_p
+        cuts = np.flatnonzero(np.diff(on.astype(np.int8))) + 1
+        for piece, keep in zip(np.split(q, cuts), np.split(on, cuts)):
+            lam = float(np.median(_sample(base.wavelength_px, piece)))
+            if keep[0] and len(piece) >= 3 and (np.sum(np.hypot(*np.diff(piece, axis=0).T))
+                                                >= MIN_TRACE_WAVELENGTHS * lam):
+                traces.append(RingTrace(piece, ring=base.traces[k].ring))
+                order.append(base.ring_order[k] if k < len(base.ring_order) else 0.0)
+    return traces, order
+
+
 def detect_rings_learned(photo: np.ndarray, *, px_per_mm: float | None = None, name: str = "face",
-                         models_dir=MODELS_DIR):
-    """Rings on one face photo by the learned net (module docstring); a RingDetection."""
+                         models_dir=MODELS_DIR, mode: LearnedMode = "snap"):
+    """Rings on one face photo by the learned net (module docstring); a RingDetection.
+
+    ``mode``: ``"snap"`` (default), the classical detector's ring pieces (their ring ids and
+    order) moved onto the net's ridge and dropped where the net sees none (:func:`_snap_to_net`);
+    ``"ridge"``, the net's own ridges across the classical ring normal (no ring ids)."""
     from scipy import ndimage
 
     from .rings import (
@@ -271,8 +333,18 @@ def detect_rings_learned(photo: np.ndarray, *, px_per_mm: float | None = None, n
         ring_map_from_traces,
     )
 
+    if mode not in LEARNED_MODES:
+        raise WoodcamError(f"mode must be one of {', '.join(LEARNED_MODES)}; got {mode!r}")
     base = detect_rings(photo, px_per_mm=px_per_mm, name=name)      # orientation and spacing
     p = ring_probability(photo, models_dir)
+    h, w = p.shape
+    warnings = []
+    sigma_px = RING_MAP_SIGMA_MM * (px_per_mm if px_per_mm else 256 / 50.0)
+    if mode == "snap":
+        traces, order = _snap_to_net(p, base)
+        return RingDetection(traces, ring_map_from_traces(traces, (h, w), sigma_px), base.normal_rad,
+                             base.wavelength_px, base.confidence, base.evidence, "learned",
+                             list(base.warnings), base.order_map, order)
     pr = ndimage.gaussian_filter(p, 1.0, order=(1, 0))
     pc = ndimage.gaussian_filter(p, 1.0, order=(0, 1))
     sn, cn = np.sin(base.normal_rad), np.cos(base.normal_rad)
@@ -285,10 +357,7 @@ def detect_rings_learned(photo: np.ndarray, *, px_per_mm: float | None = None, n
     keep = (ndimage.gaussian_filter(p, 1.0) >= 0.35) & (d2 < 0)
     polys = _contour_runs(dn, keep, 0.5 * base.wavelength_px)
     traces = [RingTrace(q) for q in polys]
-    h, w = p.shape
-    warnings = []
     if float((p > 0.35).mean()) < 0.02 * MIN_RING_AREA or not traces:
         warnings.append(f"face {name!r}: the learned detector found no rings; check the photo")
-    sigma_px = RING_MAP_SIGMA_MM * (px_per_mm if px_per_mm else 256 / 50.0)
     return RingDetection(traces, ring_map_from_traces(traces, (h, w), sigma_px), base.normal_rad,
                          base.wavelength_px, p, p > 0.35, "learned", warnings)

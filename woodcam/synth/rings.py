@@ -65,7 +65,8 @@ def ring_training_faces(spec, progress: bool = False) -> tuple[np.ndarray, np.nd
     float32)`` from ``spec.n_blocks`` synthetic 50 mm cubes, seeds ``[spec.seed, i, 7]`` (never
     the evaluation seeds), every fourth cut from a knotted log (seeds 001/003), photos augmented
     by :func:`woodcam.detect.learned.augment_photo`; targets ``exp(-(d / sigma)^2)`` of the
-    distance ``d`` (px) to the true ring lines, ``sigma = spec.target_sigma_px``."""
+    distance ``d`` (px) to the true ring lines, ``sigma = spec.target_sigma_px``. The faces'
+    colour is ``spec.style`` (:attr:`~woodcam.detect.learned.RingNetSpec.style`)."""
     from tqdm.auto import tqdm
 
     from ..detect.learned import augment_photo, net_input
@@ -83,8 +84,13 @@ def ring_training_faces(spec, progress: bool = False) -> tuple[np.ndarray, np.nd
             if placement["pattern"] != "pith-inside":
                 placement["distance_mm"] = max(half_diag + 2.0, min(placement["distance_mm"], r_in))
         field = cut_block(log, size, **placement)
+        style = getattr(spec, "style", "plain")
+        wood = None
+        if style == "realistic" or (style == "mixed" and i % 3):
+            # softwood and oak on alternate cubes (of the realistic ones)
+            wood = _RealisticWood(field, rng, "ring-porous" if i % 2 else "softwood")
         block = synth_block(field, size, face_px=spec.face_px, rng=rng, seed=None, trace_faces=(),
-                            ring_map_sigma_px=spec.target_sigma_px, ring_map_noise=0.0)
+                            ring_map_sigma_px=spec.target_sigma_px, ring_map_noise=0.0, wood=wood)
         for f in block.faces.values():
             xs.append(net_input(augment_photo(f.photo, rng)))
             ys.append(np.nan_to_num(f.ring_map, nan=0.0).astype(np.float32))
