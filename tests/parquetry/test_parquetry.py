@@ -295,6 +295,67 @@ def test_coarse_search_prefers_calm_wood_for_a_flat_target():
 
 
 
+def test_detail_weight_scales_the_coarse_cost_of_grain_and_flat_fraction():
+    """The coarse SSD with the detail channel weighted w is sum_c w_c (S_c - T_c)^2: against a
+    flat template, calm and grained wood of the same low-passed tone differ only in the
+    detail channel, so their cost gap grows exactly w times; the flat share is 1 for a flat
+    target and 0 for one with contrast in every window."""
+    from woodcam.parquetry.matching import SheetBank, _coarse, _flat_fraction
+
+    calm = np.full((96, 96), 0.5, np.float32)
+    grain = np.full((96, 384), 0.5, np.float32)
+    grain[:, ::2] += 0.1
+    grain[:, 1::2] -= 0.1
+    bank = SheetBank([grain, calm], [np.ones(grain.shape, bool), np.ones(calm.shape, bool)],
+                     n_rot=1, mode="fast", coarse_factor=4, top_k=2)
+    tc = _coarse(bank.features(np.full((28, 28), 0.5, np.float32)), 4)
+
+    def gap(w):
+        best = {}
+        for t, _x, _y, c in bank.atlas.search(tc, 400, detail_weight=w):
+            best.setdefault(bank.atlas.tiles[t][0], c)
+        return best[0] - best[1]
+
+    assert gap(1.0) > 1e-3
+    assert gap(3.0) == pytest.approx(3.0 * gap(1.0), rel=1e-3)
+    assert _flat_fraction(np.full((28, 28), 0.4, np.float32)) == 1.0
+    checker = (np.indices((28, 28)).sum(0) % 2).astype(np.float32)
+    assert _flat_fraction(checker) == 0.0
+    assert _flat_fraction(np.kron(checker, np.ones((4, 4), np.float32)), 4.0) == 0.0
+
+
+def test_used_wood_slivers_do_not_send_the_search_to_the_exact_scan():
+    """A flat target drains the one flat region of a sheet (the rest is a tone lighter). The
+    coarse map's used wood is optimistic, so the slivers left between used pieces stay its
+    cheapest anchors; every one of them is dead at full resolution. They are remembered once
+    and never re-ranked again, so the exact scan of every rotation (seconds per patch on the
+    issue's sheets: coffee ran for 20 CPU-min) runs only for the last call, when the wood is
+    gone, and the run still stops only when no free window is left anywhere."""
+    import cv2
+
+    from woodcam.parquetry.matching import SheetBank
+
+    rng = np.random.default_rng(0)
+    g = 0.5 + 0.01 * cv2.GaussianBlur(rng.standard_normal((300, 900)).astype(np.float32), (0, 0), 3)
+    g[:, 300:] += 0.1
+    bank = SheetBank([g], [np.ones(g.shape, bool)], n_rot=15, kerf_px=4, mode="fast",
+                     coarse_factor=8, top_k=1)
+    tmpl = bank.features(np.full((40, 40), 0.5, np.float32))
+    placed = 0
+    while (m := bank.best(tmpl)) is not None:
+        bank.take(m, 40, 40)
+        placed += 1
+    assert placed > 60 and bank.dead_anchors > 50
+    # without the memory: 24 exact scans (14 CPU-s); forgotten between calls: 20 re-ranks a patch
+    assert bank.fallback_scans <= 1
+    assert bank.exact_reranks < 5 * placed
+    for j in range(len(bank.angles_deg)):
+        _, (h, w) = bank.rotation(0, j)
+        r = max(h, w)
+        assert not any(bank.is_free(0, bank.footprint(0, j, x, y, 40, 40))
+                       for _, x, y in bank.exact_costs(0, j, r, r, r, tmpl)), j
+
+
 def test_fast_grown_leaves_are_calmer_than_quarter_sawn():
     """``builtin:fast-grown`` (10 mm rings, flat-sawn 500 mm from the pith) is the calm veneer
     source: against a flat target at 0.7 mm pixels (the camera's at 360 mm) its maple leaf costs

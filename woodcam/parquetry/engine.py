@@ -231,7 +231,8 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
                      coarse_factor=params.coarse_factor_for(sum(g.size for g in grey)),
                      top_k=params.top_k,
                      single_use=params.single_use, w_struct=params.w_struct,
-                     rerank=params.rerank)
+                     rerank=params.rerank, flat_detail=params.flat_detail,
+                     flat_rerank=params.flat_rerank)
     names = names or [f"target{k}" for k in range(len(targets))]
     panels = [prepare_target(t, params, src_vals, k, names[k]) for k, t in enumerate(targets)]
 

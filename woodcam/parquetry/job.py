@@ -61,6 +61,11 @@ class ParquetryParams:
         target image's own pixels, the wood area-averaged to them) that re-ranks the ``rerank``
         cheapest distinct free candidates of eq. 4 (woodcam's addition; 0: eq. 4 alone). 0.02 raised SSIM by 0.01-0.02 on the skimage targets at an unchanged
         feature cost (tests/bench/test_parquetry_bench.py)
+    flat_detail, flat_rerank : where the target is flat (the share of its 7 x 7 windows on
+        its own pixels with a variance below SSIM's C2), the fast coarse search weighs its
+        detail-amplitude channel up to ``flat_detail`` times (calm wood is ranked in) and up to
+        ``flat_rerank`` candidates are re-ranked; 1.0 and ``rerank`` (the defaults) leave both
+        off (woodcam's addition; README, "flat windows")
     """
 
     w_intens: float = 0.5
@@ -84,6 +89,8 @@ class ParquetryParams:
     single_use: bool = True
     w_struct: float = 0.02
     rerank: int = 4
+    flat_detail: float = 1.0
+    flat_rerank: int = 4
 
     def check(self) -> ParquetryParams:
         """Validate at the door; returns self."""
@@ -111,6 +118,9 @@ class ParquetryParams:
         if self.px_per_mm <= 0 or self.tool_diameter_mm < 0 or (self.kerf_mm or 0) < 0:
             raise WoodcamError("px_per_mm must be > 0, tool_diameter_mm and kerf_mm >= 0; got "
                                f"{self.px_per_mm}, {self.tool_diameter_mm}, {self.kerf_mm}")
+        if self.flat_detail < 1.0 or self.flat_rerank < self.rerank:
+            raise WoodcamError(f"flat_detail must be >= 1 and flat_rerank >= rerank ({self.rerank}); "
+                               f"got {self.flat_detail}, {self.flat_rerank}")
         if self.w_struct < 0 or self.rerank < 1:
             raise WoodcamError(f"w_struct must be >= 0 and rerank >= 1; got {self.w_struct}, {self.rerank}")
         if (self.coarse_factor is not None and self.coarse_factor < 1) or self.top_k < 1:

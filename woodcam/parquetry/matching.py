@@ -102,6 +102,7 @@ class _Atlas:
         self.shape = self.F.shape
         del self.F
         self._base_cache: dict[tuple[int, int], np.ndarray] = {}
+        self._dsum_cache: dict[tuple[int, int], np.ndarray] = {}
         # Cached anchor maps (float32, one per template size: interior, edge and corner
         # patches, and their trimmed coarse templates) held to ~200 MB, 2 to 8 copies.
         self._max_cached = int(np.clip(200_000_000 // (4 * H * W), 2, 8))
@@ -112,16 +113,24 @@ class _Atlas:
     @property
     def nbytes(self) -> int:
         return (sum(c.nbytes for c in self._chan) + self._f2.nbytes + self.blocked.nbytes + self.tile_id.nbytes
-                + sum(b.nbytes for b in self._base_cache.values()))
+                + sum(b.nbytes for b in self._base_cache.values())
+                + sum(b.nbytes for b in self._dsum_cache.values()))
 
     def search(self, template: np.ndarray, k: int,
-               trim: tuple[int, int, int, int] = (0, 0, 0, 0)) -> list[tuple[int, int, int, float]]:
+               trim: tuple[int, int, int, int] = (0, 0, 0, 0),
+               exclude: tuple[np.ndarray, np.ndarray] | None = None,
+               detail_weight: float = 1.0) -> list[tuple[int, int, int, float]]:
         """The ``k`` best valid anchors: ``[(tile, x_in_tile, y_in_tile, cost), ...]`` sorted.
         ``template (th, tw, c)`` has the atlas' channels (at a coarse level: :func:`_coarse`).
 
         trim : ``(top, left, bottom, right)`` pixels cut off a window of ``(th + top + bottom,
             tw + left + right)``: the cost is the trimmed template's, the anchors and the
-            free-wood test are the whole window's."""
+            free-wood test are the whole window's.
+        exclude : ``(rows, cols)`` atlas anchors (of the whole window) left out, e.g. those
+            known to hold no free window (see :meth:`SheetBank.best`).
+        detail_weight : weight of the coarse level's detail-amplitude channel (the last one,
+            see :func:`_downsample`) in the SSD; above 1 a textured window costs more against
+            a calm template (see :meth:`SheetBank.best`)."""
         import cv2
 
         th, tw = template.shape[:2]
@@ -132,8 +141,11 @@ class _Atlas:
         base = self._base(th, tw)
         cc = None
         oh, ow = self.shape[0] - th + 1, self.shape[1] - tw + 1
+        wd = float(detail_weight) if self.f > 1 else 1.0
         for ch in range(self.shape[2]):
             t = np.ascontiguousarray(template[..., ch], np.float32)
+            if ch == self.shape[2] - 1 and wd != 1.0:
+                t = t * np.float32(wd)
             if max(th, tw) <= _DIRECT_MAX:
                 # filter2D correlates directly (anchored top-left it is TM_CCORR on the valid
                 # part); for the coarse search's few-pixel templates that is ~2.7 times quicker
@@ -147,23 +159,42 @@ class _Atlas:
         # SSD = sum S^2 - 2 sum S T + sum T^2 (eq. 4); base carries sum S^2 and +inf where the
         # window touches used or unusable wood, so no mask has to be applied per search.
         cost = cv2.scaleAdd(cc, -2.0, base)
+        if wd != 1.0:
+            # sum_c w_c (S_c - T_c)^2: base holds the detail channel's S^2 once
+            cost = cv2.scaleAdd(self._detail_sums(th, tw), wd - 1.0, cost)
         if thf != th or twf != tw:
             # whole-window anchor a scores the trimmed template at a + (ty, tx); it is valid
             # only where the whole window is free
             ohf, owf = self.shape[0] - thf + 1, self.shape[1] - twf + 1
             cost = cost[ty:ty + ohf, tx:tx + owf].copy()
             cost[np.isinf(self._base(thf, twf))] = np.inf
+        if exclude is not None and exclude[0].size:
+            cost[exclude] = np.inf
         flat = cost.ravel()
         sel = _smallest(flat, k)
         if sel.size == 0:
             return []
-        tsum = float((template.astype(np.float64) ** 2).sum())
+        t2 = (template.astype(np.float64) ** 2).sum(axis=(0, 1))
+        if wd != 1.0:
+            t2[-1] *= wd
+        tsum = float(t2.sum())
         sel = sel[np.argsort(flat[sel], kind="stable")]
         ya, xa = np.divmod(sel, cost.shape[1])
         t = self.tile_id[ya, xa]
         org = self._origins[t]
         return list(zip(t.tolist(), (xa - org[:, 1]).tolist(), (ya - org[:, 0]).tolist(),
                         np.maximum(flat[sel].astype(np.float64) + tsum, 0.0).tolist()))
+
+    def _detail_sums(self, th: int, tw: int) -> np.ndarray:
+        """Windowed sum of the detail channel's square per anchor for a ``(th, tw)``
+        template (no blocking: :meth:`_base` carries that); cached per size."""
+        key = (th, tw)
+        if key not in self._dsum_cache:
+            while len(self._dsum_cache) >= self._max_cached:
+                self._dsum_cache.pop(next(iter(self._dsum_cache)))
+            d = self._chan[-1]
+            self._dsum_cache[key] = _window_sums(d * d, th, tw)
+        return self._dsum_cache[key]
 
     def _base(self, th: int, tw: int) -> np.ndarray:
         """Windowed sum of S^2 per anchor for a ``(th, tw)`` template, +inf where the window
@@ -350,6 +381,28 @@ def _polygon_pixels(poly_xy: np.ndarray, shape) -> tuple[np.ndarray, np.ndarray]
     return polygon(poly_xy[:, 1], poly_xy[:, 0], shape)
 
 
+class _Anchors:
+    """A growing set of atlas anchors ``(row, col)`` with its ``(rows, cols)`` index arrays,
+    extended rather than rebuilt (thousands may pile up late in a run)."""
+
+    def __init__(self) -> None:
+        self._new: list[tuple[int, int]] = []
+        self._arr = (np.zeros(0, np.intp), np.zeros(0, np.intp))
+
+    def append(self, rc: tuple[int, int]) -> None:
+        self._new.append(rc)
+
+    def __len__(self) -> int:
+        return self._arr[0].size + len(self._new)
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._new:
+            add = np.array(self._new, np.intp).reshape(-1, 2)
+            self._arr = (np.concatenate([self._arr[0], add[:, 0]]), np.concatenate([self._arr[1], add[:, 1]]))
+            self._new = []
+        return self._arr
+
+
 class SheetBank:
     """Veneer features, rotations and the consumed-wood state (see module docstring).
 
@@ -366,13 +419,17 @@ class SheetBank:
     single_use : False gives the unconstrained matcher (wood may be reused; an upper bound)
     w_struct, rerank : structural re-ranking of the ``rerank`` cheapest free candidates (see
         :meth:`_choose`); 0 picks by eq. 4 alone
+    flat_detail, flat_rerank : where the template's target is flat (:func:`_flat_fraction`),
+        the coarse detail channel's weight and the number re-ranked rise towards these
+        (1.0 and ``rerank``: off; see :meth:`best`)
     """
 
     def __init__(self, grey, usable, w_intens: float = 0.5, w_edge: float = 0.5,
                  n_rot: int = 15, kerf_px: float = 0.0,
                  mode: MatchMode = "fast", coarse_factor: int = 4, top_k: int = 12,
                  single_use: bool = True, max_atlas_bytes: int = 2_500_000_000,
-                 w_struct: float = 0.0, rerank: int = 4):
+                 w_struct: float = 0.0, rerank: int = 4, flat_detail: float = 1.0,
+                 flat_rerank: int | None = None):
         if mode not in ("exhaustive", "fast"):
             raise WoodcamError(f"mode must be one of ['exhaustive', 'fast']; got {mode!r}")
         if n_rot < 1:
@@ -392,6 +449,8 @@ class SheetBank:
         self.top_k = top_k
         self.single_use = single_use
         self.w_struct, self.rerank = float(w_struct), max(1, int(rerank))
+        self.flat_detail = float(flat_detail)
+        self.flat_rerank = max(self.rerank, int(flat_rerank or 0))
         est = sum(g.shape[0] * g.shape[1] for g in self.grey) * n_rot * 2.0 * 13 / self.f ** 2
         if est > max_atlas_bytes:
             raise WoodcamError(
@@ -399,6 +458,13 @@ class SheetBank:
                 f"{max_atlas_bytes / 1e9:.1f} GB); use mode 'fast', fewer rotations, or a lower "
                 "working resolution (px_per_mm)")
         self.atlas = _Atlas(self, self.f)
+        # Coarse anchors known to hold no free window, per full template size (see best());
+        # how many were found, how many coarse anchors were re-ranked exactly, and how often
+        # the exact scan of every rotation ran (the slow path: tests count it).
+        self._dead: dict[tuple[int, int], _Anchors] = {}
+        self.dead_anchors = 0
+        self.fallback_scans = 0
+        self.exact_reranks = 0
         self._rot = [[rotation_matrix(g.shape[:2], a) for a in self.angles_deg] for g in self.grey]
 
     def rotation(self, sheet: int, rot: int) -> tuple[np.ndarray, tuple[int, int]]:
@@ -523,26 +589,78 @@ class SheetBank:
                 tc = np.ascontiguousarray(tc[t[0]:tc.shape[0] - t[2], t[1]:tc.shape[1] - t[3]])
         else:
             tc = _coarse(template, f)
-        # One coarse search ranks 16 top_k distinct anchors (of its 32 top_k best); they are
-        # re-ranked exactly top_k at a time, and the next batch is looked at only when every candidate of this one
-        # collides with used wood (late in a run, where the cheapest wood is gone).
-        cands = _distinct(self.atlas.search(tc, self.top_k * 32, trim))[:self.top_k * 16]
-        for b in range(0, len(cands), self.top_k):
-            found: list[tuple[float, int, int, int, int]] = []
-            for t, xc, yc, _ in cands[b:b + self.top_k]:
-                i, j = self.atlas.tiles[t][:2]
-                # Coarse tiles are the full rotated canvases downsampled: coarse pixel X
-                # covers full pixels f X .. f X + f - 1.
-                xf, yf = xc * f, yc * f
-                for c, x, y in self.exact_costs(i, j, xf, yf, self.radius, template, keep=3):
-                    found.append((c, i, j, x, y))
-            found.sort()
-            m = self._choose(template, found, struct_px)
-            if m is not None:
-                return m
-        return self._fallback(template) if cands else None
+        # A coarse search ranks 16 top_k distinct anchors (of its 32 top_k best); they are
+        # re-ranked exactly top_k at a time, and the next batch is looked at only when every
+        # candidate of this one collides with used wood (late in a run, where the cheapest wood
+        # is gone). The coarse map's used wood is optimistic (a coarse pixel is blocked when its
+        # centre is), so slivers between used pieces look free there: an anchor whose exact
+        # windows are all taken is remembered as dead for this template size (wood is only ever
+        # consumed, so it stays dead) and left out of every later search, and the search is
+        # run again until a free window turns up or no coarse anchor is left. Without that
+        # memory, a target with wide flat areas (coffee) drew the same dead slivers patch after
+        # patch and fell through to the exact scan of every rotation (minutes per patch).
+        # Where the target is flat, grain of any visible amplitude costs SSIM its contrast-
+        # structure term, which eq. 4 weighs no more than a slightly wrong tone: the coarse
+        # search weighs the wood's detail amplitude more there and more candidates are
+        # re-ranked structurally (both in proportion to the share of flat windows; off by default).
+        wd, nr = 1.0, self.rerank
+        if (self.flat_detail != 1.0 or self.flat_rerank > self.rerank) and self.w_intens > 0:
+            flat = _flat_fraction(template[..., 0] / self.w_intens, struct_px)
+            wd = 1.0 + (self.flat_detail - 1.0) * flat
+            nr = round(self.rerank + max(0, self.flat_rerank - self.rerank) * flat)
+        dead = self._dead.setdefault((th, tw), _Anchors())
+        searched = False
+        while True:
+            cands = _distinct(self.atlas.search(tc, self.top_k * 32, trim, dead.arrays(), wd))[:self.top_k * 16]
+            if not cands:
+                break
+            searched = True
+            for b in range(0, len(cands), self.top_k):
+                m = self._rerank_batch(template, cands[b:b + self.top_k], dead, struct_px, nr)
+                if m is not None:
+                    return m
+        return self._fallback(template) if searched or len(dead) else None
 
-    def _choose(self, template: np.ndarray, found: list, struct_px: float = 1.0) -> Match | None:
+    def _rerank_batch(self, template: np.ndarray, batch: list[tuple[int, int, int, float]],
+                      dead: _Anchors, struct_px: float, rerank: int | None = None) -> Match | None:
+        """Exact re-ranking of coarse anchors ``batch = [(tile, x, y, cost)]`` (see
+        :meth:`best`); anchors with no free window are appended to ``dead`` (atlas rows, cols)."""
+        th, tw = template.shape[:2]
+        f = self.f
+        found: list[tuple[float, int, int, int, int]] = []
+        live = []
+        for t, xc, yc, _ in batch:
+            i, j, y0, x0 = self.atlas.tiles[t][:4]
+            # Coarse tiles are the full rotated canvases downsampled: coarse pixel X covers
+            # full pixels f X .. f X + f - 1.
+            ex = self.exact_costs(i, j, xc * f, yc * f, self.radius, template, keep=3)
+            self.exact_reranks += 1
+            if not ex:
+                dead.append((y0 + yc, x0 + xc))
+                self.dead_anchors += 1
+                continue
+            live.append((t, xc, yc, i, j, y0, x0))
+            found += [(c, i, j, x, y) for c, x, y in ex]
+        found.sort()
+        m = self._choose(template, found, struct_px, rerank)
+        if m is not None or not self.single_use:
+            return m
+        # Every anchor's three best windows collide: its other windows may not, and an anchor
+        # is dead only when none of them is free.
+        more = []
+        for t, xc, yc, i, j, y0, x0 in live:
+            ex = self.exact_costs(i, j, xc * f, yc * f, self.radius, template)
+            hit = next(((c, i, j, x, y) for c, x, y in ex[3:]
+                        if self.is_free(i, self.footprint(i, j, x, y, th, tw))), None)
+            if hit is None:
+                dead.append((y0 + yc, x0 + xc))
+                self.dead_anchors += 1
+            else:
+                more.append(hit)
+        return self._choose(template, sorted(more), struct_px, rerank)
+
+    def _choose(self, template: np.ndarray, found: list, struct_px: float = 1.0,
+                rerank: int | None = None) -> Match | None:
         """The candidate to take from ``found = [(cost, sheet, rot, x, y)]`` (sorted by cost).
 
         With ``w_struct == 0`` the cheapest free one (eq. 4). Otherwise the first
@@ -562,7 +680,7 @@ class SheetBank:
                 continue    # the same bit of wood shifted a pixel or two: nothing new to rank
             if not self.single_use or self.is_free(i, self.footprint(i, j, x, y, th, tw)):
                 free.append(Match(i, j, x, y, c))
-                if self.w_struct <= 0 or self.w_intens <= 0 or len(free) >= self.rerank:
+                if self.w_struct <= 0 or self.w_intens <= 0 or len(free) >= (rerank or self.rerank):
                     break
         if len(free) <= 1:
             return free[0] if free else None
@@ -572,21 +690,31 @@ class SheetBank:
         return free[int(np.argmin(score))]
 
     def _fallback(self, template: np.ndarray) -> Match | None:
-        """Exact scan of every rotation for a free anchor when the ranked candidates all
-        collide with used wood (rare: only when the atlas' blocked pixels are optimistic at a
-        boundary); slow but complete."""
+        """Exact scan of every rotation for the cheapest free anchor, when no coarse anchor is
+        left (the coarse map's usable wood is conservative: a window at the very edge of the
+        usable wood may only be seen here); complete. Counted in ``fallback_scans``.
+
+        Per rotation, only anchors whose window is free in the rotated used-wood mask are
+        costed, cheapest first, and only as many as it takes to find one that
+        :meth:`is_free` accepts."""
+        self.fallback_scans += 1
         th, tw = template.shape[:2]
         best = None
         for i in range(len(self.grey)):
             for j in range(len(self.angles_deg)):
                 _, (H, W) = self._rot[i][j]
                 r = max(H, W)
-                for c, x, y in self.exact_costs(i, j, r, r, r, template):
-                    if best is not None and c >= best.cost:
+                keep = 8
+                while True:
+                    ex = self.exact_costs(i, j, r, r, r, template, keep=keep)
+                    hit = next(((c, x, y) for c, x, y in ex
+                                if (best is None or c < best.cost)
+                                and self.is_free(i, self.footprint(i, j, x, y, th, tw))), None)
+                    if hit is not None:
+                        best = Match(i, j, hit[1], hit[2], hit[0])
+                    if hit is not None or len(ex) < keep or (best is not None and ex[-1][0] >= best.cost):
                         break
-                    if self.is_free(i, self.footprint(i, j, x, y, th, tw)):
-                        best = Match(i, j, x, y, c)
-                        break
+                    keep *= 8
         return best
 
     def take(self, m: Match, th: int, tw: int) -> np.ndarray:
@@ -650,6 +778,32 @@ _SSIM_WIN = 7
 _SSIM_C2 = (0.03 * 1.0) ** 2
 
 
+def _native_grey(g: np.ndarray, scale: float) -> np.ndarray:
+    """An intensity ``(h, w)`` area-averaged by ``scale`` (the target image's own pixels; at
+    least 7 x 7 of them kept), float32; unchanged for ``scale <= 1``."""
+    import cv2
+
+    a = np.asarray(g, np.float32)
+    if scale > 1.0:
+        h, w = a.shape
+        size = (max(_SSIM_WIN, round(w / scale)), max(_SSIM_WIN, round(h / scale)))
+        a = cv2.resize(a, size, interpolation=cv2.INTER_AREA)
+    return a
+
+
+def _flat_fraction(gt: np.ndarray, scale: float = 1.0) -> float:
+    """Share of the 7 x 7 windows of a target intensity ``gt (h, w)`` (on the target image's
+    own pixels, see :func:`_native_grey`) whose variance is below SSIM's C2: where grain of
+    any visible amplitude costs SSIM its contrast-structure term."""
+    import cv2
+
+    k = (_SSIM_WIN, _SSIM_WIN)
+    b = _native_grey(gt, scale)
+    mb = cv2.blur(b, k)
+    vb = cv2.blur(b * b, k) - mb * mb
+    return float(np.mean(vb < _SSIM_C2))
+
+
 def _structure_penalty(gs: np.ndarray, gt: np.ndarray, scale: float = 1.0) -> float:
     """Mean of ``1 - cs`` over 7 x 7 box windows of two ``(h, w)`` intensities, where
     ``cs = (2 cov + C2) / (var_s + var_t + C2)`` is SSIM's contrast-structure term: 0 when the
@@ -659,12 +813,7 @@ def _structure_penalty(gs: np.ndarray, gt: np.ndarray, scale: float = 1.0) -> fl
     import cv2
 
     k = (_SSIM_WIN, _SSIM_WIN)
-    a, b = np.asarray(gs, np.float32), np.asarray(gt, np.float32)
-    if scale > 1.0:
-        h, w = a.shape
-        size = (max(_SSIM_WIN, round(w / scale)), max(_SSIM_WIN, round(h / scale)))
-        a = cv2.resize(a, size, interpolation=cv2.INTER_AREA)
-        b = cv2.resize(b, size, interpolation=cv2.INTER_AREA)
+    a, b = _native_grey(gs, scale), _native_grey(gt, scale)
     ma, mb = cv2.blur(a, k), cv2.blur(b, k)
     va = cv2.blur(a * a, k) - ma * ma
     vb = cv2.blur(b * b, k) - mb * mb
