@@ -8,7 +8,9 @@ that prints and stores the figures::
     python tests/bench/test_parquetry_bench.py quality|speed|fig14|exhaustive|exhaustive4|full|calm|calm-flat OUT.json [COARSE_FACTOR | IMAGES | OUT_DIR] [OUT_DIR]
 
 Timings are CPU seconds of the matching (``time.process_time``), so they are comparable under
-the shared machine's load; wall seconds are stored too.
+the shared machine's load; wall seconds are stored too. ``speed``, ``exhaustive_vs_fast`` and
+``exhaustive_vs_fast_4ppm`` take ``params`` (ParquetryParams fields changed, e.g. ``FLAT``) so
+the flat-window options can be compared against the defaults in one run (README, "flat windows").
 """
 
 from __future__ import annotations
@@ -129,7 +131,7 @@ def quality(images=("camera", "astronaut", "coffee", "chelsea"), size_mm=112.0, 
     return out
 
 
-def speed(size_mm=70.0, ppm=4.0, sheet=(600, 400), coarse_factor=None, top_k=12):
+def speed(size_mm=70.0, ppm=4.0, sheet=(600, 400), coarse_factor=None, top_k=12, params=None):
     """The issue's sheets (four 600 x 400 mm at 4 px/mm, 15 rotations), fast mode, square
     patches (seams are not part of the per-patch matching time). The time per patch depends on
     the wood searched, not on the target's size, so a 70 mm crop of the target (25 patches)
@@ -142,13 +144,15 @@ def speed(size_mm=70.0, ppm=4.0, sheet=(600, 400), coarse_factor=None, top_k=12)
 
     sheets = _sheets(sheet, ppm, leaves=2, mokume=False, n_species=2)
     img = data.camera()[40:300, 120:380].astype(np.float32) / 255
-    prm = ParquetryParams(image_size_mm=size_mm, px_per_mm=ppm, coarse_factor=coarse_factor, top_k=top_k)
+    prm = ParquetryParams(image_size_mm=size_mm, px_per_mm=ppm, coarse_factor=coarse_factor, top_k=top_k,
+                          **(params or {}))
     t = time.process_time()
     run = build_parquetry([img], sheets, prm, seams=False, progress=True)
     out = {"workload": f"camera crop at {size_mm:g} mm, 14 mm patches, {len(sheets)} sheets {sheet[0]}x{sheet[1]} mm "
            f"at {ppm:g} px/mm (2 walnut + 2 maple leaves sliced from builtin blocks), 15 rotations, "
            f"coarse factor {run.bank.f}, top_k {top_k}",
-           "atlas_px": int(run.bank.atlas.blocked.size), "coarse_factor": run.bank.f,
+           "params": dict(params or {}), "atlas_px": int(run.bank.atlas.blocked.size),
+           "coarse_factor": run.bank.f,
            "fast": _figures(run, prm), "fast_total_cpu_s": time.process_time() - t}
     print(json.dumps(out), flush=True)
     return out
@@ -178,7 +182,7 @@ def fig14(size_mm=70.0, ppm=2.0, copies=7):
     return out
 
 
-def exhaustive_vs_fast(size_mm=70.0, ppm=2.0):
+def exhaustive_vs_fast(size_mm=70.0, ppm=2.0, params=None):
     """Fast vs exhaustive on one workload small enough for the exhaustive search here: a
     5 x 5-patch camera crop, one 200 x 150 mm leaf of each of six species + 12 Mokume faces."""
     import dataclasses
@@ -189,7 +193,7 @@ def exhaustive_vs_fast(size_mm=70.0, ppm=2.0):
 
     sheets = _sheets((200, 150), ppm, leaves=1)
     img = data.camera()[40:300, 120:380].astype(np.float32) / 255
-    base = ParquetryParams(image_size_mm=size_mm, px_per_mm=ppm)
+    base = ParquetryParams(image_size_mm=size_mm, px_per_mm=ppm, **(params or {}))
     out = {"workload": f"camera crop at {size_mm:g} mm, {len(sheets)} sheets (12 Mokume faces + one "
            f"200x150 mm leaf of six species), {ppm:g} px/mm, 15 rotations", "runs": {}}
     for label, prm in (("fast", base), ("exhaustive", dataclasses.replace(base, mode="exhaustive"))):
@@ -199,7 +203,7 @@ def exhaustive_vs_fast(size_mm=70.0, ppm=2.0):
     return out
 
 
-def exhaustive_vs_fast_4ppm(size_mm=70.0, ppm=4.0, factors=(4, 8, 16)):
+def exhaustive_vs_fast_4ppm(size_mm=70.0, ppm=4.0, factors=(4, 8, 16), params=None):
     """Fast (several coarse factors) vs exhaustive at the issue's resolution (4 px/mm, 14 mm
     patches, 15 rotations) on wood the exhaustive atlas can hold on this machine: one
     300 x 200 mm leaf each of walnut and maple (the issue's four 600 x 400 mm sheets would
@@ -212,7 +216,7 @@ def exhaustive_vs_fast_4ppm(size_mm=70.0, ppm=4.0, factors=(4, 8, 16)):
 
     sheets = _sheets((300, 200), ppm, leaves=1, mokume=False, n_species=2)
     img = data.camera()[40:300, 120:380].astype(np.float32) / 255
-    base = ParquetryParams(image_size_mm=size_mm, px_per_mm=ppm)
+    base = ParquetryParams(image_size_mm=size_mm, px_per_mm=ppm, **(params or {}))
     out = {"workload": f"camera crop at {size_mm:g} mm (25 patches of 14 mm), one 300x200 mm leaf "
            f"each of walnut and maple at {ppm:g} px/mm, 15 rotations, square patches", "runs": {}}
     runs = [("exhaustive", dataclasses.replace(base, mode="exhaustive"))]
