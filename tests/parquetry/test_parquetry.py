@@ -589,3 +589,29 @@ def test_planted_violation_is_repaired_and_files_pass(sheets, tmp_path):
     assert checked == len(run.patches)
     n = rasterise(read_svg_pieces(tmp_path / "assembly.svg"), p.matched.shape, PPM)
     assert (n == 1).all()
+
+
+def test_is_free_quick_accept_gives_the_rasterised_answer():
+    """is_free's bounding-box shortcut must answer exactly as rasterising the footprint does:
+    random used wood, random rotations, anchors and sizes (down to 2 px and off the sheet)."""
+    from woodcam.parquetry.matching import SheetBank, _polygon_pixels
+
+    rng = np.random.default_rng(3)
+    g = np.full((120, 150), 0.5, np.float32)
+    bank = SheetBank([g], [np.ones(g.shape, bool)], n_rot=15, mode="fast", coarse_factor=4)
+    taken = bank.taken[0]
+    taken[rng.random(taken.shape) < 0.002] = True
+    taken[40:60, 70:100] = True
+    quick = 0
+    for _ in range(3000):
+        j = int(rng.integers(15))
+        th, tw = (int(v) for v in rng.integers(2, 40, 2))
+        x, y = (float(v) for v in rng.integers(-10, 200, 2))
+        poly = bank.footprint(0, j, x, y, th, tw)
+        rr, cc = _polygon_pixels(poly, taken.shape)
+        lo, hi = poly.min(0), poly.max(0)
+        on = lo.min() >= -0.5 - 1e-6 and hi[0] <= 150 - 0.5 + 1e-6 and hi[1] <= 120 - 0.5 + 1e-6
+        want = bool(on and rr.size and not taken[rr, cc].any())
+        assert bank.is_free(0, poly) == want, (j, th, tw, x, y)
+        quick += want
+    assert quick > 100
