@@ -615,3 +615,38 @@ def test_is_free_quick_accept_gives_the_rasterised_answer():
         assert bank.is_free(0, poly) == want, (j, th, tw, x, y)
         quick += want
     assert quick > 100
+
+
+def test_flat_window_weighting_is_on_by_default(sheets, monkeypatch):
+    """The defaults (flat_detail 3, flat_rerank 12; README "flat windows"): a flat target's
+    coarse search weighs the detail channel 3 times and re-ranks up to 12 candidates, a target
+    with contrast everywhere keeps weight 1 and 4; flat_detail=1, flat_rerank=4 turns it off."""
+    from woodcam.parquetry import ParquetryParams, build_parquetry
+    from woodcam.parquetry.matching import SheetBank, _Atlas
+
+    assert (ParquetryParams().flat_detail, ParquetryParams().flat_rerank) == (3.0, 12)
+    weights, reranks = [], []
+    search, rerank_batch = _Atlas.search, SheetBank._rerank_batch
+
+    def spy_search(self, template, k, trim=(0, 0, 0, 0), exclude=None, detail_weight=1.0):
+        weights.append(detail_weight)
+        return search(self, template, k, trim, exclude, detail_weight)
+
+    def spy_rerank(self, template, batch, dead, struct_px, rerank=None):
+        reranks.append(rerank)
+        return rerank_batch(self, template, batch, dead, struct_px, rerank)
+
+    monkeypatch.setattr(_Atlas, "search", spy_search)
+    monkeypatch.setattr(SheetBank, "_rerank_batch", spy_rerank)
+    flat = np.full((64, 64), 0.45, np.float32)
+    prm = ParquetryParams(image_size_mm=28, px_per_mm=PPM)
+    build_parquetry(flat, sheets, prm, seams=False)
+    assert set(weights) == {3.0} and set(reranks) == {12}
+    weights.clear(), reranks.clear()
+    checker = np.kron(np.indices((32, 32)).sum(0) % 2, np.ones((2, 2))).astype(np.float32)
+    build_parquetry(checker, sheets, prm, seams=False)
+    assert set(weights) == {1.0} and set(reranks) == {4}
+    weights.clear(), reranks.clear()
+    off = ParquetryParams(image_size_mm=28, px_per_mm=PPM, flat_detail=1.0, flat_rerank=4)
+    build_parquetry(flat, sheets, off, seams=False)
+    assert set(weights) == {1.0} and set(reranks) == {4}

@@ -97,6 +97,12 @@ def register(subparsers) -> None:
                    help="weight of the structural re-rank of the cheapest candidates (SSIM's "
                    "contrast-structure on 7 x 7 windows of the target image's own pixels, unitless; "
                    "default 0.02; 0 = eq. 4 alone)")
+    f.add_argument("--flat-detail", type=float, default=None, metavar="X",
+                   help="where the target is flat, the fast search weighs the wood's fine detail "
+                   "up to X times more, so calm wood is found (unitless, >= 1; default 3; 1 = off)")
+    f.add_argument("--flat-rerank", type=int, default=None, metavar="N",
+                   help="where the target is flat, up to N candidate placements per patch (>= 4) get "
+                   "the structural re-rank instead of 4 (default 12; 4 = off)")
     f.add_argument("--overlap-mm", type=float, default=None,
                    help="patch overlap for seam cutting in mm (default min(patch/4, "
                    "(patch - min-piece)/2) = 3.5); 0 = square pieces")
@@ -118,7 +124,7 @@ _OPTION_PARAMS = {"w_intens": "w_intens", "w_edge": "w_edge", "w_hist": "w_hist"
                   "image_size_mm": "image_size_mm", "patch_mm": "patch_mm", "n_adaptive": "n_adaptive",
                   "w_adaptive": "w_adaptive", "n_rot": "n_rot", "priority": "priority", "queue": "queue",
                   "px_per_mm": "px_per_mm", "mode": "mode", "coarse_factor": "coarse_factor",
-                  "w_struct": "w_struct",
+                  "w_struct": "w_struct", "flat_detail": "flat_detail", "flat_rerank": "flat_rerank",
                   "overlap_mm": "overlap_mm",
                   "min_piece_mm": "min_piece_mm", "tool_diameter": "tool_diameter_mm",
                   "kerf_mm": "kerf_mm"}
