@@ -270,18 +270,26 @@ def test_adaptive_supersampling_matches_full_at_a_third_of_the_samples():
     assert np.allclose(smooth.rgb[0, :, 0], 0.5 + 0.001 * (np.arange(240) + 0.5) / 4.0, atol=1e-6)
 
 
-def test_coarse_search_prefers_calm_wood_for_a_flat_target():
-    """Two sheets of the same mean tone, one flat and one with 2 px grain that the coarse
-    low-pass removes entirely: for a flat target the fast search's coarse stage ranks the calm
-    sheet first (its detail-amplitude channel), and the exact choice is the calm sheet."""
-    from woodcam.parquetry.matching import SheetBank, _coarse
+def _grain_and_calm_bank():
+    """A fast-mode bank of two sheets of tone 0.5: sheet 0 with +-0.1 grain every 2 px (which
+    the coarse low-pass removes entirely), sheet 1 flat."""
+    from woodcam.parquetry.matching import SheetBank
 
     calm = np.full((96, 96), 0.5, np.float32)
     grain = np.full((96, 384), 0.5, np.float32)
     grain[:, ::2] += 0.1
     grain[:, 1::2] -= 0.1
-    bank = SheetBank([grain, calm], [np.ones(grain.shape, bool), np.ones(calm.shape, bool)],
+    return SheetBank([grain, calm], [np.ones(grain.shape, bool), np.ones(calm.shape, bool)],
                      n_rot=1, mode="fast", coarse_factor=4, top_k=2)
+
+
+def test_coarse_search_prefers_calm_wood_for_a_flat_target():
+    """Two sheets of the same mean tone, one flat and one with 2 px grain that the coarse
+    low-pass removes entirely: for a flat target the fast search's coarse stage ranks the calm
+    sheet first (its detail-amplitude channel), and the exact choice is the calm sheet."""
+    from woodcam.parquetry.matching import _coarse
+
+    bank = _grain_and_calm_bank()
     tmpl = bank.features(np.full((28, 28), 0.5, np.float32))
     cands = bank.atlas.search(_coarse(tmpl, 4), 50)
     assert bank.atlas.tiles[cands[0][0]][0] == 1
@@ -294,20 +302,14 @@ def test_coarse_search_prefers_calm_wood_for_a_flat_target():
     assert m.sheet == 1 and m.cost < 1e-6
 
 
-
 def test_detail_weight_scales_the_coarse_cost_of_grain_and_flat_fraction():
     """The coarse SSD with the detail channel weighted w is sum_c w_c (S_c - T_c)^2: against a
     flat template, calm and grained wood of the same low-passed tone differ only in the
     detail channel, so their cost gap grows exactly w times; the flat share is 1 for a flat
     target and 0 for one with contrast in every window."""
-    from woodcam.parquetry.matching import SheetBank, _coarse, _flat_fraction
+    from woodcam.parquetry.matching import _coarse, _flat_fraction
 
-    calm = np.full((96, 96), 0.5, np.float32)
-    grain = np.full((96, 384), 0.5, np.float32)
-    grain[:, ::2] += 0.1
-    grain[:, 1::2] -= 0.1
-    bank = SheetBank([grain, calm], [np.ones(grain.shape, bool), np.ones(calm.shape, bool)],
-                     n_rot=1, mode="fast", coarse_factor=4, top_k=2)
+    bank = _grain_and_calm_bank()
     tc = _coarse(bank.features(np.full((28, 28), 0.5, np.float32)), 4)
 
     def gap(w):
