@@ -614,7 +614,8 @@ class SheetBank:
         # Where the target is flat, grain of any visible amplitude costs SSIM its contrast-
         # structure term, which eq. 4 weighs no more than a slightly wrong tone: the coarse
         # search weighs the wood's detail amplitude more there and more candidates are
-        # re-ranked structurally (both in proportion to the share of flat windows; off by default).
+        # re-ranked structurally (both in proportion to the share of flat windows; off in a bare
+        # SheetBank, on in ParquetryParams's defaults).
         wd, nr = 1.0, self.rerank
         if (self.flat_detail != 1.0 or self.flat_rerank > self.rerank) and self.w_intens > 0:
             flat = _flat_fraction(template[..., 0] / self.w_intens, struct_px)
