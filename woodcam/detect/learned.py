@@ -25,7 +25,7 @@ import time
 from dataclasses import asdict, dataclass
 from dataclasses import fields as dc_fields
 from pathlib import Path
-from typing import Literal
+from typing import Literal, get_args
 
 import numpy as np
 
@@ -269,19 +269,16 @@ def ring_probability(photo: np.ndarray, models_dir=MODELS_DIR) -> np.ndarray:
     net = load_ring_net(models_dir)
     # one thread: the net is small, and on a 256 px face torch's two threads spent 0.69 CPU-s
     # where one spends 0.15 (the budget is 1 CPU-s per face for the whole detector)
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    try:
-        with torch.no_grad():
-            p = torch.sigmoid(net(torch.from_numpy(x)[None, None]))[0, 0].numpy()
-    finally:
-        torch.set_num_threads(threads)
+    from .._threads import torch_threads
+
+    with torch_threads(torch, 1), torch.no_grad():
+        p = torch.sigmoid(net(torch.from_numpy(x)[None, None]))[0, 0].numpy()
     return p[:h, :w].astype(np.float32)
 
 
 #: How the learned detector places its ring lines (:func:`detect_rings_learned`).
 LearnedMode = Literal["snap", "ridge"]
-LEARNED_MODES: tuple[str, ...] = ("snap", "ridge")
+LEARNED_MODES: tuple[str, ...] = get_args(LearnedMode)
 #: Net probability below which a snapped line is dropped (``"snap"``): the net sees no ring
 #: boundary within reach of the classical line.
 SNAP_MIN_PROBABILITY = 0.2

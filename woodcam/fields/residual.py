@@ -35,6 +35,19 @@ def face_knots(length_mm: float, spacing_mm: float) -> np.ndarray:
     return np.concatenate([[0.0] * 3, np.linspace(0.0, length_mm, n + 1), [length_mm] * 3])
 
 
+def face_spline_knots(size_mm: np.ndarray, face: str, spacing_mm: float) -> tuple[np.ndarray, np.ndarray]:
+    """The B-spline knots (:func:`face_knots`) of ``face``'s two axes, ascending, for a block of
+    ``size_mm (3,)``."""
+    return tuple(face_knots(size_mm[a], spacing_mm) for a in range(3) if a != FACE_AXIS[face])
+
+
+def face_weight(d_mm: np.ndarray, depth_mm: float) -> np.ndarray:
+    """Fall-off ``exp(-(d / depth)^2)`` of a face's residual at ``d_mm`` from it, 0 where below
+    :data:`_MIN_WEIGHT` (what evaluation and fits both leave out)."""
+    w = np.exp(-(np.asarray(d_mm, float) / depth_mm) ** 2)
+    return np.where(w > _MIN_WEIGHT, w, 0.0)
+
+
 def face_geometry(points_mm: np.ndarray, size_mm: np.ndarray, face: str):
     """``(d (n,), uv (n, 2))``: distance (mm, >= 0) from each point to ``face``'s plane (0 on or
     outside it) and the point projected onto the face, clamped to it, in the block frame's two
@@ -62,8 +75,7 @@ class FaceResidual:
 
     def knots(self, face: str) -> tuple[np.ndarray, np.ndarray]:
         """The B-spline knots of ``face``'s two axes."""
-        other = [a for a in range(3) if a != FACE_AXIS[face]]
-        return tuple(face_knots(self.size_mm[a], self.spacing_mm) for a in other)
+        return face_spline_knots(self.size_mm, face, self.spacing_mm)
 
     def _spline(self, face: str, c: np.ndarray):
         from scipy.interpolate import NdBSpline
@@ -71,8 +83,8 @@ class FaceResidual:
         return NdBSpline(self.knots(face), c, 3)
 
     def weight(self, d_mm: np.ndarray) -> np.ndarray:
-        """Fall-off ``exp(-(d / depth)^2)`` of a face's residual at ``d_mm`` from it."""
-        return np.exp(-(np.asarray(d_mm, float) / self.depth_mm) ** 2)
+        """Fall-off of a face's residual at ``d_mm`` from it (:func:`face_weight`)."""
+        return face_weight(d_mm, self.depth_mm)
 
     def __call__(self, points_mm: ArrayLike) -> np.ndarray:
         p = np.asarray(points_mm, float).reshape(-1, 3)
@@ -82,7 +94,7 @@ class FaceResidual:
                 continue
             d, uv = face_geometry(p, self.size_mm, face)
             w = self.weight(d)
-            near = w > _MIN_WEIGHT  # deep points: no face's residual reaches them (nor its fit)
+            near = w > 0  # deep points: no face's residual reaches them (nor its fit)
             if near.any():
                 out[near] += w[near] * self._splines[face](uv[near])
         return out
@@ -114,4 +126,4 @@ class ResidualField:
         return getattr(self.base, name)
 
 
-__all__ = ["FaceResidual", "ResidualField", "face_geometry", "face_knots"]
+__all__ = ["FaceResidual", "ResidualField", "face_geometry", "face_knots", "face_spline_knots", "face_weight"]

@@ -165,6 +165,15 @@ def _held_out_faces(obs: RingObservations) -> list[int]:
     return [int(i) for i, c in zip(ids, counts) if c >= EVIDENCE_MIN_FACE_POINTS]
 
 
+def _held_points(obs: RingObservations, held: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Indices of the held-out face's ring points (``held (n,) bool``) scored in its fold: at
+    most :data:`EVIDENCE_MAX_HELD_POINTS`, drawn from ``rng`` (one draw per face, in face order)."""
+    idx = np.flatnonzero(held)
+    if len(idx) > EVIDENCE_MAX_HELD_POINTS:
+        idx = np.sort(rng.choice(idx, EVIDENCE_MAX_HELD_POINTS, replace=False))
+    return idx
+
+
 def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: int = 0,
                      predictions: dict | None = None, fold_fields: dict | None = None) -> dict:
     """Leave-one-face-out score of every hypothesis on every face with enough ring points.
@@ -186,9 +195,7 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
     for f in faces:
         held = obs.face == f
         rest = obs.subset(~held)
-        idx = np.flatnonzero(held)
-        if len(idx) > EVIDENCE_MAX_HELD_POINTS:
-            idx = np.sort(rng.choice(idx, EVIDENCE_MAX_HELD_POINTS, replace=False))
+        idx = _held_points(obs, held, rng)
         pts, yrs = obs.points_mm[idx], obs.years[idx]
         for h in hypotheses:
             try:
@@ -375,9 +382,7 @@ def residual_evidence(obs: RingObservations, chosen: str, fold_fields: dict, siz
     for f in _held_out_faces(obs):
         base = fold_fields.get((chosen, FACES[f]))
         held = obs.face == f
-        idx = np.flatnonzero(held)
-        if len(idx) > EVIDENCE_MAX_HELD_POINTS:  # the same draw as holdout_evidence's
-            idx = np.sort(rng.choice(idx, EVIDENCE_MAX_HELD_POINTS, replace=False))
+        idx = _held_points(obs, held, rng)  # the same draw as holdout_evidence's
         if base is None:  # the chosen recipe could not refit this fold: no evidence either way
             continue
         pts, yrs = obs.points_mm[idx], obs.years[idx]

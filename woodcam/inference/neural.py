@@ -251,13 +251,11 @@ def fit_neural_details(block, *, model=None, faces=None, steps: int = 300, seed:
     """Fit eq. 5 (labelled) or the year-free loss (unlabelled) to ``block``; see :func:`fit_neural`
     (this returns more)."""
     torch = require("torch", "learn", "fitting the neural growth field")
-    old_threads = torch.get_num_threads()
-    torch.set_num_threads(int(threads))
-    try:
+    from .._threads import torch_threads
+
+    with torch_threads(torch, threads):
         return _fit(torch, block, model, faces, steps, seed, progress, spacing_mm, labels,
                     year_free_steps, start)
-    finally:
-        torch.set_num_threads(old_threads)
 
 
 def _check_steps(name: str, steps) -> int:

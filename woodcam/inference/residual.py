@@ -22,7 +22,7 @@ import numpy as np
 
 from .._types import ArrayLike
 from ..errors import WoodcamError
-from ..fields.residual import _MIN_WEIGHT, FaceResidual, face_geometry, face_knots
+from ..fields.residual import FaceResidual, face_geometry, face_spline_knots, face_weight
 from ..frames import FACE_AXIS, FACES
 from ..tolerances import (RESIDUAL_CURVATURE, RESIDUAL_DEPTH_MM, RESIDUAL_HUBER_YEARS, RESIDUAL_MAX_POINTS,
                           RESIDUAL_RIDGE, RESIDUAL_SLOPE, RESIDUAL_SPACING_MM)
@@ -113,13 +113,11 @@ def fit_face_residual(obs: RingObservations, base: Callable, size_mm: ArrayLike,
         w_data[sel] = cells / sel.sum()
     blocks, pens, shapes = [], [], {}
     for face in FACES:
-        other = [a for a in range(3) if a != FACE_AXIS[face]]
-        knots = tuple(face_knots(size[a], spacing_mm) for a in other)
+        knots = face_spline_knots(size, face, spacing_mm)
         nu, nv = (len(t) - 4 for t in knots)
         shapes[face] = (nu, nv)
         d, uv = face_geometry(p, size, face)
-        wt = np.exp(-(d / depth_mm) ** 2)
-        wt[wt <= _MIN_WEIGHT] = 0.0  # as FaceResidual evaluates it
+        wt = face_weight(d, depth_mm)  # as FaceResidual evaluates it
         dm = NdBSpline.design_matrix(uv, knots, 3)
         # scipy sizes the matrix by the last basis function the points touch: give it every one
         dm = sparse.csr_array((dm.data, dm.indices, dm.indptr), shape=(len(uv), nu * nv))
