@@ -108,6 +108,37 @@ def test_fit_evidence_with_a_planted_extra_hypothesis(block, obs):
     assert res.scores[res.chosen]["mean"] > 90.0
 
 
+def test_year_labelled_rings_are_fitted_and_judged_on_the_years_given(block, obs, monkeypatch):
+    """The radial fit renumbers a labelled trace it misfits by over half a year; that is its own
+    correction, not what the other hypotheses are judged on. Planted: the radial numbering moves
+    one correct trace of the front face a year (as it did to a trace in rings bent round a knot,
+    README "Judged on the given years"); the true field, an extra hypothesis, still predicts
+    every held-out face exactly. Checked by breaking it: judged on the radial numbering, the
+    truth loses points on the front face and this test fails."""
+    import woodcam.inference.evidence as ev
+    from woodcam.frames import FACES
+    from woodcam.inference.observations import RingObservations
+
+    real = ev.fit_radial_hypotheses
+    front = obs.face == FACES.index("front")
+    groups, counts = np.unique(obs.group[front], return_counts=True)
+    moved = groups[np.argmax(counts)]  # the front face's longest trace
+
+    def misnumbered(o, *args, **kw):
+        fields, numbered = real(o, *args, **kw)
+        years = numbered.years + (numbered.group == moved)
+        return fields, RingObservations(numbered.points_mm, years, numbered.group, numbered.face)
+
+    monkeypatch.setattr(ev, "fit_radial_hypotheses", misnumbered)
+    truth = block.true_field
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", WoodcamWarning)  # broken, the truth is "contradicted"
+        res = fit_evidence(obs, block.size_mm, n_basins=1, candidates=("radial",),
+                           extra=[Hypothesis("truth", truth, lambda o: truth)])
+    scores = {face: v for face, v in res.scores["truth"].items() if face != "mean"}
+    assert scores and min(scores.values()) == 100.0, scores
+
+
 def test_one_face_is_unverified_and_warns(block):
     one = gather_observations(block, ["front"])
     with pytest.warns(WoodcamWarning, match="only one face"):

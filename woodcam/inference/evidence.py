@@ -7,7 +7,9 @@ faces it was *not* fitted to can. So:
 
 1. Hypotheses: the radial fit from its best distinct pith-axis basins
    (:func:`~.radial.fit_radial_hypotheses`), a thin-plate RBF of the (numbered) ring points
-   (seed 000's baseline), the best radial stem plus a smoothed RBF of its residual
+   (seed 000's baseline; unlabelled rings numbered by the first radial fit, year-labelled ones
+   taken as given: each recipe corrects mislabelled traces its own way), the best radial stem
+   plus a smoothed RBF of its residual
    (part 4's small-scale distortion, seed 000 Fig. 16b), and the stem model of part 2
    (:mod:`.stem`: a curved pith near a block axis, ring density by direction, height and year).
 2. Evidence: for each observed face ``f`` every hypothesis' *recipe* is refitted on the other
@@ -582,6 +584,14 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         raise WoodcamError(f"candidates must include 'radial' and come from {CANDIDATES}; got {list(candidates)}")
     with _one_blas_thread():
         radials, numbered = fit_radial_hypotheses(obs, size_mm, n_basins=n_basins, seed=seed)
+        if obs.labelled:
+            # Years given: every hypothesis is fitted and judged on them. The radial fit's
+            # renumbering of traces it misfits by over half a year is its own correction (each
+            # recipe makes its own: the stem's, each basin's), not a fact the others are judged
+            # on: a correct trace in rings bent round a knot, which no radial field can follow,
+            # was moved a year and the bend that fits it lost its fold (README, "Judged on the
+            # given years").
+            numbered = obs
         hyps = [Hypothesis("radial" if i == 0 else f"radial basin {i + 1}", f, radial_recipe(f, seed, size_mm))
                 for i, f in enumerate(radials)]
         if "stem" in candidates:

@@ -29,8 +29,9 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: basin whose numbering makes neighbouring rings one year apart; 9: the knots' ring bend on by
 #: default, competing while the evidence keeps its stem; 10: knot strands from the cones fitted to
 #: the masks by default, and a refinement chosen only when it beats every plain hypothesis by more
-#: than the accept margin).
-FIT_VERSION = 10
+#: than the accept margin; 11: year-labelled rings fitted and judged on the years given, not on
+#: the radial fit's renumbering of them).
+FIT_VERSION = 11
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
