@@ -100,3 +100,41 @@ def test_a_cone_bend_the_rings_do_not_show_is_rejected(corner_block):
     assert "stem + knot bend" in ev.scores  # it competed (the cone pins a strand) ...
     assert "knot bend" not in ev.chosen, ev.message  # ... and lost
     assert ev.scores["stem + knot bend"]["mean"] < ev.scores["stem"]["mean"] - 2.0, ev.scores
+
+
+def test_cone_fits_are_remembered_per_start_and_give_the_same_cone(corner_block, monkeypatch):
+    """A knot end cut by an edge starts its cone from its samples' three axes and one direction
+    down the stem's years, the only one that changes between folds: the memo keeps each start's
+    fit, so a second stem refits one start, not four, and the cone is the all-starts fit's bit
+    for bit. Checked by breaking it: remembered by the whole set of starts, the second call
+    refits all four and this test fails."""
+    import woodcam.inference.knots as kn
+
+    exits = knot_exits(corner_block)
+    end = [k for k, e in enumerate(exits) if e["face"] in ("front", "left")]
+    surface = exits[0]["surface"]
+    positive = np.concatenate([exits[k]["pixels"] for k in end])
+    ignore = np.concatenate([exits[k]["pixels"] for k in range(len(exits)) if k not in end])
+    samples = surface[0][positive]
+    c0, r0 = samples.mean(axis=0), float(np.mean([exits[k]["radius_mm"] for k in end]))
+    axes = np.linalg.svd(samples - c0, full_matrices=False)[2]
+    starts_a = np.vstack([axes, [[0.6, 0.8, 0.0]]])
+    starts_b = np.vstack([axes, [[0.8, 0.6, 0.0]]])
+
+    calls = []
+    real = kn._fit_cone
+
+    def counting(*args, **kw):
+        calls.append(1)
+        return real(*args, **kw)
+
+    monkeypatch.setattr(kn, "_fit_cone", counting)
+    memo: dict = {}
+    a = kn._memo_cone(memo, surface, positive, ignore, c0, starts_a, r0)
+    assert len(calls) == 4
+    b = kn._memo_cone(memo, surface, positive, ignore, c0, starts_b, r0)
+    assert len(calls) == 5  # only the changed start
+    for got, starts in ((a, starts_a), (b, starts_b)):
+        want = real(surface, positive, ignore, c0, starts, r0)
+        for g, w in zip(got, want):
+            np.testing.assert_array_equal(g, w)

@@ -96,14 +96,15 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         from .knots import knot_bend_recipes, knot_exits, with_knots
 
         # the stem with the rings bent round its knots competes as more hypotheses
-        stem, recipes = (knot_bend_recipes(block.size_mm, knot_exits(block, faces), cones=knot_cones)
+        exits = knot_exits(block, faces)  # once: their cone fits are remembered with them
+        stem, recipes = (knot_bend_recipes(block.size_mm, exits, cones=knot_cones)
                          if knot_bend else (None, None))
         ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem,
                           refines=dict.fromkeys(recipes or {}, "stem"), residual=residual)
         if isinstance(getattr(ev.field, "base", ev.field), StemWithKnots):  # it holds its knots already
             strands = ev.field.strands
         else:
-            ev.field, strands = with_knots(block, ev.field, faces, knot_cones)  # knots from the masks (part 3)
+            ev.field, strands = with_knots(block, ev.field, faces, knot_cones, exits)  # knots from the masks (part 3)
         used = sorted({int(i) for i in np.unique(obs.face)})
         return bake_evidence(ev, block.size_mm, used, strands) if baked else ev
     if method == "rbf":
