@@ -33,7 +33,7 @@ faces it was *not* fitted to can. So:
 5. Confidence (part 5): the spread (years) of the hypotheses whose evidence is close to the
    best one's, per point (:meth:`EvidenceFit.uncertainty_years`).
 
-Years: labelled traces are scored against their labels (a few mislabelled traces cost a few
+Years: labelled traces are fitted and scored against their labels (a few mislabelled traces cost a few
 points of share, equally for every hypothesis); unlabelled rings are numbered once by the best
 in-sample radial fit and every hypothesis is fitted and scored on those numbers.
 """
