@@ -122,19 +122,19 @@ def test_cone_fits_are_remembered_per_start_and_give_the_same_cone(corner_block,
     starts_b = np.vstack([axes, [[0.8, 0.6, 0.0]]])
 
     calls = []
-    real = kn._fit_cone
+    real = kn._fit_cone_start
 
     def counting(*args, **kw):
         calls.append(1)
         return real(*args, **kw)
 
-    monkeypatch.setattr(kn, "_fit_cone", counting)
+    monkeypatch.setattr(kn, "_fit_cone_start", counting)
     memo: dict = {}
-    a = kn._memo_cone(memo, surface, positive, ignore, c0, starts_a, r0)
+    a = kn._fit_cone(surface, positive, ignore, c0, starts_a, r0, memo=memo)
     assert len(calls) == 4
-    b = kn._memo_cone(memo, surface, positive, ignore, c0, starts_b, r0)
+    b = kn._fit_cone(surface, positive, ignore, c0, starts_b, r0, memo=memo)
     assert len(calls) == 5  # only the changed start
     for got, starts in ((a, starts_a), (b, starts_b)):
-        want = real(surface, positive, ignore, c0, starts, r0)
+        want = kn._fit_cone(surface, positive, ignore, c0, starts, r0)  # no memo: every start fitted
         for g, w in zip(got, want):
             np.testing.assert_array_equal(g, w)

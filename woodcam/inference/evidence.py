@@ -551,8 +551,9 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     candidates : hypothesis families, from :data:`CANDIDATES`
     extra : further hypotheses to judge with the others (e.g. a planted one in a test)
     recipes : further hypotheses as recipes, name -> ``RingObservations -> field``, fitted on
-        the numbered rings here (e.g. the stem with its knots' bend,
-        :func:`woodcam.inference.knots.knot_bend_recipes`); a recipe that cannot fit is left out
+        the same rings as the others (the given years, else the radial numbering; e.g. the stem
+        with its knots' bend, :func:`woodcam.inference.knots.knot_bend_recipes`); a recipe that
+        cannot fit is left out
     refines : recipe name -> the hypothesis it refines (:attr:`Hypothesis.refines`; the knots'
         bend refines ``"stem"``)
     stem : the stem hypothesis' recipe (default :func:`stem_recipe`): one that remembers its
@@ -584,39 +585,37 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         raise WoodcamError(f"candidates must include 'radial' and come from {CANDIDATES}; got {list(candidates)}")
     with _one_blas_thread():
         radials, numbered = fit_radial_hypotheses(obs, size_mm, n_basins=n_basins, seed=seed)
-        if obs.labelled:
-            # Years given: every hypothesis is fitted and judged on them. The radial fit's
-            # renumbering of traces it misfits by over half a year is its own correction (each
-            # recipe makes its own: the stem's, each basin's), not a fact the others are judged
-            # on: a correct trace in rings bent round a knot, which no radial field can follow,
-            # was moved a year and the bend that fits it lost its fold (README, "Judged on the
-            # given years").
-            numbered = obs
+        # the rings every hypothesis is fitted and judged on. Years given: those. The radial
+        # fit's renumbering of traces it misfits by over half a year is its own correction (each
+        # recipe makes its own: the stem's, each basin's), not a fact the others are judged on:
+        # a correct trace in rings bent round a knot, which no radial field can follow, was moved
+        # a year and the bend that fits it lost its fold (README, "Judged on the given years").
+        rings = obs if obs.labelled else numbered
         hyps = [Hypothesis("radial" if i == 0 else f"radial basin {i + 1}", f, radial_recipe(f, seed, size_mm))
                 for i, f in enumerate(radials)]
         if "stem" in candidates:
             rec = stem_recipe(size_mm, seed) if stem is None else stem
             try:
-                hyps.append(Hypothesis("stem", rec(numbered), rec))
+                hyps.append(Hypothesis("stem", rec(rings), rec))
             except WoodcamError:  # too few rings for the stem: the others still compete
                 pass
         if "rbf" in candidates:
             rec = _rbf_recipe(EVIDENCE_RBF_POINTS)
-            hyps.append(Hypothesis("rbf", rec(numbered), rec))
+            hyps.append(Hypothesis("rbf", rec(rings), rec))
         if "residual" in candidates:
             rec = _residual_recipe(hyps[0].refit, EVIDENCE_RBF_POINTS)  # shares radial's fold fits
-            hyps.append(Hypothesis("radial + residual", rec(numbered), rec))
+            hyps.append(Hypothesis("radial + residual", rec(rings), rec))
         for name, rec in (recipes or {}).items():
             try:
-                hyps.append(Hypothesis(name, rec(numbered), rec, (refines or {}).get(name)))
+                hyps.append(Hypothesis(name, rec(rings), rec, (refines or {}).get(name)))
             except WoodcamError:  # too few rings for it: the others still compete
                 pass
         hyps += list(extra or [])
         predictions: dict = {}
         folds: dict | None = {} if residual else None
-        result = choose(hyps, holdout_evidence(hyps, numbered, seed, predictions, folds))
+        result = choose(hyps, holdout_evidence(hyps, rings, seed, predictions, folds))
         if residual:
-            result = add_residual(result, numbered, size_mm, folds, seed)
+            result = add_residual(result, rings, size_mm, folds, seed)
         if blend == "everywhere":
             result = blend_accepted(result)
         elif blend == "away_from_faces" and len(result.accepted) > 1:

@@ -146,31 +146,15 @@ def _cone_margin(points, c, u, rc, slope):
     return np.maximum(rc + slope * t, KNOT_CONE_MIN_RADIUS_MM) - d
 
 
-def _memo_cone(memo, surface, positive, ignore, c0, u0, r0, outward: bool = False):
-    """:func:`_fit_cone`, each starting direction's fit remembered in ``memo`` (a dict, or None)
-    by all of its arguments, the least cost kept (the first of equal costs, as
-    :func:`_fit_cone` keeps it: the same cone bit for bit). Per start because a knot end cut by
-    a block edge starts from three directions of its own samples and one down the stem's
-    years: only that one changes from fold to fold and round to round (seed 91841 block 7, six
-    faces: 101 cone fits of four starts each were 132 of the fit's 147 CPU-s)."""
-    if memo is None:
-        return _fit_cone(surface, positive, ignore, c0, u0, r0, outward)
-    head = (np.asarray(positive).tobytes(), np.asarray(ignore).tobytes(), np.asarray(c0, float).tobytes(),
-            float(r0), bool(outward))
-    best = None
-    for u_start in np.atleast_2d(np.asarray(u0, float)):
-        key = head + (u_start.tobytes(),)
-        if key not in memo:
-            memo[key] = _fit_cone(surface, positive, ignore, c0, u_start, r0, outward)
-        if best is None or memo[key][4] < best[4]:
-            best = memo[key]
-    return best
-
-
-def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False):
+def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False, memo: dict | None = None):
     """A knot's cone fitted to the knot masks of every face: ``(c (3,), u (3,), rc, slope,
-    cost)``; ``u0`` (3,) or (k, 3) starting directions, the fit of least cost kept; ``outward``:
-    each ``u0`` points away from the pith and the radius may not shrink along it.
+    cost)``; ``u0`` (3,) or (k, 3) starting directions, the fit of least cost kept (the first of
+    equal costs); ``outward``: each ``u0`` points away from the pith and the radius may not
+    shrink along it; ``memo``: a dict remembering each start's fit by all of its arguments.
+    Per start because a knot end cut by a block edge starts from three directions of its own
+    samples and one down the stem's years, and only that one changes from fold to fold and
+    round to round (seed 91841 block 7, six faces: 101 cone fits of four starts each were 132
+    of the fit's 147 CPU-s).
 
     A branch is a cone round its strand (seed 001/003: its diameter grows along it), so its
     exits are where that cone cuts the block's faces. The cone is fitted to the sampled face
@@ -185,8 +169,26 @@ def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False):
     cut by a block edge or split over two faces, and its bend and rings then land off the knot
     (dev seed 7777 block 2: the true strand takes the bend's cut planes from 26 to 94 % within
     1 mm; scipy has no cone fit, so it is written here)."""
-    from scipy.optimize import least_squares
+    head = (np.asarray(positive).tobytes(), np.asarray(ignore).tobytes(), np.asarray(c0, float).tobytes(),
+            float(r0), bool(outward))
+    problem, best = None, None
+    for u_start in np.atleast_2d(np.asarray(u0, float)):  # several starting directions
+        key = head + (u_start.tobytes(),)
+        fit = None if memo is None else memo.get(key)
+        if fit is None:
+            if problem is None:
+                problem = _cone_problem(surface, positive, ignore, c0, r0)
+            fit = _fit_cone_start(problem, c0, u_start, r0, outward)
+            if memo is not None:
+                memo[key] = fit
+        if best is None or fit[4] < best[4]:  # the least misfit wins
+            best = fit
+    return best
 
+
+def _cone_problem(surface, positive, ignore, c0, r0):
+    """``(P (m, 3), y (m,), w)``: the samples a cone started at ``c0`` with radius ``r0`` is
+    fitted to (:func:`_fit_cone`), their inside labels and their common weight."""
     pts, knot = surface
     keep = np.ones(len(pts), bool)
     keep[ignore] = False
@@ -198,7 +200,15 @@ def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False):
                    + KNOT_CONE_REACH_MM)
     near &= label.astype(bool) | ~knot
     P, y = pts[near], label[near]
-    w = 1.0 / np.sqrt(max(len(y), 1))  # every sample alike: the misfit is the area misclassified
+    return P, y, 1.0 / np.sqrt(max(len(y), 1))  # every sample alike: the misfit is the area misclassified
+
+
+def _fit_cone_start(problem, c0, u_start, r0, outward: bool):
+    """One start of :func:`_fit_cone`: ``(c, u, rc, slope, cost)`` from the line through ``c0``
+    along ``u_start (3,)`` with radius ``r0``, ``u`` in the starting sense."""
+    from scipy.optimize import least_squares
+
+    P, y, w = problem
 
     def residuals(x):
         u = x[3:6] / np.linalg.norm(x[3:6])
@@ -207,19 +217,15 @@ def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False):
         gauge = [(x[:3] - c0) @ u, np.linalg.norm(x[3:6]) - 1.0]  # c slides along u; |u| free
         return np.concatenate([w * (inside - y), gauge])
 
-    best = None
     # outward: the knot thickens away from the pith (seed 003: its radius grows with time)
     bounds = ([-np.inf] * 7 + [0.0], [np.inf] * 8) if outward else (-np.inf, np.inf)
-    for u_start in np.atleast_2d(u0):  # several starting directions: the least misfit wins
-        x0 = np.concatenate([c0, u_start, [r0, 0.0]])
-        fit = least_squares(residuals, x0, x_scale=np.array([5, 5, 5, 0.2, 0.2, 0.2, 1.0, 0.05]),
-                            max_nfev=KNOT_CONE_MAX_NFEV, bounds=bounds)
-        if best is None or fit.cost < best[0].cost:
-            best = fit, u_start
-    x, u_start = best[0].x, best[1]
+    x0 = np.concatenate([c0, u_start, [r0, 0.0]])
+    fit = least_squares(residuals, x0, x_scale=np.array([5, 5, 5, 0.2, 0.2, 0.2, 1.0, 0.05]),
+                        max_nfev=KNOT_CONE_MAX_NFEV, bounds=bounds)
+    x = fit.x
     u = x[3:6] / np.linalg.norm(x[3:6])
     sign = np.sign(u @ u_start) or 1.0  # keep the starting sense (exit to exit)
-    return x[:3], u * sign, float(x[6]), float(x[7]) * sign, float(best[0].cost)
+    return x[:3], u * sign, float(x[6]), float(x[7]) * sign, float(fit.cost)
 
 
 def _pith_first(stem, point_mm, u, length: float) -> bool:
@@ -327,14 +333,14 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
         u, cone = starts[0], None
         if surface is not None:  # the strand of the cone the masks show
             others = [k for k in range(len(exits)) if k not in group]
-            cone = _memo_cone(memo, surface, np.concatenate([exits[k]["pixels"] for k in group]),
-                              np.concatenate([exits[k]["pixels"] for k in others]) if others else np.zeros(0, int),
-                              c0, starts, float(np.mean([exits[k]["radius_mm"] for k in group])))
+            positive = np.concatenate([exits[k]["pixels"] for k in group])
+            ignore = np.concatenate([exits[k]["pixels"] for k in others]) if others else np.zeros(0, int)
+            cone = _fit_cone(surface, positive, ignore, c0, starts,
+                             float(np.mean([exits[k]["radius_mm"] for k in group])), memo=memo)
             c0, u = cone[0], cone[1]
             if _pith_first(stem, c0, u, length) == (cone[3] < 0):  # thinner away from the pith
-                cone = _memo_cone(memo, surface, np.concatenate([exits[k]["pixels"] for k in group]),
-                                 np.concatenate([exits[k]["pixels"] for k in others]) if others
-                                 else np.zeros(0, int), c0, -u if cone[3] < 0 else u, cone[2], outward=True)
+                cone = _fit_cone(surface, positive, ignore, c0, -u if cone[3] < 0 else u, cone[2], outward=True,
+                                 memo=memo)
                 c0, u = cone[0], cone[1]
         tt = (anchors - c0) @ u
         start, dist = c0 + tt.min() * u, float(np.ptp(tt))
@@ -512,8 +518,7 @@ def with_knots(block, stem, faces=None, cones: bool = False, exits: list[dict] |
     """``(field, strands)``: ``stem`` with the masked knots joined in, or ``stem`` unchanged.
     ``exits``: the block's :func:`knot_exits` where already found (their cone fits are
     remembered with them: the strands of a chosen field reuse the folds' cones)."""
-    if exits is None:
-        return with_knots(block, stem, faces, cones, knot_exits(block, faces))
+    exits = knot_exits(block, faces) if exits is None else exits
     strands = strands_from_exits(exits, stem, block.size_mm, cones)
     return (StemWithKnots(stem, strands) if strands else stem), strands
 
