@@ -138,3 +138,22 @@ def test_cone_fits_are_remembered_per_start_and_give_the_same_cone(corner_block,
         want = kn._fit_cone(surface, positive, ignore, c0, starts, r0)  # no memo: every start fitted
         for g, w in zip(got, want):
             np.testing.assert_array_equal(g, w)
+
+
+@pytest.mark.parametrize("x", [[0.3, 0.1, -0.4, 0.2, 0.9, 0.3, 2.5, 0.15],   # radius above its floor
+                               [1.0, 2.0, 0.0, 1.2, -0.1, 0.05, 0.5, -0.3]])  # partly at the floor
+def test_cone_jacobian_is_the_derivative_of_the_residuals(x):
+    """The cone fit's analytic Jacobian against central differences of its residuals (a sign or
+    a dropped term in any of c, v, rc, slope or the gauges moves it by far more than 1e-6)."""
+    from woodcam.inference.knots import _cone_jacobian, _cone_residuals
+
+    rng = np.random.default_rng(0)
+    P = rng.normal(size=(300, 3)) * 6.0
+    problem = (P, (rng.random(300) < 0.3).astype(float), 1.0 / np.sqrt(300))
+    c0, x = np.array([0.5, -0.2, 0.1]), np.asarray(x, float)
+    h = 1e-6
+    numeric = np.stack([(_cone_residuals(x + h * e, problem, c0) - _cone_residuals(x - h * e, problem, c0)) / (2 * h)
+                        for e in np.eye(8)], axis=1)
+    J = _cone_jacobian(x, problem, c0)
+    assert J.shape == (302, 8)
+    np.testing.assert_allclose(J, numeric, atol=1e-6)

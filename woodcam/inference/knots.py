@@ -137,15 +137,6 @@ def knot_exits(block, faces=None) -> list[dict]:
 _LINE_SAMPLES = 256
 
 
-def _cone_margin(points, c, u, rc, slope):
-    """``R(t) - d`` (mm, > 0 inside) of ``points (n, 3)`` for the cone round the line through
-    ``c`` along unit ``u`` with radius ``rc + slope t`` at ``t = (p - c) . u``."""
-    q = points - c
-    t = q @ u
-    d = np.linalg.norm(q - t[:, None] * u, axis=1)
-    return np.maximum(rc + slope * t, KNOT_CONE_MIN_RADIUS_MM) - d
-
-
 def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False, memo: dict | None = None):
     """A knot's cone fitted to the knot masks of every face: ``(c (3,), u (3,), rc, slope,
     cost)``; ``u0`` (3,) or (k, 3) starting directions, the fit of least cost kept (the first of
@@ -205,27 +196,74 @@ def _cone_problem(surface, positive, ignore, c0, r0):
 
 def _fit_cone_start(problem, c0, u_start, r0, outward: bool):
     """One start of :func:`_fit_cone`: ``(c, u, rc, slope, cost)`` from the line through ``c0``
-    along ``u_start (3,)`` with radius ``r0``, ``u`` in the starting sense."""
+    along ``u_start (3,)`` with radius ``r0``, ``u`` in the starting sense. The Jacobian is
+    analytic (:func:`_cone_residuals`): finite differences spent 8 more residual evaluations
+    per step, most of a knotted block's fit time."""
     from scipy.optimize import least_squares
-
-    P, y, w = problem
-
-    def residuals(x):
-        u = x[3:6] / np.linalg.norm(x[3:6])
-        m = _cone_margin(P, x[:3], u, x[6], x[7]) / KNOT_CONE_EDGE_MM
-        inside = 0.5 * (1.0 + np.tanh(0.5 * m))  # logistic, overflow-free
-        gauge = [(x[:3] - c0) @ u, np.linalg.norm(x[3:6]) - 1.0]  # c slides along u; |u| free
-        return np.concatenate([w * (inside - y), gauge])
 
     # outward: the knot thickens away from the pith (seed 003: its radius grows with time)
     bounds = ([-np.inf] * 7 + [0.0], [np.inf] * 8) if outward else (-np.inf, np.inf)
     x0 = np.concatenate([c0, u_start, [r0, 0.0]])
-    fit = least_squares(residuals, x0, x_scale=np.array([5, 5, 5, 0.2, 0.2, 0.2, 1.0, 0.05]),
+    fit = least_squares(_cone_residuals, x0, jac=_cone_jacobian, args=(problem, c0),
+                        x_scale=np.array([5, 5, 5, 0.2, 0.2, 0.2, 1.0, 0.05]),
                         max_nfev=KNOT_CONE_MAX_NFEV, bounds=bounds)
     x = fit.x
     u = x[3:6] / np.linalg.norm(x[3:6])
     sign = np.sign(u @ u_start) or 1.0  # keep the starting sense (exit to exit)
     return x[:3], u * sign, float(x[6]), float(x[7]) * sign, float(fit.cost)
+
+
+def _cone_terms(x, P):
+    """What the cone fit's residuals and Jacobian share at ``x = (c (3,), v (3,), rc, slope)``
+    (``u = v / |v|``): ``u, |v|, t (m,), d (m,), n (m, 3)`` (unit from the axis to each sample,
+    0 on it), ``active (m,)`` (the radius ``rc + slope t`` is above its floor
+    :data:`~woodcam.tolerances.KNOT_CONE_MIN_RADIUS_MM`) and the margin ``m (m,)``: that radius
+    less ``d``, in edge widths (> 0 inside)."""
+    nv = float(np.linalg.norm(x[3:6]))
+    u = x[3:6] / nv
+    q = P - x[:3]
+    t = q @ u
+    perp = q - t[:, None] * u
+    d = np.linalg.norm(perp, axis=1)
+    n = perp / np.where(d > 0, d, 1.0)[:, None]
+    radius = x[6] + x[7] * t
+    active = radius > KNOT_CONE_MIN_RADIUS_MM
+    m = (np.where(active, radius, KNOT_CONE_MIN_RADIUS_MM) - d) / KNOT_CONE_EDGE_MM
+    return u, nv, t, d, n, active, m
+
+
+def _cone_residuals(x, problem, c0):
+    """Residuals (m + 2,) of the cone fit (:func:`_fit_cone`): each sample's logistic
+    inside-ness minus its label, weighted, and two gauges (``c`` slides along ``u``; ``|v|`` = 1)."""
+    P, y, w = problem
+    u, nv, *_, m = _cone_terms(x, P)
+    inside = 0.5 * (1.0 + np.tanh(0.5 * m))  # logistic, overflow-free
+    return np.concatenate([w * (inside - y), [(x[:3] - c0) @ u, nv - 1.0]])
+
+
+def _cone_jacobian(x, problem, c0):
+    """Jacobian (m + 2, 8) of :func:`_cone_residuals`. With ``q = p - c``, ``t = q.u`` and
+    ``d = |q - t u|`` along the unit ``n``: ``dd/dc = -n``, ``dd/dv = -t n / |v|``,
+    ``dt/dc = -u``, ``dt/dv = d n / |v|`` (``n`` is normal to ``u``), so the margin
+    ``(rc + slope t - d) / edge`` moves by ``(n - a slope u) / edge`` with ``c``, by
+    ``n (t + a slope d) / (|v| edge)`` with ``v``, by ``a / edge`` with ``rc`` and ``a t / edge``
+    with ``slope`` (``a``: the radius is above its floor)."""
+    P, y, w = problem
+    u, nv, t, d, n, active, m = _cone_terms(x, P)
+    a = active.astype(float)
+    dm = np.empty((len(P), 8))
+    dm[:, :3] = n - (a * x[7])[:, None] * u
+    dm[:, 3:6] = n * ((t + a * x[7] * d) / nv)[:, None]
+    dm[:, 6] = a
+    dm[:, 7] = a * t
+    th = np.tanh(0.5 * m)
+    J = np.zeros((len(P) + 2, 8))
+    J[:-2] = dm * (w * 0.25 * (1.0 - th * th) / KNOT_CONE_EDGE_MM)[:, None]
+    proj = (np.eye(3) - np.outer(u, u)) / nv  # du/dv
+    J[-2, :3] = u
+    J[-2, 3:6] = (x[:3] - c0) @ proj
+    J[-1, 3:6] = u
+    return J
 
 
 def _pith_first(stem, point_mm, u, length: float) -> bool:
