@@ -30,8 +30,10 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: default, competing while the evidence keeps its stem; 10: knot strands from the cones fitted to
 #: the masks by default, and a refinement chosen only when it beats every plain hypothesis by more
 #: than the accept margin; 11: year-labelled rings fitted and judged on the years given, not on
-#: the radial fit's renumbering of them).
-FIT_VERSION = 11
+#: the radial fit's renumbering of them; 12: knot cones fitted with their analytic Jacobian, the
+#: same choices and scores on the dev and validation blocks but cones that differ within the
+#: fit's tolerance).
+FIT_VERSION = 12
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
