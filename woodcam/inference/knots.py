@@ -196,9 +196,9 @@ def _cone_problem(surface, positive, ignore, c0, r0):
 
 def _fit_cone_start(problem, c0, u_start, r0, outward: bool):
     """One start of :func:`_fit_cone`: ``(c, u, rc, slope, cost)`` from the line through ``c0``
-    along ``u_start (3,)`` with radius ``r0``, ``u`` in the starting sense. The Jacobian is
-    analytic (:func:`_cone_residuals`): finite differences spent 8 more residual evaluations
-    per step, most of a knotted block's fit time."""
+    along ``u_start (3,)`` with radius ``r0``, ``u`` in the starting sense. Residuals
+    :func:`_cone_residuals`, Jacobian :func:`_cone_jacobian` (analytic: 2-point differences
+    spent 8 more residual evaluations per step; seed 91841 block 7 33.9 -> 21.6 CPU-s)."""
     from scipy.optimize import least_squares
 
     # outward: the knot thickens away from the pith (seed 003: its radius grows with time)
