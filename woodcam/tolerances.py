@@ -416,6 +416,13 @@ KNOT_CONE_REACH_MM = 8.0
 #: seed 7777 settle within ~30.
 KNOT_CONE_MAX_NFEV = 40
 
+#: A cone fit's start within this angle (degrees) of a start already fitted to the same masks
+#: takes that fit (:func:`woodcam.inference.knots._fit_cone`): the start down the stem's years
+#: moves by a few degrees between folds and rounds, and on seed 91841 block 7 (six faces) its
+#: 29 starts, within 5.6 degrees of each other, ended in one cone where the fit converged (0.0
+#: degrees apart) and lost to a start along the exits' principal axes where it did not.
+KNOT_CONE_START_REUSE_DEG = 8.0
+
 #: Smallest knot radius (mm) a fitted cone gives anywhere along its strand (a branch at the
 #: pith is a few mm thick; seed 001's logs start at 2-6 mm).
 KNOT_CONE_MIN_RADIUS_MM = 1.0

@@ -106,8 +106,9 @@ def test_cone_fits_are_remembered_per_start_and_give_the_same_cone(corner_block,
     """A knot end cut by an edge starts its cone from its samples' three axes and one direction
     down the stem's years, the only one that changes between folds: the memo keeps each start's
     fit, so a second stem refits one start, not four, and the cone is the all-starts fit's bit
-    for bit. Checked by breaking it: remembered by the whole set of starts, the second call
-    refits all four and this test fails."""
+    for bit; a start within KNOT_CONE_START_REUSE_DEG of a fitted one takes its fit. Checked by
+    breaking it: remembered by the whole set of starts, the second call refits all four and
+    this test fails; with no reuse angle the third call refits."""
     import woodcam.inference.knots as kn
 
     exits = knot_exits(corner_block)
@@ -118,8 +119,19 @@ def test_cone_fits_are_remembered_per_start_and_give_the_same_cone(corner_block,
     samples = surface[0][positive]
     c0, r0 = samples.mean(axis=0), float(np.mean([exits[k]["radius_mm"] for k in end]))
     axes = np.linalg.svd(samples - c0, full_matrices=False)[2]
-    starts_a = np.vstack([axes, [[0.6, 0.8, 0.0]]])
-    starts_b = np.vstack([axes, [[0.8, 0.6, 0.0]]])
+    from scipy.spatial.transform import Rotation
+
+    from woodcam.tolerances import KNOT_CONE_START_REUSE_DEG
+
+    # the stem's start: 45 degrees from every axis; then turned 30 degrees, then 3 degrees less
+    stem_start = axes.sum(axis=0) / np.sqrt(3.0)
+    turn = np.cross(stem_start, axes[0])
+    turn /= np.linalg.norm(turn)
+    turned = Rotation.from_rotvec(np.radians(30.0) * turn).apply(stem_start)
+    nudged = Rotation.from_rotvec(np.radians(3.0) * turn).apply(stem_start)
+    starts_a, starts_b, starts_c = (np.vstack([axes, [u]]) for u in (stem_start, turned, nudged))
+    angle = np.degrees(np.arccos(np.clip(np.abs(np.vstack([axes, [stem_start]]) @ turned), -1.0, 1.0)))
+    assert angle.min() > 2 * KNOT_CONE_START_REUSE_DEG  # turned: far from every fitted start
 
     calls = []
     real = kn._fit_cone_start
@@ -134,7 +146,9 @@ def test_cone_fits_are_remembered_per_start_and_give_the_same_cone(corner_block,
     assert len(calls) == 4
     b = kn._fit_cone(surface, positive, ignore, c0, starts_b, r0, memo=memo)
     assert len(calls) == 5  # only the changed start
-    for got, starts in ((a, starts_a), (b, starts_b)):
+    c = kn._fit_cone(surface, positive, ignore, c0, starts_c, r0, memo=memo)
+    assert len(calls) == 5  # 3 degrees off a fitted start: that fit
+    for got, starts in ((a, starts_a), (b, starts_b), (c, starts_a)):
         want = kn._fit_cone(surface, positive, ignore, c0, starts, r0)  # no memo: every start fitted
         for g, w in zip(got, want):
             np.testing.assert_array_equal(g, w)

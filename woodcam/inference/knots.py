@@ -42,7 +42,7 @@ from ..fields.knots import KnotParams
 from ..frames import FACE_NORMAL, pixel_to_block
 from ..tolerances import (DEAD_KNOT_BANDS_MM, DEAD_KNOT_MIN_OUTLINED, DEAD_KNOT_SECTORS, KNOT_BEND_MAX_BEFORE_PITH,
                           KNOT_BEND_ROUNDS, KNOT_CONE_EDGE_MM, KNOT_CONE_MAX_NFEV, KNOT_CONE_MIN_RADIUS_MM,
-                          KNOT_CONE_REACH_MM, KNOT_CONE_SAMPLE_MM, KNOT_END_TOUCH_MM, KNOT_MIN_AREA_PX, KNOT_MIN_AREA_SHARE,
+                          KNOT_CONE_REACH_MM, KNOT_CONE_SAMPLE_MM, KNOT_CONE_START_REUSE_DEG, KNOT_END_TOUCH_MM, KNOT_MIN_AREA_PX, KNOT_MIN_AREA_SHARE,
                           KNOT_MIN_ENTRY_COS, KNOT_PAIR_MIN_ANGLE_DEG, KNOT_PITH_YEARS)
 
 if TYPE_CHECKING:
@@ -141,11 +141,13 @@ def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False, memo
     """A knot's cone fitted to the knot masks of every face: ``(c (3,), u (3,), rc, slope,
     cost)``; ``u0`` (3,) or (k, 3) starting directions, the fit of least cost kept (the first of
     equal costs); ``outward``: each ``u0`` points away from the pith and the radius may not
-    shrink along it; ``memo``: a dict remembering each start's fit by all of its arguments.
-    Per start because a knot end cut by a block edge starts from three directions of its own
-    samples and one down the stem's years, and only that one changes from fold to fold and
-    round to round (seed 91841 block 7, six faces: 101 cone fits of four starts each were 132
-    of the fit's 147 CPU-s).
+    shrink along it; ``memo``: a dict remembering each start's fit by the other arguments; a
+    start within :data:`~woodcam.tolerances.KNOT_CONE_START_REUSE_DEG` of one already fitted
+    takes that fit (the first such). Per start because a knot end cut by a block edge starts
+    from three directions of its own samples and one down the stem's years, and only that one
+    changes from fold to fold and round to round, by a few degrees (seed 91841 block 7, six
+    faces: 101 cone fits of four starts each were 132 of the fit's 147 CPU-s; then 29 starts
+    down the stem's years within 5.6 degrees of each other were 9 of its 21 CPU-s).
 
     A branch is a cone round its strand (seed 001/003: its diameter grows along it), so its
     exits are where that cone cuts the block's faces. The cone is fitted to the sampled face
@@ -162,16 +164,18 @@ def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False, memo
     1 mm; scipy has no cone fit, so it is written here)."""
     head = (np.asarray(positive).tobytes(), np.asarray(ignore).tobytes(), np.asarray(c0, float).tobytes(),
             float(r0), bool(outward))
+    done = [] if memo is None else memo.setdefault(head, [])  # (start (3,), fit) of this problem
+    cos_near = np.cos(np.radians(KNOT_CONE_START_REUSE_DEG))
     problem, best = None, None
     for u_start in np.atleast_2d(np.asarray(u0, float)):  # several starting directions
-        key = head + (u_start.tobytes(),)
-        fit = None if memo is None else memo.get(key)
+        near = [f for u, f in done if u @ u_start >= cos_near * np.linalg.norm(u) * np.linalg.norm(u_start)]
+        fit = near[0] if near else None
         if fit is None:
             if problem is None:
                 problem = _cone_problem(surface, positive, ignore, c0, r0)
             fit = _fit_cone_start(problem, c0, u_start, r0, outward)
             if memo is not None:
-                memo[key] = fit
+                done.append((u_start.copy(), fit))
         if best is None or fit[4] < best[4]:  # the least misfit wins
             best = fit
     return best
