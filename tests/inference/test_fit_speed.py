@@ -90,6 +90,22 @@ def _solve_ref(self, pith, d):
 _solve_now = radial._Problem.solve
 
 
+def _ring_spacing_ref(obs):
+    from scipy.spatial import cKDTree
+
+    dists = []
+    for f in np.unique(obs.face):
+        on = obs.face == f
+        pts, grp = obs.points_mm[on], obs.group[on]
+        for g in np.unique(grp):
+            mine = grp == g
+            if mine.all():
+                continue
+            dd, _ = cKDTree(pts[~mine]).query(pts[mine][:: max(1, mine.sum() // 20)])
+            dists.append(dd)
+    return float(np.median(np.concatenate(dists)))
+
+
 @contextlib.contextmanager
 def straightforward(monkeypatch):
     """Every optimised piece replaced by the code it replaced (caches never hit)."""
@@ -106,6 +122,7 @@ def straightforward(monkeypatch):
         m.setattr(stem._StemProblem, "design", lambda self, curve: _stem_design_ref(
             self.points, self.centre, self.frame, self.L, curve, self.K, self.M, self.P, self.rho0))
         m.setattr(rbf, "_thin_plate_field", lambda r: r)
+        m.setattr(radial, "_ring_spacing", _ring_spacing_ref)
         yield
 
 
@@ -153,6 +170,27 @@ def test_thin_plate_field_matches_scipys_evaluation():
     np.testing.assert_allclose(fast(x), scipy_rbf(x), rtol=0, atol=1e-9)
     other = RBFInterpolator(centres, values, kernel="cubic")
     assert rbf._thin_plate_field(other) is other  # only the thin-plate spline has the fast path
+
+
+@pytest.mark.parametrize("step_mm", [0.3, 0.004])  # traced as usual; so dense that 32 neighbours are one ring
+def test_ring_spacing_is_the_per_ring_trees(step_mm):
+    """One tree per face asked for 32 neighbours gives the per-ring trees' median bit for bit,
+    also where every neighbour of a point is its own ring and it must ask the other rings."""
+    from woodcam.inference.observations import RingObservations
+
+    rng = np.random.default_rng(3)
+    pts, grp, face = [], [], []
+    for f in range(2):  # two faces of arcs 2.5 mm apart, each ring in two pieces, one lone ring
+        for r in range(4 if f == 0 else 1):
+            for piece in range(2):
+                a = np.arange(piece * 0.8, piece * 0.8 + 0.7, step_mm / (20.0 + 2.5 * r))
+                xy = (20.0 + 2.5 * r) * np.c_[np.cos(a), np.sin(a)] + rng.normal(0, 0.05, (len(a), 2))
+                pts.append(np.c_[xy, np.full(len(a), 10.0 * f)])
+                grp.append(np.full(len(a), len(grp)))
+                face.append(np.full(len(a), f))
+    p = np.concatenate(pts)
+    obs = RingObservations(p, np.full(len(p), np.nan), np.concatenate(grp), np.concatenate(face))
+    assert radial._ring_spacing(obs) == _ring_spacing_ref(obs)
 
 
 # -- the whole fit ----------------------------------------------------------------------------
