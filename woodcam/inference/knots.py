@@ -168,8 +168,8 @@ def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False, memo
     cos_near = np.cos(np.radians(KNOT_CONE_START_REUSE_DEG))
     problem, best = None, None
     for u_start in np.atleast_2d(np.asarray(u0, float)):  # several starting directions
-        near = [f for u, f in done if u @ u_start >= cos_near * np.linalg.norm(u) * np.linalg.norm(u_start)]
-        fit = near[0] if near else None
+        fit = next((f for u, f in done if u @ u_start >= cos_near * np.linalg.norm(u) * np.linalg.norm(u_start)),
+                   None)
         if fit is None:
             if problem is None:
                 problem = _cone_problem(surface, positive, ignore, c0, r0)
@@ -208,7 +208,14 @@ def _fit_cone_start(problem, c0, u_start, r0, outward: bool):
     # outward: the knot thickens away from the pith (seed 003: its radius grows with time)
     bounds = ([-np.inf] * 7 + [0.0], [np.inf] * 8) if outward else (-np.inf, np.inf)
     x0 = np.concatenate([c0, u_start, [r0, 0.0]])
-    fit = least_squares(_cone_residuals, x0, jac=_cone_jacobian, args=(problem, c0),
+    last: dict = {}
+
+    def terms(x):  # least_squares asks for the Jacobian where it just took the residuals
+        if "x" not in last or not np.array_equal(last["x"], x):
+            last.update(x=x.copy(), terms=_cone_terms(x, problem[0]))
+        return last["terms"]
+
+    fit = least_squares(_cone_residuals, x0, jac=_cone_jacobian, args=(problem, c0, terms),
                         x_scale=np.array([5, 5, 5, 0.2, 0.2, 0.2, 1.0, 0.05]),
                         max_nfev=KNOT_CONE_MAX_NFEV, bounds=bounds)
     x = fit.x
@@ -236,24 +243,25 @@ def _cone_terms(x, P):
     return u, nv, t, d, n, active, m
 
 
-def _cone_residuals(x, problem, c0):
+def _cone_residuals(x, problem, c0, terms=None):
     """Residuals (m + 2,) of the cone fit (:func:`_fit_cone`): each sample's logistic
-    inside-ness minus its label, weighted, and two gauges (``c`` slides along ``u``; ``|v|`` = 1)."""
+    inside-ness minus its label, weighted, and two gauges (``c`` slides along ``u``; ``|v|`` = 1).
+    ``terms``: ``x -> _cone_terms(x, P)``, remembered by the caller (default: computed)."""
     P, y, w = problem
-    u, nv, *_, m = _cone_terms(x, P)
+    u, nv, *_, m = _cone_terms(x, P) if terms is None else terms(x)
     inside = 0.5 * (1.0 + np.tanh(0.5 * m))  # logistic, overflow-free
     return np.concatenate([w * (inside - y), [(x[:3] - c0) @ u, nv - 1.0]])
 
 
-def _cone_jacobian(x, problem, c0):
+def _cone_jacobian(x, problem, c0, terms=None):
     """Jacobian (m + 2, 8) of :func:`_cone_residuals`. With ``q = p - c``, ``t = q.u`` and
     ``d = |q - t u|`` along the unit ``n``: ``dd/dc = -n``, ``dd/dv = -t n / |v|``,
     ``dt/dc = -u``, ``dt/dv = d n / |v|`` (``n`` is normal to ``u``), so the margin
     ``(rc + slope t - d) / edge`` moves by ``(n - a slope u) / edge`` with ``c``, by
     ``n (t + a slope d) / (|v| edge)`` with ``v``, by ``a / edge`` with ``rc`` and ``a t / edge``
-    with ``slope`` (``a``: the radius is above its floor)."""
+    with ``slope`` (``a``: the radius is above its floor). ``terms`` as :func:`_cone_residuals`."""
     P, y, w = problem
-    u, nv, t, d, n, active, m = _cone_terms(x, P)
+    u, nv, t, d, n, active, m = _cone_terms(x, P) if terms is None else terms(x)
     a = active.astype(float)
     dm = np.empty((len(P), 8))
     dm[:, :3] = n - (a * x[7])[:, None] * u

@@ -568,9 +568,9 @@ def _ring_spacing(obs: RingObservations) -> float:
         other = grp[ii] != grp[ask][:, None]
         found = other.any(axis=1)
         dists.append(dd[found, np.argmax(other[found], axis=1)])
-        for g in np.unique(grp[ask[~found]]):  # crowded by its own ring: ask the other rings
-            mine = ask[~found][grp[ask[~found]] == g]
-            dists.append(cKDTree(pts[grp != g]).query(pts[mine])[0])
+        crowded = ask[~found]  # every neighbour its own ring's: ask the other rings
+        for g in np.unique(grp[crowded]):
+            dists.append(cKDTree(pts[grp != g]).query(pts[crowded[grp[crowded] == g]])[0])
     if not dists:
         raise WoodcamError(
             "numbering unlabelled rings needs at least two rings on one face to measure the ring "
