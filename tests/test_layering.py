@@ -17,6 +17,7 @@ LAYERS: dict[str, int] = {
     "errors": 0, "tolerances": 0, "_types": 0, "units": 0, "limits": 1, "_atomic": 1, "_cache": 2,
     "_readers": 1,                     # strict JSON of untrusted files (errors only)
     "_threads": 1,                     # BLAS thread limits for small linear algebra
+    "_parallel": 1,                    # one fit on a machine's cores: forked pieces
     "_xatlas_worker": 1,               # xatlas in a worker process (numpy + xatlas only)
     "_raster": 1,                      # numba rasteriser of the bake (numpy + numba only)
     "frames": 3,                       # block frame, faces, pixel <-> block

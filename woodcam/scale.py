@@ -68,7 +68,8 @@ CONNECT_TIMEOUT_S = 10.0
 #: Environment variables that cap the thread pools of BLAS, OpenMP (torch), numba and numexpr;
 #: set in each worker before those libraries load, and enforced at run time by threadpoolctl.
 _THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
-                "VECLIB_MAXIMUM_THREADS", "NUMBA_NUM_THREADS", "NUMEXPR_NUM_THREADS")
+                "VECLIB_MAXIMUM_THREADS", "NUMBA_NUM_THREADS", "NUMEXPR_NUM_THREADS",
+                "WOODCAM_WORKERS")  # the last: an evidence fit's forked pieces (woodcam._parallel)
 
 
 @dataclass(frozen=True)

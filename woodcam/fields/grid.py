@@ -88,11 +88,13 @@ class GridField:
 
     @classmethod
     def bake(cls, field, lo_mm, hi_mm, spacing_mm: float = 2.0, *, margin_nodes: int = 2,
-             interpolation: Interpolation = "cubic") -> GridField:
+             interpolation: Interpolation = "cubic", workers: int = 1) -> GridField:
         """Sample ``field`` on a grid covering the box ``[lo_mm, hi_mm]`` plus a margin.
 
         The margin keeps the spline's border handling away from the box, so interpolation
-        inside the box is as good as in the middle of the grid.
+        inside the box is as good as in the middle of the grid. ``workers > 1``: a share of the
+        nodes in a forked process, for a field safe to use after a fork
+        (:func:`~woodcam.fields.base.evaluate`).
         """
         lo, hi = np.asarray(lo_mm, float), np.asarray(hi_mm, float)
         if lo.shape != (3,) or hi.shape != (3,) or np.any(hi <= lo):
@@ -108,7 +110,7 @@ class GridField:
         origin = lo - margin_nodes * spacing_mm
         axes = [origin[i] + spacing_mm * np.arange(n[i]) for i in range(3)]
         pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-        years = evaluate(field, pts).reshape(tuple(n))
+        years = evaluate(field, pts, workers=workers).reshape(tuple(n))
         axis = tuple(np.asarray(getattr(field, "axis", (0.0, 0.0, 1.0)), float))
         return cls(years, tuple(origin), (spacing_mm,) * 3, interpolation, axis)
 

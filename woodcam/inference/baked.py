@@ -15,11 +15,14 @@ from ..frames import check_size
 from ..tolerances import BAKE_MARGIN_MM, BAKE_SPACING_MM
 
 
-def bake(field, size_mm, spacing_mm: float = BAKE_SPACING_MM, margin_mm: float = BAKE_MARGIN_MM) -> GridField:
+def bake(field, size_mm, spacing_mm: float = BAKE_SPACING_MM, margin_mm: float = BAKE_MARGIN_MM,
+         workers: int = 1) -> GridField:
     """Sample ``field`` (``(n, 3) mm -> (n,) years``) on a grid over the block ``[0, size_mm]``.
 
     The grid has nodes every ``spacing_mm`` and at least ``margin_mm`` beyond every face, so its
-    cubic splines are not at their border on the block's faces.
+    cubic splines are not at their border on the block's faces. ``workers > 1``: a share of
+    the nodes in a forked process, for a field safe to use after a fork
+    (:func:`woodcam.fields.base.evaluate`).
     """
     size = check_size(size_mm)
     if not spacing_mm > 0:
@@ -28,4 +31,4 @@ def bake(field, size_mm, spacing_mm: float = BAKE_SPACING_MM, margin_mm: float =
 
     with one_blas_thread():  # the fields' products are small per batch: BLAS threads only spin
         return GridField.bake(field, (0.0, 0.0, 0.0), tuple(size), spacing_mm,
-                              margin_nodes=max(1, math.ceil(margin_mm / spacing_mm)))
+                              margin_nodes=max(1, math.ceil(margin_mm / spacing_mm)), workers=workers)

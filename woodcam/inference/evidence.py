@@ -50,6 +50,7 @@ import numpy as np
 
 from .._types import ArrayLike
 
+from .._parallel import beside, fit_workers
 from ..errors import WoodcamError, WoodcamWarning
 from ..fields.base import central_gradient
 from ..fields.residual import ResidualField
@@ -96,12 +97,17 @@ class Hypothesis:
     refines : name of the hypothesis this one adds a term to (the knots' ring bend refines
         ``"stem"``), or None; a refinement is chosen only while the evidence keeps its base
         and it beats every plain hypothesis clearly (:func:`choose`)
+    alone : True when ``refit`` reads and writes no state that another hypothesis' refit or a
+        later step shares (the radial basins, the RBF, the residual on the first basin, which
+        only reads that basin's fold fit): :func:`holdout_evidence` may then refit it in a
+        forked process beside the others (:mod:`woodcam._parallel`)
     """
 
     name: str
     field: Callable
     refit: Callable
     refines: str | None = None
+    alone: bool = False
 
 
 @dataclass
@@ -177,7 +183,8 @@ def _held_points(obs: RingObservations, held: np.ndarray, rng: np.random.Generat
 
 
 def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: int = 0,
-                     predictions: dict | None = None, fold_fields: dict | None = None) -> dict:
+                     predictions: dict | None = None, fold_fields: dict | None = None,
+                     workers: int = 1) -> dict:
     """Leave-one-face-out score of every hypothesis on every face with enough ring points.
 
     predictions : optional dict, filled with ``(name, face name) -> (g (k,), grad (k, 3),
@@ -185,6 +192,10 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
         their years (what a blend of the hypotheses is scored from, :func:`_blend_evidence`).
     fold_fields : optional dict, filled with ``(name, face name) -> field``: each fold's fit
         (what the residual is refitted on in each fold, :func:`residual_evidence`).
+    workers : with 2 or more, the hypotheses marked :attr:`Hypothesis.alone` are refitted on
+        every fold in a forked process while this one refits the others (which share state:
+        the stem's fold fit, the knots' cone fits), each group fold by fold as in the serial
+        order; the same scores, predictions and fold fields bit for bit.
 
     Returns name -> {face name -> {"score": percent, "share_2mm": percent}}; empty dicts when
     fewer than two faces have rings.
@@ -194,23 +205,44 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
     if len(faces) < 2:
         return out
     rng = np.random.default_rng(seed)
+    folds = []  # (face, the other faces' rings, held-out points, their years): rng in face order
     for f in faces:
         held = obs.face == f
-        rest = obs.subset(~held)
         idx = _held_points(obs, held, rng)
-        pts, yrs = obs.points_mm[idx], obs.years[idx]
+        folds.append((f, obs.subset(~held), obs.points_mm[idx], obs.years[idx]))
+    keep_fields = fold_fields is not None
+
+    def refit_all(hyps) -> dict:
+        res = {}
+        for f, rest, pts, yrs in folds:
+            for h in hyps:
+                fitted = pred = None
+                try:
+                    fitted = h.refit(rest)
+                    g, grad = central_gradient(fitted, pts, _GRAD_STEP_MM)
+                    err = _error_mm(g, grad, yrs)
+                    pred = (g, grad, yrs)
+                except (WoodcamError, np.linalg.LinAlgError, ValueError):
+                    err = np.full(len(pts), np.inf)  # a recipe that cannot refit has no evidence
+                res[(h.name, f)] = ({"score": face_score(err), "share_2mm": float(100 * np.mean(err <= 2.0))},
+                                    pred, fitted if keep_fields else None)
+        return res
+
+    away = [h for h in hypotheses if h.alone] if workers > 1 else []
+    here = [h for h in hypotheses if not (workers > 1 and h.alone)]
+    if away and here:
+        res_away, res = beside(lambda: refit_all(away), lambda: refit_all(here))
+        res.update(res_away)
+    else:
+        res = refit_all(hypotheses)
+    for f, *_ in folds:  # filled in the serial order
         for h in hypotheses:
-            try:
-                fitted = h.refit(rest)
-                if fold_fields is not None:
-                    fold_fields[(h.name, FACES[f])] = fitted
-                g, grad = central_gradient(fitted, pts, _GRAD_STEP_MM)
-                err = _error_mm(g, grad, yrs)
-                if predictions is not None:
-                    predictions[(h.name, FACES[f])] = (g, grad, yrs)
-            except (WoodcamError, np.linalg.LinAlgError, ValueError):
-                err = np.full(len(pts), np.inf)  # a recipe that cannot refit has no evidence
-            out[h.name][FACES[f]] = {"score": face_score(err), "share_2mm": float(100 * np.mean(err <= 2.0))}
+            score, pred, fitted = res[(h.name, f)]
+            if fitted is not None:
+                fold_fields[(h.name, FACES[f])] = fitted
+            if predictions is not None and pred is not None:
+                predictions[(h.name, FACES[f])] = pred
+            out[h.name][FACES[f]] = score
     return out
 
 
@@ -540,7 +572,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                  candidates: tuple[str, ...] = CANDIDATES, seed: int = 0, extra: list[Hypothesis] | None = None,
                  warn: bool = True, recipes: dict[str, Callable] | None = None,
                  stem: Callable | None = None, refines: dict[str, str] | None = None,
-                 blend: BlendMode = "none", residual: bool = False) -> EvidenceFit:
+                 blend: BlendMode = "none", residual: bool = False, workers: int | None = None) -> EvidenceFit:
     """Fit the hypotheses and choose by leave-one-face-out evidence (module docstring).
 
     Parameters
@@ -570,6 +602,9 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         chosen field, kept only where refitted in each fold it raises the held-out faces' score
         (:func:`residual_evidence`); applied before an ``"away_from_faces"`` blend, refused with
         ``"everywhere"`` (the mean of the hypotheses replaces the field it was judged on)
+    workers : processes the radial pith search and the held-out refits may use
+        (:mod:`woodcam._parallel`; default :func:`~woodcam._parallel.fit_workers`); the result
+        is the same bit for bit
 
     Returns
     -------
@@ -583,16 +618,17 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     bad = [c for c in candidates if c not in CANDIDATES]
     if bad or "radial" not in candidates:
         raise WoodcamError(f"candidates must include 'radial' and come from {CANDIDATES}; got {list(candidates)}")
+    workers = fit_workers() if workers is None else int(workers)
     with _one_blas_thread():
-        radials, numbered = fit_radial_hypotheses(obs, size_mm, n_basins=n_basins, seed=seed)
+        radials, numbered = fit_radial_hypotheses(obs, size_mm, n_basins=n_basins, seed=seed, workers=workers)
         # the rings every hypothesis is fitted and judged on. Years given: those. The radial
         # fit's renumbering of traces it misfits by over half a year is its own correction (each
         # recipe makes its own: the stem's, each basin's), not a fact the others are judged on:
         # a correct trace in rings bent round a knot, which no radial field can follow, was moved
         # a year and the bend that fits it lost its fold (README, "Judged on the given years").
         rings = obs if obs.labelled else numbered
-        hyps = [Hypothesis("radial" if i == 0 else f"radial basin {i + 1}", f, radial_recipe(f, seed, size_mm))
-                for i, f in enumerate(radials)]
+        hyps = [Hypothesis("radial" if i == 0 else f"radial basin {i + 1}", f, radial_recipe(f, seed, size_mm),
+                           alone=True) for i, f in enumerate(radials)]
         if "stem" in candidates:
             rec = stem_recipe(size_mm, seed) if stem is None else stem
             try:
@@ -601,10 +637,10 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                 pass
         if "rbf" in candidates:
             rec = _rbf_recipe(EVIDENCE_RBF_POINTS)
-            hyps.append(Hypothesis("rbf", rec(rings), rec))
+            hyps.append(Hypothesis("rbf", rec(rings), rec, alone=True))
         if "residual" in candidates:
             rec = _residual_recipe(hyps[0].refit, EVIDENCE_RBF_POINTS)  # shares radial's fold fits
-            hyps.append(Hypothesis("radial + residual", rec(rings), rec))
+            hyps.append(Hypothesis("radial + residual", rec(rings), rec, alone=True))
         for name, rec in (recipes or {}).items():
             try:
                 hyps.append(Hypothesis(name, rec(rings), rec, (refines or {}).get(name)))
@@ -613,7 +649,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         hyps += list(extra or [])
         predictions: dict = {}
         folds: dict | None = {} if residual else None
-        result = choose(hyps, holdout_evidence(hyps, rings, seed, predictions, folds))
+        result = choose(hyps, holdout_evidence(hyps, rings, seed, predictions, folds, workers))
         if residual:
             result = add_residual(result, rings, size_mm, folds, seed)
         if blend == "everywhere":
@@ -662,24 +698,26 @@ def confidence(uncertainty: np.ndarray) -> np.ndarray:
     return np.exp(-(np.asarray(uncertainty, float) / 0.5) ** 2)
 
 
-def bake_evidence(ev: EvidenceFit, size_mm, faces, strands=()):
+def bake_evidence(ev: EvidenceFit, size_mm, faces, strands=(), workers: int | None = None):
     """Bake the chosen field to a :class:`~woodcam.fields.GridField` carrying the per-node
     :func:`uncertainty_years` and the evidence (chosen hypothesis, scores, flags) in ``meta``.
 
     The hypotheses' spread is sampled on a grid of :data:`EVIDENCE_SPREAD_SPACING_MM` and
     interpolated to the bake nodes (it is smooth; the RBF hypotheses are slow to evaluate).
+    ``workers``: processes the grid is evaluated in (default :func:`~woodcam._parallel.fit_workers`;
+    the same grid bit for bit).
     """
     with _one_blas_thread():  # many small products: BLAS threads only spin on a busy machine
-        return _bake_evidence(ev, size_mm, faces, strands)
+        return _bake_evidence(ev, size_mm, faces, strands, fit_workers() if workers is None else int(workers))
 
 
-def _bake_evidence(ev: EvidenceFit, size_mm, faces, strands):
+def _bake_evidence(ev: EvidenceFit, size_mm, faces, strands, workers: int):
     from scipy import ndimage
 
     from ..fields.grid import GridField
     from .baked import bake
 
-    grid = bake(ev.field, size_mm)
+    grid = bake(ev.field, size_mm, workers=workers)
     shape = grid.years.shape
     axes = [grid.origin_mm[i] + grid.spacing_mm[i] * np.arange(shape[i]) for i in range(3)]
     nodes = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)

@@ -40,6 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._parallel import map_processes
 from ..errors import WoodcamError
 from ..fields.base import check_points
 from ..tolerances import NUMBERING_STEP_MARGIN, RING_HISTORY_MIN_STEP, RING_HISTORY_PRIOR_POINTS, RING_HISTORY_ROUNDS
@@ -310,12 +311,14 @@ def _refine(prob: _Problem, pith, d, max_nfev: int):
 def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: float,
                        n_directions: int = 120, n_search: int = 600, n_fit: int = 2000,
                        n_starts: int = 6, coarse_K: int = 2, n_final: int = 2, n_grid_directions: int = 20,
-                       pith_grid: int = 9, seed: int = 0, n_basins: int = 0):
+                       pith_grid: int = 9, seed: int = 0, n_basins: int = 0, workers: int = 1):
     """Search + refine the pith axis; returns ``(RadialField, levels or None, group ids used)``.
 
     n_basins : 0 returns the best fit as above; ``n >= 1`` returns a list of such triples, the
         ``n`` best distinct axis basins finished at full order, best (lowest cost) first: the
         pith hypotheses that :mod:`woodcam.inference.evidence` judges by held-out faces.
+    workers : processes the starts' and the basins' descents may use (:mod:`woodcam._parallel`;
+        the same fits bit for bit)
 
     For labelled observations the returned field is the final least-squares fit. For unlabelled
     ones, ``levels`` are the fitted per-group values of ``rho * s`` (mm-like units, the field's
@@ -371,7 +374,8 @@ def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: fl
         near = [c for c in starts if np.max(np.abs(c[2])) >= np.cos(np.deg2rad(10))]
         if near and all(abs(near[0][2] @ o[2]) < np.cos(np.deg2rad(10)) for o in chosen):
             chosen.append(near[0])
-    refined = [_refine(mid, p, d, max_nfev=30) for _, p, d in chosen]
+    # each start's descent is independent: on a fit's cores (woodcam._parallel), bit for bit
+    refined = map_processes(lambda c: _refine(mid, c[1], c[2], max_nfev=30), chosen, workers)
     refined.sort(key=lambda r: r[2])
     i_f, g_f = take(n_fit)
     fine = _Problem(obs.points_mm[i_f], obs.years[i_f] if labelled else None, g_f, centre, z_scale, K, M, ridge)
@@ -382,7 +386,7 @@ def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: fl
         axial = [r for r in refined if np.max(np.abs(r[1])) >= np.cos(np.deg2rad(_AXIAL_DEG))]
         if axial and not any(r is axial[0] for r in pick):
             pick.append(axial[0])
-    finals = [_refine(fine, p, d, max_nfev=60) for p, d, _ in pick]
+    finals = map_processes(lambda r: _refine(fine, r[0], r[1], max_nfev=60), pick, workers)
     finals.sort(key=lambda r: r[2])
     distinct = []  # basins that refined into the same axis are one hypothesis
     for r in finals:
@@ -703,7 +707,9 @@ def fit_radial_hypotheses(obs: RingObservations, size_mm, n_basins: int = 3, K: 
 
     The first is :func:`fit_radial`'s answer (lowest in-sample cost). Unlabelled rings are
     numbered once, by that first fit, and every other basin is fitted to the same numbers, so
-    the hypotheses differ in their stem, not in their ring numbering.
+    the hypotheses differ in their stem, not in their ring numbering. ``search``: options of
+    :func:`fit_axis_and_shape`; its ``workers`` also finish the basins after the first in
+    forked processes (the same fits bit for bit).
 
     Returns
     -------
@@ -715,16 +721,16 @@ def fit_radial_hypotheses(obs: RingObservations, size_mm, n_basins: int = 3, K: 
                                                                  n_basins=n_basins, **search))
         first, numbered = _finish_radial(obs, size_mm, found[0], K, M, ridge, max_relabel_rounds, seed, history,
                                          numbering=numbering)
-        fields = [first]
-        for shape_field, _, _ in found[1:]:
+
+        def finish(shape_field):
             if obs.labelled:  # its own mislabel correction, not the first hypothesis'
-                f, _ = _finish_radial(obs, size_mm, (shape_field, None, None), K, M, ridge,
-                                      max_relabel_rounds, seed, history)
-            else:  # coefficients in level units: refit to the shared numbers, no renumbering
-                start = _refit_labelled(numbered, size_mm, shape_field, ridge, seed=seed)
-                f, _ = _finish_radial(numbered, size_mm, (start, None, None), K, M, ridge,
-                                      max_relabel_rounds, seed, history, relabel=False)
-            fields.append(f)
+                return _finish_radial(obs, size_mm, (shape_field, None, None), K, M, ridge,
+                                      max_relabel_rounds, seed, history)[0]
+            # coefficients in level units: refit to the shared numbers, no renumbering
+            start = _refit_labelled(numbered, size_mm, shape_field, ridge, seed=seed)
+            return _finish_radial(numbered, size_mm, (start, None, None), K, M, ridge,
+                                  max_relabel_rounds, seed, history, relabel=False)[0]
+        fields = [first] + map_processes(lambda f: finish(f[0]), found[1:], search.get("workers", 1))
     return fields, numbered
 
 
