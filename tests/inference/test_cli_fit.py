@@ -97,3 +97,21 @@ def test_eval_without_truth_scores_faces_held_out(tmp_path, capsys):
     table = (out / "eq79_holdout.md").read_text()
     assert "radial ridge ≤ 2 px" in table and "mean, held out" in table
     assert (out / "eq79_radial.png").exists()
+
+
+def test_fit_workers_option_sets_the_fit_processes_and_keeps_the_field(block_dir, tmp_path, monkeypatch):
+    """``woodcam fit --workers N``: the evidence fit on N processes (``$WOODCAM_WORKERS``) gives
+    the field it gives on one, bit for bit; 0 is refused with one line."""
+    from woodcam._parallel import WORKERS_ENV, fit_workers
+
+    folder, _, _ = block_dir
+    monkeypatch.delenv(WORKERS_ENV, raising=False)
+    fields = []
+    for n in ("1", "2"):
+        out = tmp_path / f"w{n}.npz"
+        assert main(["fit", str(folder), "--workers", n, "--out", str(out)]) == 0
+        assert fit_workers() == int(n)
+        fields.append(GridField.load(out))
+    assert np.array_equal(fields[0].years, fields[1].years)
+    assert fields[0].meta["chosen"] == fields[1].meta["chosen"]
+    assert main(["fit", str(folder), "--workers", "0", "--out", str(tmp_path / "w0.npz")]) != 0

@@ -8,8 +8,8 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
-from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
-                      allow_negative_values, stock_options, vector_type,
+from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option, add_workers_option,
+                      allow_negative_values, apply_workers, stock_options, vector_type,
                       write_screenshot)
 
 
@@ -55,6 +55,7 @@ def register(subparsers) -> None:
                    "looser tolerances, and the summary says so (default 120000)")
     add_units_option(p, "bake")
     add_bake_options(p)
+    add_workers_option(p)
     p.set_defaults(func=run_bake)
 
     p = subparsers.add_parser("preview", help="view a baked part (window, or --screenshot PNG)",
@@ -107,6 +108,7 @@ def run_bake(args: argparse.Namespace) -> int:
     from . import print_warnings
 
     check_outputs(args.out, obj=not args.no_obj, screenshot=getattr(args, "screenshot", None) or False)
+    apply_workers(args)
     stock = open_stock(args.block, **stock_options(args))
     res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
                        tolerance_mm=args.tolerance, timeout_s=args.timeout, obj=not args.no_obj, screenshot=False,

@@ -8,7 +8,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_block_argument, add_confidence_option, add_out_option, add_size_option, command_group, open_block
+from .options import (add_block_argument, add_confidence_option, add_out_option, add_size_option, add_workers_option,
+                      apply_workers, command_group, open_block)
 
 #: Faces used for "partial annotation": three faces meeting at the front-top-left corner, half
 #: of the block's surface (seed 000, section 4.3 traces "half of the block only").
@@ -36,6 +37,7 @@ def register(subparsers) -> None:
                    "each predicts the faces it was not fitted to (warns when they contradict it)")
     p.add_argument("--faces", default=None, help="comma-separated faces to use (default: all)")
     add_size_option(p)
+    add_workers_option(p)
     add_out_option(p, "the fitted field as a grid", suffixes=(".npz",))
     p.set_defaults(func=run_fit)
 
@@ -71,6 +73,7 @@ def run_fit(args) -> int:
     from ..inference.fit import fit_block
 
     _check_methods([args.method], "--method")
+    apply_workers(args)
     block, _ = open_block(args.block, args.size_mm)
     field = fit_block(block, args.method, faces=_faces(args.faces))
     path = field.save(args.out)

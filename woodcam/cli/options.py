@@ -540,6 +540,25 @@ def check_numbers(args: argparse.Namespace) -> None:
             _check_value(v, _option(dest), rng)
 
 
+def add_workers_option(p: argparse.ArgumentParser) -> None:
+    """``--workers N`` of the commands that run an evidence fit (``fit``, ``bake``): the
+    processes it may use (:mod:`woodcam._parallel`); applied by :func:`apply_workers`."""
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="processes one evidence fit may use (default: $WOODCAM_WORKERS, else "
+                   "min(2, CPU cores)); the fitted field is the same for any N, 1 is slowest")
+
+
+def apply_workers(args: argparse.Namespace) -> None:
+    """Make ``--workers`` (range-checked with every option, :data:`RANGES`) this process' fit
+    setting, ``$WOODCAM_WORKERS``."""
+    if getattr(args, "workers", None) is not None:
+        import os
+
+        from .._parallel import WORKERS_ENV
+
+        os.environ[WORKERS_ENV] = str(args.workers)
+
+
 def add_confidence_option(p: argparse.ArgumentParser, note: str = "") -> None:
     """``--confidence`` of ``eval rings`` / ``eval realistic``: the evidence fit's per-point
     confidence drawn on the cut planes; ``note`` adds what else it implies."""
