@@ -629,24 +629,31 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         rings = obs if obs.labelled else numbered
         hyps = [Hypothesis("radial" if i == 0 else f"radial basin {i + 1}", f, radial_recipe(f, seed, size_mm),
                            alone=True) for i, f in enumerate(radials)]
-        if "stem" in candidates:
-            rec = stem_recipe(size_mm, seed) if stem is None else stem
-            try:
-                hyps.append(Hypothesis("stem", rec(rings), rec))
-            except WoodcamError:  # too few rings for the stem: the others still compete
-                pass
+        alone = {}  # recipes that keep no state: fitted in a fork beside those that do
         if "rbf" in candidates:
-            rec = _rbf_recipe(EVIDENCE_RBF_POINTS)
-            hyps.append(Hypothesis("rbf", rec(rings), rec, alone=True))
-        if "residual" in candidates:
-            rec = _residual_recipe(hyps[0].refit, EVIDENCE_RBF_POINTS)  # shares radial's fold fits
-            hyps.append(Hypothesis("radial + residual", rec(rings), rec, alone=True))
-        for name, rec in (recipes or {}).items():
+            alone["rbf"] = _rbf_recipe(EVIDENCE_RBF_POINTS)
+        if "residual" in candidates:  # shares radial's fold fits, which nothing here reads
+            alone["radial + residual"] = _residual_recipe(hyps[0].refit, EVIDENCE_RBF_POINTS)
+        stem_rec = (stem_recipe(size_mm, seed) if stem is None else stem) if "stem" in candidates else None
+
+        def fitted(name, rec, base=None) -> list[Hypothesis]:
             try:
-                hyps.append(Hypothesis(name, rec(rings), rec, (refines or {}).get(name)))
+                return [Hypothesis(name, rec(rings), rec, base)]
             except WoodcamError:  # too few rings for it: the others still compete
-                pass
-        hyps += list(extra or [])
+                return []
+
+        def stateful() -> tuple[list, list]:  # the stem (remembering its fit), then the knots' bend
+            first = fitted("stem", stem_rec) if stem_rec else []
+            return first, [h for name, rec in (recipes or {}).items() for h in fitted(name, rec, (refines or {}).get(name))]
+
+        def stateless() -> dict:
+            return {name: rec(rings) for name, rec in alone.items()}
+        if workers > 1:
+            fields, (stems, bends) = beside(stateless, stateful)
+        else:
+            (stems, bends), fields = stateful(), stateless()
+        hyps += stems + [Hypothesis(name, fields[name], rec, alone=True) for name, rec in alone.items()]
+        hyps += bends + list(extra or [])
         predictions: dict = {}
         folds: dict | None = {} if residual else None
         result = choose(hyps, holdout_evidence(hyps, rings, seed, predictions, folds, workers))
