@@ -544,7 +544,7 @@ def add_workers_option(p: argparse.ArgumentParser) -> None:
     """``--workers N`` of the commands that run an evidence fit (``fit``, ``bake``): the
     processes it may use (:mod:`woodcam._parallel`); applied by :func:`apply_workers`."""
     p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="processes one evidence fit may use (default: $WOODCAM_WORKERS, else "
+                   help="workers (processes) one evidence fit may use (default: $WOODCAM_WORKERS, else "
                    "min(2, CPU cores)); the fitted field is the same for any N, 1 is slowest")
 
 
