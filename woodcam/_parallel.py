@@ -14,13 +14,14 @@ gained 1.7x where a fork gains ~2x), and several recipes keep per-fold caches.
 Each piece runs the same code on the same inputs as in a serial run, so the results are the
 same bit for bit (``tests/inference/test_parallel_fit.py``). :func:`fit_workers` says how
 many cores a fit may use: ``$WOODCAM_WORKERS`` when set (``woodcam.scale``'s workers set it
-to 1, since there the tasks are the unit of parallelism), else ``min(2, cpu count)``. Where
-``fork`` is not available (Windows) the processes' pieces run serially.
+to 1, since there the tasks are the unit of parallelism), else ``min(2, cpu count)``. Off
+Linux (:data:`_CAN_FORK`) the pieces run one after the other.
 """
 
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -49,6 +50,11 @@ def fit_workers() -> int:
     return n
 
 
+#: Fork only on Linux: Windows has no fork, and on macOS a forked child of a process that has
+#: used the system's frameworks (Accelerate's BLAS among them) may crash, which is why Python
+#: no longer forks there by default; elsewhere the pieces run one after the other.
+_CAN_FORK = sys.platform.startswith("linux")
+
 #: What forked workers run: set in the parent just before the fork, so that the children find
 #: the functions and their data without pickling them (only an index and the results travel).
 #: Not empty inside a forked piece, where further pieces run serially (no nested pools).
@@ -63,14 +69,11 @@ def _fork_beside(away: list[Callable[[], Any]], here: Callable[[], Any]) -> tupl
     """``([f() for f in away], here())`` with each ``away`` call in a forked process while
     ``here`` runs in this one; all here, one after the other, without ``fork`` (Windows) or
     inside a forked piece."""
+    if not _CAN_FORK or _FORKED or not away:
+        return [f() for f in away], here()
     import multiprocessing as mp
 
-    try:
-        ctx = mp.get_context("fork")
-    except ValueError:  # pragma: no cover - Windows
-        ctx = None
-    if ctx is None or _FORKED or not away:
-        return [f() for f in away], here()
+    ctx = mp.get_context("fork")
     from concurrent.futures import ProcessPoolExecutor
 
     _FORKED["away"] = away
