@@ -67,8 +67,8 @@ def _run_forked(i: int):
 
 def _fork_beside(away: list[Callable[[], Any]], here: Callable[[], Any]) -> tuple[list, Any]:
     """``([f() for f in away], here())`` with each ``away`` call in a forked process while
-    ``here`` runs in this one; all here, one after the other, without ``fork`` (Windows) or
-    inside a forked piece."""
+    ``here`` runs in this one; all here, one after the other, off Linux (:data:`_CAN_FORK`)
+    or inside a forked piece."""
     if not _CAN_FORK or _FORKED or not away:
         return [f() for f in away], here()
     import multiprocessing as mp

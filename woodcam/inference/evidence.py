@@ -48,9 +48,9 @@ from dataclasses import field as dc_field
 
 import numpy as np
 
+from .._parallel import beside, fit_workers
 from .._types import ArrayLike
 
-from .._parallel import beside, fit_workers
 from ..errors import WoodcamError, WoodcamWarning
 from ..fields.base import central_gradient
 from ..fields.residual import ResidualField
@@ -602,9 +602,9 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         chosen field, kept only where refitted in each fold it raises the held-out faces' score
         (:func:`residual_evidence`); applied before an ``"away_from_faces"`` blend, refused with
         ``"everywhere"`` (the mean of the hypotheses replaces the field it was judged on)
-    workers : processes the radial pith search and the held-out refits may use
-        (:mod:`woodcam._parallel`; default :func:`~woodcam._parallel.fit_workers`); the result
-        is the same bit for bit
+    workers : processes the radial pith search, the all-faces fits and the held-out refits may
+        use (:mod:`woodcam._parallel`; default :func:`~woodcam._parallel.fit_workers`); the
+        result is the same bit for bit
 
     Returns
     -------
