@@ -7,9 +7,12 @@ without pickling it (only results travel back); threads would not do: the fits a
 small numpy and least-squares steps that hold the GIL between them (a threaded grid bake
 gained 1.7x where a fork gains ~2x), and several recipes keep per-fold caches.
 
-- :func:`map_processes`: independent items on a pool (the radial axis refinements);
-- :func:`beside`: one piece in a child while this process does another (the held-out refits
-  of the hypotheses that share no state beside those that do; half of a grid bake).
+- :func:`map_processes`: independent items (the radial axis refinements);
+- :func:`share`: independent tasks in forks while this process does a piece that must stay
+  here, then helps with the tasks (the held-out refits: the hypotheses that share no state,
+  fold by fold, beside the stem and its bend);
+- :func:`beside`: one piece in a fork while this process does another (the all-faces fits of
+  the RBF and the residual beside the stem's; half of a grid bake).
 
 Each piece runs the same code on the same inputs as in a serial run, so the results are the
 same bit for bit (``tests/inference/test_parallel_fit.py``). :func:`fit_workers` says how
@@ -65,48 +68,56 @@ def _run_forked(i: int):
     return _FORKED["away"][i]()
 
 
-def _fork_beside(away: list[Callable[[], Any]], here: Callable[[], Any]) -> tuple[list, Any]:
-    """``([f() for f in away], here())`` with each ``away`` call in a forked process while
-    ``here`` runs in this one; all here, one after the other, off Linux (:data:`_CAN_FORK`)
-    or inside a forked piece."""
-    if not _CAN_FORK or _FORKED or not away:
-        return [f() for f in away], here()
+def _fork_share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers: int) -> tuple[list, Any]:
+    """``([t() for t in tasks], here())``: ``workers - 1`` forked processes work through
+    ``tasks`` from the first while this process runs ``here``, then takes the tasks none has
+    started, from the last (their costs are not known ahead: each side keeps busy until they
+    meet). All here, one after the other, off Linux (:data:`_CAN_FORK`) or inside a piece."""
+    if not _CAN_FORK or _FORKED or not tasks or workers <= 1:
+        return [t() for t in tasks], here()
     import multiprocessing as mp
-
-    ctx = mp.get_context("fork")
     from concurrent.futures import ProcessPoolExecutor
 
-    _FORKED["away"] = away
+    _FORKED["away"] = tasks
     try:
-        with ProcessPoolExecutor(len(away), mp_context=ctx) as ex:
+        with ProcessPoolExecutor(min(workers - 1, len(tasks)), mp_context=mp.get_context("fork")) as ex:
             # the first submit forks every worker: each sees the state as it is here and now
-            jobs = [ex.submit(_run_forked, i) for i in range(len(away))]
-            _FORKED.clear()
+            jobs = [ex.submit(_run_forked, i) for i in range(len(tasks))]
+            _FORKED["away"] = [None] * len(tasks)  # a piece inside a taken task runs serially
             mine = here()
-            return [j.result() for j in jobs], mine
+            done: dict = {}
+            for i in reversed(range(len(tasks))):
+                if not jobs[i].cancel():  # started (or done) in a fork: so are all before it
+                    break
+                done[i] = tasks[i]()
+            return [done[i] if i in done else jobs[i].result() for i in range(len(tasks))], mine
     finally:
         _FORKED.clear()
 
 
 def map_processes(fn: Callable[[Any], Any], items: Sequence, workers: int) -> list:
-    """``[fn(item) for item in items]`` in ``workers`` contiguous shares: the first here, the
-    others each in a forked process. ``fn``'s results must be picklable; the side effects of
-    the forked shares are lost."""
+    """``[fn(item) for item in items]``: forked processes take the items from the first, this
+    one from the last (:func:`_fork_share`). ``fn``'s results must be picklable; the side
+    effects of the items done in a fork are lost."""
     items = list(items)
     if workers <= 1 or len(items) <= 1:
         return [fn(x) for x in items]
-    bounds = [len(items) * k // min(workers, len(items)) for k in range(min(workers, len(items)) + 1)]
-    shares = [items[bounds[k]:bounds[k + 1]] for k in range(len(bounds) - 1)]
-    away, mine = _fork_beside([lambda share=share: [fn(x) for x in share] for share in shares[1:]],
-                              lambda: [fn(x) for x in shares[0]])
-    return mine + [y for share in away for y in share]
+    return _fork_share([lambda x=x: fn(x) for x in items], lambda: None, workers)[0]
 
 
 def beside(away: Callable[[], Any], here: Callable[[], Any]) -> tuple[Any, Any]:
     """``(away(), here())``: ``away`` in a forked process while ``here`` runs in this one.
     ``away``'s result must be picklable and its side effects are lost; ``here``'s stay."""
-    done, mine = _fork_beside([away], here)
+    done, mine = _fork_share([away], here, 2)
     return done[0], mine
+
+
+def share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers: int) -> tuple[list, Any]:
+    """``([t() for t in tasks], here())`` on ``workers`` processes: ``here`` in this one, which
+    then helps with the ``tasks`` (:func:`_fork_share`). Each task's result must be picklable
+    and must not depend on where it ran (a task done here keeps its side effects, one done in
+    a fork loses them)."""
+    return _fork_share(tasks, here, workers)
 
 
 __all__: list[str] = []

@@ -27,12 +27,28 @@ def test_fit_workers_reads_the_environment(monkeypatch):
             _parallel.fit_workers()
 
 
-def test_map_processes_keeps_the_order_and_runs_in_other_processes():
+def test_map_processes_keeps_the_order_forks_take_the_first_items_and_this_process_the_last():
     pids = _parallel.map_processes(lambda x: (x, os.getpid()), range(7), 3)
     assert [x for x, _ in pids] == list(range(7))
-    here = os.getpid()  # shares [0, 2), [2, 4), [4, 7): the first here, the others forked
-    assert [p == here for _, p in pids] == [True, True] + [False] * 5
+    here = [p == os.getpid() for _, p in pids]
+    assert here == sorted(here)  # a prefix in forks, the rest (a suffix, maybe empty) here
     assert _parallel.map_processes(lambda x: (x, os.getpid()), range(4), 1) == [(x, os.getpid()) for x in range(4)]
+
+
+def test_share_evens_out_tasks_between_the_fork_and_this_process():
+    """While this process is busy, the fork works from the first task; then this process takes
+    the tasks not yet started, from the last, and both meet."""
+    import time
+
+    def task(i):
+        time.sleep(0.1)
+        return i, os.getpid()
+
+    done, mine = _parallel.share([lambda i=i: task(i) for i in range(10)], lambda: time.sleep(0.25) or "here", 2)
+    assert mine == "here" and [i for i, _ in done] == list(range(10))
+    in_fork = [p != os.getpid() for _, p in done]
+    assert in_fork[0] and not in_fork[-1]  # both took part
+    assert in_fork == sorted(in_fork, reverse=True)
 
 
 def test_beside_keeps_only_its_own_side_effects():
@@ -106,7 +122,7 @@ def test_two_workers_give_the_one_worker_fit_bit_for_bit(small_knotted_block, mo
 
 
 def test_hypotheses_that_share_state_are_refitted_here(small_knotted_block):
-    """``holdout_evidence(workers=2)`` refits only hypotheses marked ``alone`` in the fork: the
+    """``holdout_evidence(workers=2)`` refits only hypotheses marked ``alone`` in a fork: the
     others (the stem and its knots' bend, whose cone fits later steps read) keep their side
     effects here, fold by fold in the serial order, and every score is the serial one."""
     from woodcam.inference.evidence import Hypothesis, holdout_evidence
@@ -127,5 +143,5 @@ def test_hypotheses_that_share_state_are_refitted_here(small_knotted_block):
     log.clear()
     forked = holdout_evidence(hyps, obs, workers=2)
     assert forked == serial and len(serial["shared"]) >= 2
-    assert [e for e in serial_log if e[0] == "shared"] == log  # here, in the same order
-    assert all(pid == os.getpid() for *_, pid in log)
+    shared = [e for e in log if e[0] == "shared"]  # ("alone" folds may be taken here too)
+    assert shared == [e for e in serial_log if e[0] == "shared"]  # here, in the same order

@@ -48,7 +48,7 @@ from dataclasses import field as dc_field
 
 import numpy as np
 
-from .._parallel import beside, fit_workers
+from .._parallel import beside, fit_workers, share
 from .._types import ArrayLike
 
 from ..errors import WoodcamError, WoodcamWarning
@@ -192,10 +192,11 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
         their years (what a blend of the hypotheses is scored from, :func:`_blend_evidence`).
     fold_fields : optional dict, filled with ``(name, face name) -> field``: each fold's fit
         (what the residual is refitted on in each fold, :func:`residual_evidence`).
-    workers : with 2 or more, the hypotheses marked :attr:`Hypothesis.alone` are refitted on
-        every fold in a forked process while this one refits the others (which share state:
-        the stem's fold fit, the knots' cone fits), each group fold by fold as in the serial
-        order; the same scores, predictions and fold fields bit for bit.
+    workers : with 2 or more, the hypotheses marked :attr:`Hypothesis.alone` are refitted in
+        forked processes, one task per fold, while this one refits the others fold by fold in
+        the serial order (they share state: the stem's fold fit, the knots' cone fits) and then
+        takes the folds no fork has started (:func:`woodcam._parallel.share`); the same
+        scores, predictions and fold fields bit for bit.
 
     Returns name -> {face name -> {"score": percent, "share_2mm": percent}}; empty dicts when
     fewer than two faces have rings.
@@ -212,9 +213,9 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
         folds.append((f, obs.subset(~held), obs.points_mm[idx], obs.years[idx]))
     keep_fields = fold_fields is not None
 
-    def refit_all(hyps) -> dict:
+    def refit_all(hyps, these) -> dict:
         res = {}
-        for f, rest, pts, yrs in folds:
+        for f, rest, pts, yrs in these:
             for h in hyps:
                 fitted = pred = None
                 try:
@@ -230,11 +231,13 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
 
     away = [h for h in hypotheses if h.alone] if workers > 1 else []
     here = [h for h in hypotheses if not (workers > 1 and h.alone)]
-    if away and here:
-        res_away, res = beside(lambda: refit_all(away), lambda: refit_all(here))
-        res.update(res_away)
+    if away:  # one task per fold, so that the two sides can even out
+        tasks = [lambda fold=fold: refit_all(away, [fold]) for fold in folds]
+        parts, res = share(tasks, lambda: refit_all(here, folds), workers)
+        for part in parts:
+            res.update(part)
     else:
-        res = refit_all(hypotheses)
+        res = refit_all(hypotheses, folds)
     for f, *_ in folds:  # filled in the serial order
         for h in hypotheses:
             score, pred, fitted = res[(h.name, f)]
