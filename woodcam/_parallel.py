@@ -68,11 +68,13 @@ def _run_forked(i: int):
     return _FORKED["away"][i]()
 
 
-def _fork_share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers: int) -> tuple[list, Any]:
+def share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers: int) -> tuple[list, Any]:
     """``([t() for t in tasks], here())``: ``workers - 1`` forked processes work through
     ``tasks`` from the first while this process runs ``here``, then takes the tasks none has
     started, from the last (their costs are not known ahead: each side keeps busy until they
-    meet). All here, one after the other, off Linux (:data:`_CAN_FORK`) or inside a piece."""
+    meet). All here, one after the other, with one worker, off Linux (:data:`_CAN_FORK`) or
+    inside a piece. Each task's result must be picklable and must not depend on where it ran
+    (a task done here keeps its side effects, one done in a fork loses them)."""
     if not _CAN_FORK or _FORKED or not tasks or workers <= 1:
         return [t() for t in tasks], here()
     import multiprocessing as mp
@@ -97,27 +99,20 @@ def _fork_share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers
 
 def map_processes(fn: Callable[[Any], Any], items: Sequence, workers: int) -> list:
     """``[fn(item) for item in items]``: forked processes take the items from the first, this
-    one from the last (:func:`_fork_share`). ``fn``'s results must be picklable; the side
-    effects of the items done in a fork are lost."""
+    one from the last (:func:`share`). ``fn``'s results must be picklable; the side effects of
+    the items done in a fork are lost."""
     items = list(items)
-    if workers <= 1 or len(items) <= 1:
+    if len(items) <= 1:  # nothing to share: no fork
         return [fn(x) for x in items]
-    return _fork_share([lambda x=x: fn(x) for x in items], lambda: None, workers)[0]
+    return share([lambda x=x: fn(x) for x in items], lambda: None, workers)[0]
 
 
-def beside(away: Callable[[], Any], here: Callable[[], Any]) -> tuple[Any, Any]:
-    """``(away(), here())``: ``away`` in a forked process while ``here`` runs in this one.
-    ``away``'s result must be picklable and its side effects are lost; ``here``'s stay."""
-    done, mine = _fork_share([away], here, 2)
+def beside(away: Callable[[], Any], here: Callable[[], Any], workers: int = 2) -> tuple[Any, Any]:
+    """``(away(), here())``: ``away`` in a forked process while ``here`` runs in this one (one
+    after the other with one worker, :func:`share`). ``away``'s result must be picklable and
+    its side effects are lost; ``here``'s stay."""
+    done, mine = share([away], here, workers)
     return done[0], mine
-
-
-def share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers: int) -> tuple[list, Any]:
-    """``([t() for t in tasks], here())`` on ``workers`` processes: ``here`` in this one, which
-    then helps with the ``tasks`` (:func:`_fork_share`). Each task's result must be picklable
-    and must not depend on where it ran (a task done here keeps its side effects, one done in
-    a fork loses them)."""
-    return _fork_share(tasks, here, workers)
 
 
 __all__: list[str] = []

@@ -229,15 +229,13 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
                                     pred, fitted if keep_fields else None)
         return res
 
-    away = [h for h in hypotheses if h.alone] if workers > 1 else []
-    here = [h for h in hypotheses if not (workers > 1 and h.alone)]
-    if away:  # one task per fold, so that the two sides can even out
-        tasks = [lambda fold=fold: refit_all(away, [fold]) for fold in folds]
-        parts, res = share(tasks, lambda: refit_all(here, folds), workers)
-        for part in parts:
-            res.update(part)
-    else:
-        res = refit_all(hypotheses, folds)
+    away = [h for h in hypotheses if h.alone]
+    here = [h for h in hypotheses if not h.alone]
+    # the alone ones one task per fold, so that the two sides can even out
+    parts, res = share([lambda fold=fold: refit_all(away, [fold]) for fold in folds] if away else [],
+                       lambda: refit_all(here, folds), workers)
+    for part in parts:
+        res.update(part)
     for f, *_ in folds:  # filled in the serial order
         for h in hypotheses:
             score, pred, fitted = res[(h.name, f)]
@@ -651,10 +649,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
 
         def stateless() -> dict:
             return {name: rec(rings) for name, rec in alone.items()}
-        if workers > 1:
-            fields, (stems, bends) = beside(stateless, stateful)
-        else:
-            (stems, bends), fields = stateful(), stateless()
+        fields, (stems, bends) = beside(stateless, stateful, workers)
         hyps += stems + [Hypothesis(name, fields[name], rec, alone=True) for name, rec in alone.items()]
         hyps += bends + list(extra or [])
         predictions: dict = {}

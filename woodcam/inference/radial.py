@@ -702,14 +702,15 @@ def _fit_radial(obs, size_mm, K, M, ridge, max_relabel_rounds, seed, history, se
 
 def fit_radial_hypotheses(obs: RingObservations, size_mm, n_basins: int = 3, K: int = 12, M: int = 1,
                           ridge: float = 1e-8, max_relabel_rounds: int = 2, seed: int = 0,
-                          history: bool = True, **search) -> tuple[list[RadialField], RingObservations]:
+                          history: bool = True, workers: int = 1,
+                          **search) -> tuple[list[RadialField], RingObservations]:
     """Radial fits from the ``n_basins`` best distinct pith-axis basins (pith hypotheses).
 
     The first is :func:`fit_radial`'s answer (lowest in-sample cost). Unlabelled rings are
     numbered once, by that first fit, and every other basin is fitted to the same numbers, so
     the hypotheses differ in their stem, not in their ring numbering. ``search``: options of
-    :func:`fit_axis_and_shape`; its ``workers`` also finish the basins after the first in
-    forked processes (the same fits bit for bit).
+    :func:`fit_axis_and_shape`; ``workers``: processes for its descents and for finishing the
+    basins after the first (:mod:`woodcam._parallel`; the same fits bit for bit).
 
     Returns
     -------
@@ -718,7 +719,7 @@ def fit_radial_hypotheses(obs: RingObservations, size_mm, n_basins: int = 3, K: 
     """
     with _one_blas_thread():
         found, numbering = _by_numbering(obs, fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed,
-                                                                 n_basins=n_basins, **search))
+                                                                 n_basins=n_basins, workers=workers, **search))
         first, numbered = _finish_radial(obs, size_mm, found[0], K, M, ridge, max_relabel_rounds, seed, history,
                                          numbering=numbering)
 
@@ -730,7 +731,7 @@ def fit_radial_hypotheses(obs: RingObservations, size_mm, n_basins: int = 3, K: 
             start = _refit_labelled(numbered, size_mm, shape_field, ridge, seed=seed)
             return _finish_radial(numbered, size_mm, (start, None, None), K, M, ridge,
                                   max_relabel_rounds, seed, history, relabel=False)[0]
-        fields = [first] + map_processes(lambda f: finish(f[0]), found[1:], search.get("workers", 1))
+        fields = [first] + map_processes(lambda f: finish(f[0]), found[1:], workers)
     return fields, numbered
 
 
