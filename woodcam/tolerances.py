@@ -361,6 +361,15 @@ EVIDENCE_REFINE_BASE_MARGIN = 15.0
 #: at 0.3 % within 2 px (the plain one 24.9 %); bends that help on dev seed 63311 win by 6-27.
 EVIDENCE_REFINE_GAIN_MARGIN = EVIDENCE_ACCEPT_MARGIN
 
+#: Where its base is the best plain hypothesis, a refinement takes the base's place
+#: (:func:`woodcam.inference.evidence.choose`) unless it misses more than this many times what
+#: the base misses of the held-out score (``100 - mean``): a bend round knots whose rings the
+#: faces do not show bent is rejected (the planted masks of ``test_knot_bend``: the stem ~100 %,
+#: its bend 92.6 %). Dev seeds 7777, 63311, 9101 and 21, knotted blocks whose stem was the best
+#: plain hypothesis and whose bend was the better inside (six noisy faces): the bends missed
+#: 0.6-1.9 times what their stems missed (7777/8: 19.0 against 10.1 points).
+EVIDENCE_REFINE_MISS_RATIO = 2.0
+
 #: Uncertainty added per mm from the nearest observed face (years/mm): a prior, not a
 #: measurement; 0.02 makes the middle of a 50 mm block seen from one face half a ring unsure.
 EVIDENCE_UNSEEN_YEARS_PER_MM = 0.02

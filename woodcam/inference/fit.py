@@ -32,8 +32,9 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: than the accept margin; 11: year-labelled rings fitted and judged on the years given, not on
 #: the radial fit's renumbering of them; 12: knot cones fitted with their analytic Jacobian, the
 #: same choices and scores on the dev and validation blocks but cones that differ within the
-#: fit's tolerance).
-FIT_VERSION = 12
+#: fit's tolerance; 13: a refinement takes its base's place where the base is the best plain
+#: hypothesis, unless it misses more than twice what the base misses).
+FIT_VERSION = 13
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
@@ -64,10 +65,12 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         exit is not offered: :func:`woodcam.inference.knots.knot_bend_recipes`). It refines
         the stem: it competes only while the held-out faces keep the plain stem within
         :data:`~woodcam.tolerances.EVIDENCE_REFINE_BASE_MARGIN` of the best hypothesis, and
-        is chosen only when it beats every plain hypothesis by more than
-        :data:`~woodcam.tolerances.EVIDENCE_REFINE_GAIN_MARGIN`
-        (:func:`woodcam.inference.evidence.choose`), which keeps H11's held-out faces where
-        they were without the bend (README). ``False`` leaves it out.
+        is chosen when it beats every plain hypothesis by more than
+        :data:`~woodcam.tolerances.EVIDENCE_REFINE_GAIN_MARGIN`, which keeps H11's held-out
+        faces where they were without the bend, or in the stem's place where the stem is the
+        best plain hypothesis and the bend misses at most
+        :data:`~woodcam.tolerances.EVIDENCE_REFINE_MISS_RATIO` times what it misses
+        (:func:`woodcam.inference.evidence.choose`; README). ``False`` leaves it out.
     knot_cones : evidence only (default True): each knot's strand and radius are the cone fitted
         to every face's knot mask, exits touching across a block edge one knot end
         (:func:`woodcam.inference.knots.strands_from_exits`); ``False``: the line through two
