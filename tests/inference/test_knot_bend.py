@@ -180,3 +180,30 @@ def test_h11_cone_bend_within_the_accept_margin_is_set_aside(shared_data):
     held = {n: score_face(f, b, "right").shares["ridge_2"] for n, f in (("chosen", ev.field),
                                                                           ("bend", ev.hypotheses["stem + knot bend"]))}
     assert held["chosen"] > 15.0 and held["bend"] < 5.0, held
+
+
+@pytest.mark.slow
+def test_the_bend_takes_the_stem_place_where_the_stem_wins_the_vote():
+    """Dev seed 63311 block 2 (six noisy faces; a knot enters by the left face and dies before
+    the right): the plain stem wins the held-out vote (84.6 against its bend's 72.3 %), but the
+    bend predicts the inside far better (cut planes within 2 mm: 90.5 against 61.9 %), so the
+    default fit chooses the bend in the stem's place (FIT_VERSION 13). Checked by breaking it:
+    without the swap in :func:`woodcam.inference.evidence.choose` the stem is chosen and this
+    test fails."""
+    import warnings
+
+    from woodcam.bench_realistic import BENCH_PIXEL_MM, make_block
+    from woodcam.errors import WoodcamWarning
+    from woodcam.inference import fit_block
+    from woodcam.inference.evaluate import DEFAULT_PLANES
+
+    block, _ = make_block(63311, 2, "noisy")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", WoodcamWarning)
+        ev = fit_block(block, baked=False)
+    sc = {n: v["mean"] for n, v in ev.scores.items()}
+    assert sc["stem"] == max(v for n, v in sc.items() if "knot bend" not in n) > sc["stem + knot bend"], sc
+    assert ev.chosen == "stem + knot bend" and "takes the place of stem" in ev.message, ev.message
+    inside = evaluate_fits(block.true_field, {"chosen": ev, "stem": ev.hypotheses["stem"]}, block.size_mm,
+                           DEFAULT_PLANES, BENCH_PIXEL_MM)
+    assert inside["chosen"][0]["matched_2"] >= 85.0 > 70.0 >= inside["stem"][0]["matched_2"], inside
