@@ -24,6 +24,7 @@ Linux (:data:`_CAN_FORK`) the pieces run one after the other.
 from __future__ import annotations
 
 import os
+import pickle
 import sys
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -64,8 +65,14 @@ _CAN_FORK = sys.platform.startswith("linux")
 _FORKED: dict = {}
 
 
-def _run_forked(i: int):
-    return _FORKED["away"][i]()
+def _run_forked(i: int) -> bytes:
+    # The result travels pickled by hand and is unpickled by this process' main thread
+    # (share): the pool's own result thread would unpickle it, importing the modules its
+    # classes live in (scipy.interpolate for an RBF) while the main thread may be importing
+    # the same package for a task it took, and Python then fails the main thread's import of
+    # the half-initialised package ("cannot import name 'RBFInterpolator'": the first fit of
+    # a process, one run in three; tests/inference/test_parallel_fit.py).
+    return pickle.dumps(_FORKED["away"][i](), protocol=pickle.HIGHEST_PROTOCOL)
 
 
 def share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers: int) -> tuple[list, Any]:
@@ -92,7 +99,7 @@ def share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers: int)
                 if not jobs[i].cancel():  # started (or done) in a fork: so are all before it
                     break
                 done[i] = tasks[i]()
-            return [done[i] if i in done else jobs[i].result() for i in range(len(tasks))], mine
+            return [done[i] if i in done else pickle.loads(jobs[i].result()) for i in range(len(tasks))], mine
     finally:
         _FORKED.clear()
 

@@ -72,6 +72,41 @@ def test_a_forked_piece_inside_another_runs_serially():
     assert len(set(inner)) == 1 and inner[0] != os.getpid()
 
 
+_IMPORT_RACE = """
+import time
+import numpy as np
+from woodcam._parallel import share
+
+def away():
+    from scipy.interpolate import RBFInterpolator
+    x = np.random.default_rng(0).random((50, 3))
+    return RBFInterpolator(x, x[:, 0])
+
+def here():
+    time.sleep(0.05)  # the forks' results arrive while this process imports the same package
+    from scipy.interpolate import RBFInterpolator
+    return RBFInterpolator.__name__
+
+done, mine = share([away, away], here, 3)
+print(type(done[0]).__name__, mine)
+"""
+
+
+@pytest.mark.skipif(not _parallel._CAN_FORK, reason="forked workers only on Linux")
+def test_forked_results_never_race_this_process_imports():
+    """A fresh process (nothing of scipy.interpolate imported yet) whose forks return RBFs while
+    it imports scipy.interpolate itself: the pool's result thread must not unpickle them (and so
+    import the package) beside the main thread. Checked by breaking it: with the results
+    returned unpickled by the pool, this fails with "cannot import name 'RBFInterpolator'" (12
+    runs of 12; the first real fit of a process failed so once in three)."""
+    import subprocess
+    import sys
+
+    for _ in range(3):
+        run = subprocess.run([sys.executable, "-c", _IMPORT_RACE], capture_output=True, text=True, timeout=120)
+        assert run.returncode == 0 and run.stdout.split() == ["RBFInterpolator", "RBFInterpolator"], run.stderr[-800:]
+
+
 def test_forked_grid_evaluation_is_the_serial_one_bit_for_bit():
     """A thin-plate RBF on a grid whose size is no multiple of anything: the forked share starts
     on an aligned point (broken once: cut at half the points, the matrix-vector kernels' row
