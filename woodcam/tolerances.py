@@ -365,9 +365,9 @@ EVIDENCE_REFINE_GAIN_MARGIN = EVIDENCE_ACCEPT_MARGIN
 #: (:func:`woodcam.inference.evidence.choose`) unless it misses more than this many times what
 #: the base misses of the held-out score (``100 - mean``): a bend round knots whose rings the
 #: faces do not show bent is rejected (the planted masks of ``test_knot_bend``: the stem ~100 %,
-#: its bend 92.6 %). Dev seeds 7777, 63311, 9101 and 21, knotted blocks whose stem was the best
+#: its bend 93.0 %). Dev seeds 7777, 63311, 9101 and 21, knotted blocks whose stem was the best
 #: plain hypothesis and whose bend was the better inside (six noisy faces): the bends missed
-#: 0.6-1.9 times what their stems missed (7777/8: 19.0 against 10.1 points).
+#: 0.7-1.9 times what their stems missed (7777/8: 19.0 against 10.1 points).
 EVIDENCE_REFINE_MISS_RATIO = 2.0
 
 #: Uncertainty added per mm from the nearest observed face (years/mm): a prior, not a

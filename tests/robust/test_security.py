@@ -18,15 +18,24 @@ TINY = {"n_fields": 8, "points_per_field": 64, "latent_dim": 4, "hidden": 16, "l
         "checkpoint_every": 10, "log_every": 10}
 
 
+#: The one unpickling allowed, as (file, code): the bytes a forked worker of this process sent
+#: back through the pool's pipe (``_parallel._run_forked``), which the pool would otherwise
+#: unpickle itself; nothing read from a file or from anyone else.
+_OWN_FORK_RESULT = ("woodcam/_parallel.py", "pickle.loads(jobs[i].result())")
+
+
 def test_no_unsafe_torch_load_anywhere():
-    """Issue 15: `woodcam train gtf` resumed with torch.load(weights_only=False)."""
+    """Issue 15: `woodcam train gtf` resumed with torch.load(weights_only=False). No pickle
+    load anywhere but of this process' own forked workers' results (``_OWN_FORK_RESULT``)."""
     offenders = []
     for p in (REPO / "woodcam").rglob("*.py"):
+        rel = str(p.relative_to(REPO))
         for i, line in enumerate(p.read_text().splitlines(), 1):
             if "torch.load(" in line and "weights_only=True" not in line:
-                offenders.append(f"{p.relative_to(REPO)}:{i}")
-            if re.search(r"weights_only\s*=\s*False|pickle\.loads?\(|allow_pickle\s*=\s*True", line):
-                offenders.append(f"{p.relative_to(REPO)}:{i}")
+                offenders.append(f"{rel}:{i}")
+            if re.search(r"weights_only\s*=\s*False|pickle\.loads?\(|allow_pickle\s*=\s*True",
+                         line.replace(_OWN_FORK_RESULT[1], "") if rel == _OWN_FORK_RESULT[0] else line):
+                offenders.append(f"{rel}:{i}")
     assert offenders == []
 
 
