@@ -56,6 +56,10 @@ def test_planted_wrong_hypothesis_is_rejected_by_held_out_faces(block, obs):
     assert acc_good > acc_wrong + 20
 
 
+def _shifted(ev_scores: dict, by: float) -> dict:
+    return {f: {"score": v["score"] + by, "share_2mm": v["share_2mm"]} for f, v in ev_scores.items()}
+
+
 def test_a_refinement_competes_only_while_the_evidence_keeps_its_base(block, obs):
     """``Hypothesis.refines`` (the knots' bend refines the stem): a refinement whose base the
     held-out faces reject (the planted tilted axis, > 30 points below the best) is set aside
@@ -66,7 +70,7 @@ def test_a_refinement_competes_only_while_the_evidence_keeps_its_base(block, obs
     hyps = [Hypothesis("radial", good, radial_recipe(good)), Hypothesis("planted", wrong, radial_recipe(wrong))]
     ev = holdout_evidence(hyps, obs)
     # 6 points above radial: more than EVIDENCE_REFINE_GAIN_MARGIN (the test below)
-    ev["refined"] = {f: {"score": v["score"] + 6.0, "share_2mm": v["share_2mm"]} for f, v in ev["radial"].items()}
+    ev["refined"] = _shifted(ev["radial"], 6.0)
     on_wrong = hyps + [Hypothesis("refined", good, radial_recipe(good), refines="planted")]
     res = choose(on_wrong, ev)
     assert res.chosen == "radial" and "refined set aside" in res.message, res.message
@@ -75,10 +79,6 @@ def test_a_refinement_competes_only_while_the_evidence_keeps_its_base(block, obs
     assert choose(on_good, ev).chosen == "refined"
     missing = hyps + [Hypothesis("refined", good, radial_recipe(good), refines="stem")]  # no such base
     assert choose(missing, ev).chosen == "radial"
-
-
-def _shifted(ev_scores: dict, by: float) -> dict:
-    return {f: {"score": v["score"] + by, "share_2mm": v["share_2mm"]} for f, v in ev_scores.items()}
 
 
 def test_a_refinement_must_beat_every_plain_hypothesis_by_the_accept_margin(block, obs):

@@ -92,7 +92,6 @@ print(type(done[0]).__name__, mine)
 """
 
 
-@pytest.mark.skipif(not _parallel._CAN_FORK, reason="forked workers only on Linux")
 def test_forked_results_never_race_this_process_imports():
     """A fresh process (nothing of scipy.interpolate imported yet) whose forks return RBFs while
     it imports scipy.interpolate itself: the pool's result thread must not unpickle them (and so

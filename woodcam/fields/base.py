@@ -51,7 +51,7 @@ def evaluate(field: GrowthFieldLike, points_mm: ArrayLike, batch: int = MAX_BATC
     if workers > 1 and len(p) > _FORK_MIN_POINTS:
         from .._parallel import beside
 
-        cut = len(p) // workers // _FORK_ALIGN * _FORK_ALIGN
+        cut = len(p) // 2 // _FORK_ALIGN * _FORK_ALIGN  # two halves: beside forks one piece
         rest, first = beside(lambda: evaluate(field, p[cut:], batch), lambda: evaluate(field, p[:cut], batch))
         return np.concatenate([first, rest])
     if len(p) <= batch:
