@@ -36,6 +36,7 @@ per ring group instead of the year, with the inverse ring width's mean over the 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -199,19 +200,13 @@ class _Problem:
 
     def solve(self, pith, d):
         """Inner linear problem; returns (residuals incl. penalty rows, coef, offset, levels)."""
-        dd, e1, e2 = _frame(d)
-        rho, B = _design(self.points, pith, dd, e1, e2, self.z_scale, self.K, self.M)
-        n, p = B.shape
-        pen = np.sqrt(self.ridge * n) * _penalty_weights(self.K, self.M) * np.median(rho)
         if self.years is not None:
-            # [[1, rho B], [0, diag(pen)]] written in place: the same matrix as stacking them
-            lhs = np.zeros((n + p, p + 1))
-            lhs[:n, 0] = 1.0
-            np.multiply(rho[:, None], B, out=lhs[:n, 1:])
-            lhs[np.arange(n, n + p), np.arange(1, p + 1)] = pen
-            rhs = np.concatenate([self.years, np.zeros(p)])
+            lhs, rhs = self._labelled_system(pith, d)[-2:]
             sol = _lstsq(lhs, rhs)
             return lhs @ sol - rhs, sol[1:], sol[0], None
+        dd, e1, e2 = _frame(d)
+        rho, B = _design(self.points, pith, dd, e1, e2, self.z_scale, self.K, self.M)
+        pen = np.sqrt(self.ridge * len(B)) * _penalty_weights(self.K, self.M) * np.median(rho)
         A = rho[:, None] * B
         # Unlabelled: rho * B c = t_g with mean(B c) = 1 over the data: c = c0 + Z y.
         bbar = B.mean(axis=0)
@@ -227,6 +222,107 @@ class _Problem:
         sol = _lstsq(lhs, rhs)
         coef = c0 + Z @ sol[:Z.shape[1]]
         return lhs @ sol - rhs, coef, 0.0, sol[Z.shape[1]:]
+
+    def residual_and_jacobian(self, theta, base) -> tuple[np.ndarray, Callable[[], np.ndarray]]:
+        """Labelled problems: :meth:`solve`'s residuals at :meth:`axis_of` ``(theta, base)`` and
+        a function returning their exact derivative ``(n + p, 4)`` over ``theta`` (computed
+        only when asked: a rejected step needs none), the variable-projection Jacobian
+        (Golub & Pereyra 1973: ``J = (I - P) dA c - A^+' dA' r``, ``A`` the ridge system,
+        ``c`` its solution, ``r`` the residual, ``P`` the projection on ``A``'s columns, and
+        the change of the normal equations' small jitter).
+
+        ``least_squares`` took it by forward differences before: four more solves per step,
+        80 % of the radial searches' time (profiled). Here it costs about one more product
+        with the design: the angle derivatives of ``trig_k(phi) zeta^m`` are the same columns
+        permuted and scaled (no further cosines). The frame's spin about the axis is not a
+        degree of freedom (a turn of ``phi`` is a rotation inside each harmonic's pair, which
+        neither the fit nor the ridge weights see), so the frame is differentiated without
+        spin: a change ``delta d`` of the axis moves ``e1`` by ``-(e1 . delta d) d``, likewise ``e2``."""
+        pith, d = self.axis_of(theta, base)
+        frame, q, a1, a2, zq, rho, B, pen, med, lhs, rhs = self._labelled_system(pith, d)
+        sol, solve_normal = _lstsq_factored(lhs, rhs)
+        r = lhs @ sol - rhs
+        return r, lambda: self._jacobian(theta, base, frame, q, a1, a2, zq, rho, B, med, pen, lhs, sol, r,
+                                         solve_normal)
+
+    def _labelled_system(self, pith, d):
+        """The labelled ridge system at a pith line: ``(frame, q, a1, a2, zq, rho, B, pen,
+        median rho, lhs, rhs)``, ``lhs = [[1, rho B], [0, diag(pen)]]`` written in place (the
+        same matrix as stacking them; :func:`_design`'s arithmetic, which the Jacobian reads)."""
+        dd, e1, e2 = _frame(d)
+        q = self.points - pith
+        a1, a2, zq = q @ e1, q @ e2, q @ dd
+        rho = np.hypot(a1, a2)
+        B = _trig_powers(np.arctan2(a2, a1), zq / self.z_scale, self.K, self.M)
+        n, p = B.shape
+        med = np.median(rho)
+        pen = np.sqrt(self.ridge * n) * _penalty_weights(self.K, self.M) * med
+        lhs = np.zeros((n + p, p + 1))
+        lhs[:n, 0] = 1.0
+        np.multiply(rho[:, None], B, out=lhs[:n, 1:])
+        lhs[np.arange(n, n + p), np.arange(1, p + 1)] = pen
+        rhs = np.concatenate([self.years, np.zeros(p)])
+        return (dd, e1, e2), q, a1, a2, zq, rho, B, pen, med, lhs, rhs
+
+    def _jacobian(self, theta, base, frame, q, a1, a2, zq, rho, B, med, pen, lhs, sol, r,
+                  solve_normal) -> np.ndarray:
+        d0, b1, b2 = base
+        nv = np.linalg.norm(d0 + theta[0] * b1 + theta[1] * b2)  # the tilt's length before normalising
+        d, e1, e2 = frame
+        K, M = self.K, self.M
+        n, p = B.shape
+        c = sol[1:]
+        # derivatives of (a1, a2, zeta) over theta = (tilt 1, tilt 2, pith 1, pith 2), (n, 4)
+        dds = [(b - d * (d @ b)) / nv for b in (b1, b2)]  # the unit axis' change per tilt
+        da1 = np.stack([-(e1 @ x) * zq for x in dds] + [np.full(n, -(e1 @ b)) for b in (b1, b2)], axis=1)
+        da2 = np.stack([-(e2 @ x) * zq for x in dds] + [np.full(n, -(e2 @ b)) for b in (b1, b2)], axis=1)
+        dz = np.stack([q @ x for x in dds] + [np.full(n, -(d @ b)) for b in (b1, b2)], axis=1) / self.z_scale
+        drho = (a1[:, None] * da1 + a2[:, None] * da2) / rho[:, None]
+        dphi = (a1[:, None] * da2 - a2[:, None] * da1) / (rho ** 2)[:, None]
+        # s and its angle and axial derivatives: the design's columns, permuted and scaled
+        C = c.reshape(2 * K + 1, M + 1)
+        k = np.arange(1, K + 1)[:, None]
+        c_phi = np.zeros_like(C)
+        c_phi[1:K + 1], c_phi[K + 1:] = k * C[K + 1:], -k * C[1:K + 1]
+        c_z = np.zeros_like(C)
+        c_z[:, :M] = C[:, 1:] * np.arange(1, M + 1)
+        s, s_phi, s_z = (B @ np.stack([C.ravel(), c_phi.ravel(), c_z.ravel()], axis=1)).T
+        # dA c: the data rows' model change at fixed coefficients, the ridge rows' pen change
+        dmed = _median_derivative(rho, drho)
+        dAc = np.empty((n + p, 4))
+        dAc[:n] = drho * s[:, None] + rho[:, None] * (s_phi[:, None] * dphi + s_z[:, None] * dz)
+        dAc[n:] = (pen * c)[:, None] * (dmed / med)[None, :]
+        # dA' r: B' (drho r) + B_phi' (rho dphi r) + B_z' (rho dz r), the last two from B' by
+        # the same permutation; the ridge rows' pen change times their residual
+        rd = r[:n]
+        G = B.T @ np.concatenate([drho * rd[:, None], (rho * rd)[:, None] * dphi,
+                                  (rho * rd)[:, None] * dz], axis=1)
+        Gr, Gp, Gz = (x.reshape(2 * K + 1, M + 1, 4) for x in np.split(G, 3, axis=1))
+        Ht = Gr.copy()
+        Ht[1:K + 1] += -k[:, :, None] * Gp[K + 1:]
+        Ht[K + 1:] += k[:, :, None] * Gp[1:K + 1]
+        Ht[:, 1:] += Gz[:, :M] * np.arange(1, M + 1)[None, :, None]
+        dAtr = np.zeros((p + 1, 4))
+        dAtr[1:] = Ht.reshape(p, 4) + (pen * r[n:])[:, None] * (dmed / med)[None, :]
+        # the normal equations' jitter (:func:`_lstsq`, 1e-10 of their mean diagonal) moves
+        # with their trace: sum over the design of A dA, where sum_j B_j^2 = (K + 1) sum_m
+        # zeta^2m, sum_j B_j dB_j/dphi = 0 (cos cos' + sin sin') and sum_j B_j dB_j/dzeta =
+        # (K + 1) sum_m m zeta^(2m - 1)
+        z = zq / self.z_scale
+        m = np.arange(M + 1)
+        s0 = (K + 1) * (z[:, None] ** (2 * m)).sum(axis=1)
+        s1 = (K + 1) * (m[1:] * z[:, None] ** (2 * m[1:] - 1)).sum(axis=1)
+        dtrace = 2 * ((rho * s0) @ drho + (rho ** 2 * s1) @ dz + (pen @ pen) * dmed / med)
+        djitter = 1e-10 * dtrace / (p + 1)
+        return dAc - lhs @ solve_normal(lhs.T @ dAc + dAtr + sol[:, None] * djitter[None, :])
+
+
+def _median_derivative(values: np.ndarray, dvalues: np.ndarray) -> np.ndarray:
+    """Derivative ``(k,)`` of ``np.median(values)`` given ``dvalues (n, k)``: that of the middle
+    element, or the mean of the two middle ones (even ``n``)."""
+    n = len(values)
+    mid = np.argpartition(values, [(n - 1) // 2, n // 2])[[(n - 1) // 2, n // 2]]
+    return dvalues[mid].mean(axis=0)
 
 
 def _hemisphere(n: int) -> np.ndarray:
@@ -263,13 +359,9 @@ def _circle_pith(points, years, group, d, centre):
     return centre + p[0] * e1 + p[1] * e2
 
 
-def _lstsq(lhs: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """Least squares by the normal equations: the systems here are tall (n >> p <= ~150) and
-    ridge-regularised, and LAPACK's SVD-based lstsq was 50x slower on them (profiled).
-
-    The Cholesky factor and solve are LAPACK's ``potrf``/``potrs``, called as
-    ``scipy.linalg.cho_factor``/``cho_solve`` call them (upper factor), without their wrappers'
-    per-call checks (a third of the cost on these small systems; finiteness is checked once)."""
+def _lstsq_factored(lhs: np.ndarray, rhs: np.ndarray):
+    """:func:`_lstsq` and a function solving further normal equations ``(lhs' lhs) x = b``
+    (``b`` ``(p,)`` or ``(p, k)``) with the same factor (the radial Jacobian's projections)."""
     from scipy.linalg import get_lapack_funcs
 
     AtA, Atb = lhs.T @ lhs, lhs.T @ rhs
@@ -277,14 +369,28 @@ def _lstsq(lhs: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     if not (np.isfinite(AtA).all() and np.isfinite(Atb).all()):  # as scipy's check_finite
         raise ValueError("array must not contain infs or NaNs")
     potrf, potrs = get_lapack_funcs(("potrf", "potrs"), (AtA,))
-    c, info = potrf(AtA, lower=False, overwrite_a=True, clean=False)
+    c, info = potrf(AtA, lower=False, overwrite_a=False, clean=False)
     if info > 0:  # not positive definite (cho_factor's LinAlgError)
-        return np.linalg.lstsq(lhs, rhs, rcond=None)[0]
-    if info == 0:
-        x, info = potrs(c, Atb, lower=False, overwrite_b=False)
-    if info != 0:
+        return np.linalg.lstsq(lhs, rhs, rcond=None)[0], lambda b: np.linalg.pinv(AtA) @ b
+    if info < 0:
         raise ValueError(f"LAPACK reported an illegal argument ({info}) in the normal equations")
-    return x
+
+    def solve_normal(b):
+        x, err = potrs(c, b, lower=False, overwrite_b=False)
+        if err != 0:
+            raise ValueError(f"LAPACK reported an illegal argument ({err}) in the normal equations")
+        return x
+    return solve_normal(Atb), solve_normal
+
+
+def _lstsq(lhs: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Least squares by the normal equations: the systems here are tall (n >> p <= ~150) and
+    ridge-regularised, and LAPACK's SVD-based lstsq was 50x slower on them (profiled).
+
+    The Cholesky factor and solve are LAPACK's ``potrf``/``potrs``, called as
+    ``scipy.linalg.cho_factor``/``cho_solve`` call them (upper factor), without their wrappers'
+    per-call checks (a third of the cost on these small systems; finiteness is checked once)."""
+    return _lstsq_factored(lhs, rhs)[0]
 
 
 def _cost(prob: _Problem, pith, d) -> float:
@@ -302,8 +408,20 @@ def _refine(prob: _Problem, pith, d, max_nfev: int):
     off = off - d * (off @ d)
     theta0 = np.array([0.0, 0.0, off @ b1, off @ b2])
     scale = np.array([0.05, 0.05, 5.0, 5.0])
-    res = least_squares(lambda th: prob.solve(*prob.axis_of(th, base))[0], theta0,
-                        x_scale=scale, diff_step=1e-4, max_nfev=max_nfev, method="trf", ftol=1e-6, xtol=1e-6)
+    if prob.years is None:  # unlabelled (levels per ring group): forward differences
+        res = least_squares(lambda th: prob.solve(*prob.axis_of(th, base))[0], theta0,
+                            x_scale=scale, diff_step=1e-4, max_nfev=max_nfev, method="trf", ftol=1e-6, xtol=1e-6)
+    else:  # labelled: the exact variable-projection Jacobian, computed with the residual
+        last: dict = {}
+
+        def both(th):
+            key = th.tobytes()
+            if key not in last:
+                last.clear()
+                last[key] = prob.residual_and_jacobian(th, base)
+            return last[key]
+        res = least_squares(lambda th: both(th)[0], theta0, jac=lambda th: both(th)[1](),
+                            x_scale=scale, max_nfev=max_nfev, method="trf", ftol=1e-6, xtol=1e-6)
     pith, d = prob.axis_of(res.x, base)
     return pith, d, float(res.cost * 2)
 
