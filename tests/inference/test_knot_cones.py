@@ -154,6 +154,52 @@ def test_cone_fits_are_remembered_per_start_and_give_the_same_cone(corner_block,
             np.testing.assert_array_equal(g, w)
 
 
+def test_cone_starts_shared_by_two_workers_are_the_one_worker_fits(corner_block, monkeypatch):
+    """The starts a cone fit has not seen are fitted in a fork and here (``workers=2``): the
+    same cone and the same memo, bit for bit, as one after the other, a start near an earlier
+    start of the same call still taking its fit; and some of them were fitted in the fork (the
+    calls counted here are fewer: a count kept in a fork is lost)."""
+    import woodcam.inference.knots as kn
+    from woodcam._parallel import _CAN_FORK
+
+    if not _CAN_FORK:
+        pytest.skip("forked workers need Linux (woodcam._parallel._CAN_FORK)")
+    exits = knot_exits(corner_block)
+    end = [k for k, e in enumerate(exits) if e["face"] in ("front", "left")]
+    surface = exits[0]["surface"]
+    positive = np.concatenate([exits[k]["pixels"] for k in end])
+    ignore = np.concatenate([exits[k]["pixels"] for k in range(len(exits)) if k not in end])
+    samples = surface[0][positive]
+    c0, r0 = samples.mean(axis=0), float(np.mean([exits[k]["radius_mm"] for k in end]))
+    axes = np.linalg.svd(samples - c0, full_matrices=False)[2]
+    stem_start = axes.sum(axis=0) / np.sqrt(3.0)
+    nudged = stem_start + 0.02 * axes[0]  # ~1.5 degrees off: takes stem_start's fit
+    starts = np.vstack([axes, [stem_start], [nudged / np.linalg.norm(nudged)]])
+    calls = []
+    real = kn._fit_cone_start
+
+    def counting(*args, **kw):
+        calls.append(1)
+        return real(*args, **kw)
+
+    monkeypatch.setattr(kn, "_fit_cone_start", counting)
+    memo1, memo2 = {}, {}
+    one = kn._fit_cone(surface, positive, ignore, c0, starts, r0, memo=memo1, workers=1)
+    assert len(calls) == 4  # five starts, the last near the fourth
+    calls.clear()
+    two = kn._fit_cone(surface, positive, ignore, c0, starts, r0, memo=memo2, workers=2)
+    assert 0 < len(calls) < 4  # the rest were fitted in the fork
+    for g, w in zip(two, one):
+        np.testing.assert_array_equal(g, w)
+    (head1, done1), = memo1.items()
+    (head2, done2), = memo2.items()
+    assert head1 == head2 and len(done1) == len(done2) == 4
+    for (u1, f1), (u2, f2) in zip(done1, done2):
+        np.testing.assert_array_equal(u1, u2)
+        for g, w in zip(f2, f1):
+            np.testing.assert_array_equal(g, w)
+
+
 @pytest.mark.parametrize("x", [[0.3, 0.1, -0.4, 0.2, 0.9, 0.3, 2.5, 0.15],   # radius above its floor
                                [1.0, 2.0, 0.0, 1.2, -0.1, 0.05, 0.5, -0.3]])  # partly at the floor
 def test_cone_jacobian_is_the_derivative_of_the_residuals(x):

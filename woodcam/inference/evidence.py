@@ -381,7 +381,7 @@ def _remembering_last_fold(fit: Callable) -> Callable:
 _FOLD_POINTS = 1000
 
 
-def stem_recipe(size_mm: ArrayLike, seed: int = 0) -> Callable:
+def stem_recipe(size_mm: ArrayLike, seed: int = 0, workers: int | None = None) -> Callable:
     """The stem fit (:func:`~.stem.fit_stem`) as a recipe that remembers its last fit (the
     knots' bend refines the same fold's stem) and warm-starts every later fit from its first
     one. The first observations it is given are all the faces' (:func:`fit_evidence` fits every
@@ -390,13 +390,16 @@ def stem_recipe(size_mm: ArrayLike, seed: int = 0) -> Callable:
     by a local descent (``fit_stem(init=)``: no start search, about 4x cheaper). Measured
     against the fold fits from scratch: dev seed 9101 blocks 0 and 8 (six noisy faces) the same
     held-out scores to 0.01 % and 2 CPU-s less per block; H11's six folds the same choices,
-    every held-out score within 0.3 points, 10-30 % less CPU."""
+    every held-out score within 0.3 points, 10-30 % less CPU. ``workers``: processes the first
+    fit's start search may use (default :func:`~woodcam._parallel.fit_workers`; inside another
+    forked share it runs here, :mod:`woodcam._parallel`)."""
     from .stem import fit_stem
 
     first: dict = {}
 
     def fit(obs: RingObservations):
-        f = fit_stem(obs, size_mm, seed=seed, init=first.get("stem"))
+        cores = 1 if "stem" in first else (fit_workers() if workers is None else int(workers))
+        f = fit_stem(obs, size_mm, seed=seed, init=first.get("stem"), workers=cores)
         first.setdefault("stem", f)
         return f
     return _remembering_last_fold(fit)
@@ -438,22 +441,38 @@ def residual_evidence(obs: RingObservations, chosen: str, fold_fields: dict, siz
     Returns ``{"kept": bool, "gain": mean gain (points), "without": {face: score},
     "with": {face: score}, "why": one line}``.
     """
+    return _residual_verdict([t() for t in _residual_fold_tasks(obs, chosen, fold_fields, size_mm, seed)])
+
+
+def _residual_fold_tasks(obs: RingObservations, chosen: str, fold_fields: dict, size_mm: ArrayLike,
+                         seed: int) -> list[Callable[[], tuple[str, float, float]]]:
+    """One task per held-out face that ``chosen`` could be refitted without: ``() -> (face,
+    score without, score with the residual)`` (:func:`residual_evidence`; independent, so they
+    may run in forks)."""
     from .residual import fit_face_residual
 
-    rng = np.random.default_rng(seed)
-    without, with_ = {}, {}
-    for f in _held_out_faces(obs):
-        base = fold_fields.get((chosen, FACES[f]))
+    def task(f, base, idx):
         held = obs.face == f
-        idx = _held_points(obs, held, rng)  # the same draw as holdout_evidence's
-        if base is None:  # the chosen recipe could not refit this fold: no evidence either way
-            continue
         pts, yrs = obs.points_mm[idx], obs.years[idx]
         g, grad = central_gradient(base, pts, _GRAD_STEP_MM)
         res = fit_face_residual(obs.subset(~held), base, size_mm, seed=seed)
         rg, rgrad = central_gradient(res, pts, _GRAD_STEP_MM)
-        without[FACES[f]] = face_score(_error_mm(g, grad, yrs))
-        with_[FACES[f]] = face_score(_error_mm(g + rg, grad + rgrad, yrs))
+        return FACES[f], face_score(_error_mm(g, grad, yrs)), face_score(_error_mm(g + rg, grad + rgrad, yrs))
+
+    rng = np.random.default_rng(seed)
+    tasks = []
+    for f in _held_out_faces(obs):
+        idx = _held_points(obs, obs.face == f, rng)  # the same draw as holdout_evidence's, in order
+        base = fold_fields.get((chosen, FACES[f]))
+        if base is not None:  # else the chosen recipe could not refit this fold: no evidence either way
+            tasks.append(lambda f=f, base=base, idx=idx: task(f, base, idx))
+    return tasks
+
+
+def _residual_verdict(scored: list[tuple[str, float, float]]) -> dict:
+    """:func:`residual_evidence`'s rule and result from its folds' ``(face, without, with)``."""
+    without = {face: a for face, a, _ in scored}
+    with_ = {face: b for face, _, b in scored}
     if not without:
         return {"kept": False, "gain": 0.0, "without": without, "with": with_,
                 "why": "no face could be held out to check it"}
@@ -472,19 +491,28 @@ def residual_evidence(obs: RingObservations, chosen: str, fold_fields: dict, siz
 
 
 def add_residual(ev: EvidenceFit, obs: RingObservations, size_mm: ArrayLike, fold_fields: dict,
-                 seed: int = 0) -> EvidenceFit:
+                 seed: int = 0, workers: int = 1) -> EvidenceFit:
     """``ev`` with the small-scale residual added to its field where the leave-one-face-out
     evidence keeps it (:func:`residual_evidence`), else ``ev``'s field untouched; either way
-    ``ev.residual`` holds the evidence and ``ev.message`` says what was done."""
+    ``ev.residual`` holds the evidence and ``ev.message`` says what was done.
+
+    ``workers``: processes the folds may use (:func:`woodcam._parallel.share`); with more than
+    one, this process fits the residual on all faces meanwhile, needed or not (the same result)."""
     from .residual import fit_face_residual
 
+    def on_all_faces():
+        return fit_face_residual(obs, ev.field, size_mm, seed=seed)
+
+    full = None
     if ev.unverified:
         ev.residual = {"kept": False, "gain": 0.0, "without": {}, "with": {},
                        "why": "no face could be held out to check it"}
     else:
-        ev.residual = residual_evidence(obs, ev.chosen, fold_fields, size_mm, seed)
+        scored, full = share(_residual_fold_tasks(obs, ev.chosen, fold_fields, size_mm, seed),
+                             on_all_faces if workers > 1 else lambda: None, workers)
+        ev.residual = _residual_verdict(scored)
     if ev.residual["kept"]:
-        ev.field = ResidualField(ev.field, fit_face_residual(obs, ev.field, size_mm, seed=seed))
+        ev.field = ResidualField(ev.field, full if full is not None else on_all_faces())
         ev.message += f"; small-scale residual kept ({ev.residual['why']})"
     else:
         ev.message += f"; small-scale residual not kept ({ev.residual['why']})"
@@ -663,7 +691,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
             alone["rbf"] = _rbf_recipe(EVIDENCE_RBF_POINTS)
         if "residual" in candidates:  # shares radial's fold fits, which nothing here reads
             alone["radial + residual"] = _residual_recipe(hyps[0].refit, EVIDENCE_RBF_POINTS)
-        stem_rec = (stem_recipe(size_mm, seed) if stem is None else stem) if "stem" in candidates else None
+        stem_rec = (stem_recipe(size_mm, seed, workers) if stem is None else stem) if "stem" in candidates else None
 
         def fitted(name, rec, base=None) -> list[Hypothesis]:
             try:
@@ -671,20 +699,23 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
             except WoodcamError:  # too few rings for it: the others still compete
                 return []
 
-        def stateful() -> tuple[list, list]:  # the stem (remembering its fit), then the knots' bend
-            first = fitted("stem", stem_rec) if stem_rec else []
-            return first, [h for name, rec in (recipes or {}).items() for h in fitted(name, rec, (refines or {}).get(name))]
+        # the stem first (remembering its fit; its start search on the fit's cores), then the
+        # knots' bend built on it here while a fork fits the hypotheses that keep no state
+        stems = fitted("stem", stem_rec) if stem_rec else []
+
+        def stateful() -> list:
+            return [h for name, rec in (recipes or {}).items() for h in fitted(name, rec, (refines or {}).get(name))]
 
         def stateless() -> dict:
             return {name: rec(rings) for name, rec in alone.items()}
-        fields, (stems, bends) = beside(stateless, stateful, workers)
+        fields, bends = beside(stateless, stateful, workers)
         hyps += stems + [Hypothesis(name, fields[name], rec, alone=True) for name, rec in alone.items()]
         hyps += bends + list(extra or [])
         predictions: dict = {}
         folds: dict | None = {} if residual else None
         result = choose(hyps, holdout_evidence(hyps, rings, seed, predictions, folds, workers))
         if residual:
-            result = add_residual(result, rings, size_mm, folds, seed)
+            result = add_residual(result, rings, size_mm, folds, seed, workers)
         if blend == "everywhere":
             result = blend_accepted(result)
         elif blend == "away_from_faces" and len(result.accepted) > 1:

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._parallel import map_processes
 from .._types import ArrayLike
 from ..fields.base import central_gradient
 from ..fields.knot_strands import KnotStrand, StemWithKnots
@@ -137,7 +138,8 @@ def knot_exits(block, faces=None) -> list[dict]:
 _LINE_SAMPLES = 256
 
 
-def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False, memo: dict | None = None):
+def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False, memo: dict | None = None,
+              workers: int = 1):
     """A knot's cone fitted to the knot masks of every face: ``(c (3,), u (3,), rc, slope,
     cost)``; ``u0`` (3,) or (k, 3) starting directions, the fit of least cost kept (the first of
     equal costs); ``outward``: each ``u0`` points away from the pith and the radius may not
@@ -161,21 +163,34 @@ def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False, memo
     mean radius). Why: the exits' centroids and areas alone misplace a strand whose exits are
     cut by a block edge or split over two faces, and its bend and rings then land off the knot
     (dev seed 7777 block 2: the true strand takes the bend's cut planes from 26 to 94 % within
-    1 mm; scipy has no cone fit, so it is written here)."""
+    1 mm; scipy has no cone fit, so it is written here).
+
+    ``workers``: processes the starts not yet fitted are shared among
+    (:func:`woodcam._parallel.map_processes`; the same fits, bit for bit); a start that would
+    take an earlier start's fit of this call waits for it, as one after the other."""
     head = (np.asarray(positive).tobytes(), np.asarray(ignore).tobytes(), np.asarray(c0, float).tobytes(),
             float(r0), bool(outward))
     done = [] if memo is None else memo.setdefault(head, [])  # (start (3,), fit) of this problem
     cos_near = np.cos(np.radians(KNOT_CONE_START_REUSE_DEG))
-    problem, best = None, None
+    known, fresh, picks = list(done), [], []  # picks: a fit, or the index of a start to fit
     for u_start in np.atleast_2d(np.asarray(u0, float)):  # several starting directions
-        fit = next((f for u, f in done if u @ u_start >= cos_near * np.linalg.norm(u) * np.linalg.norm(u_start)),
-                   None)
-        if fit is None:
-            if problem is None:
-                problem = _cone_problem(surface, positive, ignore, c0, r0)
-            fit = _fit_cone_start(problem, c0, u_start, r0, outward)
-            if memo is not None:
-                done.append((u_start.copy(), fit))
+        pick = next((f for u, f in known if u @ u_start >= cos_near * np.linalg.norm(u) * np.linalg.norm(u_start)),
+                    None)
+        if pick is None:
+            pick = len(fresh)
+            fresh.append(u_start.copy())
+            if memo is not None:  # a later start near this one takes its fit
+                known.append((u_start.copy(), pick))
+        picks.append(pick)
+    fits = []
+    if fresh:
+        problem = _cone_problem(surface, positive, ignore, c0, r0)
+        fits = map_processes(lambda u: _fit_cone_start(problem, c0, u, r0, outward), fresh, workers)
+        if memo is not None:
+            done.extend(zip(fresh, fits))
+    best = None
+    for pick in picks:
+        fit = fits[pick] if isinstance(pick, int) else pick
         if best is None or fit[4] < best[4]:  # the least misfit wins
             best = fit
     return best
@@ -347,14 +362,14 @@ def _end_centre(exits, end, cones: bool) -> np.ndarray:
 
 
 def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
-                       cones: bool = False) -> list[KnotStrand]:
+                       cones: bool = False, workers: int = 1) -> list[KnotStrand]:
     """Strands of the knot ``exits`` (:func:`knot_exits`) in ``stem``, a block of ``size_mm``
     (module docstring). ``cones``: exits touching across a block edge are one knot end
     (:func:`_ends`), and a paired strand's line and radius are its cone fitted to the face masks
     (:func:`_fit_cone`; exits from :func:`knot_exits` carry the samples); False: the line
     through two exits' centroids with radii from their areas (what
     :func:`~.fit.fit_block` ``(knot_cones=False)`` uses; the fit's default is the cones since
-    FIT_VERSION 10)."""
+    FIT_VERSION 10). ``workers``: processes each cone's starts may use (:func:`_fit_cone`)."""
     if not exits:
         return []
     axis = np.asarray(getattr(stem, "axis", (0.0, 0.0, 1.0)), float)
@@ -386,11 +401,11 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
             positive = np.concatenate([exits[k]["pixels"] for k in group])
             ignore = np.concatenate([exits[k]["pixels"] for k in others]) if others else np.zeros(0, int)
             cone = _fit_cone(surface, positive, ignore, c0, starts,
-                             float(np.mean([exits[k]["radius_mm"] for k in group])), memo=memo)
+                             float(np.mean([exits[k]["radius_mm"] for k in group])), memo=memo, workers=workers)
             c0, u = cone[0], cone[1]
             if _pith_first(stem, c0, u, length) == (cone[3] < 0):  # thinner away from the pith
                 cone = _fit_cone(surface, positive, ignore, c0, -u if cone[3] < 0 else u, cone[2], outward=True,
-                                 memo=memo)
+                                 memo=memo, workers=workers)
                 c0, u = cone[0], cone[1]
         tt = (anchors - c0) @ u
         start, dist = c0 + tt.min() * u, float(np.ptp(tt))
@@ -564,12 +579,20 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0,
     return plain, out
 
 
-def with_knots(block, stem, faces=None, cones: bool = False, exits: list[dict] | None = None):
+def with_knots(block, stem, faces=None, cones: bool = False, exits: list[dict] | None = None,
+               workers: int | None = None):
     """``(field, strands)``: ``stem`` with the masked knots joined in, or ``stem`` unchanged.
     ``exits``: the block's :func:`knot_exits` where already found (their cone fits are
-    remembered with them: the strands of a chosen field reuse the folds' cones)."""
+    remembered with them: the strands of a chosen field reuse the folds' cones). ``workers``:
+    processes a cone's starts may use (default :func:`woodcam._parallel.fit_workers`; where
+    no fold fitted the cones, e.g. no knot is pinned by two faces, they are fitted here)."""
+    from .._parallel import fit_workers
+    from .._threads import one_blas_thread
+
     exits = knot_exits(block, faces) if exits is None else exits
-    strands = strands_from_exits(exits, stem, block.size_mm, cones)
+    with one_blas_thread():  # as inside the evidence fit, whose folds fitted the cones it reuses
+        strands = strands_from_exits(exits, stem, block.size_mm, cones,
+                                     fit_workers() if workers is None else int(workers))
     return (StemWithKnots(stem, strands) if strands else stem), strands
 
 

@@ -47,6 +47,7 @@ from dataclasses import field as dc_field
 
 import numpy as np
 
+from .._parallel import map_processes
 from .._types import ArrayLike
 from ..errors import WoodcamError
 from ..fields.base import check_points
@@ -280,7 +281,7 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
              curve_prior_mm: float = STEM_CURVE_PRIOR_MM, n_search: int = 500,
              n_fit: int = 1000, n_starts: int = 2, n_final: int = 2, seed: int = 0,
              history: bool = True, offset_years: ArrayLike | None = None,
-             init: StemField | None = None) -> StemField:
+             init: StemField | None = None, workers: int = 1) -> StemField:
     """Fit the stem model (module docstring) to labelled ring observations of a block.
 
     The result depends on ``obs`` and the arguments only (no other face's data enters it), so
@@ -303,6 +304,8 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
         is fitted to ``obs.years - offset_years``; default none
     init : a stem fitted to nearly the same targets: its base axis and centreline are the one
         start, refined at full order (no start search; about 4x cheaper)
+    workers : processes the starts' and the finals' descents may use
+        (:func:`woodcam._parallel.map_processes`; the same fit bit for bit)
 
     Returns
     -------
@@ -339,15 +342,16 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
     coarse = []
     if init is not None:  # warm start: one start, the given centreline
         coarse.append((0.0, np.asarray(init.curve, float).T.reshape(-1), np.asarray(init.base_axis, float)))
+    starts = []  # (problem, start) of every base axis, each descent independent of the others
     for d0 in (_base_axes(size, base_axes) if init is None else []):
         prob = problem(i_s, d0, min(K, 2), 0)
-        for _, th in _starts(prob, obs, i_s, size, n_starts):
-            th, cost = _refine(prob, th, 20)
-            coarse.append((cost, th, d0))
+        starts += [(prob, th, d0) for _, th in _starts(prob, obs, i_s, size, n_starts)]
+    coarse += [(cost, th, d0) for (th, cost), (_, _, d0)
+               in zip(map_processes(lambda s: _refine(s[0], s[1], 20), starts, workers), starts)]
     coarse.sort(key=lambda c: c[0])
+    finals = map_processes(lambda c: _refine(problem(i_f, c[2], K, M), c[1], 30), coarse[:n_final], workers)
     best = None
-    for _, th, d0 in coarse[:n_final]:
-        th, cost = _refine(problem(i_f, d0, K, M), th, 30)
+    for (th, cost), (_, _, d0) in zip(finals, coarse[:n_final]):
         if best is None or cost < best[0]:
             best = (cost, th, d0)
     _, th, d0 = best
