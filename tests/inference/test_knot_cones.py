@@ -102,6 +102,34 @@ def test_a_cone_bend_the_rings_do_not_show_is_rejected(corner_block):
     assert ev.scores["stem + knot bend"]["mean"] < ev.scores["stem"]["mean"] - 2.0, ev.scores
 
 
+def _count_cone_fits(monkeypatch) -> list:
+    """A list that grows by one for each single-start cone fit made in this process."""
+    import woodcam.inference.knots as kn
+
+    calls: list = []
+    real = kn._fit_cone_start
+
+    def counting(*args, **kw):
+        calls.append(1)
+        return real(*args, **kw)
+
+    monkeypatch.setattr(kn, "_fit_cone_start", counting)
+    return calls
+
+
+def _corner_end(block):
+    """The cone problem of ``block``'s knot end cut by the front/left edge: ``(surface,
+    positive, ignore, c0, r0, axes)``, ``axes`` (3, 3) its samples' principal directions."""
+    exits = knot_exits(block)
+    end = [k for k, e in enumerate(exits) if e["face"] in ("front", "left")]
+    surface = exits[0]["surface"]
+    positive = np.concatenate([exits[k]["pixels"] for k in end])
+    ignore = np.concatenate([exits[k]["pixels"] for k in range(len(exits)) if k not in end])
+    samples = surface[0][positive]
+    c0, r0 = samples.mean(axis=0), float(np.mean([exits[k]["radius_mm"] for k in end]))
+    return surface, positive, ignore, c0, r0, np.linalg.svd(samples - c0, full_matrices=False)[2]
+
+
 def test_cone_fits_are_remembered_per_start_and_give_the_same_cone(corner_block, monkeypatch):
     """A knot end cut by an edge starts its cone from its samples' three axes and one direction
     down the stem's years, the only one that changes between folds: the memo keeps each start's
@@ -111,14 +139,7 @@ def test_cone_fits_are_remembered_per_start_and_give_the_same_cone(corner_block,
     this test fails; with no reuse angle the third call refits."""
     import woodcam.inference.knots as kn
 
-    exits = knot_exits(corner_block)
-    end = [k for k, e in enumerate(exits) if e["face"] in ("front", "left")]
-    surface = exits[0]["surface"]
-    positive = np.concatenate([exits[k]["pixels"] for k in end])
-    ignore = np.concatenate([exits[k]["pixels"] for k in range(len(exits)) if k not in end])
-    samples = surface[0][positive]
-    c0, r0 = samples.mean(axis=0), float(np.mean([exits[k]["radius_mm"] for k in end]))
-    axes = np.linalg.svd(samples - c0, full_matrices=False)[2]
+    surface, positive, ignore, c0, r0, axes = _corner_end(corner_block)
     from scipy.spatial.transform import Rotation
 
     from woodcam.tolerances import KNOT_CONE_START_REUSE_DEG
@@ -133,14 +154,7 @@ def test_cone_fits_are_remembered_per_start_and_give_the_same_cone(corner_block,
     angle = np.degrees(np.arccos(np.clip(np.abs(np.vstack([axes, [stem_start]]) @ turned), -1.0, 1.0)))
     assert angle.min() > 2 * KNOT_CONE_START_REUSE_DEG  # turned: far from every fitted start
 
-    calls = []
-    real = kn._fit_cone_start
-
-    def counting(*args, **kw):
-        calls.append(1)
-        return real(*args, **kw)
-
-    monkeypatch.setattr(kn, "_fit_cone_start", counting)
+    calls = _count_cone_fits(monkeypatch)
     memo: dict = {}
     a = kn._fit_cone(surface, positive, ignore, c0, starts_a, r0, memo=memo)
     assert len(calls) == 4
@@ -164,25 +178,11 @@ def test_cone_starts_shared_by_two_workers_are_the_one_worker_fits(corner_block,
 
     if not _CAN_FORK:
         pytest.skip("forked workers need Linux (woodcam._parallel._CAN_FORK)")
-    exits = knot_exits(corner_block)
-    end = [k for k, e in enumerate(exits) if e["face"] in ("front", "left")]
-    surface = exits[0]["surface"]
-    positive = np.concatenate([exits[k]["pixels"] for k in end])
-    ignore = np.concatenate([exits[k]["pixels"] for k in range(len(exits)) if k not in end])
-    samples = surface[0][positive]
-    c0, r0 = samples.mean(axis=0), float(np.mean([exits[k]["radius_mm"] for k in end]))
-    axes = np.linalg.svd(samples - c0, full_matrices=False)[2]
+    surface, positive, ignore, c0, r0, axes = _corner_end(corner_block)
     stem_start = axes.sum(axis=0) / np.sqrt(3.0)
     nudged = stem_start + 0.02 * axes[0]  # ~1.5 degrees off: takes stem_start's fit
     starts = np.vstack([axes, [stem_start], [nudged / np.linalg.norm(nudged)]])
-    calls = []
-    real = kn._fit_cone_start
-
-    def counting(*args, **kw):
-        calls.append(1)
-        return real(*args, **kw)
-
-    monkeypatch.setattr(kn, "_fit_cone_start", counting)
+    calls = _count_cone_fits(monkeypatch)
     memo1, memo2 = {}, {}
     one = kn._fit_cone(surface, positive, ignore, c0, starts, r0, memo=memo1, workers=1)
     assert len(calls) == 4  # five starts, the last near the fourth
