@@ -120,6 +120,9 @@ def test_bad_inputs_give_clear_errors(field):
         fit_block(one, "radial", faces=["left"])
     with pytest.raises(WoodcamError, match="method must be one of evidence, rbf, radial"):
         fit_block(one, "magic")
+    for seed in (-1, 1.5, True):
+        with pytest.raises(WoodcamError, match="seed must be an integer >= 0"):
+            fit_block(one, "evidence", seed=seed)
     squashed = Block((50, 50, 50), {"front": Face("front", (100, 50), traces=[
         RingTrace(np.array([[10.0, 5.0], [90.0, 40.0]]), 3)])})
     with pytest.raises(WoodcamError, match="not square; check size_mm"):

@@ -169,7 +169,7 @@ def _score(face: str, years: np.ndarray, ridge: np.ndarray, excl, thresholds) ->
 def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
                        out_dir: PathLike | None = None,
                        progress: Callable[[str], object] | None = None,
-                       reference: Block | None = None) -> dict:
+                       reference: Block | None = None, seed: int = 0) -> dict:
     """Fit ``block`` on all faces but one for each face with a ring map, score the held-out face.
 
     Parameters
@@ -183,6 +183,8 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
     out_dir : folder for ``{block}_{method}.png`` (per face: photo, ring map, predicted ARF,
         overlay of ridge and predicted lines) and ``{block}_holdout.md``; None writes nothing.
     progress : optional callable taking one line of text per fit.
+    seed : the evidence fit's random seed (:func:`~woodcam.inference.fit.fit_block`; other
+        methods ignore it): a real cube's held-out score can swing with it (H11, README).
 
     Returns
     -------
@@ -205,11 +207,11 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
     insample = {m: [] for m in methods}
     times = {m: [] for m in methods}
     for m in methods:
-        full = fit_block(block, m)
+        full = fit_block(block, m, seed=seed)
         for face in faces:
             excl, ridge = refs[face]
             t0 = time.perf_counter()
-            fit = fit_block(block, m, faces=[f for f in block.faces if f != face])
+            fit = fit_block(block, m, faces=[f for f in block.faces if f != face], seed=seed)
             times[m].append(time.perf_counter() - t0)
             shape = block.faces[face].shape
             years = face_years(fit, face, shape, block.size_mm)
