@@ -89,8 +89,8 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         ``meta["residual"]`` says whether it was kept and why (README).
     seed : evidence only: the random seed of its held-out points, fitting subsets and starts
         (the stem's and its knots' bend's too). Real cubes' held-out figures are worth
-        reporting over several (H11's ratio to chance was 1.61x with seed 0 and ~1.0 with
-        seeds 1-3: README, "H11's held-out figure is a matter of seed").
+        reporting over several (H11's ratio to chance: 1.37x with seed 0, 0.92-1.07x with
+        seeds 1-3; README, "H11's held-out figure is a matter of seed").
     Returns
     -------
     field : callable ``(n, 3) mm -> (n,) years`` in the block frame.
