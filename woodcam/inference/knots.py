@@ -172,25 +172,26 @@ def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False, memo
             float(r0), bool(outward))
     done = [] if memo is None else memo.setdefault(head, [])  # (start (3,), fit) of this problem
     cos_near = np.cos(np.radians(KNOT_CONE_START_REUSE_DEG))
-    known, fresh, picks = list(done), [], []  # picks: a fit, or the index of a start to fit
+    fits = [f for _, f in done]  # every fit this call may take, by index: the memo's, then its own
+    known = [(u, i) for i, (u, _) in enumerate(done)]
+    fresh, picks = [], []  # the starts to fit; the fit each start takes
     for u_start in np.atleast_2d(np.asarray(u0, float)):  # several starting directions
-        pick = next((f for u, f in known if u @ u_start >= cos_near * np.linalg.norm(u) * np.linalg.norm(u_start)),
+        pick = next((i for u, i in known if u @ u_start >= cos_near * np.linalg.norm(u) * np.linalg.norm(u_start)),
                     None)
         if pick is None:
-            pick = len(fresh)
+            pick = len(fits) + len(fresh)
             fresh.append(u_start.copy())
             if memo is not None:  # a later start near this one takes its fit
                 known.append((u_start.copy(), pick))
         picks.append(pick)
-    fits = []
     if fresh:
         problem = _cone_problem(surface, positive, ignore, c0, r0)
-        fits = map_processes(lambda u: _fit_cone_start(problem, c0, u, r0, outward), fresh, workers)
+        new = map_processes(lambda u: _fit_cone_start(problem, c0, u, r0, outward), fresh, workers)
+        fits += new
         if memo is not None:
-            done.extend(zip(fresh, fits))
+            done.extend(zip(fresh, new))
     best = None
-    for pick in picks:
-        fit = fits[pick] if isinstance(pick, int) else pick
+    for fit in (fits[i] for i in picks):
         if best is None or fit[4] < best[4]:  # the least misfit wins
             best = fit
     return best

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -180,6 +181,25 @@ def _warp(linear: np.ndarray, levels: np.ndarray, years: np.ndarray) -> np.ndarr
 
 # -- the fit ----------------------------------------------------------------------------------
 
+class _LabelledSystem(NamedTuple):
+    """:meth:`_Problem._labelled_system`: the pith line's frame ``(d, e1, e2)``, the points
+    about the pith ``q (n, 3)``, their coordinates ``a1, a2`` (along ``e1, e2``) and ``zq``
+    (along ``d``, mm), ``rho (n,)``, the basis ``B (n, p)``, the ridge weights ``pen (p,)``,
+    ``median(rho)`` and the system ``lhs (n + p, p + 1)``, ``rhs (n + p,)``."""
+
+    frame: tuple
+    q: np.ndarray
+    a1: np.ndarray
+    a2: np.ndarray
+    zq: np.ndarray
+    rho: np.ndarray
+    B: np.ndarray
+    pen: np.ndarray
+    med: float
+    lhs: np.ndarray
+    rhs: np.ndarray
+
+
 @dataclass
 class _Problem:
     points: np.ndarray          # (n, 3)
@@ -201,9 +221,9 @@ class _Problem:
     def solve(self, pith, d):
         """Inner linear problem; returns (residuals incl. penalty rows, coef, offset, levels)."""
         if self.years is not None:
-            lhs, rhs = self._labelled_system(pith, d)[-2:]
-            sol = _lstsq(lhs, rhs)
-            return lhs @ sol - rhs, sol[1:], sol[0], None
+            system = self._labelled_system(pith, d)
+            sol = _lstsq(system.lhs, system.rhs)
+            return system.lhs @ sol - system.rhs, sol[1:], sol[0], None
         dd, e1, e2 = _frame(d)
         rho, B = _design(self.points, pith, dd, e1, e2, self.z_scale, self.K, self.M)
         pen = np.sqrt(self.ridge * len(B)) * _penalty_weights(self.K, self.M) * np.median(rho)
@@ -238,17 +258,15 @@ class _Problem:
         degree of freedom (a turn of ``phi`` is a rotation inside each harmonic's pair, which
         neither the fit nor the ridge weights see), so the frame is differentiated without
         spin: a change ``delta d`` of the axis moves ``e1`` by ``-(e1 . delta d) d``, likewise ``e2``."""
-        pith, d = self.axis_of(theta, base)
-        frame, q, a1, a2, zq, rho, B, pen, med, lhs, rhs = self._labelled_system(pith, d)
-        sol, solve_normal = _lstsq_factored(lhs, rhs)
-        r = lhs @ sol - rhs
-        return r, lambda: self._jacobian(theta, base, frame, q, a1, a2, zq, rho, B, med, pen, lhs, sol, r,
-                                         solve_normal)
+        system = self._labelled_system(*self.axis_of(theta, base))
+        sol, solve_normal = _lstsq_factored(system.lhs, system.rhs)
+        r = system.lhs @ sol - system.rhs
+        return r, lambda: self._jacobian(theta, base, system, sol, r, solve_normal)
 
-    def _labelled_system(self, pith, d):
-        """The labelled ridge system at a pith line: ``(frame, q, a1, a2, zq, rho, B, pen,
-        median rho, lhs, rhs)``, ``lhs = [[1, rho B], [0, diag(pen)]]`` written in place (the
-        same matrix as stacking them; :func:`_design`'s arithmetic, which the Jacobian reads)."""
+    def _labelled_system(self, pith, d) -> _LabelledSystem:
+        """The labelled ridge system at a pith line, ``lhs = [[1, rho B], [0, diag(pen)]]``
+        written in place (the same matrix as stacking them; :func:`_design`'s arithmetic), with
+        the coordinates the Jacobian reads."""
         dd, e1, e2 = _frame(d)
         q = self.points - pith
         a1, a2, zq = q @ e1, q @ e2, q @ dd
@@ -262,13 +280,12 @@ class _Problem:
         np.multiply(rho[:, None], B, out=lhs[:n, 1:])
         lhs[np.arange(n, n + p), np.arange(1, p + 1)] = pen
         rhs = np.concatenate([self.years, np.zeros(p)])
-        return (dd, e1, e2), q, a1, a2, zq, rho, B, pen, med, lhs, rhs
+        return _LabelledSystem((dd, e1, e2), q, a1, a2, zq, rho, B, pen, med, lhs, rhs)
 
-    def _jacobian(self, theta, base, frame, q, a1, a2, zq, rho, B, med, pen, lhs, sol, r,
-                  solve_normal) -> np.ndarray:
+    def _jacobian(self, theta, base, system: _LabelledSystem, sol, r, solve_normal) -> np.ndarray:
         d0, b1, b2 = base
         nv = np.linalg.norm(d0 + theta[0] * b1 + theta[1] * b2)  # the tilt's length before normalising
-        d, e1, e2 = frame
+        (d, e1, e2), q, a1, a2, zq, rho, B, pen, med, lhs, _ = system
         K, M = self.K, self.M
         n, p = B.shape
         c = sol[1:]
