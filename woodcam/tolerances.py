@@ -447,6 +447,15 @@ KNOT_END_TOUCH_MM = 2.0 * KNOT_CONE_SAMPLE_MM
 #: rounds 99 / 74 / 98 %; a warm-started round costs about a quarter of a stem fit.
 KNOT_BEND_ROUNDS = 3
 
+#: Faces carrying rings that the knots' bend with a residual (the ``"stem + knot bend +
+#: residual"`` hypothesis, :func:`woodcam.inference.knots.knot_bend_recipes`) needs: the
+#: residual is a thin plate fitted on the faces, and with three faces meeting at a corner it
+#: extrapolates over the three unseen ones, where its folds (two faces each) cannot judge it.
+#: Knotted blocks, noisy traces, within 1 / 2 mm, FIT_VERSION 14 -> with it on three faces:
+#: seed 35089 47.6 / 62.4 -> 48.9 / 63.7, 60661 46.6 / 62.0 -> 46.6 / 62.0, 73939 47.0 / 62.4 ->
+#: 43.6 / 61.5 (block 15: 96.7 -> 83.5 within 2 mm); with six faces it gains on all three.
+KNOT_BEND_RESIDUAL_MIN_FACES = 4
+
 #: The joint fit keeps the plain stem when more than this share of the rings have a growth time
 #: at or below the fitted pith's: seed 003's bend is a share of the time since the pith, which
 #: such a stem (its "pith" beyond the rings' far side, density negative) does not give; dev

@@ -11,7 +11,9 @@ faces it was *not* fitted to can. So:
    taken as given: each recipe corrects mislabelled traces its own way), the best radial stem
    plus a smoothed RBF of its residual
    (part 4's small-scale distortion, seed 000 Fig. 16b), and the stem model of part 2
-   (:mod:`.stem`: a curved pith near a block axis, ring density by direction, height and year).
+   (:mod:`.stem`: a curved pith near a block axis, ring density by direction, height and year);
+   :func:`~.fit.fit_block` adds the stem bent round the masked knots and that bend with a
+   residual of its own (:func:`~.knots.knot_bend_recipes`).
 2. Evidence: for each observed face ``f`` every hypothesis' *recipe* is refitted on the other
    faces and predicts ``f``'s ring points. Every recipe sees the fold's faces only: a radial
    hypothesis refits its pith axis by descending from its own axis (the hypothesis names the
@@ -285,11 +287,17 @@ def _set_aside(hypotheses: list[Hypothesis], scores: dict) -> dict[str, str]:
     plain = [h.name for h in hypotheses if h.refines is None]
     if not plain:
         return {}
-    best = max(scores[n]["mean"] for n in plain)
     out = {}
     for h in hypotheses:
         if h.refines is None:
             continue
+        # a plain hypothesis built on this one (named after it: "stem + knot bend + residual")
+        # is not a rival it must beat: on a block bent exactly as the bend models, both score
+        # 100 % and the gain rule would set the bend aside for its own copy with a residual
+        rivals = [n for n in plain if not n.startswith(h.name + " + ")]
+        if not rivals:
+            continue
+        best = max(scores[n]["mean"] for n in rivals)
         base = scores.get(h.refines, {}).get("mean", float("nan"))
         own = scores[h.name]["mean"]
         if not base >= best - EVIDENCE_REFINE_BASE_MARGIN:  # also when the base is missing (nan)

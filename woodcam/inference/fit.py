@@ -36,8 +36,10 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: hypothesis, unless it misses more than twice what the base misses; 14: the radial axis
 #: searches of year-labelled rings take the exact variable-projection Jacobian instead of forward
 #: differences, the same optima to rounding: 95 of the 96 fresh-seed fits the same to 0.1 point,
-#: one block 0.1 point apart; the chosen field's cones fitted on one BLAS thread, as the folds').
-FIT_VERSION = 14
+#: one block 0.1 point apart; the chosen field's cones fitted on one BLAS thread, as the folds';
+#: 15: the knots' bend with a residual competes as a plain hypothesis, and the bend's fold fits
+#: start from its all-faces fit, :func:`woodcam.inference.knots.knot_bend_recipes`).
+FIT_VERSION = 15
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
@@ -73,7 +75,11 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         faces where they were without the bend, or in the stem's place where the stem is the
         best plain hypothesis and the bend misses at most
         :data:`~woodcam.tolerances.EVIDENCE_REFINE_MISS_RATIO` times what it misses
-        (:func:`woodcam.inference.evidence.choose`; README). ``False`` leaves it out.
+        (:func:`woodcam.inference.evidence.choose`; README). The same bend with a residual on
+        it (``"stem + knot bend + residual"``, a smoothed thin-plate RBF of what the bend leaves
+        on the faces) competes as a plain hypothesis where four or more faces carry rings
+        (FIT_VERSION 15: the cone bend misfits the faces near its exits while its inside is
+        right). ``False`` leaves both out.
     knot_cones : evidence only (default True): each knot's strand and radius are the cone fitted
         to every face's knot mask, exits touching across a block edge one knot end
         (:func:`woodcam.inference.knots.strands_from_exits`); ``False``: the line through two
@@ -106,20 +112,26 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
     obs = gather_observations(block, faces)
     if method == "evidence":
         from ..fields.knot_strands import StemWithKnots
+        from ..fields.residual import ResidualField
+        from ..tolerances import KNOT_BEND_RESIDUAL_MIN_FACES
         from .evidence import bake_evidence, fit_evidence
         from .knots import knot_bend_recipes, knot_exits, with_knots
 
         # the stem with the rings bent round its knots competes as more hypotheses
         exits = knot_exits(block, faces)  # once: their cone fits are remembered with them
-        stem, recipes = (knot_bend_recipes(block.size_mm, exits, seed=seed, cones=knot_cones)
-                         if knot_bend else (None, None))
-        ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem,
-                          refines=dict.fromkeys(recipes or {}, "stem"), residual=residual, seed=seed)
-        if isinstance(getattr(ev.field, "base", ev.field), StemWithKnots):  # it holds its knots already
-            strands = ev.field.strands
+        used = sorted({int(i) for i in np.unique(obs.face)})
+        stem, recipes, refines = (knot_bend_recipes(block.size_mm, exits, seed=seed, cones=knot_cones,
+                                                    residual=len(used) >= KNOT_BEND_RESIDUAL_MIN_FACES)
+                                  if knot_bend else (None, None, None))
+        ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem, refines=refines,
+                          residual=residual, seed=seed)
+        base = ev.field
+        while isinstance(base, ResidualField):  # a residual (or two) on the chosen field
+            base = base.base
+        if isinstance(base, StemWithKnots):  # it holds its knots already
+            strands = base.strands
         else:
             ev.field, strands = with_knots(block, ev.field, faces, knot_cones, exits)  # knots from the masks (part 3)
-        used = sorted({int(i) for i in np.unique(obs.face)})
         return bake_evidence(ev, block.size_mm, used, strands) if baked else ev
     if method == "rbf":
         if not obs.labelled:  # the seed's RBF needs years: number the rings as the radial fit does
