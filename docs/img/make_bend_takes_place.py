@@ -19,21 +19,28 @@ from woodcam.inference.evaluate import DEFAULT_PLANES, evaluate_fits, plot_plane
 OUT = Path(__file__).parent / "bend_takes_place_63311.png"
 
 
-def main():
+def hypotheses_on_planes(seed: int, index: int, labels: dict, out: Path, title) -> None:
+    """Fit benchmark block ``(seed, index)`` (six noisy faces, the default evidence fit) and draw
+    the cut planes of the hypotheses ``labels`` (name -> row label) against the true rings;
+    ``title(info, held)`` makes the title from the block's info and the held-out scores."""
     warnings.simplefilter("ignore")
-    block, info = make_block(63311, 2, "noisy", "realistic", 256)
+    block, info = make_block(seed, index, "noisy", "realistic", 256)
     ev = fit_block(block, baked=False)
     held = {n: v["mean"] for n, v in ev.scores.items()}
-    fields = {"stem (before)": ev.hypotheses["stem"], "bend (now)": ev.hypotheses["stem + knot bend"]}
+    fields = {label: ev.hypotheses[n] for n, label in labels.items()}
     sc = evaluate_fits(block.true_field, fields, block.size_mm, DEFAULT_PLANES, BENCH_PIXEL_MM, keep_lines=True)
     for k, v in sc.items():
         print(f"{k}: {v[0]['matched_1']:.1f} / {v[0]['matched_2']:.1f} % within 1 / 2 mm")
     print(ev.message)
-    plot_planes(OUT, {k: v[1] for k, v in sc.items()},
-                title=f"dev seed 63311 {info['name']} (six faces, noisy), black = true rings: the plain stem, "
-                      f"chosen before (held out {held['stem']:.1f} %), and the stem + knot bend, chosen now "
-                      f"(held out {held['stem + knot bend']:.1f} %)")
-    Image.open(OUT).convert("RGB").quantize(64).save(OUT, optimize=True)
+    plot_planes(out, {k: v[1] for k, v in sc.items()}, title=title(info, held))
+    Image.open(out).convert("RGB").quantize(64).save(out, optimize=True)
+
+
+def main():
+    hypotheses_on_planes(63311, 2, {"stem": "stem (before)", "stem + knot bend": "bend (now)"}, OUT,
+                         lambda info, held: f"dev seed 63311 {info['name']} (six faces, noisy), black = true rings: "
+                         f"the plain stem, chosen before (held out {held['stem']:.1f} %), and the stem + knot bend, "
+                         f"chosen now (held out {held['stem + knot bend']:.1f} %)")
 
 
 if __name__ == "__main__":

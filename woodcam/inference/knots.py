@@ -549,17 +549,16 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
     ``"stem + knot bend + residual"`` (the same with a smoothed thin-plate RBF of what it leaves
     on the faces, as ``"radial + residual"`` on the radial fit; :func:`~.fit.fit_block` offers
     it where :data:`~woodcam.tolerances.KNOT_BEND_RESIDUAL_MIN_FACES` faces carry rings) and,
-    with ``guessed``, ``"stem + guessed knot
-    bend"`` (every strand). ``refines``, name -> base, marks the bends as refinements of
-    ``"stem"`` (:attr:`~.evidence.Hypothesis.refines`); the bend with its residual competes as a
-    plain hypothesis.
+    with ``guessed``, ``"stem + guessed knot bend"`` (every strand). ``refines``, name -> base,
+    marks the bends as refinements of ``"stem"`` (:attr:`~.evidence.Hypothesis.refines`); the
+    bend with its residual competes as a plain hypothesis.
 
     Why the residual: the stem model bent by the cones cannot follow the rings within a knot
     radius or two of an exit, where the generator's curved strand, its growing radius and its
-    death bend them (fresh seed 35089, six noisy faces, block 18: the bend fits its own faces'
-    ring points at 47 % where the truth's own field reaches 93 %), so its held-out faces score
-    low (39 %) although its inside is the best of all (81 % within 2 mm against the chosen
-    62 %). The residual takes the faces' misfit and leaves the bend's inside; on 35089's
+    death bend them (seed 35089, six noisy faces, block 18: the bend fits its own faces' ring
+    points at 47 % where the truth's own field reaches 93 %), so its held-out faces score low
+    (50 %, 39 % from cold fold starts, below) although its inside is the best of all (81 % within
+    2 mm against the chosen 62 %). The residual takes the faces' misfit and leaves the bend's inside; on 35089's
     blocks 2, 6, 14 and 18 its held-out evidence was the best and its inside 98 / 85 / 78 / 90 %
     against the chosen 63 / 77 / 59 / 62 % (README, "The knots' bend with a residual").
 
