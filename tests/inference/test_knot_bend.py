@@ -279,7 +279,7 @@ def test_the_bend_with_a_residual_wins_where_the_bend_misfits_its_faces():
     bend's fold fits started from each fold's plain stem the bend's held-out score falls to
     39 % and its residual's (64.5 %) below ``"radial + residual"``'s (66.0 %): this test fails
     either way. (35089 was a validation seed of FIT_VERSION 14; the change was validated on the
-    fresh seed 73939, README.)"""
+    fresh seeds 73939 and 50287, README.)"""
     import warnings
 
     from woodcam.bench_realistic import BENCH_PIXEL_MM, make_block

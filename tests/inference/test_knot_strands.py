@@ -226,8 +226,10 @@ def test_branches_on_both_sides_of_a_pith_inside_the_block_start_at_the_pith():
     """A pith through the block and two branches out of it, 90 degrees apart (a whorl), each
     leaving through one face (right, back): two branches, not one strand joining their exits
     across the stem. Each fitted strand runs from its exit down the stem's years to the pith
-    (not past it), is marked a guess (``pinned=False``) and keeps the stem's ring spacing, so
-    the fitted knots are where the true ones are (known answer: the true strands' volume)."""
+    (not past it) and is marked a guess (``pinned=False``), so the fitted knots are where the
+    true ones are (known answer: the true strands' volume), and the guessed strands leave the
+    stem's years alone. Checked by breaking it: with guessed strands joined in by default
+    (``StemWithKnots.__call__`` without the skip) this test fails."""
     pith = (20.0, 20.0, 20.0)
     true = [KnotStrand(pith, (62.0, 20.0, 24.0), 3.0, 3.0), KnotStrand(pith, (20.0, 62.0, 16.0), 3.0, 3.0)]
     truth = StemWithKnots(radial_stem, true)
@@ -246,8 +248,11 @@ def test_branches_on_both_sides_of_a_pith_inside_the_block_start_at_the_pith():
     fitted = StemWithKnots(radial_stem, fits)
     k_fit = fitted.knot_features(p)["knot"] > 0.5
     assert (k_true & k_fit).sum() / (k_true | k_fit).sum() > 0.6
-    # a guessed strand keeps the stem's ring spacing: no years far below the stem's inside it
-    assert np.all(fitted(p) > radial_stem(p) - 3.0 * 1.0)
+    # a guessed strand marks its knot and leaves the years (FIT_VERSION 16); with
+    # bend_guessed its knot's rings are joined in with the stem's spacing, as before
+    np.testing.assert_array_equal(fitted(p), radial_stem(p))
+    written = StemWithKnots(radial_stem, fits, bend_guessed=True)(p)
+    assert np.all(written > radial_stem(p) - 3.0 * 1.0) and np.any(written < radial_stem(p) - 0.5)
     # a pinned strand (two exits) holds every ring since the pith (seed 003)
     pinned = StemWithKnots(radial_stem, [KnotStrand(pith, (62.0, 20.0, 24.0), 3.0, 3.0)])
     assert pinned(np.array([[35.0, 20.0, 21.4]]))[0] < 1.0

@@ -122,6 +122,12 @@ class StemWithKnots:
         knot, and dense rings a few mm off write wrong years over the whole cylinder (dev seed
         21: fitted one-exit strands lowered the cut-plane score, keeping the stem's spacing
         did not), so it keeps the stem's spacing. False keeps it for every strand.
+    bend_guessed : also let strands guessed from one exit (``pinned=False``) change the years:
+        bend the stem round them (with ``bend``) or join their knot's rings in (without). By
+        default a guessed strand marks its knot only (:meth:`knot_features`): even with the
+        stem's spacing, its rings a few mm to cm off the knot cost the fits' insides (FIT_VERSION
+        16: fresh seed 50287, six noisy faces, knotted blocks within 2 mm 85.4 -> 88.2 %, block
+        20 36.6 -> 60.3; README, "A guessed knot marks, it does not write years").
     """
 
     def __init__(self, stem, strands, smoothing_years: float = KNOT_SMOOTH_YEARS, dense: bool = True,
@@ -209,6 +215,8 @@ class StemWithKnots:
             return self._bent(p, gs)
         out = gs.copy()
         for strand, table in zip(self.strands, self._tables):
+            if not (strand.pinned or self.bend_guessed):  # a guessed strand marks its knot only
+                continue
             out = _smin(out, self._knot_time(p, gs, table, self.dense and strand.pinned), self.k,
                         DEAD_KNOT_SMOOTHING_FACTOR if strand.dead else 1.0)
         return out

@@ -38,8 +38,9 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: differences, the same optima to rounding: 95 of the 96 fresh-seed fits the same to 0.1 point,
 #: one block 0.1 point apart; the chosen field's cones fitted on one BLAS thread, as the folds';
 #: 15: the knots' bend with a residual competes as a plain hypothesis, and the bend's fold fits
-#: start from its all-faces fit, :func:`woodcam.inference.knots.knot_bend_recipes`).
-FIT_VERSION = 15
+#: start from its all-faces fit, :func:`woodcam.inference.knots.knot_bend_recipes`; 16: a knot
+#: strand guessed from one exit marks its knot in the chosen field and leaves its years).
+FIT_VERSION = 16
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,

@@ -17,9 +17,10 @@ exits of each end and bent the rings round two wrong strands (35 % within 1 mm; 
 An unpaired exit gets a strand into the block down the stem's year gradient (toward the pith,
 where a branch starts), ending at the pith, with its own radius; where that gradient does not
 enter the block through the face, along the face's inward normal made perpendicular to the
-stem axis. Its place is a guess (``pinned=False``): it keeps the stem's ring spacing inside
-(:class:`~woodcam.fields.knot_strands.StemWithKnots`). The strands join the stem field through
-:class:`woodcam.fields.knot_strands.StemWithKnots`.
+stem axis. Its place is a guess (``pinned=False``): it marks its knot (the knot layer a bake
+colours) and leaves the field's years as they are (FIT_VERSION 16; before, it wrote its knot's
+rings with the stem's spacing, :class:`~woodcam.fields.knot_strands.StemWithKnots`). The
+strands join the stem field through :class:`woodcam.fields.knot_strands.StemWithKnots`.
 
 Alive or dead (seed 003) is read from the face photo at each exit (:func:`exit_is_dead`): a dead
 knot is ringed by bark, a dark line along its whole boundary; an alive knot's rings run on into
