@@ -112,8 +112,6 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         return fit_neural(block, faces=faces)  # always baked to a grid (the net is slow)
     obs = gather_observations(block, faces)
     if method == "evidence":
-        from ..fields.knot_strands import StemWithKnots
-        from ..fields.residual import ResidualField
         from ..tolerances import KNOT_BEND_RESIDUAL_MIN_FACES
         from .evidence import bake_evidence, fit_evidence
         from .knots import knot_bend_recipes, knot_exits, with_knots
@@ -126,12 +124,10 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
                                   if knot_bend else (None, None, None))
         ev = fit_evidence(obs, block.size_mm, recipes=recipes, stem=stem, refines=refines,
                           residual=residual, seed=seed)
-        base = ev.field
-        while isinstance(base, ResidualField):  # a residual (or two) on the chosen field
-            base = base.base
-        if isinstance(base, StemWithKnots):  # it holds its knots already
-            strands = base.strands
-        else:
+        # a stem with its knots holds them already; a residual on it hands its base's on
+        # (:class:`~woodcam.fields.residual.ResidualField`)
+        strands = getattr(ev.field, "strands", None)
+        if strands is None:
             ev.field, strands = with_knots(block, ev.field, faces, knot_cones, exits)  # knots from the masks (part 3)
         return bake_evidence(ev, block.size_mm, used, strands) if baked else ev
     if method == "rbf":

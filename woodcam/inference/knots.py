@@ -587,17 +587,18 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
     def pinned(obs):
         if bent.get("obs") is not obs:
             first = bent.get("first")
-            if isinstance(first, StemWithKnots):  # a fold: start in the all-faces bend's basin
+            warm = isinstance(first, StemWithKnots)  # a fold: start in the all-faces bend's basin
+            if warm:
                 from .stem import fit_stem
 
                 off = first(obs.points_mm) - first.stem(obs.points_mm)
                 start = fit_stem(obs, size_mm, seed=seed, offset_years=off, init=first.stem)
-                field, _ = _fit_knotted_stem(obs, size_mm, exits, KNOT_BEND_ROUNDS, seed, False, start, cones)
+            field, same = _fit_knotted_stem(obs, size_mm, exits, KNOT_BEND_ROUNDS, seed, False,
+                                            start if warm else plain(obs), cones)
+            if warm:
                 same = False  # the guessed bend starts from the plain stem: not the same steps
                 if not isinstance(field, StemWithKnots):  # no bend in this fold: the plain stem's
                     field = plain(obs)
-            else:
-                field, same = _fit_knotted_stem(obs, size_mm, exits, KNOT_BEND_ROUNDS, seed, False, plain(obs), cones)
             bent.update(obs=obs, field=field, same=same)
             bent.setdefault("first", field)
         return bent["field"]
@@ -607,14 +608,14 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
             return bent["field"]
         return fit_knotted_stem(obs, size_mm, exits, seed=seed, guessed=True, stem=plain(obs), cones=cones)
 
-    out = {}
+    out, refines = {}, {}
     if len({e["face"] for e in exits}) >= 2:  # a strand is pinned by exits on two faces
-        out["stem + knot bend"] = pinned
+        out["stem + knot bend"], refines["stem + knot bend"] = pinned, "stem"
         if residual:
             out["stem + knot bend + residual"] = _residual_recipe(pinned, EVIDENCE_RBF_POINTS)
     if exits and guessed:
-        out["stem + guessed knot bend"] = bent_guessed
-    return plain, out, {n: "stem" for n in out if not n.endswith("+ residual")}
+        out["stem + guessed knot bend"], refines["stem + guessed knot bend"] = bent_guessed, "stem"
+    return plain, out, refines
 
 
 def with_knots(block, stem, faces=None, cones: bool = False, exits: list[dict] | None = None,

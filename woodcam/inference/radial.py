@@ -93,10 +93,17 @@ def _trig_powers(phi: np.ndarray, t: np.ndarray, K: int, M: int, out: np.ndarray
 def _design(points, pith, d, e1, e2, z_scale, K: int, M: int, out: np.ndarray | None = None):
     """rho (n,) and the basis ``trig_k(phi) zeta^m`` (n, (2K+1)(M+1)) at ``points`` (n, 3)
     (:func:`_trig_powers`, into ``out`` when given)."""
+    return _axis_design(points, pith, d, e1, e2, z_scale, K, M, out)[4:]
+
+
+def _axis_design(points, pith, d, e1, e2, z_scale, K: int, M: int, out: np.ndarray | None = None):
+    """:func:`_design` with the coordinates it is made of: ``(q, a1, a2, zq, rho, B)``, the
+    points about the pith ``q (n, 3)``, their coordinates along ``e1, e2`` and ``d`` (mm), rho
+    and the basis (what the radial Jacobian differentiates)."""
     q = points - pith
-    a1, a2, z = q @ e1, q @ e2, (q @ d) / z_scale
+    a1, a2, zq = q @ e1, q @ e2, q @ d
     rho = np.hypot(a1, a2)
-    return rho, _trig_powers(np.arctan2(a2, a1), z, K, M, out)
+    return q, a1, a2, zq, rho, _trig_powers(np.arctan2(a2, a1), zq / z_scale, K, M, out)
 
 
 def _penalty_weights(K: int, M: int) -> np.ndarray:
@@ -268,10 +275,7 @@ class _Problem:
         written in place (the same matrix as stacking them; :func:`_design`'s arithmetic), with
         the coordinates the Jacobian reads."""
         dd, e1, e2 = _frame(d)
-        q = self.points - pith
-        a1, a2, zq = q @ e1, q @ e2, q @ dd
-        rho = np.hypot(a1, a2)
-        B = _trig_powers(np.arctan2(a2, a1), zq / self.z_scale, self.K, self.M)
+        q, a1, a2, zq, rho, B = _axis_design(self.points, pith, dd, e1, e2, self.z_scale, self.K, self.M)
         n, p = B.shape
         med = np.median(rho)
         pen = np.sqrt(self.ridge * n) * _penalty_weights(self.K, self.M) * med
