@@ -408,6 +408,37 @@ KNOT_MIN_ENTRY_COS = 0.2
 #: pith on one side only (half a ring: more than a trace's mislabel or a fit's wobble).
 KNOT_PITH_YEARS = 0.5
 
+#: A branch grows out of the pith, so the line through two exits of one knot passes the fitted
+#: stem's pith: within this share of the pith distance of the exit nearer it (the sine of the
+#: angle, seen from that exit, between the line and the way to the pith: 0.4, 24 degrees), the
+#: pair is taken first, the line nearest the pith first; the others after them, in distance
+#: order (:func:`woodcam.inference.knots.strands_from_exits`). On dev seeds 7777 and 63311 (six
+#: noisy faces) the true pairs' share was 0.06-0.22, and 0.40 for two knots sharing an exit; the
+#: false pairs' mostly 0.5-1 (five of 24 at 0.11-0.33). In distance order alone dev seed 21
+#: block 22 paired a knot's exit with a knot cutting a block corner (its bend within 2 mm 66.6 %;
+#: in this order 99.8 %); by the line's miss alone, without this share, seed 50287 block 6 (its
+#: ends 9 and 14 mm from the pith, every line there passes within that of it) paired two wrong
+#: ends first (78.8 -> 59.9 %).
+KNOT_PAIR_MAX_MISS_SHARE = 0.4
+
+#: The fitted pith is a few mm off on a knotted block: a line's miss is counted as at least this
+#: (mm), so lines within it of the pith are alike and the nearest exits pair first, and where
+#: one exit lies on the pith (every line through it passes there) none passes
+#: :data:`KNOT_PAIR_MAX_MISS_SHARE` (dev seed 7777 block 7).
+KNOT_PAIR_MISS_FLOOR_MM = 3.0
+
+#: A whorl's branches leave the pith together, so near it one exit can be two knots'. An exit
+#: left unpaired pairs with an exit already taken, nearer the pith, when their line passes the
+#: pith within this many mm and within :data:`KNOT_SHARE_MAX_MISS_SHARE` of the taken exit's
+#: pith distance. The true shared pairs of dev seed 7777 and seed 50287 missed the fitted pith by
+#: 3.9 and 8.1 mm.
+KNOT_SHARE_MAX_MISS_MM = 10.0
+
+#: :data:`KNOT_PAIR_MAX_MISS_SHARE` for a shared exit (0.5, 30 degrees): its mask is two knots'
+#: and its middle lies between them, so each knot's line through it passes the pith less closely
+#: (shares 0.30 and 0.40 on seeds 50287 and 7777).
+KNOT_SHARE_MAX_MISS_SHARE = 0.5
+
 #: Spacing (mm) at which the knot masks are sampled for a knot's cone fit
 #: (:func:`woodcam.inference.knots._fit_cone`): knots are 2-20 mm across, so a 3 mm exit still
 #: has ~30 samples, and a 80 mm face ~6400.

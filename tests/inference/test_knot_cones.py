@@ -47,7 +47,9 @@ def test_a_knot_cut_by_two_edges_is_one_strand_on_its_cone(corner_block):
     """Four exit regions, one knot: the cone fit joins the two exits at each edge into one end
     and finds the true line within 3 degrees and its radius within 1 mm where it crosses the
     block. Checked by breaking it: without the cones (``cones=False``, the exits' centroids
-    paired) the same masks give two strands, each joining the two exits of one end."""
+    paired) the same masks give two strands for the one knot (each edge's two exits are two
+    ends): in distance order (FIT_VERSION 16) each joined the two exits of one end, 30 degrees and
+    more off the knot; paired by how near their line passes the pith (17), both run along it."""
     exits = knot_exits(corner_block)
     assert sorted(e["face"] for e in exits) == ["back", "front", "left", "right"]
     stem = corner_stem()
@@ -59,7 +61,7 @@ def test_a_knot_cut_by_two_edges_is_one_strand_on_its_cone(corner_block):
     r_fit = fit.radius_start_mm + t * (fit.radius_end_mm - fit.radius_start_mm)
     assert abs(r_fit - (3.0 + 3.0 * 40 / 100)) < 1.0, r_fit
     old = strands_from_exits(exits, stem, SIZE, cones=False)
-    assert len(old) == 2 and min(_angle_deg(s, STRAND) for s in old) > 30.0
+    assert len(old) == 2 and max(_angle_deg(s, STRAND) for s in old) < 3.0
 
 
 def test_the_cone_strand_lets_the_bend_predict_the_inside(corner_block):

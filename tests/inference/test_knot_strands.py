@@ -276,3 +276,40 @@ def test_bake_carries_the_knot_layers_and_more_uncertainty_round_the_knot():
     idx = lambda p: tuple(np.round((p[0] - grid.origin_mm) / grid.spacing_mm).astype(int))  # noqa: E731
     assert knot[idx(at_knot)] == 1.0 and knot[idx(off_knot)] == 0.0
     np.testing.assert_allclose(unc[idx(at_knot)] - unc[idx(off_knot)], EVIDENCE_KNOT_UNCERTAINTY_YEARS)
+
+
+class _PithStem:
+    """Round rings 2 mm apart about a pith along Z through (-10, 20) mm, outside the left face
+    of the 40 mm cube; ``pith_distance_mm`` as :class:`woodcam.inference.stem.StemField`'s."""
+
+    axis = (0.0, 0.0, 1.0)
+
+    def pith_distance_mm(self, points):
+        p = np.asarray(points, float)
+        return np.hypot(p[:, 0] + 10.0, p[:, 1] - 20.0)
+
+    def __call__(self, points):
+        return self.pith_distance_mm(points) / 2.0
+
+
+def _unit(s):
+    u = np.subtract(s.end_mm, s.start_mm)
+    return u / np.linalg.norm(u)
+
+
+def test_two_knots_of_a_whorl_share_the_exit_near_the_pith():
+    """Two branches leave the pith together (a whorl), 37 degrees apart: near the pith they
+    cross the left face as one exit, then one leaves by the right face, the other by the front.
+    Both are pinned by two exits, the shared one included (FIT_VERSION 17): each fitted strand
+    runs along its true branch (known answer: the true strands). Checked by breaking it: with
+    no sharing the right face's knot is a guess (``pinned=False``) and this test fails."""
+    stem = _PithStem()
+    d = np.array([1.0, -0.75, 0.0]) / 1.25
+    true = [KnotStrand((-10.0, 20.0, 20.0), (60.0, 20.0, 22.0), 4.5, 5.0),
+            KnotStrand((-10.0, 20.0, 19.0), tuple(np.array([-10.0, 20.0, 19.0]) + 60.0 * d), 4.5, 5.0)]
+    block = _masks_of(StemWithKnots(stem, true))
+    assert sorted(e["face"] for e in knot_exits(block)) == ["front", "left", "right"]
+    fits = fit_knot_strands(block, stem, cones=True)
+    assert len(fits) == 2 and all(s.pinned for s in fits), fits
+    for t in true:  # each true branch has its fitted strand within 8 degrees
+        assert max(abs(_unit(s) @ _unit(t)) for s in fits) > np.cos(np.deg2rad(8.0))

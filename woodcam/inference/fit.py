@@ -39,8 +39,10 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: one block 0.1 point apart; the chosen field's cones fitted on one BLAS thread, as the folds';
 #: 15: the knots' bend with a residual competes as a plain hypothesis, and the bend's fold fits
 #: start from its all-faces fit, :func:`woodcam.inference.knots.knot_bend_recipes`; 16: a knot
-#: strand guessed from one exit marks its knot in the chosen field and leaves its years).
-FIT_VERSION = 16
+#: strand guessed from one exit marks its knot in the chosen field and leaves its years; 17: knot
+#: exits paired in the order of how near their line passes the fitted pith, and an exit near the
+#: pith may be two knots' of a whorl, :func:`woodcam.inference.knots.strands_from_exits`).
+FIT_VERSION = 17
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,

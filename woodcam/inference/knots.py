@@ -5,8 +5,15 @@ centroid (block frame) and equivalent radius ``sqrt(area / pi)``. Exits on two f
 across the edge between them are one knot *end* (a knot cut by a block edge or corner). A branch
 runs across the stem (seed 003: from the pith outward, nearly perpendicular to it), so two ends
 on different faces whose joining line makes more than
-:data:`~woodcam.tolerances.KNOT_PAIR_MIN_ANGLE_DEG` with the stem's axis are one knot, the
-nearest pairs first (H11: faces C and F); an unpaired end over two faces is a knot of its own.
+:data:`~woodcam.tolerances.KNOT_PAIR_MIN_ANGLE_DEG` with the stem's axis are one knot (H11: faces
+C and F). A branch starts on the pith, so the pairs whose line passes the stem's pith
+(:data:`~woodcam.tolerances.KNOT_PAIR_MAX_MISS_SHARE`) are taken first, the line nearest it
+first, then the others, the nearest ends first (FIT_VERSION 17: in distance order alone a
+knot's exit paired with a knot cutting a block corner on dev seed 21 block 22 and seed 50287
+block 1). An unpaired end over two faces is a knot of its own. An end still unpaired then pairs
+with an end already taken that lies nearer the pith when their line passes the pith
+(:data:`~woodcam.tolerances.KNOT_SHARE_MAX_MISS_MM`): a whorl's branches leave the pith
+together, so near it one exit can be two knots'.
 A knot is a cone round its strand (its radius grows along it), and its strand and radius are
 the cone that cuts the faces as every face's mask shows (:func:`_fit_cone`: inside its exits,
 outside on the knot-free samples), extended across the block but not past the pith (the least
@@ -45,7 +52,8 @@ from ..frames import FACE_NORMAL, pixel_to_block
 from ..tolerances import (DEAD_KNOT_BANDS_MM, DEAD_KNOT_MIN_OUTLINED, DEAD_KNOT_SECTORS, KNOT_BEND_MAX_BEFORE_PITH,
                           KNOT_BEND_ROUNDS, KNOT_CONE_EDGE_MM, KNOT_CONE_MAX_NFEV, KNOT_CONE_MIN_RADIUS_MM,
                           KNOT_CONE_REACH_MM, KNOT_CONE_SAMPLE_MM, KNOT_CONE_START_REUSE_DEG, KNOT_END_TOUCH_MM, KNOT_MIN_AREA_PX, KNOT_MIN_AREA_SHARE,
-                          KNOT_MIN_ENTRY_COS, KNOT_PAIR_MIN_ANGLE_DEG, KNOT_PITH_YEARS)
+                          KNOT_MIN_ENTRY_COS, KNOT_PAIR_MIN_ANGLE_DEG, KNOT_PAIR_MISS_FLOOR_MM, KNOT_PITH_YEARS,
+                          KNOT_PAIR_MAX_MISS_SHARE, KNOT_SHARE_MAX_MISS_MM, KNOT_SHARE_MAX_MISS_SHARE)
 
 if TYPE_CHECKING:
     from .observations import RingObservations
@@ -295,6 +303,18 @@ def _cone_jacobian(x, problem, c0, terms=None):
     return J
 
 
+def _pith_miss(stem, point_mm, u, dist: float, length: float) -> float:
+    """mm: how near the line through ``point_mm (3,)`` along the unit ``u (3,)`` passes the
+    pith of ``stem`` (a :class:`~.stem.StemField`: its least ``pith_distance_mm``, sampled from
+    ``2 length`` mm behind ``point_mm`` to as far beyond the other exit, ``dist`` mm on, then
+    finely round the least)."""
+    reach = 2.0 * length + dist
+    t = np.linspace(-reach, dist + reach, _LINE_SAMPLES)
+    k = int(np.argmin(stem.pith_distance_mm(point_mm + t[:, None] * u)))
+    t = np.linspace(t[k] - (t[1] - t[0]), t[k] + (t[1] - t[0]), 41)
+    return float(np.min(stem.pith_distance_mm(point_mm + t[:, None] * u)))
+
+
 def _pith_first(stem, point_mm, u, length: float) -> bool:
     """Is the pith (the least stem years) behind ``point_mm (3,)`` along ``u (3,)``, within
     ``length`` mm either way (the sense a branch grows out along)?"""
@@ -379,7 +399,10 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
     length = float(np.linalg.norm(size_mm))
     ends = _ends(exits, cones)
     centres = [_end_centre(exits, e, cones) for e in ends]
-    pairs = []
+    # a branch grows out of the pith, so the line of two exits of one knot passes it: such pairs
+    # first, the line nearest the pith first; the others after them, the nearest exits first
+    rho = np.asarray(stem.pith_distance_mm(np.array(centres)), float) if hasattr(stem, "pith_distance_mm") else None
+    pairs = []  # (order key, distance, end, end, floored miss mm)
     for i in range(len(ends)):
         for j in range(i + 1, len(ends)):
             if {exits[k]["face"] for k in ends[i]} & {exits[k]["face"] for k in ends[j]}:
@@ -387,7 +410,11 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
             v = centres[j] - centres[i]
             dist = float(np.linalg.norm(v))
             if dist > 0 and abs(v @ axis) / dist < np.cos(np.deg2rad(KNOT_PAIR_MIN_ANGLE_DEG)):
-                pairs.append((dist, i, j))
+                miss = np.inf if rho is None else max(_pith_miss(stem, centres[i], v / dist, dist, length),
+                                                      KNOT_PAIR_MISS_FLOOR_MM)
+                through = rho is not None and miss <= KNOT_PAIR_MAX_MISS_SHARE * min(rho[i], rho[j])
+                pairs.append(((0, miss) if through else (1, dist), dist, i, j, miss))
+    pairs.sort(key=lambda q: q[:4])
     surface = exits[0].get("surface") if cones else None
     memo = exits[0].get("cone_memo")
 
@@ -446,11 +473,14 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
                           float(np.clip(ra + slope * lo_t, lo, hi)), float(np.clip(ra + slope * hi_t, lo, hi)),
                           dead=all(exits[k]["dead"] for k in group))
 
+    def pair(i, j, dist):
+        return place(ends[i] + ends[j], np.stack([centres[i], centres[j]]), ((centres[j] - centres[i]) / dist)[None])
+
     used_ends, strands = set(), []
-    for dist, i, j in sorted(pairs):
+    for _, dist, i, j, _ in pairs:
         if i in used_ends or j in used_ends:
             continue
-        strand = place(ends[i] + ends[j], np.stack([centres[i], centres[j]]), ((centres[j] - centres[i]) / dist)[None])
+        strand = pair(i, j, dist)
         if strand is not None:
             used_ends |= {i, j}
             strands.append(strand)
@@ -470,6 +500,15 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
         if strand is not None:
             used_ends.add(i)
             strands.append(strand)
+    # an exit near the pith may be two knots' of a whorl: an end left over pairs with a taken end
+    # nearer the pith where their line passes it (module docstring)
+    for _, dist, i, j, miss in pairs if rho is not None else ():
+        if (i in used_ends) != (j in used_ends):
+            near, far = (i, j) if i in used_ends else (j, i)
+            if rho[near] < rho[far] and miss <= min(KNOT_SHARE_MAX_MISS_MM, KNOT_SHARE_MAX_MISS_SHARE * rho[near]) \
+                    and (strand := pair(i, j, dist)) is not None:
+                used_ends.add(far)
+                strands.append(strand)
     used = {k for e in used_ends for k in ends[e]}
     for k, e in enumerate(exits):
         if k in used:
