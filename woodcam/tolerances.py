@@ -413,9 +413,10 @@ KNOT_PITH_YEARS = 0.5
 #: angle, seen from that exit, between the line and the way to the pith: 0.4, 24 degrees), the
 #: pair is taken first, the line nearest the pith first; the others after them, in distance
 #: order (:func:`woodcam.inference.knots.strands_from_exits`). On dev seeds 7777 and 63311 (six
-#: noisy faces) the true pairs' share was 0.06-0.22, and 0.40 for two knots sharing an exit; the
-#: false pairs' mostly 0.5-1 (five of 24 at 0.11-0.33). In distance order alone dev seed 21
-#: block 22 paired a knot's exit with a knot cutting a block corner (its bend within 2 mm 66.6 %;
+#: noisy faces) the true pairs' share was 0.06-0.22 (16 pairs; beside them 0.40 and 0.86 for two
+#: knots sharing an exit, and two blocks whose exit lies on the pith or whose fitted pith is far
+#: off); the false pairs' 0.5 and more but for five of 24 at 0.11-0.33. In distance order alone
+#: dev seed 21 block 22 paired a knot's exit with a knot cutting a block corner (its bend within 2 mm 66.6 %;
 #: in this order 99.8 %); by the line's miss alone, without this share, seed 50287 block 6 (its
 #: ends 9 and 14 mm from the pith, every line there passes within that of it) paired two wrong
 #: ends first (78.8 -> 59.9 %).
