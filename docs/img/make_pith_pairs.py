@@ -28,7 +28,7 @@ def main():
     # FIT_VERSION 16's order: no pair passes the pith, none shares an exit
     with mock.patch.object(knots, "KNOT_PAIR_MAX_MISS_SHARE", -1.0), \
             mock.patch.object(knots, "KNOT_SHARE_MAX_MISS_MM", -1.0):
-        before = knots.fit_knotted_stem(obs, block.size_mm, knots.knot_exits(block), cones=True)
+        before = knots.fit_knotted_stem(obs, block.size_mm, exits, cones=True)
     after = knots.fit_knotted_stem(obs, block.size_mm, exits, cones=True)
     fields = {"exits in distance order (v16)": before, "exits paired by the pith (v17)": after}
     sc = evaluate_fits(block.true_field, fields, block.size_mm, DEFAULT_PLANES, BENCH_PIXEL_MM, keep_lines=True)
