@@ -409,9 +409,9 @@ KNOT_MIN_ENTRY_COS = 0.2
 KNOT_PITH_YEARS = 0.5
 
 #: A branch grows out of the pith, so the line through two exits of one knot passes the fitted
-#: stem's pith: within this share of the pith distance of the exit nearer it (the sine of the
-#: angle, seen from that exit, between the line and the way to the pith: 0.4, 24 degrees), the
-#: pair is taken first, the line nearest the pith first; the others after them, in distance
+#: stem's pith beyond one of them: within this share of the pith distance of the exit nearer it
+#: (the sine of the angle, seen from that exit, between the line and the way to the pith: 0.4,
+#: 24 degrees), the pair is taken first, the line nearest the pith first; the others after them, in distance
 #: order (:func:`woodcam.inference.knots.strands_from_exits`). On dev seeds 7777 and 63311 (six
 #: noisy faces) the true pairs' share was 0.06-0.22 (16 pairs; beside them 0.40 and 0.86 for two
 #: knots sharing an exit, and two blocks whose exit lies on the pith or whose fitted pith is far

@@ -313,3 +313,17 @@ def test_two_knots_of_a_whorl_share_the_exit_near_the_pith():
     assert len(fits) == 2 and all(s.pinned for s in fits), fits
     for t in true:  # each true branch has its fitted strand within 8 degrees
         assert max(abs(_unit(s) @ _unit(t)) for s in fits) > np.cos(np.deg2rad(8.0))
+
+
+def test_pith_miss_is_the_lines_nearest_approach_and_says_which_side():
+    """Known answers with the pith along Z through (-10, 20): a line through (0, 20) and (40,
+    30) passes it 2.43 mm off (|(-10, 0) x (40, 10)| / |(40, 10)|), behind the first exit; a
+    line from (-20, 20) to (0, 20) passes through it between its ends (two branches' exits)."""
+    from woodcam.inference.knots import _pith_miss
+
+    stem = _PithStem()
+    v = np.array([40.0, 10.0, 0.0])
+    miss, beyond = _pith_miss(stem, np.array([0.0, 20.0, 5.0]), v / np.linalg.norm(v), np.linalg.norm(v), 60.0)
+    assert beyond and miss == pytest.approx(100.0 / np.linalg.norm(v), abs=0.05)
+    miss, beyond = _pith_miss(stem, np.array([-20.0, 20.0, 5.0]), np.array([1.0, 0.0, 0.0]), 20.0, 60.0)
+    assert not beyond and miss < 0.05

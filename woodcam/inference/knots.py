@@ -6,9 +6,9 @@ across the edge between them are one knot *end* (a knot cut by a block edge or c
 runs across the stem (seed 003: from the pith outward, nearly perpendicular to it), so two ends
 on different faces whose joining line makes more than
 :data:`~woodcam.tolerances.KNOT_PAIR_MIN_ANGLE_DEG` with the stem's axis are one knot (H11: faces
-C and F). A branch starts on the pith, so the pairs whose line passes the stem's pith
-(:data:`~woodcam.tolerances.KNOT_PAIR_MAX_MISS_SHARE`) are taken first, the line nearest it
-first, then the others, the nearest ends first (FIT_VERSION 17: in distance order alone a
+C and F). A branch starts on the pith, so the pairs whose line passes the stem's pith beyond
+one of them (:data:`~woodcam.tolerances.KNOT_PAIR_MAX_MISS_SHARE`) are taken first, the line
+nearest it first, then the others, the nearest ends first (FIT_VERSION 17: in distance order alone a
 knot's exit paired with a knot cutting a block corner on dev seed 21 block 22 and seed 50287
 block 1). An unpaired end over two faces is a knot of its own. An end still unpaired then pairs
 with an end already taken that lies nearer the pith when their line passes the pith
@@ -303,16 +303,19 @@ def _cone_jacobian(x, problem, c0, terms=None):
     return J
 
 
-def _pith_miss(stem, point_mm, u, dist: float, length: float) -> float:
-    """mm: how near the line through ``point_mm (3,)`` along the unit ``u (3,)`` passes the
-    pith of ``stem`` (a :class:`~.stem.StemField`: its least ``pith_distance_mm``, sampled from
-    ``2 length`` mm behind ``point_mm`` to as far beyond the other exit, ``dist`` mm on, then
-    finely round the least)."""
+def _pith_miss(stem, point_mm, u, dist: float, length: float) -> tuple[float, bool]:
+    """``(miss mm, beyond)``: how near the line through ``point_mm (3,)`` along the unit ``u (3,)``
+    passes the pith of ``stem`` (a :class:`~.stem.StemField`: its least ``pith_distance_mm``,
+    sampled from ``2 length`` mm behind ``point_mm`` to as far beyond the other exit, ``dist`` mm
+    on, then finely round the least), and whether that nearest point lies beyond the exits (not
+    between them, where the pith would part two branches)."""
     reach = 2.0 * length + dist
     t = np.linspace(-reach, dist + reach, _LINE_SAMPLES)
     k = int(np.argmin(stem.pith_distance_mm(point_mm + t[:, None] * u)))
     t = np.linspace(t[k] - (t[1] - t[0]), t[k] + (t[1] - t[0]), 41)
-    return float(np.min(stem.pith_distance_mm(point_mm + t[:, None] * u)))
+    rho = stem.pith_distance_mm(point_mm + t[:, None] * u)
+    k = int(np.argmin(rho))
+    return float(rho[k]), not 0.0 < t[k] < dist
 
 
 def _pith_first(stem, point_mm, u, length: float) -> bool:
@@ -399,10 +402,11 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
     length = float(np.linalg.norm(size_mm))
     ends = _ends(exits, cones)
     centres = [_end_centre(exits, e, cones) for e in ends]
-    # a branch grows out of the pith, so the line of two exits of one knot passes it: such pairs
-    # first, the line nearest the pith first; the others after them, the nearest exits first
+    # a branch grows out of the pith, so the line of two exits of one knot passes it beyond one of
+    # them: such pairs first, the line nearest the pith first; the others after them, the nearest
+    # exits first (a line with the pith between its exits is two branches' and comes last too)
     rho = np.asarray(stem.pith_distance_mm(np.array(centres)), float) if hasattr(stem, "pith_distance_mm") else None
-    pairs = []  # (order key, distance, end, end, floored miss mm)
+    pairs = []  # (order key, distance, end, end, floored miss mm; inf where the pith lies between)
     for i in range(len(ends)):
         for j in range(i + 1, len(ends)):
             if {exits[k]["face"] for k in ends[i]} & {exits[k]["face"] for k in ends[j]}:
@@ -410,9 +414,9 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
             v = centres[j] - centres[i]
             dist = float(np.linalg.norm(v))
             if dist > 0 and abs(v @ axis) / dist < np.cos(np.deg2rad(KNOT_PAIR_MIN_ANGLE_DEG)):
-                miss = np.inf if rho is None else max(_pith_miss(stem, centres[i], v / dist, dist, length),
-                                                      KNOT_PAIR_MISS_FLOOR_MM)
-                through = rho is not None and miss <= KNOT_PAIR_MAX_MISS_SHARE * min(rho[i], rho[j])
+                miss, beyond = (np.inf, False) if rho is None else _pith_miss(stem, centres[i], v / dist, dist, length)
+                miss = max(miss, KNOT_PAIR_MISS_FLOOR_MM) if beyond else np.inf  # the pith between: two branches
+                through = miss <= KNOT_PAIR_MAX_MISS_SHARE * min(rho[i], rho[j]) if rho is not None else False
                 pairs.append(((0, miss) if through else (1, dist), dist, i, j, miss))
     pairs.sort(key=lambda q: q[:4])
     surface = exits[0].get("surface") if cones else None
