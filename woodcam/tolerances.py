@@ -411,15 +411,15 @@ KNOT_PITH_YEARS = 0.5
 #: A branch grows out of the pith, so the line through two exits of one knot passes the fitted
 #: stem's pith beyond one of them: within this share of the pith distance of the exit nearer it
 #: (the sine of the angle, seen from that exit, between the line and the way to the pith: 0.4,
-#: 24 degrees), the pair is taken first, the line nearest the pith first; the others after them, in distance
-#: order (:func:`woodcam.inference.knots.strands_from_exits`). On dev seeds 7777 and 63311 (six
-#: noisy faces) the true pairs' share was 0.06-0.22 (16 pairs; beside them 0.40 and 0.86 for two
-#: knots sharing an exit, and two blocks whose exit lies on the pith or whose fitted pith is far
-#: off); the false pairs' 0.5 and more but for five of 24 at 0.11-0.33. In distance order alone
-#: dev seed 21 block 22 paired a knot's exit with a knot cutting a block corner (its bend within 2 mm 66.6 %;
-#: in this order 99.8 %); by the line's miss alone, without this share, seed 50287 block 6 (its
-#: ends 9 and 14 mm from the pith, every line there passes within that of it) paired two wrong
-#: ends first (78.8 -> 59.9 %).
+#: 24 degrees), the pair is taken first, the line nearest the pith first; the others after them,
+#: in distance order (:func:`woodcam.inference.knots.strands_from_exits`). On dev seeds 7777 and
+#: 63311 (six noisy faces) the true pairs' share was 0.06-0.22 (16 pairs; beside them 0.40 and
+#: 0.86 for two knots sharing an exit, and two blocks whose exit lies on the pith or whose
+#: fitted pith is far off); the false pairs' 0.5 and more but for five of 24 at 0.11-0.33. In
+#: distance order alone dev seed 21 block 22 paired a knot's exit with a knot cutting a block
+#: corner (its bend within 2 mm 66.6 %; in this order 99.8 %); by the line's miss alone, without
+#: this share, seed 50287 block 6 (its ends 9 and 14 mm from the pith, every line there passes
+#: within that of it) paired two wrong ends first (78.8 -> 59.9 %).
 KNOT_PAIR_MAX_MISS_SHARE = 0.4
 
 #: The fitted pith is a few mm off on a knotted block: a line's miss is counted as at least this

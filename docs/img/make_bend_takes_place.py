@@ -19,6 +19,17 @@ from woodcam.inference.evaluate import DEFAULT_PLANES, evaluate_fits, plot_plane
 OUT = Path(__file__).parent / "bend_takes_place_63311.png"
 
 
+def fields_on_planes(block, fields: dict, out: Path, title: str, label=lambda name, score: name) -> None:
+    """Draw the cut planes of ``fields`` (row name -> field) of ``block`` against its true rings
+    into ``out`` (64 colours), printing each one's share within 1 / 2 mm; ``label(name, score)``
+    makes a row's label from its name and :func:`evaluate_fits`'s scores."""
+    sc = evaluate_fits(block.true_field, fields, block.size_mm, DEFAULT_PLANES, BENCH_PIXEL_MM, keep_lines=True)
+    for k, v in sc.items():
+        print(f"{k}: {v[0]['matched_1']:.1f} / {v[0]['matched_2']:.1f} % within 1 / 2 mm")
+    plot_planes(out, {label(k, v[0]): v[1] for k, v in sc.items()}, title=title)
+    Image.open(out).convert("RGB").quantize(64).save(out, optimize=True)
+
+
 def hypotheses_on_planes(seed: int, index: int, labels: dict, out: Path, title) -> None:
     """Fit benchmark block ``(seed, index)`` (six noisy faces, the default evidence fit) and draw
     the cut planes of the hypotheses ``labels`` (name -> row label) against the true rings;
@@ -27,13 +38,8 @@ def hypotheses_on_planes(seed: int, index: int, labels: dict, out: Path, title) 
     block, info = make_block(seed, index, "noisy", "realistic", 256)
     ev = fit_block(block, baked=False)
     held = {n: v["mean"] for n, v in ev.scores.items()}
-    fields = {label: ev.hypotheses[n] for n, label in labels.items()}
-    sc = evaluate_fits(block.true_field, fields, block.size_mm, DEFAULT_PLANES, BENCH_PIXEL_MM, keep_lines=True)
-    for k, v in sc.items():
-        print(f"{k}: {v[0]['matched_1']:.1f} / {v[0]['matched_2']:.1f} % within 1 / 2 mm")
     print(ev.message)
-    plot_planes(out, {k: v[1] for k, v in sc.items()}, title=title(info, held))
-    Image.open(out).convert("RGB").quantize(64).save(out, optimize=True)
+    fields_on_planes(block, {label: ev.hypotheses[n] for n, label in labels.items()}, out, title(info, held))
 
 
 def main():

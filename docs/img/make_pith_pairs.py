@@ -11,11 +11,10 @@ import warnings
 from pathlib import Path
 from unittest import mock
 
-from PIL import Image
+from make_bend_takes_place import fields_on_planes  # (run from docs/img: its folder is on the path)
 
-from woodcam.bench_realistic import BENCH_PIXEL_MM, make_block
+from woodcam.bench_realistic import make_block
 from woodcam.inference import knots
-from woodcam.inference.evaluate import DEFAULT_PLANES, evaluate_fits, plot_planes
 from woodcam.inference.observations import gather_observations
 
 OUT = Path(__file__).parent / "pith_pairs_50287.png"
@@ -30,14 +29,9 @@ def main():
             mock.patch.object(knots, "KNOT_SHARE_MAX_MISS_MM", -1.0):
         before = knots.fit_knotted_stem(obs, block.size_mm, exits, cones=True)
     after = knots.fit_knotted_stem(obs, block.size_mm, exits, cones=True)
-    fields = {"exits in distance order (v16)": before, "exits paired by the pith (v17)": after}
-    sc = evaluate_fits(block.true_field, fields, block.size_mm, DEFAULT_PLANES, BENCH_PIXEL_MM, keep_lines=True)
-    for k, v in sc.items():
-        print(f"{k}: {v[0]['matched_1']:.1f} / {v[0]['matched_2']:.1f} % within 1 / 2 mm")
-    plot_planes(OUT, {f"{k}: {v[0]['matched_2']:.1f} %": v[1] for k, v in sc.items()},
-                title=f"seed 50287 {info['name']} (six faces, noisy), the stem bent round its knots' cones, "
-                "black = true rings, within 2 mm")
-    Image.open(OUT).convert("RGB").quantize(64).save(OUT, optimize=True)
+    fields_on_planes(block, {"exits in distance order (v16)": before, "exits paired by the pith (v17)": after}, OUT,
+                     f"seed 50287 {info['name']} (six faces, noisy), the stem bent round its knots' cones, "
+                     "black = true rings, within 2 mm", label=lambda name, score: f"{name}: {score['matched_2']:.1f} %")
 
 
 if __name__ == "__main__":

@@ -209,6 +209,12 @@ def radial_stem(points):
 radial_stem.axis = (0.0, 0.0, 1.0)
 
 
+def _unit(s: KnotStrand) -> np.ndarray:
+    """(3,) unit direction of a strand, start to end."""
+    u = np.subtract(s.end_mm, s.start_mm)
+    return u / np.linalg.norm(u)
+
+
 def _masks_of(truth) -> Block:
     """A 40 mm cube whose faces mark where ``truth``'s knots cross them."""
     from woodcam.frames import face_image_size_mm
@@ -238,9 +244,7 @@ def test_branches_on_both_sides_of_a_pith_inside_the_block_start_at_the_pith():
     fits = fit_knot_strands(block, radial_stem)
     assert len(fits) == 2 and not any(s.pinned for s in fits)
     for s in fits:
-        u = np.subtract(s.end_mm, s.start_mm) / np.linalg.norm(np.subtract(s.end_mm, s.start_mm))
-        best = max(abs(u @ (np.subtract(t.end_mm, t.start_mm) / np.linalg.norm(np.subtract(t.end_mm, t.start_mm))))
-                   for t in true)
+        best = max(abs(_unit(s) @ _unit(t)) for t in true)
         assert best > np.cos(np.deg2rad(8)), best
         assert np.hypot(s.end_mm[0] - 20.0, s.end_mm[1] - 20.0) < 2.0, s.end_mm  # ends at the pith
     p = np.random.default_rng(1).uniform(0, 40, (40000, 3))
@@ -292,11 +296,6 @@ class _PithStem:
         return self.pith_distance_mm(points) / 2.0
 
 
-def _unit(s):
-    u = np.subtract(s.end_mm, s.start_mm)
-    return u / np.linalg.norm(u)
-
-
 def test_two_knots_of_a_whorl_share_the_exit_near_the_pith():
     """Two branches leave the pith together (a whorl), 37 degrees apart: near the pith they
     cross the left face as one exit, then one leaves by the right face, the other by the front.
@@ -323,7 +322,7 @@ def test_pith_miss_is_the_lines_nearest_approach_and_says_which_side():
 
     stem = _PithStem()
     v = np.array([40.0, 10.0, 0.0])
-    miss, beyond = _pith_miss(stem, np.array([0.0, 20.0, 5.0]), v / np.linalg.norm(v), np.linalg.norm(v), 60.0)
-    assert beyond and miss == pytest.approx(100.0 / np.linalg.norm(v), abs=0.05)
-    miss, beyond = _pith_miss(stem, np.array([-20.0, 20.0, 5.0]), np.array([1.0, 0.0, 0.0]), 20.0, 60.0)
-    assert not beyond and miss < 0.05
+    miss, beyond = _pith_miss(stem, [[0.0, 20.0, 5.0], [-20.0, 20.0, 5.0]], [v / np.linalg.norm(v), [1.0, 0.0, 0.0]],
+                              [np.linalg.norm(v), 20.0], 60.0)  # both lines in one call
+    assert beyond[0] and miss[0] == pytest.approx(100.0 / np.linalg.norm(v), abs=0.05)
+    assert not beyond[1] and miss[1] < 0.05

@@ -8,9 +8,9 @@ on different faces whose joining line makes more than
 :data:`~woodcam.tolerances.KNOT_PAIR_MIN_ANGLE_DEG` with the stem's axis are one knot (H11: faces
 C and F). A branch starts on the pith, so the pairs whose line passes the stem's pith beyond
 one of them (:data:`~woodcam.tolerances.KNOT_PAIR_MAX_MISS_SHARE`) are taken first, the line
-nearest it first, then the others, the nearest ends first (FIT_VERSION 17: in distance order alone a
-knot's exit paired with a knot cutting a block corner on dev seed 21 block 22 and seed 50287
-block 1). An unpaired end over two faces is a knot of its own. An end still unpaired then pairs
+nearest it first, then the others, the nearest ends first (FIT_VERSION 17: in distance order
+alone a knot's exit paired with a knot cutting a block corner on dev seed 21 block 22 and seed
+50287 block 1). An unpaired end over two faces is a knot of its own. An end still unpaired then pairs
 with an end already taken that lies nearer the pith when their line passes the pith
 (:data:`~woodcam.tolerances.KNOT_SHARE_MAX_MISS_MM`): a whorl's branches leave the pith
 together, so near it one exit can be two knots'.
@@ -303,19 +303,27 @@ def _cone_jacobian(x, problem, c0, terms=None):
     return J
 
 
-def _pith_miss(stem, point_mm, u, dist: float, length: float) -> tuple[float, bool]:
-    """``(miss mm, beyond)``: how near the line through ``point_mm (3,)`` along the unit ``u (3,)``
-    passes the pith of ``stem`` (a :class:`~.stem.StemField`: its least ``pith_distance_mm``,
-    sampled from ``2 length`` mm behind ``point_mm`` to as far beyond the other exit, ``dist`` mm
-    on, then finely round the least), and whether that nearest point lies beyond the exits (not
-    between them, where the pith would part two branches)."""
+def _pith_miss(stem, points_mm, u, dist, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(miss (m,) mm, beyond (m,) bool)`` of the ``m`` lines through ``points_mm (m, 3)`` along
+    the unit ``u (m, 3)``: how near each passes the pith of ``stem`` (a
+    :class:`~.stem.StemField`: its least ``pith_distance_mm``, sampled from ``2 length`` mm behind
+    its point to as far beyond the other exit, ``dist (m,)`` mm on, then finely round the least),
+    and whether that nearest point lies beyond the exits (not between them, where the pith would
+    part two branches). All lines in one call of the stem per stage."""
+    p, u, dist = np.asarray(points_mm, float), np.asarray(u, float), np.asarray(dist, float)
+    rows = np.arange(len(dist))
+
+    def least(t):  # (m, n) positions along the lines -> the least pith distance and where
+        rho = stem.pith_distance_mm((p[:, None] + t[..., None] * u[:, None]).reshape(-1, 3)).reshape(t.shape)
+        k = np.argmin(rho, axis=1)
+        return rho[rows, k], t[rows, k]
+
     reach = 2.0 * length + dist
-    t = np.linspace(-reach, dist + reach, _LINE_SAMPLES)
-    k = int(np.argmin(stem.pith_distance_mm(point_mm + t[:, None] * u)))
-    t = np.linspace(t[k] - (t[1] - t[0]), t[k] + (t[1] - t[0]), 41)
-    rho = stem.pith_distance_mm(point_mm + t[:, None] * u)
-    k = int(np.argmin(rho))
-    return float(rho[k]), not 0.0 < t[k] < dist
+    t = np.linspace(-reach, dist + reach, _LINE_SAMPLES, axis=1)
+    step = t[:, 1] - t[:, 0]
+    _, tk = least(t)
+    miss, tk = least(np.linspace(tk - step, tk + step, 41, axis=1))
+    return miss, ~((0.0 < tk) & (tk < dist))
 
 
 def _pith_first(stem, point_mm, u, length: float) -> bool:
@@ -402,11 +410,7 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
     length = float(np.linalg.norm(size_mm))
     ends = _ends(exits, cones)
     centres = [_end_centre(exits, e, cones) for e in ends]
-    # a branch grows out of the pith, so the line of two exits of one knot passes it beyond one of
-    # them: such pairs first, the line nearest the pith first; the others after them, the nearest
-    # exits first (a line with the pith between its exits is two branches' and comes last too)
-    rho = np.asarray(stem.pith_distance_mm(np.array(centres)), float) if hasattr(stem, "pith_distance_mm") else None
-    pairs = []  # (order key, distance, end, end, floored miss mm; inf where the pith lies between)
+    candidates = []  # (distance, end, end): ends on different faces whose line crosses the stem
     for i in range(len(ends)):
         for j in range(i + 1, len(ends)):
             if {exits[k]["face"] for k in ends[i]} & {exits[k]["face"] for k in ends[j]}:
@@ -414,10 +418,19 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
             v = centres[j] - centres[i]
             dist = float(np.linalg.norm(v))
             if dist > 0 and abs(v @ axis) / dist < np.cos(np.deg2rad(KNOT_PAIR_MIN_ANGLE_DEG)):
-                miss, beyond = (np.inf, False) if rho is None else _pith_miss(stem, centres[i], v / dist, dist, length)
-                miss = max(miss, KNOT_PAIR_MISS_FLOOR_MM) if beyond else np.inf  # the pith between: two branches
-                through = miss <= KNOT_PAIR_MAX_MISS_SHARE * min(rho[i], rho[j]) if rho is not None else False
-                pairs.append(((0, miss) if through else (1, dist), dist, i, j, miss))
+                candidates.append((dist, i, j))
+    # a branch grows out of the pith, so the line of two exits of one knot passes it beyond one of
+    # them: such pairs first, the line nearest the pith first; the others after them, the nearest
+    # exits first (a line with the pith between its exits is two branches' and comes last too)
+    rho = np.asarray(stem.pith_distance_mm(np.array(centres)), float) if hasattr(stem, "pith_distance_mm") else None
+    miss = np.full(len(candidates), np.inf)  # floored, mm; inf where the pith lies between or is unknown
+    if rho is not None and candidates:
+        dists, first, second = (np.array(q) for q in zip(*candidates))
+        at = np.array(centres)
+        least, beyond = _pith_miss(stem, at[first], (at[second] - at[first]) / dists[:, None], dists, length)
+        miss = np.where(beyond, np.maximum(least, KNOT_PAIR_MISS_FLOOR_MM), np.inf)
+    pairs = [((0, mi) if rho is not None and mi <= KNOT_PAIR_MAX_MISS_SHARE * min(rho[i], rho[j]) else (1, dist),
+              dist, i, j, mi) for (dist, i, j), mi in zip(candidates, miss)]  # (order, distance, end, end, miss)
     pairs.sort(key=lambda q: q[:4])
     surface = exits[0].get("surface") if cones else None
     memo = exits[0].get("cone_memo")
@@ -602,9 +615,10 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
     death bend them (seed 35089, six noisy faces, block 18: the bend fits its own faces' ring
     points at 47 % where the truth's own field reaches 93 %), so its held-out faces score low
     (50 %, 39 % from cold fold starts, below) although its inside is the best of all (81 % within
-    2 mm against the chosen 62 %). The residual takes the faces' misfit and leaves the bend's inside; on 35089's
-    blocks 2, 6, 14 and 18 its held-out evidence was the best and its inside 98 / 85 / 78 / 90 %
-    against the chosen 63 / 77 / 59 / 62 % (README, "The knots' bend with a residual").
+    2 mm against the chosen 62 %). The residual takes the faces' misfit and leaves the bend's
+    inside; on 35089's blocks 2, 6, 14 and 18 its held-out evidence was the best and its inside
+    98 / 85 / 78 / 90 % against the chosen 63 / 77 / 59 / 62 % (README, "The knots' bend with a
+    residual").
 
     Fold fits: the first rings a recipe is given are all the faces' (:func:`~.evidence.
     fit_evidence` fits every hypothesis on them before the folds), and each fold's bend starts
