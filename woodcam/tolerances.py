@@ -403,6 +403,27 @@ KNOT_PAIR_MIN_ANGLE_DEG = 40.0
 #: (a knot exits a face it crosses, so it cannot run along it) and the face normal is used.
 KNOT_MIN_ENTRY_COS = 0.2
 
+#: A knot seen at one exit is a ray from the fitted pith through the exit
+#: (:func:`woodcam.inference.knots._pith_ray`) only where the exit lies at least this far from
+#: the pith (mm): the pith fitted from three faces is a few mm off (dev seed 7777 block 6: 7.6
+#: mm from the exit with three faces, 11.4 with six), and 3 mm at 10 mm turns the ray 17 degrees.
+KNOT_RAY_MIN_PITH_MM = 10.0
+
+#: Rises (degrees from the cross-section toward the pith's tangent) tried for a knot seen at one
+#: exit (:func:`woodcam.inference.knots._ray_rises`): seed 001's spruce knots start at about -1
+#: and end at -11 degrees (its fits to Gran_1), broadleaf and pine branches rise 10-40; a block
+#: may lie either way up, so both signs.
+KNOT_RAY_RISES_DEG = (-40.0, -20.0, 0.0, 20.0, 40.0)
+
+#: Ring points the stem's quick refit of each rise tried uses (no growth history): on dev seeds
+#: 7777 and 63311 (three noisy faces) the bend alone scored the same, 67.8 / 67.7 % within 2 mm,
+#: as with the full refit of 1000 points and every 10 degrees, at 0.6 of the CPU.
+KNOT_RAY_REFIT_POINTS = 400
+
+#: Cap (mm) of a ring point's distance from its ring when the rises are compared: a mislabelled
+#: point (3 % of the noisy traces) is a ring or more off and would otherwise weigh most.
+KNOT_RAY_MISFIT_CAP_MM = 3.0
+
 #: Two exits are one branch only when the stem's years along the line between them do not dip
 #: more than this (years) below both exits': a dip is the pith, and a branch grows out from the
 #: pith on one side only (half a ring: more than a trace's mislabel or a fit's wobble).

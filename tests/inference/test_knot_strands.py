@@ -7,7 +7,7 @@ from woodcam.block import Block, Face
 from woodcam.errors import WoodcamError
 from woodcam.fields.knot_strands import KnotStrand, StemWithKnots
 from woodcam.frames import face_pixel_points
-from woodcam.inference.knots import fit_knot_strands, knot_exits
+from woodcam.inference.knots import fit_knot_strands, knot_exits, strands_from_exits
 
 SIZE = (40.0, 40.0, 40.0)
 
@@ -326,3 +326,48 @@ def test_pith_miss_is_the_lines_nearest_approach_and_says_which_side():
                               [np.linalg.norm(v), 20.0], 60.0)  # both lines in one call
     assert beyond[0] and miss[0] == pytest.approx(100.0 / np.linalg.norm(v), abs=0.05)
     assert not beyond[1] and miss[1] < 0.05
+
+
+def test_a_knot_seen_at_one_exit_runs_from_the_pith_through_it():
+    """The pith lies outside the left face (a stem, so it has one); a branch from it crosses the
+    left face obliquely, 31 degrees off the face's normal, and leaves by the back face, which
+    was not photographed (front, top and left were). The knot's strand is the ray from the
+    fitted pith through its one exit and on across the block (FIT_VERSION 18): within 3 degrees
+    of the true branch, starting on the pith. Known answer: the true strand. Checked by
+    breaking it: the strand down the stem's years from the exit (the one before) leaves the
+    block there, and the face normal made across the stem, its stand-in, is 31 degrees off."""
+    from _stems import round_stem
+
+    stem = round_stem((-10.0, 20.0), SIZE, 0.5)
+    true = KnotStrand((-10.0, 20.0, 20.0), (40.0, 50.0, 20.0), 3.0, 3.0)
+    exits = knot_exits(_masks_of(StemWithKnots(stem, [true])), ["front", "top", "left"])
+    assert [e["face"] for e in exits] == ["left"]
+    (fit,) = strands_from_exits(exits, stem, SIZE)
+    assert _unit(fit) @ _unit(true) > np.cos(np.deg2rad(3.0)), _unit(fit)
+    np.testing.assert_allclose(fit.start_mm, true.start_mm, atol=1.0)
+    assert not fit.pinned  # no rise given: a guess, which marks its knot only
+    (tilted,) = strands_from_exits(exits, stem, SIZE, rises={0: np.deg2rad(20.0)})
+    assert tilted.pinned and np.degrees(np.arcsin(_unit(tilted)[2])) == pytest.approx(20.0)
+
+
+def test_a_ray_that_would_leave_by_a_face_showing_no_knot_there_is_not_drawn():
+    """The branch of the test above leaves the block by the back face. Where the back face was
+    photographed and its mask shows the knot there, the ray from the pith through the left exit
+    is drawn; where its mask shows no knot (the branch ended inside the block), the ray would
+    contradict it, so none is drawn and the knot stays a guess that marks its place. Known
+    answer: the mask. Checked by breaking it: without the check in ``_pith_ray`` the ray is drawn
+    either way and this test fails."""
+    from _stems import round_stem
+
+    from woodcam.inference.knots import _pith_ray
+
+    stem = round_stem((-10.0, 20.0), SIZE, 0.5)
+    block = _masks_of(StemWithKnots(stem, [KnotStrand((-10.0, 20.0, 20.0), (40.0, 50.0, 20.0), 3.0, 3.0)]))
+    faces = ["front", "top", "left", "back"]
+    seen = [e for e in knot_exits(block, faces) if e["face"] == "left"]
+    assert _pith_ray(seen[0], stem, SIZE) is not None
+    block.faces["back"].extras["knot_mask"] = np.zeros_like(block.faces["back"].extras["knot_mask"])
+    (exit_,) = knot_exits(block, faces)
+    assert exit_["face"] == "left" and _pith_ray(exit_, stem, SIZE) is None
+    (fit,) = strands_from_exits([exit_], stem, SIZE)
+    assert not fit.pinned and _unit(fit) @ np.array([1.0, 0.0, 0.0]) > 0.999  # the guess: the face normal

@@ -41,8 +41,10 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: start from its all-faces fit, :func:`woodcam.inference.knots.knot_bend_recipes`; 16: a knot
 #: strand guessed from one exit marks its knot in the chosen field and leaves its years; 17: knot
 #: exits paired in the order of how near their line passes the fitted pith, and an exit near the
-#: pith may be two knots' of a whorl, :func:`woodcam.inference.knots.strands_from_exits`).
-FIT_VERSION = 17
+#: pith may be two knots' of a whorl, :func:`woodcam.inference.knots.strands_from_exits`; 18: a
+#: knot seen at one exit is the ray from the fitted pith through it, its rise read from the rings,
+#: and bends them, :func:`woodcam.inference.knots.fit_knotted_stem`).
+FIT_VERSION = 18
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
@@ -69,8 +71,9 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         saveable with ``.save(path)``) rather than the raw fitted callable.
     knot_bend : evidence only: the stem with its knots' ring bend (seed 003's join fitted with
         the stem, :func:`woodcam.inference.knots.fit_knotted_stem`) competes as one more
-        hypothesis wherever exits on two faces pin a knot's strand (a strand guessed from one
-        exit is not offered: :func:`woodcam.inference.knots.knot_bend_recipes`). It refines
+        hypothesis wherever the masks show a knot (a strand pinned by exits on two faces, or a
+        knot seen at one exit as a ray from the pith whose rise the rings choose:
+        :func:`woodcam.inference.knots.knot_bend_recipes`). It refines
         the stem: it competes only while the held-out faces keep the plain stem within
         :data:`~woodcam.tolerances.EVIDENCE_REFINE_BASE_MARGIN` of the best hypothesis, and
         is chosen when it beats every plain hypothesis by more than

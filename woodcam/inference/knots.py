@@ -21,13 +21,17 @@ stem years along the line: a branch starts there; two exits with the pith betwee
 branches). Before (``strands_from_exits(cones=False)``): the line through two exits' centroids
 with the radius linear between their areas' radii, which on dev seed 7777 block 2 paired the two
 exits of each end and bent the rings round two wrong strands (35 % within 1 mm; the cone 97 %).
-An unpaired exit gets a strand into the block down the stem's year gradient (toward the pith,
-where a branch starts), ending at the pith, with its own radius; where that gradient does not
-enter the block through the face, along the face's inward normal made perpendicular to the
-stem axis. Its place is a guess (``pinned=False``): it marks its knot (the knot layer a bake
-colours) and leaves the field's years as they are (FIT_VERSION 16; before, it wrote its knot's
-rings with the stem's spacing, :class:`~woodcam.fields.knot_strands.StemWithKnots`). The
-strands join the stem field through :class:`woodcam.fields.knot_strands.StemWithKnots`.
+An unpaired exit in a stem with a pith (:class:`~.stem.StemField`) is the branch it is: the ray
+from the pith in its cross-section out through the exit and on across the block
+(:func:`_pith_ray`; FIT_VERSION 18). Its rise, which one exit does not show, is read from the
+rings by :func:`fit_knotted_stem` (:func:`_ray_rises`); with a rise it is placed
+(``pinned=True``) and bends the rings, without one it is a guess (``pinned=False``) that marks
+its knot (the knot layer a bake colours) and leaves the field's years as they are (FIT_VERSION
+16). In a stem without a pith the strand runs into the block down the stem's year gradient
+(toward the pith, where a branch starts), ending at the pith, with its own radius; where that
+gradient does not enter the block through the face, along the face's inward normal made
+perpendicular to the stem axis. The strands join the stem field through
+:class:`woodcam.fields.knot_strands.StemWithKnots`.
 
 Alive or dead (seed 003) is read from the face photo at each exit (:func:`exit_is_dead`): a dead
 knot is ringed by bark, a dark line along its whole boundary; an alive knot's rings run on into
@@ -53,7 +57,8 @@ from ..tolerances import (DEAD_KNOT_BANDS_MM, DEAD_KNOT_MIN_OUTLINED, DEAD_KNOT_
                           KNOT_BEND_ROUNDS, KNOT_CONE_EDGE_MM, KNOT_CONE_MAX_NFEV, KNOT_CONE_MIN_RADIUS_MM,
                           KNOT_CONE_REACH_MM, KNOT_CONE_SAMPLE_MM, KNOT_CONE_START_REUSE_DEG, KNOT_END_TOUCH_MM, KNOT_MIN_AREA_PX, KNOT_MIN_AREA_SHARE,
                           KNOT_MIN_ENTRY_COS, KNOT_PAIR_MIN_ANGLE_DEG, KNOT_PAIR_MISS_FLOOR_MM, KNOT_PITH_YEARS,
-                          KNOT_PAIR_MAX_MISS_SHARE, KNOT_SHARE_MAX_MISS_MM, KNOT_SHARE_MAX_MISS_SHARE)
+                          KNOT_PAIR_MAX_MISS_SHARE, KNOT_RAY_MIN_PITH_MM, KNOT_RAY_MISFIT_CAP_MM, KNOT_RAY_REFIT_POINTS,
+                          KNOT_RAY_RISES_DEG, KNOT_SHARE_MAX_MISS_MM, KNOT_SHARE_MAX_MISS_SHARE)
 
 if TYPE_CHECKING:
     from .observations import RingObservations
@@ -395,16 +400,24 @@ def _end_centre(exits, end, cones: bool) -> np.ndarray:
 
 
 def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
-                       cones: bool = False, workers: int = 1) -> list[KnotStrand]:
+                       cones: bool = False, workers: int = 1, rises: dict[int, float] | None = None) -> list[KnotStrand]:
     """Strands of the knot ``exits`` (:func:`knot_exits`) in ``stem``, a block of ``size_mm``
     (module docstring). ``cones``: exits touching across a block edge are one knot end
     (:func:`_ends`), and a paired strand's line and radius are its cone fitted to the face masks
     (:func:`_fit_cone`; exits from :func:`knot_exits` carry the samples); False: the line
     through two exits' centroids with radii from their areas (what
     :func:`~.fit.fit_block` ``(knot_cones=False)`` uses; the fit's default is the cones since
-    FIT_VERSION 10). ``workers``: processes each cone's starts may use (:func:`_fit_cone`)."""
+    FIT_VERSION 10). ``workers``: processes each cone's starts may use (:func:`_fit_cone`).
+    ``rises``: exit index -> rise (rad) of the knots seen at one exit whose ray from the pith
+    the rings placed (:func:`_ray_rises`): those strands bend the rings (``pinned``)."""
+    return _strands(exits, stem, size_mm, cones, workers, rises)[0]
+
+
+def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[list[KnotStrand], dict[int, int]]:
+    """:func:`strands_from_exits` and ``lone``: exit index -> index of its strand, for each knot
+    seen at one exit only (its strand a guess, or a ray whose rise ``rises`` gives)."""
     if not exits:
-        return []
+        return [], {}
     axis = np.asarray(getattr(stem, "axis", (0.0, 0.0, 1.0)), float)
     axis /= np.linalg.norm(axis)
     length = float(np.linalg.norm(size_mm))
@@ -527,9 +540,16 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
                 used_ends.add(far)
                 strands.append(strand)
     used = {k for e in used_ends for k in ends[e]}
+    lone = {}
     for k, e in enumerate(exits):
         if k in used:
             continue
+        lone[k] = len(strands)
+        if hasattr(stem, "pith_in_section_mm"):  # a branch from the pith through its exit (:func:`_pith_ray`)
+            ray = _pith_ray(e, stem, size_mm, (rises or {}).get(k, 0.0), pinned=k in (rises or {}))
+            if ray is not None:
+                strands.append(ray)
+                continue
         n = -np.asarray(FACE_NORMAL[e["face"]], float)  # into the block
         d, reach = _toward_pith(stem, e["centre_mm"] + n, n, length)
         if d is None:  # the stem gives no usable direction here: the face normal, across the stem
@@ -539,7 +559,137 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
         r = e["radius_mm"] * np.sqrt(max(abs(d @ n), 0.2))
         strands.append(KnotStrand(tuple(e["centre_mm"] - 2.0 * d), tuple(e["centre_mm"] + reach * d),
                                   r, r, dead=e["dead"], pinned=False))
-    return strands
+    return strands, lone
+
+
+def _pith_ray(exit_: dict, stem, size_mm: ArrayLike, rise: float = 0.0, pinned: bool = False) -> KnotStrand | None:
+    """The strand of a knot seen at one exit as the branch it is: from the pith (a
+    :class:`~.stem.StemField`'s, in the exit's cross-section) out through the exit and on across
+    the block of ``size_mm``, turned ``rise`` (rad) from the cross-section toward the pith's
+    tangent (a branch rises or droops: seed 001's spruce ends its knots at -11 degrees, and a
+    block may lie either way up). Its radius is the exit's, made round (an oblique strand cuts
+    the face in an ellipse of area ``pi R^2 / |cos(incidence)|``). None where the exit lies
+    within :data:`~woodcam.tolerances.KNOT_RAY_MIN_PITH_MM` of the pith (no direction to speak
+    of), the ray would run along the face (:data:`~woodcam.tolerances.KNOT_MIN_ENTRY_COS`), or
+    it would cross the block to a face whose mask shows no knot where it comes out (the knot
+    ends before that face, and where is not known; such a ray contradicts the photos).
+
+    Why not down the stem's year gradient from the exit (the strand before): where the pith lies
+    outside the block beyond the exit's face, that gradient leaves the block, and the face
+    normal made across the stem stood in for it, up to 40 degrees off the knot (seed 64151
+    block 22, three faces: 46 % within 2 mm; the ray through the exit 95 %)."""
+    size = np.asarray(size_mm, float)
+    c = np.asarray(exit_["centre_mm"], float)
+    q = stem.pith_in_section_mm(c[None])[0]
+    a = stem.grain_direction(q[None])[0]
+    v = c - q
+    v = v - (v @ a) * a
+    rho = float(np.linalg.norm(v))
+    if rho < KNOT_RAY_MIN_PITH_MM:
+        return None
+    w = np.cos(rise) * v / rho + np.sin(rise) * a
+    n = -np.asarray(FACE_NORMAL[exit_["face"]], float)
+    if abs(w @ n) < KNOT_MIN_ENTRY_COS:
+        return None
+    r = exit_["radius_mm"] * np.sqrt(abs(w @ n))
+    start, end = c - rho / np.cos(rise) * w, c + float(np.linalg.norm(size)) * w
+    other = _far_end(start, end, c, size)
+    if other is not None and "surface" in exit_:
+        pts, knot = exit_["surface"]
+        ax = int(np.argmin(np.minimum(np.abs(other), np.abs(size - other))))  # the face it leaves by
+        seen = (np.abs(pts[:, ax] - other[ax]) < 1e-6) & \
+            (np.linalg.norm(pts - other, axis=1) < max(r, 2.0 * KNOT_CONE_SAMPLE_MM))
+        if seen.any() and not knot[seen].any():  # (only that face's samples: not a neighbour's by the edge)
+            return None
+    return KnotStrand(tuple(start), tuple(end), r, r, dead=exit_["dead"], pinned=pinned)
+
+
+def _far_end(start, end, exit_mm, size) -> np.ndarray | None:
+    """(3,) where the segment ``start`` -> ``end`` crosses the surface of the block ``[0, size]``
+    away from ``exit_mm`` (the other end of its part inside), or None where that part ends
+    inside the block (the pith is in it) or the segment misses the block."""
+    d = end - start
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t0, t1 = (0.0 - start) / d, (size - start) / d
+    lo = np.nanmax(np.where(d != 0, np.minimum(t0, t1), -np.inf))
+    hi = np.nanmin(np.where(d != 0, np.maximum(t0, t1), np.inf))
+    lo, hi = max(lo, 0.0), min(hi, 1.0)
+    if lo >= hi:
+        return None
+    a, b = start + lo * d, start + hi * d
+    far = a if np.linalg.norm(a - exit_mm) > np.linalg.norm(b - exit_mm) else b
+    return None if (far is a and lo == 0.0) else far
+
+
+def _ray_misfit(field, obs, density) -> float:
+    """Mean squared distance (mm², each capped at :data:`~woodcam.tolerances.KNOT_RAY_MISFIT_CAP_MM`)
+    of ``obs``'s ring points from ``field``'s ring of their year; ``density (n,)``: the ring
+    density (years/mm) there, the stem's (a bend changes it little; 7x cheaper than the field's)."""
+    err = np.abs(np.asarray(field(obs.points_mm), float) - obs.years) / density
+    return float(np.mean(np.minimum(err, KNOT_RAY_MISFIT_CAP_MM) ** 2))
+
+
+def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int, near: dict[int, float] | None = None) -> dict[int, float]:
+    """exit index -> rise (rad) of each knot seen at one exit whose ray from the pith
+    (:func:`_pith_ray`) bends the rings: per such knot in turn, of the rises
+    :data:`~woodcam.tolerances.KNOT_RAY_RISES_DEG` (then the vertex of the parabola through the
+    best and its neighbours) and no bend at all, the one whose bend, with the stem refitted to
+    it once, leaves the least misfit on the rings (:func:`_ray_misfit`).
+
+    Why: the exit shows where a knot crosses the face and the pith where it starts, but not
+    its rise, and 10-20 degrees off puts its bend 1-2 cm off across a block (dev seeds 7777 and
+    63311, three noisy faces, knotted blocks within 2 mm: the ray across the stem 63.7 %, the
+    true knot's direction through the exit 76.5 %); the rings round the exit, on its face and
+    the others, are bent by where the knot really runs. The stem's fit absorbs a knot's bend
+    into itself, so each rise is judged after the stem is refitted to it (without that, no bend
+    always won), by a quick refit (:data:`~woodcam.tolerances.KNOT_RAY_REFIT_POINTS`).
+
+    ``near``: rises found on more rings (a fold's fit starts from the all-faces fit's, as its
+    stem does: :func:`knot_bend_recipes`): only those knots are tried, each at its rise and one
+    step of the grid either side. Why: every fold searching afresh took seed 31337 block 15 (six
+    faces, five knots seen at one exit) from 7.3 to 20.4 s wall."""
+    from .stem import fit_stem
+
+    rises: dict[int, float] = {}
+    strands, lone = _strands(exits, stem, size_mm, cones)
+    lone = {k: i for k, i in lone.items()
+            if _pith_ray(exits[k], stem, size_mm) is not None and (near is None or k in near)}
+    if not lone:
+        return rises
+    g0, grad = central_gradient(stem, obs.points_mm, 0.25)
+    density = np.maximum(np.linalg.norm(grad, axis=1), 1e-6)
+
+    def cost(k=None, rise=0.0):  # the misfit with knot k's ray at ``rise`` (None: as they are)
+        trial = list(strands)
+        if k is not None:
+            trial[lone[k]] = _pith_ray(exits[k], stem, size_mm, rise, pinned=True)
+            if trial[lone[k]] is None:  # no ray at that rise (along the face, or out by a face showing none)
+                return np.inf
+        bent = StemWithKnots(stem, trial, bend=KnotParams())
+        # every arm refitted alike, no bend too (the stem given was fitted in full: the quick
+        # refit would start behind it); the quick refit: what the comparison needs, not a fit
+        refit = fit_stem(obs, size_mm, seed=seed, offset_years=bent(obs.points_mm) - g0, init=stem, history=False,
+                         n_fit=KNOT_RAY_REFIT_POINTS)
+        return _ray_misfit(StemWithKnots(refit, trial, bend=KnotParams()), obs, density)
+
+    full = np.deg2rad(KNOT_RAY_RISES_DEG)
+    now = cost()
+    for k in lone:
+        grid = full if near is None else near[k] + np.array([-1.0, 0.0, 1.0]) * (full[1] - full[0])
+        costs = np.array([cost(k, float(rise)) for rise in grid])
+        i = int(np.argmin(costs))
+        best, rise = costs[i], float(grid[i])
+        if 0 < i < len(grid) - 1:  # the parabola's vertex through the best and its neighbours
+            c0, c1, c2 = costs[i - 1:i + 2]
+            h = 0.5 * (grid[i + 1] - grid[i - 1])
+            if np.isfinite(c0 + c2) and c0 + c2 - 2.0 * c1 > 0:
+                step = float(np.clip(0.5 * h * (c0 - c2) / (c0 + c2 - 2.0 * c1), -0.5 * h, 0.5 * h))
+                if step and (c := cost(k, rise + step)) < best:
+                    best, rise = c, rise + step
+        if best < now:  # this knot's bend fits the rings better than without it
+            rises[k], now = rise, best
+            strands[lone[k]] = _pith_ray(exits[k], stem, size_mm, rise, pinned=True)
+    return rises
 
 
 def fit_knotted_stem(obs: RingObservations, size_mm: ArrayLike, exits: list[dict],
@@ -562,10 +712,15 @@ def fit_knotted_stem(obs: RingObservations, size_mm: ArrayLike, exits: list[dict
     ``rounds`` times (dev seed 21, six noisy faces, within 1 mm: 0 rounds 40 / 29 / 36 %, 1
     round 97 / 53 / 97 %, 2 rounds 99 / 68 / 98 %, 4 rounds 99 / 74 / 98 % on blocks 1 / 9 / 10).
 
-    By default only strands pinned by two exits bend the rings: a one-exit strand is a guess a
-    few mm off its knot, and its bend then writes wrong years over a wide region (dev seed 21,
-    three faces: block 10 45 -> 25 %, block 5 86 -> 43 % within 1 mm; but block 7 63 -> 66 %):
-    ``guessed=True`` is a separate hypothesis the held-out faces judge. Strands that do not
+    The strands that bend the rings: those pinned by two exits, and each knot seen at one exit
+    whose ray from the pith, at the rise the rings choose, fits them better than no bend at all
+    (:func:`_ray_rises`, in the first round's stem; FIT_VERSION 18). Before, a one-exit strand
+    ran down the stem's years from its exit, a few mm to cm off its knot, and its bend wrote
+    wrong years over a wide region (dev seed 21, three faces: block 10 45 -> 25 %, block 5 86
+    -> 43 % within 1 mm), so only pinned strands bent the rings; the ray with its rise read
+    from the rings bends them where the rings say so (dev seeds 7777 and 63311, three noisy
+    faces, the default fit within 2 mm: 62.8 -> 67.7 %, README "A knot seen at one exit").
+    ``guessed=True`` (a separate hypothesis the held-out faces judge) bends round every strand. Strands that do not
     bend are kept for the knot's look (:meth:`StemWithKnots.knot_features`). A dead strand bends
     as an alive one: the branch was alive from the pith to its death, which the exits do not
     show, and the bend comes from that inner part (its inversion past death is left out).
@@ -573,27 +728,30 @@ def fit_knotted_stem(obs: RingObservations, size_mm: ArrayLike, exits: list[dict
     return _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones)[0]
 
 
-def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones=False):
-    """:func:`fit_knotted_stem` and whether every round placed pinned strands only (then the
-    fit with ``guessed=True`` would make the very same steps)."""
+def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones=False, near=None):
+    """:func:`fit_knotted_stem`, whether every round placed pinned strands only (then the fit
+    with ``guessed=True`` would make the very same steps) and the rises of the rays that bend
+    (:func:`_ray_rises`, ``near`` passed on)."""
     from .stem import fit_stem
 
     stem = fit_stem(obs, size_mm, seed=seed) if stem is None else stem
-    plain, field, only_pinned = stem, stem, True
+    plain, field, only_pinned, rises = stem, stem, True, None
     for r in range(rounds + 1):
         g = stem(obs.points_mm)  # once per round: the check here and the bend's offset below
         if np.mean(g <= stem.pith_years()) > KNOT_BEND_MAX_BEFORE_PITH:
-            return plain, False  # times are not "from the pith" in this stem: no bend to speak of
-        strands = strands_from_exits(exits, stem, size_mm, cones)
+            return plain, False, {}  # times are not "from the pith" in this stem: no bend to speak of
+        if rises is None:  # the rises of the knots seen at one exit, in the first round's stem
+            rises = _ray_rises(exits, stem, obs, size_mm, cones, seed, near)
+        strands = strands_from_exits(exits, stem, size_mm, cones, rises=rises)
         only_pinned &= all(s.pinned for s in strands)
         if not any(s.pinned or guessed for s in strands):
-            return plain, False
+            return plain, False, rises
         field = StemWithKnots(stem, strands, bend=KnotParams(), bend_guessed=guessed)
         if r == rounds:
             break
         off = field(obs.points_mm) - g
         stem = fit_stem(obs, size_mm, seed=seed, offset_years=off, init=stem)
-    return field, only_pinned
+    return field, only_pinned, rises
 
 
 def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, guessed: bool = False,
@@ -602,7 +760,7 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
 
     ``recipes``, name -> ``RingObservations -> field``, is :func:`fit_knotted_stem` on the given
     rings (the exits come from the masks, not from the rings a fold holds out):
-    ``"stem + knot bend"`` (pinned strands; exits on two faces needed), with ``residual``
+    ``"stem + knot bend"`` (strands pinned by two exits or rays whose rise the rings chose), with ``residual``
     ``"stem + knot bend + residual"`` (the same with a smoothed thin-plate RBF of what it leaves
     on the faces, as ``"radial + residual"`` on the radial fit; :func:`~.fit.fit_block` offers
     it where :data:`~woodcam.tolerances.KNOT_BEND_RESIDUAL_MIN_FACES` faces carry rings) and,
@@ -625,7 +783,9 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
     from that fit's stem, placed by the fold's faces (``fit_stem(init=, offset_years=)`` with
     the first fit's bend), as a radial basin's fold descends from its own axis; from the fold's
     plain stem instead, a knot-distorted stem in another basin, the bend's held-out faces fell
-    (35089/18: 49.9 -> 39.3 %). The guessed one is left out by default
+    (35089/18: 49.9 -> 39.3 %). Its rays likewise start from the all-faces fit's rises
+    (:func:`_ray_rises` ``near``): the fold's rings choose among each such rise and one grid step
+    either side, or no bend. The guessed one is left out by default
     (:func:`~.fit.fit_block` does not offer it): a strand guessed from one exit is a few mm to
     cm off its knot, and with three faces, where most knots show one exit, its bend lost more
     than it gained (seed 61297, three noisy faces, knotted: 52.4 -> 50.0 % within 1 mm; dev seed
@@ -650,14 +810,15 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
 
                 off = first(obs.points_mm) - first.stem(obs.points_mm)
                 start = fit_stem(obs, size_mm, seed=seed, offset_years=off, init=first.stem)
-            field, same = _fit_knotted_stem(obs, size_mm, exits, KNOT_BEND_ROUNDS, seed, False,
-                                            start if warm else plain(obs), cones)
+            field, same, rises = _fit_knotted_stem(obs, size_mm, exits, KNOT_BEND_ROUNDS, seed, False,
+                                                   start if warm else plain(obs), cones, bent.get("rises"))
             if warm:
                 same = False  # the guessed bend starts from the plain stem: not the same steps
                 if not isinstance(field, StemWithKnots):  # no bend in this fold: the plain stem's
                     field = plain(obs)
             bent.update(obs=obs, field=field, same=same)
             bent.setdefault("first", field)
+            bent.setdefault("rises", rises)  # the folds' rays start from the all-faces fit's rises
         return bent["field"]
 
     def bent_guessed(obs):
@@ -666,7 +827,7 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
         return fit_knotted_stem(obs, size_mm, exits, seed=seed, guessed=True, stem=plain(obs), cones=cones)
 
     out, refines = {}, {}
-    if len({e["face"] for e in exits}) >= 2:  # a strand is pinned by exits on two faces
+    if exits:  # a strand pinned by exits on two faces, or a ray from the pith the rings place
         out["stem + knot bend"], refines["stem + knot bend"] = pinned, "stem"
         if residual:
             out["stem + knot bend + residual"] = _residual_recipe(pinned, EVIDENCE_RBF_POINTS)

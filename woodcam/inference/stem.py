@@ -95,6 +95,11 @@ class StemField:
         return (np.asarray(self.centre_mm, float) + t[:, None] * d
                 + (pw @ self.curve[0])[:, None] * b1 + (pw @ self.curve[1])[:, None] * b2)
 
+    def pith_in_section_mm(self, points_mm: ArrayLike) -> np.ndarray:
+        """``(n, 3)`` the pith point in the cross-section of each of ``points_mm (n, 3)``."""
+        p = check_points(points_mm)
+        return self.pith_mm((p - self.centre_mm) @ _frame(self.base_axis)[0])
+
     @property
     def axis(self) -> np.ndarray:
         """(3,) unit pith direction at the block centre (the grain direction there)."""
