@@ -302,7 +302,7 @@ def test_the_bend_with_a_residual_wins_where_the_bend_misfits_its_faces():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed, index, pinned, bar, before", [(21, 22, 1, 95.0, 66.6), (50287, 9, 2, 85.0, 52.9)])
+@pytest.mark.parametrize("seed, index, pinned, bar, before", [(21, 22, 2, 95.0, 66.6), (50287, 9, 2, 85.0, 52.9)])
 def test_exits_pair_by_the_pith_and_share_a_whorls_exit(seed, index, pinned, bar, before):
     """Six noisy faces, the knots' bend alone (:func:`fit_knotted_stem`), its inside within 2 mm
     against ``before``, the same in distance order (FIT_VERSION 16). Dev seed 21 block 22: in
@@ -313,7 +313,8 @@ def test_exits_pair_by_the_pith_and_share_a_whorls_exit(seed, index, pinned, bar
     88.3 %). Checked by breaking it: in distance order both cases fail. (Block 9 does not test
     the shared exit: without it the refit stems' order pairs the other knot first and the edge
     end gets a cone of its own; :func:`test_two_knots_of_a_whorl_share_the_exit_near_the_pith`
-    does.)"""
+    does.) ``pinned``: the strands that bend; since FIT_VERSION 18 block 22's one pair and the
+    ray of its knot seen at one exit, at the rise its rings choose."""
     import warnings
 
     from woodcam.bench_realistic import BENCH_PIXEL_MM, make_block

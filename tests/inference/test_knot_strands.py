@@ -328,6 +328,17 @@ def test_pith_miss_is_the_lines_nearest_approach_and_says_which_side():
     assert not beyond[1] and miss[1] < 0.05
 
 
+def _branch_past_the_left_face():
+    """``(stem, true strand, block)``: rings 2 mm apart about a pith outside the left face (a
+    :class:`~woodcam.inference.stem.StemField`), and a branch from it across the left face,
+    leaving by the back face; the block's six faces mask where it crosses them."""
+    from _stems import round_stem
+
+    stem = round_stem((-10.0, 20.0), SIZE, 0.5)
+    true = KnotStrand((-10.0, 20.0, 20.0), (40.0, 50.0, 20.0), 3.0, 3.0)
+    return stem, true, _masks_of(StemWithKnots(stem, [true]))
+
+
 def test_a_knot_seen_at_one_exit_runs_from_the_pith_through_it():
     """The pith lies outside the left face (a stem, so it has one); a branch from it crosses the
     left face obliquely, 31 degrees off the face's normal, and leaves by the back face, which
@@ -336,11 +347,8 @@ def test_a_knot_seen_at_one_exit_runs_from_the_pith_through_it():
     of the true branch, starting on the pith. Known answer: the true strand. Checked by
     breaking it: the strand down the stem's years from the exit (the one before) leaves the
     block there, and the face normal made across the stem, its stand-in, is 31 degrees off."""
-    from _stems import round_stem
-
-    stem = round_stem((-10.0, 20.0), SIZE, 0.5)
-    true = KnotStrand((-10.0, 20.0, 20.0), (40.0, 50.0, 20.0), 3.0, 3.0)
-    exits = knot_exits(_masks_of(StemWithKnots(stem, [true])), ["front", "top", "left"])
+    stem, true, block = _branch_past_the_left_face()
+    exits = knot_exits(block, ["front", "top", "left"])
     assert [e["face"] for e in exits] == ["left"]
     (fit,) = strands_from_exits(exits, stem, SIZE)
     assert _unit(fit) @ _unit(true) > np.cos(np.deg2rad(3.0)), _unit(fit)
@@ -357,12 +365,9 @@ def test_a_ray_that_would_leave_by_a_face_showing_no_knot_there_is_not_drawn():
     contradict it, so none is drawn and the knot stays a guess that marks its place. Known
     answer: the mask. Checked by breaking it: without the check in ``_pith_ray`` the ray is drawn
     either way and this test fails."""
-    from _stems import round_stem
-
     from woodcam.inference.knots import _pith_ray
 
-    stem = round_stem((-10.0, 20.0), SIZE, 0.5)
-    block = _masks_of(StemWithKnots(stem, [KnotStrand((-10.0, 20.0, 20.0), (40.0, 50.0, 20.0), 3.0, 3.0)]))
+    stem, _, block = _branch_past_the_left_face()
     faces = ["front", "top", "left", "back"]
     seen = [e for e in knot_exits(block, faces) if e["face"] == "left"]
     assert _pith_ray(seen[0], stem, SIZE) is not None
