@@ -418,6 +418,7 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
     seen at one exit only (its strand a guess, or a ray whose rise ``rises`` gives)."""
     if not exits:
         return [], {}
+    rises = rises or {}
     axis = np.asarray(getattr(stem, "axis", (0.0, 0.0, 1.0)), float)
     axis /= np.linalg.norm(axis)
     length = float(np.linalg.norm(size_mm))
@@ -546,7 +547,7 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
             continue
         lone[k] = len(strands)
         if hasattr(stem, "pith_in_section_mm"):  # a branch from the pith through its exit (:func:`_pith_ray`)
-            ray = _pith_ray(e, stem, size_mm, (rises or {}).get(k, 0.0), pinned=k in (rises or {}))
+            ray = _pith_ray(e, stem, size_mm, rises.get(k, 0.0), pinned=k in rises)
             if ray is not None:
                 strands.append(ray)
                 continue
