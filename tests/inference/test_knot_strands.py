@@ -38,6 +38,11 @@ def test_knot_is_the_cylinder_and_leaves_the_stem_alone_beyond_smoothing():
     np.testing.assert_allclose(f(core[2:3]), 0.5 * plane_stem(core[2:3]), rtol=0.05)
     sparse = StemWithKnots(plane_stem, [strand], smoothing_years=1.0, dense=False)
     assert sparse(core[:1])[0] > 5.0 and f(core[:1])[0] < 0.5
+    # on the stem's spacing G = 0.5 / mm the time inside is g_S + (d / R)(g - g_S) - (R - d) G,
+    # g_S = 10 the stem's years where the strand passes (exact: the stem lies over a year later
+    # there, beyond the smoothing)
+    d_in, g_in = np.array([0.0, 1.0, 2.0]), plane_stem(core[:3])
+    np.testing.assert_allclose(sparse(core[:3]), 10.0 + d_in / 4.0 * (g_in - 10.0) - (4.0 - d_in) * 0.5, atol=1e-12)
     k = f.knot_features(p)["knot"]
     assert np.all(k[d < 3.8] == 1) and np.all(k[d > 4.2] == 0)
 

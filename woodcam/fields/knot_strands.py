@@ -138,6 +138,10 @@ class StemWithKnots:
         self.k = float(smoothing_years)
         self.axis = getattr(stem, "axis", (0.0, 0.0, 1.0))
         self._tables = [self._table(s) for s in self.strands]
+        # the stem's years and ring density along each strand, for the join without a bend only:
+        # made when first needed (the bend never reads them, and the knot-rise search builds ~200
+        # bent fields a block: 2.5 of its 13.7 profiled s were these tables, never read)
+        self._along: list = [None] * len(self.strands)
         self.bend, self.bend_guessed = bend, bool(bend_guessed)
         if bend is not None:
             if not hasattr(stem, "pith_distance_mm"):
@@ -145,33 +149,41 @@ class StemWithKnots:
                                    f"woodcam.inference.stem.StemField; got {type(stem).__name__}")
             self._pith_years = float(stem.pith_years())
 
-    def _table(self, strand: KnotStrand):
-        pts, rad = strand.samples()
-        gs, grad = central_gradient(self.stem, pts, 0.25)
-        dens = np.linalg.norm(grad, axis=1)
+    @staticmethod
+    def _table(strand: KnotStrand):
+        """The strand's line ``a`` (3,), ``v`` (3,) (start, end - start) and its sample radii ``(n,)``."""
+        _, rad = strand.samples()
         a, b = np.asarray(strand.start_mm, float), np.asarray(strand.end_mm, float)
-        return a, b - a, rad, gs, np.maximum(dens, 1e-3)
+        return a, b - a, rad
+
+    def _stem_along(self, i: int):
+        """The stem's years ``(n,)`` and ring density ``(n,)`` (years/mm, at least 1e-3) at strand
+        ``i``'s samples, made once."""
+        if self._along[i] is None:
+            gs, grad = central_gradient(self.stem, self.strands[i].samples()[0], 0.25)
+            self._along[i] = gs, np.maximum(np.linalg.norm(grad, axis=1), 1e-3)
+        return self._along[i]
 
     @staticmethod
     def _distance(p: np.ndarray, table):
         """``d``, ``R`` and the strand sample position ``s`` of each point's strand point: all
         that :meth:`knot_features` and :meth:`knot_halo` need (the two interpolations more of
         :meth:`_geometry` were ~45 % of its cost)."""
-        a, v, rad, _, _ = table
+        a, v, rad = table
         t = np.clip((p - a) @ v / (v @ v), 0.0, 1.0)
         d = np.linalg.norm(p - (a + t[:, None] * v), axis=1)
         s = t * (len(rad) - 1)
         return d, np.interp(s, np.arange(len(rad)), rad), s
 
-    @staticmethod
-    def _geometry(p: np.ndarray, table):
-        """``d``, ``R``, ``G`` and the stem time at the strand point of each point."""
-        d, R, s = StemWithKnots._distance(p, table)
-        _, _, rad, gs, dens = table
-        return d, R, np.interp(s, np.arange(len(rad)), dens), np.interp(s, np.arange(len(rad)), gs)
+    def _geometry(self, p: np.ndarray, i: int):
+        """``d``, ``R``, ``G`` and the stem time at strand ``i``'s point of each point."""
+        d, R, s = self._distance(p, self._tables[i])
+        gs, dens = self._stem_along(i)
+        at = np.arange(len(gs))
+        return d, R, np.interp(s, at, dens), np.interp(s, at, gs)
 
-    def _knot_time(self, p, g, table, dense: bool):
-        d, R, G, gS = self._geometry(p, table)
+    def _knot_time(self, p, g, i: int, dense: bool):
+        d, R, G, gS = self._geometry(p, i)
         if dense:  # seed 003: the knot holds every ring since the pith
             G = np.where(gS > 0, np.maximum(G, gS / R), G)
         inside = gS + (d / R) * (g - gS) - (R - d) * G
@@ -214,10 +226,10 @@ class StemWithKnots:
         if self.bend is not None:
             return self._bent(p, gs)
         out = gs.copy()
-        for strand, table in zip(self.strands, self._tables):
+        for i, strand in enumerate(self.strands):
             if not (strand.pinned or self.bend_guessed):  # a guessed strand marks its knot only
                 continue
-            out = _smin(out, self._knot_time(p, gs, table, self.dense and strand.pinned), self.k,
+            out = _smin(out, self._knot_time(p, gs, i, self.dense and strand.pinned), self.k,
                         DEAD_KNOT_SMOOTHING_FACTOR if strand.dead else 1.0)
         return out
 
