@@ -43,8 +43,9 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: exits paired in the order of how near their line passes the fitted pith, and an exit near the
 #: pith may be two knots' of a whorl, :func:`woodcam.inference.knots.strands_from_exits`; 18: a
 #: knot seen at one exit is the ray from the fitted pith through it, its rise read from the rings,
-#: and bends them, :func:`woodcam.inference.knots.fit_knotted_stem`).
-FIT_VERSION = 18
+#: and bends them, :func:`woodcam.inference.knots.fit_knotted_stem`; 19: its rises are searched
+#: wherever some rise of the grid has a ray, not only where the ray across the stem has one).
+FIT_VERSION = 19
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,

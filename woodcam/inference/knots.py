@@ -652,9 +652,12 @@ def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int, near: dict[int
     from .stem import fit_stem
 
     rises: dict[int, float] = {}
+    full = np.deg2rad(KNOT_RAY_RISES_DEG)
     strands, lone = _strands(exits, stem, size_mm, cones)
-    lone = {k: i for k, i in lone.items()
-            if _pith_ray(exits[k], stem, size_mm) is not None and (near is None or k in near)}
+    # a knot with a ray at any rise of the grid: one drooping 20 degrees may have none across the
+    # stem (it would run along its exit face, or enter the block by a face showing no knot)
+    lone = {k: i for k, i in lone.items() if (near is None or k in near)
+            and any(_pith_ray(exits[k], stem, size_mm, float(r)) is not None for r in full)}
     if not lone:
         return rises
     g0, grad = central_gradient(stem, obs.points_mm, 0.25)
@@ -673,7 +676,6 @@ def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int, near: dict[int
                          n_fit=KNOT_RAY_REFIT_POINTS)
         return _ray_misfit(StemWithKnots(refit, trial, bend=KnotParams()), obs, density)
 
-    full = np.deg2rad(KNOT_RAY_RISES_DEG)
     now = cost()
     for k in lone:
         grid = full if near is None else near[k] + np.array([-1.0, 0.0, 1.0]) * (full[1] - full[0])
