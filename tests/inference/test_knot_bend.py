@@ -389,9 +389,8 @@ def test_a_knot_whose_ray_across_the_stem_would_contradict_a_face_is_still_bent(
     drawn, but at a droop of 40 degrees it leaves by the bottom, as the knot does: the rises are
     searched wherever some rise of the grid has a ray, and the bend, the stem refitted to it, is
     kept (the inside within 1 mm better than the plain stem's: 89.5 against 83.0 %). Known
-    answer: the true droop.
-    Checked by breaking it: searching only knots with a ray across the stem (FIT_VERSION 18)
-    leaves it unbent, and this test fails."""
+    answer: the true droop. Checked by breaking it: searching only knots with a ray across the
+    stem (FIT_VERSION 18) leaves it unbent, and this test fails."""
     from woodcam.inference import knots
 
     b, _, _, _ = _rising_block(-30.0, 30.0)
