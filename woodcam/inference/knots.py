@@ -400,7 +400,8 @@ def _end_centre(exits, end, cones: bool) -> np.ndarray:
 
 
 def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
-                       cones: bool = False, workers: int = 1, rises: dict[int, float] | None = None) -> list[KnotStrand]:
+                       cones: bool = False, workers: int = 1,
+                       rises: dict[int, float] | None = None) -> list[KnotStrand]:
     """Strands of the knot ``exits`` (:func:`knot_exits`) in ``stem``, a block of ``size_mm``
     (module docstring). ``cones``: exits touching across a block edge are one knot end
     (:func:`_ends`), and a paired strand's line and radius are its cone fitted to the face masks
@@ -598,9 +599,9 @@ def _pith_ray(exit_: dict, stem, size_mm: ArrayLike, rise: float = 0.0, pinned: 
     if other is not None and "surface" in exit_:
         pts, knot = exit_["surface"]
         ax = int(np.argmin(np.minimum(np.abs(other), np.abs(size - other))))  # the face it leaves by
-        seen = (np.abs(pts[:, ax] - other[ax]) < 1e-6) & \
-            (np.linalg.norm(pts - other, axis=1) < max(r, 2.0 * KNOT_CONE_SAMPLE_MM))
-        if seen.any() and not knot[seen].any():  # (only that face's samples: not a neighbour's by the edge)
+        face = np.flatnonzero(np.abs(pts[:, ax] - other[ax]) < 1e-6)  # (not a neighbour's samples by the edge)
+        seen = face[np.linalg.norm(pts[face] - other, axis=1) < max(r, 2.0 * KNOT_CONE_SAMPLE_MM)]
+        if len(seen) and not knot[seen].any():
             return None
     return KnotStrand(tuple(start), tuple(end), r, r, dead=exit_["dead"], pinned=pinned)
 
@@ -630,7 +631,8 @@ def _ray_misfit(field, obs, density) -> float:
     return float(np.mean(np.minimum(err, KNOT_RAY_MISFIT_CAP_MM) ** 2))
 
 
-def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int, near: dict[int, float] | None = None) -> dict[int, float]:
+def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int,
+               near: dict[int, float] | None = None) -> dict[int, float]:
     """exit index -> rise (rad) of each knot seen at one exit whose ray from the pith
     (:func:`_pith_ray`) bends the rings: per such knot in turn, of the rises
     :data:`~woodcam.tolerances.KNOT_RAY_RISES_DEG` (then the vertex of the parabola through the
@@ -654,10 +656,17 @@ def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int, near: dict[int
     rises: dict[int, float] = {}
     full = np.deg2rad(KNOT_RAY_RISES_DEG)
     strands, lone = _strands(exits, stem, size_mm, cones)
+    made: dict = {}
+
+    def ray(k, rise):  # knot k's pinned ray at ``rise``, made once (the check below, then its cost)
+        if (k, rise) not in made:
+            made[(k, rise)] = _pith_ray(exits[k], stem, size_mm, rise, pinned=True)
+        return made[(k, rise)]
+
     # a knot with a ray at any rise of the grid: one drooping 20 degrees may have none across the
     # stem (it would run along its exit face, or enter the block by a face showing no knot)
     lone = {k: i for k, i in lone.items() if (near is None or k in near)
-            and any(_pith_ray(exits[k], stem, size_mm, float(r)) is not None for r in full)}
+            and any(ray(k, float(r)) is not None for r in full)}
     if not lone:
         return rises
     g0, grad = central_gradient(stem, obs.points_mm, 0.25)
@@ -666,7 +675,7 @@ def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int, near: dict[int
     def cost(k=None, rise=0.0):  # the misfit with knot k's ray at ``rise`` (None: as they are)
         trial = list(strands)
         if k is not None:
-            trial[lone[k]] = _pith_ray(exits[k], stem, size_mm, rise, pinned=True)
+            trial[lone[k]] = ray(k, rise)
             if trial[lone[k]] is None:  # no ray at that rise (along the face, or out by a face showing none)
                 return np.inf
         bent = StemWithKnots(stem, trial, bend=KnotParams())
@@ -691,7 +700,7 @@ def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int, near: dict[int
                     best, rise = c, rise + step
         if best < now:  # this knot's bend fits the rings better than without it
             rises[k], now = rise, best
-            strands[lone[k]] = _pith_ray(exits[k], stem, size_mm, rise, pinned=True)
+            strands[lone[k]] = ray(k, rise)
     return rises
 
 
