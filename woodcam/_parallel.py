@@ -11,8 +11,11 @@ gained 1.7x where a fork gains ~2x), and several recipes keep per-fold caches.
 - :func:`share`: independent tasks in forks while this process does a piece that must stay
   here, then helps with the tasks (the held-out refits: the hypotheses that share no state,
   fold by fold, beside the stem and its bend);
-- :func:`beside`: one piece in a fork while this process does another (the all-faces fits of
-  the RBF and the residual beside the stem's; half of a grid bake).
+- :func:`beside`: one piece in a fork while this process does another (half of a grid bake).
+
+A piece this process runs may share its own pieces with new forks (the cone starts of a knot
+inside the knots' bend, while a fork refits the hypotheses that keep no state); a piece running
+in a fork runs its pieces one after the other (its core is taken: no pools of pools).
 
 Each piece runs the same code on the same inputs as in a serial run, so the results are the
 same bit for bit (``tests/inference/test_parallel_fit.py``). :func:`fit_workers` says how
@@ -59,20 +62,45 @@ def fit_workers() -> int:
 #: no longer forks there by default; elsewhere the pieces run one after the other.
 _CAN_FORK = sys.platform.startswith("linux")
 
-#: What forked workers run: set in the parent just before the fork, so that the children find
-#: the functions and their data without pickling them (only an index and the results travel).
-#: Not empty inside a forked piece, where further pieces run serially (no nested pools).
+#: What forked workers run: ``"away"`` (the tasks) and ``"claim"`` (where the next task from
+#: the first is counted) are set in the parent just before the fork, so that the children find
+#: the functions and their data without pickling them (only an index and the results travel);
+#: ``"child"`` is set in a forked worker, whose own pieces run serially (no pools of pools: a
+#: fork's core is taken). A piece run in the parent may fork its own pieces.
 _FORKED: dict = {}
 
 
-def _run_forked(i: int) -> bytes:
+def _claim(counts, lock, from_first: bool) -> int | None:
+    """The next task not yet taken, from the first (a fork) or the last (this process), or None
+    when the two ends have met. ``counts``: shared ``[next from the first, next from the last]``."""
+    with lock:
+        first, last = counts[0], counts[1]
+        if first > last:
+            return None
+        if from_first:
+            counts[0] = first + 1
+            return first
+        counts[1] = last - 1
+        return last
+
+
+def _run_forked() -> tuple[int, bytes] | None:
+    """In a fork: the next task from the first, run, and its index with its result; None when
+    none is left. The task is claimed when the job starts, not when it is queued: the pool
+    queues a job ahead of each worker, and a task named in a queued job could no longer be
+    taken by this process, which then waited for it (a fork's last two folds of the knots'
+    bend, 1.6 s idle)."""
+    _FORKED["child"] = True
+    i = _claim(*_FORKED["claim"], from_first=True)
+    if i is None:
+        return None
     # The result travels pickled by hand and is unpickled by this process' main thread
     # (share): the pool's own result thread would unpickle it, importing the modules its
     # classes live in (scipy.interpolate for an RBF) while the main thread may be importing
     # the same package for a task it took, and Python then fails the main thread's import of
     # the half-initialised package ("cannot import name 'RBFInterpolator'": the first fit of
     # a process, one run in three; tests/inference/test_parallel_fit.py).
-    return pickle.dumps(_FORKED["away"][i](), protocol=pickle.HIGHEST_PROTOCOL)
+    return i, pickle.dumps(_FORKED["away"][i](), protocol=pickle.HIGHEST_PROTOCOL)
 
 
 def share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers: int) -> tuple[list, Any]:
@@ -80,28 +108,31 @@ def share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers: int)
     ``tasks`` from the first while this process runs ``here``, then takes the tasks none has
     started, from the last (their costs are not known ahead: each side keeps busy until they
     meet). All here, one after the other, with one worker, off Linux (:data:`_CAN_FORK`) or
-    inside a piece. Each task's result must be picklable and must not depend on where it ran
-    (a task done here keeps its side effects, one done in a fork loses them)."""
-    if not _CAN_FORK or _FORKED or not tasks or workers <= 1:
+    inside a forked piece. Each task's result must be picklable and must not depend on where it
+    ran (a task done here keeps its side effects, one done in a fork loses them)."""
+    if not _CAN_FORK or _FORKED.get("child") or not tasks or workers <= 1:
         return [t() for t in tasks], here()
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
 
-    _FORKED["away"] = tasks
+    ctx = mp.get_context("fork")
+    claim = (ctx.RawArray("l", [0, len(tasks) - 1]), ctx.Lock())
+    _FORKED.update(away=tasks, claim=claim)  # the children's copies are read
     try:
-        with ProcessPoolExecutor(min(workers - 1, len(tasks)), mp_context=mp.get_context("fork")) as ex:
+        with ProcessPoolExecutor(min(workers - 1, len(tasks)), mp_context=ctx) as ex:
             # the first submit forks every worker: each sees the state as it is here and now
-            jobs = [ex.submit(_run_forked, i) for i in range(len(tasks))]
-            _FORKED["away"] = [None] * len(tasks)  # a piece inside a taken task runs serially
+            jobs = [ex.submit(_run_forked) for _ in tasks]
             mine = here()
             done: dict = {}
-            for i in reversed(range(len(tasks))):
-                if not jobs[i].cancel():  # started (or done) in a fork: so are all before it
-                    break
+            while (i := _claim(*claim, from_first=False)) is not None:
                 done[i] = tasks[i]()
-            return [done[i] if i in done else pickle.loads(jobs[i].result()) for i in range(len(tasks))], mine
+            for job in jobs:  # what the forks did (a job that found none left returns None)
+                if (got := job.result()) is not None:
+                    done[got[0]] = pickle.loads(got[1])
+            return [done[i] for i in range(len(tasks))], mine
     finally:
-        _FORKED.clear()
+        _FORKED.pop("away", None)
+        _FORKED.pop("claim", None)
 
 
 def map_processes(fn: Callable[[Any], Any], items: Sequence, workers: int) -> list:
@@ -116,8 +147,9 @@ def map_processes(fn: Callable[[Any], Any], items: Sequence, workers: int) -> li
 
 def beside(away: Callable[[], Any], here: Callable[[], Any], workers: int = 2) -> tuple[Any, Any]:
     """``(away(), here())``: ``away`` in a forked process while ``here`` runs in this one (one
-    after the other with one worker, :func:`share`). ``away``'s result must be picklable and
-    its side effects are lost; ``here``'s stay."""
+    after the other with one worker, :func:`share`; here too when ``here`` is done before the
+    fork has started it). ``away``'s result must be picklable and must not depend on where it
+    ran; ``here``'s side effects stay."""
     done, mine = share([away], here, workers)
     return done[0], mine
 

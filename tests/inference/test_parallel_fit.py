@@ -10,6 +10,7 @@ import pytest
 
 from woodcam import _parallel
 from woodcam.errors import WoodcamError, WoodcamWarning
+from woodcam.fields.knot_strands import StemWithKnots
 from woodcam.fields.base import evaluate
 from woodcam.inference.fit import fit_block
 
@@ -52,6 +53,8 @@ def test_share_evens_out_tasks_between_the_fork_and_this_process():
 
 
 def test_beside_keeps_only_its_own_side_effects():
+    import time
+
     seen: list = []
 
     def away():
@@ -59,6 +62,7 @@ def test_beside_keeps_only_its_own_side_effects():
         return os.getpid()
 
     def here():
+        time.sleep(0.5)  # the fork starts meanwhile (else this process would take ``away`` too)
         seen.append("here")
         return os.getpid()
 
@@ -68,8 +72,24 @@ def test_beside_keeps_only_its_own_side_effects():
 
 
 def test_a_forked_piece_inside_another_runs_serially():
-    inner = _parallel.beside(lambda: _parallel.map_processes(lambda x: os.getpid(), range(3), 2), lambda: None)[0]
+    import time
+
+    inner = _parallel.beside(lambda: _parallel.map_processes(lambda x: os.getpid(), range(3), 2),
+                             lambda: time.sleep(0.5))[0]  # the fork takes the piece meanwhile
     assert len(set(inner)) == 1 and inner[0] != os.getpid()
+
+
+def test_a_piece_run_here_shares_its_own_pieces_with_a_new_fork():
+    """This process' side of a share may fork its own pieces (a knot's cone starts inside the
+    knots' bend, while a fork refits other hypotheses): they run in a fork of their own and here."""
+    import time
+
+    def slow(x):
+        time.sleep(0.2)
+        return os.getpid()
+
+    away, inner = _parallel.beside(os.getpid, lambda: _parallel.map_processes(slow, range(4), 2))
+    assert inner[-1] == os.getpid() and inner[0] not in (os.getpid(), away)
 
 
 _IMPORT_RACE = """
@@ -155,27 +175,57 @@ def test_two_workers_give_the_one_worker_fit_bit_for_bit(small_knotted_block, mo
         assert np.array_equal(one.layers[k], two.layers[k])
 
 
-def test_hypotheses_that_share_state_are_refitted_here(small_knotted_block):
-    """``holdout_evidence(workers=2)`` refits only hypotheses marked ``alone`` in a fork: the
-    others (the stem and its knots' bend, whose cone fits later steps read) keep their side
-    effects here, fold by fold in the serial order, and every score is the serial one."""
+def test_hypotheses_that_share_a_folds_fit_are_refitted_together(small_knotted_block):
+    """``holdout_evidence`` refits the hypotheses not marked ``alone`` one fold per task, in their
+    order, wherever the task runs: one that reads another's fit of the same fold (the knots'
+    bend reads the stem's, remembered by the stem's recipe) finds it, on one worker and on two,
+    and every score is the serial one. Checked by breaking it: with one task per hypothesis
+    and fold, the later hypothesis finds another fold's fit and has no prediction."""
     from woodcam.inference.evidence import Hypothesis, holdout_evidence
     from woodcam.inference.observations import gather_observations
 
     obs = gather_observations(small_knotted_block)
-    log: list = []
+    last: dict = {}
 
-    def recipe(name, scale):
-        def refit(o):
-            log.append((name, len(o.points_mm), os.getpid()))
-            return lambda p: np.asarray(p, float) @ np.array([0.0, 0.0, scale])
-        return refit
+    def base(o):
+        last["obs"] = o
+        return lambda p: np.asarray(p, float) @ np.array([0.0, 0.0, 0.4])
 
-    hyps = [Hypothesis("shared", None, recipe("shared", 0.4)), Hypothesis("alone", None, recipe("alone", 0.3), alone=True)]
-    serial = holdout_evidence(hyps, obs, workers=1)
-    serial_log = list(log)
-    log.clear()
-    forked = holdout_evidence(hyps, obs, workers=2)
-    assert forked == serial and len(serial["shared"]) >= 2
-    shared = [e for e in log if e[0] == "shared"]  # ("alone" folds may be taken here too)
-    assert shared == [e for e in serial_log if e[0] == "shared"]  # here, in the same order
+    def on_base(o):
+        if last.get("obs") is not o:  # this fold's base fit must have been made just before
+            raise WoodcamError("the base was fitted on other rings")
+        return lambda p: np.asarray(p, float) @ np.array([0.0, 0.0, 0.4]) + 0.2
+
+    hyps = [Hypothesis("base", None, base), Hypothesis("on base", None, on_base),
+            Hypothesis("alone", None, lambda o: (lambda p: np.asarray(p, float) @ np.array([0.0, 0.3, 0.0])),
+                       alone=True)]
+    runs = []
+    for workers in (1, 2):
+        predictions: dict = {}
+        runs.append(holdout_evidence(hyps, obs, workers=workers, predictions=predictions))
+        faces = set(runs[-1]["base"])
+        assert len(faces) >= 2 and {f for n, f in predictions if n == "on base"} == faces
+    assert runs[0] == runs[1]
+
+
+def test_a_fold_keeps_its_own_cone_fits(monkeypatch):
+    """The knots' bend of a fold starts from the cone fits of the all-faces bend only: what a
+    fold fits stays in it (the folds run in forks, in any order), so no fold depends on another.
+    Every start is fitted afresh here (no reuse of a start a few degrees off), so that the folds
+    fit cones of their own (the start down the stem's years of a knot cut by a block edge).
+    Checked by breaking it: with the folds writing to the shared fits, the memo grows by four."""
+    from woodcam.bench_realistic import make_block
+    from woodcam.inference import knots as K
+    from woodcam.inference.observations import gather_observations
+
+    monkeypatch.setattr(K, "KNOT_CONE_START_REUSE_DEG", 0.0)
+    block, info = make_block(7777, 7, "noisy", face_px=96)  # dev seed: knots cut by block edges
+    obs = gather_observations(block)
+    exits = K.knot_exits(block)
+    pinned = K.knot_bend_recipes(block.size_mm, exits, cones=True, workers=1)[1]["stem + knot bend"]
+    pinned(obs)
+    after_all = {k: len(v) for k, v in exits[0]["cone_memo"].items()}
+    assert sum(after_all.values()) >= 4
+    fold = pinned(obs.subset(obs.face != np.unique(obs.face)[0]))
+    assert isinstance(fold, StemWithKnots)
+    assert {k: len(v) for k, v in exits[0]["cone_memo"].items()} == after_all

@@ -50,7 +50,7 @@ from dataclasses import field as dc_field
 
 import numpy as np
 
-from .._parallel import beside, fit_workers, share
+from .._parallel import fit_workers, share
 from .._types import ArrayLike
 
 from ..errors import WoodcamError, WoodcamWarning
@@ -196,51 +196,72 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
         their years (what a blend of the hypotheses is scored from, :func:`_blend_evidence`).
     fold_fields : optional dict, filled with ``(name, face name) -> field``: each fold's fit
         (what the residual is refitted on in each fold, :func:`residual_evidence`).
-    workers : with 2 or more, the hypotheses marked :attr:`Hypothesis.alone` are refitted in
-        forked processes, one task per fold, while this one refits the others fold by fold in
-        the serial order (they share state: the stem's fold fit, the knots' cone fits) and then
-        takes the folds no fork has started (:func:`woodcam._parallel.share`); the same
-        scores, predictions and fold fields bit for bit.
+    workers : processes the folds are refitted in (:func:`woodcam._parallel.share`): one task
+        per fold and group, the hypotheses marked :attr:`Hypothesis.alone` one group, the others
+        (which share a fold's fit: the stem, its knots' bend on it) the other, refitted in the
+        serial order within their fold; the same scores, predictions and fold fields bit for bit.
 
     Returns name -> {face name -> {"score": percent, "share_2mm": percent}}; empty dicts when
     fewer than two faces have rings.
     """
+    folds = _holdout_folds(obs, seed)
+    keep = fold_fields is not None
+    # the heavier stateful tasks first: the forks take them from the first, this process the
+    # others from the last (:func:`share`), so that the two sides even out
+    tasks = _fold_tasks([h for h in hypotheses if not h.alone], folds, keep)
+    tasks += _fold_tasks([h for h in hypotheses if h.alone], folds, keep)
+    parts, _ = share(tasks, lambda: None, workers)
+    return _evidence_of(hypotheses, folds, parts, predictions, fold_fields)
+
+
+def _holdout_folds(obs: RingObservations, seed: int) -> list[tuple]:
+    """The leave-one-face-out folds: ``(face, the other faces' rings, held-out points (k, 3),
+    their years (k,))`` per face with enough ring points (none when fewer than two have), the
+    held-out points drawn from ``seed`` in face order."""
     faces = _held_out_faces(obs)
-    out = {h.name: {} for h in hypotheses}
     if len(faces) < 2:
-        return out
+        return []
     rng = np.random.default_rng(seed)
-    folds = []  # (face, the other faces' rings, held-out points, their years): rng in face order
+    folds = []
     for f in faces:
         held = obs.face == f
         idx = _held_points(obs, held, rng)
         folds.append((f, obs.subset(~held), obs.points_mm[idx], obs.years[idx]))
-    keep_fields = fold_fields is not None
+    return folds
 
-    def refit_all(hyps, these) -> dict:
+
+def _fold_tasks(hyps: list[Hypothesis], folds: list[tuple], keep_fields: bool) -> list[Callable[[], dict]]:
+    """One task per fold refitting ``hyps`` in order on its rings and scoring its held-out face:
+    ``() -> {(name, face): (score dict, (g, grad, years) or None, fold field or None)}``. The
+    tasks are independent (a recipe's state across folds is its all-faces fit's), so they may run
+    in forks (:mod:`woodcam._parallel`)."""
+    def task(fold) -> dict:
+        f, rest, pts, yrs = fold
         res = {}
-        for f, rest, pts, yrs in these:
-            for h in hyps:
-                fitted = pred = None
-                try:
-                    fitted = h.refit(rest)
-                    g, grad = central_gradient(fitted, pts, _GRAD_STEP_MM)
-                    err = _error_mm(g, grad, yrs)
-                    pred = (g, grad, yrs)
-                except (WoodcamError, np.linalg.LinAlgError, ValueError):
-                    err = np.full(len(pts), np.inf)  # a recipe that cannot refit has no evidence
-                res[(h.name, f)] = ({"score": face_score(err), "share_2mm": float(100 * np.mean(err <= 2.0))},
-                                    pred, fitted if keep_fields else None)
+        for h in hyps:
+            fitted = pred = None
+            try:
+                fitted = h.refit(rest)
+                g, grad = central_gradient(fitted, pts, _GRAD_STEP_MM)
+                err = _error_mm(g, grad, yrs)
+                pred = (g, grad, yrs)
+            except (WoodcamError, np.linalg.LinAlgError, ValueError):
+                err = np.full(len(pts), np.inf)  # a recipe that cannot refit has no evidence
+            res[(h.name, f)] = ({"score": face_score(err), "share_2mm": float(100 * np.mean(err <= 2.0))},
+                                pred, fitted if keep_fields else None)
         return res
+    return [lambda fold=fold: task(fold) for fold in folds] if hyps else []
 
-    away = [h for h in hypotheses if h.alone]
-    here = [h for h in hypotheses if not h.alone]
-    # the alone ones one task per fold, so that the two sides can even out
-    parts, res = share([lambda fold=fold: refit_all(away, [fold]) for fold in folds] if away else [],
-                       lambda: refit_all(here, folds), workers)
+
+def _evidence_of(hypotheses: list[Hypothesis], folds: list[tuple], parts: list[dict], predictions: dict | None,
+                 fold_fields: dict | None) -> dict:
+    """:func:`holdout_evidence`'s result from its fold tasks' results ``parts``, filling
+    ``predictions`` and ``fold_fields`` in the serial order."""
+    res: dict = {}
     for part in parts:
         res.update(part)
-    for f, *_ in folds:  # filled in the serial order
+    out: dict = {h.name: {} for h in hypotheses}
+    for f, *_ in folds:
         for h in hypotheses:
             score, pred, fitted = res[(h.name, f)]
             if fitted is not None:
@@ -708,7 +729,8 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                 return []
 
         # the stem first (remembering its fit; its start search on the fit's cores), then the
-        # knots' bend built on it here while a fork fits the hypotheses that keep no state
+        # knots' bend built on it here while forks fit the hypotheses that keep no state and
+        # refit them in every fold (neither needs the bend); then the folds of the others
         stems = fitted("stem", stem_rec) if stem_rec else []
 
         def stateful() -> list:
@@ -716,12 +738,17 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
 
         def stateless() -> dict:
             return {name: rec(rings) for name, rec in alone.items()}
-        fields, bends = beside(stateless, stateful, workers)
-        hyps += stems + [Hypothesis(name, fields[name], rec, alone=True) for name, rec in alone.items()]
+        split = _holdout_folds(rings, seed)
+        early = hyps + [Hypothesis(name, None, rec, alone=True) for name, rec in alone.items()]
+        done, bends = share([stateless] + _fold_tasks(early, split, residual), stateful, workers)
+        hyps += stems + [Hypothesis(name, done[0][name], rec, alone=True) for name, rec in alone.items()]
         hyps += bends + list(extra or [])
+        late = [h for h in hyps if h.name not in {e.name for e in early}]
+        parts, _ = share(_fold_tasks([h for h in late if not h.alone], split, residual)
+                         + _fold_tasks([h for h in late if h.alone], split, residual), lambda: None, workers)
         predictions: dict = {}
         folds: dict | None = {} if residual else None
-        result = choose(hyps, holdout_evidence(hyps, rings, seed, predictions, folds, workers))
+        result = choose(hyps, _evidence_of(hyps, split, done[1:] + parts, predictions, folds))
         if residual:
             result = add_residual(result, rings, size_mm, folds, seed, workers)
         if blend == "everywhere":

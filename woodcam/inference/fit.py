@@ -44,8 +44,10 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: pith may be two knots' of a whorl, :func:`woodcam.inference.knots.strands_from_exits`; 18: a
 #: knot seen at one exit is the ray from the fitted pith through it, its rise read from the rings,
 #: and bends them, :func:`woodcam.inference.knots.fit_knotted_stem`; 19: its rises are searched
-#: wherever some rise of the grid has a ray, not only where the ray across the stem has one).
-FIT_VERSION = 19
+#: wherever some rise of the grid has a ray, not only where the ray across the stem has one; 20:
+#: a fold's knot cones start from the all-faces fit's only, so the folds, refitted in forks, do
+#: not depend on each other, :func:`woodcam.inference.knots.knot_bend_recipes`).
+FIT_VERSION = 20
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,

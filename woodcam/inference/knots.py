@@ -632,7 +632,7 @@ def _ray_misfit(field, obs, density) -> float:
 
 
 def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int,
-               near: dict[int, float] | None = None) -> dict[int, float]:
+               near: dict[int, float] | None = None, workers: int = 1) -> dict[int, float]:
     """exit index -> rise (rad) of each knot seen at one exit whose ray from the pith
     (:func:`_pith_ray`) bends the rings: per such knot in turn, of the rises
     :data:`~woodcam.tolerances.KNOT_RAY_RISES_DEG` (then the vertex of the parabola through the
@@ -650,12 +650,13 @@ def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int,
     ``near``: rises found on more rings (a fold's fit starts from the all-faces fit's, as its
     stem does: :func:`knot_bend_recipes`): only those knots are tried, each at its rise and one
     step of the grid either side. Why: every fold searching afresh took seed 31337 block 15 (six
-    faces, five knots seen at one exit) from 7.3 to 20.4 s wall."""
+    faces, five knots seen at one exit) from 7.3 to 20.4 s wall. ``workers``: processes each
+    knot's cone starts may use (:func:`_fit_cone`)."""
     from .stem import fit_stem
 
     rises: dict[int, float] = {}
     full = np.deg2rad(KNOT_RAY_RISES_DEG)
-    strands, lone = _strands(exits, stem, size_mm, cones)
+    strands, lone = _strands(exits, stem, size_mm, cones, workers)
     made: dict = {}
 
     def ray(k, rise):  # knot k's pinned ray at ``rise``, made once (the check below, then its cost)
@@ -740,10 +741,10 @@ def fit_knotted_stem(obs: RingObservations, size_mm: ArrayLike, exits: list[dict
     return _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones)[0]
 
 
-def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones=False, near=None):
+def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones=False, near=None, workers=1):
     """:func:`fit_knotted_stem`, whether every round placed pinned strands only (then the fit
     with ``guessed=True`` would make the very same steps) and the rises of the rays that bend
-    (:func:`_ray_rises`, ``near`` passed on)."""
+    (:func:`_ray_rises`, ``near`` passed on); ``workers``: processes each cone's starts may use."""
     from .stem import fit_stem
 
     stem = fit_stem(obs, size_mm, seed=seed) if stem is None else stem
@@ -753,8 +754,8 @@ def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones=Fa
         if np.mean(g <= stem.pith_years()) > KNOT_BEND_MAX_BEFORE_PITH:
             return plain, False, {}  # times are not "from the pith" in this stem: no bend to speak of
         if rises is None:  # the rises of the knots seen at one exit, in the first round's stem
-            rises = _ray_rises(exits, stem, obs, size_mm, cones, seed, near)
-        strands = strands_from_exits(exits, stem, size_mm, cones, rises=rises)
+            rises = _ray_rises(exits, stem, obs, size_mm, cones, seed, near, workers)
+        strands = strands_from_exits(exits, stem, size_mm, cones, workers, rises=rises)
         only_pinned &= all(s.pinned for s in strands)
         if not any(s.pinned or guessed for s in strands):
             return plain, False, rises
@@ -767,7 +768,8 @@ def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones=Fa
 
 
 def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, guessed: bool = False,
-                      cones: bool = False, residual: bool = True) -> tuple[Callable, dict[str, Callable], dict[str, str]]:
+                      cones: bool = False, residual: bool = True,
+                      workers: int | None = None) -> tuple[Callable, dict[str, Callable], dict[str, str]]:
     """Evidence hypotheses of the knots' bend: ``(stem, recipes, refines)``.
 
     ``recipes``, name -> ``RingObservations -> field``, is :func:`fit_knotted_stem` on the given
@@ -797,7 +799,9 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
     plain stem instead, a knot-distorted stem in another basin, the bend's held-out faces fell
     (35089/18: 49.9 -> 39.3 %). Its rays likewise start from the all-faces fit's rises
     (:func:`_ray_rises` ``near``): the fold's rings choose among each such rise and one grid step
-    either side, or no bend. The guessed one is left out by default
+    either side, or no bend; and its cones from the all-faces fit's (a fold's own cone fits are
+    its own), so that no fold depends on which folds came before it or where they ran: the folds
+    are refitted in forks (:func:`~.evidence.holdout_evidence`). The guessed one is left out by default
     (:func:`~.fit.fit_block` does not offer it): a strand guessed from one exit is a few mm to
     cm off its knot, and with three faces, where most knots show one exit, its bend lost more
     than it gained (seed 61297, three noisy faces, knotted: 52.4 -> 50.0 % within 1 mm; dev seed
@@ -805,13 +809,26 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
     same choices and scores without it). ``stem`` is the plain stem's recipe (:func:`~.stem.fit_stem`)
     remembering its last fit: passed as the evidence fit's stem hypothesis
     (:func:`~.evidence.fit_evidence`'s ``stem``), each fold's stem is fitted once for all of them.
+    ``workers``: processes the stem's start search and each cone's starts may use (default
+    :func:`woodcam._parallel.fit_workers`; inside a forked fold they run serially).
     """
+    from .._parallel import fit_workers
     from ..tolerances import EVIDENCE_RBF_POINTS
     from .evidence import _residual_recipe, stem_recipe
 
-    plain = stem_recipe(size_mm, seed)  # remembers its last fit: one stem per fold for all
+    cores = fit_workers() if workers is None else int(workers)
+    plain = stem_recipe(size_mm, seed, cores)  # remembers its last fit: one stem per fold for all
 
     bent: dict = {}
+
+    def fold_exits():
+        """The exits with the cone fits of the all-faces fit only (a copy of them per fold): a
+        fold's cones never depend on which folds were fitted before it, nor where (the folds
+        run in forks, :func:`~.evidence.holdout_evidence`)."""
+        if "memo" not in bent:  # the first, all-faces fit: its cones are remembered for all
+            return exits
+        memo = {k: list(v) for k, v in bent["memo"].items()}
+        return [{**e, "cone_memo": memo} for e in exits]
 
     def pinned(obs):
         if bent.get("obs") is not obs:
@@ -822,21 +839,22 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
 
                 off = first(obs.points_mm) - first.stem(obs.points_mm)
                 start = fit_stem(obs, size_mm, seed=seed, offset_years=off, init=first.stem)
-            field, same, rises = _fit_knotted_stem(obs, size_mm, exits, KNOT_BEND_ROUNDS, seed, False,
-                                                   start if warm else plain(obs), cones, bent.get("rises"))
+            field, same, rises = _fit_knotted_stem(obs, size_mm, fold_exits(), KNOT_BEND_ROUNDS, seed, False,
+                                                   start if warm else plain(obs), cones, bent.get("rises"), cores)
             if warm:
                 same = False  # the guessed bend starts from the plain stem: not the same steps
                 if not isinstance(field, StemWithKnots):  # no bend in this fold: the plain stem's
                     field = plain(obs)
             bent.update(obs=obs, field=field, same=same)
-            bent.setdefault("first", field)
-            bent.setdefault("rises", rises)  # the folds' rays start from the all-faces fit's rises
+            if "first" not in bent:  # the all-faces fit: what every fold starts from
+                bent.update(first=field, rises=rises,  # the folds' rays start from its rises
+                            memo={k: list(v) for k, v in (exits[0].get("cone_memo") or {}).items()})  # the folds' rays start from the all-faces fit's rises
         return bent["field"]
 
     def bent_guessed(obs):
         if bent.get("obs") is obs and bent["same"]:  # no strand was a guess: the same fit
             return bent["field"]
-        return fit_knotted_stem(obs, size_mm, exits, seed=seed, guessed=True, stem=plain(obs), cones=cones)
+        return fit_knotted_stem(obs, size_mm, fold_exits(), seed=seed, guessed=True, stem=plain(obs), cones=cones)
 
     out, refines = {}, {}
     if exits:  # a strand pinned by exits on two faces, or a ray from the pith the rings place
