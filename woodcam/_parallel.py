@@ -9,8 +9,8 @@ gained 1.7x where a fork gains ~2x), and several recipes keep per-fold caches.
 
 - :func:`map_processes`: independent items (the radial axis refinements);
 - :func:`share`: independent tasks in forks while this process does a piece that must stay
-  here, then helps with the tasks (the held-out refits: the hypotheses that share no state,
-  fold by fold, beside the stem and its bend);
+  here, then helps with the tasks (the held-out refits, one task per fold: those of the
+  hypotheses that keep no state beside the all-faces fit of the knots' bend, then the others);
 - :func:`beside`: one piece in a fork while this process does another (half of a grid bake).
 
 A piece this process runs may share its own pieces with new forks (the cone starts of a knot

@@ -89,6 +89,20 @@ BAKE_SPACING_MM = 1.0
 #: edge of their grid on the block faces.
 BAKE_MARGIN_MM = 2.0
 
+#: Depth (mm) beyond which a baked thin-plate spline of face points (the RBF hypothesis, a
+#: residual) is interpolated from a grid of :data:`BAKE_SMOOTH_SPACING_MM` instead of evaluated
+#: at every node (:mod:`woodcam.inference.baked`): its centres are on the faces, so it is smooth
+#: there. The evidence fit's residuals (six noisy faces, amplitudes 1.2-10 years) baked so
+#: against every node evaluated: seeds 57131 blocks 11 and 15 at most 0.0027 and 0.0048 years
+#: off, 7777 block 10 (a 10-year residual) 0.016, all deep inside; the bake 2.45 -> 2.02,
+#: 2.70 -> 2.08 and 1.70 -> 1.35 s on two cores. At least 3 mm deep instead, up to 0.047 years
+#: off (the spline bends sharply near its centres).
+BAKE_SMOOTH_DEPTH_MM = 5.0
+
+#: Grid step (mm) of the coarse grid a baked spline is interpolated from deeper than
+#: :data:`BAKE_SMOOTH_DEPTH_MM` (3 mm: up to 0.035 years off at 5 mm deep).
+BAKE_SMOOTH_SPACING_MM = 2.0
+
 #: Spacing (mm) at which ring traces are resampled before fitting: 0.5 mm is finer than any
 #: ring's curvature radius away from the pith and keeps a fully traced 50 mm cube near 3-6k points.
 TRACE_SAMPLE_STEP_MM = 0.5

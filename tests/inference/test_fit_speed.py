@@ -172,6 +172,47 @@ def test_thin_plate_field_matches_scipys_evaluation():
     assert rbf._thin_plate_field(other) is other  # only the thin-plate spline has the fast path
 
 
+def test_a_face_spline_is_baked_exactly_near_the_faces_and_smoothly_deep_inside():
+    """A thin-plate spline of face points (the evidence fit's residual, the RBF hypothesis) is
+    baked exactly within ``BAKE_SMOOTH_DEPTH_MM`` of a face and from a coarser grid deeper
+    (:mod:`woodcam.inference.baked`); on a residual of a few years that bends sharply near its
+    centres the deep nodes stay within 0.02 years. A spline with a centre inside the block is
+    baked exactly everywhere. Checked by breaking it: interpolating every node from the coarse
+    grid, the nodes near the faces are 0.2 years off and this fails."""
+    from woodcam.fields.grid import GridField
+    from woodcam.fields.residual import ResidualField
+    from woodcam.inference.baked import bake
+    from woodcam.tolerances import BAKE_SMOOTH_DEPTH_MM
+
+    rng = np.random.default_rng(11)
+    size = np.array([40.0, 34.0, 46.0])
+    pts = rng.uniform(0, 1, (600, 3)) * size
+    face = rng.integers(0, 3, len(pts))
+    pts[np.arange(len(pts)), face] = np.where(rng.random(len(pts)) < 0.5, 0.0, size[face])  # on the faces
+    wavy = 2.0 * np.sin(pts[:, 0] / 3.0) * np.cos(pts[:, 2] / 4.0) + rng.normal(0, 0.3, len(pts))
+    spline = rbf._thin_plate_field(RBFInterpolator(pts, wavy, kernel="thin_plate_spline", smoothing=1.0))
+    stem = lambda p: np.asarray(p, float)[:, 2] / 2.5 + 3.0  # noqa: E731
+    nodes_ok = []
+    for field in (ResidualField(stem, spline), spline):
+        exact = GridField.bake(field, (0, 0, 0), tuple(size), 1.0, margin_nodes=2)
+        fast = bake(field, size)
+        shape = exact.years.shape
+        axes = [exact.origin_mm[i] + np.arange(shape[i]) for i in range(3)]
+        nodes = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 3)
+        deep = (np.min(np.minimum(nodes, size - nodes), axis=1) >= BAKE_SMOOTH_DEPTH_MM).reshape(shape)
+        diff = np.abs(fast.years - exact.years)
+        assert deep.mean() > 0.3 and np.ptp(exact.years[deep]) > 2.0  # a deep field that varies
+        np.testing.assert_allclose(fast.years[~deep], exact.years[~deep], rtol=0, atol=1e-9)
+        assert diff[deep].max() < 0.02
+        nodes_ok.append(diff[deep].max() > 0)  # deep nodes interpolated, not evaluated
+    assert all(nodes_ok)
+    inside = pts.copy()
+    inside[0] = size / 2  # one centre deep inside: no smooth interior
+    spline = rbf._thin_plate_field(RBFInterpolator(inside, wavy, kernel="thin_plate_spline", smoothing=1.0))
+    assert np.array_equal(bake(spline, size).years, GridField.bake(spline, (0, 0, 0), tuple(size), 1.0,
+                                                                    margin_nodes=2).years)
+
+
 def _labelled_problem(K, M, ridge, seed=6):
     """Rings of a tilted, eccentric radial field sampled on three faces of a 50 mm block."""
     rng = np.random.default_rng(seed)

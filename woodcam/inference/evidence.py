@@ -101,10 +101,11 @@ class Hypothesis:
         ``"stem"``), or None; a refinement is chosen only while the evidence keeps its base
         and it beats every plain hypothesis clearly, or in its base's place where the base is
         the best plain hypothesis (:func:`choose`)
-    alone : True when ``refit`` reads and writes no state that another hypothesis' refit or a
-        later step shares (the radial basins, the RBF, the residual on the first basin, which
-        only reads that basin's fold fit): :func:`holdout_evidence` may then refit it in a
-        forked process beside the others (:mod:`woodcam._parallel`)
+    alone : True when ``refit`` shares no state with the others' (the radial basins, the RBF,
+        the residual on the first basin, which only reads that basin's fold fit): its folds are
+        then refitted apart from theirs (:func:`holdout_evidence`), and in :func:`fit_evidence`
+        beside the all-faces fits of the others (:mod:`woodcam._parallel`). The others' folds
+        are refitted in order, one task per fold, their state across folds their all-faces fits'.
     """
 
     name: str
@@ -715,7 +716,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         rings = obs if obs.labelled else numbered
         hyps = [Hypothesis("radial" if i == 0 else f"radial basin {i + 1}", f, radial_recipe(f, seed, size_mm),
                            alone=True) for i, f in enumerate(radials)]
-        alone = {}  # recipes that keep no state: fitted in a fork beside those that do
+        alone = {}  # recipes that keep no state: fitted (and their folds) beside those that do
         if "rbf" in candidates:
             alone["rbf"] = _rbf_recipe(EVIDENCE_RBF_POINTS)
         if "residual" in candidates:  # shares radial's fold fits, which nothing here reads

@@ -46,8 +46,9 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: and bends them, :func:`woodcam.inference.knots.fit_knotted_stem`; 19: its rises are searched
 #: wherever some rise of the grid has a ray, not only where the ray across the stem has one; 20:
 #: a fold's knot cones start from the all-faces fit's only, so the folds, refitted in forks, do
-#: not depend on each other, :func:`woodcam.inference.knots.knot_bend_recipes`).
-FIT_VERSION = 20
+#: not depend on each other, :func:`woodcam.inference.knots.knot_bend_recipes`; 21: a baked
+#: thin-plate spline of face points is interpolated deeper than 5 mm, :mod:`woodcam.inference.baked`).
+FIT_VERSION = 21
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
