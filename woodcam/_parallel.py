@@ -108,10 +108,12 @@ def share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers: int)
     ``tasks`` from the first while this process runs ``here``, then takes the tasks none has
     started, from the last (their costs are not known ahead: each side keeps busy until they
     meet). All here, one after the other, with one worker, off Linux (:data:`_CAN_FORK`) or
-    inside a forked piece. Each task's result must be picklable and must not depend on where it
+    inside a forked piece: ``here`` first, as with forks, so that ``here`` sees no task's side
+    effects either way. Each task's result must be picklable and must not depend on where it
     ran (a task done here keeps its side effects, one done in a fork loses them)."""
     if not _CAN_FORK or _FORKED.get("child") or not tasks or workers <= 1:
-        return [t() for t in tasks], here()
+        mine = here()
+        return [t() for t in tasks], mine
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
 

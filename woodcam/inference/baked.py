@@ -58,7 +58,7 @@ def _face_spline(field, size):
     spline, rest = (field.residual, field.base) if isinstance(field, ResidualField) else (field, None)
     if not isinstance(spline, _ThinPlate):
         return field, None
-    y = spline._yc + spline._centre
+    y = np.asarray(spline.rbf.y, float)  # its centres, block frame mm
     depth = np.min(np.minimum(y, size - y), axis=1)
     if np.any(depth > 1e-6):  # a centre inside: not smooth there
         return field, None

@@ -741,10 +741,14 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
             return {name: rec(rings) for name, rec in alone.items()}
         split = _holdout_folds(rings, seed)
         early = hyps + [Hypothesis(name, None, rec, alone=True) for name, rec in alone.items()]
-        done, bends = share([stateless] + _fold_tasks(early, split, residual), stateful, workers)
+        # the stem's folds too: each starts from its all-faces fit alone (a fold's bend refits it
+        # where it needs it, from the same start: the same fit)
+        done, bends = share([stateless] + _fold_tasks(stems, split, residual) + _fold_tasks(early, split, residual),
+                            stateful, workers)
         hyps += stems + [Hypothesis(name, done[0][name], rec, alone=True) for name, rec in alone.items()]
         hyps += bends + list(extra or [])
-        late = [h for h in hyps if h.name not in {e.name for e in early}]
+        seen = {h.name for h in early + stems}  # refitted in every fold already
+        late = [h for h in hyps if h.name not in seen]
         parts, _ = share(_fold_tasks([h for h in late if not h.alone], split, residual)
                          + _fold_tasks([h for h in late if h.alone], split, residual), lambda: None, workers)
         predictions: dict = {}
