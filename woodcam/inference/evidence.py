@@ -731,7 +731,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
 
         # the stem first (remembering its fit; its start search on the fit's cores), then the
         # knots' bend built on it here while forks fit the hypotheses that keep no state and
-        # refit them in every fold (neither needs the bend); then the folds of the others
+        # refit them and the stem in every fold (none needs the bend); then the bend's folds
         stems = fitted("stem", stem_rec) if stem_rec else []
 
         def stateful() -> list:
@@ -741,8 +741,8 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
             return {name: rec(rings) for name, rec in alone.items()}
         split = _holdout_folds(rings, seed)
         early = hyps + [Hypothesis(name, None, rec, alone=True) for name, rec in alone.items()]
-        # the stem's folds too: each starts from its all-faces fit alone (a fold's bend refits it
-        # where it needs it, from the same start: the same fit)
+        # the stem's folds start from its all-faces fit alone (a fold's bend refits the stem where
+        # it needs it, from the same start: the same fit)
         done, bends = share([stateless] + _fold_tasks(stems, split, residual) + _fold_tasks(early, split, residual),
                             stateful, workers)
         hyps += stems + [Hypothesis(name, done[0][name], rec, alone=True) for name, rec in alone.items()]
