@@ -21,7 +21,7 @@ TINY = {"n_fields": 8, "points_per_field": 64, "latent_dim": 4, "hidden": 16, "l
 #: The one unpickling allowed, as (file, code): the bytes a forked worker of this process sent
 #: back through the pool's pipe (``_parallel._run_forked``), which the pool would otherwise
 #: unpickle itself; nothing read from a file or from anyone else.
-_OWN_FORK_RESULT = ("woodcam/_parallel.py", "pickle.loads(jobs[i].result())")
+_OWN_FORK_RESULT = ("woodcam/_parallel.py", "pickle.loads(got[1])")
 
 
 def test_no_unsafe_torch_load_anywhere():
