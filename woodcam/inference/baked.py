@@ -89,12 +89,16 @@ def _smooth_inside(spline, grid, size, workers: int) -> np.ndarray:
     depth = np.min(np.minimum(nodes, size - nodes), axis=1)  # < 0 outside the block
     deep = depth >= BAKE_SMOOTH_DEPTH_MM
     out = np.empty(len(nodes))
-    out[~deep] = evaluate(spline, nodes[~deep], workers=workers)
-    if deep.any():
-        h = BAKE_SMOOTH_SPACING_MM
-        lo = nodes[deep].min(axis=0) - 2 * h  # two nodes beyond the deep region: the cubic's support
-        cax = [lo[i] + h * np.arange(int(np.ceil((nodes[deep, i].max() + 2 * h - lo[i]) / h)) + 1) for i in range(3)]
-        coarse = np.stack(np.meshgrid(*cax, indexing="ij"), axis=-1).reshape(-1, 3)
-        values = evaluate(spline, coarse, workers=workers).reshape([len(a) for a in cax])
-        out[deep] = ndimage.map_coordinates(values, ((nodes[deep] - lo) / h).T, order=3, mode="nearest")
+    if not deep.any():
+        out[:] = evaluate(spline, nodes, workers=workers)
+        return out.reshape(shape)
+    h = BAKE_SMOOTH_SPACING_MM
+    lo = nodes[deep].min(axis=0) - 2 * h  # two nodes beyond the deep region: the cubic's support
+    cax = [lo[i] + h * np.arange(int(np.ceil((nodes[deep, i].max() + 2 * h - lo[i]) / h)) + 1) for i in range(3)]
+    coarse = np.stack(np.meshgrid(*cax, indexing="ij"), axis=-1).reshape(-1, 3)
+    # one call for both: its share of the points in a fork (the coarse grid alone is too few to fork)
+    values = evaluate(spline, np.concatenate([nodes[~deep], coarse]), workers=workers)
+    out[~deep] = values[:len(values) - len(coarse)]
+    coarse_values = values[len(values) - len(coarse):].reshape([len(a) for a in cax])
+    out[deep] = ndimage.map_coordinates(coarse_values, ((nodes[deep] - lo) / h).T, order=3, mode="nearest")
     return out.reshape(shape)
