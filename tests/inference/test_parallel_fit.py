@@ -52,6 +52,20 @@ def test_share_evens_out_tasks_between_the_fork_and_this_process():
     assert in_fork == sorted(in_fork, reverse=True)
 
 
+def test_a_task_the_busy_fork_has_not_started_is_taken_here():
+    """A fork claims a task when it starts it: while it is busy with the first, the second is
+    still free for this process. Checked by breaking it: with the tasks named when the pool
+    queues them (it queues one ahead of each worker), the second ran in the fork after the first."""
+    import time
+
+    def task(s):
+        time.sleep(s)
+        return os.getpid()
+
+    done, _ = _parallel.share([lambda: task(1.0), lambda: task(0.0)], lambda: time.sleep(0.3), 2)
+    assert done[0] != os.getpid() and done[1] == os.getpid()
+
+
 def test_beside_keeps_only_its_own_side_effects():
     import time
 
