@@ -10,8 +10,8 @@ import pytest
 
 from woodcam import _parallel
 from woodcam.errors import WoodcamError, WoodcamWarning
-from woodcam.fields.knot_strands import StemWithKnots
 from woodcam.fields.base import evaluate
+from woodcam.fields.knot_strands import StemWithKnots
 from woodcam.inference.fit import fit_block
 
 pytestmark = pytest.mark.skipif(not _parallel._CAN_FORK, reason="a fit forks its pieces on Linux only (woodcam._parallel)")
