@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import time
 import warnings
 
 import numpy as np
@@ -39,8 +40,6 @@ def test_map_processes_keeps_the_order_forks_take_the_first_items_and_this_proce
 def test_share_evens_out_tasks_between_the_fork_and_this_process():
     """While this process is busy, the fork works from the first task; then this process takes
     the tasks not yet started, from the last, and both meet."""
-    import time
-
     def task(i):
         time.sleep(0.1)
         return i, os.getpid()
@@ -56,8 +55,6 @@ def test_a_task_the_busy_fork_has_not_started_is_taken_here():
     """A fork claims a task when it starts it: while it is busy with the first, the second is
     still free for this process. Checked by breaking it: with the tasks named when the pool
     queues them (it queues one ahead of each worker), the second ran in the fork after the first."""
-    import time
-
     def task(s):
         time.sleep(s)
         return os.getpid()
@@ -67,8 +64,6 @@ def test_a_task_the_busy_fork_has_not_started_is_taken_here():
 
 
 def test_beside_keeps_only_its_own_side_effects():
-    import time
-
     seen: list = []
 
     def away():
@@ -86,8 +81,6 @@ def test_beside_keeps_only_its_own_side_effects():
 
 
 def test_a_forked_piece_inside_another_runs_serially():
-    import time
-
     inner = _parallel.beside(lambda: _parallel.map_processes(lambda x: os.getpid(), range(3), 2),
                              lambda: time.sleep(0.5))[0]  # the fork takes the piece meanwhile
     assert len(set(inner)) == 1 and inner[0] != os.getpid()
@@ -96,8 +89,6 @@ def test_a_forked_piece_inside_another_runs_serially():
 def test_a_piece_run_here_shares_its_own_pieces_with_a_new_fork():
     """This process' side of a share may fork its own pieces (a knot's cone starts inside the
     knots' bend, while a fork refits other hypotheses): they run in a fork of their own and here."""
-    import time
-
     def slow(x):
         time.sleep(0.2)
         return os.getpid()

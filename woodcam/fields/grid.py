@@ -26,6 +26,12 @@ Interpolation = Literal["cubic", "linear"]
 _ORDER = {"cubic": 3, "linear": 1}
 
 
+def _nodes_mm(origin_mm, spacing_mm, shape) -> np.ndarray:
+    """``(prod(shape), 3)`` mm of a grid's nodes, C order (``ij`` indexing)."""
+    axes = [origin_mm[i] + spacing_mm[i] * np.arange(shape[i]) for i in range(3)]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+
+
 @dataclass(frozen=True)
 class GridField:
     """Growth time on grid nodes plus interpolation.
@@ -108,11 +114,14 @@ class GridField:
                    "smaller block")
         n = n_float.astype(int)
         origin = lo - margin_nodes * spacing_mm
-        axes = [origin[i] + spacing_mm * np.arange(n[i]) for i in range(3)]
-        pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+        pts = _nodes_mm(origin, (spacing_mm,) * 3, n)
         years = evaluate(field, pts, workers=workers).reshape(tuple(n))
         axis = tuple(np.asarray(getattr(field, "axis", (0.0, 0.0, 1.0)), float))
         return cls(years, tuple(origin), (spacing_mm,) * 3, interpolation, axis)
+
+    def nodes_mm(self) -> np.ndarray:
+        """``(n, 3)`` block frame mm of the grid's nodes, in the order of ``years.ravel()``."""
+        return _nodes_mm(self.origin_mm, self.spacing_mm, self.years.shape)
 
     def __call__(self, points_mm: ArrayLike) -> np.ndarray:
         """Interpolated growth time ``years : (n,)`` at ``points_mm : (n, 3)``."""

@@ -51,18 +51,22 @@ def bake(field, size_mm, spacing_mm: float = BAKE_SPACING_MM, margin_mm: float =
 def _face_spline(field, size):
     """``(rest, spline)``: ``field``'s thin-plate spline whose centres all lie on the block's
     faces (itself, or a :class:`~woodcam.fields.residual.ResidualField`'s residual) and the rest
-    of it (``None`` for nothing), or ``(field, None)`` when it has none."""
+    of it (a zero field beside a lone spline), or ``(field, None)`` when it has none."""
     from ..fields.residual import ResidualField
     from .rbf import _ThinPlate
 
     spline, rest = (field.residual, field.base) if isinstance(field, ResidualField) else (field, None)
     if not isinstance(spline, _ThinPlate):
         return field, None
-    y = np.asarray(spline.rbf.y, float)  # its centres, block frame mm
-    depth = np.min(np.minimum(y, size - y), axis=1)
-    if np.any(depth > 1e-6):  # a centre inside: not smooth there
+    if np.any(_depth_mm(np.asarray(spline.rbf.y, float), size) > 1e-6):  # a centre inside: not smooth there
         return field, None
     return (rest if rest is not None else _Zero(getattr(field, "axis", (0.0, 0.0, 1.0)))), spline
+
+
+def _depth_mm(points_mm, size) -> np.ndarray:
+    """``(n,)`` mm from each of ``points_mm (n, 3)`` to the nearest face of the block
+    ``[0, size]``, negative outside it."""
+    return np.min(np.minimum(points_mm, size - points_mm), axis=1)
 
 
 class _Zero:
@@ -84,10 +88,8 @@ def _smooth_inside(spline, grid, size, workers: int) -> np.ndarray:
     from ..fields.base import evaluate
 
     shape = grid.years.shape
-    axes = [grid.origin_mm[i] + grid.spacing_mm[i] * np.arange(shape[i]) for i in range(3)]
-    nodes = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    depth = np.min(np.minimum(nodes, size - nodes), axis=1)  # < 0 outside the block
-    deep = depth >= BAKE_SMOOTH_DEPTH_MM
+    nodes = grid.nodes_mm()
+    deep = _depth_mm(nodes, size) >= BAKE_SMOOTH_DEPTH_MM
     out = np.empty(len(nodes))
     if not deep.any():
         out[:] = evaluate(spline, nodes, workers=workers)

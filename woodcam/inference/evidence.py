@@ -206,12 +206,7 @@ def holdout_evidence(hypotheses: list[Hypothesis], obs: RingObservations, seed: 
     fewer than two faces have rings.
     """
     folds = _holdout_folds(obs, seed)
-    keep = fold_fields is not None
-    # the heavier stateful tasks first: the forks take them from the first, this process the
-    # others from the last (:func:`share`), so that the two sides even out
-    tasks = _fold_tasks([h for h in hypotheses if not h.alone], folds, keep)
-    tasks += _fold_tasks([h for h in hypotheses if h.alone], folds, keep)
-    parts, _ = share(tasks, lambda: None, workers)
+    parts, _ = share(_grouped_fold_tasks(hypotheses, folds, fold_fields is not None), lambda: None, workers)
     return _evidence_of(hypotheses, folds, parts, predictions, fold_fields)
 
 
@@ -252,6 +247,14 @@ def _fold_tasks(hyps: list[Hypothesis], folds: list[tuple], keep_fields: bool) -
                                 pred, fitted if keep_fields else None)
         return res
     return [lambda fold=fold: task(fold) for fold in folds] if hyps else []
+
+
+def _grouped_fold_tasks(hyps: list[Hypothesis], folds: list[tuple], keep_fields: bool) -> list[Callable[[], dict]]:
+    """:func:`_fold_tasks` of the hypotheses that share state (not :attr:`~Hypothesis.alone`),
+    then of the alone ones: the heavier stateful tasks first, which the forks take from the
+    first while this process takes from the last (:func:`share`), so that the two sides even out."""
+    return (_fold_tasks([h for h in hyps if not h.alone], folds, keep_fields)
+            + _fold_tasks([h for h in hyps if h.alone], folds, keep_fields))
 
 
 def _evidence_of(hypotheses: list[Hypothesis], folds: list[tuple], parts: list[dict], predictions: dict | None,
@@ -749,8 +752,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         hyps += bends + list(extra or [])
         seen = {h.name for h in early + stems}  # refitted in every fold already
         late = [h for h in hyps if h.name not in seen]
-        parts, _ = share(_fold_tasks([h for h in late if not h.alone], split, residual)
-                         + _fold_tasks([h for h in late if h.alone], split, residual), lambda: None, workers)
+        parts, _ = share(_grouped_fold_tasks(late, split, residual), lambda: None, workers)
         predictions: dict = {}
         folds: dict | None = {} if residual else None
         result = choose(hyps, _evidence_of(hyps, split, done[1:] + parts, predictions, folds))
@@ -823,8 +825,7 @@ def _bake_evidence(ev: EvidenceFit, size_mm, faces, strands, workers: int):
 
     grid = bake(ev.field, size_mm, workers=workers)
     shape = grid.years.shape
-    axes = [grid.origin_mm[i] + grid.spacing_mm[i] * np.arange(shape[i]) for i in range(3)]
-    nodes = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    nodes = grid.nodes_mm()
     spread = np.zeros(len(nodes))
     if len(ev.accepted) > 1:
         step = EVIDENCE_SPREAD_SPACING_MM

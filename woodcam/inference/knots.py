@@ -767,6 +767,12 @@ def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones=Fa
     return field, only_pinned, rises
 
 
+def _memo_copy(memo: dict) -> dict:
+    """A copy of a cone memo (:func:`_fit_cone`) that fits added to it leave the original as it
+    was: its lists copied, the fits they hold shared (never changed)."""
+    return {k: list(v) for k, v in memo.items()}
+
+
 def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, guessed: bool = False,
                       cones: bool = False, residual: bool = True,
                       workers: int | None = None) -> tuple[Callable, dict[str, Callable], dict[str, str]]:
@@ -827,7 +833,7 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
         run in forks, :func:`~.evidence.holdout_evidence`)."""
         if "memo" not in bent:  # the first, all-faces fit: its cones are remembered for all
             return exits
-        memo = {k: list(v) for k, v in bent["memo"].items()}
+        memo = _memo_copy(bent["memo"])
         return [{**e, "cone_memo": memo} for e in exits]
 
     def pinned(obs):
@@ -846,9 +852,9 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
                 if not isinstance(field, StemWithKnots):  # no bend in this fold: the plain stem's
                     field = plain(obs)
             bent.update(obs=obs, field=field, same=same)
-            if "first" not in bent:  # the all-faces fit: what every fold starts from
-                bent.update(first=field, rises=rises,  # the folds' rays start from its rises
-                            memo={k: list(v) for k, v in (exits[0].get("cone_memo") or {}).items()})  # the folds' rays start from the all-faces fit's rises
+            if "first" not in bent:  # the all-faces fit: what every fold starts from (its stem,
+                # the rises of its rays and its cones)
+                bent.update(first=field, rises=rises, memo=_memo_copy(exits[0].get("cone_memo") or {}))
         return bent["field"]
 
     def bent_guessed(obs):
