@@ -385,9 +385,9 @@ def test_a_rise_whose_ray_runs_along_the_exit_face_is_not_taken(monkeypatch):
 def test_a_knot_whose_ray_across_the_stem_would_contradict_a_face_is_still_bent():
     """A branch drooping 30 degrees crosses the left face and leaves by the bottom; the right
     face was photographed too and shows no knot. Across the stem (rise 0) the ray from the pith
-    through the left exit would leave by the right face where it is clear, so that ray is not
-    drawn, but at a droop of 40 degrees it leaves by the bottom, as the knot does: the rises are
-    searched wherever some rise of the grid has a ray, and the bend, the stem refitted to it, is
+    through the left exit would leave by the right face where it is clear, so that ray stops
+    before it (FIT_VERSION 22; 19-21 drew none), but at a droop of 40 degrees it leaves by the
+    bottom, as the knot does: the rises are searched, and the bend, the stem refitted to it, is
     kept (the inside within 1 mm better than the plain stem's: 89.5 against 83.0 %). Known
     answer: the true droop. Checked by breaking it: searching only knots with a ray across the
     stem (FIT_VERSION 18) leaves it unbent, and this test fails."""
@@ -397,7 +397,9 @@ def test_a_knot_whose_ray_across_the_stem_would_contradict_a_face_is_still_bent(
     faces = ["front", "top", "left", "right"]
     exits, obs = knot_exits(b, faces), gather_observations(b, faces)
     stem = fit_stem(obs, b.size_mm)
-    assert [e["face"] for e in exits] == ["left"] and knots._pith_ray(exits[0], stem, b.size_mm) is None
+    assert [e["face"] for e in exits] == ["left"]
+    across = knots._pith_ray(exits[0], stem, b.size_mm)  # rise 0: stops before the clear right face
+    assert across.end_mm[0] < b.size_mm[0] - across.radius_end_mm, across
     rises = knots._ray_rises(exits, stem, obs, b.size_mm, True, 0)
     assert list(rises) == [0] and -45.0 < np.degrees(rises[0]) < -20.0, rises
     joint = fit_knotted_stem(obs, b.size_mm, exits, stem=stem, cones=True)

@@ -363,21 +363,34 @@ def test_a_knot_seen_at_one_exit_runs_from_the_pith_through_it():
     assert tilted.pinned and np.degrees(np.arcsin(_unit(tilted)[2])) == pytest.approx(20.0)
 
 
-def test_a_ray_that_would_leave_by_a_face_showing_no_knot_there_is_not_drawn():
-    """The branch of the test above leaves the block by the back face. Where the back face was
-    photographed and its mask shows the knot there, the ray from the pith through the left exit
-    is drawn; where its mask shows no knot (the branch ended inside the block), the ray would
-    contradict it, so none is drawn and the knot stays a guess that marks its place. Known
-    answer: the mask. Checked by breaking it: without the check in ``_pith_ray`` the ray is drawn
-    either way and this test fails."""
+def test_a_ray_that_would_leave_by_a_face_showing_no_knot_there_stops_before_it():
+    """The branch of the test above, but ending inside the block, 10 mm short of the back face
+    (a knot's end: the stem grew over it). Where the back face was photographed and its mask
+    shows no knot, the knot ends before it, and the ray from the pith through the left exit
+    stops where its surface would reach that face (FIT_VERSION 22); where the back face was
+    not photographed, the ray runs on across the block. Known answer: the true knot's volume
+    and the back face's mask. Checked by breaking it: with the ray turned away at such a face
+    (FIT_VERSION 21) the knot is a guess along the left face's normal, IoU 0.09 with the true
+    knot (here 0.81); with the ray left running on, its knot shows on the back face."""
     from woodcam.inference.knots import _pith_ray
 
-    stem, _, block = _branch_past_the_left_face()
-    faces = ["front", "top", "left", "back"]
-    seen = [e for e in knot_exits(block, faces) if e["face"] == "left"]
-    assert _pith_ray(seen[0], stem, SIZE) is not None
-    block.faces["back"].extras["knot_mask"] = np.zeros_like(block.faces["back"].extras["knot_mask"])
-    (exit_,) = knot_exits(block, faces)
-    assert exit_["face"] == "left" and _pith_ray(exit_, stem, SIZE) is None
-    (fit,) = strands_from_exits([exit_], stem, SIZE)
-    assert not fit.pinned and _unit(fit) @ np.array([1.0, 0.0, 0.0]) > 0.999  # the guess: the face normal
+    stem, through, _ = _branch_past_the_left_face()
+    u = _unit(through)
+    true = KnotStrand(through.start_mm, tuple(np.add(through.start_mm, 28.0 * u)), 3.0, 3.0)  # ends 10 mm short
+    block = _masks_of(StemWithKnots(stem, [true]))
+    (exit_,) = knot_exits(block, ["front", "top", "left", "back"])
+    assert exit_["face"] == "left" and not block.faces["back"].extras["knot_mask"].any()
+    (ray,) = strands_from_exits([exit_], stem, SIZE)
+    assert _unit(ray) @ u > np.cos(np.deg2rad(3.0))
+    grid = np.stack(np.meshgrid(*[np.linspace(0.25, 39.75, 80)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    inside = StemWithKnots(stem, [true]).knot_features(grid)["knot"] > 0.5
+
+    def iou(strand):
+        fit = StemWithKnots(stem, [strand]).knot_features(grid)["knot"] > 0.5
+        return (fit & inside).sum() / (fit | inside).sum()
+
+    back = face_pixel_points("back", (160, 160), SIZE).reshape(-1, 3)
+    assert not (StemWithKnots(stem, [ray]).knot_features(back)["knot"] > 0.5).any()  # stops before the back face
+    assert iou(ray) > 0.5, iou(ray)
+    (seen,) = knot_exits(block, ["front", "top", "left"])  # the back face not photographed
+    assert np.linalg.norm(np.subtract(_pith_ray(seen, stem, SIZE).end_mm, ray.end_mm)) > 20.0

@@ -47,8 +47,10 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: wherever some rise of the grid has a ray, not only where the ray across the stem has one; 20:
 #: a fold's knot cones start from the all-faces fit's only, so the folds, refitted in forks, do
 #: not depend on each other, :func:`woodcam.inference.knots.knot_bend_recipes`; 21: a baked
-#: thin-plate spline of face points is interpolated deeper than 5 mm, :mod:`woodcam.inference.baked`).
-FIT_VERSION = 21
+#: thin-plate spline of face points is interpolated deeper than 5 mm, :mod:`woodcam.inference.baked`;
+#: 22: a knot seen at one exit whose ray would leave by a photographed face showing no knot there
+#: ends before that face instead of having no ray, :func:`woodcam.inference.knots._pith_ray`).
+FIT_VERSION = 22
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,

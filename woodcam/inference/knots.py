@@ -570,11 +570,19 @@ def _pith_ray(exit_: dict, stem, size_mm: ArrayLike, rise: float = 0.0, pinned: 
     the block of ``size_mm``, turned ``rise`` (rad) from the cross-section toward the pith's
     tangent (a branch rises or droops: seed 001's spruce ends its knots at -11 degrees, and a
     block may lie either way up). Its radius is the exit's, made round (an oblique strand cuts
-    the face in an ellipse of area ``pi R^2 / |cos(incidence)|``). None where the exit lies
-    within :data:`~woodcam.tolerances.KNOT_RAY_MIN_PITH_MM` of the pith (no direction to speak
-    of), the ray would run along the face (:data:`~woodcam.tolerances.KNOT_MIN_ENTRY_COS`), or
-    it would cross the block to a face whose mask shows no knot where it comes out (the knot
-    ends before that face, and where is not known; such a ray contradicts the photos).
+    the face in an ellipse of area ``pi R^2 / |cos(incidence)|``). Where it would cross the
+    block to a photographed face whose mask shows no knot where it comes out, the knot ends
+    before that face (the stem grew over it): the strand stops where its surface would reach
+    the face, the longest knot the photos allow. None where the exit lies within
+    :data:`~woodcam.tolerances.KNOT_RAY_MIN_PITH_MM` of the pith (no direction to speak of),
+    the ray would run along the face (:data:`~woodcam.tolerances.KNOT_MIN_ENTRY_COS`), or it
+    would stop before it has crossed its exit.
+
+    Why stop it rather than draw no ray (FIT_VERSION 18-21): the knot was then a guess along
+    the exit face's normal that bends nothing, up to 40 degrees off a knot that runs most of the
+    way across the block (dev seed 7777 block 6). Three noisy faces, dev seeds 7777, 63311, 9101
+    and 21: 3 of 48 knotted blocks up by 7-28 points within 2 mm, none down; the knot ending
+    half way there instead: one of them down (README).
 
     Why not down the stem's year gradient from the exit (the strand before): where the pith lies
     outside the block beyond the exit's face, that gradient leaves the block, and the face
@@ -602,7 +610,11 @@ def _pith_ray(exit_: dict, stem, size_mm: ArrayLike, rise: float = 0.0, pinned: 
         face = np.flatnonzero(np.abs(pts[:, ax] - other[ax]) < 1e-6)  # (not a neighbour's samples by the edge)
         seen = face[np.linalg.norm(pts[face] - other, axis=1) < max(r, 2.0 * KNOT_CONE_SAMPLE_MM)]
         if len(seen) and not knot[seen].any():
-            return None
+            # the knot ends before that face: its strand stops where its surface would reach it
+            cos_far = max(abs(w[ax]), KNOT_MIN_ENTRY_COS)
+            end = other - (r / cos_far + KNOT_CONE_SAMPLE_MM) * w
+            if (end - c) @ w <= 0.0:
+                return None
     return KnotStrand(tuple(start), tuple(end), r, r, dead=exit_["dead"], pinned=pinned)
 
 
@@ -665,7 +677,7 @@ def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int,
         return made[(k, rise)]
 
     # a knot with a ray at any rise of the grid: one drooping 20 degrees may have none across the
-    # stem (it would run along its exit face, or enter the block by a face showing no knot)
+    # stem (it would run along its exit face)
     lone = {k: i for k, i in lone.items() if (near is None or k in near)
             and any(ray(k, float(r)) is not None for r in full)}
     if not lone:
