@@ -610,7 +610,8 @@ def _pith_ray(exit_: dict, stem, size_mm: ArrayLike, rise: float = 0.0, pinned: 
         face = np.flatnonzero(np.abs(pts[:, ax] - other[ax]) < 1e-6)  # (not a neighbour's samples by the edge)
         seen = face[np.linalg.norm(pts[face] - other, axis=1) < max(r, 2.0 * KNOT_CONE_SAMPLE_MM)]
         if len(seen) and not knot[seen].any():
-            # the knot ends before that face: its strand stops where its surface would reach it
+            # the knot ends before that face: its strand stops where its surface would reach it,
+            # one mask sample short of it (the mask shows a knot only to within a sample)
             cos_far = max(abs(w[ax]), KNOT_MIN_ENTRY_COS)
             end = other - (r / cos_far + KNOT_CONE_SAMPLE_MM) * w
             if (end - c) @ w <= 0.0:
