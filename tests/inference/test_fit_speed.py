@@ -197,8 +197,7 @@ def test_a_face_spline_is_baked_exactly_near_the_faces_and_smoothly_deep_inside(
         exact = GridField.bake(field, (0, 0, 0), tuple(size), 1.0, margin_nodes=2)
         fast = bake(field, size)
         shape = exact.years.shape
-        axes = [exact.origin_mm[i] + np.arange(shape[i]) for i in range(3)]
-        nodes = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 3)
+        nodes = exact.nodes_mm()
         deep = (np.min(np.minimum(nodes, size - nodes), axis=1) >= BAKE_SMOOTH_DEPTH_MM).reshape(shape)
         diff = np.abs(fast.years - exact.years)
         assert deep.mean() > 0.3 and np.ptp(exact.years[deep]) > 2.0  # a deep field that varies

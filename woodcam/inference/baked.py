@@ -86,6 +86,7 @@ def _smooth_inside(spline, grid, size, workers: int) -> np.ndarray:
     from scipy import ndimage
 
     from ..fields.base import evaluate
+    from ..fields.grid import _nodes_mm
 
     shape = grid.years.shape
     nodes = grid.nodes_mm()
@@ -96,11 +97,11 @@ def _smooth_inside(spline, grid, size, workers: int) -> np.ndarray:
         return out.reshape(shape)
     h = BAKE_SMOOTH_SPACING_MM
     lo = nodes[deep].min(axis=0) - 2 * h  # two nodes beyond the deep region: the cubic's support
-    cax = [lo[i] + h * np.arange(int(np.ceil((nodes[deep, i].max() + 2 * h - lo[i]) / h)) + 1) for i in range(3)]
-    coarse = np.stack(np.meshgrid(*cax, indexing="ij"), axis=-1).reshape(-1, 3)
+    n = np.ceil((nodes[deep].max(axis=0) + 2 * h - lo) / h).astype(int) + 1
+    coarse = _nodes_mm(lo, (h,) * 3, n)
     # one call for both: its share of the points in a fork (the coarse grid alone is too few to fork)
     values = evaluate(spline, np.concatenate([nodes[~deep], coarse]), workers=workers)
     out[~deep] = values[:len(values) - len(coarse)]
-    coarse_values = values[len(values) - len(coarse):].reshape([len(a) for a in cax])
-    out[deep] = ndimage.map_coordinates(coarse_values, ((nodes[deep] - lo) / h).T, order=3, mode="nearest")
+    out[deep] = ndimage.map_coordinates(values[len(values) - len(coarse):].reshape(n), ((nodes[deep] - lo) / h).T,
+                                        order=3, mode="nearest")
     return out.reshape(shape)
