@@ -144,3 +144,35 @@ def test_stem_recipe_folds_descend_from_the_all_faces_stem(curved, monkeypatch):
     cold = cold_fit(rest, block.size_mm)
     pts = np.random.default_rng(1).uniform(0, 1, (2000, 3)) * np.asarray(block.size_mm)
     assert float(np.median(np.abs(warm(pts) - cold(pts)))) < 0.05
+
+
+def test_the_knots_bend_starts_from_a_stem_whose_growth_time_rises_away_from_its_pith():
+    """Growth time counts from the pith, and seed 003's bend is a share of the time since it.
+    Known answer: the realistic generator's dev seed 9101 block 5 (six noisy faces, knotted),
+    whose true pith runs 60.0 mm from the block's centre. Its cheapest stem has a negative mean
+    ring density, its pith 140 mm off: every ring point lies "before" that pith, and the bend
+    was left out. The bend now starts from the cheapest stem whose growth time rises away from
+    its pith (``fit_stem(outward=True)``, ``stem._outward``), which finds the pith within 10 mm
+    and bends the rings round the knots (60.9 % within 2 mm on the cut planes, the cheapest stem
+    29.5). Checked by breaking it: with ``outward`` ignored the stem's asserts fail (density
+    -0.43 rings/mm); with the bend starting from the cheapest stem it is left out (a plain
+    StemField comes back)."""
+    from woodcam.bench_realistic import FACE_SETS, make_block as bench_block
+    from woodcam.fields.knot_strands import StemWithKnots
+    from woodcam.inference.knots import fit_knotted_stem, knot_exits
+    from woodcam.tolerances import KNOT_BEND_MAX_BEFORE_PITH
+
+    block, _ = bench_block(9101, 5, "noisy", "realistic", 256)
+    obs = gather_observations(block, FACE_SETS["full"])
+    centre = np.asarray(block.size_mm)[None] / 2
+    cheapest = fit_stem(obs, block.size_mm)
+    assert cheapest.coef[0] < 0.0  # the situation: c_00, rings per mm at the middle height
+    stem = fit_stem(obs, block.size_mm, outward=True)
+    assert stem.coef[0] > 0.0, stem.coef[0]
+    assert np.mean(stem(obs.points_mm) <= stem.pith_years()) <= KNOT_BEND_MAX_BEFORE_PITH
+    assert abs(stem.pith_distance_mm(centre)[0] - 60.0) < 10.0, stem.pith_distance_mm(centre)  # 50.4
+    bent = fit_knotted_stem(obs, block.size_mm, knot_exits(block, FACE_SETS["full"]), stem=cheapest, cones=True)
+    assert isinstance(bent, StemWithKnots) and any(s.pinned for s in bent.strands)
+    acc = {name: evaluate_fit(block.true_field, f, block.size_mm, pixel_mm=0.5)[0]["matched_2"]
+           for name, f in (("cheapest", cheapest), ("bent", bent))}
+    assert acc["bent"] > acc["cheapest"] + 20.0, acc

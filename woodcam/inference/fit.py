@@ -49,8 +49,10 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: not depend on each other, :func:`woodcam.inference.knots.knot_bend_recipes`; 21: a baked
 #: thin-plate spline of face points is interpolated deeper than 5 mm, :mod:`woodcam.inference.baked`;
 #: 22: a knot seen at one exit whose ray would leave by a photographed face showing no knot there
-#: ends before that face instead of having no ray, :func:`woodcam.inference.knots._pith_ray`).
-FIT_VERSION = 22
+#: ends before that face instead of having no ray, :func:`woodcam.inference.knots._pith_ray`;
+#: 23: the knots' bend starts from a stem whose growth time rises away from its pith where the
+#: plain stem's falls, :func:`woodcam.inference.knots.fit_knotted_stem`).
+FIT_VERSION = 23
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
