@@ -181,7 +181,7 @@ def test_a_face_spline_is_baked_exactly_near_the_faces_and_smoothly_deep_inside(
     grid, the nodes near the faces are 0.2 years off and this fails."""
     from woodcam.fields.grid import GridField
     from woodcam.fields.residual import ResidualField
-    from woodcam.inference.baked import bake
+    from woodcam.inference.baked import _depth_mm, bake
     from woodcam.tolerances import BAKE_SMOOTH_DEPTH_MM
 
     rng = np.random.default_rng(11)
@@ -198,7 +198,7 @@ def test_a_face_spline_is_baked_exactly_near_the_faces_and_smoothly_deep_inside(
         fast = bake(field, size)
         shape = exact.years.shape
         nodes = exact.nodes_mm()
-        deep = (np.min(np.minimum(nodes, size - nodes), axis=1) >= BAKE_SMOOTH_DEPTH_MM).reshape(shape)
+        deep = (_depth_mm(nodes, size) >= BAKE_SMOOTH_DEPTH_MM).reshape(shape)
         diff = np.abs(fast.years - exact.years)
         assert deep.mean() > 0.3 and np.ptp(exact.years[deep]) > 2.0  # a deep field that varies
         np.testing.assert_allclose(fast.years[~deep], exact.years[~deep], rtol=0, atol=1e-9)

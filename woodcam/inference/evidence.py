@@ -820,7 +820,7 @@ def bake_evidence(ev: EvidenceFit, size_mm, faces, strands=(), workers: int | No
 def _bake_evidence(ev: EvidenceFit, size_mm, faces, strands, workers: int):
     from scipy import ndimage
 
-    from ..fields.grid import GridField
+    from ..fields.grid import GridField, _nodes_mm
     from .baked import bake
 
     grid = bake(ev.field, size_mm, workers=workers)
@@ -829,10 +829,9 @@ def _bake_evidence(ev: EvidenceFit, size_mm, faces, strands, workers: int):
     spread = np.zeros(len(nodes))
     if len(ev.accepted) > 1:
         step = EVIDENCE_SPREAD_SPACING_MM
-        lo, hi = np.asarray(grid.origin_mm), nodes.max(axis=0)
-        cax = [np.arange(lo[i], hi[i] + step, step) for i in range(3)]
-        coarse = np.stack(np.meshgrid(*cax, indexing="ij"), axis=-1).reshape(-1, 3)
-        cs = ev.uncertainty_years(coarse).reshape([len(a) for a in cax])
+        lo = np.asarray(grid.origin_mm)
+        n = np.ceil((nodes.max(axis=0) + step - lo) / step).astype(int)  # past the last node
+        cs = ev.uncertainty_years(_nodes_mm(lo, (step,) * 3, n)).reshape(n)
         spread = ndimage.map_coordinates(cs, ((nodes - lo) / step).T, order=1, mode="nearest")
     unc = spread + EVIDENCE_UNSEEN_YEARS_PER_MM * distance_to_faces_mm(nodes, size_mm, faces)
     feats = ev.field.knot_layers(nodes) if strands else {}  # halo and knot weights: one pass

@@ -763,17 +763,20 @@ def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones=Fa
     (:func:`_ray_rises`, ``near`` passed on); ``workers``: processes each cone's starts may use."""
     from .stem import fit_stem
 
+    def falls(s, g):  # times are not "from the pith" in stem s (g: its years at the rings)
+        return np.mean(g <= s.pith_years()) > KNOT_BEND_MAX_BEFORE_PITH
+
     stem = fit_stem(obs, size_mm, seed=seed) if stem is None else stem
     plain, field, only_pinned, rises = stem, stem, True, None
     for r in range(rounds + 1):
         g = stem(obs.points_mm)  # once per round: the check here and the bend's offset below
-        if r == 0 and np.mean(g <= stem.pith_years()) > KNOT_BEND_MAX_BEFORE_PITH:
+        if r == 0 and falls(stem, g):
             # the pith beyond the rings' side of most years (a far pith's straight rings fit
             # either way): the bend starts from the stem whose growth time rises away from it
-            stem = fit_stem(obs, size_mm, seed=seed, outward=True)
+            stem = fit_stem(obs, size_mm, seed=seed, outward=True, workers=workers)
             g = stem(obs.points_mm)
-        if np.mean(g <= stem.pith_years()) > KNOT_BEND_MAX_BEFORE_PITH:
-            return plain, False, {}  # times are not "from the pith" in this stem: no bend to speak of
+        if falls(stem, g):
+            return plain, False, {}  # no bend to speak of
         if rises is None:  # the rises of the knots seen at one exit, in the first round's stem
             rises = _ray_rises(exits, stem, obs, size_mm, cones, seed, near, workers)
         strands = strands_from_exits(exits, stem, size_mm, cones, workers, rises=rises)
