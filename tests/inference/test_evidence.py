@@ -287,3 +287,24 @@ def test_the_blend_is_judged_by_the_folds_own_predictions():
     assert sc["mean"] == 75.0
     del pred[("b", "top")]       # a member that could not refit a fold: no evidence there
     assert _blend_evidence(["a", "b"], pred)["top"] == 0.0
+
+
+@pytest.mark.parametrize("faces, advice", [
+    (["front", "top", "left", "bottom", "right", "back"],
+     "every face was used: check the rings found on the right face (woodcam rings show) or trace more of them"),
+    (["front", "top", "left", "bottom", "back"], "photograph the right face"),
+    (["front", "top", "left"], "photograph the right face"),
+])
+def test_uncertainty_report_never_asks_for_a_face_that_was_photographed(faces, advice):
+    """The bake report's advice: the unseen face nearest the uncertain third, and, when every
+    face was photographed, not 'photograph' a face the fit already used (H11 from six photos
+    was told to photograph its bottom face)."""
+    size = np.array([50.0, 40.0, 30.0])
+    n = 11
+    x = np.linspace(0.0, size[0], n)[:, None, None] * np.ones((1, n, n))
+    unc = 0.05 + 3.0 * (x / size[0]) ** 4  # sure on the left, a guess near the right face
+    grid = GridField(np.zeros((n, n, n)), (0.0, 0.0, 0.0), tuple(size / (n - 1)),
+                     layers={"uncertainty": unc}, meta={"faces": faces})
+    pts = np.random.default_rng(0).uniform(0, 1, (3000, 3)) * size
+    line = uncertainty_report(grid, pts, size, "bowl")
+    assert "right third (left-right)" in line and line.endswith(advice)

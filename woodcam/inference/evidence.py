@@ -867,7 +867,8 @@ def uncertainty_report(field, points_mm, size_mm, what: str = "part") -> str | N
 
     points_mm : (n, 3) points of the part (block frame), e.g. its mesh vertices. The part is
     cut in thirds along each block axis; the third with the lowest mean :func:`confidence` is
-    named, with the unobserved face nearest to it to photograph (``field.meta["faces"]``).
+    named, with the unobserved face nearest to it to photograph (``field.meta["faces"]``); when
+    every face was observed, the nearest face whose rings to check instead.
     """
     layers = getattr(field, "layers", {}) or {}
     if "uncertainty" not in layers or not len(points_mm):
@@ -886,12 +887,17 @@ def uncertainty_report(field, points_mm, size_mm, what: str = "part") -> str | N
                 worst = (float(conf[sel].mean()), ax, t, p[sel].mean(axis=0))
     c, ax, t, centre = worst
     seen = set((getattr(field, "meta", {}) or {}).get("faces", []))
-    unseen = [f for f in FACES if f not in seen] or list(FACES)
-    face = min(unseen, key=lambda f: distance_to_faces_mm(centre[None], size, [FACES.index(f)])[0])
+    unseen = [f for f in FACES if f not in seen]
+    # With every face photographed there is no face left to ask for: the hypotheses disagree
+    # there, so the advice is to check (or trace) the rings found on the nearest face instead.
+    face = min(unseen or FACES, key=lambda f: distance_to_faces_mm(centre[None], size, [FACES.index(f)])[0])
     place = "middle" if t == 1 else _THIRDS[ax][t]
     axis_word = ("left-right", "front-back", "bottom-top")[ax]
+    advice = (f"photograph the {face} face" if unseen else
+              f"every face was used: check the rings found on the {face} face "
+              "(woodcam rings show) or trace more of them")
     return (f"the rings in the {place} third ({axis_word}) of this {what} are uncertain "
-            f"(confidence {c:.2f}, whole {what} {conf.mean():.2f}): photograph the {face} face")
+            f"(confidence {c:.2f}, whole {what} {conf.mean():.2f}): {advice}")
 
 
 class ConfidenceWood:
