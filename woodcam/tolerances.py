@@ -343,6 +343,13 @@ EVIDENCE_MIN_FACE_SHARE_2MM = 80.0
 #: the runs on detected rings, and not retuned on them.
 NUMBERING_STEP_MARGIN = 0.1
 
+#: A numbering with fewer than this share of neighbouring rings one year apart is wrong more
+#: often than right: the pith search is repeated on other point subsets
+#: (:func:`woodcam.inference.radial._numbered_basins`), at most :data:`NUMBERING_RESEARCHES`
+#: times. Between the good numberings of H11 (0.60-0.73) and the wrong ones (0.05-0.42) above.
+NUMBERING_MIN_STEP = 0.5
+NUMBERING_RESEARCHES = 2
+
 #: Hypotheses whose mean held-out score is within this many percent points of the best are
 #: "accepted": their spread is the fit's per-point uncertainty.
 EVIDENCE_ACCEPT_MARGIN = 5.0

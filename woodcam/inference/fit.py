@@ -51,8 +51,10 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: 22: a knot seen at one exit whose ray would leave by a photographed face showing no knot there
 #: ends before that face instead of having no ray, :func:`woodcam.inference.knots._pith_ray`;
 #: 23: the knots' bend starts from a stem whose growth time rises away from its pith where the
-#: plain stem's falls, :func:`woodcam.inference.knots.fit_knotted_stem`).
-FIT_VERSION = 23
+#: plain stem's falls, :func:`woodcam.inference.knots.fit_knotted_stem`; 24: unlabelled rings whose
+#: pith search finds no basin numbering half the neighbouring rings one year apart are searched
+#: again on other point subsets, :func:`woodcam.inference.radial._numbered_basins`).
+FIT_VERSION = 24
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
@@ -109,8 +111,9 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         ``meta["residual"]`` says whether it was kept and why (README).
     seed : evidence only: the random seed of its held-out points, fitting subsets and starts
         (the stem's and its knots' bend's too). Real cubes' held-out figures are worth
-        reporting over several (H11's ratio to chance: 1.37x with seed 0, 0.92-1.07x with
-        seeds 1-3; README, "H11's held-out figure is a matter of seed").
+        reporting over several (H11's ratio to chance, FIT_VERSION 24: 1.62, 1.50, 1.10, 1.07x
+        with seeds 0-3; README, "H11's held-out figure is a matter of seed" and "A pith search
+        that misses on one subset of the points").
     Returns
     -------
     field : callable ``(n, 3) mm -> (n,) years`` in the block frame.
