@@ -657,6 +657,7 @@ def _numbered_basins(obs: RingObservations, size_mm, K: int, M: int, ridge: floa
     evidence fit on it then reproduced 14 % of its own ring-map ridges within 2 px, against
     75-77 % with the other seeds). The step consistency judges a numbering on the rings
     themselves, whichever subset found it."""
+    n_basins = max(1, int(n_basins))  # 0 would make the search return one triple, not a list
     found = fit_axis_and_shape(obs, size_mm, K, M, ridge, seed=seed, n_basins=n_basins, workers=workers, **search)
     if obs.labelled or not found:
         return _by_numbering(obs, found)
@@ -671,7 +672,7 @@ def _numbered_basins(obs: RingObservations, size_mm, K: int, M: int, ridge: floa
                 found.append(f)
                 nums.append(_initial_numbering(obs, f[0]))
     order, numbering = _by_numbering(obs, found, nums)
-    return order[:max(1, n_basins)], numbering
+    return order[:n_basins], numbering
 
 
 def _by_numbering(obs: RingObservations, found: list, nums: list | None = None) -> tuple[list, tuple | None]:
