@@ -46,6 +46,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from dataclasses import field as dc_field
+from itertools import islice
 
 import numpy as np
 
@@ -365,19 +366,19 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
     # every axis' cheapest starts, refined at low order; the best n_final finished at full order
     coarse = []
     if init is not None:  # warm start: one start, the given centreline
-        coarse.append((0.0, np.asarray(init.curve, float).T.reshape(-1), np.asarray(init.base_axis, float)))
-    starts = []  # (problem, start) of every base axis, each descent independent of the others
+        coarse.append((0.0, np.asarray(init.curve, float).T.reshape(-1), np.asarray(init.base_axis, float), None))
+    starts = []  # (problem, start, axis) of every base axis, each descent independent of the others
     for d0 in (_base_axes(size, base_axes) if init is None else []):
         prob = problem(i_s, d0, min(K, 2), 0)
         starts += [(prob, th, d0) for _, th in _starts(prob, obs, i_s, size, n_starts)]
-    coarse += [(cost, th, d0) for (th, cost), (_, _, d0)
+    coarse += [(cost, th, d0, prob) for (th, cost), (prob, _, d0)
                in zip(map_processes(lambda s: _refine(s[0], s[1], 20), starts, workers), starts)]
     coarse.sort(key=lambda c: c[0])
-    if outward:  # the finals are the starts whose growth time rises away from their pith, if any
-        coarse = [c for c in coarse if _outward(problem(i_s, c[2], min(K, 2), 0), c[1])] or coarse
+    if outward and init is None:  # the finals: the cheapest starts whose time rises away from their pith, if any
+        coarse = list(islice((c for c in coarse if _outward(c[3], c[1])), n_final)) or coarse
     finals = map_processes(lambda c: _refine(problem(i_f, c[2], K, M), c[1], 30), coarse[:n_final], workers)
     best = None
-    for (th, cost), (_, _, d0) in zip(finals, coarse[:n_final]):
+    for (th, cost), (_, _, d0, _) in zip(finals, coarse[:n_final]):
         if best is None or cost < best[0]:
             best = (cost, th, d0)
     _, th, d0 = best
