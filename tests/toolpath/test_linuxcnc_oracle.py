@@ -137,3 +137,19 @@ def test_linuxcnc_preview_stale_position_after_m6(tmp_path):
     theirs = run_batch([p], start_mm=START)[0]["moves"][-1]
     mine = Interpreter(text, start_mm=START).run()[0][-1]
     assert theirs[2][2] == pytest.approx(10.0) and mine[2][2] == pytest.approx(5.0)
+
+
+def test_linuxcnc_runs_leave_no_scratch_files(tmp_path, monkeypatch):
+    """Each run's tool map, ini and parameter files live in one scratch folder that goes when
+    the run ends, after a good program, a refused one and a tool change alike (every run used
+    to leave two folders in the temporary directory)."""
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    monkeypatch.setenv("TMPDIR", str(scratch))  # the driver's tempfile reads it
+    good, bad = tmp_path / "good.ngc", tmp_path / "bad.ngc"
+    good.write_text("G21 G90\nT2 M6\nG1 X5 Y5 F100\nM2\n")
+    bad.write_text("G0 X1\nG1 A3 F100\nM2\n")
+    res = run_batch([good, bad], start_mm=START)
+    assert len(res[0]["moves"]) == 1 and res[0]["error"] is None
+    assert res[1]["error"] is not None
+    assert list(scratch.iterdir()) == []

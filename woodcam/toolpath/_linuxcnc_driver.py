@@ -13,6 +13,7 @@ offsets and without the tool length offset; they are added back here as AXIS doe
 import ctypes
 import json
 import os
+import shutil
 import sys
 import tempfile
 import time
@@ -23,11 +24,12 @@ _PLANE = {1: 17, 2: 19, 3: 18}  # CANON_PLANE_XY, YZ, XZ -> G17, G19, G18
 _AXES = {1: (0, 1, 2), 2: (1, 2, 0), 3: (2, 0, 1)}
 
 
-def _tool_table():
+def _tool_table(work):
     """LinuxCNC 2.9 keeps its tool table in a memory map created by the running machine's task;
     without one, a T word crashes the interpreter. Create it here with tools 1-99 of zero
-    length (woodcam measures tools from the tip)."""
-    os.environ["HOME"] = tempfile.mkdtemp(prefix="woodcam-lcnc-")
+    length (woodcam measures tools from the tip). The map is ``$HOME/.tool.mmap``, so HOME
+    points at the run's scratch folder ``work``."""
+    os.environ["HOME"] = work
     lib = ctypes.CDLL("libtooldata.so.0")
     buf = ctypes.create_string_buffer(1 << 20)
     lib._Z17tool_mmap_creatorPK13EMC_TOOL_STATi(buf, 0)
@@ -124,13 +126,20 @@ class _Canon:
 def main():
     here = os.path.dirname(os.path.abspath(__file__))  # woodcam's own gcode.py lives here
     sys.path[:] = [p for p in sys.path if os.path.abspath(p or ".") != here]
-    import gcode
-
     job = json.load(sys.stdin)
     result_fd = os.dup(1)
     os.dup2(2, 1)  # the interpreter prints debugging lines to stdout: send them to stderr
-    _tool_table()
     work = tempfile.mkdtemp(prefix="woodcam-lcnc-")
+    try:  # the scratch folder (tool map, ini, parameter files) goes whatever happens
+        _run(job, work, result_fd)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def _run(job, work, result_fd):
+    import gcode  # after main() took woodcam's own gcode.py off the path
+
+    _tool_table(work)
     ini = os.path.join(work, "sim.ini")
     var = os.path.join(work, "sim.var")
     with open(ini, "w") as f:
