@@ -132,6 +132,33 @@ def _corner_end(block):
     return surface, positive, ignore, c0, r0, np.linalg.svd(samples - c0, full_matrices=False)[2]
 
 
+def test_a_cone_across_the_line_of_two_exits_does_not_pair_them(corner_block, monkeypatch):
+    """When the cone fitted to two ends' masks runs across the line joining them, their extent
+    along it is less than one sample of the line: the pair is not one knot's two ends, and the
+    strands are made without it (the line's sampling crashed on an empty selection). Checked by
+    breaking it: without the guard this raises ValueError."""
+    import woodcam.inference.knots as kn
+
+    exits = knot_exits(corner_block)
+    ends = kn._ends(exits, True)
+    a, b = (kn._end_centre(exits, e, True) for e in ends[:2])
+    across = np.cross(b - a, [0.0, 0.0, 1.0])
+    across /= np.linalg.norm(across)
+    # 0.3 mm of the exits' 57 mm along it: under one sample (the block's diagonal / 128)
+    u = across + 0.3 / np.linalg.norm(b - a) * (b - a) / np.linalg.norm(b - a)
+    u /= np.linalg.norm(u)
+    assert 0 < abs((b - a) @ u) < np.linalg.norm(SIZE) / 128
+    monkeypatch.setattr(kn, "_fit_cone", lambda *args, **kw: ((a + b) / 2, u, 4.0, 0.0, 0.0))
+    strands = strands_from_exits(exits, corner_stem(), SIZE, cones=True)
+
+    def off(s, p):  # distance (mm) of point p from strand s's segment
+        s0, s1 = np.asarray(s.start_mm), np.asarray(s.end_mm)
+        t = np.clip((p - s0) @ (s1 - s0) / ((s1 - s0) @ (s1 - s0)), 0.0, 1.0)
+        return np.linalg.norm(s0 + t * (s1 - s0) - p)
+
+    assert strands and not any(max(off(s, a), off(s, b)) < 5.0 for s in strands)  # no strand joins them
+
+
 def test_cone_fits_are_remembered_per_start_and_give_the_same_cone(corner_block, monkeypatch):
     """A knot end cut by an edge starts its cone from its samples' three axes and one direction
     down the stem's years, the only one that changes between folds: the memo keeps each start's

@@ -477,6 +477,8 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
         t = np.linspace(-length, dist + length, _LINE_SAMPLES)
         g = np.asarray(stem(start + t[:, None] * u), float)
         between = (t >= 0) & (t <= dist)
+        if not between.any():  # the exits lie within one sample along the cone's axis: it runs
+            return None  # across the line joining them, so they are not two ends of one knot
         if not np.all(np.isfinite(g)) or \
                 g[between].min() < min(g[between][0], g[between][-1]) - KNOT_PITH_YEARS:
             return None  # the pith lies between the exits: two branches, not one
