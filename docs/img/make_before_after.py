@@ -24,6 +24,9 @@ PICTURES = {
                               "FIT_VERSION 22: the knots' bend was left out where the stem's pith lay beyond the side "
                               "where the rings count the most years; 23: the bend starts from a stem whose growth "
                               "time rises away from its pith"),
+    "knot_corner_9101.png": (9101, 14, "full", "cdee99e",
+                             "FIT_VERSION 24: a knot seen at one block corner ran on through the block and out by "
+                             "a face that shows no knot; 25: it ends before that face"),
 }
 
 _SCORE = """

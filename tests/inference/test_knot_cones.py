@@ -246,3 +246,22 @@ def test_cone_jacobian_is_the_derivative_of_the_residuals(x):
     J = _cone_jacobian(x, problem, c0)
     assert J.shape == (302, 8)
     np.testing.assert_allclose(J, numeric, atol=1e-6)
+
+
+def test_a_knot_seen_at_one_corner_ends_before_a_face_that_shows_none():
+    """A branch from the pith outside the front-left edge, at a glancing angle to the front
+    face, that ends (overgrown) inside the block: its masks show it at that edge only, one end
+    over two faces, and its line would come out by the right face, whose photo shows clear
+    wood. The strand of the cone fitted to the one end stops before that face (the longest
+    knot the photos allow), as a one-exit ray does. Checked by breaking it: without the stop
+    the strand ran on through the right face to x = 75 mm."""
+    buried = KnotStrand((-25.0, -8.0, 17.0), (25.0, 9.5, 19.5), 3.0, 4.4)
+    block = synth_block(StemWithKnots(corner_stem(), [buried], bend=KnotParams()), SIZE, face_px=128, seed=5)
+    exits = knot_exits(block)
+    assert sorted(e["face"] for e in exits) == ["front", "left"]
+    (fit,) = strands_from_exits(exits, corner_stem(), SIZE, cones=True)
+    assert fit.pinned and _angle_deg(fit, buried) < 6.0
+    a, b = np.asarray(fit.start_mm), np.asarray(fit.end_mm)
+    far, r_far = (a, fit.radius_start_mm) if a[0] > b[0] else (b, fit.radius_end_mm)
+    assert far[0] + r_far < SIZE[0], (far, r_far)  # its surface stays inside the right face
+    assert far[0] > 30.0, far  # past where it truly ends (x = 25): what the photos allow

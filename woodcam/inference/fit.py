@@ -53,8 +53,11 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: 23: the knots' bend starts from a stem whose growth time rises away from its pith where the
 #: plain stem's falls, :func:`woodcam.inference.knots.fit_knotted_stem`; 24: unlabelled rings whose
 #: pith search finds no basin numbering half the neighbouring rings one year apart are searched
-#: again on other point subsets, :func:`woodcam.inference.radial._numbered_basins`).
-FIT_VERSION = 24
+#: again on other point subsets, :func:`woodcam.inference.radial._numbered_basins`; 25: a knot
+#: seen at one end (a block corner or edge) ends before a photographed face that shows no knot
+#: where its cone would come out, as a one-exit ray does, and a cone thinning away from the pith
+#: is kept as the masks show it, :func:`woodcam.inference.knots.strands_from_exits`).
+FIT_VERSION = 25
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,

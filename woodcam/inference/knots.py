@@ -152,12 +152,11 @@ def knot_exits(block, faces=None) -> list[dict]:
 _LINE_SAMPLES = 256
 
 
-def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False, memo: dict | None = None,
+def _fit_cone(surface, positive, ignore, c0, u0, r0, memo: dict | None = None,
               workers: int = 1):
     """A knot's cone fitted to the knot masks of every face: ``(c (3,), u (3,), rc, slope,
     cost)``; ``u0`` (3,) or (k, 3) starting directions, the fit of least cost kept (the first of
-    equal costs); ``outward``: each ``u0`` points away from the pith and the radius may not
-    shrink along it; ``memo``: a dict remembering each start's fit by the other arguments; a
+    equal costs); ``memo``: a dict remembering each start's fit by the other arguments; a
     start within :data:`~woodcam.tolerances.KNOT_CONE_START_REUSE_DEG` of one already fitted
     takes that fit (the first such). Per start because a knot end cut by a block edge starts
     from three directions of its own samples and one down the stem's years, and only that one
@@ -183,7 +182,7 @@ def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False, memo
     (:func:`woodcam._parallel.map_processes`; the same fits, bit for bit); a start that would
     take an earlier start's fit of this call waits for it, as one after the other."""
     head = (np.asarray(positive).tobytes(), np.asarray(ignore).tobytes(), np.asarray(c0, float).tobytes(),
-            float(r0), bool(outward))
+            float(r0))
     done = [] if memo is None else memo.setdefault(head, [])  # (start (3,), fit) of this problem
     cos_near = np.cos(np.radians(KNOT_CONE_START_REUSE_DEG))
     fits = [f for _, f in done]  # every fit this call may take, by index: the memo's, then its own
@@ -200,7 +199,7 @@ def _fit_cone(surface, positive, ignore, c0, u0, r0, outward: bool = False, memo
         picks.append(pick)
     if fresh:
         problem = _cone_problem(surface, positive, ignore, c0, r0)
-        new = map_processes(lambda u: _fit_cone_start(problem, c0, u, r0, outward), fresh, workers)
+        new = map_processes(lambda u: _fit_cone_start(problem, c0, u, r0), fresh, workers)
         fits += new
         if memo is not None:
             done.extend(zip(fresh, new))
@@ -228,15 +227,13 @@ def _cone_problem(surface, positive, ignore, c0, r0):
     return P, y, 1.0 / np.sqrt(max(len(y), 1))  # every sample alike: the misfit is the area misclassified
 
 
-def _fit_cone_start(problem, c0, u_start, r0, outward: bool):
+def _fit_cone_start(problem, c0, u_start, r0):
     """One start of :func:`_fit_cone`: ``(c, u, rc, slope, cost)`` from the line through ``c0``
     along ``u_start (3,)`` with radius ``r0``, ``u`` in the starting sense. Residuals
     :func:`_cone_residuals`, Jacobian :func:`_cone_jacobian` (analytic: 2-point differences
     spent 8 more residual evaluations per step; seed 91841 block 7 33.9 -> 21.6 CPU-s)."""
     from scipy.optimize import least_squares
 
-    # outward: the knot thickens away from the pith (seed 003: its radius grows with time)
-    bounds = ([-np.inf] * 7 + [0.0], [np.inf] * 8) if outward else (-np.inf, np.inf)
     x0 = np.concatenate([c0, u_start, [r0, 0.0]])
     last: dict = {}
 
@@ -247,7 +244,7 @@ def _fit_cone_start(problem, c0, u_start, r0, outward: bool):
 
     fit = least_squares(_cone_residuals, x0, jac=_cone_jacobian, args=(problem, c0, terms),
                         x_scale=np.array([5, 5, 5, 0.2, 0.2, 0.2, 1.0, 0.05]),
-                        max_nfev=KNOT_CONE_MAX_NFEV, bounds=bounds)
+                        max_nfev=KNOT_CONE_MAX_NFEV)
     x = fit.x
     u = x[3:6] / np.linalg.norm(x[3:6])
     sign = np.sign(u @ u_start) or 1.0  # keep the starting sense (exit to exit)
@@ -331,14 +328,6 @@ def _pith_miss(stem, points_mm, u, dist, length: float) -> tuple[np.ndarray, np.
     return miss, ~((0.0 < tk) & (tk < dist))
 
 
-def _pith_first(stem, point_mm, u, length: float) -> bool:
-    """Is the pith (the least stem years) behind ``point_mm (3,)`` along ``u (3,)``, within
-    ``length`` mm either way (the sense a branch grows out along)?"""
-    t = np.linspace(-length, length, _LINE_SAMPLES)
-    g = np.asarray(stem(point_mm + t[:, None] * u), float)
-    return bool(np.nanargmin(np.where(np.isfinite(g), g, np.inf)) < _LINE_SAMPLES // 2) if np.isfinite(g).any() else True
-
-
 def _toward_pith(stem, point_mm, inward, length: float):
     """``(direction (3,), reach mm)`` of a branch seen at one exit: it grew from the pith out
     along the stem's radial direction, so into the block it runs down the stem's year gradient,
@@ -420,6 +409,7 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
     if not exits:
         return [], {}
     rises = rises or {}
+    size = np.asarray(size_mm, float)
     axis = np.asarray(getattr(stem, "axis", (0.0, 0.0, 1.0)), float)
     axis /= np.linalg.norm(axis)
     length = float(np.linalg.norm(size_mm))
@@ -463,11 +453,10 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
             ignore = np.concatenate([exits[k]["pixels"] for k in others]) if others else np.zeros(0, int)
             cone = _fit_cone(surface, positive, ignore, c0, starts,
                              float(np.mean([exits[k]["radius_mm"] for k in group])), memo=memo, workers=workers)
+            # the radius along it as the masks show it, even thinning away from the pith: a branch
+            # thickens outward (seed 003), but the masks pin the slope poorly and bounding it
+            # moved the axis (FIT_VERSION 25, README "A knot seen at one corner")
             c0, u = cone[0], cone[1]
-            if _pith_first(stem, c0, u, length) == (cone[3] < 0):  # thinner away from the pith
-                cone = _fit_cone(surface, positive, ignore, c0, -u if cone[3] < 0 else u, cone[2], outward=True,
-                                 memo=memo, workers=workers)
-                c0, u = cone[0], cone[1]
         tt = (anchors - c0) @ u
         start, dist = c0 + tt.min() * u, float(np.ptp(tt))
         if dist <= 0 or (single and (cone is None or dist < 1.5 * max(cone[2], KNOT_CONE_MIN_RADIUS_MM) or
@@ -503,6 +492,19 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
                                                           0.2)) for k in (group[0], group[-1]))
             slope = (rb - ra) / dist
             lo, hi = 0.5 * min(ra, rb), 2.0 * max(ra, rb)
+        if single and surface is not None:
+            # seen at one end only: where the line comes out of the block away from the pith on a
+            # photographed face whose mask shows no knot, the knot ends before that face (the
+            # stem grew over it), as a one-exit ray does (:func:`_pith_ray`)
+            out_t, pith_t = (hi_t, lo_t) if g[between][0] <= g[between][-1] else (lo_t, hi_t)
+            near, far = start + u * pith_t, start + u * out_t
+            stop = _clear_face_stop(near, far, lambda q: float(np.clip(ra + slope * ((q - start) @ u), lo, hi)),
+                                    size, surface)
+            if stop is not None and (stop - c0) @ (far - near) > 0:  # beyond its own exits
+                if out_t == hi_t:
+                    hi_t = float((stop - start) @ u)
+                else:
+                    lo_t = float((stop - start) @ u)
         return KnotStrand(tuple(start + u * lo_t), tuple(start + u * hi_t),
                           float(np.clip(ra + slope * lo_t, lo, hi)), float(np.clip(ra + slope * hi_t, lo, hi)),
                           dead=all(exits[k]["dead"] for k in group))
@@ -605,20 +607,36 @@ def _pith_ray(exit_: dict, stem, size_mm: ArrayLike, rise: float = 0.0, pinned: 
         return None
     r = exit_["radius_mm"] * np.sqrt(abs(w @ n))
     start, end = c - rho / np.cos(rise) * w, c + float(np.linalg.norm(size)) * w
-    other = _far_end(start, end, c, size)
-    if other is not None and "surface" in exit_:
-        pts, knot = exit_["surface"]
-        ax = int(np.argmin(np.minimum(np.abs(other), np.abs(size - other))))  # the face it leaves by
-        face = np.flatnonzero(np.abs(pts[:, ax] - other[ax]) < 1e-6)  # (not a neighbour's samples by the edge)
-        seen = face[np.linalg.norm(pts[face] - other, axis=1) < max(r, 2.0 * KNOT_CONE_SAMPLE_MM)]
-        if len(seen) and not knot[seen].any():
-            # the knot ends before that face: its strand stops where its surface would reach it,
-            # one mask sample short of it (the mask shows a knot only to within a sample)
-            cos_far = max(abs(w[ax]), KNOT_MIN_ENTRY_COS)
-            end = other - (r / cos_far + KNOT_CONE_SAMPLE_MM) * w
+    if "surface" in exit_:
+        stop = _clear_face_stop(start, end, lambda q: r, size, exit_["surface"], exit_mm=c)
+        if stop is not None:
+            end = stop
             if (end - c) @ w <= 0.0:
                 return None
     return KnotStrand(tuple(start), tuple(end), r, r, dead=exit_["dead"], pinned=pinned)
+
+
+def _clear_face_stop(start, end, radius, size, surface, exit_mm=None) -> np.ndarray | None:
+    """(3,) where a knot on the line ``start`` -> ``end`` (mm, ``start`` the pith's side) ends
+    because the block face it would come out of away from ``exit_mm`` (default: the end of its
+    part inside the block) is photographed and its mask shows no knot there: one mask sample
+    short of where the knot's surface, of radius ``radius(point (3,))`` mm, would reach that
+    face (the mask shows a knot only to within a sample); None where it comes out on a face
+    without a mask, or where the mask shows a knot, or it does not come out. ``surface``: the
+    faces' mask samples ``(points (n, 3), knot (n,) bool)`` (:func:`knot_exits`)."""
+    other = _far_end(start, end, start if exit_mm is None else exit_mm, size)
+    if other is None or np.min(np.minimum(np.abs(other), np.abs(size - other))) > 1e-6:
+        return None  # (or it ends inside the block)
+    pts, knot = surface
+    r = radius(other)
+    w = (end - start) / np.linalg.norm(end - start)
+    ax = int(np.argmin(np.minimum(np.abs(other), np.abs(size - other))))  # the face it leaves by
+    face = np.flatnonzero(np.abs(pts[:, ax] - other[ax]) < 1e-6)  # (not a neighbour's samples by the edge)
+    seen = face[np.linalg.norm(pts[face] - other, axis=1) < max(r, 2.0 * KNOT_CONE_SAMPLE_MM)]
+    if not len(seen) or knot[seen].any():
+        return None
+    cos_far = max(abs(w[ax]), KNOT_MIN_ENTRY_COS)
+    return other - (r / cos_far + KNOT_CONE_SAMPLE_MM) * w
 
 
 def _far_end(start, end, exit_mm, size) -> np.ndarray | None:
