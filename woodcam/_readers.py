@@ -1,8 +1,10 @@
-"""Reading untrusted text files at the door: strict JSON (no NaN/Infinity, bounded nesting),
-every failure a :class:`~woodcam.errors.WoodcamError` naming the file.
+"""Reading untrusted files at the door: strict JSON (no NaN/Infinity, bounded nesting) and
+photos as every viewer shows them, every failure a :class:`~woodcam.errors.WoodcamError` naming
+the file.
 
-Used by every reader of user files (``block.json``, log files, true-field files); it sits at
-the bottom of the import layering so ``fields`` and ``block`` can both use it.
+Used by every reader of user files (``block.json``, log files, true-field files, face photos,
+veneer scans, parquetry targets); it sits at the bottom of the import layering so ``fields``,
+``block`` and ``parquetry`` can all use it.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from typing import Any
 
 from .errors import WoodcamError
 
-__all__ = ["read_json_file", "strict_json_loads"]
+__all__ = ["photo_rgb8", "read_image_file", "read_json_file", "read_photo_rgb", "strict_json_loads"]
 
 
 def strict_json_loads(text: str, what: str) -> Any:
@@ -36,3 +38,70 @@ def read_json_file(path: Path, what: str) -> Any:
     except UnicodeDecodeError as err:
         raise WoodcamError(f"{what}: {str(path)!r} is not UTF-8 text ({err.reason})") from err
     return strict_json_loads(text, f"{what} {str(path)!r}")
+
+
+def read_image_file(path: Path, what: str):
+    """An image file decoded as every viewer shows it, turned by its EXIF orientation tag (a
+    phone stores a portrait photo as landscape pixels plus that tag: read raw it lies on its
+    side, a face's rings turned 90 degrees): ``(h, w)`` or ``(h, w, 3)`` uint8 for 8-bit modes,
+    uint16 for 16-bit ones (values kept). Files over :data:`~woodcam.limits.MAX_IMAGE_PIXELS`,
+    unreadable, truncated or of unsupported modes are WoodcamErrors naming ``what`` and the
+    file."""
+    from PIL import Image, ImageOps
+
+    from .limits import limit
+
+    try:
+        with Image.open(path) as im:
+            if im.width * im.height > limit("MAX_IMAGE_PIXELS"):
+                raise WoodcamError(
+                    f"{what}: {str(path)!r} is {im.width}x{im.height} px, more than the limit "
+                    f"MAX_IMAGE_PIXELS = {limit('MAX_IMAGE_PIXELS'):.0f}; downscale it, or raise "
+                    "the limit with WOODCAM_MAX_IMAGE_PIXELS=N")
+            im.load()  # decode now: a truncated file fails here, inside the try
+            return _image_array(ImageOps.exif_transpose(im))
+    except WoodcamError:
+        raise
+    except (OSError, SyntaxError, ValueError, Image.DecompressionBombError) as err:
+        # PIL raises UnidentifiedImageError (an OSError) for 0-byte/unknown files, OSError for
+        # truncated data, SyntaxError/ValueError for some malformed headers
+        raise WoodcamError(f"{what}: cannot decode the image {str(path)!r} ({err}); the file is damaged or "
+                           "cannot be read as an image: pass a PNG, JPEG or TIFF file") from err
+
+
+def read_photo_rgb(path: Path, what: str):
+    """``(h, w, 3) uint8`` RGB of the image file ``path`` (:func:`read_image_file`; grey repeated,
+    16-bit scaled by 1/257)."""
+    return photo_rgb8(read_image_file(path, what))
+
+
+def photo_rgb8(a):
+    """A decoded photo as (rows, cols, 3) uint8: grey repeated to RGB, 16-bit scaled by 1/257
+    (65535 -> 255) rather than wrapped modulo 256 or clipped."""
+    import numpy as np
+
+    if a.dtype == np.uint16:
+        a = np.round(a / 257.0).astype(np.uint8)
+    if a.ndim == 2:
+        a = np.repeat(a[..., None], 3, axis=2)
+    return a[..., :3].astype(np.uint8, copy=False)
+
+
+def _image_array(im):
+    """A decoded PIL image as uint8 (8-bit modes) or uint16 (16-bit modes, values kept)."""
+    import numpy as np
+
+    if im.mode in ("I;16", "I;16B", "I;16L", "I;16N"):
+        return np.asarray(im).astype(np.uint16)
+    if im.mode == "I":
+        a = np.asarray(im)
+        if a.size and (a.min() < 0 or a.max() > 65535):
+            raise WoodcamError(f"32-bit integer image with values outside 0..65535 "
+                               f"({a.min()}..{a.max()}); save it as 8- or 16-bit")
+        return a.astype(np.uint16)
+    if im.mode in ("RGB;16", "RGBA;16") or im.mode.startswith(("F", "RGBa")):
+        raise WoodcamError(f"image mode {im.mode} is not supported; save it as 8- or 16-bit PNG")
+    if im.mode not in ("L", "RGB"):
+        im = im.convert("RGB" if im.mode in ("P", "RGBA", "CMYK", "YCbCr", "LAB", "HSV", "PA")
+                        else "L")
+    return np.asarray(im)

@@ -130,6 +130,44 @@ def test_bad_photo_folders_give_one_clear_line(synth_photos, tmp_path, capsys):
     assert rc == EXIT_ERROR and "--size-mm" in err
 
 
+def test_phone_photos_are_read_upright_by_their_exif_orientation(synth_photos, tmp_path, capsys):
+    """A phone stores a portrait photo as landscape pixels plus an EXIF orientation tag that
+    every viewer honours; read raw, the face's rings were turned 90 degrees (on a cube silently).
+    The front photo saved that way (pixels turned a quarter, tag 6 = turn them clockwise to
+    view) reads back as the upright photo. Checked by breaking it: without the EXIF turn the
+    face differs from the upright photo by 27 grey levels on average, with it by JPEG noise."""
+    d = _copy(synth_photos, tmp_path / "exif", skip=("front",))
+    with Image.open(synth_photos / "front.png") as im:
+        upright = np.asarray(im.convert("RGB"))
+    exif = Image.Exif()
+    exif[0x0112] = 6  # Orientation: rotate 90 degrees clockwise to display
+    Image.fromarray(np.rot90(upright).copy()).save(d / "front.jpg", quality=95, exif=exif)
+    blk = tmp_path / "blk"
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", blk)
+    assert rc == 0, err
+    got = read_block(blk).faces["front"].photo.astype(float)
+    assert got.shape == upright.shape
+    assert np.abs(got - upright).mean() < 3.0
+    assert np.abs(got - np.rot90(upright)).mean() > 10.0
+
+
+def test_a_16_bit_photo_is_scaled_not_clipped(synth_photos, tmp_path, capsys):
+    """A 16-bit grey export (a raw developer's TIFF or PNG) reads as the same grey at 8 bits;
+    converted raw, every value above 255 clipped to white and the face was refused as
+    blank. Checked by breaking it: with the old ``convert("RGB")`` this fails."""
+    d = _copy(synth_photos, tmp_path / "16", skip=("top",))
+    with Image.open(synth_photos / "top.png") as im:
+        grey = np.asarray(im.convert("L"))
+    Image.fromarray(grey.astype(np.uint16) * 257).save(d / "top.png")
+    with Image.open(d / "top.png") as im:
+        assert im.mode.startswith("I;16")
+    blk = tmp_path / "blk"
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", blk)
+    assert rc == 0, err
+    got = read_block(blk).faces["top"].photo
+    assert np.abs(got[..., 0].astype(int) - grey).max() <= 1
+
+
 def test_face_without_rings_is_named(synth_photos, tmp_path, capsys):
     d = _copy(synth_photos, tmp_path / "p")
     rng = np.random.default_rng(0)

@@ -495,6 +495,24 @@ def test_unreadable_image(tmp_path):
         load_scan(bad, dpi=300)
 
 
+def test_a_phone_photo_is_read_upright(tmp_path):
+    """A veneer or target photographed with a phone (landscape pixels, EXIF orientation 6) is
+    read as viewers show it: 40 px wide and 60 px tall, its left half dark; raw it lay on its
+    side, 60 x 40."""
+    from PIL import Image
+
+    from woodcam.parquetry.veneers import read_image
+
+    upright = np.full((60, 40, 3), 220, np.uint8)
+    upright[:, :20] = 30
+    exif = Image.Exif()
+    exif[0x0112] = 6  # Orientation: rotate 90 degrees clockwise to display
+    Image.fromarray(np.rot90(upright).copy()).save(tmp_path / "phone.jpg", quality=95, exif=exif)
+    a = read_image(tmp_path / "phone.jpg")
+    assert a.shape == (60, 40, 3)
+    assert a[:, :18].mean() < 0.2 and a[:, 22:].mean() > 0.8
+
+
 def test_mask_of_another_size(tmp_path):
     from PIL import Image
 

@@ -54,6 +54,7 @@ import numpy as np
 
 from .._types import ArrayLike, PathLike
 from .._atomic import atomic_path, write_text
+from .._readers import photo_rgb8, read_image_file
 from ..errors import WoodcamError
 from ..fields.state import field_from_state, field_type, jsonable
 from ..frames import FACES, MOKUME_LETTER
@@ -161,7 +162,7 @@ def read_block(folder: PathLike, *, allow_outside: bool | None = None) -> Block:
         shape = tuple(int(v) for v in entry["shape"])
         photo = ring_map = None
         if entry.get("photo"):
-            photo = _photo_rgb8(_read_png(files[f"faces.{name}.photo"], f"photo of face {name!r}"))
+            photo = photo_rgb8(_read_png(files[f"faces.{name}.photo"], f"photo of face {name!r}"))
             _check_shape(photo, shape, f"photo of face {name!r} ({entry['photo']})")
         if entry.get("ring_map"):
             raw = _read_png(files[f"faces.{name}.ring_map"], f"ring map of face {name!r}")
@@ -288,56 +289,10 @@ def _write_png(path: Path, a: np.ndarray) -> None:
 
 
 def _read_png(path: Path, what: str) -> np.ndarray:
-    from PIL import Image
-
-    from ..limits import limit
-
+    """An image file of a block folder, decoded (:func:`woodcam._readers.read_image_file`)."""
     if not path.is_file():
         raise WoodcamError(f"{what}: image file {str(path)!r} is listed but missing")
-    try:
-        with Image.open(path) as im:
-            if im.width * im.height > limit("MAX_IMAGE_PIXELS"):
-                raise WoodcamError(
-                    f"{what}: {str(path)!r} is {im.width}x{im.height} px, more than the limit "
-                    f"MAX_IMAGE_PIXELS = {limit('MAX_IMAGE_PIXELS'):.0f}; downscale it, or raise "
-                    "the limit with WOODCAM_MAX_IMAGE_PIXELS=N")
-            im.load()  # decode now: a truncated file fails here, inside the try
-            return _image_array(im)
-    except WoodcamError:
-        raise
-    except (OSError, SyntaxError, ValueError, Image.DecompressionBombError) as err:
-        # PIL raises UnidentifiedImageError (an OSError) for 0-byte/unknown files, OSError for
-        # truncated data, SyntaxError/ValueError for some malformed headers
-        raise WoodcamError(f"{what}: cannot decode the image {str(path)!r} ({err}); the file "
-                           "is damaged or not an image: re-export it as PNG") from err
-
-
-def _photo_rgb8(a: np.ndarray) -> np.ndarray:
-    """A decoded photo as (rows, cols, 3) uint8: grey repeated to RGB, 16-bit scaled by 1/257
-    (65535 -> 255) rather than wrapped modulo 256."""
-    if a.dtype == np.uint16:
-        a = np.round(a / 257.0).astype(np.uint8)
-    if a.ndim == 2:
-        a = np.repeat(a[..., None], 3, axis=2)
-    return a[..., :3].astype(np.uint8, copy=False)
-
-
-def _image_array(im) -> np.ndarray:
-    """A decoded PIL image as uint8 (8-bit modes) or uint16 (16-bit modes, values kept)."""
-    if im.mode in ("I;16", "I;16B", "I;16L", "I;16N"):
-        return np.asarray(im).astype(np.uint16)
-    if im.mode == "I":
-        a = np.asarray(im)
-        if a.size and (a.min() < 0 or a.max() > 65535):
-            raise WoodcamError(f"32-bit integer image with values outside 0..65535 "
-                               f"({a.min()}..{a.max()}); save it as 8- or 16-bit")
-        return a.astype(np.uint16)
-    if im.mode in ("RGB;16", "RGBA;16") or im.mode.startswith(("F", "RGBa")):
-        raise WoodcamError(f"image mode {im.mode} is not supported; save it as 8- or 16-bit PNG")
-    if im.mode not in ("L", "RGB"):
-        im = im.convert("RGB" if im.mode in ("P", "RGBA", "CMYK", "YCbCr", "LAB", "HSV", "PA")
-                        else "L")
-    return np.asarray(im)
+    return read_image_file(path, what)
 
 
 def _check_shape(a: np.ndarray, shape, what: str) -> None:
@@ -421,7 +376,7 @@ def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *
         photo = ring_map = None
         extras = {}
         if "col" in images:
-            photo = _photo_rgb8(images["col"])
+            photo = photo_rgb8(images["col"])
         if "arl-unet" in images:
             a = images["arl-unet"]
             a = a[..., 0] if a.ndim == 3 else a

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._readers import read_photo_rgb
 from ..errors import WoodcamError
 from ..frames import (
     FACE_OF_LETTER,
@@ -100,11 +101,7 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
                            f"{', '.join(MOKUME_LETTER[f] for f in missing)}), or pass --partial")
     images, density = {}, []
     for face, path in photos.items():
-        try:
-            with Image.open(path) as im:
-                a = np.asarray(im.convert("RGB"))
-        except OSError as err:
-            raise WoodcamError(f"photo of face {face!r} ({path.name}) cannot be read: {err}") from err
+        a = read_photo_rgb(path, f"photo of face {face!r}")
         _check_exposure(face, a, path)
         h_mm, w_mm = face_image_size_mm(face, size)
         want, got = h_mm / w_mm, a.shape[0] / a.shape[1]

@@ -22,6 +22,7 @@ from typing import Literal, Protocol
 
 import numpy as np
 
+from .._readers import read_photo_rgb
 from ..errors import WoodcamError
 
 
@@ -99,18 +100,9 @@ def _check(v: Veneer) -> Veneer:
 
 
 def read_image(path, what: str = "image") -> np.ndarray:
-    """Read an image file as ``(h, w, 3)`` float32 RGB in [0, 1] (grey is repeated)."""
-    from PIL import Image, UnidentifiedImageError
-
-    p = Path(path)
-    try:
-        with Image.open(p) as im:
-            im.load()
-            a = np.asarray(im.convert("RGB"), np.float32) / 255.0
-    except (OSError, UnidentifiedImageError) as err:
-        raise WoodcamError(f"{what} {str(p)!r} cannot be read as an image ({err.__class__.__name__}); "
-                           "pass a PNG, JPEG or TIFF file") from err
-    return a
+    """Read an image file as ``(h, w, 3)`` float32 RGB in [0, 1] (grey is repeated), upright as
+    its EXIF orientation says (:func:`woodcam._readers.read_photo_rgb`)."""
+    return read_photo_rgb(Path(path), what).astype(np.float32) / 255.0
 
 
 def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | None = None,
