@@ -35,7 +35,19 @@ def test_block_synth_then_show(tmp_path, capsys):
 def test_block_errors_are_one_line(tmp_path, capsys):
     assert main(["block", "show", str(tmp_path), "--out", str(tmp_path / "x.png")]) == 1
     err = capsys.readouterr().err
-    assert err.startswith("woodcam: error: folder") and "Mokume files" in err and err.count("\n") == 1
+    assert err.startswith("woodcam: error: folder") and "is not a block" in err and err.count("\n") == 1
+    assert "block.json" in err and "Mokume files" in err and "face photos" in err
+
+
+def test_a_folder_of_face_photos_is_told_to_become_a_block(tmp_path, capsys):
+    """Photos named by face (here by Mokume letter, A.jpg ...) given where a block is wanted:
+    the error says to run ``block from-photos`` on them (it said the folder lacked Mokume
+    files, which a user with six photos cannot act on)."""
+    for letter in "ABCDEF":
+        Image.fromarray(np.full((32, 32, 3), 100, np.uint8)).save(tmp_path / f"{letter}.jpg")
+    assert main(["block", "show", str(tmp_path), "--out", str(tmp_path / "x.png")]) == 1
+    err = capsys.readouterr().err
+    assert "holds face photos (A.jpg" in err and "woodcam block from-photos" in err and err.count("\n") == 1
 
 
 def test_show_of_a_missing_folder_says_what_it_wants(tmp_path, capsys):

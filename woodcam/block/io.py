@@ -326,6 +326,19 @@ def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | No
                            f"folder; {str(folder)!r} does not exist")
     if (folder / MANIFEST).is_file():
         return read_block(folder)
+    if not any(folder.glob("*_col.*")) and not any(folder.glob("*_arl-unet.*")):
+        from .photos import find_face_photos
+
+        photos = find_face_photos(folder)
+        if photos:  # a user's own photos, not yet a block: say how to make one
+            raise WoodcamError(
+                f"folder {str(folder)!r} holds face photos ({', '.join(p.name for p in photos.values())}) but no "
+                f"{MANIFEST}: make a block of them first: woodcam block from-photos {str(folder)!r} --size-mm "
+                "WxDxH --out BLOCK_DIR")
+        raise WoodcamError(
+            f"folder {str(folder)!r} is not a block: no {MANIFEST} (a block folder), no Mokume files like "
+            "A_col.png or A_arl-unet.png, no face photos (front.jpg ...); make a block with woodcam block "
+            "from-photos or woodcam block synth")
     return read_mokume(folder, MOKUME_DEFAULT_SIZE_MM if size_mm is None else tuple(size_mm))
 
 
