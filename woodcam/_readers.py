@@ -51,6 +51,10 @@ def read_image_file(path: Path, what: str):
 
     from .limits import limit
 
+    if Path(path).suffix.lower() in (".heic", ".heif"):  # a phone camera's default format
+        from pillow_heif import register_heif_opener
+
+        register_heif_opener()  # libheif turns the pixels by the file's own rotation and resets the tag
     try:
         with Image.open(path) as im:
             if im.width * im.height > limit("MAX_IMAGE_PIXELS"):

@@ -151,6 +151,23 @@ def test_phone_photos_are_read_upright_by_their_exif_orientation(synth_photos, t
     assert np.abs(got - np.rot90(upright)).mean() > 10.0
 
 
+def test_heic_photos_are_read(synth_photos, tmp_path, capsys):
+    """HEIC, a phone camera's default format, is read (pillow-heif's opener; libheif applies the
+    file's own rotation). Checked by breaking it: without ``.heic`` among the photo suffixes the
+    front face is missing (in a fresh process without the opener PIL cannot identify the file)."""
+    import pillow_heif
+
+    d = _copy(synth_photos, tmp_path / "heic", skip=("front",))
+    with Image.open(synth_photos / "front.png") as im:
+        upright = np.asarray(im.convert("RGB"))
+    pillow_heif.from_pillow(Image.fromarray(upright)).save(d / "front.heic", quality=95)
+    blk = tmp_path / "blk"
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", blk)
+    assert rc == 0, err
+    got = read_block(blk).faces["front"].photo.astype(float)
+    assert got.shape == upright.shape and np.abs(got - upright).mean() < 4.0
+
+
 def test_a_16_bit_photo_is_scaled_not_clipped(synth_photos, tmp_path, capsys):
     """A 16-bit grey export (a raw developer's TIFF or PNG) reads as the same grey at 8 bits;
     converted raw, every value above 255 clipped to white and the face was refused as
