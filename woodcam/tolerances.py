@@ -510,6 +510,14 @@ KNOT_CONE_START_REUSE_DEG = 8.0
 #: pith is a few mm thick; seed 001's logs start at 2-6 mm).
 KNOT_CONE_MIN_RADIUS_MM = 1.0
 
+#: A knot seen at one end (its exits over two or three faces at a block edge or corner) is a
+#: strand only where its masks span at least this many cone radii along the fitted cone: a
+#: shorter end does not pin the cone's direction (a round cut fits any axis through it). Since
+#: FIT_VERSION 10; 1.0 tried with FIT_VERSION 25 (dev and fresh knotted blocks, six and three
+#: faces): dev six faces 89.27 -> 88.67 % within 2 mm (7777/10, an end of 17.0 mm against 17.55,
+#: 66.3 -> 51.0), the rest within 0.5 either way; README "A knot seen at one corner".
+KNOT_END_MIN_SPAN_RADII = 1.5
+
 #: Exits on two faces whose mask samples come this close (mm) across the edge between the faces
 #: are one knot end (a knot cut by a block edge): two sample spacings, so a mask that reaches
 #: the edge on both sides always touches.

@@ -55,7 +55,8 @@ from ..fields.knots import KnotParams
 from ..frames import FACE_NORMAL, pixel_to_block
 from ..tolerances import (DEAD_KNOT_BANDS_MM, DEAD_KNOT_MIN_OUTLINED, DEAD_KNOT_SECTORS, KNOT_BEND_MAX_BEFORE_PITH,
                           KNOT_BEND_ROUNDS, KNOT_CONE_EDGE_MM, KNOT_CONE_MAX_NFEV, KNOT_CONE_MIN_RADIUS_MM,
-                          KNOT_CONE_REACH_MM, KNOT_CONE_SAMPLE_MM, KNOT_CONE_START_REUSE_DEG, KNOT_END_TOUCH_MM, KNOT_MIN_AREA_PX, KNOT_MIN_AREA_SHARE,
+                          KNOT_CONE_REACH_MM, KNOT_CONE_SAMPLE_MM, KNOT_CONE_START_REUSE_DEG, KNOT_END_MIN_SPAN_RADII, KNOT_END_TOUCH_MM,
+                          KNOT_MIN_AREA_PX, KNOT_MIN_AREA_SHARE,
                           KNOT_MIN_ENTRY_COS, KNOT_PAIR_MIN_ANGLE_DEG, KNOT_PAIR_MISS_FLOOR_MM, KNOT_PITH_YEARS,
                           KNOT_PAIR_MAX_MISS_SHARE, KNOT_RAY_MIN_PITH_MM, KNOT_RAY_MISFIT_CAP_MM, KNOT_RAY_REFIT_POINTS,
                           KNOT_RAY_RISES_DEG, KNOT_SHARE_MAX_MISS_MM, KNOT_SHARE_MAX_MISS_SHARE)
@@ -459,7 +460,7 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
             c0, u = cone[0], cone[1]
         tt = (anchors - c0) @ u
         start, dist = c0 + tt.min() * u, float(np.ptp(tt))
-        if dist <= 0 or (single and (cone is None or dist < 1.5 * max(cone[2], KNOT_CONE_MIN_RADIUS_MM) or
+        if dist <= 0 or (single and (cone is None or dist < KNOT_END_MIN_SPAN_RADII * max(cone[2], KNOT_CONE_MIN_RADIUS_MM) or
                                      abs(u @ axis) > np.cos(np.deg2rad(KNOT_PAIR_MIN_ANGLE_DEG)))):
             return None
         # the line's stem years: a branch grows out of the pith, so it ends where they are least
