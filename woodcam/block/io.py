@@ -326,7 +326,7 @@ def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | No
                            f"folder; {str(folder)!r} does not exist")
     if (folder / MANIFEST).is_file():
         return read_block(folder)
-    if not any(folder.glob("*_col.*")) and not any(folder.glob("*_arl-unet.*")):
+    if not any(p.exists() for face in FACES for p in _mokume_files(folder, face).values()):
         from .photos import find_face_photos
 
         photos = find_face_photos(folder)
@@ -340,6 +340,12 @@ def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | No
             "A_col.png or A_arl-unet.png, no face photos (front.jpg ...); make a block with woodcam block "
             "from-photos or woodcam block synth")
     return read_mokume(folder, MOKUME_DEFAULT_SIZE_MM if size_mm is None else tuple(size_mm))
+
+
+def _mokume_files(folder: Path, face: str) -> dict[str, Path]:
+    """The files a Mokume sample folder may hold for ``face``, by kind (``A_col.png`` ...)."""
+    letter = MOKUME_LETTER[face]
+    return {k: folder / f"{letter}_{k}.png" for k in ("col", "arl-unet", "ann", "knot")}
 
 
 def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *, name: str | None = None) -> Block:
@@ -379,7 +385,7 @@ def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *
     faces = {}
     for face in FACES:
         letter = MOKUME_LETTER[face]
-        files = {k: folder / f"{letter}_{k}.png" for k in ("col", "arl-unet", "ann", "knot")}
+        files = _mokume_files(folder, face)
         if not any(p.exists() for p in files.values()):
             continue
         images = {k: _read_png(p, f"Mokume {k} of face {letter}") for k, p in files.items() if p.exists()}

@@ -473,7 +473,8 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
                 g[between].min() < min(g[between][0], g[between][-1]) - KNOT_PITH_YEARS:
             return None  # the pith lies between the exits: two branches, not one
         lo_t, hi_t = -length, dist + length
-        if g[between][0] <= g[between][-1]:  # the pith is beyond the first end: start there
+        pith_first = bool(g[between][0] <= g[between][-1])
+        if pith_first:  # the pith is beyond the first end: start there
             lo_t = float(t[t <= 0][np.argmin(g[t <= 0])]) - 1.0
         else:
             hi_t = float(t[t >= dist][np.argmin(g[t >= dist])]) + 1.0
@@ -493,21 +494,20 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
                                                           0.2)) for k in (group[0], group[-1]))
             slope = (rb - ra) / dist
             lo, hi = 0.5 * min(ra, rb), 2.0 * max(ra, rb)
+
+        def radius(at):  # the strand's radius at ``at`` mm along u from start
+            return float(np.clip(ra + slope * at, lo, hi))
+
         if single and surface is not None:
             # seen at one end only: where the line comes out of the block away from the pith on a
             # photographed face whose mask shows no knot, the knot ends before that face (the
             # stem grew over it), as a one-exit ray does (:func:`_pith_ray`)
-            out_t, pith_t = (hi_t, lo_t) if g[between][0] <= g[between][-1] else (lo_t, hi_t)
-            near, far = start + u * pith_t, start + u * out_t
-            stop = _clear_face_stop(near, far, lambda q: float(np.clip(ra + slope * ((q - start) @ u), lo, hi)),
-                                    size, surface)
+            near, far = (start + u * lo_t, start + u * hi_t) if pith_first else (start + u * hi_t, start + u * lo_t)
+            stop = _clear_face_stop(near, far, lambda q: radius((q - start) @ u), size, surface)
             if stop is not None and (stop - c0) @ (far - near) > 0:  # beyond its own exits
-                if out_t == hi_t:
-                    hi_t = float((stop - start) @ u)
-                else:
-                    lo_t = float((stop - start) @ u)
-        return KnotStrand(tuple(start + u * lo_t), tuple(start + u * hi_t),
-                          float(np.clip(ra + slope * lo_t, lo, hi)), float(np.clip(ra + slope * hi_t, lo, hi)),
+                at = float((stop - start) @ u)
+                lo_t, hi_t = (lo_t, at) if pith_first else (at, hi_t)
+        return KnotStrand(tuple(start + u * lo_t), tuple(start + u * hi_t), radius(lo_t), radius(hi_t),
                           dead=all(exits[k]["dead"] for k in group))
 
     def pair(i, j, dist):

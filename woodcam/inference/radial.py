@@ -686,8 +686,10 @@ def _by_numbering(obs: RingObservations, found: list, nums: list | None = None) 
     where none was computed (labelled rings, a single basin), and is handed to
     :func:`_finish_radial` so the chosen basin is not numbered twice.
     """
-    if obs.labelled or len(found) < 2:
+    if obs.labelled or not found:
         return found, None
+    if len(found) < 2:  # nothing to reorder; a numbering already made is handed on, not made again
+        return found, nums[0] if nums else None
     nums = nums or [_initial_numbering(obs, f[0]) for f in found]
     best = max(n[3] for n in nums)
     good = [i for i, n in enumerate(nums) if n[3] >= best - NUMBERING_STEP_MARGIN]
