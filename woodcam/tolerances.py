@@ -482,6 +482,20 @@ KNOT_SHARE_MAX_MISS_MM = 10.0
 #: (shares 0.30 and 0.40 on seeds 50287 and 7777).
 KNOT_SHARE_MAX_MISS_SHARE = 0.5
 
+#: Another pairing of knot ends than the order of :data:`KNOT_PAIR_MAX_MISS_SHARE` is taken only
+#: where its cones cut the masks better, the least IoU of its pairs' cones higher than the
+#: order's by this (:func:`woodcam.inference.knots._pairings`): the IoU of one cone fitted to two
+#: ends is a pixel's worth of noise apart between pairings that are as good (57131/19: 0.730
+#: against 0.724, and the rings' choice of the two lost 1.3 points); the exchanged crossed pairs
+#: of 9101/5 gained 0.096 (0.898 against 0.802).
+KNOT_PAIRING_MIN_IOU_GAIN = 0.02
+
+#: ... and where its bend leaves less misfit on the rings than the order's by this share
+#: (:func:`woodcam.inference.knots._bend_misfit`, a quick refit whose misfit moves a few per cent
+#: between pairings that change nothing: 63311/9's other pairing was 0.2 % better on the rings
+#: and 29 points worse inside; 9101/5's exchanged pairs were 31 % better).
+KNOT_PAIRING_MIN_MISFIT_GAIN = 0.05
+
 #: Spacing (mm) at which the knot masks are sampled for a knot's cone fit
 #: (:func:`woodcam.inference.knots._fit_cone`): knots are 2-20 mm across, so a 3 mm exit still
 #: has ~30 samples, and a 80 mm face ~6400.

@@ -27,6 +27,9 @@ PICTURES = {
     "knot_corner_9101.png": (9101, 14, "full", "cdee99e",
                              "FIT_VERSION 24: a knot seen at one block corner ran on through the block and out by "
                              "a face that shows no knot; 25: it ends before that face"),
+    "knot_pairs_9101.png": (9101, 5, "full", "d8b12bc",
+                            "FIT_VERSION 25: two knots' ends paired nearest first, crossed; 26: paired as their "
+                            "masks and rings say"),
 }
 
 _SCORE = """

@@ -265,3 +265,38 @@ def test_a_knot_seen_at_one_corner_ends_before_a_face_that_shows_none():
     far, r_far = (a, fit.radius_start_mm) if a[0] > b[0] else (b, fit.radius_end_mm)
     assert far[0] + r_far < SIZE[0], (far, r_far)  # its surface stays inside the right face
     assert far[0] > 30.0, far  # past where it truly ends (x = 25): what the photos allow
+
+
+def test_two_knots_the_nearest_ends_would_cross_are_paired_as_their_masks_and_rings_say(monkeypatch):
+    """Dev seed 9101 block 5, planted: two knots in one plane from the left face of a long block,
+    one straight out by the right face, one down and out by the bottom-right edge. Taken
+    nearest ends first (every line passes the pith), each left exit paired with the other
+    knot's far end, and the strands crossed 13-28 mm off both knots. The pairs exchanged cut
+    the masks better (cone IoU) and the bend round them fits the rings better, so they are
+    kept (FIT_VERSION 26). Checked by breaking it: with no other pairing offered the fitted
+    strands are the crossed ones."""
+    import woodcam.inference.knots as kn
+
+    size = (76.0, 31.0, 48.0)
+    flat = KnotStrand((-20.0, 15.5, 24.0), (90.0, 15.5, 24.0), 4.0, 8.0)
+    down = KnotStrand((-20.0, 15.5, 48.0), (90.0, 15.5, -12.0), 4.5, 8.0)
+    stem = round_stem((-60.0, 15.5), size)
+    block = synth_block(StemWithKnots(stem, [flat, down], bend=KnotParams()), size, face_px=128, seed=5)
+    exits = knot_exits(block)
+    assert sorted(e["face"] for e in exits) == ["bottom", "left", "left", "right", "right"]
+
+    def off(s, t):  # mm: the most strand s's line is off strand t's across the block (x = 0..76)
+        x = np.linspace(0.0, size[0], 20)[:, None]
+        line = [np.asarray(q.start_mm) + (x - q.start_mm[0]) / (q.end_mm[0] - q.start_mm[0])
+                * np.subtract(q.end_mm, q.start_mm) for q in (s, t)]
+        return float(np.abs(line[0] - line[1]).max())
+
+    crossed = strands_from_exits(exits, stem, size, cones=True)  # the order alone
+    assert len(crossed) == 2 and min(off(s, t) for s in crossed for t in (flat, down)) > 10.0
+    obs = gather_observations(block)
+    fitted = fit_knotted_stem(obs, size, exits, cones=True)
+    assert sorted(round(min(off(s, t) for s in fitted.strands), 1) <= 1.0 for t in (flat, down)) == [True, True]
+
+    monkeypatch.setattr(kn, "_pairings", lambda *args, **kw: [])
+    again = fit_knotted_stem(obs, size, knot_exits(block), cones=True)
+    assert min(off(s, t) for s in again.strands for t in (flat, down)) > 10.0

@@ -56,8 +56,10 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: again on other point subsets, :func:`woodcam.inference.radial._numbered_basins`; 25: a knot
 #: seen at one end (a block corner or edge) ends before a photographed face that shows no knot
 #: where its cone would come out, as a one-exit ray does, and a cone thinning away from the pith
-#: is kept as the masks show it, :func:`woodcam.inference.knots.strands_from_exits`).
-FIT_VERSION = 25
+#: is kept as the masks show it, :func:`woodcam.inference.knots.strands_from_exits`; 26: knot ends
+#: are paired otherwise than in that order where the other pairing's cones cut the masks better
+#: and its bend fits the rings better, :func:`woodcam.inference.knots.fit_knotted_stem`).
+FIT_VERSION = 26
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,

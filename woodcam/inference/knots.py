@@ -42,6 +42,7 @@ dead; a strand alive at one exit and dead at the other is kept alive: one flag p
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
@@ -58,7 +59,8 @@ from ..tolerances import (DEAD_KNOT_BANDS_MM, DEAD_KNOT_MIN_OUTLINED, DEAD_KNOT_
                           KNOT_CONE_REACH_MM, KNOT_CONE_SAMPLE_MM, KNOT_CONE_START_REUSE_DEG, KNOT_END_MIN_SPAN_RADII, KNOT_END_TOUCH_MM,
                           KNOT_MIN_AREA_PX, KNOT_MIN_AREA_SHARE,
                           KNOT_MIN_ENTRY_COS, KNOT_PAIR_MIN_ANGLE_DEG, KNOT_PAIR_MISS_FLOOR_MM, KNOT_PITH_YEARS,
-                          KNOT_PAIR_MAX_MISS_SHARE, KNOT_RAY_MIN_PITH_MM, KNOT_RAY_MISFIT_CAP_MM, KNOT_RAY_REFIT_POINTS,
+                          KNOT_PAIR_MAX_MISS_SHARE, KNOT_PAIRING_MIN_IOU_GAIN, KNOT_PAIRING_MIN_MISFIT_GAIN,
+                          KNOT_RAY_MIN_PITH_MM, KNOT_RAY_MISFIT_CAP_MM, KNOT_RAY_REFIT_POINTS,
                           KNOT_RAY_RISES_DEG, KNOT_SHARE_MAX_MISS_MM, KNOT_SHARE_MAX_MISS_SHARE)
 
 if TYPE_CHECKING:
@@ -228,6 +230,15 @@ def _cone_problem(surface, positive, ignore, c0, r0):
     return P, y, 1.0 / np.sqrt(max(len(y), 1))  # every sample alike: the misfit is the area misclassified
 
 
+def _cone_iou(problem, cone) -> float:
+    """Intersection over union of the samples inside ``cone`` (:func:`_fit_cone`'s ``(c, u, rc,
+    slope, cost)``) and the knot samples of ``problem`` (:func:`_cone_problem`): how well one
+    cone explains the masks it was fitted to (1: every knot sample inside, no clear one)."""
+    inside = _cone_terms(np.concatenate([cone[0], cone[1], [cone[2], cone[3]]]), problem[0])[-1] > 0
+    knot = problem[1] > 0.5
+    return float((inside & knot).sum() / max((inside | knot).sum(), 1))
+
+
 def _fit_cone_start(problem, c0, u_start, r0):
     """One start of :func:`_fit_cone`: ``(c, u, rc, slope, cost)`` from the line through ``c0``
     along ``u_start (3,)`` with radius ``r0``, ``u`` in the starting sense. Residuals
@@ -391,7 +402,7 @@ def _end_centre(exits, end, cones: bool) -> np.ndarray:
 
 def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
                        cones: bool = False, workers: int = 1,
-                       rises: dict[int, float] | None = None) -> list[KnotStrand]:
+                       rises: dict[int, float] | None = None, prefer: frozenset = frozenset()) -> list[KnotStrand]:
     """Strands of the knot ``exits`` (:func:`knot_exits`) in ``stem``, a block of ``size_mm``
     (module docstring). ``cones``: exits touching across a block edge are one knot end
     (:func:`_ends`), and a paired strand's line and radius are its cone fitted to the face masks
@@ -400,15 +411,22 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
     :func:`~.fit.fit_block` ``(knot_cones=False)`` uses; the fit's default is the cones since
     FIT_VERSION 10). ``workers``: processes each cone's starts may use (:func:`_fit_cone`).
     ``rises``: exit index -> rise (rad) of the knots seen at one exit whose ray from the pith
-    the rings placed (:func:`_ray_rises`): those strands bend the rings (``pinned``)."""
-    return _strands(exits, stem, size_mm, cones, workers, rises)[0]
+    the rings placed (:func:`_ray_rises`): those strands bend the rings (``pinned``). ``prefer``:
+    pairs of knot ends taken first, as the rings and masks chose them (:func:`_pairings`, :func:`_fit_knotted_stem`)."""
+    return _strands(exits, stem, size_mm, cones, workers, rises, prefer)[0]
 
 
-def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[list[KnotStrand], dict[int, int]]:
-    """:func:`strands_from_exits` and ``lone``: exit index -> index of its strand, for each knot
-    seen at one exit only (its strand a guess, or a ray whose rise ``rises`` gives)."""
+def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None,
+             prefer: frozenset = frozenset()) -> tuple[list[KnotStrand], dict]:
+    """:func:`strands_from_exits` and what :func:`_ray_rises` and :func:`_pairings` need of it:
+    ``{"lone": exit index -> index of its strand, for each knot seen at one exit only (its
+    strand a guess, or a ray whose rise ``rises`` gives), "ends": the knot ends (exit index
+    tuples, :func:`_ends`), "pairs": [(end, end, IoU)] the ends paired, in order, each with its
+    cone's agreement with their masks (:func:`_cone_iou`; None without cones)}``. ``prefer``:
+    pairs of ends (frozensets of two exit index tuples) taken before every other pair
+    (:func:`_pairings`)."""
     if not exits:
-        return [], {}
+        return [], {"lone": {}, "ends": [], "pairs": []}
     rises = rises or {}
     size = np.asarray(size_mm, float)
     axis = np.asarray(getattr(stem, "axis", (0.0, 0.0, 1.0)), float)
@@ -437,8 +455,12 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
         miss = np.where(beyond, np.maximum(least, KNOT_PAIR_MISS_FLOOR_MM), np.inf)
     pairs = [((0, mi) if rho is not None and mi <= KNOT_PAIR_MAX_MISS_SHARE * min(rho[i], rho[j]) else (1, dist),
               dist, i, j, mi) for (dist, i, j), mi in zip(candidates, miss)]  # (order, distance, end, end, miss)
+    if prefer:  # the pairs the rings and masks chose over the order above (:func:`_pairings`)
+        pairs = [((-1, 0) if frozenset((tuple(ends[i]), tuple(ends[j]))) in prefer else order, dist, i, j, mi)
+                 for order, dist, i, j, mi in pairs]
     pairs.sort(key=lambda q: q[:4])
     surface = exits[0].get("surface") if cones else None
+    agree: dict[tuple, float | None] = {}  # group -> its cone's IoU with the masks
     memo = exits[0].get("cone_memo")
 
     def place(group, anchors, starts, single=False):
@@ -452,8 +474,9 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
             others = [k for k in range(len(exits)) if k not in group]
             positive = np.concatenate([exits[k]["pixels"] for k in group])
             ignore = np.concatenate([exits[k]["pixels"] for k in others]) if others else np.zeros(0, int)
-            cone = _fit_cone(surface, positive, ignore, c0, starts,
-                             float(np.mean([exits[k]["radius_mm"] for k in group])), memo=memo, workers=workers)
+            r0 = float(np.mean([exits[k]["radius_mm"] for k in group]))
+            cone = _fit_cone(surface, positive, ignore, c0, starts, r0, memo=memo, workers=workers)
+            agree[tuple(group)] = _cone_iou(_cone_problem(surface, positive, ignore, c0, r0), cone)
             # the radius along it as the masks show it, even thinning away from the pith: a branch
             # thickens outward (seed 003), but the masks pin the slope poorly and bounding it
             # moved the axis (FIT_VERSION 25, README "A knot seen at one corner")
@@ -513,7 +536,7 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
     def pair(i, j, dist):
         return place(ends[i] + ends[j], np.stack([centres[i], centres[j]]), ((centres[j] - centres[i]) / dist)[None])
 
-    used_ends, strands = set(), []
+    used_ends, strands, paired = set(), [], []
     for _, dist, i, j, _ in pairs:
         if i in used_ends or j in used_ends:
             continue
@@ -521,6 +544,7 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
         if strand is not None:
             used_ends |= {i, j}
             strands.append(strand)
+            paired.append((tuple(ends[i]), tuple(ends[j]), agree.get(tuple(ends[i] + ends[j]))))
     for i, end in enumerate(ends):
         # an unpaired end over two or more faces is a knot cut by a block edge or corner: the
         # cone that cuts both faces as the masks show is its strand, started along the samples'
@@ -566,7 +590,7 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None) -> tuple[
         r = e["radius_mm"] * np.sqrt(max(abs(d @ n), 0.2))
         strands.append(KnotStrand(tuple(e["centre_mm"] - 2.0 * d), tuple(e["centre_mm"] + reach * d),
                                   r, r, dead=e["dead"], pinned=False))
-    return strands, lone
+    return strands, {"lone": lone, "ends": [tuple(e) for e in ends], "pairs": paired}
 
 
 def _pith_ray(exit_: dict, stem, size_mm: ArrayLike, rise: float = 0.0, pinned: bool = False) -> KnotStrand | None:
@@ -665,8 +689,69 @@ def _ray_misfit(field, obs, density) -> float:
     return float(np.mean(np.minimum(err, KNOT_RAY_MISFIT_CAP_MM) ** 2))
 
 
+def _bend_misfit(strands, stem, obs, size_mm, seed: int, g0, density) -> float:
+    """The rings' misfit (:func:`_ray_misfit`) of ``stem`` bent round ``strands`` with the stem
+    refitted to that bend once. ``g0 (n,)``: ``stem``'s years at ``obs``'s points; ``density
+    (n,)``: its ring density there. The stem's fit absorbs a knot's bend into itself, so a bend
+    is judged after the stem is refitted to it (without that, no bend always won), by a quick
+    refit (:data:`~woodcam.tolerances.KNOT_RAY_REFIT_POINTS`): what a comparison needs, not a
+    fit. The stem given was fitted in full, so every arm compared, no bend too, is refitted
+    alike (the quick refit would start behind it)."""
+    from .stem import fit_stem
+
+    bent = StemWithKnots(stem, strands, bend=KnotParams())
+    refit = fit_stem(obs, size_mm, seed=seed, offset_years=bent(obs.points_mm) - g0, init=stem, history=False,
+                     n_fit=KNOT_RAY_REFIT_POINTS)
+    return _ray_misfit(StemWithKnots(refit, strands, bend=KnotParams()), obs, density)
+
+
+def _pairings(exits, stem, size_mm, near: frozenset | None = None, workers: int = 1) -> list[frozenset]:
+    """Other pairings of the knot ends than the order of :func:`_strands` whose cones cut the
+    masks better: each the pairs to take first (``prefer``), the least :func:`_cone_iou` of
+    its pairs' cones higher than the order's by :data:`~woodcam.tolerances.KNOT_PAIRING_MIN_IOU_GAIN`
+    (a pairing is as good as its worst pair: one that makes a pair better by making another
+    worse is no better). :func:`_fit_knotted_stem` keeps one where the rings say so too.
+
+    Why: that order (pairs whose line passes the pith first, then the nearest ends) knows
+    nothing of which ends look like one knot, and it can cross two knots. Dev seed 9101 block 5
+    (six noisy faces, the pith 13-16 cm away, so every pair is ordered by distance): two knots
+    from the left face, one out by the right face, one by the bottom-right edge; the nearest
+    ends first paired each left exit with the other's far end, and the bend round the two
+    crossed strands scored 60.9 % within 2 mm, the pairs exchanged 93.9 % (cone IoU 0.80 / 0.96
+    against 0.97 / 0.90).
+
+    The pairings tried: two pairs of the order exchanging partners (either way), or one end of
+    a pair taking an end the order left unpaired. ``near``: the pairing the all-faces fit chose
+    (a fold: :func:`knot_bend_recipes`), the only one tried, as a fold's rises are searched
+    near the all-faces fit's."""
+    _, info = _strands(exits, stem, size_mm, True, workers)
+    base = info["pairs"]
+    if near is not None:
+        alts = [near] if near else []
+    else:
+        alts = []
+        for (a, b, _), (c, d, _) in itertools.combinations(base, 2):
+            alts += [frozenset({frozenset((a, c)), frozenset((b, d))}), frozenset({frozenset((a, d)), frozenset((b, c))})]
+        paired = {e for q in base for e in q[:2]}
+        for a, b, _ in base:
+            alts += [frozenset({frozenset((x, e))}) for x in (a, b) for e in info["ends"] if e not in paired]
+
+    def worst(pairs):  # the least IoU of the pairs' cones with their masks
+        return min((q[2] for q in pairs), default=0.0)
+
+    seen, least, better = [{frozenset(q[:2]) for q in base}], worst(base) + KNOT_PAIRING_MIN_IOU_GAIN, []
+    for alt in alts:
+        got = _strands(exits, stem, size_mm, True, workers, prefer=alt)[1]["pairs"]
+        if (pairs := {frozenset(q[:2]) for q in got}) not in seen:  # another pairing, tried once
+            seen.append(pairs)
+            if worst(got) >= least:
+                better.append(alt)
+    return better
+
+
 def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int,
-               near: dict[int, float] | None = None, workers: int = 1) -> dict[int, float]:
+               near: dict[int, float] | None = None, workers: int = 1,
+               prefer: frozenset = frozenset()) -> dict[int, float]:
     """exit index -> rise (rad) of each knot seen at one exit whose ray from the pith
     (:func:`_pith_ray`) bends the rings: per such knot in turn, of the rises
     :data:`~woodcam.tolerances.KNOT_RAY_RISES_DEG` (then the vertex of the parabola through the
@@ -677,20 +762,19 @@ def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int,
     its rise, and 10-20 degrees off puts its bend 1-2 cm off across a block (dev seeds 7777 and
     63311, three noisy faces, knotted blocks within 2 mm: the ray across the stem 63.7 %, the
     true knot's direction through the exit 76.5 %); the rings round the exit, on its face and
-    the others, are bent by where the knot really runs. The stem's fit absorbs a knot's bend
-    into itself, so each rise is judged after the stem is refitted to it (without that, no bend
-    always won), by a quick refit (:data:`~woodcam.tolerances.KNOT_RAY_REFIT_POINTS`).
+    the others, are bent by where the knot really runs. Each rise is judged after the stem is
+    refitted to it (:func:`_bend_misfit`).
 
     ``near``: rises found on more rings (a fold's fit starts from the all-faces fit's, as its
     stem does: :func:`knot_bend_recipes`): only those knots are tried, each at its rise and one
     step of the grid either side. Why: every fold searching afresh took seed 31337 block 15 (six
     faces, five knots seen at one exit) from 7.3 to 20.4 s wall. ``workers``: processes each
-    knot's cone starts may use (:func:`_fit_cone`)."""
-    from .stem import fit_stem
-
+    knot's cone starts may use (:func:`_fit_cone`). ``prefer``: the ends' pairing
+    (:func:`_pairings`)."""
     rises: dict[int, float] = {}
     full = np.deg2rad(KNOT_RAY_RISES_DEG)
-    strands, lone = _strands(exits, stem, size_mm, cones, workers)
+    strands, info = _strands(exits, stem, size_mm, cones, workers, prefer=prefer)
+    lone = info["lone"]
     made: dict = {}
 
     def ray(k, rise):  # knot k's pinned ray at ``rise``, made once (the check below, then its cost)
@@ -713,12 +797,7 @@ def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int,
             trial[lone[k]] = ray(k, rise)
             if trial[lone[k]] is None:  # no ray at that rise (along the face, or out by a face showing none)
                 return np.inf
-        bent = StemWithKnots(stem, trial, bend=KnotParams())
-        # every arm refitted alike, no bend too (the stem given was fitted in full: the quick
-        # refit would start behind it); the quick refit: what the comparison needs, not a fit
-        refit = fit_stem(obs, size_mm, seed=seed, offset_years=bent(obs.points_mm) - g0, init=stem, history=False,
-                         n_fit=KNOT_RAY_REFIT_POINTS)
-        return _ray_misfit(StemWithKnots(refit, trial, bend=KnotParams()), obs, density)
+        return _bend_misfit(trial, stem, obs, size_mm, seed, g0, density)
 
     now = cost()
     for k in lone:
@@ -770,6 +849,16 @@ def fit_knotted_stem(obs: RingObservations, size_mm: ArrayLike, exits: list[dict
     -> 43 % within 1 mm), so only pinned strands bent the rings; the ray with its rise read
     from the rings bends them where the rings say so (dev seeds 7777 and 63311, three noisy
     faces, the default fit within 2 mm: 62.8 -> 67.7 %, README "A knot seen at one exit").
+    Knot ends are paired in the order of :func:`strands_from_exits`, or (FIT_VERSION 26) as
+    another pairing whose cones cut the masks better (:func:`_pairings`) where the fixed point
+    with it leaves less misfit on the rings, by the share
+    :data:`~woodcam.tolerances.KNOT_PAIRING_MIN_MISFIT_GAIN` (:func:`_ray_misfit`, each
+    pairing's bend fitted in full: a quick refit from the first round's stem, as the rises are
+    judged, preferred the crossed pairs of dev seed 9101 block 5, 2.98 against 3.51 mm², where
+    the fixed point gives 0.83 against 0.57). Both are asked because either alone chose wrong
+    pairs on the development blocks: the rings alone were worse in 4 of the 7 blocks where they
+    preferred another pairing (24683/16 83.7 -> 38.1 % within 2 mm, whose other cone cut its
+    masks at IoU 0.72 against 0.92); the masks alone by a hair (57131/19).
     ``guessed=True`` (a separate hypothesis the held-out faces judge) bends round every strand. Strands that do not
     bend are kept for the knot's look (:meth:`StemWithKnots.knot_features`). A dead strand bends
     as an alive one: the branch was alive from the pith to its death, which the exits do not
@@ -778,38 +867,58 @@ def fit_knotted_stem(obs: RingObservations, size_mm: ArrayLike, exits: list[dict
     return _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones)[0]
 
 
-def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones=False, near=None, workers=1):
+def _fit_knotted_stem(obs, size_mm, exits, rounds, seed, guessed, stem, cones=False, near=None, workers=1,
+                      near_pairing=None):
     """:func:`fit_knotted_stem`, whether every round placed pinned strands only (then the fit
-    with ``guessed=True`` would make the very same steps) and the rises of the rays that bend
-    (:func:`_ray_rises`, ``near`` passed on); ``workers``: processes each cone's starts may use."""
+    with ``guessed=True`` would make the very same steps), the rises of the rays that bend
+    (:func:`_ray_rises`, ``near`` passed on) and the pairing of the knot ends it kept (the
+    ``prefer`` of :func:`strands_from_exits`; ``near_pairing`` is :func:`_pairings`' ``near``);
+    ``workers``: processes each cone's starts may use."""
     from .stem import fit_stem
 
     def falls(s, g):  # times are not "from the pith" in stem s (g: its years at the rings)
         return np.mean(g <= s.pith_years()) > KNOT_BEND_MAX_BEFORE_PITH
 
     stem = fit_stem(obs, size_mm, seed=seed) if stem is None else stem
-    plain, field, only_pinned, rises = stem, stem, True, None
-    for r in range(rounds + 1):
-        g = stem(obs.points_mm)  # once per round: the check here and the bend's offset below
-        if r == 0 and falls(stem, g):
-            # the pith beyond the rings' side of most years (a far pith's straight rings fit
-            # either way): the bend starts from the stem whose growth time rises away from it
-            stem = fit_stem(obs, size_mm, seed=seed, outward=True, workers=workers)
-            g = stem(obs.points_mm)
-        if falls(stem, g):
-            return plain, False, {}  # no bend to speak of
-        if rises is None:  # the rises of the knots seen at one exit, in the first round's stem
-            rises = _ray_rises(exits, stem, obs, size_mm, cones, seed, near, workers)
-        strands = strands_from_exits(exits, stem, size_mm, cones, workers, rises=rises)
-        only_pinned &= all(s.pinned for s in strands)
-        if not any(s.pinned or guessed for s in strands):
-            return plain, False, rises
-        field = StemWithKnots(stem, strands, bend=KnotParams(), bend_guessed=guessed)
-        if r == rounds:
-            break
-        off = field(obs.points_mm) - g
-        stem = fit_stem(obs, size_mm, seed=seed, offset_years=off, init=stem)
-    return field, only_pinned, rises
+    plain, g = stem, stem(obs.points_mm)
+    if falls(stem, g):
+        # the pith beyond the rings' side of most years (a far pith's straight rings fit
+        # either way): the bend starts from the stem whose growth time rises away from it
+        stem = fit_stem(obs, size_mm, seed=seed, outward=True, workers=workers)
+        g = stem(obs.points_mm)
+    if falls(stem, g):
+        return plain, False, {}, frozenset()  # no bend to speak of
+
+    def bend(pairing):  # the fixed point with the knot ends paired as ``pairing`` prefers
+        s, field, only_pinned, rises = stem, plain, True, None
+        for r in range(rounds + 1):
+            g = s(obs.points_mm)  # once per round: the check here and the bend's offset below
+            if r and falls(s, g):
+                return plain, False, {}
+            if rises is None:  # the rises of the knots seen at one exit, in the first round's stem
+                rises = _ray_rises(exits, s, obs, size_mm, cones, seed, near, workers, pairing)
+            strands = strands_from_exits(exits, s, size_mm, cones, workers, rises=rises, prefer=pairing)
+            only_pinned &= all(x.pinned for x in strands)
+            if not any(x.pinned or guessed for x in strands):
+                return plain, False, rises
+            field = StemWithKnots(s, strands, bend=KnotParams(), bend_guessed=guessed)
+            if r == rounds:
+                break
+            s = fit_stem(obs, size_mm, seed=seed, offset_years=field(obs.points_mm) - g, init=s)
+        return field, only_pinned, rises
+
+    field, only_pinned, rises = bend(frozenset())
+    pairing: frozenset = frozenset()
+    alts = _pairings(exits, stem, size_mm, near_pairing, workers) \
+        if cones and exits and "surface" in exits[0] and isinstance(field, StemWithKnots) else []
+    if alts:  # another pairing whose cones cut the masks better: kept where the rings fit it better too
+        density = np.maximum(np.linalg.norm(central_gradient(stem, obs.points_mm, 0.25)[1], axis=1), 1e-6)
+        limit = (1.0 - KNOT_PAIRING_MIN_MISFIT_GAIN) * _ray_misfit(field, obs, density)
+        for alt in alts:
+            got = bend(alt)
+            if isinstance(got[0], StemWithKnots) and (cost := _ray_misfit(got[0], obs, density)) < limit:
+                limit, (field, only_pinned, rises), pairing = cost, got, alt
+    return field, only_pinned, rises, pairing
 
 
 def _memo_copy(memo: dict) -> dict:
@@ -890,8 +999,9 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
 
                 off = first(obs.points_mm) - first.stem(obs.points_mm)
                 start = fit_stem(obs, size_mm, seed=seed, offset_years=off, init=first.stem)
-            field, same, rises = _fit_knotted_stem(obs, size_mm, fold_exits(), KNOT_BEND_ROUNDS, seed, False,
-                                                   start if warm else plain(obs), cones, bent.get("rises"), cores)
+            field, same, rises, pairing = _fit_knotted_stem(obs, size_mm, fold_exits(), KNOT_BEND_ROUNDS, seed, False,
+                                                            start if warm else plain(obs), cones, bent.get("rises"),
+                                                            cores, bent.get("pairing"))
             if warm:
                 same = False  # the guessed bend starts from the plain stem: not the same steps
                 if not isinstance(field, StemWithKnots):  # no bend in this fold: the plain stem's
@@ -899,7 +1009,8 @@ def knot_bend_recipes(size_mm: ArrayLike, exits: list[dict], seed: int = 0, gues
             bent.update(obs=obs, field=field, same=same)
             if "first" not in bent:  # the all-faces fit: what every fold starts from (its stem,
                 # the rises of its rays and its cones)
-                bent.update(first=field, rises=rises, memo=_memo_copy(exits[0].get("cone_memo") or {}))
+                bent.update(first=field, rises=rises, pairing=pairing,
+                            memo=_memo_copy(exits[0].get("cone_memo") or {}))
         return bent["field"]
 
     def bent_guessed(obs):
