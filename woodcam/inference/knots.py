@@ -10,7 +10,10 @@ C and F). A branch starts on the pith, so the pairs whose line passes the stem's
 one of them (:data:`~woodcam.tolerances.KNOT_PAIR_MAX_MISS_SHARE`) are taken first, the line
 nearest it first, then the others, the nearest ends first (FIT_VERSION 17: in distance order
 alone a knot's exit paired with a knot cutting a block corner on dev seed 21 block 22 and seed
-50287 block 1). An unpaired end over two faces is a knot of its own. An end still unpaired then pairs
+50287 block 1). Another pairing (two pairs exchanging partners, or a pair taking an end left
+over) is kept where its cones cut the masks better and the bend fits the rings better
+(:func:`_pairings`, FIT_VERSION 26: dev seed 9101 block 5's two knots were crossed). An
+unpaired end over two faces is a knot of its own. An end still unpaired then pairs
 with an end already taken that lies nearer the pith when their line passes the pith
 (:data:`~woodcam.tolerances.KNOT_SHARE_MAX_MISS_MM`): a whorl's branches leave the pith
 together, so near it one exit can be two knots'.
@@ -689,22 +692,6 @@ def _ray_misfit(field, obs, density) -> float:
     return float(np.mean(np.minimum(err, KNOT_RAY_MISFIT_CAP_MM) ** 2))
 
 
-def _bend_misfit(strands, stem, obs, size_mm, seed: int, g0, density) -> float:
-    """The rings' misfit (:func:`_ray_misfit`) of ``stem`` bent round ``strands`` with the stem
-    refitted to that bend once. ``g0 (n,)``: ``stem``'s years at ``obs``'s points; ``density
-    (n,)``: its ring density there. The stem's fit absorbs a knot's bend into itself, so a bend
-    is judged after the stem is refitted to it (without that, no bend always won), by a quick
-    refit (:data:`~woodcam.tolerances.KNOT_RAY_REFIT_POINTS`): what a comparison needs, not a
-    fit. The stem given was fitted in full, so every arm compared, no bend too, is refitted
-    alike (the quick refit would start behind it)."""
-    from .stem import fit_stem
-
-    bent = StemWithKnots(stem, strands, bend=KnotParams())
-    refit = fit_stem(obs, size_mm, seed=seed, offset_years=bent(obs.points_mm) - g0, init=stem, history=False,
-                     n_fit=KNOT_RAY_REFIT_POINTS)
-    return _ray_misfit(StemWithKnots(refit, strands, bend=KnotParams()), obs, density)
-
-
 def _pairings(exits, stem, size_mm, near: frozenset | None = None, workers: int = 1) -> list[frozenset]:
     """Other pairings of the knot ends than the order of :func:`_strands` whose cones cut the
     masks better: each the pairs to take first (``prefer``), the least :func:`_cone_iou` of
@@ -762,8 +749,9 @@ def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int,
     its rise, and 10-20 degrees off puts its bend 1-2 cm off across a block (dev seeds 7777 and
     63311, three noisy faces, knotted blocks within 2 mm: the ray across the stem 63.7 %, the
     true knot's direction through the exit 76.5 %); the rings round the exit, on its face and
-    the others, are bent by where the knot really runs. Each rise is judged after the stem is
-    refitted to it (:func:`_bend_misfit`).
+    the others, are bent by where the knot really runs. The stem's fit absorbs a knot's bend
+    into itself, so each rise is judged after the stem is refitted to it (without that, no bend
+    always won), by a quick refit (:data:`~woodcam.tolerances.KNOT_RAY_REFIT_POINTS`).
 
     ``near``: rises found on more rings (a fold's fit starts from the all-faces fit's, as its
     stem does: :func:`knot_bend_recipes`): only those knots are tried, each at its rise and one
@@ -771,6 +759,8 @@ def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int,
     faces, five knots seen at one exit) from 7.3 to 20.4 s wall. ``workers``: processes each
     knot's cone starts may use (:func:`_fit_cone`). ``prefer``: the ends' pairing
     (:func:`_pairings`)."""
+    from .stem import fit_stem
+
     rises: dict[int, float] = {}
     full = np.deg2rad(KNOT_RAY_RISES_DEG)
     strands, info = _strands(exits, stem, size_mm, cones, workers, prefer=prefer)
@@ -797,7 +787,12 @@ def _ray_rises(exits, stem, obs, size_mm, cones: bool, seed: int,
             trial[lone[k]] = ray(k, rise)
             if trial[lone[k]] is None:  # no ray at that rise (along the face, or out by a face showing none)
                 return np.inf
-        return _bend_misfit(trial, stem, obs, size_mm, seed, g0, density)
+        bent = StemWithKnots(stem, trial, bend=KnotParams())
+        # every arm refitted alike, no bend too (the stem given was fitted in full: the quick
+        # refit would start behind it); the quick refit: what the comparison needs, not a fit
+        refit = fit_stem(obs, size_mm, seed=seed, offset_years=bent(obs.points_mm) - g0, init=stem, history=False,
+                         n_fit=KNOT_RAY_REFIT_POINTS)
+        return _ray_misfit(StemWithKnots(refit, trial, bend=KnotParams()), obs, density)
 
     now = cost()
     for k in lone:
