@@ -490,10 +490,10 @@ KNOT_SHARE_MAX_MISS_SHARE = 0.5
 #: of 9101/5 gained 0.096 (0.898 against 0.802).
 KNOT_PAIRING_MIN_IOU_GAIN = 0.02
 
-#: ... and where its bend leaves less misfit on the rings than the order's by this share
-#: (:func:`woodcam.inference.knots._bend_misfit`, a quick refit whose misfit moves a few per cent
-#: between pairings that change nothing: 63311/9's other pairing was 0.2 % better on the rings
-#: and 29 points worse inside; 9101/5's exchanged pairs were 31 % better).
+#: ... and where its bend, fitted in full, leaves less misfit on the rings than the order's by this
+#: share (:func:`woodcam.inference.knots.fit_knotted_stem`; the misfit moves a few per cent
+#: between pairings the rings cannot tell apart: 63311/9's other pairing was 0.2 % better on the
+#: rings and 29 points worse inside; 9101/5's exchanged pairs were 31 % better).
 KNOT_PAIRING_MIN_MISFIT_GAIN = 0.05
 
 #: Spacing (mm) at which the knot masks are sampled for a knot's cone fit

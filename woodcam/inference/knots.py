@@ -420,14 +420,14 @@ def strands_from_exits(exits: list[dict], stem: Callable, size_mm: ArrayLike,
 
 
 def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None,
-             prefer: frozenset = frozenset()) -> tuple[list[KnotStrand], dict]:
+             prefer: frozenset = frozenset(), iou: bool = False) -> tuple[list[KnotStrand], dict]:
     """:func:`strands_from_exits` and what :func:`_ray_rises` and :func:`_pairings` need of it:
     ``{"lone": exit index -> index of its strand, for each knot seen at one exit only (its
     strand a guess, or a ray whose rise ``rises`` gives), "ends": the knot ends (exit index
     tuples, :func:`_ends`), "pairs": [(end, end, IoU)] the ends paired, in order, each with its
-    cone's agreement with their masks (:func:`_cone_iou`; None without cones)}``. ``prefer``:
-    pairs of ends (frozensets of two exit index tuples) taken before every other pair
-    (:func:`_pairings`)."""
+    cone's agreement with their masks (:func:`_cone_iou`, with ``iou`` and cones; else None)}``.
+    ``prefer``: pairs of ends (frozensets of two exit index tuples) taken before every other
+    pair (:func:`_pairings`)."""
     if not exits:
         return [], {"lone": {}, "ends": [], "pairs": []}
     rises = rises or {}
@@ -463,7 +463,7 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None,
                  for order, dist, i, j, mi in pairs]
     pairs.sort(key=lambda q: q[:4])
     surface = exits[0].get("surface") if cones else None
-    agree: dict[tuple, float | None] = {}  # group -> its cone's IoU with the masks
+    agree: dict[tuple, float] = {}  # paired group -> its cone's IoU with the masks (``iou``)
     memo = exits[0].get("cone_memo")
 
     def place(group, anchors, starts, single=False):
@@ -479,7 +479,8 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None,
             ignore = np.concatenate([exits[k]["pixels"] for k in others]) if others else np.zeros(0, int)
             r0 = float(np.mean([exits[k]["radius_mm"] for k in group]))
             cone = _fit_cone(surface, positive, ignore, c0, starts, r0, memo=memo, workers=workers)
-            agree[tuple(group)] = _cone_iou(_cone_problem(surface, positive, ignore, c0, r0), cone)
+            if iou and not single:  # only :func:`_pairings` asks (each fit once, not every round)
+                agree[tuple(group)] = _cone_iou(_cone_problem(surface, positive, ignore, c0, r0), cone)
             # the radius along it as the masks show it, even thinning away from the pith: a branch
             # thickens outward (seed 003), but the masks pin the slope poorly and bounding it
             # moved the axis (FIT_VERSION 25, README "A knot seen at one corner")
@@ -653,12 +654,15 @@ def _clear_face_stop(start, end, radius, size, surface, exit_mm=None) -> np.ndar
     without a mask, or where the mask shows a knot, or it does not come out. ``surface``: the
     faces' mask samples ``(points (n, 3), knot (n,) bool)`` (:func:`knot_exits`)."""
     other = _far_end(start, end, start if exit_mm is None else exit_mm, size)
-    if other is None or np.min(np.minimum(np.abs(other), np.abs(size - other))) > 1e-6:
-        return None  # (or it ends inside the block)
+    if other is None:
+        return None
+    gap = np.minimum(np.abs(other), np.abs(size - other))  # mm from each pair of opposite faces
+    if gap.min() > 1e-6:
+        return None  # it ends inside the block
     pts, knot = surface
     r = radius(other)
     w = (end - start) / np.linalg.norm(end - start)
-    ax = int(np.argmin(np.minimum(np.abs(other), np.abs(size - other))))  # the face it leaves by
+    ax = int(np.argmin(gap))  # the face it leaves by
     face = np.flatnonzero(np.abs(pts[:, ax] - other[ax]) < 1e-6)  # (not a neighbour's samples by the edge)
     seen = face[np.linalg.norm(pts[face] - other, axis=1) < max(r, 2.0 * KNOT_CONE_SAMPLE_MM)]
     if not len(seen) or knot[seen].any():
@@ -711,10 +715,12 @@ def _pairings(exits, stem, size_mm, near: frozenset | None = None, workers: int 
     a pair taking an end the order left unpaired. ``near``: the pairing the all-faces fit chose
     (a fold: :func:`knot_bend_recipes`), the only one tried, as a fold's rises are searched
     near the all-faces fit's."""
-    _, info = _strands(exits, stem, size_mm, True, workers)
+    if near is not None and not near:  # a fold of a fit that kept the order: nothing to try
+        return []
+    _, info = _strands(exits, stem, size_mm, True, workers, iou=True)
     base = info["pairs"]
     if near is not None:
-        alts = [near] if near else []
+        alts = [near]
     else:
         alts = []
         for (a, b, _), (c, d, _) in itertools.combinations(base, 2):
@@ -728,7 +734,7 @@ def _pairings(exits, stem, size_mm, near: frozenset | None = None, workers: int 
 
     seen, least, better = [{frozenset(q[:2]) for q in base}], worst(base) + KNOT_PAIRING_MIN_IOU_GAIN, []
     for alt in alts:
-        got = _strands(exits, stem, size_mm, True, workers, prefer=alt)[1]["pairs"]
+        got = _strands(exits, stem, size_mm, True, workers, prefer=alt, iou=True)[1]["pairs"]
         if (pairs := {frozenset(q[:2]) for q in got}) not in seen:  # another pairing, tried once
             seen.append(pairs)
             if worst(got) >= least:
