@@ -40,7 +40,9 @@ import json
 import logging
 import os
 import re
+import shutil
 import sys
+import tempfile
 import time
 import traceback
 from dataclasses import dataclass
@@ -271,9 +273,9 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
     todo = [k for k in keys if k not in done_before]
     skipped = len(keys) - len(todo)
 
-    client = cluster = None
+    client = cluster = scratch = None
     if todo and engine == "dask":  # connect first: a bad address fails before any progress bar
-        client, cluster = _dask_client(address, workers, memory_limit_mb, connect_timeout_s)
+        client, cluster, scratch = _dask_client(address, workers, memory_limit_mb, connect_timeout_s)
 
     from tqdm.auto import tqdm
 
@@ -304,6 +306,8 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
             client.close()
         if cluster is not None:
             cluster.close()
+        if scratch is not None:
+            shutil.rmtree(scratch, ignore_errors=True)
     return RunSummary(out_dir, engine, n_workers, len(keys), skipped, counts["ok"],
                       counts["failed"], time.perf_counter() - t0)
 
@@ -335,24 +339,34 @@ def _run_local(fn, todo, n_workers, retries, memory_limit_mb, finish) -> None:
 
 
 def _dask_client(address, workers, memory_limit_mb, connect_timeout_s):
-    """``(client, cluster or None)``: a client of the scheduler at ``address``, or of a new
-    loopback LocalCluster of ``workers`` single-threaded processes."""
+    """``(client, cluster or None, scratch directory or None)``: a client of the scheduler at
+    ``address``, or of a new loopback LocalCluster of ``workers`` single-threaded processes."""
     from .errors import require
 
     require("distributed", "scale", "running tasks on Dask")
     from distributed import Client, LocalCluster
 
     if address is None:
-        cluster = LocalCluster(
-            n_workers=2 if workers is None else workers, threads_per_worker=1, processes=True,
-            host="127.0.0.1", dashboard_address=None,
-            memory_limit=f"{memory_limit_mb}MiB" if memory_limit_mb else 0,
-            # the cluster's own log lines (and its shutdown races) would bury the progress bar;
-            # a task's errors come back in its record, a lost worker as a failed record
-            silence_logs=logging.CRITICAL)
-        return Client(cluster), cluster
+        # the workers' spill and lock files in a directory of this run, removed with the cluster:
+        # dask's default, dask-scratch-space in the shared temp directory, outlived every run
+        scratch = tempfile.mkdtemp(prefix="woodcam-dask-")
+        import dask
+
+        try:
+            with dask.config.set({"temporary-directory": scratch}):  # the scheduler's, made in this process
+                cluster = LocalCluster(
+                    n_workers=2 if workers is None else workers, threads_per_worker=1, processes=True,
+                    host="127.0.0.1", dashboard_address=None, local_directory=scratch,
+                    memory_limit=f"{memory_limit_mb}MiB" if memory_limit_mb else 0,
+                    # the cluster's own log lines (and its shutdown races) would bury the progress bar;
+                    # a task's errors come back in its record, a lost worker as a failed record
+                    silence_logs=logging.CRITICAL)
+        except BaseException:
+            shutil.rmtree(scratch, ignore_errors=True)
+            raise
+        return Client(cluster), cluster, scratch
     try:
-        return Client(address, timeout=connect_timeout_s), None
+        return Client(address, timeout=connect_timeout_s), None, None
     except (OSError, TimeoutError) as err:
         raise WoodcamError(
             f"address: no Dask scheduler answered at {address} within {connect_timeout_s:g} s "

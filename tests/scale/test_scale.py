@@ -149,6 +149,19 @@ def test_memory_limit_per_local_worker(tmp_path):
     assert s.done == 1
 
 
+def test_local_dask_cluster_leaves_nothing_in_the_temp_directory(tmp_path, monkeypatch):
+    # dask's default scratch space (dask-scratch-space with its lock files) outlived every run
+    import tempfile
+
+    temp = tmp_path / "temp"
+    temp.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(temp))
+    s = run_many(tasks.value_of, ["k1", "k2", "k3"], tmp_path / "run", engine="dask", workers=2, progress=False)
+    assert (s.done, s.failed) == (3, 0)
+    assert [r["result"] for r in read_records(tmp_path / "run").values()] == [tasks.value_of(k) for k in ("k1", "k2", "k3")]
+    assert list(temp.iterdir()) == []
+
+
 def test_unreachable_address_is_one_clear_error(tmp_path):
     with pytest.raises(WoodcamError, match=r"address: no Dask scheduler answered at tcp://127\.0\.0\.1:9"):
         run_many(tasks.value_of, ["k1"], tmp_path, engine="dask", address="tcp://127.0.0.1:9",
