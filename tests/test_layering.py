@@ -18,6 +18,7 @@ LAYERS: dict[str, int] = {
     "_readers": 2,                     # strict JSON and images of untrusted files (errors, limits)
     "_threads": 1,                     # BLAS thread limits for small linear algebra
     "_parallel": 1,                    # one fit on a machine's cores: forked pieces
+    "_progress": 1,                    # progress bars (tqdm only), on a terminal
     "_xatlas_worker": 1,               # xatlas in a worker process (numpy + xatlas only)
     "_raster": 1,                      # numba rasteriser of the bake (numpy + numba only)
     "frames": 3,                       # block frame, faces, pixel <-> block

@@ -715,9 +715,9 @@ def _rasterise(xy: np.ndarray, faces: np.ndarray, width: int, height: int, *,
     chunks = np.linspace(0, len(faces), min(len(faces), 16) + 1).astype(np.int64)
     steps = list(zip(chunks[:-1], chunks[1:]))
     if progress:
-        from tqdm import tqdm
+        from ._progress import progress_bar
 
-        steps = tqdm(steps, desc="rasterise", unit="chunk")
+        steps = progress_bar(steps, desc="rasterise", unit="chunk")
     for first, last in steps:
         rasterise_kernel(p, valid, int(width), int(height), float(reach), int(first), int(last),
                          owner, best_out, best_tri)

@@ -448,10 +448,10 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
     for kind in ("clear", "knotted"):
         sample += [r["result"]["index"] for r in records.values()
                    if r["status"] == "ok" and r["result"]["kind"] == kind][:thumbnails]
-    from tqdm.auto import tqdm
+    from ._progress import progress_bar
 
-    for i in tqdm(picks + [i for i in sample if i not in picks], desc="gallery", unit="block",
-                  disable=not progress):  # the worst are refitted; the sample only drawn
+    for i in progress_bar(picks + [i for i in sample if i not in picks], desc="gallery", unit="block",
+                          enabled=progress):  # the worst are refitted; the sample only drawn
         bench_gallery(run["seed"], i, run["settings"], out / "gallery", planes=i in picks)
     s["gallery"] = picks
     return s

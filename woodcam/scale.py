@@ -241,7 +241,7 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
         Per worker (MiB): an address-space cap of each local worker process, the
         ``memory_limit`` of each LocalCluster worker. None: no cap.
     progress : bool
-        A tqdm bar with rate and ETA on stderr.
+        A tqdm bar with rate and ETA on stderr (on a terminal: woodcam._progress).
 
     Returns
     -------
@@ -277,10 +277,10 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
     if todo and engine == "dask":  # connect first: a bad address fails before any progress bar
         client, cluster, scratch = _dask_client(address, workers, memory_limit_mb, connect_timeout_s)
 
-    from tqdm.auto import tqdm
+    from ._progress import progress_bar
 
-    bar = tqdm(total=len(keys), initial=skipped, desc=desc, unit="task", smoothing=0.1,
-               disable=not progress, dynamic_ncols=True)
+    bar = progress_bar(total=len(keys), initial=skipped, desc=desc, unit="task", smoothing=0.1,
+                       enabled=progress, dynamic_ncols=True)
     counts = {"ok": 0, "failed": 0}
 
     def finish(rec: dict) -> None:

@@ -300,9 +300,9 @@ def train_translation(pairs, spec: TranslationSpec | None = None, *, progress: b
     opt = torch.optim.Adam(net.parameters(), lr=spec.lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, spec.steps, eta_min=0.05 * spec.lr)
     order = torch.from_numpy(rng.permutation(np.resize(np.arange(len(X)), spec.steps * spec.batch)))
-    from tqdm.auto import tqdm
+    from .._progress import progress_bar
 
-    bar = tqdm(range(spec.steps), desc=desc, disable=not progress, leave=False, unit="step")
+    bar = progress_bar(range(spec.steps), desc=desc, unit="step", enabled=progress, leave=False)
     tail = []
     net.train()
     for s in bar:

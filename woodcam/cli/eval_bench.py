@@ -57,7 +57,7 @@ def register(subparsers) -> None:
 def run_realistic(args) -> int:
     import json
 
-    from tqdm.auto import tqdm
+    from .._progress import progress_bar, write
 
     from .._atomic import write_text
     from ..bench_realistic import FACE_SETS, SCENARIOS, confidence_markdown, markdown, score_block, summarise
@@ -75,7 +75,7 @@ def run_realistic(args) -> int:
              for kind, n in (("realistic", args.count), ("eq79", args.eq79)) for i in range(n)]
     rows = []
     plots = args.plots or args.confidence
-    for kind, i, s, f in tqdm(tasks, desc="benchmark blocks", unit="block"):
+    for kind, i, s, f in progress_bar(tasks, desc="benchmark blocks", unit="block"):
         row = score_block(args.seed, i, methods, s, f, kind, face_px=args.face_px, keep_lines=plots,
                           knot_bend=args.knot_bend, knot_cones=args.knot_cones, residual=args.residual)
         if plots:
@@ -85,7 +85,7 @@ def run_realistic(args) -> int:
                         title=f"{row['name']} ({row['kind']}, {s}, {f}): black = true rings",
                         confidence=args.confidence)
         rows.append(row)
-        tqdm.write(f"{row['name']} {row['kind']} {s} {f}: " + ", ".join(
+        write(f"{row['name']} {row['kind']} {s} {f}: " + ", ".join(
             f"{m} {row[m]['matched_1']:.0f}/{row[m]['matched_2']:.0f}% {row[m]['fit_s']:.1f}s" for m in methods))
         write_text(out / "records.json", json.dumps(rows, indent=1))
     table = markdown(summarise(rows, methods), methods)

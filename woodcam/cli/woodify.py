@@ -277,7 +277,7 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
 def run(args) -> int:
     """Run a parsed ``woodify`` command; returns the exit status."""
     import numpy as np
-    from tqdm import tqdm
+    from .._progress import progress_bar
 
     from ..woodify import load_brushes, woodify
 
@@ -285,7 +285,7 @@ def run(args) -> int:
     if not (np.isfinite(args.years) and args.years > 0):
         raise WoodcamError(f"--years must be > 0 (years to grow); got {args.years:g}")
     up = _vec(args.up, "--up")
-    steps = tqdm(total=4, desc="woodify", unit="stage", leave=False)
+    steps = progress_bar(total=4, desc="woodify", unit="stage", leave=False)
     mesh, textured, painted = _load_mesh(args.part)
     obstacles = [_load_mesh(str(o))[0] for o in args.obstacle]
     brushes = load_brushes(args.brushes) if args.brushes else ()

@@ -105,7 +105,7 @@ def detect_block(block: Block, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool
     ``curved``: as :func:`detect_face`.
     Returns the block and the warnings (each names its face).
     """
-    from tqdm.auto import tqdm
+    from .._progress import progress_bar
 
     out = copy.copy(block)
     out.faces = dict(block.faces)
@@ -115,7 +115,7 @@ def detect_block(block: Block, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool
         raise WoodcamError(f"block {block.name!r} has no face photos to detect rings on; "
                            f"make the block with 'woodcam block from-photos'")
     msgs: list[str] = []
-    for name in tqdm(names, desc="detecting rings", unit="face", delay=2.0, disable=not progress):
+    for name in progress_bar(names, desc="detecting rings", unit="face", enabled=progress):
         px_mm = block.face_pixel_size_mm(name)
         out.faces[name], w = detect_face(block.faces[name], 1.0 / min(px_mm), rule, knots, detector, curved)
         msgs += w

@@ -185,7 +185,7 @@ def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, 
     write ``rings_spec.json``, ``rings.pt`` and ``rings_train_log.csv`` to ``out_dir``.
     Returns ``{"steps", "train_s", "final_loss", "params"}``."""
     torch = require("torch", "learn", "training the ring net")
-    from tqdm.auto import tqdm
+    from .._progress import progress_bar
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -202,7 +202,7 @@ def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, 
     c = spec.crop_px
     t0 = time.perf_counter()
     rows, loss_avg, step = [], None, 0
-    bar = tqdm(range(spec.steps), desc="training ring net", unit="step", disable=not progress)
+    bar = progress_bar(range(spec.steps), desc="training ring net", unit="step", enabled=progress)
     for step in bar:
         idx = rng.integers(0, n, spec.batch)
         r0 = rng.integers(0, h - c + 1, spec.batch)

@@ -414,8 +414,8 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
 
     bar = None
     if progress:
-        from tqdm import tqdm
-        bar = tqdm(total=total, initial=min(step, total), desc="train gtf", unit="step")
+        from .._progress import progress_bar
+        bar = progress_bar(total=total, initial=min(step, total), desc="train gtf", unit="step")
     t0 = time.perf_counter()
     base = elapsed
     n_f, n_p = spec.n_fields, spec.points_per_field

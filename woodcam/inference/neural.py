@@ -514,8 +514,8 @@ def _adam(torch, opt, w, loss_fn, steps, progress, desc):
     base_lrs = [g["lr"] for g in opt.param_groups]
     it = range(steps)
     if progress:
-        from tqdm import tqdm
-        it = tqdm(it, desc=desc, unit="step")
+        from .._progress import progress_bar
+        it = progress_bar(it, desc=desc, unit="step")
     for i in it:
         scale = 0.5 * (1 + np.cos(np.pi * i / max(steps, 1)))
         for grp, lr in zip(opt.param_groups, base_lrs):

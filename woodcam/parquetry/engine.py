@@ -306,9 +306,9 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
 
     bar = None
     if progress:
-        from tqdm import tqdm
+        from .._progress import progress_bar
 
-        bar = tqdm(total=planned_cells, desc="matching patches", unit="cell")
+        bar = progress_bar(total=planned_cells, desc="matching patches", unit="cell")
     t0, c0 = time.perf_counter(), time.process_time()
     message = ""
     try:

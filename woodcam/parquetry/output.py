@@ -148,9 +148,9 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
     sheets_used = sorted({pc.sheet for pc in pieces})
     it = sheets_used
     if progress and len(sheets_used) > 1:
-        from tqdm import tqdm
+        from .._progress import progress_bar
 
-        it = tqdm(sheets_used, desc="writing cut files", unit="sheet")
+        it = progress_bar(sheets_used, desc="writing cut files", unit="sheet")
     for i in it:
         v = run.veneers[i]
         W, H = v.size_mm

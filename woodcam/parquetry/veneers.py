@@ -215,9 +215,9 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
     sheets = []
     it = range(n_sheets)
     if progress:
-        from tqdm import tqdm
+        from .._progress import progress_bar
 
-        it = tqdm(it, desc="slicing veneers", unit="sheet")
+        it = progress_bar(it, desc="slicing veneers", unit="sheet")
     for k in it:
         turned = k % 2 == 1
         s = start + k * pitch + (thickness_mm if turned else 0.0)

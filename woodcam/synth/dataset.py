@@ -82,7 +82,7 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
     list of Path
         The block folders, in order.
     """
-    from tqdm.auto import tqdm
+    from .._progress import progress_bar
 
     if count < 1:
         raise WoodcamError(f"count must be >= 1; got {count!r}")
@@ -94,8 +94,7 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
              "ring_width_range_mm": list(ring_width_range_mm),
              "knotted_available": log_fields is not None, "blocks": []}
     folders = []
-    # tqdm's delay keeps the bar hidden for runs shorter than ~2 s.
-    for i in tqdm(range(count), desc="synthesising blocks", unit="block", delay=2.0, disable=not progress):
+    for i in progress_bar(range(count), desc="synthesising blocks", unit="block", enabled=progress):
         block, info = benchmark_set_block(
             seed, i, face_px=face_px, size_range_mm=size_range_mm,
             ring_width_range_mm=ring_width_range_mm, log_fields=log_fields,

@@ -67,12 +67,12 @@ def ring_training_faces(spec, progress: bool = False) -> tuple[np.ndarray, np.nd
     by :func:`woodcam.detect.learned.augment_photo`; targets ``exp(-(d / sigma)^2)`` of the
     distance ``d`` (px) to the true ring lines, ``sigma = spec.target_sigma_px``. The faces'
     colour is ``spec.style`` (:attr:`~woodcam.detect.learned.RingNetSpec.style`)."""
-    from tqdm.auto import tqdm
+    from .._progress import progress_bar
 
     from ..detect.learned import augment_photo, net_input
 
     xs, ys = [], []
-    for i in tqdm(range(spec.n_blocks), desc="synthesising faces", unit="block", disable=not progress):
+    for i in progress_bar(range(spec.n_blocks), desc="synthesising faces", unit="block", enabled=progress):
         rng = np.random.default_rng([spec.seed, i, 7])
         size = (50.0, 50.0, 50.0)
         pattern = PATTERNS[i % len(PATTERNS)]

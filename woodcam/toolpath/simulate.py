@@ -299,9 +299,9 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     cells = 0
     it = runs
     if progress:
-        from tqdm import tqdm
+        from .._progress import progress_bar
 
-        it = tqdm(runs, desc="simulate", unit="run")
+        it = progress_bar(runs, desc="simulate", unit="run")
     for run in it:
         if not len(run):
             continue
