@@ -57,9 +57,8 @@ def register(subparsers) -> None:
 def run_realistic(args) -> int:
     import json
 
-    from .._progress import progress_bar, write
-
     from .._atomic import write_text
+    from .._progress import progress_bar, write
     from ..bench_realistic import FACE_SETS, SCENARIOS, confidence_markdown, markdown, score_block, summarise
 
     methods, scenarios, faces = _list(args.methods), _list(args.scenarios), _list(args.faces)
