@@ -201,6 +201,9 @@ def test_export_errors_are_clear(baked, tmp_path):
     with pytest.raises(WoodcamError, match="is not a glTF 2.0 binary"):
         (tmp_path / "bad.glb").write_bytes(b"\0" * 32)
         read_glb_metadata(tmp_path / "bad.glb")
+    with pytest.raises(WoodcamError, match="is 7 bytes, too short to be a GLB file .* pass a .glb"):
+        (tmp_path / "short.glb").write_bytes(b"garbage")
+        read_glb_metadata(tmp_path / "short.glb")
     with pytest.raises(WoodcamError, match="no file at"):
         load_textured(tmp_path / "missing.glb")
 

@@ -446,7 +446,8 @@ def read_glb_metadata(path: PathLike) -> dict:
     except OSError as err:
         raise WoodcamError(f"read_glb_metadata: cannot read {str(path)!r} ({err.strerror})") from err
     if len(data) < 20:
-        raise WoodcamError(f"read_glb_metadata: {str(path)!r} is too short to be a GLB file")
+        raise WoodcamError(f"read_glb_metadata: {str(path)!r} is {len(data)} bytes, too short to be a GLB file "
+                           f"(its headers alone take 20); pass a .glb written by woodcam bake or another glTF exporter")
     magic, version, _length = struct.unpack_from("<III", data, 0)
     chunk_len, chunk_type = struct.unpack_from("<II", data, 12)
     if magic != _GLB_MAGIC or version != 2 or chunk_type != _GLB_CHUNK_JSON:
