@@ -344,14 +344,14 @@ def _dask_client(address, workers, memory_limit_mb, connect_timeout_s):
     from .errors import require
 
     require("distributed", "scale", "running tasks on Dask")
+    import dask
     from distributed import Client, LocalCluster
 
     if address is None:
         # the workers' spill and lock files in a directory of this run, removed with the cluster:
         # dask's default, dask-scratch-space in the shared temp directory, outlived every run
         scratch = tempfile.mkdtemp(prefix="woodcam-dask-")
-        import dask
-
+        cluster = None
         try:
             with dask.config.set({"temporary-directory": scratch}):  # the scheduler's, made in this process
                 cluster = LocalCluster(
@@ -361,10 +361,12 @@ def _dask_client(address, workers, memory_limit_mb, connect_timeout_s):
                     # the cluster's own log lines (and its shutdown races) would bury the progress bar;
                     # a task's errors come back in its record, a lost worker as a failed record
                     silence_logs=logging.CRITICAL)
-        except BaseException:
+            return Client(cluster), cluster, scratch
+        except BaseException:  # a cluster or client that failed to start leaves no process or file behind
+            if cluster is not None:
+                cluster.close()
             shutil.rmtree(scratch, ignore_errors=True)
             raise
-        return Client(cluster), cluster, scratch
     try:
         return Client(address, timeout=connect_timeout_s), None, None
     except (OSError, TimeoutError) as err:
