@@ -32,7 +32,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._atomic import atomic_path, write_text
+from .._atomic import atomic_path, write_bytes, write_text
 from .._cache import cache_dir, digest, load_or_build
 from ..block.block import Block, Face
 from ..errors import WoodcamError, WoodcamWarning
@@ -209,7 +209,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     out.mkdir(parents=True, exist_ok=True)
     if out.resolve() != src.resolve():
         for name, svg in edited.items():     # carry the user's SVG over unchanged
-            (out / svg.name).write_bytes(svg.read_bytes())
+            write_bytes(out / svg.name, svg.read_bytes())
     manifest = write_block(block, out)
     m = json.loads(manifest.read_text())
     hashes = {}

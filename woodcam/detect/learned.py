@@ -29,6 +29,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from .._atomic import atomic_path, atomic_write, write_text
 from ..errors import WoodcamError, require
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
@@ -87,7 +88,7 @@ class RingNetSpec:
         return cls(**d)
 
     def save(self, path) -> None:
-        Path(path).write_text(json.dumps(asdict(self), indent=1))
+        write_text(path, json.dumps(asdict(self), indent=1))
 
 
 def _net(spec: RingNetSpec):
@@ -227,10 +228,9 @@ def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, 
             break
     train_s = time.perf_counter() - t0
     spec.save(out / SPEC_NAME)
-    tmp = out / f".{WEIGHTS_NAME}.tmp"
-    torch.save({k: v.detach().clone() for k, v in net.state_dict().items()}, tmp)
-    tmp.replace(out / WEIGHTS_NAME)
-    with open(out / LOG_NAME, "w", newline="") as fh:
+    with atomic_path(out / WEIGHTS_NAME) as tmp:
+        torch.save({k: v.detach().clone() for k, v in net.state_dict().items()}, tmp)
+    with atomic_write(out / LOG_NAME, "w", newline="") as fh:
         wr = csv.DictWriter(fh, ["step", "loss", "loss_avg", "seconds"])
         wr.writeheader()
         wr.writerows(rows)
