@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._atomic import atomic_path, write_text
 from .errors import WoodcamError
 
 if TYPE_CHECKING:
@@ -411,7 +412,8 @@ def _plot(s: dict, path: Path) -> Path:
         ax.set_title(f"{label}: mean over blocks, 95 % bootstrap CI")
         ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.08))
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with atomic_path(path) as tmp:  # a half-written picture never replaces a whole one
+        fig.savefig(tmp, dpi=110, format=Path(path).suffix.lstrip('.') or 'png')
     plt.close(fig)
     return path
 
@@ -432,9 +434,7 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
     s = summarise_bench(read_records(run_dir))
     out.mkdir(parents=True, exist_ok=True)
     write_json_atomic(out / "report.json", {"seed": run["seed"], "settings": run["settings"], **s})
-    tmp = out / ".report.md.tmp"
-    tmp.write_text(_markdown(s, run))
-    tmp.replace(out / "report.md")
+    write_text(out / "report.md", _markdown(s, run))
     _plot(s, out / "table1.png")
     # the gallery: worst distinct blocks first, then a sample of each kind as thumbnails
     worst = sorted({(w["matched_1"], w["index"]) for label in s["worst"] for rows in s["worst"][label].values()
@@ -540,7 +540,6 @@ TRAINING_SHARD_FIELDS = 256
 
 def _training_shard_task(key: str, spec: dict, shard_fields: int, out_dir: str) -> dict:
     """Write shard ``key`` (``shard_0003``) of the training set of ``spec`` as an npz."""
-    from ._atomic import atomic_path
     from .fields.neural import GTFSpec, make_training_shard
 
     sp = GTFSpec.from_dict(spec)

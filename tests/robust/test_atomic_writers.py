@@ -4,9 +4,11 @@ A static check over the package's source: a writer that opens its target directl
 truncated file behind on Ctrl-C or a crash (the brief: "every file write is atomic"), and a
 review found three that did (the ring net's spec, weights and training log, and the copy of a
 user's corrected SVG). The rule: ``open(..., "w"/"a"/"x")``, ``Path.write_text``,
-``Path.write_bytes``, ``np.save*`` and ``torch.save`` may only write to a name bound by
-``with atomic_path(...) as name`` or ``with atomic_files(...) as names`` (or an item of it);
-everything else calls ``woodcam._atomic.write_text`` / ``write_bytes`` / ``atomic_write``.
+``Path.write_bytes``, matplotlib's ``savefig``, ``np.save*`` and ``torch.save`` may only write
+to a temporary of ``with atomic_path(...) as tmp`` / ``atomic_files(...)`` / ``atomic_write(...)``
+in the same function (or its parameter ``tmp``, the caller's temporary); everything else calls
+``woodcam._atomic.write_text`` / ``write_bytes``. PIL's ``Image.save`` is not checked (its
+receiver's type is not known statically): those writers save into a ``BytesIO`` or a temporary.
 """
 
 from __future__ import annotations
@@ -35,13 +37,13 @@ def _callee(node: ast.expr) -> str:
     return ""
 
 
-def _bound_temporaries(tree: ast.AST) -> set[str]:
+def _bound_temporaries(tree: ast.AST, names: set[str]) -> set[str]:
     """Names that hold an atomic temporary: bound by ``with atomic_path(...) as name`` /
     ``atomic_files(...) as names`` / ``atomic_write(...) as fh``, by ``with open(temporary) as
     fh``, by a ``for`` loop over temporaries, or the parameter of a ``lambda`` handed to an
-    ``..._atomic..`` helper (which calls it with its temporary). Module-wide, not per scope:
-    a temporary's name is not reused for a final path in this package."""
-    names: set[str] = set()
+    ``..._atomic..`` helper (which calls it with its temporary), within ``tree`` (a function: its
+    own temporaries); ``names``: those known before (a function's parameter ``tmp``)."""
+    names = set(names)
     for _ in range(3):  # a file opened on a temporary, a loop over them: bound after the first pass
         for node in ast.walk(tree):
             if isinstance(node, (ast.With, ast.AsyncWith)):
@@ -73,40 +75,57 @@ def _write_mode(call: ast.Call) -> bool:
     return isinstance(mode, ast.Constant) and isinstance(mode.value, str) and any(c in mode.value for c in "wax+")
 
 
-def raw_writes(source: str) -> list[tuple[int, str]]:
-    """``(line, what)`` of every write in ``source`` that does not go to an atomic temporary."""
-    tree = ast.parse(source)
-    temps = _bound_temporaries(tree)
-    found = []
-    for node in ast.walk(tree):
+def _writes(scope: ast.AST):
+    """``(call, target, what)`` of the write calls in ``scope`` (not inside functions nested in it)."""
+    todo = list(ast.iter_child_nodes(scope))
+    while todo:
+        node = todo.pop()
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            continue  # its own scope
+        todo += ast.iter_child_nodes(node)
         if not isinstance(node, ast.Call):
             continue
-        f, target, what = node.func, None, None
+        f = node.func
         if isinstance(f, ast.Name) and f.id == "open" and node.args and _write_mode(node):
-            target, what = node.args[0], "open(..., write mode)"
+            yield node, node.args[0], "open(..., write mode)"
         elif isinstance(f, ast.Attribute) and f.attr in ("write_text", "write_bytes"):
-            target, what = f.value, f".{f.attr}()"
+            yield node, f.value, f".{f.attr}()"
+        elif isinstance(f, ast.Attribute) and f.attr == "savefig" and node.args:
+            yield node, node.args[0], ".savefig()"
         elif isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and f.value.id in ("np", "numpy") \
                 and f.attr in _NUMPY_SAVES and node.args:
-            target, what = node.args[0], f"np.{f.attr}()"
+            yield node, node.args[0], f"np.{f.attr}()"
         elif isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and f.value.id == "torch" \
                 and f.attr == "save" and len(node.args) > 1:
-            target, what = node.args[1], "torch.save()"
-        if what is not None and not _is_temporary(target, temps):
-            found.append((node.lineno, what))
-    return found
+            yield node, node.args[1], "torch.save()"
+
+
+def raw_writes(source: str) -> list[tuple[int, str]]:
+    """``(line, what)`` of every write in ``source`` that does not go to an atomic temporary of
+    its own function (a parameter named ``tmp`` is the caller's temporary, by convention)."""
+    tree = ast.parse(source)
+    found = []
+    for scope in [tree] + [n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))]:
+        params = () if isinstance(scope, ast.Module) else scope.args.args + scope.args.kwonlyargs
+        temps = _bound_temporaries(scope, {a.arg for a in params if a.arg == "tmp"})
+        found += [(call.lineno, what) for call, target, what in _writes(scope) if not _is_temporary(target, temps)]
+    return sorted(found)
 
 
 def test_the_check_finds_a_direct_write_and_passes_an_atomic_one():
-    bad = "from pathlib import Path\nPath('x').write_text('a')\nwith open('y', 'w') as fh: pass\nnp.save('z', a)\n"
-    assert sorted(w for _, w in raw_writes(bad)) == [".write_text()", "np.save()", "open(..., write mode)"]
+    bad = ("from pathlib import Path\nPath('x').write_text('a')\nwith open('y', 'w') as fh: pass\nnp.save('z', a)\n"
+           "def f(p):\n    with atomic_path(p) as tmp:\n        pass\n"
+           "def g(out):\n    tmp = out / '.x.tmp'\n    tmp.write_text('a')\n    fig.savefig(out)\n")
+    assert [w for _, w in raw_writes(bad)] == [".write_text()", "open(..., write mode)", "np.save()", ".write_text()",
+                                               ".savefig()"]
     good = ("with atomic_path(p) as tmp:\n    tmp.write_text('a')\n    np.savez(tmp, a=1)\n"
             "with atomic_files([p, q]) as temps:\n    open(temps[0], 'wb').close()\n"
             "with atomic_write(p) as fh:\n    np.savez_compressed(fh, a=1)\n"
             "with atomic_path(p) as tmp, open(tmp, 'wb') as fh:\n    np.save(fh, a)\n"
             "for t in temps[1:]:\n    t.write_bytes(b'')\n"
             "_atomic(p, lambda q: q.write_text('a'))\n"
-            "with open(p) as fh: pass\nwrite_text(p, 'a')\n")
+            "with open(p) as fh: pass\nwrite_text(p, 'a')\n"
+            "def h(value, tmp):\n    np.savez(tmp, a=value)\n")
     assert raw_writes(good) == []
 
 
