@@ -7,7 +7,9 @@ user's corrected SVG). The rule: ``open(..., "w"/"a"/"x")``, ``Path.write_text``
 ``Path.write_bytes``, matplotlib's ``savefig``, ``np.save*`` and ``torch.save`` may only write
 to a temporary of ``with atomic_path(...) as tmp`` / ``atomic_files(...)`` / ``atomic_write(...)``
 in the same function (or its parameter ``tmp``, the caller's temporary); everything else calls
-``woodcam._atomic.write_text`` / ``write_bytes``. PIL's ``Image.save`` is not checked (its
+``woodcam._atomic.write_text`` / ``write_bytes``, and no writer renames a temporary of its own
+(``tempfile.mkstemp``, ``os.replace``: the parquetry outputs were written so, with mode 0600,
+unreadable to anyone else). PIL's ``Image.save`` is not checked (its
 receiver's type is not known statically): those writers save into a ``BytesIO`` or a temporary.
 """
 
@@ -26,6 +28,10 @@ _NOT_OUTPUTS = {
     "_atomic.py": "the helpers themselves",
     "toolpath/linuxcnc.py": "the program handed to LinuxCNC, in a private temporary directory",
     "toolpath/_linuxcnc_driver.py": "LinuxCNC's ini, parameter and tool files, in that directory",
+}
+#: Single writes allowed elsewhere, each with why: (module, what) -> reason.
+_ALLOWED = {
+    ("benchmark.py", "os.replace()"): "a whole block folder swapped into place (_atomic writes files)",
 }
 
 
@@ -98,6 +104,12 @@ def _writes(scope: ast.AST):
         elif isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and f.value.id == "torch" \
                 and f.attr == "save" and len(node.args) > 1:
             yield node, node.args[1], "torch.save()"
+        elif isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and \
+                (f.value.id, f.attr) in (("os", "replace"), ("os", "rename"), ("tempfile", "mkstemp")):
+            yield node, None, f"{f.value.id}.{f.attr}()"  # a temp + rename of its own: _atomic's job
+        elif isinstance(f, ast.Attribute) and f.attr in ("replace", "rename") and isinstance(f.value, ast.Name) \
+                and "tmp" in f.value.id and len(node.args) == 1:
+            yield node, None, f".{f.attr}() of a temporary"
 
 
 def raw_writes(source: str) -> list[tuple[int, str]]:
@@ -108,16 +120,19 @@ def raw_writes(source: str) -> list[tuple[int, str]]:
     for scope in [tree] + [n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))]:
         params = () if isinstance(scope, ast.Module) else scope.args.args + scope.args.kwonlyargs
         temps = _bound_temporaries(scope, {a.arg for a in params if a.arg == "tmp"})
-        found += [(call.lineno, what) for call, target, what in _writes(scope) if not _is_temporary(target, temps)]
+        found += [(call.lineno, what) for call, target, what in _writes(scope)
+                  if target is None or not _is_temporary(target, temps)]
     return sorted(found)
 
 
 def test_the_check_finds_a_direct_write_and_passes_an_atomic_one():
     bad = ("from pathlib import Path\nPath('x').write_text('a')\nwith open('y', 'w') as fh: pass\nnp.save('z', a)\n"
            "def f(p):\n    with atomic_path(p) as tmp:\n        pass\n"
-           "def g(out):\n    tmp = out / '.x.tmp'\n    tmp.write_text('a')\n    fig.savefig(out)\n")
+           "def g(out):\n    tmp = out / '.x.tmp'\n    tmp.write_text('a')\n    fig.savefig(out)\n"
+           "    tmp.replace(out)\n    fd, t = tempfile.mkstemp()\n    os.replace(t, out)\n")
     assert [w for _, w in raw_writes(bad)] == [".write_text()", "open(..., write mode)", "np.save()", ".write_text()",
-                                               ".savefig()"]
+                                               ".savefig()", ".replace() of a temporary", "tempfile.mkstemp()",
+                                               "os.replace()"]
     good = ("with atomic_path(p) as tmp:\n    tmp.write_text('a')\n    np.savez(tmp, a=1)\n"
             "with atomic_files([p, q]) as temps:\n    open(temps[0], 'wb').close()\n"
             "with atomic_write(p) as fh:\n    np.savez_compressed(fh, a=1)\n"
@@ -135,6 +150,7 @@ def test_every_file_write_in_the_package_is_atomic():
         rel = path.relative_to(PACKAGE).as_posix()
         if rel in _NOT_OUTPUTS or rel.startswith("examples/"):  # users' standalone scripts write as they like
             continue
-        offenders += [f"{rel}:{line}: {what}" for line, what in raw_writes(path.read_text(encoding="utf-8"))]
+        offenders += [f"{rel}:{line}: {what}" for line, what in raw_writes(path.read_text(encoding="utf-8"))
+                      if (rel, what) not in _ALLOWED]
     assert not offenders, "writes that bypass woodcam._atomic (use write_text/write_bytes/atomic_path):\n" + \
         "\n".join(offenders)

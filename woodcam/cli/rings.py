@@ -107,6 +107,7 @@ def run(args) -> int:
         import numpy as np
         from PIL import Image
 
+        from .._atomic import atomic_path
         from ..block.io import MANIFEST, read_block, read_mokume
         from ..detect.block import with_detected_rings
         from ..detect.show import rings_picture
@@ -128,10 +129,8 @@ def run(args) -> int:
                 f.extras.pop("knot_mask", None)
             block = with_detected_rings(mok, progress=True)
         pic = rings_picture(block, zoom=args.zoom, references=refs)
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = args.out.with_name(f".{args.out.name}.tmp.png")
-        Image.fromarray(np.asarray(pic)).save(tmp)
-        tmp.replace(args.out)
+        with atomic_path(args.out, mkdir=True) as tmp:
+            Image.fromarray(np.asarray(pic)).save(tmp, format="PNG")
         print(f"wrote {args.out}")
         return 0
     raise AssertionError(args.rings_command)

@@ -1,25 +1,16 @@
-"""Atomic file writes for the parquetry outputs (temp file in the same folder + os.replace)."""
+"""File writes of the parquetry outputs, through :mod:`woodcam._atomic` (temp file in the same
+folder, fsync, rename; the files get the user's usual permissions)."""
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
+
+from .._atomic import write_bytes
 
 
 def atomic_write_bytes(path, data: bytes) -> Path:
-    p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, p)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return p
+    """Write ``data`` to ``path`` atomically, making its folder if needed."""
+    return write_bytes(path, data, mkdir=True)
 
 
 def atomic_write_text(path, text: str) -> Path:

@@ -149,17 +149,10 @@ class SynthSpec:
         return _from_dict(cls, d, "synth spec")
 
     def save(self, path) -> Path:
-        """Write the spec as JSON (atomically: temp file in the same folder, then replace)."""
-        import os
-        import tempfile
+        """Write the spec as JSON (atomically: :func:`woodcam._atomic.write_text`)."""
+        from .._atomic import write_text
 
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-        with os.fdopen(fd, "w") as fh:
-            fh.write(json.dumps(self.to_dict(), indent=2) + "\n")
-        os.replace(tmp, path)
-        return path
+        return write_text(path, json.dumps(self.to_dict(), indent=2) + "\n", mkdir=True)
 
     @classmethod
     def load(cls, path) -> SynthSpec:
