@@ -43,7 +43,7 @@ from typing import IO
 from .errors import WoodcamError
 
 __all__ = ["all_or_nothing", "atomic_files", "atomic_path", "atomic_write", "check_output_path",
-           "write_bytes", "write_text"]
+           "write_bytes", "write_figure", "write_text"]
 
 
 def _umask() -> int:
@@ -230,6 +230,15 @@ def write_text(path, text: str, **kwargs) -> Path:
     with atomic_write(path, "w", **kwargs) as fh:
         fh.write(text)
     return Path(path)
+
+
+def write_figure(fig, path, **savefig_kwargs) -> Path:
+    """Atomically save the matplotlib figure ``fig`` to ``path`` (format from its suffix, PNG by
+    default; ``savefig_kwargs`` such as ``dpi`` go to ``fig.savefig``); returns ``Path(path)``."""
+    path = Path(path)
+    with atomic_path(path) as tmp:  # matplotlib writes in pieces: a half picture never lands
+        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", **savefig_kwargs)
+    return path
 
 
 @contextlib.contextmanager

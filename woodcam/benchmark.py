@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._atomic import atomic_path, write_text
+from ._atomic import atomic_path, write_figure, write_text
 from .errors import WoodcamError
 
 if TYPE_CHECKING:
@@ -412,8 +412,7 @@ def _plot(s: dict, path: Path) -> Path:
         ax.set_title(f"{label}: mean over blocks, 95 % bootstrap CI")
         ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.08))
     fig.tight_layout()
-    with atomic_path(path) as tmp:  # a half-written picture never replaces a whole one
-        fig.savefig(tmp, dpi=110, format=Path(path).suffix.lstrip('.') or 'png')
+    write_figure(fig, path, dpi=110)
     plt.close(fig)
     return path
 

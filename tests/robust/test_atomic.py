@@ -222,3 +222,23 @@ def _current_umask() -> int:
     mask = os.umask(0o022)
     os.umask(mask)
     return mask
+
+
+def test_a_figure_that_fails_half_way_leaves_the_old_picture(tmp_path):
+    from woodcam._atomic import write_figure
+
+    class HalfFigure:  # matplotlib writes a PNG in pieces; this one dies after the first
+        def savefig(self, fname, format=None, **kwargs):
+            Path(fname).write_bytes(b"\x89PNG half")
+            raise KeyboardInterrupt
+
+    class Figure:
+        def savefig(self, fname, format=None, **kwargs):
+            Path(fname).write_bytes(f"{format} {kwargs['dpi']}".encode())
+
+    target = tmp_path / "plot.png"
+    target.write_bytes(b"old")
+    with pytest.raises(KeyboardInterrupt):
+        write_figure(HalfFigure(), target, dpi=100)
+    assert target.read_bytes() == b"old" and _leftovers(tmp_path) == []
+    assert write_figure(Figure(), tmp_path / "plot.svg", dpi=72).read_bytes() == b"svg 72"

@@ -16,13 +16,12 @@ Cut planes are given by a block-frame point and a normal; each is sampled on a s
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from pathlib import Path
 from typing import TYPE_CHECKING
 from dataclasses import dataclass, field as dc_field
 
 import numpy as np
 
-from .._atomic import atomic_path, write_text
+from .._atomic import write_figure, write_text
 from .._types import ArrayLike, GrowthFieldLike, PathLike
 from ..errors import WoodcamError, require
 from ..fields.base import evaluate
@@ -377,8 +376,7 @@ def plot_planes(path, scores_by_method: dict, title: str = "", confidence: bool 
     if title:
         fig.suptitle(title, fontsize=9)
     fig.tight_layout()
-    with atomic_path(path) as tmp:  # a half-written picture never replaces a whole one
-        fig.savefig(tmp, dpi=110, format=Path(path).suffix.lstrip('.') or 'png')
+    write_figure(fig, path, dpi=110)
     plt.close(fig)
     return path
 

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import atomic_path, write_text
+from .._atomic import write_figure, write_text
 from .._types import PathLike
 from ..errors import WoodcamError, require
 from ..fields.base import arf
@@ -310,8 +310,7 @@ def plot_holdout(path, block, scores: list[FaceScore], title: str = ""):
     if title:
         fig.suptitle(title, fontsize=9)
     fig.tight_layout()
-    with atomic_path(path) as tmp:  # a half-written picture never replaces a whole one
-        fig.savefig(tmp, dpi=100, format=Path(path).suffix.lstrip('.') or 'png')
+    write_figure(fig, path, dpi=100)
     plt.close(fig)
     return path
 
