@@ -39,3 +39,9 @@ def test_bad_options_are_named():
         score_block(1, 0, ("magic",))
     with pytest.raises(WoodcamError, match="face_set must be one of"):
         score_block(1, 0, ("radial",), "clean", "two")
+
+
+@pytest.mark.parametrize("seed, index", [(-1, 0), (3, -2), (1.5, 0), (True, 0)])
+def test_a_benchmark_block_needs_a_seed_and_index_that_name_one(seed, index):
+    with pytest.raises(WoodcamError, match="must be an integer >= 0"):
+        make_block(seed, index)

@@ -66,6 +66,9 @@ def make_block(seed: int, index: int, scenario: Scenario = "noisy", kind: Kind =
 
     if scenario not in SCENARIOS:
         raise WoodcamError(f"scenario must be one of {', '.join(SCENARIOS)}; got {scenario!r}")
+    for name, v in (("seed", seed), ("index", index)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+            raise WoodcamError(f"{name} must be an integer >= 0 (a block is named by its seed and index); got {v!r}")
     if kind == "realistic":
         return benchmark_set_block(seed, index, face_px=face_px, log_fields=knotted_log_field,
                                    knotted_fraction=knotted_fraction, **SCENARIOS[scenario])

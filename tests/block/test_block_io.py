@@ -129,3 +129,10 @@ def test_block_from_images_of_a_real_block(tmp_path):
         block_from_images((40, 30, 20), photos={"front": grey}, ring_maps={"front": np.zeros((21, 40))})
     with pytest.raises(WoodcamError, match="photo of face 'top' must be an 8-bit RGB image"):
         block_from_images((40, 30, 20), photos={"top": np.zeros((4, 4, 3))})
+
+
+def test_a_missing_block_folder_is_named_as_given(tmp_path):
+    """It said ``folder '<parent>' must hold a block.json`` about the parent of the path."""
+    missing = tmp_path / "no_such_block"
+    with pytest.raises(WoodcamError, match=f"block folder '{missing}' does not exist"):
+        read_block(missing)

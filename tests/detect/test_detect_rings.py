@@ -335,3 +335,15 @@ def test_no_speck_pieces_after_the_snap():
         if length < 0.8 * MIN_TRACE_WAVELENGTHS * float(np.median(det.wavelength_px[r, c])):
             short.append(round(length, 1))
     assert det.traces and not short, short
+
+
+@pytest.mark.parametrize("photo, match", [
+    (np.full((64, 64, 3), np.nan), "finite values in \\[0, 1\\].*12288 non-finite"),
+    (np.full((64, 64, 3), 200.0), "finite values in \\[0, 1\\]; got range \\[200.0, 200.0\\]"),
+    (np.full((64, 64, 3), 40000, np.uint16), "uint8 \\(0..255\\) or float \\(0..1\\); got dtype uint16"),
+])
+def test_a_photo_the_detector_would_misread_is_refused(photo, match):
+    """A 16-bit photo or a float one in 0..255 was read as if in 0..1 (all white), and NaNs
+    reached OpenCV's own assertion."""
+    with pytest.raises(WoodcamError, match=match):
+        detect_rings(photo, px_per_mm=5.0)

@@ -176,3 +176,8 @@ def test_the_knots_bend_starts_from_a_stem_whose_growth_time_rises_away_from_its
     acc = {name: evaluate_fit(block.true_field, f, block.size_mm, pixel_mm=0.5)[0]["matched_2"]
            for name, f in (("cheapest", cheapest), ("bent", bent))}
     assert acc["bent"] > acc["cheapest"] + 20.0, acc
+
+
+def test_fit_stem_refuses_what_is_not_ring_observations():
+    with pytest.raises(WoodcamError, match="obs must be RingObservations.*got NoneType"):
+        fit_stem(None, (50, 50, 50))

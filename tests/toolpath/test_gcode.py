@@ -202,3 +202,12 @@ def test_corpus_programs_simulate_or_fail_with_their_reason(path):
     assert np.isfinite(res.heightmap).all()
     if (prog.end_mm[prog.kind == FEED, 2] < 0).any():  # (two language tests stay above)
         assert res.removed_volume_mm3 > 0
+
+
+def test_a_program_file_without_a_gcode_suffix_is_read_as_a_file(tmp_path):
+    """A one-line string naming an existing file is that file, whatever its suffix (posts
+    write .out, .prg ...); before, its path was parsed as G-code."""
+    p = tmp_path / "part.out"
+    p.write_text("G21 G90\nG0 X1 Y2 Z3\n")
+    prog = read_gcode(str(p))
+    assert prog.source == str(p) and np.allclose(prog.end_mm[-1], (1, 2, 3))

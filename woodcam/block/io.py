@@ -148,6 +148,9 @@ def read_block(folder: PathLike, *, allow_outside: bool | None = None) -> Block:
     from ._schema import check_manifest
 
     folder = Path(folder)
+    if not folder.exists():
+        raise WoodcamError(f"block folder {str(folder)!r} does not exist; pass a folder written by "
+                           "write_block or 'woodcam block synth/from-photos' (or its block.json)")
     path = folder / MANIFEST if folder.is_dir() else folder
     folder = path.parent
     if not path.is_file():

@@ -216,8 +216,20 @@ class RingDetection:
 
 
 def luminance(photo: np.ndarray) -> np.ndarray:
-    """``(h, w)`` float32 luminance in [0, 1] of an ``(h, w, 3)`` uint8 photo (Rec. 601)."""
+    """``(h, w)`` float32 luminance in [0, 1] of an ``(h, w, 3)`` photo (Rec. 601): uint8, or float
+    in [0, 1]; ``(h, w)`` grey the same."""
     a = np.asarray(photo)
+    if a.dtype != np.uint8:
+        # another integer type (a 16-bit export) or a float photo in 0..255 would be read as if
+        # in 0..1, and NaNs reach OpenCV: refused here with what to pass instead
+        if not np.issubdtype(a.dtype, np.floating):
+            raise WoodcamError(f"photo must be uint8 (0..255) or float (0..1); got dtype {a.dtype}; convert "
+                               "it with woodcam._readers.photo_rgb8 (16-bit exports are scaled to 8 bits)")
+        if a.size and not (np.all(np.isfinite(a)) and -1e-3 <= float(a.min()) and float(a.max()) <= 1.0 + 1e-3):
+            raise WoodcamError(f"a float photo must hold finite values in [0, 1]; got range "
+                               f"[{np.nanmin(a) if np.isfinite(a).any() else 'nan'}, "
+                               f"{np.nanmax(a) if np.isfinite(a).any() else 'nan'}] with "
+                               f"{int(np.sum(~np.isfinite(a)))} non-finite; divide by 255 or pass uint8")
     if a.ndim == 2:
         return a.astype(np.float32) / (255.0 if a.dtype == np.uint8 else 1.0)
     if a.ndim != 3 or a.shape[2] < 3:

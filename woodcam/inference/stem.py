@@ -336,6 +336,9 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
     -------
     StemField
     """
+    if not isinstance(obs, RingObservations):
+        raise WoodcamError(f"obs must be RingObservations (woodcam.inference.observations.gather_observations "
+                           f"of a block); got {type(obs).__name__}")
     if not obs.labelled:
         raise WoodcamError("fit_stem needs year-labelled rings; number unlabelled rings first "
                            "(woodcam.inference.radial.number_observations or fit_evidence)")

@@ -173,6 +173,15 @@ class Program:
                    full(spindle_rpm, float), source, sorted(set(t.tolist())))
 
 
+def _names_a_file(text: str) -> bool:
+    """Is the one-line ``text`` the path of an existing file (a program saved without a G-code
+    suffix, e.g. ``part.out``)? False for text no path can be (too long, a NUL)."""
+    try:
+        return len(text) < 4096 and Path(text).is_file()
+    except (OSError, ValueError):
+        return False
+
+
 def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_TOL_MM,
                start_mm: ArrayLike | None = None, dialect: str = "linuxcnc",
                interpreter: str = "woodcam") -> Program:
@@ -181,8 +190,9 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
     Parameters
     ----------
     text_or_path : str | os.PathLike
-        Program text, or the path of a ``.nc/.gcode/.ngc/.tap`` file. A ``str`` containing a
-        newline or a G-code word is taken as text.
+        Program text, or the path of a G-code file: a ``Path``, a one-line ``str`` naming an
+        existing file, or one ending in ``.nc/.gcode/.ngc/.tap/.cnc/.txt`` (which must exist).
+        Any other ``str`` is taken as program text.
     chord_tol_mm : float
         Largest sagitta (mm) between an arc and its chords.
     start_mm : (3,) float | None
@@ -198,9 +208,10 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
         For an unsupported or malformed line, naming the line number and the word.
     """
     source = "<string>"
-    if isinstance(text_or_path, Path) or (isinstance(text_or_path, str) and "\n" not in text_or_path
-                                          and Path(text_or_path).suffix.lower()
-                                          in {".nc", ".gcode", ".ngc", ".tap", ".cnc", ".txt"}):
+    one_line = isinstance(text_or_path, str) and "\n" not in text_or_path
+    if isinstance(text_or_path, Path) or (one_line and (
+            Path(text_or_path).suffix.lower() in {".nc", ".gcode", ".ngc", ".tap", ".cnc", ".txt"}
+            or _names_a_file(text_or_path))):
         path = Path(text_or_path)
         if not path.is_file():
             raise WoodcamError(f"read_gcode: text_or_path={str(path)!r} is not a file; "
