@@ -90,3 +90,32 @@ def test_rule_is_in_the_main_help(capsys):
         main(["--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert " ".join(OUT_RULE.split()) in text
+
+
+FOLDER_COMMANDS = [c for c in COMMANDS if not c[1].get_default("_out_suffixes")]
+
+
+@pytest.mark.parametrize("path,p", FOLDER_COMMANDS, ids=[" ".join(c[0]) for c in FOLDER_COMMANDS])
+def test_a_folder_that_cannot_be_made_is_refused_before_work(path, p, tmp_path, capsys):
+    """``train rings --out`` under a file trained for minutes, then failed with a traceback."""
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    capsys.readouterr()
+    assert main(_argv(path, p, blocker / "sub")) == EXIT_USAGE
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"cannot make the folder '{blocker / 'sub'}'" in err[0] and "is a file" in err[0], err
+
+
+def test_a_refusal_by_the_system_is_one_line_not_a_traceback(monkeypatch, capsys):
+    import errno
+
+    import woodcam.cli.options as options
+
+    def full(args):
+        raise OSError(errno.ENOSPC, "No space left on device", "out/bowl.glb")
+
+    monkeypatch.setattr(options, "check_numbers", full)
+    assert main(["bake", "x.py", "--block", "builtin:flat-sawn", "--out", "out/bowl.glb"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["woodcam: error: No space left on device (out/bowl.glb); check the path, its permissions "
+                   "and the free space"]

@@ -176,6 +176,11 @@ def main(argv: list[str] | None = None) -> int:
         except KeyboardInterrupt:
             print("woodcam: interrupted", file=sys.stderr)
             return EXIT_INTERRUPTED
+        except OSError as err:  # the system refused a read or write (disk full, no permission)
+            where = f" ({err.filename})" if err.filename else ""
+            print(f"woodcam: error: {err.strerror or err}{where}; check the path, its permissions and "
+                  "the free space", file=sys.stderr)
+            return EXIT_ERROR
         finally:
             print_warnings(str(w.message) for w in caught if _is_ours(w))
     return rc

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import re
 from pathlib import Path
 
@@ -93,6 +94,14 @@ def check_out(args: argparse.Namespace) -> None:
         raise UsageError(f"--out of 'woodcam {command}' is a FOLDER (it writes several files); "
                          f"got {str(out)!r}, {what}; give a folder such as "
                          f"{str(out.with_name(out.stem + '_out' if out.is_file() else out.stem))!r}")
+    else:  # a folder made later: its nearest existing ancestor must be a folder one may write in
+        base = out.absolute()
+        while not base.exists() and base != base.parent:
+            base = base.parent
+        if not base.is_dir() or not os.access(base, os.W_OK | os.X_OK):
+            why = "is a file" if not base.is_dir() else "is not writable"
+            raise UsageError(f"--out of 'woodcam {command}': cannot make the folder {str(out)!r}: "
+                             f"{str(base)!r} {why}; choose an output folder you can write to")
 
 
 # -- --units: lengths on the command line and in printed summaries ------------------------------

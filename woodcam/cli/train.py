@@ -25,6 +25,7 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
+    args.out.mkdir(parents=True, exist_ok=True)  # before minutes of training, not after
     if args.what == "rings":
         from ..detect.learned import RingNetSpec, train_ring_net
 
