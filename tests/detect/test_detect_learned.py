@@ -20,6 +20,11 @@ def test_spec_round_trip_and_unknown_keys(tmp_path):
     (tmp_path / "bad.json").write_text('{"seed": 1, "depth": 9}')
     with pytest.raises(WoodcamError, match="unknown keys"):
         RingNetSpec.load(tmp_path / "bad.json")
+    (tmp_path / "list.json").write_text("[1]")
+    for path, match in ((tmp_path, "cannot read a JSON ring net spec"), (tmp_path / "list.json", "JSON object; got list"),
+                        (tmp_path / "none.json", "cannot read a JSON ring net spec")):
+        with pytest.raises(WoodcamError, match=match):
+            RingNetSpec.load(path)
 
 
 @pytest.mark.slow

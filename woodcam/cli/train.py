@@ -25,7 +25,6 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
-    args.out.mkdir(parents=True, exist_ok=True)  # before minutes of training, not after
     if args.what == "rings":
         from ..detect.learned import RingNetSpec, train_ring_net
 
@@ -36,6 +35,8 @@ def run(args) -> int:
             spec = replace(spec, steps=args.steps)
         from ..synth.rings import ring_training_faces
 
+        args.out.mkdir(parents=True, exist_ok=True)  # before minutes of training, not after
+
         # the training faces come from woodcam's own synthesis (synth sits above detect)
         x, y = ring_training_faces(spec, progress=True)
         r = train_ring_net(spec, x, y, args.out, progress=True)
@@ -45,6 +46,7 @@ def run(args) -> int:
     from ..fields.neural import GTFSpec, train_gtf
 
     spec = GTFSpec.load(args.spec) if args.spec is not None else GTFSpec()
+    args.out.mkdir(parents=True, exist_ok=True)
     training_set = None
     if args.engine is not None or args.address is not None:
         # the same training set, made in shards on an engine, kept in OUT/trainset/ (resumable)
