@@ -145,6 +145,8 @@ def crease_normals(mesh: Mesh, crease_angle_deg: float | None = None) -> Mesh:
 
     from woodcam.tolerances import CREASE_ANGLE_DEG, CREASE_WELD_MM
 
+    if not isinstance(mesh, trimesh.Trimesh):
+        raise WoodcamError(f"mesh must be a trimesh.Trimesh; got {type(mesh).__name__}")
     angle = CREASE_ANGLE_DEG if crease_angle_deg is None else float(crease_angle_deg)
     if not (math.isfinite(angle) and 0.0 <= angle <= 180.0):
         raise WoodcamError(

@@ -123,6 +123,11 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
     -------
     field : callable ``(n, 3) mm -> (n,) years`` in the block frame.
     """
+    from ..block.block import Block
+
+    if not isinstance(block, Block):
+        raise WoodcamError(f"block must be a woodcam.block.Block (read_block, builtin_block, synth_block); "
+                           f"got {type(block).__name__}")
     if method not in METHODS:
         raise WoodcamError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:

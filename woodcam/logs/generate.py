@@ -396,6 +396,9 @@ def generate_log(seed: int | np.random.Generator | None = 0, *, length_mm: float
         raise WoodcamError(f"length_mm must be > 100 mm; got {length_mm!r}")
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     n_l, n_t = heightmap_shape or (int(np.ceil(length_mm / 5.0)) + 1, 360)
+    from ..limits import check_grid
+
+    check_grid((n_l, n_t), "the log's surface height map", fix="generate a shorter log (length_mm)")
     if n_l < 10 or n_t < 16:
         raise WoodcamError(f"heightmap_shape must be at least (10, 16); got {(n_l, n_t)}")
     l_ax, t_ax = heightmap_axes(length_mm, n_l, n_t)
