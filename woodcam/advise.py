@@ -124,7 +124,8 @@ def _sample(mesh, count: int, rng):
 
 def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1000,
                      margin_mm: float = 1.0, samples: int = 1500,
-                     weights: dict[str, float] | None = None, seed: int = 0) -> PlacementAdvice:
+                     weights: dict[str, float] | None = None, seed: int = 0,
+                     progress: bool = False) -> PlacementAdvice:
     """Rank placements of ``part`` in ``stock`` (see module docstring).
 
     Parameters
@@ -144,7 +145,11 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
         Term weights; default :data:`DEFAULT_WEIGHTS`.
     seed : int
         Seed of the surface sample.
+    progress : bool
+        A progress bar over the orientations (:func:`woodcam._progress.progress_bar`).
     """
+    from ._progress import progress_bar
+
     if not (isinstance(candidates, int) and 1 <= candidates <= 1_000_000):
         raise WoodcamError(f"candidates must be an integer in [1, 1e6]; got {candidates!r}")
     if not (math.isfinite(margin_mm) and margin_mm >= 0):
@@ -164,7 +169,7 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
     orients = _orientations(rotations)
     per = max(1, candidates // len(orients))
     ranked: list[Placement] = []
-    for ops, rot in orients:
+    for ops, rot in progress_bar(orients, desc="scoring placements", unit="orientation", enabled=progress):
         local = depth_pts - centre
         ext = np.abs(rot) @ (hi - lo)  # rotated bounding-box extent
         room = size - 2 * margin_mm - ext
@@ -214,8 +219,9 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
     return PlacementAdvice(ranked, len(ranked), elongation, w)
 
 
-def render_advice(advice: PlacementAdvice, part, stock, png, *, top: int = 3):
-    """The ``top`` placements side by side in one PNG (see :mod:`woodcam.view.compare`)."""
+def render_advice(advice: PlacementAdvice, part, stock, png, *, top: int = 3, progress: bool = False):
+    """The ``top`` placements side by side in one PNG (see :mod:`woodcam.view.compare`);
+    ``progress``: a bar over the panels (about 1.5 s each)."""
     from .view.compare import render_side_by_side
 
     base = _part_mesh(part)
@@ -233,7 +239,7 @@ def render_advice(advice: PlacementAdvice, part, stock, png, *, top: int = 3):
     meshes.append(m)
     titles.append(f"worst: score {worst.score:.2f}\nknots {worst.terms['knots']:.2f} "
                   f"pith {worst.terms['pith']:.2f}")
-    return render_side_by_side(meshes, [stock.wood] * len(meshes), stock.size_mm, titles, png)
+    return render_side_by_side(meshes, [stock.wood] * len(meshes), stock.size_mm, titles, png, progress=progress)
 
 
 #: A region of a long thin part whose fibres cross its long axis by more than this is short

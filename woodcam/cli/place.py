@@ -47,7 +47,7 @@ def run_place(args: argparse.Namespace) -> int:
     check_output_path(out / "placements.json", suffixes=(".json",), what="--out", mkdir=True)
     stock = open_stock(args.block)
     advice = advise_placement(args.part, stock, rotations=args.rotations,
-                              candidates=args.candidates, margin_mm=args.margin)
+                              candidates=args.candidates, margin_mm=args.margin, progress=True)
     k = 1 / MM_PER_UNIT[args.units]
     print(advice.table(args.top, op_text=str if k == 1 else (lambda op: place_op_in(op, k))))
     record = {"block": args.block, "part": str(args.part), "candidates": advice.candidates,
@@ -55,6 +55,6 @@ def run_place(args: argparse.Namespace) -> int:
               "ranked": [{"ops": p.ops, "score": p.score, **p.terms,
                           "matrix": p.matrix.tolist()} for p in advice.ranked[:max(args.top, 10)]]}
     write_bytes(out / "placements.json", json.dumps(record, indent=1).encode())
-    png = render_advice(advice, args.part, stock, out / "placements.png", top=args.top)
+    png = render_advice(advice, args.part, stock, out / "placements.png", top=args.top, progress=True)
     print(f"scored {advice.candidates} placements; wrote {png} and {out / 'placements.json'}")
     return 0

@@ -12,15 +12,18 @@ import numpy as np
 _EDGE_MM = 0.7
 
 
-def render_side_by_side(meshes, woods, size_mm, titles, png, *, panel_px: int = 420) -> Path:
+def render_side_by_side(meshes, woods, size_mm, titles, png, *, panel_px: int = 420,
+                        progress: bool = False) -> Path:
     """Render ``meshes[i]`` (trimesh, block frame, mm) coloured by ``woods[i].color`` at its
-    vertices in panel ``i`` of one PNG, with the block outline and ``titles[i]`` above it."""
+    vertices in panel ``i`` of one PNG, with the block outline and ``titles[i]`` above it;
+    ``progress``: a bar over the panels."""
     from ..errors import require
     from .scene import _prefer_egl_off_screen
 
     pv = require("pyvista", "view", "rendering placement pictures")
     import trimesh
     from .._atomic import atomic_path
+    from .._progress import progress_bar
 
     _prefer_egl_off_screen()
     n = len(meshes)
@@ -28,7 +31,8 @@ def render_side_by_side(meshes, woods, size_mm, titles, png, *, panel_px: int = 
                          border=False)
     try:
         W, D, H = (float(v) for v in size_mm)
-        for i, (mesh, wood, title) in enumerate(zip(meshes, woods, titles)):
+        for i, (mesh, wood, title) in enumerate(progress_bar(list(zip(meshes, woods, titles)), desc="rendering",
+                                                            unit="panel", enabled=progress)):
             plotter.subplot(0, i)
             # vertex colours need vertices about every EDGE_MM: split long CAD triangles
             verts, tris = trimesh.remesh.subdivide_to_size(
