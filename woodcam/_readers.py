@@ -15,7 +15,8 @@ from typing import Any
 
 from .errors import WoodcamError
 
-__all__ = ["photo_rgb8", "read_image_file", "read_json_file", "read_photo_rgb", "strict_json_loads"]
+__all__ = ["photo_rgb8", "read_image_file", "read_json_file", "read_json_object", "read_photo_rgb",
+           "strict_json_loads"]
 
 
 def strict_json_loads(text: str, what: str) -> Any:
@@ -38,6 +39,15 @@ def read_json_file(path: Path, what: str) -> Any:
     except UnicodeDecodeError as err:
         raise WoodcamError(f"{what}: {str(path)!r} is not UTF-8 text ({err.reason})") from err
     return strict_json_loads(text, f"{what} {str(path)!r}")
+
+
+def read_json_object(path, what: str) -> dict:
+    """:func:`read_json_file` of a file that must hold a JSON object (a spec, a job): the dict,
+    or a WoodcamError naming ``what``, the file and what it held instead."""
+    d = read_json_file(Path(path), what)
+    if not isinstance(d, dict):
+        raise WoodcamError(f"{what} {str(path)!r} must hold a JSON object; got {type(d).__name__}")
+    return d
 
 
 def read_image_file(path: Path, what: str):

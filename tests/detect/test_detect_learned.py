@@ -21,8 +21,8 @@ def test_spec_round_trip_and_unknown_keys(tmp_path):
     with pytest.raises(WoodcamError, match="unknown keys"):
         RingNetSpec.load(tmp_path / "bad.json")
     (tmp_path / "list.json").write_text("[1]")
-    for path, match in ((tmp_path, "cannot read a JSON ring net spec"), (tmp_path / "list.json", "JSON object; got list"),
-                        (tmp_path / "none.json", "cannot read a JSON ring net spec")):
+    for path, match in ((tmp_path, "ring net spec: cannot read"), (tmp_path / "list.json", "JSON object; got list"),
+                        (tmp_path / "none.json", "ring net spec: cannot read")):
         with pytest.raises(WoodcamError, match=match):
             RingNetSpec.load(path)
 

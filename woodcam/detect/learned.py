@@ -80,12 +80,9 @@ class RingNetSpec:
 
     @classmethod
     def load(cls, path) -> RingNetSpec:
-        try:
-            d = json.loads(Path(path).read_text())
-        except (OSError, ValueError) as err:
-            raise WoodcamError(f"spec {path}: cannot read a JSON ring net spec: {err}") from err
-        if not isinstance(d, dict):
-            raise WoodcamError(f"spec {path}: must hold a JSON object; got {type(d).__name__}")
+        from .._readers import read_json_object
+
+        d = read_json_object(path, "ring net spec")
         names = {f.name for f in dc_fields(cls)}
         bad = set(d) - names
         if bad:

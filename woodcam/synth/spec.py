@@ -156,12 +156,9 @@ class SynthSpec:
 
     @classmethod
     def load(cls, path) -> SynthSpec:
-        try:
-            d = json.loads(Path(path).read_text())
-        except (OSError, ValueError) as err:
-            raise WoodcamError(f"spec {path}: cannot read a JSON synth spec: {err}") from err
-        if not isinstance(d, dict):
-            raise WoodcamError(f"spec {path}: must hold a JSON object; got {type(d).__name__}")
+        from .._readers import read_json_object
+
+        d = read_json_object(path, "synth spec")
         return cls.from_dict(d)
 
     # -- the flat keywords of synth_block ---------------------------------------------------
