@@ -2,8 +2,8 @@
 
 A static check over the package's source: a writer that opens its target directly leaves a
 truncated file behind on Ctrl-C or a crash (the brief: "every file write is atomic"), and a
-review found three that did (the ring net's spec, weights and training log, and the copy of a
-user's corrected SVG). The rule: ``open(..., "w"/"a"/"x")``, ``Path.write_text``,
+sweep found a dozen that did (the ring net's spec, weights and training log, the copy of a
+user's corrected SVG, matplotlib figures, the bench report, hand-made temp + rename). The rule: ``open(..., "w"/"a"/"x")``, ``Path.write_text``,
 ``Path.write_bytes``, matplotlib's ``savefig``, ``np.save*`` and ``torch.save`` may only write
 to a temporary of ``with atomic_path(...) as tmp`` / ``atomic_files(...)`` / ``atomic_write(...)``
 in the same function (or its parameter ``tmp``, the caller's temporary); everything else calls
