@@ -344,8 +344,8 @@ def _cli_case(data):
         def check(_):
             v = getattr(args, option[2:].replace("-", "_"))
             assert math.isfinite(v)
-            lo, hi, lo_open = RANGES.get((args.command, option[2:].replace("-", "_")),
-                                         RANGES[option[2:].replace("-", "_")])
+            name = option[2:].replace("-", "_")  # a command's own range first, as check_numbers reads them
+            lo, hi, lo_open = RANGES.get((args.command, name)) or RANGES[name]
             assert lo <= v <= hi and not (lo_open and v <= lo)
 
         return own_error_or_valid(lambda: check_numbers(args), check)
