@@ -27,3 +27,12 @@ def test_crease_normals_refuses_what_is_not_a_mesh():
 
     with pytest.raises(WoodcamError, match="mesh must be a trimesh.Trimesh; got NoneType"):
         crease_normals(None)
+
+
+def test_grain_direction_refuses_what_is_not_a_field():
+    import numpy as np
+
+    from woodcam import grain_direction
+
+    with pytest.raises(WoodcamError, match="field must be a growth field.*got NoneType"):
+        grain_direction(None, np.zeros((2, 3)))

@@ -99,6 +99,8 @@ def grain_direction(field: GrowthFieldLike, points_mm: ArrayLike) -> np.ndarray:
     fn = getattr(field, "grain_direction", None)
     if fn is not None:
         return np.asarray(fn(p), dtype=float)
+    if not callable(field):
+        raise WoodcamError(f"field must be a growth field ((n, 3) mm -> years); got {type(field).__name__}")
     axis = np.asarray(getattr(field, "axis", (0.0, 0.0, 1.0)), dtype=float)
     return np.broadcast_to(axis / np.linalg.norm(axis), p.shape)
 
