@@ -209,11 +209,12 @@ def test_temporaries_of_killed_writers_are_swept(tmp_path):
 def test_every_writer_gives_new_files_the_usual_permissions(tmp_path):
     """Outputs are for other programs and people too (a CNC machine's account, a web server):
     the parquetry files and a synth spec were written through ``tempfile.mkstemp``, mode 0600."""
-    from woodcam.parquetry._io import atomic_write_png, atomic_write_text
+    from woodcam.parquetry._io import atomic_write_png
+    from woodcam.parquetry.job import ParquetryJob, write_job
     from woodcam.synth.spec import SynthSpec
 
     expected = 0o666 & ~_current_umask()
-    made = [write_text(tmp_path / "a.txt", "a"), atomic_write_text(tmp_path / "sub" / "b.svg", "<svg/>"),
+    made = [write_text(tmp_path / "a.txt", "a"), write_job(ParquetryJob(), tmp_path / "sub" / "b.json"),
             atomic_write_png(tmp_path / "c.png", np.zeros((2, 2, 3))), SynthSpec().save(tmp_path / "d.json")]
     assert {p.name: oct(p.stat().st_mode & 0o777) for p in made} == {p.name: oct(expected) for p in made}
 

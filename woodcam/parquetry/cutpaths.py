@@ -359,7 +359,7 @@ def write_dxf(path, height_mm: float, pieces: list[tuple[int, list]], tool_radiu
     from ezdxf import units
     from shapely.geometry import Polygon
 
-    from ._io import atomic_write_text
+    from .._atomic import write_text
 
     doc = ezdxf.new("R2010")
     doc.units = units.MM
@@ -387,7 +387,7 @@ def write_dxf(path, height_mm: float, pieces: list[tuple[int, list]], tool_radiu
 
     buf = io.StringIO()
     doc.write(buf)
-    return atomic_write_text(path, buf.getvalue())
+    return write_text(path, buf.getvalue(), mkdir=True)
 
 
 def read_dxf_pieces(path, height_mm: float) -> dict[int, np.ndarray]:

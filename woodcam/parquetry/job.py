@@ -230,7 +230,7 @@ def read_job(path: str | Path) -> ParquetryJob:
 
 def write_job(job: ParquetryJob, path: str | Path) -> Path:
     """Write a job file in the paper's layout (woodcam-only keys under ``"woodcam"``), atomically."""
-    from ._io import atomic_write_text
+    from .._atomic import write_text
 
     prm = asdict(job.params)
     d = {"source_textures": job.scans, "targets": job.targets}
@@ -238,7 +238,7 @@ def write_job(job: ParquetryJob, path: str | Path) -> Path:
         d[k] = prm[name]
     d["sort_patches_saliency"] = job.params.priority == "saliency"
     d["woodcam"] = {"params": prm, "blocks": job.blocks, "mokume": job.mokume}
-    return atomic_write_text(path, json.dumps(d, indent=2))
+    return write_text(path, json.dumps(d, indent=2), mkdir=True)
 
 
 def job_veneers(job: ParquetryJob, open_stock=None, progress: bool = False) -> list:

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._io import atomic_write_png, atomic_write_text
+from .._atomic import write_text
+from ._io import atomic_write_png
 from .cutpaths import (
     Piece,
     check_piece,
@@ -140,7 +141,7 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
               f'href="data:image/png;base64,{base64.b64encode(buf.getvalue()).decode()}"/>')
         doc = svg_document(W, H, [(q.id, by_id[q.id].outline_panel) for q in p.patches],
                            background=bg, title=f"woodcam parquetry assembly {p.name}")
-        files.append(atomic_write_text(out / f"assembly{sfx}.svg", doc))
+        files.append(write_text(out / f"assembly{sfx}.svg", doc, mkdir=True))
         if glb_writer is not None:
             files.append(glb_writer(panel_mesh(p.render, ppm), out / f"panel{sfx}.glb",
                                     metadata={"kind": "parquetry panel", "units": "mm",
@@ -155,9 +156,9 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
         v = run.veneers[i]
         W, H = v.size_mm
         mine = [(pc.id, pc.outline_sheet) for pc in pieces if pc.sheet == i]
-        files.append(atomic_write_text(out / f"veneer_{v.id}.svg",
-                                       svg_document(W, H, mine, prm.tool_diameter_mm / 2,
-                                                    title=f"woodcam veneer {v.id}")))
+        files.append(write_text(out / f"veneer_{v.id}.svg",
+                                svg_document(W, H, mine, prm.tool_diameter_mm / 2, title=f"woodcam veneer {v.id}"),
+                                mkdir=True))
         files.append(write_dxf(out / f"veneer_{v.id}.dxf", H, mine, prm.tool_diameter_mm / 2))
     summ = summary(run)
     problems = {pc.id: pc.problems for pc in pieces if pc.problems}
@@ -175,7 +176,7 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
         "fabricability": {"pieces": len(pieces), "problems": problems,
                           "repaired": {str(k): v for k, v in run.repaired.items()}},
     }
-    files.append(atomic_write_text(out / "result.json", json.dumps(result, indent=1, default=float)))
+    files.append(write_text(out / "result.json", json.dumps(result, indent=1, default=float), mkdir=True))
     return {"files": [str(f) for f in files], "summary": summ, "problems": problems}
 
 
