@@ -54,3 +54,19 @@ def test_work_offset_must_be_three_finite_numbers(value, capsys):
               "builtin:flat-sawn", "--out", "x.glb", f"--work-offset={value}"])
     assert exc.value.code == 2
     assert "finite numbers X,Y,Z" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, prog", [
+    (["bake"], "woodcam bake"),  # required arguments missing
+    (["bake", "x.py", "--block", "builtin:flat-sawn", "--out", "x.glb", "--tolerance", "abc"], "woodcam bake"),
+    (["nosuch"], "woodcam"),  # an unknown command
+    (["block", "synth", "--count", "x"], "woodcam block synth"),
+])
+def test_usage_errors_are_one_line_with_a_pointer_to_help(argv, prog, capsys):
+    """argparse's own errors printed the whole usage block (up to 15 lines) before the error."""
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1, err
+    assert err.startswith(f"{prog}: error: ") and err.rstrip().endswith(f"(see '{prog} --help')"), err

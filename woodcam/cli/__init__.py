@@ -78,9 +78,19 @@ command line is wrong (usage); 3 the work was done but a check failed (e.g. gcod
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_CHECKS, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser, whose usage errors are one line: argparse prints the whole usage block
+    (up to 15 lines for ``bake``) before its error, which buries the one line that says what is
+    wrong; the pointer to ``--help`` replaces the block. Sub-parsers inherit the class
+    (``add_subparsers`` makes them with ``type(self)``)."""
+
+    def error(self, message: str):
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The whole ``woodcam`` parser: every module of :data:`COMMANDS` registers its commands."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="woodcam", description="CNC cut preview for solid wood: carve a part out of a "
         "block whose growth rings are known and see the wood on every surface.",
         epilog=_EPILOG + "\n" + textwrap.fill("output: " + OUT_RULE, 95) + "\n",
