@@ -488,6 +488,47 @@ def test_job_file_round_trip_and_paper_keys(tmp_path):
 
 
 # -- bad input ------------------------------------------------------------------------------
+_T = [{"filename": "t.png"}]
+
+
+@pytest.mark.parametrize("job, match", [
+    ({"targets": "t.png"}, r"'targets' must be a list of objects; got str"),
+    ({"targets": [{}]}, r"targets\[0\] needs a 'filename' path"),
+    ({"targets": _T, "source_textures": [{"dpi": 300}]}, r"source_textures\[0\] needs a 'texture'"),
+    ({"targets": _T, "source_textures": [{"texture": "a.png", "dpi": -3}]}, r"source_textures\[0\].dpi must be > 0"),
+    ({"targets": _T, "woodcam": 3}, r"'woodcam' and 'woodcam.params' must be objects"),
+    ({"targets": _T, "woodcam": {"mokume": "CN03"}}, r"'woodcam.mokume' must be a list"),
+    ({"targets": _T, "woodcam": {"blocks": [{"spec": "builtin:flat-sawn", "sheets": "2"}]}},
+     r"woodcam.blocks\[0\].sheets must be a whole number; got '2'"),
+    ({"targets": _T, "num_source_rotations": "abc"}, r"n_rot must be a whole number; got 'abc'"),
+    ({"targets": _T, "num_source_rotations": 0}, r"n_rot must be >= 1"),
+    ({"targets": _T, "woodcam": {"params": {"patch_mm": "14"}}}, r"patch_mm must be a finite number"),
+    ({"targets": _T, "woodcam": {"params": {"single_use": 1}}}, r"single_use must be true or false"),
+    ([_T], r"must hold a JSON object; got list"),
+])
+def test_a_bad_job_file_is_one_error_naming_the_entry(job, match, tmp_path):
+    """Each of these was a KeyError, TypeError, AttributeError or ValueError traceback from the
+    CLI (``woodcam parquetry --config``) before the job's entries were checked at the door."""
+    (tmp_path / "job.json").write_text(json.dumps(job))
+    with pytest.raises(WoodcamError, match=match):
+        read_job(tmp_path / "job.json")
+
+
+def test_a_job_file_with_nan_is_refused(tmp_path):
+    (tmp_path / "job.json").write_text('{"targets": [{"filename": "t.png"}], "weight_sobel": NaN}')
+    with pytest.raises(WoodcamError, match="finite numbers"):
+        read_job(tmp_path / "job.json")
+
+
+def test_parameters_of_the_wrong_type_are_refused_by_name():
+    with pytest.raises(WoodcamError, match="patch_mm must be a finite number; got nan"):
+        ParquetryParams(patch_mm=float("nan")).check()
+    with pytest.raises(WoodcamError, match="n_rot must be a whole number; got 2.5"):
+        ParquetryParams(n_rot=2.5).check()
+    prm = ParquetryParams(n_rot=9.0, overlap_mm=None).check()  # a whole float (JSON may write 9.0)
+    assert prm.n_rot == 9 and type(prm.n_rot) is int
+
+
 def test_unreadable_image(tmp_path):
     bad = tmp_path / "scan.png"
     bad.write_text("not an image")

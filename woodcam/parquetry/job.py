@@ -17,6 +17,7 @@ with woodcam's own keys (Table 1 names in mm, fabrication, veneers sliced from b
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Literal
@@ -97,6 +98,10 @@ class ParquetryParams:
 
     def check(self) -> ParquetryParams:
         """Validate at the door; returns self."""
+        for f in fields(self):  # the types first: a job file's "abc" or NaN fails here, by name
+            setattr(self, f.name, _check_type(f"parquetry parameter {f.name}", getattr(self, f.name), str(f.type)))
+        if self.n_rot < 1:
+            raise WoodcamError(f"n_rot must be >= 1 (rotated copies of each sheet, sec. 3.2); got {self.n_rot}")
         for name in ("w_intens", "w_edge", "w_hist"):
             v = getattr(self, name)
             if not 0.0 <= v <= 1.0:
@@ -168,6 +173,45 @@ class ParquetryParams:
         return round(self.overlap * self.px_per_mm)
 
 
+def _check_type(what: str, v, annotation: str):
+    """``v`` checked against the dataclass field type ``annotation`` (a string: ``float``,
+    ``int | None``, ``bool``, a Literal alias): numbers finite, ints whole (returned as int:
+    JSON may write 15.0), bools true bools; else a WoodcamError naming ``what``."""
+    if v is None and "None" in annotation:
+        return v
+    kind = annotation.split("|")[0].strip()
+    if kind == "bool":
+        ok = isinstance(v, bool)
+    elif kind in ("float", "int"):
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) \
+            and (kind == "float" or float(v).is_integer())
+    else:  # a Literal: its own check below names the choices
+        return v
+    if not ok:
+        rule = {"bool": "true or false", "float": "a finite number", "int": "a whole number"}[kind]
+        raise WoodcamError(f"{what} must be {rule}; got {v!r}")
+    return int(v) if kind == "int" else v
+
+
+def _entries(d: dict, key: str, where: str, need: str | None) -> list[dict]:
+    """``d[key]`` of a job file: a list of JSON objects (missing: empty), each with a string
+    ``need`` and its numbers ``dpi``, ``scale``, ``px_per_mm`` finite and > 0 where given."""
+    items = d.get(key, [])
+    if not isinstance(items, list):
+        raise WoodcamError(f"{where} {key!r} must be a list of objects; got {type(items).__name__}")
+    for i, t in enumerate(items):
+        if not isinstance(t, dict):
+            raise WoodcamError(f"{where} {key}[{i}] must be an object; got {t!r}")
+        if need is not None and not (isinstance(t.get(need), str) and t[need]):
+            raise WoodcamError(f"{where} {key}[{i}] needs a {need!r} path; got {t.get(need)!r}")
+        for num in ("dpi", "scale", "px_per_mm"):
+            if t.get(num) is not None:
+                _check_type(f"{where} {key}[{i}].{num}", t[num], "float")
+                if t[num] <= 0:
+                    raise WoodcamError(f"{where} {key}[{i}].{num} must be > 0; got {t[num]!r}")
+    return items
+
+
 # The reference code's keys for Table 1 / sec. 3.2 parameters.
 _PAPER_KEYS = {"num_source_rotations": "n_rot", "patch_levels": "n_adaptive",
                "patch_quality_factor": "w_adaptive", "weight_intensity": "w_intens",
@@ -194,15 +238,28 @@ class ParquetryJob:
 
 def read_job(path: str | Path) -> ParquetryJob:
     """Read a job file (paper layout + ``"woodcam"`` extras); paths resolved against its folder."""
+    from .._readers import read_json_object
+
     p = Path(path)
-    try:
-        d = json.loads(p.read_text())
-    except (OSError, ValueError) as err:
-        raise WoodcamError(f"job file {str(p)!r} cannot be read as JSON ({err}); pass a "
-                           "WoodPixel-style job (source_textures, targets, ...)") from err
-    if not isinstance(d, dict) or "targets" not in d:
-        raise WoodcamError(f"job file {str(p)!r} must be a JSON object with 'targets' (and "
-                           "'source_textures' or woodcam.blocks); see woodcam.parquetry.job")
+    d = read_json_object(p, "parquetry job file")
+    where = f"job file {str(p)!r}:"
+    if "targets" not in d:
+        raise WoodcamError(f"{where} needs 'targets' (and 'source_textures' or woodcam.blocks); see "
+                           "woodcam.parquetry.job")
+    extra = d.get("woodcam", {}) or {}
+    if not isinstance(extra, dict) or not isinstance(extra.get("params", {}), dict):
+        raise WoodcamError(f"{where} 'woodcam' and 'woodcam.params' must be objects; got {extra!r}")
+    mokume = extra.get("mokume", [])
+    if not isinstance(mokume, list) or not all(isinstance(m, str) for m in mokume):
+        raise WoodcamError(f"{where} 'woodcam.mokume' must be a list of folder paths; got {mokume!r}")
+    targets = _entries(d, "targets", where, "filename")
+    scans = _entries(d, "source_textures", where, "texture")
+    blocks = _entries(extra, "blocks", f"{where} woodcam", "spec")
+    for i, b in enumerate(blocks):  # the leaves' numbers (slice_veneers checks their ranges)
+        for num, kind in (("sheets", "int"), ("width_mm", "float"), ("height_mm", "float"),
+                          ("thickness_mm", "float"), ("kerf_mm", "float")):
+            if num in b:
+                _check_type(f"{where} woodcam.blocks[{i}].{num}", b[num], kind)
     base = p.parent
     names = {f.name for f in fields(ParquetryParams)}
     kw = {}
@@ -211,7 +268,6 @@ def read_job(path: str | Path) -> ParquetryJob:
             kw[_PAPER_KEYS[k]] = v
         elif k == "sort_patches_saliency":
             kw["priority"] = "saliency" if v else "center"
-    extra = d.get("woodcam", {}) or {}
     for k, v in extra.get("params", {}).items():
         if k not in names:
             raise WoodcamError(f"job file key woodcam.params.{k} is unknown; known: {sorted(names)}")
@@ -220,12 +276,12 @@ def read_job(path: str | Path) -> ParquetryJob:
     def _abs(s):
         return str((base / s).resolve()) if s else s
 
-    scans = [dict(t, texture=_abs(t["texture"]), mask=_abs(t.get("mask")))
-             for t in d.get("source_textures", [])]
-    targets = [dict(t, filename=_abs(t["filename"])) for t in d["targets"]]
-    blocks = list(extra.get("blocks", []))
-    mokume = [_abs(m) for m in extra.get("mokume", [])]
-    return ParquetryJob(scans, blocks, mokume, targets, ParquetryParams(**kw).check())
+    if any(t.get("mask") is not None and not isinstance(t["mask"], str) for t in scans):
+        raise WoodcamError(f"{where} a source_textures mask must be a path or null")
+    scans = [dict(t, texture=_abs(t["texture"]), mask=_abs(t.get("mask"))) for t in scans]
+    targets = [dict(t, filename=_abs(t["filename"])) for t in targets]
+    mokume = [_abs(m) for m in mokume]
+    return ParquetryJob(scans, list(blocks), mokume, targets, ParquetryParams(**kw).check())
 
 
 def write_job(job: ParquetryJob, path: str | Path) -> Path:
