@@ -20,6 +20,10 @@ def test_round_trip_of_synthetic_traces(tmp_path):
         assert a.year == b.year
         np.testing.assert_allclose(b.points_px, a.points_px, atol=1e-9)
     assert any(t.year is None for t in back)
+    # the photo underneath is an SVG 1.1 xlink:href (Inkscape before 1.3 ignores a plain href)
+    import xml.etree.ElementTree as ET
+    image = ET.parse(path).getroot().find("{http://www.w3.org/2000/svg}image")
+    assert image.get("{http://www.w3.org/1999/xlink}href") == "top_photo.png"
 
 
 def test_editor_style_svg(tmp_path):

@@ -37,6 +37,12 @@ def test_glb_round_trip_holds_surface_and_coloured_knots(log, tmp_path):
     assert tuple(LIVE_KNOT_RGBA) in colours and tuple(DEAD_KNOT_RGBA) in colours
     # knots stay inside the log's length (with the knots' own radius as slack)
     assert knots.bounds[0, 2] > -40 and knots.bounds[1, 2] < 1240
+    # glTF's conventions: metres and +Y up, so the 1200 mm log stands 1.2 units tall (it lay
+    # 1200 units long along +Z, a 1.2 km log on its side); the extras are not nested twice
+    lo, hi = scene.bounds
+    assert lo[1] == pytest.approx(0.0, abs=1e-9) and hi[1] == pytest.approx(1.2, rel=1e-6)
+    assert hi[0] - lo[0] < 0.5 and hi[2] - lo[2] < 0.5
+    assert scene.metadata.get("units") == "mm" and "extras" not in scene.metadata
 
 
 def test_heightmap_png_decodes_back_to_mm(log, tmp_path):

@@ -81,12 +81,13 @@ def test_cli_maps_and_export_round_trip(tmp_path):
     src = write_log(_log(), tmp_path / "log.json")
     a = _parse(["log", "maps", str(src), "--out", str(tmp_path / "maps")])
     assert a.func(a) == 0
+    # into a folder not made yet, as every other FILE output (it failed: no such file)
     b = _parse(["log", "export", "--maps", str(tmp_path / "maps"), "--out",
-                str(tmp_path / "back.json")])
+                str(tmp_path / "new" / "back.json")])
     assert b.func(b) == 0
     from woodcam.logs.io import read_log
 
-    log, back = _log(), read_log(tmp_path / "back.json")
+    log, back = _log(), read_log(tmp_path / "new" / "back.json")
     assert len(back.knots) == len(log.knots) == 1           # the knot survives the maps
     k, kb = log.knots[0], back.knots[0]
     assert abs(kb.z0_mm - k.z0_mm) < 3.0 and abs(kb.r_death_mm - k.r_death_mm) < 3.0

@@ -163,6 +163,35 @@ def test_seams_are_6_connected_and_in_their_bands(finished):
     assert any(np.ptp(ln.raw) > 0 for ln in p.seams_v)
 
 
+def test_cut_files_escape_names_and_place_labels_as_the_svg(tmp_path):
+    """A veneer named oak&ash<1> made an SVG title no XML reader accepts; the DXF's ids sat
+    left-aligned on the inner point (the SVG centres them 1 mm lower) and its header extents
+    stayed at +-1e20."""
+    import xml.etree.ElementTree as ET
+
+    import ezdxf
+    from shapely.geometry import Polygon
+
+    from woodcam.parquetry.cutpaths import svg_document, write_dxf
+
+    sq = [("L", np.array(a, float), np.array(b, float))
+          for a, b in (((10, 10), (40, 10)), ((40, 10), (40, 30)), ((40, 30), (10, 30)), ((10, 30), (10, 10)))]
+    doc = svg_document(50, 40, [(7, sq)], 1.0, title="woodcam veneer oak&ash<1>")
+    root = ET.fromstring(doc)
+    assert root.find("{http://www.w3.org/2000/svg}title").text == "woodcam veneer oak&ash<1>"
+    text = root.find(".//{http://www.w3.org/2000/svg}text")
+    write_dxf(tmp_path / "v.dxf", 40, [(7, sq)], 1.0)
+    dxf = ezdxf.readfile(str(tmp_path / "v.dxf"))
+    (label,) = dxf.modelspace().query("TEXT")
+    assert label.dxf.text == "7" and label.dxf.halign == 1 and label.dxf.valign == 0  # centred on its baseline
+    c = Polygon([s[1] for s in sq]).representative_point()
+    assert (float(text.get("x")), float(text.get("y"))) == pytest.approx((c.x, c.y + 1.0), abs=1e-3)
+    assert tuple(label.dxf.align_point)[:2] == pytest.approx((c.x, 40 - (c.y + 1.0)), abs=1e-6)  # y up
+    lo, hi = dxf.header["$EXTMIN"], dxf.header["$EXTMAX"]
+    assert lo[0] == pytest.approx(9.0, abs=0.1) and hi[0] == pytest.approx(41.0, abs=0.1)  # the tool path
+    assert lo[1] == pytest.approx(9.0, abs=0.1) and hi[1] == pytest.approx(31.0, abs=0.1)
+
+
 @pytest.mark.parametrize("mode, patch_mm", [("exhaustive", 7.0), ("fast", 14.0)])
 @pytest.mark.parametrize("rot", [0, 4])
 def test_crop_of_a_veneer_is_rebuilt_from_that_crop(sheets, mode, patch_mm, rot):

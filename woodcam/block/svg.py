@@ -48,10 +48,12 @@ def write_traces_svg(face: Face, path, *, photo_href: str | None = None, stroke_
         Stroke width in pixels.
     """
     rows, cols = face.shape
-    root = ET.Element("svg", {"xmlns": _SVG_NS, "width": str(cols), "height": str(rows),
-                              "viewBox": f"0 0 {cols} {rows}"})
+    root = ET.Element("svg", {"xmlns": _SVG_NS, "xmlns:xlink": "http://www.w3.org/1999/xlink",
+                              "width": str(cols), "height": str(rows), "viewBox": f"0 0 {cols} {rows}"})
     if photo_href:
-        ET.SubElement(root, "image", {"href": photo_href, "x": "0", "y": "0",
+        # xlink:href, not SVG 2's plain href: SVG 1.1 readers (Inkscape before 1.3) see only the
+        # former, and every browser and SVG 2 reader still reads it
+        ET.SubElement(root, "image", {"xlink:href": photo_href, "x": "0", "y": "0",
                                       "width": str(cols), "height": str(rows)})
     group = ET.SubElement(root, "g", {"id": f"rings-{face.name}", "fill": "none",
                                       "stroke-width": f"{stroke_px:g}"})

@@ -1,8 +1,9 @@
 """Pictures and 3-D files of a generated log: GLB (surface + knots) and heightmap PNG.
 
-Meshes are in the log frame (mm, ``z`` along the log, see :mod:`.generate`). glTF viewers
-read metres by convention; we write millimetres as numbers unchanged (as every woodcam export
-does) and say so in the file's ``extras``.
+Meshes are in the log frame (mm, ``z`` along the log, see :mod:`.generate`). The GLB follows
+glTF's conventions (metres, +Y up) as every woodcam GLB does: the vertices stay in mm and one
+root node carries :data:`~woodcam.frames.BLOCK_TO_GLTF` (scale 1/1000, ``z`` -> ``+Y``), so the
+log stands upright at its true size in any viewer; the file's ``extras`` say so.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import trimesh
 
 from .._atomic import atomic_path, write_bytes
 from ..errors import WoodcamError
+from ..frames import BLOCK_TO_GLTF, GLTF_ROOT_NODE
 from .generate import GeneratedKnot, GeneratedLog
 
 #: Colours (RGBA, 0-255): debarked sapwood, a live (intergrown) knot, a dead (loose) knot.
@@ -111,7 +113,8 @@ def export_log_glb(log: GeneratedLog, path, *, surface_alpha: float = 1.0, max_r
     """Write ``log`` as a binary glTF: the surface mesh (node ``surface``) and the knots (``knots``).
 
     ``surface_alpha`` < 1 makes the surface translucent (alpha blending) so the knots show.
-    Units: mm as plain numbers (module docstring). Returns the path written.
+    Vertices in mm under a root node that makes them metres, +Y up (module docstring). Returns
+    the path written.
     """
     if not (0.0 < surface_alpha <= 1.0):
         raise WoodcamError(f"surface_alpha must lie in (0, 1]; got {surface_alpha!r}")
@@ -125,11 +128,14 @@ def export_log_glb(log: GeneratedLog, path, *, surface_alpha: float = 1.0, max_r
         alphaMode="BLEND" if surface_alpha < 1 else "OPAQUE", doubleSided=surface_alpha < 1)
     surf.visual = trimesh.visual.TextureVisuals(material=mat)
     scene = trimesh.Scene()
-    scene.add_geometry(surf, node_name="surface", geom_name="surface")
+    scene.graph.update(frame_from=scene.graph.base_frame, frame_to=GLTF_ROOT_NODE, matrix=BLOCK_TO_GLTF)
+    scene.add_geometry(surf, node_name="surface", geom_name="surface", parent_node_name=GLTF_ROOT_NODE)
     km = knots_mesh(log)
     if len(km.faces):
-        scene.add_geometry(km, node_name="knots", geom_name="knots")
-    scene.metadata["extras"] = {"units": "mm", "frame": "log frame, z along the log", "seed": log.seed}
+        scene.add_geometry(km, node_name="knots", geom_name="knots", parent_node_name=GLTF_ROOT_NODE)
+    # trimesh writes scene.metadata as the scene's extras
+    scene.metadata.update({"units": "mm", "frame": "log frame, z along the log", "seed": log.seed,
+                           "block_to_gltf": BLOCK_TO_GLTF.tolist()})
     p.parent.mkdir(parents=True, exist_ok=True)
     write_bytes(p, scene.export(file_type="glb"))
     return p

@@ -35,7 +35,7 @@ def write_log(log: LogSkeleton, path: PathLike) -> Path:
     """Write ``log`` as a woodcam log file (JSON, mm); returns the path."""
     from .._atomic import write_text
 
-    return write_text(Path(path), json.dumps(log.to_json()))
+    return write_text(Path(path), json.dumps(log.to_json()), mkdir=True)
 
 
 def read_log(path: PathLike) -> LogSkeleton:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass, field
+from xml.sax.saxutils import escape
 
 import numpy as np
 
@@ -288,8 +289,8 @@ def svg_document(width_mm: float, height_mm: float, pieces: list[tuple[int, list
     ``engrave`` (piece ids at the centroids)."""
     from shapely.geometry import Polygon
 
-    out = [(f'<svg xmlns="http://www.w3.org/2000/svg" width="{width_mm:.3f}mm" height="{height_mm:.3f}mm" '
-           f'viewBox="0 0 {width_mm:.4f} {height_mm:.4f}">'), f"<title>{title}</title>"]
+    out = [(f'<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="{width_mm:.3f}mm" height="{height_mm:.3f}mm" '
+           f'viewBox="0 0 {width_mm:.4f} {height_mm:.4f}">'), f"<title>{escape(title)}</title>"]
     if background:
         out.append(background)
     out.append('<g id="cut" fill="none" stroke="#d00" stroke-width="0.2">')
@@ -351,12 +352,15 @@ def read_svg_segments(path) -> dict[int, list]:
 
 # -- DXF ------------------------------------------------------------------------------------
 def write_dxf(path, height_mm: float, pieces: list[tuple[int, list]], tool_radius_mm: float = 0.0):
-    """DXF (R2010, mm, y up): layer CUT (each outline as SPLINE/LINE entities of one closed
-    ezdxf path, xdata-free: the piece id is the entity's layer-group ``PIECE_<id>``), layer
-    TOOLPATH (compensated polylines), layer ENGRAVE (ids as TEXT)."""
+    """DXF (R2010, mm, y up): each outline on its own layer ``PIECE_<id>`` (SPLINE/LINE
+    entities of one closed ezdxf path, xdata-free: the layer names the piece), layer TOOLPATH
+    (compensated polylines), layer ENGRAVE (ids as TEXT, placed as the SVG's: centred on their
+    baseline 1 mm below the piece's inner point); the header's extents are the drawing's."""
     import ezdxf
+    from ezdxf import bbox
     from ezdxf import path as dpath
     from ezdxf import units
+    from ezdxf.enums import TextEntityAlignment
     from shapely.geometry import Polygon
 
     from .._atomic import write_text
@@ -382,7 +386,11 @@ def write_dxf(path, height_mm: float, pieces: list[tuple[int, list]], tool_radiu
             msp.add_lwpolyline([fl(q) for q in tool_path(segs, tool_radius_mm)], close=True,
                                dxfattribs={"layer": "TOOLPATH"})
         c = Polygon(flatten(segs)).representative_point()
-        msp.add_text(str(pid), height=3, dxfattribs={"layer": "ENGRAVE"}).set_placement(fl((c.x, c.y)))
+        msp.add_text(str(pid), height=3, dxfattribs={"layer": "ENGRAVE"}).set_placement(
+            fl((c.x, c.y + 1.0)), align=TextEntityAlignment.CENTER)
+    ext = bbox.extents(msp, fast=True)  # viewers that zoom to the header's extents need them
+    if ext.has_data:  # ezdxf writes the header's $EXTMIN/$EXTMAX from the modelspace's own
+        msp.dxf.extmin, msp.dxf.extmax = ext.extmin, ext.extmax
     import io
 
     buf = io.StringIO()

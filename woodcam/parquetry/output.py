@@ -137,8 +137,11 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
         W, H = p.matched.shape[1] / ppm, p.matched.shape[0] / ppm
         buf = io.BytesIO()
         Image.fromarray((np.clip(p.render, 0, 1) * 255 + 0.5).astype(np.uint8)).save(buf, format="PNG")
+        uri = "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode()
+        # xlink:href, not SVG 2's plain href: SVG 1.1 readers (Inkscape before 1.3) see only the
+        # former, and every browser and SVG 2 reader still reads it
         bg = (f'<image x="0" y="0" width="{W:.3f}" height="{H:.3f}" preserveAspectRatio="none" '
-              f'href="data:image/png;base64,{base64.b64encode(buf.getvalue()).decode()}"/>')
+              f'xlink:href="{uri}"/>')
         doc = svg_document(W, H, [(q.id, by_id[q.id].outline_panel) for q in p.patches],
                            background=bg, title=f"woodcam parquetry assembly {p.name}")
         files.append(write_text(out / f"assembly{sfx}.svg", doc, mkdir=True))
