@@ -108,6 +108,20 @@ def test_glb_is_metres_and_y_up_for_every_viewer(baked, tmp_path):
     assert read_glb_metadata(path)["block_to_gltf"][1] == [0.0, 0.0, 0.001, 0.0]
 
 
+def test_a_texture_that_wraps_is_repeated_not_clamped(tmp_path):
+    """woodify's bark gives seam triangles u + 1 so the picture wraps round the stem; the sampler
+    was always CLAMP_TO_EDGE, which smeared the texture's last column over the seam strip."""
+    from woodcam.woodify.bark import textured_mesh
+
+    cyl = trimesh.creation.cylinder(radius=5.0, height=10.0, sections=16)
+    u = 0.5 + np.arctan2(cyl.vertices[:, 1], cyl.vertices[:, 0]) / (2 * np.pi)
+    bark = textured_mesh(cyl, np.c_[u, cyl.vertices[:, 2] / 10 + 0.5], np.full((8, 8, 3), 128, np.uint8))
+    assert bark.visual.uv[:, 0].max() > 1.0  # the seam's copies
+    gltf, *_ = _gltf_world(export_glb(bark, tmp_path / "bark.glb"))
+    sampler = gltf.samplers[gltf.textures[0].sampler]
+    assert (sampler.wrapS, sampler.wrapT) == (10497, 33071)  # repeat along u, clamp along v
+
+
 def test_crease_normals_split_sharp_edges_and_smooth_flat_ones():
     from woodcam.export import crease_normals
 
@@ -127,6 +141,29 @@ def test_crease_normals_split_sharp_edges_and_smooth_flat_ones():
     np.testing.assert_allclose(np.abs(c.vertex_normals[~side, 2]), 1.0, atol=1e-12)  # flat caps
     with pytest.raises(WoodcamError, match="crease_angle_deg must be in"):
         crease_normals(box, -1.0)
+
+
+def test_crease_normals_of_zero_area_faces_are_unit_vectors():
+    """A zero-area face (woodify's grown meshes have some) gave its corners zero normals, which
+    glTF forbids (NORMAL must be unit: ACCESSOR_VECTOR3_NON_UNIT)."""
+    from woodcam.export import crease_normals
+
+    box = trimesh.creation.box((10.0, 10.0, 10.0))
+    n = len(box.vertices)
+    extra = np.array([[-5.0, -5.0, 5.0], [0.0, -5.0, 5.0], [5.0, -5.0, 5.0],   # along the top front edge
+                      [40.0, 0.0, 0.0], [41.0, 0.0, 0.0], [42.0, 0.0, 0.0]])  # alone, far away
+    mesh = trimesh.Trimesh(np.vstack([box.vertices, extra]),
+                           np.vstack([box.faces, [[n, n + 1, n + 2], [n + 3, n + 4, n + 5]]]), process=False)
+    out = crease_normals(mesh)
+    np.testing.assert_allclose(np.linalg.norm(out.vertex_normals, axis=1), 1.0, atol=1e-12)
+    # the corners on the box's corners take the smooth normal of the three faces there; the one
+    # between them touches no face's corner, as the lone face's corners, and gets +Z
+    edge = out.vertex_normals[out.faces[-2]]
+    np.testing.assert_allclose(edge, [[-1 / 3 ** 0.5, -1 / 3 ** 0.5, 1 / 3 ** 0.5], [0.0, 0.0, 1.0],
+                                      [1 / 3 ** 0.5, -1 / 3 ** 0.5, 1 / 3 ** 0.5]], atol=1e-12)
+    np.testing.assert_allclose(out.vertex_normals[out.faces[-1]], np.tile([0.0, 0.0, 1.0], (3, 1)), atol=1e-12)
+    np.testing.assert_allclose(out.vertex_normals[out.faces[:-2]],  # the box's own normals unchanged
+                               np.repeat(box.face_normals[:, None], 3, axis=1), atol=1e-12)
 
 
 @pytest.mark.parametrize(("units", "up", "scale", "height_axis"),

@@ -47,6 +47,15 @@ def test_woodify_writes_field_surfaces_sections_and_bark(grown_dir):
 
     glb = load_textured(grown_dir / "grown.glb")
     assert glb.visual.uv is not None and len(glb.faces) > 100
+    # the GLB says it is in the block frame, and is: the grown trunk (axis along the input's x)
+    # is the object frame moved by -block_origin, not the input mesh's frame (review placed its
+    # section colours 25 mm off the mesh)
+    meta = __import__("woodcam.export", fromlist=["x"]).read_glb_metadata(grown_dir / "grown.glb")
+    assert meta["frame"] == "block"
+    origin = np.asarray(meta["woodify"]["block_origin_mm"])
+    np.testing.assert_allclose(origin, f.block_origin_mm)
+    # the bark is the surface of the last year: the block's field reads 8 years on its vertices
+    assert np.percentile(np.abs(f(glb.vertices) - 8.0), 95) < 0.2
     summary = json.loads((grown_dir / "woodify.json").read_text())
     assert summary["method"] == "offset" and summary["cracks"]["count"] >= 0
 
@@ -87,10 +96,12 @@ def test_input_texture_is_carried_to_the_grown_bark(tmp_path):
     out = tmp_path / "grown"
     assert main(["woodify", str(tmp_path / "ball.glb"), "--years", "5", "--growth", "6",
                  "--resolution", "40", "--cracks", "none", "--out", str(out)]) == 0
-    from woodcam.export import load_textured
+    from woodcam.export import load_textured, read_glb_metadata
 
     g = load_textured(out / "grown.glb")
-    p = g.vertices / np.linalg.norm(g.vertices, axis=1, keepdims=True)
+    w = read_glb_metadata(out / "grown.glb")["woodify"]  # block frame -> the input's frame
+    q = g.vertices @ np.asarray(w["block_rotation"]).T + np.asarray(w["block_origin_mm"])
+    p = q / np.linalg.norm(q, axis=1, keepdims=True)
     lat = 0.5 + np.arcsin(p[:, 2]) / np.pi
     # latitude is smooth everywhere (longitude wraps at the seam): compare it
     assert np.percentile(np.abs(g.visual.uv[:, 1] - lat), 95) < 0.03

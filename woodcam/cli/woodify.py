@@ -237,13 +237,19 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
         width[crack_edges.ravel()] = 1.0
         mesh = groove(mesh, width, 0.6 * res.front.grid.spacing_mm)
     bark = textured_mesh(mesh, uv, image)
-    files.append(atomic(out / "grown.glb", lambda p: export_glb(bark, p, metadata={
-        "woodify": {"years": Y, "speed": res.speed.to_dict()}})))
     # the block cut from the grown object: default its bounding box
     lo, hi = mesh.bounds
     size = tuple(hi - lo) if block_size_mm is None else tuple(block_size_mm)
     centre = tuple((lo + hi) / 2) if block_centre_mm is None else tuple(block_centre_mm)
     placed = res.field.placed(size, centre)
+    # a woodcam GLB is in the block frame (its metadata says so, and `review --block
+    # woodify:field.npz` reads it so): object = block_origin + R @ block, so block = R^T (object
+    # - block_origin); the origin is kept in the metadata to put it back over the input mesh
+    bark.vertices = (np.asarray(bark.vertices) - placed.block_origin_mm) @ placed.rotation
+    files.append(atomic(out / "grown.glb", lambda p: export_glb(bark, p, metadata={
+        "woodify": {"years": Y, "speed": res.speed.to_dict(),
+                    "block_origin_mm": placed.block_origin_mm.tolist(),
+                    "block_rotation": placed.rotation.tolist()}})))
     files.append(placed.save(out / "field.npz"))
     summary["block"] = {"size_mm": list(size), "centre_mm": list(centre)}
     for y in surface_years:

@@ -52,7 +52,7 @@ _GL_ARRAY_BUFFER = 34962
 _GL_ELEMENT_ARRAY_BUFFER = 34963
 _GL_LINEAR = 9729
 _GL_LINEAR_MIPMAP_LINEAR = 9987
-_GL_CLAMP_TO_EDGE = 33071
+_GL_CLAMP_TO_EDGE, _GL_REPEAT = 33071, 10497
 
 #: zlib level of the texture PNG: level 1 encodes the bowl's 2k^2 atlas in 0.21 CPU-s (3.2 MB),
 #: PIL's default 6 in 0.76-0.96 s (2.9 MB); the GLB and the OBJ's PNG share one encoding.
@@ -160,7 +160,10 @@ def crease_normals(mesh: Mesh, crease_angle_deg: float | None = None) -> Mesh:
     face_of_corner = np.repeat(np.arange(n_faces), 3)
     cross = np.cross(verts[faces[:, 1]] - verts[faces[:, 0]], verts[faces[:, 2]] - verts[faces[:, 0]])
     area2 = np.linalg.norm(cross, axis=1)
-    unit = cross / np.maximum(area2, 1e-300)[:, None]
+    # a zero-area face (collinear corners) has no normal of its own: it counts for nothing and
+    # its corners take the smooth normal of every face at their position (below)
+    flat = area2 <= 1e-14 * max(float(area2.max(initial=0.0)), 1e-300)
+    unit = np.where(flat[:, None], 0.0, cross / np.maximum(area2, 1e-300)[:, None])
     # position id of every corner (welded at CREASE_WELD_MM)
     keys = np.round(verts / CREASE_WELD_MM).astype(np.int64)
     _, pos_of_vertex = np.unique(keys, axis=0, return_inverse=True)
@@ -171,7 +174,7 @@ def crease_normals(mesh: Mesh, crease_angle_deg: float | None = None) -> Mesh:
     same = (incidence @ incidence.T).tocoo()
     a, b = same.row, same.col
     cos = np.einsum("ij,ij->i", unit[face_of_corner[a]], unit[face_of_corner[b]])
-    keep = cos >= math.cos(math.radians(angle)) - 1e-12
+    keep = (cos >= math.cos(math.radians(angle)) - 1e-12) | flat[face_of_corner[a]]
     a, b = a[keep], b[keep]
     # Angle-weighted normals (Thuerrner & Wuethrich 1998): each neighbour corner weighs its
     # face's normal by its own corner angle, so the result does not depend on how a flat
@@ -188,9 +191,10 @@ def crease_normals(mesh: Mesh, crease_angle_deg: float | None = None) -> Mesh:
     for k in range(3):
         normal[:, k] = np.bincount(a, weights=weighted[b, k], minlength=n_corners)
     length = np.linalg.norm(normal, axis=1)
-    degenerate = length < 1e-300
-    normal[degenerate] = unit[face_of_corner[degenerate]]
-    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+    # no face with a normal at this position (an isolated zero-area face): any unit vector
+    # beats the zero one glTF forbids (ACCESSOR_VECTOR3_NON_UNIT)
+    normal[length < 1e-300] = (0.0, 0.0, 1.0)
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
     # one output vertex per (input vertex, normal)
     qn = np.round(normal * 1e6).astype(np.int64)
     table = np.column_stack([corners, qn])
@@ -258,12 +262,18 @@ def export_glb(mesh: Mesh, path: PathLike, metadata: dict | None = None, *,
                       "matrix": [float(v) for v in BLOCK_TO_GLTF.T.reshape(-1)]})
         scene["nodes"] = [len(nodes) - 1]
         tree["samplers"] = [{"magFilter": _GL_LINEAR, "minFilter": _GL_LINEAR_MIPMAP_LINEAR,
-                             "wrapS": _GL_CLAMP_TO_EDGE, "wrapT": _GL_CLAMP_TO_EDGE}]
+                             "wrapS": wrap[0], "wrapT": wrap[1]}]
         for texture in tree.get("textures", []):
             texture["sampler"] = 0
         _set_buffer_view_targets(tree)
 
     shaded = _shaded(mesh, crease_angle_deg, normals, "export_glb")
+    # an atlas (a bake) lies in [0, 1] and is clamped, so its border texels never bleed across;
+    # coordinates beyond it mean a repeating picture (woodify's bark wraps round the stem with
+    # u + 1 on the seam triangles), which clamping would smear
+    uv = np.asarray(shaded.visual.uv, float)
+    wrap = [_GL_REPEAT if len(uv) and (uv[:, k].min() < -1e-9 or uv[:, k].max() > 1 + 1e-9)
+            else _GL_CLAMP_TO_EDGE for k in (0, 1)]
     _with_encoded_texture(shaded, "baseColorTexture")
     scene = trimesh.Scene()
     scene.add_geometry(shaded, geom_name="part", node_name="part")
