@@ -76,6 +76,16 @@ def test_version_prints_the_package_version(capsys):
     assert capsys.readouterr().out.strip() == f"woodcam {__version__}"
 
 
+@pytest.mark.parametrize("module", ["woodcam", "woodcam.cli"])
+def test_python_dash_m_runs_the_command(module):
+    """``python -m woodcam`` said 'No module named woodcam.__main__'."""
+    from woodcam import __version__
+
+    res = subprocess.run([sys.executable, "-m", module, "--version"], cwd=REPO, capture_output=True,
+                         text=True, timeout=120)
+    assert res.returncode == 0 and res.stdout.strip() == f"woodcam {__version__}", res.stderr
+
+
 def test_preview_takes_negative_vectors_and_view_flags():
     from woodcam.cli import build_parser
 

@@ -83,11 +83,11 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
     ``.obj``/``.mtl``/``.png`` beside it when ``obj``, and the rendered ``*_view.png`` (or the
     given screenshot path). Returns ``out_glb`` as a Path; raises WoodcamError naming the path."""
     from ._atomic import check_output_path
+    from .export import obj_siblings
 
     out_glb = check_output_path(out_glb, suffixes=(".glb",), what=what, mkdir=True)
     if obj:
-        for sibling in (out_glb.with_suffix(".obj"), out_glb.with_suffix(".mtl"),
-                        out_glb.with_name(out_glb.stem + "_texture.png")):
+        for sibling in (out_glb.with_suffix(".obj"), *obj_siblings(out_glb.with_suffix(".obj"))):
             suffix = sibling.suffix
             check_output_path(sibling, what=f"{what} (the {suffix[1:].upper()} "
                               "beside the GLB; --no-obj skips it)")

@@ -108,6 +108,18 @@ def test_glb_is_metres_and_y_up_for_every_viewer(baked, tmp_path):
     assert read_glb_metadata(path)["block_to_gltf"][1] == [0.0, 0.0, 0.001, 0.0]
 
 
+def test_obj_names_with_spaces_stay_one_token(baked, tmp_path):
+    """'my tray.obj' wrote 'mtllib my tray.mtl' and 'usemtl my tray_texture': OBJ readers split
+    those at whitespace (two files 'my' and 'tray.mtl')."""
+    path = export_obj(baked.mesh, tmp_path / "my tray.obj")
+    text = path.read_text()
+    assert "mtllib my_tray.mtl\n" in text and "usemtl my_tray_texture\n" in text
+    mtl = (tmp_path / "my_tray.mtl").read_text()
+    assert "newmtl my_tray_texture\n" in mtl and "map_Kd my_tray_texture.png\n" in mtl
+    assert (tmp_path / "my_tray_texture.png").is_file()
+    assert len(load_textured(path).faces) == len(baked.mesh.faces)
+
+
 def test_a_texture_that_wraps_is_repeated_not_clamped(tmp_path):
     """woodify's bark gives seam triangles u + 1 so the picture wraps round the stem; the sampler
     was always CLAMP_TO_EDGE, which smeared the texture's last column over the seam strip."""

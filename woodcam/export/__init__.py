@@ -32,6 +32,7 @@ from .._types import Mesh, PathLike
 import copy
 import json
 import math
+import re
 import struct
 from pathlib import Path
 from typing import get_args
@@ -310,9 +311,20 @@ def _set_buffer_view_targets(tree: dict) -> None:
                     views[view]["target"] = target
 
 
+def obj_siblings(obj_path: PathLike) -> tuple[Path, Path]:
+    """The MTL and texture files :func:`export_obj` writes beside ``obj_path``: ``NAME.mtl`` and
+    ``NAME_texture.png``, whitespace in NAME made ``_`` (``mtllib`` is a list of names split at
+    whitespace, ``usemtl`` one token and ``map_Kd``'s file its last: a reader takes "my tray.mtl"
+    for the two files "my" and "tray.mtl")."""
+    path = Path(obj_path)
+    name = re.sub(r"\s", "_", path.stem)
+    return path.with_name(f"{name}.mtl"), path.with_name(f"{name}_texture.png")
+
+
 def export_obj(mesh: Mesh, path: PathLike, *, units: ObjUnits = "m", up: ObjUp = "y",
                crease_angle_deg: float | None = None, normals: str = "crease") -> Path:
-    """Write ``mesh`` as ``NAME.obj`` + ``NAME.mtl`` + ``NAME_texture.png`` side by side.
+    """Write ``mesh`` as ``NAME.obj`` + ``NAME.mtl`` + ``NAME_texture.png`` side by side (the
+    last two with whitespace in NAME made ``_``: :func:`obj_siblings`).
 
     Parameters
     ----------
@@ -345,7 +357,8 @@ def export_obj(mesh: Mesh, path: PathLike, *, units: ObjUnits = "m", up: ObjUp =
         raise WoodcamError(f"export_obj: up must be one of {get_args(ObjUp)}; got {up!r}")
     from ._obj_text import obj_blocks
 
-    stem = path.stem
+    mtl_path, tex_path = obj_siblings(path)
+    stem = mtl_path.stem
     out = _shaded(mesh, crease_angle_deg, normals, "export_obj")
     transform = obj_transform(units, up)
     # einsum, not "@": BLAS multiplies an (n, 3) by a 3 x 3 ~10x slower (0.1 CPU-s per
@@ -358,7 +371,7 @@ def export_obj(mesh: Mesh, path: PathLike, *, units: ObjUnits = "m", up: ObjUp =
     image = getattr(material, "image", None) or getattr(material, "baseColorTexture", None)
     # NAME_texture.png, not NAME.png: a screenshot named after the part must never overwrite
     # the texture (issue 17: 'woodcam preview bowl.glb --screenshot bowl.png' did)
-    tex = f"{stem}_texture"
+    tex = tex_path.stem
     # Viewers multiply map_Kd by Kd: white keeps the baked colours as baked. Wood is matte.
     mtl = (f"newmtl {tex}\nKa 1.00000000 1.00000000 1.00000000\nKd 1.00000000 1.00000000 "
            f"1.00000000\nKs 0.07843137 0.07843137 0.07843137\nNs 1.00000000\n")
