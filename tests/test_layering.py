@@ -39,7 +39,7 @@ LAYERS: dict[str, int] = {
     "benchmark": 14,                   # bench tasks and reports, run by scale
     "bench_realistic": 14,             # realistic-generator scoring per block (issue 12)
     "cli": 15,                         # the command, on top
-    "__main__": 15,                    # python -m woodcam: the command
+    "__main__": 16,                    # python -m woodcam: runs the command
     "woodcam": 16,                     # the package's lazy re-exports
 }
 #: Data folders (no code).
