@@ -27,3 +27,32 @@ def test_cache_follows_xdg_and_keeps_under_its_limit(tmp_path, monkeypatch, caps
     assert "deleted 2 entries" in capsys.readouterr().out
     assert list((cache_root() / "fields").glob("*.bin")) == []
     assert prune(0) == 0
+
+
+def test_clear_takes_only_a_known_kind(tmp_path, monkeypatch, capsys):
+    """'cache clear --kind /some/folder' deleted every file under that folder (a kind was joined
+    to the cache root unchecked), and '--kind bogus' said 'deleted 0' with exit 0."""
+    import pytest
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    victim = tmp_path / "victim"
+    (victim / "sub").mkdir(parents=True)
+    (victim / "a.txt").write_text("a")
+    (victim / "sub" / "b.txt").write_text("b")
+    (tmp_path / "cache" / "fields").mkdir(parents=True)
+    (tmp_path / "cache" / "fields" / "x.npz").write_bytes(b"x")
+    (tmp_path / "cache" / "detect").mkdir()
+    (tmp_path / "cache" / "detect" / "y.npz").write_bytes(b"y")
+    for kind in (str(victim), "../victim", "bogus", ""):
+        with pytest.raises(SystemExit) as exc:
+            main(["cache", "clear", "--kind", kind])
+        assert exc.value.code == 2 and "invalid choice" in capsys.readouterr().err
+    assert (victim / "a.txt").is_file() and (victim / "sub" / "b.txt").is_file()
+    from woodcam._cache import clear
+    from woodcam.errors import WoodcamError
+
+    with pytest.raises(WoodcamError, match="cache kind must be one of"):
+        clear("../victim")
+    assert main(["cache", "clear", "--kind", "fields"]) == 0
+    assert "deleted 1 entries" in capsys.readouterr().out
+    assert (tmp_path / "cache" / "detect" / "y.npz").is_file()

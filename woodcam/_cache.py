@@ -55,8 +55,17 @@ def cache_root() -> Path:
     return Path(platformdirs.user_cache_dir("woodcam", appauthor=False))
 
 
+#: The kinds of cache entry, one folder each: fitted fields (``woodcam.stock``), neural colour
+#: volumes (``woodcam.appearance.neural``) and ring detections (``woodcam.detect.block``).
+CACHE_KINDS: tuple[str, ...] = ("appearance", "detect", "fields")
+
+
 def cache_dir(kind: str) -> Path:
-    """The folder of one kind of cache entry (``"fields"``, ``"appearance"``, ...); not created."""
+    """The folder of one kind of cache entry (:data:`CACHE_KINDS`); not created. Any other
+    name is refused: a kind is a folder name under the cache, and ``woodcam cache clear
+    --kind /home/me`` emptied whatever folder it was given."""
+    if kind not in CACHE_KINDS:
+        raise WoodcamError(f"cache kind must be one of {', '.join(CACHE_KINDS)}; got {kind!r}")
     return cache_root() / kind
 
 
@@ -202,7 +211,7 @@ def cache_max_bytes() -> int:
 
 def entries(kind: str | None = None) -> list[Path]:
     """Cache entry files (lock files left out), of one ``kind`` or all, oldest use first."""
-    root = cache_dir(kind) if kind else cache_root()
+    root = cache_root() if kind is None else cache_dir(kind)
     if not root.is_dir():
         return []
     files = [p for p in root.rglob("*") if p.is_file() and p.suffix != ".lock"]

@@ -18,8 +18,11 @@ def register(subparsers) -> None:
     info = sub.add_parser("info", help="where the cache is and how much it holds")
     info.set_defaults(func=run_info)
     clear = sub.add_parser("clear", help="delete cache entries (they are rebuilt when needed)")
-    clear.add_argument("--kind", default=None,
-                       help="only this kind of entry, e.g. fields or appearance (default: all)")
+    from .._cache import CACHE_KINDS
+
+    clear.add_argument("--kind", default=None, choices=CACHE_KINDS,
+                       help="only this kind of entry: fitted fields, neural colour volumes "
+                       "(appearance) or ring detections (detect) (default: all)")
     clear.set_defaults(func=run_clear)
 
 
