@@ -61,6 +61,43 @@ def test_disc_background_outside_the_log():
         lr.end_grain_disc(log, 5000.0)
 
 
+def test_sections_off_the_log_are_refused_by_name():
+    """--board 1e9 0 60 rendered a board a million metres up a 600 mm log (exit 0); --radial 1e300 0
+    overflowed (a traceback); --px-per-mm 1000 asked for 1.57 TiB; an azimuth of 1e300 degrees
+    made a file name too long."""
+    log = _log()  # 600 mm long, 100 mm radius
+    with pytest.raises(WoodcamError, match=r"--board Z AZ OFF\) must lie in the log, \[0, 600\] mm"):
+        lr.tangential_board(log, 1e9, 0.0, 60.0)
+    with pytest.raises(WoodcamError, match=r"offset_mm \(--board Z AZ OFF\) must be within the log's radius"):
+        lr.tangential_board(log, 300.0, 0.0, 1e6)
+    with pytest.raises(WoodcamError, match=r"--radial Z AZ\) must lie in the log"):
+        lr.radial_section(log, 1e300, 0.0)
+    with pytest.raises(WoodcamError, match="MAX_GRID_CELLS.*lower --px-per-mm"):
+        lr.radial_section(log, 300.0, 0.0, px_per_mm=1000.0).points()
+    assert lr.radial_section(log, 300.0, np.radians(1e300)).name.startswith("radial_z300_az")
+    assert len(lr.radial_section(log, 300.0, np.radians(-90.0)).name) < 20
+    assert lr.radial_section(log, 300.0, np.radians(-90.0)).name == "radial_z300_az270"
+
+
+def test_a_log_file_names_no_path_and_says_mm(tmp_path):
+    """A log file named "../../escaped" made 'log render' write outside --out; "units": "inch"
+    was read as mm without a word."""
+    import json
+
+    from woodcam.logs.io import read_log
+
+    d = json.loads(write_log(_log(), tmp_path / "log.json").read_text())
+    for name in ("../../escaped", "/etc/x", "", "a/b"):
+        (tmp_path / "bad.json").write_text(json.dumps(dict(d, name=name)))
+        with pytest.raises(WoodcamError, match="name must be a plain name"):
+            read_log(tmp_path / "bad.json")
+    (tmp_path / "inch.json").write_text(json.dumps(dict(d, units="inch")))
+    with pytest.raises(WoodcamError, match="units must be 'mm'"):
+        read_log(tmp_path / "inch.json")
+    (tmp_path / "ok.json").write_text(json.dumps(dict(d, name="Gran 1.b-2")))
+    assert read_log(tmp_path / "ok.json").name == "Gran 1.b-2"
+
+
 def _parse(argv):
     return build_parser().parse_args(argv)
 

@@ -22,6 +22,7 @@ by other tools (images, generators) and the parametric real-log knots share one 
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -216,6 +217,11 @@ class LogSkeleton:
         if rad.ndim != 2 or rad.shape[0] != len(z) or rad.shape[1] < 4 or np.any(rad <= 0):
             raise WoodcamError(f"Log.radii_mm must be ({len(z)}, a>=4) positive radii; got "
                                f"shape {rad.shape}; give one row of azimuth radii per pith height")
+        # the name becomes part of output file names (``woodcam log render``): a plain name,
+        # never a path (a log file named "../../x" wrote outside --out)
+        if not (isinstance(self.name, str) and re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9 ._+-]{0,99}", self.name)):
+            raise WoodcamError(f"Log.name must be a plain name (letters, digits, space . _ + -, at most "
+                               f"100, no path); got {self.name!r}")
         object.__setattr__(self, "pith_z_mm", z)
         object.__setattr__(self, "pith_xy_mm", xy)
         object.__setattr__(self, "radii_mm", rad)
@@ -283,10 +289,14 @@ class LogSkeleton:
         if d.get("format") != "woodcam-log":
             raise WoodcamError(f"log file format must be 'woodcam-log'; got {d.get('format')!r}; "
                                "write the file with woodcam.logs.write_log")
+        if d.get("units", "mm") != "mm":  # it was read as mm whatever it said
+            raise WoodcamError(f"log file units must be 'mm' (every length in millimetres); got "
+                               f"{d.get('units')!r}; convert the file's lengths to mm")
+        name = d.get("name", "log")
         try:
             return cls(d["pith_z_mm"], d["pith_xy_mm"], d["radii_mm"],
                        tuple(BranchStrand.from_json(k) for k in d.get("knots", [])),
-                       d.get("name", "log"))
+                       name)
         except KeyError as err:
             raise WoodcamError(f"log file is missing the key {err.args[0]!r}; it needs "
                                "pith_z_mm, pith_xy_mm and radii_mm") from err

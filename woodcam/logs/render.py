@@ -46,6 +46,11 @@ class Section:
 
     def points(self) -> np.ndarray:
         """Pixel-centre points ``(rows, cols, 3)`` in the log frame, mm."""
+        from ..limits import check_grid
+
+        # a 4 m board at 1000 px/mm asked for 1.57 TiB (3 floats a point)
+        check_grid((self.size_mm[1] * self.px_per_mm, self.size_mm[0] * self.px_per_mm, 3),
+                   f"the section {self.name!r} at {self.px_per_mm:g} px/mm", fix="lower --px-per-mm")
         rows, cols = self.shape()
         o, u, v = (np.asarray(a, float) for a in (self.origin_mm, self.u, self.v))
         j = (np.arange(cols) + 0.5) / self.px_per_mm
@@ -53,13 +58,24 @@ class Section:
         return o + j[None, :, None] * u + i[:, None, None] * v
 
 
+def _check_height(log: LogSkeleton, z_mm: float, what: str) -> None:
+    """``z_mm`` lies along the log (a section elsewhere shows only air, and 1e300 overflowed)."""
+    if not (log.pith_z_mm[0] <= z_mm <= log.pith_z_mm[-1]):
+        raise WoodcamError(f"{what} must lie in the log, [{log.pith_z_mm[0]:g}, {log.pith_z_mm[-1]:g}] "
+                           f"mm along it; got {z_mm:g}")
+
+
+def _deg(azimuth_rad: float) -> str:
+    """An azimuth for a file name: whole degrees in [0, 360) (1e300 degrees made a name longer
+    than the file system allows)."""
+    return f"{np.degrees(azimuth_rad) % 360.0:.0f}"
+
+
 def end_grain_disc(log: LogSkeleton, z_mm: float, *, px_per_mm: float = 2.0, margin_mm: float = 5.0
                    ) -> Section:
     """Horizontal section at height ``z_mm`` covering the whole log cross-section, seen from
     above (``+x`` to the right, ``+y`` up in the image)."""
-    if not (log.pith_z_mm[0] <= z_mm <= log.pith_z_mm[-1]):
-        raise WoodcamError(f"z_mm must lie in the log [{log.pith_z_mm[0]}, {log.pith_z_mm[-1]}] "
-                           f"mm; got {z_mm}")
+    _check_height(log, z_mm, "the disc's height z_mm (--disc)")
     c = log.pith_at(np.array([z_mm]))[0]
     h = log.r_max_mm + margin_mm
     return Section((c[0] - h, c[1] + h, z_mm), (1, 0, 0), (0, -1, 0), (2 * h, 2 * h), px_per_mm,
@@ -72,13 +88,17 @@ def tangential_board(log: LogSkeleton, z_center_mm: float, azimuth_rad: float, o
     """Face of a flat-sawn board: a plane parallel to the log axis at ``offset_mm`` from the
     pith (at ``z_center_mm``), facing azimuth ``azimuth_rad``. Image columns run along the log
     (``+z`` to the right), rows across it."""
+    _check_height(log, z_center_mm, "the board's centre height z_center_mm (--board Z AZ OFF)")
+    if not abs(offset_mm) < log.r_max_mm:
+        raise WoodcamError(f"the board's offset from the pith offset_mm (--board Z AZ OFF) must be within "
+                           f"the log's radius, |offset| < {log.r_max_mm:g} mm; got {offset_mm:g}")
     c = log.pith_at(np.array([z_center_mm]))[0]
     n = np.array([np.cos(azimuth_rad), np.sin(azimuth_rad), 0.0])
     t = np.array([-np.sin(azimuth_rad), np.cos(azimuth_rad), 0.0])
     centre = np.array([c[0], c[1], z_center_mm]) + offset_mm * n
     origin = centre - 0.5 * length_mm * np.array([0, 0, 1.0]) + 0.5 * width_mm * t
     return Section(tuple(origin), (0, 0, 1), tuple(-t), (length_mm, width_mm), px_per_mm,
-                   f"board_z{z_center_mm:.0f}_az{np.degrees(azimuth_rad):.0f}_off{offset_mm:.0f}")
+                   f"board_z{z_center_mm:.0f}_az{_deg(azimuth_rad)}_off{offset_mm:.0f}")
 
 
 def radial_section(log: LogSkeleton, z_center_mm: float, azimuth_rad: float, *,
@@ -88,12 +108,13 @@ def radial_section(log: LogSkeleton, z_center_mm: float, azimuth_rad: float, *,
     azimuth ``azimuth_rad``, from the far bark to the near bark. Columns run along the log
     (``+z`` to the right); rows from ``azimuth_rad`` (top) through the pith to the opposite
     side. Knots show as spikes growing out of the pith."""
+    _check_height(log, z_center_mm, "the section's centre height z_center_mm (--radial Z AZ)")
     c = log.pith_at(np.array([z_center_mm]))[0]
     n = np.array([np.cos(azimuth_rad), np.sin(azimuth_rad), 0.0])
     h = log.r_max_mm + margin_mm
     origin = np.array([c[0], c[1], z_center_mm - 0.5 * length_mm]) + h * n
     return Section(tuple(origin), (0, 0, 1), tuple(-n), (length_mm, 2 * h), px_per_mm,
-                   f"radial_z{z_center_mm:.0f}_az{np.degrees(azimuth_rad):.0f}")
+                   f"radial_z{z_center_mm:.0f}_az{_deg(azimuth_rad)}")
 
 
 def busiest_board(log: LogSkeleton, *, offset_mm: float = 60.0, length_mm: float = 600.0,
