@@ -9,6 +9,8 @@ import pytest
 from woodcam.cli import EXIT_ERROR, EXIT_USAGE, main
 
 BAKE = ["bake", "cad_examples/bowl.py", "--block", "builtin:flat-sawn"]
+GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb", "--no-obj",
+         "--cell-size", "0.5"]
 
 
 @pytest.mark.parametrize("argv, match", [
@@ -30,6 +32,11 @@ BAKE = ["bake", "cad_examples/bowl.py", "--block", "builtin:flat-sawn"]
     ([*BAKE, "--out", "OUT/file.txt/x.glb"], r"is a file, not a folder"),
     ([*BAKE, "--out", "OUT/x.glb", "--screenshot", "OUT/x.jpg"], r"--screenshot must end in .png"),
     ([*BAKE, "--out", "OUT/objdir/x.glb"], r"the OBJ beside the GLB"),
+    # an infinite machining time was an OverflowError traceback
+    ([*GCODE, "--tool", "flat:6", "--start=1e300,0,0"], r"--start must be in \[-100000, 100000\]; got 1e\+300"),
+    ([*GCODE, "--tool", "flat:6", "--rapid-rate", "1e-320"], r"--rapid-rate must be in \[0.1, 1e\+06\]"),
+    # a bad spec after a good tool number was reported as a bad number
+    ([*GCODE, "--tool", "5=flat:6:7"], r"--tool '5=flat:6:7': tool spec 'flat:6:7': flat takes 1 number"),
 ])
 def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(__import__("pathlib").Path(__file__).resolve().parents[2])

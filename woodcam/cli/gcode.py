@@ -130,10 +130,14 @@ def _tools_from_args(args, program) -> dict:
         if "=" in item.split(":", 1)[0]:  # N=SPEC (a spec's own key=value parts follow ':')
             num, spec = item.split("=", 1)
             try:
-                tools[int(num)] = parse_tool_spec(spec)
+                number = int(num)
             except ValueError as err:
                 raise WoodcamError(f"--tool {item!r}: the part before '=' must be a tool "
                                    "number, e.g. 2=ball:3") from err
+            try:
+                tools[number] = parse_tool_spec(spec)
+            except WoodcamError as err:  # what is wrong with the spec, not with the number
+                raise WoodcamError(f"--tool {item!r}: {err}") from err
         else:
             unnumbered.append(parse_tool_spec(item))
     if unnumbered:
@@ -264,6 +268,8 @@ def run(args) -> int:
 
 
 def _hms(seconds: float) -> str:
+    if not math.isfinite(seconds):  # a program that never ends (its own numbers: no traceback)
+        return "unbounded"
     m, s = divmod(int(round(seconds)), 60)
     h, m = divmod(m, 60)
     return f"{h}:{m:02d}:{s:02d}"

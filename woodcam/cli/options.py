@@ -517,6 +517,11 @@ RANGES: dict = {
     "workers": (1, 1024, False),
     "memory_limit_mb": (64, 1_048_576, False),
     "connect_timeout_s": (0.0, 3600.0, True),
+    # gcode: a rapid rate of 1e-320 mm/min made the machining time infinite (a traceback), a
+    # start point 1e300 mm away the same; 100 m is beyond any machine's travel
+    ("gcode", "rapid_rate"): (0.1, 1e6, False),  # mm/min
+    ("gcode", "start"): (-1e5, 1e5, False),      # mm, work coordinates
+    ("gcode", "work_offset"): (-1e5, 1e5, False),
 }
 
 
