@@ -25,12 +25,11 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import os
+import sys
 import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, TypeVar
-
-import numpy as np
 
 from ._atomic import atomic_path
 from .errors import WoodcamError, WoodcamWarning
@@ -81,7 +80,9 @@ def _feed(h, obj: Any) -> None:
     elif isinstance(obj, (bytes, bytearray, memoryview)):
         b = bytes(obj)
         h.update(b"B" + len(b).to_bytes(8, "little") + b)
-    elif isinstance(obj, np.ndarray) or np.isscalar(obj):
+    elif "numpy" in sys.modules and isinstance(obj, (sys.modules["numpy"].ndarray, sys.modules["numpy"].generic)):
+        import numpy as np  # not at the top: `woodcam cache --help` stays light (an array means it is loaded)
+
         a = np.ascontiguousarray(obj)
         h.update(b"A" + a.dtype.str.encode() + repr(a.shape).encode())
         h.update(a.tobytes())

@@ -36,3 +36,25 @@ def test_grain_direction_refuses_what_is_not_a_field():
 
     with pytest.raises(WoodcamError, match="field must be a growth field.*got NoneType"):
         grain_direction(None, np.zeros((2, 3)))
+
+
+def test_sizes_that_cannot_be_held_are_refused_before_allocating():
+    """rings_picture(zoom=1e6) was a MemoryError from PIL; slice_veneers of 1e300 mm sheets a
+    ValueError from numpy; woodify(growth_mm=1e20) a ZeroDivisionError deep in the rasteriser."""
+    import numpy as np
+    import trimesh
+
+    from woodcam.detect.show import rings_picture
+    from woodcam.parquetry import slice_veneers
+    from woodcam.stock import open_stock
+    from woodcam.synth import cut_block, synth_block
+    from woodcam.woodify import woodify
+
+    block = synth_block(cut_block(lambda p: np.hypot(p[:, 0], p[:, 1]) / 2.0, (20, 20, 20), "rift"),
+                        (20, 20, 20), face_px=32, seed=1)
+    with pytest.raises(WoodcamError, match="the picture at --zoom 1000000 .*MAX_IMAGE_PIXELS"):
+        rings_picture(block, zoom=1_000_000)
+    with pytest.raises(WoodcamError, match="leaves of 1e\\+300 x 10 mm .*MAX_GRID_CELLS"):
+        slice_veneers(open_stock("builtin:flat-sawn"), 2, (1e300, 10.0), px_per_mm=1.0)
+    with pytest.raises(WoodcamError, match="growth_mm must be in \\(0, 10000\\]"):
+        woodify(trimesh.creation.icosphere(radius=5.0), 3.0, growth_mm=1e20)

@@ -35,6 +35,18 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     # an infinite machining time was an OverflowError traceback
     ([*GCODE, "--tool", "flat:6", "--start=1e300,0,0"], r"--start must be in \[-100000, 100000\]; got 1e\+300"),
     ([*GCODE, "--tool", "flat:6", "--rapid-rate", "1e-320"], r"--rapid-rate must be in \[0.1, 1e\+06\]"),
+    # tracebacks (an allocation, OpenCV's assertion) or a run that never ended
+    (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--sheet-size", "1e300x10"],
+     r"--sheet-size takes WxH in mm"),
+    (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--image-size-mm", "1e300"],
+     r"image_size_mm \(--image-size-mm\) must be in \[patch_mm = 14, 10000\] mm"),
+    (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--sheets", "1000000"],
+     r"--sheets must be in \[1, 1000\]"),
+    (["rings", "show", "OUT/none", "--out", "OUT/x.png", "--zoom", "1000000"], r"--zoom must be in \[1, 64\]"),
+    # accepted: a block at -5 px/mm, or at 0 px/mm for a 1e300 mm cube
+    (["block", "from-photos", "OUT/none", "--size-mm", "50", "--out", "OUT/fp", "--max-px-per-mm=-5"],
+     r"--max-px-per-mm must be in \(0, 1000\]"),
+    (["block", "from-photos", "OUT/none", "--size-mm", "1e300", "--out", "OUT/fp"], r"--size-mm takes WxDxH in mm"),
     # a bad spec after a good tool number was reported as a bad number
     ([*GCODE, "--tool", "5=flat:6:7"], r"--tool '5=flat:6:7': tool spec 'flat:6:7': flat takes 1 number"),
 ])
@@ -68,6 +80,8 @@ def test_work_offset_must_be_three_finite_numbers(value, capsys):
     (["bake", "x.py", "--block", "builtin:flat-sawn", "--out", "x.glb", "--tolerance", "abc"], "woodcam bake"),
     (["nosuch"], "woodcam"),  # an unknown command
     (["block", "synth", "--count", "x"], "woodcam block synth"),
+    (["gcode", "x.nc", "--block", "builtin:flat-sawn", "--out", "x.glb", "--stock", "1e300x10x10"],
+     "woodcam gcode"),  # a stock of 1e300 mm: the message printed a 300-digit grid
 ])
 def test_usage_errors_are_one_line_with_a_pointer_to_help(argv, prog, capsys):
     """argparse's own errors printed the whole usage block (up to 15 lines) before the error."""

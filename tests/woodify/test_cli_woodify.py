@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 
 import numpy as np
@@ -74,7 +75,21 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
     m = trimesh.creation.icosphere(subdivisions=2, radius=5.0)
     m.export(tmp_path / "ball.stl")
     assert main(["woodify", str(tmp_path / "ball.stl"), "--years", "0", "--out", str(tmp_path / "o")]) == 1
-    assert "--years must be > 0" in capsys.readouterr().err
+    assert "--years must be in (0, 10000]" in capsys.readouterr().err
+    # each was accepted (exit 0, silently clamped) or a ZeroDivisionError traceback after the growth
+    for opt, value, said in (("--growth", "1e20", "--growth must be in (0, 10000]"),
+                             ("--crack-years", "0", "--crack-years must be in [1, 1000]"),
+                             ("--crack-threshold", "-1", "--crack-threshold must be in (0,"),
+                             ("--crack-region", "0,0,0,-5", "--crack-region X,Y,Z,R needs a radius R > 0"),
+                             ("--block-size", "1e300x10x10", "--block-size takes WxDxH in mm"),
+                             ("--block-centre", "1e300,0,0", "--block-centre takes 3 comma-separated"),
+                             ("--shape", "1e300", "--shape must be in (0, 100]")):
+        t0 = time.perf_counter()
+        assert main(["woodify", str(tmp_path / "ball.stl"), "--years", "3", "--resolution", "256",
+                     "--out", str(tmp_path / "o"), f"{opt}={value}"]) == 1, opt
+        assert time.perf_counter() - t0 < 10.0, f"{opt}: refused only after the growth (a minute at 256)"
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and said in err, err
     trimesh.Trimesh(m.vertices, m.faces[:-4]).export(tmp_path / "open.stl")
     assert main(["woodify", str(tmp_path / "open.stl"), "--years", "3", "--out", str(tmp_path / "o")]) == 1
     assert "must be watertight" in capsys.readouterr().err

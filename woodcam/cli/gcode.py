@@ -14,7 +14,7 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
 from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
-                      allow_negative_values, stock_options, vector_type)
+                      allow_negative_values, sizes_type, stock_options, vector_type)
 
 _EXAMPLES = """\
 examples:
@@ -71,7 +71,7 @@ def register(subparsers) -> None:
     p.add_argument("--interpreter", choices=("woodcam", "linuxcnc"), default="woodcam",
                    help="read the program with woodcam's interpreter (default) or with "
                    "LinuxCNC's own (needs Debian's linuxcnc-uspace)")
-    p.add_argument("--stock", default=None, metavar="WxDxH", type=_size,
+    p.add_argument("--stock", default=None, metavar="WxDxH", type=sizes_type("--stock"),
                    help="stock size in mm cut from the block's wood (default: the block's "
                    "own size), e.g. 167x208x25")
     p.add_argument("--stock-origin", default=None, metavar="X,Y,Z",
@@ -108,17 +108,6 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
     allow_negative_values(p)  # --work-offset -14,5,3
 
-
-def _size(text: str) -> tuple[float, float, float]:
-    """argparse type: ``"WxDxH"`` -> three finite sizes > 0 (mm)."""
-    try:
-        vals = tuple(float(v) for v in text.lower().split("x"))
-    except ValueError:
-        vals = ()
-    if len(vals) != 3 or not all(math.isfinite(v) and v > 0 for v in vals):
-        raise argparse.ArgumentTypeError(f"--stock {text!r}: give WxDxH in mm, three finite "
-                                         "numbers > 0, e.g. 167x208x25")
-    return vals
 
 
 def _tools_from_args(args, program) -> dict:

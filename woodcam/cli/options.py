@@ -275,6 +275,39 @@ def allow_negative_values(p: argparse.ArgumentParser) -> None:
     p._negative_number_matcher = _NEGATIVE_VALUES
 
 
+def parse_sizes(text: str, option: str, n: int = 3, *, cube: bool = False) -> tuple[float, ...]:
+    """``"WxDxH"`` (``x``, ``×`` or ``,`` between them) -> ``n`` sizes in mm, each finite and in
+    (0, :data:`~woodcam.limits.MAX_BLOCK_SIZE_MM`]; with ``cube`` one number is a cube's side.
+    Otherwise a WoodcamError naming ``option`` (``--sheet-size 1e300x10`` reached an allocation
+    and ``--size-mm 1e300`` a block of 0 px/mm)."""
+    import math
+
+    from ..limits import MAX_BLOCK_SIZE_MM
+
+    try:
+        vals = tuple(float(v) for v in re.split(r"[x×,]", str(text).lower()))
+    except ValueError:
+        vals = ()
+    if cube and len(vals) == 1:
+        vals = vals * 3
+    dims = "x".join("WDH"[:n]) if n == 3 else "x".join("WH"[:n])
+    if len(vals) != n or not all(math.isfinite(v) and 0 < v <= MAX_BLOCK_SIZE_MM for v in vals):
+        raise WoodcamError(f"{option} takes {dims} in mm, {n} numbers in (0, {MAX_BLOCK_SIZE_MM:g}]"
+                           + (" (or one, a cube's side)" if cube else "") + ", e.g. "
+                           + "x".join(["50"] * n) + f"; got {text!r}")
+    return vals
+
+
+def sizes_type(option: str, n: int = 3):
+    """argparse ``type`` of :func:`parse_sizes` (a usage error, exit 2)."""
+    def parse(text: str) -> tuple[float, ...]:
+        try:
+            return parse_sizes(text, option, n)
+        except WoodcamError as err:
+            raise argparse.ArgumentTypeError(str(err)) from err
+    return parse
+
+
 def vector_type(option: str):
     """argparse ``type`` for ``option``: ``"X,Y,Z"`` -> three finite floats, or a one-line error
     naming the option (negative values parse as values: see :func:`allow_negative_values`)."""
@@ -522,6 +555,16 @@ RANGES: dict = {
     ("gcode", "rapid_rate"): (0.1, 1e6, False),  # mm/min
     ("gcode", "start"): (-1e5, 1e5, False),      # mm, work coordinates
     ("gcode", "work_offset"): (-1e5, 1e5, False),
+    # woodify: --growth 1e20 divided by zero deep in the rasteriser; --crack-years 0 became 1
+    ("woodify", "growth"): (0.0, 10_000.0, True),       # mm (woodcam.limits.MAX_BLOCK_SIZE_MM)
+    ("woodify", "years"): (0.0, 10_000.0, True),        # the oldest trees are ~5000 years old
+    ("woodify", "time_scale"): (0.0, 1e6, True),        # years
+    ("woodify", "shape"): (0.0, 100.0, True),           # Weibull shape c
+    ("woodify", "crack_years"): (1, 1000, False),
+    ("woodify", "crack_threshold"): (0.0, 1e12, True),  # separation eigenvalue (> 0)
+    "max_px_per_mm": (0.0, 1000.0, True),  # block from-photos: -5 wrote a block at -5 px/mm
+    "zoom": (1, 64, False),                # rings show: picture pixels per face pixel
+    "sheets": (1, 1000, False),            # parquetry leaves per block (1e6 ran on, memory growing)
 }
 
 

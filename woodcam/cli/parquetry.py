@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .options import SPECIES_HELP, add_out_option, add_units_option
+from .options import SPECIES_HELP, add_out_option, add_units_option, parse_sizes
 
 _EPILOG = """\
 veneer sources (any number, mixed):
@@ -178,10 +178,7 @@ def run(args) -> int:
     if args.target:
         job.targets = [{"filename": str(t), "scale": 1.0} for t in args.target]
     job.scans = job.scans + [_scan_entry(s) for s in args.veneer]
-    try:
-        w, h = (float(x) for x in args.sheet_size.lower().split("x"))
-    except ValueError as err:
-        raise WoodcamError(f"--sheet-size must read WxH in mm (e.g. 600x400); got {args.sheet_size!r}") from err
+    w, h = parse_sizes(args.sheet_size, "--sheet-size", n=2)
     for spec in args.veneer_from:
         sp = Path(spec)
         if sp.is_dir() and any(sp.glob("?_col.png")):

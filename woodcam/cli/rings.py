@@ -9,19 +9,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_out_option
+from .options import add_out_option, parse_sizes
 
 
 def _size(text: str) -> tuple[float, float, float]:
-    try:
-        vals = tuple(float(v) for v in text.lower().replace("×", "x").split("x"))
-    except ValueError:
-        vals = ()
-    if len(vals) == 1:
-        vals = vals * 3
-    if len(vals) != 3 or min(vals) <= 0:
-        raise WoodcamError(f"--size-mm takes WxDxH in mm (e.g. 50x50x50) or one side of a cube; got {text!r}")
-    return vals
+    return parse_sizes(text, "--size-mm", cube=True)
 
 
 def add_from_photos(sub) -> None:
@@ -45,7 +37,7 @@ def run_from_photos(args) -> int:
     from ..block.photos import MAX_PX_PER_MM, block_from_photos
 
     block = block_from_photos(args.photos_dir, _size(args.size_mm), partial=args.partial,
-                              max_px_per_mm=args.max_px_per_mm or MAX_PX_PER_MM)
+                              max_px_per_mm=MAX_PX_PER_MM if args.max_px_per_mm is None else args.max_px_per_mm)
     write_block(block, args.out)
     shapes = ", ".join(f"{n} {f.shape[1]}x{f.shape[0]}" for n, f in block.faces.items())
     print(f"wrote {args.out} ({len(block.faces)} faces at {block.meta['px_per_mm']:.2f} px/mm: {shapes}); "

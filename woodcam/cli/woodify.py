@@ -15,19 +15,19 @@ import time
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_out_option, add_units_option
+from .options import add_out_option, add_units_option, parse_sizes
 
 
-def _vec(text: str, option: str, n: int = 3, positive: bool = False) -> tuple[float, ...]:
+def _vec(text: str, option: str, n: int = 3) -> tuple[float, ...]:
+    """``"X,Y,Z"`` -> ``n`` numbers within 100 m (mm; 1e300 is a typo, not a place)."""
     import math
 
     try:
-        vals = tuple(float(v) for v in text.replace("x", ",").split(","))
+        vals = tuple(float(v) for v in text.split(","))
     except ValueError:
         vals = ()
-    if len(vals) != n or not all(math.isfinite(v) for v in vals) or (positive and min(vals) <= 0):
-        kind = "sizes > 0" if positive else "numbers"
-        raise WoodcamError(f"{option} takes {n} comma-separated {kind} (mm); got {text!r}")
+    if len(vals) != n or not all(math.isfinite(v) and abs(v) <= 1e5 for v in vals):
+        raise WoodcamError(f"{option} takes {n} comma-separated numbers within +-100000 (mm); got {text!r}")
     return vals
 
 
@@ -191,7 +191,9 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
     t = time.perf_counter()
     crack_edges = np.zeros((0, 2), int)
     if cracks != "none":
-        n = max(int(crack_years), 1)
+        n = int(crack_years)
+        if n < 1:
+            raise WoodcamError(f"crack_years (--crack-years) must be >= 1; got {crack_years!r}")
         ys = [max(Y - n + k, 0.0) for k in range(n + 1)]
         ys = sorted(set(ys))
         cs = simulate_cracks(res, ys, pattern=cracks, region=crack_region, threshold=crack_threshold,
@@ -291,15 +293,7 @@ def run(args) -> int:
     if not (np.isfinite(args.years) and args.years > 0):
         raise WoodcamError(f"--years must be > 0 (years to grow); got {args.years:g}")
     up = _vec(args.up, "--up")
-    steps = progress_bar(total=4, desc="woodify", unit="stage", leave=False)
-    mesh, textured, painted = _load_mesh(args.part)
-    obstacles = [_load_mesh(str(o))[0] for o in args.obstacle]
-    brushes = load_brushes(args.brushes) if args.brushes else ()
-    steps.update(1)
-    res = woodify(mesh, args.years, growth_mm=args.growth, time_scale_years=args.time_scale,
-                  shape=args.shape, eccentricity=args.eccentricity, up=up, obstacles=obstacles,
-                  brushes=brushes, resolution=args.resolution, method=args.method, **painted)
-    steps.update(1)
+    # every option checked before the growth (minutes on a fine grid)
     if args.surface_years:
         try:
             years = [float(v) for v in args.surface_years.split(",")]
@@ -310,9 +304,20 @@ def run(args) -> int:
                                f"got {args.surface_years!r}")
     else:
         years = [args.years * k / 4 for k in (1, 2, 3)]
-    size = _vec(args.block_size, "--block-size", positive=True) if args.block_size else None
+    size = parse_sizes(args.block_size, "--block-size") if args.block_size else None
     centre = _vec(args.block_centre, "--block-centre") if args.block_centre else None
     region = _vec(args.crack_region, "--crack-region", n=4) if args.crack_region else None
+    if region is not None and not region[3] > 0:
+        raise WoodcamError(f"--crack-region X,Y,Z,R needs a radius R > 0 (mm); got {args.crack_region!r}")
+    steps = progress_bar(total=4, desc="woodify", unit="stage", leave=False)
+    mesh, textured, painted = _load_mesh(args.part)
+    obstacles = [_load_mesh(str(o))[0] for o in args.obstacle]
+    brushes = load_brushes(args.brushes) if args.brushes else ()
+    steps.update(1)
+    res = woodify(mesh, args.years, growth_mm=args.growth, time_scale_years=args.time_scale,
+                  shape=args.shape, eccentricity=args.eccentricity, up=up, obstacles=obstacles,
+                  brushes=brushes, resolution=args.resolution, method=args.method, **painted)
+    steps.update(1)
     files, summary = _write_outputs(
         res, args.out, textured=textured, surface_years=years, block_size_mm=size,
         block_centre_mm=centre, cracks=args.cracks, crack_region=region,

@@ -59,7 +59,13 @@ def rings_picture(block, zoom: int = 2, references: dict | None = None) -> np.nd
     if not block.faces:
         raise WoodcamError(f"block {block.name!r} has no faces to show")
     if zoom < 1:
-        raise WoodcamError(f"zoom must be a whole number >= 1; got {zoom!r}")
+        raise WoodcamError(f"zoom (--zoom) must be a whole number >= 1; got {zoom!r}")
+    from ..limits import check_limit
+
+    # the cross of six faces is about 4 x 3 faces: refuse before PIL allocates it (--zoom 1e6
+    # was a MemoryError traceback)
+    px = 12 * max(f.shape[0] * f.shape[1] for f in block.faces.values()) * float(zoom) ** 2
+    check_limit("MAX_IMAGE_PIXELS", px, f"the picture at --zoom {zoom}", fix="lower --zoom")
     refs = references or {}
     images = {n: face_picture(f, zoom, refs.get(n)) for n, f in block.faces.items()}
     return unfold_cross(images, block.size_mm, background=24)

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Literal
 
 from ..errors import WoodcamError
+from ..limits import MAX_BLOCK_SIZE_MM
 
 Priority = Literal["saliency", "center"]
 
@@ -113,8 +114,9 @@ class ParquetryParams:
                 f"patch_mm must be at least min_piece_mm = {self.min_piece_mm:g} mm (the smallest "
                 f"piece that can be cut and assembled); got {self.patch_mm:g} mm; use a larger "
                 "--patch-mm or lower --min-piece-mm")
-        if self.image_size_mm < self.patch_mm:
-            raise WoodcamError(f"image_size_mm must be >= patch_mm ({self.patch_mm:g}); got {self.image_size_mm:g}")
+        if not self.patch_mm <= self.image_size_mm <= MAX_BLOCK_SIZE_MM:  # 1e300 reached OpenCV's assertion
+            raise WoodcamError(f"image_size_mm (--image-size-mm) must be in [patch_mm = {self.patch_mm:g}, "
+                               f"{MAX_BLOCK_SIZE_MM:g}] mm; got {self.image_size_mm:g}")
         if self.n_adaptive < 0 or self.w_adaptive <= 0:
             raise WoodcamError(f"n_adaptive must be >= 0 and w_adaptive > 0; got {self.n_adaptive}, {self.w_adaptive}")
         if self.priority not in ("saliency", "center"):

@@ -204,6 +204,11 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
     nw, nh = round(w_mm * px_per_mm), round(h_mm * px_per_mm)
     if nw < 1 or nh < 1:
         raise WoodcamError(f"size_mm must give at least one pixel at {px_per_mm} px/mm; got {size_mm}")
+    from ..limits import check_grid
+
+    # every leaf is an RGB float image, sampled ss x ss times (1e300 mm sheets were a traceback)
+    check_grid((n_sheets * nh * ss, nw * ss, 3), f"{n_sheets} leaves of {w_mm:g} x {h_mm:g} mm at "
+               f"{px_per_mm:g} px/mm", itemsize=4, fix="use smaller or fewer sheets (--sheet-size, --sheets)")
     ax = "xyz".index(axis)
     # In-plane directions: sheet x (right) and sheet y (down) as block axes, chosen so the
     # sheet reads like the block face with that normal in docs/conventions.md.
