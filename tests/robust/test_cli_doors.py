@@ -91,3 +91,31 @@ def test_usage_errors_are_one_line_with_a_pointer_to_help(argv, prog, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1, err
     assert err.startswith(f"{prog}: error: ") and err.rstrip().endswith(f"(see '{prog} --help')"), err
+
+
+def test_an_unexpected_error_is_one_line_and_a_wrapped_ctrl_c_is_an_interrupt(monkeypatch, capsys):
+    """The last net of the CLI: an exception no door foresaw printed a traceback, and a Ctrl-C that
+    numba's compiler re-raised as a RuntimeError was a traceback with exit 1."""
+    import woodcam.cli.bake as bake_cli
+
+    def boom(args):
+        raise ValueError("x" * 1000)
+
+    def wrapped_interrupt(args):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as err:
+            raise RuntimeError("no compiled object yet") from err
+
+    monkeypatch.setattr(bake_cli, "run_blocks", boom)
+    monkeypatch.delenv("WOODCAM_DEBUG", raising=False)
+    assert main(["blocks"]) == EXIT_ERROR
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("woodcam: error: internal error (ValueError: xxx")
+    assert "WOODCAM_DEBUG=1" in err and len(err) < 500
+    monkeypatch.setenv("WOODCAM_DEBUG", "1")
+    with pytest.raises(ValueError):
+        main(["blocks"])
+    monkeypatch.setattr(bake_cli, "run_blocks", wrapped_interrupt)
+    assert main(["blocks"]) == 130
+    assert capsys.readouterr().err == "woodcam: interrupted\n"

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 import textwrap
 import warnings
@@ -191,9 +192,31 @@ def main(argv: list[str] | None = None) -> int:
             print(f"woodcam: error: {err.strerror or err}{where}; check the path, its permissions and "
                   "the free space", file=sys.stderr)
             return EXIT_ERROR
+        except Exception as err:  # noqa: BLE001 - the last net: a one-line report, never a traceback
+            if _interrupted(err):  # Ctrl-C inside a library that wrapped it (numba's compiler)
+                print("woodcam: interrupted", file=sys.stderr)
+                return EXIT_INTERRUPTED
+            if os.environ.get("WOODCAM_DEBUG"):
+                raise
+            print(f"woodcam: error: internal error ({type(err).__name__}: {str(err)[:300]}); this is a "
+                  "woodcam bug: please report the command (WOODCAM_DEBUG=1 shows the traceback)",
+                  file=sys.stderr)
+            return EXIT_ERROR
         finally:
             print_warnings(str(w.message) for w in caught if _is_ours(w))
     return rc
+
+
+def _interrupted(err: BaseException) -> bool:
+    """Whether a KeyboardInterrupt is among the causes of ``err`` (libraries re-raise it as their
+    own error: numba's compiler as a RuntimeError)."""
+    seen = set()
+    while err is not None and id(err) not in seen:
+        if isinstance(err, KeyboardInterrupt):
+            return True
+        seen.add(id(err))
+        err = err.__cause__ or err.__context__
+    return False
 
 
 def _is_ours(w) -> bool:
