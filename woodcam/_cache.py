@@ -25,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import os
+import re
 import sys
 import warnings
 from collections.abc import Callable, Iterator
@@ -66,6 +67,13 @@ def cache_dir(kind: str) -> Path:
     if kind not in CACHE_KINDS:
         raise WoodcamError(f"cache kind must be one of {', '.join(CACHE_KINDS)}; got {kind!r}")
     return cache_root() / kind
+
+
+def entry_stem(name: str) -> str:
+    """A block's name as the start of a cache entry's file name: letters, digits, ``_.-`` only,
+    at most 40 (a block named "../../x" put its detection outside the cache; 250 characters
+    made the file name too long)."""
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", str(name))[:40] or "block"
 
 
 def _feed(h, obj: Any) -> None:

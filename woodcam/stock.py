@@ -341,10 +341,9 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
 
     folder : the block folder, only named in errors (None for a Mokume sample).
     """
-    import re
 
     from . import __version__
-    from ._cache import cache_dir, digest, load_or_build
+    from ._cache import cache_dir, digest, entry_stem, load_or_build
     from .appearance.volumes import block_fingerprint
     from .fields.grid import GridField
     from .inference import fit_block
@@ -356,8 +355,7 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
             "to fit one to; trace rings on at least one face (or use 'woodcam block synth')"
         )
     key = digest(block_fingerprint(block), method, FIT_VERSION, __version__)
-    stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", block.name)[:40] or "block"
-    path = cache_dir("fields") / f"{stem}-{method}-{key}.npz"
+    path = cache_dir("fields") / f"{entry_stem(block.name)}-{method}-{key}.npz"
     field, _hit = load_or_build(path, load=GridField.load, build=lambda: fit_block(block, method=method),
                                 save=lambda f, tmp: f.save(tmp), what=f"fitted field of block {block.name!r}")
     return field

@@ -95,6 +95,49 @@ def test_corrected_svg_wins_over_detection(synth_photos, tmp_path, capsys):
     assert json.loads((blk / "block.json").read_text())["meta"]["detection"]["user_svg"] == ["front"]
 
 
+def test_a_corrected_svg_survives_an_interrupted_detection(synth_photos, tmp_path, capsys, monkeypatch):
+    """A Ctrl-C of 'rings detect X --out X' after its manifest was written and before its SVGs
+    were: the manifest then named no SVG, and the next run overwrote the user's correction."""
+    import woodcam.block.svg as svg_mod
+
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
+    assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 0
+    mine = ('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
+            '<path d="M 10.5,20.5 L 150.5,20.5" data-year="3"/></svg>')
+    (blk / "front_traces.svg").write_text(mine)
+    real, calls = svg_mod.write_traces_svg, []
+
+    def interrupted(*a, **k):  # Ctrl-C while the second face's SVG is written
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*a, **k)
+
+    monkeypatch.setattr(svg_mod, "write_traces_svg", interrupted)
+    assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 130
+    monkeypatch.setattr(svg_mod, "write_traces_svg", real)
+    rc, out, _err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and "kept the corrected front_traces.svg" in out
+    assert (blk / "front_traces.svg").read_text() == mine
+
+
+def test_the_detection_cache_stays_in_the_cache_whatever_the_block_is_named(synth_photos, tmp_path, monkeypatch):
+    """A block named "../../escaped/evil" cached its detection outside the cache folder, and a
+    name of 250 characters failed with 'File name too long'."""
+    from woodcam.block.photos import block_from_photos
+    from woodcam.detect.block import with_detected_rings
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    block = block_from_photos(synth_photos, (50.0, 50.0, 50.0))
+    for name in ("../../escaped/evil", "L" * 250):
+        block.name = name
+        assert with_detected_rings(block).faces["top"].traces
+    assert not (tmp_path / "escaped").exists()
+    files = [p for p in (tmp_path / "cache").rglob("*") if p.is_file()]
+    assert files and all(p.parent == tmp_path / "cache" / "detect" for p in files)
+
+
 def test_mokume_folder_is_redetected(tmp_path, capsys):
     from .test_detect_rings import _mokume
 

@@ -13,7 +13,6 @@ with a :class:`AppearanceFallbackWarning`, when the block has no photos to learn
 from __future__ import annotations
 
 import json
-import re
 import time
 import warnings
 from dataclasses import dataclass
@@ -243,10 +242,9 @@ def fit_neural_appearance(block, field=None, *, resolution: int = 128, quality: 
     if cache_dir is False:
         return NeuralAppearance(_build_volumes(block, field, grid, spec, settings, key, orientation,
                                                source, detail, progress, threads, None))
-    from .._cache import load_or_build
+    from .._cache import entry_stem, load_or_build
 
-    stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", block.name)[:40] or "block"
-    path = Path(cache_dir or default_cache_dir()) / f"{stem}-{key}.npz"
+    path = Path(cache_dir or default_cache_dir()) / f"{entry_stem(block.name)}-{key}.npz"
     built: dict = {}
 
     def build():

@@ -74,7 +74,7 @@ MOKUME_DEFAULT_SIZE_MM = (50.0, 50.0, 50.0)
 # -- woodcam manifest folders --------------------------------------------------------------------
 
 def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16] = 16,
-                overwrite: bool = True) -> Path:
+                overwrite: bool = True, traces_svg: dict[str, str] | None = None) -> Path:
     """Write ``block`` to ``folder`` as ``block.json`` plus PNG images (see module docstring).
 
     Parameters
@@ -86,6 +86,10 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
         Ring-map PNG depth; 16 keeps maps within 7.6e-6 of the original, 8 within 2e-3.
     overwrite : bool
         If False, refuse to write into a folder that already holds a manifest.
+    traces_svg : dict, optional
+        face -> the name of an SVG of its traces already in ``folder``, recorded as the face's
+        ``traces_svg`` (ring detection writes its SVGs first, so the manifest, written last,
+        is complete in one step).
 
     Returns
     -------
@@ -125,6 +129,11 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
         for key, value in face.extras.items():
             extras[key] = _write_extra(folder, name, key, value)
         entry["extras"] = extras
+        if traces_svg and name in traces_svg:
+            if not (folder / traces_svg[name]).is_file():
+                raise WoodcamError(f"traces_svg of face {name!r}: {traces_svg[name]!r} is not a file in "
+                                   f"{str(folder)!r}; write the SVG first")
+            entry["traces_svg"] = traces_svg[name]
         faces[name] = entry
     manifest = {
         "format": FORMAT, "version": VERSION, "name": block.name,

@@ -32,8 +32,8 @@ from typing import Literal
 
 import numpy as np
 
-from .._atomic import atomic_path, write_bytes, write_text
-from .._cache import cache_dir, digest, load_or_build
+from .._atomic import atomic_path, write_bytes
+from .._cache import cache_dir, digest, entry_stem, load_or_build
 from ..block.block import Block, Face
 from ..errors import WoodcamError, WoodcamWarning
 from .knots import detect_knots
@@ -130,10 +130,6 @@ def _sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-def _atomic_json(path: Path, doc: dict) -> None:
-    write_text(path, json.dumps(doc, indent=1))
-
-
 def user_edited_faces(folder) -> dict[str, Path]:
     """Faces of a block folder whose ``<face>_traces.svg`` differs from what the detector wrote
     (a user corrected it) -> the SVG path."""
@@ -210,25 +206,27 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     if out.resolve() != src.resolve():
         for name, svg in edited.items():     # carry the user's SVG over unchanged
             write_bytes(out / svg.name, svg.read_bytes())
-    manifest = write_block(block, out)
-    m = json.loads(manifest.read_text())
+    # The SVGs first, the manifest last and in one step: a manifest written before its SVGs
+    # (as it was) named no SVG until they were done, so a Ctrl-C in between made the next run
+    # take the user's corrected SVG for the detector's and overwrite it. Interrupted now, the old
+    # manifest stays, and a detector SVG written meanwhile differs from its recorded hash: it is
+    # then kept as if corrected (a wrong label, never a lost edit).
     hashes = {}
-    for name in block.faces:
-        svg = out / f"{name}_traces.svg"
+    for name, f in block.faces.items():
         if name in kept:
-            m["faces"][name]["traces_svg"] = svg.name
             continue
-        f = block.faces[name]
-        face = Face(name, f.shape, traces=det_traces.get(name, []))
+        svg = out / f"{name}_traces.svg"
         with atomic_path(svg) as tmp:
-            write_traces_svg(face, tmp, photo_href=m["faces"][name].get("photo"))
-        m["faces"][name]["traces_svg"] = svg.name
+            write_traces_svg(Face(name, f.shape, traces=det_traces.get(name, [])), tmp,
+                             photo_href=f"{name}_photo.png" if f.photo is not None else None)
         hashes[name] = _sha256(svg)
-    det = m["meta"].setdefault("detection", {"detector": detector, "version": DETECT_VERSION, "rule": rule,
-                                              "curved": _curved(curved)})
+    block.meta = dict(block.meta)
+    det = dict(block.meta.get("detection") or {"detector": detector, "version": DETECT_VERSION, "rule": rule,
+                                               "curved": _curved(curved)})
     det["svg_sha256"] = hashes
     det["user_svg"] = sorted(kept)
-    _atomic_json(manifest, m)
+    block.meta["detection"] = det
+    manifest = write_block(block, out, traces_svg={n: f"{n}_traces.svg" for n in block.faces})
     return manifest, msgs
 
 
@@ -302,7 +300,7 @@ def with_detected_rings(block: Block, rule: BoundaryRule = DEFAULT_RULE, *, cach
         return ({n: f for n, f in out.faces.items() if n in out.meta["detection"]["faces"]}, msgs)
 
     if cache:
-        path = cache_dir("detect") / f"{block.name}-{_detection_key(block, rule)}.npz"
+        path = cache_dir("detect") / f"{entry_stem(block.name)}-{_detection_key(block, rule)}.npz"
         raw, hit = load_or_build(path, load=_load_detection, build=build, save=_save_detection,
                                  what="ring detection")
         if not hit:
