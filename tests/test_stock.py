@@ -61,6 +61,34 @@ def test_block_folder_without_truth_is_fitted_once_and_cached(tmp_path, monkeypa
     assert cache.stat().st_mtime == stamp  # reused, not refitted
 
 
+def test_a_cached_fit_repeats_its_warning(tmp_path, monkeypatch):
+    """A fit contradicted by its held-out faces warned when it was made and never again: every
+    later run (a cache hit) carved from it without a word."""
+    import warnings
+
+    import woodcam.inference as inference
+    from woodcam.errors import WoodcamWarning
+    from woodcam.fields.builtin import builtin_block
+    from woodcam.fields.grid import GridField
+    from woodcam.stock import fitted_field
+    from woodcam.synth import synth_block
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    block = synth_block(builtin_block("flat-sawn").field, (20, 20, 20), face_px=32, seed=0)
+    said = "fit CONTRADICTED by the held-out faces: front 12 %"
+
+    def fake_fit(block, method):
+        warnings.warn(said, WoodcamWarning)
+        return GridField(np.zeros((3, 3, 3)), (0, 0, 0), 10.0, meta={"contradicted": True, "message": said})
+
+    monkeypatch.setattr(inference, "fit_block", fake_fit)
+    for run in ("fit", "cache hit"):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            fitted_field(block)
+        assert [str(w.message) for w in caught if issubclass(w.category, WoodcamWarning)] == [said], run
+
+
 def test_block_folder_with_no_rings_is_a_clear_error(tmp_path):
     from woodcam.block import Block
     from woodcam.block.io import write_block

@@ -29,6 +29,7 @@ block and sample folders are only read, never written (they are often read-only 
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
@@ -36,7 +37,7 @@ from typing import Literal
 import numpy as np
 
 from .appearance import ColorMapAppearance, Wood
-from .errors import WoodcamError
+from .errors import WoodcamError, WoodcamWarning
 from .fields.builtin import BUILTIN_NAMES, builtin_block
 
 AppearanceKind = Literal["colormap", "neural"]
@@ -356,8 +357,13 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
         )
     key = digest(block_fingerprint(block), method, FIT_VERSION, __version__)
     path = cache_dir("fields") / f"{entry_stem(block.name)}-{method}-{key}.npz"
-    field, _hit = load_or_build(path, load=GridField.load, build=lambda: fit_block(block, method=method),
-                                save=lambda f, tmp: f.save(tmp), what=f"fitted field of block {block.name!r}")
+    field, hit = load_or_build(path, load=GridField.load, build=lambda: fit_block(block, method=method),
+                               save=lambda f, tmp: f.save(tmp), what=f"fitted field of block {block.name!r}")
+    meta = getattr(field, "meta", {}) or {}
+    if hit and (meta.get("contradicted") or meta.get("unverified")):
+        # the fit warned when it was made; a cached fit is the same fit and must say so again
+        # (it was silent on every later run, and for the second of two concurrent ones)
+        warnings.warn(str(meta.get("message", "")), WoodcamWarning, stacklevel=2)
     return field
 
 
