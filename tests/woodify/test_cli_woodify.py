@@ -97,6 +97,37 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
         open_stock(f"woodify:{tmp_path / 'missing.npz'}")
 
 
+def test_an_interrupted_run_leaves_the_last_runs_products(tmp_path, monkeypatch, capsys):
+    """A Ctrl-C while writing left the new grown.glb and field.npz beside the old woodify.json and
+    sections; and each run at other --surface-years left its surfaces beside the last run's."""
+    import woodcam.cli.woodify as wcli
+
+    trimesh.creation.icosphere(subdivisions=2, radius=5.0).export(tmp_path / "ball.stl")
+    out = tmp_path / "o"
+
+    def grow(years, surfaces):
+        return main(["woodify", str(tmp_path / "ball.stl"), "--years", years, "--resolution", "24",
+                     "--cracks", "none", "--surface-years", surfaces, "--out", str(out)])
+
+    assert grow("4", "1,2") == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    real = wcli.json.dumps
+
+    def interrupted(doc, **kw):  # Ctrl-C as the summary, the last file, is written
+        if isinstance(doc, dict) and "total_s" in doc:
+            raise KeyboardInterrupt
+        return real(doc, **kw)
+
+    monkeypatch.setattr(wcli.json, "dumps", interrupted)
+    assert grow("6", "3") == 130
+    monkeypatch.setattr(wcli.json, "dumps", real)
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before  # nothing new, no temporaries
+    assert grow("6", "3") == 0
+    assert sorted(p.name for p in out.glob("surface_y*.stl")) == ["surface_y3.stl"]
+    assert json.loads((out / "woodify.json").read_text())["years"] == 6.0
+    capsys.readouterr()
+
+
 def test_input_texture_is_carried_to_the_grown_bark(tmp_path):
     """A textured input (UV = longitude, latitude) keeps its picture in place: every grown
     vertex's UV is the UV of the input point straight below it (radial growth of a sphere)."""

@@ -248,10 +248,12 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
     # woodify:field.npz` reads it so): object = block_origin + R @ block, so block = R^T (object
     # - block_origin); the origin is kept in the metadata to put it back over the input mesh
     bark.vertices = (np.asarray(bark.vertices) - placed.block_origin_mm) @ placed.rotation
-    files.append(atomic(out / "grown.glb", lambda p: export_glb(bark, p, metadata={
+    # export_glb writes atomically itself (through atomic(), its temporary would be renamed
+    # before export_glb's own one, inside the caller's all_or_nothing)
+    files.append(export_glb(bark, out / "grown.glb", metadata={
         "woodify": {"years": Y, "speed": res.speed.to_dict(),
                     "block_origin_mm": placed.block_origin_mm.tolist(),
-                    "block_rotation": placed.rotation.tolist()}})))
+                    "block_rotation": placed.rotation.tolist()}}))
     files.append(placed.save(out / "field.npz"))
     summary["block"] = {"size_mm": list(size), "centre_mm": list(centre)}
     for y in surface_years:
@@ -318,17 +320,27 @@ def run(args) -> int:
                   shape=args.shape, eccentricity=args.eccentricity, up=up, obstacles=obstacles,
                   brushes=brushes, resolution=args.resolution, method=args.method, **painted)
     steps.update(1)
-    files, summary = _write_outputs(
-        res, args.out, textured=textured, surface_years=years, block_size_mm=size,
-        block_centre_mm=centre, cracks=args.cracks, crack_region=region,
-        crack_years=args.crack_years, crack_render=args.crack_render,
-        crack_threshold=args.crack_threshold, relief=args.relief, seed=args.seed,
-        atomic=_atomic, progress=lambda: steps.update(1))
-    steps.close()
-    summary["total_s"] = time.perf_counter() - t0
-    summary["input"] = str(args.part)
-    _atomic(Path(args.out) / "woodify.json",
-            lambda p: p.write_text(json.dumps(summary, indent=1, default=float)))
+    from .._atomic import all_or_nothing
+
+    # one unit: a Ctrl-C leaves the last run's products, never new ones beside old ones (a grown.glb
+    # of 13 years beside a woodify.json of 11)
+    with all_or_nothing():
+        files, summary = _write_outputs(
+            res, args.out, textured=textured, surface_years=years, block_size_mm=size,
+            block_centre_mm=centre, cracks=args.cracks, crack_region=region,
+            crack_years=args.crack_years, crack_render=args.crack_render,
+            crack_threshold=args.crack_threshold, relief=args.relief, seed=args.seed,
+            atomic=_atomic, progress=lambda: steps.update(1))
+        steps.close()
+        summary["total_s"] = time.perf_counter() - t0
+        summary["input"] = str(args.part)
+        _atomic(Path(args.out) / "woodify.json",
+                lambda p: p.write_text(json.dumps(summary, indent=1, default=float)))
+    # an earlier run's surfaces at other years are not this run's: they went on piling up
+    ours = {Path(f).resolve() for f in files}
+    for old in Path(args.out).glob("surface_y*.stl"):
+        if old.resolve() not in ours:
+            old.unlink()
     print(f"grew {args.part} for {args.years:g} years on a {'x'.join(map(str, res.front.grid.shape))} "
           f"grid ({res.front.method}, {summary['total_s']:.1f} s); wrote "
           + ", ".join(str(f) for f in files))
