@@ -56,3 +56,20 @@ def test_clear_takes_only_a_known_kind(tmp_path, monkeypatch, capsys):
     assert main(["cache", "clear", "--kind", "fields"]) == 0
     assert "deleted 1 entries" in capsys.readouterr().out
     assert (tmp_path / "cache" / "detect" / "y.npz").is_file()
+
+
+def test_clear_removes_the_idle_locks_but_not_a_held_one(tmp_path, monkeypatch, capsys):
+    """One .lock file was left per entry ever built; clearing and pruning skipped them."""
+    from woodcam._cache import clear, file_lock
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path))
+    for i in range(3):
+        load_or_build(tmp_path / "fields" / f"e{i}.bin", load=lambda p: p.read_bytes(),
+                      build=lambda: b"x", save=lambda v, p: p.write_bytes(v))
+    assert len(list((tmp_path / "fields").glob("*.lock"))) == 3
+    with file_lock(tmp_path / "fields" / "building.bin"):  # another process building an entry
+        assert clear() == (3, 3)
+        assert [p.name for p in (tmp_path / "fields").iterdir()] == ["building.bin.lock"]
+    assert prune(0) == 0
+    clear()
+    assert list((tmp_path / "fields").iterdir()) == []

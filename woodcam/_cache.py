@@ -243,16 +243,42 @@ def prune(max_bytes: int | None = None, *, keep: Path | None = None) -> int:
         with contextlib.suppress(OSError):
             p.unlink()
             freed += size
+    if freed:
+        _drop_idle_locks(cache_root())
     return freed
 
 
+def _drop_idle_locks(root: Path) -> None:
+    """Delete the ``.lock`` files under ``root`` whose entry is gone and that nobody holds: one
+    was left per entry ever built, and neither clearing nor pruning removed them. A lock being
+    built under is held, so it stays (taking the lock without waiting tells which)."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - Windows: no lock files
+        return
+    if not root.is_dir():
+        return
+    for lock in root.rglob("*.lock"):
+        if Path(str(lock)[:-len(".lock")]).exists():
+            continue
+        with contextlib.suppress(OSError):
+            fd = os.open(lock, os.O_RDWR)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # OSError when held: keep it
+                lock.unlink()
+            finally:
+                os.close(fd)
+
+
 def clear(kind: str | None = None) -> tuple[int, int]:
-    """Delete every cache entry (of one ``kind``); returns (files, bytes) deleted."""
+    """Delete every cache entry (of one ``kind``) and the idle locks left beside them; returns
+    (entries, bytes) deleted."""
     n = size = 0
     for p in entries(kind):
         with contextlib.suppress(OSError):
             b = p.stat().st_size
             p.unlink()
             n, size = n + 1, size + b
+    _drop_idle_locks(cache_root() if kind is None else cache_dir(kind))
     return n, size
 
