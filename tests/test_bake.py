@@ -459,6 +459,51 @@ def test_a_unwrap_that_always_crashes_is_one_clear_error(monkeypatch):
         bake(_box(), SmoothWood(), texels_per_mm=2.0, unwrap="xatlas")
 
 
+def test_the_unwrap_worker_does_not_outlive_an_interrupted_bake(monkeypatch, tmp_path):
+    """Ctrl-C during a long unwrap waited for the worker (the pool's exit joined it), and a killed
+    woodcam left it running for minutes at gigabytes."""
+    import os
+    import signal
+    import threading
+    import time
+
+    import woodcam._xatlas_worker as _xatlas_worker
+
+    pid_file = tmp_path / "worker.pid"
+
+    def slow_layout(verts, faces, pieces, **kw):
+        pid_file.write_text(str(os.getpid()))
+        time.sleep(120)
+
+    monkeypatch.setattr(_xatlas_worker, "layout", slow_layout)
+    timer = threading.Timer(3.0, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            bake(_box(), SmoothWood(), texels_per_mm=2.0, unwrap="xatlas")
+    finally:
+        timer.cancel()
+    assert time.perf_counter() - t0 < 30.0  # not the worker's 120 s
+    worker = int(pid_file.read_text())
+    time.sleep(0.5)
+    with pytest.raises(ProcessLookupError):  # killed and reaped
+        os.kill(worker, 0)
+
+
+def test_a_mesh_with_a_far_or_nan_vertex_is_refused():
+    """A box with one vertex at 1e12 mm ran for minutes at 7.7 GB; a NaN vertex was scipy's
+    ValueError."""
+    box = _box()
+    for bad in (1e12, np.nan):
+        v = np.asarray(box.vertices).copy()
+        v[0, 0] = bad
+        with pytest.raises(WoodcamError, match="vertices must be finite and span at most 10000 mm"):
+            bake(trimesh.Trimesh(v, box.faces, process=False), SmoothWood(), texels_per_mm=2.0)
+    with pytest.raises(WoodcamError, match=r"max_atlas_px must be an integer in \[64, 65536\]"):
+        bake(box, SmoothWood(), texels_per_mm=2.0, max_atlas_px=10**9)
+
+
 def test_the_82k_triangle_icosphere_that_crashed_xatlas_bakes():
     """Regression: xatlas segfaults on this closed sphere in one piece (issue 16)."""
     sphere = trimesh.creation.icosphere(subdivisions=6, radius=40.0)

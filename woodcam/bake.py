@@ -52,6 +52,7 @@ from typing import Any, Literal, get_args
 import numpy as np
 
 from woodcam.errors import WoodcamError, WoodcamWarning
+from woodcam.limits import MAX_BLOCK_SIZE_MM
 from woodcam.tolerances import (
     ATLAS_PADDING_PX,
     MAX_BATCH_POINTS,
@@ -351,6 +352,13 @@ def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals) ->
             f"{type(mesh).__name__} with {0 if faces is None else len(faces)} faces; pass the "
             "carved part's surface mesh"
         )
+    verts = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=float)
+    if not np.isfinite(verts).all() or (len(verts) and np.ptp(verts, axis=0).max() > MAX_BLOCK_SIZE_MM):
+        raise WoodcamError(
+            f"bake: the mesh's vertices must be finite and span at most {MAX_BLOCK_SIZE_MM:g} mm (the "
+            f"largest block); got a span of {np.ptp(verts, axis=0).max() if len(verts) else 0:.4g} mm "
+            "or NaN/inf; check the part's units and coordinates (one far vertex made a 7 GB atlas)"
+        )
     if not callable(getattr(wood, "color", None)):
         raise WoodcamError(
             f"bake: wood must have a method color(points_mm, normals) -> rgb; got "
@@ -362,9 +370,10 @@ def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals) ->
             f"bake: texels_per_mm must be a finite number > 0; got {texels_per_mm!r}; "
             "use e.g. 10 (0.1 mm texels)"
         )
-    if not isinstance(max_atlas_px, (int, np.integer)) or max_atlas_px < 64:
+    if not isinstance(max_atlas_px, (int, np.integer)) or not 64 <= max_atlas_px <= 65_536:
         raise WoodcamError(
-            f"bake: max_atlas_px must be an integer >= 64; got {max_atlas_px!r}; use e.g. 4096"
+            f"bake: max_atlas_px must be an integer in [64, 65536] (the --max-atlas range); got "
+            f"{max_atlas_px!r}; use e.g. 4096"
         )
     if not isinstance(padding_px, (int, np.integer)) or padding_px < _MIN_PADDING_PX:
         raise WoodcamError(
@@ -626,12 +635,22 @@ def _run_guarded(name: str, *args, **kwargs):
     # and it runs only xatlas' own threads and numpy, none of the parent's thread pools.
     # ``run_<name>`` looks ``<name>`` up when called, so a test's crashing stand-in is what the
     # forked worker runs.
-    with cf.ProcessPoolExecutor(max_workers=1, mp_context=mp.get_context("fork")) as pool:
+    pool = cf.ProcessPoolExecutor(max_workers=1, mp_context=mp.get_context("fork"),
+                                  initializer=_xatlas_worker.die_with_parent)
+    try:
         job = pool.submit(getattr(_xatlas_worker, f"run_{name}"), *args, **kwargs)
         try:
             return job.result()
         except cf.process.BrokenProcessPool as err:
             raise _WorkerCrashed(name) from err
+    except BaseException:
+        # Ctrl-C (or any error) while it works: the worker must not outlive the call (leaving
+        # the with-block waited for it to finish, minutes on a huge atlas)
+        for proc in list((getattr(pool, "_processes", None) or {}).values()):
+            proc.kill()
+        raise
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _layout_guarded(verts, faces, pieces, chart_cap, tpm, padding, messages):
