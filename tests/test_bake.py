@@ -342,7 +342,7 @@ def test_atlas_overshoot_is_rescaled_or_re_unwrapped(monkeypatch, efficiency):
         ({"texels_per_mm": float("nan")}, "texels_per_mm must be a finite number > 0"),
         ({"normals": "vertex"}, r"normals must be one of \('face', 'smooth'\)"),
         ({"padding_px": 1}, "padding_px must be an integer >= 2"),
-        ({"max_atlas_px": 10}, "max_atlas_px must be an integer >= 64"),
+        ({"max_atlas_px": 10}, "max_atlas_px must be an integer in \\[64, 65536\\]"),
     ],
 )
 def test_bad_arguments_raise_clear_errors(kwargs, match):
