@@ -28,7 +28,10 @@ def test_log_spec_puts_the_knot_on_the_front_face(shared_data):
 @pytest.mark.parametrize("spec, message", [
     ("log:gran1", "must read 'log:LOG@KNOT'"),
     ("log:gran1@x", "must read 'log:LOG@KNOT'"),
-    ("log:gran1@1:10x10", "must read 'log:LOG@KNOT'"),
+    ("log:gran1@1:10x10", "the size must be WxDxH in mm"),
+    ("log:gran1@1:0x0x0", "the size must be WxDxH in mm"),   # these three were accepted as sizes
+    ("log:gran1@1:nanx80x50", "the size must be WxDxH in mm"),
+    ("log:gran1@1:1e9x80x50", "the size must be WxDxH in mm"),
     ("log:/nowhere/log.json@1", "does not exist"),
     ("mystery", "neither 'builtin:NAME'"),
 ])

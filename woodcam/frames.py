@@ -221,6 +221,10 @@ def unfold_cross(images: dict, size_mm: ArrayLike, background: float | ArrayLike
     f0, im0 = next(iter(faces.items()))
     px_per_mm = im0.shape[1] / face_image_size_mm(f0, size)[1]
     layout = CrossLayout(tuple(size), px_per_mm)
+    from .limits import check_grid
+
+    # a thin 50000 x 100 px face of a flat block made a 14 GiB cross
+    check_grid(layout.shape + im0.shape[2:], "the unfolded cross", itemsize=im0.dtype.itemsize)
     out = np.full(layout.shape + im0.shape[2:], background, dtype=im0.dtype)
     for face, im in faces.items():
         want = layout.face_shape(face)

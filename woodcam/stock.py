@@ -211,7 +211,7 @@ def _parse_size(text: str, spec: str) -> tuple[float, float, float]:
     if len(size) != 3 or not all(math.isfinite(v) and 0 < v <= _MAX_BLOCK_SIDE_MM for v in size):
         raise WoodcamError(
             f"block spec {spec!r}: the size must be WxDxH in mm, each > 0 and <= "
-            f"{_MAX_BLOCK_SIDE_MM:g}; got {text!r}, e.g. builtin:flat-sawn:300x120x40")
+            f"{_MAX_BLOCK_SIDE_MM:g}; got {text!r}, e.g. 300x120x40")
     return size
 
 
@@ -412,14 +412,12 @@ def _log_block_field(spec: str):
         source, rest = body.split("@", 1)
         knot, _, size = rest.partition(":")
         knot = int(knot)
-        size_mm = tuple(float(v) for v in size.lower().split("x")) if size else (100.0, 80.0, 50.0)
-        if len(size_mm) != 3:
-            raise ValueError(size)
     except ValueError as err:
         raise WoodcamError(
             f"log block spec {spec!r} must read 'log:LOG@KNOT' or 'log:LOG@KNOT:WxDxH' "
             "(e.g. log:gran1@52:100x80x50)"
         ) from err
+    size_mm = _parse_size(size, spec) if size else (100.0, 80.0, 50.0)  # 0x0x0, NaN, 1e9 were accepted
     log = read_gran1() if source == "gran1" else read_log(source)
     if not 0 <= knot < len(log.knots):
         raise WoodcamError(f"knot index in {spec!r} must be 0..{len(log.knots) - 1}; got {knot}")

@@ -58,3 +58,31 @@ def test_sizes_that_cannot_be_held_are_refused_before_allocating():
         slice_veneers(open_stock("builtin:flat-sawn"), 2, (1e300, 10.0), px_per_mm=1.0)
     with pytest.raises(WoodcamError, match="growth_mm must be in \\(0, 10000\\]"):
         woodify(trimesh.creation.icosphere(radius=5.0), 3.0, growth_mm=1e20)
+
+
+def test_small_inputs_that_asked_for_gigabytes_or_hung_are_refused(tmp_path):
+    """A 150-byte SVG curve asked for 30 GiB of samples; a thin 5 MB face image a 14 GiB unfolded
+    cross; detect_rings at 1e6 px/mm blurred for ever; a NaN point was a ZeroDivisionError in a
+    compiled kernel."""
+    import numpy as np
+
+    from woodcam import detect_rings, unfold_cross
+    from woodcam.block.svg import read_traces_svg
+    from woodcam.fields import builtin_block
+
+    (tmp_path / "h.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 10 10" width="10" '
+                                    'height="10"><path d="M0,0 C1e9,1e9 -1e9,1e9 10,10"/></svg>')
+    with pytest.raises(WoodcamError, match="a curve of .* px in the SVG .*MAX_TRACE_POINTS"):
+        read_traces_svg(tmp_path / "h.svg", (10, 10))
+    with pytest.raises(WoodcamError, match="the unfolded cross .*MAX_GRID_CELLS"):
+        unfold_cross({"front": np.ones((50000, 100), np.uint8)}, (1, 500, 500))
+    photo = np.random.default_rng(0).integers(0, 255, (51, 64, 3), dtype=np.uint8)
+    for ppm in (1e6, -1.0, float("nan")):
+        with pytest.raises(WoodcamError, match=r"px_per_mm of face 'face' must be a number in \(0, 1000\]"):
+            detect_rings(photo, px_per_mm=ppm)
+    with pytest.raises(WoodcamError, match="too small to hold a ring"):
+        detect_rings(photo, px_per_mm=500.0)
+    field = builtin_block("flat-sawn").field
+    for bad in ([[np.nan, 40, 25]], [[1.0, np.inf, 2.0]]):
+        with pytest.raises(WoodcamError, match="points_mm must be finite; point 0 is"):
+            field(np.asarray(bad))

@@ -115,6 +115,7 @@ def _polylines(path, scale: np.ndarray) -> list[np.ndarray]:
     sampled every :data:`~woodcam.tolerances.SVG_CURVE_STEP_PX` image pixels or finer."""
     import svgelements
 
+    from ..limits import check_limit
     from ..tolerances import SVG_CURVE_STEP_PX
 
     lines: list[np.ndarray] = []
@@ -131,7 +132,10 @@ def _polylines(path, scale: np.ndarray) -> list[np.ndarray]:
             cur.append(np.array([[seg.end.x, seg.end.y]]))
         else:  # CubicBezier, QuadraticBezier, Arc: sample along the curve
             length_px = seg.length(error=1e-6) * float(scale.max())
-            n = max(2, int(math.ceil(length_px / SVG_CURVE_STEP_PX)) + 1)
+            n = max(2, int(math.ceil(length_px / SVG_CURVE_STEP_PX)) + 1) if math.isfinite(length_px) else -1
+            # a 150-byte curve with control points at 1e9 px asked for 30 GiB of samples
+            check_limit("MAX_TRACE_POINTS", n if n > 0 else math.inf,
+                        f"a curve of {length_px:.4g} px in the SVG", fix="redraw it inside the face")
             cur.append(np.asarray(seg.npoint(np.linspace(0.0, 1.0, n)), float)[1:])
     if len(cur) >= 2:
         lines.append(np.vstack(cur))

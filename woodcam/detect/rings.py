@@ -800,12 +800,20 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     h, w = lum.shape
     if min(h, w) < 16:
         raise WoodcamError(f"photo of face {name!r} is {h}x{w} px; ring detection needs at least 16x16 px")
+    if px_per_mm is not None and not (isinstance(px_per_mm, (int, float, np.number))
+                                      and 0 < px_per_mm <= 1000):  # 1e6 blurred for ever (sigma 1e6 px)
+        raise WoodcamError(f"px_per_mm of face {name!r} must be a number in (0, 1000] px/mm; got {px_per_mm!r}")
     if wavelength_range_px is None:
         wavelength_range_px = WAVELENGTH_RANGE_PX if not px_per_mm else (
             max(WAVELENGTH_RANGE_PX[0], RING_SPACING_RANGE_MM[0] * px_per_mm), RING_SPACING_RANGE_MM[1] * px_per_mm)
+    if len(tuple(wavelength_range_px)) != 2:
+        raise WoodcamError(f"wavelength_range_px must be (min, max) px; got {wavelength_range_px!r}")
     lo, hi = wavelength_range_px
     if not 2.0 <= lo < hi:
         raise WoodcamError(f"wavelength_range_px must be (min, max) with 2 <= min < max; got {wavelength_range_px!r}")
+    if lo > 0.5 * max(h, w):
+        raise WoodcamError(f"photo of face {name!r} is {h}x{w} px: too small to hold a ring of {lo:.3g} px or "
+                           f"more (the shortest ring spacing at {px_per_mm} px/mm); check px_per_mm")
     hi = max(min(hi, 0.5 * max(h, w)), 1.5 * lo)
     n_scales = max(3, int(np.round(np.log2(hi / lo) * SCALES_PER_OCTAVE)) + 1)
     wavelengths = lo * 2.0 ** (np.arange(n_scales) / SCALES_PER_OCTAVE)

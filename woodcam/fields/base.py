@@ -35,6 +35,9 @@ def check_points(points_mm, name: str = "points_mm") -> np.ndarray:
     p = np.asarray(points_mm, dtype=float)
     if p.ndim != 2 or p.shape[1] != 3:
         raise WoodcamError(f"{name} must have shape (n, 3) in mm; got shape {p.shape}")
+    if not np.isfinite(p).all():  # a NaN point was a ZeroDivisionError in a compiled kernel
+        bad = int(np.argmin(np.isfinite(p).all(axis=1)))
+        raise WoodcamError(f"{name} must be finite; point {bad} is {p[bad].tolist()}")
     return p
 
 
