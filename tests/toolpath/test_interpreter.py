@@ -197,3 +197,12 @@ def test_words_no_code_uses_are_refused_and_io_warned():
             _ends(line + "\nM2\n")
     prog = read_gcode("G0 X1 Y0 Z0\nM64 P1\nM101\nG1 X2 F100\nM2\n")
     assert [w.split(":")[0] for w in prog.warnings] == ["line 2", "line 3"]
+
+
+@pytest.mark.parametrize("text", ["G0 X" + "[" * 400 + "1" + "]" * 400, "G0 X[" + "-" * 3000 + "1]",
+                                  "G0 X" + "abs[" * 400 + "1" + "]" * 400])
+def test_an_expression_nested_too_deep_is_one_error(text):
+    """G-code is untrusted input: these were RecursionError tracebacks."""
+    with pytest.raises(GcodeError, match="line 1: .*nested deeper than 100 levels"):
+        read_gcode(text + "\n")
+    assert len(read_gcode("G0 X" + "[" * 50 + "1" + "]" * 50 + "\n")) == 1  # deep but sane

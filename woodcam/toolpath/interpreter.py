@@ -81,6 +81,10 @@ _ARC_REL_TOL = 0.001
 TRAVERSE, FEED, ARC = 0, 1, 2
 
 
+#: Deepest nesting of brackets, unary signs and functions one G-code expression may have.
+MAX_EXPR_DEPTH = 100
+
+
 class GcodeError(WoodcamError):
     """A G-code line that woodcam refuses; ``line`` is the 1-based source line."""
 
@@ -319,6 +323,18 @@ class Interpreter:
     # -- expression reader ------------------------------------------------------------------
     # Works on the normalised line text ``s`` with an index; returns (value, next index).
     def value(self, s: str, i: int):
+        # a depth bound: 400 nested brackets (or 3000 unary minus signs) hit Python's recursion
+        # limit, a RecursionError traceback; no real program nests a tenth as deep
+        self._depth = getattr(self, "_depth", 0) + 1
+        try:
+            if self._depth > MAX_EXPR_DEPTH:
+                raise self.err(s[:20], f"expression nested deeper than {MAX_EXPR_DEPTH} levels",
+                               "simplify it")
+            return self._value(s, i)
+        finally:
+            self._depth -= 1
+
+    def _value(self, s: str, i: int):
         if i >= len(s):
             raise self.err(s, "a value is missing at the end of the line", "complete the word")
         c = s[i]
