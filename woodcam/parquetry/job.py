@@ -101,8 +101,13 @@ class ParquetryParams:
         """Validate at the door; returns self."""
         for f in fields(self):  # the types first: a job file's "abc" or NaN fails here, by name
             setattr(self, f.name, _check_type(f"parquetry parameter {f.name}", getattr(self, f.name), str(f.type)))
-        if self.n_rot < 1:
-            raise WoodcamError(f"n_rot must be >= 1 (rotated copies of each sheet, sec. 3.2); got {self.n_rot}")
+        if not 1 <= self.n_rot <= 360:  # 1e9 filled the memory before the search's own estimate
+            raise WoodcamError(f"n_rot must be in [1, 360] (rotated copies of each sheet, sec. 3.2); got {self.n_rot}")
+        if not 0 < self.px_per_mm <= 50:  # 200 px/mm asked OpenCV for 1.6 GB on a 100 mm veneer
+            raise WoodcamError(f"px_per_mm must be in (0, 50] (the working resolution; 4 is the paper's "
+                               f"scale); got {self.px_per_mm}")
+        if self.min_piece_mm < 0:
+            raise WoodcamError(f"min_piece_mm must be >= 0 mm; got {self.min_piece_mm}")
         for name in ("w_intens", "w_edge", "w_hist"):
             v = getattr(self, name)
             if not 0.0 <= v <= 1.0:
