@@ -530,7 +530,7 @@ _T = [{"filename": "t.png"}]
     ({"targets": _T, "woodcam": {"blocks": [{"spec": "builtin:flat-sawn", "sheets": "2"}]}},
      r"woodcam.blocks\[0\].sheets must be a whole number; got '2'"),
     ({"targets": _T, "num_source_rotations": "abc"}, r"n_rot must be a whole number; got 'abc'"),
-    ({"targets": _T, "num_source_rotations": 0}, r"n_rot must be >= 1"),
+    ({"targets": _T, "num_source_rotations": 0}, r"n_rot must be in \[1, 360\]"),
     ({"targets": _T, "woodcam": {"params": {"patch_mm": "14"}}}, r"patch_mm must be a finite number"),
     ({"targets": _T, "woodcam": {"params": {"single_use": 1}}}, r"single_use must be true or false"),
     ([_T], r"must hold a JSON object; got list"),
