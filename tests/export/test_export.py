@@ -363,3 +363,27 @@ def test_bulk_obj_text_matches_python_formatting_and_round_trips():
     assert obj_body(v[:3], None, vn[:3], np.array([[0, 1, 0]])).decode().endswith(
         "f 1//1 2//2 1//1\n")
     assert obj_body(v[:3], None, None, np.array([[0, 1, 2]])).decode().endswith("f 1 2 3\n")
+
+
+def test_damaged_files_and_bad_arguments_are_one_error(baked, tmp_path):
+    """A damaged GLB was trimesh's ValueError, an OBJ of points an AttributeError, an empty mesh
+    numpy's ValueError, a string angle float()'s; metadata could overwrite "frame" (the file was
+    then read back in metres) or write a bare NaN into the glTF JSON."""
+    (tmp_path / "bad.glb").write_bytes(b"x" * 70)
+    (tmp_path / "pts.obj").write_text("# woodcam: units=m up=y\nv 0 0 0\nv 1 0 0\n")
+    with pytest.raises(WoodcamError, match="cannot be read as a mesh"):
+        load_textured(tmp_path / "bad.glb")
+    with pytest.raises(WoodcamError, match="holds no triangle mesh"):
+        load_textured(tmp_path / "pts.obj")
+    from woodcam.export import crease_normals
+
+    with pytest.raises(WoodcamError, match="mesh has no triangles"):
+        crease_normals(trimesh.Trimesh())
+    with pytest.raises(WoodcamError, match="crease_angle_deg must be in"):
+        crease_normals(trimesh.creation.box(), "abc")
+    with pytest.raises(WoodcamError, match=r"metadata may not change \['frame'\]"):
+        export_glb(baked.mesh, tmp_path / "a.glb", metadata={"frame": "x"})
+    with pytest.raises(WoodcamError, match="metadata must be JSON-serialisable"):
+        export_glb(baked.mesh, tmp_path / "a.glb", metadata={"x": float("nan")})
+    export_glb(baked.mesh, tmp_path / "a.glb", metadata={"units": "mm", "kind": "k"})  # the same value: fine
+    assert read_glb_metadata(tmp_path / "a.glb")["kind"] == "k"

@@ -148,12 +148,17 @@ def crease_normals(mesh: Mesh, crease_angle_deg: float | None = None) -> Mesh:
 
     if not isinstance(mesh, trimesh.Trimesh):
         raise WoodcamError(f"mesh must be a trimesh.Trimesh; got {type(mesh).__name__}")
-    angle = CREASE_ANGLE_DEG if crease_angle_deg is None else float(crease_angle_deg)
+    try:
+        angle = CREASE_ANGLE_DEG if crease_angle_deg is None else float(crease_angle_deg)
+    except (TypeError, ValueError):
+        angle = math.nan
     if not (math.isfinite(angle) and 0.0 <= angle <= 180.0):
         raise WoodcamError(
             f"crease_normals: crease_angle_deg must be in [0, 180]; got {crease_angle_deg!r}; "
             "use e.g. 30 (0 = flat shading, 180 = smooth everywhere)"
         )
+    if len(mesh.faces) == 0:
+        raise WoodcamError("crease_normals: mesh has no triangles; pass a surface with at least one")
     verts = np.asarray(mesh.vertices, dtype=np.float64)
     faces = np.asarray(mesh.faces, dtype=np.int64)
     n_faces = len(faces)
@@ -245,8 +250,13 @@ def export_glb(mesh: Mesh, path: PathLike, metadata: dict | None = None, *,
     path = check_output_path(path, suffixes=(".glb",), what="export_glb: path", mkdir=True)
     payload = {"units": "mm", "frame": "block", "block_to_gltf": BLOCK_TO_GLTF.tolist()}
     if metadata is not None:
-        try:
-            payload.update(json.loads(json.dumps(metadata)))
+        clash = sorted(k for k in (metadata if isinstance(metadata, dict) else {})
+                       if k in payload and metadata[k] != payload[k])
+        if clash:  # the file's own contract: readers trust "frame" to undo the root transform
+            raise WoodcamError(f"export_glb: metadata may not change {clash}; export_glb writes them "
+                               "itself (vertices in block-frame mm under BLOCK_TO_GLTF); use other keys")
+        try:  # strict: NaN would be written as a bare NaN, which no JSON reader accepts
+            payload.update(json.loads(json.dumps(metadata, allow_nan=False)))
         except (TypeError, ValueError) as err:
             raise WoodcamError(
                 f"export_glb: metadata must be JSON-serialisable; got {type(metadata).__name__} "
@@ -416,7 +426,15 @@ def load_textured(path: PathLike) -> Mesh:
     path = Path(path)
     if not path.is_file():
         raise WoodcamError(f"load_textured: no file at {str(path)!r}; check the path")
-    loaded = trimesh.load(path, process=False, maintain_order=True)
+    try:
+        loaded = trimesh.load(path, process=False, maintain_order=True)
+    except Exception as err:  # noqa: BLE001 - trimesh raises anything on a damaged file
+        raise WoodcamError(f"load_textured: {str(path)!r} cannot be read as a mesh ({type(err).__name__}: "
+                           f"{str(err)[:200]}); is it a GLB or OBJ written by woodcam?") from err
+    if not isinstance(loaded, (trimesh.Trimesh, trimesh.Scene)) or (
+            isinstance(loaded, trimesh.Trimesh) and len(loaded.faces) == 0):
+        raise WoodcamError(f"load_textured: {str(path)!r} holds no triangle mesh (a "
+                           f"{type(loaded).__name__}); pass a GLB or OBJ written by woodcam")
     if path.suffix.lower() == ".obj" and not isinstance(loaded, trimesh.Scene):
         recorded = obj_header_transform(path)
         if recorded is not None:
