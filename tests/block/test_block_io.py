@@ -136,3 +136,28 @@ def test_a_missing_block_folder_is_named_as_given(tmp_path):
     missing = tmp_path / "no_such_block"
     with pytest.raises(WoodcamError, match=f"block folder '{missing}' does not exist"):
         read_block(missing)
+
+
+def test_write_block_refuses_what_read_block_would_refuse(tmp_path):
+    """These were written (over a good block folder, by default) and then refused by read_block,
+    or came back changed: NaN in meta, a 20 m block, a face of 0 x 0 px, a trace far outside its
+    face, a name that is not a string, an RGBA extra (read back as RGB)."""
+    import numpy as np
+
+    from woodcam.block import Block, Face, RingTrace, write_block
+    from woodcam.errors import WoodcamError
+
+    with pytest.raises(WoodcamError, match=r"block.meta must be JSON-serialisable"):
+        write_block(Block((10, 10, 10), meta={"x": float("nan")}), tmp_path / "a")
+    with pytest.raises(WoodcamError, match="at most 10000 mm a side"):
+        Block((20000, 10, 10))
+    with pytest.raises(WoodcamError, match="must be two pixel counts"):
+        Face("top", (0, 0))
+    with pytest.raises(WoodcamError, match="lies beyond its 4x4 px image"):
+        Face("top", (4, 4), traces=[RingTrace([[0, 0], [100, 100]])])
+    with pytest.raises(WoodcamError, match="Block.name must be a string"):
+        Block((10, 10, 10), name=5)
+    rgba = Face("top", (4, 4), extras={"paint": np.zeros((4, 4, 4), np.uint8)})
+    with pytest.raises(WoodcamError, match=r"grey \(h, w\) or RGB \(h, w, 3\)"):
+        write_block(Block((10, 10, 10), faces={"top": rgba}), tmp_path / "b")
+    assert not (tmp_path / "a" / "block.json").exists() and not (tmp_path / "b" / "block.json").exists()

@@ -99,6 +99,18 @@ class Face:
     def __post_init__(self):
         self.name = check_face(self.name)
         self.shape = (int(self.shape[0]), int(self.shape[1]))
+        from ..limits import limit
+
+        top = int(limit("MAX_FACE_PX"))
+        if not all(1 <= s <= top for s in self.shape):  # (0, 0) or (-3, 4) was accepted and written
+            raise WoodcamError(f"shape of face {self.name!r} must be two pixel counts in [1, {top}]; got {self.shape}")
+        rows, cols = self.shape
+        for k, t in enumerate(self.traces):  # where read_block takes them: half a face of slack
+            p = np.asarray(t.points_px, float)
+            if (p[:, 0] < -0.5 - 0.5 * rows).any() or (p[:, 0] > 1.5 * rows - 0.5).any() or \
+                    (p[:, 1] < -0.5 - 0.5 * cols).any() or (p[:, 1] > 1.5 * cols - 0.5).any():
+                raise WoodcamError(f"trace {k} of face {self.name!r} lies beyond its {rows}x{cols} px image (more "
+                                   "than half a face past an edge); check its (row, col) pixel coordinates")
         if self.photo is not None:
             self.photo = _check_image(self.photo, self.shape, 3, f"photo of face {self.name!r}")
         if self.ring_map is not None:
@@ -141,6 +153,13 @@ class Block:
 
     def __post_init__(self):
         self.size_mm = tuple(float(s) for s in check_size(self.size_mm))
+        from ..limits import limit
+
+        if not isinstance(self.name, str):
+            raise WoodcamError(f"Block.name must be a string; got {self.name!r}")
+        if max(self.size_mm) > limit("MAX_BLOCK_SIZE_MM"):  # read_block refuses it
+            raise WoodcamError(f"Block.size_mm must be at most {limit('MAX_BLOCK_SIZE_MM'):g} mm a side "
+                               f"(woodcam.limits.MAX_BLOCK_SIZE_MM); got {self.size_mm}")
         faces = {}
         for key, face in self.faces.items():
             if check_face(key) != face.name:

@@ -223,12 +223,13 @@ def _write_extra(folder: Path, face: str, key: str, value) -> dict:
         fname = f"{face}_{key}.png"
         if value.dtype == bool:
             _write_png(folder / fname, value.astype(np.uint8) * 255)
-        elif value.dtype in (np.uint8, np.uint16) and value.ndim in (2, 3):
+        elif value.dtype in (np.uint8, np.uint16) and (value.ndim == 2 or (value.ndim == 3 and value.shape[2] == 3)):
+            # grey or RGB only: the PNG reader gives RGBA back as RGB and grey + alpha as grey
             _write_png(folder / fname, value)
         else:
             raise WoodcamError(
-                f"extras[{key!r}] of face {face!r} must be a bool, uint8 or uint16 image to be "
-                f"stored as PNG; got dtype {value.dtype}, shape {value.shape}"
+                f"extras[{key!r}] of face {face!r} must be a bool, uint8 or uint16 image, grey (h, w) "
+                f"or RGB (h, w, 3), to be stored as PNG; got dtype {value.dtype}, shape {value.shape}"
             )
         return {"png": fname, "dtype": str(value.dtype)}
     return {"json": jsonable(value, f"extras[{key!r}] of face {face!r}")}

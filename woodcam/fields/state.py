@@ -35,7 +35,8 @@ def jsonable(obj, what: str):
             return list(o)
         raise TypeError(type(o).__name__)
     try:
-        return json.loads(json.dumps(obj, default=default))
+        # strict: a NaN is written as a bare NaN, which read_block (strict JSON) then refuses
+        return json.loads(json.dumps(obj, default=default, allow_nan=False))
     except (TypeError, ValueError) as err:
         raise WoodcamError(
             f"{what} must be JSON-serialisable (numbers, strings, lists, dicts, numpy arrays); "
