@@ -47,6 +47,14 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["block", "from-photos", "OUT/none", "--size-mm", "50", "--out", "OUT/fp", "--max-px-per-mm=-5"],
      r"--max-px-per-mm must be in \(0, 1000\]"),
     (["block", "from-photos", "OUT/none", "--size-mm", "1e300", "--out", "OUT/fp"], r"--size-mm takes WxDxH in mm"),
+    # empty or repeated lists were taken as the default (an empty benchmark table, exit 0)
+    (["fit", "/nonexistent", "--faces", "", "--out", "OUT/f.npz"], r"--faces must be 'all' or a comma list"),
+    (["fit", "/nonexistent", "--faces", "front,front", "--out", "OUT/f.npz"], r"--faces must be 'all'"),
+    (["eval", "rings", "/nonexistent", "--methods", "", "--out", "OUT/e"], r"--methods must be 'all'"),
+    (["eval", "realistic", "--seed", "5", "--methods", "", "--out", "OUT/e"], r"--methods must be a comma list from"),
+    (["bench", "report", "OUT", "--gallery", "-1", "--out", "OUT/r"], r"--gallery must be in \[0, 1000\]"),
+    # it blamed the block spec for a missing file
+    (["review", "OUT/nope.glb", "--out", "OUT/r.html"], r"review: no file at"),
     # a bad spec after a good tool number was reported as a bad number
     ([*GCODE, "--tool", "5=flat:6:7"], r"--tool '5=flat:6:7': tool spec 'flat:6:7': flat takes 1 number"),
 ])

@@ -62,7 +62,10 @@ def run_realistic(args) -> int:
     from ..bench_realistic import FACE_SETS, SCENARIOS, confidence_markdown, markdown, score_block, summarise
 
     methods, scenarios, faces = _list(args.methods), _list(args.scenarios), _list(args.faces)
-    for name, got, allowed in (("--scenarios", scenarios, SCENARIOS), ("--faces", faces, FACE_SETS)):
+    from .fit import METHODS
+
+    for name, got, allowed in (("--methods", methods, METHODS), ("--scenarios", scenarios, SCENARIOS),
+                               ("--faces", faces, FACE_SETS)):
         bad = [g for g in got if g not in allowed]
         if bad or not got:
             raise WoodcamError(f"{name} must be a comma list from {', '.join(allowed)}; got {got}")

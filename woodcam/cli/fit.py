@@ -21,8 +21,16 @@ PARTIAL_FACES = ("front", "top", "left")
 METHODS = ("evidence", "rbf", "radial", "neural")
 
 
-def _faces(text):
-    return None if text in (None, "", "all") else [f.strip() for f in text.split(",") if f.strip()]
+def _names(text, option: str):
+    """A comma list option (``--faces``, ``--methods``): None for "all" or not given (the
+    default); else the names, each once. An empty list or a repeated name was taken as the
+    default without a word."""
+    if text in (None, "all"):
+        return None
+    names = [f.strip() for f in text.split(",")]
+    if not all(names) or len(set(names)) != len(names):
+        raise WoodcamError(f"{option} must be 'all' or a comma list of distinct names; got {text!r}")
+    return names
 
 
 def register(subparsers) -> None:
@@ -76,9 +84,10 @@ def run_fit(args) -> int:
     from ..inference.fit import fit_block
 
     _check_methods([args.method], "--method")
+    faces = _names(args.faces, "--faces")  # before the block is read
     apply_workers(args)
     block, _ = open_block(args.block, args.size_mm)
-    field = fit_block(block, args.method, faces=_faces(args.faces))
+    field = fit_block(block, args.method, faces=faces)
     path = field.save(args.out)
     print(f"wrote {path} ({args.method} fit of {block.name}, grid {field.years.shape}, "
           f"{field.spacing_mm[0]:g} mm)")
@@ -91,8 +100,9 @@ def run_eval(args) -> int:
     from ..fields.grid import GridField
     from ..inference.evaluate import benchmark
 
-    methods = _faces(args.methods) or ["rbf", "radial"]
+    methods = _names(args.methods, "--methods") or ["rbf", "radial"]
     _check_methods(methods, "--methods")
+    partial = None if args.partial_faces.lower() == "none" else _names(args.partial_faces, "--partial-faces")
     blocks = [open_block(p, args.size_mm)[0] for p in args.block]
     if args.truth:
         if len(args.truth) != len(blocks):
@@ -106,7 +116,7 @@ def run_eval(args) -> int:
     if known:
         sets = {"full": None}
         if args.partial_faces.lower() != "none":
-            sets["partial"] = _faces(args.partial_faces)
+            sets["partial"] = partial
         res = benchmark(known, methods, sets, out_dir=args.out, progress=print, confidence=args.confidence)
         print(res["table"])
         print(f"wrote {Path(args.out) / 'table.md'} and cut-plane images")

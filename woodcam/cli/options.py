@@ -37,7 +37,7 @@ SPECIES_HELP = ("colour preset: cited (README 'Species presets'): red-oak, white
 
 BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], woodify:DIR/field.npz "
                    "(a block cut from a grown object), a block folder "
-                   "(block.json) or a Mokume sample folder (a 50 mm cube unless --size-mm); "
+                   "(block.json) or a Mokume sample folder (a 50 mm cube); "
                    "append ~x90/~y90/~z90 to turn the block under the part")
 
 
@@ -565,6 +565,8 @@ RANGES: dict = {
     "max_px_per_mm": (0.0, 1000.0, True),  # block from-photos: -5 wrote a block at -5 px/mm
     "zoom": (1, 64, False),                # rings show: picture pixels per face pixel
     "sheets": (1, 1000, False),            # parquetry leaves per block (1e6 ran on, memory growing)
+    "gallery": (0, 1000, False),           # bench report: -1 went into Python slicing
+    "thumbnails": (0, 1000, False),
 }
 
 

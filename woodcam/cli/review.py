@@ -34,7 +34,9 @@ def run_review(args: argparse.Namespace) -> int:
     from ..review import VOLUME_VOXELS, write_review
     from .options import stock_of_glb
 
-    meta = read_glb_metadata(args.part) if args.part.is_file() else {}
+    if not args.part.is_file():  # it said "records no block spec", blaming the spec for a missing file
+        raise WoodcamError(f"review: no file at {str(args.part)!r}; pass a GLB written by woodcam bake or gcode")
+    meta = read_glb_metadata(args.part)
     stock = stock_of_glb(args.part, args.block)
     if stock is None:
         raise WoodcamError(f"review: {str(args.part)!r} records no block spec; pass --block SPEC")
