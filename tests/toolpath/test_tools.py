@@ -60,6 +60,15 @@ def test_load_tool_table(tmp_path):
         load_tool_table(p)
     with pytest.raises(WoodcamError, match="does not exist"):
         load_tool_table(tmp_path / "missing.toml")
+    # a typo was ignored: flute_length (for flute_length_mm) silently turned the reach checks off
+    p.write_text('[tools.5]\ntype = "flat"\ndiameter_mm = 3\nflute_length = 2\n')
+    with pytest.raises(WoodcamError, match=r"\[tools.5\] \(type 'flat'\) has unknown key\(s\) \['flute_length'\]"):
+        load_tool_table(p)
+    p.write_text('[tools.5]\ntype = "flat"\ndiameter_mm = 3\nangle_deg = 60\n')  # not a flat's
+    with pytest.raises(WoodcamError, match=r"unknown key\(s\) \['angle_deg'\]"):
+        load_tool_table(p)
+    p.write_text('[tools.5]\ntype = "flat"\ndiameter_mm = 3\nflute_length_mm = 2\ndescription = "1/8 in"\n')
+    assert load_tool_table(p)[5].flute_length_mm == 2
 
 
 TOOLS = [FlatEndMill(6), BallEndMill(6), BullNoseMill(6, corner_radius_mm=1.5),

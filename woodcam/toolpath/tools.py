@@ -519,6 +519,13 @@ def load_tool_table(path: PathLike) -> dict[int, Tool]:
         if kind not in TOOL_TYPES or d is None:
             raise WoodcamError(f"load_tool_table: {path}: [tools.{key}] needs type (one of "
                                f"{TOOL_TYPES}) and diameter_mm, got {dict(entry)!r}")
+        # every key must mean something for this type: a typo (flute_length for flute_length_mm)
+        # was ignored, which silently turned off the reach checks it was written for
+        known = {"type", "diameter_mm", *REACH_FIELDS.values(), *_TYPE_KEYS.get(kind, ()), *_NOTE_KEYS}
+        unknown = sorted(set(entry) - known)
+        if unknown:
+            raise WoodcamError(f"load_tool_table: {path}: [tools.{key}] (type {kind!r}) has unknown "
+                               f"key(s) {unknown}; known: {sorted(known)}")
         num = lambda k: _number(entry.get(k, math.nan), path, key, k)  # noqa: E731
         d = num("diameter_mm")
         reach = {name: num(name) for name in REACH_FIELDS.values() if name in entry}
@@ -538,6 +545,14 @@ def load_tool_table(path: PathLike) -> dict[int, Tool]:
             tool = VBit(d, num("angle_deg"))
         out[number] = tool.with_reach(**reach) if reach else tool
     return out
+
+
+#: Keys a tool table may carry for people (read by no one).
+_NOTE_KEYS = ("name", "description", "comment", "note", "vendor")
+#: The keys each tool type reads beyond type, diameter_mm and the reach (load_tool_table).
+_TYPE_KEYS = {"bull": ("corner_radius_mm",), "snub": ("angle_deg", "tip_diameter_mm"),
+              "chamfer": ("angle_deg", "tip_diameter_mm"), "taperball": ("tip_diameter_mm", "taper_deg"),
+              "vbit": ("angle_deg",)}
 
 
 def _number(value, path, key, name) -> float:
