@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .options import add_block_argument, add_engine_options, add_out_option, add_size_option, engine_options, open_block
+from .options import (add_block_argument, add_engine_options, add_out_option, add_size_option, engine_options,
+                      engine_requested, open_block)
 
 
 def register(subparsers) -> None:
@@ -72,7 +73,7 @@ def run(args) -> int:
                  "trace_dropout_chunk_mm": args.dropout_chunk_mm, "mislabel_fraction": args.mislabel}
         if args.ring_maps_only:
             noise["trace_faces"] = []
-        if args.engine is not None or args.address is not None:
+        if engine_requested(args):
             # one task per block: the same blocks as without an engine (noise included),
             # resumable (a record per block), on an engine
             from ..benchmark import write_benchmark_set

@@ -647,6 +647,15 @@ def add_engine_options(p: argparse.ArgumentParser) -> None:
                    help="seconds to wait for the scheduler at --address (default 10)")
 
 
+_ENGINE_DESTS = ("engine", "address", "workers", "memory_limit_mb", "connect_timeout_s")
+
+
+def engine_requested(args) -> bool:
+    """Whether any of :func:`add_engine_options`' options was given: then the work runs on an
+    engine (``--workers 4`` alone ran serially in this process, as if it had not been given)."""
+    return any(getattr(args, d, None) is not None for d in _ENGINE_DESTS)
+
+
 def engine_options(args) -> dict:
     """The keyword arguments of :func:`woodcam.scale.run_many` from :func:`add_engine_options`."""
     if args.address is not None and args.engine not in (None, "dask"):

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .options import add_engine_options, add_out_option, engine_options
+from ..errors import WoodcamError
+from .options import add_engine_options, add_out_option, engine_options, engine_requested
 
 
 def register(subparsers) -> None:
@@ -28,6 +29,11 @@ def run(args) -> int:
     if args.what == "rings":
         from ..detect.learned import RingNetSpec, train_ring_net
 
+        if engine_requested(args) or args.no_resume:  # they were accepted and ignored
+            raise WoodcamError("train rings runs in this process and always from scratch: the engine "
+                               "options (--engine, --address, --workers, ...) and --no-resume are for "
+                               "'train gtf'")
+
         spec = RingNetSpec.load(args.spec) if args.spec is not None else RingNetSpec()
         if args.steps is not None:
             from dataclasses import replace
@@ -48,7 +54,7 @@ def run(args) -> int:
     spec = GTFSpec.load(args.spec) if args.spec is not None else GTFSpec()
     args.out.mkdir(parents=True, exist_ok=True)
     training_set = None
-    if args.engine is not None or args.address is not None:
+    if engine_requested(args):
         # the same training set, made in shards on an engine, kept in OUT/trainset/ (resumable)
         from ..benchmark import make_training_set_many
 
