@@ -38,7 +38,9 @@ def test_fit_scales_into_the_block_with_the_margin():
 
 @pytest.mark.parametrize(("ops", "match"), [
     (["rotate:w:90"], "rotate:AXIS:DEG"), (["translate:1,2"], "translate:X,Y,Z"),
-    (["scale:-1"], "scale must be > 0"), (["spin"], "is not a placement operation"),
+    (["scale:-1"], r"scale must be in \(0, 1000\]"), (["spin"], "is not a placement operation"),
+    # these overflowed: the part's volume became NaN (its warnings vanished) or 0 ("inside-out?")
+    (["scale:1e300"], r"scale must be in \(0, 1000\]"), (["translate:1e300,0,0"], "within 100 m"),
     (["translate:1,nan,2"], "not a finite number"), (["fit:60"], "leaves no room")])
 def test_bad_placements_are_clear_errors(ops, match):
     with pytest.raises(WoodcamError, match=match):

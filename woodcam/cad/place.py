@@ -89,11 +89,14 @@ def placement_matrix(ops: Sequence[str], bounds_mm, size_mm) -> np.ndarray:
             parts = arg.split(",")
             if len(parts) != 3:
                 raise WoodcamError(f"--place {op!r}: expected translate:X,Y,Z in mm; use {_HELP}")
-            step = _translate([_number(p, op) for p in parts])
+            move = [_number(p, op) for p in parts]
+            if max(abs(v) for v in move) > 1e5:  # 1e300 made the part's volume 0 ("inside-out?")
+                raise WoodcamError(f"--place {op!r}: a move must stay within 100 m (1e5 mm); got {arg}")
+            step = _translate(move)
         elif name == "scale":
             factor = _number(arg, op)
-            if factor <= 0:
-                raise WoodcamError(f"--place {op!r}: the scale must be > 0; got {factor:g}")
+            if not 0 < factor <= 1000:  # 1e300 overflowed the volume to NaN: the warnings vanished
+                raise WoodcamError(f"--place {op!r}: the scale must be in (0, 1000]; got {factor:g}")
             step = _about(centre, np.eye(3) * factor)
         elif name == "center" and not arg:
             step = _translate(size / 2 - centre)
