@@ -55,6 +55,10 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["bench", "report", "OUT", "--gallery", "-1", "--out", "OUT/r"], r"--gallery must be in \[0, 1000\]"),
     # it blamed the block spec for a missing file
     (["review", "OUT/nope.glb", "--out", "OUT/r.html"], r"review: no file at"),
+    # in inches the error showed the value converted ("got 12.7" for 0.5 against a mm range)
+    (["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb", "--tool", "flat:6",
+      "--units", "inch", "--mesh-tol", "0.5"],
+     r"--mesh-tol must be in \(0, 10\] mm; got 0.5 inch = 12.7 mm"),
     # a bad spec after a good tool number was reported as a bad number
     ([*GCODE, "--tool", "5=flat:6:7"], r"--tool '5=flat:6:7': tool spec 'flat:6:7': flat takes 1 number"),
 ])

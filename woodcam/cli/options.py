@@ -231,6 +231,8 @@ def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
         value = getattr(args, dest, None)
         if cmd == command and value is not None and value is not sub.get_default(dest):
             setattr(args, dest, _value_to_mm(kind, value, k))
+            # what was typed, for the range errors: "--mesh-tol 0.5" (inch) said "got 12.7"
+            args.__dict__.setdefault("_typed", {})[dest] = (value, units)
 
 
 def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction:
@@ -574,7 +576,7 @@ def _option(dest: str) -> str:
     return "--" + dest.replace("_", "-")
 
 
-def _check_value(value, option: str, rng) -> None:
+def _check_value(value, option: str, rng, typed=None) -> None:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return
     if isinstance(value, float) and not math.isfinite(value):
@@ -583,8 +585,10 @@ def _check_value(value, option: str, rng) -> None:
         return
     lo, hi, lo_open = rng
     if value < lo or value > hi or (lo_open and value <= lo):
-        raise WoodcamError(f"{option} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}]; got "
-                           f"{value!r}; see 'woodcam COMMAND --help' for its meaning and default")
+        got = f"{value!r}" if typed is None else f"{typed[0]!r} {typed[1]} = {value:g} mm"
+        raise WoodcamError(f"{option} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}]"
+                           f"{' mm' if typed is not None else ''}; got {got}; see 'woodcam COMMAND --help' "
+                           "for its meaning and default")
 
 
 def check_numbers(args: argparse.Namespace) -> None:
@@ -595,8 +599,10 @@ def check_numbers(args: argparse.Namespace) -> None:
             continue
         rng = RANGES.get((command, dest), RANGES.get(dest))
         values = value if isinstance(value, (list, tuple)) else [value]
+        typed = vars(args).get("_typed", {}).get(dest)
         for v in values:
-            _check_value(v, _option(dest), rng)
+            _check_value(v, _option(dest), rng, None if typed is None or isinstance(typed[0], (list, tuple))
+                         else typed)
 
 
 def add_workers_option(p: argparse.ArgumentParser) -> None:
