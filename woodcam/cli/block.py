@@ -42,7 +42,9 @@ def register(subparsers) -> None:
     v = sub.add_parser("show", help="draw a block's faces as one unfolded-cross PNG")
     add_block_argument(v, option=False)
     add_out_option(v, "the unfolded faces with a cut layer", suffixes=(".png",))
-    v.add_argument("--layer", choices=("photo", "ring_map", "both"), default="photo")
+    v.add_argument("--layer", choices=("photo", "ring_map", "both"), default="photo",
+                   help="what to draw on each face: its photo, its ring map or both side by side "
+                   "(default photo)")
     v.add_argument("--no-traces", action="store_true", help="do not draw traced rings")
     add_size_option(v)
 

@@ -32,7 +32,8 @@ def register(subparsers) -> None:
                    help="benchmark seed; use seeds never used while developing a fitter")
     r.add_argument("--count", type=int, default=6, help="blocks per row (default 6)")
     r.add_argument("--methods", default="rbf,radial,evidence",
-                   help="comma list of fitting methods (default rbf,radial,evidence)")
+                   help="comma list of fitting methods from evidence, rbf, radial, neural (default "
+                   "rbf,radial,evidence)")
     r.add_argument("--scenarios", default="noisy",
                    help="comma list of clean, noisy, ring-maps (default noisy)")
     r.add_argument("--faces", default="full,three", help="comma list of full, three (default both)")

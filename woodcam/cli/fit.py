@@ -43,7 +43,8 @@ def register(subparsers) -> None:
                    "our pith axis, ring-width shape and growth history by least squares; evidence "
                    "(default): radial pith hypotheses, RBF and radial + residual, chosen by how well "
                    "each predicts the faces it was not fitted to (warns when they contradict it)")
-    p.add_argument("--faces", default=None, help="comma-separated faces to use (default: all)")
+    p.add_argument("--faces", default=None, help="comma-separated faces to use, from front, top, left, "
+                   "bottom, right, back (default: all)")
     add_size_option(p)
     add_workers_option(p)
     add_out_option(p, "the fitted field as a grid", suffixes=(".npz",))
