@@ -123,3 +123,20 @@ def test_engine_options_alone_run_on_the_engine_and_train_rings_refuses_them(tmp
         assert main(["train", "rings", "--out", str(tmp_path / "t"), *extra]) == EXIT_ERROR
         assert "are for 'train gtf'" in capsys.readouterr().err
     assert not (tmp_path / "t").exists()
+
+
+def test_options_that_would_change_nothing_are_named(tmp_path, capsys, shared_data):
+    """--size-mm on a block folder, and the leaf-slicing options with only Mokume veneers, were
+    accepted and ignored without a word."""
+    from woodcam.cli import EXIT_ERROR
+
+    assert main(["block", "synth", "--count", "1", "--seed", "3", "--out", str(tmp_path / "b"), "--face-px", "32",
+                 "--quiet", "--knotted-fraction", "0"]) == 0
+    capsys.readouterr()
+    assert main(["block", "show", str(tmp_path / "b" / "block_0000"), "--size-mm", "30",
+                 "--out", str(tmp_path / "s.png")]) == 0
+    assert "--size-mm (size_mm (30.0, 30.0, 30.0)) is for Mokume sample folders" in capsys.readouterr().err
+    # no target: the run stops before any work, after the warning
+    assert main(["parquetry", "--veneer-from", str(shared_data / "mokume" / "CN03"), "--sheets", "3",
+                 "--slice-axis", "x", "--out", str(tmp_path / "pq")]) == EXIT_ERROR
+    assert "--sheets, --slice-axis slice leaves from blocks" in capsys.readouterr().err

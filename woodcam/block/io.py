@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from pathlib import Path
 from typing import Literal
 
@@ -55,7 +56,7 @@ import numpy as np
 from .._types import ArrayLike, PathLike
 from .._atomic import atomic_path, write_text
 from .._readers import photo_rgb8, read_image_file
-from ..errors import WoodcamError
+from ..errors import WoodcamError, WoodcamWarning
 from ..fields.state import field_from_state, field_type, jsonable
 from ..frames import FACES, MOKUME_LETTER
 from ..tolerances import KNOT_POINT_MAX_PX, KNOT_REGION_SMOOTH_PX
@@ -338,7 +339,12 @@ def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | No
         raise WoodcamError(f"folder must be a block folder (with {MANIFEST}) or a Mokume sample "
                            f"folder; {str(folder)!r} does not exist")
     if (folder / MANIFEST).is_file():
-        return read_block(folder)
+        block = read_block(folder)
+        if size_mm is not None and tuple(map(float, size_mm)) != tuple(block.size_mm):
+            # nothing silently dropped: --size-mm was accepted and ignored
+            warnings.warn(f"--size-mm (size_mm {tuple(size_mm)}) is for Mokume sample folders; {str(folder)!r} "
+                          f"records its own size {block.size_mm} mm, which is used", WoodcamWarning, stacklevel=2)
+        return block
     if not any(p.exists() for face in FACES for p in _mokume_files(folder, face).values()):
         from .photos import find_face_photos
 

@@ -8,8 +8,10 @@ Table 1.
 from __future__ import annotations
 
 import argparse
+import warnings
 from pathlib import Path
 
+from ..errors import WoodcamWarning
 from .options import SPECIES_HELP, add_out_option, add_units_option, parse_sizes
 
 _EPILOG = """\
@@ -29,6 +31,11 @@ examples:
 writes render.png, baseline.png, target_matched.png, assembly.svg, veneer_<id>.svg/.dxf,
 result.json, panel.glb and job.json (the run as a job file) into --out.
 """
+
+
+#: The options that slice leaves from a --veneer-from block, and their defaults.
+_SLICING = {"sheets": 2, "sheet_size": "600x400", "leaf_thickness": 0.6, "saw_kerf": 0.4, "slice_axis": "y",
+            "species": None}
 
 
 def register(subparsers) -> None:
@@ -52,14 +59,14 @@ def register(subparsers) -> None:
                    "'Npx/mm'")
     v.add_argument("--veneer-from", action="append", default=[], metavar="SPEC",
                    help="Mokume sample folder, or block spec to slice leaves from (repeatable)")
-    v.add_argument("--sheets", type=int, default=2, help="leaves per --veneer-from block (default 2)")
-    v.add_argument("--sheet-size", default="600x400", metavar="WxH",
+    v.add_argument("--sheets", type=int, default=_SLICING["sheets"], help="leaves per --veneer-from block (default 2)")
+    v.add_argument("--sheet-size", default=_SLICING["sheet_size"], metavar="WxH",
                    help="size of each sliced leaf in mm (default 600x400)")
-    v.add_argument("--leaf-thickness", type=float, default=0.6, metavar="MM",
+    v.add_argument("--leaf-thickness", type=float, default=_SLICING["leaf_thickness"], metavar="MM",
                    help="sliced leaf thickness in mm (default 0.6)")
-    v.add_argument("--saw-kerf", type=float, default=0.4, metavar="MM",
+    v.add_argument("--saw-kerf", type=float, default=_SLICING["saw_kerf"], metavar="MM",
                    help="wood lost between sliced leaves in mm (default 0.4)")
-    v.add_argument("--slice-axis", choices=("x", "y", "z"), default="y",
+    v.add_argument("--slice-axis", choices=("x", "y", "z"), default=_SLICING["slice_axis"],
                    help="normal of the slicing planes in the block frame (default y: leaves "
                    "parallel to the front face)")
     add_units_option(v, "parquetry")
@@ -187,6 +194,11 @@ def run(args) -> int:
             job.blocks.append({"spec": spec, "sheets": args.sheets, "width_mm": w, "height_mm": h,
                                "thickness_mm": args.leaf_thickness, "kerf_mm": args.saw_kerf,
                                "axis": args.slice_axis, "species": args.species})
+    given = ["--" + d.replace("_", "-") for d, default in _SLICING.items() if getattr(args, d) != default]
+    if given and job.mokume and not job.blocks:  # nothing silently dropped
+        warnings.warn(f"{', '.join(given)} slice leaves from blocks; the Mokume sample folders given "
+                      "are used as their photos are, so these options change nothing here", WoodcamWarning,
+                      stacklevel=2)
     if not job.targets:
         raise WoodcamError("parquetry needs a target image (TARGET or a --config job with targets)")
     if not (job.scans or job.mokume or job.blocks):
