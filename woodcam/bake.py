@@ -44,6 +44,7 @@ Pipeline (each step timed in :attr:`BakeResult.timings`)
 from __future__ import annotations
 
 import math
+import numbers
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -364,7 +365,7 @@ def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals) ->
             f"bake: wood must have a method color(points_mm, normals) -> rgb; got "
             f"{type(wood).__name__}; pass a woodcam.appearance.Wood or any object with .color"
         )
-    if not (isinstance(texels_per_mm, (int, float)) and math.isfinite(texels_per_mm)
+    if not (isinstance(texels_per_mm, numbers.Real) and math.isfinite(texels_per_mm)
             and texels_per_mm > 0):
         raise WoodcamError(
             f"bake: texels_per_mm must be a finite number > 0; got {texels_per_mm!r}; "

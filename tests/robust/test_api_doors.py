@@ -86,3 +86,25 @@ def test_small_inputs_that_asked_for_gigabytes_or_hung_are_refused(tmp_path):
     for bad in ([[np.nan, 40, 25]], [[1.0, np.inf, 2.0]]):
         with pytest.raises(WoodcamError, match="points_mm must be finite; point 0 is"):
             field(np.asarray(bad))
+
+
+def test_numpy_scalars_are_numbers_and_a_polyline_of_nan_is_refused(tmp_path):
+    """bake(texels_per_mm=np.float32(2)) and read_gcode(chord_tol_mm=np.float32(0.01)) were refused
+    as not numbers; a polyline "0,0 nan,1 2,2" was read as the points (0, 0) and (1, 2)."""
+    import numpy as np
+    import trimesh
+
+    from woodcam import bake, read_gcode
+    from woodcam.block.svg import read_traces_svg
+
+    class Grey:
+        def color(self, points_mm, normals):
+            return np.full((len(points_mm), 3), 0.5)
+
+    box = trimesh.creation.box((10, 10, 10))
+    assert len(bake(box, Grey(), texels_per_mm=np.float32(2.0)).mesh.faces) == 12
+    assert len(read_gcode("G1 X1 F100\n", chord_tol_mm=np.float32(0.01))) == 1
+    (tmp_path / "t.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10">'
+                                    '<polyline points="0,0 nan,1 2,2"/></svg>')
+    with pytest.raises(WoodcamError, match="a polyline's points must be pairs of finite numbers"):
+        read_traces_svg(tmp_path / "t.svg", (10, 10))

@@ -102,12 +102,30 @@ def read_traces_svg(path, shape) -> list[RingTrace]:
             continue  # Polygon is a Polyline; rects, circles, images and text are no traces
         year = _year(el.values.get("attributes", {}))
         ring = _ring(el.values.get("attributes", {}))
+        if isinstance(el, svgelements.Polyline):
+            _check_points_attribute(el.values.get("points"), path)
         path_ = el if isinstance(el, svgelements.Path) else svgelements.Path(el)
         for xy in _polylines(path_, scale):
             if len(xy) >= 2:
                 px = xy * scale
                 traces.append(RingTrace(np.stack([px[:, 1] - 0.5, px[:, 0] - 0.5], axis=1), year, ring))
     return traces
+
+
+def _check_points_attribute(points, path) -> None:
+    """A polyline's ``points`` are pairs of finite numbers: svgelements skips a token it cannot
+    read ("nan") and pairs the numbers after it anew, so "0,0 nan,1 2,2" came back as the points
+    (0, 0) and (1, 2)."""
+    if points is None:
+        return
+    tokens = [t for t in re.split(r"[\s,]+", str(points).strip()) if t]
+    try:
+        ok = len(tokens) % 2 == 0 and all(math.isfinite(float(t)) for t in tokens)
+    except ValueError:
+        ok = False
+    if not ok:
+        raise WoodcamError(f"{str(path)!r}: a polyline's points must be pairs of finite numbers "
+                           f"'x,y x,y ...'; got {str(points)[:80]!r}")
 
 
 def _polylines(path, scale: np.ndarray) -> list[np.ndarray]:

@@ -23,6 +23,7 @@ has set all three axes is warned about.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -219,7 +220,7 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
         source, text = str(path), path.read_text(errors="replace")
     else:
         text = str(text_or_path)
-    if not (isinstance(chord_tol_mm, (int, float)) and math.isfinite(chord_tol_mm)
+    if not (isinstance(chord_tol_mm, numbers.Real) and math.isfinite(chord_tol_mm)
             and chord_tol_mm > 0):
         raise WoodcamError(f"read_gcode: chord_tol_mm must be a finite number > 0, got "
                            f"{chord_tol_mm!r}; use e.g. {ARC_CHORD_TOL_MM}")
