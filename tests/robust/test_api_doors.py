@@ -108,3 +108,19 @@ def test_numpy_scalars_are_numbers_and_a_polyline_of_nan_is_refused(tmp_path):
                                     '<polyline points="0,0 nan,1 2,2"/></svg>')
     with pytest.raises(WoodcamError, match="a polyline's points must be pairs of finite numbers"):
         read_traces_svg(tmp_path / "t.svg", (10, 10))
+
+
+def test_simulate_refuses_sizes_it_cannot_use():
+    """size_mm=(inf, 10, 10) was an OverflowError, a string size a ValueError, a string
+    resolution a TypeError, a two-number work offset a broadcast ValueError."""
+    from woodcam import read_gcode
+    from woodcam.toolpath import FlatEndMill
+    from woodcam.toolpath.simulate import simulate
+
+    prog = read_gcode("G1 X5 Y5 Z-1 F100\n")
+    tools = {0: FlatEndMill(3.0)}
+    for kw in (dict(size_mm=(float("inf"), 10, 10)), dict(size_mm="abc"), dict(resolution_mm="x"),
+               dict(work_offset_mm=(0, 0))):
+        args = dict(size_mm=(10, 10, 10), resolution_mm=0.5) | kw
+        with pytest.raises(WoodcamError, match="simulate: "):
+            simulate(prog, tools, args.pop("size_mm"), **args)

@@ -213,15 +213,25 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     SimResult
         ``heightmap (ny, nx)``, ``report`` (issues with line numbers), ``stats`` (timings).
     """
-    size = np.asarray(size_mm, float).reshape(-1)
-    if size.shape != (3,) or not np.all(size > 0):
-        raise WoodcamError(f"simulate: size_mm must be (W, D, H) > 0 in mm, got {size_mm!r}")
-    if not resolution_mm > 0:
-        raise WoodcamError(f"simulate: resolution_mm must be > 0, got {resolution_mm!r}; "
+    try:  # strings, inf and short vectors were bare ValueError/TypeError/OverflowError
+        size = np.asarray(size_mm, float).reshape(-1)
+        res_mm = float(resolution_mm)
+        off_in = None if work_offset_mm is None else np.asarray(work_offset_mm, float).reshape(-1)
+    except (TypeError, ValueError) as err:
+        raise WoodcamError(f"simulate: size_mm, resolution_mm and work_offset_mm must be numbers; got "
+                           f"{size_mm!r}, {resolution_mm!r}, {work_offset_mm!r}") from err
+    if size.shape != (3,) or not np.all(np.isfinite(size) & (size > 0)):
+        raise WoodcamError(f"simulate: size_mm must be (W, D, H) finite and > 0 in mm, got {size_mm!r}")
+    if not (np.isfinite(res_mm) and res_mm > 0):
+        raise WoodcamError(f"simulate: resolution_mm must be finite and > 0, got {resolution_mm!r}; "
                            "use e.g. 0.1")
+    if off_in is not None and (off_in.shape != (3,) or not np.isfinite(off_in).all()):
+        raise WoodcamError(f"simulate: work_offset_mm must be three finite numbers (X, Y, Z) in mm; "
+                           f"got {work_offset_mm!r}")
+    resolution_mm = res_mm
     _reuse_freed_memory()
     W, D, H = size
-    off = np.array([0.0, 0.0, H]) if work_offset_mm is None else np.asarray(work_offset_mm, float)
+    off = np.array([0.0, 0.0, H]) if off_in is None else off_in
     nx, ny = max(1, round(W / resolution_mm)), max(1, round(D / resolution_mm))
     if nx * ny > 1 << 27:
         raise WoodcamError(f"simulate: {nx} x {ny} cells is too many for resolution_mm="
