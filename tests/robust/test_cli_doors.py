@@ -114,6 +114,11 @@ def test_an_unexpected_error_is_one_line_and_a_wrapped_ctrl_c_is_an_interrupt(mo
         raise ValueError("x" * 1000)
 
     def wrapped_interrupt(args):
+        import warnings
+
+        from woodcam.errors import WoodcamWarning
+
+        warnings.warn("a warning of the work before the interrupt", WoodcamWarning)
         try:
             raise KeyboardInterrupt
         except KeyboardInterrupt as err:
@@ -130,4 +135,4 @@ def test_an_unexpected_error_is_one_line_and_a_wrapped_ctrl_c_is_an_interrupt(mo
         main(["blocks"])
     monkeypatch.setattr(bake_cli, "run_blocks", wrapped_interrupt)
     assert main(["blocks"]) == 130
-    assert capsys.readouterr().err == "woodcam: interrupted\n"
+    assert capsys.readouterr().err == "woodcam: interrupted\n"  # one line: the warning is not printed after it

@@ -169,6 +169,7 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``woodcam`` console script; returns the exit status."""
     parser = build_parser()
     args = parser.parse_args(_apply_aliases(list(sys.argv[1:] if argv is None else argv), parser))
+    interrupted = False
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
@@ -185,6 +186,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"woodcam: error: {err}", file=sys.stderr)
             return EXIT_ERROR
         except KeyboardInterrupt:
+            interrupted = True
             print("woodcam: interrupted", file=sys.stderr)
             return EXIT_INTERRUPTED
         except OSError as err:  # the system refused a read or write (disk full, no permission)
@@ -194,6 +196,7 @@ def main(argv: list[str] | None = None) -> int:
             return EXIT_ERROR
         except Exception as err:  # noqa: BLE001 - the last net: a one-line report, never a traceback
             if _interrupted(err):  # Ctrl-C inside a library that wrapped it (numba's compiler)
+                interrupted = True
                 print("woodcam: interrupted", file=sys.stderr)
                 return EXIT_INTERRUPTED
             if os.environ.get("WOODCAM_DEBUG"):
@@ -203,7 +206,8 @@ def main(argv: list[str] | None = None) -> int:
                   file=sys.stderr)
             return EXIT_ERROR
         finally:
-            print_warnings(str(w.message) for w in caught if _is_ours(w))
+            if not interrupted:  # an interrupted run is one line: its work is dropped anyway
+                print_warnings(str(w.message) for w in caught if _is_ours(w))
     return rc
 
 
