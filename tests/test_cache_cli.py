@@ -73,3 +73,24 @@ def test_clear_removes_the_idle_locks_but_not_a_held_one(tmp_path, monkeypatch, 
     assert prune(0) == 0
     clear()
     assert list((tmp_path / "fields").iterdir()) == []
+
+
+def test_a_folder_where_an_entry_belongs_is_replaced_by_the_entry(tmp_path, monkeypatch):
+    """The entry was never saved (it could not replace the folder), so the work was redone on
+    every run, with a warning each time."""
+    import warnings
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path))
+    entry = tmp_path / "fields" / "e.bin"
+    (entry / "junk").mkdir(parents=True)
+    builds = []
+
+    def build():
+        builds.append(1)
+        return b"x"
+
+    for _ in range(2):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            load_or_build(entry, load=lambda p: p.read_bytes(), build=build, save=lambda v, p: p.write_bytes(v))
+    assert entry.is_file() and len(builds) == 1

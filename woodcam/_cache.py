@@ -186,6 +186,14 @@ def load_or_build(path, *, load: Callable[[Path], T], build: Callable[[], T],
         if ok:
             return value, True
         value = build()
+        if path.is_dir() and not path.is_symlink() and cache_root().resolve() in path.resolve().parents:
+            # a folder where the entry belongs (made by hand or by another tool) blocked every
+            # save, so the work was redone on every run: it goes, as a broken entry does
+            import shutil
+
+            warnings.warn(CacheWarning(f"{what}: removed the folder {str(path)!r} that stood where the "
+                                       "cache entry belongs"), stacklevel=2)
+            shutil.rmtree(path, ignore_errors=True)
         try:
             with atomic_path(path) as tmp:
                 save(value, tmp)
