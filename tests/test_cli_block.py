@@ -108,7 +108,8 @@ def test_block_synth_noise_options_on_an_engine_write_the_same_blocks(tmp_path, 
     assert main(["block", "synth", "--count", "1", "--out", str(tmp_path / "bad"), "--engine", "local",
                  "--dropout", "1.5"]) == EXIT_ERROR
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["woodcam: error: trace_dropout must be a fraction in [0, 1]; got 1.5"]
+    assert err == ["woodcam: error: --dropout must be in [0, 1]; got 1.5; see 'woodcam COMMAND --help' for its "
+                   "meaning and default"]  # it named the parameter (trace_dropout), not the option
 
 
 def test_engine_options_alone_run_on_the_engine_and_train_rings_refuses_them(tmp_path, capsys):

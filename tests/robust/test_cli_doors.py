@@ -59,6 +59,11 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb", "--tool", "flat:6",
       "--units", "inch", "--mesh-tol", "0.5"],
      r"--mesh-tol must be in \(0, 10\] mm; got 0.5 inch = 12.7 mm"),
+    # the errors named the Python parameters (trace_dropout (traces.dropout), thickness_mm, relief)
+    (["block", "synth", "--count", "1", "--dropout", "2", "--out", "OUT/b"], r"--dropout must be in \[0, 1\]"),
+    (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--leaf-thickness", "-1", "--out", "OUT/pq"],
+     r"--leaf-thickness must be in \(0, 100\]"),
+    (["woodify", "x.stl", "--years", "3", "--relief", "2", "--out", "OUT/w"], r"--relief must be in \[0, 1\]"),
     # a bad spec after a good tool number was reported as a bad number
     ([*GCODE, "--tool", "5=flat:6:7"], r"--tool '5=flat:6:7': tool spec 'flat:6:7': flat takes 1 number"),
 ])

@@ -569,6 +569,19 @@ RANGES: dict = {
     "sheets": (1, 1000, False),            # parquetry leaves per block (1e6 ran on, memory growing)
     "gallery": (0, 1000, False),           # bench report: -1 went into Python slicing
     "thumbnails": (0, 1000, False),
+    # the options' own names in the errors (they named the Python parameters: trace_dropout,
+    # thickness_mm, relief ...)
+    **{(cmd, d): r for cmd in ("block", "bench") for d, r in (
+        ("dropout", (0.0, 1.0, False)), ("mislabel", (0.0, 1.0, False)), ("knotted_fraction", (0.0, 1.0, False)),
+        ("jitter_mm", (0.0, 100.0, False)), ("dropout_chunk_mm", (0.0, 10_000.0, True)))},
+    ("parquetry", "px_per_mm"): (0.0, 50.0, True),     # woodcam.parquetry.ParquetryParams.check
+    ("parquetry", "leaf_thickness"): (0.0, 100.0, True),
+    ("parquetry", "saw_kerf"): (0.0, 100.0, False),
+    ("parquetry", "patch_mm"): (0.0, 10_000.0, True),
+    ("parquetry", "min_piece_mm"): (0.0, 1000.0, False),
+    ("parquetry", "tool_diameter"): (0.0, 100.0, False),
+    ("parquetry", "kerf_mm"): (0.0, 100.0, False),
+    ("woodify", "relief"): (0.0, 1.0, False),
 }
 
 
