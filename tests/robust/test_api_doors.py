@@ -124,3 +124,23 @@ def test_simulate_refuses_sizes_it_cannot_use():
         args = dict(size_mm=(10, 10, 10), resolution_mm=0.5) | kw
         with pytest.raises(WoodcamError, match="simulate: "):
             simulate(prog, tools, args.pop("size_mm"), **args)
+
+
+def test_a_fit_from_one_face_warns_and_rbf_says_why_it_cannot():
+    """'woodcam fit --faces front' ended in an internal error (LinAlgError: a thin-plate spline's
+    linear tail is singular on the points of one plane) where the README promises a warning."""
+    import warnings
+
+    from woodcam.errors import WoodcamWarning
+    from woodcam.fields import builtin_block
+    from woodcam.inference.fit import fit_block
+    from woodcam.synth import synth_block
+
+    block = synth_block(builtin_block("flat-sawn").field, (40, 30, 20), face_px=64, seed=0)
+    with pytest.warns(WoodcamWarning, match="only one face carries rings"):
+        field = fit_block(block, "evidence", faces=["top"])
+    assert field.meta["unverified"] and field.meta["chosen"] == "radial"
+    with pytest.raises(WoodcamError, match="'rbf' needs rings on at least two faces"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fit_block(block, "rbf", faces=["top"])

@@ -720,9 +720,12 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         hyps = [Hypothesis("radial" if i == 0 else f"radial basin {i + 1}", f, radial_recipe(f, seed, size_mm),
                            alone=True) for i, f in enumerate(radials)]
         alone = {}  # recipes that keep no state: fitted (and their folds) beside those that do
-        if "rbf" in candidates:
+        # a thin-plate RBF's linear tail is singular on points of one plane: with rings on one face
+        # only, RBF and the RBF residual cannot be fitted (a LinAlgError ended the whole fit)
+        solid = len(np.unique(rings.face)) > 1
+        if "rbf" in candidates and solid:
             alone["rbf"] = _rbf_recipe(EVIDENCE_RBF_POINTS)
-        if "residual" in candidates:  # shares radial's fold fits, which nothing here reads
+        if "residual" in candidates and solid:  # shares radial's fold fits, which nothing here reads
             alone["radial + residual"] = _residual_recipe(hyps[0].refit, EVIDENCE_RBF_POINTS)
         stem_rec = (stem_recipe(size_mm, seed, workers) if stem is None else stem) if "stem" in candidates else None
 

@@ -40,6 +40,9 @@ def fit_rbf(obs: RingObservations, kernel: str = "thin_plate_spline", smoothing:
             "method 'rbf' needs year-labelled traces; this block's rings are unlabelled "
             "(traces without years or ring maps); use method 'radial', which numbers rings itself"
         )
+    if len(np.unique(obs.face)) < 2:  # its linear tail is singular on one plane (a LinAlgError)
+        raise WoodcamError("method 'rbf' needs rings on at least two faces (a thin-plate spline cannot "
+                           "extend one plane's rings into the block); use 'radial' or 'evidence'")
     i = thin_out(len(obs.points_mm), max_points)
     pts, yrs = obs.points_mm[i], obs.years[i]
     # Duplicate points (a ring traced twice) make the interpolation matrix singular.
