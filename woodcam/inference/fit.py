@@ -58,8 +58,12 @@ METHODS: tuple[str, ...] = get_args(Method)
 #: where its cone would come out, as a one-exit ray does, and a cone thinning away from the pith
 #: is kept as the masks show it, :func:`woodcam.inference.knots.strands_from_exits`; 26: knot ends
 #: are paired otherwise than in that order where the other pairing's cones cut the masks better
-#: and its bend fits the rings better, :func:`woodcam.inference.knots.fit_knotted_stem`).
-FIT_VERSION = 26
+#: and its bend fits the rings better, :func:`woodcam.inference.knots.fit_knotted_stem`; 27: a
+#: block whose ring points are mostly unlabelled fits them all with the labels dropped (a few
+#: year labels threw the other rings away), :func:`woodcam.inference.observations.gather_observations`,
+#: and rings on one face only leave RBF out of the evidence fit; fits of blocks all labelled or
+#: all unlabelled on two or more faces, every benchmark block, are those of 26).
+FIT_VERSION = 27
 
 
 def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | None = None,
