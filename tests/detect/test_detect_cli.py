@@ -122,6 +122,20 @@ def test_a_corrected_svg_survives_an_interrupted_detection(synth_photos, tmp_pat
     assert (blk / "front_traces.svg").read_text() == mine
 
 
+def test_a_corrected_svg_in_another_out_folder_is_kept(synth_photos, tmp_path, capsys):
+    """'rings detect SRC --out OTHER' looked for corrections in SRC only, and overwrote the one
+    the user had made in OTHER."""
+    blk, det = tmp_path / "blk", tmp_path / "det"
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
+    assert _run(capsys, "rings", "detect", blk, "--out", det)[0] == 0
+    mine = ('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
+            '<path d="M 10.5,20.5 L 150.5,20.5" data-year="3"/></svg>')
+    (det / "front_traces.svg").write_text(mine)
+    rc, out, _err = _run(capsys, "rings", "detect", blk, "--out", det)
+    assert rc == 0 and "kept the corrected front_traces.svg" in out
+    assert (det / "front_traces.svg").read_text() == mine
+
+
 def test_the_detection_cache_stays_in_the_cache_whatever_the_block_is_named(synth_photos, tmp_path, monkeypatch):
     """A block named "../../escaped/evil" cached its detection outside the cache folder, and a
     name of 250 characters failed with 'File name too long'."""

@@ -176,6 +176,10 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
                                f"files (A_col.png ...); found neither")
         block = read_block(src)
         edited = user_edited_faces(src)
+    if out.resolve() != src.resolve() and (out / MANIFEST).is_file():
+        # corrections made in the output folder of an earlier run win too (only the source's
+        # were looked for, and detection overwrote the ones in --out)
+        edited.update(user_edited_faces(out))
     todo = [n for n, f in block.faces.items() if f.photo is not None and n not in edited]
     msgs: list[str] = []
     if todo:
