@@ -106,3 +106,23 @@ def test_bad_size_and_shape():
         pixel_to_block("front", 0, 0, (10, 10), (1, -1, 1))
     with pytest.raises(WoodcamError, match="image_shape"):
         pixel_to_block("front", 0, 0, (0, 10), SIZE)
+
+
+def test_rings_show_of_a_block_whose_faces_round_at_zoom_2():
+    """'woodcam rings show' failed at its default --zoom 2 on a block of 62 x 43.5 x 32 mm (a
+    synth block): each face enlarged twice was a pixel off its slot of the cross. Another
+    density is still refused."""
+    import pytest
+
+    from woodcam import unfold_cross
+    from woodcam.detect.show import rings_picture
+    from woodcam.errors import WoodcamError
+    from woodcam.fields import builtin_block
+    from woodcam.synth import synth_block
+
+    block = synth_block(builtin_block("flat-sawn").field, (62.0, 43.5, 32.0), face_px=256, seed=0)
+    for zoom in (2, 3):
+        assert rings_picture(block, zoom=zoom).ndim == 3
+    size = (62.0, 43.5, 32.0)
+    with pytest.raises(WoodcamError, match="must be .* px to share the density"):
+        unfold_cross({"front": np.zeros((32, 62)), "top": np.zeros((87, 124))}, size)
