@@ -320,7 +320,7 @@ def test_atlas_overshoot_is_rescaled_or_re_unwrapped(monkeypatch, efficiency):
     """Fool the size prediction so xatlas' atlas overshoots max_atlas_px (here by 18 % and 35 %:
     xatlas runs again at a lower density, whose result overshoots by < 1 % and is scaled down).
     The atlas fits, the density is reported and the bake still meets the bound."""
-    import woodcam.bake as bake_module
+    bake_module = __import__("importlib").import_module("woodcam.bake")  # the module: woodcam.bake is bake()
 
     monkeypatch.setattr(bake_module, "_PACK_EFFICIENCY", efficiency)
     mesh = _carved()
@@ -597,7 +597,7 @@ def test_fragmented_projected_charts_of_a_noisy_mesh_fall_back_to_xatlas(monkeyp
     """A scanned-looking sphere (0.3 mm noise on its vertices): its normals jump between cones, the
     projected charts fragment and pack poorly, so xatlas' charts are made too and kept when
     fuller; a clean sphere keeps the projected charts."""
-    import woodcam.bake as bake_module
+    bake_module = __import__("importlib").import_module("woodcam.bake")  # the module: woodcam.bake is bake()
 
     rng = np.random.default_rng(3)
     noisy = trimesh.creation.icosphere(subdivisions=4, radius=30.0)

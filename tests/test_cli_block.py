@@ -85,7 +85,7 @@ def test_block_synth_noise_options_on_an_engine_write_the_same_blocks(tmp_path, 
     """`block synth --engine` takes the benchmark's noise flags (issue 12 part 6) and writes
     the same noisy blocks, byte for byte, as the plain command; a bad fraction is refused at the
     door with one line."""
-    from woodcam.cli import EXIT_ERROR
+    from woodcam.cli import EXIT_USAGE
 
     flags = ["--count", "2", "--seed", "7", "--face-px", "40", "--quiet", "--jitter-mm", "0.3",
              "--dropout", "0.2", "--mislabel", "0.1", "--knotted-fraction", "0", "--size-range-mm", "30,40"]
@@ -106,9 +106,9 @@ def test_block_synth_noise_options_on_an_engine_write_the_same_blocks(tmp_path, 
     assert all(not f.traces and f.ring_map is not None for f in read_block(maps / "block_0000").faces.values())
     capsys.readouterr()
     assert main(["block", "synth", "--count", "1", "--out", str(tmp_path / "bad"), "--engine", "local",
-                 "--dropout", "1.5"]) == EXIT_ERROR
+                 "--dropout", "1.5"]) == EXIT_USAGE
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["woodcam: error: --dropout must be in [0, 1]; got 1.5; see 'woodcam COMMAND --help' for its "
+    assert err == ["woodcam: error: --dropout must be in [0, 1]; got 1.5; see 'woodcam block synth --help' for its "
                    "meaning and default"]  # it named the parameter (trace_dropout), not the option
 
 

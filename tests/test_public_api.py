@@ -33,3 +33,19 @@ def test_public_api_is_annotated():
 def test_every_export_resolves():
     for name in woodcam.__all__:
         assert getattr(woodcam, name) is not None, name
+
+
+def test_a_public_name_that_is_also_a_submodule_stays_the_public_object():
+    """Importing the submodule woodcam.bake bound the package attribute ``bake`` to the module,
+    so ``from woodcam import bake`` gave a module ("'module' object is not callable") once
+    anything had imported it; likewise ``benchmark``."""
+    import importlib
+
+    import woodcam
+
+    for name in ("bake", "benchmark"):
+        module = importlib.import_module(f"woodcam.{name}")
+        assert callable(getattr(woodcam, name)) and getattr(woodcam, name) is not module
+    from woodcam import bake
+
+    assert bake is importlib.import_module("woodcam.bake").bake

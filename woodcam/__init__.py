@@ -13,6 +13,8 @@ The pipeline, one name per stage::
 """
 
 import importlib
+import sys
+import types
 
 # Public names and the module each lives in. They load on first use (PEP 562), so
 # ``import woodcam`` and ``woodcam --help`` stay fast while trimesh, scipy and numba load later.
@@ -51,6 +53,22 @@ _WHERE = {name: mod for mod, names in _EXPORTS.items() for name in names}
 
 __version__ = "0.1.0"
 __all__ = sorted(_WHERE)
+
+
+class _Package(types.ModuleType):
+    """The ``woodcam`` module's class: importing the submodule ``woodcam.bake`` (or
+    ``woodcam.benchmark``) makes Python bind the package attribute of that name to the
+    submodule, so ``from woodcam import bake`` gave the module, not the function, as soon as
+    anything had imported it ("'module' object is not callable"). The public name wins: the
+    submodule stays in ``sys.modules`` (``importlib.import_module("woodcam.bake")``)."""
+
+    def __setattr__(self, name, value):
+        if name in _WHERE and isinstance(value, types.ModuleType) and value.__name__ == f"{__name__}.{name}":
+            value = getattr(importlib.import_module(_WHERE[name], __name__), name)
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
 
 
 def __getattr__(name: str):

@@ -52,6 +52,7 @@ from typing import Any, Literal, get_args
 
 import numpy as np
 
+from woodcam._types import Mesh, WoodLike
 from woodcam.errors import WoodcamError, WoodcamWarning
 from woodcam.limits import MAX_BLOCK_SIZE_MM
 from woodcam.tolerances import (
@@ -170,8 +171,8 @@ class BakeResult:
 
 
 def bake(
-    mesh,
-    wood,
+    mesh: Mesh,
+    wood: WoodLike,
     *,
     texels_per_mm: float = 10.0,
     max_atlas_px: int = 4096,

@@ -90,5 +90,5 @@ def save_cross_png(block: Block, path, layer: Layer = "photo", **kwargs) -> None
     """Write :func:`cross_image` of ``block`` to ``path`` as PNG."""
     from PIL import Image
 
-    with atomic_path(path) as tmp:
-        Image.fromarray(cross_image(block, layer, **kwargs)).save(tmp)
+    with atomic_path(path, mkdir=True) as tmp:  # a missing --out folder failed after the work
+        Image.fromarray(cross_image(block, layer, **kwargs)).save(tmp, format="PNG")

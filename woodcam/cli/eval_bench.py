@@ -12,7 +12,10 @@ from .options import add_confidence_option, add_out_option, command_group
 
 
 def _list(text: str) -> list[str]:
-    return [t.strip() for t in text.split(",") if t.strip()]
+    items = [t.strip() for t in text.split(",") if t.strip()]
+    if len(set(items)) != len(items):  # full,full counted every block twice (n and its interval)
+        raise WoodcamError(f"a comma list of --methods, --scenarios or --faces names each item once; got {text!r}")
+    return items
 
 
 def register(subparsers) -> None:

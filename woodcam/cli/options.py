@@ -35,10 +35,12 @@ SPECIES_HELP = ("colour preset: cited (README 'Species presets'): red-oak, white
                 "western-larch, douglas-fir, engelmann-spruce; legacy, uncited: oak, maple, "
                 "walnut, cherry, pine, spruce")
 
-BLOCK_SPEC_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], woodify:DIR/field.npz "
+#: The block argument of the commands that read a block (fit, eval, block show); those that
+#: carve from it (bake, gcode, place, review) may also turn it: :data:`BLOCK_SPEC_HELP`.
+BLOCK_READ_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], woodify:DIR/field.npz "
                    "(a block cut from a grown object), a block folder "
-                   "(block.json) or a Mokume sample folder (a 50 mm cube); "
-                   "append ~x90/~y90/~z90 to turn the block under the part")
+                   "(block.json) or a Mokume sample folder (a 50 mm cube)")
+BLOCK_SPEC_HELP = BLOCK_READ_HELP + "; append ~x90/~y90/~z90 to turn the block under the part"
 
 
 # -- --out: one rule for every command ---------------------------------------------------------
@@ -250,9 +252,9 @@ def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction
 def add_block_argument(p: argparse.ArgumentParser, *, option: bool = True, nargs=None) -> None:
     """``--block SPEC`` (required) or, with ``option=False``, a positional ``block``."""
     if option:
-        p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
-    else:
-        p.add_argument("block", nargs=nargs, help=BLOCK_SPEC_HELP)
+        p.add_argument("--block", required=True, help=BLOCK_READ_HELP)
+    else:  # read, not carved from: no ~x90 turn (it was offered here and refused)
+        p.add_argument("block", nargs=nargs, help=BLOCK_READ_HELP)
 
 
 def add_size_option(p: argparse.ArgumentParser) -> None:
@@ -532,7 +534,8 @@ RANGES: dict = {
     "finetune_epochs": (0, 100_000, False),
     "steps": (1, 100_000_000, False),
     "count": (1, 1_000_000, False),
-    "face_px": (8, 16_384, False),             # woodcam.limits.MAX_FACE_PX
+    "face_px": (16, 16_384, False),            # woodcam.limits.MAX_FACE_PX; 8 px made faces of
+                                               # non-square pixels that the fit refused
     "seed": (0, 2**32 - 1, False),
     "ring_width": (0.0, 1000.0, True),         # mm per year
     "px_per_mm": (0.0, 1000.0, True),
@@ -589,24 +592,30 @@ def _option(dest: str) -> str:
     return "--" + dest.replace("_", "-")
 
 
-def _check_value(value, option: str, rng, typed=None) -> None:
+def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND") -> None:
+    # a UsageError (exit 2): a number out of range is a wrong command line, as the exit statuses
+    # in 'woodcam --help' say (it exited 1, as a failed work)
+    from ..errors import UsageError
+
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return
     if isinstance(value, float) and not math.isfinite(value):
-        raise WoodcamError(f"{option} must be a finite number; got {value!r}")
+        raise UsageError(f"{option} must be a finite number; got {value!r}")
     if rng is None:
         return
     lo, hi, lo_open = rng
     if value < lo or value > hi or (lo_open and value <= lo):
         got = f"{value!r}" if typed is None else f"{typed[0]!r} {typed[1]} = {value:g} mm"
-        raise WoodcamError(f"{option} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}]"
-                           f"{' mm' if typed is not None else ''}; got {got}; see 'woodcam COMMAND --help' "
-                           "for its meaning and default")
+        raise UsageError(f"{option} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}]"
+                         f"{' mm' if typed is not None else ''}; got {got}; see 'woodcam {command} --help' "
+                         "for its meaning and default")
 
 
 def check_numbers(args: argparse.Namespace) -> None:
     """Raise a WoodcamError for the first numeric option that is non-finite or out of range."""
     command = getattr(args, "command", None)
+    # the whole command for the pointer to its help ("block synth", not "COMMAND")
+    name = " ".join(str(c) for c in (command, getattr(args, f"{command}_command", None)) if c)
     for dest, value in vars(args).items():
         if dest.startswith("_") or value is None:
             continue
@@ -615,7 +624,7 @@ def check_numbers(args: argparse.Namespace) -> None:
         typed = vars(args).get("_typed", {}).get(dest)
         for v in values:
             _check_value(v, _option(dest), rng, None if typed is None or isinstance(typed[0], (list, tuple))
-                         else typed)
+                         else typed, name or "COMMAND")
 
 
 def add_workers_option(p: argparse.ArgumentParser) -> None:
