@@ -141,3 +141,9 @@ def test_options_that_would_change_nothing_are_named(tmp_path, capsys, shared_da
     assert main(["parquetry", "--veneer-from", str(shared_data / "mokume" / "CN03"), "--sheets", "3",
                  "--slice-axis", "x", "--out", str(tmp_path / "pq")]) == EXIT_ERROR
     assert "--sheets, --slice-axis slice leaves from blocks" in capsys.readouterr().err
+
+
+def test_block_show_makes_its_out_folder(tmp_path, capsys):
+    """It did the work, then failed on a missing folder naming a hidden temporary file."""
+    assert main(["block", "show", "builtin:flat-sawn", "--out", str(tmp_path / "new" / "deeper" / "s.png")]) == 0
+    assert (tmp_path / "new" / "deeper" / "s.png").stat().st_size > 1000
