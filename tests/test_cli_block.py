@@ -147,3 +147,14 @@ def test_block_show_makes_its_out_folder(tmp_path, capsys):
     """It did the work, then failed on a missing folder naming a hidden temporary file."""
     assert main(["block", "show", "builtin:flat-sawn", "--out", str(tmp_path / "new" / "deeper" / "s.png")]) == 0
     assert (tmp_path / "new" / "deeper" / "s.png").stat().st_size > 1000
+
+
+def test_eval_rings_detect_on_a_block_with_a_true_field_says_it_is_not_used(tmp_path, capsys):
+    """--detect re-detects real blocks only; on a synthetic block it was ignored without a word
+    (the table was the run without it)."""
+    assert main(["block", "synth", "--count", "1", "--seed", "3", "--out", str(tmp_path / "b"), "--face-px", "48",
+                 "--quiet", "--knotted-fraction", "0"]) == 0
+    capsys.readouterr()
+    assert main(["eval", "rings", str(tmp_path / "b" / "block_0000"), "--methods", "radial", "--partial-faces",
+                 "none", "--detect", "--out", str(tmp_path / "e")]) == 0
+    assert "--detect re-detects the rings of real blocks only" in capsys.readouterr().err

@@ -123,3 +123,16 @@ def test_mokume_folder_is_a_stock_with_a_cached_fitted_field(shared_data, tmp_pa
     assert np.mean(np.abs(g - np.round(g)) < 0.2) > 0.7
     again = open_stock(str(folder))
     np.testing.assert_allclose(again.wood.field(pts), g, atol=1e-9)
+
+
+def test_a_species_that_changes_nothing_is_named(shared_data, tmp_path, monkeypatch):
+    """--species on a photographed cube was accepted and ignored (its colours come from the
+    photos), and the GLB and page said "black-walnut"."""
+    import warnings
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path))
+    with warnings.catch_warnings(record=True) as caught:  # the fit warns too (H11's held-out faces)
+        warnings.simplefilter("always")
+        open_stock(str(shared_data / "mokume" / "H11"), species="walnut")
+    said = [str(w.message) for w in caught]
+    assert any("--species walnut: block 'H11' has photos along all three axes" in m for m in said), said

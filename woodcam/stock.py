@@ -395,6 +395,13 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
             appearance_params.setdefault("cache_dir", cache_dir)
         app = block_appearance(block, field, "neural", species=species or "oak", **appearance_params)
     elif any(f.photo is not None for f in block.faces.values()):
+        from .frames import FACE_AXIS
+
+        axes = {FACE_AXIS[n] for n, f in block.faces.items() if f.photo is not None}
+        if species is not None and len(axes) == 3:  # nothing silently dropped: photos set every colour
+            warnings.warn(f"--species {species}: block {block.name!r} has photos along all three axes, and its "
+                          "colours are fitted to them; the species changes nothing here (it colours the axes "
+                          "without photos)", WoodcamWarning, stacklevel=2)
         app = ColorMapAppearance.fit_to_block(block, field, species or "oak", **appearance_params)
     else:
         app = ColorMapAppearance(species or "oak", **appearance_params)

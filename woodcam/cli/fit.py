@@ -121,6 +121,13 @@ def run_eval(args) -> int:
         res = benchmark(known, methods, sets, out_dir=args.out, progress=print, confidence=args.confidence)
         print(res["table"])
         print(f"wrote {Path(args.out) / 'table.md'} and cut-plane images")
+    if args.detect and known:  # nothing silently dropped
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        warnings.warn(f"--detect re-detects the rings of real blocks only; {', '.join(b.name for b in known)} "
+                      "have a true field and are scored on their own traces", WoodcamWarning, stacklevel=2)
     if real:
         from ..inference.holdout import leave_one_face_out
 
