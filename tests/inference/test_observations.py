@@ -82,3 +82,17 @@ def test_a_few_year_labels_do_not_throw_the_other_rings_away():
     with pytest.warns(WoodcamWarning, match="75 % .*only the labelled ones are fitted"):
         obs = gather_observations(block)
     assert sorted(np.unique(obs.years)) == [6.0, 7.0, 8.0]
+
+
+def test_a_face_asked_for_without_rings_is_named():
+    """'fit --faces top,front' with no rings on top fitted front alone without a word."""
+    import pytest
+
+    from woodcam.errors import WoodcamWarning
+
+    traces = [RingTrace(np.array([[r, 2.0], [r, 60.0]]), None, k) for k, r in enumerate((10, 20, 30))]
+    block = Block((50, 50, 50), faces={"top": Face("top", (64, 64)),
+                                       "front": Face("front", (64, 64), traces=traces)})
+    with pytest.warns(WoodcamWarning, match="face 'top' of block .* has no traced rings and no ring map: it is not used"):
+        obs = gather_observations(block, faces=["top", "front"])
+    assert set(np.unique(obs.face)) == {FACES.index("front")}

@@ -896,7 +896,8 @@ def uncertainty_report(field, points_mm, size_mm, what: str = "part") -> str | N
     face = min(unseen or FACES, key=lambda f: distance_to_faces_mm(centre[None], size, [FACES.index(f)])[0])
     place = "middle" if t == 1 else _THIRDS[ax][t]
     axis_word = ("left-right", "front-back", "bottom-top")[ax]
-    advice = (f"photograph the {face} face" if unseen else
+    # a face outside the fit may be missing or photographed with no rings found: ask for both
+    advice = (f"photograph the {face} face or trace its rings" if unseen else
               f"every face was used: check the rings found on the {face} face "
               "(woodcam rings show) or trace more of them")
     return (f"the rings in the {place} third ({axis_word}) of this {what} are uncertain "

@@ -158,6 +158,10 @@ def gather_observations(block, faces=None, step_mm: float = TRACE_SAMPLE_STEP_MM
             # (midpoints between neighbouring rings) was tuned on
             polys = [(c[::max(1, stride // 2)] if len(c) > 4 * stride else c, None, None) for c in comps]
         else:
+            if faces is not None:  # asked for by name and left out without a word
+                warnings.warn(f"face {name!r} of block {block.name!r} has no traced rings and no ring map: it is "
+                              "not used; trace its rings (or detect them on its photo)", WoodcamWarning,
+                              stacklevel=2)
             continue
         # unlabelled pieces of one ring of this face (RingTrace.ring) are one group: one level
         ring_group: dict[int, int] = {}
