@@ -43,8 +43,8 @@ def register(subparsers) -> None:
     add_block_argument(v, option=False)
     add_out_option(v, "the unfolded faces with a cut layer", suffixes=(".png",))
     v.add_argument("--layer", choices=("photo", "ring_map", "both"), default="photo",
-                   help="what to draw on each face: its photo, its ring map or both side by side "
-                   "(default photo)")
+                   help="what to draw: the face photos, the ring maps, or both (the photos' cross above "
+                   "the ring maps') (default photo)")
     v.add_argument("--no-traces", action="store_true", help="do not draw traced rings")
     add_size_option(v)
 

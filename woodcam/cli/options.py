@@ -147,9 +147,8 @@ def add_units_option(p: argparse.ArgumentParser, command: str) -> None:
     p.add_argument("--units", choices=("mm", "inch"), default="mm",
                    help=f"unit of {', '.join(names)}"
                    + (" and of the printed summary" if command in _SUMMARY_IN_UNITS else "")
-                   + "; options "
-                   "named in mm (--texels-per-mm, --size-mm, ...), defaults and the files "
-                   "written stay mm (default mm)")
+                   + "; options whose names carry their unit (-mm, -per-mm), defaults and the "
+                   "files written stay mm (default mm)")
 
 
 def _num(v: float) -> str:
