@@ -158,3 +158,14 @@ def test_eval_rings_detect_on_a_block_with_a_true_field_says_it_is_not_used(tmp_
     assert main(["eval", "rings", str(tmp_path / "b" / "block_0000"), "--methods", "radial", "--partial-faces",
                  "none", "--detect", "--out", str(tmp_path / "e")]) == 0
     assert "--detect re-detects the rings of real blocks only" in capsys.readouterr().err
+
+
+def test_fit_says_an_unverified_fit_once(tmp_path, capsys):
+    """'fit --faces top' printed 'only one face carries rings ...' twice: as the warning and again
+    as the fit's summary."""
+    assert main(["block", "synth", "--count", "1", "--seed", "3", "--out", str(tmp_path / "b"), "--face-px", "48",
+                 "--quiet", "--knotted-fraction", "0"]) == 0
+    capsys.readouterr()
+    assert main(["fit", str(tmp_path / "b" / "block_0000"), "--faces", "top", "--out", str(tmp_path / "f.npz")]) == 0
+    out = capsys.readouterr()
+    assert (out.out + out.err).count("only one face carries rings") == 1

@@ -92,8 +92,8 @@ def run_fit(args) -> int:
     path = field.save(args.out)
     print(f"wrote {path} ({args.method} fit of {block.name}, grid {field.years.shape}, "
           f"{field.spacing_mm[0]:g} mm)")
-    if field.meta.get("message"):
-        print(field.meta["message"])
+    if field.meta.get("message") and not (field.meta.get("contradicted") or field.meta.get("unverified")):
+        print(field.meta["message"])  # a contradicted or unverified fit said it as a warning already
     return 0
 
 
