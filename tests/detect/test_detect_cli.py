@@ -176,6 +176,9 @@ def test_bad_photo_folders_give_one_clear_line(synth_photos, tmp_path, capsys):
     Image.fromarray(np.full((160, 160, 3), 128, np.uint8)).save(d / "left.png")
     rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
     assert rc == EXIT_ERROR and "face 'left'" in err and "blank" in err
+    Image.fromarray(np.full((160, 160, 3), 255, np.uint8)).save(d / "left.png")  # it was called blank
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and "face 'left'" in err and "over-exposed" in err
     d = _copy(synth_photos, tmp_path / "d")
     with Image.open(d / "right.png") as im:
         a = np.asarray(im).copy()

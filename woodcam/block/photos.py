@@ -63,9 +63,7 @@ def find_face_photos(folder) -> dict[str, Path]:
 
 def _check_exposure(face: str, photo: np.ndarray, path: Path) -> None:
     lum = photo[..., :3].astype(np.float32) @ np.array([0.299, 0.587, 0.114], np.float32)
-    if float(lum.std()) / 255.0 < BLANK_STD:
-        raise WoodcamError(f"photo of face {face!r} ({path.name}) is blank (luminance spread "
-                           f"{lum.std() / 255:.3f} < {BLANK_STD}); retake it with the face in view")
+    # the exposure first: an all-white photo is over-exposed, not "blank" (it was called blank)
     high, low = float(np.mean(lum >= 252)), float(np.mean(lum <= 3))
     if high > CLIPPED_SHARE:
         raise WoodcamError(f"photo of face {face!r} ({path.name}) is over-exposed ({100 * high:.0f} % of "
@@ -73,6 +71,9 @@ def _check_exposure(face: str, photo: np.ndarray, path: Path) -> None:
     if low > CLIPPED_SHARE:
         raise WoodcamError(f"photo of face {face!r} ({path.name}) is under-exposed ({100 * low:.0f} % of "
                            f"pixels black); retake it with more light")
+    if float(lum.std()) / 255.0 < BLANK_STD:
+        raise WoodcamError(f"photo of face {face!r} ({path.name}) is blank (luminance spread "
+                           f"{lum.std() / 255:.3f} < {BLANK_STD}); retake it with the face in view")
 
 
 def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: float = MAX_PX_PER_MM,
