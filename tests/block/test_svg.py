@@ -158,3 +158,17 @@ def test_ring_ids_round_trip_and_bad_ones_are_refused(tmp_path):
         read_traces_svg(bad, (20, 20))
     with pytest.raises(WoodcamError, match="ring of a ring trace must be a non-negative integer"):
         RingTrace(line, ring=-1)
+
+
+def test_bad_attributes_name_the_file_and_nan_in_a_path_is_refused(tmp_path):
+    """A bad data-ring named neither the file nor the element (a block folder holds six SVGs); a
+    NaN in a path's data was dropped and the numbers after it read on."""
+    (tmp_path / "front_traces.svg").write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10">'
+        '<polyline id="trace-3" points="0,0 5,5" data-ring="x1"/></svg>')
+    with pytest.raises(WoodcamError, match=r"front_traces.svg', element trace-3: data-ring must be"):
+        read_traces_svg(tmp_path / "front_traces.svg", (10, 10))
+    (tmp_path / "p.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10">'
+                                    '<path d="M 0,0 L nan,1 2,2"/></svg>')
+    with pytest.raises(WoodcamError, match="a path's data must hold finite numbers"):
+        read_traces_svg(tmp_path / "p.svg", (10, 10))

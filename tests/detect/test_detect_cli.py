@@ -281,3 +281,14 @@ def test_curved_option_reaches_the_detector(synth_photos, tmp_path, capsys):
     assert other.shape != want.shape or not np.allclose(other, want, atol=0.01)
     rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", tmp_path / "x", "--curved", "--detector", "learned")
     assert rc != 0 and "curved" in err and err.count("\n") == 1, err
+
+
+def test_gif_photos_are_read(synth_photos, tmp_path, capsys):
+    """A face photo named top.gif was not found ("no face photos found, name them front.jpg ...")."""
+    d = _copy(synth_photos, tmp_path / "g")
+    with Image.open(d / "top.png") as im:
+        im.convert("P", palette=Image.ADAPTIVE).save(d / "top.gif")
+    (d / "top.png").unlink()
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == 0, err
+    assert read_block(tmp_path / "o").faces["top"].photo.shape == (160, 160, 3)

@@ -1,7 +1,7 @@
 """A block folder from six face photos: find them by name, check them, write the block.
 
 Photos are files in one folder named by face: ``front.jpg``, ``top.png``, ... (any of
-``.jpg .jpeg .png .tif .tiff .bmp .webp .heic .heif``, any case), or by Mokume letter (``A.jpg`` ... or the
+``.jpg .jpeg .png .tif .tiff .bmp .webp .heic .heif .gif``, any case), or by Mokume letter (``A.jpg`` ... or the
 Mokume sample names ``A_col.png`` ...). Each must already be rectified to its face (cropped to
 the face's edges, seen from outside, oriented as ``docs/conventions.md`` says).
 
@@ -31,7 +31,7 @@ from ..frames import (
 from ..tolerances import FACE_PIXEL_ASPECT_RTOL
 from .block import Block, Face
 
-PHOTO_SUFFIXES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".webp", ".heic", ".heif")
+PHOTO_SUFFIXES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".webp", ".heic", ".heif", ".gif")
 #: A photo whose luminance standard deviation is below this (fraction of full scale) is blank.
 BLANK_STD = 0.01
 #: A photo with more than this share of pixels at <= 3 or >= 252 (of 255) is badly exposed.

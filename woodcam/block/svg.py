@@ -100,10 +100,17 @@ def read_traces_svg(path, shape) -> list[RingTrace]:
     for el in svg.elements():
         if not isinstance(el, (svgelements.Path, svgelements.Polyline, svgelements.SimpleLine)):
             continue  # Polygon is a Polyline; rects, circles, images and text are no traces
-        year = _year(el.values.get("attributes", {}))
-        ring = _ring(el.values.get("attributes", {}))
+        try:  # the file and the element in the message: a folder has six SVGs
+            year = _year(el.values.get("attributes", {}))
+            ring = _ring(el.values.get("attributes", {}))
+        except WoodcamError as err:
+            raise WoodcamError(f"{str(path)!r}, element {el.values.get('id') or type(el).__name__}: {err}") from err
         if isinstance(el, svgelements.Polyline):
             _check_points_attribute(el.values.get("points"), path)
+        elif isinstance(el, svgelements.Path) and re.search(r"nan|inf", str(el.values.get("d", "")), re.IGNORECASE):
+            # svgelements drops the token and reads on, as in a polyline's points
+            raise WoodcamError(f"{str(path)!r}: a path's data must hold finite numbers; got "
+                               f"{str(el.values.get('d'))[:80]!r}")
         path_ = el if isinstance(el, svgelements.Path) else svgelements.Path(el)
         for xy in _polylines(path_, scale):
             if len(xy) >= 2:
