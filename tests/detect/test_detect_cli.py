@@ -292,3 +292,13 @@ def test_gif_photos_are_read(synth_photos, tmp_path, capsys):
     rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
     assert rc == 0, err
     assert read_block(tmp_path / "o").faces["top"].photo.shape == (160, 160, 3)
+
+
+def test_a_photo_too_small_for_rings_is_refused(synth_photos, tmp_path, capsys):
+    """An 8 x 8 px face photo was enlarged to 16 x 16 and recorded at a density it lacks; detection
+    then 'found' rings on it."""
+    d = _copy(synth_photos, tmp_path / "t")
+    with Image.open(d / "top.png") as im:
+        im.resize((8, 8)).save(d / "top.png")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and "face 'top'" in err and "8x8 px: too small to hold rings" in err

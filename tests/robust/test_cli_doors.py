@@ -55,6 +55,8 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["bench", "report", "OUT", "--gallery", "-1", "--out", "OUT/r"], r"--gallery must be in \[0, 1000\]"),
     (["eval", "realistic", "--seed", "5", "--faces", "full,full", "--out", "OUT/e"], r"names each item once"),
     (["block", "synth", "--count", "1", "--face-px", "8", "--out", "OUT/b"], r"--face-px must be in \[16,"),
+    # 100 mm of jitter failed every block with an unrelated message in its record
+    (["block", "synth", "--count", "1", "--jitter-mm", "100", "--out", "OUT/b"], r"--jitter-mm must be in \[0, 10\]"),
     # it blamed the block spec for a missing file
     (["review", "OUT/nope.glb", "--out", "OUT/r.html"], r"review: no file at"),
     # in inches the error showed the value converted ("got 12.7" for 0.5 against a mm range)

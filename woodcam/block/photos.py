@@ -111,6 +111,9 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
                 f"photo of face {face!r} ({path.name}) is {a.shape[1]}x{a.shape[0]} px (aspect {got:.3f}) but "
                 f"the face is {w_mm:g}x{h_mm:g} mm (aspect {want:.3f}) for --size-mm "
                 f"{size[0]:g}x{size[1]:g}x{size[2]:g}; crop the photo to the face or check --size-mm")
+        if min(a.shape[:2]) < 16:  # an 8 x 8 px photo was enlarged and recorded at a density it lacks
+            raise WoodcamError(f"photo of face {face!r} ({path.name}) is {a.shape[1]}x{a.shape[0]} px: too small to "
+                               "hold rings; give at least 16 px a side (a phone photo has thousands)")
         images[face] = a
         density.append(min(a.shape[0] / h_mm, a.shape[1] / w_mm))
     ppm = min(min(density), max_px_per_mm)

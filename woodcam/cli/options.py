@@ -575,7 +575,7 @@ RANGES: dict = {
     # thickness_mm, relief ...)
     **{(cmd, d): r for cmd in ("block", "bench") for d, r in (
         ("dropout", (0.0, 1.0, False)), ("mislabel", (0.0, 1.0, False)), ("knotted_fraction", (0.0, 1.0, False)),
-        ("jitter_mm", (0.0, 100.0, False)), ("dropout_chunk_mm", (0.0, 10_000.0, True)))},
+        ("jitter_mm", (0.0, 10.0, False)), ("dropout_chunk_mm", (0.0, 10_000.0, True)))},
     ("parquetry", "px_per_mm"): (0.0, 50.0, True),     # woodcam.parquetry.ParquetryParams.check
     ("parquetry", "leaf_thickness"): (0.0, 100.0, True),
     ("parquetry", "saw_kerf"): (0.0, 100.0, False),

@@ -442,8 +442,11 @@ def _fit_labelled(torch, net, spec, pts, yrs, size, steps, rng, progress, name, 
         f = net(zero, torch.from_numpy(q.astype(np.float32))).double().numpy()
     k, a, score = _solve_scale_offset(f, gs)
     if not np.isfinite(score).any():
-        raise WoodcamError(f"block {name!r}: no pith placement makes the "
-                           f"labelled years grow away from a pith; check the trace year labels")
+        # the years may be the user's labels or the fit's own numbering of unlabelled rings: say
+        # both (it blamed "the trace year labels" on blocks that had none)
+        raise WoodcamError(f"block {name!r}: no pith placement makes the rings' years (their labels, or "
+                           f"the numbering of unlabelled rings) grow away from a pith; check the year labels "
+                           f"if any, or use method 'radial' or 'evidence'")
     sub = rng.choice(len(pts), min(_ADAM_POINTS, len(pts)), replace=False)
     # the best placement of each pith direction, best first: distinct starts
     order = np.argsort(score)
