@@ -98,3 +98,21 @@ def test_blocks_lists_builtins(capsys):
     assert main(["blocks"]) == 0
     out = capsys.readouterr().out
     assert "builtin:flat-sawn" in out and "builtin:knotty" in out
+
+
+def test_a_part_sticking_out_is_said_in_the_report_files(tmp_path, capsys):
+    """'part sticks out of the block' went to stderr only: the report files kept no trace of it."""
+    import json
+
+    import trimesh
+
+    from woodcam.cli import main
+
+    box = trimesh.creation.box((40, 40, 40))
+    box.apply_translation((95, 40, 20))  # the flat-sawn block is 100 mm wide: 15 mm stick out
+    box.export(tmp_path / "box.stl")
+    assert main(["bake", str(tmp_path / "box.stl"), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "b.glb"),
+                 "--no-obj", "--texels-per-mm", "1"]) == 0
+    said = json.loads((tmp_path / "b_report.json").read_text())["warnings"]
+    assert any(w.startswith("part sticks out of the block") for w in said)
+    assert "warning: part sticks out of the block" in (tmp_path / "b_report.txt").read_text()

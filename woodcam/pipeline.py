@@ -269,6 +269,9 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
             result.report = _part_report(mesh, stock)
             if rings_line:
                 result.report.setdefault("warnings", []).append(rings_line)
+            for w in result.warnings:  # the carve's ("part sticks out of the block") were on stderr only
+                if w not in result.report.setdefault("warnings", []):
+                    result.report["warnings"].append(w)
             stem = out_glb.with_name(out_glb.stem + "_report")
             write_bytes(stem.with_suffix(".json"), json.dumps(result.report, indent=1).encode())
             write_bytes(stem.with_suffix(".txt"), (report_text(result.report, out_glb.stem)
