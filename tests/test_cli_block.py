@@ -169,3 +169,10 @@ def test_fit_says_an_unverified_fit_once(tmp_path, capsys):
     assert main(["fit", str(tmp_path / "b" / "block_0000"), "--faces", "top", "--out", str(tmp_path / "f.npz")]) == 0
     out = capsys.readouterr()
     assert (out.out + out.err).count("only one face carries rings") == 1
+
+
+def test_trace_noise_with_ring_maps_only_is_named(tmp_path, capsys):
+    """--ring-maps-only --jitter-mm 0.3 recorded a jitter in every block that nothing had."""
+    assert main(["block", "synth", "--count", "1", "--seed", "3", "--out", str(tmp_path / "b"), "--face-px", "32",
+                 "--quiet", "--knotted-fraction", "0", "--ring-maps-only", "--jitter-mm", "0.3"]) == 0
+    assert "--jitter-mm act on traced rings; with --ring-maps-only" in capsys.readouterr().err

@@ -75,6 +75,15 @@ def run(args) -> int:
                  "trace_dropout_chunk_mm": args.dropout_chunk_mm, "mislabel_fraction": args.mislabel}
         if args.ring_maps_only:
             noise["trace_faces"] = []
+            given = [o for o, v in (("--jitter-mm", args.jitter_mm), ("--dropout", args.dropout),
+                                    ("--mislabel", args.mislabel)) if v]
+            if given:  # recorded in the blocks' metadata, yet they act on traces only
+                import warnings
+
+                from ..errors import WoodcamWarning
+
+                warnings.warn(f"{', '.join(given)} act on traced rings; with --ring-maps-only no trace is written, "
+                              "so they change nothing", WoodcamWarning, stacklevel=2)
         if engine_requested(args):
             # one task per block: the same blocks as without an engine (noise included),
             # resumable (a record per block), on an engine
