@@ -23,7 +23,8 @@ def register(subparsers) -> None:
     add_out_option(p, "one self-contained page", suffixes=(".html",))
     p.add_argument("--voxels", type=int, default=None, metavar="N",
                    help="voxels of each of the three colour volumes behind the section cap "
-                   "(default 400000: ~1 mm voxels on a 100x80x50 mm block, page ~2-3 MB)")
+                   "(default 400000: ~1 mm voxels on a 100x80x50 mm block; the page also holds the "
+                   "part's texture: ~10 MB for the demo bowl)")
     add_units_option(p, "review")
     p.set_defaults(func=run_review)
 

@@ -75,7 +75,8 @@ def register(subparsers) -> None:
                    help="cube side in mm for a Mokume folder (default 50)")
 
     s = sub.add_parser("show", help="draw each face photo with the rings and knots found on it",
-                       description="Unfolded cross of the face photos (2x) with ring traces (red), knot "
+                       description="Unfolded cross of the face photos (2x) with ring traces (the pieces of one "
+                       "ring share a colour), knot "
                        "outlines (yellow) and, for a Mokume folder, the U-Net map's ridge (cyan). A "
                        "Mokume folder is detected first (cached).")
     s.add_argument("block", type=Path, help="block folder (after 'rings detect') or Mokume sample folder")
