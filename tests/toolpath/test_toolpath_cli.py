@@ -151,3 +151,21 @@ def test_grid_coarser_than_half_the_stepover_warns(tmp_path, monkeypatch, capsys
     args = _parse([*base, "--cell-size", "0.2"])
     args.func(args)
     assert "step-over" not in capsys.readouterr().err
+
+
+def test_the_simulations_issues_reach_the_review_page_as_hotspots(tmp_path, capsys):
+    """gcode printed its issues but stored none in the GLB, so the review page, which reads them
+    from there, never showed a G-code hotspot."""
+    from woodcam.cli import main
+    from woodcam.export import read_glb_metadata
+
+    glb = tmp_path / "p.glb"
+    assert main(["gcode", str(REPO / "toolpaths" / "profile_tabs.nc"), "--tool", "flat:6.35", "--block",
+                 "builtin:flat-sawn", "--out", str(glb), "--no-obj", "--cell-size", "0.5"]) == 0
+    spots = read_glb_metadata(glb)["warnings"]
+    assert len(spots) == 5 and all("below_stock_bottom" in s["message"] for s in spots)
+    # where the move ends in the block frame: 0.5 mm under the 50 mm block's bottom
+    assert all(s["at_mm"][2] == pytest.approx(-0.5) for s in spots)
+    assert main(["review", str(glb), "--out", str(tmp_path / "p.html"), "--voxels", "20000"]) == 0
+    page = (tmp_path / "p.html").read_text()
+    assert page.count("below_stock_bottom") >= 5

@@ -213,7 +213,8 @@ def run(args) -> int:
                   f"T{t}: {_hms(f + r)} ({_hms(f)} feeding)" for t, (f, r) in times.items()))
         meta_programs.append({"gcode": str(path),
                               "tools": {str(t): v.spec() for t, v in sorted(tools.items())},
-                              "machining_time_s": sum(f + r for f, r in times.values())})
+                              "machining_time_s": sum(f + r for f, r in times.values()),
+                              "warnings": _issue_spots(program, res.report, stock.size_mm, offset, path.name)})
         last = (program, res)
     program, res = last
     if args.part:
@@ -232,6 +233,8 @@ def run(args) -> int:
         n_warn += len(dev.gouges)
     meta = {"gcode": [m["gcode"] for m in meta_programs] if len(meta_programs) > 1
             else meta_programs[0]["gcode"],
+            # the review page's G-code hotspots (it read this key, which nothing wrote)
+            "warnings": [w for m in meta_programs for w in m["warnings"]][:200],
             "tools": {t: v for m in meta_programs for t, v in m["tools"].items()},
             "resolution_mm": float(np.mean(res.cell_mm)),
             "machining_time_s": sum(m["machining_time_s"] for m in meta_programs)}
@@ -254,6 +257,22 @@ def run(args) -> int:
                      initial_heightmap=hm_before, until_line=args.until_line,
                      heightmap=res.heightmap)  # the stock it opens on: simulated already
     return 3 if args.strict and n_warn else 0
+
+
+def _issue_spots(program, issues, size_mm, offset, name: str) -> list[dict]:
+    """The simulation's issues as ``{"message", "line", "at_mm"}``: where the first move of the
+    issue's line ends, in the block frame (the work offset as simulate applies it)."""
+    import numpy as np
+
+    off = np.array([0.0, 0.0, float(size_mm[2])]) if offset is None else np.asarray(offset, float)
+    lines = np.asarray(program.line)
+    out = []
+    for issue in issues:
+        at = np.flatnonzero(lines == issue.line)
+        if len(at):
+            out.append({"message": f"{name} {issue}", "line": int(issue.line),
+                        "at_mm": [float(v) for v in np.asarray(program.end_mm)[at[0]] + off]})
+    return out
 
 
 def _hms(seconds: float) -> str:
