@@ -169,3 +169,20 @@ def test_the_simulations_issues_reach_the_review_page_as_hotspots(tmp_path, caps
     assert main(["review", str(glb), "--out", str(tmp_path / "p.html"), "--voxels", "20000"]) == 0
     page = (tmp_path / "p.html").read_text()
     assert page.count("below_stock_bottom") >= 5
+
+
+def test_review_with_another_block_than_the_baked_one_says_so(tmp_path, capsys):
+    """review/preview --block of another block (another size, an edited folder) was taken without a
+    word, so the section cap showed other wood than the part's surface."""
+    from woodcam.cli import main
+
+    glb = tmp_path / "p.glb"
+    assert main(["gcode", str(REPO / "toolpaths" / "profile_tabs.nc"), "--tool", "flat:6.35", "--block",
+                 "builtin:flat-sawn", "--out", str(glb), "--no-obj", "--cell-size", "0.5"]) == 0
+    capsys.readouterr()
+    assert main(["review", str(glb), "--block", "builtin:flat-sawn:200x80x50", "--out", str(tmp_path / "a.html"),
+                 "--voxels", "20000"]) == 0
+    assert "is not the block p.glb was baked from (builtin:flat-sawn, 100x80x50 mm)" in capsys.readouterr().err
+    assert main(["review", str(glb), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "b.html"),
+                 "--voxels", "20000"]) == 0
+    assert "is not the block" not in capsys.readouterr().err  # the same block: no word

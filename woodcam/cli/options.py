@@ -455,6 +455,12 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
               "appearance": app.get("kind") or "colormap",
               **_trusted_appearance_params(app.get("params"), glb)}
     if block:
+        if meta.get("block_digest") and spec_digest(block) != meta["block_digest"]:
+            # --block of another block (another size, an edited folder) was taken without a word:
+            # the section cap then shows other wood than the part's surface
+            warnings.warn(f"--block {block} is not the block {glb.name} was baked from ({meta.get('block')}, "
+                          f"{'x'.join(f'{v:g}' for v in meta.get('size_mm', []))} mm): the wood shown inside "
+                          "differs from the part's surface", WoodcamWarning, stacklevel=2)
         return open_stock(block, **{**kwargs, "species": species or kwargs["species"]})
     spec = meta.get("block")
     if not spec:
