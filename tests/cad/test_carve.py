@@ -56,6 +56,14 @@ def test_box_fully_inside_keeps_its_volume_exactly():
     np.testing.assert_allclose(result.mesh.bounds, [[5, 6, 7], [35, 26, 17]], atol=1e-9)
 
 
+def test_a_part_too_small_to_carve_says_so():
+    """A 0.02 mm part inside the block was said not to intersect it, with the advice to move it by
+    (0, 0, 0) mm."""
+    part = manifold3d.Manifold.cube((0.02, 0.02, 0.02)).translate((50, 40, 25))
+    with pytest.raises(WoodcamError, match="the part's volume is 8e-06 mm\\^3, too small to carve; check its units"):
+        carve(part, DEMO_BLOCK_MM)
+
+
 def test_part_filling_the_block_exactly_has_no_warning():
     result = carve(manifold3d.Manifold.cube(DEMO_BLOCK_MM), DEMO_BLOCK_MM)
     _check_result(result)

@@ -105,6 +105,10 @@ def carve(
     carved = solid ^ block
     part_volume = float(solid.volume())
     volume = float(carved.volume()) if not carved.is_empty() else 0.0
+    if part_volume <= OUTSIDE_VOLUME_EPS_MM3:  # it was told it misses the block, "move it by (0, 0, 0)"
+        raise WoodcamError(
+            f"the part's volume is {part_volume:.3g} mm^3, too small to carve; check its units (a part "
+            "modelled in metres or inches is read as millimetres)")
     if carved.is_empty() or volume <= OUTSIDE_VOLUME_EPS_MM3:
         lo, hi = _bounds(solid)
         raise WoodcamError(
