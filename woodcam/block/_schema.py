@@ -21,6 +21,7 @@ from typing import Any
 
 from ..errors import WoodcamError
 from ..frames import FACES
+from .block import trace_bounds_px
 
 #: Environment variable that lets manifests name files outside their folder (absolute or ``..``).
 ALLOW_OUTSIDE_ENV = "WOODCAM_ALLOW_OUTSIDE_PATHS"
@@ -163,8 +164,7 @@ def check_manifest(m: Any, folder: Path, src: str, allow_outside: bool | None = 
             if isinstance(bits, bool) or bits not in (8, 16):
                 c.fail(f"{w}.ring_map_bits", "must be 8 or 16 (the PNG's bit depth)", bits)
         traces = c.lst(entry.get("traces", []), f"{w}.traces")
-        lo_r, lo_c = -0.5 - 0.5 * rows, -0.5 - 0.5 * cols
-        hi_r, hi_c = rows - 0.5 + 0.5 * rows, cols - 0.5 + 0.5 * cols
+        (lo_r, lo_c), (hi_r, hi_c) = (b.tolist() for b in trace_bounds_px((rows, cols)))
         for k, t in enumerate(traces):
             tw = f"{w}.traces[{k}]"
             c.obj(t, tw)

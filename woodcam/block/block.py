@@ -71,6 +71,15 @@ class RingTrace:
         object.__setattr__(self, "points_px", p)
 
 
+
+def trace_bounds_px(shape) -> tuple[np.ndarray, np.ndarray]:
+    """``(lo, hi)`` ``(2,)`` (row, col) bounds of a trace's points on a face image of ``shape``:
+    the image with half a face of slack, for traces drawn past an edge. The one rule of
+    :class:`Face` and the ``block.json`` reader."""
+    rows, cols = shape
+    return np.array([-0.5 - 0.5 * rows, -0.5 - 0.5 * cols]), np.array([1.5 * rows - 0.5, 1.5 * cols - 0.5])
+
+
 @dataclass
 class Face:
     """What is known about one face of a block.
@@ -104,13 +113,15 @@ class Face:
         top = int(limit("MAX_FACE_PX"))
         if not all(1 <= s <= top for s in self.shape):  # (0, 0) or (-3, 4) was accepted and written
             raise WoodcamError(f"shape of face {self.name!r} must be two pixel counts in [1, {top}]; got {self.shape}")
-        rows, cols = self.shape
-        for k, t in enumerate(self.traces):  # where read_block takes them: half a face of slack
-            p = np.asarray(t.points_px, float)
-            if (p[:, 0] < -0.5 - 0.5 * rows).any() or (p[:, 0] > 1.5 * rows - 0.5).any() or \
-                    (p[:, 1] < -0.5 - 0.5 * cols).any() or (p[:, 1] > 1.5 * cols - 0.5).any():
-                raise WoodcamError(f"trace {k} of face {self.name!r} lies beyond its {rows}x{cols} px image (more "
-                                   "than half a face past an edge); check its (row, col) pixel coordinates")
+        if self.traces:  # where read_block takes them (trace_bounds_px), all traces in one pass
+            lo, hi = trace_bounds_px(self.shape)
+            p = np.concatenate([np.asarray(t.points_px, float) for t in self.traces])
+            out = ((p < lo) | (p > hi)).any(axis=1)
+            if out.any():
+                k = int(np.searchsorted(np.cumsum([len(t.points_px) for t in self.traces]), np.argmax(out), "right"))
+                raise WoodcamError(f"trace {k} of face {self.name!r} lies beyond its {self.shape[0]}x{self.shape[1]} "
+                                   "px image (more than half a face past an edge); check its (row, col) pixel "
+                                   "coordinates")
         if self.photo is not None:
             self.photo = _check_image(self.photo, self.shape, 3, f"photo of face {self.name!r}")
         if self.ring_map is not None:
