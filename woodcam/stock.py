@@ -202,13 +202,10 @@ def _builtin(rest: str):
 
 
 def _parse_size(text: str, spec: str) -> tuple[float, float, float]:
-    import math
+    from .units import parse_lengths
 
-    try:
-        size = tuple(float(v) for v in text.lower().split("x"))
-    except ValueError:
-        size = ()
-    if len(size) != 3 or not all(math.isfinite(v) and 0 < v <= _MAX_BLOCK_SIDE_MM for v in size):
+    size = parse_lengths(text, 3, max_mm=_MAX_BLOCK_SIDE_MM)
+    if size is None:
         raise WoodcamError(
             f"block spec {spec!r}: the size must be WxDxH in mm, each > 0 and <= "
             f"{_MAX_BLOCK_SIDE_MM:g}; got {text!r}, e.g. 300x120x40")

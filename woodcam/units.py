@@ -7,6 +7,8 @@ summaries with :func:`fmt_length` / :func:`fmt_volume`. Files written stay in mi
 
 from __future__ import annotations
 
+import math
+import re
 from typing import Literal
 
 Units = Literal["mm", "inch"]
@@ -26,3 +28,19 @@ def fmt_volume(mm3: float, units: Units = "mm") -> str:
     if units == "mm":
         return f"{mm3:.0f} mm^3"
     return f"{mm3 / MM_PER_UNIT[units] ** 3:.4g} {_SYMBOL[units]}^3"
+
+
+def parse_lengths(text: str, n: int = 3, *, max_mm: float, cube: bool = False) -> tuple[float, ...] | None:
+    """``"WxDxH"`` (``x``, ``×`` or ``,`` between them) -> ``n`` lengths in mm, each finite and in
+    (0, ``max_mm``]; with ``cube`` one number is a cube's side. None when the text is not that:
+    the caller names its option or spec in the error. The one parser of every size a user types
+    (``--stock``, ``--size-mm``, ``--sheet-size``, a block spec's ``:WxDxH`` ...)."""
+    try:
+        vals = tuple(float(v) for v in re.split(r"[x×,]", str(text).lower()))
+    except ValueError:
+        return None
+    if cube and len(vals) == 1:
+        vals = vals * 3
+    if len(vals) != n or not all(math.isfinite(v) and 0 < v <= max_mm for v in vals):
+        return None
+    return vals

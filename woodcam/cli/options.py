@@ -283,18 +283,12 @@ def parse_sizes(text: str, option: str, n: int = 3, *, cube: bool = False) -> tu
     (0, :data:`~woodcam.limits.MAX_BLOCK_SIZE_MM`]; with ``cube`` one number is a cube's side.
     Otherwise a WoodcamError naming ``option`` (``--sheet-size 1e300x10`` reached an allocation
     and ``--size-mm 1e300`` a block of 0 px/mm)."""
-    import math
-
     from ..limits import MAX_BLOCK_SIZE_MM
+    from ..units import parse_lengths
 
-    try:
-        vals = tuple(float(v) for v in re.split(r"[x×,]", str(text).lower()))
-    except ValueError:
-        vals = ()
-    if cube and len(vals) == 1:
-        vals = vals * 3
+    vals = parse_lengths(text, n, max_mm=MAX_BLOCK_SIZE_MM, cube=cube)
     dims = "x".join("WDH"[:n]) if n == 3 else "x".join("WH"[:n])
-    if len(vals) != n or not all(math.isfinite(v) and 0 < v <= MAX_BLOCK_SIZE_MM for v in vals):
+    if vals is None:
         raise WoodcamError(f"{option} takes {dims} in mm, {n} numbers in (0, {MAX_BLOCK_SIZE_MM:g}]"
                            + (" (or one, a cube's side)" if cube else "") + ", e.g. "
                            + "x".join(["50"] * n) + f"; got {text!r}")
