@@ -355,11 +355,12 @@ def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals) ->
             "carved part's surface mesh"
         )
     verts = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=float)
-    if not np.isfinite(verts).all() or (len(verts) and np.ptp(verts, axis=0).max() > MAX_BLOCK_SIZE_MM):
+    span = float(np.ptp(verts, axis=0).max()) if len(verts) else 0.0  # NaN with a NaN vertex
+    if not span <= MAX_BLOCK_SIZE_MM:
         raise WoodcamError(
             f"bake: the mesh's vertices must be finite and span at most {MAX_BLOCK_SIZE_MM:g} mm (the "
-            f"largest block); got a span of {np.ptp(verts, axis=0).max() if len(verts) else 0:.4g} mm "
-            "or NaN/inf; check the part's units and coordinates (one far vertex made a 7 GB atlas)"
+            f"largest block); got a span of {span:.4g} mm or NaN/inf; check the part's units and "
+            "coordinates (one far vertex made a 7 GB atlas)"
         )
     if not callable(getattr(wood, "color", None)):
         raise WoodcamError(

@@ -265,13 +265,12 @@ def _issue_spots(program, issues, size_mm, offset, name: str) -> list[dict]:
     import numpy as np
 
     off = np.array([0.0, 0.0, float(size_mm[2])]) if offset is None else np.asarray(offset, float)
-    lines = np.asarray(program.line)
+    lines, ends = np.asarray(program.line), np.asarray(program.end_mm) + off
     out = []
     for issue in issues:
         at = np.flatnonzero(lines == issue.line)
         if len(at):
-            out.append({"message": f"{name} {issue}", "line": int(issue.line),
-                        "at_mm": [float(v) for v in np.asarray(program.end_mm)[at[0]] + off]})
+            out.append({"message": f"{name} {issue}", "line": int(issue.line), "at_mm": ends[at[0]].tolist()})
     return out
 
 
