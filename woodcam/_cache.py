@@ -76,6 +76,13 @@ def entry_stem(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", str(name))[:40] or "block"
 
 
+def _is_numpy(obj: Any) -> bool:
+    """An array or numpy scalar, told without importing numpy (`woodcam cache --help` stays light;
+    an object of numpy's comes from a loaded numpy)."""
+    np = sys.modules.get("numpy")
+    return np is not None and isinstance(obj, (np.ndarray, np.generic))
+
+
 def _feed(h, obj: Any) -> None:
     """Feed ``obj`` to the hash unambiguously: type tag, length, content (arrays by dtype, shape
     and bytes; dicts by sorted key)."""
@@ -88,8 +95,8 @@ def _feed(h, obj: Any) -> None:
     elif isinstance(obj, (bytes, bytearray, memoryview)):
         b = bytes(obj)
         h.update(b"B" + len(b).to_bytes(8, "little") + b)
-    elif "numpy" in sys.modules and isinstance(obj, (sys.modules["numpy"].ndarray, sys.modules["numpy"].generic)):
-        import numpy as np  # not at the top: `woodcam cache --help` stays light (an array means it is loaded)
+    elif _is_numpy(obj):
+        import numpy as np
 
         a = np.ascontiguousarray(obj)
         h.update(b"A" + a.dtype.str.encode() + repr(a.shape).encode())
