@@ -215,6 +215,68 @@ def test_the_section_cap_shows_the_wood_inside(page, browser, tmp_path):
     assert img[20, 20].max() < 0.05 and img[480, 980].max() < 0.05
 
 
+def _ndc(browser, key: str) -> np.ndarray:
+    """The probe's NDC bounds (x0, y0, x1, y1) of the block or the part under the shown camera."""
+    return np.array(browser.evaluate(f"document.getElementById('probe').dataset.{key}").split(","),
+                    float)
+
+
+def _frames(browser) -> None:
+    browser.evaluate("new Promise((ok) => requestAnimationFrame(() => "
+                     "requestAnimationFrame(() => ok(true))))")
+
+
+def _assert_framed(browser, fills: bool, what: str) -> None:
+    """The whole block (and so the part) lies inside the frame (NDC -1..1); ``fills``: the block
+    face seen square on meets two opposite edges exactly, else the block spans at least 0.65 of
+    the frame in one direction."""
+    block, part = _ndc(browser, "ndcBlock"), _ndc(browser, "ndcPart")
+    assert np.all(np.abs(block) <= 1 + 1e-3), f"{what}: block {block} leaves the frame"
+    assert block[0] <= part[0] and block[1] <= part[1] and part[2] <= block[2] and part[3] <= block[3]
+    extent = max(block[2] - block[0], block[3] - block[1]) / 2
+    if fills:
+        assert extent == pytest.approx(1, abs=1e-3), f"{what}: block {block} should fill the frame"
+    else:
+        assert extent >= 0.65, f"{what}: block {block} is drawn too small"
+
+
+def test_views_frame_the_block_at_any_aspect_and_the_hash_sets_the_ui(page, browser):
+    """QA item 5: the front orthographic view was framed by the height only (cropped in any
+    window narrower than the block's W:H) and kept that zoom for the other views; the narrow
+    page (sidebar taking half the width) cropped the perspective view; #ortho left the checkbox
+    unchecked; a bare #cut=z cut at D/2, and #cut=x:nan or z:9999 gave NaN or an outside cut."""
+    _, _, out, _ = page
+    # 700 x 900 with the 320 px sidebar: the canvas is ~3x taller than wide
+    assert browser.load(f"file://{out}#view=front&ortho&cut=z", size=(700, 900)) == "box: ready"
+    assert browser.evaluate("document.getElementById('view').clientWidth * 2 < "
+                            "document.getElementById('view').clientHeight")
+    assert browser.evaluate("document.getElementById('ortho').checked") is True
+    assert browser.evaluate("document.getElementById('cut-label').textContent") == "z = 25.0 mm"
+    assert float(browser.evaluate("document.getElementById('cut-pos').value")) == 25
+    _assert_framed(browser, True, "front, orthographic")
+    for view in ("top", "left", "iso"):
+        browser.evaluate(f"document.querySelector('[data-view={view}]').click()")
+        _frames(browser)
+        _assert_framed(browser, view != "iso", f"{view}, orthographic")
+    browser.evaluate("(() => { const o = document.getElementById('ortho'); o.checked = false; "
+                     "o.dispatchEvent(new Event('change')); })()")
+    _frames(browser)
+    _assert_framed(browser, False, "iso, perspective")
+    for size in ((1400, 500), (500, 900)):  # a resized window keeps it in frame
+        browser.call("Emulation.setDeviceMetricsOverride", session=True, width=size[0],
+                     height=size[1], deviceScaleFactor=1, mobile=False)
+        browser.evaluate("new Promise((ok) => setTimeout(() => ok(true), 200))")
+        _frames(browser)
+        _assert_framed(browser, False, f"iso, perspective, {size}")
+    for arg, label in (("x:nan", "x = 50.0 mm"), ("z:9999", "z = 50.0 mm"),
+                       ("q:zz", "y = 40.0 mm")):
+        browser.call("Page.navigate", session=True, url="about:blank")
+        assert browser.load(f"file://{out}#cut={arg}") == "box: ready"
+        assert browser.evaluate("document.getElementById('cut-label').textContent") == label, arg
+        assert browser.evaluate("document.getElementById('cut-on').checked") is True
+        assert browser.evaluate("document.getElementById('ortho').checked") is False
+
+
 def test_review_errors_are_clear(page, tmp_path):
     stock, glb, _, _ = page
     with pytest.raises(WoodcamError, match="must be an existing .glb"):

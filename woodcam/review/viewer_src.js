@@ -34,24 +34,50 @@ scene.add(sun);
 
 const centre = worldOfBlock(W / 2, D / 2, H / 2);
 const span = Math.hypot(W, D, H) / 1000;
+const radius = span / 2;  // the block's bounding sphere (m): every view keeps it in frame
+const MARGIN = 1.08;  // room round the sphere (the fit of a box's sphere already leaves some)
 const persp = new THREE.PerspectiveCamera(35, 1, span / 100, span * 20);
 const ortho = new THREE.OrthographicCamera(-1, 1, 1, -1, -span * 10, span * 10);
 let camera = params.has('ortho') ? ortho : persp;
 const controls = new OrbitControls(camera, canvas);
 controls.target.copy(centre);
 
-function resize() {
+// width / height of the canvas; 1 while it has no size (hidden, e.g. while printing)
+function canvasAspect() {
   const w = canvas.clientWidth, h = canvas.clientHeight;
-  renderer.setSize(w, h, false);
-  persp.aspect = w / h;
-  persp.updateProjectionMatrix();
-  setOrthoFrame(w / h);
+  return w > 0 && h > 0 ? w / h : 1;
 }
 
-let orthoHalf = span / 2;
-function setOrthoFrame(aspect) {
-  ortho.left = -orthoHalf * aspect; ortho.right = orthoHalf * aspect;
-  ortho.top = orthoHalf; ortho.bottom = -orthoHalf;
+// Distance (m) from the centre at which the perspective camera sees the whole bounding sphere,
+// through the narrower of its vertical and horizontal fields of view.
+function perspDistance(aspect) {
+  const half = THREE.MathUtils.degToRad(persp.fov / 2);
+  return radius * MARGIN / Math.sin(Math.min(half, Math.atan(Math.tan(half) * aspect)));
+}
+
+// What the orthographic camera frames, width and height in m: the block face seen square on
+// (it fills the frame exactly when the aspect matches, README), else the bounding sphere.
+function orthoExtent(name) {
+  const face = { front: [W, H], back: [W, H], left: [D, H], right: [D, H], top: [W, D] }[name];
+  return face ? [face[0] / 1000, face[1] / 1000] : [2 * radius * MARGIN, 2 * radius * MARGIN];
+}
+
+let viewName = 'iso';
+function resize() {
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  if (!(w > 0 && h > 0)) return;
+  renderer.setSize(w, h, false);
+  const aspect = w / h;
+  // keep the user's dolly: scale the distance by how much the fit changes with the aspect
+  const offset = persp.position.clone().sub(controls.target);
+  persp.position.copy(controls.target)
+    .addScaledVector(offset, perspDistance(aspect) / perspDistance(persp.aspect));
+  persp.aspect = aspect;
+  persp.updateProjectionMatrix();
+  const [ew, eh] = orthoExtent(viewName);
+  const half = Math.max(eh, ew / aspect) / 2;
+  ortho.left = -half * aspect; ortho.right = half * aspect;
+  ortho.top = half; ortho.bottom = -half;
   ortho.updateProjectionMatrix();
 }
 
@@ -61,19 +87,37 @@ const VIEWS = {
   iso: [1, -1, 0.8],
 };
 function setView(name) {
-  const d = VIEWS[name] || VIEWS.iso;
+  viewName = name in VIEWS ? name : 'iso';
+  const d = VIEWS[viewName];
   const dir = worldOfBlock(d[0], d[1], d[2]).normalize();
+  persp.aspect = canvasAspect();  // resize() below then keeps this distance
   for (const cam of [persp, ortho]) {
-    cam.position.copy(centre).addScaledVector(dir, span * 1.8);
-    cam.up.set(0, name === 'top' ? 0 : 1, name === 'top' ? -1 : 0);
+    cam.position.copy(centre).addScaledVector(dir, perspDistance(persp.aspect));
+    cam.up.set(0, viewName === 'top' ? 0 : 1, viewName === 'top' ? -1 : 0);
     cam.lookAt(centre);
   }
+  ortho.zoom = 1;
   controls.target.copy(centre);
-  if (name === 'front') {
-    // front, orthographic: the block's front face fills the frame exactly (W x H mm)
-    orthoHalf = H / 2000;
-  }
   resize();
+}
+
+// Test hook: the normalised device coordinates (x0,y0,x1,y1; the frame is -1..1) that the
+// block's and the part's bounding boxes span under the camera shown.
+let partBox = null;
+function ndcBounds(lo, hi) {
+  const b = new THREE.Box2();
+  for (let i = 0; i < 8; i++) {
+    const p = new THREE.Vector3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+    const q = p.project(camera);
+    b.expandByPoint(new THREE.Vector2(q.x, q.y));
+  }
+  return [b.min.x, b.min.y, b.max.x, b.max.y].map((v) => v.toFixed(4)).join(',');
+}
+function updateProbe() {
+  const probe = document.getElementById('probe');
+  const block = new THREE.Box3().setFromPoints([worldOfBlock(0, 0, 0), worldOfBlock(W, D, H)]);
+  probe.dataset.ndcBlock = ndcBounds(block.min, block.max);
+  if (partBox) probe.dataset.ndcPart = ndcBounds(partBox.min, partBox.max);
 }
 
 // ---- the wood inside: three 3-D textures (one per cut axis, colour for that normal) ----------
@@ -123,10 +167,16 @@ const capFragment = `
   out vec4 colour;
   void main() { colour = vec4(texture(wood, clamp(vBlock / size, 0.0, 1.0)).rgb, 1.0); }`;
 
-// #cut=AXIS:MM sets the cut, #cut=off starts without one (default: y through the middle)
+// #cut=AXIS:MM sets the cut, MM clamped to the block; a bare axis, or an MM that is not a
+// number, cuts through the middle of that axis. #cut=off starts without one; anything else
+// (an unknown axis) gives the default, y through the middle.
+const LIMITS = { x: W, y: D, z: H };
 const cutArg = (params.get('cut') || '').split(':');
-const cut = { axis: ['x', 'y', 'z'].includes(cutArg[0]) ? cutArg[0] : 'y',
-              pos: cutArg.length > 1 ? parseFloat(cutArg[1]) : D / 2,
+const cutAxis = cutArg[0] in LIMITS ? cutArg[0] : 'y';
+const cutMm = cutAxis === cutArg[0] && cutArg.length > 1 ? parseFloat(cutArg[1]) : NaN;
+const cut = { axis: cutAxis,
+              pos: Number.isFinite(cutMm) ? THREE.MathUtils.clamp(cutMm, 0, LIMITS[cutAxis])
+                : LIMITS[cutAxis] / 2,
               on: cutArg[0] !== 'off' };
 const plane = new THREE.Plane();
 let capMesh = null, textures = {}, part = null;
@@ -235,19 +285,25 @@ function addHotspots() {
 // ---- UI ------------------------------------------------------------------------------------
 function bindUi() {
   for (const b of document.querySelectorAll('[data-view]')) b.onclick = () => setView(b.dataset.view);
-  document.getElementById('ortho').onchange = (e) => {
-    camera = e.target.checked ? ortho : persp;
+  const orthoBox = document.getElementById('ortho');
+  orthoBox.checked = camera === ortho;  // #ortho
+  orthoBox.onchange = () => {
+    // the other camera takes over where this one is looking from
+    const prev = camera;
+    camera = orthoBox.checked ? ortho : persp;
+    camera.position.copy(prev.position);
+    camera.up.copy(prev.up);
+    camera.lookAt(controls.target);
     controls.object = camera;
   };
   const axis = document.getElementById('cut-axis'), pos = document.getElementById('cut-pos');
   const on = document.getElementById('cut-on'), label = document.getElementById('cut-label');
-  const limits = { x: W, y: D, z: H };
   const sync = () => {
-    pos.max = limits[cut.axis]; pos.value = cut.pos;
+    pos.max = LIMITS[cut.axis]; pos.value = cut.pos;
     label.textContent = `${cut.axis} = ${cut.pos.toFixed(1)} mm`;
   };
   axis.value = cut.axis; on.checked = cut.on; sync();
-  axis.onchange = () => { cut.axis = axis.value; cut.pos = limits[cut.axis] / 2; sync(); updatePlane(); };
+  axis.onchange = () => { cut.axis = axis.value; cut.pos = LIMITS[cut.axis] / 2; sync(); updatePlane(); };
   pos.oninput = () => { cut.pos = parseFloat(pos.value); sync(); updatePlane(); };
   on.onchange = () => { cut.on = on.checked; updatePlane(); };
   document.getElementById('print').onclick = () => {
@@ -268,6 +324,7 @@ async function main() {
   part.updateMatrixWorld(true);
   part.traverse((o) => { if (o.isMesh) stencilFor(o.geometry, o.matrixWorld); });
   const box = new THREE.Box3().setFromObject(part);
+  partBox = box;
   const probe = document.getElementById('probe');
   probe.dataset.bboxMin = box.min.toArray().join(',');
   probe.dataset.bboxMax = box.max.toArray().join(',');
@@ -279,7 +336,7 @@ async function main() {
   setView(params.get('view') || 'iso');
   updatePlane();
   window.addEventListener('resize', resize);
-  renderer.setAnimationLoop(() => { controls.update(); renderer.render(scene, camera); });
+  renderer.setAnimationLoop(() => { controls.update(); renderer.render(scene, camera); updateProbe(); });
   status.textContent = 'ready';
   document.title = `${data.title}: ready`;
 }
