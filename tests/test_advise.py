@@ -92,3 +92,20 @@ def test_knot_spots_find_the_knots_through_a_surface(knotty):
     assert (knotty.wood.features(at)["knot"] > 0.5).all()  # every spot sits on knot wood
     clear = open_stock("builtin:flat-sawn")
     assert knot_spots(box, clear.wood) == []
+
+
+def test_every_placement_panel_names_the_same_terms(knotty, monkeypatch, tmp_path):
+    """QA item 6: the "worst" panel's caption left out end grain and runout."""
+    import woodcam.view.compare
+    from woodcam.advise import render_advice
+
+    titles = []
+    monkeypatch.setattr(woodcam.view.compare, "render_side_by_side",
+                        lambda meshes, woods, size, t, png, **kw: titles.extend(t))
+    part = manifold3d.Manifold.cube([20.0, 10.0, 8.0])
+    advice = advise_placement(part, knotty, rotations="none", candidates=50)
+    render_advice(advice, part, knotty, tmp_path / "p.png", top=2)
+    assert len(titles) == 3 and titles[-1].startswith("worst:")
+    for title in titles:
+        assert all(f"{term} " in title for term in ("score", "knots", "pith", "end grain",
+                                                    "runout")), title

@@ -547,3 +547,39 @@ def test_window_keys_switch_views_and_toggle_the_block(tmp_path):
         assert "1 front" in KEY_HELP and "woodcam-keys" in plotter.actors
     finally:
         plotter.close()
+
+
+@pytest.mark.parametrize("size", [(300.0, 60.0, 30.0), (100.0, 80.0, 50.0), (20.0, 20.0, 120.0)])
+def test_placement_panels_frame_the_block_below_their_titles(size):
+    """QA item 6: placements.png's panels had a fixed camera (made for a 100 mm block), which
+    cut the block off at the panel's left edge and showed only one end of a 300 mm block. Each
+    panel now frames its box: the eight corners, projected by the panel's own VTK camera, lie
+    inside the panel and below its title band, and fill most of the panel's width or band."""
+    from woodcam.view.compare import _TITLE_SHARE, frame_panel
+
+    panel = 300
+    plotter = pv.Plotter(off_screen=True, shape=(1, 2), window_size=(2 * panel, panel),
+                         border=False)
+    try:
+        bounds = np.array([0.0, size[0], 0.0, size[1], 0.0, size[2]])
+        corners = [(x, y, z) for x in bounds[:2] for y in bounds[2:4] for z in bounds[4:]]
+        for i in range(2):
+            plotter.subplot(0, i)
+            plotter.add_mesh(pv.Box(bounds=tuple(bounds)).outline())
+            frame_panel(plotter, bounds)
+        plotter.render()
+        for i in range(2):
+            plotter.subplot(0, i)
+            ren = plotter.renderer
+            px = []
+            for c in corners:
+                ren.SetWorldPoint(*c, 1.0)
+                ren.WorldToDisplay()
+                px.append(ren.GetDisplayPoint()[:2])  # window px, origin bottom left
+            px = np.array(px) - [i * panel, 0.0]
+            band = (1 - _TITLE_SHARE) * panel
+            assert px.min() >= 0 and px[:, 0].max() <= panel and px[:, 1].max() <= band, px
+            span = px.max(axis=0) - px.min(axis=0)
+            assert max(span[0] / panel, span[1] / band) >= 0.85, span
+    finally:
+        plotter.close()

@@ -226,19 +226,14 @@ def render_advice(advice: PlacementAdvice, part, stock, png, *, top: int = 3, pr
 
     base = _part_mesh(part)
     meshes, titles = [], []
-    for i, p in enumerate(advice.ranked[:top], 1):
+    shown = [(f"#{i}", p) for i, p in enumerate(advice.ranked[:top], 1)]
+    for label, p in [*shown, ("worst:", advice.ranked[-1])]:
         m = base.copy()
         m.apply_transform(p.matrix)
         meshes.append(m)
-        t = p.terms
-        titles.append(f"#{i} score {p.score:.2f}\nknots {t['knots']:.2f} pith {t['pith']:.2f}\n"
+        t = p.terms  # every panel names the same terms
+        titles.append(f"{label} score {p.score:.2f}\nknots {t['knots']:.2f} pith {t['pith']:.2f}\n"
                       f"end grain {t['end_grain']:.2f} runout {t['runout']:.2f}")
-    worst = advice.ranked[-1]
-    m = base.copy()
-    m.apply_transform(worst.matrix)
-    meshes.append(m)
-    titles.append(f"worst: score {worst.score:.2f}\nknots {worst.terms['knots']:.2f} "
-                  f"pith {worst.terms['pith']:.2f}")
     return render_side_by_side(meshes, [stock.wood] * len(meshes), stock.size_mm, titles, png, progress=progress)
 
 

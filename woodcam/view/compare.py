@@ -10,6 +10,27 @@ import numpy as np
 
 #: Longest triangle edge (mm) of the rendered surface: its vertex colours show rings ~2 mm wide.
 _EDGE_MM = 0.7
+#: Top share of a panel's height kept clear for its title (up to three lines at font size 10).
+_TITLE_SHARE = 0.16
+
+
+def frame_panel(plotter, bounds) -> None:
+    """Look at the box ``bounds`` (x0, x1, y0, y1, z0, z1, block frame, mm) from
+    front-right-above in ``plotter``'s active panel, framed tightly below its title band
+    (:data:`_TITLE_SHARE` of the panel's height)."""
+    from .camera import frame_camera
+
+    x0, y0, x1, y1 = plotter.renderer.GetViewport()  # share of the window
+    w, h = (x1 - x0) * plotter.window_size[0], (y1 - y0) * plotter.window_size[1]  # px
+    keep = 1.0 - _TITLE_SHARE
+    angle = plotter.camera.view_angle  # vertical, degrees
+    # frame into the band under the title: its height sees keep * tan(angle / 2) ...
+    band = np.degrees(2.0 * np.arctan(keep * np.tan(np.radians(angle) / 2.0)))
+    position, focal, up = frame_camera("iso", bounds, (w, keep * h), band)
+    plotter.camera_position = [tuple(position), tuple(focal), tuple(up)]
+    # ... and the off-axis window centre moves the framed view down to that band's middle
+    plotter.camera.SetWindowCenter(0.0, _TITLE_SHARE)
+    plotter.reset_camera_clipping_range()
 
 
 def render_side_by_side(meshes, woods, size_mm, titles, png, *, panel_px: int = 420,
@@ -47,8 +68,10 @@ def render_side_by_side(meshes, woods, size_mm, titles, png, *, panel_px: int = 
             plotter.add_mesh(pv.Box(bounds=(0, W, 0, D, 0, H)).outline(), color="black",
                              line_width=2)
             plotter.add_text(title, font_size=10, position="upper_left")
-            plotter.camera_position = [(W * 1.6, -D * 1.9, H * 2.6), (W / 2, D / 2, H / 2),
-                                       (0, 0, 1)]
+            # the block, and the part should it stick out
+            lo = np.minimum(fine.bounds[0], 0.0)
+            hi = np.maximum(fine.bounds[1], (W, D, H))
+            frame_panel(plotter, np.column_stack([lo, hi]).ravel())
         path = Path(png)
         with atomic_path(path, mkdir=True) as tmp:
             plotter.screenshot(str(tmp))
