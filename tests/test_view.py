@@ -583,3 +583,49 @@ def test_placement_panels_frame_the_block_below_their_titles(size):
             assert max(span[0] / panel, span[1] / band) >= 0.85, span
     finally:
         plotter.close()
+
+
+def _face_samples(inset_mm: float):
+    """A finely meshed part ``inset_mm`` inside the SIZE block, in the preview's iso scene
+    (depth peeling and SSAA as :func:`preview`): colours (n, 3) at 360 points inside the part's
+    front face (y = inset), the block actor's bounds, the camera's clipping range and position."""
+    box = trimesh.creation.box([s - 2 * inset_mm for s in SIZE])
+    box.apply_translation(np.asarray(SIZE) / 2)
+    box = trimesh.Trimesh(*trimesh.remesh.subdivide_to_size(box.vertices, box.faces, 5.0))
+    plotter = pv.Plotter(off_screen=True, window_size=(400, 300))
+    try:
+        build_scene(plotter, box, size_mm=SIZE, cut_plane=False)
+        plotter.enable_depth_peeling()
+        plotter.enable_anti_aliasing("ssaa")
+        img = plotter.screenshot(return_img=True).astype(float)
+        ren, cam = plotter.renderer, plotter.camera
+        px = []
+        for x in np.linspace(15, 85, 30):
+            for z in np.linspace(8, 32, 12):
+                ren.SetWorldPoint(x, inset_mm, z, 1.0)
+                ren.WorldToDisplay()
+                px.append(ren.GetDisplayPoint()[:2])
+        px = np.rint(px).astype(int)
+        colours = img[img.shape[0] - 1 - px[:, 1], px[:, 0]]
+        return (colours, np.asarray(plotter.actors["woodcam-block"].GetBounds()),
+                cam.clipping_range, np.asarray(cam.position))
+    finally:
+        plotter.close()
+
+
+def test_a_part_face_on_a_block_face_is_drawn_clean():
+    """QA item 11: a part face lying on a block face was drawn at the same depth as the
+    translucent block face, and the two fought for each pixel (a screen-door pattern: colours
+    spread over 16 levels on a flat, evenly lit face). The block's faces are now drawn outside
+    the block, by many depth-buffer steps and less than a pixel, and the face is as even as one
+    1 mm inside the block."""
+    colours, block, (near, far), eye = _face_samples(0.0)
+    inside, *_ = _face_samples(1.0)
+    outset = np.abs(block - np.array([0, SIZE[0], 0, SIZE[1], 0, SIZE[2]]))
+    corners = np.array([(x, y, z) for x in (0, SIZE[0]) for y in (0, SIZE[1]) for z in (0, SIZE[2])])
+    d = np.linalg.norm(corners - eye, axis=1).max()
+    depth_step = d**2 * (far - near) / (far * near * 2**24)  # mm, 24-bit depth at distance d
+    assert outset.min() >= 10 * depth_step
+    assert outset.max() <= 0.2  # mm; ~1 px at this size
+    assert np.ptp(colours, axis=0).max() <= np.ptp(inside, axis=0).max() + 2
+    np.testing.assert_allclose(colours.mean(axis=0), inside.mean(axis=0), atol=1.0)
