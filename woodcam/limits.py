@@ -35,6 +35,12 @@ MAX_GRID_CELLS = 200_000_000
 #: Bytes one array allocation may ask for before we refuse (estimated ahead of allocating).
 MAX_ALLOC_BYTES = 4 * 1024**3
 
+#: Voxels of each of the review page's three colour volumes (woodcam.review, ``review --voxels``),
+#: the one home of the range both read: 8 M RGB voxels a volume is ~70 MB of page before PNG
+#: compression; under 1000 the section cap is a few blurred cells. Not a MAX_ guard: no
+#: environment variable raises it.
+REVIEW_VOXELS_RANGE = (1_000, 8_000_000)
+
 _DEFAULTS = {name: value for name, value in globals().items() if name.startswith("MAX_")}
 
 

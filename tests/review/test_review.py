@@ -293,3 +293,20 @@ def test_the_cli_writes_the_page_from_the_glbs_own_block(page, tmp_path, capsys)
     assert main(["review", str(glb), "--out", str(tmp_path / "r.html"), "--voxels", "20000"]) == 0
     assert "wrote" in capsys.readouterr().out and (tmp_path / "r.html").stat().st_size > 1e5
     assert Path(tmp_path / "r.html").read_text().count("data:image/png;base64,") == 3
+
+
+def test_voxels_has_one_range_for_the_cli_and_the_library(tmp_path, capsys):
+    """--voxels 1e7 passed the command line's range (up to 5e7) and then failed in write_review
+    (up to 8e6) with a message naming its parameter 'voxels', exit 1."""
+    from woodcam.cli import main
+    from woodcam.limits import REVIEW_VOXELS_RANGE
+
+    lo, hi = REVIEW_VOXELS_RANGE
+    for bad in (hi + 1, lo - 1):
+        assert main(["review", str(tmp_path / "p.glb"), "--out", str(tmp_path / "r.html"),
+                     "--voxels", str(bad)]) == 2
+        assert f"--voxels must be in [{lo}, {hi:g}]; got {bad}" in capsys.readouterr().err
+    (tmp_path / "p.glb").write_bytes(b"glTF")  # the voxels are checked before the GLB is read
+    with pytest.raises(WoodcamError, match=re.escape(f"voxels must be an integer in [{lo}, {hi:g}]")):
+        write_review(tmp_path / "p.glb", tmp_path / "r.html", wood=None, size_mm=(10, 10, 10),
+                     voxels=hi + 1)

@@ -26,6 +26,7 @@ import re
 from pathlib import Path
 
 from ..errors import WoodcamError
+from ..limits import REVIEW_VOXELS_RANGE
 from ..units import MM_PER_UNIT
 
 #: The --species presets (woodcam.appearance.SPECIES, listed here so that --help imports no
@@ -550,7 +551,7 @@ RANGES: dict = {
     "candidates": (1, 10_000_000, False),      # placement candidates
     "margin": (0.0, 1000.0, False),            # mm
     "top": (1, 100_000, False),
-    "voxels": (1000, 50_000_000, False),       # voxels per review colour volume (default 4e5)
+    "voxels": (*REVIEW_VOXELS_RANGE, False),  # per review colour volume; the library's own range
     "workers": (1, 1024, False),
     "memory_limit_mb": (64, 1_048_576, False),
     "connect_timeout_s": (0.0, 3600.0, True),

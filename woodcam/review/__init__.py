@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import WoodcamError
+from ..limits import REVIEW_VOXELS_RANGE
 
 _HERE = Path(__file__).resolve().parent
 #: three.js version the committed bundle was built from (``make review-bundle``).
@@ -131,8 +132,9 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
     if not bundle.is_file():
         raise WoodcamError(
             f"review: the viewer bundle {bundle} is missing; rebuild it with 'make review-bundle'")
-    if not (isinstance(voxels, int) and 1_000 <= voxels <= 8_000_000):
-        raise WoodcamError(f"review: voxels must be an integer in [1000, 8e6]; got {voxels!r}")
+    lo, hi = REVIEW_VOXELS_RANGE
+    if not (isinstance(voxels, int) and lo <= voxels <= hi):
+        raise WoodcamError(f"review: voxels must be an integer in [{lo}, {hi:g}]; got {voxels!r}")
     size = [float(v) for v in size_mm]
     cell = volume_cell_mm(size, voxels)
     volumes = {}
