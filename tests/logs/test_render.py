@@ -79,6 +79,28 @@ def test_sections_off_the_log_are_refused_by_name():
     assert lr.radial_section(log, 300.0, np.radians(-90.0)).name == "radial_z300_az270"
 
 
+def test_a_section_past_the_logs_end_says_which_part_is_background():
+    """--board 3900 0 60 on the 3990 mm log drew its last 210 mm as background without a word."""
+    from woodcam.errors import WoodcamWarning
+
+    log = _log()  # 600 mm long
+    with pytest.warns(WoodcamWarning, match=r"the board \(--board Z AZ OFF, 200 mm long\) spans z 450\.\.650 mm.*"
+                      r"its right 50 mm \(z > 600 mm\) is drawn as background; a centre height in \[100, 500\]"):
+        s = lr.tangential_board(log, 550.0, 0.0, 60.0, length_mm=200, width_mm=40, px_per_mm=0.5)
+    img = lr.render_section(KnottedLogField(log), s)
+    bg = (np.array(lr.BACKGROUND_RGB) * 255 + 0.5).astype(np.uint8)
+    assert (img[:, -20:] == bg).all() and not (img[:, :70] == bg).all()  # the right 50 mm: 25 px
+    with pytest.warns(WoodcamWarning, match=r"radial section \(--radial Z AZ.*its left 50 mm \(z < 0 mm\)"):
+        lr.radial_section(log, 100.0, 0.0, length_mm=300)
+    with pytest.warns(WoodcamWarning, match="left 100 mm.*and its right 100 mm.*the log is only 600 mm long"):
+        lr.tangential_board(log, 300.0, 0.0, 60.0, length_mm=800)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lr.tangential_board(log, 500.0, 0.0, 60.0, length_mm=200)  # inside, to its end: no word
+
+
 def test_a_log_file_names_no_path_and_says_mm(tmp_path):
     """A log file named "../../escaped" made 'log render' write outside --out; "units": "inch"
     was read as mm without a word."""

@@ -14,6 +14,7 @@ arrays; only :func:`save_png` writes.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -21,7 +22,7 @@ import numpy as np
 
 from ..appearance.colormap import ColorMapAppearance, Species
 from ..appearance.knots import KnotShading
-from ..errors import WoodcamError
+from ..errors import WoodcamError, WoodcamWarning
 from ..fields.base import arf
 from ..fields.knots import KnottedLogField
 from ..fields.skeleton import LogSkeleton
@@ -65,6 +66,23 @@ def _check_height(log: LogSkeleton, z_mm: float, what: str) -> None:
                            f"mm along it; got {z_mm:g}")
 
 
+def _warn_past_ends(log: LogSkeleton, z_lo: float, z_hi: float, what: str) -> None:
+    """Warn when the z range ``[z_lo, z_hi]`` of a section whose columns run along the log (``+z``
+    to the right) passes one of its ends: that part is drawn as background (it was, silently)."""
+    lo, hi = float(log.pith_z_mm[0]), float(log.pith_z_mm[-1])
+    parts = []
+    if z_lo < lo:
+        parts.append(f"its left {lo - z_lo:.0f} mm (z < {lo:g} mm)")
+    if z_hi > hi:
+        parts.append(f"its right {z_hi - hi:.0f} mm (z > {hi:g} mm)")
+    if parts:
+        fits = (f"a centre height in [{lo + (z_hi - z_lo) / 2:g}, {hi - (z_hi - z_lo) / 2:g}] mm keeps "
+                "it inside" if z_hi - z_lo <= hi - lo else f"the log is only {hi - lo:g} mm long")
+        warnings.warn(f"{what} spans z {z_lo:g}..{z_hi:g} mm, past the log's end ([{lo:g}, {hi:g}] mm "
+                      f"along it): {' and '.join(parts)} is drawn as background; {fits}",
+                      WoodcamWarning, stacklevel=3)
+
+
 def _deg(azimuth_rad: float) -> str:
     """An azimuth for a file name: whole degrees in [0, 360) (1e300 degrees made a name longer
     than the file system allows)."""
@@ -97,6 +115,8 @@ def tangential_board(log: LogSkeleton, z_center_mm: float, azimuth_rad: float, o
     t = np.array([-np.sin(azimuth_rad), np.cos(azimuth_rad), 0.0])
     centre = np.array([c[0], c[1], z_center_mm]) + offset_mm * n
     origin = centre - 0.5 * length_mm * np.array([0, 0, 1.0]) + 0.5 * width_mm * t
+    _warn_past_ends(log, z_center_mm - length_mm / 2, z_center_mm + length_mm / 2,
+                    f"the board (--board Z AZ OFF, {length_mm:g} mm long)")
     return Section(tuple(origin), (0, 0, 1), tuple(-t), (length_mm, width_mm), px_per_mm,
                    f"board_z{z_center_mm:.0f}_az{_deg(azimuth_rad)}_off{offset_mm:.0f}")
 
@@ -113,6 +133,8 @@ def radial_section(log: LogSkeleton, z_center_mm: float, azimuth_rad: float, *,
     n = np.array([np.cos(azimuth_rad), np.sin(azimuth_rad), 0.0])
     h = log.r_max_mm + margin_mm
     origin = np.array([c[0], c[1], z_center_mm - 0.5 * length_mm]) + h * n
+    _warn_past_ends(log, z_center_mm - length_mm / 2, z_center_mm + length_mm / 2,
+                    f"the radial section (--radial Z AZ, {length_mm:g} mm long)")
     return Section(tuple(origin), (0, 0, 1), tuple(-n), (length_mm, 2 * h), px_per_mm,
                    f"radial_z{z_center_mm:.0f}_az{_deg(azimuth_rad)}")
 
