@@ -18,6 +18,14 @@ from woodcam.woodify import WoodifiedField
 REPO = Path(__file__).resolve().parents[2]
 
 
+def _rc(argv) -> int:
+    """``main``'s exit status, also for argparse's usage errors (a SystemExit)."""
+    try:
+        return main(argv)
+    except SystemExit as exit_:
+        return exit_.code
+
+
 @pytest.fixture(scope="module")
 def grown_dir(tmp_path_factory):
     d = tmp_path_factory.mktemp("woodify")
@@ -82,10 +90,10 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
                              ("--crack-threshold", "-1", "--crack-threshold must be in (0,"),
                              ("--crack-region", "0,0,0,-5", "--crack-region X,Y,Z,R needs a radius R > 0"),
                              ("--block-size", "1e300x10x10", "--block-size takes WxDxH in mm"),
-                             ("--block-centre", "1e300,0,0", "--block-centre takes 3 comma-separated"),
+                             ("--block-centre", "1e300,0,0", "--block-centre must be in [-100000, 100000]"),
                              ("--shape", "1e300", "--shape must be in (0, 100]")):
         t0 = time.perf_counter()
-        assert main(["woodify", str(tmp_path / "ball.stl"), "--years", "3", "--resolution", "256",
+        assert _rc(["woodify", str(tmp_path / "ball.stl"), "--years", "3", "--resolution", "256",
                      "--out", str(tmp_path / "o"), f"{opt}={value}"]) in (1, 2), opt  # 2: a range (usage)
         assert time.perf_counter() - t0 < 10.0, f"{opt}: refused only after the growth (a minute at 256)"
         err = capsys.readouterr().err
@@ -95,6 +103,26 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
     assert "must be watertight" in capsys.readouterr().err
     with pytest.raises(WoodcamError, match="does not exist"):
         open_stock(f"woodify:{tmp_path / 'missing.npz'}")
+
+
+def test_vectors_and_sizes_are_refused_at_the_door_as_typed(tmp_path, capsys):
+    """woodify parsed --up, --block-centre and --crack-region with its own _vec (exit 1, after
+    --units had converted them: --block-size 1000x10x10 --units inch said '25400x254x254'); --up
+    0,0,0 reached the library, which named its parameter 'up'. They are the shared vector_type /
+    sizes_type and RANGES now: exit 2, the option and the value as typed."""
+    ball = tmp_path / "ball.stl"
+    trimesh.creation.icosphere(subdivisions=1, radius=5.0).export(ball)
+    for extra, said in (
+            (["--up", "0,0,0"], "--up '0,0,0': a direction must not be zero; e.g. 0,0,1"),
+            (["--crack-region", "0,0,0"], "--crack-region '0,0,0': give 4 finite numbers X,Y,Z,R"),
+            (["--crack-region=1,2,3,0"], "--crack-region X,Y,Z,R needs a radius R > 0; got R = 0 mm"),
+            (["--block-size", "1000x10x10", "--units", "inch"],
+             "--block-size must be in (0, 10000] mm; got 1000.0 inch = 25400 mm"),
+            (["--block-centre=5000,0,0", "--units", "inch"],
+             "--block-centre must be in [-100000, 100000] mm; got 5000.0 inch = 127000 mm")):
+        assert _rc(["woodify", str(ball), "--years", "3", "--out", str(tmp_path / "o"), *extra]) == 2, extra
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and said in err, err
 
 
 def test_an_interrupted_run_leaves_the_last_runs_products(tmp_path, monkeypatch, capsys):

@@ -109,7 +109,7 @@ def check_out(args: argparse.Namespace) -> None:
 
 # -- --units: lengths on the command line and in printed summaries ------------------------------
 #: ``(command, option dest)`` -> how the value holds lengths: "number" (float), "vector" (a
-#: tuple of floats), "sizes" / "csv" (a text "WxDxH" / "X,Y,Z,R" of lengths), "spec" (a block
+#: tuple of floats), "sizes" (a text "WxH" of lengths), "spec" (a block
 #: spec's :WxDxH size), "place" (``--place`` operations: translate:X,Y,Z and fit:MARGIN),
 #: "tools" (``--tool`` specs: diameters, corner radii, tips; angles stay degrees). ``--rapid-rate`` reads unit/min. Options whose name carries a unit
 #: (``--texels-per-mm``, ``--size-mm``) keep it; files stay mm.
@@ -123,8 +123,8 @@ LENGTH_OPTIONS: dict[tuple[str, str], str] = {
     ("gcode", "stock"): "vector", ("gcode", "stock_origin"): "vector",
     ("gcode", "rapid_rate"): "number", ("gcode", "mesh_tol"): "number",
     ("gcode", "tool"): "tools",
-    ("woodify", "growth"): "number", ("woodify", "block_size"): "sizes",
-    ("woodify", "block_centre"): "csv", ("woodify", "crack_region"): "csv",
+    ("woodify", "growth"): "number", ("woodify", "block_size"): "vector",
+    ("woodify", "block_centre"): "vector", ("woodify", "crack_region"): "vector",
     ("parquetry", "sheet_size"): "sizes", ("parquetry", "leaf_thickness"): "number",
     ("parquetry", "saw_kerf"): "number", ("parquetry", "tool_diameter"): "number",
 }
@@ -174,9 +174,8 @@ def _value_to_mm(kind: str, value, k: float):
         return value * k
     if kind == "vector":
         return tuple(v * k for v in value)
-    if kind in ("sizes", "csv"):
-        return _scaled_numbers(str(value).lower() if kind == "sizes" else str(value),
-                               "x" if kind == "sizes" else ",", k)
+    if kind == "sizes":
+        return _scaled_numbers(str(value).lower(), "x", k)
     if kind == "spec":
         m = _SPEC_SIZE.match(str(value))
         if not m:
@@ -306,20 +305,26 @@ def sizes_type(option: str, n: int = 3):
     return parse
 
 
-def vector_type(option: str):
-    """argparse ``type`` for ``option``: ``"X,Y,Z"`` -> three finite floats, or a one-line error
-    naming the option (negative values parse as values: see :func:`allow_negative_values`)."""
-    import math
+def vector_type(option: str, form: str = "X,Y,Z", example: str = "0,0,50", *, nonzero: bool = False):
+    """argparse ``type`` for ``option``: a text like ``form`` (``"X,Y,Z"``, ``"X,Y,Z,R"``) -> as
+    many finite floats, not all zero with ``nonzero`` (a direction), or a one-line usage error
+    naming the option. The one parser of every comma-separated vector a user types; limits on
+    the values are :data:`RANGES`' (checked in mm after ``--units``). Negative values parse as
+    values with :func:`allow_negative_values`."""
+    n = form.count(",") + 1
 
-    def parse(text: str) -> tuple[float, float, float]:
+    def parse(text: str) -> tuple[float, ...]:
         try:
             vals = tuple(float(v) for v in text.split(","))
         except ValueError:
             vals = ()
-        if len(vals) != 3 or not all(math.isfinite(v) for v in vals):
-            raise argparse.ArgumentTypeError(f"{option} {text!r}: give three finite numbers "
-                                             "X,Y,Z, e.g. 0,0,50")
-        return vals  # type: ignore[return-value]
+        if len(vals) != n or not all(math.isfinite(v) for v in vals):
+            raise argparse.ArgumentTypeError(f"{option} {text!r}: give {n} finite numbers {form}, "
+                                             f"e.g. {example}")
+        if nonzero and not any(vals):
+            raise argparse.ArgumentTypeError(f"{option} {text!r}: a direction must not be zero; "
+                                             f"e.g. {example}")
+        return vals
     return parse
 
 
@@ -585,6 +590,11 @@ RANGES: dict = {
     ("parquetry", "tool_diameter"): (0.0, 100.0, False),
     ("parquetry", "kerf_mm"): (0.0, 100.0, False),
     ("woodify", "relief"): (0.0, 1.0, False),
+    # sizes and places typed as vectors (vector_type, sizes_type): limits in mm, after --units
+    ("woodify", "block_size"): (0.0, 10_000.0, True),     # woodcam.limits.MAX_BLOCK_SIZE_MM
+    ("gcode", "stock"): (0.0, 10_000.0, True),
+    ("woodify", "block_centre"): (-1e5, 1e5, False),      # 100 m: 1e300 is a typo, not a place
+    ("woodify", "crack_region"): (-1e5, 1e5, False),
 }
 
 
@@ -622,9 +632,12 @@ def check_numbers(args: argparse.Namespace) -> None:
         rng = RANGES.get((command, dest), RANGES.get(dest))
         values = value if isinstance(value, (list, tuple)) else [value]
         typed = vars(args).get("_typed", {}).get(dest)
-        for v in values:
-            _check_value(v, _option(dest), rng, None if typed is None or isinstance(typed[0], (list, tuple))
-                         else typed, name or "COMMAND")
+        for i, v in enumerate(values):
+            if typed is not None and isinstance(typed[0], (list, tuple)):  # a vector: its typed element
+                item = (typed[0][i], typed[1]) if isinstance(typed[0][i], (int, float)) else None
+            else:
+                item = typed
+            _check_value(v, _option(dest), rng, item, name or "COMMAND")
 
 
 def add_workers_option(p: argparse.ArgumentParser) -> None:

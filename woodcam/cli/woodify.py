@@ -14,21 +14,8 @@ import json
 import time
 from pathlib import Path
 
-from ..errors import WoodcamError
-from .options import add_out_option, add_units_option, parse_sizes
-
-
-def _vec(text: str, option: str, n: int = 3) -> tuple[float, ...]:
-    """``"X,Y,Z"`` -> ``n`` numbers within 100 m (mm; 1e300 is a typo, not a place)."""
-    import math
-
-    try:
-        vals = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        vals = ()
-    if len(vals) != n or not all(math.isfinite(v) and abs(v) <= 1e5 for v in vals):
-        raise WoodcamError(f"{option} takes {n} comma-separated numbers within +-100000 (mm); got {text!r}")
-    return vals
+from ..errors import UsageError, WoodcamError
+from .options import add_out_option, add_units_option, sizes_type, vector_type
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -52,7 +39,8 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--shape", type=float, default=2.0, help="Weibull shape c of eq. 4.1 (default 2)")
     p.add_argument("--eccentricity", type=float, default=0.0,
                    help="delta in (-1, 1): speed (1 + delta n.up) (default 0)")
-    p.add_argument("--up", default="0,0,1", metavar="X,Y,Z", help="direction the eccentric growth favours (unit-normalised; default 0,0,1)")
+    p.add_argument("--up", default="0,0,1", metavar="X,Y,Z",
+                   type=vector_type("--up", example="0,0,1", nonzero=True), help="direction the eccentric growth favours (unit-normalised; default 0,0,1)")
     p.add_argument("--obstacle", type=Path, action="append", default=[], metavar="MESH",
                    help="closed obstacle mesh or part (mm); repeatable")
     p.add_argument("--brushes", type=Path, default=None, metavar="JSON",
@@ -64,16 +52,17 @@ def register(subparsers) -> argparse.ArgumentParser:
                    "without obstacles, anisotropic otherwise)")
     p.add_argument("--surface-years", default=None, metavar="Y1,Y2,..",
                    help="also write watertight surfaces at these years (default: quarters of --years)")
-    p.add_argument("--block-size", default=None, metavar="WxDxH",
+    p.add_argument("--block-size", default=None, metavar="WxDxH", type=sizes_type("--block-size"),
                    help="size of the block cut from the grown object (mm); default the grown "
                    "object's bounding box")
-    p.add_argument("--block-centre", default=None, metavar="X,Y,Z",
+    p.add_argument("--block-centre", default=None, metavar="X,Y,Z", type=vector_type("--block-centre"),
                    help="centre of that block in the input's frame (mm); default the grown "
                    "object's bounding-box centre (write --block-centre=-9,0,35 when the first "
                    "value is negative)")
     p.add_argument("--cracks", choices=("none", "stress", "vertical", "horizontal", "random"),
                    default="stress", help="bark crack pattern (default stress: natural directions)")
     p.add_argument("--crack-region", default=None, metavar="X,Y,Z,R",
+                   type=vector_type("--crack-region", "X,Y,Z,R", "0,0,50,10"),
                    help="only crack within this sphere (mm)")
     add_units_option(p, "woodify")
     p.add_argument("--crack-years", type=int, default=5,
@@ -294,7 +283,6 @@ def run(args) -> int:
     t0 = time.perf_counter()
     if not (np.isfinite(args.years) and args.years > 0):
         raise WoodcamError(f"--years must be > 0 (years to grow); got {args.years:g}")
-    up = _vec(args.up, "--up")
     # every option checked before the growth (minutes on a fine grid)
     if args.surface_years:
         try:
@@ -306,18 +294,16 @@ def run(args) -> int:
                                f"got {args.surface_years!r}")
     else:
         years = [args.years * k / 4 for k in (1, 2, 3)]
-    size = parse_sizes(args.block_size, "--block-size") if args.block_size else None
-    centre = _vec(args.block_centre, "--block-centre") if args.block_centre else None
-    region = _vec(args.crack_region, "--crack-region", n=4) if args.crack_region else None
+    region = args.crack_region
     if region is not None and not region[3] > 0:
-        raise WoodcamError(f"--crack-region X,Y,Z,R needs a radius R > 0 (mm); got {args.crack_region!r}")
+        raise UsageError(f"--crack-region X,Y,Z,R needs a radius R > 0; got R = {region[3]:g} mm")
     steps = progress_bar(total=4, desc="woodify", unit="stage", leave=False)
     mesh, textured, painted = _load_mesh(args.part)
     obstacles = [_load_mesh(str(o))[0] for o in args.obstacle]
     brushes = load_brushes(args.brushes) if args.brushes else ()
     steps.update(1)
     res = woodify(mesh, args.years, growth_mm=args.growth, time_scale_years=args.time_scale,
-                  shape=args.shape, eccentricity=args.eccentricity, up=up, obstacles=obstacles,
+                  shape=args.shape, eccentricity=args.eccentricity, up=args.up, obstacles=obstacles,
                   brushes=brushes, resolution=args.resolution, method=args.method, **painted)
     steps.update(1)
     from .._atomic import all_or_nothing
@@ -326,8 +312,8 @@ def run(args) -> int:
     # of 13 years beside a woodify.json of 11)
     with all_or_nothing():
         files, summary = _write_outputs(
-            res, args.out, textured=textured, surface_years=years, block_size_mm=size,
-            block_centre_mm=centre, cracks=args.cracks, crack_region=region,
+            res, args.out, textured=textured, surface_years=years, block_size_mm=args.block_size,
+            block_centre_mm=args.block_centre, cracks=args.cracks, crack_region=region,
             crack_years=args.crack_years, crack_render=args.crack_render,
             crack_threshold=args.crack_threshold, relief=args.relief, seed=args.seed,
             atomic=_atomic, progress=lambda: steps.update(1))
