@@ -125,6 +125,17 @@ def test_vectors_and_sizes_are_refused_at_the_door_as_typed(tmp_path, capsys):
         assert err.count("\n") == 1 and said in err, err
 
 
+def test_eccentricity_is_refused_by_its_option_name(tmp_path, capsys):
+    """--eccentricity 1 was refused by the library as 'eccentricity must lie in (-1, 1)', exit 1."""
+    for value in ("1", "-1", "2"):
+        assert _rc(["woodify", str(tmp_path / "p.stl"), "--years", "3", "--out", str(tmp_path / "o"),
+                    f"--eccentricity={value}"]) == 2
+        assert f"--eccentricity must be in (-1, 1); got {float(value)!r}" in capsys.readouterr().err
+    assert _rc(["woodify", str(tmp_path / "p.stl"), "--years", "3", "--out", str(tmp_path / "o"),
+                "--eccentricity=0.999"]) == 1  # in range: on to the missing part file
+    assert "p.stl" in capsys.readouterr().err
+
+
 def test_an_interrupted_run_leaves_the_last_runs_products(tmp_path, monkeypatch, capsys):
     """A Ctrl-C while writing left the new grown.glb and field.npz beside the old woodify.json and
     sections; and each run at other --surface-years left its surfaces beside the last run's."""

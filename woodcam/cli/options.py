@@ -526,8 +526,8 @@ def _trusted_appearance_params(params, glb) -> dict:
 # and inf, and a value out of range must fail with one line, not a hang, an out-of-memory kill
 # or a silent substitution (``--tolerance 0`` used to become 0.05 without a word).
 
-#: option dest -> (low, high, low_is_open). ``(command, dest)`` keys override a plain ``dest``
-#: for commands where the same option name means another quantity.
+#: option dest -> (low, high, low_is_open[, high_is_open]). ``(command, dest)`` keys override a
+#: plain ``dest`` for commands where the same option name means another quantity.
 RANGES: dict = {
     "texels_per_mm": (0.0, 100.0, True),       # 100 texels/mm = 0.01 mm texels, far below a cutter
     "tolerance": (0.0, 10.0, True),            # tessellation chord, mm
@@ -590,6 +590,7 @@ RANGES: dict = {
     ("parquetry", "tool_diameter"): (0.0, 100.0, False),
     ("parquetry", "kerf_mm"): (0.0, 100.0, False),
     ("woodify", "relief"): (0.0, 1.0, False),
+    ("woodify", "eccentricity"): (-1.0, 1.0, True, True),  # speed (1 + delta n.up) stays > 0
     # sizes and places typed as vectors (vector_type, sizes_type): limits in mm, after --units
     ("woodify", "block_size"): (0.0, 10_000.0, True),     # woodcam.limits.MAX_BLOCK_SIZE_MM
     ("gcode", "stock"): (0.0, 10_000.0, True),
@@ -613,10 +614,11 @@ def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND") 
         raise UsageError(f"{option} must be a finite number; got {value!r}")
     if rng is None:
         return
-    lo, hi, lo_open = rng
-    if value < lo or value > hi or (lo_open and value <= lo):
+    lo, hi, lo_open, hi_open = (*rng, False)[:4]
+    if value < lo or value > hi or (lo_open and value <= lo) or (hi_open and value >= hi):
         got = f"{value!r}" if typed is None else f"{typed[0]!r} {typed[1]} = {value:g} mm"
-        raise UsageError(f"{option} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}]"
+        raise UsageError(f"{option} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}"
+                         f"{')' if hi_open else ']'}"
                          f"{' mm' if typed is not None else ''}; got {got}; see 'woodcam {command} --help' "
                          "for its meaning and default")
 
