@@ -98,6 +98,32 @@ def test_preview_takes_negative_vectors_and_view_flags():
     assert exc.value.code == 2
 
 
+def test_preview_names_its_own_arguments_and_ignores_nothing_silently(tmp_path, monkeypatch, capsys):
+    """preview of a missing file said 'mesh_or_path: no file at ...' and --cut-normal 0,0,0
+    'cut_normal must be ...' (the viewer's parameters); --no-cut dropped --cut-origin and
+    --cut-normal without a word."""
+    import woodcam.view as view
+
+    got = []
+    monkeypatch.setattr(view, "preview", lambda mesh, **kw: got.append(kw))
+    monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block: None)
+    assert cli.main(["preview", str(tmp_path / "nope.glb"), "--screenshot"]) == 1
+    assert f"preview: no file at {str(tmp_path / 'nope.glb')!r}" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exc:
+        cli.main(["preview", "x.glb", "--cut-normal", "0,0,0"])
+    assert exc.value.code == 2
+    assert "--cut-normal '0,0,0': a direction must not be zero" in capsys.readouterr().err
+    glb = tmp_path / "part.glb"
+    glb.write_bytes(b"")
+    assert cli.main(["preview", str(glb), "--screenshot", "--no-cut", "--cut-origin", "1,2,3",
+                     "--cut-normal", "0,0,1"]) == 0
+    assert ("woodcam: warning: --cut-origin and --cut-normal place the cut plane, which --no-cut "
+            "leaves out: ignored") in capsys.readouterr().err
+    assert got[-1]["cut_plane"] is False
+    assert cli.main(["preview", str(glb), "--screenshot", "--cut-origin", "1,2,3"]) == 0
+    assert "warning" not in capsys.readouterr().err
+
+
 def _commands():
     """{command: its argparse parser} for every sub-command (nested ones included)."""
     import argparse

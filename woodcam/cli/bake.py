@@ -75,7 +75,8 @@ def register(subparsers) -> None:
                    help="no cut plane: the part alone in its translucent block")
     p.add_argument("--cut-origin", type=vector_type("--cut-origin"), default=None, metavar="X,Y,Z",
                    help="a point of the cut plane, block frame mm (default the block centre)")
-    p.add_argument("--cut-normal", type=vector_type("--cut-normal"), default=None, metavar="X,Y,Z",
+    p.add_argument("--cut-normal", type=vector_type("--cut-normal", example="1,0,0", nonzero=True),
+                   default=None, metavar="X,Y,Z",
                    help="the cut plane's normal, towards the side cut away (default: the block's "
                    "longest axis facing the camera)")
     allow_negative_values(p)
@@ -142,6 +143,19 @@ def run_preview(args: argparse.Namespace) -> int:
     from ..view import preview
     from .options import stock_of_glb
 
+    if not args.mesh.is_file():  # the viewer named its parameter: "mesh_or_path: no file at ..."
+        raise WoodcamError(f"preview: no file at {str(args.mesh)!r}; pass a .glb or .obj written by "
+                           "woodcam bake or gcode")
+    if args.no_cut and (args.cut_origin is not None or args.cut_normal is not None):
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        given = [o for o, v in (("--cut-origin", args.cut_origin), ("--cut-normal", args.cut_normal))
+                 if v is not None]
+        warnings.warn(f"{' and '.join(given)} place{'s' if len(given) == 1 else ''} the cut plane, which "
+                      "--no-cut leaves out: "
+                      "ignored; drop --no-cut to see that cut", WoodcamWarning, stacklevel=2)
     stock = stock_of_glb(args.mesh, args.block)
     wood = stock.wood if stock else None
     if args.confidence:
