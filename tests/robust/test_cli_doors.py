@@ -53,7 +53,13 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["eval", "rings", "/nonexistent", "--methods", "", "--out", "OUT/e"], r"--methods must be 'all'"),
     (["eval", "realistic", "--seed", "5", "--methods", "", "--out", "OUT/e"], r"--methods must be a comma list from"),
     (["bench", "report", "OUT", "--gallery", "-1", "--out", "OUT/r"], r"--gallery must be in \[0, 1000\]"),
-    (["eval", "realistic", "--seed", "5", "--faces", "full,full", "--out", "OUT/e"], r"names each item once"),
+    (["eval", "realistic", "--seed", "5", "--faces", "full,full", "--out", "OUT/e"],
+     r"--faces must be a comma list from full, three, each name once; got 'full,full'"),
+    # eval realistic dropped empty names ('rbf,,radial') where fit refused them: one parser now
+    (["eval", "realistic", "--seed", "5", "--methods", "rbf,,radial", "--scenarios", "bogus", "--out", "OUT/e"],
+     r"--methods must be a comma list from evidence, rbf, radial, neural, each name once; got 'rbf,,radial'"),
+    (["eval", "rings", "/nonexistent", "--methods", "radial,radial", "--out", "OUT/e"],
+     r"--methods must be 'all' or a comma list from evidence, rbf, radial, neural, each name once"),
     (["block", "synth", "--count", "1", "--face-px", "8", "--out", "OUT/b"], r"--face-px must be in \[16,"),
     # 100 mm of jitter failed every block with an unrelated message in its record
     (["block", "synth", "--count", "1", "--jitter-mm", "100", "--out", "OUT/b"], r"--jitter-mm must be in \[0, 10\]"),

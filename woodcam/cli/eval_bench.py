@@ -8,14 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_confidence_option, add_out_option, command_group
-
-
-def _list(text: str) -> list[str]:
-    items = [t.strip() for t in text.split(",") if t.strip()]
-    if len(set(items)) != len(items):  # full,full counted every block twice (n and its interval)
-        raise WoodcamError(f"a comma list of --methods, --scenarios or --faces names each item once; got {text!r}")
-    return items
+from .options import add_confidence_option, add_out_option, comma_names, command_group
 
 
 def register(subparsers) -> None:
@@ -65,14 +58,11 @@ def run_realistic(args) -> int:
     from .._progress import progress_bar, write
     from ..bench_realistic import FACE_SETS, SCENARIOS, confidence_markdown, markdown, score_block, summarise
 
-    methods, scenarios, faces = _list(args.methods), _list(args.scenarios), _list(args.faces)
     from .fit import METHODS
 
-    for name, got, allowed in (("--methods", methods, METHODS), ("--scenarios", scenarios, SCENARIOS),
-                               ("--faces", faces, FACE_SETS)):
-        bad = [g for g in got if g not in allowed]
-        if bad or not got:
-            raise WoodcamError(f"{name} must be a comma list from {', '.join(allowed)}; got {got}")
+    methods = comma_names(args.methods, "--methods", METHODS)
+    scenarios = comma_names(args.scenarios, "--scenarios", tuple(SCENARIOS))
+    faces = comma_names(args.faces, "--faces", tuple(FACE_SETS))
     if args.count < 1 or args.eq79 < 0:
         raise WoodcamError(f"--count must be >= 1 and --eq79 >= 0; got {args.count} and {args.eq79}")
     out = Path(args.out)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 from .options import (add_block_argument, add_confidence_option, add_out_option, add_size_option, add_workers_option,
-                      apply_workers, command_group, open_block)
+                      apply_workers, comma_names, command_group, open_block)
 
 #: Faces used for "partial annotation": three faces meeting at the front-top-left corner, half
 #: of the block's surface (seed 000, section 4.3 traces "half of the block only").
@@ -19,18 +19,6 @@ PARTIAL_FACES = ("front", "top", "left")
 #: The fitting methods of :data:`woodcam.inference.fit.METHODS`, spelled out here so that
 #: ``woodcam --help`` need not import the fitters (numpy, scipy); a test keeps the two equal.
 METHODS = ("evidence", "rbf", "radial", "neural")
-
-
-def _names(text, option: str):
-    """A comma list option (``--faces``, ``--methods``): None for "all" or not given (the
-    default); else the names, each once. An empty list or a repeated name was taken as the
-    default without a word."""
-    if text in (None, "all"):
-        return None
-    names = [f.strip() for f in text.split(",")]
-    if not all(names) or len(set(names)) != len(names):
-        raise WoodcamError(f"{option} must be 'all' or a comma list of distinct names; got {text!r}")
-    return names
 
 
 def register(subparsers) -> None:
@@ -85,7 +73,7 @@ def run_fit(args) -> int:
     from ..inference.fit import fit_block
 
     _check_methods([args.method], "--method")
-    faces = _names(args.faces, "--faces")  # before the block is read
+    faces = None if args.faces is None else comma_names(args.faces, "--faces", all_=True)  # before the block is read
     apply_workers(args)
     block, _ = open_block(args.block, args.size_mm)
     field = fit_block(block, args.method, faces=faces)
@@ -101,9 +89,9 @@ def run_eval(args) -> int:
     from ..fields.grid import GridField
     from ..inference.evaluate import benchmark
 
-    methods = _names(args.methods, "--methods") or ["rbf", "radial"]
-    _check_methods(methods, "--methods")
-    partial = None if args.partial_faces.lower() == "none" else _names(args.partial_faces, "--partial-faces")
+    methods = comma_names(args.methods, "--methods", METHODS, all_=True) or ["rbf", "radial"]
+    partial = (None if args.partial_faces.lower() == "none"
+               else comma_names(args.partial_faces, "--partial-faces", all_=True))
     blocks = [open_block(p, args.size_mm)[0] for p in args.block]
     if args.truth:
         if len(args.truth) != len(blocks):

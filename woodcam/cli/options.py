@@ -328,6 +328,26 @@ def vector_type(option: str, form: str = "X,Y,Z", example: str = "0,0,50", *, no
     return parse
 
 
+def comma_names(text: str, option: str, choices: tuple[str, ...] = (), *,
+                all_: bool = False) -> list[str] | None:
+    """The names of a comma list option (``--methods``, ``--faces`` ...): each non-empty, each
+    once and, with ``choices``, each one of them; with ``all_`` the word ``all`` gives None (every
+    name, the command's default). Else a WoodcamError naming ``option``: an empty list or a
+    repeated name was taken as the default, or counted twice, without a word. The one parser of
+    such lists."""
+    if all_ and text == "all":
+        return None
+    names = [t.strip() for t in str(text).split(",")]
+    if not all(names) or len(set(names)) != len(names):
+        whole = "'all' or " if all_ else ""
+        among = f" from {', '.join(choices)}" if choices else ""
+        raise WoodcamError(f"{option} must be {whole}a comma list{among}, each name once; got {text!r}")
+    bad = [n for n in names if choices and n not in choices]
+    if bad:
+        raise WoodcamError(f"{option} must be from {', '.join(choices)}; got {bad}")
+    return names
+
+
 def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None = 10.0,
                      species: bool = True, screenshot: bool = True) -> None:
     """The options of every command that bakes wood onto a mesh (``bake``, ``demo``, ``gcode``).
