@@ -77,6 +77,19 @@ def test_from_photos_detect_show_and_fit(synth_photos, tmp_path, capsys, monkeyp
         assert im.size == (4 * 2 * 160, 3 * 2 * 160)
 
 
+def test_size_mm_on_a_block_folder_is_said_to_be_unused(synth_photos, tmp_path, capsys):
+    """rings detect / rings show BLOCKDIR --size-mm 30 exited 0 without a word while the block kept
+    its own 50 mm (block show and fit warned)."""
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
+    for size, argv in (("30", ("rings", "detect", blk, "--out", blk, "--no-knots")),
+                       ("40", ("rings", "show", blk, "--out", tmp_path / "s.png"))):
+        rc, _out, err = _run(capsys, *argv, "--size-mm", size)
+        said = f"--size-mm (size_mm ({size}.0, {size}.0, {size}.0)) is for Mokume sample folders"
+        assert rc == 0 and said in err and "(50.0, 50.0, 50.0) mm, which is used" in err, (argv, err)
+    assert read_block(blk).size_mm == (50.0, 50.0, 50.0)
+
+
 def test_corrected_svg_wins_over_detection(synth_photos, tmp_path, capsys):
     blk = tmp_path / "blk"
     assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0

@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_out_option, parse_sizes
+from .options import add_out_option, add_size_option, parse_sizes
 
 
 def _size(text: str) -> tuple[float, float, float]:
@@ -71,8 +71,7 @@ def register(subparsers) -> None:
                    help="classical detector: place and order the rings by a Gabor filter that follows "
                    "each ring's curve (slower; default: off, the straight filter bank)")
     d.add_argument("--no-knots", action="store_true", help="do not detect knot masks")
-    d.add_argument("--size-mm", type=float, default=None,
-                   help="cube side in mm for a Mokume folder (default 50)")
+    add_size_option(d)
 
     s = sub.add_parser("show", help="draw each face photo with the rings and knots found on it",
                        description="Unfolded cross of the face photos (2x) with ring traces (the pieces of one "
@@ -82,7 +81,7 @@ def register(subparsers) -> None:
     s.add_argument("block", type=Path, help="block folder (after 'rings detect') or Mokume sample folder")
     add_out_option(s, "the photos with the rings and knots found", suffixes=(".png",))
     s.add_argument("--zoom", type=int, default=2, help="enlargement: picture pixels per face pixel, a whole number (default 2)")
-    s.add_argument("--size-mm", type=float, default=None, help="cube side in mm for a Mokume folder (default 50)")
+    add_size_option(s)
 
 
 def run(args) -> int:
@@ -101,7 +100,7 @@ def run(args) -> int:
         from PIL import Image
 
         from .._atomic import atomic_path
-        from ..block.io import MANIFEST, read_block, read_mokume
+        from ..block.io import MANIFEST, read_block_folder, read_mokume
         from ..detect.block import with_detected_rings
         from ..detect.show import rings_picture
 
@@ -110,7 +109,7 @@ def run(args) -> int:
             raise WoodcamError(f"block folder {str(folder)!r} does not exist")
         refs = None
         if (folder / MANIFEST).exists():
-            block = read_block(folder)
+            block = read_block_folder(folder, (args.size_mm,) * 3 if args.size_mm else None)
             if not any(f.has_rings for f in block.faces.values()):
                 raise WoodcamError(f"block {str(folder)!r} has no rings yet; run 'woodcam rings detect "
                                    f"{folder} --out {folder}' first")

@@ -156,7 +156,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     ``out`` may be ``src`` itself. ``curved``: as :func:`detect_face`. Returns the manifest path
     and the warnings.
     """
-    from ..block.io import MANIFEST, read_block, read_mokume, write_block
+    from ..block.io import MANIFEST, read_block_folder, read_mokume, write_block
     from ..block.svg import read_traces_svg, write_traces_svg
 
     src, out = Path(src), Path(out)
@@ -174,7 +174,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
         if not (src / MANIFEST).exists():
             raise WoodcamError(f"folder {str(src)!r} must hold a {MANIFEST} (a block folder) or Mokume "
                                f"files (A_col.png ...); found neither")
-        block = read_block(src)
+        block = read_block_folder(src, size_mm)  # it warns that a size_mm given is not used
         edited = user_edited_faces(src)
     if out.resolve() != src.resolve() and (out / MANIFEST).is_file():
         # corrections made in the output folder of an earlier run win too (only the source's
