@@ -115,6 +115,20 @@ def test_cli_parser_wires_run(capsys, tmp_path):
     assert "is neither 'builtin:NAME'" in capsys.readouterr().err
 
 
+def test_a_grid_too_coarse_to_learn_from_names_resolution(capsys, tmp_path):
+    """eval appearance --resolution 8 (in its range) failed with 'training images must be at least
+    patch_px=8 pixels ...; use ... a smaller patch_px', an option no command has."""
+    pytest.importorskip("torch")
+    from woodcam.cli import main
+
+    assert main(["eval", "appearance", "builtin:flat-sawn", "--out", str(tmp_path), "--resolution", "8",
+                 "--quality", "draft", "--epochs", "1", "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert "patch_px" not in err and err.count("\n") == 1
+    assert ("at least 8 cells on each side; the colour-volume grid gives 4x8, 6x8, 4x6, 4x6, 6x8 cells; "
+            "raise its resolution (--resolution") in err
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("sample", ["H11", "CN03"])
 def test_leave_one_face_out_on_mokume_cubes(shared_data, sample):

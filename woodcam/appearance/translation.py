@@ -213,9 +213,11 @@ def _crop_pool(pairs, spec: TranslationSpec, rng: np.random.Generator):
     usable = [(x, y, m) for x, y, m in pairs if x.shape[1] >= p and x.shape[2] >= p]
     if not usable:
         shapes = [x.shape[1:] for x, _, _ in pairs]
+        # patch_px is no option of any command: name the grid resolution, which sets the sizes
         raise WoodcamError(
-            f"training images must be at least patch_px={p} pixels on each side; got {shapes}; "
-            "use a higher resolution or a smaller patch_px"
+            f"the appearance networks learn from face images at least {p} cells on each side; the "
+            f"colour-volume grid gives {', '.join('x'.join(map(str, s)) for s in shapes)} cells; raise "
+            "its resolution (--resolution, cells along the block's longest side)"
         )
     areas = np.array([x.shape[1] * x.shape[2] for x, _, _ in usable], float)
     which = rng.choice(len(usable), size=spec.patches, p=areas / areas.sum())
