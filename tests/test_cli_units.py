@@ -83,6 +83,20 @@ def test_every_length_option_exists_and_its_command_has_units():
         assert {dest, "units"} <= dests, (command, dest)
 
 
+def test_every_length_option_says_it_is_read_in_units():
+    """gcode --work-offset, --start, --stock, --stock-origin (and woodify's, parquetry's ...) said
+    "mm" in their help while --units inch read them in inches."""
+    commands = build_parser().get_default("_commands").choices
+    wrong = []
+    for (command, dest), kind in LENGTH_OPTIONS.items():
+        if kind == "spec":  # a block spec: the --units help names its WxDxH
+            continue
+        action = next(a for a in commands[command]._actions if a.dest == dest)
+        if "--units" not in (action.help or "") or "MM" in str(action.metavar or ""):
+            wrong.append(f"{command} {action.option_strings[-1]} {action.metavar}: {action.help}")
+    assert not wrong, wrong
+
+
 def test_defaults_stay_millimetres():
     a = _parsed("gcode", ["p.nc", "--block", "b", "--out", "x.glb"], "inch")
     assert (a.cell_size, a.mesh_tol, a.rapid_rate) == (0.1, 0.05, 5000.0)

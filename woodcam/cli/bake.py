@@ -37,8 +37,8 @@ def register(subparsers) -> None:
     add_out_option(p, "the baked part; beside it PART.obj/.mtl, PART_texture.png, the "
                    "part report PART_report.txt/.json and, with --screenshot, PART_view.png",
                    suffixes=(".glb",))
-    p.add_argument("--tolerance", type=float, default=None, metavar="MM",
-                   help="tessellation chord tolerance for B-rep parts, mm (default: scaled to "
+    p.add_argument("--tolerance", type=float, default=None, metavar="LEN",
+                   help="tessellation chord tolerance for B-rep parts, a length in --units (default: scaled to "
                    "the part and the texel, min(a quarter texel, 0.1 %% of the part's bounding-box "
                    "diagonal): 0.025 mm for the demo bowl at 10 texels/mm)")
     p.add_argument("--timeout", type=float, default=None, metavar="S",
@@ -46,7 +46,7 @@ def register(subparsers) -> None:
                    "after S seconds (default: no limit)")
     p.add_argument("--place", action="append", default=[], metavar="OP",
                    help="place the part in the block before carving; repeatable, applied in "
-                   "order: rotate:AXIS:DEG (about the part's centre), translate:X,Y,Z (mm), "
+                   "order: rotate:AXIS:DEG (about the part's centre), translate:X,Y,Z (in --units), "
                    "scale:S, center, drop (onto the bottom face), fit[:MARGIN] (scale into the "
                    "block, default margin 2 mm). Turn the block instead with a spec ending in "
                    "~AXIS90 (e.g. builtin:flat-sawn~z90)")
@@ -74,7 +74,7 @@ def register(subparsers) -> None:
     p.add_argument("--no-cut", action="store_true",
                    help="no cut plane: the part alone in its translucent block")
     p.add_argument("--cut-origin", type=vector_type("--cut-origin"), default=None, metavar="X,Y,Z",
-                   help="a point of the cut plane, block frame mm (default the block centre)")
+                   help="a point of the cut plane, block frame, in --units (default the block centre)")
     p.add_argument("--cut-normal", type=vector_type("--cut-normal", example="1,0,0", nonzero=True),
                    default=None, metavar="X,Y,Z",
                    help="the cut plane's normal, towards the side cut away (default: the block's "

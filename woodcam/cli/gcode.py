@@ -60,10 +60,10 @@ def register(subparsers) -> None:
                    metavar="LEN", help="height-field cell size, a length in --units (default "
                    "0.1 mm; the old spelling --resolution still works)")
     p.add_argument("--work-offset", default=None, metavar="X,Y,Z", type=vector_type("--work-offset"),
-                   help="block-frame position of G-code zero in mm (default 0,0,H: "
+                   help="block-frame position of G-code zero in --units (default 0,0,H: "
                    "top-front-left); negative values as --work-offset -14,5,3")
     p.add_argument("--start", default=None, metavar="X,Y,Z", type=vector_type("--start"),
-                   help="machine position (G-code frame, mm) before the first move, also the "
+                   help="machine position (G-code frame, in --units) before the first move, also the "
                    "G28/G30 home (default 0,0,10: 10 mm over the work zero)")
     p.add_argument("--dialect", choices=("linuxcnc", "grbl", "fanuc"), default="linuxcnc",
                    help="whose meaning the program has (default linuxcnc): grbl has no "
@@ -72,17 +72,17 @@ def register(subparsers) -> None:
                    help="read the program with woodcam's interpreter (default) or with "
                    "LinuxCNC's own (needs Debian's linuxcnc-uspace)")
     p.add_argument("--stock", default=None, metavar="WxDxH", type=sizes_type("--stock"),
-                   help="stock size in mm cut from the block's wood (default: the block's "
+                   help="stock size in --units cut from the block's wood (default: the block's "
                    "own size), e.g. 167x208x25")
     p.add_argument("--stock-origin", default=None, metavar="X,Y,Z",
                    type=vector_type("--stock-origin"),
-                   help="block-frame position (mm) of the --stock's corner in the block's wood "
+                   help="block-frame position (in --units) of the --stock's corner in the block's wood "
                    "(default 0,0,0)")
     p.add_argument("--until-line", type=int, default=None, metavar="N",
                    help="simulate the (last) program only up to source line N (default: all)")
-    p.add_argument("--rapid-rate", type=float, default=5000.0, metavar="MM_PER_MIN",
-                   help="machine rapid rate for the machining time estimate (default 5000 "
-                   "mm/min)")
+    p.add_argument("--rapid-rate", type=float, default=5000.0, metavar="RATE",
+                   help="machine rapid rate for the machining time estimate, --units per minute "
+                   "(default 5000 mm/min)")
     p.add_argument("--camera", choices=("iso", "top", "front", "back", "left", "right"),
                    default="iso", help="screenshot view (default iso with a cut plane; top "
                    "shows a relief without a cut; all drawn from the baked texture without "
@@ -99,8 +99,8 @@ def register(subparsers) -> None:
                    "deviation map (OUT with _deviation.png)")
     p.add_argument("--strict", action="store_true",
                    help="exit with status 3 when the reader or the simulation warned")
-    p.add_argument("--mesh-tol", type=float, default=0.05, metavar="MM",
-                   help="merge nearly planar regions of the result mesh within this (default "
+    p.add_argument("--mesh-tol", type=float, default=0.05, metavar="LEN",
+                   help="merge nearly planar regions of the result mesh within this length in --units (default "
                    "0.05 mm: the 20,000-move raster's mesh shrinks from 2.0 M to 0.44 M "
                    "triangles, its volume moves by 0.0006 mm on average)")
     add_units_option(p, "gcode")

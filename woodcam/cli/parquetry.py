@@ -61,11 +61,11 @@ def register(subparsers) -> None:
                    help="Mokume sample folder, or block spec to slice leaves from (repeatable)")
     v.add_argument("--sheets", type=int, default=_SLICING["sheets"], help="leaves per --veneer-from block (default 2)")
     v.add_argument("--sheet-size", default=_SLICING["sheet_size"], metavar="WxH",
-                   help="size of each sliced leaf in mm (default 600x400)")
-    v.add_argument("--leaf-thickness", type=float, default=_SLICING["leaf_thickness"], metavar="MM",
-                   help="sliced leaf thickness in mm (default 0.6)")
-    v.add_argument("--saw-kerf", type=float, default=_SLICING["saw_kerf"], metavar="MM",
-                   help="wood lost between sliced leaves in mm (default 0.4)")
+                   help="size of each sliced leaf in --units (default 600x400 mm)")
+    v.add_argument("--leaf-thickness", type=float, default=_SLICING["leaf_thickness"], metavar="LEN",
+                   help="sliced leaf thickness in --units (default 0.6 mm)")
+    v.add_argument("--saw-kerf", type=float, default=_SLICING["saw_kerf"], metavar="LEN",
+                   help="wood lost between sliced leaves in --units (default 0.4 mm)")
     v.add_argument("--slice-axis", choices=("x", "y", "z"), default=_SLICING["slice_axis"],
                    help="normal of the slicing planes in the block frame (default y: leaves "
                    "parallel to the front face)")
@@ -116,8 +116,8 @@ def register(subparsers) -> None:
     f.add_argument("--no-seams", action="store_true", help="square pieces, no seam optimisation")
     f.add_argument("--min-piece-mm", type=float, default=None,
                    help="narrowest piece in mm (default 5, the paper's bound)")
-    f.add_argument("--tool-diameter", type=float, default=None, metavar="MM",
-                   help="router bit diameter in mm: concave bends >= its radius, tool paths offset "
+    f.add_argument("--tool-diameter", type=float, default=None, metavar="LEN",
+                   help="router bit diameter in --units (default mm): concave bends >= its radius, tool paths offset "
                    "by it (default 2)")
     f.add_argument("--kerf-mm", type=float, default=None,
                    help="wood lost between pieces on a sheet in mm (default: the tool diameter)")

@@ -28,8 +28,8 @@ def register(subparsers) -> None:
                    "axis-aligned ones")
     p.add_argument("--candidates", type=int, default=1000, metavar="N",
                    help="about how many placements to score (default 1000)")
-    p.add_argument("--margin", type=float, default=1.0, metavar="MM",
-                   help="distance kept from the block faces (default 1 mm)")
+    p.add_argument("--margin", type=float, default=1.0, metavar="LEN",
+                   help="distance kept from the block faces, in --units (default 1 mm)")
     p.add_argument("--top", type=int, default=3, metavar="K",
                    help="placements shown in the picture and table (default 3)")
     add_units_option(p, "place")

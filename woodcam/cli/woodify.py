@@ -31,8 +31,8 @@ def register(subparsers) -> argparse.ArgumentParser:
                    "dir_x, dir_y, dir_z (growth direction, length = strength < 1)")
     p.add_argument("--years", type=float, required=True, help="years to grow (> 0)")
     add_out_option(p, "field.npz, grown.glb, surfaces and section PNGs, woodify.json")
-    p.add_argument("--growth", type=float, default=None, metavar="MM",
-                   help="how far a flat surface grows in --years (mm); default a quarter of the "
+    p.add_argument("--growth", type=float, default=None, metavar="LEN",
+                   help="how far a flat surface grows in --years (in --units); default a quarter of the "
                    "input's largest side")
     p.add_argument("--time-scale", type=float, default=None, metavar="YEARS",
                    help="Weibull time scale lambda (years); default --years")
@@ -53,17 +53,17 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--surface-years", default=None, metavar="Y1,Y2,..",
                    help="also write watertight surfaces at these years (default: quarters of --years)")
     p.add_argument("--block-size", default=None, metavar="WxDxH", type=sizes_type("--block-size"),
-                   help="size of the block cut from the grown object (mm); default the grown "
+                   help="size of the block cut from the grown object (in --units); default the grown "
                    "object's bounding box")
     p.add_argument("--block-centre", default=None, metavar="X,Y,Z", type=vector_type("--block-centre"),
-                   help="centre of that block in the input's frame (mm); default the grown "
+                   help="centre of that block in the input's frame (in --units); default the grown "
                    "object's bounding-box centre (write --block-centre=-9,0,35 when the first "
                    "value is negative)")
     p.add_argument("--cracks", choices=("none", "stress", "vertical", "horizontal", "random"),
                    default="stress", help="bark crack pattern (default stress: natural directions)")
     p.add_argument("--crack-region", default=None, metavar="X,Y,Z,R",
                    type=vector_type("--crack-region", "X,Y,Z,R", "0,0,50,10"),
-                   help="only crack within this sphere (mm)")
+                   help="only crack within this sphere (centre and radius in --units)")
     add_units_option(p, "woodify")
     p.add_argument("--crack-years", type=int, default=5,
                    help="last years simulated for cracks (default 5)")
