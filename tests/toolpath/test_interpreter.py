@@ -174,6 +174,14 @@ def test_canned_cycles_retract_planes():
                                               -1.746, -3, 1]
 
 
+def test_cycle_repeats_travel_at_the_retract_plane():
+    # G91 G99 with L: after the first hole the next ones are reached at R (LinuxCNC's
+    # convert_cycle_xy sets old_cc = clear_cc after each repeat), not at the initial Z
+    ends = _ends("G0 X0 Y0 Z5\nG91 G99 G81 X10 R-3 Z-5 L3 F100\nG90 G80\nM2\n")
+    assert ends == [(0, 0, 5), (10, 0, 5), (10, 0, 2), (10, 0, -3), (10, 0, 2),
+                    (20, 0, 2), (20, 0, -3), (20, 0, 2), (30, 0, 2), (30, 0, -3), (30, 0, 2)]
+
+
 def test_dialects():
     safety = "G00 G17 G21 G40 G49 G80 G90\nG0 X1 Y1 Z5\nG1 Z-1 F100\n"
     for d in ("linuxcnc", "fanuc", "grbl"):

@@ -1220,6 +1220,7 @@ class Interpreter:
             elif self.motion == 89.0:
                 self._cyc(FEED, x, y, clear)
             self._cyc(TRAVERSE, x, y, clear)
+            old_z = clear  # LinuxCNC: the next repeat (L) travels at the clearance plane
 
     def _cyc(self, kind, x, y, z):
         self.emit(kind, self.to_machine([x, y, z]))
