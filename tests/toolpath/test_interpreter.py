@@ -182,6 +182,14 @@ def test_cycle_repeats_travel_at_the_retract_plane():
                     (20, 0, 2), (20, 0, -3), (20, 0, 2), (30, 0, 2), (30, 0, -3), (30, 0, 2)]
 
 
+def test_g43_1_axis_words_are_the_offset_not_a_move():
+    # "G43.1 Z-5" in G1 mode fed 4 mm deeper; in LinuxCNC its axis words are the dynamic tool
+    # length offset (woodcam measures tools from the tip: nothing moves)
+    ends = _ends("G0 X0 Y0 Z5\nG1 Z-1 F100\nG43.1 X3 Z-5\nG1 X10\nG49\nM2\n")
+    assert ends == [(0, 0, 5), (0, 0, -1), (10, 0, -1)]
+    assert _ends("G0 X0 Y0 Z5\nG43.1 Z2 G1 X5 F100\nM2\n")[-1] == (5, 0, 2)
+
+
 def test_dialects():
     safety = "G00 G17 G21 G40 G49 G80 G90\nG0 X1 Y1 Z5\nG1 Z-1 F100\n"
     for d in ("linuxcnc", "fanuc", "grbl"):

@@ -944,8 +944,11 @@ class Interpreter:
                 self.p[5210] = 0.0
         elif 92.3 in g:
             self.g92 = [self.p.get(5211 + i, 0.0) * self.scale for i in range(3)]
-        if nonmodal & {10.0, 28.0, 30.0, 92.0}:
-            axis = []  # the axis words belonged to the non-modal code
+        if nonmodal & {10.0, 28.0, 30.0, 92.0} or (43.1 in g and not motion_here):
+            # the axis words belonged to the non-modal code, or are G43.1's dynamic tool
+            # length offset (LinuxCNC: "G43.1 Z2" moves nothing; with a motion code on the line
+            # both read them)
+            axis = []
         if motion_here:
             self.motion = motion_here[0] if motion_here[0] != 80.0 else None
         if self.motion not in _CYCLES:
