@@ -190,6 +190,14 @@ def test_g43_1_axis_words_are_the_offset_not_a_move():
     assert _ends("G0 X0 Y0 Z5\nG43.1 Z2 G1 X5 F100\nM2\n")[-1] == (5, 0, 2)
 
 
+def test_cutter_compensation_is_refused_by_its_g_code_not_its_d_word():
+    # "G41 D1" was refused as "unsupported word D (... no A/B/C/U/V/W axes)"
+    with pytest.raises(GcodeError, match="line 2: 'G41': cutter radius compensation"):
+        _ends("G0 X10 Y10 Z5\nG41 D1 G1 X20 Y20 F100\nG40\nM2\n")
+    with pytest.raises(GcodeError, match="line 1: 'D1': D word with no G or M code"):
+        _ends("G1 X1 D1 F100\nM2\n")
+
+
 def test_dialects():
     safety = "G00 G17 G21 G40 G49 G80 G90\nG0 X1 Y1 Z5\nG1 Z-1 F100\n"
     for d in ("linuxcnc", "fanuc", "grbl"):

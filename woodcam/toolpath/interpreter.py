@@ -115,7 +115,9 @@ _BINOPS = (("**", 6), ("*", 5), ("/", 5), ("mod", 5), ("+", 4), ("-", 4), ("eq",
            ("gt", 3), ("ge", 3), ("lt", 3), ("le", 3), ("and", 2), ("or", 2), ("xor", 2))
 _OKEYS = ("sub", "endsub", "call", "return", "if", "elseif", "else", "endif", "while",
           "endwhile", "do", "repeat", "endrepeat", "break", "continue")
-_LETTERS = set("fgmnstxyzijkrpqlh")  # the words a 3-axis mill program may carry
+# the words a 3-axis mill program may carry (D only beside cutter compensation, which is
+# refused by its G code: a "G41 D1" line names G41, not an unknown letter)
+_LETTERS = set("dfgmnstxyzijkrpqlh")
 _MOTION = {0.0, 1.0, 2.0, 3.0, 73.0, 80.0, 81.0, 82.0, 83.0, 85.0, 86.0, 89.0}
 _CYCLES = {73.0, 81.0, 82.0, 83.0, 85.0, 86.0, 89.0}
 _G_GROUPS = {
@@ -983,6 +985,7 @@ class Interpreter:
             or bool(mset & {50, 51, 52, 53, 62, 63, 64, 65, 66, 67, 68}),
             "l": 10.0 in g or eff in _CYCLES,
             "h": 43.0 in g,
+            "d": bool(g & {41.0, 42.0, 41.1, 42.1}),
         }
         for k, used in uses.items():
             if k in w and not used:
