@@ -161,6 +161,14 @@ def test_arcs_r_form_turns_and_planes():
     _ends("G0 X0 Y0\nG2 X20.028 Y0 I10 J0 F100\nM2\n")
     with pytest.raises(GcodeError, match="radius to end of arc"):
         _ends("G0 X0 Y0\nG2 X20.029 Y0 I10 J0 F100\nM2\n")
+    # LinuxCNC's zero-radius limit, 0.00005 inch: 0.00126 mm refused, 0.00128 mm read (the
+    # 0.001 mm arc of a CAM post's arc fitting was read; LinuxCNC stops the program there)
+    _ends("G0 X0 Y0\nG2 X0.00256 Y0 I0.00128 J0 F100\nM2\n")
+    _ends("G20 G0 X0 Y0\nG2 X0.000102 Y0 I0.000051 J0 F10\nM2\n")
+    for arc in ("G21 G2 X0.00252 Y0 I0.00126 J0", "G21 G2 X0.002 Y0 I0.001 J0",
+                "G20 G2 X0.000098 Y0 I0.000049 J0"):
+        with pytest.raises(GcodeError, match="line 2: 'G2': zero-radius arc"):
+            _ends(f"G0 X0 Y0\n{arc} F100\nM2\n")
 
 
 def test_canned_cycles_retract_planes():

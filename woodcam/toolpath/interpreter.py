@@ -77,6 +77,9 @@ _EQ_TOL = 1e-4
 #: 2.9: 0.028 mm on a 10 mm radius is read, 0.029 mm refused).
 _ARC_ABS_TOL = {"in": 2 * 0.001 * math.sqrt(2), "mm": 2 * 0.01 * math.sqrt(2)}
 _ARC_REL_TOL = 0.001
+#: LinuxCNC refuses a centre-format arc whose start or end radius is below 0.00005 inch
+#: ("Zero-radius arc"; measured against LinuxCNC 2.9: 0.00126 mm refused, 0.00128 mm read).
+_ARC_MIN_RADIUS_MM = 0.00005 * 25.4
 
 TRAVERSE, FEED, ARC = 0, 1, 2
 
@@ -1136,8 +1139,12 @@ class Interpreter:
                 c2 = mc[a2] if names[1] in w else s2
             r0 = math.hypot(s1 - c1, s2 - c2)
             r1 = math.hypot(e1 - c1, e2 - c2)
+            if min(r0, r1) < _ARC_MIN_RADIUS_MM:
+                raise self.err(code, f"zero-radius arc: radius {min(r0, r1):.4g} mm is below "
+                               f"LinuxCNC's {_ARC_MIN_RADIUS_MM:g} mm (0.00005 inch)",
+                               "replace the arc by a G1 to its end point")
             err = abs(r1 - r0)
-            if r0 == 0 or r1 == 0 or err > 100 * tol or (err > tol
+            if err > 100 * tol or (err > tol
                                                           and err / max(r0, r1) > _ARC_REL_TOL):
                 raise self.err(code, f"radius to end of arc {r1:.4f} mm differs from radius "
                                f"to start {r0:.4f} mm (LinuxCNC's tolerance {tol:.4g} mm "
