@@ -146,6 +146,21 @@ def test_units_incremental_g53_g28():
     assert [m[2] for m in moves] == [(6, 0, 30), (1, 0, 30), (0, 0, 30)]
 
 
+def test_feed_is_read_in_the_units_of_its_f_word():
+    # LinuxCNC converts F when it is read (measured with its interpreter): a later G20/G21 keeps
+    # the physical feed, and on a "G20 ... F10" line F comes before the units switch (10 mm/min);
+    # woodcam scaled the F number by the units of each move (300 mm/min became 300 inch/min)
+    prog = read_gcode("G21 G90\nG0 X0 Y0 Z5\nG1 X10 F300\nG20\nG1 X1\nG1 X2 F40\nG21\n"
+                      "G1 X80\nG20 G1 X4 F10\nM2\n")
+    assert prog.feed_mm_min.tolist() == pytest.approx([0, 300, 300, 1016, 1016, 10])
+    assert prog.machining_time_s()[0][0] == pytest.approx(
+        60 * (10 / 300 + 15.4 / 300 + 25.4 / 1016 + 29.2 / 1016 + 21.6 / 10))
+    # grbl converts F with the units of its own line (gc_execute_line): 10 inch/min
+    grbl = read_gcode("G21 G90\nG0 X0 Y0 Z5\nG1 X10 F300\nG20\nG1 X1\nG20 G1 X4 F10\n",
+                      dialect="grbl")
+    assert grbl.feed_mm_min.tolist() == pytest.approx([0, 300, 300, 254])
+
+
 def test_arcs_r_form_turns_and_planes():
     moves, _ = Interpreter("G0 X0 Y0 Z0\nG2 X10 R5 F100\nG3 X0 R-5\n"
                            "G17 G91 G2 X10 Y0 I5 J0 P2\nG18 G90 G2 X20 Z0 I5 K0\n"

@@ -234,7 +234,9 @@ class Interpreter:
         self.plane = 17
         self.motion: float | None = 0.0 if dialect != "linuxcnc" else None
         self.retract_old_z = False  # LinuxCNC starts in G99 (retract to R)
-        self.feed = 0.0  # program units / min
+        # mm/min: LinuxCNC (and grbl) convert F when it is read, so a later G20/G21 keeps the
+        # physical feed (on a "G20 F10" line F is read first: 10 mm/min)
+        self.feed = 0.0
         self.spindle = 0.0
         self.spindle_on = False
         self.tool = 0
@@ -288,7 +290,7 @@ class Interpreter:
             self._t_warned.add(self.selected)
             self.warn(f"T{self.selected} was selected without M6: the cut goes on with the "
                       f"loaded tool T{self.tool}, as the controller does")
-        feed = self.feed * self.scale
+        feed = self.feed
         self.moves.append((kind, self.line_no, tuple(end), centre, rotation, self.plane, feed,
                            self.spindle if self.spindle_on else 0.0, self.tool))
         self.pos = list(end)
@@ -320,7 +322,7 @@ class Interpreter:
         prog = self.to_program(self.pos)
         return {"_x": prog[0], "_y": prog[1], "_z": prog[2], "_metric": float(not self.inch),
                 "_imperial": float(self.inch), "_absolute": float(not self.incremental),
-                "_incremental": float(self.incremental), "_feed": self.feed,
+                "_incremental": float(self.incremental), "_feed": self.feed / self.scale,
                 "_rpm": self.spindle, "_current_tool": float(self.tool),
                 "_selected_tool": float(self.selected), "_line": float(self.line_no),
                 "_coord_system": float(540 + 10 * (self.cs - 1))}.get(name, 0.0)
@@ -827,7 +829,7 @@ class Interpreter:
             if "f" in w:
                 if w["f"] < 0:
                     raise self.err(f"F{w['f']:g}", "negative feed rate", "give F >= 0")
-                self.feed = w["f"]
+                self.feed = w["f"] * self.scale
             self.cycle_il = None
             axis = [a for a in "xyz" if a in w]
             if axis:
@@ -872,7 +874,10 @@ class Interpreter:
         if "f" in w:
             if w["f"] < 0:
                 raise self.err(f"F{w['f']:g}", "negative feed rate", "give F >= 0")
-            self.feed = w["f"]
+            scale = self.scale
+            if self.dialect == "grbl" and g & {20.0, 21.0}:  # grbl reads F in its line's units
+                scale = MM_PER_INCH if 20.0 in g else 1.0
+            self.feed = w["f"] * scale
         if "s" in w:
             if w["s"] < 0:
                 raise self.err(f"S{w['s']:g}", "negative spindle speed", "give S >= 0")
