@@ -153,6 +153,34 @@ def test_grid_coarser_than_half_the_stepover_warns(tmp_path, monkeypatch, capsys
     assert "step-over" not in capsys.readouterr().err
 
 
+def _raster(step: float, levels: int, passes: int, length: float = 30.0) -> str:
+    """A zig-zag raster written as CAM posts do ("G1 Y..." then "G1 X..." per pass), cut in
+    ``levels`` stacked depth levels."""
+    text = ["G21 G90 G17 F1000", "G0 X0 Y0 Z5"]
+    for lev in range(1, levels + 1):
+        text.append(f"G1 X0 Y0 Z{-lev}")
+        for k in range(passes):
+            text += [f"G1 Y{k * step:.3f}", f"G1 X{length if k % 2 == 0 else 0}"]
+    return "\n".join(text + ["M2", ""])
+
+
+def test_stepover_of_stacked_levels_helices_and_crossings():
+    """The step-over read 0.05 mm for a 2.4 mm pocket in six depth levels (the stacked copies
+    filled the nearest neighbours), 0.15 mm for a helical bore and 0.1 mm for two crossing
+    slots, each with a warning to use a grid 4-16x finer; a raster written "G1 Y / G1 X" read
+    twice its step-over (the next pass is two source lines on)."""
+    pocket = read_gcode(_raster(2.4, 6, 17, 60)).stepover_mm(0.1)
+    assert pocket is None or pocket > 1  # wide passes are seldom among the nearest points
+    assert read_gcode(_raster(0.15, 3, 100)).stepover_mm(0.1) == pytest.approx(0.15)
+    assert read_gcode(_raster(0.15, 1, 100)).stepover_mm(0.1) == pytest.approx(0.15)
+    helix = "G21 G90 F500\nG0 X57 Y40 Z1\n" + "".join(
+        f"G3 X57 Y40 Z{-z} I-7 J0\n" for z in range(6)) + "M2\n"
+    assert read_gcode(helix).stepover_mm(0.1) is None
+    crossing = "G21 G90 F500\nG0 X-20 Y40 Z5\nG1 Z-5\nG1 X130\nG0 Z5\nG0 X50 Y-20\n" \
+        "G1 Z-5\nG1 Y100\nG0 Z5\nM2\n"
+    assert read_gcode(crossing).stepover_mm(0.1) is None
+
+
 def test_the_simulations_issues_reach_the_review_page_as_hotspots(tmp_path, capsys):
     """gcode printed its issues but stored none in the GLB, so the review page, which reads them
     from there, never showed a G-code hotspot."""

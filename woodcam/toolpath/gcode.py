@@ -109,8 +109,9 @@ class Program:
     def stepover_mm(self, spacing_mm: float = 0.1) -> float | None:
         """Typical distance (mm) between neighbouring passes of the feed moves: the median,
         over points every ``spacing_mm`` along the feeds, of the XY distance to the nearest
-        point of another pass (a source line more than 2 lines away, not stacked at the same
-        XY); ``None`` without such pairs.
+        point of another pass (not the same or the next source line, not stacked at the same
+        XY, beside the point rather than ahead of it); ``None`` when under a tenth of the points
+        have such a pass near them (a profile, a helix, crossing lines).
         Used to warn when the simulation grid is too coarse for the program (aliasing)."""
         from scipy.spatial import cKDTree
 
@@ -122,6 +123,17 @@ class Program:
         seg = np.repeat(np.arange(len(a)), n)
         t = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n) + 0.5) / n[seg]
         pts = a[seg] + t[:, None] * (b[seg] - a[seg])
+        # One point per half-spacing XY cell: passes stacked at the same XY (depth levels,
+        # repeated sweeps) otherwise fill the nearest neighbours with copies of the point
+        # itself, and the pass beside it is never among them (a 2.4 mm step-over pocket in six
+        # levels read as 0.05 mm)
+        if len(pts) < 4:
+            return None
+        cell = np.floor(pts[:, :2] / (0.5 * spacing_mm)).astype(np.int64)
+        cell -= cell.min(axis=0)
+        first = np.sort(np.unique(cell[:, 0] * (int(cell[:, 1].max()) + 1) + cell[:, 1],
+                                  return_index=True)[1])
+        seg, pts = seg[first], pts[first]
         lines = ln[seg]
         if len(pts) < 4:
             return None
@@ -141,11 +153,15 @@ class Program:
         dist, idx = cKDTree(xy).query(xy[q], k=k)
         rel = xy[np.minimum(idx, len(xy) - 1)] - xy[q][:, None, :]
         lateral = np.abs(rel[..., 0] * u[:, None, 1] - rel[..., 1] * u[:, None, 0])
-        other = (np.abs(lines[np.minimum(idx, len(xy) - 1)] - lines[q][:, None]) > 2) & \
-            np.isfinite(dist) & (lateral > 0.5 * spacing_mm)
+        along = np.abs(rel[..., 0] * u[:, None, 0] + rel[..., 1] * u[:, None, 1])
+        # beside, not ahead: the next turn of a helix or a line crossing the pass is no
+        # neighbouring pass (their points ahead read as 0.1-0.15 mm step-overs)
+        other = (np.abs(lines[np.minimum(idx, len(xy) - 1)] - lines[q][:, None]) > 1) & \
+            np.isfinite(dist) & (lateral > 0.5 * spacing_mm) & (along <= lateral)
         d = np.where(other, lateral, np.inf).min(axis=1)
         d = d[np.isfinite(d)]
-        return float(np.median(d)) if len(d) else None
+        # a pass beside under a tenth of the points: crossings, lead-ins, not a step-over
+        return float(np.median(d)) if len(d) >= 0.1 * len(q) else None
 
     def until_line(self, line: int) -> Program:
         """The moves of source lines ``<= line`` (the simulation scrubbed to that line)."""
