@@ -36,6 +36,31 @@ def test_tool_arguments():
         _tools_from_args(args, prog)
 
 
+def test_rapids_before_the_first_tool_change_need_no_tool(tmp_path, monkeypatch):
+    """Carbide Create starts every file with "G53G0Z-5.000" before "M6T1": the rapid ran as
+    T0, so "--tool flat:3.175" went to T0 and the run stopped with "the program uses tool 1 but
+    tools has [0]"; with two tools, T0 needed a --tool 0=SPEC of its own."""
+    from woodcam.toolpath import simulate
+
+    _stub_preview(monkeypatch, {})
+    text = "G90 G21\nG0 Z5\nM6 T1\nM3 S18000\nG0 X10 Y10\nG1 Z-1 F300\nG1 X50\nG0 Z5\n" \
+        "M6 T2\nG0 X10 Y30\nG1 Z-1\nG1 X50\nG0 Z5\nM2\n"
+    prog = read_gcode(text, start_mm=(0, 0, 10))
+    assert prog.tool.tolist()[0] == 0
+    base = ["p.nc", "--block", "b", "--out", "o.glb", "--tool", "flat:3.175"]
+    assert _tools_from_args(_parse(base + ["--tool", "ball:3"]), prog) == {
+        1: FlatEndMill(3.175), 2: BallEndMill(3)}
+    res = simulate(prog, {1: FlatEndMill(3.175), 2: BallEndMill(3)}, (100, 80, 50))
+    assert res.removed_volume_mm3 > 0
+    one = read_gcode(text.split("M6 T2")[0] + "M2\n", start_mm=(0, 0, 10))
+    assert _tools_from_args(_parse(base), one) == {1: FlatEndMill(3.175)}
+    path = tmp_path / "cc.nc"
+    path.write_text(text.split("M6 T2")[0] + "M2\n")
+    args = _parse([str(path), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+                   "--tool", "flat:3.175", "--cell-size", "0.5"])
+    assert args.func(args) == 0
+
+
 def test_run_simulates_and_hands_a_watertight_mesh_to_the_pipeline(tmp_path, monkeypatch,
                                                                    capsys):
     seen = {}

@@ -131,6 +131,10 @@ def _tools_from_args(args, program) -> dict:
             unnumbered.append(parse_tool_spec(item))
     if unnumbered:
         used = [t for t in dict.fromkeys(program.tool.tolist()) if t not in tools]
+        if len(used) > 1 and 0 in used and not (program.tool[program.kind == 1] == 0).any():
+            # T0 only rapids before the first M6 (Carbide Create's "G53 G0 Z-5", a G28): no tool
+            # of its own; simulate gives those rapids the first tool loaded
+            used.remove(0)
         if len(unnumbered) == 1 and len(used) <= 1:
             used = used or [0]
         if len(unnumbered) > len(used):
