@@ -189,6 +189,37 @@ def _raster(step: float, levels: int, passes: int, length: float = 30.0) -> str:
     return "\n".join(text + ["M2", ""])
 
 
+def test_the_simulation_shows_a_progress_bar_over_its_moves(tmp_path, monkeypatch):
+    """woodcam gcode ran simulate with progress=False (no bar on a 200,000-line raster), and
+    simulate's bar counted runs: a raster is one run, its bar stood at 0/1 to the end."""
+    import woodcam._progress
+
+    bars = []
+
+    class Bar:
+        def __init__(self, **kw):
+            self.kw, self.n = kw, 0
+            bars.append(self)
+
+        def update(self, k):
+            self.n += k
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(woodcam._progress, "progress_bar", lambda iterable=None, **kw: Bar(**kw))
+    _stub_preview(monkeypatch, {})
+    prog = tmp_path / "raster.nc"
+    prog.write_text("G0 X0 Y0 Z2 M3 S9000\nG1 Z-1 F600\n" + "".join(
+        f"G1 X{60 * (k % 2)} Y{k}\n" for k in range(40)) + "G0 Z2\nM2\n")
+    args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+                   "--tool", "flat:6", "--cell-size", "0.5"])
+    assert args.func(args) == 0
+    sim = [b for b in bars if b.kw.get("desc") == "simulate"]
+    assert len(sim) == 1 and sim[0].kw["enabled"] and sim[0].kw["unit"] == "move"
+    assert sim[0].n == sim[0].kw["total"] == 41
+
+
 def test_stepover_of_stacked_levels_helices_and_crossings():
     """The step-over read 0.05 mm for a 2.4 mm pocket in six depth levels (the stacked copies
     filled the nearest neighbours), 0.15 mm for a helical bore and 0.1 mm for two crossing

@@ -202,7 +202,7 @@ def run(args) -> int:
                   file=sys.stderr)
             n_warn += 1
         res = simulate(program, tools, stock.size_mm, resolution_mm=args.cell_size,
-                       work_offset_mm=offset, progress=False, initial_heightmap=hm,
+                       work_offset_mm=offset, progress=True, initial_heightmap=hm,
                        track_lines=bool(args.part))
         hm = res.heightmap
         for issue in res.report:

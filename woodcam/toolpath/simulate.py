@@ -311,12 +311,11 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
         brk[1:] = (tool_of[act][1:] != tool_of[act][:-1]) | rap[1:] | rap[:-1]
     runs = np.split(np.arange(len(act)), np.flatnonzero(brk))
     cells = 0
-    it = runs
-    if progress:
-        from .._progress import progress_bar
+    from .._progress import progress_bar
 
-        it = progress_bar(runs, desc="simulate", unit="run")
-    for run in it:
+    # over the moves, not the runs: a raster is one run, and its bar stood at 0/1 to the end
+    bar = progress_bar(desc="simulate", unit="move", total=len(act), enabled=progress)
+    for run in runs:
         if not len(run):
             continue
         idx_run = act[run]
@@ -336,6 +335,8 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
                                       i1[idx],
                                       j1[idx], int(wy[g[0]]), int(wx[g[0]]), dx, dy, kind[idx],
                                       lines[idx], issues)
+                bar.update(len(idx))
+    bar.close()
     n_active = len(act)
     np.clip(hm, 0.0, H, out=hm)
     wall = time.perf_counter() - t0
