@@ -205,6 +205,18 @@ def test_cycle_repeats_travel_at_the_retract_plane():
                     (20, 0, 2), (20, 0, -3), (20, 0, 2), (30, 0, 2), (30, 0, -3), (30, 0, 2)]
 
 
+def test_incremental_cycle_series_count_r_from_the_initial_level():
+    # "G91 G81 R-6 Z-5" from Z8, then "X5" lines: every hole has R at 8 - 6 = 2 and its bottom
+    # at -3; R was counted from the Z the last hole retracted to (G99: R), so the second hole
+    # went to -9, 6 mm too deep (LinuxCNC 2.9 drills all three to -3)
+    ends = _ends("G0 X0 Y0 Z8\nG99 G91 G81 R-6 Z-5 F100\nX5\nX5\nG90 G80\nM2\n")
+    assert min(e[2] for e in ends) == -3
+    assert ends[-3:] == [(10, 0, 2), (10, 0, -3), (10, 0, 2)]
+    # R and Z set in G90, the series continued in G91: R from the initial level too
+    ends = _ends("G0 X0 Y0 Z8\nG81 R2 Z-3 F100\nG91 X5\nG90 G80\nM2\n")
+    assert ends[-4:] == [(0, 0, 10), (5, 0, 10), (5, 0, 7), (5, 0, 10)]
+
+
 def test_g43_1_axis_words_are_the_offset_not_a_move():
     # "G43.1 Z-5" in G1 mode fed 4 mm deeper; in LinuxCNC its axis words are the dynamic tool
     # length offset (woodcam measures tools from the tip: nothing moves)

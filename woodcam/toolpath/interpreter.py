@@ -1193,7 +1193,10 @@ class Interpreter:
         if self.cycle_il is None:  # LinuxCNC's "initial level": Z where the cycles began
             self.cycle_il = cur_z
         if self.incremental:
-            r = cur_z + c["r"]
+            # R counts from the initial level of the series, not from where the last hole left
+            # the tool (LinuxCNC 2.9, measured: after a G99 retract to R the next "X5" line's R
+            # is not taken from R)
+            r = self.cycle_il + c["r"]
             bottom = r + c["z"]
         else:
             r, bottom = c["r"], c["z"]
