@@ -220,6 +220,21 @@ def test_the_simulation_shows_a_progress_bar_over_its_moves(tmp_path, monkeypatc
     assert sim[0].n == sim[0].kw["total"] == 41
 
 
+def test_a_refused_line_names_its_program(tmp_path, monkeypatch):
+    """With several programs of one job, "G-code line 5: 'G41': ..." did not say which."""
+    from woodcam.toolpath import GcodeError
+
+    _stub_preview(monkeypatch, {})
+    rough, finish = tmp_path / "rough.nc", tmp_path / "finish.nc"
+    rough.write_text("G0 X20 Y20 Z2 M3 S9000\nG1 Z-3 F600\nX40\nG0 Z2\nM2\n")
+    finish.write_text("G0 X20 Y20 Z2 M3 S9000\nG41 G1 Z-3 F600\nM2\n")
+    args = _parse([str(rough), str(finish), "--block", "builtin:flat-sawn", "--out",
+                   str(tmp_path / "o.glb"), "--tool", "flat:6", "--cell-size", "0.5"])
+    with pytest.raises(GcodeError, match=r"^finish\.nc: G-code line 2: 'G41': cutter radius") as e:
+        args.func(args)
+    assert e.value.line == 2
+
+
 def test_stepover_of_stacked_levels_helices_and_crossings():
     """The step-over read 0.05 mm for a 2.4 mm pocket in six depth levels (the stacked copies
     filled the nearest neighbours), 0.15 mm for a helical bore and 0.1 mm for two crossing

@@ -156,7 +156,7 @@ def run(args) -> int:
 
     from ..pipeline import check_outputs, preview_heightfield
     from ..stock import open_stock, resize_stock
-    from ..toolpath.gcode import read_gcode
+    from ..toolpath.gcode import GcodeError, read_gcode
     from ..toolpath.simulate import simulate
 
     if args.until_line is not None and args.until_line < 1:
@@ -180,8 +180,11 @@ def run(args) -> int:
     for k, path in enumerate(args.program):
         hm_before = hm
         t0 = time.perf_counter()
-        program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
-                             interpreter=args.interpreter)
+        try:
+            program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
+                                 interpreter=args.interpreter)
+        except GcodeError as err:  # which of the programs: "G-code line 5" alone does not say
+            raise GcodeError(err.line, err.word, err.rule, err.fix, source=path.name) from None
         t_read = time.perf_counter() - t0
         full = program  # the whole last program, for the window's slider
         if args.until_line is not None and k == len(args.program) - 1:

@@ -91,11 +91,13 @@ MAX_EXPR_DEPTH = 100
 class GcodeError(WoodcamError):
     """A G-code line that woodcam refuses; ``line`` is the 1-based source line."""
 
-    def __init__(self, line: int, word: str, rule: str, fix: str):
-        super().__init__(f"G-code line {line}: {word!r}: {rule}; {fix}")
+    def __init__(self, line: int, word: str, rule: str, fix: str, source: str | None = None):
+        where = f"{source}: G-code line" if source else "G-code line"
+        super().__init__(f"{where} {line}: {word!r}: {rule}; {fix}")
         self.line = line
         self.word = word
         self.rule = rule
+        self.fix = fix
 
 
 # ------------------------------------------------------------------------------------------
