@@ -40,3 +40,48 @@ def gran1():
         pytest.skip("shared/data/trees (the CT-measured spruce log) is not available; "
                     "set WOODCAM_SHARED_DATA")
     return read_gran1(base / "trees")
+
+
+class RecordedBar:
+    """A stand-in for a tqdm bar: what :func:`woodcam._progress.progress_bar` was asked to draw
+    (``desc``, ``total``, the descriptions it showed) and how far it went (``n``)."""
+
+    def __init__(self, iterable=None, *, desc, unit, enabled=True, **kwargs):
+        self.iterable, self.desc, self.unit = iterable, desc, unit
+        self.total = kwargs.get("total", len(iterable) if hasattr(iterable, "__len__") else None)
+        self.n, self.shown, self.closed, self.disable = 0, [desc], False, False
+
+    def __iter__(self):
+        for x in self.iterable:
+            yield x
+            self.n += 1
+
+    def update(self, k=1):
+        self.n += k
+
+    def set_description_str(self, desc, refresh=True):
+        self.shown.append(desc)
+
+    def set_postfix(self, refresh=True, **values):
+        pass
+
+    def refresh(self):
+        pass
+
+    def close(self):
+        self.closed = True
+
+
+@pytest.fixture
+def bars(monkeypatch) -> list[RecordedBar]:
+    """Every progress bar the package makes in the test, recorded (:class:`RecordedBar`)."""
+    import woodcam._progress
+
+    made: list[RecordedBar] = []
+
+    def record(iterable=None, **kwargs):
+        made.append(RecordedBar(iterable, **kwargs))
+        return made[-1]
+
+    monkeypatch.setattr(woodcam._progress, "progress_bar", record)
+    return made

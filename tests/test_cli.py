@@ -14,8 +14,14 @@ from woodcam.export import read_glb_metadata
 REPO = __import__("pathlib").Path(__file__).resolve().parents[1]
 
 
-def test_demo_quick_writes_every_output(tmp_path, capsys):
+def test_demo_quick_writes_every_output(tmp_path, capsys, bars):
     assert main(["demo", "--out", str(tmp_path), "--quick"]) == 0
+    # sweep h5 item 7: 20 s with no bar; now one over the parts and one of each part's stages
+    demo = [b for b in bars if b.desc == "demo"]
+    assert len(demo) == 1 and demo[0].total == demo[0].n == 4 and demo[0].closed
+    for part in ("bowl", "tray", "lid"):
+        own = [b for b in bars if b.desc == part]
+        assert len(own) == 1 and own[0].total == own[0].n == 6 and own[0].closed  # render too
     out = capsys.readouterr().out
     for part in ("bowl", "tray", "lid"):
         for suffix in (".glb", ".obj", ".mtl", "_texture.png", "_view.png"):
@@ -116,3 +122,18 @@ def test_a_part_sticking_out_is_said_in_the_report_files(tmp_path, capsys):
     said = json.loads((tmp_path / "b_report.json").read_text())["warnings"]
     assert any(w.startswith("part sticks out of the block") for w in said)
     assert "warning: part sticks out of the block" in (tmp_path / "b_report.txt").read_text()
+
+
+def test_bake_draws_one_stage_bar_over_the_whole_run(tmp_path, bars, capsys):
+    """Sweep h5 item 7: 20 s of bake drew nothing (only the rasterise chunks had a bar, each
+    shorter than its 2 s delay); opening the block (a fit: minutes) had none either."""
+    box = trimesh.creation.box((20, 20, 20))
+    box.apply_translation((50, 40, 25))
+    box.export(tmp_path / "box.stl")
+    assert main(["bake", str(tmp_path / "box.stl"), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "b.glb"),
+                 "--no-obj", "--texels-per-mm", "1", "--screenshot"]) == 0
+    stage = [b for b in bars if b.unit == "stage"]
+    assert len(stage) == 1 and stage[0].desc == "bake b"
+    plan = ["open block", "load", "carve", "bake", "report", "export", "render"]
+    assert stage[0].total == len(plan) and stage[0].n == len(plan) and stage[0].closed
+    assert [d.split(": ")[-1] for d in stage[0].shown[1:-1]] == plan

@@ -141,7 +141,7 @@ def test_gcode_in_inches_cuts_what_the_mm_run_cuts(tmp_path, monkeypatch, capsys
     assert removed_in3 == pytest.approx(removed_mm3 / 25.4 ** 3, rel=1e-3)
 
 
-def test_place_in_inches_ranks_what_the_mm_run_ranks_and_prints_inches(tmp_path, capsys):
+def test_place_in_inches_ranks_what_the_mm_run_ranks_and_prints_inches(tmp_path, capsys, bars):
     """End to end: the same placements, their JSON in mm, the printed --place in inches."""
     import json
 
@@ -153,6 +153,11 @@ def test_place_in_inches_ranks_what_the_mm_run_ranks_and_prints_inches(tmp_path,
     assert main([*common, "--units", "inch", "--block", "builtin:knotty:4x3x2", "--margin",
                  "0.05", "--out", str(tmp_path / "in")]) == 0
     out_inch = capsys.readouterr().out
+    # sweep h5 item 7: a bar over the whole run (opening the block, loading the part: seconds)
+    (run,) = [b for b in bars if b.desc == "place"]
+    assert run.total == run.n == 4 and run.closed
+    assert [d.split(": ")[-1] for d in run.shown[1:-1]] == ["open block", "load part", "score placements",
+                                                            "render"]
     assert main([*common, "--block", "builtin:knotty:101.6x76.2x50.8", "--margin", "1.27",
                  "--out", str(tmp_path / "mm")]) == 0
     out_mm = capsys.readouterr().out

@@ -13,7 +13,9 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator, Sequence
+from contextlib import contextmanager
+import time
 from typing import Any
 
 #: Seconds before a bar is drawn: the brief's "progress bars on anything over ~2 s".
@@ -36,6 +38,55 @@ def write(line: str) -> None:
     from tqdm.auto import tqdm
 
     tqdm.write(line)
+
+
+class StageBar:
+    """A bar of one step per stage, for work that is not a loop (a bake: open the block, load
+    the part, carve, bake, export...): its description names the stage running now.
+
+    ``stages`` is the plan, in order (its length is the bar's total); :meth:`stage` wraps each
+    as it runs. Drawn like
+    :func:`progress_bar` (after :data:`PROGRESS_DELAY_S`, on a terminal only), but a timer draws
+    it once the delay has passed even in the middle of a stage: tqdm draws a delayed bar only at
+    its next step, and one stage (a fit, a neural training) can last minutes.
+    """
+
+    def __init__(self, stages: Sequence[str], *, desc: str, enabled: bool = True, **kwargs: Any):
+        self.stages = list(stages)
+        self.desc = desc
+        self._delay = kwargs.setdefault("delay", PROGRESS_DELAY_S)
+        self._t0 = time.monotonic()
+        self.bar = progress_bar(total=len(self.stages), desc=desc, unit="stage", enabled=enabled,
+                                **kwargs)
+        self._timer = None
+        if not self.bar.disable:
+            import threading
+
+            self._timer = threading.Timer(self._delay, self.bar.refresh)
+            self._timer.daemon = True
+            self._timer.start()
+
+    @contextmanager
+    def stage(self, name: str) -> Iterator[None]:
+        """Run one stage of the plan: named in the bar while it runs, one step when it ends."""
+        # redrawn at once only where the bar is drawn already (past the delay)
+        self.bar.set_description_str(f"{self.desc}: {name}",
+                                     refresh=time.monotonic() - self._t0 >= self._delay)
+        yield
+        self.bar.update(1)
+
+    def close(self) -> None:
+        """Stop the timer and close the bar (left on screen when drawn, as tqdm's are)."""
+        if self._timer is not None:
+            self._timer.cancel()
+        self.bar.set_description_str(self.desc, refresh=False)
+        self.bar.close()
+
+    def __enter__(self) -> StageBar:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 __all__: list[str] = []

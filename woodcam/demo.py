@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ._atomic import atomic_path
+from ._progress import StageBar
 from .errors import WoodcamError
 from .pipeline import PartPreview, preview_part
 from .stock import open_stock
@@ -68,17 +69,22 @@ def run_demo(out_dir, *, quick: bool = False, texels_per_mm: float | None = None
     tpm = texels_per_mm or (4.0 if quick else 10.0)
     report = DemoReport()
     t0 = time.perf_counter()
-    for script, spec in DEMO_PARTS:
-        params = dict(appearance_params)
-        if appearance == "neural":
-            params.setdefault("quality", "draft" if quick else "normal")
-            params["progress"] = progress
-        stock = open_stock(spec, appearance=appearance, species=species, **params)
-        res = preview_part(examples_dir() / script, stock, out / f"{Path(script).stem}.glb",
-                           texels_per_mm=tpm, obj=obj, progress=progress)
-        res.meta_block = spec
-        report.parts.append(res)
-    report.overview = render_overview(report.parts, out / "demo.png")
+    names = [Path(script).stem for script, _ in DEMO_PARTS]
+    # a bar over the parts, each part's own bar of its stages under it
+    with StageBar([*names, "overview"], desc="demo", enabled=progress) as bar:
+        for name, (script, spec) in zip(names, DEMO_PARTS):
+            with bar.stage(name):
+                params = dict(appearance_params)
+                if appearance == "neural":
+                    params.setdefault("quality", "draft" if quick else "normal")
+                    params["progress"] = progress
+                stock = open_stock(spec, appearance=appearance, species=species, **params)
+                res = preview_part(examples_dir() / script, stock, out / f"{name}.glb",
+                                   texels_per_mm=tpm, obj=obj, progress=progress)
+            res.meta_block = spec
+            report.parts.append(res)
+        with bar.stage("overview"):
+            report.overview = render_overview(report.parts, out / "demo.png")
     report.total_s = time.perf_counter() - t0
     return report
 

@@ -52,6 +52,8 @@ class PartPreview:
     #: what :func:`woodcam.view.stockview.stock_view` and the top view draw; None otherwise
     texture: object = None
     charts: object = None
+    #: the :class:`woodcam._progress.StageBar` each :meth:`stage` advances (None: no bar)
+    stages: object = field(default=None, repr=False, compare=False)
 
     def chart_texels(self, name: str) -> np.ndarray:
         """The ``(h, w, 3) uint8`` texels of chart ``name`` ("top": the stock seen from +Z, row
@@ -61,9 +63,19 @@ class PartPreview:
 
     @contextmanager
     def stage(self, name: str) -> Iterator[None]:
+        """Time stage ``name`` into :attr:`timings_s` (and run it as a step of :attr:`stages`)."""
         t0 = time.perf_counter()
-        yield
+        if self.stages is None:
+            yield
+        else:
+            with self.stages.stage(name):
+                yield
         self.timings_s[name] = self.timings_s.get(name, 0.0) + time.perf_counter() - t0
+
+
+def part_stages(screenshot: bool) -> list[str]:
+    """The stages :func:`preview_part` runs, in order (:attr:`PartPreview.stages`' plan)."""
+    return ["load", "carve", "bake", "report", "export"] + (["render"] if screenshot else [])
 
 
 def screenshot_path(screenshot: bool | str | Path | None, beside: Path) -> Path | None:
@@ -103,39 +115,51 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
                  obj_up: str = "y", max_triangles: int | None = None,
                  max_atlas_px: int = 4096, place: list[str] | tuple = (),
-                 timeout_s: float | None = None) -> PartPreview:
+                 timeout_s: float | None = None, stages=None) -> PartPreview:
     """Carve ``source`` (anything :func:`woodcam.cad.load_part` takes) out of ``stock``, bake it
     and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``).
 
     ``place`` lists placement operations applied to the loaded part before carving
     (:mod:`woodcam.cad.place`, e.g. ``["rotate:x:90", "center", "drop"]``); the resulting
     4 x 4 matrix is recorded in the GLB metadata as ``placement``. A ``.py`` source is trusted
-    code run with your rights; ``timeout_s`` bounds its loading."""
+    code run with your rights; ``timeout_s`` bounds its loading.
+
+    ``progress`` draws a bar of its stages (:func:`part_stages`) on a terminal, or advances
+    ``stages`` (a :class:`woodcam._progress.StageBar` whose plan holds them) when given."""
     from .cad import carve, load_part
     from .tolerances import MAX_PART_TRIANGLES
 
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)  # before minutes of work
-    result = PartPreview(out_glb.stem)
-    with result.stage("load"):
-        part = load_part(source, tolerance_mm=tolerance_mm, texels_per_mm=texels_per_mm,
-                         timeout_s=timeout_s,
-                         max_triangles=max_triangles or MAX_PART_TRIANGLES,
-                         report=result.tessellation)
-    result.warnings += list(result.tessellation.get("notes", []))
-    metadata = None
-    if place:
-        from .cad.place import place_part
+    result = PartPreview(out_glb.stem, stages=stages)
+    if progress and stages is None:  # a bar of its own
+        from ._progress import StageBar
 
-        part, matrix = place_part(part, list(place), stock.size_mm)
-        metadata = {"placement": {"ops": list(place), "matrix": matrix.tolist()}}
-    with result.stage("carve"):
-        carved = carve(part, stock.size_mm)
-    result.warnings += list(carved.warnings)
-    return preview_mesh(carved.mesh, stock, out_glb, texels_per_mm=texels_per_mm, obj=obj,
-                        part_report=True,
-                        screenshot=screenshot, progress=progress, result=result,
-                        obj_units=obj_units, obj_up=obj_up, max_atlas_px=max_atlas_px,
-                        metadata=metadata)
+        result.stages = StageBar(part_stages(screenshot), desc=out_glb.stem, leave=False)
+    try:
+        with result.stage("load"):
+            part = load_part(source, tolerance_mm=tolerance_mm, texels_per_mm=texels_per_mm,
+                             timeout_s=timeout_s,
+                             max_triangles=max_triangles or MAX_PART_TRIANGLES,
+                             report=result.tessellation)
+        result.warnings += list(result.tessellation.get("notes", []))
+        metadata = None
+        if place:
+            from .cad.place import place_part
+
+            part, matrix = place_part(part, list(place), stock.size_mm)
+            metadata = {"placement": {"ops": list(place), "matrix": matrix.tolist()}}
+        with result.stage("carve"):
+            carved = carve(part, stock.size_mm)
+        result.warnings += list(carved.warnings)
+        return preview_mesh(carved.mesh, stock, out_glb, texels_per_mm=texels_per_mm, obj=obj,
+                            part_report=True,
+                            screenshot=screenshot, progress=progress, result=result,
+                            obj_units=obj_units, obj_up=obj_up, max_atlas_px=max_atlas_px,
+                            metadata=metadata)
+    finally:
+        if stages is None and result.stages is not None:
+            result.stages.close()
+            result.stages = None
 
 
 def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: float = 10.0, obj: bool = True,

@@ -288,7 +288,7 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
         counts[rec["status"]] += 1
         bar.update(1)
         if counts["failed"]:
-            bar.set_postfix(failed=counts["failed"])
+            bar.set_postfix(failed=counts["failed"], refresh=False)
 
     t0 = time.perf_counter()
     n_workers = 0

@@ -91,10 +91,13 @@ def test_leave_one_face_out_runs_all_models(tmp_path):
         assert im.size[0] >= 4 * res[0].photo.shape[1]
 
 
-def test_leave_one_face_out_on_ring_maps_without_a_field():
+def test_leave_one_face_out_on_ring_maps_without_a_field(bars):
     block, _ = _tiny_eval_block()
     res = leave_one_face_out(block, None, resolution=40, quality="draft", epochs=1, faces=["left"],
-                             progress=False)
+                             progress=True)
+    # sweep h5 item 7: a bar over the held-out faces (each trains up to three nets)
+    (faces,) = [b for b in bars if b.unit == "face"]
+    assert faces.total == faces.n == 1
     assert res[0].end_grain is None and set(res[0].predictions) == set(MODELS)
     _assert_predictions_resemble_the_photo(res[0])
 

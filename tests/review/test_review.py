@@ -286,11 +286,14 @@ def test_review_errors_are_clear(page, tmp_path):
         write_review(glb, tmp_path / "r.txt", wood=stock.wood, size_mm=stock.size_mm)
 
 
-def test_the_cli_writes_the_page_from_the_glbs_own_block(page, tmp_path, capsys):
+def test_the_cli_writes_the_page_from_the_glbs_own_block(page, tmp_path, capsys, bars):
     from woodcam.cli import main
 
     _, glb, _, _ = page
     assert main(["review", str(glb), "--out", str(tmp_path / "r.html"), "--voxels", "20000"]) == 0
+    # sweep h5 item 7: 10 s of colour volumes at --voxels 3e6 with no bar
+    (volumes,) = [b for b in bars if b.unit == "volume"]
+    assert volumes.total == volumes.n == 3
     assert "wrote" in capsys.readouterr().out and (tmp_path / "r.html").stat().st_size > 1e5
     assert Path(tmp_path / "r.html").read_text().count("data:image/png;base64,") == 3
 

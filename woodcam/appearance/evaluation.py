@@ -213,8 +213,12 @@ def leave_one_face_out(block, field=None, *, resolution: int = 128, quality: Qua
                                           desc=f"eval: train on {'+'.join(key[0])}", threads=threads)
         return nets[key]
 
+    from .._progress import progress_bar
+
     out = []
-    for f in (faces or usable):
+    # a bar over the held-out faces: each trains up to three nets, whose own bars come and go
+    for f in progress_bar(list(faces or usable), desc=f"eval {block.name}: held-out faces", unit="face",
+                          enabled=progress):
         x, photo, _ = pairs[f]
         rest = [g for g in usable if g != f]
         same = [g for g in rest if FACE_AXIS[g] == FACE_AXIS[f]]

@@ -324,5 +324,5 @@ def train_translation(pairs, spec: TranslationSpec | None = None, *, progress: b
         if s >= spec.steps - max(1, spec.steps // 10):
             tail.append(float(l1.detach()))
         if progress and s % 20 == 0:
-            bar.set_postfix(l1=f"{float(l1.detach()):.3f}")
+            bar.set_postfix(l1=f"{float(l1.detach()):.3f}", refresh=False)
     return TranslationNet(net, spec, c_in, time.perf_counter() - t0, float(np.mean(tail)))

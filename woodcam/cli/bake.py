@@ -108,15 +108,25 @@ def run_bake(args: argparse.Namespace) -> int:
     from ..stock import open_stock
     from . import print_warnings
 
+    from .._progress import StageBar
+    from ..pipeline import part_stages
+
     check_outputs(args.out, obj=not args.no_obj, screenshot=getattr(args, "screenshot", None) or False)
     apply_workers(args)
-    stock = open_stock(args.block, **stock_options(args))
-    res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
-                       tolerance_mm=args.tolerance, timeout_s=args.timeout, obj=not args.no_obj, screenshot=False,
-                       progress=True, obj_units=args.obj_units, obj_up=args.obj_up,
-                       max_triangles=args.max_triangles, max_atlas_px=args.max_atlas,
-                       place=args.place)
-    write_screenshot(args, res.files, stock)
+    shot = bool(getattr(args, "screenshot", None))
+    # one bar for the whole run: opening the block can fit its rings (minutes, once)
+    with StageBar(["open block", *part_stages(False), *(["render"] if shot else [])],
+                  desc=f"bake {Path(args.out).stem}", leave=False) as bar:
+        with bar.stage("open block"):
+            stock = open_stock(args.block, **stock_options(args))
+        res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
+                           tolerance_mm=args.tolerance, timeout_s=args.timeout, obj=not args.no_obj,
+                           screenshot=False, progress=True, obj_units=args.obj_units, obj_up=args.obj_up,
+                           max_triangles=args.max_triangles, max_atlas_px=args.max_atlas,
+                           place=args.place, stages=bar)
+        if shot:
+            with bar.stage("render"):
+                write_screenshot(args, res.files, stock)
     print_warnings(res.warnings)
     tess = res.tessellation
     mesh_note = ""

@@ -40,21 +40,32 @@ def run_place(args: argparse.Namespace) -> int:
     import json
 
     from .._atomic import check_output_path, write_bytes
+    from .._progress import StageBar
+    from ..cad import load_part
     from ..advise import advise_placement, render_advice
     from ..stock import open_stock
 
     out = Path(args.out)
     check_output_path(out / "placements.json", suffixes=(".json",), what="--out", mkdir=True)
-    stock = open_stock(args.block)
-    advice = advise_placement(args.part, stock, rotations=args.rotations,
-                              candidates=args.candidates, margin_mm=args.margin, progress=True)
-    k = 1 / MM_PER_UNIT[args.units]
+    # one bar over the run, the orientations' and panels' own under it; the part is loaded
+    # once for the search and the picture (a .py part runs its CAD: seconds)
+    with StageBar(["open block", "load part", "score placements", "render"], desc="place",
+                  leave=False) as bar:
+        with bar.stage("open block"):
+            stock = open_stock(args.block)
+        with bar.stage("load part"):
+            part = load_part(args.part)
+        with bar.stage("score placements"):
+            advice = advise_placement(part, stock, rotations=args.rotations,
+                                      candidates=args.candidates, margin_mm=args.margin, progress=True)
+        k = 1 / MM_PER_UNIT[args.units]
+        record = {"block": args.block, "part": str(args.part), "candidates": advice.candidates,
+                  "weights": advice.weights, "elongation": advice.elongation,
+                  "ranked": [{"ops": p.ops, "score": p.score, **p.terms,
+                              "matrix": p.matrix.tolist()} for p in advice.ranked[:max(args.top, 10)]]}
+        write_bytes(out / "placements.json", json.dumps(record, indent=1).encode())
+        with bar.stage("render"):
+            png = render_advice(advice, part, stock, out / "placements.png", top=args.top, progress=True)
     print(advice.table(args.top, op_text=str if k == 1 else (lambda op: place_op_in(op, k))))
-    record = {"block": args.block, "part": str(args.part), "candidates": advice.candidates,
-              "weights": advice.weights, "elongation": advice.elongation,
-              "ranked": [{"ops": p.ops, "score": p.score, **p.terms,
-                          "matrix": p.matrix.tolist()} for p in advice.ranked[:max(args.top, 10)]]}
-    write_bytes(out / "placements.json", json.dumps(record, indent=1).encode())
-    png = render_advice(advice, args.part, stock, out / "placements.png", top=args.top, progress=True)
     print(f"scored {advice.candidates} placements; wrote {png} and {out / 'placements.json'}")
     return 0

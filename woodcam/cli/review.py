@@ -61,6 +61,6 @@ def run_review(args: argparse.Namespace) -> int:
                   if getattr(f, "photo", None) is not None}
     out = write_review(args.part, args.out, wood=stock.wood, size_mm=stock.size_mm,
                        report=report, photos=photos, hotspots=hotspots,
-                       voxels=args.voxels or VOLUME_VOXELS)
+                       voxels=args.voxels or VOLUME_VOXELS, progress=True)
     print(f"wrote {out} ({out.stat().st_size / 2**20:.1f} MiB)")
     return 0

@@ -225,7 +225,7 @@ def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, 
         loss_avg = v if loss_avg is None else 0.98 * loss_avg + 0.02 * v
         if step % spec.log_every == 0:
             rows.append({"step": step, "loss": v, "loss_avg": loss_avg, "seconds": time.perf_counter() - t0})
-            bar.set_postfix(loss=f"{loss_avg:.4f}")
+            bar.set_postfix(loss=f"{loss_avg:.4f}", refresh=False)
         if time.perf_counter() - t0 > spec.max_train_s:
             break
     train_s = time.perf_counter() - t0

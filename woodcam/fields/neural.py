@@ -436,7 +436,7 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
         if step % spec.log_every == 0 or step == total:
             log.append((step, float(l1.detach()), elapsed))
             if bar is not None:
-                bar.set_postfix(l1=f"{log[-1][1]:.4f}")
+                bar.set_postfix(l1=f"{log[-1][1]:.4f}", refresh=False)
         if bar is not None:
             bar.update(1)
         if step % spec.checkpoint_every == 0 or step == total:

@@ -96,7 +96,8 @@ def _photo_urls(photos: dict | None) -> dict:
 
 def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
                  report: dict | None = None, photos: dict | None = None,
-                 hotspots: list[dict] | None = None, voxels: int = VOLUME_VOXELS) -> Path:
+                 hotspots: list[dict] | None = None, voxels: int = VOLUME_VOXELS,
+                 progress: bool = False) -> Path:
     """Write the review page of a baked part.
 
     Parameters
@@ -119,6 +120,8 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
         ``{"kind": "knot" | "gcode", "label": str, "at_mm": [x, y, z]}``, block frame.
     voxels : int
         Voxels per colour volume (see :data:`VOLUME_VOXELS`).
+    progress : bool
+        A bar over the three colour volumes (seconds each at a few million voxels).
     """
     from .._atomic import check_output_path, write_bytes
 
@@ -137,8 +140,10 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
         raise WoodcamError(f"review: voxels must be an integer in [{lo}, {hi:g}]; got {voxels!r}")
     size = [float(v) for v in size_mm]
     cell = volume_cell_mm(size, voxels)
+    from .._progress import progress_bar
+
     volumes = {}
-    for axis in "xyz":
+    for axis in progress_bar("xyz", desc="review: colour volumes", unit="volume", enabled=progress):
         vol = colour_volume(wood, size, axis, cell)
         png, tiles = _tiled_png(vol)
         volumes[axis] = {"png": png, "tiles": tiles, "shape": [vol.shape[2], vol.shape[1], vol.shape[0]]}
