@@ -136,3 +136,13 @@ def test_a_species_that_changes_nothing_is_named(shared_data, tmp_path, monkeypa
         open_stock(str(shared_data / "mokume" / "H11"), species="walnut")
     said = [str(w.message) for w in caught]
     assert any("--species walnut: block 'H11' has photos along all three axes" in m for m in said), said
+
+
+def test_a_turn_given_to_a_command_that_reads_the_block_is_named():
+    """Sweep h5 item 10: 'builtin:flat-sawn~z90' in block show / eval appearance said "unknown
+    built-in block 'flat-sawn~z90'"; the turn is for the commands that carve a part."""
+    from woodcam.stock import open_block
+
+    with pytest.raises(WoodcamError, match=r"a turn \('~z90'\) is for the commands that carve a part from "
+                       r"the block \(bake, gcode, place, review\); .* give 'builtin:flat-sawn'"):
+        open_block("builtin:flat-sawn~z90")
