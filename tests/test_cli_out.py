@@ -119,3 +119,18 @@ def test_a_refusal_by_the_system_is_one_line_not_a_traceback(monkeypatch, capsys
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["woodcam: error: No space left on device (out/bowl.glb); check the path, its permissions "
                    "and the free space"]
+
+
+FILE_COMMANDS = [c for c in COMMANDS if c[1].get_default("_out_suffixes")]
+
+
+@pytest.mark.parametrize("path,p", FILE_COMMANDS, ids=[" ".join(c[0]) for c in FILE_COMMANDS])
+def test_a_file_in_a_folder_that_cannot_be_written_is_refused_before_work(path, p, capsys):
+    """Sweep h5 item 8: ``block show --out /proc/k.png`` did the work, then failed naming its
+    temporary file ('/proc/.k.png.13252-6nk58k2c.tmp.png')."""
+    out = "/proc/self/k" + p.get_default("_out_suffixes")[0]  # read-only even for root
+    capsys.readouterr()
+    assert main(_argv(path, p, out)) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"woodcam: error: --out of 'woodcam {' '.join(path)}': the folder '/proc/self' is not "
+                   "writable (No such file or directory); choose an output folder you can write to"], err

@@ -184,7 +184,10 @@ def atomic_path(path, *, fsync: bool = True, mkdir: bool = False) -> Iterator[Pa
     path = Path(path)
     if mkdir:
         path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = _temp_in(path)
+    try:
+        tmp = _temp_in(path)
+    except OSError as err:  # it named the temporary file (/proc/.k.png.13252-6nk58k2c.tmp.png)
+        raise OSError(err.errno, err.strerror, str(path)) from err
     try:
         yield tmp
         if not tmp.exists():

@@ -243,3 +243,10 @@ def test_a_figure_that_fails_half_way_leaves_the_old_picture(tmp_path):
         write_figure(HalfFigure(), target, dpi=100)
     assert target.read_bytes() == b"old" and _leftovers(tmp_path) == []
     assert write_figure(Figure(), tmp_path / "plot.svg", dpi=72).read_bytes() == b"svg 72"
+
+
+def test_a_refused_write_names_the_file_asked_for_not_its_temporary():
+    """Sweep h5 item 8: the error named '/proc/.k.png.13252-6nk58k2c.tmp.png'."""
+    with pytest.raises(OSError) as err, atomic_path("/proc/self/k.png"):
+        pass
+    assert err.value.filename == "/proc/self/k.png"

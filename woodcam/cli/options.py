@@ -92,6 +92,10 @@ def check_out(args: argparse.Namespace) -> None:
         if suffix not in suffixes:
             raise UsageError(f"--out of 'woodcam {command}' must end in {' or '.join(suffixes)}; "
                              f"got {str(out)!r}; give e.g. {str(out.with_suffix(suffixes[0]))!r}")
+        if out.parent.is_dir():  # a real write probe: as root os.access() says yes even to /proc
+            from .._atomic import check_output_path
+
+            check_output_path(out, what=f"--out of 'woodcam {command}'")
     elif suffix in FILE_SUFFIXES or out.is_file():
         what = "an existing file" if out.is_file() else f"a file name ({suffix})"
         raise UsageError(f"--out of 'woodcam {command}' is a FOLDER (it writes several files); "
