@@ -1,5 +1,6 @@
 """The woodcam command end to end: demo, bake, preview, and clean one-line errors."""
 
+import re
 import subprocess
 import sys
 
@@ -122,6 +123,11 @@ def test_a_part_sticking_out_is_said_in_the_report_files(tmp_path, capsys):
     said = json.loads((tmp_path / "b_report.json").read_text())["warnings"]
     assert any(w.startswith("part sticks out of the block") for w in said)
     assert "warning: part sticks out of the block" in (tmp_path / "b_report.txt").read_text()
+    # sweep h5 item 9: the review page had block, spec, species and texels only
+    assert main(["review", str(tmp_path / "b.glb"), "--out", str(tmp_path / "b.html"), "--voxels", "1000"]) == 0
+    page = (tmp_path / "b.html").read_text()
+    assert "<th>warning 1</th><td>part sticks out of the block" in page
+    assert re.search(r"<th>part</th><td>\d+ mm\^3, yield [\d.]+ % of the block", page)
 
 
 def test_bake_draws_one_stage_bar_over_the_whole_run(tmp_path, bars, capsys):

@@ -307,6 +307,17 @@ def report_text(report: dict, name: str, units: Units = "mm") -> str:
     return "\n".join(lines)
 
 
+def report_rows(report: dict, units: Units = "mm") -> dict[str, str]:
+    """:func:`report_text`'s lines as label -> text rows (the review page's table): "part",
+    one per region, then "warning 1", "warning 2", ..."""
+    first, *rest = report_text(report, "", units).splitlines()
+    rows = {"part": first.removeprefix(": ")}
+    for r, line in zip(report["regions"], rest):
+        rows[r["region"]] = line.strip().removeprefix(r["region"]).strip()
+    rows.update({f"warning {i}": w for i, w in enumerate(report["warnings"], 1)})
+    return rows
+
+
 def knot_spots(mesh, wood, *, samples: int = 20000, link_mm: float = 2.0, seed: int = 0) -> list[dict]:
     """Where knots come through the surface of ``mesh`` (block frame, mm): one entry per
     connected patch of knot wood, ``{"kind": "knot", "label": str, "at_mm": [x, y, z]}`` (the

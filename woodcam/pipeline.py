@@ -311,6 +311,8 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
                            "params": stock.meta.get("appearance_params", {})},
             **(metadata or {}),
             "texels_per_mm": float(baked.texels_per_mm)}
+    if result.report:  # the review page shows it (volume, yield, "part sticks out", ...)
+        meta["report"] = result.report
     from ._atomic import all_or_nothing
 
     with result.stage("export"), all_or_nothing():  # GLB + OBJ + MTL + PNG appear as one set

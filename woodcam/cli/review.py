@@ -43,6 +43,10 @@ def run_review(args: argparse.Namespace) -> int:
         raise WoodcamError(f"review: {str(args.part)!r} records no block spec; pass --block SPEC")
     spec = stock.spec
     report = {"block spec": spec, "species": stock.meta.get("species", "")}
+    if isinstance(meta.get("report"), dict):  # the bake's part report (volume, yield, warnings)
+        from ..advise import report_rows
+
+        report.update(report_rows(meta["report"], units=args.units))
     for key in ("texels_per_mm", "gcode", "placement"):
         if key in meta:
             report[key] = meta[key]
