@@ -79,3 +79,17 @@ def test_woodcam_species_lists_every_preset_with_its_source(capsys):
     walnut = next(line for line in lines if line.startswith("black-walnut "))
     assert "earlywood #ad7c63 latewood #442112" in walnut  # ISCC-NBS light / dark brown
     assert "Wood Handbook" in walnut
+
+
+@pytest.mark.parametrize("argv", [["bake", "p.stl", "--block", "builtin:flat-sawn", "--out", "x.glb"],
+                                  ["log", "render", "--real", "--out", "d"]])
+def test_an_unknown_species_is_a_usage_error(argv, capsys):
+    """Sweep h5 item 13: --species teak was refused by the library after parsing, with exit 1."""
+    from woodcam.cli import main
+    from woodcam.cli.options import CITED_SPECIES, LEGACY_SPECIES
+
+    assert set(CITED_SPECIES + LEGACY_SPECIES) == set(SPECIES)  # the CLI's list is the library's
+    with pytest.raises(SystemExit) as code:
+        main([*argv, "--species", "teak"])
+    assert code.value.code == 2
+    assert "argument --species: 'teak' is not a colour preset; choose one of red-oak" in capsys.readouterr().err

@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import SPECIES_HELP, add_knot_options, add_out_option, knot_shading
+from .options import SPECIES_HELP, add_knot_options, add_out_option, knot_shading, species_type
 
 
 def register(subparsers) -> None:
@@ -49,7 +49,7 @@ def register(subparsers) -> None:
     r.add_argument("--k-knot", type=float, default=5.0,
                    help="the same inside knots, in (0, 1000]; high: a crisp knot edge (default 5)")
     add_knot_options(r)
-    r.add_argument("--species", default="spruce",
+    r.add_argument("--species", default="spruce", type=species_type,
                    help=SPECIES_HELP + " (default spruce, the real log's)")
     r.add_argument("--outline-mm", type=float, default=1.0,
                    help="dead-knot outline thickness (mm)")

@@ -31,10 +31,22 @@ from ..units import MM_PER_UNIT
 
 #: The --species presets (woodcam.appearance.SPECIES, listed here so that --help imports no
 #: numba; tests/appearance/test_species.py checks the two agree). README: "Species presets".
-SPECIES_HELP = ("colour preset: cited (README 'Species presets'): red-oak, white-oak, black-walnut, "
-                "black-cherry, white-ash, sassafras, black-willow, buckeye, ponderosa-pine, "
-                "western-larch, douglas-fir, engelmann-spruce; legacy, uncited: oak, maple, "
-                "walnut, cherry, pine, spruce")
+CITED_SPECIES = ("red-oak", "white-oak", "black-walnut", "black-cherry", "white-ash", "sassafras",
+                 "black-willow", "buckeye", "ponderosa-pine", "western-larch", "douglas-fir",
+                 "engelmann-spruce")
+LEGACY_SPECIES = ("oak", "maple", "walnut", "cherry", "pine", "spruce")
+SPECIES_HELP = (f"colour preset: cited (README 'Species presets'): {', '.join(CITED_SPECIES)}; "
+                f"legacy, uncited: {', '.join(LEGACY_SPECIES)}")
+
+
+def species_type(text: str) -> str:
+    """argparse ``type`` of ``--species``: a preset name, else a usage error (exit 2; the
+    library's refusal came after parsing, with exit 1)."""
+    if text not in CITED_SPECIES + LEGACY_SPECIES:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a colour preset; choose one of "
+                                         f"{', '.join(CITED_SPECIES + LEGACY_SPECIES)} ('woodcam species' "
+                                         "lists their colours)")
+    return text
 
 #: The block argument of the commands that read a block (fit, eval, block show); those that
 #: carve from it (bake, gcode, place, review) may also turn it: :data:`BLOCK_SPEC_HELP`.
@@ -364,7 +376,7 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                    + (f"{texels_default:g} = {1 / texels_default:g} mm texels)" if texels_default
                       else "10, or 4 with --quick)"))
     if species:
-        p.add_argument("--species", default=None,
+        p.add_argument("--species", default=None, type=species_type,
                        help=SPECIES_HELP + " (default: the block's)")
     p.add_argument("--appearance", choices=("colormap", "neural"), default="colormap",
                    help="colormap: fast colour-of-ring model (default); neural: colour volumes "

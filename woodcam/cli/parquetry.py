@@ -12,7 +12,7 @@ import warnings
 from pathlib import Path
 
 from ..errors import WoodcamWarning
-from .options import SPECIES_HELP, add_out_option, add_units_option, parse_sizes
+from .options import SPECIES_HELP, add_out_option, add_units_option, parse_sizes, species_type
 
 _EPILOG = """\
 veneer sources (any number, mixed):
@@ -70,7 +70,7 @@ def register(subparsers) -> None:
                    help="normal of the slicing planes in the block frame (default y: leaves "
                    "parallel to the front face)")
     add_units_option(v, "parquetry")
-    v.add_argument("--species", default=None,
+    v.add_argument("--species", default=None, type=species_type,
                    help=SPECIES_HELP + " (default: the block's own)")
     t = p.add_argument_group("parameters (seed 002, Table 1)")
     t.add_argument("--w-intens", type=float, default=None, help="intensity weight of eq. 1, in [0, 1] (default 0.5)")
