@@ -93,7 +93,10 @@ def test_eval_without_truth_scores_faces_held_out(tmp_path, capsys):
     write_block(block, folder)
     out = tmp_path / "ev"
     assert main(["eval", str(folder), "--methods", "radial", "--out", str(out)]) == 0  # old form
-    assert "no true field; scoring each face predicted from the others" in capsys.readouterr().out
+    said = capsys.readouterr().out
+    assert "no true field; scoring each face predicted from the others" in said
+    # sweep h5 item 13: it printed the pattern '<block>_holdout.md and <block>_<method>.png'
+    assert f"wrote {out / 'eq79_holdout.md'}, {out / 'eq79_radial.png'}" in said and "<block>" not in said
     table = (out / "eq79_holdout.md").read_text()
     assert "radial ridge ≤ 2 px" in table and "mean, held out" in table
     assert (out / "eq79_radial.png").exists()

@@ -131,7 +131,10 @@ def run_eval(args) -> int:
             res = leave_one_face_out(fit_on, methods, out_dir=args.out, progress=print, reference=ref,
                                      seed=args.seed)
             print(res["table"])
-        print(f"wrote {Path(args.out)}/<block>_holdout.md and <block>_<method>.png")
+            # the files' own names (it printed the pattern '<block>_holdout.md and <block>_<method>.png')
+            out = Path(args.out)
+            print("wrote " + ", ".join(str(out / f"{fit_on.name}_{kind}")
+                                       for kind in ["holdout.md", *(f"{m}.png" for m in methods)]))
     return 0
 
 
