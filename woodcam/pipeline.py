@@ -19,6 +19,8 @@ from .stock import Stock
 if TYPE_CHECKING:
     import numpy as np
 
+    from ._progress import StageBar
+
 
 @dataclass
 class PartPreview:
@@ -53,7 +55,7 @@ class PartPreview:
     texture: object = None
     charts: object = None
     #: the :class:`woodcam._progress.StageBar` each :meth:`stage` advances (None: no bar)
-    stages: object = field(default=None, repr=False, compare=False)
+    stages: StageBar | None = field(default=None, repr=False, compare=False)
 
     def chart_texels(self, name: str) -> np.ndarray:
         """The ``(h, w, 3) uint8`` texels of chart ``name`` ("top": the stock seen from +Z, row
@@ -115,7 +117,7 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
                  obj_up: str = "y", max_triangles: int | None = None,
                  max_atlas_px: int = 4096, place: list[str] | tuple = (),
-                 timeout_s: float | None = None, stages=None) -> PartPreview:
+                 timeout_s: float | None = None, stages: StageBar | None = None) -> PartPreview:
     """Carve ``source`` (anything :func:`woodcam.cad.load_part` takes) out of ``stock``, bake it
     and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``).
 
