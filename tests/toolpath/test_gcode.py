@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from woodcam.errors import WoodcamError
 from woodcam.toolpath import GcodeError, read_gcode
 from woodcam.toolpath.gcode import DEFAULT_START_MM, FEED, RAPID
 
@@ -170,13 +171,59 @@ def test_cut_before_known_position_warns_with_line():
 def test_fanuc_program_number_g28_and_g53():
     prog = read_gcode("O1001\nG0 X10 Y10 Z5\nG1 Z-1 F100\nG91 G28 Z2\nG90\n"
                       "G53 G0 Z7\nG0 X20 Y10\nG1 Z-1\nM30\n", dialect="fanuc",
-                      start_mm=(0, 0, 40))
+                      start_mm=(0, 0, 40), machine_zero_mm=(0, 0, 0))
     # G28 Z2 (incremental): rapid up 2 mm to the intermediate point, then Z to the home, which
-    # woodcam keeps at the start position; G53 moves in machine coordinates (= G54 here)
+    # woodcam keeps at the start position; G53 moves in machine coordinates (= G54 here: the
+    # machine zero given at G-code zero)
     np.testing.assert_allclose(prog.end_mm, [[10, 10, 5], [10, 10, -1], [10, 10, 1],
                                              [10, 10, 40], [10, 10, 7], [20, 10, 7],
                                              [20, 10, -1]])
     assert prog.line.tolist() == [2, 3, 4, 4, 6, 7, 8]
+
+
+#: Carbide Create (Shapeoko) begins and ends with "G53G0Z-5.000": 5 mm below the machine's Z
+#: home, near the top of Z travel; the stock's top is G-code Z0.
+CARBIDE = ("G90\nG21\nG53G0Z-5.000\nM6T1\nM03S18000\nG0X10.000Y10.000\nG0Z5.000\n"
+           "G1Z-1.000F254.0\nG1X50.000F1016.0\nG0Z5.000\nG53G0Z-5.000\nM02\n")
+
+
+def test_g53_retract_without_the_machine_zero_is_a_retract_and_is_warned():
+    from woodcam.toolpath import FlatEndMill, simulate
+
+    # machine zero taken at G-code zero, the retract rapided 5 mm into the stock (twice) and
+    # every Carbide Create file reported rapid_through_stock
+    prog = read_gcode(CARBIDE, start_mm=(0, 0, 10))
+    res = simulate(prog, {1: FlatEndMill(3.175)}, (100, 80, 50), resolution_mm=0.5)
+    assert [i.kind for i in res.report] == []
+    assert prog.end_mm[prog.line == 11].tolist() == [[50, 10, 10]]  # up to the --start height
+    assert prog.end_mm[:, 2].min() == -1
+    g53 = [w for w in prog.warnings if "G53" in w]
+    assert len(g53) == 1 and g53[0].startswith("line 3:") and "line(s) 3, 11:" in g53[0]
+    assert "retract to Z10 mm" in g53[0] and "--machine-zero" in g53[0]
+    # a retract never plunges: from above the start height the tool stays where it is; X/Y
+    # cannot be placed without the machine zero: kept at G-code X/Y, warned apart
+    prog = read_gcode("G0 X1 Y1 Z30\nG53 G0 Z-5\nG1 Z-1 F100\nG53 G0 Z0 X0\nM2\n",
+                      start_mm=(0, 0, 10))
+    assert prog.end_mm.tolist() == [[1, 1, 30], [1, 1, -1], [0, 1, 10]]
+    assert [w.split(":")[0] for w in prog.warnings] == ["line 2", "line 4"]
+    assert "line(s) 2, 4:" in prog.warnings[0] and "line(s) 4:" in prog.warnings[1]
+    assert "X/Y" in prog.warnings[1]
+
+
+def test_machine_zero_places_g53_as_linuxcnc_does():
+    # LinuxCNC: machine = work + G54 offset, the offset being the work zero in machine
+    # coordinates; the machine zero lies at -offset in the work frame. With the work zero 80 mm
+    # below the Z home, G53 Z-5 is work Z75, G53 X7 work X17; "G10 L2 P1 X5" puts the work zero
+    # at machine X5, i.e. G-code frame X15 (checked against LinuxCNC in the oracle test)
+    prog = read_gcode(CARBIDE, start_mm=(0, 0, 10), machine_zero_mm=(0, 0, 80))
+    assert prog.end_mm[prog.line == 11].tolist() == [[50, 10, 75]]
+    assert prog.end_mm[0].tolist() == [0, 0, 75] and prog.warnings == []
+    prog = read_gcode("G0 X1 Y2 Z3\nG53 G0 X7 Z-5\nG10 L2 P1 X5\nG0 X1\nG28\nG1 Z0 F9\nM2\n",
+                      start_mm=(4, 5, 10), machine_zero_mm=(10, 20, 80))
+    np.testing.assert_allclose(prog.end_mm, [[1, 2, 3], [17, 2, 75], [16, 2, 75], [4, 5, 10],
+                                             [4, 5, 0]], atol=1e-12)
+    with pytest.raises(WoodcamError, match="machine_zero_mm must be three finite numbers"):
+        read_gcode(CARBIDE, machine_zero_mm=(0, 80))
 
 
 CORPUS = sorted((Path(__file__).resolve().parents[2] / "toolpaths" / "corpus").glob("*.*[!y]"))

@@ -125,6 +125,30 @@ def test_interpreter_option_linuxcnc_gives_the_same_program():
         read_gcode("G0 X1\nG1 A3 F100\nM2\n", interpreter="linuxcnc")
 
 
+def test_machine_zero_agrees_with_linuxcnc_g54_offset(tmp_path):
+    """A machine zero M in the G-code frame is LinuxCNC with the G54 offset -M (the work zero in
+    machine coordinates), moves shifted back by M: G53 moves, G10 L2 offsets, G28 homes and arcs
+    in two planes agree; M = 0 is the machine frame of the other tests."""
+    text = ("G21 G90\nG0 X1 Y2 Z3\nG2 X5 Y2 I2 J0 F100\nG53 G0 Z-5 X7\nG28\nG10 L2 P1 X5\n"
+            "G0 X1 Z0\nG18 G3 X3 Z0 I1 K0\nG53 G0 Y3\nG20 G53 G0 X1\nG21 G0 Y1\nM2\n")
+    p = tmp_path / "g53.ngc"
+    p.write_text(text)
+    for mzero in ((0, 0, 0), (10, 20, 80), (-3.5, 7, -40)):
+        theirs = run_batch([p], start_mm=START, machine_zero_mm=mzero)[0]
+        assert theirs["error"] is None
+        mine, warnings = Interpreter(text, start_mm=START, machine_zero_mm=mzero).run()
+        assert compare_canonical(canonical(mine, START), canonical(theirs["moves"], START),
+                                 TOL_MM) is None, mzero
+        assert not warnings
+    assert [m[2] for m in theirs["moves"] if m[1] == 4][-1] == pytest.approx((3.5, 2, -45))
+    # not known: LinuxCNC has no such state; --interpreter linuxcnc runs it at G-code zero and
+    # says which lines that touches
+    prog = read_gcode(text, interpreter="linuxcnc")
+    assert prog.end_mm[prog.line == 4][-1].tolist() == pytest.approx([7, 2, -5])
+    assert len(prog.warnings) == 1 and "line(s) 4, 9, 10:" in prog.warnings[0]
+    assert read_gcode(text, interpreter="linuxcnc", machine_zero_mm=(0, 0, 0)).warnings == []
+
+
 def test_linuxcnc_preview_stale_position_after_m6(tmp_path):
     """A known difference, not a woodcam error: after a tool change (a synch point) LinuxCNC's
     ``gcode`` preview module resumes from the end of the last straight move, forgetting arcs

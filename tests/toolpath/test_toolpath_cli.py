@@ -9,7 +9,7 @@ import pytest
 import woodcam.pipeline
 from woodcam.errors import WoodcamError
 from woodcam.toolpath import BallEndMill, FlatEndMill, read_gcode
-from woodcam.cli import build_parser
+from woodcam.cli import build_parser, main
 from woodcam.cli.gcode import _tools_from_args
 
 REPO = Path(__file__).resolve().parents[2]
@@ -121,6 +121,30 @@ def _stub_preview(monkeypatch, seen):
         return woodcam.pipeline.PartPreview("x", files={"glb": Path(out_glb)}, triangles=1)
 
     monkeypatch.setattr(woodcam.pipeline, "preview_heightfield", fake_preview)
+
+
+def test_machine_zero_option_places_carbide_create_retracts(tmp_path, monkeypatch, capsys):
+    """Carbide Create's "G53G0Z-5.000" went 5 mm into the stock (machine zero taken at G-code
+    zero): rapid_through_stock on every such file. Without --machine-zero it is a retract to the
+    --start height, warned with its lines; --machine-zero (in --units) places it."""
+    _stub_preview(monkeypatch, {})
+    path = tmp_path / "cc.nc"
+    path.write_text("G90\nG21\nG53G0Z-5.000\nM6T1\nM03S18000\nG0X10.000Y10.000\nG0Z5.000\n"
+                    "G1Z-1.000F254.0\nG1X50.000F1016.0\nG0Z5.000\nG53G0Z-5.000\nM02\n")
+    base = [str(path), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+            "--tool", "flat:3.175", "--cell-size", "0.5"]
+    assert main(["gcode", *base]) == 0
+    err = capsys.readouterr().err
+    assert "rapid_through_stock" not in err
+    assert "cc.nc line 3: G53 (machine coordinates) on line(s) 3, 11:" in err
+    assert main(["gcode", *base, "--strict"]) == 3  # the assumption is a warning
+    capsys.readouterr()
+    inch = [str(path), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+            "--tool", "flat:0.125", "--cell-size", "0.02", "--units", "inch"]
+    assert main(["gcode", *inch, "--strict", "--machine-zero", "0,0,3"]) == 0  # Z home 76.2 mm up
+    assert "warning" not in capsys.readouterr().err
+    assert main(["gcode", *base, "--machine-zero", "0,0,1e9"]) == 2
+    assert "--machine-zero must be in [-100000, 100000]" in capsys.readouterr().err
 
 
 def test_programs_in_sequence_until_line_stock_and_strict(tmp_path, monkeypatch, capsys):

@@ -65,6 +65,15 @@ def register(subparsers) -> None:
     p.add_argument("--start", default=None, metavar="X,Y,Z", type=vector_type("--start"),
                    help="machine position (G-code frame, in --units) before the first move, also the "
                    "G28/G30 home (default 0,0,10: 10 mm over the work zero)")
+    p.add_argument("--machine-zero", default=None, metavar="X,Y,Z",
+                   type=vector_type("--machine-zero", example="0,0,80"),
+                   help="where the machine's own origin (G53 coordinates) lies in the G-code "
+                   "frame (the frame of --start), in --units: LinuxCNC's G54 offset negated, "
+                   "e.g. 0,0,80 when the work zero is 80 mm below the machine's Z home, so "
+                   "'G53 G0 Z-5' goes to Z75. Default: not known; a G53 Z move (the posts' "
+                   "'G53 G0 Z-5' retract) is then taken as a retract to the --start height "
+                   "and G53 X/Y as if machine zero were G-code zero, each with a warning "
+                   "naming the lines")
     p.add_argument("--dialect", choices=("linuxcnc", "grbl", "fanuc"), default="linuxcnc",
                    help="whose meaning the program has (default linuxcnc): grbl has no "
                    "parameters or O-words; fanuc reads O1234 program numbers")
@@ -182,7 +191,8 @@ def run(args) -> int:
         t0 = time.perf_counter()
         try:
             program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
-                                 interpreter=args.interpreter)
+                                 interpreter=args.interpreter,
+                                 machine_zero_mm=args.machine_zero)
         except GcodeError as err:  # which of the programs: "G-code line 5" alone does not say
             raise GcodeError(err.line, err.word, err.rule, err.fix, source=path.name) from None
         t_read = time.perf_counter() - t0

@@ -136,6 +136,7 @@ LENGTH_OPTIONS: dict[tuple[str, str], str] = {
     ("review", "block"): "spec",
     ("gcode", "block"): "spec", ("gcode", "cell_size"): "number",
     ("gcode", "work_offset"): "vector", ("gcode", "start"): "vector",
+    ("gcode", "machine_zero"): "vector",
     ("gcode", "stock"): "vector", ("gcode", "stock_origin"): "vector",
     ("gcode", "rapid_rate"): "number", ("gcode", "mesh_tol"): "number",
     ("gcode", "tool"): "tools",
@@ -601,6 +602,7 @@ RANGES: dict = {
     ("gcode", "rapid_rate"): (0.1, 1e6, False),  # mm/min
     ("gcode", "start"): (-1e5, 1e5, False),      # mm, work coordinates
     ("gcode", "work_offset"): (-1e5, 1e5, False),
+    ("gcode", "machine_zero"): (-1e5, 1e5, False),  # mm, G-code frame
     # woodify: --growth 1e20 divided by zero deep in the rasteriser; --crack-years 0 became 1
     ("woodify", "growth"): (0.0, 10_000.0, True),       # mm (woodcam.limits.MAX_BLOCK_SIZE_MM)
     ("woodify", "years"): (0.0, 10_000.0, True),        # the oldest trees are ~5000 years old

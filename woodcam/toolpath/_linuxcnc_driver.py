@@ -3,11 +3,14 @@ the one its AXIS preview uses) on G-code files and prints canonical moves as JSO
 
 Run by :mod:`woodcam.toolpath.linuxcnc` with Debian's ``/usr/bin/python3`` (the module is built
 for it, not for woodcam's virtualenv); never imported by woodcam. Input (stdin, JSON):
-``{"files": [path, ...], "start_mm": [x, y, z], "timeout_s": t}``; output (stdout, JSON): one
+``{"files": [path, ...], "start_mm": [x, y, z], "timeout_s": t, "machine_zero_mm": [x, y, z]}``
+(the last optional, default zero); output (stdout, JSON): one
 ``{"moves": [...], "error": null | [line, message], "result": code}`` per file, moves as
 woodcam's canonical tuples ``[kind, line, [x, y, z], [c1, c2] | null, rotation, plane]`` in the
 machine frame, mm, tool tip (LinuxCNC's canon reports program coordinates before the G5x/G92
-offsets and without the tool length offset; they are added back here as AXIS does).
+offsets and without the tool length offset; they are added back here as AXIS does), shifted by
+``machine_zero_mm``: the G54 offset is ``-machine_zero_mm``, so the moves come out in the G54
+frame the start position is given in (as woodcam's interpreter does).
 """
 
 import ctypes
@@ -59,6 +62,7 @@ class _Canon:
         self.g92 = [0.0] * 3
         self.tlo = [0.0] * 3
         self.rot = 0.0
+        self.mzero = [0.0] * 3  # the output shift: machine origin in the G54 frame, mm
 
     def __getattr__(self, name):  # every other canon call has no effect on the moves
         if name.startswith("__"):
@@ -102,7 +106,8 @@ class _Canon:
         self.plane = plane
 
     def _mach(self, p):
-        return [v * MM + a + b + t for v, a, b, t in zip(p, self.g5x, self.g92, self.tlo)]
+        return [v * MM + a + b + t + m
+                for v, a, b, t, m in zip(p, self.g5x, self.g92, self.tlo, self.mzero)]
 
     def straight_traverse(self, x, y, z, *rest):
         self.moves.append([0, self.line, self._mach((x, y, z)), None, 0, 17])
@@ -115,7 +120,7 @@ class _Canon:
         end = [0.0] * 3
         end[a1], end[a2], end[an] = e1, e2, en
         end = self._mach(end)
-        off = [a + b + t for a, b, t in zip(self.g5x, self.g92, self.tlo)]
+        off = [a + b + t + m for a, b, t, m in zip(self.g5x, self.g92, self.tlo, self.mzero)]
         centre = [c1 * MM + off[a1], c2 * MM + off[a2]]
         self.moves.append([2, self.line, end, centre, int(rot), _PLANE[self.plane]])
 
@@ -146,15 +151,20 @@ def _run(job, work, result_fd):
         f.write("[RS274NGC]\nPARAMETER_FILE = sim.var\n[TRAJ]\nLINEAR_UNITS = mm\n"
                 "SPINDLES = 1\n")
     os.environ["INI_FILE_NAME"] = ini
-    sx, sy, sz = job["start_mm"]
+    mzero = [float(v) for v in job.get("machine_zero_mm") or (0.0, 0.0, 0.0)]
+    # the start in machine coordinates: G54 frame minus the machine origin's place in it
+    sx, sy, sz = (v - m for v, m in zip(job["start_mm"], mzero))
     out = []
     for path in job["files"]:
         with open(var, "w") as f:  # G28/G30 homes at the start position, as woodcam does
             for base in (5161, 5181):  # (the parameter file holds inches)
                 for i, v in enumerate((sx, sy, sz)):
                     f.write(f"{base + i}\t{v / MM:.15f}\n")
-            f.write("5220\t1.000000\n")
+            f.write("5220\t1.000000\n")  # (LinuxCNC reads the numbers in increasing order)
+            for i, m in enumerate(mzero):  # G54 offset: the G54 origin in machine coordinates
+                f.write(f"{5221 + i}\t{-m / MM:.15f}\n")
         canon = _Canon(var, time.time() + job.get("timeout_s", 10.0))
+        canon.mzero = mzero
         init = ["G21", "G90", f"G53 G0 X{sx:.12f} Y{sy:.12f} Z{sz:.12f}"]
         t0, c0 = time.perf_counter(), time.process_time()
         try:

@@ -201,7 +201,7 @@ def _names_a_file(text: str) -> bool:
 
 def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_TOL_MM,
                start_mm: ArrayLike | None = None, dialect: str = "linuxcnc",
-               interpreter: str = "woodcam") -> Program:
+               interpreter: str = "woodcam", machine_zero_mm: ArrayLike | None = None) -> Program:
     """Read G-code text or a file path into a :class:`Program` of straight moves (mm).
 
     Parameters
@@ -218,6 +218,11 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
         Which controller's meaning the program has (:mod:`woodcam.toolpath.interpreter`).
     interpreter : "woodcam" | "linuxcnc"
         ``"linuxcnc"`` runs LinuxCNC's own interpreter (needs Debian's ``linuxcnc-uspace``).
+    machine_zero_mm : (3,) float | None
+        Where the machine's origin (``G53``) lies in the G-code (G54) frame of ``start_mm``, mm:
+        LinuxCNC's G54 offset negated. ``None``: not known; a ``G53`` Z move is then taken as a
+        retract to the start height and a warning names those lines
+        (:mod:`woodcam.toolpath.interpreter`). ``(0, 0, 0)`` is LinuxCNC with every offset zero.
 
     Raises
     ------
@@ -245,12 +250,21 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
     if start.shape != (3,) or not np.all(np.isfinite(start)):
         raise WoodcamError(f"read_gcode: start_mm must be three finite numbers (mm), got "
                            f"{start_mm!r}; e.g. (0, 0, 10)")
+    mzero = None
+    if machine_zero_mm is not None:
+        mzero = np.asarray(machine_zero_mm, float).reshape(-1)
+        if mzero.shape != (3,) or not np.all(np.isfinite(mzero)):
+            raise WoodcamError(f"read_gcode: machine_zero_mm must be three finite numbers (mm) "
+                               f"or None, got {machine_zero_mm!r}; e.g. (0, 0, 80)")
+        mzero = tuple(mzero.tolist())
     if interpreter == "linuxcnc":
         from .linuxcnc import run_linuxcnc
 
-        moves, warnings = run_linuxcnc(text, start_mm=tuple(start.tolist()))
+        moves, warnings = run_linuxcnc(text, start_mm=tuple(start.tolist()),
+                                       machine_zero_mm=mzero)
     elif interpreter == "woodcam":
-        moves, warnings = Interpreter(text, dialect=dialect, start_mm=start.tolist()).run()
+        moves, warnings = Interpreter(text, dialect=dialect, start_mm=start.tolist(),
+                                      machine_zero_mm=mzero).run()
     else:
         raise WoodcamError(f"read_gcode: interpreter must be 'woodcam' or 'linuxcnc', got "
                            f"{interpreter!r}")

@@ -33,8 +33,17 @@ or O-words (they are errors there), needs no ``M2``. ``fanuc`` reads ``O1234`` p
 lines and allows ``G80`` beside a motion code (Fanuc keeps canned cycles in their own group, as
 in the ``G00 G80 G40 G49`` safety line); LinuxCNC 2.9 also accepts that line.
 
-Output: canonical moves in the machine (``G53``) frame, millimetres, tool tip; with all offsets
-at their defaults (zero) the machine frame is the G54 work frame. A canonical move is
+Output: canonical moves in the G-code frame, millimetres, tool tip: the G54 work frame as the
+machine has it before the program runs (the frame of ``start_mm``). Where the machine's own
+origin (``G53``) lies in it is ``machine_zero_mm``: the default ``(0, 0, 0)`` is LinuxCNC with
+every offset zero (the machine frame is the G54 frame; the oracle's setting); a given point
+``M`` is LinuxCNC with the G54 offset ``-M`` (LinuxCNC keeps the G54 origin's position in
+machine coordinates, so the machine origin lies at ``-offset`` in G54), the machine frame
+shifted by ``M`` on output; ``None`` (not known) reads a ``G53`` Z move as a retract to the
+start height (``start_mm`` Z, or the tool's Z if higher; posts write ``G53 G0 Z-5`` or ``G53
+G0 Z0`` for "near the top of Z travel", which in machine coordinates is no place in the work
+frame) and a ``G53`` X/Y with machine zero at G-code zero, each warned once with its lines.
+A canonical move is
 ``(kind, line, end (3,), centre (2,) | None, rotation, plane, feed_mm_min, spindle_rpm, tool)``:
 ``kind`` 0 = traverse, 1 = feed, 2 = arc (``centre`` in the plane's first/second axes,
 ``rotation`` = +/-turns, + counter-clockwise, as LinuxCNC's ``ARC_FEED``).
@@ -152,6 +161,23 @@ _PLANES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}  # (first, second, norma
 _CENTRE = {17: "ij", 18: "ki", 19: "jk"}
 
 
+def _shifted(move, d):
+    """A canonical move moved by ``d`` (3,) mm: its end and, for an arc, its centre (which holds
+    the plane's first and second axes)."""
+    kind, line, end, centre, rot, plane, *rest = move
+    end = tuple(e + o for e, o in zip(end, d))
+    if centre is not None:
+        a1, a2, _ = _PLANES[plane]
+        centre = (centre[0] + d[a1], centre[1] + d[a2])
+    return (kind, line, end, centre, rot, plane, *rest)
+
+
+def _line_list(lines: list[int], most: int = 12) -> str:
+    """``[7, 17, 30]`` -> ``"7, 17, 30"``; beyond ``most`` lines, ``"... (40 lines)"``."""
+    text = ", ".join(map(str, lines[:most]))
+    return text + (f", ... ({len(lines)} lines)" if len(lines) > most else "")
+
+
 def _cs_base(n: int) -> int:
     """First parameter of coordinate system ``n`` (1 = G54 ... 9 = G59.3): 5221 + 20 (n-1)."""
     return 5221 + 20 * (n - 1)
@@ -209,18 +235,24 @@ class Interpreter:
 
     def __init__(self, text: str, *, dialect: Dialect = "linuxcnc", start_mm=(0.0, 0.0, 0.0),
                  params: dict[int, float] | None = None, max_blocks: int = MAX_BLOCKS,
-                 max_moves: int = MAX_MOVES):
+                 max_moves: int = MAX_MOVES, machine_zero_mm=(0.0, 0.0, 0.0)):
         if dialect not in DIALECTS:
             raise WoodcamError(f"dialect must be one of {DIALECTS}, got {dialect!r}")
         self.dialect = dialect
         self.max_blocks, self.max_moves = int(max_blocks), int(max_moves)
         self.src = text.splitlines()
-        self.pos = [float(v) for v in start_mm]  # machine frame, mm
+        # machine origin in the G-code frame (mm), None: not known (module docstring)
+        self.mzero = None if machine_zero_mm is None else [float(v) for v in machine_zero_mm]
+        shift = self.mzero or [0.0, 0.0, 0.0]
+        self.start_z = float(start_mm[2])  # the retract height of an unplaced G53 Z
+        self.pos = [float(v) - m for v, m in zip(start_mm, shift)]  # machine frame, mm
         self.p: dict[int, float] = {}
         for k in range(5161, 5164):
             self.p[k] = self.pos[k - 5161]
         for k in range(5181, 5184):
             self.p[k] = self.pos[k - 5181]
+        for i in range(3):  # G54 offset: the G-code zero in machine coordinates
+            self.p[5221 + i] = -shift[i]
         self.p[5220] = 1.0
         if params:
             self.p.update({int(k): float(v) for k, v in params.items()})
@@ -252,6 +284,7 @@ class Interpreter:
         self.known = [False, False, False]
         self._warned_start = False
         self._t_warned: set[int] = set()
+        self._g53_unplaced: dict[str, list[int]] = {"z": [], "xy": []}  # lines, machine zero unknown
         self.line_no = 0
 
     # -- helpers ----------------------------------------------------------------------------
@@ -285,9 +318,9 @@ class Interpreter:
         if kind != TRAVERSE and not self._warned_start and not all(self.known):
             self._warned_start = True
             miss = "".join(a for a, k in zip("XYZ", self.known) if not k).upper()
+            x, y, z = (v + m for v, m in zip(self.pos, self.mzero or (0, 0, 0)))  # G-code frame
             self.warn(f"the first cut starts before the program set {miss}: it starts from "
-                      f"the start position X{self.pos[0]:g} Y{self.pos[1]:g} Z{self.pos[2]:g} "
-                      "mm (--start)")
+                      f"the start position X{x:g} Y{y:g} Z{z:g} mm (--start)")
         if kind != TRAVERSE and self.selected != self.tool and self.selected not in self._t_warned:
             self._t_warned.add(self.selected)
             self.warn(f"T{self.selected} was selected without M6: the cut goes on with the "
@@ -715,7 +748,24 @@ class Interpreter:
             if self.dialect == "linuxcnc":
                 self.warn("the file ends without M2, M30 or '%' (LinuxCNC stops here with "
                           "'File ended with no percent sign or program end')")
+        self._warn_g53_unplaced()
+        if self.mzero and any(self.mzero):
+            self.moves = [_shifted(m, self.mzero) for m in self.moves]
         return self.moves, self.warnings
+
+    def _warn_g53_unplaced(self):
+        """One warning per kind of G53 move placed without the machine zero, naming its lines."""
+        fix = ("give where the machine zero lies in the G-code frame (--machine-zero X,Y,Z) to "
+               "place them")
+        for key, what in (("z", f"without the machine zero each G53 Z was taken as a retract "
+                                f"to Z{self.start_z:g} mm (the --start height, or the tool's Z "
+                                "if higher)"),
+                          ("xy", "without the machine zero their X/Y were taken with the "
+                                 "machine zero at G-code zero: the machine goes elsewhere")):
+            lines = self._g53_unplaced[key]
+            if lines:
+                self.warnings.append((lines[0], f"G53 (machine coordinates) on line(s) "
+                                      f"{_line_list(lines)}: {what}; {fix}"))
 
     def _cond(self, ln):
         s = ln.oexpr
@@ -1054,8 +1104,15 @@ class Interpreter:
         if machine:
             end = list(self.pos)
             for i, a in enumerate("xyz"):
-                if a in w:
-                    end[i] = w[a] * self.scale
+                if a not in w:
+                    continue
+                end[i] = w[a] * self.scale
+                if self.mzero is None:  # not known: see the module docstring
+                    key = "z" if a == "z" else "xy"
+                    if self.line_no not in self._g53_unplaced[key]:
+                        self._g53_unplaced[key].append(self.line_no)
+                    if a == "z":
+                        end[i] = max(self.start_z, self.pos[i])
             return end
         if (not self.incremental and not self.inch and not any(self.g5x)
                 and not any(self.g92)):

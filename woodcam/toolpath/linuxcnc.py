@@ -12,12 +12,13 @@ from __future__ import annotations
 import functools
 import json
 import os
+import re
 import subprocess
 import tempfile
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .interpreter import GcodeError
+from .interpreter import GcodeError, _line_list, _split_comments
 
 #: Debian's interpreter, for which the ``gcode`` module is built.
 LINUXCNC_PYTHON = "/usr/bin/python3"
@@ -40,37 +41,52 @@ def linuxcnc_missing() -> str | None:
     return None
 
 
-def run_batch(paths, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 10.0) -> list[dict]:
+def run_batch(paths, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 10.0,
+              machine_zero_mm=(0.0, 0.0, 0.0)) -> list[dict]:
     """Run LinuxCNC's interpreter on each file of ``paths`` in one subprocess.
 
     Returns one dict per file: ``moves`` (canonical ``[kind, line, end, centre, rotation,
-    plane]``, machine frame mm), ``error`` (``None`` or ``[line, message]``), ``seconds``.
+    plane]``, mm, in the frame of ``start_mm``: the G54 frame, whose offset is
+    ``-machine_zero_mm``; the default zero is the machine frame), ``error`` (``None`` or
+    ``[line, message]``), ``seconds``.
     """
     why = linuxcnc_missing()
     if why:
         raise WoodcamError(f"--interpreter linuxcnc: {why}; or use --interpreter woodcam")
     job = {"files": [str(Path(p).resolve()) for p in paths], "start_mm": list(start_mm),
-           "timeout_s": float(timeout_s)}
+           "timeout_s": float(timeout_s), "machine_zero_mm": list(machine_zero_mm)}
     r = subprocess.run([LINUXCNC_PYTHON, "-I", str(_DRIVER)], input=json.dumps(job),
                        capture_output=True, text=True,
                        timeout=timeout_s * max(1, len(job["files"])) + 60)
     if r.returncode:
         if len(job["files"]) > 1:  # one program crashed the interpreter: run them one by one
-            return [run_batch([p], start_mm=start_mm, timeout_s=timeout_s)[0] for p in paths]
+            return [run_batch([p], start_mm=start_mm, timeout_s=timeout_s,
+                              machine_zero_mm=machine_zero_mm)[0] for p in paths]
         return [{"moves": [], "error": [0, f"LinuxCNC's interpreter crashed (exit "
                                            f"{r.returncode})"], "seconds": 0.0}]
     return json.loads(r.stdout)
 
 
-def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.0):
+def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.0,
+                 machine_zero_mm=(0.0, 0.0, 0.0)):
     """LinuxCNC's canonical moves of program ``text`` in woodcam's canonical form
     (:mod:`.interpreter`): ``(moves, warnings)``; a refusal raises :class:`GcodeError` with
-    LinuxCNC's message and line."""
+    LinuxCNC's message and line. ``machine_zero_mm``: the machine origin in the G54 frame
+    (mm); ``None`` (not known) runs with it at G-code zero and warns about the G53 lines, whose
+    moves are then not where the machine goes (LinuxCNC has no "not known")."""
     with tempfile.TemporaryDirectory(prefix="woodcam-lcnc-") as d:
         p = Path(d) / "program.ngc"
         p.write_text(text)
-        res = run_batch([p], start_mm=start_mm, timeout_s=timeout_s)[0]
+        res = run_batch([p], start_mm=start_mm, timeout_s=timeout_s,
+                        machine_zero_mm=machine_zero_mm or (0.0, 0.0, 0.0))[0]
     warnings = []
+    g53 = _g53_lines(text) if machine_zero_mm is None else []
+    if g53:
+        warnings.append((g53[0], f"G53 (machine coordinates) on line(s) {_line_list(g53)}: "
+                         "without the machine zero LinuxCNC's interpreter took it at G-code "
+                         "zero (a G53 Z-5 retract goes 5 mm below the work zero); give where "
+                         "the machine zero lies in the G-code frame (--machine-zero X,Y,Z) to "
+                         "place them"))
     if res["error"]:
         line, msg = res["error"]
         if msg != NO_END:
@@ -80,6 +96,23 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
     moves = [(k, ln, tuple(e), tuple(c) if c else None, rot, plane, 0.0, 0.0, 0)
              for k, ln, e, c, rot, plane in res["moves"]]
     return moves, warnings
+
+
+_G53 = re.compile(r"g0*53(?![\d.])")
+
+
+def _g53_lines(text: str) -> list[int]:
+    """1-based lines of ``text`` with a G53 word (comments taken out, as LinuxCNC reads them)."""
+    out = []
+    for no, raw in enumerate(text.splitlines(), 1):
+        if "53" in raw:
+            try:
+                line = _split_comments(raw, no)[0]
+            except GcodeError:  # LinuxCNC read the program: cannot happen; no warning then
+                continue
+            if _G53.search(line):
+                out.append(no)
+    return out
 
 
 def canonical(moves, start_mm) -> list[tuple]:
