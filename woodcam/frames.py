@@ -141,9 +141,13 @@ def block_to_pixel(face: str, points_mm: ArrayLike, image_shape: ArrayLike,
     face = check_face(face)
     n_rows, n_cols = _check_shape(image_shape)
     A, b = _affine(face, check_size(size_mm))
-    p = np.asarray(points_mm, dtype=float)
-    if p.shape[-1] != 3:
-        raise WoodcamError(f"points_mm must have shape (..., 3); got {p.shape}")
+    try:
+        p = np.asarray(points_mm, dtype=float)
+    except (TypeError, ValueError):
+        p = np.empty(0)
+    if p.ndim == 0 or p.shape[-1] != 3:  # a scalar was an IndexError
+        raise WoodcamError(f"points_mm must have shape (..., 3) in mm; got {points_mm!r}; pass "
+                           "block points, e.g. [[10, 20, 5]]")
     # Each column of A has exactly one non-zero entry, so (u, v) is read off two coordinates.
     iu, iv = int(np.flatnonzero(A[:, 0])[0]), int(np.flatnonzero(A[:, 1])[0])
     u = (p[..., iu] - b[iu]) / A[iu, 0]
@@ -166,10 +170,17 @@ def face_pixel_points(face: str, image_shape, size_mm) -> np.ndarray:
 
 
 def _check_shape(image_shape) -> tuple[int, int]:
-    shape = tuple(int(s) for s in tuple(image_shape)[:2])
-    if len(shape) != 2 or min(shape) <= 0:
-        raise WoodcamError(f"image_shape must be (n_rows, n_cols) > 0; got {image_shape!r}")
-    return shape
+    """``(n_rows, n_cols)`` of ``image_shape`` (an image's ``.shape``: extra channel counts are
+    ignored), whole pixel counts > 0; a scalar, a NaN or 10.7 rows is refused, not truncated."""
+    try:
+        head = np.asarray(tuple(image_shape)[:2], dtype=float)
+    except (TypeError, ValueError):
+        head = np.empty(0)
+    if head.shape != (2,) or not np.all(np.isfinite(head)) or np.any(head <= 0) \
+            or np.any(head != np.round(head)):
+        raise WoodcamError(f"image_shape must be (n_rows, n_cols), whole pixel counts > 0; got "
+                           f"{image_shape!r}; pass the face image's .shape")
+    return int(head[0]), int(head[1])
 
 
 # -- the unfolded cross --------------------------------------------------------------------------
@@ -215,10 +226,25 @@ def unfold_cross(images: dict, size_mm: ArrayLike, background: float | ArrayLike
     All images must share one pixel density; faces that are absent stay ``background``.
     """
     size = check_size(size_mm)
+    if not isinstance(images, dict):
+        raise WoodcamError(f"images must be a dict face name -> image; got {type(images).__name__}; "
+                           "e.g. {'front': photo}")
     faces = {check_face(k): np.asarray(v) for k, v in images.items()}
     if not faces:
         raise WoodcamError("images must hold at least one face image; got an empty dict")
     f0, im0 = next(iter(faces.items()))
+    for face, im in faces.items():  # a 1-D image, or grey beside RGB, failed deep in numpy
+        if im.ndim not in (2, 3) or im.shape[2:] != im0.shape[2:]:
+            raise WoodcamError(f"image of face {face!r} must be (h, w) or (h, w, c) with the channels of "
+                               f"face {f0!r} {im0.shape[2:]}; got shape {im.shape}; convert all faces "
+                               "to one kind (all grey or all RGB)")
+    try:
+        bg = np.asarray(background, dtype=float)
+    except (TypeError, ValueError):
+        bg = np.empty((0, 0))
+    if bg.ndim > 1 or (bg.ndim == 1 and bg.shape != im0.shape[2:]) or not np.all(np.isfinite(bg)):
+        raise WoodcamError(f"background must be one value or one per channel {im0.shape[2:]}; got "
+                           f"{background!r}; e.g. background=0")
     px_per_mm = im0.shape[1] / face_image_size_mm(f0, size)[1]
     layout = CrossLayout(tuple(size), px_per_mm)
     from .limits import check_grid

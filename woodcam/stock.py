@@ -120,6 +120,7 @@ def open_stock(spec: str, *, species: str | None = None,
     """
     if appearance not in ("colormap", "neural"):
         raise WoodcamError(f"appearance must be one of ['colormap', 'neural']; got {appearance!r}")
+    _check_appearance_params(appearance, appearance_params)
     base, turns = _split_turns(spec)
     stock = _open_base_stock(base, species, appearance, appearance_params)
     stock.meta["appearance_params"] = {k: (list(v) if isinstance(v, tuple) else v)
@@ -131,6 +132,25 @@ def open_stock(spec: str, *, species: str | None = None,
     for axis, quarter_turns in turns:
         wood, size = wood.turned(axis, quarter_turns, size)
     return Stock(spec, size, wood, stock.description, {**stock.meta, "turns": turns})
+
+
+def _check_appearance_params(appearance: str, params: dict) -> None:
+    """Refuse a keyword the chosen appearance does not take, before any fit (``foo=1`` was a
+    bare TypeError deep inside, after the block was read)."""
+    import inspect
+
+    if appearance == "neural":
+        from .appearance.neural import fit_neural_appearance
+
+        targets = [fit_neural_appearance]
+    else:  # a block's photos go through fit_to_block (anchor=) to the constructor
+        targets = [ColorMapAppearance, ColorMapAppearance.fit_to_block]
+    taken = {k for t in targets for k, p in inspect.signature(t).parameters.items()
+             if p.kind is not p.VAR_KEYWORD} - {"self", "cls", "species", "block", "field"}
+    unknown = sorted(set(params) - taken)
+    if unknown:
+        raise WoodcamError(f"open_stock: appearance_params must be parameters of the {appearance} "
+                           f"appearance ({', '.join(sorted(taken))}); got {unknown[0]!r}; check its spelling")
 
 
 def absolute_spec(spec: str) -> str:

@@ -71,7 +71,7 @@ def test_arf_eq6():
 def test_errors():
     with pytest.raises(WoodcamError, match="ring_width_mm must be > 0"):
         RadialScalingField(LogFrame(), ring_width_mm=0)
-    with pytest.raises(WoodcamError, match="axis must be a non-zero 3-vector"):
+    with pytest.raises(WoodcamError, match="axis must be a non-zero direction"):
         LogFrame((0, 0, 0), (0, 0, 0))
     with pytest.raises(WoodcamError, match=r"points_mm must have shape \(n, 3\)"):
         RadialScalingField(LogFrame())(np.zeros((4, 2)))

@@ -144,3 +144,86 @@ def test_a_fit_from_one_face_warns_and_rbf_says_why_it_cannot():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             fit_block(block, "rbf", faces=["top"])
+
+
+def _wrong_types_and_shapes():
+    """``(id, call, match)``: each call raised a bare TypeError/ValueError/IndexError/KeyError/
+    AttributeError/ZeroDivisionError, or was silently accepted (marked *), before its door check."""
+    import numpy as np
+
+    import woodcam as w
+    from woodcam import frames
+    from woodcam.block.block import Block, Face, RingTrace
+    from woodcam.cad.parts import auto_tolerance_mm
+    from woodcam.fields import builtin_block
+    from woodcam.fields.base import LogFrame
+    from woodcam.fields.grid import GridField
+    from woodcam.fields.state import field_from_state
+    from woodcam.toolpath.tools import VBit
+
+    fld = builtin_block("flat-sawn").field
+    g3 = np.zeros((3, 3, 3))
+    return [
+        ("grid origin of 2 *", lambda: GridField(g3, (0, 0), 1), "origin_mm must be three finite numbers"),
+        ("grid spacing of 2", lambda: GridField(g3, (0, 0, 0), (1, 1)), "spacing_mm must be three finite"),
+        ("grid zero axis *", lambda: GridField(g3, (0, 0, 0), 1, axis=(0, 0, 0)), "axis must be a non-zero"),
+        ("grid NaN axis *", lambda: GridField(g3, (0, 0, 0), 1, axis=(np.nan, 0, 0)), "axis must be three finite"),
+        ("grid.bake array spacing", lambda: GridField.bake(fld, (0, 0, 0), (9, 9, 9), np.ones(2)),
+         "spacing_mm must be a finite number > 0"),
+        ("grid.bake str spacing", lambda: GridField.bake(fld, (0, 0, 0), (9, 9, 9), "a"), "spacing_mm must be"),
+        ("grid.bake margin", lambda: GridField.bake(fld, (0, 0, 0), (9, 9, 9), 1, margin_nodes=-6),
+         "margin_nodes must be an integer >= 0"),
+        ("logframe pith of 2", lambda: LogFrame((0, 0)).to_log(np.zeros((1, 3))), "pith_point_mm must be three"),
+        ("logframe NaN pith *", lambda: LogFrame((np.nan, 0, 0)), "pith_point_mm must be three finite"),
+        ("face shape of 1", lambda: Face("top", (3,)), "shape of face 'top' must be two pixel counts"),
+        ("face shape 10.7 *", lambda: Face("top", (10.7, 10)), "shape of face 'top' must be two pixel counts"),
+        ("face trace not a RingTrace", lambda: Face("top", (8, 8), traces=[np.zeros((2, 2))]),
+         "trace 0 of face 'top' must be a RingTrace"),
+        ("block face not a Face", lambda: Block((10, 10, 10), faces={"top": 5}), r"Block.faces\['top'\] must be a Face"),
+        ("missing face", lambda: Block((10, 10, 10)).face_pixel_size_mm("top"), "face 'top' is not known on block"),
+        ("trace of letters", lambda: RingTrace("ab"), "points_px of a ring trace must be"),
+        ("image_shape scalar", lambda: frames.pixel_to_block("top", 1, 1, 5, (9, 9, 9)), "image_shape must be"),
+        ("image_shape NaN", lambda: frames.pixel_to_block("top", 1, 1, (np.nan, 9), (9, 9, 9)), "image_shape must be"),
+        ("image_shape 10.7 *", lambda: frames.pixel_to_block("top", 1, 1, (10.7, 9), (9, 9, 9)), "image_shape must be"),
+        ("block_to_pixel scalar", lambda: frames.block_to_pixel("top", 5.0, (9, 9), (9, 9, 9)),
+         r"points_mm must have shape \(\.\.\., 3\)"),
+        ("unfold 1-D image", lambda: w.unfold_cross({"front": np.ones(10)}, (10, 10, 10)), "image of face 'front'"),
+        ("unfold grey beside RGB", lambda: w.unfold_cross({"front": np.ones((10, 10)), "top": np.ones((10, 10, 3))},
+                                                          (10, 10, 10)), "image of face 'top'"),
+        ("unfold background of 2", lambda: w.unfold_cross({"front": np.ones((10, 10, 3))}, (10, 10, 10), (1, 2)),
+         "background must be one value or one per channel"),
+        ("unfold list", lambda: w.unfold_cross([np.ones((10, 10))], (10, 10, 10)), "images must be a dict"),
+        ("auto tolerance 0 texels", lambda: auto_tolerance_mm(10, texels_per_mm=0), "texels_per_mm must be"),
+        ("auto tolerance NaN *", lambda: auto_tolerance_mm(np.nan), "diagonal_mm must be"),
+        ("auto tolerance < 0 *", lambda: auto_tolerance_mm(-5), "diagonal_mm must be"),
+        ("turned size of 2", lambda: w.Wood(fld).turned("z", 1, (1, 1)), "size_mm must be three"),
+        ("turned quarter_turns str", lambda: w.Wood(fld).turned("z", "a", (9, 9, 9)), "quarter_turns must be"),
+        ("open_stock unknown keyword", lambda: w.open_stock("builtin:flat-sawn", foo=1),
+         "appearance_params must be parameters of the colormap appearance.*'foo'"),
+        ("field state missing keys", lambda: field_from_state({"type": "woodcam.fields.radial:RadialScalingField",
+                                                               "state": {}}), "saved state of field type"),
+        ("field state a list", lambda: field_from_state([1, 2]), "a saved field must be a dict"),
+        ("vbit angle str", lambda: VBit(6, angle_deg="60"), "angle_deg must be a number"),
+        ("generate_log seed str", lambda: w.generate_log("a"), "seed must be an integer"),
+        ("machining time str", lambda: w.read_gcode("G1 X10 F100\n").machining_time_s("a"),
+         "rapid_mm_min must be a finite number"),
+    ]
+
+
+@pytest.mark.parametrize("name, call, match", _wrong_types_and_shapes(), ids=lambda v: v if isinstance(v, str) else "")
+def test_wrong_types_and_shapes_are_refused_naming_the_argument(name, call, match):
+    with pytest.raises(WoodcamError, match=match):
+        call()
+
+
+def test_woodify_refuses_a_string_resolution_and_nan_vertex_gains():
+    import numpy as np
+    import trimesh
+
+    from woodcam.woodify import woodify
+
+    ball = trimesh.creation.icosphere(radius=10)
+    with pytest.raises(WoodcamError, match="resolution must be an integer in"):
+        woodify(ball, 2, resolution="32")
+    with pytest.raises(WoodcamError, match="vertex_gain must be .* finite values > 0"):
+        woodify(ball, 2, resolution=32, vertex_gain=np.full(len(ball.vertices), np.nan))

@@ -7,9 +7,11 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from .._checks import check_number
 from .._types import AppearanceLike, ArrayLike, GrowthFieldLike, WoodLike
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, evaluate, grain_direction
+from ..frames import check_size
 from ..tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS
 from .colormap import ColorMapAppearance
 
@@ -62,11 +64,10 @@ class Wood:
             The turned wood, in the turned block's frame (origin at its bottom-front-left
             corner), and the turned block's size.
         """
-        if axis not in ("x", "y", "z") or int(quarter_turns) != quarter_turns:
-            raise WoodcamError(
-                f"turned: axis must be 'x', 'y' or 'z' and quarter_turns an integer; got "
-                f"axis={axis!r}, quarter_turns={quarter_turns!r}; e.g. turned('z', 1, size)")
-        k = int(quarter_turns) % 4
+        if axis not in ("x", "y", "z"):
+            raise WoodcamError(f"turned: axis must be 'x', 'y' or 'z'; got {axis!r}; e.g. turned('z', 1, size)")
+        k = check_number(quarter_turns, "turned: quarter_turns", integer=True,
+                         fix="e.g. turned('z', 1, size)") % 4
         i, j = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}[axis]  # cyclic: e_i -> e_j
         rot = np.eye(3)
         for _ in range(k):  # exact integer quarter turns: (e_i, e_j) -> (e_j, -e_i)
@@ -74,7 +75,7 @@ class Wood:
             step[i, i] = step[j, j] = 0.0
             step[j, i], step[i, j] = 1.0, -1.0
             rot = step @ rot
-        size = np.asarray(size_mm, dtype=float)
+        size = check_size(size_mm)  # (1, 1) was a reshape error
         corners = np.array(np.meshgrid(*[(0.0, v) for v in size], indexing="ij")).reshape(3, -1).T
         moved = corners @ rot.T
         shift = -moved.min(axis=0)

@@ -9,6 +9,7 @@ optional integer year label counted outward from the pith. A ring map is a grey 
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -42,7 +43,11 @@ class RingTrace:
     def __post_init__(self):
         from ..limits import limit
 
-        p = np.asarray(self.points_px, dtype=float)
+        try:
+            p = np.asarray(self.points_px, dtype=float)
+        except (TypeError, ValueError) as err:  # "ab": not numbers
+            raise WoodcamError(f"points_px of a ring trace must be (row, col) numbers, shape (k >= 2, 2); "
+                               f"got {self.points_px!r}") from err
         if p.ndim != 2 or p.shape[1] != 2 or len(p) < 2:
             raise WoodcamError(
                 f"points_px of a ring trace must have shape (k >= 2, 2) as (row, col); got {p.shape}"
@@ -107,12 +112,22 @@ class Face:
 
     def __post_init__(self):
         self.name = check_face(self.name)
-        self.shape = (int(self.shape[0]), int(self.shape[1]))
         from ..limits import limit
 
         top = int(limit("MAX_FACE_PX"))
-        if not all(1 <= s <= top for s in self.shape):  # (0, 0) or (-3, 4) was accepted and written
-            raise WoodcamError(f"shape of face {self.name!r} must be two pixel counts in [1, {top}]; got {self.shape}")
+        shape = np.asarray(self.shape, dtype=object) if np.ndim(self.shape) == 1 else None
+        # (0, 0) or (-3, 4) was accepted and written, (3,) an IndexError, (10.7, 10) cut to 10
+        if shape is None or len(shape) != 2 or not all(
+                isinstance(s, numbers.Real) and not isinstance(s, bool) and float(s).is_integer()
+                and 1 <= s <= top for s in shape):
+            raise WoodcamError(f"shape of face {self.name!r} must be two pixel counts (n_rows, n_cols), whole "
+                               f"in [1, {top}]; got {self.shape!r}; pass the face image's shape[:2]")
+        self.shape = (int(shape[0]), int(shape[1]))
+        self.traces = list(self.traces)
+        for k, t in enumerate(self.traces):
+            if not isinstance(t, RingTrace):
+                raise WoodcamError(f"trace {k} of face {self.name!r} must be a RingTrace; got "
+                                   f"{type(t).__name__}; wrap its (row, col) points: RingTrace(points_px)")
         if self.traces:  # where read_block takes them (trace_bounds_px), all traces in one pass
             lo, hi = trace_bounds_px(self.shape)
             p = np.concatenate([np.asarray(t.points_px, float) for t in self.traces])
@@ -171,16 +186,29 @@ class Block:
         if max(self.size_mm) > limit("MAX_BLOCK_SIZE_MM"):  # read_block refuses it
             raise WoodcamError(f"Block.size_mm must be at most {limit('MAX_BLOCK_SIZE_MM'):g} mm a side "
                                f"(woodcam.limits.MAX_BLOCK_SIZE_MM); got {self.size_mm}")
+        if not isinstance(self.faces, dict):
+            raise WoodcamError(f"Block.faces must be a dict face name -> Face; got {type(self.faces).__name__}")
         faces = {}
         for key, face in self.faces.items():
+            if not isinstance(face, Face):
+                raise WoodcamError(f"Block.faces[{key!r}] must be a Face; got {face!r}; build it with "
+                                   f"Face({key!r}, shape) and its photo, traces or ring map")
             if check_face(key) != face.name:
                 raise WoodcamError(f"faces[{key!r}] holds face {face.name!r}; keys must match Face.name")
             faces[face.name] = face
         self.faces = {f: faces[f] for f in FACES if f in faces}
 
+    def _face(self, face: str) -> Face:
+        """The :class:`Face` called ``face`` (a name or a Mokume letter), or a clear error."""
+        name = check_face(face)
+        if name not in self.faces:
+            raise WoodcamError(f"face {face!r} is not known on block {self.name!r}; it has "
+                               f"{', '.join(self.faces) or 'no faces'}; pass one of those")
+        return self.faces[name]
+
     def face_pixel_size_mm(self, face: str) -> tuple[float, float]:
         """Size in mm of one pixel ``(row step, col step)`` of ``face``'s images."""
-        f = self.faces[check_face(face)]
+        f = self._face(face)
         h, w = face_image_size_mm(f.name, self.size_mm)
         return h / f.shape[0], w / f.shape[1]
 
@@ -194,7 +222,7 @@ class Block:
         """
         pts, yrs = [], []
         for name in faces or list(self.faces):
-            f = self.faces[check_face(name)]
+            f = self._face(name)
             for t in f.traces:
                 pts.append(pixel_to_block(f.name, t.points_px[:, 0], t.points_px[:, 1], f.shape, self.size_mm))
                 yrs.append(np.full(len(t.points_px), np.nan if t.year is None else float(t.year)))

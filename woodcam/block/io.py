@@ -280,10 +280,9 @@ def _read_field(entry, path: Path | None):
     try:
         return field_from_state({"type": entry["type"], "state": state})
     except (KeyError, TypeError, ValueError, IndexError, AttributeError) as err:
-        if isinstance(err, WoodcamError):
-            raise
+        why = str(err) if isinstance(err, WoodcamError) else f"{type(err).__name__}: {err}"
         raise WoodcamError(f"true field {str(path)!r} does not hold a valid {entry['type']} "
-                           f"({type(err).__name__}: {err}); rewrite the block or drop the file") from err
+                           f"({why}); rewrite the block or drop the file") from err
 
 
 # -- images ---------------------------------------------------------------------------------------

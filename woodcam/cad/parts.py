@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import check_number
 from ..errors import WoodcamError, require
 from ..tolerances import (
     MAX_PART_TRIANGLES,
@@ -70,8 +71,12 @@ def auto_tolerance_mm(diagonal_mm: float, texels_per_mm: float = _DEFAULT_TEXELS
     texel, and finer still on small parts (reasons in :mod:`woodcam.tolerances`). The 113 mm
     demo bowl at 10 texels/mm: 0.025 mm; a 17 mm knob: 0.017 mm; a 2 m table top at 2
     texels/mm: 0.125 mm."""
-    texel_limit = TESSELLATION_TEXEL_FRACTION / float(texels_per_mm)
-    return max(TESSELLATION_MIN_TOL_MM, min(texel_limit, TESSELLATION_REL_TOL * float(diagonal_mm)))
+    texels_per_mm = check_number(texels_per_mm, "auto_tolerance_mm: texels_per_mm", lo=0, lo_open=True,
+                                 fix="the bake's texel density, e.g. 10")
+    diagonal_mm = check_number(diagonal_mm, "auto_tolerance_mm: diagonal_mm", lo=0,
+                               fix="the part's bounding-box diagonal in mm")
+    texel_limit = TESSELLATION_TEXEL_FRACTION / texels_per_mm
+    return max(TESSELLATION_MIN_TOL_MM, min(texel_limit, TESSELLATION_REL_TOL * diagonal_mm))
 
 
 def load_part(

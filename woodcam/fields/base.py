@@ -18,6 +18,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from .._checks import check_vector
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..tolerances import MAX_BATCH_POINTS
@@ -108,14 +109,6 @@ def grain_direction(field: GrowthFieldLike, points_mm: ArrayLike) -> np.ndarray:
     return np.broadcast_to(axis / np.linalg.norm(axis), p.shape)
 
 
-def _unit(v, name: str) -> np.ndarray:
-    v = np.asarray(v, dtype=float)
-    n = np.linalg.norm(v)
-    if v.shape != (3,) or not np.isfinite(n) or n < 1e-12:
-        raise WoodcamError(f"{name} must be a non-zero 3-vector; got {v!r}")
-    return v / n
-
-
 @dataclass(frozen=True)
 class LogFrame:
     """Rigid placement of a log's own frame in the block frame.
@@ -140,11 +133,13 @@ class LogFrame:
     _rot: np.ndarray = dc_field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        z = _unit(self.axis, "axis")
+        object.__setattr__(self, "pith_point_mm", tuple(float(x) for x in check_vector(
+            self.pith_point_mm, "pith_point_mm", fix="pass a block-frame point on the pith, mm")))
+        z = check_vector(self.axis, "axis", unit=True)
         ref = self.reference
         if ref is None:
             ref = (1.0, 0.0, 0.0) if abs(z[0]) < 0.9 else (0.0, 1.0, 0.0)
-        x = _unit(ref, "reference")
+        x = check_vector(ref, "reference", unit=True)
         x = x - z * (x @ z)
         if np.linalg.norm(x) < 1e-9:
             raise WoodcamError(f"reference must not be parallel to axis; got {ref!r} and {self.axis!r}")

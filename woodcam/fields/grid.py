@@ -18,12 +18,24 @@ from typing import Literal
 
 import numpy as np
 
+from .._checks import check_number, check_vector
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from .base import check_points, evaluate
 
 Interpolation = Literal["cubic", "linear"]
 _ORDER = {"cubic": 3, "linear": 1}
+
+
+def _spacing(spacing_mm) -> np.ndarray:
+    """``(3,)`` node spacing from one number or three, each finite and > 0."""
+    fix = "pass one spacing in mm or three (X, Y, Z), e.g. 2.0"
+    if np.ndim(spacing_mm) == 0:
+        return np.full(3, check_number(spacing_mm, "spacing_mm", lo=0, lo_open=True, fix=fix))
+    sp = check_vector(spacing_mm, "spacing_mm", fix=fix)
+    if np.any(sp <= 0):
+        raise WoodcamError(f"spacing_mm must be > 0 along each axis; got {spacing_mm!r}; {fix}")
+    return sp
 
 
 def _nodes_mm(origin_mm, spacing_mm, shape) -> np.ndarray:
@@ -70,14 +82,15 @@ class GridField:
             raise WoodcamError(f"years must be a finite (nx, ny, nz) grid, each >= 2; got shape {g.shape}")
         if self.interpolation not in _ORDER:
             raise WoodcamError(f"interpolation must be one of {list(_ORDER)}; got {self.interpolation!r}")
-        sp = np.broadcast_to(np.asarray(self.spacing_mm, dtype=float), (3,))
-        if not np.all(np.isfinite(sp) & (sp > 0)):
-            raise WoodcamError(f"spacing_mm must be finite and > 0; got {self.spacing_mm!r}")
-        if not np.all(np.isfinite(np.asarray(self.origin_mm, float))):
-            raise WoodcamError(f"origin_mm must be finite; got {self.origin_mm!r}")
+        sp = _spacing(self.spacing_mm)
+        origin = check_vector(self.origin_mm, "origin_mm", fix="pass the mm position of node (0, 0, 0)")
+        # a zero or NaN axis made grain_direction NaN everywhere, silently
+        check_vector(self.axis, "axis", unit=True, fix="pass the pith direction, e.g. (0, 0, 1)")
+        axis = np.asarray(self.axis, float)  # kept as given: grain_direction normalises it
         object.__setattr__(self, "years", g)
-        object.__setattr__(self, "spacing_mm", tuple(sp))
-        object.__setattr__(self, "origin_mm", tuple(np.asarray(self.origin_mm, float)))
+        object.__setattr__(self, "spacing_mm", tuple(float(x) for x in sp))
+        object.__setattr__(self, "origin_mm", tuple(float(x) for x in origin))
+        object.__setattr__(self, "axis", tuple(float(x) for x in axis))
         layers = {}
         for name, v in dict(self.layers).items():
             u = np.asarray(v, dtype=float)
@@ -105,8 +118,9 @@ class GridField:
         lo, hi = np.asarray(lo_mm, float), np.asarray(hi_mm, float)
         if lo.shape != (3,) or hi.shape != (3,) or np.any(hi <= lo):
             raise WoodcamError(f"lo_mm < hi_mm must be 3-vectors; got {lo_mm!r}, {hi_mm!r}")
-        if not spacing_mm > 0:
-            raise WoodcamError(f"spacing_mm must be > 0; got {spacing_mm!r}")
+        spacing_mm = check_number(spacing_mm, "spacing_mm", lo=0, lo_open=True,
+                                  fix="pass one node spacing in mm, e.g. 2.0")
+        margin_nodes = check_number(margin_nodes, "margin_nodes", lo=0, integer=True, fix="e.g. 2")
         n_float = np.ceil((hi - lo) / spacing_mm) + 1 + 2 * margin_nodes
         from ..limits import check_grid  # before allocating: 1e9 mm blocks must not reach numpy
 
@@ -195,6 +209,6 @@ class GridField:
                 layers = {k[len("layer_"):]: z[k] for k in z.files if k.startswith("layer_")}
                 return cls(z["years"], tuple(z["origin_mm"]), tuple(z["spacing_mm"]),
                            str(z["interpolation"]), tuple(z["axis"]), layers, meta)
-        except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile) as err:
+        except (OSError, KeyError, ValueError, TypeError, EOFError, zipfile.BadZipFile) as err:
             raise WoodcamError(f"{path}: not a woodcam grid field (.npz with 'years', "
                                f"'origin_mm', 'spacing_mm'): {err}") from err

@@ -67,6 +67,9 @@ _MOVED = {"woodcam.synth:AnalyticLogField": "woodcam.fields.analytic:AnalyticLog
 
 def field_from_state(d: dict):
     """Inverse of :func:`field_to_state`."""
+    if not (isinstance(d, dict) and isinstance(d.get("type"), str) and isinstance(d.get("state"), dict)):
+        raise WoodcamError(f"a saved field must be a dict {{'type': 'module:Class', 'state': {{...}}}}; got "
+                           f"{d!r:.200}; pass what field_to_state returned")
     kind = _MOVED.get(d["type"], d["type"])
     module, _, qualname = kind.partition(":")
     if not module.startswith("woodcam."):
@@ -80,4 +83,8 @@ def field_from_state(d: dict):
             f"field type {kind!r} cannot be imported from this woodcam version; upgrade woodcam "
             "or drop the saved field"
         ) from err
-    return obj.from_dict(d["state"])
+    try:
+        return obj.from_dict(d["state"])
+    except (KeyError, TypeError, IndexError) as err:  # a state missing a key or of the wrong kind
+        raise WoodcamError(f"the saved state of field type {kind!r} is incomplete or malformed "
+                           f"({type(err).__name__}: {err}); pass what field_to_state returned for it") from err

@@ -57,6 +57,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._checks import check_number
 from .._types import ArrayLike
 from ..errors import WoodcamError
 from ..fields.skeleton import KNOT_TABLE_SAMPLES, BranchStrand, LogSkeleton
@@ -394,6 +395,9 @@ def generate_log(seed: int | np.random.Generator | None = 0, *, length_mm: float
     """
     if not (np.isfinite(length_mm) and length_mm > 100):
         raise WoodcamError(f"length_mm must be > 100 mm; got {length_mm!r}")
+    if not (seed is None or isinstance(seed, np.random.Generator)):  # "a" was numpy's TypeError
+        seed = check_number(seed, "generate_log: seed", lo=0, integer=True,
+                            fix="pass an integer >= 0 (same seed, same log), a numpy Generator or None")
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     n_l, n_t = heightmap_shape or (int(np.ceil(length_mm / 5.0)) + 1, 360)
     from ..limits import check_grid

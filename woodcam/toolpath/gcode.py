@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._checks import check_number
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from ..tolerances import ARC_CHORD_TOL_MM
@@ -94,9 +95,8 @@ class Program:
         """Estimated time per tool: ``{tool: (feed seconds, rapid seconds)}`` from the move
         lengths (mm), the programmed feeds (mm/min) and ``rapid_mm_min`` for rapids (the
         machine's rapid rate; no acceleration is modelled, so real jobs take longer)."""
-        if not (math.isfinite(rapid_mm_min) and rapid_mm_min > 0):
-            raise WoodcamError(f"machining_time_s: rapid_mm_min must be > 0, got "
-                               f"{rapid_mm_min!r}; e.g. 5000")
+        rapid_mm_min = check_number(rapid_mm_min, "machining_time_s: rapid_mm_min", lo=0, lo_open=True,
+                                    fix="the machine's rapid rate in mm/min, e.g. 5000")
         length = np.linalg.norm(self.end_mm - self.start_mm, axis=1)
         feed = self.kind == FEED
         with np.errstate(divide="ignore"):

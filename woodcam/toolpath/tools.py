@@ -42,8 +42,9 @@ from __future__ import annotations
 
 from typing import Any
 import math
+import numbers
 import tomllib
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Literal
 
@@ -86,6 +87,11 @@ class Tool:
     kind = "tool"
 
     def __post_init__(self):
+        for f in fields(self):  # the subclasses' range checks compare: "60" was a bare TypeError
+            v = getattr(self, f.name)
+            if f.type == "float" and (isinstance(v, bool) or not isinstance(v, numbers.Real)):
+                raise WoodcamError(f"{type(self).__name__}: {f.name} must be a number; got {v!r}; "
+                                   "give it in mm (angles in degrees)")
         d = self.diameter_mm
         if (isinstance(d, bool) or not isinstance(d, (int, float, np.number))
                 or not (0 < d <= MAX_TOOL_DIAMETER_MM)):

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import WoodcamError
+from .._checks import check_vector  # noqa: F401  (re-exported: scene and tests import it here)
 from ..tolerances import ON_FACE_TOL_MM
 
 BOX_EDGES = np.array(
@@ -20,25 +20,6 @@ BOX_EDGES = np.array(
      [0, 2], [1, 3], [4, 6], [5, 7],   # along Y
      [0, 4], [1, 5], [2, 6], [3, 7]]   # along Z
 )
-
-
-
-def check_vector(value, name: str, *, unit: bool) -> np.ndarray:
-    try:
-        v = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as err:
-        raise WoodcamError(f"{name} must be three numbers (x, y, z); got {value!r}") from err
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
-        raise WoodcamError(f"{name} must be three finite numbers (x, y, z); got {value!r}")
-    if unit:
-        n = float(np.linalg.norm(v))
-        if n < 1e-12:
-            raise WoodcamError(
-                f"{name} must be a non-zero direction; got {value!r}; e.g. {name}=(1, 0, 0)"
-            )
-        v = v / n
-    return v
-
 
 
 def plane_basis(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -93,14 +93,36 @@ def paint(origin_mm, brushes=(), *, vertex_gain=None, vertex_direction=None, mes
         from .surfaces import barycentric_on, carry
 
         _, bary = barycentric_on(mesh, p, tri)
-        if vertex_gain is not None:
-            vg = np.asarray(vertex_gain, float)
-            if vg.shape != (len(mesh.vertices),) or np.any(~(vg > 0)):
-                raise WoodcamError(f"vertex_gain must be ({len(mesh.vertices)},) values > 0; got shape {vg.shape}")
+        vg, vd = check_vertex_paint(vertex_gain, vertex_direction, len(mesh.vertices))
+        if vg is not None:
             gain *= carry(mesh, vg, tri, bary)
-        if vertex_direction is not None:
-            vd = np.asarray(vertex_direction, float)
-            if vd.shape != (len(mesh.vertices), 3):
-                raise WoodcamError(f"vertex_direction must have shape ({len(mesh.vertices)}, 3); got {vd.shape}")
+        if vd is not None:
             wind += carry(mesh, vd, tri, bary)
     return gain, wind
+
+
+def check_vertex_paint(vertex_gain, vertex_direction, n_vertices: int):
+    """``(vertex_gain (n,) float > 0 or None, vertex_direction (n, 3) finite float or None)``
+    for a mesh of ``n_vertices``, or a clear error (a NaN gain was a bare ValueError deep in
+    the grid sizing)."""
+    vg = vd = None
+    if vertex_gain is not None:
+        try:
+            vg = np.asarray(vertex_gain, float)
+        except (TypeError, ValueError):
+            vg = np.empty(0)
+        if vg.shape != (n_vertices,) or not np.all(np.isfinite(vg) & (vg > 0)):
+            raise WoodcamError(f"vertex_gain must be {n_vertices} finite values > 0, one per vertex of "
+                               f"the mesh; got shape {vg.shape}" + ("" if vg.shape != (n_vertices,) else
+                                                                   " with a value <= 0, NaN or inf")
+                               + "; e.g. np.ones(len(mesh.vertices))")
+    if vertex_direction is not None:
+        try:
+            vd = np.asarray(vertex_direction, float)
+        except (TypeError, ValueError):
+            vd = np.empty(0)
+        if vd.shape != (n_vertices, 3) or not np.all(np.isfinite(vd)):
+            raise WoodcamError(f"vertex_direction must be finite with shape ({n_vertices}, 3), one wind "
+                               f"vector per vertex of the mesh; got shape {vd.shape}"
+                               + ("" if vd.shape != (n_vertices, 3) else " with NaN or inf"))
+    return vg, vd

@@ -1,0 +1,65 @@
+"""Door checks of the public API's plain arguments: one number, one vector.
+
+A wrong type or shape must fail where it enters, as a :class:`~woodcam.errors.WoodcamError`
+naming the argument, the rule, the value received and a fix, not as a bare ``TypeError`` or
+broadcast error three calls down (or, worse, as a NaN result). Richer checks (points, sizes,
+faces, images) build on these in their own modules (:func:`woodcam.fields.base.check_points`,
+:func:`woodcam.frames.check_size`).
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+
+import numpy as np
+
+from .errors import WoodcamError
+
+
+def _fail(name: str, rule: str, value, fix: str):
+    raise WoodcamError(f"{name} must be {rule}; got {value!r}" + (f"; {fix}" if fix else ""))
+
+
+def check_number(value, name: str, *, lo: float | None = None, hi: float | None = None,
+                 lo_open: bool = False, integer: bool = False, fix: str = "") -> float:
+    """``value`` as a float (an int with ``integer=True``) that is finite and in the range.
+
+    ``lo``/``hi`` are inclusive bounds (``lo_open=True``: ``> lo``). A bool, a string or an
+    array is refused even where Python would convert it; numpy scalars are accepted.
+    """
+    kind = "an integer" if integer else "a finite number"
+    rule = kind
+    if lo is not None and hi is not None:
+        rule += f" in {'(' if lo_open else '['}{lo:g}, {hi:g}]"
+    elif lo is not None:
+        rule += f" {'>' if lo_open else '>='} {lo:g}"
+    elif hi is not None:
+        rule += f" <= {hi:g}"
+    ok_type = numbers.Integral if integer else numbers.Real
+    if isinstance(value, bool) or not isinstance(value, ok_type):
+        _fail(name, rule, value, fix)
+    v = int(value) if integer else float(value)
+    if not math.isfinite(v) or (lo is not None and (v <= lo if lo_open else v < lo)) \
+            or (hi is not None and v > hi):
+        _fail(name, rule, value, fix)
+    return v
+
+
+def check_vector(value, name: str, *, n: int = 3, unit: bool = False, fix: str = "") -> np.ndarray:
+    """``value`` as a float ``(n,)`` array of finite numbers; ``unit=True``: a non-zero
+    direction, returned normalised to length 1."""
+    what = "three finite numbers (x, y, z)" if n == 3 else f"{n} finite numbers"
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        v = np.empty(0)
+    if v.shape != (n,) or not np.all(np.isfinite(v)):
+        _fail(name, what, value, fix)
+    if unit:
+        length = float(np.linalg.norm(v))
+        if length < 1e-12:
+            _fail(name, "a non-zero direction", value,
+                  fix or f"e.g. {name}=({', '.join(['1'] + ['0'] * (n - 1))})")
+        v = v / length
+    return v
