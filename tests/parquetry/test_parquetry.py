@@ -534,6 +534,7 @@ _T = [{"filename": "t.png"}]
     ({"targets": _T, "woodcam": {"params": {"patch_mm": "14"}}}, r"patch_mm must be a finite number"),
     ({"targets": _T, "woodcam": {"params": {"single_use": 1}}}, r"single_use must be true or false"),
     ([_T], r"must hold a JSON object; got list"),
+    ({"targets": _T, "woodcam": {"image_size_mm": 50}}, r"key woodcam.image_size_mm is unknown.*woodcam.params"),
 ])
 def test_a_bad_job_file_is_one_error_naming_the_entry(job, match, tmp_path):
     """Each of these was a KeyError, TypeError, AttributeError or ValueError traceback from the

@@ -256,6 +256,10 @@ def read_job(path: str | Path) -> ParquetryJob:
     extra = d.get("woodcam", {}) or {}
     if not isinstance(extra, dict) or not isinstance(extra.get("params", {}), dict):
         raise WoodcamError(f"{where} 'woodcam' and 'woodcam.params' must be objects; got {extra!r}")
+    unknown = sorted(set(extra) - {"params", "blocks", "mokume"})
+    if unknown:  # {"woodcam": {"image_size_mm": 50}} was ignored: a parameter belongs in params
+        raise WoodcamError(f"{where} key woodcam.{unknown[0]} is unknown; the 'woodcam' object holds "
+                           "params, blocks and mokume (parameters go in woodcam.params)")
     mokume = extra.get("mokume", [])
     if not isinstance(mokume, list) or not all(isinstance(m, str) for m in mokume):
         raise WoodcamError(f"{where} 'woodcam.mokume' must be a list of folder paths; got {mokume!r}")
