@@ -35,7 +35,7 @@ from typing import Any, TypeVar
 from ._atomic import atomic_path
 from .errors import WoodcamError, WoodcamWarning
 
-__all__ = ["CacheWarning", "cache_dir", "cache_root", "digest", "file_lock", "load_or_build"]
+__all__ = ["CacheWarning", "cache_dir", "cache_root", "digest", "entry_path", "file_lock", "load_or_build"]
 
 T = TypeVar("T")
 
@@ -74,6 +74,25 @@ def entry_stem(name: str) -> str:
     at most 40 (a block named "../../x" put its detection outside the cache; 250 characters
     made the file name too long)."""
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", str(name))[:40] or "block"
+
+
+def entry_path(folder, name: str, key: str, suffix: str = ".npz") -> Path:
+    """The file of the entry keyed ``key`` in ``folder``: ``<entry_stem(name)>-<key><suffix>``,
+    or an entry of the same key already there under another block name.
+
+    The key is the content; the name only labels the file for someone browsing the cache. A
+    block folder copied under another name is the same content, and was fitted and stored a
+    second time (byte-identical) when the name chose the file."""
+    folder = Path(folder)
+    tail = f"-{key}{suffix}"
+    own = folder / f"{entry_stem(name)}{tail}"
+    if own.is_file():
+        return own
+    with contextlib.suppress(OSError):
+        for p in sorted(folder.glob(f"*{tail}")):
+            if p.is_file():
+                return p
+    return own
 
 
 def _is_numpy(obj: Any) -> bool:
@@ -179,6 +198,9 @@ def load_or_build(path, *, load: Callable[[Path], T], build: Callable[[], T],
     ok, value = _try_load(path, load, what)
     if ok:
         return value, True
+    # a folder where the lock belongs failed the lock's open with "Is a directory", reported as
+    # an unusable cache folder, and every run redid the work
+    _remove_folder_at(Path(str(path) + ".lock"), what, "cache entry's lock file")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         lock = file_lock(path)
@@ -193,14 +215,7 @@ def load_or_build(path, *, load: Callable[[Path], T], build: Callable[[], T],
         if ok:
             return value, True
         value = build()
-        if path.is_dir() and not path.is_symlink() and cache_root().resolve() in path.resolve().parents:
-            # a folder where the entry belongs (made by hand or by another tool) blocked every
-            # save, so the work was redone on every run: it goes, as a broken entry does
-            import shutil
-
-            warnings.warn(CacheWarning(f"{what}: removed the folder {str(path)!r} that stood where the "
-                                       "cache entry belongs"), stacklevel=2)
-            shutil.rmtree(path, ignore_errors=True)
+        _remove_folder_at(path, what, "cache entry")
         try:
             with atomic_path(path) as tmp:
                 save(value, tmp)
@@ -211,6 +226,18 @@ def load_or_build(path, *, load: Callable[[Path], T], build: Callable[[], T],
         return value, False
     finally:
         lock.__exit__(None, None, None)
+
+
+def _remove_folder_at(path: Path, what: str, role: str) -> None:
+    """Remove a folder standing where the cache's file ``path`` belongs (made by hand or by
+    another tool): it blocked every save, so the work was redone on every run. It goes, as a
+    broken entry does; only inside the cache root, never through a link."""
+    if path.is_dir() and not path.is_symlink() and cache_root().resolve() in path.resolve().parents:
+        import shutil
+
+        warnings.warn(CacheWarning(f"{what}: removed the folder {str(path)!r} that stood where the "
+                                   f"{role} belongs"), stacklevel=3)
+        shutil.rmtree(path, ignore_errors=True)
 
 
 #: Default size limit of the whole cache (bytes); ``$WOODCAM_CACHE_MAX_MB`` overrides it. Fitted

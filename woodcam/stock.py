@@ -367,7 +367,7 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
     """
 
     from . import __version__
-    from ._cache import cache_dir, digest, entry_stem, load_or_build
+    from ._cache import cache_dir, digest, entry_path, load_or_build
     from .appearance.volumes import block_fingerprint
     from .fields.grid import GridField
     from .inference import fit_block
@@ -379,7 +379,7 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
             "to fit one to; trace rings on at least one face (or use 'woodcam block synth')"
         )
     key = digest(block_fingerprint(block), method, FIT_VERSION, __version__)
-    path = cache_dir("fields") / f"{entry_stem(block.name)}-{method}-{key}.npz"
+    path = entry_path(cache_dir("fields"), block.name, f"{method}-{key}")
     field, hit = load_or_build(path, load=GridField.load, build=lambda: fit_block(block, method=method),
                                save=lambda f, tmp: f.save(tmp), what=f"fitted field of block {block.name!r}")
     meta = getattr(field, "meta", {}) or {}

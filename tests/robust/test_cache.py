@@ -71,6 +71,22 @@ def test_unwritable_cache_folder_still_returns_the_value(tmp_path):
     assert not hit and value.tolist() == [1, 1, 1]
 
 
+def test_a_folder_where_the_lock_belongs_is_removed_and_the_entry_kept(tmp_path, monkeypatch):
+    """A folder at ``<entry>.lock`` was reported as an unusable cache folder ("Is a directory"),
+    although the folder was fine, and the entry was rebuilt on every run, never kept."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path))
+    path = tmp_path / "fields" / "entry.npy"
+    (tmp_path / "fields" / "entry.npy.lock").mkdir(parents=True)
+    calls = []
+    with pytest.warns(CacheWarning, match="removed the folder .*entry.npy.lock.* where the cache entry's lock file belongs"):
+        _value, hit = _npy_cache(path, np.ones(3), calls)
+    assert not hit and path.is_file() and (tmp_path / "fields" / "entry.npy.lock").is_file()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _value, hit = _npy_cache(path, np.ones(3), calls)
+    assert hit and calls == [1]
+
+
 def test_concurrent_builders_build_once(tmp_path):
     """Two processes asking for the same missing entry: one builds, the other waits and loads."""
     script = textwrap.dedent(f"""
@@ -147,6 +163,27 @@ def test_field_cache_key_is_content_not_mtime(traced_block, tmp_path, monkeypatc
     assert len(_field_entries(tmp_path)) == 3
     fitted_field(copy.deepcopy(traced_block))  # same content: reused
     assert len(_field_entries(tmp_path)) == 3
+
+
+def test_the_same_content_under_another_name_is_one_entry(traced_block, tmp_path, monkeypatch):
+    """The key is the content, but the entry's file name began with the block's name: the same
+    block folder copied as another name was fitted again and stored twice, byte-identical."""
+    import copy
+
+    from woodcam import stock
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path))
+    stock.fitted_field(traced_block)
+    (entry,) = _field_entries(tmp_path)
+    renamed = copy.deepcopy(traced_block)
+    renamed.name = "copy_of_it"
+
+    def no_refit(*args, **kwargs):
+        raise AssertionError("refitted a block whose content is cached under another name")
+
+    monkeypatch.setattr("woodcam.inference.fit_block", no_refit)
+    stock.fitted_field(renamed)
+    assert _field_entries(tmp_path) == [entry]
 
 
 def test_read_only_block_folder_is_never_written(traced_block, tmp_path, monkeypatch):

@@ -242,9 +242,9 @@ def fit_neural_appearance(block, field=None, *, resolution: int = 128, quality: 
     if cache_dir is False:
         return NeuralAppearance(_build_volumes(block, field, grid, spec, settings, key, orientation,
                                                source, detail, progress, threads, None))
-    from .._cache import entry_stem, load_or_build
+    from .._cache import entry_path, load_or_build
 
-    path = Path(cache_dir or default_cache_dir()) / f"{entry_stem(block.name)}-{key}.npz"
+    path = entry_path(cache_dir or default_cache_dir(), block.name, key)
     built: dict = {}
 
     def build():

@@ -33,7 +33,7 @@ from typing import Literal
 import numpy as np
 
 from .._atomic import atomic_path, write_bytes
-from .._cache import cache_dir, digest, entry_stem, load_or_build
+from .._cache import cache_dir, digest, entry_path, load_or_build
 from ..block.block import Block, Face
 from ..errors import WoodcamError, WoodcamWarning
 from .knots import detect_knots
@@ -304,7 +304,7 @@ def with_detected_rings(block: Block, rule: BoundaryRule = DEFAULT_RULE, *, cach
         return ({n: f for n, f in out.faces.items() if n in out.meta["detection"]["faces"]}, msgs)
 
     if cache:
-        path = cache_dir("detect") / f"{entry_stem(block.name)}-{_detection_key(block, rule)}.npz"
+        path = entry_path(cache_dir("detect"), block.name, _detection_key(block, rule))
         raw, hit = load_or_build(path, load=_load_detection, build=build, save=_save_detection,
                                  what="ring detection")
         if not hit:
