@@ -746,3 +746,35 @@ def test_flat_window_weighting_is_on_by_default(sheets, monkeypatch):
     off = ParquetryParams(image_size_mm=28, px_per_mm=PPM, flat_detail=1.0, flat_rerank=4)
     build_parquetry(flat, sheets, off, seams=False)
     assert set(weights) == {1.0} and set(reranks) == {4}
+
+
+def test_cut_files_state_the_real_sheet_size_not_the_pixel_grid(tmp_path):
+    """A 101 px scan at 50 dpi is 51.308 mm, but resampled to 2 px/mm it has 103 px and its cut
+    file said 51.5 mm; an 8 x 6 in leaf (203.2 x 152.4 mm) at 4 px/mm said 203.25 x 152.5 mm.
+    The files now state the real size and place the pieces in real sheet mm."""
+    import re
+
+    from skimage import data
+
+    from woodcam.stock import open_stock
+
+    st = open_stock("builtin:flat-sawn", species="walnut")
+    (leaf,) = slice_veneers(st, 1, (203.2, 152.4), px_per_mm=0.5, id_prefix="leaf")
+    assert leaf.size_mm == (203.2, 152.4) and leaf.rgb.shape[:2] == (76, 102)
+    (big,) = slice_veneers(st, 1, (60.3, 60.3), px_per_mm=50 / 25.4, id_prefix="src")
+    scan = Veneer("scan", big.rgb[:101, :101], 50 / 25.4, np.ones((101, 101), bool))
+    real = 101 / (50 / 25.4)
+    assert scan.resampled(PPM).size_mm == pytest.approx((real, real), abs=1e-12)
+    img = data.camera()[:128, :128].astype(np.float32) / 255.0
+    run = build_parquetry(img, [scan], ParquetryParams(image_size_mm=28, px_per_mm=PPM))
+    write_parquetry(run, tmp_path)
+    svg = (tmp_path / "veneer_scan.svg").read_text()
+    w, h = (float(v) for v in re.search(r'width="([\d.]+)mm" height="([\d.]+)mm"', svg).groups())
+    assert (w, h) == (round(real, 3), round(real, 3))
+    result = json.loads((tmp_path / "result.json").read_text())
+    assert result["veneers"][0]["size_mm"] == pytest.approx([real, real])
+    # the panel-to-sheet affine carries the scale of the sheet's rounded pixel grid
+    s = real * PPM / 103
+    for q in result["patches"]:
+        lin = np.asarray(q["panel_to_sheet_mm"])[:, :2]
+        np.testing.assert_allclose(np.linalg.norm(lin, axis=1), [s, s], rtol=1e-9)

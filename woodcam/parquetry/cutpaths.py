@@ -45,7 +45,9 @@ class Piece:
     id : the patch id (engraved)
     sheet : index of its veneer sheet
     outline_panel : segments in panel mm
-    outline_sheet : the same segments in sheet mm (a rigid motion of the panel outline)
+    outline_sheet : the same segments in real sheet mm (a rigid motion of the panel outline,
+        scaled by :meth:`~woodcam.parquetry.veneers.Veneer.pixel_scale`: at most half a pixel
+        over the sheet where its pixel count was rounded)
     """
 
     id: int

@@ -33,11 +33,19 @@ def run_pieces(run: ParquetryRun) -> list[Piece]:
         outlines = panel_outlines(p, ppm)
         for q in p.patches:
             segs = outlines[q.id]
-            sheet = transform_outline(segs, q.target_to_sheet(run.bank, ppm))
+            sheet = transform_outline(segs, panel_to_sheet_mm(run, q))
             pc = Piece(q.id, q.match.sheet, segs, sheet)
             pc.problems = check_piece(segs, run.params.min_piece_mm, run.params.tool_diameter_mm / 2)
             pieces.append(pc)
     return pieces
+
+
+def panel_to_sheet_mm(run: ParquetryRun, q) -> np.ndarray:
+    """``(2, 3)`` affine taking patch ``q``'s panel mm to real mm on its sheet: the match's
+    rigid motion on the working grid, then the sheet's :meth:`~woodcam.parquetry.veneers.Veneer.pixel_scale`
+    (the grid's pixel count is rounded: a 50 dpi scan's 520 px stand for 130.048 mm, not 130)."""
+    sx, sy = run.veneers[q.match.sheet].pixel_scale()
+    return q.target_to_sheet(run.bank, run.params.px_per_mm) * np.array([[sx], [sy]])
 
 
 def _suffix(run: ParquetryRun, k: int) -> str:
@@ -174,7 +182,7 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
                      "region_mm": [q.col * prm.patch_mm, q.row * prm.patch_mm, q.cells * prm.patch_mm],
                      "sheet": run.veneers[q.match.sheet].id, "rotation_deg": run.bank.angles_deg[q.match.rot],
                      "anchor_px": [q.match.x, q.match.y], "cost": q.match.cost, "cost_px": q.cost_px,
-                     "panel_to_sheet_mm": q.target_to_sheet(run.bank, ppm).tolist()}
+                     "panel_to_sheet_mm": panel_to_sheet_mm(run, q).tolist()}
                     for q in run.patches],
         "fabricability": {"pieces": len(pieces), "problems": problems,
                           "repaired": {str(k): v for k, v in run.repaired.items()}},

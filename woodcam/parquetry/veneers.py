@@ -54,6 +54,11 @@ class Veneer:
         True where the wood may be used (no background, cracks, screw holes).
     source : str
         Where it came from (file path, block spec + plane), for result.json.
+    sheet_mm : (width, height) mm or None
+        The sheet's real size when its whole pixel count at ``px_per_mm`` rounds it (a resampled
+        scan, a leaf of a size given in mm): the rgb then spans exactly this size, each pixel
+        ``sheet_mm / (w, h)`` mm, within half a pixel of ``1 / px_per_mm``. None: ``(w, h) /
+        px_per_mm`` exactly.
     """
 
     id: str
@@ -61,12 +66,23 @@ class Veneer:
     px_per_mm: float
     mask: np.ndarray
     source: str = ""
+    sheet_mm: tuple[float, float] | None = None
 
     @property
     def size_mm(self) -> tuple[float, float]:
-        """``(width, height)`` of the sheet in mm."""
+        """``(width, height)`` of the sheet in mm (its real size, not the pixel grid's)."""
+        if self.sheet_mm is not None:
+            return float(self.sheet_mm[0]), float(self.sheet_mm[1])
         h, w = self.rgb.shape[:2]
         return w / self.px_per_mm, h / self.px_per_mm
+
+    def pixel_scale(self) -> tuple[float, float]:
+        """``(x, y)`` real mm of one pixel times ``px_per_mm``: 1 on an exact grid, within half a
+        pixel over the sheet of 1 on a rounded one. Sheet mm counted in pixels of
+        ``1 / px_per_mm`` times this are real mm on the sheet (the cut files' coordinates)."""
+        h, w = self.rgb.shape[:2]
+        W, H = self.size_mm
+        return W * self.px_per_mm / w, H * self.px_per_mm / h
 
     def resampled(self, px_per_mm: float) -> Veneer:
         """The same sheet at another resolution (area-averaged down, bilinear up)."""
@@ -81,7 +97,10 @@ class Veneer:
         rgb = cv2.resize(self.rgb, (nw, nh), interpolation=interp)
         # A resampled pixel is usable only if all the wood it averages was usable.
         m = cv2.resize(self.mask.astype(np.float32), (nw, nh), interpolation=interp) > 1 - 1e-4
-        return Veneer(self.id, np.clip(rgb, 0, 1).astype(np.float32), px_per_mm, m, self.source)
+        # the pixel count is rounded: the sheet's real size stays what it was (a 256 px scan at
+        # 50 dpi is 130.048 mm, not the 520 px / 4 = 130.000 mm of its working grid)
+        return Veneer(self.id, np.clip(rgb, 0, 1).astype(np.float32), px_per_mm, m, self.source,
+                      self.size_mm)
 
 
 def _check(v: Veneer) -> Veneer:
@@ -244,13 +263,14 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
                 out[a:b] = np.asarray(stock.wood.color(pts, normals), np.float32)
             return out
 
-        rgb = _supersampled(colour, nh, nw, px_per_mm, ss, adaptive)
+        # nw x nh pixels span the sheet exactly (8 in at 4 px/mm: 813 px of 0.24993 mm)
+        rgb = _supersampled(colour, nh, nw, (w_mm / nw, h_mm / nh), ss, adaptive)
         if turned:
             rgb = rgb[:, ::-1]
         sheets.append(_check(Veneer(f"{prefix}-{k:02d}", np.ascontiguousarray(rgb, np.float32),
                                     float(px_per_mm), np.ones((nh, nw), bool),
                                     f"{stock.spec} leaf {k} at {axis}={s:g} mm"
-                                    + (" (turned over)" if turned else ""))))
+                                    + (" (turned over)" if turned else ""), (float(w_mm), float(h_mm)))))
     return sheets
 
 
@@ -265,11 +285,11 @@ _SAMPLES_PER_CALL = 1_000_000
 _ONE_D = 6.0
 
 
-def _supersampled(colour, nh: int, nw: int, px_per_mm: float, ss: int,
+def _supersampled(colour, nh: int, nw: int, pixel_mm: tuple[float, float], ss: int,
                   adaptive: bool = True) -> np.ndarray:
     """A sheet ``(nh, nw, 3)`` float32 whose pixels are the mean of ``ss x ss`` point samples
-    of ``colour(u_mm, v_mm)`` over their squares (sample ``(i, j)`` of pixel ``(r, c)`` at
-    ``(c + (j + 0.5) / ss, r + (i + 0.5) / ss) / px_per_mm``).
+    of ``colour(u_mm, v_mm)`` over their rectangles of ``pixel_mm = (pu, pv)`` mm (sample
+    ``(i, j)`` of pixel ``(r, c)`` at ``((c + (j + 0.5) / ss) pu, (r + (i + 0.5) / ss) pv)``).
 
     adaptive : first every pixel's centre is sampled. A pixel whose 3 x 3 neighbourhood of
         centres varies by at most :data:`~woodcam.tolerances.PARQUETRY_SUPERSAMPLE_TOL` keeps
@@ -283,8 +303,9 @@ def _supersampled(colour, nh: int, nw: int, px_per_mm: float, ss: int,
 
     from ..tolerances import PARQUETRY_SUPERSAMPLE_TOL
 
-    uc = (np.arange(nw) + 0.5) / px_per_mm
-    vc = (np.arange(nh) + 0.5) / px_per_mm
+    pu, pv = pixel_mm
+    uc = (np.arange(nw) + 0.5) * pu
+    vc = (np.arange(nh) + 0.5) * pv
     t = [(j + 0.5) / ss - 0.5 for j in range(ss)]
     if not adaptive:
         cu, cv_ = np.meshgrid(uc, vc)
@@ -292,7 +313,7 @@ def _supersampled(colour, nh: int, nw: int, px_per_mm: float, ss: int,
         acc = np.zeros((cu.size, 3))
         for dv in t:
             for du in t:
-                acc += colour(cu + du / px_per_mm, cv_ + dv / px_per_mm)
+                acc += colour(cu + du * pu, cv_ + dv * pv)
         return (acc / (ss * ss)).reshape(nh, nw, 3).astype(np.float32)
     cu, cv_ = np.meshgrid(uc, vc)
     rgb = colour(cu.ravel(), cv_.ravel()).reshape(nh, nw, 3)
@@ -316,6 +337,6 @@ def _supersampled(colour, nh: int, nw: int, px_per_mm: float, ss: int,
         acc = np.zeros((rr.size, 3))
         for du, dv in offs:
             # the centre (odd ss) was sampled already
-            acc += rgb[rr, cc] if du == dv == 0.0 else colour(uc[cc] + du / px_per_mm, vc[rr] + dv / px_per_mm)
+            acc += rgb[rr, cc] if du == dv == 0.0 else colour(uc[cc] + du * pu, vc[rr] + dv * pv)
         rgb[rr, cc] = (acc / len(offs)).astype(np.float32)
     return rgb
