@@ -66,6 +66,15 @@ def test_a_glb_baked_from_a_relative_block_folder_reopens_from_another_folder(tm
     shutil.rmtree(work / "myblock")
     with pytest.raises(WoodcamError, match="which is not there any more; pass --block"):
         stock_of_glb(glb)
+    # a preview without a cut plane needs only the baked texture and the recorded block size: it
+    # was refused for the missing folder
+    from woodcam.cli import main
+
+    shown = {}
+    monkeypatch.setattr("woodcam.view.preview", lambda mesh, **kw: shown.update(kw, mesh=mesh))
+    assert main(["preview", str(glb), "--no-cut", "--screenshot", str(elsewhere / "p.png")]) == 0
+    assert shown["size_mm"] == stock.size_mm and shown["cut_plane"] is False
+    assert shown.get("wood") is None
 
 
 def test_a_synthetic_block_keeps_its_species_and_turns(tmp_path):

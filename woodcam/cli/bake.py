@@ -150,8 +150,9 @@ def run_bake(args: argparse.Namespace) -> int:
 
 
 def run_preview(args: argparse.Namespace) -> int:
+    from ..pipeline import screenshot_path
     from ..view import preview
-    from .options import stock_of_glb
+    from .options import recorded_block_size, stock_of_glb
 
     if not args.mesh.is_file():  # the viewer named its parameter: "mesh_or_path: no file at ..."
         raise WoodcamError(f"preview: no file at {str(args.mesh)!r}; pass a .glb or .obj written by "
@@ -166,6 +167,15 @@ def run_preview(args: argparse.Namespace) -> int:
         warnings.warn(f"{' and '.join(given)} place{'s' if len(given) == 1 else ''} the cut plane, which "
                       "--no-cut leaves out: "
                       "ignored; drop --no-cut to see that cut", WoodcamWarning, stacklevel=2)
+    if args.no_cut and not args.block and not args.confidence:
+        # no cut plane, no wood shown inside: the baked texture and the block's recorded size
+        # are all it needs (the block folder it was baked from may be gone, or slow to fit)
+        size = recorded_block_size(args.mesh)
+        out = preview(args.mesh, size_mm=size, screenshot=screenshot_path(args.screenshot, args.mesh),
+                      camera=args.camera, cut_plane=False)
+        if out:
+            print(f"wrote {out}")
+        return 0
     stock = stock_of_glb(args.mesh, args.block)
     wood = stock.wood if stock else None
     if args.confidence:
@@ -175,8 +185,6 @@ def run_preview(args: argparse.Namespace) -> int:
             raise WoodcamError("--confidence needs a block whose field was fitted (a block folder "
                                "without a true field, or a Mokume folder); pass --block")
         wood = ConfidenceWood(stock.wood.field)
-    from ..pipeline import screenshot_path
-
     out = preview(args.mesh, wood=wood, size_mm=stock.size_mm if stock else None,
                   screenshot=screenshot_path(args.screenshot, args.mesh),
                   camera=args.camera, cut_plane=not args.no_cut, cut_origin=args.cut_origin,

@@ -473,6 +473,22 @@ def write_screenshot(args, files: dict, stock) -> None:
     files["png"] = png
 
 
+def recorded_block_size(glb: Path):
+    """The block size ``(W, D, H)`` mm a baked GLB's metadata records, or None (another
+    program's file, an OBJ). A malformed size is named in a WoodcamError."""
+    from ..errors import WoodcamError
+    from ..export import read_glb_metadata
+    from ..frames import check_size
+
+    meta = read_glb_metadata(glb) if glb.suffix.lower() == ".glb" and glb.is_file() else {}
+    if meta.get("size_mm") is None:
+        return None
+    try:
+        return tuple(float(v) for v in check_size(meta["size_mm"]))
+    except WoodcamError as err:
+        raise WoodcamError(f"{str(glb)!r}: its metadata's {err}; re-bake it or pass --block SPEC") from err
+
+
 def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None):
     """The stock a baked GLB was cut from, as its metadata records it (absolute block spec,
     content digest, species, appearance and its parameters), or ``block`` when given.
