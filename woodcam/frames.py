@@ -281,6 +281,29 @@ BLOCK_TO_GLTF = np.array([[1e-3, 0.0, 0.0, 0.0],
                           [0.0, -1e-3, 0.0, 0.0],
                           [0.0, 0.0, 0.0, 1.0]])
 
+#: A glTF file that woodcam did not write is in metres with +Y up by the glTF 2.0 spec, yet some
+#: exporters write millimetres there anyway. A part whose largest side is under this many file
+#: units is read as the spec says (under 1 mm no router carves a part; over 1 m is a table, not a
+#: turned bowl): a trimesh 0.05 m box was read as a 0.05 mm speck, an empty preview and "too
+#: small to carve". From it up the numbers are taken as millimetres, Z up, as stored.
+FOREIGN_GLTF_METRES_BELOW = 1.0
+
+
+def foreign_gltf_frame(extent: float, what: str) -> tuple[np.ndarray, str] | None:
+    """For a glTF file not written by woodcam whose parts span ``extent`` file units along their
+    longest side: ``(4x4 file -> block frame (mm, Z up), one-line note naming ``what``)`` when it
+    is read as metres with +Y up (:data:`FOREIGN_GLTF_METRES_BELOW`), else None (mm, as stored)."""
+    if not 0 < extent < FOREIGN_GLTF_METRES_BELOW:
+        return None
+    note = (f"{what} is a glTF that woodcam did not write and spans {extent:.4g} units: read as "
+            f"metres with +Y up, as glTF specifies ({extent * 1e3:.4g} mm along its longest side); "
+            f"a glTF whose part spans {FOREIGN_GLTF_METRES_BELOW:g} unit or more is read as millimetres, Z up")
+    gltf_to_block = np.zeros((4, 4))
+    gltf_to_block[:3, :3] = BLOCK_TO_GLTF[:3, :3].T * 1e6  # exact: 1e3 m -> mm, not inv()'s 999.99...
+    gltf_to_block[3, 3] = 1.0
+    return np.round(gltf_to_block, 9), note
+
+
 #: Name of the GLB root node that carries :data:`BLOCK_TO_GLTF` above the block-frame mesh.
 GLTF_ROOT_NODE = "woodcam_block_frame"
 

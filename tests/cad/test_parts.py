@@ -228,6 +228,26 @@ def test_mesh_file_round_trip(tmp_path, block_minus_cylinder_mesh, suffix):
     assert load_part(str(path)).volume() == pytest.approx(volume, rel=FILE_ROUND_TRIP_RTOL)
 
 
+def test_another_programs_gltf_in_metres_is_read_as_metres_y_up(tmp_path):
+    """glTF is metres with +Y up by its spec: a 0.05 m box from trimesh was a 0.05 mm speck ("too
+    small to carve", an empty preview). A part under 1 unit is now read so, with a warning; the
+    woodcam view reads it the same way."""
+    from woodcam.export import load_textured
+
+    box = trimesh.creation.box((0.04, 0.02, 0.03))  # metres: x 40 mm, y (up) 20 mm, z (toward the viewer) 30 mm
+    box.apply_translation((0.1, 0.01, -0.05))
+    path = tmp_path / "box_m.glb"
+    path.write_bytes(box.export(file_type="glb"))
+    with pytest.warns(WoodcamWarning, match="read as metres with \\+Y up, as glTF specifies"):
+        solid = load_part(path)
+    assert solid.volume() == pytest.approx(40 * 20 * 30, rel=1e-6)
+    # block x = glTF x, block y = -glTF z, block z = glTF y; mm
+    np.testing.assert_allclose(solid.bounding_box(), (80, 35, 0, 120, 65, 20), atol=1e-4)
+    with pytest.warns(WoodcamWarning, match="read as metres"):
+        mesh = load_textured(path)
+    np.testing.assert_allclose(mesh.bounds, [(80, 35, 0), (120, 65, 20)], atol=1e-4)
+
+
 def test_step_round_trip(tmp_path, bd):
     part = bd.Pos(50, 40, 25) * (bd.Box(40, 30, 20) - bd.Cylinder(radius=8, height=20))
     path = tmp_path / "part.step"

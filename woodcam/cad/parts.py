@@ -14,7 +14,9 @@ Accepted sources (:func:`load_part`):
 - a list or tuple of any of these (incl. a build123d ``ShapeList``): their union;
 - a path (``str`` / ``Path``) to ``.step``/``.stp`` (B-rep, read with OpenCascade),
   ``.stl``/``.obj``/``.glb``/``.gltf`` (meshes, read with trimesh, coordinates taken as mm in the
-  block frame as stored: no unit or Y-up conversion), or a ``.py`` script that defines a
+  block frame as stored: no unit or Y-up conversion; except woodcam's own GLB/OBJ, put back in
+  the block frame, and another program's glTF whose part spans under 1 unit, read as the glTF
+  spec's metres with +Y up, with a warning), or a ``.py`` script that defines a
   module-level ``part`` (any of the objects above).
 
 B-rep shapes (build123d, cadquery, STEP) are tessellated with OpenCascade's
@@ -356,11 +358,21 @@ def _load_mesh_file(path: Path):
 
 def _undo_woodcam_export_frame(scene, path: Path) -> None:
     """A GLB/OBJ written by woodcam is metres and Y up on disk (glTF/OBJ conventions); put it
-    back in the block frame (mm, Z up) so re-baking an exported part lands where it was cut."""
-    from woodcam.frames import GLTF_ROOT_NODE, obj_header_transform
+    back in the block frame (mm, Z up) so re-baking an exported part lands where it was cut.
+    Another program's glTF is metres and Y up too when its size says so
+    (:func:`woodcam.frames.foreign_gltf_frame`)."""
+    import warnings
+
+    from woodcam.errors import WoodcamWarning
+    from woodcam.frames import GLTF_ROOT_NODE, foreign_gltf_frame, obj_header_transform
 
     if GLTF_ROOT_NODE in scene.graph.nodes:
         scene.graph.update(frame_to=GLTF_ROOT_NODE, matrix=np.eye(4))
+    elif path.suffix.lower() in (".glb", ".gltf") and not scene.is_empty:
+        metres = foreign_gltf_frame(float(np.max(scene.extents)), f"mesh file {str(path)!r}")
+        if metres is not None:
+            scene.apply_transform(metres[0])
+            warnings.warn(metres[1], WoodcamWarning, stacklevel=4)
     elif path.suffix.lower() == ".obj":
         recorded = obj_header_transform(path)
         if recorded is not None:

@@ -126,18 +126,19 @@ def _load_mesh(mesh_or_path):
                 f"mesh_or_path: no file at {str(path)!r}; pass a .glb/.obj/.ply/.stl file "
                 "written by woodcam (e.g. out/part.glb) or a trimesh.Trimesh"
             )
-        from woodcam.export import load_textured, written_by_woodcam
+        from woodcam.export import foreign_gltf_in_block_frame, load_textured, written_by_woodcam
 
         try:
-            # woodcam's own GLB/OBJ are metres/Y-up on disk: load_textured returns the block frame
-            loaded = (load_textured(path) if written_by_woodcam(path)
-                      else trimesh.load(path, force="mesh"))
+            # woodcam's own GLB/OBJ are metres/Y-up on disk: load_textured returns the block frame;
+            # another program's glTF is metres/Y-up too when its size says so
+            ours = written_by_woodcam(path)
+            loaded = load_textured(path) if ours else trimesh.load(path, force="mesh")
         except Exception as err:  # trimesh raises many types for unreadable files
             raise WoodcamError(
                 f"mesh_or_path: could not read a mesh from {str(path)!r} ({err}); "
                 "pass a .glb/.obj/.ply/.stl file"
             ) from err
-        mesh_or_path = loaded
+        mesh_or_path = loaded if ours else foreign_gltf_in_block_frame(loaded, path)
     if isinstance(mesh_or_path, trimesh.Scene):
         meshes = [g for g in mesh_or_path.dump() if isinstance(g, trimesh.Trimesh)]
         if not meshes:
