@@ -137,8 +137,10 @@ def open_stock(spec: str, *, species: str | None = None,
 def _check_appearance_params(appearance: str, params: dict) -> None:
     """Refuse a keyword the chosen appearance does not take, before any fit (``foo=1`` was a
     bare TypeError deep inside, after the block was read)."""
+    from collections.abc import Callable
     import inspect
 
+    targets: list[Callable]
     if appearance == "neural":
         from .appearance.neural import fit_neural_appearance
 
