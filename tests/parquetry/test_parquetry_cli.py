@@ -66,3 +66,27 @@ def test_cli_bad_input_is_one_line(scans, capsys, args, message):
     assert main(argv) == 1
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and err.startswith("woodcam: error:") and message in err
+
+
+def _small_run(scans, out, *extra):
+    return main(["parquetry", str(scans / "coffee.png"), "--veneer", f"{scans / 'light.png'}:2px/mm",
+                 "--veneer", f"{scans / 'dark.png'}:2px/mm", "--image-size-mm", "42", "--px-per-mm", "2",
+                 "--no-seams", "--out", str(out), "--quiet", *extra])
+
+
+def test_an_interrupted_rerun_leaves_the_previous_files_whole(scans, capsys, monkeypatch):
+    """Ctrl-C while the cut files were written left a new render.png and assembly.svg beside
+    the previous run's result.json and sheets."""
+    import woodcam.parquetry.output as output
+    from woodcam.cli import EXIT_INTERRUPTED
+
+    out = scans / "out"
+    assert _small_run(scans, out) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(output, "write_dxf", interrupted)
+    assert _small_run(scans, out, "--n-rot", "4", "--priority", "center") == EXIT_INTERRUPTED
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before   # no file changed, none added

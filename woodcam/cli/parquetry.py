@@ -172,7 +172,6 @@ def run(args) -> int:
         job_targets,
         job_veneers,
         read_job,
-        write_job,
     )
     from ..parquetry.output import format_summary, write_parquetry
 
@@ -214,10 +213,9 @@ def run(args) -> int:
     glb_writer = None
     if not args.no_glb:
         from ..export import export_glb as glb_writer
-    res = write_parquetry(run_, args.out, glb_writer=glb_writer, progress=progress)
-    write_job(job, Path(args.out) / "job.json")
+    res = write_parquetry(run_, args.out, glb_writer=glb_writer, progress=progress, job=job)
     print(format_summary(res["summary"], res["problems"]))
-    print(f"wrote {len(res['files']) + 1} files to {args.out}")
+    print(f"wrote {len(res['files'])} files to {args.out}")
     from . import EXIT_CHECKS, EXIT_OK
 
     return EXIT_OK if run_.complete else EXIT_CHECKS

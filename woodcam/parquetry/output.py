@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import write_text
+from .._atomic import all_or_nothing, write_text
 from ._io import atomic_write_png
 from .cutpaths import (
     Piece,
@@ -19,6 +19,7 @@ from .cutpaths import (
     write_dxf,
 )
 from .engine import ParquetryRun, feature_cost, ssim_vs_matched
+from .job import ParquetryJob, write_job
 
 #: Thickness (mm) of the board in panel.glb: 0.6 mm veneer on a 1.5 mm birch ply substrate,
 #: the build-up of seed 002 sec. 3.1.
@@ -112,7 +113,8 @@ def summary(run: ParquetryRun) -> dict:
 
 
 def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
-                    glb_writer: Callable[..., Path] | None = None, progress: bool = False) -> dict:
+                    glb_writer: Callable[..., Path] | None = None, progress: bool = False,
+                    job: ParquetryJob | None = None) -> dict:
     """Write every file of a run into ``out_dir``; returns ``{"files": [...], "summary": {...},
     "problems": {...}}``.
 
@@ -122,8 +124,10 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
     that gives a piece (cut paths in sheet mm, tool paths, engraved ids), ``result.json``
     (every patch: region, sheet, rotation, anchor, cost; parameters; figures; fabricability),
     ``panel.glb`` (the panel as a textured board, when ``glb_writer`` is given: pass
-    ``woodcam.export_glb``, which sits in a sibling layer). Several targets get ``_<name>``
-    suffixes.
+    ``woodcam.export_glb``, which sits in a sibling layer), ``job.json`` (the run as a job
+    file, when ``job`` is given). Several targets get ``_<name>`` suffixes. The files are one
+    set (:func:`woodcam._atomic.all_or_nothing`): an interrupted or failed write leaves the
+    folder's previous files as they were, never new ones beside old ones.
     """
     import base64
     import io
@@ -137,57 +141,62 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
     files = []
     pieces = run_pieces(run)
     by_id = {pc.id: pc for pc in pieces}
-    for k, p in enumerate(run.panels):
-        sfx = _suffix(run, k)
-        files.append(atomic_write_png(out / f"render{sfx}.png", p.render))
-        files.append(atomic_write_png(out / f"baseline{sfx}.png", p.baseline))
-        files.append(atomic_write_png(out / f"target_matched{sfx}.png", np.repeat(p.matched[..., None], 3, 2)))
-        W, H = p.matched.shape[1] / ppm, p.matched.shape[0] / ppm
-        buf = io.BytesIO()
-        Image.fromarray((np.clip(p.render, 0, 1) * 255 + 0.5).astype(np.uint8)).save(buf, format="PNG")
-        uri = "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode()
-        # xlink:href, not SVG 2's plain href: SVG 1.1 readers (Inkscape before 1.3) see only the
-        # former, and every browser and SVG 2 reader still reads it
-        bg = (f'<image x="0" y="0" width="{W:.3f}" height="{H:.3f}" preserveAspectRatio="none" '
-              f'xlink:href="{uri}"/>')
-        doc = svg_document(W, H, [(q.id, by_id[q.id].outline_panel) for q in p.patches],
-                           background=bg, title=f"woodcam parquetry assembly {p.name}")
-        files.append(write_text(out / f"assembly{sfx}.svg", doc, mkdir=True))
-        if glb_writer is not None:
-            files.append(glb_writer(panel_mesh(p.render, ppm), out / f"panel{sfx}.glb",
-                                    metadata={"kind": "parquetry panel", "units": "mm",
-                                              "size_mm": [W, H, PANEL_THICKNESS_MM]}))
-    sheets_used = sorted({pc.sheet for pc in pieces})
-    it = sheets_used
-    if progress and len(sheets_used) > 1:
-        from .._progress import progress_bar
+    # one set: a Ctrl-C while the cut files are written left a new render.png and assembly.svg
+    # beside the previous run's result.json and sheets
+    with all_or_nothing():
+        for k, p in enumerate(run.panels):
+            sfx = _suffix(run, k)
+            files.append(atomic_write_png(out / f"render{sfx}.png", p.render))
+            files.append(atomic_write_png(out / f"baseline{sfx}.png", p.baseline))
+            files.append(atomic_write_png(out / f"target_matched{sfx}.png", np.repeat(p.matched[..., None], 3, 2)))
+            W, H = p.matched.shape[1] / ppm, p.matched.shape[0] / ppm
+            buf = io.BytesIO()
+            Image.fromarray((np.clip(p.render, 0, 1) * 255 + 0.5).astype(np.uint8)).save(buf, format="PNG")
+            uri = "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode()
+            # xlink:href, not SVG 2's plain href: SVG 1.1 readers (Inkscape before 1.3) see only the
+            # former, and every browser and SVG 2 reader still reads it
+            bg = (f'<image x="0" y="0" width="{W:.3f}" height="{H:.3f}" preserveAspectRatio="none" '
+                  f'xlink:href="{uri}"/>')
+            doc = svg_document(W, H, [(q.id, by_id[q.id].outline_panel) for q in p.patches],
+                               background=bg, title=f"woodcam parquetry assembly {p.name}")
+            files.append(write_text(out / f"assembly{sfx}.svg", doc, mkdir=True))
+            if glb_writer is not None:
+                files.append(glb_writer(panel_mesh(p.render, ppm), out / f"panel{sfx}.glb",
+                                        metadata={"kind": "parquetry panel", "units": "mm",
+                                                  "size_mm": [W, H, PANEL_THICKNESS_MM]}))
+        sheets_used = sorted({pc.sheet for pc in pieces})
+        it = sheets_used
+        if progress and len(sheets_used) > 1:
+            from .._progress import progress_bar
 
-        it = progress_bar(sheets_used, desc="writing cut files", unit="sheet")
-    for i in it:
-        v = run.veneers[i]
-        W, H = v.size_mm
-        mine = [(pc.id, pc.outline_sheet) for pc in pieces if pc.sheet == i]
-        files.append(write_text(out / f"veneer_{v.id}.svg",
-                                svg_document(W, H, mine, prm.tool_diameter_mm / 2, title=f"woodcam veneer {v.id}"),
-                                mkdir=True))
-        files.append(write_dxf(out / f"veneer_{v.id}.dxf", H, mine, prm.tool_diameter_mm / 2))
-    summ = summary(run)
-    problems = {pc.id: pc.problems for pc in pieces if pc.problems}
-    result = {
-        "params": {**prm.__dict__, "overlap_mm_used": prm.overlap, "kerf_mm_used": prm.kerf},
-        "summary": summ,
-        "veneers": [{"id": v.id, "source": v.source, "size_mm": list(v.size_mm),
-                     "px_per_mm": v.px_per_mm, "file_svg": f"veneer_{v.id}.svg"} for v in run.veneers],
-        "patches": [{"id": q.id, "target": q.target, "row": q.row, "col": q.col, "cells": q.cells,
-                     "region_mm": [q.col * prm.patch_mm, q.row * prm.patch_mm, q.cells * prm.patch_mm],
-                     "sheet": run.veneers[q.match.sheet].id, "rotation_deg": run.bank.angles_deg[q.match.rot],
-                     "anchor_px": [q.match.x, q.match.y], "cost": q.match.cost, "cost_px": q.cost_px,
-                     "panel_to_sheet_mm": panel_to_sheet_mm(run, q).tolist()}
-                    for q in run.patches],
-        "fabricability": {"pieces": len(pieces), "problems": problems,
-                          "repaired": {str(k): v for k, v in run.repaired.items()}},
-    }
-    files.append(write_text(out / "result.json", json.dumps(result, indent=1, default=float), mkdir=True))
+            it = progress_bar(sheets_used, desc="writing cut files", unit="sheet")
+        for i in it:
+            v = run.veneers[i]
+            W, H = v.size_mm
+            mine = [(pc.id, pc.outline_sheet) for pc in pieces if pc.sheet == i]
+            files.append(write_text(out / f"veneer_{v.id}.svg",
+                                    svg_document(W, H, mine, prm.tool_diameter_mm / 2, title=f"woodcam veneer {v.id}"),
+                                    mkdir=True))
+            files.append(write_dxf(out / f"veneer_{v.id}.dxf", H, mine, prm.tool_diameter_mm / 2))
+        summ = summary(run)
+        problems = {pc.id: pc.problems for pc in pieces if pc.problems}
+        result = {
+            "params": {**prm.__dict__, "overlap_mm_used": prm.overlap, "kerf_mm_used": prm.kerf},
+            "summary": summ,
+            "veneers": [{"id": v.id, "source": v.source, "size_mm": list(v.size_mm),
+                         "px_per_mm": v.px_per_mm, "file_svg": f"veneer_{v.id}.svg"} for v in run.veneers],
+            "patches": [{"id": q.id, "target": q.target, "row": q.row, "col": q.col, "cells": q.cells,
+                         "region_mm": [q.col * prm.patch_mm, q.row * prm.patch_mm, q.cells * prm.patch_mm],
+                         "sheet": run.veneers[q.match.sheet].id, "rotation_deg": run.bank.angles_deg[q.match.rot],
+                         "anchor_px": [q.match.x, q.match.y], "cost": q.match.cost, "cost_px": q.cost_px,
+                         "panel_to_sheet_mm": panel_to_sheet_mm(run, q).tolist()}
+                        for q in run.patches],
+            "fabricability": {"pieces": len(pieces), "problems": problems,
+                              "repaired": {str(k): v for k, v in run.repaired.items()}},
+        }
+        files.append(write_text(out / "result.json", json.dumps(result, indent=1, default=float), mkdir=True))
+        if job is not None:
+            files.append(write_job(job, out / "job.json"))
     return {"files": [str(f) for f in files], "summary": summ, "problems": problems}
 
 
