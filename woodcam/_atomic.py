@@ -43,7 +43,7 @@ from typing import IO
 from .errors import WoodcamError
 
 __all__ = ["all_or_nothing", "atomic_files", "atomic_path", "atomic_write", "check_output_path",
-           "write_bytes", "write_figure", "write_text"]
+           "remove_stale", "write_bytes", "write_figure", "write_text"]
 
 
 def _umask() -> int:
@@ -233,6 +233,23 @@ def write_text(path, text: str, **kwargs) -> Path:
     with atomic_write(path, "w", **kwargs) as fh:
         fh.write(text)
     return Path(path)
+
+
+def remove_stale(folder, patterns: Iterable[str], keep: Iterable) -> list[Path]:
+    """Delete the files of ``folder`` that match one of the glob ``patterns`` but are not in
+    ``keep`` (the files a run has just written there): what an earlier run into the same
+    folder wrote and this one does not replace (a veneer sheet no longer cut, a surface at
+    another year) would otherwise pass for this run's. Call it after the new files are in
+    place. Returns the paths removed."""
+    folder = Path(folder)
+    ours = {Path(f).resolve() for f in keep}
+    gone = []
+    for pattern in patterns:
+        for old in folder.glob(pattern):
+            if old.is_file() and old.resolve() not in ours:
+                old.unlink(missing_ok=True)
+                gone.append(old)
+    return gone
 
 
 def write_figure(fig, path, **savefig_kwargs) -> Path:

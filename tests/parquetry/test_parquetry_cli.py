@@ -90,3 +90,20 @@ def test_an_interrupted_rerun_leaves_the_previous_files_whole(scans, capsys, mon
     monkeypatch.setattr(output, "write_dxf", interrupted)
     assert _small_run(scans, out, "--n-rot", "4", "--priority", "center") == EXIT_INTERRUPTED
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before   # no file changed, none added
+
+
+def test_a_rerun_leaves_no_sheet_of_the_earlier_run(scans, capsys):
+    """A rerun into the same folder left the earlier run's veneer_<id>.svg/.dxf (sheets this
+    run does not cut, which a router would cut all the same) and its panel.glb under --no-glb."""
+    out = scans / "out"
+    assert _small_run(scans, out) == 0
+    assert (out / "veneer_dark.svg").is_file() and (out / "veneer_dark.dxf").is_file()
+    (out / "notes.txt").write_text("mine")
+    assert main(["parquetry", str(scans / "coffee.png"), "--veneer", f"{scans / 'light.png'}:2px/mm",
+                 "--image-size-mm", "42", "--px-per-mm", "2", "--no-seams", "--no-glb", "--out", str(out),
+                 "--quiet"]) == 0
+    result = json.loads((out / "result.json").read_text())
+    assert {p["sheet"] for p in result["patches"]} == {"light"}
+    assert sorted(p.name for p in out.iterdir()) == [
+        "assembly.svg", "baseline.png", "job.json", "notes.txt", "render.png", "result.json",
+        "target_matched.png", "veneer_light.dxf", "veneer_light.svg"]

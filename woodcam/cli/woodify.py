@@ -306,7 +306,7 @@ def run(args) -> int:
                   shape=args.shape, eccentricity=args.eccentricity, up=args.up, obstacles=obstacles,
                   brushes=brushes, resolution=args.resolution, method=args.method, **painted)
     steps.update(1)
-    from .._atomic import all_or_nothing
+    from .._atomic import all_or_nothing, remove_stale
 
     # one unit: a Ctrl-C leaves the last run's products, never new ones beside old ones (a grown.glb
     # of 13 years beside a woodify.json of 11)
@@ -323,10 +323,7 @@ def run(args) -> int:
         _atomic(Path(args.out) / "woodify.json",
                 lambda p: p.write_text(json.dumps(summary, indent=1, default=float)))
     # an earlier run's surfaces at other years are not this run's: they went on piling up
-    ours = {Path(f).resolve() for f in files}
-    for old in Path(args.out).glob("surface_y*.stl"):
-        if old.resolve() not in ours:
-            old.unlink()
+    remove_stale(args.out, ["surface_y*.stl"], files)
     print(f"grew {args.part} for {args.years:g} years on a {'x'.join(map(str, res.front.grid.shape))} "
           f"grid ({res.front.method}, {summary['total_s']:.1f} s); wrote "
           + ", ".join(str(f) for f in files))

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import all_or_nothing, write_text
+from .._atomic import all_or_nothing, remove_stale, write_text
 from ._io import atomic_write_png
 from .cutpaths import (
     Piece,
@@ -127,7 +127,9 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
     ``woodcam.export_glb``, which sits in a sibling layer), ``job.json`` (the run as a job
     file, when ``job`` is given). Several targets get ``_<name>`` suffixes. The files are one
     set (:func:`woodcam._atomic.all_or_nothing`): an interrupted or failed write leaves the
-    folder's previous files as they were, never new ones beside old ones.
+    folder's previous files as they were, never new ones beside old ones; once they are in
+    place, the files of those kinds an earlier run left there (sheets not cut this time) are
+    removed.
     """
     import base64
     import io
@@ -197,6 +199,12 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
         files.append(write_text(out / "result.json", json.dumps(result, indent=1, default=float), mkdir=True))
         if job is not None:
             files.append(write_job(job, out / "job.json"))
+    # an earlier run's sheets (and panels of other targets, a panel.glb under --no-glb) are not
+    # this run's: sent to the router with the rest, they would be cut for nothing
+    remove_stale(out, [f"{stem}{s}" for stem in ("render", "baseline", "target_matched")
+                       for s in (".png", "_*.png")]
+                 + ["assembly.svg", "assembly_*.svg", "panel.glb", "panel_*.glb", "veneer_*.svg",
+                    "veneer_*.dxf"], files)
     return {"files": [str(f) for f in files], "summary": summ, "problems": problems}
 
 
