@@ -107,3 +107,21 @@ def test_a_rerun_leaves_no_sheet_of_the_earlier_run(scans, capsys):
     assert sorted(p.name for p in out.iterdir()) == [
         "assembly.svg", "baseline.png", "job.json", "notes.txt", "render.png", "result.json",
         "target_matched.png", "veneer_light.dxf", "veneer_light.svg"]
+
+
+def test_leaf_slicing_options_reach_the_job_file_blocks_or_are_named(scans, capsys):
+    """--sheets, --species, --sheet-size ... were ignored without a word with only scans, and
+    did not reach the blocks of a --config job ('options given here override it')."""
+    out = scans / "out"
+    assert _small_run(scans, out, "--sheets", "5", "--species", "walnut") == 0
+    err = capsys.readouterr().err
+    assert "--sheets, --species slice leaves from blocks" in err and "scans (--veneer)" in err
+    job = json.loads((out / "job.json").read_text())
+    job["woodcam"]["blocks"] = [{"spec": "builtin:flat-sawn", "sheets": 2, "width_mm": 80, "height_mm": 60}]
+    (scans / "job.json").write_text(json.dumps(job))
+    assert main(["parquetry", "--config", str(scans / "job.json"), "--species", "walnut", "--sheets", "1",
+                 "--sheet-size", "70x56", "--out", str(scans / "out2"), "--quiet", "--no-glb"]) == 0
+    assert "change nothing" not in capsys.readouterr().err
+    sliced = [v for v in json.loads((scans / "out2" / "result.json").read_text())["veneers"]
+              if v["id"].startswith("builtin")]
+    assert [(v["id"], v["size_mm"]) for v in sliced] == [("builtin-flat-sawn-walnut-00", [70.0, 56.0])]

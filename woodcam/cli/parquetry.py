@@ -185,19 +185,26 @@ def run(args) -> int:
         job.targets = [{"filename": str(t), "scale": 1.0} for t in args.target]
     job.scans = job.scans + [_scan_entry(s) for s in args.veneer]
     w, h = parse_sizes(args.sheet_size, "--sheet-size", n=2)
+    given = [d for d, default in _SLICING.items() if getattr(args, d) != default]
+    # the slicing options given here override the job file's blocks too (--config's rule: options
+    # given here override it); they were ignored there
+    leaf = {"sheets": args.sheets, "width_mm": w, "height_mm": h, "thickness_mm": args.leaf_thickness,
+            "kerf_mm": args.saw_kerf, "axis": args.slice_axis, "species": args.species}
+    keys = {"sheets": ["sheets"], "sheet_size": ["width_mm", "height_mm"], "leaf_thickness": ["thickness_mm"],
+            "saw_kerf": ["kerf_mm"], "slice_axis": ["axis"], "species": ["species"]}
+    job.blocks = [{**b, **{k: leaf[k] for d in given for k in keys[d]}} for b in job.blocks]
     for spec in args.veneer_from:
         sp = Path(spec)
         if sp.is_dir() and any(sp.glob("?_col.png")):
             job.mokume.append(str(sp))
         else:
-            job.blocks.append({"spec": spec, "sheets": args.sheets, "width_mm": w, "height_mm": h,
-                               "thickness_mm": args.leaf_thickness, "kerf_mm": args.saw_kerf,
-                               "axis": args.slice_axis, "species": args.species})
-    given = ["--" + d.replace("_", "-") for d, default in _SLICING.items() if getattr(args, d) != default]
-    if given and job.mokume and not job.blocks:  # nothing silently dropped
-        warnings.warn(f"{', '.join(given)} slice leaves from blocks; the Mokume sample folders given "
-                      "are used as their photos are, so these options change nothing here", WoodcamWarning,
-                      stacklevel=2)
+            job.blocks.append({"spec": spec, **leaf})
+    if given and not job.blocks:  # nothing silently dropped
+        sources = " and ".join(n for n, on in (("scans (--veneer)", job.scans),
+                                               ("Mokume sample folders", job.mokume)) if on)
+        warnings.warn(f"{', '.join('--' + d.replace('_', '-') for d in given)} slice leaves from blocks "
+                      f"(--veneer-from BLOCK_SPEC) and none is given; the {sources or 'veneers'} are used "
+                      "as they are, so these options change nothing here", WoodcamWarning, stacklevel=2)
     if not job.targets:
         raise WoodcamError("parquetry needs a target image (TARGET or a --config job with targets)")
     if not (job.scans or job.mokume or job.blocks):
