@@ -155,32 +155,39 @@ def _check_appearance_params(appearance: str, params: dict) -> None:
                            f"appearance ({', '.join(sorted(taken))}); got {unknown[0]!r}; check its spelling")
 
 
-def absolute_spec(spec: str) -> str:
-    """``spec`` with any folder or log file it names made absolute, so a file that records it
-    (a GLB) reopens the same block from any working folder."""
-    base, sep, turns = str(spec).partition("~")
+def spec_path(spec: str) -> Path | None:
+    """The file or folder a block ``spec`` names (a block or sample folder, a log file, a
+    woodify field), as written; None for built-in blocks and the shared ``gran1`` log."""
+    base = str(spec).partition("~")[0]
     if base.startswith("log:"):
-        source, at, rest = base[len("log:"):].partition("@")
-        if source.lower().endswith(".json"):
-            base = f"log:{Path(source).resolve()}{at}{rest}"
-    elif not base.startswith("builtin:"):
-        base = str(Path(base).resolve())
+        source = base[len("log:"):].partition("@")[0]
+        return Path(source) if source.lower().endswith(".json") else None
+    if base.startswith("woodify:"):
+        return Path(base[len("woodify:"):])
+    return None if base.startswith("builtin:") else Path(base)
+
+
+def absolute_spec(spec: str) -> str:
+    """``spec`` with any folder, log file or woodify field it names made absolute, so a file
+    that records it (a GLB) reopens the same block from any working folder."""
+    base, sep, turns = str(spec).partition("~")
+    path = spec_path(base)
+    if path is not None and base.startswith("log:"):
+        _, at, rest = base.partition("@")
+        base = f"log:{path.resolve()}{at}{rest}"
+    elif path is not None:
+        base = f"{'woodify:' if base.startswith('woodify:') else ''}{path.resolve()}"
     return base + sep + turns
 
 
 def spec_digest(spec: str) -> str:
     """Content identity of the block ``spec`` names: a digest of every file of a block or sample
-    folder (or of a log file), or of the spec itself for synthetic blocks."""
+    folder (or of a log file or woodify field), or of the spec itself for synthetic blocks."""
     from . import __version__
     from ._cache import digest
 
     base = str(spec).partition("~")[0]
-    path = None
-    if base.startswith("log:"):
-        source = base[len("log:"):].partition("@")[0]
-        path = Path(source) if source.lower().endswith(".json") else None
-    elif not base.startswith("builtin:"):
-        path = Path(base)
+    path = spec_path(base)
     if path is not None and path.is_dir():
         files = sorted(p for p in path.rglob("*") if p.is_file() and not p.name.startswith("."))
         return digest([(str(p.relative_to(path)), p) for p in files])

@@ -79,6 +79,40 @@ def test_bake_carves_a_bowl_from_the_grown_wood(grown_dir, tmp_path):
     assert rc == 0 and out.stat().st_size > 10_000
 
 
+def test_a_glb_baked_from_a_grown_block_reopens_its_wood(grown_dir, tmp_path, monkeypatch):
+    """A part baked from 'woodify:DIR/field.npz' recorded the block as the folder
+    '<cwd>/woodify:DIR/field.npz': preview and review of it failed ('not there any more'), and
+    its digest was of the spec's text, blind to a changed field.npz."""
+    import shutil
+
+    from woodcam.cli.options import stock_of_glb
+    from woodcam.errors import WoodcamWarning
+    from woodcam.export import read_glb_metadata
+    from woodcam.pipeline import preview_mesh
+
+    shutil.copy(grown_dir / "field.npz", tmp_path / "field.npz")
+    monkeypatch.chdir(tmp_path)
+    stock = open_stock("woodify:field.npz")
+    box = trimesh.creation.box((20.0, 16.0, 10.0))
+    box.apply_translation([50.0, 40.0, 25.0])
+    glb = preview_mesh(box, stock, tmp_path / "part.glb", texels_per_mm=1.0, obj=False,
+                       screenshot=False).files["glb"]
+    assert read_glb_metadata(glb)["block"] == f"woodify:{tmp_path / 'field.npz'}"
+    monkeypatch.chdir(grown_dir)
+    again = stock_of_glb(glb)
+    p = np.random.default_rng(0).uniform(5.0, 45.0, (200, 3))
+    n = np.tile([0.0, 0.0, 1.0], (len(p), 1))
+    np.testing.assert_allclose(again.wood.color(p, n), stock.wood.color(p, n), atol=1e-6)
+    # another grown field under the same name: a warning; none: an error naming the file
+    f = WoodifiedField.load(tmp_path / "field.npz")
+    f.placed((90.0, 80.0, 50.0), tuple(f.block_origin_mm + (45.0, 40.0, 25.0))).save(tmp_path / "field.npz")
+    with pytest.warns(WoodcamWarning, match="changed since part.glb was baked"):
+        stock_of_glb(glb)
+    (tmp_path / "field.npz").unlink()
+    with pytest.raises(WoodcamError, match="field.npz', which is not there any more; pass --block"):
+        stock_of_glb(glb)
+
+
 def test_cli_errors_are_one_line(tmp_path, capsys):
     m = trimesh.creation.icosphere(subdivisions=2, radius=5.0)
     m.export(tmp_path / "ball.stl")

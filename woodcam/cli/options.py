@@ -500,7 +500,7 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
 
     from ..errors import WoodcamError, WoodcamWarning
     from ..export import read_glb_metadata
-    from ..stock import open_stock, spec_digest
+    from ..stock import open_stock, spec_digest, spec_path
 
     meta = read_glb_metadata(glb) if glb.suffix.lower() == ".glb" and glb.is_file() else {}
     app = meta.get("appearance") if isinstance(meta.get("appearance"), dict) else {}
@@ -521,10 +521,10 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
     if not isinstance(spec, str) or len(spec) > 4096:
         raise WoodcamError(f"the block spec in {str(glb)!r}'s metadata must be a string; got a "
                            f"{type(spec).__name__}; pass --block SPEC")
-    base = str(spec).partition("~")[0]
-    if not base.startswith(("builtin:", "log:")) and not Path(base).exists():
+    path = spec_path(spec)
+    if path is not None and not path.exists():
         raise WoodcamError(
-            f"{str(glb)!r} was baked from the block folder {base!r}, which is not there any more; "
+            f"{str(glb)!r} was baked from the block {str(path)!r}, which is not there any more; "
             "pass --block SPEC (the same block, moved) to rebuild its wood")
     if meta.get("block_digest") and spec_digest(spec) != meta["block_digest"]:
         warnings.warn(f"the block {spec!r} changed since {glb.name} was baked (its files differ); "
