@@ -193,7 +193,7 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     targets : list of (h, w, 3) float RGB in [0, 1] (or one array)
     veneers : list of :class:`Veneer` (any resolution; resampled to ``params.px_per_mm``)
     params : :class:`ParquetryParams` (Table 1 defaults)
-    progress : tqdm bar over the patches
+    progress : progress bars over the sheets' rotations and the patches
     seams : cut optimal seams in the overlaps (eq. 8-9); False keeps square patches
     repair : straighten the seams round pieces a router cannot cut (see
         :func:`repair_fabricability`); False leaves them to be reported
@@ -232,7 +232,7 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
                      top_k=params.top_k,
                      single_use=params.single_use, w_struct=params.w_struct,
                      rerank=params.rerank, flat_detail=params.flat_detail,
-                     flat_rerank=params.flat_rerank)
+                     flat_rerank=params.flat_rerank, progress=progress)
     names = names or [f"target{k}" for k in range(len(targets))]
     panels = [prepare_target(t, params, src_vals, k, names[k]) for k, t in enumerate(targets)]
 

@@ -55,22 +55,28 @@ class Match:
 class _Atlas:
     """All rotated sheets of one pyramid level in one image (see module docstring)."""
 
-    def __init__(self, bank: SheetBank, f: int):
+    def __init__(self, bank: SheetBank, f: int, progress: bool = False):
+        import itertools
+
         import cv2
+
+        from .._progress import progress_bar
 
         self.f = f
         tiles = []                      # (sheet, rot, feats, usable, affine)
-        for i, (G, U) in enumerate(zip(bank.grey, bank.usable)):
-            for j, a in enumerate(bank.angles_deg):
-                # eq. 3: the features of the rotated sheet (not the rotated features)
-                Gr, Ur, m = rotate(G, U, a)
-                Fr = bank.features(Gr)
-                if f > 1:
-                    Fr = _coarse(Fr, f)
-                    hc, wc = Fr.shape[:2]
-                    Ur = cv2.resize(Ur[:hc * f, :wc * f].astype(np.float32), (wc, hc),
-                                    interpolation=cv2.INTER_AREA) > 1 - 1e-4
-                tiles.append((i, j, Fr, Ur, m))
+        # seconds to minutes before the first patch is matched (every sheet rotated n_rot times)
+        every = progress_bar(list(itertools.product(range(len(bank.grey)), range(len(bank.angles_deg)))),
+                             desc="rotating sheets", unit="rotation", enabled=progress)
+        for i, j in every:
+            # eq. 3: the features of the rotated sheet (not the rotated features)
+            Gr, Ur, m = rotate(bank.grey[i], bank.usable[i], bank.angles_deg[j])
+            Fr = bank.features(Gr)
+            if f > 1:
+                Fr = _coarse(Fr, f)
+                hc, wc = Fr.shape[:2]
+                Ur = cv2.resize(Ur[:hc * f, :wc * f].astype(np.float32), (wc, hc),
+                                interpolation=cv2.INTER_AREA) > 1 - 1e-4
+            tiles.append((i, j, Fr, Ur, m))
         # Shelf packing, rows about as wide as the square root of the total area.
         pad = 1
         width = int(max(max(t[2].shape[1] for t in tiles) + pad,
@@ -422,6 +428,7 @@ class SheetBank:
     flat_detail, flat_rerank : where the template's target is flat (:func:`_flat_fraction`),
         the coarse detail channel's weight and the number re-ranked rise towards these
         (1.0 and ``rerank``: off; see :meth:`best`)
+    progress : a bar over the rotated sheets while they are prepared (woodcam._progress)
     """
 
     def __init__(self, grey, usable, w_intens: float = 0.5, w_edge: float = 0.5,
@@ -429,7 +436,7 @@ class SheetBank:
                  mode: MatchMode = "fast", coarse_factor: int = 4, top_k: int = 12,
                  single_use: bool = True, max_atlas_bytes: int = 2_500_000_000,
                  w_struct: float = 0.0, rerank: int = 4, flat_detail: float = 1.0,
-                 flat_rerank: int | None = None):
+                 flat_rerank: int | None = None, progress: bool = False):
         if mode not in ("exhaustive", "fast"):
             raise WoodcamError(f"mode must be one of ['exhaustive', 'fast']; got {mode!r}")
         if n_rot < 1:
@@ -457,7 +464,7 @@ class SheetBank:
                 f"the {mode} search would hold ~{est / 1e9:.1f} GB of rotated sheets (limit "
                 f"{max_atlas_bytes / 1e9:.1f} GB); use mode 'fast', fewer rotations, or a lower "
                 "working resolution (px_per_mm)")
-        self.atlas = _Atlas(self, self.f)
+        self.atlas = _Atlas(self, self.f, progress)
         # Coarse anchors known to hold no free window, per full template size (see best());
         # how many were found, how many coarse anchors were re-ranked exactly, and how often
         # the exact scan of every rotation ran (the slow path: tests count it).
