@@ -125,3 +125,23 @@ def test_leaf_slicing_options_reach_the_job_file_blocks_or_are_named(scans, caps
     sliced = [v for v in json.loads((scans / "out2" / "result.json").read_text())["veneers"]
               if v["id"].startswith("builtin")]
     assert [(v["id"], v["size_mm"]) for v in sliced] == [("builtin-flat-sawn-walnut-00", [70.0, 56.0])]
+
+
+def test_two_scans_of_the_same_file_name_get_their_own_sheets(scans, capsys):
+    """a/oak.png and b/oak.png were both 'oak' and the run was refused ('veneer ids must be
+    unique'), with no way to name a scan on the command line."""
+    for name, src in (("a", "light"), ("b", "dark")):
+        (scans / name).mkdir()
+        (scans / name / "oak.png").write_bytes((scans / f"{src}.png").read_bytes())
+    out = scans / "out"
+    assert main(["parquetry", str(scans / "coffee.png"), "--veneer", f"{scans / 'a' / 'oak.png'}:2px/mm",
+                 "--veneer", f"{scans / 'b' / 'oak.png'}:2px/mm", "--image-size-mm", "42", "--px-per-mm", "2",
+                 "--no-seams", "--no-glb", "--out", str(out), "--quiet"]) == 0
+    result = json.loads((out / "result.json").read_text())
+    assert [(v["id"], v["source"].split("/")[-2]) for v in result["veneers"]] == [("oak-1", "a"), ("oak-2", "b")]
+    assert {p["sheet"] for p in result["patches"]} == {"oak-1", "oak-2"}   # light and dark wood both used
+    assert (out / "veneer_oak-1.svg").is_file() and (out / "veneer_oak-2.dxf").is_file()
+    # the same block sliced twice gives the same leaves twice: refused, saying what to do
+    assert main(["parquetry", str(scans / "coffee.png"), "--veneer-from", "builtin:flat-sawn",
+                 "--veneer-from", "builtin:flat-sawn", "--sheet-size", "60x50", "--out", str(out), "--quiet"]) == 1
+    assert "slice a block once, with more --sheets" in capsys.readouterr().err

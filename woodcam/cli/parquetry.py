@@ -55,7 +55,8 @@ def register(subparsers) -> None:
     add_out_option(p, "cut paths (SVG/DXF), panel.png, result.json, panel.glb and job.json")
     v = p.add_argument_group("veneers")
     v.add_argument("--veneer", action="append", default=[], metavar="SCAN[:DPI][:MASK]",
-                   help="scanned veneer image (repeatable); resolution in dpi (default 300) or "
+                   help="scanned veneer image (repeatable; its id, in veneer_<id>.svg, is the file's "
+                   "stem, numbered when two share one: oak-1, oak-2); resolution in dpi (default 300) or "
                    "'Npx/mm'")
     v.add_argument("--veneer-from", action="append", default=[], metavar="SPEC",
                    help="Mokume sample folder, or block spec to slice leaves from (repeatable)")
@@ -164,6 +165,7 @@ def run(args) -> int:
     """Run a parsed ``parquetry`` command; returns the exit status: 0, or
     :data:`~woodcam.cli.EXIT_CHECKS` when the wood ran out (what was made is written)."""
     import dataclasses
+    from collections import Counter
 
     from ..errors import WoodcamError
     from ..parquetry.engine import build_parquetry
@@ -183,7 +185,15 @@ def run(args) -> int:
     job.params = dataclasses.replace(job.params, **over).check()
     if args.target:
         job.targets = [{"filename": str(t), "scale": 1.0} for t in args.target]
-    job.scans = job.scans + [_scan_entry(s) for s in args.veneer]
+    scans = [_scan_entry(s) for s in args.veneer]
+    # scans of the same file name in two folders (a/oak.png, b/oak.png) were both 'oak', refused
+    # as duplicate ids with no way to name them here: number them, oak-1 and oak-2
+    count, seen = Counter(e["id"] for e in job.scans + scans), Counter()
+    for e in scans:
+        if count[e["id"]] > 1:
+            seen[e["id"]] += 1
+            e["id"] = f"{e['id']}-{seen[e['id']]}"
+    job.scans = job.scans + scans
     w, h = parse_sizes(args.sheet_size, "--sheet-size", n=2)
     given = [d for d, default in _SLICING.items() if getattr(args, d) != default]
     # the slicing options given here override the job file's blocks too (--config's rule: options

@@ -212,7 +212,10 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
         raise WoodcamError("veneers must hold at least one sheet; got none (pass --veneer or --veneer-from)")
     ids = [v.id for v in veneers]
     if len(set(ids)) != len(ids):
-        raise WoodcamError(f"veneer ids must be unique; got {ids}")
+        twice = sorted({i for i in ids if ids.count(i) > 1})
+        raise WoodcamError(f"veneer ids must be unique (each names its cut files veneer_<id>.svg/.dxf); "
+                           f"got {twice} more than once; give the sheets their own ids (a job file's "
+                           "source_textures 'id'), and slice a block once, with more --sheets")
     sheets = [v.resampled(params.px_per_mm) for v in veneers]
     top_cells = 2 ** params.n_adaptive
     for v in sheets:
