@@ -145,3 +145,13 @@ def test_two_scans_of_the_same_file_name_get_their_own_sheets(scans, capsys):
     assert main(["parquetry", str(scans / "coffee.png"), "--veneer-from", "builtin:flat-sawn",
                  "--veneer-from", "builtin:flat-sawn", "--sheet-size", "60x50", "--out", str(out), "--quiet"]) == 1
     assert "slice a block once, with more --sheets" in capsys.readouterr().err
+
+
+def test_reused_wood_says_the_cut_files_cannot_be_cut(scans, capsys):
+    """--reuse-wood wrote cut files whose pieces overlap on the sheets and printed '0 pieces
+    with problems left', exit 0, without a word that they cannot be cut."""
+    out = scans / "out"
+    assert _small_run(scans, out, "--reuse-wood") == 0
+    text = capsys.readouterr().out
+    assert "pieces overlap on the veneer sheets, so the cut files cannot be cut" in text
+    assert json.loads((out / "result.json").read_text())["summary"]["single_use"] is False

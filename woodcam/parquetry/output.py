@@ -89,6 +89,7 @@ def summary(run: ParquetryRun) -> dict:
     prm = run.params
     out = {"placed_cells": run.placed, "planned_cells": run.planned, "patches": len(run.patches),
            "complete": run.complete, "message": run.message, "repaired_pieces": len(run.repaired),
+           "single_use": prm.single_use,
            "match_seconds": round(run.match_seconds, 3), "match_cpu_seconds": round(run.cpu_seconds, 3),
            "seconds_per_patch": round(run.match_seconds / max(1, len(run.patches)), 4),
            "panels": []}
@@ -228,6 +229,10 @@ def format_summary(summ: dict, problems: dict) -> str:
     lines.append(f"fabricability: {summ.get('repaired_pieces', 0)} pieces repaired (seams "
                  f"straightened), {len(problems)} pieces with problems left"
                  + ("" if not problems else " (listed in result.json)"))
+    if not summ.get("single_use", True):
+        # the fabricability line above counts each piece's own shape only: say what it misses
+        lines.append("wood reused (--reuse-wood): pieces overlap on the veneer sheets, so the cut files "
+                     "cannot be cut as they are (a bound on quality, not a job for the router)")
     if summ["message"]:
         lines.append(summ["message"])
     return "\n".join(lines)
