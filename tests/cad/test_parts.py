@@ -104,6 +104,29 @@ def test_trimesh_scene_meshes_are_unioned():
     assert load_part(scene).volume() == pytest.approx(1500, rel=1e-9)
 
 
+def test_shells_of_one_mesh_overlap_nest_and_flip():
+    """An assembly exported as one STL holds overlapping bodies: their union, not the sum
+    (10000 mm^3, not 16000 carved as two stacked surfaces); an inward shell inside a body is a
+    cavity, a body inside that cavity counts again, and a body with flipped normals beside
+    another is a body."""
+    def box(size, centre, inward=False):
+        b = trimesh.creation.box(extents=(size,) * 3)
+        b.apply_translation(centre)
+        if inward:
+            b.invert()
+        return b
+
+    overlap = trimesh.util.concatenate([box(20, (50, 40, 25)), box(20, (45, 40, 25))])
+    solid = load_part(overlap)
+    assert solid.volume() == pytest.approx(20 * 20 * 25, rel=1e-12)
+    assert len(solid.decompose()) == 1
+    nested = trimesh.util.concatenate([box(30, (0, 0, 0)), box(20, (0, 0, 0), inward=True),
+                                       box(10, (0, 0, 0))])
+    assert load_part(nested).volume() == pytest.approx(27000 - 8000 + 1000, rel=1e-12)
+    flipped = trimesh.util.concatenate([box(10, (0, 0, 0)), box(10, (50, 0, 0), inward=True)])
+    assert load_part(flipped).volume() == pytest.approx(2000, rel=1e-12)
+
+
 def test_mesh_with_holes_is_repaired():
     box = trimesh.creation.box(extents=(10, 10, 10))
     one_missing = trimesh.Trimesh(box.vertices, box.faces[:-1])

@@ -430,9 +430,44 @@ def _manifold_from_trimesh(mesh, origin: str):
             f"{_count_open_edges(welded)} open or non-manifold edges; close the mesh in your CAD "
             f"program (export a solid, not surfaces) or repair it (e.g. Meshmixer, MeshLab)"
         )
-    if welded.volume < 0:
-        welded.invert()
-    return _manifold_from_arrays(welded.vertices, welded.faces, origin)
+    return _manifold_from_shells(welded, origin)
+
+
+def _manifold_from_shells(mesh, origin: str):
+    """The solid a closed, consistently wound ``mesh`` (block frame, mm) encloses, one shell
+    per face-connected component; a mesh whose shells sum to a negative volume is inside out
+    and turned.
+
+    Shells are applied largest (by absolute volume) first: an outward one adds, an inward one
+    (a cavity) subtracts, so bodies that overlap (an assembly exported as one STL) are unioned
+    instead of counted twice and carved as stacked surfaces, and a hollow part keeps its void.
+    An inward shell that is not inside what is solid so far is a body with flipped normals: it
+    is added."""
+    import manifold3d
+    import trimesh
+
+    faces = np.asarray(mesh.faces)
+    labels = trimesh.graph.connected_component_labels(mesh.face_adjacency, node_count=len(faces))
+    tri = np.asarray(mesh.vertices)[faces]
+    signed = np.bincount(labels, np.einsum("ij,ij->i", tri[:, 0],
+                                           np.cross(tri[:, 1], tri[:, 2])) / 6)
+    if signed.sum() < 0:  # the whole mesh inside out (trimesh's volume divides by it: no 0)
+        faces, signed = faces[:, ::-1], -signed
+    if len(signed) == 1:
+        return _manifold_from_arrays(mesh.vertices, faces, origin)
+    shells = []
+    for k in np.argsort(-np.abs(signed), kind="stable"):
+        own = faces[labels == k]
+        used, local = np.unique(own if signed[k] > 0 else own[:, ::-1], return_inverse=True)
+        shells.append((signed[k] > 0, _manifold_from_arrays(
+            np.asarray(mesh.vertices)[used], local.reshape(-1, 3), origin)))
+    if all(outward for outward, _ in shells):  # no cavity: one batch union
+        return _union([shell for _, shell in shells], origin)
+    solid = manifold3d.Manifold()
+    for outward, shell in shells:
+        inside = not outward and (shell - solid).volume() <= 1e-6 * shell.volume()
+        solid = solid - shell if inside else solid + shell
+    return _check_manifold(solid, origin)
 
 
 def _close_holes(mesh, origin: str):
