@@ -21,6 +21,7 @@ from .._types import ArrayLike
 from ..errors import WoodcamError, WoodcamWarning
 from ..frames import check_size
 from ..tolerances import OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG
+from ..units import MM_PER_UNIT
 from .parts import load_part
 
 
@@ -93,6 +94,8 @@ def carve(
     WoodcamWarning
         If more than ``OUTSIDE_VOLUME_EPS_MM3`` of the part lies outside the block; the part is
         carved anyway and the message gives the outside volume in mm^3 and percent.
+        If the part, 25.4 times larger, would still fit the block (a part file in inches, read
+        as mm): the message says how to scale it.
     """
     import manifold3d
     import trimesh
@@ -128,6 +131,19 @@ def carve(
             f"({100.0 * outside / part_volume:.3g} % of the part's {part_volume:.6g} mm^3) lies "
             f"outside and is not carved; part bounding box {_fmt_box(lo, hi)} mm, block "
             f"{_fmt_box(np.zeros(3), np.array(size))} mm; move the part or use a larger block"
+        )
+        messages.append(message)
+        warnings.warn(message, WoodcamWarning, stacklevel=2)
+    lo, hi = _bounds(solid)
+    if np.all(np.sort(hi - lo) * MM_PER_UNIT["inch"] <= np.sort(size)):
+        # STL and OBJ carry no units: a part exported in inches is read 25.4 x too small and
+        # carved as a speck without a word
+        message = (
+            f"the part is only {'x'.join(f'{v:.3g}' for v in hi - lo)} mm in the "
+            f"{'x'.join(f'{v:g}' for v in size)} mm block: 25.4 times larger it would still fit. "
+            "Part files are read as millimetres (STL and OBJ carry no units); if it was modelled "
+            "in inches add --place scale:25.4 --place center (in metres: scale:1000), or export "
+            "it in mm"
         )
         messages.append(message)
         warnings.warn(message, WoodcamWarning, stacklevel=2)
