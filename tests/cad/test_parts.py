@@ -303,6 +303,30 @@ def test_python_script_imports_helpers_next_to_it(tmp_path):
     assert load_part(script).volume() == pytest.approx(343, rel=1e-12)
 
 
+def test_cadquery_scripts_showing_result_and_assemblies(tmp_path, cq):
+    """CQ-editor scripts end with `show_object(result)` (a NameError before) and assemble
+    parts with cq.Assembly (refused before): the shown objects, the assembly's parts where it
+    puts them."""
+    shown = tmp_path / "shown.py"
+    shown.write_text("import cadquery as cq\n"
+                     "result = cq.Workplane().box(10, 10, 10).translate((20, 20, 20))\n"
+                     "show_object(result, name='body', options={'color': 'red'})\n"
+                     "show_object(cq.Workplane().box(10, 10, 10).translate((40, 20, 20)))\n")
+    solid = load_part(shown)
+    assert solid.volume() == pytest.approx(2000, rel=1e-9)
+    np.testing.assert_allclose(solid.bounding_box(), (15, 15, 15, 45, 25, 25), atol=1e-6)
+    unshown = tmp_path / "unshown.py"
+    unshown.write_text("import cadquery as cq\nresult = cq.Workplane().box(10, 10, 10)\n")
+    with pytest.raises(WoodcamError, match="defines `result`.*add `part = result`"):
+        load_part(unshown)
+    assembly = cq.Assembly()
+    assembly.add(cq.Workplane().box(20, 20, 20), name="a", loc=cq.Location((30, 40, 25)))
+    assembly.add(cq.Workplane().box(20, 20, 20), name="b", loc=cq.Location((70, 40, 25)))
+    solid = load_part(assembly)
+    assert solid.volume() == pytest.approx(16000, rel=1e-9)
+    np.testing.assert_allclose(solid.bounding_box(), (20, 30, 15, 80, 50, 35), atol=1e-6)
+
+
 def test_python_script_with_trimesh_part(tmp_path):
     script = tmp_path / "mesh_part.py"
     script.write_text("import trimesh\npart = trimesh.creation.box(extents=(2, 3, 4))\n")

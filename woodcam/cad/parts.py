@@ -17,7 +17,9 @@ Accepted sources (:func:`load_part`):
   block frame as stored: no unit or Y-up conversion; except woodcam's own GLB/OBJ, put back in
   the block frame, and another program's glTF whose part spans under 1 unit, read as the glTF
   spec's metres with +Y up, with a warning), or a ``.py`` script that defines a
-  module-level ``part`` (any of the objects above).
+  module-level ``part`` (any of the objects above) or, as in CQ-editor, passes it to
+  ``show_object`` (several calls: their union);
+- a cadquery ``Assembly`` (its parts where it places them).
 
 B-rep shapes (build123d, cadquery, STEP) are tessellated with OpenCascade's
 ``BRepMesh_IncrementalMesh`` at a chord tolerance (mm) and an angular tolerance (degrees at this
@@ -98,11 +100,11 @@ def load_part(
 
     Parameters
     ----------
-    source : build123d Shape | BuildPart | cadquery Workplane | cadquery Shape | trimesh.Trimesh
+    source : build123d Shape | BuildPart | cadquery Workplane | Shape | Assembly | trimesh.Trimesh
         | trimesh.Scene | manifold3d.Manifold | list of these | str | Path
         The part, modelled in the block frame in millimetres, or a path to a ``.step``/``.stp``,
         ``.stl``, ``.obj``, ``.glb``/``.gltf`` file or a ``.py`` script defining ``part``
-        (run with ``runpy`` under the name ``"__woodcam_part__"``, so its
+        or passing it to ``show_object`` (CQ-editor's convention; ``part`` wins) (run with ``runpy`` under the name ``"__woodcam_part__"``, so its
         ``if __name__ == "__main__":`` block does not run; its folder is on ``sys.path``
         meanwhile so it can import helpers next to it).
     tolerance_mm : float or None
@@ -252,6 +254,8 @@ def _load(source: Any, tess: "_Tessellation", origin: str):
                           origin)
         if isinstance(source, cq.Shape):
             return _manifold_from_topods(source.wrapped, tess, origin)
+        if isinstance(source, cq.Assembly):  # every part where the assembly puts it
+            return _manifold_from_topods(source.toCompound().wrapped, tess, origin)
     if module.startswith("OCP") and hasattr(source, "ShapeType"):  # raw TopoDS_Shape
         return _manifold_from_topods(source, tess, origin)
 
@@ -286,9 +290,15 @@ def _load_path(path: Path, tess: "_Tessellation"):
 def _load_script(path: Path, tess: "_Tessellation"):
     """Run a part script (``runpy``, not as ``__main__``) and load its module-level ``part``."""
     folder = str(path.resolve().parent)
+    shown: list = []
+
+    def show_object(obj, *args, **kwargs):  # CQ-editor's and cq-cli's way to give the result
+        shown.append(obj)
+
     sys.path.insert(0, folder)  # like `python script.py`: helpers next to the script import
     try:
-        namespace = runpy.run_path(str(path), run_name="__woodcam_part__")
+        namespace = runpy.run_path(str(path), init_globals={"show_object": show_object},
+                                   run_name="__woodcam_part__")
     except SystemExit as err:
         raise WoodcamError(
             f"part script {str(path)!r} called sys.exit({err.code!r}) while being loaded; "
@@ -302,14 +312,21 @@ def _load_script(path: Path, tess: "_Tessellation"):
     finally:
         if folder in sys.path:
             sys.path.remove(folder)
-    if "part" not in namespace:
+    if "part" not in namespace and shown:
+        part = shown[0] if len(shown) == 1 else shown
+        origin = f"what script {str(path)!r} passes to show_object"
+    elif "part" not in namespace:
+        fix = ("it defines `result` (cadquery's convention): add `part = result` or "
+               "`show_object(result)`" if "result" in namespace else
+               "add e.g. `part = Box(10, 10, 10)` (a build123d/cadquery solid, trimesh mesh or "
+               "manifold)")
         raise WoodcamError(
-            f"part script {str(path)!r} does not define a module-level variable `part`; add "
-            f"e.g. `part = Box(10, 10, 10)` (a build123d/cadquery solid, trimesh mesh or "
-            f"manifold) at the end of the script"
+            f"part script {str(path)!r} does not define a module-level variable `part` nor "
+            f"call show_object; {fix} at the end of the script"
         )
-    part = namespace["part"]
-    origin = f"`part` of script {str(path)!r}"
+    else:
+        part = namespace["part"]
+        origin = f"`part` of script {str(path)!r}"
     if isinstance(part, (str, Path)):
         raise WoodcamError(
             f"{origin} is a path ({str(part)!r}), but a script must define the part itself; "
