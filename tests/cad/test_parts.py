@@ -138,6 +138,15 @@ def test_mesh_with_holes_is_repaired():
         assert load_part(two_missing).volume() == pytest.approx(1000, rel=1e-12)
 
 
+def test_duplicate_triangles_are_dropped_and_said():
+    """A triangle written twice (some STL exporters) was refused as '8 open or non-manifold
+    edges', a message that did not say why."""
+    box = trimesh.creation.box(extents=(10, 10, 10))
+    doubled = trimesh.Trimesh(box.vertices, np.vstack([box.faces, box.faces[:4]]), process=False)
+    with pytest.warns(WoodcamWarning, match="has 4 duplicate triangles.*dropped the copies"):
+        assert load_part(doubled).volume() == pytest.approx(1000, rel=1e-12)
+
+
 def test_open_surface_raises():
     square = trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2], [0, 2, 3]])
     with pytest.raises(WoodcamError, match="not a closed .watertight. mesh.*4 open"):

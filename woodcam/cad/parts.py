@@ -435,6 +435,20 @@ def _manifold_from_trimesh(mesh, origin: str):
     if not keep.all():
         welded.update_faces(keep)
         welded.remove_unreferenced_vertices()
+    unique = welded.unique_faces()
+    if not unique.all():
+        # a triangle written twice (some exporters do) leaves its edges used four times:
+        # refused as '8 open or non-manifold edges' before, with no word of the cause
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        warnings.warn(WoodcamWarning(
+            f"{origin} has {int(np.count_nonzero(~unique))} duplicate triangles (the same three "
+            "corners twice); woodcam dropped the copies (the solid is unchanged)"),
+            stacklevel=3)
+        welded.update_faces(unique)
+        welded.remove_unreferenced_vertices()
     if not welded.is_watertight:
         # Closed by flat fans, one per hole, and said so: trimesh's fill_holes turned a box
         # missing one side into an 833 mm^3 solid instead of 1000 without a word (issue 15).
