@@ -143,3 +143,24 @@ def test_bake_draws_one_stage_bar_over_the_whole_run(tmp_path, bars, capsys):
     plan = ["open block", "load", "carve", "bake", "report", "export", "render"]
     assert stage[0].total == len(plan) and stage[0].n == len(plan) and stage[0].closed
     assert [d.split(": ")[-1] for d in stage[0].shown[1:-1]] == plan
+
+
+def test_meshing_options_on_a_mesh_part_are_said_to_be_ignored(tmp_path, capsys):
+    """--tolerance and --max-triangles only mesh B-rep parts; on an STL they did nothing,
+    without a word."""
+    import trimesh
+
+    from woodcam.cli import main
+
+    box = trimesh.creation.box((20, 20, 20))
+    box.apply_translation((50, 40, 25))
+    box.export(tmp_path / "box.stl")
+    argv = ["bake", str(tmp_path / "box.stl"), "--block", "builtin:flat-sawn", "--no-obj",
+            "--texels-per-mm", "1"]
+    assert main([*argv, "--out", str(tmp_path / "a.glb"), "--max-triangles", "1000",
+                 "--tolerance", "0.5"]) == 0
+    err = capsys.readouterr().err
+    assert "--tolerance and --max-triangles set how B-rep parts" in err
+    assert "box.stl is a triangle mesh, baked as it is: ignored" in err
+    assert main([*argv, "--out", str(tmp_path / "b.glb")]) == 0
+    assert "ignored" not in capsys.readouterr().err

@@ -129,6 +129,18 @@ def run_bake(args: argparse.Namespace) -> int:
                 write_screenshot(args, res.files, stock)
     print_warnings(res.warnings)
     tess = res.tessellation
+    ignored = [opt for opt, value in (("--tolerance", args.tolerance),
+                                      ("--max-triangles", args.max_triangles)) if value is not None]
+    if ignored and not tess.get("triangles"):  # nothing was tessellated: the part was a mesh
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        warnings.warn(f"{' and '.join(ignored)} set{'s' if len(ignored) == 1 else ''} how B-rep parts "
+                      f"(build123d/cadquery solids, STEP) are meshed, but {args.part} is a triangle "
+                      "mesh, baked as it is: ignored; drop "
+                      f"{'it' if len(ignored) == 1 else 'them'} (decimate the mesh in your CAD "
+                      "program to bake it coarser)", WoodcamWarning, stacklevel=2)
     mesh_note = ""
     if tess.get("tolerance_mm") and tess.get("triangles"):
         from ..tolerances import TESSELLATION_REL_TOL, TESSELLATION_TEXEL_FRACTION
