@@ -59,6 +59,20 @@ def test_no_orientation_fits_is_a_clear_error(knotty):
         advise_placement(manifold3d.Manifold.cube([10.0, 10.0, 10.0]), knotty, rotations="any")
 
 
+def test_place_warns_of_a_part_in_inches_and_advises_only_what_is_left(knotty):
+    """A part file in inches (read as mm: 25.4 x too small) was ranked as a speck without a
+    word; a part too long in every one of the 24 orientations was told to 'allow more
+    rotations'."""
+    from woodcam.errors import WoodcamWarning
+
+    with pytest.warns(WoodcamWarning, match="25.4 times larger it would still fit.*scale:25.4"):
+        advise_placement(manifold3d.Manifold.cube([3.0, 2.0, 0.5]), knotty, candidates=8)
+    with pytest.raises(WoodcamError, match="with a 1 mm margin; a smaller margin .--margin. or a bigger block"):
+        advise_placement(manifold3d.Manifold.cube([120.0, 10.0, 10.0]), knotty, rotations="all90")
+    with pytest.raises(WoodcamError, match="allow more rotations .--rotations all90."):
+        advise_placement(manifold3d.Manifold.cube([120.0, 10.0, 10.0]), knotty, rotations="z90")
+
+
 def test_the_part_report_warns_of_short_grain_only_across_the_fibres():
     import trimesh
 

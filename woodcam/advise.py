@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import WoodcamError
+from .errors import WoodcamError, WoodcamWarning
 from .units import Units, fmt_volume
 
 #: Points within this many years of the pith count as pith (juvenile wood and the pith itself).
@@ -161,6 +161,13 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
     depth_pts = np.concatenate([pts] + [pts - d * nrm for d in SUBSURFACE_MM])
     lo, hi = mesh.bounds
     centre = (lo + hi) / 2
+    from .cad.carve import units_hint
+
+    hint = units_hint(lo, hi, stock.size_mm)
+    if hint:  # ranking a speck's placements is no answer for a part exported in inches
+        import warnings
+
+        warnings.warn(hint, WoodcamWarning, stacklevel=2)
     # the part's long axis and how long-and-thin it is (principal axes of the surface sample)
     evals, evecs = np.linalg.eigh(np.cov((pts - pts.mean(axis=0)).T))
     long_axis = evecs[:, -1]
@@ -210,11 +217,12 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
                 matrix=matrix, terms={n: float(v[i]) for n, v in terms.items()},
                 score=float(score[i])))
     if not ranked:
+        more = "" if rotations == "all90" else "allow more rotations (--rotations all90), "
         raise WoodcamError(
             f"advise_placement: the part ({'x'.join(f'{v:.1f}' for v in hi - lo)} mm) fits the "
             f"{'x'.join(f'{v:g}' for v in size)} mm block in none of the '{rotations}' "
-            f"orientations with a {margin_mm:g} mm margin; allow more rotations, a smaller margin "
-            "or a bigger block")
+            f"orientations with a {margin_mm:g} mm margin; {more}a smaller margin (--margin) or "
+            "a bigger block")
     ranked.sort(key=lambda p: p.score)
     return PlacementAdvice(ranked, len(ranked), elongation, w)
 

@@ -134,17 +134,8 @@ def carve(
         )
         messages.append(message)
         warnings.warn(message, WoodcamWarning, stacklevel=2)
-    lo, hi = _bounds(solid)
-    if np.all(np.sort(hi - lo) * MM_PER_UNIT["inch"] <= np.sort(size)):
-        # STL and OBJ carry no units: a part exported in inches is read 25.4 x too small and
-        # carved as a speck without a word
-        message = (
-            f"the part is only {'x'.join(f'{v:.3g}' for v in hi - lo)} mm in the "
-            f"{'x'.join(f'{v:g}' for v in size)} mm block: 25.4 times larger it would still fit. "
-            "Part files are read as millimetres (STL and OBJ carry no units); if it was modelled "
-            "in inches add --place scale:25.4 --place center (in metres: scale:1000), or export "
-            "it in mm"
-        )
+    message = units_hint(*_bounds(solid), size)
+    if message:
         messages.append(message)
         warnings.warn(message, WoodcamWarning, stacklevel=2)
 
@@ -164,6 +155,21 @@ def carve(
         warnings=messages,
         size_mm=size,
     )
+
+
+def units_hint(lo, hi, size_mm) -> str | None:
+    """What to say when a part with bounds ``lo, hi (3,)`` mm would still fit the block
+    ``size_mm (3,)`` 25.4 times larger (None otherwise): STL and OBJ carry no units, so a part
+    exported in inches is read 25.4 x too small and carved or placed as a speck."""
+    extent = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
+    size = np.asarray(size_mm, dtype=float)
+    if not np.all(np.sort(extent) * MM_PER_UNIT["inch"] <= np.sort(size)):
+        return None
+    return (f"the part is only {'x'.join(f'{v:.3g}' for v in extent)} mm in the "
+            f"{'x'.join(f'{v:g}' for v in size)} mm block: 25.4 times larger it would still fit. "
+            "Part files are read as millimetres (STL and OBJ carry no units); if it was modelled "
+            "in inches add --place scale:25.4 --place center (in metres: scale:1000), or export "
+            "it in mm")
 
 
 def _bounds(solid) -> tuple[np.ndarray, np.ndarray]:
