@@ -177,7 +177,7 @@ def test_unsupported_object_raises():
 
 
 def test_build123d_sketch_without_solid_raises(bd):
-    with pytest.raises(WoodcamError, match="contains no solid .only faces"):
+    with pytest.raises(WoodcamError, match="contains no solid nor shell .only faces"):
         load_part(bd.Rectangle(10, 10))
 
 
@@ -289,6 +289,22 @@ def test_step_round_trip(tmp_path, bd):
     assert solid.volume() == pytest.approx(expected, rel=CARVE_VOLUME_RTOL)
     assert solid.volume() == pytest.approx(load_part(part).volume(), rel=1e-9)
     np.testing.assert_allclose(solid.bounding_box(), (30, 25, 15, 70, 55, 35), atol=1e-6)
+
+
+def test_step_surface_model_of_shells_is_a_part(tmp_path, bd):
+    """A STEP surface model (SHELL_BASED_SURFACE_MODEL: SketchUp, Blender, mesh tools) bounds
+    the part with a closed shell and no solid: it was refused as 'contains no solid ...
+    extrude, revolve or thicken it'."""
+    box = bd.Pos(50, 40, 25) * bd.Box(20, 20, 20)
+    path = tmp_path / "shell.step"
+    bd.export_step(bd.Shell(box.faces()), str(path))
+    assert "SHELL_BASED_SURFACE_MODEL" in path.read_text()
+    solid = load_part(path)
+    assert solid.volume() == pytest.approx(8000, rel=1e-9)
+    np.testing.assert_allclose(solid.bounding_box(), (40, 30, 15, 60, 50, 35), atol=1e-6)
+    bd.export_step(bd.Shell(box.faces()[:-1]), str(path))  # one side missing: capped, and said
+    with pytest.warns(WoodcamWarning, match="was not closed.*capped each hole flat"):
+        assert load_part(path).volume() == pytest.approx(8000, rel=1e-9)
 
 
 def test_python_script_defining_part(tmp_path, bd):

@@ -619,20 +619,25 @@ def _union(solids: list, origin: str):
 def _manifold_from_topods(shape, tess: "_Tessellation", origin: str):
     """Tessellate an OpenCascade ``TopoDS_Shape`` solid by solid and union the pieces."""
     require("OCP", "cad", "tessellating B-rep parts")
-    from OCP.TopAbs import TopAbs_SOLID
+    from OCP.TopAbs import TopAbs_SHELL, TopAbs_SOLID
     from OCP.TopExp import TopExp_Explorer
 
     if shape is None or shape.IsNull():
         raise WoodcamError(f"{origin} is an empty (null) shape; build a solid first")
     solids = []
-    explorer = TopExp_Explorer(shape, TopAbs_SOLID)
-    while explorer.More():
-        solids.append(explorer.Current())
-        explorer.Next()
+    for kind in (TopAbs_SOLID, TopAbs_SHELL):
+        # no solid: a surface model (STEP from SketchUp, Blender or a mesh tool) bounds the part
+        # with shells; they are meshed like a mesh file (closed, or holes capped with a warning)
+        explorer = TopExp_Explorer(shape, kind)
+        while explorer.More():
+            solids.append(explorer.Current())
+            explorer.Next()
+        if solids:
+            break
     if not solids:
         raise WoodcamError(
-            f"{origin} contains no solid (only faces, wires or an empty compound); extrude, "
-            f"revolve or thicken it into a solid"
+            f"{origin} contains no solid nor shell (only faces, wires or an empty compound); "
+            f"extrude, revolve or thicken it into a solid"
         )
     meshes = tess.mesh_solids(solids, origin)
     pieces = [_manifold_from_trimesh(_trimesh(v, f), origin) for v, f in meshes]
