@@ -422,7 +422,7 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
     ``out_dir``, plus a failure gallery: the cut planes of the ``gallery`` worst blocks (same
     year within 1 mm, over all methods and face sets) and face thumbnails of ``thumbnails``
     blocks of each kind, all regenerated from the seed. Returns the summary dict."""
-    from .scale import read_records, write_json_atomic
+    from .scale import read_records, record_path, write_json_atomic
 
     run_dir, out = Path(run_dir), Path(out_dir)
     mpath = run_dir / RUN_MANIFEST
@@ -430,7 +430,16 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
         raise WoodcamError(f"run_dir must be a bench run folder with {RUN_MANIFEST}; {str(run_dir)!r} "
                            f"has none (make one with `woodcam bench run --out DIR`)")
     run = json.loads(mpath.read_text())
-    s = summarise_bench(read_records(run_dir))
+    records = read_records(run_dir)
+    for key, rec in records.items():  # a record copied in from another run would be counted
+        res = rec.get("result") or {}
+        index = res.get("index")
+        if rec["status"] == "ok" and (res.get("seed") != run["seed"] or not isinstance(index, int)
+                                      or key != bench_key(index)):
+            raise WoodcamError(f"record {record_path(run_dir, key)} is block {index} of seed "
+                               f"{res.get('seed')}, not block {key} of this run's seed {run['seed']} "
+                               f"({mpath}); delete it and re-run `woodcam bench run` to recompute it")
+    s = summarise_bench(records)
     out.mkdir(parents=True, exist_ok=True)
     write_json_atomic(out / "report.json", {"seed": run["seed"], "settings": run["settings"], **s})
     write_text(out / "report.md", _markdown(s, run))
@@ -442,7 +451,6 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
     for _, i in worst:
         if i not in picks and len(picks) < gallery:
             picks.append(i)
-    records = read_records(run_dir)
     sample = []
     for kind in ("clear", "knotted"):
         sample += [r["result"]["index"] for r in records.values()

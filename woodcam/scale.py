@@ -126,6 +126,16 @@ def read_records(out_dir: str | Path) -> dict[str, dict]:
         except ValueError as err:  # never happens with atomic writes; say so if it does
             raise WoodcamError(f"record {p} is not valid JSON ({err}); delete it and re-run "
                                f"to recompute that key") from err
+        # a record's file is named by its key: a copy ("b000001 (copy).json") or a renamed file
+        # holding another key was silently merged into that key, and one without a key or status
+        # was a KeyError
+        if not isinstance(rec, dict) or not isinstance(rec.get("key"), str) or "status" not in rec:
+            raise WoodcamError(f"record {p} is not a run record (a JSON object with 'key' and "
+                               f"'status'); delete it and re-run to recompute that key")
+        if rec["key"] != p.stem:
+            raise WoodcamError(f"record {p} holds key {rec['key']!r}, not its file's name "
+                               f"{p.stem!r} (a copied or renamed record?); one record per key, "
+                               f"named <key>.json: delete it and re-run to recompute that key")
         out[rec["key"]] = rec
     return out
 
@@ -135,10 +145,13 @@ def _finished_keys(out_dir: Path) -> set[str]:
     done = set()
     for p in folder.glob("[!.]*.json"):
         try:
-            if json.loads(p.read_text()).get("status") == "ok":
-                done.add(p.stem)
+            rec = json.loads(p.read_text())
         except ValueError:
             continue  # treat as not done; it is overwritten
+        # done only when it is that key's own record (read_records' rule): a copied, renamed or
+        # key-less one is recomputed, and so overwritten
+        if isinstance(rec, dict) and rec.get("key") == p.stem and rec.get("status") == "ok":
+            done.add(p.stem)
     return done
 
 

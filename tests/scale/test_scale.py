@@ -292,6 +292,37 @@ def test_report_statistics_known_answers(tmp_path):
     assert s["cpu_hours_per_1e5"] == pytest.approx(1.5 * 1e5 / 3600)
 
 
+def test_a_copied_renamed_or_foreign_record_is_named_not_merged(tmp_path):
+    """A record file copied beside its original, renamed to another key, without a key, or
+    from another seed's run: the report names the file (it was silently merged into its key,
+    counted as the wrong block, or a KeyError)."""
+    import shutil
+
+    from woodcam.benchmark import bench_report
+
+    rec = lambda run, name: run / RECORDS_DIR / name  # noqa: E731
+    cases = {
+        "copy": lambda run: shutil.copy(rec(run, "b000001.json"), rec(run, "b000001 (copy).json")),
+        "renamed": lambda run: shutil.copy(rec(run, "b000001.json"), rec(run, "b000011.json")),
+        "no key": lambda run: rec(run, "b000002.json").write_text('{"status": "ok"}'),
+        "other seed": lambda run: rec(run, "b000003.json").write_text(
+            rec(run, "b000003.json").read_text().replace('"seed":0', '"seed":7')),
+    }
+    named = {"copy": "b000001 (copy).json", "renamed": "b000011.json", "no key": "b000002.json",
+             "other seed": "b000003.json"}
+    for case, spoil in cases.items():
+        run = _fake_records(tmp_path / case.replace(" ", "_"))
+        spoil(run)
+        with pytest.raises(WoodcamError, match="delete it and re-run") as err:
+            bench_report(run, tmp_path / "rep", gallery=0, thumbnails=0, progress=False)
+        assert named[case] in str(err.value), case
+    # and a run does not take the key-less record for a finished block: re-running recomputes it
+    from woodcam.scale import _finished_keys
+
+    assert "b000002" not in _finished_keys(tmp_path / "no_key")
+    assert "b000001" in _finished_keys(tmp_path / "no_key")
+
+
 def test_report_on_a_real_run_writes_tables_and_gallery(tmp_path):
     from woodcam.benchmark import bench_report, run_bench
 
