@@ -112,6 +112,26 @@ def test_block_synth_noise_options_on_an_engine_write_the_same_blocks(tmp_path, 
                    "meaning and default"]  # it named the parameter (trace_dropout), not the option
 
 
+def test_block_synth_on_an_engine_into_a_set_of_another_seed_is_refused(tmp_path, capsys):
+    """A second `block synth --engine` into the same folder with another seed found every
+    block's record done, kept the first seed's blocks and wrote an index.json of the second."""
+    from woodcam.cli import EXIT_ERROR
+
+    out = tmp_path / "set"
+    flags = ["--count", "1", "--face-px", "32", "--quiet", "--knotted-fraction", "0", "--workers", "1",
+             "--out", str(out)]
+    assert main(["block", "synth", "--seed", "1", *flags]) == 0
+    first = (out / "block_0000" / "block.json").read_bytes()
+    capsys.readouterr()
+    assert main(["block", "synth", "--seed", "2", *flags]) == EXIT_ERROR
+    assert "another seed or settings (seed 1 there, 2 now)" in capsys.readouterr().err
+    assert json.loads((out / "index.json").read_text())["seed"] == 1
+    assert (out / "block_0000" / "block.json").read_bytes() == first
+    # the same seed resumes; more blocks of it extend the set
+    assert main(["block", "synth", "--seed", "1", *flags[2:], "--count", "2"]) == 0
+    assert "1 already done, 1 computed" in capsys.readouterr().out
+
+
 def test_engine_options_alone_run_on_the_engine_and_train_rings_refuses_them(tmp_path, capsys):
     """'block synth --workers 2' ran serially in this process, as if --workers were not given;
     'train rings' accepted --address, --workers and --no-resume and used none of them."""

@@ -209,23 +209,15 @@ def run_bench(out_dir: str | Path, blocks: int, seed: int, settings: dict | None
     settings is refused (a run folder holds one experiment). Returns the
     :class:`woodcam.scale.RunSummary`.
     """
-    from .scale import run_many, write_json_atomic
+    from .scale import check_manifest, run_many
 
     if not isinstance(blocks, int) or blocks < 1:
         raise WoodcamError(f"blocks must be an integer >= 1; got {blocks!r}")
     settings = bench_settings() if settings is None else bench_settings(**settings)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    manifest = {"format": "woodcam-bench-run", "version": 1, "seed": int(seed), "settings": settings}
-    mpath = out / RUN_MANIFEST
-    if mpath.exists():
-        old = json.loads(mpath.read_text())
-        if {k: old.get(k) for k in manifest} != manifest:
-            raise WoodcamError(f"out_dir {str(out)!r} holds a bench run with another seed or settings "
-                               f"(seed {old.get('seed')}); resume it with the same options or pick a "
-                               f"new --out")
-    else:
-        write_json_atomic(mpath, manifest)
+    check_manifest(out / RUN_MANIFEST, {"format": "woodcam-bench-run", "version": 1, "seed": int(seed),
+                                        "settings": settings})
     keys = [bench_key(i) for i in range(start, start + blocks)]
     return run_many(partial(_bench_task, seed=int(seed), settings=settings), keys, out,
                     desc="bench blocks", **run_options)
@@ -509,7 +501,7 @@ def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, k
     on every engine as without one. With a Dask ``address`` the workers write the block folders,
     so they need ``out_dir`` on a shared disk. ``run_options`` go to
     :func:`woodcam.scale.run_many`. Returns ``(RunSummary, index dict)``."""
-    from .scale import read_records, run_many, write_json_atomic
+    from .scale import check_manifest, read_records, run_many, write_json_atomic
 
     if not isinstance(count, int) or count < 1:
         raise WoodcamError(f"count must be an integer >= 1; got {count!r}")
@@ -526,6 +518,11 @@ def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, k
         opts["size_range_mm"] = [float(v) for v in opts["size_range_mm"]]
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    # the records say which blocks are done, not of which set: a rerun with another seed kept the
+    # old seed's blocks under an index.json of the new one
+    check_manifest(out / ".synth" / RUN_MANIFEST, {
+        "format": "woodcam-benchmark-set", "seed": int(seed), "face_px": int(face_px),
+        "knotted": bool(knotted), "block_options": opts})
     keys = [f"block_{i:04d}" for i in range(count)]
     summary = run_many(partial(_synth_set_task, seed=int(seed), out_dir=str(out.resolve()),
                                face_px=int(face_px), knotted=bool(knotted), block_options=opts),
@@ -569,12 +566,17 @@ def make_training_set_many(spec, out_dir, *, shard_fields: int = TRAINING_SHARD_
     -------
     points : (N, M, 3) float32, values : (N, M) float32
     """
-    from .scale import read_records, run_many
+    from .fields.neural import TRAINING_SET_FIELDS
+    from .scale import check_manifest, read_records, run_many
 
     if not isinstance(shard_fields, int) or shard_fields < 1:
         raise WoodcamError(f"shard_fields must be an integer >= 1; got {shard_fields!r}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    # the shards of another spec's training set (another seed ...) were reused without a word
+    check_manifest(out / ".records" / RUN_MANIFEST, {
+        "format": "woodcam-training-set", "shard_fields": shard_fields,
+        "spec": {k: spec.to_dict()[k] for k in TRAINING_SET_FIELDS}})
     n_shards = -(-spec.n_fields // shard_fields)
     keys = [f"shard_{i:04d}" for i in range(n_shards)]
     s = run_many(partial(_training_shard_task, spec=spec.to_dict(), shard_fields=shard_fields,

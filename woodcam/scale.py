@@ -106,6 +106,40 @@ def write_json_atomic(path, obj) -> Path:
     return path
 
 
+def check_manifest(path: str | Path, manifest: dict, what: str = "out_dir") -> None:
+    """Tie a run folder to the settings its records were made with: write ``manifest`` (a
+    JSON-able dict: seed, settings ...) to ``path`` when there is none, else refuse another one.
+
+    :func:`run_many` skips every key with an ``ok`` record whatever made it, so a rerun into the
+    same folder with another seed or settings would keep the old results under the new
+    settings' name; callers whose task results depend on settings call this first. Raises
+    :class:`WoodcamError` naming each setting that differs (one level into nested dicts).
+    """
+    path = Path(path)
+    want = json.loads(json.dumps(manifest))  # tuples -> lists, as the file holds them
+    if not path.is_file():
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_json_atomic(path, want)
+        return
+    try:
+        old = json.loads(path.read_text())
+    except ValueError as err:
+        raise WoodcamError(f"{path} is not valid JSON ({err}); delete the folder {str(path.parent)!r} "
+                           f"or pick a new --out") from err
+    old = old if isinstance(old, dict) else {}
+    diffs = []
+    for k, v in want.items():
+        o = old.get(k)
+        if isinstance(v, dict) and isinstance(o, dict):
+            diffs += [f"{k}.{j} {o.get(j)!r} there, {v.get(j)!r} now"
+                      for j in sorted(set(v) | set(o)) if o.get(j) != v.get(j)]
+        elif o != v:
+            diffs.append(f"{k} {o!r} there, {v!r} now")
+    if diffs:
+        raise WoodcamError(f"{what} {str(path.parent)!r} holds a run with another seed or settings "
+                           f"({'; '.join(diffs)}); resume it with the same options or pick a new --out")
+
+
 def record_path(out_dir, key: str) -> Path:
     return Path(out_dir) / RECORDS_DIR / f"{key}.json"
 
@@ -425,4 +459,4 @@ def _run_dask(client, fn, todo, retries, finish) -> int:
 
 
 __all__ = ["DEFAULT_MEMORY_LIMIT_MB", "ENGINES", "Engine", "RECORDS_DIR", "RunSummary",
-           "read_records", "record_path", "run_many", "write_json_atomic"]
+           "check_manifest", "read_records", "record_path", "run_many", "write_json_atomic"]

@@ -362,6 +362,23 @@ def test_training_set_in_shards_is_bit_identical_and_trains_the_same(tmp_path):
     assert (tmp_path / "engine" / "trainset" / "shard_0000.npz").exists()
 
 
+def test_training_set_of_another_spec_is_refused_not_reused(tmp_path):
+    """The shards of a training set were reused for a spec with another seed (another training
+    set), silently; a spec that differs in the network only keeps them."""
+    from dataclasses import replace
+
+    from woodcam.benchmark import make_training_set_many
+    from woodcam.fields.neural import GTFSpec, make_training_set
+
+    spec = GTFSpec(n_fields=8, points_per_field=20, batch_fields=4)
+    kw = dict(shard_fields=4, engine="local", workers=1, progress=False)
+    make_training_set_many(spec, tmp_path / "ts", **kw)
+    with pytest.raises(WoodcamError, match=r"another seed or settings \(spec.seed 0 there, 5 now\)"):
+        make_training_set_many(replace(spec, seed=5), tmp_path / "ts", **kw)
+    pts, vals = make_training_set_many(replace(spec, hidden=16), tmp_path / "ts", **kw)
+    np.testing.assert_array_equal(vals, make_training_set(spec)[1])
+
+
 def test_cli_bench_run_and_report(tmp_path, capsys):
     from woodcam.cli import main
 

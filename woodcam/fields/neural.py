@@ -177,6 +177,12 @@ def family_gtf(points: np.ndarray, r_minus: np.ndarray, r_plus: np.ndarray) -> n
     return np.hypot(x, y) / np.maximum((1 - w) * rm + w * rp, 1e-3)
 
 
+#: The fields of :class:`GTFSpec` that :func:`make_training_set` reads: two specs equal in these
+#: have the same training set (the network and optimiser settings do not change it).
+TRAINING_SET_FIELDS = ("seed", "n_fields", "points_per_field", "pith_fraction", "n_constraints",
+                       "constraint_sigma", "radius_samples")
+
+
 def make_training_set(spec: GTFSpec) -> tuple[np.ndarray, np.ndarray]:
     """Sample the training pairs of §3.2.5: ``points (N, M, 3)`` and ``values (N, M)``, float32."""
     return make_training_shard(spec, 0, spec.n_fields)
