@@ -118,6 +118,8 @@ def test_resumed_training_equals_straight_run(tmp_path):
     # a checkpoint of another spec is refused
     with pytest.raises(WoodcamError, match="another spec"):
         train_gtf(GTFSpec(**{**TINY, "seed": 1}), tmp_path / "b", progress=False)
+    # and leaves the folder as it was: the spec beside the weights is still theirs
+    assert GTFSpec.load(tmp_path / "b" / SPEC_NAME) == spec
 
 
 def test_training_reduces_the_error(tmp_path):

@@ -330,7 +330,7 @@ def _load_checkpoint(torch, ckpt: Path, spec: GTFSpec) -> dict:
     if state["spec"] != spec.to_dict():
         theirs = state["spec"] if isinstance(state["spec"], dict) else {}
         raise WoodcamError(f"checkpoint {ckpt} was written for another spec; delete it or "
-                           f"pass resume=False (spec differs in "
+                           f"pass resume=False (CLI: --no-resume) (spec differs in "
                            f"{sorted(k for k in spec.to_dict() if theirs.get(k) != spec.to_dict()[k])})")
     return state
 
@@ -378,10 +378,12 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
     total = spec.steps if steps is None else int(steps)
     if total < 0:
         raise WoodcamError(f"steps must be >= 0; got {steps!r}")
-    spec.save(out / SPEC_NAME)
     ckpt = out / _CHECKPOINT_NAME
-    # read (and refuse) a checkpoint before minutes of work building the training set
+    # read (and refuse) a checkpoint before minutes of work building the training set, and before
+    # the spec is written: a refused run overwrote gtf_spec.json, leaving gtf.pt with a spec
+    # of another shape beside it
     state = _load_checkpoint(torch, ckpt, spec) if resume and ckpt.is_file() else None
+    spec.save(out / SPEC_NAME)
 
     if training_set is None:
         pts_np, vals_np = make_training_set(spec)
