@@ -50,6 +50,15 @@ def test_eval_writes_table_and_images(block_dir, tmp_path):
     assert len(list(out.glob("*.png"))) == 1
 
 
+def test_eval_seed_on_blocks_with_a_truth_is_said_to_change_nothing(block_dir, tmp_path, capsys):
+    """--seed seeds the held-out scoring of real blocks; on blocks with a true field it was
+    accepted and ignored without a word."""
+    folder, truth, _ = block_dir
+    assert main(["eval", "rings", str(folder), "--truth", str(truth), "--methods", "radial",
+                 "--partial-faces", "none", "--seed", "3", "--out", str(tmp_path / "ev")]) == 0
+    assert "--seed 3 seeds the held-out scoring of real blocks only; eq79 have a true field" in capsys.readouterr().err
+
+
 @pytest.mark.slow
 def test_eval_confidence_overlay_and_summary(block_dir, tmp_path):
     """`eval rings --confidence` (issue 12 part 5): the evidence fit's confidence drawn under its

@@ -61,7 +61,7 @@ def register(subparsers) -> None:
     e.add_argument("--detect", action="store_true",
                    help="real blocks: fit from rings detected on the photos (woodcam.detect) and score "
                    "against the block's own ring maps (e.g. the Mokume U-Net maps) as the reference")
-    e.add_argument("--seed", type=int, default=0,
+    e.add_argument("--seed", type=int, default=None,
                    help="real blocks: the evidence fit's random seed (held-out points, fitting subsets; "
                    "default 0); a real cube's held-out score can swing with it, so compare several")
     add_confidence_option(e)
@@ -102,6 +102,14 @@ def run_eval(args) -> int:
             b.true_field = GridField.load(t)
     known = [b for b in blocks if b.true_field is not None]
     real = [b for b in blocks if b.true_field is None]
+    if args.seed is not None and not real:  # before the work: nothing silently dropped
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        warnings.warn(f"--seed {args.seed} seeds the held-out scoring of real blocks only; "
+                      f"{', '.join(b.name for b in known)} have a true field and are scored on cut "
+                      "planes, which it does not change", WoodcamWarning, stacklevel=2)
     if known:
         sets = {"full": None}
         if args.partial_faces.lower() != "none":
@@ -129,7 +137,7 @@ def run_eval(args) -> int:
                 fit_on.name = f"{b.name}-detected"
                 print(f"{b.name}: fitting from rings detected on its photos, scored against its own maps")
             res = leave_one_face_out(fit_on, methods, out_dir=args.out, progress=print, reference=ref,
-                                     seed=args.seed)
+                                     seed=0 if args.seed is None else args.seed)
             print(res["table"])
             # the files' own names (it printed the pattern '<block>_holdout.md and <block>_<method>.png')
             out = Path(args.out)
