@@ -27,6 +27,19 @@ def test_score_block_is_plain_json_and_scores_the_sanity_row():
     assert "| clean | full | eq79 | 2 |" in markdown([g], ["radial"])
 
 
+def test_worst_cell_names_the_block_of_each_value():
+    """Block a is the worst within 1 mm, block b within 2 mm: the cell said '50.0 / 80.0 (b)',
+    giving b a 1 mm score that is a's."""
+    def row(name, m1, m2):
+        return {"scenario": "noisy", "faces": "full", "kind": "clear", "name": name,
+                "radial": {"matched_1": m1, "matched_2": m2, "fit_s": 1.0, "fit_cpu_s": 1.0}}
+
+    md = markdown(summarise([row("a", 50.0, 90.0), row("b", 60.0, 80.0)], ["radial"]), ["radial"])
+    assert "50.0 (a) / 80.0 (b)" in md
+    md = markdown(summarise([row("a", 50.0, 70.0), row("b", 60.0, 80.0)], ["radial"]), ["radial"])
+    assert "50.0 / 70.0 (a)" in md
+
+
 def test_bootstrap_interval_brackets_the_mean():
     lo, hi = bootstrap_ci([80.0, 90.0, 100.0, 70.0])
     assert lo < 85.0 < hi and 70 <= lo and hi <= 100
