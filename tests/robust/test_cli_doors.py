@@ -61,6 +61,11 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["eval", "rings", "/nonexistent", "--methods", "radial,radial", "--out", "OUT/e"],
      r"--methods must be 'all' or a comma list from evidence, rbf, radial, neural, each name once"),
     (["block", "synth", "--count", "1", "--face-px", "8", "--out", "OUT/b"], r"--face-px must be in \[16,"),
+    # they named the Python parameters (face_px, blocks, retries), exit 1, after writing run.json
+    (["bench", "run", "--blocks", "1", "--face-px", "20", "--out", "OUT/b"], r"--face-px must be in \[32, 16384\]"),
+    (["bench", "run", "--blocks", "0", "--out", "OUT/b"], r"--blocks must be in \[1,"),
+    (["bench", "run", "--blocks", "1", "--retries", "-1", "--out", "OUT/b"], r"--retries must be in \[0, 100\]"),
+    (["eval", "realistic", "--seed", "1", "--eq79", "-1", "--out", "OUT/e"], r"--eq79 must be in \[0, 1000\]"),
     # 100 mm of jitter failed every block with an unrelated message in its record
     (["block", "synth", "--count", "1", "--jitter-mm", "100", "--out", "OUT/b"], r"--jitter-mm must be in \[0, 10\]"),
     # it blamed the block spec for a missing file
@@ -86,7 +91,7 @@ def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monk
     argv = [a.replace("OUT", str(out)) for a in argv]
     t0 = time.perf_counter()
     # a wrong command line exits 2 (the --out rule, a number out of range), failed work 1
-    usage = "--out of" in match or "is a FILE" in match or __import__("re").match(r"--[a-z-]+ must be (in|a finite)", match)
+    usage = "--out of" in match or "is a FILE" in match or __import__("re").match(r"--[a-z0-9-]+ must be (in|a finite)", match)
     assert main(argv) == (EXIT_USAGE if usage else EXIT_ERROR)
     assert time.perf_counter() - t0 < 30.0  # refused before any fitting or baking (minutes)
     err = capsys.readouterr().err

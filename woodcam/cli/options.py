@@ -630,6 +630,12 @@ RANGES: dict = {
     "zoom": (1, 64, False),                # rings show: picture pixels per face pixel
     "sheets": (1, 1000, False),            # parquetry leaves per block (1e6 ran on, memory growing)
     "gallery": (0, 1000, False),           # bench report: -1 went into Python slicing
+    # bench run / eval realistic: exit 1 naming the Python parameters (face_px, blocks, retries),
+    # after run.json was written; bench's face_px has the library's floor (bench_settings)
+    ("bench", "face_px"): (32, 16_384, False),
+    ("bench", "blocks"): (1, 10_000_000, False),
+    "retries": (0, 100, False),
+    "eq79": (0, 1000, False),
     "thumbnails": (0, 1000, False),
     # the options' own names in the errors (they named the Python parameters: trace_dropout,
     # thickness_mm, relief ...)
