@@ -360,6 +360,12 @@ def _markdown(s: dict, run: dict) -> str:
               f"{s['task_s_median']:.1f} s per block (one worker, one thread); 10^5 blocks = "
               f"{s['cpu_hours_per_1e5']:.0f} CPU-hours, about {s['cpu_hours_per_1e5'] / 100:.1f} h "
               f"on 100 cores, {s['cpu_hours_per_1e5'] / 1000:.2f} h on 1000.", ""]
+    if s.get("gallery") or s.get("thumbnails"):
+        lines += ["## gallery", ""]
+        lines += [f"- {bench_key(i)}: cut planes `gallery/{bench_key(i)}_<face set>.png` (refitted from "
+                  f"its seed), faces `gallery/{bench_key(i)}_faces.png`" for i in s.get("gallery", [])]
+        lines += [f"- {bench_key(i)}: faces `gallery/{bench_key(i)}_faces.png`" for i in s.get("thumbnails", [])]
+        lines.append("")
     if s["failed"]:
         lines += [f"## failed tasks ({len(s['failed'])})", ""]
         lines += [f"- {f['key']}: {f['error']}" for f in s["failed"][:50]]
@@ -432,11 +438,9 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
                                f"{res.get('seed')}, not block {key} of this run's seed {run['seed']} "
                                f"({mpath}); delete it and re-run `woodcam bench run` to recompute it")
     s = summarise_bench(records)
-    out.mkdir(parents=True, exist_ok=True)
-    write_json_atomic(out / "report.json", {"seed": run["seed"], "settings": run["settings"], **s})
-    write_text(out / "report.md", _markdown(s, run))
-    _plot(s, out / "table1.png")
-    # the gallery: worst distinct blocks first, then a sample of each kind as thumbnails
+    # the gallery: worst distinct blocks first, then a sample of each kind as thumbnails; chosen
+    # before the report is written, so report.json and report.md say which blocks it draws (they
+    # did not: the picks were only returned)
     worst = sorted({(w["matched_1"], w["index"]) for label in s["worst"] for rows in s["worst"][label].values()
                     for w in rows})
     picks = []
@@ -447,12 +451,17 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
     for kind in ("clear", "knotted"):
         sample += [r["result"]["index"] for r in records.values()
                    if r["status"] == "ok" and r["result"]["kind"] == kind][:thumbnails]
+    s["gallery"] = picks
+    s["thumbnails"] = [i for i in sample if i not in picks]
+    out.mkdir(parents=True, exist_ok=True)
+    write_json_atomic(out / "report.json", {"seed": run["seed"], "settings": run["settings"], **s})
+    write_text(out / "report.md", _markdown(s, run))
+    _plot(s, out / "table1.png")
     from ._progress import progress_bar
 
-    for i in progress_bar(picks + [i for i in sample if i not in picks], desc="gallery", unit="block",
+    for i in progress_bar(picks + s["thumbnails"], desc="gallery", unit="block",
                           enabled=progress):  # the worst are refitted; the sample only drawn
         bench_gallery(run["seed"], i, run["settings"], out / "gallery", planes=i in picks)
-    s["gallery"] = picks
     return s
 
 

@@ -331,6 +331,9 @@ def test_report_on_a_real_run_writes_tables_and_gallery(tmp_path):
     md = (tmp_path / "rep" / "report.md").read_text()
     assert "seed 1, 2 blocks (1 clear, 1 knotted)" in md and "| radial |" in md
     assert s["gallery"] == [1]  # the knotted block is the worst
+    # the report files say which blocks the gallery draws (only the returned dict did)
+    assert json.loads((tmp_path / "rep" / "report.json").read_text())["gallery"] == [1]
+    assert "- b000001: cut planes `gallery/b000001_<face set>.png`" in md
     for f in ("report.json", "table1.png", "gallery/b000001_full.png", "gallery/b000001_faces.png"):
         assert (tmp_path / "rep" / f).stat().st_size > 1000, f
 
