@@ -73,7 +73,7 @@ def read_image_file(path: Path, what: str):
                     f"MAX_IMAGE_PIXELS = {limit('MAX_IMAGE_PIXELS'):.0f}; downscale it, or raise "
                     "the limit with WOODCAM_MAX_IMAGE_PIXELS=N")
             im.load()  # decode now: a truncated file fails here, inside the try
-            return _image_array(ImageOps.exif_transpose(im))
+            return _image_array(ImageOps.exif_transpose(im), f"{what}: {str(path)!r}")
     except WoodcamError:
         raise
     except (OSError, SyntaxError, ValueError, Image.DecompressionBombError) as err:
@@ -101,8 +101,9 @@ def photo_rgb8(a):
     return a[..., :3].astype(np.uint8, copy=False)
 
 
-def _image_array(im):
-    """A decoded PIL image as uint8 (8-bit modes) or uint16 (16-bit modes, values kept)."""
+def _image_array(im, where: str):
+    """A decoded PIL image as uint8 (8-bit modes) or uint16 (16-bit modes, values kept);
+    ``where`` (what and the file) starts the message of an image that cannot be."""
     import numpy as np
 
     if im.mode in ("I;16", "I;16B", "I;16L", "I;16N"):
@@ -110,11 +111,13 @@ def _image_array(im):
     if im.mode == "I":
         a = np.asarray(im)
         if a.size and (a.min() < 0 or a.max() > 65535):
-            raise WoodcamError(f"32-bit integer image with values outside 0..65535 "
+            raise WoodcamError(f"{where} is a 32-bit integer image with values outside 0..65535 "
                                f"({a.min()}..{a.max()}); save it as 8- or 16-bit")
         return a.astype(np.uint16)
     if im.mode in ("RGB;16", "RGBA;16") or im.mode.startswith(("F", "RGBa")):
-        raise WoodcamError(f"image mode {im.mode} is not supported; save it as 8- or 16-bit PNG")
+        kind = " (floating point)" if im.mode.startswith("F") else ""
+        raise WoodcamError(f"{where} has image mode {im.mode}{kind}, which is not supported; save it as an "
+                           "8- or 16-bit PNG")
     if im.mode not in ("L", "RGB"):
         im = im.convert("RGB" if im.mode in ("P", "RGBA", "CMYK", "YCbCr", "LAB", "HSV", "PA")
                         else "L")

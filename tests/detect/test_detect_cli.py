@@ -315,3 +315,14 @@ def test_a_photo_too_small_for_rings_is_refused(synth_photos, tmp_path, capsys):
         im.resize((8, 8)).save(d / "top.png")
     rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
     assert rc == EXIT_ERROR and "face 'top'" in err and "8x8 px: too small to hold rings" in err
+
+
+def test_an_unsupported_image_mode_names_the_face_and_file(synth_photos, tmp_path, capsys):
+    """A 32-bit float TIFF was refused as 'image mode F is not supported' without saying which
+    face or file."""
+    d = _copy(synth_photos, tmp_path / "f", skip=("left",))
+    with Image.open(synth_photos / "left.png") as im:
+        Image.fromarray(np.asarray(im.convert("L"), np.float32) / 255).save(d / "left.tif")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and err.count("\n") == 1, err
+    assert "face 'left'" in err and "left.tif" in err and "mode F" in err
