@@ -55,8 +55,8 @@ def read_image_file(path: Path, what: str):
     phone stores a portrait photo as landscape pixels plus that tag: read raw it lies on its
     side, a face's rings turned 90 degrees): ``(h, w)`` or ``(h, w, 3)`` uint8 for 8-bit modes,
     uint16 for 16-bit ones (values kept). Files over :data:`~woodcam.limits.MAX_IMAGE_PIXELS`,
-    unreadable, truncated or of unsupported modes are WoodcamErrors naming ``what`` and the
-    file."""
+    unreadable, truncated, animated (a GIF, PNG or WebP of several frames: which is the face?)
+    or of unsupported modes are WoodcamErrors naming ``what`` and the file."""
     from PIL import Image, ImageOps
 
     from .limits import limit
@@ -72,6 +72,12 @@ def read_image_file(path: Path, what: str):
                     f"{what}: {str(path)!r} is {im.width}x{im.height} px, more than the limit "
                     f"MAX_IMAGE_PIXELS = {limit('MAX_IMAGE_PIXELS'):.0f}; downscale it, or raise "
                     "the limit with WOODCAM_MAX_IMAGE_PIXELS=N")
+            # an animation's first frame was taken without a word; a phone's MPO JPEG (a depth
+            # or gain map as its second image) is one photo and is read as such
+            if getattr(im, "is_animated", False) and im.format in ("GIF", "PNG", "WEBP"):
+                raise WoodcamError(
+                    f"{what}: {str(path)!r} is an animated {im.format} of {im.n_frames} frames, not one "
+                    "photo; save the frame that shows the face as a still JPEG or PNG")
             im.load()  # decode now: a truncated file fails here, inside the try
             return _image_array(ImageOps.exif_transpose(im), f"{what}: {str(path)!r}")
     except WoodcamError:

@@ -317,6 +317,25 @@ def test_a_photo_too_small_for_rings_is_refused(synth_photos, tmp_path, capsys):
     assert rc == EXIT_ERROR and "face 'top'" in err and "8x8 px: too small to hold rings" in err
 
 
+def test_an_animated_photo_is_refused_naming_face_and_file(synth_photos, tmp_path, capsys):
+    """An animated GIF or WebP (a phone's burst or live-photo export) was read as its first
+    frame without a word: here a grey frame, refused as 'blank', and a first frame of another
+    face would have been taken for this one. A phone's MPO JPEG (a second, depth image) is
+    one photo and is read."""
+    d = _copy(synth_photos, tmp_path / "anim", skip=("front",))
+    with Image.open(synth_photos / "front.png") as im:
+        upright = im.convert("RGB")
+    grey = Image.new("RGB", upright.size, (128, 128, 128))
+    grey.save(d / "front.webp", save_all=True, append_images=[upright], lossless=True)
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and err.count("\n") == 1, err
+    assert "face 'front'" in err and "front.webp" in err and "animated WEBP of 2 frames" in err
+    (d / "front.webp").unlink()
+    upright.save(d / "front.jpg", format="MPO", save_all=True, append_images=[upright.resize((40, 40))])
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == 0, err
+
+
 def test_an_unsupported_image_mode_names_the_face_and_file(synth_photos, tmp_path, capsys):
     """A 32-bit float TIFF was refused as 'image mode F is not supported' without saying which
     face or file."""
