@@ -345,3 +345,24 @@ def test_an_unsupported_image_mode_names_the_face_and_file(synth_photos, tmp_pat
     rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
     assert rc == EXIT_ERROR and err.count("\n") == 1, err
     assert "face 'left'" in err and "left.tif" in err and "mode F" in err
+
+
+def test_photos_not_cropped_to_their_faces_are_all_named_with_the_fix(synth_photos, tmp_path, capsys):
+    """Photos with background round the face were refused one face per run ('crop the photo to
+    the face'), and a photo turned a quarter the same way. Now one line names every face that
+    does not fit, the size its crop would have, a turned photo as turned, and how to crop."""
+    d = _copy(synth_photos, tmp_path / "uncropped")
+    for name in ("front", "top"):      # 20 px of table to each side, none above and below
+        with Image.open(d / f"{name}.png") as im:
+            a = np.asarray(im.convert("RGB"))
+        Image.fromarray(np.pad(a, ((0, 0), (20, 20), (0, 0)), constant_values=200)).save(d / f"{name}.png")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and err.count("\n") == 1, err
+    assert "2 photos" in err and "face 'front' (front.png)" in err and "face 'top' (top.png)" in err
+    assert "200x160 px" in err and "about 160x160 px when cropped" in err and "to its face's edges" in err
+    d = _copy(synth_photos, tmp_path / "turned", skip=("front", "top", "bottom", "right", "back"))
+    with Image.open(d / "left.png") as im:      # a 50 x 40 mm left face, 160 x 128 px, turned a quarter
+        im.resize((128, 160)).save(d / "left.png")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x40", "--partial", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and "photo does not fit" in err and "face 'left' (left.png)" in err, err
+    assert "turned 90 degrees" in err

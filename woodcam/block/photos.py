@@ -76,6 +76,18 @@ def _check_exposure(face: str, photo: np.ndarray, path: Path) -> None:
                            f"{lum.std() / 255:.3f} < {BLANK_STD}); retake it with the face in view")
 
 
+def _aspect_misfit(face: str, path: Path, shape, h_mm: float, w_mm: float) -> str:
+    """What is wrong with a photo of ``shape`` (rows, cols, ...) for a face ``w_mm`` x ``h_mm``:
+    its size, the face's, and the height a crop of its width would have (or that it is turned)."""
+    rows, cols = shape[:2]
+    want, got = h_mm / w_mm, rows / cols
+    what = f"face {face!r} ({path.name}) is {cols}x{rows} px (aspect {got:.3f}) for {w_mm:g}x{h_mm:g} mm ({want:.3f})"
+    if want != 1.0 and abs(got * want - 1.0) <= FACE_PIXEL_ASPECT_RTOL:
+        return f"{what}, turned 90 degrees: turn it upright as docs/conventions.md lays the face out"
+    if got > want:
+        return f"{what}, about {cols}x{round(cols * want)} px when cropped"
+    return f"{what}, about {round(rows / want)}x{rows} px when cropped"
+
 def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: float = MAX_PX_PER_MM,
                       name: str | None = None) -> Block:
     """Read and check the face photos in ``folder`` (module docstring) -> a :class:`Block` with
@@ -100,22 +112,26 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
         raise WoodcamError(f"missing face photos: {', '.join(missing)} (found {', '.join(photos)}); add "
                            f"{', '.join(f + '.jpg' for f in missing)} (or Mokume letters "
                            f"{', '.join(MOKUME_LETTER[f] for f in missing)}), or pass --partial")
-    images, density = {}, []
+    images, density, misfit = {}, [], []
     for face, path in photos.items():
         a = read_photo_rgb(path, f"photo of face {face!r}")
         _check_exposure(face, a, path)
         h_mm, w_mm = face_image_size_mm(face, size)
         want, got = h_mm / w_mm, a.shape[0] / a.shape[1]
         if abs(got - want) > FACE_PIXEL_ASPECT_RTOL * want:
-            raise WoodcamError(
-                f"photo of face {face!r} ({path.name}) is {a.shape[1]}x{a.shape[0]} px (aspect {got:.3f}) but "
-                f"the face is {w_mm:g}x{h_mm:g} mm (aspect {want:.3f}) for --size-mm "
-                f"{size[0]:g}x{size[1]:g}x{size[2]:g}; crop the photo to the face or check --size-mm")
+            misfit.append(_aspect_misfit(face, path, a.shape, h_mm, w_mm))
+            continue
         if min(a.shape[:2]) < 16:  # an 8 x 8 px photo was enlarged and recorded at a density it lacks
             raise WoodcamError(f"photo of face {face!r} ({path.name}) is {a.shape[1]}x{a.shape[0]} px: too small to "
                                "hold rings; give at least 16 px a side (a phone photo has thousands)")
         images[face] = a
         density.append(min(a.shape[0] / h_mm, a.shape[1] / w_mm))
+    if misfit:  # all of them at once: photos not cropped to the face are seldom alone
+        raise WoodcamError(
+            f"{'photo does' if len(misfit) == 1 else f'{len(misfit)} photos do'} not fit the block's faces for "
+            f"--size-mm {size[0]:g}x{size[1]:g}x{size[2]:g}: {'; '.join(misfit)}; crop each photo to its face's "
+            "edges, the wood alone with no table or background round it (a photo editor's perspective crop also "
+            "squares up a face taken at an angle), or check --size-mm")
     ppm = min(min(density), max_px_per_mm)
     faces = {}
     for face, a in images.items():
