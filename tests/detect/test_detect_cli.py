@@ -366,3 +366,39 @@ def test_photos_not_cropped_to_their_faces_are_all_named_with_the_fix(synth_phot
     rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x40", "--partial", "--out", tmp_path / "o")
     assert rc == EXIT_ERROR and "photo does not fit" in err and "face 'left' (left.png)" in err, err
     assert "turned 90 degrees" in err
+
+
+def test_large_photos_are_brought_to_the_cap_one_at_a_time_under_a_bar(synth_photos, tmp_path, capsys, monkeypatch):
+    """Six phone photos were all held at full size, and a float copy of each one's three channels
+    made for the exposure check, before any was resampled: six 48 MP photos took 1.8 GB, 35 s
+    without a progress bar. Now each is brought down to the --max-px-per-mm cap as it is read
+    (the faces written are the same), under a 'reading photos' bar."""
+    import tracemalloc
+
+    from woodcam import _progress
+    from woodcam.block.photos import block_from_photos
+
+    d = tmp_path / "big"
+    d.mkdir()
+    for p in synth_photos.iterdir():
+        with Image.open(p) as im:
+            im.convert("RGB").resize((1200, 1200), Image.BILINEAR).save(d / p.name, compress_level=1)
+    one_photo = 1200 * 1200 * 3
+    tracemalloc.start()
+    try:
+        block = block_from_photos(d, (50, 50, 50), max_px_per_mm=2.0)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert all(f.photo.shape == (100, 100, 3) for f in block.faces.values())
+    assert peak < 2.5 * one_photo, f"peak {peak / one_photo:.1f} photos"
+    bars = []
+
+    def bar(iterable=None, **kw):
+        bars.append(kw)
+        return iterable
+
+    monkeypatch.setattr(_progress, "progress_bar", bar)
+    rc, _out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == 0, err
+    assert [(b["desc"], b["enabled"]) for b in bars] == [("reading photos", True)]

@@ -37,7 +37,8 @@ def run_from_photos(args) -> int:
     from ..block.photos import MAX_PX_PER_MM, block_from_photos
 
     block = block_from_photos(args.photos_dir, _size(args.size_mm), partial=args.partial,
-                              max_px_per_mm=MAX_PX_PER_MM if args.max_px_per_mm is None else args.max_px_per_mm)
+                              max_px_per_mm=MAX_PX_PER_MM if args.max_px_per_mm is None else args.max_px_per_mm,
+                              progress=True)
     write_block(block, args.out)
     shapes = ", ".join(f"{n} {f.shape[1]}x{f.shape[0]}" for n, f in block.faces.items())
     print(f"wrote {args.out} ({len(block.faces)} faces at {block.meta['px_per_mm']:.2f} px/mm: {shapes}); "
