@@ -402,3 +402,15 @@ def test_large_photos_are_brought_to_the_cap_one_at_a_time_under_a_bar(synth_pho
     rc, _out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", tmp_path / "o")
     assert rc == 0, err
     assert [(b["desc"], b["enabled"]) for b in bars] == [("reading photos", True)]
+
+
+def test_from_photos_says_when_the_photos_are_brought_down_to_the_cap(synth_photos, tmp_path, capsys):
+    """Phone photos far denser than --max-px-per-mm were stored at the cap with only 'faces at
+    10.00 px/mm' said: nothing told that the photos held more, or which option keeps it."""
+    rc, out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--max-px-per-mm", "2",
+                        "--out", tmp_path / "o")
+    assert rc == 0, err
+    assert "faces at 2.00 px/mm, down from the photos' 3.20 (the --max-px-per-mm cap" in out
+    assert read_block(tmp_path / "o").meta["photos_px_per_mm"] == pytest.approx(3.2)
+    rc, out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", tmp_path / "p")
+    assert rc == 0 and "faces at 3.20 px/mm:" in out and "down from" not in out, out + err

@@ -174,5 +174,6 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
         shape = _face_shape(face, size, ppm)
         faces[face] = Face(face, shape, photo=_resampled(a, shape))
     meta = {"source": "photos", "photos_dir": str(Path(folder).resolve()), "px_per_mm": float(ppm),
+            "photos_px_per_mm": float(min(density)),
             "photos": {f: p.name for f, p in photos.items()}}
     return Block(tuple(size), faces=faces, name=name or Path(folder).name, meta=meta)

@@ -41,7 +41,11 @@ def run_from_photos(args) -> int:
                               progress=True)
     write_block(block, args.out)
     shapes = ", ".join(f"{n} {f.shape[1]}x{f.shape[0]}" for n, f in block.faces.items())
-    print(f"wrote {args.out} ({len(block.faces)} faces at {block.meta['px_per_mm']:.2f} px/mm: {shapes}); "
+    ppm, photos_ppm = block.meta["px_per_mm"], block.meta["photos_px_per_mm"]
+    # say when the photos held more: a 12 MP phone photo of a 50 mm face is 60 px/mm, stored at 10
+    capped = (f", down from the photos' {photos_ppm:.2f} (the --max-px-per-mm cap, default {MAX_PX_PER_MM:g}: "
+              f"rings 0.8 mm apart keep 8 px)" if photos_ppm > ppm * (1 + 1e-9) else "")
+    print(f"wrote {args.out} ({len(block.faces)} faces at {ppm:.2f} px/mm{capped}: {shapes}); "
           f"next: woodcam rings detect {args.out} --out {args.out}")
     return 0
 
