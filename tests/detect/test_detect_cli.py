@@ -11,6 +11,7 @@ from PIL import Image
 
 from woodcam.block import read_block
 from woodcam.cli import EXIT_ERROR, main
+from woodcam.errors import WoodcamWarning
 from woodcam.frames import FACES
 
 
@@ -414,3 +415,26 @@ def test_from_photos_says_when_the_photos_are_brought_down_to_the_cap(synth_phot
     assert read_block(tmp_path / "o").meta["photos_px_per_mm"] == pytest.approx(3.2)
     rc, out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", tmp_path / "p")
     assert rc == 0 and "faces at 3.20 px/mm:" in out and "down from" not in out, out + err
+
+
+def test_photos_named_for_no_face_are_said(synth_photos, tmp_path, capsys):
+    """'top face.jpg' or IMG_1234.JPG beside the face photos were passed over without a word: the
+    missing-face error did not say they were there, and with --partial the face was just left out.
+    Hidden files (.DS_Store, macOS ._front.png), other files and a Mokume sample's maps are not photos."""
+    d = _copy(synth_photos, tmp_path / "n", skip=("top",))
+    (d / "top face.png").write_bytes((synth_photos / "top.png").read_bytes())
+    (d / "._front.png").write_bytes(b"\0\5\26\7")
+    (d / "A_arl-unet.png").write_bytes((synth_photos / "top.png").read_bytes())
+    for junk in ("Thumbs.db", ".DS_Store", "notes.txt"):
+        (d / junk).write_text("x")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and err.count("\n") == 1, err
+    assert "missing face photos: top" in err and "top face.png is named for no face" in err
+    assert "._front" not in err and "arl-unet" not in err
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--partial", "--out", tmp_path / "o")
+    assert rc == 0 and err.count("warning") == 1, err
+    assert "top face.png is named for no face, so not read" in err and "._front" not in err
+    from woodcam.block.photos import block_from_photos
+
+    with pytest.warns(WoodcamWarning, match=r"top face\.png is named for no face"):
+        assert "top" not in block_from_photos(d, (50, 50, 50), partial=True).faces

@@ -15,12 +15,13 @@ the faces unfold into one cross and ring widths are alike in pixels.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from .._readers import read_photo_rgb
-from ..errors import WoodcamError
+from ..errors import WoodcamError, WoodcamWarning
 from ..frames import (
     FACE_OF_LETTER,
     FACES,
@@ -41,18 +42,37 @@ CLIPPED_SHARE = 0.4
 MAX_PX_PER_MM = 10.0
 
 
+def _image_files(folder: Path) -> list[Path]:
+    """The files in ``folder`` with a photo suffix (:data:`PHOTO_SUFFIXES`), sorted; hidden ones
+    (macOS ``._front.jpg`` resource forks) left out."""
+    return [p for p in sorted(folder.iterdir())
+            if p.suffix.lower() in PHOTO_SUFFIXES and not p.name.startswith(".") and p.is_file()]
+
+
+def _face_of(path: Path) -> str | None:
+    """The face a photo file is named for (module docstring), or None."""
+    stem = path.stem.lower().removesuffix("_col")
+    return stem if stem in FACES else FACE_OF_LETTER.get(stem.upper()) if len(stem) == 1 else None
+
+
+def stray_photos(folder) -> list[Path]:
+    """Image files in ``folder`` named for no face (``IMG_1234.jpg``, ``front face.jpg``); a
+    Mokume sample's maps and masks (``A_arl-unet.png``, ``A_ann.png``, ``A_knot.png``) are not."""
+    def mokume_map(p: Path) -> bool:
+        letter, _, kind = p.stem.partition("_")
+        return letter.upper() in FACE_OF_LETTER and kind in ("arl-unet", "ann", "knot")
+
+    return [p for p in _image_files(Path(folder)) if _face_of(p) is None and not mokume_map(p)]
+
+
 def find_face_photos(folder) -> dict[str, Path]:
     """Face name -> photo path for the photos in ``folder`` (module docstring for the names)."""
     folder = Path(folder)
     if not folder.is_dir():
         raise WoodcamError(f"PHOTOS_DIR must be a folder of face photos; {str(folder)!r} is not a folder")
     found: dict[str, list[Path]] = {}
-    for p in sorted(folder.iterdir()):
-        if p.suffix.lower() not in PHOTO_SUFFIXES or not p.is_file():
-            continue
-        stem = p.stem.lower()
-        stem = stem.removesuffix("_col")
-        face = stem if stem in FACES else FACE_OF_LETTER.get(stem.upper()) if len(stem) == 1 else None
+    for p in _image_files(folder):
+        face = _face_of(p)
         if face:
             found.setdefault(face, []).append(p)
     dup = {f: [q.name for q in ps] for f, ps in found.items() if len(ps) > 1}
@@ -147,13 +167,19 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
     size = check_size(size_mm)
     photos = find_face_photos(folder)
     missing = [f for f in FACES if f not in photos]
+    stray = [p.name for p in stray_photos(folder)]
+    # a photo named for no face was passed over without a word (with --partial, its face was left out)
+    unnamed = f"{', '.join(stray)} {'is' if len(stray) == 1 else 'are'} named for no face"
     if not photos:
-        raise WoodcamError(f"no face photos found in {str(folder)!r}: name them front.jpg, top.jpg, left.jpg, "
-                           f"bottom.jpg, right.jpg, back.jpg (or A..F, or Mokume A_col.png ...)")
+        raise WoodcamError(f"no face photos found in {str(folder)!r}{'; ' + unnamed if stray else ''}: name them front.jpg, top.jpg, "
+                           f"left.jpg, bottom.jpg, right.jpg, back.jpg (or A..F, or Mokume A_col.png ...)")
     if missing and not partial:
-        raise WoodcamError(f"missing face photos: {', '.join(missing)} (found {', '.join(photos)}); add "
+        raise WoodcamError(f"missing face photos: {', '.join(missing)} (found {', '.join(photos)}){'; ' + unnamed if stray else ''}; add "
                            f"{', '.join(f + '.jpg' for f in missing)} (or Mokume letters "
                            f"{', '.join(MOKUME_LETTER[f] for f in missing)}), or pass --partial")
+    if stray:
+        warnings.warn(f"{str(folder)!r}: {unnamed}, so not read; rename a face's photo front.jpg, top.jpg, "
+                      "left.jpg, bottom.jpg, right.jpg or back.jpg (or A..F)", WoodcamWarning, stacklevel=2)
     images, density, misfit = {}, [], []
     for face, path in progress_bar(photos.items(), desc="reading photos", unit="photo", enabled=progress):
         got = _read_face_photo(face, path, size, max_px_per_mm)
