@@ -34,6 +34,11 @@ def test_demo_quick_writes_every_output(tmp_path, capsys, bars):
     assert (tmp_path / "demo.png").is_file()
     for stage in ("load", "carve", "bake", "export", "render"):
         assert stage in out
+    # the summary's "files:" list names every file written (it left out the MTL, the texture
+    # and the JSON report)
+    listed = set(re.findall(r"\S+", out.split("files:", 1)[1].replace(",", " ")))
+    written = {str(f) for f in tmp_path.iterdir() if f.name != "demo.png"}
+    assert written <= listed, written - listed
 
 
 def test_bake_and_preview_from_the_command_line(tmp_path, capsys):

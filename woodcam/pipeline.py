@@ -33,7 +33,8 @@ class PartPreview:
         Volume of the carved part.
     triangles : int
     atlas_px : (h, w)
-    files : dict kind -> Path ("glb", "obj", "png")
+    files : dict kind -> Path, every file written ("glb", "obj", "mtl", "texture", "report",
+        "report_json", "png")
     timings_s : dict stage -> seconds
     warnings : list of str
     """
@@ -303,6 +304,7 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
             write_bytes(stem.with_suffix(".txt"), (report_text(result.report, out_glb.stem)
                                                    + "\n").encode())
         result.files["report"] = stem.with_suffix(".txt")
+        result.files["report_json"] = stem.with_suffix(".json")
     result.warnings += list(getattr(baked, "warnings", []))
     from .stock import absolute_spec, spec_digest
 
@@ -329,6 +331,9 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
             obj_path = out_glb.with_suffix(".obj")
             result.files["obj"] = Path(export_obj(shaded, obj_path, units=obj_units,
                                                   up=obj_up, normals=normals) or obj_path)
+            from .export import obj_siblings
+
+            result.files["mtl"], result.files["texture"] = obj_siblings(result.files["obj"])
     if screenshot:
         _render_screenshot(baked.mesh, stock, out_glb, result)
     return result
