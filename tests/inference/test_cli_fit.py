@@ -127,3 +127,22 @@ def test_fit_workers_option_sets_the_fit_processes_and_keeps_the_field(block_dir
     assert np.array_equal(fields[0].years, fields[1].years)
     assert fields[0].meta["chosen"] == fields[1].meta["chosen"]
     assert main(["fit", str(folder), "--workers", "0", "--out", str(tmp_path / "w0.npz")]) != 0
+
+
+def test_eval_methods_all_is_every_method(block_dir, tmp_path, monkeypatch):
+    """``--methods all`` ran the default rbf,radial."""
+    import woodcam.inference.evaluate as evaluate
+    from woodcam.cli.fit import METHODS
+
+    folder, truth, _ = block_dir
+    asked = []
+
+    def fake(blocks, methods, sets, **kw):
+        asked.append(list(methods))
+        return {"table": ""}
+
+    monkeypatch.setattr(evaluate, "benchmark", fake)
+    assert main(["eval", "rings", str(folder), "--truth", str(truth), "--methods", "all",
+                 "--out", str(tmp_path)]) == 0
+    assert main(["eval", "rings", str(folder), "--truth", str(truth), "--out", str(tmp_path)]) == 0
+    assert asked == [list(METHODS), ["rbf", "radial"]]

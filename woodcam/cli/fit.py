@@ -55,7 +55,7 @@ def register(subparsers) -> None:
     e.add_argument("--truth", type=Path, nargs="*", default=None,
                    help="true field files (.npz), one per block; default: each block's own")
     e.add_argument("--methods", default="rbf,radial",
-                   help=f"comma list of {', '.join(METHODS)} (default rbf,radial)")
+                   help=f"comma list of {', '.join(METHODS)}, or all (default rbf,radial)")
     e.add_argument("--partial-faces", default=",".join(PARTIAL_FACES),
                    help="faces of the partial-annotation run ('none' to skip it)")
     e.add_argument("--detect", action="store_true",
@@ -89,7 +89,8 @@ def run_eval(args) -> int:
     from ..fields.grid import GridField
     from ..inference.evaluate import benchmark
 
-    methods = comma_names(args.methods, "--methods", METHODS, all_=True) or ["rbf", "radial"]
+    # 'all' is every method (it gave the default rbf,radial)
+    methods = comma_names(args.methods, "--methods", METHODS, all_=True) or list(METHODS)
     partial = (None if args.partial_faces.lower() == "none"
                else comma_names(args.partial_faces, "--partial-faces", all_=True))
     blocks = [open_block(p, args.size_mm)[0] for p in args.block]
