@@ -33,3 +33,19 @@ def test_every_numeric_option_names_its_unit():
                if a.type in (int, float) and a.option_strings[-1] not in DIMENSIONLESS
                and not UNITS.search(a.help or "")]
     assert not missing, missing
+
+
+def _sub_commands(parser):
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sp in action.choices.items():
+                yield name, sp
+                yield from _sub_commands(sp)
+
+
+def test_every_command_says_what_it_does():
+    """``block show --help`` (and nine others) went from usage straight to the arguments."""
+    commands = list(_sub_commands(build_parser()))
+    assert {"show", "synth", "render", "info", "species", "rings"} <= {n for n, _ in commands}
+    silent = [name for name, sp in commands if not (sp.description or "").strip()]
+    assert not silent, silent

@@ -110,7 +110,27 @@ def build_parser() -> argparse.ArgumentParser:
         register(sub)
     parser.set_defaults(_commands=sub)
     _state_defaults(parser)
+    _describe_commands(parser)
     return parser
+
+
+def _commands(parser: argparse.ArgumentParser):
+    """Every (name, help, parser) of ``parser``'s sub-commands, at any depth."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            helps = {a.dest: a.help for a in action._choices_actions}
+            for name, sp in action.choices.items():
+                yield name, helps.get(name), sp
+                yield from _commands(sp)
+
+
+def _describe_commands(parser: argparse.ArgumentParser) -> None:
+    """A command without a description of its own opens its ``--help`` with its one-line help
+    from the command list (``woodcam block show --help`` went straight from usage to arguments,
+    saying nowhere what the command does)."""
+    for _name, text, sp in _commands(parser):
+        if not sp.description and text:
+            sp.description = text[0].upper() + text[1:] + ("" if text.endswith(".") else ".")
 
 
 def _walk_options(parser: argparse.ArgumentParser):
