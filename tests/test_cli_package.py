@@ -107,6 +107,7 @@ def test_preview_names_its_own_arguments_and_ignores_nothing_silently(tmp_path, 
     got = []
     monkeypatch.setattr(view, "preview", lambda mesh, **kw: got.append(kw))
     monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block: None)
+    monkeypatch.setattr("woodcam.cli.options.recorded_block_size", lambda mesh: None)
     assert cli.main(["preview", str(tmp_path / "nope.glb"), "--screenshot"]) == 1
     assert f"preview: no file at {str(tmp_path / 'nope.glb')!r}" in capsys.readouterr().err
     with pytest.raises(SystemExit) as exc:
