@@ -277,6 +277,52 @@ def test_views_frame_the_block_at_any_aspect_and_the_hash_sets_the_ui(page, brow
         assert browser.evaluate("document.getElementById('ortho').checked") is False
 
 
+def _click_front(browser, x: float, z: float, size_mm) -> None:
+    """Click the canvas where block point (x, *, z) mm is drawn in the front view."""
+    W, _, H = size_mm
+    x0, y0, x1, y1 = _ndc(browser, "ndcBlock")
+    left, top, width, height = browser.evaluate(
+        "(() => { const r = document.getElementById('view').getBoundingClientRect(); "
+        "return [r.left, r.top, r.width, r.height]; })()")
+    nx, ny = x0 + x / W * (x1 - x0), y0 + z / H * (y1 - y0)
+    at = {"x": left + (nx + 1) / 2 * width, "y": top + (1 - ny) / 2 * height}
+    for kind in ("mousePressed", "mouseReleased"):
+        browser.call("Input.dispatchMouseEvent", session=True, type=kind, button="left",
+                     clickCount=1, **at)
+    _frames(browser)
+
+
+def test_measure_picks_the_part_and_the_cut_face(page, browser):
+    """Two clicks give the distance in mm of the picked points. With the section on, a click
+    on the cut face (the cap: no part of the GLB) picked nothing, so the wall thickness on a
+    section could not be measured; now it picks the point of the plane."""
+    stock, _, out, _ = page
+    measured = "document.getElementById('measurement').textContent"
+    assert browser.load(f"file://{out}#view=front&ortho&cut=off", size=(1320, 600)) == "box: ready"
+    browser.evaluate("document.getElementById('measure').click()")
+    _click_front(browser, 20, 15, stock.size_mm)  # the box's front face y = 10
+    _click_front(browser, 80, 35, stock.size_mm)
+    text = browser.evaluate(measured)
+    mm, *coords = map(float, re.findall(r"-?\d+\.\d+", text))
+    a, b = np.reshape(coords, (2, 3))
+    # the points are shown to 0.1 mm, the distance to 0.01 mm; a pixel is 0.1 mm
+    assert mm == pytest.approx(np.linalg.norm(a - b), abs=0.1), text
+    assert mm == pytest.approx(np.hypot(60, 20), abs=0.3), text
+    np.testing.assert_allclose([a, b], [[20, 10, 15], [80, 10, 35]], atol=0.3)
+    browser.call("Page.navigate", session=True, url="about:blank")
+    assert browser.load(f"file://{out}#view=front&ortho&cut=y:40", size=(1320, 600)) == "box: ready"
+    browser.evaluate("document.getElementById('measure').click()")
+    _click_front(browser, 20, 15, stock.size_mm)  # on the cut face, y = 40
+    _click_front(browser, 80, 35, stock.size_mm)
+    text = browser.evaluate(measured)
+    assert text, "a click on the cut face picked nothing"
+    mm, *coords = map(float, re.findall(r"-?\d+\.\d+", text))
+    a, b = np.reshape(coords, (2, 3))
+    np.testing.assert_allclose([a, b], [[20, 40, 15], [80, 40, 35]], atol=0.3)
+    assert mm == pytest.approx(np.linalg.norm(a - b), abs=0.1), text
+    assert mm == pytest.approx(np.hypot(60, 20), abs=0.3), text
+
+
 def test_review_errors_are_clear(page, tmp_path):
     stock, glb, _, _ = page
     with pytest.raises(WoodcamError, match="must be an existing .glb"):

@@ -240,13 +240,32 @@ const raycaster = new THREE.Raycaster();
 const picks = [];
 const marks = new THREE.Group();
 scene.add(marks);
+// Whether world point p lies inside the closed part: a ray from p crosses its surface an odd
+// number of times (front and back faces both count; the direction is skewed so it grazes no
+// axis-aligned face). The same rule as the stencil that draws the cap.
+const ODD_RAY = new THREE.Vector3(0.31, 0.53, 0.79).normalize();
+function insidePart(p) {
+  const sides = [];
+  part.traverse((o) => {
+    for (const m of o.isMesh ? [].concat(o.material) : []) { sides.push([m, m.side]); m.side = THREE.DoubleSide; }
+  });
+  const hits = new THREE.Raycaster(p, ODD_RAY).intersectObject(part, true);
+  for (const [m, side] of sides) m.side = side;
+  return hits.length % 2 === 1;
+}
 function onClick(ev) {
   if (!part || !document.getElementById('measure').checked) return;
   const r = canvas.getBoundingClientRect();
   const ndc = new THREE.Vector2(((ev.clientX - r.left) / r.width) * 2 - 1,
                                 -((ev.clientY - r.top) / r.height) * 2 + 1);
   raycaster.setFromCamera(ndc, camera);
-  const hit = raycaster.intersectObject(part, true).find((h) => !cut.on || plane.distanceToPoint(h.point) >= 0);
+  let hit = raycaster.intersectObject(part, true).find((h) => !cut.on || plane.distanceToPoint(h.point) >= 0);
+  if (cut.on) {
+    // the cut face (the cap) is no part of the GLB: a click on it picks the point of the plane,
+    // where the plane lies inside the part and nothing kept is nearer
+    const p = raycaster.ray.intersectPlane(plane, new THREE.Vector3());
+    if (p && insidePart(p) && (!hit || raycaster.ray.origin.distanceTo(p) < hit.distance)) hit = { point: p };
+  }
   if (!hit) return;
   picks.push(hit.point.clone());
   const dot = new THREE.Mesh(new THREE.SphereGeometry(span / 150), new THREE.MeshBasicMaterial({ color: 0xd01010 }));
