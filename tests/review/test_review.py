@@ -323,6 +323,32 @@ def test_measure_picks_the_part_and_the_cut_face(page, browser):
     assert mm == pytest.approx(np.hypot(60, 20), abs=0.3), text
 
 
+def test_clicking_a_hotspot_moves_the_view_to_it(page, browser, tmp_path):
+    """The hotspot list was text only: clicking an issue did nothing. Now the orbit centre goes
+    to it, twice as close; a cut that hides it is turned off. No hotspots: the list says none."""
+    stock, glb, _, _ = page
+    spots = [{"kind": "gcode", "label": "rapid into the stock", "at_mm": [80, 60, 45]},
+             {"kind": "knot", "label": "front", "at_mm": [20, 10, 30]}]  # cut away by y = 40
+    out = write_review(glb, tmp_path / "spots.html", wood=stock.wood, size_mm=stock.size_mm,
+                       hotspots=spots, voxels=20000)
+    assert browser.load(f"file://{out}#cut=y:40", size=(1000, 600)) == "box: ready"
+    extent = np.ptp(_ndc(browser, "ndcBlock").reshape(2, 2), axis=0).max()
+    items = "document.querySelectorAll('#hotspots li')"
+    assert browser.evaluate(f"{items}.length") == 2
+    for k, spot in enumerate(spots):
+        browser.evaluate(f"{items}[{k}].click()")
+        _frames(browser)
+        assert np.ptp(_ndc(browser, "ndcBlock").reshape(2, 2), axis=0).max() > 1.5 * extent
+        np.testing.assert_allclose(_ndc(browser, "targetMm"), spot["at_mm"], atol=0.01)
+        assert browser.evaluate(f"{items}[{k}].className") == "focused"
+        # the first spot lies beyond the cut, the second on the side cut away
+        assert browser.evaluate("document.getElementById('cut-on').checked") is (k == 0)
+    assert browser.evaluate("document.getElementById('cut-on').checked") is False
+    bare = write_review(glb, tmp_path / "none.html", wood=stock.wood, size_mm=stock.size_mm,
+                        voxels=20000)
+    assert '<h2>Hotspots</h2><i id="hotspots">none</i>' in bare.read_text()
+
+
 def test_review_errors_are_clear(page, tmp_path):
     stock, glb, _, _ = page
     with pytest.raises(WoodcamError, match="must be an existing .glb"):

@@ -188,6 +188,7 @@ def _page(data: dict, glb_b64: str, bundle: str) -> str:
  #panel th {{ text-align: left; padding-right: 6px; vertical-align: top; }}
  figure {{ display: inline-block; margin: 2px; }} figure img {{ width: 90px; }}
  figcaption {{ font-size: 11px; text-align: center; }}
+ #hotspots li {{ cursor: pointer; }} #hotspots li.focused {{ font-weight: bold; }}
  #snapshot {{ display: none; }}
  body.bare #panel {{ display: none; }}
  @media print {{ #view, button, .ui {{ display: none !important; }}
@@ -209,7 +210,7 @@ def _page(data: dict, glb_b64: str, bundle: str) -> str:
 <h2>Measure</h2><div class="ui"><label><input type="checkbox" id="measure"> two clicks on the
  part</label><div id="measurement"></div></div>
 <h2>Block and bake</h2><table><tr><th>block</th><td>{W:g} x {D:g} x {H:g} mm</td></tr>{report_rows}</table>
-<h2>Hotspots</h2><ul id="hotspots"></ul>
+<h2>Hotspots</h2>{'<ul id="hotspots"></ul>' if data['hotspots'] else '<i id="hotspots">none</i>'}
 <h2>Face photos</h2><div>{photos or '<i>none</i>'}</div>
 <p><button id="print">print shop sheet</button> <span id="status">loading</span></p>
 <img id="snapshot" alt="view"><div id="probe" hidden></div>

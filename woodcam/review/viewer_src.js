@@ -118,6 +118,7 @@ function updateProbe() {
   const block = new THREE.Box3().setFromPoints([worldOfBlock(0, 0, 0), worldOfBlock(W, D, H)]);
   probe.dataset.ndcBlock = ndcBounds(block.min, block.max);
   if (partBox) probe.dataset.ndcPart = ndcBounds(partBox.min, partBox.max);
+  probe.dataset.targetMm = blockOfWorld(controls.target).map((v) => v.toFixed(2)).join(',');
 }
 
 // ---- the wood inside: three 3-D textures (one per cut axis, colour for that normal) ----------
@@ -286,6 +287,24 @@ function onClick(ev) {
   }
 }
 
+// Look at a hotspot: the orbit centre moves onto it, seen from the same direction, twice as
+// close (orthographic: zoom 2); a cut that hides it (the spot on the side cut away) is turned off.
+function focusOn(atMm) {
+  const p = worldOfBlock(...atMm);
+  const offset = camera.position.clone().sub(controls.target);
+  offset.setLength(Math.min(offset.length(), perspDistance(canvasAspect()) / 2));
+  controls.target.copy(p);
+  camera.position.copy(p).add(offset);
+  camera.lookAt(p);
+  if (camera === ortho) { ortho.zoom = 2; ortho.updateProjectionMatrix(); }
+  if (cut.on && plane.distanceToPoint(p) < -1e-6) {
+    cut.on = false;
+    const on = document.getElementById('cut-on');
+    if (on) on.checked = false;
+    updatePlane();
+  }
+}
+
 function addHotspots() {
   const list = document.getElementById('hotspots');
   for (const h of data.hotspots || []) {
@@ -297,6 +316,12 @@ function addHotspots() {
     scene.add(m);
     const li = document.createElement('li');
     li.textContent = `${h.kind}: ${h.label} at (${h.at_mm.map((v) => v.toFixed(1)).join(', ')}) mm`;
+    li.title = 'click: look at it';
+    li.onclick = () => {
+      for (const other of list.children) other.classList.remove('focused');
+      li.classList.add('focused');
+      focusOn(h.at_mm);
+    };
     list.appendChild(li);
   }
 }
