@@ -349,6 +349,33 @@ def test_clicking_a_hotspot_moves_the_view_to_it(page, browser, tmp_path):
     assert '<h2>Hotspots</h2><i id="hotspots">none</i>' in bare.read_text()
 
 
+def test_the_printed_shop_sheet_has_the_picture_and_says_what_it_shows(page, browser):
+    """The browser's own Print (Ctrl+P, here Page.printToPDF) printed a broken image: only the
+    page's button filled the picture; the sheet did not say that the picture is a section, and
+    printed empty 'Section'/'Measure' headings and the word 'ready'."""
+    _, _, out, _ = page
+    assert browser.load(f"file://{out}#cut=x:30", size=(1000, 600)) == "box: ready"
+    src = "document.getElementById('snapshot').src"
+    assert browser.evaluate(src) == ""
+    pdf = base64.b64decode(browser.call("Page.printToPDF", session=True)["data"])
+    assert pdf.startswith(b"%PDF")
+    assert browser.evaluate(f"{src}.startsWith('data:image/png;base64,') && {src}.length > 10000")
+    browser.call("Emulation.setEmulatedMedia", session=True, media="print")
+    shown = ("(id) => getComputedStyle(document.getElementById(id)).display !== 'none'")
+    for element, printed in (("snapshot", True), ("sheet-state", True), ("status", False),
+                             ("view", False), ("print", False)):
+        assert browser.evaluate(f"({shown})('{element}')") is printed, element
+    assert browser.evaluate("Array.from(document.querySelectorAll('h2')).filter((h) => "
+                            "getComputedStyle(h).display !== 'none').map((h) => h.textContent)"
+                            ) == ["Block and bake", "Hotspots", "Face photos"]
+    state = browser.evaluate("document.getElementById('sheet-state').textContent")
+    assert "cut at x = 30.0 mm" in state and "perspective" in state, state
+    browser.call("Emulation.setEmulatedMedia", session=True, media="")
+    # the page's button: the same picture, then the print dialog
+    assert browser.evaluate("window.printed = 0; window.print = () => { window.printed += 1; }; "
+                            "document.getElementById('print').click(); window.printed") == 1
+
+
 def test_review_errors_are_clear(page, tmp_path):
     stock, glb, _, _ = page
     with pytest.raises(WoodcamError, match="must be an existing .glb"):

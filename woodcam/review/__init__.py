@@ -191,29 +191,32 @@ def _page(data: dict, glb_b64: str, bundle: str) -> str:
  #hotspots li {{ cursor: pointer; }} #hotspots li.focused {{ font-weight: bold; }}
  #snapshot {{ display: none; }}
  body.bare #panel {{ display: none; }}
- @media print {{ #view, button, .ui {{ display: none !important; }}
-   #snapshot {{ display: block; width: 100%; }} #wrap {{ display: block; }}
+ .print-only {{ display: none; }}
+ @media print {{ #view, button, .ui, #status {{ display: none !important; }}
+   #snapshot {{ display: block; max-width: 100%; max-height: 14cm; margin: 6px 0; }}
+   .print-only {{ display: block; }} #wrap {{ display: block; }}
    #panel {{ width: auto; border: 0; background: none; }} }}
 </style></head>
 <body><div id="wrap"><canvas id="view"></canvas>
 <div id="panel"><h1>{title}</h1>
+<p id="sheet-state" class="print-only"></p><img id="snapshot" alt="view">
 <div class="ui"><b>View</b>
  <button data-view="front">front</button><button data-view="top">top</button>
  <button data-view="left">left</button><button data-view="iso">iso</button>
  <label><input type="checkbox" id="ortho"> orthographic</label></div>
-<h2>Section</h2><div class="ui">
+<h2 class="ui">Section</h2><div class="ui">
  <label><input type="checkbox" id="cut-on"> cut</label>
  <select id="cut-axis"><option>x</option><option>y</option><option>z</option></select>
  <input type="range" id="cut-pos" min="0" step="0.1" style="width:150px"> <span id="cut-label"></span>
  <p style="font-size:12px">The cut face shows the wood inside the block
  (Wood.color on {data['block']['voxel_mm']:.2f} mm voxels).</p></div>
-<h2>Measure</h2><div class="ui"><label><input type="checkbox" id="measure"> two clicks on the
+<h2 class="ui">Measure</h2><div class="ui"><label><input type="checkbox" id="measure"> two clicks on the
  part</label><div id="measurement"></div></div>
 <h2>Block and bake</h2><table><tr><th>block</th><td>{W:g} x {D:g} x {H:g} mm</td></tr>{report_rows}</table>
 <h2>Hotspots</h2>{'<ul id="hotspots"></ul>' if data['hotspots'] else '<i id="hotspots">none</i>'}
 <h2>Face photos</h2><div>{photos or '<i>none</i>'}</div>
 <p><button id="print">print shop sheet</button> <span id="status">loading</span></p>
-<img id="snapshot" alt="view"><div id="probe" hidden></div>
+<div id="probe" hidden></div>
 </div></div>
 <script type="application/json" id="woodcam-data">{payload}</script>
 <script type="text/plain" id="woodcam-glb">{glb_b64}</script>

@@ -327,6 +327,17 @@ function addHotspots() {
 }
 
 // ---- UI ------------------------------------------------------------------------------------
+// The printed sheet: the picture on screen and what it shows (the browser's own Print too, by
+// 'beforeprint': the canvas itself is not printed).
+function snapshot() {
+  document.getElementById('snapshot').src = canvas.toDataURL('image/png');
+  const measured = document.getElementById('measurement').textContent;
+  document.getElementById('sheet-state').textContent =
+    `Picture: the view on screen (${camera === ortho ? 'orthographic' : 'perspective'}). Section: ` +
+    (cut.on ? `cut at ${cut.axis} = ${cut.pos.toFixed(1)} mm, the part beyond it shown; the cut face ` +
+              'shows the wood inside.' : 'none, the whole part.') +
+    (measured ? ` Measured: ${measured}.` : '');
+}
 function bindUi() {
   for (const b of document.querySelectorAll('[data-view]')) b.onclick = () => setView(b.dataset.view);
   const orthoBox = document.getElementById('ortho');
@@ -350,10 +361,7 @@ function bindUi() {
   axis.onchange = () => { cut.axis = axis.value; cut.pos = LIMITS[cut.axis] / 2; sync(); updatePlane(); };
   pos.oninput = () => { cut.pos = parseFloat(pos.value); sync(); updatePlane(); };
   on.onchange = () => { cut.on = on.checked; updatePlane(); };
-  document.getElementById('print').onclick = () => {
-    document.getElementById('snapshot').src = canvas.toDataURL('image/png');
-    window.print();
-  };
+  document.getElementById('print').onclick = () => { snapshot(); window.print(); };
   canvas.addEventListener('click', onClick);
 }
 
@@ -380,6 +388,7 @@ async function main() {
   setView(params.get('view') || 'iso');
   updatePlane();
   window.addEventListener('resize', resize);
+  window.addEventListener('beforeprint', snapshot);
   renderer.setAnimationLoop(() => { controls.update(); renderer.render(scene, camera); updateProbe(); });
   status.textContent = 'ready';
   document.title = `${data.title}: ready`;
