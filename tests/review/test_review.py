@@ -376,6 +376,22 @@ def test_the_printed_shop_sheet_has_the_picture_and_says_what_it_shows(page, bro
                             "document.getElementById('print').click(); window.printed") == 1
 
 
+def test_the_page_says_its_units_and_draws_the_block_frame(page, browser, tmp_path):
+    """The cut axis x/y/z and every coordinate were given with no word of what x, y, z are; now
+    the panel says mm and the block frame, and arrows x (red), y (green) stand at its origin."""
+    _, _, out, _ = page
+    text = out.read_text()
+    assert "Lengths in mm, in the block frame: origin at the block's bottom-front-left corner" in text
+    assert "<td>100 x 80 x 50 mm (x, y, z)</td>" in text
+    png = tmp_path / "iso.png"
+    assert browser.load(f"file://{out}#cut=off", size=(1000, 600)) == "box: ready"
+    browser.screenshot(png)
+    img = np.asarray(Image.open(png).convert("RGB"), dtype=int)
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    assert np.count_nonzero((r > 150) & (g < 80) & (b < 80)) >= 20, "no red x arrow"
+    assert np.count_nonzero((g > 120) & (r < 90) & (b < 90)) >= 20, "no green y arrow"
+
+
 def test_review_errors_are_clear(page, tmp_path):
     stock, glb, _, _ = page
     with pytest.raises(WoodcamError, match="must be an existing .glb"):

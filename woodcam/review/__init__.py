@@ -184,6 +184,7 @@ def _page(data: dict, glb_b64: str, bundle: str) -> str:
           border-left: 1px solid #ccc; }}
  #panel h1 {{ font-size: 17px; margin: 4px 0 8px; }}
  #panel h2 {{ font-size: 14px; margin: 14px 0 4px; }}
+ #panel .frame {{ font-size: 12px; margin: 0 0 8px; }}
  #panel table {{ border-collapse: collapse; width: 100%; font-size: 12px; }}
  #panel th {{ text-align: left; padding-right: 6px; vertical-align: top; }}
  figure {{ display: inline-block; margin: 2px; }} figure img {{ width: 90px; }}
@@ -199,6 +200,9 @@ def _page(data: dict, glb_b64: str, bundle: str) -> str:
 </style></head>
 <body><div id="wrap"><canvas id="view"></canvas>
 <div id="panel"><h1>{title}</h1>
+<p class="frame">Lengths in mm, in the block frame: origin at the block's bottom-front-left corner,
+ x to the right (width), y away from the front (depth), z up (height); the arrows at the origin
+ are x (red), y (green), z (blue).</p>
 <p id="sheet-state" class="print-only"></p><img id="snapshot" alt="view">
 <div class="ui"><b>View</b>
  <button data-view="front">front</button><button data-view="top">top</button>
@@ -212,7 +216,7 @@ def _page(data: dict, glb_b64: str, bundle: str) -> str:
  (Wood.color on {data['block']['voxel_mm']:.2f} mm voxels).</p></div>
 <h2 class="ui">Measure</h2><div class="ui"><label><input type="checkbox" id="measure"> two clicks on the
  part</label><div id="measurement"></div></div>
-<h2>Block and bake</h2><table><tr><th>block</th><td>{W:g} x {D:g} x {H:g} mm</td></tr>{report_rows}</table>
+<h2>Block and bake</h2><table><tr><th>block</th><td>{W:.5g} x {D:.5g} x {H:.5g} mm (x, y, z)</td></tr>{report_rows}</table>
 <h2>Hotspots</h2>{'<ul id="hotspots"></ul>' if data['hotspots'] else '<i id="hotspots">none</i>'}
 <h2>Face photos</h2><div>{photos or '<i>none</i>'}</div>
 <p><button id="print">print shop sheet</button> <span id="status">loading</span></p>

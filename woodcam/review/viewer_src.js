@@ -236,6 +236,36 @@ function stencilFor(geometry, matrixWorld) {
   }
 }
 
+// ---- the block frame: arrows along x, y, z from the block's origin, drawn over everything ----
+function label(text, colour) {
+  const c = document.createElement('canvas');
+  c.width = c.height = 64;
+  const g = c.getContext('2d');
+  g.font = 'bold 48px sans-serif'; g.textAlign = 'center'; g.textBaseline = 'middle';
+  g.fillStyle = colour; g.fillText(text, 32, 34);
+  const s = new THREE.Sprite(new THREE.SpriteMaterial({ map: new THREE.CanvasTexture(c), depthTest: false }));
+  s.renderOrder = 4;
+  return s;
+}
+function addAxes() {
+  const len = 0.3 * Math.max(W, D, H), origin = worldOfBlock(0, 0, 0);
+  const axes = new THREE.Group();
+  for (const [name, dir, colour] of [['x', [1, 0, 0], '#d02020'], ['y', [0, 1, 0], '#20a020'],
+                                     ['z', [0, 0, 1], '#2040e0']]) {
+    const d = worldOfBlock(...dir).normalize();
+    const arrow = new THREE.ArrowHelper(d, origin, len / 1000, new THREE.Color(colour).getHex(),
+                                        0.15 * len / 1000, 0.08 * len / 1000);
+    arrow.traverse((o) => { if (o.material) o.material.depthTest = false; o.renderOrder = 4; });
+    axes.add(arrow);
+    const tag = label(name, colour);
+    tag.position.copy(origin).addScaledVector(d, 1.12 * len / 1000);
+    tag.scale.setScalar(0.12 * len / 1000);
+    axes.add(tag);
+  }
+  scene.add(axes);
+  document.getElementById('probe').dataset.axes = 'x,y,z';
+}
+
 // ---- measurement and hotspots --------------------------------------------------------------
 const raycaster = new THREE.Raycaster();
 const picks = [];
@@ -384,7 +414,7 @@ async function main() {
   part.traverse((o) => { if (o.isMesh && o.geometry.attributes.normal) normals += 1; });
   probe.dataset.meshesWithNormals = String(normals);
   addHotspots();
-  if (!params.has('bare')) bindUi();
+  if (!params.has('bare')) { bindUi(); addAxes(); }
   setView(params.get('view') || 'iso');
   updatePlane();
   window.addEventListener('resize', resize);
