@@ -413,6 +413,34 @@ def test_the_cli_writes_the_page_from_the_glbs_own_block(page, tmp_path, capsys,
     assert Path(tmp_path / "r.html").read_text().count("data:image/png;base64,") == 3
 
 
+def test_review_of_a_photographed_block_names_no_species_nobody_gave(tmp_path, capsys, monkeypatch):
+    """review (and preview) of a part baked on a block with photos along all three axes warned
+    '--species oak: ... the species changes nothing here' though no --species was typed: the
+    species the GLB records was passed on as if asked for."""
+    import warnings
+
+    from woodcam.cli import main
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    assert main(["block", "synth", "--count", "1", "--out", str(tmp_path / "blocks"),
+                 "--face-px", "64", "--quiet"]) == 0
+    folder = next((tmp_path / "blocks").glob("block_*"))
+    size = json.loads((folder / "block.json").read_text())["size_mm"]
+    box = trimesh.creation.box(np.asarray(size) * 0.8)
+    box.apply_translation(np.asarray(size) / 2)
+    box.export(tmp_path / "part.stl")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert main(["bake", str(tmp_path / "part.stl"), "--block", str(folder), "--out",
+                     str(tmp_path / "part.glb"), "--no-obj", "--texels-per-mm", "2"]) == 0
+        capsys.readouterr()
+        del caught[:]
+        assert main(["review", str(tmp_path / "part.glb"), "--out", str(tmp_path / "r.html"),
+                     "--voxels", "20000"]) == 0
+    said = [str(w.message) for w in caught] + [capsys.readouterr().err]
+    assert not any("--species" in m for m in said), said
+
+
 def test_voxels_has_one_range_for_the_cli_and_the_library(tmp_path, capsys):
     """--voxels 1e7 passed the command line's range (up to 5e7) and then failed in write_review
     (up to 8e6) with a message naming its parameter 'voxels', exit 1."""

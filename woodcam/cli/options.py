@@ -20,6 +20,7 @@ Nothing heavy is imported at module level (``woodcam --help`` loads this module)
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import re
@@ -514,7 +515,8 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
             warnings.warn(f"--block {block} is not the block {glb.name} was baked from ({meta.get('block')}, "
                           f"{'x'.join(f'{v:g}' for v in meta.get('size_mm', []))} mm): the wood shown inside "
                           "differs from the part's surface", WoodcamWarning, stacklevel=2)
-        return open_stock(block, **{**kwargs, "species": species or kwargs["species"]})
+        with _recorded_species_quiet(species):
+            return open_stock(block, **{**kwargs, "species": species or kwargs["species"]})
     spec = meta.get("block")
     if not spec:
         return None
@@ -529,7 +531,24 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
     if meta.get("block_digest") and spec_digest(spec) != meta["block_digest"]:
         warnings.warn(f"the block {spec!r} changed since {glb.name} was baked (its files differ); "
                       "the wood shown is today's", WoodcamWarning, stacklevel=2)
-    return open_stock(spec, **kwargs)
+    with _recorded_species_quiet(species):
+        return open_stock(spec, **kwargs)
+
+
+@contextlib.contextmanager
+def _recorded_species_quiet(species: str | None):
+    """Reopen a GLB's stock with the species it records (the bake's, default oak) without
+    open_stock's '--species X: ... changes nothing here': that note is about a --species typed
+    now, so it is kept only when ``species`` was given."""
+    import warnings
+
+    from ..errors import WoodcamWarning
+
+    with warnings.catch_warnings():
+        if species is None:
+            warnings.filterwarnings("ignore", message=r"--species .* changes nothing here",
+                                    category=WoodcamWarning)
+        yield
 
 
 #: Appearance parameters a GLB's metadata may carry, with their rules. A GLB is untrusted input:
