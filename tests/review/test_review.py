@@ -441,6 +441,28 @@ def test_review_of_a_photographed_block_names_no_species_nobody_gave(tmp_path, c
     assert not any("--species" in m for m in said), said
 
 
+def test_review_refuses_a_parquetry_panel_and_names_woodifys_field(page, tmp_path, capsys):
+    """A parquetry panel.glb was told 'records no block spec; pass --block SPEC', and with
+    --block it made a page whose cut showed that one block's wood; woodify's grown.glb was told
+    the same without naming the field.npz that woodify wrote beside it."""
+    from woodcam.cli import main
+
+    _, glb, _, _ = page
+    mesh = trimesh.load(glb, force="mesh")
+    panel = export_glb(mesh, tmp_path / "parq" / "panel.glb",
+                       metadata={"kind": "parquetry panel", "size_mm": [56, 56, 2.1]})
+    for extra in ([], ["--block", "builtin:flat-sawn"]):
+        assert main(["review", str(panel), "--out", str(tmp_path / "p.html"), *extra]) == 1
+        err = capsys.readouterr().err
+        assert "is a parquetry panel" in err and "woodcam preview" in err, err
+    assert not (tmp_path / "p.html").exists()
+    grown = export_glb(mesh, tmp_path / "tree" / "grown.glb", metadata={"woodify": {"years": 10}})
+    (tmp_path / "tree" / "field.npz").write_bytes(b"")
+    assert main(["review", str(grown), "--out", str(tmp_path / "g.html")]) == 1
+    err = capsys.readouterr().err
+    assert f"pass --block woodify:{tmp_path / 'tree' / 'field.npz'}" in err, err
+
+
 def test_voxels_has_one_range_for_the_cli_and_the_library(tmp_path, capsys):
     """--voxels 1e7 passed the command line's range (up to 5e7) and then failed in write_review
     (up to 8e6) with a message naming its parameter 'voxels', exit 1."""

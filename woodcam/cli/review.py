@@ -38,8 +38,18 @@ def run_review(args: argparse.Namespace) -> int:
     if not args.part.is_file():  # it said "records no block spec", blaming the spec for a missing file
         raise WoodcamError(f"review: no file at {str(args.part)!r}; pass a GLB written by woodcam bake or gcode")
     meta = read_glb_metadata(args.part)
+    if meta.get("kind") == "parquetry panel":  # --block would put one block's wood under the cut
+        raise WoodcamError(
+            f"review: {str(args.part)!r} is a parquetry panel (veneer pieces from several sheets, each "
+            "turned its own way), not a part cut from one block, so the page's section has no wood "
+            f"to show; view it with 'woodcam preview {args.part}'")
     stock = stock_of_glb(args.part, args.block)
     if stock is None:
+        field = args.part.parent / "field.npz"
+        if "woodify" in meta and field.is_file():  # woodify's grown.glb: its field lies beside it
+            raise WoodcamError(
+                f"review: {str(args.part)!r} (woodify's grown object) records no block spec; pass "
+                f"--block woodify:{field} (the growth field woodify wrote beside it)")
         raise WoodcamError(f"review: {str(args.part)!r} records no block spec; pass --block SPEC")
     spec = stock.spec
     report = {"block spec": spec, "species": stock.meta.get("species", "")}
