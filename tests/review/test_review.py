@@ -275,6 +275,10 @@ def test_views_frame_the_block_at_any_aspect_and_the_hash_sets_the_ui(page, brow
         assert browser.evaluate("document.getElementById('cut-label').textContent") == label, arg
         assert browser.evaluate("document.getElementById('cut-on').checked") is True
         assert browser.evaluate("document.getElementById('ortho').checked") is False
+    # an edited hash on the open page applies (it changed nothing until a reload)
+    browser.evaluate("document.title = 'stale'")
+    assert browser.load(f"file://{out}#view=top&cut=x:10") == "box: ready"
+    assert browser.evaluate("document.getElementById('cut-label').textContent") == "x = 10.0 mm"
 
 
 def _click_front(browser, x: float, z: float, size_mm) -> None:

@@ -14,6 +14,9 @@ import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 
 const data = JSON.parse(document.getElementById('woodcam-data').textContent);
 const params = new URLSearchParams(location.hash.slice(1));
+// the hash is the page's starting state (view, cut, ortho): an edited hash on an open page
+// changed nothing until a reload, so a new hash reloads the page
+window.addEventListener('hashchange', () => location.reload());
 const [W, D, H] = data.block.size_mm;
 const status = document.getElementById('status');
 
