@@ -438,3 +438,27 @@ def test_photos_named_for_no_face_are_said(synth_photos, tmp_path, capsys):
 
     with pytest.warns(WoodcamWarning, match=r"top face\.png is named for no face"):
         assert "top" not in block_from_photos(d, (50, 50, 50), partial=True).faces
+
+
+def test_rings_detect_warns_of_a_face_photographed_turned(tmp_path, capsys, synth_photos):
+    """A cube's top photo turned 90 degrees passes the aspect check; rings detect names it and the
+    fix, and block show --check-layout does too (and says so when all is well)."""
+    photos = _copy(synth_photos, tmp_path / "photos")
+    top = Image.open(photos / "top.png")
+    top.rotate(-90).save(photos / "top.png")          # PIL: negative angles turn clockwise
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", photos, "--size-mm", "50", "--out", blk)[0] == 0
+    rc, out, _ = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0
+    assert ("woodcam: warning: face 'top' looks turned 90 degrees clockwise: its rings meet its "
+            "neighbours' along its 4 edges only when corrected") in out
+    assert "turn its photo top.png 90 degrees counter-clockwise" in out
+    rc, _, err = _run(capsys, "block", "show", blk, "--check-layout", "--out", tmp_path / "x.png")
+    assert rc == 0 and "woodcam: warning: face 'top' looks turned 90 degrees clockwise" in err
+    top.save(photos / "top.png")
+    good = tmp_path / "good"
+    assert _run(capsys, "block", "from-photos", photos, "--size-mm", "50", "--out", good)[0] == 0
+    rc, out, _ = _run(capsys, "rings", "detect", good, "--out", good)
+    assert rc == 0 and "looks turned" not in out
+    rc, out, _ = _run(capsys, "block", "show", good, "--check-layout", "--out", tmp_path / "y.png")
+    assert rc == 0 and "layout: 6 faces checked, none looks turned or mirrored" in out

@@ -7,8 +7,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .options import (add_block_argument, add_engine_options, add_out_option, add_size_option, engine_options,
-                      engine_requested, open_block)
+from .options import (add_block_argument, add_check_layout_option, add_engine_options, add_out_option,
+                      add_size_option, engine_options, engine_requested, open_block, report_layout)
 
 
 def register(subparsers) -> None:
@@ -46,6 +46,7 @@ def register(subparsers) -> None:
                    help="what to draw: the face photos, the ring maps, or both (the photos' cross above "
                    "the ring maps') (default photo)")
     v.add_argument("--no-traces", action="store_true", help="do not draw traced rings")
+    add_check_layout_option(v)
     add_size_option(v)
 
     from .rings import add_from_photos
@@ -111,6 +112,8 @@ def run(args) -> int:
         from ..block.render import save_cross_png
 
         block, _ = open_block(args.block, args.size_mm)
+        if args.check_layout:
+            report_layout(block)
         save_cross_png(block, args.out, args.layer, traces=not args.no_traces)
         print(f"wrote {args.out}")
         return 0

@@ -280,6 +280,29 @@ def add_size_option(p: argparse.ArgumentParser) -> None:
                    "default 50)")
 
 
+def add_check_layout_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--check-layout", action="store_true",
+                   help="check that every face is laid out as docs/conventions.md says: rings meet "
+                   "across the block's edges; warn of a face that looks turned or mirrored "
+                   "('woodcam rings detect' always checks)")
+
+
+def report_layout(block) -> None:
+    """``--check-layout``: a warning per face that looks turned or mirrored
+    (:func:`woodcam.detect.layout.check_face_layout`), else one line saying the layout holds."""
+    import warnings
+
+    from ..detect.layout import check_face_layout
+    from ..errors import WoodcamWarning
+
+    report = check_face_layout(block)
+    for w in report.warnings:
+        warnings.warn(w, WoodcamWarning, stacklevel=2)
+    if not report.warnings:
+        print(f"layout: {len(report.faces)} faces checked, none looks turned or mirrored"
+              if report.faces else "layout: not checked (no two neighbouring faces with a photo or ring map)")
+
+
 def open_block(spec, size_mm: float | None = None, face_px: int = 256):
     """``(block, field or None)`` for a block argument: :func:`woodcam.stock.open_block`."""
     from ..stock import open_block as _open_block

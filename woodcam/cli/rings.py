@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_out_option, add_size_option, parse_sizes
+from .options import add_check_layout_option, add_out_option, add_size_option, parse_sizes, report_layout
 
 
 def _size(text: str) -> tuple[float, float, float]:
@@ -86,6 +86,7 @@ def register(subparsers) -> None:
     s.add_argument("block", type=Path, help="block folder (after 'rings detect') or Mokume sample folder")
     add_out_option(s, "the photos with the rings and knots found", suffixes=(".png",))
     s.add_argument("--zoom", type=int, default=2, help="enlargement: picture pixels per face pixel, a whole number (default 2)")
+    add_check_layout_option(s)
     add_size_option(s)
 
 
@@ -125,6 +126,8 @@ def run(args) -> int:
                 f.ring_map, f.traces = None, []
                 f.extras.pop("knot_mask", None)
             block = with_detected_rings(mok, progress=True)
+        if args.check_layout:
+            report_layout(block)
         pic = rings_picture(block, zoom=args.zoom, references=refs)
         with atomic_path(args.out, mkdir=True) as tmp:
             Image.fromarray(np.asarray(pic)).save(tmp, format="PNG")

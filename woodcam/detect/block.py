@@ -37,6 +37,7 @@ from .._cache import cache_dir, digest, entry_path, load_or_build
 from ..block.block import Block, Face
 from ..errors import WoodcamError, WoodcamWarning
 from .knots import detect_knots
+from .layout import check_face_layout
 from .rings import DEFAULT_RULE, RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, ring_map_from_traces
 
 #: Bumped whenever detection results change, so cached detections are recomputed (3: traces
@@ -230,6 +231,8 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     det["svg_sha256"] = hashes
     det["user_svg"] = sorted(kept)
     block.meta["detection"] = det
+    # a face photographed turned or mirrored ruins the fit without a word otherwise
+    msgs += check_face_layout(block).warnings
     manifest = write_block(block, out, traces_svg={n: f"{n}_traces.svg" for n in block.faces})
     return manifest, msgs
 

@@ -1,0 +1,69 @@
+"""The face-layout check (:mod:`woodcam.detect.layout`): rings meet across the block's edges."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from woodcam.block.block import Block, Face
+from woodcam.detect.layout import LAYOUT_MARGIN, VARIANTS, check_face_layout
+
+
+@pytest.fixture(scope="module")
+def cube() -> Block:
+    """A 50 mm flat-sawn cube of six 160 px photos, laid out as the conventions say."""
+    from woodcam.synth import AnalyticLogField, cut_block, synth_block
+
+    field = cut_block(AnalyticLogField(ring_width_mm=3.0, eccentricity=0.05), (50, 50, 50), "flat-sawn")
+    return synth_block(field, (50, 50, 50), face_px=160, seed=4, ring_map_faces=())
+
+
+def _with(block: Block, face: str, photo: np.ndarray) -> Block:
+    faces = dict(block.faces)
+    faces[face] = Face(face, photo.shape[:2], photo=np.ascontiguousarray(photo))
+    return Block(block.size_mm, faces=faces, name=block.name, meta={"photos": {face: "top.jpg"}})
+
+
+def test_a_correct_layout_is_not_flagged(cube):
+    report = check_face_layout(cube)
+    assert report.warnings == [] and report.corrections == {}
+    assert set(report.faces) == set(cube.faces) and set(report.source.values()) == {"photo"}
+    # every face meets its neighbours at least as well as laid out as in any variant, within the margin
+    assert max(fl.margin for fl in report.faces.values()) < LAYOUT_MARGIN
+    assert all(fl.edges == 4 and len(fl.scores) == 8 for fl in report.faces.values())
+
+
+@pytest.mark.parametrize("face, turn, fix, says", [
+    ("top", lambda a: np.rot90(a, -1), "rot90ccw", "looks turned 90 degrees clockwise"),
+    ("bottom", lambda a: np.rot90(a, 2), "rot180", "looks turned 180 degrees"),
+    ("right", lambda a: a[:, ::-1], "flip-lr", "looks mirrored left-right"),
+])
+def test_a_turned_or_mirrored_face_is_named_with_its_correction(cube, face, turn, fix, says):
+    report = check_face_layout(_with(cube, face, turn(cube.faces[face].photo)))
+    assert report.corrections == {face: fix}, report.warnings
+    (msg,) = report.warnings
+    assert msg.startswith(f"face {face!r} {says}: its rings meet its neighbours' along its 4 edges")
+    assert "docs/conventions.md" in msg and "make the block again" in msg
+    # the correction it names undoes the turn
+    undone = VARIANTS[fix][0](turn(cube.faces[face].photo))
+    assert np.array_equal(undone, cube.faces[face].photo)
+    if face == "top":
+        assert "turn its photo top.jpg 90 degrees counter-clockwise" in msg
+
+
+def test_a_non_square_face_is_tried_only_in_variants_keeping_its_shape(cube):
+    from woodcam.synth import AnalyticLogField, cut_block, synth_block
+
+    field = cut_block(AnalyticLogField(ring_width_mm=3.0), (60, 40, 30), "flat-sawn")
+    block = synth_block(field, (60, 40, 30), face_px=150, seed=1, ring_map_faces=())
+    report = check_face_layout(block)
+    assert report.warnings == []
+    assert set(report.faces["top"].scores) == {"as laid out", "rot180", "flip-lr", "flip-tb"}
+    turned = check_face_layout(_with(block, "top", np.rot90(block.faces["top"].photo, 2)))
+    assert turned.corrections == {"top": "rot180"}
+
+
+def test_faces_without_neighbours_or_images_are_not_scored(cube):
+    lone = Block(cube.size_mm, faces={"top": cube.faces["top"], "bottom": cube.faces["bottom"]})
+    report = check_face_layout(lone)
+    assert report.faces == {} and report.warnings == []
