@@ -49,3 +49,92 @@ def test_the_quick_start_runs_as_written(tmp_path):
     assert (tmp_path / "out" / "bowl.png").is_file() and (tmp_path / "out" / "bowl_texture.png").is_file()
     assert (tmp_path / "out" / "bowl.html").stat().st_size > 1e6
     assert (tmp_path / "out" / "place" / "placements.png").is_file()
+
+
+# --- every command line the READMEs show is one the CLI takes ----------------------------------
+
+_DOCS = ("README.md", "toolpaths/README.md", "cad_examples/README.md")
+
+
+def _doc_commands(text: str) -> list[tuple[str, str]]:
+    """Every ``woodcam ...`` command of ``text`` as ``(kind, command)``: kind ``block`` for a line
+    of a code block (``\\`` continuations joined, ``  #`` comments cut), ``inline`` for a
+    backtick span outside code blocks (which may wrap over lines; often a fragment)."""
+    found: list[tuple[str, str]] = []
+    for i, part in enumerate(re.split(r"(```.*?```)", text, flags=re.S)):
+        if i % 2:  # a code block
+            joined = re.sub(r"\\\n\s*", " ", part)
+            found += [("block", " ".join(line.split("  #")[0].split()))
+                      for line in joined.splitlines() if line.strip().startswith("woodcam ")]
+        else:
+            found += [("inline", " ".join(m.group(1).split()))
+                      for m in re.finditer(r"`(?:[A-Z_]+=\S+ )?(woodcam [^`]+)`", part)]
+    return found
+
+
+def _command_problems(kind: str, command: str, parser) -> list[str]:
+    """What is wrong with ``command`` for ``parser``: a command or sub-command that does not exist,
+    an ``--option`` its command does not have, and for a complete code-block line (no ``...``)
+    anything argparse refuses (a required argument left out)."""
+    import argparse
+    import contextlib
+    import io
+
+    def subcommands(p):
+        return next((a.choices for a in p._actions if isinstance(a, argparse._SubParsersAction)), {})
+
+    tokens = command.replace("[", " ").replace("]", " ").split()[1:]
+    p, path = parser, ["woodcam"]
+    while subcommands(p) and tokens and tokens[0] in subcommands(p):
+        path.append(tokens.pop(0))
+        p = subcommands(p)[path[-1]]
+    problems = []
+    if subcommands(p) and tokens and not tokens[0].startswith("-"):
+        problems.append(f"{' '.join(path)} has no sub-command {tokens[0]!r}")
+    options = {s for a in p._actions for s in a.option_strings}
+    problems += [f"{' '.join(path)} has no option {t.split('=')[0]}" for t in tokens
+                 if t.startswith("--") and t.split("=")[0] not in options]
+    if kind == "block" and "..." not in command and not problems:
+        err = io.StringIO()
+        try:
+            with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+                parser.parse_args(shlex.split(command)[1:])
+        except SystemExit:
+            problems.append(err.getvalue().strip().splitlines()[-1])
+    return problems
+
+
+def test_the_checker_catches_a_wrong_command_option_or_missing_argument():
+    """The check below is not vacuous: each kind of mistake a README line can make is caught."""
+    from woodcam.cli import build_parser
+
+    parser = build_parser()
+    text = ("Run `woodcam eval MOKUME --detect`, `woodcam gcode x.nc --tol 0.1 --out o.glb` or\n"
+            "`woodcam bake part.py --block\nbuiltin:rift --out p.glb --texels 4`:\n\n```\n"
+            "woodcam block show blocks/b --out x.png   # fine\n"
+            "woodcam review out/bowl.glb               # no --out\n"
+            "woodcam fit BLOCK \\\n    --method radial --out f.npz --face front\n```\n")
+    problems = {c: _command_problems(k, c, parser) for k, c in _doc_commands(text)}
+    assert problems["woodcam eval MOKUME --detect"] == [
+        "woodcam eval has no sub-command 'MOKUME'", "woodcam eval has no option --detect"]
+    assert problems["woodcam gcode x.nc --tol 0.1 --out o.glb"] == ["woodcam gcode has no option --tol"]
+    assert problems["woodcam bake part.py --block builtin:rift --out p.glb --texels 4"] == [
+        "woodcam bake has no option --texels"]
+    assert problems["woodcam block show blocks/b --out x.png"] == []
+    assert "--out" in problems["woodcam review out/bowl.glb"][0]
+    assert problems["woodcam fit BLOCK --method radial --out f.npz --face front"] == [
+        "woodcam fit has no option --face"]
+
+
+def test_every_readme_command_is_one_the_cli_takes():
+    """Every ``woodcam`` command the READMEs show names real commands and options of that
+    command, and every complete code-block line parses (a user copies them)."""
+    from woodcam.cli import build_parser
+
+    parser = build_parser()
+    commands = [(doc, kind, command) for doc in _DOCS
+                for kind, command in _doc_commands((REPO / doc).read_text())]
+    assert len(commands) > 60 and sum(kind == "block" for _, kind, _ in commands) > 15
+    wrong = [f"{doc}: {command}: {problem}" for doc, kind, command in commands
+             for problem in _command_problems(kind, command, parser)]
+    assert not wrong, "\n".join(wrong)
