@@ -201,6 +201,16 @@ def test_an_interrupted_run_leaves_the_last_runs_products(tmp_path, monkeypatch,
     capsys.readouterr()
 
 
+def test_the_summary_names_every_file_written(tmp_path, capsys):
+    """The printed 'wrote ...' list left out woodify.json, which the README lists in out/tree/."""
+    trimesh.creation.icosphere(subdivisions=2, radius=5.0).export(tmp_path / "ball.stl")
+    out = tmp_path / "o"
+    assert main(["woodify", str(tmp_path / "ball.stl"), "--years", "3", "--resolution", "24",
+                 "--cracks", "none", "--out", str(out)]) == 0
+    wrote = capsys.readouterr().out.split("; wrote ", 1)[1].splitlines()[0].split(", ")
+    assert sorted(Path(f).name for f in wrote) == sorted(p.name for p in out.iterdir())
+
+
 def test_input_texture_is_carried_to_the_grown_bark(tmp_path):
     """A textured input (UV = longitude, latitude) keeps its picture in place: every grown
     vertex's UV is the UV of the input point straight below it (radial growth of a sphere)."""

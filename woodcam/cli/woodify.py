@@ -322,6 +322,7 @@ def run(args) -> int:
         summary["input"] = str(args.part)
         _atomic(Path(args.out) / "woodify.json",
                 lambda p: p.write_text(json.dumps(summary, indent=1, default=float)))
+    files = [*files, Path(args.out) / "woodify.json"]  # the summary names every file written
     # an earlier run's surfaces at other years are not this run's: they went on piling up
     remove_stale(args.out, ["surface_y*.stl"], files)
     print(f"grew {args.part} for {args.years:g} years on a {'x'.join(map(str, res.front.grid.shape))} "
