@@ -41,6 +41,17 @@ def test_cli_run_writes_everything(scans, capsys):
     for name in ("render.png", "baseline.png", "target_matched.png", "assembly.svg", "panel.glb",
                  "result.json", "job.json", "veneer_light.svg", "veneer_light.dxf"):
         assert (out / name).is_file(), name
+    # the --out help names what is written (it promised a panel.png that no run writes)
+    import re
+
+    from woodcam.cli import build_parser, _walk_options
+
+    help_ = " ".join(next(a.help for path, a in _walk_options(build_parser())
+                          if path == ["parquetry"] and "--out" in a.option_strings).split())
+    for f in out.iterdir():
+        name = re.sub(r"^veneer_.*\.(svg|dxf)$", "veneer_<id>.svg/.dxf", f.name)
+        assert name in help_, (f.name, help_)
+    assert "panel.png" not in help_
     result = json.loads((out / "result.json").read_text())
     assert result["summary"]["complete"] and len(result["patches"]) == 6 * 4
     # the job file written reruns the same job

@@ -52,7 +52,8 @@ def register(subparsers) -> None:
     p.add_argument("--config", type=Path, default=None, metavar="JOB.json",
                    help="a job file in the paper's layout (source_textures, targets, Table 1 keys); "
                    "options given here override it")
-    add_out_option(p, "cut paths (SVG/DXF), panel.png, result.json, panel.glb and job.json")
+    add_out_option(p, "render.png, baseline.png, target_matched.png, assembly.svg, the cut files "
+                      "veneer_<id>.svg/.dxf, result.json, panel.glb and job.json")
     v = p.add_argument_group("veneers")
     v.add_argument("--veneer", action="append", default=[], metavar="SCAN[:DPI][:MASK]",
                    help="scanned veneer image (repeatable; its id, in veneer_<id>.svg, is the file's "
