@@ -282,8 +282,10 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
     from .inference.evidence import uncertainty_report
 
     surface = mesh if mesh is not None else baked.mesh  # the part, else what was baked
-    rings_line = uncertainty_report(stock.wood.field, surface.vertices, stock.size_mm, result.name)
-    if rings_line:  # a fitted field says where its rings are a guess (issue 12 part 5)
+    # a fitted field says where its rings are a guess (issue 12 part 5); only that is a warning
+    rings_line = uncertainty_report(stock.wood.field, surface.vertices, stock.size_mm, result.name,
+                                    confident_line=False)
+    if rings_line:
         result.warnings.append(rings_line)
     if part_report:
         import json

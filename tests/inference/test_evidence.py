@@ -308,3 +308,31 @@ def test_uncertainty_report_never_asks_for_a_face_that_was_photographed(faces, a
     pts = np.random.default_rng(0).uniform(0, 1, (3000, 3)) * size
     line = uncertainty_report(grid, pts, size, "bowl")
     assert "right third (left-right)" in line and line.endswith(advice)
+
+
+@pytest.mark.parametrize("spread_years, warned", [(0.0, False), (40.0, True)])
+def test_a_bake_warns_of_uncertain_rings_only(tmp_path, spread_years, warned):
+    """A bake printed 'warning: the rings of this box are well constrained' (good news as a
+    warning); only rings that are a guess are a warning."""
+    import trimesh
+
+    from woodcam.appearance.wood import Wood
+    from woodcam.fields.grid import GridField
+    from woodcam.pipeline import preview_part
+    from woodcam.stock import Stock
+
+    size = (40.0, 30.0, 20.0)
+    nodes = (9, 7, 5)
+    x = np.stack(np.meshgrid(*[np.linspace(0, s, k) for s, k in zip(size, nodes)], indexing="ij"), -1)
+    years = np.hypot(x[..., 0] - 20.0, x[..., 2] + 60.0) / 3.0  # flat-sawn rings, 3 mm wide
+    grid = GridField(years, (0.0, 0.0, 0.0), (5.0, 5.0, 5.0),
+                     layers={"uncertainty": np.full(nodes, spread_years)})
+    stock = Stock("test", size, Wood(grid), "a fitted block", {})
+    box = trimesh.creation.box((10, 10, 10))
+    box.apply_translation((20, 15, 10))
+    res = preview_part(box, stock, tmp_path / "box.glb", texels_per_mm=1, obj=False, screenshot=False)
+    said = [w for w in res.warnings if "rings" in w]
+    assert bool(said) is warned and all("uncertain" in w for w in said), res.warnings
+    assert ("well constrained" in uncertainty_report(grid, box.vertices, size, "box")) is not warned
+    assert uncertainty_report(grid, box.vertices, size, "box", confident_line=False) == (
+        None if not warned else uncertainty_report(grid, box.vertices, size, "box"))

@@ -864,9 +864,12 @@ def _bake_evidence(ev: EvidenceFit, size_mm, faces, strands, workers: int):
 _THIRDS = (("left", "middle", "right"), ("front", "middle", "back"), ("bottom", "middle", "top"))
 
 
-def uncertainty_report(field, points_mm, size_mm, what: str = "part") -> str | None:
+def uncertainty_report(field, points_mm, size_mm, what: str = "part", *,
+                       confident_line: bool = True) -> str | None:
     """One line on where a fit's rings are a guess (issue 12 part 5), or None when ``field``
-    carries no uncertainty (a true field, a plain fit).
+    carries no uncertainty (a true field, a plain fit). Where the rings are well constrained the
+    line says so, or with ``confident_line=False`` it is None (only a warning left: a bake
+    printed the good news as "warning: ... well constrained").
 
     points_mm : (n, 3) points of the part (block frame), e.g. its mesh vertices. The part is
     cut in thirds along each block axis; the third with the lowest mean :func:`confidence` is
@@ -879,7 +882,8 @@ def uncertainty_report(field, points_mm, size_mm, what: str = "part") -> str | N
     p = np.asarray(points_mm, float)
     conf = confidence(field.uncertainty_years(p))
     if conf.mean() >= CONFIDENT_MEAN:
-        return f"the rings of this {what} are well constrained (mean confidence {conf.mean():.2f})"
+        return (f"the rings of this {what} are well constrained (mean confidence {conf.mean():.2f})"
+                if confident_line else None)
     size = np.asarray(size_mm, float)
     worst = None
     for ax in range(3):
