@@ -123,3 +123,27 @@ def test_every_placement_panel_names_the_same_terms(knotty, monkeypatch, tmp_pat
     for title in titles:
         assert all(f"{term} " in title for term in ("score", "knots", "pith", "end grain",
                                                     "runout")), title
+
+
+def test_the_report_quotes_the_surface_knot_share_its_warning_gives(knotty):
+    """The report's line gave the knot share of the surface and the wood 1-3 mm under it
+    (19.8 %) beside a warning 'knots show on 15.3 % of the surface': two numbers for one thing."""
+    import re
+
+    import trimesh
+
+    from woodcam.advise import part_report, report_text
+
+    for x in np.linspace(20, 280, 6):  # some of these boxes cross a knot of the knotty block
+        box = trimesh.creation.box((30, 30, 30))
+        box.apply_translation((x, knotty.size_mm[1] / 2, knotty.size_mm[2] / 2))
+        rep = part_report(box, knotty)
+        if rep["knots_surface"] > 0 and rep["knots"] != rep["knots_surface"]:
+            break
+    else:
+        pytest.fail("no box showed a knot on its surface")
+    text = report_text(rep, "box")
+    warned = re.search(r"knots show on ([\d.]+) % of the surface", text).group(1)
+    assert f"knots {warned} % of the surface (" in text
+    old = {k: v for k, v in rep.items() if k != "knots_surface"}  # a report written before
+    assert f"knots {100 * rep['knots']:.1f} %, pith" in report_text(old, "box")
