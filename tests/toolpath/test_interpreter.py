@@ -249,6 +249,31 @@ def test_dialects():
         read_gcode(safety, dialect="haas")
 
 
+_BODY = "G21 G90 F100\nG0 X0 Y0 Z5\nG1 X1\n"
+
+
+def _refused(text, line, word, rule, **kw):
+    with pytest.raises(GcodeError, match=rule) as e:
+        read_gcode(text, **kw)
+    assert (e.value.line, e.value.word) == (line, word)
+
+
+def test_a_percent_line_counts_only_as_linuxcnc_reads_it():
+    """LinuxCNC refuses these ("Bad character '%' used", checked against its interpreter in
+    test_linuxcnc_oracle.py); woodcam skipped the '%' and ran the moves after it."""
+    rule = "'%' is read only as a line of its own"
+    _refused(_BODY + "%\nG1 X50\nM2\n", 4, "%", rule)  # no opening '%'
+    _refused("(header)\n%\n" + _BODY + "M2\n", 2, "%", rule)  # not the first line
+    _refused("% (c)\n" + _BODY + "%\n", 1, "%", rule)  # a comment beside it
+    _refused("%\n" + _BODY + "% (end)\nG1 X50\n", 5, "%", rule)
+    # what LinuxCNC reads: blank lines before the opening '%', blanks around either; nothing
+    # after the closing one; a '%' after the program end is never reached
+    assert len(read_gcode("\n %\n" + _BODY + "\t%\nG1 X50\n")) == 2
+    assert len(read_gcode(_BODY + "M2\n%\nG1 X50\n")) == 2
+    # grbl has no '%' (error 1 in the firmware): its senders drop the lines
+    assert len(read_gcode(_BODY + "%\nG1 X50\n", dialect="grbl")) == 3
+
+
 def test_words_no_code_uses_are_refused_and_io_warned():
     for line, word in (("G1 X1 Q2 F100", "Q2"), ("G0 X1 R3", "R3"), ("G1 X1 P5 F100", "P5"),
                        ("G0 X1 L2", "L2"), ("G0 X1 H1", "H1"), ("G0 X1 I2", "I2")):

@@ -23,7 +23,9 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``G54-G59.3``, ``G61/G61.1/G64``, ``G73 G81 G82 G83 G85 G86 G89`` with ``G98/G99`` and ``L``,
   ``G80``, ``G90/G91``, ``G90.1/G91.1``, ``G92/G92.1/G92.2/G92.3``, ``G94``, ``G97``;
   ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60``; ``F S T N``; ``( )``/``;`` comments,
-  ``(msg,...)``, block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters.
+  ``(msg,...)``, block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
+  of its own: the first non-blank line opens, the next ends the program; any other ``%`` is an
+  error, as in LinuxCNC).
 
 Everything else is an error naming the line and the word; what is read but has no effect on the
 cut is silent, what is read and could matter but is not simulated is a warning with its line.
@@ -549,19 +551,27 @@ class Interpreter:
         ``o100 if`` ... ``o100 endif``)."""
         lines: list[_Line] = []
         percent = False
+        closing = None  # index of the line of the closing '%'
         first = True
+        grbl = self.dialect == "grbl"
         for no, raw in enumerate(self.src, start=1):
             self.line_no = no
             text, msg = _split_comments(raw, no)
-            if first and (text or msg):
+            # LinuxCNC reads '%' only as a line of its own (blanks around it, no comment): the
+            # first non-blank line opens a %-delimited program and the next such line ends it;
+            # any other '%' is refused when it is reached ("Bad character '%' used": the
+            # moves after it never run). grbl has no '%' at all; its senders drop those lines.
+            bare = text == "%" if grbl else raw.strip() == "%"
+            if first and ((text or msg) if grbl else raw.strip()):
                 first = False
-                if text == "%":
+                if bare:
                     percent = True
                     continue
-            if text == "%":
-                if percent:
-                    lines.append(_Line("%", no, msg))
-                    break
+            if bare and percent:
+                closing = len(lines)
+                lines.append(_Line("%", no, msg))
+                break
+            if text == "%" and grbl:
                 continue
             ln = _Line(text, no, msg)
             body = text[1:] if text.startswith("/") else text
@@ -591,7 +601,7 @@ class Interpreter:
                                "--dialect fanuc)", "remove it or pass --dialect fanuc")
             lines.append(ln)
         self.lines = lines
-        self.percent = percent
+        self.closing = closing
         # match structure
         self.match: dict[int, int] = {}   # opener index -> closer index (and back)
         self.branches: dict[int, list[int]] = {}  # if index -> [elseif/else..., endif]
@@ -669,7 +679,7 @@ class Interpreter:
                 self.messages.append((ln.no, m))
             k = ln.okey
             if k is None:
-                if ln.text == "%":
+                if pc == self.closing:
                     self.ended = True
                     break
                 if ln.text:
@@ -839,6 +849,12 @@ class Interpreter:
                 raise self.err(s[i:i + 10], "a value without a letter", "write a word like X1")
             letter = c
             if letter not in _LETTERS:
+                if c == "%":  # (a '%' line of its own that opens or ends a program never gets here)
+                    raise self.err("%", "'%' is read only as a line of its own that opens the "
+                                   "file and then ends the program (LinuxCNC refuses this "
+                                   "line: 'Bad character '%' used'; the moves after it never "
+                                   "run)", "end the program with M2 or M30 instead, or remove "
+                                   "the '%' (and any comment beside it)")
                 if not c.isalpha():
                     raise self.err(c, f"bad character {c!r} (a word is a letter and a value)",
                                    "fix or remove it")
