@@ -274,6 +274,19 @@ def test_a_percent_line_counts_only_as_linuxcnc_reads_it():
     assert len(read_gcode(_BODY + "%\nG1 X50\n", dialect="grbl")) == 3
 
 
+def test_two_m_codes_of_one_modal_group_are_refused():
+    """LinuxCNC: "Two m codes used from same modal group", "Too many m codes on line"; grbl
+    refuses the pairs of its groups alike (error 21). woodcam ran ``M4 M5`` as M5."""
+    _refused(_BODY + "M4 M5\nM2\n", 4, "M4 M5", "two spindle M codes on one line")
+    _refused(_BODY + "M3 M3\nM2\n", 4, "M3 M3", "two spindle M codes")
+    _refused(_BODY + "M7 M9\nM2\n", 4, "M7 M9", "two coolant M codes")
+    _refused(_BODY + "M2 M30\n", 4, "M2 M30", "two stopping M codes")
+    _refused(_BODY + "M3 M8 M48 M100 M6\nM2\n", 4, "M3 M8 M48 M100 M6",
+             "more than 4 M codes on one line")
+    _refused(_BODY + "M4 M5\n", 4, "M4 M5", "two spindle M codes", dialect="grbl")
+    assert len(read_gcode(_BODY + "S1000 M3 M8 M48 M101\nM2\n")) == 2  # one of each group
+
+
 def test_words_no_code_uses_are_refused_and_io_warned():
     for line, word in (("G1 X1 Q2 F100", "Q2"), ("G0 X1 R3", "R3"), ("G1 X1 P5 F100", "P5"),
                        ("G0 X1 L2", "L2"), ("G0 X1 H1", "H1"), ("G0 X1 I2", "I2")):

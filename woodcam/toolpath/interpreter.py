@@ -152,6 +152,14 @@ _G_REFUSED = {41.0: "cutter radius compensation changes the path", 42.0: "cutter
               93.0: "inverse-time feed is not simulated", 95.0: "feed per revolution is not "
               "simulated", 96.0: "constant surface speed is not simulated"}
 _M_KNOWN = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 30, 48, 49, 50, 51, 52, 53, 60, 61}
+#: LinuxCNC's M modal groups: two M codes of one group on a line are refused ("Two m codes used
+#: from same modal group"; grbl refuses its M0/M1/M2/M30, M3-M5 and M7-M9 pairs the same way,
+#: error 21), as are more than :data:`MAX_M_PER_LINE` M codes on one line.
+_M_GROUPS = {"stopping": {0, 1, 2, 30, 60}, "spindle": {3, 4, 5, 19}, "tool change": {6, 61},
+             "coolant": {7, 8, 9}, "override": set(range(48, 54)),
+             "input/output": set(range(62, 69)), "user-defined": set(range(100, 200))}
+#: LinuxCNC refuses a fifth M code on one line ("Too many m codes on line").
+MAX_M_PER_LINE = 4
 #: M codes that switch I/O or call user programs: read, not simulated, warned about.
 _M_WARN = {19: "spindle orientation", 62: "digital output", 63: "digital output",
            64: "digital output", 65: "digital output", 66: "wait on input",
@@ -921,6 +929,14 @@ class Interpreter:
                     continue
                 raise self.err(" ".join(f"G{c:g}" for c in sorted(hit)),
                                f"two {name} G codes on one line", "keep one")
+        if len(ms) > MAX_M_PER_LINE and self.dialect != "grbl":
+            raise self.err(" ".join(f"M{v:g}" for v in ms), f"more than {MAX_M_PER_LINE} M "
+                           "codes on one line (LinuxCNC's limit)", "split the line")
+        for name, codes in _M_GROUPS.items():
+            hit = [v for v in ms if v in codes]
+            if len(hit) > 1:
+                raise self.err(" ".join(f"M{v:g}" for v in hit),
+                               f"two {name} M codes on one line", "keep one")
         mset = set()
         for v in ms:
             if v == math.floor(v) and int(v) in _M_WARN:
