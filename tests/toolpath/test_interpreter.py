@@ -287,6 +287,18 @@ def test_two_m_codes_of_one_modal_group_are_refused():
     assert len(read_gcode(_BODY + "S1000 M3 M8 M48 M101\nM2\n")) == 2  # one of each group
 
 
+def test_an_n_word_is_read_only_at_the_start_of_a_line():
+    """LinuxCNC refuses an N word after another word ("Bad character 'n' used"); grbl reads it
+    anywhere on the line, once (error 25 twice). woodcam read N anywhere in every dialect."""
+    rule = "N word.* in the middle of a line"
+    _refused(_BODY + "G1 X2 F100 N5\nM2\n", 4, "N5", rule)
+    _refused(_BODY + "N5 N6 G1 X2\nM2\n", 4, "N6", rule)
+    _refused(_BODY + "N5 #1=2 N6\nM2\n", 4, "N6", rule)
+    assert len(read_gcode(_BODY + "N5 G1 X2\n/N6 G1 X3\n n7 g1 x4\nM2\n")) == 5
+    assert len(read_gcode(_BODY + "G1 X2 N5\n", dialect="grbl")) == 3
+    _refused(_BODY + "N5 G1 X2 N6\n", 4, "N6", "word N twice", dialect="grbl")
+
+
 def test_words_no_code_uses_are_refused_and_io_warned():
     for line, word in (("G1 X1 Q2 F100", "Q2"), ("G0 X1 R3", "R3"), ("G1 X1 P5 F100", "P5"),
                        ("G0 X1 L2", "L2"), ("G0 X1 H1", "H1"), ("G0 X1 I2", "I2")):

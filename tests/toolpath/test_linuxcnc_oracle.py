@@ -177,3 +177,16 @@ def test_linuxcnc_runs_leave_no_scratch_files(tmp_path, monkeypatch):
     assert len(res[0]["moves"]) == 1 and res[0]["error"] is None
     assert res[1]["error"] is not None
     assert list(scratch.iterdir()) == []
+
+
+def test_percent_lines_m_groups_and_n_words_are_read_as_linuxcnc_reads_them(tmp_path):
+    """Each of these LinuxCNC refuses or reads, and woodcam alike (it read the refused ones)."""
+    body = "G21 G90 F100\nG0 X0 Y0 Z5\nG1 X1\n"
+    texts = [body + "%\nG1 X50\nM2\n", "(c)\n%\n" + body + "M2\n", "% (c)\n" + body + "%\n",
+             " %\n" + body + "\t%\nG1 X50\n", body + "M2\n%\nG1 X50\n", "%\n" + body + "%G1\n",
+             body + "M4 M5\nM2\n", body + "M7 M8\nM2\n", body + "M3 M8 M48 M100\nM2\n",
+             body + "M3 M8 M48 M100 M6\nM2\n", body + "G1 X2 N5\nM2\n", body + "N5 N6 X2\nM2\n",
+             body + "N5 G1 X2\n/N6 X3\nM2\n"]
+    agree, bad = _differences(_written(tmp_path, texts), texts)
+    assert not bad, bad
+    assert agree == len(texts)

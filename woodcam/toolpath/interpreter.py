@@ -22,7 +22,8 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   are measured from the tip, so tool length offsets do not move the tip), ``G53``,
   ``G54-G59.3``, ``G61/G61.1/G64``, ``G73 G81 G82 G83 G85 G86 G89`` with ``G98/G99`` and ``L``,
   ``G80``, ``G90/G91``, ``G90.1/G91.1``, ``G92/G92.1/G92.2/G92.3``, ``G94``, ``G97``;
-  ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60``; ``F S T N``; ``( )``/``;`` comments,
+  ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60`` (one of each modal group a line);
+  ``F S T``, ``N`` (the first word of a line; grbl: anywhere); ``( )``/``;`` comments,
   ``(msg,...)``, block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
   of its own: the first non-blank line opens, the next ends the program; any other ``%`` is an
   error, as in LinuxCNC).
@@ -832,6 +833,7 @@ class Interpreter:
         gs: list[float] = []
         ms: list[int] = []
         pending: list[tuple] = []
+        n_seen = False
         i = 0
         n = len(s)
         while i < n:
@@ -876,12 +878,21 @@ class Interpreter:
             if self.dialect == "grbl" and i + 1 < n and s[i + 1] in "[#":
                 raise self.err(s[i:i + 6], "grbl has no expressions or parameters",
                                "use --dialect linuxcnc")
+            at = i
             v, i = self.value(s, i + 1)
             if letter == "g":
                 gs.append(v)
             elif letter == "m":
                 ms.append(v)
             elif letter == "n":
+                if self.dialect == "grbl":  # grbl reads N anywhere on the line, once
+                    if n_seen:
+                        raise self.err(f"N{v:g}", "word N twice on one line", "keep one")
+                    n_seen = True
+                elif at:  # LinuxCNC: "Bad character 'n' used"
+                    raise self.err(f"N{v:g}", "a line number (N word) in the middle of a line: "
+                                   "LinuxCNC reads N only as the first word of a line",
+                                   "move it to the start of the line or remove it")
                 continue
             else:
                 if letter in words:
