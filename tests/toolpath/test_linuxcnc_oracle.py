@@ -190,3 +190,16 @@ def test_percent_lines_m_groups_and_n_words_are_read_as_linuxcnc_reads_them(tmp_
     agree, bad = _differences(_written(tmp_path, texts), texts)
     assert not bad, bad
     assert agree == len(texts)
+
+
+def test_a_tool_length_offset_does_not_carry_into_the_next_file_of_a_batch(tmp_path):
+    """LinuxCNC's interpreter kept file 1's G43.1 Z3 when it read file 2: the start of file 2
+    was 3 mm low (its G91 Z-1 ended at Z6, not Z9)."""
+    a, b = tmp_path / "a.ngc", tmp_path / "b.ngc"
+    a.write_text("G21 G90\nG43.1 Z3\nG0 X1 Y0 Z5\nM2\n")
+    b.write_text("G21 G91\nG0 Z-1\nG90 G0 X2\nM2\n")
+    alone = run_batch([b], start_mm=START)[0]
+    after = run_batch([a, b], start_mm=START)[1]
+    assert alone["error"] is None and after["error"] is None
+    assert after["moves"] == alone["moves"]
+    assert after["moves"][0][2] == pytest.approx([0, 0, 9])
