@@ -146,6 +146,20 @@ def test_units_incremental_g53_g28():
     assert [m[2] for m in moves] == [(6, 0, 30), (1, 0, 30), (0, 0, 30)]
 
 
+def test_parameter_lengths_are_mm_whatever_the_units():
+    """A metric machine's parameters: G28 in a G20 program went to 25.4x the stored home (Z254
+    for a home at Z10), G10 L2 in G20 stored inches that G55 then read as mm."""
+    start = (0, 7, 10)
+    home = Interpreter("G20 G90\nG0 X1 Y1 Z1\nG28\nM2\n", start_mm=start).run()[0]
+    assert home[-1][2] == pytest.approx(start)
+    home = Interpreter("G20 G91 G28 Z0\nM2\n", start_mm=start).run()[0]
+    assert home == []  # already at the home (was a rapid up to Z254)
+    assert _ends("G20\nG10 L2 P2 X1\nG55 G0 X0 Y0 Z0\nM2\n")[-1] == pytest.approx((25.4, 0, 0))
+    # #5221 holds 76.2 (mm) after G10 L2 P1 X3 in G20: G21 X#5221 is 76.2 past the offset
+    assert _ends("G20\nG10 L2 P1 X3\nG21 G0 X#5221 Y0 Z5\nM2\n")[-1][0] == pytest.approx(152.4)
+    assert _ends("G20\nG0 X1 Y0 Z0\nG92 X0\nG21 G0 X#5211\nM2\n")[-1][0] == pytest.approx(50.8)
+
+
 def test_feed_is_read_in_the_units_of_its_f_word():
     # LinuxCNC converts F when it is read (measured with its interpreter): a later G20/G21 keeps
     # the physical feed, and on a "G20 ... F10" line F comes before the units switch (10 mm/min);

@@ -203,3 +203,24 @@ def test_a_tool_length_offset_does_not_carry_into_the_next_file_of_a_batch(tmp_p
     assert alone["error"] is None and after["error"] is None
     assert after["moves"] == alone["moves"]
     assert after["moves"][0][2] == pytest.approx([0, 0, 9])
+
+
+def test_the_oracle_is_a_metric_machine_whose_parameters_read_in_mm(tmp_path):
+    """The driver declared an inch machine: ``#5162`` with the home at Y7 mm read 0.2756 in a
+    G21 program. Now mm (a metric machine, as woodcam's interpreter), and programs that store
+    and read offsets and homes across G20/G21 agree with woodcam's interpreter."""
+    start = (0.0, 7.0, 10.0)
+    p = tmp_path / "params.ngc"
+    p.write_text("G21\nG0 X#5221 Y#5162 Z#5163\nM2\n")
+    res = run_batch([p], start_mm=start, machine_zero_mm=(-3.0, 0.0, 0.0))[0]
+    assert res["error"] is None
+    assert res["moves"][-1][2] == pytest.approx([3 - 3 + 3, 7 - 0, 10])  # G54 offset X3
+    texts = ["G20\nG10 L2 P2 X1\nG55 G0 X0 Y0 Z0\nM2\n",
+             "G20\nG0 X1 Y0 Z0\nG92 X0\nG21 G0 X#5211\nG92.1\nM2\n",
+             "G21\nG0 X1 Y0 Z0\nG92 X0\nG92.2\nG20 G92.3\nG0 X0\nM2\n",
+             "G20 G90\nG0 X1 Y1 Z1\nG28\nM2\n", "G20 G91 G28 Z0\nG90 G30\nM2\n",
+             "G20\nG10 L20 P1 X1\nG21 G0 X#5221\nG54 G0 X0\nM2\n",
+             "G20\nG0 X1 Y0 Z0\nG28.1\nG0 X2\nG28\nM2\n",
+             "G20\nG10 L2 P1 X3\nG21 G0 X#5221 Y0 Z5\nM2\n"]
+    agree, bad = _differences(_written(tmp_path, texts), texts)
+    assert not bad, bad

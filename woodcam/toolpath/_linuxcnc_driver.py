@@ -10,7 +10,9 @@ woodcam's canonical tuples ``[kind, line, [x, y, z], [c1, c2] | null, rotation, 
 machine frame, mm, tool tip (LinuxCNC's canon reports program coordinates before the G5x/G92
 offsets and without the tool length offset; they are added back here as AXIS does), shifted by
 ``machine_zero_mm``: the G54 offset is ``-machine_zero_mm``, so the moves come out in the G54
-frame the start position is given in (as woodcam's interpreter does).
+frame the start position is given in (as woodcam's interpreter does). The machine is metric
+(external length units mm, the parameter file in mm), as woodcam's interpreter: a program reads
+``#5161`` or ``#5221`` in mm (the canon calls still come in inches: the module converts them).
 """
 
 import ctypes
@@ -76,7 +78,7 @@ class _Canon:
         return 1.0
 
     def get_external_length_units(self):
-        return 1 / MM
+        return 1.0  # a metric machine (LinuxCNC's TRAJ LINEAR_UNITS = mm): parameters in mm
 
     def get_axis_mask(self):
         return 7
@@ -157,12 +159,12 @@ def _run(job, work, result_fd):
     out = []
     for path in job["files"]:
         with open(var, "w") as f:  # G28/G30 homes at the start position, as woodcam does
-            for base in (5161, 5181):  # (the parameter file holds inches)
+            for base in (5161, 5181):  # (the parameter file holds the machine's units, mm)
                 for i, v in enumerate((sx, sy, sz)):
-                    f.write(f"{base + i}\t{v / MM:.15f}\n")
+                    f.write(f"{base + i}\t{v:.15f}\n")
             f.write("5220\t1.000000\n")  # (LinuxCNC reads the numbers in increasing order)
             for i, m in enumerate(mzero):  # G54 offset: the G54 origin in machine coordinates
-                f.write(f"{5221 + i}\t{-m / MM:.15f}\n")
+                f.write(f"{5221 + i}\t{-m:.15f}\n")
         canon = _Canon(var, time.time() + job.get("timeout_s", 10.0))
         canon.mzero = mzero
         # G49: the interpreter keeps a G43.1 tool length offset from one file to the next

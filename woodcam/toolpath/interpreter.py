@@ -6,7 +6,9 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``#<name>`` and global ``#<_name>`` parameters, indirect ``##1`` / ``#[1+2]``; system
   parameters: coordinate systems ``#5221``... (G54 at 5221, each next one 20 higher), G92
   ``#5210``-``#5213``, G28/G30 homes ``#5161``/``#5181``, ``#5220`` (active system),
-  ``#5400`` (tool), ``#<_value>`` (last return value);
+  ``#5400`` (tool), ``#<_value>`` (last return value); their lengths are millimetres whatever
+  ``G20/G21`` (LinuxCNC on a metric machine: the machine's units), so ``G28`` in a ``G20``
+  program returns to the stored home and a ``G20`` program reads ``#5221`` in mm;
 - expressions ``[...]`` with ``** * / mod + - eq ne gt ge lt le and or xor`` (LinuxCNC's six
   precedence levels, all left-associative; ``eq``/``ne`` within 1e-4 as LinuxCNC),
   unary minus, functions ``sin cos tan asin acos atan[a]/[b] sqrt abs round fix fup exp ln
@@ -1039,7 +1041,7 @@ class Interpreter:
                 if a in w:
                     # G92 makes the current point read w[a]: offset = pos - g5x - value
                     self.g92[i] = self.pos[i] - self.g5x[i] - w[a] * self.scale
-                    self.p[5211 + i] = self.g92[i] / self.scale
+                    self.p[5211 + i] = self.g92[i]
             self.p[5210] = 1.0
         elif 92.1 in g or 92.2 in g:
             self.g92 = [0.0] * 3
@@ -1048,7 +1050,7 @@ class Interpreter:
                     self.p[5211 + i] = 0.0
                 self.p[5210] = 0.0
         elif 92.3 in g:
-            self.g92 = [self.p.get(5211 + i, 0.0) * self.scale for i in range(3)]
+            self.g92 = [self.p.get(5211 + i, 0.0) for i in range(3)]
         if nonmodal & {10.0, 28.0, 30.0, 92.0} or (43.1 in g and not motion_here):
             # the axis words belonged to the non-modal code, or are G43.1's dynamic tool
             # length offset (LinuxCNC: "G43.1 Z2" moves nothing; with a motion code on the line
@@ -1124,7 +1126,7 @@ class Interpreter:
                 val = w[a] * self.scale
             else:  # L20: the current point shall read w[a] in system n
                 val = self.pos[i] - self.g92[i] - w[a] * self.scale
-            self.p[base + i] = val / self.scale
+            self.p[base + i] = val
             if n == self.cs:
                 self.g5x[i] = val
 
@@ -1138,7 +1140,7 @@ class Interpreter:
         idx = [i for i, a in enumerate("xyz") if a in w] if axis else [0, 1, 2]
         end = list(self.pos)
         for i in idx:
-            end[i] = self.p.get(base + i, 0.0) * self.scale
+            end[i] = self.p.get(base + i, 0.0)
             self.known[i] = True
         self.emit(TRAVERSE, end)
 
