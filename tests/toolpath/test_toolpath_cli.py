@@ -294,6 +294,24 @@ def test_the_simulations_issues_reach_the_review_page_as_hotspots(tmp_path, caps
     assert page.count("below_stock_bottom") >= 5
 
 
+def test_the_review_page_of_a_gcode_glb_shows_its_tools_and_machining_time(tmp_path, capsys):
+    """The GLB records the run's tools and machining time, but the page (and its printed shop
+    sheet) showed neither."""
+    from woodcam.cli import main
+    from woodcam.cli.gcode import _hms
+    from woodcam.export import read_glb_metadata
+
+    glb = tmp_path / "p.glb"
+    assert main(["gcode", str(REPO / "toolpaths" / "profile_tabs.nc"), "--tool", "1=flat:6.35",
+                 "--block", "builtin:flat-sawn", "--out", str(glb), "--no-obj", "--cell-size", "1"]) == 0
+    meta = read_glb_metadata(glb)
+    assert meta["tools"] == {"1": "flat:6.35"} and meta["machining_time_s"] > 60
+    assert main(["review", str(glb), "--out", str(tmp_path / "p.html"), "--voxels", "20000"]) == 0
+    page = (tmp_path / "p.html").read_text()
+    assert "<tr><th>tools (--tool specs, mm)</th><td>T1 flat:6.35</td></tr>" in page
+    assert f"<tr><th>machining time</th><td>{_hms(meta['machining_time_s'])} (estimate" in page
+
+
 def test_review_with_another_block_than_the_baked_one_says_so(tmp_path, capsys):
     """review/preview --block of another block (another size, an edited folder) was taken without a
     word, so the section cap showed other wood than the part's surface."""

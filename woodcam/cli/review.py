@@ -60,6 +60,7 @@ def run_review(args: argparse.Namespace) -> int:
     for key in ("texels_per_mm", "gcode", "placement"):
         if key in meta:
             report[key] = meta[key]
+    report.update(_gcode_run_rows(meta))
     from ..advise import knot_spots
     from ..export import load_textured
 
@@ -78,3 +79,21 @@ def run_review(args: argparse.Namespace) -> int:
                        voxels=args.voxels or VOLUME_VOXELS, progress=True)
     print(f"wrote {out} ({out.stat().st_size / 2**20:.1f} MiB)")
     return 0
+
+
+def _gcode_run_rows(meta: dict) -> dict:
+    """The rows of a ``woodcam gcode`` run recorded in its GLB (none for a baked part): the
+    tools by number with their specs and the machining time estimate, for the page and its
+    printed shop sheet."""
+    from .gcode import _hms
+
+    rows = {}
+    tools = meta.get("tools")
+    if isinstance(tools, dict) and tools:
+        order = sorted(tools, key=lambda t: (not str(t).isdigit(), int(t) if str(t).isdigit() else 0, str(t)))
+        rows["tools (--tool specs, mm)"] = ", ".join(f"T{t} {tools[t]}" for t in order)
+    t = meta.get("machining_time_s")
+    if isinstance(t, (int, float)) and not isinstance(t, bool) and t >= 0:
+        rows["machining time"] = (f"{_hms(t)} (estimate from the programmed feeds and the rapid "
+                                  "rate, no acceleration: real jobs take longer)")
+    return rows
