@@ -116,6 +116,34 @@ def test_report_names_lines():
     assert res.heightmap.min() == 0.0  # clamped to the stock bottom
 
 
+@pytest.mark.parametrize("tool, enters_at_x", [(FlatEndMill(4), -2.0),  # closed-form sweep
+                                                (parse_tool_spec("vbit:90:8"), -3.0)])
+def test_an_issue_is_placed_where_it_first_happens(tool, enters_at_x):
+    """A G-code issue's spot (the review page's hotspot) stood at the end of the first move of
+    its line: a rapid crossing the stock was marked where it left it, 60 mm away. Now where the
+    problem first happens: the rapid where the tool meets the stock, the plunge where the tip
+    goes through the bottom."""
+    from woodcam.cli.gcode import _issue_spots
+
+    text = ("G0 X-20 Y15 Z2 M3 S9000\n"  # 1
+            "G0 Z-3\n"                    # 2 down beside the stock
+            "G0 X60\n"                    # 3 rapid through it at Z-3 (block Z9)
+            "G0 Z2\n"                     # 4
+            "G0 X20 Y25\n"                # 5
+            "G1 Z-13 F300\n"              # 6 plunge 1 mm through the bottom (block Z0)
+            "G0 Z2\nM2\n")
+    prog = read_gcode(text)
+    res = simulate(prog, tool, SIZE, resolution_mm=0.2)
+    spots = {s["line"]: s["at_mm"] for s in _issue_spots(prog, res.report, SIZE, None, "p.nc")}
+    assert sorted(spots) == [3, 6]
+    # the tool's edge meets the stock's face X0 when its axis is at X = -radius at the top
+    # of the cut (the flat: -2; the 90-degree V-bit 3 mm deep: -3), to one cell
+    x, y, z = spots[3]
+    assert enters_at_x - 0.05 <= x <= enters_at_x + 0.2 + 0.05 and (y, z) == (15, 9)
+    assert spots[6] == pytest.approx([20, 25, 0])
+    assert [i.at_mm for i in res.report] == [tuple(spots[3]), tuple(spots[6])]
+
+
 def test_rapid_into_an_already_cut_pocket_is_not_reported():
     text = "G0 X10 Y10 Z2 M3 S9000\nG1 Z-3 F300\nX20\nG0 Z2\nG0 X10\nG0 Z-2\nG1 Z-4\nG0 Z2\n"
     res = simulate(read_gcode(text), FlatEndMill(4), SIZE)

@@ -287,8 +287,9 @@ def test_the_simulations_issues_reach_the_review_page_as_hotspots(tmp_path, caps
                  "builtin:flat-sawn", "--out", str(glb), "--no-obj", "--cell-size", "0.5"]) == 0
     spots = read_glb_metadata(glb)["warnings"]
     assert len(spots) == 5 and all("below_stock_bottom" in s["message"] for s in spots)
-    # where the move ends in the block frame: 0.5 mm under the 50 mm block's bottom
-    assert all(s["at_mm"][2] == pytest.approx(-0.5) for s in spots)
+    # where the tip goes through the 50 mm block's bottom (block frame Z0; the moves end 0.5 mm
+    # under it)
+    assert all(s["at_mm"][2] == pytest.approx(0.0) for s in spots)
     assert main(["review", str(glb), "--out", str(tmp_path / "p.html"), "--voxels", "20000"]) == 0
     page = (tmp_path / "p.html").read_text()
     assert page.count("below_stock_bottom") >= 5

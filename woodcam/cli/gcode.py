@@ -277,17 +277,20 @@ def run(args) -> int:
 
 
 def _issue_spots(program, issues, size_mm, offset, name: str) -> list[dict]:
-    """The simulation's issues as ``{"message", "line", "at_mm"}``: where the first move of the
-    issue's line ends, in the block frame (the work offset as simulate applies it)."""
+    """The simulation's issues as ``{"message", "line", "at_mm"}``, block frame: where the
+    simulation says the problem first happens (``Issue.at_mm``), else the middle of the first
+    move of the issue's line (the work offset as simulate applies it)."""
     import numpy as np
 
     off = np.array([0.0, 0.0, float(size_mm[2])]) if offset is None else np.asarray(offset, float)
-    lines, ends = np.asarray(program.line), np.asarray(program.end_mm) + off
+    lines = np.asarray(program.line)
+    mids = 0.5 * (np.asarray(program.start_mm) + np.asarray(program.end_mm)) + off
     out = []
     for issue in issues:
         at = np.flatnonzero(lines == issue.line)
-        if len(at):
-            out.append({"message": f"{name} {issue}", "line": int(issue.line), "at_mm": ends[at[0]].tolist()})
+        if issue.at_mm is not None or len(at):
+            spot = list(issue.at_mm) if issue.at_mm is not None else mids[at[0]].tolist()
+            out.append({"message": f"{name} {issue}", "line": int(issue.line), "at_mm": spot})
     return out
 
 

@@ -67,12 +67,16 @@ MAX_ISSUES_PER_KIND = 12
 
 @dataclass(frozen=True)
 class Issue:
-    """A problem the simulation found on G-code lines ``line .. last_line`` (1-based)."""
+    """A problem the simulation found on G-code lines ``line .. last_line`` (1-based).
+    ``at_mm``: where it first happens (tool tip, block frame, mm): a rapid's first point that
+    cuts the stock, where a move goes below the stock bottom, else the middle of the offending
+    move; ``None`` where the simulation does not say (the reach checks)."""
 
     kind: IssueKind
     line: int
     message: str
     last_line: int | None = None
+    at_mm: tuple[float, float, float] | None = None
 
     def __str__(self):
         where = f"line {self.line}" if not self.last_line or self.last_line == self.line \
@@ -94,13 +98,13 @@ def _summarise(issues: dict, move_lines: np.ndarray) -> list[Issue]:
                 runs[-1].append(it)
             else:
                 runs.append([it])
-        merged = [Issue(kind, r[0].line, r[0].message, r[-1].line) for r in runs]
+        merged = [Issue(kind, r[0].line, r[0].message, r[-1].line, r[0].at_mm) for r in runs]
         if len(merged) > MAX_ISSUES_PER_KIND:
             rest = merged[MAX_ISSUES_PER_KIND:]
             n_lines = sum(len(r) for r in runs[MAX_ISSUES_PER_KIND:])
             merged = merged[:MAX_ISSUES_PER_KIND] + [Issue(
                 kind, rest[0].line, f"and {n_lines} more lines like this, the last at line "
-                f"{rest[-1].last_line}", rest[-1].last_line)]
+                f"{rest[-1].last_line}", rest[-1].last_line, rest[0].at_mm)]
         out += merged
     return sorted(out, key=lambda i: (i.line, i.kind))
 
@@ -286,17 +290,21 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     below_top = zmin < H - SIM_CONTACT_TOL_MM
     kind, lines = program.kind, program.line
     # a move ending below the bottom (the retract out of it is not reported again)
+    mid = 0.5 * (p0 + p1)
     for k in np.flatnonzero((p1[:, 2] < -SIM_CONTACT_TOL_MM) & over):
+        # where the tip goes through the bottom (z = 0), or the start if it is below already
+        t = p0[k, 2] / (p0[k, 2] - p1[k, 2]) if p0[k, 2] > 0 else 0.0
         _add(issues, "below_stock_bottom", lines[k],
              f"tool tip at z = {p1[k, 2] - off[2]:.3f} mm (G-code frame), {-p1[k, 2]:.3f} mm "
-             "below the stock bottom")
+             "below the stock bottom", p0[k] + t * (p1[k] - p0[k]))
     for k in np.flatnonzero(below_top & outside & (kind == FEED)):
         _add(issues, "cut_outside_stock", lines[k],
              f"tool T{tool_of[k]} is below the stock top (z = {zmin[k] - off[2]:.3f} mm) with "
-             "its footprint outside the stock")
+             "its footprint outside the stock", mid[k])
     for k in np.flatnonzero(below_top & over & (kind == FEED) & ~(program.spindle_rpm > 0)):
         _add(issues, "spindle_off", lines[k], "feed move into the stock with the spindle off "
-             "(no M3/M4 with S > 0 before it): the controller would cut with a still tool")
+             "(no M3/M4 with S > 0 before it): the controller would cut with a still tool",
+             mid[k])
     # tools with reach data: the stock each move meets must not reach the shank or holder
     for rkind, rline, message in reach_issues(p0, p1, tool_of, lookup, lines, size,
                                               initial_heightmap):
@@ -386,10 +394,37 @@ def _clip_segments(a, b, lo, hi):
     return na, nb, ok
 
 
-def _add(issues, kind, line, message):
+def _add(issues, kind, line, message, at=None):
     key = (kind, int(line))
     if key not in issues:
-        issues[key] = Issue(kind, int(line), message)
+        issues[key] = Issue(kind, int(line), message,
+                            at_mm=None if at is None else tuple(float(v) for v in at))
+
+
+def _first_contact(tool, a, b, window, j0, i0, dx, dy):
+    """The first tip position (block frame, mm, (3,)) along the move ``a -> b`` where ``tool``
+    reaches more than SIM_CONTACT_TOL_MM below the stock before the move, sampled every quarter
+    cell; the middle of the move when no sample does (a graze between samples). ``window``: the
+    height field's cells ``[j0:j0 + wy, i0:i0 + wx]`` before the move (they hold the move's
+    footprint). Only for the few moves reported as issues."""
+    R = float(tool.radius_mm)
+    wy, wx = window.shape
+    di = np.arange(-int(np.ceil(R / dx)) - 1, int(np.ceil(R / dx)) + 2)
+    dj = np.arange(-int(np.ceil(R / dy)) - 1, int(np.ceil(R / dy)) + 2)
+    n = int(min(1 << 14, max(2, np.ceil(np.linalg.norm(b - a) / (0.25 * min(dx, dy)))))) + 1
+    for t in np.array_split(np.linspace(0.0, 1.0, n), max(1, n // 256)):
+        p = a + t[:, None] * (b - a)
+        i = np.floor(p[:, 0] / dx).astype(np.int64)[:, None, None] + di[None, None, :]
+        j = np.floor(p[:, 1] / dy).astype(np.int64)[:, None, None] + dj[None, :, None]
+        r = np.hypot((i + 0.5) * dx - p[:, 0, None, None], (j + 0.5) * dy - p[:, 1, None, None])
+        li, lj = i - i0, j - j0
+        inside = (li >= 0) & (li < wx) & (lj >= 0) & (lj < wy)  # off the grid: no stock
+        top = np.where(inside, window[np.clip(lj, 0, wy - 1), np.clip(li, 0, wx - 1)], -np.inf)
+        depth = (top - p[:, 2, None, None] - tool.profile(r)).max(axis=(1, 2))
+        hit = np.flatnonzero(depth > SIM_CONTACT_TOL_MM)
+        if len(hit):
+            return p[hit[0]]
+    return 0.5 * (a + b)
 
 
 def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind, lines,
@@ -413,13 +448,17 @@ def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind,
 
         depth = np.empty(n)
         track = line_map is not None
+        # the stock under each rapid before it (its first contact, if it cuts)
+        before = {k: hm[js[k]:js[k] + wy, is_[k]:is_[k] + wx].copy()
+                  for k in np.flatnonzero(kind == RAPID)}
         cells = sweep_update(hm, line_map if track else np.zeros((1, 1), np.int64), track,
                              closed, float(tool.radius_mm), np.ascontiguousarray(a, float),
                              np.ascontiguousarray(b, float), js, is_, wy, wx, dx, dy,
                              np.asarray(lines, np.int64), depth)
         for k in np.flatnonzero((kind == RAPID) & (depth > SIM_CONTACT_TOL_MM)):
             _add(issues, "rapid_through_stock", lines[k],
-                 f"rapid move (G0) cuts up to {depth[k]:.3f} mm into the stock")
+                 f"rapid move (G0) cuts up to {depth[k]:.3f} mm into the stock",
+                 _first_contact(tool, a[k], b[k], before[k], js[k], is_[k], dx, dy))
         return int(cells)
     f32 = np.float32
     cx = ((is_[:, None] + np.arange(wx)[None, :] + 0.5) * dx - a[:, 0, None]).astype(f32)
@@ -446,7 +485,8 @@ def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind,
             depth = float((cur - env[k]).max())
             if depth > SIM_CONTACT_TOL_MM:
                 _add(issues, "rapid_through_stock", lines[k],
-                     f"rapid move (G0) cuts up to {depth:.3f} mm into the stock")
+                     f"rapid move (G0) cuts up to {depth:.3f} mm into the stock",
+                     _first_contact(tool, a[k], b[k], cur, js[k], is_[k], dx, dy))
     for k in range(n):  # scatter: one slice per move (windows overlap, so no fancy indexing)
         view = hm[js[k]:js[k] + wy, is_[k]:is_[k] + wx]
         if line_map is not None:  # remember which line cut each cell last (deviation map)
