@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._atomic import atomic_path, write_figure, write_text
+from ._atomic import all_or_nothing, atomic_path, remove_stale, write_figure, write_text
 from .errors import WoodcamError
 
 if TYPE_CHECKING:
@@ -419,7 +419,10 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
     """Write ``report.md``, ``report.json`` and ``table1.png`` for a bench run folder into
     ``out_dir``, plus a failure gallery: the cut planes of the ``gallery`` worst blocks (same
     year within 1 mm, over all methods and face sets) and face thumbnails of ``thumbnails``
-    blocks of each kind, all regenerated from the seed. Returns the summary dict."""
+    blocks of each kind, all regenerated from the seed. The files are one set
+    (:func:`woodcam._atomic.all_or_nothing`): an interrupted report leaves the folder's previous
+    one as it was; once they are in place, the gallery pictures an earlier report left there
+    (of other blocks) are removed. Returns the summary dict."""
     from .scale import read_records, record_path, write_json_atomic
 
     run_dir, out = Path(run_dir), Path(out_dir)
@@ -454,14 +457,19 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
     s["gallery"] = picks
     s["thumbnails"] = [i for i in sample if i not in picks]
     out.mkdir(parents=True, exist_ok=True)
-    write_json_atomic(out / "report.json", {"seed": run["seed"], "settings": run["settings"], **s})
-    write_text(out / "report.md", _markdown(s, run))
-    _plot(s, out / "table1.png")
     from ._progress import progress_bar
 
-    for i in progress_bar(picks + s["thumbnails"], desc="gallery", unit="block",
-                          enabled=progress):  # the worst are refitted; the sample only drawn
-        bench_gallery(run["seed"], i, run["settings"], out / "gallery", planes=i in picks)
+    # one set: an interrupted gallery (minutes of refits) left a new report.md beside the
+    # previous report's pictures
+    with all_or_nothing():
+        files = [write_json_atomic(out / "report.json", {"seed": run["seed"], "settings": run["settings"], **s}),
+                 write_text(out / "report.md", _markdown(s, run)), _plot(s, out / "table1.png")]
+        for i in progress_bar(picks + s["thumbnails"], desc="gallery", unit="block",
+                              enabled=progress):  # the worst are refitted; the sample only drawn
+            files += bench_gallery(run["seed"], i, run["settings"], out / "gallery", planes=i in picks)
+    # an earlier report's gallery drew other blocks: beside this one's, a reader took them for
+    # this report's worst blocks
+    remove_stale(out / "gallery", ["b*_*.png"], files)
     return s
 
 

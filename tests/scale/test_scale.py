@@ -338,6 +338,44 @@ def test_report_on_a_real_run_writes_tables_and_gallery(tmp_path):
         assert (tmp_path / "rep" / f).stat().st_size > 1000, f
 
 
+def test_a_report_into_an_earlier_reports_folder_leaves_one_set(tmp_path, monkeypatch):
+    """A report written where an earlier one lies kept the earlier gallery's pictures beside
+    its own (a reader took them for this report's blocks); a report that fails half-way leaves
+    the earlier one whole."""
+    import importlib
+
+    bm = importlib.import_module("woodcam.benchmark")  # woodcam.benchmark is also a function
+    from woodcam.scale import record_path, write_json_atomic
+
+    run, rep = tmp_path / "run", tmp_path / "rep"
+    (run / RECORDS_DIR).mkdir(parents=True)
+    write_json_atomic(run / bm.RUN_MANIFEST, {"seed": 0, "settings": bm.bench_settings(
+        **{**TINY, "face_px": 32, "knotted_fraction": 0.0})})
+    for i in range(2):
+        met = {"full": {"radial": {k: 50.0 + i for k in bm.METRICS}}}
+        write_json_atomic(record_path(run, f"b{i:06d}"), {
+            "key": f"b{i:06d}", "status": "ok", "attempts": 1, "seconds": 2.0, "cpu_s": 1.5,
+            "result": {"seed": 0, "index": i, "kind": "clear", "params": {}, "metrics": met,
+                       "timing": {}}})
+    bm.bench_report(run, rep, gallery=0, thumbnails=2, progress=False)
+    assert sorted(p.name for p in (rep / "gallery").iterdir()) == ["b000000_faces.png",
+                                                                   "b000001_faces.png"]
+    bm.bench_report(run, rep, gallery=0, thumbnails=1, progress=False)
+    assert sorted(p.name for p in (rep / "gallery").iterdir()) == ["b000000_faces.png"]
+    md = (rep / "report.md").read_text()
+
+    def broken(*a, **k):
+        raise WoodcamError("interrupted")
+
+    monkeypatch.setattr(bm, "bench_gallery", broken)
+    monkeypatch.setattr(bm, "_markdown", lambda *a: "another report")
+    with pytest.raises(WoodcamError, match="interrupted"):
+        bm.bench_report(run, rep, gallery=0, thumbnails=1, progress=False)
+    assert (rep / "report.md").read_text() == md
+    assert sorted(p.name for p in rep.rglob("*") if p.is_file()) == [
+        "b000000_faces.png", "report.json", "report.md", "table1.png"]
+
+
 # -- training sets --------------------------------------------------------------------------------
 
 def test_training_set_in_shards_is_bit_identical_and_trains_the_same(tmp_path):
