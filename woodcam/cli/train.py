@@ -55,10 +55,14 @@ def run(args) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     training_set = None
     if engine_requested(args):
-        # the same training set, made in shards on an engine, kept in OUT/trainset/ (resumable)
+        # the same training set, made in shards on an engine, kept in OUT/trainset/ (resumable);
+        # made by train_gtf once it has checked the checkpoint: a run refused for another spec
+        # built the shards (minutes) first
+        from functools import partial
+
         from ..benchmark import make_training_set_many
 
-        training_set = make_training_set_many(spec, args.out / "trainset", **engine_options(args))
+        training_set = partial(make_training_set_many, spec, args.out / "trainset", **engine_options(args))
     r = train_gtf(spec, args.out, steps=args.steps, resume=not args.no_resume, progress=True,
                   training_set=training_set)
     print(f"trained {int(r['step'][-1]) if len(r['step']) else 0} steps in {r['train_s']:.0f} s; "

@@ -36,6 +36,7 @@ from __future__ import annotations
 import csv
 import json
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields as dc_fields
 from pathlib import Path
 
@@ -344,7 +345,8 @@ def _lr_scale(step: int, total: int, floor: float) -> float:
 
 def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool = True,
               progress: bool = True, threads: int = 1,
-              training_set: tuple[np.ndarray, np.ndarray] | None = None) -> dict:
+              training_set: tuple[np.ndarray, np.ndarray] | Callable[[], tuple[np.ndarray, np.ndarray]]
+              | None = None) -> dict:
     """Train the generic model (eq. 3) and write spec, weights and log into ``out_dir``.
 
     A checkpoint (network, latent codes, optimiser, log) is written every
@@ -362,7 +364,9 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
         machine two OpenMP threads contending with other processes ran 5-40x slower than one.
     training_set : (points (N, M, 3), values (N, M)) float32, optional
         :func:`make_training_set` of ``spec`` made elsewhere (e.g. in shards on many workers
-        by :func:`woodcam.benchmark.make_training_set_many`); default: made here.
+        by :func:`woodcam.benchmark.make_training_set_many`), or a function of no arguments
+        that returns it, called only once the checkpoint was checked (a run refused for another
+        spec then spends nothing on the set); default: made here.
 
     Returns
     -------
@@ -385,6 +389,8 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
     state = _load_checkpoint(torch, ckpt, spec) if resume and ckpt.is_file() else None
     spec.save(out / SPEC_NAME)
 
+    if callable(training_set):
+        training_set = training_set()
     if training_set is None:
         pts_np, vals_np = make_training_set(spec)
     else:
