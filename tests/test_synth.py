@@ -250,6 +250,22 @@ def test_benchmark_set_uses_knotted_log_factory(tmp_path):
     assert calls
 
 
+def test_knotted_blocks_have_their_ring_width_in_the_index(tmp_path):
+    """index.json gave knotted blocks ``ring_width_mm: null`` (clear ones a number): it is the
+    knotted log's ring width, the same at every radius, as the block's meta says."""
+    from woodcam.block.io import read_block
+    from woodcam.synth import knotted_log_field
+
+    synth_benchmark_set(tmp_path, 2, 5, face_px=24, log_fields=knotted_log_field, progress=False)
+    blocks = json.loads((tmp_path / "index.json").read_text())["blocks"]
+    assert [b["knotted"] for b in blocks] == [False, True]
+    for b in blocks:
+        assert 1.5 <= b["ring_width_mm"] <= 6.0 * 1.05, b
+        assert read_block(tmp_path / b["name"]).meta["ring_width_mm"] == b["ring_width_mm"]
+    knotted = read_block(tmp_path / blocks[1]["name"]).true_field.log_field
+    assert blocks[1]["ring_width_mm"] == knotted.ring_width_mm == knotted.ring_width_at(80.0)
+
+
 def test_placed_field_serialises_only_when_the_log_field_does():
     f = cut_block(AnalyticLogField(ring_width_mm=2.0, eccentricity=0.1), SIZE, "rift", tilt_deg=3)
     g = PlacedField.from_dict(json.loads(json.dumps(f.to_dict())))

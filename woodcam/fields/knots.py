@@ -315,6 +315,14 @@ class KnottedLogField:
         _, _, ds, _, sp = self._stem(p)
         return ds / sp / self.ring_width_mm
 
+    def ring_width_at(self, radius_mm: float) -> float:
+        """Ring width (mm) at ``radius_mm`` from the pith, averaged around the log: the stem's
+        rings are evenly spaced (``ring_width_mm`` at every radius; around the log they follow
+        the outline's relative radius, and knots bend them locally), as
+        :meth:`AnalyticLogField.ring_width_at <woodcam.fields.analytic.AnalyticLogField.ring_width_at>`
+        ignores eccentricity and lobes."""
+        return self.ring_width_mm
+
     def knot_features(self, points_mm: ArrayLike) -> dict:
         """``{"knot", "dead", "outline"}``, each ``(n,)`` in 0..1, at log-frame points."""
         out = self.evaluate(points_mm)

@@ -45,7 +45,9 @@ def benchmark_set_block(seed: int, index: int, *, face_px: int = 512, size_range
         field = cut_block(log, size, **placement)
     name = f"block_{i:04d}"
     info = {"name": name, "index": i, "size_mm": list(size), "knotted": bool(knotted),
-            "ring_width_mm": log.ring_width_at(placement["distance_mm"]) if not knotted else None,
+            # a knotted log's rings are as wide at the block as anywhere (KnottedLogField):
+            # the index gave null for them, as if the width were unknown
+            "ring_width_mm": float(log.ring_width_at(placement["distance_mm"])),
             **{k: (float(v) if isinstance(v, (float, np.floating)) else v) for k, v in placement.items()}}
     wood = None if wood_factory is None else wood_factory(field)
     block = synth_block(field, size, wood=wood, face_px=face_px, rng=rng, seed=None, name=name,
