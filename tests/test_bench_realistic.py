@@ -40,6 +40,16 @@ def test_worst_cell_names_the_block_of_each_value():
     assert "50.0 / 70.0 (a)" in md
 
 
+def test_the_interval_is_printed_at_the_means_precision():
+    """A mean of 95.7 was printed beside '[96–96]': the interval had no decimals."""
+    def row(name, m):
+        return {"scenario": "noisy", "faces": "full", "kind": "clear", "name": name,
+                "radial": {"matched_1": m, "matched_2": m, "fit_s": 1.0, "fit_cpu_s": 1.0}}
+
+    md = markdown(summarise([row("a", 95.6), row("b", 95.8)], ["radial"]), ["radial"])
+    assert "| 95.7 [95.6–95.8] | 95.7 [95.6–95.8] |" in md
+
+
 def test_bootstrap_interval_brackets_the_mean():
     lo, hi = bootstrap_ci([80.0, 90.0, 100.0, 70.0])
     assert lo < 85.0 < hi and 70 <= lo and hi <= 100

@@ -204,8 +204,10 @@ def markdown(summary: list[dict], methods) -> str:
                      if s["matched_1_worst_block"] == s["matched_2_worst_block"] else
                      f"{s['matched_1_worst']:.1f} ({s['matched_1_worst_block']}) / "
                      f"{s['matched_2_worst']:.1f} ({s['matched_2_worst_block']})")
-            cells += [f"{s['matched_1']:.1f} [{s['matched_1_ci'][0]:.0f}–{s['matched_1_ci'][1]:.0f}]",
-                      f"{s['matched_2']:.1f} [{s['matched_2_ci'][0]:.0f}–{s['matched_2_ci'][1]:.0f}]", worst]
+            # the interval at the mean's precision: '95.7 [96–96]' put the mean outside its own
+            # interval
+            cells += [f"{s[c]:.1f} [{s[c + '_ci'][0]:.1f}–{s[c + '_ci'][1]:.1f}]"
+                      for c in ("matched_1", "matched_2")] + [worst]
         cells += [f"{g[m]['fit_s_median']:.1f} / {g[m]['fit_cpu_s_median']:.1f}" for m in methods]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
