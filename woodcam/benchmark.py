@@ -206,8 +206,9 @@ def run_bench(out_dir: str | Path, blocks: int, seed: int, settings: dict | None
 
     ``out_dir/run.json`` holds the seed and settings; running again into the same folder with the
     same seed and settings computes only the blocks without a record, and a different seed or
-    settings is refused (a run folder holds one experiment). Returns the
-    :class:`woodcam.scale.RunSummary`.
+    settings is refused (a run folder holds one experiment). The order of ``methods`` is not a
+    setting: the same methods in another order resume the run in its recorded order. Returns
+    the :class:`woodcam.scale.RunSummary`.
     """
     from .scale import check_manifest, run_many
 
@@ -216,11 +217,26 @@ def run_bench(out_dir: str | Path, blocks: int, seed: int, settings: dict | None
     settings = bench_settings() if settings is None else bench_settings(**settings)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    settings = _recorded_method_order(out / RUN_MANIFEST, settings)
     check_manifest(out / RUN_MANIFEST, {"format": "woodcam-bench-run", "version": 1, "seed": int(seed),
                                         "settings": settings})
     keys = [bench_key(i) for i in range(start, start + blocks)]
     return run_many(partial(_bench_task, seed=int(seed), settings=settings), keys, out,
                     desc="bench blocks", **run_options)
+
+
+def _recorded_method_order(manifest: Path, settings: dict) -> dict:
+    """``settings`` with its methods in the order ``manifest`` (a run's run.json) records, when
+    they are the same methods: every method is fitted and scored on its own, so the order
+    changes no result, and ``--methods rbf,radial`` into a run of ``radial,rbf`` was refused as
+    other settings. Anything else (no manifest, other methods) is left to check_manifest."""
+    try:
+        recorded = json.loads(manifest.read_text())["settings"]["methods"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return settings
+    if isinstance(recorded, list) and sorted(map(str, recorded)) == sorted(settings["methods"]):
+        return {**settings, "methods": list(recorded)}
+    return settings
 
 
 def bench_gallery(seed: int, index: int, settings: dict, out_dir, *, planes: bool = True,

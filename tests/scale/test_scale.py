@@ -75,6 +75,21 @@ def test_rerun_with_other_settings_is_refused(tmp_path):
         run_bench(tmp_path, 1, seed=5, settings=tiny, engine="local", workers=1, progress=False)
 
 
+def test_the_same_methods_in_another_order_resume_the_run(tmp_path):
+    """``--methods rbf,radial`` into a run made with ``radial,rbf`` was refused as other
+    settings; the order is no setting: the run resumes in its recorded order."""
+    from woodcam.benchmark import RUN_MANIFEST, run_bench
+
+    tiny = {**TINY, "knotted_fraction": 0.0, "face_px": 32}
+    kw = dict(engine="local", workers=1, progress=False)
+    run_bench(tmp_path, 1, seed=4, settings={**tiny, "methods": ["radial", "rbf"]}, **kw)
+    s = run_bench(tmp_path, 1, seed=4, settings={**tiny, "methods": ["rbf", "radial"]}, **kw)
+    assert (s.skipped, s.done) == (1, 0)
+    assert json.loads((tmp_path / RUN_MANIFEST).read_text())["settings"]["methods"] == ["radial", "rbf"]
+    with pytest.raises(WoodcamError, match=r"settings.methods \['radial', 'rbf'\] there, \['rbf'\] now"):
+        run_bench(tmp_path, 1, seed=4, settings={**tiny, "methods": ["rbf"]}, **kw)
+
+
 # -- resuming after kill -9 -----------------------------------------------------------------------
 
 def test_kill9_mid_run_then_rerun_recomputes_nothing_and_loses_nothing(tmp_path):
