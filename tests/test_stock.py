@@ -146,3 +146,24 @@ def test_a_turn_given_to_a_command_that_reads_the_block_is_named():
     with pytest.raises(WoodcamError, match=r"a turn \('~z90'\) is for the commands that carve a part from "
                        r"the block \(bake, gcode, place, review\); .* give 'builtin:flat-sawn'"):
         open_block("builtin:flat-sawn~z90")
+
+
+def test_a_photo_keyword_on_a_stock_without_photos_is_refused_naming_every_unknown(tmp_path):
+    """``anchor`` fits colours to photos: a built-in block (or a folder without photos) calls the
+    colour map's constructor alone, and ``anchor='field'`` was a bare TypeError there; only the
+    first of several unknown keywords was named."""
+    from woodcam.block.io import write_block
+    from woodcam.fields.builtin import builtin_block
+    from woodcam.synth import synth_block
+
+    with pytest.raises(WoodcamError, match=r"got 'anchor'; anchor fits colours to face photos, which block "
+                                           r"spec 'builtin:flat-sawn' has none of: drop it"):
+        open_stock("builtin:flat-sawn~z90", anchor="field")
+    with pytest.raises(WoodcamError, match=r"got 'anchor', 'bar', 'foo';.*drop it; check the spelling of 'bar', 'foo'"):
+        open_stock("builtin:flat-sawn", foo=1, anchor="field", bar=2)
+    block = synth_block(builtin_block("flat-sawn").field, (20, 20, 20), face_px=16, seed=0)
+    for face in block.faces.values():
+        face.photo = None
+    write_block(block, tmp_path / "b")
+    with pytest.raises(WoodcamError, match=r"without photos.*got 'anchor'; anchor fits colours to face photos"):
+        open_stock(str(tmp_path / "b"), anchor="field")

@@ -120,8 +120,12 @@ def open_stock(spec: str, *, species: str | None = None,
     """
     if appearance not in ("colormap", "neural"):
         raise WoodcamError(f"appearance must be one of ['colormap', 'neural']; got {appearance!r}")
-    _check_appearance_params(appearance, appearance_params)
     base, turns = _split_turns(spec)
+    # built-in, log and woodify blocks have no photos: their colour map is the constructor's
+    # (a folder's photos are known once it is read: _real_block_stock checks again)
+    _check_appearance_params(appearance, appearance_params,
+                             photos=not base.startswith(("builtin:", "log:", "woodify:")),
+                             where=f"block spec {base!r}")
     stock = _open_base_stock(base, species, appearance, appearance_params)
     stock.meta["appearance_params"] = {k: (list(v) if isinstance(v, tuple) else v)
                                        for k, v in appearance_params.items()
@@ -134,9 +138,17 @@ def open_stock(spec: str, *, species: str | None = None,
     return Stock(spec, size, wood, stock.description, {**stock.meta, "turns": turns})
 
 
-def _check_appearance_params(appearance: str, params: dict) -> None:
+def _check_appearance_params(appearance: str, params: dict, *, photos: bool = True,
+                             where: str = "") -> None:
     """Refuse a keyword the chosen appearance does not take, before any fit (``foo=1`` was a
-    bare TypeError deep inside, after the block was read)."""
+    bare TypeError deep inside, after the block was read).
+
+    photos : whether the stock's colour map is fitted to face photos
+        (:meth:`ColorMapAppearance.fit_to_block`, which also takes ``anchor``); a stock without
+        photos (built-in, log and woodify blocks, a folder without photos) calls the
+        :class:`ColorMapAppearance` constructor alone. Ignored for ``"neural"``.
+    where : what the stock is, named in the message (e.g. ``"block spec 'builtin:flat-sawn'"``).
+    """
     from collections.abc import Callable
     import inspect
 
@@ -145,14 +157,28 @@ def _check_appearance_params(appearance: str, params: dict) -> None:
         from .appearance.neural import fit_neural_appearance
 
         targets = [fit_neural_appearance]
-    else:  # a block's photos go through fit_to_block (anchor=) to the constructor
+    elif photos:  # a block's photos go through fit_to_block (anchor=) to the constructor
         targets = [ColorMapAppearance, ColorMapAppearance.fit_to_block]
+    else:
+        targets = [ColorMapAppearance]
     taken = {k for t in targets for k, p in inspect.signature(t).parameters.items()
              if p.kind is not p.VAR_KEYWORD} - {"self", "cls", "species", "block", "field"}
     unknown = sorted(set(params) - taken)
     if unknown:
-        raise WoodcamError(f"open_stock: appearance_params must be parameters of the {appearance} "
-                           f"appearance ({', '.join(sorted(taken))}); got {unknown[0]!r}; check its spelling")
+        without = appearance != "neural" and not photos
+        kind = f"{appearance} appearance" + (" of a stock without photos" if without else "")
+        got = ", ".join(repr(k) for k in unknown)
+        photo_only = [k for k in unknown
+                      if without and k in inspect.signature(ColorMapAppearance.fit_to_block).parameters]
+        fixes = [f"{', '.join(photo_only)} fit{'s' if len(photo_only) == 1 else ''} colours to face "
+                 f"photos, which {where or 'this stock'} has none of: drop {'it' if len(photo_only) == 1 else 'them'}"
+                 ] if photo_only else []
+        misspelt = [k for k in unknown if k not in photo_only]
+        if misspelt:
+            fixes.append(f"check the spelling of {', '.join(repr(k) for k in misspelt)}")
+        fix = "; ".join(fixes)
+        raise WoodcamError(f"open_stock: appearance_params must be parameters of the {kind} "
+                           f"({', '.join(sorted(taken))}); got {got}; {fix}")
 
 
 def spec_path(spec: str) -> Path | None:
@@ -436,6 +462,7 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
                           "without photos)", WoodcamWarning, stacklevel=2)
         app = ColorMapAppearance.fit_to_block(block, field, species or "oak", **appearance_params)
     else:
+        _check_appearance_params(appearance, appearance_params, photos=False, where=f"block {block.name!r}")
         app = ColorMapAppearance(species or "oak", **appearance_params)
     meta = {**dict(block.meta), "appearance": appearance, "species": species or "oak"}
     return Stock(spec, block.size_mm, Wood(field, app), block.name, meta)
