@@ -352,6 +352,28 @@ def test_cadquery_scripts_showing_result_and_assemblies(tmp_path, cq):
     np.testing.assert_allclose(solid.bounding_box(), (20, 30, 15, 80, 50, 35), atol=1e-6)
 
 
+def test_a_script_showing_objects_in_a_loop_loads_them_all(tmp_path):
+    """`for part in parts: show_object(part)` loaded only the last (`part` won, 1000 mm^3 of
+    2000, no word): the shown objects win; a `part` not among them is named in a warning."""
+    import warnings
+
+    from woodcam.errors import WoodcamWarning
+
+    loop = tmp_path / "loop.py"
+    loop.write_text("import manifold3d\n"
+                    "parts = [manifold3d.Manifold.cube((10, 10, 10)).translate((x, 0, 0)) for x in (0, 20)]\n"
+                    "for part in parts:\n    show_object(part)\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert load_part(loop).volume() == pytest.approx(2000, rel=1e-12)
+    other = tmp_path / "other.py"
+    other.write_text("import manifold3d\npart = manifold3d.Manifold.cube((10, 10, 10))\n"
+                     "show_object(manifold3d.Manifold.cube((2, 2, 2)))\n")
+    with pytest.warns(WoodcamWarning, match=r"defines `part` and passes 1 other object to show_object: "
+                                            r"loaded what it shows.*pass it to show_object too"):
+        assert load_part(other).volume() == pytest.approx(8, rel=1e-12)
+
+
 def test_python_script_with_trimesh_part(tmp_path):
     script = tmp_path / "mesh_part.py"
     script.write_text("import trimesh\npart = trimesh.creation.box(extents=(2, 3, 4))\n")

@@ -18,7 +18,7 @@ Accepted sources (:func:`load_part`):
   the block frame, and another program's glTF whose part spans under 1 unit, read as the glTF
   spec's metres with +Y up, with a warning), or a ``.py`` script that defines a
   module-level ``part`` (any of the objects above) or, as in CQ-editor, passes it to
-  ``show_object`` (several calls: their union);
+  ``show_object`` (several calls: their union; what is shown wins over ``part``);
 - a cadquery ``Assembly`` (its parts where it places them).
 
 B-rep shapes (build123d, cadquery, STEP) are tessellated with OpenCascade's
@@ -104,7 +104,8 @@ def load_part(
         | trimesh.Scene | manifold3d.Manifold | list of these | str | Path
         The part, modelled in the block frame in millimetres, or a path to a ``.step``/``.stp``,
         ``.stl``, ``.obj``, ``.glb``/``.gltf`` file or a ``.py`` script defining ``part``
-        or passing it to ``show_object`` (CQ-editor's convention; ``part`` wins) (run with ``runpy`` under the name ``"__woodcam_part__"``, so its
+        or passing it to ``show_object`` (CQ-editor's convention: the union of the shown
+        objects, which win over ``part``; a ``part`` not among them is named in a warning) (run with ``runpy`` under the name ``"__woodcam_part__"``, so its
         ``if __name__ == "__main__":`` block does not run; its folder is on ``sys.path``
         meanwhile so it can import helpers next to it).
     tolerance_mm : float or None
@@ -312,7 +313,20 @@ def _load_script(path: Path, tess: "_Tessellation"):
     finally:
         if folder in sys.path:
             sys.path.remove(folder)
-    if "part" not in namespace and shown:
+    if shown:
+        # What the script shows is what its author saw in CQ-editor: it wins over a `part`
+        # variable, which may be a loop variable (`for part in parts: show_object(part)` loaded
+        # only the last) or an intermediate; a `part` not among them is named, not dropped.
+        if "part" in namespace and not any(namespace["part"] is obj for obj in shown):
+            import warnings
+
+            from ..errors import WoodcamWarning
+
+            warnings.warn(WoodcamWarning(
+                f"part script {str(path)!r} defines `part` and passes {len(shown)} other "
+                f"object{'s' if len(shown) > 1 else ''} to show_object: loaded what it shows (as "
+                f"CQ-editor does), not `part`; to load `part`, pass it to show_object too or "
+                f"remove the show_object calls"), stacklevel=5)
         part = shown[0] if len(shown) == 1 else shown
         origin = f"what script {str(path)!r} passes to show_object"
     elif "part" not in namespace:
