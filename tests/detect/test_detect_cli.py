@@ -462,3 +462,30 @@ def test_rings_detect_warns_of_a_face_photographed_turned(tmp_path, capsys, synt
     assert rc == 0 and "looks turned" not in out
     rc, out, _ = _run(capsys, "block", "show", good, "--check-layout", "--out", tmp_path / "y.png")
     assert rc == 0 and "layout: 6 faces checked, none looks turned or mirrored" in out
+
+
+def test_a_photo_only_block_with_a_turned_face_warns_wherever_it_is_detected(tmp_path, capsys, monkeypatch,
+                                                                             synth_photos):
+    """fit, bake, eval and open_stock detect a photo-only folder through with_detected_rings,
+    which did not check the layout (only rings detect did): a turned face ruined the fit without
+    a word. Now it warns each time (the cached detection too); the CLI says it once."""
+    import warnings
+
+    from woodcam.block.photos import block_from_photos
+    from woodcam.detect.block import with_detected_rings
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    photos = _copy(synth_photos, tmp_path / "photos")
+    Image.open(photos / "top.png").rotate(-90).save(photos / "top.png")
+    block = block_from_photos(photos, (50.0, 50.0, 50.0))
+    for run in ("detected", "cache hit"):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            with_detected_rings(block)
+        turned = [str(w.message) for w in caught if "looks turned" in str(w.message)]
+        assert len(turned) == 1 and turned[0].startswith("face 'top' looks turned 90 degrees clockwise"), run
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", photos, "--size-mm", "50", "--out", blk)[0] == 0
+    monkeypatch.setattr("woodcam.cli._printed", set())  # an earlier test's main() printed it already
+    rc, _, err = _run(capsys, "block", "show", blk, "--check-layout", "--out", tmp_path / "x.png")
+    assert rc == 0 and err.count("face 'top' looks turned 90 degrees clockwise") == 1, err

@@ -298,7 +298,9 @@ def with_detected_rings(block: Block, rule: BoundaryRule = DEFAULT_RULE, *, cach
                         progress: bool = False) -> Block:
     """``block`` itself when it has rings; otherwise a copy with rings and knots detected on its
     photos, computed once and cached by content (module docstring; :mod:`woodcam._cache`).
-    Warnings naming faces are issued as :class:`~woodcam.errors.WoodcamWarning` each time."""
+    Warnings naming faces, and a face that looks turned or mirrored
+    (:func:`~woodcam.detect.layout.check_face_layout`), are issued as
+    :class:`~woodcam.errors.WoodcamWarning` each time."""
     if not needs_detection(block):
         return block
 
@@ -326,6 +328,10 @@ def with_detected_rings(block: Block, rule: BoundaryRule = DEFAULT_RULE, *, cach
                             extras={**f.extras, **extras})
     out.meta = {**block.meta, "detection": {"detector": DEFAULT_DETECTOR, "version": DETECT_VERSION,
                                             "rule": rule, "faces": sorted(faces)}}
+    # A face photographed turned or mirrored ruins the fit without a word otherwise (detect_folder
+    # checked; fit, bake, eval and open_stock came here). Checked on every call, cache hit too (a
+    # cached entry made before the check would say nothing); the CLI prints a warning once.
+    msgs = [*msgs, *check_face_layout(out).warnings]
     for w in msgs:
         warnings.warn(w, WoodcamWarning, stacklevel=2)
     return out
