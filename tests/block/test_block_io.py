@@ -161,3 +161,30 @@ def test_write_block_refuses_what_read_block_would_refuse(tmp_path):
     with pytest.raises(WoodcamError, match=r"grey \(h, w\) or RGB \(h, w, 3\)"):
         write_block(Block((10, 10, 10), faces={"top": rgba}), tmp_path / "b")
     assert not (tmp_path / "a" / "block.json").exists() and not (tmp_path / "b" / "block.json").exists()
+
+
+def test_a_ragged_saved_field_is_refused_with_one_fix_naming_the_file(tmp_path):
+    """A ragged r_minus in a RadialScalingField state was a bare ValueError (only KeyError,
+    TypeError and IndexError were caught), and the block reader's message offered two fixes."""
+    from woodcam.fields import LogFrame
+    from woodcam.fields.radial import RadialScalingField, RadiusFunction
+    from woodcam.fields.state import field_from_state, field_to_state
+
+    field = RadialScalingField(LogFrame((0, 0, -50), (0, 0, 1)), 3.0, RadiusFunction(np.ones(16)),
+                               RadiusFunction(np.ones(16)))
+    state = field_to_state(field)
+    state["state"]["r_minus"] = [[1, 2], [3]]
+    with pytest.raises(WoodcamError, match=r"incomplete or malformed \(ValueError: .*\); pass what "
+                                           r"field_to_state returned for it$"):
+        field_from_state(state)
+    write_block(Block((10, 10, 10), true_field=field), tmp_path / "b")
+    (saved,) = [p for p in (tmp_path / "b").iterdir() if p.suffix == ".json" and p.name != "block.json"]
+    raw = json.loads(saved.read_text())
+    raw["r_minus"] = [[1, 2], [3]]
+    saved.write_text(json.dumps(raw))
+    with pytest.raises(WoodcamError) as err:
+        read_block(tmp_path / "b")
+    msg = str(err.value)
+    assert msg.startswith(f"true field {str(saved)!r}: the saved state of field type") and "ValueError" in msg
+    assert msg.endswith(f"; write the block again (woodcam.block.write_block) to replace {saved.name}")
+    assert msg.count("; ") == 1 and "drop the file" not in msg and "returned for it" not in msg

@@ -277,12 +277,14 @@ def _read_field(entry, path: Path | None):
     from .._readers import read_json_file
 
     state = read_json_file(path, "true field of the block")
+    fix = f"write the block again (woodcam.block.write_block) to replace {path.name}"
     try:
-        return field_from_state({"type": entry["type"], "state": state})
+        return field_from_state({"type": entry["type"], "state": state}, fix=fix)
+    except WoodcamError as err:  # it says what is wrong, and the fix naming the file
+        raise WoodcamError(f"true field {str(path)!r}: {err}") from err
     except (KeyError, TypeError, ValueError, IndexError, AttributeError) as err:
-        why = str(err) if isinstance(err, WoodcamError) else f"{type(err).__name__}: {err}"
         raise WoodcamError(f"true field {str(path)!r} does not hold a valid {entry['type']} "
-                           f"({why}); rewrite the block or drop the file") from err
+                           f"({type(err).__name__}: {err}); {fix}") from err
 
 
 # -- images ---------------------------------------------------------------------------------------

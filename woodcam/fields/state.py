@@ -65,15 +65,21 @@ def field_to_state(field) -> dict:
 _MOVED = {"woodcam.synth:AnalyticLogField": "woodcam.fields.analytic:AnalyticLogField"}
 
 
-def field_from_state(d: dict):
-    """Inverse of :func:`field_to_state`."""
+def field_from_state(d: dict, *, fix: str | None = None):
+    """Inverse of :func:`field_to_state`.
+
+    fix : the fix a malformed ``d`` is refused with (a type this version lacks says "upgrade
+        woodcam" whatever it is); default for a library caller ("pass what field_to_state
+        returned"). A reader of a file passes one naming the file.
+    """
     if not (isinstance(d, dict) and isinstance(d.get("type"), str) and isinstance(d.get("state"), dict)):
         raise WoodcamError(f"a saved field must be a dict {{'type': 'module:Class', 'state': {{...}}}}; got "
-                           f"{d!r:.200}; pass what field_to_state returned")
+                           f"{d!r:.200}; {fix or 'pass what field_to_state returned'}")
     kind = _MOVED.get(d["type"], d["type"])
     module, _, qualname = kind.partition(":")
     if not module.startswith("woodcam."):
-        raise WoodcamError(f"field type must be a woodcam class; got {kind!r}")
+        raise WoodcamError(f"field type must be a woodcam class; got {kind!r}; "
+                           f"{fix or 'pass what field_to_state returned'}")
     try:
         obj = importlib.import_module(module)
         for part in qualname.split("."):
@@ -85,6 +91,10 @@ def field_from_state(d: dict):
         ) from err
     try:
         return obj.from_dict(d["state"])
-    except (KeyError, TypeError, IndexError) as err:  # a state missing a key or of the wrong kind
+    except WoodcamError:  # a ValueError too: already says what is wrong
+        raise
+    except (KeyError, TypeError, IndexError, ValueError, AttributeError) as err:
+        # a state missing a key, of the wrong kind, or ragged (np.asarray of [[1, 2], [3]])
         raise WoodcamError(f"the saved state of field type {kind!r} is incomplete or malformed "
-                           f"({type(err).__name__}: {err}); pass what field_to_state returned for it") from err
+                           f"({type(err).__name__}: {err}); "
+                           f"{fix or 'pass what field_to_state returned for it'}") from err
