@@ -64,3 +64,15 @@ def test_builtin_blocks_have_many_rings(name, rng):
 def test_unknown_builtin():
     with pytest.raises(WoodcamError, match="unknown built-in block 'oak-burl'"):
         builtin_block("oak-burl")
+
+
+@pytest.mark.parametrize("lo, hi, match", [
+    ("a", (1, 1, 1), r"lo_mm must be three finite numbers \(x, y, z\); got 'a'; the box's low corner"),
+    ((0, 0, 0), (np.nan, 1, 1), r"hi_mm must be three finite numbers .*got \(nan, 1, 1\)"),
+    ((0, 0), (1, 1, 1), r"lo_mm must be three finite numbers"),
+    ((0, 0, 5), (1, 1, 1), r"hi_mm must exceed lo_mm on every axis"),
+])
+def test_bake_refuses_a_box_that_is_not_two_corners(lo, hi, match):
+    """'a' was a bare ValueError and a NaN corner a misleading grid-size (MAX_GRID_CELLS) message."""
+    with pytest.raises(WoodcamError, match=match):
+        GridField.bake(builtin_block("flat-sawn").field, lo, hi, 2.0)

@@ -115,9 +115,12 @@ class GridField:
         nodes in a forked process, for a field safe to use after a fork
         (:func:`~woodcam.fields.base.evaluate`).
         """
-        lo, hi = np.asarray(lo_mm, float), np.asarray(hi_mm, float)
-        if lo.shape != (3,) or hi.shape != (3,) or np.any(hi <= lo):
-            raise WoodcamError(f"lo_mm < hi_mm must be 3-vectors; got {lo_mm!r}, {hi_mm!r}")
+        # 'a' was a bare ValueError, NaN a misleading grid-size message
+        lo = check_vector(lo_mm, "lo_mm", fix="the box's low corner in mm, e.g. (0, 0, 0)")
+        hi = check_vector(hi_mm, "hi_mm", fix="the box's high corner in mm, e.g. (50, 40, 30)")
+        if np.any(hi <= lo):
+            raise WoodcamError(f"hi_mm must exceed lo_mm on every axis; got lo_mm={lo_mm!r}, "
+                               f"hi_mm={hi_mm!r}; swap them or widen the box")
         spacing_mm = check_number(spacing_mm, "spacing_mm", lo=0, lo_open=True,
                                   fix="pass one node spacing in mm, e.g. 2.0")
         margin_nodes = check_number(margin_nodes, "margin_nodes", lo=0, integer=True, fix="e.g. 2")
