@@ -65,7 +65,8 @@ def test_place_warns_of_a_part_in_inches_and_advises_only_what_is_left(knotty):
     rotations'."""
     from woodcam.errors import WoodcamWarning
 
-    with pytest.warns(WoodcamWarning, match="25.4 times larger it would still fit.*scale:25.4"):
+    with pytest.warns(WoodcamWarning, match=r"25.4 times larger it would still fit.*in inches scale it first: "
+                                           r"woodcam.cad.place.place_part\(part, \['scale:25.4'\]"):
         advise_placement(manifold3d.Manifold.cube([3.0, 2.0, 0.5]), knotty, candidates=8)
     with pytest.raises(WoodcamError, match="with a 1 mm margin; a smaller margin .--margin. or a bigger block"):
         advise_placement(manifold3d.Manifold.cube([120.0, 10.0, 10.0]), knotty, rotations="all90")

@@ -169,3 +169,21 @@ def test_meshing_options_on_a_mesh_part_are_said_to_be_ignored(tmp_path, capsys)
     assert "box.stl is a triangle mesh, baked as it is: ignored" in err
     assert main([*argv, "--out", str(tmp_path / "b.glb")]) == 0
     assert "ignored" not in capsys.readouterr().err
+
+
+def test_a_part_in_inches_gets_each_commands_own_fix(tmp_path, capsys, monkeypatch):
+    """The warning of a part in inches told `woodcam place` (no --place option) and library
+    callers of carve() to 'add --place scale:25.4 --place center': each caller says its own."""
+    monkeypatch.setattr("woodcam.cli._printed", set())  # another test's main() may have printed it
+    part = tmp_path / "tray_inches.stl"
+    trimesh.creation.box((3.0, 2.0, 0.5)).apply_translation((50, 40, 25)).export(part)
+    assert main(["bake", str(part), "--block", "builtin:knotty", "--out", str(tmp_path / "t.glb"),
+                 "--texels-per-mm", "2", "--no-obj"]) == 0
+    err = capsys.readouterr().err
+    assert "25.4 times larger it would still fit" in err
+    assert "if it was modelled in inches add --place scale:25.4 --place center (in metres: scale:1000)" in err
+    assert main(["place", str(part), "--block", "builtin:knotty", "--candidates", "8", "--top", "1",
+                 "--out", str(tmp_path / "place")]) == 0
+    err = capsys.readouterr().err
+    assert "if it was modelled in inches scale the part file by 25.4 in your CAD program" in err
+    assert "--place" not in err

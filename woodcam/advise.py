@@ -125,7 +125,9 @@ def _sample(mesh, count: int, rng):
 def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1000,
                      margin_mm: float = 1.0, samples: int = 1500,
                      weights: dict[str, float] | None = None, seed: int = 0,
-                     progress: bool = False) -> PlacementAdvice:
+                     progress: bool = False,
+                     units_fix: str = ("scale it first: woodcam.cad.place.place_part(part, ['scale:25.4'], "
+                                       "stock.size_mm) (in metres: 'scale:1000')")) -> PlacementAdvice:
     """Rank placements of ``part`` in ``stock`` (see module docstring).
 
     Parameters
@@ -147,6 +149,9 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
         Seed of the surface sample.
     progress : bool
         A progress bar over the orientations (:func:`woodcam._progress.progress_bar`).
+    units_fix : str
+        How to scale the part, in the warning of a part in inches
+        (:func:`woodcam.cad.carve.units_hint`; ``woodcam place`` names the CAD program).
     """
     from ._progress import progress_bar
 
@@ -163,7 +168,7 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
     centre = (lo + hi) / 2
     from .cad.carve import units_hint
 
-    hint = units_hint(lo, hi, stock.size_mm)
+    hint = units_hint(lo, hi, stock.size_mm, units_fix)
     if hint:  # ranking a speck's placements is no answer for a part exported in inches
         import warnings
 

@@ -118,14 +118,17 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
                  obj_up: str = "y", max_triangles: int | None = None,
                  max_atlas_px: int = 4096, place: list[str] | tuple = (),
-                 timeout_s: float | None = None, stages: StageBar | None = None) -> PartPreview:
+                 timeout_s: float | None = None, stages: StageBar | None = None,
+                 units_fix: str = "add 'scale:25.4' and 'center' to place (in metres: 'scale:1000')"
+                 ) -> PartPreview:
     """Carve ``source`` (anything :func:`woodcam.cad.load_part` takes) out of ``stock``, bake it
     and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``).
 
     ``place`` lists placement operations applied to the loaded part before carving
     (:mod:`woodcam.cad.place`, e.g. ``["rotate:x:90", "center", "drop"]``); the resulting
     4 x 4 matrix is recorded in the GLB metadata as ``placement``. A ``.py`` source is trusted
-    code run with your rights; ``timeout_s`` bounds its loading.
+    code run with your rights; ``timeout_s`` bounds its loading. ``units_fix``: how to scale a part
+    in inches, in its warning (:func:`woodcam.cad.carve.units_hint`; the CLI names ``--place``).
 
     ``progress`` draws a bar of its stages (:func:`part_stages`) on a terminal, or advances
     ``stages`` (a :class:`woodcam._progress.StageBar` whose plan holds them) when given."""
@@ -152,7 +155,7 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
             part, matrix = place_part(part, list(place), stock.size_mm)
             metadata = {"placement": {"ops": list(place), "matrix": matrix.tolist()}}
         with result.stage("carve"):
-            carved = carve(part, stock.size_mm)
+            carved = carve(part, stock.size_mm, units_fix=units_fix)
         result.warnings += list(carved.warnings)
         return preview_mesh(carved.mesh, stock, out_glb, texels_per_mm=texels_per_mm, obj=obj,
                             part_report=True,

@@ -69,7 +69,8 @@ def test_a_part_in_inches_read_as_mm_says_how_to_scale_it():
     3.5 x 2.8 x 0.7 mm speck, which was carved and reported ('0 mm^3') without a word."""
     tray = manifold3d.Manifold.cube((90, 70, 18)).translate((5, 5, 2)).scale([1 / 25.4] * 3)
     with pytest.warns(WoodcamWarning, match=r"only 3.54x2.76x0.709 mm in the 100x80x50 mm block: "
-                      r"25.4 times larger it would still fit.*--place scale:25.4 --place center"):
+                      r"25.4 times larger it would still fit.*in inches scale it before carving: "
+                      r"woodcam.cad.place.place_part\(part, \['scale:25.4', 'center'\], size_mm\)"):
         result = carve(tray, DEMO_BLOCK_MM)
     assert any("25.4 times larger" in w for w in result.warnings)
     # a small part that would not fit 25.4 x larger is taken as meant

@@ -59,12 +59,18 @@ class CarveResult:
     size_mm: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
+#: How a library caller scales a part read 25.4 x too small (:func:`units_hint`'s default fix).
+UNITS_FIX = ("scale it before carving: woodcam.cad.place.place_part(part, ['scale:25.4', 'center'], "
+             "size_mm) (in metres: 'scale:1000')")
+
+
 def carve(
     part: Any,
     size_mm: ArrayLike,
     *,
     tolerance_mm: float | None = None,
     angular_tolerance_deg: float = TESSELLATION_ANGLE_DEG,
+    units_fix: str = UNITS_FIX,
 ) -> CarveResult:
     """Carve ``part`` out of the block ``[0, W] x [0, D] x [0, H]`` (block frame, mm).
 
@@ -77,6 +83,9 @@ def carve(
         Block size ``(W, D, H)`` in mm, each finite and > 0.
     tolerance_mm, angular_tolerance_deg : float (tolerance_mm None: scaled to the part)
         Tessellation tolerances passed to :func:`load_part` for B-rep sources.
+    units_fix : str
+        How to scale the part, in the warning of a part in inches (:func:`units_hint`; default
+        for a library caller: ``place_part`` ops).
 
     Returns
     -------
@@ -134,7 +143,7 @@ def carve(
         )
         messages.append(message)
         warnings.warn(message, WoodcamWarning, stacklevel=2)
-    message = units_hint(*_bounds(solid), size)
+    message = units_hint(*_bounds(solid), size, units_fix)
     if message:
         messages.append(message)
         warnings.warn(message, WoodcamWarning, stacklevel=2)
@@ -157,10 +166,13 @@ def carve(
     )
 
 
-def units_hint(lo, hi, size_mm) -> str | None:
+def units_hint(lo, hi, size_mm, fix: str = UNITS_FIX) -> str | None:
     """What to say when a part with bounds ``lo, hi (3,)`` mm would still fit the block
     ``size_mm (3,)`` 25.4 times larger (None otherwise): STL and OBJ carry no units, so a part
-    exported in inches is read 25.4 x too small and carved or placed as a speck."""
+    exported in inches is read 25.4 x too small and carved or placed as a speck.
+
+    fix : how the caller's user scales the part by 25.4 (the command's option, or the library
+        call); the CLI's ``--place`` is no use to ``woodcam place`` or a library caller."""
     extent = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
     size = np.asarray(size_mm, dtype=float)
     if not np.all(np.sort(extent) * MM_PER_UNIT["inch"] <= np.sort(size)):
@@ -168,8 +180,7 @@ def units_hint(lo, hi, size_mm) -> str | None:
     return (f"the part is only {'x'.join(f'{v:.3g}' for v in extent)} mm in the "
             f"{'x'.join(f'{v:g}' for v in size)} mm block: 25.4 times larger it would still fit. "
             "Part files are read as millimetres (STL and OBJ carry no units); if it was modelled "
-            "in inches add --place scale:25.4 --place center (in metres: scale:1000), or export "
-            "it in mm")
+            f"in inches {fix}, or export it in mm")
 
 
 def _bounds(solid) -> tuple[np.ndarray, np.ndarray]:

@@ -123,7 +123,8 @@ def run_bake(args: argparse.Namespace) -> int:
                            tolerance_mm=args.tolerance, timeout_s=args.timeout, obj=not args.no_obj,
                            screenshot=False, progress=True, obj_units=args.obj_units, obj_up=args.obj_up,
                            max_triangles=args.max_triangles, max_atlas_px=args.max_atlas,
-                           place=args.place, stages=bar)
+                           place=args.place, stages=bar,
+                           units_fix="add --place scale:25.4 --place center (in metres: scale:1000)")
         if shot:
             with bar.stage("render"):
                 write_screenshot(args, res.files, stock)

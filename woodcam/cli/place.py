@@ -57,7 +57,8 @@ def run_place(args: argparse.Namespace) -> int:
             part = load_part(args.part)
         with bar.stage("score placements"):
             advice = advise_placement(part, stock, rotations=args.rotations,
-                                      candidates=args.candidates, margin_mm=args.margin, progress=True)
+                                      candidates=args.candidates, margin_mm=args.margin, progress=True,
+                                      units_fix="scale the part file by 25.4 in your CAD program (in metres: by 1000)")
         k = 1 / MM_PER_UNIT[args.units]
         record = {"block": args.block, "part": str(args.part), "candidates": advice.candidates,
                   "weights": advice.weights, "elongation": advice.elongation,
