@@ -490,3 +490,15 @@ def test_a_large_part_stays_under_the_triangle_budget(bd):
     load_part(sphere, texels_per_mm=1.0, max_triangles=12_000, report=coarse)
     assert coarse["notes"] == [] and coarse["triangles"] <= 12_000
     assert coarse["tolerance_mm"] == pytest.approx(0.25)
+
+
+def test_shells_beside_a_solid_are_named_not_dropped_silently(tmp_path, bd):
+    """Shells were used only when there was no solid: a STEP (or compound) with a solid and a
+    separate shell body lost the shell without a word."""
+    solid = bd.Pos(20, 20, 20) * bd.Box(10, 10, 10)
+    shell = bd.Shell((bd.Pos(60, 20, 20) * bd.Box(10, 10, 10)).faces())
+    path = tmp_path / "mixed.step"
+    bd.export_step(bd.Compound([solid, shell]), str(path))
+    with pytest.warns(WoodcamWarning, match=r"mixed.step' holds 1 solid and 1 shell \(surface body\) outside any "
+                                            r"solid: carved the solids only, the 1 shell left out; if it belongs"):
+        assert load_part(path).volume() == pytest.approx(1000, rel=1e-9)

@@ -638,16 +638,33 @@ def _manifold_from_topods(shape, tess: "_Tessellation", origin: str):
 
     if shape is None or shape.IsNull():
         raise WoodcamError(f"{origin} is an empty (null) shape; build a solid first")
-    solids = []
-    for kind in (TopAbs_SOLID, TopAbs_SHELL):
-        # no solid: a surface model (STEP from SketchUp, Blender or a mesh tool) bounds the part
-        # with shells; they are meshed like a mesh file (closed, or holes capped with a warning)
-        explorer = TopExp_Explorer(shape, kind)
+    def explore(kind, avoid=None):
+        explorer = TopExp_Explorer(shape, kind) if avoid is None else TopExp_Explorer(shape, kind, avoid)
+        found = []
         while explorer.More():
-            solids.append(explorer.Current())
+            found.append(explorer.Current())
             explorer.Next()
-        if solids:
-            break
+        return found
+
+    solids = explore(TopAbs_SOLID)
+    # shells outside every solid: with no solid, a surface model (STEP from SketchUp, Blender or
+    # a mesh tool) bounds the part with them, meshed like a mesh file (closed, or holes capped
+    # with a warning); beside solids they may be construction surfaces: left out, and said
+    shells = explore(TopAbs_SHELL, TopAbs_SOLID)
+    if solids and shells:
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        many = len(shells) > 1
+        warnings.warn(WoodcamWarning(
+            f"{origin} holds {len(solids)} solid{'s' if len(solids) > 1 else ''} and {len(shells)} "
+            f"shell{'s' if many else ''} (surface bod{'ies' if many else 'y'}) outside any solid: carved "
+            f"the solids only, {'those' if many else 'the'} {len(shells)} shell{'s' if many else ''} left "
+            f"out; if {'they belong' if many else 'it belongs'} to the part, sew "
+            f"{'them' if many else 'it'} into a solid in your CAD program"),
+            stacklevel=5)
+    solids = solids or shells
     if not solids:
         raise WoodcamError(
             f"{origin} contains no solid nor shell (only faces, wires or an empty compound); "
