@@ -126,3 +126,13 @@ def test_rings_show_of_a_block_whose_faces_round_at_zoom_2():
     size = (62.0, 43.5, 32.0)
     with pytest.raises(WoodcamError, match="must be .* px to share the density"):
         unfold_cross({"front": np.zeros((32, 62)), "top": np.zeros((87, 124))}, size)
+
+
+def test_block_to_pixel_names_the_shape_of_wrong_points_not_every_point():
+    """A (5000, 2) array of points printed all its numbers in the error message."""
+    with pytest.raises(WoodcamError, match=r"points_mm must have shape \(\.\.\., 3\) in mm; got shape "
+                                           r"\(5000, 2\); pass block points") as err:
+        block_to_pixel("top", np.zeros((5000, 2)), (9, 9), SIZE)
+    assert len(str(err.value)) < 200
+    with pytest.raises(WoodcamError, match=r"got 5\.0; pass block points"):
+        block_to_pixel("top", 5.0, (9, 9), SIZE)

@@ -146,7 +146,9 @@ def block_to_pixel(face: str, points_mm: ArrayLike, image_shape: ArrayLike,
     except (TypeError, ValueError):
         p = np.empty(0)
     if p.ndim == 0 or p.shape[-1] != 3:  # a scalar was an IndexError
-        raise WoodcamError(f"points_mm must have shape (..., 3) in mm; got {points_mm!r}; pass "
+        # the shape, not the points: a (100000, 2) array printed whole was the message
+        got = f"shape {p.shape}" if p.ndim and p.size else f"{points_mm!r:.80}"
+        raise WoodcamError(f"points_mm must have shape (..., 3) in mm; got {got}; pass "
                            "block points, e.g. [[10, 20, 5]]")
     # Each column of A has exactly one non-zero entry, so (u, v) is read off two coordinates.
     iu, iv = int(np.flatnonzero(A[:, 0])[0]), int(np.flatnonzero(A[:, 1])[0])
