@@ -5,10 +5,13 @@ Photos are files in one folder named by face: ``front.jpg``, ``top.png``, ... (a
 Mokume sample names ``A_col.png`` ...). Each must already be rectified to its face (cropped to
 the face's edges, seen from outside, oriented as ``docs/conventions.md`` says).
 
-Checks, each failing with one message naming the face: every face present (or ``partial``);
-one file per face; the image's aspect (rows / cols) within :data:`~woodcam.tolerances.FACE_PIXEL_ASPECT_RTOL`
-of the face's in ``size_mm``; not blank (luminance spread below :data:`BLANK_STD`), not over- or
-under-exposed (more than :data:`CLIPPED_SHARE` of the pixels at the ends of the range).
+Checks, each failing with one message naming the faces at fault: every face present (or
+``partial``); one file per face; the image's aspect (rows / cols) within
+:data:`~woodcam.tolerances.FACE_PIXEL_ASPECT_RTOL` of the face's in ``size_mm`` (every misfit in
+one message: photos not cropped to their face are seldom alone); not blank (luminance spread
+below :data:`BLANK_STD`), not over- or under-exposed (more than :data:`CLIPPED_SHARE` of the
+pixels at the ends of the range). An image file named for no face is named in a warning (or in
+the error when faces are missing), never passed over silently.
 Faces are resampled to one density (the lowest of the photos', at most ``max_px_per_mm``), so
 the faces unfold into one cross and ring widths are alike in pixels.
 """

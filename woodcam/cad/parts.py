@@ -139,7 +139,8 @@ def load_part(
     ------
     WoodcamError
         For an unsupported object or suffix, a missing or unreadable file, a script that fails
-        or does not define ``part``, empty geometry, or a mesh that is not a closed solid even
+        or neither defines ``part`` nor calls ``show_object`` (with a build123d/cadquery object,
+        a cadquery ``Assembly``, a mesh or a manifold), empty geometry, or a mesh that is not a closed solid even
         after repair (hole filling, normal fixing).
     """
     if tolerance_mm is not None and not (isinstance(tolerance_mm, Real)
@@ -263,7 +264,7 @@ def _load(source: Any, tess: "_Tessellation", origin: str):
     raise WoodcamError(
         f"{origin}: cannot use an object of type {type(source).__module__}."
         f"{type(source).__qualname__} as a part; pass a build123d Part/Solid/Compound, a cadquery "
-        f"Workplane/Shape, a trimesh.Trimesh, a manifold3d.Manifold, or a path to a file with "
+        f"Workplane/Shape/Assembly, a trimesh.Trimesh, a manifold3d.Manifold, or a path to a file with "
         f"suffix {', '.join(SUPPORTED_SUFFIXES)}"
     )
 
@@ -289,7 +290,9 @@ def _load_path(path: Path, tess: "_Tessellation"):
 
 
 def _load_script(path: Path, tess: "_Tessellation"):
-    """Run a part script (``runpy``, not as ``__main__``) and load its module-level ``part``."""
+    """Run a part script (``runpy``, not as ``__main__``) and load what it passes to
+    ``show_object`` (their union), else its module-level ``part``: any object :func:`_load`
+    takes (build123d, cadquery Workplane/Shape/Assembly, trimesh, manifold3d)."""
     folder = str(path.resolve().parent)
     shown: list = []
 

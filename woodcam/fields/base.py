@@ -135,11 +135,13 @@ class LogFrame:
     def __post_init__(self):
         object.__setattr__(self, "pith_point_mm", tuple(float(x) for x in check_vector(
             self.pith_point_mm, "pith_point_mm", fix="pass a block-frame point on the pith, mm")))
-        z = check_vector(self.axis, "axis", unit=True)
+        z = check_vector(self.axis, "axis", unit=True,
+                         fix="pass the log axis as a block-frame direction, e.g. (0, 0, 1)")
         ref = self.reference
         if ref is None:
             ref = (1.0, 0.0, 0.0) if abs(z[0]) < 0.9 else (0.0, 1.0, 0.0)
-        x = check_vector(ref, "reference", unit=True)
+        x = check_vector(ref, "reference", unit=True,
+                         fix="pass a block-frame direction across the axis, e.g. (1, 0, 0), or None")
         x = x - z * (x @ z)
         if np.linalg.norm(x) < 1e-9:
             raise WoodcamError(f"reference must not be parallel to axis; got {ref!r} and {self.axis!r}")
