@@ -9,8 +9,8 @@ import pytest
 from scipy.spatial import ConvexHull
 
 from woodcam.errors import WoodcamError
-from woodcam.view.section import (box_section_uv, check_vector, cut_segments, plane_basis,
-                                  signed_row_distance)
+from woodcam._checks import check_vector
+from woodcam.view.section import box_section_uv, cut_segments, plane_basis, signed_row_distance
 
 SIZE = np.array([100.0, 80.0, 40.0])
 REPO = Path(__file__).resolve().parents[1]

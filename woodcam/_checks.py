@@ -3,8 +3,9 @@
 A wrong type or shape must fail where it enters, as a :class:`~woodcam.errors.WoodcamError`
 naming the argument, the rule, the value received and a fix, not as a bare ``TypeError`` or
 broadcast error three calls down (or, worse, as a NaN result). Richer checks (points, sizes,
-faces, images) build on these in their own modules (:func:`woodcam.fields.base.check_points`,
-:func:`woodcam.frames.check_size`).
+image shapes) live in their own modules (:func:`woodcam.fields.base.check_points`,
+:func:`woodcam.frames.check_size`) and parse their input with :func:`as_floats`, as
+:func:`check_vector` does.
 """
 
 from __future__ import annotations
@@ -19,6 +20,15 @@ from .errors import WoodcamError
 
 def _fail(name: str, rule: str, value, fix: str):
     raise WoodcamError(f"{name} must be {rule}; got {value!r}" + (f"; {fix}" if fix else ""))
+
+
+def as_floats(value) -> np.ndarray | None:
+    """``value`` as a float array of any shape, or None where numpy cannot make one (a string
+    such as ``'a'``, a ragged list): the caller refuses it with its own message."""
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return None
 
 
 def check_number(value, name: str, *, lo: float | None = None, hi: float | None = None,
@@ -50,11 +60,8 @@ def check_vector(value, name: str, *, n: int = 3, unit: bool = False, fix: str =
     """``value`` as a float ``(n,)`` array of finite numbers; ``unit=True``: a non-zero
     direction, returned normalised to length 1."""
     what = "three finite numbers (x, y, z)" if n == 3 else f"{n} finite numbers"
-    try:
-        v = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        v = np.empty(0)
-    if v.shape != (n,) or not np.all(np.isfinite(v)):
+    v = as_floats(value)
+    if v is None or v.shape != (n,) or not np.all(np.isfinite(v)):
         _fail(name, what, value, fix)
     if unit:
         length = float(np.linalg.norm(v))

@@ -15,6 +15,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from ._checks import as_floats
 from ._types import ArrayLike
 from .errors import WoodcamError
 
@@ -65,11 +66,8 @@ def check_face(face: str) -> FaceName:
 
 def check_size(size_mm) -> np.ndarray:
     """Validate a block size ``(W, D, H)`` in mm and return it as a float array of shape (3,)."""
-    try:
-        size = np.asarray(size_mm, dtype=float)
-    except (TypeError, ValueError):
-        size = np.empty(0)
-    if size.shape != (3,) or not np.all(np.isfinite(size)) or np.any(size <= 0):
+    size = as_floats(size_mm)
+    if size is None or size.shape != (3,) or not np.all(np.isfinite(size)) or np.any(size <= 0):
         raise WoodcamError(
             f"size_mm must be three positive finite lengths (W, D, H) in mm; got {size_mm!r}; "
             "pass the block size, e.g. size_mm=(100, 80, 50)"
@@ -141,13 +139,10 @@ def block_to_pixel(face: str, points_mm: ArrayLike, image_shape: ArrayLike,
     face = check_face(face)
     n_rows, n_cols = _check_shape(image_shape)
     A, b = _affine(face, check_size(size_mm))
-    try:
-        p = np.asarray(points_mm, dtype=float)
-    except (TypeError, ValueError):
-        p = np.empty(0)
-    if p.ndim == 0 or p.shape[-1] != 3:  # a scalar was an IndexError
+    p = as_floats(points_mm)
+    if p is None or p.ndim == 0 or p.shape[-1] != 3:  # a scalar was an IndexError
         # the shape, not the points: a (100000, 2) array printed whole was the message
-        got = f"shape {p.shape}" if p.ndim and p.size else f"{points_mm!r:.80}"
+        got = f"shape {p.shape}" if p is not None and p.ndim and p.size else f"{points_mm!r:.80}"
         raise WoodcamError(f"points_mm must have shape (..., 3) in mm; got {got}; pass "
                            "block points, e.g. [[10, 20, 5]]")
     # Each column of A has exactly one non-zero entry, so (u, v) is read off two coordinates.
@@ -175,10 +170,10 @@ def _check_shape(image_shape) -> tuple[int, int]:
     """``(n_rows, n_cols)`` of ``image_shape`` (an image's ``.shape``: extra channel counts are
     ignored), whole pixel counts > 0; a scalar, a NaN or 10.7 rows is refused, not truncated."""
     try:
-        head = np.asarray(tuple(image_shape)[:2], dtype=float)
-    except (TypeError, ValueError):
-        head = np.empty(0)
-    if head.shape != (2,) or not np.all(np.isfinite(head)) or np.any(head <= 0) \
+        head = as_floats(tuple(image_shape)[:2])
+    except TypeError:  # not iterable: a scalar
+        head = None
+    if head is None or head.shape != (2,) or not np.all(np.isfinite(head)) or np.any(head <= 0) \
             or np.any(head != np.round(head)):
         raise WoodcamError(f"image_shape must be (n_rows, n_cols), whole pixel counts > 0; got "
                            f"{image_shape!r}; pass the face image's .shape")
@@ -240,11 +235,8 @@ def unfold_cross(images: dict, size_mm: ArrayLike, background: float | ArrayLike
             raise WoodcamError(f"image of face {face!r} must be (h, w) or (h, w, c) with the channels of "
                                f"face {f0!r} {im0.shape[2:]}; got shape {im.shape}; convert all faces "
                                "to one kind (all grey or all RGB)")
-    try:
-        bg = np.asarray(background, dtype=float)
-    except (TypeError, ValueError):
-        bg = np.empty((0, 0))
-    if bg.ndim > 1 or (bg.ndim == 1 and bg.shape != im0.shape[2:]) or not np.all(np.isfinite(bg)):
+    bg = as_floats(background)
+    if bg is None or bg.ndim > 1 or (bg.ndim == 1 and bg.shape != im0.shape[2:]) or not np.all(np.isfinite(bg)):
         raise WoodcamError(f"background must be one value or one per channel {im0.shape[2:]}; got "
                            f"{background!r}; e.g. background=0")
     px_per_mm = im0.shape[1] / face_image_size_mm(f0, size)[1]

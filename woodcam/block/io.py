@@ -70,6 +70,9 @@ VERSION = 1
 #: side and does not store the physical size; its cubes are roughly 50 mm hardwood/softwood
 #: cubes, so 50 mm is the default here. Pass the real size when you know it.
 MOKUME_DEFAULT_SIZE_MM = (50.0, 50.0, 50.0)
+#: A Mokume sample's files beside a face's photo ``A_col.png``: ``A_arl-unet.png``, ... (ring
+#: map, annual-ring map, knot mask).
+MOKUME_MAP_KINDS = ("arl-unet", "ann", "knot")
 
 
 # -- woodcam manifest folders --------------------------------------------------------------------
@@ -365,7 +368,7 @@ def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | No
 def _mokume_files(folder: Path, face: str) -> dict[str, Path]:
     """The files a Mokume sample folder may hold for ``face``, by kind (``A_col.png`` ...)."""
     letter = MOKUME_LETTER[face]
-    return {k: folder / f"{letter}_{k}.png" for k in ("col", "arl-unet", "ann", "knot")}
+    return {k: folder / f"{letter}_{k}.png" for k in ("col", *MOKUME_MAP_KINDS)}
 
 
 def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *, name: str | None = None) -> Block:

@@ -61,9 +61,11 @@ def _face_of(path: Path) -> str | None:
 def stray_photos(folder) -> list[Path]:
     """Image files in ``folder`` named for no face (``IMG_1234.jpg``, ``front face.jpg``); a
     Mokume sample's maps and masks (``A_arl-unet.png``, ``A_ann.png``, ``A_knot.png``) are not."""
+    from .io import MOKUME_MAP_KINDS
+
     def mokume_map(p: Path) -> bool:
         letter, _, kind = p.stem.partition("_")
-        return letter.upper() in FACE_OF_LETTER and kind in ("arl-unet", "ann", "knot")
+        return letter.upper() in FACE_OF_LETTER and kind in MOKUME_MAP_KINDS
 
     return [p for p in _image_files(Path(folder)) if _face_of(p) is None and not mokume_map(p)]
 

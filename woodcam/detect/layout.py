@@ -25,6 +25,7 @@ import numpy as np
 
 from ..block.block import Block
 from ..frames import FACE_AXIS, FACE_NORMAL, FaceName, block_to_pixel
+from .rings import luminance
 
 #: Depths (pixels of the face image) inside a face at which its edge strip is read, averaged:
 #: off the outermost pixels of a crop, yet near enough that a ring crossing the edge obliquely
@@ -133,8 +134,7 @@ def _face_signal(face, detected: bool) -> tuple[np.ndarray, str] | None:
     if face.ring_map is not None and not (detected and face.photo is not None):
         return np.asarray(face.ring_map, np.float32), "ring map"
     if face.photo is not None:
-        rgb = np.asarray(face.photo, np.float32)[..., :3]
-        return rgb @ np.array([0.299, 0.587, 0.114], np.float32), "photo"
+        return luminance(face.photo), "photo"
     return None
 
 

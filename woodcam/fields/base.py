@@ -18,7 +18,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from .._checks import check_vector
+from .._checks import as_floats, check_vector
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..tolerances import MAX_BATCH_POINTS
@@ -33,9 +33,10 @@ class GrowthField(Protocol):
 
 def check_points(points_mm, name: str = "points_mm") -> np.ndarray:
     """Return ``points_mm`` as a float64 ``(n, 3)`` array or raise a clear error."""
-    p = np.asarray(points_mm, dtype=float)
-    if p.ndim != 2 or p.shape[1] != 3:
-        raise WoodcamError(f"{name} must have shape (n, 3) in mm; got shape {p.shape}")
+    p = as_floats(points_mm)
+    if p is None or p.ndim != 2 or p.shape[1] != 3:  # a ragged list was a bare ValueError
+        got = f"{points_mm!r:.80}" if p is None else f"shape {p.shape}"
+        raise WoodcamError(f"{name} must have shape (n, 3) in mm; got {got}")
     if not np.isfinite(p).all():  # a NaN point was a ZeroDivisionError in a compiled kernel
         bad = int(np.argmin(np.isfinite(p).all(axis=1)))
         raise WoodcamError(f"{name} must be finite; point {bad} is {p[bad].tolist()}")

@@ -33,12 +33,12 @@ import numpy as np
 
 from .._types import ArrayLike, Mesh, PathLike, WoodLike
 from ..errors import WoodcamError, require
+from .._checks import check_vector
 from ..frames import check_size
 from ..tolerances import ON_FACE_TOL_MM
 from .camera import Camera, check_camera, default_cut_normal, set_camera
 from .section import (
     box_section_uv,
-    check_vector,
     cut_segments,
     part_triangles,
     plane_basis,

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import check_vector  # noqa: F401  (re-exported: scene and tests import it here)
 from ..tolerances import ON_FACE_TOL_MM
 
 BOX_EDGES = np.array(
