@@ -41,6 +41,11 @@ MAX_ALLOC_BYTES = 4 * 1024**3
 #: environment variable raises it.
 REVIEW_VOXELS_RANGE = (1_000, 8_000_000)
 
+#: Grid nodes along the longest side of a woodify grid (``woodify(resolution=)``, ``woodcam
+#: woodify --resolution``), the one home of the range both read: 1024^3 nodes is the most one
+#: arrival-time grid may hold; under 16 the input is a few nodes across. Not a MAX_ guard.
+WOODIFY_RESOLUTION_RANGE = (16, 1024)
+
 _DEFAULTS = {name: value for name, value in globals().items() if name.startswith("MAX_")}
 
 

@@ -249,3 +249,26 @@ def test_ply_vertex_properties_paint_the_growth(tmp_path):
     top = f.arrival(np.array([[0, 0, 8 + 6 * 1.6]]) - f.block_origin_mm)
     bottom = f.arrival(np.array([[0, 0, -8 - 6.0]]) - f.block_origin_mm)
     assert top[0] == pytest.approx(6.0, abs=1.5) and bottom[0] == pytest.approx(6.0, abs=0.6)
+
+
+def test_resolution_has_the_librarys_range_on_the_command_line(tmp_path, capsys):
+    """--resolution went through the colour-volume cells' range [8, 256]: 512 (which the library
+    grows) was refused at 256, and 12 passed the door to fail in the library (exit 1)."""
+    from woodcam.cli import build_parser
+    from woodcam.cli.options import check_numbers
+    from woodcam.limits import WOODIFY_RESOLUTION_RANGE
+    from woodcam.woodify.front import VoxelGrid
+
+    def args(value):
+        return build_parser().parse_args(["woodify", "ball.stl", "--years", "3", "--resolution", value,
+                                          "--out", str(tmp_path / "o")])
+
+    lo, hi = WOODIFY_RESOLUTION_RANGE
+    check_numbers(args(str(hi)))  # accepted at the door, as by the library
+    VoxelGrid.around((0, 0, 0), (1, 1, 1), hi)
+    trimesh.creation.icosphere(subdivisions=1, radius=5.0).export(tmp_path / "ball.stl")
+    assert _rc(["woodify", str(tmp_path / "ball.stl"), "--years", "3", "--resolution", str(lo - 4),
+                "--out", str(tmp_path / "o")]) == 2
+    assert f"--resolution must be in [{lo}, {hi}]; got {lo - 4}" in capsys.readouterr().err
+    with pytest.raises(WoodcamError, match=f"resolution must be an integer in \\[{lo}, {hi}\\]"):
+        VoxelGrid.around((0, 0, 0), (1, 1, 1), hi + 1)

@@ -27,7 +27,7 @@ import re
 from pathlib import Path
 
 from ..errors import WoodcamError
-from ..limits import REVIEW_VOXELS_RANGE
+from ..limits import REVIEW_VOXELS_RANGE, WOODIFY_RESOLUTION_RANGE
 from ..units import MM_PER_UNIT
 
 #: The --species presets (woodcam.appearance.SPECIES, listed here so that --help imports no
@@ -629,6 +629,7 @@ RANGES: dict = {
     "size_mm": (0.0, 10_000.0, True),          # a block side, mm (woodcam.limits.MAX_BLOCK_SIZE_MM)
     "mesh_tol": (0.0, 10.0, True),             # mm
     "resolution": (8, 256, False),             # colour-volume cells along the longest side
+    ("woodify", "resolution"): (*WOODIFY_RESOLUTION_RANGE, False),  # grid nodes: the library's range
     ("gcode", "cell_size"): (0.005, 10.0, False),  # stock grid cell, mm (5 um .. 10 mm)
     "epochs": (1, 100_000, False),
     "finetune_epochs": (0, 100_000, False),

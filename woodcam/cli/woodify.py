@@ -46,7 +46,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--brushes", type=Path, default=None, metavar="JSON",
                    help="growth brushes (centre_mm, radius_mm, gain, direction, strength)")
     p.add_argument("--resolution", type=int, default=128,
-                   help="grid nodes along the longest side (default 128)")
+                   help="grid nodes along the longest side, 16 to 1024 (default 128)")
     p.add_argument("--method", choices=("auto", "fmm", "offset", "anisotropic"), default="auto",
                    help="front solver (default auto: fmm if isotropic, offset for eccentricity "
                    "without obstacles, anisotropic otherwise)")

@@ -32,11 +32,21 @@ from typing import Literal
 
 import numpy as np
 
+from .._checks import check_number
 from ..errors import WoodcamError
+from ..limits import WOODIFY_RESOLUTION_RANGE
 from ..tolerances import WOODIFY_BAND_NODES, WOODIFY_OBSTACLE_CLEARANCE_VOXELS
 
 Method = Literal["auto", "fmm", "offset", "anisotropic"]
 METHODS: tuple[str, ...] = ("auto", "fmm", "offset", "anisotropic")
+
+
+def check_resolution(resolution) -> int:
+    """``resolution`` (grid nodes along the longest side) as an int in
+    :data:`woodcam.limits.WOODIFY_RESOLUTION_RANGE`, else a WoodcamError naming it."""
+    lo, hi = WOODIFY_RESOLUTION_RANGE
+    return int(check_number(resolution, "resolution", lo=lo, hi=hi, integer=True,
+                            fix="grid nodes along the longest side; 128 is a good default"))
 
 
 @dataclass(frozen=True)
@@ -51,10 +61,7 @@ class VoxelGrid:
     def around(cls, lo_mm, hi_mm, resolution: int) -> VoxelGrid:
         """Grid covering the box ``[lo_mm, hi_mm]`` with ``resolution`` nodes on its longest side."""
         lo, hi = np.asarray(lo_mm, float), np.asarray(hi_mm, float)
-        if not (isinstance(resolution, (int, np.integer)) and 16 <= resolution <= 1024):
-            raise WoodcamError(
-                f"resolution must be an integer number of grid nodes in [16, 1024]; got "
-                f"{resolution!r}; 128 is a good default")
+        resolution = check_resolution(resolution)
         h = float(np.max(hi - lo)) / (resolution - 1)
         shape = tuple(int(np.ceil((hi[d] - lo[d]) / h)) + 1 for d in range(3))
         return cls(tuple(lo), h, shape)

@@ -18,12 +18,11 @@ from dataclasses import field as dc_field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._checks import check_number
 from ..errors import WoodcamError
 from ..limits import MAX_BLOCK_SIZE_MM
 from .brushes import Brush, check_vertex_paint, paint
 from .field import WoodifiedField
-from .front import Front, Method, VoxelGrid, check_watertight, propagate
+from .front import Front, Method, VoxelGrid, check_resolution, check_watertight, propagate
 from .speed import GrowthSpeed, weibull_cdf
 
 if TYPE_CHECKING:
@@ -139,8 +138,7 @@ def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: 
     if not (isinstance(years, (int, float, np.integer, np.floating)) and np.isfinite(years) and years > 0):
         raise WoodcamError(f"years must be a number > 0 (years to grow); got {years!r}; e.g. 40")
     mesh = check_watertight(mesh, "mesh")
-    check_number(resolution, "resolution", lo=16, hi=1024, integer=True,
-                 fix="grid nodes along the longest side; 128 is a good default")
+    resolution = check_resolution(resolution)
     vertex_gain, vertex_direction = check_vertex_paint(vertex_gain, vertex_direction, len(mesh.vertices))
     lam = float(years) if time_scale_years is None else float(time_scale_years)
     if growth_mm is not None and velocity_mm is not None:
