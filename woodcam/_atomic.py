@@ -59,10 +59,15 @@ _FILE_MODE = 0o666 & ~_umask()  # what open() would have given a new file
 def _temp_in(path: Path) -> Path:
     """A new, empty, uniquely named temporary file next to ``path`` (same folder), named
     ``.<name>.<pid>-<random>.tmp<suffix>``; temporaries of the same target left by a process
-    that no longer runs (killed mid-write) are removed first, so crashes leave no litter."""
+    that no longer runs (killed mid-write) are removed first, so crashes leave no litter.
+    A refusal is an OSError naming ``path``, the file asked for, for every writer: it named the
+    temporary (``/proc/self/.k.png.13252-6nk58k2c.tmp.png``)."""
     _sweep_orphans(path)
-    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}-",
-                                suffix=f".tmp{path.suffix}")
+    try:
+        fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}-",
+                                    suffix=f".tmp{path.suffix}")
+    except OSError as err:
+        raise OSError(err.errno, err.strerror, str(path)) from err
     os.close(fd)
     return Path(name)
 
@@ -184,10 +189,7 @@ def atomic_path(path, *, fsync: bool = True, mkdir: bool = False) -> Iterator[Pa
     path = Path(path)
     if mkdir:
         path.parent.mkdir(parents=True, exist_ok=True)
-    try:
-        tmp = _temp_in(path)
-    except OSError as err:  # it named the temporary file (/proc/.k.png.13252-6nk58k2c.tmp.png)
-        raise OSError(err.errno, err.strerror, str(path)) from err
+    tmp = _temp_in(path)
     try:
         yield tmp
         if not tmp.exists():

@@ -387,3 +387,16 @@ def test_damaged_files_and_bad_arguments_are_one_error(baked, tmp_path):
         export_glb(baked.mesh, tmp_path / "a.glb", metadata={"x": float("nan")})
     export_glb(baked.mesh, tmp_path / "a.glb", metadata={"units": "mm", "kind": "k"})  # the same value: fine
     assert read_glb_metadata(tmp_path / "a.glb")["kind"] == "k"
+
+
+def test_an_export_refused_by_its_folder_names_the_file_asked_for(baked, monkeypatch):
+    """export_obj / export_glb (atomic_files) failed naming their temporary
+    ('/proc/self/.a.obj.30286-xnsxkkqg.tmp.obj') when the folder refused the write after the
+    door's check (the check is skipped here to reach the write)."""
+    import woodcam.export as export
+
+    monkeypatch.setattr(export, "check_output_path", lambda path, **_: Path(path))
+    for write, name in ((export_obj, "a.obj"), (export_glb, "a.glb")):
+        with pytest.raises(OSError) as err:
+            write(baked.mesh, f"/proc/self/{name}")  # read-only even for root
+        assert err.value.filename == f"/proc/self/{name}", write.__name__

@@ -245,8 +245,17 @@ def test_a_figure_that_fails_half_way_leaves_the_old_picture(tmp_path):
     assert write_figure(Figure(), tmp_path / "plot.svg", dpi=72).read_bytes() == b"svg 72"
 
 
-def test_a_refused_write_names_the_file_asked_for_not_its_temporary():
-    """Sweep h5 item 8: the error named '/proc/.k.png.13252-6nk58k2c.tmp.png'."""
+def test_a_refused_write_names_the_file_asked_for_not_its_temporary(tmp_path):
+    """Sweep h5 item 8: the error named '/proc/.k.png.13252-6nk58k2c.tmp.png'; only atomic_path
+    was fixed, atomic_files (export_obj, export_glb) still named its temporary."""
     with pytest.raises(OSError) as err, atomic_path("/proc/self/k.png"):
         pass
     assert err.value.filename == "/proc/self/k.png"
+    with pytest.raises(OSError) as err, atomic_write("/proc/self/k.txt", "w"):
+        pass
+    assert err.value.filename == "/proc/self/k.txt"
+    # the side file's folder refuses: named as asked, and the primary's temporary is gone
+    with pytest.raises(OSError) as err, atomic_files([tmp_path / "a.obj", "/proc/self/a.mtl"]):
+        pass
+    assert err.value.filename == "/proc/self/a.mtl"
+    assert _leftovers(tmp_path) == []
