@@ -36,11 +36,12 @@ import contextlib
 import contextvars
 import os
 import tempfile
+import warnings
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO
 
-from .errors import WoodcamError
+from .errors import WoodcamError, WoodcamWarning
 
 __all__ = ["all_or_nothing", "atomic_files", "atomic_path", "atomic_write", "check_output_path",
            "remove_stale", "write_bytes", "write_figure", "write_text"]
@@ -237,20 +238,26 @@ def write_text(path, text: str, **kwargs) -> Path:
     return Path(path)
 
 
-def remove_stale(folder, patterns: Iterable[str], keep: Iterable) -> list[Path]:
+def remove_stale(folder: str | os.PathLike, patterns: Iterable[str],
+                 keep: Iterable[str | os.PathLike]) -> list[Path]:
     """Delete the files of ``folder`` that match one of the glob ``patterns`` but are not in
     ``keep`` (the files a run has just written there): what an earlier run into the same
     folder wrote and this one does not replace (a veneer sheet no longer cut, a surface at
     another year) would otherwise pass for this run's. Call it after the new files are in
-    place. Returns the paths removed."""
+    place. A WoodcamWarning names every file removed (a file of the user's own that matches a
+    pattern is removed too: never without a word). Returns the paths removed."""
     folder = Path(folder)
     ours = {Path(f).resolve() for f in keep}
     gone = []
     for pattern in patterns:
-        for old in folder.glob(pattern):
+        for old in sorted(folder.glob(pattern)):
             if old.is_file() and old.resolve() not in ours:
                 old.unlink(missing_ok=True)
                 gone.append(old)
+    if gone:
+        warnings.warn(f"removed {len(gone)} file(s) of an earlier run in {str(folder)!r} that this run "
+                      f"does not write again, so that they do not pass for this run's: "
+                      f"{', '.join(p.name for p in gone)}", WoodcamWarning, stacklevel=2)
     return gone
 
 

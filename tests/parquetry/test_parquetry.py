@@ -11,7 +11,7 @@ import json
 import numpy as np
 import pytest
 
-from woodcam.errors import WoodcamError
+from woodcam.errors import WoodcamError, WoodcamWarning
 from woodcam.parquetry import (
     ParquetryJob,
     ParquetryParams,
@@ -466,6 +466,21 @@ def test_running_out_of_wood_stops_with_a_message_and_writes(sheets, tmp_path):
     v = run.veneers[0]
     n = rasterise(read_svg_pieces(tmp_path / f"veneer_{v.id}.svg"), v.mask.shape, v.px_per_mm)
     assert n.max() == 1 and len(run.patches) > 5
+
+
+def test_a_rerun_without_a_job_removes_the_old_job_file_and_says_what_it_removed(sheets, tmp_path):
+    """An API call without ``job`` left an earlier run's job.json beside a result.json it does
+    not describe; and the files removed as an earlier run's were removed without a word (a
+    user's own veneer_notes.svg among them)."""
+    prm = ParquetryParams(image_size_mm=20, px_per_mm=PPM)
+    run = build_parquetry(np.full((40, 40), 0.5, np.float32), sheets[:1], prm)
+    (tmp_path / "job.json").write_text("{}")  # an earlier run's
+    (tmp_path / "veneer_notes.svg").write_text("<svg/>")  # the user's, matching a cut-file name
+    with pytest.warns(WoodcamWarning, match=r"removed 2 file\(s\) of an earlier run .*: "
+                      r"veneer_notes\.svg, job\.json$"):
+        res = write_parquetry(run, tmp_path)
+    assert not (tmp_path / "job.json").exists() and not (tmp_path / "veneer_notes.svg").exists()
+    assert "job.json" not in {p.rsplit("/", 1)[-1] for p in res["files"]}
 
 
 def test_adaptive_patches_split_by_w_adaptive(sheets):

@@ -118,6 +118,27 @@ def test_a_rerun_leaves_no_sheet_of_the_earlier_run(scans, capsys):
     assert sorted(p.name for p in out.iterdir()) == [
         "assembly.svg", "baseline.png", "job.json", "notes.txt", "render.png", "result.json",
         "target_matched.png", "veneer_light.dxf", "veneer_light.svg"]
+    # removed with a word: the files were deleted silently
+    err = capsys.readouterr().err
+    assert "woodcam: warning: removed 3 file(s) of an earlier run" in err
+    assert "panel.glb, veneer_dark.svg, veneer_dark.dxf" in err
+
+
+def test_a_sheet_no_piece_is_cut_from_has_no_cut_file_in_the_result(scans, capsys):
+    """result.json named veneer_<id>.svg for every sheet, also one no piece is cut from (not
+    written, and removed as an earlier run's): null for it."""
+    Image.fromarray(np.full((60, 60, 3), 235, np.uint8)).save(scans / "white.png")
+    out = scans / "out"
+    assert main(["parquetry", str(scans / "white.png"), "--veneer", f"{scans / 'light.png'}:2px/mm",
+                 "--veneer", f"{scans / 'dark.png'}:2px/mm", "--image-size-mm", "20", "--px-per-mm", "2",
+                 "--no-seams", "--no-glb", "--out", str(out), "--quiet"]) == 0
+    result = json.loads((out / "result.json").read_text())
+    assert len(result["patches"]) == 1  # one patch: one sheet cut, the other not
+    used = result["patches"][0]["sheet"]
+    files = {v["id"]: v["file_svg"] for v in result["veneers"]}
+    assert set(files) == {"light", "dark"} and files[used] == f"veneer_{used}.svg"
+    assert (out / files[used]).is_file()
+    assert [files[i] for i in files if i != used] == [None]
 
 
 def test_leaf_slicing_options_reach_the_job_file_blocks_or_are_named(scans, capsys):

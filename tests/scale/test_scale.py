@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import _scale_tasks as tasks
-from woodcam.errors import WoodcamError
+from woodcam.errors import WoodcamError, WoodcamWarning
 from woodcam.scale import RECORDS_DIR, read_records, run_many
 
 HERE = Path(__file__).resolve().parent
@@ -375,7 +375,8 @@ def test_a_report_into_an_earlier_reports_folder_leaves_one_set(tmp_path, monkey
     bm.bench_report(run, rep, gallery=0, thumbnails=2, progress=False)
     assert sorted(p.name for p in (rep / "gallery").iterdir()) == ["b000000_faces.png",
                                                                    "b000001_faces.png"]
-    bm.bench_report(run, rep, gallery=0, thumbnails=1, progress=False)
+    with pytest.warns(WoodcamWarning, match=r"removed 1 file\(s\) of an earlier run .*: b000001_faces\.png$"):
+        bm.bench_report(run, rep, gallery=0, thumbnails=1, progress=False)  # says what it removed
     assert sorted(p.name for p in (rep / "gallery").iterdir()) == ["b000000_faces.png"]
     md = (rep / "report.md").read_text()
 

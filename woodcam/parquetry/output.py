@@ -129,8 +129,10 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
     file, when ``job`` is given). Several targets get ``_<name>`` suffixes. The files are one
     set (:func:`woodcam._atomic.all_or_nothing`): an interrupted or failed write leaves the
     folder's previous files as they were, never new ones beside old ones; once they are in
-    place, the files of those kinds an earlier run left there (sheets not cut this time) are
-    removed.
+    place, the files of those kinds an earlier run left there (sheets not cut this time, a
+    ``job.json`` without ``job``) are removed, with a WoodcamWarning naming them
+    (:func:`woodcam._atomic.remove_stale`). In ``result.json`` a sheet no piece is cut from
+    has ``file_svg`` null.
     """
     import base64
     import io
@@ -187,7 +189,10 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
             "params": {**prm.__dict__, "overlap_mm_used": prm.overlap, "kerf_mm_used": prm.kerf},
             "summary": summ,
             "veneers": [{"id": v.id, "source": v.source, "size_mm": list(v.size_mm),
-                         "px_per_mm": v.px_per_mm, "file_svg": f"veneer_{v.id}.svg"} for v in run.veneers],
+                         "px_per_mm": v.px_per_mm,
+                         # a sheet no piece is cut from has no cut file (null, not a name)
+                         "file_svg": f"veneer_{v.id}.svg" if i in sheets_used else None}
+                        for i, v in enumerate(run.veneers)],
             "patches": [{"id": q.id, "target": q.target, "row": q.row, "col": q.col, "cells": q.cells,
                          "region_mm": [q.col * prm.patch_mm, q.row * prm.patch_mm, q.cells * prm.patch_mm],
                          "sheet": run.veneers[q.match.sheet].id, "rotation_deg": run.bank.angles_deg[q.match.rot],
@@ -200,12 +205,13 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
         files.append(write_text(out / "result.json", json.dumps(result, indent=1, default=float), mkdir=True))
         if job is not None:
             files.append(write_job(job, out / "job.json"))
-    # an earlier run's sheets (and panels of other targets, a panel.glb under --no-glb) are not
-    # this run's: sent to the router with the rest, they would be cut for nothing
+    # an earlier run's sheets (and panels of other targets, a panel.glb under --no-glb, a
+    # job.json a run without a job does not describe) are not this run's: sent to the router
+    # with the rest, they would be cut for nothing
     remove_stale(out, [f"{stem}{s}" for stem in ("render", "baseline", "target_matched")
                        for s in (".png", "_*.png")]
                  + ["assembly.svg", "assembly_*.svg", "panel.glb", "panel_*.glb", "veneer_*.svg",
-                    "veneer_*.dxf"], files)
+                    "veneer_*.dxf", "job.json"], files)
     return {"files": [str(f) for f in files], "summary": summ, "problems": problems}
 
 
