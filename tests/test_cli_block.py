@@ -3,10 +3,12 @@
 import json
 
 import numpy as np
+import pytest
 from PIL import Image
 
 from woodcam.cli import main
 from woodcam.block import read_block
+from woodcam.errors import WoodcamError
 from woodcam.frames import CrossLayout
 
 
@@ -124,12 +126,29 @@ def test_block_synth_on_an_engine_into_a_set_of_another_seed_is_refused(tmp_path
     first = (out / "block_0000" / "block.json").read_bytes()
     capsys.readouterr()
     assert main(["block", "synth", "--seed", "2", *flags]) == EXIT_ERROR
-    assert "another seed or settings (seed 1 there, 2 now)" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "another seed or settings (seed 1 there, 2 now)" in err
+    # the --out given, not its hidden records folder ('delete .../set/.synth' lost the set's index)
+    assert f"{str(out)!r} holds a run" in err and ".synth" not in err
     assert json.loads((out / "index.json").read_text())["seed"] == 1
     assert (out / "block_0000" / "block.json").read_bytes() == first
     # the same seed resumes; more blocks of it extend the set
     assert main(["block", "synth", "--seed", "1", *flags[2:], "--count", "2"]) == 0
     assert "1 already done, 1 computed" in capsys.readouterr().out
+
+
+def test_a_benchmark_set_resumes_with_its_defaults_spelled_out(tmp_path):
+    """block_options were stored as given: a rerun spelling out a default (size_range_mm
+    [30, 80], as 'block synth --engine' does) was refused as a set of other settings."""
+    from woodcam.benchmark import write_benchmark_set
+
+    kw = dict(face_px=32, knotted=False, engine="local", workers=1, progress=False)
+    write_benchmark_set(tmp_path / "set", 1, 4, **kw)
+    summary, index = write_benchmark_set(tmp_path / "set", 1, 4, block_options={
+        "size_range_mm": (30, 80), "knotted_fraction": 0.5, "trace_dropout": 0.0}, **kw)
+    assert (summary.skipped, summary.done) == (1, 0) and index["size_range_mm"] == [30.0, 80.0]
+    with pytest.raises(WoodcamError, match=r"block_options.trace_dropout 0.0 there, 0.2 now"):
+        write_benchmark_set(tmp_path / "set", 1, 4, block_options={"trace_dropout": 0.2}, **kw)
 
 
 def test_engine_options_alone_run_on_the_engine_and_train_rings_refuses_them(tmp_path, capsys):

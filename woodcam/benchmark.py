@@ -210,7 +210,7 @@ def run_bench(out_dir: str | Path, blocks: int, seed: int, settings: dict | None
     setting: the same methods in another order resume the run in its recorded order. Returns
     the :class:`woodcam.scale.RunSummary`.
     """
-    from .scale import check_manifest, run_many
+    from .scale import check_run_manifest, run_many
 
     if not isinstance(blocks, int) or blocks < 1:
         raise WoodcamError(f"blocks must be an integer >= 1; got {blocks!r}")
@@ -218,8 +218,8 @@ def run_bench(out_dir: str | Path, blocks: int, seed: int, settings: dict | None
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     settings = _recorded_method_order(out / RUN_MANIFEST, settings)
-    check_manifest(out / RUN_MANIFEST, {"format": "woodcam-bench-run", "version": 1, "seed": int(seed),
-                                        "settings": settings})
+    check_run_manifest(out / RUN_MANIFEST, {"format": "woodcam-bench-run", "version": 1,
+                                            "seed": int(seed), "settings": settings})
     keys = [bench_key(i) for i in range(start, start + blocks)]
     return run_many(partial(_bench_task, seed=int(seed), settings=settings), keys, out,
                     desc="bench blocks", **run_options)
@@ -229,7 +229,7 @@ def _recorded_method_order(manifest: Path, settings: dict) -> dict:
     """``settings`` with its methods in the order ``manifest`` (a run's run.json) records, when
     they are the same methods: every method is fitted and scored on its own, so the order
     changes no result, and ``--methods rbf,radial`` into a run of ``radial,rbf`` was refused as
-    other settings. Anything else (no manifest, other methods) is left to check_manifest."""
+    other settings. Anything else (no manifest, other methods) is left to check_run_manifest."""
     try:
         recorded = json.loads(manifest.read_text())["settings"]["methods"]
     except (OSError, ValueError, KeyError, TypeError):
@@ -525,6 +525,19 @@ BLOCK_OPTIONS = ("size_range_mm", "knotted_fraction", "trace_jitter_mm", "trace_
                  "trace_dropout_chunk_mm", "mislabel_fraction", "trace_faces")
 
 
+def _block_option_defaults() -> dict:
+    """The default of every :data:`BLOCK_OPTIONS` name: those of
+    :func:`woodcam.synth.benchmark_set_block`, else of :class:`woodcam.synth.SynthSpec` (flat)."""
+    import inspect
+
+    from .synth import benchmark_set_block
+    from .synth.spec import SynthSpec
+
+    own = inspect.signature(benchmark_set_block).parameters
+    flat = SynthSpec().flat()
+    return {k: own[k].default if k in own else flat[k] for k in BLOCK_OPTIONS}
+
+
 def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, knotted: bool = True,
                         block_options: dict | None = None, **run_options):
     """:func:`woodcam.synth.synth_benchmark_set` with the knotted generator, one task per block on
@@ -534,7 +547,7 @@ def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, k
     on every engine as without one. With a Dask ``address`` the workers write the block folders,
     so they need ``out_dir`` on a shared disk. ``run_options`` go to
     :func:`woodcam.scale.run_many`. Returns ``(RunSummary, index dict)``."""
-    from .scale import check_manifest, read_records, run_many, write_json_atomic
+    from .scale import check_run_manifest, read_records, run_many, write_json_atomic
 
     if not isinstance(count, int) or count < 1:
         raise WoodcamError(f"count must be an integer >= 1; got {count!r}")
@@ -547,22 +560,26 @@ def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, k
     for name in ("knotted_fraction", "trace_dropout", "mislabel_fraction"):
         if name in opts:  # at the door, not once per failing task
             _check_fraction(name, opts[name])
-    if "size_range_mm" in opts:  # JSON-friendly in the task's arguments
-        opts["size_range_mm"] = [float(v) for v in opts["size_range_mm"]]
+    # every option, defaults filled in: a rerun that spells out a default (size_range_mm
+    # [30, 80], as the CLI does) is the same set, not one of other settings
+    opts = {**_block_option_defaults(), **opts}
+    opts["size_range_mm"] = [float(v) for v in opts["size_range_mm"]]  # JSON-friendly in the task
+    if opts["trace_faces"] is not None:
+        opts["trace_faces"] = list(opts["trace_faces"])
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     # the records say which blocks are done, not of which set: a rerun with another seed kept the
     # old seed's blocks under an index.json of the new one
-    check_manifest(out / ".synth" / RUN_MANIFEST, {
+    check_run_manifest(out / ".synth" / RUN_MANIFEST, {
         "format": "woodcam-benchmark-set", "seed": int(seed), "face_px": int(face_px),
-        "knotted": bool(knotted), "block_options": opts})
+        "knotted": bool(knotted), "block_options": opts}, out)
     keys = [f"block_{i:04d}" for i in range(count)]
     summary = run_many(partial(_synth_set_task, seed=int(seed), out_dir=str(out.resolve()),
                                face_px=int(face_px), knotted=bool(knotted), block_options=opts),
                        keys, out / ".synth", desc="synthesising blocks", **run_options)
     recs = read_records(out / ".synth")
     index = {"format": "woodcam-benchmark", "version": 1, "seed": int(seed), "count": int(count),
-             "face_px": int(face_px), "size_range_mm": opts.get("size_range_mm", [30.0, 80.0]),
+             "face_px": int(face_px), "size_range_mm": opts["size_range_mm"],
              "ring_width_range_mm": [1.5, 6.0], "knotted_available": bool(knotted),
              "blocks": [recs[k]["result"] for k in keys if k in recs and recs[k]["status"] == "ok"]}
     write_json_atomic(out / "index.json", index)
@@ -600,16 +617,16 @@ def make_training_set_many(spec, out_dir, *, shard_fields: int = TRAINING_SHARD_
     points : (N, M, 3) float32, values : (N, M) float32
     """
     from .fields.neural import TRAINING_SET_FIELDS
-    from .scale import check_manifest, read_records, run_many
+    from .scale import check_run_manifest, read_records, run_many
 
     if not isinstance(shard_fields, int) or shard_fields < 1:
         raise WoodcamError(f"shard_fields must be an integer >= 1; got {shard_fields!r}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     # the shards of another spec's training set (another seed ...) were reused without a word
-    check_manifest(out / ".records" / RUN_MANIFEST, {
+    check_run_manifest(out / ".records" / RUN_MANIFEST, {
         "format": "woodcam-training-set", "shard_fields": shard_fields,
-        "spec": {k: spec.to_dict()[k] for k in TRAINING_SET_FIELDS}})
+        "spec": {k: spec.to_dict()[k] for k in TRAINING_SET_FIELDS}}, out)
     n_shards = -(-spec.n_fields // shard_fields)
     keys = [f"shard_{i:04d}" for i in range(n_shards)]
     s = run_many(partial(_training_shard_task, spec=spec.to_dict(), shard_fields=shard_fields,

@@ -106,16 +106,19 @@ def write_json_atomic(path, obj) -> Path:
     return path
 
 
-def check_manifest(path: str | Path, manifest: dict, what: str = "out_dir") -> None:
+def check_run_manifest(path: str | Path, manifest: dict, out_dir: str | Path | None = None) -> None:
     """Tie a run folder to the settings its records were made with: write ``manifest`` (a
     JSON-able dict: seed, settings ...) to ``path`` when there is none, else refuse another one.
 
     :func:`run_many` skips every key with an ``ok`` record whatever made it, so a rerun into the
     same folder with another seed or settings would keep the old results under the new
-    settings' name; callers whose task results depend on settings call this first. Raises
+    settings' name; callers whose task results depend on settings call this first. ``out_dir``
+    is the folder the user gave (``--out``), named in the errors where ``path`` lies in a hidden
+    folder of it (``OUT/.synth/run.json``); default ``path``'s folder. Raises
     :class:`WoodcamError` naming each setting that differs (one level into nested dicts).
     """
     path = Path(path)
+    folder = str(path.parent if out_dir is None else Path(out_dir))
     want = json.loads(json.dumps(manifest))  # tuples -> lists, as the file holds them
     if not path.is_file():
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -124,7 +127,7 @@ def check_manifest(path: str | Path, manifest: dict, what: str = "out_dir") -> N
     try:
         old = json.loads(path.read_text())
     except ValueError as err:
-        raise WoodcamError(f"{path} is not valid JSON ({err}); delete the folder {str(path.parent)!r} "
+        raise WoodcamError(f"{path} is not valid JSON ({err}); delete the run folder {folder!r} "
                            f"or pick a new --out") from err
     old = old if isinstance(old, dict) else {}
     diffs = []
@@ -136,7 +139,7 @@ def check_manifest(path: str | Path, manifest: dict, what: str = "out_dir") -> N
         elif o != v:
             diffs.append(f"{k} {o!r} there, {v!r} now")
     if diffs:
-        raise WoodcamError(f"{what} {str(path.parent)!r} holds a run with another seed or settings "
+        raise WoodcamError(f"{folder!r} holds a run with another seed or settings "
                            f"({'; '.join(diffs)}); resume it with the same options or pick a new --out")
 
 
@@ -459,4 +462,4 @@ def _run_dask(client, fn, todo, retries, finish) -> int:
 
 
 __all__ = ["DEFAULT_MEMORY_LIMIT_MB", "ENGINES", "Engine", "RECORDS_DIR", "RunSummary",
-           "check_manifest", "read_records", "record_path", "run_many", "write_json_atomic"]
+           "check_run_manifest", "read_records", "record_path", "run_many", "write_json_atomic"]
