@@ -11,13 +11,15 @@ Pixel coordinates here are continuous: pixel centres sit at integer ``(r, c)``.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal, get_args
+from typing import Literal, TypeVar, get_args
 
 import numpy as np
 
 from ._checks import as_floats
 from ._types import ArrayLike
 from .errors import WoodcamError
+
+_G = TypeVar("_G")  # a trimesh.Trimesh or trimesh.Scene, returned as given
 
 FaceName = Literal["front", "top", "left", "bottom", "right", "back"]
 
@@ -296,6 +298,30 @@ def foreign_gltf_frame(extent: float, what: str) -> tuple[np.ndarray, str] | Non
     gltf_to_block[:3, :3] = BLOCK_TO_GLTF[:3, :3].T * 1e6  # exact: 1e3 m -> mm, not inv()'s 999.99...
     gltf_to_block[3, 3] = 1.0
     return np.round(gltf_to_block, 9), note
+
+
+def foreign_gltf_in_block_frame(geometry: _G, path, *, stacklevel: int = 2) -> _G:
+    """``geometry`` (a ``trimesh.Trimesh`` or ``trimesh.Scene``) read from ``path``, a file
+    woodcam did not write (the caller knows: ``woodcam.export.written_by_woodcam``, the GLB root
+    node), in the block frame: a ``.glb``/``.gltf`` whose size says metres
+    (:func:`foreign_gltf_frame`) is scaled to mm and turned from +Y up to Z up in place, with a
+    WoodcamWarning that points ``stacklevel`` frames up from here (1: the caller, as
+    ``warnings.warn`` counts from it); anything else is left as it is.
+    Returns ``geometry``. The one home of that reading (export, view and cad parts)."""
+    import warnings
+    from pathlib import Path
+
+    from .errors import WoodcamWarning
+
+    path = Path(path)
+    extents = geometry.extents  # None when empty
+    if path.suffix.lower() not in (".glb", ".gltf") or extents is None:
+        return geometry
+    metres = foreign_gltf_frame(float(np.max(extents)), f"mesh file {str(path)!r}")
+    if metres is not None:
+        geometry.apply_transform(metres[0])
+        warnings.warn(metres[1], WoodcamWarning, stacklevel=stacklevel + 1)
+    return geometry
 
 
 #: Name of the GLB root node that carries :data:`BLOCK_TO_GLTF` above the block-frame mesh.

@@ -394,19 +394,13 @@ def _undo_woodcam_export_frame(scene, path: Path) -> None:
     """A GLB/OBJ written by woodcam is metres and Y up on disk (glTF/OBJ conventions); put it
     back in the block frame (mm, Z up) so re-baking an exported part lands where it was cut.
     Another program's glTF is metres and Y up too when its size says so
-    (:func:`woodcam.frames.foreign_gltf_frame`)."""
-    import warnings
-
-    from woodcam.errors import WoodcamWarning
-    from woodcam.frames import GLTF_ROOT_NODE, foreign_gltf_frame, obj_header_transform
+    (:func:`woodcam.frames.foreign_gltf_in_block_frame`)."""
+    from woodcam.frames import GLTF_ROOT_NODE, foreign_gltf_in_block_frame, obj_header_transform
 
     if GLTF_ROOT_NODE in scene.graph.nodes:
         scene.graph.update(frame_to=GLTF_ROOT_NODE, matrix=np.eye(4))
-    elif path.suffix.lower() in (".glb", ".gltf") and not scene.is_empty:
-        metres = foreign_gltf_frame(float(np.max(scene.extents)), f"mesh file {str(path)!r}")
-        if metres is not None:
-            scene.apply_transform(metres[0])
-            warnings.warn(metres[1], WoodcamWarning, stacklevel=4)
+    elif path.suffix.lower() in (".glb", ".gltf"):
+        foreign_gltf_in_block_frame(scene, path, stacklevel=4)
     elif path.suffix.lower() == ".obj":
         recorded = obj_header_transform(path)
         if recorded is not None:

@@ -34,16 +34,15 @@ import json
 import math
 import re
 import struct
-import warnings
 from pathlib import Path
 from typing import get_args
 
 import numpy as np
 
 from woodcam._atomic import atomic_files, check_output_path, write_bytes
-from woodcam.errors import WoodcamError, WoodcamWarning
+from woodcam.errors import WoodcamError
 from woodcam.frames import (BLOCK_TO_GLTF, GLTF_ROOT_NODE, OBJ_HEADER, ObjUnits, ObjUp,
-                            foreign_gltf_frame, obj_header_transform, obj_transform)
+                            foreign_gltf_in_block_frame, obj_header_transform, obj_transform)
 
 #: Key under the glTF scene ``extras`` that holds woodcam's metadata.
 GLB_METADATA_KEY = "woodcam"
@@ -413,7 +412,9 @@ def export_obj(mesh: Mesh, path: PathLike, *, units: ObjUnits = "m", up: ObjUp =
 def load_textured(path: PathLike) -> Mesh:
     """Load a GLB or OBJ written by this module as ONE textured ``trimesh.Trimesh`` in the block
     frame (mm, Z up): the GLB root transform and the OBJ's recorded units/up axis are undone.
-    Other files come back as their node transforms place them.
+    Other files come back as their node transforms place them, except another program's
+    glTF/GLB whose part spans under 1 unit: read as metres with +Y up, as glTF specifies, and
+    returned in mm, Z up, with a WoodcamWarning (:func:`woodcam.frames.foreign_gltf_in_block_frame`).
 
     Vertices are not merged (``process=False``), so the vertex count is the exported one.
 
@@ -461,23 +462,9 @@ def load_textured(path: PathLike) -> Mesh:
             loaded = geoms[0]
         else:  # someone else's file with a node transform: bake it into the vertices
             loaded = loaded.to_mesh()
-        loaded = foreign_gltf_in_block_frame(loaded, path)
+        if not written_by_woodcam(path):  # someone else's glTF: metres, Y up when its size says so
+            loaded = foreign_gltf_in_block_frame(loaded, path, stacklevel=2)
     return loaded
-
-
-def foreign_gltf_in_block_frame(mesh, path: PathLike):
-    """``mesh`` (a ``trimesh.Trimesh`` read from ``path``) in the block frame: a ``.glb``/
-    ``.gltf`` that woodcam did not write and whose size says metres is scaled to mm and turned
-    from +Y up to Z up, with a warning (:func:`woodcam.frames.foreign_gltf_frame`); any other
-    mesh is returned as it is."""
-    path = Path(path)
-    if path.suffix.lower() not in (".glb", ".gltf") or written_by_woodcam(path) or len(mesh.vertices) == 0:
-        return mesh
-    metres = foreign_gltf_frame(float(np.max(mesh.extents)), repr(str(path)))
-    if metres is not None:
-        mesh.apply_transform(metres[0])
-        warnings.warn(metres[1], WoodcamWarning, stacklevel=3)
-    return mesh
 
 
 def written_by_woodcam(path: PathLike) -> bool:

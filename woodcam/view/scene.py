@@ -126,7 +126,8 @@ def _load_mesh(mesh_or_path):
                 f"mesh_or_path: no file at {str(path)!r}; pass a .glb/.obj/.ply/.stl file "
                 "written by woodcam (e.g. out/part.glb) or a trimesh.Trimesh"
             )
-        from woodcam.export import foreign_gltf_in_block_frame, load_textured, written_by_woodcam
+        from woodcam.export import load_textured, written_by_woodcam
+        from woodcam.frames import foreign_gltf_in_block_frame
 
         try:
             # woodcam's own GLB/OBJ are metres/Y-up on disk: load_textured returns the block frame;
@@ -138,7 +139,7 @@ def _load_mesh(mesh_or_path):
                 f"mesh_or_path: could not read a mesh from {str(path)!r} ({err}); "
                 "pass a .glb/.obj/.ply/.stl file"
             ) from err
-        mesh_or_path = loaded if ours else foreign_gltf_in_block_frame(loaded, path)
+        mesh_or_path = loaded if ours else foreign_gltf_in_block_frame(loaded, path, stacklevel=2)
     if isinstance(mesh_or_path, trimesh.Scene):
         meshes = [g for g in mesh_or_path.dump() if isinstance(g, trimesh.Trimesh)]
         if not meshes:
