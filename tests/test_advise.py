@@ -133,7 +133,7 @@ def test_the_report_quotes_the_surface_knot_share_its_warning_gives(knotty):
 
     import trimesh
 
-    from woodcam.advise import part_report, report_text
+    from woodcam.advise import part_report, report_rows, report_text
 
     for x in np.linspace(20, 280, 6):  # some of these boxes cross a knot of the knotty block
         box = trimesh.creation.box((30, 30, 30))
@@ -146,5 +146,11 @@ def test_the_report_quotes_the_surface_knot_share_its_warning_gives(knotty):
     text = report_text(rep, "box")
     warned = re.search(r"knots show on ([\d.]+) % of the surface", text).group(1)
     assert f"knots {warned} % of the surface (" in text
+    # the regions' share counts the wood under the surface too, labelled so (it was a bare
+    # 'knots 19.8 %' under a first line that leads with the surface's share), on the review page too
+    for r in rep["regions"]:
+        assert f"knots {100 * r['knots']:.1f} % with the wood 1-3 mm under it" in text
+        assert report_rows(rep)[r["region"]].endswith(f"knots {100 * r['knots']:.1f} % with the wood "
+                                                      "1-3 mm under it")
     old = {k: v for k, v in rep.items() if k != "knots_surface"}  # a report written before
     assert f"knots {100 * rep['knots']:.1f} %, pith" in report_text(old, "box")

@@ -261,10 +261,13 @@ def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
     """What the wood will do in ``mesh`` (a carved part, block frame, mm) as placed.
 
     Returns a JSON-able dict: ``volume_mm3``, ``yield`` (part / block volume), the terms of
-    :func:`advise_placement` for this placement (``knots``, ``pith``, ``end_grain``,
-    ``runout``), and ``regions``: the part cut into :data:`REPORT_REGIONS` slabs along its long
-    axis, each with its mean fibre direction, runout angle (degrees) and knot share; plus
-    ``warnings`` in words (short grain, knots or pith on the surface).
+    :func:`advise_placement` for this placement (``knots`` and ``pith``: shares of the surface
+    and the wood :data:`SUBSURFACE_MM` under it together, ``end_grain``: share of the surface),
+    ``knots_surface`` (the knot share of the surface alone, which the warning quotes),
+    ``elongation``, and ``regions``: the part cut into :data:`REPORT_REGIONS` slabs along its
+    long axis, each with its mean fibre direction, runout angle (degrees) and knot share (the
+    surface and the wood under it, as ``knots``); plus ``warnings`` in words (short grain,
+    knots or pith on the surface). Shares are fractions in [0, 1].
     """
     rng = np.random.default_rng(seed)
     pts, nrm = _sample(mesh, samples, rng)
@@ -323,7 +326,8 @@ def report_text(report: dict, name: str, units: Units = "mm") -> str:
              "under it"]
     for r in report["regions"]:
         lines.append(f"  {r['region']:<13} grain ({', '.join(f'{v:+.2f}' for v in r['grain'])}) "
-                     f"runout {r['runout_deg']:.0f} deg, knots {100 * r['knots']:.1f} %")
+                     f"runout {r['runout_deg']:.0f} deg, knots {100 * r['knots']:.1f} % with the "
+                     "wood 1-3 mm under it")  # not the surface share the first line leads with
     lines += [f"  warning: {w}" for w in report["warnings"]]
     return "\n".join(lines)
 
