@@ -44,7 +44,9 @@ class Patch:
     cost_px: float
 
     def target_to_sheet(self, bank: SheetBank, px_per_mm: float) -> np.ndarray:
-        """``(2, 3)`` affine taking panel mm (x, y) to sheet mm (x, y) for this patch."""
+        """``(2, 3)`` affine taking panel mm (x, y) to mm (x, y) on the sheet's working grid
+        for this patch: sheet pixels over ``px_per_mm``, not yet the sheet's real mm (its pixel
+        count is rounded; :func:`woodcam.parquetry.output.panel_to_sheet_mm` gives those)."""
         mat, _ = bank.rotation(self.match.sheet, self.match.rot)
         ainv = np.linalg.inv(mat[:, :2])
         y0, x0 = self.grown[:2]
