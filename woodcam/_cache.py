@@ -69,7 +69,7 @@ def cache_dir(kind: str) -> Path:
     return cache_root() / kind
 
 
-def entry_stem(name: str) -> str:
+def _entry_stem(name: str) -> str:
     """A block's name as the start of a cache entry's file name: letters, digits, ``_.-`` only,
     at most 40 (a block named "../../x" put its detection outside the cache; 250 characters
     made the file name too long)."""
@@ -77,7 +77,7 @@ def entry_stem(name: str) -> str:
 
 
 def entry_path(folder, name: str, key: str, suffix: str = ".npz") -> Path:
-    """The file of the entry keyed ``key`` in ``folder``: ``<entry_stem(name)>-<key><suffix>``,
+    """The file of the entry keyed ``key`` in ``folder``: ``<_entry_stem(name)>-<key><suffix>``,
     or an entry of the same key already there under another block name.
 
     The key is the content; the name only labels the file for someone browsing the cache. A
@@ -85,7 +85,7 @@ def entry_path(folder, name: str, key: str, suffix: str = ".npz") -> Path:
     second time (byte-identical) when the name chose the file."""
     folder = Path(folder)
     tail = f"-{key}{suffix}"
-    own = folder / f"{entry_stem(name)}{tail}"
+    own = folder / f"{_entry_stem(name)}{tail}"
     if own.is_file():
         return own
     with contextlib.suppress(OSError):
