@@ -101,7 +101,8 @@ def paint(origin_mm, brushes=(), *, vertex_gain=None, vertex_direction=None, mes
     return gain, wind
 
 
-def check_vertex_paint(vertex_gain, vertex_direction, n_vertices: int):
+def check_vertex_paint(vertex_gain, vertex_direction,
+                       n_vertices: int) -> tuple[np.ndarray | None, np.ndarray | None]:
     """``(vertex_gain (n,) float > 0 or None, vertex_direction (n, 3) finite float or None)``
     for a mesh of ``n_vertices``, or a clear error (a NaN gain was a bare ValueError deep in
     the grid sizing)."""
