@@ -261,3 +261,16 @@ def test_compiled_ball_and_flat_sweeps_match_the_numpy_envelopes(tool, monkeypat
         for ln in (fast.line_map[j, i], slow.line_map[j, i]):
             alone = simulate(prog.lines_between(ln - 1, ln), tool, SIZE, resolution_mm=0.2)
             assert alone.heightmap[j, i] == pytest.approx(fast.heightmap[j, i], abs=1e-4)
+
+
+def test_a_program_of_t0_rapids_only_is_refused_clearly():
+    """Every move T0 and none fed, with a table of two tools: the "T0 only rapids before the
+    first M6" rule indexed the first tool loaded, of which there is none (IndexError)."""
+    prog = read_gcode("G0 X1 Z5\nM2")
+    with pytest.raises(WoodcamError, match=r"uses tool 0 \(first at line 1\) but tools has \[1, 2\]"):
+        simulate(prog, {1: FlatEndMill(2), 2: FlatEndMill(4)}, SIZE)
+    assert prog.tool_of_leading_rapids() is None
+    lead = read_gcode("G0 Z5\nT2 M6\nG0 X5 Y5\nG1 Z-1 F100\nM2")
+    assert lead.tool_of_leading_rapids() == 2
+    res = simulate(lead, {1: FlatEndMill(2), 2: FlatEndMill(4)}, SIZE, resolution_mm=0.1)
+    assert res.removed_volume_mm3 == pytest.approx(4 * math.pi, rel=2e-2)

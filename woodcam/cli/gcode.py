@@ -140,7 +140,7 @@ def _tools_from_args(args, program) -> dict:
             unnumbered.append(parse_tool_spec(item))
     if unnumbered:
         used = [t for t in dict.fromkeys(program.tool.tolist()) if t not in tools]
-        if len(used) > 1 and 0 in used and not (program.tool[program.kind == 1] == 0).any():
+        if len(used) > 1 and 0 in used and program.tool_of_leading_rapids() is not None:
             # T0 only rapids before the first M6 (Carbide Create's "G53 G0 Z-5", a G28): no tool
             # of its own; simulate gives those rapids the first tool loaded
             used.remove(0)

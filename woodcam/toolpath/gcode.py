@@ -106,6 +106,16 @@ class Program:
                          float(t[~feed & (self.tool == k)].sum()))
                 for k in np.unique(self.tool)}
 
+    def tool_of_leading_rapids(self) -> int | None:
+        """The tool that tool 0's moves stand for: the first tool the program loads (``M6``)
+        when tool 0 only makes rapids before it (a safe-Z move, Carbide Create's
+        ``G53 G0 Z-5``, a ``G28``), which need no tool of their own; ``None`` when tool 0 also
+        feeds or the program loads no tool."""
+        loaded = self.tool[self.tool != 0]
+        if not len(loaded) or (self.tool[self.kind == FEED] == 0).any():
+            return None
+        return int(loaded[0])
+
     def stepover_mm(self, spacing_mm: float = 0.1) -> float | None:
         """Typical distance (mm) between neighbouring passes of the feed moves: the median,
         over points every ``spacing_mm`` along the feeds, of the XY distance to the nearest

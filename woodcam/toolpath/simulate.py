@@ -155,10 +155,9 @@ def _tool_lookup(program: Program, tools) -> dict[int, Tool]:
             out[t] = tools[t]
         elif t == 0 and len(tools) == 1:  # program never loads a tool (no M6): the only one
             out[t] = next(iter(tools.values()))
-        elif t == 0 and not (program.tool[program.kind == FEED] == 0).any() \
-                and int(program.tool[program.tool != 0][0]) in tools:
+        elif t == 0 and program.tool_of_leading_rapids() in tools:
             # rapids before the first M6 (a safe-Z move): the first tool the program loads
-            out[t] = tools[int(program.tool[program.tool != 0][0])]
+            out[t] = tools[program.tool_of_leading_rapids()]
         else:
             line = int(program.line[np.argmax(program.tool == t)])
             raise WoodcamError(f"simulate: the program uses tool {t} (first at line {line}) "
