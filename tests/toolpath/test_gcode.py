@@ -222,8 +222,10 @@ def test_machine_zero_places_g53_as_linuxcnc_does():
                       start_mm=(4, 5, 10), machine_zero_mm=(10, 20, 80))
     np.testing.assert_allclose(prog.end_mm, [[1, 2, 3], [17, 2, 75], [16, 2, 75], [4, 5, 10],
                                              [4, 5, 0]], atol=1e-12)
-    with pytest.raises(WoodcamError, match="machine_zero_mm must be three finite numbers"):
-        read_gcode(CARBIDE, machine_zero_mm=(0, 80))
+    # a string and a (1, 3) array were a bare ValueError and accepted (copied by hand)
+    for bad in [(0, 80), "abc", [[0, 0, 1]]]:
+        with pytest.raises(WoodcamError, match="machine_zero_mm must be three finite numbers"):
+            read_gcode(CARBIDE, machine_zero_mm=bad)
 
 
 CORPUS = sorted((Path(__file__).resolve().parents[2] / "toolpaths" / "corpus").glob("*.*[!y]"))

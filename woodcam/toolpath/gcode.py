@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_number
+from .._checks import check_number, check_vector
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from ..tolerances import ARC_CHORD_TOL_MM
@@ -269,11 +269,8 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
                            f"{start_mm!r}; e.g. (0, 0, 10)")
     mzero = None
     if machine_zero_mm is not None:
-        mzero = np.asarray(machine_zero_mm, float).reshape(-1)
-        if mzero.shape != (3,) or not np.all(np.isfinite(mzero)):
-            raise WoodcamError(f"read_gcode: machine_zero_mm must be three finite numbers (mm) "
-                               f"or None, got {machine_zero_mm!r}; e.g. (0, 0, 80)")
-        mzero = tuple(mzero.tolist())
+        mzero = tuple(check_vector(machine_zero_mm, "read_gcode: machine_zero_mm",
+                                   fix="give millimetres, e.g. (0, 0, 80), or None").tolist())
     if interpreter == "linuxcnc":
         from .linuxcnc import run_linuxcnc
 
