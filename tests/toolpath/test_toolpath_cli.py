@@ -302,7 +302,7 @@ def test_the_review_page_of_a_gcode_glb_shows_its_tools_and_machining_time(tmp_p
     """The GLB records the run's tools and machining time, but the page (and its printed shop
     sheet) showed neither."""
     from woodcam.cli import main
-    from woodcam.cli.gcode import _hms
+    from woodcam.cli.gcode import fmt_hms
     from woodcam.export import read_glb_metadata
 
     glb = tmp_path / "p.glb"
@@ -313,7 +313,7 @@ def test_the_review_page_of_a_gcode_glb_shows_its_tools_and_machining_time(tmp_p
     assert main(["review", str(glb), "--out", str(tmp_path / "p.html"), "--voxels", "20000"]) == 0
     page = (tmp_path / "p.html").read_text()
     assert "<tr><th>tools (--tool specs, mm)</th><td>T1 flat:6.35</td></tr>" in page
-    assert f"<tr><th>machining time</th><td>{_hms(meta['machining_time_s'])} (estimate" in page
+    assert f"<tr><th>machining time</th><td>{fmt_hms(meta['machining_time_s'])} (estimate" in page
 
 
 def test_review_with_another_block_than_the_baked_one_says_so(tmp_path, capsys):

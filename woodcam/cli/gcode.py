@@ -227,7 +227,7 @@ def run(args) -> int:
               f"{s['grid'][1]}x{s['grid'][0]} cells in {s['wall_s']:.2f} s "
               f"({s['moves_per_s']:.0f} moves/s), removed {fmt_volume(res.removed_volume_mm3, args.units)}, "
               f"{len(res.report)} issue(s); machining time " + ", ".join(
-                  f"T{t}: {_hms(f + r)} ({_hms(f)} feeding)" for t, (f, r) in times.items()))
+                  f"T{t}: {fmt_hms(f + r)} ({fmt_hms(f)} feeding)" for t, (f, r) in times.items()))
         meta_programs.append({"gcode": str(path),
                               "tools": {str(t): v.spec() for t, v in sorted(tools.items())},
                               "machining_time_s": sum(f + r for f, r in times.values()),
@@ -294,7 +294,8 @@ def _issue_spots(program, issues, size_mm, offset, name: str) -> list[dict]:
     return out
 
 
-def _hms(seconds: float) -> str:
+def fmt_hms(seconds: float) -> str:
+    """Seconds -> ``"h:mm:ss"`` (``"unbounded"`` for inf/nan), for machining times."""
     if not math.isfinite(seconds):  # a program that never ends (its own numbers: no traceback)
         return "unbounded"
     m, s = divmod(int(round(seconds)), 60)

@@ -85,7 +85,7 @@ def _gcode_run_rows(meta: dict) -> dict:
     """The rows of a ``woodcam gcode`` run recorded in its GLB (none for a baked part): the
     tools by number with their specs and the machining time estimate, for the page and its
     printed shop sheet."""
-    from .gcode import _hms
+    from .gcode import fmt_hms
 
     rows = {}
     tools = meta.get("tools")
@@ -94,6 +94,6 @@ def _gcode_run_rows(meta: dict) -> dict:
         rows["tools (--tool specs, mm)"] = ", ".join(f"T{t} {tools[t]}" for t in order)
     t = meta.get("machining_time_s")
     if isinstance(t, (int, float)) and not isinstance(t, bool) and t >= 0:
-        rows["machining time"] = (f"{_hms(t)} (estimate from the programmed feeds and the rapid "
+        rows["machining time"] = (f"{fmt_hms(t)} (estimate from the programmed feeds and the rapid "
                                   "rate, no acceleration: real jobs take longer)")
     return rows

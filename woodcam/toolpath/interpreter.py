@@ -185,7 +185,7 @@ def _shifted(move, d):
     return (kind, line, end, centre, rot, plane, *rest)
 
 
-def _line_list(lines: list[int], most: int = 12) -> str:
+def line_list(lines: list[int], most: int = 12) -> str:
     """``[7, 17, 30]`` -> ``"7, 17, 30"``; beyond ``most`` lines, ``"... (40 lines)"``."""
     text = ", ".join(map(str, lines[:most]))
     return text + (f", ... ({len(lines)} lines)" if len(lines) > most else "")
@@ -213,7 +213,10 @@ class _Line:
         self.okey = self.olabel = self.oexpr = None
 
 
-def _split_comments(raw: str, no: int) -> tuple[str, list[str]]:
+def split_comments(raw: str, no: int) -> tuple[str, list[str]]:
+    """Source line ``raw`` (1-based number ``no``) -> ``(text, messages)``: the text outside
+    comments, lowercase, without whitespace, and the ``(MSG, ...)`` comments' messages.
+    Raises :class:`GcodeError` for an unclosed, nested or unopened comment."""
     if "(" not in raw and ")" not in raw and ";" not in raw:  # most lines: no comment
         return "".join(raw.split()).lower(), []
     msgs = []
@@ -567,7 +570,7 @@ class Interpreter:
         grbl = self.dialect == "grbl"
         for no, raw in enumerate(self.src, start=1):
             self.line_no = no
-            text, msg = _split_comments(raw, no)
+            text, msg = split_comments(raw, no)
             # LinuxCNC reads '%' only as a line of its own (blanks around it, no comment): the
             # first non-blank line opens a %-delimited program and the next such line ends it;
             # any other '%' is refused when it is reached ("Bad character '%' used": the
@@ -786,7 +789,7 @@ class Interpreter:
             lines = self._g53_unplaced[key]
             if lines:
                 self.warnings.append((lines[0], f"G53 (machine coordinates) on line(s) "
-                                      f"{_line_list(lines)}: {what}; {fix}"))
+                                      f"{line_list(lines)}: {what}; {fix}"))
 
     def _cond(self, ln):
         s = ln.oexpr

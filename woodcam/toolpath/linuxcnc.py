@@ -18,7 +18,7 @@ import tempfile
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .interpreter import GcodeError, _line_list, _split_comments
+from .interpreter import GcodeError, line_list, split_comments
 
 #: Debian's interpreter, for which the ``gcode`` module is built.
 LINUXCNC_PYTHON = "/usr/bin/python3"
@@ -82,7 +82,7 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
     warnings = []
     g53 = _g53_lines(text) if machine_zero_mm is None else []
     if g53:
-        warnings.append((g53[0], f"G53 (machine coordinates) on line(s) {_line_list(g53)}: "
+        warnings.append((g53[0], f"G53 (machine coordinates) on line(s) {line_list(g53)}: "
                          "without the machine zero LinuxCNC's interpreter took it at G-code "
                          "zero (a G53 Z-5 retract goes 5 mm below the work zero); give where "
                          "the machine zero lies in the G-code frame (--machine-zero X,Y,Z) to "
@@ -107,7 +107,7 @@ def _g53_lines(text: str) -> list[int]:
     for no, raw in enumerate(text.splitlines(), 1):
         if "53" in raw:
             try:
-                line = _split_comments(raw, no)[0]
+                line = split_comments(raw, no)[0]
             except GcodeError:  # LinuxCNC read the program: cannot happen; no warning then
                 continue
             if _G53.search(line):
