@@ -4,8 +4,8 @@
 own as the oracle, :mod:`.linuxcnc`), tools and tool tables (:mod:`.tools`), the stock-removal
 simulation (:mod:`.simulate`), the result mesh and its planar charts (:mod:`.mesh`), the
 deviation from a design part (:mod:`.deviation`) and the exact manifold3d reference used by
-tests and benchmarks (:mod:`.reference`). Lengths in mm; the machine frame is the G-code
-work frame, the result is in the block frame of ``docs/conventions.md``.
+tests and benchmarks (:mod:`.reference`). Lengths in mm; the moves are in the G-code (G54)
+frame, the result is in the block frame of ``docs/conventions.md``.
 """
 
 from .gcode import GcodeError, Move, Program, read_gcode

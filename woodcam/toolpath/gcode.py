@@ -3,9 +3,10 @@
 Data form
 ---------
 A :class:`Program` holds ``n`` straight moves as arrays: ``start_mm, end_mm : (n, 3) float`` in
-the machine frame (the G54 work frame while the program leaves the work offsets at zero),
-millimetres, whatever ``G20/G21`` the program used; ``kind : (n,) uint8`` (0 = rapid ``G0``,
-1 = feed ``G1/G2/G3``), ``tool : (n,) int`` (the tool number loaded by the last ``M6``, 0 before
+the G-code frame (the G54 work frame as the machine has it before the program runs, the frame of
+``start_mm``; the machine's own origin, ``G53``, lies at ``machine_zero_mm`` in it),
+millimetres, whatever ``G20/G21`` the program used; ``kind : (n,) uint8`` (0 = rapid ``G0``, 1 =
+feed ``G1/G2/G3``), ``tool : (n,) int`` (the tool number loaded by the last ``M6``, 0 before
 any), ``line : (n,) int`` (1-based source line) and ``feed_mm_min, spindle_rpm : (n,) float``
 (``spindle_rpm`` is 0 while the spindle is off). Arcs are split into chords whose sagitta is at
 most ``chord_tol_mm`` (default :data:`woodcam.tolerances.ARC_CHORD_TOL_MM`), so every arc vertex
@@ -41,7 +42,7 @@ __all__ = ["DEFAULT_START_MM", "FEED", "MAX_CHORDS_PER_ARC", "MM_PER_INCH", "RAP
 RAPID, FEED = 0, 1
 _KIND_NAMES = ("rapid", "feed")
 
-#: Where the machine starts (machine frame, mm): over the work zero at a clearance height.
+#: Where the machine starts (G-code frame, mm): over the work zero at a clearance height.
 DEFAULT_START_MM = (0.0, 0.0, 10.0)
 #: Chords one arc may become before woodcam refuses it (an arc of radius 1e9 mm would need
 #: millions): a 1 m radius half circle at 0.005 mm needs ~1,100.
@@ -50,7 +51,7 @@ MAX_CHORDS_PER_ARC = 200_000
 
 @dataclass(frozen=True)
 class Move:
-    """One straight move. ``start_mm, end_mm : (3,)`` machine frame, mm."""
+    """One straight move. ``start_mm, end_mm : (3,)`` G-code (G54) frame, mm."""
 
     start_mm: tuple[float, float, float]
     end_mm: tuple[float, float, float]
@@ -219,7 +220,8 @@ def _names_a_file(text: str) -> bool:
 def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_TOL_MM,
                start_mm: ArrayLike | None = None, dialect: str = "linuxcnc",
                interpreter: str = "woodcam", machine_zero_mm: ArrayLike | None = None) -> Program:
-    """Read G-code text or a file path into a :class:`Program` of straight moves (mm).
+    """Read G-code text or a file path into a :class:`Program` of straight moves (G-code
+    frame, mm).
 
     Parameters
     ----------
@@ -230,7 +232,7 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
     chord_tol_mm : float
         Largest sagitta (mm) between an arc and its chords.
     start_mm : (3,) float | None
-        Start position in the machine frame (mm); ``None``: :data:`DEFAULT_START_MM`.
+        Start position in the G-code (G54) frame (mm); ``None``: :data:`DEFAULT_START_MM`.
     dialect : "linuxcnc" | "grbl" | "fanuc"
         Which controller's meaning the program has (:mod:`woodcam.toolpath.interpreter`).
     interpreter : "woodcam" | "linuxcnc"

@@ -197,7 +197,8 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     Parameters
     ----------
     program : Program
-        Straight moves from :func:`woodcam.toolpath.read_gcode` (machine frame, mm).
+        Straight moves from :func:`woodcam.toolpath.read_gcode` (G-code frame, mm; placed
+        in the block by ``work_offset_mm``).
     tools : Tool | Mapping[int, Tool]
         One tool for every move, or the tool table by tool number.
     size_mm : (3,) float
@@ -403,7 +404,7 @@ def _add(issues, kind, line, message, at=None):
 def _first_contact(tool, a, b, window, j0, i0, dx, dy):
     """The first tip position (block frame, mm, (3,)) along the move ``a -> b`` where ``tool``
     reaches more than SIM_CONTACT_TOL_MM below the stock before the move, sampled every quarter
-    cell; the middle of the move when no sample does (a graze between samples). ``window``: the
+    cell, at most 16,385 samples (a longer move more coarsely); the middle of the move when no sample does (a graze between samples). ``window``: the
     height field's cells ``[j0:j0 + wy, i0:i0 + wx]`` before the move (they hold the move's
     footprint). Only for the few moves reported as issues."""
     R = float(tool.radius_mm)
