@@ -482,3 +482,40 @@ def test_voxels_has_one_range_for_the_cli_and_the_library(tmp_path, capsys):
     with pytest.raises(WoodcamError, match=re.escape(f"voxels must be an integer in [{lo}, {hi:g}]")):
         write_review(tmp_path / "p.glb", tmp_path / "r.html", wood=None, size_mm=(10, 10, 10),
                      voxels=hi + 1)
+
+
+def _with_report(page, tmp_path, report) -> Path:
+    """The page fixture's part re-exported with ``report`` as its bake report."""
+    from woodcam.export import load_textured
+
+    stock, glb, _, _ = page
+    return export_glb(load_textured(glb), tmp_path / "part.glb",
+                      metadata={"block": stock.spec, "report": report})
+
+
+def test_the_pages_report_rows_are_in_mm_as_the_page_says(page, tmp_path):
+    """--units inch printed the bake report's volume in in^3 on a page whose header says
+    'Lengths in mm' (review's --units reads the lengths typed, not the page)."""
+    from woodcam.cli import main
+
+    report = {"volume_mm3": 16387.064, "yield": 0.5, "end_grain": 0.1, "knots": 0.0, "pith": 0.0,
+              "regions": [], "warnings": []}
+    glb = _with_report(page, tmp_path, report)
+    assert main(["review", str(glb), "--out", str(tmp_path / "r.html"), "--voxels", "1000",
+                 "--units", "inch"]) == 0
+    text = (tmp_path / "r.html").read_text()
+    assert "Lengths in mm" in text
+    assert re.search(r"<th>part</th><td>16[,.]?387 mm\^3, yield 50\.0 %", text), \
+        re.search(r"<th>part</th><td>[^<]*", text)
+
+
+def test_a_malformed_bake_report_in_the_glb_is_warned_not_a_traceback(page, tmp_path, capsys):
+    """report_rows({}) raised KeyError 'knots' out of woodcam review: GLB metadata is
+    untrusted (an edited or another program's file)."""
+    from woodcam.cli import main
+
+    glb = _with_report(page, tmp_path, {"volume_mm3": 5.0})
+    assert main(["review", str(glb), "--out", str(tmp_path / "r.html"), "--voxels", "1000"]) == 0
+    err = capsys.readouterr().err
+    assert f"warning: {str(glb)!r}: the bake report in its metadata is malformed" in err, err
+    assert "<th>part</th>" not in (tmp_path / "r.html").read_text()

@@ -54,9 +54,7 @@ def run_review(args: argparse.Namespace) -> int:
     spec = stock.spec
     report = {"block spec": spec, "species": stock.meta.get("species", "")}
     if isinstance(meta.get("report"), dict):  # the bake's part report (volume, yield, warnings)
-        from ..advise import report_rows
-
-        report.update(report_rows(meta["report"], units=args.units))
+        report.update(_report_rows(meta["report"], args.part))
     for key in ("texels_per_mm", "gcode", "placement"):
         if key in meta:
             report[key] = meta[key]
@@ -79,6 +77,24 @@ def run_review(args: argparse.Namespace) -> int:
                        voxels=args.voxels or VOLUME_VOXELS, progress=True)
     print(f"wrote {out} ({out.stat().st_size / 2**20:.1f} MiB)")
     return 0
+
+
+def _report_rows(bake_report: dict, glb: Path) -> dict:
+    """The bake report's rows for the page, in mm as the page says (``--units`` reads the
+    lengths typed, not this table); ``{}`` with a warning for a malformed report (GLB metadata is
+    untrusted: an edited or foreign file)."""
+    import warnings
+
+    from ..advise import report_rows
+    from ..errors import WoodcamWarning
+
+    try:
+        return report_rows(bake_report, units="mm")
+    except (KeyError, TypeError, ValueError, AttributeError, IndexError) as err:
+        warnings.warn(f"{str(glb)!r}: the bake report in its metadata is malformed ({type(err).__name__}: "
+                      f"{err}); the page shows no report rows. Re-bake the part to have them",
+                      WoodcamWarning, stacklevel=2)
+        return {}
 
 
 def _gcode_run_rows(meta: dict) -> dict:
