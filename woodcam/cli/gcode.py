@@ -194,7 +194,7 @@ def run(args) -> int:
                                  interpreter=args.interpreter,
                                  machine_zero_mm=args.machine_zero)
         except GcodeError as err:  # which of the programs: "G-code line 5" alone does not say
-            raise GcodeError(err.line, err.word, err.rule, err.fix, source=path.name) from None
+            raise GcodeError(err.line, err.word, err.rule, err.fix, source=str(path)) from None
         t_read = time.perf_counter() - t0
         full = program  # the whole last program, for the window's slider
         if args.until_line is not None and k == len(args.program) - 1:
