@@ -159,6 +159,21 @@ def test_leaf_slicing_options_reach_the_job_file_blocks_or_are_named(scans, caps
     assert [(v["id"], v["size_mm"]) for v in sliced] == [("builtin-flat-sawn-walnut-00", [70.0, 56.0])]
 
 
+def test_a_slicing_option_typed_at_its_default_still_overrides_the_job_file(scans, capsys):
+    """--sheets 2 (the default's value) did not reach a --config job's block of one sheet: a
+    typed value was told from the default by its value."""
+    out = scans / "out"
+    assert _small_run(scans, out) == 0
+    job = json.loads((out / "job.json").read_text())
+    job["woodcam"]["blocks"] = [{"spec": "builtin:flat-sawn", "sheets": 1, "width_mm": 70, "height_mm": 56}]
+    (scans / "job.json").write_text(json.dumps(job))
+    assert main(["parquetry", "--config", str(scans / "job.json"), "--sheets", "2",
+                 "--out", str(scans / "out2"), "--quiet", "--no-glb"]) == 0
+    sliced = [v["id"] for v in json.loads((scans / "out2" / "result.json").read_text())["veneers"]
+              if v["id"].startswith("builtin")]
+    assert len(sliced) == 2, sliced
+
+
 def test_two_scans_of_the_same_file_name_get_their_own_sheets(scans, capsys):
     """a/oak.png and b/oak.png were both 'oak' and the run was refused ('veneer ids must be
     unique'), with no way to name a scan on the command line."""

@@ -33,7 +33,9 @@ result.json, panel.glb and job.json (the run as a job file) into --out.
 """
 
 
-#: The options that slice leaves from a --veneer-from block, and their defaults.
+#: The options that slice leaves from a --veneer-from block, and their defaults (mm): the
+#: parser's defaults are None (not typed), so a value typed equal to its default still
+#: overrides a --config job's blocks; these fill in the rest.
 _SLICING = {"sheets": 2, "sheet_size": "600x400", "leaf_thickness": 0.6, "saw_kerf": 0.4, "slice_axis": "y",
             "species": None}
 
@@ -61,14 +63,14 @@ def register(subparsers) -> None:
                    "'Npx/mm'")
     v.add_argument("--veneer-from", action="append", default=[], metavar="SPEC",
                    help="Mokume sample folder, or block spec to slice leaves from (repeatable)")
-    v.add_argument("--sheets", type=int, default=_SLICING["sheets"], help="leaves per --veneer-from block (default 2)")
-    v.add_argument("--sheet-size", default=_SLICING["sheet_size"], metavar="WxH",
+    v.add_argument("--sheets", type=int, default=None, help="leaves per --veneer-from block (default 2)")
+    v.add_argument("--sheet-size", default=None, metavar="WxH",
                    help="size of each sliced leaf in --units (default 600x400 mm)")
-    v.add_argument("--leaf-thickness", type=float, default=_SLICING["leaf_thickness"], metavar="LEN",
+    v.add_argument("--leaf-thickness", type=float, default=None, metavar="LEN",
                    help="sliced leaf thickness in --units (default 0.6 mm)")
-    v.add_argument("--saw-kerf", type=float, default=_SLICING["saw_kerf"], metavar="LEN",
+    v.add_argument("--saw-kerf", type=float, default=None, metavar="LEN",
                    help="wood lost between sliced leaves in --units (default 0.4 mm)")
-    v.add_argument("--slice-axis", choices=("x", "y", "z"), default=_SLICING["slice_axis"],
+    v.add_argument("--slice-axis", choices=("x", "y", "z"), default=None,
                    help="normal of the slicing planes in the block frame (default y: leaves "
                    "parallel to the front face)")
     add_units_option(v, "parquetry")
@@ -195,8 +197,12 @@ def run(args) -> int:
             seen[e["id"]] += 1
             e["id"] = f"{e['id']}-{seen[e['id']]}"
     job.scans = job.scans + scans
+    # None: not typed (a value typed equal to its default, --sheets 2, is given all the same)
+    given = [d for d in _SLICING if getattr(args, d) is not None]
+    for d, default in _SLICING.items():
+        if getattr(args, d) is None:
+            setattr(args, d, default)
     w, h = parse_sizes(args.sheet_size, "--sheet-size", n=2)
-    given = [d for d, default in _SLICING.items() if getattr(args, d) != default]
     # the slicing options given here override the job file's blocks too (--config's rule: options
     # given here override it); they were ignored there
     leaf = {"sheets": args.sheets, "width_mm": w, "height_mm": h, "thickness_mm": args.leaf_thickness,
