@@ -136,6 +136,13 @@ def test_a_species_that_changes_nothing_is_named(shared_data, tmp_path, monkeypa
         open_stock(str(shared_data / "mokume" / "H11"), species="walnut")
     said = [str(w.message) for w in caught]
     assert any("--species walnut: block 'H11' has photos along all three axes" in m for m in said), said
+    # a species recorded earlier (a baked GLB's), not asked for now: opened without the note,
+    # by an explicit keyword (the CLI matched the note's text to silence it)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        stock = open_stock(str(shared_data / "mokume" / "H11"), species="walnut", species_given=False)
+    assert not any("--species" in str(w.message) for w in caught), [str(w.message) for w in caught]
+    assert stock.meta["species"] == "walnut"
 
 
 def test_a_turn_given_to_a_command_that_reads_the_block_is_named():

@@ -100,7 +100,8 @@ def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:
 
 
 def open_stock(spec: str, *, species: str | None = None,
-               appearance: AppearanceKind = "colormap", **appearance_params) -> Stock:
+               appearance: AppearanceKind = "colormap", species_given: bool = True,
+               **appearance_params) -> Stock:
     """Resolve a block spec (see module docstring) to a :class:`Stock`.
 
     Parameters
@@ -113,6 +114,10 @@ def open_stock(spec: str, *, species: str | None = None,
         (:func:`~woodcam.appearance.neural.fit_neural_appearance`, cached on disk); a built-in
         block's photos are first rendered by :func:`woodcam.synth.synth_block`, and a block
         without photos falls back to the colour map with an ``AppearanceFallbackWarning``.
+    species_given : bool
+        False: ``species`` is one recorded earlier (a baked GLB's), not asked for now, so a
+        block whose photos set every colour is opened without the warning that the species
+        changes nothing.
     **appearance_params
         Passed to :class:`~woodcam.appearance.ColorMapAppearance` (e.g. knot darkening), or for
         ``"neural"`` to ``fit_neural_appearance`` (``resolution``, ``quality``, ``epochs``,
@@ -126,7 +131,7 @@ def open_stock(spec: str, *, species: str | None = None,
     _check_appearance_params(appearance, appearance_params,
                              photos=not base.startswith(("builtin:", "log:", "woodify:")),
                              where=f"block spec {base!r}")
-    stock = _open_base_stock(base, species, appearance, appearance_params)
+    stock = _open_base_stock(base, species, appearance, appearance_params, species_given)
     stock.meta["appearance_params"] = {k: (list(v) if isinstance(v, tuple) else v)
                                        for k, v in appearance_params.items()
                                        if isinstance(v, (int, float, str, tuple, list))}
@@ -271,7 +276,7 @@ def _parse_size(text: str, spec: str) -> tuple[float, float, float]:
 _MAX_BLOCK_SIDE_MM = 5000.0
 
 
-def _open_base_stock(spec: str, species, appearance, appearance_params) -> Stock:
+def _open_base_stock(spec: str, species, appearance, appearance_params, species_given=True) -> Stock:
     if spec.startswith("builtin:"):
         b, field, size = _builtin(spec.split(":", 1)[1])
         return _synthetic_stock(spec, field, size, species or b.species, b.description,
@@ -286,8 +291,8 @@ def _open_base_stock(spec: str, species, appearance, appearance_params) -> Stock
                                 appearance, appearance_params)
     path = _existing_folder(spec)
     if (path / "block.json").is_file():
-        return _open_block_folder(path, species, appearance, appearance_params)
-    return _open_mokume_folder(path, species, appearance, appearance_params)
+        return _open_block_folder(path, species, appearance, appearance_params, species_given)
+    return _open_mokume_folder(path, species, appearance, appearance_params, species_given)
 
 
 def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
@@ -425,15 +430,15 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
     return field
 
 
-def _open_mokume_folder(path: Path, species, appearance, appearance_params) -> Stock:
+def _open_mokume_folder(path: Path, species, appearance, appearance_params, species_given=True) -> Stock:
     from .block.io import read_block_folder
 
     block = read_block_folder(path)
     return _real_block_stock(str(path), block, fitted_field(block, None), species, appearance,
-                             appearance_params, cache_dir=None)
+                             appearance_params, cache_dir=None, species_given=species_given)
 
 
-def _open_block_folder(path: Path, species, appearance, appearance_params) -> Stock:
+def _open_block_folder(path: Path, species, appearance, appearance_params, species_given=True) -> Stock:
     from .block.io import read_block_folder  # imported when a folder is used
 
     from .detect.block import with_detected_rings
@@ -442,10 +447,11 @@ def _open_block_folder(path: Path, species, appearance, appearance_params) -> St
     block = with_detected_rings(read_block_folder(path), progress=True)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
     return _real_block_stock(str(path), block, field, species, appearance, appearance_params,
-                             cache_dir=None)
+                             cache_dir=None, species_given=species_given)
 
 
-def _real_block_stock(spec, block, field, species, appearance, appearance_params, cache_dir) -> Stock:
+def _real_block_stock(spec, block, field, species, appearance, appearance_params, cache_dir,
+                      species_given=True) -> Stock:
     if appearance == "neural":
         from .appearance.neural import block_appearance
 
@@ -456,7 +462,7 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
         from .frames import FACE_AXIS
 
         axes = {FACE_AXIS[n] for n, f in block.faces.items() if f.photo is not None}
-        if species is not None and len(axes) == 3:  # nothing silently dropped: photos set every colour
+        if species is not None and species_given and len(axes) == 3:  # nothing silently dropped: photos set every colour
             warnings.warn(f"--species {species}: block {block.name!r} has photos along all three axes, and its "
                           "colours are fitted to them; the species changes nothing here (it colours the axes "
                           "without photos)", WoodcamWarning, stacklevel=2)

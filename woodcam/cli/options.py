@@ -20,7 +20,6 @@ Nothing heavy is imported at module level (``woodcam --help`` loads this module)
 from __future__ import annotations
 
 import argparse
-import contextlib
 import math
 import os
 import re
@@ -538,8 +537,10 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
             warnings.warn(f"--block {block} is not the block {glb.name} was baked from ({meta.get('block')}, "
                           f"{'x'.join(f'{v:g}' for v in meta.get('size_mm', []))} mm): the wood shown inside "
                           "differs from the part's surface", WoodcamWarning, stacklevel=2)
-        with _recorded_species_quiet(species):
-            return open_stock(block, **{**kwargs, "species": species or kwargs["species"]})
+        # the recorded species (the bake's, default oak) was not asked for now: no note that
+        # it changes nothing
+        return open_stock(block, **{**kwargs, "species": species or kwargs["species"]},
+                          species_given=species is not None)
     spec = meta.get("block")
     if not spec:
         return None
@@ -554,24 +555,7 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
     if meta.get("block_digest") and spec_digest(spec) != meta["block_digest"]:
         warnings.warn(f"the block {spec!r} changed since {glb.name} was baked (its files differ); "
                       "the wood shown is today's", WoodcamWarning, stacklevel=2)
-    with _recorded_species_quiet(species):
-        return open_stock(spec, **kwargs)
-
-
-@contextlib.contextmanager
-def _recorded_species_quiet(species: str | None):
-    """Reopen a GLB's stock with the species it records (the bake's, default oak) without
-    open_stock's '--species X: ... changes nothing here': that note is about a --species typed
-    now, so it is kept only when ``species`` was given."""
-    import warnings
-
-    from ..errors import WoodcamWarning
-
-    with warnings.catch_warnings():
-        if species is None:
-            warnings.filterwarnings("ignore", message=r"--species .* changes nothing here",
-                                    category=WoodcamWarning)
-        yield
+    return open_stock(spec, **kwargs, species_given=species is not None)
 
 
 #: Appearance parameters a GLB's metadata may carry, with their rules. A GLB is untrusted input:
