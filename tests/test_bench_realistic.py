@@ -68,3 +68,23 @@ def test_bad_options_are_named():
 def test_a_benchmark_block_needs_a_seed_and_index_that_name_one(seed, index):
     with pytest.raises(WoodcamError, match="must be an integer >= 0"):
         make_block(seed, index)
+
+
+def test_eval_realistic_takes_methods_all_as_eval_rings_does(tmp_path, monkeypatch):
+    """'eval rings --methods all' ran every method; 'eval realistic --methods all' was refused
+    ('--methods must be from ...; got ['all']')."""
+    import woodcam.bench_realistic
+    from woodcam.cli import main
+    from woodcam.cli.fit import METHODS
+
+    asked = []
+
+    def score_block(seed, index, methods, *args, **kwargs):
+        asked.append(list(methods))
+        raise SystemExit(0)  # the methods are all this test needs
+
+    monkeypatch.setattr(woodcam.bench_realistic, "score_block", score_block)
+    with pytest.raises(SystemExit):
+        main(["eval", "realistic", "--seed", "1", "--count", "1", "--methods", "all", "--out",
+              str(tmp_path / "out")])
+    assert asked == [list(METHODS)]

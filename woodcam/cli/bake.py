@@ -115,7 +115,7 @@ def run_bake(args: argparse.Namespace) -> int:
     apply_workers(args)
     shot = bool(getattr(args, "screenshot", None))
     # one bar for the whole run: opening the block can fit its rings (minutes, once)
-    with StageBar(["open block", *part_stages(False), *(["render"] if shot else [])],
+    with StageBar(["open block", *part_stages(shot)],
                   desc=f"bake {Path(args.out).stem}", leave=False) as bar:
         with bar.stage("open block"):
             stock = open_stock(args.block, **stock_options(args))

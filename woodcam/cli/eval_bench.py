@@ -7,7 +7,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import WoodcamError
 from .options import add_confidence_option, add_out_option, comma_names, command_group
 
 
@@ -28,8 +27,8 @@ def register(subparsers) -> None:
                    help="benchmark seed; use seeds never used while developing a fitter")
     r.add_argument("--count", type=int, default=6, help="blocks per row (default 6)")
     r.add_argument("--methods", default="rbf,radial,evidence",
-                   help="comma list of fitting methods from evidence, rbf, radial, neural (default "
-                   "rbf,radial,evidence)")
+                   help="comma list of fitting methods from evidence, rbf, radial, neural, or all "
+                   "(default rbf,radial,evidence)")
     r.add_argument("--scenarios", default="noisy",
                    help="comma list of clean, noisy, ring-maps (default noisy)")
     r.add_argument("--faces", default="full,three", help="comma list of full, three (default both)")
@@ -60,11 +59,10 @@ def run_realistic(args) -> int:
 
     from .fit import METHODS
 
-    methods = comma_names(args.methods, "--methods", METHODS)
+    # 'all' is every method, as in eval rings
+    methods = comma_names(args.methods, "--methods", METHODS, all_=True) or list(METHODS)
     scenarios = comma_names(args.scenarios, "--scenarios", tuple(SCENARIOS))
     faces = comma_names(args.faces, "--faces", tuple(FACE_SETS))
-    if args.count < 1 or args.eq79 < 0:
-        raise WoodcamError(f"--count must be >= 1 and --eq79 >= 0; got {args.count} and {args.eq79}")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     tasks = [(kind, i, s, f) for s in scenarios for f in faces

@@ -25,7 +25,7 @@ def register(subparsers) -> None:
     """Add ``fit`` and ``eval rings`` (``eval DIRS`` still means ``eval rings DIRS``)."""
     p = subparsers.add_parser("fit", help="infer a block's growth field from its traced faces")
     add_block_argument(p, option=False)
-    p.add_argument("--method", default="evidence", metavar="{" + ",".join(METHODS) + "}",
+    p.add_argument("--method", default="evidence", choices=METHODS,
                    help="rbf: seed 000's RBF baseline (unlabelled rings numbered by the radial fit); "
                    "neural: seed 000's eq. 5 with the generic neural field (needs torch); radial: "
                    "our pith axis, ring-width shape and growth history by least squares; evidence "
@@ -72,7 +72,6 @@ def register(subparsers) -> None:
 def run_fit(args) -> int:
     from ..inference.fit import fit_block
 
-    _check_methods([args.method], "--method")
     faces = None if args.faces is None else comma_names(args.faces, "--faces", all_=True)  # before the block is read
     apply_workers(args)
     block, _ = open_block(args.block, args.size_mm)
@@ -145,9 +144,3 @@ def run_eval(args) -> int:
             print("wrote " + ", ".join(str(out / f"{fit_on.name}_{kind}")
                                        for kind in ["holdout.md", *(f"{m}.png" for m in methods)]))
     return 0
-
-
-def _check_methods(methods, option: str) -> None:
-    bad = [m for m in methods if m not in METHODS]
-    if bad:
-        raise WoodcamError(f"{option} must be from {', '.join(METHODS)}; got {bad}")

@@ -496,14 +496,20 @@ def write_screenshot(args, files: dict, stock) -> None:
     files["png"] = png
 
 
+def _glb_metadata(glb: Path) -> dict:
+    """The woodcam metadata of a GLB file; ``{}`` for another file (an OBJ, a missing path)."""
+    from ..export import read_glb_metadata
+
+    return read_glb_metadata(glb) if glb.suffix.lower() == ".glb" and glb.is_file() else {}
+
+
 def recorded_block_size(glb: Path):
     """The block size ``(W, D, H)`` mm a baked GLB's metadata records, or None (another
     program's file, an OBJ). A malformed size is named in a WoodcamError."""
     from ..errors import WoodcamError
-    from ..export import read_glb_metadata
     from ..frames import check_size
 
-    meta = read_glb_metadata(glb) if glb.suffix.lower() == ".glb" and glb.is_file() else {}
+    meta = _glb_metadata(glb)
     if meta.get("size_mm") is None:
         return None
     try:
@@ -522,10 +528,9 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
     import warnings
 
     from ..errors import WoodcamError, WoodcamWarning
-    from ..export import read_glb_metadata
     from ..stock import open_stock, spec_digest, spec_path
 
-    meta = read_glb_metadata(glb) if glb.suffix.lower() == ".glb" and glb.is_file() else {}
+    meta = _glb_metadata(glb)
     app = meta.get("appearance") if isinstance(meta.get("appearance"), dict) else {}
     kwargs = {"species": species or app.get("species"),
               "appearance": app.get("kind") or "colormap",
