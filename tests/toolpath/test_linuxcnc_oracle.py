@@ -141,12 +141,16 @@ def test_machine_zero_agrees_with_linuxcnc_g54_offset(tmp_path):
                                  TOL_MM) is None, mzero
         assert not warnings
     assert [m[2] for m in theirs["moves"] if m[1] == 4][-1] == pytest.approx((3.5, 2, -45))
-    # not known: LinuxCNC has no such state; --interpreter linuxcnc runs it at G-code zero and
-    # says which lines that touches
-    prog = read_gcode(text, interpreter="linuxcnc")
-    assert prog.end_mm[prog.line == 4][-1].tolist() == pytest.approx([7, 2, -5])
-    assert len(prog.warnings) == 1 and "line(s) 4, 9, 10:" in prog.warnings[0]
+    # not known: LinuxCNC has no such state; --interpreter linuxcnc ran it at G-code zero (the
+    # G53 Z-5 retract 5 mm into the stock, where woodcam's interpreter retracts to --start):
+    # refused, naming the lines and --machine-zero
+    with pytest.raises(GcodeError, match=r"line 4: 'G53': machine coordinates \(G53, on line\(s\) "
+                       r"4, 9, 10\) without the machine zero.*--machine-zero"):
+        read_gcode(text, interpreter="linuxcnc")
     assert read_gcode(text, interpreter="linuxcnc", machine_zero_mm=(0, 0, 0)).warnings == []
+    # run_batch's callers pass None for "not known": the machine frame, not a TypeError
+    assert run_batch([p], start_mm=START, machine_zero_mm=None)[0]["moves"] == \
+        run_batch([p], start_mm=START)[0]["moves"]
 
 
 def test_linuxcnc_preview_stale_position_after_m6(tmp_path):

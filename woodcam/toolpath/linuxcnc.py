@@ -47,14 +47,15 @@ def run_batch(paths, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 10.0,
 
     Returns one dict per file: ``moves`` (canonical ``[kind, line, end, centre, rotation,
     plane]``, mm, in the frame of ``start_mm``: the G54 frame, whose offset is
-    ``-machine_zero_mm``; the default zero is the machine frame), ``error`` (``None`` or
+    ``-machine_zero_mm``; the default zero, or ``None``, is the machine frame), ``error`` (``None`` or
     ``[line, message]``), ``seconds``.
     """
     why = linuxcnc_missing()
     if why:
         raise WoodcamError(f"--interpreter linuxcnc: {why}; or use --interpreter woodcam")
     job = {"files": [str(Path(p).resolve()) for p in paths], "start_mm": list(start_mm),
-           "timeout_s": float(timeout_s), "machine_zero_mm": list(machine_zero_mm)}
+           "timeout_s": float(timeout_s),
+           "machine_zero_mm": [0.0, 0.0, 0.0] if machine_zero_mm is None else list(machine_zero_mm)}
     r = subprocess.run([LINUXCNC_PYTHON, "-I", str(_DRIVER)], input=json.dumps(job),
                        capture_output=True, text=True,
                        timeout=timeout_s * max(1, len(job["files"])) + 60)
@@ -72,21 +73,23 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
     """LinuxCNC's canonical moves of program ``text`` in woodcam's canonical form
     (:mod:`.interpreter`): ``(moves, warnings)``; a refusal raises :class:`GcodeError` with
     LinuxCNC's message and line. ``machine_zero_mm``: the machine origin in the G54 frame
-    (mm); ``None`` (not known) runs with it at G-code zero and warns about the G53 lines, whose
-    moves are then not where the machine goes (LinuxCNC has no "not known")."""
+    (mm); ``None`` (not known) refuses a program with G53 lines: LinuxCNC has no "not known"
+    and would take machine zero at G-code zero (a ``G53 G0 Z-5`` retract 5 mm into the stock),
+    where woodcam's interpreter takes a G53 Z move as a retract to the start height."""
+    g53 = _g53_lines(text) if machine_zero_mm is None else []
+    if g53:
+        raise GcodeError(g53[0], "G53", f"machine coordinates (G53, on line(s) {line_list(g53)}) "
+                         "without the machine zero: LinuxCNC's interpreter would take it at "
+                         "G-code zero (a G53 Z-5 retract goes 5 mm below the work zero)",
+                         "give where the machine zero lies in the G-code frame (--machine-zero "
+                         "X,Y,Z; read_gcode's machine_zero_mm), or use --interpreter woodcam, "
+                         "which takes a G53 Z move as a retract to the --start height")
     with tempfile.TemporaryDirectory(prefix="woodcam-lcnc-") as d:
         p = Path(d) / "program.ngc"
         p.write_text(text)
         res = run_batch([p], start_mm=start_mm, timeout_s=timeout_s,
-                        machine_zero_mm=machine_zero_mm or (0.0, 0.0, 0.0))[0]
+                        machine_zero_mm=machine_zero_mm)[0]
     warnings = []
-    g53 = _g53_lines(text) if machine_zero_mm is None else []
-    if g53:
-        warnings.append((g53[0], f"G53 (machine coordinates) on line(s) {line_list(g53)}: "
-                         "without the machine zero LinuxCNC's interpreter took it at G-code "
-                         "zero (a G53 Z-5 retract goes 5 mm below the work zero); give where "
-                         "the machine zero lies in the G-code frame (--machine-zero X,Y,Z) to "
-                         "place them"))
     if res["error"]:
         line, msg = res["error"]
         if msg != NO_END:
