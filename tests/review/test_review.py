@@ -268,13 +268,19 @@ def test_views_frame_the_block_at_any_aspect_and_the_hash_sets_the_ui(page, brow
         browser.evaluate("new Promise((ok) => setTimeout(() => ok(true), 200))")
         _frames(browser)
         _assert_framed(browser, False, f"iso, perspective, {size}")
+    # an inherited key (toString) was taken as an axis and a view: NaN cut, NaN camera
     for arg, label in (("x:nan", "x = 50.0 mm"), ("z:9999", "z = 50.0 mm"),
-                       ("q:zz", "y = 40.0 mm")):
+                       ("q:zz", "y = 40.0 mm"), ("toString:5&view=toString", "y = 40.0 mm")):
         browser.call("Page.navigate", session=True, url="about:blank")
         assert browser.load(f"file://{out}#cut={arg}") == "box: ready"
+        assert np.all(np.isfinite(_ndc(browser, "ndcBlock"))), arg
         assert browser.evaluate("document.getElementById('cut-label').textContent") == label, arg
         assert browser.evaluate("document.getElementById('cut-on').checked") is True
         assert browser.evaluate("document.getElementById('ortho').checked") is False
+    # the probe follows view changes, not every animation frame (it was rewritten per frame)
+    browser.evaluate("document.getElementById('probe').dataset.ndcBlock = 'kept'")
+    _frames(browser)
+    assert browser.evaluate("document.getElementById('probe').dataset.ndcBlock") == "kept"
     # an edited hash on the open page applies (it changed nothing until a reload)
     browser.evaluate("document.title = 'stale'")
     assert browser.load(f"file://{out}#view=top&cut=x:10") == "box: ready"

@@ -82,6 +82,7 @@ function resize() {
   ortho.left = -half * aspect; ortho.right = half * aspect;
   ortho.top = half; ortho.bottom = -half;
   ortho.updateProjectionMatrix();
+  updateProbe();
 }
 
 // Views: front looks along block +Y, top down block -Z, iso from front-right-above.
@@ -90,7 +91,7 @@ const VIEWS = {
   iso: [1, -1, 0.8],
 };
 function setView(name) {
-  viewName = name in VIEWS ? name : 'iso';
+  viewName = Object.hasOwn(VIEWS, name) ? name : 'iso';  // not 'toString' (inherited)
   const d = VIEWS[viewName];
   const dir = worldOfBlock(d[0], d[1], d[2]).normalize();
   persp.aspect = canvasAspect();  // resize() below then keeps this distance
@@ -116,7 +117,10 @@ function ndcBounds(lo, hi) {
   }
   return [b.min.x, b.min.y, b.max.x, b.max.y].map((v) => v.toFixed(4)).join(',');
 }
+// Updated when the view changes (setView, resize, focusOn, the controls' 'change', the
+// orthographic switch), not every frame.
 function updateProbe() {
+  camera.updateMatrixWorld();  // the render has not run yet: project with the camera as it is now
   const probe = document.getElementById('probe');
   const block = new THREE.Box3().setFromPoints([worldOfBlock(0, 0, 0), worldOfBlock(W, D, H)]);
   probe.dataset.ndcBlock = ndcBounds(block.min, block.max);
@@ -176,7 +180,7 @@ const capFragment = `
 // (an unknown axis) gives the default, y through the middle.
 const LIMITS = { x: W, y: D, z: H };
 const cutArg = (params.get('cut') || '').split(':');
-const cutAxis = cutArg[0] in LIMITS ? cutArg[0] : 'y';
+const cutAxis = Object.hasOwn(LIMITS, cutArg[0]) ? cutArg[0] : 'y';  // #cut=toString:5 was NaN
 const cutMm = cutAxis === cutArg[0] && cutArg.length > 1 ? parseFloat(cutArg[1]) : NaN;
 const cut = { axis: cutAxis,
               pos: Number.isFinite(cutMm) ? THREE.MathUtils.clamp(cutMm, 0, LIMITS[cutAxis])
@@ -336,6 +340,7 @@ function focusOn(atMm) {
     if (on) on.checked = false;
     updatePlane();
   }
+  updateProbe();
 }
 
 function addHotspots() {
@@ -383,6 +388,7 @@ function bindUi() {
     camera.up.copy(prev.up);
     camera.lookAt(controls.target);
     controls.object = camera;
+    updateProbe();
   };
   const axis = document.getElementById('cut-axis'), pos = document.getElementById('cut-pos');
   const on = document.getElementById('cut-on'), label = document.getElementById('cut-label');
@@ -422,7 +428,9 @@ async function main() {
   updatePlane();
   window.addEventListener('resize', resize);
   window.addEventListener('beforeprint', snapshot);
-  renderer.setAnimationLoop(() => { controls.update(); renderer.render(scene, camera); updateProbe(); });
+  controls.addEventListener('change', updateProbe);  // orbit, pan, zoom, damping
+  updateProbe();
+  renderer.setAnimationLoop(() => { controls.update(); renderer.render(scene, camera); });
   status.textContent = 'ready';
   document.title = `${data.title}: ready`;
 }
