@@ -174,7 +174,6 @@ def test_meshing_options_on_a_mesh_part_are_said_to_be_ignored(tmp_path, capsys)
 def test_a_part_in_inches_gets_each_commands_own_fix(tmp_path, capsys, monkeypatch):
     """The warning of a part in inches told `woodcam place` (no --place option) and library
     callers of carve() to 'add --place scale:25.4 --place center': each caller says its own."""
-    monkeypatch.setattr("woodcam.cli._printed", set())  # another test's main() may have printed it
     part = tmp_path / "tray_inches.stl"
     trimesh.creation.box((3.0, 2.0, 0.5)).apply_translation((50, 40, 25)).export(part)
     assert main(["bake", str(part), "--block", "builtin:knotty", "--out", str(tmp_path / "t.glb"),

@@ -171,3 +171,19 @@ def test_preview_screenshot_takes_an_optional_name_like_bake_and_gcode(tmp_path,
         for action in parser._actions:
             if "--screenshot" in action.option_strings:
                 assert action.nargs == "?", name
+
+
+def test_a_second_run_in_one_process_prints_its_warnings_too(tmp_path, monkeypatch, capsys):
+    """The record of printed warnings lived as long as the process: a second cli.main() (a
+    notebook, a test, a script driving woodcam) printed none that the first had printed."""
+    import woodcam.view as view
+
+    monkeypatch.setattr(view, "preview", lambda mesh, **kw: None)
+    monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block: None)
+    monkeypatch.setattr("woodcam.cli.options.recorded_block_size", lambda mesh: None)
+    glb = tmp_path / "part.glb"
+    glb.write_bytes(b"")
+    argv = ["preview", str(glb), "--screenshot", "--no-cut", "--cut-origin", "1,2,3"]
+    for _ in range(2):
+        assert cli.main(argv) == 0
+        assert "woodcam: warning: --cut-origin places the cut plane" in capsys.readouterr().err

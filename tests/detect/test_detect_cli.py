@@ -486,6 +486,5 @@ def test_a_photo_only_block_with_a_turned_face_warns_wherever_it_is_detected(tmp
         assert len(turned) == 1 and turned[0].startswith("face 'top' looks turned 90 degrees clockwise"), run
     blk = tmp_path / "blk"
     assert _run(capsys, "block", "from-photos", photos, "--size-mm", "50", "--out", blk)[0] == 0
-    monkeypatch.setattr("woodcam.cli._printed", set())  # an earlier test's main() printed it already
     rc, _, err = _run(capsys, "block", "show", blk, "--check-layout", "--out", tmp_path / "x.png")
     assert rc == 0 and err.count("face 'top' looks turned 90 degrees clockwise") == 1, err

@@ -189,6 +189,7 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``woodcam`` console script; returns the exit status."""
     parser = build_parser()
     args = parser.parse_args(_apply_aliases(list(sys.argv[1:] if argv is None else argv), parser))
+    _printed.clear()  # once per run: a second main() in one process printed none of the first's
     interrupted = False
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
