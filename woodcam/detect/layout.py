@@ -43,7 +43,7 @@ SMOOTH_MM = 0.2
 STEP_MM = 0.1
 #: A variant of a face must beat its layout by more than this mean edge correlation to be
 #: reported. Measured (README "From photos alone"): faces laid out right reach at most -0.02
-#: (Mokume CN03, H11, photos) and +0.11 (synthetic blocks), so 0.15 leaves room for a false alarm.
+#: (Mokume CN03, H11, photos) and +0.11 (synthetic blocks): 0.15 keeps a margin against false alarms.
 LAYOUT_MARGIN = 0.15
 #: Another correction scoring within this of the best is named beside it: on a nearly symmetric
 #: face (rings mirrored in its own midline) turning 180 degrees and flipping look alike.
