@@ -114,36 +114,32 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _commands(parser: argparse.ArgumentParser):
-    """Every (name, help, parser) of ``parser``'s sub-commands, at any depth."""
+def _commands(parser: argparse.ArgumentParser, path: tuple[str, ...] = ()):
+    """Every (command path, help, parser) of ``parser``'s sub-commands, at any depth."""
     for action in parser._actions:
         if isinstance(action, argparse._SubParsersAction):
             helps = {a.dest: a.help for a in action._choices_actions}
             for name, sp in action.choices.items():
-                yield name, helps.get(name), sp
-                yield from _commands(sp)
+                yield (*path, name), helps.get(name), sp
+                yield from _commands(sp, (*path, name))
 
 
 def _describe_commands(parser: argparse.ArgumentParser) -> None:
     """A command without a description of its own opens its ``--help`` with its one-line help
     from the command list (``woodcam block show --help`` went straight from usage to arguments,
     saying nowhere what the command does)."""
-    for _name, text, sp in _commands(parser):
+    for _path, text, sp in _commands(parser):
         if not sp.description and text:
             sp.description = text[0].upper() + text[1:] + ("" if text.endswith(".") else ".")
 
 
 def _walk_options(parser: argparse.ArgumentParser):
     """Every (command path, optional action) of ``parser`` and its sub-commands."""
-    stack: list[tuple[list[str], argparse.ArgumentParser]] = [([], parser)]
-    while stack:
-        path, p = stack.pop()
+    for path, _help, p in [((), None, parser), *_commands(parser)]:
         for action in p._actions:
-            if isinstance(action, argparse._SubParsersAction):
-                stack += [([*path, name], sp) for name, sp in action.choices.items()]
-            elif action.option_strings and not isinstance(
+            if action.option_strings and not isinstance(
                     action, (argparse._HelpAction, argparse._VersionAction)):
-                yield path, action
+                yield list(path), action
 
 
 def _state_defaults(parser: argparse.ArgumentParser) -> None:
