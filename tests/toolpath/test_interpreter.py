@@ -313,6 +313,22 @@ def test_an_n_word_is_read_only_at_the_start_of_a_line():
     _refused(_BODY + "N5 G1 X2 N6\n", 4, "N6", "word N twice", dialect="grbl")
 
 
+def test_an_n_word_is_digits_before_any_comment():
+    """LinuxCNC refuses a line number after a comment or a block delete after one ("Bad
+    character 'n' used"), and one that is not digits ("Bad format unsigned integer"); woodcam
+    read them all. A line that is never reached (an uncalled subroutine) is not refused."""
+    _refused(_BODY + "(c) N5 G1 X2\nM2\n", 4, "N", "line number .N word. after a comment")
+    _refused(_BODY + "/(c)N5 G1 X2\nM2\n", 4, "N", "after a comment")
+    _refused(_BODY + "(c) /G1 X2\nM2\n", 4, "/", "block delete '/' after a comment")
+    _refused(_BODY + "(c) N5 o100 sub\nG1 X2\no100 endsub\nM2\n", 4, "N", "after a comment")
+    for word in ("N-5", "N+5", "N5.", "N.5", "N#1", "N[5]", "N"):
+        _refused(_BODY + f"{word} G1 X2\nM2\n", 4, word, "line number must be digits")
+    prog = read_gcode(_BODY + "N5 (c) G1 X2\nN6.5 G1 X3\n/ (c) G1 X4\no1 sub\n(c) N7 G1 X9\n"
+                      "o1 endsub\nM2\n")
+    assert [round(m.end_mm[0]) for m in prog.moves] == [0, 1, 2, 3, 4]
+    assert len(read_gcode(_BODY + "(c) N-5 G1 X2\n", dialect="grbl")) == 3
+
+
 def test_words_no_code_uses_are_refused_and_io_warned():
     for line, word in (("G1 X1 Q2 F100", "Q2"), ("G0 X1 R3", "R3"), ("G1 X1 P5 F100", "P5"),
                        ("G0 X1 L2", "L2"), ("G0 X1 H1", "H1"), ("G0 X1 I2", "I2")):

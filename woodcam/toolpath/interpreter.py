@@ -25,7 +25,7 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``G54-G59.3``, ``G61/G61.1/G64``, ``G73 G81 G82 G83 G85 G86 G89`` with ``G98/G99`` and ``L``,
   ``G80``, ``G90/G91``, ``G90.1/G91.1``, ``G92/G92.1/G92.2/G92.3``, ``G94``, ``G97``;
   ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60`` (one of each modal group a line);
-  ``F S T``, ``N`` (the first word of a line; grbl: anywhere); ``( )``/``;`` comments,
+  ``F S T``, ``N`` (digits, the first word of a line, before any comment; grbl: anywhere); ``( )``/``;`` comments,
   ``(msg,...)``, block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
   of its own: the first non-blank line opens, the next ends the program; any other ``%`` is an
   error, as in LinuxCNC).
@@ -117,7 +117,11 @@ class GcodeError(WoodcamError):
 # ------------------------------------------------------------------------------------------
 # words
 _NUM = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
-_OWORD = re.compile(r"(?:n\d+(?:\.\d*)?)?o(<[^>]*>|\d+)([a-z]+)(.*)$")
+_OWORD = re.compile(r"(?:n\d+(?:\.\d+)?)?o(<[^>]*>|\d+)([a-z]+)(.*)$")
+#: LinuxCNC's line number: digits, optionally '.' and more digits ("N5", "N5.1"; it refuses
+#: "N-5", "N+5", "N5.", "N.5", "N#1" with "Bad format unsigned integer").
+_LINE_NUMBER = re.compile(r"\d+(?:\.\d+)?(?!\.)")
+_N_WORD = re.compile(r"n[^a-z]*")  # an N word as written, for the message
 _ONUMBER = re.compile(r"(?:n\d+)?o\d+$")
 #: Words of a plain move line ("X12.5 Z-1.2 F900" in G0/G1): :meth:`Interpreter.execute`
 #: runs them on a short path (the raster lines of a relief program are nearly all such lines).
@@ -206,11 +210,26 @@ class _Line:
     """A source line after comments are taken out: lowercase, no whitespace (LinuxCNC's
     normalisation), the 1-based line number and the messages of its comments."""
 
-    __slots__ = ("text", "no", "msg", "okey", "olabel", "oexpr")
+    __slots__ = ("text", "no", "msg", "okey", "olabel", "oexpr", "late")
 
     def __init__(self, text, no, msg):
         self.text, self.no, self.msg = text, no, msg
         self.okey = self.olabel = self.oexpr = None
+        self.late = None  # 'N' or '/': that start-of-line word came after a comment
+
+
+def _after_comment(raw: str, text: str) -> str | None:
+    """``'N'`` or ``'/'`` when the line's leading block delete or line number (``text``, the
+    normalised line) follows a comment in ``raw`` (``(c) N5 G1``, ``(c) /G1``): LinuxCNC reads
+    both only as the line's first characters ("Bad character 'n' used"), else ``None``."""
+    if "(" not in raw or text[:1] not in ("n", "/"):
+        return None
+    head = raw.lstrip()
+    if text[0] == "/":
+        if not head.startswith("/"):
+            return "/"
+        head, text = head[1:].lstrip(), text[1:]
+    return "N" if text[:1] == "n" and head[:1] not in ("n", "N") else None
 
 
 def split_comments(raw: str, no: int) -> tuple[str, list[str]]:
@@ -588,6 +607,8 @@ class Interpreter:
             if text == "%" and grbl:
                 continue
             ln = _Line(text, no, msg)
+            if not grbl:
+                ln.late = _after_comment(raw, text)
             body = text[1:] if text.startswith("/") else text
             m = _OWORD.match(body) if "o" in body else None
             if m:
@@ -691,6 +712,12 @@ class Interpreter:
                                "endless loop?)", "check the loop conditions")
             for m in ln.msg:
                 self.messages.append((ln.no, m))
+            if ln.late:  # refused when reached, as LinuxCNC (an uncalled sub's line is not)
+                what = ("a line number (N word)" if ln.late == "N"
+                        else "a block delete '/'")
+                raise self.err(ln.late, f"{what} after a comment: LinuxCNC reads it only as "
+                               "the first word of a line ('Bad character' there)",
+                               f"move the comment after the {ln.late} or remove the {ln.late}")
             k = ln.okey
             if k is None:
                 if pc == self.closing:
@@ -884,6 +911,11 @@ class Interpreter:
                 raise self.err(s[i:i + 6], "grbl has no expressions or parameters",
                                "use --dialect linuxcnc")
             at = i
+            if letter == "n" and self.dialect != "grbl" and not _LINE_NUMBER.match(s, i + 1):
+                raise self.err(_N_WORD.match(s, i).group(0).upper(), "a line number must be "
+                               "digits, optionally '.' and digits (N10, N10.1); LinuxCNC "
+                               "refuses a sign, expression or parameter there ('Bad format "
+                               "unsigned integer')", "write N10 or remove the N word")
             v, i = self.value(s, i + 1)
             if letter == "g":
                 gs.append(v)
