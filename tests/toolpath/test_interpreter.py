@@ -146,6 +146,29 @@ def test_units_incremental_g53_g28():
     assert [m[2] for m in moves] == [(6, 0, 30), (1, 0, 30), (0, 0, 30)]
 
 
+def test_position_and_tool_parameters_read_as_linuxcnc():
+    """#5420-#5422 are the current position in the program's units and frame (checked against
+    LinuxCNC's interpreter); they read 0. #5400 missed M61. The read-only ones could be
+    assigned, and tool-table, probe and input values the machine would supply read 0."""
+    assert _ends("G0 X5 Y6 Z7\nG0 X[#5420+1] Y[#5421+1] Z[#5422+1]\nM2\n")[1] == (6, 7, 8)
+    # G20, G55 with its X offset at 1 inch: program X0 Y2 Z3 (inch)
+    ends = _ends("G20 G0 X1 Y2 Z3\nG55\nG10 L2 P2 X1\nG0 X#5420 Y[#5421+1] Z#5422 \nM2\n")
+    assert ends[-1] == pytest.approx((25.4, 76.2, 76.2))
+    assert _ends("G0 X1 Y2 Z3\nG91\nG0 X#5420 Y#5423\nM2\n")[-1] == (2, 2, 3)
+    assert _ends("G0 X1\nG92 X0\nG0 Y[#5420+1]\nM2\n")[-1] == (1, 1, 0)
+    assert _ends("T3 M6\nG0 X#5400\nM61 Q5\nG0 Y#5400\nM2\n")[-1] == (3, 5, 0)
+    assert _ends("G0 X#5599 Y#5600 Z1\n#5061=2\nG0 X#5061\nM2\n") == [(1, 0, 1), (2, 0, 1)]
+    for n in (5400, 5401, 5410, 5420, 5428):
+        with pytest.raises(GcodeError, match=f"#{n} is a read-only system parameter"):
+            _ends(f"#{n} = 3\nM2\n")
+    with pytest.raises(GcodeError, match="#5410 is the loaded tool's .* tool table"):
+        _ends("G0 X#5410\nM2\n")
+    with pytest.raises(GcodeError, match="#5063 holds a G38 probe result"):
+        _ends("G0 Z#5063\nM2\n")
+    with pytest.raises(GcodeError, match="#5399 holds an M66 input"):
+        Interpreter("#5399=1\nG0 X#5399\nM66 P0\nG0 X#5399\nM2\n").run()
+
+
 def test_parameter_lengths_are_mm_whatever_the_units():
     """A metric machine's parameters: G28 in a G20 program went to 25.4x the stored home (Z254
     for a home at Z10), G10 L2 in G20 stored inches that G55 then read as mm."""

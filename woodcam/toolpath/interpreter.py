@@ -6,7 +6,13 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``#<name>`` and global ``#<_name>`` parameters, indirect ``##1`` / ``#[1+2]``; system
   parameters: coordinate systems ``#5221``... (G54 at 5221, each next one 20 higher), G92
   ``#5210``-``#5213``, G28/G30 homes ``#5161``/``#5181``, ``#5220`` (active system),
-  ``#5400`` (tool), ``#<_value>`` (last return value); their lengths are millimetres whatever
+  ``#5400`` (loaded tool), ``#5420``-``#5428`` (current position, program units and frame,
+  as ``#<_x>``...; A-W read 0: woodcam has no such axes), ``#5599`` (1), ``#5600``/``#5601``
+  (0: no tool-changer faults), ``#<_value>`` (last return value); read-only ones
+  (``#5400``-``#5413``, ``#5420``-``#5428``) cannot be assigned, as in LinuxCNC; reading what
+  woodcam cannot know is refused: the tool table's offsets and diameter ``#5401``-``#5413``, and
+  probe (``#5061``-``#5070``) or input (``#5399``) results the program did not assign; lengths
+  are millimetres whatever
   ``G20/G21`` (LinuxCNC on a metric machine: the machine's units), so ``G28`` in a ``G20``
   program returns to the stored home and a ``G20`` program reads ``#5221`` in mm;
 - expressions ``[...]`` with ``** * / mod + - eq ne gt ge lt le and or xor`` (LinuxCNC's six
@@ -200,6 +206,14 @@ def _cs_base(n: int) -> int:
     return 5221 + 20 * (n - 1)
 
 
+#: LinuxCNC's read-only numbered parameters (assigning one is refused there, "Parameter is
+#: readonly"): #5400 the loaded tool, #5401-#5413 its tool-table entry, #5420-#5428 the position.
+_READ_ONLY_NUM = frozenset(range(5400, 5414)) | frozenset(range(5420, 5429))
+#: Parameters that hold what the machine measured when the program ran: a G38 probe result
+#: (#5061-#5070) or an M66 input (#5399); woodcam simulates neither, so reading one the program
+#: did not assign is refused (LinuxCNC would read the last probe's or input's value).
+_MEASURED = {**{k: "a G38 probe result" for k in range(5061, 5071)}, 5399: "an M66 input"}
+
 #: LinuxCNC 2.9's predefined read-only named parameters that woodcam knows.
 _READ_ONLY = {"_x", "_y", "_z", "_a", "_b", "_c", "_u", "_v", "_w", "_metric", "_imperial",
               "_absolute", "_incremental", "_feed", "_rpm", "_current_tool", "_selected_tool",
@@ -289,6 +303,7 @@ class Interpreter:
         for i in range(3):  # G54 offset: the G-code zero in machine coordinates
             self.p[5221 + i] = -shift[i]
         self.p[5220] = 1.0
+        self.p[5599] = 1.0  # LinuxCNC's (DEBUG,...) output flag, on by default
         if params:
             self.p.update({int(k): float(v) for k, v in params.items()})
         self.globals: dict[str, float] = {}
@@ -368,6 +383,23 @@ class Interpreter:
     # -- parameters -------------------------------------------------------------------------
     def get_num(self, n: float, word: str) -> float:
         k = self._param_index(n, word)
+        if 5400 <= k <= 5601:
+            if k == 5400:
+                return float(self.tool)
+            if 5420 <= k <= 5422:  # as #<_x> #<_y> #<_z>: program units and frame
+                return self.to_program(self.pos)[k - 5420]
+            if 5423 <= k <= 5428 or k in (5600, 5601):  # A-W; no tool-changer faults
+                return 0.0
+            if 5401 <= k <= 5413:
+                raise self.err(word, f"#{k} is the loaded tool's offset, diameter, angle or "
+                               "orientation in the machine's tool table (#5401-#5413), which "
+                               "woodcam does not know (its tools are measured from the tip)",
+                               "put the value in a parameter of the program's own, e.g. "
+                               "#<dia> = 6")
+        if k in _MEASURED and k not in self.p:
+            raise self.err(word, f"#{k} holds {_MEASURED[k]} from the machine, which woodcam "
+                           "does not simulate, and the program did not assign it",
+                           f"assign #{k} before reading it")
         return self.p.get(k, 0.0)
 
     def _param_index(self, n, word):
@@ -940,6 +972,9 @@ class Interpreter:
             if ref[0] == "n" and ref[1] in _READ_ONLY:
                 raise self.err(f"#<{ref[1]}>", f"#<{ref[1]}> is a read-only system parameter",
                                "use another name")
+            if ref[0] == "i" and ref[1] in _READ_ONLY_NUM:
+                raise self.err(f"#{ref[1]}", f"#{ref[1]} is a read-only system parameter "
+                               "(LinuxCNC: 'Parameter is readonly')", "use another parameter")
             if ref[0] == "n":
                 (self.globals if ref[1].startswith("_") else self.locals)[ref[1]] = v
             else:
@@ -1022,7 +1057,8 @@ class Interpreter:
             self.tool = self.selected = int(w["q"])
         if 6 in mset:
             self.tool = self.selected
-            self.p[5400] = float(self.tool)
+        if 66 in mset:  # the input it waits for lands in #5399: not known from here on
+            self.p.pop(5399, None)
         if mset & {3, 4}:
             self.spindle_on = True
         if 5 in mset:
