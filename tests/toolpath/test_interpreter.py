@@ -307,8 +307,25 @@ def test_a_percent_line_counts_only_as_linuxcnc_reads_it():
     # after the closing one; a '%' after the program end is never reached
     assert len(read_gcode("\n %\n" + _BODY + "\t%\nG1 X50\n")) == 2
     assert len(read_gcode(_BODY + "M2\n%\nG1 X50\n")) == 2
-    # grbl has no '%' (error 1 in the firmware): its senders drop the lines
-    assert len(read_gcode(_BODY + "%\nG1 X50\n", dialect="grbl")) == 3
+
+
+def test_a_percent_line_inside_a_grbl_program_is_skipped_with_a_warning():
+    """grbl's firmware answers every '%' line with error:1; its senders drop the lines (UGS) or
+    report the error and stream on (grbl's stream.py): the moves after any '%' run. woodcam
+    skipped a stray '%' without a word, and ended the program at a second '%' (LinuxCNC's
+    reading) where the senders run on."""
+    prog = read_gcode(_BODY + "%\nG1 X50\n", dialect="grbl")
+    assert len(prog) == 3
+    assert prog.warnings == [
+        "line 4: '%' on line(s) 4 inside the program: grbl's firmware answers it with error:1 "
+        "(Expected command letter); senders drop the line or report the error and go on, so "
+        "woodcam skipped it, but a sender that stops on errors stops the job there; keep '%' "
+        "to the first and last line"]
+    prog = read_gcode("%\n" + _BODY + "%\nG1 X50\n%\n", dialect="grbl")
+    assert len(prog) == 3 and [w[:7] for w in prog.warnings] == ["line 5:"]
+    # the delimiters a post writes first and last, comments around them: no warning
+    prog = read_gcode("(post)\n%\n(job)\n" + _BODY + "M30\n%\n(end)\n", dialect="grbl")
+    assert len(prog) == 2 and prog.warnings == []
 
 
 def test_two_m_codes_of_one_modal_group_are_refused():

@@ -619,25 +619,34 @@ class Interpreter:
         closing = None  # index of the line of the closing '%'
         first = True
         grbl = self.dialect == "grbl"
+        grbl_percent: list[int] = []  # grbl: the '%' lines dropped
         for no, raw in enumerate(self.src, start=1):
             self.line_no = no
             text, msg = split_comments(raw, no)
             # LinuxCNC reads '%' only as a line of its own (blanks around it, no comment): the
             # first non-blank line opens a %-delimited program and the next such line ends it;
             # any other '%' is refused when it is reached ("Bad character '%' used": the
-            # moves after it never run). grbl has no '%' at all; its senders drop those lines.
-            bare = text == "%" if grbl else raw.strip() == "%"
-            if first and ((text or msg) if grbl else raw.strip()):
-                first = False
-                if bare:
-                    percent = True
+            # moves after it never run). grbl's firmware has no '%' at all: it answers every
+            # '%' line with error:1 ("Expected command letter") and moves nothing; its senders
+            # drop those lines (Universal G-code Sender strips every '%') or report the error
+            # and stream on (grbl's own stream.py), so the moves after any '%' run: woodcam
+            # drops them all, and warns about one inside the program (not the delimiters a
+            # post writes first and last), where a sender that stops on errors stops the job.
+            if grbl:
+                if text == "%":
+                    grbl_percent.append(no)
                     continue
-            if bare and percent:
-                closing = len(lines)
-                lines.append(_Line("%", no, msg))
-                break
-            if text == "%" and grbl:
-                continue
+            else:
+                bare = raw.strip() == "%"
+                if first and raw.strip():
+                    first = False
+                    if bare:
+                        percent = True
+                        continue
+                if bare and percent:
+                    closing = len(lines)
+                    lines.append(_Line("%", no, msg))
+                    break
             ln = _Line(text, no, msg)
             if not grbl:
                 ln.late = _after_comment(raw, text)
@@ -669,6 +678,15 @@ class Interpreter:
             lines.append(ln)
         self.lines = lines
         self.closing = closing
+        words = [ln.no for ln in lines if ln.text]
+        inside = [no for no in grbl_percent if words and words[0] < no < words[-1]]
+        if inside:
+            self.warnings.append((inside[0], f"'%' on line(s) {line_list(inside)} inside the "
+                                  "program: grbl's firmware answers it with error:1 (Expected "
+                                  "command letter); senders drop the line or report the error "
+                                  "and go on, so woodcam skipped it, but a sender that stops on "
+                                  "errors stops the job there; keep '%' to the first and last "
+                                  "line"))
         # match structure
         self.match: dict[int, int] = {}   # opener index -> closer index (and back)
         self.branches: dict[int, list[int]] = {}  # if index -> [elseif/else..., endif]
