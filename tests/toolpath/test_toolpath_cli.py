@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import woodcam.pipeline
@@ -279,6 +280,17 @@ def test_stepover_of_stacked_levels_helices_and_crossings():
     crossing = "G21 G90 F500\nG0 X-20 Y40 Z5\nG1 Z-5\nG1 X130\nG0 Z5\nG0 X50 Y-20\n" \
         "G1 Z-5\nG1 Y100\nG0 Z5\nM2\n"
     assert read_gcode(crossing).stepover_mm(0.1) is None
+
+
+def test_the_corpus_pocket_steps_over_5_mm():
+    """lcnc_params_pocket.ngc (a zig-zag at 5 mm) went from the end of each leftward pass
+    diagonally to the start of the next rightward one, across the passes: its step-over read
+    1.09 mm and the pocket was cut on a slant. Each feed now runs along X or Y."""
+    prog = read_gcode(REPO / "toolpaths" / "corpus" / "lcnc_params_pocket.ngc")
+    d = prog.end_mm - prog.start_mm
+    feed = (prog.kind == 1) & (np.abs(d[:, :2]).max(axis=1) > 0)
+    assert (np.abs(d[feed, :2]).min(axis=1) < 1e-9).all()
+    assert prog.stepover_mm(0.5) == pytest.approx(5.0)
 
 
 def test_the_simulations_issues_reach_the_review_page_as_hotspots(tmp_path, capsys):
