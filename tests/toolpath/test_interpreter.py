@@ -369,6 +369,29 @@ def test_an_n_word_is_digits_before_any_comment():
     assert len(read_gcode(_BODY + "(c) N-5 G1 X2\n", dialect="grbl")) == 3
 
 
+def test_analog_io_words_are_read_and_checked_as_linuxcnc():
+    """LinuxCNC reads "M67 E0 Q50" (a laser's power), "M66 P0 L3 Q5" (wait for an input);
+    woodcam refused every E word as an axis it lacks and every L beside M66. Their checks as
+    LinuxCNC's (each line below checked against its interpreter)."""
+    prog = read_gcode(_BODY + "M67 E0 Q50 G1 X2\nM68 E1.5 Q3\nM66 E0 L0\nM66 P0 L3 Q5\n"
+                      "M66 P1\nM2\n")
+    assert len(prog) == 3
+    assert [w.split(": ", 1)[1] for w in prog.warnings] == [
+        "M67 (analog output) is not simulated", "M68 (analog output) is not simulated",
+        "M66 (wait on input) is not simulated", "M66 (wait on input) is not simulated",
+        "M66 (wait on input) is not simulated"]
+    for line, word, rule in (("G0 X1 E5", "E5", "E word with no G or M code"),
+                             ("M62 P0 E1", "E1", "E word with no G or M code"),
+                             ("M66 P0 E1", "P0 E1", "not both"),
+                             ("M66 L0", "M66", "needs P .* or E"),
+                             ("M66 P-1", "M66", "needs P .* or E"),
+                             ("M66 P0 L2", "L2", "needs a timeout Q > 0"),
+                             ("M67 Q5", "M67", "needs E"), ("M68 E-1 Q5", "M68", "needs E")):
+        _refused(_BODY + line + "\nM2\n", 4, word, rule)
+    with pytest.raises(GcodeError, match="unsupported word E"):
+        read_gcode(_BODY + "M67 E0 Q5\n", dialect="grbl")
+
+
 def test_words_no_code_uses_are_refused_and_io_warned():
     for line, word in (("G1 X1 Q2 F100", "Q2"), ("G0 X1 R3", "R3"), ("G1 X1 P5 F100", "P5"),
                        ("G0 X1 L2", "L2"), ("G0 X1 H1", "H1"), ("G0 X1 I2", "I2")):

@@ -31,7 +31,7 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``G54-G59.3``, ``G61/G61.1/G64``, ``G73 G81 G82 G83 G85 G86 G89`` with ``G98/G99`` and ``L``,
   ``G80``, ``G90/G91``, ``G90.1/G91.1``, ``G92/G92.1/G92.2/G92.3``, ``G94``, ``G97``;
   ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60`` (one of each modal group a line);
-  ``F S T``, ``N`` (digits, the first word of a line, before any comment; grbl: anywhere); ``( )``/``;`` comments,
+  ``F S T``, ``E`` (beside ``M66``-``M68``), ``N`` (digits, the first word of a line, before any comment; grbl: anywhere); ``( )``/``;`` comments,
   ``(msg,...)``, block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
   of its own: the first non-blank line opens, the next ends the program; any other ``%`` is an
   error, as in LinuxCNC).
@@ -145,8 +145,9 @@ _BINOPS = (("**", 6), ("*", 5), ("/", 5), ("mod", 5), ("+", 4), ("-", 4), ("eq",
 _OKEYS = ("sub", "endsub", "call", "return", "if", "elseif", "else", "endif", "while",
           "endwhile", "do", "repeat", "endrepeat", "break", "continue")
 # the words a 3-axis mill program may carry (D only beside cutter compensation, which is
-# refused by its G code: a "G41 D1" line names G41, not an unknown letter)
-_LETTERS = set("dfgmnstxyzijkrpqlh")
+# refused by its G code: a "G41 D1" line names G41, not an unknown letter; E only beside
+# LinuxCNC's analog I/O M66/M67/M68, "M67 E0 Q50" setting a laser's or plasma's power)
+_LETTERS = set("dfgmnstxyzijkrpqlhe")
 _MOTION = {0.0, 1.0, 2.0, 3.0, 73.0, 80.0, 81.0, 82.0, 83.0, 85.0, 86.0, 89.0}
 _CYCLES = {73.0, 81.0, 82.0, 83.0, 85.0, 86.0, 89.0}
 _G_GROUPS = {
@@ -940,7 +941,7 @@ class Interpreter:
             if c == "[" or c.isdigit():
                 raise self.err(s[i:i + 10], "a value without a letter", "write a word like X1")
             letter = c
-            if letter not in _LETTERS:
+            if letter not in _LETTERS or (letter == "e" and self.dialect == "grbl"):
                 if c == "%":  # (a '%' line of its own that opens or ends a program never gets here)
                     raise self.err("%", "'%' is read only as a line of its own that opens the "
                                    "file and then ends the program (LinuxCNC refuses this "
@@ -1053,6 +1054,8 @@ class Interpreter:
                 raise self.err(f"{k.upper()}{w[k]:g}", "must be a non-negative integer",
                                f"write {k.upper()}{max(0, round(w[k])):d}" if abs(w[k]) < 1e9
                                else "fix the number")
+        if mset & {66, 67, 68}:
+            self._analog_io(mset, w)
         # 3-5. feed mode (LinuxCNC zeroes F on every G93/G94/G95), feed, spindle, tool
         if g & {93.0, 94.0, 95.0}:
             self.feed = 0.0
@@ -1169,15 +1172,35 @@ class Interpreter:
         if mset & {2, 30}:
             self.ended = True
 
+    def _analog_io(self, mset, w):
+        """LinuxCNC's checks of M66 (wait on digital input P or analog input E, wait type L,
+        timeout Q s) and M67/M68 (analog output E set to Q): read, not simulated, but a line
+        LinuxCNC refuses is refused here too."""
+        if 66 in mset:
+            if "p" in w and "e" in w:
+                raise self.err(f"P{w['p']:g} E{w['e']:g}", "M66 selects a digital input (P) or "
+                               "an analog one (E), not both", "keep one")
+            if w.get("p", w.get("e", -1.0)) < 0:
+                raise self.err("M66", "M66 needs P (a digital input) or E (an analog input), "
+                               ">= 0", "write M66 P0 L0")
+            if w.get("l", 0.0) != 0 and w.get("q", 0.0) <= 0:
+                raise self.err(f"L{w['l']:g}", "M66 waiting for an edge or a level (L not 0) "
+                               "needs a timeout Q > 0 (seconds)", "write e.g. M66 P0 L3 Q5")
+        for code in (67, 68):
+            if code in mset and w.get("e", -1.0) < 0:
+                raise self.err(f"M{code}", f"M{code} needs E = the analog output, >= 0",
+                               f"write M{code} E0 Q50")
+
     def _unused_words(self, g, mset, w, motion_here, axis):
-        """LinuxCNC refuses a P/Q/R/L/H/I/J/K word that no code of the line uses."""
+        """LinuxCNC refuses a P/Q/R/L/E/H/I/J/K word that no code of the line uses."""
         eff = motion_here[0] if motion_here else (self.motion if axis else None)
         uses = {
             "q": bool(g & {10.0, 64.0}) or eff in (73.0, 83.0) or bool(mset & {61, 66, 67, 68}),
             "r": 10.0 in g or eff in (2.0, 3.0) or eff in _CYCLES,
             "p": bool(g & {4.0, 10.0, 64.0}) or eff in (2.0, 3.0, 82.0, 86.0, 89.0)
             or bool(mset & {50, 51, 52, 53, 62, 63, 64, 65, 66, 67, 68}),
-            "l": 10.0 in g or eff in _CYCLES,
+            "l": 10.0 in g or eff in _CYCLES or 66 in mset,
+            "e": bool(mset & {66, 67, 68}),
             "h": 43.0 in g,
             "d": bool(g & {41.0, 42.0, 41.1, 42.1}),
         }
