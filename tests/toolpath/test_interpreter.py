@@ -341,6 +341,17 @@ def test_two_m_codes_of_one_modal_group_are_refused():
     assert len(read_gcode(_BODY + "S1000 M3 M8 M48 M101\nM2\n")) == 2  # one of each group
 
 
+def test_one_g_code_twice_on_a_line_is_two_of_its_group():
+    """LinuxCNC refuses "G0 G0", "G90 G90", "G4 P1 G4" ("Two g codes used from same modal
+    group"; grbl too, error 21) but reads "G80 G80"; woodcam read them all."""
+    _refused(_BODY + "G0 G0 X2\nM2\n", 4, "G0 G0", "two motion G codes")
+    _refused(_BODY + "G00 G0 X2\nM2\n", 4, "G0 G0", "two motion G codes")
+    _refused(_BODY + "G90 G90\nM2\n", 4, "G90 G90", "two distance G codes")
+    _refused(_BODY + "G4 P1 G4\nM2\n", 4, "G4 G4", "two non-modal G codes")
+    _refused(_BODY + "G21 G21\n", 4, "G21 G21", "two units G codes", dialect="grbl")
+    assert len(read_gcode(_BODY + "G80 G80\nG0 X2\nM2\n")) == 3
+
+
 def test_an_n_word_is_read_only_at_the_start_of_a_line():
     """LinuxCNC refuses an N word after another word ("Bad character 'n' used"); grbl reads it
     anywhere on the line, once (error 25 twice). woodcam read N anywhere in every dialect."""

@@ -1022,6 +1022,10 @@ class Interpreter:
                                "post-process the program for a 3-axis mill")
             if c in _G_REFUSED:
                 raise self.err(f"G{v:g}", _G_REFUSED[c], "post-process without it")
+            if c in g and c != 80.0:  # LinuxCNC counts "G0 G0" as two codes (G80 G80 passes)
+                name = next(n for n, codes in _G_GROUPS.items() if c in codes)
+                raise self.err(f"G{c:g} G{c:g}", f"two {name} G codes on one line",
+                               "keep one")
             g.add(c)
         for name, codes in _G_GROUPS.items():
             hit = g & codes
