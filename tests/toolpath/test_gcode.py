@@ -134,7 +134,7 @@ def test_drilling_cycles_expand_to_moves():
     ("G0 X0\nG0 X[1 / [2 - 2]]\n", 2, "1 / 0"),
     ("N7 G0 X0 Y0 Z0\nN8 G1 F10 X1 Y1 Z1 X2\n", 2, "X2"),
     ("G0 X0\nG41 G1 X10 F100\n", 2, "G41"),           # cutter compensation: refused
-    ("G0 X0\nO1001\n", 2, "o1001"),                   # Fanuc program number, LinuxCNC dialect
+    ("G0 X0\nO1001\nM99\n", 3, "M99"),                 # Fanuc-style subprogram return
 ])
 def test_malformed_and_unsupported_lines_name_line_and_word(text, line, word):
     with pytest.raises(GcodeError, match=rf"line {line}\b.*'{__import__('re').escape(word)}") as e:

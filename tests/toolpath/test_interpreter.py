@@ -278,7 +278,14 @@ def test_dialects():
         read_gcode("#1 = 3\nG0 X#1\n", dialect="grbl")
     with pytest.raises(GcodeError, match="grbl has no O-word"):
         read_gcode("o1 sub\no1 endsub\n", dialect="grbl")
-    assert len(read_gcode("O0042\n" + safety, dialect="fanuc")) == 2
+    # an O1234 program number: LinuxCNC 2.9 runs through it (woodcam refused it there), as
+    # Fanuc; grbl has none; the M98/M99 subprograms it labels are refused with their rewrite
+    for d in ("fanuc", "linuxcnc"):
+        assert len(read_gcode("O0042 (job)\n" + safety + "N9 O43\nM30\n", dialect=d)) == 2
+    with pytest.raises(GcodeError, match="grbl has no O words"):
+        read_gcode("O0042\n" + safety, dialect="grbl")
+    with pytest.raises(GcodeError, match=r"'M98': Fanuc-style subprograms .*o1234 call"):
+        read_gcode(safety + "M98 P43\nM30\nO43\nG0 X2\nM99\n")
     # a missing program end is a warning in LinuxCNC's dialect only
     assert any("without M2" in w for w in read_gcode(safety).warnings)
     assert read_gcode(safety, dialect="grbl").warnings == []

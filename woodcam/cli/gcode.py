@@ -76,7 +76,7 @@ def register(subparsers) -> None:
                    "naming the lines")
     p.add_argument("--dialect", choices=("linuxcnc", "grbl", "fanuc"), default="linuxcnc",
                    help="whose meaning the program has (default linuxcnc): grbl has no "
-                   "parameters or O-words; fanuc reads O1234 program numbers")
+                   "parameters or O-words; fanuc starts in G0 and needs no M2")
     p.add_argument("--interpreter", choices=("woodcam", "linuxcnc"), default="woodcam",
                    help="read the program with woodcam's interpreter (default) or with "
                    "LinuxCNC's own (needs Debian's linuxcnc-uspace)")

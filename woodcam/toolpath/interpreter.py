@@ -40,9 +40,11 @@ Everything else is an error naming the line and the word; what is read but has n
 cut is silent, what is read and could matter but is not simulated is a warning with its line.
 
 Dialects: ``linuxcnc`` (the default) is the reference. ``grbl`` has no parameters, expressions
-or O-words (they are errors there), needs no ``M2``. ``fanuc`` reads ``O1234`` program-number
-lines and allows ``G80`` beside a motion code (Fanuc keeps canned cycles in their own group, as
-in the ``G00 G80 G40 G49`` safety line); LinuxCNC 2.9 also accepts that line.
+or O-words (they are errors there, ``O1234`` too), needs no ``M2``. ``fanuc`` starts in
+``G0`` and needs no ``M2`` either. ``O1234`` program-number lines are read in ``linuxcnc`` and
+``fanuc`` (LinuxCNC 2.9 passes through them; they label its Fanuc-style ``M98`` subprograms,
+which, with ``M99``, are refused), as is ``G80`` beside a motion code (Fanuc keeps canned cycles
+in their own group, as in the ``G00 G80 G40 G49`` safety line; LinuxCNC 2.9 accepts it too).
 
 Output: canonical moves in the G-code frame, millimetres, tool tip: the G54 work frame as the
 machine has it before the program runs (the frame of ``start_mm``). Where the machine's own
@@ -671,11 +673,11 @@ class Interpreter:
                                    "use --dialect linuxcnc")
                 ln.okey, ln.olabel, ln.oexpr = key, label, rest
             elif m is None and "o" in body and _ONUMBER.match(body):
-                if self.dialect == "fanuc":  # O1234: Fanuc program number
+                if not grbl:  # O1234: a program number; LinuxCNC 2.9 runs through it
                     continue
-                raise GcodeError(no, text, "O-word without a command (LinuxCNC reads O only as "
-                               "sub/call/if/while...; Fanuc's O1234 program number needs "
-                               "--dialect fanuc)", "remove it or pass --dialect fanuc")
+                raise GcodeError(no, text, "grbl has no O words (an O1234 program number is "
+                               "LinuxCNC's or Fanuc's)", "remove it or pass --dialect "
+                               "linuxcnc")
             lines.append(ln)
         self.lines = lines
         self.closing = closing
@@ -1049,6 +1051,11 @@ class Interpreter:
                 self.warn(f"M{int(v)} ({_M_WARN[int(v)]}) is not simulated")
                 mset.add(int(v))
                 continue
+            if v in (98.0, 99.0):
+                raise self.err(f"M{v:g}", "Fanuc-style subprograms (M98 P calls the O1234 line, "
+                               "M99 returns or, in the main program, starts it again) are not "
+                               "simulated", "write the subprogram as an o-word subroutine "
+                               "(o1234 sub ... o1234 endsub, o1234 call; L repeats as o1 repeat)")
             if v != math.floor(v) or int(v) not in _M_KNOWN:
                 raise self.err(f"M{v:g}", "unsupported M code (woodcam reads M0-M9, M30, "
                                "M48-M53, M60, M61; M19, M62-M68 and M100-M199 with a warning)", "remove it or post-process for a 3-axis mill")
