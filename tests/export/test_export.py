@@ -191,6 +191,18 @@ def test_obj_units_and_up_axis_round_trip(baked, tmp_path, units, up, scale, hei
     vn = np.array([[float(x) for x in line.split()[1:4]] for line in text.splitlines()
                    if line.startswith("vn ")])
     np.testing.assert_allclose(np.linalg.norm(vn, axis=1), 1.0, atol=1e-6)
+    # the file's axes, read from the file itself (the round trip below undoes any transform,
+    # a mirror included): up = y is glTF's frame, block +Y (away from the viewer) along -Z, a
+    # rotation; up = z is the block frame. The 30 x 20 x 16 mm part spans:
+    want = {"y": ([0, 0, -20], [30, 16, 0]), "z": ([0, 0, 0], [30, 20, 16])}[up]
+    np.testing.assert_allclose([v.min(axis=0), v.max(axis=0)], np.multiply(want, scale), atol=1e-9)
+    # and a rotation keeps the winding: every triangle's corners turn counter-clockwise about
+    # the normals written with them (outward), as OBJ readers shade it
+    f = np.array([[int(c.split("/")[0]) - 1 for c in line.split()[1:4]] for line in text.splitlines()
+                  if line.startswith("f ")])
+    fn = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    big = np.linalg.norm(fn, axis=1) > 1e-6 * scale ** 2
+    assert np.all(np.einsum("ij,ij->i", fn[big], vn[f[big]].sum(axis=1)) > 0)
     loaded = load_textured(path)  # back in the block frame, mm
     np.testing.assert_allclose(_corners(loaded)[0], _corners(baked.mesh)[0], atol=1e-6)
 
