@@ -37,6 +37,15 @@ def test_a_correct_layout_is_not_flagged(cube):
     ("top", lambda a: np.rot90(a, -1), "rot90ccw", "looks turned 90 degrees clockwise"),
     ("bottom", lambda a: np.rot90(a, 2), "rot180", "looks turned 180 degrees"),
     ("right", lambda a: a[:, ::-1], "flip-lr", "looks mirrored left-right"),
+    # every other wrong layout of a square face (on the top face, where none of them looks like
+    # another on this cube: the end-grain faces' symmetric rings make e.g. rot90ccw and
+    # transpose the same picture there)
+    ("top", lambda a: np.rot90(a, 1), "rot90cw", "looks turned 90 degrees counter-clockwise"),
+    ("top", lambda a: a[::-1], "flip-tb", "looks mirrored top-bottom"),
+    ("top", lambda a: np.swapaxes(a, 0, 1), "transpose",
+     "looks mirrored across its top-left to bottom-right diagonal"),
+    ("top", lambda a: np.swapaxes(np.rot90(a, 2), 0, 1), "antitranspose",
+     "looks mirrored across its top-right to bottom-left diagonal"),
 ])
 def test_a_turned_or_mirrored_face_is_named_with_its_correction(cube, face, turn, fix, says):
     report = check_face_layout(_with(cube, face, turn(cube.faces[face].photo)))
@@ -47,8 +56,16 @@ def test_a_turned_or_mirrored_face_is_named_with_its_correction(cube, face, turn
     # the correction it names undoes the turn
     undone = VARIANTS[fix][0](turn(cube.faces[face].photo))
     assert np.array_equal(undone, cube.faces[face].photo)
-    if face == "top":
-        assert "turn its photo top.jpg 90 degrees counter-clockwise" in msg
+    # and says it in words that undo the turn (the diagonal mirrors checked by hand: flip-lr
+    # then rot90 is the transpose, flip-lr then rot90 clockwise the anti-transpose)
+    does = {"rot90ccw": "turn its photo top.jpg 90 degrees counter-clockwise",
+            "rot180": "turn its photo top.jpg 180 degrees",
+            "rot90cw": "turn its photo top.jpg 90 degrees clockwise",
+            "flip-lr": "flip its photo top.jpg left-right",
+            "flip-tb": "flip its photo top.jpg top-bottom",
+            "transpose": "flip its photo top.jpg left-right, then turn it 90 degrees counter-clockwise",
+            "antitranspose": "flip its photo top.jpg left-right, then turn it 90 degrees clockwise"}
+    assert f"as laid out); {does[fix]}" in msg, msg  # first, before any "(or ...: nearly as good)"
 
 
 def test_a_non_square_face_is_tried_only_in_variants_keeping_its_shape(cube):
