@@ -488,3 +488,40 @@ def test_a_photo_only_block_with_a_turned_face_warns_wherever_it_is_detected(tmp
     assert _run(capsys, "block", "from-photos", photos, "--size-mm", "50", "--out", blk)[0] == 0
     rc, _, err = _run(capsys, "block", "show", blk, "--check-layout", "--out", tmp_path / "x.png")
     assert rc == 0 and err.count("face 'top' looks turned 90 degrees clockwise") == 1, err
+
+
+def test_the_detection_cache_is_keyed_by_the_photos_and_the_rule(tmp_path, monkeypatch):
+    """The cached detection of a photo-only block is the detection of these photos with this rule:
+    a block whose photo changed, or asked with another rule, is detected afresh (its own entry),
+    and the same photos and rule read the entry back. Known answers: each against a detection
+    run without the cache."""
+    import warnings
+
+    from woodcam.detect.block import photos_only, with_detected_rings
+    from woodcam.synth import AnalyticLogField, cut_block, synth_block
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+
+    def block(ring_width_mm):
+        field = cut_block(AnalyticLogField(ring_width_mm=ring_width_mm), (30, 30, 30), "rift")
+        b = synth_block(field, (30, 30, 30), face_px=96, seed=4, ring_map_faces=())
+        return photos_only(b)
+
+    first, other = block(3.0), block(4.5)
+    changed = photos_only(first)
+    changed.faces["front"] = other.faces["front"]  # one photo replaced
+
+    def traces(b, **kw):
+        with warnings.catch_warnings():  # faces with little ring evidence are named; not tested here
+            warnings.simplefilter("ignore", WoodcamWarning)
+            out = with_detected_rings(b, **kw)
+        return {n: [t.points_px.tolist() for t in f.traces] for n, f in out.faces.items()}
+
+    entries = lambda: sorted((tmp_path / "cache" / "detect").glob("*.npz"))  # noqa: E731
+    base = traces(first)
+    assert len(entries()) == 1 and base == traces(first, cache=False)
+    assert traces(changed) == traces(changed, cache=False) != base
+    assert len(entries()) == 2
+    assert traces(first, rule="dark-line") == traces(first, rule="dark-line", cache=False) != base
+    assert len(entries()) == 3
+    assert traces(photos_only(first)) == base and len(entries()) == 3  # the same content: read back
