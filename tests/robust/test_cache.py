@@ -165,6 +165,32 @@ def test_field_cache_key_is_content_not_mtime(traced_block, tmp_path, monkeypatc
     assert len(_field_entries(tmp_path)) == 3
 
 
+def test_field_cache_key_holds_which_pieces_are_one_ring(traced_block, tmp_path, monkeypatch):
+    """Pieces of one ring share ``RingTrace.ring`` and the fitter gives them one growth time, but
+    the key left the ids out: a block whose pieces were linked otherwise (an SVG's ring ids
+    edited) was given the field fitted before the edit. Known answer: the field fitted to the
+    edited block without the cache."""
+    import copy
+
+    from woodcam.block import RingTrace
+    from woodcam.inference import fit_block
+    from woodcam.stock import fitted_field
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path))
+    rings = copy.deepcopy(traced_block)  # unlabelled, each trace a ring of its own
+    for f in rings.faces.values():
+        f.traces = [RingTrace(t.points_px, None, k) for k, t in enumerate(f.traces)]
+    linked = copy.deepcopy(rings)  # the front face's first three traces made one ring
+    front = linked.faces["front"]
+    front.traces = [RingTrace(t.points_px, None, 0 if k < 3 else k) for k, t in enumerate(front.traces)]
+    pts = np.random.default_rng(0).uniform(0, 1, (500, 3)) * (40, 30, 20)
+    before = fitted_field(rings)(pts)
+    after = fitted_field(linked)(pts)
+    assert len(_field_entries(tmp_path)) == 2
+    np.testing.assert_allclose(after, fit_block(linked)(pts), atol=1e-9)
+    assert np.abs(after - before).max() > 0.1  # the link changes the fit: a stale field is wrong
+
+
 def test_the_same_content_under_another_name_is_one_entry(traced_block, tmp_path, monkeypatch):
     """The key is the content, but the entry's file name began with the block's name: the same
     block folder copied as another name was fitted again and stored twice, byte-identical."""

@@ -463,13 +463,15 @@ def field_fingerprint(field, size_mm, n: int = 2048) -> str:
 
 def block_fingerprint(block) -> str:
     """A digest of everything a block's faces hold: its size, and per face the photo, ring map,
-    ring traces (points and years) and extras (knot masks, annotations), so any edit that could
-    change a fit or an appearance changes the digest."""
+    ring traces (points, years and ring ids: pieces sharing an id are one ring to the fitter)
+    and extras (knot masks, annotations), so any edit that could change a fit or an appearance
+    changes the digest."""
     from .._cache import digest
 
     faces = []
     for name, f in block.faces.items():
-        traces = [(t.points_px, -1 if t.year is None else int(t.year)) for t in f.traces]
+        traces = [(t.points_px, -1 if t.year is None else int(t.year), -1 if t.ring is None else int(t.ring))
+                  for t in f.traces]
         extras = {k: (v if isinstance(v, np.ndarray) else json.dumps(v, sort_keys=True, default=str))
                   for k, v in f.extras.items()}
         faces.append((name, list(f.shape), f.photo, f.ring_map, traces, extras))
