@@ -91,8 +91,11 @@ def test_confidence_summary_splits_right_and_wrong_lines(tmp_path):
     assert sc.confidence.shape == sc.d_matched.shape
     sure, unsure = sc.confidence == 1.0, sc.confidence < 0.01   # parallel to the line points' errors
     assert np.mean(sc.d_matched[sure] <= 2.0) > 0.95 and np.mean(sc.d_matched[unsure] > 2.0) > 0.95
-    img = sc.confidence_img
-    assert img.shape == sc.confidence_img.shape and np.nanmin(img) < 0.01 and np.nanmax(img) == 1.0
+    # the confidence image is the plane's grid: sure where x < 25 mm, unsure beyond, NaN outside
+    sample = sample_plane(PLANE[0], (50, 50, 50), 0.2)
+    img, left = sc.confidence_img, sample.points_mm[..., 0] < 25
+    assert img.shape == sample.inside.shape and np.isnan(img[~sample.inside]).all()
+    assert np.all(img[sample.inside & left] == 1.0) and np.all(img[sample.inside & ~left] < 0.01)
     # a plain fit carries no confidence: no keys, nothing drawn
     s2, sc2 = evaluate_fit(_Cylinder(), _Cylinder(), (50, 50, 50), planes=PLANE, pixel_mm=0.2)
     assert "confidence_mean" not in s2 and sc2[0].confidence is None
