@@ -134,3 +134,18 @@ def test_a_file_in_a_folder_that_cannot_be_written_is_refused_before_work(path, 
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"woodcam: error: --out of 'woodcam {' '.join(path)}': the folder '/proc/self' is not "
                    "writable (No such file or directory); choose an output folder you can write to"], err
+
+
+@pytest.mark.parametrize("path,p", FILE_COMMANDS, ids=[" ".join(c[0]) for c in FILE_COMMANDS])
+def test_a_file_under_a_file_is_refused_before_work(path, p, tmp_path, capsys):
+    """``block show --out afile/sub/x.png`` drew the block, then failed with 'Not a directory
+    (afile/sub)', naming no option; ``fit`` fitted first. The missing folder is made later, so
+    its nearest existing ancestor must be a folder."""
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    out = blocker / "sub" / ("x" + p.get_default("_out_suffixes")[0])
+    capsys.readouterr()
+    assert main(_argv(path, p, out)) == EXIT_USAGE
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"woodcam: error: --out of 'woodcam {' '.join(path)}': cannot make the folder "
+                   f"'{out.parent}': '{blocker}' is a file; choose an output folder you can write to"], err

@@ -108,19 +108,29 @@ def check_out(args: argparse.Namespace) -> None:
             from .._atomic import check_output_path
 
             check_output_path(out, what=f"--out of 'woodcam {command}'")
+        else:  # the missing folder is made when the file is written: under a file it failed after the work
+            _check_folder_can_be_made(out.parent, command)
     elif suffix in FILE_SUFFIXES or out.is_file():
         what = "an existing file" if out.is_file() else f"a file name ({suffix})"
         raise UsageError(f"--out of 'woodcam {command}' is a FOLDER (it writes several files); "
                          f"got {str(out)!r}, {what}; give a folder such as "
                          f"{str(out.with_name(out.stem + '_out' if out.is_file() else out.stem))!r}")
-    else:  # a folder made later: its nearest existing ancestor must be a folder one may write in
-        base = out.absolute()
-        while not base.exists() and base != base.parent:
-            base = base.parent
-        if not base.is_dir() or not os.access(base, os.W_OK | os.X_OK):
-            why = "is a file" if not base.is_dir() else "is not writable"
-            raise UsageError(f"--out of 'woodcam {command}': cannot make the folder {str(out)!r}: "
-                             f"{str(base)!r} {why}; choose an output folder you can write to")
+    else:
+        _check_folder_can_be_made(out, command)
+
+
+def _check_folder_can_be_made(folder: Path, command: str) -> None:
+    """A folder made later (``--out`` itself, or a FILE ``--out``'s missing parent): its nearest
+    existing ancestor must be a folder one may write in, else a UsageError before any work."""
+    from ..errors import UsageError
+
+    base = folder.absolute()
+    while not base.exists() and base != base.parent:
+        base = base.parent
+    if not base.is_dir() or not os.access(base, os.W_OK | os.X_OK):
+        why = "is a file" if not base.is_dir() else "is not writable"
+        raise UsageError(f"--out of 'woodcam {command}': cannot make the folder {str(folder)!r}: "
+                         f"{str(base)!r} {why}; choose an output folder you can write to")
 
 
 # -- --units: lengths on the command line and in printed summaries ------------------------------
