@@ -39,6 +39,15 @@ def test_fit_writes_a_grid_field_close_to_the_truth(block_dir, tmp_path, capsys)
     assert np.percentile(np.abs(fit(p) - field(p)), 99) < 0.1
 
 
+def test_fit_makes_a_missing_out_folder(block_dir, tmp_path, capsys):
+    """Every other FILE --out makes its missing folder; 'fit --out fits/f.npz' fitted, then failed
+    with 'No such file or directory (fits/f.npz)'."""
+    folder, _, _ = block_dir
+    out = tmp_path / "fits" / "new" / "f.npz"
+    assert main(["fit", str(folder), "--method", "radial", "--out", str(out)]) == 0
+    assert GridField.load(out).years.size
+
+
 def test_eval_writes_table_and_images(block_dir, tmp_path):
     folder, truth, _ = block_dir
     out = tmp_path / "ev"
