@@ -149,3 +149,25 @@ def test_a_file_under_a_file_is_refused_before_work(path, p, tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"woodcam: error: --out of 'woodcam {' '.join(path)}': cannot make the folder "
                    f"'{out.parent}': '{blocker}' is a file; choose an output folder you can write to"], err
+
+
+SCREENSHOT_COMMANDS = {"bake": ["bake", "x.py", "--block", "builtin:flat-sawn", "--out", "OUT/b.glb"],
+                       "gcode": ["gcode", "x.nc", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb"],
+                       "preview": ["preview", "x.glb"]}
+
+
+@pytest.mark.parametrize("command", sorted(SCREENSHOT_COMMANDS))
+@pytest.mark.parametrize("shot,says", [("view.jpg", "not a .png name"), ("a_folder", "an existing folder"),
+                                       ("a_file/sub/v.png", "is a file")])
+def test_a_named_screenshot_that_cannot_be_written_is_refused_before_work(command, shot, says, tmp_path, capsys):
+    """'--screenshot x.jpg' was refused after the bake (or, in preview, after the block was read)
+    with exit 1 and, in preview, without the option's dashes ('screenshot must be a .png path')."""
+    (tmp_path / "a_folder").mkdir()
+    (tmp_path / "a_file").write_text("")
+    argv = [a.replace("OUT", str(tmp_path)) for a in SCREENSHOT_COMMANDS[command]]
+    capsys.readouterr()
+    assert main([*argv, "--screenshot", str(tmp_path / shot)]) == EXIT_USAGE
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"woodcam: error: --screenshot of 'woodcam {command}'"), err
+    assert says in err[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file", "a_folder"]  # nothing was done

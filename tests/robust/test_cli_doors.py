@@ -30,7 +30,7 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     ([*BAKE, "--out", "OUT"], r"--out of 'woodcam bake' is a FILE ending in .glb; got .*a folder"),
     ([*BAKE, "--out", "OUT/dir.glb"], r"is a FILE ending in .glb; got .*dir.glb', a folder"),
     ([*BAKE, "--out", "OUT/file.txt/x.glb"], r"--out of .woodcam bake.: cannot make the folder .*file.txt. is a file"),
-    ([*BAKE, "--out", "OUT/x.glb", "--screenshot", "OUT/x.jpg"], r"--screenshot must end in .png"),
+    ([*BAKE, "--out", "OUT/x.glb", "--screenshot", "OUT/x.jpg"], r"--screenshot of .woodcam bake. is a FILE ending in .png"),
     ([*BAKE, "--out", "OUT/objdir/x.glb"], r"the OBJ beside the GLB"),
     # an infinite machining time was an OverflowError traceback
     ([*GCODE, "--tool", "flat:6", "--start=1e300,0,0"], r"--start must be in \[-100000, 100000\]; got 1e\+300"),

@@ -190,9 +190,10 @@ def main(argv: list[str] | None = None) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            from .options import check_numbers, check_out, lengths_to_mm
+            from .options import check_numbers, check_out, check_screenshot, lengths_to_mm
 
             check_out(args)  # the --out rule, before any work
+            check_screenshot(args)  # and a named --screenshot PNG's
             lengths_to_mm(args, parser)  # --units inch: every length in mm from here on
             check_numbers(args)  # every numeric option finite and in range, before any work
             rc = args.func(args)

@@ -119,7 +119,31 @@ def check_out(args: argparse.Namespace) -> None:
         _check_folder_can_be_made(out, command)
 
 
-def _check_folder_can_be_made(folder: Path, command: str) -> None:
+def check_screenshot(args: argparse.Namespace) -> None:
+    """Refuse a named ``--screenshot PNG`` (bake, gcode, preview) that cannot be written, before
+    any work: a UsageError (exit 2) when it does not end in ``.png``, is a folder, or its folder
+    cannot be made. The name-less form writes beside ``--out``, which :func:`check_out` checks."""
+    from ..errors import UsageError
+
+    shot = getattr(args, "screenshot", None)
+    if not isinstance(shot, (str, Path)):
+        return
+    shot = Path(shot)
+    command = args.command
+    if shot.is_dir() or shot.suffix.lower() != ".png":
+        what = "an existing folder" if shot.is_dir() else "not a .png name"
+        raise UsageError(f"--screenshot of 'woodcam {command}' is a FILE ending in .png; got "
+                         f"{str(shot)!r}, {what}; give e.g. "
+                         f"{str(shot / 'view.png' if shot.is_dir() else shot.with_suffix('.png'))!r}")
+    if shot.parent.is_dir():
+        from .._atomic import check_output_path
+
+        check_output_path(shot, what=f"--screenshot of 'woodcam {command}'")
+    else:
+        _check_folder_can_be_made(shot.parent, command, "--screenshot")
+
+
+def _check_folder_can_be_made(folder: Path, command: str, option: str = "--out") -> None:
     """A folder made later (``--out`` itself, or a FILE ``--out``'s missing parent): its nearest
     existing ancestor must be a folder one may write in, else a UsageError before any work."""
     from ..errors import UsageError
@@ -129,7 +153,7 @@ def _check_folder_can_be_made(folder: Path, command: str) -> None:
         base = base.parent
     if not base.is_dir() or not os.access(base, os.W_OK | os.X_OK):
         why = "is a file" if not base.is_dir() else "is not writable"
-        raise UsageError(f"--out of 'woodcam {command}': cannot make the folder {str(folder)!r}: "
+        raise UsageError(f"{option} of 'woodcam {command}': cannot make the folder {str(folder)!r}: "
                          f"{str(base)!r} {why}; choose an output folder you can write to")
 
 
