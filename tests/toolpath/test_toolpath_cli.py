@@ -345,3 +345,18 @@ def test_review_with_another_block_than_the_baked_one_says_so(tmp_path, capsys):
     assert main(["review", str(glb), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "b.html"),
                  "--voxels", "20000"]) == 0
     assert "is not the block" not in capsys.readouterr().err  # the same block: no word
+
+
+@pytest.mark.parametrize("part,says", [("nope.stl", "does not exist"), ("design.jpg", "unsupported suffix")])
+def test_a_bad_design_part_is_refused_before_the_simulation(part, says, tmp_path, capsys):
+    """``--part nope.stl`` simulated the whole program (minutes on a real job), then failed
+    naming 'part file', not the option."""
+    capsys.readouterr()
+    assert main(["gcode", str(REPO / "toolpaths" / "drilling.nc"), "--tool", "flat:6", "--block",
+                 "builtin:flat-sawn", "--cell-size", "0.5", "--out", str(tmp_path / "g.glb"),
+                 "--part", str(tmp_path / part)]) == 1
+    out = capsys.readouterr()
+    assert "moves read" not in out.out  # nothing was simulated
+    err = out.err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("woodcam: error: --part: part file") and says in err[0], err
+    assert not (tmp_path / "g.glb").exists()

@@ -174,6 +174,16 @@ def run(args) -> int:
         raise WoodcamError(f"--rapid-rate {args.rapid_rate}: give a rate > 0 in mm/min, e.g. "
                            "5000")
     check_outputs(args.out, obj=not args.no_obj, screenshot=args.screenshot or False)
+    design = None
+    if args.part:  # a missing or unreadable design part failed only after the whole simulation
+        from .._atomic import check_output_path
+        from ..cad import load_part
+
+        check_output_path(_deviation_png(args.out), what="--out (its deviation PNG, with --part)")
+        try:
+            design = load_part(args.part)
+        except WoodcamError as err:
+            raise WoodcamError(f"--part: {err}") from None
     if args.view:
         from ..view.scrub import check_display
 
@@ -234,12 +244,11 @@ def run(args) -> int:
                               "warnings": _issue_spots(program, res.report, stock.size_mm, offset, path.name)})
         last = (program, res)
     program, res = last
-    if args.part:
-        from ..cad import load_part
+    if design is not None:
         from ..toolpath.deviation import deviation, deviation_png, fmt_depth
 
-        dev = deviation(res, load_part(args.part))
-        png = Path(args.out).with_name(Path(args.out).stem + "_deviation.png")
+        dev = deviation(res, design)
+        png = _deviation_png(args.out)
         deviation_png(dev, png, title=f"{Path(args.part).name}:\n{dev.summary(gouges=False)}"
                       + (f", {len(dev.gouges)} gouging lines" if dev.gouges else ""))
         print(f"deviation from {Path(args.part).name}: {dev.summary(units=args.units)}; "
@@ -301,6 +310,11 @@ def fmt_hms(seconds: float) -> str:
     m, s = divmod(int(round(seconds)), 60)
     h, m = divmod(m, 60)
     return f"{h}:{m:02d}:{s:02d}"
+
+
+def _deviation_png(out) -> Path:
+    """Where ``--part``'s deviation map goes: OUT with ``_deviation.png``."""
+    return Path(out).with_name(Path(out).stem + "_deviation.png")
 
 
 def _screenshot(args, stock, program, offset, made, heightmap) -> None:
