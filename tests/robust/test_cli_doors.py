@@ -158,3 +158,14 @@ def test_an_unexpected_error_is_one_line_and_a_wrapped_ctrl_c_is_an_interrupt(mo
     monkeypatch.setattr(bake_cli, "run_blocks", wrapped_interrupt)
     assert main(["blocks"]) == 130
     assert capsys.readouterr().err == "woodcam: interrupted\n"  # one line: the warning is not printed after it
+
+
+def test_ctrl_c_while_a_part_script_imports_a_pybind11_module_is_an_interrupt(tmp_path, capsys):
+    """Ctrl-C while bowl.py imported build123d: OCP (pybind11) turns the KeyboardInterrupt into
+    'ImportError: initialization failed', and bake said 'part script ... failed with ImportError:
+    ...; fix the script', exit 1. It is an interrupt: exit 130, one line."""
+    script = tmp_path / "part.py"
+    script.write_text("raise ImportError('initialization failed') from KeyboardInterrupt()\n")
+    capsys.readouterr()
+    assert main(["bake", str(script), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "p.glb")]) == 130
+    assert capsys.readouterr().err == "woodcam: interrupted\n"

@@ -200,23 +200,26 @@ def main(argv: list[str] | None = None) -> int:
         except UsageError as err:
             print(f"woodcam: error: {err}", file=sys.stderr)
             return EXIT_USAGE
-        except WoodcamError as err:
-            print(f"woodcam: error: {err}", file=sys.stderr)
-            return EXIT_ERROR
         except KeyboardInterrupt:
             interrupted = True
             print("woodcam: interrupted", file=sys.stderr)
             return EXIT_INTERRUPTED
-        except OSError as err:  # the system refused a read or write (disk full, no permission)
-            where = f" ({err.filename})" if err.filename else ""
-            print(f"woodcam: error: {err.strerror or err}{where}; check the path, its permissions and "
-                  "the free space", file=sys.stderr)
-            return EXIT_ERROR
         except Exception as err:  # noqa: BLE001 - the last net: a one-line report, never a traceback
-            if _interrupted(err):  # Ctrl-C inside a library that wrapped it (numba's compiler)
+            # Ctrl-C inside a library that wrapped it (numba's compiler; a pybind11 module such as
+            # OCP, imported by a part script, raises ImportError: woodcam's WoodcamError about it
+            # then blamed the script, or said the package was not installed)
+            if _interrupted(err):
                 interrupted = True
                 print("woodcam: interrupted", file=sys.stderr)
                 return EXIT_INTERRUPTED
+            if isinstance(err, WoodcamError):
+                print(f"woodcam: error: {err}", file=sys.stderr)
+                return EXIT_ERROR
+            if isinstance(err, OSError):  # the system refused a read or write (disk full, no permission)
+                where = f" ({err.filename})" if err.filename else ""
+                print(f"woodcam: error: {err.strerror or err}{where}; check the path, its permissions and "
+                      "the free space", file=sys.stderr)
+                return EXIT_ERROR
             if os.environ.get("WOODCAM_DEBUG"):
                 raise
             print(f"woodcam: error: internal error ({type(err).__name__}: {str(err)[:300]}); this is a "
