@@ -49,3 +49,15 @@ def test_every_command_says_what_it_does():
     assert {"show", "synth", "render", "info", "species", "rings"} <= {n for n, _ in commands}
     silent = [name for name, sp in commands if not (sp.description or "").strip()]
     assert not silent, silent
+
+
+def test_a_block_spec_read_in_units_says_so():
+    """``bake --help`` said 'builtin:NAME[:WxDxH] (mm)' under --block and 'unit of a block spec's
+    WxDxH' under --units: with --units inch the size is in inches."""
+    from woodcam.cli.options import LENGTH_OPTIONS
+
+    wrong = [f"{' '.join(path)} {a.option_strings[-1]}: {a.help!r}"
+             for path, a in _walk_options(build_parser())
+             if path and LENGTH_OPTIONS.get((path[0], a.dest)) == "spec"
+             and ("WxDxH] (mm)" in (a.help or "") or "--units" not in (a.help or ""))]
+    assert not wrong, wrong

@@ -68,7 +68,7 @@ def register(subparsers) -> None:
                    help="render off-screen to this PNG instead of opening a window (default "
                    "name: MESH with _view.png)")
     p.add_argument("--block", default=None,
-                   help="block spec for the cut plane (default: the one stored in the GLB)")
+                   help=BLOCK_SPEC_HELP + ", for the cut plane (default: the one stored in the GLB)")
     p.add_argument("--camera", choices=("iso", "front", "back", "left", "right", "top", "bottom"),
                    default="iso", help="view direction (default iso: from front-right-above)")
     p.add_argument("--no-cut", action="store_true",

@@ -50,10 +50,13 @@ def species_type(text: str) -> str:
 
 #: The block argument of the commands that read a block (fit, eval, block show); those that
 #: carve from it (bake, gcode, place, review) may also turn it: :data:`BLOCK_SPEC_HELP`.
-BLOCK_READ_HELP = ("block spec: builtin:NAME[:WxDxH] (mm), log:gran1@K[:WxDxH], woodify:DIR/field.npz "
-                   "(a block cut from a grown object), a block folder "
-                   "(block.json) or a Mokume sample folder (a 50 mm cube)")
-BLOCK_SPEC_HELP = BLOCK_READ_HELP + "; append ~x90/~y90/~z90 to turn the block under the part"
+_BLOCK_HELP = ("block spec: builtin:NAME[:WxDxH] ({unit}), log:gran1@K[:WxDxH], woodify:DIR/field.npz "
+               "(a block cut from a grown object), a block folder "
+               "(block.json) or a Mokume sample folder (a 50 mm cube)")
+BLOCK_READ_HELP = _BLOCK_HELP.format(unit="mm")
+# the carving commands read the WxDxH in --units (LENGTH_OPTIONS): "(mm)" contradicted it
+BLOCK_SPEC_HELP = (_BLOCK_HELP.format(unit="in --units, default mm")
+                   + "; append ~x90/~y90/~z90 to turn the block under the part")
 
 
 # -- --out: one rule for every command ---------------------------------------------------------
