@@ -78,6 +78,17 @@ def test_from_photos_detect_show_and_fit(synth_photos, tmp_path, capsys, monkeyp
         assert im.size == (4 * 2 * 160, 3 * 2 * 160)
 
 
+def test_from_photos_prints_a_next_command_that_pastes(synth_photos, tmp_path, capsys):
+    """'next: woodcam rings detect my block --out my block' was four words where two paths were
+    meant: the shell split the folder name."""
+    import shlex
+
+    blk = tmp_path / "my blöck"
+    rc, out, _err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)
+    assert rc == 0
+    assert shlex.split(out.split("next: ")[1]) == ["woodcam", "rings", "detect", str(blk), "--out", str(blk)]
+
+
 def test_size_mm_on_a_block_folder_is_said_to_be_unused(synth_photos, tmp_path, capsys):
     """rings detect / rings show BLOCKDIR --size-mm 30 exited 0 without a word while the block kept
     its own 50 mm (block show and fit warned)."""

@@ -459,12 +459,12 @@ def test_review_refuses_a_parquetry_panel_and_names_woodifys_field(page, tmp_pat
 
     _, glb, _, _ = page
     mesh = trimesh.load(glb, force="mesh")
-    panel = export_glb(mesh, tmp_path / "parq" / "panel.glb",
+    panel = export_glb(mesh, tmp_path / "my parq" / "panel.glb",  # the command to paste is quoted
                        metadata={"kind": "parquetry panel", "size_mm": [56, 56, 2.1]})
     for extra in ([], ["--block", "builtin:flat-sawn"]):
         assert main(["review", str(panel), "--out", str(tmp_path / "p.html"), *extra]) == 1
         err = capsys.readouterr().err
-        assert "is a parquetry panel" in err and "woodcam preview" in err, err
+        assert "is a parquetry panel" in err and f"woodcam preview '{panel}'" in err, err
     assert not (tmp_path / "p.html").exists()
     grown = export_glb(mesh, tmp_path / "tree" / "grown.glb", metadata={"woodify": {"years": 10}})
     (tmp_path / "tree" / "field.npz").write_bytes(b"")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import shlex
 from pathlib import Path
 
 from .options import BLOCK_SPEC_HELP, add_out_option, add_units_option
@@ -42,7 +43,7 @@ def run_review(args: argparse.Namespace) -> int:
         raise WoodcamError(
             f"review: {str(args.part)!r} is a parquetry panel (veneer pieces from several sheets, each "
             "turned its own way), not a part cut from one block, so the page's section has no wood "
-            f"to show; view it with 'woodcam preview {args.part}'")
+            f"to show; view it with: woodcam preview {shlex.quote(str(args.part))}")
     stock = stock_of_glb(args.part, args.block)
     if stock is None:
         field = args.part.parent / "field.npz"

@@ -6,6 +6,7 @@ Registered by :mod:`woodcam.cli` through :func:`register`; :mod:`woodcam.cli.blo
 
 from __future__ import annotations
 
+import shlex
 from pathlib import Path
 
 from ..errors import WoodcamError
@@ -45,8 +46,9 @@ def run_from_photos(args) -> int:
     # say when the photos held more: a 12 MP phone photo of a 50 mm face is 60 px/mm, stored at 10
     capped = (f", down from the photos' {photos_ppm:.2f} (the --max-px-per-mm cap, default {MAX_PX_PER_MM:g}: "
               f"rings 0.8 mm apart keep 8 px)" if photos_ppm > ppm * (1 + 1e-9) else "")
+    out = shlex.quote(str(args.out))  # a command to paste: 'my block' was two arguments
     print(f"wrote {args.out} ({len(block.faces)} faces at {ppm:.2f} px/mm{capped}: {shapes}); "
-          f"next: woodcam rings detect {args.out} --out {args.out}")
+          f"next: woodcam rings detect {out} --out {out}")
     return 0
 
 
