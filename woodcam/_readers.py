@@ -51,21 +51,24 @@ def read_json_object(path, what: str) -> dict:
 
 
 def read_image_file(path: Path, what: str):
-    """An image file decoded as every viewer shows it, turned by its EXIF orientation tag (a
-    phone stores a portrait photo as landscape pixels plus that tag: read raw it lies on its
-    side, a face's rings turned 90 degrees): ``(h, w)`` or ``(h, w, 3)`` uint8 for 8-bit modes,
-    uint16 for 16-bit ones (values kept). Files over :data:`~woodcam.limits.MAX_IMAGE_PIXELS`,
+    """An image file decoded as every viewer shows it (its format told by its content, not its
+    name), turned by its EXIF orientation tag (a phone stores a portrait photo as landscape
+    pixels plus that tag: read raw it lies on its side, a face's rings turned 90 degrees):
+    ``(h, w)`` or ``(h, w, 3)`` uint8 for 8-bit modes, uint16 for 16-bit ones (values kept). Files over :data:`~woodcam.limits.MAX_IMAGE_PIXELS`,
     unreadable, truncated, animated (a GIF, PNG or WebP of several frames: which is the face?)
     or of unsupported modes are WoodcamErrors naming ``what`` and the file."""
     from PIL import Image, ImageOps
 
     from .limits import limit
 
-    if Path(path).suffix.lower() in (".heic", ".heif"):  # a phone camera's default format
-        from pillow_heif import register_heif_opener
-
-        register_heif_opener()  # libheif turns the pixels by the file's own rotation and resets the tag
     try:
+        # by the content, not the name: phones and messengers save HEIC under a .jpg name (PIL
+        # already tells a PNG named .jpg by its bytes; HEIF needs pillow-heif's opener)
+        with open(path, "rb") as f:
+            if f.read(12)[4:8] == b"ftyp":  # an ISO media file: HEIF, a phone camera's default format
+                from pillow_heif import register_heif_opener
+
+                register_heif_opener()  # libheif turns the pixels by the file's own rotation and resets the tag
         with Image.open(path) as im:
             if im.width * im.height > limit("MAX_IMAGE_PIXELS"):
                 raise WoodcamError(

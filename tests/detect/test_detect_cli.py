@@ -253,6 +253,31 @@ def test_heic_photos_are_read(synth_photos, tmp_path, capsys):
     assert got.shape == upright.shape and np.abs(got - upright).mean() < 4.0
 
 
+def test_photos_are_read_by_their_content_not_their_name(synth_photos, tmp_path, capsys, monkeypatch):
+    """Phones and messengers save HEIC under a ``.jpg`` name: it was refused as 'cannot decode'
+    (pillow-heif's opener was registered for a ``.heic`` or ``.heif`` name only). A PNG named
+    ``.jpg`` is read too. The opener is taken out of PIL first, as in a fresh process."""
+    import pillow_heif
+
+    monkeypatch.setattr(Image, "ID", [i for i in Image.ID if i not in ("HEIF", "AVIF")])
+    for key in ("HEIF", "AVIF"):
+        monkeypatch.delitem(Image.OPEN, key, raising=False)
+    d = _copy(synth_photos, tmp_path / "named", skip=("front", "top"))
+    upright = {}
+    for name in ("front", "top"):
+        with Image.open(synth_photos / f"{name}.png") as im:
+            upright[name] = np.asarray(im.convert("RGB"))
+    pillow_heif.from_pillow(Image.fromarray(upright["front"])).save(d / "front.jpg", quality=95)
+    Image.fromarray(upright["top"]).save(d / "top.jpg", format="PNG")
+    assert (d / "front.jpg").read_bytes()[4:8] == b"ftyp"
+    blk = tmp_path / "blk"
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", blk)
+    assert rc == 0, err
+    faces = read_block(blk).faces
+    assert np.abs(faces["front"].photo.astype(float) - upright["front"]).mean() < 4.0
+    assert np.array_equal(faces["top"].photo, upright["top"])
+
+
 def test_a_16_bit_photo_is_scaled_not_clipped(synth_photos, tmp_path, capsys):
     """A 16-bit grey export (a raw developer's TIFF or PNG) reads as the same grey at 8 bits;
     converted raw, every value above 255 clipped to white and the face was refused as
