@@ -441,6 +441,29 @@ def test_large_photos_are_brought_to_the_cap_one_at_a_time_under_a_bar(synth_pho
     assert [(b["desc"], b["enabled"]) for b in bars] == [("reading photos", True)]
 
 
+def test_a_face_is_resampled_once_whatever_the_other_photos_densities(synth_photos, tmp_path):
+    """A photo denser than --max-px-per-mm was brought down to the cap as it was read and again
+    to the set's density when another photo lay below the cap: resampled twice, its face differed
+    from the one written when no cap applies. Now a face's pixels depend on the other photos only
+    through the common density: byte-identical with and without the cap, and equal to one Lanczos
+    resampling of its original."""
+    from woodcam.block.photos import block_from_photos
+
+    d = _copy(synth_photos, tmp_path / "mixed")
+    with Image.open(d / "front.png") as im:  # 8 px/mm, above the cap of 4
+        big = np.asarray(im.convert("RGB").resize((400, 400), Image.BICUBIC))
+    Image.fromarray(big).save(d / "front.png")
+    with Image.open(d / "top.png") as im:    # 3 px/mm, below it: the set's density
+        im.resize((150, 150), Image.LANCZOS).save(d / "top.png")
+    capped = block_from_photos(d, (50, 50, 50), max_px_per_mm=4.0)
+    free = block_from_photos(d, (50, 50, 50), max_px_per_mm=100.0)
+    assert capped.meta["px_per_mm"] == free.meta["px_per_mm"] == 3.0
+    once = np.asarray(Image.fromarray(big).resize((150, 150), Image.LANCZOS))
+    for face in FACES:
+        assert np.array_equal(capped.faces[face].photo, free.faces[face].photo), face
+    assert np.array_equal(capped.faces["front"].photo, once)
+
+
 def test_from_photos_says_when_the_photos_are_brought_down_to_the_cap(synth_photos, tmp_path, capsys):
     """Phone photos far denser than --max-px-per-mm were stored at the cap with only 'faces at
     10.00 px/mm' said: nothing told that the photos held more, or which option keeps it."""

@@ -13,7 +13,8 @@ below :data:`BLANK_STD`), not over- or under-exposed (more than :data:`CLIPPED_S
 pixels at the ends of the range). An image file named for no face is named in a warning (or in
 the error when faces are missing), never passed over silently.
 Faces are resampled to one density (the lowest of the photos', at most ``max_px_per_mm``), so
-the faces unfold into one cross and ring widths are alike in pixels.
+the faces unfold into one cross and ring widths are alike in pixels; each once, from its
+original, so a face's pixels depend on the other photos only through that density.
 """
 
 from __future__ import annotations
@@ -185,26 +186,32 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
     if stray:
         warnings.warn(f"{str(folder)!r}: {unnamed}, so not read; rename a face's photo front.jpg, top.jpg, "
                       "left.jpg, bottom.jpg, right.jpg or back.jpg (or A..F)", WoodcamWarning, stacklevel=2)
-    images, density, misfit = {}, [], []
+    images, density, misfit = {}, {}, []
     for face, path in progress_bar(photos.items(), desc="reading photos", unit="photo", enabled=progress):
         got = _read_face_photo(face, path, size, max_px_per_mm)
         if isinstance(got, str):
             misfit.append(got)
         else:
-            images[face], px_mm = got
-            density.append(px_mm)
+            images[face], density[face] = got
     if misfit:  # all of them at once: photos not cropped to the face are seldom alone
         raise WoodcamError(
             f"{'photo does' if len(misfit) == 1 else f'{len(misfit)} photos do'} not fit the block's faces for "
             f"--size-mm {size[0]:g}x{size[1]:g}x{size[2]:g}: {'; '.join(misfit)}; crop each photo to its face's "
             "edges, the wood alone with no table or background round it (a photo editor's perspective crop also "
             "squares up a face taken at an angle), or check --size-mm")
-    ppm = min(min(density), max_px_per_mm)
+    ppm = min(min(density.values()), max_px_per_mm)
+    # a photo brought down to the cap while another lies below it is read again and resampled
+    # once, from its original: resampled twice (to the cap, then to ppm), a face's pixels
+    # depended on the other photos' densities beyond the common target density
+    again = [f for f in images if density[f] > max_px_per_mm > ppm]
+    for face in progress_bar(again, desc="re-reading photos", unit="photo", enabled=progress) if again else ():
+        images[face] = None  # freed before its original is read again
+        images[face], _ = _read_face_photo(face, photos[face], size, ppm)
     faces = {}
     for face, a in images.items():
         shape = _face_shape(face, size, ppm)
         faces[face] = Face(face, shape, photo=_resampled(a, shape))
     meta = {"source": "photos", "photos_dir": str(Path(folder).resolve()), "px_per_mm": float(ppm),
-            "photos_px_per_mm": float(min(density)),
+            "photos_px_per_mm": float(min(density.values())),
             "photos": {f: p.name for f, p in photos.items()}}
     return Block(tuple(size), faces=faces, name=name or Path(folder).name, meta=meta)
