@@ -405,6 +405,36 @@ def test_photos_not_cropped_to_their_faces_are_all_named_with_the_fix(synth_phot
     assert "turned 90 degrees" in err
 
 
+def test_a_photo_with_background_all_round_is_said(synth_photos, tmp_path, capsys):
+    """A photo not cropped to its face but with even margins of background round the block keeps
+    the face's aspect and passed without a word (the table's grey became the face's edge). Now a
+    near-uniform border unlike the wood on all four sides is warned of, naming the face and the
+    fix; Mokume's real faces (cropped) and woodcam's synthetic ones are not."""
+    import warnings
+
+    from woodcam.block.photos import block_from_photos
+
+    from .test_detect_rings import _mokume
+
+    d = _copy(synth_photos, tmp_path / "margins")
+    with Image.open(d / "front.png") as im:  # the face in 136 px, 12 px of table round it
+        face = np.asarray(im.convert("RGB").resize((136, 136), Image.LANCZOS)).astype(float)
+    rng = np.random.default_rng(0)
+    table = 120.0 + 10.0 * np.linspace(-1, 1, 160)[:, None, None] + 2.0 * rng.standard_normal((160, 160, 3))
+    table[12:148, 12:148] = face
+    Image.fromarray(np.clip(np.round(table), 0, 255).astype(np.uint8)).save(d / "front.jpg", quality=90)
+    (d / "front.png").unlink()
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == 0 and err.count("warning") == 1, err
+    assert "face 'front' (front.jpg) has a uniform border unlike the wood on all four sides" in err
+    assert "top 7 %" in err and "crop the photo to the face's edges" in err
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        block_from_photos(synth_photos, (50, 50, 50))
+        for sample in ("CN03", "H11"):
+            block_from_photos(_mokume(sample), (50, 50, 50))
+
+
 def test_large_photos_are_brought_to_the_cap_one_at_a_time_under_a_bar(synth_photos, tmp_path, capsys, monkeypatch):
     """Six phone photos were all held at full size, and a float copy of each one's three channels
     made for the exposure check, before any was resampled: six 48 MP photos took 1.8 GB, 35 s

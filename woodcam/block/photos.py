@@ -11,7 +11,9 @@ Checks, each failing with one message naming the faces at fault: every face pres
 one message: photos not cropped to their face are seldom alone); not blank (luminance spread
 below :data:`BLANK_STD`), not over- or under-exposed (more than :data:`CLIPPED_SHARE` of the
 pixels at the ends of the range). An image file named for no face is named in a warning (or in
-the error when faces are missing), never passed over silently.
+the error when faces are missing), never passed over silently; so is a photo with a near-uniform
+border unlike the wood on all four sides (:func:`_uniform_border`: background round the face in
+the face's proportions keeps its aspect).
 Faces are resampled to one density (the lowest of the photos', at most ``max_px_per_mm``), so
 the faces unfold into one cross and ring widths are alike in pixels; each once, from its
 original, so a face's pixels depend on the other photos only through that density.
@@ -41,6 +43,14 @@ PHOTO_SUFFIXES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".webp", ".h
 BLANK_STD = 0.01
 #: A photo with more than this share of pixels at <= 3 or >= 252 (of 255) is badly exposed.
 CLIPPED_SHARE = 0.4
+#: A photo's edge line is background-like where it varies (std, after a straight-line trend such
+#: as light falling off is taken out, of the smoothed grey) by less than this share of the wood's
+#: median line; Mokume's faces and woodcam's synthetic ones stay above 0.5 on all four sides.
+BORDER_TEXTURE_RATIO = 0.3
+#: ... and its mean colour is within this (of 255, any channel) of the outermost line's.
+BORDER_COLOUR_TOL = 10.0
+#: A border all round is said when its mean colour differs from the inside's by more than this.
+BORDER_COLOUR_STEP = 15.0
 #: Default upper density (px/mm): 10 px/mm keeps 0.1 mm detail (rings are >= 0.8 mm) and a
 #: 50 mm face at 500 px, which the ring detector handles in about a second.
 MAX_PX_PER_MM = 10.0
@@ -109,6 +119,47 @@ def _check_exposure(face: str, photo: np.ndarray, path: Path) -> None:
     if spread < BLANK_STD:
         raise WoodcamError(f"photo of face {face!r} ({path.name}) is blank (luminance spread "
                            f"{spread:.3f} < {BLANK_STD}); retake it with the face in view")
+
+
+def _line_texture(lum: np.ndarray) -> np.ndarray:
+    """(rows,) std along each row of ``lum`` (rows, cols) after its straight-line fit: light
+    falling off across a table is no texture."""
+    x = np.linspace(-1.0, 1.0, lum.shape[1], dtype=np.float32)
+    resid = lum - lum.mean(1, keepdims=True) - np.outer(lum @ x / (x @ x), x)
+    return resid.std(1)
+
+
+def _uniform_border(a: np.ndarray) -> tuple[float, float, float, float] | None:
+    """The widths of a border round ``a`` (rows, cols, 3) uint8 unlike the wood inside, as shares
+    of its (height, height, width, width) at (top, bottom, left, right): a photo taken with
+    background round the face and so not cropped to it; or None unless all four sides have one
+    (at least 2 px and 1 %) of near-uniform lines (:data:`BORDER_TEXTURE_RATIO`,
+    :data:`BORDER_COLOUR_TOL`) whose colour differs from the inside's by
+    :data:`BORDER_COLOUR_STEP`. A face's edge lines vary as its inside does (the rings cross at
+    least two sides of any face), so a cropped face is not taken for one."""
+    from scipy.ndimage import gaussian_filter
+
+    rgb = a.astype(np.float32)
+    # smoothed: sensor and JPEG noise is texture at the pixel scale, where the wood has little
+    lum = gaussian_filter(rgb @ np.array([0.299, 0.587, 0.114], np.float32), 1.5)
+    h, w = lum.shape
+    tex_r, tex_c = _line_texture(lum), _line_texture(lum.T)
+    wood = min(np.median(tex_r[h // 4: 3 * h // 4 + 1]), np.median(tex_c[w // 4: 3 * w // 4 + 1]))
+    mean_r, mean_c = rgb.mean(1), rgb.mean(0)
+    widths = []
+    for tex, mean in ((tex_r, mean_r), (tex_r[::-1], mean_r[::-1]), (tex_c, mean_c), (tex_c[::-1], mean_c[::-1])):
+        n = len(tex) // 4  # a border wider than a quarter is no face with background round it
+        flat = (tex[:n] < BORDER_TEXTURE_RATIO * wood) & (np.abs(mean[:n] - mean[0]).max(1) < BORDER_COLOUR_TOL)
+        k = n if flat.all() else int(np.argmin(flat))
+        if k < max(2, 0.01 * len(tex)):
+            return None
+        widths.append(k)
+    top, bottom, left, right = widths
+    border = np.ones((h, w), bool)
+    border[top:h - bottom, left:w - right] = False
+    if np.abs(rgb[border].mean(0) - rgb[~border].mean(0)).max() <= BORDER_COLOUR_STEP:
+        return None
+    return top / h, bottom / h, left / w, right / w
 
 
 def _face_shape(face: str, size, px_per_mm: float) -> tuple[int, int]:
@@ -211,6 +262,13 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
     for face, a in images.items():
         shape = _face_shape(face, size, ppm)
         faces[face] = Face(face, shape, photo=_resampled(a, shape))
+        border = _uniform_border(faces[face].photo)
+        if border:  # margins in the face's proportions keep its aspect and passed silently
+            warnings.warn(
+                f"photo of face {face!r} ({photos[face].name}) has a uniform border unlike the wood on all four "
+                f"sides (top {100 * border[0]:.0f} %, bottom {100 * border[1]:.0f} % of its height, left "
+                f"{100 * border[2]:.0f} %, right {100 * border[3]:.0f} % of its width): background round the "
+                "face? crop the photo to the face's edges, the wood alone", WoodcamWarning, stacklevel=2)
     meta = {"source": "photos", "photos_dir": str(Path(folder).resolve()), "px_per_mm": float(ppm),
             "photos_px_per_mm": float(min(density.values())),
             "photos": {f: p.name for f, p in photos.items()}}
