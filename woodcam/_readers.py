@@ -56,7 +56,8 @@ def read_image_file(path: Path, what: str):
     pixels plus that tag: read raw it lies on its side, a face's rings turned 90 degrees):
     ``(h, w)`` or ``(h, w, 3)`` uint8 for 8-bit modes, uint16 for 16-bit ones (values kept). Files over :data:`~woodcam.limits.MAX_IMAGE_PIXELS`,
     unreadable, truncated, animated (a GIF, PNG or WebP of several frames: which is the face?)
-    or of unsupported modes are WoodcamErrors naming ``what`` and the file."""
+    or of unsupported modes are WoodcamErrors naming ``what`` and the file; transparent pixels
+    (a cut-out) are read as the colour stored under them, with a WoodcamWarning."""
     from PIL import Image, ImageOps
 
     from .limits import limit
@@ -127,7 +128,29 @@ def _image_array(im, where: str):
         kind = " (floating point)" if im.mode.startswith("F") else ""
         raise WoodcamError(f"{where} has image mode {im.mode}{kind}, which is not supported; save it as an "
                            "8- or 16-bit PNG")
+    share = _transparent_share(im)
+    if share:  # the alpha was dropped without a word: a cut-out's background read as wood
+        import warnings
+
+        from .errors import WoodcamWarning
+
+        warnings.warn(f"{where} has transparent pixels ({100 * share:.3g} % of them, a cut-out?), read as the "
+                      "colour stored under them, the transparency dropped; crop the image so every pixel is "
+                      "opaque, or flatten it onto its background", WoodcamWarning, stacklevel=3)
     if im.mode not in ("L", "RGB"):
         im = im.convert("RGB" if im.mode in ("P", "RGBA", "CMYK", "YCbCr", "LAB", "HSV", "PA")
                         else "L")
     return np.asarray(im)
+
+
+def _transparent_share(im) -> float:
+    """The share of a PIL image's pixels not fully opaque (alpha < 255): 0 for modes without
+    alpha or a transparent colour."""
+    if im.mode in ("RGBA", "LA", "PA"):
+        alpha = im.getchannel("A")
+    elif "transparency" in im.info and im.mode in ("P", "L", "RGB"):  # a palette or colour key
+        alpha = im.convert("RGBA").getchannel("A")
+    else:
+        return 0.0
+    hist = alpha.histogram()
+    return 1.0 - hist[255] / sum(hist)

@@ -278,6 +278,24 @@ def test_photos_are_read_by_their_content_not_their_name(synth_photos, tmp_path,
     assert np.array_equal(faces["top"].photo, upright["top"])
 
 
+def test_a_cut_out_photo_with_transparent_pixels_is_said(synth_photos, tmp_path, capsys):
+    """A phone's cut-out of the block (a PNG with a transparent background round it) had its
+    alpha dropped without a word: the background was read as the colour stored under it (black
+    here) and taken for wood. Now the transparent share is named with the fix; an opaque RGBA
+    PNG is read without a word."""
+    d = _copy(synth_photos, tmp_path / "alpha", skip=("front", "top"))
+    for name in ("front", "top"):
+        with Image.open(synth_photos / f"{name}.png") as im:
+            rgba = np.dstack([np.asarray(im.convert("RGB")), np.full((160, 160), 255, np.uint8)])
+        if name == "front":  # the lower 10 rows cut away, transparent black
+            rgba[150:] = 0
+        Image.fromarray(rgba).save(d / f"{name}.png")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == 0 and err.count("warning") == 1, err
+    assert "photo of face 'front': " in err and "front.png' has transparent pixels (6.25 % of them" in err
+    assert "crop the image so every pixel is opaque" in err
+
+
 def test_a_16_bit_photo_is_scaled_not_clipped(synth_photos, tmp_path, capsys):
     """A 16-bit grey export (a raw developer's TIFF or PNG) reads as the same grey at 8 bits;
     converted raw, every value above 255 clipped to white and the face was refused as
