@@ -278,6 +278,24 @@ def test_photos_are_read_by_their_content_not_their_name(synth_photos, tmp_path,
     assert np.array_equal(faces["top"].photo, upright["top"])
 
 
+def test_jpegs_saved_as_jfif_and_avif_photos_are_found(synth_photos, tmp_path, capsys):
+    """A browser or phone saves JPEGs as ``front.jfif`` (or ``.jpe``): the file was passed over
+    without a word (not a photo suffix, so not even named as a stray) and the face called
+    missing. AVIF, a phone camera's newer format, is found too where Pillow reads it."""
+    from PIL import features
+
+    d = _copy(synth_photos, tmp_path / "jfif", skip=("front", "top", "left"))
+    for name, suffix, fmt in (("front", "jfif", "JPEG"), ("top", "JPE", "JPEG"), ("left", "avif", "AVIF")):
+        if fmt == "AVIF" and not features.check("avif"):
+            fmt = "PNG"  # this Pillow has no AVIF: the name is still found, the content read
+        with Image.open(synth_photos / f"{name}.png") as im:
+            im.convert("RGB").save(d / f"{name}.{suffix}", format=fmt, quality=95)
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == 0 and not err, err
+    assert read_block(tmp_path / "o").meta["photos"] == {
+        **{f: f"{f}.png" for f in FACES}, "front": "front.jfif", "top": "top.JPE", "left": "left.avif"}
+
+
 def test_a_cut_out_photo_with_transparent_pixels_is_said(synth_photos, tmp_path, capsys):
     """A phone's cut-out of the block (a PNG with a transparent background round it) had its
     alpha dropped without a word: the background was read as the colour stored under it (black

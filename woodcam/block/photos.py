@@ -1,7 +1,8 @@
 """A block folder from six face photos: find them by name, check them, write the block.
 
 Photos are files in one folder named by face: ``front.jpg``, ``top.png``, ... (any of
-``.jpg .jpeg .png .tif .tiff .bmp .webp .heic .heif .gif``, any case), or by Mokume letter (``A.jpg`` ... or the
+``.jpg .jpeg .jfif .jpe .png .tif .tiff .bmp .webp .heic .heif .avif .gif``, any case; read by their
+content, whatever the suffix says), or by Mokume letter (``A.jpg`` ... or the
 Mokume sample names ``A_col.png`` ...). Each must already be rectified to its face (cropped to
 the face's edges, seen from outside, oriented as ``docs/conventions.md`` says).
 
@@ -38,7 +39,10 @@ from ..frames import (
 from ..tolerances import FACE_PIXEL_ASPECT_RTOL
 from .block import Block, Face
 
-PHOTO_SUFFIXES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".webp", ".heic", ".heif", ".gif")
+# .jfif and .jpe: JPEGs as browsers and some phones save them (a front.jfif was passed over
+# without a word); .avif: a phone camera's newer format (Pillow reads it)
+PHOTO_SUFFIXES = (".jpg", ".jpeg", ".jfif", ".jpe", ".png", ".tif", ".tiff", ".bmp", ".webp", ".heic", ".heif",
+                  ".avif", ".gif")
 #: A photo whose luminance standard deviation is below this (fraction of full scale) is blank.
 BLANK_STD = 0.01
 #: A photo with more than this share of pixels at <= 3 or >= 252 (of 255) is badly exposed.
