@@ -261,7 +261,9 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
     again = [f for f in images if density[f] > max_px_per_mm > ppm]
     for face in progress_bar(again, desc="re-reading photos", unit="photo", enabled=progress) if again else ():
         images[face] = None  # freed before its original is read again
-        images[face], _ = _read_face_photo(face, photos[face], size, ppm)
+        again_read = _read_face_photo(face, photos[face], size, ppm)
+        assert not isinstance(again_read, str)  # its aspect passed on the first read
+        images[face] = again_read[0]
     faces = {}
     for face, a in images.items():
         shape = _face_shape(face, size, ppm)
