@@ -36,7 +36,7 @@ from typing import Literal
 
 import numpy as np
 
-from .appearance import ColorMapAppearance, Wood
+from .appearance import ColorMapAppearance, NeuralAppearance, Wood
 from .errors import WoodcamError, WoodcamWarning
 from .fields.builtin import BUILTIN_NAMES, builtin_block
 
@@ -132,8 +132,16 @@ def open_stock(spec: str, *, species: str | None = None,
                              photos=not base.startswith(("builtin:", "log:", "woodify:")),
                              where=f"block spec {base!r}")
     stock = _open_base_stock(base, species, appearance, appearance_params, species_given)
+    if species is not None and species_given and stock.meta.get("appearance") == "neural":
+        # nothing silently dropped: the neural volumes take every colour from the photos
+        warnings.warn(f"--species {species}: the neural appearance learns every colour from the block's "
+                      "photos; the species changes nothing (it colours --appearance colormap)",
+                      WoodcamWarning, stacklevel=2)
+    # a neural appearance that fell back to the colour map (a block without photos) used none of
+    # its parameters: a GLB recording them reopened as "neural" and warned again in preview/review
+    used = appearance_params if stock.meta.get("appearance") == appearance else {}
     stock.meta["appearance_params"] = {k: (list(v) if isinstance(v, tuple) else v)
-                                       for k, v in appearance_params.items()
+                                       for k, v in used.items()
                                        if isinstance(v, (int, float, str, tuple, list))}
     if not turns:
         return stock
@@ -470,7 +478,9 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
     else:
         _check_appearance_params(appearance, appearance_params, photos=False, where=f"block {block.name!r}")
         app = ColorMapAppearance(species or "oak", **appearance_params)
-    meta = {**dict(block.meta), "appearance": appearance, "species": species or "oak"}
+    # the kind used, not the one asked for: "neural" falls back to the colour map without photos
+    meta = {**dict(block.meta), "species": species or "oak",
+            "appearance": "neural" if isinstance(app, NeuralAppearance) else "colormap"}
     return Stock(spec, block.size_mm, Wood(field, app), block.name, meta)
 
 

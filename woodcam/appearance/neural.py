@@ -330,8 +330,9 @@ def block_appearance(block, field, kind: AppearanceKind = "colormap", *, species
     """The appearance of ``block``: its photo-fitted colour map or its neural volumes.
 
     ``kind="neural"`` on a block without photos falls back to the species colour map and says
-    so with an :class:`AppearanceFallbackWarning`. ``neural_params`` go to
-    :func:`fit_neural_appearance`.
+    so with an :class:`AppearanceFallbackWarning`, naming the training settings in
+    ``neural_params`` it then ignores (``quality``, ``epochs`` ...: they were taken without a
+    word). ``neural_params`` go to :func:`fit_neural_appearance`.
     """
     if kind not in APPEARANCE_KINDS:
         raise WoodcamError(f"appearance must be one of {', '.join(APPEARANCE_KINDS)}; got {kind!r}")
@@ -339,9 +340,14 @@ def block_appearance(block, field, kind: AppearanceKind = "colormap", *, species
     if kind == "neural":
         if has_photos:
             return fit_neural_appearance(block, field, **neural_params)
+        # where the cache lives and whether a bar shows change no colour: not worth a word
+        ignored = [f"--{k.replace('_', '-')} {v}" for k, v in neural_params.items()
+                   if k not in ("cache_dir", "progress", "threads") and v is not None]
         warnings.warn(AppearanceFallbackWarning(
             f"block {block.name!r} has no face photos to learn a neural appearance from; "
-            f"using the {species} colour map instead"), stacklevel=2)
+            f"using the {species} colour map instead"
+            + (f", and {', '.join(ignored)} (neural training settings) have no effect; add face "
+               "photos to the block or drop them" if ignored else "")), stacklevel=2)
     if has_photos:
         return ColorMapAppearance.fit_to_block(block, field, species)
     return ColorMapAppearance(species)
