@@ -10,11 +10,18 @@ Data form
   committed with three.js' licence (``THREE_LICENSE``) so installs need no npm;
 * the part: the GLB (metres, Y up, as exported) base64-encoded;
 * the wood inside: three colour volumes over the block, one per cut axis (``Wood.color`` at
-  voxel centres with the normal of that axis, eq. 10 of seed 000 depends on it), each a PNG of
-  tiled z slices; the cap shader samples them trilinearly, so the cap shows ``Wood.color`` up
-  to the voxel size (:func:`volume_cell_mm`);
+  voxel centres with the normal of that axis, eq. 10 of seed 000 depends on it), each a
+  lossless WebP of tiled z slices (a third smaller than a PNG, which cannot predict real wood's
+  busier rings: a 50 mm Mokume cube's three PNGs took 3.2 MiB in base64, over the page's 3 MiB;
+  WebP is read by every browser since 2020); the cap shader samples them trilinearly, so the
+  cap shows ``Wood.color`` up to the voxel size (:func:`volume_cell_mm`);
 * the report (block, size, placement, texel density and anything the caller adds), the block's
   face photos where it has them, and hotspots (knots, G-code warnings) with positions in mm.
+
+Size: at most 3 MiB besides the part's GLB at the default voxels, photographed blocks included
+(``tests/review``), 3.5 MiB with the neural appearance, whose volumes carry the photos' fine
+texture: a low-amplitude noise that no lossless codec shrinks, and fewer voxels or a lossy codec
+would blur the texture that model was chosen for.
 """
 
 from __future__ import annotations
@@ -35,7 +42,8 @@ _HERE = Path(__file__).resolve().parent
 #: three.js version the committed bundle was built from (``make review-bundle``).
 THREE_VERSION = "0.187.0"
 #: Voxels per colour volume (one per cut axis): three volumes of this many RGB voxels keep the
-#: page near 2 MB (PNG-compressed) with ~1 mm voxels on a 100 x 80 x 50 mm block.
+#: page near 2 MB (lossless WebP) with ~1 mm voxels on a 100 x 80 x 50 mm block, 0.7 mm on a
+#: 50 mm cube.
 VOLUME_VOXELS = 400_000
 
 
@@ -63,8 +71,9 @@ def colour_volume(wood, size_mm, axis: str, cell_mm: float) -> np.ndarray:
     return np.round(np.clip(rgb, 0.0, 1.0) * 255).astype(np.uint8).reshape(*shape[::-1], 3)
 
 
-def _tiled_png(volume: np.ndarray) -> tuple[str, int]:
-    """(nz, ny, nx, 3) -> a PNG data URL of the z slices tiled ``tiles`` across, and ``tiles``."""
+def _tiled_image(volume: np.ndarray) -> tuple[str, int]:
+    """(nz, ny, nx, 3) -> a lossless WebP data URL of the z slices tiled ``tiles`` across, and
+    ``tiles``."""
     from PIL import Image
 
     nz, ny, nx, _ = volume.shape
@@ -75,8 +84,10 @@ def _tiled_png(volume: np.ndarray) -> tuple[str, int]:
         r, c = divmod(k, tiles)
         sheet[r * ny:(r + 1) * ny, c * nx:(c + 1) * nx] = volume[k]
     buf = io.BytesIO()
-    Image.fromarray(sheet).save(buf, format="PNG", optimize=True)
-    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii"), tiles
+    # lossless: the cap must show Wood.color, not a codec's guess; method 4 is within 1 % of the
+    # smallest (6) at a tenth of its time
+    Image.fromarray(sheet).save(buf, format="WEBP", lossless=True, method=4)
+    return "data:image/webp;base64," + base64.b64encode(buf.getvalue()).decode("ascii"), tiles
 
 
 def _photo_urls(photos: dict | None) -> dict:
@@ -145,8 +156,8 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
     volumes = {}
     for axis in progress_bar("xyz", desc="review: colour volumes", unit="volume", enabled=progress):
         vol = colour_volume(wood, size, axis, cell)
-        png, tiles = _tiled_png(vol)
-        volumes[axis] = {"png": png, "tiles": tiles, "shape": [vol.shape[2], vol.shape[1], vol.shape[0]]}
+        image, tiles = _tiled_image(vol)
+        volumes[axis] = {"image": image, "tiles": tiles, "shape": [vol.shape[2], vol.shape[1], vol.shape[0]]}
     data = {
         "title": title or glb_path.stem,
         "block": {"size_mm": size, "voxel_mm": cell},

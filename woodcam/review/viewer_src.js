@@ -130,8 +130,11 @@ function updateProbe() {
 
 // ---- the wood inside: three 3-D textures (one per cut axis, colour for that normal) ----------
 function loadVolume(vol) {
-  return new Promise((resolve) => {
+  return new Promise((resolve, reject) => {
     const img = new Image();
+    // an image the browser cannot read left the page "loading" for ever
+    img.onerror = () => reject(new Error('this browser cannot read the colour volumes (lossless '
+                                         + 'WebP: Chrome 32+, Firefox 65+, Safari 14+)'));
     img.onload = () => {
       const c = document.createElement('canvas');
       c.width = img.width; c.height = img.height;
@@ -155,7 +158,7 @@ function loadVolume(vol) {
       tex.needsUpdate = true;
       resolve(tex);
     };
-    img.src = vol.png;
+    img.src = vol.image;
   });
 }
 
