@@ -167,3 +167,38 @@ def test_renders_put_the_surface_where_the_geometry_says():
     sphere = render_sphere(_NormalColour(), size, px=128, light=(0, 0, 1))
     disc = np.any(sphere != 1.0, axis=2)
     assert disc.mean() == pytest.approx(np.pi / 4, rel=0.03)
+
+
+@pytest.mark.parametrize("longest", [8, 16, 48, 256])
+def test_the_side_by_side_labels_never_overlap(tmp_path, longest, rng):
+    """At --resolution 48 the scores were drawn one photo's width apart (24-48 px) and overlapped,
+    and the face's '(side grain)' ran into the next column's label: every label and image now
+    has its own box, inside the figure, at any image size."""
+    from PIL import Image
+
+    from woodcam.appearance.evaluation import FaceEval, _side_by_side_layout
+
+    shapes = {"front": (longest // 2, longest), "top": (max(1, longest * 4 // 5), longest),
+              "left": (longest // 2, max(1, longest * 4 // 5))}
+    res = []
+    for i, (face, (h, w)) in enumerate(shapes.items()):
+        photo = rng.uniform(0, 1, (h, w, 3))
+        models = MODELS if i else MODELS[:-1]  # a model that did not run is labelled too
+        res.append(FaceEval(face, [None, True, False][i], photo, {m: photo for m in models},
+                            {m: {"histogram": 0.123, "spectrum": 12.34, "patch": 0.456} for m in models}))
+    title = "builtin:flat-sawn: held-out faces (ARF of field input)"
+    (w, h), items = _side_by_side_layout(res, title)
+    boxes = [box for _, box, _ in items]
+    assert all(0 <= x0 < x1 <= w and 0 <= y0 < y1 <= h for x0, y0, x1, y1 in boxes)
+    for i, a in enumerate(boxes):
+        for b in boxes[i + 1:]:
+            assert a[2] <= b[0] or b[2] <= a[0] or a[3] <= b[1] or b[3] <= a[1], (a, b, items)
+    texts = [what[2] for kind, _, what in items if kind == "text"]
+    assert title in texts and "not run" in texts and "(end grain)" in texts
+    side_by_side(res, tmp_path / "sbs.png", title=title)
+    with Image.open(tmp_path / "sbs.png") as im:
+        assert im.size == (w, h)
+    # the three scores of a row side by side fit across the figure (the old one was 4 photos wide)
+    from PIL import ImageDraw, ImageFont
+
+    assert w > 3 * ImageDraw.Draw(Image.new("RGB", (1, 1))).textlength("0.123/12.34/0.456", font=ImageFont.load_default())

@@ -260,41 +260,76 @@ def summarise(results: list[FaceEval]) -> dict:
     return summary
 
 
-def side_by_side(results: list[FaceEval], path, title: str = "") -> None:
-    """One PNG: a row per face, photo | neural | agnostic | colormap, labelled."""
-    from PIL import Image, ImageDraw
+def _side_by_side_layout(results: list[FaceEval], title: str = ""):
+    """Where everything of :func:`side_by_side` goes: ``((width, height), items)``, each item
+    ``("text", (x0, y0, x1, y1), (x, y, str))`` (the ink's box, the text drawn at ``(x, y)``) or
+    ``("image", (x0, y0, x1, y1), (h, w, 3) float)`` (already zoomed to its box); pixels.
 
-    cols = ["photo"] + list(MODELS)
-    rows = []
+    Columns are as wide as their widest image or label, so no two items overlap at any image
+    size (at ``--resolution 48`` the faces were 24-48 px wide and the scores, drawn one photo's
+    width apart, overlapped); images under 64 px are zoomed by a whole factor so that the wood
+    shows.
+    """
+    from PIL import Image, ImageDraw, ImageFont
+
+    font = ImageFont.load_default()
+    probe = ImageDraw.Draw(Image.new("RGB", (1, 1)))
+
+    def text(x: int, y: int, s: str):
+        return ("text", tuple(int(v) for v in probe.textbbox((x, y), s, font=font)), (x, y, s))
+
+    def width(s: str) -> int:
+        return int(np.ceil(probe.textbbox((0, 0), s, font=font)[2]))
+
+    pad, gap = 4, 8
+    line = int(probe.textbbox((0, 0), "Ag|(/", font=font)[3]) + 3
+    zoom = max(1, -(-64 // max(max(r.photo.shape[:2]) for r in results)))
+    grains = {True: "end grain", False: "side grain", None: "grain ?"}
+    rows = []  # per face: (labels, image) per column, photo then each model
     for r in results:
-        ims = [r.photo] + [r.predictions.get(m, np.zeros_like(r.photo)) for m in MODELS]
-        h = max(i.shape[0] for i in ims)
-        pads = [np.pad(i, ((0, h - i.shape[0]), (0, 4), (0, 0)), constant_values=1.0) for i in ims]
-        rows.append((r, np.concatenate(pads, axis=1)))
-    width = max(a.shape[1] for _, a in rows)
-    label_h = 26
-    canvas = np.ones((28 + sum(a.shape[0] + label_h for _, a in rows), width, 3))
-    y = 28
-    boxes = []
-    for r, a in rows:
-        canvas[y + label_h:y + label_h + a.shape[0], :a.shape[1]] = a
-        boxes.append((y, r))
-        y += a.shape[0] + label_h
+        row = [(["photo"], r.photo)]
+        for m in MODELS:
+            sc = r.scores.get(m)
+            row.append(([m, f"{sc['histogram']:.3f}/{sc['spectrum']:.2f}/{sc['patch']:.3f}" if sc
+                         else "not run"], r.predictions.get(m, np.ones_like(r.photo))))
+        rows.append(row)
+    left = max(width(t) for r in results for t in (r.face, f"({grains[r.end_grain]})"))
+    col_w = [max(max(max(width(t) for t in labels), im.shape[1] * zoom) for labels, im in column)
+             for column in zip(*rows)]
+    xs = [pad + left + gap]
+    for w in col_w[:-1]:
+        xs.append(xs[-1] + w + gap)
+    header = [title, "under each model: histogram / spectrum / patch distance to the photo, lower is better"]
+    items = [text(pad, pad + i * line, t) for i, t in enumerate(header) if t]
+    y = pad + len(header) * line + gap
+    for r, row in zip(results, rows):
+        items += [text(pad, y, r.face), text(pad, y + line, f"({grains[r.end_grain]})")]
+        tallest = 0
+        for x, (labels, im) in zip(xs, row):
+            items += [text(x, y + i * line, t) for i, t in enumerate(labels)]
+            big = np.repeat(np.repeat(np.asarray(im, float), zoom, axis=0), zoom, axis=1)
+            items.append(("image", (x, y + 2 * line, x + big.shape[1], y + 2 * line + big.shape[0]), big))
+            tallest = max(tallest, big.shape[0])
+        y += 2 * line + tallest + gap
+    return (max(box[2] for _, box, _ in items) + pad, y - gap + pad), items
+
+
+def side_by_side(results: list[FaceEval], path, title: str = "") -> None:
+    """One PNG: a row per face, photo | neural | agnostic | colormap, each labelled with its
+    model and scores (placed by :func:`_side_by_side_layout`)."""
+    from PIL import Image, ImageDraw, ImageFont
+
+    (w, h), items = _side_by_side_layout(results, title)
+    canvas = np.ones((h, w, 3))
+    for kind, (x0, y0, x1, y1), what in items:
+        if kind == "image":
+            canvas[y0:y1, x0:x1] = what
     img = Image.fromarray((np.clip(canvas, 0, 1) * 255 + 0.5).astype(np.uint8))
-    d = ImageDraw.Draw(img)
-    d.text((4, 2), title, fill=(0, 0, 0))
-    d.text((4, 14), " | ".join(cols) + "   (hist / spectrum / patch distance, lower is better)", fill=(0, 0, 0))
-    col_w = r.photo.shape[1] + 4
-    for y0, r in boxes:
-        grain = {True: "end grain", False: "side grain", None: "grain ?"}[r.end_grain]
-        d.text((4, y0 + 1), f"{r.face}", fill=(0, 0, 0))
-        d.text((4, y0 + 12), f"({grain})", fill=(0, 0, 0))
-        for i, m in enumerate(MODELS):
-            if m in r.scores:
-                sc = r.scores[m]
-                d.text(((i + 1) * col_w + 2, y0 + 1), m, fill=(0, 0, 0))
-                d.text(((i + 1) * col_w + 2, y0 + 12),
-                       f"{sc['histogram']:.3f}/{sc['spectrum']:.2f}/{sc['patch']:.3f}", fill=(0, 0, 0))
+    draw, font = ImageDraw.Draw(img), ImageFont.load_default()
+    for kind, _, what in items:
+        if kind == "text":
+            x, y, s = what
+            draw.text((x, y), s, fill=(0, 0, 0), font=font)
     with atomic_path(path) as tmp:  # a complete image or none
         img.save(tmp)
 
