@@ -61,17 +61,34 @@ def test_bake_and_preview_from_the_command_line(tmp_path, capsys):
      "unknown built-in block 'oak-burl'"),
     (["bake", "cad_examples/tray.py", "--block", "nowhere/", "--out", "x.glb"],
      "neither 'builtin:NAME'"),
-    (["bake", "cad_examples/tray.py", "--block", "builtin:knotty", "--out", "x.glb",
-      "--knot-darkening", "0.3"], "--knot-darkening takes 2 comma-separated numbers in [0, 1]; got '0.3'"),
-    (["bake", "cad_examples/tray.py", "--block", "builtin:knotty", "--out", "x.glb",
-      "--knot-outline", "0.1,0.1,2"], "--knot-outline takes 3"),
-    (["bake", "cad_examples/tray.py", "--block", "builtin:knotty", "--out", "x.glb",
-      "--appearance", "neural", "--knot-darkening", "0.3,0.4"], "apply to --appearance colormap only"),
 ])
 def test_errors_are_one_clean_line(argv, message, tmp_path):
     res = subprocess.run([sys.executable, "-m", "woodcam.cli", *argv], cwd=REPO,
                          capture_output=True, text=True)
     assert res.returncode == 1  # a runtime error; 2 is for usage errors
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("woodcam: error:") and message in lines[0]
+    assert "Traceback" not in res.stderr
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--knot-darkening", "0.3"], "--knot-darkening takes 2 comma-separated numbers in [0, 1]; got '0.3'; "
+     "e.g. 0.25,0.45"),
+    (["--knot-outline", "0.1,0.1,2"], "--knot-outline takes 3 comma-separated numbers in [0, 1]; got "
+     "'0.1,0.1,2'; e.g. 0.16,0.10,0.06"),
+    # argparse took "-0.1,0.3" for an option: "expected one argument", not the rule
+    (["--knot-darkening", "-0.1,0.3"], "--knot-darkening takes 2 comma-separated numbers in [0, 1]; "
+     "got '-0.1,0.3'"),
+    (["--knot-outline", "-1,0,0"], "--knot-outline takes 3 comma-separated numbers in [0, 1]; got '-1,0,0'"),
+    (["--appearance", "neural", "--knot-darkening", "0.3,0.4"], "apply to --appearance colormap only"),
+    (["--quality", "draft"], "--quality and --epochs apply to --appearance neural only"),
+])
+def test_appearance_options_out_of_range_or_contradicting_are_usage_errors(argv, message):
+    """A knot darkening or outline colour out of [0, 1], or a knot option beside the neural
+    appearance, exited 1 (a runtime error) where every other range error exits 2."""
+    res = subprocess.run([sys.executable, "-m", "woodcam.cli", "bake", "cad_examples/tray.py", "--block",
+                          "builtin:knotty", "--out", "x.glb", *argv], cwd=REPO, capture_output=True, text=True)
+    assert res.returncode == 2, res.stderr
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("woodcam: error:") and message in lines[0]
     assert "Traceback" not in res.stderr

@@ -25,7 +25,7 @@ import os
 import re
 from pathlib import Path
 
-from ..errors import WoodcamError
+from ..errors import UsageError, WoodcamError
 from ..limits import REVIEW_VOXELS_RANGE, WOODIFY_RESOLUTION_RANGE
 from ..units import MM_PER_UNIT
 
@@ -471,6 +471,8 @@ def add_knot_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--knot-outline", default=None, metavar="R,G,B",
                    help="colour of the bark ring round dead knots, each in [0, 1] "
                    "(default 0.16,0.10,0.06)")
+    # "--knot-darkening -0.1,0.3" was argparse's "expected one argument", not the [0, 1] rule
+    allow_negative_values(p)
 
 
 def knot_shading(args):
@@ -480,20 +482,22 @@ def knot_shading(args):
     changes = {}
     if args.knot_darkening is not None:
         changes["alive_darkening"], changes["dead_darkening"] = floats(
-            args.knot_darkening, 2, "--knot-darkening")
+            args.knot_darkening, 2, "--knot-darkening", "0.25,0.45")
     if args.knot_outline is not None:
-        changes["outline_rgb"] = floats(args.knot_outline, 3, "--knot-outline")
+        changes["outline_rgb"] = floats(args.knot_outline, 3, "--knot-outline", "0.16,0.10,0.06")
     return KnotShading(**changes)
 
 
-def floats(text: str, n: int, option: str) -> tuple[float, ...]:
-    """``"a,b,..."`` -> n floats in [0, 1], or a WoodcamError naming the option."""
+def floats(text: str, n: int, option: str, example: str) -> tuple[float, ...]:
+    """``"a,b,..."`` -> n floats in [0, 1], or a UsageError (exit 2, a range error like
+    :data:`RANGES`') naming the option, with ``example`` as the fix."""
     try:
         vals = tuple(float(v) for v in text.split(","))
     except ValueError:
         vals = ()
     if len(vals) != n or not all(0.0 <= v <= 1.0 for v in vals):
-        raise WoodcamError(f"{option} takes {n} comma-separated numbers in [0, 1]; got {text!r}")
+        raise UsageError(f"{option} takes {n} comma-separated numbers in [0, 1]; got {text!r}; "
+                         f"e.g. {example}")
     return vals
 
 
@@ -503,14 +507,14 @@ def appearance_params(args) -> dict:
     knots = args.knot_darkening is not None or args.knot_outline is not None
     if args.appearance != "neural":
         if args.quality or args.epochs:
-            raise WoodcamError("--quality and --epochs apply to --appearance neural only; "
+            raise UsageError("--quality and --epochs apply to --appearance neural only; "
                                f"got --appearance {args.appearance}")
         if not knots:
             return {}
         # a darkening asked for replaces the knot colour a colour map would fit to the photos
         return {"knots": knot_shading(args), **({"knot_lut": None} if args.knot_darkening is not None else {})}
     if knots:
-        raise WoodcamError("--knot-darkening and --knot-outline apply to --appearance colormap "
+        raise UsageError("--knot-darkening and --knot-outline apply to --appearance colormap "
                            "only (the neural appearance learns knot colours from the photos)")
     return {k: v for k, v in (("quality", args.quality), ("epochs", args.epochs)) if v is not None}
 
