@@ -182,6 +182,25 @@ def test_screenshot_with_wood_shows_the_section_and_cut_plane_false_hides_it(tmp
     assert (_red(with_cut) | _blue(with_cut)).sum() < 0.8 * part_no_cut.sum()
 
 
+def test_a_cut_plane_that_misses_the_block_is_named(tmp_path):
+    """preview --cut-origin 500,0,0 drew the part uncut without a word: the plane missed the
+    block. A plane through it (or touching a face) says nothing."""
+    import warnings
+
+    from woodcam.errors import WoodcamWarning
+
+    box = _textured_box()
+    with pytest.warns(WoodcamWarning, match=r"the cut plane through \(500.0, 0.0, 0.0\) mm with normal "
+                      r"\(1.0, 0.0, 0.0\) misses the block \[0, 100\] x \[0, 80\] x \[0, 40\] mm"):
+        preview(box, wood=GreenWood(), size_mm=SIZE, cut_origin=(500.0, 0.0, 0.0),
+                cut_normal=(1.0, 0.0, 0.0), screenshot=tmp_path / "a.png", window_size=SMALL)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for origin in [(50.0, 0.0, 0.0), (100.0, 0.0, 0.0)]:
+            preview(box, wood=GreenWood(), size_mm=SIZE, cut_origin=origin, cut_normal=(1.0, 0.0, 0.0),
+                    screenshot=tmp_path / "b.png", window_size=SMALL)
+
+
 def test_screenshot_without_size_frames_the_part(tmp_path):
     img = _read(preview(_textured_box(), screenshot=tmp_path / "p.png", window_size=SMALL))
     # No block: the framed part alone fills a large share of the picture.

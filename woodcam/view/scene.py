@@ -627,6 +627,20 @@ def build_scene(
     normal = (default_cut_normal(camera, b[:, 1] - b[:, 0]) if cut_normal is None
               else check_vector(cut_normal, "cut_normal", unit=True))
 
+    if opt.cut_plane and wood is not None and size is not None and (cut_origin is not None or cut_normal is not None):
+        corners = np.stack(np.meshgrid(*b, indexing="ij"), axis=-1).reshape(-1, 3)
+        side = (corners - origin) @ (np.asarray(normal, float) / np.linalg.norm(normal))
+        if side.min() > 0.0 or side.max() < 0.0:
+            # the picture showed the part uncut without a word (e.g. --cut-origin 500,0,0)
+            import warnings
+
+            from ..errors import WoodcamWarning
+
+            warnings.warn(f"the cut plane through {tuple(round(float(v), 3) for v in origin)} mm with normal "
+                          f"{tuple(round(float(v), 3) for v in normal)} misses the block "
+                          f"[0, {b[0, 1]:g}] x [0, {b[1, 1]:g}] x [0, {b[2, 1]:g}] mm, so nothing is cut; "
+                          "give --cut-origin (cut_origin) a point inside the block", WoodcamWarning,
+                          stacklevel=3)
     plotter.set_background(opt.background)
     if size is not None:
         _add_block(plotter, size)
