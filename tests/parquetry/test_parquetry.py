@@ -702,6 +702,45 @@ def test_planted_violation_is_repaired_and_files_pass(sheets, tmp_path):
     assert (n == 1).all()
 
 
+def test_pieces_keep_the_kerf_clear_of_the_sheet_edge_and_unusable_wood(sheets, tmp_path):
+    """Parsed back from the written veneer SVG and DXF: every piece grown by the kerf (the wood
+    the router takes round it) lies on its sheet and off the mask's unusable wood (a hole in
+    the first sheet), whatever the rotation; the old rule let pieces lie on the sheet's edge."""
+    from skimage import data
+    from shapely.geometry import Polygon, box
+    from shapely.ops import unary_union
+
+    v0 = sheets[0]
+    yy, xx = np.mgrid[:v0.mask.shape[0], :v0.mask.shape[1]]
+    hole = v0.mask & ((yy - 80) ** 2 + (xx - 120) ** 2 >= 40 ** 2)
+    mine = [Veneer(v0.id, v0.rgb, v0.px_per_mm, hole, v0.source, v0.sheet_mm), *sheets[1:]]
+    target = data.camera()[40:300, 120:380].astype(np.float32) / 255.0
+    run = build_parquetry(target, mine, ParquetryParams(image_size_mm=70, px_per_mm=PPM))
+    assert run.complete
+    write_parquetry(run, tmp_path)
+    kerf = run.params.kerf
+    checked = 0
+    for v in run.veneers:
+        f = tmp_path / f"veneer_{v.id}.svg"
+        if not f.exists():
+            continue
+        W, H = v.size_mm
+        sx, sy = v.pixel_scale()
+        r, c = np.nonzero(~v.mask)
+        off = unary_union([box(x * sx / PPM, y * sy / PPM, (x + 1) * sx / PPM, (y + 1) * sy / PPM)
+                           for y, x in zip(r, c)])
+        for polys in (read_svg_pieces(f), read_dxf_pieces(tmp_path / f"veneer_{v.id}.dxf", H)):
+            for pid, q in polys.items():
+                edge = min(q[:, 0].min(), q[:, 1].min(), W - q[:, 0].max(), H - q[:, 1].max())
+                assert edge >= kerf - 1e-3, f"piece {pid} lies {edge:.3f} mm from the edge of {v.id}"
+                if not off.is_empty:
+                    gap = Polygon(q).distance(off)
+                    assert gap >= kerf - 1e-3, f"piece {pid} lies {gap:.3f} mm from unusable wood"
+                checked += 1
+    assert checked == 2 * len(run.patches)
+    assert any(f.name == f"veneer_{v0.id}.svg" for f in tmp_path.iterdir())
+
+
 def test_is_free_quick_accept_gives_the_rasterised_answer():
     """is_free's bounding-box shortcut must answer exactly as rasterising the footprint does:
     random used wood, random rotations, anchors and sizes (down to 2 px and off the sheet)."""

@@ -220,13 +220,15 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
                            "source_textures 'id'), and slice a block once, with more --sheets")
     sheets = [v.resampled(params.px_per_mm) for v in veneers]
     top_cells = 2 ** params.n_adaptive
+    # a piece keeps the kerf clear of the sheet's edges (SheetBank.clears_edges)
+    need_px = params.patch_px + 2 * params.overlap_px + 2 * params.kerf * params.px_per_mm
     for v in sheets:
         h, w = v.rgb.shape[:2]
-        if min(h, w) < params.patch_px + 2 * params.overlap_px:
+        if min(h, w) < need_px:
             raise WoodcamError(
                 f"veneer {v.id!r} is {w / params.px_per_mm:.1f} x {h / params.px_per_mm:.1f} mm, "
-                f"smaller than one patch with its overlap ({(params.patch_px + 2 * params.overlap_px) / params.px_per_mm:g} mm); "
-                "use larger sheets or a smaller patch_mm")
+                f"smaller than one patch with its overlap and the kerf round it ({need_px / params.px_per_mm:g} mm); "
+                "use larger sheets, a smaller patch_mm or a smaller kerf_mm")
     grey = [intensity(v.rgb) for v in sheets]
     src_vals = np.concatenate([g[v.mask] for g, v in zip(grey, sheets)])
     if src_vals.size > 2_000_000:   # the CDF needs no more samples than this

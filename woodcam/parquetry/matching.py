@@ -9,7 +9,10 @@ kerf. A patch is a rectangle of ``(th, tw)`` pixels in the frame of sheet ``i`` 
 top-left pixel ``(x, y)``; its *footprint* is that rectangle mapped back to the sheet frame, a
 rotated rectangle. A candidate may be used only when every sheet pixel whose centre lies in
 its footprint is usable and untaken; single use is checked there, in the sheet frame, so it
-is exact whatever frame the search ran in.
+is exact whatever frame the search ran in. The footprint grown by the kerf must also lie on
+the sheet and off unusable wood (checked on the polygon itself, not its pixel centres): the
+router cuts round a piece, so a piece on the sheet's edge or on the mask's edge would be cut
+off the sheet or into unusable wood. The search sees usable wood shrunk by the kerf.
 
 Search (eq. 4, SSD over all sheets, rotations and positions) runs on an *atlas*: all rotated
 sheets of one pyramid level packed into one image, separated by blocked pixels, so one
@@ -443,11 +446,14 @@ class SheetBank:
             raise WoodcamError(f"n_rot must be >= 1; got {n_rot}")
         self.grey = [np.ascontiguousarray(g, np.float32) for g in grey]
         self.w_intens, self.w_edge = float(w_intens), float(w_edge)
-        self.usable = [np.asarray(u, bool) for u in usable]
+        self.kerf_px = float(kerf_px)
+        # the wood as given (is_free's exact test), and what the search may use: pixels whose
+        # centres keep the kerf clear of unusable wood and the sheet's edge
+        self._off_wood = [~np.asarray(u, bool) for u in usable]
+        self.usable = [_clear_of(~off, self.kerf_px) for off in self._off_wood]
         self.taken = [~u for u in self.usable]
         self._unusable = [~u for u in self.usable]
         self.angles_deg = [360.0 * k / n_rot for k in range(n_rot)]
-        self.kerf_px = float(kerf_px)
         self.mode = mode
         self.f = 1 if mode == "exhaustive" else max(1, int(coarse_factor))
         # Exact re-ranking radius round a coarse anchor X (full px f X): the area-averaged
@@ -493,13 +499,12 @@ class SheetBank:
         return (corners - t) @ np.linalg.inv(a).T
 
     def is_free(self, sheet: int, poly: np.ndarray) -> bool:
-        """True when every sheet pixel centred in ``poly`` is usable and not taken."""
-        # The polygon must lie on the sheet: pixels clipped away would be outside the wood.
+        """True when every sheet pixel centred in ``poly`` is usable and not taken, and
+        ``poly`` grown by the kerf lies on the sheet and off unusable wood (:meth:`clears_edges`)."""
+        if not self.clears_edges(sheet, poly):
+            return False
         lo, hi = poly.min(0), poly.max(0)
         taken = self.taken[sheet]
-        h, w = taken.shape
-        if lo[0] < -0.5 - 1e-6 or lo[1] < -0.5 - 1e-6 or hi[0] > w - 0.5 + 1e-6 or hi[1] > h - 0.5 + 1e-6:
-            return False
         # Quick accept (the same answer, without rasterising): every pixel centred in the
         # polygon lies in its bounding box, so a free box means a free footprint, and a
         # rectangle whose sides are both >= sqrt(2) px holds a disc of radius >= sqrt(2)/2,
@@ -515,6 +520,34 @@ class SheetBank:
         if rr.size == 0:
             return False
         return not taken[rr, cc].any()
+
+    def clears_edges(self, sheet: int, poly: np.ndarray) -> bool:
+        """True when the footprint ``poly (4, 2)`` sheet px grown by ``kerf_px`` (the wood the
+        router takes round the piece cut in it) lies on the sheet and no unusable pixel's square
+        reaches into it: exact on the polygon, where the pixel-centre test of :meth:`is_free`
+        lets a rotated footprint's edge stray up to a pixel past its centres."""
+        import shapely
+
+        k = self.kerf_px
+        off = self._off_wood[sheet]
+        h, w = off.shape
+        # the sheet spans [-0.5, w - 0.5] x [-0.5, h - 0.5] px; the bounding box of the polygon
+        # grown by a disc of radius k is its own bounding box grown by k
+        lo, hi = poly.min(0) - k, poly.max(0) + k
+        if lo[0] < -0.5 - 1e-6 or lo[1] < -0.5 - 1e-6 or hi[0] > w - 0.5 + 1e-6 or hi[1] > h - 0.5 + 1e-6:
+            return False
+        # unusable pixels whose squares reach the grown bounding box
+        r0, c0 = max(0, int(np.ceil(lo[1] - 0.5))), max(0, int(np.ceil(lo[0] - 0.5)))
+        r1, c1 = int(np.floor(hi[1] + 0.5)) + 1, int(np.floor(hi[0] + 0.5)) + 1
+        rr, cc = np.nonzero(off[r0:r1, c0:c1])
+        if rr.size == 0:
+            return True
+        rr, cc = rr + r0, cc + c0
+        squares = shapely.box(cc - 0.5, rr - 0.5, cc + 0.5, rr + 0.5)
+        fp = shapely.Polygon(poly)
+        if k > 0:
+            return bool((shapely.distance(fp, squares) >= k - 1e-6).all())
+        return bool((shapely.area(shapely.intersection(fp, squares)) <= 1e-9).all())
 
     def consume(self, sheet: int, poly: np.ndarray) -> None:
         """Mark the footprint, grown by the kerf, as used wood (no-op when not single use)."""
@@ -698,7 +731,8 @@ class SheetBank:
             if self.w_struct > 0 and any(m.sheet == i and m.rot == j and abs(m.x - x) <= near
                                          and abs(m.y - y) <= near for m in free):
                 continue    # the same bit of wood shifted a pixel or two: nothing new to rank
-            if not self.single_use or self.is_free(i, self.footprint(i, j, x, y, th, tw)):
+            # nothing is taken without single use: is_free then checks the sheet's edges only
+            if self.is_free(i, self.footprint(i, j, x, y, th, tw)):
                 free.append(Match(i, j, x, y, c))
                 if self.w_struct <= 0 or self.w_intens <= 0 or len(free) >= (rerank or self.rerank):
                     break
@@ -840,6 +874,21 @@ def _structure_penalty(gs: np.ndarray, gt: np.ndarray, scale: float = 1.0) -> fl
     cv = cv2.blur(a * b, k) - ma * mb
     cs = (2 * cv + _SSIM_C2) / (np.maximum(va, 0) + np.maximum(vb, 0) + _SSIM_C2)
     return float(np.mean(1.0 - cs))
+
+
+def _clear_of(usable: np.ndarray, kerf_px: float) -> np.ndarray:
+    """The pixels of ``usable (h, w)`` bool whose centres lie at least ``kerf_px`` plus half a
+    pixel from every unusable pixel's square and from the sheet's edge (off the sheet counts as
+    unusable): an axis-aligned footprint on them, whose edge lies half a pixel past its centres,
+    keeps the kerf clear. Measured centre to centre (Euclidean) less the half pixel to a square's
+    side, so a pixel diagonal to unusable wood is kept up to 0.2 px nearer; the exact test is
+    :meth:`SheetBank.clears_edges`. ``kerf_px <= 0`` keeps ``usable`` as it is."""
+    from scipy.ndimage import distance_transform_edt
+
+    if kerf_px <= 0:
+        return usable.copy()
+    d = distance_transform_edt(np.pad(usable, 1, constant_values=False))[1:-1, 1:-1]
+    return d >= kerf_px + 1.0 - 1e-9
 
 
 def _grow(poly: np.ndarray, d: float) -> np.ndarray:
