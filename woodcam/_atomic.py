@@ -44,7 +44,7 @@ from typing import IO
 from .errors import WoodcamError, WoodcamWarning
 
 __all__ = ["all_or_nothing", "atomic_files", "atomic_path", "atomic_write", "check_output_path",
-           "remove_stale", "write_bytes", "write_figure", "write_text"]
+           "manifest_path", "remove_stale", "write_bytes", "write_figure", "write_text"]
 
 
 def _umask() -> int:
@@ -238,26 +238,74 @@ def write_text(path, text: str, **kwargs) -> Path:
     return Path(path)
 
 
+def manifest_path(folder: str | os.PathLike, kind: str) -> Path:
+    """The list of the files the last ``kind`` run wrote in ``folder`` (see :func:`remove_stale`)."""
+    return Path(folder) / f".woodcam-{kind}-files.json"
+
+
+def _read_manifest(path: Path) -> list[str] | None:
+    """The file names listed in a manifest, or None when there is none or it cannot be read
+    as one (then the caller falls back to the pattern rule). Only plain names inside the
+    folder are taken: a list edited to name ``../x`` or ``/etc/x`` deletes nothing there."""
+    import json
+
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):
+        return None
+    names = data.get("files") if isinstance(data, dict) else None
+    if not isinstance(names, list):
+        return None
+    return [n for n in names if isinstance(n, str) and n not in ("", ".", "..")
+            and "/" not in n and "\\" not in n and n != path.name]
+
+
 def remove_stale(folder: str | os.PathLike, patterns: Iterable[str],
-                 keep: Iterable[str | os.PathLike]) -> list[Path]:
-    """Delete the files of ``folder`` that match one of the glob ``patterns`` but are not in
-    ``keep`` (the files a run has just written there): what an earlier run into the same
-    folder wrote and this one does not replace (a veneer sheet no longer cut, a surface at
-    another year) would otherwise pass for this run's. Call it after the new files are in
-    place. A WoodcamWarning names every file removed (a file of the user's own that matches a
-    pattern is removed too: never without a word). Returns the paths removed."""
+                 keep: Iterable[str | os.PathLike], *, kind: str) -> list[Path]:
+    """Delete the files an earlier ``kind`` run wrote in ``folder`` that this run, which has
+    just written ``keep`` there, does not write again (a veneer sheet no longer cut, a surface
+    at another year): beside this run's they would pass for its own. Call it after the new
+    files are in place.
+
+    Each run lists the files it wrote in ``folder`` in :func:`manifest_path` (written
+    atomically, after the removal), and a rerun removes exactly the files of that list it does
+    not write again. Files that match one of the glob ``patterns`` but were not listed (a file
+    of the user's named like an output) are left, with a WoodcamWarning naming them. A folder
+    without a readable list (written before woodcam kept one) falls back to the patterns: every
+    matching file not in ``keep`` is removed. A WoodcamWarning names every file removed.
+    Returns the paths removed."""
+    import json
+
     folder = Path(folder)
     ours = {Path(f).resolve() for f in keep}
-    gone = []
+    manifest = manifest_path(folder, kind)
+    listed = _read_manifest(manifest)
+    looks = []   # pattern by pattern, as the patterns are given
     for pattern in patterns:
-        for old in sorted(folder.glob(pattern)):
-            if old.is_file() and old.resolve() not in ours:
-                old.unlink(missing_ok=True)
-                gone.append(old)
+        looks += [old for old in sorted(folder.glob(pattern))
+                  if old.is_file() and old.resolve() not in ours and old not in looks]
+    if listed is None:
+        stale, foreign = looks, []
+        how = ("(no list of an earlier run's files there: every file named like this run's "
+               "outputs was taken for one)")
+    else:
+        stale = [folder / n for n in listed if (folder / n).is_file() and (folder / n).resolve() not in ours]
+        foreign = [old for old in looks if old.name not in set(listed)]
+        how = f"(listed in {manifest.name})"
+    gone = []
+    for old in stale:
+        old.unlink(missing_ok=True)
+        gone.append(old)
     if gone:
-        warnings.warn(f"removed {len(gone)} file(s) of an earlier run in {str(folder)!r} that this run "
+        warnings.warn(f"removed {len(gone)} file(s) of an earlier run in {str(folder)!r} {how} that this run "
                       f"does not write again, so that they do not pass for this run's: "
                       f"{', '.join(p.name for p in gone)}", WoodcamWarning, stacklevel=2)
+    if foreign:
+        warnings.warn(f"left {len(foreign)} file(s) in {str(folder)!r} named like this run's outputs that "
+                      f"no earlier run wrote (not in {manifest.name}); remove them if they are stale: "
+                      f"{', '.join(p.name for p in foreign)}", WoodcamWarning, stacklevel=2)
+    mine = list(dict.fromkeys(Path(f).name for f in keep if Path(f).resolve().parent == folder.resolve()))
+    write_text(manifest, json.dumps({"written_by": f"woodcam {kind}", "files": mine}, indent=1) + "\n")
     return gone
 
 

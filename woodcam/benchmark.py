@@ -485,7 +485,7 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
             files += bench_gallery(run["seed"], i, run["settings"], out / "gallery", planes=i in picks)
     # an earlier report's gallery drew other blocks: beside this one's, a reader took them for
     # this report's worst blocks
-    remove_stale(out / "gallery", ["b*_*.png"], files)
+    remove_stale(out / "gallery", ["b*_*.png"], files, kind="benchmark-gallery")
     return s
 
 

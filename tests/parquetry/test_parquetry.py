@@ -483,6 +483,33 @@ def test_a_rerun_without_a_job_removes_the_old_job_file_and_says_what_it_removed
     assert "job.json" not in {p.rsplit("/", 1)[-1] for p in res["files"]}
 
 
+def test_a_rerun_removes_exactly_the_files_the_earlier_run_listed(sheets, tmp_path):
+    """A rerun removed earlier outputs by file pattern, so a user's veneer_notes.svg went with
+    them: each run lists its files (.woodcam-parquetry-files.json, written atomically) and a
+    rerun removes exactly the listed files it does not write again; a file named like an
+    output that no run wrote is left, with a warning naming it."""
+    prm = ParquetryParams(image_size_mm=20, px_per_mm=PPM)
+    grey = np.full((40, 40), 0.5, np.float32)
+    first = write_parquetry(build_parquetry(grey, sheets[:1], prm), tmp_path)
+    listed = json.loads((tmp_path / ".woodcam-parquetry-files.json").read_text())["files"]
+    assert listed == [f.rsplit("/", 1)[-1] for f in first["files"]]
+    old = sheets[0].id
+    assert f"veneer_{old}.svg" in listed
+    (tmp_path / "veneer_notes.svg").write_text("<svg/>")   # the user's, named like a cut file
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.warns(WoodcamWarning) as rec:
+        second = write_parquetry(build_parquetry(grey, sheets[2:3], prm), tmp_path)
+    said = [str(w.message) for w in rec if issubclass(w.category, WoodcamWarning)]
+    assert any(m.startswith("removed 2 file(s)") and m.endswith(f"veneer_{old}.svg, veneer_{old}.dxf")
+               for m in said), said
+    assert any(m.startswith("left 1 file(s)") and m.endswith(": veneer_notes.svg") for m in said), said
+    names = sorted(q.name for q in tmp_path.iterdir())
+    assert names == sorted([".woodcam-parquetry-files.json", "veneer_notes.svg", "notes.txt",
+                            *(f.rsplit("/", 1)[-1] for f in second["files"])])
+    assert json.loads((tmp_path / ".woodcam-parquetry-files.json").read_text())["files"] == \
+        [f.rsplit("/", 1)[-1] for f in second["files"]]
+
+
 def test_adaptive_patches_split_by_w_adaptive(sheets):
     from skimage import data
 

@@ -116,7 +116,7 @@ def test_a_rerun_leaves_no_sheet_of_the_earlier_run(scans, capsys):
     result = json.loads((out / "result.json").read_text())
     assert {p["sheet"] for p in result["patches"]} == {"light"}
     assert sorted(p.name for p in out.iterdir()) == [
-        "assembly.svg", "baseline.png", "job.json", "notes.txt", "render.png", "result.json",
+        ".woodcam-parquetry-files.json", "assembly.svg", "baseline.png", "job.json", "notes.txt", "render.png", "result.json",
         "target_matched.png", "veneer_light.dxf", "veneer_light.svg"]
     # removed with a word: the files were deleted silently
     err = capsys.readouterr().err

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -17,6 +18,8 @@ from woodcam._atomic import (
     atomic_path,
     atomic_write,
     check_output_path,
+    manifest_path,
+    remove_stale,
     write_bytes,
     write_text,
 )
@@ -259,3 +262,31 @@ def test_a_refused_write_names_the_file_asked_for_not_its_temporary(tmp_path):
         pass
     assert err.value.filename == "/proc/self/a.mtl"
     assert _leftovers(tmp_path) == []
+
+
+def test_remove_stale_removes_the_listed_files_only(tmp_path):
+    """Earlier outputs were removed by file pattern: the manifest of the earlier run decides
+    (a file it did not write is left, with a warning; a list naming ../x deletes nothing
+    outside); a folder without a readable list falls back to the patterns, with the warning."""
+    from woodcam.errors import WoodcamWarning
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (tmp_path / "outside.txt").write_text("keep")
+    for n in ("a_1.txt", "a_2.txt", "a_mine.txt"):
+        (out / n).write_text(n)
+    man = manifest_path(out, "t")
+    man.write_text('{"files": ["a_1.txt", "a_2.txt", "../outside.txt", "/etc/hostname"]}')
+    with pytest.warns(WoodcamWarning) as rec:
+        gone = remove_stale(out, ["a_*.txt"], [out / "a_1.txt"], kind="t")
+    assert [p.name for p in gone] == ["a_2.txt"]
+    assert sorted(p.name for p in out.iterdir()) == [man.name, "a_1.txt", "a_mine.txt"]
+    assert (tmp_path / "outside.txt").exists()
+    said = [str(w.message) for w in rec]
+    assert any("removed 1 file(s)" in m and m.endswith(": a_2.txt") for m in said)
+    assert any(m.startswith("left 1 file(s)") and m.endswith(": a_mine.txt") for m in said)
+    assert json.loads(man.read_text())["files"] == ["a_1.txt"]
+    man.write_text("not json")          # unreadable: the pattern rule, as before manifests
+    with pytest.warns(WoodcamWarning, match=r"no list of an earlier run.*: a_mine\.txt$"):
+        remove_stale(out, ["a_*.txt"], [out / "a_1.txt"], kind="t")
+    assert sorted(p.name for p in out.iterdir()) == [man.name, "a_1.txt"]

@@ -373,11 +373,12 @@ def test_a_report_into_an_earlier_reports_folder_leaves_one_set(tmp_path, monkey
             "result": {"seed": 0, "index": i, "kind": "clear", "params": {}, "metrics": met,
                        "timing": {}}})
     bm.bench_report(run, rep, gallery=0, thumbnails=2, progress=False)
-    assert sorted(p.name for p in (rep / "gallery").iterdir()) == ["b000000_faces.png",
-                                                                   "b000001_faces.png"]
+    assert sorted(p.name for p in (rep / "gallery").iterdir()) == [
+        ".woodcam-benchmark-gallery-files.json", "b000000_faces.png", "b000001_faces.png"]
     with pytest.warns(WoodcamWarning, match=r"removed 1 file\(s\) of an earlier run .*: b000001_faces\.png$"):
         bm.bench_report(run, rep, gallery=0, thumbnails=1, progress=False)  # says what it removed
-    assert sorted(p.name for p in (rep / "gallery").iterdir()) == ["b000000_faces.png"]
+    assert sorted(p.name for p in (rep / "gallery").iterdir()) == [
+        ".woodcam-benchmark-gallery-files.json", "b000000_faces.png"]
     md = (rep / "report.md").read_text()
 
     def broken(*a, **k):
@@ -389,7 +390,8 @@ def test_a_report_into_an_earlier_reports_folder_leaves_one_set(tmp_path, monkey
         bm.bench_report(run, rep, gallery=0, thumbnails=1, progress=False)
     assert (rep / "report.md").read_text() == md
     assert sorted(p.name for p in rep.rglob("*") if p.is_file()) == [
-        "b000000_faces.png", "report.json", "report.md", "table1.png"]
+        ".woodcam-benchmark-gallery-files.json", "b000000_faces.png", "report.json", "report.md",
+        "table1.png"]
 
 
 # -- training sets --------------------------------------------------------------------------------

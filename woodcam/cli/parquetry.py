@@ -29,7 +29,8 @@ examples:
   woodcam parquetry --config job.json --out out/eye/
 
 writes render.png, baseline.png, target_matched.png, assembly.svg, veneer_<id>.svg/.dxf,
-result.json, panel.glb and job.json (the run as a job file) into --out.
+result.json, panel.glb and job.json (the run as a job file) into --out, and lists them in
+.woodcam-parquetry-files.json: a rerun removes the listed files it does not write again.
 """
 
 
@@ -55,7 +56,8 @@ def register(subparsers) -> None:
                    help="a job file in the paper's layout (source_textures, targets, Table 1 keys); "
                    "options given here override it")
     add_out_option(p, "render.png, baseline.png, target_matched.png, assembly.svg, the cut files "
-                      "veneer_<id>.svg/.dxf, result.json, panel.glb and job.json")
+                      "veneer_<id>.svg/.dxf, result.json, panel.glb and job.json, listed in "
+                      ".woodcam-parquetry-files.json")
     v = p.add_argument_group("veneers")
     v.add_argument("--veneer", action="append", default=[], metavar="SCAN[:DPI][:MASK]",
                    help="scanned veneer image (repeatable; its id, in veneer_<id>.svg, is the file's "

@@ -30,7 +30,8 @@ def register(subparsers) -> argparse.ArgumentParser:
                    "(mm); a PLY may paint growth per vertex: properties gain (speed gain) and "
                    "dir_x, dir_y, dir_z (growth direction, length = strength < 1)")
     p.add_argument("--years", type=float, required=True, help="years to grow (> 0)")
-    add_out_option(p, "field.npz, grown.glb, surfaces and section PNGs, woodify.json")
+    add_out_option(p, "field.npz, grown.glb, surfaces and section PNGs, woodify.json, listed in "
+                      ".woodcam-woodify-files.json")
     p.add_argument("--growth", type=float, default=None, metavar="LEN",
                    help="how far a flat surface grows in --years (in --units); default a quarter of the "
                    "input's largest side")
@@ -306,7 +307,7 @@ def run(args) -> int:
                   shape=args.shape, eccentricity=args.eccentricity, up=args.up, obstacles=obstacles,
                   brushes=brushes, resolution=args.resolution, method=args.method, **painted)
     steps.update(1)
-    from .._atomic import all_or_nothing, remove_stale
+    from .._atomic import all_or_nothing, manifest_path, remove_stale
 
     # one unit: a Ctrl-C leaves the last run's products, never new ones beside old ones (a grown.glb
     # of 13 years beside a woodify.json of 11)
@@ -324,7 +325,8 @@ def run(args) -> int:
                 lambda p: p.write_text(json.dumps(summary, indent=1, default=float)))
     files = [*files, Path(args.out) / "woodify.json"]  # the summary names every file written
     # an earlier run's surfaces at other years are not this run's: they went on piling up
-    remove_stale(args.out, ["surface_y*.stl"], files)
+    remove_stale(args.out, ["surface_y*.stl"], files, kind="woodify")
+    files.append(manifest_path(args.out, "woodify"))  # the list of them, for the next run
     print(f"grew {args.part} for {args.years:g} years on a {'x'.join(map(str, res.front.grid.shape))} "
           f"grid ({res.front.method}, {summary['total_s']:.1f} s); wrote "
           + ", ".join(str(f) for f in files))

@@ -129,8 +129,9 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
     file, when ``job`` is given). Several targets get ``_<name>`` suffixes. The files are one
     set (:func:`woodcam._atomic.all_or_nothing`): an interrupted or failed write leaves the
     folder's previous files as they were, never new ones beside old ones; once they are in
-    place, the files of those kinds an earlier run left there (sheets not cut this time, a
-    ``job.json`` without ``job``) are removed, with a WoodcamWarning naming them
+    place, the files an earlier run wrote there and this one does not (sheets not cut this
+    time, a ``job.json`` without ``job``) are removed, with a WoodcamWarning naming them; the
+    run lists its files in ``.woodcam-parquetry-files.json`` for the next
     (:func:`woodcam._atomic.remove_stale`). In ``result.json`` a sheet no piece is cut from
     has ``file_svg`` null.
     """
@@ -211,7 +212,7 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
     remove_stale(out, [f"{stem}{s}" for stem in ("render", "baseline", "target_matched")
                        for s in (".png", "_*.png")]
                  + ["assembly.svg", "assembly_*.svg", "panel.glb", "panel_*.glb", "veneer_*.svg",
-                    "veneer_*.dxf", "job.json"], files)
+                    "veneer_*.dxf", "job.json"], files, kind="parquetry")
     return {"files": [str(f) for f in files], "summary": summ, "problems": problems}
 
 
