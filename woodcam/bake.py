@@ -342,11 +342,81 @@ def bake_charts(mesh, uv_px, size_px, texels, wood, *, texels_per_mm: float,
                       uv_fill=float(coverage.mean()))
 
 
+def rebake_texture(mesh, corner_uv, image, *, texels_per_mm: float, max_atlas_px: int = 4096,
+                   padding_px: int = ATLAS_PADDING_PX) -> BakeResult:
+    """Move a picture laid on ``mesh`` by any texture coordinates into an atlas of even texel
+    density (:func:`bake`'s unwrap): every face gets ``texels_per_mm`` along the surface, also
+    where the given coordinates squeeze it to a line (a cylindrical projection of a flat face).
+    What is drawn into the result per mm of surface (cracks) then no longer depends on how the
+    picture was laid on.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh, mm
+    corner_uv : (f, 3, 2) float
+        Texture coordinates of every face's corners (u right, v up from the image's bottom row;
+        outside [0, 1] the picture repeats).
+    image : (h, w, 3) uint8
+    texels_per_mm, max_atlas_px, padding_px : as :func:`bake`
+
+    Returns
+    -------
+    BakeResult ; ``mesh.faces`` keep the input's order, ``vertex_map`` names each vertex's input
+    vertex, the atlas is the picture sampled bilinearly (repeating) at every texel.
+    """
+    import trimesh
+
+    t_start = time.perf_counter()
+    corner_uv = np.asarray(corner_uv, np.float64)
+    faces_in = np.asarray(mesh.faces)
+    if corner_uv.shape != (len(faces_in), 3, 2):
+        raise WoodcamError(f"rebake_texture: corner_uv must be (faces, 3, 2) = ({len(faces_in)}, 3, 2); "
+                           f"got {corner_uv.shape}")
+    _check_args(mesh, None, texels_per_mm, max_atlas_px, padding_px, "face", picture=True)
+    messages: list[str] = []
+    vmap, faces, xy, width, height, tpm, stretch = _unwrap(
+        mesh, float(texels_per_mm), int(max_atlas_px), int(padding_px), messages, "auto")
+    img_w, img_h = _round_up(width, _ATLAS_SIZE_MULTIPLE), _round_up(height, _ATLAS_SIZE_MULTIPLE)
+    tri_of_texel = _rasterise(xy, faces, img_w, img_h)
+    painted = np.flatnonzero(tri_of_texel >= 0)
+    tri = tri_of_texel[painted]
+    # per corner: a face's own uv (a seam's two sides differ), interpolated over its triangle
+    corners = np.arange(3 * len(faces)).reshape(-1, 3)
+    uv_map = _affine_maps(xy[faces].reshape(-1, 2), corners, corner_uv.reshape(-1, 2))
+    pic = np.asarray(image, np.float32)
+    ph, pw = pic.shape[:2]
+    atlas = np.zeros((img_h * img_w, 3), np.uint8)
+    for s in range(0, len(painted), MAX_BATCH_POINTS):
+        idx, t = painted[s:s + MAX_BATCH_POINTS], tri[s:s + MAX_BATCH_POINTS]
+        uv = _apply_affine(uv_map, t, (idx % img_w + 0.5)[:, None], (idx // img_w + 0.5)[:, None])
+        x, y = uv[:, 0] * pw - 0.5, (1.0 - uv[:, 1]) * ph - 0.5
+        x0, y0 = np.floor(x), np.floor(y)
+        fx, fy = (x - x0)[:, None], (y - y0)[:, None]
+        c0, r0 = x0.astype(np.int64) % pw, y0.astype(np.int64) % ph
+        c1, r1 = (c0 + 1) % pw, (r0 + 1) % ph
+        rgb = ((pic[r0, c0] * (1 - fx) + pic[r0, c1] * fx) * (1 - fy)
+               + (pic[r1, c0] * (1 - fx) + pic[r1, c1] * fx) * fy)
+        atlas[idx] = np.round(np.clip(rgb, 0, 255)).astype(np.uint8)
+    coverage = (tri_of_texel >= 0).reshape(img_h, img_w)
+    atlas = _dilate(atlas.reshape(img_h, img_w, 3), coverage)
+    uv_out = np.column_stack([xy[:, 0] / img_w, 1.0 - xy[:, 1] / img_h])
+    out = _textured_mesh(trimesh, np.asarray(mesh.vertices, np.float64)[vmap], faces, uv_out, atlas)
+    for msg in messages:
+        warnings.warn(msg, WoodcamWarning, stacklevel=2)
+    return BakeResult(mesh=out, atlas=atlas, coverage_mask=coverage, texels_per_mm=tpm,
+                      timings={"total": time.perf_counter() - t_start}, warnings=messages,
+                      vertex_map=vmap, uv_fill=_uv_fill(xy, faces, img_w, img_h),
+                      density_stretch=stretch)
+
+
 # ------------------------------------------------------------------------------------------------
 # helpers
 
 
-def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals) -> None:
+def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals, *,
+                picture: bool = False) -> None:
+    """The arguments of :func:`bake` checked at the door (``picture``: a picture is baked, no
+    wood, as :func:`rebake_texture`)."""
     faces = getattr(mesh, "faces", None)
     if faces is None or len(faces) == 0:
         raise WoodcamError(
@@ -362,7 +432,7 @@ def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals) ->
             f"largest block); got a span of {span:.4g} mm or NaN/inf; check the part's units and "
             "coordinates (one far vertex made a 7 GB atlas)"
         )
-    if not callable(getattr(wood, "color", None)):
+    if not picture and not callable(getattr(wood, "color", None)):
         raise WoodcamError(
             f"bake: wood must have a method color(points_mm, normals) -> rgb; got "
             f"{type(wood).__name__}; pass a woodcam.appearance.Wood or any object with .color"

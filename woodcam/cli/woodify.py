@@ -162,9 +162,13 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
 
     from ..export import export_glb
     from ..woodify.bark import (
+        BARK_TEXELS_PER_VOXEL,
+        CRACK_WIDTH_VOXELS,
         bark_image,
+        corner_uv,
         cylindrical_uv,
         groove,
+        paint_crack_faces,
         paint_cracks,
         textured_mesh,
     )
@@ -206,7 +210,8 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
         mat = textured.visual.material
         img = getattr(mat, "baseColorTexture", None) or getattr(mat, "image", None)
         image = np.asarray(img.convert("RGB")) if img is not None else None
-    if image is None:
+    procedural = image is None
+    if procedural:
         up = res.field.stem_axis
         c = res.mesh.centroid
 
@@ -216,19 +221,41 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
 
         uv = cylindrical_uv(origins, up, c, 2 * np.pi * mean_radius(res.mesh.vertices))
         # the carried coordinates stretch with the growth; lay as many bark tiles round the
-        # stem as the grown girth holds, as one picture (so each crack is drawn once)
+        # stem as the grown girth holds, as one picture
         k = max(1, int(round(mean_radius(mesh.vertices) / mean_radius(res.mesh.vertices))))
         uv = uv * k
         rows = max(1, int(np.ceil(uv[:, 1].max())))
         image = np.tile(bark_image(256, seed), (rows, k, 1))
         uv = uv / np.array([k, rows])
-    if crack_render == "material" and len(crack_edges):
-        image = paint_cracks(image, uv, crack_edges)
-    elif crack_render == "groove" and len(crack_edges):
+    h = res.front.grid.spacing_mm
+    if crack_render == "groove" and len(crack_edges):
         width = np.zeros(len(mesh.vertices))
         width[crack_edges.ravel()] = 1.0
-        mesh = groove(mesh, width, 0.6 * res.front.grid.spacing_mm)
-    bark = textured_mesh(mesh, uv, image)
+        mesh = groove(mesh, width, 0.6 * h)
+    if procedural:
+        # Cylindrical coordinates squeeze every face that does not face away from the stem (the
+        # top of a flat lid, a rim grown from a sharp edge) to a sliver of the picture: cracks
+        # drawn there crowded one band, and the band covered most of the bark. The bark is
+        # moved into an atlas of even texel density first, so a crack darkens the same
+        # share of the bark per mm wherever it runs.
+        from ..bake import rebake_texture
+
+        baked = rebake_texture(mesh, corner_uv(uv, mesh.faces), image,
+                               texels_per_mm=BARK_TEXELS_PER_VOXEL / h)
+        bark = baked.mesh
+        if crack_render == "material" and len(crack_edges):
+            atlas = np.asarray(bark.visual.material.baseColorTexture)
+            ah, aw = atlas.shape[:2]
+            xy = np.asarray(bark.visual.uv) * [aw, ah]
+            xy[:, 1] = ah - xy[:, 1]
+            width_px = max(1, round(CRACK_WIDTH_VOXELS * h * baked.texels_per_mm))
+            atlas = paint_crack_faces(atlas, xy[bark.faces], mesh.faces, crack_edges, width_px)
+            bark.visual.material.baseColorTexture = Image.fromarray(atlas)
+    else:
+        # the input's own picture and coordinates stay as they were given
+        if crack_render == "material" and len(crack_edges):
+            image = paint_cracks(image, uv, crack_edges)
+        bark = textured_mesh(mesh, uv, image)
     # the block cut from the grown object: default its bounding box
     lo, hi = mesh.bounds
     size = tuple(hi - lo) if block_size_mm is None else tuple(block_size_mm)

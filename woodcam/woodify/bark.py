@@ -117,6 +117,52 @@ def paint_cracks(image, uv, edges, width_px: int = 2) -> np.ndarray:
     return img
 
 
+#: Texels per voxel of the growth grid in the procedural bark's atlas (see
+#: :func:`woodcam.bake.rebake_texture`), and the width of a crack drawn into it, in voxels: the
+#: cracks run along the grown surface's edges, about a voxel long, so finer would show nothing
+#: the simulation knows.
+BARK_TEXELS_PER_VOXEL = 4.0
+CRACK_WIDTH_VOXELS = 0.5
+
+
+def corner_uv(uv, faces) -> np.ndarray:
+    """Per-face corner coordinates ``(f, 3, 2)`` of per-vertex ``uv (n, 2)`` that wrap in ``u``
+    (cylindrical bark): a face across the wrap (``u`` near 0 and 1) has ``u + 1`` on its low
+    corners, as :func:`textured_mesh` gives it, so the picture does not smear round the stem."""
+    c = np.asarray(uv, float)[np.asarray(faces)].copy()
+    u = c[..., 0]
+    seam = (u.max(1) - u.min(1)) > 0.5
+    u[seam] = np.where(u[seam] < 0.5, u[seam] + 1.0, u[seam])
+    return c
+
+
+def paint_crack_faces(image, corner_xy, faces, edges, width_px: int) -> np.ndarray:
+    """Draw crack edges ``(m, 2)`` (vertex indices of ``faces (f, 3)``) dark into an atlas whose
+    faces have their own corner texel coordinates ``corner_xy (f, 3, 2)`` (x right, y down, texel
+    corners at integers): each edge is drawn in every face that holds it, so a crack on a chart
+    seam shows in both charts. In an atlas of even texel density (:func:`woodcam.bake.rebake_texture`)
+    a crack covers the same share of the texture per mm of bark wherever it lies."""
+    import cv2
+
+    img = np.array(image, np.uint8, copy=True)
+    faces = np.asarray(faces)
+    edges = np.asarray(edges).reshape(-1, 2)
+    if not len(edges):
+        return img
+    n = int(max(faces.max(), edges.max())) + 1
+    pairs = faces[:, [[0, 1], [1, 2], [2, 0]]]                    # (f, 3, 2) vertices per side
+    key = pairs.min(2).astype(np.int64) * n + pairs.max(2)
+    want = edges.min(1).astype(np.int64) * n + edges.max(1)
+    f, i = np.nonzero(np.isin(key, want))
+    a = corner_xy[f, i] - 0.5                                     # cv2: pixel centres at integers
+    b = corner_xy[f, (i + 1) % 3] - 0.5
+    k = 16                                                        # 4 bits of sub-texel position
+    for p, q in zip(np.round(a * k).astype(np.int64), np.round(b * k).astype(np.int64)):
+        cv2.line(img, (int(p[0]), int(p[1])), (int(q[0]), int(q[1])), (28, 20, 14),
+                 int(width_px), lineType=cv2.LINE_AA, shift=4)
+    return img
+
+
 def groove(mesh, crack_weight, depth_mm: float):
     """Cut cracks into the geometry: vertices move inward by ``depth_mm * crack_weight``."""
     out = mesh.copy()
