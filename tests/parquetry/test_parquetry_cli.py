@@ -202,3 +202,18 @@ def test_reused_wood_says_the_cut_files_cannot_be_cut(scans, capsys):
     text = capsys.readouterr().out
     assert "pieces overlap on the veneer sheets, so the cut files cannot be cut" in text
     assert json.loads((out / "result.json").read_text())["summary"]["single_use"] is False
+
+
+def test_a_scan_that_states_its_dpi_is_not_sized_by_the_default_without_a_word(scans, capsys):
+    """--veneer SCAN without :DPI used 300 dpi over a scan tagged 101.6 dpi (every piece cut at a
+    third of its size, silently): the tag is named with the fix; a typed :DPI says nothing."""
+    Image.open(scans / "light.png").save(scans / "tagged.png", dpi=(101.6, 101.6))
+    argv = ["parquetry", str(scans / "coffee.png"), "--image-size-mm", "28", "--px-per-mm", "2",
+            "--no-seams", "--no-glb", "--quiet", "--veneer", f"{scans / 'dark.png'}:2px/mm"]
+    # sized at 300 dpi the sheet is too small for a patch: the warning says why
+    assert main(argv + ["--veneer", str(scans / "tagged.png"), "--out", str(scans / "a")]) == 1
+    err = capsys.readouterr().err
+    assert "the file states 101.6 dpi, but no resolution was given, so the default 300 dpi was used; " \
+           f"give {scans / 'tagged.png'}:101.6" in err
+    assert main(argv + ["--veneer", f"{scans / 'tagged.png'}:101.6", "--out", str(scans / "b")]) == 0
+    assert "warning" not in capsys.readouterr().err

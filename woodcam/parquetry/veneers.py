@@ -124,6 +124,23 @@ def read_image(path, what: str = "image") -> np.ndarray:
     return read_photo_rgb(Path(path), what).astype(np.float32) / 255.0
 
 
+def dpi_tag(path: str | Path) -> float | None:
+    """The resolution a scan file states (PNG pHYs, JPEG/TIFF density), dpi, or None when it
+    states none or cannot be read (reading it properly is :func:`load_scan`'s business)."""
+    from PIL import Image
+
+    try:
+        with Image.open(path) as im:
+            tag = im.info.get("dpi")
+    except Exception:  # noqa: BLE001 - any unreadable file: the scan's own reader says why
+        return None
+    try:
+        dpi = float(tag[0])
+    except (TypeError, ValueError, IndexError):
+        return None
+    return dpi if np.isfinite(dpi) and dpi > 1 else None
+
+
 def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | None = None,
               mask: str | Path | np.ndarray | None = None, id: str | None = None) -> Veneer:
     """A scanned veneer.
