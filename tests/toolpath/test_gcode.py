@@ -134,7 +134,8 @@ def test_drilling_cycles_expand_to_moves():
     ("G0 X0\nG0 X[1 / [2 - 2]]\n", 2, "1 / 0"),
     ("N7 G0 X0 Y0 Z0\nN8 G1 F10 X1 Y1 Z1 X2\n", 2, "X2"),
     ("G0 X0\nG41 G1 X10 F100\n", 2, "G41"),           # cutter compensation: refused
-    ("G0 X0\nO1001\nM99\n", 3, "M99"),                 # Fanuc-style subprogram return
+    ("G0 X0\nO1001\nM98 P1001\n", 3, "M98 P1001"),     # LinuxCNC: the label follows the call
+    ("G0 X0\nM98 P1\nM30\nO1\nG1 Y1 M99\n", 5, "M99"),  # a return first on its line
 ])
 def test_malformed_and_unsupported_lines_name_line_and_word(text, line, word):
     with pytest.raises(GcodeError, match=rf"line {line}\b.*'{__import__('re').escape(word)}") as e:

@@ -279,13 +279,11 @@ def test_dialects():
     with pytest.raises(GcodeError, match="grbl has no O-word"):
         read_gcode("o1 sub\no1 endsub\n", dialect="grbl")
     # an O1234 program number: LinuxCNC 2.9 runs through it (woodcam refused it there), as
-    # Fanuc; grbl has none; the M98/M99 subprograms it labels are refused with their rewrite
+    # Fanuc; grbl has none (nor the M98/M99 subprograms it labels: test_fanuc_style_subprograms)
     for d in ("fanuc", "linuxcnc"):
         assert len(read_gcode("O0042 (job)\n" + safety + "N9 O43\nM30\n", dialect=d)) == 2
     with pytest.raises(GcodeError, match="grbl has no O words"):
         read_gcode("O0042\n" + safety, dialect="grbl")
-    with pytest.raises(GcodeError, match=r"'M98': Fanuc-style subprograms .*o1234 call"):
-        read_gcode(safety + "M98 P43\nM30\nO43\nG0 X2\nM99\n")
     # a missing program end is a warning in LinuxCNC's dialect only
     assert any("without M2" in w for w in read_gcode(safety).warnings)
     assert read_gcode(safety, dialect="grbl").warnings == []
@@ -294,6 +292,70 @@ def test_dialects():
 
 
 _BODY = "G21 G90 F100\nG0 X0 Y0 Z5\nG1 X1\n"
+
+
+_SUBS = """G21 G90 F100
+#1 = 2 #<depth> = -1
+G0 X0 Y0 Z5
+M98 P1000 L2
+G0 X#1 Y#2
+M30
+O1000 (a row of half circles, then 10 mm over)
+G91 G1 Z#<depth>
+M98 P2000 L#1
+G91 G0 Z1 X10
+G90
+M99
+O2000
+#<depth> = 7 (a local of this call: O1000's #<depth> is undefined here)
+G91 G3 X4 Y0 I2 J0
+#1 = [#1 + 1] #2 = 5
+G90
+M99
+"""
+
+
+def test_fanuc_style_subprograms():
+    """M98 P<n> [L<count>] calls the subprogram labelled O<n>, M99 returns: LinuxCNC 2.9 runs
+    them (checked against its interpreter in test_linuxcnc_oracle.py), as Fanuc and Mach3 do;
+    woodcam refused every M98/M99 line."""
+    with pytest.raises(GcodeError, match="named parameter #<depth> not defined"):
+        read_gcode(_SUBS)  # named parameters are the call's own, as in an o-word call
+    text = _SUBS.replace("G91 G1 Z#<depth>", "G91 G1 Z-1")
+    for dialect in ("linuxcnc", "fanuc"):
+        assert read_gcode(text, dialect=dialect).warnings == []
+        moves = Interpreter(text, dialect=dialect, start_mm=(0, 0, 10)).run()[0]
+        # O1000 twice (L2); in it O2000 L#1: #1 is shared with the caller (no #1-#30 of its
+        # own, unlike an o-word call) and L is read once per M98 line, so the first O1000
+        # calls O2000 twice (#1 = 2 -> 4), the second four times (#1 -> 8)
+        assert [m[1] for m in moves] == [3, 8, 15, 15, 10, 8, 15, 15, 15, 15, 10, 5]
+        assert [moves[i][2] for i in (3, 4, 9, 10, 11)] == [
+            (8, 0, 4), (18, 0, 5), (34, 0, 4), (44, 0, 5), (8, 5, 5)]
+    # what LinuxCNC refuses, named: a missing label, recursion past its 9 calls, an M98 not
+    # first on its line, an M99 return with words after it, a label before its first call
+    _refused(_BODY + "M98 P7\nM30\n", 4, "M98 P7", "no O7 line in this file")
+    _refused(_BODY + "M98 P7\nM30\nO7\nG91 G0 X1\nM98 P7\nM99\n", 8, "M98 P7",
+             rf"more than {MAX_CALL_DEPTH} nested subroutine calls .*O7 > O7")
+    _refused(_BODY + "G0 X1 M98 P7\nM30\nO7\nM99\n", 4, "M98", "first word of its line")
+    _refused(_BODY + "M98 P7\nM30\nO7\nM99 P3\n", 7, "M99 P3", "nothing may follow an M99")
+    _refused(_BODY + "O7\nG1 X2\nM98 P7\nM30\n", 6, "M98 P7", "O7 is on line 4, before the M98")
+    _refused(_BODY + "M98 P7 X3\nM30\nO7\nM99\n", 4, "M98 X3", "P .* and L .* only")
+    _refused(_BODY + "M98 P7\nM30\no7 sub\no7 endsub\n", 4, "M98 P7", "o-word subroutine")
+    _refused(_BODY + "M98 P7\nM30\n", 4, "M98", "grbl has no subprograms", dialect="grbl")
+    # Fanuc keeps its programs apart: the label may come first, and P51002 is O1002 5 times
+    prog = read_gcode(_BODY + "M30\nO1002\nG91 G1 X1\nG90\nM99\nM98 P51002\n",
+                      dialect="fanuc")
+    assert len(prog) == 2  # (M30 came first: the call never runs)
+    prog = read_gcode(_BODY + "M98 P51002\nM30\nO1002\nG91 G1 X1\nG90\nM99\n",
+                      dialect="fanuc")
+    assert prog.end_mm[-1].tolist() == [6.0, 0.0, 5.0]
+    # M99 in the main program starts it again forever: one pass, and a warning naming the fix
+    prog = read_gcode(_BODY + "G1 X2\nM99\n")
+    assert len(prog) == 3
+    assert prog.warnings == [
+        "line 5: M99 in the main program: the control starts the program again from the top "
+        "and repeats it forever (LinuxCNC, Fanuc and Mach3 alike); woodcam simulated one pass; "
+        "replace this M99 with M30 (or M2) to stop after one pass"]
 
 
 def _refused(text, line, word, rule, **kw):

@@ -56,7 +56,8 @@ def test_corpus_is_large_and_covers_the_features():
     for feature in ("#<", "o100 sub", "call", "while", "do", "repeat", "break", "continue",
                     "elseif", "return", "g10 l2", "g10 l20", "g59.3", "g92.1", "g92.2", "g92.3",
                     "g43", "g49", "g18", "g19", "g83", "g73", "g98", "g99", "g20", "g91",
-                    "atan", "mod", "**", "xor", "g00 g17 g21 g40 g49 g80", "g28 g91 z0"):
+                    "atan", "mod", "**", "xor", "g00 g17 g21 g40 g49 g80", "g28 g91 z0",
+                    "m98 p1000 l2", "m98 p", "m99", "o1001"):
         assert feature in text, feature
 
 

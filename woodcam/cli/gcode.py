@@ -75,8 +75,10 @@ def register(subparsers) -> None:
                    "and G53 X/Y as if machine zero were G-code zero, each with a warning "
                    "naming the lines")
     p.add_argument("--dialect", choices=("linuxcnc", "grbl", "fanuc"), default="linuxcnc",
-                   help="whose meaning the program has (default linuxcnc): grbl has no "
-                   "parameters or O-words; fanuc starts in G0 and needs no M2")
+                   help="whose meaning the program has (default linuxcnc): linuxcnc and "
+                   "fanuc run M98/M99 subprograms; grbl has no parameters, O-words or "
+                   "subprograms; fanuc starts in G0, needs no M2, reads M98 P51000 as O1000 "
+                   "five times and takes an O1000 label before or after its call")
     p.add_argument("--interpreter", choices=("woodcam", "linuxcnc"), default="woodcam",
                    help="read the program with woodcam's interpreter (default) or with "
                    "LinuxCNC's own (needs Debian's linuxcnc-uspace)")

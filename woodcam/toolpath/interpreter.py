@@ -25,6 +25,19 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``do/while``, ``repeat/endrepeat``, ``break``, ``continue``; at most
   :data:`MAX_CALL_DEPTH` nested calls (LinuxCNC's limit) and :data:`MAX_BLOCKS` executed lines
   (woodcam's guard against endless loops);
+- Fanuc-style subprograms (LinuxCNC 2.9's "Fanuc-Style Numbered Programs", measured against
+  its interpreter): ``M98 P1000 L2`` (the first word of its line; only P and L on it) calls
+  the subprogram that starts at the line ``O1000`` twice (no L: once; ``L0``: not at all), and
+  ``M99``, alone first on its line, returns; the M98 line runs again for each repeat (P read
+  again, L once); ``#1``-``#30`` are the caller's (not saved or restored, unlike ``call``),
+  named parameters the call's own; nested M98 and o-word calls share the :data:`MAX_CALL_DEPTH`
+  limit, and the two kinds do not mix (``M98`` calls no ``o100 sub``, an ``o100 sub`` holds no
+  ``O``/``M99`` line). An ``O1000`` line reached without a call is run through, as a program
+  number. LinuxCNC finds the ``O1000`` line by searching forward from the first M98 that calls
+  it (a label before that call is refused); ``fanuc`` keeps its programs apart: the one
+  ``O1000`` line wherever it is, and ``M98 P51000`` without L is ``O1000`` five times (Fanuc's
+  count-and-4-digit form) when the file has no ``O51000``. ``M99`` in the main program starts
+  it again forever on a machine: woodcam simulates one pass and warns;
 - ``G0 G1 G2 G3`` (I/J/K and R arcs in the three planes, ``P`` turns), ``G4``, ``G10 L2/L20``,
   ``G17-G19``, ``G20/G21``, ``G28/G28.1/G30/G30.1``, ``G40``, ``G43/G43.1/G49`` (woodcam tools
   are measured from the tip, so tool length offsets do not move the tip), ``G53``,
@@ -39,11 +52,10 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
 Everything else is an error naming the line and the word; what is read but has no effect on the
 cut is silent, what is read and could matter but is not simulated is a warning with its line.
 
-Dialects: ``linuxcnc`` (the default) is the reference. ``grbl`` has no parameters, expressions
-or O-words (they are errors there, ``O1234`` too), needs no ``M2``. ``fanuc`` starts in
-``G0`` and needs no ``M2`` either. ``O1234`` program-number lines are read in ``linuxcnc`` and
-``fanuc`` (LinuxCNC 2.9 passes through them; they label its Fanuc-style ``M98`` subprograms,
-which, with ``M99``, are refused), as is ``G80`` beside a motion code (Fanuc keeps canned cycles
+Dialects: ``linuxcnc`` (the default) is the reference. ``grbl`` has no parameters, expressions,
+O-words or subprograms (they are errors there, ``O1234`` and ``M98`` too), needs no ``M2``.
+``fanuc`` starts in ``G0`` and needs no ``M2`` either. ``O1234`` program-number lines and
+``M98``/``M99`` subprograms are read in ``linuxcnc`` and ``fanuc``, as is ``G80`` beside a motion code (Fanuc keeps canned cycles
 in their own group, as in the ``G00 G80 G40 G49`` safety line; LinuxCNC 2.9 accepts it too).
 
 Output: canonical moves in the G-code frame, millimetres, tool tip: the G54 work frame as the
@@ -131,6 +143,9 @@ _OWORD = re.compile(r"(?:n\d+(?:\.\d+)?)?o(<[^>]*>|\d+)([a-z]+)(.*)$")
 _LINE_NUMBER = re.compile(r"\d+(?:\.\d+)?(?!\.)")
 _N_WORD = re.compile(r"n[^a-z]*")  # an N word as written, for the message
 _ONUMBER = re.compile(r"(?:n\d+)?o\d+$")
+#: A Fanuc-style subprogram call or return: M98 or M99 as the first word of the line (after its
+#: N word); LinuxCNC reads only such a line as one ("G0 X1 M98 P100": "Unknown m code used").
+_M98_M99 = re.compile(r"(?:n\d+(?:\.\d+)?)?m0*(98|99)(?:\.0*)?(?![\d.])(.*)$")
 #: Words of a plain move line ("X12.5 Z-1.2 F900" in G0/G1): :meth:`Interpreter.execute`
 #: runs them on a short path (the raster lines of a relief program are nearly all such lines).
 _PLAIN_WORDS = frozenset("xyzf")
@@ -171,7 +186,7 @@ _M_KNOWN = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 30, 48, 49, 50, 51, 52, 53, 60, 61}
 #: LinuxCNC's M modal groups: two M codes of one group on a line are refused ("Two m codes used
 #: from same modal group"; grbl refuses its M0/M1/M2/M30, M3-M5 and M7-M9 pairs the same way,
 #: error 21), as are more than :data:`MAX_M_PER_LINE` M codes on one line.
-_M_GROUPS = {"stopping": {0, 1, 2, 30, 60}, "spindle": {3, 4, 5, 19}, "tool change": {6, 61},
+_M_GROUPS = {"stopping": {0, 1, 2, 30, 60, 99}, "spindle": {3, 4, 5, 19}, "tool change": {6, 61},
              "coolant": {7, 8, 9}, "override": set(range(48, 54)),
              "input/output": set(range(62, 69)), "user-defined": set(range(100, 200))}
 #: LinuxCNC refuses a fifth M code on one line ("Too many m codes on line").
@@ -225,7 +240,9 @@ _READ_ONLY = {"_x", "_y", "_z", "_a", "_b", "_c", "_u", "_v", "_w", "_metric", "
 
 class _Line:
     """A source line after comments are taken out: lowercase, no whitespace (LinuxCNC's
-    normalisation), the 1-based line number and the messages of its comments."""
+    normalisation), the 1-based line number and the messages of its comments. ``okey``: the
+    O-word command (``sub``, ``call``, ...), ``"o"`` for a bare ``O1000`` program number (a
+    Fanuc-style subprogram's label), ``"m98"``/``"m99"`` for a subprogram call or return."""
 
     __slots__ = ("text", "no", "msg", "okey", "olabel", "oexpr", "late")
 
@@ -338,6 +355,7 @@ class Interpreter:
         self._warned_start = False
         self._t_warned: set[int] = set()
         self._g53_unplaced: dict[str, list[int]] = {"z": [], "xy": []}  # lines, machine zero unknown
+        self._frames: list[tuple] = []  # the active calls while run() runs
         self.line_no = 0
 
     # -- helpers ----------------------------------------------------------------------------
@@ -673,11 +691,17 @@ class Interpreter:
                                    "use --dialect linuxcnc")
                 ln.okey, ln.olabel, ln.oexpr = key, label, rest
             elif m is None and "o" in body and _ONUMBER.match(body):
-                if not grbl:  # O1234: a program number; LinuxCNC 2.9 runs through it
-                    continue
-                raise GcodeError(no, text, "grbl has no O words (an O1234 program number is "
-                               "LinuxCNC's or Fanuc's)", "remove it or pass --dialect "
-                               "linuxcnc")
+                if grbl:
+                    raise GcodeError(no, text, "grbl has no O words (an O1234 program number is "
+                                   "LinuxCNC's or Fanuc's)", "remove it or pass --dialect "
+                                   "linuxcnc")
+                # O1234: a program number, which LinuxCNC 2.9 runs through; it labels the
+                # Fanuc-style subprogram that M98 P1234 calls
+                ln.okey, ln.olabel = "o", str(int(body[body.index("o") + 1:]))
+            elif not grbl and "m9" in body:
+                mm = _M98_M99.match(body)
+                if mm:  # M98/M99 first on the line: a call or return (grbl: refused as M codes)
+                    ln.okey, ln.oexpr = "m" + mm.group(1), mm.group(2)
             lines.append(ln)
         self.lines = lines
         self.closing = closing
@@ -696,11 +720,27 @@ class Interpreter:
         self.owner: dict[int, int] = {}  # break/continue/elseif/else/return index -> opener
         self.subs: dict[str, int] = {}
         stack: list[tuple[str, str, int]] = []
+        self.olabels: dict[str, list[int]] = {}  # bare O label -> its line indices
         for idx, ln in enumerate(lines):
             k = ln.okey
             if k is None:
                 continue
             self.line_no = ln.no
+            if k in ("o", "m99"):
+                sub = next((s for s in stack if s[0] == "sub"), None)
+                if sub is not None:  # LinuxCNC refuses both when it passes the definition
+                    word = f"O{ln.olabel}" if k == "o" else "M99"
+                    raise GcodeError(ln.no, word, f"{word} inside the o{sub[1]} sub "
+                                     "definition (LinuxCNC: 'Nested subroutine definition' / "
+                                     "'Found M99 instead of O endsub'): Fanuc-style subprograms "
+                                     "(O1000 ... M99) and o-word subroutines (o100 sub ... o100 "
+                                     "endsub) do not mix", f"end o{sub[1]} with o{sub[1]} endsub "
+                                     "and put the O1000 subprogram after it")
+                if k == "o":
+                    self.olabels.setdefault(ln.olabel, []).append(idx)
+                continue
+            if k == "m98":
+                continue
             if k == "while" and stack and stack[-1][0] == "do" and stack[-1][1] == ln.olabel:
                 _, _, op = stack.pop()
                 self.match[op], self.match[idx] = idx, op
@@ -751,7 +791,12 @@ class Interpreter:
     def run(self):
         self._prepare()
         lines = self.lines
-        frames: list[tuple] = []  # (return index, saved #1-#30, saved locals, sub index)
+        # (return index, saved #1-#30 (None for M98), saved locals, sub index, the call's label
+        # and line): one per active o-word call or M98 subprogram call
+        frames: list[tuple] = []
+        self._frames = frames
+        self._m98_left: dict[int, int] = {}  # M98 L repeats left, by calling depth
+        self._m98_target: dict[str, int] = {}  # O label -> line index, once an M98 found it
         repeat_left: dict[int, int] = {}
         pc = 0
         blocks = 0
@@ -784,6 +829,24 @@ class Interpreter:
                 continue
             if k == "sub":
                 pc = self.match[pc] + 1
+            elif k == "o":  # a program number: run through it, as LinuxCNC and Fanuc
+                if frames and frames[-1][1] is not None:  # inside an o-word call
+                    raise self.err(f"O{ln.olabel}", f"Fanuc-style subprogram O{ln.olabel} "
+                                   f"reached inside the o-word subroutine o{frames[-1][4]} "
+                                   "(LinuxCNC: 'Fanuc O.... subroutine must be called with "
+                                   "M98')", f"end o{frames[-1][4]} with o{frames[-1][4]} "
+                                   "endsub before it")
+                pc += 1
+            elif k == "m98":
+                pc = self._m98(pc, ln)
+            elif k == "m99":
+                if not frames:  # the main program's M99: an ordinary line (LinuxCNC's read_m)
+                    self.block(ln.text)
+                    if self.ended:
+                        break
+                    pc += 1
+                    continue
+                pc = self._m99(ln)
             elif k == "call":
                 if len(frames) >= MAX_CALL_DEPTH:
                     raise self.err(f"o{ln.olabel} call", f"more than {MAX_CALL_DEPTH} nested "
@@ -795,7 +858,8 @@ class Interpreter:
                                    "define it in the program")
                 args = self._call_args(ln.oexpr)
                 saved = {i: self.p.get(i, 0.0) for i in range(1, 31)}
-                frames.append((pc + 1, saved, self.locals, self.subs[ln.olabel]))
+                frames.append((pc + 1, saved, self.locals, self.subs[ln.olabel], ln.olabel,
+                               ln.no))
                 self.locals = {}
                 for i in range(1, 31):
                     self.p[i] = args[i - 1] if i <= len(args) else 0.0
@@ -807,7 +871,12 @@ class Interpreter:
                 if not frames:  # a sub body reached without a call: LinuxCNC skips it
                     pc = (self.match[pc] if k == "endsub" else self.match[self.owner[pc]]) + 1
                     continue
-                ret, saved, loc, _ = frames.pop()
+                if frames[-1][1] is None:
+                    raise self.err(f"o{ln.olabel} {k}", f"o{ln.olabel} {k} inside the "
+                                   f"Fanuc-style subprogram O{frames[-1][4]} (LinuxCNC: 'Fanuc "
+                                   "O.... subroutine definition must end with M99')",
+                                   f"return from O{frames[-1][4]} with M99")
+                ret, saved, loc, *_ = frames.pop()
                 self.p.update(saved)
                 self.locals = loc
                 pc = ret
@@ -848,7 +917,11 @@ class Interpreter:
                 pc = op if lines[op].okey in ("while", "repeat") else self.match[op]
             else:  # pragma: no cover - _prepare only lets the keys above through
                 raise self.err(k, "unknown O-word", "fix it")
-        if not self.ended:
+        if not self.ended and frames and frames[-1][1] is None:
+            self.warn(f"the file ends inside the subprogram O{frames[-1][4]} (called on line "
+                      f"{frames[-1][5]}): no M99 returns from it and nothing ends the program "
+                      "(LinuxCNC: 'File ended with no percent sign or program end')")
+        elif not self.ended:
             if self.dialect == "linuxcnc":
                 self.warn("the file ends without M2, M30 or '%' (LinuxCNC stops here with "
                           "'File ended with no percent sign or program end')")
@@ -870,6 +943,117 @@ class Interpreter:
             if lines:
                 self.warnings.append((lines[0], f"G53 (machine coordinates) on line(s) "
                                       f"{line_list(lines)}: {what}; {fix}"))
+
+    def _m98(self, pc, ln):
+        """``M98 P<n> [L<count>]`` on line index ``pc``: call the subprogram labelled ``O<n>``
+        as LinuxCNC 2.9 does (module docstring); returns the next line index."""
+        w = self._m98_words(ln.oexpr)
+        if "p" not in w:
+            raise self.err("M98", "M98 without P (the number of the subprogram to call; "
+                           "LinuxCNC: 'Found m98 code with no P-word')",
+                           "write M98 P1000 to call the subprogram labelled O1000")
+        p = w["p"]
+        n = math.floor(p)
+        if p - n > 0.9999:  # LinuxCNC's integer reading
+            n += 1
+        elif p - n > 0.0001:
+            raise self.err(f"P{p:g}", "M98 P must be a whole number (an O program number)",
+                           "fix P")
+        reps = None
+        if "l" in w:
+            if w["l"] < 0 or abs(w["l"] - round(w["l"])) > 0.0001:
+                raise self.err(f"L{w['l']:g}", "M98 L (how many times to call) must be a whole "
+                               "number >= 0", "fix L")
+            reps = int(round(w["l"]))
+        label = str(n)
+        if (self.dialect == "fanuc" and reps is None and n > 9999
+                and label not in self.olabels and str(n % 10000) in self.olabels):
+            # Fanuc's own form: M98 P51002 calls O1002 five times (count, then 4 digits)
+            reps, label = n // 10000, str(n % 10000)
+        depth = len(self._frames)
+        ret = pc + 1
+        if reps is not None:
+            if reps == 0 and depth not in self._m98_left:
+                if self.dialect == "linuxcnc":
+                    self.warn(f"M98 P{label} L0 calls nothing; LinuxCNC 2.9 still opens a call "
+                              "level there that it never closes (named parameters set before "
+                              "it read as undefined after it, and a later M99 returns to it): "
+                              "woodcam simulated the call skipped; remove the line")
+                return pc + 1
+            left = self._m98_left.get(depth, reps) - 1
+            if left > 0:  # LinuxCNC runs the M98 line again after the M99 (P read again)
+                self._m98_left[depth] = left
+                ret = pc
+            else:
+                self._m98_left.pop(depth, None)
+        target = self._m98_target.get(label)
+        if target is None:
+            target = self._find_olabel(pc, label)
+            self._m98_target[label] = target
+        if depth >= MAX_CALL_DEPTH:
+            chain = " > ".join(f"O{f[4]}" if f[1] is None else f"o{f[4]}" for f in self._frames)
+            raise self.err(f"M98 P{label}", f"more than {MAX_CALL_DEPTH} nested subroutine calls "
+                           f"(LinuxCNC's limit; the calls open: {chain}): a subprogram that calls "
+                           "itself never returns", "reduce the nesting or end the recursion")
+        self._frames.append((ret, None, self.locals, target, label, ln.no))
+        self.locals = {}  # named locals are the call's own (#1-#30 are shared: not saved)
+        return target + 1
+
+    def _find_olabel(self, pc, label):
+        """Line index of the ``O<label>`` line an ``M98 P<label>`` on line index ``pc`` calls:
+        LinuxCNC searches forward from its first call; Fanuc keeps each program apart, so the
+        fanuc dialect takes the one ``O<label>`` line wherever it is."""
+        where = self.olabels.get(label, [])
+        if not where:
+            if label in self.subs:
+                raise self.err(f"M98 P{label}", f"o{label} is an o-word subroutine (o{label} "
+                               "sub), which M98 does not call (LinuxCNC: 'O.... sub' subroutine "
+                               "must be called with 'O.... call')", f"write o{label} call")
+            raise self.err(f"M98 P{label}", f"no O{label} line in this file (woodcam reads one "
+                           f"file; a control would look for program O{label} in its memory)",
+                           f"add the subprogram (O{label} ... M99) after the main program's "
+                           "M30, or fix P")
+        if self.dialect != "linuxcnc":
+            if len(where) > 1:
+                raise self.err(f"M98 P{label}", f"O{label} labels lines "
+                               f"{line_list([self.lines[i].no for i in where])}: which one M98 "
+                               "calls is ambiguous", "renumber one of them")
+            return where[0]
+        after = [i for i in where if i > pc]
+        if not after:
+            raise self.err(f"M98 P{label}", f"O{label} is on line {self.lines[where[0]].no}, "
+                           "before the M98 that first calls it: LinuxCNC searches the file "
+                           "forward from there ('EOF seeking o-word')",
+                           f"move the subprogram O{label} ... M99 after the main program's M30")
+        return after[0]
+
+    def _m98_words(self, s):
+        """The words of an M98 line after ``M98`` (normalised text ``s``): ``{'p': .., 'l': ..}``."""
+        w: dict[str, float] = {}
+        i = 0
+        while i < len(s):
+            c = s[i]
+            if c not in "pl":
+                raise self.err(f"M98 {s[i:].upper()}", "an M98 line holds P (the subprogram) "
+                               "and L (how many times) only: LinuxCNC skips any other word on "
+                               "it without a word", "put the other words on a line of their own")
+            if c in w:
+                raise self.err(c.upper(), f"word {c.upper()} twice on one line", "keep one")
+            w[c], i = self.value(s, i + 1)
+        return w
+
+    def _m99(self, ln):
+        """``M99`` first on its line inside an M98 call: return (the main program's M99 is an
+        ordinary line, :meth:`execute`); returns the next line index."""
+        if ln.oexpr:
+            raise self.err(f"M99 {ln.oexpr.upper()}", "nothing may follow an M99 that returns "
+                           "from a subprogram (LinuxCNC: 'Unexpected character after O-word'; "
+                           "Fanuc's M99 P<n>, a return to line N<n>, is not read)",
+                           "write M99 alone on its line")
+        ret, _, loc, *_ = self._frames.pop()
+        self.locals = loc
+        self.globals["_value"] = self.globals["_value_returned"] = 0.0  # LinuxCNC: no value
+        return ret
 
     def _cond(self, ln):
         s = ln.oexpr
@@ -1052,10 +1236,15 @@ class Interpreter:
                 mset.add(int(v))
                 continue
             if v in (98.0, 99.0):
-                raise self.err(f"M{v:g}", "Fanuc-style subprograms (M98 P calls the O1234 line, "
-                               "M99 returns or, in the main program, starts it again) are not "
-                               "simulated", "write the subprogram as an o-word subroutine "
-                               "(o1234 sub ... o1234 endsub, o1234 call; L repeats as o1 repeat)")
+                if self.dialect == "grbl":
+                    raise self.err(f"M{v:g}", "grbl has no subprograms (M98 calls, M99 returns)",
+                                   "pass --dialect fanuc or linuxcnc, whose controls run them")
+                if v == 98.0 or self._frames:
+                    raise self.err(f"M{v:g}", f"M{v:g} after other words: LinuxCNC reads a "
+                                   "subprogram call or return only as the first word of its "
+                                   "line (after its N word)", f"put M{v:g} on a line of its own")
+                mset.add(99)  # the main program's M99: ends the pass (see below)
+                continue
             if v != math.floor(v) or int(v) not in _M_KNOWN:
                 raise self.err(f"M{v:g}", "unsupported M code (woodcam reads M0-M9, M30, "
                                "M48-M53, M60, M61; M19, M62-M68 and M100-M199 with a warning)", "remove it or post-process for a 3-axis mill")
@@ -1182,6 +1371,12 @@ class Interpreter:
                            "give X/Y/Z with G2/G3")
         if mset & {2, 30}:
             self.ended = True
+        if 99 in mset:
+            self.ended = True
+            self.warn("M99 in the main program: the control starts the program again from the "
+                      "top and repeats it forever (LinuxCNC, Fanuc and Mach3 alike); woodcam "
+                      "simulated one pass; replace this M99 with M30 (or M2) to stop after one "
+                      "pass")
 
     def _analog_io(self, mset, w):
         """LinuxCNC's checks of M66 (wait on digital input P or analog input E, wait type L,
