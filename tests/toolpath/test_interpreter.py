@@ -256,9 +256,10 @@ def test_incremental_cycle_series_count_r_from_the_initial_level():
 
 def test_g43_1_axis_words_are_the_offset_not_a_move():
     # "G43.1 Z-5" in G1 mode fed 4 mm deeper; in LinuxCNC its axis words are the dynamic tool
-    # length offset (woodcam measures tools from the tip: nothing moves)
+    # length offset: nothing moves, and the tip is now 5 mm higher and 3 mm left (the
+    # spindle stands: test_a_tool_length_offset_change_moves_the_tip_not_the_spindle)
     ends = _ends("G0 X0 Y0 Z5\nG1 Z-1 F100\nG43.1 X3 Z-5\nG1 X10\nG49\nM2\n")
-    assert ends == [(0, 0, 5), (0, 0, -1), (10, 0, -1)]
+    assert ends == [(0, 0, 5), (0, 0, -1), (10, 0, 4)]
     assert _ends("G0 X0 Y0 Z5\nG43.1 Z2 G1 X5 F100\nM2\n")[-1] == (5, 0, 2)
 
 
@@ -292,6 +293,18 @@ def test_dialects():
 
 
 _BODY = "G21 G90 F100\nG0 X0 Y0 Z5\nG1 X1\n"
+
+
+def test_a_tool_length_offset_change_moves_the_tip_not_the_spindle():
+    """LinuxCNC keeps the spindle where it is when G43.1/G43/G49 change the offset, so the tip
+    it moves by the program's coordinates jumps by the change (measured against its
+    interpreter in test_linuxcnc_oracle.py); woodcam ignored the offset: after G43.1 Z1 a G91
+    Z-1 from Z10 ended at Z9, not Z8, and G53/G28 put the tip where the spindle goes."""
+    ends = _ends("G0 Z10\nG43.1 Z1\nG91 G0 Z-1\nG90 G0 Z5\nG43.1 X0.5\nG91 G0 Y1\nG49\n"
+                 "G0 Y1\nG90 G43.1 Z2\nG53 G0 Z20\nG28.1\nG49 G0 Z3\nG28\nM2\n")
+    assert ends == [(0, 0, 10), (0, 0, 8), (0, 0, 5), (-0.5, 1, 5), (0, 2, 6), (0, 2, 18),
+                    (0, 2, 3), (0, 2, 20)]  # absolute moves: the tip where the program says;
+    # G53 Z20 and G28's home place the spindle, the tip the offset (2) lower
 
 
 _SUBS = """G21 G90 F100

@@ -210,6 +210,23 @@ def test_a_tool_length_offset_does_not_carry_into_the_next_file_of_a_batch(tmp_p
     assert after["moves"][0][2] == pytest.approx([0, 0, 9])
 
 
+def test_the_oracle_reports_the_tool_tip_whatever_the_tool_length_offset(tmp_path):
+    """The driver added LinuxCNC's tool length offset to the moves, as AXIS draws the
+    controlled point: after G43.1 Z1, G0 Z5 read Z6 where the tip, which woodcam simulates, is
+    at Z5. It reports the tip now, and drops the moves where the spindle stands (G28's
+    intermediate point after an offset change reported the tip's jump as a move); woodcam
+    moves the tip by an offset change as LinuxCNC does (corpus lcnc_tool_length.ngc)."""
+    p = tmp_path / "tlo.ngc"
+    p.write_text("G21 G90\nG0 X1 Y1 Z10\nG43.1 Z1\nG0 Z5\nG91 G0 X1\nG43.1 Z3\nG28\nM2\n")
+    res = run_batch([p], start_mm=START)[0]
+    assert res["error"] is None
+    ends = [v for m in res["moves"] for v in m[2]]
+    assert ends == pytest.approx([1, 1, 10, 1, 1, 5, 2, 1, 5, 0, 0, 7])  # G28: the home (the
+    # start) with the tip 3 lower
+    agree, bad = _differences([p])
+    assert not bad, bad
+
+
 def test_the_oracle_is_a_metric_machine_whose_parameters_read_in_mm(tmp_path):
     """The driver declared an inch machine: ``#5162`` with the home at Y7 mm read 0.2756 in a
     G21 program. Now mm (a metric machine, as woodcam's interpreter), and programs that store

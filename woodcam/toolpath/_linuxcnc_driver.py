@@ -8,7 +8,9 @@ for it, not for woodcam's virtualenv); never imported by woodcam. Input (stdin, 
 ``{"moves": [...], "error": null | [line, message], "result": code}`` per file, moves as
 woodcam's canonical tuples ``[kind, line, [x, y, z], [c1, c2] | null, rotation, plane]`` in the
 machine frame, mm, tool tip (LinuxCNC's canon reports program coordinates before the G5x/G92
-offsets and without the tool length offset; they are added back here as AXIS does), shifted by
+offsets, which are added back here as AXIS does, and without the tool length offset, which is
+not: AXIS adds it too and draws the controlled point, the spindle's gauge line, where a tool
+with that length offset has its tip the offset lower; woodcam simulates the tip), shifted by
 ``machine_zero_mm``: the G54 offset is ``-machine_zero_mm``, so the moves come out in the G54
 frame the start position is given in (as woodcam's interpreter does). The machine is metric
 (external length units mm, the parameter file in mm), as woodcam's interpreter: a program reads
@@ -62,8 +64,9 @@ class _Canon:
         self.plane = 1
         self.g5x = [0.0] * 3
         self.g92 = [0.0] * 3
-        self.tlo = [0.0] * 3
         self.rot = 0.0
+        self.tlo = [0.0] * 3  # the tool length offset: the controlled point is the tip plus it
+        self.ctrl = None  # the controlled point after the last move, mm
         self.mzero = [0.0] * 3  # the output shift: machine origin in the G54 frame, mm
 
     def __getattr__(self, name):  # every other canon call has no effect on the moves
@@ -108,26 +111,37 @@ class _Canon:
         self.plane = plane
 
     def _mach(self, p):
-        return [v * MM + a + b + t + m
-                for v, a, b, t, m in zip(p, self.g5x, self.g92, self.tlo, self.mzero)]
+        return [v * MM + a + b + m for v, a, b, m in zip(p, self.g5x, self.g92, self.mzero)]
+
+    def _straight(self, kind, p):
+        end = self._mach(p)
+        ctrl = [e + t for e, t in zip(end, self.tlo)]
+        if self.ctrl is not None and max(abs(a - b) for a, b in zip(ctrl, self.ctrl)) < 1e-9:
+            # the spindle stands: no motion. LinuxCNC emits such moves, and after a tool
+            # length offset change (G28's intermediate point, say) the tip they report has
+            # jumped by the change, a move that never happens
+            return
+        self.ctrl = ctrl
+        self.moves.append([kind, self.line, end, None, 0, 17])
 
     def straight_traverse(self, x, y, z, *rest):
-        self.moves.append([0, self.line, self._mach((x, y, z)), None, 0, 17])
+        self._straight(0, (x, y, z))
 
     def straight_feed(self, x, y, z, *rest):
-        self.moves.append([1, self.line, self._mach((x, y, z)), None, 0, 17])
+        self._straight(1, (x, y, z))
 
     def arc_feed(self, e1, e2, c1, c2, rot, en, *rest):
         a1, a2, an = _AXES[self.plane]
         end = [0.0] * 3
         end[a1], end[a2], end[an] = e1, e2, en
         end = self._mach(end)
-        off = [a + b + t + m for a, b, t, m in zip(self.g5x, self.g92, self.tlo, self.mzero)]
+        off = [a + b + m for a, b, m in zip(self.g5x, self.g92, self.mzero)]
         centre = [c1 * MM + off[a1], c2 * MM + off[a2]]
+        self.ctrl = [e + t for e, t in zip(end, self.tlo)]
         self.moves.append([2, self.line, end, centre, int(rot), _PLANE[self.plane]])
 
     def rigid_tap(self, x, y, z, *rest):
-        self.moves.append([1, self.line, self._mach((x, y, z)), None, 0, 17])
+        self._straight(1, (x, y, z))
 
 
 def main():

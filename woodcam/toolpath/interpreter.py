@@ -40,7 +40,11 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   it again forever on a machine: woodcam simulates one pass and warns;
 - ``G0 G1 G2 G3`` (I/J/K and R arcs in the three planes, ``P`` turns), ``G4``, ``G10 L2/L20``,
   ``G17-G19``, ``G20/G21``, ``G28/G28.1/G30/G30.1``, ``G40``, ``G43/G43.1/G49`` (woodcam tools
-  are measured from the tip, so tool length offsets do not move the tip), ``G53``,
+  are measured from the tip and the moves are the tip's, so an offset does not move where a
+  program coordinate cuts; as LinuxCNC, the spindle stands still when the offset changes, so
+  the tip moves by the change: ``G43.1 Z1`` then ``G91 G0 Z-1`` from Z10 ends at Z8, and
+  ``G53``, ``G28``/``G30`` homes and ``G28.1`` place the spindle, the tip the offset lower;
+  ``G43 H`` takes the tool table's length as 0), ``G53``,
   ``G54-G59.3``, ``G61/G61.1/G64``, ``G73 G81 G82 G83 G85 G86 G89`` with ``G98/G99`` and ``L``,
   ``G80``, ``G90/G91``, ``G90.1/G91.1``, ``G92/G92.1/G92.2/G92.3``, ``G94``, ``G97``;
   ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60`` (one of each modal group a line);
@@ -348,6 +352,7 @@ class Interpreter:
         self.cs = int(self.p[5220])
         self.g5x = [self.p.get(_cs_base(self.cs) + i, 0.0) for i in range(3)]
         self.g92 = [self.p.get(5211 + i, 0.0) for i in range(3)] if self.p.get(5210) else [0.0] * 3
+        self.tlo = [0.0, 0.0, 0.0]  # the active tool length offset (G43.1), mm
         self.cycle_il: float | None = None
         self.cyc = {"r": math.nan, "z": math.nan, "q": math.nan, "p": 0.0, "l": 1}
         self.ended = False
@@ -1297,6 +1302,8 @@ class Interpreter:
         if 43.0 in g and "h" not in w:
             self.warn("G43 without H uses the loaded tool's length; woodcam measures tools "
                       "from the tip, so tool lengths do not move the cut")
+        if g & {43.0, 43.1, 49.0}:
+            self._tool_length_offset(g, w)
         for c in _CS:
             if c in g:
                 self.cs = _CS.index(c) + 1
@@ -1324,8 +1331,8 @@ class Interpreter:
             self.home(30.0 if 30.0 in g else 28.0, w)
         elif nonmodal & {28.1, 30.1}:
             base = 5161 if 28.1 in g else 5181
-            for i in range(3):
-                self.p[base + i] = self.pos[i]
+            for i in range(3):  # the controlled point (module docstring)
+                self.p[base + i] = self.pos[i] + self.tlo[i]
         elif 92.0 in g:
             if not axis:
                 raise self.err("G92", "G92 needs axis words", "write G92 X0 Y0 Z0")
@@ -1448,6 +1455,20 @@ class Interpreter:
             if n == self.cs:
                 self.g5x[i] = val
 
+    def _tool_length_offset(self, g, w):
+        """G43 H (the tool table's length: 0, as woodcam's tools are measured from the tip; the
+        oracle's table holds 0 too), G43.1 (the axes it names, in program units; the others
+        keep theirs, as LinuxCNC) or G49 (none). The control keeps the controlled point (the
+        spindle) where it is, so the tip it moves by the program's coordinates is now the
+        change lower: woodcam's tip position moves by it (no motion: the spindle stands)."""
+        new = [0.0, 0.0, 0.0] if g & {43.0, 49.0} else list(self.tlo)
+        if 43.1 in g:
+            for i, a in enumerate("xyz"):
+                if a in w:
+                    new[i] = w[a] * self.scale
+        self.pos = [p - (n - o) for p, n, o in zip(self.pos, new, self.tlo)]
+        self.tlo = new
+
     def home(self, code, w):
         """G28/G30: rapid through the (optional) intermediate point to the stored home
         (#5161-#5163 / #5181-#5183, machine frame; woodcam stores its start position there)."""
@@ -1457,8 +1478,8 @@ class Interpreter:
             self.emit(TRAVERSE, self._target(w, axis))
         idx = [i for i, a in enumerate("xyz") if a in w] if axis else [0, 1, 2]
         end = list(self.pos)
-        for i in idx:
-            end[i] = self.p.get(base + i, 0.0)
+        for i in idx:  # the home holds the controlled point: the tip is the offset lower
+            end[i] = self.p.get(base + i, 0.0) - self.tlo[i]
             self.known[i] = True
         self.emit(TRAVERSE, end)
 
@@ -1469,7 +1490,7 @@ class Interpreter:
             for i, a in enumerate("xyz"):
                 if a not in w:
                     continue
-                end[i] = w[a] * self.scale
+                end[i] = w[a] * self.scale - self.tlo[i]  # G53 places the controlled point
                 if self.mzero is None:  # not known: see the module docstring
                     key = "z" if a == "z" else "xy"
                     if self.line_no not in self._g53_unplaced[key]:
