@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import signal
+from collections import Counter
 from contextlib import contextmanager
 
 import numpy as np
@@ -78,7 +79,8 @@ def test_moves_far_outside_the_stock_cut_what_they_say(text, volume):
 
 
 def _check(text):
-    """The invariant: a WoodcamError, or a program of finite moves that simulates."""
+    """The invariant: a WoodcamError, or a program of finite moves that simulates. Returns
+    ``"error"``, ``"simulated"`` or ``"read"`` (no moves, or too many to simulate here)."""
     try:
         prog = read_gcode(text)
     except WoodcamError:
@@ -88,6 +90,7 @@ def _check(text):
     if 0 < len(prog) <= 50_000:  # the simulation of long programs is tested on its own
         res = simulate(prog, parse_tool_spec("ball:6"), (40, 30, 20), resolution_mm=1.0)
         assert np.isfinite(res.heightmap).all()
+        return "simulated"
     return "read"
 
 
@@ -104,19 +107,37 @@ _NUMS = st.one_of(st.integers(-10**6, 10**6).map(str),
                   st.sampled_from(["0", "-0", ".5", "5.", DIGITS_400, BIG, "1" + "0" * 15]))
 _TOKENS = st.one_of(_WORDS, _NUMS)
 _LINE = st.lists(_TOKENS, max_size=8).map(" ".join)
-_PROGRAM = st.lists(_LINE, max_size=15).map("\n".join)
+# moves with hostile numbers among the token lines: a line of random tokens is nearly always
+# refused, so programs of token lines alone never reached the simulation (300 of 300 refused
+# or empty)
+_AXIS = st.tuples(st.sampled_from("XYZ"), st.sampled_from(["", " "]), _NUMS).map("".join)
+_MOVE = st.tuples(st.sampled_from(["G0", "G1 F100", "G1", "G91 G1 F100", "G90 G0"]),
+                  st.lists(_AXIS, min_size=1, max_size=3, unique_by=lambda w: w[0])).map(
+    lambda t: " ".join([t[0], *t[1]]))
+_CIRCLE = _NUMS.map(lambda v: f"G2 I{v} J0 F100")  # a full circle about a point I mm away
+_PROGRAM = st.lists(st.one_of(_LINE, _MOVE, _MOVE, _CIRCLE), max_size=15).map("\n".join)
 
 
-@settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck))
-@given(_PROGRAM)
-def test_fuzzed_token_programs_keep_the_invariant(text):
-    with _deadline(10):
-        _check(text)
+def test_fuzzed_token_programs_keep_the_invariant():
+    outcomes = []
+
+    @settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck))
+    @given(_PROGRAM)
+    def one(text):
+        with _deadline(10):
+            outcomes.append(_check(text))
+
+    one()
+    # the invariant holds on programs that were read and simulated, not only on refusals;
+    # floors well under what 300 examples give (4 runs measured: 40-46 simulated, 243-250
+    # refused)
+    assert outcomes.count("simulated") >= 20, Counter(outcomes)
+    assert outcomes.count("error") >= 100, Counter(outcomes)
 
 
 def test_fuzzed_structured_programs_keep_the_invariant():
     outcomes = [_check(program(seed, valid_share=0.98)) for seed in range(60)]
-    assert outcomes.count("read") >= 20  # mostly real geometry, not only refusals
+    assert outcomes.count("simulated") >= 20  # mostly real geometry, not only refusals (32)
 
 
 @pytest.mark.slow
@@ -133,4 +154,5 @@ def test_fuzz_campaign_structured_programs():
     for seed in range(5000, 7000):
         with _deadline(10):
             outcomes.append(_check(program(seed, n_lines=60, valid_share=0.99)))
-    print(f"structured fuzz: {outcomes.count('read')} read, {outcomes.count('error')} refused")
+    print(f"structured fuzz: {outcomes.count('simulated')} simulated, "
+          f"{outcomes.count('error')} refused")
