@@ -78,28 +78,46 @@ def test_run_is_complete_with_seams(finished):
 
 def test_single_use_on_every_sheet_from_svg_and_dxf(finished):
     """Rasterise every parsed-back cut path onto its sheet: no sheet pixel is used twice, and
-    only usable wood is used; the kerf keeps pieces apart by at least kerf - 1 px."""
+    only usable wood is used; the kerf keeps pieces apart by at least kerf - 1 px. The DXF's
+    pieces are the SVG's, each in its place: the DXF read back (y down) covers the same area,
+    and in the file itself (y up) a piece spans ``H - y`` of the SVG's ``y``."""
+    import ezdxf
+    from ezdxf import bbox
+    from shapely.geometry import Polygon
+
     run, out, _ = finished
     kerf = run.params.kerf
-    used = 0
+    used = placed = 0
     for v in run.veneers:
         f_svg = out / f"veneer_{v.id}.svg"
         if not f_svg.exists():
             continue
         _W, H = v.size_mm
         h, w = v.mask.shape
-        for polys in (read_svg_pieces(f_svg), read_dxf_pieces(out / f"veneer_{v.id}.dxf", H)):
+        svg, dxf = read_svg_pieces(f_svg), read_dxf_pieces(out / f"veneer_{v.id}.dxf", H)
+        for polys in (svg, dxf):
             n = rasterise(polys, (h, w), v.px_per_mm)
             assert n.max() == 1, f"sheet {v.id}: a pixel is used by {n.max()} pieces"
             assert not (n > 0)[~v.mask].any()
             used += len(polys)
+        assert dxf.keys() == svg.keys()
+        msp = ezdxf.readfile(str(out / f"veneer_{v.id}.dxf")).modelspace()
+        for pid, poly in svg.items():
+            a, b = Polygon(poly), Polygon(dxf[pid])
+            assert a.symmetric_difference(b).area < 0.01 * a.area, (v.id, pid)
+            ext = bbox.extents(msp.query(f'*[layer=="PIECE_{pid}"]'))
+            assert (ext.extmin.y, ext.extmax.y) == pytest.approx(
+                (H - poly[:, 1].max(), H - poly[:, 1].min()), abs=0.05), (v.id, pid)
+            assert (ext.extmin.x, ext.extmax.x) == pytest.approx(
+                (poly[:, 0].min(), poly[:, 0].max()), abs=0.05), (v.id, pid)
+            placed += 1
         # Pieces grown by half the kerf (less half a pixel of rasterisation) still never touch.
         from shapely.geometry import Polygon
 
         grown = {k: np.asarray(Polygon(q).buffer(kerf / 2 - 0.5 / v.px_per_mm).exterior.coords)
                  for k, q in read_svg_pieces(f_svg).items()}
         assert rasterise(grown, (h, w), v.px_per_mm).max() == 1
-    assert used == 2 * 25
+    assert used == 2 * 25 and placed == 25
 
 
 def test_every_target_pixel_covered_once_from_assembly_svg(finished):
