@@ -45,6 +45,12 @@ def test_round_trip(tmp_path, block, bits, tol):
         err = np.abs(g.ring_map.astype(float) - f.ring_map.astype(float)).max()
         assert err <= tol + 1e-7            # float32 storage of the map adds ~6e-8
         _assert_same_traces(f.traces, g.traces)
+        # the files as any image program reads them, row 0 the face's top row (a writer and a
+        # reader that both flipped an image agreed with each other, not with the file)
+        assert np.array_equal(np.asarray(Image.open(tmp_path / f"{name}_photo.png")), f.photo)
+        on_disk = np.asarray(Image.open(tmp_path / f"{name}_ring_map.png")).astype(float)
+        assert on_disk.shape == f.shape
+        assert np.abs(on_disk / (2 ** bits - 1) - f.ring_map).max() <= tol + 1e-7
     assert any(t.year is None for f in back.faces.values() for t in f.traces)
     assert np.array_equal(back.faces["left"].extras["knot_mask"], block.faces["left"].extras["knot_mask"])
     assert back.faces["left"].extras["comment"] == {"who": "test", "n": 2}
