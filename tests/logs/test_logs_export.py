@@ -50,6 +50,18 @@ def test_heightmap_png_decodes_back_to_mm(log, tmp_path):
     back = read_heightmap_png(p)
     span = log.heightmap_mm.max() - log.heightmap_mm.min()
     np.testing.assert_allclose(back, log.heightmap_mm, atol=span / 65535)
+    # the file itself stands like the log: its row 0 is the top (l = length), grey 0 and 65535
+    # the range's ends in its text chunk (a writer and a reader that both skipped the flip, or
+    # both flipped twice, agreed with each other, not with the picture)
+    from PIL import Image
+
+    with Image.open(p) as im:
+        lo, hi = map(float, im.text["woodcam:range_mm"].split())
+        grey = np.asarray(im, dtype=float)
+    assert (lo, hi) == pytest.approx((log.heightmap_mm.min(), log.heightmap_mm.max()), abs=1e-5)
+    np.testing.assert_allclose(lo + grey / 65535 * (hi - lo), log.heightmap_mm[::-1],
+                               atol=span / 65535 + 1e-5)
+    assert abs(log.heightmap_mm[0].mean() - log.heightmap_mm[-1].mean()) > 100 * span / 65535
     img, (lo, hi) = heightmap_image(log, "detail")
     assert lo == -hi and img.min() >= 0 and img.max() <= 1
 
