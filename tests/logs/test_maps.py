@@ -85,3 +85,44 @@ def test_missing_maps_are_named(tmp_path):
         read_maps(tmp_path)
     with pytest.raises(WoodcamError, match="height_mm"):
         decode_maps({}, {"r_min_mm": 1, "r_max_mm": 2})
+
+
+def test_the_written_maps_hold_the_documented_layout(tmp_path):
+    """The PNGs themselves, read with PIL, against the layout of woodcam.logs.maps on a log
+    whose numbers are known: row 0 the butt end, columns counter-clockwise from +x, a
+    counter-clockwise twist in G (an encoder and a decoder that both turned the columns the
+    other way, or both put the top end in row 0, agreed with each other, not with the seed's
+    files)."""
+    from PIL import Image
+
+    from woodcam.fields.skeleton import BranchStrand, LogSkeleton
+
+    z = np.arange(0.0, 401.0, 10.0)                       # a 400 mm log
+    az = 2 * np.pi * np.arange(36) / 36
+    radii = 100 + 10 * np.sin(az)[None, :] + 0.05 * z[:, None]  # 90..130 mm, widest at +y, top
+    pith = np.stack([np.linspace(-5, 5, len(z)), np.zeros(len(z))], 1)
+    r = np.array([0.0, 50.0, 120.0])
+    knot = BranchStrand(100.0, np.pi / 2, r, [0.0, 10.0, 20.0], [0.0, 0.3, 0.6],
+                        [5.0, 15.0, 25.0], 120.0, 120.0)
+    write_maps(LogSkeleton(z, pith, radii, (knot,)), tmp_path)
+    png = {k: np.asarray(Image.open(tmp_path / f)).astype(int)
+           for k, f in (("stem", "stem_map.png"), ("height", "knot_height_map.png"),
+                        ("orientation", "knot_orientation_map.png"))}
+    stem = png["stem"]
+    rows, cols = stem.shape[:2]
+    zi = np.arange(rows) * 400.0 / (rows - 1)
+    om = 2 * np.pi * np.arange(cols) / cols
+    want = np.rint((100 + 10 * np.sin(om)[None, :] + 0.05 * zi[:, None] - 90) / 40 * 255)
+    assert np.abs(stem[:, :, 2] - want).max() <= 1     # B: outer radius over [r_min, r_max]
+    assert stem[0, cols // 4, 2] > stem[0, 3 * cols // 4, 2] + 100   # +y wide, -y narrow
+    # R: pith x minus the pith at mid-length over [-r_min/2, r_min/2]: -5 mm at the butt end
+    assert stem[0, 0, 0] == round(40 / 90 * 255) and stem[-1, 0, 0] == round(50 / 90 * 255)
+    assert (stem[:, :, 1] == 128).all()                 # G: pith y = 0 (127.5 rounds to even)
+    h, o = png["height"][0], png["orientation"][0]
+    assert (h[:, 0] == round(100 / 400 * 255)).all()    # R: start height over [0, h]
+    assert (o[:, 0] == round(0.25 * 255)).all()         # R: start azimuth pi/2 over [0, 2 pi)
+    d = np.arange(len(h)) * 130.0 / (len(h) - 1)       # columns: pith distance over [0, r_max]
+    assert np.abs(h[:, 1] - np.rint(np.interp(d, r, [0, 10, 20]) / 90 * 255)).max() <= 1
+    assert (h[:, 2] == 0).all()                         # the knot rises: no fall in B
+    assert np.abs(o[:, 1] - np.rint(np.interp(d, r, [0, 0.3, 0.6]) / (np.pi / 2) * 255)).max() <= 1
+    assert (o[:, 2] == 0).all()                         # the twist is counter-clockwise: G, not B
