@@ -277,6 +277,8 @@ def remove_stale(folder: str | os.PathLike, patterns: Iterable[str],
     import json
 
     folder = Path(folder)
+    if not folder.is_dir():  # nothing written there (a report without a gallery): no list to keep
+        return []
     ours = {Path(f).resolve() for f in keep}
     manifest = manifest_path(folder, kind)
     listed = _read_manifest(manifest)

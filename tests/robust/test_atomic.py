@@ -290,3 +290,12 @@ def test_remove_stale_removes_the_listed_files_only(tmp_path):
     with pytest.warns(WoodcamWarning, match=r"no list of an earlier run.*: a_mine\.txt$"):
         remove_stale(out, ["a_*.txt"], [out / "a_1.txt"], kind="t")
     assert sorted(p.name for p in out.iterdir()) == [man.name, "a_1.txt"]
+
+
+def test_remove_stale_in_a_folder_never_made_writes_no_list(tmp_path):
+    """A report without a gallery (``--gallery 0 --thumbnails 0``) never makes its gallery
+    folder; writing the run's list there failed with 'No such file or directory'."""
+    from woodcam._atomic import remove_stale
+
+    assert remove_stale(tmp_path / "gallery", ["b*_*.png"], [], kind="benchmark-gallery") == []
+    assert not (tmp_path / "gallery").exists()
