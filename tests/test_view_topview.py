@@ -10,16 +10,23 @@ from woodcam.view.topview import top_view, write_top_view
 
 
 def test_a_flat_stock_shows_its_texture_unshaded_inside_a_white_margin():
+    """Seen from +Z: +X right, +Y up. Each quadrant of the chart (row 0 at Y = D, column 0 at
+    X = 0) lands in its own quadrant of the picture, so a flip of either axis is caught."""
     tex = np.zeros((40, 60, 3), np.uint8)
-    tex[:20] = (200, 100, 50)   # the back half (row 0 is Y = D)
-    tex[20:] = (50, 100, 200)
+    tex[:20, :30] = (200, 100, 50)   # back left (row 0 is Y = D, column 0 is X = 0)
+    tex[:20, 30:] = (200, 50, 100)   # back right
+    tex[20:, :30] = (50, 100, 200)   # front left
+    tex[20:, 30:] = (100, 200, 50)   # front right
     img = top_view(np.full((8, 12), 5.0), (60.0, 40.0, 10.0), tex, window_size=(160, 120),
                    margin_px=20)
     assert img.shape == (120, 160, 3)
     # 60 x 40 mm fitted in 120 x 80 px: 2 px/mm, centred
     assert (img[:20] == 255).all() and (img[:, :20] == 255).all()
-    np.testing.assert_array_equal(img[30, 80], (200, 100, 50))  # back: upper half of the image
-    np.testing.assert_array_equal(img[90, 80], (50, 100, 200))
+    assert (img[100:] == 255).all() and (img[:, 140:] == 255).all()
+    np.testing.assert_array_equal(img[30, 40], (200, 100, 50))  # back: upper half, left: left
+    np.testing.assert_array_equal(img[30, 120], (200, 50, 100))
+    np.testing.assert_array_equal(img[90, 40], (50, 100, 200))
+    np.testing.assert_array_equal(img[90, 120], (100, 200, 50))
 
 
 def test_slopes_facing_the_light_are_brighter_and_segments_are_drawn():
@@ -31,6 +38,19 @@ def test_slopes_facing_the_light_are_brighter_and_segments_are_drawn():
     assert img[40, 50, 0] > flat[40, 50, 0] == 150
     down = top_view(hm[:, ::-1], (50.0, 40.0, 10.0), tex, window_size=(100, 80), margin_px=0)
     assert down[40, 50, 0] < 150  # the falling slope faces away from the light
+    # Along Y (heightmap row 0 at Y = 0): rising to +Y faces -Y, away from the light above the
+    # back; rising to -Y faces it.
+    rise_y = np.tile(np.linspace(0, 10, 40)[:, None], (1, 50))
+    back = top_view(rise_y, (50.0, 40.0, 10.0), tex, window_size=(100, 80), margin_px=0)
+    front = top_view(rise_y[::-1], (50.0, 40.0, 10.0), tex, window_size=(100, 80), margin_px=0)
+    assert back[40, 50, 0] < 150 < front[40, 50, 0]
+    # The shading sits where its slope is: a ramp over the front-left quadrant only (rows
+    # 0..19 are Y < 20 mm, columns 0..24 X < 25 mm) lights the picture's lower left alone.
+    ramp = np.zeros((40, 50))
+    ramp[:20, :25] = np.linspace(0, 5, 25)
+    lit = top_view(ramp, (50.0, 40.0, 10.0), tex, window_size=(100, 80), margin_px=0).astype(int)
+    assert lit[70, 20, 0] > 150                                  # X 10 mm, Y 5 mm
+    assert lit[10, 20, 0] == lit[10, 80, 0] == lit[70, 80, 0] == 150  # the three flat quadrants
     seg = np.array([[[0.0, 20.0, 1.0], [50.0, 20.0, 1.0]]])  # Y = 20 mm: the middle row
     lined = top_view(np.zeros((40, 50)), (50.0, 40.0, 10.0), tex, window_size=(100, 80),
                      margin_px=0, overlay=[(seg, "red", 1.0)])
