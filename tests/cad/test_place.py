@@ -26,6 +26,32 @@ def test_rotate_center_drop_place_a_box_exactly():
     np.testing.assert_allclose(np.linalg.det(matrix[:3, :3]), 1.0)
 
 
+def _nubbed_box(axis: int):
+    """A 30 mm cube centred at the origin with a 4 mm nub on the middle of its +``axis`` face."""
+    nub = np.zeros(3)
+    nub[axis] = 17.0
+    return (manifold3d.Manifold.cube([30.0] * 3, center=True)
+            + manifold3d.Manifold.cube([4.0] * 3, center=True).translate(nub))
+
+
+@pytest.mark.parametrize("axis", ["x", "z"])
+def test_a_quarter_turn_follows_the_right_hand_rule(axis):
+    """rotate:AXIS:90 turns by the right hand rule: about x, +y goes to +z; about z, +x goes
+    to +y. The box's extents alone cannot tell +90 from -90; its nub on one face can."""
+    i = {"x": 1, "z": 0}[axis]          # the face the nub starts on: +y (about x), +x (about z)
+    j = {"x": 2, "z": 1}[axis]          # where the right hand sends it: +z, +y
+    placed, matrix = place_part(_nubbed_box(i), [f"rotate:{axis}:90"], (100.0, 80.0, 50.0))
+    want = np.zeros(3)
+    want[j] = 1.0
+    np.testing.assert_allclose(matrix[:3, :3] @ np.eye(3)[i], want, atol=1e-12)
+    lo, hi = _bounds(placed)
+    # the nub sticks out 4 mm on the +j side of the turned cube (about the bounding box's centre,
+    # which is 2 mm towards the nub: the cube spans [-17, 13] there and the nub reaches 17)
+    assert hi[j] - lo[j] == pytest.approx(34.0, abs=1e-9)
+    top = placed.trim_by_plane(list(want), float(hi[j]) - 3.0)  # the part beyond the cube's face
+    assert top.volume() == pytest.approx(3 * 16.0, rel=1e-9)
+
+
 def test_fit_scales_into_the_block_with_the_margin():
     big = manifold3d.Manifold.cube([400.0, 100.0, 100.0])
     placed, matrix = place_part(big, ["fit:5"], (100.0, 80.0, 50.0))
