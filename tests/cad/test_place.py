@@ -34,12 +34,13 @@ def _nubbed_box(axis: int):
             + manifold3d.Manifold.cube([4.0] * 3, center=True).translate(nub))
 
 
-@pytest.mark.parametrize("axis", ["x", "z"])
+@pytest.mark.parametrize("axis", ["x", "y", "z"])
 def test_a_quarter_turn_follows_the_right_hand_rule(axis):
-    """rotate:AXIS:90 turns by the right hand rule: about x, +y goes to +z; about z, +x goes
-    to +y. The box's extents alone cannot tell +90 from -90; its nub on one face can."""
-    i = {"x": 1, "z": 0}[axis]          # the face the nub starts on: +y (about x), +x (about z)
-    j = {"x": 2, "z": 1}[axis]          # where the right hand sends it: +z, +y
+    """rotate:AXIS:90 turns by the right hand rule: about x, +y goes to +z; about y, +z goes to
+    +x; about z, +x goes to +y. The box's extents alone cannot tell +90 from -90; its nub on one
+    face can. rotate:y turned the other way (left-handed) before this test."""
+    i = {"x": 1, "y": 2, "z": 0}[axis]  # the face the nub starts on
+    j = {"x": 2, "y": 0, "z": 1}[axis]  # where the right hand sends it
     placed, matrix = place_part(_nubbed_box(i), [f"rotate:{axis}:90"], (100.0, 80.0, 50.0))
     want = np.zeros(3)
     want[j] = 1.0

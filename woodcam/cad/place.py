@@ -39,8 +39,11 @@ _HELP = ("rotate:AXIS:DEG, translate:X,Y,Z, scale:S, center, drop or fit[:MARGIN
 
 
 def _rotation(axis: int, deg: float) -> np.ndarray:
+    """Right-handed rotation about block axis ``axis`` (0, 1, 2 = x, y, z) by ``deg`` degrees."""
     c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
-    i, j = [k for k in range(3) if k != axis]
+    # the cyclic pair (e_i turns towards e_j): y needs (z, x); the ascending (x, z) turned it
+    # left-handed
+    i, j = (axis + 1) % 3, (axis + 2) % 3
     r = np.eye(3)
     r[i, i], r[i, j], r[j, i], r[j, j] = c, -s, s, c
     return r
