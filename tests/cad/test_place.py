@@ -100,6 +100,15 @@ def test_turning_the_block_turns_its_wood():
     n = np.tile([1.0, 0.0, 0.0], (len(p), 1))  # +x in the old block is +y in the turned one
     np.testing.assert_allclose(turned.wood.color(q, n[:, [1, 0, 2]]), plain.wood.color(p, n),
                                atol=1e-6)
+    # about x (+y to +z) and y (+z to +x), right hand: a left-handed turn would give the same
+    # sizes and mirror the wood
+    for turn, size, moved in (
+            ("x", (W, H, D), lambda p: np.column_stack([p[:, 0], H - p[:, 2], p[:, 1]])),
+            ("y", (H, D, W), lambda p: np.column_stack([p[:, 2], p[:, 1], W - p[:, 0]]))):
+        other = open_stock(f"builtin:flat-sawn~{turn}90")
+        assert other.size_mm == size, turn
+        np.testing.assert_allclose(other.wood.years(moved(p)), plain.wood.years(p), atol=1e-9,
+                                   err_msg=turn)
     full = open_stock("builtin:flat-sawn~z90~z90~z90~z90")
     np.testing.assert_allclose(full.wood.years(p), plain.wood.years(p), atol=1e-9)
     with pytest.raises(WoodcamError, match="multiple of 90 degrees"):
