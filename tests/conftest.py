@@ -44,12 +44,14 @@ def gran1():
 
 class RecordedBar:
     """A stand-in for a tqdm bar: what :func:`woodcam._progress.progress_bar` was asked to draw
-    (``desc``, ``total``, the descriptions it showed) and how far it went (``n``)."""
+    (``desc``, ``total``, the descriptions it showed), whether it may be drawn at all
+    (``enabled``: a bar made with ``enabled=False`` never shows, so a test of a bar asserts it)
+    and how far it went (``n``)."""
 
     def __init__(self, iterable=None, *, desc, unit, enabled=True, **kwargs):
-        self.iterable, self.desc, self.unit = iterable, desc, unit
+        self.iterable, self.desc, self.unit, self.enabled = iterable, desc, unit, enabled
         self.total = kwargs.get("total", len(iterable) if hasattr(iterable, "__len__") else None)
-        self.n, self.shown, self.closed, self.disable = 0, [desc], False, False
+        self.n, self.shown, self.closed, self.disable = 0, [desc], False, not enabled
 
     def __iter__(self):
         for x in self.iterable:

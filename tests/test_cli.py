@@ -19,10 +19,11 @@ def test_demo_quick_writes_every_output(tmp_path, capsys, bars):
     assert main(["demo", "--out", str(tmp_path), "--quick"]) == 0
     # sweep h5 item 7: 20 s with no bar; now one over the parts and one of each part's stages
     demo = [b for b in bars if b.desc == "demo"]
-    assert len(demo) == 1 and demo[0].total == demo[0].n == 4 and demo[0].closed
+    assert len(demo) == 1 and demo[0].total == demo[0].n == 4 and demo[0].closed and demo[0].enabled
     for part in ("bowl", "tray", "lid"):
         own = [b for b in bars if b.desc == part]
         assert len(own) == 1 and own[0].total == own[0].n == 6 and own[0].closed  # render too
+        assert own[0].enabled
     out = capsys.readouterr().out
     for part in ("bowl", "tray", "lid"):
         for suffix in (".glb", ".obj", ".mtl", "_texture.png", "_view.png"):
@@ -161,7 +162,7 @@ def test_bake_draws_one_stage_bar_over_the_whole_run(tmp_path, bars, capsys):
     assert main(["bake", str(tmp_path / "box.stl"), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "b.glb"),
                  "--no-obj", "--texels-per-mm", "1", "--screenshot"]) == 0
     stage = [b for b in bars if b.unit == "stage"]
-    assert len(stage) == 1 and stage[0].desc == "bake b"
+    assert len(stage) == 1 and stage[0].desc == "bake b" and stage[0].enabled
     plan = ["open block", "load", "carve", "bake", "report", "export", "render"]
     assert stage[0].total == len(plan) and stage[0].n == len(plan) and stage[0].closed
     assert [d.split(": ")[-1] for d in stage[0].shown[1:-1]] == plan

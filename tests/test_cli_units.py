@@ -157,7 +157,7 @@ def test_place_in_inches_ranks_what_the_mm_run_ranks_and_prints_inches(tmp_path,
     out_inch = capsys.readouterr().out
     # sweep h5 item 7: a bar over the whole run (opening the block, loading the part: seconds)
     (run,) = [b for b in bars if b.desc == "place"]
-    assert run.total == run.n == 4 and run.closed
+    assert run.total == run.n == 4 and run.closed and run.enabled
     assert [d.split(": ")[-1] for d in run.shown[1:-1]] == ["open block", "load part", "score placements",
                                                             "render"]
     assert main([*common, "--block", "builtin:knotty:101.6x76.2x50.8", "--margin", "1.27",

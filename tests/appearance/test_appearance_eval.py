@@ -97,7 +97,7 @@ def test_leave_one_face_out_on_ring_maps_without_a_field(bars):
                              progress=True)
     # sweep h5 item 7: a bar over the held-out faces (each trains up to three nets)
     (faces,) = [b for b in bars if b.unit == "face"]
-    assert faces.total == faces.n == 1
+    assert faces.total == faces.n == 1 and faces.enabled
     assert res[0].end_grain is None and set(res[0].predictions) == set(MODELS)
     _assert_predictions_resemble_the_photo(res[0])
 

@@ -480,7 +480,7 @@ def test_the_cli_writes_the_page_from_the_glbs_own_block(page, tmp_path, capsys,
     assert main(["review", str(glb), "--out", str(tmp_path / "r.html"), "--voxels", "20000"]) == 0
     # sweep h5 item 7: 10 s of colour volumes at --voxels 3e6 with no bar
     (volumes,) = [b for b in bars if b.unit == "volume"]
-    assert volumes.total == volumes.n == 3
+    assert volumes.total == volumes.n == 3 and volumes.enabled
     assert "wrote" in capsys.readouterr().out and (tmp_path / "r.html").stat().st_size > 1e5
     assert Path(tmp_path / "r.html").read_text().count("data:image/webp;base64,") == 3
 
