@@ -27,9 +27,27 @@ def test_block_synth_then_show(tmp_path, capsys):
     for name, face in block.faces.items():          # every face photo sits where the cross says
         r0, c0 = layout.origin[name]
         assert np.array_equal(im[r0:r0 + face.shape[0], c0:c0 + face.shape[1]], face.photo), name
-    # with traces drawn, pixels change only on the faces, and some do
+    # with traces drawn, pixels change only on the faces, on their rings: each face's changed
+    # pixels lie along its traces (pixel (row, col) = points_px), and most trace points are drawn
     assert main(["block", "show", str(out / "block_0001"), "--out", str(png)]) == 0
-    assert (np.asarray(Image.open(png)) != im).any()
+    traced = np.asarray(Image.open(png))
+    changed = (traced != im).any(axis=-1)
+    assert changed.any()
+    from scipy import ndimage
+
+    on_faces = 0
+    for name, face in block.faces.items():
+        r0, c0 = layout.origin[name]
+        here = changed[r0:r0 + face.shape[0], c0:c0 + face.shape[1]]
+        near = np.zeros(face.shape, bool)
+        pts = np.concatenate([t.points_px for t in face.traces]) if face.traces else np.zeros((0, 2))
+        rc = np.clip(np.round(pts).astype(int), 0, np.array(face.shape) - 1)
+        near[rc[:, 0], rc[:, 1]] = True
+        assert not (here & ~ndimage.binary_dilation(near, iterations=2)).any(), name
+        if len(rc):
+            assert here[rc[:, 0], rc[:, 1]].mean() > 0.8, name
+        on_faces += here.sum()
+    assert on_faces == changed.sum() > 0
     assert main(["block", "show", str(out / "block_0001"), "--out", str(png), "--layer", "both"]) == 0
     assert np.asarray(Image.open(png)).shape == (2 * layout.shape[0] + 8, layout.shape[1], 3)
 
