@@ -106,7 +106,7 @@ def test_preview_names_its_own_arguments_and_ignores_nothing_silently(tmp_path, 
 
     got = []
     monkeypatch.setattr(view, "preview", lambda mesh, **kw: got.append(kw))
-    monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block: None)
+    monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block, **kw: None)
     monkeypatch.setattr("woodcam.cli.options.recorded_block_size", lambda mesh: None)
     assert cli.main(["preview", str(tmp_path / "nope.glb"), "--screenshot"]) == 1
     assert f"preview: no file at {str(tmp_path / 'nope.glb')!r}" in capsys.readouterr().err
@@ -163,7 +163,7 @@ def test_preview_screenshot_takes_an_optional_name_like_bake_and_gcode(tmp_path,
     monkeypatch.setattr(view, "preview", lambda mesh, **kw: got.append(kw["screenshot"]))
     glb = tmp_path / "bowl.glb"
     glb.write_bytes(b"")
-    monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block: None)
+    monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block, **kw: None)
     assert cli.main(["preview", str(glb), "--screenshot"]) == 0
     assert cli.main(["preview", str(glb), "--screenshot", str(tmp_path / "x.png")]) == 0
     assert got == [tmp_path / "bowl_view.png", tmp_path / "x.png"]
@@ -179,7 +179,7 @@ def test_a_second_run_in_one_process_prints_its_warnings_too(tmp_path, monkeypat
     import woodcam.view as view
 
     monkeypatch.setattr(view, "preview", lambda mesh, **kw: None)
-    monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block: None)
+    monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block, **kw: None)
     monkeypatch.setattr("woodcam.cli.options.recorded_block_size", lambda mesh: None)
     glb = tmp_path / "part.glb"
     glb.write_bytes(b"")

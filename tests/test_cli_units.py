@@ -200,3 +200,45 @@ def test_gcode_deviation_and_gouges_print_in_inches(tmp_path, monkeypatch, capsy
     depth_mm = float(mm.err.split("gouge: cuts ")[1].split(" mm ")[0])
     assert depth_mm == pytest.approx(2.54, abs=0.01) and depth_in == pytest.approx(0.1, abs=1e-3)
     assert " mm" not in inch.out.split("deviation from")[1].split("; map")[0]
+
+
+def test_messages_of_an_inch_run_quote_what_was_typed_and_speak_inches(tmp_path, monkeypatch, capsys):
+    """Sweep h13 item 1: with --units inch the preview block-mismatch warning named the spec as
+    converted (builtin:flat-sawn:101.6x81.28x50.8) and the baked size in mm, a block spec too big
+    was refused as '25400x25.4x25.4 ... in mm', and the bake report said '1-3 mm under it'."""
+    import json
+    import struct
+
+    import woodcam.view as view
+    from woodcam.advise import SUBSURFACE_MM, report_text
+    from woodcam.stock import spec_digest
+    from woodcam.units import fmt_size, fmt_span
+
+    assert fmt_span(*SUBSURFACE_MM) == "1-3 mm" and fmt_span(*SUBSURFACE_MM, "inch") == "0.039-0.12 in"
+    assert fmt_size((101.6, 81.28, 50.8), "inch") == "4x3.2x2 in" and fmt_size((100, 80, 50)) == "100x80x50 mm"
+    meta = {"block": "builtin:flat-sawn", "block_digest": spec_digest("builtin:flat-sawn"),
+            "size_mm": [100.0, 80.0, 50.0]}
+    body = json.dumps({"asset": {"version": "2.0"}, "scenes": [{"extras": {"woodcam": meta}}]}).encode()
+    body += b" " * (-len(body) % 4)
+    glb = tmp_path / "tray.glb"
+    glb.write_bytes(struct.pack("<III", 0x46546C67, 2, 20 + len(body))
+                    + struct.pack("<II", len(body), 0x4E4F534A) + body)
+    monkeypatch.setattr(view, "preview", lambda mesh, **kw: None)
+    assert main(["preview", str(glb), "--screenshot", "--units", "inch",
+                 "--block", "builtin:flat-sawn:4x3.2x2"]) == 0
+    err = capsys.readouterr().err
+    assert ("--block builtin:flat-sawn:4x3.2x2 is not the block tray.glb was baked from "
+            "(builtin:flat-sawn, 3.937x3.15x1.969 in)") in err
+    assert main(["bake", "p.stl", "--units", "inch", "--block", "builtin:knotty:1000x1x1",
+                 "--out", str(tmp_path / "x.glb")]) == 2  # at the door: a usage error
+    err = capsys.readouterr().err
+    assert "--block builtin:knotty:1000x1x1: the size must be WxDxH in --units inch" in err
+    assert "got '1000x1x1'" in err and "25400" not in err
+    report = {"volume_mm3": 16387.064, "yield": 0.1, "knots": 0.02, "knots_surface": 0.0, "pith": 0.0,
+              "end_grain": 0.2, "elongation": 0.3, "warnings": [
+                  "a knot lies 1-3 mm under the surface (it may show after sanding)"],
+              "regions": [{"region": "first third", "grain": [1, 0, 0], "runout_deg": 1, "knots": 0.0}]}
+    text = report_text(report, "tray", "inch")
+    assert " mm" not in text and text.count("0.039-0.12 in under") == 4, text
+    assert "tray: 1 in^3" in text
+    assert report_text(report, "tray").count("1-3 mm under") == 4

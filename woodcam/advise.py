@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import WoodcamError, WoodcamWarning
-from .units import Units, fmt_volume
+from .units import Units, fmt_span, fmt_volume
 
 #: Points within this many years of the pith count as pith (juvenile wood and the pith itself).
 PITH_YEARS = 2.0
@@ -299,7 +299,7 @@ def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
     if knot[0].any():
         warnings.append(f"knots show on {100 * knot[0].mean():.1f} % of the surface")
     elif knot.any():
-        warnings.append("a knot lies 1-3 mm under the surface (it may show after sanding)")
+        warnings.append(_subsurface_knot_warning("mm"))
     if pith.any():
         warnings.append(f"the pith (within {PITH_YEARS:g} years) reaches the part: expect checks")
     volume = float(abs(mesh.volume))
@@ -311,24 +311,30 @@ def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
             "regions": regions, "warnings": warnings}
 
 
+def _subsurface_knot_warning(units: Units) -> str:
+    return f"a knot lies {fmt_span(*SUBSURFACE_MM, units)} under the surface (it may show after sanding)"
+
+
 def report_text(report: dict, name: str, units: Units = "mm") -> str:
-    """The part report as a few lines of text; the volume in ``units``^3."""
+    """The part report as a few lines of text; the volume and the depths under the surface
+    (:data:`SUBSURFACE_MM`) in ``units``."""
+    under = f"the wood {fmt_span(*SUBSURFACE_MM, units)} under it"
     # the surface's knot share first: the warning below quotes it, and the one number counting
     # the wood under the surface too read as a contradiction of it (knots 19.8 % beside "knots
     # show on 15.3 % of the surface")
     knots = f"{100 * report['knots']:.1f} %"
     if "knots_surface" in report:  # reports written before it had the one number
-        knots = (f"{100 * report['knots_surface']:.1f} % of the surface ({knots} with the wood "
-                 "1-3 mm under it)")
+        knots = f"{100 * report['knots_surface']:.1f} % of the surface ({knots} with {under})"
     lines = [f"{name}: {fmt_volume(report['volume_mm3'], units)}, yield {100 * report['yield']:.1f} % of "
              f"the block; end grain {100 * report['end_grain']:.0f} % of the surface; knots "
-             f"{knots}, pith {100 * report['pith']:.1f} % of the surface and the wood 1-3 mm "
-             "under it"]
+             f"{knots}, pith {100 * report['pith']:.1f} % of the surface and {under}"]
     for r in report["regions"]:
         lines.append(f"  {r['region']:<13} grain ({', '.join(f'{v:+.2f}' for v in r['grain'])}) "
-                     f"runout {r['runout_deg']:.0f} deg, knots {100 * r['knots']:.1f} % with the "
-                     "wood 1-3 mm under it")  # not the surface share the first line leads with
-    lines += [f"  warning: {w}" for w in report["warnings"]]
+                     f"runout {r['runout_deg']:.0f} deg, knots {100 * r['knots']:.1f} % with "
+                     f"{under}")  # not the surface share the first line leads with
+    # the report (a file) keeps its warnings in mm; the one with a length is said in ``units``
+    lines += [f"  warning: {_subsurface_knot_warning(units) if w == _subsurface_knot_warning('mm') else w}"
+              for w in report["warnings"]]
     return "\n".join(lines)
 
 

@@ -23,6 +23,19 @@ def fmt_length(mm: float, units: Units = "mm", digits: int = 3) -> str:
     return f"{mm / MM_PER_UNIT[units]:.{digits}g} {_SYMBOL[units]}"
 
 
+def fmt_size(size_mm, units: Units = "mm", digits: int = 4) -> str:
+    """A size ``(W, D, H)`` (or any lengths) given in mm, printed ``"WxDxH unit"`` in ``units``:
+    ``fmt_size((101.6, 81.28, 50.8), "inch") == "4x3.2x2 in"``, as a block spec's size is typed."""
+    return "x".join(f"{v / MM_PER_UNIT[units]:.{digits}g}" for v in size_mm) + f" {_SYMBOL[units]}"
+
+
+def fmt_span(lo_mm: float, hi_mm: float, units: Units = "mm", digits: int = 2) -> str:
+    """A range of lengths given in mm, printed ``"lo-hi unit"`` in ``units``:
+    ``fmt_span(1, 3) == "1-3 mm"``, ``fmt_span(1, 3, "inch") == "0.039-0.12 in"``."""
+    k = MM_PER_UNIT[units]
+    return f"{lo_mm / k:.{digits}g}-{hi_mm / k:.{digits}g} {_SYMBOL[units]}"
+
+
 def fmt_volume(mm3: float, units: Units = "mm") -> str:
     """A volume given in mm^3, printed in ``units``^3: ``"1234 mm^3"`` or ``"0.07531 in^3"``."""
     if units == "mm":

@@ -165,7 +165,7 @@ def run_bake(args: argparse.Namespace) -> int:
 def run_preview(args: argparse.Namespace) -> int:
     from ..pipeline import screenshot_path
     from ..view import preview
-    from .options import recorded_block_size, stock_of_glb
+    from .options import as_typed, recorded_block_size, stock_of_glb
 
     if not args.mesh.is_file():  # the viewer named its parameter: "mesh_or_path: no file at ..."
         raise WoodcamError(f"preview: no file at {str(args.mesh)!r}; pass a .glb or .obj written by "
@@ -189,7 +189,7 @@ def run_preview(args: argparse.Namespace) -> int:
         if out:
             print(f"wrote {out}")
         return 0
-    stock = stock_of_glb(args.mesh, args.block)
+    stock = stock_of_glb(args.mesh, args.block, units=args.units, typed=as_typed(args, "block"))
     wood = stock.wood if stock else None
     if args.confidence:
         from ..inference.evidence import ConfidenceWood

@@ -27,7 +27,7 @@ from pathlib import Path
 
 from ..errors import UsageError, WoodcamError
 from ..limits import REVIEW_VOXELS_RANGE, WOODIFY_RESOLUTION_RANGE
-from ..units import MM_PER_UNIT
+from ..units import MM_PER_UNIT, Units, fmt_length, fmt_size
 
 #: The --species presets (woodcam.appearance.SPECIES, listed here so that --help imports no
 #: numba; tests/appearance/test_species.py checks the two agree). README: "Species presets".
@@ -285,9 +285,32 @@ def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
     for (cmd, dest), kind in LENGTH_OPTIONS.items():
         value = getattr(args, dest, None)
         if cmd == command and value is not None and value is not sub.get_default(dest):
+            if kind == "spec":
+                _check_spec_size(value, units)
             setattr(args, dest, _value_to_mm(kind, value, k))
             # what was typed, for the range errors: "--mesh-tol 0.5" (inch) said "got 12.7"
             args.__dict__.setdefault("_typed", {})[dest] = (value, units)
+
+
+def _check_spec_size(spec: str, units: Units) -> None:
+    """A block spec's ``:WxDxH`` read in ``units``, checked as typed (the stock's own check would
+    name the spec converted to mm: '1000x1x1' inches said "got '25400x25.4x25.4' ... in mm")."""
+    from ..errors import UsageError
+    from ..stock import MAX_BLOCK_SIDE_MM
+    from ..units import parse_lengths
+
+    m = _SPEC_SIZE.match(str(spec))
+    if m and parse_lengths(m.group(2), 3, max_mm=MAX_BLOCK_SIDE_MM / MM_PER_UNIT[units]) is None:
+        raise UsageError(f"--block {spec}: the size must be WxDxH in --units {units}, each > 0 and "
+                         f"<= {fmt_length(MAX_BLOCK_SIDE_MM, units, 4)}; got {m.group(2)!r}, e.g. "
+                         f"{m.group(1)}" + "x".join(f"{v / MM_PER_UNIT[units]:.2g}" for v in (300, 120, 40)))
+
+
+def as_typed(args: argparse.Namespace, dest: str):
+    """Option ``dest`` as the user typed it, before :func:`lengths_to_mm` (for messages that
+    quote it: ``--block builtin:oak:4x3x2``, not its size in mm)."""
+    typed = vars(args).get("_typed", {}).get(dest)
+    return getattr(args, dest, None) if typed is None else typed[0]
 
 
 def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction:
@@ -559,9 +582,12 @@ def recorded_block_size(glb: Path):
         raise WoodcamError(f"{str(glb)!r}: its metadata's {err}; re-bake it or pass --block SPEC") from err
 
 
-def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None):
+def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None, *,
+                 units: Units = "mm", typed: str | None = None):
     """The stock a baked GLB was cut from, as its metadata records it (absolute block spec,
-    content digest, species, appearance and its parameters), or ``block`` when given.
+    content digest, species, appearance and its parameters), or ``block`` when given. The
+    messages name ``block`` as the user ``typed`` it (before ``--units``) and the recorded
+    size in ``units``.
 
     Returns None for a file that records no block and no ``block`` given (``preview`` then shows
     the part alone). A recorded block that no longer exists, or whose content changed since the
@@ -580,8 +606,11 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
         if meta.get("block_digest") and spec_digest(block) != meta["block_digest"]:
             # --block of another block (another size, an edited folder) was taken without a word:
             # the section cap then shows other wood than the part's surface
-            warnings.warn(f"--block {block} is not the block {glb.name} was baked from ({meta.get('block')}, "
-                          f"{'x'.join(f'{v:g}' for v in meta.get('size_mm', []))} mm): the wood shown inside "
+            size = meta.get("size_mm")
+            size = (", " + fmt_size(size, units)) if isinstance(size, list) and all(
+                isinstance(v, (int, float)) for v in size) else ""
+            warnings.warn(f"--block {typed or block} is not the block {glb.name} was baked from "
+                          f"({meta.get('block')}{size}): the wood shown inside "
                           "differs from the part's surface", WoodcamWarning, stacklevel=2)
         # the recorded species (the bake's, default oak) was not asked for now: no note that
         # it changes nothing

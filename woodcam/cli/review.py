@@ -34,7 +34,7 @@ def run_review(args: argparse.Namespace) -> int:
     from ..errors import WoodcamError
     from ..export import read_glb_metadata
     from ..review import VOLUME_VOXELS, write_review
-    from .options import stock_of_glb
+    from .options import as_typed, stock_of_glb
 
     if not args.part.is_file():  # it said "records no block spec", blaming the spec for a missing file
         raise WoodcamError(f"review: no file at {str(args.part)!r}; pass a GLB written by woodcam bake or gcode")
@@ -44,7 +44,7 @@ def run_review(args: argparse.Namespace) -> int:
             f"review: {str(args.part)!r} is a parquetry panel (veneer pieces from several sheets, each "
             "turned its own way), not a part cut from one block, so the page's section has no wood "
             f"to show; view it with: woodcam preview {shlex.quote(str(args.part))}")
-    stock = stock_of_glb(args.part, args.block)
+    stock = stock_of_glb(args.part, args.block, units=args.units, typed=as_typed(args, "block"))
     if stock is None:
         field = args.part.parent / "field.npz"
         if "woodify" in meta and field.is_file():  # woodify's grown.glb: its field lies beside it
