@@ -154,3 +154,23 @@ def test_the_report_quotes_the_surface_knot_share_its_warning_gives(knotty):
                                                       "1-3 mm under it")
     old = {k: v for k, v in rep.items() if k != "knots_surface"}  # a report written before
     assert f"knots {100 * rep['knots']:.1f} %, pith" in report_text(old, "box")
+
+
+def test_the_report_volume_is_the_summarys_for_a_tiny_part_and_a_normal_one():
+    """Sweep h13 item 2: the report rounded the volume to 0.1 mm^3, so a 1.52 mm^3 part read
+    9.154e-05 in^3 in the report under the bake summary's 9.263e-05 in^3 (the same mesh's
+    volume, PartPreview.volume_mm3): now both are the mesh's volume, to 7 significant digits."""
+    import trimesh
+
+    from woodcam.advise import part_report
+    from woodcam.units import fmt_volume
+
+    stock = open_stock("builtin:flat-sawn")
+    for radius in (0.715, 20.0):  # about 1.5 mm^3, and a normal part of about 33,500 mm^3
+        ball = trimesh.creation.icosphere(subdivisions=3, radius=radius)
+        ball.apply_translation([50.0, 40.0, 25.0])
+        rep = part_report(ball, stock, samples=500)
+        assert rep["volume_mm3"] == pytest.approx(ball.volume, rel=1e-6)
+        for units in ("mm", "inch"):
+            assert fmt_volume(rep["volume_mm3"], units) == fmt_volume(ball.volume, units)
+    assert fmt_volume(1.5179342) == "1.518 mm^3" and fmt_volume(33_493.4) == "33493 mm^3"  # not "2 mm^3"

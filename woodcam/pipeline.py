@@ -179,7 +179,7 @@ def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: 
 
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
     result = result or PartPreview(out_glb.stem)
-    result.volume_mm3 = float(mesh.volume)
+    result.volume_mm3 = abs(float(mesh.volume))  # as the part report's (advise.part_report)
     result.triangles = int(len(mesh.faces))
     with result.stage("bake"):
         baked = bake(mesh, stock.wood, texels_per_mm=texels_per_mm, progress=progress,
