@@ -187,3 +187,38 @@ def test_a_second_run_in_one_process_prints_its_warnings_too(tmp_path, monkeypat
     for _ in range(2):
         assert cli.main(argv) == 0
         assert "woodcam: warning: --cut-origin places the cut plane" in capsys.readouterr().err
+
+
+def test_camera_is_one_shared_option_and_bake_draws_the_one_asked(tmp_path, monkeypatch, capsys):
+    """Sweep h13 item 3: preview offered bottom, gcode not (without a word why), bake had no
+    --camera at all (its --screenshot always iso), and gcode's --camera without --screenshot was
+    dropped silently. Now one option (options.add_camera_option, the views of woodcam._types):
+    gcode's help says why it has no bottom; a --camera with nothing to draw warns."""
+    import argparse
+
+    import woodcam.pipeline
+    import woodcam.view as view
+    from woodcam._types import CAMERAS
+    from woodcam.cli.options import write_screenshot
+
+    choices, helps = {}, {}
+    for name in ("bake", "preview", "gcode"):
+        (action,) = [a for a in _commands()[name]._actions if "--camera" in a.option_strings]
+        choices[name], helps[name] = tuple(action.choices), action.help
+    assert choices["bake"] == choices["preview"] == CAMERAS
+    assert choices["gcode"] == tuple(c for c in CAMERAS if c != "bottom")
+    assert "No bottom: the simulated stock is a height field" in helps["gcode"]
+    got = []
+    monkeypatch.setattr(view, "preview", lambda mesh, **kw: got.append(kw["camera"]))
+    for camera, drawn in (("bottom", "bottom"), (None, "iso")):
+        args = argparse.Namespace(screenshot=True, out=str(tmp_path / "p.glb"), camera=camera)
+        write_screenshot(args, {"glb": tmp_path / "p.glb"}, argparse.Namespace(wood=None, size_mm=(1, 1, 1)))
+        assert got[-1] == drawn
+    monkeypatch.setattr(woodcam.pipeline, "preview_heightfield",
+                        lambda hm, stock, out, **kw: woodcam.pipeline.PartPreview("x", files={"glb": out}))
+    prog = tmp_path / "slot.nc"
+    prog.write_text("G21\nG0 X20 Y40 Z2\nG1 Z-3 F300\nX80\nG0 Z2\n")
+    assert cli.main(["gcode", str(prog), "--block", "builtin:flat-sawn", "--tool", "flat:6", "--cell-size",
+                     "1", "--out", str(tmp_path / "o.glb"), "--camera", "top"]) == 0
+    assert ("woodcam: warning: --camera top chooses the view of --screenshot, which was not asked for: "
+            "ignored; add --screenshot") in capsys.readouterr().err

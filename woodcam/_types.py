@@ -6,12 +6,14 @@
 - :data:`Mesh`: a ``trimesh.Trimesh`` (block frame, mm).
 - :class:`AppearanceLike`: ``appearance.color(field, points_mm, normals) -> rgb (n, 3)``.
 - :class:`WoodLike`: ``wood.color(points_mm (n, 3), normals (n, 3)) -> rgb (n, 3)``, the seam.
+- :data:`Camera` / :data:`CAMERAS`: the named views (``woodcam.view.camera``; here so that the
+  command line's ``--camera`` offers them without importing the viewer).
 """
 
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, Any, Protocol, Union
+from typing import TYPE_CHECKING, Any, Literal, Protocol, Union, get_args
 
 if TYPE_CHECKING:
     import numpy as np
@@ -24,6 +26,9 @@ else:  # numpy and trimesh stay unimported until a function needs them
     Mesh = Any
 
 PathLike = Union[str, "os.PathLike[str]"]
+
+Camera = Literal["iso", "top", "front", "back", "left", "right", "bottom"]
+CAMERAS: tuple[str, ...] = get_args(Camera)
 
 
 class GrowthFieldLike(Protocol):

@@ -8,9 +8,9 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
-from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option, add_workers_option,
-                      allow_negative_values, apply_workers, stock_options, vector_type,
-                      write_screenshot)
+from .options import (BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
+                      add_workers_option, allow_negative_values, apply_workers, camera_of, stock_options,
+                      vector_type, write_screenshot)
 
 
 def register(subparsers) -> None:
@@ -55,6 +55,7 @@ def register(subparsers) -> None:
                    "looser tolerances, and the summary says so (default 120000)")
     add_units_option(p, "bake")
     add_bake_options(p)
+    add_camera_option(p, "; of the --screenshot")
     add_workers_option(p)
     p.set_defaults(func=run_bake)
 
@@ -69,8 +70,7 @@ def register(subparsers) -> None:
                    "name: MESH with _view.png)")
     p.add_argument("--block", default=None,
                    help=BLOCK_SPEC_HELP + ", for the cut plane (default: the one stored in the GLB)")
-    p.add_argument("--camera", choices=("iso", "front", "back", "left", "right", "top", "bottom"),
-                   default="iso", help="view direction (default iso: from front-right-above)")
+    add_camera_option(p)
     p.add_argument("--no-cut", action="store_true",
                    help="no cut plane: the part alone in its translucent block")
     p.add_argument("--cut-origin", type=vector_type("--cut-origin"), default=None, metavar="X,Y,Z",
@@ -114,6 +114,7 @@ def run_bake(args: argparse.Namespace) -> int:
     check_outputs(args.out, obj=not args.no_obj, screenshot=getattr(args, "screenshot", None) or False)
     apply_workers(args)
     shot = bool(getattr(args, "screenshot", None))
+    camera_of(args, shot)  # a --camera without --screenshot warns before the work
     # one bar for the whole run: opening the block can fit its rings (minutes, once)
     with StageBar(["open block", *part_stages(shot)],
                   desc=f"bake {Path(args.out).stem}", leave=False) as bar:
@@ -185,7 +186,7 @@ def run_preview(args: argparse.Namespace) -> int:
         # are all it needs (the block folder it was baked from may be gone, or slow to fit)
         size = recorded_block_size(args.mesh)
         out = preview(args.mesh, size_mm=size, screenshot=screenshot_path(args.screenshot, args.mesh),
-                      camera=args.camera, cut_plane=False)
+                      camera=camera_of(args), cut_plane=False)
         if out:
             print(f"wrote {out}")
         return 0
@@ -200,7 +201,7 @@ def run_preview(args: argparse.Namespace) -> int:
         wood = ConfidenceWood(stock.wood.field)
     out = preview(args.mesh, wood=wood, size_mm=stock.size_mm if stock else None,
                   screenshot=screenshot_path(args.screenshot, args.mesh),
-                  camera=args.camera, cut_plane=not args.no_cut, cut_origin=args.cut_origin,
+                  camera=camera_of(args), cut_plane=not args.no_cut, cut_origin=args.cut_origin,
                   cut_normal=args.cut_normal)
     if out:
         print(f"wrote {out}")

@@ -13,8 +13,8 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
-from .options import (BLOCK_SPEC_HELP, add_bake_options, add_out_option, add_units_option,
-                      allow_negative_values, sizes_type, stock_options, vector_type)
+from .options import (BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
+                      allow_negative_values, camera_of, sizes_type, stock_options, vector_type)
 
 _EXAMPLES = """\
 examples:
@@ -94,10 +94,12 @@ def register(subparsers) -> None:
     p.add_argument("--rapid-rate", type=float, default=5000.0, metavar="RATE",
                    help="machine rapid rate for the machining time estimate, --units per minute "
                    "(default 5000 mm/min)")
-    p.add_argument("--camera", choices=("iso", "top", "front", "back", "left", "right"),
-                   default="iso", help="screenshot view (default iso with a cut plane; top "
-                   "shows a relief without a cut; all drawn from the baked texture without "
-                   "VTK)")
+    add_camera_option(p, "; of the --screenshot, drawn from the baked texture without VTK: iso "
+                      "and the sides with a cut plane, top without one. No bottom: the simulated "
+                      "stock is a height field cut from above, its underside always the uncut face "
+                      "(a through cut reaches Z = 0 but leaves no hole in it), so a bottom view "
+                      "would show nothing of the job: through cuts show from the top and iso",
+                      exclude=("bottom",))
     p.add_argument("--view", action="store_true",
                    help="after writing the files, open a window (needs a display) with the "
                    "stock, the toolpath and a slider that scrubs the simulation to any line "
@@ -176,6 +178,7 @@ def run(args) -> int:
         raise WoodcamError(f"--rapid-rate {args.rapid_rate}: give a rate > 0 in mm/min, e.g. "
                            "5000")
     check_outputs(args.out, obj=not args.no_obj, screenshot=args.screenshot or False)
+    camera_of(args, bool(args.screenshot))  # a --camera without --screenshot warns before the work
     design = None
     if args.part:  # a missing or unreadable design part failed only after the whole simulation
         from .._atomic import check_output_path
@@ -336,7 +339,8 @@ def _screenshot(args, stock, program, offset, made, heightmap) -> None:
         seg = np.stack([program.start_mm + off, program.end_mm + off], axis=1)
         feed = program.kind == 1
         overlay = [(seg[~feed], "red", 1.0), (seg[feed], "royalblue", 1.0)]
-    if args.camera == "top":
+    camera = camera_of(args)
+    if camera == "top":
         # seen from +Z the stock is its atlas's top chart: drawn with numpy
         from ..view.topview import write_top_view
 
@@ -345,5 +349,5 @@ def _screenshot(args, stock, program, offset, made, heightmap) -> None:
         from ..view.stockview import write_stock_view
 
         write_stock_view(png, heightmap, stock.size_mm, made.texture, made.charts,
-                         wood=stock.wood, camera=args.camera, overlay=overlay)
+                         wood=stock.wood, camera=camera, overlay=overlay)
     made.files["png"] = png

@@ -25,6 +25,7 @@ import os
 import re
 from pathlib import Path
 
+from .._types import CAMERAS
 from ..errors import UsageError, WoodcamError
 from ..limits import REVIEW_VOXELS_RANGE, WOODIFY_RESOLUTION_RANGE
 from ..units import MM_PER_UNIT, Units, fmt_length, fmt_size
@@ -542,6 +543,32 @@ def appearance_params(args) -> dict:
     return {k: v for k, v in (("quality", args.quality), ("epochs", args.epochs)) if v is not None}
 
 
+def add_camera_option(p: argparse.ArgumentParser, note: str = "", exclude: tuple[str, ...] = ()) -> None:
+    """``--camera`` of every command that draws a view (``bake`` and ``gcode``: their
+    ``--screenshot``; ``preview``): the same named views everywhere (:data:`woodcam._types.CAMERAS`)
+    but those in ``exclude``, which ``note`` (how the command draws them) must say why it lacks.
+    Read it with :func:`camera_of`."""
+    views = {"iso": "iso (from front-right-above, the default)",
+             "bottom": "bottom (the part's underside, e.g. a bowl's foot, or where a cut went through)"}
+    p.add_argument("--camera", choices=[c for c in CAMERAS if c not in exclude], default=None,
+                   help="view direction: " + ", ".join(views.get(c, c) for c in CAMERAS if c not in exclude)
+                   + note)
+
+
+def camera_of(args: argparse.Namespace, shot: bool = True) -> str:
+    """``--camera``'s view, ``"iso"`` when not given. ``shot``: whether the command draws a view
+    at all (bake/gcode without ``--screenshot`` do not): a ``--camera`` then warns that it is
+    ignored."""
+    if args.camera is not None and not shot:
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        warnings.warn(f"--camera {args.camera} chooses the view of --screenshot, which was not asked "
+                      "for: ignored; add --screenshot", WoodcamWarning, stacklevel=2)
+    return args.camera or "iso"
+
+
 def stock_options(args) -> dict:
     """Every keyword of :func:`woodcam.stock.open_stock` the bake options carry."""
     return {"species": getattr(args, "species", None), "appearance": args.appearance,
@@ -556,7 +583,8 @@ def write_screenshot(args, files: dict, stock) -> None:
     from ..view import preview
 
     png = screenshot_path(args.screenshot, Path(args.out))
-    preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png)
+    preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png,
+            camera=getattr(args, "camera", None) or "iso")
     files["png"] = png
 
 

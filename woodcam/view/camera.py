@@ -6,14 +6,12 @@ Pure numpy apart from the plotter handed to :func:`set_camera` (any object with
 
 from __future__ import annotations
 
-from typing import Literal, get_args
-
 import numpy as np
 
+from .._types import CAMERAS, Camera
 from ..errors import WoodcamError
 
-Camera = Literal["iso", "top", "front", "back", "left", "right", "bottom"]
-CAMERAS: tuple[str, ...] = get_args(Camera)
+__all__ = ["CAMERAS", "Camera", "check_camera", "default_cut_normal", "frame_camera", "set_camera"]
 
 #: Direction from the focal point to the camera and the camera's up vector, block frame.
 #: "iso" looks from front-right-above (the viewer stands at -Y, conventions.md). "top" has +Y
