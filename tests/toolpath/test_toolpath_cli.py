@@ -360,3 +360,25 @@ def test_a_bad_design_part_is_refused_before_the_simulation(part, says, tmp_path
     err = out.err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("woodcam: error: --part: part file") and says in err[0], err
     assert not (tmp_path / "g.glb").exists()
+
+
+def test_the_glb_records_the_programs_resolved(tmp_path, monkeypatch):
+    """Sweep h13 item 4: the GLB recorded the G-code path as typed ('job/slot.nc'), relative to
+    a working folder it does not record, so its review page, made from another folder, named
+    no file there; now resolved, as the block spec is (stock.absolute_spec)."""
+    seen = []
+    monkeypatch.setattr(woodcam.pipeline, "preview_heightfield",
+                        lambda hm, stock, out, **kw: seen.append(kw["metadata"])
+                        or woodcam.pipeline.PartPreview("x", files={"glb": out}))
+    (tmp_path / "job").mkdir()
+    for name in ("rough.nc", "finish.nc"):
+        (tmp_path / "job" / name).write_text("G21\nG0 X20 Y40 Z2\nG1 Z-3 F300\nX80\nG0 Z2\n")
+    monkeypatch.chdir(tmp_path)
+    common = ["--block", "builtin:flat-sawn", "--tool", "flat:6", "--cell-size", "1", "--out", "o.glb"]
+    assert main(["gcode", "job/rough.nc", *common]) == 0
+    assert main(["gcode", "job/rough.nc", "job/finish.nc", *common]) == 0
+    one, two = seen
+    assert one["gcode"] == str(tmp_path.resolve() / "job" / "rough.nc")
+    assert two["gcode"] == [str(tmp_path.resolve() / "job" / n) for n in ("rough.nc", "finish.nc")]
+    monkeypatch.chdir(REPO)  # another folder: the recorded paths still name the files
+    assert all(Path(p).is_file() for p in [one["gcode"], *two["gcode"]])
