@@ -41,6 +41,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO
 
+from . import _interrupt
 from .errors import WoodcamError, WoodcamWarning
 
 __all__ = ["all_or_nothing", "atomic_files", "atomic_path", "atomic_write", "check_output_path",
@@ -119,6 +120,7 @@ _PENDING: contextvars.ContextVar[list | None] = contextvars.ContextVar("woodcam_
 
 
 def _commit(tmp: Path, path: Path, fsync: bool) -> None:
+    _interrupt.check()  # after a Ctrl-C (even one a library swallowed) no file lands
     os.chmod(tmp, _FILE_MODE)  # mkstemp makes 0600; give the file ordinary permissions
     if fsync:
         _fsync_path(tmp)
@@ -156,6 +158,7 @@ def all_or_nothing() -> Iterator[None]:
     _PENDING.reset(token)
     order = pending[1:] + pending[:1]
     try:
+        _interrupt.check()
         for tmp, path in order:
             os.replace(tmp, path)
     except BaseException:

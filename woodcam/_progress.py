@@ -15,8 +15,11 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
+import functools
 import time
 from typing import Any
+
+from . import _interrupt
 
 #: Seconds before a bar is drawn: the brief's "progress bars on anything over ~2 s".
 PROGRESS_DELAY_S = 2.0
@@ -26,11 +29,30 @@ def progress_bar(iterable: Iterable | None = None, *, desc: str, unit: str, enab
                  **kwargs: Any):
     """A ``tqdm.auto.tqdm`` over ``iterable`` (or with ``total=`` and manual ``update``) drawn
     on a terminal after :data:`PROGRESS_DELAY_S` only (module docstring); ``enabled=False``
-    never draws it. ``kwargs`` go to tqdm (``total``, ``initial``, ``leave``, ...)."""
+    never draws it. ``kwargs`` go to tqdm (``total``, ``initial``, ``leave``, ...). Each step,
+    drawn or not, is a Ctrl-C checkpoint (:func:`woodcam._interrupt.check`)."""
+    _interrupt.check()
+    kwargs.setdefault("delay", PROGRESS_DELAY_S)
+    return _bar_class()(iterable, desc=desc, unit=unit, disable=None if enabled else True, **kwargs)
+
+
+@functools.cache
+def _bar_class():
+    """``tqdm.auto.tqdm`` whose every step checks for a recorded Ctrl-C: the loops under a bar
+    are where a command spends its time, so one a library swallowed ends the run there."""
     from tqdm.auto import tqdm
 
-    kwargs.setdefault("delay", PROGRESS_DELAY_S)
-    return tqdm(iterable, desc=desc, unit=unit, disable=None if enabled else True, **kwargs)
+    class _Bar(tqdm):
+        def __iter__(self):
+            for item in super().__iter__():
+                _interrupt.check()
+                yield item
+
+        def update(self, n=1):
+            _interrupt.check()
+            return super().update(n)
+
+    return _Bar
 
 
 def write(line: str) -> None:
@@ -68,7 +90,9 @@ class StageBar:
 
     @contextmanager
     def stage(self, name: str) -> Iterator[None]:
-        """Run one stage of the plan: named in the bar while it runs, one step when it ends."""
+        """Run one stage of the plan: named in the bar while it runs, one step when it ends.
+        A Ctrl-C checkpoint as it starts (the bar's step checks as it ends)."""
+        _interrupt.check()
         # redrawn at once only where the bar is drawn already (past the delay)
         self.bar.set_description_str(f"{self.desc}: {name}",
                                      refresh=time.monotonic() - self._t0 >= self._delay)

@@ -66,7 +66,11 @@ class PartPreview:
 
     @contextmanager
     def stage(self, name: str) -> Iterator[None]:
-        """Time stage ``name`` into :attr:`timings_s` (and run it as a step of :attr:`stages`)."""
+        """Time stage ``name`` into :attr:`timings_s` (and run it as a step of :attr:`stages`).
+        A Ctrl-C checkpoint as it starts (:func:`woodcam._interrupt.check`)."""
+        from ._interrupt import check
+
+        check()
         t0 = time.perf_counter()
         if self.stages is None:
             yield

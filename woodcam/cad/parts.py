@@ -215,6 +215,9 @@ def _load(source: Any, tess: "_Tessellation", origin: str):
     import manifold3d
     import trimesh
 
+    from .._interrupt import check
+
+    check()  # trimesh's imports swallow a Ctrl-C (except BaseException): end before the script runs
     if source is None:
         raise WoodcamError(
             f"{origin} is None; the script or builder produced no shape: make sure it builds "

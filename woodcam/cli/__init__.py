@@ -183,8 +183,23 @@ def print_warnings(items) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``woodcam`` console script; returns the exit status."""
-    parser = build_parser()
-    args = parser.parse_args(_apply_aliases(list(sys.argv[1:] if argv is None else argv), parser))
+    from .. import _interrupt
+
+    # from the first moment: a Ctrl-C while the command modules import is an interrupt too
+    with _interrupt.handling():
+        try:
+            parser = build_parser()
+            args = parser.parse_args(_apply_aliases(list(sys.argv[1:] if argv is None else argv), parser))
+        except KeyboardInterrupt:
+            print("woodcam: interrupted", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        return _run(args, parser)
+
+
+def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
+    """Run the parsed command; every way it ends becomes an exit status and at most one line."""
+    from .. import _interrupt
+
     _printed.clear()  # once per run: a second main() in one process printed none of the first's
     interrupted = False
     with warnings.catch_warnings(record=True) as caught:
@@ -197,21 +212,21 @@ def main(argv: list[str] | None = None) -> int:
             lengths_to_mm(args, parser)  # --units inch: every length in mm from here on
             check_numbers(args)  # every numeric option finite and in range, before any work
             rc = args.func(args)
-        except UsageError as err:
-            print(f"woodcam: error: {err}", file=sys.stderr)
-            return EXIT_USAGE
-        except KeyboardInterrupt:
-            interrupted = True
-            print("woodcam: interrupted", file=sys.stderr)
-            return EXIT_INTERRUPTED
-        except Exception as err:  # noqa: BLE001 - the last net: a one-line report, never a traceback
-            # Ctrl-C inside a library that wrapped it (numba's compiler; a pybind11 module such as
-            # OCP, imported by a part script, raises ImportError: woodcam's WoodcamError about it
-            # then blamed the script, or said the package was not installed)
-            if _interrupted(err):
+            _interrupt.check()  # a Ctrl-C a library swallowed: the run did not end as asked
+        except BaseException as err:
+            # Ctrl-C, or an error after one: a library swallowed it (trimesh's imports catch
+            # BaseException) or left itself half-imported (scipy: NameError), or wrapped it
+            # (numba's compiler; a pybind11 module such as OCP, imported by a part script,
+            # raises ImportError: woodcam's WoodcamError about it then blamed the script)
+            if _interrupt.requested() or _interrupted(err):
                 interrupted = True
                 print("woodcam: interrupted", file=sys.stderr)
                 return EXIT_INTERRUPTED
+            if not isinstance(err, Exception):  # SystemExit and the like: not ours to report
+                raise
+            if isinstance(err, UsageError):
+                print(f"woodcam: error: {err}", file=sys.stderr)
+                return EXIT_USAGE
             if isinstance(err, WoodcamError):
                 print(f"woodcam: error: {err}", file=sys.stderr)
                 return EXIT_ERROR
