@@ -204,3 +204,29 @@ def test_a_part_in_inches_gets_each_commands_own_fix(tmp_path, capsys, monkeypat
     err = capsys.readouterr().err
     assert "if it was modelled in inches scale the part file by 25.4 in your CAD program" in err
     assert "--place" not in err
+
+
+def test_a_no_obj_rerun_removes_the_earlier_runs_obj_but_never_an_input_or_a_foreign_obj(tmp_path, capsys):
+    """Rerunning `bake --no-obj` into a folder left the earlier run's OBJ + MTL + PNG beside the
+    new GLB, where they passed for the new part. They go (named in a warning); a baked OBJ
+    given as the part, or an OBJ another program wrote, stays."""
+    box = trimesh.creation.box((20, 20, 20))
+    box.apply_translation((50, 40, 25))
+    box.export(tmp_path / "box.stl")
+    out = tmp_path / "a.glb"
+    bake = ["bake", str(tmp_path / "box.stl"), "--block", "builtin:flat-sawn", "--out", str(out),
+            "--texels-per-mm", "1"]
+    assert main(bake) == 0
+    trio = [tmp_path / n for n in ("a.obj", "a.mtl", "a_texture.png")]
+    assert all(p.is_file() for p in trio)
+    capsys.readouterr()
+    # the earlier OBJ is this run's part: kept whole
+    assert main(["bake", str(trio[0]), *bake[2:], "--no-obj"]) == 0
+    assert all(p.is_file() for p in trio) and "removed" not in capsys.readouterr().err
+    assert main([*bake, "--no-obj"]) == 0
+    assert not any(p.exists() for p in trio)
+    assert "removed 3 file(s) of an earlier run" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.glb", "a_report.json", "a_report.txt", "box.stl"]
+    box.export(trio[0])  # trimesh's OBJ, not woodcam's: not ours to remove
+    assert main([*bake, "--no-obj"]) == 0
+    assert trio[0].is_file() and "removed" not in capsys.readouterr().err

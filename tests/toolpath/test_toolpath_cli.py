@@ -382,3 +382,17 @@ def test_the_glb_records_the_programs_resolved(tmp_path, monkeypatch):
     assert two["gcode"] == [str(tmp_path.resolve() / "job" / n) for n in ("rough.nc", "finish.nc")]
     monkeypatch.chdir(REPO)  # another folder: the recorded paths still name the files
     assert all(Path(p).is_file() for p in [one["gcode"], *two["gcode"]])
+
+
+def test_a_no_obj_rerun_removes_the_earlier_runs_obj(tmp_path, capsys):
+    """gcode --no-obj into a folder left the earlier run's OBJ + MTL + PNG beside the new GLB."""
+    from woodcam.cli import main
+
+    argv = ["gcode", str(REPO / "toolpaths" / "drilling.nc"), "--tool", "flat:6", "--block",
+            "builtin:flat-sawn", "--out", str(tmp_path / "g.glb"), "--cell-size", "1", "--texels-per-mm", "1"]
+    assert main(argv) == 0
+    assert (tmp_path / "g.obj").is_file()
+    capsys.readouterr()
+    assert main([*argv, "--no-obj"]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["g.glb"]
+    assert "removed 3 file(s) of an earlier run" in capsys.readouterr().err

@@ -588,6 +588,26 @@ def write_screenshot(args, files: dict, stock) -> None:
     files["png"] = png
 
 
+def remove_stale_obj(args, out_glb, files: dict, inputs=()) -> None:
+    """``--no-obj``: the OBJ + MTL + PNG an earlier run wrote beside ``out_glb`` would pass for
+    this run's part; removed once this run's files are in place, with a warning naming them
+    (:func:`woodcam._atomic.remove_stale`). Only woodcam's own OBJ set (its header says so,
+    :func:`woodcam.export.written_obj_set`), and never one holding an input of this run
+    (``inputs``: a baked OBJ given as the part)."""
+    if not args.no_obj:
+        return
+    import glob
+
+    from .._atomic import remove_stale
+    from ..export import written_obj_set
+
+    old = written_obj_set(Path(out_glb).with_suffix(".obj"))
+    given = {Path(p).resolve() for p in inputs if p}
+    if any(p.resolve() in given for p in old):
+        return
+    remove_stale(Path(out_glb).parent, [glob.escape(p.name) for p in old], files.values())
+
+
 def _glb_metadata(glb: Path) -> dict:
     """The woodcam metadata of a GLB file; ``{}`` for another file (an OBJ, a missing path)."""
     from ..export import read_glb_metadata

@@ -331,6 +331,20 @@ def obj_siblings(obj_path: PathLike) -> tuple[Path, Path]:
     return path.with_name(f"{name}.mtl"), path.with_name(f"{name}_texture.png")
 
 
+def written_obj_set(obj_path: PathLike) -> list[Path]:
+    """The files of the OBJ set :func:`export_obj` wrote at ``obj_path`` (the OBJ, its MTL and
+    texture: :func:`obj_siblings`) that exist, when the OBJ there is woodcam's (its first line is
+    export_obj's ``# woodcam:`` header); ``[]`` for no OBJ or another program's (a part file
+    of the user's must never be taken for an earlier run's output)."""
+    path = Path(obj_path)
+    try:
+        with open(path, "rb") as fh:
+            ours = fh.readline(200).startswith(OBJ_HEADER.encode())
+    except OSError:
+        return []
+    return [p for p in (path, *obj_siblings(path)) if p.is_file()] if ours else []
+
+
 def export_obj(mesh: Mesh, path: PathLike, *, units: ObjUnits = "m", up: ObjUp = "y",
                crease_angle_deg: float | None = None, normals: str = "crease") -> Path:
     """Write ``mesh`` as ``NAME.obj`` + ``NAME.mtl`` + ``NAME_texture.png`` side by side (the
