@@ -230,3 +230,23 @@ def test_a_no_obj_rerun_removes_the_earlier_runs_obj_but_never_an_input_or_a_for
     box.export(trio[0])  # trimesh's OBJ, not woodcam's: not ours to remove
     assert main([*bake, "--no-obj"]) == 0
     assert trio[0].is_file() and "removed" not in capsys.readouterr().err
+
+
+def test_an_interrupted_export_leaves_the_earlier_runs_report_with_its_glb(tmp_path, capsys, monkeypatch):
+    """The part report was written before the GLB, on its own: Ctrl-C during the export left
+    this run's report (another block's yield, grain, knots) beside the previous run's GLB. The
+    report is now part of the export's set."""
+    import woodcam.export as export
+
+    trimesh.creation.box((20, 20, 20)).apply_translation((50, 40, 25)).export(tmp_path / "box.stl")
+    out = tmp_path / "out"
+    argv = ["bake", str(tmp_path / "box.stl"), "--out", str(out / "p.glb"), "--texels-per-mm", "1"]
+    assert main([*argv, "--block", "builtin:flat-sawn"]) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(export, "export_glb", interrupted)
+    assert main([*argv, "--block", "builtin:rift"]) == 130
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before

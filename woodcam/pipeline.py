@@ -309,9 +309,10 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
                 if w not in result.report.setdefault("warnings", []):
                     result.report["warnings"].append(w)
             stem = out_glb.with_name(out_glb.stem + "_report")
-            write_bytes(stem.with_suffix(".json"), json.dumps(result.report, indent=1).encode())
-            write_bytes(stem.with_suffix(".txt"), (report_text(result.report, out_glb.stem)
-                                                   + "\n").encode())
+            # written with the GLB (below), as one set: an interrupted export left this part's
+            # report beside the previous run's GLB
+            report_bytes = {"report": (report_text(result.report, out_glb.stem) + "\n").encode(),
+                            "report_json": json.dumps(result.report, indent=1).encode()}
         result.files["report"] = stem.with_suffix(".txt")
         result.files["report_json"] = stem.with_suffix(".json")
     result.warnings += list(getattr(baked, "warnings", []))
@@ -336,6 +337,9 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
             shaded, normals = crease_normals(baked.mesh), "mesh"
         result.files["glb"] = Path(export_glb(shaded, out_glb, metadata=meta,
                                               normals=normals) or out_glb)
+        if part_report:
+            for kind, data in report_bytes.items():
+                write_bytes(result.files[kind], data)
         if obj:
             obj_path = out_glb.with_suffix(".obj")
             result.files["obj"] = Path(export_obj(shaded, obj_path, units=obj_units,
