@@ -605,7 +605,7 @@ def remove_stale_obj(args, out_glb, files: dict, inputs=()) -> None:
     given = {Path(p).resolve() for p in inputs if p}
     if any(p.resolve() in given for p in old):
         return
-    remove_stale(Path(out_glb).parent, [glob.escape(p.name) for p in old], files.values())
+    remove_stale(Path(out_glb).parent, [glob.escape(p.name) for p in old], files.values(), kind=None)
 
 
 def _glb_metadata(glb: Path) -> dict:
