@@ -87,13 +87,40 @@ def test_nested_calls_return_values_and_recursion_limit():
     ends = _ends(text)
     assert ends[0][0] == 25 and ends[1][1] == 4
     # a sub that ends without a value resets #<_value> to 0 (LinuxCNC)
-    assert _ends("o1 sub\no1 endsub\n#<_value> = 9\no1 call\nG0 X[#<_value> + 1]\nM2\n")[0][0] == 1
+    assert _ends("o2 sub\no2 return [9]\no2 endsub\no1 sub\no1 endsub\no2 call\no1 call\n"
+                 "G0 X[#<_value> + 1]\nM2\n")[0][0] == 1
     deep = "o1 sub\no2 if [#1 lt {n}]\no1 call [#1 + 1]\no2 endif\nG0 X#1\no1 endsub\n" \
            "o1 call [1]\nM2\n"
     assert len(_ends(deep.format(n=MAX_CALL_DEPTH))) == MAX_CALL_DEPTH
     with pytest.raises(GcodeError, match="nested subroutine calls") as e:
         _ends(deep.format(n=MAX_CALL_DEPTH + 1))
     assert e.value.line == 3
+
+
+def test_endsub_with_a_value_returns_it_as_linuxcnc():
+    """``o1 endsub [5]`` returns 5 as ``o1 return [5]`` does (woodcam read a value only on
+    return: #<_value> read 0); #<_value_returned> reads 1 after a value, 0 before any call and
+    after a sub without one; LinuxCNC reads a definition's endsub value as it passes over it;
+    both are read-only. Each case agrees with LinuxCNC (test_linuxcnc_oracle)."""
+    read = "G0 X#<_value> Y#<_value_returned> Z3\n"
+    assert _ends("o1 sub\no1 endsub [#1 * 2]\no1 call [3.5]\n" + read + "M2\n") == [(7, 1, 3)]
+    assert _ends("o1 sub\n#<r> = [#1 + 1]\no1 endsub [#<r>]\no1 call [4]\n" + read
+                 + "M2\n") == [(5, 1, 3)]
+    assert _ends(read + "M2\n") == [(0, 0, 3)]
+    assert _ends("o1 sub\no1 endsub [5]\no2 sub\no2 endsub\no1 call\no2 call\n" + read
+                 + "M2\n") == [(0, 0, 3)]
+    assert _ends("G0 X4\no1 sub\no1 endsub [#<_x> + 1]\n" + read + "M2\n")[-1] == (5, 1, 3)
+    assert _ends("o1 sub\no1 return [6]\no1 endsub\n" + read + "M2\n") == [(0, 0, 3)]
+    with pytest.raises(GcodeError, match=r"line 3: '#<_value>': o1 endsub on line 2 set "
+                       r"#<_value> where its subroutine is defined.*#<r> has no value"):
+        _ends("o1 sub\no1 endsub [#<r>]\n" + read + "M2\n")
+    for name in ("_value", "_value_returned"):
+        with pytest.raises(GcodeError, match=f"#<{name}> is a read-only"):
+            _ends(f"#<{name}> = 3\nM2\n")
+    with pytest.raises(GcodeError, match=r"endsub needs a \[value\]"):
+        _ends("o1 sub\no1 endsub 5\no1 call\nM2\n")
+    with pytest.raises(GcodeError, match="division by zero"):
+        _ends("o1 sub\no1 endsub [1/0]\nM2\n")
 
 
 def test_loops_if_while_do_repeat_break_continue():

@@ -274,3 +274,32 @@ def test_the_oracle_is_a_metric_machine_whose_parameters_read_in_mm(tmp_path):
              "G20\nG10 L2 P1 X3\nG21 G0 X#5221 Y0 Z5\nM2\n"]
     agree, bad = _differences(_written(tmp_path, texts), texts)
     assert not bad, bad
+
+
+def test_return_values_of_endsub_and_return_agree_with_linuxcnc(tmp_path):
+    """``o1 endsub [5]`` returns 5 as ``o1 return [5]`` does (woodcam's #<_value> read 0 after
+    it); #<_value_returned>, a definition's endsub read as it is passed over, nested calls and
+    the refusals agree with LinuxCNC."""
+    read = "G0 X#<_value> Y#<_value_returned> Z3\n"
+    texts = ["G21 G90\no1 sub\nG0 X1\no1 endsub [5]\no1 call\n" + read + "M2\n",
+             "G21 G90\no1 sub\no1 return [5]\no1 endsub\no1 call\n" + read + "M2\n",
+             "G21 G90\no1 sub\no1 endsub [#1*2]\no1 call [3.5]\nG0 X1\n" + read + "M2\n",
+             "G21 G90\no1 sub\no1 endsub [5]\no2 sub\no2 endsub\no1 call\no2 call\n" + read
+             + "M2\n",
+             "G21 G90\no1 sub\no1 endsub [5]\no2 sub\n" + read + "o2 endsub\no1 call\n"
+             "o2 call\nM2\n",
+             "G21 G90\no2 sub\no2 endsub [9]\no1 sub\no2 call\n" + read + "o1 endsub [3]\n"
+             "o1 call\n" + read + "M2\n",
+             "G21 G90\n" + read + "M2\n",
+             "G21 G90\nG0 X4\no1 sub\no1 return [6]\no1 endsub [#<_x>]\n" + read + "M2\n",
+             "G21 G90\no2 sub\no2 endsub [3]\no2 call\no1 sub\no1 endsub\n" + read + "M2\n",
+             "G21 G90\no1 sub\no1 endsub [8]\no9 if [0]\no1 call\no9 endif\n" + read + "M2\n",
+             "G21 G90\no1 sub\no1 endsub [5] (why)\no1 call\n" + read + "M2\n",
+             "G21 G90\no1 sub\no1 endsub [1/0]\no1 call\n" + read + "M2\n",
+             "G21 G90\no1 sub\no1 endsub 5\no1 call\n" + read + "M2\n",
+             "G21 G90\no1 sub\no1 endsub [5] [6]\no1 call\n" + read + "M2\n",
+             "G21 G90\n#<_value> = 3\n" + read + "M2\n",
+             "G21 G90\n#<_value_returned> = 3\n" + read + "M2\n"]
+    agree, bad = _differences(_written(tmp_path, texts), texts)
+    assert not bad, bad
+    assert agree == len(texts)

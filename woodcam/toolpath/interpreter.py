@@ -8,9 +8,11 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``#5210``-``#5213``, G28/G30 homes ``#5161``/``#5181``, ``#5220`` (active system),
   ``#5400`` (loaded tool), ``#5420``-``#5428`` (current position, program units and frame,
   as ``#<_x>``...; A-W read 0: woodcam has no such axes), ``#5599`` (1), ``#5600``/``#5601``
-  (0: no tool-changer faults), ``#<_value>`` (last return value); read-only ones
-  (``#5400``-``#5413``, ``#5420``-``#5428``) cannot be assigned, as in LinuxCNC; reading what
-  woodcam cannot know is refused: the tool table's offsets and diameter ``#5401``-``#5413``, and
+  (0: no tool-changer faults), ``#<_value>`` and ``#<_value_returned>`` (the value of the last
+  ``return [v]`` or ``endsub [v]``, and 1 if it had one; LinuxCNC reads a definition's
+  ``endsub [v]`` as it passes over it, and so does woodcam); read-only ones (``#5400``-``#5413``,
+  ``#5420``-``#5428``, ``#<_value>``, ``#<_value_returned>``) cannot be assigned, as in
+  LinuxCNC; reading what woodcam cannot know is refused: the tool table's offsets and diameter ``#5401``-``#5413``, and
   probe (``#5061``-``#5070``) or input (``#5399``) results the program did not assign; lengths
   are millimetres whatever
   ``G20/G21`` (LinuxCNC on a metric machine: the machine's units), so ``G28`` in a ``G20``
@@ -240,6 +242,13 @@ _MEASURED = {**{k: "a G38 probe result" for k in range(5061, 5071)}, 5399: "an M
 _READ_ONLY = {"_x", "_y", "_z", "_a", "_b", "_c", "_u", "_v", "_w", "_metric", "_imperial",
               "_absolute", "_incremental", "_feed", "_rpm", "_current_tool", "_selected_tool",
               "_line", "_coord_system"}
+#: What the last return or endsub left (LinuxCNC: read-only, 0 before any).
+_RETURNED = ("_value", "_value_returned")
+
+
+class _Unread(Exception):
+    """A parameter without a value read by a sub definition's ``endsub [...]``: LinuxCNC reads
+    that expression as it passes over the definition and takes undefined memory for it."""
 
 
 class _Line:
@@ -332,6 +341,8 @@ class Interpreter:
             self.p.update({int(k): float(v) for k, v in params.items()})
         self.globals: dict[str, float] = {}
         self.locals: dict[str, float] = {}
+        self._defining = False  # reading a definition's endsub value: see _returned
+        self._value_unknown: str | None = None  # why #<_value> holds what LinuxCNC cannot know
         self.moves: list = []
         self.warnings: list[tuple[int, str]] = []
         self.messages: list[tuple[int, str]] = []
@@ -423,6 +434,8 @@ class Interpreter:
                                "put the value in a parameter of the program's own, e.g. "
                                "#<dia> = 6")
         if k in _MEASURED and k not in self.p:
+            if self._defining:
+                raise _Unread(word)
             raise self.err(word, f"#{k} holds {_MEASURED[k]} from the machine, which woodcam "
                            "does not simulate, and the program did not assign it",
                            f"assign #{k} before reading it")
@@ -438,11 +451,16 @@ class Interpreter:
     def get_named(self, name, word):
         if name in _READ_ONLY:
             return self._system(name)
+        if name == "_value" and self._value_unknown:
+            raise self.err(word, self._value_unknown, "call the subroutine before reading "
+                           "#<_value>")
         d = self.globals if name.startswith("_") else self.locals
         if name in d:
             return d[name]
-        if name == "_value":
+        if name in _RETURNED:
             return 0.0
+        if self._defining:
+            raise _Unread(word)
         raise self.err(word, f"named parameter #<{name}> not defined",
                        "assign it before reading it")
 
@@ -833,6 +851,9 @@ class Interpreter:
                 pc += 1
                 continue
             if k == "sub":
+                # LinuxCNC reads the definition's endsub as it passes over the body (not a
+                # return in it): #<_value> becomes its value, 0 without one, though no call ran
+                self._returned(lines[self.match[pc]], definition=True)
                 pc = self.match[pc] + 1
             elif k == "o":  # a program number: run through it, as LinuxCNC and Fanuc
                 if frames and frames[-1][1] is not None:  # inside an o-word call
@@ -870,9 +891,7 @@ class Interpreter:
                     self.p[i] = args[i - 1] if i <= len(args) else 0.0
                 pc = self.subs[ln.olabel] + 1
             elif k in ("endsub", "return"):
-                v = self._cond(ln)[0] if k == "return" and ln.oexpr else None
-                self.globals["_value"] = 0.0 if v is None else v  # LinuxCNC: 0 without a value
-                self.globals["_value_returned"] = float(v is not None)
+                self._returned(ln)
                 if not frames:  # a sub body reached without a call: LinuxCNC skips it
                     pc = (self.match[pc] if k == "endsub" else self.match[self.owner[pc]]) + 1
                     continue
@@ -1062,13 +1081,37 @@ class Interpreter:
 
     def _cond(self, ln):
         s = ln.oexpr
+        what = "value" if ln.okey in ("return", "endsub") else "condition"
         if not s.startswith("["):
-            raise self.err(f"o{ln.olabel} {ln.okey}{s}", f"{ln.okey} needs a [condition]",
+            raise self.err(f"o{ln.olabel} {ln.okey}{s}", f"{ln.okey} needs a [{what}]",
                            f"write o{ln.olabel} {ln.okey} [...]")
         v, i = self.value(s, 0)
         if s[i:]:
-            raise self.err(s[i:], "text after the condition", "remove it")
+            raise self.err(s[i:], f"text after the {what}", "remove it")
         return v, i
+
+    def _returned(self, ln, definition: bool = False) -> None:
+        """Set ``#<_value>`` and ``#<_value_returned>`` as LinuxCNC's ``return`` or ``endsub``
+        line ``ln`` does: ``o1 return [v]`` and ``o1 endsub [v]`` alike give ``v`` and 1,
+        either without a value 0 and 0. ``definition``: ``ln`` closes a definition passed
+        over, where a parameter without a value leaves ``#<_value>`` unknown (refused when
+        read) instead of refusing the program."""
+        v = None
+        self._value_unknown = None
+        if ln.oexpr:
+            self.line_no, self._defining = ln.no, definition
+            try:
+                v = self._cond(ln)[0]
+            except _Unread as e:
+                v = 0.0
+                self._value_unknown = (
+                    f"o{ln.olabel} endsub on line {ln.no} set #<_value> where its subroutine "
+                    f"is defined, before any call, and there {e} has no value (LinuxCNC reads "
+                    "undefined memory for it)")
+            finally:
+                self._defining = False
+        self.globals["_value"] = 0.0 if v is None else v
+        self.globals["_value_returned"] = float(v is not None)
 
     def _call_args(self, s):
         args = []
@@ -1179,7 +1222,7 @@ class Interpreter:
                                    "one line", "keep one")
                 words[letter] = v
         for ref, v in pending:  # the end-of-line assignment rule
-            if ref[0] == "n" and ref[1] in _READ_ONLY:
+            if ref[0] == "n" and (ref[1] in _READ_ONLY or ref[1] in _RETURNED):
                 raise self.err(f"#<{ref[1]}>", f"#<{ref[1]}> is a read-only system parameter",
                                "use another name")
             if ref[0] == "i" and ref[1] in _READ_ONLY_NUM:
