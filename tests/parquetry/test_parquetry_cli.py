@@ -217,3 +217,21 @@ def test_a_scan_that_states_its_dpi_is_not_sized_by_the_default_without_a_word(s
            f"give {scans / 'tagged.png'}:101.6" in err
     assert main(argv + ["--veneer", f"{scans / 'tagged.png'}:101.6", "--out", str(scans / "b")]) == 0
     assert "warning" not in capsys.readouterr().err
+
+
+def test_a_target_of_a_few_pixels_is_made_and_its_ssim_said_to_have_no_value(scans, capsys):
+    """A 4 x 4 px target (pixel art: a pixel a patch) was matched, seamed and cut, then the
+    summary's SSIM on the target's own pixels raised skimage's ValueError (fewer pixels than
+    its 7 x 7 window): an internal error, nothing written. Now made, that SSIM n/a."""
+    Image.fromarray(np.asarray(Image.open(scans / "coffee.png"))[::100, ::150][:4, :4]).save(
+        scans / "tiny.png")
+    out = scans / "out"
+    assert main(["parquetry", str(scans / "tiny.png"), "--veneer", f"{scans / 'light.png'}:2px/mm",
+                 "--veneer", f"{scans / 'dark.png'}:2px/mm", "--image-size-mm", "56", "--px-per-mm",
+                 "2", "--no-glb", "--out", str(out), "--quiet"]) == 0
+    text = capsys.readouterr().out
+    assert "on the target's own 4 x 4 pixels" in text
+    assert "SSIM n/a (fewer pixels than its 7 x 7 window)" in text
+    panel = json.loads((out / "result.json").read_text())["summary"]["panels"][0]
+    assert panel["ssim_native"] is None and panel["ssim_native_baseline"] is None
+    assert 0 < panel["ssim"] <= 1 and len(panel["cells"]) == 2 and panel["patches"] == 16

@@ -466,12 +466,14 @@ def feature_cost(p: Parquetry, image: np.ndarray, params: ParquetryParams,
 
 
 def ssim_vs_matched(p: Parquetry, image: np.ndarray, downsample: int = 1,
-                    grid: MetricGrid = "working") -> float:
+                    grid: MetricGrid = "working") -> float | None:
     """SSIM (scikit-image: 7 x 7 windows, grey, data range 1) between an image's intensity and
     the matched target (eq. 2), both ``(H, W)`` at the working resolution, or first
     area-averaged by ``downsample`` (``round(px_per_mm)`` gives 1 mm pixels, 7 mm windows:
     structure at half a patch rather than the wood's sub-millimetre grain), or with
-    ``grid="native"`` to the target image's own pixels (``downsample`` then unused)."""
+    ``grid="native"`` to the target image's own pixels (``downsample`` then unused). None
+    where that grid, or the working one, is narrower than the 7 x 7 window (a 4 x 4 px
+    target's own pixels): SSIM has no value there."""
     from skimage.metrics import structural_similarity
 
     a, b = intensity(image), p.matched
@@ -479,5 +481,7 @@ def ssim_vs_matched(p: Parquetry, image: np.ndarray, downsample: int = 1,
     if shape is None and downsample > 1:
         h, w = b.shape
         shape = (max(7, h // downsample), max(7, w // downsample))
+    if min(b.shape) < 7 or (shape is not None and min(shape) < 7):
+        return None  # skimage raised ValueError: an internal error at the end of a whole run
     a, b = _area(a, shape), p.metric_target("matched", shape)
     return float(structural_similarity(a, b, data_range=1.0))

@@ -223,13 +223,15 @@ def format_summary(summ: dict, problems: dict) -> str:
         line = (f"{d['name']}: {d['cells'][1]} x {d['cells'][0]} cells, {d['size_mm'][0]:g} x "
                 f"{d['size_mm'][1]:g} mm, {d['patches']} patches")
         if "feature_cost" in d:
+            def ssim(key):  # None: the grid is narrower than SSIM's 7 x 7 window
+                return ("n/a (fewer pixels than its 7 x 7 window)" if d[key] is None
+                        else f"{d[key]:.3f} (baseline {d[key + '_baseline']:.3f})")
             line += (f"; feature cost/px {d['feature_cost']:.5f} (mean-colour baseline "
-                     f"{d['feature_cost_baseline']:.5f}), SSIM {d['ssim']:.3f} (baseline "
-                     f"{d['ssim_baseline']:.3f}), at 1 mm pixels {d['ssim_1mm']:.3f} (baseline "
-                     f"{d['ssim_1mm_baseline']:.3f}); on the target's own "
+                     f"{d['feature_cost_baseline']:.5f}), SSIM {ssim('ssim')}, at 1 mm pixels "
+                     f"{ssim('ssim_1mm')}; on the target's own "
                      f"{d['native_px'][1]} x {d['native_px'][0]} pixels feature cost "
                      f"{d['feature_cost_native']:.5f} (baseline {d['feature_cost_native_baseline']:.5f}), "
-                     f"SSIM {d['ssim_native']:.3f} (baseline {d['ssim_native_baseline']:.3f})")
+                     f"SSIM {ssim('ssim_native')}")
         lines.append(line)
     lines.append(f"matching: {summ['match_seconds']:.1f} s wall, {summ['match_cpu_seconds']:.1f} CPU-s, "
                  f"{summ['seconds_per_patch']:.3f} s per patch")
