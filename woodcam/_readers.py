@@ -10,6 +10,7 @@ veneer scans, parquetry targets); it sits at the bottom of the import layering s
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -62,6 +63,17 @@ def read_image_file(path: Path, what: str):
 
     from .limits import limit
 
+    cap = limit("MAX_IMAGE_PIXELS")
+
+    def too_big(size: str) -> WoodcamError:
+        return WoodcamError(f"{what}: {str(path)!r} is {size}, more than the limit MAX_IMAGE_PIXELS = "
+                            f"{cap:.0f}; downscale it, or raise the limit with WOODCAM_MAX_IMAGE_PIXELS=N")
+
+    # PIL's own bomb guard (89 Mpx, an error above 179 Mpx) came before woodcam's: a 200 Mpx
+    # target within woodcam's limit was refused as "damaged", whatever WOODCAM_MAX_IMAGE_PIXELS
+    # said; woodcam's limit is the guard (checked below from the header), PIL's set to it
+    if Image.MAX_IMAGE_PIXELS is not None and Image.MAX_IMAGE_PIXELS < cap:
+        Image.MAX_IMAGE_PIXELS = cap
     try:
         # by the content, not the name: phones and messengers save HEIC under a .jpg name (PIL
         # already tells a PNG named .jpg by its bytes; HEIF needs pillow-heif's opener)
@@ -71,11 +83,8 @@ def read_image_file(path: Path, what: str):
 
                 register_heif_opener()  # libheif turns the pixels by the file's own rotation and resets the tag
         with Image.open(path) as im:
-            if im.width * im.height > limit("MAX_IMAGE_PIXELS"):
-                raise WoodcamError(
-                    f"{what}: {str(path)!r} is {im.width}x{im.height} px, more than the limit "
-                    f"MAX_IMAGE_PIXELS = {limit('MAX_IMAGE_PIXELS'):.0f}; downscale it, or raise "
-                    "the limit with WOODCAM_MAX_IMAGE_PIXELS=N")
+            if im.width * im.height > cap:
+                raise too_big(f"{im.width}x{im.height} px")
             # an animation's first frame was taken without a word; a phone's MPO JPEG (a depth
             # or gain map as its second image) is one photo and is read as such
             if getattr(im, "is_animated", False) and im.format in ("GIF", "PNG", "WEBP"):
@@ -89,7 +98,10 @@ def read_image_file(path: Path, what: str):
             return _image_array(im, f"{what}: {str(path)!r}")
     except WoodcamError:
         raise
-    except (OSError, SyntaxError, ValueError, Image.DecompressionBombError) as err:
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as err:  # over the cap
+        n = re.search(r"\((\d+) pixels\)", str(err))  # PIL's message holds the count
+        raise too_big(f"{n.group(1) if n else 'too many'} pixels") from err
+    except (OSError, SyntaxError, ValueError) as err:
         # PIL raises UnidentifiedImageError (an OSError) for 0-byte/unknown files, OSError for
         # truncated data, SyntaxError/ValueError for some malformed headers
         raise WoodcamError(f"{what}: cannot decode the image {str(path)!r} ({err}); the file is damaged or "

@@ -631,6 +631,55 @@ def test_unreadable_image(tmp_path):
         load_scan(bad, dpi=300)
 
 
+def test_a_large_target_is_read_up_to_woodcams_pixel_limit_and_in_one_float_array(tmp_path, monkeypatch):
+    """PIL's own bomb guard (89 Mpx; an error above 179 Mpx) came before woodcam's limit
+    (268 Mpx): a 200 Mpx target was refused as 'damaged or cannot be read as an image', and
+    WOODCAM_MAX_IMAGE_PIXELS could not raise it. Shown here with PIL's guard at 1000 px: a
+    100 x 100 target is read; over woodcam's limit it is refused naming the limit, however far
+    over. And the read made two float copies (astype, then / 255): its peak is now one."""
+    import tracemalloc
+    import warnings
+
+    from PIL import Image
+
+    from woodcam.parquetry.veneers import read_image
+
+    Image.fromarray(np.random.default_rng(0).integers(0, 256, (100, 100, 3), np.uint8)).save(
+        tmp_path / "t.png")
+    monkeypatch.setattr(Image, "MAX_IMAGE_PIXELS", 1000)
+    a = read_image(tmp_path / "t.png", "target image")
+    assert a.shape == (100, 100, 3) and a.dtype == np.float32
+    # over the limit: PIL's warning (up to twice it; an error here, as filterwarnings says, and
+    # ignored as the CLI does), PIL's error (beyond), woodcam's own check from the header
+    for cap, ignore, said in ((5000, False, "is 10000 pixels"), (2000, False, "is 10000 pixels"),
+                              (5000, True, "is 100x100 px")):
+        monkeypatch.setenv("WOODCAM_MAX_IMAGE_PIXELS", str(cap))
+        monkeypatch.setattr(Image, "MAX_IMAGE_PIXELS", 1000)
+        with pytest.raises(WoodcamError, match=f"target image: .*t.png' {said}, more than the limit "
+                           f"MAX_IMAGE_PIXELS = {cap}; downscale it, or raise the limit with "
+                           "WOODCAM_MAX_IMAGE_PIXELS=N"), warnings.catch_warnings():
+            if ignore:
+                warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            read_image(tmp_path / "t.png", "target image")
+    monkeypatch.delenv("WOODCAM_MAX_IMAGE_PIXELS")
+    Image.fromarray(np.random.default_rng(0).integers(0, 256, (500, 400, 3), np.uint8)).save(
+        tmp_path / "t.png")
+    tracemalloc.start()
+    try:
+        a = read_image(tmp_path / "t.png", "target image")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 1.4 * a.nbytes  # the float image and the 8-bit one (a quarter of it)
+    assert np.array_equal(a * 255, np.round(a * 255)) and a.max() <= 1.0
+    # a mask is thresholded on its 8-bit values: grey 128 (0.502) is wood, 127 is not
+    Image.new("RGB", (4, 1)).save(tmp_path / "s.png")
+    m = np.array([[[128] * 3, [127] * 3, [255, 128, 0], [255, 127, 0]]], np.uint8)
+    Image.fromarray(m).save(tmp_path / "m.png")
+    assert load_scan(tmp_path / "s.png", dpi=100, mask=tmp_path / "m.png").mask.tolist() == [
+        [True, False, True, False]]
+
+
 def test_a_phone_photo_is_read_upright(tmp_path):
     """A veneer or target photographed with a phone (landscape pixels, EXIF orientation 6) is
     read as viewers show it: 40 px wide and 60 px tall, its left half dark; raw it lay on its
