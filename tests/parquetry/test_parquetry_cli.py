@@ -235,3 +235,21 @@ def test_a_target_of_a_few_pixels_is_made_and_its_ssim_said_to_have_no_value(sca
     panel = json.loads((out / "result.json").read_text())["summary"]["panels"][0]
     assert panel["ssim_native"] is None and panel["ssim_native_baseline"] is None
     assert 0 < panel["ssim"] <= 1 and len(panel["cells"]) == 2 and panel["patches"] == 16
+
+
+def test_a_job_file_texture_without_an_id_is_named_by_its_file(scans, capsys):
+    """The reference code's 'id' is optional, but a source texture without one was a KeyError
+    from the CLI (an internal error); now its file's stem, as for --veneer. An id that is no
+    name is refused naming the entry."""
+    job = {"source_textures": [{"texture": "light.png", "dpi": 50.8}, {"texture": "dark.png", "dpi": 50.8}],
+           "targets": [{"filename": "coffee.png", "scale": 1.0}]}
+    (scans / "job.json").write_text(json.dumps(job))
+    out = scans / "out"
+    assert main(["parquetry", "--config", str(scans / "job.json"), "--image-size-mm", "42", "--px-per-mm",
+                 "2", "--no-seams", "--no-glb", "--out", str(out), "--quiet"]) == 0
+    assert [v["id"] for v in json.loads((out / "result.json").read_text())["veneers"]] == ["light", "dark"]
+    job["source_textures"][0]["id"] = 5
+    (scans / "job.json").write_text(json.dumps(job))
+    assert main(["parquetry", "--config", str(scans / "job.json"), "--out", str(out), "--quiet"]) == 1
+    assert "source_textures[0].id must be a name (a string, it names veneer_<id>.svg); got 5" in \
+        capsys.readouterr().err

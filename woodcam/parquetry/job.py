@@ -289,7 +289,14 @@ def read_job(path: str | Path) -> ParquetryJob:
 
     if any(t.get("mask") is not None and not isinstance(t["mask"], str) for t in scans):
         raise WoodcamError(f"{where} a source_textures mask must be a path or null")
-    scans = [dict(t, texture=_abs(t["texture"]), mask=_abs(t.get("mask"))) for t in scans]
+    for i, t in enumerate(scans):
+        if t.get("id") is not None and not (isinstance(t["id"], str) and t["id"]):
+            raise WoodcamError(f"{where} source_textures[{i}].id must be a name (a string, it names "
+                               f"veneer_<id>.svg); got {t['id']!r}")
+    # the reference code's id is optional: the file's stem, as for --veneer (a texture without
+    # one was a KeyError from the CLI)
+    scans = [dict(t, texture=_abs(t["texture"]), mask=_abs(t.get("mask")),
+                  id=t.get("id") or Path(t["texture"]).stem) for t in scans]
     targets = [dict(t, filename=_abs(t["filename"])) for t in targets]
     mokume = [_abs(m) for m in mokume]
     return ParquetryJob(scans, list(blocks), mokume, targets, ParquetryParams(**kw).check())
