@@ -557,23 +557,34 @@ def test_sliced_leaves_are_book_matched():
 def test_job_file_round_trip_and_paper_keys(tmp_path):
     job = ParquetryJob(scans=[{"texture": str(tmp_path / "a.png"), "mask": None, "id": "a",
                                "scale": 1.0, "dpi": 300.0}],
-                       targets=[{"filename": str(tmp_path / "t.png"), "scale": 1.0, "dpi": 300.0}],
+                       targets=[{"filename": str(tmp_path / "t.png"), "scale": 1.0}],
                        params=ParquetryParams(n_rot=9, w_edge=0.3, priority="center"))
     write_job(job, tmp_path / "job.json")
     d = json.loads((tmp_path / "job.json").read_text())
     assert d["num_source_rotations"] == 9 and d["weight_sobel"] == 0.3 and d["sort_patches_saliency"] is False
     back = read_job(tmp_path / "job.json")
     assert back.params == job.params and back.scans[0]["id"] == "a"
-    # the reference code's own sample (keys only; Table 1 names map across)
-    (tmp_path / "paper.json").write_text(json.dumps({
-        "source_textures": [{"texture": "wood.jpg", "mask": "m.png", "id": "f1", "scale": 0.7, "dpi": 300.0}],
-        "targets": [{"filename": "target.jpg", "scale": 1.0, "dpi": 300.0}],
-        "num_source_rotations": 15, "patch_levels": 1, "patch_quality_factor": 1.5,
-        "weight_intensity": 0.5, "weight_sobel": 0.5, "histogram_matching": 0.5,
-        "sort_patches_saliency": True}))
-    j = read_job(tmp_path / "paper.json")
+    # the reference code's own sample (Table 1 names map across; its keys woodcam reads no
+    # value from are said: they were silently dropped, the run unlike the reference code's)
+    paper = {"source_textures": [{"texture": "wood.jpg", "mask": "m.png", "id": "f1", "scale": 0.7, "dpi": 300.0}],
+             "targets": [{"filename": "target.jpg", "scale": 1.0, "dpi": 300.0, "morphed_grid": "grid/grid.json"}],
+             "num_source_rotations": 15, "min_patch_size": 48, "patch_levels": 1, "patch_quality_factor": 1.5,
+             "weight_intensity": 0.5, "weight_sobel": 0.5, "weight_gabor": 0.0, "histogram_matching": 0.5,
+             "filter_resolution": 32, "num_filter_directions": 4, "filter_bandwidth_octaves": 1.0,
+             "sort_patches_saliency": True}
+    (tmp_path / "paper.json").write_text(json.dumps(paper))
+    with pytest.warns(WoodcamWarning, match=r"paper.json': woodcam reads no value from min_patch_size "
+                      r"\(woodcam's patch side is patch_mm.*; targets\[0\] dpi and scale \(the panel's "
+                      r"shorter side is image_size_mm.*; targets\[0\].morphed_grid \(woodcam cuts a square "
+                      r"grid of patches\); the run may differ from the reference code's") as w:
+        j = read_job(tmp_path / "paper.json")
+    assert len(w) == 1 and "gabor" not in str(w[0].message)  # weight 0: no effect there either
     assert (j.params.n_adaptive, j.params.w_adaptive, j.params.priority) == (1, 1.5, "saliency")
     assert j.scans[0]["texture"] == str((tmp_path / "wood.jpg").resolve())
+    paper["weight_gabor"] = 0.3
+    (tmp_path / "paper.json").write_text(json.dumps(paper))
+    with pytest.warns(WoodcamWarning, match=r"weight_gabor = 0.3 \(woodcam matches intensity and Sobel"):
+        read_job(tmp_path / "paper.json")
 
 
 # -- bad input ------------------------------------------------------------------------------
@@ -595,6 +606,15 @@ _T = [{"filename": "t.png"}]
     ({"targets": _T, "woodcam": {"params": {"single_use": 1}}}, r"single_use must be true or false"),
     ([_T], r"must hold a JSON object; got list"),
     ({"targets": _T, "woodcam": {"image_size_mm": 50}}, r"key woodcam.image_size_mm is unknown.*woodcam.params"),
+    # a typo was ignored, the run made with the default; a string read as true
+    ({"targets": _T, "num_source_rotation": 3}, r"key 'num_source_rotation' is unknown \(neither woodcam nor "
+     r"the reference code reads it\); the known ones there: downsample, .*num_source_rotations, "),
+    ({"targets": [{"filename": "t.png", "scal": 0.5}]}, r"key targets\[0\].'scal' is unknown .*: dpi, "
+     r"filename, morphed_grid, scale$"),
+    ({"targets": _T, "sort_patches_saliency": "no"}, r"sort_patches_saliency must be true or false; got 'no'"),
+    ({"targets": _T, "source_textures": [{"json": "t.json", "scale": 1}]},
+     r"source_textures\[0\] describes its texture in another file \('json': 't.json'\), which woodcam does "
+     r"not read; give its 'texture', 'dpi' and 'mask' in this entry"),
 ])
 def test_a_bad_job_file_is_one_error_naming_the_entry(job, match, tmp_path):
     """Each of these was a KeyError, TypeError, AttributeError or ValueError traceback from the

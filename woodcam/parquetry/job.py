@@ -18,11 +18,12 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Literal
 
-from ..errors import WoodcamError
+from ..errors import WoodcamError, WoodcamWarning
 from ..limits import MAX_BLOCK_SIZE_MM
 
 Priority = Literal["saliency", "center"]
@@ -223,6 +224,51 @@ def _entries(d: dict, key: str, where: str, need: str | None) -> list[dict]:
 _PAPER_KEYS = {"num_source_rotations": "n_rot", "patch_levels": "n_adaptive",
                "patch_quality_factor": "w_adaptive", "weight_intensity": "w_intens",
                "weight_sobel": "w_edge", "histogram_matching": "w_hist"}
+#: The reference code's keys woodcam reads no value from, and why: a job file holding them
+#: (its sample does) is said to, not silently run otherwise than the reference code would.
+_PAPER_UNUSED = {
+    "min_patch_size": "woodcam's patch side is patch_mm: woodcam.params.patch_mm, --patch-mm",
+    "downsample": "the reference code ignores it too (deprecated)"}
+#: Its Gabor-filter keys: no effect there either while weight_gabor is 0.
+_GABOR = ("weight_gabor", "filter_resolution", "num_filter_directions", "filter_bandwidth_octaves")
+_TOP_KEYS = {"source_textures", "targets", "woodcam", "sort_patches_saliency", *_PAPER_KEYS,
+             *_PAPER_UNUSED, *_GABOR}
+_ENTRY_KEYS = {"source_textures": {"texture", "mask", "id", "scale", "dpi", "px_per_mm", "markers_pixel",
+                                   "json"},
+               "targets": {"filename", "scale", "dpi", "morphed_grid"}}
+
+
+def _unused_keys(d: dict, where: str) -> None:
+    """Refuse keys of a job file that neither woodcam nor the reference code reads (a typo:
+    ``num_source_rotation`` was ignored), warn of those it reads that woodcam has no use for."""
+    unknown = [("", k, _TOP_KEYS) for k in sorted(set(d) - _TOP_KEYS)]
+    for key in ("source_textures", "targets"):
+        for i, t in enumerate(d.get(key, [])):
+            unknown += [(f"{key}[{i}].", k, _ENTRY_KEYS[key]) for k in sorted(set(t) - _ENTRY_KEYS[key])]
+            if key == "source_textures" and "json" in t:
+                raise WoodcamError(f"{where} {key}[{i}] describes its texture in another file ('json': "
+                                   f"{t['json']!r}), which woodcam does not read; give its 'texture', "
+                                   "'dpi' and 'mask' in this entry")
+    if unknown:
+        at, k, known = unknown[0]
+        raise WoodcamError(f"{where} key {at}{k!r} is unknown (neither woodcam nor the reference code "
+                           f"reads it); the known ones there: {', '.join(sorted(known))}")
+    said = [f"{k} ({why})" for k, why in _PAPER_UNUSED.items() if k in d]
+    if d.get("weight_gabor"):
+        said.append(f"weight_gabor = {d['weight_gabor']!r} (woodcam matches intensity and Sobel edges, "
+                    "eq. 1 without the Gabor term)")
+    for i, t in enumerate(d.get("targets", [])):
+        if t.get("dpi") is not None or t.get("scale", 1.0) != 1.0:
+            said.append(f"targets[{i}] dpi and scale (the panel's shorter side is image_size_mm: "
+                        "woodcam.params.image_size_mm, --image-size-mm)")
+        if "morphed_grid" in t:
+            said.append(f"targets[{i}].morphed_grid (woodcam cuts a square grid of patches)")
+    said += [f"source_textures[{i}].markers_pixel (woodcam's cut files carry no registration marks)"
+             for i, t in enumerate(d.get("source_textures", [])) if "markers_pixel" in t]
+    if said:
+        warnings.warn(f"{where} woodcam reads no value from {'; '.join(said)}; the run may differ from "
+                      "the reference code's: remove these keys, or set what woodcam reads instead",
+                      WoodcamWarning, stacklevel=3)
 
 
 @dataclass
@@ -263,6 +309,9 @@ def read_job(path: str | Path) -> ParquetryJob:
     mokume = extra.get("mokume", [])
     if not isinstance(mokume, list) or not all(isinstance(m, str) for m in mokume):
         raise WoodcamError(f"{where} 'woodcam.mokume' must be a list of folder paths; got {mokume!r}")
+    _entries(d, "source_textures", where, None)  # lists of objects, before their keys are read
+    _entries(d, "targets", where, None)
+    _unused_keys(d, where)
     targets = _entries(d, "targets", where, "filename")
     scans = _entries(d, "source_textures", where, "texture")
     blocks = _entries(extra, "blocks", f"{where} woodcam", "spec")
@@ -277,8 +326,8 @@ def read_job(path: str | Path) -> ParquetryJob:
     for k, v in d.items():
         if k in _PAPER_KEYS:
             kw[_PAPER_KEYS[k]] = v
-        elif k == "sort_patches_saliency":
-            kw["priority"] = "saliency" if v else "center"
+        elif k == "sort_patches_saliency":  # "no" was read as true
+            kw["priority"] = "saliency" if _check_type(f"{where} {k}", v, "bool") else "center"
     for k, v in extra.get("params", {}).items():
         if k not in names:
             raise WoodcamError(f"job file key woodcam.params.{k} is unknown; known: {sorted(names)}")
