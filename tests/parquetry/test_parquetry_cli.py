@@ -253,3 +253,22 @@ def test_a_job_file_texture_without_an_id_is_named_by_its_file(scans, capsys):
     assert main(["parquetry", "--config", str(scans / "job.json"), "--out", str(out), "--quiet"]) == 1
     assert "source_textures[0].id must be a name (a string, it names veneer_<id>.svg); got 5" in \
         capsys.readouterr().err
+
+
+def test_the_job_file_of_a_run_with_relative_paths_reruns_from_anywhere(scans, capsys, monkeypatch):
+    """job.json kept the paths as typed (coffee.png, relative to the working folder) and a job
+    file's paths are read relative to its own folder: --config out/job.json looked for
+    out/coffee.png ('No such file'). Now written absolute."""
+    monkeypatch.chdir(scans)
+    assert main(["parquetry", "coffee.png", "--veneer", "light.png:2px/mm:dark_mask.png", "--veneer",
+                 "dark.png:2px/mm", "--image-size-mm", "42", "--px-per-mm", "2", "--no-seams", "--no-glb",
+                 "--out", "out", "--quiet"]) == 0
+    job = json.loads((scans / "out" / "job.json").read_text())
+    assert job["targets"][0]["filename"] == str(scans / "coffee.png")
+    assert job["source_textures"][0]["mask"] == str(scans / "dark_mask.png")
+    (scans / "elsewhere").mkdir()
+    monkeypatch.chdir(scans / "elsewhere")
+    assert main(["parquetry", "--config", "../out/job.json", "--out", "again", "--quiet", "--no-glb"]) == 0
+    first, again = (json.loads((scans / d / "result.json").read_text())["patches"]
+                    for d in ("out", "elsewhere/again"))
+    assert [p["anchor_px"] for p in again] == [p["anchor_px"] for p in first]

@@ -352,15 +352,22 @@ def read_job(path: str | Path) -> ParquetryJob:
 
 
 def write_job(job: ParquetryJob, path: str | Path) -> Path:
-    """Write a job file in the paper's layout (woodcam-only keys under ``"woodcam"``), atomically."""
+    """Write a job file in the paper's layout (woodcam-only keys under ``"woodcam"``), atomically.
+    Its paths are written absolute: the job's are relative to the working folder (as given on
+    the command line), a job file's to its own folder."""
     from .._atomic import write_text
 
+    def _abs(s):  # coffee.png typed in the working folder was read back as OUT/coffee.png
+        return str(Path(s).absolute()) if s else s
+
     prm = asdict(job.params)
-    d = {"source_textures": job.scans, "targets": job.targets}
+    d = {"source_textures": [dict(t, texture=_abs(t["texture"]), **({"mask": _abs(t["mask"])} if "mask" in t
+                                                                     else {})) for t in job.scans],
+         "targets": [dict(t, filename=_abs(t["filename"])) for t in job.targets]}
     for k, name in _PAPER_KEYS.items():
         d[k] = prm[name]
     d["sort_patches_saliency"] = job.params.priority == "saliency"
-    d["woodcam"] = {"params": prm, "blocks": job.blocks, "mokume": job.mokume}
+    d["woodcam"] = {"params": prm, "blocks": job.blocks, "mokume": [_abs(m) for m in job.mokume]}
     return write_text(path, json.dumps(d, indent=2), mkdir=True)
 
 
