@@ -101,6 +101,8 @@ def read_image_file(path: Path, what: str):
     except (Image.DecompressionBombError, Image.DecompressionBombWarning) as err:  # over the cap
         n = re.search(r"\((\d+) pixels\)", str(err))  # PIL's message holds the count
         raise too_big(f"{n.group(1) if n else 'too many'} pixels") from err
+    except FileNotFoundError as err:  # not 'the file is damaged'
+        raise WoodcamError(f"{what}: no such file {str(path)!r}; check the path") from err
     except (OSError, SyntaxError, ValueError) as err:
         # PIL raises UnidentifiedImageError (an OSError) for 0-byte/unknown files, OSError for
         # truncated data, SyntaxError/ValueError for some malformed headers

@@ -555,6 +555,8 @@ def test_sliced_leaves_are_book_matched():
 
 
 def test_job_file_round_trip_and_paper_keys(tmp_path):
+    for name in ("a.png", "t.png", "wood.jpg", "m.png", "target.jpg"):  # a job's files must exist
+        (tmp_path / name).touch()
     job = ParquetryJob(scans=[{"texture": str(tmp_path / "a.png"), "mask": None, "id": "a",
                                "scale": 1.0, "dpi": 300.0}],
                        targets=[{"filename": str(tmp_path / "t.png"), "scale": 1.0}],
@@ -622,6 +624,36 @@ def test_a_bad_job_file_is_one_error_naming_the_entry(job, match, tmp_path):
     (tmp_path / "job.json").write_text(json.dumps(job))
     with pytest.raises(WoodcamError, match=match):
         read_job(tmp_path / "job.json")
+
+
+def test_a_job_files_missing_file_is_named_by_its_entry_and_folder(tmp_path, monkeypatch):
+    """A job file's missing target, texture or mask was 'cannot decode the image ... the file is
+    damaged' once the run reached it; a path written from the working folder rather than the
+    job file's (as the reference code, which tries the working folder first, allows) said
+    nothing of where it was looked for. Now refused at the door, naming the entry and both."""
+    from PIL import Image
+
+    (tmp_path / "jobs").mkdir()
+    Image.new("RGB", (40, 30)).save(tmp_path / "jobs" / "t.png")
+    Image.new("RGB", (40, 30)).save(tmp_path / "s.png")
+    monkeypatch.chdir(tmp_path)
+    for entries, said in (
+            ({"targets": [{"filename": "nope.png"}]}, r"targets\[0\].filename 'nope.png': no such file "
+             r"'.*jobs/nope.png' \(a job file's paths are relative to its folder\); check the path"),
+            ({"targets": [{"filename": "t.png"}], "source_textures": [{"texture": "s.png", "dpi": 300}]},
+             r"source_textures\[0\].texture 's.png': no such file '.*jobs/s.png' \(a job file's paths are "
+             r"relative to its folder\); 's.png' is there from the working folder: give the path from the "
+             r"job file's folder, or an absolute one"),
+            ({"targets": [{"filename": "t.png"}], "source_textures": [{"texture": "t.png", "dpi": 300,
+                                                                         "mask": "m.png"}]},
+             r"source_textures\[0\].mask 'm.png': no such file")):
+        (tmp_path / "jobs" / "job.json").write_text(json.dumps(entries))
+        with pytest.raises(WoodcamError, match=r"job file 'jobs/job.json': " + said):
+            read_job("jobs/job.json")
+    from woodcam.parquetry.veneers import read_image
+
+    with pytest.raises(WoodcamError, match=r"^target image: no such file 'nope.png'; check the path$"):
+        read_image("nope.png", "target image")
 
 
 def test_a_job_file_with_nan_is_refused(tmp_path):

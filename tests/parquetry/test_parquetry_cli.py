@@ -65,7 +65,7 @@ def test_cli_run_writes_everything(scans, capsys):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["{d}/nope.png", "--veneer", "{d}/light.png"], "cannot be read as an image"),
+    (["{d}/nope.png", "--veneer", "{d}/light.png"], "target image: no such file '{d}/nope.png'; check the path"),
     (["{d}/coffee.png", "--veneer", "{d}/light.png:300:{d}/coffee.png"], "mask must have the image's size"),
     (["{d}/coffee.png", "--veneer", "{d}/light.png", "--patch-mm", "4"], "patch_mm must be at least min_piece_mm"),
     (["{d}/coffee.png", "--veneer", "{d}/light.png:2000"], "smaller than one patch"),
@@ -76,7 +76,7 @@ def test_cli_bad_input_is_one_line(scans, capsys, args, message):
     argv = ["parquetry"] + [a.format(d=scans) for a in args] + ["--out", str(scans / "o"), "--quiet"]
     assert main(argv) == 1
     err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and err.startswith("woodcam: error:") and message in err
+    assert err.count("\n") == 0 and err.startswith("woodcam: error:") and message.format(d=scans) in err
 
 
 def _small_run(scans, out, *extra):

@@ -333,8 +333,22 @@ def read_job(path: str | Path) -> ParquetryJob:
             raise WoodcamError(f"job file key woodcam.params.{k} is unknown; known: {sorted(names)}")
         kw[k] = v
 
+    params = ParquetryParams(**kw).check()
+
     def _abs(s):
         return str((base / s).resolve()) if s else s
+
+    # found at the door, each named by its entry: a missing file was 'cannot decode the image ...
+    # the file is damaged' after the job's other files were read
+    named = [(f"source_textures[{i}].{k}", t.get(k)) for i, t in enumerate(scans) for k in ("texture", "mask")]
+    named += [(f"targets[{i}].filename", t["filename"]) for i, t in enumerate(targets)]
+    named += [(f"woodcam.mokume[{i}]", m) for i, m in enumerate(mokume)]
+    for key, s in named:
+        if s and not Path(_abs(s)).exists():
+            here = (f"; {s!r} is there from the working folder: give the path from the job file's folder, "
+                    "or an absolute one") if not Path(s).is_absolute() and Path(s).exists() else ""
+            raise WoodcamError(f"{where} {key} {s!r}: no such file {_abs(s)!r} (a job file's paths are "
+                               f"relative to its folder){here or '; check the path'}")
 
     if any(t.get("mask") is not None and not isinstance(t["mask"], str) for t in scans):
         raise WoodcamError(f"{where} a source_textures mask must be a path or null")
@@ -348,7 +362,7 @@ def read_job(path: str | Path) -> ParquetryJob:
                   id=t.get("id") or Path(t["texture"]).stem) for t in scans]
     targets = [dict(t, filename=_abs(t["filename"])) for t in targets]
     mokume = [_abs(m) for m in mokume]
-    return ParquetryJob(scans, list(blocks), mokume, targets, ParquetryParams(**kw).check())
+    return ParquetryJob(scans, list(blocks), mokume, targets, params)
 
 
 def write_job(job: ParquetryJob, path: str | Path) -> Path:
