@@ -130,6 +130,37 @@ def test_blocks_lists_builtins(capsys):
     assert "builtin:flat-sawn" in out and "builtin:knotty" in out
 
 
+def test_a_closed_output_pipe_ends_quietly_but_write_errors_are_said(tmp_path, capsys, monkeypatch):
+    """``woodcam blocks | head``: the reader went away; the command stops as git and ls do
+    (exit 141, not a word) -- it printed 'woodcam: error: Broken pipe; check the path, its
+    permissions and the free space', exit 1."""
+    import os
+
+    read_end, write_end = os.pipe()
+    os.close(read_end)  # the reader is gone before the first line: every write is EPIPE
+    try:
+        res = subprocess.run([sys.executable, "-m", "woodcam.cli", "blocks"], cwd=REPO,
+                             stdout=write_end, stderr=subprocess.PIPE, text=True, timeout=120)
+    finally:
+        os.close(write_end)
+    assert (res.returncode, res.stderr) == (141, ""), res.stderr  # 128 + SIGPIPE, as git and ls
+    # a real write error on stdout is still one line and exit 1
+    if os.path.exists("/dev/full"):
+        with open("/dev/full", "w") as full:
+            res = subprocess.run([sys.executable, "-m", "woodcam.cli", "blocks"], cwd=REPO,
+                                 stdout=full, stderr=subprocess.PIPE, text=True, timeout=120)
+        assert res.returncode == 1 and "No space left on device" in res.stderr, res.stderr
+    # a broken pipe that is not stdout's (a worker process that died) is an error, not quiet
+    import woodcam.cli.bake as bake_cli
+
+    def worker_died(args):
+        raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr(bake_cli, "run_blocks", worker_died)
+    assert main(["blocks"]) == 1
+    assert "woodcam: error: Broken pipe" in capsys.readouterr().err
+
+
 def test_a_part_sticking_out_is_said_in_the_report_files(tmp_path, capsys):
     """'part sticks out of the block' went to stderr only: the report files kept no trace of it."""
     import json

@@ -72,11 +72,15 @@ examples:
 
 exit status: 0 done; 1 the work failed (a one-line 'woodcam: error: ...' says why); 2 the
 command line is wrong (usage); 3 the work was done but a check failed (e.g. gcode --strict);
-130 interrupted.
+130 interrupted; 141 the pipe it printed to was closed (woodcam blocks | head), quietly, as git
+and ls.
 """
 
 #: Exit statuses (documented in ``woodcam --help`` and the README).
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_CHECKS, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+#: Standard output was a pipe whose reader went away (``woodcam blocks | head``): 128 + SIGPIPE,
+#: what git, ls and seq end with there (killed by the signal), and like them without a word.
+EXIT_BROKEN_PIPE = 141
 
 
 class _Parser(argparse.ArgumentParser):
@@ -213,6 +217,7 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             check_numbers(args)  # every numeric option finite and in range, before any work
             rc = args.func(args)
             _interrupt.check()  # a Ctrl-C a library swallowed: the run did not end as asked
+            sys.stdout.flush()  # here, not at exit: a closed pipe is then caught below
         except BaseException as err:
             # Ctrl-C, or an error after one: a library swallowed it (trimesh's imports catch
             # BaseException) or left itself half-imported (scipy: NameError), or wrapped it
@@ -224,6 +229,8 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
                 return EXIT_INTERRUPTED
             if not isinstance(err, Exception):  # SystemExit and the like: not ours to report
                 raise
+            if _stdout_closed(err):  # the reader of a pipe went away: it wants no more lines
+                return EXIT_BROKEN_PIPE
             if isinstance(err, UsageError):
                 print(f"woodcam: error: {err}", file=sys.stderr)
                 return EXIT_USAGE
@@ -257,6 +264,29 @@ def _interrupted(err: BaseException) -> bool:
         seen.add(id(err))
         err = err.__cause__ or err.__context__
     return False
+
+
+def _stdout_closed(err: BaseException) -> bool:
+    """Whether ``err`` is standard output's pipe closed by its reader (``| head``); then stdout
+    is pointed at /dev/null so the interpreter's last flush raises nothing. EPIPE is only
+    ever a pipe's, never an output file's (written to a temporary and renamed), and the pipe
+    is asked itself: one to a worker process that died is not the user's pipe."""
+    if not isinstance(err, BrokenPipeError):
+        return False
+    try:
+        fd = sys.stdout.fileno()
+        import select
+
+        poller = select.poll()
+        poller.register(fd, select.POLLOUT)
+        gone = any(events & select.POLLERR for _, events in poller.poll(0))
+    except (AttributeError, OSError, ValueError):  # no real stdout, or no poll (Windows)
+        return False
+    if gone:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, fd)
+        os.close(devnull)
+    return gone
 
 
 def _is_ours(w) -> bool:
