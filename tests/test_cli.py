@@ -184,6 +184,33 @@ def test_a_part_sticking_out_is_said_in_the_report_files(tmp_path, capsys):
     assert re.search(r"<th>part</th><td>\d+ mm\^3, yield [\d.]+ % of the block", page)
 
 
+def test_a_rerun_removes_the_earlier_runs_outputs_it_does_not_write_again(tmp_path, capsys):
+    """A rerun without --screenshot left NAME_view.png of the earlier run beside the new GLB,
+    passing for a view of it. Now each run lists the files it wrote for the GLB
+    (.woodcam-NAME.glb-files.json) and a rerun removes the listed ones it does not write again,
+    naming each; never a file no run listed, nor an input of the run."""
+    box = trimesh.creation.box((20, 20, 20))
+    box.apply_translation((50, 40, 25))
+    box.export(tmp_path / "box.stl")
+    mine = tmp_path / "b_deviation.png"  # the user's, named like an output: no run wrote it
+    mine.write_bytes(b"not woodcam's")
+    bake = ["bake", "--block", "builtin:flat-sawn", "--out", str(tmp_path / "b.glb"), "--texels-per-mm", "1"]
+    assert main([*bake, str(tmp_path / "box.stl"), "--screenshot"]) == 0
+    first = {p.name for p in tmp_path.iterdir()}
+    assert {"b.glb", "b.obj", "b.mtl", "b_texture.png", "b_report.txt", "b_view.png"} <= first
+    capsys.readouterr()
+    # the earlier run's OBJ is this run's part: it and its MTL and texture stay; the view goes
+    assert main([*bake, str(tmp_path / "b.obj"), "--no-obj"]) == 0
+    err = capsys.readouterr().err
+    assert re.search(r"warning: removed 1 file\(s\) of an earlier run .*: b_view.png$", err, re.M), err
+    assert {p.name for p in tmp_path.iterdir()} == first - {"b_view.png"}
+    # a run that neither writes nor reads the OBJ set removes it: it is still the first run's
+    assert main([*bake, str(tmp_path / "box.stl"), "--no-obj"]) == 0
+    assert re.search(r"removed 3 file\(s\) .*: b.obj, b.mtl, b_texture.png$", capsys.readouterr().err, re.M)
+    assert {p.name for p in tmp_path.iterdir()} == first - {"b_view.png", "b.obj", "b.mtl", "b_texture.png"}
+    assert mine.read_bytes() == b"not woodcam's"
+
+
 def test_bake_draws_one_stage_bar_over_the_whole_run(tmp_path, bars, capsys):
     """Sweep h5 item 7: 20 s of bake drew nothing (only the rasterise chunks had a bar, each
     shorter than its 2 s delay); opening the block (a fit: minutes) had none either."""
@@ -257,7 +284,8 @@ def test_a_no_obj_rerun_removes_the_earlier_runs_obj_but_never_an_input_or_a_for
     assert main([*bake, "--no-obj"]) == 0
     assert not any(p.exists() for p in trio)
     assert "removed 3 file(s) of an earlier run" in capsys.readouterr().err
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.glb", "a_report.json", "a_report.txt", "box.stl"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".woodcam-a.glb-files.json", "a.glb", "a_report.json",
+                                                          "a_report.txt", "box.stl"]
     box.export(trio[0])  # trimesh's OBJ, not woodcam's: not ours to remove
     assert main([*bake, "--no-obj"]) == 0
     assert trio[0].is_file() and "removed" not in capsys.readouterr().err

@@ -264,7 +264,8 @@ def _read_manifest(path: Path) -> list[str] | None:
 
 
 def remove_stale(folder: str | os.PathLike, patterns: Iterable[str],
-                 keep: Iterable[str | os.PathLike], *, kind: str | None) -> list[Path]:
+                 keep: Iterable[str | os.PathLike], *, kind: str,
+                 spare: Iterable[str | os.PathLike] = ()) -> list[Path]:
     """Delete the files an earlier ``kind`` run wrote in ``folder`` that this run, which has
     just written ``keep`` there, does not write again (a veneer sheet no longer cut, a surface
     at another year): beside this run's they would pass for its own. Call it after the new
@@ -275,31 +276,34 @@ def remove_stale(folder: str | os.PathLike, patterns: Iterable[str],
     not write again. Files that match one of the glob ``patterns`` but were not listed (a file
     of the user's named like an output) are left, with a WoodcamWarning naming them. A folder
     without a readable list (written before woodcam kept one) falls back to the patterns: every
-    matching file not in ``keep`` is removed. ``kind=None``: the patterns name exactly the
-    earlier run's files (found by a mark of woodcam's in them, such as its OBJ header), so the
-    pattern rule applies and no list is kept: a folder several runs write into (bake's ``--out``
-    FILE) must not have one run's list remove another's outputs. A WoodcamWarning names every
-    file removed. Returns the paths removed."""
+    matching file not in ``keep`` is removed (no ``patterns``: nothing is). A WoodcamWarning
+    names every file removed. ``spare``: the run's inputs (an earlier run's OBJ given as the
+    part), never removed by this run; one that was on the list stays on it (still an earlier
+    run's output: a later run that neither writes nor reads it removes it). Returns the paths
+    removed."""
     import json
 
     folder = Path(folder)
     if not folder.is_dir():  # nothing written there (a report without a gallery): no list to keep
         return []
     ours = {Path(f).resolve() for f in keep}
-    manifest = manifest_path(folder, kind or "none")
-    listed = _read_manifest(manifest) if kind else None
+    spared = {Path(f).resolve() for f in spare}
+    manifest = manifest_path(folder, kind)
+    listed = _read_manifest(manifest)
     looks = []   # pattern by pattern, as the patterns are given
     for pattern in patterns:
         looks += [old for old in sorted(folder.glob(pattern))
                   if old.is_file() and old.resolve() not in ours and old not in looks]
     if listed is None:
-        stale, foreign = looks, []
+        earlier, foreign = looks, []
         how = ("(no list of an earlier run's files there: every file named like this run's "
-               "outputs was taken for one)") if kind else "(woodcam's own, by their mark)"
+               "outputs was taken for one)")
     else:
-        stale = [folder / n for n in listed if (folder / n).is_file() and (folder / n).resolve() not in ours]
-        foreign = [old for old in looks if old.name not in set(listed)]
+        earlier = [folder / n for n in listed if (folder / n).is_file() and (folder / n).resolve() not in ours]
+        foreign = [old for old in looks if old.name not in set(listed) and old.resolve() not in spared]
         how = f"(listed in {manifest.name})"
+    stale = [old for old in earlier if old.resolve() not in spared]
+    carried = [old.name for old in earlier if old.resolve() in spared]
     gone = []
     for old in stale:
         old.unlink(missing_ok=True)
@@ -312,9 +316,8 @@ def remove_stale(folder: str | os.PathLike, patterns: Iterable[str],
         warnings.warn(f"left {len(foreign)} file(s) in {str(folder)!r} named like this run's outputs that "
                       f"no earlier run wrote (not in {manifest.name}); remove them if they are stale: "
                       f"{', '.join(p.name for p in foreign)}", WoodcamWarning, stacklevel=2)
-    if kind is None:
-        return gone
-    mine = list(dict.fromkeys(Path(f).name for f in keep if Path(f).resolve().parent == folder.resolve()))
+    mine = list(dict.fromkeys([*(Path(f).name for f in keep if Path(f).resolve().parent == folder.resolve()),
+                               *carried]))
     write_text(manifest, json.dumps({"written_by": f"woodcam {kind}", "files": mine}, indent=1) + "\n")
     return gone
 

@@ -34,7 +34,8 @@ class PartPreview:
     triangles : int
     atlas_px : (h, w)
     files : dict kind -> Path, every file written ("glb", "obj", "mtl", "texture", "report",
-        "report_json", "png")
+        "report_json", "png"; the CLI adds "deviation", gcode's map, and "list",
+        the list of them, ``woodcam.cli.options.remove_stale_outputs``)
     timings_s : dict stage -> seconds
     warnings : list of str
     """

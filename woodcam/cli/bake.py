@@ -9,8 +9,8 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
 from .options import (BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
-                      add_workers_option, allow_negative_values, apply_workers, camera_of, remove_stale_obj,
-                      stock_options, vector_type, write_screenshot)
+                      add_workers_option, allow_negative_values, apply_workers, camera_of,
+                      remove_stale_outputs, stock_options, vector_type, write_screenshot)
 
 
 def register(subparsers) -> None:
@@ -100,7 +100,7 @@ def run_demo(args: argparse.Namespace) -> int:
     report = demo(args.out, quick=args.quick, texels_per_mm=args.texels_per_mm,
                   obj=not args.no_obj, **stock_options(args))
     for part in report.parts:
-        remove_stale_obj(args, part.files["glb"], part.files)
+        remove_stale_outputs(part.files["glb"], part.files)
     print(report.summary())
     return 0
 
@@ -131,7 +131,7 @@ def run_bake(args: argparse.Namespace) -> int:
         if shot:
             with bar.stage("render"):
                 write_screenshot(args, res.files, stock)
-    remove_stale_obj(args, args.out, res.files, inputs=[args.part])
+    remove_stale_outputs(args.out, res.files, inputs=[args.part])
     print_warnings(res.warnings)
     tess = res.tessellation
     ignored = [opt for opt, value in (("--tolerance", args.tolerance),

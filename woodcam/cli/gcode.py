@@ -14,7 +14,7 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
 from .options import (BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
-                      allow_negative_values, camera_of, remove_stale_obj, sizes_type, stock_options, vector_type)
+                      allow_negative_values, camera_of, remove_stale_outputs, sizes_type, stock_options, vector_type)
 
 _EXAMPLES = """\
 examples:
@@ -280,9 +280,11 @@ def run(args) -> int:
                               obj_units=args.obj_units, obj_up=args.obj_up,
                               max_atlas_px=args.max_atlas)
     t_bake = time.perf_counter() - t1
+    if design is not None:
+        out.files["deviation"] = _deviation_png(args.out)
     if args.screenshot:
         _screenshot(args, stock, program, offset, out, res.heightmap)
-    remove_stale_obj(args, args.out, out.files, inputs=[*args.program, args.part])
+    remove_stale_outputs(args.out, out.files, inputs=[*args.program, args.part])
     print(f"meshed and baked {out.triangles} triangles in {t_bake:.2f} s; wrote "
           + ", ".join(map(str, out.files.values())))
     if args.view:

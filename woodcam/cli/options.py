@@ -588,24 +588,31 @@ def write_screenshot(args, files: dict, stock) -> None:
     files["png"] = png
 
 
-def remove_stale_obj(args, out_glb, files: dict, inputs=()) -> None:
-    """``--no-obj``: the OBJ + MTL + PNG an earlier run wrote beside ``out_glb`` would pass for
-    this run's part; removed once this run's files are in place, with a warning naming them
-    (:func:`woodcam._atomic.remove_stale`). Only woodcam's own OBJ set (its header says so,
-    :func:`woodcam.export.written_obj_set`), and never one holding an input of this run
-    (``inputs``: a baked OBJ given as the part)."""
-    if not args.no_obj:
-        return
+def remove_stale_outputs(out_glb, files: dict, inputs=()) -> None:
+    """The files an earlier ``bake``, ``gcode`` or ``demo`` run wrote for the GLB ``out_glb``
+    that this run, which wrote ``files`` (a PartPreview's: kind -> path), does not write again
+    would pass for this run's: a NAME_view.png when ``--screenshot`` is dropped, gcode's
+    NAME_deviation.png without ``--part``, bake's NAME_report.* under a gcode GLB, the OBJ set
+    under ``--no-obj``. They go with a warning naming each (:func:`woodcam._atomic.remove_stale`),
+    and ``files["list"]`` is the list's path.
+    Every run writing a GLB lists its files beside it in ``.woodcam-NAME.glb-files.json``, one
+    list whatever the command, and only listed files go: never a file woodcam did not write
+    there, nor one of ``inputs`` (the part or program of this run; an OBJ with its MTL and
+    texture). Where no run kept a list yet, the OBJ set woodcam wrote there goes (its header
+    says so, :func:`woodcam.export.written_obj_set`) and nothing else. Call it once this
+    run's files are in place."""
     import glob
 
-    from .._atomic import remove_stale
-    from ..export import written_obj_set
+    from .._atomic import manifest_path, remove_stale
+    from ..export import obj_siblings, written_obj_set
 
-    old = written_obj_set(Path(out_glb).with_suffix(".obj"))
-    given = {Path(p).resolve() for p in inputs if p}
-    if any(p.resolve() in given for p in old):
-        return
-    remove_stale(Path(out_glb).parent, [glob.escape(p.name) for p in old], files.values(), kind=None)
+    out_glb = Path(out_glb)
+    listed = manifest_path(out_glb.parent, out_glb.name)
+    spare = [Path(p) for p in inputs if p]
+    spare += [s for p in spare if p.suffix.lower() == ".obj" for s in obj_siblings(p)]  # its set
+    marked = [] if listed.is_file() else [glob.escape(p.name) for p in written_obj_set(out_glb.with_suffix(".obj"))]
+    remove_stale(out_glb.parent, marked, [out_glb, *files.values()], kind=out_glb.name, spare=spare)
+    files["list"] = listed  # every file written is named
 
 
 def _glb_metadata(glb: Path) -> dict:
