@@ -88,3 +88,45 @@ def test_eval_realistic_takes_methods_all_as_eval_rings_does(tmp_path, monkeypat
         main(["eval", "realistic", "--seed", "1", "--count", "1", "--methods", "all", "--out",
               str(tmp_path / "out")])
     assert asked == [list(METHODS)]
+
+
+def test_eval_realistic_outputs_land_as_one_set_and_a_rerun_removes_the_earlier_runs(tmp_path, monkeypatch,
+                                                                                     capsys):
+    """records.json was rewritten after every block and the PNGs drawn as they came, table.md at
+    the end: a Ctrl-C left new records and pictures beside an earlier run's table, and a rerun
+    with fewer blocks kept the earlier run's pictures. Now the run's files land together (or
+    none do) and the earlier run's it does not write again go, with a warning."""
+    import re
+
+    import woodcam.bench_realistic
+    import woodcam.inference.evaluate
+    from woodcam._atomic import write_text
+    from woodcam.cli import main
+
+    def score_block(seed, index, methods, scenario, faces, kind, **kwargs):
+        if index == stop_at[0]:
+            raise KeyboardInterrupt
+        return {"name": f"b{index}", "kind": kind, "scenario": scenario, "faces": faces, "planes": [],
+                **{m: {"matched_1": 90.0 + index, "matched_2": 95.0, "fit_s": 0.1} for m in methods}}
+
+    stop_at = [None]
+    monkeypatch.setattr(woodcam.bench_realistic, "score_block", score_block)
+    monkeypatch.setattr(woodcam.inference.evaluate, "plot_planes",
+                        lambda path, planes, **kw: write_text(path, "a picture"))
+    out = tmp_path / "out"
+    run = ["eval", "realistic", "--seed", "1", "--methods", "radial", "--faces", "full", "--eq79", "0",
+           "--plots", "--out", str(out)]
+    assert main([*run, "--count", "3"]) == 0
+    first = {p.name: (p.stat().st_ino, p.read_bytes()) for p in out.iterdir()}
+    assert {"b0_noisy_full.png", "b2_noisy_full.png", "records.json", "table.md"} <= set(first)
+    stop_at[0] = 1  # a Ctrl-C at the second block
+    assert main([*run, "--count", "2"]) == 130
+    assert {p.name: (p.stat().st_ino, p.read_bytes()) for p in out.iterdir()} == first
+    stop_at[0] = None
+    capsys.readouterr()
+    assert main([*run, "--count", "2"]) == 0
+    assert re.search(r"warning: removed 1 file\(s\) of an earlier run .*: b2_noisy_full.png$",
+                     capsys.readouterr().err, re.M)
+    assert sorted(p.name for p in out.iterdir()) == [".woodcam-eval-files.json", "b0_noisy_full.png",
+                                                     "b1_noisy_full.png", "records.json", "table.md"]
+    assert [r["name"] for r in json.loads((out / "records.json").read_text())] == ["b0", "b1"]

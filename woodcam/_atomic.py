@@ -20,6 +20,9 @@ middle of a write never leaves a truncated GLB, a 0-byte OBJ or a half cache beh
 * :func:`all_or_nothing` -- ``with all_or_nothing(): export_glb(...); export_obj(...)``: every
   atomic write inside the block is renamed into place only when the whole block succeeded
   (the first file written, renamed last), so a GLB and its OBJ + MTL + PNG appear as one set.
+  :func:`apart` keeps a write out of the set (a cache entry, of use whatever becomes of it).
+* :func:`run_outputs` -- a command's files in its output folder as one set, and the earlier
+  run's files it does not write again removed (:func:`remove_stale`).
 * :func:`check_output_path` -- validate an output path *before* the work starts: known suffix,
   not a directory, parent folder exists, is a folder and is writable. Raises
   :class:`~woodcam.errors.WoodcamError` naming the option, the rule, the value and a fix.
@@ -44,8 +47,8 @@ from typing import IO
 from . import _interrupt
 from .errors import WoodcamError, WoodcamWarning
 
-__all__ = ["all_or_nothing", "atomic_files", "atomic_path", "atomic_write", "check_output_path",
-           "manifest_path", "remove_stale", "write_bytes", "write_figure", "write_text"]
+__all__ = ["all_or_nothing", "apart", "atomic_files", "atomic_path", "atomic_write", "check_output_path",
+           "manifest_path", "remove_stale", "run_outputs", "write_bytes", "write_figure", "write_text"]
 
 
 def _umask() -> int:
@@ -115,8 +118,10 @@ def _fsync_dir(folder: Path) -> None:
         os.close(fd)
 
 
-#: Renames deferred by an active :func:`all_or_nothing` block: [(tmp, target), ...].
-_PENDING: contextvars.ContextVar[list | None] = contextvars.ContextVar("woodcam_pending", default=None)
+#: Renames deferred by an active :func:`all_or_nothing` block, and the list it yields of the
+#: targets renamed at its end: ([(tmp, target), ...], [target, ...]).
+_PENDING: contextvars.ContextVar[tuple[list, list] | None] = contextvars.ContextVar("woodcam_pending",
+                                                                                   default=None)
 
 
 def _commit(tmp: Path, path: Path, fsync: bool) -> None:
@@ -124,9 +129,9 @@ def _commit(tmp: Path, path: Path, fsync: bool) -> None:
     os.chmod(tmp, _FILE_MODE)  # mkstemp makes 0600; give the file ordinary permissions
     if fsync:
         _fsync_path(tmp)
-    pending = _PENDING.get()
-    if pending is not None:  # inside all_or_nothing(): renamed when the whole block succeeds
-        pending.append((tmp, path))
+    deferred = _PENDING.get()
+    if deferred is not None:  # inside all_or_nothing(): renamed when the whole block succeeds
+        deferred[0].append((tmp, path))
         return
     os.replace(tmp, path)
     if fsync:
@@ -134,22 +139,25 @@ def _commit(tmp: Path, path: Path, fsync: bool) -> None:
 
 
 @contextlib.contextmanager
-def all_or_nothing() -> Iterator[None]:
+def all_or_nothing() -> Iterator[list[Path]]:
     """Defer every atomic write made inside the block and rename them together at its end.
 
     Several writers (e.g. ``export_glb`` then ``export_obj``) become one unit: if anything in
     the block raises, every temporary file is removed and no target changes; on success the
     targets are renamed in the order they were written, except the *first* one (the primary
     file, e.g. the GLB), which is renamed last so its presence means the set is complete.
-    Blocks nest: an inner block joins the outer one.
+    Yields a list that then holds every target, in the order written. Blocks nest: an inner
+    block joins the outer one (and yields the outer's list, filled when that one ends).
     """
-    if _PENDING.get() is not None:
-        yield
+    outer = _PENDING.get()
+    if outer is not None:
+        yield outer[1]
         return
     pending: list = []
-    token = _PENDING.set(pending)
+    written: list[Path] = []
+    token = _PENDING.set((pending, written))
     try:
-        yield
+        yield written
     except BaseException:
         _PENDING.reset(token)
         for tmp, _ in pending:
@@ -167,6 +175,19 @@ def all_or_nothing() -> Iterator[None]:
         raise
     for folder in {path.parent for _, path in order}:
         _fsync_dir(folder)
+    written += [path for _, path in pending]
+
+
+@contextlib.contextmanager
+def apart() -> Iterator[None]:
+    """Atomic writes inside the block land at once even within :func:`all_or_nothing`: a cache
+    entry is of use whether or not the outputs it served are kept, and is read back before
+    the set ends."""
+    token = _PENDING.set(None)
+    try:
+        yield
+    finally:
+        _PENDING.reset(token)
 
 
 def _discard(tmp: Path) -> None:
@@ -320,6 +341,22 @@ def remove_stale(folder: str | os.PathLike, patterns: Iterable[str],
                                *carried]))
     write_text(manifest, json.dumps({"written_by": f"woodcam {kind}", "files": mine}, indent=1) + "\n")
     return gone
+
+
+@contextlib.contextmanager
+def run_outputs(folder: str | os.PathLike, *, kind: str) -> Iterator[list[Path]]:
+    """Write a command's outputs in ``folder`` as one set (:func:`all_or_nothing`: a run stopped
+    part way leaves the earlier run's files whole, never new ones beside old ones), then
+    remove the files the earlier ``kind`` run listed there and this one did not write again
+    (:func:`remove_stale`, no name patterns: only listed files go). Yields the list of the
+    files written, filled when the block ends (the list file is not among them). Not inside
+    another set: its files are renamed at that one's end, after the removal."""
+    if _PENDING.get() is not None:
+        raise WoodcamError("run_outputs: called inside all_or_nothing(); call it outside, around "
+                           "the whole set")
+    with all_or_nothing() as written:
+        yield written
+    remove_stale(folder, (), written, kind=kind)
 
 
 def write_figure(fig, path, **savefig_kwargs) -> Path:

@@ -32,7 +32,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, TypeVar
 
-from ._atomic import atomic_path
+from ._atomic import apart, atomic_path
 from .errors import WoodcamError, WoodcamWarning
 
 __all__ = ["CacheWarning", "cache_dir", "cache_root", "digest", "entry_path", "file_lock", "load_or_build"]
@@ -217,7 +217,7 @@ def load_or_build(path, *, load: Callable[[Path], T], build: Callable[[], T],
         value = build()
         _remove_folder_at(path, what, "cache entry")
         try:
-            with atomic_path(path) as tmp:
+            with apart(), atomic_path(path) as tmp:  # not part of the outputs' set it serves
                 save(value, tmp)
             prune(keep=path)
         except OSError as err:

@@ -202,3 +202,43 @@ def test_the_side_by_side_labels_never_overlap(tmp_path, longest, rng):
     from PIL import ImageDraw, ImageFont
 
     assert w > 3 * ImageDraw.Draw(Image.new("RGB", (1, 1))).textlength("0.123/12.34/0.456", font=ImageFont.load_default())
+
+
+def test_eval_appearance_outputs_land_as_one_set_and_a_rerun_removes_the_earlier_runs(tmp_path, monkeypatch,
+                                                                                      capsys):
+    """Each block's PNG was written as it came and results.json at the end: a Ctrl-C left a new
+    PNG beside an earlier run's results, and a rerun with fewer blocks kept the earlier run's
+    pictures. Now the run's files land together (or none do) and the earlier run's it does
+    not write again go, with a warning."""
+    import re
+
+    import woodcam.appearance.evaluation as evaluation
+    from woodcam._atomic import write_text
+    from woodcam.cli import main
+
+    seen = []
+
+    def held_out(block, field, **kwargs):
+        seen.append(block.name)
+        if len(seen) == stop_at[0]:
+            raise KeyboardInterrupt
+        return []
+
+    stop_at = [None]
+    monkeypatch.setattr(evaluation, "leave_one_face_out", held_out)
+    monkeypatch.setattr(evaluation, "side_by_side", lambda res, path, **kw: write_text(path, "a picture"))
+    monkeypatch.setattr(evaluation, "summarise", lambda res: {"all": {}})
+    run = ["eval", "appearance", "--out", str(tmp_path), "--quiet"]
+    assert main([*run, "builtin:flat-sawn", "builtin:rift"]) == 0
+    first = {p.name: (p.stat().st_ino, p.read_bytes()) for p in tmp_path.iterdir()}
+    assert {"flat-sawn.png", "rift.png", "results.json"} <= set(first)
+    stop_at[0] = len(seen) + 2  # a Ctrl-C at the second block
+    assert main([*run, "builtin:rift", "builtin:flat-sawn"]) == 130
+    assert {p.name: (p.stat().st_ino, p.read_bytes()) for p in tmp_path.iterdir()} == first
+    stop_at[0] = None
+    capsys.readouterr()
+    assert main([*run, "builtin:rift"]) == 0
+    assert re.search(r"warning: removed 1 file\(s\) of an earlier run .*: flat-sawn.png$",
+                     capsys.readouterr().err, re.M)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".woodcam-eval-appearance-files.json", "results.json",
+                                                          "rift.png"]

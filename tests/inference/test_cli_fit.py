@@ -1,5 +1,7 @@
 """``woodcam fit`` / ``woodcam eval rings`` through the CLI's parser (woodcam.cli.fit)."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -157,3 +159,50 @@ def test_eval_methods_all_is_every_method(block_dir, tmp_path, monkeypatch):
                  "--out", str(tmp_path)]) == 0
     assert main(["eval", "rings", str(folder), "--truth", str(truth), "--out", str(tmp_path)]) == 0
     assert asked == [list(METHODS), ["rbf", "radial"]]
+
+
+def test_eval_outputs_land_as_one_set_and_a_rerun_removes_the_earlier_runs(block_dir, tmp_path,
+                                                                            monkeypatch, capsys):
+    """A Ctrl-C at 7 s left block_0000_full.png alone (the table is written last), and a rerun
+    with fewer blocks left the earlier run's pictures beside the new table.md. Now the run's
+    files land together (or none do) and the earlier run's files it does not write again go,
+    named in a warning; only files a run listed (.woodcam-eval-files.json)."""
+    import json
+    import shutil
+
+    import woodcam.inference.fit as fit
+
+    folder, truth, _ = block_dir
+    other = tmp_path / "b1"
+    shutil.copytree(folder, other)
+    meta = json.loads((other / "block.json").read_text())
+    (other / "block.json").write_text(json.dumps({**meta, "name": "eq79b"}))
+    out = tmp_path / "ev"
+    out.mkdir()
+    (out / "notes_full.png").write_bytes(b"mine")  # named like an output; no run wrote it
+    ev = ["eval", "rings", "--methods", "radial", "--partial-faces", "none", "--out", str(out)]
+    assert main([*ev, str(folder), str(other), "--truth", str(truth), str(truth)]) == 0
+    both = {p.name: (p.stat().st_ino, p.read_bytes()) for p in out.iterdir()}
+    assert {"eq79_full.png", "eq79b_full.png", "table.md", "notes_full.png"} <= set(both)
+    real_fit, calls = fit.fit_block, []
+
+    def interrupted_at_the_second_block(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real_fit(*args, **kwargs)
+
+    monkeypatch.setattr(fit, "fit_block", interrupted_at_the_second_block)
+    capsys.readouterr()
+    assert main([*ev, str(other), str(folder), "--truth", str(truth), str(truth)]) == 130
+    assert capsys.readouterr().err == "woodcam: interrupted\n"
+    # eq79b_full.png was drawn before the Ctrl-C: nothing of the run landed (not even the same
+    # bytes again: the same files, inode for inode), no temporary is left
+    assert {p.name: (p.stat().st_ino, p.read_bytes()) for p in out.iterdir()} == both
+    monkeypatch.setattr(fit, "fit_block", real_fit)
+    assert main([*ev, str(folder), "--truth", str(truth)]) == 0
+    assert re.search(r"warning: removed 1 file\(s\) of an earlier run .*: eq79b_full.png$",
+                     capsys.readouterr().err, re.M)
+    assert sorted(p.name for p in out.iterdir()) == [".woodcam-eval-files.json", "eq79_full.png",
+                                                     "notes_full.png", "table.md"]
+    assert "eq79b" not in (out / "table.md").read_text()

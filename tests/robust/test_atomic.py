@@ -299,3 +299,19 @@ def test_remove_stale_in_a_folder_never_made_writes_no_list(tmp_path):
 
     assert remove_stale(tmp_path / "gallery", ["b*_*.png"], [], kind="benchmark-gallery") == []
     assert not (tmp_path / "gallery").exists()
+
+
+def test_all_or_nothing_names_what_it_wrote_and_a_cache_entry_stays_apart(tmp_path):
+    """The set's files are known at its end (run_outputs lists them for the next run), and a
+    cache entry written inside the set (a fit a command caches while writing its outputs) lands
+    at once: deferred, a second lookup in the same run missed it, and a Ctrl-C dropped it."""
+    from woodcam._atomic import apart, all_or_nothing, write_bytes
+
+    with all_or_nothing() as written:
+        write_bytes(tmp_path / "a.png", b"a")
+        with apart():
+            write_bytes(tmp_path / "entry.npz", b"cached")
+        assert (tmp_path / "entry.npz").read_bytes() == b"cached"
+        assert not (tmp_path / "a.png").exists() and written == []
+        write_bytes(tmp_path / "table.md", b"t")
+    assert written == [tmp_path / "a.png", tmp_path / "table.md"]

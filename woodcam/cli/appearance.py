@@ -46,6 +46,17 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     """Run ``eval appearance``; returns the exit status."""
+    from .._atomic import run_outputs
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    with run_outputs(args.out, kind="eval-appearance"):  # one set; an earlier run's other blocks go
+        _run(args)
+    print(f"wrote {args.out / 'results.json'} and one PNG per block")
+    return 0
+
+
+def _run(args) -> None:
+    """``eval appearance``' work: each block's faces held out, a PNG each and results.json."""
     from ..appearance.evaluation import (
         MODELS,
         leave_one_face_out,
@@ -54,7 +65,6 @@ def run(args) -> int:
     )
     from ..frames import check_face
 
-    args.out.mkdir(parents=True, exist_ok=True)
     report = {}
     for spec in args.block:
         block, field = open_block(spec, args.size_mm)
@@ -77,5 +87,3 @@ def run(args) -> int:
             f"{m} hist {s[m]['histogram']:.3f} spec {s[m]['spectrum']:.3f} patch {s[m]['patch']:.3f}"
             for m in MODELS if m in s))
     write_text(args.out / "results.json", json.dumps(report, indent=1))
-    print(f"wrote {args.out / 'results.json'} and one PNG per block")
-    return 0

@@ -53,7 +53,7 @@ def register(subparsers) -> None:
 def run_realistic(args) -> int:
     import json
 
-    from .._atomic import write_text
+    from .._atomic import run_outputs, write_text
     from .._progress import progress_bar, write
     from ..bench_realistic import FACE_SETS, SCENARIOS, confidence_markdown, markdown, score_block, summarise
 
@@ -69,26 +69,30 @@ def run_realistic(args) -> int:
              for kind, n in (("realistic", args.count), ("eq79", args.eq79)) for i in range(n)]
     rows = []
     plots = args.plots or args.confidence
-    for kind, i, s, f in progress_bar(tasks, desc="benchmark blocks", unit="block"):
-        row = score_block(args.seed, i, methods, s, f, kind, face_px=args.face_px, keep_lines=plots,
-                          knot_bend=args.knot_bend, knot_cones=args.knot_cones, residual=args.residual)
-        if plots:
-            from ..inference.evaluate import plot_planes
+    # one set, as eval rings' (whose table.md it replaces: one list of files): an interrupted
+    # run left new PNGs and records.json beside an earlier run's table.md
+    with run_outputs(out, kind="eval"):
+        for kind, i, s, f in progress_bar(tasks, desc="benchmark blocks", unit="block"):
+            row = score_block(args.seed, i, methods, s, f, kind, face_px=args.face_px, keep_lines=plots,
+                              knot_bend=args.knot_bend, knot_cones=args.knot_cones, residual=args.residual)
+            if plots:
+                from ..inference.evaluate import plot_planes
 
-            plot_planes(out / f"{row['name']}_{s}_{f}.png", row.pop("planes"),
-                        title=f"{row['name']} ({row['kind']}, {s}, {f}): black = true rings",
-                        confidence=args.confidence)
-        rows.append(row)
-        write(f"{row['name']} {row['kind']} {s} {f}: " + ", ".join(
-            f"{m} {row[m]['matched_1']:.0f}/{row[m]['matched_2']:.0f}% {row[m]['fit_s']:.1f}s" for m in methods))
-        write_text(out / "records.json", json.dumps(rows, indent=1))
-    table = markdown(summarise(rows, methods), methods)
-    conf = confidence_markdown(rows, methods)
-    if conf:
-        table += ("\nConfidence of the fits that carry one, on their predicted ring lines (a "
-                  "point is confident at >= 0.5):\n\n" + conf)
-    write_text(out / "table.md", f"seed {args.seed}, {args.count} blocks per row, methods "
-               f"{', '.join(methods)}: matched ring lines within 1 / 2 mm on 7 cut planes\n\n" + table)
+                plot_planes(out / f"{row['name']}_{s}_{f}.png", row.pop("planes"),
+                            title=f"{row['name']} ({row['kind']}, {s}, {f}): black = true rings",
+                            confidence=args.confidence)
+            rows.append(row)
+            write(f"{row['name']} {row['kind']} {s} {f}: " + ", ".join(
+                f"{m} {row[m]['matched_1']:.0f}/{row[m]['matched_2']:.0f}% {row[m]['fit_s']:.1f}s"
+                for m in methods))
+        write_text(out / "records.json", json.dumps(rows, indent=1))  # once: the set lands at the end
+        table = markdown(summarise(rows, methods), methods)
+        conf = confidence_markdown(rows, methods)
+        if conf:
+            table += ("\nConfidence of the fits that carry one, on their predicted ring lines (a "
+                      "point is confident at >= 0.5):\n\n" + conf)
+        write_text(out / "table.md", f"seed {args.seed}, {args.count} blocks per row, methods "
+                   f"{', '.join(methods)}: matched ring lines within 1 / 2 mm on 7 cut planes\n\n" + table)
     print(table)
     print(f"wrote {out / 'table.md'} and {out / 'records.json'}")
     return 0

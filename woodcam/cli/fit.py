@@ -86,7 +86,6 @@ def run_fit(args) -> int:
 
 def run_eval(args) -> int:
     from ..fields.grid import GridField
-    from ..inference.evaluate import benchmark
 
     # 'all' is every method (it gave the default rbf,radial)
     methods = comma_names(args.methods, "--methods", METHODS, all_=True) or list(METHODS)
@@ -100,6 +99,19 @@ def run_eval(args) -> int:
             )
         for b, t in zip(blocks, args.truth):
             b.true_field = GridField.load(t)
+    from .._atomic import run_outputs
+
+    # one set: a Ctrl-C left block_0000_full.png alone, and a rerun mixed its files with an
+    # earlier run's table and pictures (eval realistic writes table.md too: one list)
+    with run_outputs(args.out, kind="eval"):
+        _run_eval(args, blocks, methods, partial)
+    return 0
+
+
+def _run_eval(args, blocks, methods, partial) -> None:
+    """``eval rings``' work: the known blocks on cut planes, the others held out face by face."""
+    from ..inference.evaluate import benchmark
+
     known = [b for b in blocks if b.true_field is not None]
     real = [b for b in blocks if b.true_field is None]
     if args.seed is not None and not real:  # before the work: nothing silently dropped
@@ -143,4 +155,3 @@ def run_eval(args) -> int:
             out = Path(args.out)
             print("wrote " + ", ".join(str(out / f"{fit_on.name}_{kind}")
                                        for kind in ["holdout.md", *(f"{m}.png" for m in methods)]))
-    return 0
