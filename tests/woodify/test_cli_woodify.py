@@ -303,3 +303,21 @@ def test_crack_density_per_bark_area_does_not_depend_on_flatness(tmp_path):
         shares[name] = _crack_share(tmp_path / name / "grown.glb")
     assert 0.05 < shares["stem"] < 0.4, shares
     assert 0.6 < shares["disc"] / shares["stem"] < 1.6, shares
+
+
+def test_a_mesh_saved_in_metres_is_named_as_such(tmp_path, capsys):
+    """A 40 mm box saved as 0.04 units grew, silently, into a 0.06 mm speck (mesh files carry no
+    units and are read as mm, whatever --units says): it is warned about, with the unit it looks
+    saved in and the fix; the same box in mm grows silently."""
+    trimesh.creation.box((0.04, 0.04, 0.03)).export(tmp_path / "m.stl")
+    for units in ("mm", "inch"):
+        assert main(["woodify", str(tmp_path / "m.stl"), "--years", "5", "--resolution", "16",
+                     "--cracks", "none", "--units", units, "--out", str(tmp_path / "o")]) == 0
+        (msg,) = [line for line in capsys.readouterr().err.splitlines() if "metres" in line]
+        assert msg.startswith("woodcam: warning: part '" + str(tmp_path / "m.stl") + "'")
+        assert "0.04x0.04x0.03 mm" in msg and "40x40x30 mm" in msg
+        assert "scale it by 1000" in msg and "--units" in msg
+    trimesh.creation.box((40.0, 40.0, 30.0)).export(tmp_path / "mm.stl")
+    assert main(["woodify", str(tmp_path / "mm.stl"), "--years", "5", "--resolution", "16",
+                 "--cracks", "none", "--out", str(tmp_path / "o2")]) == 0
+    assert "warning" not in capsys.readouterr().err

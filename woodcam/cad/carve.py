@@ -19,7 +19,7 @@ import numpy as np
 
 from .._types import ArrayLike
 from ..errors import WoodcamError, WoodcamWarning
-from ..frames import check_size
+from ..frames import FOREIGN_GLTF_METRES_BELOW, check_size
 from ..tolerances import OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG
 from ..units import MM_PER_UNIT
 from .parts import load_part
@@ -166,14 +166,27 @@ def carve(
     )
 
 
-def units_hint(lo, hi, size_mm, fix: str = UNITS_FIX) -> str | None:
+def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX) -> str | None:
     """What to say when a part with bounds ``lo, hi (3,)`` mm would still fit the block
     ``size_mm (3,)`` 25.4 times larger (None otherwise): STL and OBJ carry no units, so a part
     exported in inches is read 25.4 x too small and carved or placed as a speck.
 
-    fix : how the caller's user scales the part by 25.4 (the command's option, or the library
-        call); the CLI's ``--place`` is no use to ``woodcam place`` or a library caller."""
+    Without a block (``size_mm`` None: ``woodcam woodify`` grows a mesh alone) the part's own
+    size decides: under :data:`woodcam.frames.FOREIGN_GLTF_METRES_BELOW` mm along its longest
+    side (no router carves anything smaller; the size below which a foreign glTF is read as
+    metres) it is taken for a part in metres, 1000 x too small.
+
+    fix : how the caller's user scales the part by 25.4 (or, without a block, by 1000: the
+        command's option, or the library call); the CLI's ``--place`` is no use to
+        ``woodcam place`` or a library caller."""
     extent = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
+    if size_mm is None:
+        if not 0 < float(np.max(extent)) < FOREIGN_GLTF_METRES_BELOW:
+            return None
+        return (f"the part is only {'x'.join(f'{v:.3g}' for v in extent)} mm: part files are read "
+                f"as millimetres (STL and OBJ carry no units), and nothing that small is carved; "
+                f"it looks modelled in metres (1000 times larger: "
+                f"{'x'.join(f'{v * 1e3:.3g}' for v in extent)} mm): {fix}")
     size = np.asarray(size_mm, dtype=float)
     if not np.all(np.sort(extent) * MM_PER_UNIT["inch"] <= np.sort(size)):
         return None

@@ -192,6 +192,9 @@ _SPEC_SIZE = re.compile(r"^((?:builtin|log):[^~]*:)([^:~]+)(~.*)?$")
 
 #: Commands whose printed summary (volumes, suggested --place options) follows --units.
 _SUMMARY_IN_UNITS = {"bake", "gcode", "place"}
+#: Commands that read every mesh file as mm whatever --units says (woodify: the mesh to grow and
+#: its obstacles; a user reading "--units inch" took it for the mesh's unit).
+_MESHES_IN_MM = {"woodify"}
 
 
 def add_units_option(p: argparse.ArgumentParser, command: str) -> None:
@@ -203,8 +206,9 @@ def add_units_option(p: argparse.ArgumentParser, command: str) -> None:
     p.add_argument("--units", choices=("mm", "inch"), default="mm",
                    help=f"unit of {', '.join(names)}"
                    + (" and of the printed summary" if command in _SUMMARY_IN_UNITS else "")
-                   + "; options whose names carry their unit (-mm, -per-mm), defaults and the "
-                   "files written stay mm (default mm)")
+                   + "; options whose names carry their unit (-mm, -per-mm), defaults"
+                   + (", the meshes read" if command in _MESHES_IN_MM else "")
+                   + " and the files written stay mm (default mm)")
 
 
 def _num(v: float) -> str:

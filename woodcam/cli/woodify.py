@@ -27,7 +27,8 @@ def register(subparsers) -> argparse.ArgumentParser:
         "woodify:OUT/field.npz), grown surfaces, ring sections and a bark-textured grown.glb. "
         "Lengths in mm, time in years.")
     p.add_argument("part", help="input: a .py part script, .step, or a closed .stl/.obj/.ply/.glb mesh "
-                   "(mm); a PLY may paint growth per vertex: properties gain (speed gain) and "
+                   "(mesh files are read as mm whatever --units says; one under 1 mm long gets a warning that it "
+                   "looks saved in metres); a PLY may paint growth per vertex: properties gain (speed gain) and "
                    "dir_x, dir_y, dir_z (growth direction, length = strength < 1)")
     p.add_argument("--years", type=float, required=True, help="years to grow (> 0)")
     add_out_option(p, "field.npz, grown.glb, surfaces and section PNGs, woodify.json, listed in "
@@ -43,7 +44,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--up", default="0,0,1", metavar="X,Y,Z",
                    type=vector_type("--up", example="0,0,1", nonzero=True), help="direction the eccentric growth favours (unit-normalised; default 0,0,1)")
     p.add_argument("--obstacle", type=Path, action="append", default=[], metavar="MESH",
-                   help="closed obstacle mesh or part (mm); repeatable")
+                   help="closed obstacle mesh or part (read as mm); repeatable")
     p.add_argument("--brushes", type=Path, default=None, metavar="JSON",
                    help="growth brushes (centre_mm, radius_mm, gain, direction, strength)")
     p.add_argument("--resolution", type=int, default=128,
@@ -103,6 +104,7 @@ def _load_mesh(path: str):
         except Exception as err:  # trimesh raises many kinds for unreadable files
             raise WoodcamError(f"part {path!r} could not be read as a mesh: {err}") from err
         textured = loaded if getattr(loaded.visual, "uv", None) is not None else None
+        _warn_units(loaded, path)
         paint = _ply_paint(loaded, path)
         if paint:
             if not loaded.is_watertight:
@@ -120,6 +122,21 @@ def _load_mesh(path: str):
     solid = load_part(path)
     m = solid.to_mesh()
     return trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts)), None, {}
+
+
+def _warn_units(mesh, path: str) -> None:
+    """Warn when a mesh file's size says it was saved in metres: it is read as mm, and a 40 mm
+    box saved as 0.04 grew, silently, into a 0.06 mm speck (woodcam.cad.carve.units_hint)."""
+    import warnings
+
+    from ..cad.carve import units_hint
+    from ..errors import WoodcamWarning
+
+    lo, hi = mesh.bounds
+    hint = units_hint(lo, hi, None, "scale it by 1000 in your CAD program or export it in "
+                      "mm (--units converts only the lengths typed as options, never the mesh)")
+    if hint:
+        warnings.warn(f"part {path!r}: {hint}", WoodcamWarning, stacklevel=3)
 
 
 def _ply_paint(mesh, path) -> dict:
