@@ -171,9 +171,12 @@ def _atomic(path: Path, write) -> Path:
 def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=None,
                   block_centre_mm=None, cracks="stress", crack_region=None, crack_years=5,
                   crack_render="material", crack_threshold=None, relief=0.3, seed=0,
-                  atomic=_atomic, progress=None):
+                  atomic=_atomic, stage=None):
     """Write the products of a :class:`~woodcam.woodify.Woodification` into ``out`` (module
-    docstring); returns (files written, summary dict)."""
+    docstring); returns (files written, summary dict). ``stage(name)``: a context manager round
+    each of "surface and cracks", "bark and surfaces" and "ring sections" (a
+    :meth:`woodcam._progress.StageBar.stage`; default none)."""
+    from contextlib import nullcontext
     import numpy as np
     from PIL import Image
 
@@ -192,6 +195,7 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
     from ..woodify.cracks import simulate_cracks
     from ..woodify.surfaces import barycentric_on, carry, section_image
 
+    stage = stage or (lambda name: nullcontext())
     out = Path(out)
     files = []
     Y = res.years
@@ -199,129 +203,128 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
                "grid": {"shape": list(res.front.grid.shape), "spacing_mm": res.front.grid.spacing_mm,
                         "origin_mm": list(res.front.grid.origin_mm)},
                "timings": dict(res.timings)}
-    t = time.perf_counter()
-    crack_edges = np.zeros((0, 2), int)
-    if cracks != "none":
-        n = int(crack_years)
-        if n < 1:
-            raise WoodcamError(f"crack_years (--crack-years) must be >= 1; got {crack_years!r}")
-        ys = [max(Y - n + k, 0.0) for k in range(n + 1)]
-        ys = sorted(set(ys))
-        cs = simulate_cracks(res, ys, pattern=cracks, region=crack_region, threshold=crack_threshold,
-                             relief=relief, seed=seed)
-        mesh, origins, tri = cs.mesh, cs.origins_mm, cs.tri
-        crack_edges = cs.crack_edges
-        summary["cracks"] = {"pattern": cracks, "log": cs.log, "count": len(cs.crack_directions),
-                             "render": crack_render}
-    else:
-        mesh = res.surface(Y)
-        origins, tri = res.origins(mesh.vertices)
-    summary["timings"]["cracks_s" if cracks != "none" else "surface_s"] = time.perf_counter() - t
-    if progress:
-        progress()
-    # persistent texture: the input's own UVs and image, else cylindrical bark coordinates
-    image = None
-    if textured is not None:
-        _, bary = barycentric_on(textured, origins, tri)
-        uv = carry(textured, textured.visual.uv, tri, bary)
-        mat = textured.visual.material
-        img = getattr(mat, "baseColorTexture", None) or getattr(mat, "image", None)
-        image = np.asarray(img.convert("RGB")) if img is not None else None
-    procedural = image is None
-    if procedural:
-        up = res.field.stem_axis
-        c = res.mesh.centroid
+    with stage("surface and cracks"):
+        t = time.perf_counter()
+        crack_edges = np.zeros((0, 2), int)
+        if cracks != "none":
+            n = int(crack_years)
+            if n < 1:
+                raise WoodcamError(f"crack_years (--crack-years) must be >= 1; got {crack_years!r}")
+            ys = [max(Y - n + k, 0.0) for k in range(n + 1)]
+            ys = sorted(set(ys))
+            cs = simulate_cracks(res, ys, pattern=cracks, region=crack_region, threshold=crack_threshold,
+                                 relief=relief, seed=seed)
+            mesh, origins, tri = cs.mesh, cs.origins_mm, cs.tri
+            crack_edges = cs.crack_edges
+            summary["cracks"] = {"pattern": cracks, "log": cs.log, "count": len(cs.crack_directions),
+                                 "render": crack_render}
+        else:
+            mesh = res.surface(Y)
+            origins, tri = res.origins(mesh.vertices)
+        summary["timings"]["cracks_s" if cracks != "none" else "surface_s"] = time.perf_counter() - t
+    with stage("bark and surfaces"):
+        # persistent texture: the input's own UVs and image, else cylindrical bark coordinates
+        image = None
+        if textured is not None:
+            _, bary = barycentric_on(textured, origins, tri)
+            uv = carry(textured, textured.visual.uv, tri, bary)
+            mat = textured.visual.material
+            img = getattr(mat, "baseColorTexture", None) or getattr(mat, "image", None)
+            image = np.asarray(img.convert("RGB")) if img is not None else None
+        procedural = image is None
+        if procedural:
+            up = res.field.stem_axis
+            c = res.mesh.centroid
 
-        def mean_radius(v):
-            d = v - c
-            return max(float(np.linalg.norm(d - np.outer(d @ up, up), axis=1).mean()), 1e-3)
+            def mean_radius(v):
+                d = v - c
+                return max(float(np.linalg.norm(d - np.outer(d @ up, up), axis=1).mean()), 1e-3)
 
-        uv = cylindrical_uv(origins, up, c, 2 * np.pi * mean_radius(res.mesh.vertices))
-        # the carried coordinates stretch with the growth; lay as many bark tiles round the
-        # stem as the grown girth holds, as one picture
-        k = max(1, int(round(mean_radius(mesh.vertices) / mean_radius(res.mesh.vertices))))
-        uv = uv * k
-        rows = max(1, int(np.ceil(uv[:, 1].max())))
-        image = np.tile(bark_image(256, seed), (rows, k, 1))
-        uv = uv / np.array([k, rows])
-    h = res.front.grid.spacing_mm
-    if crack_render == "groove" and len(crack_edges):
-        width = np.zeros(len(mesh.vertices))
-        width[crack_edges.ravel()] = 1.0
-        mesh = groove(mesh, width, 0.6 * h)
-    if procedural:
-        # Cylindrical coordinates squeeze every face that does not face away from the stem (the
-        # top of a flat lid, a rim grown from a sharp edge) to a sliver of the picture: cracks
-        # drawn there crowded one band, and the band covered most of the bark. The bark is
-        # moved into an atlas of even texel density first, so a crack darkens the same
-        # share of the bark per mm wherever it runs.
-        from ..bake import rebake_texture
+            uv = cylindrical_uv(origins, up, c, 2 * np.pi * mean_radius(res.mesh.vertices))
+            # the carried coordinates stretch with the growth; lay as many bark tiles round the
+            # stem as the grown girth holds, as one picture
+            k = max(1, int(round(mean_radius(mesh.vertices) / mean_radius(res.mesh.vertices))))
+            uv = uv * k
+            rows = max(1, int(np.ceil(uv[:, 1].max())))
+            image = np.tile(bark_image(256, seed), (rows, k, 1))
+            uv = uv / np.array([k, rows])
+        h = res.front.grid.spacing_mm
+        if crack_render == "groove" and len(crack_edges):
+            width = np.zeros(len(mesh.vertices))
+            width[crack_edges.ravel()] = 1.0
+            mesh = groove(mesh, width, 0.6 * h)
+        if procedural:
+            # Cylindrical coordinates squeeze every face that does not face away from the stem (the
+            # top of a flat lid, a rim grown from a sharp edge) to a sliver of the picture: cracks
+            # drawn there crowded one band, and the band covered most of the bark. The bark is
+            # moved into an atlas of even texel density first, so a crack darkens the same
+            # share of the bark per mm wherever it runs.
+            from ..bake import rebake_texture
 
-        baked = rebake_texture(mesh, corner_uv(uv, mesh.faces), image,
-                               texels_per_mm=BARK_TEXELS_PER_VOXEL / h)
-        bark = baked.mesh
-        if crack_render == "material" and len(crack_edges):
-            atlas = np.asarray(bark.visual.material.baseColorTexture)
-            ah, aw = atlas.shape[:2]
-            xy = np.asarray(bark.visual.uv) * [aw, ah]
-            xy[:, 1] = ah - xy[:, 1]
-            width_px = max(1, round(CRACK_WIDTH_VOXELS * h * baked.texels_per_mm))
-            atlas = paint_crack_faces(atlas, xy[bark.faces], mesh.faces, crack_edges, width_px)
-            bark.visual.material.baseColorTexture = Image.fromarray(atlas)
-    else:
-        # the input's own picture and coordinates stay as they were given
-        if crack_render == "material" and len(crack_edges):
-            image = paint_cracks(image, uv, crack_edges)
-        bark = textured_mesh(mesh, uv, image)
-    # the block cut from the grown object: default its bounding box
-    lo, hi = mesh.bounds
-    size = tuple(hi - lo) if block_size_mm is None else tuple(block_size_mm)
-    centre = tuple((lo + hi) / 2) if block_centre_mm is None else tuple(block_centre_mm)
-    placed = res.field.placed(size, centre)
-    # a woodcam GLB is in the block frame (its metadata says so, and `review --block
-    # woodify:field.npz` reads it so): object = block_origin + R @ block, so block = R^T (object
-    # - block_origin); the origin is kept in the metadata to put it back over the input mesh
-    bark.vertices = (np.asarray(bark.vertices) - placed.block_origin_mm) @ placed.rotation
-    # export_glb writes atomically itself (through atomic(), its temporary would be renamed
-    # before export_glb's own one, inside the caller's all_or_nothing)
-    files.append(export_glb(bark, out / "grown.glb", metadata={
-        "woodify": {"years": Y, "speed": res.speed.to_dict(),
-                    "block_origin_mm": placed.block_origin_mm.tolist(),
-                    "block_rotation": placed.rotation.tolist()}}))
-    files.append(placed.save(out / "field.npz"))
-    summary["block"] = {"size_mm": list(size), "centre_mm": list(centre)}
-    for y in surface_years:
-        surf = res.surface(float(y))
-        files.append(atomic(out / f"surface_y{float(y):g}.stl", lambda p, s=surf: s.export(p)))
-    if progress:
-        progress()
-    # ring sections through the block centre (seed Fig. 5.1)
-    g = res.front.grid
-    ext = (np.asarray(g.shape) - 1) * g.spacing_mm
-    o = np.asarray(g.origin_mm)
-    cc = np.asarray(centre)
-    px = 640
-    f = res.field
+            baked = rebake_texture(mesh, corner_uv(uv, mesh.faces), image,
+                                   texels_per_mm=BARK_TEXELS_PER_VOXEL / h)
+            bark = baked.mesh
+            if crack_render == "material" and len(crack_edges):
+                atlas = np.asarray(bark.visual.material.baseColorTexture)
+                ah, aw = atlas.shape[:2]
+                xy = np.asarray(bark.visual.uv) * [aw, ah]
+                xy[:, 1] = ah - xy[:, 1]
+                width_px = max(1, round(CRACK_WIDTH_VOXELS * h * baked.texels_per_mm))
+                atlas = paint_crack_faces(atlas, xy[bark.faces], mesh.faces, crack_edges, width_px)
+                bark.visual.material.baseColorTexture = Image.fromarray(atlas)
+        else:
+            # the input's own picture and coordinates stay as they were given
+            if crack_render == "material" and len(crack_edges):
+                image = paint_cracks(image, uv, crack_edges)
+            bark = textured_mesh(mesh, uv, image)
+        # the block cut from the grown object: default its bounding box
+        lo, hi = mesh.bounds
+        size = tuple(hi - lo) if block_size_mm is None else tuple(block_size_mm)
+        centre = tuple((lo + hi) / 2) if block_centre_mm is None else tuple(block_centre_mm)
+        placed = res.field.placed(size, centre)
+        # a woodcam GLB is in the block frame (its metadata says so, and `review --block
+        # woodify:field.npz` reads it so): object = block_origin + R @ block, so block = R^T (object
+        # - block_origin); the origin is kept in the metadata to put it back over the input mesh
+        bark.vertices = (np.asarray(bark.vertices) - placed.block_origin_mm) @ placed.rotation
+        # export_glb writes atomically itself (through atomic(), its temporary would be renamed
+        # before export_glb's own one, inside the caller's all_or_nothing)
+        files.append(export_glb(bark, out / "grown.glb", metadata={
+            "woodify": {"years": Y, "speed": res.speed.to_dict(),
+                        "block_origin_mm": placed.block_origin_mm.tolist(),
+                        "block_rotation": placed.rotation.tolist()}}))
+        files.append(placed.save(out / "field.npz"))
+        summary["block"] = {"size_mm": list(size), "centre_mm": list(centre)}
+        for y in surface_years:
+            surf = res.surface(float(y))
+            files.append(atomic(out / f"surface_y{float(y):g}.stl", lambda p, s=surf: s.export(p)))
+    with stage("ring sections"):
+        # ring sections through the block centre (seed Fig. 5.1)
+        g = res.front.grid
+        ext = (np.asarray(g.shape) - 1) * g.spacing_mm
+        o = np.asarray(g.origin_mm)
+        cc = np.asarray(centre)
+        px = 640
+        f = res.field
 
-    def inside(p):
-        return f.arrival(p) <= 0
+        def inside(p):
+            return f.arrival(p) <= 0
 
-    for name, (a, b) in {"xz": (0, 2), "xy": (0, 1)}.items():
-        origin = cc.copy()
-        origin[a], origin[b] = o[a], o[b]
-        u = np.zeros(3)
-        v = np.zeros(3)
-        u[a], v[b] = ext[a], ext[b]
-        rows = max(int(px * ext[b] / ext[a]), 16)
-        img = section_image(f, f.no_wood, inside, origin, u, v, (rows, px), years_final=Y)
-        files.append(atomic(out / f"section_{name}.png", lambda p, im=img: Image.fromarray(im).save(p, format="PNG")))
+        for name, (a, b) in {"xz": (0, 2), "xy": (0, 1)}.items():
+            origin = cc.copy()
+            origin[a], origin[b] = o[a], o[b]
+            u = np.zeros(3)
+            v = np.zeros(3)
+            u[a], v[b] = ext[a], ext[b]
+            rows = max(int(px * ext[b] / ext[a]), 16)
+            img = section_image(f, f.no_wood, inside, origin, u, v, (rows, px), years_final=Y)
+            files.append(atomic(out / f"section_{name}.png", lambda p, im=img: Image.fromarray(im).save(p, format="PNG")))
     return files, summary
 
 
 def run(args) -> int:
     """Run a parsed ``woodify`` command; returns the exit status."""
     import numpy as np
-    from .._progress import progress_bar
+    from .._progress import StageBar
 
     from ..woodify import load_brushes, woodify
 
@@ -342,31 +345,34 @@ def run(args) -> int:
     region = args.crack_region
     if region is not None and not region[3] > 0:
         raise UsageError(f"--crack-region X,Y,Z,R needs a radius R > 0; got R = {region[3]:g} mm")
-    steps = progress_bar(total=4, desc="woodify", unit="stage", leave=False)
-    mesh, textured, painted = _load_mesh(args.part)
-    obstacles = [_load_mesh(str(o))[0] for o in args.obstacle]
-    brushes = load_brushes(args.brushes) if args.brushes else ()
-    steps.update(1)
-    res = woodify(mesh, args.years, growth_mm=args.growth, time_scale_years=args.time_scale,
-                  shape=args.shape, eccentricity=args.eccentricity, up=args.up, obstacles=obstacles,
-                  brushes=brushes, resolution=args.resolution, method=args.method, **painted)
-    steps.update(1)
     from .._atomic import all_or_nothing, manifest_path, remove_stale
 
-    # one unit: a Ctrl-C leaves the last run's products, never new ones beside old ones (a grown.glb
-    # of 13 years beside a woodify.json of 11)
-    with all_or_nothing():
-        files, summary = _write_outputs(
-            res, args.out, textured=textured, surface_years=years, block_size_mm=args.block_size,
-            block_centre_mm=args.block_centre, cracks=args.cracks, crack_region=region,
-            crack_years=args.crack_years, crack_render=args.crack_render,
-            crack_threshold=args.crack_threshold, relief=args.relief, seed=args.seed,
-            atomic=_atomic, progress=lambda: steps.update(1))
-        steps.close()
-        summary["total_s"] = time.perf_counter() - t0
-        summary["input"] = str(args.part)
-        _atomic(Path(args.out) / "woodify.json",
-                lambda p: p.write_text(json.dumps(summary, indent=1, default=float)))
+    # A bar of stages whose timer draws it 2 s in even mid-stage: the bar of plain updates this
+    # was drew nothing until a stage ended (a 13 s growth on a 160^3 grid showed none at all).
+    with StageBar(["read the mesh", "grow", "surface and cracks", "bark and surfaces", "ring sections"],
+                  desc="woodify", leave=False) as bar:
+        with bar.stage("read the mesh"):
+            mesh, textured, painted = _load_mesh(args.part)
+            obstacles = [_load_mesh(str(o))[0] for o in args.obstacle]
+            brushes = load_brushes(args.brushes) if args.brushes else ()
+        with bar.stage("grow"):
+            res = woodify(mesh, args.years, growth_mm=args.growth, time_scale_years=args.time_scale,
+                          shape=args.shape, eccentricity=args.eccentricity, up=args.up,
+                          obstacles=obstacles, brushes=brushes, resolution=args.resolution,
+                          method=args.method, **painted)
+        # one unit: a Ctrl-C leaves the last run's products, never new ones beside old ones (a
+        # grown.glb of 13 years beside a woodify.json of 11)
+        with all_or_nothing():
+            files, summary = _write_outputs(
+                res, args.out, textured=textured, surface_years=years, block_size_mm=args.block_size,
+                block_centre_mm=args.block_centre, cracks=args.cracks, crack_region=region,
+                crack_years=args.crack_years, crack_render=args.crack_render,
+                crack_threshold=args.crack_threshold, relief=args.relief, seed=args.seed,
+                atomic=_atomic, stage=bar.stage)
+            summary["total_s"] = time.perf_counter() - t0
+            summary["input"] = str(args.part)
+            _atomic(Path(args.out) / "woodify.json",
+                    lambda p: p.write_text(json.dumps(summary, indent=1, default=float)))
     files = [*files, Path(args.out) / "woodify.json"]  # the summary names every file written
     # an earlier run's surfaces at other years are not this run's: they went on piling up
     remove_stale(args.out, ["surface_y*.stl"], files, kind="woodify")
