@@ -43,7 +43,9 @@ REVIEW_VOXELS_RANGE = (1_000, 8_000_000)
 
 #: Grid nodes along the longest side of a woodify grid (``woodify(resolution=)``, ``woodcam
 #: woodify --resolution``), the one home of the range both read: 1024^3 nodes is the most one
-#: arrival-time grid may hold; under 16 the input is a few nodes across. Not a MAX_ guard.
+#: arrival-time grid may hold; under 16 the input is a few nodes across. Not a MAX_ guard: the
+#: memory a grid needs is (MAX_GRID_CELLS, MAX_ALLOC_BYTES at woodcam.woodify.grow's
+#: WOODIFY_BYTES_PER_NODE), so 1024 passes for a slender input and not for a cube.
 WOODIFY_RESOLUTION_RANGE = (16, 1024)
 
 _DEFAULTS = {name: value for name, value in globals().items() if name.startswith("MAX_")}

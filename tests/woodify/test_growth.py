@@ -194,3 +194,25 @@ def test_inside_out_or_reordered_corners_grow_the_same_field():
         assert np.array_equal(T[within], T0[within])
         s = r.surface(20)
         assert np.array_equal(s.vertices, grown.vertices) and np.array_equal(s.faces, grown.faces)
+
+
+def test_a_grid_too_big_for_memory_is_refused_before_it_is_allocated(monkeypatch):
+    """A fine grid ran into the OOM killer, not an error: about 180 B a node live at once (1.83 GB
+    on 200^3), so a cube at the top resolution, 1024, asked ~190 GB. The grid is sized against
+    MAX_GRID_CELLS and MAX_ALLOC_BYTES first, with the resolution and the fix named."""
+    import woodcam.woodify.grow as grow_module
+
+    def no_growth(*args, **kwargs):
+        raise AssertionError("the grid was allocated")
+
+    monkeypatch.setattr(grow_module, "propagate", no_growth)
+    box = trimesh.creation.box((40.0, 40.0, 40.0))
+    with pytest.raises(WoodcamError, match=r"resolution 1024 \(a \d+x\d+x1024 grid\).*MAX_GRID_CELLS.*"
+                                           r"lower the resolution"):
+        woodify(box, 20, resolution=1024)
+    monkeypatch.setenv("WOODCAM_MAX_ALLOC_BYTES", str(100 * 24 ** 3))
+    with pytest.raises(WoodcamError, match=r"resolution 24 .*MAX_ALLOC_BYTES.*WOODCAM_MAX_ALLOC_BYTES="):
+        woodify(box, 20, resolution=24)
+    monkeypatch.setenv("WOODCAM_MAX_ALLOC_BYTES", str(200 * 24 ** 3))
+    with pytest.raises(AssertionError, match="allocated"):  # within the limit: it grows
+        woodify(box, 20, resolution=24)

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import WoodcamError
-from ..limits import MAX_BLOCK_SIZE_MM
+from ..limits import MAX_BLOCK_SIZE_MM, check_grid
 from .brushes import Brush, check_vertex_paint, paint
 from .field import WoodifiedField
 from .front import Front, Method, VoxelGrid, check_resolution, check_watertight, propagate
@@ -30,6 +30,13 @@ if TYPE_CHECKING:
 
 #: Nodes of margin kept between the final grown surface and the grid border.
 _MARGIN_NODES = 4
+
+#: Peak memory (bytes) of a woodify run per grid node, measured: ``woodcam woodify`` of a sphere
+#: (stress cracks, default products) peaked at 0.60 GB on a 100^3 grid and 1.83 GB on 200^3,
+#: 176 B a node: the front's arrays (arrival, distance, closest point, triangle, inside: ~40 B)
+#: and the back-traces' gradients and fills (float64 grids, ~70 B) live at once. A 1024^3 grid
+#: (the top of WOODIFY_RESOLUTION_RANGE, a cube-shaped input) would ask ~190 GB: refused ahead.
+WOODIFY_BYTES_PER_NODE = 180
 
 
 @dataclass
@@ -168,6 +175,10 @@ def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: 
     h_est = ext / (resolution - 1 - 2 * _MARGIN_NODES)
     pad = reach + _MARGIN_NODES * h_est
     grid = VoxelGrid.around(lo - pad, hi + pad, resolution)
+    # refused before any of it is allocated: the OOM killer, not an error, ended a fine grid
+    check_grid(grid.shape, f"woodify's grid at resolution {resolution}",
+               itemsize=WOODIFY_BYTES_PER_NODE,
+               fix="lower the resolution (--resolution on the command line; default 128)")
     obstacles = [check_watertight(o, f"obstacles[{i}]") for i, o in enumerate(obstacles)]
     paint_fn = None
     if strokes or vertex_gain is not None or vertex_direction is not None:
