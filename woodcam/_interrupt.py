@@ -52,9 +52,12 @@ def _on_sigint(signum, frame) -> None:
 def handling() -> Iterator[None]:
     """Record every Ctrl-C of the block (the flag starts clear) and restore the previous SIGINT
     handler and a clear flag at its end. A no-op off the main thread (signals cannot be handled
-    there)."""
+    there), and where SIGINT is not Python's own handler: a parent that ignored it (``nohup``,
+    ``cmd &`` in a script) meant the command to run on through Ctrl-C, an embedding program's
+    handler is its own (and one set outside Python reads as None, which cannot be restored)."""
     global _requested
-    if threading.current_thread() is not threading.main_thread():
+    if (threading.current_thread() is not threading.main_thread()
+            or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
         yield
         return
     _requested = False

@@ -217,6 +217,32 @@ def test_a_ctrl_c_a_library_swallowed_still_ends_the_command(after, monkeypatch,
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # pytest's own again
 
 
+def test_a_command_whose_parent_ignored_ctrl_c_runs_on_through_it():
+    """A parent that set SIGINT to be ignored (``nohup``, ``cmd &`` in a script) means the command
+    runs on through Ctrl-C, as Python leaves it: woodcam installed its own handler anyway and
+    ended with 'interrupted', exit 130. It leaves the ignore in place, before, during and after."""
+    import subprocess
+    import sys
+
+    code = (
+        "import os, signal, time\n"
+        "signal.signal(signal.SIGINT, signal.SIG_IGN)\n"
+        "import woodcam.cli.bake as bake_cli\n"
+        "from woodcam.cli import main\n"
+        "def command(args):\n"
+        "    os.kill(os.getpid(), signal.SIGINT)\n"
+        "    time.sleep(0.2)\n"
+        "    return 0\n"
+        "bake_cli.run_blocks = command\n"
+        "rc = main(['blocks'])\n"
+        "print(rc, signal.getsignal(signal.SIGINT) is signal.SIG_IGN)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["0", "True"]
+    assert "interrupted" not in done.stderr
+
+
 def test_the_interrupt_flag_lives_for_one_command_only(monkeypatch, capsys):
     """The flag is clear at each command's start and after its end, so a Ctrl-C of one run never
     ends the next (main() runs many times in one process: tests, notebooks), and outside a
