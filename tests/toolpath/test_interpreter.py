@@ -114,6 +114,9 @@ def test_endsub_with_a_value_returns_it_as_linuxcnc():
     with pytest.raises(GcodeError, match=r"line 3: '#<_value>': o1 endsub on line 2 set "
                        r"#<_value> where its subroutine is defined.*#<r> has no value"):
         _ends("o1 sub\no1 endsub [#<r>]\n" + read + "M2\n")
+    # an M99 return sets #<_value> to 0 as LinuxCNC does, the unreadable value gone with it
+    assert _ends("o1 sub\no1 endsub [#<r>]\nM98 P100\nG0 X[#<_value> + 1]\nM30\nO100\nM99\n"
+                 ) == [(1, 0, 0)]
     for name in ("_value", "_value_returned"):
         with pytest.raises(GcodeError, match=f"#<{name}> is a read-only"):
             _ends(f"#<{name}> = 3\nM2\n")

@@ -299,7 +299,8 @@ def test_return_values_of_endsub_and_return_agree_with_linuxcnc(tmp_path):
              "G21 G90\no1 sub\no1 endsub 5\no1 call\n" + read + "M2\n",
              "G21 G90\no1 sub\no1 endsub [5] [6]\no1 call\n" + read + "M2\n",
              "G21 G90\n#<_value> = 3\n" + read + "M2\n",
-             "G21 G90\n#<_value_returned> = 3\n" + read + "M2\n"]
+             "G21 G90\n#<_value_returned> = 3\n" + read + "M2\n",
+             "G21 G90\no1 sub\no1 endsub [#<r>]\nM98 P100\n" + read + "M30\nO100\nM99\n"]
     agree, bad = _differences(_written(tmp_path, texts), texts)
     assert not bad, bad
     assert agree == len(texts)

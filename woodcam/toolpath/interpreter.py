@@ -1077,6 +1077,7 @@ class Interpreter:
         ret, _, loc, *_ = self._frames.pop()
         self.locals = loc
         self.globals["_value"] = self.globals["_value_returned"] = 0.0  # LinuxCNC: no value
+        self._value_unknown = None  # a definition's unreadable endsub value is replaced
         return ret
 
     def _cond(self, ln):
