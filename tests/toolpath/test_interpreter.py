@@ -484,6 +484,20 @@ def test_an_n_word_is_digits_before_any_comment():
     _refused(_BODY + "/(c)N5 G1 X2\nM2\n", 4, "N", "after a comment")
     _refused(_BODY + "(c) /G1 X2\nM2\n", 4, "/", "block delete '/' after a comment")
     _refused(_BODY + "(c) N5 o100 sub\nG1 X2\no100 endsub\nM2\n", 4, "N", "after a comment")
+    # so do O words, M98 and a returning M99 ("Bad character 'o' used", "Unknown m code used:
+    # M98", "EOF seeking o-word"): woodcam ran the call, returned, took the label
+    sub = "M30\nO7\nG1 Y1\nM99\n"
+    _refused(_BODY + "(c) M98 P7\n" + sub, 4, "M98", "call M98 after a comment")
+    _refused(_BODY + "N5 (c) M98 P7\n" + sub, 4, "M98", "call M98 after a comment")
+    _refused(_BODY + "M98 P7\n" + sub.replace("M99", "(c) M99"), 8, "M99",
+             "return M99 after a comment")
+    _refused(_BODY + "M98 P7\nM30\n(c) O7\nM99\n", 4, "M98 P7",
+             "the O7 on line 6 follows a comment")
+    _refused(_BODY + "(c) O7\nG1 X2\nM2\n", 4, "O7", r"O word \(O7\) after a comment")
+    _refused(_BODY + "(c) o1 sub\nG1 X2\no1 endsub\nM2\n", 4, "o1 sub", "after a comment")
+    # what LinuxCNC runs: a comment after the word, and the main program's M99 (one pass)
+    assert len(read_gcode(_BODY + "M98 (c) P7\n" + sub)) == 3
+    assert len(read_gcode(_BODY + "G1 X2\n(c) M99\n").moves) == 3
     for word in ("N-5", "N+5", "N5.", "N.5", "N#1", "N[5]", "N"):
         _refused(_BODY + f"{word} G1 X2\nM2\n", 4, word, "line number must be digits")
     prog = read_gcode(_BODY + "N5 (c) G1 X2\nN6.5 G1 X3\n/ (c) G1 X4\no1 sub\n(c) N7 G1 X9\n"

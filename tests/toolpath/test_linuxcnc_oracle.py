@@ -225,6 +225,24 @@ def test_percent_lines_m_groups_and_n_words_are_read_as_linuxcnc_reads_them(tmp_
     assert agree == len(texts)
 
 
+def test_o_words_m98_and_m99_after_a_comment_are_read_as_linuxcnc_reads_them(tmp_path):
+    """LinuxCNC reads an O word, M98 and a returning M99 only as the first word of a line (after
+    its N word): woodcam ran ``(c) M98 P100``, returned at ``(c) M99`` and took ``(c) O100`` as
+    the label."""
+    body = "G21 G90 F100\nG0 X0 Y0 Z5\nG1 X1\n"
+    sub = "M30\nO100\nG1 Y1\nM99\n"
+    texts = [body + "(c) M98 P100\n" + sub, body + "N5 (c) M98 P100\n" + sub,
+             body + "/(c) M98 P100\n" + sub, body + "M98 (c) P100\n" + sub,
+             body + "M98 P100\n" + sub.replace("M99", "(c) M99\nG1 Y2\nM99"),
+             body + "M98 P100\nM30\n(c) O100\nG1 Y1\nM99\n",
+             body + "M98 P100\nM30\n(c) O100\nO100\nG1 Y1\nM99\n",
+             body + "(c) O100\nG1 X2\nM2\n", body + "G1 X2\n(c) M99\nG1 X3\nM2\n",
+             body + "o1 sub\nG1 Y1\n(c) M99\no1 endsub\no1 call\nG1 X2\nM2\n"]
+    agree, bad = _differences(_written(tmp_path, texts), texts)
+    assert not bad, bad
+    assert agree == len(texts)
+
+
 def test_a_tool_length_offset_does_not_carry_into_the_next_file_of_a_batch(tmp_path):
     """LinuxCNC's interpreter kept file 1's G43.1 Z3 when it read file 2: the start of file 2
     was 3 mm low (its G91 Z-1 ended at Z6, not Z9)."""

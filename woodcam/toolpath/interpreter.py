@@ -28,7 +28,8 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   :data:`MAX_CALL_DEPTH` nested calls (LinuxCNC's limit) and :data:`MAX_BLOCKS` executed lines
   (woodcam's guard against endless loops);
 - Fanuc-style subprograms (LinuxCNC 2.9's "Fanuc-Style Numbered Programs", measured against
-  its interpreter): ``M98 P1000 L2`` (the first word of its line; only P and L on it) calls
+  its interpreter): ``M98 P1000 L2`` (the first word of its line, before any comment, as
+  ``O`` words and the returning ``M99``; only P and L on it) calls
   the subprogram that starts at the line ``O1000`` twice (no L: once; ``L0``: not at all), and
   ``M99``, alone first on its line, returns; the M98 line runs again for each repeat (P read
   again, L once); ``#1``-``#30`` are the caller's (not saved or restored, unlike ``call``),
@@ -262,7 +263,8 @@ class _Line:
     def __init__(self, text, no, msg):
         self.text, self.no, self.msg = text, no, msg
         self.okey = self.olabel = self.oexpr = None
-        self.late = None  # 'N' or '/': that start-of-line word came after a comment
+        # 'N', '/', 'M98', 'M99' or the O word: that start-of-line word came after a comment
+        self.late = None
 
 
 def _after_comment(raw: str, text: str) -> str | None:
@@ -277,6 +279,40 @@ def _after_comment(raw: str, text: str) -> str | None:
             return "/"
         head, text = head[1:].lstrip(), text[1:]
     return "N" if text[:1] == "n" and head[:1] not in ("n", "N") else None
+
+
+_N_PREFIX = re.compile(r"/?(?:n\d+(?:\.\d+)?)?")
+
+
+def _first_word_after_comment(raw: str, text: str) -> bool:
+    """Whether the first word after the line number of ``text`` (the normalised line) follows a
+    comment in ``raw`` (``(c) M98 P100``, ``N5 (c) O100``): LinuxCNC reads an O word, M98 or
+    M99 as one only there ("Bad character 'o' used", "Unknown m code used: M98")."""
+    if "(" not in raw:
+        return False
+    before = "".join(raw[:raw.index("(")].split()).lower()  # the normalised text before it
+    return len(before) <= _N_PREFIX.match(text).end()
+
+
+def _late_rule(word: str) -> tuple[str, str]:
+    """``(rule, fix)`` of the error for a start-of-line ``word`` (``_Line.late``) reached after
+    a comment."""
+    if word in ("N", "/"):
+        what = "a line number (N word)" if word == "N" else "a block delete '/'"
+        return (f"{what} after a comment: LinuxCNC reads it only as the first word of a line "
+                "('Bad character' there)", f"move the comment after the {word} or remove the "
+                f"{word}")
+    if word == "M98":
+        what = "a subprogram call M98 after a comment: LinuxCNC reads M98 as a call only as " \
+               "the first word of its line ('Unknown m code used: M98' there)"
+    elif word == "M99":
+        what = "a subprogram return M99 after a comment: LinuxCNC reads M99 as a return only " \
+               "as the first word of its line (it stops there)"
+    else:
+        label = "" if " " in word else "; M98 does not find such a label"
+        what = f"an O word ({word}) after a comment: LinuxCNC reads O words only as the first " \
+               f"word of a line ('Bad character' there{label})"
+    return what, f"move the comment after the {word.split()[0]}"
 
 
 def split_comments(raw: str, no: int) -> tuple[str, list[str]]:
@@ -664,6 +700,7 @@ class Interpreter:
         first = True
         grbl = self.dialect == "grbl"
         grbl_percent: list[int] = []  # grbl: the '%' lines dropped
+        self._late_olabels: dict[str, int] = {}  # O label after a comment -> its first line
         for no, raw in enumerate(self.src, start=1):
             self.line_no = no
             text, msg = split_comments(raw, no)
@@ -692,8 +729,10 @@ class Interpreter:
                     lines.append(_Line("%", no, msg))
                     break
             ln = _Line(text, no, msg)
+            late = False  # the O word, M98 or M99 that may start the line follows a comment
             if not grbl:
                 ln.late = _after_comment(raw, text)
+                late = _first_word_after_comment(raw, text)
             body = text[1:] if text.startswith("/") else text
             m = _OWORD.match(body) if "o" in body else None
             if m:
@@ -713,6 +752,8 @@ class Interpreter:
                     raise GcodeError(no, text, "grbl has no O-word subroutines or loops",
                                    "use --dialect linuxcnc")
                 ln.okey, ln.olabel, ln.oexpr = key, label, rest
+                if late:  # refused when reached (kept in the structure: the refusal is here)
+                    ln.late = ln.late or f"o{label} {key}"
             elif m is None and "o" in body and _ONUMBER.match(body):
                 if grbl:
                     raise GcodeError(no, text, "grbl has no O words (an O1234 program number is "
@@ -720,10 +761,17 @@ class Interpreter:
                                    "linuxcnc")
                 # O1234: a program number, which LinuxCNC 2.9 runs through; it labels the
                 # Fanuc-style subprogram that M98 P1234 calls
-                ln.okey, ln.olabel = "o", str(int(body[body.index("o") + 1:]))
+                label = str(int(body[body.index("o") + 1:]))
+                if late:  # refused when reached; M98 does not find it
+                    ln.late = ln.late or f"O{label}"
+                    self._late_olabels.setdefault(label, no)
+                else:
+                    ln.okey, ln.olabel = "o", label
             elif not grbl and "m9" in body:
                 mm = _M98_M99.match(body)
-                if mm:  # M98/M99 first on the line: a call or return (grbl: refused as M codes)
+                if mm and late:  # M98 refused when reached, M99 when it would return
+                    ln.late = ln.late or "M" + mm.group(1)
+                elif mm:  # M98/M99 first on the line: a call or return (grbl: refused as M codes)
                     ln.okey, ln.oexpr = "m" + mm.group(1), mm.group(2)
             lines.append(ln)
         self.lines = lines
@@ -833,12 +881,10 @@ class Interpreter:
                                "endless loop?)", "check the loop conditions")
             for m in ln.msg:
                 self.messages.append((ln.no, m))
-            if ln.late:  # refused when reached, as LinuxCNC (an uncalled sub's line is not)
-                what = ("a line number (N word)" if ln.late == "N"
-                        else "a block delete '/'")
-                raise self.err(ln.late, f"{what} after a comment: LinuxCNC reads it only as "
-                               "the first word of a line ('Bad character' there)",
-                               f"move the comment after the {ln.late} or remove the {ln.late}")
+            # refused when reached, as LinuxCNC (an uncalled sub's line is not); the main
+            # program's M99 is an ordinary line there too (below)
+            if ln.late and (ln.late != "M99" or frames):
+                raise self.err(ln.late, *_late_rule(ln.late))
             k = ln.okey
             if k is None:
                 if pc == self.closing:
@@ -1033,6 +1079,11 @@ class Interpreter:
                 raise self.err(f"M98 P{label}", f"o{label} is an o-word subroutine (o{label} "
                                "sub), which M98 does not call (LinuxCNC: 'O.... sub' subroutine "
                                "must be called with 'O.... call')", f"write o{label} call")
+            if label in self._late_olabels:
+                raise self.err(f"M98 P{label}", f"the O{label} on line "
+                               f"{self._late_olabels[label]} follows a comment: LinuxCNC reads "
+                               "an O label only as the first word of its line ('EOF seeking "
+                               "o-word')", f"move the comment after the O{label}")
             raise self.err(f"M98 P{label}", f"no O{label} line in this file (woodcam reads one "
                            f"file; a control would look for program O{label} in its memory)",
                            f"add the subprogram (O{label} ... M99) after the main program's "
