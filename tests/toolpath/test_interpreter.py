@@ -385,6 +385,9 @@ def test_fanuc_style_subprograms():
     _refused(_BODY + "M98 P7 X3\nM30\nO7\nM99\n", 4, "M98 X3", "P .* and L .* only")
     _refused(_BODY + "M98 P7\nM30\no7 sub\no7 endsub\n", 4, "M98 P7", "o-word subroutine")
     _refused(_BODY + "M98 P7\nM30\n", 4, "M98", "grbl has no subprograms", dialect="grbl")
+    # a decimal point: LinuxCNC reads neither as a call or return (woodcam ran both)
+    _refused(_BODY + "M98.0 P7\nM30\nO7\nM99\n", 4, "M98.0", "without a decimal point")
+    _refused(_BODY + "M98 P7\nM30\nO7\nM99.0\n", 7, "M99.0", "without a decimal point")
     # Fanuc keeps its programs apart: the label may come first, and P51002 is O1002 5 times
     prog = read_gcode(_BODY + "M30\nO1002\nG91 G1 X1\nG90\nM99\nM98 P51002\n",
                       dialect="fanuc")

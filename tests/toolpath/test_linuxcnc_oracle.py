@@ -228,7 +228,7 @@ def test_percent_lines_m_groups_and_n_words_are_read_as_linuxcnc_reads_them(tmp_
 def test_o_words_m98_and_m99_after_a_comment_are_read_as_linuxcnc_reads_them(tmp_path):
     """LinuxCNC reads an O word, M98 and a returning M99 only as the first word of a line (after
     its N word): woodcam ran ``(c) M98 P100``, returned at ``(c) M99`` and took ``(c) O100`` as
-    the label."""
+    the label; it also ran ``M98.0`` and ``M99.0`` as a call and a return."""
     body = "G21 G90 F100\nG0 X0 Y0 Z5\nG1 X1\n"
     sub = "M30\nO100\nG1 Y1\nM99\n"
     texts = [body + "(c) M98 P100\n" + sub, body + "N5 (c) M98 P100\n" + sub,
@@ -237,7 +237,10 @@ def test_o_words_m98_and_m99_after_a_comment_are_read_as_linuxcnc_reads_them(tmp
              body + "M98 P100\nM30\n(c) O100\nG1 Y1\nM99\n",
              body + "M98 P100\nM30\n(c) O100\nO100\nG1 Y1\nM99\n",
              body + "(c) O100\nG1 X2\nM2\n", body + "G1 X2\n(c) M99\nG1 X3\nM2\n",
-             body + "o1 sub\nG1 Y1\n(c) M99\no1 endsub\no1 call\nG1 X2\nM2\n"]
+             body + "o1 sub\nG1 Y1\n(c) M99\no1 endsub\no1 call\nG1 X2\nM2\n",
+             # and neither M98.0 nor M99.0 as a call or return; M99.0 ends the main program
+             body + "M98.0 P100\n" + sub, body + "M98 P100\n" + sub.replace("M99", "M99.0"),
+             body + "G1 X2\nM99.0\nG1 X3\nM2\n"]
     agree, bad = _differences(_written(tmp_path, texts), texts)
     assert not bad, bad
     assert agree == len(texts)

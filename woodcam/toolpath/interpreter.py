@@ -152,7 +152,9 @@ _N_WORD = re.compile(r"n[^a-z]*")  # an N word as written, for the message
 _ONUMBER = re.compile(r"(?:n\d+)?o\d+$")
 #: A Fanuc-style subprogram call or return: M98 or M99 as the first word of the line (after its
 #: N word); LinuxCNC reads only such a line as one ("G0 X1 M98 P100": "Unknown m code used").
-_M98_M99 = re.compile(r"(?:n\d+(?:\.\d+)?)?m0*(98|99)(?:\.0*)?(?![\d.])(.*)$")
+_M98_M99 = re.compile(r"(?:n\d+(?:\.\d+)?)?m0*(98|99)(?![\d.])(.*)$")
+#: The same with a decimal point ("M98.0"): LinuxCNC reads neither as a call or return.
+_M98_M99_DECIMAL = re.compile(r"(?:n\d+(?:\.\d+)?)?(m0*(?:98|99)\.\d*)")
 #: Words of a plain move line ("X12.5 Z-1.2 F900" in G0/G1): :meth:`Interpreter.execute`
 #: runs them on a short path (the raster lines of a relief program are nearly all such lines).
 _PLAIN_WORDS = frozenset("xyzf")
@@ -263,7 +265,8 @@ class _Line:
     def __init__(self, text, no, msg):
         self.text, self.no, self.msg = text, no, msg
         self.okey = self.olabel = self.oexpr = None
-        # 'N', '/', 'M98', 'M99' or the O word: that start-of-line word came after a comment
+        # 'N', '/', 'M98', 'M99' or the O word: that start-of-line word came after a comment;
+        # 'M98.0'/'M99.0' (as written): a call or return with a decimal point
         self.late = None
 
 
@@ -302,6 +305,11 @@ def _late_rule(word: str) -> tuple[str, str]:
         return (f"{what} after a comment: LinuxCNC reads it only as the first word of a line "
                 "('Bad character' there)", f"move the comment after the {word} or remove the "
                 f"{word}")
+    if word[:4] in ("M98.", "M99."):
+        said = "Bad character '.' used" if word[:3] == "M98" else "Unexpected character " \
+               "after O-word"
+        return (f"{word}: LinuxCNC reads a subprogram call or return only as M98 or M99 "
+                f"without a decimal point ('{said}')", f"write {word[:3]}")
     if word == "M98":
         what = "a subprogram call M98 after a comment: LinuxCNC reads M98 as a call only as " \
                "the first word of its line ('Unknown m code used: M98' there)"
@@ -773,6 +781,8 @@ class Interpreter:
                     ln.late = ln.late or "M" + mm.group(1)
                 elif mm:  # M98/M99 first on the line: a call or return (grbl: refused as M codes)
                     ln.okey, ln.oexpr = "m" + mm.group(1), mm.group(2)
+                elif not late and (md := _M98_M99_DECIMAL.match(body)):
+                    ln.late = ln.late or md.group(1).upper()
             lines.append(ln)
         self.lines = lines
         self.closing = closing
@@ -883,7 +893,7 @@ class Interpreter:
                 self.messages.append((ln.no, m))
             # refused when reached, as LinuxCNC (an uncalled sub's line is not); the main
             # program's M99 is an ordinary line there too (below)
-            if ln.late and (ln.late != "M99" or frames):
+            if ln.late and (not ln.late.startswith("M99") or frames):
                 raise self.err(ln.late, *_late_rule(ln.late))
             k = ln.okey
             if k is None:
