@@ -911,13 +911,8 @@ class Interpreter:
                 # return in it): #<_value> becomes its value, 0 without one, though no call ran
                 self._returned(lines[self.match[pc]], definition=True)
                 pc = self.match[pc] + 1
-            elif k == "o":  # a program number: run through it, as LinuxCNC and Fanuc
-                if frames and frames[-1][1] is not None:  # inside an o-word call
-                    raise self.err(f"O{ln.olabel}", f"Fanuc-style subprogram O{ln.olabel} "
-                                   f"reached inside the o-word subroutine o{frames[-1][4]} "
-                                   "(LinuxCNC: 'Fanuc O.... subroutine must be called with "
-                                   "M98')", f"end o{frames[-1][4]} with o{frames[-1][4]} "
-                                   "endsub before it")
+            elif k == "o":  # a program number: run through it, as LinuxCNC and Fanuc (never
+                # inside an o-word sub: _prepare refuses one in a definition)
                 pc += 1
             elif k == "m98":
                 pc = self._m98(pc, ln)
@@ -951,11 +946,8 @@ class Interpreter:
                 if not frames:  # a sub body reached without a call: LinuxCNC skips it
                     pc = (self.match[pc] if k == "endsub" else self.match[self.owner[pc]]) + 1
                     continue
-                if frames[-1][1] is None:
-                    raise self.err(f"o{ln.olabel} {k}", f"o{ln.olabel} {k} inside the "
-                                   f"Fanuc-style subprogram O{frames[-1][4]} (LinuxCNC: 'Fanuc "
-                                   "O.... subroutine definition must end with M99')",
-                                   f"return from O{frames[-1][4]} with M99")
+                # the innermost call is this sub's: an M98 subprogram starts at an O label,
+                # outside every definition (_prepare), and passes over a definition it meets
                 ret, saved, loc, *_ = frames.pop()
                 self.p.update(saved)
                 self.locals = loc
