@@ -335,6 +335,12 @@ def test_a_tool_length_offset_change_moves_the_tip_not_the_spindle():
     assert ends == [(0, 0, 10), (0, 0, 8), (0, 0, 5), (-0.5, 1, 5), (0, 2, 6), (0, 2, 18),
                     (0, 2, 3), (0, 2, 20)]  # absolute moves: the tip where the program says;
     # G53 Z20 and G28's home place the spindle, the tip the offset (2) lower
+    # G43 takes the tool table's length as 0, so it ends an offset, and says so
+    moves, warnings = Interpreter("G0 Z10\nG43.1 Z2\nG43\nG0 X1\nM2\n", start_mm=(0, 0, 0)).run()
+    assert moves[-1][2] == (1, 0, 10)
+    assert warnings == [(3, "G43 without H uses the loaded tool's length from the machine's tool "
+                         "table, which woodcam does not know: tool table lengths are taken as 0 "
+                         "(woodcam measures tools from the tip), so the offset becomes 0")]
 
 
 _SUBS = """G21 G90 F100

@@ -1397,8 +1397,9 @@ class Interpreter:
         if 21.0 in g:
             self.inch = False
         if 43.0 in g and "h" not in w:
-            self.warn("G43 without H uses the loaded tool's length; woodcam measures tools "
-                      "from the tip, so tool lengths do not move the cut")
+            self.warn("G43 without H uses the loaded tool's length from the machine's tool "
+                      "table, which woodcam does not know: tool table lengths are taken as 0 "
+                      "(woodcam measures tools from the tip), so the offset becomes 0")
         if g & {43.0, 43.1, 49.0}:
             self._tool_length_offset(g, w)
         for c in _CS:
