@@ -197,6 +197,13 @@ def test_position_and_tool_parameters_read_as_linuxcnc():
         _ends("G0 Z#5063\nM2\n")
     with pytest.raises(GcodeError, match="#5399 holds an M66 input"):
         Interpreter("#5399=1\nG0 X#5399\nM66 P0\nG0 X#5399\nM2\n").run()
+    # values given through params: a probe result is taken; the machine's state (which the
+    # interpreter keeps itself) was silently ignored, #5401-#5413 refused though supplied
+    assert _ends("G0 Z#5063\nM2\n", params={5063: 4}) == [(0, 0, 4)]
+    for n in (5400, 5403, 5420, 5428, 5600):
+        with pytest.raises(WoodcamError, match=rf"params: #{n} is the machine's state.*got "
+                           rf"params \[{n}\]; leave them out"):
+            Interpreter("G0 X#5403\nM2\n", params={n: 2.0})
 
 
 def test_parameter_lengths_are_mm_whatever_the_units():

@@ -13,7 +13,9 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``endsub [v]`` as it passes over it, and so does woodcam); read-only ones (``#5400``-``#5413``,
   ``#5420``-``#5428``, ``#<_value>``, ``#<_value_returned>``) cannot be assigned, as in
   LinuxCNC; reading what woodcam cannot know is refused: the tool table's offsets and diameter ``#5401``-``#5413``, and
-  probe (``#5061``-``#5070``) or input (``#5399``) results the program did not assign; lengths
+  probe (``#5061``-``#5070``) or input (``#5399``) results the program did not assign (the
+  ``params`` argument may supply them; the machine's state, ``#5400``-``#5413``,
+  ``#5420``-``#5428``, ``#5600``/``#5601``, it refuses); lengths
   are millimetres whatever
   ``G20/G21`` (LinuxCNC on a metric machine: the machine's units), so ``G28`` in a ``G20``
   program returns to the stored home and a ``G20`` program reads ``#5221`` in mm;
@@ -382,6 +384,17 @@ class Interpreter:
         self.p[5220] = 1.0
         self.p[5599] = 1.0  # LinuxCNC's (DEBUG,...) output flag, on by default
         if params:
+            # the machine-state ones are the interpreter's own (the loaded tool, its table
+            # entry, the position, no tool-changer fault): a supplied value would be ignored,
+            # so it is refused, as a program assigning one is; a probe result or input
+            # (#5061-#5070, #5399) is the program's to read, and taken
+            fixed = sorted(int(k) for k in params if int(k) in _READ_ONLY_NUM | {5600, 5601})
+            if fixed:
+                raise WoodcamError(f"params: #{fixed[0]} is the machine's state, which the "
+                                   "interpreter keeps itself (#5400 the loaded tool, #5401-#5413 "
+                                   "its tool table entry, #5420-#5428 the position, #5600/#5601 "
+                                   f"no tool-changer fault); got params {fixed}; leave them out "
+                                   "(start_mm gives the start position)")
             self.p.update({int(k): float(v) for k, v in params.items()})
         self.globals: dict[str, float] = {}
         self.locals: dict[str, float] = {}
