@@ -40,6 +40,16 @@ def test_bad_specs(spec, message):
         open_stock(spec)
 
 
+def test_a_block_specs_size_has_the_one_block_size_limit():
+    """A spec's size was capped at 5000 mm (stock.MAX_BLOCK_SIDE_MM) while every other block
+    size (--stock, a block folder, Block.size_mm) takes up to woodcam.limits.MAX_BLOCK_SIZE_MM."""
+    from woodcam.limits import MAX_BLOCK_SIZE_MM
+
+    assert open_stock("builtin:flat-sawn:6000x100x100").size_mm == (6000.0, 100.0, 100.0)
+    with pytest.raises(WoodcamError, match=f"<= {MAX_BLOCK_SIZE_MM:g}; got '10001x1x1'"):
+        open_stock("builtin:flat-sawn:10001x1x1")
+
+
 def test_block_folder_without_truth_is_fitted_once_and_cached(tmp_path, monkeypatch):
     """A block folder with traced rings but no true field gets a fitted field, cached on disk in
     the cache folder (never in the block folder)."""

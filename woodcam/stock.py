@@ -270,19 +270,17 @@ def _builtin(rest: str):
 
 
 def _parse_size(text: str, spec: str) -> tuple[float, float, float]:
+    """A block spec's ``WxDxH`` in mm, each side at most :data:`woodcam.limits.MAX_BLOCK_SIZE_MM`
+    (``--units inch`` checks a typed spec's size against it at the door, ``woodcam.cli.options``)."""
+    from .limits import MAX_BLOCK_SIZE_MM
     from .units import parse_lengths
 
-    size = parse_lengths(text, 3, max_mm=MAX_BLOCK_SIDE_MM)
+    size = parse_lengths(text, 3, max_mm=MAX_BLOCK_SIZE_MM)
     if size is None:
         raise WoodcamError(
             f"block spec {spec!r}: the size must be WxDxH in mm, each > 0 and <= "
-            f"{MAX_BLOCK_SIDE_MM:g}; got {text!r}, e.g. 300x120x40")
+            f"{MAX_BLOCK_SIZE_MM:g}; got {text!r}, e.g. 300x120x40")
     return size
-
-
-#: Largest side (mm) a synthetic block may be given: a woodworker's block, not a building
-#: (``--units inch`` checks a typed spec's size against it at the door, ``woodcam.cli.options``).
-MAX_BLOCK_SIDE_MM = 5000.0
 
 
 def _open_base_stock(spec: str, species, appearance, appearance_params, species_given=True) -> Stock:

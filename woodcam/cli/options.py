@@ -27,7 +27,7 @@ from pathlib import Path
 
 from .._types import CAMERAS
 from ..errors import UsageError, WoodcamError
-from ..limits import REVIEW_VOXELS_RANGE, WOODIFY_RESOLUTION_RANGE
+from ..limits import MAX_BLOCK_SIZE_MM, REVIEW_VOXELS_RANGE, WOODIFY_RESOLUTION_RANGE
 from ..units import MM_PER_UNIT, Units, fmt_length, fmt_size
 
 #: The --species presets (woodcam.appearance.SPECIES, listed here so that --help imports no
@@ -300,15 +300,13 @@ def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
 def _check_spec_size(spec: str, units: Units) -> None:
     """A block spec's ``:WxDxH`` read in ``units``, checked as typed (the stock's own check would
     name the spec converted to mm: '1000x1x1' inches said "got '25400x25.4x25.4' ... in mm")."""
-    from ..errors import UsageError
-    from ..stock import MAX_BLOCK_SIDE_MM
     from ..units import parse_lengths
 
     m = _SPEC_SIZE.match(str(spec))
-    if m and parse_lengths(m.group(2), 3, max_mm=MAX_BLOCK_SIDE_MM / MM_PER_UNIT[units]) is None:
+    if m and parse_lengths(m.group(2), 3, max_mm=MAX_BLOCK_SIZE_MM / MM_PER_UNIT[units]) is None:
         raise UsageError(f"--block {spec}: the size must be WxDxH in --units {units}, each > 0 and "
-                         f"<= {fmt_length(MAX_BLOCK_SIDE_MM, units, 4)}; got {m.group(2)!r}, e.g. "
-                         f"{m.group(1)}" + "x".join(f"{v / MM_PER_UNIT[units]:.2g}" for v in (300, 120, 40)))
+                         f"<= {fmt_length(MAX_BLOCK_SIZE_MM, units, 4)}; got {m.group(2)!r}, e.g. "
+                         f"{fmt_size((300, 120, 40), units, 3)}")
 
 
 def as_typed(args: argparse.Namespace, dest: str):
@@ -388,7 +386,6 @@ def parse_sizes(text: str, option: str, n: int = 3, *, cube: bool = False) -> tu
     (0, :data:`~woodcam.limits.MAX_BLOCK_SIZE_MM`]; with ``cube`` one number is a cube's side.
     Otherwise a WoodcamError naming ``option`` (``--sheet-size 1e300x10`` reached an allocation
     and ``--size-mm 1e300`` a block of 0 px/mm)."""
-    from ..limits import MAX_BLOCK_SIZE_MM
     from ..units import parse_lengths
 
     vals = parse_lengths(text, n, max_mm=MAX_BLOCK_SIZE_MM, cube=cube)
