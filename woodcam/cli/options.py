@@ -282,30 +282,33 @@ def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
     Defaults are millimetres already (the help states them in mm) and are left alone: argparse
     stores a default as the very object of the parser, a typed value as a new one."""
     units = getattr(args, "units", None)
+    command = getattr(args, "command", None)
+    for (cmd, dest), kind in LENGTH_OPTIONS.items():  # a block spec's size, in every unit
+        if kind == "spec" and cmd == command and getattr(args, dest, None) is not None:
+            _check_spec_size(getattr(args, dest), units or "mm")
     if units in (None, "mm"):
         return
     k = MM_PER_UNIT[units]
-    command = getattr(args, "command", None)
     sub = parser.get_default("_commands").choices[command]
     for (cmd, dest), kind in LENGTH_OPTIONS.items():
         value = getattr(args, dest, None)
         if cmd == command and value is not None and value is not sub.get_default(dest):
-            if kind == "spec":
-                _check_spec_size(value, units)
             setattr(args, dest, _value_to_mm(kind, value, k))
             # what was typed, for the range errors: "--mesh-tol 0.5" (inch) said "got 12.7"
             args.__dict__.setdefault("_typed", {})[dest] = (value, units)
 
 
 def _check_spec_size(spec: str, units: Units) -> None:
-    """A block spec's ``:WxDxH`` read in ``units``, checked as typed (the stock's own check would
-    name the spec converted to mm: '1000x1x1' inches said "got '25400x25.4x25.4' ... in mm")."""
+    """A block spec's ``:WxDxH`` read in ``units``, checked as typed at the door, a usage error
+    in every unit (the stock's own check, a WoodcamError, would name the spec converted to mm:
+    '1000x1x1' inches said "got '25400x25.4x25.4' ... in mm")."""
     from ..units import parse_lengths
 
     m = _SPEC_SIZE.match(str(spec))
     if m and parse_lengths(m.group(2), 3, max_mm=MAX_BLOCK_SIZE_MM / MM_PER_UNIT[units]) is None:
-        raise UsageError(f"--block {spec}: the size must be WxDxH in --units {units}, each > 0 and "
-                         f"<= {fmt_length(MAX_BLOCK_SIZE_MM, units, 4)}; got {m.group(2)!r}, e.g. "
+        said = "mm" if units == "mm" else f"--units {units}"
+        raise UsageError(f"--block {spec}: the size must be WxDxH in {said}, each > 0 and "
+                         f"<= {fmt_length(MAX_BLOCK_SIZE_MM, units, 5)}; got {m.group(2)!r}, e.g. "
                          f"{fmt_size((300, 120, 40), units, 3)}")
 
 
