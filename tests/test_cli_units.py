@@ -223,9 +223,11 @@ def test_messages_of_an_inch_run_quote_what_was_typed_and_speak_inches(tmp_path,
     glb = tmp_path / "tray.glb"
     glb.write_bytes(struct.pack("<III", 0x46546C67, 2, 20 + len(body))
                     + struct.pack("<II", len(body), 0x4E4F534A) + body)
-    monkeypatch.setattr(view, "preview", lambda mesh, **kw: None)
+    seen = {}
+    monkeypatch.setattr(view, "preview", lambda mesh, **kw: seen.update(kw))
     assert main(["preview", str(glb), "--screenshot", "--units", "inch",
                  "--block", "builtin:flat-sawn:4x3.2x2"]) == 0
+    assert seen["units"] == "inch"  # the scene's messages (a cut plane missing the block) too
     err = capsys.readouterr().err
     assert ("--block builtin:flat-sawn:4x3.2x2 is not the block tray.glb was baked from "
             "(builtin:flat-sawn, 3.937x3.15x1.969 in)") in err

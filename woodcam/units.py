@@ -29,6 +29,12 @@ def fmt_size(size_mm, units: Units = "mm", digits: int = 4) -> str:
     return "x".join(f"{v / MM_PER_UNIT[units]:.{digits}g}" for v in size_mm) + f" {_SYMBOL[units]}"
 
 
+def fmt_point(point_mm, units: Units = "mm", digits: int = 4) -> str:
+    """A point given in mm, printed ``"(x, y, z) unit"`` in ``units``:
+    ``fmt_point((508, 0, 12.7), "inch") == "(20, 0, 0.5) in"``."""
+    return "(" + ", ".join(f"{v / MM_PER_UNIT[units]:.{digits}g}" for v in point_mm) + f") {_SYMBOL[units]}"
+
+
 def fmt_span(lo_mm: float, hi_mm: float, units: Units = "mm", digits: int = 2) -> str:
     """A range of lengths given in mm, printed ``"lo-hi unit"`` in ``units``:
     ``fmt_span(1, 3) == "1-3 mm"``, ``fmt_span(1, 3, "inch") == "0.039-0.12 in"``."""
