@@ -588,7 +588,7 @@ def write_screenshot(args, files: dict, stock) -> None:
 
     png = screenshot_path(args.screenshot, Path(args.out))
     preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png,
-            camera=getattr(args, "camera", None) or "iso")
+            camera=camera_of(args))
     files["png"] = png
 
 
