@@ -548,10 +548,11 @@ def appearance_params(args) -> dict:
 
 
 def add_camera_option(p: argparse.ArgumentParser, note: str = "", exclude: tuple[str, ...] = ()) -> None:
-    """``--camera`` of every command that draws a view (``bake`` and ``gcode``: their
-    ``--screenshot``; ``preview``): the same named views everywhere (:data:`woodcam._types.CAMERAS`)
-    but those in ``exclude``, which ``note`` (how the command draws them) must say why it lacks.
-    Read it with :func:`camera_of`."""
+    """``--camera`` of the commands that draw a view of one part the user points
+    (``bake`` and ``gcode``: their ``--screenshot``; ``preview``); ``demo``'s renders and
+    ``place``'s placements picture keep their fixed views and have none. The same named views
+    everywhere (:data:`woodcam._types.CAMERAS`) but those in ``exclude``, which ``note`` (how the
+    command draws them) must say why it lacks. Read it with :func:`camera_of`."""
     views = {"iso": "iso (from front-right-above, the default)",
              "bottom": "bottom (the part's underside, e.g. a bowl's foot, or where a cut went through)"}
     p.add_argument("--camera", choices=[c for c in CAMERAS if c not in exclude], default=None,
