@@ -171,3 +171,20 @@ def test_a_named_screenshot_that_cannot_be_written_is_refused_before_work(comman
     assert len(err) == 1 and err[0].startswith(f"woodcam: error: --screenshot of 'woodcam {command}'"), err
     assert says in err[0]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file", "a_folder"]  # nothing was done
+
+
+def test_previews_name_less_screenshot_beside_mesh_is_checked_before_work(tmp_path, capsys, monkeypatch):
+    """preview MESH --screenshot writes MESH_view.png; when that is a folder it was refused only
+    after the block was read (exit 1, 'screenshot: ...'): now at the door, as a named one."""
+    import woodcam.cli.options as options
+
+    mesh = tmp_path / "part.glb"
+    mesh.write_bytes(b"glTF")
+    (tmp_path / "part_view.png").mkdir()
+    monkeypatch.setattr(options, "stock_of_glb", lambda *a, **k: pytest.fail("the block was read"))
+    capsys.readouterr()
+    assert main(["preview", str(mesh), "--screenshot"]) == EXIT_USAGE
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"woodcam: error: --screenshot of 'woodcam preview' is a FILE ending in .png; got "
+                   f"{str(tmp_path / 'part_view.png')!r}, an existing folder (--screenshot without a "
+                   f"name writes MESH_view.png); give e.g. {str(tmp_path / 'part_view.png' / 'view.png')!r}"]

@@ -124,18 +124,27 @@ def check_out(args: argparse.Namespace) -> None:
 
 
 def check_screenshot(args: argparse.Namespace) -> None:
-    """Refuse a named ``--screenshot PNG`` (bake, gcode, preview) that cannot be written, before
-    any work: a UsageError (exit 2) when it does not end in ``.png``, is a folder, or its folder
-    cannot be made. The name-less form writes beside ``--out``, which :func:`check_out` checks."""
+    """Refuse a ``--screenshot`` PNG (bake, gcode, preview) that cannot be written, before any
+    work: a UsageError (exit 2) when it does not end in ``.png``, is a folder, or its folder
+    cannot be made. The name-less form writes beside ``--out`` (bake, gcode), which
+    :func:`check_out` checks, or beside preview's MESH (MESH_view.png), checked here when MESH
+    is a file (a missing MESH is the command's own error)."""
     from ..errors import UsageError
+    from ..pipeline import screenshot_path
 
     shot = getattr(args, "screenshot", None)
+    mesh = getattr(args, "mesh", None)
+    derived = shot is True and not hasattr(args, "out") and isinstance(mesh, Path) and mesh.is_file()
+    if derived:
+        shot = screenshot_path(True, mesh)
     if not isinstance(shot, (str, Path)):
         return
     shot = Path(shot)
     command = args.command
     if shot.is_dir() or shot.suffix.lower() != ".png":
         what = "an existing folder" if shot.is_dir() else "not a .png name"
+        if derived:
+            what += " (--screenshot without a name writes MESH_view.png)"
         raise UsageError(f"--screenshot of 'woodcam {command}' is a FILE ending in .png; got "
                          f"{str(shot)!r}, {what}; give e.g. "
                          f"{str(shot / 'view.png' if shot.is_dir() else shot.with_suffix('.png'))!r}")
