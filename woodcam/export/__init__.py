@@ -334,13 +334,13 @@ def obj_siblings(obj_path: PathLike) -> tuple[Path, Path]:
 def written_obj_set(obj_path: PathLike) -> list[Path]:
     """The files of the OBJ set :func:`export_obj` wrote at ``obj_path`` (the OBJ, its MTL and
     texture: :func:`obj_siblings`) that exist, when the OBJ there is woodcam's (its first line is
-    export_obj's ``# woodcam:`` header); ``[]`` for no OBJ or another program's (a part file
-    of the user's must never be taken for an earlier run's output)."""
+    export_obj's ``# woodcam:`` header, read by :func:`woodcam.frames.obj_header_transform`);
+    ``[]`` for no OBJ, another program's or one whose header was edited out of shape (a part
+    file of the user's must never be taken for an earlier run's output)."""
     path = Path(obj_path)
     try:
-        with open(path, "rb") as fh:
-            ours = fh.readline(200).startswith(OBJ_HEADER.encode())
-    except OSError:
+        ours = obj_header_transform(path) is not None
+    except (OSError, WoodcamError):
         return []
     return [p for p in (path, *obj_siblings(path)) if p.is_file()] if ours else []
 
