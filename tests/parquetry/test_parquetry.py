@@ -614,6 +614,11 @@ _T = [{"filename": "t.png"}]
     ({"targets": [{"filename": "t.png", "scal": 0.5}]}, r"key targets\[0\].'scal' is unknown .*: dpi, "
      r"filename, morphed_grid, scale$"),
     ({"targets": _T, "sort_patches_saliency": "no"}, r"sort_patches_saliency must be true or false; got 'no'"),
+    # a TypeError: the file-exists check joined the mask to the job's folder before its type was checked
+    ({"targets": _T, "source_textures": [{"texture": "t.png", "dpi": 300, "mask": 5}]},
+     r"source_textures\[0\].mask must be a path or null; got 5$"),
+    ({"targets": _T, "source_textures": [{"texture": "t.png", "dpi": 300, "id": 7}]},
+     r"source_textures\[0\].id must be a name .*; got 7$"),
     ({"targets": _T, "source_textures": [{"json": "t.json", "scale": 1}]},
      r"source_textures\[0\] describes its texture in another file \('json': 't.json'\), which woodcam does "
      r"not read; give its 'texture', 'dpi' and 'mask' in this entry"),

@@ -338,6 +338,14 @@ def read_job(path: str | Path) -> ParquetryJob:
     def _abs(s):
         return str((base / s).resolve()) if s else s
 
+    # the types first: the file-exists check below joins each path to the job's folder ({"mask": 5}
+    # was a TypeError there)
+    for i, t in enumerate(scans):
+        if t.get("mask") is not None and not isinstance(t["mask"], str):
+            raise WoodcamError(f"{where} source_textures[{i}].mask must be a path or null; got {t['mask']!r}")
+        if t.get("id") is not None and not (isinstance(t["id"], str) and t["id"]):
+            raise WoodcamError(f"{where} source_textures[{i}].id must be a name (a string, it names "
+                               f"veneer_<id>.svg); got {t['id']!r}")
     # found at the door, each named by its entry: a missing file was 'cannot decode the image ...
     # the file is damaged' after the job's other files were read
     named = [(f"source_textures[{i}].{k}", t.get(k)) for i, t in enumerate(scans) for k in ("texture", "mask")]
@@ -350,12 +358,6 @@ def read_job(path: str | Path) -> ParquetryJob:
             raise WoodcamError(f"{where} {key} {s!r}: no such file {_abs(s)!r} (a job file's paths are "
                                f"relative to its folder){here or '; check the path'}")
 
-    if any(t.get("mask") is not None and not isinstance(t["mask"], str) for t in scans):
-        raise WoodcamError(f"{where} a source_textures mask must be a path or null")
-    for i, t in enumerate(scans):
-        if t.get("id") is not None and not (isinstance(t["id"], str) and t["id"]):
-            raise WoodcamError(f"{where} source_textures[{i}].id must be a name (a string, it names "
-                               f"veneer_<id>.svg); got {t['id']!r}")
     # the reference code's id is optional: the file's stem, as for --veneer (a texture without
     # one was a KeyError from the CLI)
     scans = [dict(t, texture=_abs(t["texture"]), mask=_abs(t.get("mask")),
