@@ -601,3 +601,14 @@ STEM_RADIAL_SD = 0.3
 #: arc) is sampled at. A circular arc of radius r sampled every s pixels strays s^2 / (8 r) from
 #: its chord: 0.003 px for s = 0.5 and a ring of radius 10 px, far below a ring map's 1 px.
 SVG_CURVE_STEP_PX = 0.5
+
+#: Resolutions (dpi) a file states without having been measured: cameras write 72 dpi into
+#: EXIF (a phone JPEG's placeholder), editors 72 or 96 (GIMP's PNG pHYs of 2835 px/m reads
+#: back as 72.009 dpi, 3780 px/m as 96.012). A veneer file stating one of them states no
+#: resolution: taken as the scan's, a phone photo of a sheet would be sized ~4x too large.
+DPI_PLACEHOLDERS = (72.0, 96.0)
+
+#: How far (dpi) a stated resolution may be from a placeholder and still be one: the metric
+#: rounding of PNG pHYs (2835 px/m = 72.009 dpi) and of a JPEG density in dots/cm (28/cm =
+#: 71.12 dpi, 38/cm = 96.52 dpi); a scanner's own settings (75, 100, 150 dpi) are well outside.
+DPI_PLACEHOLDER_TOL = 1.0

@@ -9,6 +9,7 @@ import pytest
 from PIL import Image
 
 from woodcam.cli import main
+from woodcam.errors import WoodcamWarning
 
 
 @pytest.fixture
@@ -214,9 +215,28 @@ def test_a_scan_that_states_its_dpi_is_not_sized_by_the_default_without_a_word(s
     assert main(argv + ["--veneer", str(scans / "tagged.png"), "--out", str(scans / "a")]) == 1
     err = capsys.readouterr().err
     assert "the file states 101.6 dpi, but no resolution was given, so the default 300 dpi was used; " \
-           f"give {scans / 'tagged.png'}:101.6" in err
+           f"give the resolution the sheet was scanned at: {scans / 'tagged.png'}:101.6 if the file's" in err
     assert main(argv + ["--veneer", f"{scans / 'tagged.png'}:101.6", "--out", str(scans / "b")]) == 0
     assert "warning" not in capsys.readouterr().err
+
+
+def test_a_placeholder_dpi_is_no_stated_resolution(scans):
+    """A phone JPEG's EXIF/JFIF 72 dpi and a GIMP PNG's 72.009 (pHYs 2835 px/m) were read as
+    the scan's resolution: the warning fired on ordinary files and its fix, SCAN:72, sized the
+    sheet ~4x too large. 72 and 96 dpi (and their roundings) now state nothing."""
+    from woodcam.parquetry.veneers import dpi_tag
+
+    im = Image.open(scans / "light.png")
+    for name, dpi in (("phone.jpg", 72), ("gimp.png", 72.009), ("win.png", 96.012), ("cm.jpg", 71.12),
+                      ("scan.png", 75), ("scan2.png", 150)):
+        im.convert("RGB").save(scans / name, dpi=(dpi, dpi))
+    assert [dpi_tag(scans / n) for n in ("phone.jpg", "gimp.png", "win.png", "cm.jpg")] == [None] * 4
+    assert round(dpi_tag(scans / "scan.png")) == 75 and round(dpi_tag(scans / "scan2.png")) == 150
+    from woodcam.cli.parquetry import _scan_entry
+
+    assert _scan_entry(str(scans / "phone.jpg"))["dpi"] == 300  # no warning (they are errors here)
+    with pytest.warns(WoodcamWarning, match=r"states 150 dpi.*scan2.png:150 if the file's is right"):
+        _scan_entry(str(scans / "scan2.png"))
 
 
 def test_a_target_of_a_few_pixels_is_made_and_its_ssim_said_to_have_no_value(scans, capsys):

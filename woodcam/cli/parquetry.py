@@ -62,7 +62,7 @@ def register(subparsers) -> None:
     v.add_argument("--veneer", action="append", default=[], metavar="SCAN[:DPI][:MASK]",
                    help="scanned veneer image (repeatable; its id, in veneer_<id>.svg, is the file's "
                    "stem, numbered when two share one: oak-1, oak-2); resolution in dpi (default 300, with a warning "
-                   "when the file states another) or "
+                   "when the file states another, other than the 72/96 dpi cameras and editors write unmeasured) or "
                    "'Npx/mm'")
     v.add_argument("--veneer-from", action="append", default=[], metavar="SPEC",
                    help="Mokume sample folder, or block spec to slice leaves from (repeatable)")
@@ -171,12 +171,14 @@ def _scan_entry(text: str) -> dict:
         from ..parquetry.veneers import dpi_tag
 
         # the default 300 dpi over a scan that states its own resolution sized every piece
-        # wrongly without a word (a 150 dpi scan cut at half size)
+        # wrongly without a word (a 150 dpi scan cut at half size); a camera's or editor's
+        # placeholder (72, 96 dpi) is no resolution, so never named as the fix
         tag = dpi_tag(parts[0])
         if tag is not None and abs(tag - entry["dpi"]) > 0.01 * entry["dpi"]:
             warnings.warn(f"--veneer {parts[0]!r}: the file states {tag:.4g} dpi, but no resolution was "
-                          f"given, so the default {entry['dpi']:g} dpi was used; give {parts[0]}:{tag:.4g} "
-                          f"to use the file's (or {parts[0]}:{entry['dpi']:g} to keep the default)",
+                          f"given, so the default {entry['dpi']:g} dpi was used; give the resolution the "
+                          f"sheet was scanned at: {parts[0]}:{tag:.4g} if the file's is right, "
+                          f"{parts[0]}:{entry['dpi']:g} to keep the default",
                           WoodcamWarning, stacklevel=2)
     return entry
 

@@ -130,8 +130,12 @@ def read_image(path, what: str = "image") -> np.ndarray:
 
 def dpi_tag(path: str | Path) -> float | None:
     """The resolution a scan file states (PNG pHYs, JPEG/TIFF density), dpi, or None when it
-    states none or cannot be read (reading it properly is :func:`load_scan`'s business)."""
+    states none, states a placeholder (72 or 96 dpi: :data:`~woodcam.tolerances.DPI_PLACEHOLDERS`,
+    what cameras and editors write without measuring) or cannot be read (reading it properly is
+    :func:`load_scan`'s business)."""
     from PIL import Image
+
+    from ..tolerances import DPI_PLACEHOLDER_TOL, DPI_PLACEHOLDERS
 
     try:
         with Image.open(path) as im:
@@ -142,7 +146,9 @@ def dpi_tag(path: str | Path) -> float | None:
         dpi = float(tag[0])
     except (TypeError, ValueError, IndexError):
         return None
-    return dpi if np.isfinite(dpi) and dpi > 1 else None
+    if not np.isfinite(dpi) or dpi <= 1 or any(abs(dpi - p) <= DPI_PLACEHOLDER_TOL for p in DPI_PLACEHOLDERS):
+        return None
+    return dpi
 
 
 def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | None = None,
