@@ -610,3 +610,46 @@ def test_fragmented_projected_charts_of_a_noisy_mesh_fall_back_to_xatlas(monkeyp
     assert auto.density_stretch == 1.0 and auto.uv_fill > projected.uv_fill
     clean = trimesh.creation.icosphere(subdivisions=4, radius=30.0)
     assert bake_module._projected_charts(clean)[4] == 0.0
+
+
+# ------------------------------------------------------------------------------------------------
+# rebake_texture: a picture laid on by any coordinates, moved into an even-density atlas
+
+
+def test_rebake_texture_puts_the_pictures_colours_where_the_picture_had_them():
+    """A picture of four solid quadrants laid on the box by its (x, y) (a projection that
+    squeezes the box's sides to lines): every surface point away from a quadrant's border shows
+    its quadrant's colour in the rebaked atlas, faces keep their order, texel density is even."""
+    from woodcam.bake import rebake_texture
+
+    mesh = _box()
+    colours = np.array([[[200, 30, 30], [30, 200, 30]], [[30, 30, 200], [220, 220, 40]]], np.uint8)
+    picture = np.repeat(np.repeat(colours, 32, axis=0), 32, axis=1)      # (64, 64, 3), row 0 on top
+    # the box on the picture's middle half (clear of its repeating edges); v up: y = 30 is on top
+    uv = 0.25 + mesh.vertices[:, :2] / [80.0, 60.0]
+    result = rebake_texture(mesh, uv[mesh.faces], picture, texels_per_mm=3.0)
+    out = result.mesh
+    assert np.array_equal(result.vertex_map[out.faces], np.asarray(mesh.faces))
+    assert result.texels_per_mm == 3.0 and result.coverage_mask.any()
+    atlas = np.asarray(out.visual.material.baseColorTexture.convert("RGB")).astype(float)
+    faces, bary = _surface_samples(out, 5000, np.random.default_rng(1))
+    tri = out.faces[faces]
+    points = np.einsum("kc,kcd->kd", bary, out.vertices[tri])
+    sampled, _ = _bilinear(atlas, np.einsum("kc,kcd->kd", bary, np.asarray(out.visual.uv)[tri]))
+    inner = (np.abs(points[:, 0] - 20) > 1.5) & (np.abs(points[:, 1] - 15) > 1.5)
+    expected = colours[(points[:, 1] < 15).astype(int), (points[:, 0] > 20).astype(int)]
+    assert inner.sum() > 3000
+    assert np.abs(sampled[inner] - expected[inner]).max() <= 1.0
+
+
+def test_rebake_texture_refuses_a_picture_that_is_not_rgb():
+    """A grey (h, w) picture was read as h rows of w-wide colours and built a 2^18 x 2^18
+    atlas index (MemoryError); now refused at the door, naming ``image``."""
+    from woodcam.bake import rebake_texture
+
+    mesh = _box()
+    uv = mesh.vertices[:, :2] / [40.0, 30.0]
+    for bad in (np.zeros((64, 64), np.uint8), np.zeros((64, 64, 4), np.uint8), np.zeros((0, 8, 3))):
+        with pytest.raises(WoodcamError, match=r"rebake_texture: image must be an \(h, w, 3\) RGB array; "
+                           rf"got shape \({bad.shape[0]}, {bad.shape[1]}"):
+            rebake_texture(mesh, uv[mesh.faces], bad, texels_per_mm=3.0)

@@ -212,21 +212,61 @@ def bake(
     -------
     BakeResult
     """
-    import trimesh
-
     from .appearance.wood import wood_colors  # the one check of the colour contract
 
     t_start = time.perf_counter()
     _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals)
     if unwrap not in get_args(UnwrapMode):
         raise WoodcamError(f"bake: unwrap must be one of {get_args(UnwrapMode)}; got {unwrap!r}")
+    verts_in = np.asarray(mesh.vertices, dtype=np.float64)
+
+    def colours(vmap, faces, xy):
+        # xatlas keeps face order, so output face i is input face i.
+        point_map = _affine_maps(xy, faces, verts_in[vmap])
+        if normals == "face":
+            face_normals = np.asarray(mesh.face_normals, dtype=np.float64)
+        else:
+            normal_map = _affine_maps(xy, faces, np.asarray(mesh.vertex_normals,
+                                                             dtype=np.float64)[vmap])
+
+        def paint(t, cx, cy):
+            points = _apply_affine(point_map, t, cx, cy)
+            if normals == "face":
+                nrm = face_normals[t]
+            else:
+                nrm = _apply_affine(normal_map, t, cx, cy)
+                nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-12)
+            rgb = wood_colors(wood, points, nrm)
+            return np.round(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
+        return paint
+
+    result = _bake_atlas(mesh, float(texels_per_mm), int(max_atlas_px), int(padding_px), unwrap,
+                         colours, progress=progress, t_start=t_start)
+    if normals == "smooth":
+        # Shading normals from the unsplit input, so viewers show no shading seam where xatlas
+        # split vertices (normals recomputed on the split mesh differ on each side of a seam).
+        # The GLB exporter writes them as NORMAL; "face" mode leaves them out (flat shading).
+        result.mesh.vertex_normals = np.asarray(mesh.vertex_normals, dtype=np.float64)[result.vertex_map]
+        result.timings["total"] = time.perf_counter() - t_start
+    return result
+
+
+def _bake_atlas(mesh, tpm: float, max_px: int, padding: int, unwrap: str, colours, *,
+                progress: bool = False, t_start: float) -> BakeResult:
+    """The pipeline :func:`bake` and :func:`rebake_texture` share: unwrap, rasterise, colour
+    every covered texel, dilate, and the textured mesh. Only the colour source differs:
+    ``colours(vmap (m,), faces (f, 3), xy (m, 2) texel coordinates) -> paint``, and
+    ``paint(tri (k,), cx (k, 1), cy (k, 1)) -> (k, 3) uint8`` colours the texels whose centres
+    ``(cx, cy)`` (texels) lie in output faces ``tri``, called in batches of MAX_BATCH_POINTS.
+    Arguments are checked by the callers; warnings are raised at their callers."""
+    import trimesh
+
     messages: list[str] = []
     timings: dict[str, float] = {}
 
     # ---- 1. unwrap -------------------------------------------------------------------------
     t0 = time.perf_counter()
-    vmap, faces, xy, width, height, tpm, stretch = _unwrap(
-        mesh, float(texels_per_mm), int(max_atlas_px), int(padding_px), messages, unwrap)
+    vmap, faces, xy, width, height, tpm, stretch = _unwrap(mesh, tpm, max_px, padding, messages, unwrap)
     timings["unwrap"] = time.perf_counter() - t0
     img_w = _round_up(width, _ATLAS_SIZE_MULTIPLE)
     img_h = _round_up(height, _ATLAS_SIZE_MULTIPLE)
@@ -240,29 +280,13 @@ def bake(
 
     # ---- 3. colour -------------------------------------------------------------------------
     t0 = time.perf_counter()
-    verts = np.asarray(mesh.vertices, dtype=np.float64)[vmap]
-    point_map = _affine_maps(xy, faces, verts)
-    if normals == "face":
-        # xatlas keeps face order, so output face i is input face i.
-        face_normals = np.asarray(mesh.face_normals, dtype=np.float64)
-    else:
-        normal_map = _affine_maps(xy, faces, np.asarray(mesh.vertex_normals,
-                                                         dtype=np.float64)[vmap])
+    paint = colours(vmap, faces, xy)
     atlas = np.zeros((img_h * img_w, 3), dtype=np.uint8)
     # Batches of MAX_BATCH_POINTS texels: bounded memory, arrays that stay in cache.
     for s in range(0, len(painted), MAX_BATCH_POINTS):
         idx = painted[s:s + MAX_BATCH_POINTS]
-        t = tri[s:s + MAX_BATCH_POINTS]
-        cx = (idx % img_w + 0.5)[:, None]
-        cy = (idx // img_w + 0.5)[:, None]
-        points = _apply_affine(point_map, t, cx, cy)
-        if normals == "face":
-            nrm = face_normals[t]
-        else:
-            nrm = _apply_affine(normal_map, t, cx, cy)
-            nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-12)
-        rgb = wood_colors(wood, points, nrm)
-        atlas[idx] = np.round(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
+        atlas[idx] = paint(tri[s:s + MAX_BATCH_POINTS], (idx % img_w + 0.5)[:, None],
+                           (idx // img_w + 0.5)[:, None])
     atlas = atlas.reshape(img_h, img_w, 3)
     coverage = (tri_of_texel >= 0).reshape(img_h, img_w)
     timings["color"] = time.perf_counter() - t0
@@ -273,15 +297,10 @@ def bake(
     timings["dilate"] = time.perf_counter() - t0
 
     uv = np.column_stack([xy[:, 0] / img_w, 1.0 - xy[:, 1] / img_h])
-    out = _textured_mesh(trimesh, verts, faces, uv, atlas)
-    if normals == "smooth":
-        # Shading normals from the unsplit input, so viewers show no shading seam where xatlas
-        # split vertices (normals recomputed on the split mesh differ on each side of a seam).
-        # The GLB exporter writes them as NORMAL; "face" mode leaves them out (flat shading).
-        out.vertex_normals = np.asarray(mesh.vertex_normals, dtype=np.float64)[vmap]
+    out = _textured_mesh(trimesh, np.asarray(mesh.vertices, dtype=np.float64)[vmap], faces, uv, atlas)
     timings["total"] = time.perf_counter() - t_start
     for msg in messages:
-        warnings.warn(msg, WoodcamWarning, stacklevel=2)
+        warnings.warn(msg, WoodcamWarning, stacklevel=3)  # at the caller of bake / rebake_texture
     return BakeResult(
         mesh=out,
         atlas=atlas,
@@ -364,49 +383,40 @@ def rebake_texture(mesh, corner_uv, image, *, texels_per_mm: float, max_atlas_px
     BakeResult ; ``mesh.faces`` keep the input's order, ``vertex_map`` names each vertex's input
     vertex, the atlas is the picture sampled bilinearly (repeating) at every texel.
     """
-    import trimesh
-
     t_start = time.perf_counter()
     corner_uv = np.asarray(corner_uv, np.float64)
     faces_in = np.asarray(mesh.faces)
     if corner_uv.shape != (len(faces_in), 3, 2):
         raise WoodcamError(f"rebake_texture: corner_uv must be (faces, 3, 2) = ({len(faces_in)}, 3, 2); "
                            f"got {corner_uv.shape}")
+    shape = np.shape(image)
+    if len(shape) != 3 or shape[2] != 3 or not shape[0] or not shape[1]:
+        # a grey (h, w) picture was read as h rows of w-wide "colours": a 2^18 x 2^18 atlas
+        raise WoodcamError(f"rebake_texture: image must be an (h, w, 3) RGB array; got shape {shape}; "
+                           "repeat a grey picture into three channels (np.dstack([grey] * 3))")
     _check_args(mesh, None, texels_per_mm, max_atlas_px, padding_px, "face", picture=True)
-    messages: list[str] = []
-    vmap, faces, xy, width, height, tpm, stretch = _unwrap(
-        mesh, float(texels_per_mm), int(max_atlas_px), int(padding_px), messages, "auto")
-    img_w, img_h = _round_up(width, _ATLAS_SIZE_MULTIPLE), _round_up(height, _ATLAS_SIZE_MULTIPLE)
-    tri_of_texel = _rasterise(xy, faces, img_w, img_h)
-    painted = np.flatnonzero(tri_of_texel >= 0)
-    tri = tri_of_texel[painted]
-    # per corner: a face's own uv (a seam's two sides differ), interpolated over its triangle
-    corners = np.arange(3 * len(faces)).reshape(-1, 3)
-    uv_map = _affine_maps(xy[faces].reshape(-1, 2), corners, corner_uv.reshape(-1, 2))
     pic = np.asarray(image, np.float32)
     ph, pw = pic.shape[:2]
-    atlas = np.zeros((img_h * img_w, 3), np.uint8)
-    for s in range(0, len(painted), MAX_BATCH_POINTS):
-        idx, t = painted[s:s + MAX_BATCH_POINTS], tri[s:s + MAX_BATCH_POINTS]
-        uv = _apply_affine(uv_map, t, (idx % img_w + 0.5)[:, None], (idx // img_w + 0.5)[:, None])
-        x, y = uv[:, 0] * pw - 0.5, (1.0 - uv[:, 1]) * ph - 0.5
-        x0, y0 = np.floor(x), np.floor(y)
-        fx, fy = (x - x0)[:, None], (y - y0)[:, None]
-        c0, r0 = x0.astype(np.int64) % pw, y0.astype(np.int64) % ph
-        c1, r1 = (c0 + 1) % pw, (r0 + 1) % ph
-        rgb = ((pic[r0, c0] * (1 - fx) + pic[r0, c1] * fx) * (1 - fy)
-               + (pic[r1, c0] * (1 - fx) + pic[r1, c1] * fx) * fy)
-        atlas[idx] = np.round(np.clip(rgb, 0, 255)).astype(np.uint8)
-    coverage = (tri_of_texel >= 0).reshape(img_h, img_w)
-    atlas = _dilate(atlas.reshape(img_h, img_w, 3), coverage)
-    uv_out = np.column_stack([xy[:, 0] / img_w, 1.0 - xy[:, 1] / img_h])
-    out = _textured_mesh(trimesh, np.asarray(mesh.vertices, np.float64)[vmap], faces, uv_out, atlas)
-    for msg in messages:
-        warnings.warn(msg, WoodcamWarning, stacklevel=2)
-    return BakeResult(mesh=out, atlas=atlas, coverage_mask=coverage, texels_per_mm=tpm,
-                      timings={"total": time.perf_counter() - t_start}, warnings=messages,
-                      vertex_map=vmap, uv_fill=_uv_fill(xy, faces, img_w, img_h),
-                      density_stretch=stretch)
+
+    def colours(vmap, faces, xy):
+        # per corner: a face's own uv (a seam's two sides differ), interpolated over its triangle
+        corners = np.arange(3 * len(faces)).reshape(-1, 3)
+        uv_map = _affine_maps(xy[faces].reshape(-1, 2), corners, corner_uv.reshape(-1, 2))
+
+        def paint(t, cx, cy):
+            uv = _apply_affine(uv_map, t, cx, cy)
+            x, y = uv[:, 0] * pw - 0.5, (1.0 - uv[:, 1]) * ph - 0.5
+            x0, y0 = np.floor(x), np.floor(y)
+            fx, fy = (x - x0)[:, None], (y - y0)[:, None]
+            c0, r0 = x0.astype(np.int64) % pw, y0.astype(np.int64) % ph
+            c1, r1 = (c0 + 1) % pw, (r0 + 1) % ph
+            rgb = ((pic[r0, c0] * (1 - fx) + pic[r0, c1] * fx) * (1 - fy)
+                   + (pic[r1, c0] * (1 - fx) + pic[r1, c1] * fx) * fy)
+            return np.round(np.clip(rgb, 0, 255)).astype(np.uint8)
+        return paint
+
+    return _bake_atlas(mesh, float(texels_per_mm), int(max_atlas_px), int(padding_px), "auto", colours,
+                       t_start=t_start)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -157,3 +157,39 @@ def test_brush_file_round_trip_and_errors(tmp_path):
     p.write_text('{"brushes": [{"radius_mm": 4}]}')
     with pytest.raises(WoodcamError, match="brushes file .* must be JSON like"):
         load_brushes(p)
+
+
+def test_corner_uv_gives_each_face_the_corners_textured_mesh_gives_it():
+    """A face across the wrap (u near 0 and 1) has u + 1 on its low corners, the others keep
+    their vertices' coordinates: the same corners as textured_mesh's split copies."""
+    from woodcam.woodify.bark import corner_uv, textured_mesh
+
+    mesh = trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0], [2, 0, 0]],
+                           [[0, 1, 2], [1, 3, 2], [1, 4, 3]], process=False)
+    uv = np.array([[0.95, 0.1], [0.05, 0.1], [0.9, 0.6], [0.1, 0.6], [0.2, 0.1]])
+    c = corner_uv(uv, mesh.faces)
+    assert c.shape == (3, 3, 2)
+    assert np.allclose(c[0, :, 0], [0.95, 1.05, 0.9]) and np.allclose(c[1, :, 0], [1.05, 1.1, 0.9])
+    assert np.allclose(c[2], uv[mesh.faces[2]])          # not across the wrap: as given
+    t = textured_mesh(mesh, uv, np.zeros((4, 4, 3), np.uint8))
+    assert np.allclose(np.asarray(t.visual.uv)[t.faces], c)
+
+
+def test_paint_crack_faces_draws_an_edge_in_every_face_that_holds_it():
+    """Edge (0, 1) lies in two faces laid in different places of the atlas (a chart seam): the
+    crack is drawn in both, dark along the edge; texels away from it are untouched; no edges,
+    an untouched copy."""
+    from woodcam.woodify.bark import paint_crack_faces
+
+    img = np.full((40, 40, 3), 200, np.uint8)
+    faces = np.array([[0, 1, 2], [1, 0, 3]])
+    corner_xy = np.array([[[5, 5], [15, 5], [10, 12]],      # face 0: edge 0-1 along row 5
+                          [[30, 35], [20, 35], [25, 28]]],  # face 1 elsewhere: edge 1-0 along row 35
+                         float)
+    assert np.array_equal(paint_crack_faces(img, corner_xy, faces, np.zeros((0, 2), int), 1), img)
+    out = paint_crack_faces(img, corner_xy, faces, np.array([[1, 0]]), 1)
+    assert out is not img and (img == 200).all()             # a copy
+    assert out[4:6, 7:13].max() < 120 and out[34:36, 22:28].max() < 120
+    changed = (out != 200).any(2)
+    changed[2:8, 3:18] = changed[32:38, 18:33] = False
+    assert not changed.any()                                  # edges 1-2, 2-0 are not cracks
