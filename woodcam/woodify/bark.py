@@ -76,20 +76,12 @@ def textured_mesh(mesh, uv, image):
 
     uv = np.asarray(uv, float)
     faces = mesh.faces.copy()
-    fu = uv[faces, 0]
-    seam = (fu.max(1) - fu.min(1)) > 0.5
-    verts = [mesh.vertices]
-    uvs = [uv]
-    if seam.any():
-        corners = faces[seam]
-        low = uv[corners, 0] < 0.5
-        new = corners[low]
-        start = len(mesh.vertices)
-        verts.append(mesh.vertices[new])
-        uvs.append(uv[new] + np.array([1.0, 0.0]))
-        sub = faces[seam]
-        sub[low] = start + np.arange(len(new))
-        faces[seam] = sub
+    corners = corner_uv(uv, faces)
+    moved = corners[..., 0] > uv[faces, 0]  # the low corners of faces across the wrap (u + 1)
+    new = faces[moved]
+    verts = [mesh.vertices, mesh.vertices[new]]
+    uvs = [uv, corners[moved]]
+    faces[moved] = len(mesh.vertices) + np.arange(len(new))
     V = np.concatenate(verts)
     UV = np.concatenate(uvs)
     material = trimesh.visual.material.PBRMaterial(
@@ -128,7 +120,8 @@ CRACK_WIDTH_VOXELS = 0.5
 def corner_uv(uv, faces) -> np.ndarray:
     """Per-face corner coordinates ``(f, 3, 2)`` of per-vertex ``uv (n, 2)`` that wrap in ``u``
     (cylindrical bark): a face across the wrap (``u`` near 0 and 1) has ``u + 1`` on its low
-    corners, as :func:`textured_mesh` gives it, so the picture does not smear round the stem."""
+    corners (the one home of this rule: :func:`textured_mesh` splits those corners off), so the
+    picture does not smear round the stem."""
     c = np.asarray(uv, float)[np.asarray(faces)].copy()
     u = c[..., 0]
     seam = (u.max(1) - u.min(1)) > 0.5
