@@ -918,6 +918,41 @@ def test_is_free_quick_accept_gives_the_rasterised_answer():
     assert quick > 100
 
 
+def test_is_free_tests_taken_wood_before_the_exact_edge_test_and_keeps_its_answers(monkeypatch):
+    """is_free ran the exact (shapely, ~2 ms) kerf test before the cheap taken-pixel test; now
+    the exact test runs only for a footprint clear of taken wood, and only on the unusable
+    squares that may come within the kerf. The answers are those of the exact test on every
+    square of the grown box (random unusable wood, rotations, sizes, kerfs)."""
+    import shapely
+
+    from woodcam.parquetry.matching import SheetBank
+
+    rng = np.random.default_rng(5)
+    g = np.full((90, 120), 0.5, np.float32)
+    usable = rng.random(g.shape) > 0.01
+    usable[30:45, 50:80] = False
+    for kerf in (0.0, 1.3, 3.0):
+        bank = SheetBank([g], [usable], n_rot=15, kerf_px=kerf, mode="fast", coarse_factor=4)
+        off = ~usable
+        for _ in range(400):
+            j = int(rng.integers(15))
+            th, tw = (int(v) for v in rng.integers(2, 30, 2))
+            x, y = (float(v) for v in rng.integers(-5, 130, 2))
+            poly = bank.footprint(0, j, x, y, th, tw)
+            lo, hi = poly.min(0) - kerf, poly.max(0) + kerf
+            on = lo.min() >= -0.5 - 1e-6 and hi[0] <= 120 - 0.5 + 1e-6 and hi[1] <= 90 - 0.5 + 1e-6
+            rr, cc = np.nonzero(off)
+            squares = shapely.box(cc - 0.5, rr - 0.5, cc + 0.5, rr + 0.5)
+            fp = shapely.Polygon(poly)
+            clear = (bool((shapely.distance(fp, squares) >= kerf - 1e-6).all()) if kerf > 0 else
+                     bool((shapely.area(shapely.intersection(fp, squares)) <= 1e-9).all()))
+            assert bank.clears_edges(0, poly) == (on and clear), (kerf, j, th, tw, x, y)
+    calls = []
+    monkeypatch.setattr(SheetBank, "clears_edges", lambda self, i, poly: calls.append(i) or True)
+    bank.taken[0][:] = True
+    assert not bank.is_free(0, bank.footprint(0, 3, 40.0, 40.0, 10, 10)) and calls == []
+
+
 def test_flat_window_weighting_is_on_by_default(sheets, monkeypatch):
     """The defaults (flat_detail 3, flat_rerank 12; README "flat windows"): a flat target's
     coarse search weighs the detail channel 3 times and re-ranks up to 12 candidates, a target
