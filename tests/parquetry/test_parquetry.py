@@ -784,6 +784,21 @@ def test_sheet_smaller_than_one_patch():
         build_parquetry(np.zeros((50, 50, 3), np.float32), [v], ParquetryParams(px_per_mm=2.0))
 
 
+
+def test_a_sheet_too_small_for_a_patch_and_its_whole_pixel_kerf_is_refused():
+    """The search keeps ceil(kerf_px) whole pixels clear at each edge (matching._clear_of): a
+    13 px sheet passed the size check for a 10 px patch at a 1.2 px kerf (12.4 px) and the run
+    placed nothing ('the veneers ran out of free wood'). It needs 10 + 2 x 2 = 14 px."""
+    prm = ParquetryParams(px_per_mm=1.0, patch_mm=10, overlap_mm=0, kerf_mm=1.2, image_size_mm=20)
+    target = np.zeros((20, 20, 3), np.float32)
+    v = Veneer("s13", np.full((13, 13, 3), 0.5, np.float32), 1.0, np.ones((13, 13), bool))
+    with pytest.raises(WoodcamError, match=r"'s13' is 13.0 x 13.0 mm, smaller than one patch with its "
+                       r"overlap and the kerf round it \(14 mm\)"):
+        build_parquetry(target, [v], prm, seams=False)
+    v = Veneer("s14", np.full((14, 14, 3), 0.5, np.float32), 1.0, np.ones((14, 14), bool))
+    assert len(build_parquetry(target, [v], prm, seams=False).patches) == 1
+
+
 def test_adaptive_patches_with_seams_cover_once_and_use_wood_once(tmp_path):
     """Mixed 14 and 28 mm pieces with seams: the cut files still tile the panel exactly and
     never share wood."""

@@ -9,6 +9,7 @@ to whole cells (Table 1: 360 mm -> 26 x 14 = 364 mm), the long side cropped cent
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from typing import Literal
@@ -220,8 +221,10 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
                            "source_textures 'id'), and slice a block once, with more --sheets")
     sheets = [v.resampled(params.px_per_mm) for v in veneers]
     top_cells = 2 ** params.n_adaptive
-    # a piece keeps the kerf clear of the sheet's edges (SheetBank.clears_edges)
-    need_px = params.patch_px + 2 * params.overlap_px + 2 * params.kerf * params.px_per_mm
+    # a piece keeps the kerf clear of the sheet's edges (SheetBank.clears_edges): the search
+    # uses whole pixels, ceil(kerf_px) of them lost at each edge (matching._clear_of; a 13 px
+    # sheet passed for a 10 px patch at a 1.2 px kerf and placed nothing)
+    need_px = params.patch_px + 2 * params.overlap_px + 2 * math.ceil(params.kerf * params.px_per_mm - 1e-9)
     for v in sheets:
         h, w = v.rgb.shape[:2]
         if min(h, w) < need_px:
