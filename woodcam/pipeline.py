@@ -317,7 +317,8 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
         result.files["report"] = stem.with_suffix(".txt")
         result.files["report_json"] = stem.with_suffix(".json")
     result.warnings += list(getattr(baked, "warnings", []))
-    from .stock import absolute_spec, spec_digest
+    from ._specs import absolute_spec
+    from .stock import spec_digest
 
     meta = {"block": absolute_spec(stock.spec), "block_digest": spec_digest(stock.spec),
             "size_mm": list(stock.size_mm),

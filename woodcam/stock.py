@@ -36,6 +36,7 @@ from typing import Literal
 
 import numpy as np
 
+from ._specs import spec_path
 from .appearance import ColorMapAppearance, NeuralAppearance, Wood
 from .errors import WoodcamError, WoodcamWarning
 from .fields.builtin import BUILTIN_NAMES, builtin_block
@@ -192,31 +193,6 @@ def _check_appearance_params(appearance: str, params: dict, *, photos: bool = Tr
         fix = "; ".join(fixes)
         raise WoodcamError(f"open_stock: appearance_params must be parameters of the {kind} "
                            f"({', '.join(sorted(taken))}); got {got}; {fix}")
-
-
-def spec_path(spec: str) -> Path | None:
-    """The file or folder a block ``spec`` names (a block or sample folder, a log file, a
-    woodify field), as written; None for built-in blocks and the shared ``gran1`` log."""
-    base = str(spec).partition("~")[0]
-    if base.startswith("log:"):
-        source = base[len("log:"):].partition("@")[0]
-        return Path(source) if source.lower().endswith(".json") else None
-    if base.startswith("woodify:"):
-        return Path(base[len("woodify:"):])
-    return None if base.startswith("builtin:") else Path(base)
-
-
-def absolute_spec(spec: str) -> str:
-    """``spec`` with any folder, log file or woodify field it names made absolute, so a file
-    that records it (a GLB) reopens the same block from any working folder."""
-    base, sep, turns = str(spec).partition("~")
-    path = spec_path(base)
-    if path is not None and base.startswith("log:"):
-        _, at, rest = base.partition("@")
-        base = f"log:{path.resolve()}{at}{rest}"
-    elif path is not None:
-        base = f"{'woodify:' if base.startswith('woodify:') else ''}{path.resolve()}"
-    return base + sep + turns
 
 
 def spec_digest(spec: str) -> str:

@@ -589,6 +589,28 @@ def test_job_file_round_trip_and_paper_keys(tmp_path):
         read_job(tmp_path / "paper.json")
 
 
+def test_a_job_files_block_specs_are_written_absolute_and_read_from_its_folder(tmp_path, monkeypatch):
+    """woodcam.blocks specs naming a block folder, log:PATH or woodify:PATH were written as typed
+    and read from the working folder (a job file's textures from its own): a rerun from
+    elsewhere opened another block or none. Now written absolute, read as the textures are."""
+    (tmp_path / "jobs").mkdir()
+    (tmp_path / "jobs" / "t.png").touch()
+    monkeypatch.chdir(tmp_path)
+    specs = ["blk~z90", "log:logs/l.json@2:60x40x20", "woodify:grown/field.npz", "builtin:flat-sawn", "log:gran1@3"]
+    job = ParquetryJob(blocks=[{"spec": s, "sheets": 2} for s in specs], targets=[{"filename": "jobs/t.png"}])
+    write_job(job, tmp_path / "out" / "job.json")
+    written = [b["spec"] for b in json.loads((tmp_path / "out" / "job.json").read_text())["woodcam"]["blocks"]]
+    assert written == [f"{tmp_path}/blk~z90", f"log:{tmp_path}/logs/l.json@2:60x40x20",
+                       f"woodify:{tmp_path}/grown/field.npz", "builtin:flat-sawn", "log:gran1@3"]
+    (tmp_path / "jobs" / "job.json").write_text(json.dumps(
+        {"targets": [{"filename": "t.png"}], "woodcam": {"blocks": [{"spec": s} for s in specs]}}))
+    monkeypatch.chdir(tmp_path / "out")
+    read = [b["spec"] for b in read_job(tmp_path / "jobs" / "job.json").blocks]
+    jobs = tmp_path / "jobs"
+    assert read == [f"{jobs}/blk~z90", f"log:{jobs}/logs/l.json@2:60x40x20", f"woodify:{jobs}/grown/field.npz",
+                    "builtin:flat-sawn", "log:gran1@3"]
+
+
 # -- bad input ------------------------------------------------------------------------------
 _T = [{"filename": "t.png"}]
 

@@ -243,7 +243,7 @@ def run(args) -> int:
               f"({s['moves_per_s']:.0f} moves/s), removed {fmt_volume(res.removed_volume_mm3, args.units)}, "
               f"{len(res.report)} issue(s); machining time " + ", ".join(
                   f"T{t}: {fmt_hms(f + r)} ({fmt_hms(f)} feeding)" for t, (f, r) in times.items()))
-        # resolved, as the block spec (stock.absolute_spec): the review page of the GLB, opened
+        # resolved, as the block spec (_specs.absolute_spec): the review page of the GLB, opened
         # from another folder, names the program that cut it (as typed it was relative to a
         # working folder the GLB does not record)
         meta_programs.append({"gcode": str(Path(path).resolve()),

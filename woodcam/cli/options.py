@@ -664,7 +664,8 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
     import warnings
 
     from ..errors import WoodcamError, WoodcamWarning
-    from ..stock import open_stock, spec_digest, spec_path
+    from .._specs import spec_path
+    from ..stock import open_stock, spec_digest
 
     meta = _glb_metadata(glb)
     app = meta.get("appearance") if isinstance(meta.get("appearance"), dict) else {}

@@ -23,6 +23,7 @@ from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Literal
 
+from .._specs import absolute_spec
 from ..errors import WoodcamError, WoodcamWarning
 from ..limits import MAX_BLOCK_SIZE_MM
 
@@ -364,7 +365,9 @@ def read_job(path: str | Path) -> ParquetryJob:
                   id=t.get("id") or Path(t["texture"]).stem) for t in scans]
     targets = [dict(t, filename=_abs(t["filename"])) for t in targets]
     mokume = [_abs(m) for m in mokume]
-    return ParquetryJob(scans, list(blocks), mokume, targets, params)
+    # a block folder, log:PATH or woodify:PATH as the textures: from the job file's folder
+    blocks = [dict(b, spec=absolute_spec(b["spec"], base)) for b in blocks]
+    return ParquetryJob(scans, blocks, mokume, targets, params)
 
 
 def write_job(job: ParquetryJob, path: str | Path) -> Path:
@@ -383,7 +386,8 @@ def write_job(job: ParquetryJob, path: str | Path) -> Path:
     for k, name in _PAPER_KEYS.items():
         d[k] = prm[name]
     d["sort_patches_saliency"] = job.params.priority == "saliency"
-    d["woodcam"] = {"params": prm, "blocks": job.blocks, "mokume": [_abs(m) for m in job.mokume]}
+    d["woodcam"] = {"params": prm, "blocks": [dict(b, spec=absolute_spec(b["spec"])) for b in job.blocks],
+                    "mokume": [_abs(m) for m in job.mokume]}
     return write_text(path, json.dumps(d, indent=2), mkdir=True)
 
 
