@@ -636,6 +636,13 @@ _T = [{"filename": "t.png"}]
     ({"targets": [{"filename": "t.png", "scal": 0.5}]}, r"key targets\[0\].'scal' is unknown .*: dpi, "
      r"filename, morphed_grid, scale$"),
     ({"targets": _T, "sort_patches_saliency": "no"}, r"sort_patches_saliency must be true or false; got 'no'"),
+    # a typo in a block ran with the default; px_per_mm silently won over dpi and scale
+    ({"targets": _T, "woodcam": {"blocks": [{"spec": "builtin:flat-sawn", "sheet": 3}]}},
+     r"key woodcam.blocks\[0\].'sheet' is unknown \(woodcam reads no such key\); the known ones there: axis, "
+     r"height_mm, id, kerf_mm, sheets, spec, species, thickness_mm, width_mm$"),
+    ({"targets": _T, "source_textures": [{"texture": "t.png", "px_per_mm": 4, "dpi": 300, "scale": 0.5}]},
+     r"source_textures\[0\] gives px_per_mm \(4\) and dpi/scale \(300/0.5\); the resolution is one or the "
+     r"other: keep px_per_mm alone, or dpi \(times scale\)$"),
     # a TypeError: the file-exists check joined the mask to the job's folder before its type was checked
     ({"targets": _T, "source_textures": [{"texture": "t.png", "dpi": 300, "mask": 5}]},
      r"source_textures\[0\].mask must be a path or null; got 5$"),

@@ -237,6 +237,8 @@ _TOP_KEYS = {"source_textures", "targets", "woodcam", "sort_patches_saliency", *
 _ENTRY_KEYS = {"source_textures": {"texture", "mask", "id", "scale", "dpi", "px_per_mm", "markers_pixel",
                                    "json"},
                "targets": {"filename", "scale", "dpi", "morphed_grid"}}
+#: The keys of a ``woodcam.blocks`` entry (:func:`job_veneers` reads them).
+_BLOCK_KEYS = {"spec", "sheets", "width_mm", "height_mm", "thickness_mm", "kerf_mm", "axis", "species", "id"}
 
 
 def _unused_keys(d: dict, where: str) -> None:
@@ -316,6 +318,16 @@ def read_job(path: str | Path) -> ParquetryJob:
     targets = _entries(d, "targets", where, "filename")
     scans = _entries(d, "source_textures", where, "texture")
     blocks = _entries(extra, "blocks", f"{where} woodcam", "spec")
+    for i, b in enumerate(blocks):  # a typo ("sheet": 3) ran with the default
+        unknown = sorted(set(b) - _BLOCK_KEYS)
+        if unknown:
+            raise WoodcamError(f"{where} key woodcam.blocks[{i}].{unknown[0]!r} is unknown (woodcam reads "
+                               f"no such key); the known ones there: {', '.join(sorted(_BLOCK_KEYS))}")
+    for i, t in enumerate(scans):  # px_per_mm won and the dpi or scale was dropped without a word
+        if t.get("px_per_mm") is not None and (t.get("dpi") is not None or t.get("scale") is not None):
+            raise WoodcamError(f"{where} source_textures[{i}] gives px_per_mm ({t['px_per_mm']!r}) and "
+                               f"dpi/scale ({t.get('dpi')!r}/{t.get('scale')!r}); the resolution is one or "
+                               "the other: keep px_per_mm alone, or dpi (times scale)")
     for i, b in enumerate(blocks):  # the leaves' numbers (slice_veneers checks their ranges)
         for num, kind in (("sheets", "int"), ("width_mm", "float"), ("height_mm", "float"),
                           ("thickness_mm", "float"), ("kerf_mm", "float")):
