@@ -583,6 +583,10 @@ def test_job_file_round_trip_and_paper_keys(tmp_path):
     assert len(w) == 1 and "gabor" not in str(w[0].message)  # weight 0: no effect there either
     assert (j.params.n_adaptive, j.params.w_adaptive, j.params.priority) == (1, 1.5, "saliency")
     assert j.scans[0]["texture"] == str((tmp_path / "wood.jpg").resolve())
+    # downsample: the reference code ignores it too, so nothing to say (a warning said the run
+    # might differ from the reference code's)
+    (tmp_path / "down.json").write_text(json.dumps({"targets": [{"filename": "target.jpg"}], "downsample": 2}))
+    read_job(tmp_path / "down.json")  # no warning (they are errors here)
     paper["weight_gabor"] = 0.3
     (tmp_path / "paper.json").write_text(json.dumps(paper))
     with pytest.warns(WoodcamWarning, match=r"weight_gabor = 0.3 \(woodcam matches intensity and Sobel"):

@@ -228,12 +228,14 @@ _PAPER_KEYS = {"num_source_rotations": "n_rot", "patch_levels": "n_adaptive",
 #: The reference code's keys woodcam reads no value from, and why: a job file holding them
 #: (its sample does) is said to, not silently run otherwise than the reference code would.
 _PAPER_UNUSED = {
-    "min_patch_size": "woodcam's patch side is patch_mm: woodcam.params.patch_mm, --patch-mm",
-    "downsample": "the reference code ignores it too (deprecated)"}
+    "min_patch_size": "woodcam's patch side is patch_mm: woodcam.params.patch_mm, --patch-mm"}
+#: The reference code's keys that it ignores too (deprecated): accepted without a word, as the
+#: run is the reference code's either way.
+_PAPER_IGNORED = {"downsample"}
 #: Its Gabor-filter keys: no effect there either while weight_gabor is 0.
 _GABOR = ("weight_gabor", "filter_resolution", "num_filter_directions", "filter_bandwidth_octaves")
 _TOP_KEYS = {"source_textures", "targets", "woodcam", "sort_patches_saliency", *_PAPER_KEYS,
-             *_PAPER_UNUSED, *_GABOR}
+             *_PAPER_UNUSED, *_PAPER_IGNORED, *_GABOR}
 _ENTRY_KEYS = {"source_textures": {"texture", "mask", "id", "scale", "dpi", "px_per_mm", "markers_pixel",
                                    "json"},
                "targets": {"filename", "scale", "dpi", "morphed_grid"}}
