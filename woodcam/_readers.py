@@ -51,14 +51,19 @@ def read_json_object(path, what: str) -> dict:
     return d
 
 
-def read_image_file(path: Path, what: str):
+#: What a photo's transparent pixels most likely are, and the fix (:func:`read_image_file`).
+PHOTO_ALPHA_FIX = ("a cut-out?", "crop the image so every pixel is opaque, or flatten it onto its background")
+
+
+def read_image_file(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_ALPHA_FIX):
     """An image file decoded as every viewer shows it (its format told by its content, not its
     name), turned by its EXIF orientation tag (a phone stores a portrait photo as landscape
     pixels plus that tag: read raw it lies on its side, a face's rings turned 90 degrees):
     ``(h, w)`` or ``(h, w, 3)`` uint8 for 8-bit modes, uint16 for 16-bit ones (values kept). Files over :data:`~woodcam.limits.MAX_IMAGE_PIXELS`,
     unreadable, truncated, animated (a GIF, PNG or WebP of several frames: which is the face?)
     or of unsupported modes are WoodcamErrors naming ``what`` and the file; transparent pixels
-    (a cut-out) are read as the colour stored under them, with a WoodcamWarning."""
+    (a cut-out) are read as the colour stored under them, with a WoodcamWarning saying
+    ``alpha_fix``: (what they may be, the fix) for the image's use (a photo, a mask, a target)."""
     from PIL import Image, ImageOps
 
     from .limits import limit
@@ -95,7 +100,7 @@ def read_image_file(path: Path, what: str):
             # in place: a copy of an upright 48 MP photo (PIL's 4 bytes a pixel, 190 MB) made
             # for nothing raised a read's peak by a third
             ImageOps.exif_transpose(im, in_place=True)
-            return _image_array(im, f"{what}: {str(path)!r}")
+            return _image_array(im, f"{what}: {str(path)!r}", alpha_fix)
     except WoodcamError:
         raise
     except (Image.DecompressionBombError, Image.DecompressionBombWarning) as err:  # over the cap
@@ -110,10 +115,10 @@ def read_image_file(path: Path, what: str):
                            "cannot be read as an image: pass a PNG, JPEG or TIFF file") from err
 
 
-def read_photo_rgb(path: Path, what: str):
+def read_photo_rgb(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_ALPHA_FIX):
     """``(h, w, 3) uint8`` RGB of the image file ``path`` (:func:`read_image_file`; grey repeated,
     16-bit scaled by 1/257)."""
-    return photo_rgb8(read_image_file(path, what))
+    return photo_rgb8(read_image_file(path, what, alpha_fix))
 
 
 def photo_rgb8(a):
@@ -128,11 +133,20 @@ def photo_rgb8(a):
     return a[..., :3].astype(np.uint8, copy=False)
 
 
-def _image_array(im, where: str):
+def _image_array(im, where: str, alpha_fix: tuple[str, str] = PHOTO_ALPHA_FIX):
     """A decoded PIL image as uint8 (8-bit modes) or uint16 (16-bit modes, values kept);
     ``where`` (what and the file) starts the message of an image that cannot be."""
     import numpy as np
 
+    share = _transparent_share(im)
+    if share:  # the alpha was dropped without a word: a cut-out's background read as wood
+        import warnings
+
+        from .errors import WoodcamWarning
+
+        warnings.warn(f"{where} has transparent pixels ({100 * share:.3g} % of them, {alpha_fix[0]}), read as "
+                      f"the colour stored under them, the transparency dropped; {alpha_fix[1]}",
+                      WoodcamWarning, stacklevel=3)
     if im.mode in ("I;16", "I;16B", "I;16L", "I;16N"):
         return np.asarray(im).astype(np.uint16)
     if im.mode == "I":
@@ -145,15 +159,6 @@ def _image_array(im, where: str):
         kind = " (floating point)" if im.mode.startswith("F") else ""
         raise WoodcamError(f"{where} has image mode {im.mode}{kind}, which is not supported; save it as an "
                            "8- or 16-bit PNG")
-    share = _transparent_share(im)
-    if share:  # the alpha was dropped without a word: a cut-out's background read as wood
-        import warnings
-
-        from .errors import WoodcamWarning
-
-        warnings.warn(f"{where} has transparent pixels ({100 * share:.3g} % of them, a cut-out?), read as the "
-                      "colour stored under them, the transparency dropped; crop the image so every pixel is "
-                      "opaque, or flatten it onto its background", WoodcamWarning, stacklevel=3)
     if im.mode not in ("L", "RGB"):
         im = im.convert("RGB" if im.mode in ("P", "RGBA", "CMYK", "YCbCr", "LAB", "HSV", "PA")
                         else "L")
@@ -163,8 +168,12 @@ def _image_array(im, where: str):
 def _transparent_share(im) -> float:
     """The share of a PIL image's pixels not fully opaque (alpha < 255): 0 for modes without
     alpha or a transparent colour."""
+    import numpy as np
+
     if im.mode in ("RGBA", "LA", "PA"):
         alpha = im.getchannel("A")
+    elif "transparency" in im.info and im.mode.startswith("I;16"):  # a 16-bit grey's colour key
+        return float(np.mean(np.asarray(im) == im.info["transparency"]))
     elif "transparency" in im.info and im.mode in ("P", "L", "RGB"):  # a palette or colour key
         alpha = im.convert("RGBA").getchannel("A")
     else:

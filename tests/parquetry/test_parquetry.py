@@ -1085,3 +1085,32 @@ def test_preparing_the_rotated_sheets_has_a_bar(sheets, monkeypatch):
     build_parquetry(target, sheets[:1], ParquetryParams(image_size_mm=28, px_per_mm=PPM, n_rot=3),
                     progress=True)
     assert seen[:2] == [("rotating sheets", True), ("matching patches", True)]
+
+
+def test_transparent_pixels_are_named_with_the_fix_for_what_the_image_is_for(tmp_path):
+    """The alpha warning assumed a photo ('a cut-out? crop the image') for parquetry masks and
+    target logos too, and a 16-bit grey PNG's transparent colour was dropped without a word.
+    A mask: paint unusable wood black; a target: flatten it onto the background wanted."""
+    from PIL import Image
+
+    from woodcam.parquetry.job import ParquetryJob, job_targets
+
+    rgba = np.zeros((20, 20, 4), np.uint8)
+    rgba[..., :3], rgba[..., 3] = 180, 255
+    rgba[:5, :, 3] = 0
+    Image.fromarray(rgba).save(tmp_path / "logo.png")
+    Image.fromarray(rgba).save(tmp_path / "mask.png")
+    Image.new("RGB", (20, 20), (150, 100, 60)).save(tmp_path / "scan.png")
+    with pytest.warns(WoodcamWarning, match=r"target image: .*logo.png' has transparent pixels \(25 % of them, "
+                      r"a logo or cut-out\?\), .*; flatten it onto the background you want the panel to show$"):
+        job_targets(ParquetryJob(targets=[{"filename": str(tmp_path / "logo.png")}]))
+    with pytest.warns(WoodcamWarning, match=r"veneer mask: .*mask.png' has transparent pixels \(25 % of them, "
+                      r"transparency does not mark wood as unusable\), .*; paint unusable wood black and "
+                      r"usable wood white, every pixel opaque$"):
+        load_scan(tmp_path / "scan.png", dpi=100, mask=tmp_path / "mask.png")
+    grey = np.full((20, 20), 30000, np.uint16)
+    grey[:2] = 0
+    Image.fromarray(grey).save(tmp_path / "grey16.png", transparency=0)
+    with pytest.warns(WoodcamWarning, match=r"veneer scan: .*grey16.png' has transparent pixels \(10 % of them, "
+                      r"a cut-out\?\), .*; crop the image so every pixel is opaque"):
+        load_scan(tmp_path / "grey16.png", dpi=100)

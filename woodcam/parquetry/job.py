@@ -447,13 +447,13 @@ def job_veneers(job: ParquetryJob, open_stock=None, progress: bool = False) -> l
 
 def job_targets(job: ParquetryJob) -> tuple[list, list[str]]:
     """The job's target images ``(h, w, 3)`` float RGB and their names (file stems)."""
-    from .veneers import read_image
+    from .veneers import TARGET_ALPHA_FIX, read_image
 
     imgs, names = [], []
     for t in job.targets:
         if "filename" not in t:
             raise WoodcamError(f"targets entry {t} needs a 'filename'")
-        imgs.append(read_image(t["filename"], "target image"))
+        imgs.append(read_image(t["filename"], "target image", TARGET_ALPHA_FIX))
         names.append(Path(t["filename"]).stem)
     if len(set(names)) != len(names):
         names = [f"{n}{k}" for k, n in enumerate(names)]

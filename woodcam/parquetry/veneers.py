@@ -22,7 +22,7 @@ from typing import Literal, Protocol
 
 import numpy as np
 
-from .._readers import read_photo_rgb
+from .._readers import PHOTO_ALPHA_FIX, read_photo_rgb
 from ..errors import WoodcamError
 
 
@@ -118,10 +118,17 @@ def _check(v: Veneer) -> Veneer:
     return v
 
 
-def read_image(path, what: str = "image") -> np.ndarray:
+#: A target's transparent pixels and the fix (:func:`woodcam._readers.read_image_file`).
+TARGET_ALPHA_FIX = ("a logo or cut-out?", "flatten it onto the background you want the panel to show")
+#: A veneer mask's transparent pixels and the fix: the mask is read by its colour alone.
+MASK_ALPHA_FIX = ("transparency does not mark wood as unusable",
+                  "paint unusable wood black and usable wood white, every pixel opaque")
+
+
+def read_image(path, what: str = "image", alpha_fix: tuple[str, str] = PHOTO_ALPHA_FIX) -> np.ndarray:
     """Read an image file as ``(h, w, 3)`` float32 RGB in [0, 1] (grey is repeated), upright as
-    its EXIF orientation says (:func:`woodcam._readers.read_photo_rgb`)."""
-    rgb8 = read_photo_rgb(Path(path), what)
+    its EXIF orientation says (:func:`woodcam._readers.read_photo_rgb`; ``alpha_fix`` as there)."""
+    rgb8 = read_photo_rgb(Path(path), what, alpha_fix)
     # one pass into one float array: astype then / 255 made two (a 100 Mpx target peaked at
     # 2.4 GB and spent 10 s there); float32 arithmetic both ways, so the same values
     out = np.empty(rgb8.shape, np.float32)
@@ -177,7 +184,7 @@ def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | 
     else:
         # white where the mean of R, G, B over 255 is above 0.5, on the 8-bit values: the float
         # image (12 bytes a pixel) of a scan-sized mask was made only to be thresholded
-        m = read_photo_rgb(Path(mask), "veneer mask").sum(axis=2, dtype=np.uint16) > 382
+        m = read_photo_rgb(Path(mask), "veneer mask", MASK_ALPHA_FIX).sum(axis=2, dtype=np.uint16) > 382
     return _check(Veneer(id or Path(path).stem, rgb, ppm, m, str(path)))
 
 
