@@ -13,7 +13,8 @@ Data form
   voxel centres with the normal of that axis, eq. 10 of seed 000 depends on it), each a
   lossless WebP of tiled z slices (a third smaller than a PNG, which cannot predict real wood's
   busier rings: a 50 mm Mokume cube's three PNGs took 3.2 MiB in base64, over the page's 3 MiB;
-  WebP is read by every browser since 2020); the cap shader samples them trilinearly, so the
+  lossless WebP is read by Chrome 32+, Firefox 65+ and Safari 14+ on macOS 11+ / iOS 14+ (Safari
+  14-15 on older macOS cannot, and the page then says so)); the cap shader samples them trilinearly, so the
   cap shows ``Wood.color`` up to the voxel size (:func:`volume_cell_mm`);
 * the report (block, size, placement, texel density and anything the caller adds), the block's
   face photos where it has them, and hotspots (knots, G-code warnings) with positions in mm.
