@@ -9,8 +9,8 @@ import trimesh
 
 from woodcam.errors import WoodcamError
 from woodcam.woodify import Brush, woodify
-from woodcam.woodify.cracks import growth_stress, separation, simulate_cracks
-from woodcam.woodify.surfaces import barycentric_on, carry, trace_back
+from woodcam.woodify.cracks import growth_stress, separation, separation_local, simulate_cracks
+from woodcam.woodify.surfaces import barycentric_on, carry, trace_back, trace_grids
 
 
 @pytest.fixture(scope="module")
@@ -48,6 +48,64 @@ def test_hoop_stress_of_a_growing_cylinder_is_circumferential(cylinder):
     hv = np.stack([-mesh.vertices[vl, 1], mesh.vertices[vl, 0], 0 * mesh.vertices[vl, 0]], 1)
     hv /= np.linalg.norm(hv, axis=1, keepdims=True)
     assert np.median(np.abs(np.sum(e * hv, 1))) > 0.95  # opening across the circumference
+
+
+def _grids_from_scratch(front):
+    """The back-trace grids as trace_back built them on every call before they were cached."""
+    T = np.where(np.isfinite(front.arrival_mm), front.arrival_mm, np.nan)
+    Tf = np.where(np.isnan(T), np.nanmax(T), T)
+    return Tf.astype(np.float32), [g.astype(np.float32) for g in np.gradient(Tf, front.grid.spacing_mm)]
+
+
+def test_trace_back_grids_are_built_once_per_front_and_never_shared(cylinder):
+    import dataclasses
+
+    a = dataclasses.replace(cylinder.front)  # own cache, the module fixture stays untouched
+    # a second front on the same grid: a different growth, so different grids and origins
+    b = dataclasses.replace(a, arrival_mm=np.where(a.arrival_mm > 0, a.arrival_mm * 1.3, a.arrival_mm))
+    pts = cylinder.surface(4.0).vertices
+    ra, _ = trace_back(a, pts, until_mm=cylinder.tau(2.0))
+    assert trace_grids(a)[1][0] is trace_grids(a)[1][0]  # kept, not rebuilt
+    rb, _ = trace_back(b, pts, until_mm=cylinder.tau(2.0))
+    assert np.abs(ra - rb).max() > 0.1 * cylinder.front.grid.spacing_mm
+    for front in (a, b):  # the same bytes as the per-call grids of the old code
+        T, grads, t_max = trace_grids(front)
+        T0, grads0 = _grids_from_scratch(front)
+        assert t_max == np.nanmax(np.where(np.isfinite(front.arrival_mm), front.arrival_mm, np.nan))
+        assert T.dtype == np.float32 and np.array_equal(T, T0)
+        assert all(np.array_equal(g, g0) for g, g0 in zip(grads, grads0))
+    rb_fresh, _ = trace_back(dataclasses.replace(b), pts, until_mm=cylinder.tau(2.0))
+    assert np.array_equal(rb, rb_fresh)
+    assert np.array_equal(trace_back(a, pts, until_mm=cylinder.tau(2.0))[0], ra)
+    # a new arrival array on the same front rebuilds the grids
+    a.arrival_mm = b.arrival_mm.copy()
+    assert np.array_equal(trace_back(a, pts, until_mm=cylinder.tau(2.0))[0], rb)
+
+
+def test_separation_after_a_relief_is_that_of_the_faces_round_the_vertices(cylinder):
+    from scipy.spatial import cKDTree
+
+    mesh = cylinder.surface(4.0)
+    old, _ = trace_back(cylinder.front, mesh.vertices, until_mm=cylinder.tau(3.0))
+    sig = growth_stress(mesh, old)
+    ring = np.array([5, 17, 400, 401, 1200, 3])
+    # the old way: a submesh of those faces, its vertices found again by position
+    vf = mesh.vertex_faces[ring]
+    faces = np.unique(vf[vf >= 0])
+    sub = mesh.submesh([faces], append=True, repair=False)
+    _, j = cKDTree(sub.vertices).query(mesh.vertices[ring])
+    expect = separation(sub, sig[faces])[j]
+    assert np.array_equal(separation_local(mesh, sig, ring), expect)
+    assert np.allclose(expect, separation(mesh, sig)[ring], rtol=1e-12, atol=1e-15)
+
+
+def test_vertex_neighbours_are_listed_in_trimeshs_order(cylinder):
+    from woodcam.woodify.cracks import _neighbours
+
+    # the order decides a walk's ties and which vertex gets which draw of the random pattern
+    mesh = cylinder.surface(3.0)
+    expect = trimesh.Trimesh(mesh.vertices, mesh.faces, process=False).vertex_neighbors
+    assert _neighbours(mesh) == [[int(i) for i in nb] for nb in expect]
 
 
 def test_cracks_of_a_growing_cylinder_run_along_its_axis(cylinder):

@@ -96,3 +96,37 @@ def test_whole_run_with_cracks_and_surfaces_at_5_years():
             cracks=int(sum(x["cracks"] for x in cs.log)), cpu_s=round(dt, 2),
             timings=res.timings)
     assert all(s.is_watertight for s in surfaces)
+
+
+def test_crack_stage_against_the_growth_stage_at_200(monkeypatch):
+    """The crack stage at a fine grid, as ratios in the same run: to the growth (front) stage,
+    and to the same cracks with the back-trace grids rebuilt on every call (the old code path:
+    two full-grid float64 gradients a crack year)."""
+    from woodcam.woodify import surfaces
+
+    mesh = _tree_mesh()
+    years = 10
+    t = time.process_time()
+    res = woodify(mesh, years, resolution=200, eccentricity=0.2)
+    t_front = time.process_time() - t
+    ys = [years - 5 + k for k in range(6)]
+    t = time.process_time()
+    cs = simulate_cracks(res, ys)
+    t_cracks = time.process_time() - t
+    cached = surfaces.trace_grids
+
+    def rebuilt(front):
+        front._trace_cache = None
+        return cached(front)
+
+    monkeypatch.setattr(surfaces, "trace_grids", rebuilt)
+    t = time.process_time()
+    old = simulate_cracks(res, ys)
+    t_rebuilt = time.process_time() - t
+    _report("crack stage, 5 years", grid=list(res.front.grid.shape), cracks=len(cs.crack_directions),
+            vertices=len(cs.mesh.vertices), front_cpu_s=round(t_front, 2),
+            cracks_cpu_s=round(t_cracks, 2), ratio_to_front=round(t_cracks / t_front, 2),
+            grids_rebuilt_per_call_cpu_s=round(t_rebuilt, 2),
+            ratio_to_rebuilt=round(t_cracks / t_rebuilt, 2))
+    assert np.array_equal(cs.crack_edges, old.crack_edges)
+    assert np.array_equal(cs.crack_width, old.crack_width)

@@ -138,11 +138,15 @@ def _split(sig):
 
 def separation(mesh, stress) -> np.ndarray:
     """Per-vertex separation tensor ``(n, 3, 3)`` from per-face stress (module docstring)."""
-    tri = mesh.triangles
-    area = mesh.area_faces
     _, nrm = _frames(mesh)
+    return _separation(mesh.faces, mesh.triangles, mesh.area_faces, nrm, stress, len(mesh.vertices))
+
+
+def _separation(faces, tri, area, nrm, stress, n_vertices) -> np.ndarray:
+    """:func:`separation` on plain arrays: ``faces (f, 3)`` int indexing ``n_vertices``,
+    corners ``tri (f, 3, 3)`` mm, ``area (f,)``, unit normals ``nrm (f, 3)``, ``stress (f, 3, 3)``."""
     pos, neg = _split(stress)
-    zeta = np.zeros((len(mesh.vertices), 3, 3))
+    zeta = np.zeros((n_vertices, 3, 3))
     for i in range(3):
         a, b = tri[:, (i + 1) % 3], tri[:, (i + 2) % 3]
         edge = b - a
@@ -153,7 +157,7 @@ def separation(mesh, stress) -> np.ndarray:
             f = area[:, None] * np.einsum("fij,fj->fi", part, g)
             mag = np.linalg.norm(f, axis=1)
             m = np.einsum("fi,fj->fij", f, f) / np.maximum(mag, 1e-18)[:, None, None]
-            np.add.at(zeta, mesh.faces[:, i], 0.5 * sign * m)
+            np.add.at(zeta, faces[:, i], 0.5 * sign * m)
     return zeta
 
 
@@ -176,8 +180,10 @@ def _crack_frame(zeta, normals, pattern, up, rng):
     return lam, d
 
 
-def _walk(mesh, neighbours, start, direction, length_mm, cracked_edges):
-    """Follow mesh edges from ``start`` along ``direction`` for ``length_mm``; returns vertices."""
+def _walk(verts, neighbours, start, direction, length_mm, cracked_edges):
+    """Follow mesh edges from ``start`` along ``direction`` for ``length_mm``; returns vertices.
+
+    ``verts (n, 3)`` is a plain array (a trimesh ``TrackedArray`` re-hashes on every access)."""
     path = [start]
     v = start
     travelled = 0.0
@@ -186,7 +192,7 @@ def _walk(mesh, neighbours, start, direction, length_mm, cracked_edges):
         nb = neighbours[v]
         if not nb:
             break
-        vec = mesh.vertices[nb] - mesh.vertices[v]
+        vec = verts[nb] - verts[v]
         ln = np.linalg.norm(vec, axis=1)
         cos = (vec @ d) / np.maximum(ln, 1e-12)
         k = int(np.argmax(cos))
@@ -201,6 +207,44 @@ def _walk(mesh, neighbours, start, direction, length_mm, cracked_edges):
         v = nxt
         path.append(v)
     return path
+
+
+@dataclass
+class _MeshArrays:
+    """One year's surface as plain arrays, read once: trimesh re-hashes its arrays to check its
+    cache on every property access, which cost more than the crack work itself."""
+
+    verts: np.ndarray  # (n, 3) mm
+    faces: np.ndarray  # (f, 3) int
+    normals: np.ndarray  # (n, 3) vertex normals
+    tri: np.ndarray  # (f, 3, 3) corners
+    area: np.ndarray  # (f,)
+    face_normals: np.ndarray  # (f, 3) unit, as _frames
+    vertex_faces: np.ndarray  # (n, k) int, -1 padded
+    neighbours: list  # per vertex, list of vertex indices (trimesh's order)
+
+    @classmethod
+    def of(cls, mesh) -> _MeshArrays:
+        _, nrm = _frames(mesh)
+        return cls(np.asarray(mesh.vertices).view(np.ndarray), np.asarray(mesh.faces).view(np.ndarray),
+                   np.asarray(mesh.vertex_normals).view(np.ndarray),
+                   np.asarray(mesh.triangles).view(np.ndarray), np.asarray(mesh.area_faces).view(np.ndarray),
+                   nrm, np.asarray(mesh.vertex_faces).view(np.ndarray), _neighbours(mesh))
+
+
+def _neighbours(mesh) -> list:
+    """``mesh.vertex_neighbors`` in the same order, without trimesh's per-edge Python loop.
+
+    trimesh adds each edge's ends to per-vertex sets in edge order and lists the sets; the same
+    insertions in the same order give the same set, so the same list order (which decides the
+    walks' ties and the random pattern's draws)."""
+    E = np.asarray(mesh.edges_unique)
+    src = E.reshape(-1)  # a0, b0, a1, b1, ...
+    dst = E[:, ::-1].reshape(-1)  # b0, a0, b1, a1, ...
+    order = np.argsort(src, kind="stable")
+    d = dst[order].tolist()
+    cut = np.searchsorted(src[order], np.arange(len(mesh.vertices) + 1)).tolist()
+    return [list(set(d[i:j])) for i, j in zip(cut[:-1], cut[1:])]
 
 
 def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region=None,
@@ -254,39 +298,40 @@ def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region
     directions, points = [], []
     for k in range(1, len(ys)):
         mesh = wd.surface(ys[k])
-        origins, tri = wd.origins(mesh.vertices)
-        old_pos, _ = trace_back(wd.front, mesh.vertices, wind=wd.speed.wind,
-                                until_mm=wd.tau(ys[k - 1]))
+        ma = _MeshArrays.of(mesh)
+        V, nbrs = ma.verts, ma.neighbours
+        origins, tri = wd.origins(V)
+        old_pos, _ = trace_back(wd.front, V, wind=wd.speed.wind, until_mm=wd.tau(ys[k - 1]))
         stress = growth_stress(mesh, old_pos)
-        width = np.zeros(len(mesh.vertices))
+        width = np.zeros(len(V))
         cracked_edges: set = set()
         if prev is not None:
             # carry last year's stress (per face, by face-centre origin) and cracks (per vertex)
-            fo = origins[mesh.faces].mean(1)
+            fo = origins[ma.faces].mean(1)
             _, j = cKDTree(prev.origins_mm[prev.mesh.faces].mean(1)).query(fo)
             stress = stress + prev.stress[j]
             # each old crack edge maps to the new vertices nearest its ends' origins, rejoined
             # along the new edges (the seed's coupling through unique vertex identities)
-            _, ja = cKDTree(origins).query(prev.origins_mm[prev.crack_edges[:, 0]])
-            _, jb = cKDTree(origins).query(prev.origins_mm[prev.crack_edges[:, 1]])
-            nbrs = mesh.vertex_neighbors
+            tree = cKDTree(origins)
+            _, ja = tree.query(prev.origins_mm[prev.crack_edges[:, 0]])
+            _, jb = tree.query(prev.origins_mm[prev.crack_edges[:, 1]])
             old_w = np.maximum(prev.crack_width[prev.crack_edges[:, 0]],
                                prev.crack_width[prev.crack_edges[:, 1]])
             for a, b, wo in zip(ja, jb, old_w):
                 if a == b:
                     continue
-                seg = mesh.vertices[b] - mesh.vertices[a]
+                seg = V[b] - V[a]
                 ln = float(np.linalg.norm(seg))
-                path = _walk(mesh, nbrs, int(a), seg / ln, ln * 0.99, cracked_edges)
+                path = _walk(V, nbrs, int(a), seg / ln, ln * 0.99, cracked_edges)
                 width[path] = np.maximum(width[path], wo)
         # an open crack keeps widening while the bark stretches, and carries no stress across
         cracked_v = width > 0
         if cracked_v.any():
             width = np.where(cracked_v, np.minimum(width + 0.25, 1.0), 0.0)
-            on_crack = cracked_v[mesh.faces].any(1)
+            on_crack = cracked_v[ma.faces].any(1)
             stress[on_crack] *= relief
-        zeta = separation(mesh, stress)
-        lam, d = _crack_frame(zeta, mesh.vertex_normals, pattern, up, rng)
+        zeta = _separation(ma.faces, ma.tri, ma.area, ma.face_normals, stress, len(V))
+        lam, d = _crack_frame(zeta, ma.normals, pattern, up, rng)
         allowed = np.ones(len(lam), bool)
         if region is not None:
             c = np.asarray(region[:3], float)
@@ -296,8 +341,7 @@ def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region
             thr = 2.0 * float(base) if base > 0 else float(np.max(lam) + 1.0)
         heap = [(-lam[v], v) for v in np.nonzero(allowed & (lam > thr) & ~cracked_v)[0]]
         heapq.heapify(heap)
-        nbrs = mesh.vertex_neighbors
-        vf = mesh.vertex_faces
+        vf = ma.vertex_faces
         inserted = 0
         current = lam.copy()
         while heap:
@@ -305,14 +349,14 @@ def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region
             if -neg != current[v] or current[v] <= thr or width[v] > 0:
                 continue
             length = crack_length_voxels * h * min(current[v] / thr, 3.0)
-            path = _walk(mesh, nbrs, v, d[v], length / 2, cracked_edges)[::-1][:-1]
-            path += _walk(mesh, nbrs, v, -d[v], length / 2, cracked_edges)
+            path = _walk(V, nbrs, v, d[v], length / 2, cracked_edges)[::-1][:-1]
+            path += _walk(V, nbrs, v, -d[v], length / 2, cracked_edges)
             if len(path) < 2:
                 current[v] = -np.inf
                 continue
             inserted += 1
             directions.append(d[v])
-            points.append(mesh.vertices[v])
+            points.append(V[v])
             path = np.asarray(path)
             width[path] = np.maximum(width[path], 0.25)
             # relief: the faces round the crack keep only `relief` of their stress
@@ -323,13 +367,13 @@ def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region
             faces = np.unique(vf[ring])
             faces = faces[faces >= 0]
             stress[faces] *= relief
-            z = separation_local(mesh, stress, ring)
-            lam_r, d_r = _crack_frame(z, mesh.vertex_normals[ring], pattern, up, rng)
+            z = separation_local(ma, stress, ring)
+            lam_r, d_r = _crack_frame(z, ma.normals[ring], pattern, up, rng)
             current[ring] = lam_r
             d[ring] = d_r
-            for a, la in zip(ring, lam_r):
-                if la > thr and allowed[a] and width[a] == 0:
-                    heapq.heappush(heap, (-la, a))
+            back = (lam_r > thr) & allowed[ring] & (width[ring] == 0)
+            for a, la in zip(ring[back].tolist(), lam_r[back].tolist()):
+                heapq.heappush(heap, (-la, a))
         stress = _diffuse(mesh, stress, diffusion)
         log.append({"year": ys[k], "cracks": inserted, "max_eigenvalue": float(np.max(lam)),
                     "threshold": thr})
@@ -343,15 +387,15 @@ def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region
 
 def separation_local(mesh, stress, vertices) -> np.ndarray:
     """Separation tensors ``(k, 3, 3)`` of some vertices (recomputed after a relief)."""
-    vf = mesh.vertex_faces[vertices]
+    m = mesh if isinstance(mesh, _MeshArrays) else _MeshArrays.of(mesh)
+    vf = m.vertex_faces[vertices]
     faces = np.unique(vf[vf >= 0])
-    sub = mesh.submesh([faces], append=True, repair=False)
-    # map the wanted vertices into the submesh by position (submesh renumbers)
-    from scipy.spatial import cKDTree
-
-    z = separation(sub, stress[faces])
-    _, j = cKDTree(sub.vertices).query(mesh.vertices[vertices])
-    return z[j]
+    # only the faces round the vertices count; number their corners compactly (ascending, as
+    # a submesh would) so the sums run in the same order as over the whole mesh
+    used, local = np.unique(m.faces[faces], return_inverse=True)
+    z = _separation(local.reshape(-1, 3), m.tri[faces], m.area[faces], m.face_normals[faces],
+                    stress[faces], len(used))
+    return z[np.searchsorted(used, vertices)]
 
 
 def _diffuse(mesh, stress, rate: float, steps: int = 2):

@@ -28,6 +28,7 @@ Grid convention: nodes at ``origin_mm + (i, j, k) * spacing_mm``, arrays ``[x, y
 from __future__ import annotations
 
 from dataclasses import dataclass
+from dataclasses import field as dc_field
 from typing import Literal
 
 import numpy as np
@@ -102,6 +103,11 @@ class Front:
         The input triangle of that closest point, -1 beyond the band.
     method : str
         The solver used.
+
+    ``arrival_mm`` is read-only once the front is built: the back-trace grids
+    (:func:`woodcam.woodify.surfaces.trace_grids`) are derived from it once and kept in
+    ``_trace_cache``, checked against the array's identity (assigning a new array rebuilds
+    them; writing into this one in place would not).
     """
 
     grid: VoxelGrid
@@ -112,6 +118,7 @@ class Front:
     input_closest_mm: np.ndarray
     input_tri: np.ndarray
     method: str
+    _trace_cache: tuple | None = dc_field(default=None, init=False, repr=False, compare=False)
 
 
 def check_watertight(mesh, name: str):

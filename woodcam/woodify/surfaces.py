@@ -55,11 +55,29 @@ def surface_at(front, tau_mm: float):
     return mesh
 
 
-def _grad_grids(T: np.ndarray, h: float):
-    Tf = np.where(np.isfinite(T), T, np.nan)
-    fill = np.nanmax(Tf)
-    Tf = np.where(np.isnan(Tf), fill, Tf)
-    return [np.asarray(g, np.float32) for g in np.gradient(Tf, h)]
+def trace_grids(front):
+    """The grids :func:`trace_back` interpolates, built once per front and kept on it.
+
+    Returns ``(T, grads, t_max)``: ``T (nx, ny, nz) float32`` the arrival time with the nodes
+    never reached set to ``t_max`` (mm, the largest finite arrival), and ``grads`` its three
+    partial derivatives (float32 grids, central differences in float64 first). A crack run
+    traces back twice per year; rebuilding these each call was most of its grid work. The
+    cache (16 bytes a node) is tied to the ``front.arrival_mm`` array object (see
+    :class:`~.front.Front`).
+    """
+    cache = front._trace_cache
+    if cache is not None and cache[0] is front.arrival_mm:
+        return cache[1:]
+    A = front.arrival_mm
+    finite = np.isfinite(A)
+    t_max = float(np.max(A[finite])) if finite.any() else float("nan")
+    Tf = np.where(finite, A, t_max)
+    h = front.grid.spacing_mm
+    # one axis at a time: the float64 differences of a 200^3 grid are 64 MB each
+    grads = tuple(np.gradient(Tf, h, axis=d).astype(np.float32) for d in range(3))
+    out = (Tf.astype(np.float32), grads, t_max)
+    front._trace_cache = (A, *out)
+    return out
 
 
 def trace_back(front, points_mm, wind=None, step_voxels: float = 0.5, until_mm: float = 0.0):
@@ -87,14 +105,12 @@ def trace_back(front, points_mm, wind=None, step_voxels: float = 0.5, until_mm: 
     """
     h = front.grid.spacing_mm
     o = np.asarray(front.grid.origin_mm)
-    T = np.where(np.isfinite(front.arrival_mm), front.arrival_mm, np.nan)
-    grads = _grad_grids(T, h)
-    Tfill = np.where(np.isnan(T), np.nanmax(T), T).astype(np.float32)
+    Tfill, grads, t_max = trace_grids(front)
     w = np.zeros(3) if wind is None else np.asarray(wind, float)
     x = np.array(points_mm, dtype=float)
     active = np.ones(len(x), bool)
     step = step_voxels * h
-    n_steps = int(np.nanmax(T) / step / (1 - np.linalg.norm(w) + 1e-9)) + 8
+    n_steps = int(t_max / step / (1 - np.linalg.norm(w) + 1e-9)) + 8
     for _ in range(n_steps):
         if not active.any():
             break
