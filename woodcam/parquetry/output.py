@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import all_or_nothing, remove_stale, write_text
+from .._atomic import all_or_nothing, manifest_path, remove_stale, write_text
 from ._io import atomic_write_png
 from .cutpaths import (
     Piece,
@@ -213,6 +213,7 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
                        for s in (".png", "_*.png")]
                  + ["assembly.svg", "assembly_*.svg", "panel.glb", "panel_*.glb", "veneer_*.svg",
                     "veneer_*.dxf", "job.json"], files, kind="parquetry")
+    files.append(manifest_path(out, "parquetry"))  # the list of them, for the next run (as woodify's)
     return {"files": [str(f) for f in files], "summary": summ, "problems": problems}
 
 
