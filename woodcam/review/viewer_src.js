@@ -134,7 +134,7 @@ function loadVolume(vol) {
     const img = new Image();
     // an image the browser cannot read left the page "loading" for ever
     img.onerror = () => reject(new Error('this browser cannot read the colour volumes (lossless '
-                                         + 'WebP: Chrome 32+, Firefox 65+, Safari 14+)'));
+                                         + 'WebP: Chrome 32+, Firefox 65+, Safari 14+ on macOS 11+ or iOS 14+)'));
     img.onload = () => {
       const c = document.createElement('canvas');
       c.width = img.width; c.height = img.height;
