@@ -13,7 +13,9 @@ eccentric logs, every sawing pattern, a quarter of them knotted logs of seed 001
 :func:`woodcam.synth.synth_block`, with photo-style augmentation: colour and exposure, blur,
 noise, JPEG, lighting gradients, dark pores and ray streaks. The target is the exact distance
 to the true ring lines (the integer iso-lines of the true field), ``exp(-(d / sigma)^2)``.
-Everything is seeded by :attr:`RingNetSpec.seed`; the spec, the weights and a CSV log are
+The quilted styles (opt-in; the committed net is ``"mixed"``) paint training faces with real
+photos' texture placed by ring phase (:mod:`woodcam.detect._quilt`; the photos are read when
+training, never at run time). Everything is seeded by :attr:`RingNetSpec.seed`; the spec, the weights and a CSV log are
 written together. The committed model lives in ``woodcam/models/rings.*``.
 """
 
@@ -37,7 +39,21 @@ SPEC_NAME = "rings_spec.json"
 WEIGHTS_NAME = "rings.pt"
 LOG_NAME = "rings_train_log.csv"
 #: Colours of the training faces (:attr:`RingNetSpec.style`).
-TRAINING_STYLES = ("plain", "realistic", "mixed")
+TRAINING_STYLES = ("plain", "realistic", "mixed", "quilted", "mixed-quilted", "quilted-softwood")
+#: The styles that paint some training cubes with real photos' texture (need ``texture_samples``).
+QUILTED_STYLES = ("quilted", "mixed-quilted", "quilted-softwood")
+#: Per style, the colour of training cube ``i``: entry ``i % len(...)``.
+_CUBE_STYLES = {"plain": ("plain",), "realistic": ("realistic",), "mixed": ("plain", "realistic", "realistic"),
+                "quilted": ("plain", "quilted", "quilted"), "mixed-quilted": ("plain", "realistic", "quilted"),
+                "quilted-softwood": ("plain", "quilted", "softwood", "quilted", "quilted")}
+
+
+def cube_style(style: str, i: int) -> str:
+    """The colour (``"plain"``, ``"realistic"`` (softwood or oak by ``i``'s parity), ``"softwood"``
+    (realistic softwood) or ``"quilted"``) of training cube ``i`` of a
+    :class:`RingNetSpec` of ``style``."""
+    kinds = _CUBE_STYLES[style]
+    return kinds[i % len(kinds)]
 
 
 @dataclass(frozen=True)
@@ -57,7 +73,16 @@ class RingNetSpec:
         :class:`woodcam.synth.photos._RealisticWood` (narrow softwood latewood darkest at the
         boundary, or ring-porous oak whose pore band starts at it; rays, figure, faint rings),
         softwood and oak on alternate cubes; ``"mixed"``: every third cube plain, the others
-        realistic. The target is the true ring boundary on every style.
+        realistic; ``"quilted"``: every third cube plain, the others painted with real photos'
+        texture placed by ring phase (:mod:`woodcam.detect._quilt`), spruce-like and oak-like
+        cubes alternating by ``texture_samples``; ``"mixed-quilted"``: plain, realistic and
+        quilted cubes in turn; ``"quilted-softwood"``: of every five cubes one plain, one
+        realistic softwood and three quilted (:func:`cube_style`). The target is the true ring
+        boundary on every style.
+    texture_samples : for the quilted styles (:data:`QUILTED_STYLES`) only (refused otherwise): Mokume sample folders whose six
+        face photos are the textures, relative to the shared data folder
+        (``$WOODCAM_SHARED_DATA``), cube ``i`` of the training set painted from sample
+        ``i % len(texture_samples)``. Read when the training faces are made, never at run time.
     """
 
     seed: int = 0
@@ -72,11 +97,21 @@ class RingNetSpec:
     max_train_s: float = 660.0
     log_every: int = 25
     style: str = "plain"
+    texture_samples: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.style not in TRAINING_STYLES:
             raise WoodcamError(f"ring net spec style must be one of {', '.join(TRAINING_STYLES)}; "
                                f"got {self.style!r}")
+        samples = self.texture_samples
+        if isinstance(samples, str) or not all(isinstance(x, str) and x for x in samples):
+            raise WoodcamError(f"ring net spec texture_samples must be a list of sample folders (e.g. "
+                               f"[\"mokume/H11\"]); got {samples!r}")
+        object.__setattr__(self, "texture_samples", tuple(samples))   # JSON gives a list
+        if (self.style in QUILTED_STYLES) != bool(self.texture_samples):
+            raise WoodcamError(f"ring net spec texture_samples go with styles {', '.join(QUILTED_STYLES)} (their "
+                               f"real texture photos) and only with them; got style {self.style!r} and texture_samples "
+                               f"{list(self.texture_samples)}")
 
     @classmethod
     def load(cls, path) -> RingNetSpec:

@@ -14,6 +14,7 @@ from typing import Literal
 import numpy as np
 
 from ..errors import WoodcamError
+from ..fields.base import evaluate
 from ..frames import FACES
 from .block import synth_block
 from .cut import PATTERNS, cut_block, random_log_placement
@@ -59,39 +60,97 @@ def ring_eval_faces(seed: int, face_px: int = 256, size_mm: float = 50.0,
     return out
 
 
-def ring_training_faces(spec, progress: bool = False) -> tuple[np.ndarray, np.ndarray]:
+def texture_sources(samples, progress: bool = False) -> list:
+    """The texture sources of ``RingNetSpec.texture_samples``: per sample folder (relative to the
+    shared data folder, ``$WOODCAM_SHARED_DATA``; a Mokume sample), its face photos prepared by
+    :func:`woodcam.detect._quilt.quilt_source` (faces with too little usable phase left out)."""
+    from pathlib import Path
+
+    from .._progress import progress_bar
+    from ..block.io import read_mokume
+    from ..detect._quilt import SOURCE_MIN_SHARE, quilt_source
+    from ..logs.io import shared_data_dir
+
+    base = shared_data_dir()
+    folders = [None if base is None else Path(base) / s for s in samples]
+    missing = [s for s, f in zip(samples, folders) if f is None or not f.is_dir()]
+    if missing:
+        raise WoodcamError(f"ring net spec texture_samples {missing} not found under the shared data folder "
+                           f"({base if base is not None else 'none found'}): style 'quilted' reads their real "
+                           f"face photos when training; set WOODCAM_SHARED_DATA=/path/to/shared/data or "
+                           f"train another style")
+    groups = []
+    for s, folder in progress_bar(list(zip(samples, folders)), desc="reading texture photos", unit="sample",
+                                  enabled=progress):
+        block = read_mokume(folder)
+        group = []
+        for name, f in block.faces.items():
+            if f.photo is None:
+                continue
+            src = quilt_source(f.photo, 1.0 / min(block.face_pixel_size_mm(name)), f"{s} {name}")
+            if src.valid.mean() >= SOURCE_MIN_SHARE:
+                group.append(src)
+        if not group:
+            raise WoodcamError(f"ring net spec texture_samples: no face photo of {s!r} shows rings the "
+                               f"classical detector can follow; leave it out")
+        groups.append(group)
+    return groups
+
+
+def ring_training_faces(spec, progress: bool = False, sources=None) -> tuple[np.ndarray, np.ndarray]:
     """Training data of the learned ring detector for ``spec``
     (:class:`woodcam.detect.learned.RingNetSpec`): ``(inputs (n, h, w) float32, targets (n, h, w)
     float32)`` from ``spec.n_blocks`` synthetic 50 mm cubes, seeds ``[spec.seed, i, 7]`` (never
     the evaluation seeds), every fourth cut from a knotted log (seeds 001/003), photos augmented
     by :func:`woodcam.detect.learned.augment_photo`; targets ``exp(-(d / sigma)^2)`` of the
     distance ``d`` (px) to the true ring lines, ``sigma = spec.target_sigma_px``. The faces'
-    colour is ``spec.style`` (:attr:`~woodcam.detect.learned.RingNetSpec.style`)."""
+    colour is ``spec.style`` (:attr:`~woodcam.detect.learned.RingNetSpec.style`).
+
+    ``sources``: for ``style="quilted"``, a list of groups (one per real cube), each a list of
+    :class:`woodcam.detect._quilt.QuiltSource`; default :func:`texture_sources` of
+    ``spec.texture_samples``. Every third cube is plain, the others are painted by
+    :func:`woodcam.detect._quilt.quilt_face` with the textures of group ``i % len(sources)``
+    (one source face per synthetic face, drawn at random from the group)."""
     from .._progress import progress_bar
 
-    from ..detect.learned import augment_photo, net_input
+    from ..detect.learned import QUILTED_STYLES, augment_photo, cube_style, net_input
+
+    if getattr(spec, "style", "plain") in QUILTED_STYLES and sources is None:
+        sources = texture_sources(spec.texture_samples, progress)
 
     xs, ys = [], []
     for i in progress_bar(range(spec.n_blocks), desc="synthesising faces", unit="block", enabled=progress):
         rng = np.random.default_rng([spec.seed, i, 7])
         size = (50.0, 50.0, 50.0)
+        kind = cube_style(getattr(spec, "style", "plain"), i)
         pattern = PATTERNS[i % len(PATTERNS)]
-        log, placement = random_log_placement(rng, pattern, size, (0.8, 6.0))
+        # quilted cubes: rings no narrower than the evaluation faces' 1.5 mm, so real texture is
+        # not shrunk five-fold into noise (the real faces' spacings read 3-12 mm)
+        widths = (1.5, 6.0) if kind == "quilted" else (0.8, 6.0)
+        log, placement = random_log_placement(rng, pattern, size, widths)
         if i % 4 == 3:                     # a knotted log; the block kept inside it
-            log = knotted_log_field(rng, (0.8, 6.0))
+            log = knotted_log_field(rng, widths)
             half_diag = 0.5 * math.hypot(size[0], size[1])
             r_in = float(getattr(getattr(log, "log", None), "r_min_mm", 100.0)) - half_diag - 5.0
             if placement["pattern"] != "pith-inside":
                 placement["distance_mm"] = max(half_diag + 2.0, min(placement["distance_mm"], r_in))
         field = cut_block(log, size, **placement)
-        style = getattr(spec, "style", "plain")
         wood = None
-        if style == "realistic" or (style == "mixed" and i % 3):
-            # softwood and oak on alternate cubes (of the realistic ones)
-            wood = _RealisticWood(field, rng, "ring-porous" if i % 2 else "softwood")
+        quilted = kind == "quilted"
+        if kind in ("realistic", "softwood"):
+            # softwood and oak on alternate cubes (of the "realistic" ones; "softwood" cubes all softwood)
+            wood = _RealisticWood(field, rng, "ring-porous" if i % 2 and kind == "realistic" else "softwood")
         block = synth_block(field, size, face_px=spec.face_px, rng=rng, seed=None, trace_faces=(),
                             ring_map_sigma_px=spec.target_sigma_px, ring_map_noise=0.0, wood=wood)
-        for f in block.faces.values():
-            xs.append(net_input(augment_photo(f.photo, rng)))
+        for name, f in block.faces.items():
+            photo = f.photo
+            if quilted:
+                from ..detect._quilt import quilt_face
+                from ..frames import face_pixel_points
+
+                group = sources[i % len(sources)]
+                years = evaluate(field, face_pixel_points(name, f.shape, size).reshape(-1, 3)).reshape(f.shape)
+                photo, _ = quilt_face(years, group[int(rng.integers(len(group)))], rng)
+            xs.append(net_input(augment_photo(photo, rng)))
             ys.append(np.nan_to_num(f.ring_map, nan=0.0).astype(np.float32))
     return np.stack(xs), np.stack(ys)
