@@ -53,3 +53,18 @@ def test_quilted_face_puts_the_source_ring_boundary_on_the_true_one(direction, a
         assert min(at, 1 - at) <= 1.5 / 32 and abs(best) <= 1, (at, best)
     else:   # the darkest bin (0.08 of a ring after the fall, 2.6 bins) on the line
         assert min(np.argmin(prof), 32 - np.argmin(prof)) <= 1 and -4 <= best <= -2, (np.argmin(prof), best)
+
+
+def test_a_source_without_usable_phase_is_refused_with_the_fix():
+    """A source with no usable ring phase raised a bare ValueError: now the project's error,
+    naming the source and the fix."""
+    import dataclasses
+
+    from woodcam.errors import WoodcamError
+
+    photo = _stand_in(1.0)
+    src = quilt_source(photo)
+    empty = dataclasses.replace(src, valid=np.zeros_like(src.valid))
+    years = np.add.outer(np.arange(64.0), np.zeros(64)) / 13.0
+    with pytest.raises(WoodcamError, match="no usable ring phase.*SOURCE_MIN_SHARE"):
+        quilt_face(years, empty, np.random.default_rng(0))

@@ -321,6 +321,11 @@ def test_a_mesh_saved_in_metres_is_named_as_such(tmp_path, capsys):
     assert main(["woodify", str(tmp_path / "mm.stl"), "--years", "5", "--resolution", "16",
                  "--cracks", "none", "--out", str(tmp_path / "o2")]) == 0
     assert "warning" not in capsys.readouterr().err
+    # an obstacle file in metres is named as the obstacle it is, not as the part
+    assert main(["woodify", str(tmp_path / "mm.stl"), "--years", "5", "--resolution", "16", "--cracks",
+                 "none", "--obstacle", str(tmp_path / "m.stl"), "--out", str(tmp_path / "o3")]) == 0
+    (msg,) = [line for line in capsys.readouterr().err.splitlines() if "metres" in line]
+    assert msg.startswith("woodcam: warning: --obstacle '" + str(tmp_path / "m.stl") + "'")
 
 
 def test_a_bar_is_drawn_while_the_growth_runs(tmp_path, monkeypatch):

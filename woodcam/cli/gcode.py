@@ -281,7 +281,7 @@ def run(args) -> int:
                               max_atlas_px=args.max_atlas)
     t_bake = time.perf_counter() - t1
     if design is not None:
-        out.files["deviation"] = _deviation_png(args.out)
+        out.files["deviation"] = png  # the map written above
     if args.screenshot:
         _screenshot(args, stock, program, offset, out, res.heightmap)
     remove_stale_outputs(args.out, out.files, inputs=[*args.program, args.part])

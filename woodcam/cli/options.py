@@ -130,12 +130,13 @@ def check_screenshot(args: argparse.Namespace) -> None:
     :func:`check_out` checks, or beside preview's MESH (MESH_view.png), checked here when MESH
     is a file (a missing MESH is the command's own error)."""
     from ..errors import UsageError
-    from ..pipeline import screenshot_path
 
     shot = getattr(args, "screenshot", None)
     mesh = getattr(args, "mesh", None)
     derived = shot is True and not hasattr(args, "out") and isinstance(mesh, Path) and mesh.is_file()
-    if derived:
+    if derived:  # imported here only: woodcam.pipeline pulls in numba and scipy (0.3 s on every command)
+        from ..pipeline import screenshot_path
+
         shot = screenshot_path(True, mesh)
     if not isinstance(shot, (str, Path)):
         return

@@ -82,15 +82,16 @@ def register(subparsers) -> argparse.ArgumentParser:
     return p
 
 
-def _load_mesh(path: str):
-    """(watertight geometry, textured original or None) from a part or mesh file."""
+def _load_mesh(path: str, what: str = "part"):
+    """(watertight geometry, textured original or None) from a part or mesh file; ``what`` names
+    it in messages (``part``, ``--obstacle``)."""
     import numpy as np
     import trimesh
 
     pth = Path(path)
     if pth.suffix.lower() in (".stl", ".obj", ".ply", ".glb", ".gltf", ".off"):
         if not pth.is_file():
-            raise WoodcamError(f"part {path!r} does not exist")
+            raise WoodcamError(f"{what} {path!r} does not exist")
         try:
             if pth.suffix.lower() in (".glb", ".gltf", ".obj"):
                 from ..export import load_textured  # undoes woodcam's glTF/OBJ frame
@@ -103,14 +104,14 @@ def _load_mesh(path: str):
         except WoodcamError:
             raise
         except Exception as err:  # trimesh raises many kinds for unreadable files
-            raise WoodcamError(f"part {path!r} could not be read as a mesh: {err}") from err
+            raise WoodcamError(f"{what} {path!r} could not be read as a mesh: {err}") from err
         textured = loaded if getattr(loaded.visual, "uv", None) is not None else None
-        _warn_units(loaded, path)
+        _warn_units(loaded, path, what)
         paint = _ply_paint(loaded, path)
         if paint:
             if not loaded.is_watertight:
                 raise WoodcamError(
-                    f"part {path!r} carries growth attributes per vertex, so it must be watertight "
+                    f"{what} {path!r} carries growth attributes per vertex, so it must be watertight "
                     "as stored (shared vertices), without merging; weld its vertices first")
             return loaded, None, paint
         geom = trimesh.Trimesh(loaded.vertices, loaded.faces, process=True)
@@ -125,7 +126,7 @@ def _load_mesh(path: str):
     return trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts)), None, {}
 
 
-def _warn_units(mesh, path: str) -> None:
+def _warn_units(mesh, path: str, what: str = "part") -> None:
     """Warn when a mesh file's size says it was saved in metres: it is read as mm, and a 40 mm
     box saved as 0.04 grew, silently, into a 0.06 mm speck (woodcam.cad.carve.units_hint)."""
     import warnings
@@ -137,7 +138,7 @@ def _warn_units(mesh, path: str) -> None:
     hint = units_hint(lo, hi, None, "scale it by 1000 in your CAD program or export it in "
                       "mm (--units converts only the lengths typed as options, never the mesh)")
     if hint:
-        warnings.warn(f"part {path!r}: {hint}", WoodcamWarning, stacklevel=3)
+        warnings.warn(f"{what} {path!r}: {hint}", WoodcamWarning, stacklevel=3)
 
 
 def _ply_paint(mesh, path) -> dict:
@@ -354,7 +355,7 @@ def run(args) -> int:
                   desc="woodify", leave=False) as bar:
         with bar.stage("read the mesh"):
             mesh, textured, painted = _load_mesh(args.part)
-            obstacles = [_load_mesh(str(o))[0] for o in args.obstacle]
+            obstacles = [_load_mesh(str(o), "--obstacle")[0] for o in args.obstacle]
             brushes = load_brushes(args.brushes) if args.brushes else ()
         with bar.stage("grow"):
             res = woodify(mesh, args.years, growth_mm=args.growth, time_scale_years=args.time_scale,

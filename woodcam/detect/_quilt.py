@@ -30,6 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import WoodcamError
+
 #: Phase bins of the luminance profile across a ring (:func:`phase_profile`).
 PROFILE_BINS = 32
 #: Smoothing (px) of the source phase field before its gradient (normal and spacing) is read.
@@ -227,7 +229,9 @@ def quilt_face(years: np.ndarray, source: QuiltSource, rng: np.random.Generator,
     gr, gc = ndimage.gaussian_filter(gr, 1.0), ndimage.gaussian_filter(gc, 1.0)
     usable = np.flatnonzero(source.valid.ravel())
     if not len(usable):
-        raise ValueError(f"texture source {source.name!r} has no usable ring phase")
+        raise WoodcamError(f"quilt_face: texture source {source.name!r} has no usable ring phase (its valid "
+                           f"share is 0); pass a source whose valid share is at least SOURCE_MIN_SHARE, as "
+                           f"texture_sources keeps")
     hs, ws = source.valid.shape
     src_r, src_c = np.divmod(usable, ws)
     centres_r = np.arange(0, h + stride_px, stride_px, dtype=float)

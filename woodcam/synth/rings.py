@@ -76,7 +76,7 @@ def texture_sources(samples, progress: bool = False) -> list:
     missing = [s for s, f in zip(samples, folders) if f is None or not f.is_dir()]
     if missing:
         raise WoodcamError(f"ring net spec texture_samples {missing} not found under the shared data folder "
-                           f"({base if base is not None else 'none found'}): style 'quilted' reads their real "
+                           f"({base if base is not None else 'none found'}): the quilted styles read their real "
                            f"face photos when training; set WOODCAM_SHARED_DATA=/path/to/shared/data or "
                            f"train another style")
     groups = []
@@ -106,9 +106,10 @@ def ring_training_faces(spec, progress: bool = False, sources=None) -> tuple[np.
     distance ``d`` (px) to the true ring lines, ``sigma = spec.target_sigma_px``. The faces'
     colour is ``spec.style`` (:attr:`~woodcam.detect.learned.RingNetSpec.style`).
 
-    ``sources``: for ``style="quilted"``, a list of groups (one per real cube), each a list of
-    :class:`woodcam.detect._quilt.QuiltSource`; default :func:`texture_sources` of
-    ``spec.texture_samples``. Every third cube is plain, the others are painted by
+    ``sources``: for the quilted styles (:data:`woodcam.detect.learned.QUILTED_STYLES`), a list of
+    groups (one per real cube), each a list of :class:`woodcam.detect._quilt.QuiltSource`; default
+    :func:`texture_sources` of ``spec.texture_samples``. Cube ``i`` is drawn in
+    :func:`woodcam.detect.learned.cube_style` ``(spec.style, i)``; a quilted one is painted by
     :func:`woodcam.detect._quilt.quilt_face` with the textures of group ``i % len(sources)``
     (one source face per synthetic face, drawn at random from the group)."""
     from .._progress import progress_bar
