@@ -150,13 +150,10 @@ def phase_between_lines(lines: list, normal_rad: np.ndarray, wavelength_px: np.n
     (``wavelength_px``) or ``b + f`` exceeds that (a missed ring between)."""
     from scipy import ndimage
 
-    from .evaluate import dense_polyline
+    from .rings import lines_mask
 
     h, w = normal_rad.shape
-    on = np.zeros((h, w), bool)
-    for q in lines:
-        d = np.round(dense_polyline(np.asarray(q, float), 0.5)).astype(int)
-        on[np.clip(d[:, 0], 0, h - 1), np.clip(d[:, 1], 0, w - 1)] = True
+    on = lines_mask(lines, (h, w))
     hit = (ndimage.distance_transform_edt(~on) <= 0.75).astype(np.float32)
     lam = np.asarray(wavelength_px, float)
     reach = max_span * lam

@@ -744,18 +744,23 @@ def _sample(img: np.ndarray, p: np.ndarray) -> np.ndarray:
     return ndimage.map_coordinates(img, p.T, order=1, mode="nearest")
 
 
-def ring_map_from_traces(traces, shape, sigma_px: float) -> np.ndarray:
-    """``(h, w)`` float32 map ``exp(-(d / sigma_px)^2)`` of the distance ``d`` (px) to the traces
-    (rasterised every half pixel along them)."""
-    from scipy import ndimage
-
+def lines_mask(lines, shape) -> np.ndarray:
+    """``(h, w)`` bool: the pixels of the polylines ``lines`` (each ``(k, 2)`` row, col px),
+    rasterised every half pixel along them (rounded, clipped to the image)."""
     h, w = shape
     on = np.zeros(shape, bool)
-    for t in traces:
-        p = _resample_polyline(t.points_px, 0.5)
-        r = np.clip(np.round(p[:, 0]).astype(int), 0, h - 1)
-        c = np.clip(np.round(p[:, 1]).astype(int), 0, w - 1)
-        on[r, c] = True
+    for q in lines:
+        p = _resample_polyline(np.asarray(q, float), 0.5)
+        on[np.clip(np.round(p[:, 0]).astype(int), 0, h - 1), np.clip(np.round(p[:, 1]).astype(int), 0, w - 1)] = True
+    return on
+
+
+def ring_map_from_traces(traces, shape, sigma_px: float) -> np.ndarray:
+    """``(h, w)`` float32 map ``exp(-(d / sigma_px)^2)`` of the distance ``d`` (px) to the traces
+    (rasterised every half pixel along them, :func:`lines_mask`)."""
+    from scipy import ndimage
+
+    on = lines_mask([t.points_px for t in traces], shape)
     if not on.any():
         return np.zeros(shape, np.float32)
     d = ndimage.distance_transform_edt(~on)
