@@ -206,3 +206,28 @@ def test_eval_outputs_land_as_one_set_and_a_rerun_removes_the_earlier_runs(block
     assert sorted(p.name for p in out.iterdir()) == [".woodcam-eval-files.json", "eq79_full.png",
                                                      "notes_full.png", "table.md"]
     assert "eq79b" not in (out / "table.md").read_text()
+
+
+def test_eval_says_what_it_wrote_once_the_set_has_landed(block_dir, tmp_path, monkeypatch, capsys):
+    """eval rings printed 'wrote DIR/table.md and cut-plane images' (and, per real block, its
+    files) inside its set, before any of them was in place, and named the pictures by kind; eval
+    appearance and eval realistic say it after the set has landed. Now one 'wrote' line after
+    the set, naming each file it wrote (not the set's list file)."""
+    import woodcam._atomic as atomic
+
+    folder, truth, _ = block_dir
+    out = tmp_path / "ev"
+    said_before, real_remove = [], atomic.remove_stale
+
+    def landing(*args, **kwargs):  # called once the set's files are renamed into place
+        said_before.append(capsys.readouterr().out)
+        return real_remove(*args, **kwargs)
+
+    monkeypatch.setattr(atomic, "remove_stale", landing)
+    assert main(["eval", "rings", str(folder), "--truth", str(truth), "--methods", "radial",
+                 "--out", str(out)]) == 0
+    assert len(said_before) == 1 and "wrote" not in said_before[0]
+    wrote = [line for line in capsys.readouterr().out.splitlines() if line.startswith("wrote")]
+    files = [out / "eq79_full.png", out / "eq79_partial.png", out / "table.md"]
+    assert wrote == ["wrote " + ", ".join(map(str, files))]
+    assert all(f.is_file() for f in files) and (out / ".woodcam-eval-files.json").is_file()

@@ -103,8 +103,11 @@ def run_eval(args) -> int:
 
     # one set: a Ctrl-C left block_0000_full.png alone, and a rerun mixed its files with an
     # earlier run's table and pictures (eval realistic writes table.md too: one list)
-    with run_outputs(args.out, kind="eval"):
+    with run_outputs(args.out, kind="eval") as written:
         _run_eval(args, blocks, methods, partial)
+    # once the set has landed, as eval appearance and eval realistic say it, and by the files'
+    # own names (not 'cut-plane images'); the list file of the set is bookkeeping, not an output
+    print("wrote " + ", ".join(str(p) for p in written))
     return 0
 
 
@@ -128,7 +131,6 @@ def _run_eval(args, blocks, methods, partial) -> None:
             sets["partial"] = partial
         res = benchmark(known, methods, sets, out_dir=args.out, progress=print, confidence=args.confidence)
         print(res["table"])
-        print(f"wrote {Path(args.out) / 'table.md'} and cut-plane images")
     if args.detect and known:  # nothing silently dropped
         import warnings
 
@@ -151,7 +153,3 @@ def _run_eval(args, blocks, methods, partial) -> None:
             res = leave_one_face_out(fit_on, methods, out_dir=args.out, progress=print, reference=ref,
                                      seed=0 if args.seed is None else args.seed)
             print(res["table"])
-            # the files' own names (it printed the pattern '<block>_holdout.md and <block>_<method>.png')
-            out = Path(args.out)
-            print("wrote " + ", ".join(str(out / f"{fit_on.name}_{kind}")
-                                       for kind in ["holdout.md", *(f"{m}.png" for m in methods)]))
