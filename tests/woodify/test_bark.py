@@ -251,3 +251,21 @@ def test_paint_crack_faces_draws_an_edge_in_every_face_that_holds_it():
     changed = (out != 200).any(2)
     changed[2:8, 3:18] = changed[32:38, 18:33] = False
     assert not changed.any()                                  # edges 1-2, 2-0 are not cracks
+
+
+def test_separation_local_takes_a_trimesh_only(cylinder):
+    """The public separation_local took a trimesh or the module's private _MeshArrays (whatever
+    had vertex_faces, faces, tri...): its input was a private type. Now a trimesh, checked at
+    the door; the crack loop's read-once arrays go through the private _separation_local."""
+    from woodcam.woodify.cracks import _MeshArrays
+
+    mesh = cylinder.surface(4.0)
+    old, _ = trace_back(cylinder.front, mesh.vertices, until_mm=cylinder.tau(3.0))
+    sig = growth_stress(mesh, old)
+    ring = np.array([5, 17, 400])
+    with pytest.raises(WoodcamError, match=r"separation_local: mesh must be a trimesh.Trimesh; got _MeshArrays"):
+        separation_local(_MeshArrays.of(mesh), sig, ring)
+    with pytest.raises(WoodcamError, match=r"stress must be \(f, 3, 3\)"):
+        separation_local(mesh, sig[:-1], ring)
+    with pytest.raises(WoodcamError, match=r"vertices must be a 1-D integer array .* values 5..\d+"):
+        separation_local(mesh, sig, np.array([5, len(mesh.vertices)]))

@@ -367,7 +367,7 @@ def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region
             faces = np.unique(vf[ring])
             faces = faces[faces >= 0]
             stress[faces] *= relief
-            z = separation_local(ma, stress, ring)
+            z = _separation_local(ma, stress, ring)
             lam_r, d_r = _crack_frame(z, ma.normals[ring], pattern, up, rng)
             current[ring] = lam_r
             d[ring] = d_r
@@ -386,8 +386,39 @@ def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region
 
 
 def separation_local(mesh, stress, vertices) -> np.ndarray:
-    """Separation tensors ``(k, 3, 3)`` of some vertices (recomputed after a relief)."""
-    m = mesh if isinstance(mesh, _MeshArrays) else _MeshArrays.of(mesh)
+    """Separation tensors ``(k, 3, 3)`` of some vertices (recomputed after a relief): equal to
+    ``separation(mesh, stress)[vertices]``, from the faces round those vertices only.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+        The surface, mm.
+    stress : ndarray (f, 3, 3)
+        Per-face stress (:func:`growth_stress`), one per face of ``mesh``.
+    vertices : ndarray (k,) int
+        Indices of vertices of ``mesh``.
+    """
+    import trimesh
+
+    if not isinstance(mesh, trimesh.Trimesh):
+        raise WoodcamError(f"separation_local: mesh must be a trimesh.Trimesh; got {type(mesh).__name__}")
+    stress = np.asarray(stress, float)
+    if stress.shape != (len(mesh.faces), 3, 3):
+        raise WoodcamError(f"separation_local: stress must be (f, 3, 3) with f = {len(mesh.faces)} faces of "
+                           f"mesh; got shape {stress.shape}; pass growth_stress(mesh, ...) of this mesh")
+    vertices = np.asarray(vertices)
+    if vertices.ndim != 1 or vertices.dtype.kind not in "iu" or (
+            len(vertices) and not (0 <= vertices.min() and vertices.max() < len(mesh.vertices))):
+        got = f"{vertices.dtype} array of shape {vertices.shape}"
+        if vertices.size and vertices.dtype.kind in "iu":
+            got += f", values {vertices.min()}..{vertices.max()}"
+        raise WoodcamError(f"separation_local: vertices must be a 1-D integer array of vertex indices in "
+                           f"[0, {len(mesh.vertices)}); got a {got}")
+    return _separation_local(_MeshArrays.of(mesh), stress, vertices)
+
+
+def _separation_local(m: _MeshArrays, stress, vertices) -> np.ndarray:
+    """:func:`separation_local` on a surface read once (the crack loop calls it per crack)."""
     vf = m.vertex_faces[vertices]
     faces = np.unique(vf[vf >= 0])
     # only the faces round the vertices count; number their corners compactly (ascending, as
