@@ -134,3 +134,23 @@ def test_no_two_public_classes_share_a_name():
                 where.setdefault(node.name, []).append(str(path.relative_to(PACKAGE.parent)))
     twice = {name: paths for name, paths in where.items() if len(paths) > 1}
     assert not twice, f"public classes defined more than once: {twice}"
+
+
+def _private_imports():
+    """Imports of a unit's private module (``woodcam.<unit>._x``) from another unit."""
+    found = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        source = _unit(".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts))
+        for line, target in _imports(path):
+            parts = target.split(".")
+            if (parts[0] == "woodcam" and len(parts) > 2 and parts[1] != source
+                    and any(p.startswith("_") and not p.startswith("__") for p in parts[2:])):
+                found.append(f"{path.relative_to(PACKAGE.parent)}:{line}: {source} imports {target}")
+    return found
+
+
+def test_no_unit_imports_another_units_private_module():
+    """A private module is its unit's business: synth imported woodcam.detect._quilt and view
+    woodcam.toolpath._surface (now the public woodcam.detect.quilt and woodcam.toolpath.surface).
+    What another unit needs is that unit's public API."""
+    assert not _private_imports(), "private modules imported across units:\n" + "\n".join(_private_imports())

@@ -1,4 +1,4 @@
-"""Texture by numbers (woodcam.detect._quilt): a real face's rings copied onto a synthetic face's
+"""Texture by numbers (woodcam.detect.quilt): a real face's rings copied onto a synthetic face's
 true rings, the ring boundary onto the boundary."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from woodcam.detect._quilt import phase_profile, quilt_face, quilt_source, steepest_fall
+from woodcam.detect.quilt import phase_profile, quilt_face, quilt_source, steepest_fall
 
 
 def _ring_profile(phi: np.ndarray) -> np.ndarray:

@@ -14,7 +14,7 @@ eccentric logs, every sawing pattern, a quarter of them knotted logs of seed 001
 noise, JPEG, lighting gradients, dark pores and ray streaks. The target is the exact distance
 to the true ring lines (the integer iso-lines of the true field), ``exp(-(d / sigma)^2)``.
 The quilted styles (opt-in; the committed net is ``"mixed"``) paint training faces with real
-photos' texture placed by ring phase (:mod:`woodcam.detect._quilt`; the photos are read when
+photos' texture placed by ring phase (:mod:`woodcam.detect.quilt`; the photos are read when
 training, never at run time). Everything is seeded by :attr:`RingNetSpec.seed`; the spec, the weights and a CSV log are
 written together. The committed model lives in ``woodcam/models/rings.*``.
 """
@@ -74,7 +74,7 @@ class RingNetSpec:
         boundary, or ring-porous oak whose pore band starts at it; rays, figure, faint rings),
         softwood and oak on alternate cubes; ``"mixed"``: every third cube plain, the others
         realistic; ``"quilted"``: every third cube plain, the others painted with real photos'
-        texture placed by ring phase (:mod:`woodcam.detect._quilt`), spruce-like and oak-like
+        texture placed by ring phase (:mod:`woodcam.detect.quilt`), spruce-like and oak-like
         cubes alternating by ``texture_samples``; ``"mixed-quilted"``: plain, realistic and
         quilted cubes in turn; ``"quilted-softwood"``: of every five cubes one plain, one
         realistic softwood and three quilted (:func:`cube_style`). The target is the true ring

@@ -63,12 +63,12 @@ def ring_eval_faces(seed: int, face_px: int = 256, size_mm: float = 50.0,
 def texture_sources(samples, progress: bool = False) -> list:
     """The texture sources of ``RingNetSpec.texture_samples``: per sample folder (relative to the
     shared data folder, ``$WOODCAM_SHARED_DATA``; a Mokume sample), its face photos prepared by
-    :func:`woodcam.detect._quilt.quilt_source` (faces with too little usable phase left out)."""
+    :func:`woodcam.detect.quilt.quilt_source` (faces with too little usable phase left out)."""
     from pathlib import Path
 
     from .._progress import progress_bar
     from ..block.io import read_mokume
-    from ..detect._quilt import SOURCE_MIN_SHARE, quilt_source
+    from ..detect.quilt import SOURCE_MIN_SHARE, quilt_source
     from ..logs.io import shared_data_dir
 
     base = shared_data_dir()
@@ -107,10 +107,10 @@ def ring_training_faces(spec, progress: bool = False, sources=None) -> tuple[np.
     colour is ``spec.style`` (:attr:`~woodcam.detect.learned.RingNetSpec.style`).
 
     ``sources``: for the quilted styles (:data:`woodcam.detect.learned.QUILTED_STYLES`), a list of
-    groups (one per real cube), each a list of :class:`woodcam.detect._quilt.QuiltSource`; default
+    groups (one per real cube), each a list of :class:`woodcam.detect.quilt.QuiltSource`; default
     :func:`texture_sources` of ``spec.texture_samples``. Cube ``i`` is drawn in
     :func:`woodcam.detect.learned.cube_style` ``(spec.style, i)``; a quilted one is painted by
-    :func:`woodcam.detect._quilt.quilt_face` with the textures of group ``i % len(sources)``
+    :func:`woodcam.detect.quilt.quilt_face` with the textures of group ``i % len(sources)``
     (one source face per synthetic face, drawn at random from the group)."""
     from .._progress import progress_bar
 
@@ -146,7 +146,7 @@ def ring_training_faces(spec, progress: bool = False, sources=None) -> tuple[np.
         for name, f in block.faces.items():
             photo = f.photo
             if quilted:
-                from ..detect._quilt import quilt_face
+                from ..detect.quilt import quilt_face
                 from ..frames import face_pixel_points
 
                 group = sources[i % len(sources)]

@@ -71,7 +71,7 @@ def _heightfield_arrays(grid, size_mm, flat_tol_mm):
     runs)``. ``grid_index`` is each vertex's flat index into the ``(ny + 2) x (nx + 2)``
     vertex grid (``-1`` for the bottom ring and centre); ``runs`` maps each name of
     :data:`_CHART_ORDER` to its face range ``(start, stop)``."""
-    from ._surface import quad_faces
+    from .surface import quad_faces
 
     xs, ys, z = grid
     nyv, nxv = z.shape
@@ -283,7 +283,7 @@ class HeightfieldCharts:
             n = len(u)
             nrm = np.zeros((n, 3))
             if name == "top":
-                from ._surface import top_chart_points
+                from .surface import top_chart_points
 
                 pts, nrm = top_chart_points(np.ascontiguousarray(self.hm, float), W, D, w, h)
             elif name == "bottom":

@@ -4,7 +4,7 @@ triangle rasteriser, a deferred shading pass and a depth-tested line drawer.
 Written by hand because the one renderer installed (VTK, through pyvista) costs ~1 s of imports
 and ~2 s of off-screen rendering for one picture of a 1.6 M-triangle height field, more than the
 whole simulation; a z-buffer over the height field's own grid needs no mesh at all. This module
-imports only numpy, numba and the height field's surface (:mod:`woodcam.toolpath._surface`).
+imports only numpy, numba and the height field's surface (:mod:`woodcam.toolpath.surface`).
 
 Conventions. ``cam : (16,) float64`` = camera position (3), right (3), up (3), forward (3, unit,
 into the scene), focal length ``f`` in pixels, principal point ``(cx, cy)`` px, near distance
@@ -29,7 +29,7 @@ import math
 import numba
 import numpy as np
 
-from ..toolpath._surface import surface_point, vertex_x, vertex_z
+from ..toolpath.surface import surface_point, vertex_x, vertex_z
 
 TOP, BOTTOM, FRONT, BACK, LEFT, RIGHT = range(6)
 

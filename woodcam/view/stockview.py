@@ -117,7 +117,7 @@ def _section(wood, hm, size, normal, origin):
     """The wood on the cut plane: ``(axis, at_mm, colours (nv, nu, 3) float32 0..255, span
     (2,) mm, outline segments (k, 2, 3) mm)``."""
     from ..appearance.wood import wood_colors
-    from ..toolpath._surface import surface_points
+    from ..toolpath.surface import surface_points
     from .scene import SECTION_MAX_SAMPLES_SCREENSHOT, SECTION_RESOLUTION_MM
 
     axis = int(np.argmax(np.abs(normal)))
