@@ -561,3 +561,17 @@ def test_an_expression_nested_too_deep_is_one_error(text):
     with pytest.raises(GcodeError, match="line 1: .*nested deeper than 100 levels"):
         read_gcode(text + "\n")
     assert len(read_gcode("G0 X" + "[" * 50 + "1" + "]" * 50 + "\n")) == 1  # deep but sane
+
+
+def test_axis_words_without_a_motion_mode_name_why_there_is_none():
+    """The linuxcnc dialect starts in G80, as LinuxCNC does (checked against its interpreter in
+    test_linuxcnc_oracle.py): a bare X10 first was refused as "G80 cancelled it" though no G80
+    was given. grbl's and Fanuc's controls start in G0: there it moves."""
+    _refused("G21 G90\nX10\nM2\n", 2, "X10", r"axis words without a motion mode \(LinuxCNC starts in G80, "
+             r"without one\); add G0 or G1 to the line")
+    _refused("G21 G90\nG1 F100 X1\nG80\nX10\nM2\n", 4, "X10",
+             r"axis words without a motion mode \(G80 cancelled it\)")
+    for dialect in ("grbl", "fanuc"):
+        moves, _ = Interpreter("G21 G90\nX10\nM2\n", dialect=dialect, start_mm=(0, 0, 5)).run()
+        assert [m[:3] for m in moves] == [(0, 2, (10.0, 0.0, 5.0))]
+        _refused("G21 G90\nG80\nX10\nM2\n", 3, "X10", r"\(G80 cancelled it\)", dialect=dialect)

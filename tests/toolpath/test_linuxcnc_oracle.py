@@ -325,3 +325,19 @@ def test_return_values_of_endsub_and_return_agree_with_linuxcnc(tmp_path):
     agree, bad = _differences(_written(tmp_path, texts), texts)
     assert not bad, bad
     assert agree == len(texts)
+
+
+def test_axis_words_at_the_program_start_are_refused_as_linuxcnc_does(tmp_path):
+    """LinuxCNC starts in G80: a bare ``X10`` before any motion code is "Cannot use axis values
+    without a g code that uses them". The oracle placed its start with a G0 that stayed the
+    motion mode, so it read that X10 as a G0 move where woodcam's linuxcnc dialect refused it."""
+    texts = ["X10\nM2\n", "G21 G90\nX10 Y2\nM2\n", "G21 G90 F100\nZ-1\nG1 X3\nM2\n"]
+    results = run_batch(_written(tmp_path, texts), start_mm=START)
+    for text, res in zip(texts, results):
+        assert res["moves"] == [] and "Cannot use axis values without a g code" in res["error"][1], res
+    agree, bad = _differences(_written(tmp_path, texts), texts, same_line=True)
+    assert not bad and agree == len(texts), bad
+    # a G0/G1 first: both read the following bare axis words in its mode
+    texts = ["G21 G90\nG0 X1\nX10 Y2\nG1 F100 Z-1\nX3\nM2\n"]
+    agree, bad = _differences(_written(tmp_path, texts), texts, same_line=True)
+    assert not bad and agree == 1, bad

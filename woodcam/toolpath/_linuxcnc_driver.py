@@ -181,8 +181,10 @@ def _run(job, work, result_fd):
                 f.write(f"{5221 + i}\t{-m:.15f}\n")
         canon = _Canon(var, time.time() + job.get("timeout_s", 10.0))
         canon.mzero = mzero
-        # G49: the interpreter keeps a G43.1 tool length offset from one file to the next
-        init = ["G21", "G90", "G49", f"G53 G0 X{sx:.12f} Y{sy:.12f} Z{sz:.12f}"]
+        # G49: the interpreter keeps a G43.1 tool length offset from one file to the next;
+        # G80: the G0 that places the start must not be the program's motion mode (LinuxCNC
+        # starts in G80: a bare "X10" first is refused, and was read as a G0 here)
+        init = ["G21", "G90", "G49", f"G53 G0 X{sx:.12f} Y{sy:.12f} Z{sz:.12f}", "G80"]
         t0, c0 = time.perf_counter(), time.process_time()
         try:
             result, seq = gcode.parse(path, canon, init, "")

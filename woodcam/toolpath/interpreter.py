@@ -408,7 +408,10 @@ class Interpreter:
         self.incremental = False
         self.arc_incremental = True
         self.plane = 17
+        # LinuxCNC starts in G80 (axis words alone are refused until a G0/G1/...); grbl and
+        # Fanuc's controls start in G0 (Fanuc: parameter 3402 bit 0 clear, the default)
         self.motion: float | None = 0.0 if dialect != "linuxcnc" else None
+        self.motion_cancelled = False  # a G80 has run (the refusal names it, or the start)
         self.retract_old_z = False  # LinuxCNC starts in G99 (retract to R)
         # mm/min: LinuxCNC (and grbl) convert F when it is read, so a later G20/G21 keeps the
         # physical feed (on a "G20 F10" line F is read first: 10 mm/min)
@@ -1468,6 +1471,7 @@ class Interpreter:
             axis = []
         if motion_here:
             self.motion = motion_here[0] if motion_here[0] != 80.0 else None
+            self.motion_cancelled = self.motion_cancelled or self.motion is None
         if self.motion not in _CYCLES:
             self.cycle_il = None
         if 53.0 in g:
@@ -1479,9 +1483,12 @@ class Interpreter:
                        and any(k in w for k in "ijk"))  # LinuxCNC: G2 I5 is a full circle
         if axis or full_circle or (motion_here and self.motion in _CYCLES):
             if self.motion is None:
+                # only linuxcnc starts without one (LinuxCNC's interpreter starts in G80; grbl's
+                # and Fanuc's controls in G0); elsewhere a G80 has cancelled it
+                why = "G80 cancelled it" if self.motion_cancelled else "LinuxCNC starts in G80, without one"
                 raise self.err("".join(f"{a.upper()}{w[a]:g}" for a in axis),
-                               "axis words without a motion mode (G80 cancelled it)",
-                               "start the line with G0 or G1")
+                               f"axis words without a motion mode ({why})",
+                               "add G0 or G1 to the line")
             self.move(w, axis, 53.0 in g)
         elif any(k in w for k in "ijkr") and not (self.motion in _CYCLES and "r" in w):
             k = next(k for k in "ijkr" if k in w)
