@@ -575,3 +575,13 @@ def test_axis_words_without_a_motion_mode_name_why_there_is_none():
         moves, _ = Interpreter("G21 G90\nX10\nM2\n", dialect=dialect, start_mm=(0, 0, 5)).run()
         assert [m[:3] for m in moves] == [(0, 2, (10.0, 0.0, 5.0))]
         _refused("G21 G90\nG80\nX10\nM2\n", 3, "X10", r"\(G80 cancelled it\)", dialect=dialect)
+
+
+def test_assigning_the_tool_changer_fault_parameters_is_refused():
+    """``#5600 = 3`` was taken and then read 0 (the machine's no-fault value): the assignment
+    silently dropped. LinuxCNC does the same (checked in test_linuxcnc_oracle.py); woodcam
+    refuses it as it refuses the read-only ones and the params argument's #5600/#5601."""
+    for n, what in ((5600, "flag"), (5601, "reason")):
+        _refused(f"G21 G90\n#{n} = 3\nG0 X#{n}\nM2\n", 2, f"#{n}",
+                 rf"#{n} is the tool changer's fault {what}, which the machine sets .*; use another parameter")
+    assert _ends("G0 X#5600 Y#5601 Z1\nM2\n") == [(0, 0, 1)]  # reading them stays 0: no fault

@@ -341,3 +341,11 @@ def test_axis_words_at_the_program_start_are_refused_as_linuxcnc_does(tmp_path):
     texts = ["G21 G90\nG0 X1\nX10 Y2\nG1 F100 Z-1\nX3\nM2\n"]
     agree, bad = _differences(_written(tmp_path, texts), texts, same_line=True)
     assert not bad and agree == 1, bad
+
+
+def test_linuxcnc_reads_the_tool_changer_fault_over_an_assignment(tmp_path):
+    """The ground for woodcam refusing ``#5600 = 3`` (test_interpreter.py): LinuxCNC accepts
+    the assignment and reads the machine's value (0) after it, dropping the 3."""
+    texts = ["G21 G90\n#5600 = 3\nG0 X[#5600 + 1]\nM2\n", "G21 G90\n#5601 = 2\nG0 X[#5601 + 1]\nM2\n"]
+    for res in run_batch(_written(tmp_path, texts), start_mm=START):
+        assert res["error"] is None and [m[2] for m in res["moves"]] == [pytest.approx([1.0, 0.0, 10.0])], res

@@ -12,7 +12,8 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``return [v]`` or ``endsub [v]``, and 1 if it had one; LinuxCNC reads a definition's
   ``endsub [v]`` as it passes over it, and so does woodcam); read-only ones (``#5400``-``#5413``,
   ``#5420``-``#5428``, ``#<_value>``, ``#<_value_returned>``) cannot be assigned, as in
-  LinuxCNC; reading what woodcam cannot know is refused: the tool table's offsets and diameter ``#5401``-``#5413``, and
+  LinuxCNC, nor can ``#5600``/``#5601`` (LinuxCNC takes the assignment and reads the machine's
+  value over it: the value would be dropped); reading what woodcam cannot know is refused: the tool table's offsets and diameter ``#5401``-``#5413``, and
   probe (``#5061``-``#5070``) or input (``#5399``) results the program did not assign (the
   ``params`` argument may supply them; the machine's state, ``#5400``-``#5413``,
   ``#5420``-``#5428``, ``#5600``/``#5601``, it refuses); lengths
@@ -238,6 +239,9 @@ def _cs_base(n: int) -> int:
 #: LinuxCNC's read-only numbered parameters (assigning one is refused there, "Parameter is
 #: readonly"): #5400 the loaded tool, #5401-#5413 its tool-table entry, #5420-#5428 the position.
 _READ_ONLY_NUM = frozenset(range(5400, 5414)) | frozenset(range(5420, 5429))
+#: The tool changer's fault flag and reason, set by the machine (0 here: no fault). LinuxCNC
+#: lets a program assign them but reads the machine's value over the assignment.
+_TOOLCHANGER_FAULT = {5600: "flag", 5601: "reason"}
 #: Parameters that hold what the machine measured when the program ran: a G38 probe result
 #: (#5061-#5070) or an M66 input (#5399); woodcam simulates neither, so reading one the program
 #: did not assign is refused (LinuxCNC would read the last probe's or input's value).
@@ -388,7 +392,7 @@ class Interpreter:
             # entry, the position, no tool-changer fault): a supplied value would be ignored,
             # so it is refused, as a program assigning one is; a probe result or input
             # (#5061-#5070, #5399) is the program's to read, and taken
-            fixed = sorted(int(k) for k in params if int(k) in _READ_ONLY_NUM | {5600, 5601})
+            fixed = sorted(int(k) for k in params if int(k) in _READ_ONLY_NUM | set(_TOOLCHANGER_FAULT))
             if fixed:
                 raise WoodcamError(f"params: #{fixed[0]} is the machine's state, which the "
                                    "interpreter keeps itself (#5400 the loaded tool, #5401-#5413 "
@@ -485,7 +489,7 @@ class Interpreter:
                 return float(self.tool)
             if 5420 <= k <= 5422:  # as #<_x> #<_y> #<_z>: program units and frame
                 return self.to_program(self.pos)[k - 5420]
-            if 5423 <= k <= 5428 or k in (5600, 5601):  # A-W; no tool-changer faults
+            if 5423 <= k <= 5428 or k in _TOOLCHANGER_FAULT:  # A-W; no tool-changer faults
                 return 0.0
             if 5401 <= k <= 5413:
                 raise self.err(word, f"#{k} is the loaded tool's offset, diameter, angle or "
@@ -1298,6 +1302,13 @@ class Interpreter:
             if ref[0] == "i" and ref[1] in _READ_ONLY_NUM:
                 raise self.err(f"#{ref[1]}", f"#{ref[1]} is a read-only system parameter "
                                "(LinuxCNC: 'Parameter is readonly')", "use another parameter")
+            if ref[0] == "i" and ref[1] in _TOOLCHANGER_FAULT:
+                # LinuxCNC takes the assignment without a word and reads the machine's value
+                # over it: the value assigned is dropped, so woodcam refuses it
+                raise self.err(f"#{ref[1]}", f"#{ref[1]} is the tool changer's fault "
+                               f"{_TOOLCHANGER_FAULT[ref[1]]}, which the machine sets (LinuxCNC "
+                               "accepts the assignment but reads the machine's value, 0 here, "
+                               "over it)", "use another parameter")
             if ref[0] == "n":
                 (self.globals if ref[1].startswith("_") else self.locals)[ref[1]] = v
             else:
