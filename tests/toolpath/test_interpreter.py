@@ -585,3 +585,20 @@ def test_assigning_the_tool_changer_fault_parameters_is_refused():
         _refused(f"G21 G90\n#{n} = 3\nG0 X#{n}\nM2\n", 2, f"#{n}",
                  rf"#{n} is the tool changer's fault {what}, which the machine sets .*; use another parameter")
     assert _ends("G0 X#5600 Y#5601 Z1\nM2\n") == [(0, 0, 1)]  # reading them stays 0: no fault
+
+
+def test_an_o_word_after_a_comment_is_refused_at_the_first_such_line():
+    """``o1 call`` ... ``(c) o1 sub`` ... ``(c) o1 endsub``: woodcam took the commented sub for
+    one, ran it and refused at its endsub (line 7). LinuxCNC reads no O word after a comment
+    (checked in test_linuxcnc_oracle.py): the call finds no sub, refused there naming the
+    first commented line; a structure that matches only with the commented lines is refused
+    at the first of them; one skipped as text runs, with a warning."""
+    _refused(_BODY + "o1 call\nM2\n(c) o1 sub\nG1 X2\n(c) o1 endsub\n", 4, "o1 call",
+             r"the o1 on line 6 follows a comment: .* no o1 sub .*; move the comment after the o1")
+    _refused(_BODY + "(c) o1 sub\nG1 X2\n(c) o1 endsub\nM2\n", 4, "o1 sub", "after a comment")
+    _refused(_BODY + "o1 sub\nG1 X2\n(c) o1 endsub\nG1 X5\nM2\n", 6, "o1 endsub",
+             r"without it the O words do not match \(line 4: o1 sub is never closed\)")
+    prog = read_gcode(_BODY + "o1 if [0]\nG1 X2\n(c) o1 else\nG1 X3\no1 endif\nM2\n")
+    assert len(prog) == 2 and prog.warnings == [  # the body's two moves: G1 X3 skipped as LinuxCNC does
+        "line 6: 'o1 else' follows a comment, so it is no O word (LinuxCNC reads one only as the first "
+        "word of its line) and was skipped as text; move the comment after the o1"]

@@ -349,3 +349,44 @@ def test_linuxcnc_reads_the_tool_changer_fault_over_an_assignment(tmp_path):
     texts = ["G21 G90\n#5600 = 3\nG0 X[#5600 + 1]\nM2\n", "G21 G90\n#5601 = 2\nG0 X[#5601 + 1]\nM2\n"]
     for res in run_batch(_written(tmp_path, texts), start_mm=START):
         assert res["error"] is None and [m[2] for m in res["moves"]] == [pytest.approx([1.0, 0.0, 10.0])], res
+
+
+def test_o_words_after_a_comment_open_and_close_nothing_as_in_linuxcnc(tmp_path):
+    """``(c) o1 sub`` is no O word for LinuxCNC: run, it is "Bad character 'o'"; inside a
+    definition or a branch not taken it is skipped as text, so it opens or closes nothing.
+    woodcam kept such lines in the O-word structure: it ran an o1 sub only a commented line
+    defined and refused at its endsub, took ``(c) o1 else`` as the else (ran X2, which
+    LinuxCNC skips) and refused a commented ``o3 if`` in a branch not taken."""
+    body = "G21 G90\n"
+    texts = [body + "(c) o1 sub\nG0 X1\n(c) o1 endsub\no1 call\nM2\n",
+             body + "o1 call\nM2\n(c) o1 sub\nG0 X1\n(c) o1 endsub\n",
+             body + "o2 if [0]\n(c) o3 if [1]\no2 endif\nG0 X3\nM2\n",
+             body + "o2 if [0]\n(c) o1 call\no2 endif\nG0 X3\nM2\n",
+             body + "o1 if [0]\nG0 X1\n(c) o1 else\nG0 X2\no1 endif\nM2\n",
+             body + "o1 if [1]\nG0 X1\n(c) o1 else\nG0 X2\no1 endif\nM2\n",
+             body + "o1 sub\n(c) o2 if [1]\nG0 X1\n(c) o2 endif\no1 endsub\nG0 X4\nM2\n"]
+    counts = {}
+    agree, bad = _differences(_written(tmp_path, texts), texts, counts, same_line=True)
+    assert not bad and agree == len(texts), bad
+    assert counts["ran"] == 4 and counts["refused"] == 3, counts
+    # refused inside a call: LinuxCNC names the line after the call, woodcam the line itself
+    texts = [body + "o1 sub\n(c) o2 if [1]\nG0 X1\n(c) o2 endif\no1 endsub\no1 call\nM2\n"]
+    agree, bad = _differences(_written(tmp_path, texts), texts)
+    assert not bad and agree == 1, bad
+    # O words that match only with a commented one: woodcam refuses the program at that line
+    # before it runs; LinuxCNC there too, after the moves before it
+    texts = [body + "G0 X1\n(c) o1 sub\nG0 X2\no1 endsub\nM2\n",
+             body + "#1=0\no1 while [#1 LT 2]\n#1=[#1+1]\nG0 X#1\n(c) o1 endwhile\nM2\n"]
+    for text, res in zip(texts, run_batch(_written(tmp_path, texts), start_mm=START)):
+        with pytest.raises(GcodeError, match="after a comment.*without it the O words do not match") as e:
+            Interpreter(text, start_mm=START).run()
+        assert res["error"][1] == "Bad character 'o' used" and res["error"][0] - e.value.line == 1
+        assert len(res["moves"]) == 1
+    # a commented endsub: LinuxCNC takes the rest of the file for the sub's body (no moves, "no
+    # program end"); woodcam refuses at that line
+    texts = [body + "o1 sub\nG0 X1\n(c) o1 endsub\nG0 X5\nM2\n"]
+    res = run_batch(_written(tmp_path, texts), start_mm=START)[0]
+    assert res["moves"] == [] and res["error"][1] == NO_END
+    with pytest.raises(GcodeError, match=r"line 4: 'o1 endsub': .*without it the O words do not match "
+                       r"\(line 2: o1 sub is never closed\)"):
+        Interpreter(texts[0], start_mm=START).run()

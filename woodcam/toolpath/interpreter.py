@@ -27,7 +27,9 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
 - parameter assignments take effect after the whole line was read (``#1=6 G0 X#1`` moves to the
   old ``#1``);
 - O-words: ``sub/endsub/call/return``, ``if/elseif/else/endif``, ``while/endwhile``,
-  ``do/while``, ``repeat/endrepeat``, ``break``, ``continue``; at most
+  ``do/while``, ``repeat/endrepeat``, ``break``, ``continue`` (the first word of its line,
+  after any N word: after a comment LinuxCNC reads none, so such a line opens or closes
+  nothing, is refused when reached and warned about when skipped); at most
   :data:`MAX_CALL_DEPTH` nested calls (LinuxCNC's limit) and :data:`MAX_BLOCKS` executed lines
   (woodcam's guard against endless loops);
 - Fanuc-style subprograms (LinuxCNC 2.9's "Fanuc-Style Numbered Programs", measured against
@@ -729,6 +731,8 @@ class Interpreter:
         grbl = self.dialect == "grbl"
         grbl_percent: list[int] = []  # grbl: the '%' lines dropped
         self._late_olabels: dict[str, int] = {}  # O label after a comment -> its first line
+        self._late_owords: dict[str, int] = {}  # o-word label after a comment -> its first line
+        late_first: int | None = None  # index of the first line with an o-word after a comment
         for no, raw in enumerate(self.src, start=1):
             self.line_no = no
             text, msg = split_comments(raw, no)
@@ -779,9 +783,20 @@ class Interpreter:
                 if self.dialect == "grbl":
                     raise GcodeError(no, text, "grbl has no O-word subroutines or loops",
                                    "use --dialect linuxcnc")
-                ln.okey, ln.olabel, ln.oexpr = key, label, rest
-                if late:  # refused when reached (kept in the structure: the refusal is here)
+                if late:  # LinuxCNC reads no O word there: a plain line, "Bad character"
+                    # when it runs, skipped as text inside a definition or a branch not taken
+                    # (so it opens or closes nothing): refused when reached
                     ln.late = ln.late or f"o{label} {key}"
+                    self._late_owords.setdefault(label, no)
+                    # said for a program that runs (one that reaches the line is refused): the
+                    # line was skipped, an else or endwhile with the lines it was to frame
+                    self.warnings.append((no, f"'o{label} {key}' follows a comment, so it is "
+                                          "no O word (LinuxCNC reads one only as the first word "
+                                          "of its line) and was skipped as text; move the "
+                                          f"comment after the o{label}"))
+                    late_first = len(lines) if late_first is None else late_first
+                else:
+                    ln.okey, ln.olabel, ln.oexpr = key, label, rest
             elif m is None and "o" in body and _ONUMBER.match(body):
                 if grbl:
                     raise GcodeError(no, text, "grbl has no O words (an O1234 program number is "
@@ -815,7 +830,20 @@ class Interpreter:
                                   "and go on, so woodcam skipped it, but a sender that stops on "
                                   "errors stops the job there; keep '%' to the first and last "
                                   "line"))
-        # match structure
+        try:
+            self._match_structure(lines)
+        except GcodeError as e:
+            if late_first is None:
+                raise
+            # the o-word after a comment is why the labels do not match (LinuxCNC does not
+            # read it as one): refused there, the first such line
+            first = lines[late_first]
+            rule, fix = _late_rule(first.late)
+            raise GcodeError(first.no, first.late, f"{rule}; without it the O words do not "
+                             f"match (line {e.line}: {e.rule})", fix) from None
+
+    def _match_structure(self, lines):
+        """Match the O-word structure of the normalised ``lines`` (the parts of _prepare)."""
         self.match: dict[int, int] = {}   # opener index -> closer index (and back)
         self.branches: dict[int, list[int]] = {}  # if index -> [elseif/else..., endif]
         self.owner: dict[int, int] = {}  # break/continue/elseif/else/return index -> opener
@@ -948,6 +976,12 @@ class Interpreter:
                 if len(frames) >= MAX_CALL_DEPTH:
                     raise self.err(f"o{ln.olabel} call", f"more than {MAX_CALL_DEPTH} nested "
                                    "subroutine calls (LinuxCNC's limit)", "reduce the nesting")
+                if ln.olabel not in self.subs and ln.olabel in self._late_owords:
+                    raise self.err(f"o{ln.olabel} call", f"the o{ln.olabel} on line "
+                                   f"{self._late_owords[ln.olabel]} follows a comment: LinuxCNC "
+                                   "reads an O word only as the first word of its line, so "
+                                   f"there is no o{ln.olabel} sub ('EOF seeking o-word')",
+                                   f"move the comment after the o{ln.olabel}")
                 if ln.olabel not in self.subs:
                     raise self.err(f"o{ln.olabel} call", f"subroutine o{ln.olabel} is not "
                                    "defined in this file (woodcam reads one file; LinuxCNC "
