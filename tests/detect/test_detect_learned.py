@@ -186,3 +186,101 @@ def test_realistic_training_faces_share_the_plain_targets():
     xr, yr = ring_training_faces(replace(plain, style="realistic"))
     np.testing.assert_array_equal(yp, yr)
     assert np.abs(xp - xr).mean() > 0.05
+
+
+def _write_member(folder, spec, seed, member="main"):
+    """A random-weights net of ``spec`` saved as ``member`` of ``folder`` (what training writes)."""
+    import torch
+
+    from woodcam.detect.learned import _net, member_files
+
+    spec_name, weights_name, _ = member_files(member)
+    folder.mkdir(parents=True, exist_ok=True)
+    torch.manual_seed(seed)
+    net = _net(spec)
+    for p in net.parameters():             # a distinct, non-flat map per seed
+        p.data.normal_(0, 0.5)
+    torch.save(net.state_dict(), folder / weights_name)
+    spec.save(folder / spec_name)
+    return folder
+
+
+_TINY = RingNetSpec(width=4)
+_TINY_QUILTED = RingNetSpec(width=4, style="quilted", texture_samples=["mokume/H11"])
+
+
+def test_a_members_folder_combines_the_members_probabilities_by_the_documented_mean(tmp_path):
+    """Issue 13: a folder with a quilted member (``rings_quilted.*``) gives the weighted mean of
+    its members' probabilities, and the detector runs on that map (``ridge`` returns it as
+    its confidence); a folder without one is the main net alone."""
+    from woodcam.detect.learned import QUILTED_MEMBER_WEIGHT, detect_rings_learned, ring_members, ring_probability
+
+    from .test_detect_rings import _line_face
+
+    main_only = _write_member(tmp_path / "main", _TINY, seed=1)
+    quilted_alone = _write_member(tmp_path / "quilted", _TINY_QUILTED, seed=2)
+    both = _write_member(_write_member(tmp_path / "both", _TINY, seed=1), _TINY_QUILTED, seed=2, member="quilted")
+    photo, _ = _line_face(spacing=16.0, width=2.5)
+    p_main, p_q, p_both = (ring_probability(photo, models_dir=d) for d in (main_only, quilted_alone, both))
+    w = QUILTED_MEMBER_WEIGHT
+    assert w == 0.5 and ring_members(main_only) == [("main", 1.0)]
+    assert ring_members(both) == [("main", 1 - w), ("quilted", w)]
+    assert np.abs(p_main - p_q).mean() > 0.02                          # the members differ
+    np.testing.assert_allclose(p_both, (1 - w) * p_main + w * p_q, atol=1e-6)
+    det = detect_rings_learned(photo, models_dir=both, mode="ridge")
+    np.testing.assert_array_equal(det.confidence, p_both)
+
+
+def test_a_broken_quilted_member_is_refused(tmp_path):
+    """A quilted member that is half there, unreadable, of another shape than its spec, or not a
+    quilted net is refused with the folder, the files and the fix, never skipped."""
+    import torch
+
+    from woodcam.detect.learned import ring_probability
+
+    photo = np.full((40, 44, 3), 128, np.uint8)
+    cases = {}
+    d = cases["no spec"] = _write_member(tmp_path / "a", _TINY, seed=1)
+    torch.save(torch.load(d / WEIGHTS_NAME), d / "rings_quilted.pt")
+    d = cases["no weights"] = _write_member(tmp_path / "b", _TINY, seed=1)
+    _TINY_QUILTED.save(d / "rings_quilted_spec.json")
+    d = cases["garbage"] = _write_member(_write_member(tmp_path / "c", _TINY, seed=1), _TINY_QUILTED, 2, "quilted")
+    (d / "rings_quilted.pt").write_bytes(b"not a torch file")
+    d = cases["shape"] = _write_member(_write_member(tmp_path / "d", _TINY, seed=1), _TINY_QUILTED, 2, "quilted")
+    replace(_TINY_QUILTED, width=8).save(d / "rings_quilted_spec.json")
+    d = cases["style"] = _write_member(tmp_path / "e", _TINY, seed=1)
+    _write_member(d, _TINY_QUILTED, 2, "quilted")
+    _TINY.save(d / "rings_quilted_spec.json")                          # a mixed-style net as the member
+    for case, folder in cases.items():
+        with pytest.raises(WoodcamError, match="ring net 'quilted' in .* cannot be loaded") as exc:
+            ring_probability(photo, models_dir=folder)
+        msg = str(exc.value)
+        assert str(folder) in msg and "--member quilted" in msg and "rings_quilted.pt" in msg, (case, msg)
+    with pytest.raises(WoodcamError, match="not a quilted one"):
+        ring_probability(photo, models_dir=cases["style"])
+
+
+def test_train_writes_the_quilted_member_and_refuses_it_for_other_styles(tmp_path, capsys):
+    """``member="quilted"`` (``train rings --member quilted``) writes ``rings_quilted.*`` beside
+    the main net; a spec of another style is refused before any work (CLI: one line naming
+    --member); ``train gtf`` refuses --member (it would change nothing)."""
+    from woodcam.cli import EXIT_ERROR, main
+    from woodcam.detect.learned import member_files, ring_members, train_ring_net
+
+    rng = np.random.default_rng(0)
+    x = rng.standard_normal((2, 32, 32)).astype(np.float32)
+    y = (rng.uniform(size=(2, 32, 32)) < 0.1).astype(np.float32)
+    tiny = dict(crop_px=16, batch=2, steps=2, log_every=1)
+    out = _write_member(tmp_path / "m", _TINY, seed=1)
+    r = train_ring_net(replace(_TINY_QUILTED, **tiny), x, y, out, progress=False, member="quilted")
+    assert r["steps"] == 2 and ring_members(out)[1][0] == "quilted"
+    assert all((out / n).is_file() for n in member_files("quilted"))
+    assert RingNetSpec.load(out / "rings_quilted_spec.json").style == "quilted"
+    with pytest.raises(WoodcamError, match="member quilted needs a spec of a quilted style"):
+        train_ring_net(replace(_TINY, **tiny), x, y, tmp_path / "n", progress=False, member="quilted")
+    assert main(["train", "rings", "--member", "quilted", "--out", str(tmp_path / "t")]) == EXIT_ERROR
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--member quilted needs a spec of a quilted style" in err
+    assert "got style 'plain'" in err and not (tmp_path / "t").exists()
+    assert main(["train", "gtf", "--member", "quilted", "--out", str(tmp_path / "g")]) == EXIT_ERROR
+    assert "is for 'train rings'" in capsys.readouterr().err and not (tmp_path / "g").exists()

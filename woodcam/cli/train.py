@@ -19,6 +19,10 @@ def register(subparsers) -> None:
     add_out_option(p, "the spec, weights and training log (gtf: gtf_spec.json, gtf.pt, "
                    "gtf_train_log.csv and the checkpoint; rings: rings_spec.json, rings.pt, "
                    "rings_train_log.csv)")
+    p.add_argument("--member", choices=["main", "quilted"], default=None,
+                   help="rings only: which net of the OUT folder to write; main (default): rings.*; quilted: "
+                   "rings_quilted.*, a second net (its --spec of a quilted style) whose probability the "
+                   "learned detector averages with the main net's")
     p.add_argument("--steps", type=int, default=None, help="stop after N steps in total (default: spec.steps)")
     p.add_argument("--no-resume", action="store_true", help="start over instead of resuming the checkpoint")
     add_engine_options(p)  # with --engine: the training set is made in shards of 256 fields
@@ -27,7 +31,7 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     if args.what == "rings":
-        from ..detect.learned import RingNetSpec, train_ring_net
+        from ..detect.learned import RingNetSpec, check_member, train_ring_net
 
         if engine_requested(args) or args.no_resume:  # they were accepted and ignored
             raise WoodcamError("train rings runs in this process and always from scratch: the engine "
@@ -39,16 +43,21 @@ def run(args) -> int:
             from dataclasses import replace
 
             spec = replace(spec, steps=args.steps)
+        member = args.member or "main"
+        check_member(spec, member, what="--member")   # before minutes of training faces
         from ..synth.rings import ring_training_faces
 
         args.out.mkdir(parents=True, exist_ok=True)  # before minutes of training, not after
 
         # the training faces come from woodcam's own synthesis (synth sits above detect)
         x, y = ring_training_faces(spec, progress=True)
-        r = train_ring_net(spec, x, y, args.out, progress=True)
-        print(f"trained the ring net ({r['params']} parameters) {r['steps']} steps in {r['train_s']:.0f} s; "
+        r = train_ring_net(spec, x, y, args.out, progress=True, member=member)
+        print(f"trained the ring net{'' if member == 'main' else ' member ' + member} ({r['params']} parameters) {r['steps']} steps in {r['train_s']:.0f} s; "
               f"final loss {r['final_loss']:.4f}; wrote {args.out}")
         return 0
+    if args.member is not None:        # accepted by the parser, no effect on gtf
+        raise WoodcamError(f"--member {args.member} is for 'train rings' (the ring net's members); "
+                           f"'train gtf' trains one model: leave it out")
     from ..fields.neural import GTFSpec, train_gtf
 
     spec = GTFSpec.load(args.spec) if args.spec is not None else GTFSpec()

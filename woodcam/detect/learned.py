@@ -17,6 +17,11 @@ The quilted styles (opt-in; the committed net is ``"mixed"``) paint training fac
 photos' texture placed by ring phase (:mod:`woodcam.detect.quilt`; the photos are read when
 training, never at run time). Everything is seeded by :attr:`RingNetSpec.seed`; the spec, the weights and a CSV log are
 written together. The committed model lives in ``woodcam/models/rings.*``.
+
+Members (opt-in, issue 13; the committed folder holds the main net only): a models folder may hold a second
+net beside ``rings.*``, the ``"quilted"`` member ``rings_quilted.*`` (a net of a quilted style,
+``woodcam train rings --member quilted``); :func:`ring_probability` is then the weighted mean of
+the members' probabilities (:data:`QUILTED_MEMBER_WEIGHT`), and everything downstream runs on it.
 """
 
 from __future__ import annotations
@@ -38,6 +43,17 @@ MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
 SPEC_NAME = "rings_spec.json"
 WEIGHTS_NAME = "rings.pt"
 LOG_NAME = "rings_train_log.csv"
+#: The nets a models folder may hold (module docstring): ``"main"`` (``rings.*``, always) and
+#: the optional ``"quilted"`` member (``rings_quilted.*``, a net of a :data:`QUILTED_STYLES` style).
+RING_NET_MEMBERS = ("main", "quilted")
+#: Weight of the quilted member: the folder's probability is ``(1 - w) p_main + w p_quilted``.
+#: Issue 13, the committed net with the quilted v2 fold nets, blind (each fold's net on the other
+#: fold's faces): the arithmetic mean (0.5) was the only rule tried that kept both bars: the 12
+#: real faces' ridge 0.464 / 0.734 within 2 / 5 px (v2 alone 0.475 / 0.754, the committed net
+#: 0.411 / 0.633) and the synthetic test's realistic faces (seeds 1000-1001, snap) 0.755 / 0.752
+#: (committed 0.791, v2 0.723 / 0.726); 0.67 gave 0.468 / 0.745 but 0.743 / 0.746, the
+#: geometric mean 0.769 / 0.769 but 0.453 / 0.694.
+QUILTED_MEMBER_WEIGHT = 0.5
 #: Colours of the training faces (:attr:`RingNetSpec.style`).
 TRAINING_STYLES = ("plain", "realistic", "mixed", "quilted", "mixed-quilted", "quilted-softwood")
 #: The styles that paint some training cubes with real photos' texture (need ``texture_samples``).
@@ -54,6 +70,27 @@ def cube_style(style: str, i: int) -> str:
     :class:`RingNetSpec` of ``style``."""
     kinds = _CUBE_STYLES[style]
     return kinds[i % len(kinds)]
+
+
+def member_files(member: str = "main") -> tuple[str, str, str]:
+    """The spec, weights and training-log file names of a models folder's ``member``
+    (:data:`RING_NET_MEMBERS`): ``rings_spec.json``, ``rings.pt``, ``rings_train_log.csv`` for
+    ``"main"``; ``rings_quilted_spec.json``, ``rings_quilted.pt``, ... for ``"quilted"``."""
+    if member not in RING_NET_MEMBERS:
+        raise WoodcamError(f"ring net member must be one of {', '.join(RING_NET_MEMBERS)}; got {member!r}")
+    if member == "main":
+        return SPEC_NAME, WEIGHTS_NAME, LOG_NAME
+    return f"rings_{member}_spec.json", f"rings_{member}.pt", f"rings_{member}_train_log.csv"
+
+
+def check_member(spec: RingNetSpec, member: str, what: str = "member") -> None:
+    """Refuse a ``member`` that ``spec`` cannot be: the quilted member is a net of a quilted style
+    (its combination weight was measured for those). ``what`` names the argument in the message."""
+    member_files(member)
+    if member == "quilted" and spec.style not in QUILTED_STYLES:
+        raise WoodcamError(f"{what} quilted needs a spec of a quilted style ({', '.join(QUILTED_STYLES)}, with "
+                           f"texture_samples); got style {spec.style!r}; train it with --spec naming such a style, "
+                           f"or leave out {what} for the main net")
 
 
 @dataclass(frozen=True)
@@ -217,13 +254,18 @@ def net_input(photo: np.ndarray) -> np.ndarray:
     return _normalise(lum, sigma=0.5 * max(lum.shape)).astype(np.float32)
 
 
-def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, progress: bool = True) -> dict:
+def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, progress: bool = True,
+                   member: str = "main") -> dict:
     """Train the ring net of ``spec`` from scratch on inputs ``x (n, h, w)`` (:func:`net_input`)
     and targets ``y (n, h, w)`` in [0, 1] (made by :func:`woodcam.synth.ring_training_faces`);
-    write ``rings_spec.json``, ``rings.pt`` and ``rings_train_log.csv`` to ``out_dir``.
+    write ``rings_spec.json``, ``rings.pt`` and ``rings_train_log.csv`` to ``out_dir``
+    (``member="quilted"``: ``rings_quilted_*``, :func:`member_files`; ``spec`` of a quilted style).
     Returns ``{"steps", "train_s", "final_loss", "params"}``."""
     torch = require("torch", "learn", "training the ring net")
     from .._progress import progress_bar
+
+    check_member(spec, member)
+    spec_name, weights_name, log_name = member_files(member)
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -264,10 +306,10 @@ def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, 
         if time.perf_counter() - t0 > spec.max_train_s:
             break
     train_s = time.perf_counter() - t0
-    spec.save(out / SPEC_NAME)
-    with atomic_path(out / WEIGHTS_NAME) as tmp:
+    spec.save(out / spec_name)
+    with atomic_path(out / weights_name) as tmp:
         torch.save({k: v.detach().clone() for k, v in net.state_dict().items()}, tmp)
-    with atomic_write(out / LOG_NAME, "w", newline="") as fh:
+    with atomic_write(out / log_name, "w", newline="") as fh:
         wr = csv.DictWriter(fh, ["step", "loss", "loss_avg", "seconds"])
         wr.writeheader()
         wr.writerows(rows)
@@ -279,38 +321,63 @@ def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, 
 _CACHE: dict = {}
 
 
-def load_ring_net(models_dir=MODELS_DIR):
-    """The trained net (eval mode) from ``models_dir``; cached per folder."""
+def load_ring_net(models_dir=MODELS_DIR, member: str = "main"):
+    """The trained net (eval mode) ``member`` (:data:`RING_NET_MEMBERS`) of ``models_dir``;
+    cached per folder and member."""
     torch = require("torch", "learn", "the learned ring detector")
-    key = str(Path(models_dir).resolve())
+    spec_name, weights_name, _ = member_files(member)
+    key = (str(Path(models_dir).resolve()), member)
     if key not in _CACHE:
-        path = Path(models_dir) / WEIGHTS_NAME
-        if not path.is_file():
+        path = Path(models_dir) / weights_name
+        if member == "main" and not path.is_file():
             raise WoodcamError(f"no trained ring net at {str(path)!r}; train one with "
                                f"'woodcam train rings --out {models_dir}'")
-        spec = RingNetSpec.load(Path(models_dir) / SPEC_NAME)
-        net = _net(spec)
-        net.load_state_dict(torch.load(path, map_location="cpu", weights_only=True))
+        try:
+            spec = RingNetSpec.load(Path(models_dir) / spec_name)
+            if member != "main" and spec.style not in QUILTED_STYLES:
+                raise WoodcamError(f"its spec has style {spec.style!r}, not a quilted one ({', '.join(QUILTED_STYLES)})")
+            net = _net(spec)
+            net.load_state_dict(torch.load(path, map_location="cpu", weights_only=True))
+        except Exception as e:
+            if member == "main" and isinstance(e, WoodcamError):
+                raise
+            fix = (f"retrain it with 'woodcam train rings --member {member} --spec SPEC --out {models_dir}' "
+                   f"or remove {spec_name} and {weights_name}" if member != "main" else
+                   f"retrain it with 'woodcam train rings --out {models_dir}'")
+            raise WoodcamError(f"ring net {member!r} in {str(models_dir)!r} ({weights_name} with {spec_name}) cannot "
+                               f"be loaded: {e}; {fix}") from e
         net.eval()
         _CACHE[key] = net
     return _CACHE[key]
 
 
+def ring_members(models_dir=MODELS_DIR) -> list[tuple[str, float]]:
+    """The members of ``models_dir`` and their weights in :func:`ring_probability`:
+    ``[("main", 1.0)]``, or with a quilted member (either of its files present; a half-present
+    member is refused when loaded) ``[("main", 1 - w), ("quilted", w)]``, ``w`` =
+    :data:`QUILTED_MEMBER_WEIGHT`."""
+    if any((Path(models_dir) / n).exists() for n in member_files("quilted")[:2]):
+        return [("main", 1.0 - QUILTED_MEMBER_WEIGHT), ("quilted", QUILTED_MEMBER_WEIGHT)]
+    return [("main", 1.0)]
+
+
 def ring_probability(photo: np.ndarray, models_dir=MODELS_DIR) -> np.ndarray:
-    """``(h, w)`` float32 in [0, 1]: the net's ring-line probability on a face photo."""
+    """``(h, w)`` float32 in [0, 1]: the net's ring-line probability on a face photo (with a
+    quilted member, the weighted mean of the members' probabilities, :func:`ring_members`)."""
     torch = require("torch", "learn", "the learned ring detector")
     x = net_input(photo)
     h, w = x.shape
     ph, pw = (-h) % 4, (-w) % 4
     x = np.pad(x, ((0, ph), (0, pw)), mode="reflect")
-    net = load_ring_net(models_dir)
+    members = [(load_ring_net(models_dir, m), wt) for m, wt in ring_members(models_dir)]
     # one thread: the net is small, and on a 256 px face torch's two threads spent 0.69 CPU-s
     # where one spends 0.15 (the budget is 1 CPU-s per face for the whole detector)
     from .._threads import torch_threads
 
     with torch_threads(torch, 1), torch.no_grad():
-        p = torch.sigmoid(net(torch.from_numpy(x)[None, None]))[0, 0].numpy()
-    return p[:h, :w].astype(np.float32)
+        xt = torch.from_numpy(x)[None, None]
+        p = sum(wt * torch.sigmoid(net(xt))[0, 0].numpy().astype(np.float64) for net, wt in members)
+    return np.clip(p[:h, :w], 0.0, 1.0).astype(np.float32)
 
 
 #: How the learned detector places its ring lines (:func:`detect_rings_learned`).
