@@ -155,6 +155,29 @@ def test_crease_normals_split_sharp_edges_and_smooth_flat_ones():
         crease_normals(box, -1.0)
 
 
+def test_the_crease_angle_is_in_degrees_a_45_degree_hinge_splits_at_30_and_not_at_60():
+    """Two triangles folded 45 degrees along a shared edge: the default 30 degree crease splits
+    the edge's two vertices (each face keeps its own normal), a 60 degree one shares the bisector
+    there. cos(30) read as radians (0.15, an 81 degree crease) smoothed the hinge."""
+    from woodcam.export import crease_normals
+
+    t = np.radians(45.0)
+    verts = np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [5.0, 10.0, 0.0],
+                      [5.0, -10.0 * np.cos(t), 10.0 * np.sin(t)]])
+    hinge = trimesh.Trimesh(verts, [[0, 1, 2], [1, 0, 3]], process=False)
+    np.testing.assert_allclose(hinge.face_normals @ hinge.face_normals[0], [1.0, np.cos(t)], atol=1e-12)
+    split = crease_normals(hinge)
+    assert len(split.vertices) == 6
+    np.testing.assert_allclose(split.vertex_normals[split.faces],
+                               np.repeat(hinge.face_normals[:, None], 3, axis=1), atol=1e-12)
+    smooth = crease_normals(hinge, 60.0)
+    assert len(smooth.vertices) == 4
+    bisector = hinge.face_normals.sum(axis=0) / np.linalg.norm(hinge.face_normals.sum(axis=0))
+    on_edge = smooth.vertices[:, 1] == 0.0
+    assert on_edge.sum() == 2
+    np.testing.assert_allclose(smooth.vertex_normals[on_edge], [bisector, bisector], atol=1e-12)
+
+
 def test_crease_normals_of_zero_area_faces_are_unit_vectors():
     """A zero-area face (woodify's grown meshes have some) gave its corners zero normals, which
     glTF forbids (NORMAL must be unit: ACCESSOR_VECTOR3_NON_UNIT)."""
@@ -205,6 +228,12 @@ def test_obj_units_and_up_axis_round_trip(baked, tmp_path, units, up, scale, hei
     assert np.all(np.einsum("ij,ij->i", fn[big], vn[f[big]].sum(axis=1)) > 0)
     loaded = load_textured(path)  # back in the block frame, mm
     np.testing.assert_allclose(_corners(loaded)[0], _corners(baked.mesh)[0], atol=1e-6)
+    # and so are its normals: every corner's the crease normal of the block-frame part
+    from woodcam.export import crease_normals
+
+    want = crease_normals(baked.mesh)
+    np.testing.assert_allclose(loaded.vertex_normals[loaded.faces], want.vertex_normals[want.faces],
+                               atol=1e-6)
 
 
 def test_obj_writes_obj_mtl_png_named_after_the_obj_and_reloads(baked, tmp_path):
