@@ -49,6 +49,21 @@ def test_editor_style_svg(tmp_path):
     np.testing.assert_allclose(traces[2].points_px, [[0.5, 5.5], [0.5, 7.5]])
 
 
+def test_a_path_of_several_subpaths_is_one_trace_each(tmp_path):
+    """A ``<path>`` whose ``M``/``m`` starts a new stroke (an editor's combined path, or a ring
+    redrawn in pieces) is one trace per subpath, each with the path's year: the jump between
+    them is no part of any ring."""
+    (tmp_path / "p.svg").write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="40" height="40">'
+        '<path data-year="5" d="M 1,2 L 11,2 M 1,30 L 21,30 m 0,4 h 10"/></svg>')
+    traces = read_traces_svg(tmp_path / "p.svg", (40, 40))
+    assert [t.year for t in traces] == [5, 5, 5]
+    # (x, y) -> (row, col) = (y - 0.5, x - 0.5)
+    np.testing.assert_allclose(traces[0].points_px, [[1.5, 0.5], [1.5, 10.5]], atol=1e-12)
+    np.testing.assert_allclose(traces[1].points_px, [[29.5, 0.5], [29.5, 20.5]], atol=1e-12)
+    np.testing.assert_allclose(traces[2].points_px, [[33.5, 20.5], [33.5, 30.5]], atol=1e-12)
+
+
 def test_bad_files_are_refused(tmp_path):
     (tmp_path / "bad.svg").write_text("<svg")
     with pytest.raises(WoodcamError, match="must be a readable SVG"):
