@@ -60,6 +60,23 @@ def test_h11_knot_on_left_and_back_at_the_back_left_edge():
         assert lum[disc].mean() < np.median(lum) - 15, name
 
 
+def test_a_one_pixel_knot_mark_grows_to_the_dark_knot_around_it(tmp_path):
+    """H11's knot masks mark one pixel per knot; the face's knot_mask is the dark disc of the
+    photo around that pixel (connected to it: another dark patch on the face is not the knot)."""
+    rr, cc = np.mgrid[:96, :128]
+    knot = (rr - 40) ** 2 + (cc - 50) ** 2 < 20 ** 2
+    other = (rr - 70) ** 2 + (cc - 110) ** 2 < 8 ** 2  # a dark patch of its own
+    photo = np.full((96, 128, 3), 200, np.uint8)
+    photo[knot | other] = 90
+    mark = np.full((96, 128), 255, np.uint8)
+    mark[40, 50] = 0
+    Image.fromarray(photo).save(tmp_path / "C_col.png")
+    Image.fromarray(mark).save(tmp_path / "C_knot.png")
+    mask = read_mokume(tmp_path).faces["left"].extras["knot_mask"]
+    assert mask[40, 50] and not (mask & other).any()
+    assert (mask & knot).sum() / (mask | knot).sum() > 0.9  # the disc, not the one marked pixel
+
+
 def test_mokume_block_survives_the_manifest_round_trip(tmp_path):
     b = read_mokume(_mokume("H11"))
     write_block(b, tmp_path, ring_map_bits=8)
