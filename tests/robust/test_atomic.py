@@ -80,6 +80,63 @@ def test_atomic_files_all_or_nothing(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["p.mtl", "p.obj", "p.png"]
 
 
+def test_every_writer_flushes_the_data_before_the_rename_and_the_folder_after(tmp_path, monkeypatch):
+    """A rename is atomic, but without fsync of the data first a power cut can leave the new
+    name on an empty file (delayed allocation), and without fsync of the folder after it the
+    old one: each file lands as data-fsync, rename, folder-fsync."""
+    events = []
+    real_fsync, real_replace = os.fsync, os.replace
+
+    def fsync(fd):
+        events.append(("fsync", os.readlink(f"/proc/self/fd/{fd}")))
+        real_fsync(fd)
+
+    def replace(src, dst):
+        events.append(("replace", str(src), str(dst)))
+        real_replace(src, dst)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+    monkeypatch.setattr(os, "replace", replace)
+    write_bytes(tmp_path / "a.bin", b"a")
+    with atomic_path(tmp_path / "b.npy") as tmp:
+        np.save(tmp, np.arange(3))
+    with atomic_files([tmp_path / "c.obj", tmp_path / "c.mtl"]) as temps:
+        for t in temps:
+            t.write_text("c")
+    renames = [e for e in events if e[0] == "replace"]
+    assert sorted(Path(e[2]).name for e in renames) == ["a.bin", "b.npy", "c.mtl", "c.obj"]
+    for _, src, dst in renames:
+        at = events.index(("replace", src, dst))
+        assert ("fsync", src) in events[:at], f"{Path(dst).name}: data not flushed before the rename"
+        assert ("fsync", str(tmp_path)) in events[at + 1:], f"{Path(dst).name}: folder not flushed"
+
+
+def test_no_file_lands_after_a_recorded_ctrl_c(tmp_path, monkeypatch):
+    """A Ctrl-C a library swallowed is recorded (woodcam._interrupt); every atomic write checks
+    it before its file lands, so nothing is written after it, and no temporary is left."""
+    from woodcam import _interrupt
+    from woodcam._atomic import all_or_nothing
+
+    target = tmp_path / "a.txt"
+    write_text(target, "old")
+    monkeypatch.setattr(_interrupt, "_requested", True)
+    with pytest.raises(KeyboardInterrupt):
+        write_text(target, "new")
+    with pytest.raises(KeyboardInterrupt), atomic_path(tmp_path / "b.png") as tmp:
+        tmp.write_bytes(b"b")
+    with pytest.raises(KeyboardInterrupt), atomic_files([tmp_path / "c.obj", tmp_path / "c.mtl"]) as temps:
+        for t in temps:
+            t.write_text("c")
+    assert target.read_text() == "old" and sorted(p.name for p in tmp_path.iterdir()) == ["a.txt"]
+    # inside a set the files land at its end: a Ctrl-C recorded after the writes stops them there
+    monkeypatch.setattr(_interrupt, "_requested", False)
+    with pytest.raises(KeyboardInterrupt), all_or_nothing():
+        write_text(target, "new")
+        write_bytes(tmp_path / "d.bin", b"d")
+        monkeypatch.setattr(_interrupt, "_requested", True)
+    assert target.read_text() == "old" and sorted(p.name for p in tmp_path.iterdir()) == ["a.txt"]
+
+
 def test_atomic_files_rejects_duplicate_targets(tmp_path):
     with pytest.raises(WoodcamError, match="distinct"), atomic_files([tmp_path / "a", tmp_path / "a"]):
         pass
