@@ -17,15 +17,26 @@ from woodcam._cache import CacheWarning, cache_root, digest, load_or_build
 REPO = Path(__file__).resolve().parents[2]
 
 
-def test_digest_is_content_based():
+def test_digest_is_content_based(tmp_path):
     a = np.zeros((4, 4), np.uint8)
     b = a.copy()
     assert digest(a, "x", 1.0) == digest(b, "x", 1.0)
     b[2, 2] = 1
     assert digest(a) != digest(b)
     assert digest(a.astype(np.uint16)) != digest(a)  # dtype is part of the content
+    # so is the shape: the same bytes as a (2, 8) or a (16,) array are other content
+    assert len({digest(a), digest(a.reshape(2, 8)), digest(a.reshape(16))}) == 3
     assert digest([1, 2]) != digest([12]) and digest("ab", "c") != digest("a", "bc")
+    assert digest(1) != digest("1") and digest(True) != digest("True")  # and the type
     assert digest({"k": 1, "j": 2}) == digest({"j": 2, "k": 1})
+    # a Path is its file's content: an edit changes the key, a copy under another name does not
+    f, g = tmp_path / "f.json", tmp_path / "g.json"
+    f.write_text("one")
+    g.write_text("one")
+    before = digest(f)
+    assert before == digest(g) == digest(b"one")
+    f.write_text("two")
+    assert digest(f) == digest(b"two") != before
 
 
 def test_cache_root_honours_xdg(monkeypatch, tmp_path):
