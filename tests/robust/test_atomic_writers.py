@@ -4,13 +4,14 @@ A static check over the package's source: a writer that opens its target directl
 truncated file behind on Ctrl-C or a crash (the brief: "every file write is atomic"), and a
 sweep found a dozen that did (the ring net's spec, weights and training log, the copy of a
 user's corrected SVG, matplotlib figures, the bench report, hand-made temp + rename). The rule: ``open(..., "w"/"a"/"x")``, ``Path.write_text``,
-``Path.write_bytes``, matplotlib's ``savefig``, ``np.save*`` and ``torch.save`` may only write
-to a temporary of ``with atomic_path(...) as tmp`` / ``atomic_files(...)`` / ``atomic_write(...)``
-in the same function (or its parameter ``tmp``, the caller's temporary); everything else calls
+``Path.write_bytes``, matplotlib's ``savefig``, ``np.save*``, ``torch.save`` and PIL's
+``Image.save`` may only write to a temporary of ``with atomic_path(...) as tmp`` /
+``atomic_files(...)`` / ``atomic_write(...)`` in the same function (or its parameter ``tmp``, the
+caller's temporary) or, for PIL, to an ``io.BytesIO``; everything else calls
 ``woodcam._atomic.write_text`` / ``write_bytes``, and no writer renames a temporary of its own
 (``tempfile.mkstemp``, ``os.replace``: the parquetry outputs were written so, with mode 0600,
-unreadable to anyone else). PIL's ``Image.save`` is not checked (its
-receiver's type is not known statically): those writers save into a ``BytesIO`` or a temporary.
+unreadable to anyone else). A PIL save is known by what is statically visible: a ``.save()``
+given ``format=``, or called on ``Image.fromarray/open/new(...)`` or on a name such as ``img``.
 """
 
 from __future__ import annotations
@@ -23,6 +24,9 @@ import woodcam
 PACKAGE = Path(woodcam.__file__).parent
 _ATOMIC_CONTEXTS = {"atomic_path", "atomic_files"}
 _NUMPY_SAVES = {"save", "savez", "savez_compressed"}
+#: Receivers of ``.save()`` taken for a PIL image: calls that make one, names that hold one.
+_PIL_MAKERS = {"fromarray", "open", "new", "convert", "resize", "crop", "rotate", "transpose"}
+_PIL_NAMES = {"img", "image", "im", "pic", "photo", "picture", "sheet", "strip", "thumb"}
 #: Modules whose writes are not woodcam's outputs, each with why.
 _NOT_OUTPUTS = {
     "_atomic.py": "the helpers themselves",
@@ -70,6 +74,27 @@ def _bound_temporaries(tree: ast.AST, names: set[str]) -> set[str]:
     return names
 
 
+def _in_memory_buffers(tree: ast.AST) -> set[str]:
+    """Names bound to ``io.BytesIO()`` in ``tree``: a PIL save there writes no file."""
+    return {t.id for node in ast.walk(tree) if isinstance(node, ast.Assign)
+            and isinstance(node.value, ast.Call) and _callee(node.value.func) == "BytesIO"
+            for t in node.targets if isinstance(t, ast.Name)}
+
+
+def _pil_save(call: ast.Call) -> bool:
+    """``call`` is ``<image>.save(file, ...)`` (not ``type(image).save(image, file)``, whose first
+    argument is the image, nor a class's own ``save(path)`` method on another object)."""
+    f = call.func
+    if not (isinstance(f, ast.Attribute) and f.attr == "save" and call.args):
+        return False
+    receiver = f.value
+    if isinstance(receiver, ast.Call) and _callee(receiver.func) == "type":
+        return False
+    return (any(k.arg == "format" for k in call.keywords)
+            or (isinstance(receiver, ast.Call) and _callee(receiver.func) in _PIL_MAKERS)
+            or (isinstance(receiver, ast.Name) and receiver.id in _PIL_NAMES))
+
+
 def _is_temporary(node: ast.expr | None, temps: set[str]) -> bool:
     if isinstance(node, ast.Subscript):
         node = node.value
@@ -98,6 +123,8 @@ def _writes(scope: ast.AST):
             yield node, f.value, f".{f.attr}()"
         elif isinstance(f, ast.Attribute) and f.attr == "savefig" and node.args:
             yield node, node.args[0], ".savefig()"
+        elif _pil_save(node):
+            yield node, node.args[0], "Image.save()"
         elif isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and f.value.id in ("np", "numpy") \
                 and f.attr in _NUMPY_SAVES and node.args:
             yield node, node.args[0], f"np.{f.attr}()"
@@ -119,7 +146,7 @@ def raw_writes(source: str) -> list[tuple[int, str]]:
     found = []
     for scope in [tree] + [n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))]:
         params = () if isinstance(scope, ast.Module) else scope.args.args + scope.args.kwonlyargs
-        temps = _bound_temporaries(scope, {a.arg for a in params if a.arg == "tmp"})
+        temps = _bound_temporaries(scope, {a.arg for a in params if a.arg == "tmp"}) | _in_memory_buffers(scope)
         found += [(call.lineno, what) for call, target, what in _writes(scope)
                   if target is None or not _is_temporary(target, temps)]
     return sorted(found)
@@ -129,10 +156,12 @@ def test_the_check_finds_a_direct_write_and_passes_an_atomic_one():
     bad = ("from pathlib import Path\nPath('x').write_text('a')\nwith open('y', 'w') as fh: pass\nnp.save('z', a)\n"
            "def f(p):\n    with atomic_path(p) as tmp:\n        pass\n"
            "def g(out):\n    tmp = out / '.x.tmp'\n    tmp.write_text('a')\n    fig.savefig(out)\n"
-           "    tmp.replace(out)\n    fd, t = tempfile.mkstemp()\n    os.replace(t, out)\n")
+           "    tmp.replace(out)\n    fd, t = tempfile.mkstemp()\n    os.replace(t, out)\n"
+           "def k(out, a):\n    Image.fromarray(a).save(out)\n    img.save(out / 'x.png')\n"
+           "    Image.open(out).save(out, format='PNG')\n")
     assert [w for _, w in raw_writes(bad)] == [".write_text()", "open(..., write mode)", "np.save()", ".write_text()",
                                                ".savefig()", ".replace() of a temporary", "tempfile.mkstemp()",
-                                               "os.replace()"]
+                                               "os.replace()", "Image.save()", "Image.save()", "Image.save()"]
     good = ("with atomic_path(p) as tmp:\n    tmp.write_text('a')\n    np.savez(tmp, a=1)\n"
             "with atomic_files([p, q]) as temps:\n    open(temps[0], 'wb').close()\n"
             "with atomic_write(p) as fh:\n    np.savez_compressed(fh, a=1)\n"
@@ -140,7 +169,10 @@ def test_the_check_finds_a_direct_write_and_passes_an_atomic_one():
             "for t in temps[1:]:\n    t.write_bytes(b'')\n"
             "_atomic(p, lambda q: q.write_text('a'))\n"
             "with open(p) as fh: pass\nwrite_text(p, 'a')\n"
-            "def h(value, tmp):\n    np.savez(tmp, a=value)\n")
+            "def h(value, tmp):\n    np.savez(tmp, a=value)\n"
+            "def k(p, a):\n    buf = io.BytesIO()\n    Image.fromarray(a).save(buf, format='PNG')\n"
+            "    with atomic_path(p) as tmp:\n        img.save(tmp)\n    spec.save(p)\n"
+            "    type(img).save(img, p, format='PNG')\n")
     assert raw_writes(good) == []
 
 
