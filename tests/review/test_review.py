@@ -277,6 +277,41 @@ def test_the_section_cap_shows_the_wood_inside(page, browser, tmp_path):
     assert img[20, 20].max() < 0.05 and img[480, 980].max() < 0.05
 
 
+class _RampWood:
+    """A known answer for the cap: red, green, blue rise linearly with x, y, z over the block
+    (trilinear sampling reproduces a linear function exactly) and green carries half the
+    normal's y component, so a y-cut shows the +y normal's colour."""
+
+    def __init__(self, size_mm):
+        self.size = np.asarray(size_mm, float)
+
+    def color(self, points_mm, normals):
+        rgb = np.asarray(points_mm, float) / self.size
+        rgb[:, 1] = 0.5 * rgb[:, 1] + 0.5 * np.abs(np.asarray(normals, float)[:, 1])
+        return rgb
+
+
+def test_the_section_cap_shows_each_point_where_it_lies(page, browser, tmp_path):
+    """Known answer: the cap of a linear colour ramp, front orthographic view, cut at y = 40 mm,
+    shows (x / W, 0.5 + 0.5 * 40 / D, z / H) at block point (x, 40, z): a volume shifted by a
+    voxel (2.7 mm here), or sampled with another normal than the cut's, is off by far more than
+    the page's filtering (CAP_VS_VOLUME_TOL) and the volume's 8-bit step."""
+    stock, glb, _, _ = page
+    W, D, H = stock.size_mm
+    out = write_review(glb, tmp_path / "ramp.html", wood=_RampWood(stock.size_mm),
+                       size_mm=stock.size_mm, voxels=20000)
+    png = tmp_path / "ramp.png"
+    assert browser.load(f"file://{out}#bare&ortho&view=front&cut=y:40", size=(1000, 500)) == "box: ready"
+    browser.screenshot(png)
+    img = np.asarray(Image.open(png).convert("RGB"), dtype=float) / 255
+    rng = np.random.default_rng(1)
+    cols, rows = rng.integers(120, 880, 300), rng.integers(70, 430, 300)  # inside the part's section
+    x, z = (cols + 0.5) * W / 1000, H - (rows + 0.5) * H / 500
+    want = np.column_stack([x / W, np.full_like(x, 0.5 + 0.5 * 40 / D), z / H])
+    err = np.abs(img[rows, cols] - want).max(axis=0)
+    assert err.max() <= CAP_VS_VOLUME_TOL + 0.5 / 255
+
+
 def _ndc(browser, key: str) -> np.ndarray:
     """The probe's NDC bounds (x0, y0, x1, y1) of the block or the part under the shown camera."""
     return np.array(browser.evaluate(f"document.getElementById('probe').dataset.{key}").split(","),
