@@ -202,19 +202,10 @@ def test_a_photographed_cubes_page_keeps_the_budget_and_its_volumes_exact(shared
     """A 50 mm Mokume cube's colour volumes took 3.2 MiB as PNG in base64 (busier rings than a
     synthetic block's; the same voxels and channels) and the page 4.0 MiB besides its GLB, over
     the budget; they are lossless WebP now, and what the page holds is the volume exactly."""
-    import io
-
     stock, glb, out = _cube_page(shared_data, tmp_path)
     assert out.stat().st_size - 4 / 3 * glb.stat().st_size <= PAGE_BUDGET_BYTES
-    data = json.loads(re.search(r'id="woodcam-data">(.*?)</script>', out.read_text(), re.S)
-                      .group(1).replace("<\\/", "</"))
-    vol = data["volumes"]["z"]
-    sheet = np.asarray(Image.open(io.BytesIO(base64.b64decode(vol["image"].split(",", 1)[1]))).convert("RGB"))
-    nx, ny, nz = vol["shape"]
     expected = colour_volume(stock.wood, stock.size_mm, "z", volume_cell_mm(stock.size_mm))
-    for k in range(nz):
-        r, c = divmod(k, vol["tiles"])
-        np.testing.assert_array_equal(sheet[r * ny:(r + 1) * ny, c * nx:(c + 1) * nx], expected[k])
+    np.testing.assert_array_equal(_page_volume(out, "z"), expected)
 
 
 def test_a_volume_the_browser_cannot_read_is_an_error_not_loading_for_ever(page, browser, tmp_path):
@@ -508,16 +499,40 @@ def test_review_errors_are_clear(page, tmp_path):
         write_review(glb, tmp_path / "r.txt", wood=stock.wood, size_mm=stock.size_mm)
 
 
+def _page_volume(html: Path, axis: str) -> np.ndarray:
+    """The page's colour volume of ``axis`` as (nz, ny, nx, 3) uint8, untiled from its sheet."""
+    import io
+
+    data = json.loads(re.search(r'id="woodcam-data">(.*?)</script>', html.read_text(), re.S)
+                      .group(1).replace("<\\/", "</"))
+    vol = data["volumes"][axis]
+    sheet = np.asarray(Image.open(io.BytesIO(base64.b64decode(vol["image"].split(",", 1)[1]))).convert("RGB"))
+    nx, ny, nz = vol["shape"]
+    return np.stack([sheet[(k // vol["tiles"]) * ny:(k // vol["tiles"] + 1) * ny,
+                           (k % vol["tiles"]) * nx:(k % vol["tiles"] + 1) * nx] for k in range(nz)])
+
+
 def test_the_cli_writes_the_page_from_the_glbs_own_block(page, tmp_path, capsys, bars):
+    """The wood under the cut is the block the GLB records (here builtin:rift, not the
+    flat-sawn default of other commands): its colour volume, voxel for voxel."""
     from woodcam.cli import main
+    from woodcam.export import load_textured
 
     _, glb, _, _ = page
-    assert main(["review", str(glb), "--out", str(tmp_path / "r.html"), "--voxels", "20000"]) == 0
+    rift = export_glb(load_textured(glb), tmp_path / "rift.glb", metadata={"block": "builtin:rift"})
+    assert main(["review", str(rift), "--out", str(tmp_path / "r.html"), "--voxels", "20000"]) == 0
     # sweep h5 item 7: 10 s of colour volumes at --voxels 3e6 with no bar
     (volumes,) = [b for b in bars if b.unit == "volume"]
     assert volumes.total == volumes.n == 3 and volumes.enabled
     assert "wrote" in capsys.readouterr().out and (tmp_path / "r.html").stat().st_size > 1e5
     assert Path(tmp_path / "r.html").read_text().count("data:image/webp;base64,") == 3
+    stock = open_stock("builtin:rift")
+    want = colour_volume(stock.wood, stock.size_mm, "x", volume_cell_mm(stock.size_mm, 20000))
+    flat = open_stock("builtin:flat-sawn")
+    assert np.abs(colour_volume(flat.wood, flat.size_mm, "x", volume_cell_mm(flat.size_mm, 20000)).astype(int)
+                  - want).max() > 50  # the two blocks' woods differ
+    np.testing.assert_array_equal(_page_volume(tmp_path / "r.html", "x"), want)
+    assert "<td>builtin:rift</td>" in (tmp_path / "r.html").read_text()
 
 
 def test_review_of_a_photographed_block_names_no_species_nobody_gave(tmp_path, capsys, monkeypatch):
