@@ -535,7 +535,7 @@ def test_the_cli_writes_the_page_from_the_glbs_own_block(page, tmp_path, capsys,
     assert "<td>builtin:rift</td>" in (tmp_path / "r.html").read_text()
 
 
-def test_review_of_a_photographed_block_names_no_species_nobody_gave(tmp_path, capsys, monkeypatch):
+def test_review_of_a_photographed_block_shows_its_photos_and_names_no_species_nobody_gave(tmp_path, capsys, monkeypatch):
     """review (and preview) of a part baked on a block with photos along all three axes warned
     '--species oak: ... the species changes nothing here' though no --species was typed: the
     species the GLB records was passed on as if asked for."""
@@ -561,6 +561,20 @@ def test_review_of_a_photographed_block_names_no_species_nobody_gave(tmp_path, c
                      "--voxels", "20000"]) == 0
     said = [str(w.message) for w in caught] + [capsys.readouterr().err]
     assert not any("--species" in m for m in said), said
+    # the page shows the block's own face photos, each under its face's name
+    import io
+
+    from woodcam.block.io import read_block
+
+    block = read_block(folder)
+    shown = {face: b64 for b64, face in re.findall(r'<img src="data:image/jpeg;base64,([^"]+)" alt="face (\w+)"',
+                                                   (tmp_path / "r.html").read_text())}
+    assert sorted(shown) == sorted(f for f, face in block.faces.items() if face.photo is not None)
+    for face, b64 in shown.items():
+        img = np.asarray(Image.open(io.BytesIO(base64.b64decode(b64))).convert("RGB"), float)
+        photo = block.faces[face].photo.astype(float)
+        assert img.shape == photo.shape, face  # under 320 px: not resized
+        assert np.abs(img - photo).mean() < 6, face  # the photo, through JPEG at quality 80
 
 
 def test_review_refuses_a_parquetry_panel_and_names_woodifys_field(page, tmp_path, capsys):
