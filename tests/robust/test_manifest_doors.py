@@ -109,6 +109,10 @@ def test_absolute_and_parent_paths_are_refused_unless_trusted(folder, tmp_path, 
         with pytest.raises(WoodcamError, match="points outside the block folder"):
             read_block(folder)
     assert read_block(folder, allow_outside=True).faces["top"].photo.max() == 7
+    for off in ("0", "false", "no"):  # the variable set to say no trusts nothing
+        monkeypatch.setenv("WOODCAM_ALLOW_OUTSIDE_PATHS", off)
+        with pytest.raises(WoodcamError, match="points outside the block folder"):
+            read_block(folder)
     monkeypatch.setenv("WOODCAM_ALLOW_OUTSIDE_PATHS", "1")
     assert read_block(folder).faces["top"].photo.max() == 7
 
