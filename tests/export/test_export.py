@@ -329,6 +329,8 @@ def test_glb_passes_the_khronos_validator(baked, tmp_path, normals):
     errors = [m for m in issues["messages"] if m["severity"] == 0]
     assert issues["numErrors"] == 0, errors
     assert issues["numWarnings"] == 0, issues["messages"]
+    # nor hints: every buffer view says what it holds (BUFFER_VIEW_TARGET_MISSING otherwise)
+    assert issues["numHints"] == 0, [m for m in issues["messages"] if m["severity"] == 3]
     info = report["info"]
     assert info["materialCount"] == 1 and info["hasTextures"]
 
@@ -441,3 +443,17 @@ def test_an_export_refused_by_its_folder_names_the_file_asked_for(baked, monkeyp
         with pytest.raises(OSError) as err:
             write(baked.mesh, f"/proc/self/{name}")  # read-only even for root
         assert err.value.filename == f"/proc/self/{name}", write.__name__
+
+
+def test_another_programs_glb_comes_back_where_its_node_transform_places_it(tmp_path):
+    """load_textured keeps a file's vertex buffer as stored only for woodcam's own GLB (its
+    BLOCK_TO_GLTF root, metadata frame "block"); another program's node transform is applied:
+    a 10 x 20 x 30 box turned 90 degrees about x and moved to (100, 50, 25) spans 10 x 30 x 20."""
+    box = trimesh.creation.box((10.0, 20.0, 30.0))
+    placed = trimesh.transformations.rotation_matrix(np.pi / 2, [1, 0, 0])
+    placed[:3, 3] = [100.0, 50.0, 25.0]
+    scene = trimesh.Scene()
+    scene.add_geometry(box, transform=placed)
+    (tmp_path / "other.glb").write_bytes(scene.export(file_type="glb"))
+    loaded = load_textured(tmp_path / "other.glb")  # 1 unit or more: no metres guess, no warning
+    np.testing.assert_allclose(loaded.bounds, [[95.0, 35.0, 15.0], [105.0, 65.0, 35.0]], atol=1e-9)
