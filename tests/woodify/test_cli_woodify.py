@@ -305,6 +305,58 @@ def test_crack_density_per_bark_area_does_not_depend_on_flatness(tmp_path):
     assert 0.6 < shares["disc"] / shares["stem"] < 1.6, shares
 
 
+def _bark_feature_mm(glb: Path, region: str, along: str, n_lines: int = 120) -> float:
+    """Feature size (mm) of the bark of a written GLB along surface lines: the lag where the
+    luminance autocorrelation first drops below 0.25. Lines through random points of the lid
+    (normal . z > 0.98) run ``radial`` (from the axis) or ``tangential``; on the sides (|normal .
+    z| < 0.1) ``tangential`` (across the fibres, the stem is z) or ``axial``."""
+    from scipy.spatial import cKDTree
+
+    scene = trimesh.load(glb)
+    m = next(iter(scene.geometry.values()))
+    img = np.asarray(m.visual.material.baseColorTexture.convert("L"), float)
+    h, w = img.shape
+    pts, fi = trimesh.sample.sample_surface(m, 1_500_000, seed=1)
+    bary = trimesh.triangles.points_to_barycentric(m.triangles[fi], pts)
+    uv = (m.visual.uv[m.faces[fi]] * bary[:, :, None]).sum(1)
+    lum = img[np.clip((1 - uv[:, 1] % 1) * h, 0, h - 1).astype(int), np.clip((uv[:, 0] % 1) * w, 0, w - 1).astype(int)]
+    z = np.array([0.0, 0.0, 1.0])
+    nz = m.face_normals @ z
+    sel = np.nonzero(nz > 0.98 if region == "lid" else np.abs(nz) < 0.1)[0]
+    rng = np.random.default_rng(0)
+    f = rng.choice(sel, n_lines, p=m.area_faces[sel] / m.area_faces[sel].sum())
+    p = m.triangles[f].mean(1)
+    rad = p - m.vertices.mean(0)
+    rad[:, 2] = 0.0
+    rad /= np.linalg.norm(rad, axis=1, keepdims=True)
+    t = {"radial": rad, "tangential": np.cross(z, rad if region == "lid" else m.face_normals[f]),
+         "axial": np.broadcast_to(z, p.shape)}[along]
+    t = t / np.linalg.norm(t, axis=1, keepdims=True)
+    step, s = 0.1, np.arange(-8.0, 8.0, 0.1)
+    L = lum[cKDTree(pts).query((p[:, None] + s[None, :, None] * t[:, None]).reshape(-1, 3))[1]]
+    L = L.reshape(n_lines, len(s))
+    L = L - L.mean(1, keepdims=True)
+    L = L[L.std(1) > 0] / L[L.std(1) > 0].std(1, keepdims=True)
+    ac = np.array([np.mean(L[:, :len(s) - k] * L[:, k:]) for k in range(len(s) // 2)])
+    return float(np.argmax(ac < 0.25) * step) if (ac < 0.25).any() else float(len(ac) * step)
+
+
+def test_bark_is_not_stretched_on_flat_faces(tmp_path):
+    """The procedural bark was a picture laid on by cylindrical coordinates round the stem,
+    which squeeze a flat lid to a line: its plates ran as radial streaks (on a grown box, features
+    2.3x longer along the radius than across it, 1.5x those across the fibres on the sides). A
+    solid texture has the same features per mm on every face: the lid's radial and tangential
+    feature sizes agree, and match the sides' across the fibres."""
+    trimesh.creation.box(extents=(30.0, 30.0, 60.0)).export(tmp_path / "box.stl")
+    assert main(["woodify", str(tmp_path / "box.stl"), "--years", "6", "--resolution", "48",
+                 "--cracks", "none", "--out", str(tmp_path / "box")]) == 0
+    glb = tmp_path / "box" / "grown.glb"
+    radial, tangential = _bark_feature_mm(glb, "lid", "radial"), _bark_feature_mm(glb, "lid", "tangential")
+    across = _bark_feature_mm(glb, "side", "tangential")
+    assert 0.75 < radial / tangential < 1.33, (radial, tangential)
+    assert 0.75 < radial / across < 1.33, (radial, across)
+
+
 def test_a_mesh_saved_in_metres_is_named_as_such(tmp_path, capsys):
     """A 40 mm box saved as 0.04 units grew, silently, into a 0.06 mm speck (mesh files carry no
     units and are read as mm, whatever --units says): it is warned about, with the unit it looks

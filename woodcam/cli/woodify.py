@@ -186,9 +186,7 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
     from ..woodify.bark import (
         BARK_TEXELS_PER_VOXEL,
         CRACK_WIDTH_VOXELS,
-        bark_image,
-        corner_uv,
-        cylindrical_uv,
+        SolidBark,
         groove,
         paint_crack_faces,
         paint_cracks,
@@ -225,7 +223,7 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
             origins, tri = res.origins(mesh.vertices)
         summary["timings"]["cracks_s" if cracks != "none" else "surface_s"] = time.perf_counter() - t
     with stage("bark and surfaces"):
-        # persistent texture: the input's own UVs and image, else cylindrical bark coordinates
+        # persistent texture: the input's own UVs and image, else solid bark (below)
         image = None
         if textured is not None:
             _, bary = barycentric_on(textured, origins, tri)
@@ -234,37 +232,24 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
             img = getattr(mat, "baseColorTexture", None) or getattr(mat, "image", None)
             image = np.asarray(img.convert("RGB")) if img is not None else None
         procedural = image is None
-        if procedural:
-            up = res.field.stem_axis
-            c = res.mesh.centroid
-
-            def mean_radius(v):
-                d = v - c
-                return max(float(np.linalg.norm(d - np.outer(d @ up, up), axis=1).mean()), 1e-3)
-
-            uv = cylindrical_uv(origins, up, c, 2 * np.pi * mean_radius(res.mesh.vertices))
-            # the carried coordinates stretch with the growth; lay as many bark tiles round the
-            # stem as the grown girth holds, as one picture
-            k = max(1, int(round(mean_radius(mesh.vertices) / mean_radius(res.mesh.vertices))))
-            uv = uv * k
-            rows = max(1, int(np.ceil(uv[:, 1].max())))
-            image = np.tile(bark_image(256, seed), (rows, k, 1))
-            uv = uv / np.array([k, rows])
         h = res.front.grid.spacing_mm
         if crack_render == "groove" and len(crack_edges):
             width = np.zeros(len(mesh.vertices))
             width[crack_edges.ravel()] = 1.0
             mesh = groove(mesh, width, 0.6 * h)
         if procedural:
-            # Cylindrical coordinates squeeze every face that does not face away from the stem (the
-            # top of a flat lid, a rim grown from a sharp edge) to a sliver of the picture: cracks
-            # drawn there crowded one band, and the band covered most of the bark. The bark is
-            # moved into an atlas of even texel density first, so a crack darkens the same
-            # share of the bark per mm wherever it runs.
-            from ..bake import rebake_texture
+            # Bark as a solid texture round the stem, baked into an atlas of even texel density:
+            # a picture laid on by cylindrical coordinates was squeezed to a line on every face
+            # that does not face away from the stem (a flat lid, a rim grown from a sharp edge),
+            # which showed as radial streaks and drew cracks there into one band. Now the
+            # bark's plates and a crack's share of the bark per mm are the same wherever they lie.
+            from ..bake import bake
 
-            baked = rebake_texture(mesh, corner_uv(uv, mesh.faces), image,
-                                   texels_per_mm=BARK_TEXELS_PER_VOXEL / h)
+            up = res.field.stem_axis
+            c = res.mesh.centroid
+            d = np.asarray(res.mesh.vertices) - c
+            girth = 2 * np.pi * max(float(np.linalg.norm(d - np.outer(d @ up, up), axis=1).mean()), 1e-3)
+            baked = bake(mesh, SolidBark(up, c, girth, seed), texels_per_mm=BARK_TEXELS_PER_VOXEL / h)
             bark = baked.mesh
             if crack_render == "material" and len(crack_edges):
                 atlas = np.asarray(bark.visual.material.baseColorTexture)

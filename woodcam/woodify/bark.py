@@ -1,11 +1,11 @@
-"""Bark on a grown surface: texture coordinates carried from the input, a bark image, cracks.
+"""Bark on a grown surface: texture coordinates carried from the input, a solid bark, cracks.
 
-Texture coordinates come from where each grown vertex came from on the input surface
-(:func:`woodcam.woodify.surfaces.trace_back`): the input's own UVs when it has them (its image
-stays put while the object grows, seed Fig. 4.6), otherwise cylindrical coordinates of the
-origin round the stem axis (``u`` = angle / 2 pi, ``v`` = height / circumference), so a procedural
-bark image is carried in the same way. Cracks are drawn either into the image along their UV
-paths (``"material"``) or cut into the geometry (``"groove"``, :func:`groove`).
+An input with its own UVs keeps its picture: each grown vertex gets the UV of where it came
+from on the input surface (:func:`woodcam.woodify.surfaces.trace_back`), so the image stays put
+while the object grows (seed Fig. 4.6). An untextured input gets procedural bark,
+:class:`SolidBark`, a solid texture round the stem axis baked into an atlas of even texel density
+(:func:`woodcam.bake.bake`). Cracks are drawn either into the picture along their edges
+(``"material"``) or cut into the geometry (``"groove"``, :func:`groove`).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ CRACK_RENDERS: tuple[str, ...] = ("groove", "material")
 
 def stem_axis(mesh) -> np.ndarray:
     """Unit direction ``(3,)`` of a mesh's longest principal axis (area-weighted surface PCA):
-    the stem of a trunk-like input, round which bark coordinates wrap and fibres run."""
+    the stem of a trunk-like input, along which the bark's plates and the fibres run."""
     c = mesh.triangles_center
     w = mesh.area_faces
     mu = (c * w[:, None]).sum(0) / w.sum()
@@ -32,37 +32,53 @@ def stem_axis(mesh) -> np.ndarray:
     return a if a[np.argmax(np.abs(a))] > 0 else -a
 
 
-def cylindrical_uv(origins_mm, up, centre_mm, circumference_mm: float) -> np.ndarray:
-    """``(n, 2)`` UVs of input-surface points round the axis through ``centre_mm`` along ``up``
-    (here: the stem axis, not the eccentricity's up)."""
-    up = np.asarray(up, float) / np.linalg.norm(up)
-    ref = np.array([1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    e1 = ref - up * (ref @ up)
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(up, e1)
-    d = np.asarray(origins_mm, float) - np.asarray(centre_mm, float)
-    u = (np.arctan2(d @ e2, d @ e1) / (2 * np.pi)) % 1.0
-    v = (d @ up) / circumference_mm
-    return np.stack([u, v - np.floor(v.min())], axis=1)
+class SolidBark:
+    """Procedural bark as a solid texture round the stem: plates between furrows that run along
+    ``axis``, repeating every ``period_mm`` in every direction.
 
+    A picture laid on by surface coordinates squeezes wherever they degenerate: cylindrical
+    coordinates map a flat lid (normal along the stem) and a rim grown from a sharp edge to a
+    line, which drew the bark there as radial streaks several times the size of the plates on
+    the stem. A solid texture has no coordinates to degenerate: every surface, flat or curved,
+    cuts the same field, so the bark has the same feature size per mm everywhere (on the stem
+    the plates' long side runs along it; a lid cuts across them). It is the ``wood`` of
+    :func:`woodcam.bake.bake`: ``color(points_mm (n, 3), normals) -> (n, 3)`` RGB in [0, 1].
+    """
 
-def bark_image(size_px: int = 512, seed: int = 0) -> np.ndarray:
-    """A tileable procedural bark picture ``(size, size, 3) uint8``: plates between vertical furrows."""
-    rng = np.random.default_rng(seed)
-    n = size_px
-    noise = rng.standard_normal((n, n))
-    # stretched along v (rows): long plates and furrows running up the stem
-    plates = ndimage.gaussian_filter(noise, (n / 24, n / 160), mode="wrap")
-    fine = ndimage.gaussian_filter(rng.standard_normal((n, n)), (n / 128, n / 512), mode="wrap")
-    plates = (plates - plates.mean()) / (plates.std() + 1e-9)
-    fine = (fine - fine.mean()) / (fine.std() + 1e-9)
-    furrow = np.clip(-plates - 0.3, 0, None)  # deep furrows where the plate field is low
-    light = np.clip(0.65 + 0.12 * fine - 0.35 * np.tanh(furrow), 0, 1)
-    base = np.array([112, 92, 74], float)
-    grey = np.array([140, 134, 126], float)
-    mix = np.clip(0.5 + 0.25 * plates, 0, 1)[..., None]
-    img = (base * (1 - mix) + grey * mix) * light[..., None] * 1.5
-    return np.clip(img, 0, 255).astype(np.uint8)
+    #: Voxels of the periodic noise across the stem (two axes) and along it: the plates are
+    #: 1/160 of the period wide and 1/24 long (Gaussian sigma), the fine grain finer.
+    CELLS = (160, 160, 64)
+
+    def __init__(self, axis, centre_mm, period_mm: float, seed: int = 0) -> None:
+        up = np.asarray(axis, float) / np.linalg.norm(axis)
+        ref = np.array([1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        e1 = ref - up * (ref @ up)
+        e1 /= np.linalg.norm(e1)
+        self._frame = np.stack([e1, np.cross(up, e1), up])    # rows: across, across, along
+        self._centre = np.asarray(centre_mm, float)
+        self._period = float(period_mm)
+        rng = np.random.default_rng(seed)
+        n, _, m = self.CELLS
+        plates = ndimage.gaussian_filter(rng.standard_normal(self.CELLS), (n / 160, n / 160, m / 24),
+                                         mode="wrap")
+        fine = ndimage.gaussian_filter(rng.standard_normal(self.CELLS), (n / 512, n / 512, m / 128),
+                                       mode="wrap")
+        self._plates = ((plates - plates.mean()) / (plates.std() + 1e-9)).astype(np.float32)
+        self._fine = ((fine - fine.mean()) / (fine.std() + 1e-9)).astype(np.float32)
+
+    def color(self, points_mm, normals=None) -> np.ndarray:
+        """Bark colour ``(n, 3)`` float in [0, 1] at ``points_mm (n, 3)`` (normals unused)."""
+        q = (np.asarray(points_mm, float) - self._centre) @ self._frame.T / self._period
+        idx = (q * np.asarray(self.CELLS)).T
+        plates = ndimage.map_coordinates(self._plates, idx, order=1, mode="grid-wrap")
+        fine = ndimage.map_coordinates(self._fine, idx, order=1, mode="grid-wrap")
+        furrow = np.clip(-plates - 0.3, 0, None)  # deep furrows where the plate field is low
+        light = np.clip(0.65 + 0.12 * fine - 0.35 * np.tanh(furrow), 0, 1)
+        base = np.array([112, 92, 74], float)
+        grey = np.array([140, 134, 126], float)
+        mix = np.clip(0.5 + 0.25 * plates, 0, 1)[:, None]
+        rgb = (base * (1 - mix) + grey * mix) * light[:, None] * 1.5
+        return np.clip(rgb / 255.0, 0.0, 1.0)
 
 
 def textured_mesh(mesh, uv, image):
@@ -110,7 +126,7 @@ def paint_cracks(image, uv, edges, width_px: int = 2) -> np.ndarray:
 
 
 #: Texels per voxel of the growth grid in the procedural bark's atlas (see
-#: :func:`woodcam.bake.rebake_texture`), and the width of a crack drawn into it, in voxels: the
+#: :func:`woodcam.bake.bake`), and the width of a crack drawn into it, in voxels: the
 #: cracks run along the grown surface's edges, about a voxel long, so finer would show nothing
 #: the simulation knows.
 BARK_TEXELS_PER_VOXEL = 4.0
@@ -119,9 +135,9 @@ CRACK_WIDTH_VOXELS = 0.5
 
 def corner_uv(uv, faces) -> np.ndarray:
     """Per-face corner coordinates ``(f, 3, 2)`` of per-vertex ``uv (n, 2)`` that wrap in ``u``
-    (cylindrical bark): a face across the wrap (``u`` near 0 and 1) has ``u + 1`` on its low
+    (a picture wrapped round the object, as a longitude-latitude map): a face across the wrap (``u`` near 0 and 1) has ``u + 1`` on its low
     corners (the one home of this rule: :func:`textured_mesh` splits those corners off), so the
-    picture does not smear round the stem."""
+    picture does not smear round the object."""
     c = np.asarray(uv, float)[np.asarray(faces)].copy()
     u = c[..., 0]
     seam = (u.max(1) - u.min(1)) > 0.5
@@ -133,7 +149,7 @@ def paint_crack_faces(image, corner_xy, faces, edges, width_px: int) -> np.ndarr
     """Draw crack edges ``(m, 2)`` (vertex indices of ``faces (f, 3)``) dark into an atlas whose
     faces have their own corner texel coordinates ``corner_xy (f, 3, 2)`` (x right, y down, texel
     corners at integers): each edge is drawn in every face that holds it, so a crack on a chart
-    seam shows in both charts. In an atlas of even texel density (:func:`woodcam.bake.rebake_texture`)
+    seam shows in both charts. In an atlas of even texel density (:func:`woodcam.bake.bake`)
     a crack covers the same share of the texture per mm of bark wherever it lies."""
     import cv2
 
