@@ -305,6 +305,35 @@ def test_crack_density_per_bark_area_does_not_depend_on_flatness(tmp_path):
     assert 0.6 < shares["disc"] / shares["stem"] < 1.6, shares
 
 
+def test_cracks_on_a_textured_input_cover_as_much_bark_as_untextured(tmp_path):
+    """The same trunk with a picture (cylindrical UVs, its vertices split per face as many
+    exporters write them) cracks as often as without one, but its cracks were drawn into the
+    picture at the picture's scale (2 px of a 256 px picture: 1.3 mm wide) and piled onto its lid
+    (one row of the picture): 0.35 of the bark showed as crack against 0.19 untextured. Drawn into
+    an atlas of even texel density, as the untextured bark's, the two agree (0.16 here)."""
+    from PIL import Image
+
+    trunk = trimesh.creation.cylinder(radius=12.0, height=60.0, sections=48)
+    trunk.export(tmp_path / "trunk.stl")
+    split = trimesh.Trimesh(trunk.triangles.reshape(-1, 3), np.arange(3 * len(trunk.faces)).reshape(-1, 3),
+                            process=False)
+    v = split.vertices
+    uv = np.c_[(np.arctan2(v[:, 1], v[:, 0]) / (2 * np.pi)) % 1, (v[:, 2] + 30) / 60]
+    grey = (np.random.default_rng(0).random((256, 256, 3)) * 80 + 120).astype(np.uint8)
+    split.visual = trimesh.visual.TextureVisuals(uv=uv, image=Image.fromarray(grey))
+    split.export(tmp_path / "trunk.glb")
+    shares, counts = {}, {}
+    for name in ("trunk.stl", "trunk.glb"):
+        out = tmp_path / name.replace(".", "_")
+        assert main(["woodify", str(tmp_path / name), "--years", "6", "--resolution", "40",
+                     "--crack-years", "3", "--out", str(out)]) == 0
+        shares[name] = _crack_share(out / "grown.glb")
+        counts[name] = json.loads((out / "woodify.json").read_text())["cracks"]["count"]
+    assert counts["trunk.glb"] == counts["trunk.stl"] > 10, counts
+    assert 0.05 < shares["trunk.stl"] < 0.4, shares
+    assert 0.7 < shares["trunk.glb"] / shares["trunk.stl"] < 1.4, shares
+
+
 def _bark_feature_mm(glb: Path, region: str, along: str, n_lines: int = 120) -> float:
     """Feature size (mm) of the bark of a written GLB along surface lines: the lag where the
     luminance autocorrelation first drops below 0.25. Lines through random points of the lid

@@ -187,9 +187,10 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
         BARK_TEXELS_PER_VOXEL,
         CRACK_WIDTH_VOXELS,
         SolidBark,
+        corner_uv,
         groove,
         paint_crack_faces,
-        paint_cracks,
+        picture_density,
         textured_mesh,
     )
     from ..woodify.cracks import simulate_cracks
@@ -237,21 +238,33 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
             width = np.zeros(len(mesh.vertices))
             width[crack_edges.ravel()] = 1.0
             mesh = groove(mesh, width, 0.6 * h)
-        if procedural:
+        painted = crack_render == "material" and len(crack_edges) > 0
+        if procedural or painted:
             # Bark as a solid texture round the stem, baked into an atlas of even texel density:
             # a picture laid on by cylindrical coordinates was squeezed to a line on every face
             # that does not face away from the stem (a flat lid, a rim grown from a sharp edge),
             # which showed as radial streaks and drew cracks there into one band. Now the
             # bark's plates and a crack's share of the bark per mm are the same wherever they lie.
-            from ..bake import bake
+            # An input's own picture is moved into such an atlas too when cracks are drawn into
+            # it: drawn into the picture at its own scale, a crack was as many mm wide as its
+            # texels (2 px of a 256 px picture round a trunk: 1.3 mm) and piled up where the
+            # input's UVs squeeze (a lid on one row), showing 2.3x the crack share of the same
+            # cracks on the untextured input. Never coarser than the picture was.
+            from ..bake import bake, rebake_texture
 
-            up = res.field.stem_axis
-            c = res.mesh.centroid
-            d = np.asarray(res.mesh.vertices) - c
-            girth = 2 * np.pi * max(float(np.linalg.norm(d - np.outer(d @ up, up), axis=1).mean()), 1e-3)
-            baked = bake(mesh, SolidBark(up, c, girth, seed), texels_per_mm=BARK_TEXELS_PER_VOXEL / h)
+            tpm = BARK_TEXELS_PER_VOXEL / h
+            if procedural:
+                up = res.field.stem_axis
+                c = res.mesh.centroid
+                d = np.asarray(res.mesh.vertices) - c
+                girth = 2 * np.pi * max(float(np.linalg.norm(d - np.outer(d @ up, up), axis=1).mean()), 1e-3)
+                baked = bake(mesh, SolidBark(up, c, girth, seed), texels_per_mm=tpm)
+            else:
+                corners = corner_uv(uv, mesh.faces)
+                baked = rebake_texture(mesh, corners, image,
+                                       texels_per_mm=max(tpm, picture_density(mesh, corners, image)))
             bark = baked.mesh
-            if crack_render == "material" and len(crack_edges):
+            if painted:
                 atlas = np.asarray(bark.visual.material.baseColorTexture)
                 ah, aw = atlas.shape[:2]
                 xy = np.asarray(bark.visual.uv) * [aw, ah]
@@ -261,8 +274,6 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
                 bark.visual.material.baseColorTexture = Image.fromarray(atlas)
         else:
             # the input's own picture and coordinates stay as they were given
-            if crack_render == "material" and len(crack_edges):
-                image = paint_cracks(image, uv, crack_edges)
             bark = textured_mesh(mesh, uv, image)
         # the block cut from the grown object: default its bounding box
         lo, hi = mesh.bounds

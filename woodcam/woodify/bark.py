@@ -4,8 +4,10 @@ An input with its own UVs keeps its picture: each grown vertex gets the UV of wh
 from on the input surface (:func:`woodcam.woodify.surfaces.trace_back`), so the image stays put
 while the object grows (seed Fig. 4.6). An untextured input gets procedural bark,
 :class:`SolidBark`, a solid texture round the stem axis baked into an atlas of even texel density
-(:func:`woodcam.bake.bake`). Cracks are drawn either into the picture along their edges
-(``"material"``) or cut into the geometry (``"groove"``, :func:`groove`).
+(:func:`woodcam.bake.bake`). Cracks are drawn either into such an atlas along their edges
+(``"material"``, :func:`paint_crack_faces`; an input's own picture is moved into one first, no
+coarser than it was, :func:`picture_density`) or cut into the geometry (``"groove"``,
+:func:`groove`).
 """
 
 from __future__ import annotations
@@ -108,21 +110,14 @@ def textured_mesh(mesh, uv, image):
     return out
 
 
-def paint_cracks(image, uv, edges, width_px: int = 2) -> np.ndarray:
-    """Draw crack edges ``(m, 2)`` (vertex indices, with ``uv (n, 2)``) dark into the image."""
-    import cv2
-
-    img = np.array(image, np.uint8, copy=True)
-    h, w = img.shape[:2]
-    a = uv[edges[:, 0]]
-    b = uv[edges[:, 1]]
-    ok = np.abs(a[:, 0] - b[:, 0]) < 0.5  # skip the wrap
-    for p, q in zip(a[ok], b[ok]):
-        # texture repeats: draw in the wrapped tile (v measured from the image bottom)
-        pp = (int((p[0] % 1) * w), int((1 - p[1] % 1) * h))
-        qq = (int(pp[0] + (q[0] - p[0]) * w), int(pp[1] - (q[1] - p[1]) * h))
-        cv2.line(img, pp, qq, (28, 20, 14), width_px, lineType=cv2.LINE_AA)
-    return img
+def picture_density(mesh, corner_uv, image) -> float:
+    """Mean texels per mm ``image (h, w, 3)`` has on ``mesh`` (mm) laid on by ``corner_uv (f, 3,
+    2)``: the square root of the faces' picture area (texels, repeats counted) over their area."""
+    h, w = np.shape(image)[:2]
+    c = np.asarray(corner_uv, float) * [w, h]
+    a, b = c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]
+    texels = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]).sum()
+    return float(np.sqrt(texels / max(float(mesh.area), 1e-12)))
 
 
 #: Texels per voxel of the growth grid in the procedural bark's atlas (see
