@@ -84,6 +84,78 @@ def test_threads_give_identical_colours(rng):
     np.testing.assert_array_equal(a, b)
 
 
+def _untextured(name, **changes):
+    """Preset ``name`` without streaks and end-grain mottling (and with ``changes``)."""
+    from dataclasses import replace
+
+    from woodcam.appearance import get_species
+
+    return replace(get_species(name), streak_contrast=0.0, endgrain_roughness=0.0, **changes)
+
+
+def test_end_grain_is_the_side_grain_colour_darkened_by_the_preset(rng):
+    """Without noise, pure end grain (normal along the fibres) is side grain times
+    ``1 - endgrain_darkening``; side grain is the species ramp itself."""
+    species = _untextured("oak", pore_contrast=0.0)
+    app = ColorMapAppearance(species)
+    wood = Wood(AXIS_Z, app)
+    p = rng.uniform(0, 50, (5000, 3))
+    side = wood.color(p, np.tile([0.0, -1, 0], (len(p), 1)))
+    top = wood.color(p, np.tile([0.0, 0, 1], (len(p), 1)))
+    np.testing.assert_allclose(side, app.ramp(wood.arf(p)), atol=1e-5)
+    np.testing.assert_allclose(top, side * (1 - species.endgrain_darkening), atol=1e-5)
+
+
+def test_the_noise_seed_changes_the_texture_only_and_repeats(rng):
+    """``seed`` picks the pores and streaks: another seed, other texture; the same seed, the
+    same colours."""
+    p = rng.uniform(0, 50, (20000, 3))
+    n = np.tile([0.0, -1, 0], (len(p), 1))
+    c0, c1, c1_again = (Wood(AXIS_Z, ColorMapAppearance("oak", seed=s)).color(p, n) for s in (0, 1, 1))
+    np.testing.assert_array_equal(c1, c1_again)
+    assert np.abs(c0 - c1).mean() > 0.01
+    np.testing.assert_allclose(c0.mean(0), c1.mean(0), atol=0.01)   # texture, not colour
+
+
+def test_ring_porous_pores_sit_in_the_earlywood_only(rng):
+    """A ring-porous preset (oak) has its pores in the earlywood: in the latewood (ARF near 1)
+    side grain is the bare ramp colour; a diffuse-porous one keeps them there too."""
+    p = rng.uniform(0, 50, (60000, 3))
+    n = np.tile([0.0, -1, 0], (len(p), 1))
+    for porous in (True, False):
+        app = ColorMapAppearance(_untextured("oak", ring_porous=porous))
+        wood = Wood(AXIS_Z, app)
+        a = wood.arf(p)
+        ratio = (wood.color(p, n) / app.ramp(a)).mean(1)       # 1 - pore darkening
+        late, early = a > 0.99, a < 0.3
+        assert late.sum() > 100
+        assert ratio[early].min() < 0.8                         # pores in the earlywood
+        if porous:
+            np.testing.assert_allclose(ratio[late], 1.0, atol=1e-3)
+        else:
+            assert ratio[late].min() < 0.8
+
+
+def test_a_fitted_ramp_is_read_at_the_ring_phase(rng):
+    """A fitted ramp holds the colour at each bin's centre phase ``(i + 0.5) / LUT_BINS``; the
+    renderer interpolates between centres, per axis. Known answer: a ramp linear in the phase
+    (red = phase on X, 0.5 phase on Y, 0.8 phase on Z) renders red = that multiple of the phase."""
+    from dataclasses import replace
+
+    centres = (np.arange(LUT_BINS) + 0.5) / LUT_BINS
+    scale = np.array([1.0, 0.5, 0.8])
+    luts = np.stack([np.stack([s * centres, 1 - centres, np.full(LUT_BINS, 0.5)], 1) for s in scale])
+    app = replace(ColorMapAppearance(_untextured("oak", pore_contrast=0.0)), axis_luts=luts)
+    wood = Wood(AXIS_Z, app)
+    p = rng.uniform(0, 50, (20000, 3))
+    phase = np.mod(AXIS_Z(p), 1.0)
+    inner = (phase > centres[0]) & (phase < centres[-1])      # held flat beyond the end centres
+    for k in range(3):
+        rgb = wood.color(p, np.tile(np.eye(3)[k], (len(p), 1)))
+        np.testing.assert_allclose(rgb[inner, 0], scale[k] * phase[inner], atol=1e-4)
+        np.testing.assert_allclose(rgb[inner, 1], 1 - phase[inner], atol=1e-4)
+
+
 def _render_block(field, luts, size=(60.0, 50.0, 40.0), px_per_mm=2.0):
     """Faces coloured exactly by a known colour-of-ring-phase function (``luts`` at the phase
     bin centres, phase = years mod 1 = sqrt(ARF)) per block axis."""
