@@ -45,6 +45,24 @@ def test_save_load_round_trip(tmp_path, rng):
     np.testing.assert_allclose(h.axis, b.field.axis)
 
 
+def test_save_load_round_trip_keeps_interpolation_layers_and_meta(tmp_path, rng):
+    """Everything :meth:`GridField.save` writes comes back: a linear grid stays linear (its
+    value between nodes is the trilinear one, not the cubic spline's), layers and meta too."""
+    years = rng.uniform(0, 10, (5, 6, 7))
+    knot = rng.uniform(0, 1, years.shape)
+    g = GridField(years, (1.0, -2.0, 3.0), (2.0, 1.5, 1.0), "linear", axis=(0.0, 1.0, 0.0),
+                  layers={"knot": knot}, meta={"method": "rbf", "warnings": ["x"]})
+    h = GridField.load(g.save(tmp_path / "g.npz"))
+    assert h.interpolation == "linear" and h.meta == g.meta
+    assert h.spacing_mm == (2.0, 1.5, 1.0) and h.origin_mm == (1.0, -2.0, 3.0)
+    p = np.array([[2.0, -2.0, 3.0]])                    # halfway between nodes (0,0,0) and (1,0,0)
+    assert h(p)[0] == pytest.approx((years[0, 0, 0] + years[1, 0, 0]) / 2)
+    q = rng.uniform(0, 1, (100, 3)) * (8.0, 7.5, 6.0) + (1.0, -2.0, 3.0)
+    np.testing.assert_array_equal(h(q), g(q))
+    np.testing.assert_array_equal(h.knot_features(q)["knot"], g.knot_features(q)["knot"])
+    assert h.knot_features(p)["knot"][0] == pytest.approx((knot[0, 0, 0] + knot[1, 0, 0]) / 2)
+
+
 def test_load_garbage(tmp_path):
     bad = tmp_path / "x.npz"
     bad.write_text("not a field")
