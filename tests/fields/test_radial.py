@@ -62,6 +62,15 @@ def test_to_dict_round_trip(rng):
     g = RadialScalingField.from_dict(f.to_dict())
     p = rng.uniform(0, 50, (100, 3))
     np.testing.assert_array_equal(f(p), g(p))
+    # every setting, none at its default: the reference direction (phi = 0) and the pith age
+    frame = LogFrame((1, 2, 3), (0.2, 0, 1), reference=(0, 1, 0))
+    f = RadialScalingField(frame, 2.5, RadiusFunction.random(rng), RadiusFunction.random(rng),
+                           half_length_mm=30.0, age_offset_years=4.0)
+    g = RadialScalingField.from_dict(f.to_dict())
+    assert g.to_dict() == f.to_dict()
+    np.testing.assert_array_equal(f(p), g(p))
+    assert g.age_offset_years == 4.0 and g.half_length_mm == 30.0
+    np.testing.assert_allclose(g.frame.rotation, frame.rotation)
 
 
 def test_arf_eq6():
