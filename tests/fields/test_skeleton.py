@@ -52,8 +52,12 @@ def test_knot_from_model_follows_the_readme_formulas():
 def test_log_file_round_trip_is_exact(tmp_path, gran1):
     table_knot = BranchStrand(100.0, 0.5, [0, 50, 100], [0, 5, 12], [0, 0.1, 0.15], [0, 8, 14],
                       90.0, 60.0)
-    log = gran1.with_knots(gran1.knots[:5] + (table_knot,))
+    # the pith samples start off z = 0 and the log has its own name: both must come back
+    log = LogSkeleton(gran1.pith_z_mm + 25.0, gran1.pith_xy_mm, gran1.radii_mm,
+                      gran1.knots[:5] + (table_knot,), "gran 1 top")
     back = read_log(write_log(log, tmp_path / "log.json"))
+    assert back.name == "gran 1 top"
+    assert np.array_equal(back.pith_z_mm, log.pith_z_mm)
     assert np.array_equal(back.pith_xy_mm, log.pith_xy_mm)
     assert np.array_equal(back.radii_mm, log.radii_mm)
     assert len(back.knots) == 6
