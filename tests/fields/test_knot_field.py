@@ -169,6 +169,51 @@ def test_dead_knot_smoothing_changes_sign_after_death():
     assert fa(far_after)[0] < f0(far_after)[0]
 
 
+def test_knot_noise_zero_gives_a_round_knot():
+    """``knot_noise`` is the irregularity of the knot's radius round its axis: without it the
+    knot's width is the same across every diameter (within the stem's own curvature), with
+    the default 8 % it is not."""
+    s = np.linspace(-15, 15, 3001)
+    widths = {}
+    for noise in (0.0, 0.08):
+        f = KnottedLogField(simple_log(knots=[_knot()]), params=KnotParams(knot_noise=noise))
+        w = []
+        for b in np.radians(np.arange(0, 180, 15)):       # diameters round the knot axis at r = 60
+            line = np.stack([np.full_like(s, 60.0), s * np.cos(b), 300 + s * np.sin(b)], 1)
+            w.append(np.ptp(s[f.knot_features(line)["knot"] > 0.5]))
+        widths[noise] = np.array(w)
+    assert np.ptp(widths[0.0]) < 0.15, widths[0.0]            # 0.06 mm
+    assert np.ptp(widths[0.08]) > 0.3, widths[0.08]           # 0.64 mm
+
+
+@pytest.mark.parametrize("outline_mm", [0.5, 2.0])
+def test_dead_knot_outline_is_outline_mm_thick(outline_mm):
+    """The bark ring of a dead knot is ``outline_mm`` thick across the knot (measured along the
+    log through the knot's axis: 0.13-0.2 mm more, the step where the rings break)."""
+    zz = np.linspace(280.0, 320.0, 40001)
+    line = np.stack([np.full_like(zz, 70.0), np.zeros_like(zz), zz], 1)
+    f = KnottedLogField(simple_log(knots=[_knot(r_death=40.0)]), params=KnotParams(outline_mm=outline_mm))
+    on = f.evaluate(line)["outline"] > 0
+    for side in (zz > 300, zz < 300):
+        assert np.ptp(zz[on & side]) == pytest.approx(outline_mm, abs=0.25)
+
+
+def test_butterfly_weakens_the_inversion_above_and_below_a_dead_knot():
+    """``butterfly``: f = 1 + (f - 1)(1 - butterfly sin^2 beta), beta from the tangential
+    direction. At the knot's side (beta = 0) it changes nothing; above it (beta = 90 deg) the
+    rings bulge as at the side with butterfly 0 and are pulled in, not inverted, with 1."""
+    f0 = KnottedLogField(simple_log())
+    side, above = np.array([[95.0, 12.0, 300.0]]), np.array([[95.0, 0.0, 312.0]])
+    bulge = {}
+    for b in (0.0, 0.5, 1.0):
+        fd = KnottedLogField(simple_log(knots=[_knot(r_death=40.0, r_end=140.0)]),
+                             params=KnotParams(knot_noise=0, butterfly=b))
+        bulge[b] = (fd(side)[0] - f0(side)[0], fd(above)[0] - f0(above)[0])
+    assert bulge[0.0][0] > 0.1 and bulge[0.0][0] == bulge[0.5][0] == bulge[1.0][0]
+    assert bulge[0.0][1] == pytest.approx(bulge[0.0][0], rel=0.05)
+    assert bulge[1.0][1] < bulge[0.5][1] < 0.0
+
+
 @pytest.mark.skipif(len(BACKENDS) < 2, reason="numba is not installed")
 def test_backends_agree(gran1):
     rng = np.random.default_rng(5)
