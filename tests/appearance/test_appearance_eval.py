@@ -102,6 +102,32 @@ def test_leave_one_face_out_on_ring_maps_without_a_field(bars):
     _assert_predictions_resemble_the_photo(res[0])
 
 
+def test_summarise_known_answers():
+    """Mean of each measure per model over all / end-grain / side-grain faces (a face of unknown
+    grain counts in "all" only), and on how many faces neural scores lower (better)."""
+    from woodcam.appearance.evaluation import METRICS, FaceEval
+
+    def face(name, end_grain, neural, agnostic, colormap):
+        scores = {m: dict.fromkeys(METRICS, v) for m, v in zip(MODELS, (neural, agnostic, colormap))}
+        return FaceEval(name, end_grain, np.zeros((2, 2, 3)), scores=scores)
+
+    res = [face("top", True, 0.1, 0.3, 0.2), face("front", False, 0.5, 0.2, 0.4),
+           face("left", None, 0.2, 0.4, 0.2), face("bottom", True, 0.3, 0.1, 0.5)]
+    s = summarise(res)
+    assert s["all"]["faces"] == ["top", "front", "left", "bottom"]
+    assert s["end_grain"]["faces"] == ["top", "bottom"] and s["side_grain"]["faces"] == ["front"]
+    for k in METRICS:
+        assert s["all"]["neural"][k] == pytest.approx(0.275)   # median 0.25
+        assert s["end_grain"]["agnostic"][k] == pytest.approx(0.2)
+        assert s["side_grain"]["colormap"][k] == pytest.approx(0.4)
+        # neural lower than agnostic on top and left; lower than colormap on top and bottom (a
+        # tie, left, is no win)
+        assert s["all"]["neural_beats_agnostic"][k] == "2/4"
+        assert s["all"]["neural_beats_colormap"][k] == "2/4"
+        assert s["end_grain"]["neural_beats_colormap"][k] == "2/2"
+        assert s["side_grain"]["neural_beats_agnostic"][k] == "0/1"
+
+
 def test_leave_one_face_out_needs_two_photos():
     one = Block((10, 10, 10), faces={"top": Face("top", (8, 8), photo=np.zeros((8, 8, 3), np.uint8))})
     with pytest.raises(WoodcamError, match="at least two faces"):
