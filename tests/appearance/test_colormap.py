@@ -235,9 +235,16 @@ def test_fit_with_only_some_faces_keeps_species_ramp_elsewhere():
     app = ColorMapAppearance.fit_to_block(block, AXIS_Z)
     assert np.isfinite(app.axis_luts[1]).all()
     assert np.isnan(app.axis_luts[0]).all() and np.isnan(app.axis_luts[2]).all()
-    wood = Wood(AXIS_Z, app)
-    c = wood.color(np.array([[10.0, 10, 10]]), np.array([[1.0, 0, 0]]))
-    assert np.isfinite(c).all()
+    # X and Z, without photos, render exactly as the species preset does; Y takes the photos'
+    # flat grey (times the pores and streaks, the same in both)
+    p = np.random.default_rng(0).uniform(0, 40, (2000, 3))
+    fitted, preset = Wood(AXIS_Z, app), Wood(AXIS_Z, ColorMapAppearance("oak"))
+    for n in ([1.0, 0, 0], [0, 0, 1.0]):
+        normals = np.tile(n, (len(p), 1))
+        np.testing.assert_array_equal(fitted.color(p, normals), preset.color(p, normals))
+    plain = ColorMapAppearance.fit_to_block(block, AXIS_Z, _untextured("oak", pore_contrast=0.0))
+    c = Wood(AXIS_Z, plain).color(p, np.tile([0, 1.0, 0], (len(p), 1)))
+    np.testing.assert_allclose(c, 0.5, atol=1 / 255)
 
 
 def test_fit_without_photos_is_a_clear_error():
