@@ -183,6 +183,11 @@ def test_knot_noise_zero_gives_a_round_knot():
             w.append(np.ptp(s[f.knot_features(line)["knot"] > 0.5]))
         widths[noise] = np.array(w)
     assert np.ptp(widths[0.0]) < 0.15, widths[0.0]            # 0.06 mm
+    # Known answer along the log (beta = 90 deg, d_s = 60 mm throughout): the weight
+    # 1 / (1 + (1.2 t_b - t_s) / L)^14 (L = 100 mm) is 1/2 where t_b = (t_s + (2^(1/14) - 1) L) / 1.2,
+    # and t_b = |P - S_b| / rho with rho = 0.125 (the knot's radius over its pith distance).
+    half = 0.125 * (60.0 + (2 ** (1 / 14) - 1) * 100.0) / 1.2
+    assert widths[0.0][6] == pytest.approx(2 * half, abs=0.02)    # 13.56 mm
     assert np.ptp(widths[0.08]) > 0.3, widths[0.08]           # 0.64 mm
 
 
