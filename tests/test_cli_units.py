@@ -251,3 +251,45 @@ def test_messages_of_an_inch_run_quote_what_was_typed_and_speak_inches(tmp_path,
     assert " mm" not in text and text.count("0.039-0.12 in under") == 4, text
     assert "tray: 1 in^3" in text
     assert report_text(report, "tray").count("1-3 mm under") == 4
+
+
+def test_library_messages_of_an_inch_run_speak_inches(tmp_path, monkeypatch, capsys):
+    """Sweep h3 item 1: with --units inch the library's own messages said mm: place's no-fit
+    error ('a 1 mm margin'), the carve hint of a part in inches ('only 1x1x1 mm in the 50.8x...
+    mm block') and the G-code simulation issues ('cuts up to 1.000 mm into the stock'). They
+    follow --units now (woodcam.units.message_units); a library caller still reads mm."""
+    import trimesh
+
+    from woodcam.advise import advise_placement
+    from woodcam.errors import WoodcamError
+    from woodcam.stock import open_stock
+
+    big, tiny = tmp_path / "big.stl", tmp_path / "tiny.stl"
+    trimesh.creation.box((240.0, 18.0, 10.0)).apply_translation((120, 9, 5)).export(big)
+    trimesh.creation.box((1.0, 1.0, 1.0)).apply_translation((20, 20, 20)).export(tiny)
+    assert main(["place", str(big), "--units", "inch", "--block", "builtin:knotty:4x3x2",
+                 "--out", str(tmp_path / "pl")]) == 1
+    err = capsys.readouterr().err
+    assert "the part (9.449x0.7087x0.3937 in) fits the 4x3x2 in block" in err, err
+    assert "with a 0.03937 in margin" in err and " mm" not in err, err
+    with pytest.raises(WoodcamError, match=r"\(240.0x18.0x10.0 mm\) fits the 101.6x76.2x50.8 mm "
+                       r"block .* with a 1 mm margin"):  # the library's callers: mm, as before
+        advise_placement(big, open_stock("builtin:knotty:101.6x76.2x50.8"), candidates=4)
+    assert main(["place", str(tiny), "--units", "inch", "--block", "builtin:knotty:2x2x2",
+                 "--candidates", "4", "--top", "1", "--out", str(tmp_path / "pt")]) == 0
+    err = capsys.readouterr().err
+    assert "the part is only 0.03937x0.03937x0.03937 in in the 2x2x2 in block" in err, err
+
+    monkeypatch.setattr(woodcam.pipeline, "preview_heightfield",
+                        lambda hm, stock, out, **kw: woodcam.pipeline.PartPreview(
+                            "x", files={"glb": out}, triangles=1))
+    prog = tmp_path / "p.nc"
+    prog.write_text("G21\nM3 S1000\nG0 X20 Y40 Z2\nG1 Z-30 F300\nX80\nG0 Z-1\nX10\nG0 Z2\nM5\nM2\n")
+    assert main(["gcode", str(prog), "--units", "inch", "--block", "builtin:flat-sawn:4x3x1",
+                 "--tool", "flat:0.25", "--cell-size", "0.04", "--work-offset", "0,0,1",
+                 "--out", str(tmp_path / "g.glb")]) == 0
+    err = capsys.readouterr().err
+    assert "below_stock_bottom: tool tip at z = -1.181 in (G-code frame), 0.1811 in below" in err, err
+    assert "rapid_through_stock: rapid move (G0) cuts up to 0.03937 in into the stock" in err, err
+    assert " mm" not in err, err
+

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import WoodcamError, WoodcamWarning
-from .units import Units, fmt_span, fmt_volume
+from .units import Units, fmt_span, fmt_volume, say_length
 
 #: Points within this many years of the pith count as pith (juvenile wood and the pith itself).
 PITH_YEARS = 2.0
@@ -224,9 +224,9 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
     if not ranked:
         more = "" if rotations == "all90" else "allow more rotations (--rotations all90), "
         raise WoodcamError(
-            f"advise_placement: the part ({'x'.join(f'{v:.1f}' for v in hi - lo)} mm) fits the "
-            f"{'x'.join(f'{v:g}' for v in size)} mm block in none of the '{rotations}' "
-            f"orientations with a {margin_mm:g} mm margin; {more}a smaller margin (--margin) or "
+            f"advise_placement: the part ({say_length(hi - lo, '.1f')}) fits the "
+            f"{say_length(size, 'g')} block in none of the '{rotations}' "
+            f"orientations with a {say_length(margin_mm, 'g')} margin; {more}a smaller margin (--margin) or "
             "a bigger block")
     ranked.sort(key=lambda p: p.score)
     return PlacementAdvice(ranked, len(ranked), elongation, w)

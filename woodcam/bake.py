@@ -55,6 +55,7 @@ import numpy as np
 from woodcam._types import Mesh, WoodLike
 from woodcam.errors import WoodcamError, WoodcamWarning
 from woodcam.limits import MAX_BLOCK_SIZE_MM
+from woodcam.units import say_length
 from woodcam.tolerances import (
     ATLAS_PADDING_PX,
     MAX_BATCH_POINTS,
@@ -438,8 +439,8 @@ def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals, *,
     span = float(np.ptp(verts, axis=0).max()) if len(verts) else 0.0  # NaN with a NaN vertex
     if not span <= MAX_BLOCK_SIZE_MM:
         raise WoodcamError(
-            f"bake: the mesh's vertices must be finite and span at most {MAX_BLOCK_SIZE_MM:g} mm (the "
-            f"largest block); got a span of {span:.4g} mm or NaN/inf; check the part's units and "
+            f"bake: the mesh's vertices must be finite and span at most {say_length(MAX_BLOCK_SIZE_MM, 'g')} (the "
+            f"largest block); got a span of {say_length(span, '.4g')} or NaN/inf; check the part's units and "
             "coordinates (one far vertex made a 7 GB atlas)"
         )
     if not picture and not callable(getattr(wood, "color", None)):

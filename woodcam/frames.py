@@ -18,6 +18,7 @@ import numpy as np
 from ._checks import as_floats
 from ._types import ArrayLike
 from .errors import WoodcamError
+from .units import say_length
 
 _G = TypeVar("_G")  # a trimesh.Trimesh or trimesh.Scene, returned as given
 
@@ -292,7 +293,7 @@ def foreign_gltf_frame(extent: float, what: str) -> tuple[np.ndarray, str] | Non
     if not 0 < extent < FOREIGN_GLTF_METRES_BELOW:
         return None
     note = (f"{what} is a glTF that woodcam did not write and spans {extent:.4g} units: read as "
-            f"metres with +Y up, as glTF specifies ({extent * 1e3:.4g} mm along its longest side); "
+            f"metres with +Y up, as glTF specifies ({say_length(extent * 1e3, '.4g')} along its longest side); "
             f"a glTF whose part spans {FOREIGN_GLTF_METRES_BELOW:g} unit or more is read as millimetres, Z up")
     gltf_to_block = np.zeros((4, 4))
     gltf_to_block[:3, :3] = BLOCK_TO_GLTF[:3, :3].T * 1e6  # exact: 1e3 m -> mm, not inv()'s 999.99...

@@ -3,12 +3,19 @@
 Everything below the command line takes and returns millimetres (``docs/conventions.md``);
 ``woodcam --units inch`` converts the lengths a user types (``woodcam.cli.options``) and prints
 summaries with :func:`fmt_length` / :func:`fmt_volume`. Files written stay in millimetres.
+
+Messages (warnings, errors, G-code simulation issues) are written deep in the library, far from
+``--units``: they write their lengths with :func:`say_length` / :func:`say_volume`, which follow
+the message units the command line sets for its run (:func:`message_units`); mm for a library
+caller, so their text there is what it always was.
 """
 
 from __future__ import annotations
 
 import math
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Literal
 
 Units = Literal["mm", "inch"]
@@ -48,6 +55,46 @@ def fmt_volume(mm3: float, units: Units = "mm") -> str:
     if units == "mm":
         return f"{mm3:.0f} mm^3" if abs(mm3) >= 1000 else f"{mm3:.4g} mm^3"
     return f"{mm3 / MM_PER_UNIT[units] ** 3:.4g} {_SYMBOL[units]}^3"
+
+
+#: The unit messages speak in for this run (:func:`message_units`); a plain global, not a context
+#: variable: messages are also written in worker threads, which a context variable does not reach.
+_message_units: Units = "mm"
+
+
+@contextmanager
+def message_units(units: Units | None) -> Iterator[None]:
+    """Within the block, :func:`say_length` / :func:`say_volume` write ``units`` (None: mm); the
+    CLI sets it to ``--units`` for the whole run of a command."""
+    global _message_units
+    before, _message_units = _message_units, units or "mm"
+    try:
+        yield
+    finally:
+        _message_units = before
+
+
+def say_length(mm, spec: str = ".3g", sep: str = "x", form: str | None = None) -> str:
+    """A length (or several) given in mm, for a message, in the message units
+    (:func:`message_units`), one unit symbol after them: in mm with the format ``spec`` the
+    message always used, in inches with four significant digits. Several are joined by ``sep``,
+    or put in ``form`` (one ``{}`` each): ``say_length(4.6, ".3f") == "4.600 mm"``,
+    ``say_length((1, 2, 3)) == "1x2x3 mm"``, ``say_length((1, 2), form="[{}, {}]") ==
+    "[1, 2] mm"``; under ``--units inch`` ``"0.1811 in"``, ``"0.03937x0.07874x0.1181 in"``."""
+    units = _message_units
+    values = [float(v) for v in (mm if hasattr(mm, "__len__") else [mm])]
+    if units == "mm":
+        texts = [f"{v:{spec}}" for v in values]
+    else:
+        texts = [f"{v / MM_PER_UNIT[units]:.4g}" for v in values]
+    return (form.format(*texts) if form else sep.join(texts)) + f" {_SYMBOL[units]}"
+
+
+def say_volume(mm3: float, spec: str = ".4g") -> str:
+    """A volume given in mm^3, for a message, in the message units (:func:`message_units`): in
+    mm^3 with the message's ``spec``, else :func:`fmt_volume`'s inches^3."""
+    units = _message_units
+    return f"{mm3:{spec}} mm^3" if units == "mm" else fmt_volume(mm3, units)
 
 
 def parse_lengths(text: str, n: int = 3, *, max_mm: float, cube: bool = False) -> tuple[float, ...] | None:

@@ -21,7 +21,7 @@ from .._types import ArrayLike
 from ..errors import WoodcamError, WoodcamWarning
 from ..frames import FOREIGN_GLTF_METRES_BELOW, check_size
 from ..tolerances import OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG
-from ..units import MM_PER_UNIT
+from ..units import MM_PER_UNIT, say_length, say_volume
 from .parts import load_part
 
 
@@ -119,15 +119,15 @@ def carve(
     volume = float(carved.volume()) if not carved.is_empty() else 0.0
     if part_volume <= OUTSIDE_VOLUME_EPS_MM3:  # it was told it misses the block, "move it by (0, 0, 0)"
         raise WoodcamError(
-            f"the part's volume is {part_volume:.3g} mm^3, too small to carve; check its units (a part "
+            f"the part's volume is {say_volume(part_volume, '.3g')}, too small to carve; check its units (a part "
             "modelled in metres or inches is read as millimetres)")
     if carved.is_empty() or volume <= OUTSIDE_VOLUME_EPS_MM3:
         lo, hi = _bounds(solid)
         raise WoodcamError(
             f"part does not intersect the block: the part's bounding box is "
-            f"{_fmt_box(lo, hi)} mm but the block is {_fmt_box(np.zeros(3), np.array(size))} mm "
+            f"{_fmt_box(lo, hi)} but the block is {_fmt_box(np.zeros(3), np.array(size))} "
             f"(block frame: origin at the bottom-front-left corner); model the part in the block "
-            f"frame, e.g. move it by {_fmt_vec(np.array(size) / 2 - (lo + hi) / 2)} mm to centre "
+            f"frame, e.g. move it by {say_length(np.array(size) / 2 - (lo + hi) / 2, '.4g', form='({}, {}, {})')} to centre "
             f"it, or give the right block size"
         )
 
@@ -136,10 +136,10 @@ def carve(
     if outside > OUTSIDE_VOLUME_EPS_MM3:
         lo, hi = _bounds(solid)
         message = (
-            f"part sticks out of the block: {outside:.4g} mm^3 "
-            f"({100.0 * outside / part_volume:.3g} % of the part's {part_volume:.6g} mm^3) lies "
-            f"outside and is not carved; part bounding box {_fmt_box(lo, hi)} mm, block "
-            f"{_fmt_box(np.zeros(3), np.array(size))} mm; move the part or use a larger block"
+            f"part sticks out of the block: {say_volume(outside, '.4g')} "
+            f"({100.0 * outside / part_volume:.3g} % of the part's {say_volume(part_volume, '.6g')}) lies "
+            f"outside and is not carved; part bounding box {_fmt_box(lo, hi)}, block "
+            f"{_fmt_box(np.zeros(3), np.array(size))}; move the part or use a larger block"
         )
         messages.append(message)
         warnings.warn(message, WoodcamWarning, stacklevel=2)
@@ -183,15 +183,15 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX) -> str |
     if size_mm is None:
         if not 0 < float(np.max(extent)) < FOREIGN_GLTF_METRES_BELOW:
             return None
-        return (f"the part is only {'x'.join(f'{v:.3g}' for v in extent)} mm: part files are read "
+        return (f"the part is only {say_length(extent, '.3g')}: part files are read "
                 f"as millimetres (STL and OBJ carry no units), and nothing that small is carved; "
                 f"it looks modelled in metres (1000 times larger: "
-                f"{'x'.join(f'{v * 1e3:.3g}' for v in extent)} mm): {fix}")
+                f"{say_length(extent * 1e3, '.3g')}): {fix}")
     size = np.asarray(size_mm, dtype=float)
     if not np.all(np.sort(extent) * MM_PER_UNIT["inch"] <= np.sort(size)):
         return None
-    return (f"the part is only {'x'.join(f'{v:.3g}' for v in extent)} mm in the "
-            f"{'x'.join(f'{v:g}' for v in size)} mm block: 25.4 times larger it would still fit. "
+    return (f"the part is only {say_length(extent, '.3g')} in the "
+            f"{say_length(size, 'g')} block: 25.4 times larger it would still fit. "
             "Part files are read as millimetres (STL and OBJ carry no units); if it was modelled "
             f"in inches {fix}, or export it in mm")
 
@@ -202,9 +202,7 @@ def _bounds(solid) -> tuple[np.ndarray, np.ndarray]:
     return box[:3], box[3:]
 
 
-def _fmt_vec(v) -> str:
-    return "(" + ", ".join(f"{x:.4g}" for x in v) + ")"
-
-
 def _fmt_box(lo, hi) -> str:
-    return f"[{lo[0]:.4g}, {hi[0]:.4g}] x [{lo[1]:.4g}, {hi[1]:.4g}] x [{lo[2]:.4g}, {hi[2]:.4g}]"
+    """``"[x0, x1] x [y0, y1] x [z0, z1] mm"`` (in the message units)."""
+    return say_length([v for a, b in zip(lo, hi) for v in (a, b)], ".4g",
+                      form="[{}, {}] x [{}, {}] x [{}, {}]")

@@ -43,6 +43,7 @@ import numpy as np
 
 from .._checks import check_number
 from ..errors import WoodcamError, require
+from ..units import say_length, say_volume
 from ..tolerances import (
     MAX_PART_TRIANGLES,
     TESSELLATION_ANGLE_DEG,
@@ -569,7 +570,7 @@ def _close_holes(mesh, origin: str):
         warnings.warn(WoodcamWarning(
             f"{origin} was not closed: {len(boundary)} open edges in {len(loops)} hole(s); "
             f"woodcam capped each hole flat ({len(caps)} triangles added), giving a solid of "
-            f"{vol:.6g} mm^3. Check that this is the part you meant, or export a closed solid"),
+            f"{say_volume(vol, '.6g')}. Check that this is the part you meant, or export a closed solid"),
             stacklevel=4)
     return closed
 
@@ -612,7 +613,7 @@ def _check_manifold(solid, origin: str):
         )
     if solid.volume() <= 0:
         raise WoodcamError(
-            f"{origin} has non-positive volume {solid.volume():.6g} mm^3 (inside-out normals?); "
+            f"{origin} has non-positive volume {say_volume(solid.volume(), '.6g')} (inside-out normals?); "
             f"flip its faces so normals point outward"
         )
     return solid
@@ -705,9 +706,9 @@ class _Tessellation:
             diagonal = _diagonal_mm(solids)
             tol_mm = auto_tolerance_mm(diagonal, self.texels_per_mm)
             self.rule = (f"auto: min({TESSELLATION_TEXEL_FRACTION:g} texel = "
-                         f"{TESSELLATION_TEXEL_FRACTION / self.texels_per_mm:.3g} mm, "
-                         f"{TESSELLATION_REL_TOL:g} x the {diagonal:.4g} mm diagonal = "
-                         f"{TESSELLATION_REL_TOL * diagonal:.3g} mm)")
+                         f"{say_length(TESSELLATION_TEXEL_FRACTION / self.texels_per_mm, '.3g')}, "
+                         f"{TESSELLATION_REL_TOL:g} x the {say_length(diagonal, '.4g')} diagonal = "
+                         f"{say_length(TESSELLATION_REL_TOL * diagonal, '.3g')})")
         else:
             tol_mm = self.tol_mm
             self.rule = "given"
@@ -730,9 +731,9 @@ class _Tessellation:
         self.used_tol_mm, self.used_ang_rad = tol_mm, ang_rad
         if tries > 1:
             self.notes.append(
-                f"{origin}: {first[0]} triangles at {first[1]:.3g} mm / {first[2]:.3g} deg "
+                f"{origin}: {first[0]} triangles at {say_length(first[1], '.3g')} / {first[2]:.3g} deg "
                 f"exceeded max_triangles={self.max_triangles}; re-meshed to {count} triangles at "
-                f"{tol_mm:.3g} mm / {math.degrees(ang_rad):.3g} deg"
+                f"{say_length(tol_mm, '.3g')} / {math.degrees(ang_rad):.3g} deg"
                 + ("" if count <= self.max_triangles else
                    " (still over: the angular tolerance stops at "
                    f"{_MAX_BUDGET_ANGLE_DEG:g} deg; raise --max-triangles or simplify the part)"))

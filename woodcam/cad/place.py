@@ -28,6 +28,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import WoodcamError
+from ..units import say_length
 
 #: Default margin (mm) ``fit`` keeps to every block face.
 FIT_MARGIN_MM = 2.0
@@ -109,8 +110,8 @@ def placement_matrix(ops: Sequence[str], bounds_mm, size_mm) -> np.ndarray:
             margin = _number(arg, op) if arg else FIT_MARGIN_MM
             room = size - 2 * margin
             if margin < 0 or np.any(room <= 0):
-                raise WoodcamError(f"--place {op!r}: a margin of {margin:g} mm leaves no room in the "
-                                   f"{'x'.join(f'{v:g}' for v in size)} mm block")
+                raise WoodcamError(f"--place {op!r}: a margin of {say_length(margin, 'g')} leaves no room in the "
+                                   f"{say_length(size, 'g')} block")
             factor = float(np.min(room / np.maximum(hi - lo, 1e-12)))
             step = _translate(size / 2 - centre) @ _about(centre, np.eye(3) * factor)
         else:

@@ -203,10 +203,12 @@ def main(argv: list[str] | None = None) -> int:
 def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     """Run the parsed command; every way it ends becomes an exit status and at most one line."""
     from .. import _interrupt
+    from ..units import message_units
 
     _printed.clear()  # once per run: a second main() in one process printed none of the first's
     interrupted = False
-    with warnings.catch_warnings(record=True) as caught:
+    # the library's warnings, errors and G-code issues say their lengths in --units (mm without)
+    with warnings.catch_warnings(record=True) as caught, message_units(getattr(args, "units", None)):
         warnings.simplefilter("always")
         try:
             from .options import check_numbers, check_out, check_screenshot, lengths_to_mm

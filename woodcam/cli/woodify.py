@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 from ..errors import UsageError, WoodcamError
+from ..units import message_units, say_length
 from .options import add_out_option, add_units_option, sizes_type, vector_type
 
 
@@ -135,8 +136,9 @@ def _warn_units(mesh, path: str, what: str = "part") -> None:
     from ..errors import WoodcamWarning
 
     lo, hi = mesh.bounds
-    hint = units_hint(lo, hi, None, "scale it by 1000 in your CAD program or export it in "
-                      "mm (--units converts only the lengths typed as options, never the mesh)")
+    with message_units("mm"):  # the mesh's own numbers, read as mm whatever --units says
+        hint = units_hint(lo, hi, None, "scale it by 1000 in your CAD program or export it in "
+                          "mm (--units converts only the lengths typed as options, never the mesh)")
     if hint:
         warnings.warn(f"{what} {path!r}: {hint}", WoodcamWarning, stacklevel=3)
 
@@ -342,7 +344,7 @@ def run(args) -> int:
         years = [args.years * k / 4 for k in (1, 2, 3)]
     region = args.crack_region
     if region is not None and not region[3] > 0:
-        raise UsageError(f"--crack-region X,Y,Z,R needs a radius R > 0; got R = {region[3]:g} mm")
+        raise UsageError(f"--crack-region X,Y,Z,R needs a radius R > 0; got R = {say_length(region[3], 'g')}")
     from .._atomic import all_or_nothing, manifest_path, remove_stale
 
     # A bar of stages whose timer draws it 2 s in even mid-stage: the bar of plain updates this

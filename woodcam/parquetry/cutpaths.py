@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import WoodcamError
 from ..tolerances import PARQUETRY_CORNER_SIN, PARQUETRY_CURVATURE_SLACK, PARQUETRY_WIDTH_TOL_MM
+from ..units import say_length
 
 #: Bézier segments are flattened at this many points for areas, offsets and raster checks;
 #: a 2 mm seam segment bends < 0.2 mm, so 8 points keep chords within ~3 um of the curve.
@@ -250,8 +251,8 @@ def check_piece(segs: list, min_piece_mm: float, tool_radius_mm: float) -> list[
     if any(orient * cr < -PARQUETRY_CORNER_SIN for _, cr, _ in _turns(segs)):
         worst = 0.0
     if tool_radius_mm > 0 and worst < PARQUETRY_CURVATURE_SLACK * tool_radius_mm:
-        problems.append(f"concave bend of radius {worst:.2f} mm, tighter than the tool radius "
-                        f"{tool_radius_mm:g} mm")
+        problems.append(f"concave bend of radius {say_length(worst, '.2f')}, tighter than the tool radius "
+                        f"{say_length(tool_radius_mm, 'g')}")
     return problems
 
 

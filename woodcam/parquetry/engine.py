@@ -17,6 +17,7 @@ from typing import Literal
 import numpy as np
 
 from ..errors import WoodcamError
+from ..units import say_length
 from .features import edge, features, intensity, match_histogram
 from .job import ParquetryParams
 from .matching import Match, SheetBank
@@ -229,8 +230,8 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
         h, w = v.rgb.shape[:2]
         if min(h, w) < need_px:
             raise WoodcamError(
-                f"veneer {v.id!r} is {w / params.px_per_mm:.1f} x {h / params.px_per_mm:.1f} mm, "
-                f"smaller than one patch with its overlap and the kerf round it ({need_px / params.px_per_mm:g} mm); "
+                f"veneer {v.id!r} is {say_length((w / params.px_per_mm, h / params.px_per_mm), '.1f', ' x ')}, "
+                f"smaller than one patch with its overlap and the kerf round it ({say_length(need_px / params.px_per_mm, 'g')}); "
                 "use larger sheets, a smaller patch_mm or a smaller kerf_mm")
     grey = [intensity(v.rgb) for v in sheets]
     src_vals = np.concatenate([g[v.mask] for g, v in zip(grey, sheets)])

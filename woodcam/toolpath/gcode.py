@@ -34,6 +34,7 @@ from .._checks import check_number, check_vector
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from ..tolerances import ARC_CHORD_TOL_MM
+from ..units import say_length
 from .interpreter import ARC, MM_PER_INCH, GcodeError, Interpreter
 
 __all__ = ["DEFAULT_START_MM", "FEED", "MAX_CHORDS_PER_ARC", "MM_PER_INCH", "RAPID", "GcodeError",
@@ -348,7 +349,7 @@ def _arc_chords(start, end, centre, rot, plane, tol, line) -> np.ndarray:
     step = 2 * math.acos(max(1 - tol / rmax, -1.0)) if tol < rmax else math.pi
     n_f = abs(sweep) / step - 1e-9 if step > 0 else math.inf
     if not n_f <= MAX_CHORDS_PER_ARC:
-        raise GcodeError(line, "G2/G3", f"an arc of radius {rmax:.4g} mm sweeping "
+        raise GcodeError(line, "G2/G3", f"an arc of radius {say_length(rmax, '.4g')} sweeping "
                          f"{math.degrees(abs(sweep)):.4g} degrees needs more than "
                          f"{MAX_CHORDS_PER_ARC} chords at chord_tol_mm={tol:g}",
                          "check the arc's radius and end point, or raise chord_tol_mm")

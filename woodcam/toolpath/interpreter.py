@@ -99,6 +99,7 @@ import re
 from typing import Literal
 
 from ..errors import WoodcamError
+from ..units import say_length
 
 Dialect = Literal["linuxcnc", "grbl", "fanuc"]
 DIALECTS: tuple[str, ...] = ("linuxcnc", "grbl", "fanuc")
@@ -473,7 +474,7 @@ class Interpreter:
             miss = "".join(a for a, k in zip("XYZ", self.known) if not k).upper()
             x, y, z = (v + m for v, m in zip(self.pos, self.mzero or (0, 0, 0)))  # G-code frame
             self.warn(f"the first cut starts before the program set {miss}: it starts from "
-                      f"the start position X{x:g} Y{y:g} Z{z:g} mm (--start)")
+                      f"the start position {say_length((x, y, z), 'g', form='X{} Y{} Z{}')} (--start)")
         if kind != TRAVERSE and self.selected != self.tool and self.selected not in self._t_warned:
             self._t_warned.add(self.selected)
             self.warn(f"T{self.selected} was selected without M6: the cut goes on with the "
@@ -1061,7 +1062,7 @@ class Interpreter:
         fix = ("give where the machine zero lies in the G-code frame (--machine-zero X,Y,Z) to "
                "place them")
         for key, what in (("z", f"without the machine zero each G53 Z was taken as a retract "
-                                f"to Z{self.start_z:g} mm (the --start height, or the tool's Z "
+                                f"to Z{say_length(self.start_z, 'g')} (the --start height, or the tool's Z "
                                 "if higher)"),
                           ("xy", "without the machine zero their X/Y were taken with the "
                                  "machine zero at G-code zero: the machine goes elsewhere")):
@@ -1727,8 +1728,8 @@ class Interpreter:
                                "no unique centre)", "use the I/J/K form for full circles")
             half = dist / 2
             if abs(r) < half - tol:
-                raise self.err(f"R{w['r']:g}", f"arc radius {abs(r):g} mm too small to reach "
-                               f"the end point (half chord {half:g} mm)", "fix R or the end")
+                raise self.err(f"R{w['r']:g}", f"arc radius {say_length(abs(r), 'g')} too small to reach "
+                               f"the end point (half chord {say_length(half, 'g')})", "fix R or the end")
             h = math.sqrt(max(r * r - half * half, 0.0)) / dist
             # centre on the right of start->end for G2 with R > 0 (LinuxCNC/grbl convention)
             if cw == (r > 0):
@@ -1751,14 +1752,14 @@ class Interpreter:
             r0 = math.hypot(s1 - c1, s2 - c2)
             r1 = math.hypot(e1 - c1, e2 - c2)
             if min(r0, r1) < _ARC_MIN_RADIUS_MM:
-                raise self.err(code, f"zero-radius arc: radius {min(r0, r1):.4g} mm is below "
+                raise self.err(code, f"zero-radius arc: radius {say_length(min(r0, r1), '.4g')} is below "
                                f"LinuxCNC's {_ARC_MIN_RADIUS_MM:g} mm (0.00005 inch)",
                                "replace the arc by a G1 to its end point")
             err = abs(r1 - r0)
             if err > 100 * tol or (err > tol
                                                           and err / max(r0, r1) > _ARC_REL_TOL):
-                raise self.err(code, f"radius to end of arc {r1:.4f} mm differs from radius "
-                               f"to start {r0:.4f} mm (LinuxCNC's tolerance {tol:.4g} mm "
+                raise self.err(code, f"radius to end of arc {say_length(r1, '.4f')} differs from radius "
+                               f"to start {say_length(r0, '.4f')} (LinuxCNC's tolerance {say_length(tol, '.4g')} "
                                "and 0.1 %)", "fix the centre (I/J/K) or the end point")
         if not all(math.isfinite(v) for v in (c1, c2)):
             raise self.err(code, "arc centre out of range", "fix the arc")

@@ -29,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..tolerances import REACH_GRID_MM, REACH_TOL_MM
+from ..units import say_length
 
 #: Issue kinds of this check (see :class:`woodcam.toolpath.simulate.Issue`).
 REACH_KINDS = ("deeper_than_flute", "shank_collision", "holder_collision")
@@ -101,16 +102,16 @@ def reach_issues(p0, p1, tool_of, lookup, lines, size_mm, initial_heightmap=None
                 continue
             if name == "holder":
                 out.append(("holder_collision", int(lines[k]),
-                            f"the {2 * r:g} mm holder ({bottom:g} mm above the tip) meets the "
-                            f"stock {e:.2f} mm deep"))
+                            f"the {say_length(2 * r, 'g')} holder ({say_length(bottom, 'g')} above the tip) "
+                            f"meets the stock {say_length(e, '.2f')} deep"))
             elif d2[worst] <= (R + max(dx, dy)) ** 2:
                 out.append(("deeper_than_flute", int(lines[k]),
-                            f"cuts {e + bottom:.2f} mm deep with {bottom:g} mm of flute: the "
-                            f"shank rubs {e:.2f} mm of stock above the flutes"))
+                            f"cuts {say_length(e + bottom, '.2f')} deep with {say_length(bottom, 'g')} of "
+                            f"flute: the shank rubs {say_length(e, '.2f')} of stock above the flutes"))
             else:
                 out.append(("shank_collision", int(lines[k]),
-                            f"the {2 * r:g} mm shank meets the stock {e:.2f} mm above the "
-                            f"flutes ({bottom:g} mm)"))
+                            f"the {say_length(2 * r, 'g')} shank meets the stock {say_length(e, '.2f')} "
+                            f"above the flutes ({say_length(bottom, 'g')})"))
         pending.append(k)  # then this move cuts the coarse stock
     flush()
     return out

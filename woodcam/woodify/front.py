@@ -37,6 +37,7 @@ from .._checks import check_number
 from ..errors import WoodcamError
 from ..limits import WOODIFY_RESOLUTION_RANGE
 from ..tolerances import WOODIFY_BAND_NODES, WOODIFY_OBSTACLE_CLEARANCE_VOXELS
+from ..units import say_length
 
 Method = Literal["auto", "fmm", "offset", "anisotropic"]
 METHODS: tuple[str, ...] = ("auto", "fmm", "offset", "anisotropic")
@@ -206,7 +207,7 @@ def propagate(mesh, grid: VoxelGrid, *, wind=None, gain=None, obstacles=(), meth
     if not np.any(inside):
         raise WoodcamError(
             "mesh must enclose at least one grid node; it is smaller than the grid spacing "
-            f"{h:.3g} mm; raise the resolution or scale the mesh up")
+            f"{say_length(h, '.3g')}; raise the resolution or scale the mesh up")
     w = np.zeros(3) if wind is None else np.asarray(wind, float)
     if w.shape not in ((3,), grid.shape + (3,)):
         raise WoodcamError(f"wind must have shape (3,) or {grid.shape + (3,)}; got {w.shape}")
