@@ -309,9 +309,11 @@ def test_a_cut_out_photo_with_transparent_pixels_is_said(synth_photos, tmp_path,
             rgba[150:] = 0
         Image.fromarray(rgba).save(d / f"{name}.png")
     rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
-    assert rc == 0 and err.count("warning") == 1, err
+    # the black band is background beside the face too (sweep h3: a border on one side is said)
+    assert rc == 0 and err.count("warning") == 2, err
     assert "photo of face 'front': " in err and "front.png' has transparent pixels (6.25 % of them" in err
     assert "crop the image so every pixel is opaque" in err
+    assert "face 'front' (front.png) has a uniform border unlike the wood on its bottom side" in err
 
 
 def test_a_16_bit_photo_is_scaled_not_clipped(synth_photos, tmp_path, capsys):
@@ -469,6 +471,27 @@ def test_a_photo_with_background_all_round_is_said(synth_photos, tmp_path, capsy
         block_from_photos(synth_photos, (50, 50, 50))
         for sample in ("CN03", "H11"):
             block_from_photos(_mokume(sample), (50, 50, 50))
+
+
+def test_a_photo_with_background_on_one_side_is_said(synth_photos, tmp_path, capsys):
+    """Sweep h3 item 2: only a border on all four sides was said; a photo cropped off the face's
+    centre, a dark strip of background down its left side (its aspect kept), passed without a
+    word. Now each side is judged on its own and the warning names the face and the side."""
+    d = _copy(synth_photos, tmp_path / "strip")
+    with Image.open(d / "front.png") as im:
+        a = np.asarray(im.convert("RGB")).copy()
+    rng = np.random.default_rng(0)  # 14 px of a dark mat, a little sensor noise
+    a[:, :14] = np.clip(30 + 2 * rng.standard_normal((160, 14, 3)), 0, 255).astype(np.uint8)
+    Image.fromarray(a).save(d / "front.png")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == 0 and err.count("warning") == 1, err
+    assert ("photo of face 'front' (front.png) has a uniform border unlike the wood on its left side "
+            "(left 9 % of its width): background beside the face?") in err, err
+    assert "crop the photo to the face's edges" in err
+    a[:16] = a[:16, :1]  # and along the top: the mat's corner
+    Image.fromarray(a).save(d / "front.png")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o2")
+    assert rc == 0 and "on its top and left sides (top 9 % of its height, left 8 % of its width)" in err, err
 
 
 def test_large_photos_are_brought_to_the_cap_one_at_a_time_under_a_bar(synth_photos, tmp_path, capsys, monkeypatch):

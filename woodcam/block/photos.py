@@ -13,8 +13,8 @@ one message: photos not cropped to their face are seldom alone); not blank (lumi
 below :data:`BLANK_STD`), not over- or under-exposed (more than :data:`CLIPPED_SHARE` of the
 pixels at the ends of the range). An image file named for no face is named in a warning (or in
 the error when faces are missing), never passed over silently; so is a photo with a near-uniform
-border unlike the wood on all four sides (:func:`_uniform_border`: background round the face in
-the face's proportions keeps its aspect).
+border unlike the wood on any side (:func:`_uniform_border`: background round the face in
+the face's proportions keeps its aspect, a strip beside a face cropped off its centre too).
 Faces are resampled to one density (the lowest of the photos', at most ``max_px_per_mm``), so
 the faces unfold into one cross and ring widths are alike in pixels; each once, from its
 original, so a face's pixels depend on the other photos only through that density.
@@ -141,12 +141,13 @@ def _line_texture(lum: np.ndarray) -> np.ndarray:
 
 def _uniform_border(a: np.ndarray) -> tuple[float, float, float, float] | None:
     """The widths of a border round ``a`` (rows, cols, 3) uint8 unlike the wood inside, as shares
-    of its (height, height, width, width) at (top, bottom, left, right): a photo taken with
-    background round the face and so not cropped to it; or None unless all four sides have one
-    (at least 2 px and 1 %) of near-uniform lines (:data:`BORDER_TEXTURE_RATIO`,
-    :data:`BORDER_COLOUR_TOL`) whose colour differs from the inside's by
-    :data:`BORDER_COLOUR_STEP`. A face's edge lines vary as its inside does (the rings cross at
-    least two sides of any face), so a cropped face is not taken for one."""
+    of its (height, height, width, width) at (top, bottom, left, right), 0 on a side without one:
+    a photo taken with background round the face, or beside it, and so not cropped to it; None
+    when no side has one. A side's border is at least 2 px and 1 % of near-uniform lines
+    (:data:`BORDER_TEXTURE_RATIO`, :data:`BORDER_COLOUR_TOL`) whose colour differs from the
+    inside's by :data:`BORDER_COLOUR_STEP`. A face's edge lines vary as its inside does (the
+    calibration faces stay above 0.5 of the wood's texture on every side), so a cropped face is
+    not taken for one; a strip on one side only (the photo cropped off the face's centre) is one."""
     from scipy.ndimage import gaussian_filter
 
     rgb = a.astype(np.float32)
@@ -161,15 +162,17 @@ def _uniform_border(a: np.ndarray) -> tuple[float, float, float, float] | None:
         n = len(tex) // 4  # a border wider than a quarter is no face with background round it
         flat = (tex[:n] < BORDER_TEXTURE_RATIO * wood) & (np.abs(mean[:n] - mean[0]).max(1) < BORDER_COLOUR_TOL)
         k = n if flat.all() else int(np.argmin(flat))
-        if k < max(2, 0.01 * len(tex)):
-            return None
-        widths.append(k)
+        widths.append(k if k >= max(2, 0.01 * len(tex)) else 0)
     top, bottom, left, right = widths
-    border = np.ones((h, w), bool)
-    border[top:h - bottom, left:w - right] = False
-    if np.abs(rgb[border].mean(0) - rgb[~border].mean(0)).max() <= BORDER_COLOUR_STEP:
+    inside = rgb[top:h - bottom, left:w - right].reshape(-1, 3).mean(0)
+    bands = (rgb[:top], rgb[h - bottom:], rgb[:, :left], rgb[:, w - right:])
+    # each side's band on its own: a strip of the wood's own colour is wood to the eye as to
+    # the detector, whatever the other sides hold
+    found = [k if k and np.abs(band.reshape(-1, 3).mean(0) - inside).max() > BORDER_COLOUR_STEP else 0
+             for k, band in zip(widths, bands)]
+    if not any(found):
         return None
-    return top / h, bottom / h, left / w, right / w
+    return found[0] / h, found[1] / h, found[2] / w, found[3] / w
 
 
 def _face_shape(face: str, size, px_per_mm: float) -> tuple[int, int]:
@@ -276,11 +279,15 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
         faces[face] = Face(face, shape, photo=_resampled(a, shape))
         border = _uniform_border(faces[face].photo)
         if border:  # margins in the face's proportions keep its aspect and passed silently
+            sides = [(side, share) for side, share in zip(("top", "bottom", "left", "right"), border) if share]
+            where = "all four sides" if len(sides) == 4 else \
+                f"its {' and '.join(side for side, _ in sides)} side{'s' if len(sides) > 1 else ''}"
+            shares = ", ".join(f"{side} {100 * share:.0f} % of its {'height' if side in ('top', 'bottom') else 'width'}"
+                               for side, share in sides)
             warnings.warn(
-                f"photo of face {face!r} ({photos[face].name}) has a uniform border unlike the wood on all four "
-                f"sides (top {100 * border[0]:.0f} %, bottom {100 * border[1]:.0f} % of its height, left "
-                f"{100 * border[2]:.0f} %, right {100 * border[3]:.0f} % of its width): background round the "
-                "face? crop the photo to the face's edges, the wood alone", WoodcamWarning, stacklevel=2)
+                f"photo of face {face!r} ({photos[face].name}) has a uniform border unlike the wood on {where} "
+                f"({shares}): background {'round' if len(sides) == 4 else 'beside'} the face? crop the photo "
+                "to the face's edges, the wood alone", WoodcamWarning, stacklevel=2)
     meta = {"source": "photos", "photos_dir": str(Path(folder).resolve()), "px_per_mm": float(ppm),
             "photos_px_per_mm": float(min(density.values())),
             "photos": {f: p.name for f, p in photos.items()}}
