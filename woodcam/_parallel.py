@@ -122,19 +122,34 @@ def share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers: int)
     _FORKED.update(away=tasks, claim=claim)  # the children's copies are read
     try:
         with ProcessPoolExecutor(min(workers - 1, len(tasks)), mp_context=ctx) as ex:
-            # the first submit forks every worker: each sees the state as it is here and now
-            jobs = [ex.submit(_run_forked) for _ in tasks]
-            mine = here()
-            done: dict = {}
-            while (i := _claim(*claim, from_first=False)) is not None:
-                done[i] = tasks[i]()
-            for job in jobs:  # what the forks did (a job that found none left returns None)
-                if (got := job.result()) is not None:
-                    done[got[0]] = pickle.loads(got[1])
-            return [done[i] for i in range(len(tasks))], mine
+            try:
+                # the first submit forks every worker: each sees the state as it is here and now
+                jobs = [ex.submit(_run_forked) for _ in tasks]
+                mine = here()
+                done: dict = {}
+                while (i := _claim(*claim, from_first=False)) is not None:
+                    done[i] = tasks[i]()
+                for job in jobs:  # what the forks did (a job that found none left returns None)
+                    if (got := job.result()) is not None:
+                        done[got[0]] = pickle.loads(got[1])
+                return [done[i] for i in range(len(tasks))], mine
+            except BaseException:
+                # Ctrl-C (or an error) here: leaving the with-block waited for the forks to
+                # finish their tasks (a fit's held-out refits: 5-8 s after the Ctrl-C)
+                kill_workers(ex)
+                raise
     finally:
         _FORKED.pop("away", None)
         _FORKED.pop("claim", None)
+
+
+def kill_workers(pool) -> None:
+    """Kill the worker processes of ``pool`` (a ``ProcessPoolExecutor``) and drop its queued
+    jobs, so that its shutdown does not wait for their work: on a Ctrl-C or an error, whose
+    run's results are never used."""
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        proc.kill()
+    pool.shutdown(wait=False, cancel_futures=True)
 
 
 def map_processes(fn: Callable[[Any], Any], items: Sequence, workers: int) -> list:

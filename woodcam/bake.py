@@ -730,8 +730,9 @@ def _run_guarded(name: str, *args, **kwargs):
     except BaseException:
         # Ctrl-C (or any error) while it works: the worker must not outlive the call (leaving
         # the with-block waited for it to finish, minutes on a huge atlas)
-        for proc in list((getattr(pool, "_processes", None) or {}).values()):
-            proc.kill()
+        from ._parallel import kill_workers
+
+        kill_workers(pool)
         raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)

@@ -231,3 +231,57 @@ def test_eval_says_what_it_wrote_once_the_set_has_landed(block_dir, tmp_path, mo
     files = [out / "eq79_full.png", out / "eq79_partial.png", out / "table.md"]
     assert wrote == ["wrote " + ", ".join(map(str, files))]
     assert all(f.is_file() for f in files) and (out / ".woodcam-eval-files.json").is_file()
+
+
+_SLOW_SHARE = """
+import pathlib, sys, time
+import woodcam.inference.evidence as evidence
+from woodcam._parallel import share
+from woodcam.cli import main
+
+def slow_share(tasks, here, workers):
+    # the held-out refits, each made 60 s long; this process' own piece says it started
+    def mine():
+        pathlib.Path(sys.argv[1]).write_text('sharing')
+        time.sleep(60)
+    return share([lambda: time.sleep(60) for _ in tasks], mine, 2)
+
+evidence.share = slow_share
+sys.exit(main(['fit', sys.argv[2], '--out', sys.argv[3]]))
+"""
+
+
+def test_ctrl_c_during_the_forked_refits_ends_the_fit_at_once(block_dir, tmp_path):
+    """Sweep h3 item 3: a Ctrl-C while the fit's held-out refits ran in forks (woodcam._parallel.
+    share) was seen, then the pool's shutdown waited for the forks to finish their refits (5-8 s
+    on a real fit; here 60 s refits). Now the forks are killed: exit 130 within a fraction of the
+    refits' time, one line, no file written. SIGINT goes to the woodcam process only, so its
+    forks never see it."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    folder, _, _ = block_dir
+    mark, out = tmp_path / "mark", tmp_path / "out"
+    out.mkdir()
+    env = dict(os.environ, WOODCAM_WORKERS="2")
+    proc = subprocess.Popen([sys.executable, "-c", _SLOW_SHARE, str(mark), str(folder), str(out / "f.npz")],
+                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        t0 = time.perf_counter()
+        while not mark.exists():
+            assert proc.poll() is None and time.perf_counter() - t0 < 120, proc.stderr.read()
+            time.sleep(0.05)
+        time.sleep(0.5)  # the forks are at work
+        os.kill(proc.pid, signal.SIGINT)
+        t1 = time.perf_counter()
+        err = proc.communicate(timeout=120)[1]
+        waited = time.perf_counter() - t1
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert (proc.returncode, err) == (130, "woodcam: interrupted\n"), err[-2000:]
+    assert waited < 0.25 * 60, waited  # not the forks' 60 s
+    assert sorted(p.name for p in out.iterdir()) == []
