@@ -524,7 +524,7 @@ def _unwrap(mesh, tpm: float, max_px: int, padding: int, messages: list[str],
     else:  # pragma: no cover - xatlas overshooting four times in a row
         raise WoodcamError(
             f"bake: could not fit the atlas into max_atlas_px={max_px} (last {width}x{height} at "
-            f"{tpm:.3g} texels/mm); raise max_atlas_px or lower texels_per_mm"
+            f"{tpm:.3g} texels/mm); raise max_atlas_px (--max-atlas) or lower texels_per_mm"
         )
     # xatlas-python normalises by the atlas size; back to texel coordinates (float64).
     xy = np.asarray(uv, dtype=np.float64) * np.array([width, height], dtype=np.float64)
@@ -538,7 +538,7 @@ def _unwrap(mesh, tpm: float, max_px: int, padding: int, messages: list[str],
         messages.append(
             f"bake: texels_per_mm lowered from {asked:g} to {tpm:.4g} (texel {1 / tpm:.3g} mm) "
             f"so the {area:.0f} mm^2 surface fits a {width}x{height} atlas within "
-            f"max_atlas_px={max_px}; raise max_atlas_px for finer texels"
+            f"max_atlas_px={max_px}; raise max_atlas_px (--max-atlas) for finer texels"
         )
     return (vmap.astype(np.int64), faces.astype(np.int64), xy, width, height, float(tpm),
             float(stretch))

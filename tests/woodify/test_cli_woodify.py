@@ -386,6 +386,32 @@ def test_bark_is_not_stretched_on_flat_faces(tmp_path):
     assert 0.75 < radial / across < 1.33, (radial, across)
 
 
+def test_max_atlas_bounds_the_bark_atlas_and_is_named_as_typed(tmp_path, capsys):
+    """woodify bakes its bark into an atlas, and a surface too large for it got a lower density
+    with a warning that said 'raise max_atlas_px', an option woodify did not have: --max-atlas
+    bounds the atlas as bake's does, the warning names it as typed; where no atlas is baked (the
+    input's own picture kept) the option is said to have no effect."""
+    from PIL import Image
+
+    trimesh.creation.box(extents=(30.0, 30.0, 60.0)).export(tmp_path / "box.stl")
+    assert main(["woodify", str(tmp_path / "box.stl"), "--years", "4", "--resolution", "32",
+                 "--cracks", "none", "--max-atlas", "128", "--out", str(tmp_path / "o")]) == 0
+    (grown,) = trimesh.load(tmp_path / "o" / "grown.glb").geometry.values()
+    assert max(grown.visual.material.baseColorTexture.size) <= 128
+    (msg,) = [line for line in capsys.readouterr().err.splitlines() if "lowered" in line]
+    assert "max_atlas_px=128" in msg and "--max-atlas" in msg
+    # a textured input keeps its picture without cracks drawn into it: no atlas to bound
+    m = trimesh.creation.icosphere(subdivisions=2, radius=8.0)
+    uv = np.c_[0.5 + 0.5 * m.vertices[:, 0] / 8.0, 0.5 + 0.5 * m.vertices[:, 2] / 8.0]
+    img = Image.fromarray(np.full((32, 32, 3), 120, np.uint8))
+    m.visual = trimesh.visual.TextureVisuals(uv=uv, image=img)
+    m.export(tmp_path / "ball.glb")
+    assert main(["woodify", str(tmp_path / "ball.glb"), "--years", "3", "--resolution", "24",
+                 "--cracks", "none", "--max-atlas", "256", "--out", str(tmp_path / "b")]) == 0
+    (msg,) = [line for line in capsys.readouterr().err.splitlines() if "max-atlas" in line]
+    assert "--max-atlas 256 has no effect" in msg
+
+
 def test_a_mesh_saved_in_metres_is_named_as_such(tmp_path, capsys):
     """A 40 mm box saved as 0.04 units grew, silently, into a 0.06 mm speck (mesh files carry no
     units and are read as mm, whatever --units says): it is warned about, with the unit it looks

@@ -484,9 +484,7 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                    help="training effort of the neural appearance (default normal)")
     p.add_argument("--epochs", type=int, default=None, help="override the neural training epochs")
     add_knot_options(p)
-    p.add_argument("--max-atlas", type=int, default=4096, metavar="PX",
-                   help="largest texture side in texels (default 4096, what every GPU takes); "
-                   "a part needing more gets a lower texel density, stated in the summary")
+    add_max_atlas_option(p)
     p.add_argument("--no-obj", action="store_true", help="write only the GLB, not OBJ+MTL+PNG")
     p.add_argument("--obj-units", choices=("m", "mm"), default="m",
                    help="length unit of the OBJ's coordinates (default m, what Blender and most "
@@ -497,6 +495,13 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
         p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
                        help="also render the result off-screen to PNG (default name: OUT with "
                        "_view.png; no display needed)")
+
+
+def add_max_atlas_option(p: argparse.ArgumentParser) -> None:
+    """``--max-atlas PX`` (the library's ``max_atlas_px``): every command that bakes an atlas."""
+    p.add_argument("--max-atlas", type=int, default=4096, metavar="PX",
+                   help="largest texture side in texels (default 4096, what every GPU takes); "
+                   "a surface needing more gets a lower texel density, and a warning says so")
 
 
 def add_knot_options(p: argparse.ArgumentParser) -> None:

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ..errors import UsageError, WoodcamError
 from ..units import message_units, say_length
-from .options import add_out_option, add_units_option, sizes_type, vector_type
+from .options import add_max_atlas_option, add_out_option, add_units_option, sizes_type, vector_type
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -79,6 +79,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--relief", type=float, default=0.3,
                    help="stress left next to a new crack, in [0, 1] (0 removes all; default 0.3)")
     p.add_argument("--seed", type=int, default=0, help="random seed of the bark picture and random cracks (default 0)")
+    add_max_atlas_option(p)
     p.set_defaults(func=run)
     return p
 
@@ -175,7 +176,7 @@ def _atomic(path: Path, write) -> Path:
 def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=None,
                   block_centre_mm=None, cracks="stress", crack_region=None, crack_years=5,
                   crack_render="material", crack_threshold=None, relief=0.3, seed=0,
-                  atomic=_atomic, stage=None):
+                  max_atlas_px=4096, atomic=_atomic, stage=None):
     """Write the products of a :class:`~woodcam.woodify.Woodification` into ``out`` (module
     docstring); returns (files written, summary dict). ``stage(name)``: a context manager round
     each of "surface and cracks", "bark and surfaces" and "ring sections" (a
@@ -260,11 +261,13 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
                 c = res.mesh.centroid
                 d = np.asarray(res.mesh.vertices) - c
                 girth = 2 * np.pi * max(float(np.linalg.norm(d - np.outer(d @ up, up), axis=1).mean()), 1e-3)
-                baked = bake(mesh, SolidBark(up, c, girth, seed), texels_per_mm=tpm)
+                baked = bake(mesh, SolidBark(up, c, girth, seed), texels_per_mm=tpm,
+                             max_atlas_px=max_atlas_px)
             else:
                 corners = corner_uv(uv, mesh.faces)
                 baked = rebake_texture(mesh, corners, image,
-                                       texels_per_mm=max(tpm, picture_density(mesh, corners, image)))
+                                       texels_per_mm=max(tpm, picture_density(mesh, corners, image)),
+                                       max_atlas_px=max_atlas_px)
             bark = baked.mesh
             if painted:
                 atlas = np.asarray(bark.visual.material.baseColorTexture)
@@ -276,6 +279,15 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
                 bark.visual.material.baseColorTexture = Image.fromarray(atlas)
         else:
             # the input's own picture and coordinates stay as they were given
+            if max_atlas_px != 4096:
+                import warnings
+
+                from ..errors import WoodcamWarning
+
+                warnings.warn(
+                    f"woodify: --max-atlas {max_atlas_px} has no effect: the input's own picture "
+                    f"is kept as given (no crack is drawn into it); drop --max-atlas",
+                    WoodcamWarning, stacklevel=2)
             bark = textured_mesh(mesh, uv, image)
         # the block cut from the grown object: default its bounding box
         lo, hi = mesh.bounds
@@ -368,6 +380,7 @@ def run(args) -> int:
                 block_centre_mm=args.block_centre, cracks=args.cracks, crack_region=region,
                 crack_years=args.crack_years, crack_render=args.crack_render,
                 crack_threshold=args.crack_threshold, relief=args.relief, seed=args.seed,
+                max_atlas_px=args.max_atlas,
                 atomic=_atomic, stage=bar.stage)
             summary["total_s"] = time.perf_counter() - t0
             summary["input"] = str(args.part)
