@@ -77,10 +77,10 @@ def _check_outputs(out: Path) -> list[str]:
     return problems
 
 
-def _kill_then_rerun(cmd, cache, out, kill_after_s: float, timeout_s: float = 900) -> dict:
-    """Start ``cmd``, SIGKILL it after ``kill_after_s`` (if still running), check the outputs,
-    run it again without cleaning anything and check that run."""
-    env = _env(cache)
+def _start_and_kill(cmd, env, kill_after_s: float) -> tuple[bool, float]:
+    """Start ``cmd`` and SIGKILL its process group after ``kill_after_s`` if it is still running;
+    returns (whether it was killed, seconds it ran)."""
+    t0 = time.perf_counter()
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                             start_new_session=True)
     try:
@@ -90,15 +90,54 @@ def _kill_then_rerun(cmd, cache, out, kill_after_s: float, timeout_s: float = 90
         os.killpg(proc.pid, signal.SIGKILL)
         proc.wait()
         killed = True
+    return killed, time.perf_counter() - t0
+
+
+def _check_then_rerun(cmd, env, out, timeout_s: float = 900) -> dict:
+    """Check the outputs left in ``out``, run ``cmd`` again without cleaning anything and check
+    that run."""
     after_kill = _check_outputs(out)
     t0 = time.perf_counter()
     rerun = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout_s,
                            check=False)
-    return {"kill_s": round(kill_after_s, 2), "killed": killed, "partial": after_kill,
-            "rerun_rc": rerun.returncode, "rerun_err": rerun.stderr.strip().splitlines()[-1:]
-            if rerun.returncode else [], "rerun_s": round(time.perf_counter() - t0, 1),
-            "after_rerun": _check_outputs(out),
+    return {"partial": after_kill, "rerun_rc": rerun.returncode,
+            "rerun_err": rerun.stderr.strip().splitlines()[-1:] if rerun.returncode else [],
+            "rerun_s": round(time.perf_counter() - t0, 1), "after_rerun": _check_outputs(out),
             "complete": all((out / n).exists() for n in OUTPUTS)}
+
+
+def _kill_then_rerun(cmd, cache, out, kill_after_s: float, timeout_s: float = 900) -> dict:
+    """Start ``cmd``, SIGKILL it after ``kill_after_s`` (if still running), check the outputs,
+    run it again without cleaning anything and check that run."""
+    env = _env(cache)
+    killed, _ = _start_and_kill(cmd, env, kill_after_s)
+    return {"kill_s": round(kill_after_s, 2), "killed": killed,
+            **_check_then_rerun(cmd, env, out, timeout_s)}
+
+
+def _real_kill_then_rerun(make_cmd, folder: Path, full_s: float, share: float,
+                          tries: int = 3, shrink: float = 0.6) -> dict:
+    """One kill point that is a real kill: ``make_cmd(out)`` killed at ``share`` of the
+    calibrated run time ``full_s`` (s), then checked and rerun as :func:`_kill_then_rerun`.
+
+    Each try runs cold, on a fresh cache and output folder under ``folder`` (as the calibration
+    run did: a warm cache or earlier outputs would make the run shorter or hide a partial file).
+    A run that ends before its kill (a loaded machine that sped up, a calibration that was slow)
+    is tried again at ``shrink`` x the kill time, up to ``tries`` times; then the point fails,
+    with the timings, rather than passing without having killed anything."""
+    kill_s, tried = share * full_s, []
+    for i in range(tries):
+        out, cache = folder / f"out{i}", folder / f"cache{i}"
+        out.mkdir(parents=True)
+        cmd, env = make_cmd(out), _env(cache)
+        killed, ran_s = _start_and_kill(cmd, env, kill_s)
+        tried.append(f"kill at {kill_s:.2f} s: " + ("killed" if killed else
+                                                    f"ended by itself after {ran_s:.2f} s"))
+        if killed:
+            return {"kill_s": round(kill_s, 2), "killed": True, "tries": tried,
+                    **_check_then_rerun(cmd, env, out)}
+        kill_s *= shrink
+    pytest.fail(f"never killed: the calibration run took {full_s:.2f} s; {'; '.join(tried)}")
 
 
 def _ctrl_c(cmd, env, after_s: float, cwd=None) -> tuple[int, str, bool]:
@@ -142,13 +181,14 @@ def test_ctrl_c_in_the_first_seconds_of_a_bake_is_an_interrupt(tmp_path, after_s
 def test_kill_a_quick_bake_then_rerun(tmp_path):
     """One kill point in the default run: a built-in block, killed mid-run."""
     part = _box_stl(tmp_path, (50.0, 40.0, 25.0))
-    out = tmp_path / "out"
-    out.mkdir()
-    cmd = _bake_cmd(part, "builtin:flat-sawn", out, 2)
+    cal = tmp_path / "cal"
+    cal.mkdir()
     t0 = time.perf_counter()
-    subprocess.run(cmd, env=_env(tmp_path / "cal"), check=True, capture_output=True)
+    subprocess.run(_bake_cmd(part, "builtin:flat-sawn", cal, 2), env=_env(tmp_path / "calcache"),
+                   check=True, capture_output=True)
     full_s = time.perf_counter() - t0
-    res = _kill_then_rerun(cmd, tmp_path / "cache", out, 0.8 * full_s)
+    res = _real_kill_then_rerun(lambda out: _bake_cmd(part, "builtin:flat-sawn", out, 2),
+                                tmp_path / "kill", full_s, 0.8)
     assert res["partial"] == [] and res["rerun_rc"] == 0, res
     assert res["after_rerun"] == [] and res["complete"], res
 
@@ -270,15 +310,19 @@ def test_kill_a_gcode_preview_then_rerun(tmp_path):
     """Issue 15 part 6 for ``woodcam gcode``: killed mid-run, no partial output; the rerun,
     with nothing cleaned, completes (the same all-or-nothing export as bake)."""
     repo = Path(__file__).resolve().parents[2]
-    out = tmp_path / "out"
-    out.mkdir()
-    cmd = [sys.executable, "-m", "woodcam.cli", "gcode", str(repo / "toolpaths" / "pocket_islands.nc"),
-           "--tools", str(repo / "toolpaths" / "tools.toml"), "--block", "builtin:flat-sawn",
-           "--out", str(out / "part.glb"), "--texels-per-mm", "2"]
+
+    def cmd(out: Path) -> list[str]:
+        return [sys.executable, "-m", "woodcam.cli", "gcode",
+                str(repo / "toolpaths" / "pocket_islands.nc"),
+                "--tools", str(repo / "toolpaths" / "tools.toml"), "--block", "builtin:flat-sawn",
+                "--out", str(out / "part.glb"), "--texels-per-mm", "2"]
+
+    cal = tmp_path / "cal"
+    cal.mkdir()
     t0 = time.perf_counter()
-    subprocess.run(cmd, env=_env(tmp_path / "cal"), check=True, capture_output=True, cwd=repo)
+    subprocess.run(cmd(cal), env=_env(tmp_path / "calcache"), check=True, capture_output=True)
     full_s = time.perf_counter() - t0
     for share in (0.5, 0.9):
-        res = _kill_then_rerun(cmd, tmp_path / "cache", out, share * full_s)
+        res = _real_kill_then_rerun(cmd, tmp_path / f"kill{share:g}", full_s, share)
         assert res["partial"] == [] and res["rerun_rc"] == 0, res
         assert res["after_rerun"] == [] and res["complete"], res
