@@ -184,3 +184,52 @@ def test_a_photo_keyword_on_a_stock_without_photos_is_refused_naming_every_unkno
     write_block(block, tmp_path / "b")
     with pytest.raises(WoodcamError, match=r"without photos.*got 'anchor'; anchor fits colours to face photos"):
         open_stock(str(tmp_path / "b"), anchor="field")
+
+
+def test_a_sized_builtin_is_cut_round_the_builtin_blocks_centre():
+    """'builtin:NAME:WxDxH' is the same wood round the same centre: its point p is the built-in
+    block's point p + (size_builtin - size) / 2 (rings, knots and fibres; the colour map's fibre
+    noise is drawn in the stock's own frame)."""
+    for name in ("flat-sawn", "knotty"):
+        whole = open_stock(f"builtin:{name}")
+        cut = open_stock(f"builtin:{name}:60x40x30")
+        offset = (np.asarray(whole.size_mm) - (60, 40, 30)) / 2
+        p = np.random.default_rng(1).uniform(0, 1, (500, 3)) * (60, 40, 30)
+        got, want = cut.wood.features(p), whole.wood.features(p + offset)
+        for key in ("years", "knot", "grain"):
+            np.testing.assert_allclose(got[key], want[key], atol=1e-9, err_msg=f"{name} {key}")
+
+
+def test_a_resized_stock_is_its_parents_wood_from_its_origin():
+    """resize_stock (``woodcam gcode --stock W x D x H --stock-origin X,Y,Z``): the new stock's
+    point p is the parent's point origin + p, and its spec names both."""
+    from woodcam.stock import resize_stock
+
+    parent = open_stock("builtin:knotty")
+    small = resize_stock(parent, (30.0, 20.0, 10.0), (5.0, 6.0, 7.0))
+    assert small.size_mm == (30.0, 20.0, 10.0) and small.spec == "builtin:knotty[30x20x10@5,6,7]"
+    p = np.random.default_rng(2).uniform(0, 1, (500, 3)) * (30, 20, 10)
+    n = np.tile([0.0, 0.0, 1.0], (len(p), 1))
+    np.testing.assert_allclose(small.wood.color(p, n), parent.wood.color(p + (5, 6, 7), n), atol=1e-9)
+    same = resize_stock(parent, (300.0, 20.0, 10.0))
+    assert same.spec == "builtin:knotty[300x20x10]"
+    np.testing.assert_allclose(same.wood.color(p, n), parent.wood.color(p, n), atol=1e-9)
+
+
+def test_turns_in_a_spec_turn_the_block_by_the_right_hand_rule_and_undo():
+    """'~z90' turns the block a quarter about +Z (X onto Y): the turned block's point (x, y, z)
+    is the block's (y, D - x, z); '~z90~z-90' is the block itself, '~z90~z90' is '~z180'."""
+    whole = open_stock("builtin:flat-sawn")          # 100 x 80 x 50 mm
+    p = np.random.default_rng(3).uniform(0, 1, (500, 3)) * (80, 100, 50)
+    turned = open_stock("builtin:flat-sawn~z90")
+    assert turned.size_mm == (80.0, 100.0, 50.0)
+    np.testing.assert_allclose(turned.wood.features(p)["years"],
+                               whole.wood.features(np.column_stack([p[:, 1], 80 - p[:, 0], p[:, 2]]))["years"],
+                               atol=1e-9)
+    q = p[:, [1, 0, 2]]                              # points of the 100 x 80 x 50 block
+    back = open_stock("builtin:flat-sawn~z90~z-90")
+    assert back.size_mm == whole.size_mm
+    np.testing.assert_allclose(back.wood.features(q)["years"], whole.wood.features(q)["years"], atol=1e-9)
+    np.testing.assert_allclose(open_stock("builtin:flat-sawn~z90~z90").wood.features(q)["years"],
+                               open_stock("builtin:flat-sawn~z180").wood.features(q)["years"], atol=1e-9)
+    assert open_stock("builtin:flat-sawn~x90").size_mm == (100.0, 50.0, 80.0)
