@@ -174,3 +174,97 @@ def test_the_report_volume_is_the_summarys_for_a_tiny_part_and_a_normal_one():
         for units in ("mm", "inch"):
             assert fmt_volume(rep["volume_mm3"], units) == fmt_volume(ball.volume, units)
     assert fmt_volume(1.5179342) == "1.518 mm^3" and fmt_volume(33_493.4) == "33493 mm^3"  # not "2 mm^3"
+
+
+class _SlabWood:
+    """An analytic wood for known answers: fibres along X, the pith a line along Z at
+    ``pith_xy`` (years = distance / 2.5 mm), and one flat knot, z 16-18 mm over x 20-40 mm,
+    y 15-35 mm, whose own years (along its branch) are 0.5: knot wood, not stem pith."""
+
+    def __init__(self, pith_xy=(30.0, 25.0), grain=(1.0, 0.0, 0.0)):
+        self.pith_xy = np.asarray(pith_xy, float)
+        self.grain = np.asarray(grain, float)
+
+    def features(self, p):
+        p = np.asarray(p, float)
+        knot = ((p[:, 2] >= 16) & (p[:, 2] <= 18) & (p[:, 0] >= 20) & (p[:, 0] <= 40)
+                & (p[:, 1] >= 15) & (p[:, 1] <= 35))
+        years = np.where(knot, 0.5, np.hypot(*(p[:, :2] - self.pith_xy).T) / 2.5)
+        return {"years": years, "knot": knot.astype(float), "grain": np.tile(self.grain, (len(p), 1))}
+
+
+def _slab_stock(pith_xy=(30.0, 25.0), grain=(1.0, 0.0, 0.0)):
+    from woodcam.stock import Stock
+
+    return Stock("slab", (100.0, 80.0, 50.0), _SlabWood(pith_xy, grain))
+
+
+def test_the_part_report_terms_match_an_analytic_wood():
+    """A 40 x 30 x 20 mm box (x 10-50, y 10-40, z 0-20) over _SlabWood: no knot on the surface
+    or 1 mm under it, but 3 mm under the top face (z 17) the knot covers 400 of the surface's
+    5200 mm^2 (one of three depths); the pith (within 5 mm of the axis at x 30, y 25) crosses the
+    top and bottom faces (25 pi mm^2 each) at every depth but the top's 3 mm, which is knot;
+    end grain is the two 30 x 20 mm ends."""
+    import trimesh
+
+    from woodcam.advise import part_report
+
+    box = trimesh.creation.box((40.0, 30.0, 20.0))
+    box.apply_translation((30.0, 25.0, 10.0))
+    rep = part_report(box, _slab_stock(), samples=20000)
+    assert rep["knots_surface"] == 0.0
+    assert rep["knots"] == pytest.approx(400 / 5200 / 3, rel=0.1)
+    assert rep["pith"] == pytest.approx(5 * 25 * np.pi / 5200 / 3, rel=0.1)
+    assert rep["end_grain"] == pytest.approx(2 * 30 * 20 / 5200, rel=0.05)
+    assert rep["warnings"] == ["a knot lies 1-3 mm under the surface (it may show after sanding)",
+                               "the pith (within 2 years) reaches the part: expect checks"]
+    assert all(r["runout_deg"] < 1 for r in rep["regions"])
+    # the pith far from the part: none, and no warning of it
+    assert part_report(box, _slab_stock((90.0, 70.0)), samples=2000)["pith"] == 0.0
+    # end grain is within 45 degrees of the fibres: tilted 50 degrees from X toward Z, the
+    # 40 x 30 mm top and bottom are end grain and the ends are not
+    tilted = (np.cos(np.radians(50)), 0.0, np.sin(np.radians(50)))
+    rep = part_report(box, _slab_stock(grain=tilted), samples=4000)
+    assert rep["end_grain"] == pytest.approx(2 * 40 * 30 / 5200, rel=0.05)
+
+
+def test_placements_score_pith_keep_the_margin_and_weigh_as_asked():
+    """A 10 mm cube in _SlabWood with the pith through the block's centre (x 50, y 40): a
+    placement scores pith exactly when the cube comes within 5 mm (2 years) of the axis; every
+    placement keeps margin_mm from the faces, and the grid reaches it; score is the weighted sum
+    of the terms with the weights given; a cube is not long and thin, so no runout; end grain
+    is the turned part's."""
+    from woodcam.advise import DEFAULT_WEIGHTS
+
+    stock = _slab_stock((50.0, 40.0))
+    part = manifold3d.Manifold.cube([10.0, 10.0, 10.0])
+    weights = {"pith": 10.0, "end_grain": 0.0}
+    w = {**DEFAULT_WEIGHTS, **weights}
+    # all90: the cube turned every way (runout); none: a finer grid, some cubes on the knot
+    for rotations in ("all90", "none"):
+        advice = advise_placement(part, stock, rotations=rotations, candidates=500, margin_mm=2.0,
+                                  weights=weights)
+        assert advice.weights == w and w != DEFAULT_WEIGHTS
+        near, on_knot = [], []
+        for p in advice.ranked:
+            assert p.score == pytest.approx(sum(w[k] * v for k, v in p.terms.items()), abs=1e-9)
+            assert p.terms["runout"] < 0.05
+            placed, _ = place_part(part, p.ops, stock.size_mm)
+            lo, hi = np.asarray(placed.bounding_box()).reshape(2, 3)
+            assert (lo >= 2.0 - 1e-6).all() and (hi <= np.asarray(stock.size_mm) - 2.0 + 1e-6).all(), p.ops
+            near.append(lo.min() < 2.0 + 1e-6)
+            on_knot.append(p.terms["knots"] > 0)
+            d = np.linalg.norm(np.maximum(0.0, np.maximum(lo[:2] - (50, 40), (50, 40) - hi[:2])))
+            if d < 4.5:
+                assert p.terms["pith"] > 0, (p.ops, d)
+            elif d > 5.5:  # knot wood (its own years 0.5) is not pith
+                assert p.terms["pith"] == 0, (p.ops, d)
+        assert any(near)
+        assert advice.ranked[0].terms["pith"] == 0 and advice.ranked[-1].terms["pith"] > 0.1
+    assert any(on_knot)
+    # end grain is scored on the turned part: a 60 x 10 x 10 mm stick along the fibres (X) shows
+    # its two 10 x 10 mm ends; turned a quarter, its 60 x 10 mm sides face along the fibres
+    stick = manifold3d.Manifold.cube([60.0, 10.0, 10.0])
+    for p in advise_placement(stick, _slab_stock((90.0, 70.0)), rotations="z90", candidates=8).ranked:
+        quarter = p.ops[0] in ("rotate:z:90", "rotate:z:270")
+        assert p.terms["end_grain"] == pytest.approx(1200 / 2600 if quarter else 200 / 2600, abs=0.03), p.ops
