@@ -127,14 +127,24 @@ def test_it_frames_the_stock_as_the_vtk_screenshot_does(bowl, tmp_path):
 
     from woodcam.view import preview
 
+    import pyvista as pv
+
     hm, atlas, charts = bowl
     b = bake_heightfield(hm, (W, D, H), _CoordWood(), texels_per_mm=4.0)
     png = tmp_path / "vtk.png"
+    # skip only where VTK itself cannot draw off screen (no EGL/OSMesa): a failure of preview
+    # is a failure (any exception of preview was a skip)
+    from woodcam.view.scene import _prefer_egl_off_screen
+
+    _prefer_egl_off_screen()  # as preview does before its plotter
     try:
-        preview(b.mesh, wood=_CoordWood(), size_mm=(W, D, H), screenshot=png,
-                window_size=WIN)
-    except Exception as err:  # no EGL/OSMesa on this machine
+        probe = pv.Plotter(off_screen=True, window_size=(32, 32))
+        probe.add_mesh(pv.Cube())
+        probe.screenshot(return_img=True)
+        probe.close()
+    except Exception as err:
         pytest.skip(f"VTK cannot render off screen here: {err}")
+    preview(b.mesh, wood=_CoordWood(), size_mm=(W, D, H), screenshot=png, window_size=WIN)
     vtk = np.asarray(Image.open(png).convert("RGB")).astype(int)
     ours = stock_view(hm, (W, D, H), atlas, charts, wood=_CoordWood(),
                       window_size=WIN).astype(int)
@@ -167,3 +177,72 @@ def test_preview_heightfield_draws_its_screenshot_without_vtk(tmp_path, bowl, mo
     assert (img.min(axis=-1) < 200).mean() > 0.1  # the stock is drawn, not a white picture
     top = res.chart_texels("top")
     assert top.shape[:2] == (int(np.ceil(stock.size_mm[1] * 2)), int(np.ceil(stock.size_mm[0] * 2)))
+
+
+def _bake(hm):
+    b = bake_heightfield(hm, (W, D, H), _CoordWood(), texels_per_mm=4.0)
+    return hm, b.atlas, HeightfieldCharts(np.zeros((1, 1)), (W, D, H), b.texels_per_mm).charts
+
+
+def _assert_lit(rgb, p):
+    """``rgb`` is the texel of block point ``p`` (colour = p / size) under the lights: light *
+    texel + a white specular, as in test_each_face_shows_its_own_chart_at_its_own_place."""
+    want = 255 * np.asarray(p, float) / np.array([W, D, H])
+    (light, spec), *_ = np.linalg.lstsq(np.column_stack([want, np.ones(3)]), rgb, rcond=None)
+    assert 0.5 < light < 1.3 and spec >= -3, (rgb, want)
+    np.testing.assert_allclose(light * want + spec, rgb, atol=8, err_msg=f"{rgb} is not {want}")
+
+
+def test_each_named_camera_looks_at_its_face_the_right_way_up():
+    """A flat stock from each named camera: the picture's centre shows that face (the channel
+    of its axis at 0 or full), and the picture's right and up run along the block axes a person
+    facing that face sees (conventions.md; 'top' has +Y up, 'bottom' -Y up)."""
+    hm, atlas, charts = _bake(np.full((60, 80), H))
+    # camera: (channel, its value at the face: 0 or 1, channel rising to the right and its
+    # sign, channel rising upward and its sign)
+    faces = {"front": (1, 0, 0, 1, 2, 1), "back": (1, 1, 0, -1, 2, 1), "left": (0, 0, 1, -1, 2, 1),
+             "right": (0, 1, 1, 1, 2, 1), "top": (2, 1, 0, 1, 1, 1), "bottom": (2, 0, 0, 1, 1, -1)}
+    for camera, (ch, value, ch_right, s_right, ch_up, s_up) in faces.items():
+        img = stock_view(hm, (W, D, H), atlas, charts, camera=camera, window_size=WIN).astype(int)
+        r, c = WIN[1] // 2, WIN[0] // 2
+        centre = img[r, c]
+        assert (centre[ch] < 20) if value == 0 else (centre[ch] > 120), (camera, centre)
+        assert s_right * (img[r, c + 40, ch_right] - img[r, c - 40, ch_right]) > 20, camera
+        assert s_up * (img[r - 25, c, ch_up] - img[r + 25, c, ch_up]) > 20, camera
+
+
+def test_each_wall_follows_its_own_border_of_the_heightmap():
+    """Slots open through the front wall (x 10-20, y 0-15) and the right wall (y 10-20,
+    x 25-40), 10 mm deep: each wall stops at its own border's height, so its camera looks into
+    the slot there (at the slot's far end) and sees the wall elsewhere."""
+    ny, nx = 60, 80
+    X, Y = np.meshgrid((np.arange(nx) + 0.5) * W / nx, (np.arange(ny) + 0.5) * D / ny)
+    hm = np.full((ny, nx), H)
+    hm[(X > 10) & (X < 20) & (Y < 15)] = H - 10
+    hm[(Y > 10) & (Y < 20) & (X > 25)] = H - 10
+    hm, atlas, charts = _bake(hm)
+    z = H - 5
+    for camera, wall, seen in (("front", [15.0, 0.0, z], [15.0, 15.0, z]),   # into the slot
+                               ("front", [30.0, 0.0, z], None),
+                               ("back", [15.0, D, z], None),
+                               ("left", [0.0, 15.0, z], None),
+                               ("right", [W, 15.0, z], [25.0, 15.0, z]),      # into the slot
+                               ("right", [W, 25.0, z], None)):
+        img = stock_view(hm, (W, D, H), atlas, charts, camera=camera, window_size=WIN).astype(float)
+        r, c = _pixel(wall, camera)
+        _assert_lit(img[r[0], c[0]], wall if seen is None else seen)
+
+
+def test_the_cut_follows_the_camera_and_the_background_is_used(bowl):
+    """From the top the cut plane is horizontal (Z = H / 2, the top camera's own axis): the
+    wood at mid-height shows through the block's translucent top; around the block the given
+    background."""
+    hm, atlas, charts = bowl
+    img = stock_view(hm, (W, D, H), atlas, charts, wood=_CoordWood(), camera="top",
+                     window_size=WIN, background=(0, 0, 0)).astype(float)
+    assert (img[0, 0] == 0).all() and (img[-1, -1] == 0).all()
+    p = np.array([34.0, 25.0, H / 2])
+    r, c = _pixel(p, "top")
+    tint = BLOCK_OPACITY * 255 * np.asarray(BLOCK_COLOR)
+    np.testing.assert_allclose(img[r[0], c[0]], (1 - BLOCK_OPACITY) * 255 * p / np.array([W, D, H]) + tint,
+                               atol=3)
