@@ -654,3 +654,42 @@ def test_a_part_face_on_a_block_face_is_drawn_clean():
     assert outset.max() <= 0.2  # mm; ~1 px at this size
     assert np.ptp(colours, axis=0).max() <= np.ptp(inside, axis=0).max() + 2
     np.testing.assert_allclose(colours.mean(axis=0), inside.mean(axis=0), atol=1.0)
+
+
+def test_preview_draws_its_overlay_where_the_segments_are(tmp_path):
+    """``preview(overlay=...)``: segments in the block frame over the scene in their colour.
+    From the top (+Y up) a red line along X at Y = 60 mm, above a plain (wood-coloured) part,
+    lies in the picture's upper half, in one band of rows across the block's width; a blue
+    one along Y at X = 20 mm in one band of columns in the left half."""
+    plain = _textured_box()
+    plain.visual = trimesh.visual.ColorVisuals(plain)
+    red = np.array([[[0.0, 60.0, 45.0], [100.0, 60.0, 45.0]]])
+    blue = np.array([[[20.0, 0.0, 45.0], [20.0, 80.0, 45.0]]])
+    img = _read(preview(plain, size_mm=SIZE, screenshot=tmp_path / "p.png", window_size=SMALL,
+                        camera="top", overlay=[(red, "red", 3), (blue, (0.1, 0.2, 0.9), 3)]))
+    rows, cols = np.nonzero(_red(img))
+    assert cols.size > 100 and np.ptp(cols) > 0.6 * SMALL[0]
+    assert np.ptp(rows) <= 6 and rows.max() < SMALL[1] / 2
+    rows, cols = np.nonzero(_blue(img))
+    assert rows.size > 100 and np.ptp(rows) > 0.6 * SMALL[1]
+    assert np.ptp(cols) <= 6 and cols.max() < SMALL[0] / 2
+    bare = _read(preview(plain, size_mm=SIZE, screenshot=tmp_path / "q.png", window_size=SMALL,
+                         camera="top"))
+    assert not _red(bare).any() and not _blue(bare).any()
+
+
+def test_the_scene_samples_its_section_at_the_resolution_asked():
+    """build_scene's resolution_mm (preview's too) is the section's sample spacing."""
+    plotter = pv.Plotter(off_screen=True, window_size=SMALL)
+    try:
+        for res in (1.0, 4.0):
+            plotter.clear()
+            callback = build_scene(plotter, _textured_box(), wood=PositionWood(), size_mm=SIZE,
+                                   cut_normal=(1.0, 0.0, 0.0), resolution_mm=res)
+            section = callback.section
+            assert section.field_data["resolution_mm"][0] == res
+            # normal to X: a (D / res + 1) x (H / res + 1) grid, plus the part's outline
+            assert (SIZE[1] / res + 1) * (SIZE[2] / res + 1) <= section.n_points \
+                < (SIZE[1] / res + 1) * (SIZE[2] / res + 1) + 4 * (SIZE[1] + SIZE[2]) / res
+    finally:
+        plotter.close()
