@@ -144,3 +144,34 @@ def test_the_window_opens_on_the_stock_it_is_given_without_simulating_again(monk
         np.testing.assert_array_equal(cb.heightmap, want.heightmap)
     finally:
         plotter.close()
+
+
+def test_done_feeds_are_blue_rapids_red_and_the_stock_wears_its_wood():
+    """At line 8 of PROG the done moves are the feeds of lines 3, 4, 7, 8 (royalblue) and the
+    rapids of lines 2, 5, 6 (red); the stock's vertices carry the wood's colour at their own
+    block position (a wood whose colour is the position / size)."""
+    from woodcam.view.scrub import DONE_ACTORS, _stock_polydata, gcode_window
+
+    class CoordWood:
+        def color(self, points_mm, normals):
+            return np.clip(np.asarray(points_mm) / np.array(_Stock.size_mm), 0, 1)
+
+    class CoordStock(_Stock):
+        wood = CoordWood()
+
+    plotter, cb = gcode_window(read_gcode(PROG), parse_tool_spec("flat:6"), CoordStock(),
+                               resolution_mm=0.5, off_screen=True, window_size=(160, 120))
+    try:
+        cb(8)
+        for name, n_lines, rgb in ((DONE_ACTORS[0], 4, (65, 105, 225)), (DONE_ACTORS[1], 3, (255, 0, 0))):
+            actor = plotter.actors[name]
+            assert actor.GetMapper().GetInput().n_lines == n_lines, name
+            np.testing.assert_allclose(np.asarray(actor.GetProperty().GetColor()) * 255, rgb, atol=1)
+        # the stock drawn is _stock_polydata of the heightmap at line 8
+        stock = _stock_polydata(pv, cb.heightmap, _Stock.size_mm, CoordWood())
+        pts = np.asarray(stock.points)
+        assert pts[:, 2].min() == 0.0 and pts[:, 2].max() == 20.0 and (pts[:, 2] == 15.0).any()
+        np.testing.assert_array_equal(np.asarray(stock.point_data["rgb"]),
+                                      np.round(pts / np.array(_Stock.size_mm) * 255).astype(np.uint8))
+    finally:
+        plotter.close()
