@@ -86,3 +86,31 @@ def test_the_toolpath_reds_and_blues_are_the_stock_views_and_the_vtk_previews():
         want = np.round((1 - _OVERLAY_ALPHA) * np.float32(150)
                         + _OVERLAY_ALPHA * np.asarray(rgb, np.float32))
         np.testing.assert_allclose(img[40, 50], want, atol=1)
+
+
+def test_shading_and_overlay_on_cells_that_are_not_square_and_a_stock_off_centre():
+    """Cells 1 mm along X and 2 mm along Y (a 50 x 40 mm stock on a 20 x 50 heightmap): a ramp
+    of slope 0.2 along X, then along Y, is shaded by Lambert's law with its own normal
+    (-0.2, 0, 1) or (0, -0.2, 1), relative to a flat top; the stock sits off the picture's
+    corner (50 px margin left and right), and a segment lands on its own pixels there."""
+    from woodcam.view.topview import _AMBIENT, _LIGHT
+
+    def shade(normal):
+        n = np.asarray(normal, float) / np.linalg.norm(normal)
+        return (_AMBIENT + (1 - _AMBIENT) * max(n @ _LIGHT, 0)) / (_AMBIENT + (1 - _AMBIENT) * _LIGHT[2])
+
+    tex = np.full((40, 50, 3), 150, np.uint8)
+    x = (np.arange(50) + 0.5) * 1.0
+    y = (np.arange(20) + 0.5) * 2.0
+    size = (50.0, 40.0, 20.0)
+    for hm, normal in ((np.tile(0.2 * x, (20, 1)), (-0.2, 0, 1)),
+                       (np.tile(0.2 * y[:, None], (1, 50)), (0, -0.2, 1))):
+        img = top_view(hm, size, tex, window_size=(200, 80), margin_px=0).astype(int)
+        # 2 px/mm: the stock covers columns 50-149, all rows; white beside it
+        assert (img[:, :50] == 255).all() and (img[:, 150:] == 255).all()
+        assert abs(img[40, 100, 0] - 150 * shade(normal)) <= 1, (normal, img[40, 100])
+    seg = np.array([[[0.0, 20.0, 1.0], [50.0, 20.0, 1.0]]])  # Y = 20 mm across the stock
+    lined = top_view(np.zeros((20, 50)), size, tex, window_size=(200, 80), margin_px=0,
+                     overlay=[(seg, "red", 1.0)]).astype(int)
+    assert (lined[40, 55:145, 0] > lined[40, 55:145, 2] + 50).all()
+    assert (lined[:, :48] == 255).all() and (lined[:, 152:] == 255).all()
