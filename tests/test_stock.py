@@ -188,8 +188,8 @@ def test_a_photo_keyword_on_a_stock_without_photos_is_refused_naming_every_unkno
 
 def test_a_sized_builtin_is_cut_round_the_builtin_blocks_centre():
     """'builtin:NAME:WxDxH' is the same wood round the same centre: its point p is the built-in
-    block's point p + (size_builtin - size) / 2 (rings, knots and fibres; the colour map's fibre
-    noise is drawn in the stock's own frame)."""
+    block's point p + (size_builtin - size) / 2 (rings, knots and fibres; the colours:
+    test_a_piece_cut_from_a_block_has_its_colours)."""
     for name in ("flat-sawn", "knotty"):
         whole = open_stock(f"builtin:{name}")
         cut = open_stock(f"builtin:{name}:60x40x30")
@@ -198,6 +198,39 @@ def test_a_sized_builtin_is_cut_round_the_builtin_blocks_centre():
         got, want = cut.wood.features(p), whole.wood.features(p + offset)
         for key in ("years", "knot", "grain"):
             np.testing.assert_allclose(got[key], want[key], atol=1e-9, err_msg=f"{name} {key}")
+
+
+def test_a_piece_cut_from_a_block_has_its_colours(shared_data):
+    """A blank cut out of a block is the same wood, colour included: at the same wood point a
+    sized built-in, a turned one, a resized one and a smaller log block through the same knot
+    have the colours of the whole block to 1/255 (the colour map's fibre noise was drawn in the
+    small stock's own frame: up to 70/255 off)."""
+    from woodcam.stock import resize_stock
+
+    rng = np.random.default_rng(4)
+    p = rng.uniform(0, 1, (3000, 3)) * (40, 40, 20)
+    n = rng.normal(size=p.shape)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+
+    def same(cut, whole, q, normals=n, what=""):
+        np.testing.assert_allclose(cut.wood.color(p, n), whole.wood.color(q, normals), atol=1 / 255,
+                                   rtol=0, err_msg=what)
+
+    for name in ("flat-sawn", "knotty"):
+        whole = open_stock(f"builtin:{name}")
+        offset = (np.asarray(whole.size_mm) - (40, 40, 20)) / 2
+        same(open_stock(f"builtin:{name}:40x40x20"), whole, p + offset, what=name)
+        same(resize_stock(open_stock(f"builtin:{name}:60x50x30"), (40, 40, 20), (3, 2, 1)), whole,
+             p + (np.asarray(whole.size_mm) - (60, 50, 30)) / 2 + (3, 2, 1), what=f"{name} resized")
+    # '~z90': the turned block's point (x, y, z) is the sized block's (y, D - x, z), its normals too
+    whole = open_stock("builtin:flat-sawn")
+    turned = open_stock("builtin:flat-sawn:40x40x20~z90")
+    src = np.column_stack([p[:, 1], 40 - p[:, 0], p[:, 2]]) + (30, 20, 15)
+    same(turned, whole, src, np.column_stack([n[:, 1], -n[:, 0], n[:, 2]]), what="turned")
+    # a smaller block through the same knot: its front face is the default block's, centred
+    same(open_stock("log:gran1@52:40x40x20"), open_stock("log:gran1@52"), p + (30, 0, 15), what="log")
+    with pytest.raises(WoodcamError, match="got 'texture_frame'"):  # the spec's to set, not a parameter
+        open_stock("builtin:flat-sawn", texture_frame=None)
 
 
 def test_a_resized_stock_is_its_parents_wood_from_its_origin():

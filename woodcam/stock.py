@@ -4,10 +4,11 @@ A block spec is a string the CLI and GLB metadata carry:
 
 - ``builtin:NAME`` or ``builtin:NAME:WxDxH``: a built-in synthetic block (``woodcam blocks``
   lists them) of its own size or of ``W x D x H`` mm, cut from the same wood round the same
-  centre (e.g. ``builtin:flat-sawn:300x120x40``).
+  centre (e.g. ``builtin:flat-sawn:300x120x40``), colours included.
 - ``log:LOG@K`` or ``log:LOG@K:WxDxH``: a block cut tangentially through knot ``K`` of a
   knotted log, ``LOG`` being ``gran1`` (the CT-measured spruce log of the shared data) or a
-  woodcam log file (``.json``); size default 100x80x50 mm, Z along the log.
+  woodcam log file (``.json``); size default 100x80x50 mm, Z along the log; every size has the
+  default block's colours where they overlap (the same piece of the log).
 - ``woodify:PATH/field.npz``: a block cut out of a grown object (``woodcam woodify``); size
   and position are the placement stored in the file (``--block-size``, ``--block-centre``).
 - a block folder with a ``block.json`` manifest (real or synthetic): its true field if it has
@@ -176,7 +177,7 @@ def _check_appearance_params(appearance: str, params: dict, *, photos: bool = Tr
     else:
         targets = [ColorMapAppearance]
     taken = {k for t in targets for k, p in inspect.signature(t).parameters.items()
-             if p.kind is not p.VAR_KEYWORD} - {"self", "cls", "species", "block", "field"}
+             if p.kind is not p.VAR_KEYWORD} - {"self", "cls", "species", "block", "field", "texture_frame"}
     unknown = sorted(set(params) - taken)
     if unknown:
         without = appearance != "neural" and not photos
@@ -262,12 +263,14 @@ def _parse_size(text: str, spec: str) -> tuple[float, float, float]:
 def _open_base_stock(spec: str, species, appearance, appearance_params, species_given=True) -> Stock:
     if spec.startswith("builtin:"):
         b, field, size = _builtin(spec.split(":", 1)[1])
+        # a sized built-in draws the whole block's texture: the same wood, the same colours
+        texture = field.frame if field is not b.field else None
         return _synthetic_stock(spec, field, size, species or b.species, b.description,
-                                appearance, appearance_params)
+                                appearance, appearance_params, texture)
     if spec.startswith("log:"):
         field, size_mm, description = _log_block_field(spec)
         return _synthetic_stock(spec, field, size_mm, species or "spruce", description,
-                                appearance, appearance_params)
+                                appearance, appearance_params, _log_texture_frame(spec, field))
     if spec.startswith("woodify:"):
         field, size_mm, description = _woodify_field(spec)
         return _synthetic_stock(spec, field, size_mm, species or "oak", description,
@@ -354,8 +357,11 @@ def _existing_folder(spec: str) -> Path:
     return path
 
 
-def _synthetic_stock(spec, field, size_mm, species, description, appearance, params) -> Stock:
-    """A stock whose true field is known but which has no photos of its own."""
+def _synthetic_stock(spec, field, size_mm, species, description, appearance, params,
+                     texture_frame=None) -> Stock:
+    """A stock whose true field is known but which has no photos of its own; ``texture_frame``
+    (a :class:`~woodcam.fields.base.LogFrame` or None) is the colour map's
+    (:class:`ColorMapAppearance`: the frame of the block this one is cut from)."""
     from .fields.state import is_saveable
 
     meta = {"appearance": appearance}
@@ -370,7 +376,7 @@ def _synthetic_stock(spec, field, size_mm, species, description, appearance, par
         app = fit_neural_appearance(photos, field, **params)
         meta["appearance_key"] = app.meta.get("key")
     else:
-        app = ColorMapAppearance(species, **params)
+        app = ColorMapAppearance(species, **params, texture_frame=texture_frame)
         meta["species"] = app.species.name
     return Stock(spec, tuple(size_mm), Wood(field, app), description, meta)
 
@@ -480,3 +486,25 @@ def _log_block_field(spec: str):
         raise WoodcamError(f"knot index in {spec!r} must be 0..{len(log.knots) - 1}; got {knot}")
     field = place_block_in_log(KnottedLogField(log), *block_at_knot(log, knot, size_mm))
     return field, size_mm, f"block through knot {knot} of log {source}"
+
+
+def _log_texture_frame(spec: str, field):
+    """The frame of ``log:LOG@K`` (the block of the default size through the same knot) placed in
+    the frame of the block ``spec`` names, whose ``field`` is a PlacedField in the same log; None
+    for the default size itself. Every size of block through a knot draws the default block's
+    texture, so the same piece of the log has the same colours in each."""
+    from .fields.base import LogFrame
+
+    source, _, rest = spec[len("log:"):].partition("@")
+    knot, _, size = rest.partition(":")
+    if not size:
+        return None
+    base = f"log:{source}@{knot}"
+    default, _, _ = _log_block_field(base)
+    here, there = field.frame, default.frame
+    if here == there:
+        return None
+    # block point p -> log point rot_h (p - c_h) -> default block point rot_t^T (...) + c_t
+    rot = there.rotation.T @ here.rotation
+    centre = np.asarray(here.pith_point_mm, float) - rot.T @ np.asarray(there.pith_point_mm, float)
+    return LogFrame(tuple(centre), tuple(rot[2]), tuple(rot[0]))

@@ -25,7 +25,7 @@ import numpy as np
 
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
-from ..fields.base import arf, check_points, grain_direction
+from ..fields.base import LogFrame, arf, check_points, grain_direction
 from ..frames import FACE_AXIS, face_pixel_points
 from .knots import KnotShading
 from .noise import TABLE, noise_at
@@ -233,6 +233,12 @@ class ColorMapAppearance:
     knot_darkening_alive, knot_darkening_dead, dead_outline_rgb : optional
         Shorthands that replace those settings of ``knots`` (the CLI's ``--knot-darkening``
         and ``--knot-outline``).
+    texture_frame : LogFrame or None
+        The frame the wood's texture (pores, fibre streaks, end-grain mottling) is drawn in,
+        placed in this block's frame (mm): a block cut out of another's wood (a sized built-in
+        or log block, :mod:`woodcam.stock`) draws the other's texture at the same wood point,
+        so the same piece of wood has the same colours in both. ``None``: this block's frame.
+        Set by the block spec, not an appearance parameter.
     """
 
     species: Species | str = "oak"
@@ -245,10 +251,14 @@ class ColorMapAppearance:
     knot_darkening_alive: InitVar[float | None] = None
     knot_darkening_dead: InitVar[float | None] = None
     dead_outline_rgb: InitVar[tuple[float, float, float] | None] = None
+    texture_frame: LogFrame | None = None
 
     def __post_init__(self, knot_darkening_alive=None, knot_darkening_dead=None,
                       dead_outline_rgb=None):
         object.__setattr__(self, "species", get_species(self.species))
+        if self.texture_frame is not None and not isinstance(self.texture_frame, LogFrame):
+            raise WoodcamError(f"texture_frame must be a LogFrame (the frame the texture is drawn in, "
+                               f"placed in the block frame) or None; got {type(self.texture_frame).__name__}")
         changes = {k: v for k, v in (("alive_darkening", knot_darkening_alive),
                                      ("dead_darkening", knot_darkening_dead),
                                      ("outline_rgb", dead_outline_rgb)) if v is not None}
@@ -328,8 +338,16 @@ class ColorMapAppearance:
                            s.endgrain_roughness, self.knots.alive_darkening,
                            self.knots.dead_darkening], np.float32)
         colours = np.array([s.earlywood_rgb, s.latewood_rgb, self.knots.outline_rgb], np.float32)
-        _shade_kernel(arf(years).astype(np.float32), np.ascontiguousarray(grain, np.float32),
-                      p.astype(np.float32), normals if blend else np.zeros((1, 3), np.float32),
+        grain = np.ascontiguousarray(grain, np.float32)
+        p32 = p.astype(np.float32)
+        # the texture is a function of the wood point: drawn in the frame of the block this one
+        # was cut from (the fibre noise of a sized built-in was its own frame's: other colours)
+        frame = self.texture_frame
+        q, gq = (p32, grain) if frame is None else (
+            frame.to_log(p).astype(np.float32),
+            np.ascontiguousarray(np.einsum("ij,kj->ik", grain, frame.rotation), np.float32))
+        _shade_kernel(arf(years).astype(np.float32), grain, p32, q, gq,
+                      normals if blend else np.zeros((1, 3), np.float32),
                       knot, dead, outline, params, colours, np.nan_to_num(luts).astype(np.float32),
                       lut_ok, np.nan_to_num(knot_lut).astype(np.float32), knot_lut_ok,
                       gains, span, np.int64(self.seed), TABLE, blend, out)
@@ -656,10 +674,13 @@ def _field_sample(field, points_mm):
 
 
 @numba.njit(nogil=True, fastmath=True, cache=True)
-def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, luts, lut_ok,
+def _shade_kernel(a, grain, p, q, gq, normals, knot, dead, outline, params, colours, luts, lut_ok,
                   knot_lut, knot_lut_ok, gains, span, seed, table, blend, out):  # pragma: no cover - compiled
     """Per point: ramp, pores and streaks, end grain per axis, knots, and eq. 10 (``blend``, by
     :func:`~woodcam.appearance.orientation.eq10_weights`, the one implementation).
+
+    ``p``, ``grain`` (n, 3): points and fibre directions in the block frame (end grain,
+    exposure); ``q``, ``gq`` (n, 3): the same in the texture's frame (the noise).
 
     One compiled pass instead of ~40 numpy array operations with their temporaries, which
     made colour lookup memory-bound. Writes the blend to ``out[0] (n, 3)`` when ``blend``,
@@ -675,8 +696,8 @@ def _shade_kernel(a, grain, p, normals, knot, dead, outline, params, colours, lu
         # ramp between earlywood and latewood (smoothstep from latewood_start to 1)
         t = min(max((a[i] - lw_start) / (1.0 - lw_start), 0.0), 1.0)
         t = t * t * (3.0 - 2.0 * t)
-        gx, gy, gz = grain[i, 0], grain[i, 1], grain[i, 2]
-        px, py, pz = p[i, 0], p[i, 1], p[i, 2]
+        gx, gy, gz = gq[i, 0], gq[i, 1], gq[i, 2]
+        px, py, pz = q[i, 0], q[i, 1], q[i, 2]
         along = px * gx + py * gy + pz * gz
         # one solid noise stretched along the grain: streaks on side grain, dots on end grain
         s1 = along * (inv_l - inv_a)
