@@ -244,6 +244,16 @@ def test_a_resized_stock_is_its_parents_wood_from_its_origin():
     p = np.random.default_rng(2).uniform(0, 1, (500, 3)) * (30, 20, 10)
     n = np.tile([0.0, 0.0, 1.0], (len(p), 1))
     np.testing.assert_allclose(small.wood.color(p, n), parent.wood.color(p + (5, 6, 7), n), atol=1e-9)
+    # the growth field moved with the colours (years and knots were the parent's at p)
+    got, want = small.wood.features(p), parent.wood.features(p + (5, 6, 7))
+    for key in ("years", "knot", "grain"):
+        np.testing.assert_allclose(got[key], want[key], atol=1e-9, err_msg=key)
+    np.testing.assert_allclose(small.wood.years(p), parent.wood.years(p + (5, 6, 7)), atol=1e-9)
+    turned = resize_stock(open_stock("builtin:knotty~z90"), (20.0, 30.0, 10.0), (6.0, 5.0, 7.0))
+    r = p[:, [1, 0, 2]]  # ~z90: the turned point (x, y, z) is the block's (y, D - x, z)
+    np.testing.assert_allclose(turned.wood.years(r),
+                               parent.wood.years(np.column_stack([r[:, 1] + 5, 80 - (r[:, 0] + 6), r[:, 2] + 7])),
+                               atol=1e-9)
     same = resize_stock(parent, (300.0, 20.0, 10.0))
     assert same.spec == "builtin:knotty[300x20x10]"
     np.testing.assert_allclose(same.wood.color(p, n), parent.wood.color(p, n), atol=1e-9)

@@ -66,20 +66,6 @@ class Stock:
     meta: dict = field(default_factory=dict)
 
 
-class _ShiftedWood:
-    """``wood`` seen from a stock whose corner sits at ``origin_mm`` of the block frame."""
-
-    def __init__(self, wood, origin_mm):
-        self._wood = wood
-        self._origin = np.asarray(origin_mm, float).reshape(1, 3)
-
-    def color(self, points_mm, normals):
-        return self._wood.color(np.asarray(points_mm, float) + self._origin, normals)
-
-    def __getattr__(self, name):  # field, appearance...: the wood's own
-        return getattr(self._wood, name)
-
-
 def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:
     """A ``W x D x H`` stock cut from ``stock``'s wood with its corner at ``origin_mm`` (block
     frame, mm): any size and position, not only the built-in blocks' (the wood's growth field
@@ -95,7 +81,12 @@ def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:
     W, D, H = size.tolist()
     spec = f"{stock.spec}[{W:g}x{D:g}x{H:g}" + (f"@{','.join(f'{v:g}' for v in origin)}]"
                                                  if origin.any() else "]")
-    wood = _ShiftedWood(stock.wood, origin) if origin.any() else stock.wood
+    if origin.any() and not isinstance(stock.wood, Wood):
+        raise WoodcamError(f"resize_stock: stock.wood must be a woodcam Wood (its growth field and colours "
+                           f"move with the origin); got {type(stock.wood).__name__}; open the stock with open_stock")
+    # the wood itself moved, not only its colours: a wrapper shifted color() and left the growth
+    # field (wood.years, wood.features) the parent's at the stock's own points
+    wood = stock.wood.shifted(origin) if origin.any() else stock.wood
     return Stock(spec, (W, D, H), wood, stock.description,
                  {**stock.meta, "parent_size_mm": list(stock.size_mm),
                   "origin_mm": origin.tolist()})

@@ -7,7 +7,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .._checks import check_number
+from .._checks import check_number, check_vector
 from .._types import AppearanceLike, ArrayLike, GrowthFieldLike, WoodLike
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, evaluate, grain_direction
@@ -33,8 +33,8 @@ class Wood:
         Worker threads for :meth:`color` (numpy releases the GIL in its kernels);
         default: the number of CPU cores.
 
-    A wood made by :meth:`turned` maps its points and normals back to the source block's frame
-    before the field and the appearance see them.
+    A wood made by :meth:`turned` or :meth:`shifted` maps its points and normals back to the
+    source block's frame before the field and the appearance see them.
     """
 
     def __init__(self, field: GrowthFieldLike, appearance: AppearanceLike | None = None, *, threads: int | None = None):
@@ -43,7 +43,8 @@ class Wood:
         self.field = field
         self.appearance = appearance if appearance is not None else ColorMapAppearance()
         self.threads = max(1, threads or os.cpu_count() or 1)
-        #: (R (3, 3), t (3,)) with source point = R^T (p - t), or None (this block's own frame)
+        #: (R (3, 3), t (3,)) with source point = R^T (p - t) (turns and shifts), or None (this
+        #: block's own frame)
         self._turn: tuple[np.ndarray, np.ndarray] | None = None
 
     def turned(self, axis: str, quarter_turns: int, size_mm: ArrayLike) -> tuple["Wood", tuple]:
@@ -88,6 +89,16 @@ class Wood:
             out._turn = (rot @ r0, rot @ t0 + shift)
         new_size = tuple(float(v) for v in np.abs(rot) @ size)
         return out, new_size
+
+    def shifted(self, origin_mm: ArrayLike) -> "Wood":
+        """The same wood seen from a block whose corner sits at ``origin_mm (3,)`` (mm) of this
+        wood's block frame: its point ``p`` is this wood's ``origin_mm + p`` for the growth field,
+        the features and the colours alike (a smaller stock cut out of this one)."""
+        o = check_vector(origin_mm, "shifted: origin_mm", fix="pass the corner's block-frame position, mm")
+        out = Wood(self.field, self.appearance, threads=self.threads)
+        rot, shift = self._turn if self._turn is not None else (np.eye(3), np.zeros(3))
+        out._turn = (rot, shift - o)  # source = rot^T (p + o - shift)
+        return out
 
     def _to_source(self, points, normals=None):
         if self._turn is None:
