@@ -233,6 +233,36 @@ def test_a_piece_cut_from_a_block_has_its_colours(shared_data):
         open_stock("builtin:flat-sawn", texture_frame=None)
 
 
+def test_blocks_placed_anywhere_in_a_grown_object_have_its_colours(tmp_path):
+    """Two 'woodify:DIR/field.npz' of the same grown object written with other --block-size and
+    --block-centre (and, through the API, a quarter turn) colour the same object point alike to
+    1/255: the colour map's texture is drawn in the object's frame (it was each block's own:
+    up to 64/255 off)."""
+    from woodcam.woodify.field import WoodifiedField
+    from woodcam.woodify.speed import GrowthSpeed
+
+    g = np.mgrid[0:41, 0:41, 0:41].astype(float) * 2.0 - 40.0
+    grown = WoodifiedField(np.hypot(g[0], g[1]) + 0.1 * g[2], (-40.0, -40.0, -40.0), 2.0,
+                           GrowthSpeed(velocity_mm=100.0, time_scale_years=30.0), 20.0)
+    turn = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    grown.placed((40.0, 30.0, 20.0), (0.0, 0.0, 0.0)).save(tmp_path / "a.npz")
+    a = open_stock(f"woodify:{tmp_path / 'a.npz'}")
+    rng = np.random.default_rng(5)
+    for name, size, centre, rot in (("b", (30.0, 24.0, 16.0), (5.0, -3.0, 2.0), None),
+                                    ("c", (24.0, 30.0, 16.0), (-4.0, 2.0, -1.0), turn)):
+        grown.placed(size, centre, rot).save(tmp_path / f"{name}.npz")
+        b = open_stock(f"woodify:{tmp_path / f'{name}.npz'}")
+        p = rng.uniform(0, 1, (2000, 3)) * size
+        n = rng.normal(size=p.shape)
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        fa, fb = a.wood.field, b.wood.field
+        q = (fb.to_object(p) - fa.block_origin_mm) @ fa.rotation  # a's block point of b's p
+        m = n @ (fa.rotation.T @ fb.rotation).T
+        np.testing.assert_allclose(b.wood.years(p), a.wood.years(q), atol=1e-9)
+        np.testing.assert_allclose(b.wood.color(p, n), a.wood.color(q, m), atol=1 / 255, rtol=0,
+                                   err_msg=name)
+
+
 def test_a_resized_stock_is_its_parents_wood_from_its_origin():
     """resize_stock (``woodcam gcode --stock W x D x H --stock-origin X,Y,Z``): the new stock's
     point p is the parent's point origin + p, and its spec names both."""

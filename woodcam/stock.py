@@ -10,7 +10,8 @@ A block spec is a string the CLI and GLB metadata carry:
   woodcam log file (``.json``); size default 100x80x50 mm, Z along the log; every size has the
   default block's colours where they overlap (the same piece of the log).
 - ``woodify:PATH/field.npz``: a block cut out of a grown object (``woodcam woodify``); size
-  and position are the placement stored in the file (``--block-size``, ``--block-centre``).
+  and position are the placement stored in the file (``--block-size``, ``--block-centre``); its
+  texture is drawn in the grown object's frame, so every placement has the object's colours.
 - a block folder with a ``block.json`` manifest (real or synthetic): its true field if it has
   one, otherwise a field fitted to its rings (fit once, cached in the user cache folder); a
   folder of photos only (``woodcam block from-photos``) first gets its rings detected on the
@@ -264,8 +265,10 @@ def _open_base_stock(spec: str, species, appearance, appearance_params, species_
                                 appearance, appearance_params, _log_texture_frame(spec, field))
     if spec.startswith("woodify:"):
         field, size_mm, description = _woodify_field(spec)
+        # the texture drawn in the grown object's frame: two blocks placed differently in the
+        # same object (--block-size, --block-centre) have the same colours where they overlap
         return _synthetic_stock(spec, field, size_mm, species or "oak", description,
-                                appearance, appearance_params)
+                                appearance, appearance_params, field.object_frame)
     path = _existing_folder(spec)
     if (path / "block.json").is_file():
         return _open_block_folder(path, species, appearance, appearance_params, species_given)

@@ -236,8 +236,9 @@ class ColorMapAppearance:
     texture_frame : LogFrame or None
         The frame the wood's texture (pores, fibre streaks, end-grain mottling) is drawn in,
         placed in this block's frame (mm): a block cut out of another's wood (a sized built-in
-        or log block, :mod:`woodcam.stock`) draws the other's texture at the same wood point,
-        so the same piece of wood has the same colours in both. ``None``: this block's frame.
+        or log block, a block of a grown object, :mod:`woodcam.stock`) draws the other's (the
+        object's) texture at the same wood point, so the same piece of wood has the same
+        colours in both. ``None``: this block's frame.
         Set by the block spec, not an appearance parameter.
     """
 

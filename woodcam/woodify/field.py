@@ -36,7 +36,7 @@ from scipy import ndimage
 
 from .._atomic import atomic_path
 from ..errors import WoodcamError
-from ..fields.base import check_points
+from ..fields.base import LogFrame, check_points
 from .speed import GrowthSpeed
 
 Interpolation = Literal["linear", "cubic"]
@@ -113,6 +113,15 @@ class WoodifiedField:
     def axis(self) -> np.ndarray:
         """Fibre direction (the stem axis) in the block frame, (3,)."""
         return self.rotation.T @ self.stem_axis
+
+    @property
+    def object_frame(self) -> LogFrame:
+        """The grown object's frame placed in the block frame: its ``to_log`` is
+        :meth:`to_object`. Blocks cut anywhere out of the object draw the colour map's texture
+        in it (``ColorMapAppearance.texture_frame``), so the same wood has the same colours
+        however the block is placed."""
+        R = self.rotation
+        return LogFrame(tuple(-(R.T @ self.block_origin_mm)), tuple(R[2]), tuple(R[0]))
 
     def to_object(self, points_mm: ArrayLike) -> np.ndarray:
         """Block-frame points ``(n, 3)`` -> object-frame points ``(n, 3)`` (mm)."""
