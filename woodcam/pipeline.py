@@ -291,7 +291,7 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
 
     surface = mesh if mesh is not None else baked.mesh  # the part, else what was baked
     # a fitted field says where its rings are a guess (issue 12 part 5); only that is a warning
-    rings_line = uncertainty_report(stock.wood.field, surface.vertices, stock.size_mm, result.name,
+    rings_line = uncertainty_report(stock.wood, surface.vertices, stock.size_mm, result.name,
                                     confident_line=False)
     if rings_line:
         result.warnings.append(rings_line)

@@ -336,3 +336,48 @@ def test_a_bake_warns_of_uncertain_rings_only(tmp_path, spread_years, warned):
     assert ("well constrained" in uncertainty_report(grid, box.vertices, size, "box")) is not warned
     assert uncertainty_report(grid, box.vertices, size, "box", confident_line=False) == (
         None if not warned else uncertainty_report(grid, box.vertices, size, "box"))
+
+
+def test_a_turned_fitted_block_reads_its_uncertainty_where_its_years_are(tmp_path):
+    """The bake's rings line and preview's --confidence overlay read the fit's uncertainty at the
+    stock's own points in the SOURCE block's frame (``stock.wood.field``): a block turned by
+    '~z90' (or resized) was sure where its source is a guess and the other way round. They read
+    it where the years are now (Wood.uncertainty_years), and name the face to photograph as the
+    fitted block's photos do."""
+    import trimesh
+
+    from woodcam.appearance.wood import Wood
+    from woodcam.pipeline import preview_part
+    from woodcam.stock import Stock
+
+    size = (40.0, 30.0, 20.0)
+    nodes = (9, 7, 5)
+    x = np.stack(np.meshgrid(*[np.linspace(0, s, k) for s, k in zip(size, nodes)], indexing="ij"), -1)
+    years = np.hypot(x[..., 0] - 20.0, x[..., 2] + 60.0) / 3.0
+    unc = np.where(x[..., 0] > 22.0, 40.0, 0.0)  # sure on the left, a guess on the right
+    grid = GridField(years, (0.0, 0.0, 0.0), (5.0, 5.0, 5.0), layers={"uncertainty": unc},
+                     meta={"faces": ["front", "top", "left", "bottom"]})
+    wood = Wood(grid)
+    turned, tsize = wood.turned("z", 1, size)  # '~z90': its (x, y, z) is the block's (y, 30 - x, z)
+    assert tsize == (30.0, 40.0, 20.0) and turned.has_uncertainty
+    p = np.random.default_rng(0).uniform(0, 1, (2000, 3)) * tsize
+    src = np.column_stack([p[:, 1], 30.0 - p[:, 0], p[:, 2]])
+    np.testing.assert_allclose(turned.uncertainty_years(p), grid.uncertainty_years(src), atol=1e-9)
+    np.testing.assert_allclose(ConfidenceWood(turned).color(p), ConfidenceWood(grid).color(src), atol=1e-9)
+    moved = wood.shifted((10.0, 5.0, 0.0))
+    np.testing.assert_allclose(moved.uncertainty_years(p[:, [1, 0, 2]] / 2),
+                               grid.uncertainty_years(p[:, [1, 0, 2]] / 2 + (10.0, 5.0, 0.0)), atol=1e-9)
+    # the back third of the turned block is the source's right (unseen) third: its rings are
+    # the guess, and the face to photograph is the block's right face (the turned block's back)
+    line = uncertainty_report(turned, p, tsize, "bowl")
+    assert line.startswith("the rings in the back third (front-back) of this bowl are uncertain")
+    assert line.endswith("photograph the right face or trace its rings")
+    # a bake from the turned stock: a box at the front (the source's sure left) is not warned
+    stock = Stock("test~z90", tsize, turned, "a fitted block", {})
+    box = trimesh.creation.box((8, 8, 8))
+    box.apply_translation((24, 8, 10))
+    res = preview_part(box, stock, tmp_path / "box.glb", texels_per_mm=1, obj=False, screenshot=False)
+    assert not [w for w in res.warnings if "rings" in w], res.warnings
+    box.apply_translation((-18, 26, 0))  # at the back: the source's right, a guess
+    res = preview_part(box, stock, tmp_path / "box2.glb", texels_per_mm=1, obj=False, screenshot=False)
+    assert [w for w in res.warnings if "rings" in w and "uncertain" in w], res.warnings

@@ -11,7 +11,7 @@ from .._checks import check_number, check_vector
 from .._types import AppearanceLike, ArrayLike, GrowthFieldLike, WoodLike
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, evaluate, grain_direction
-from ..frames import check_size
+from ..frames import FACE_NORMAL, FACES, check_face, check_size
 from ..tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS
 from .colormap import ColorMapAppearance
 
@@ -136,6 +136,30 @@ class Wood:
         """Growth time ``(n,)`` in years at ``points_mm : (n, 3)``."""
         p, _ = self._to_source(check_points(points_mm))
         return evaluate(self.field, p)
+
+    @property
+    def has_uncertainty(self) -> bool:
+        """Whether the growth field is a fit that says where its rings are a guess (an
+        ``uncertainty`` layer, :func:`woodcam.inference.evidence.bake_evidence`)."""
+        return "uncertainty" in (getattr(self.field, "layers", None) or {})
+
+    def uncertainty_years(self, points_mm: ArrayLike) -> np.ndarray:
+        """Years of uncertainty ``(n,)`` of a fitted field at ``points_mm : (n, 3)`` (block frame,
+        mm), read where :meth:`years` reads (a turned or resized block's point is its source
+        block's); zeros when the field carries none (a true field, a plain fit)."""
+        p, _ = self._to_source(check_points(points_mm))
+        if not self.has_uncertainty:
+            return np.zeros(len(p))
+        return np.asarray(self.field.uncertainty_years(p), dtype=float)  # type: ignore[attr-defined]
+
+    def source_face(self, face: str) -> str:
+        """The face of the source block (the one the field was fitted or grown in, whose photos
+        name its faces) that faces the way this block's ``face`` does: ``face`` itself unless the
+        wood is turned (a resized block's faces are parallel to its parent's)."""
+        n = np.asarray(FACE_NORMAL[check_face(face)], float)
+        if self._turn is not None:
+            n = n @ self._turn[0]  # source direction = rot^T n
+        return next(f for f in FACES if np.allclose(FACE_NORMAL[f], n))
 
     def arf(self, points_mm: ArrayLike) -> np.ndarray:
         """Annual-ring field ``(n,)`` in [0, 1) at ``points_mm`` (eq. 6 of seed 000)."""

@@ -198,10 +198,10 @@ def run_preview(args: argparse.Namespace) -> int:
     if args.confidence:
         from ..inference.evidence import ConfidenceWood
 
-        if stock is None or "uncertainty" not in (getattr(stock.wood.field, "layers", {}) or {}):
+        if stock is None or not getattr(stock.wood, "has_uncertainty", False):
             raise WoodcamError("--confidence needs a block whose field was fitted (a block folder "
                                "without a true field, or a Mokume folder); pass --block")
-        wood = ConfidenceWood(stock.wood.field)
+        wood = ConfidenceWood(stock.wood)  # read where its years are (turned, resized)
     out = preview(args.mesh, wood=wood, size_mm=stock.size_mm if stock else None,
                   screenshot=screenshot_path(args.screenshot, args.mesh),
                   camera=camera_of(args), cut_plane=not args.no_cut, cut_origin=args.cut_origin,

@@ -864,23 +864,27 @@ def _bake_evidence(ev: EvidenceFit, size_mm, faces, strands, workers: int):
 _THIRDS = (("left", "middle", "right"), ("front", "middle", "back"), ("bottom", "middle", "top"))
 
 
-def uncertainty_report(field, points_mm, size_mm, what: str = "part", *,
+def uncertainty_report(wood, points_mm, size_mm, what: str = "part", *,
                        confident_line: bool = True) -> str | None:
-    """One line on where a fit's rings are a guess (issue 12 part 5), or None when ``field``
-    carries no uncertainty (a true field, a plain fit). Where the rings are well constrained the
-    line says so, or with ``confident_line=False`` it is None (only a warning left: a bake
-    printed the good news as "warning: ... well constrained").
+    """One line on where a fit's rings are a guess (issue 12 part 5), or None when the wood's
+    field carries no uncertainty (a true field, a plain fit). Where the rings are well
+    constrained the line says so, or with ``confident_line=False`` it is None (only a warning
+    left: a bake printed the good news as "warning: ... well constrained").
 
+    wood : a stock's :class:`~woodcam.appearance.Wood` (turned or cut out of the fitted block:
+    its points are read where its years are, :meth:`~woodcam.appearance.Wood.uncertainty_years`),
+    or a fitted field in its own block's frame.
     points_mm : (n, 3) points of the part (block frame), e.g. its mesh vertices. The part is
     cut in thirds along each block axis; the third with the lowest mean :func:`confidence` is
-    named, with the unobserved face nearest to it to photograph (``field.meta["faces"]``); when
-    every face was observed, the nearest face whose rings to check instead.
+    named, with the unobserved face nearest to it to photograph (``field.meta["faces"]``, named
+    as the fitted block's: a turned block's face is its source's); when every face was
+    observed, the nearest face whose rings to check instead.
     """
-    layers = getattr(field, "layers", {}) or {}
-    if "uncertainty" not in layers or not len(points_mm):
+    wood = _as_wood(wood)
+    if not wood.has_uncertainty or not len(points_mm):
         return None
     p = np.asarray(points_mm, float)
-    conf = confidence(field.uncertainty_years(p))
+    conf = confidence(wood.uncertainty_years(p))
     if conf.mean() >= CONFIDENT_MEAN:
         return (f"the rings of this {what} are well constrained (mean confidence {conf.mean():.2f})"
                 if confident_line else None)
@@ -893,11 +897,14 @@ def uncertainty_report(field, points_mm, size_mm, what: str = "part", *,
             if sel.mean() >= 0.05 and (worst is None or conf[sel].mean() < worst[0]):
                 worst = (float(conf[sel].mean()), ax, t, p[sel].mean(axis=0))
     c, ax, t, centre = worst
-    seen = set((getattr(field, "meta", {}) or {}).get("faces", []))
-    unseen = [f for f in FACES if f not in seen]
+    seen = set((getattr(wood.field, "meta", {}) or {}).get("faces", []))
+    # this block's faces as the fitted block's photos name them (they differ once turned)
+    named = {f: wood.source_face(f) for f in FACES}
+    unseen = [f for f in FACES if named[f] not in seen]
     # With every face photographed there is no face left to ask for: the hypotheses disagree
     # there, so the advice is to check (or trace) the rings found on the nearest face instead.
-    face = min(unseen or FACES, key=lambda f: distance_to_faces_mm(centre[None], size, [FACES.index(f)])[0])
+    face = named[min(unseen or FACES,
+                     key=lambda f: distance_to_faces_mm(centre[None], size, [FACES.index(f)])[0])]
     place = "middle" if t == 1 else _THIRDS[ax][t]
     axis_word = ("left-right", "front-back", "bottom-top")[ax]
     # a face outside the fit may be missing or photographed with no rings found: ask for both
@@ -908,15 +915,27 @@ def uncertainty_report(field, points_mm, size_mm, what: str = "part", *,
             f"(confidence {c:.2f}, whole {what} {conf.mean():.2f}): {advice}")
 
 
+def _as_wood(wood):
+    """A :class:`~woodcam.appearance.Wood` as given, or a bare field as a wood in its own frame."""
+    from ..appearance.wood import Wood
+
+    return wood if isinstance(wood, Wood) else Wood(wood)
+
+
 class ConfidenceWood:
     """A stand-in for a ``Wood`` that colours surfaces by the fit's :func:`confidence`
-    (red 0 -> yellow 0.5 -> green 1): the ``--confidence`` overlay of ``woodcam preview``."""
+    (red 0 -> yellow 0.5 -> green 1): the ``--confidence`` overlay of ``woodcam preview``.
 
-    def __init__(self, field):
-        self.field = field
+    wood : the stock's :class:`~woodcam.appearance.Wood` (the confidence is read where its
+    years are: a turned or resized block's point is its source's), or a fitted field in its
+    own frame.
+    """
+
+    def __init__(self, wood):
+        self.wood = _as_wood(wood)
 
     def color(self, points_mm, normals=None) -> np.ndarray:
-        c = confidence(self.field.uncertainty_years(np.asarray(points_mm, float)))
+        c = confidence(self.wood.uncertainty_years(np.asarray(points_mm, float)))
         return np.stack([np.clip(2 - 2 * c, 0, 1), np.clip(2 * c, 0, 1), np.full_like(c, 0.1)], axis=1)
 
 
