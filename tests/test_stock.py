@@ -263,6 +263,52 @@ def test_blocks_placed_anywhere_in_a_grown_object_have_its_colours(tmp_path):
                                    err_msg=name)
 
 
+def test_a_sized_builtins_photos_are_the_whole_blocks_wood(monkeypatch):
+    """--appearance neural learns a synthetic block's colours from face photos synth_block
+    renders: a sized built-in's were drawn with the fibre texture in its own frame (24-34/255
+    off the whole block's at the same wood point, so other learned colours). With the camera's
+    exposure, vignette and noise off (a photo's own), its photos are the whole block's colour at
+    those points to 1/255, and open_block renders the same ones."""
+    import woodcam.appearance.neural as neural
+    import woodcam.synth.block as synth
+    from woodcam.fields.base import LogFrame, evaluate
+    from woodcam.frames import FACE_NORMAL, face_pixel_points
+    from woodcam.stock import open_block
+    from woodcam.synth.photos import _BuiltinWood
+
+    monkeypatch.setattr(synth, "_camera", lambda rgb, rng, noise, variation, blur_px=0.0:
+                        np.clip(np.round(rgb * 255.0), 0, 255).astype(np.uint8))
+    taught = []
+
+    class Taught(Exception):
+        pass
+
+    def fit(photos, field, **settings):  # what the net would learn from, not the net
+        taught.append(photos)
+        raise Taught
+
+    monkeypatch.setattr(neural, "fit_neural_appearance", fit)
+    size = (40.0, 40.0, 20.0)
+    for name in ("flat-sawn", "knotty"):
+        with pytest.raises(Taught):
+            open_stock(f"builtin:{name}:40x40x20", appearance="neural")
+        whole = open_stock(f"builtin:{name}").wood.field
+        offset = (np.asarray(open_stock(f"builtin:{name}").size_mm) - size) / 2
+        colour = _BuiltinWood(whole, np.random.default_rng(0))  # the whole block's photos' (seed 0)
+        shown, _ = open_block(f"builtin:{name}:40x40x20", face_px=256)
+        for face, f in taught[-1].faces.items():
+            p = face_pixel_points(face, f.shape, size).reshape(-1, 3) + offset
+            years = evaluate(whole, p)
+            dr, dc = np.gradient(years.reshape(f.shape))
+            want = colour.color(p, np.broadcast_to(np.asarray(FACE_NORMAL[face], float), p.shape), years=years,
+                                years_per_px=np.hypot(dr, dc).ravel())
+            np.testing.assert_allclose(f.photo.reshape(-1, 3) / 255, want, atol=1 / 255 + 1e-9, rtol=0,
+                                       err_msg=f"{name} {face}")
+            np.testing.assert_array_equal(shown.faces[face].photo, f.photo)
+    with pytest.raises(WoodcamError, match="texture_frame is for the built-in colours"):
+        synth.synth_block(whole, size, wood=open_stock("builtin:knotty").wood, texture_frame=LogFrame())
+
+
 def test_a_resized_stock_is_its_parents_wood_from_its_origin():
     """resize_stock (``woodcam gcode --stock W x D x H --stock-origin X,Y,Z``): the new stock's
     point p is the parent's point origin + p, and its spec names both."""

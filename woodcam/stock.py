@@ -255,20 +255,16 @@ def _parse_size(text: str, spec: str) -> tuple[float, float, float]:
 def _open_base_stock(spec: str, species, appearance, appearance_params, species_given=True) -> Stock:
     if spec.startswith("builtin:"):
         b, field, size = _builtin(spec.split(":", 1)[1])
-        # a sized built-in draws the whole block's texture: the same wood, the same colours
-        texture = field.frame if field is not b.field else None
         return _synthetic_stock(spec, field, size, species or b.species, b.description,
-                                appearance, appearance_params, texture)
+                                appearance, appearance_params, _texture_frame(spec, field))
     if spec.startswith("log:"):
         field, size_mm, description = _log_block_field(spec)
         return _synthetic_stock(spec, field, size_mm, species or "spruce", description,
-                                appearance, appearance_params, _log_texture_frame(spec, field))
+                                appearance, appearance_params, _texture_frame(spec, field))
     if spec.startswith("woodify:"):
         field, size_mm, description = _woodify_field(spec)
-        # the texture drawn in the grown object's frame: two blocks placed differently in the
-        # same object (--block-size, --block-centre) have the same colours where they overlap
         return _synthetic_stock(spec, field, size_mm, species or "oak", description,
-                                appearance, appearance_params, field.object_frame)
+                                appearance, appearance_params, _texture_frame(spec, field))
     path = _existing_folder(spec)
     if (path / "block.json").is_file():
         return _open_block_folder(path, species, appearance, appearance_params, species_given)
@@ -315,7 +311,8 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         else:
             field, size, _ = _log_block_field(spec)
             name = spec.replace(":", "-").replace("/", "_")
-        return synth_block(field, size, face_px=face_px, seed=0, name=name), field
+        return synth_block(field, size, face_px=face_px, seed=0, name=name,
+                           texture_frame=_texture_frame(spec, field)), field
     from .block.io import read_block_folder
 
     from .detect.block import with_detected_rings
@@ -354,8 +351,8 @@ def _existing_folder(spec: str) -> Path:
 def _synthetic_stock(spec, field, size_mm, species, description, appearance, params,
                      texture_frame=None) -> Stock:
     """A stock whose true field is known but which has no photos of its own; ``texture_frame``
-    (a :class:`~woodcam.fields.base.LogFrame` or None) is the colour map's
-    (:class:`ColorMapAppearance`: the frame of the block this one is cut from)."""
+    (a :class:`~woodcam.fields.base.LogFrame` or None, :func:`_texture_frame`) is the colour
+    map's (:class:`ColorMapAppearance`) and the neural appearance's synthetic photos'."""
     from .fields.state import is_saveable
 
     meta = {"appearance": appearance}
@@ -366,7 +363,10 @@ def _synthetic_stock(spec, field, size_mm, species, description, appearance, par
         from .appearance.neural import fit_neural_appearance
         from .synth import synth_block
 
-        photos = synth_block(field, size_mm, face_px=256, seed=0, name=spec.replace(":", "-"))
+        # in the texture frame of the block cut from: a sized block's photos (and so its
+        # learned colours) are the whole block's at the same wood point
+        photos = synth_block(field, size_mm, face_px=256, seed=0, name=spec.replace(":", "-"),
+                             texture_frame=texture_frame)
         app = fit_neural_appearance(photos, field, **params)
         meta["appearance_key"] = app.meta.get("key")
     else:
@@ -480,6 +480,19 @@ def _log_block_field(spec: str):
         raise WoodcamError(f"knot index in {spec!r} must be 0..{len(log.knots) - 1}; got {knot}")
     field = place_block_in_log(KnottedLogField(log), *block_at_knot(log, knot, size_mm))
     return field, size_mm, f"block through knot {knot} of log {source}"
+
+
+def _texture_frame(spec: str, field):
+    """The frame a synthetic block's texture is drawn in (colour map and synthetic photos alike),
+    placed in its block frame, or None (its own): a sized built-in draws the whole block's, a
+    sized log block the default-size block's through the same knot, a woodify block the grown
+    object's (two blocks placed differently in the same object, --block-size, --block-centre).
+    The same wood has the same colours however it is cut."""
+    if spec.startswith("builtin:"):  # a size given: the PlacedField of _builtin in the whole block
+        return field.frame if spec.split(":", 1)[1].partition(":")[2] else None
+    if spec.startswith("log:"):
+        return _log_texture_frame(spec, field)
+    return field.object_frame  # woodify
 
 
 def _log_texture_frame(spec: str, field):

@@ -7,7 +7,7 @@ import numpy as np
 from .._types import ArrayLike, GrowthFieldLike, WoodLike
 from ..block import Block, Face
 from ..errors import WoodcamError
-from ..fields.base import evaluate
+from ..fields.base import LogFrame, evaluate
 from ..fields.rings import MOKUME_RING_SIGMA_MM, ring_map
 from ..frames import (
     FACE_NORMAL,
@@ -25,7 +25,8 @@ from .traces import _trace_face
 def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | None = None, *,
                 wood: WoodLike | None = None,
                 rng: np.random.Generator | None = None, name: str = "synthetic",
-                meta: dict | None = None, knot_masks: bool = True, **settings) -> Block:
+                meta: dict | None = None, knot_masks: bool = True,
+                texture_frame: LogFrame | None = None, **settings) -> Block:
     """Render a synthetic :class:`Block` from a growth field placed in the block frame.
 
     Parameters
@@ -50,6 +51,11 @@ def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | No
         Block name and extra metadata.
     knot_masks : for a field with ``knot_features`` (knotted logs), mark each face's knot wood
         (weight > 0.5) in ``extras["knot_mask"]``, as the knot masks of Mokume's H11.
+    texture_frame : LogFrame, optional
+        For the built-in colours (no ``wood``): the frame their fibre texture is drawn in,
+        placed in the block frame; a block cut out of another's wood passes the other's (as
+        ``ColorMapAppearance.texture_frame``), so its photos show the same wood as the other's.
+        A given ``wood`` draws its own texture: passing both is refused.
 
     Returns
     -------
@@ -66,6 +72,12 @@ def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | No
         raise WoodcamError(
             f"wood must have a color(points_mm, normals) method; got {type(wood).__name__}"
         )
+    if wood is not None and texture_frame is not None:
+        raise WoodcamError("texture_frame is for the built-in colours; a given wood draws its own texture "
+                           f"(got wood={type(wood).__name__} and a texture_frame); pass one of them")
+    if texture_frame is not None and not isinstance(texture_frame, LogFrame):
+        raise WoodcamError(f"texture_frame must be a LogFrame (placed in the block frame) or None; "
+                           f"got {type(texture_frame).__name__}")
     faces = list(spec.faces)
     trace_faces = set(faces if spec.trace_faces is None else spec.trace_faces)
     ring_map_faces = set(faces if spec.ring_map_faces is None else spec.ring_map_faces)
@@ -81,7 +93,7 @@ def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | No
     ph, tr = spec.photo, spec.traces
 
     appearance = "builtin" if wood is None else type(wood).__name__
-    wood = _BuiltinWood(field, rng) if wood is None else wood
+    wood = _BuiltinWood(field, rng, texture_frame=texture_frame) if wood is None else wood
     out = {}
     for face in faces:
         shape = layout.face_shape(face)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..appearance.colormap import get_species
-from ..fields.base import arf, check_points, evaluate, grain_direction
+from ..fields.base import LogFrame, arf, check_points, evaluate, grain_direction
 
 #: Species whose earlywood/latewood colours the built-in photos use (the one colour table,
 #: :data:`woodcam.appearance.SPECIES`).
@@ -20,6 +20,11 @@ class _BuiltinWood:
     a little darker, and a fibre texture: smooth 3-D noise stretched along the fibres
     (``_FIBRE_SCALES_MM``: streaks on side grain, pores on end grain). All random parts are
     drawn once per block, so the six faces agree where they meet.
+
+    ``texture_frame`` (a :class:`~woodcam.fields.base.LogFrame` placed in the block frame, or
+    None for the block's own): the frame the fibre texture is drawn in. A block cut out of
+    another's wood draws the other's (``ColorMapAppearance.texture_frame``), so its photos are
+    the other's at the same wood point.
     """
 
     #: (across-fibre, along-fibre) noise scales (mm) and weights of the fibre texture octaves.
@@ -27,8 +32,9 @@ class _BuiltinWood:
     _FIBRE_AMPLITUDE = 0.05
 
     def __init__(self, field, rng: np.random.Generator, lattice: int = 64,
-                 species: str = BUILTIN_PHOTO_SPECIES):
+                 species: str = BUILTIN_PHOTO_SPECIES, texture_frame: LogFrame | None = None):
         s = get_species(species)
+        self.texture_frame = texture_frame
         self.earlywood = np.asarray(s.earlywood_rgb, float)
         self.latewood = np.asarray(s.latewood_rgb, float)
         self.field = field
@@ -39,6 +45,9 @@ class _BuiltinWood:
     def _fibre_texture(self, p: np.ndarray, fib: np.ndarray) -> np.ndarray:
         from scipy.ndimage import map_coordinates
 
+        frame = self.texture_frame
+        if frame is not None:  # the wood point and fibre in the frame of the block cut from
+            p, fib = frame.to_log(p), np.einsum("ij,kj->ik", fib, frame.rotation)
         along = (p * fib).sum(1, keepdims=True)
         tex = np.zeros(len(p))
         for (l_across, l_along, w), grid, off in zip(self._FIBRE_SCALES_MM, self.lattice, self.offsets):
