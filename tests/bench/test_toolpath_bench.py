@@ -27,6 +27,13 @@ pytestmark = pytest.mark.bench
 REPO = Path(__file__).resolve().parents[2]
 SIZE = (100.0, 100.0, 30.0)
 
+#: Bar on woodcam's interpreter speed over LinuxCNC's (lines per CPU-s, same raster, same
+#: run). No target is stated (DEVELOPERS.md reports the figure): measured 0.53-0.68 in
+#: three runs on the shared 2-core machine at load ~5 (Dec 2026), divided by a 1.5x margin,
+#: so an interpreter markedly slower than today (e.g. without its short path for plain
+#: ``X.. Z.. F..`` lines) fails.
+MIN_INTERPRETER_OVER_LINUXCNC = 0.35
+
 
 def _raster_program() -> Program:
     spec = importlib.util.spec_from_file_location("make_samples",
@@ -130,7 +137,9 @@ def test_whole_gcode_preview_of_the_raster(tmp_path):
 def test_interpreter_lines_per_cpu_second_vs_linuxcnc(tmp_path):
     """Reading speed (source lines per CPU second) of woodcam's interpreter and of LinuxCNC's
     own (Debian ``linuxcnc-uspace``, its ``gcode`` module with a canon that records moves, as
-    the oracle test runs it) on the same 20,500-line raster, in the same run."""
+    the oracle test runs it) on the same 20,500-line raster, in the same run, best of three
+    each. Asserted: woodcam's speed over LinuxCNC's (their CPU-s over ours) above
+    :data:`MIN_INTERPRETER_OVER_LINUXCNC`."""
     from woodcam.toolpath.interpreter import Interpreter
     from woodcam.toolpath.linuxcnc import linuxcnc_missing, run_batch
 
@@ -145,15 +154,21 @@ def test_interpreter_lines_per_cpu_second_vs_linuxcnc(tmp_path):
     path = tmp_path / "raster.ngc"
     path.write_text(text)
     n = len(text.splitlines())
-    c = time.process_time()
-    moves, _ = Interpreter(text, start_mm=(0.0, 0.0, 10.0)).run()
-    ours = time.process_time() - c
-    res = run_batch([path])[0]
-    assert res["error"] is None and len(res["moves"]) - len(moves) in (0, 1)  # + its start
-    theirs = res["cpu_seconds"]
+    ours = float("inf")
+    for _ in range(3):
+        c = time.process_time()
+        moves, _ = Interpreter(text, start_mm=(0.0, 0.0, 10.0)).run()
+        ours = min(ours, time.process_time() - c)
+    runs = run_batch([path] * 3)
+    for res in runs:
+        assert res["error"] is None and len(res["moves"]) - len(moves) in (0, 1)  # + its start
+    theirs = min(res["cpu_seconds"] for res in runs)
     print(f"\ninterpreter on {n} lines: woodcam {n / ours:,.0f} lines/CPU-s, LinuxCNC "
-          f"{n / theirs:,.0f} lines/CPU-s; woodcam/LinuxCNC = {theirs / ours:.2f}x; load "
-          f"{os.getloadavg()[0]:.1f}")
+          f"{n / theirs:,.0f} lines/CPU-s; woodcam/LinuxCNC = {theirs / ours:.2f}x (bar "
+          f"{MIN_INTERPRETER_OVER_LINUXCNC}); load {os.getloadavg()[0]:.1f}")
+    assert theirs / ours > MIN_INTERPRETER_OVER_LINUXCNC, (
+        f"woodcam's interpreter reads at {theirs / ours:.2f}x LinuxCNC's speed; bar "
+        f"{MIN_INTERPRETER_OVER_LINUXCNC} (measured 0.53-0.68, divided by 1.5)")
 
 
 def test_relief_job_167x208_end_to_end(tmp_path):
