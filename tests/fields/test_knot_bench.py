@@ -1,7 +1,9 @@
 """Throughput of the knotted-log field (benchmarks: run with ``-m bench -s``).
 
 Reports points/s for the real 108-knot log against the stem field alone (same points, same
-run) and how the cost grows with the number of knots. Ratios, not timed asserts.
+run) and how the cost grows with the number of knots. Ratios, not timed asserts: the CPU cost
+of the knotted field over the stem's is asserted below :data:`MAX_KNOTS_OVER_STEM` (CPU, not
+wall: the machine is shared).
 """
 
 import time
@@ -13,6 +15,12 @@ from woodcam.fields.knots import KnottedLogField, available_backends
 from woodcam.fields.skeleton import BranchStrand, simple_log
 
 pytestmark = pytest.mark.bench
+
+#: Bars on CPU(real 108-knot log) / CPU(stem alone), same points, per backend. No target is
+#: stated: measured 6.2-6.7 (numpy) and 3.8-5.2 (numba) in four runs on the shared 2-core
+#: machine at load ~5-8 (Dec 2026), times a 1.5x margin, so a knot evaluation markedly slower
+#: than today (e.g. the spatial culling off, every knot tested at every point) fails.
+MAX_KNOTS_OVER_STEM = {"numpy": 10.0, "numba": 7.8}
 
 
 def _rate(f, p, repeat=3, cpu=False):
@@ -48,8 +56,11 @@ def test_throughput_real_log(gran1, backend):
     stem_cpu, full_cpu = _rate(fs, p, cpu=True), _rate(ff, p, cpu=True)
     print(f"\n[{backend}] real log, 108 knots: {full / 1e6:.2f} M points/s wall-clock "
           f"({full_cpu / 1e6:.2f} M points/s per 2 CPU-seconds); stem alone {stem / 1e6:.2f} "
-          f"({stem_cpu / 1e6:.2f}); knots cost {stem / full:.1f}x the stem")
-    assert full > 0
+          f"({stem_cpu / 1e6:.2f}); knots cost {stem / full:.1f}x the stem wall, "
+          f"{stem_cpu / full_cpu:.1f}x CPU (bar {MAX_KNOTS_OVER_STEM[backend]})")
+    assert stem_cpu / full_cpu < MAX_KNOTS_OVER_STEM[backend], (
+        f"[{backend}] the 108-knot log costs {stem_cpu / full_cpu:.1f}x the stem's CPU time; bar "
+        f"{MAX_KNOTS_OVER_STEM[backend]} (measured 3.8-6.7, times 1.5)")
 
 
 @pytest.mark.parametrize("backend", available_backends())
