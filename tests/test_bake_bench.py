@@ -1,4 +1,5 @@
-"""Benchmarks of the bake (``pytest -m bench -s tests/test_bake_bench.py``); no timed asserts.
+"""Benchmarks of the bake (``pytest -m bench -s tests/test_bake_bench.py``); no timed asserts
+(the bake's CPU ratio to xatlas' charting in the same run is asserted, :data:`MIN_XATLAS_OVER_AUTO`).
 
 Figures printed:
 * colour lookup throughput (texels/s) of the smooth test appearance, and its ratio to a plain
@@ -35,6 +36,15 @@ def _best_of(fn, repeat=3):
         best = min(best, time.perf_counter() - t)
         best_cpu = min(best_cpu, time.process_time() - c)
     return best, best_cpu, out
+
+
+#: Bar on CPU(bake with xatlas' own charts) / CPU(bake with woodcam's projected charts, the
+#: default), same part, same run. The target (<= 3 s for the bake) is ~0.8 of the xatlas bake's
+#: ~2.3-2.5 CPU-s, too loose to notice a bake twice as slow; so the bar is the measured ratio,
+#: 2.52-3.02 in four runs on the shared 2-core machine at load ~5-8 (Dec 2026; the default
+#: bake 0.82-0.93 CPU-s), divided by a 1.5x margin. Only a slowdown of the default's own steps
+#: (its charts) moves the ratio: one in the steps both share (rasterise, colour, dilate) does not.
+MIN_XATLAS_OVER_AUTO = 1.68
 
 
 def _part_20k():
@@ -103,4 +113,8 @@ def test_bake_time_20k_triangles_2048_atlas():
               f"painted texels; best of 2 {cpu:.2f} CPU-s, {wall:.2f} s wall ({steps}); colour "
               f"step {painted / result.timings['color'] / 1e6:.1f} M texels/s wall")
         assert max(result.atlas.shape[:2]) <= 2048
-    print(f"CPU ratio xatlas / auto: {best['xatlas'][0] / best['auto'][0]:.2f}")
+    ratio = best["xatlas"][0] / best["auto"][0]
+    print(f"CPU ratio xatlas / auto: {ratio:.2f} (bar > {MIN_XATLAS_OVER_AUTO})")
+    assert ratio > MIN_XATLAS_OVER_AUTO, (
+        f"the default bake costs 1/{ratio:.2f} of the xatlas bake's CPU time; bar 1/"
+        f"{MIN_XATLAS_OVER_AUTO} (measured 1/2.52-1/3.02, with a 1.5x margin)")
