@@ -2,7 +2,8 @@
 
 Times are CPU seconds of this process (``time.process_time``), which the shared machine's load
 inflates less than wall clock; the baseline is scikit-fmm's ``travel_time`` alone on the same
-grid in the same run. Printed as one JSON line per figure.
+grid in the same run. Printed as one JSON line per figure. The field's CPU ratios to the
+scikit-fmm baseline are asserted (:data:`MAX_FIELD_OVER_SKFMM`).
 """
 
 from __future__ import annotations
@@ -19,6 +20,12 @@ from woodcam.woodify import woodify
 from woodcam.woodify.cracks import simulate_cracks
 
 pytestmark = pytest.mark.bench
+
+#: Bars on CPU(woodify's 40-year field) / CPU(scikit-fmm's travel_time alone on its grid), per
+#: case. No target is stated: measured 1.46-1.91 (isotropic), 3.06-3.8 (eccentric) and
+#: 6.96-8.55 (obstacle) in three runs on the shared 2-core machine at load ~5 (Dec 2026),
+#: times a 1.5x margin, so a field markedly slower than today fails.
+MAX_FIELD_OVER_SKFMM = {"isotropic": 2.9, "eccentric": 5.7, "eccentric + obstacle": 13.0}
 
 
 def _tree_mesh(target_faces: int = 20_000):
@@ -46,15 +53,24 @@ def test_field_of_a_20k_triangle_mesh_at_128():
 
     mesh = _tree_mesh()
     nf = len(mesh.faces)
+    post = trimesh.creation.cylinder(radius=3.0, height=200.0, sections=32)
+    post.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (1, 0, 0)))
+    post.apply_translation((20.0, 0.0, 0.0))
+    # warm-up of each method on a coarse grid: numba compiles (or loads its cache) on the
+    # first call, which cost the first figure ~3 CPU-s with a cold cache (ratio 4.7, warm 1.5-1.9)
+    for kw in ({}, {"eccentricity": 0.3}, {"eccentricity": 0.3, "obstacles": [post]}):
+        woodify(mesh, 40, growth_mm=20.0, resolution=24, **kw)
     t = time.process_time()
     res = woodify(mesh, 40, growth_mm=20.0, resolution=128)
     t_woodify = time.process_time() - t
     g = res.front.grid
     # baseline: scikit-fmm alone on the same grid (a sphere's level set as input)
     phi = np.linalg.norm(g.nodes() - mesh.centroid, axis=1).reshape(g.shape) - 10.0
-    t = time.process_time()
-    skfmm.travel_time(phi, np.ones_like(phi), dx=float(g.spacing_mm))
-    t_skfmm = time.process_time() - t
+    t_skfmm = np.inf
+    for _ in range(3):  # best of three: the baseline's CPU time varied 0.5-0.9 s under load
+        t = time.process_time()
+        skfmm.travel_time(phi, np.ones_like(phi), dx=float(g.spacing_mm))
+        t_skfmm = min(t_skfmm, time.process_time() - t)
     _report("field 40 years, isotropic", triangles=nf, grid=list(g.shape), method=res.front.method,
             woodify_cpu_s=round(t_woodify, 2), skfmm_alone_cpu_s=round(t_skfmm, 2),
             ratio=round(t_woodify / t_skfmm, 2))
@@ -63,9 +79,6 @@ def test_field_of_a_20k_triangle_mesh_at_128():
     t_ecc = time.process_time() - t
     _report("field 40 years, eccentric", method=ecc.front.method, cpu_s=round(t_ecc, 2),
             ratio_to_skfmm=round(t_ecc / t_skfmm, 2))
-    post = trimesh.creation.cylinder(radius=3.0, height=200.0, sections=32)
-    post.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (1, 0, 0)))
-    post.apply_translation((20.0, 0.0, 0.0))
     t = time.process_time()
     obs = woodify(mesh, 40, growth_mm=20.0, resolution=128, eccentricity=0.3, obstacles=[post])
     t_obs = time.process_time() - t
@@ -81,6 +94,14 @@ def test_field_of_a_20k_triangle_mesh_at_128():
     dt, dw = time.process_time() - t, time.perf_counter() - tw
     _report("field evaluation", points=len(pts), points_per_cpu_s=round(len(pts) / dt),
             points_per_wall_s=round(len(pts) / dw), cpu_s=round(dt, 3))
+    ratios = {"isotropic": t_woodify / t_skfmm, "eccentric": t_ecc / t_skfmm,
+              "eccentric + obstacle": t_obs / t_skfmm}
+    _report("field CPU over scikit-fmm alone", **{k: round(v, 2) for k, v in ratios.items()},
+            bars=MAX_FIELD_OVER_SKFMM)
+    for case, ratio in ratios.items():
+        assert ratio < MAX_FIELD_OVER_SKFMM[case], (
+            f"the 40-year field ({case}) costs {ratio:.2f}x scikit-fmm's CPU time on its grid; bar "
+            f"{MAX_FIELD_OVER_SKFMM[case]} (measured 1.46-8.55 by case, times 1.5)")
     assert len(pts) / dt > 1e6
 
 
