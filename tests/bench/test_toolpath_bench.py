@@ -27,6 +27,11 @@ pytestmark = pytest.mark.bench
 REPO = Path(__file__).resolve().parents[2]
 SIZE = (100.0, 100.0, 30.0)
 
+#: Bar on CPU(manifold3d reference) / CPU(height-field simulation) on the raster's first 2,000
+#: moves. No target is stated; the bar was 5: measured 1028-1109x in three runs on the shared
+#: 2-core machine at load ~5 (Dec 2026), divided by a 1.5x margin, so a simulation markedly
+#: slower than today fails.
+MIN_SIM_SPEEDUP_OVER_MANIFOLD = 680
 #: Bar on woodcam's interpreter speed over LinuxCNC's (lines per CPU-s, same raster, same
 #: run). No target is stated (DEVELOPERS.md reports the figure): measured 0.53-0.68 in
 #: three runs on the shared 2-core machine at load ~5 (Dec 2026), divided by a 1.5x margin,
@@ -72,16 +77,21 @@ def test_raster_20k_moves_throughput_and_ratio_to_manifold():
 
     n_ref = os.environ.get("WOODCAM_BENCH_REF_MOVES", "2000")
     sub = prog if n_ref == "all" else _prefix(prog, int(n_ref))
-    sim_sub, swall, scpu = _timed(lambda: simulate(sub, tool, SIZE, resolution_mm=0.1))
+    # best of three: the height field takes ~0.04 CPU-s on the 2,000-move prefix
+    runs = [_timed(lambda: simulate(sub, tool, SIZE, resolution_mm=0.1)) for _ in range(3)]
+    sim_sub, swall, scpu = runs[0][0], min(r[1] for r in runs), min(r[2] for r in runs)
     # manifold3d evaluates booleans lazily: volume() inside the timing forces the result
     vol, rwall, rcpu = _timed(lambda: reference_stock(sub, tool, SIZE, segments=96).volume())
     v_ref = np.prod(SIZE) - vol
     rel = sim_sub.removed_volume_mm3 / v_ref - 1
     print(f"reference on {len(sub)} moves: manifold3d wall {rwall:.1f} s cpu {rcpu:.1f} s; "
           f"height field wall {swall:.3f} s cpu {scpu:.3f} s; ratio (cpu) {rcpu / scpu:.0f}x, "
-          f"(wall) {rwall / swall:.0f}x; removed volume differs by {100 * rel:+.3f} %")
+          f"(wall) {rwall / swall:.0f}x (bar {MIN_SIM_SPEEDUP_OVER_MANIFOLD}); removed volume differs by "
+          f"{100 * rel:+.3f} %")
     assert abs(rel) < 5e-3
-    assert rcpu / scpu > 5
+    assert rcpu / scpu > MIN_SIM_SPEEDUP_OVER_MANIFOLD, (
+        f"the height field is {rcpu / scpu:.0f}x faster than manifold3d in CPU time; bar "
+        f"{MIN_SIM_SPEEDUP_OVER_MANIFOLD} (measured 1028-1109, divided by 1.5)")
 
 
 def _cli_run(tmp_path, src_root, label, extra=()):
