@@ -233,6 +233,19 @@ def test_synthetic_faces_first_heldout_seed():
     assert s["chance F@2"] < 0.2
 
 
+def test_a_face_of_one_ring_piece_is_detected_without_a_scale():
+    """detect_rings without px_per_mm on a face whose rings came out as one piece (seed 1000's
+    plain back face) raised IndexError where the pieces' end pairs are matched: with no pair, the
+    'first of each pair' mask had one entry for none. It finds the piece, as with the face's scale."""
+    from woodcam.synth import ring_eval_faces
+
+    (face,) = [f for f in ring_eval_faces(1000) if f.label == "seed 1000 flat-sawn plain back"]
+    det = detect_rings(face.photo)
+    assert len(det.traces) == 1 and det.warnings == []
+    (res,) = score_synthetic([face], detector=lambda photo, ppm: detect_rings(photo))
+    assert res.score.f[5.0] > 0.65, res.score.f
+
+
 @pytest.mark.slow
 def test_synthetic_faces_all_heldout_seeds():
     faces = _faces(EVAL_SEEDS)

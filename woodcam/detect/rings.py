@@ -455,7 +455,7 @@ def _ring_ids(polys: list, order: list[float], evidence: np.ndarray, order_map: 
     first = np.lexsort((gap, np.maximum(pa, pb), np.minimum(pa, pb)))
     key = np.minimum(pa, pb)[first] * (n + 1) + np.maximum(pa, pb)[first]
     nearest = np.zeros(len(gap), bool)
-    nearest[first[np.r_[True, key[1:] != key[:-1]]]] = True
+    nearest[first[np.diff(key, prepend=-1) != 0]] = True   # keys >= 0; also right with no pair
     ok = (nearest & (pa != pb) & (region[pa] == region[pb]) & (region[pa] > 0) & (faint[pa] == faint[pb])
           & (np.abs(o[pa] - o[pb]) <= LINK_ORDER_TOL) & (gap <= np.minimum(reach[ea], reach[eb])))
     t = np.linspace(0.0, 1.0, 9)[:, None]
