@@ -3,12 +3,23 @@
 from __future__ import annotations
 
 import os
+import signal
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
+
+
+def pytest_configure(config) -> None:
+    """A suite started in the background of a script (``pytest ... &``) inherits SIGINT ignored,
+    and woodcam keeps an ignored SIGINT ignored (as ``nohup`` asks): every Ctrl-C test then saw the
+    command run on to exit 0 and failed, though a terminal's Ctrl-C works. The Ctrl-C tests stand
+    for a terminal user, so the suite and the commands it starts get SIGINT back (a Python handler
+    becomes the default action across exec); the ignored case has its own test in test_cli_doors."""
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def shared_data_dir() -> Path:
