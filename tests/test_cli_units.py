@@ -293,3 +293,32 @@ def test_library_messages_of_an_inch_run_speak_inches(tmp_path, monkeypatch, cap
     assert "rapid_through_stock: rapid move (G0) cuts up to 0.03937 in into the stock" in err, err
     assert " mm" not in err, err
 
+
+
+def test_an_inch_bake_files_its_report_in_mm_and_prints_its_warnings_in_inches(tmp_path, capsys):
+    """Sweep h13 item 1: under --units inch the part report's files (_report.txt, _report.json,
+    the GLB's metadata) held the carve's "part sticks out" warning in inches beside their mm
+    numbers. Files stay in mm (woodcam.units.said / filed); the warning printed follows --units."""
+    import json
+
+    import trimesh
+
+    from woodcam.export import read_glb_metadata
+
+    part = tmp_path / "out.stl"
+    trimesh.creation.box((30.0, 20.0, 10.0)).apply_translation((10, 10, 5)).export(part)
+    out = tmp_path / "b.glb"
+    assert main(["bake", str(part), "--units", "inch", "--block", "builtin:knotty:2x2x2",
+                 "--texels-per-mm", "2", "--no-obj", "--out", str(out)]) == 0
+    captured = capsys.readouterr()
+    said = ("part sticks out of the block: 0.06102 in^3 (16.7 % of the part's 0.3661 in^3) lies outside "
+            "and is not carved; part bounding box [-0.1969, 0.9843] x [0, 0.7874] x [0, 0.3937] in, "
+            "block [0, 2] x [0, 2] x [0, 2] in")
+    assert f"woodcam: warning: {said}" in captured.err and f"  warning: {said}" in captured.out
+    filed = ("part sticks out of the block: 1000 mm^3 (16.7 % of the part's 6000 mm^3) lies outside "
+             "and is not carved; part bounding box [-5, 25] x [0, 20] x [0, 10] mm, "
+             "block [0, 50.8] x [0, 50.8] x [0, 50.8] mm")
+    text = (tmp_path / "b_report.txt").read_text()
+    assert f"  warning: {filed}" in text and " in^3" not in text and "] in" not in text, text
+    assert json.loads((tmp_path / "b_report.json").read_text())["warnings"][0].startswith(filed)
+    assert read_glb_metadata(out)["report"]["warnings"][0].startswith(filed)

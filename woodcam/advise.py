@@ -335,7 +335,9 @@ def report_text(report: dict, name: str, units: Units = "mm") -> str:
         lines.append(f"  {r['region']:<13} grain ({', '.join(f'{v:+.2f}' for v in r['grain'])}) "
                      f"runout {r['runout_deg']:.0f} deg, knots {100 * r['knots']:.1f} % with "
                      f"{under}")  # not the surface share the first line leads with
-    # the report (a file) keeps its warnings in mm; the one with a length is said in ``units``
+    # part_report writes its one warning with a length in mm (a report file keeps mm): it is said
+    # in ``units`` here; the library's warnings (the carve's) come in the message units already
+    # in the report a bake returns, in mm in its files (woodcam.units.said / filed)
     lines += [f"  warning: {_subsurface_knot_warning(units) if w == _subsurface_knot_warning('mm') else w}"
               for w in report["warnings"]]
     return "\n".join(lines)

@@ -295,12 +295,14 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
                                     confident_line=False)
     if rings_line:
         result.warnings.append(rings_line)
+    filed_report = result.report
     if part_report:
         import json
 
         from ._atomic import write_bytes
         from .advise import part_report as _part_report
         from .advise import report_text
+        from .units import filed
 
         with result.stage("report"):
             result.report = _part_report(mesh, stock)
@@ -309,11 +311,14 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
             for w in result.warnings:  # the carve's ("part sticks out of the block") were on stderr only
                 if w not in result.report.setdefault("warnings", []):
                     result.report["warnings"].append(w)
+            # the files stay in mm (woodcam.units.filed); result.report, which the CLI prints,
+            # keeps the warnings as they were said, in --units
+            filed_report = {**result.report, "warnings": [filed(w) for w in result.report["warnings"]]}
             stem = out_glb.with_name(out_glb.stem + "_report")
             # written with the GLB (below), as one set: an interrupted export left this part's
             # report beside the previous run's GLB
-            report_bytes = {"report": (report_text(result.report, out_glb.stem) + "\n").encode(),
-                            "report_json": json.dumps(result.report, indent=1).encode()}
+            report_bytes = {"report": (report_text(filed_report, out_glb.stem) + "\n").encode(),
+                            "report_json": json.dumps(filed_report, indent=1).encode()}
         result.files["report"] = stem.with_suffix(".txt")
         result.files["report_json"] = stem.with_suffix(".json")
     result.warnings += list(getattr(baked, "warnings", []))
@@ -328,7 +333,7 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
             **(metadata or {}),
             "texels_per_mm": float(baked.texels_per_mm)}
     if result.report:  # the review page shows it (volume, yield, "part sticks out", ...)
-        meta["report"] = result.report
+        meta["report"] = filed_report
     from ._atomic import all_or_nothing
 
     with result.stage("export"), all_or_nothing():  # GLB + OBJ + MTL + PNG appear as one set

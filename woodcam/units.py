@@ -7,14 +7,15 @@ summaries with :func:`fmt_length` / :func:`fmt_volume`. Files written stay in mi
 Messages (warnings, errors, G-code simulation issues) are written deep in the library, far from
 ``--units``: they write their lengths with :func:`say_length` / :func:`say_volume`, which follow
 the message units the command line sets for its run (:func:`message_units`); mm for a library
-caller, so their text there is what it always was.
+caller, so their text there is what it always was. A message that also goes into a file (the
+part report) is made with :func:`said`, which keeps its text in mm for :func:`filed`.
 """
 
 from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Literal
 
@@ -95,6 +96,27 @@ def say_volume(mm3: float, spec: str = ".4g") -> str:
     mm^3 with the message's ``spec``, else :func:`fmt_volume`'s inches^3."""
     units = _message_units
     return f"{mm3:{spec}} mm^3" if units == "mm" else fmt_volume(mm3, units)
+
+
+class _Said(str):
+    """A message in the message units that keeps its text in mm (:func:`said`)."""
+
+    in_mm: str
+
+
+def said(make: Callable[[], str]) -> str:
+    """The message ``make()`` builds (with :func:`say_length` ...) in the message units, keeping
+    its text in mm for a file (:func:`filed`): files written stay in millimetres whatever
+    ``--units`` says, while the same warning on the terminal follows it."""
+    text = _Said(make())
+    with message_units("mm"):
+        text.in_mm = make()
+    return text
+
+
+def filed(message: str) -> str:
+    """A message's text for a file: in mm when :func:`said` made it, else as it is."""
+    return getattr(message, "in_mm", message)
 
 
 def parse_lengths(text: str, n: int = 3, *, max_mm: float, cube: bool = False) -> tuple[float, ...] | None:

@@ -21,7 +21,7 @@ from .._types import ArrayLike
 from ..errors import WoodcamError, WoodcamWarning
 from ..frames import FOREIGN_GLTF_METRES_BELOW, check_size
 from ..tolerances import OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG
-from ..units import MM_PER_UNIT, say_length, say_volume
+from ..units import MM_PER_UNIT, said, say_length, say_volume
 from .parts import load_part
 
 
@@ -135,12 +135,12 @@ def carve(
     messages: list[str] = []
     if outside > OUTSIDE_VOLUME_EPS_MM3:
         lo, hi = _bounds(solid)
-        message = (
+        message = said(lambda: (  # the part report (a file) keeps it in mm
             f"part sticks out of the block: {say_volume(outside, '.4g')} "
             f"({100.0 * outside / part_volume:.3g} % of the part's {say_volume(part_volume, '.6g')}) lies "
             f"outside and is not carved; part bounding box {_fmt_box(lo, hi)}, block "
             f"{_fmt_box(np.zeros(3), np.array(size))}; move the part or use a larger block"
-        )
+        ))
         messages.append(message)
         warnings.warn(message, WoodcamWarning, stacklevel=2)
     message = units_hint(*_bounds(solid), size, units_fix)

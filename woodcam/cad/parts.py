@@ -43,7 +43,7 @@ import numpy as np
 
 from .._checks import check_number
 from ..errors import WoodcamError, require
-from ..units import say_length, say_volume
+from ..units import said, say_length, say_volume
 from ..tolerances import (
     MAX_PART_TRIANGLES,
     TESSELLATION_ANGLE_DEG,
@@ -730,13 +730,13 @@ class _Tessellation:
             ang_rad = min(math.radians(_MAX_BUDGET_ANGLE_DEG), ang_rad * math.sqrt(ratio))
         self.used_tol_mm, self.used_ang_rad = tol_mm, ang_rad
         if tries > 1:
-            self.notes.append(
+            self.notes.append(said(lambda: (  # the part report (a file) keeps it in mm
                 f"{origin}: {first[0]} triangles at {say_length(first[1], '.3g')} / {first[2]:.3g} deg "
                 f"exceeded max_triangles={self.max_triangles}; re-meshed to {count} triangles at "
                 f"{say_length(tol_mm, '.3g')} / {math.degrees(ang_rad):.3g} deg"
                 + ("" if count <= self.max_triangles else
                    " (still over: the angular tolerance stops at "
-                   f"{_MAX_BUDGET_ANGLE_DEG:g} deg; raise --max-triangles or simplify the part)"))
+                   f"{_MAX_BUDGET_ANGLE_DEG:g} deg; raise --max-triangles or simplify the part)"))))
         self.triangles += count
         return meshes
 
