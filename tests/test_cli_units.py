@@ -322,3 +322,18 @@ def test_an_inch_bake_files_its_report_in_mm_and_prints_its_warnings_in_inches(t
     assert f"  warning: {filed}" in text and " in^3" not in text and "] in" not in text, text
     assert json.loads((tmp_path / "b_report.json").read_text())["warnings"][0].startswith(filed)
     assert read_glb_metadata(out)["report"]["warnings"][0].startswith(filed)
+
+
+def test_an_inch_place_error_quotes_the_op_as_typed(tmp_path, capsys):
+    """Sweep h13 item 2: a --place error of an inch run quoted the op converted to mm beside a
+    margin in inches ("--place 'fit:38.1': a margin of 1.5 in"); it quotes the op as typed."""
+    import trimesh
+
+    part = tmp_path / "p.stl"
+    trimesh.creation.box((10.0, 10.0, 10.0)).apply_translation((20, 20, 20)).export(part)
+    for op, said in (("fit:1.5", "--place 'fit:1.5': a margin of 1.5 in leaves no room in the 2x2x2 in block"),
+                     ("translate:1e5,0,0", "--place 'translate:1e5,0,0': a move must stay within 100 m")):
+        assert main(["bake", str(part), "--units", "inch", "--block", "builtin:knotty:2x2x2",
+                     "--place", "center", "--place", op, "--out", str(tmp_path / "b.glb")]) == 1
+        err = capsys.readouterr().err
+        assert said in err and "38.1" not in err and "2540000" not in err, err

@@ -123,6 +123,7 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
                  obj_up: str = "y", max_triangles: int | None = None,
                  max_atlas_px: int = 4096, place: list[str] | tuple = (),
+                 place_as_typed: list[str] | None = None,
                  timeout_s: float | None = None, stages: StageBar | None = None,
                  units_fix: str = "add 'scale:25.4' and 'center' to place (in metres: 'scale:1000')"
                  ) -> PartPreview:
@@ -131,7 +132,8 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
 
     ``place`` lists placement operations applied to the loaded part before carving
     (:mod:`woodcam.cad.place`, e.g. ``["rotate:x:90", "center", "drop"]``); the resulting
-    4 x 4 matrix is recorded in the GLB metadata as ``placement``. A ``.py`` source is trusted
+    4 x 4 matrix is recorded in the GLB metadata as ``placement``; ``place_as_typed``: the same
+    operations as the user typed them, for its errors (the CLI's, in ``--units``). A ``.py`` source is trusted
     code run with your rights; ``timeout_s`` bounds its loading. ``units_fix``: how to scale a part
     in inches, in its warning (:func:`woodcam.cad.carve.units_hint`; the CLI names ``--place``).
 
@@ -157,7 +159,7 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
         if place:
             from .cad.place import place_part
 
-            part, matrix = place_part(part, list(place), stock.size_mm)
+            part, matrix = place_part(part, list(place), stock.size_mm, as_typed=place_as_typed)
             metadata = {"placement": {"ops": list(place), "matrix": matrix.tolist()}}
         with result.stage("carve"):
             carved = carve(part, stock.size_mm, units_fix=units_fix)

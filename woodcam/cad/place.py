@@ -73,14 +73,18 @@ def _number(text: str, op: str) -> float:
     return value
 
 
-def placement_matrix(ops: Sequence[str], bounds_mm, size_mm) -> np.ndarray:
+def placement_matrix(ops: Sequence[str], bounds_mm, size_mm, *,
+                     as_typed: Sequence[str] | None = None) -> np.ndarray:
     """The 4 x 4 transform (block frame, mm) of the operations ``ops`` applied in order to a
-    part whose bounding box is ``bounds_mm (2, 3)``, in a block of ``size_mm (3,)``."""
+    part whose bounding box is ``bounds_mm (2, 3)``, in a block of ``size_mm (3,)``.
+    ``as_typed``: the same operations as the user typed them, quoted in the errors (the CLI's
+    ``--place`` in ``--units``: "--place 'fit:1.5'", not its 'fit:38.1' mm); default ``ops``."""
     lo, hi = (np.asarray(b, dtype=float) for b in np.asarray(bounds_mm, dtype=float))
     size = np.asarray(size_mm, dtype=float)
     total = np.eye(4)
-    for op in ops:
-        name, _, arg = str(op).strip().partition(":")
+    for mm_op, op in zip(ops, ops if as_typed is None else as_typed, strict=True):
+        # ``op`` (as typed) is what the errors quote; ``arg`` (mm) is what is computed
+        name, _, arg = str(mm_op).strip().partition(":")
         name = name.lower()
         centre = (lo + hi) / 2
         if name == "rotate":
@@ -95,7 +99,7 @@ def placement_matrix(ops: Sequence[str], bounds_mm, size_mm) -> np.ndarray:
                 raise WoodcamError(f"--place {op!r}: expected translate:X,Y,Z in mm; use {_HELP}")
             move = [_number(p, op) for p in parts]
             if max(abs(v) for v in move) > 1e5:  # 1e300 made the part's volume 0 ("inside-out?")
-                raise WoodcamError(f"--place {op!r}: a move must stay within 100 m (1e5 mm); got {arg}")
+                raise WoodcamError(f"--place {op!r}: a move must stay within 100 m (1e5 mm)")
             step = _translate(move)
         elif name == "scale":
             factor = _number(arg, op)
@@ -123,8 +127,9 @@ def placement_matrix(ops: Sequence[str], bounds_mm, size_mm) -> np.ndarray:
     return total
 
 
-def place_part(solid, ops: Sequence[str], size_mm):
-    """Apply the placement ``ops`` to ``solid`` (a ``manifold3d.Manifold``, block frame, mm).
+def place_part(solid, ops: Sequence[str], size_mm, *, as_typed: Sequence[str] | None = None):
+    """Apply the placement ``ops`` to ``solid`` (a ``manifold3d.Manifold``, block frame, mm);
+    ``as_typed``: the ops as typed, for the errors (:func:`placement_matrix`).
 
     Returns
     -------
@@ -134,5 +139,5 @@ def place_part(solid, ops: Sequence[str], size_mm):
     if not ops:
         return solid, np.eye(4)
     bounds = np.asarray(solid.bounding_box(), dtype=float).reshape(2, 3)
-    matrix = placement_matrix(ops, bounds, size_mm)
+    matrix = placement_matrix(ops, bounds, size_mm, as_typed=as_typed)
     return solid.transform(matrix[:3, :].tolist()), matrix

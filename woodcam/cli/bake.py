@@ -9,7 +9,7 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
 from .options import (BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
-                      add_workers_option, allow_negative_values, apply_workers, camera_of,
+                      add_workers_option, allow_negative_values, apply_workers, as_typed, camera_of,
                       remove_stale_outputs, stock_options, vector_type, write_screenshot)
 
 
@@ -126,7 +126,7 @@ def run_bake(args: argparse.Namespace) -> int:
                            tolerance_mm=args.tolerance, timeout_s=args.timeout, obj=not args.no_obj,
                            screenshot=False, progress=True, obj_units=args.obj_units, obj_up=args.obj_up,
                            max_triangles=args.max_triangles, max_atlas_px=args.max_atlas,
-                           place=args.place, stages=bar,
+                           place=args.place, place_as_typed=as_typed(args, "place"), stages=bar,
                            units_fix="add --place scale:25.4 --place center (in metres: scale:1000)")
         if shot:
             with bar.stage("render"):
@@ -169,7 +169,7 @@ def run_bake(args: argparse.Namespace) -> int:
 def run_preview(args: argparse.Namespace) -> int:
     from ..pipeline import screenshot_path
     from ..view import preview
-    from .options import as_typed, recorded_block_size, stock_of_glb
+    from .options import recorded_block_size, stock_of_glb
 
     if not args.mesh.is_file():  # the viewer named its parameter: "mesh_or_path: no file at ..."
         raise WoodcamError(f"preview: no file at {str(args.mesh)!r}; pass a .glb or .obj written by "
