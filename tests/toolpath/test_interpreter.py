@@ -602,3 +602,27 @@ def test_an_o_word_after_a_comment_is_refused_at_the_first_such_line():
     assert len(prog) == 2 and prog.warnings == [  # the body's two moves: G1 X3 skipped as LinuxCNC does
         "line 6: 'o1 else' follows a comment, so it is no O word (LinuxCNC reads one only as the first "
         "word of its line) and was skipped as text; move the comment after the o1"]
+
+
+def test_a_structure_error_is_not_blamed_on_an_unrelated_commented_o_word():
+    """Sweep h13 item 3: any O-word structure error was refused at the first O word after a
+    comment, related or not: an unclosed o7 while was blamed on a commented o5 call. The
+    commented one takes the blame only when the O words match with it read as one, or when it
+    carries the label of the line at fault."""
+    _refused(_BODY + "o1 if [1]\no1 endif\n(c) o5 call\no7 while [1 LT 2]\nG1 X1\nM2\n", 7,
+             "o7 while", r"^G-code line 7: 'o7 while': o7 while is never closed; close it$")
+    _refused(_BODY + "o7 while [1 LT 2]\n(c) o5 call\nG1 X1\n(c) o7 endwhile\nM2\n", 5,
+             "o5 call", r"without it the O words do not match \(line 4: o7 while is never closed\)")
+    # no match either way (o8 if is never closed), but the label at fault is a commented one's
+    _refused(_BODY + "o8 if [1]\n(c) o5 call\no7 while [1 LT 2]\nG1 X1\n(c) o7 endwhile\nM2\n", 8,
+             "o7 endwhile", r"without it the O words do not match \(line 6: o7 while is never closed\)")
+
+
+def test_a_call_is_told_of_a_commented_sub_only():
+    """Sweep h13 item 4: every kind of commented O word was recorded as why a call finds no
+    sub: a call of an undefined o5 after a commented 'o5 call' said "the o5 on line 5 follows
+    a comment ... there is no o5 sub"; only a commented 'o5 sub' explains that."""
+    _refused(_BODY + "o2 if [0]\n(c) o5 call\no2 endif\no5 call\nM2\n", 7, "o5 call",
+             r"^G-code line 7: 'o5 call': subroutine o5 is not defined in this file")
+    _refused(_BODY + "o5 call\nM2\n(c) o5 sub\nG1 X2\n(c) o5 endsub\n", 4, "o5 call",
+             r"the o5 on line 6 follows a comment: .* no o5 sub")

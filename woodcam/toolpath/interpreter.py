@@ -732,8 +732,9 @@ class Interpreter:
         grbl = self.dialect == "grbl"
         grbl_percent: list[int] = []  # grbl: the '%' lines dropped
         self._late_olabels: dict[str, int] = {}  # O label after a comment -> its first line
-        self._late_owords: dict[str, int] = {}  # o-word label after a comment -> its first line
-        late_first: int | None = None  # index of the first line with an o-word after a comment
+        self._late_subs: dict[str, int] = {}  # 'oN sub' label after a comment -> its first line
+        # line index -> (key, label, rest) of each o-word after a comment, as it would be read
+        late_owords: dict[int, tuple[str, str, str]] = {}
         for no, raw in enumerate(self.src, start=1):
             self.line_no = no
             text, msg = split_comments(raw, no)
@@ -788,14 +789,15 @@ class Interpreter:
                     # when it runs, skipped as text inside a definition or a branch not taken
                     # (so it opens or closes nothing): refused when reached
                     ln.late = ln.late or f"o{label} {key}"
-                    self._late_owords.setdefault(label, no)
+                    if key == "sub":  # why a call finds no oN sub (a commented call defines none)
+                        self._late_subs.setdefault(label, no)
                     # said for a program that runs (one that reaches the line is refused): the
                     # line was skipped, an else or endwhile with the lines it was to frame
                     self.warnings.append((no, f"'o{label} {key}' follows a comment, so it is "
                                           "no O word (LinuxCNC reads one only as the first word "
                                           "of its line) and was skipped as text; move the "
                                           f"comment after the o{label}"))
-                    late_first = len(lines) if late_first is None else late_first
+                    late_owords[len(lines)] = (key, label, rest)
                 else:
                     ln.okey, ln.olabel, ln.oexpr = key, label, rest
             elif m is None and "o" in body and _ONUMBER.match(body):
@@ -834,14 +836,37 @@ class Interpreter:
         try:
             self._match_structure(lines)
         except GcodeError as e:
-            if late_first is None:
+            blame = self._late_blame(lines, late_owords, e)
+            if blame is None:
                 raise
             # the o-word after a comment is why the labels do not match (LinuxCNC does not
-            # read it as one): refused there, the first such line
-            first = lines[late_first]
+            # read it as one): refused there
+            first = lines[blame]
             rule, fix = _late_rule(first.late)
             raise GcodeError(first.no, first.late, f"{rule}; without it the O words do not "
                              f"match (line {e.line}: {e.rule})", fix) from None
+
+    def _late_blame(self, lines: list[_Line], late_owords: dict[int, tuple[str, str, str]],
+                    e: GcodeError) -> int | None:
+        """The index in ``lines`` of the o-word after a comment (``late_owords``: index -> its
+        key, label, rest) to refuse for the O-word structure error ``e``, or None when none
+        explains it: the first of them when the structure matches with them read as O words,
+        else the first with the label of the line ``e`` names (an unrelated commented o5 call
+        took the blame for an unclosed o7 while)."""
+        if not late_owords:
+            return None
+        trial = []
+        for i, ln in enumerate(lines):  # copies: matching marks a do's while as "dowhile"
+            t = _Line(ln.text, ln.no, ln.msg)
+            t.okey, t.olabel, t.oexpr = late_owords.get(i, (ln.okey, ln.olabel, ln.oexpr))
+            t.okey = "while" if t.okey == "dowhile" else t.okey
+            trial.append(t)
+        try:
+            self._match_structure(trial)  # the program is refused either way
+        except GcodeError:
+            label = next((ln.olabel for ln in lines if ln.no == e.line and ln.olabel is not None), None)
+            return next((i for i, (_, lab, _) in late_owords.items() if lab == label), None)
+        return min(late_owords)
 
     def _match_structure(self, lines):
         """Match the O-word structure of the normalised ``lines`` (the parts of _prepare)."""
@@ -977,9 +1002,9 @@ class Interpreter:
                 if len(frames) >= MAX_CALL_DEPTH:
                     raise self.err(f"o{ln.olabel} call", f"more than {MAX_CALL_DEPTH} nested "
                                    "subroutine calls (LinuxCNC's limit)", "reduce the nesting")
-                if ln.olabel not in self.subs and ln.olabel in self._late_owords:
+                if ln.olabel not in self.subs and ln.olabel in self._late_subs:
                     raise self.err(f"o{ln.olabel} call", f"the o{ln.olabel} on line "
-                                   f"{self._late_owords[ln.olabel]} follows a comment: LinuxCNC "
+                                   f"{self._late_subs[ln.olabel]} follows a comment: LinuxCNC "
                                    "reads an O word only as the first word of its line, so "
                                    f"there is no o{ln.olabel} sub ('EOF seeking o-word')",
                                    f"move the comment after the o{ln.olabel}")
