@@ -315,6 +315,17 @@ def test_too_large_atlas_lowers_density_with_a_warning():
     np.testing.assert_allclose(mm_per_texel, 1 / result.texels_per_mm, rtol=0.05)
 
 
+def test_the_atlas_warning_of_an_inch_run_speaks_inches():
+    """Sweep h13 item 5: the warning said "(texel 0.0254 mm) so the 5200 mm^2 surface" under
+    --units inch (woodcam.units.message_units)."""
+    from woodcam.units import message_units
+
+    with message_units("inch"), pytest.warns(UserWarning, match="texels_per_mm lowered") as caught:
+        bake(_box(), SmoothWood(), texels_per_mm=100.0, max_atlas_px=256)
+    text = str(caught[0].message)
+    assert " mm" not in text and " in) so the 8.06 in^2 surface fits" in text, text
+
+
 @pytest.mark.parametrize("efficiency", [1.0, 20.0], ids=["mild", "far"])
 def test_atlas_overshoot_is_rescaled_or_re_unwrapped(monkeypatch, efficiency):
     """Fool the size prediction so xatlas' atlas overshoots max_atlas_px (here by 18 % and 35 %:

@@ -337,3 +337,20 @@ def test_an_inch_place_error_quotes_the_op_as_typed(tmp_path, capsys):
                      "--place", "center", "--place", op, "--out", str(tmp_path / "b.glb")]) == 1
         err = capsys.readouterr().err
         assert said in err and "38.1" not in err and "2540000" not in err, err
+
+
+def test_areas_and_limits_in_library_messages_speak_the_message_units():
+    """Sweep h13 items 5, 6, 12: under --units inch the bake's atlas warning still said "(texel
+    X mm) ... N mm^2 surface", parquetry's cut check "N mm^2 of it is narrower" and the G-code
+    zero-radius arc error "radius 3.937e-05 in is below LinuxCNC's 0.00127 mm"."""
+    from woodcam.toolpath import GcodeError, read_gcode
+    from woodcam.units import message_units, say_area
+
+    assert say_area(645.16) == "645.2 mm^2" and say_area(1234.4, ".0f") == "1234 mm^2"
+    arc = "G21 G0 X0 Y0\nG2 X0.002 Y0 I0.001 J0 F100\nM2\n"
+    with pytest.raises(GcodeError, match=r"radius 0.001 mm is below LinuxCNC's 0.00127 mm;"):
+        read_gcode(arc)
+    with message_units("inch"):
+        assert say_area(645.16) == "1 in^2" and say_area(1234.4, ".0f") == "1.913 in^2"
+        with pytest.raises(GcodeError, match=r"radius 3.937e-05 in is below LinuxCNC's 5e-05 in;"):
+            read_gcode(arc)

@@ -55,7 +55,7 @@ import numpy as np
 from woodcam._types import Mesh, WoodLike
 from woodcam.errors import WoodcamError, WoodcamWarning
 from woodcam.limits import MAX_BLOCK_SIZE_MM
-from woodcam.units import say_length
+from woodcam.units import say_area, say_length
 from woodcam.tolerances import (
     ATLAS_PADDING_PX,
     MAX_BATCH_POINTS,
@@ -536,8 +536,8 @@ def _unwrap(mesh, tpm: float, max_px: int, padding: int, messages: list[str],
         tpm *= scale
     if tpm < asked:
         messages.append(
-            f"bake: texels_per_mm lowered from {asked:g} to {tpm:.4g} (texel {1 / tpm:.3g} mm) "
-            f"so the {area:.0f} mm^2 surface fits a {width}x{height} atlas within "
+            f"bake: texels_per_mm lowered from {asked:g} to {tpm:.4g} (texel {say_length(1 / tpm, '.3g')}) "
+            f"so the {say_area(area, '.0f')} surface fits a {width}x{height} atlas within "
             f"max_atlas_px={max_px}; raise max_atlas_px (--max-atlas) for finer texels"
         )
     return (vmap.astype(np.int64), faces.astype(np.int64), xy, width, height, float(tpm),

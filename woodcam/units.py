@@ -5,7 +5,7 @@ Everything below the command line takes and returns millimetres (``docs/conventi
 summaries with :func:`fmt_length` / :func:`fmt_volume`. Files written stay in millimetres.
 
 Messages (warnings, errors, G-code simulation issues) are written deep in the library, far from
-``--units``: they write their lengths with :func:`say_length` / :func:`say_volume`, which follow
+``--units``: they write their lengths with :func:`say_length` / :func:`say_area` / :func:`say_volume`, which follow
 the message units the command line sets for its run (:func:`message_units`); mm for a library
 caller, so their text there is what it always was. A message that also goes into a file (the
 part report) is made with :func:`said`, which keeps its text in mm for :func:`filed`.
@@ -96,6 +96,16 @@ def say_volume(mm3: float, spec: str = ".4g") -> str:
     mm^3 with the message's ``spec``, else :func:`fmt_volume`'s inches^3."""
     units = _message_units
     return f"{mm3:{spec}} mm^3" if units == "mm" else fmt_volume(mm3, units)
+
+
+def say_area(mm2: float, spec: str = ".4g") -> str:
+    """An area given in mm^2, for a message, in the message units (:func:`message_units`): in
+    mm^2 with the message's ``spec``, in inches^2 with four significant digits:
+    ``say_area(645.16) == "645.2 mm^2"``, under ``--units inch`` ``"1 in^2"``."""
+    units = _message_units
+    if units == "mm":
+        return f"{mm2:{spec}} mm^2"
+    return f"{mm2 / MM_PER_UNIT[units] ** 2:.4g} {_SYMBOL[units]}^2"
 
 
 class _Said(str):

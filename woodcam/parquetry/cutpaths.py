@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import WoodcamError
 from ..tolerances import PARQUETRY_CORNER_SIN, PARQUETRY_CURVATURE_SLACK, PARQUETRY_WIDTH_TOL_MM
-from ..units import say_length
+from ..units import say_area, say_length
 
 #: Bézier segments are flattened at this many points for areas, offsets and raster checks;
 #: a 2 mm seam segment bends < 0.2 mm, so 8 points keep chords within ~3 um of the curve.
@@ -229,7 +229,7 @@ def check_piece(segs: list, min_piece_mm: float, tool_radius_mm: float) -> list[
         thin_parts = [g for g in getattr(thin, "geoms", [thin])
                       if g.area > 1e-4 and not g.buffer(-PARQUETRY_WIDTH_TOL_MM).is_empty]
         if thin_parts:
-            problems.append(f"{sum(g.area for g in thin_parts):.2f} mm^2 of it is narrower than "
+            problems.append(f"{say_area(sum(g.area for g in thin_parts), '.2f')} of it is narrower than "
                             f"min_piece_mm = {min_piece_mm:g} mm away from its corners")
     # Concave bends: orientation sign s = +1 for a counter-clockwise outline in a y-up sense.
     worst = np.inf

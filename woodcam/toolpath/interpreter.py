@@ -1778,7 +1778,7 @@ class Interpreter:
             r1 = math.hypot(e1 - c1, e2 - c2)
             if min(r0, r1) < _ARC_MIN_RADIUS_MM:
                 raise self.err(code, f"zero-radius arc: radius {say_length(min(r0, r1), '.4g')} is below "
-                               f"LinuxCNC's {_ARC_MIN_RADIUS_MM:g} mm (0.00005 inch)",
+                               f"LinuxCNC's {say_length(_ARC_MIN_RADIUS_MM, 'g')}",
                                "replace the arc by a G1 to its end point")
             err = abs(r1 - r0)
             if err > 100 * tol or (err > tol
