@@ -354,3 +354,15 @@ def test_areas_and_limits_in_library_messages_speak_the_message_units():
         assert say_area(645.16) == "1 in^2" and say_area(1234.4, ".0f") == "1.913 in^2"
         with pytest.raises(GcodeError, match=r"radius 3.937e-05 in is below LinuxCNC's 5e-05 in;"):
             read_gcode(arc)
+
+
+def test_say_length_takes_a_0d_array():
+    """Sweep h13 item 9: say_length(np.array(2.0)) raised TypeError (iteration over a 0-d array)."""
+    import numpy as np
+
+    from woodcam.units import message_units, say_length
+
+    assert say_length(np.array(2.0)) == "2 mm" and say_length(np.float64(2.5), ".2f") == "2.50 mm"
+    assert say_length(np.array([1.0, 2.0])) == "1x2 mm" and say_length(3) == "3 mm"
+    with message_units("inch"):
+        assert say_length(np.array(25.4)) == "1 in"

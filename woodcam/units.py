@@ -19,6 +19,8 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Literal
 
+import numpy as np
+
 Units = Literal["mm", "inch"]
 #: Millimetres per unit (the inch is exactly 25.4 mm since 1959).
 MM_PER_UNIT: dict[str, float] = {"mm": 1.0, "inch": 25.4}
@@ -83,7 +85,8 @@ def say_length(mm, spec: str = ".3g", sep: str = "x", form: str | None = None) -
     ``say_length((1, 2, 3)) == "1x2x3 mm"``, ``say_length((1, 2), form="[{}, {}]") ==
     "[1, 2] mm"``; under ``--units inch`` ``"0.1811 in"``, ``"0.03937x0.07874x0.1181 in"``."""
     units = _message_units
-    values = [float(v) for v in (mm if hasattr(mm, "__len__") else [mm])]
+    # a 0-d array (np.float64(2) made one by arithmetic on arrays) is one length, not a sequence
+    values = [float(v) for v in np.atleast_1d(np.asarray(mm, dtype=float))]
     if units == "mm":
         texts = [f"{v:{spec}}" for v in values]
     else:
