@@ -278,7 +278,8 @@ def test_library_messages_of_an_inch_run_speak_inches(tmp_path, monkeypatch, cap
     assert main(["place", str(tiny), "--units", "inch", "--block", "builtin:knotty:2x2x2",
                  "--candidates", "4", "--top", "1", "--out", str(tmp_path / "pt")]) == 0
     err = capsys.readouterr().err
-    assert "the part is only 0.03937x0.03937x0.03937 in in the 2x2x2 in block" in err, err
+    # the hint of a part modelled in inches is about the file's own numbers: mm (sweep h13 item 7)
+    assert "the part is only 1x1x1 mm in the 50.8x50.8x50.8 mm block" in err, err
 
     monkeypatch.setattr(woodcam.pipeline, "preview_heightfield",
                         lambda hm, stock, out, **kw: woodcam.pipeline.PartPreview(
@@ -366,3 +367,21 @@ def test_say_length_takes_a_0d_array():
     assert say_length(np.array([1.0, 2.0])) == "1x2 mm" and say_length(3) == "3 mm"
     with message_units("inch"):
         assert say_length(np.array(25.4)) == "1 in"
+
+
+def test_the_units_hint_speaks_the_files_millimetres_under_every_units():
+    """Sweep h13 item 7: the hint of a part modelled in inches said "0.03937x... in in the 2x2x2
+    in block" under --units inch from carve and advise_placement, while woodify said mm: the
+    hint is about the file's own numbers, read as mm whatever --units says, so mm for all."""
+    import trimesh
+
+    from woodcam.cad import carve
+    from woodcam.errors import WoodcamWarning
+    from woodcam.units import message_units
+
+    tiny = trimesh.creation.box((1.0, 2.0, 1.0)).apply_translation((20, 20, 20))
+    for units in ("mm", "inch"):
+        with message_units(units), pytest.warns(WoodcamWarning) as caught:
+            carve(tiny, (50.8, 50.8, 50.8))
+        assert [str(w.message) for w in caught if "only" in str(w.message)][0].startswith(
+            "the part is only 1x2x1 mm in the 50.8x50.8x50.8 mm block: 25.4 times larger"), units

@@ -21,7 +21,7 @@ from .._types import ArrayLike
 from ..errors import WoodcamError, WoodcamWarning
 from ..frames import FOREIGN_GLTF_METRES_BELOW, check_size
 from ..tolerances import OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG
-from ..units import MM_PER_UNIT, said, say_length, say_volume
+from ..units import MM_PER_UNIT, message_units, said, say_length, say_volume
 from .parts import load_part
 
 
@@ -169,7 +169,8 @@ def carve(
 def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX) -> str | None:
     """What to say when a part with bounds ``lo, hi (3,)`` mm would still fit the block
     ``size_mm (3,)`` 25.4 times larger (None otherwise): STL and OBJ carry no units, so a part
-    exported in inches is read 25.4 x too small and carved or placed as a speck.
+    exported in inches is read 25.4 x too small and carved or placed as a speck. Its lengths
+    are in mm under every ``--units``: they are the file's own numbers.
 
     Without a block (``size_mm`` None: ``woodcam woodify`` grows a mesh alone) the part's own
     size decides: under :data:`woodcam.frames.FOREIGN_GLTF_METRES_BELOW` mm along its longest
@@ -180,20 +181,21 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX) -> str |
         command's option, or the library call); the CLI's ``--place`` is no use to
         ``woodcam place`` or a library caller."""
     extent = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
-    if size_mm is None:
-        if not 0 < float(np.max(extent)) < FOREIGN_GLTF_METRES_BELOW:
+    with message_units("mm"):  # about the file's own numbers, read as mm whatever --units says
+        if size_mm is None:
+            if not 0 < float(np.max(extent)) < FOREIGN_GLTF_METRES_BELOW:
+                return None
+            return (f"the part is only {say_length(extent, '.3g')}: part files are read "
+                    f"as millimetres (STL and OBJ carry no units), and nothing that small is carved; "
+                    f"it looks modelled in metres (1000 times larger: "
+                    f"{say_length(extent * 1e3, '.3g')}): {fix}")
+        size = np.asarray(size_mm, dtype=float)
+        if not np.all(np.sort(extent) * MM_PER_UNIT["inch"] <= np.sort(size)):
             return None
-        return (f"the part is only {say_length(extent, '.3g')}: part files are read "
-                f"as millimetres (STL and OBJ carry no units), and nothing that small is carved; "
-                f"it looks modelled in metres (1000 times larger: "
-                f"{say_length(extent * 1e3, '.3g')}): {fix}")
-    size = np.asarray(size_mm, dtype=float)
-    if not np.all(np.sort(extent) * MM_PER_UNIT["inch"] <= np.sort(size)):
-        return None
-    return (f"the part is only {say_length(extent, '.3g')} in the "
-            f"{say_length(size, 'g')} block: 25.4 times larger it would still fit. "
-            "Part files are read as millimetres (STL and OBJ carry no units); if it was modelled "
-            f"in inches {fix}, or export it in mm")
+        return (f"the part is only {say_length(extent, '.3g')} in the "
+                f"{say_length(size, 'g')} block: 25.4 times larger it would still fit. "
+                "Part files are read as millimetres (STL and OBJ carry no units); if it was modelled "
+                f"in inches {fix}, or export it in mm")
 
 
 def _bounds(solid) -> tuple[np.ndarray, np.ndarray]:

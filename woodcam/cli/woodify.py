@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 from ..errors import UsageError, WoodcamError
-from ..units import message_units, say_length
+from ..units import say_length
 from .options import add_max_atlas_option, add_out_option, add_units_option, sizes_type, vector_type
 
 
@@ -137,9 +137,8 @@ def _warn_units(mesh, path: str, what: str = "part") -> None:
     from ..errors import WoodcamWarning
 
     lo, hi = mesh.bounds
-    with message_units("mm"):  # the mesh's own numbers, read as mm whatever --units says
-        hint = units_hint(lo, hi, None, "scale it by 1000 in your CAD program or export it in "
-                          "mm (--units converts only the lengths typed as options, never the mesh)")
+    hint = units_hint(lo, hi, None, "scale it by 1000 in your CAD program or export it in "
+                      "mm (--units converts only the lengths typed as options, never the mesh)")
     if hint:
         warnings.warn(f"{what} {path!r}: {hint}", WoodcamWarning, stacklevel=3)
 
