@@ -385,3 +385,17 @@ def test_the_units_hint_speaks_the_files_millimetres_under_every_units():
             carve(tiny, (50.8, 50.8, 50.8))
         assert [str(w.message) for w in caught if "only" in str(w.message)][0].startswith(
             "the part is only 1x2x1 mm in the 50.8x50.8x50.8 mm block: 25.4 times larger"), units
+
+
+def test_say_length_and_say_volume_take_a_summarys_units():
+    """Sweep h13 item 8: the deviation summary's depths and volumes had their own formatting
+    (fmt_depth, _volume) beside say_length / say_volume; these take ``units=`` now (a summary's
+    unit, not the run's message units) and the summary goes through them, its text unchanged."""
+    from woodcam.toolpath.deviation import fmt_depth
+    from woodcam.units import message_units, say_length, say_volume
+
+    with message_units("inch"):  # an explicit unit wins over the message units
+        assert say_length(0.085, ".3f", units="mm") == "0.085 mm" == fmt_depth(0.085)
+        assert say_volume(0.6, ".1f", units="mm") == "0.6 mm^3"
+    assert say_length(25.4, ".3f", units="inch") == "1 in" == fmt_depth(25.4, "inch")
+    assert say_volume(16387.064, ".0f", units="inch") == "1 in^3"

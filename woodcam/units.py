@@ -27,29 +27,38 @@ MM_PER_UNIT: dict[str, float] = {"mm": 1.0, "inch": 25.4}
 _SYMBOL = {"mm": "mm", "inch": "in"}
 
 
+def _lengths(mm, units: Units, spec: str, sep: str = "x", form: str | None = None) -> str:
+    """Lengths given in mm (one, or a sequence), each written in ``units`` with the format
+    ``spec``, joined by ``sep`` or put in ``form`` (one ``{}`` each), then the unit's symbol: the
+    one writer of every ``fmt_*`` and ``say_*`` of lengths."""
+    k = MM_PER_UNIT[units]
+    # a 0-d array (np.float64(2) made one by arithmetic on arrays) is one length, not a sequence
+    texts = [f"{float(v) / k:{spec}}" for v in np.atleast_1d(np.asarray(mm, dtype=float))]
+    return (form.format(*texts) if form else sep.join(texts)) + f" {_SYMBOL[units]}"
+
+
 def fmt_length(mm: float, units: Units = "mm", digits: int = 3) -> str:
     """A length given in mm, printed in ``units`` with its symbol:
     ``fmt_length(50.8, "inch") == "2 in"``."""
-    return f"{mm / MM_PER_UNIT[units]:.{digits}g} {_SYMBOL[units]}"
+    return _lengths(mm, units, f".{digits}g")
 
 
 def fmt_size(size_mm, units: Units = "mm", digits: int = 4) -> str:
     """A size ``(W, D, H)`` (or any lengths) given in mm, printed ``"WxDxH unit"`` in ``units``:
     ``fmt_size((101.6, 81.28, 50.8), "inch") == "4x3.2x2 in"``, as a block spec's size is typed."""
-    return "x".join(f"{v / MM_PER_UNIT[units]:.{digits}g}" for v in size_mm) + f" {_SYMBOL[units]}"
+    return _lengths(size_mm, units, f".{digits}g")
 
 
 def fmt_point(point_mm, units: Units = "mm", digits: int = 4) -> str:
     """A point given in mm, printed ``"(x, y, z) unit"`` in ``units``:
     ``fmt_point((508, 0, 12.7), "inch") == "(20, 0, 0.5) in"``."""
-    return "(" + ", ".join(f"{v / MM_PER_UNIT[units]:.{digits}g}" for v in point_mm) + f") {_SYMBOL[units]}"
+    return _lengths(point_mm, units, f".{digits}g", form="(" + ", ".join("{}" for _ in point_mm) + ")")
 
 
 def fmt_span(lo_mm: float, hi_mm: float, units: Units = "mm", digits: int = 2) -> str:
     """A range of lengths given in mm, printed ``"lo-hi unit"`` in ``units``:
     ``fmt_span(1, 3) == "1-3 mm"``, ``fmt_span(1, 3, "inch") == "0.039-0.12 in"``."""
-    k = MM_PER_UNIT[units]
-    return f"{lo_mm / k:.{digits}g}-{hi_mm / k:.{digits}g} {_SYMBOL[units]}"
+    return _lengths((lo_mm, hi_mm), units, f".{digits}g", "-")
 
 
 def fmt_volume(mm3: float, units: Units = "mm") -> str:
@@ -77,27 +86,23 @@ def message_units(units: Units | None) -> Iterator[None]:
         _message_units = before
 
 
-def say_length(mm, spec: str = ".3g", sep: str = "x", form: str | None = None) -> str:
+def say_length(mm, spec: str = ".3g", sep: str = "x", form: str | None = None, *,
+               units: Units | None = None) -> str:
     """A length (or several) given in mm, for a message, in the message units
     (:func:`message_units`), one unit symbol after them: in mm with the format ``spec`` the
     message always used, in inches with four significant digits. Several are joined by ``sep``,
     or put in ``form`` (one ``{}`` each): ``say_length(4.6, ".3f") == "4.600 mm"``,
     ``say_length((1, 2, 3)) == "1x2x3 mm"``, ``say_length((1, 2), form="[{}, {}]") ==
-    "[1, 2] mm"``; under ``--units inch`` ``"0.1811 in"``, ``"0.03937x0.07874x0.1181 in"``."""
-    units = _message_units
-    # a 0-d array (np.float64(2) made one by arithmetic on arrays) is one length, not a sequence
-    values = [float(v) for v in np.atleast_1d(np.asarray(mm, dtype=float))]
-    if units == "mm":
-        texts = [f"{v:{spec}}" for v in values]
-    else:
-        texts = [f"{v / MM_PER_UNIT[units]:.4g}" for v in values]
-    return (form.format(*texts) if form else sep.join(texts)) + f" {_SYMBOL[units]}"
+    "[1, 2] mm"``; under ``--units inch`` ``"0.1811 in"``, ``"0.03937x0.07874x0.1181 in"``.
+    ``units`` (a summary's, not a message's) overrides the message units."""
+    units = units or _message_units
+    return _lengths(mm, units, spec if units == "mm" else ".4g", sep, form)
 
 
-def say_volume(mm3: float, spec: str = ".4g") -> str:
-    """A volume given in mm^3, for a message, in the message units (:func:`message_units`): in
-    mm^3 with the message's ``spec``, else :func:`fmt_volume`'s inches^3."""
-    units = _message_units
+def say_volume(mm3: float, spec: str = ".4g", *, units: Units | None = None) -> str:
+    """A volume given in mm^3, for a message, in the message units (:func:`message_units`) or
+    ``units``: in mm^3 with the message's ``spec``, else :func:`fmt_volume`'s inches^3."""
+    units = units or _message_units
     return f"{mm3:{spec}} mm^3" if units == "mm" else fmt_volume(mm3, units)
 
 

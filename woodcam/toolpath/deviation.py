@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import WoodcamError
 from ..tolerances import SIM_CONTACT_TOL_MM
-from ..units import Units, fmt_length, fmt_volume
+from ..units import Units, say_length, say_volume
 
 
 @dataclass
@@ -38,9 +38,10 @@ class Deviation:
         """One line: leftover and overcut volumes with their deepest points and, with
         ``gouges``, the five deepest gouging lines; lengths and volumes in ``units``."""
         worst = ", ".join(f"line {ln} ({fmt_depth(d, units)})" for ln, d in self.gouges[:5])
-        return (f"leftover {_volume(self.leftover_mm3, units, 0)} (max "
+        # the overcut to 0.1 mm^3: a 0.6 mm^3 overcut must not print as 1
+        return (f"leftover {say_volume(self.leftover_mm3, '.0f', units=units)} (max "
                 f"{fmt_depth(max(self.difference_mm.max(), 0), units)}), overcut "
-                f"{_volume(self.overcut_mm3, units, 1)} (max "
+                f"{say_volume(self.overcut_mm3, '.1f', units=units)} (max "
                 f"{fmt_depth(max(-self.difference_mm.min(), 0), units)})"
                 + (f"; gouges at {worst}" + (" ..." if len(self.gouges) > 5 else "")
                    if self.gouges and gouges else ""))
@@ -48,13 +49,7 @@ class Deviation:
 
 def fmt_depth(mm: float, units: Units = "mm") -> str:
     """Depths to the micrometre in mm (``0.085 mm``), four significant digits in inches."""
-    return f"{mm:.3f} mm" if units == "mm" else fmt_length(mm, units, 4)
-
-
-def _volume(mm3: float, units: Units, decimals: int) -> str:
-    """Volumes to ``decimals`` in mm^3 (a 0.6 mm^3 overcut must not print as 1), else
-    :func:`~woodcam.units.fmt_volume`."""
-    return f"{mm3:.{decimals}f} mm^3" if units == "mm" else fmt_volume(mm3, units)
+    return say_length(mm, ".3f", units=units)
 
 
 def deviation(result, part, *, tol_mm: float = SIM_CONTACT_TOL_MM * 100) -> Deviation:
