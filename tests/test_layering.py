@@ -74,10 +74,21 @@ def _imports(path: Path):
                         unit = alias.name in _units_on_disk()
                         yield node.lineno, f"woodcam.{alias.name}" if unit else "woodcam"
                     continue
-            yield node.lineno, target
+            # "from ..toolpath import _surface" imports the module woodcam.toolpath._surface
+            subs = [f"{target}.{a.name}" for a in node.names if _is_module(f"{target}.{a.name}")]
+            yield from ((node.lineno, sub) for sub in subs)
+            if len(subs) < len(node.names):
+                yield node.lineno, target
         elif isinstance(node, ast.Import):
             for alias in node.names:
                 yield node.lineno, alias.name
+
+
+def _is_module(dotted: str) -> bool:
+    """Whether ``dotted`` (``woodcam.x.y``) is a module or package of woodcam on disk."""
+    path = PACKAGE.parent.joinpath(*dotted.split("."))
+    return dotted.startswith("woodcam.") and (path.with_suffix(".py").is_file()
+                                              or (path / "__init__.py").is_file())
 
 
 def _units_on_disk() -> set[str]:
@@ -137,7 +148,8 @@ def test_no_two_public_classes_share_a_name():
 
 
 def _private_imports():
-    """Imports of a unit's private module (``woodcam.<unit>._x``) from another unit."""
+    """Imports of a unit's private module (``woodcam.<unit>._x``, also as ``from
+    ..<unit> import _x``) from another unit."""
     found = []
     for path in sorted(PACKAGE.rglob("*.py")):
         source = _unit(".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts))
