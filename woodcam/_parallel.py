@@ -30,9 +30,12 @@ import os
 import pickle
 import sys
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .errors import WoodcamError
+
+if TYPE_CHECKING:
+    from concurrent.futures import ProcessPoolExecutor
 
 #: The environment variable that caps the cores one fit uses.
 WORKERS_ENV = "WOODCAM_WORKERS"
@@ -143,7 +146,7 @@ def share(tasks: list[Callable[[], Any]], here: Callable[[], Any], workers: int)
         _FORKED.pop("claim", None)
 
 
-def kill_workers(pool) -> None:
+def kill_workers(pool: ProcessPoolExecutor) -> None:
     """Kill the worker processes of ``pool`` (a ``ProcessPoolExecutor``) and drop its queued
     jobs, so that its shutdown does not wait for their work: on a Ctrl-C or an error, whose
     run's results are never used."""

@@ -17,7 +17,7 @@ import numpy as np
 
 
 @numba.njit(inline="always")
-def vertex_x(i, nv, L):
+def vertex_x(i: int, nv: int, L: float) -> float:
     """Coordinate (mm) of vertex ``i`` of ``nv`` along an axis of length ``L``: 0, the
     ``nv - 2`` cell centres, L."""
     if i <= 0:
@@ -28,14 +28,14 @@ def vertex_x(i, nv, L):
 
 
 @numba.njit(inline="always")
-def vertex_z(hm, j, i):
+def vertex_z(hm: np.ndarray, j: int, i: int) -> float:
     """Z (mm) of vertex ``(j, i)``: the nearest cell's height (border vertices copy theirs)."""
     ny, nx = hm.shape
     return hm[min(max(j - 1, 0), ny - 1), min(max(i - 1, 0), nx - 1)]
 
 
 @numba.njit(nogil=True, cache=True)
-def surface_point(hm, W, D, x, y, n):
+def surface_point(hm: np.ndarray, W: float, D: float, x: float, y: float, n: np.ndarray) -> float:
     """Height (mm) of the surface at block-frame ``(x, y)``; its triangle's unit normal goes
     to ``n : (3,)``."""
     ny, nx = hm.shape
@@ -61,7 +61,8 @@ def surface_point(hm, W, D, x, y, n):
 
 
 @numba.njit(nogil=True, cache=True)
-def surface_points(hm, W, D, x, y):
+def surface_points(hm: np.ndarray, W: float, D: float, x: np.ndarray,
+                   y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`surface_point` at ``x, y : (k,)``: ``(z (k,), normals (k, 3))``."""
     z = np.empty(x.shape[0])
     nrm = np.empty((x.shape[0], 3))
@@ -71,7 +72,8 @@ def surface_points(hm, W, D, x, y):
 
 
 @numba.njit(nogil=True, cache=True)
-def top_chart_points(hm, W, D, w, h):
+def top_chart_points(hm: np.ndarray, W: float, D: float, w: int,
+                     h: int) -> tuple[np.ndarray, np.ndarray]:
     """Points and normals ``(w h, 3)`` of the top chart's texels, row by row (row 0 at
     ``Y = D``): texel ``(r, c)`` sits at ``((c + .5) W / w, D - (r + .5) D / h)`` on the
     surface."""
@@ -89,7 +91,7 @@ def top_chart_points(hm, W, D, w, h):
 
 
 @numba.njit(nogil=True, cache=True)
-def quad_faces(covered, nxv, out):
+def quad_faces(covered: np.ndarray, nxv: int, out: np.ndarray) -> int:
     """The two triangles (v00, v01, v11) and (v00, v11, v10) of every quad ``(j, i)`` of the
     vertex grid not ``covered : (nyv - 1, nxv - 1) bool`` by a merged block, as flat vertex-grid
     indices into ``out : (2 k, 3)``, row by row."""
