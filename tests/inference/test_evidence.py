@@ -189,6 +189,7 @@ def test_fit_block_evidence_grid_carries_meta_and_uncertainty(block, tmp_path):
     assert isinstance(grid, GridField)
     assert grid.meta["method"] == "evidence" and grid.meta["chosen"] in grid.meta["scores"]
     assert grid.meta["faces"] == ["front", "top", "left"]
+    assert grid.meta["size_mm"] == [float(v) for v in block.size_mm]  # the box its faces are named in
     # uncertainty grows away from the observed faces: the back-bottom-right corner is unseen
     size = np.asarray(block.size_mm)
     near = grid.uncertainty_years([[1.0, 1.0, size[2] - 1]])
@@ -368,10 +369,11 @@ def test_a_turned_fitted_block_reads_its_uncertainty_where_its_years_are(tmp_pat
     np.testing.assert_allclose(moved.uncertainty_years(p[:, [1, 0, 2]] / 2),
                                grid.uncertainty_years(p[:, [1, 0, 2]] / 2 + (10.0, 5.0, 0.0)), atol=1e-9)
     # the back third of the turned block is the source's right (unseen) third: its rings are
-    # the guess, and the face to photograph is the block's right face (the turned block's back)
+    # the guess, and the face to photograph is the fitted block's right face, the turned block's
+    # back (both named: the third is named in the turned block's frame)
     line = uncertainty_report(turned, p, tsize, "bowl")
     assert line.startswith("the rings in the back third (front-back) of this bowl are uncertain")
-    assert line.endswith("photograph the right face or trace its rings")
+    assert line.endswith("photograph the fitted block's right face (this block's back) or trace its rings")
     # a bake from the turned stock: a box at the front (the source's sure left) is not warned
     stock = Stock("test~z90", tsize, turned, "a fitted block", {})
     box = trimesh.creation.box((8, 8, 8))
@@ -381,3 +383,27 @@ def test_a_turned_fitted_block_reads_its_uncertainty_where_its_years_are(tmp_pat
     box.apply_translation((-18, 26, 0))  # at the back: the source's right, a guess
     res = preview_part(box, stock, tmp_path / "box2.glb", texels_per_mm=1, obj=False, screenshot=False)
     assert [w for w in res.warnings if "rings" in w and "uncertain" in w], res.warnings
+
+
+def test_a_resized_stock_is_told_the_fitted_blocks_nearest_face():
+    """A stock cut out of a fitted block (``--stock WxDxH --stock-origin``, Wood.shifted) was
+    told the face nearest its uncertain third in its own box: its right third, 10..50 mm into a
+    100 mm block, is nearer the fitted block's LEFT face (the one to photograph), not its right."""
+    from woodcam.appearance.wood import Wood
+    from woodcam.stock import Stock, resize_stock
+
+    size = (100.0, 30.0, 20.0)
+    nodes = (21, 7, 5)
+    x = np.stack(np.meshgrid(*[np.linspace(0, s, k) for s, k in zip(size, nodes)], indexing="ij"), -1)
+    grid = GridField(x[..., 0] / 3.0, (0.0, 0.0, 0.0), (5.0, 5.0, 5.0),
+                     layers={"uncertainty": 0.02 * x[..., 0]},  # a guess further right
+                     meta={"faces": ["front", "back", "top", "bottom"], "size_mm": list(size)})
+    small = resize_stock(Stock("test", size, Wood(grid), "a fitted block", {}), (40.0, 30.0, 20.0),
+                         (10.0, 0.0, 0.0))
+    p = np.random.default_rng(0).uniform(0, 1, (3000, 3)) * small.size_mm
+    line = uncertainty_report(small.wood, p, small.size_mm, "bowl")
+    assert line.startswith("the rings in the right third (left-right) of this bowl are uncertain")
+    assert line.endswith("photograph the fitted block's left face or trace its rings")
+    # the fitted block itself: its own right third, nearest its right face, as before
+    whole = uncertainty_report(grid, np.random.default_rng(0).uniform(0, 1, (3000, 3)) * size, size, "bowl")
+    assert whole.endswith("photograph the right face or trace its rings")

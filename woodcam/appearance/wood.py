@@ -100,6 +100,17 @@ class Wood:
         out._turn = (rot, shift - o)  # source = rot^T (p + o - shift)
         return out
 
+    @property
+    def in_source_frame(self) -> bool:
+        """Whether this block is the source block itself (the one the field was fitted or grown
+        in), not turned or cut out of it by :meth:`turned` or :meth:`shifted`."""
+        return self._turn is None
+
+    def to_source(self, points_mm: ArrayLike) -> np.ndarray:
+        """``(n, 3)`` mm: this block's ``points_mm (n, 3)`` in the source block's frame (where
+        the field, its photos and its faces are), as :meth:`years` reads them."""
+        return self._to_source(check_points(points_mm))[0]
+
     def _to_source(self, points, normals=None):
         if self._turn is None:
             return points, normals

@@ -848,7 +848,9 @@ def _bake_evidence(ev: EvidenceFit, size_mm, faces, strands, workers: int):
         if any(s.dead for s in strands):  # dead knots: their flag and bark ring for the colour map
             layers["dead"] = np.asarray(feats["dead"]).reshape(shape)
             layers["outline"] = np.asarray(feats["outline"]).reshape(shape)
-    meta = {"method": "evidence", "chosen": ev.chosen, "contradicted": ev.contradicted,
+    # size_mm: the fitted block's box, whose faces uncertainty_report names for a stock cut from it
+    meta = {"method": "evidence", "size_mm": [float(v) for v in size_mm], "chosen": ev.chosen,
+            "contradicted": ev.contradicted,
             "unverified": ev.unverified, "accepted": list(ev.accepted), "message": ev.message,
             "faces": [FACES[i] for i in faces],
             "scores": {n: {k: round(float(v), 2) for k, v in sc.items()} for n, sc in ev.scores.items()}}
@@ -876,9 +878,10 @@ def uncertainty_report(wood, points_mm, size_mm, what: str = "part", *,
     or a fitted field in its own block's frame.
     points_mm : (n, 3) points of the part (block frame), e.g. its mesh vertices. The part is
     cut in thirds along each block axis; the third with the lowest mean :func:`confidence` is
-    named, with the unobserved face nearest to it to photograph (``field.meta["faces"]``, named
-    as the fitted block's: a turned block's face is its source's); when every face was
-    observed, the nearest face whose rings to check instead.
+    named, with the unobserved face nearest to it to photograph (``field.meta["faces"]``): the
+    fitted block's face nearest it in the fitted block's box (``field.meta["size_mm"]``), named
+    "the fitted block's right face (this block's back)" for a turned or resized block; when
+    every face was observed, the nearest face whose rings to check instead.
     """
     wood = _as_wood(wood)
     if not wood.has_uncertainty or not len(points_mm):
@@ -897,19 +900,31 @@ def uncertainty_report(wood, points_mm, size_mm, what: str = "part", *,
             if sel.mean() >= 0.05 and (worst is None or conf[sel].mean() < worst[0]):
                 worst = (float(conf[sel].mean()), ax, t, p[sel].mean(axis=0))
     c, ax, t, centre = worst
-    seen = set((getattr(wood.field, "meta", {}) or {}).get("faces", []))
-    # this block's faces as the fitted block's photos name them (they differ once turned)
-    named = {f: wood.source_face(f) for f in FACES}
-    unseen = [f for f in FACES if named[f] not in seen]
+    meta = getattr(wood.field, "meta", {}) or {}
+    seen = set(meta.get("faces", []))
+    # The photos are of the fitted block: the face nearest the uncertain third is measured in its
+    # frame and box (a stock cut out of it has its faces elsewhere: its right third may lie
+    # nearer the fitted block's left face). A fit from before its size was recorded: this
+    # block's box, its faces named as the fitted block's.
+    if "size_mm" in meta:
+        src = wood.to_source(centre[None])
+        dist = {f: distance_to_faces_mm(src, meta["size_mm"], [FACES.index(f)])[0] for f in FACES}
+    else:
+        dist = {wood.source_face(f): distance_to_faces_mm(centre[None], size, [FACES.index(f)])[0]
+                for f in FACES}
+    unseen = [f for f in FACES if f not in seen]
     # With every face photographed there is no face left to ask for: the hypotheses disagree
     # there, so the advice is to check (or trace) the rings found on the nearest face instead.
-    face = named[min(unseen or FACES,
-                     key=lambda f: distance_to_faces_mm(centre[None], size, [FACES.index(f)])[0])]
+    face = min(unseen or FACES, key=dist.__getitem__)
+    if not wood.in_source_frame:  # the photos' name, and this block's where a turn renamed it
+        mine = next(f for f in FACES if wood.source_face(f) == face)
+        face = f"fitted block's {face}" + (f" face (this block's {mine})" if mine != face else "")
     place = "middle" if t == 1 else _THIRDS[ax][t]
     axis_word = ("left-right", "front-back", "bottom-top")[ax]
     # a face outside the fit may be missing or photographed with no rings found: ask for both
-    advice = (f"photograph the {face} face or trace its rings" if unseen else
-              f"every face was used: check the rings found on the {face} face "
+    face_word = face if face.endswith(")") else f"{face} face"
+    advice = (f"photograph the {face_word} or trace its rings" if unseen else
+              f"every face was used: check the rings found on the {face_word} "
               "(woodcam rings show) or trace more of them")
     return (f"the rings in the {place} third ({axis_word}) of this {what} are uncertain "
             f"(confidence {c:.2f}, whole {what} {conf.mean():.2f}): {advice}")
