@@ -263,6 +263,10 @@ def test_a_broken_quilted_member_is_refused(tmp_path):
             ring_probability(photo, models_dir=folder)
         msg = str(exc.value)
         assert str(folder) in msg and "--member quilted" in msg and "rings_quilted.pt" in msg, (case, msg)
+        assert len(msg.splitlines()) == 1, (case, msg)  # the README's one line, not torch's 66
+    with pytest.raises(WoodcamError, match=r"another net than the spec \(tensors \d+ of another shape; "
+                                           r"first 'e1\.0\.weight' is \(4, 1, 3, 3\), the spec's net has \(8, 1, 3, 3\)\)"):
+        ring_probability(photo, models_dir=cases["shape"])
     with pytest.raises(WoodcamError, match="not a quilted one"):
         ring_probability(photo, models_dir=cases["style"])
 
