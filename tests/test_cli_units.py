@@ -24,8 +24,9 @@ PAIRS = {
     "preview": (["x.glb", "--block", "builtin:knotty:2x2x2", "--cut-origin", "1,-0.5,0.25"],
                 ["x.glb", "--block", "builtin:knotty:50.8x50.8x50.8", "--cut-origin",
                  "25.4,-12.7,6.35"]),
-    "review": (["x.glb", "--block", "builtin:rift:2x2x1", "--out", "r.html"],
-               ["x.glb", "--block", "builtin:rift:50.8x50.8x25.4", "--out", "r.html"]),
+    "review": (["x.glb", "--block", "builtin:rift:2x2x1~z90[1x1x0.5@0.5,0,0.25]", "--out", "r.html"],
+               ["x.glb", "--block", "builtin:rift:50.8x50.8x25.4~z90[25.4x25.4x12.7@12.7,0,6.35]",
+                "--out", "r.html"]),  # a resize in a spec (what gcode --stock records) in units too
     "woodify": (["p.stl", "--years", "5", "--out", "d", "--growth", "0.5", "--block-size",
                  "4x3x2", "--block-centre=-1,0,0.5", "--crack-region", "0,0,1,0.25"],
                 ["p.stl", "--years", "5", "--out", "d", "--growth", "12.7", "--block-size",

@@ -335,6 +335,47 @@ def test_a_resized_stock_is_its_parents_wood_from_its_origin():
     np.testing.assert_allclose(same.wood.color(p, n), parent.wood.color(p, n), atol=1e-9)
 
 
+@pytest.mark.parametrize("base", ["builtin:knotty", "builtin:knotty~z90", "builtin:flat-sawn:60x50x30~x-90"])
+def test_every_spec_woodcam_writes_reopens_as_the_same_wood(base, tmp_path):
+    """A resized stock's spec (``gcode --stock 40x30x20 --stock-origin 5,5,5`` writes
+    'builtin:knotty[40x30x20@5,5,5]' into its GLB) was refused by open_stock, so 'woodcam
+    preview' of that GLB failed ('unknown built-in block'; a turned one: "turn '~z90[...]'").
+    It reopens as the same block: size, years, knots, grain and colours at the same points, and
+    a resize of the reopened stock chains."""
+    from woodcam._specs import absolute_spec, spec_path, split_spec
+    from woodcam.stock import resize_stock, spec_digest
+
+    small = resize_stock(open_stock(base), (40.0, 30.0, 20.0), (5.0, 5.0, 5.0))
+    again = open_stock(small.spec)
+    assert again.spec == small.spec and again.size_mm == small.size_mm
+    p = np.random.default_rng(3).uniform(0, 1, (500, 3)) * small.size_mm
+    n = np.tile([0.0, 0.6, 0.8], (len(p), 1))
+    np.testing.assert_allclose(again.wood.color(p, n), small.wood.color(p, n), atol=1e-9)
+    got, want = again.wood.features(p), small.wood.features(p)
+    for key in ("years", "knot", "grain"):
+        np.testing.assert_allclose(got[key], want[key], atol=1e-9, err_msg=key)
+    twice = resize_stock(again, (10.0, 10.0, 10.0), (1.0, 2.0, 3.0))
+    assert open_stock(twice.spec).wood.years(p / 4).tolist() == twice.wood.years(p / 4).tolist()
+    assert split_spec(twice.spec)[0] == base.partition("~")[0]
+    # a block folder's resized spec still names the folder (path, digest, absolute form)
+    folder = tmp_path / "blk"
+    folder.mkdir()
+    (folder / "block.json").write_text("{}")
+    spec = f"{folder}~z90[40x30x20@5,5,5]"
+    assert spec_path(spec) == folder and spec_digest(spec) == spec_digest(str(folder))
+    assert absolute_spec(spec) == f"{folder.resolve()}~z90[40x30x20@5,5,5]"
+
+
+@pytest.mark.parametrize("spec, message", [
+    ("builtin:knotty[40x30]", "the size must be WxDxH in mm"),
+    ("builtin:knotty[40x30x20@1,2]", r"a resize must be \[WxDxH\] or \[WxDxH@X,Y,Z\]"),
+    ("builtin:knotty[40x30x20@a,1,2]", r"got \[40x30x20@a,1,2\]"),
+])
+def test_a_bad_resize_in_a_spec_is_named(spec, message):
+    with pytest.raises(WoodcamError, match=message):
+        open_stock(spec)
+
+
 def test_turns_in_a_spec_turn_the_block_by_the_right_hand_rule_and_undo():
     """'~z90' turns the block a quarter about +Z (X onto Y): the turned block's point (x, y, z)
     is the block's (y, D - x, z); '~z90~z-90' is the block itself, '~z90~z90' is '~z180'."""

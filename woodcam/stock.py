@@ -22,7 +22,11 @@ A block spec is a string the CLI and GLB metadata carry:
 
 Any spec may end in turns of the block under the part, ``~AXIS90`` (a multiple of 90 degrees
 about the block axis ``x``, ``y`` or ``z``; chainable, e.g. ``builtin:flat-sawn~z90`` runs the
-grain along Y): the block's size axes swap accordingly and the wood turns with it.
+grain along Y): the block's size axes swap accordingly and the wood turns with it. It may also
+end in resizes, ``[WxDxH]`` or ``[WxDxH@X,Y,Z]``: a ``W x D x H`` mm block cut from the block
+before it with its corner at ``X, Y, Z`` mm of that block's frame (:func:`resize_stock`, what
+``woodcam gcode --stock --stock-origin`` records in its GLB, so ``woodcam preview`` reopens
+it). Turns and resizes apply in the order written.
 
 Fitted fields and neural colour volumes are cached under ``$WOODCAM_CACHE_DIR`` or the user
 cache folder (``$XDG_CACHE_HOME/woodcam``, ``~/.cache/woodcam``), keyed by the block's content:
@@ -38,7 +42,7 @@ from typing import Literal
 
 import numpy as np
 
-from ._specs import spec_path
+from ._specs import spec_path, split_spec
 from .appearance import ColorMapAppearance, NeuralAppearance, Wood
 from .errors import WoodcamError, WoodcamWarning
 from .fields.builtin import BUILTIN_NAMES, builtin_block
@@ -119,7 +123,7 @@ def open_stock(spec: str, *, species: str | None = None,
     """
     if appearance not in ("colormap", "neural"):
         raise WoodcamError(f"appearance must be one of ['colormap', 'neural']; got {appearance!r}")
-    base, turns = _split_turns(spec)
+    base, ops = _split_ops(spec)
     # built-in, log and woodify blocks have no photos: their colour map is the constructor's
     # (a folder's photos are known once it is read: _real_block_stock checks again)
     _check_appearance_params(appearance, appearance_params,
@@ -137,12 +141,18 @@ def open_stock(spec: str, *, species: str | None = None,
     stock.meta["appearance_params"] = {k: (list(v) if isinstance(v, tuple) else v)
                                        for k, v in used.items()
                                        if isinstance(v, (int, float, str, tuple, list))}
-    if not turns:
+    if not ops:
         return stock
-    wood, size = stock.wood, stock.size_mm
-    for axis, quarter_turns in turns:
-        wood, size = wood.turned(axis, quarter_turns, size)
-    return Stock(spec, size, wood, stock.description, {**stock.meta, "turns": turns})
+    turns = []
+    for op in ops:  # in the order written: a resize of a turned block is cut in the turned frame
+        if op[0] == "resize":
+            stock = resize_stock(stock, op[1], op[2])
+        else:
+            wood, size = stock.wood.turned(op[1], op[2], stock.size_mm)
+            turns.append(op[1:])
+            stock = Stock(stock.spec, size, wood, stock.description, {**stock.meta, "turns": list(turns)})
+    stock.spec = spec  # as given (resize_stock writes its numbers with :g)
+    return stock
 
 
 def _check_appearance_params(appearance: str, params: dict, *, photos: bool = True,
@@ -194,7 +204,7 @@ def spec_digest(spec: str) -> str:
     from . import __version__
     from ._cache import digest
 
-    base = str(spec).partition("~")[0]
+    base = split_spec(spec)[0]
     path = spec_path(base)
     if path is not None and path.is_dir():
         files = sorted(p for p in path.rglob("*") if p.is_file() and not p.name.startswith("."))
@@ -204,11 +214,16 @@ def spec_digest(spec: str) -> str:
     return digest(base, __version__)
 
 
-def _split_turns(spec: str) -> tuple[str, list[tuple[str, int]]]:
-    """``"SPEC~z90~x-90"`` -> ``("SPEC", [("z", 1), ("x", -1)])`` (see module docstring)."""
-    base, *parts = str(spec).split("~")
-    turns = []
-    for part in parts:
+def _split_ops(spec: str) -> tuple[str, list[tuple]]:
+    """``"SPEC~z90~x-90[40x30x20@5,5,5]"`` -> ``("SPEC", [("turn", "z", 1), ("turn", "x", -1),
+    ("resize", (40, 30, 20), (5, 5, 5))])`` (see module docstring)."""
+    base, texts = split_spec(spec)
+    ops: list[tuple] = []
+    for text in texts:
+        if text.startswith("["):
+            ops.append(("resize", *_parse_resize(text[1:-1], spec)))
+            continue
+        part = text[1:]
         axis, deg = part[:1].lower(), part[1:]
         try:
             quarter, rest = divmod(float(deg), 90.0)
@@ -218,8 +233,23 @@ def _split_turns(spec: str) -> tuple[str, list[tuple[str, int]]]:
             raise WoodcamError(
                 f"block spec {spec!r}: turn '~{part}' must be ~AXIS then a multiple of 90 degrees "
                 "(AXIS x, y or z), e.g. 'builtin:flat-sawn~z90'")
-        turns.append((axis, int(quarter)))
-    return base, turns
+        ops.append(("turn", axis, int(quarter)))
+    return base, ops
+
+
+def _parse_resize(text: str, spec: str) -> tuple[tuple[float, float, float], tuple[float, ...]]:
+    """A spec's ``WxDxH`` or ``WxDxH@X,Y,Z`` (what :func:`resize_stock` writes) -> ``(size_mm,
+    origin_mm)``, mm."""
+    size_text, at, origin_text = text.partition("@")
+    size = _parse_size(size_text, spec)
+    try:
+        origin = tuple(float(v) for v in origin_text.split(",")) if at else (0.0, 0.0, 0.0)
+    except ValueError:
+        origin = ()
+    if len(origin) != 3 or not np.isfinite(origin).all():
+        raise WoodcamError(f"block spec {spec!r}: a resize must be [WxDxH] or [WxDxH@X,Y,Z] (the corner "
+                           f"in mm of the block before it), got [{text}], e.g. 'builtin:knotty[40x30x20@5,5,5]'")
+    return size, origin
 
 
 def _builtin(rest: str):

@@ -197,7 +197,7 @@ LENGTH_OPTIONS: dict[tuple[str, str], str] = {
 #: Positions of the lengths among a tool spec's numbers (``vbit:ANGLE:D`` -> D only).
 _TOOL_LENGTHS = {"flat": (0,), "ball": (0,), "bull": (0, 1), "vbit": (1,), "snub": (1, 2),
                  "chamfer": (1, 2), "taperball": (0, 1)}
-_SPEC_SIZE = re.compile(r"^((?:builtin|log):[^~]*:)([^:~]+)(~.*)?$")
+_SPEC_SIZE = re.compile(r"^((?:builtin|log):[^~\[]*:)([^:~\[]+)([~\[].*)?$")
 
 
 #: Commands whose printed summary (volumes, suggested --place options) follows --units.
@@ -245,11 +245,19 @@ def _value_to_mm(kind: str, value, k: float):
         return tuple(v * k for v in value)
     if kind == "sizes":
         return _scaled_numbers(str(value).lower(), "x", k)
-    if kind == "spec":
-        m = _SPEC_SIZE.match(str(value))
-        if not m:
-            return value
-        return m.group(1) + _scaled_numbers(m.group(2).lower(), "x", k) + (m.group(3) or "")
+    if kind == "spec":  # its :WxDxH and its resizes [WxDxH@X,Y,Z]; turns stay degrees
+        from .._specs import split_spec
+
+        base, ops = split_spec(str(value))
+        m = _SPEC_SIZE.match(base)
+        if m:
+            base = m.group(1) + _scaled_numbers(m.group(2).lower(), "x", k)
+        for i, op in enumerate(ops):
+            if op.startswith("["):
+                size, at, origin = op[1:-1].partition("@")
+                ops[i] = (f"[{_scaled_numbers(size.lower(), 'x', k)}{at}"
+                          f"{_scaled_numbers(origin, ',', k) if at else ''}]")
+        return base + "".join(ops)
     if kind == "place":
         return [place_op_in(op, k) for op in value]
     if kind == "tools":
