@@ -200,13 +200,10 @@ def test_a_sized_builtin_is_cut_round_the_builtin_blocks_centre():
             np.testing.assert_allclose(got[key], want[key], atol=1e-9, err_msg=f"{name} {key}")
 
 
-def test_a_piece_cut_from_a_block_has_its_colours(shared_data):
-    """A blank cut out of a block is the same wood, colour included: at the same wood point a
-    sized built-in, a turned one, a resized one and a smaller log block through the same knot
-    have the colours of the whole block to 1/255 (the colour map's fibre noise was drawn in the
-    small stock's own frame: up to 70/255 off)."""
-    from woodcam.stock import resize_stock
-
+def _cut_points():
+    """``(p, n, same)``: 3000 points ``p`` of a 40 x 40 x 20 mm piece with unit normals ``n``, and
+    ``same(cut, whole, q, normals=n, what="")`` asserting the piece ``cut`` coloured at ``p`` is
+    ``whole`` coloured at its points ``q`` to 1/255."""
     rng = np.random.default_rng(4)
     p = rng.uniform(0, 1, (3000, 3)) * (40, 40, 20)
     n = rng.normal(size=p.shape)
@@ -215,6 +212,17 @@ def test_a_piece_cut_from_a_block_has_its_colours(shared_data):
     def same(cut, whole, q, normals=n, what=""):
         np.testing.assert_allclose(cut.wood.color(p, n), whole.wood.color(q, normals), atol=1 / 255,
                                    rtol=0, err_msg=what)
+    return p, n, same
+
+
+def test_a_piece_cut_from_a_block_has_its_colours():
+    """A blank cut out of a block is the same wood, colour included: at the same wood point a
+    sized built-in, a turned one and a resized one have the colours of the whole block to 1/255
+    (the colour map's fibre noise was drawn in the small stock's own frame: up to 70/255 off).
+    A log block: test_a_smaller_log_block_through_the_same_knot_has_its_colours (shared data)."""
+    from woodcam.stock import resize_stock
+
+    p, n, same = _cut_points()
 
     for name in ("flat-sawn", "knotty"):
         whole = open_stock(f"builtin:{name}")
@@ -227,10 +235,15 @@ def test_a_piece_cut_from_a_block_has_its_colours(shared_data):
     turned = open_stock("builtin:flat-sawn:40x40x20~z90")
     src = np.column_stack([p[:, 1], 40 - p[:, 0], p[:, 2]]) + (30, 20, 15)
     same(turned, whole, src, np.column_stack([n[:, 1], -n[:, 0], n[:, 2]]), what="turned")
-    # a smaller block through the same knot: its front face is the default block's, centred
-    same(open_stock("log:gran1@52:40x40x20"), open_stock("log:gran1@52"), p + (30, 0, 15), what="log")
     with pytest.raises(WoodcamError, match="got 'texture_frame'"):  # the spec's to set, not a parameter
         open_stock("builtin:flat-sawn", texture_frame=None)
+
+
+def test_a_smaller_log_block_through_the_same_knot_has_its_colours(shared_data):
+    """A smaller block through the same knot of the shared gran1 log: its front face is the
+    default block's, centred, and so are its colours (to 1/255)."""
+    p, _, same = _cut_points()
+    same(open_stock("log:gran1@52:40x40x20"), open_stock("log:gran1@52"), p + (30, 0, 15), what="log")
 
 
 def test_blocks_placed_anywhere_in_a_grown_object_have_its_colours(tmp_path):
