@@ -235,8 +235,13 @@ def test_a_piece_cut_from_a_block_has_its_colours():
     turned = open_stock("builtin:flat-sawn:40x40x20~z90")
     src = np.column_stack([p[:, 1], 40 - p[:, 0], p[:, 2]]) + (30, 20, 15)
     same(turned, whole, src, np.column_stack([n[:, 1], -n[:, 0], n[:, 2]]), what="turned")
-    with pytest.raises(WoodcamError, match="got 'texture_frame'"):  # the spec's to set, not a parameter
+    # the spec's to set, not a parameter: said so, not "check the spelling"
+    with pytest.raises(WoodcamError, match="got 'texture_frame'; texture_frame is set by the block spec, "
+                                           "not an appearance parameter: drop it") as exc:
         open_stock("builtin:flat-sawn", texture_frame=None)
+    assert "spelling" not in str(exc.value)
+    with pytest.raises(WoodcamError, match="set by the block spec.*; check the spelling of 'fooo'"):
+        open_stock("builtin:flat-sawn", texture_frame=None, fooo=1)
 
 
 def test_a_smaller_log_block_through_the_same_knot_has_its_colours(shared_data):

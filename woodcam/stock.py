@@ -169,6 +169,9 @@ def _check_appearance_params(appearance: str, params: dict, *, photos: bool = Tr
     from collections.abc import Callable
     import inspect
 
+    # set by the block spec (the wood's frame: a sized, turned or log block's colours are its
+    # parent's), never an appearance parameter of the caller's
+    by_spec = {"texture_frame"}
     targets: list[Callable]
     if appearance == "neural":
         from .appearance.neural import fit_neural_appearance
@@ -179,7 +182,7 @@ def _check_appearance_params(appearance: str, params: dict, *, photos: bool = Tr
     else:
         targets = [ColorMapAppearance]
     taken = {k for t in targets for k, p in inspect.signature(t).parameters.items()
-             if p.kind is not p.VAR_KEYWORD} - {"self", "cls", "species", "block", "field", "texture_frame"}
+             if p.kind is not p.VAR_KEYWORD} - {"self", "cls", "species", "block", "field"} - by_spec
     unknown = sorted(set(params) - taken)
     if unknown:
         without = appearance != "neural" and not photos
@@ -190,7 +193,11 @@ def _check_appearance_params(appearance: str, params: dict, *, photos: bool = Tr
         fixes = [f"{', '.join(photo_only)} fit{'s' if len(photo_only) == 1 else ''} colours to face "
                  f"photos, which {where or 'this stock'} has none of: drop {'it' if len(photo_only) == 1 else 'them'}"
                  ] if photo_only else []
-        misspelt = [k for k in unknown if k not in photo_only]
+        spec_set = [k for k in unknown if k in by_spec]
+        if spec_set:
+            fixes.append(f"{', '.join(spec_set)} is set by the block spec, not an appearance parameter: "
+                         "drop it (a sized, turned or resized spec keeps the parent block's colours)")
+        misspelt = [k for k in unknown if k not in photo_only and k not in by_spec]
         if misspelt:
             fixes.append(f"check the spelling of {', '.join(repr(k) for k in misspelt)}")
         fix = "; ".join(fixes)
