@@ -305,3 +305,25 @@ def test_separation_local_takes_a_trimesh_only(cylinder):
         separation_local(mesh, sig[:-1], ring)
     with pytest.raises(WoodcamError, match=r"vertices must be a 1-D integer array .* values 5..\d+"):
         separation_local(mesh, sig, np.array([5, len(mesh.vertices)]))
+
+
+def test_picture_density_is_the_densest_parts_not_the_mean():
+    """The texels per mm an input's picture is moved into an atlas at (cracks drawn into it) was
+    an area mean, so wherever the input's UVs are denser than the mean the picture was resampled
+    coarser ('no coarser than it was', README). Half a surface at 10 texels/mm and half at 2
+    ask 10 (the mean said sqrt((100 + 4) / 2) = 7.2); a sliver face does not set it."""
+    from woodcam.woodify.bark import picture_density
+
+    # two 10 x 10 mm squares side by side, two triangles each; a 100 x 100 px picture
+    v = np.array([[0, 0, 0], [10, 0, 0], [10, 10, 0], [0, 10, 0], [20, 0, 0], [20, 10, 0]], float)
+    f = np.array([[0, 1, 2], [0, 2, 3], [1, 4, 5], [1, 5, 2]])
+    mesh = trimesh.Trimesh(v, f, process=False)
+    image = np.zeros((100, 100, 3), np.uint8)
+    fine = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)         # 100 px over 10 mm: 10 /mm
+    coarse = fine * 0.2                                                 # 20 px over 10 mm: 2 /mm
+    corners = np.stack([fine[[0, 1, 2]], fine[[0, 2, 3]], coarse[[0, 1, 3]], coarse[[0, 3, 2]]])
+    assert picture_density(mesh, corners, image) == pytest.approx(10.0)
+    # a sliver (next to no area, a whole picture on it) is under the 5 % left out
+    sliver = trimesh.Trimesh(np.vstack([v, [[0, 0, 0], [10, 0, 0], [5, 1e-4, 0]]]),
+                             np.vstack([f, [[6, 7, 8]]]), process=False)
+    assert picture_density(sliver, np.concatenate([corners, fine[None, [0, 1, 2]]]), image) == pytest.approx(10.0)

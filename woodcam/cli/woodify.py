@@ -251,7 +251,8 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
             # it: drawn into the picture at its own scale, a crack was as many mm wide as its
             # texels (2 px of a 256 px picture round a trunk: 1.3 mm) and piled up where the
             # input's UVs squeeze (a lid on one row), showing 2.3x the crack share of the same
-            # cracks on the untextured input. Never coarser than the picture was.
+            # cracks on the untextured input. Never coarser than the picture was (on 95 % of
+            # the surface: picture_density; the atlas limit may still lower it, with a warning).
             from ..bake import bake, rebake_texture
 
             tpm = BARK_TEXELS_PER_VOXEL / h

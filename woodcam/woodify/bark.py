@@ -110,14 +110,30 @@ def textured_mesh(mesh, uv, image):
     return out
 
 
+#: Share of the surface (by area) on which an input's picture moved into an atlas is no
+#: coarser than it was (:func:`picture_density`): the densest rest is left out so that a sliver
+#: face (picture area on next to no surface) does not set the whole atlas's density.
+PICTURE_DENSITY_SHARE = 0.95
+
+
 def picture_density(mesh, corner_uv, image) -> float:
-    """Mean texels per mm ``image (h, w, 3)`` has on ``mesh`` (mm) laid on by ``corner_uv (f, 3,
-    2)``: the square root of the faces' picture area (texels, repeats counted) over their area."""
+    """Texels per mm ``image (h, w, 3)`` has on ``mesh`` (mm) laid on by ``corner_uv (f, 3, 2)``,
+    as its densest part asks: per face the square root of its picture area (texels, repeats
+    counted) over its area, and of those the one :data:`PICTURE_DENSITY_SHARE` of the surface
+    (by area) is at or under. An atlas of this density is no coarser than the picture on that
+    share (an area mean was coarser wherever the input's UVs are denser than average)."""
     h, w = np.shape(image)[:2]
     c = np.asarray(corner_uv, float) * [w, h]
     a, b = c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]
-    texels = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]).sum()
-    return float(np.sqrt(texels / max(float(mesh.area), 1e-12)))
+    texels = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+    area = np.asarray(mesh.area_faces, float)
+    ok = area > 1e-12
+    if not ok.any():
+        return 0.0
+    dens = np.sqrt(texels[ok] / area[ok])
+    order = np.argsort(dens)
+    cum = np.cumsum(area[ok][order])
+    return float(dens[order][np.searchsorted(cum, PICTURE_DENSITY_SHARE * cum[-1])])
 
 
 #: Texels per voxel of the growth grid in the procedural bark's atlas (see
