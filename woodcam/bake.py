@@ -58,6 +58,7 @@ from woodcam.limits import MAX_BLOCK_SIZE_MM
 from woodcam.units import say_area, say_length
 from woodcam.tolerances import (
     ATLAS_PADDING_PX,
+    DEFAULT_MAX_ATLAS_PX,
     MAX_BATCH_POINTS,
     MIN_UV_AREA_TEXELS2,
     RASTER_MARGIN_TEXELS,
@@ -176,7 +177,7 @@ def bake(
     wood: WoodLike,
     *,
     texels_per_mm: float = 10.0,
-    max_atlas_px: int = 4096,
+    max_atlas_px: int = DEFAULT_MAX_ATLAS_PX,
     padding_px: int = ATLAS_PADDING_PX,
     normals: NormalsMode = "face",
     progress: bool = False,
@@ -362,7 +363,7 @@ def bake_charts(mesh, uv_px, size_px, texels, wood, *, texels_per_mm: float,
                       uv_fill=float(coverage.mean()))
 
 
-def rebake_texture(mesh, corner_uv, image, *, texels_per_mm: float, max_atlas_px: int = 4096,
+def rebake_texture(mesh, corner_uv, image, *, texels_per_mm: float, max_atlas_px: int = DEFAULT_MAX_ATLAS_PX,
                    padding_px: int = ATLAS_PADDING_PX) -> BakeResult:
     """Move a picture laid on ``mesh`` by any texture coordinates into an atlas of even texel
     density (:func:`bake`'s unwrap): every face gets ``texels_per_mm`` along the surface, also
@@ -457,7 +458,7 @@ def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals, *,
     if not isinstance(max_atlas_px, (int, np.integer)) or not 64 <= max_atlas_px <= 65_536:
         raise WoodcamError(
             f"bake: max_atlas_px must be an integer in [64, 65536] (the --max-atlas range); got "
-            f"{max_atlas_px!r}; use e.g. 4096"
+            f"{max_atlas_px!r}; use e.g. {DEFAULT_MAX_ATLAS_PX}"
         )
     if not isinstance(padding_px, (int, np.integer)) or padding_px < _MIN_PADDING_PX:
         raise WoodcamError(

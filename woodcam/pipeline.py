@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 
 from ._types import Mesh, PathLike
 from .stock import Stock
+from .tolerances import DEFAULT_MAX_ATLAS_PX
 
 if TYPE_CHECKING:
     import numpy as np
@@ -122,7 +123,7 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
                  tolerance_mm: float | None = None, obj: bool = True,
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
                  obj_up: str = "y", max_triangles: int | None = None,
-                 max_atlas_px: int = 4096, place: list[str] | tuple = (),
+                 max_atlas_px: int = DEFAULT_MAX_ATLAS_PX, place: list[str] | tuple = (),
                  place_as_typed: list[str] | None = None,
                  timeout_s: float | None = None, stages: StageBar | None = None,
                  units_fix: str = "add 'scale:25.4' and 'center' to place (in metres: 'scale:1000')"
@@ -179,7 +180,7 @@ def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: 
                  screenshot: bool = True, progress: bool = False,
                  result: PartPreview | None = None, metadata: dict | None = None,
                  obj_units: str = "m", obj_up: str = "y",
-                 max_atlas_px: int = 4096, part_report: bool = False) -> PartPreview:
+                 max_atlas_px: int = DEFAULT_MAX_ATLAS_PX, part_report: bool = False) -> PartPreview:
     """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files: the GLB
     in metres, Y up (glTF's convention); the OBJ in ``obj_units`` with ``obj_up`` up."""
     from .bake import bake
@@ -199,7 +200,7 @@ def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: 
 def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: float = 10.0,
                         flat_tol_mm: float = 0.01, obj: bool = True, screenshot: bool = False,
                         metadata: dict | None = None, obj_units: str = "m",
-                        obj_up: str = "y", max_atlas_px: int = 4096) -> PartPreview:
+                        obj_up: str = "y", max_atlas_px: int = DEFAULT_MAX_ATLAS_PX) -> PartPreview:
     """:func:`preview_mesh` for a simulated stock ``heightmap : (ny, nx)`` (block-frame Z, mm,
     over the stock's XY): meshed and baked by its own planar charts
     (:func:`woodcam.bake.bake_heightfield`), no generic unwrap. The result keeps the atlas and
@@ -238,7 +239,7 @@ def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: floa
 
 
 def bake_heightfield(heightmap, size_mm, wood, *, texels_per_mm: float = 10.0,
-                     flat_tol_mm: float = 1e-9, max_atlas_px: int = 4096):
+                     flat_tol_mm: float = 1e-9, max_atlas_px: int = DEFAULT_MAX_ATLAS_PX):
     """Mesh and bake a height-field stock (:mod:`woodcam.toolpath.simulate`) without a
     generic unwrap: a :class:`woodcam.bake.BakeResult`.
 

@@ -48,6 +48,11 @@ ON_FACE_TOL_MM = 1e-4
 #: filtering and mip levels up to 2^3 never reach unpainted texels.
 ATLAS_PADDING_PX = 8
 
+#: Default largest side of a baked atlas, texels (``max_atlas_px``, ``--max-atlas``): what
+#: every GPU takes. The one home of the default: the bake functions, the preview pipeline and
+#: the CLI option read it.
+DEFAULT_MAX_ATLAS_PX = 4096
+
 #: Maximum points evaluated in one batch by fields and appearances; bounds peak memory at
 #: roughly 100 floats per point -> ~0.2 GB per batch.
 MAX_BATCH_POINTS = 1 << 18

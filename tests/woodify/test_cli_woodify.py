@@ -410,6 +410,13 @@ def test_max_atlas_bounds_the_bark_atlas_and_is_named_as_typed(tmp_path, capsys)
                  "--cracks", "none", "--max-atlas", "256", "--out", str(tmp_path / "b")]) == 0
     (msg,) = [line for line in capsys.readouterr().err.splitlines() if "max-atlas" in line]
     assert "--max-atlas 256 has no effect" in msg
+    # given as the default's value it is given all the same (4096 was taken for "not given"),
+    # and not given it says nothing
+    for extra, said in ((["--max-atlas", "4096"], 1), ([], 0)):
+        assert main(["woodify", str(tmp_path / "ball.glb"), "--years", "3", "--resolution", "24",
+                     "--cracks", "none", *extra, "--out", str(tmp_path / "b")]) == 0
+        err = [line for line in capsys.readouterr().err.splitlines() if "max-atlas" in line]
+        assert len(err) == said and all("--max-atlas 4096 has no effect" in e for e in err), (extra, err)
 
 
 def test_a_mesh_saved_in_metres_is_named_as_such(tmp_path, capsys):

@@ -505,11 +505,15 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                        "_view.png; no display needed)")
 
 
-def add_max_atlas_option(p: argparse.ArgumentParser) -> None:
-    """``--max-atlas PX`` (the library's ``max_atlas_px``): every command that bakes an atlas."""
-    p.add_argument("--max-atlas", type=int, default=4096, metavar="PX",
-                   help="largest texture side in texels (default 4096, what every GPU takes); "
-                   "a surface needing more gets a lower texel density, and a warning says so")
+def add_max_atlas_option(p: argparse.ArgumentParser, *, given_only: bool = False) -> None:
+    """``--max-atlas PX`` (the library's ``max_atlas_px``): every command that bakes an atlas.
+    ``given_only``: its value is None unless typed (a command that bakes an atlas only for some
+    inputs warns when it was given for nothing), the library default otherwise."""
+    from ..tolerances import DEFAULT_MAX_ATLAS_PX
+
+    p.add_argument("--max-atlas", type=int, default=None if given_only else DEFAULT_MAX_ATLAS_PX, metavar="PX",
+                   help=f"largest texture side in texels (default {DEFAULT_MAX_ATLAS_PX}, what every GPU "
+                   "takes); a surface needing more gets a lower texel density, and a warning says so")
 
 
 def add_knot_options(p: argparse.ArgumentParser) -> None:

@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 from ..errors import UsageError, WoodcamError
+from ..tolerances import DEFAULT_MAX_ATLAS_PX
 from ..units import say_length
 from .options import add_max_atlas_option, add_out_option, add_units_option, sizes_type, vector_type
 
@@ -79,7 +80,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--relief", type=float, default=0.3,
                    help="stress left next to a new crack, in [0, 1] (0 removes all; default 0.3)")
     p.add_argument("--seed", type=int, default=0, help="random seed of the bark picture and random cracks (default 0)")
-    add_max_atlas_option(p)
+    add_max_atlas_option(p, given_only=True)  # None unless typed: a kept picture warns
     p.set_defaults(func=run)
     return p
 
@@ -175,9 +176,11 @@ def _atomic(path: Path, write) -> Path:
 def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=None,
                   block_centre_mm=None, cracks="stress", crack_region=None, crack_years=5,
                   crack_render="material", crack_threshold=None, relief=0.3, seed=0,
-                  max_atlas_px=4096, atomic=_atomic, stage=None):
+                  max_atlas_px=None, atomic=_atomic, stage=None):
     """Write the products of a :class:`~woodcam.woodify.Woodification` into ``out`` (module
-    docstring); returns (files written, summary dict). ``stage(name)``: a context manager round
+    docstring); returns (files written, summary dict). ``max_atlas_px``: the bark atlas's
+    largest side, None for :data:`~woodcam.tolerances.DEFAULT_MAX_ATLAS_PX` (a value given where
+    no atlas is baked warns). ``stage(name)``: a context manager round
     each of "surface and cracks", "bark and surfaces" and "ring sections" (a
     :meth:`woodcam._progress.StageBar.stage`; default none)."""
     from contextlib import nullcontext
@@ -256,18 +259,19 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
             from ..bake import bake, rebake_texture
 
             tpm = BARK_TEXELS_PER_VOXEL / h
+            atlas_px = DEFAULT_MAX_ATLAS_PX if max_atlas_px is None else max_atlas_px
             if procedural:
                 up = res.field.stem_axis
                 c = res.mesh.centroid
                 d = np.asarray(res.mesh.vertices) - c
                 girth = 2 * np.pi * max(float(np.linalg.norm(d - np.outer(d @ up, up), axis=1).mean()), 1e-3)
                 baked = bake(mesh, SolidBark(up, c, girth, seed), texels_per_mm=tpm,
-                             max_atlas_px=max_atlas_px)
+                             max_atlas_px=atlas_px)
             else:
                 corners = corner_uv(uv, mesh.faces)
                 baked = rebake_texture(mesh, corners, image,
                                        texels_per_mm=max(tpm, picture_density(mesh, corners, image)),
-                                       max_atlas_px=max_atlas_px)
+                                       max_atlas_px=atlas_px)
             bark = baked.mesh
             if painted:
                 atlas = np.asarray(bark.visual.material.baseColorTexture)
@@ -279,7 +283,7 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
                 bark.visual.material.baseColorTexture = Image.fromarray(atlas)
         else:
             # the input's own picture and coordinates stay as they were given
-            if max_atlas_px != 4096:
+            if max_atlas_px is not None:  # given (even as the default's 4096) for nothing
                 import warnings
 
                 from ..errors import WoodcamWarning
