@@ -475,3 +475,12 @@ def test_a_bar_is_drawn_while_the_growth_runs(tmp_path, monkeypatch):
     assert main(["woodify", str(tmp_path / "ball.stl"), "--years", "3", "--resolution", "16",
                  "--cracks", "none", "--out", str(tmp_path / "o")]) == 0
     assert "woodify: grow" in seen[0] and "1/5" in seen[0]
+
+
+def test_seed_help_names_what_it_seeds(capsys):
+    """--seed seeds the procedural bark (SolidBark) and random cracks; its help said 'the bark
+    picture', which an input's own picture is (and --seed never changes)."""
+    with pytest.raises(SystemExit):
+        main(["woodify", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "random seed of the procedural bark and random cracks" in text and "bark picture" not in text

@@ -79,7 +79,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                    "first simulated year)")
     p.add_argument("--relief", type=float, default=0.3,
                    help="stress left next to a new crack, in [0, 1] (0 removes all; default 0.3)")
-    p.add_argument("--seed", type=int, default=0, help="random seed of the bark picture and random cracks (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="random seed of the procedural bark and random cracks (default 0)")
     add_max_atlas_option(p, given_only=True)  # None unless typed: a kept picture warns
     p.set_defaults(func=run)
     return p
