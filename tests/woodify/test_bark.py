@@ -327,3 +327,23 @@ def test_picture_density_is_the_densest_parts_not_the_mean():
     sliver = trimesh.Trimesh(np.vstack([v, [[0, 0, 0], [10, 0, 0], [5, 1e-4, 0]]]),
                              np.vstack([f, [[6, 7, 8]]]), process=False)
     assert picture_density(sliver, np.concatenate([corners, fine[None, [0, 1, 2]]]), image) == pytest.approx(10.0)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"period_mm": 0.0}, r"SolidBark: period_mm must be a finite number > 0; got 0.0"),
+    ({"period_mm": float("nan")}, r"SolidBark: period_mm must be a finite number > 0"),
+    ({"axis": (0.0, 0.0, 0.0)}, r"SolidBark: axis must be a non-zero direction"),
+    ({"axis": (0.0, 1.0)}, r"SolidBark: axis must be three finite numbers"),
+    ({"centre_mm": (0.0, float("inf"), 0.0)}, r"SolidBark: centre_mm must be three finite numbers"),
+    ({"seed": 1.5}, r"SolidBark: seed must be an integer"),
+])
+def test_solid_bark_refuses_what_would_colour_nan(kwargs, message):
+    """SolidBark checked nothing: a period of 0 coloured every point NaN, a zero axis gave a
+    NaN frame. Each is refused naming the argument, the rule and the value."""
+    from woodcam.woodify.bark import SolidBark
+
+    good = {"axis": (0.0, 0.0, 2.0), "centre_mm": (1.0, 2.0, 3.0), "period_mm": 50.0, "seed": 0}
+    rgb = SolidBark(**good).color(np.random.default_rng(0).uniform(-40, 40, (200, 3)))
+    assert np.isfinite(rgb).all() and rgb.min() >= 0 and rgb.max() <= 1
+    with pytest.raises(WoodcamError, match=message):
+        SolidBark(**{**good, **kwargs})

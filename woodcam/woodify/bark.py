@@ -17,6 +17,8 @@ from typing import Literal
 import numpy as np
 from scipy import ndimage
 
+from .._checks import check_number, check_vector
+
 CrackRender = Literal["groove", "material"]
 CRACK_RENDERS: tuple[str, ...] = ("groove", "material")
 
@@ -48,17 +50,24 @@ class SolidBark:
     """
 
     #: Voxels of the periodic noise across the stem (two axes) and along it: the plates are
-    #: 1/160 of the period wide and 1/24 long (Gaussian sigma), the fine grain finer.
+    #: 1/160 of the period wide and 1/24 long (Gaussian sigma); the fine grain is smoothed by
+    #: less than a voxel, so it is as fine as the voxels: 1/160 of the period across, 1/64 along.
     CELLS = (160, 160, 64)
 
     def __init__(self, axis, centre_mm, period_mm: float, seed: int = 0) -> None:
-        up = np.asarray(axis, float) / np.linalg.norm(axis)
+        """axis : (3,) stem direction, any length > 0; centre_mm : (3,) a point on the stem, mm;
+        period_mm : the texture's period, mm > 0 (e.g. the stem's girth); seed : int."""
+        up = check_vector(axis, "SolidBark: axis", unit=True, fix="give the stem's direction, e.g. (0, 0, 1)")
+        centre = check_vector(centre_mm, "SolidBark: centre_mm", fix="give a point on the stem in mm")
+        period = check_number(period_mm, "SolidBark: period_mm", lo=0.0, lo_open=True,
+                              fix="give the bark's repeat in mm, e.g. the stem's girth")
+        seed = check_number(seed, "SolidBark: seed", integer=True, fix="e.g. 0")
         ref = np.array([1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
         e1 = ref - up * (ref @ up)
         e1 /= np.linalg.norm(e1)
         self._frame = np.stack([e1, np.cross(up, e1), up])    # rows: across, across, along
-        self._centre = np.asarray(centre_mm, float)
-        self._period = float(period_mm)
+        self._centre = centre
+        self._period = period
         rng = np.random.default_rng(seed)
         n, _, m = self.CELLS
         plates = ndimage.gaussian_filter(rng.standard_normal(self.CELLS), (n / 160, n / 160, m / 24),
