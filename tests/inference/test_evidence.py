@@ -407,3 +407,26 @@ def test_a_resized_stock_is_told_the_fitted_blocks_nearest_face():
     # the fitted block itself: its own right third, nearest its right face, as before
     whole = uncertainty_report(grid, np.random.default_rng(0).uniform(0, 1, (3000, 3)) * size, size, "bowl")
     assert whole.endswith("photograph the right face or trace its rings")
+
+
+def test_a_field_with_an_uncertainty_layer_but_no_reader_has_none():
+    """Wood.has_uncertainty tested the layer alone (evaluate's copy also wanted a callable
+    uncertainty_years): a field with an 'uncertainty' layer and no reader was said to carry
+    one, and Wood.uncertainty_years raised AttributeError. One test now, for both."""
+    from woodcam.appearance.wood import Wood
+    from woodcam.fields.base import has_uncertainty
+
+    class Layered:
+        layers = {"uncertainty": np.zeros((2, 2, 2))}
+
+        def __call__(self, p):
+            return np.asarray(p, float)[:, 0]
+
+    field = Layered()
+    wood = Wood(field)
+    assert not has_uncertainty(field) and not wood.has_uncertainty
+    np.testing.assert_array_equal(wood.uncertainty_years([[1.0, 2.0, 3.0]]), [0.0])
+    assert uncertainty_report(wood, [[1.0, 2.0, 3.0]], (4.0, 4.0, 4.0)) is None
+    grid = GridField(np.zeros((2, 2, 2)), (0.0, 0.0, 0.0), (1.0, 1.0, 1.0),
+                     layers={"uncertainty": np.ones((2, 2, 2))})
+    assert has_uncertainty(grid) and Wood(grid).has_uncertainty

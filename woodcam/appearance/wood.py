@@ -10,7 +10,7 @@ import numpy as np
 from .._checks import check_number, check_vector
 from .._types import AppearanceLike, ArrayLike, GrowthFieldLike, WoodLike
 from ..errors import WoodcamError
-from ..fields.base import arf, check_points, evaluate, grain_direction
+from ..fields.base import arf, check_points, evaluate, grain_direction, has_uncertainty
 from ..frames import FACE_NORMAL, FACES, check_face, check_size
 from ..tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS
 from .colormap import ColorMapAppearance
@@ -151,8 +151,9 @@ class Wood:
     @property
     def has_uncertainty(self) -> bool:
         """Whether the growth field is a fit that says where its rings are a guess (an
-        ``uncertainty`` layer, :func:`woodcam.inference.evidence.bake_evidence`)."""
-        return "uncertainty" in (getattr(self.field, "layers", None) or {})
+        ``uncertainty`` layer, :func:`woodcam.inference.evidence.bake_evidence`, read by its
+        ``uncertainty_years``): :func:`woodcam.fields.base.has_uncertainty`."""
+        return has_uncertainty(self.field)
 
     def uncertainty_years(self, points_mm: ArrayLike) -> np.ndarray:
         """Years of uncertainty ``(n,)`` of a fitted field at ``points_mm : (n, 3)`` (block frame,

@@ -78,6 +78,14 @@ _FORK_MIN_POINTS = 1 << 16
 _FORK_ALIGN = 1 << 14
 
 
+def has_uncertainty(field) -> bool:
+    """Whether ``field`` is a fit that says where its rings are a guess: an ``uncertainty``
+    layer (:func:`woodcam.inference.evidence.bake_evidence`) and ``uncertainty_years(points_mm
+    (n, 3)) -> (n,)`` to read it. The one test of it (Wood.has_uncertainty, the fit reports)."""
+    layers = getattr(field, "layers", None)
+    return bool(layers) and "uncertainty" in layers and callable(getattr(field, "uncertainty_years", None))
+
+
 def arf(years: ArrayLike) -> np.ndarray:
     """Annual-ring field from growth time: ``(years mod 1)^2`` (eq. 6 of seed 000).
 

@@ -24,7 +24,7 @@ import numpy as np
 from .._atomic import write_figure, write_text
 from .._types import ArrayLike, GrowthFieldLike, PathLike
 from ..errors import WoodcamError, require
-from ..fields.base import evaluate
+from ..fields.base import evaluate, has_uncertainty
 from ..frames import check_size
 from ..tolerances import EVAL_PIXEL_MM, EVAL_THRESHOLDS_MM
 from ..fields.rings import ring_lines as _ring_lines
@@ -159,7 +159,7 @@ def score_plane(true_field, fitted_field, sample: PlaneSample, step_mm: float | 
     )
     if keep_lines:
         s.lines = {"true": (tp, ty), "fit": (pp, py)}
-    if _has_uncertainty(fitted_field):
+    if has_uncertainty(fitted_field):
         from .evidence import confidence
 
         s.confidence = confidence(fitted_field.uncertainty_years(_plane_points(sample, pp)))
@@ -168,12 +168,6 @@ def score_plane(true_field, fitted_field, sample: PlaneSample, step_mm: float | 
             img[sample.inside] = confidence(fitted_field.uncertainty_years(sample.points_mm[sample.inside]))
             s.confidence_img, s.pixel_mm = img, sample.pixel_mm
     return s
-
-
-def _has_uncertainty(field) -> bool:
-    """True when ``field`` carries a per-point uncertainty (an evidence fit's baked grid)."""
-    layers = getattr(field, "layers", None)
-    return bool(layers) and "uncertainty" in layers and callable(getattr(field, "uncertainty_years", None))
 
 
 def _plane_points(sample: PlaneSample, plane_mm: np.ndarray) -> np.ndarray:
