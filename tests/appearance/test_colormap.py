@@ -619,3 +619,23 @@ def test_h11_bakes_its_knot_dark_and_ringed_and_each_face_at_its_photos_colour(s
         assert abs(lb[core].mean() - lp[core].mean()) < 0.06, (f, lb[core].mean(), lp[core].mean())
         contrast = ring_scale(lb)[core].std() / ring_scale(lp)[core].std()
         assert 0.75 < contrast < 1.5, (f, contrast)
+
+
+def test_a_texture_frame_is_checked_once_and_fibres_map_like_points():
+    """The colour map and the built-in photos each mapped the wood point and fibre into the
+    texture frame and each checked it (two wordings): LogFrame.direction_to_log (the inverse of
+    direction_to_block) and fields.base.check_texture_frame, one message for every caller."""
+    from woodcam.synth import synth_block
+
+    frame = LogFrame((3.0, -2.0, 1.0), (0.3, 0.2, 1.0), (1.0, 0.5, 0.0))
+    d = np.random.default_rng(0).normal(size=(50, 3))
+    np.testing.assert_allclose(frame.direction_to_block(frame.direction_to_log(d)), d, atol=1e-12)
+    np.testing.assert_allclose(frame.direction_to_log(d), frame.to_log(d) - frame.to_log(np.zeros((1, 3))),
+                               atol=1e-12)
+    messages = set()
+    for make in (lambda: ColorMapAppearance(texture_frame="frame"),
+                 lambda: synth_block(lambda p: np.zeros(len(p)), (10, 10, 10), texture_frame="frame")):
+        with pytest.raises(WoodcamError, match="texture_frame must be a LogFrame") as exc:
+            make()
+        messages.add(str(exc.value))
+    assert len(messages) == 1, messages

@@ -25,7 +25,7 @@ import numpy as np
 
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
-from ..fields.base import LogFrame, arf, check_points, grain_direction
+from ..fields.base import LogFrame, arf, check_points, check_texture_frame, grain_direction
 from ..frames import FACE_AXIS, face_pixel_points
 from .knots import KnotShading
 from .noise import TABLE, noise_at
@@ -257,9 +257,7 @@ class ColorMapAppearance:
     def __post_init__(self, knot_darkening_alive=None, knot_darkening_dead=None,
                       dead_outline_rgb=None):
         object.__setattr__(self, "species", get_species(self.species))
-        if self.texture_frame is not None and not isinstance(self.texture_frame, LogFrame):
-            raise WoodcamError(f"texture_frame must be a LogFrame (the frame the texture is drawn in, "
-                               f"placed in the block frame) or None; got {type(self.texture_frame).__name__}")
+        check_texture_frame(self.texture_frame)
         changes = {k: v for k, v in (("alive_darkening", knot_darkening_alive),
                                      ("dead_darkening", knot_darkening_dead),
                                      ("outline_rgb", dead_outline_rgb)) if v is not None}
@@ -345,8 +343,7 @@ class ColorMapAppearance:
         # was cut from (the fibre noise of a sized built-in was its own frame's: other colours)
         frame = self.texture_frame
         q, gq = (p32, grain) if frame is None else (
-            frame.to_log(p).astype(np.float32),
-            np.ascontiguousarray(np.einsum("ij,kj->ik", grain, frame.rotation), np.float32))
+            frame.to_log(p).astype(np.float32), np.ascontiguousarray(frame.direction_to_log(grain), np.float32))
         _shade_kernel(arf(years).astype(np.float32), grain, p32, q, gq,
                       normals if blend else np.zeros((1, 3), np.float32),
                       knot, dead, outline, params, colours, np.nan_to_num(luts).astype(np.float32),

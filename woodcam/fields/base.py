@@ -178,3 +178,18 @@ class LogFrame:
     def direction_to_block(self, dirs_log: ArrayLike) -> np.ndarray:
         """Rotate log-frame direction vectors ``(n, 3)`` into the block frame."""
         return np.einsum("ij,jk->ik", np.asarray(dirs_log, dtype=float), self._rot)
+
+    def direction_to_log(self, dirs_mm: ArrayLike) -> np.ndarray:
+        """Rotate block-frame direction vectors ``(n, 3)`` (fibres, normals) into the log frame."""
+        return np.einsum("ij,kj->ik", np.asarray(dirs_mm, dtype=float), self._rot)
+
+
+def check_texture_frame(frame) -> "LogFrame | None":
+    """``frame`` as given when it is a :class:`LogFrame` or None, else a WoodcamError: the one
+    check of a ``texture_frame`` (the frame a wood's texture is drawn in, placed in the block
+    frame: the block a smaller one was cut from), for the colour map and the built-in photos."""
+    if frame is not None and not isinstance(frame, LogFrame):
+        raise WoodcamError(f"texture_frame must be a LogFrame (the frame the texture is drawn in, placed in "
+                           f"the block frame) or None; got {type(frame).__name__}; pass the parent "
+                           "block's LogFrame, or None for this block's own frame")
+    return frame

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..appearance.colormap import get_species
-from ..fields.base import LogFrame, arf, check_points, evaluate, grain_direction
+from ..fields.base import LogFrame, arf, check_points, check_texture_frame, evaluate, grain_direction
 
 #: Species whose earlywood/latewood colours the built-in photos use (the one colour table,
 #: :data:`woodcam.appearance.SPECIES`).
@@ -34,7 +34,7 @@ class _BuiltinWood:
     def __init__(self, field, rng: np.random.Generator, lattice: int = 64,
                  species: str = BUILTIN_PHOTO_SPECIES, texture_frame: LogFrame | None = None):
         s = get_species(species)
-        self.texture_frame = texture_frame
+        self.texture_frame = check_texture_frame(texture_frame)
         self.earlywood = np.asarray(s.earlywood_rgb, float)
         self.latewood = np.asarray(s.latewood_rgb, float)
         self.field = field
@@ -47,7 +47,7 @@ class _BuiltinWood:
 
         frame = self.texture_frame
         if frame is not None:  # the wood point and fibre in the frame of the block cut from
-            p, fib = frame.to_log(p), np.einsum("ij,kj->ik", fib, frame.rotation)
+            p, fib = frame.to_log(p), frame.direction_to_log(fib)
         along = (p * fib).sum(1, keepdims=True)
         tex = np.zeros(len(p))
         for (l_across, l_along, w), grid, off in zip(self._FIBRE_SCALES_MM, self.lattice, self.offsets):
