@@ -244,11 +244,19 @@ def test_a_piece_cut_from_a_block_has_its_colours():
         open_stock("builtin:flat-sawn", texture_frame=None, fooo=1)
 
 
-def test_a_smaller_log_block_through_the_same_knot_has_its_colours(shared_data):
+def test_a_smaller_log_block_through_the_same_knot_has_its_colours(shared_data, monkeypatch):
     """A smaller block through the same knot of the shared gran1 log: its front face is the
-    default block's, centred, and so are its colours (to 1/255)."""
+    default block's, centred, and so are its colours (to 1/255); the log is read once for the
+    block and the default block's texture frame (it was parsed and read again for the frame)."""
+    import woodcam.logs.io as io
+
     p, _, same = _cut_points()
-    same(open_stock("log:gran1@52:40x40x20"), open_stock("log:gran1@52"), p + (30, 0, 15), what="log")
+    reads = []
+    read = io.read_gran1
+    monkeypatch.setattr(io, "read_gran1", lambda *a, **k: reads.append(1) or read(*a, **k))
+    small = open_stock("log:gran1@52:40x40x20")
+    assert len(reads) == 1
+    same(small, open_stock("log:gran1@52"), p + (30, 0, 15), what="log")
 
 
 def test_blocks_placed_anywhere_in_a_grown_object_have_its_colours(tmp_path):

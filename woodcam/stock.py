@@ -295,9 +295,9 @@ def _open_base_stock(spec: str, species, appearance, appearance_params, species_
         return _synthetic_stock(spec, field, size, species or b.species, b.description,
                                 appearance, appearance_params, _texture_frame(spec, field))
     if spec.startswith("log:"):
-        field, size_mm, description = _log_block_field(spec)
+        field, size_mm, description, frame = _log_block_field(spec)
         return _synthetic_stock(spec, field, size_mm, species or "spruce", description,
-                                appearance, appearance_params, _texture_frame(spec, field))
+                                appearance, appearance_params, frame)
     if spec.startswith("woodify:"):
         field, size_mm, description = _woodify_field(spec)
         return _synthetic_stock(spec, field, size_mm, species or "oak", description,
@@ -342,14 +342,15 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         if spec.startswith("builtin:"):
             b, field, size = _builtin(spec.split(":", 1)[1])
             name = b.name if tuple(size) == tuple(b.size_mm) else spec.replace(":", "-")
+            frame = _texture_frame(spec, field)
         elif spec.startswith("woodify:"):
             field, size, _ = _woodify_field(spec)
             name = "woodify-" + Path(spec.split(":", 1)[1]).parent.name
+            frame = _texture_frame(spec, field)
         else:
-            field, size, _ = _log_block_field(spec)
+            field, size, _, frame = _log_block_field(spec)
             name = spec.replace(":", "-").replace("/", "_")
-        return synth_block(field, size, face_px=face_px, seed=0, name=name,
-                           texture_frame=_texture_frame(spec, field)), field
+        return synth_block(field, size, face_px=face_px, seed=0, name=name, texture_frame=frame), field
     from .block.io import read_block_folder
 
     from .detect.block import with_detected_rings
@@ -496,8 +497,16 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
     return Stock(spec, block.size_mm, Wood(field, app), block.name, meta)
 
 
+#: Size (W, D, H) mm of ``log:LOG@K`` without a size; every size through a knot draws its texture.
+_LOG_BLOCK_SIZE_MM = (100.0, 80.0, 50.0)
+
+
 def _log_block_field(spec: str):
-    """``log:LOG@K[:WxDxH]`` -> (block-frame field, size_mm, description)."""
+    """``log:LOG@K[:WxDxH]`` -> (block-frame field, size_mm, description, texture_frame): the
+    texture frame is that of ``log:LOG@K`` (the block of the default size through the same knot)
+    placed in this block's frame, None for the default size itself. Every size of block through
+    a knot draws the default block's texture, so the same piece of the log has the same colours
+    in each."""
     from .fields import KnottedLogField, block_at_knot, place_block_in_log
     from .logs.io import read_gran1, read_log
 
@@ -511,41 +520,36 @@ def _log_block_field(spec: str):
             f"log block spec {spec!r} must read 'log:LOG@KNOT' or 'log:LOG@KNOT:WxDxH' "
             "(e.g. log:gran1@52:100x80x50)"
         ) from err
-    size_mm = _parse_size(size, spec) if size else (100.0, 80.0, 50.0)  # 0x0x0, NaN, 1e9 were accepted
+    size_mm = _parse_size(size, spec) if size else _LOG_BLOCK_SIZE_MM  # 0x0x0, NaN, 1e9 were accepted
     log = read_gran1() if source == "gran1" else read_log(source)
     if not 0 <= knot < len(log.knots):
         raise WoodcamError(f"knot index in {spec!r} must be 0..{len(log.knots) - 1}; got {knot}")
-    field = place_block_in_log(KnottedLogField(log), *block_at_knot(log, knot, size_mm))
-    return field, size_mm, f"block through knot {knot} of log {source}"
+    log_field = KnottedLogField(log)
+    field = place_block_in_log(log_field, *block_at_knot(log, knot, size_mm))
+    frame = None
+    if size:  # the same log, read once: the default block's placement through the knot
+        default = place_block_in_log(log_field, *block_at_knot(log, knot, _LOG_BLOCK_SIZE_MM))
+        frame = _frame_in(field.frame, default.frame)
+    return field, size_mm, f"block through knot {knot} of log {source}", frame
 
 
 def _texture_frame(spec: str, field):
     """The frame a synthetic block's texture is drawn in (colour map and synthetic photos alike),
     placed in its block frame, or None (its own): a sized built-in draws the whole block's, a
-    sized log block the default-size block's through the same knot, a woodify block the grown
-    object's (two blocks placed differently in the same object, --block-size, --block-centre).
-    The same wood has the same colours however it is cut."""
+    woodify block the grown object's (two blocks placed differently in the same object,
+    --block-size, --block-centre); a sized log block the default-size block's through the same
+    knot, which :func:`_log_block_field` returns with the block (the log read once). The same
+    wood has the same colours however it is cut."""
     if spec.startswith("builtin:"):  # a size given: the PlacedField of _builtin in the whole block
         return field.frame if spec.split(":", 1)[1].partition(":")[2] else None
-    if spec.startswith("log:"):
-        return _log_texture_frame(spec, field)
     return field.object_frame  # woodify
 
 
-def _log_texture_frame(spec: str, field):
-    """The frame of ``log:LOG@K`` (the block of the default size through the same knot) placed in
-    the frame of the block ``spec`` names, whose ``field`` is a PlacedField in the same log; None
-    for the default size itself. Every size of block through a knot draws the default block's
-    texture, so the same piece of the log has the same colours in each."""
+def _frame_in(here, there):
+    """The frame ``there`` (a block's LogFrame in the log) placed in the frame of the block whose
+    LogFrame in the same log is ``here``; None when they are the same block frame."""
     from .fields.base import LogFrame
 
-    source, _, rest = spec[len("log:"):].partition("@")
-    knot, _, size = rest.partition(":")
-    if not size:
-        return None
-    base = f"log:{source}@{knot}"
-    default, _, _ = _log_block_field(base)
-    here, there = field.frame, default.frame
     if here == there:
         return None
     # block point p -> log point rot_h (p - c_h) -> default block point rot_t^T (...) + c_t
