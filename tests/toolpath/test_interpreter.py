@@ -606,13 +606,17 @@ def test_an_o_word_after_a_comment_is_refused_at_the_first_such_line():
 
 def test_a_structure_error_is_not_blamed_on_an_unrelated_commented_o_word():
     """Sweep h13 item 3: any O-word structure error was refused at the first O word after a
-    comment, related or not: an unclosed o7 while was blamed on a commented o5 call. The
-    commented one takes the blame only when the O words match with it read as one, or when it
-    carries the label of the line at fault."""
+    comment, related or not: an unclosed o7 while was blamed on a commented o5 call (also when
+    a commented o7 endwhile explained it). The commented one carrying the label of the line at
+    fault takes the blame; else, when the O words match with them read as ones, the first that
+    opens or closes one (a call or return matches nothing)."""
     _refused(_BODY + "o1 if [1]\no1 endif\n(c) o5 call\no7 while [1 LT 2]\nG1 X1\nM2\n", 7,
              "o7 while", r"^G-code line 7: 'o7 while': o7 while is never closed; close it$")
-    _refused(_BODY + "o7 while [1 LT 2]\n(c) o5 call\nG1 X1\n(c) o7 endwhile\nM2\n", 5,
-             "o5 call", r"without it the O words do not match \(line 4: o7 while is never closed\)")
+    # it matches with the commented lines read as O words: the o7 endwhile is why, not the o5 call
+    _refused(_BODY + "o7 while [1 LT 2]\n(c) o5 call\nG1 X1\n(c) o7 endwhile\nM2\n", 7,
+             "o7 endwhile", r"without it the O words do not match \(line 4: o7 while is never closed\)")
+    _refused(_BODY + "(c) o5 call\no7 while [1 LT 2]\nG1 X1\n(c) o7 endwhile\nM2\n", 7,
+             "o7 endwhile", r"without it the O words do not match \(line 5: o7 while is never closed\)")
     # no match either way (o8 if is never closed), but the label at fault is a commented one's
     _refused(_BODY + "o8 if [1]\n(c) o5 call\no7 while [1 LT 2]\nG1 X1\n(c) o7 endwhile\nM2\n", 8,
              "o7 endwhile", r"without it the O words do not match \(line 6: o7 while is never closed\)")

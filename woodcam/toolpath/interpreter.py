@@ -850,9 +850,10 @@ class Interpreter:
                     e: GcodeError) -> int | None:
         """The index in ``lines`` of the o-word after a comment (``late_owords``: index -> its
         key, label, rest) to refuse for the O-word structure error ``e``, or None when none
-        explains it: the first of them when the structure matches with them read as O words,
-        else the first with the label of the line ``e`` names (an unrelated commented o5 call
-        took the blame for an unclosed o7 while)."""
+        explains it: the first with the label of the line ``e`` names (an unrelated commented
+        o5 call took the blame for an unclosed o7 while); when none carries it but the structure
+        matches with them read as O words, the first that opens or closes one (not a call or
+        return, which match nothing)."""
         if not late_owords:
             return None
         trial = []
@@ -861,12 +862,16 @@ class Interpreter:
             t.okey, t.olabel, t.oexpr = late_owords.get(i, (ln.okey, ln.olabel, ln.oexpr))
             t.okey = "while" if t.okey == "dowhile" else t.okey
             trial.append(t)
+        label = next((ln.olabel for ln in lines if ln.no == e.line and ln.olabel is not None), None)
+        same = next((i for i, (_, lab, _) in sorted(late_owords.items()) if lab == label), None)
         try:
             self._match_structure(trial)  # the program is refused either way
         except GcodeError:
-            label = next((ln.olabel for ln in lines if ln.no == e.line and ln.olabel is not None), None)
-            return next((i for i, (_, lab, _) in late_owords.items() if lab == label), None)
-        return min(late_owords)
+            return same
+        if same is not None:
+            return same
+        return next((i for i, (key, _, _) in sorted(late_owords.items())
+                     if key not in ("call", "return")), min(late_owords))
 
     def _match_structure(self, lines):
         """Match the O-word structure of the normalised ``lines`` (the parts of _prepare)."""
