@@ -19,8 +19,6 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Literal
 
-import numpy as np
-
 Units = Literal["mm", "inch"]
 #: Millimetres per unit (the inch is exactly 25.4 mm since 1959).
 MM_PER_UNIT: dict[str, float] = {"mm": 1.0, "inch": 25.4}
@@ -32,8 +30,11 @@ def _lengths(mm, units: Units, spec: str, sep: str = "x", form: str | None = Non
     ``spec``, joined by ``sep`` or put in ``form`` (one ``{}`` each), then the unit's symbol: the
     one writer of every ``fmt_*`` and ``say_*`` of lengths."""
     k = MM_PER_UNIT[units]
-    # a 0-d array (np.float64(2) made one by arithmetic on arrays) is one length, not a sequence
-    texts = [f"{float(v) / k:{spec}}" for v in np.atleast_1d(np.asarray(mm, dtype=float))]
+    # a 0-d array (np.float64(2) made one by arithmetic on arrays) is one length, not a
+    # sequence; told by its ndim, not numpy, which `woodcam --help` (units via cli.options) must
+    # not load
+    one = getattr(mm, "ndim", None) == 0 or not hasattr(mm, "__iter__")
+    texts = [f"{float(v) / k:{spec}}" for v in ([mm] if one else mm)]
     return (form.format(*texts) if form else sep.join(texts)) + f" {_SYMBOL[units]}"
 
 
