@@ -419,3 +419,20 @@ def test_turns_in_a_spec_turn_the_block_by_the_right_hand_rule_and_undo():
     np.testing.assert_allclose(open_stock("builtin:flat-sawn~z90~z90").wood.features(q)["years"],
                                open_stock("builtin:flat-sawn~z180").wood.features(q)["years"], atol=1e-9)
     assert open_stock("builtin:flat-sawn~x90").size_mm == (100.0, 50.0, 80.0)
+
+
+def test_only_real_turns_and_resizes_are_split_off_a_spec(tmp_path):
+    """Review h15 item 3: any trailing '[...]' counted as a resize (a folder 'blocks/oak[2]' was
+    refused) and a turn ate '/' ('/data/~scan/oak~z90' -> base '/data'). Only '~AXIS DEG' and
+    '[WxDxH(@X,Y,Z)]' are operations; a spec that is an existing path stays whole."""
+    from woodcam._specs import spec_path, split_spec
+
+    assert split_spec("/data/~scan/oak~z90") == ("/data/~scan/oak", ["~z90"])
+    assert split_spec("/data/~scan/oak~z90[40x30x20@5,5,5]") == ("/data/~scan/oak", ["~z90", "[40x30x20@5,5,5]"])
+    assert split_spec("blocks/oak[2]") == ("blocks/oak[2]", [])
+    folder = tmp_path / "oak~z90"
+    folder.mkdir()
+    assert split_spec(str(folder)) == (str(folder), []) and spec_path(str(folder)) == folder
+    assert split_spec(f"{folder}[40x30x20]") == (str(folder), ["[40x30x20]"])
+    with pytest.raises(WoodcamError, match=r"turn '~q90' must be ~AXIS"):
+        open_stock("builtin:knotty~q90")

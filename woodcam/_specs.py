@@ -7,30 +7,50 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-#: A spec's trailing operations, applied in order: turns ``~AXIS90`` and the resizes
-#: ``[WxDxH]`` / ``[WxDxH@X,Y,Z]`` that :func:`woodcam.stock.resize_stock` appends.
-_OPS = re.compile(r"(?:~[^~\[\]]*|\[[^\[\]]*\])+$")
-_OP = re.compile(r"~[^~\[\]]*|\[[^\[\]]*\]")
+_NUM = r"(?:\d+(?:\.\d*)?|\.\d+)"
+#: A turn ``~AXIS DEGREES`` (``~z90``, ``~x-90``) and a resize ``[WxDxH]`` / ``[WxDxH@X,Y,Z]``
+#: (unit-free numbers, mm), as :func:`woodcam.stock.resize_stock` appends them: only these, so
+#: a path's own ``~`` or ``[...]`` (``/data/~scan/oak``, ``blocks/oak[2]``) is no operation.
+_ONE_OP = (rf"~[xyzXYZ][-+]?{_NUM}"
+           rf"|\[{_NUM}[xX]{_NUM}[xX]{_NUM}(?:@[-+]?{_NUM},[-+]?{_NUM},[-+]?{_NUM})?\]")
+#: A spec's trailing operations, applied in order.
+_OPS = re.compile(rf"(?:{_ONE_OP})+$")
+_OP = re.compile(_ONE_OP)
+#: The end of a base that looks like a turn or resize but is none (``~q90``, ``[40x30]``):
+#: :mod:`woodcam.stock` names it as a bad operation unless the base is an existing path.
+LOOSE_OP = re.compile(r"(?:~[^~\[\]/]*|\[[^\[\]/]*\])$")
 
 
-def split_spec(spec: str) -> tuple[str, list[str]]:
-    """``"BASE~z90[40x30x20@5,5,5]"`` -> ``("BASE", ["~z90", "[40x30x20@5,5,5]"])``: the block
-    a spec names and its trailing turns and resizes, as written."""
-    text = str(spec)
-    m = _OPS.search(text)
-    return (text, []) if m is None else (text[:m.start()], _OP.findall(m.group()))
-
-
-def spec_path(spec: str) -> Path | None:
-    """The file or folder a block ``spec`` names (a block or sample folder, a log file, a
-    woodify field), as written; None for built-in blocks and the shared ``gran1`` log."""
-    base = split_spec(spec)[0]
+def _base_path(base: str) -> Path | None:
+    """The file or folder the block ``base`` (a spec without its operations) names."""
     if base.startswith("log:"):
         source = base[len("log:"):].partition("@")[0]
         return Path(source) if source.lower().endswith(".json") else None
     if base.startswith("woodify:"):
         return Path(base[len("woodify:"):])
     return None if base.startswith("builtin:") else Path(base)
+
+
+def split_spec(spec: str) -> tuple[str, list[str]]:
+    """``"BASE~z90[40x30x20@5,5,5]"`` -> ``("BASE", ["~z90", "[40x30x20@5,5,5]"])``: the block
+    a spec names and its trailing turns and resizes, as written; the longest base that is an
+    existing file or folder keeps what it ends with (a folder named ``oak~z90``)."""
+    text = str(spec)
+    m = _OPS.search(text)
+    ops = [] if m is None else _OP.findall(m.group())
+    end = len(text)
+    for k in range(len(ops), 0, -1):  # the whole spec first, then fewer of its ends kept
+        path = None if text.startswith("log:") else _base_path(text[:end])
+        if path is not None and path.exists():
+            return text[:end], ops[k:]
+        end -= len(ops[k - 1])
+    return text[:end], ops
+
+
+def spec_path(spec: str) -> Path | None:
+    """The file or folder a block ``spec`` names (a block or sample folder, a log file, a
+    woodify field), as written; None for built-in blocks and the shared ``gran1`` log."""
+    return _base_path(split_spec(spec)[0])
 
 
 def absolute_spec(spec: str, folder: str | Path | None = None) -> str:

@@ -42,7 +42,7 @@ from typing import Literal
 
 import numpy as np
 
-from ._specs import spec_path, split_spec
+from ._specs import LOOSE_OP, spec_path, split_spec
 from .appearance import ColorMapAppearance, NeuralAppearance, Wood
 from .errors import WoodcamError, WoodcamWarning
 from .fields.builtin import BUILTIN_NAMES, builtin_block
@@ -225,6 +225,10 @@ def _split_ops(spec: str) -> tuple[str, list[tuple]]:
     """``"SPEC~z90~x-90[40x30x20@5,5,5]"`` -> ``("SPEC", [("turn", "z", 1), ("turn", "x", -1),
     ("resize", (40, 30, 20), (5, 5, 5))])`` (see module docstring)."""
     base, texts = split_spec(spec)
+    loose, path = LOOSE_OP.search(base), spec_path(base)
+    bad = loose.group() if loose and not (path is not None and path.exists()) else None
+    if bad:  # not a turn or resize as written (~q90, [40x30]): named below as one, not a path
+        texts = [bad, *texts]
     ops: list[tuple] = []
     for text in texts:
         if text.startswith("["):
@@ -241,6 +245,10 @@ def _split_ops(spec: str) -> tuple[str, list[tuple]]:
                 f"block spec {spec!r}: turn '~{part}' must be ~AXIS then a multiple of 90 degrees "
                 "(AXIS x, y or z), e.g. 'builtin:flat-sawn~z90'")
         ops.append(("turn", axis, int(quarter)))
+    if bad:  # read above, yet not in the grammar
+        raise WoodcamError(f"block spec {spec!r}: {bad!r} is neither a turn ~AXIS then "
+                           "degrees nor a resize [WxDxH] or [WxDxH@X,Y,Z] (plain numbers, mm), "
+                           "e.g. 'builtin:knotty~z90[40x30x20@5,5,5]'")
     return base, ops
 
 
