@@ -388,7 +388,8 @@ def test_every_spec_woodcam_writes_reopens_as_the_same_wood(base, tmp_path):
     folder.mkdir()
     (folder / "block.json").write_text("{}")
     spec = f"{folder}~z90[40x30x20@5,5,5]"
-    assert spec_path(spec) == folder and spec_digest(spec) == spec_digest(str(folder))
+    assert spec_path(spec) == folder and spec_digest(spec) == spec_digest(f"{folder}~Z90[40x30x20.0@5,5,5]")
+    assert spec_digest(spec) != spec_digest(str(folder))  # a cut block is not the block
     assert absolute_spec(spec) == f"{folder.resolve()}~z90[40x30x20@5,5,5]"
 
 

@@ -207,18 +207,23 @@ def _check_appearance_params(appearance: str, params: dict, *, photos: bool = Tr
 
 def spec_digest(spec: str) -> str:
     """Content identity of the block ``spec`` names: a digest of every file of a block or sample
-    folder (or of a log file or woodify field), or of the spec itself for synthetic blocks."""
+    folder (or of a log file or woodify field), or of the spec itself for synthetic blocks, and
+    of its turns and resizes: a resized block is not the block it was cut from (a block without
+    them keeps the digest it always had)."""
     from . import __version__
     from ._cache import digest
 
-    base = split_spec(spec)[0]
+    base, ops = _split_ops(spec)
     path = spec_path(base)
     if path is not None and path.is_dir():
         files = sorted(p for p in path.rglob("*") if p.is_file() and not p.name.startswith("."))
-        return digest([(str(p.relative_to(path)), p) for p in files])
-    if path is not None and path.is_file():
-        return digest(path)
-    return digest(base, __version__)
+        content = digest([(str(p.relative_to(path)), p) for p in files])
+    elif path is not None and path.is_file():
+        content = digest(path)
+    else:
+        content = digest(base, __version__)
+    # the parsed operations: '~Z90' and '~z90.0' are one turn
+    return digest(content, repr(ops)) if ops else content
 
 
 def _split_ops(spec: str) -> tuple[str, list[tuple]]:
