@@ -163,6 +163,11 @@ def test_a_turn_given_to_a_command_that_reads_the_block_is_named():
     with pytest.raises(WoodcamError, match=r"a turn \('~z90'\) is for the commands that carve a part from "
                        r"the block \(bake, gcode, place, review\); .* give 'builtin:flat-sawn'"):
         open_block("builtin:flat-sawn~z90")
+    # review h15 item 6: a resize was looked for by '~' only: "unknown built-in block 'knotty[40x30x20]'"
+    with pytest.raises(WoodcamError, match=r"a resize \('\[40x30x20\]'\) is for the commands .* give 'builtin:knotty'"):
+        open_block("builtin:knotty[40x30x20]")
+    with pytest.raises(WoodcamError, match=r"a turn and a resize \('~z90\[40x30x20@1,1,1\]'\) is for"):
+        open_block("builtin:knotty~z90[40x30x20@1,1,1]")
 
 
 def test_a_photo_keyword_on_a_stock_without_photos_is_refused_naming_every_unknown(tmp_path):

@@ -343,12 +343,13 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         The field is the block's true field where one is known (synthetic blocks, block
         folders that store one), else None: no field is fitted here.
     """
-    if "~" in spec and not Path(spec).exists():  # "unknown built-in block 'flat-sawn~z90'" said only
-        base, turn = spec.split("~", 1)
+    base, ops = split_spec(spec)
+    if ops:  # "unknown built-in block 'flat-sawn~z90'" (or 'knotty[40x30x20]') said only
+        kinds = sorted({"a turn" if op.startswith("~") else "a resize" for op in ops}, reverse=True)
         raise WoodcamError(
-            f"block spec {spec!r}: a turn ('~{turn}') is for the commands that carve "
-            f"a part from the block (bake, gcode, place, review); this one reads the block as it "
-            f"is: give {base!r}")
+            f"block spec {spec!r}: {' and '.join(kinds)} ('{''.join(ops)}') is for the commands "
+            f"that carve a part from the block (bake, gcode, place, review); this one reads the "
+            f"block as it is: give {base!r}")
     if spec.startswith(("builtin:", "log:", "woodify:")):
         from .synth import synth_block
 
