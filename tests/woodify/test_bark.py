@@ -347,3 +347,12 @@ def test_solid_bark_refuses_what_would_colour_nan(kwargs, message):
     assert np.isfinite(rgb).all() and rgb.min() >= 0 and rgb.max() <= 1
     with pytest.raises(WoodcamError, match=message):
         SolidBark(**{**good, **kwargs})
+
+
+@pytest.mark.parametrize("seed", [-1, 2**32])
+def test_a_bark_seed_out_of_numpy_range_is_named(seed):
+    """Review h15 item 10: SolidBark(seed=-1) was numpy's bare ValueError of default_rng."""
+    from woodcam.woodify.bark import SolidBark
+
+    with pytest.raises(WoodcamError, match=rf"SolidBark: seed must be an integer in \[0, .*got {seed}"):
+        SolidBark((0, 0, 1), (0, 0, 0), 100.0, seed=seed)

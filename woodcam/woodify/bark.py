@@ -61,7 +61,8 @@ class SolidBark:
         centre = check_vector(centre_mm, "SolidBark: centre_mm", fix="give a point on the stem in mm")
         period = check_number(period_mm, "SolidBark: period_mm", lo=0.0, lo_open=True,
                               fix="give the bark's repeat in mm, e.g. the stem's girth")
-        seed = check_number(seed, "SolidBark: seed", integer=True, fix="e.g. 0")
+        # numpy seeds are non-negative (seed=-1 was a bare ValueError of default_rng)
+        seed = check_number(seed, "SolidBark: seed", lo=0, hi=2**32 - 1, integer=True, fix="e.g. 0")
         ref = np.array([1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
         e1 = ref - up * (ref @ up)
         e1 /= np.linalg.norm(e1)
