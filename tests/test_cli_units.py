@@ -282,8 +282,9 @@ def test_library_messages_of_an_inch_run_speak_inches(tmp_path, monkeypatch, cap
     # the hint of a part modelled in inches is about the file's own numbers: mm (sweep h13 item 7)
     assert "the part is only 1x1x1 mm in the 50.8x50.8x50.8 mm block" in err, err
 
+    meta = {}
     monkeypatch.setattr(woodcam.pipeline, "preview_heightfield",
-                        lambda hm, stock, out, **kw: woodcam.pipeline.PartPreview(
+                        lambda hm, stock, out, **kw: meta.update(kw["metadata"]) or woodcam.pipeline.PartPreview(
                             "x", files={"glb": out}, triangles=1))
     prog = tmp_path / "p.nc"
     prog.write_text("G21\nM3 S1000\nG0 X20 Y40 Z2\nG1 Z-30 F300\nX80\nG0 Z-1\nX10\nG0 Z2\nM5\nM2\n")
@@ -294,6 +295,10 @@ def test_library_messages_of_an_inch_run_speak_inches(tmp_path, monkeypatch, cap
     assert "below_stock_bottom: tool tip at z = -1.181 in (G-code frame), 0.1811 in below" in err, err
     assert "rapid_through_stock: rapid move (G0) cuts up to 0.03937 in into the stock" in err, err
     assert " mm" not in err, err
+    # review h15 item 7: the GLB's metadata copy of the issues was in inches too: files stay mm
+    filed = " ".join(w["message"] for w in meta["warnings"])
+    assert "below_stock_bottom: tool tip at z = -30.000 mm (G-code frame), 4.600 mm below" in filed, filed
+    assert "rapid move (G0) cuts up to 1.000 mm into the stock" in filed and " in " not in filed, filed
 
 
 

@@ -300,7 +300,11 @@ def _issue_spots(program, issues, size_mm, offset, name: str) -> list[dict]:
     """The simulation's issues as ``{"message", "line", "at_mm"}``, block frame: where the
     simulation says the problem first happens (``Issue.at_mm``), else the middle of the first
     move of the issue's line (the work offset as simulate applies it)."""
+    import dataclasses
+
     import numpy as np
+
+    from ..units import filed
 
     off = np.array([0.0, 0.0, float(size_mm[2])]) if offset is None else np.asarray(offset, float)
     lines = np.asarray(program.line)
@@ -310,7 +314,9 @@ def _issue_spots(program, issues, size_mm, offset, name: str) -> list[dict]:
         at = np.flatnonzero(lines == issue.line)
         if issue.at_mm is not None or len(at):
             spot = list(issue.at_mm) if issue.at_mm is not None else mids[at[0]].tolist()
-            out.append({"message": f"{name} {issue}", "line": int(issue.line), "at_mm": spot})
+            # the file stays in mm under --units inch (the terminal's copy follows it)
+            text = str(dataclasses.replace(issue, message=filed(issue.message)))
+            out.append({"message": f"{name} {text}", "line": int(issue.line), "at_mm": spot})
     return out
 
 

@@ -46,7 +46,7 @@ import numpy as np
 from .._types import ArrayLike, Mesh
 from ..errors import WoodcamError
 from ..tolerances import SIM_CONTACT_TOL_MM
-from ..units import say_length
+from ..units import said, say_length
 from .gcode import FEED, RAPID, Program
 from .reach import REACH_KINDS, _cell_window, reach_issues
 from .tools import BallEndMill, FlatEndMill, Tool
@@ -296,12 +296,12 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
         # where the tip goes through the bottom (z = 0), or the start if it is below already
         t = p0[k, 2] / (p0[k, 2] - p1[k, 2]) if p0[k, 2] > 0 else 0.0
         _add(issues, "below_stock_bottom", lines[k],
-             f"tool tip at z = {say_length(p1[k, 2] - off[2], '.3f')} (G-code frame), "
-             f"{say_length(-p1[k, 2], '.3f')} below the stock bottom", p0[k] + t * (p1[k] - p0[k]))
+             said(lambda: f"tool tip at z = {say_length(p1[k, 2] - off[2], '.3f')} (G-code frame), "
+                  f"{say_length(-p1[k, 2], '.3f')} below the stock bottom"), p0[k] + t * (p1[k] - p0[k]))
     for k in np.flatnonzero(below_top & outside & (kind == FEED)):
         _add(issues, "cut_outside_stock", lines[k],
-             f"tool T{tool_of[k]} is below the stock top (z = {say_length(zmin[k] - off[2], '.3f')}) with "
-             "its footprint outside the stock", mid[k])
+             said(lambda: f"tool T{tool_of[k]} is below the stock top (z = "
+                  f"{say_length(zmin[k] - off[2], '.3f')}) with its footprint outside the stock"), mid[k])
     for k in np.flatnonzero(below_top & over & (kind == FEED) & ~(program.spindle_rpm > 0)):
         _add(issues, "spindle_off", lines[k], "feed move into the stock with the spindle off "
              "(no M3/M4 with S > 0 before it): the controller would cut with a still tool",
@@ -458,7 +458,7 @@ def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind,
                              np.asarray(lines, np.int64), depth)
         for k in np.flatnonzero((kind == RAPID) & (depth > SIM_CONTACT_TOL_MM)):
             _add(issues, "rapid_through_stock", lines[k],
-                 f"rapid move (G0) cuts up to {say_length(depth[k], '.3f')} into the stock",
+                 said(lambda: f"rapid move (G0) cuts up to {say_length(depth[k], '.3f')} into the stock"),
                  _first_contact(tool, a[k], b[k], before[k], js[k], is_[k], dx, dy))
         return int(cells)
     f32 = np.float32
@@ -486,7 +486,7 @@ def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind,
             depth = float((cur - env[k]).max())
             if depth > SIM_CONTACT_TOL_MM:
                 _add(issues, "rapid_through_stock", lines[k],
-                     f"rapid move (G0) cuts up to {say_length(depth, '.3f')} into the stock",
+                     said(lambda: f"rapid move (G0) cuts up to {say_length(depth, '.3f')} into the stock"),
                      _first_contact(tool, a[k], b[k], cur, js[k], is_[k], dx, dy))
     for k in range(n):  # scatter: one slice per move (windows overlap, so no fancy indexing)
         view = hm[js[k]:js[k] + wy, is_[k]:is_[k] + wx]
