@@ -113,3 +113,17 @@ def test_turning_the_block_turns_its_wood():
     np.testing.assert_allclose(full.wood.years(p), plain.wood.years(p), atol=1e-9)
     with pytest.raises(WoodcamError, match="multiple of 90 degrees"):
         open_stock("builtin:flat-sawn~z45")
+
+
+def test_ops_as_typed_must_match_the_ops_one_for_one():
+    """placement_matrix quotes each op as the user typed it; a list of another length raised a
+    bare ValueError from zip: it is refused naming as_typed, and --place's translate rule names
+    the units of both doors."""
+    from woodcam.cad.place import placement_matrix
+
+    box = ((0, 0, 0), (10, 10, 10))
+    with pytest.raises(WoodcamError, match=r"as_typed must hold one text per operation \(2\); got 1"):
+        placement_matrix(["center", "rotate:z:90"], box, (50, 50, 50), as_typed=["center"])
+    with pytest.raises(WoodcamError, match=r"--place 'translate:1,2': expected translate:X,Y,Z "
+                                           r"\(in --units on the command line, mm in the library\)"):
+        placement_matrix(["translate:1,2"], box, (50, 50, 50))

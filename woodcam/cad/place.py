@@ -82,6 +82,9 @@ def placement_matrix(ops: Sequence[str], bounds_mm, size_mm, *,
     lo, hi = (np.asarray(b, dtype=float) for b in np.asarray(bounds_mm, dtype=float))
     size = np.asarray(size_mm, dtype=float)
     total = np.eye(4)
+    if as_typed is not None and len(as_typed) != len(ops):
+        raise WoodcamError(f"placement_matrix: as_typed must hold one text per operation ({len(ops)}); "
+                           f"got {len(as_typed)}: {list(as_typed)!r}; pass the ops as typed, or leave it out")
     for mm_op, op in zip(ops, ops if as_typed is None else as_typed, strict=True):
         # ``op`` (as typed) is what the errors quote; ``arg`` (mm) is what is computed
         name, _, arg = str(mm_op).strip().partition(":")
@@ -96,7 +99,8 @@ def placement_matrix(ops: Sequence[str], bounds_mm, size_mm, *,
         elif name == "translate":
             parts = arg.split(",")
             if len(parts) != 3:
-                raise WoodcamError(f"--place {op!r}: expected translate:X,Y,Z in mm; use {_HELP}")
+                raise WoodcamError(f"--place {op!r}: expected translate:X,Y,Z (in --units on the command "
+                                   f"line, mm in the library); use {_HELP}")
             move = [_number(p, op) for p in parts]
             if max(abs(v) for v in move) > 1e5:  # 1e300 made the part's volume 0 ("inside-out?")
                 raise WoodcamError(f"--place {op!r}: a move must stay within 100 m (1e5 mm)")
