@@ -548,15 +548,18 @@ def _log_block_field(spec: str):
 
 
 def _texture_frame(spec: str, field):
-    """The frame a synthetic block's texture is drawn in (colour map and synthetic photos alike),
-    placed in its block frame, or None (its own): a sized built-in draws the whole block's, a
-    woodify block the grown object's (two blocks placed differently in the same object,
-    --block-size, --block-centre); a sized log block the default-size block's through the same
-    knot, which :func:`_log_block_field` returns with the block (the log read once). The same
-    wood has the same colours however it is cut."""
+    """The frame a built-in or woodify block's texture is drawn in (colour map and synthetic
+    photos alike), placed in its block frame, or None (its own): a sized built-in draws the whole
+    block's, a woodify block the grown object's (two blocks placed differently in the same
+    object, --block-size, --block-centre). The same wood has the same colours however it is cut.
+    (A log block's frame, the default-size block's through the same knot, comes with the block
+    from :func:`_log_block_field`, which reads the log once.)"""
     if spec.startswith("builtin:"):  # a size given: the PlacedField of _builtin in the whole block
         return field.frame if spec.split(":", 1)[1].partition(":")[2] else None
-    return field.object_frame  # woodify
+    if spec.startswith("woodify:"):
+        return field.object_frame
+    raise ValueError(f"_texture_frame: no texture frame rule for {spec!r} (log blocks: "
+                     "_log_block_field)")  # a programming error, never a user's input
 
 
 def _frame_in(here, there):
