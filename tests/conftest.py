@@ -98,3 +98,22 @@ def bars(monkeypatch) -> list[RecordedBar]:
 
     monkeypatch.setattr(woodcam._progress, "progress_bar", record)
     return made
+
+
+def _glb_with(meta: dict, path: Path) -> Path:
+    """A minimal GLB (no mesh) whose JSON chunk holds ``meta`` as woodcam's scene extras."""
+    import json
+    import struct
+
+    body = json.dumps({"asset": {"version": "2.0"}, "scenes": [{"extras": {"woodcam": meta}}]})
+    body = body.encode() + b" " * (-len(body) % 4)
+    path.write_bytes(struct.pack("<III", 0x46546C67, 2, 20 + len(body))
+                     + struct.pack("<II", len(body), 0x4E4F534A) + body)
+    return path
+
+
+@pytest.fixture
+def glb_with():
+    """``glb_with(meta, path) -> path``: a minimal GLB carrying only woodcam's metadata ``meta``
+    (what ``stock_of_glb`` and ``preview`` read), for tests of the block a GLB names."""
+    return _glb_with

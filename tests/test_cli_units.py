@@ -203,12 +203,10 @@ def test_gcode_deviation_and_gouges_print_in_inches(tmp_path, monkeypatch, capsy
     assert " mm" not in inch.out.split("deviation from")[1].split("; map")[0]
 
 
-def test_messages_of_an_inch_run_quote_what_was_typed_and_speak_inches(tmp_path, monkeypatch, capsys):
+def test_messages_of_an_inch_run_quote_what_was_typed_and_speak_inches(tmp_path, monkeypatch, capsys, glb_with):
     """Sweep h13 item 1: with --units inch the preview block-mismatch warning named the spec as
     converted (builtin:flat-sawn:101.6x81.28x50.8) and the baked size in mm, a block spec too big
     was refused as '25400x25.4x25.4 ... in mm', and the bake report said '1-3 mm under it'."""
-    import json
-    import struct
 
     import woodcam.view as view
     from woodcam.advise import SUBSURFACE_MM, report_text
@@ -219,11 +217,7 @@ def test_messages_of_an_inch_run_quote_what_was_typed_and_speak_inches(tmp_path,
     assert fmt_size((101.6, 81.28, 50.8), "inch") == "4x3.2x2 in" and fmt_size((100, 80, 50)) == "100x80x50 mm"
     meta = {"block": "builtin:flat-sawn", "block_digest": spec_digest("builtin:flat-sawn"),
             "size_mm": [100.0, 80.0, 50.0]}
-    body = json.dumps({"asset": {"version": "2.0"}, "scenes": [{"extras": {"woodcam": meta}}]}).encode()
-    body += b" " * (-len(body) % 4)
-    glb = tmp_path / "tray.glb"
-    glb.write_bytes(struct.pack("<III", 0x46546C67, 2, 20 + len(body))
-                    + struct.pack("<II", len(body), 0x4E4F534A) + body)
+    glb = glb_with(meta, tmp_path / "tray.glb")
     seen = {}
     monkeypatch.setattr(view, "preview", lambda mesh, **kw: seen.update(kw))
     assert main(["preview", str(glb), "--screenshot", "--units", "inch",

@@ -85,23 +85,17 @@ def test_a_synthetic_block_keeps_its_species_and_turns(tmp_path):
     _same_wood(stock, again)
 
 
-def test_a_resized_block_is_not_the_block_a_glb_was_baked_from(tmp_path):
+def test_a_resized_block_is_not_the_block_a_glb_was_baked_from(tmp_path, glb_with):
     """Review h15 item 5: spec_digest digested only the spec's base, so --block
     'builtin:flat-sawn[40x30x20]' for a GLB baked from 'builtin:flat-sawn' was taken without the
     'is not the block' warning; the turns and resizes are part of the block's identity."""
-    import json
-    import struct
     import warnings
 
     from woodcam.stock import spec_digest
 
     meta = {"block": "builtin:flat-sawn", "block_digest": spec_digest("builtin:flat-sawn"),
             "size_mm": [100.0, 80.0, 50.0]}
-    body = json.dumps({"asset": {"version": "2.0"}, "scenes": [{"extras": {"woodcam": meta}}]}).encode()
-    body += b" " * (-len(body) % 4)
-    glb = tmp_path / "tray.glb"
-    glb.write_bytes(struct.pack("<III", 0x46546C67, 2, 20 + len(body))
-                    + struct.pack("<II", len(body), 0x4E4F534A) + body)
+    glb = glb_with(meta, tmp_path / "tray.glb")
     for other in ("builtin:flat-sawn[40x30x20]", "builtin:flat-sawn~z90"):
         with pytest.warns(WoodcamWarning, match="is not the block tray.glb was baked from"):
             stock_of_glb(glb, other)

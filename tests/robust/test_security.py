@@ -74,18 +74,6 @@ def test_checkpoint_of_plain_data_resumes(tmp_path):
     assert list(res["step"]) == [10, 20]
 
 
-def _glb_with(meta: dict, path: Path) -> Path:
-    """A minimal GLB whose JSON chunk holds ``meta`` as woodcam's scene extras."""
-    import json
-    import struct
-
-    body = json.dumps({"asset": {"version": "2.0"}, "scenes": [{"extras": {"woodcam": meta}}]})
-    body = body.encode() + b" " * (-len(body) % 4)
-    path.write_bytes(struct.pack("<III", 0x46546C67, 2, 20 + len(body))
-                     + struct.pack("<II", len(body), 0x4E4F534A) + body)
-    return path
-
-
 @pytest.mark.parametrize("meta, match", [
     ({"block": "builtin:rift", "appearance": {"kind": "neural", "params": {"cache_dir": "/tmp/x"}}},
      "params.cache_dir .* is not an accepted appearance parameter"),
@@ -94,16 +82,16 @@ def _glb_with(meta: dict, path: Path) -> Path:
     ({"block": "builtin:rift", "appearance": {"params": ["x"]}}, "params must be an object"),
     ({"block": ["builtin:rift"]}, "must be a string"),
 ])
-def test_glb_metadata_cannot_choose_where_or_how_much(tmp_path, meta, match):
+def test_glb_metadata_cannot_choose_where_or_how_much(tmp_path, meta, match, glb_with):
     """Issue 15: a crafted GLB made `preview` fit and write a cache into a folder it names. A
     GLB's metadata may name its block and appearance, never a cache folder or unbounded work."""
     from woodcam.cli.options import stock_of_glb
 
     with pytest.raises(WoodcamError, match=match):
-        stock_of_glb(_glb_with(meta, tmp_path / "x.glb"))
+        stock_of_glb(glb_with(meta, tmp_path / "x.glb"))
 
 
-def test_glb_naming_a_folder_never_writes_into_it(tmp_path, monkeypatch):
+def test_glb_naming_a_folder_never_writes_into_it(tmp_path, monkeypatch, glb_with):
     from woodcam.block.io import write_block
     from woodcam.cli.options import stock_of_glb
     from woodcam.fields.builtin import builtin_block
@@ -115,7 +103,7 @@ def test_glb_naming_a_folder_never_writes_into_it(tmp_path, monkeypatch):
     victim = tmp_path / "victim"
     write_block(block, victim)
     before = {p: p.stat().st_mtime_ns for p in victim.rglob("*")}
-    stock = stock_of_glb(_glb_with({"block": str(victim)}, tmp_path / "x.glb"))
+    stock = stock_of_glb(glb_with({"block": str(victim)}, tmp_path / "x.glb"))
     assert stock.size_mm == (30.0, 20.0, 10.0)
     assert {p: p.stat().st_mtime_ns for p in victim.rglob("*")} == before
     assert list((tmp_path / "cache" / "fields").glob("*.npz"))
