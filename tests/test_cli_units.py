@@ -399,3 +399,21 @@ def test_say_length_and_say_volume_take_a_summarys_units():
         assert say_volume(0.6, ".1f", units="mm") == "0.6 mm^3"
     assert say_length(25.4, ".3f", units="inch") == "1 in" == fmt_depth(25.4, "inch")
     assert say_volume(16387.064, ".0f", units="inch") == "1 in^3"
+
+
+@pytest.mark.parametrize("units, spec", [
+    (["--units", "inch"], "builtin:knotty[4x3]"),          # three sides wanted
+    (["--units", "inch"], "builtin:knotty[1000x1x1]"),     # over the cap once in inches
+    (["--units", "inch"], "builtin:knotty:4x3x2[4x3x0@1,1,1]"),
+    ([], "builtin:knotty[40x30x20@a,1,2]"),
+])
+def test_a_spec_resize_is_checked_as_typed_at_the_door(units, spec, tmp_path, capsys):
+    """Sweep h16 item A: only a spec's :WxDxH was checked at the door; a resize [WxDxH@X,Y,Z]
+    reached the stock's check converted: --units inch 'builtin:knotty[1000x1x1]' said
+    "block spec 'builtin:knotty[25400x25.4x25.4]': the size must be WxDxH in mm" (exit 1)."""
+    assert main(["bake", "p.stl", *units, "--block", spec, "--out", str(tmp_path / "x.glb")]) == 2
+    err = capsys.readouterr().err
+    said = "--units inch" if units else "mm"
+    assert err.startswith(f"woodcam: error: --block {spec}: a resize must be [WxDxH] or "
+                          f"[WxDxH@X,Y,Z] in {said}"), err
+    assert "25.4" not in err and "101.6" not in err and err.count("\n") == 1

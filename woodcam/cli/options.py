@@ -317,17 +317,43 @@ def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
 
 
 def _check_spec_size(spec: str, units: Units) -> None:
-    """A block spec's ``:WxDxH`` read in ``units``, checked as typed at the door, a usage error
-    in every unit (the stock's own check, a WoodcamError, would name the spec converted to mm:
-    '1000x1x1' inches said "got '25400x25.4x25.4' ... in mm")."""
+    """A block spec's ``:WxDxH`` and each resize ``[WxDxH@X,Y,Z]`` read in ``units``, checked as
+    typed at the door, a usage error in every unit (the stock's own check, a WoodcamError, would
+    name the spec converted to mm: '1000x1x1' inches said "got '25400x25.4x25.4' ... in mm")."""
+    import numpy as np
+
+    from .._specs import LOOSE_OP, spec_path, split_spec
     from ..units import parse_lengths
 
+    said = "mm" if units == "mm" else f"--units {units}"
+    cap = MAX_BLOCK_SIZE_MM / MM_PER_UNIT[units]
     m = _SPEC_SIZE.match(str(spec))
-    if m and parse_lengths(m.group(2), 3, max_mm=MAX_BLOCK_SIZE_MM / MM_PER_UNIT[units]) is None:
-        said = "mm" if units == "mm" else f"--units {units}"
+    if m and parse_lengths(m.group(2), 3, max_mm=cap) is None:
         raise UsageError(f"--block {spec}: the size must be WxDxH in {said}, each > 0 and "
                          f"<= {fmt_length(MAX_BLOCK_SIZE_MM, units, 5)}; got {m.group(2)!r}, e.g. "
                          f"{fmt_size((300, 120, 40), units, 3)}")
+    base, ops = split_spec(str(spec))
+    # a bracket the spec grammar does not read ([40x30]) is a resize typed wrong, as the stock
+    # reads it, unless the base is an existing path that ends so
+    loose, path = LOOSE_OP.search(base), spec_path(base)
+    if loose and loose.group().startswith("[") and not (path is not None and path.exists()):
+        ops = [loose.group(), *ops]
+    for op in ops:
+        if not op.startswith("["):
+            continue
+        size, at, corner = op[1:-1].partition("@")
+        try:
+            origin = [float(v) for v in corner.split(",")] if at else [0.0, 0.0, 0.0]
+        except ValueError:
+            origin = []
+        if (parse_lengths(size, 3, max_mm=cap) is None or len(origin) != 3
+                or not np.isfinite(origin).all()):
+            e = 1 / MM_PER_UNIT[units]
+            raise UsageError(
+                f"--block {spec}: a resize must be [WxDxH] or [WxDxH@X,Y,Z] in {said} (X,Y,Z the "
+                f"corner in the block before it), each side > 0 and <= "
+                f"{fmt_length(MAX_BLOCK_SIZE_MM, units, 5)}; got {op}, e.g. "
+                f"'builtin:knotty[{40 * e:.3g}x{30 * e:.3g}x{20 * e:.3g}@{5 * e:.2g},{5 * e:.2g},{5 * e:.2g}]'")
 
 
 def as_typed(args: argparse.Namespace, dest: str):
