@@ -107,11 +107,11 @@ def say_volume(mm3: float, spec: str = ".4g", *, units: Units | None = None) -> 
     return f"{mm3:{spec}} mm^3" if units == "mm" else fmt_volume(mm3, units)
 
 
-def say_area(mm2: float, spec: str = ".4g") -> str:
-    """An area given in mm^2, for a message, in the message units (:func:`message_units`): in
-    mm^2 with the message's ``spec``, in inches^2 with four significant digits:
+def say_area(mm2: float, spec: str = ".4g", *, units: Units | None = None) -> str:
+    """An area given in mm^2, for a message, in the message units (:func:`message_units`) or
+    ``units``: in mm^2 with the message's ``spec``, in inches^2 with four significant digits:
     ``say_area(645.16) == "645.2 mm^2"``, under ``--units inch`` ``"1 in^2"``."""
-    units = _message_units
+    units = units or _message_units
     if units == "mm":
         return f"{mm2:{spec}} mm^2"
     return f"{mm2 / MM_PER_UNIT[units] ** 2:.4g} {_SYMBOL[units]}^2"

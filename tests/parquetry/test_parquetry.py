@@ -167,6 +167,27 @@ def test_fabricability_check_catches_thin_and_tight_pieces():
     assert any("narrower" in m for m in check_piece(tongue, 5, 0))
 
 
+def test_check_piece_says_min_piece_in_the_message_units():
+    """Sweep h16 item B: under --units inch the narrowness problems said "0.0155 in^2 of it is
+    narrower than min_piece_mm = 5 mm": the area in inches beside the length in mm."""
+    from woodcam.units import message_units, say_area
+
+    def poly(pts):
+        pts = [np.array(p, float) for p in pts]
+        return [("L", a, b) for a, b in zip(pts, pts[1:] + pts[:1])]
+
+    strip = poly([(0, 0), (20, 0), (20, 3), (0, 3)])
+    tongue = poly([(0, 0), (10, 0), (10, 4), (26, 4), (26, 6), (10, 6), (10, 10), (0, 10)])
+    assert "min_piece_mm = 5 mm (a disc" in check_piece(strip, 5, 1)[0]
+    with message_units("inch"):
+        said = check_piece(strip, 5, 1) + check_piece(tongue, 5, 0)
+        assert said[0].startswith("narrower than min_piece_mm = 0.1969 in (a disc"), said
+        assert any(" in^2 of it is narrower than min_piece_mm = 0.1969 in away" in m for m in said), said
+        assert not any(" mm" in m for m in said), said
+        assert say_area(645.16, units="mm") == "645.2 mm^2"  # a summary's units over the message's
+    assert say_area(645.16, units="inch") == "1 in^2"
+
+
 def test_seams_are_6_connected_and_in_their_bands(finished):
     run, _, _ = finished
     p = run.panels[0]

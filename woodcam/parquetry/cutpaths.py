@@ -208,7 +208,7 @@ def check_piece(segs: list, min_piece_mm: float, tool_radius_mm: float) -> list[
     orient = np.sign(_signed_area(poly))
     inner = shp.buffer(-r * (1 - 1e-6))
     if inner.is_empty or inner.geom_type != "Polygon":
-        problems.append(f"narrower than min_piece_mm = {min_piece_mm:g} mm (a disc of that "
+        problems.append(f"narrower than min_piece_mm = {say_length(min_piece_mm, 'g')} (a disc of that "
                         "diameter does not fit, or the piece has a neck)")
     else:
         # What a disc of diameter min_piece_mm cannot reach must be corner tips only: every
@@ -230,7 +230,7 @@ def check_piece(segs: list, min_piece_mm: float, tool_radius_mm: float) -> list[
                       if g.area > 1e-4 and not g.buffer(-PARQUETRY_WIDTH_TOL_MM).is_empty]
         if thin_parts:
             problems.append(f"{say_area(sum(g.area for g in thin_parts), '.2f')} of it is narrower than "
-                            f"min_piece_mm = {min_piece_mm:g} mm away from its corners")
+                            f"min_piece_mm = {say_length(min_piece_mm, 'g')} away from its corners")
     # Concave bends: orientation sign s = +1 for a counter-clockwise outline in a y-up sense.
     worst = np.inf
     t = np.linspace(0, 1, 17)
