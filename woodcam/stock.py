@@ -90,8 +90,10 @@ def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:
         raise WoodcamError(f"resize_stock: stock.wood must be a woodcam Wood (its growth field and colours "
                            f"move with the origin); got {type(stock.wood).__name__}; open the stock with open_stock")
     # the wood itself moved, not only its colours: a wrapper shifted color() and left the growth
-    # field (wood.years, wood.features) the parent's at the stock's own points
-    wood = stock.wood.shifted(origin) if origin.any() else stock.wood
+    # field (wood.years, wood.features) the parent's at the stock's own points. Shifted at the
+    # origin too: the wood then knows it is a cut piece (Wood.in_source_frame), not the fitted
+    # block whose photos name the faces (the uncertainty advice named them as this stock's)
+    wood = stock.wood.shifted(origin) if isinstance(stock.wood, Wood) else stock.wood
     return Stock(spec, (W, D, H), wood, stock.description,
                  {**stock.meta, "parent_size_mm": list(stock.size_mm),
                   "origin_mm": origin.tolist()})

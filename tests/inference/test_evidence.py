@@ -409,6 +409,27 @@ def test_a_resized_stock_is_told_the_fitted_blocks_nearest_face():
     assert whole.endswith("photograph the right face or trace its rings")
 
 
+def test_a_stock_cut_at_the_fitted_blocks_corner_is_a_cut_piece():
+    """Sweep h16 item C: resize_stock at origin (0, 0, 0) kept the parent's wood (no
+    Wood.shifted), so the cut piece passed for the fitted block (in_source_frame) and the advice
+    said "photograph the left face": this 40 mm stock's left, not the 100 mm fitted block's."""
+    from woodcam.appearance.wood import Wood
+    from woodcam.stock import Stock, resize_stock
+
+    size = (100.0, 30.0, 20.0)
+    x = np.stack(np.meshgrid(*[np.linspace(0, s, k) for s, k in zip(size, (21, 7, 5))], indexing="ij"), -1)
+    grid = GridField(x[..., 0] / 3.0, (0.0, 0.0, 0.0), (5.0, 5.0, 5.0),
+                     layers={"uncertainty": 0.02 * x[..., 0]},  # a guess further right
+                     meta={"faces": ["front", "back", "top", "bottom"], "size_mm": list(size)})
+    small = resize_stock(Stock("test", size, Wood(grid), "a fitted block", {}), (40.0, 30.0, 20.0))
+    assert not small.wood.in_source_frame and small.spec == "test[40x30x20]"
+    p = np.random.default_rng(0).uniform(0, 1, (3000, 3)) * small.size_mm
+    np.testing.assert_allclose(small.wood.years(p), grid(p), atol=1e-9)  # the same wood, unmoved
+    line = uncertainty_report(small.wood, p, small.size_mm, "bowl")
+    assert line.startswith("the rings in the right third (left-right) of this bowl are uncertain")
+    assert line.endswith("photograph the fitted block's left face or trace its rings"), line
+
+
 def test_a_field_with_an_uncertainty_layer_but_no_reader_has_none():
     """Wood.has_uncertainty tested the layer alone (evaluate's copy also wanted a callable
     uncertainty_years): a field with an 'uncertainty' layer and no reader was said to carry
