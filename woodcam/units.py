@@ -127,6 +127,8 @@ def said(make: Callable[[], str]) -> str:
     """The message ``make()`` builds (with :func:`say_length` ...) in the message units, keeping
     its text in mm for a file (:func:`filed`): files written stay in millimetres whatever
     ``--units`` says, while the same warning on the terminal follows it."""
+    if _message_units == "mm":  # the same text either way: build it once
+        return make()
     text = _Said(make())
     with message_units("mm"):
         text.in_mm = make()

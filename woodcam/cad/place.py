@@ -85,7 +85,7 @@ def placement_matrix(ops: Sequence[str], bounds_mm, size_mm, *,
     if as_typed is not None and len(as_typed) != len(ops):
         raise WoodcamError(f"placement_matrix: as_typed must hold one text per operation ({len(ops)}); "
                            f"got {len(as_typed)}: {list(as_typed)!r}; pass the ops as typed, or leave it out")
-    for mm_op, op in zip(ops, ops if as_typed is None else as_typed, strict=True):
+    for mm_op, op in zip(ops, ops if as_typed is None else as_typed):  # lengths checked above
         # ``op`` (as typed) is what the errors quote; ``arg`` (mm) is what is computed
         name, _, arg = str(mm_op).strip().partition(":")
         name = name.lower()

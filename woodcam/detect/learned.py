@@ -54,14 +54,14 @@ RING_NET_MEMBERS = ("main", "quilted")
 #: (committed 0.791, v2 0.723 / 0.726); 0.67 gave 0.468 / 0.745 but 0.743 / 0.746, the
 #: geometric mean 0.769 / 0.769 but 0.453 / 0.694.
 QUILTED_MEMBER_WEIGHT = 0.5
-#: Colours of the training faces (:attr:`RingNetSpec.style`).
-TRAINING_STYLES = ("plain", "realistic", "mixed", "quilted", "mixed-quilted", "quilted-softwood")
-#: The styles that paint some training cubes with real photos' texture (need ``texture_samples``).
-QUILTED_STYLES = ("quilted", "mixed-quilted", "quilted-softwood")
 #: Per style, the colour of training cube ``i``: entry ``i % len(...)``.
 _CUBE_STYLES = {"plain": ("plain",), "realistic": ("realistic",), "mixed": ("plain", "realistic", "realistic"),
                 "quilted": ("plain", "quilted", "quilted"), "mixed-quilted": ("plain", "realistic", "quilted"),
                 "quilted-softwood": ("plain", "quilted", "softwood", "quilted", "quilted")}
+#: Colours of the training faces (:attr:`RingNetSpec.style`): the styles above, one home.
+TRAINING_STYLES = tuple(_CUBE_STYLES)
+#: The styles that paint some training cubes with real photos' texture (need ``texture_samples``).
+QUILTED_STYLES = ("quilted", "mixed-quilted", "quilted-softwood")
 
 
 def cube_style(style: str, i: int) -> str:

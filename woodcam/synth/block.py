@@ -7,7 +7,7 @@ import numpy as np
 from .._types import ArrayLike, GrowthFieldLike, WoodLike
 from ..block import Block, Face
 from ..errors import WoodcamError
-from ..fields.base import LogFrame, check_texture_frame, evaluate
+from ..fields.base import LogFrame, evaluate
 from ..fields.rings import MOKUME_RING_SIGMA_MM, ring_map
 from ..frames import (
     FACE_NORMAL,
@@ -75,7 +75,6 @@ def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | No
     if wood is not None and texture_frame is not None:
         raise WoodcamError("texture_frame is for the built-in colours; a given wood draws its own texture "
                            f"(got wood={type(wood).__name__} and a texture_frame); pass one of them")
-    check_texture_frame(texture_frame)
     faces = list(spec.faces)
     trace_faces = set(faces if spec.trace_faces is None else spec.trace_faces)
     ring_map_faces = set(faces if spec.ring_map_faces is None else spec.ring_map_faces)

@@ -116,14 +116,15 @@ def ring_training_faces(spec, progress: bool = False, sources=None) -> tuple[np.
 
     from ..detect.learned import QUILTED_STYLES, augment_photo, cube_style, net_input
 
-    if getattr(spec, "style", "plain") in QUILTED_STYLES and sources is None:
+    style = getattr(spec, "style", "plain")
+    if style in QUILTED_STYLES and sources is None:
         sources = texture_sources(spec.texture_samples, progress)
 
     xs, ys = [], []
     for i in progress_bar(range(spec.n_blocks), desc="synthesising faces", unit="block", enabled=progress):
         rng = np.random.default_rng([spec.seed, i, 7])
         size = (50.0, 50.0, 50.0)
-        kind = cube_style(getattr(spec, "style", "plain"), i)
+        kind = cube_style(style, i)
         pattern = PATTERNS[i % len(PATTERNS)]
         # quilted cubes: rings no narrower than the evaluation faces' 1.5 mm, so real texture is
         # not shrunk five-fold into noise (the real faces' spacings read 3-12 mm)

@@ -457,6 +457,8 @@ def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind,
                              np.ascontiguousarray(b, float), js, is_, wy, wx, dx, dy,
                              np.asarray(lines, np.int64), depth)
         for k in np.flatnonzero((kind == RAPID) & (depth > SIM_CONTACT_TOL_MM)):
+            if ("rapid_through_stock", int(lines[k])) in issues:  # _add keeps a line's first
+                continue
             _add(issues, "rapid_through_stock", lines[k],
                  said(lambda: f"rapid move (G0) cuts up to {say_length(depth[k], '.3f')} into the stock"),
                  _first_contact(tool, a[k], b[k], before[k], js[k], is_[k], dx, dy))
@@ -484,7 +486,7 @@ def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind,
         for k in np.flatnonzero(rap):
             cur = hm[js[k]:js[k] + wy, is_[k]:is_[k] + wx]
             depth = float((cur - env[k]).max())
-            if depth > SIM_CONTACT_TOL_MM:
+            if depth > SIM_CONTACT_TOL_MM and ("rapid_through_stock", int(lines[k])) not in issues:
                 _add(issues, "rapid_through_stock", lines[k],
                      said(lambda: f"rapid move (G0) cuts up to {say_length(depth, '.3f')} into the stock"),
                      _first_contact(tool, a[k], b[k], cur, js[k], is_[k], dx, dy))
