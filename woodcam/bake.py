@@ -221,19 +221,22 @@ def bake(
     if unwrap not in get_args(UnwrapMode):
         raise WoodcamError(f"bake: unwrap must be one of {get_args(UnwrapMode)}; got {unwrap!r}")
     verts_in = np.asarray(mesh.vertices, dtype=np.float64)
+    # "smooth": the input's vertex normals, read once; the colour lookup interpolates them and
+    # the result mesh keeps them as its shading normals (_bake_atlas)
+    vertex_normals = (np.asarray(mesh.vertex_normals, dtype=np.float64) if normals == "smooth"
+                      else None)
 
     def colours(vmap, faces, xy):
         # xatlas keeps face order, so output face i is input face i.
         point_map = _affine_maps(xy, faces, verts_in[vmap])
-        if normals == "face":
+        if vertex_normals is None:
             face_normals = np.asarray(mesh.face_normals, dtype=np.float64)
         else:
-            normal_map = _affine_maps(xy, faces, np.asarray(mesh.vertex_normals,
-                                                             dtype=np.float64)[vmap])
+            normal_map = _affine_maps(xy, faces, vertex_normals[vmap])
 
         def paint(t, cx, cy):
             points = _apply_affine(point_map, t, cx, cy)
-            if normals == "face":
+            if vertex_normals is None:
                 nrm = face_normals[t]
             else:
                 nrm = _apply_affine(normal_map, t, cx, cy)
@@ -242,24 +245,22 @@ def bake(
             return np.round(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
         return paint
 
-    result = _bake_atlas(mesh, float(texels_per_mm), int(max_atlas_px), int(padding_px), unwrap,
-                         colours, progress=progress, t_start=t_start)
-    if normals == "smooth":
-        # Shading normals from the unsplit input, so viewers show no shading seam where xatlas
-        # split vertices (normals recomputed on the split mesh differ on each side of a seam).
-        # The GLB exporter writes them as NORMAL; "face" mode leaves them out (flat shading).
-        result.mesh.vertex_normals = np.asarray(mesh.vertex_normals, dtype=np.float64)[result.vertex_map]
-        result.timings["total"] = time.perf_counter() - t_start
-    return result
+    return _bake_atlas(mesh, float(texels_per_mm), int(max_atlas_px), int(padding_px), unwrap,
+                       colours, progress=progress, t_start=t_start, vertex_normals=vertex_normals)
 
 
 def _bake_atlas(mesh, tpm: float, max_px: int, padding: int, unwrap: str, colours, *,
-                progress: bool = False, t_start: float) -> BakeResult:
+                progress: bool = False, t_start: float,
+                vertex_normals: np.ndarray | None = None) -> BakeResult:
     """The pipeline :func:`bake` and :func:`rebake_texture` share: unwrap, rasterise, colour
     every covered texel, dilate, and the textured mesh. Only the colour source differs:
     ``colours(vmap (m,), faces (f, 3), xy (m, 2) texel coordinates) -> paint``, and
     ``paint(tri (k,), cx (k, 1), cy (k, 1)) -> (k, 3) uint8`` colours the texels whose centres
     ``(cx, cy)`` (texels) lie in output faces ``tri``, called in batches of MAX_BATCH_POINTS.
+    ``vertex_normals`` (optional, (n, 3) unit, the INPUT mesh's) become the result mesh's
+    shading normals, split with its vertices: no shading seam where the unwrap split vertices
+    (normals recomputed on the split mesh differ on each side of a seam; ``export_glb(...,
+    normals="mesh")`` writes them as they are). ``timings["total"]`` runs from ``t_start``.
     Arguments are checked by the callers; warnings are raised at their callers."""
     import trimesh
 
@@ -299,7 +300,8 @@ def _bake_atlas(mesh, tpm: float, max_px: int, padding: int, unwrap: str, colour
     timings["dilate"] = time.perf_counter() - t0
 
     uv = np.column_stack([xy[:, 0] / img_w, 1.0 - xy[:, 1] / img_h])
-    out = _textured_mesh(trimesh, np.asarray(mesh.vertices, dtype=np.float64)[vmap], faces, uv, atlas)
+    out = _textured_mesh(trimesh, np.asarray(mesh.vertices, dtype=np.float64)[vmap], faces, uv, atlas,
+                         None if vertex_normals is None else vertex_normals[vmap])
     timings["total"] = time.perf_counter() - t_start
     for msg in messages:
         warnings.warn(msg, WoodcamWarning, stacklevel=3)  # at the caller of bake / rebake_texture
@@ -351,9 +353,9 @@ def bake_charts(mesh, uv_px, size_px, texels, wood, *, texels_per_mm: float,
     timings["dilate"] = time.perf_counter() - t0
     uv_px = np.asarray(uv_px, float)
     uv = np.column_stack([uv_px[:, 0] / w, 1.0 - uv_px[:, 1] / h])
-    out = _textured_mesh(trimesh, np.asarray(mesh.vertices), np.asarray(mesh.faces), uv, atlas)
-    if vertex_normals is not None:
-        out.vertex_normals = vertex_normals  # exported as is (export normals="mesh")
+    # vertex_normals exported as they are (export normals="mesh")
+    out = _textured_mesh(trimesh, np.asarray(mesh.vertices), np.asarray(mesh.faces), uv, atlas,
+                         vertex_normals)
     timings["total"] = time.perf_counter() - t_start
     messages = list(messages)
     for msg in messages:
@@ -874,7 +876,10 @@ def _dilate(atlas: np.ndarray, coverage: np.ndarray) -> np.ndarray:
     return atlas.reshape(h * w, -1)[source].reshape(atlas.shape)
 
 
-def _textured_mesh(trimesh, verts, faces, uv, atlas):
+def _textured_mesh(trimesh, verts, faces, uv, atlas, vertex_normals=None):
+    """The baked mesh: ``verts (m, 3)`` mm, ``faces (f, 3)``, ``uv (m, 2)`` (origin bottom-left),
+    the atlas as its PBR base colour, and ``vertex_normals (m, 3)`` (optional) as its shading
+    normals (none: trimesh computes them from the faces on demand)."""
     from PIL import Image
 
     material = trimesh.visual.material.PBRMaterial(
@@ -884,4 +889,5 @@ def _textured_mesh(trimesh, verts, faces, uv, atlas):
         roughnessFactor=0.8,  # unfinished / satin wood; a viewer-side choice, not measured
     )
     visual = trimesh.visual.TextureVisuals(uv=uv, material=material)
-    return trimesh.Trimesh(vertices=verts, faces=faces, visual=visual, process=False)
+    return trimesh.Trimesh(vertices=verts, faces=faces, visual=visual, vertex_normals=vertex_normals,
+                           process=False)
