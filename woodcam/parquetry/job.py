@@ -243,21 +243,30 @@ _ENTRY_KEYS = {"source_textures": {"texture", "mask", "id", "scale", "dpi", "px_
 _BLOCK_KEYS = {"spec", "sheets", "width_mm", "height_mm", "thickness_mm", "kerf_mm", "axis", "species", "id"}
 
 
+def _refuse_unknown_keys(where: str, objects: list[tuple[str, dict, set[str]]], why: str) -> None:
+    """The one check of a job file's keys: ``objects`` are ``(at, object, known keys)``, ``at``
+    the object's place in the file (``""`` at the top, ``"targets[0]."``); the first key, in
+    that order and sorted, that is not known is refused as ``key {at}'k' is unknown ({why})``
+    with the keys known there (a typo was ignored and the run took the default)."""
+    for at, obj, known in objects:
+        unknown = sorted(set(obj) - known)
+        if unknown:
+            raise WoodcamError(f"{where} key {at}{unknown[0]!r} is unknown ({why}); the known ones "
+                               f"there: {', '.join(sorted(known))}")
+
+
 def _unused_keys(d: dict, where: str) -> None:
     """Refuse keys of a job file that neither woodcam nor the reference code reads (a typo:
     ``num_source_rotation`` was ignored), warn of those it reads that woodcam has no use for."""
-    unknown = [("", k, _TOP_KEYS) for k in sorted(set(d) - _TOP_KEYS)]
+    objects = [("", d, _TOP_KEYS)]
     for key in ("source_textures", "targets"):
         for i, t in enumerate(d.get(key, [])):
-            unknown += [(f"{key}[{i}].", k, _ENTRY_KEYS[key]) for k in sorted(set(t) - _ENTRY_KEYS[key])]
+            objects.append((f"{key}[{i}].", t, _ENTRY_KEYS[key]))
             if key == "source_textures" and "json" in t:
                 raise WoodcamError(f"{where} {key}[{i}] describes its texture in another file ('json': "
                                    f"{t['json']!r}), which woodcam does not read; give its 'texture', "
                                    "'dpi' and 'mask' in this entry")
-    if unknown:
-        at, k, known = unknown[0]
-        raise WoodcamError(f"{where} key {at}{k!r} is unknown (neither woodcam nor the reference code "
-                           f"reads it); the known ones there: {', '.join(sorted(known))}")
+    _refuse_unknown_keys(where, objects, "neither woodcam nor the reference code reads it")
     said = [f"{k} ({why})" for k, why in _PAPER_UNUSED.items() if k in d]
     if d.get("weight_gabor"):
         said.append(f"weight_gabor = {d['weight_gabor']!r} (woodcam matches intensity and Sobel edges, "
@@ -320,11 +329,9 @@ def read_job(path: str | Path) -> ParquetryJob:
     targets = _entries(d, "targets", where, "filename")
     scans = _entries(d, "source_textures", where, "texture")
     blocks = _entries(extra, "blocks", f"{where} woodcam", "spec")
-    for i, b in enumerate(blocks):  # a typo ("sheet": 3) ran with the default
-        unknown = sorted(set(b) - _BLOCK_KEYS)
-        if unknown:
-            raise WoodcamError(f"{where} key woodcam.blocks[{i}].{unknown[0]!r} is unknown (woodcam reads "
-                               f"no such key); the known ones there: {', '.join(sorted(_BLOCK_KEYS))}")
+    # a typo ("sheet": 3) ran with the default
+    _refuse_unknown_keys(where, [(f"woodcam.blocks[{i}].", b, _BLOCK_KEYS) for i, b in enumerate(blocks)],
+                         "woodcam reads no such key")
     for i, t in enumerate(scans):  # px_per_mm won and the dpi or scale was dropped without a word
         if t.get("px_per_mm") is not None and (t.get("dpi") is not None or t.get("scale") is not None):
             raise WoodcamError(f"{where} source_textures[{i}] gives px_per_mm ({t['px_per_mm']!r}) and "
