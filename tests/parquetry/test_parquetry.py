@@ -854,6 +854,34 @@ def test_a_sheet_too_small_for_a_patch_and_its_whole_pixel_kerf_is_refused():
     assert len(build_parquetry(target, [v], prm, seams=False).patches) == 1
 
 
+@pytest.mark.parametrize("kerf_mm, margin", [(0.0, 0), (0.5, 1), (1.0 - 1e-12, 1), (1.0, 1), (1.0 + 1e-12, 1),
+                                             (1.2, 2), (2.0, 2), (2.5, 3)])
+def test_the_size_check_and_the_search_agree_on_the_kerf_at_the_sheet_edge(kerf_mm, margin):
+    """The engine's smallest sheet (a patch and edge_margin_px at both sides) and the wood the
+    search may use (SheetBank.usable, matching._clear_of) follow one kerf rule, also at whole
+    pixels (1 px: the pixel next to the edge lies exactly 1 + 1/2 + 1/2 px from the one off the
+    sheet). At that side a piece is placed; one pixel less holds no patch-wide run of usable
+    wood, and the size check refuses it."""
+    from woodcam.parquetry.matching import SheetBank, edge_margin_px
+
+    assert edge_margin_px(kerf_mm) == margin
+    prm = ParquetryParams(px_per_mm=1.0, patch_mm=10, overlap_mm=0, kerf_mm=kerf_mm, image_size_mm=20)
+    side = prm.patch_px + 2 * margin
+    target = np.zeros((20, 20, 3), np.float32)
+    for n in (side, side - 1):
+        bank = SheetBank([np.zeros((n, n), np.float32)], [np.ones((n, n), bool)], n_rot=1, kerf_px=kerf_mm)
+        run_px = int(bank.usable[0].sum(axis=1).max())  # the widest run of usable wood in a row
+        assert run_px == n - 2 * margin
+        v = Veneer(f"s{n}", np.full((n, n, 3), 0.5, np.float32), 1.0, np.ones((n, n), bool))
+        if n == side:
+            assert len(build_parquetry(target, [v], prm, seams=False).patches) == 1
+        else:
+            assert run_px < prm.patch_px
+            with pytest.raises(WoodcamError, match=rf"'s{n}' is .* smaller than one patch with its overlap "
+                               rf"and the kerf round it \({side:g} mm\)"):
+                build_parquetry(target, [v], prm, seams=False)
+
+
 def test_adaptive_patches_with_seams_cover_once_and_use_wood_once(tmp_path):
     """Mixed 14 and 28 mm pieces with seams: the cut files still tile the panel exactly and
     never share wood."""

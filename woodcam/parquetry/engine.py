@@ -9,7 +9,6 @@ to whole cells (Table 1: 360 mm -> 26 x 14 = 364 mm), the long side cropped cent
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass, field
 from typing import Literal
@@ -20,7 +19,7 @@ from ..errors import WoodcamError
 from ..units import say_length
 from .features import edge, features, intensity, match_histogram
 from .job import ParquetryParams
-from .matching import Match, SheetBank
+from .matching import Match, SheetBank, edge_margin_px
 from .veneers import Veneer
 
 
@@ -223,9 +222,10 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     sheets = [v.resampled(params.px_per_mm) for v in veneers]
     top_cells = 2 ** params.n_adaptive
     # a piece keeps the kerf clear of the sheet's edges (SheetBank.clears_edges): the search
-    # uses whole pixels, ceil(kerf_px) of them lost at each edge (matching._clear_of; a 13 px
-    # sheet passed for a 10 px patch at a 1.2 px kerf and placed nothing)
-    need_px = params.patch_px + 2 * params.overlap_px + 2 * math.ceil(params.kerf * params.px_per_mm - 1e-9)
+    # uses whole pixels, edge_margin_px of them lost at each edge (a 13 px sheet passed for a
+    # 10 px patch at a 1.2 px kerf and placed nothing)
+    kerf_px = params.kerf * params.px_per_mm
+    need_px = params.patch_px + 2 * params.overlap_px + 2 * edge_margin_px(kerf_px)
     for v in sheets:
         h, w = v.rgb.shape[:2]
         if min(h, w) < need_px:
@@ -238,7 +238,7 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     if src_vals.size > 2_000_000:   # the CDF needs no more samples than this
         src_vals = src_vals[np.random.default_rng(0).choice(src_vals.size, 2_000_000, replace=False)]
     bank = SheetBank(grey, [v.mask for v in sheets], params.w_intens, params.w_edge, params.n_rot,
-                     kerf_px=params.kerf * params.px_per_mm, mode=params.mode,
+                     kerf_px=kerf_px, mode=params.mode,
                      coarse_factor=params.coarse_factor_for(sum(g.size for g in grey)),
                      top_k=params.top_k,
                      single_use=params.single_use, w_struct=params.w_struct,

@@ -27,6 +27,7 @@ the blocked pixels rules out anchors whose window touches used or unusable wood.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Literal
 
@@ -889,19 +890,39 @@ def _structure_penalty(gs: np.ndarray, gt: np.ndarray, scale: float = 1.0) -> fl
     return float(np.mean(1.0 - cs))
 
 
+def _clear_distance_px(kerf_px: float) -> float:
+    """The search's kerf rule, its one home: the least distance (px, centre to centre,
+    Euclidean) from a pixel a piece may cover to the nearest unusable pixel or pixel off the
+    sheet: ``kerf_px``, plus the half pixel from a footprint's edge to its centres, plus the half
+    pixel from an unusable pixel's side to its centre; less 1e-9, so a kerf of whole pixels (a
+    distance met exactly) leaves exactly that many."""
+    return kerf_px + 1.0 - 1e-9
+
+
+def edge_margin_px(kerf_px: float) -> int:
+    """Whole pixels the search loses along each straight edge of a sheet at ``kerf_px``
+    (:func:`_clear_of` along a row: the pixel ``c`` px in from the edge lies ``c + 1`` px from
+    the first pixel off the sheet): ``ceil(kerf_px)``, 0 without a kerf. A sheet smaller than a
+    patch with this at both sides holds no piece (the engine's size check)."""
+    if kerf_px <= 0:
+        return 0
+    return math.ceil(_clear_distance_px(kerf_px)) - 1
+
+
 def _clear_of(usable: np.ndarray, kerf_px: float) -> np.ndarray:
     """The pixels of ``usable (h, w)`` bool whose centres lie at least ``kerf_px`` plus half a
     pixel from every unusable pixel's square and from the sheet's edge (off the sheet counts as
-    unusable): an axis-aligned footprint on them, whose edge lies half a pixel past its centres,
-    keeps the kerf clear. Measured centre to centre (Euclidean) less the half pixel to a square's
-    side, so a pixel diagonal to unusable wood is kept up to 0.2 px nearer; the exact test is
-    :meth:`SheetBank.clears_edges`. ``kerf_px <= 0`` keeps ``usable`` as it is."""
+    unusable; :func:`_clear_distance_px`): an axis-aligned footprint on them, whose edge lies
+    half a pixel past its centres, keeps the kerf clear. Measured centre to centre (Euclidean)
+    less the half pixel to a square's side, so a pixel diagonal to unusable wood is kept up to
+    0.2 px nearer; the exact test is :meth:`SheetBank.clears_edges`. ``kerf_px <= 0`` keeps
+    ``usable`` as it is."""
     from scipy.ndimage import distance_transform_edt
 
     if kerf_px <= 0:
         return usable.copy()
     d = distance_transform_edt(np.pad(usable, 1, constant_values=False))[1:-1, 1:-1]
-    return d >= kerf_px + 1.0 - 1e-9
+    return d >= _clear_distance_px(kerf_px)
 
 
 def _grow(poly: np.ndarray, d: float) -> np.ndarray:
