@@ -211,7 +211,7 @@ def test_messages_of_an_inch_run_quote_what_was_typed_and_speak_inches(tmp_path,
     import woodcam.view as view
     from woodcam.advise import SUBSURFACE_MM, report_text
     from woodcam.stock import spec_digest
-    from woodcam.units import fmt_size, fmt_span
+    from woodcam.units import fmt_size, fmt_span, say_length
 
     assert fmt_span(*SUBSURFACE_MM) == "1-3 mm" and fmt_span(*SUBSURFACE_MM, "inch") == "0.039-0.12 in"
     assert fmt_size((101.6, 81.28, 50.8), "inch") == "4x3.2x2 in" and fmt_size((100, 80, 50)) == "100x80x50 mm"
@@ -219,10 +219,11 @@ def test_messages_of_an_inch_run_quote_what_was_typed_and_speak_inches(tmp_path,
             "size_mm": [100.0, 80.0, 50.0]}
     glb = glb_with(meta, tmp_path / "tray.glb")
     seen = {}
-    monkeypatch.setattr(view, "preview", lambda mesh, **kw: seen.update(kw))
+    # the scene's messages (a cut plane missing the block) speak the message units, set for the run
+    monkeypatch.setattr(view, "preview", lambda mesh, **kw: seen.update(kw, inch=say_length(25.4)))
     assert main(["preview", str(glb), "--screenshot", "--units", "inch",
                  "--block", "builtin:flat-sawn:4x3.2x2"]) == 0
-    assert seen["units"] == "inch"  # the scene's messages (a cut plane missing the block) too
+    assert seen["inch"] == "1 in"
     err = capsys.readouterr().err
     assert ("--block builtin:flat-sawn:4x3.2x2 is not the block tray.glb was baked from "
             "(builtin:flat-sawn, 3.937x3.15x1.969 in)") in err

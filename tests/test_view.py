@@ -194,12 +194,15 @@ def test_a_cut_plane_that_misses_the_block_is_named(tmp_path):
                       r"\(1.0, 0.0, 0.0\) misses the block \(0 to 100x80x40 mm along X, Y, Z\)"):
         preview(box, wood=GreenWood(), size_mm=SIZE, cut_origin=(500.0, 0.0, 0.0),
                 cut_normal=(1.0, 0.0, 0.0), screenshot=tmp_path / "a.png", window_size=SMALL)
-    # in the user's units (preview --units inch --cut-origin 20,0,0 said "(508.0, 0.0, 0.0) mm")
-    with pytest.warns(WoodcamWarning, match=r"through \(20, 0, 0\) in with normal \(1.0, 0.0, 0.0\) "
-                      r"misses the block \(0 to 3.937x3.15x1.575 in along X, Y, Z\)"):
+    # in the message units, which the CLI sets to --units (preview --units inch --cut-origin
+    # 20,0,0 said "(508.0, 0.0, 0.0) mm")
+    from woodcam.units import message_units
+
+    with message_units("inch"), pytest.warns(WoodcamWarning, match=r"through \(20, 0, 0\) in with normal "
+                                             r"\(1.0, 0.0, 0.0\) misses the block \(0 to 3.937x3.15x1.575 in "
+                                             r"along X, Y, Z\)"):
         preview(box, wood=GreenWood(), size_mm=SIZE, cut_origin=(508.0, 0.0, 0.0),
-                cut_normal=(1.0, 0.0, 0.0), screenshot=tmp_path / "a.png", window_size=SMALL,
-                units="inch")
+                cut_normal=(1.0, 0.0, 0.0), screenshot=tmp_path / "a.png", window_size=SMALL)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         for origin in [(50.0, 0.0, 0.0), (100.0, 0.0, 0.0)]:

@@ -205,7 +205,7 @@ def run_preview(args: argparse.Namespace) -> int:
     out = preview(args.mesh, wood=wood, size_mm=stock.size_mm if stock else None,
                   screenshot=screenshot_path(args.screenshot, args.mesh),
                   camera=camera_of(args), cut_plane=not args.no_cut, cut_origin=args.cut_origin,
-                  cut_normal=args.cut_normal, units=args.units)
+                  cut_normal=args.cut_normal)
     if out:
         print(f"wrote {out}")
     return 0

@@ -36,7 +36,7 @@ from ..errors import WoodcamError, require
 from .._checks import check_vector
 from ..frames import check_size
 from ..tolerances import ON_FACE_TOL_MM
-from ..units import MM_PER_UNIT, Units, fmt_point, fmt_size
+from ..units import say_length
 from .camera import Camera, check_camera, default_cut_normal, set_camera
 from .section import (
     box_section_uv,
@@ -546,9 +546,9 @@ class SceneOptions:
         Cap on wood samples per section (see :func:`cut_plane_image`); default
         :data:`SECTION_MAX_SAMPLES_INTERACTIVE` with the plane widget (it redraws while
         dragged), else :data:`SECTION_MAX_SAMPLES_SCREENSHOT`.
-    units : "mm" | "inch"
-        The unit the scene's messages give lengths in (the CLI's ``--units``); the lengths
-        above stay millimetres.
+
+    The scene's messages give lengths in the message units (:func:`woodcam.units.message_units`,
+    which the CLI sets to ``--units``), as every library message does.
     """
 
     cut_plane: bool = True
@@ -558,12 +558,9 @@ class SceneOptions:
     cut_normal: tuple[float, float, float] | None = None
     resolution_mm: float = SECTION_RESOLUTION_MM
     max_samples: int | None = None
-    units: Units = "mm"
 
     def __post_init__(self) -> None:
         check_camera(self.camera)
-        if self.units not in MM_PER_UNIT:
-            raise WoodcamError(f"units must be one of {sorted(MM_PER_UNIT)}; got {self.units!r}")
         if self.cut_origin is not None:
             object.__setattr__(self, "cut_origin",
                                tuple(check_vector(self.cut_origin, "cut_origin", unit=False)))
@@ -643,9 +640,9 @@ def build_scene(
 
             from ..errors import WoodcamWarning
 
-            warnings.warn(f"the cut plane through {fmt_point(origin, opt.units)} with normal "
-                          f"{tuple(round(float(v), 3) for v in normal)} misses the block (0 to "
-                          f"{fmt_size(b[:, 1], opt.units)} along X, Y, Z), so nothing is cut; "
+            warnings.warn(f"the cut plane through {say_length(origin, '.4g', form='({}, {}, {})')} with "
+                          f"normal {tuple(round(float(v), 3) for v in normal)} misses the block (0 to "
+                          f"{say_length(b[:, 1], '.4g')} along X, Y, Z), so nothing is cut; "
                           "give --cut-origin (cut_origin) a point inside the block", WoodcamWarning,
                           stacklevel=3)
     plotter.set_background(opt.background)
