@@ -135,6 +135,29 @@ def test_separation_after_a_relief_is_that_of_the_faces_round_the_vertices(cylin
     assert np.allclose(expect, separation(mesh, sig)[ring], rtol=1e-12, atol=1e-15)
 
 
+def test_a_crack_year_frames_its_faces_once(cylinder, monkeypatch):
+    """The crack loop read a year's face frames into its arrays, then growth_stress computed the
+    same frames again from the mesh: now the loop hands its frames over, once per year for the
+    surface and once for last year's corners, and the stress is growth_stress's to the bit."""
+    from woodcam.woodify import cracks
+
+    mesh = cylinder.surface(4.0)
+    old, _ = trace_back(cylinder.front, mesh.vertices, until_mm=cylinder.tau(3.0))
+    ma = cracks._MeshArrays.of(mesh)
+    # the reference: growth_stress from the mesh itself
+    assert np.array_equal(cracks._growth_stress(ma.frames, ma.tri, old[ma.faces]), growth_stress(mesh, old))
+    # the frames: orthonormal columns in each face's plane (trimesh's face normals), to 1e-9
+    gram = np.einsum("fdk,fdl->fkl", ma.frames, ma.frames)
+    assert np.allclose(gram, np.eye(2), atol=1e-9)
+    assert np.abs(np.einsum("fdk,fd->fk", ma.frames, mesh.face_normals)).max() < 1e-9
+    calls = []
+    real = cracks._frames_of
+    monkeypatch.setattr(cracks, "_frames_of", lambda tri: calls.append(len(tri)) or real(tri))
+    simulate_cracks(cylinder, [2, 3, 4, 5])
+    faces = [len(cylinder.surface(y).faces) for y in (3, 4, 5)]
+    assert calls == [f for f in faces for _ in range(2)]  # each year: its surface, its old corners
+
+
 def test_vertex_neighbours_are_listed_in_trimeshs_order(cylinder):
     from woodcam.woodify.cracks import _neighbours
 

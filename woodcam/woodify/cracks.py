@@ -84,29 +84,33 @@ class CrackedSurface:
     log: list = dc_field(default_factory=list)
 
 
-def _frames(mesh):
-    """Per-face orthonormal in-plane basis ``(f, 3, 2)`` and unit normal ``(f, 3)``."""
-    tri = mesh.triangles
+def _frames_of(tri):
+    """Per-face orthonormal in-plane basis ``(f, 3, 2)`` (columns: along edge 01, then in-plane
+    across it) and unit normal ``(f, 3)`` of triangles ``tri (f, 3, 3)`` mm."""
     u = tri[:, 1] - tri[:, 0]
     v = tri[:, 2] - tri[:, 0]
     e1 = u / np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-12)
     n = np.cross(u, v)
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
-    e2 = np.cross(n, e1)
-    return np.stack([e1, e2], axis=2), n
+    return np.stack([e1, np.cross(n, e1)], axis=2), n
 
 
 def growth_stress(mesh, prev_positions) -> np.ndarray:
     """Per-face stress ``(f, 3, 3)`` of the stretch from ``prev_positions (n, 3)`` to ``mesh``."""
-    E, _ = _frames(mesh)
-    cur = mesh.vertices[mesh.faces]
-    old = np.asarray(prev_positions)[mesh.faces]
+    tri = np.asarray(mesh.triangles)
+    return _growth_stress(_frames_of(tri)[0], tri, np.asarray(prev_positions)[mesh.faces])
+
+
+def _growth_stress(E, cur, old) -> np.ndarray:
+    """:func:`growth_stress` on plain arrays: the faces' frames ``E (f, 3, 2)`` (:func:`_frames_of`
+    of ``cur``), their corners now ``cur (f, 3, 3)`` and a year earlier ``old (f, 3, 3)``, mm.
+    The crack loop passes the frames its year's surface already holds (:class:`_MeshArrays`)."""
     # edge matrices in the current face frame (2 x 2): columns are edges 01 and 02
     dc = np.stack([cur[:, 1] - cur[:, 0], cur[:, 2] - cur[:, 0]], axis=2)
     do = np.stack([old[:, 1] - old[:, 0], old[:, 2] - old[:, 0]], axis=2)
     Xc = np.einsum("fdk,fde->fke", E, dc)
     # the old edges in their own plane: project onto the old face's frame
-    Eo = _frames_of(old)
+    Eo, _ = _frames_of(old)
     Xo = np.einsum("fdk,fde->fke", Eo, do)
     det = np.linalg.det(Xo)
     good = np.abs(det) > 1e-12 * np.maximum(np.abs(np.linalg.det(Xc)), 1e-30)
@@ -119,15 +123,6 @@ def growth_stress(mesh, prev_positions) -> np.ndarray:
     return np.einsum("fik,fkl,fjl->fij", E, S2, E)
 
 
-def _frames_of(tri):
-    u = tri[:, 1] - tri[:, 0]
-    v = tri[:, 2] - tri[:, 0]
-    e1 = u / np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-12)
-    n = np.cross(u, v)
-    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
-    return np.stack([e1, np.cross(n, e1)], axis=2)
-
-
 def _split(sig):
     """Tensile and compressive parts ``(f, 3, 3)`` of symmetric tensors."""
     w, V = np.linalg.eigh(sig)
@@ -138,8 +133,8 @@ def _split(sig):
 
 def separation(mesh, stress) -> np.ndarray:
     """Per-vertex separation tensor ``(n, 3, 3)`` from per-face stress (module docstring)."""
-    _, nrm = _frames(mesh)
-    return _separation(mesh.faces, mesh.triangles, mesh.area_faces, nrm, stress, len(mesh.vertices))
+    tri = np.asarray(mesh.triangles)
+    return _separation(mesh.faces, tri, mesh.area_faces, _frames_of(tri)[1], stress, len(mesh.vertices))
 
 
 def _separation(faces, tri, area, nrm, stress, n_vertices) -> np.ndarray:
@@ -219,17 +214,19 @@ class _MeshArrays:
     normals: np.ndarray  # (n, 3) vertex normals
     tri: np.ndarray  # (f, 3, 3) corners
     area: np.ndarray  # (f,)
-    face_normals: np.ndarray  # (f, 3) unit, as _frames
+    frames: np.ndarray  # (f, 3, 2) in-plane bases, as _frames_of
+    face_normals: np.ndarray  # (f, 3) unit, as _frames_of
     vertex_faces: np.ndarray  # (n, k) int, -1 padded
     neighbours: list  # per vertex, list of vertex indices (trimesh's order)
 
     @classmethod
     def of(cls, mesh) -> _MeshArrays:
-        _, nrm = _frames(mesh)
+        tri = np.asarray(mesh.triangles).view(np.ndarray)
+        E, nrm = _frames_of(tri)
         return cls(np.asarray(mesh.vertices).view(np.ndarray), np.asarray(mesh.faces).view(np.ndarray),
-                   np.asarray(mesh.vertex_normals).view(np.ndarray),
-                   np.asarray(mesh.triangles).view(np.ndarray), np.asarray(mesh.area_faces).view(np.ndarray),
-                   nrm, np.asarray(mesh.vertex_faces).view(np.ndarray), _neighbours(mesh))
+                   np.asarray(mesh.vertex_normals).view(np.ndarray), tri,
+                   np.asarray(mesh.area_faces).view(np.ndarray), E, nrm,
+                   np.asarray(mesh.vertex_faces).view(np.ndarray), _neighbours(mesh))
 
 
 def _neighbours(mesh) -> list:
@@ -302,7 +299,7 @@ def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region
         V, nbrs = ma.verts, ma.neighbours
         origins, tri = wd.origins(V)
         old_pos, _ = trace_back(wd.front, V, wind=wd.speed.wind, until_mm=wd.tau(ys[k - 1]))
-        stress = growth_stress(mesh, old_pos)
+        stress = _growth_stress(ma.frames, ma.tri, old_pos[ma.faces])
         width = np.zeros(len(V))
         cracked_edges: set = set()
         if prev is not None:
