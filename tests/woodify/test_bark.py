@@ -135,6 +135,31 @@ def test_separation_after_a_relief_is_that_of_the_faces_round_the_vertices(cylin
     assert np.allclose(expect, separation(mesh, sig)[ring], rtol=1e-12, atol=1e-15)
 
 
+def test_separation_local_reads_only_the_faces_round_the_vertices(cylinder, monkeypatch):
+    """separation_local read the whole surface per call (neighbour lists, frames, vertex normals
+    and faces of every vertex) for the few faces round its vertices: now only those faces, with
+    the crack loop's read-once result to the bit."""
+    from woodcam.woodify import cracks
+
+    src = cylinder.surface(4.0)
+    old, _ = trace_back(cylinder.front, src.vertices, until_mm=cylinder.tau(3.0))
+    sig = growth_stress(src, old)
+    whole = cracks._MeshArrays.of(src)
+    rings = [np.array([5, 17, 400, 401, 1200, 3]), np.array([], int), np.arange(len(src.vertices)),
+             np.array([7, 7, 2])]
+    expect = [cracks._separation_local(whole, sig, r) for r in rings]
+
+    def whole_read(*_):
+        raise AssertionError("the whole surface was read")
+
+    monkeypatch.setattr(cracks, "_neighbours", whole_read)
+    monkeypatch.setattr(cracks._MeshArrays, "of", whole_read)
+    mesh = trimesh.Trimesh(src.vertices.copy(), src.faces.copy(), process=False)  # nothing cached
+    for ring, z in zip(rings, expect):
+        assert np.array_equal(separation_local(mesh, sig, ring), z)
+    assert "vertex_faces" not in mesh._cache.cache and "vertex_normals" not in mesh._cache.cache
+
+
 def test_a_crack_year_frames_its_faces_once(cylinder, monkeypatch):
     """The crack loop read a year's face frames into its arrays, then growth_stress computed the
     same frames again from the mesh: now the loop hands its frames over, once per year for the
