@@ -238,6 +238,28 @@ def test_a_members_folder_combines_the_members_probabilities_by_the_documented_m
     np.testing.assert_array_equal(det.confidence, p_both)
 
 
+def test_a_face_resolves_its_models_folder_once(tmp_path, monkeypatch):
+    """ring_probability runs per face and resolved the models folder once per member (the cache
+    key of each net): now once per call, the members loaded from that one key, the probability
+    the members' own to the bit."""
+    import pathlib
+
+    from woodcam.detect.learned import load_ring_net, ring_probability
+
+    both = _write_member(_write_member(tmp_path / "both", _TINY, seed=1), _TINY_QUILTED, seed=2, member="quilted")
+    photo = np.full((40, 44, 3), 128, np.uint8)
+    photo[:, ::9] = 40
+    first = ring_probability(photo, models_dir=both)
+    assert load_ring_net(both, "quilted") is load_ring_net(str(both) + "/", "quilted")   # one cache key
+    resolved = []
+    real = pathlib.Path.resolve
+    monkeypatch.setattr(pathlib.Path, "resolve", lambda self, *a, **k: resolved.append(self) or real(self, *a, **k))
+    again = ring_probability(photo, models_dir=both)
+    monkeypatch.undo()
+    assert resolved == [both]
+    assert np.array_equal(again, first)
+
+
 def test_a_broken_quilted_member_is_refused(tmp_path):
     """A quilted member that is half there, unreadable, of another shape than its spec, or not a
     quilted net is refused with the folder, the files and the fix, never skipped."""

@@ -324,9 +324,15 @@ _CACHE: dict = {}
 def load_ring_net(models_dir=MODELS_DIR, member: str = "main"):
     """The trained net (eval mode) ``member`` (:data:`RING_NET_MEMBERS`) of ``models_dir``;
     cached per folder and member."""
+    return _load_ring_net(models_dir, member, str(Path(models_dir).resolve()))
+
+
+def _load_ring_net(models_dir, member: str, folder_key: str):
+    """:func:`load_ring_net` with the folder's resolved path ``folder_key`` (the cache key) read by
+    the caller: :func:`ring_probability` resolves its folder once for all its members."""
     torch = require("torch", "learn", "the learned ring detector")
     spec_name, weights_name, _ = member_files(member)
-    key = (str(Path(models_dir).resolve()), member)
+    key = (folder_key, member)
     if key not in _CACHE:
         path = Path(models_dir) / weights_name
         if member == "main" and not path.is_file():
@@ -378,7 +384,8 @@ def ring_members(models_dir=MODELS_DIR) -> list[tuple[str, float]]:
     ``[("main", 1.0)]``, or with a quilted member (either of its files present; a half-present
     member is refused when loaded) ``[("main", 1 - w), ("quilted", w)]``, ``w`` =
     :data:`QUILTED_MEMBER_WEIGHT`."""
-    if any((Path(models_dir) / n).exists() for n in member_files("quilted")[:2]):
+    folder = Path(models_dir)
+    if any((folder / n).exists() for n in member_files("quilted")[:2]):
         return [("main", 1.0 - QUILTED_MEMBER_WEIGHT), ("quilted", QUILTED_MEMBER_WEIGHT)]
     return [("main", 1.0)]
 
@@ -391,7 +398,8 @@ def ring_probability(photo: np.ndarray, models_dir=MODELS_DIR) -> np.ndarray:
     h, w = x.shape
     ph, pw = (-h) % 4, (-w) % 4
     x = np.pad(x, ((0, ph), (0, pw)), mode="reflect")
-    members = [(load_ring_net(models_dir, m), wt) for m, wt in ring_members(models_dir)]
+    folder_key = str(Path(models_dir).resolve())  # once per face, not once per member
+    members = [(_load_ring_net(models_dir, m, folder_key), wt) for m, wt in ring_members(models_dir)]
     # one thread: the net is small, and on a 256 px face torch's two threads spent 0.69 CPU-s
     # where one spends 0.15 (the budget is 1 CPU-s per face for the whole detector)
     from .._threads import torch_threads
