@@ -147,7 +147,14 @@ def test_separation_local_reads_only_the_faces_round_the_vertices(cylinder, monk
     whole = cracks._MeshArrays.of(src)
     rings = [np.array([5, 17, 400, 401, 1200, 3]), np.array([], int), np.arange(len(src.vertices)),
              np.array([7, 7, 2])]
-    expect = [cracks._separation_local(whole, sig, r) for r in rings]
+
+    def read_once(ring):  # as the crack loop does it, from its read-once arrays
+        vf = whole.vertex_faces[ring]
+        f = np.unique(vf[vf >= 0])
+        return cracks._separation_round(whole.faces[f], whole.tri[f], whole.area[f], whole.face_normals[f], sig[f],
+                                        ring)
+
+    expect = [read_once(r) for r in rings]
 
     def whole_read(*_):
         raise AssertionError("the whole surface was read")
@@ -340,7 +347,7 @@ def test_paint_crack_faces_draws_an_edge_in_every_face_that_holds_it():
 def test_separation_local_takes_a_trimesh_only(cylinder):
     """The public separation_local took a trimesh or the module's private _MeshArrays (whatever
     had vertex_faces, faces, tri...): its input was a private type. Now a trimesh, checked at
-    the door; the crack loop's read-once arrays go through the private _separation_local."""
+    the door; the crack loop's read-once arrays go through the private _separation_round."""
     from woodcam.woodify.cracks import _MeshArrays
 
     mesh = cylinder.surface(4.0)

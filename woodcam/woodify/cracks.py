@@ -364,7 +364,9 @@ def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region
             faces = np.unique(vf[ring])
             faces = faces[faces >= 0]
             stress[faces] *= relief
-            z = _separation_local(ma, stress, ring)
+            # the separation of the ring from those same faces (not found again from the ring)
+            z = _separation_round(ma.faces[faces], ma.tri[faces], ma.area[faces], ma.face_normals[faces],
+                                  stress[faces], ring)
             lam_r, d_r = _crack_frame(z, ma.normals[ring], pattern, up, rng)
             current[ring] = lam_r
             d[ring] = d_r
@@ -419,14 +421,6 @@ def separation_local(mesh, stress, vertices) -> np.ndarray:
     round_ = np.flatnonzero(np.isin(faces, vertices).any(axis=1))
     tri = np.asarray(mesh.vertices).view(np.ndarray)[faces[round_]]
     return _separation_round(faces[round_], tri, triangle_areas(tri), _frames_of(tri)[1], stress[round_],
-                             vertices)
-
-
-def _separation_local(m: _MeshArrays, stress, vertices) -> np.ndarray:
-    """:func:`separation_local` on a surface read once (the crack loop calls it per crack)."""
-    vf = m.vertex_faces[vertices]
-    faces = np.unique(vf[vf >= 0])
-    return _separation_round(m.faces[faces], m.tri[faces], m.area[faces], m.face_normals[faces], stress[faces],
                              vertices)
 
 
