@@ -16,7 +16,7 @@ LAYERS: dict[str, int] = {
     # foundations: errors, tolerances, limits, atomic writes, content-keyed caches
     "errors": 0, "tolerances": 0, "_types": 0, "units": 0, "limits": 1, "_checks": 1, "_atomic": 1, "_cache": 2,
     "_interrupt": 0,                   # Ctrl-C recorded, so one a library swallowed still ends the run
-    "_specs": 0,                       # the paths a block spec names (strings and paths only)
+    "_specs": 2,                       # a block spec's grammar and the paths it names (errors, limits, units)
     "_readers": 2,                     # strict JSON and images of untrusted files (errors, limits)
     "_threads": 1,                     # BLAS thread limits for small linear algebra
     "_parallel": 1,                    # one fit on a machine's cores: forked pieces

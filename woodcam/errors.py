@@ -16,6 +16,18 @@ class UsageError(WoodcamError):
     contradict each other): caught before any work; the CLI exits 2, like argparse."""
 
 
+class BlockSpecError(WoodcamError):
+    """A block spec that breaks its grammar (:func:`woodcam._specs.parse_spec`); the message
+    names the spec in mm. ``part`` says which part ("size": the base's ``:WxDxH``; "resize",
+    "turn", "op": an operation not in the grammar; "log": ``log:LOG@KNOT``), ``text`` is that
+    part as written and ``rule`` the message without the spec, so the command line can say it
+    of its ``--block`` in the units typed."""
+
+    def __init__(self, message: str, *, part: str = "", text: str = "", rule: str = ""):
+        super().__init__(message)
+        self.part, self.text, self.rule = part, text, rule
+
+
 class MissingDependencyError(WoodcamError, ImportError):
     """An optional dependency is not installed; the message gives the install command."""
 

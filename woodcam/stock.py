@@ -42,7 +42,7 @@ from typing import Literal
 
 import numpy as np
 
-from ._specs import LOOSE_OP, spec_path, split_spec
+from ._specs import ParsedSpec, parse_spec, split_spec
 from .appearance import ColorMapAppearance, NeuralAppearance, Wood
 from .errors import WoodcamError, WoodcamWarning
 from .fields.builtin import BUILTIN_NAMES, builtin_block
@@ -125,13 +125,12 @@ def open_stock(spec: str, *, species: str | None = None,
     """
     if appearance not in ("colormap", "neural"):
         raise WoodcamError(f"appearance must be one of ['colormap', 'neural']; got {appearance!r}")
-    base, ops = _split_ops(spec)
+    parsed = parse_spec(spec)
     # built-in, log and woodify blocks have no photos: their colour map is the constructor's
     # (a folder's photos are known once it is read: _real_block_stock checks again)
-    _check_appearance_params(appearance, appearance_params,
-                             photos=not base.startswith(("builtin:", "log:", "woodify:")),
-                             where=f"block spec {base!r}")
-    stock = _open_base_stock(base, species, appearance, appearance_params, species_given)
+    _check_appearance_params(appearance, appearance_params, photos=parsed.kind == "folder",
+                             where=f"block spec {parsed.base!r}")
+    stock = _open_base_stock(parsed, species, appearance, appearance_params, species_given)
     if species is not None and species_given and stock.meta.get("appearance") == "neural":
         # nothing silently dropped: the neural volumes take every colour from the photos
         warnings.warn(f"--species {species}: the neural appearance learns every colour from the block's "
@@ -143,10 +142,10 @@ def open_stock(spec: str, *, species: str | None = None,
     stock.meta["appearance_params"] = {k: (list(v) if isinstance(v, tuple) else v)
                                        for k, v in used.items()
                                        if isinstance(v, (int, float, str, tuple, list))}
-    if not ops:
+    if not parsed.ops:
         return stock
     turns = []
-    for op in ops:  # in the order written: a resize of a turned block is cut in the turned frame
+    for op in parsed.ops:  # in the order written: a resize of a turned block is cut in the turned frame
         if op[0] == "resize":
             stock = resize_stock(stock, op[1], op[2])
         else:
@@ -215,108 +214,49 @@ def spec_digest(spec: str) -> str:
     from . import __version__
     from ._cache import digest
 
-    base, ops = _split_ops(spec)
-    path = spec_path(base)
+    parsed = parse_spec(spec)
+    path = parsed.path
     if path is not None and path.is_dir():
         files = sorted(p for p in path.rglob("*") if p.is_file() and not p.name.startswith("."))
         content = digest([(str(p.relative_to(path)), p) for p in files])
     elif path is not None and path.is_file():
         content = digest(path)
     else:
-        content = digest(base, __version__)
-    # the parsed operations: '~Z90' and '~z90.0' are one turn
-    return digest(content, repr(ops)) if ops else content
+        content = digest(parsed.base, __version__)
+    # the parsed operations: '~Z90' and '~z90.0' are one turn (a list's repr, as it always was)
+    return digest(content, repr(list(parsed.ops))) if parsed.ops else content
 
 
-def _split_ops(spec: str) -> tuple[str, list[tuple]]:
-    """``"SPEC~z90~x-90[40x30x20@5,5,5]"`` -> ``("SPEC", [("turn", "z", 1), ("turn", "x", -1),
-    ("resize", (40, 30, 20), (5, 5, 5))])`` (see module docstring)."""
-    base, texts = split_spec(spec)
-    loose, path = LOOSE_OP.search(base), spec_path(base)
-    bad = loose.group() if loose and not (path is not None and path.exists()) else None
-    if bad:  # not a turn or resize as written (~q90, [40x30]): named below as one, not a path
-        texts = [bad, *texts]
-    ops: list[tuple] = []
-    for text in texts:
-        if text.startswith("["):
-            ops.append(("resize", *_parse_resize(text[1:-1], spec)))
-            continue
-        part = text[1:]
-        axis, deg = part[:1].lower(), part[1:]
-        try:
-            quarter, rest = divmod(float(deg), 90.0)
-        except ValueError:
-            quarter, rest = 0, 1.0
-        if axis not in ("x", "y", "z") or rest != 0.0:
-            raise WoodcamError(
-                f"block spec {spec!r}: turn '~{part}' must be ~AXIS then a multiple of 90 degrees "
-                "(AXIS x, y or z), e.g. 'builtin:flat-sawn~z90'")
-        ops.append(("turn", axis, int(quarter)))
-    if bad:  # read above, yet not in the grammar
-        raise WoodcamError(f"block spec {spec!r}: {bad!r} is neither a turn ~AXIS then "
-                           "degrees nor a resize [WxDxH] or [WxDxH@X,Y,Z] (plain numbers, mm), "
-                           "e.g. 'builtin:knotty~z90[40x30x20@5,5,5]'")
-    return base, ops
-
-
-def _parse_resize(text: str, spec: str) -> tuple[tuple[float, float, float], tuple[float, ...]]:
-    """A spec's ``WxDxH`` or ``WxDxH@X,Y,Z`` (what :func:`resize_stock` writes) -> ``(size_mm,
-    origin_mm)``, mm."""
-    size_text, at, origin_text = text.partition("@")
-    size = _parse_size(size_text, spec)
-    try:
-        origin = tuple(float(v) for v in origin_text.split(",")) if at else (0.0, 0.0, 0.0)
-    except ValueError:
-        origin = ()
-    if len(origin) != 3 or not np.isfinite(origin).all():
-        raise WoodcamError(f"block spec {spec!r}: a resize must be [WxDxH] or [WxDxH@X,Y,Z] (the corner "
-                           f"in mm of the block before it), got [{text}], e.g. 'builtin:knotty[40x30x20@5,5,5]'")
-    return size, origin
-
-
-def _builtin(rest: str):
-    """``NAME`` or ``NAME:WxDxH`` -> ``(BuiltinBlock, field, size_mm)``; a given size cuts a block
-    of that size from the same wood, centred where the built-in block's centre is."""
-    import numpy as np
-
-    name, _, size_text = rest.partition(":")
-    b = builtin_block(name)
-    if not size_text:
+def _builtin(parsed: ParsedSpec):
+    """``builtin:NAME`` or ``builtin:NAME:WxDxH`` -> ``(BuiltinBlock, field, size_mm)``; a given
+    size cuts a block of that size from the same wood, centred where the built-in block's centre
+    is."""
+    b = builtin_block(parsed.source)
+    if parsed.size_mm is None:
         return b, b.field, tuple(b.size_mm)
-    size = _parse_size(size_text, f"builtin:{rest}")
+    size = parsed.size_mm
     from .fields.placement import PlacedField
 
     offset = (np.asarray(b.size_mm, dtype=float) - np.asarray(size)) / 2
     return b, PlacedField(b.field, origin_mm=offset), size
 
 
-def _parse_size(text: str, spec: str) -> tuple[float, float, float]:
-    """A block spec's ``WxDxH`` in mm, each side at most :data:`woodcam.limits.MAX_BLOCK_SIZE_MM`
-    (``--units inch`` checks a typed spec's size against it at the door, ``woodcam.cli.options``)."""
-    from .limits import MAX_BLOCK_SIZE_MM
-    from .units import parse_lengths
-
-    size = parse_lengths(text, 3, max_mm=MAX_BLOCK_SIZE_MM)
-    if size is None:
-        raise WoodcamError(
-            f"block spec {spec!r}: the size must be WxDxH in mm, each > 0 and <= "
-            f"{MAX_BLOCK_SIZE_MM:g}; got {text!r}, e.g. 300x120x40")
-    return size
-
-
-def _open_base_stock(spec: str, species, appearance, appearance_params, species_given=True) -> Stock:
-    if spec.startswith("builtin:"):
-        b, field, size = _builtin(spec.split(":", 1)[1])
+def _open_base_stock(parsed: ParsedSpec, species, appearance, appearance_params,
+                     species_given=True) -> Stock:
+    """The stock ``parsed``'s base names, before its turns and resizes."""
+    spec = parsed.base
+    if parsed.kind == "builtin":
+        b, field, size = _builtin(parsed)
         return _synthetic_stock(spec, field, size, species or b.species, b.description,
-                                appearance, appearance_params, _texture_frame(spec, field))
-    if spec.startswith("log:"):
-        field, size_mm, description, frame = _log_block_field(spec)
+                                appearance, appearance_params, _texture_frame(parsed, field))
+    if parsed.kind == "log":
+        field, size_mm, description, frame = _log_block_field(parsed)
         return _synthetic_stock(spec, field, size_mm, species or "spruce", description,
                                 appearance, appearance_params, frame)
-    if spec.startswith("woodify:"):
-        field, size_mm, description = _woodify_field(spec)
+    if parsed.kind == "woodify":
+        field, size_mm, description = _woodify_field(parsed)
         return _synthetic_stock(spec, field, size_mm, species or "oak", description,
-                                appearance, appearance_params, _texture_frame(spec, field))
+                                appearance, appearance_params, _texture_frame(parsed, field))
     path = _existing_folder(spec)
     if (path / "block.json").is_file():
         return _open_block_folder(path, species, appearance, appearance_params, species_given)
@@ -346,25 +286,27 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         folders that store one), else None: no field is fitted here.
     """
     base, ops = split_spec(spec)
-    if ops:  # "unknown built-in block 'flat-sawn~z90'" (or 'knotty[40x30x20]') said only
+    if ops:  # "unknown built-in block 'flat-sawn~z90'" (or 'knotty[40x30x20]') said only; named
+        # before the operations are read: this command takes none, however written
         kinds = sorted({"a turn" if op.startswith("~") else "a resize" for op in ops}, reverse=True)
         raise WoodcamError(
             f"block spec {spec!r}: {' and '.join(kinds)} ('{''.join(ops)}') is for the commands "
             f"that carve a part from the block (bake, gcode, place, review); this one reads the "
             f"block as it is: give {base!r}")
-    if spec.startswith(("builtin:", "log:", "woodify:")):
+    parsed = parse_spec(spec)  # a loose end ('[40x30]') named as the bad operation it is
+    if parsed.kind != "folder":
         from .synth import synth_block
 
-        if spec.startswith("builtin:"):
-            b, field, size = _builtin(spec.split(":", 1)[1])
+        if parsed.kind == "builtin":
+            b, field, size = _builtin(parsed)
             name = b.name if tuple(size) == tuple(b.size_mm) else spec.replace(":", "-")
-            frame = _texture_frame(spec, field)
-        elif spec.startswith("woodify:"):
-            field, size, _ = _woodify_field(spec)
-            name = "woodify-" + Path(spec.split(":", 1)[1]).parent.name
-            frame = _texture_frame(spec, field)
+            frame = _texture_frame(parsed, field)
+        elif parsed.kind == "woodify":
+            field, size, _ = _woodify_field(parsed)
+            name = "woodify-" + Path(parsed.source).parent.name
+            frame = _texture_frame(parsed, field)
         else:
-            field, size, _, frame = _log_block_field(spec)
+            field, size, _, frame = _log_block_field(parsed)
             name = spec.replace(":", "-").replace("/", "_")
         return synth_block(field, size, face_px=face_px, seed=0, name=name, texture_frame=frame), field
     from .block.io import read_block_folder
@@ -378,11 +320,11 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
     return block, block.true_field
 
 
-def _woodify_field(spec: str):
+def _woodify_field(parsed: ParsedSpec):
     """``woodify:PATH/field.npz`` -> (field, size_mm, description): the block stored in it."""
     from .woodify.field import WoodifiedField
 
-    path = spec.split(":", 1)[1]
+    path = parsed.source
     field = WoodifiedField.load(path)
     return field, field.block_size_mm, f"block cut from an object grown {field.years_final:g} years ({path})"
 
@@ -517,7 +459,7 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
 _LOG_BLOCK_SIZE_MM = (100.0, 80.0, 50.0)
 
 
-def _log_block_field(spec: str):
+def _log_block_field(parsed: ParsedSpec):
     """``log:LOG@K[:WxDxH]`` -> (block-frame field, size_mm, description, texture_frame): the
     texture frame is that of ``log:LOG@K`` (the block of the default size through the same knot)
     placed in this block's frame, None for the default size itself. Every size of block through
@@ -526,41 +468,33 @@ def _log_block_field(spec: str):
     from .fields import KnottedLogField, block_at_knot, place_block_in_log
     from .logs.io import read_gran1, read_log
 
-    body = spec[len("log:"):]
-    try:
-        source, rest = body.split("@", 1)
-        knot, _, size = rest.partition(":")
-        knot = int(knot)
-    except ValueError as err:
-        raise WoodcamError(
-            f"log block spec {spec!r} must read 'log:LOG@KNOT' or 'log:LOG@KNOT:WxDxH' "
-            "(e.g. log:gran1@52:100x80x50)"
-        ) from err
-    size_mm = _parse_size(size, spec) if size else _LOG_BLOCK_SIZE_MM  # 0x0x0, NaN, 1e9 were accepted
+    source, knot, spec = parsed.source, parsed.knot, parsed.base
+    assert knot is not None  # parse_spec reads a log block's knot
+    size_mm = parsed.size_mm or _LOG_BLOCK_SIZE_MM
     log = read_gran1() if source == "gran1" else read_log(source)
     if not 0 <= knot < len(log.knots):
         raise WoodcamError(f"knot index in {spec!r} must be 0..{len(log.knots) - 1}; got {knot}")
     log_field = KnottedLogField(log)
     field = place_block_in_log(log_field, *block_at_knot(log, knot, size_mm))
     frame = None
-    if size:  # the same log, read once: the default block's placement through the knot
+    if parsed.size_mm is not None:  # the same log, read once: the default block's placement through the knot
         default = place_block_in_log(log_field, *block_at_knot(log, knot, _LOG_BLOCK_SIZE_MM))
         frame = _frame_in(field.frame, default.frame)
     return field, size_mm, f"block through knot {knot} of log {source}", frame
 
 
-def _texture_frame(spec: str, field):
+def _texture_frame(parsed: ParsedSpec, field):
     """The frame a built-in or woodify block's texture is drawn in (colour map and synthetic
     photos alike), placed in its block frame, or None (its own): a sized built-in draws the whole
     block's, a woodify block the grown object's (two blocks placed differently in the same
     object, --block-size, --block-centre). The same wood has the same colours however it is cut.
     (A log block's frame, the default-size block's through the same knot, comes with the block
     from :func:`_log_block_field`, which reads the log once.)"""
-    if spec.startswith("builtin:"):  # a size given: the PlacedField of _builtin in the whole block
-        return field.frame if spec.split(":", 1)[1].partition(":")[2] else None
-    if spec.startswith("woodify:"):
+    if parsed.kind == "builtin":  # a size given: the PlacedField of _builtin in the whole block
+        return None if parsed.size_mm is None else field.frame
+    if parsed.kind == "woodify":
         return field.object_frame
-    raise ValueError(f"_texture_frame: no texture frame rule for {spec!r} (log blocks: "
+    raise ValueError(f"_texture_frame: no texture frame rule for {parsed.spec!r} (log blocks: "
                      "_log_block_field)")  # a programming error, never a user's input
 
 
