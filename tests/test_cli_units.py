@@ -3,6 +3,8 @@ millimetres give (2 in == 50.8 mm); defaults stay mm; summaries print in the uni
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 import woodcam.pipeline
@@ -418,3 +420,49 @@ def test_a_spec_resize_is_checked_as_typed_at_the_door(units, spec, tmp_path, ca
     assert err.startswith(f"woodcam: error: --block {spec}: a resize must be [WxDxH] or "
                           f"[WxDxH@X,Y,Z] in {said}"), err
     assert "25.4" not in err and "101.6" not in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("spec, stock_says, door_says", [
+    ("builtin:knotty:4x3x2:", "the size must be WxDxH in mm", "the size must be WxDxH in mm"),  # a trailing ':'
+    ("builtin:knotty[40 x30x20]", "'[40 x30x20]' is neither a turn", "a resize must be [WxDxH]"),
+    ("builtin:knotty~q90", "turn '~q90' must be ~AXIS", "turn '~q90' must be ~AXIS"),
+    ("builtin:knotty~z90 ", "'~z90 ' is neither a turn", "'~z90 ' is neither a turn"),
+    ("log:gran1@x:60x40x30", "a log block must read 'log:LOG@KNOT'", "a log block must read 'log:LOG@KNOT'"),
+])
+def test_the_door_refuses_what_the_stock_refuses(spec, stock_says, door_says, tmp_path, capsys):
+    """Sweep H1: the --block door check had a grammar of its own (a pattern for the :WxDxH, the
+    resizes by the ops' text), so it let through specs the stock refused once the command ran
+    (exit 1): a trailing ':', a space in a resize, a bad turn, a log block without a knot. It
+    now reads the spec with the stock's own reader (woodcam._specs.parse_spec)."""
+    from woodcam.errors import WoodcamError
+    from woodcam.stock import open_stock
+
+    with pytest.raises(WoodcamError, match=re.escape(stock_says)):
+        open_stock(spec)
+    assert main(["bake", "p.stl", "--block", spec, "--out", str(tmp_path / "x.glb")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"woodcam: error: --block {spec}: ") and door_says in err, err
+    assert err.count("\n") == 1
+
+
+@pytest.mark.parametrize("inch, mm", [
+    ("log:/data/~scan/l.json@2:4x3x2~z90[1x1x1@0.5,0,0]",
+     "log:/data/~scan/l.json@2:101.6x76.2x50.8~z90[25.4x25.4x25.4@12.7,0,0]"),
+    ("log:/data/logs[2]/l.json@2:4x3x2", "log:/data/logs[2]/l.json@2:101.6x76.2x50.8"),
+    ("builtin:knotty:4X3X2~Z90.0[2X1X1]", "builtin:knotty:101.6x76.2x50.8~z90[50.8x25.4x25.4]"),
+])
+def test_an_inch_spec_is_the_block_its_mm_spelling_is(inch, mm, tmp_path, capsys):
+    """Sweep H1: --units inch scaled a log block's :WxDxH only when its path had no '~' or '['
+    (a pattern of its own): 'log:/data/~scan/l.json@2:4x3x2' stayed a 4x3x2 mm block, and was
+    not checked at the door either. The spec is read once and written back in mm."""
+    from woodcam.stock import spec_digest
+
+    from woodcam._specs import parse_spec
+
+    got = _parsed("place", ["p.py", "--block", inch, "--out", "d"], "inch").block
+    assert spec_digest(got) == spec_digest(mm), got  # the same block, turns and resizes included
+    assert parse_spec(got).size_mm == pytest.approx(parse_spec(mm).size_mm, rel=1e-12)
+    big = inch.replace("4x3x2", "1000x1x1").replace("4X3X2", "1000x1x1")  # 25.4 m: refused as typed
+    assert main(["place", "p.stl", "--units", "inch", "--block", big, "--out", str(tmp_path / "d")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"woodcam: error: --block {big}: the size must be WxDxH in --units inch"), err

@@ -28,7 +28,7 @@ _OPS = re.compile(rf"(?:{_ONE_OP})+$")
 _OP = re.compile(_ONE_OP)
 #: The end of a base that looks like a turn or resize but is none (``~q90``, ``[40x30]``):
 #: named as a bad operation unless the base is an existing path.
-LOOSE_OP = re.compile(r"(?:~[^~\[\]/]*|\[[^\[\]/]*\])$")
+_LOOSE_OP = re.compile(r"(?:~[^~\[\]/]*|\[[^\[\]/]*\])$")
 
 SpecKind = Literal["builtin", "log", "woodify", "folder"]
 #: What part of a spec broke its grammar (:class:`woodcam.errors.BlockSpecError` ``part``).
@@ -127,7 +127,7 @@ def parse_spec(spec: str, *, mm_per_unit: float = 1.0) -> ParsedSpec:
     """
     text = str(spec)
     base, texts = split_spec(text)
-    loose = LOOSE_OP.search(base)
+    loose = _LOOSE_OP.search(base)
     path = _base_path(base)
     bad = loose.group() if loose and not (path is not None and path.exists()) else None
     if bad:  # not a turn or resize as written (~q90, [40x30]): named below as one, not a path

@@ -174,7 +174,7 @@ def _check_folder_can_be_made(folder: Path, command: str, option: str = "--out")
 # -- --units: lengths on the command line and in printed summaries ------------------------------
 #: ``(command, option dest)`` -> how the value holds lengths: "number" (float), "vector" (a
 #: tuple of floats), "sizes" (a text "WxH" of lengths), "spec" (a block
-#: spec's :WxDxH size), "place" (``--place`` operations: translate:X,Y,Z and fit:MARGIN),
+#: spec's :WxDxH size and its resizes, read by :func:`woodcam._specs.parse_spec`), "place" (``--place`` operations: translate:X,Y,Z and fit:MARGIN),
 #: "tools" (``--tool`` specs: diameters, corner radii, tips; angles stay degrees). ``--rapid-rate`` reads unit/min. Options whose name carries a unit
 #: (``--texels-per-mm``, ``--size-mm``) keep it; files stay mm.
 LENGTH_OPTIONS: dict[tuple[str, str], str] = {
@@ -197,7 +197,6 @@ LENGTH_OPTIONS: dict[tuple[str, str], str] = {
 #: Positions of the lengths among a tool spec's numbers (``vbit:ANGLE:D`` -> D only).
 _TOOL_LENGTHS = {"flat": (0,), "ball": (0,), "bull": (0, 1), "vbit": (1,), "snub": (1, 2),
                  "chamfer": (1, 2), "taperball": (0, 1)}
-_SPEC_SIZE = re.compile(r"^((?:builtin|log):[^~\[]*:)([^:~\[]+)([~\[].*)?$")
 
 
 #: Commands whose printed summary (volumes, suggested --place options) follows --units.
@@ -245,19 +244,6 @@ def _value_to_mm(kind: str, value, k: float):
         return tuple(v * k for v in value)
     if kind == "sizes":
         return _scaled_numbers(str(value).lower(), "x", k)
-    if kind == "spec":  # its :WxDxH and its resizes [WxDxH@X,Y,Z]; turns stay degrees
-        from .._specs import split_spec
-
-        base, ops = split_spec(str(value))
-        m = _SPEC_SIZE.match(base)
-        if m:
-            base = m.group(1) + _scaled_numbers(m.group(2).lower(), "x", k)
-        for i, op in enumerate(ops):
-            if op.startswith("["):
-                size, at, origin = op[1:-1].partition("@")
-                ops[i] = (f"[{_scaled_numbers(size.lower(), 'x', k)}{at}"
-                          f"{_scaled_numbers(origin, ',', k) if at else ''}]")
-        return base + "".join(ops)
     if kind == "place":
         return [place_op_in(op, k) for op in value]
     if kind == "tools":
@@ -281,7 +267,8 @@ def _value_to_mm(kind: str, value, k: float):
                     pos += 1
             out.append(num + kind_ + ":" + ":".join(parts))
         return out
-    raise ValueError(kind)  # pragma: no cover - LENGTH_OPTIONS holds only the kinds above
+    raise ValueError(kind)  # pragma: no cover - LENGTH_OPTIONS holds only the kinds above (a
+    # "spec" is read once at the door and written back in mm: lengths_to_mm)
 
 
 def place_op_in(op: str, k: float) -> str:
@@ -299,11 +286,13 @@ def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
     everything below the CLI takes); called by :func:`woodcam.cli.main` before the range checks.
     Defaults are millimetres already (the help states them in mm) and are left alone: argparse
     stores a default as the very object of the parser, a typed value as a new one."""
+    from .._specs import format_spec
+
     units = getattr(args, "units", None)
     command = getattr(args, "command", None)
-    for (cmd, dest), kind in LENGTH_OPTIONS.items():  # a block spec's size, in every unit
-        if kind == "spec" and cmd == command and getattr(args, dest, None) is not None:
-            _check_spec_size(getattr(args, dest), units or "mm")
+    specs = {dest: _read_spec(str(getattr(args, dest)), units or "mm")  # in every unit
+             for (cmd, dest), kind in LENGTH_OPTIONS.items()
+             if kind == "spec" and cmd == command and getattr(args, dest, None) is not None}
     if units in (None, "mm"):
         return
     k = MM_PER_UNIT[units]
@@ -311,49 +300,45 @@ def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
     for (cmd, dest), kind in LENGTH_OPTIONS.items():
         value = getattr(args, dest, None)
         if cmd == command and value is not None and value is not sub.get_default(dest):
-            setattr(args, dest, _value_to_mm(kind, value, k))
+            # a spec as read at the door, written back in mm: its text is not split again
+            setattr(args, dest, format_spec(specs[dest]) if kind == "spec" else _value_to_mm(kind, value, k))
             # what was typed, for the range errors: "--mesh-tol 0.5" (inch) said "got 12.7"
             args.__dict__.setdefault("_typed", {})[dest] = (value, units)
 
 
-def _check_spec_size(spec: str, units: Units) -> None:
-    """A block spec's ``:WxDxH`` and each resize ``[WxDxH@X,Y,Z]`` read in ``units``, checked as
-    typed at the door, a usage error in every unit (the stock's own check, a WoodcamError, would
-    name the spec converted to mm: '1000x1x1' inches said "got '25400x25.4x25.4' ... in mm")."""
-    import numpy as np
+def _read_spec(spec: str, units: Units):
+    """A typed block spec read in ``units`` by the stock's own reader
+    (:func:`woodcam._specs.parse_spec`): what the stock would refuse is refused here, at the
+    door, a usage error in every unit that names the spec as typed (the stock's error, after
+    the conversion, named it in mm: '1000x1x1' inches said "got '25400x25.4x25.4' ... in mm";
+    and a door of its own grammar let through what the stock refused)."""
+    from .._specs import parse_spec
+    from ..errors import BlockSpecError
 
-    from .._specs import LOOSE_OP, spec_path, split_spec
-    from ..units import parse_lengths
+    try:
+        return parse_spec(spec, mm_per_unit=MM_PER_UNIT[units])
+    except BlockSpecError as err:
+        raise UsageError(_spec_usage(spec, units, err)) from err
 
+
+def _spec_usage(spec: str, units: Units, err) -> str:
+    """The door's words for ``err`` (a BlockSpecError of ``spec`` read in ``units``): its
+    lengths' rules in ``units``, the rest as the stock says it."""
     said = "mm" if units == "mm" else f"--units {units}"
-    cap = MAX_BLOCK_SIZE_MM / MM_PER_UNIT[units]
-    m = _SPEC_SIZE.match(str(spec))
-    if m and parse_lengths(m.group(2), 3, max_mm=cap) is None:
-        raise UsageError(f"--block {spec}: the size must be WxDxH in {said}, each > 0 and "
-                         f"<= {fmt_length(MAX_BLOCK_SIZE_MM, units, 5)}; got {m.group(2)!r}, e.g. "
-                         f"{fmt_size((300, 120, 40), units, 3)}")
-    base, ops = split_spec(str(spec))
-    # a bracket the spec grammar does not read ([40x30]) is a resize typed wrong, as the stock
-    # reads it, unless the base is an existing path that ends so
-    loose, path = LOOSE_OP.search(base), spec_path(base)
-    if loose and loose.group().startswith("[") and not (path is not None and path.exists()):
-        ops = [loose.group(), *ops]
-    for op in ops:
-        if not op.startswith("["):
-            continue
-        size, at, corner = op[1:-1].partition("@")
-        try:
-            origin = [float(v) for v in corner.split(",")] if at else [0.0, 0.0, 0.0]
-        except ValueError:
-            origin = []
-        if (parse_lengths(size, 3, max_mm=cap) is None or len(origin) != 3
-                or not np.isfinite(origin).all()):
-            e = 1 / MM_PER_UNIT[units]
-            raise UsageError(
-                f"--block {spec}: a resize must be [WxDxH] or [WxDxH@X,Y,Z] in {said} (X,Y,Z the "
-                f"corner in the block before it), each side > 0 and <= "
-                f"{fmt_length(MAX_BLOCK_SIZE_MM, units, 5)}; got {op}, e.g. "
-                f"'builtin:knotty[{40 * e:.3g}x{30 * e:.3g}x{20 * e:.3g}@{5 * e:.2g},{5 * e:.2g},{5 * e:.2g}]'")
+    cap = fmt_length(MAX_BLOCK_SIZE_MM, units, 5)
+    if err.part == "size":
+        return (f"--block {spec}: the size must be WxDxH in {said}, each > 0 and <= {cap}; got "
+                f"{err.text!r}, e.g. {fmt_size((300, 120, 40), units, 3)}")
+    e = 1 / MM_PER_UNIT[units]
+    example = f"'builtin:knotty[{40 * e:.3g}x{30 * e:.3g}x{20 * e:.3g}@{5 * e:.2g},{5 * e:.2g},{5 * e:.2g}]'"
+    # a bracket the grammar does not read ([40x30]) is a resize typed wrong, as the stock reads it
+    if err.part == "resize" or (err.part == "op" and err.text.startswith("[")):
+        return (f"--block {spec}: a resize must be [WxDxH] or [WxDxH@X,Y,Z] in {said} (X,Y,Z the "
+                f"corner in the block before it), each side > 0 and <= {cap}; got {err.text}, e.g. {example}")
+    if err.part == "op":
+        return (f"--block {spec}: {err.text!r} is neither a turn ~AXIS then degrees nor a resize "
+                f"[WxDxH] or [WxDxH@X,Y,Z] (plain numbers, in {said}), e.g. {example}")
+    return f"--block {spec}: {err.rule}"  # a turn, a log's knot: no lengths
 
 
 def as_typed(args: argparse.Namespace, dest: str):
