@@ -442,3 +442,24 @@ def test_only_real_turns_and_resizes_are_split_off_a_spec(tmp_path):
     assert split_spec(f"{folder}[40x30x20]") == (str(folder), ["[40x30x20]"])
     with pytest.raises(WoodcamError, match=r"turn '~q90' must be ~AXIS"):
         open_stock("builtin:knotty~q90")
+
+
+def test_a_resize_reads_the_numbers_a_size_reads_and_what_resize_stock_writes():
+    """Sweep H1: ':1e1x30x20' and ':+40x30x20' were read as a block's size, while a resize
+    '[1e1x30x20]' or '@+5,-5e-1,5' was 'neither a turn nor a resize'; and resize_stock wrote its
+    numbers with ':g' (6 digits: a stock cut at 12.3456789 mm reopened at 12.3457, another
+    block) and wrote '1e-05', which the reader refused (a GLB of gcode --stock-origin could not
+    be reopened)."""
+    from woodcam.stock import resize_stock, spec_digest
+
+    whole = open_stock("builtin:knotty")
+    for origin in [(1e-5, 0.0, 0.0), (12.3456789, 0.5, 7.0)]:
+        cut = resize_stock(whole, (40.0, 30.0, 20.0), origin)
+        again = open_stock(cut.spec)
+        assert again.size_mm == cut.size_mm and again.meta["origin_mm"] == list(origin), cut.spec
+    odd = "builtin:knotty[1e1x3E1x+20@+5,-5e-1,5]"
+    got = open_stock(odd)
+    assert got.size_mm == (10.0, 30.0, 20.0) and got.meta["origin_mm"] == [5.0, -0.5, 5.0]
+    assert spec_digest(odd) == spec_digest("builtin:knotty[10x30x20@5,-0.5,5]")
+    with pytest.raises(WoodcamError, match=r"the size must be WxDxH in mm, each > 0 .* got '-40x30x20'"):
+        open_stock("builtin:knotty[-40x30x20]")  # a resize, its size refused as such

@@ -17,12 +17,14 @@ from .errors import BlockSpecError
 from .limits import MAX_BLOCK_SIZE_MM
 from .units import parse_lengths
 
-_NUM = r"(?:\d+(?:\.\d*)?|\.\d+)"
+#: A number of an operation, signed, as a block's ``:WxDxH`` reads it (``+40``, ``1e2``, ``.5``)
+#: and as :func:`format_op` may write it (``1e-05``); a size's sign is checked when it is read.
+_NUM = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
 #: A turn ``~AXIS DEGREES`` (``~z90``, ``~x-90``) and a resize ``[WxDxH]`` / ``[WxDxH@X,Y,Z]``
 #: (unit-free numbers, mm), as :func:`woodcam.stock.resize_stock` appends them: only these, so
 #: a path's own ``~`` or ``[...]`` (``/data/~scan/oak``, ``blocks/oak[2]``) is no operation.
-_ONE_OP = (rf"~[xyzXYZ][-+]?{_NUM}"
-           rf"|\[{_NUM}[xX]{_NUM}[xX]{_NUM}(?:@[-+]?{_NUM},[-+]?{_NUM},[-+]?{_NUM})?\]")
+_ONE_OP = (rf"~[xyzXYZ]{_NUM}"
+           rf"|\[{_NUM}[xX]{_NUM}[xX]{_NUM}(?:@{_NUM},{_NUM},{_NUM})?\]")
 #: A spec's trailing operations, applied in order.
 _OPS = re.compile(rf"(?:{_ONE_OP})+$")
 _OP = re.compile(_ONE_OP)

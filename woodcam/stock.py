@@ -42,7 +42,7 @@ from typing import Literal
 
 import numpy as np
 
-from ._specs import ParsedSpec, parse_spec, split_spec
+from ._specs import ParsedSpec, format_op, parse_spec, split_spec
 from .appearance import ColorMapAppearance, NeuralAppearance, Wood
 from .errors import WoodcamError, WoodcamWarning
 from .fields.builtin import BUILTIN_NAMES, builtin_block
@@ -84,8 +84,9 @@ def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:
         raise WoodcamError(f"resize_stock: origin_mm must be three finite numbers (mm), got "
                            f"{origin_mm!r}; e.g. (0, 0, 0)")
     W, D, H = size.tolist()
-    spec = f"{stock.spec}[{W:g}x{D:g}x{H:g}" + (f"@{','.join(f'{v:g}' for v in origin)}]"
-                                                 if origin.any() else "]")
+    # written as the spec reader reads it back (12 digits: ':g' rounded 0.1234567 to 0.123457,
+    # and its '1e-05' was no operation to the reader)
+    spec = stock.spec + format_op(("resize", (W, D, H), tuple(origin.tolist())))
     if origin.any() and not isinstance(stock.wood, Wood):
         raise WoodcamError(f"resize_stock: stock.wood must be a woodcam Wood (its growth field and colours "
                            f"move with the origin); got {type(stock.wood).__name__}; open the stock with open_stock")
