@@ -102,6 +102,41 @@ def test_a_cached_fit_repeats_its_warning(tmp_path, monkeypatch):
         assert [str(w.message) for w in caught if issubclass(w.category, WoodcamWarning)] == [said], run
 
 
+def test_a_cached_fit_from_before_size_mm_names_the_fitted_blocks_faces(tmp_path, monkeypatch):
+    """Sweep H1: bake_evidence records the fitted block's box (meta["size_mm"]) that
+    uncertainty_report names the faces of a stock cut from it in; a fit cached before it did
+    (the cache key, FIT_VERSION 27, is the same) lacks it, and a stock cut at 10..50 mm of a
+    100 mm block was silently told the face nearest in its own box ('the fitted block's right
+    face', the wrong end). The fitted block is the block the cache entry is keyed by: its size."""
+    import woodcam.inference as inference
+    from woodcam.appearance.wood import Wood
+    from woodcam.fields.builtin import builtin_block
+    from woodcam.fields.grid import GridField
+    from woodcam.inference.evidence import uncertainty_report
+    from woodcam.stock import Stock, fitted_field, resize_stock
+    from woodcam.synth import synth_block
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    size = (100.0, 30.0, 20.0)
+    block = synth_block(builtin_block("flat-sawn").field, size, face_px=32, seed=0)
+    x = np.stack(np.meshgrid(*[np.linspace(0, s, k) for s, k in zip(size, (21, 7, 5))], indexing="ij"), -1)
+
+    def old_fit(block, method):  # an evidence fit as made before meta["size_mm"]: a guess further right
+        return GridField(x[..., 0] / 3.0, (0.0, 0.0, 0.0), (5.0, 5.0, 5.0),
+                         layers={"uncertainty": 0.02 * x[..., 0]},
+                         meta={"method": "evidence", "faces": ["front", "back", "top", "bottom"]})
+
+    monkeypatch.setattr(inference, "fit_block", old_fit)
+    p = np.random.default_rng(0).uniform(0, 1, (3000, 3)) * (40.0, 30.0, 20.0)
+    for run in ("fit", "cache hit"):
+        field = fitted_field(block)
+        small = resize_stock(Stock("test", size, Wood(field), "a fitted block", {}), (40.0, 30.0, 20.0),
+                             (10.0, 0.0, 0.0))
+        line = uncertainty_report(small.wood, p, small.size_mm, "bowl")
+        assert line.endswith("photograph the fitted block's left face or trace its rings"), (run, line)
+        assert field.meta["size_mm"] == list(size), run
+
+
 def test_block_folder_with_no_rings_is_a_clear_error(tmp_path):
     from woodcam.block import Block
     from woodcam.block.io import write_block

@@ -402,7 +402,13 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
     path = entry_path(cache_dir("fields"), block.name, f"{method}-{key}")
     field, hit = load_or_build(path, load=GridField.load, build=lambda: fit_block(block, method=method),
                                save=lambda f, tmp: f.save(tmp), what=f"fitted field of block {block.name!r}")
-    meta = getattr(field, "meta", {}) or {}
+    meta = getattr(field, "meta", None)
+    meta = meta if isinstance(meta, dict) else {}
+    if "uncertainty" in getattr(field, "layers", {}) and "size_mm" not in meta:
+        # an evidence fit cached before bake_evidence recorded the box its faces are named in
+        # (the same cache key): the block it is keyed by. uncertainty_report measured a cut
+        # stock's nearest face in the stock's own box without it, and named the wrong one.
+        meta["size_mm"] = [float(v) for v in block.size_mm]
     if hit and (meta.get("contradicted") or meta.get("unverified")):
         # the fit warned when it was made; a cached fit is the same fit and must say so again
         # (it was silent on every later run, and for the second of two concurrent ones)

@@ -904,7 +904,8 @@ def uncertainty_report(wood, points_mm, size_mm, what: str = "part", *,
     seen = set(meta.get("faces", []))
     # The photos are of the fitted block: the face nearest the uncertain third is measured in its
     # frame and box (a stock cut out of it has its faces elsewhere: its right third may lie
-    # nearer the fitted block's left face). A fit from before its size was recorded: this
+    # nearer the fitted block's left face). A field from before its size was recorded (a cached
+    # fit has it filled in by woodcam.stock.fitted_field; a bare field passed here may not): this
     # block's box, its faces named as the fitted block's.
     if "size_mm" in meta:
         src = wood.to_source(centre[None])
