@@ -498,3 +498,28 @@ def test_a_resize_reads_the_numbers_a_size_reads_and_what_resize_stock_writes():
     assert spec_digest(odd) == spec_digest("builtin:knotty[10x30x20@5,-0.5,5]")
     with pytest.raises(WoodcamError, match=r"the size must be WxDxH in mm, each > 0 .* got '-40x30x20'"):
         open_stock("builtin:knotty[-40x30x20]")  # a resize, its size refused as such
+
+
+def test_a_log_file_in_a_folder_with_an_at_sign_is_read(tmp_path, monkeypatch):
+    """Sweep H1: 'log:LOG@KNOT' was split at the first '@', so a log file in a folder like
+    'u@host' (a user's share, a mail-like name) read as log 'u' with knot 'host/l.json@0' and
+    was refused ("must read 'log:LOG@KNOT'"); the knot is after the last '@'."""
+    from woodcam._specs import absolute_spec, parse_spec, spec_path
+    from woodcam.fields.skeleton import BranchStrand, simple_log
+    from woodcam.logs.io import write_log
+
+    knot = BranchStrand.from_model(0.25, 0.0, 300.0, 0.0, 0.0, 0.0, 0.0, 100.0, 45.0)
+    (tmp_path / "u@host").mkdir()
+    (tmp_path / "plain").mkdir()
+    for folder in ("u@host", "plain"):
+        write_log(simple_log(knots=[knot]), tmp_path / folder / "l.json")
+    monkeypatch.chdir(tmp_path)
+    spec = "log:u@host/l.json@0:40x30x20~z90"
+    parsed = parse_spec(spec)
+    assert (parsed.source, parsed.knot, parsed.size_mm) == ("u@host/l.json", 0, (40.0, 30.0, 20.0))
+    assert spec_path(spec) == parsed.path == tmp_path.joinpath("u@host", "l.json").relative_to(tmp_path)
+    assert absolute_spec(spec) == f"log:{tmp_path / 'u@host' / 'l.json'}@0:40x30x20~z90"
+    got, want = open_stock(spec), open_stock("log:plain/l.json@0:40x30x20~z90")
+    p = np.random.default_rng(1).uniform(0, 1, (500, 3)) * got.size_mm
+    assert got.size_mm == want.size_mm == (30.0, 40.0, 20.0)
+    np.testing.assert_array_equal(got.wood.years(p), want.wood.years(p))

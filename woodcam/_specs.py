@@ -86,8 +86,9 @@ def _error(spec: str, rule: str, *, part: SpecPart, text: str) -> BlockSpecError
 
 def _base_path(base: str) -> Path | None:
     """The file or folder the block ``base`` (a spec without its operations) names."""
-    if base.startswith("log:"):
-        source = base[len("log:"):].partition("@")[0]
+    if base.startswith("log:"):  # the knot after the last '@': a folder 'u@host' is the path's
+        body = base[len("log:"):]
+        source = body[:body.rfind("@")] if "@" in body else body
         return Path(source) if source.lower().endswith(".json") else None
     if base.startswith("woodify:"):
         return Path(base[len("woodify:"):])
@@ -147,9 +148,12 @@ def parse_spec(spec: str, *, mm_per_unit: float = 1.0) -> ParsedSpec:
         source, _, size_text = base[len("builtin:"):].partition(":")
     elif base.startswith("log:"):
         kind = "log"
+        # the knot after the last '@' (a log file in a folder 'u@host' was 'log:u' knot 'host/...')
+        source, at, rest = base[len("log:"):].rpartition("@")
+        knot_text, _, size_text = rest.partition(":")
         try:
-            source, rest = base[len("log:"):].split("@", 1)
-            knot_text, _, size_text = rest.partition(":")
+            if not at:
+                raise ValueError("no '@'")
             knot = int(knot_text)
         except ValueError as err:
             raise _error(base, "a log block must read 'log:LOG@KNOT' or 'log:LOG@KNOT:WxDxH' "
@@ -242,7 +246,7 @@ def absolute_spec(spec: str, folder: str | Path | None = None) -> str:
     if path is not None and folder is not None and not path.is_absolute():
         path = Path(folder) / path
     if path is not None and base.startswith("log:"):
-        _, at, rest = base.partition("@")
+        _, at, rest = base.rpartition("@")
         base = f"log:{path.resolve()}{at}{rest}"
     elif path is not None:
         base = f"{'woodify:' if base.startswith('woodify:') else ''}{path.resolve()}"
