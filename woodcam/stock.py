@@ -26,7 +26,10 @@ grain along Y): the block's size axes swap accordingly and the wood turns with i
 end in resizes, ``[WxDxH]`` or ``[WxDxH@X,Y,Z]``: a ``W x D x H`` mm block cut from the block
 before it with its corner at ``X, Y, Z`` mm of that block's frame (:func:`resize_stock`, what
 ``woodcam gcode --stock --stock-origin`` records in its GLB, so ``woodcam preview`` reopens
-it). Turns and resizes apply in the order written.
+it). Turns and resizes apply in the order written. Their numbers are plain numbers (a sign and
+an exponent allowed, as in ``:WxDxH``), with no spaces. One reader parses this grammar,
+:func:`woodcam._specs.parse_spec` (the command line's ``--block`` check and ``--units``
+conversion too), and :func:`woodcam._specs.format_spec` writes it back.
 
 Fitted fields and neural colour volumes are cached under ``$WOODCAM_CACHE_DIR`` or the user
 cache folder (``$XDG_CACHE_HOME/woodcam``, ``~/.cache/woodcam``), keyed by the block's content:
