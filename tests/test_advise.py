@@ -268,3 +268,15 @@ def test_placements_score_pith_keep_the_margin_and_weigh_as_asked():
     for p in advise_placement(stick, _slab_stock((90.0, 70.0)), rotations="z90", candidates=8).ranked:
         quarter = p.ops[0] in ("rotate:z:90", "rotate:z:270")
         assert p.terms["end_grain"] == pytest.approx(1200 / 2600 if quarter else 200 / 2600, abs=0.03), p.ops
+
+
+def test_the_candidates_asked_for_are_scored_when_only_some_orientations_fit(knotty):
+    """``--candidates`` was split over every orientation, fitting or not: a 90 mm stick fits the
+    100 x 80 x 50 mm block in 8 of the 24 axis-aligned orientations (its length along X), so
+    200 asked scored 8 x 2^3 = 64; split over the 8 that fit, 8 x 3^3 = 216."""
+    stick = manifold3d.Manifold.cube([90.0, 10.0, 10.0])
+    advice = advise_placement(stick, knotty, rotations="all90", candidates=200, samples=100)
+    orientations = {tuple(np.round(p.matrix[:3, :3]).astype(int).ravel()) for p in advice.ranked}
+    assert len(orientations) == 8
+    assert all(abs(p.matrix[:3, :3] @ np.array([1.0, 0.0, 0.0]))[0] > 0.99 for p in advice.ranked)
+    assert advice.candidates == len(advice.ranked) == 216
