@@ -48,7 +48,7 @@ def register(subparsers) -> None:
                    help="place the part in the block before carving; repeatable, applied in "
                    "order: rotate:AXIS:DEG (about the part's centre), translate:X,Y,Z (in --units), "
                    "scale:S, center, drop (onto the bottom face), fit[:MARGIN] (scale into the "
-                   "block, default margin 2 mm). Turn the block instead with a spec ending in "
+                   "block, MARGIN in --units, default 2 mm). Turn the block instead with a spec ending in "
                    "~AXIS90 (e.g. builtin:flat-sawn~z90)")
     p.add_argument("--max-triangles", type=int, default=None, metavar="N",
                    help="triangle budget for B-rep parts: above it the part is re-meshed with "

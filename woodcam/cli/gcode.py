@@ -24,11 +24,12 @@ examples:
       --block builtin:quarter-sawn --out out/pocket.glb
   woodcam gcode prog.nc --tool 1=flat:6.35 --tool 2=ball:3 --block builtin:rift --out out/p.glb
 
-Tool specs (diameters in mm, angles in degrees): flat:D, ball:D, bull:D:CORNER_R, vbit:ANGLE:D,
-snub:ANGLE:D:TIP (engraving cone with a flat tip), chamfer:ANGLE:D:TIP, taperball:D:TIP:TAPER
-(taper per side); prefix N= to give the tool number of the program (T N M6). --tools reads a
-TOML tool table or a CAMotics JSON tool table. Work zero defaults to the stock's
-top-front-left corner (G-code z = 0 on the top face).
+Tool specs (diameters, corner radii and tips in --units, default mm; angles and the taper in
+degrees): flat:D, ball:D, bull:D:CORNER_R, vbit:ANGLE:D, snub:ANGLE:D:TIP (engraving cone with a
+flat tip), chamfer:ANGLE:D:TIP, taperball:D:TIP:TAPER (taper per side); prefix N= to give the
+tool number of the program (T N M6). --tools reads a TOML tool table or a CAMotics JSON tool
+table (its lengths in its own units). Work zero defaults to the stock's top-front-left corner
+(G-code z = 0 on the top face).
 """
 
 
@@ -50,7 +51,7 @@ def register(subparsers) -> None:
                    "(repeatable; without N= the tools go to the program's tool numbers in "
                    "order of first use); the reach for the flute/shank/holder checks as "
                    "flat:6:flute=22:shank=6:stickout=30:holder=35 (lengths in --units, "
-                   "default mm)")
+                   "default mm). Default: none; give --tool or --tools")
     p.add_argument("--tools", type=Path, default=None, metavar="TOML",
                    help="tool table file: TOML ([tools.N] type/diameter_mm/...) or a CAMotics "
                    "JSON tool table (.json)")

@@ -20,8 +20,9 @@ veneer sources (any number, mixed):
                                      px/mm; SCAN.png:300:MASK.png adds a usable-wood mask
   --veneer-from MOKUME_FOLDER        the six face photos of a Mokume sample (50 mm cube faces)
   --veneer-from BLOCK_SPEC           leaves sliced from a woodcam block or log (builtin:NAME,
-                                     log:gran1@K, a block folder): --sheets of --sheet-size mm,
-                                     --leaf-thickness + --saw-kerf apart, book-matched
+                                     log:gran1@K, a block folder): --sheets of --sheet-size,
+                                     --leaf-thickness + --saw-kerf apart (in --units),
+                                     book-matched
 
 examples:
   woodcam parquetry eye.png --veneer walnut.png:300 --veneer oak.png:300:oak_mask.png --out out/eye/
@@ -124,8 +125,8 @@ def register(subparsers) -> None:
     f.add_argument("--min-piece-mm", type=float, default=None,
                    help="narrowest piece in mm (default 5, the paper's bound)")
     f.add_argument("--tool-diameter", type=float, default=None, metavar="LEN",
-                   help="router bit diameter in --units (default mm): concave bends >= its radius, tool paths offset "
-                   "by it (default 2)")
+                   help="router bit diameter in --units: concave bends >= its radius, tool paths offset "
+                   "by it (default 2 mm)")
     f.add_argument("--kerf-mm", type=float, default=None,
                    help="wood lost between pieces on a sheet in mm (default: the tool diameter)")
     f.add_argument("--reuse-wood", action="store_true",

@@ -27,7 +27,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         description="Grow a watertight part or mesh outward year by year (Weibull speed, "
         "eccentricity, obstacles, brushes), then write its growth field (usable as --block "
         "woodify:OUT/field.npz), grown surfaces, ring sections and a bark-textured grown.glb. "
-        "Lengths in mm, time in years.")
+        "Lengths in mm (the options' in --units), time in years.")
     p.add_argument("part", help="input: a .py part script, .step, or a closed .stl/.obj/.ply/.glb mesh "
                    "(mesh files are read as mm whatever --units says; one under 1 mm long gets a warning that it "
                    "looks saved in metres); a PLY may paint growth per vertex: properties gain (speed gain) and "
