@@ -192,11 +192,13 @@ def test_a_species_that_changes_nothing_is_named(shared_data, tmp_path, monkeypa
 
 def test_a_turn_given_to_a_command_that_reads_the_block_is_named():
     """Sweep h5 item 10: 'builtin:flat-sawn~z90' in block show / eval appearance said "unknown
-    built-in block 'flat-sawn~z90'"; the turn is for the commands that carve a part."""
+    built-in block 'flat-sawn~z90'"; the turn is for the commands that carve a part. The list
+    left out preview and parquetry's --veneer-from, which take a turn too (sweep h6)."""
     from woodcam.stock import open_block
 
     with pytest.raises(WoodcamError, match=r"a turn \('~z90'\) is for the commands that carve a part from "
-                       r"the block \(bake, gcode, place, review\); .* give 'builtin:flat-sawn'"):
+                       r"the block \(bake, gcode, place, preview, review and parquetry's --veneer-from\); "
+                       r".* give 'builtin:flat-sawn'"):
         open_block("builtin:flat-sawn~z90")
     # review h15 item 6: a resize was looked for by '~' only: "unknown built-in block 'knotty[40x30x20]'"
     with pytest.raises(WoodcamError, match=r"a resize \('\[40x30x20\]'\) is for the commands .* give 'builtin:knotty'"):

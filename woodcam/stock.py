@@ -295,7 +295,8 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         kinds = sorted({"a turn" if op.startswith("~") else "a resize" for op in ops}, reverse=True)
         raise WoodcamError(
             f"block spec {spec!r}: {' and '.join(kinds)} ('{''.join(ops)}') is for the commands "
-            f"that carve a part from the block (bake, gcode, place, review); this one reads the "
+            f"that carve a part from the block (bake, gcode, place, preview, review and parquetry's "
+            f"--veneer-from); this one reads the "
             f"block as it is: give {base!r}")
     parsed = parse_spec(spec)  # a loose end ('[40x30]') named as the bad operation it is
     if parsed.kind != "folder":
