@@ -95,6 +95,23 @@ def test_appearance_options_out_of_range_or_contradicting_are_usage_errors(argv,
     assert "Traceback" not in res.stderr
 
 
+
+def test_a_line_number_or_candidate_count_out_of_range_is_a_usage_error(tmp_path, capsys):
+    """Sweep h6: ``gcode --until-line -3`` exited 1 (a runtime error) and ``place --candidates
+    5000000`` passed the range check (up to 1e7), loaded the part, then exited 1 naming the Python
+    parameter ('candidates must be an integer in [1, 1e6]'); every other range error exits 2,
+    before any work, naming the option."""
+    from woodcam.cli import main
+
+    out = tmp_path / "o.glb"
+    assert main(["gcode", str(REPO / "toolpaths/vcarve_text.nc"), "--tool", "vbit:60:12", "--block", "builtin:flat-sawn",
+                 "--until-line", "-3", "--out", str(out)]) == 2
+    assert "--until-line must be in [1, 1e+08]; got -3" in capsys.readouterr().err
+    assert main(["place", str(REPO / "cad_examples/lid.py"), "--block", "builtin:flat-sawn", "--candidates", "5000000",
+                 "--out", str(tmp_path / "place")]) == 2
+    assert "--candidates must be in [1, 1e+06]; got 5000000" in capsys.readouterr().err
+    assert not out.exists() and not (tmp_path / "place").exists()
+
 def test_knot_flags_reach_the_colour_map(tmp_path):
     """--knot-darkening 0,0 leaves knot wood as light as the stem's; 0.9,0.9 makes it dark."""
     from woodcam.appearance.knots import KnotShading

@@ -173,8 +173,6 @@ def run(args) -> int:
     from ..toolpath.gcode import GcodeError, read_gcode
     from ..toolpath.simulate import simulate
 
-    if args.until_line is not None and args.until_line < 1:
-        raise WoodcamError(f"--until-line {args.until_line}: give a source line number >= 1")
     if not (math.isfinite(args.rapid_rate) and args.rapid_rate > 0):
         raise WoodcamError(f"--rapid-rate {args.rapid_rate}: give a rate > 0 in mm/min, e.g. "
                            "5000")

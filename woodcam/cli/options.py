@@ -807,7 +807,8 @@ RANGES: dict = {
     "timeout": (0.0, 1e7, True),               # seconds
     "max_triangles": (100, 100_000_000, False),  # B-rep budget; 1e8 triangles is ~10 GB
     "max_atlas": (64, 65_536, False),          # texture side, texels
-    "candidates": (1, 10_000_000, False),      # placement candidates
+    "candidates": (1, 1_000_000, False),       # placement candidates: woodcam.advise.advise_placement's
+    # bound (1e7 passed here, loaded the part, then failed with exit 1 naming 'candidates')
     "margin": (0.0, 1000.0, False),            # mm
     "top": (1, 100_000, False),
     "voxels": (*REVIEW_VOXELS_RANGE, False),  # per review colour volume; the library's own range
@@ -817,6 +818,7 @@ RANGES: dict = {
     # gcode: a rapid rate of 1e-320 mm/min made the machining time infinite (a traceback), a
     # start point 1e300 mm away the same; 100 m is beyond any machine's travel
     ("gcode", "rapid_rate"): (0.1, 1e6, False),  # mm/min
+    ("gcode", "until_line"): (1, 100_000_000, False),  # a source line number (-3 exited 1, not 2)
     ("gcode", "start"): (-1e5, 1e5, False),      # mm, work coordinates
     ("gcode", "work_offset"): (-1e5, 1e5, False),
     ("gcode", "machine_zero"): (-1e5, 1e5, False),  # mm, G-code frame
