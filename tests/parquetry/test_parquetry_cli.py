@@ -80,6 +80,25 @@ def test_cli_bad_input_is_one_line(scans, capsys, args, message):
     assert err.count("\n") == 0 and err.startswith("woodcam: error:") and message.format(d=scans) in err
 
 
+
+@pytest.mark.parametrize("option, value, said", [
+    ("--w-intens", "2", "--w-intens must be in [0, 1]; got 2.0"),
+    ("--n-rot", "0", "--n-rot must be in [1, 360]; got 0"),
+    ("--n-adaptive", "-1", "--n-adaptive must be in [0, 32]; got -1"),
+    ("--w-struct", "-1", "--w-struct must be in [0, 1e+06]; got -1.0"),
+    ("--flat-detail", "0.5", "--flat-detail must be in [1, 1e+06]; got 0.5"),
+    ("--overlap-mm", "-1", "--overlap-mm must be in [0, 10000]; got -1.0"),
+])
+def test_a_table_1_parameter_out_of_range_is_a_usage_error_naming_the_option(scans, capsys, option, value, said):
+    """Sweep h6: these exited 1 (a failed work, where the README's exit statuses give 2 for a wrong
+    command line) and named the job file's parameter ('w_intens must be in [0, 1]'), not the option."""
+    argv = ["parquetry", str(scans / "coffee.png"), "--veneer", str(scans / "light.png"), option, value,
+            "--out", str(scans / "o"), "--quiet"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith("woodcam: error:") and said in err
+    assert not (scans / "o").exists()
+
 def _small_run(scans, out, *extra):
     return main(["parquetry", str(scans / "coffee.png"), "--veneer", f"{scans / 'light.png'}:2px/mm",
                  "--veneer", f"{scans / 'dark.png'}:2px/mm", "--image-size-mm", "42", "--px-per-mm", "2",

@@ -852,6 +852,20 @@ RANGES: dict = {
     ("parquetry", "min_piece_mm"): (0.0, 1000.0, False),
     ("parquetry", "tool_diameter"): (0.0, 100.0, False),
     ("parquetry", "kerf_mm"): (0.0, 100.0, False),
+    # Table 1's parameters and the search's: ParquetryParams.check's bounds (exit 1 there, naming
+    # w_intens, n_rot ...); the bounds it sets relative to other options (image size >= patch,
+    # overlap <= (patch - min piece) / 2) stay its own. The tops ParquetryParams leaves open are
+    # far beyond use: 2^32 adaptive levels, a cost ratio or weight of 1e6
+    **{("parquetry", d): (0.0, 1.0, False) for d in ("w_intens", "w_edge", "w_hist")},
+    ("parquetry", "image_size_mm"): (0.0, 10_000.0, True),  # woodcam.limits.MAX_BLOCK_SIZE_MM
+    ("parquetry", "n_adaptive"): (0, 32, False),
+    ("parquetry", "w_adaptive"): (0.0, 1e6, True),
+    ("parquetry", "n_rot"): (1, 360, False),
+    ("parquetry", "coarse_factor"): (1, 1024, False),
+    ("parquetry", "w_struct"): (0.0, 1e6, False),
+    ("parquetry", "flat_detail"): (1.0, 1e6, False),
+    ("parquetry", "flat_rerank"): (4, 1_000_000, False),  # >= the structural re-rank's 4
+    ("parquetry", "overlap_mm"): (0.0, 10_000.0, False),
     ("woodify", "relief"): (0.0, 1.0, False),
     ("woodify", "eccentricity"): (-1.0, 1.0, True, True),  # speed (1 + delta n.up) stays > 0
     # sizes and places typed as vectors (vector_type, sizes_type): limits in mm, after --units
