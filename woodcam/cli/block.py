@@ -41,7 +41,7 @@ def register(subparsers) -> None:
 
     v = sub.add_parser("show", help="draw a block's faces as one unfolded-cross PNG")
     add_block_argument(v, option=False)
-    add_out_option(v, "the unfolded faces with a cut layer", suffixes=(".png",))
+    add_out_option(v, "the unfolded faces (--layer) with their traced rings", suffixes=(".png",))
     v.add_argument("--layer", choices=("photo", "ring_map", "both"), default="photo",
                    help="what to draw: the face photos, the ring maps, or both (the photos' cross above "
                    "the ring maps') (default photo)")
