@@ -195,7 +195,7 @@ def _aspect_misfit(face: str, path: Path, shape, h_mm: float, w_mm: float) -> st
     want, got = h_mm / w_mm, rows / cols
     what = f"face {face!r} ({path.name}) is {cols}x{rows} px (aspect {got:.3f}) for {w_mm:g}x{h_mm:g} mm ({want:.3f})"
     if want != 1.0 and abs(got * want - 1.0) <= FACE_PIXEL_ASPECT_RTOL:
-        return f"{what}, turned 90 degrees: turn it upright as docs/conventions.md lays the face out"
+        return f"{what}, turned 90 degrees: turn it upright as ../shared/docs/conventions.md lays the face out"
     if got > want:
         return f"{what}, about {cols}x{round(cols * want)} px when cropped"
     return f"{what}, about {round(rows / want)}x{rows} px when cropped"

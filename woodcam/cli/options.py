@@ -376,7 +376,7 @@ def add_size_option(p: argparse.ArgumentParser) -> None:
 
 def add_check_layout_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--check-layout", action="store_true",
-                   help="check that every face is laid out as docs/conventions.md says: rings meet "
+                   help="check that every face is laid out as ../shared/docs/conventions.md says: rings meet "
                    "across the block's edges; warn of a face that looks turned or mirrored "
                    "('woodcam rings detect' always checks)")
 

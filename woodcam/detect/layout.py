@@ -218,7 +218,8 @@ def check_face_layout(block: Block, margin: float = LAYOUT_MARGIN) -> LayoutRepo
             f"face {fl.face!r} looks {_SAY[variant][0]}: its rings meet its neighbours' along its "
             f"{fl.edges} edges only when corrected (mean edge correlation {score:.2f}, {fl.as_laid_out:.2f} "
             f"as laid out); {_SAY[variant][1].format(it=it)}{also}, so that it is seen from outside and "
-            f"laid out as in the unfolded cross of docs/conventions.md, and make the block again")
+            f"laid out as in the unfolded cross of ../shared/docs/conventions.md (README 'The block "
+            f"frame'), and make the block again")
         corrections[fl.face] = variant
         images[fl.face] = np.ascontiguousarray(VARIANTS[variant][0](images[fl.face]))
         layouts = {n: v for n, v in _score_faces(images, size).items() if n not in corrections}
