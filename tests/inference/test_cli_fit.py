@@ -285,3 +285,14 @@ def test_ctrl_c_during_the_forked_refits_ends_the_fit_at_once(block_dir, tmp_pat
     assert (proc.returncode, err) == (130, "woodcam: interrupted\n"), err[-2000:]
     assert waited < 0.25 * 60, waited  # not the forks' 60 s
     assert sorted(p.name for p in out.iterdir()) == []
+
+
+def test_fit_draws_one_stage_bar_over_the_block_and_the_fit(block_dir, tmp_path, bars):
+    """'woodcam fit' of H11 from its photos lasts 20-30 s (2 cores) and drew no bar, where 'bake'
+    of the same block draws one over the same fit: it draws a stage bar naming the fit now."""
+    folder, _, _ = block_dir
+    assert main(["fit", str(folder), "--method", "radial", "--out", str(tmp_path / "f.npz")]) == 0
+    [bar] = [b for b in bars if b.desc == "fit"]
+    assert bar.enabled and bar.unit == "stage" and bar.total == 3
+    assert bar.shown[1:4] == ["fit: open block", "fit: fit", "fit: write"]
+    assert bar.n == 3 and bar.closed

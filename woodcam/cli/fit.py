@@ -70,13 +70,20 @@ def register(subparsers) -> None:
 
 
 def run_fit(args) -> int:
+    from .._progress import StageBar
     from ..inference.fit import fit_block
 
     faces = None if args.faces is None else comma_names(args.faces, "--faces", all_=True)  # before the block is read
     apply_workers(args)
-    block, _ = open_block(args.block, args.size_mm)
-    field = fit_block(block, args.method, faces=faces)
-    path = field.save(args.out)
+    # one bar for the run, as bake's: the evidence fit of a real cube lasts 20-30 s (H11 from its
+    # photos, 2 cores) and a photo-only block is detected first; it ran without a bar
+    with StageBar(["open block", "fit", "write"], desc="fit", leave=False) as bar:
+        with bar.stage("open block"):
+            block, _ = open_block(args.block, args.size_mm)
+        with bar.stage("fit"):
+            field = fit_block(block, args.method, faces=faces)
+        with bar.stage("write"):
+            path = field.save(args.out)
     print(f"wrote {path} ({args.method} fit of {block.name}, grid {field.years.shape}, "
           f"{field.spacing_mm[0]:g} mm)")
     if field.meta.get("message") and not (field.meta.get("contradicted") or field.meta.get("unverified")):
