@@ -55,11 +55,12 @@ def _bar_class():
     return _Bar
 
 
-def write(line: str) -> None:
-    """Print ``line`` to stdout without breaking a bar being drawn (``tqdm.write``)."""
+def write(line: str, file=None) -> None:
+    """Print ``line`` to ``file`` (default stdout) without breaking a bar being drawn
+    (``tqdm.write``)."""
     from tqdm.auto import tqdm
 
-    tqdm.write(line)
+    tqdm.write(line, file=file)
 
 
 class StageBar:

@@ -215,25 +215,9 @@ def _raster(step: float, levels: int, passes: int, length: float = 30.0) -> str:
     return "\n".join(text + ["M2", ""])
 
 
-def test_the_simulation_shows_a_progress_bar_over_its_moves(tmp_path, monkeypatch):
+def test_the_simulation_shows_a_progress_bar_over_its_moves(tmp_path, monkeypatch, bars):
     """woodcam gcode ran simulate with progress=False (no bar on a 200,000-line raster), and
     simulate's bar counted runs: a raster is one run, its bar stood at 0/1 to the end."""
-    import woodcam._progress
-
-    bars = []
-
-    class Bar:
-        def __init__(self, **kw):
-            self.kw, self.n = kw, 0
-            bars.append(self)
-
-        def update(self, k):
-            self.n += k
-
-        def close(self):
-            pass
-
-    monkeypatch.setattr(woodcam._progress, "progress_bar", lambda iterable=None, **kw: Bar(**kw))
     _stub_preview(monkeypatch, {})
     prog = tmp_path / "raster.nc"
     prog.write_text("G0 X0 Y0 Z2 M3 S9000\nG1 Z-1 F600\n" + "".join(
@@ -241,9 +225,26 @@ def test_the_simulation_shows_a_progress_bar_over_its_moves(tmp_path, monkeypatc
     args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
                    "--tool", "flat:6", "--cell-size", "0.5"])
     assert args.func(args) == 0
-    sim = [b for b in bars if b.kw.get("desc") == "simulate"]
-    assert len(sim) == 1 and sim[0].kw["enabled"] and sim[0].kw["unit"] == "move"
-    assert sim[0].n == sim[0].kw["total"] == 41
+    sim = [b for b in bars if b.desc == "simulate"]
+    assert len(sim) == 1 and sim[0].enabled and sim[0].unit == "move"
+    assert sim[0].n == sim[0].total == 41
+
+
+def test_one_stage_bar_runs_over_the_whole_job(tmp_path, monkeypatch, bars):
+    """Opening a photographed block (its fit: 20-30 s once), meshing, baking and the screenshot
+    ran without a bar (the simulation's own is drawn only while it simulates): 'woodcam gcode' of
+    a pocket on the H11 cube took 10-25 s with none. One stage bar, as bake's, names each step."""
+    _stub_preview(monkeypatch, {})
+    rough, finish = tmp_path / "rough.nc", tmp_path / "finish.nc"
+    rough.write_text("G0 X20 Y20 Z2 M3 S9000\nG1 Z-3 F600\nX40\nG0 Z2\nM2\n")
+    finish.write_text("G0 X20 Y20 Z2 M3 S9000\nG1 Z-4 F600\nX40\nG0 Z2\nM2\n")
+    assert main(["gcode", str(rough), str(finish), "--block", "builtin:flat-sawn", "--out",
+                 str(tmp_path / "job.glb"), "--tool", "flat:6", "--cell-size", "0.5"]) == 0
+    [bar] = [b for b in bars if b.desc == "gcode job"]
+    assert bar.enabled and bar.unit == "stage"
+    assert bar.shown[1:] == ["gcode job: open block", "gcode job: simulate rough.nc",
+                             "gcode job: simulate finish.nc", "gcode job: mesh and bake", "gcode job"]
+    assert bar.n == bar.total == 4 and bar.closed
 
 
 def test_a_refused_line_names_its_program(tmp_path, monkeypatch):

@@ -168,6 +168,7 @@ def run(args) -> int:
     Exit status 0, or 3 with ``--strict`` when the reader or the simulation warned."""
     import numpy as np
 
+    from .._progress import StageBar, write
     from ..pipeline import check_outputs, preview_heightfield
     from ..stock import open_stock, resize_stock
     from ..toolpath.gcode import GcodeError, read_gcode
@@ -192,97 +193,112 @@ def run(args) -> int:
         from ..view.scrub import check_display
 
         check_display()
-    stock = open_stock(args.block, **stock_options(args))
-    if args.stock or args.stock_origin:
-        stock = resize_stock(stock, args.stock or stock.size_mm, args.stock_origin or (0, 0, 0))
-    offset = list(args.work_offset) if args.work_offset else None
-    n_warn = 0
-    hm = None
-    meta_programs, last = [], None
-    hm_before = None  # the stock the last program starts from (the window's slider)
-    for k, path in enumerate(args.program):
-        hm_before = hm
-        t0 = time.perf_counter()
-        try:
-            program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
-                                 interpreter=args.interpreter,
-                                 machine_zero_mm=args.machine_zero)
-        except GcodeError as err:  # which of the programs: "G-code line 5" alone does not say
-            raise GcodeError(err.line, err.word, err.rule, err.fix, source=str(path)) from None
-        t_read = time.perf_counter() - t0
-        full = program  # the whole last program, for the window's slider
-        if args.until_line is not None and k == len(args.program) - 1:
-            program = program.until_line(args.until_line)
-        for w in program.warnings:
-            print(f"woodcam: warning: {path.name} {w}", file=sys.stderr)
-        n_warn += len(program.warnings)
-        if not (program.kind == 1).any() and args.until_line is None:
-            raise WoodcamError(f"woodcam gcode: {path} has no cutting move (G1/G2/G3 or a "
-                               "drilling cycle); nothing to simulate. Check that it is the "
-                               "program you meant")
-        tools = _tools_from_args(args, program)
-        step = program.stepover_mm(spacing_mm=args.cell_size)
-        if step is not None and args.cell_size > step / 2:
-            print(f"woodcam: warning: {path.name}: the grid ({fmt_length(args.cell_size, args.units)}) "
-                  f"is coarser than half the step-over ({fmt_length(step, args.units)}): expect "
-                  f"aliasing waves; use --cell-size {step / 2 / MM_PER_UNIT[args.units]:.2g} or finer",
-                  file=sys.stderr)
-            n_warn += 1
-        res = simulate(program, tools, stock.size_mm, resolution_mm=args.cell_size,
-                       work_offset_mm=offset, progress=True, initial_heightmap=hm,
-                       track_lines=bool(args.part))
-        hm = res.heightmap
-        for issue in res.report:
-            print(f"woodcam: warning: {path.name} {issue}", file=sys.stderr)
-        n_warn += len(res.report)
-        times = program.machining_time_s(args.rapid_rate)
-        s = res.stats
-        print(f"{path.name}: {len(program)} moves read in {t_read:.2f} s, simulated on "
-              f"{s['grid'][1]}x{s['grid'][0]} cells in {s['wall_s']:.2f} s "
-              f"({s['moves_per_s']:.0f} moves/s), removed {fmt_volume(res.removed_volume_mm3, args.units)}, "
-              f"{len(res.report)} issue(s); machining time " + ", ".join(
-                  f"T{t}: {fmt_hms(f + r)} ({fmt_hms(f)} feeding)" for t, (f, r) in times.items()))
-        # resolved, as the block spec (_specs.absolute_spec): the review page of the GLB, opened
-        # from another folder, names the program that cut it (as typed it was relative to a
-        # working folder the GLB does not record)
-        meta_programs.append({"gcode": str(Path(path).resolve()),
-                              "tools": {str(t): v.spec() for t, v in sorted(tools.items())},
-                              "machining_time_s": sum(f + r for f, r in times.values()),
-                              "warnings": _issue_spots(program, res.report, stock.size_mm, offset, path.name)})
-        last = (program, res)
-    program, res = last
-    if design is not None:
-        from ..toolpath.deviation import deviation, deviation_png, fmt_depth
+    # one bar for the whole run, as bake's: opening a photographed block can fit its rings
+    # (20-30 s, once), the simulation draws its own bar below it, and the mesh, bake and view
+    # took 5-10 s more with none
+    stages = ["open block", *(f"simulate {Path(p).name}" for p in args.program),
+              *(["deviation"] if design is not None else []), "mesh and bake",
+              *(["render"] if args.screenshot else [])]
+    bar = StageBar(stages, desc=f"gcode {Path(args.out).stem}", leave=False)
+    try:
+        with bar.stage("open block"):
+            stock = open_stock(args.block, **stock_options(args))
+            if args.stock or args.stock_origin:
+                stock = resize_stock(stock, args.stock or stock.size_mm, args.stock_origin or (0, 0, 0))
+        offset = list(args.work_offset) if args.work_offset else None
+        n_warn = 0
+        hm = None
+        meta_programs, last = [], None
+        hm_before = None  # the stock the last program starts from (the window's slider)
+        for k, path in enumerate(args.program):
+            with bar.stage(f"simulate {Path(path).name}"):
+                hm_before = hm
+                t0 = time.perf_counter()
+                try:
+                    program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
+                                         interpreter=args.interpreter,
+                                         machine_zero_mm=args.machine_zero)
+                except GcodeError as err:  # which of the programs: "G-code line 5" alone does not say
+                    raise GcodeError(err.line, err.word, err.rule, err.fix, source=str(path)) from None
+                t_read = time.perf_counter() - t0
+                full = program  # the whole last program, for the window's slider
+                if args.until_line is not None and k == len(args.program) - 1:
+                    program = program.until_line(args.until_line)
+                for w in program.warnings:
+                    write(f"woodcam: warning: {path.name} {w}", file=sys.stderr)
+                n_warn += len(program.warnings)
+                if not (program.kind == 1).any() and args.until_line is None:
+                    raise WoodcamError(f"woodcam gcode: {path} has no cutting move (G1/G2/G3 or a "
+                                       "drilling cycle); nothing to simulate. Check that it is the "
+                                       "program you meant")
+                tools = _tools_from_args(args, program)
+                step = program.stepover_mm(spacing_mm=args.cell_size)
+                if step is not None and args.cell_size > step / 2:
+                    write(f"woodcam: warning: {path.name}: the grid ({fmt_length(args.cell_size, args.units)}) "
+                          f"is coarser than half the step-over ({fmt_length(step, args.units)}): expect "
+                          f"aliasing waves; use --cell-size {step / 2 / MM_PER_UNIT[args.units]:.2g} or finer",
+                          file=sys.stderr)
+                    n_warn += 1
+                res = simulate(program, tools, stock.size_mm, resolution_mm=args.cell_size,
+                               work_offset_mm=offset, progress=True, initial_heightmap=hm,
+                               track_lines=bool(args.part))
+                hm = res.heightmap
+                for issue in res.report:
+                    write(f"woodcam: warning: {path.name} {issue}", file=sys.stderr)
+                n_warn += len(res.report)
+                times = program.machining_time_s(args.rapid_rate)
+                s = res.stats
+                write(f"{path.name}: {len(program)} moves read in {t_read:.2f} s, simulated on "
+                      f"{s['grid'][1]}x{s['grid'][0]} cells in {s['wall_s']:.2f} s "
+                      f"({s['moves_per_s']:.0f} moves/s), removed {fmt_volume(res.removed_volume_mm3, args.units)}, "
+                      f"{len(res.report)} issue(s); machining time " + ", ".join(
+                          f"T{t}: {fmt_hms(f + r)} ({fmt_hms(f)} feeding)" for t, (f, r) in times.items()))
+                # resolved, as the block spec (_specs.absolute_spec): the review page of the GLB, opened
+                # from another folder, names the program that cut it (as typed it was relative to a
+                # working folder the GLB does not record)
+                meta_programs.append({"gcode": str(Path(path).resolve()),
+                                      "tools": {str(t): v.spec() for t, v in sorted(tools.items())},
+                                      "machining_time_s": sum(f + r for f, r in times.values()),
+                                      "warnings": _issue_spots(program, res.report, stock.size_mm, offset, path.name)})
+                last = (program, res)
+        program, res = last
+        if design is not None:
+            with bar.stage("deviation"):
+                from ..toolpath.deviation import deviation, deviation_png, fmt_depth
 
-        dev = deviation(res, design)
-        png = _deviation_png(args.out)
-        deviation_png(dev, png, title=f"{Path(args.part).name}:\n{dev.summary(gouges=False)}"
-                      + (f", {len(dev.gouges)} gouging lines" if dev.gouges else ""))
-        print(f"deviation from {Path(args.part).name}: {dev.summary(units=args.units)}; "
-              f"map {png} (in mm)")
-        for ln, d in dev.gouges[:12]:
-            print(f"woodcam: warning: line {ln}: gouge: cuts {fmt_depth(d, args.units)} "
-                  "into the part", file=sys.stderr)
-        n_warn += len(dev.gouges)
-    meta = {"gcode": [m["gcode"] for m in meta_programs] if len(meta_programs) > 1
-            else meta_programs[0]["gcode"],
-            # the review page's G-code hotspots (it read this key, which nothing wrote)
-            "warnings": [w for m in meta_programs for w in m["warnings"]][:200],
-            "tools": {t: v for m in meta_programs for t, v in m["tools"].items()},
-            "resolution_mm": float(np.mean(res.cell_mm)),
-            "machining_time_s": sum(m["machining_time_s"] for m in meta_programs)}
-    if args.until_line is not None:
-        meta["until_line"] = args.until_line
-    t1 = time.perf_counter()
-    out = preview_heightfield(res.heightmap, stock, args.out, texels_per_mm=args.texels_per_mm,
-                              flat_tol_mm=args.mesh_tol, obj=not args.no_obj, metadata=meta,
-                              obj_units=args.obj_units, obj_up=args.obj_up,
-                              max_atlas_px=args.max_atlas)
-    t_bake = time.perf_counter() - t1
-    if design is not None:
-        out.files["deviation"] = png  # the map written above
-    if args.screenshot:
-        _screenshot(args, stock, program, offset, out, res.heightmap)
+                dev = deviation(res, design)
+                png = _deviation_png(args.out)
+                deviation_png(dev, png, title=f"{Path(args.part).name}:\n{dev.summary(gouges=False)}"
+                              + (f", {len(dev.gouges)} gouging lines" if dev.gouges else ""))
+                write(f"deviation from {Path(args.part).name}: {dev.summary(units=args.units)}; "
+                      f"map {png} (in mm)")
+                for ln, d in dev.gouges[:12]:
+                    write(f"woodcam: warning: line {ln}: gouge: cuts {fmt_depth(d, args.units)} "
+                          "into the part", file=sys.stderr)
+                n_warn += len(dev.gouges)
+        meta = {"gcode": [m["gcode"] for m in meta_programs] if len(meta_programs) > 1
+                else meta_programs[0]["gcode"],
+                # the review page's G-code hotspots (it read this key, which nothing wrote)
+                "warnings": [w for m in meta_programs for w in m["warnings"]][:200],
+                "tools": {t: v for m in meta_programs for t, v in m["tools"].items()},
+                "resolution_mm": float(np.mean(res.cell_mm)),
+                "machining_time_s": sum(m["machining_time_s"] for m in meta_programs)}
+        if args.until_line is not None:
+            meta["until_line"] = args.until_line
+        t1 = time.perf_counter()
+        with bar.stage("mesh and bake"):
+            out = preview_heightfield(res.heightmap, stock, args.out, texels_per_mm=args.texels_per_mm,
+                                      flat_tol_mm=args.mesh_tol, obj=not args.no_obj, metadata=meta,
+                                      obj_units=args.obj_units, obj_up=args.obj_up,
+                                      max_atlas_px=args.max_atlas)
+        t_bake = time.perf_counter() - t1
+        if design is not None:
+            out.files["deviation"] = png  # the map written above
+        if args.screenshot:
+            with bar.stage("render"):
+                _screenshot(args, stock, program, offset, out, res.heightmap)
+    finally:
+        bar.close()
     remove_stale_outputs(args.out, out.files, inputs=[*args.program, args.part])
     print(f"meshed and baked {out.triangles} triangles in {t_bake:.2f} s; wrote "
           + ", ".join(map(str, out.files.values())))
