@@ -280,3 +280,29 @@ def test_the_candidates_asked_for_are_scored_when_only_some_orientations_fit(kno
     assert len(orientations) == 8
     assert all(abs(p.matrix[:3, :3] @ np.array([1.0, 0.0, 0.0]))[0] > 0.99 for p in advice.ranked)
     assert advice.candidates == len(advice.ranked) == 216
+
+
+def test_the_report_names_its_thirds_by_the_blocks_ends_whatever_the_eigenvector_sign(monkeypatch):
+    """The thirds ran along an eigenvector whose sign numpy leaves arbitrary: the same bowl on
+    the H11 cube baked at 5 and at 10 texels/mm had its knots in the 'last third' and then in the
+    'first', and nothing said which end was first. A stick along X through _SlabWood's knot
+    (x 20-40, z 16-18: only in the stick's left part, x 10-90) has its knots in the left third,
+    and the report is the same with every eigenvector negated."""
+    import trimesh
+
+    from woodcam.advise import part_report
+
+    stick = trimesh.creation.box((80.0, 10.0, 10.0))
+    stick.apply_translation((50.0, 25.0, 17.0))
+    rep = part_report(stick, _slab_stock(), samples=6000)
+    assert [r["region"] for r in rep["regions"]] == ["left third", "middle third", "right third"]
+    # the knot band meets the stick's y faces over 2 mm of height: 2 * 2 * 16.7 mm^2 of the left
+    # third's 1167 mm^2 of surface, 2 * 2 * 3.3 of the middle's 1067 (the wood under the y
+    # faces alike; under the z faces none)
+    left, middle, right = (r["knots"] for r in rep["regions"])
+    assert left == pytest.approx(4 * 16.67 / 1167, rel=0.25)
+    assert middle == pytest.approx(4 * 3.33 / 1067, abs=0.006) and right == 0.0
+
+    eigh = np.linalg.eigh
+    monkeypatch.setattr(np.linalg, "eigh", lambda a: (eigh(a)[0], -eigh(a)[1]))
+    assert part_report(stick, _slab_stock(), samples=6000) == rep

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import WoodcamError, WoodcamWarning
+from .frames import AXIS_ENDS
 from .units import Units, fmt_span, fmt_volume, say_length
 
 #: Points within this many years of the pith count as pith (juvenile wood and the pith itself).
@@ -175,7 +176,11 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
         warnings.warn(hint, WoodcamWarning, stacklevel=2)
     # the part's long axis and how long-and-thin it is (principal axes of the surface sample)
     evals, evecs = np.linalg.eigh(np.cov((pts - pts.mean(axis=0)).T))
-    long_axis = evecs[:, -1]
+    # eigh's sign is arbitrary: the same bowl baked at 5 and at 10 texels/mm had its knots in the
+    # "last third" and then the "first", with nothing to say which end was which. Pointed to
+    # + along the block axis it runs nearest, the thirds are named by the block's ends.
+    ax = int(np.argmax(np.abs(evecs[:, -1])))
+    long_axis = evecs[:, -1] * np.sign(evecs[ax, -1])
     elongation = float(1.0 - math.sqrt(max(evals[1], 0.0) / max(evals[2], 1e-12)))
     size = np.asarray(stock.size_mm, dtype=float)
     # the candidates are split over the orientations the part fits in: split over all of them,
@@ -266,7 +271,8 @@ def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
     and the wood :data:`SUBSURFACE_MM` under it together, ``end_grain``: share of the surface),
     ``knots_surface`` (the knot share of the surface alone, which the warning quotes),
     ``elongation``, and ``regions``: the part cut into :data:`REPORT_REGIONS` slabs along its
-    long axis, each with its mean fibre direction, runout angle (degrees) and knot share (the
+    long axis, named by the block's ends along the block axis nearest it (``"left third"``,
+    ``"middle third"``, ``"right third"``; :data:`woodcam.frames.AXIS_ENDS`), each with its mean fibre direction, runout angle (degrees) and knot share (the
     surface and the wood under it, as ``knots``); plus ``warnings`` in words (short grain,
     knots or pith on the surface). Shares are fractions in [0, 1].
     """
@@ -278,14 +284,18 @@ def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
     knot = feats["knot"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) > 0.5
     pith = (feats["years"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) < PITH_YEARS) & ~knot
     evals, evecs = np.linalg.eigh(np.cov((pts - pts.mean(axis=0)).T))
-    long_axis = evecs[:, -1]
+    # eigh's sign is arbitrary: the same bowl baked at 5 and at 10 texels/mm had its knots in the
+    # "last third" and then the "first", with nothing to say which end was which. Pointed to
+    # + along the block axis it runs nearest, the thirds are named by the block's ends.
+    ax = int(np.argmax(np.abs(evecs[:, -1])))
+    long_axis = evecs[:, -1] * np.sign(evecs[ax, -1])
     elongation = float(1.0 - math.sqrt(max(evals[1], 0.0) / max(evals[2], 1e-12)))
     end = np.abs(np.einsum("ij,ij->i", grain, nrm)) > math.cos(math.radians(45))
     t = (pts - pts.mean(axis=0)) @ long_axis
     edges = np.quantile(t, np.linspace(0, 1, REPORT_REGIONS + 1))
     region = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, REPORT_REGIONS - 1)
     regions, warnings = [], []
-    names = ("first third", "middle third", "last third")
+    names = (f"{AXIS_ENDS[ax][0]} third", "middle third", f"{AXIS_ENDS[ax][1]} third")
     for r in range(REPORT_REGIONS):
         sel = region == r
         g = grain[sel].mean(axis=0)

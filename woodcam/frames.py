@@ -27,6 +27,10 @@ FaceName = Literal["front", "top", "left", "bottom", "right", "back"]
 #: The six faces in the conventions' order.
 FACES: tuple[FaceName, ...] = get_args(FaceName)
 
+#: The faces at each block axis' low and high end (x = 0 and W, y = 0 and D, z = 0 and H): what
+#: the end thirds of the block, or of a part, along that axis are called.
+AXIS_ENDS: tuple[tuple[FaceName, FaceName], ...] = (("left", "right"), ("front", "back"), ("bottom", "top"))
+
 #: Mokume dataset letter of each face.
 MOKUME_LETTER: dict[FaceName, str] = {
     "front": "A", "top": "B", "left": "C", "bottom": "D", "right": "E", "back": "F",

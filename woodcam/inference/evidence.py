@@ -56,7 +56,7 @@ from .._types import ArrayLike
 from ..errors import WoodcamError, WoodcamWarning
 from ..fields.base import central_gradient
 from ..fields.residual import ResidualField
-from ..frames import FACES
+from ..frames import AXIS_ENDS, FACES
 from ..tolerances import (
     EVIDENCE_ACCEPT_MARGIN,
     EVIDENCE_BLEND_DEPTH_MM,
@@ -863,9 +863,6 @@ def _bake_evidence(ev: EvidenceFit, size_mm, faces, strands, workers: int):
                      layers, meta)
 
 
-_THIRDS = (("left", "middle", "right"), ("front", "middle", "back"), ("bottom", "middle", "top"))
-
-
 def uncertainty_report(wood, points_mm, size_mm, what: str = "part", *,
                        confident_line: bool = True) -> str | None:
     """One line on where a fit's rings are a guess (issue 12 part 5), or None when the wood's
@@ -920,7 +917,7 @@ def uncertainty_report(wood, points_mm, size_mm, what: str = "part", *,
     if not wood.in_source_frame:  # the photos' name, and this block's where a turn renamed it
         mine = next(f for f in FACES if wood.source_face(f) == face)
         face = f"fitted block's {face}" + (f" face (this block's {mine})" if mine != face else "")
-    place = "middle" if t == 1 else _THIRDS[ax][t]
+    place = "middle" if t == 1 else AXIS_ENDS[ax][t // 2]
     axis_word = ("left-right", "front-back", "bottom-top")[ax]
     # a face outside the fit may be missing or photographed with no rings found: ask for both
     face_word = face if face.endswith(")") else f"{face} face"
