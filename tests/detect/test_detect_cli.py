@@ -161,6 +161,33 @@ def test_a_corrected_svg_in_another_out_folder_is_kept(synth_photos, tmp_path, c
     assert (det / "front_traces.svg").read_text() == mine
 
 
+def test_a_corrected_svg_drawn_over_another_photo_is_refused(synth_photos, tmp_path, capsys):
+    """'rings detect NEW --out OLD' kept the SVG corrected over OLD's front photo as the rings of
+    NEW's front photo (H11 with its front turned 90 degrees took rings drawn across it), with
+    only 'kept the corrected front_traces.svg'. Now it is refused, naming the face, the SVG and
+    the fix, and nothing in OLD is touched; the same photos keep the correction."""
+    old, new, det = tmp_path / "old", tmp_path / "new", tmp_path / "det"
+    turned = _copy(synth_photos, tmp_path / "turned")
+    Image.open(turned / "front.png").rotate(90).save(turned / "front.png")
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", old)[0] == 0
+    assert _run(capsys, "block", "from-photos", turned, "--size-mm", "50", "--out", new)[0] == 0
+    assert _run(capsys, "rings", "detect", old, "--out", det)[0] == 0
+    mine = ('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
+            '<path d="M 10.5,20.5 L 150.5,20.5" data-year="3"/></svg>')
+    (det / "front_traces.svg").write_text(mine)
+    before = {p.name: p.read_bytes() for p in det.iterdir()}
+    rc, out, err = _run(capsys, "rings", "detect", new, "--out", det)
+    assert rc == EXIT_ERROR and "kept the corrected" not in out
+    assert (f"face 'front': the corrected {det / 'front_traces.svg'} was traced over another front photo "
+            "than this block's") in err
+    assert "move front_traces.svg out of" in err and "detect into another --out" in err
+    assert {p.name: p.read_bytes() for p in det.iterdir()} == before
+    # the photos it was drawn over: kept, as before
+    rc, out, _err = _run(capsys, "rings", "detect", old, "--out", det)
+    assert rc == 0 and "kept the corrected front_traces.svg" in out
+    assert (det / "front_traces.svg").read_text() == mine
+
+
 def test_the_detection_cache_stays_in_the_cache_whatever_the_block_is_named(synth_photos, tmp_path, monkeypatch):
     """A block named "../../escaped/evil" cached its detection outside the cache folder, and a
     name of 250 characters failed with 'File name too long'."""

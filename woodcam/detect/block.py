@@ -12,7 +12,9 @@ A block's faces after detection carry (pixels of each face image, ``docs/convent
 **A user's SVG wins.** The manifest records the SHA-256 of each SVG the detector wrote
 (``meta["detection"]["svg_sha256"]``). When a face's SVG no longer matches (someone corrected it
 in an editor), detecting again keeps that SVG, takes its traces as the face's rings and redraws
-the ring map from them; only faces whose SVG is untouched (or missing) are detected afresh.
+the ring map from them; only faces whose SVG is untouched (or missing) are detected afresh. It
+also records a digest of each face photo traced (``meta["detection"]["photo_digest"]``): a
+corrected SVG drawn over another photo than the face's now is refused, not kept.
 
 **Photo-only blocks elsewhere** (``fit``, ``bake``, ``eval``): :func:`with_detected_rings`
 detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
@@ -147,6 +149,33 @@ def user_edited_faces(folder) -> dict[str, Path]:
     return out
 
 
+def _photo_digest(photo) -> str:
+    """Digest of a face photo's pixels as stored in a block folder (what a traced SVG is drawn over)."""
+    return digest(np.asarray(photo))
+
+
+def _check_corrections_match_photos(block: Block, edited: dict[str, Path]) -> None:
+    """Refuse a corrected SVG drawn over another photo than ``block``'s face photo now.
+
+    Detecting a new block into the folder of an earlier one (``rings detect NEW --out OLD``), or
+    a face photo replaced after its SVG was corrected, kept the old correction as the new
+    photo's rings without a word (a face turned 90 degrees since took rings drawn across it).
+    Its manifest records the digest of each face photo it traced (``photo_digest``); folders
+    written before it was recorded cannot be checked."""
+    from ..block.io import MANIFEST
+
+    for name, svg in edited.items():
+        m = json.loads((svg.parent / MANIFEST).read_text())
+        was = m.get("meta", {}).get("detection", {}).get("photo_digest", {}).get(name)
+        photo = block.faces[name].photo
+        if was is not None and photo is not None and was != _photo_digest(photo):
+            raise WoodcamError(
+                f"face {name!r}: the corrected {svg} was traced over another {name} photo than this "
+                f"block's (the photo changed since, or --out holds an earlier block's detection): its "
+                f"rings are not this photo's, and detecting would overwrite the correction; move "
+                f"{svg.name} out of {str(svg.parent)!r} (or detect into another --out) and run again")
+
+
 def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = True,
                   size_mm=None, progress: bool = False,
                   detector: Detector = DEFAULT_DETECTOR, curved: bool | None = None) -> tuple[Path, list[str]]:
@@ -181,6 +210,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
         # corrections made in the output folder of an earlier run win too (only the source's
         # were looked for, and detection overwrote the ones in --out)
         edited.update(user_edited_faces(out))
+    _check_corrections_match_photos(block, edited)
     todo = [n for n, f in block.faces.items() if f.photo is not None and n not in edited]
     msgs: list[str] = []
     if todo:
@@ -229,6 +259,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     det = dict(block.meta.get("detection") or {"detector": detector, "version": DETECT_VERSION, "rule": rule,
                                                "curved": _curved(curved)})
     det["svg_sha256"] = hashes
+    det["photo_digest"] = {n: _photo_digest(f.photo) for n, f in block.faces.items() if f.photo is not None}
     det["user_svg"] = sorted(kept)
     block.meta["detection"] = det
     # a face photographed turned or mirrored ruins the fit without a word otherwise
