@@ -651,3 +651,32 @@ def test_a_malformed_bake_report_in_the_glb_is_warned_not_a_traceback(page, tmp_
     err = capsys.readouterr().err
     assert f"warning: {str(glb)!r}: the bake report in its metadata is malformed" in err, err
     assert "<th>part</th>" not in (tmp_path / "r.html").read_text()
+
+
+def test_review_and_preview_draw_a_bar_while_the_block_opens(tmp_path, capsys, bars, monkeypatch):
+    """Where the cache lacks the block's field, review and preview fit it again (H11: 20-30 s)
+    with no bar, and review opened the block, read the part and its knots (5 s more) before the
+    colour volumes' bar. Each now draws a stage bar from the block on, preview's closed before
+    its window opens."""
+    import woodcam.view as view
+    from woodcam.cli import main
+
+    box = trimesh.creation.box((30.0, 20.0, 10.0))
+    box.apply_translation((50.0, 40.0, 25.0))
+    box.export(tmp_path / "part.stl")
+    glb = tmp_path / "part.glb"
+    assert main(["bake", str(tmp_path / "part.stl"), "--block", "builtin:rift", "--out", str(glb),
+                 "--no-obj", "--texels-per-mm", "2"]) == 0
+    del bars[:]
+    assert main(["review", str(glb), "--out", str(tmp_path / "r.html"), "--voxels", "20000"]) == 0
+    [bar] = [b for b in bars if b.desc == "review"]
+    assert bar.enabled and bar.unit == "stage"
+    assert bar.shown[1:4] == ["review: open block", "review: hotspots", "review: page"]
+    assert bar.n == bar.total == 3 and bar.closed
+    del bars[:]
+    opened = []
+    monkeypatch.setattr(view, "preview", lambda mesh, **kw: opened.append([b.closed for b in bars]))
+    assert main(["preview", str(glb)]) == 0
+    [bar] = [b for b in bars if b.desc == "preview"]
+    assert bar.enabled and bar.shown[1] == "preview: open block" and bar.n == bar.total == 1
+    assert opened == [[True]]  # the window opened after the bar was gone

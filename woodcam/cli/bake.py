@@ -193,7 +193,12 @@ def run_preview(args: argparse.Namespace) -> int:
         if out:
             print(f"wrote {out}")
         return 0
-    stock = stock_of_glb(args.mesh, args.block, units=args.units, typed=as_typed(args, "block"))
+    from .._progress import StageBar
+
+    # a bar while the block opens: its field is fitted again where the cache lacks it (H11: 20-30 s
+    # with none); closed before the window opens
+    with StageBar(["open block"], desc="preview", leave=False) as bar, bar.stage("open block"):
+        stock = stock_of_glb(args.mesh, args.block, units=args.units, typed=as_typed(args, "block"))
     wood = stock.wood if stock else None
     if args.confidence:
         from ..inference.evidence import ConfidenceWood

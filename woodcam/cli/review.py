@@ -31,9 +31,9 @@ def register(subparsers) -> None:
 
 
 def run_review(args: argparse.Namespace) -> int:
+    from .._progress import StageBar
     from ..errors import WoodcamError
     from ..export import read_glb_metadata
-    from ..review import VOLUME_VOXELS, write_review
     from .options import as_typed, stock_of_glb
 
     if not args.part.is_file():  # it said "records no block spec", blaming the spec for a missing file
@@ -44,7 +44,22 @@ def run_review(args: argparse.Namespace) -> int:
             f"review: {str(args.part)!r} is a parquetry panel (veneer pieces from several sheets, each "
             "turned its own way), not a part cut from one block, so the page's section has no wood "
             f"to show; view it with: woodcam preview {shlex.quote(str(args.part))}")
-    stock = stock_of_glb(args.part, args.block, units=args.units, typed=as_typed(args, "block"))
+    # one bar for the run, as bake's: the block's field is fitted again where the cache lacks it
+    # (H11: 20-30 s), and opening the block, reading the part and its knots took 5 s more before
+    # the colour volumes' bar, with none
+    with StageBar(["open block", "hotspots", "page"], desc="review", leave=False) as bar:
+        with bar.stage("open block"):
+            stock = stock_of_glb(args.part, args.block, units=args.units, typed=as_typed(args, "block"))
+        out = _page(args, meta, stock, bar)
+    print(f"wrote {out} ({out.stat().st_size / 2**20:.1f} MiB)")
+    return 0
+
+
+def _page(args: argparse.Namespace, meta: dict, stock, bar) -> Path:
+    """``review``'s work after the block is open: the report rows, the hotspots and the page."""
+    from ..errors import WoodcamError
+    from ..review import VOLUME_VOXELS, write_review
+
     if stock is None:
         field = args.part.parent / "field.npz"
         if "woodify" in meta and field.is_file():  # woodify's grown.glb: its field lies beside it
@@ -63,21 +78,21 @@ def run_review(args: argparse.Namespace) -> int:
     from ..advise import knot_spots
     from ..export import load_textured
 
-    hotspots = knot_spots(load_textured(args.part), stock.wood)
-    hotspots += [{"kind": "gcode", "label": str(w.get("message", "")), "at_mm": w["at_mm"]}
-                 for w in meta.get("warnings", []) if isinstance(w, dict) and "at_mm" in w]
-    photos = None
-    if Path(spec).is_dir():  # a block or Mokume folder: show its face photos
-        from ..stock import open_block
+    with bar.stage("hotspots"):
+        hotspots = knot_spots(load_textured(args.part), stock.wood)
+        hotspots += [{"kind": "gcode", "label": str(w.get("message", "")), "at_mm": w["at_mm"]}
+                     for w in meta.get("warnings", []) if isinstance(w, dict) and "at_mm" in w]
+    with bar.stage("page"):
+        photos = None
+        if Path(spec).is_dir():  # a block or Mokume folder: show its face photos
+            from ..stock import open_block
 
-        block, _ = open_block(spec)
-        photos = {face: f.photo for face, f in block.faces.items()
-                  if getattr(f, "photo", None) is not None}
-    out = write_review(args.part, args.out, wood=stock.wood, size_mm=stock.size_mm,
-                       report=report, photos=photos, hotspots=hotspots,
-                       voxels=args.voxels or VOLUME_VOXELS, progress=True)
-    print(f"wrote {out} ({out.stat().st_size / 2**20:.1f} MiB)")
-    return 0
+            block, _ = open_block(spec)
+            photos = {face: f.photo for face, f in block.faces.items()
+                      if getattr(f, "photo", None) is not None}
+        return write_review(args.part, args.out, wood=stock.wood, size_mm=stock.size_mm,
+                            report=report, photos=photos, hotspots=hotspots,
+                            voxels=args.voxels or VOLUME_VOXELS, progress=True)
 
 
 def _report_rows(bake_report: dict, glb: Path) -> dict:
