@@ -188,6 +188,37 @@ def test_a_corrected_svg_drawn_over_another_photo_is_refused(synth_photos, tmp_p
     assert (det / "front_traces.svg").read_text() == mine
 
 
+def test_an_interrupted_from_photos_leaves_the_earlier_block_whole(synth_photos, tmp_path, capsys, monkeypatch):
+    """A Ctrl-C of 'block from-photos NEW --out BLK' into the block folder of an earlier run, once
+    its first photo was written: BLK held the new front photo beside the old faces and the old
+    manifest (with the old run's rings), a block of two runs read without a word. The photos,
+    maps and manifest now land together: interrupted, BLK is the earlier block byte for byte."""
+    import woodcam.block.io as io_mod
+
+    blk = tmp_path / "blk"
+    turned = _copy(synth_photos, tmp_path / "turned")
+    Image.open(turned / "front.png").rotate(90).save(turned / "front.png")
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
+    assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 0
+    before = {p.name: p.read_bytes() for p in blk.iterdir()}
+    real, calls = io_mod._write_png, []
+
+    def interrupted(path, a):  # Ctrl-C while the second photo is written
+        calls.append(path.name)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(path, a)
+
+    monkeypatch.setattr(io_mod, "_write_png", interrupted)
+    assert _run(capsys, "block", "from-photos", turned, "--size-mm", "50", "--out", blk)[0] == 130
+    assert calls == ["front_photo.png", "top_photo.png"]
+    assert {p.name: p.read_bytes() for p in blk.iterdir()} == before  # no mix, no temporary file
+    monkeypatch.setattr(io_mod, "_write_png", real)
+    assert _run(capsys, "block", "from-photos", turned, "--size-mm", "50", "--out", blk)[0] == 0
+    new = np.asarray(Image.open(turned / "front.png").convert("RGB"))
+    assert np.array_equal(read_block(blk).faces["front"].photo, new)  # the new block, whole
+
+
 def test_the_detection_cache_stays_in_the_cache_whatever_the_block_is_named(synth_photos, tmp_path, monkeypatch):
     """A block named "../../escaped/evil" cached its detection outside the cache folder, and a
     name of 250 characters failed with 'File name too long'."""

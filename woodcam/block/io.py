@@ -54,7 +54,7 @@ from typing import Literal
 import numpy as np
 
 from .._types import ArrayLike, PathLike
-from .._atomic import atomic_path, write_text
+from .._atomic import all_or_nothing, atomic_path, write_text
 from .._readers import photo_rgb8, read_image_file
 from ..errors import WoodcamError, WoodcamWarning
 from ..fields.state import field_from_state, field_type, jsonable
@@ -108,43 +108,48 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
         raise WoodcamError(
             f"folder {str(folder)!r} already holds a {MANIFEST}; pass overwrite=True or pick a new folder"
         )
-    faces = {}
-    for name, face in block.faces.items():
-        entry: dict = {"shape": list(face.shape), "photo": None, "ring_map": None}
-        if face.photo is not None:
-            photo = np.asarray(face.photo)
-            if photo.dtype != np.uint8:
-                raise WoodcamError(
-                    f"photo of face {name!r} must be uint8 to be stored losslessly; got {photo.dtype}; "
-                    "convert with np.clip(photo * 255, 0, 255).round().astype(np.uint8)"
-                )
-            entry["photo"] = f"{name}_photo.png"
-            _write_png(folder / entry["photo"], photo)
-        if face.ring_map is not None:
-            entry["ring_map"] = f"{name}_ring_map.png"
-            entry["ring_map_bits"] = int(ring_map_bits)
-            _write_png(folder / entry["ring_map"], _quantise(face.ring_map, ring_map_bits, name))
-        entry["traces"] = [
-            {"year": None if t.year is None else int(t.year), "points_px": t.points_px.tolist(),
-             **({} if t.ring is None else {"ring": int(t.ring)})}
-            for t in face.traces
-        ]
-        extras = {}
-        for key, value in face.extras.items():
-            extras[key] = _write_extra(folder, name, key, value)
-        entry["extras"] = extras
-        if traces_svg and name in traces_svg:
-            if not (folder / traces_svg[name]).is_file():
-                raise WoodcamError(f"traces_svg of face {name!r}: {traces_svg[name]!r} is not a file in "
-                                   f"{str(folder)!r}; write the SVG first")
-            entry["traces_svg"] = traces_svg[name]
-        faces[name] = entry
-    manifest = {
-        "format": FORMAT, "version": VERSION, "name": block.name,
-        "size_mm": list(block.size_mm), "meta": jsonable(block.meta, "block.meta"),
-        "faces": faces, "true_field": _write_field(block.true_field, folder),
-    }
-    write_text(manifest_path, json.dumps(manifest, indent=1))  # last: images are in place
+    # One set: the photos, maps and manifest land together or not at all. Written file by file,
+    # a Ctrl-C of 'block from-photos' (or 'rings detect') into a block folder of an earlier run
+    # left the new front photo beside the old faces and the old manifest's rings: a block of two
+    # runs, read without a word.
+    with all_or_nothing():
+        faces = {}
+        for name, face in block.faces.items():
+            entry: dict = {"shape": list(face.shape), "photo": None, "ring_map": None}
+            if face.photo is not None:
+                photo = np.asarray(face.photo)
+                if photo.dtype != np.uint8:
+                    raise WoodcamError(
+                        f"photo of face {name!r} must be uint8 to be stored losslessly; got {photo.dtype}; "
+                        "convert with np.clip(photo * 255, 0, 255).round().astype(np.uint8)"
+                    )
+                entry["photo"] = f"{name}_photo.png"
+                _write_png(folder / entry["photo"], photo)
+            if face.ring_map is not None:
+                entry["ring_map"] = f"{name}_ring_map.png"
+                entry["ring_map_bits"] = int(ring_map_bits)
+                _write_png(folder / entry["ring_map"], _quantise(face.ring_map, ring_map_bits, name))
+            entry["traces"] = [
+                {"year": None if t.year is None else int(t.year), "points_px": t.points_px.tolist(),
+                 **({} if t.ring is None else {"ring": int(t.ring)})}
+                for t in face.traces
+            ]
+            extras = {}
+            for key, value in face.extras.items():
+                extras[key] = _write_extra(folder, name, key, value)
+            entry["extras"] = extras
+            if traces_svg and name in traces_svg:
+                if not (folder / traces_svg[name]).is_file():
+                    raise WoodcamError(f"traces_svg of face {name!r}: {traces_svg[name]!r} is not a file in "
+                                       f"{str(folder)!r}; write the SVG first")
+                entry["traces_svg"] = traces_svg[name]
+            faces[name] = entry
+        manifest = {
+            "format": FORMAT, "version": VERSION, "name": block.name,
+            "size_mm": list(block.size_mm), "meta": jsonable(block.meta, "block.meta"),
+            "faces": faces, "true_field": _write_field(block.true_field, folder),
+        }
+        write_text(manifest_path, json.dumps(manifest, indent=1))  # last: images are in place
     return manifest_path
 
 
