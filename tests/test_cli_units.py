@@ -466,3 +466,29 @@ def test_an_inch_spec_is_the_block_its_mm_spelling_is(inch, mm, tmp_path, capsys
     assert main(["place", "p.stl", "--units", "inch", "--block", big, "--out", str(tmp_path / "d")]) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"woodcam: error: --block {big}: the size must be WxDxH in --units inch"), err
+
+
+def test_a_malformed_place_is_refused_before_the_block_is_opened(tmp_path, capsys, monkeypatch):
+    """'bake --place fit:abc' (or rotate:q:90, or a negative fit margin) was refused only when the
+    part was placed: after the block was opened (a photographed block's fit, 20-30 s the first
+    time) and the part loaded. It is refused first now, quoting the op as typed."""
+    import trimesh
+
+    import woodcam.stock
+
+    opened = []
+    real = woodcam.stock.open_stock
+    monkeypatch.setattr(woodcam.stock, "open_stock", lambda *a, **k: opened.append(a) or real(*a, **k))
+    part = tmp_path / "p.stl"
+    trimesh.creation.box((10.0, 10.0, 10.0)).apply_translation((20, 20, 20)).export(part)
+    for op, said in (("fit:abc", "--place 'fit:abc': 'abc' is not a finite number"),
+                     ("rotate:q:90", "--place 'rotate:q:90': expected rotate:AXIS:DEG"),
+                     ("fit:-0.1", "--place 'fit:-0.1': a margin must be >= 0; got -0.1 in")):
+        assert main(["bake", str(part), "--units", "inch", "--block", "builtin:knotty:2x2x2",
+                     "--place", "center", "--place", op, "--out", str(tmp_path / "b.glb")]) == 1
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and said in err, err
+    assert opened == []
+    assert main(["bake", str(part), "--block", "builtin:flat-sawn", "--place", "center", "--place", "fit:1",
+                 "--out", str(tmp_path / "b.glb"), "--no-obj", "--texels-per-mm", "1"]) == 0
+    assert len(opened) == 1

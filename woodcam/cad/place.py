@@ -82,53 +82,77 @@ def placement_matrix(ops: Sequence[str], bounds_mm, size_mm, *,
     lo, hi = (np.asarray(b, dtype=float) for b in np.asarray(bounds_mm, dtype=float))
     size = np.asarray(size_mm, dtype=float)
     total = np.eye(4)
-    if as_typed is not None and len(as_typed) != len(ops):
-        raise WoodcamError(f"placement_matrix: as_typed must hold one text per operation ({len(ops)}); "
-                           f"got {len(as_typed)}: {list(as_typed)!r}; pass the ops as typed, or leave it out")
-    for mm_op, op in zip(ops, ops if as_typed is None else as_typed):  # lengths checked above
-        # ``op`` (as typed) is what the errors quote; ``arg`` (mm) is what is computed
-        name, _, arg = str(mm_op).strip().partition(":")
-        name = name.lower()
+    for name, value, op in parse_place(ops, as_typed=as_typed):
+        # ``op`` (as typed) is what the errors quote; ``value`` (mm) is what is computed
         centre = (lo + hi) / 2
         if name == "rotate":
-            axis, _, deg = arg.partition(":")
-            if axis.lower() not in _AXES or not deg:
-                raise WoodcamError(f"--place {op!r}: expected rotate:AXIS:DEG with AXIS x, y or z; "
-                                   f"use {_HELP}")
-            step = _about(centre, _rotation(_AXES[axis.lower()], _number(deg, op)))
+            axis, deg = value
+            step = _about(centre, _rotation(axis, deg))
         elif name == "translate":
-            parts = arg.split(",")
-            if len(parts) != 3:
-                raise WoodcamError(f"--place {op!r}: expected translate:X,Y,Z (in --units on the command "
-                                   f"line, mm in the library); use {_HELP}")
-            move = [_number(p, op) for p in parts]
-            if max(abs(v) for v in move) > 1e5:  # 1e300 made the part's volume 0 ("inside-out?")
-                raise WoodcamError(f"--place {op!r}: a move must stay within 100 m (1e5 mm)")
-            step = _translate(move)
+            step = _translate(value)
         elif name == "scale":
-            factor = _number(arg, op)
-            if not 0 < factor <= 1000:  # 1e300 overflowed the volume to NaN: the warnings vanished
-                raise WoodcamError(f"--place {op!r}: the scale must be in (0, 1000]; got {factor:g}")
-            step = _about(centre, np.eye(3) * factor)
-        elif name == "center" and not arg:
+            step = _about(centre, np.eye(3) * value)
+        elif name == "center":
             step = _translate(size / 2 - centre)
-        elif name == "drop" and not arg:
+        elif name == "drop":
             step = _translate([0.0, 0.0, -lo[2]])
-        elif name == "fit":
-            margin = _number(arg, op) if arg else FIT_MARGIN_MM
+        else:  # fit
+            margin = value
             room = size - 2 * margin
-            if margin < 0 or np.any(room <= 0):
+            if np.any(room <= 0):
                 raise WoodcamError(f"--place {op!r}: a margin of {say_length(margin, 'g')} leaves no room in the "
                                    f"{say_length(size, 'g')} block")
             factor = float(np.min(room / np.maximum(hi - lo, 1e-12)))
             step = _translate(size / 2 - centre) @ _about(centre, np.eye(3) * factor)
-        else:
-            raise WoodcamError(f"--place {op!r} is not a placement operation; use {_HELP}")
         total = step @ total
         corners = np.array(np.meshgrid(*zip(lo, hi), indexing="ij")).reshape(3, -1).T
         moved = corners @ step[:3, :3].T + step[:3, 3]
         lo, hi = moved.min(axis=0), moved.max(axis=0)
     return total
+
+
+def parse_place(ops: Sequence[str], *, as_typed: Sequence[str] | None = None) -> list[tuple]:
+    """The placement ``ops`` read and checked without a part or a block: one ``(name, value,
+    op as typed)`` per operation, ``value`` ``(axis index, degrees)`` for rotate, the move
+    ``[X, Y, Z]`` mm for translate, the factor for scale, the margin mm for fit, None for center
+    and drop. A WoodcamError quoting ``as_typed`` (default ``ops``) for a malformed one, so a
+    command can refuse it before it opens the block (a fit of minutes) and loads the part."""
+    if as_typed is not None and len(as_typed) != len(ops):
+        raise WoodcamError(f"placement_matrix: as_typed must hold one text per operation ({len(ops)}); "
+                           f"got {len(as_typed)}: {list(as_typed)!r}; pass the ops as typed, or leave it out")
+    out: list[tuple] = []
+    for mm_op, op in zip(ops, ops if as_typed is None else as_typed):
+        name, _, arg = str(mm_op).strip().partition(":")
+        name = name.lower()
+        value: object = None
+        if name == "rotate":
+            axis, _, deg = arg.partition(":")
+            if axis.lower() not in _AXES or not deg:
+                raise WoodcamError(f"--place {op!r}: expected rotate:AXIS:DEG with AXIS x, y or z; "
+                                   f"use {_HELP}")
+            value = (_AXES[axis.lower()], _number(deg, op))
+        elif name == "translate":
+            parts = arg.split(",")
+            if len(parts) != 3:
+                raise WoodcamError(f"--place {op!r}: expected translate:X,Y,Z (in --units on the command "
+                                   f"line, mm in the library); use {_HELP}")
+            value = [_number(p, op) for p in parts]
+            if max(abs(v) for v in value) > 1e5:  # 1e300 made the part's volume 0 ("inside-out?")
+                raise WoodcamError(f"--place {op!r}: a move must stay within 100 m (1e5 mm)")
+        elif name == "scale":
+            value = _number(arg, op)
+            if not 0 < value <= 1000:  # 1e300 overflowed the volume to NaN: the warnings vanished
+                raise WoodcamError(f"--place {op!r}: the scale must be in (0, 1000]; got {value:g}")
+        elif name in ("center", "drop") and not arg:
+            pass
+        elif name == "fit":
+            value = _number(arg, op) if arg else FIT_MARGIN_MM
+            if value < 0:
+                raise WoodcamError(f"--place {op!r}: a margin must be >= 0; got {say_length(value, 'g')}")
+        else:
+            raise WoodcamError(f"--place {op!r} is not a placement operation; use {_HELP}")
+        out.append((name, value, op))
+    return out
 
 
 def place_part(solid, ops: Sequence[str], size_mm, *, as_typed: Sequence[str] | None = None):

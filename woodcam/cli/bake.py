@@ -114,6 +114,12 @@ def run_bake(args: argparse.Namespace) -> int:
     from ..pipeline import part_stages
 
     check_outputs(args.out, obj=not args.no_obj, screenshot=getattr(args, "screenshot", None) or False)
+    if args.place:
+        # a malformed --place was refused only when the part was placed, after the block was
+        # opened (a photographed block's fit: 20-30 s) and the part loaded
+        from ..cad.place import parse_place
+
+        parse_place(args.place, as_typed=as_typed(args, "place"))
     apply_workers(args)
     shot = bool(getattr(args, "screenshot", None))
     camera_of(args, shot)  # a --camera without --screenshot warns before the work
