@@ -247,6 +247,33 @@ def test_one_stage_bar_runs_over_the_whole_job(tmp_path, monkeypatch, bars):
     assert bar.n == bar.total == 4 and bar.closed
 
 
+def test_programs_and_tools_are_refused_before_the_block_is_opened(tmp_path, capsys, monkeypatch):
+    """A missing program, a bad --tool or a missing --tools table was refused only after the
+    block was opened (a photographed block's fit: 20-30 s the first time), and two of the
+    errors named Python parameters ("read_gcode: text_or_path='x.nc' is not a file",
+    "load_tool_table: path='t.toml' does not exist"). Each is refused first now, naming what
+    was typed."""
+    import woodcam.stock
+
+    opened = []
+    monkeypatch.setattr(woodcam.stock, "open_stock", lambda *a, **k: opened.append(a))
+    prog = tmp_path / "p.nc"
+    prog.write_text("G0 X20 Y20 Z2 M3 S9000\nG1 Z-3 F600\nX40\nG0 Z2\nM2\n")
+    base = ["--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb")]
+    for argv, said in (
+            ([str(tmp_path / "nope.nc"), "--tool", "flat:6"],
+             f"woodcam gcode: program {str(tmp_path / 'nope.nc')!r} is not a file; pass the G-code file(s)"),
+            ([str(prog), "--tools", str(tmp_path / "t.toml")],
+             f"--tools {str(tmp_path / 't.toml')!r} is not a file; pass a TOML tool table"),
+            ([str(prog), "--tool", "1=flat:abc"], "--tool '1=flat:abc': tool spec 'flat:abc'"),
+            ([str(prog)], "no tools given; pass --tool SPEC")):
+        assert main(["gcode", *argv, *base]) == 1
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and said in err, err
+        assert "text_or_path" not in err and "path=" not in err
+    assert opened == []
+
+
 def test_a_refused_line_names_its_program(tmp_path, monkeypatch):
     """With several programs of one job, "G-code line 5: 'G41': ..." did not say which."""
     from woodcam.toolpath import GcodeError

@@ -127,6 +127,10 @@ def register(subparsers) -> None:
 def _tools_from_args(args, program) -> dict:
     from ..toolpath.tools import load_tool_table, parse_tool_spec
 
+    if args.tools and not Path(args.tools).is_file():  # load_tool_table named its parameter: "path='x'"
+        raise WoodcamError(f"--tools {str(args.tools)!r} is not a file; pass a TOML tool table "
+                           "([tools.N] type/diameter_mm/..., e.g. toolpaths/tools.toml) or a CAMotics "
+                           "JSON tool table")
     tools = dict(load_tool_table(args.tools)) if args.tools else {}
     unnumbered = []
     for item in args.tool:
@@ -193,6 +197,42 @@ def run(args) -> int:
         from ..view.scrub import check_display
 
         check_display()
+    # The programs and their tools first: a missing program, a program without a cut or a bad
+    # --tool/--tools was refused only after the block was opened (a photographed block's fit,
+    # 20-30 s the first time).
+    n_warn = 0
+    programs = []  # (path, program as simulated, the whole program, seconds to read, tools)
+    for k, path in enumerate(args.program):
+        if not Path(path).is_file():  # read_gcode named its parameter: "text_or_path='x.nc'"
+            raise WoodcamError(f"woodcam gcode: program {str(path)!r} is not a file; pass the G-code "
+                               "file(s) to simulate (.nc, .gcode, .ngc, .tap)")
+        t0 = time.perf_counter()
+        try:
+            program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
+                                 interpreter=args.interpreter,
+                                 machine_zero_mm=args.machine_zero)
+        except GcodeError as err:  # which of the programs: "G-code line 5" alone does not say
+            raise GcodeError(err.line, err.word, err.rule, err.fix, source=str(path)) from None
+        t_read = time.perf_counter() - t0
+        full = program  # the whole last program, for the window's slider
+        if args.until_line is not None and k == len(args.program) - 1:
+            program = program.until_line(args.until_line)
+        for w in program.warnings:
+            print(f"woodcam: warning: {path.name} {w}", file=sys.stderr)
+        n_warn += len(program.warnings)
+        if not (program.kind == 1).any() and args.until_line is None:
+            raise WoodcamError(f"woodcam gcode: {path} has no cutting move (G1/G2/G3 or a "
+                               "drilling cycle); nothing to simulate. Check that it is the "
+                               "program you meant")
+        tools = _tools_from_args(args, program)
+        step = program.stepover_mm(spacing_mm=args.cell_size)
+        if step is not None and args.cell_size > step / 2:
+            print(f"woodcam: warning: {path.name}: the grid ({fmt_length(args.cell_size, args.units)}) "
+                  f"is coarser than half the step-over ({fmt_length(step, args.units)}): expect "
+                  f"aliasing waves; use --cell-size {step / 2 / MM_PER_UNIT[args.units]:.2g} or finer",
+                  file=sys.stderr)
+            n_warn += 1
+        programs.append((path, program, full, t_read, tools))
     # one bar for the whole run, as bake's: opening a photographed block can fit its rings
     # (20-30 s, once), the simulation draws its own bar below it, and the mesh, bake and view
     # took 5-10 s more with none
@@ -206,39 +246,12 @@ def run(args) -> int:
             if args.stock or args.stock_origin:
                 stock = resize_stock(stock, args.stock or stock.size_mm, args.stock_origin or (0, 0, 0))
         offset = list(args.work_offset) if args.work_offset else None
-        n_warn = 0
         hm = None
         meta_programs, last = [], None
         hm_before = None  # the stock the last program starts from (the window's slider)
-        for k, path in enumerate(args.program):
+        for path, program, full, t_read, tools in programs:
             with bar.stage(f"simulate {Path(path).name}"):
                 hm_before = hm
-                t0 = time.perf_counter()
-                try:
-                    program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
-                                         interpreter=args.interpreter,
-                                         machine_zero_mm=args.machine_zero)
-                except GcodeError as err:  # which of the programs: "G-code line 5" alone does not say
-                    raise GcodeError(err.line, err.word, err.rule, err.fix, source=str(path)) from None
-                t_read = time.perf_counter() - t0
-                full = program  # the whole last program, for the window's slider
-                if args.until_line is not None and k == len(args.program) - 1:
-                    program = program.until_line(args.until_line)
-                for w in program.warnings:
-                    write(f"woodcam: warning: {path.name} {w}", file=sys.stderr)
-                n_warn += len(program.warnings)
-                if not (program.kind == 1).any() and args.until_line is None:
-                    raise WoodcamError(f"woodcam gcode: {path} has no cutting move (G1/G2/G3 or a "
-                                       "drilling cycle); nothing to simulate. Check that it is the "
-                                       "program you meant")
-                tools = _tools_from_args(args, program)
-                step = program.stepover_mm(spacing_mm=args.cell_size)
-                if step is not None and args.cell_size > step / 2:
-                    write(f"woodcam: warning: {path.name}: the grid ({fmt_length(args.cell_size, args.units)}) "
-                          f"is coarser than half the step-over ({fmt_length(step, args.units)}): expect "
-                          f"aliasing waves; use --cell-size {step / 2 / MM_PER_UNIT[args.units]:.2g} or finer",
-                          file=sys.stderr)
-                    n_warn += 1
                 res = simulate(program, tools, stock.size_mm, resolution_mm=args.cell_size,
                                work_offset_mm=offset, progress=True, initial_heightmap=hm,
                                track_lines=bool(args.part))
