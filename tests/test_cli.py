@@ -326,3 +326,19 @@ def test_an_interrupted_export_leaves_the_earlier_runs_report_with_its_glb(tmp_p
     monkeypatch.setattr(export, "export_glb", interrupted)
     assert main([*argv, "--block", "builtin:rift"]) == 130
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
+def test_bake_refuses_a_missing_or_unreadable_part_before_the_block_is_opened(tmp_path, capsys, monkeypatch):
+    """'bake nope.stl --block B' said the part was missing only after the block was opened (a
+    photographed block's fit: 20-30 s the first time); a part of a suffix no reader takes, too."""
+    import woodcam.stock
+
+    opened = []
+    monkeypatch.setattr(woodcam.stock, "open_stock", lambda *a, **k: opened.append(a))
+    (tmp_path / "part.dwg").write_text("x")
+    for part, said in ((tmp_path / "nope.stl", "does not exist or is not a file; check the path"),
+                       (tmp_path / "part.dwg", "has unsupported suffix '.dwg'; use one of")):
+        assert main(["bake", str(part), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "b.glb")]) == 1
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"part file {str(part)!r} " in err and said in err, err
+    assert opened == []

@@ -273,10 +273,12 @@ def _load(source: Any, tess: "_Tessellation", origin: str):
     )
 
 
-def _load_path(path: Path, tess: "_Tessellation"):
-    """Read a part file; the suffix picks the reader."""
-    suffix = path.suffix.lower()
-    if suffix not in SUPPORTED_SUFFIXES:
+def check_part_path(path) -> Path:
+    """``path`` as a part file :func:`load_part` can read (a supported suffix, an existing file),
+    else a WoodcamError saying what to do; for a command to check before its slow work (the
+    block's fit)."""
+    path = Path(path)
+    if path.suffix.lower() not in SUPPORTED_SUFFIXES:
         raise WoodcamError(
             f"part file {str(path)!r} has unsupported suffix {path.suffix!r}; use one of "
             f"{', '.join(SUPPORTED_SUFFIXES)} (export the part from your CAD program as STEP or "
@@ -286,6 +288,12 @@ def _load_path(path: Path, tess: "_Tessellation"):
         raise WoodcamError(
             f"part file {str(path)!r} does not exist or is not a file; check the path"
         )
+    return path
+
+
+def _load_path(path: Path, tess: "_Tessellation"):
+    """Read a part file; the suffix picks the reader."""
+    suffix = check_part_path(path).suffix.lower()
     if suffix in SCRIPT_SUFFIXES:
         return _load_script(path, tess)
     if suffix in STEP_SUFFIXES:

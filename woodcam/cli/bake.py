@@ -114,6 +114,9 @@ def run_bake(args: argparse.Namespace) -> int:
     from ..pipeline import part_stages
 
     check_outputs(args.out, obj=not args.no_obj, screenshot=getattr(args, "screenshot", None) or False)
+    from ..cad.parts import check_part_path
+
+    check_part_path(args.part)  # a missing part was said after the block was opened (its fit: 20-30 s)
     if args.place:
         # a malformed --place was refused only when the part was placed, after the block was
         # opened (a photographed block's fit: 20-30 s) and the part loaded
