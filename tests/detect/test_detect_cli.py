@@ -219,6 +219,33 @@ def test_an_interrupted_from_photos_leaves_the_earlier_block_whole(synth_photos,
     assert np.array_equal(read_block(blk).faces["front"].photo, new)  # the new block, whole
 
 
+def test_a_block_made_again_in_its_folder_keeps_its_corrected_svgs(synth_photos, tmp_path, capsys):
+    """The layout check says "turn its photo top.png ... and make the block again": remade with
+    'block from-photos' into its folder, the block's manifest dropped the detection's record and
+    the next 'rings detect' took the corrected front SVG for the detector's and overwrote it
+    without a word. The record is kept: the correction of the unchanged front photo stays; one
+    of a photo that changed is refused, not overwritten."""
+    blk = tmp_path / "blk"
+    turned = _copy(synth_photos, tmp_path / "turned")
+    Image.open(turned / "top.png").rotate(90).save(turned / "top.png")
+    assert _run(capsys, "block", "from-photos", turned, "--size-mm", "50", "--out", blk)[0] == 0
+    assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 0
+    mine = ('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
+            '<path d="M 10.5,20.5 L 150.5,20.5" data-year="3"/></svg>')
+    (blk / "front_traces.svg").write_text(mine)
+    (blk / "top_traces.svg").write_text(mine)
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
+    assert read_block(blk).faces["front"].traces == []  # no rings before 'rings detect'
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == EXIT_ERROR and "face 'top': the corrected" in err and "traced over another top photo" in err
+    assert (blk / "front_traces.svg").read_text() == mine and (blk / "top_traces.svg").read_text() == mine
+    (blk / "top_traces.svg").unlink()  # as the error says
+    rc, out, _err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and "kept the corrected front_traces.svg" in out and "top_traces" not in out
+    assert (blk / "front_traces.svg").read_text() == mine
+    assert len(read_block(blk).faces["top"].traces) > 1  # detected afresh on the new top photo
+
+
 def test_the_detection_cache_stays_in_the_cache_whatever_the_block_is_named(synth_photos, tmp_path, monkeypatch):
     """A block named "../../escaped/evil" cached its detection outside the cache folder, and a
     name of 250 characters failed with 'File name too long'."""

@@ -36,10 +36,14 @@ def add_from_photos(sub) -> None:
 def run_from_photos(args) -> int:
     from ..block.io import write_block
     from ..block.photos import MAX_PX_PER_MM, block_from_photos
+    from ..detect.block import detection_record
 
     block = block_from_photos(args.photos_dir, _size(args.size_mm), partial=args.partial,
                               max_px_per_mm=MAX_PX_PER_MM if args.max_px_per_mm is None else args.max_px_per_mm,
                               progress=True)
+    prior = detection_record(args.out)  # the block made again into its folder: its SVG corrections kept
+    if prior:
+        block.meta["detection_before"] = prior
     write_block(block, args.out)
     shapes = ", ".join(f"{n} {f.shape[1]}x{f.shape[0]}" for n, f in block.faces.items())
     ppm, photos_ppm = block.meta["px_per_mm"], block.meta["photos_px_per_mm"]

@@ -133,17 +133,51 @@ def _sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-def user_edited_faces(folder) -> dict[str, Path]:
-    """Faces of a block folder whose ``<face>_traces.svg`` differs from what the detector wrote
-    (a user corrected it) -> the SVG path."""
+def _detection_record(folder: Path) -> dict:
+    """What the last detection in block folder ``folder`` wrote: ``svg_sha256`` and
+    ``photo_digest`` (face -> digest) and ``traces_svg`` (face -> SVG name), from its manifest;
+    a manifest remade by ``block from-photos`` keeps them as ``meta["detection_before"]``
+    (:func:`detection_record`). Empty when none was recorded."""
+    from ..block.io import MANIFEST
+
+    m = json.loads((folder / MANIFEST).read_text())
+    meta = m.get("meta", {})
+    if meta.get("detection"):
+        return {**meta["detection"], "traces_svg": {n: e["traces_svg"] for n, e in m.get("faces", {}).items()
+                                                     if e.get("traces_svg")}}
+    return meta.get("detection_before") or {}
+
+
+def detection_record(folder) -> dict | None:
+    """The detection record of the block folder ``folder`` (its SVGs' and photos' digests and
+    the SVGs' names, those still in the folder), for ``block from-photos`` to keep in the
+    manifest it writes there (``meta["detection_before"]``); None without one.
+
+    A block remade into its own folder (a photo turned, as the layout check asks) dropped the
+    record, and the next 'rings detect' took the corrected SVGs for the detector's and
+    overwrote them: kept, a correction of an unchanged photo stays and one of a changed photo is
+    refused (:func:`detect_folder`)."""
     from ..block.io import MANIFEST
 
     folder = Path(folder)
-    m = json.loads((folder / MANIFEST).read_text())
-    written = m.get("meta", {}).get("detection", {}).get("svg_sha256", {})
+    if not (folder / MANIFEST).is_file():
+        return None
+    rec = _detection_record(folder)
+    svgs = {n: svg for n, svg in rec.get("traces_svg", {}).items() if (folder / svg).is_file()}
+    if not svgs:
+        return None
+    return {"traces_svg": svgs, "svg_sha256": rec.get("svg_sha256", {}),
+            "photo_digest": rec.get("photo_digest", {})}
+
+
+def user_edited_faces(folder) -> dict[str, Path]:
+    """Faces of a block folder whose ``<face>_traces.svg`` differs from what the detector wrote
+    (a user corrected it) -> the SVG path."""
+    folder = Path(folder)
+    rec = _detection_record(folder)
+    written = rec.get("svg_sha256", {})
     out = {}
-    for name, entry in m.get("faces", {}).items():
-        svg = entry.get("traces_svg")
+    for name, svg in rec.get("traces_svg", {}).items():
         if svg and (folder / svg).is_file() and _sha256(folder / svg) != written.get(name):
             out[name] = folder / svg
     return out
@@ -162,11 +196,8 @@ def _check_corrections_match_photos(block: Block, edited: dict[str, Path]) -> No
     photo's rings without a word (a face turned 90 degrees since took rings drawn across it).
     Its manifest records the digest of each face photo it traced (``photo_digest``); folders
     written before it was recorded cannot be checked."""
-    from ..block.io import MANIFEST
-
     for name, svg in edited.items():
-        m = json.loads((svg.parent / MANIFEST).read_text())
-        was = m.get("meta", {}).get("detection", {}).get("photo_digest", {}).get(name)
+        was = _detection_record(svg.parent).get("photo_digest", {}).get(name)
         photo = block.faces[name].photo
         if was is not None and photo is not None and was != _photo_digest(photo):
             raise WoodcamError(
@@ -256,6 +287,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
                              photo_href=f"{name}_photo.png" if f.photo is not None else None)
         hashes[name] = _sha256(svg)
     block.meta = dict(block.meta)
+    block.meta.pop("detection_before", None)  # superseded by this detection's record
     det = dict(block.meta.get("detection") or {"detector": detector, "version": DETECT_VERSION, "rule": rule,
                                                "curved": _curved(curved)})
     det["svg_sha256"] = hashes
