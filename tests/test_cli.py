@@ -342,3 +342,33 @@ def test_bake_refuses_a_missing_or_unreadable_part_before_the_block_is_opened(tm
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and f"part file {str(part)!r} " in err and said in err, err
     assert opened == []
+
+
+def test_a_ctrl_c_while_the_view_is_drawn_leaves_no_earlier_view_beside_the_new_glb(tmp_path, capsys, monkeypatch):
+    """The GLB set lands before the view is drawn: a Ctrl-C while drawing (seconds) left the
+    earlier run's NAME_view.png beside the new part's GLB, passing for its view. The earlier
+    view is gone once the new GLB is in place; a PNG no run listed (the user's) is kept."""
+    import woodcam.view as view
+
+    def drawn(mesh, screenshot=None, **kw):
+        screenshot.write_bytes(b"view of " + read_glb_metadata(mesh)["placement"]["ops"][0].encode())
+
+    part = tmp_path / "p.stl"
+    trimesh.creation.box((10.0, 10.0, 10.0)).apply_translation((20, 20, 20)).export(part)
+    out, png = tmp_path / "b.glb", tmp_path / "b_view.png"
+    base = ["bake", str(part), "--block", "builtin:flat-sawn", "--out", str(out), "--no-obj",
+            "--texels-per-mm", "1", "--screenshot"]
+    monkeypatch.setattr(view, "preview", drawn)
+    assert main([*base, "--place", "drop"]) == 0 and png.read_bytes() == b"view of drop"
+
+    def interrupted(mesh, **kw):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(view, "preview", interrupted)
+    assert main([*base, "--place", "center"]) == 130
+    assert read_glb_metadata(out)["placement"]["ops"] == ["center"]  # the new part landed
+    assert not png.exists()
+    mine = tmp_path / "mine.png"
+    mine.write_bytes(b"mine")
+    assert main([*base[:-1], "--screenshot", str(mine), "--place", "center"]) == 130
+    assert mine.read_bytes() == b"mine"

@@ -48,7 +48,7 @@ from . import _interrupt
 from .errors import WoodcamError, WoodcamWarning
 
 __all__ = ["all_or_nothing", "apart", "atomic_files", "atomic_path", "atomic_write", "check_output_path",
-           "manifest_path", "remove_stale", "run_outputs", "write_bytes", "write_figure", "write_text"]
+           "listed_outputs", "manifest_path", "remove_stale", "run_outputs", "write_bytes", "write_figure", "write_text"]
 
 
 def _umask() -> int:
@@ -282,6 +282,12 @@ def _read_manifest(path: Path) -> list[str] | None:
         return None
     return [n for n in names if isinstance(n, str) and n not in ("", ".", "..")
             and "/" not in n and "\\" not in n and n != path.name]
+
+
+def listed_outputs(folder: str | os.PathLike, kind: str) -> list[str]:
+    """The file names the last ``kind`` run listed in ``folder`` (:func:`remove_stale`'s list);
+    empty without a readable list."""
+    return _read_manifest(manifest_path(folder, kind)) or []
 
 
 def remove_stale(folder: str | os.PathLike, patterns: Iterable[str],

@@ -14,7 +14,8 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
 from .options import (BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
-                      allow_negative_values, camera_of, remove_stale_outputs, sizes_type, stock_options, vector_type)
+                      allow_negative_values, camera_of, drop_earlier_view, remove_stale_outputs, sizes_type,
+                      stock_options, vector_type)
 
 _EXAMPLES = """\
 examples:
@@ -373,6 +374,7 @@ def _screenshot(args, stock, program, offset, made, heightmap) -> None:
 
     out = Path(args.out)
     png = screenshot_path(args.screenshot, out)
+    drop_earlier_view(png, out)
     overlay = None
     if not args.no_overlay and len(program):
         off = np.asarray(offset if offset else (0.0, 0.0, stock.size_mm[2]), float)
