@@ -451,3 +451,26 @@ def test_a_rerun_removes_the_deviation_map_and_the_bakes_report_it_does_not_writ
     assert re.search(r"warning: removed 2 file\(s\) .*: g_report.txt, g_report.json$",
                      capsys.readouterr().err, re.M)
     assert sorted(p.name for p in tmp_path.iterdir()) == [".woodcam-g.glb-files.json", "box.stl", "g.glb"]
+
+
+def test_a_ctrl_c_while_baking_leaves_the_earlier_deviation_map_with_its_glb(tmp_path, capsys, monkeypatch):
+    """The deviation map was written before the stock was meshed and baked: a Ctrl-C there left
+    the new cut's map beside the earlier run's GLB (a map of another cut). It is drawn once the
+    GLB set is in place: interrupted, the folder is the earlier run's."""
+    import trimesh
+
+    box = trimesh.creation.box((20, 20, 20))
+    box.apply_translation((50, 40, 25))
+    box.export(tmp_path / "box.stl")
+    gcode = ["gcode", str(REPO / "toolpaths" / "drilling.nc"), "--tool", "flat:6", "--block",
+             "builtin:flat-sawn", "--cell-size", "1", "--out", str(tmp_path / "g.glb"), "--no-obj",
+             "--part", str(tmp_path / "box.stl")]
+    assert main(gcode) == 0
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(woodcam.pipeline, "preview_heightfield", interrupted)
+    assert main([*gcode[:-1], str(tmp_path / "box.stl"), "--until-line", "12"]) == 130
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before

@@ -282,8 +282,6 @@ def run(args) -> int:
 
                 dev = deviation(res, design)
                 png = _deviation_png(args.out)
-                deviation_png(dev, png, title=f"{Path(args.part).name}:\n{dev.summary(gouges=False)}"
-                              + (f", {len(dev.gouges)} gouging lines" if dev.gouges else ""))
                 write(f"deviation from {Path(args.part).name}: {dev.summary(units=args.units)}; "
                       f"map {png} (in mm)")
                 for ln, d in dev.gouges[:12]:
@@ -307,7 +305,11 @@ def run(args) -> int:
                                       max_atlas_px=args.max_atlas)
         t_bake = time.perf_counter() - t1
         if design is not None:
-            out.files["deviation"] = png  # the map written above
+            # drawn once the GLB set is in place: written before it, a Ctrl-C while meshing and
+            # baking left this cut's map beside the earlier run's GLB
+            deviation_png(dev, png, title=f"{Path(args.part).name}:\n{dev.summary(gouges=False)}"
+                          + (f", {len(dev.gouges)} gouging lines" if dev.gouges else ""))
+            out.files["deviation"] = png
         if args.screenshot:
             with bar.stage("render"):
                 _screenshot(args, stock, program, offset, out, res.heightmap)
