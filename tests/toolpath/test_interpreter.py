@@ -260,6 +260,20 @@ def test_arcs_r_form_turns_and_planes():
             _ends(f"G0 X0 Y0\n{arc} F100\nM2\n")
 
 
+def test_r_arc_short_of_the_half_chord_is_refused_as_linuxcnc_does():
+    # LinuxCNC 2.9 reads an R arc whose |R| is short of the half chord by up to 0.00005 inch
+    # (centre at the chord's midpoint) and refuses more, in G20 and G21 alike; woodcam used
+    # the centre-format tolerance (0.028 mm, 0.072 mm in G20) and cut "G2 X10 R4.99"
+    moves, _ = Interpreter("G0 X0 Y0\nG2 X10 Y0 R4.99874 F100\nM2\n").run()
+    assert moves[-1][3] == pytest.approx((5.0, 0.0), abs=1e-12)
+    _ends("G20 G0 X0 Y0\nG2 X1 Y0 R0.499951 F10\nM2\n")
+    for arc in ("G21 G2 X10 Y0 R4.99872", "G21 G2 X10 Y0 R4.99", "G21 G3 X10 Y0 R-4.995",
+                "G20 G2 X1 Y0 R0.499949", "G21 G18 G2 X10 Z0 R4.993"):
+        with pytest.raises(GcodeError,
+                           match=r"line 2: 'R[-.0-9]+': arc radius .* too small to reach"):
+            _ends(f"G0 X0 Y0 Z0\n{arc} F100\nM2\n")
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

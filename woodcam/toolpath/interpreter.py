@@ -127,6 +127,11 @@ _ARC_REL_TOL = 0.001
 #: LinuxCNC refuses a centre-format arc whose start or end radius is below 0.00005 inch
 #: ("Zero-radius arc"; measured against LinuxCNC 2.9: 0.00126 mm refused, 0.00128 mm read).
 _ARC_MIN_RADIUS_MM = 0.00005 * 25.4
+#: LinuxCNC refuses an R-format arc whose half chord exceeds |R| by more than 0.00005 inch
+#: ("Arc radius too small to reach end point"), in G20 and G21 alike (measured against
+#: LinuxCNC 2.9: R 0.00126 mm short of the half chord is read, 0.00128 mm refused; in inch
+#: 0.000049 read, 0.000051 refused); within it the centre is the chord's midpoint.
+_ARC_R_TOL_MM = 0.00005 * 25.4
 
 TRAVERSE, FEED, ARC = 0, 1, 2
 
@@ -1757,9 +1762,10 @@ class Interpreter:
                 raise self.err(f"R{w['r']:g}", "R-form arc with end = start (a full circle has "
                                "no unique centre)", "use the I/J/K form for full circles")
             half = dist / 2
-            if abs(r) < half - tol:
+            if half - abs(r) > _ARC_R_TOL_MM:
                 raise self.err(f"R{w['r']:g}", f"arc radius {say_length(abs(r), 'g')} too small to reach "
-                               f"the end point (half chord {say_length(half, 'g')})", "fix R or the end")
+                               f"the end point (half chord {say_length(half, 'g')}; LinuxCNC's tolerance "
+                               f"{say_length(_ARC_R_TOL_MM, 'g')})", "fix R or the end")
             h = math.sqrt(max(r * r - half * half, 0.0)) / dist
             # centre on the right of start->end for G2 with R > 0 (LinuxCNC/grbl convention)
             if cw == (r > 0):
