@@ -274,6 +274,20 @@ def test_r_arc_short_of_the_half_chord_is_refused_as_linuxcnc_does():
             _ends(f"G0 X0 Y0 Z0\n{arc} F100\nM2\n")
 
 
+def test_arc_lines_without_axis_words_as_linuxcnc_runs_them():
+    # LinuxCNC 2.9 runs the modal arc on a line of I/J/K alone (a full circle; with P, turns)
+    # and refuses a G2/G3 written with neither an end nor a centre; woodcam refused the
+    # first ("I word with no G2/G3") and read the second as a mode change
+    moves, _ = Interpreter("G0 X0 Y0 Z0\nG2 X10 I5 F100\nI5\nG91 J5 P2\nM2\n").run()
+    assert [(m[1], m[2], m[3], m[4]) for m in moves[-2:]] == [
+        (3, (10, 0, 0), (15, 0), -1), (4, (10, 0, 0), (10, 5), -2)]
+    for line in ("G3", "G2 F200", "G3 M3", "G3 P2"):
+        with pytest.raises(GcodeError, match="line 3: 'G[23]': G[23] with no end point"):
+            _ends(f"G0 X0 Y0 Z0\nG2 X10 I5 F100\n{line}\nM2\n")
+    with pytest.raises(GcodeError, match="line 4: 'I5': I word with no G2/G3"):
+        _ends("G0 X0 Y0 Z0\nG2 X10 I5 F100\nG1 X0\nI5\nM2\n")
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

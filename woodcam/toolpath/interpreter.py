@@ -46,7 +46,9 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``O1000`` line wherever it is, and ``M98 P51000`` without L is ``O1000`` five times (Fanuc's
   count-and-4-digit form) when the file has no ``O51000``. ``M99`` in the main program starts
   it again forever on a machine: woodcam simulates one pass and warns;
-- ``G0 G1 G2 G3`` (I/J/K and R arcs in the three planes, ``P`` turns), ``G4``, ``G10 L2/L20``,
+- ``G0 G1 G2 G3`` (I/J/K and R arcs in the three planes, ``P`` turns; in ``linuxcnc`` a line
+  of I/J/K alone under a modal G2/G3 is a full circle, a G2/G3 with neither end nor centre
+  words an error, as LinuxCNC runs them), ``G4``, ``G10 L2/L20``,
   ``G17-G19``, ``G20/G21``, ``G28/G28.1/G30/G30.1``, ``G40``, ``G43/G43.1/G49`` (woodcam tools
   are measured from the tip and the moves are the tip's, so an offset does not move where a
   program coordinate cuts; as LinuxCNC, the spindle stands still when the offset changes, so
@@ -1519,7 +1521,12 @@ class Interpreter:
         motion_here = [c for c in g if c in _MOTION]
         axis = [a for a in "xyz" if a in w]
         nonmodal = g & _G_GROUPS["non-modal"]
-        self._unused_words(g, mset, w, motion_here, axis)
+        # LinuxCNC runs the modal arc on a line with I/J/K and no axis words ("I5" after a G2:
+        # a full circle), as it runs the modal motion on a line with axis words
+        modal_arc = (self.dialect == "linuxcnc" and not motion_here and not axis
+                     and self.motion in (2.0, 3.0) and not nonmodal & {10.0, 28.0, 30.0, 92.0}
+                     and any(k in w for k in "ijk"))
+        self._unused_words(g, mset, w, motion_here, axis or modal_arc)
         if 10.0 in g:
             self.g10(w)
         elif nonmodal & {28.0, 30.0}:
@@ -1560,8 +1567,8 @@ class Interpreter:
                 raise self.err("G53", "G53 needs G0 or G1 and axis words", "write G53 G0 Z0")
             if self.incremental:
                 raise self.err("G53", "G53 in incremental mode (G91)", "use G90")
-        full_circle = (bool(motion_here) and self.motion in (2.0, 3.0) and not axis
-                       and any(k in w for k in "ijk"))  # LinuxCNC: G2 I5 is a full circle
+        full_circle = modal_arc or (bool(motion_here) and self.motion in (2.0, 3.0) and not axis
+                                    and any(k in w for k in "ijk"))  # G2 I5: a full circle
         if axis or full_circle or (motion_here and self.motion in _CYCLES):
             if self.motion is None:
                 # only linuxcnc starts without one (LinuxCNC's interpreter starts in G80; grbl's
@@ -1575,6 +1582,13 @@ class Interpreter:
             k = next(k for k in "ijkr" if k in w)
             raise self.err(f"{k.upper()}{w[k]:g}", "arc words without an end point",
                            "give X/Y/Z with G2/G3")
+        elif self.dialect == "linuxcnc" and motion_here and self.motion in (2.0, 3.0):
+            # LinuxCNC runs a G2/G3 written on a line even without axis words: with neither
+            # an end nor a centre it refuses the line ("R i j k words all missing for arc")
+            raise self.err(f"G{self.motion:g}", f"G{self.motion:g} with no end point (X/Y/Z) "
+                           "and no centre (I/J/K or R): LinuxCNC refuses the line",
+                           f"give the arc's end and centre, or remove G{self.motion:g} "
+                           "(the next arc line sets the mode)")
         if mset & {2, 30}:
             self.ended = True
         if 99 in mset:
@@ -1604,7 +1618,9 @@ class Interpreter:
                                f"write M{code} E0 Q50")
 
     def _unused_words(self, g, mset, w, motion_here, axis):
-        """LinuxCNC refuses a P/Q/R/L/E/H/I/J/K word that no code of the line uses."""
+        """LinuxCNC refuses a P/Q/R/L/E/H/I/J/K word that no code of the line uses.
+        ``axis``: true when the line runs the modal motion (axis words, or LinuxCNC's I/J/K
+        under a modal arc)."""
         eff = motion_here[0] if motion_here else (self.motion if axis else None)
         uses = {
             "q": bool(g & {10.0, 64.0}) or eff in (73.0, 83.0) or bool(mset & {61, 66, 67, 68}),
