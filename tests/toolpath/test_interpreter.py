@@ -288,6 +288,16 @@ def test_arc_lines_without_axis_words_as_linuxcnc_runs_them():
         _ends("G0 X0 Y0 Z0\nG2 X10 I5 F100\nG1 X0\nI5\nM2\n")
 
 
+def test_a_dwell_beside_an_arc_is_refused_as_linuxcnc_does():
+    # "G2 ... G4 P1": LinuxCNC refuses the line (both codes read P); woodcam cut the arc with
+    # P turns and dwelt P seconds. A G4 beside a modal arc (no G2 written) runs both there.
+    for line in ("G2 X10 Y0 I5 J0 G4 P1", "G3 X10 Y0 I5 J0 P1 G4", "G4 P0.5 G2 X10 I5"):
+        with pytest.raises(GcodeError, match="line 2: 'G4 G[23]': G4 and G[23] on one line"):
+            _ends(f"G0 X0 Y0 Z0 F100\n{line}\nM2\n")
+    moves, _ = Interpreter("G0 X0 Y0 Z0\nG2 X10 I5 F100\nG4 P1 I5\nM2\n").run()
+    assert moves[-1][3] == (15, 0) and moves[-1][4] == -1
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

@@ -1526,6 +1526,11 @@ class Interpreter:
         modal_arc = (self.dialect == "linuxcnc" and not motion_here and not axis
                      and self.motion in (2.0, 3.0) and not nonmodal & {10.0, 28.0, 30.0, 92.0}
                      and any(k in w for k in "ijk"))
+        if (self.dialect == "linuxcnc" and 4.0 in g and motion_here
+                and motion_here[0] in (2.0, 3.0)):
+            raise self.err(f"G4 G{motion_here[0]:g}", f"G4 and G{motion_here[0]:g} on one line "
+                           "both read P (dwell seconds, arc turns); LinuxCNC refuses the line",
+                           "put the dwell on a line of its own")
         self._unused_words(g, mset, w, motion_here, axis or modal_arc)
         if 10.0 in g:
             self.g10(w)
