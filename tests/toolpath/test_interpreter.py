@@ -298,6 +298,19 @@ def test_a_dwell_beside_an_arc_is_refused_as_linuxcnc_does():
     assert moves[-1][3] == (15, 0) and moves[-1][4] == -1
 
 
+def test_an_absolute_centre_arc_needs_both_centre_words():
+    # G90.1: I/J/K are the centre's coordinates. LinuxCNC 2.9 refuses an arc missing one ("J
+    # word missing in absolute center arc"); woodcam took the start's coordinate for it and cut
+    # "G90.1 G2 X10 I5" round (5, 0) from (0, 0) and "G2 X10 Y0 J0" as a zero-radius arc
+    for arc, word in (("G17 G2 X10 I5", "J"), ("G17 G2 X10 Y0 J0", "I"),
+                      ("G18 G2 X10 I5", "K"), ("G19 G3 Y10 K0", "J")):
+        with pytest.raises(GcodeError, match=f"line 3: 'G[23]': {word} word missing in an "
+                                             "absolute-centre arc"):
+            _ends(f"G0 X0 Y0 Z0\nG90.1 F100\n{arc}\nM2\n")
+    moves, _ = Interpreter("G0 X0 Y0 Z0\nG90.1 G18 G2 X10 I5 K0 F100\nM2\n").run()
+    assert moves[-1][3] == (0, 5) and moves[-1][5] == 18
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

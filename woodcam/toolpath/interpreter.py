@@ -1800,12 +1800,19 @@ class Interpreter:
             if self.arc_incremental:
                 c1, c2 = s1 + o1, s2 + o2
             else:  # G90.1: centre in program coordinates
+                both = " and ".join(sorted(names.upper()))
+                for k in names:
+                    if k not in w:  # LinuxCNC refuses it ("J word missing in absolute center
+                        # arc"): the word is a coordinate, and a missing one is no "unchanged"
+                        raise self.err(code, f"{k.upper()} word missing in an absolute-centre "
+                                       f"arc (G90.1: {both} are the centre's coordinates)",
+                                       f"give both {both}, or G91.1 for centres relative "
+                                       "to the start")
                 prog_c = [0.0, 0.0, 0.0]
-                prog_c[a1] = w.get(names[0], 0.0)
-                prog_c[a2] = w.get(names[1], 0.0)
+                prog_c[a1] = w[names[0]]
+                prog_c[a2] = w[names[1]]
                 mc = self.to_machine(prog_c)
-                c1 = mc[a1] if names[0] in w else s1
-                c2 = mc[a2] if names[1] in w else s2
+                c1, c2 = mc[a1], mc[a2]
             r0 = math.hypot(s1 - c1, s2 - c2)
             r1 = math.hypot(e1 - c1, e2 - c2)
             if min(r0, r1) < _ARC_MIN_RADIUS_MM:
