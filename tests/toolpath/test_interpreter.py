@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import re
 
 import pytest
 
@@ -309,6 +310,21 @@ def test_an_absolute_centre_arc_needs_both_centre_words():
             _ends(f"G0 X0 Y0 Z0\nG90.1 F100\n{arc}\nM2\n")
     moves, _ = Interpreter("G0 X0 Y0 Z0\nG90.1 G18 G2 X10 I5 K0 F100\nM2\n").run()
     assert moves[-1][3] == (0, 5) and moves[-1][5] == 18
+
+
+@pytest.mark.parametrize("dialect", ["grbl", "linuxcnc"])
+def test_grbl_system_commands_are_refused_naming_what_they_do(dialect):
+    # "$H" opens many hand-written grbl programs: not G-code (LinuxCNC: "Bad character '$'
+    # used"; grbl's sender hands it to the controller, which homes). woodcam said "bad
+    # character '$'", naming neither the command nor what to do
+    for line, what, fix in (("$H", "homing", "home the machine before the job"),
+                            ("$J=G91 X10 F500", "jog", "write the move as a G0/G1 line"),
+                            ("$X", "alarm unlock", "it does not move the machine"),
+                            ("$110=2000", "a setting change", "set the controller beforehand"),
+                            ("$$", "a settings, state or build report", "remove the line")):
+        with pytest.raises(GcodeError, match=rf"line 2: '{re.escape(line[:3].upper())}.*': "
+                                             rf"grbl system command \({what}.*{fix}"):
+            _ends(f"G21 G90\n{line}\nG0 X1 Y1 Z1\nG1 X2 F100\nM2\n", dialect=dialect)
 
 
 def test_canned_cycles_retract_planes():

@@ -142,6 +142,20 @@ TRAVERSE, FEED, ARC = 0, 1, 2
 MAX_EXPR_DEPTH = 100
 
 
+#: grbl's ``$`` system commands (grbl 1.1 "Commands"): (line start, what it does, the fix).
+_GRBL_SYSTEM = (
+    ("$h", "homing: the machine drives to its home switches",
+     "remove the line and home the machine before the job (woodcam starts the tool at --start)"),
+    ("$j=", "jog: a move in the jog's own words", "write the move as a G0/G1 line"),
+    ("$x", "alarm unlock", "remove the line (it does not move the machine)"),
+    ("$c", "check mode: the controller then parses without moving",
+     "remove the line (a checked program cuts nothing)"),
+    ("$rst=", "settings reset", "remove the line"),
+    ("$slp", "sleep", "remove the line"),
+    ("<n>=", "a setting change", "remove the line and set the controller beforehand"),
+)  # any other: a settings, state or build report ($$, $#, $G, $I, $N)
+
+
 class GcodeError(WoodcamError):
     """A G-code line that woodcam refuses; ``line`` is the 1-based source line."""
 
@@ -1328,6 +1342,8 @@ class Interpreter:
                                    "line: 'Bad character '%' used'; the moves after it never "
                                    "run)", "end the program with M2 or M30 instead, or remove "
                                    "the '%' (and any comment beside it)")
+                if c == "$":
+                    raise self._grbl_system(s[i:])
                 if not c.isalpha():
                     raise self.err(c, f"bad character {c!r} (a word is a letter and a value)",
                                    "fix or remove it")
@@ -1602,6 +1618,22 @@ class Interpreter:
                       "top and repeats it forever (LinuxCNC, Fanuc and Mach3 alike); woodcam "
                       "simulated one pass; replace this M99 with M30 (or M2) to stop after one "
                       "pass")
+
+    def _grbl_system(self, cmd: str) -> GcodeError:
+        """The refusal of grbl's ``$`` system command ``cmd`` (the rest of its line, lower
+        case): not G-code (LinuxCNC: "Bad character '$' used"); grbl senders pass it to the
+        controller, which homes, jogs or reports. woodcam refuses it in every dialect, naming
+        what it does: homing and jogging move the machine to where the program does not say
+        (the machine's switches, a jog's own frame), the rest change settings or report."""
+        word = cmd[:12].upper()
+        for prefix, what, fix in _GRBL_SYSTEM:
+            if cmd.startswith(prefix) or (prefix == "<n>=" and re.match(r"\$\d+=", cmd)):
+                return self.err(word, f"grbl system command ({what}), not G-code: a grbl "
+                                "sender passes it to the controller and woodcam does not "
+                                "simulate it", fix)
+        return self.err(word, "grbl system command (a settings, state or build report), not "
+                        "G-code: woodcam does not simulate it",
+                        "remove the line (it does not move the machine)")
 
     def _analog_io(self, mset, w):
         """LinuxCNC's checks of M66 (wait on digital input P or analog input E, wait type L,
