@@ -327,6 +327,25 @@ def test_grbl_system_commands_are_refused_naming_what_they_do(dialect):
             _ends(f"G21 G90\n{line}\nG0 X1 Y1 Z1\nG1 X2 F100\nM2\n", dialect=dialect)
 
 
+def test_g52_local_offset_as_linuxcnc():
+    # LinuxCNC 2.9 runs G52 (woodcam refused it as an unsupported G code): the G92 offset is
+    # set to the words themselves, axis by axis, in G90 and G91 alike and in program units;
+    # G92 replaces it, G92.1 clears it, G92.3 restores it (numbers from LinuxCNC's interpreter)
+    ends = _ends("G0 X1 Y2 Z5\nG52 X10\nG0 X0 Y0\nG52 Y5\nG0 X1 Y1\nG52 X0 Y0\nG0 X2 Y2\nM2\n")
+    assert ends == [(1, 2, 5), (10, 0, 5), (11, 6, 5), (2, 2, 5)]
+    ends = _ends("G0 X1 Y2 Z5\nG91 G52 X10\nG0 X1\nG90 G0 X0\nG20 G52 X1\nG0 X0\nM2\n")
+    assert ends == [(1, 2, 5), (2, 2, 5), (10, 2, 5), (pytest.approx(25.4), 2, 5)]
+    ends = _ends("G0 X1 Y2 Z5\nG52 X10 Y3\nG92 X0\nG0 X1 Y1\n#1=#5211 #2=#5212 #3=#5210\n"
+                 "G0 X#1 Y#2 Z#3\nG92.2\nG0 X0 Y0\nG92.3\nG0 X0\nM2\n")
+    assert ends == [(1, 2, 5), (2, 4, 5), (2, 6, 1), (0, 0, 1), (1, 0, 1)]
+    for prog, match in (("G52\n", "line 1: 'G52': G52 needs axis words"),
+                        ("G52 X1 G92 Y0\n", "line 1: 'G52 G92': two non-modal G codes")):
+        with pytest.raises(GcodeError, match=match):
+            _ends(prog + "G0 X1\nM2\n")
+    with pytest.raises(GcodeError, match="line 1: 'G52': grbl has no G52"):
+        _ends("G52 X1\nG0 X1\n", dialect="grbl")
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

@@ -55,7 +55,8 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   the tip moves by the change: ``G43.1 Z1`` then ``G91 G0 Z-1`` from Z10 ends at Z8, and
   ``G53``, ``G28``/``G30`` homes and ``G28.1`` place the spindle, the tip the offset lower;
   ``G43 H`` takes the tool table's length as 0), ``G53``,
-  ``G54-G59.3``, ``G61/G61.1/G64``, ``G73 G81 G82 G83 G85 G86 G89`` with ``G98/G99`` and ``L``,
+  ``G54-G59.3``, ``G52`` (the G92 offset set to its words, as LinuxCNC), ``G61/G61.1/G64``,
+  ``G73 G81 G82 G83 G85 G86 G89`` with ``G98/G99`` and ``L``,
   ``G80``, ``G90/G91``, ``G90.1/G91.1``, ``G92/G92.1/G92.2/G92.3``, ``G94``, ``G97``;
   ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60`` (one of each modal group a line);
   ``F S T``, ``E`` (beside ``M66``-``M68``), ``N`` (digits, the first word of a line, before any comment; grbl: anywhere); ``( )``/``;`` comments,
@@ -210,9 +211,12 @@ _G_GROUPS = {
     "tool length offset": {43.0, 43.1, 49.0}, "retract": {98.0, 99.0},
     "coordinate system": {54.0, 55.0, 56.0, 57.0, 58.0, 59.0, 59.1, 59.2, 59.3},
     "path control": {61.0, 61.1, 64.0}, "spindle mode": {96.0, 97.0},
-    "non-modal": {4.0, 10.0, 28.0, 28.1, 30.0, 30.1, 53.0, 92.0, 92.1, 92.2, 92.3},
+    "non-modal": {4.0, 10.0, 28.0, 28.1, 30.0, 30.1, 52.0, 53.0, 92.0, 92.1, 92.2, 92.3},
 }
 _G_KNOWN = set().union(*_G_GROUPS.values())
+#: Non-modal codes whose line's axis words are theirs, not a move (LinuxCNC's
+#: "mode_zero_covets_axes").
+_AXIS_CODES = {10.0, 28.0, 30.0, 52.0, 92.0}
 _G_REFUSED = {41.0: "cutter radius compensation changes the path", 42.0: "cutter radius "
               "compensation changes the path", 41.1: "cutter radius compensation changes the "
               "path", 42.1: "cutter radius compensation changes the path",
@@ -1540,7 +1544,7 @@ class Interpreter:
         # LinuxCNC runs the modal arc on a line with I/J/K and no axis words ("I5" after a G2:
         # a full circle), as it runs the modal motion on a line with axis words
         modal_arc = (self.dialect == "linuxcnc" and not motion_here and not axis
-                     and self.motion in (2.0, 3.0) and not nonmodal & {10.0, 28.0, 30.0, 92.0}
+                     and self.motion in (2.0, 3.0) and not nonmodal & _AXIS_CODES
                      and any(k in w for k in "ijk"))
         if (self.dialect == "linuxcnc" and 4.0 in g and motion_here
                 and motion_here[0] in (2.0, 3.0)):
@@ -1565,6 +1569,21 @@ class Interpreter:
                     self.g92[i] = self.pos[i] - self.g5x[i] - w[a] * self.scale
                     self.p[5211 + i] = self.g92[i]
             self.p[5210] = 1.0
+        elif 52.0 in g:
+            # LinuxCNC's local offset: the G92 offset set to the words themselves (mm in the
+            # program's units, G90 or G91 alike), the unnamed axes' offsets kept; G92.1 clears
+            # it, G92.3 restores it (measured against LinuxCNC 2.9's interpreter)
+            if self.dialect == "grbl":
+                raise self.err("G52", "grbl has no G52 local offset",
+                               "use G92 or G10 L20, or pass --dialect linuxcnc")
+            if not axis:
+                raise self.err("G52", "G52 needs axis words", "write G52 X10 Y0 (G52 X0 Y0 Z0 "
+                               "cancels it)")
+            for i, a in enumerate("xyz"):
+                if a in w:
+                    self.g92[i] = w[a] * self.scale
+                    self.p[5211 + i] = self.g92[i]
+            self.p[5210] = 1.0
         elif 92.1 in g or 92.2 in g:
             self.g92 = [0.0] * 3
             if 92.1 in g:
@@ -1573,7 +1592,7 @@ class Interpreter:
                 self.p[5210] = 0.0
         elif 92.3 in g:
             self.g92 = [self.p.get(5211 + i, 0.0) for i in range(3)]
-        if nonmodal & {10.0, 28.0, 30.0, 92.0} or (43.1 in g and not motion_here):
+        if nonmodal & _AXIS_CODES or (43.1 in g and not motion_here):
             # the axis words belonged to the non-modal code, or are G43.1's dynamic tool
             # length offset (LinuxCNC: "G43.1 Z2" moves nothing; with a motion code on the line
             # both read them)
