@@ -346,6 +346,17 @@ def test_g52_local_offset_as_linuxcnc():
         _ends("G52 X1\nG0 X1\n", dialect="grbl")
 
 
+@pytest.mark.parametrize("dialect", ["linuxcnc", "fanuc", "grbl"])
+def test_old_units_codes_g70_g71_are_refused_naming_g20_g21(dialect):
+    # Vectric's Mach3 mm post writes "G00G21G17G90G40G49G80" then "G71G91.1": LinuxCNC refuses
+    # G71 (a lathe cycle there); woodcam said "unsupported G code ... post-process the program
+    # for a 3-axis mill", which a mill program already is
+    for code, units, fix in (("G71", "mm", "G21"), ("G70", "inch", "G20")):
+        with pytest.raises(GcodeError, match=rf"line 2: '{code}': {code} is an old {units} "
+                                             rf"units code .* replace it by {fix}"):
+            _ends(f"G00G21G17G90G40G49G80\n{code}G91.1\nG0 X1 Y1 Z1\nM2\n", dialect=dialect)
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

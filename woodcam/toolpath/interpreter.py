@@ -1423,6 +1423,13 @@ class Interpreter:
         g: set[float] = set()
         for v in gs:
             c = round(v, 1)
+            if v in (70.0, 71.0):  # Vectric's Mach3 posts open with "G00G21G17G90G40G49G80 G71"
+                raise self.err(f"G{v:g}", f"G{v:g} is an old {'inch' if v == 70 else 'mm'} units "
+                               "code (Mach3, old Fanuc posts); LinuxCNC reads it as a lathe "
+                               "cycle and refuses it ('G7x.x requires a Q word')",
+                               f"replace it by G{20 if v == 70 else 21} (or remove it where "
+                               f"the program has G{20 if v == 70 else 21} already), or post "
+                               "for LinuxCNC")
             if (abs(v - c) > 1e-4 or c not in _G_KNOWN) and c not in _G_REFUSED:
                 raise self.err(f"G{v:g}", "unsupported G code (woodcam reads the G codes "
                                "listed in woodcam.toolpath.interpreter)",
