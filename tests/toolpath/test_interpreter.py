@@ -368,6 +368,28 @@ def test_canned_cycles_retract_planes():
                                               -1.746, -3, 1]
 
 
+def test_a_cycle_code_after_another_mode_needs_its_own_words():
+    # LinuxCNC 2.9 carries R, Z, Q (G73/G83) and P (G82/G86/G89) over only from lines of the
+    # same cycle code; woodcam kept them from any earlier cycle (and P = 0 when never given),
+    # drilling holes LinuxCNC refuses: "G81 ... / G82 X2 P1" (no R), "G83 ... / G73 X2 R2 Z-3"
+    # (no Q), "G82 X1 Z-3 R2" (no P), a G81 after a G0 or G80 without R
+    start = "G0 X0 Y0 Z10\n"
+    for prog, word in (("G81 X1 Z-3 R2 F100\nG82 X2 Z-3 P1", "R"),
+                       ("G81 X1 Z-3 R2 F100\nG82 X2 R2 P1", "Z"),
+                       ("G83 X1 Z-3 R2 Q1 F100\nG73 X2 Z-3 R2", "Q"),
+                       ("G82 X1 Z-3 R2 P1 F100\nG89 X2 Z-3 R2", "P"),
+                       ("G82 X1 Z-3 R2 F100", "P"),
+                       ("G81 X1 Z-3 R2 F100\nG0 X5\nG81 X2 Z-3", "R"),
+                       ("G81 X1 Z-3 R2 F100\nG80\nG81 X2 Z-3", "R")):
+        n = prog.count("\n") + 2
+        with pytest.raises(GcodeError, match=rf"line {n}: 'G8\d|G73': .* without {word} "
+                                             r"\(.*LinuxCNC keeps"):
+            _ends(start + prog + "\nG80\nM2\n")
+    # the same code goes on with the words it had (G82's P too), as in LinuxCNC
+    ends = _ends(start + "G82 X1 Z-3 R2 P1 F100\nG82 X2\nM3\nX3\nG80\nM2\n")
+    assert ends[-4:] == [(2, 0, 2), (3, 0, 2), (3, 0, -3), (3, 0, 2)]  # LinuxCNC's numbers
+
+
 def test_cycle_repeats_travel_at_the_retract_plane():
     # G91 G99 with L: after the first hole the next ones are reached at R (LinuxCNC's
     # convert_cycle_xy sets old_cc = clear_cc after each repeat), not at the initial Z

@@ -56,7 +56,8 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``G53``, ``G28``/``G30`` homes and ``G28.1`` place the spindle, the tip the offset lower;
   ``G43 H`` takes the tool table's length as 0), ``G53``,
   ``G54-G59.3``, ``G52`` (the G92 offset set to its words, as LinuxCNC), ``G61/G61.1/G64``,
-  ``G73 G81 G82 G83 G85 G86 G89`` with ``G98/G99`` and ``L``,
+  ``G73 G81 G82 G83 G85 G86 G89`` with ``G98/G99`` and ``L`` (in ``linuxcnc`` R, Z, Q and P
+  carry over only between lines of one cycle code, as LinuxCNC),
   ``G80``, ``G90/G91``, ``G90.1/G91.1``, ``G92/G92.1/G92.2/G92.3``, ``G94``, ``G97``;
   ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60`` (one of each modal group a line);
   ``F S T``, ``E`` (beside ``M66``-``M68``), ``N`` (digits, the first word of a line, before any comment; grbl: anywhere); ``( )``/``;`` comments,
@@ -458,6 +459,7 @@ class Interpreter:
         self.tlo = [0.0, 0.0, 0.0]  # the active tool length offset (G43.1), mm
         self.cycle_il: float | None = None
         self.cyc = {"r": math.nan, "z": math.nan, "q": math.nan, "p": 0.0, "l": 1}
+        self.motion_before = self.motion  # the motion mode before the line being run
         self.ended = False
         self.known = [False, False, False]
         self._warned_start = False
@@ -1604,6 +1606,7 @@ class Interpreter:
             # length offset (LinuxCNC: "G43.1 Z2" moves nothing; with a motion code on the line
             # both read them)
             axis = []
+        self.motion_before = self.motion
         if motion_here:
             self.motion = motion_here[0] if motion_here[0] != 80.0 else None
             self.motion_cancelled = self.motion_cancelled or self.motion is None
@@ -1896,6 +1899,22 @@ class Interpreter:
         if self.feed <= 0:
             raise self.err(code, "drilling with feed rate 0 (no F yet)", "set F")
         c = self.cyc
+        if self.dialect == "linuxcnc" and self.motion_before != self.motion:
+            # LinuxCNC carries R, Z, Q (G73/G83) and P (G82/G86/G89) over only from lines of
+            # the same cycle code ("R clearance plane unspecified in cycle", "Dwell time p word
+            # missing with g82", ...): a cycle code written after another mode needs them all
+            needs = {"r": "R (the retract plane)", "z": "Z (the hole bottom)"}
+            if self.motion in (73.0, 83.0):
+                needs["q"] = "Q (the peck depth)"
+            if self.motion in (82.0, 86.0, 89.0):
+                needs["p"] = "P (the dwell at the bottom, seconds)"
+            # (no mode: LinuxCNC starts in G80, and G80 cancels one)
+            before = "G80" if self.motion_before is None else f"G{self.motion_before:g}"
+            for k, what in needs.items():
+                if k not in w:
+                    raise self.err(code, f"{code} after {before} without {what}: LinuxCNC "
+                                   f"keeps {k.upper()} only from lines of the same cycle code",
+                                   f"give {k.upper()} on the line that starts {code}")
         if "r" in w:
             c["r"] = w["r"]
         if "z" in w:
