@@ -357,6 +357,29 @@ def test_old_units_codes_g70_g71_are_refused_naming_g20_g21(dialect):
             _ends(f"G00G21G17G90G40G49G80\n{code}G91.1\nG0 X1 Y1 Z1\nM2\n", dialect=dialect)
 
 
+def test_lines_are_numbered_and_blanks_read_as_linuxcnc_does(tmp_path):
+    # LinuxCNC and editors break lines at "\n" only and skip only spaces, tabs and the CR of a
+    # line end. woodcam read files with universal newlines and split with str.splitlines, so
+    # "\r\r\n" line ends (a twice-converted file) doubled every line number in its errors, a
+    # form feed shifted the later ones, "G1 X5\r Y5" became two moves, and a no-break space
+    # (copied from a web page) or vertical tab, which LinuxCNC refuses, was read as a blank
+    path = tmp_path / "twice_converted.ngc"
+    path.write_bytes(b"G21 G90\r\r\nG0 X0 Y0 Z5\r\r\nG1 Z-1 F100\r\r\nG1 X5 Y\r\r\nM2\r\r\n")
+    with pytest.raises(GcodeError, match="line 4: 'g1x5y': a value is missing"):
+        read_gcode(path)
+    path.write_bytes(b"G21 G90\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X5\r Y5\nM2\n")
+    assert read_gcode(path).end_mm.tolist()[-1] == [5, 5, -1]
+    for bad, shown in (("\x0c", r"\\x0c"), ("\xa0", r"\\xa0"), ("\x0b", r"\\x0b")):
+        with pytest.raises(GcodeError, match=f"line 3: '{shown}': bad character"):
+            _ends(f"G21 G90\n(a{bad}comment)\nG1{bad}X5 F100\nG1 X6 Y\nM2\n")
+    # a form feed inside a comment is the comment's: the next error is named on its own line
+    with pytest.raises(GcodeError, match="line 4: 'g1x6y'"):
+        _ends("G21 G90\n(a\x0ccomment)\nG1 X5 F100\nG1 X6 Y\nM2\n")
+    # a file whose lines end in CR alone (classic Mac OS) is read line by line, with a warning
+    moves, warnings = Interpreter("G0 X1 Y1 Z1\rG1 X2 F100\rM2\r").run()
+    assert moves[-1][1:3] == (2, (2, 1, 1)) and "CR alone" in warnings[0][1]
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

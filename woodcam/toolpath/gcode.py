@@ -258,7 +258,9 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
         if not path.is_file():
             raise WoodcamError(f"read_gcode: text_or_path={str(path)!r} is not a file; "
                                "pass an existing G-code file or the program text")
-        source, text = str(path), path.read_text(errors="replace")
+        # newline="": the line ends as written, numbered as LinuxCNC does (source_lines)
+        with path.open(errors="replace", newline="") as f:
+            source, text = str(path), f.read()
     else:
         text = str(text_or_path)
     if not (isinstance(chord_tol_mm, numbers.Real) and math.isfinite(chord_tol_mm)

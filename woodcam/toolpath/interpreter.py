@@ -328,7 +328,7 @@ def _first_word_after_comment(raw: str, text: str) -> bool:
     M99 as one only there ("Bad character 'o' used", "Unknown m code used: M98")."""
     if "(" not in raw:
         return False
-    before = "".join(raw[:raw.index("(")].split()).lower()  # the normalised text before it
+    before = raw[:raw.index("(")].translate(_BLANKS).lower()  # the normalised text before it
     return len(before) <= _N_PREFIX.match(text).end()
 
 
@@ -358,12 +358,34 @@ def _late_rule(word: str) -> tuple[str, str]:
     return what, f"move the comment after the {word.split()[0]}"
 
 
+#: What LinuxCNC skips between words: space and tab (and the carriage return of a CRLF line
+#: end). Python's str.split() also skips form feed, vertical tab, no-break space, ..., which
+#: LinuxCNC refuses ("Bad character '\014' used").
+_BLANKS = str.maketrans("", "", " \t\r")
+
+
+def source_lines(text: str) -> list[str]:
+    """The lines of program ``text`` as LinuxCNC and editors number them: broken at ``\\n``
+    (``\\r\\n`` too) only. ``str.splitlines`` also breaks at ``\\r`` alone, form feed, vertical
+    tab, ``\\x1c``-``\\x1e``, ``\\x85`` and U+2028/9, which shifted every later line number (a
+    file with ``\\r\\r\\n`` line ends doubled them) and cut ``G1 X5\\r Y5`` into two moves. A
+    file with ``\\r`` alone for its line ends (classic Mac OS) is broken at ``\\r``: LinuxCNC
+    reads it as one line and refuses it; :class:`Interpreter` warns."""
+    if "\n" not in text and "\r" in text:
+        lines = text.split("\r")
+    else:
+        lines = text.split("\n")
+    if lines and lines[-1] == "":
+        lines.pop()
+    return lines
+
+
 def split_comments(raw: str, no: int) -> tuple[str, list[str]]:
     """Source line ``raw`` (1-based number ``no``) -> ``(text, messages)``: the text outside
     comments, lowercase, without whitespace, and the ``(MSG, ...)`` comments' messages.
     Raises :class:`GcodeError` for an unclosed, nested or unopened comment."""
     if "(" not in raw and ")" not in raw and ";" not in raw:  # most lines: no comment
-        return "".join(raw.split()).lower(), []
+        return raw.translate(_BLANKS).lower(), []
     msgs = []
     out = []
     i = 0
@@ -387,8 +409,8 @@ def split_comments(raw: str, no: int) -> tuple[str, list[str]]:
             raise GcodeError(no, ")", "')' without '('", "remove it")
         out.append(c)
         i += 1
-    # LinuxCNC drops all whitespace and case outside comments, inside #<names> too
-    return "".join("".join(out).split()).lower(), msgs
+    # LinuxCNC drops blanks and case outside comments, inside #<names> too
+    return "".join(out).translate(_BLANKS).lower(), msgs
 
 
 class Interpreter:
@@ -401,7 +423,7 @@ class Interpreter:
             raise WoodcamError(f"dialect must be one of {DIALECTS}, got {dialect!r}")
         self.dialect = dialect
         self.max_blocks, self.max_moves = int(max_blocks), int(max_moves)
-        self.src = text.splitlines()
+        self.src = source_lines(text)
         # machine origin in the G-code frame (mm), None: not known (module docstring)
         self.mzero = None if machine_zero_mm is None else [float(v) for v in machine_zero_mm]
         shift = self.mzero or [0.0, 0.0, 0.0]
@@ -435,6 +457,10 @@ class Interpreter:
         self._value_unknown: str | None = None  # why #<_value> holds what LinuxCNC cannot know
         self.moves: list = []
         self.warnings: list[tuple[int, str]] = []
+        if dialect == "linuxcnc" and "\r" in text and "\n" not in text and len(self.src) > 1:
+            self.warnings.append((1, "the lines end in CR alone (classic Mac OS): woodcam reads "
+                                  "them as lines, LinuxCNC reads the file as one line and "
+                                  "refuses it; convert the line ends to LF or CRLF"))
         self.messages: list[tuple[int, str]] = []
         # modal state
         self.inch = False

@@ -18,7 +18,7 @@ import tempfile
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .interpreter import GcodeError, line_list, split_comments
+from .interpreter import GcodeError, line_list, source_lines, split_comments
 
 #: Debian's interpreter, for which the ``gcode`` module is built.
 LINUXCNC_PYTHON = "/usr/bin/python3"
@@ -107,7 +107,7 @@ _G53 = re.compile(r"g0*53(?![\d.])")
 def _g53_lines(text: str) -> list[int]:
     """1-based lines of ``text`` with a G53 word (comments taken out, as LinuxCNC reads them)."""
     out = []
-    for no, raw in enumerate(text.splitlines(), 1):
+    for no, raw in enumerate(source_lines(text), 1):
         if "53" in raw:
             try:
                 line = split_comments(raw, no)[0]
