@@ -380,6 +380,20 @@ def test_lines_are_numbered_and_blanks_read_as_linuxcnc_does(tmp_path):
     assert moves[-1][1:3] == (2, (2, 1, 1)) and "CR alone" in warnings[0][1]
 
 
+def test_a_byte_order_mark_is_refused_naming_it(tmp_path):
+    # Notepad's "UTF-8 with BOM" puts EF BB BF before the first line; LinuxCNC refuses it
+    # ("Bad character '\\357' used"), and woodcam did too, as "bad character '\\ufeff'"
+    for first in ("G21 G90", "(post: a comment first)"):
+        path = tmp_path / "bom.ngc"
+        path.write_bytes(b"\xef\xbb\xbf" + f"{first}\nG0 X0 Y0 Z5\nG1 Z-1 F100\nM2\n".encode())
+        with pytest.raises(GcodeError, match="line 1: 'BOM': a byte-order mark .* save the "
+                                             "file as UTF-8 without BOM"):
+            read_gcode(path)
+    # two files joined (roughing, then finishing), the second saved with a BOM: its line
+    with pytest.raises(GcodeError, match="line 3: 'BOM': a byte-order mark"):
+        _ends("G21 G90\nG0 X0 Y0 Z5\n\ufeffG1 Z-1 F100\nM2\n")
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

@@ -1376,6 +1376,11 @@ class Interpreter:
                                    "the '%' (and any comment beside it)")
                 if c == "$":
                     raise self._grbl_system(s[i:])
+                if c == "\ufeff":  # a Windows editor's UTF-8 "BOM"; LinuxCNC: "Bad character"
+                    raise self.err("BOM", "a byte-order mark (U+FEFF, bytes EF BB BF: the "
+                                   "file, or one pasted into it, was saved as 'UTF-8 with "
+                                   "BOM'), which LinuxCNC refuses too", "save the file as "
+                                   "UTF-8 without BOM (or ASCII)")
                 if not c.isalpha():
                     raise self.err(c, f"bad character {c!r} (a word is a letter and a value)",
                                    "fix or remove it")
