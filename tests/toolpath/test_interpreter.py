@@ -394,6 +394,19 @@ def test_a_byte_order_mark_is_refused_naming_it(tmp_path):
         _ends("G21 G90\nG0 X0 Y0 Z5\n\ufeffG1 Z-1 F100\nM2\n")
 
 
+def test_g10_needs_p_and_reads_a_zero_rotation_as_linuxcnc():
+    # LinuxCNC 2.9 refuses G10 L2/L20 without P ("P value out of range (0-9)"), which woodcam
+    # read as P0 (the active system); it runs "G10 L2 P1 R0 X2" (no rotation), which woodcam
+    # refused as "'R0': arc words without an end point"; it refuses R in G10 L20
+    for line, match in (("G10 L2 X2", "'G10 L2': G10 L2 without P"),
+                        ("G10 L20 X2", "'G10 L20': G10 L20 without P"),
+                        ("G10 L20 P1 R0 X2", "'R0': R \\(a rotation\\) is not allowed in G10 L20"),
+                        ("G10 L2 P1 R30 X2", "'R30': G10 L2 R \\(rotated coordinate systems\\)")):
+        with pytest.raises(GcodeError, match=f"line 2: {match}"):
+            _ends(f"G0 X1 Y1 Z10\n{line}\nG0 X0\nM2\n")
+    assert _ends("G0 X1 Y1 Z10\nG10 L2 P1 R0 X2\nG0 X0\nM2\n")[-1] == (2, 1, 10)
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

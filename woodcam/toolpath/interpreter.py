@@ -1659,7 +1659,8 @@ class Interpreter:
                                f"axis words without a motion mode ({why})",
                                "add G0 or G1 to the line")
             self.move(w, axis, 53.0 in g)
-        elif any(k in w for k in "ijkr") and not (self.motion in _CYCLES and "r" in w):
+        elif any(k in w for k in "ijk") or ("r" in w and self.motion not in _CYCLES
+                                            and 10.0 not in g):  # (G10 L2's R: read there)
             k = next(k for k in "ijkr" if k in w)
             raise self.err(f"{k.upper()}{w[k]:g}", "arc words without an end point",
                            "give X/Y/Z with G2/G3")
@@ -1747,11 +1748,18 @@ class Interpreter:
             raise self.err(f"G10 L{ln:g}" if ln is not None else "G10", "woodcam reads G10 L2 "
                            "and G10 L20 (work offsets); tool tables come from --tools",
                            "remove it")
-        p = w.get("p", 0.0)
+        if "p" not in w:  # LinuxCNC: "P value out of range (0-9) with G10 L2"
+            raise self.err(f"G10 L{ln:g}", f"G10 L{ln:g} without P (the coordinate system: 0 "
+                           "the active one, 1-9 G54-G59.3); LinuxCNC refuses it",
+                           f"write e.g. G10 L{ln:g} P1 X0 Y0 Z0")
+        p = w["p"]
         if p != math.floor(p) or not 0 <= p <= 9:
             raise self.err(f"P{p:g}", "G10 P must be 0 (active) or 1-9 (G54-G59.3)",
                            "fix P")
-        if "r" in w and w["r"] != 0:
+        if "r" in w and ln == 20.0:
+            raise self.err(f"R{w['r']:g}", "R (a rotation) is not allowed in G10 L20 "
+                           "(LinuxCNC refuses it)", "remove R, or set the rotation with G10 L2")
+        if "r" in w and w["r"] != 0:  # (R0, no rotation, is read)
             raise self.err(f"R{w['r']:g}", "G10 L2 R (rotated coordinate systems) is not "
                            "simulated", "remove the rotation")
         n = int(p) or self.cs
