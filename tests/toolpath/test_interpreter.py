@@ -407,6 +407,22 @@ def test_g10_needs_p_and_reads_a_zero_rotation_as_linuxcnc():
     assert _ends("G0 X1 Y1 Z10\nG10 L2 P1 R0 X2\nG0 X0\nM2\n")[-1] == (2, 1, 10)
 
 
+@pytest.mark.parametrize("code, what, fix", [
+    ("G84", "a tapping cycle", "drill the hole with G81"),
+    ("G88", "a boring cycle with a spindle stop", "use G85 or G89"),
+    ("G38.2", "a probing move", "probe before the job"),
+    ("G5.1", "a spline or NURBS", "post-process with lines and arcs"),
+    ("G33.1", "threading or rigid tapping", "remove the threading; drill the hole with G81"),
+    ("G43.2", "an added tool length offset", "remove it")])
+def test_codes_linuxcnc_runs_but_woodcam_does_not_simulate_say_what_they_are(code, what, fix):
+    # LinuxCNC 2.9 runs these; woodcam refuses them on purpose, and said "unsupported G code
+    # ...; post-process the program for a 3-axis mill" (a tapping or probing line is 3-axis)
+    with pytest.raises(GcodeError, match=rf"line 2: '{re.escape(code)}': {re.escape(code)} "
+                                         rf"\({what}.*\) is not simulated by woodcam "
+                                         rf"\(LinuxCNC runs it\); {fix}"):
+        _ends(f"G0 X0 Y0 Z10 F100 S1000 M3\n{code} X1 Z-3 R2 P1 Q1 I1 J1 K1 H1\nM2\n")
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

@@ -223,6 +223,21 @@ _G_REFUSED = {41.0: "cutter radius compensation changes the path", 42.0: "cutter
               "path", 42.1: "cutter radius compensation changes the path",
               93.0: "inverse-time feed is not simulated", 95.0: "feed per revolution is not "
               "simulated", 96.0: "constant surface speed is not simulated"}
+#: G codes LinuxCNC runs that woodcam does not simulate: (what it is, the fix).
+_G_NOT_SIMULATED = {
+    **dict.fromkeys((5.0, 5.1, 5.2, 5.3), ("a spline or NURBS", "post-process with lines and "
+                                            "arcs (G1/G2/G3)")),
+    **dict.fromkeys((7.0, 8.0), ("a lathe diameter/radius mode", "post-process for a mill")),
+    **dict.fromkeys((33.0, 33.1, 76.0), ("threading or rigid tapping, spindle-synchronised",
+                                         "remove the threading; drill the hole with G81")),
+    **dict.fromkeys((38.2, 38.3, 38.4, 38.5), ("a probing move", "probe before the job and "
+                                               "remove the probing lines")),
+    **dict.fromkeys((74.0, 84.0), ("a tapping cycle", "drill the hole with G81 (woodcam "
+                                   "does not simulate tapping)")),
+    **dict.fromkeys((87.0, 88.0), ("a boring cycle with a spindle stop",
+                                   "use G85 or G89 (bore, feed out), which woodcam simulates")),
+    43.2: ("an added tool length offset", "remove it (woodcam measures tools from the tip)"),
+}
 _M_KNOWN = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 30, 48, 49, 50, 51, 52, 53, 60, 61}
 #: LinuxCNC's M modal groups: two M codes of one group on a line are refused ("Two m codes used
 #: from same modal group"; grbl refuses its M0/M1/M2/M30, M3-M5 and M7-M9 pairs the same way,
@@ -1463,6 +1478,10 @@ class Interpreter:
                                f"replace it by G{20 if v == 70 else 21} (or remove it where "
                                f"the program has G{20 if v == 70 else 21} already), or post "
                                "for LinuxCNC")
+            if abs(v - c) <= 1e-4 and c in _G_NOT_SIMULATED:
+                what, fix = _G_NOT_SIMULATED[c]
+                raise self.err(f"G{v:g}", f"G{v:g} ({what}) is not simulated by woodcam "
+                               "(LinuxCNC runs it)", fix)
             if (abs(v - c) > 1e-4 or c not in _G_KNOWN) and c not in _G_REFUSED:
                 raise self.err(f"G{v:g}", "unsupported G code (woodcam reads the G codes "
                                "listed in woodcam.toolpath.interpreter)",
