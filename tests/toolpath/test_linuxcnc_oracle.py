@@ -154,6 +154,34 @@ def test_interpreter_option_linuxcnc_gives_the_same_program():
         read_gcode("G0 X1\nG1 A3 F100\nM2\n", interpreter="linuxcnc")
 
 
+def test_feed_spindle_and_tool_agree_with_linuxcnc():
+    """Each move's feed (mm/min), spindle speed (0: off) and tool from LinuxCNC's interpreter
+    (set_feed_rate, change_tool, the spindle state it reports) equal woodcam's on the corpus and
+    the samples. The oracle reported none: --interpreter linuxcnc cut every move with the first
+    tool (T0 for all), warned "spindle off" on every cut and estimated days of machining at
+    feed 0."""
+    paths = [p for p in CORPUS if not p.name.startswith(("err_", "fanuc_"))]
+    compared = 0
+    for path, res in zip(paths, run_batch(paths, start_mm=START)):
+        mine, _ = Interpreter(path.read_text(), start_mm=START).run()
+        theirs = {(m[1], tuple(round(v, 6) for v in m[2])): m[6:9] for m in res["moves"]}
+        for m in mine:
+            t = theirs.get((m[1], tuple(round(v, 6) for v in m[2])))
+            if t is not None:  # (a rapid's feed is not used: woodcam keeps 0 before any F)
+                assert (t[0] if m[0] else 0, t[1], t[2]) == (
+                    pytest.approx(m[6] if m[0] else 0), m[7], m[8]), (path.name, m)
+                compared += 1
+    assert compared > 15000  # measured: 19103 moves of 35 programs
+    # two tools, the spindle on the line of a move, a feed before G20 (mm/min, as LinuxCNC)
+    prog = read_gcode("G21 G90\nT1 M6\nG0 X1 Y1 Z5\nM3 S12000 G1 Z-1 F300\nG1 X5\n"
+                      "G0 Z5\nT2 M6\nG1 X9 Z-1 F200\nG20 G1 X1 F10\nM2\n",
+                      interpreter="linuxcnc")
+    assert prog.tool.tolist() == [1, 1, 1, 1, 2, 2]
+    assert prog.feed_mm_min[prog.kind != 0].tolist() == pytest.approx([300, 300, 200, 10])
+    # (LinuxCNC stops the spindle at a tool change: T2's cuts report it off)
+    assert prog.spindle_rpm.tolist()[1:] == [12000, 12000, 12000, 0, 0]
+
+
 def test_machine_zero_agrees_with_linuxcnc_g54_offset(tmp_path):
     """A machine zero M in the G-code frame is LinuxCNC with the G54 offset -M (the work zero in
     machine coordinates), moves shifted back by M: G53 moves, G10 L2 offsets, G28 homes and arcs

@@ -6,7 +6,8 @@ for it, not for woodcam's virtualenv); never imported by woodcam. Input (stdin, 
 ``{"files": [path, ...], "start_mm": [x, y, z], "timeout_s": t, "machine_zero_mm": [x, y, z]}``
 (the last optional, default zero); output (stdout, JSON): one
 ``{"moves": [...], "error": null | [line, message], "result": code}`` per file, moves as
-woodcam's canonical tuples ``[kind, line, [x, y, z], [c1, c2] | null, rotation, plane]`` in the
+woodcam's canonical tuples ``[kind, line, [x, y, z], [c1, c2] | null, rotation, plane,
+feed_mm_min, spindle_rpm, tool]`` in the
 machine frame, mm, tool tip (LinuxCNC's canon reports program coordinates before the G5x/G92
 offsets, which are added back here as AXIS does, and without the tool length offset, which is
 not: AXIS adds it too and draws the controlled point, the spindle's gauge line, where a tool
@@ -68,6 +69,14 @@ class _Canon:
         self.tlo = [0.0] * 3  # the tool length offset: the controlled point is the tip plus it
         self.ctrl = None  # the controlled point after the last move, mm
         self.mzero = [0.0] * 3  # the output shift: machine origin in the G54 frame, mm
+        self.feed = 0.0  # mm/min (set_feed_rate: inch/min, as the module converts lengths)
+        self.tool = 0  # the loaded tool (change_tool: M6)
+        # the spindle: the interpreter's state reaches Python only through next_line, as it
+        # was after the last block it finished (S and M3/M4/M5 of a line come before its
+        # motion, so a move's own line sets it): a line's moves take the state read at the
+        # next line's first call when that is the very next line, else the one before them
+        self.rpm = 0.0
+        self.pending = None  # (line, index of its first move) awaiting the state after it
 
     def __getattr__(self, name):  # every other canon call has no effect on the moves
         if name.startswith("__"):
@@ -75,7 +84,24 @@ class _Canon:
         return lambda *a: None
 
     def next_line(self, st):
+        rpm = float(st.speed) if st.spindle in (3, 4) else 0.0  # st.spindle: its M code
+        if self.pending is not None and st.sequence_number == self.pending[0] + 1:
+            for m in self.moves[self.pending[1]:]:
+                m[7] = rpm
+        self.pending = None
+        self.rpm = rpm
         self.line = st.sequence_number
+
+    def set_feed_rate(self, rate):
+        self.feed = rate * MM
+
+    def change_tool(self, tool):
+        self.tool = int(tool)
+
+    def _append(self, move):
+        if self.pending is None:
+            self.pending = (self.line, len(self.moves))
+        self.moves.append(move + [self.feed, self.rpm, self.tool])
 
     def get_external_angular_units(self):
         return 1.0
@@ -122,7 +148,7 @@ class _Canon:
             # jumped by the change, a move that never happens
             return
         self.ctrl = ctrl
-        self.moves.append([kind, self.line, end, None, 0, 17])
+        self._append([kind, self.line, end, None, 0, 17])
 
     def straight_traverse(self, x, y, z, *rest):
         self._straight(0, (x, y, z))
@@ -138,7 +164,7 @@ class _Canon:
         off = [a + b + m for a, b, m in zip(self.g5x, self.g92, self.mzero)]
         centre = [c1 * MM + off[a1], c2 * MM + off[a2]]
         self.ctrl = [e + t for e, t in zip(end, self.tlo)]
-        self.moves.append([2, self.line, end, centre, int(rot), _PLANE[self.plane]])
+        self._append([2, self.line, end, centre, int(rot), _PLANE[self.plane]])
 
     def rigid_tap(self, x, y, z, *rest):
         self._straight(1, (x, y, z))

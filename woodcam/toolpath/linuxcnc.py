@@ -96,8 +96,8 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
             raise GcodeError(int(line), "LinuxCNC", msg, "fix the line (LinuxCNC's own "
                              "interpreter refused it)")
         warnings.append((int(line), msg))
-    moves = [(k, ln, tuple(e), tuple(c) if c else None, rot, plane, 0.0, 0.0, 0)
-             for k, ln, e, c, rot, plane in res["moves"]]
+    moves = [(k, ln, tuple(e), tuple(c) if c else None, rot, plane, feed, rpm, tool)
+             for k, ln, e, c, rot, plane, feed, rpm, tool in res["moves"]]
     return moves, warnings
 
 
