@@ -227,6 +227,20 @@ def test_spindle_off_and_tool_without_m6_are_reported_with_lines():
     assert [w for w in prog.warnings if "without M6" in w][0].startswith("line 8:")
 
 
+def test_a_tool_change_stops_the_spindle_as_linuxcnc_does():
+    # LinuxCNC stops the spindle at M6 (its interpreter reports it stopped; an M3 on the M6
+    # line starts it again): woodcam kept it turning, so T2's cuts without a new M3 were not
+    # reported; fanuc and grbl keep their old reading
+    text = ("G0 X10 Y10 Z2\nT1 M6\nS9000 M3\nG1 Z-2 F300\nG0 Z2\nT2 M6\nG1 Z-2\nG1 X20\n"
+            "G0 Z2\nT3 M6 M3\nG1 Z-2\nM2\n")
+    prog = read_gcode(text)
+    assert prog.spindle_rpm[prog.kind != 0].tolist() == [9000, 0, 0, 9000]
+    res = simulate(prog, FlatEndMill(4), SIZE)
+    assert [(i.kind, i.line, i.last_line) for i in res.report] == [("spindle_off", 7, 8)]
+    assert "since a tool change" in res.report[0].message
+    assert (read_gcode(text, dialect="fanuc").spindle_rpm[prog.kind != 0] == 9000).all()
+
+
 @pytest.mark.parametrize("tool", [BallEndMill(6), FlatEndMill(4)])
 def test_compiled_ball_and_flat_sweeps_match_the_numpy_envelopes(tool, monkeypatch):
     """Ball and flat end mills run through the one-pass numba kernel

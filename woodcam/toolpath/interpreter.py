@@ -59,7 +59,8 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``G73 G81 G82 G83 G85 G86 G89`` with ``G98/G99`` and ``L`` (in ``linuxcnc`` R, Z, Q and P
   carry over only between lines of one cycle code, as LinuxCNC),
   ``G80``, ``G90/G91``, ``G90.1/G91.1``, ``G92/G92.1/G92.2/G92.3``, ``G94``, ``G97``;
-  ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60`` (one of each modal group a line);
+  ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60`` (one of each modal group a line; in
+  ``linuxcnc`` M6 stops the spindle, as LinuxCNC's tool change does);
   ``F S T``, ``E`` (beside ``M66``-``M68``), ``N`` (digits, the first word of a line, before any comment; grbl: anywhere); ``( )``/``;`` comments,
   ``(msg,...)``, block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
   of its own: the first non-blank line opens, the next ends the program; any other ``%`` is an
@@ -1558,6 +1559,11 @@ class Interpreter:
             self.tool = self.selected = int(w["q"])
         if 6 in mset:
             self.tool = self.selected
+            if self.dialect == "linuxcnc":
+                # LinuxCNC stops the spindle for a tool change (TOOL_CHANGE_WITH_SPINDLE_ON
+                # is off by default); an M3/M4 on the same line starts it again (step 7 of its
+                # order of execution, after the change at step 6)
+                self.spindle_on = False
         if 66 in mset:  # the input it waits for lands in #5399: not known from here on
             self.p.pop(5399, None)
         if mset & {3, 4}:

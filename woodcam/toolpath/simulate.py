@@ -304,7 +304,8 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
                   f"{say_length(zmin[k] - off[2], '.3f')}) with its footprint outside the stock"), mid[k])
     for k in np.flatnonzero(below_top & over & (kind == FEED) & ~(program.spindle_rpm > 0)):
         _add(issues, "spindle_off", lines[k], "feed move into the stock with the spindle off "
-             "(no M3/M4 with S > 0 before it): the controller would cut with a still tool",
+             "(no M3/M4 with S > 0 before it, or none since a tool change, which stops it "
+             "in LinuxCNC): the controller would cut with a still tool",
              mid[k])
     # tools with reach data: the stock each move meets must not reach the shank or holder
     for rkind, rline, message in reach_issues(p0, p1, tool_of, lookup, lines, size,
