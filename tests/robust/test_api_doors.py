@@ -227,3 +227,53 @@ def test_woodify_refuses_a_string_resolution_and_nan_vertex_gains():
         woodify(ball, 2, resolution="32")
     with pytest.raises(WoodcamError, match="vertex_gain must be .* finite values > 0"):
         woodify(ball, 2, resolution=32, vertex_gain=np.full(len(ball.vertices), np.nan))
+
+
+def _library_door_sweep():
+    """``(id, call, match)`` from a sweep of the library doors with the mistakes a user makes (a
+    wrong shape, NaN, a string for a number, a wrong kind of object): each raised a bare
+    TypeError/ValueError/AttributeError/IndexError/ZeroDivisionError, returned garbage (marked *)
+    or named the wrong argument (marked !) before its door check."""
+    import numpy as np
+
+    import woodcam as w
+
+    fld = w.builtin_block("flat-sawn").field
+    pts = np.array([[5.0, 5.0, 5.0], [1.0, 2.0, 3.0]])
+    return [
+        ("evaluate batch -1 *", lambda: w.evaluate(fld, pts, batch=-1), "batch must be an integer >= 1; got -1"),
+        ("evaluate batch 0", lambda: w.evaluate(fld, pts, batch=0), "batch must be an integer >= 1; got 0"),
+        ("evaluate batch 1.5", lambda: w.evaluate(fld, pts, batch=1.5), "batch must be an integer >= 1; got 1.5"),
+        ("evaluate workers str", lambda: w.evaluate(fld, pts, workers="2"), "workers must be an integer >= 1; got '2'"),
+        ("evaluate field None", lambda: w.evaluate(None, pts), "field must be a growth field .*got NoneType"),
+        ("GridField.bake field str", lambda: w.GridField.bake("oak", (0, 0, 0), (9, 9, 9), 3),
+         "field must be a growth field .*got str"),
+    ]
+
+
+@pytest.mark.parametrize("name, call, match", _library_door_sweep(), ids=lambda v: v if isinstance(v, str) else "")
+def test_library_doors_refuse_a_users_mistakes_naming_the_argument(name, call, match):
+    with pytest.raises(WoodcamError, match=match):
+        call()
+
+
+def _library_door_valid_calls():
+    """``(id, call, check)``: the valid call beside each refused one still works (ints where
+    floats, numpy scalars, lists for arrays), checked against a known answer."""
+    import numpy as np
+
+    import woodcam as w
+
+    fld = w.builtin_block("flat-sawn").field
+    pts = np.array([[5.0, 5.0, 5.0], [1.0, 2.0, 3.0]])
+    whole = fld(pts)
+    return [
+        ("evaluate in batches of 1", lambda: w.evaluate(fld, pts, batch=1), lambda r: np.array_equal(r, whole)),
+        ("evaluate numpy batch", lambda: w.evaluate(fld, pts.tolist(), batch=np.int64(5), workers=np.int32(1)),
+         lambda r: np.array_equal(r, whole)),
+    ]
+
+
+@pytest.mark.parametrize("name, call, check", _library_door_valid_calls(), ids=lambda v: v if isinstance(v, str) else "")
+def test_library_doors_still_take_a_valid_call(name, call, check):
+    assert check(call())

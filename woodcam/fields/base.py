@@ -18,7 +18,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from .._checks import as_floats, check_vector
+from .._checks import as_floats, check_number, check_vector
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..tolerances import MAX_BATCH_POINTS
@@ -53,6 +53,13 @@ def evaluate(field: GrowthFieldLike, points_mm: ArrayLike, batch: int = MAX_BATC
     Each batch runs the same operations either way, so the result is the same bit for bit
     when a point's value does not depend on the other points of its batch."""
     p = check_points(points_mm)
+    if not callable(field):  # was "'NoneType' object is not callable" from inside the loop
+        raise WoodcamError(f"field must be a growth field ((n, 3) mm -> years); got {type(field).__name__}; "
+                           "pass e.g. woodcam.builtin_block('flat-sawn').field")
+    # batch=-1 returned np.empty's uninitialised memory as years (range(0, n, -1) is empty),
+    # 0 and 1.5 were bare errors of range(); workers='2' a TypeError of the comparison
+    batch = int(check_number(batch, "batch", lo=1, integer=True, fix=f"e.g. {MAX_BATCH_POINTS}"))
+    workers = int(check_number(workers, "workers", lo=1, integer=True, fix="1 evaluates here, 2 forks one process"))
     if workers > 1 and len(p) > _FORK_MIN_POINTS:
         from .._parallel import beside
 
