@@ -128,9 +128,23 @@ def pixel_to_block(face: str, rows: ArrayLike, cols: ArrayLike, image_shape: Arr
     points_mm : (..., 3) float, on the face plane.
     """
     n_rows, n_cols = _check_shape(image_shape)
-    u = (np.asarray(cols, float) + 0.5) / n_cols
-    v = (np.asarray(rows, float) + 0.5) / n_rows
-    return uv_to_block(face, u, v, size_mm)
+    r, c = _pixel_coords(rows, "rows"), _pixel_coords(cols, "cols")
+    try:  # rows of 2 and cols of 3 were numpy's broadcast ValueError from inside uv_to_block
+        r, c = np.broadcast_arrays(r, c)
+    except ValueError:
+        raise WoodcamError(f"rows and cols must broadcast together (one pixel coordinate each); got "
+                           f"shapes {r.shape} and {c.shape}; pass as many rows as cols") from None
+    return uv_to_block(face, (c + 0.5) / n_cols, (r + 0.5) / n_rows, size_mm)
+
+
+def _pixel_coords(value, name: str) -> np.ndarray:
+    """Pixel coordinates ``rows``/``cols`` as a finite float array: a string was numpy's bare
+    ValueError, a NaN a NaN point on the face."""
+    a = as_floats(value)
+    if a is None or not np.all(np.isfinite(a)):
+        raise WoodcamError(f"{name} must be finite pixel coordinates (numbers); got {value!r:.80}; "
+                           "pass the trace's points, e.g. points_px[:, 0] for rows")
+    return a
 
 
 def block_to_pixel(face: str, points_mm: ArrayLike, image_shape: ArrayLike,
@@ -152,6 +166,10 @@ def block_to_pixel(face: str, points_mm: ArrayLike, image_shape: ArrayLike,
         got = f"shape {p.shape}" if p is not None and p.ndim and p.size else f"{points_mm!r:.80}"
         raise WoodcamError(f"points_mm must have shape (..., 3) in mm; got {got}; pass "
                            "block points, e.g. [[10, 20, 5]]")
+    if not np.all(np.isfinite(p)):  # a NaN point was a NaN pixel, passed on silently
+        bad = np.argwhere(~np.isfinite(p))[0][:-1]
+        raise WoodcamError(f"points_mm must be finite; point {tuple(int(i) for i in bad)} is "
+                           f"{p[tuple(bad)].tolist()}; drop the points outside the block first")
     # Each column of A has exactly one non-zero entry, so (u, v) is read off two coordinates.
     iu, iv = int(np.flatnonzero(A[:, 0])[0]), int(np.flatnonzero(A[:, 1])[0])
     u = (p[..., iu] - b[iu]) / A[iu, 0]

@@ -248,6 +248,14 @@ def _library_door_sweep():
         ("evaluate field None", lambda: w.evaluate(None, pts), "field must be a growth field .*got NoneType"),
         ("GridField.bake field str", lambda: w.GridField.bake("oak", (0, 0, 0), (9, 9, 9), 3),
          "field must be a growth field .*got str"),
+        ("block_to_pixel NaN point *", lambda: w.block_to_pixel("top", [[np.nan, 1, 1]], (10, 10), (10, 10, 10)),
+         r"points_mm must be finite; point \(0,\) is \[nan, 1.0, 1.0\]"),
+        ("pixel_to_block NaN row *", lambda: w.pixel_to_block("top", [np.nan], [1], (10, 10), (10, 10, 10)),
+         r"rows must be finite pixel coordinates .*got \[nan\]"),
+        ("pixel_to_block str cols", lambda: w.pixel_to_block("top", [1], "a", (10, 10), (10, 10, 10)),
+         "cols must be finite pixel coordinates .*got 'a'"),
+        ("pixel_to_block 2 rows 3 cols", lambda: w.pixel_to_block("top", [1, 2], [1, 2, 3], (10, 10), (10, 10, 10)),
+         r"rows and cols must broadcast together .*shapes \(2,\) and \(3,\)"),
     ]
 
 
@@ -271,6 +279,11 @@ def _library_door_valid_calls():
         ("evaluate in batches of 1", lambda: w.evaluate(fld, pts, batch=1), lambda r: np.array_equal(r, whole)),
         ("evaluate numpy batch", lambda: w.evaluate(fld, pts.tolist(), batch=np.int64(5), workers=np.int32(1)),
          lambda r: np.array_equal(r, whole)),
+        ("pixel_to_block of block_to_pixel", lambda: w.pixel_to_block(
+            "top", *w.block_to_pixel("top", [[2.5, 7.5, 10]], (10, 20), (10, 10, 10)), (10, 20), [10, 10, 10]),
+         lambda r: np.allclose(r, [[2.5, 7.5, 10.0]])),
+        ("pixel_to_block one row many cols", lambda: w.pixel_to_block("top", 0, [0, 19], (10, 20), (10, 10, 10)),
+         lambda r: np.allclose(r, [[0.25, 9.5, 10.0], [9.75, 9.5, 10.0]])),
     ]
 
 
