@@ -85,7 +85,7 @@ def test_arf_eq6():
 
 
 def test_errors():
-    with pytest.raises(WoodcamError, match="ring_width_mm must be > 0"):
+    with pytest.raises(WoodcamError, match="ring_width_mm must be a finite number > 0"):
         RadialScalingField(LogFrame(), ring_width_mm=0)
     with pytest.raises(WoodcamError, match="axis must be a non-zero direction"):
         LogFrame((0, 0, 0), (0, 0, 0))

@@ -256,6 +256,18 @@ def _library_door_sweep():
          "cols must be finite pixel coordinates .*got 'a'"),
         ("pixel_to_block 2 rows 3 cols", lambda: w.pixel_to_block("top", [1, 2], [1, 2, 3], (10, 10), (10, 10, 10)),
          r"rows and cols must broadcast together .*shapes \(2,\) and \(3,\)"),
+        ("radial frame None", lambda: w.RadialScalingField(None), "frame must be a woodcam.fields.LogFrame; got NoneType"),
+        ("radial r_minus array", lambda: w.RadialScalingField(w.LogFrame(), r_minus=np.ones(5)),
+         "r_minus must be a RadiusFunction; got ndarray"),
+        ("radial ring width str", lambda: w.RadialScalingField(w.LogFrame(), ring_width_mm="3"),
+         "ring_width_mm must be a finite number > 0; got '3'"),
+        ("radial NaN age *", lambda: w.RadialScalingField(w.LogFrame(), age_offset_years=np.nan),
+         "age_offset_years must be a finite number; got nan"),
+        ("grid years str", lambda: w.GridField("abc", (0, 0, 0), 1), "years must be a finite .*got 'abc'"),
+        ("grid years NaN", lambda: w.GridField(np.full((3, 3, 3), np.nan), (0, 0, 0), 1),
+         r"years must be a finite .*got shape \(3, 3, 3\) with 27 non-finite"),
+        ("grid layers list", lambda: w.GridField(np.zeros((3, 3, 3)), (0, 0, 0), 1, layers=[np.zeros((3, 3, 3))]),
+         "layers must be a dict .*got list"),
     ]
 
 
@@ -284,6 +296,11 @@ def _library_door_valid_calls():
          lambda r: np.allclose(r, [[2.5, 7.5, 10.0]])),
         ("pixel_to_block one row many cols", lambda: w.pixel_to_block("top", 0, [0, 19], (10, 20), (10, 10, 10)),
          lambda r: np.allclose(r, [[0.25, 9.5, 10.0], [9.75, 9.5, 10.0]])),
+        ("radial of ints", lambda: w.RadialScalingField(w.LogFrame(), ring_width_mm=2, age_offset_years=np.float32(1))(
+            [[3, 4, 0]]), lambda r: np.allclose(r, [1 + 5 / 2])),
+        ("grid of lists", lambda: w.GridField(np.arange(27.0).reshape(3, 3, 3).tolist(), [0, 0, 0], 1,
+                                              interpolation="linear", layers={"u": np.ones((3, 3, 3))})([[1, 1, 1]]),
+         lambda r: np.allclose(r, [13.0])),
     ]
 
 

@@ -11,6 +11,7 @@ always computed from the interpolated growth time, never interpolated itself.
 from __future__ import annotations
 
 import zipfile
+from collections.abc import Mapping
 from dataclasses import dataclass
 from dataclasses import field as dc_field
 from pathlib import Path
@@ -18,7 +19,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._checks import check_number, check_vector
+from .._checks import as_floats, check_number, check_vector
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from .base import check_points, evaluate
@@ -77,9 +78,14 @@ class GridField:
     _coeffs: np.ndarray = dc_field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        g = np.asarray(self.years, dtype=float)
-        if g.ndim != 3 or min(g.shape) < 2 or not np.all(np.isfinite(g)):
-            raise WoodcamError(f"years must be a finite (nx, ny, nz) grid, each >= 2; got shape {g.shape}")
+        g = as_floats(self.years)  # a string was numpy's bare "could not convert string to float"
+        if g is None or g.ndim != 3 or min(g.shape) < 2 or not np.all(np.isfinite(g)):
+            got = f"{self.years!r:.80}" if g is None else f"shape {g.shape}" + (
+                "" if g.ndim != 3 or np.all(np.isfinite(g)) else f" with {int(np.sum(~np.isfinite(g)))} non-finite")
+            raise WoodcamError(f"years must be a finite (nx, ny, nz) grid, each >= 2; got {got}")
+        if not isinstance(self.layers, Mapping):  # a list was dict()'s bare TypeError
+            raise WoodcamError(f"layers must be a dict {{name: grid shaped like years}}; got "
+                               f"{type(self.layers).__name__}; e.g. layers={{'uncertainty': grid}} or leave it out")
         if self.interpolation not in _ORDER:
             raise WoodcamError(f"interpolation must be one of {list(_ORDER)}; got {self.interpolation!r}")
         sp = _spacing(self.spacing_mm)

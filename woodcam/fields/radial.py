@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from .._checks import check_number
 from .._types import ArrayLike
 from ..errors import WoodcamError
 from ..tolerances import MIN_RADIUS_SCALE
@@ -147,10 +148,19 @@ class RadialScalingField:
     age_offset_years: float = 0.0
 
     def __post_init__(self):
-        if not (np.isfinite(self.ring_width_mm) and self.ring_width_mm > 0):
-            raise WoodcamError(f"ring_width_mm must be > 0 mm; got {self.ring_width_mm!r}")
-        if not (np.isfinite(self.half_length_mm) and self.half_length_mm > 0):
-            raise WoodcamError(f"half_length_mm must be > 0 mm; got {self.half_length_mm!r}")
+        # the frame and radius functions are read only at the first call: None was an
+        # AttributeError there, a plain array for r_minus one too ('has no attribute samples')
+        if not isinstance(self.frame, LogFrame):
+            raise WoodcamError(f"frame must be a woodcam.fields.LogFrame; got {type(self.frame).__name__}; "
+                               "pass e.g. LogFrame(pith_point_mm=(50, -30, 0), axis=(0, 0, 1))")
+        for name in ("r_minus", "r_plus"):
+            if not isinstance(getattr(self, name), RadiusFunction):
+                raise WoodcamError(f"{name} must be a RadiusFunction; got {type(getattr(self, name)).__name__}; "
+                                   f"pass RadiusFunction(samples) or RadiusFunction.constant()")
+        # '3' was a TypeError of np.isfinite; a NaN age offset made every year NaN, silently
+        check_number(self.ring_width_mm, "ring_width_mm", lo=0, lo_open=True, fix="mm per year, e.g. 3.0")
+        check_number(self.half_length_mm, "half_length_mm", lo=0, lo_open=True, fix="mm, e.g. 100.0")
+        check_number(self.age_offset_years, "age_offset_years", fix="growth years at the pith, 0 for a real pith")
 
     @property
     def axis(self) -> np.ndarray:
