@@ -268,6 +268,14 @@ def _library_door_sweep():
          r"years must be a finite .*got shape \(3, 3, 3\) with 27 non-finite"),
         ("grid layers list", lambda: w.GridField(np.zeros((3, 3, 3)), (0, 0, 0), 1, layers=[np.zeros((3, 3, 3))]),
          "layers must be a dict .*got list"),
+        ("wood appearance a species name", lambda: w.Wood(fld, appearance="oak"),
+         r"appearance must have a method color.*got 'oak'.*ColorMapAppearance\('walnut'\)"),
+        ("wood threads str", lambda: w.Wood(fld, threads="2"), "threads must be an integer >= 1; got '2'"),
+        ("wood threads -1 *", lambda: w.Wood(fld, threads=-1), "threads must be an integer >= 1; got -1"),
+        ("colormap seed str", lambda: w.ColorMapAppearance(seed="a"), "seed must be an integer in \\[0, .*got 'a'"),
+        ("colormap seed 2**70", lambda: w.ColorMapAppearance(seed=2**70), "seed must be an integer in .*got 1180591620717411303424"),
+        ("colormap seed 1.5 *", lambda: w.ColorMapAppearance(seed=1.5), "seed must be an integer in .*got 1.5"),
+        ("open_stock seed str", lambda: w.open_stock("builtin:flat-sawn", seed="a"), "seed must be an integer in .*got 'a'"),
     ]
 
 
@@ -301,6 +309,9 @@ def _library_door_valid_calls():
         ("grid of lists", lambda: w.GridField(np.arange(27.0).reshape(3, 3, 3).tolist(), [0, 0, 0], 1,
                                               interpolation="linear", layers={"u": np.ones((3, 3, 3))})([[1, 1, 1]]),
          lambda r: np.allclose(r, [13.0])),
+        ("wood of a numpy seed and threads", lambda: w.Wood(fld, w.ColorMapAppearance(seed=np.int64(3)), threads=np.int32(2))
+         .color(pts, [[0, 0, 1]] * 2), lambda r: np.array_equal(r, w.Wood(fld, w.ColorMapAppearance(seed=3), threads=1)
+                                                                  .color(pts, [[0, 0, 1]] * 2))),
     ]
 
 

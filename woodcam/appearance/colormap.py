@@ -23,6 +23,7 @@ from typing import Literal
 import numba
 import numpy as np
 
+from .._checks import check_number
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, arf, check_points, check_texture_frame, grain_direction
@@ -257,6 +258,10 @@ class ColorMapAppearance:
     def __post_init__(self, knot_darkening_alive=None, knot_darkening_dead=None,
                       dead_outline_rgb=None):
         object.__setattr__(self, "species", get_species(self.species))
+        # 'a' was int()'s ValueError at the first colour, 2**70 an OverflowError of np.int64 and
+        # 1.5 was read as seed 1; the compiled noise adds up to 2 to it in int64
+        object.__setattr__(self, "seed", int(check_number(self.seed, "seed", lo=0, hi=2**62, integer=True,
+                                                          fix="the colour noise's seed, e.g. seed=0")))
         check_texture_frame(self.texture_frame)
         changes = {k: v for k, v in (("alive_darkening", knot_darkening_alive),
                                      ("dead_darkening", knot_darkening_dead),

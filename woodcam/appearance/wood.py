@@ -40,6 +40,15 @@ class Wood:
     def __init__(self, field: GrowthFieldLike, appearance: AppearanceLike | None = None, *, threads: int | None = None):
         if not callable(field):
             raise WoodcamError(f"field must be callable as field(points_mm) -> years; got {type(field).__name__}")
+        # an appearance without color() (a species name, a number) was an AttributeError at the
+        # first colour; threads='2' a TypeError of max(), -1 and 1.5 were taken as 1 thread
+        if appearance is not None and not callable(getattr(appearance, "color", None)):
+            raise WoodcamError(f"appearance must have a method color(field, points_mm, normals) -> rgb; got "
+                               f"{appearance!r:.60}; pass a ColorMapAppearance (ColorMapAppearance('walnut') "
+                               "for a species) or None for the oak preset")
+        if threads is not None:
+            threads = int(check_number(threads, "threads", lo=1, integer=True,
+                                       fix="worker threads for color(), or None for one per CPU core"))
         self.field = field
         self.appearance = appearance if appearance is not None else ColorMapAppearance()
         self.threads = max(1, threads or os.cpu_count() or 1)
