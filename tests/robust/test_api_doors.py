@@ -276,6 +276,17 @@ def _library_door_sweep():
         ("colormap seed 2**70", lambda: w.ColorMapAppearance(seed=2**70), "seed must be an integer in .*got 1180591620717411303424"),
         ("colormap seed 1.5 *", lambda: w.ColorMapAppearance(seed=1.5), "seed must be an integer in .*got 1.5"),
         ("open_stock seed str", lambda: w.open_stock("builtin:flat-sawn", seed="a"), "seed must be an integer in .*got 'a'"),
+        ("cut_block NaN distance !", lambda: w.cut_block(fld, (20, 20, 20), distance_mm=np.nan),
+         "distance_mm must be a finite number >= 0; got nan"),
+        ("cut_block NaN angle !", lambda: w.cut_block(fld, (20, 20, 20), angle_deg=np.nan),
+         "angle_deg must be a finite number; got nan"),
+        ("cut_block NaN tilt !", lambda: w.cut_block(fld, (20, 20, 20), tilt_deg=np.nan), "tilt_deg must be a finite number; got nan"),
+        ("cut_block inf height !", lambda: w.cut_block(fld, (20, 20, 20), height_mm=np.inf),
+         "height_mm must be a finite number; got inf"),
+        ("cut_block str azimuth", lambda: w.cut_block(fld, (20, 20, 20), azimuth_deg="a"),
+         "azimuth_deg must be a finite number; got 'a'"),
+        ("cut_block tuple log_frame", lambda: w.cut_block(fld, (20, 20, 20), log_frame=(0, 0, 1)),
+         "log_frame must be a woodcam.fields.LogFrame or None; got tuple"),
     ]
 
 
@@ -312,6 +323,9 @@ def _library_door_valid_calls():
         ("wood of a numpy seed and threads", lambda: w.Wood(fld, w.ColorMapAppearance(seed=np.int64(3)), threads=np.int32(2))
          .color(pts, [[0, 0, 1]] * 2), lambda r: np.array_equal(r, w.Wood(fld, w.ColorMapAppearance(seed=3), threads=1)
                                                                   .color(pts, [[0, 0, 1]] * 2))),
+        ("cut_block of ints", lambda: w.cut_block(lambda p: np.hypot(p[:, 0], p[:, 1]), (20, 20, 20), "quarter-sawn",
+                                                  distance_mm=40, azimuth_deg=np.float32(0), tilt_deg=0)([[10, 10, 10]]),
+         lambda r: np.allclose(r, [40.0])),
     ]
 
 

@@ -7,6 +7,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from .._checks import check_number
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..fields.analytic import AnalyticLogField
@@ -87,12 +88,21 @@ def cut_block(log_field: GrowthFieldLike, size_mm: ArrayLike, pattern: SawPatter
     if pattern not in PATTERNS:
         raise WoodcamError(f"pattern must be one of {', '.join(PATTERNS)}; got {pattern!r}")
     if log_frame is not None:
+        if not isinstance(log_frame, LogFrame):  # a tuple was taken and failed at the first call
+            raise WoodcamError(f"log_frame must be a woodcam.fields.LogFrame or None; got "
+                               f"{type(log_frame).__name__}; pass e.g. LogFrame((50, -60, 0), (0, 0, 1))")
         return PlacedField.from_log_frame(log_field, log_frame)
     W, D, _ = size
+    # each number by name: a NaN was refused as the LogFrame's 'pith_point_mm'/'reference'
+    # (or, for angle_deg and tilt_deg, as 'the pith inside the block'), a string was math's TypeError
     if distance_mm is None:
         distance_mm = 0.0 if pattern == "pith-inside" else 1.5 * max(W, D)
-    if distance_mm < 0:
-        raise WoodcamError(f"distance_mm must be >= 0; got {distance_mm!r}")
+    distance_mm = check_number(distance_mm, "distance_mm", lo=0, fix="mm from the pith to the block centre")
+    azimuth_deg, height_mm, tilt_deg = (check_number(v, name, fix="a finite number, in degrees or mm")
+                                        for v, name in ((azimuth_deg, "azimuth_deg"), (height_mm, "height_mm"),
+                                                        (tilt_deg, "tilt_deg")))
+    if angle_deg is not None:
+        angle_deg = check_number(angle_deg, "angle_deg", fix="degrees from +Y towards +X, or None for the pattern's")
     ang = math.radians(_PATTERN_ANGLE_DEG[pattern] if angle_deg is None else angle_deg)
     b_r = np.array([math.sin(ang), math.cos(ang), 0.0])        # outward radial at the centre
     z = np.array([0.0, 0.0, 1.0])
