@@ -287,6 +287,13 @@ def _library_door_sweep():
          "azimuth_deg must be a finite number; got 'a'"),
         ("cut_block tuple log_frame", lambda: w.cut_block(fld, (20, 20, 20), log_frame=(0, 0, 1)),
          "log_frame must be a woodcam.fields.LogFrame or None; got tuple"),
+        ("synth spec dict", lambda: w.synth_block(fld, (20, 20, 20), {"face_px": 16}), "spec must be a SynthSpec or None; got dict"),
+        ("synth rng int", lambda: w.synth_block(fld, (20, 20, 20), face_px=16, rng=1), "rng must be a numpy Generator or None; got 1"),
+        ("synth meta list", lambda: w.synth_block(fld, (20, 20, 20), face_px=16, meta=[1]),
+         "meta must be a dict of extra block metadata or None; got list"),
+        ("synth seed str", lambda: w.synth_block(fld, (20, 20, 20), face_px=16, seed="a"), "seed must be an integer >= 0; got 'a'"),
+        ("synth NaN field", lambda: w.synth_block(lambda p: np.full(len(p), np.nan), (20, 20, 20), face_px=16),
+         "field must give finite years on the block; it gave 256 NaN/inf of 256 pixels of face 'front'"),
     ]
 
 
@@ -326,6 +333,9 @@ def _library_door_valid_calls():
         ("cut_block of ints", lambda: w.cut_block(lambda p: np.hypot(p[:, 0], p[:, 1]), (20, 20, 20), "quarter-sawn",
                                                   distance_mm=40, azimuth_deg=np.float32(0), tilt_deg=0)([[10, 10, 10]]),
          lambda r: np.allclose(r, [40.0])),
+        ("synth of a numpy seed and a generator", lambda: w.synth_block(fld, [16, 16, 16], face_px=16, seed=np.int64(2),
+                                                                     rng=np.random.default_rng(2), meta={"k": 1}),
+         lambda b: b.size_mm == (16.0, 16.0, 16.0) and b.faces["front"].photo.shape == (16, 16, 3) and b.meta["k"] == 1),
     ]
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from .._types import ArrayLike, GrowthFieldLike, WoodLike
@@ -64,6 +66,15 @@ def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | No
         Clean traces (no jitter, no mislabelling) lie on the integer iso-lines within
         :data:`woodcam.tolerances.TRACE_ISO_TOL_YEARS` years.
     """
+    # a dict spec, an int rng and a list meta were AttributeError/TypeError deep in the render
+    if spec is not None and not isinstance(spec, SynthSpec):
+        raise WoodcamError(f"spec must be a SynthSpec or None; got {type(spec).__name__}; pass "
+                           "SynthSpec.from_dict(d), or the settings as keywords (face_px=64)")
+    if rng is not None and not isinstance(rng, np.random.Generator):
+        raise WoodcamError(f"rng must be a numpy Generator or None; got {rng!r:.40}; pass "
+                           "np.random.default_rng(seed), or seed=... to let the spec make one")
+    if meta is not None and not isinstance(meta, Mapping):
+        raise WoodcamError(f"meta must be a dict of extra block metadata or None; got {type(meta).__name__}")
     spec = (SynthSpec() if spec is None else spec).replace_flat(**settings)
     size = check_size(size_mm)
     if not callable(field):
@@ -98,6 +109,10 @@ def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | No
         px_mm = (hmm / shape[0], wmm / shape[1])
         pts = face_pixel_points(face, shape, size).reshape(-1, 3)
         g = evaluate(field, pts)
+        if not np.all(np.isfinite(g)):  # NaN years were int()'s ValueError in the iso-line tracer
+            raise WoodcamError(f"field must give finite years on the block; it gave {int(np.sum(~np.isfinite(g)))} "
+                               f"NaN/inf of {g.size} pixels of face {face!r}; check the field and that the "
+                               "block lies where it is defined")
         normals = np.broadcast_to(np.asarray(FACE_NORMAL[face], float), pts.shape)
         if isinstance(wood, _BuiltinWood):
             gr, gc = np.gradient(g.reshape(shape))

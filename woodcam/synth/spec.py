@@ -14,6 +14,7 @@ import json
 from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 
+from .._checks import check_number
 from ..errors import WoodcamError
 from ..frames import FACES, check_face
 
@@ -132,6 +133,9 @@ class SynthSpec:
             raise WoodcamError(f"face_px must be >= 2 pixels; got {self.face_px!r}")
         if self.px_per_mm is not None and not self.px_per_mm > 0:
             raise WoodcamError(f"px_per_mm must be > 0; got {self.px_per_mm!r}")
+        if self.seed is not None:  # 'a' was numpy's SeedSequence TypeError when rendering
+            object.__setattr__(self, "seed", int(check_number(self.seed, "seed", lo=0, integer=True,
+                                                              fix="same seed, same block; or None")))
         for name, kind in (("photo", PhotoSpec), ("traces", TraceSpec), ("ring_map", RingMapSpec)):
             v = getattr(self, name)
             if isinstance(v, dict):
