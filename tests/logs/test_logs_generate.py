@@ -121,7 +121,7 @@ def test_group_whorls_splits_at_gaps():
 
 
 def test_bad_length_is_refused():
-    with pytest.raises(WoodcamError, match="length_mm must be > 100"):
+    with pytest.raises(WoodcamError, match="length_mm must be a number > 100"):
         generate_log(0, length_mm=10.0)
 
 

@@ -294,7 +294,32 @@ def _library_door_sweep():
         ("synth seed str", lambda: w.synth_block(fld, (20, 20, 20), face_px=16, seed="a"), "seed must be an integer >= 0; got 'a'"),
         ("synth NaN field", lambda: w.synth_block(lambda p: np.full(len(p), np.nan), (20, 20, 20), face_px=16),
          "field must give finite years on the block; it gave 256 NaN/inf of 256 pixels of face 'front'"),
+        ("brush radius str", lambda: w.Brush((0, 0, 0), "5"), "brush radius_mm must be a number; got '5'"),
+        ("growth speed velocity str", lambda: w.GrowthSpeed("1", 1), "velocity_mm must be a number; got '1'"),
+        ("generate_log length str", lambda: w.generate_log(1, length_mm="200"), "length_mm must be a number > 100 mm; got '200'"),
+        ("generate_log stats None", lambda: w.generate_log(1, length_mm=200, stats=None),
+         "stats must be a woodcam.logs.generate.LogStats; got NoneType"),
+        ("generate_log heightmap of 1", lambda: w.generate_log(1, length_mm=200, heightmap_shape=(10,)),
+         r"heightmap_shape must be two whole counts .*got \(10,\)"),
+        ("generate_log heightmap str", lambda: w.generate_log(1, length_mm=200, heightmap_shape="ab"),
+         "heightmap_shape must be two whole counts .*got 'ab'"),
+        ("knotted table_samples 0", lambda: w.KnottedLogField(_small_log(), table_samples=0),
+         "table_samples must be an integer >= 2; got 0"),
+        ("knotted table_samples 1", lambda: w.KnottedLogField(_small_log(), table_samples=1),
+         "table_samples must be an integer >= 2; got 1"),
+        ("knotted ring width str", lambda: w.KnottedLogField(_small_log(), ring_width_mm="2"),
+         "ring_width_mm must be a finite number > 0; got '2'"),
+        ("knotted smoothing (0, -1) *", lambda: w.KnottedLogField(_small_log(), surface_smoothing=(0, -1)),
+         r"surface_smoothing must be two window sizes >= 1 .*got \(0, -1\)"),
+        ("knotted chunk 0 *", lambda: w.KnottedLogField(_small_log(), chunk=0), "chunk must be an integer >= 1; got 0"),
     ]
+
+
+def _small_log():
+    """A 200 mm generated spruce log (knots and all): the input of KnottedLogField."""
+    import woodcam as w
+
+    return w.generate_log(1, length_mm=200).to_skeleton()
 
 
 @pytest.mark.parametrize("name, call, match", _library_door_sweep(), ids=lambda v: v if isinstance(v, str) else "")
@@ -336,6 +361,14 @@ def _library_door_valid_calls():
         ("synth of a numpy seed and a generator", lambda: w.synth_block(fld, [16, 16, 16], face_px=16, seed=np.int64(2),
                                                                      rng=np.random.default_rng(2), meta={"k": 1}),
          lambda b: b.size_mm == (16.0, 16.0, 16.0) and b.faces["front"].photo.shape == (16, 16, 3) and b.meta["k"] == 1),
+        ("brush of ints", lambda: w.Brush([0, 0, 0], 5, gain=2, strength=np.float32(0.5)).weight([[5, 0, 0]]),
+         lambda r: np.allclose(r, [np.exp(-0.5)])),
+        ("growth speed of ints", lambda: w.GrowthSpeed(20, 30, shape=2, eccentricity=0).velocity_mm, lambda r: r == 20),
+        ("generate_log of a numpy heightmap shape", lambda: w.generate_log(1, length_mm=200, heightmap_shape=(
+            np.int64(41), 360)).heightmap_mm.shape, lambda r: r == (41, 360)),
+        ("knotted of ints", lambda: w.KnottedLogField(_small_log(), ring_width_mm=2, surface_smoothing=[1, 1], chunk=64,
+                                                      table_samples=np.int64(32))([[0, 0, 50]]),
+         lambda r: r.shape == (1,) and np.isfinite(r).all()),
     ]
 
 

@@ -41,11 +41,13 @@ cost grows with the knots near a point, not with all knots of the log.
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import asdict, dataclass, replace
 from typing import Literal
 
 import numpy as np
 
+from .._checks import check_number
 from .._types import ArrayLike
 from ..errors import WoodcamError
 from .base import check_points
@@ -240,9 +242,18 @@ class KnottedLogField:
         if not isinstance(log, LogSkeleton):
             raise WoodcamError(f"log must be a woodcam.fields.skeleton.LogSkeleton; got "
                                f"{type(log).__name__}; read one with read_log or read_gran1")
-        if not (ring_width_mm > 0):
-            raise WoodcamError(f"ring_width_mm must be > 0 mm/year; got {ring_width_mm}; "
-                               "spruce is about 2")
+        # '2' was a TypeError of '>', table_samples=0 and 1 numpy's empty-min ValueError and a
+        # ZeroDivisionError, surface_smoothing=(0, -1) and chunk=0 were quietly made something else
+        ring_width_mm = check_number(ring_width_mm, "ring_width_mm", lo=0, lo_open=True,
+                                     fix="mm/year; spruce is about 2")
+        table_samples = int(check_number(table_samples, "table_samples", lo=2, integer=True,
+                                         fix="radii sampled along each knot, e.g. 128"))
+        if chunk is not None:
+            chunk = int(check_number(chunk, "chunk", lo=1, integer=True, fix="points per chunk, e.g. 2048, or None"))
+        sm = surface_smoothing if isinstance(surface_smoothing, (tuple, list)) else ()
+        if len(sm) != 2 or not all(isinstance(v, numbers.Integral) and not isinstance(v, bool) and v >= 1 for v in sm):
+            raise WoodcamError(f"surface_smoothing must be two window sizes >= 1 (heights, azimuths); got "
+                               f"{surface_smoothing!r}; e.g. (11, 5), or (1, 1) for none")
         self.log = log
         self.ring_width_mm = float(ring_width_mm)
         self.params = params if params is not None else KnotParams()

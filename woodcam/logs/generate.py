@@ -52,6 +52,7 @@ knot origins within 1.5 mm of the data's):
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
@@ -393,13 +394,24 @@ def generate_log(seed: int | np.random.Generator | None = 0, *, length_mm: float
     heightmap_shape : (n_l, n_theta), optional
         Heightmap grid; default one row per 5 mm and one column per degree.
     """
-    if not (np.isfinite(length_mm) and length_mm > 100):
-        raise WoodcamError(f"length_mm must be > 100 mm; got {length_mm!r}")
+    if isinstance(length_mm, bool) or not isinstance(length_mm, numbers.Real) \
+            or not (np.isfinite(length_mm) and length_mm > 100):  # '100' was np.isfinite's TypeError
+        raise WoodcamError(f"length_mm must be a number > 100 mm; got {length_mm!r}; e.g. length_mm=4000")
+    if not isinstance(stats, LogStats):  # None or a dict was an AttributeError mid-way
+        raise WoodcamError(f"stats must be a woodcam.logs.generate.LogStats; got {type(stats).__name__}; "
+                           "leave it out for the spruce statistics, or replace(SPRUCE, ...) to change some")
     if not (seed is None or isinstance(seed, np.random.Generator)):  # "a" was numpy's TypeError
         seed = check_number(seed, "generate_log: seed", lo=0, integer=True,
                             fix="pass an integer >= 0 (same seed, same log), a numpy Generator or None")
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-    n_l, n_t = heightmap_shape or (int(np.ceil(length_mm / 5.0)) + 1, 360)
+    if heightmap_shape is None:
+        n_l, n_t = int(np.ceil(length_mm / 5.0)) + 1, 360
+    else:  # (10,) was an unpacking ValueError, 'ab' float()'s
+        hs = tuple(heightmap_shape) if isinstance(heightmap_shape, (tuple, list, np.ndarray)) else ()
+        if len(hs) != 2 or not all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in hs):
+            raise WoodcamError(f"heightmap_shape must be two whole counts (n_l, n_theta) or None; got "
+                               f"{heightmap_shape!r}; e.g. (801, 360)")
+        n_l, n_t = int(hs[0]), int(hs[1])
     from ..limits import check_grid
 
     check_grid((n_l, n_t), "the log's surface height map", fix="generate a shorter log (length_mm)")

@@ -20,6 +20,7 @@ optional).
 from __future__ import annotations
 
 import json
+import numbers
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -43,6 +44,10 @@ class Brush:
         c = np.asarray(self.centre_mm, float)
         if c.shape != (3,) or not np.all(np.isfinite(c)):
             raise WoodcamError(f"brush centre_mm must be 3 finite numbers (mm); got {self.centre_mm!r}")
+        for name in ("radius_mm", "gain", "strength"):  # '5' was a TypeError of np.isfinite
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, numbers.Real):
+                raise WoodcamError(f"brush {name} must be a number; got {v!r}; e.g. Brush((0, 0, 10), radius_mm=5)")
         if not (np.isfinite(self.radius_mm) and self.radius_mm > 0):
             raise WoodcamError(f"brush radius_mm must be > 0 (mm); got {self.radius_mm!r}")
         if not (np.isfinite(self.gain) and self.gain > 0):

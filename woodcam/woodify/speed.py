@@ -24,6 +24,7 @@ with eccentricity its centre moves by ``delta * tau(t)`` along ``up``; it never 
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -89,6 +90,11 @@ class GrowthSpeed:
     up: tuple[float, float, float] = (0.0, 0.0, 1.0)
 
     def __post_init__(self):
+        for name in ("velocity_mm", "time_scale_years", "shape", "eccentricity"):  # '1' was np.isfinite's TypeError
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, numbers.Real):
+                raise WoodcamError(f"{name} must be a number; got {v!r}; e.g. GrowthSpeed(velocity_mm=20, "
+                                   "time_scale_years=30)")
         if not (np.isfinite(self.velocity_mm) and self.velocity_mm > 0):
             raise WoodcamError(f"velocity_mm must be > 0 (mm of total growth); got {self.velocity_mm!r}")
         if not (np.isfinite(self.time_scale_years) and self.time_scale_years > 0):
