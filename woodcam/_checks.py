@@ -1,4 +1,4 @@
-"""Door checks of the public API's plain arguments: one number, one vector.
+"""Door checks of the public API's plain arguments: one number, one vector, one path.
 
 A wrong type or shape must fail where it enters, as a :class:`~woodcam.errors.WoodcamError`
 naming the argument, the rule, the value received and a fix, not as a bare ``TypeError`` or
@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
+from pathlib import Path
 
 import numpy as np
 
@@ -70,3 +72,11 @@ def check_vector(value, name: str, *, n: int = 3, unit: bool = False, fix: str =
                   fix or f"e.g. {name}=({', '.join(['1'] + ['0'] * (n - 1))})")
         v = v / length
     return v
+
+
+def check_path(value, name: str, *, fix: str = "") -> Path:
+    """``value`` (a ``str`` or ``os.PathLike``, not empty) as a ``Path``. None, a number or a
+    list was ``Path()``'s bare TypeError ("expected str, bytes or os.PathLike object")."""
+    if isinstance(value, bool) or not isinstance(value, (str, os.PathLike)) or str(value) == "":
+        _fail(name, "a file path (str or pathlib.Path)", value, fix)
+    return Path(value)

@@ -312,7 +312,32 @@ def _library_door_sweep():
         ("knotted smoothing (0, -1) *", lambda: w.KnottedLogField(_small_log(), surface_smoothing=(0, -1)),
          r"surface_smoothing must be two window sizes >= 1 .*got \(0, -1\)"),
         ("knotted chunk 0 *", lambda: w.KnottedLogField(_small_log(), chunk=0), "chunk must be an integer >= 1; got 0"),
+        ("read_log None", lambda: w.read_log(None), r"read_log: path must be a file path \(str or pathlib.Path\); got None"),
+        ("write_log path None", lambda: w.write_log(_small_log(), None), "write_log: path must be a file path .*got None"),
+        ("write_log log None", lambda: w.write_log(None, "l.json"), "log must be a woodcam.fields.skeleton.LogSkeleton; got NoneType"),
+        ("load_textured None", lambda: w.load_textured(None), "load_textured: path must be a file path .*got None"),
+        ("export_glb path None", lambda: w.export_glb(_baked_box(), None), "export_glb: path must be a file path .*got None"),
+        ("export_obj path 5", lambda: w.export_obj(_baked_box(), 5), "export_obj: path must be a file path .*got 5"),
+        ("load_tool_table None", lambda: w.load_tool_table(None), "load_tool_table: path must be a file path .*got None"),
+        ("load_scan None", lambda: w.load_scan(None, dpi=300), "load_scan: path must be a file path .*got None"),
+        ("read_gcode None !", lambda: w.read_gcode(None), "read_gcode: text_or_path must be the program text .*got None"),
+        ("read_gcode start str", lambda: w.read_gcode("G1 X1 F100\n", start_mm="abc"),
+         "read_gcode: start_mm must be three finite numbers .*got 'abc'"),
     ]
+
+
+def _baked_box():
+    """A 10 mm cube baked grey at 1 texel/mm: what export_glb and export_obj take."""
+    import numpy as np
+    import trimesh
+
+    import woodcam as w
+
+    class Grey:
+        def color(self, points_mm, normals):
+            return np.full((len(points_mm), 3), 0.5)
+
+    return w.bake(trimesh.creation.box((10, 10, 10)), Grey(), texels_per_mm=1).mesh
 
 
 def _small_log():
@@ -369,9 +394,35 @@ def _library_door_valid_calls():
         ("knotted of ints", lambda: w.KnottedLogField(_small_log(), ring_width_mm=2, surface_smoothing=[1, 1], chunk=64,
                                                       table_samples=np.int64(32))([[0, 0, 50]]),
          lambda r: r.shape == (1,) and np.isfinite(r).all()),
+        ("read_gcode of a list start", lambda: w.read_gcode("G1 X1 F100\n", start_mm=[0, 0, 5]).start_mm.tolist(),
+         lambda r: r == [[0.0, 0.0, 5.0]]),
     ]
 
 
 @pytest.mark.parametrize("name, call, check", _library_door_valid_calls(), ids=lambda v: v if isinstance(v, str) else "")
 def test_library_doors_still_take_a_valid_call(name, call, check):
     assert check(call())
+
+
+def test_a_path_door_takes_a_str_and_a_path_like(tmp_path):
+    """The path doors refuse None and numbers (above) but take str and any os.PathLike: a log
+    written and read back is the same log; a G-code file given as a PathLike is read as a file."""
+    import os
+
+    import numpy as np
+
+    import woodcam as w
+
+    class Where(os.PathLike):
+        def __init__(self, p):
+            self.p = p
+
+        def __fspath__(self):
+            return str(self.p)
+
+    log = _small_log()
+    back = w.read_log(w.write_log(log, str(tmp_path / "l.json")))
+    assert np.array_equal(back.radii_mm, log.radii_mm) and np.array_equal(back.pith_z_mm, log.pith_z_mm)
+    (tmp_path / "p.nc").write_text("G1 X3 F100\n")
+    prog = w.read_gcode(Where(tmp_path / "p.nc"))
+    assert prog.source == str(tmp_path / "p.nc") and prog.end_mm[-1, 0] == 3.0

@@ -40,6 +40,7 @@ from typing import get_args
 import numpy as np
 
 from woodcam._atomic import atomic_files, check_output_path, write_bytes
+from woodcam._checks import check_path
 from woodcam.errors import WoodcamError
 from woodcam.frames import (BLOCK_TO_GLTF, GLTF_ROOT_NODE, OBJ_HEADER, ObjUnits, ObjUp,
                             foreign_gltf_in_block_frame, obj_header_transform, obj_transform)
@@ -247,7 +248,8 @@ def export_glb(mesh: Mesh, path: PathLike, metadata: dict | None = None, *,
     from trimesh.exchange.gltf import export_glb as _trimesh_export_glb
 
     _require_textured(mesh, "export_glb")
-    path = check_output_path(path, suffixes=(".glb",), what="export_glb: path", mkdir=True)
+    path = check_output_path(check_path(path, "export_glb: path", fix="e.g. 'out/part.glb'"),  # None: Path()'s TypeError
+                             suffixes=(".glb",), what="export_glb: path", mkdir=True)
     payload = {"units": "mm", "frame": "block", "block_to_gltf": BLOCK_TO_GLTF.tolist()}
     if metadata is not None:
         clash = sorted(k for k in (metadata if isinstance(metadata, dict) else {})
@@ -374,7 +376,8 @@ def export_obj(mesh: Mesh, path: PathLike, *, units: ObjUnits = "m", up: ObjUp =
         (``# woodcam: units=m up=y``) so :func:`load_textured` returns the block frame.
     """
     _require_textured(mesh, "export_obj")
-    path = check_output_path(path, suffixes=(".obj",), what="export_obj: path", mkdir=True)
+    path = check_output_path(check_path(path, "export_obj: path", fix="e.g. 'out/part.obj'"),  # None: Path()'s TypeError
+                             suffixes=(".obj",), what="export_obj: path", mkdir=True)
     if units not in get_args(ObjUnits):
         raise WoodcamError(f"export_obj: units must be one of {get_args(ObjUnits)}; got {units!r}")
     if up not in get_args(ObjUp):
@@ -439,7 +442,7 @@ def load_textured(path: PathLike) -> Mesh:
     """
     import trimesh
 
-    path = Path(path)
+    path = check_path(path, "load_textured: path", fix="a GLB or OBJ written by woodcam")
     if not path.is_file():
         raise WoodcamError(f"load_textured: no file at {str(path)!r}; check the path")
     try:

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._checks import check_path
 from .._types import PathLike
 from ..errors import WoodcamError
 from ..fields.skeleton import BranchStrand, LogSkeleton
@@ -35,12 +36,16 @@ def write_log(log: LogSkeleton, path: PathLike) -> Path:
     """Write ``log`` as a woodcam log file (JSON, mm); returns the path."""
     from .._atomic import write_text
 
-    return write_text(Path(path), json.dumps(log.to_json()), mkdir=True)
+    if not isinstance(log, LogSkeleton):  # None was an AttributeError ('to_json')
+        raise WoodcamError(f"log must be a woodcam.fields.skeleton.LogSkeleton; got {type(log).__name__}; "
+                           "pass read_log(...), read_gran1() or generate_log(...).to_skeleton()")
+    return write_text(check_path(path, "write_log: path", fix="e.g. 'logs/spruce.json'"),
+                      json.dumps(log.to_json()), mkdir=True)
 
 
 def read_log(path: PathLike) -> LogSkeleton:
     """Read a woodcam log file written by :func:`write_log` (or by hand, same keys)."""
-    path = Path(path)
+    path = check_path(path, "read_log: path", fix="a JSON log file written by write_log")
     if not path.is_file():
         raise WoodcamError(f"log file {str(path)!r} does not exist; give a path to a JSON file "
                            "written by woodcam (or use the real log: --real)")

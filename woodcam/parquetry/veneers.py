@@ -22,6 +22,7 @@ from typing import Literal, Protocol
 
 import numpy as np
 
+from .._checks import check_path
 from .._readers import PHOTO_ALPHA_FIX, read_photo_rgb
 from ..errors import WoodcamError
 
@@ -172,6 +173,7 @@ def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | 
     id : str, optional
         Default: the file's stem.
     """
+    path = check_path(path, "load_scan: path", fix="a PNG, JPEG or TIFF scan of the veneer")
     if (dpi is None) == (px_per_mm is None):
         raise WoodcamError(f"scan {str(path)!r}: give exactly one of dpi or px_per_mm; got "
                            f"dpi={dpi}, px_per_mm={px_per_mm} (e.g. SCAN.png:300 for 300 dpi)")
@@ -184,7 +186,8 @@ def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | 
     else:
         # white where the mean of R, G, B over 255 is above 0.5, on the 8-bit values: the float
         # image (12 bytes a pixel) of a scan-sized mask was made only to be thresholded
-        m = read_photo_rgb(Path(mask), "veneer mask", MASK_ALPHA_FIX).sum(axis=2, dtype=np.uint16) > 382
+        m = read_photo_rgb(check_path(mask, "load_scan: mask", fix="an image file or an (h, w) bool array"),
+                           "veneer mask", MASK_ALPHA_FIX).sum(axis=2, dtype=np.uint16) > 382
     return _check(Veneer(id or Path(path).stem, rgb, ppm, m, str(path)))
 
 

@@ -25,12 +25,13 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_number, check_vector
+from .._checks import as_floats, check_number, check_vector
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from ..tolerances import ARC_CHORD_TOL_MM
@@ -250,8 +251,11 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
         For an unsupported or malformed line, naming the line number and the word.
     """
     source = "<string>"
+    if not isinstance(text_or_path, (str, os.PathLike)):  # None was parsed as the program 'None'
+        raise WoodcamError(f"read_gcode: text_or_path must be the program text (str) or a file path; got "
+                           f"{text_or_path!r:.60}; pass read_gcode(Path('part.nc')) or the text itself")
     one_line = isinstance(text_or_path, str) and "\n" not in text_or_path
-    if isinstance(text_or_path, Path) or (one_line and (
+    if isinstance(text_or_path, os.PathLike) or (one_line and (
             Path(text_or_path).suffix.lower() in {".nc", ".gcode", ".ngc", ".tap", ".cnc", ".txt"}
             or _names_a_file(text_or_path))):
         path = Path(text_or_path)
@@ -268,8 +272,9 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
         raise WoodcamError(f"read_gcode: chord_tol_mm must be a finite number > 0, got "
                            f"{chord_tol_mm!r}; use e.g. {ARC_CHORD_TOL_MM}")
     start = DEFAULT_START_MM if start_mm is None else start_mm
-    start = np.asarray(start, float).reshape(-1)
-    if start.shape != (3,) or not np.all(np.isfinite(start)):
+    start = as_floats(start)  # 'abc' was numpy's bare ValueError
+    start = None if start is None else start.reshape(-1)
+    if start is None or start.shape != (3,) or not np.all(np.isfinite(start)):
         raise WoodcamError(f"read_gcode: start_mm must be three finite numbers (mm), got "
                            f"{start_mm!r}; e.g. (0, 0, 10)")
     mzero = None

@@ -50,6 +50,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._checks import check_path
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 
@@ -489,7 +490,7 @@ def parse_tool_spec(spec: str) -> Tool:
 def load_tool_table(path: PathLike) -> dict[int, Tool]:
     """Read a TOML tool table (module docstring), or a CAMotics JSON tool table
     (:func:`load_camotics_tools`), into ``{tool number: Tool}``."""
-    path = Path(path)
+    path = check_path(path, "load_tool_table: path", fix="a TOML or CAMotics JSON tool table")
     if path.suffix.lower() in (".json", ".camotics"):
         return load_camotics_tools(path)
     try:
