@@ -323,6 +323,12 @@ def _library_door_sweep():
         ("read_gcode None !", lambda: w.read_gcode(None), "read_gcode: text_or_path must be the program text .*got None"),
         ("read_gcode start str", lambda: w.read_gcode("G1 X1 F100\n", start_mm="abc"),
          "read_gcode: start_mm must be three finite numbers .*got 'abc'"),
+        ("Tool base class *", lambda: w.Tool(3.0), r"Tool is the base class .*parse_tool_spec\('flat:6'\)"),
+        ("simulate G-code text", lambda: w.simulate("G1 X5 F100\n", w.parse_tool_spec("flat:3"), (10, 10, 10)),
+         r"simulate: program must be a Program; got str; .*read_gcode"),
+        ("simulate str heightmap", lambda: w.simulate(w.read_gcode("G1 X5 F100\n"), w.parse_tool_spec("flat:3"),
+                                                      (10, 10, 10), resolution_mm=0.5, initial_heightmap="a"),
+         r"simulate: initial_heightmap must be a finite \(20, 20\) array .*got 'a'"),
     ]
 
 
@@ -426,3 +432,24 @@ def test_a_path_door_takes_a_str_and_a_path_like(tmp_path):
     (tmp_path / "p.nc").write_text("G1 X3 F100\n")
     prog = w.read_gcode(Where(tmp_path / "p.nc"))
     assert prog.source == str(tmp_path / "p.nc") and prog.end_mm[-1, 0] == 3.0
+
+
+def test_simulate_takes_a_list_heightmap_and_leaves_the_callers_array_alone():
+    """The valid call beside the refused ones: a flat 3 mm end mill 1 mm deep along Y = 5 mm of a
+    10 mm stock cuts the cells within 1.5 mm of it to 9 mm; the stock given as a list (the
+    same heights) gives the same cut, and a float array given is not cut in place."""
+    import numpy as np
+
+    import woodcam as w
+
+    prog = w.read_gcode("G0 X-3 Y5 Z2\nG1 Z-1 F100\nG1 X13\n")  # Z 0: the stock top
+    tool = w.parse_tool_spec("flat:3")
+    fresh = w.simulate(prog, tool, (10, 10, 10), resolution_mm=0.5).heightmap
+    ys = (np.arange(20) + 0.5) * 0.5
+    assert np.array_equal(fresh[np.abs(ys - 5) < 1.4], np.full(((np.abs(ys - 5) < 1.4).sum(), 20), 9.0))
+    assert np.array_equal(fresh[np.abs(ys - 5) > 1.6], np.full(((np.abs(ys - 5) > 1.6).sum(), 20), 10.0))
+    stock = np.full((20, 20), 10.0)
+    again = w.simulate(prog, {0: tool}, (10, 10, 10), resolution_mm=0.5, initial_heightmap=stock.tolist()).heightmap
+    assert np.array_equal(again, fresh)
+    w.simulate(prog, tool, (10, 10, 10), resolution_mm=0.5, initial_heightmap=stock)
+    assert np.all(stock == 10.0)

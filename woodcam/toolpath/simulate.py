@@ -43,6 +43,7 @@ from typing import Literal, Mapping
 
 import numpy as np
 
+from .._checks import as_floats
 from .._types import ArrayLike, Mesh
 from ..errors import WoodcamError
 from ..tolerances import SIM_CONTACT_TOL_MM
@@ -144,6 +145,9 @@ class SimResult:
 
 
 def _tool_lookup(program: Program, tools) -> dict[int, Tool]:
+    if not isinstance(program, Program):  # G-code text or None was an AttributeError ('tool')
+        raise WoodcamError(f"simulate: program must be a Program; got {type(program).__name__}; "
+                           "read it first: simulate(read_gcode(text_or_path), tools, size_mm)")
     used = sorted(set(np.unique(program.tool).tolist()))
     if isinstance(tools, Tool):
         return {t: tools for t in used}
@@ -252,12 +256,14 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     if initial_heightmap is None:
         hm = np.full((ny, nx), H, float)
     else:
-        hm = np.array(initial_heightmap, float)
-        if hm.shape != (ny, nx) or not np.isfinite(hm).all():
+        hm = as_floats(initial_heightmap)  # 'a' was numpy's bare ValueError
+        if hm is None or hm.shape != (ny, nx) or not np.isfinite(hm).all():
+            got = f"{initial_heightmap!r:.40}" if hm is None else hm.shape
             raise WoodcamError(f"simulate: initial_heightmap must be a finite ({ny}, {nx}) "
-                               f"array for this stock and resolution, got {hm.shape}; pass the "
+                               f"array for this stock and resolution, got {got}; pass the "
                                "heightmap of an earlier simulate() with the same size_mm and "
                                "resolution_mm")
+        hm = hm.copy()  # cut in place below: the caller's array stays as it was
     p0 = program.start_mm + off
     p1 = program.end_mm + off
     if not (np.isfinite(p0).all() and np.isfinite(p1).all()):

@@ -88,6 +88,10 @@ class Tool:
     kind = "tool"
 
     def __post_init__(self):
+        if type(self) is Tool:  # the base has no profile: Tool(3) was accepted, then simulate's NotImplementedError
+            raise WoodcamError("Tool is the base class of the cutters and has no profile; got Tool(...); "
+                               "make one with parse_tool_spec('flat:6') or a subclass such as "
+                               "woodcam.toolpath.FlatEndMill(6)")
         for f in fields(self):  # the subclasses' range checks compare: "60" was a bare TypeError
             v = getattr(self, f.name)
             if f.type == "float" and (isinstance(v, bool) or not isinstance(v, numbers.Real)):
