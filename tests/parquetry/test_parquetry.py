@@ -294,7 +294,7 @@ def test_sliced_leaf_pixels_are_the_mean_of_their_point_samples():
     averaged = slice_veneers(st, 1, (60, 40), px_per_mm=4.0)[0]
     e1, e3 = (float((edge(intensity(v.rgb)) ** 2).mean()) for v in (single, averaged))
     assert e3 < 0.9 * e1
-    with pytest.raises(WoodcamError, match="supersample must be in"):
+    with pytest.raises(WoodcamError, match="supersample must be an integer in"):
         slice_veneers(st, 1, (30, 20), supersample=0)
 
 

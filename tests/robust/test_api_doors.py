@@ -329,7 +329,79 @@ def _library_door_sweep():
         ("simulate str heightmap", lambda: w.simulate(w.read_gcode("G1 X5 F100\n"), w.parse_tool_spec("flat:3"),
                                                       (10, 10, 10), resolution_mm=0.5, initial_heightmap="a"),
          r"simulate: initial_heightmap must be a finite \(20, 20\) array .*got 'a'"),
+        ("parquetry params dict", lambda: w.build_parquetry(_target(), [_veneer()], {"patch_mm": 4}),
+         "params must be a ParquetryParams or None; got dict"),
+        ("parquetry 1-D target", lambda: w.build_parquetry(np.ones(10), [_veneer()], _small_params()),
+         r"target 0 must be an \(h, w, 3\) RGB or \(h, w\) grey image; got shape \(10,\)"),
+        ("parquetry empty target", lambda: w.build_parquetry(np.zeros((0, 0, 3)), [_veneer()], _small_params()),
+         r"target 0 must be .*got shape \(0, 0, 3\)"),
+        ("parquetry 0..255 float target *", lambda: w.build_parquetry(_target() * 255, [_veneer()], _small_params()),
+         r"target 0 must hold finite values in \[0, 1\]; got range \[.*, 25\d.*\] with 0 non-finite"),
+        ("parquetry NaN target *", lambda: w.build_parquetry(np.full((20, 20, 3), np.nan), [_veneer()], _small_params()),
+         r"target 0 must hold finite values .*got range \[nan, nan\] with 1200 non-finite"),
+        ("parquetry path target", lambda: w.build_parquetry("moon.png", [_veneer()], _small_params()),
+         "targets must be images .*not a path; got 'moon.png'"),
+        ("parquetry array veneer", lambda: w.build_parquetry(_target(), [np.zeros((10, 10, 3))], _small_params()),
+         r"veneers\[0\] must be a Veneer; got ndarray"),
+        ("parquetry names short", lambda: w.build_parquetry([_target(), _target()], [_veneer()], _small_params(), names=["a"]),
+         r"names must be one name per target \(2\); got \['a'\]"),
+        ("slice n_sheets 1.5", lambda: w.slice_veneers(_stock(), 1.5, (10, 10), px_per_mm=1), "n_sheets must be an integer >= 1; got 1.5"),
+        ("slice size of 3", lambda: w.slice_veneers(_stock(), 2, (10, 10, 10), px_per_mm=1),
+         r"size_mm must be 2 finite numbers; got \(10, 10, 10\)"),
+        ("slice NaN size", lambda: w.slice_veneers(_stock(), 2, (np.nan, 10), px_per_mm=1), "size_mm must be 2 finite numbers; got"),
+        ("slice NaN px_per_mm", lambda: w.slice_veneers(_stock(), 2, (10, 10), px_per_mm=np.nan),
+         "px_per_mm must be a finite number > 0; got nan"),
+        ("slice NaN thickness !", lambda: w.slice_veneers(_stock(), 2, (10, 10), thickness_mm=np.nan, px_per_mm=1),
+         "thickness_mm must be a finite number > 0; got nan"),
+        ("slice str start", lambda: w.slice_veneers(_stock(), 2, (10, 10), px_per_mm=1, start_mm="a"),
+         "start_mm must be a finite number; got 'a'"),
+        ("slice supersample 1.5 *", lambda: w.slice_veneers(_stock(), 2, (10, 10), px_per_mm=1, supersample=1.5),
+         r"supersample must be an integer in \[1, 16\]; got 1.5"),
+        ("load_scan dpi 'x'", lambda: w.load_scan(_scan_file(), dpi="x"), "dpi must be a finite number > 0; got 'x'"),
     ]
+
+
+def _stock():
+    import woodcam as w
+
+    return w.open_stock("builtin:flat-sawn")
+
+
+def _target():
+    """A 20 x 20 px RGB target in [0, 1] (seeded noise)."""
+    import numpy as np
+
+    return np.random.default_rng(1).random((20, 20, 3))
+
+
+def _veneer():
+    """A 40 x 40 px sheet at 4 px/mm (seeded noise)."""
+    import numpy as np
+
+    from woodcam.parquetry import Veneer
+
+    rgb = np.random.default_rng(0).random((40, 40, 3)).astype(np.float32)
+    return Veneer("v", rgb, 4.0, np.ones((40, 40), bool), "noise")
+
+
+def _small_params():
+    import woodcam as w
+
+    return w.ParquetryParams(image_size_mm=10, patch_mm=4, px_per_mm=2, n_rot=2, min_piece_mm=1,
+                             tool_diameter_mm=0.5)
+
+
+def _scan_file():
+    """A 40 x 40 px PNG scan in a temporary folder of this process."""
+    import tempfile
+    from pathlib import Path
+
+    import numpy as np
+    from PIL import Image
+
+    path = Path(tempfile.mkdtemp(prefix="woodcam-doors-")) / "scan.png"
+    Image.fromarray(np.random.default_rng(0).integers(0, 255, (40, 40, 3), dtype=np.uint8)).save(path)
+    return path
 
 
 def _baked_box():
@@ -400,6 +472,17 @@ def _library_door_valid_calls():
         ("knotted of ints", lambda: w.KnottedLogField(_small_log(), ring_width_mm=2, surface_smoothing=[1, 1], chunk=64,
                                                       table_samples=np.int64(32))([[0, 0, 50]]),
          lambda r: r.shape == (1,) and np.isfinite(r).all()),
+        ("parquetry of a uint8 target and numpy params", lambda: w.build_parquetry(
+            (_target() * 255).astype(np.uint8), [_veneer()], w.ParquetryParams(
+                image_size_mm=np.float32(10), patch_mm=4, px_per_mm=2, n_rot=np.int64(2), min_piece_mm=1,
+                tool_diameter_mm=0.5, single_use=np.bool_(True))),
+         lambda r: r.panels[0].target_rgb.shape == (16, 16, 3) and type(r.params.n_rot) is int
+         and type(r.params.image_size_mm) is float and r.params.single_use is True
+         and np.allclose(r.panels[0].target_rgb, w.build_parquetry((_target() * 255).astype(np.uint8) / 255.0, [_veneer()],
+                                                            _small_params()).panels[0].target_rgb)),
+        ("slice of ints and a list size", lambda: w.slice_veneers(_stock(), np.int64(2), [10, 5], px_per_mm=1,
+                                                                  start_mm=40, supersample=np.int32(1)),
+         lambda r: len(r) == 2 and r[0].rgb.shape == (5, 10, 3)),
         ("read_gcode of a list start", lambda: w.read_gcode("G1 X1 F100\n", start_mm=[0, 0, 5]).start_mm.tolist(),
          lambda r: r == [[0.0, 0.0, 5.0]]),
     ]

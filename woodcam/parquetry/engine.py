@@ -182,6 +182,26 @@ def prepare_target(rgb: np.ndarray, params: ParquetryParams, source_values: np.n
                      native_shape=native)
 
 
+def _check_target(t, k: int) -> np.ndarray:
+    """Target ``k`` as float RGB/grey in [0, 1]: uint8 is scaled by 1/255. A float image in
+    0..255 or a NaN was clipped to white/garbage silently, a 1-D or empty array a bare
+    ValueError/ZeroDivisionError in the resampling."""
+    a = np.asarray(t)
+    if a.dtype == np.uint8:
+        a = a.astype(np.float32) / 255.0
+    elif a.dtype == bool or not np.issubdtype(a.dtype, np.number):
+        raise WoodcamError(f"target {k} must be an image of numbers (uint8, or float in [0, 1]); got dtype "
+                           f"{a.dtype}; read it with woodcam.parquetry.veneers.read_image")
+    if a.ndim not in (2, 3) or (a.ndim == 3 and a.shape[2] != 3) or min(a.shape[:2], default=0) < 1:
+        raise WoodcamError(f"target {k} must be an (h, w, 3) RGB or (h, w) grey image; got shape {a.shape}")
+    finite = np.isfinite(a)
+    if not finite.all() or a.min() < 0 or a.max() > 1:
+        lo, hi = (a[finite].min(), a[finite].max()) if finite.any() else (np.nan, np.nan)
+        raise WoodcamError(f"target {k} must hold finite values in [0, 1]; got range [{lo:g}, {hi:g}] with "
+                           f"{int(np.sum(~finite))} non-finite; divide a 0..255 image by 255 (or pass it as uint8)")
+    return a
+
+
 class _OutOfWood(Exception):
     pass
 
@@ -206,13 +226,26 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     ParquetryRun ; when the wood runs out, ``complete`` is False, ``message`` says how many
     patches were placed, and the panels hold what was made (unplaced cells are -1).
     """
+    if params is not None and not isinstance(params, ParquetryParams):  # a dict: AttributeError 'check'
+        raise WoodcamError(f"params must be a ParquetryParams or None; got {type(params).__name__}; "
+                           "pass ParquetryParams(**settings)")
     params = (params or ParquetryParams()).check()
     if isinstance(targets, np.ndarray):
         targets = [targets]
     if not targets:
         raise WoodcamError("targets must hold at least one image; got none")
+    if isinstance(targets, str):
+        raise WoodcamError(f"targets must be images (arrays), not a path; got {targets!r:.60}; read it first "
+                           "with woodcam.parquetry.veneers.read_image(path, 'target')")
+    targets = [_check_target(t, k) for k, t in enumerate(targets)]
     if not veneers:
         raise WoodcamError("veneers must hold at least one sheet; got none (pass --veneer or --veneer-from)")
+    for i, v in enumerate(veneers):  # an image array was an AttributeError ('id')
+        if not isinstance(v, Veneer):
+            raise WoodcamError(f"veneers[{i}] must be a Veneer; got {type(v).__name__}; make one with "
+                               "load_scan(path, dpi=...) or slice_veneers(stock, ...)")
+    if names is not None and (isinstance(names, str) or len(names) != len(targets)):  # an IndexError
+        raise WoodcamError(f"names must be one name per target ({len(targets)}); got {names!r:.80}")
     ids = [v.id for v in veneers]
     if len(set(ids)) != len(ids):
         twice = sorted({i for i in ids if ids.count(i) > 1})

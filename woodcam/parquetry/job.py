@@ -18,10 +18,13 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 import warnings
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Literal
+
+import numpy as np
 
 from .._specs import absolute_spec
 from ..errors import WoodcamError, WoodcamWarning
@@ -189,17 +192,21 @@ def _check_type(what: str, v, annotation: str):
     if v is None and "None" in annotation:
         return v
     kind = annotation.split("|")[0].strip()
+    # numpy scalars are numbers and bools (np.float32(4) was 'must be a finite number'); they
+    # come back as Python's, which a job file's JSON can hold
     if kind == "bool":
-        ok = isinstance(v, bool)
+        ok = isinstance(v, (bool, np.bool_))
     elif kind in ("float", "int"):
-        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) \
+        ok = isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v) \
             and (kind == "float" or float(v).is_integer())
     else:  # a Literal: its own check below names the choices
         return v
     if not ok:
         rule = {"bool": "true or false", "float": "a finite number", "int": "a whole number"}[kind]
         raise WoodcamError(f"{what} must be {rule}; got {v!r}")
-    return int(v) if kind == "int" else v
+    if kind == "bool":
+        return bool(v)
+    return int(v) if kind == "int" else (v if isinstance(v, (int, float)) else float(v))
 
 
 def _entries(d: dict, key: str, where: str, need: str | None) -> list[dict]:

@@ -22,7 +22,7 @@ from typing import Literal, Protocol
 
 import numpy as np
 
-from .._checks import check_path
+from .._checks import check_number, check_path, check_vector
 from .._readers import PHOTO_ALPHA_FIX, read_photo_rgb
 from ..errors import WoodcamError
 
@@ -177,7 +177,8 @@ def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | 
     if (dpi is None) == (px_per_mm is None):
         raise WoodcamError(f"scan {str(path)!r}: give exactly one of dpi or px_per_mm; got "
                            f"dpi={dpi}, px_per_mm={px_per_mm} (e.g. SCAN.png:300 for 300 dpi)")
-    ppm = float(px_per_mm) if px_per_mm is not None else float(dpi) / MM_PER_INCH
+    ppm = (check_number(px_per_mm, "px_per_mm", lo=0, lo_open=True, fix="e.g. 11.8 (300 dpi)") if px_per_mm is not None
+           else check_number(dpi, "dpi", lo=0, lo_open=True, fix="the scan's resolution, e.g. 300") / MM_PER_INCH)
     rgb = read_image(path, "veneer scan")
     if mask is None:
         m = np.ones(rgb.shape[:2], bool)
@@ -249,16 +250,20 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
     if not hasattr(stock, "wood") or not hasattr(stock, "size_mm"):
         raise WoodcamError(f"stock must be a woodcam Stock (woodcam.open_stock(spec)); got "
                            f"{type(stock).__name__}")
-    if n_sheets < 1:
-        raise WoodcamError(f"n_sheets must be >= 1; got {n_sheets}")
-    if thickness_mm <= 0 or kerf_mm < 0:
-        raise WoodcamError(f"thickness_mm must be > 0 and kerf_mm >= 0; got {thickness_mm}, {kerf_mm}")
+    # each number by name: n_sheets=1.5 or '2', size_mm of 1 or 3 numbers, a NaN size or
+    # px_per_mm and a string start_mm were bare TypeError/ValueError; a NaN thickness, kerf or
+    # start_mm was refused as NaN 'points_mm'; supersample=1.5 ran as 1
+    n_sheets = int(check_number(n_sheets, "n_sheets", lo=1, integer=True, fix="e.g. 4"))
+    thickness_mm = check_number(thickness_mm, "thickness_mm", lo=0, lo_open=True, fix="leaf thickness, e.g. 0.6")
+    kerf_mm = check_number(kerf_mm, "kerf_mm", lo=0, fix="saw kerf between leaves, e.g. 0.4")
+    px_per_mm = check_number(px_per_mm, "px_per_mm", lo=0, lo_open=True, fix="sheet resolution, e.g. 4")
+    if start_mm is not None:
+        start_mm = check_number(start_mm, "start_mm", fix="the first plane along axis, mm, or None for the middle")
     if axis not in ("x", "y", "z"):
         raise WoodcamError(f"axis must be one of ['x', 'y', 'z']; got {axis!r}")
-    if not 1 <= int(supersample) <= 16:
-        raise WoodcamError(f"supersample must be in [1, 16]; got {supersample}")
-    ss = int(supersample)
-    w_mm, h_mm = size_mm
+    ss = int(check_number(supersample, "supersample", lo=1, hi=16, integer=True, fix="e.g. 3"))
+    size = check_vector(size_mm, "size_mm", n=2, fix="(width, height) of each sheet in mm, e.g. (200, 100)")
+    w_mm, h_mm = float(size[0]), float(size[1])
     nw, nh = round(w_mm * px_per_mm), round(h_mm * px_per_mm)
     if nw < 1 or nh < 1:
         raise WoodcamError(f"size_mm must give at least one pixel at {px_per_mm} px/mm; got {size_mm}")
