@@ -358,7 +358,27 @@ def _library_door_sweep():
         ("slice supersample 1.5 *", lambda: w.slice_veneers(_stock(), 2, (10, 10), px_per_mm=1, supersample=1.5),
          r"supersample must be an integer in \[1, 16\]; got 1.5"),
         ("load_scan dpi 'x'", lambda: w.load_scan(_scan_file(), dpi="x"), "dpi must be a finite number > 0; got 'x'"),
+        ("fit_block faces a string !", lambda: w.fit_block(w.Block((10, 10, 10)), "radial", faces="top"),
+         r"faces must be a list of face names or None; got the string 'top'; pass \['top'\]"),
+        ("detect_rings wavelength scalar", lambda: w.detect_rings(_photo(), px_per_mm=5, wavelength_range_px=5),
+         "wavelength_range_px must be \\(min, max\\) px; got 5"),
+        ("detect_rings wavelength str", lambda: w.detect_rings(_photo(), px_per_mm=5, wavelength_range_px=("a", "b")),
+         r"wavelength_range_px must be \(min, max\) px; got \('a', 'b'\)"),
+        ("load_part report list", lambda: w.load_part(_cube(), report=[]), "report must be a dict .*got list"),
     ]
+
+
+def _photo():
+    """A 64 x 64 px RGB noise photo (seeded)."""
+    import numpy as np
+
+    return np.random.default_rng(0).integers(0, 255, (64, 64, 3), dtype=np.uint8)
+
+
+def _cube():
+    import trimesh
+
+    return trimesh.creation.box((10, 10, 10))
 
 
 def _stock():
@@ -483,6 +503,10 @@ def _library_door_valid_calls():
         ("slice of ints and a list size", lambda: w.slice_veneers(_stock(), np.int64(2), [10, 5], px_per_mm=1,
                                                                   start_mm=40, supersample=np.int32(1)),
          lambda r: len(r) == 2 and r[0].rgb.shape == (5, 10, 3)),
+        ("detect_rings of a list wavelength range", lambda: w.detect_rings(_photo(), px_per_mm=5, wavelength_range_px=[4, 20]),
+         lambda r: r.ring_map.shape == (64, 64)),
+        ("load_part fills a report", lambda: (lambda rep: (w.load_part(_cube(), report=rep), rep)[1])({}),
+         lambda rep: isinstance(rep, dict) and len(rep) > 0),
         ("read_gcode of a list start", lambda: w.read_gcode("G1 X1 F100\n", start_mm=[0, 0, 5]).start_mm.tolist(),
          lambda r: r == [[0.0, 0.0, 5.0]]),
     ]

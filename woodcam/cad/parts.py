@@ -34,6 +34,7 @@ import contextlib
 import math
 import runpy
 import sys
+from collections.abc import MutableMapping
 from dataclasses import dataclass, field
 from numbers import Integral, Real
 from pathlib import Path
@@ -163,6 +164,9 @@ def load_part(
                                       and timeout_s > 0):
         raise WoodcamError(f"timeout_s must be a finite number of seconds > 0 or None; got "
                            f"{timeout_s!r}")
+    if report is not None and not isinstance(report, MutableMapping):  # [] was an AttributeError after the load
+        raise WoodcamError(f"report must be a dict to fill with the tessellation notes, or None; got "
+                           f"{type(report).__name__}; pass report={{}}")
     tess = _Tessellation(None if tolerance_mm is None else float(tolerance_mm),
                          math.radians(angular_tolerance_deg), _check_budget(max_triangles),
                          texels_per_mm=float(texels_per_mm))

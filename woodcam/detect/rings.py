@@ -74,6 +74,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._checks import as_floats
 from ..block.block import RingTrace
 from ..errors import WoodcamError
 
@@ -811,9 +812,10 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     if wavelength_range_px is None:
         wavelength_range_px = WAVELENGTH_RANGE_PX if not px_per_mm else (
             max(WAVELENGTH_RANGE_PX[0], RING_SPACING_RANGE_MM[0] * px_per_mm), RING_SPACING_RANGE_MM[1] * px_per_mm)
-    if len(tuple(wavelength_range_px)) != 2:
+    wl = as_floats(wavelength_range_px)  # 5 was a TypeError of tuple(), ('a', 'b') one of '<='
+    if wl is None or wl.shape != (2,):
         raise WoodcamError(f"wavelength_range_px must be (min, max) px; got {wavelength_range_px!r}")
-    lo, hi = wavelength_range_px
+    lo, hi = float(wl[0]), float(wl[1])
     if not 2.0 <= lo < hi:
         raise WoodcamError(f"wavelength_range_px must be (min, max) with 2 <= min < max; got {wavelength_range_px!r}")
     if lo > 0.5 * max(h, w):

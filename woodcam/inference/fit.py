@@ -136,6 +136,9 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         raise WoodcamError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise WoodcamError(f"seed must be an integer >= 0 (the evidence fit's random seed); got {seed!r}")
+    if isinstance(faces, str):  # 'top' was read letter by letter: "face must be ...; got 't'"
+        raise WoodcamError(f"faces must be a list of face names or None; got the string {faces!r}; "
+                           f"pass [{faces!r}]")
     if method == "neural":
         from .neural import fit_neural  # torch loads only here
 
