@@ -49,6 +49,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, Literal, get_args
 
+from ._checks import check_path
 from .errors import WoodcamError
 
 Engine = Literal["local", "dask"]
@@ -152,7 +153,7 @@ def read_records(out_dir: str | Path) -> dict[str, dict]:
 
     Temp files left by a killed run start with a dot and are not records.
     """
-    folder = Path(out_dir) / RECORDS_DIR
+    folder = check_path(out_dir, "read_records: out_dir", fix="the run folder given to run_many") / RECORDS_DIR
     if not folder.is_dir():
         raise WoodcamError(f"out_dir must be a run folder with a {RECORDS_DIR}/ sub-folder; "
                            f"{str(out_dir)!r} has none (run `woodcam bench run --out DIR` first)")

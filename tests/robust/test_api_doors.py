@@ -365,6 +365,17 @@ def _library_door_sweep():
         ("detect_rings wavelength str", lambda: w.detect_rings(_photo(), px_per_mm=5, wavelength_range_px=("a", "b")),
          r"wavelength_range_px must be \(min, max\) px; got \('a', 'b'\)"),
         ("load_part report list", lambda: w.load_part(_cube(), report=[]), "report must be a dict .*got list"),
+        ("read_block None", lambda: w.read_block(None), "read_block: folder must be a file path .*got None"),
+        ("write_block None", lambda: w.write_block(None, "b"), "block must be a woodcam.block.Block; got NoneType"),
+        ("write_block folder None", lambda: w.write_block(w.Block((10, 10, 10)), None),
+         "write_block: folder must be a file path .*got None"),
+        ("read_mokume None", lambda: w.read_mokume(None), "read_mokume: folder must be a file path .*got None"),
+        ("read_job None", lambda: w.read_job(None), "read_job: path must be a file path .*got None"),
+        ("write_job None", lambda: w.write_job(None, "j.json"), "job must be a ParquetryJob; got NoneType"),
+        ("read_records None", lambda: w.read_records(None), "read_records: out_dir must be a file path .*got None"),
+        ("repair_fabricability None", lambda: w.repair_fabricability(None),
+         "repair_fabricability: run must be a ParquetryRun; got NoneType"),
+        ("write_parquetry None", lambda: w.write_parquetry(None, "out"), "write_parquetry: run must be a ParquetryRun; got NoneType"),
     ]
 
 
@@ -560,3 +571,20 @@ def test_simulate_takes_a_list_heightmap_and_leaves_the_callers_array_alone():
     assert np.array_equal(again, fresh)
     w.simulate(prog, tool, (10, 10, 10), resolution_mm=0.5, initial_heightmap=stock)
     assert np.all(stock == 10.0)
+
+
+def test_a_block_and_a_job_written_to_a_path_like_read_back(tmp_path):
+    """The valid calls beside the refused ones: write_block/read_block and write_job/read_job
+    round-trip through a pathlib.Path and a str."""
+    import numpy as np
+
+    import woodcam as w
+    from woodcam.parquetry import ParquetryJob
+
+    block = w.synth_block(w.builtin_block("rift").field, (16, 12, 8), face_px=16, seed=0)
+    back = w.read_block(w.write_block(block, tmp_path / "b").parent)
+    assert back.size_mm == (16.0, 12.0, 8.0)
+    assert np.array_equal(back.faces["top"].photo, block.faces["top"].photo)
+    job = ParquetryJob([], [], [], [], _small_params())
+    again = w.read_job(str(w.write_job(job, str(tmp_path / "j.json"))))
+    assert again.params.patch_mm == 4 and again.params.n_rot == 2

@@ -53,6 +53,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._checks import check_path
 from .._types import ArrayLike, PathLike
 from .._atomic import all_or_nothing, atomic_path, write_text
 from .._readers import photo_rgb8, read_image_file
@@ -101,7 +102,10 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
     """
     if ring_map_bits not in (8, 16):
         raise WoodcamError(f"ring_map_bits must be 8 or 16; got {ring_map_bits!r}")
-    folder = Path(folder)
+    if not isinstance(block, Block):  # None was an AttributeError ('faces')
+        raise WoodcamError(f"block must be a woodcam.block.Block; got {type(block).__name__}; pass read_block(...), "
+                           "builtin_block(...) or synth_block(...)")
+    folder = check_path(folder, "write_block: folder", fix="the block folder to write, e.g. 'blocks/oak1'")
     folder.mkdir(parents=True, exist_ok=True)
     manifest_path = folder / MANIFEST
     if manifest_path.exists() and not overwrite:
@@ -165,7 +169,7 @@ def read_block(folder: PathLike, *, allow_outside: bool | None = None) -> Block:
     from .._readers import read_json_file
     from ._schema import check_manifest
 
-    folder = Path(folder)
+    folder = check_path(folder, "read_block: folder", fix="a folder written by write_block, or its block.json")
     if not folder.exists():
         raise WoodcamError(f"block folder {str(folder)!r} does not exist; pass a folder written by "
                            "write_block or 'woodcam block synth/from-photos' (or its block.json)")
@@ -407,7 +411,7 @@ def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *
     WoodcamError
         When the folder has no Mokume files, or images of one face differ in size.
     """
-    folder = Path(folder)
+    folder = check_path(folder, "read_mokume: folder", fix="a Mokume sample folder such as shared/data/mokume/H11")
     if not folder.is_dir():
         raise WoodcamError(f"folder must be a Mokume sample folder; {str(folder)!r} is not a directory")
     faces = {}

@@ -202,6 +202,13 @@ def _check_target(t, k: int) -> np.ndarray:
     return a
 
 
+def _check_run(run, where: str) -> None:
+    """``run`` must be what :func:`build_parquetry` returned (None was an AttributeError)."""
+    if not isinstance(run, ParquetryRun):
+        raise WoodcamError(f"{where}: run must be a ParquetryRun; got {type(run).__name__}; pass what "
+                           "build_parquetry(...) returned")
+
+
 class _OutOfWood(Exception):
     pass
 
@@ -433,6 +440,7 @@ def repair_fabricability(run: ParquetryRun, max_rounds: int = 4) -> dict[int, st
     from .cutpaths import check_piece, panel_outlines
     from .seams import labels_from_lines, straight_line
 
+    _check_run(run, "repair_fabricability")
     prm = run.params
     done: dict[int, str] = {}
     for p in run.panels:

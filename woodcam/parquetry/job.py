@@ -26,6 +26,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._checks import check_path
 from .._specs import absolute_spec
 from ..errors import WoodcamError, WoodcamWarning
 from ..limits import MAX_BLOCK_SIZE_MM
@@ -314,7 +315,7 @@ def read_job(path: str | Path) -> ParquetryJob:
     """Read a job file (paper layout + ``"woodcam"`` extras); paths resolved against its folder."""
     from .._readers import read_json_object
 
-    p = Path(path)
+    p = check_path(path, "read_job: path", fix="a parquetry job file (JSON)")
     d = read_json_object(p, "parquetry job file")
     where = f"job file {str(p)!r}:"
     if "targets" not in d:
@@ -403,6 +404,10 @@ def write_job(job: ParquetryJob, path: str | Path) -> Path:
     Its paths are written absolute: the job's are relative to the working folder (as given on
     the command line), a job file's to its own folder."""
     from .._atomic import write_text
+
+    if not isinstance(job, ParquetryJob):  # None was an AttributeError ('params')
+        raise WoodcamError(f"job must be a ParquetryJob; got {type(job).__name__}; read one with read_job(path)")
+    path = check_path(path, "write_job: path", fix="e.g. 'job.json'")
 
     def _abs(s):  # coffee.png typed in the working folder was read back as OUT/coffee.png
         return str(Path(s).absolute()) if s else s

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic import all_or_nothing, manifest_path, remove_stale, write_text
+from .._checks import check_path
 from ._io import atomic_write_png
 from .cutpaths import (
     Piece,
@@ -18,7 +19,7 @@ from .cutpaths import (
     transform_outline,
     write_dxf,
 )
-from .engine import ParquetryRun, feature_cost, ssim_vs_matched
+from .engine import ParquetryRun, _check_run, feature_cost, ssim_vs_matched
 from .job import ParquetryJob, write_job
 
 #: Thickness (mm) of the board in panel.glb: 0.6 mm veneer on a 1.5 mm birch ply substrate,
@@ -140,7 +141,8 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
 
     from PIL import Image
 
-    out = Path(out_dir)
+    _check_run(run, "write_parquetry")
+    out = check_path(out_dir, "write_parquetry: out_dir", fix="the folder to write the panels and cut files to")
     out.mkdir(parents=True, exist_ok=True)
     prm = run.params
     ppm = prm.px_per_mm
