@@ -3,6 +3,8 @@ names it (found by a sweep of bad inputs: these raised AttributeError or a 1.5 T
 
 from __future__ import annotations
 
+import functools
+
 import pytest
 
 from woodcam.errors import WoodcamError
@@ -376,7 +378,26 @@ def _library_door_sweep():
         ("repair_fabricability None", lambda: w.repair_fabricability(None),
          "repair_fabricability: run must be a ParquetryRun; got NoneType"),
         ("write_parquetry None", lambda: w.write_parquetry(None, "out"), "write_parquetry: run must be a ParquetryRun; got NoneType"),
+        ("fit_stem size of 2", lambda: w.fit_stem(_obs(), (40, 30)), r"size_mm must be three positive .*got \(40, 30\)"),
+        ("fit_stem K str", lambda: w.fit_stem(_obs(), (40, 30, 20), K="4"), "K must be an integer >= 0; got '4'"),
+        ("fit_stem M -1", lambda: w.fit_stem(_obs(), (40, 30, 20), M=-1), "M must be an integer >= 0; got -1"),
+        ("fit_stem n_search 0", lambda: w.fit_stem(_obs(), (40, 30, 20), n_search=0), "n_search must be an integer >= 20; got 0"),
+        ("fit_stem n_starts 0 *", lambda: w.fit_stem(_obs(), (40, 30, 20), n_starts=0), "n_starts must be an integer >= 1; got 0"),
+        ("fit_stem workers 0 *", lambda: w.fit_stem(_obs(), (40, 30, 20), workers=0), "workers must be an integer >= 1; got 0"),
+        ("fit_stem seed str", lambda: w.fit_stem(_obs(), (40, 30, 20), seed="a"), "seed must be an integer >= 0; got 'a'"),
+        ("fit_stem init int", lambda: w.fit_stem(_obs(), (40, 30, 20), init=5), "init must be a StemField .*got int"),
+        ("fit_stem NaN tilt", lambda: w.fit_stem(_obs(), (40, 30, 20), tilt_prior_deg=np.nan),
+         "tilt_prior_deg must be a finite number > 0; got nan"),
     ]
+
+
+@functools.lru_cache(maxsize=1)
+def _obs():
+    """The labelled ring observations of a small synthetic flat-sawn block (one render)."""
+    import woodcam as w
+    from woodcam.inference.observations import gather_observations
+
+    return gather_observations(w.synth_block(w.builtin_block("flat-sawn").field, (40, 30, 20), face_px=32, seed=0))
 
 
 def _photo():
@@ -518,6 +539,9 @@ def _library_door_valid_calls():
          lambda r: r.ring_map.shape == (64, 64)),
         ("load_part fills a report", lambda: (lambda rep: (w.load_part(_cube(), report=rep), rep)[1])({}),
          lambda rep: isinstance(rep, dict) and len(rep) > 0),
+        ("fit_stem of numpy ints and a list size", lambda: w.fit_stem(
+            _obs(), [40, 30, 20], K=np.int64(2), n_search=np.int32(60), n_fit=60, n_starts=1, n_final=1, seed=np.int64(0),
+            history=False)(np.array([[20.0, 15.0, 10.0]])), lambda r: r.shape == (1,) and np.isfinite(r).all()),
         ("read_gcode of a list start", lambda: w.read_gcode("G1 X1 F100\n", start_mm=[0, 0, 5]).start_mm.tolist(),
          lambda r: r == [[0.0, 0.0, 5.0]]),
     ]

@@ -50,10 +50,12 @@ from itertools import islice
 
 import numpy as np
 
+from .._checks import check_number
 from .._parallel import map_processes
 from .._types import ArrayLike
 from ..errors import WoodcamError
 from ..fields.base import check_points
+from ..frames import check_size
 from ..tolerances import (RING_HISTORY_MIN_STEP, RING_HISTORY_PRIOR_POINTS, RING_HISTORY_ROUNDS,
                           STEM_AXIAL_SD, STEM_CURVE_PRIOR_MM, STEM_HARMONIC_SD, STEM_PRIOR_YEARS,
                           STEM_RADIAL_SD, STEM_TILT_PRIOR_DEG)
@@ -345,8 +347,21 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
     if len(obs.points_mm) < 20 or len(np.unique(obs.years)) < 3:
         raise WoodcamError(f"fit_stem needs at least 20 ring points on 3 rings; got {len(obs.points_mm)} "
                            f"points on {len(np.unique(obs.years))} rings: trace more rings")
-    if not (tilt_prior_deg > 0 and curve_prior_mm > 0):
-        raise WoodcamError(f"tilt_prior_deg and curve_prior_mm must be > 0; got {tilt_prior_deg}, {curve_prior_mm}")
+    # the plain arguments by name: a size of 2 was a broadcast ValueError, K='4' a TypeError,
+    # M=-1 an IndexError, n_search=0 a reshape ValueError, seed='a' numpy's TypeError, init=5
+    # an AttributeError; n_starts=0 and workers=0 ran as if 1
+    size_mm = check_size(size_mm)
+    K, M, P = (int(check_number(v, name, lo=lo, integer=True, fix="the stem model's order, e.g. K=4, M=1, P=2"))
+               for v, name, lo in ((K, "K", 0), (M, "M", 0), (P, "P", 1)))
+    n_search, n_fit = (int(check_number(v, name, lo=20, integer=True, fix="ring points, e.g. 500"))
+                       for v, name in ((n_search, "n_search"), (n_fit, "n_fit")))
+    n_starts, n_final, workers = (int(check_number(v, name, lo=1, integer=True, fix="e.g. 2"))
+                                  for v, name in ((n_starts, "n_starts"), (n_final, "n_final"), (workers, "workers")))
+    seed = int(check_number(seed, "seed", lo=0, integer=True, fix="same seed, same fit"))
+    if init is not None and not isinstance(init, StemField):
+        raise WoodcamError(f"init must be a StemField (an earlier fit_stem) or None; got {type(init).__name__}")
+    tilt_prior_deg, curve_prior_mm = (check_number(v, name, lo=0, lo_open=True, fix="a prior's standard deviation")
+                                      for v, name in ((tilt_prior_deg, "tilt_prior_deg"), (curve_prior_mm, "curve_prior_mm")))
     n = len(obs.points_mm)
     off = np.zeros(n) if offset_years is None else np.asarray(offset_years, float).reshape(-1)
     if off.shape != (n,) or not np.all(np.isfinite(off)):
