@@ -388,6 +388,20 @@ def _library_door_sweep():
         ("fit_stem init int", lambda: w.fit_stem(_obs(), (40, 30, 20), init=5), "init must be a StemField .*got int"),
         ("fit_stem NaN tilt", lambda: w.fit_stem(_obs(), (40, 30, 20), tilt_prior_deg=np.nan),
          "tilt_prior_deg must be a finite number > 0; got nan"),
+        ("fit_evidence obs None", lambda: w.fit_evidence(None, (40, 30, 20)), "obs must be RingObservations .*got NoneType"),
+        ("evaluate_fit pixel 0", lambda: w.evaluate_fit(fld, fld, (40, 30, 20), pixel_mm=0), "pixel_mm must be a finite number > 0; got 0"),
+        ("evaluate_fit NaN pixel", lambda: w.evaluate_fit(fld, fld, (40, 30, 20), pixel_mm=np.nan),
+         "pixel_mm must be a finite number > 0; got nan"),
+        ("evaluate_fit plane of 1", lambda: w.evaluate_fit(fld, fld, (40, 30, 20), planes=[1]), "planes must be CutPlanes; got 1"),
+        ("evaluate_fit NaN field", lambda: w.evaluate_fit(fld, lambda p: np.full(len(p), np.nan), (40, 30, 20), pixel_mm=1),
+         "field must give finite years in the block; it gave \\d+ NaN/inf of \\d+ points of cut plane 'z=0.5'"),
+        ("leave_one_face_out None", lambda: w.leave_one_face_out(None), "block must be a woodcam.block.Block; got NoneType"),
+        ("leave_one_face_out reference 5", lambda: w.leave_one_face_out(w.Block((9, 9, 9)), reference=5),
+         "reference must be a woodcam.block.Block; got int"),
+        ("leave_one_face_out methods str !", lambda: w.leave_one_face_out(w.Block((9, 9, 9)), methods="radial"),
+         r"methods must be a list of method names; got the string 'radial'; pass \['radial'\]"),
+        ("leave_one_face_out progress 5", lambda: w.leave_one_face_out(w.Block((9, 9, 9)), progress=5),
+         "progress must be a callable .*got int"),
     ]
 
 
@@ -542,6 +556,8 @@ def _library_door_valid_calls():
         ("fit_stem of numpy ints and a list size", lambda: w.fit_stem(
             _obs(), [40, 30, 20], K=np.int64(2), n_search=np.int32(60), n_fit=60, n_starts=1, n_final=1, seed=np.int64(0),
             history=False)(np.array([[20.0, 15.0, 10.0]])), lambda r: r.shape == (1,) and np.isfinite(r).all()),
+        ("evaluate_fit of a field against itself", lambda: w.evaluate_fit(fld, fld, [40, 30, 20], pixel_mm=1)[0],
+         lambda summary: summary["matched_1"] == 100.0),
         ("read_gcode of a list start", lambda: w.read_gcode("G1 X1 F100\n", start_mm=[0, 0, 5]).start_mm.tolist(),
          lambda r: r == [[0.0, 0.0, 5.0]]),
     ]

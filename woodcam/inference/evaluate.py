@@ -22,6 +22,7 @@ from dataclasses import dataclass, field as dc_field
 import numpy as np
 
 from .._atomic import write_figure, write_text
+from .._checks import check_number
 from .._types import ArrayLike, GrowthFieldLike, PathLike
 from ..errors import WoodcamError, require
 from ..fields.base import evaluate, has_uncertainty
@@ -185,6 +186,10 @@ def plane_lines(field, sample: PlaneSample, step_mm: float | None = None):
     """Ring lines ``(points (m, 2) mm, years (m,))`` of ``field`` on a sampled plane."""
     step = sample.pixel_mm if step_mm is None else step_mm
     g = evaluate(field, sample.points_mm.reshape(-1, 3)).reshape(sample.inside.shape)
+    bad = int(np.sum(~np.isfinite(g[sample.inside])))
+    if bad:  # NaN years were int()'s ValueError in the iso-line tracer
+        raise WoodcamError(f"field must give finite years in the block; it gave {bad} NaN/inf of "
+                           f"{int(sample.inside.sum())} points of cut plane {sample.plane.name!r}")
     return ring_lines(g, sample.inside, sample.pixel_mm, step)
 
 
@@ -249,6 +254,14 @@ def evaluate_fits(true_field, fitted: dict, size_mm, planes=DEFAULT_PLANES,
 
     Returns dict name -> ``(summary, scores)``.
     """
+    # pixel_mm=0 or NaN was np.arange's ValueError, a plane that is not a CutPlane an AttributeError
+    pixel_mm = check_number(pixel_mm, "pixel_mm", lo=0, lo_open=True,
+                            fix=f"the cut planes' sample spacing in mm, e.g. {EVAL_PIXEL_MM}")
+    check_size(size_mm)
+    for p in planes:
+        if not isinstance(p, CutPlane):
+            raise WoodcamError(f"planes must be CutPlanes; got {p!r:.60}; e.g. CutPlane('z=0.5', (0.5, 0.5, 0.5), "
+                               "(0, 0, 1)) or leave planes out for the seven of Table 1")
     out = {name: [] for name in fitted}
     for p in planes:
         sample = sample_plane(p, size_mm, pixel_mm)

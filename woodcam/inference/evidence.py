@@ -700,6 +700,9 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     -------
     EvidenceFit
     """
+    if not isinstance(obs, RingObservations):  # None was an AttributeError ('labelled')
+        raise WoodcamError(f"obs must be RingObservations (woodcam.inference.observations.gather_observations "
+                           f"of a block); got {type(obs).__name__}")
     if blend not in BLEND_MODES:
         raise WoodcamError(f"blend must be one of {', '.join(BLEND_MODES)}; got {blend!r}")
     if residual and blend == "everywhere":

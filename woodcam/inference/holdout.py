@@ -192,6 +192,16 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
     :data:`STRAIGHT_OWN` and ``"all faces"``: each ``method -> list of FaceScore``;
     ``"fit_s"``: method -> mean held-out fit seconds; ``"table"``: markdown text.
     """
+    from ..block.block import Block
+
+    for name, b in (("block", block), ("reference", reference)):  # None was an AttributeError ('faces')
+        if not isinstance(b, Block) and not (name == "reference" and b is None):
+            raise WoodcamError(f"{name} must be a woodcam.block.Block; got {type(b).__name__}; pass read_block(...)"
+                               + (" or None" if name == "reference" else ""))
+    if isinstance(methods, str):  # 'radial' was read letter by letter: "method must be ...; got 'r'"
+        raise WoodcamError(f"methods must be a list of method names; got the string {methods!r}; pass [{methods!r}]")
+    if progress is not None and not callable(progress):
+        raise WoodcamError(f"progress must be a callable taking one line of text, or None; got {type(progress).__name__}")
     ref_block = block if reference is None else reference
     faces = [n for n, f in block.faces.items() if f.has_rings and n in ref_block.faces
              and ref_block.faces[n].ring_map is not None]
