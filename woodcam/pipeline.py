@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ._types import Mesh, PathLike
+from .errors import WoodcamError
 from .stock import Stock
 from .tolerances import DEFAULT_MAX_ATLAS_PX
 
@@ -104,9 +105,11 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
     ``.obj``/``.mtl``/``.png`` beside it when ``obj``, and the rendered ``*_view.png`` (or the
     given screenshot path). Returns ``out_glb`` as a Path; raises WoodcamError naming the path."""
     from ._atomic import check_output_path
+    from ._checks import check_path
     from .export import obj_siblings
 
-    out_glb = check_output_path(out_glb, suffixes=(".glb",), what=what, mkdir=True)
+    out_glb = check_output_path(check_path(out_glb, what, fix="e.g. 'out/part.glb'"), suffixes=(".glb",),
+                                what=what, mkdir=True)
     if obj:
         for sibling in (out_glb.with_suffix(".obj"), *obj_siblings(out_glb.with_suffix(".obj"))):
             suffix = sibling.suffix
@@ -117,6 +120,13 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
     elif screenshot:
         check_output_path(screenshot, suffixes=(".png",), what="--screenshot", mkdir=True)
     return out_glb
+
+
+def _check_stock(stock) -> None:
+    """``stock`` must be a :class:`Stock` (None was an AttributeError, 'size_mm' or 'wood')."""
+    if not isinstance(stock, Stock):
+        raise WoodcamError(f"stock must be a woodcam Stock; got {type(stock).__name__}; pass "
+                           "woodcam.open_stock('builtin:flat-sawn')")
 
 
 def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_mm: float = 10.0,
@@ -143,6 +153,9 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
     from .cad import carve, load_part
     from .tolerances import MAX_PART_TRIANGLES
 
+    _check_stock(stock)
+    if isinstance(place, str):  # 'center' was read letter by letter: "--place 'c' is not a placement"
+        raise WoodcamError(f"place must be a list of placement operations; got the string {place!r}; pass [{place!r}]")
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)  # before minutes of work
     result = PartPreview(out_glb.stem, stages=stages)
     if progress and stages is None:  # a bar of its own
@@ -183,8 +196,14 @@ def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: 
                  max_atlas_px: int = DEFAULT_MAX_ATLAS_PX, part_report: bool = False) -> PartPreview:
     """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files: the GLB
     in metres, Y up (glTF's convention); the OBJ in ``obj_units`` with ``obj_up`` up."""
+    import trimesh
+
     from .bake import bake
 
+    _check_stock(stock)
+    if not isinstance(mesh, trimesh.Trimesh):  # None was an AttributeError ('volume')
+        raise WoodcamError(f"mesh must be a trimesh.Trimesh (a carved part's surface); got {type(mesh).__name__}; "
+                           "pass carve(part, stock.size_mm).mesh")
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
     result = result or PartPreview(out_glb.stem)
     result.volume_mm3 = abs(float(mesh.volume))  # as the part report's (advise.part_report)

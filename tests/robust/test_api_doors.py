@@ -402,6 +402,20 @@ def _library_door_sweep():
          r"methods must be a list of method names; got the string 'radial'; pass \['radial'\]"),
         ("leave_one_face_out progress 5", lambda: w.leave_one_face_out(w.Block((9, 9, 9)), progress=5),
          "progress must be a callable .*got int"),
+        ("preview_mesh None", lambda: w.preview_mesh(None, _stock(), "p.glb", obj=False, screenshot=False),
+         "mesh must be a trimesh.Trimesh .*got NoneType"),
+        ("preview_mesh stock None", lambda: w.preview_mesh(_cube(), None, "p.glb", obj=False, screenshot=False),
+         "stock must be a woodcam Stock; got NoneType"),
+        ("preview_mesh out None", lambda: w.preview_mesh(_cube(), _stock(), None, obj=False, screenshot=False),
+         "--out must be a file path .*got None"),
+        ("preview_part stock None", lambda: w.preview_part(_cube(), None, "p.glb", obj=False, screenshot=False),
+         "stock must be a woodcam Stock; got NoneType"),
+        ("preview_part place str !", lambda: w.preview_part(_cube(), _stock(), "p.glb", place="center", obj=False,
+                                                            screenshot=False),
+         r"place must be a list of placement operations; got the string 'center'; pass \['center'\]"),
+        ("scene resolution 0 *", lambda: w.SceneOptions(resolution_mm=0), "resolution_mm must be a finite number > 0; got 0"),
+        ("scene resolution NaN *", lambda: w.SceneOptions(resolution_mm=np.nan), "resolution_mm must be a finite number > 0; got nan"),
+        ("scene max_samples 0 *", lambda: w.SceneOptions(max_samples=0), "max_samples must be an integer >= 1; got 0"),
     ]
 
 
@@ -558,6 +572,8 @@ def _library_door_valid_calls():
             history=False)(np.array([[20.0, 15.0, 10.0]])), lambda r: r.shape == (1,) and np.isfinite(r).all()),
         ("evaluate_fit of a field against itself", lambda: w.evaluate_fit(fld, fld, [40, 30, 20], pixel_mm=1)[0],
          lambda summary: summary["matched_1"] == 100.0),
+        ("scene options of numpy numbers", lambda: w.SceneOptions(resolution_mm=np.float32(0.5), max_samples=np.int64(1000)),
+         lambda o: o.resolution_mm == 0.5 and o.max_samples == 1000 and o.samples_cap(True) == 1000),
         ("read_gcode of a list start", lambda: w.read_gcode("G1 X1 F100\n", start_mm=[0, 0, 5]).start_mm.tolist(),
          lambda r: r == [[0.0, 0.0, 5.0]]),
     ]

@@ -33,7 +33,7 @@ import numpy as np
 
 from .._types import ArrayLike, Mesh, PathLike, WoodLike
 from ..errors import WoodcamError, require
-from .._checks import check_vector
+from .._checks import check_number, check_vector
 from ..frames import check_size
 from ..tolerances import ON_FACE_TOL_MM
 from ..units import say_length
@@ -567,6 +567,12 @@ class SceneOptions:
         if self.cut_normal is not None:
             object.__setattr__(self, "cut_normal",
                                tuple(check_vector(self.cut_normal, "cut_normal", unit=True)))
+        # resolution_mm=0 or NaN and max_samples=0 were taken and reached the section sampler
+        object.__setattr__(self, "resolution_mm", check_number(
+            self.resolution_mm, "resolution_mm", lo=0, lo_open=True, fix=f"the cut's sample spacing, e.g. {SECTION_RESOLUTION_MM}"))
+        if self.max_samples is not None:
+            object.__setattr__(self, "max_samples", int(check_number(
+                self.max_samples, "max_samples", lo=1, integer=True, fix="a cap on the cut's samples, or None")))
 
     @classmethod
     def merged(cls, options: SceneOptions | None, keywords: dict) -> SceneOptions:
