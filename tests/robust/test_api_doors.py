@@ -416,6 +416,14 @@ def _library_door_sweep():
         ("scene resolution 0 *", lambda: w.SceneOptions(resolution_mm=0), "resolution_mm must be a finite number > 0; got 0"),
         ("scene resolution NaN *", lambda: w.SceneOptions(resolution_mm=np.nan), "resolution_mm must be a finite number > 0; got nan"),
         ("scene max_samples 0 *", lambda: w.SceneOptions(max_samples=0), "max_samples must be an integer >= 1; got 0"),
+        ("block meta list *", lambda: w.Block((10, 10, 10), meta=[1]), "Block.meta must be a dict of block metadata; got list"),
+        ("face extras list *", lambda: w.Face("top", (8, 8), extras=[1]), "extras of face 'top' must be a dict .*got list"),
+        ("face NaN ring map *", lambda: w.Face("top", (8, 8), ring_map=np.full((8, 8), np.nan)),
+         r"ring_map of face 'top' must hold finite values in \[0, 1\]; got range \[nan, nan\] with 64 non-finite"),
+        ("face photo 0..255 float *", lambda: w.Face("top", (8, 8), photo=np.full((8, 8, 3), 200.0)),
+         r"photo of face 'top' must hold finite values in \[0, 1\]; got range \[200, 200\]"),
+        ("face photo of ints", lambda: w.Face("top", (8, 8), photo=np.full((8, 8, 3), 200)),
+         "photo of face 'top' must be uint8 .*got dtype int64"),
     ]
 
 
@@ -574,6 +582,9 @@ def _library_door_valid_calls():
          lambda summary: summary["matched_1"] == 100.0),
         ("scene options of numpy numbers", lambda: w.SceneOptions(resolution_mm=np.float32(0.5), max_samples=np.int64(1000)),
          lambda o: o.resolution_mm == 0.5 and o.max_samples == 1000 and o.samples_cap(True) == 1000),
+        ("face of a uint8 photo and a float ring map", lambda: w.Face("top", [8, 8], photo=np.full((8, 8, 3), 200, np.uint8),
+                                                                     ring_map=np.full((8, 8), 0.5, np.float32), extras={"k": 1}),
+         lambda f: f.shape == (8, 8) and f.has_rings and f.photo.dtype == np.uint8),
         ("read_gcode of a list start", lambda: w.read_gcode("G1 X1 F100\n", start_mm=[0, 0, 5]).start_mm.tolist(),
          lambda r: r == [[0.0, 0.0, 5.0]]),
     ]

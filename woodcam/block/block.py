@@ -141,6 +141,9 @@ class Face:
             self.photo = _check_image(self.photo, self.shape, 3, f"photo of face {self.name!r}")
         if self.ring_map is not None:
             self.ring_map = _check_image(self.ring_map, self.shape, 0, f"ring_map of face {self.name!r}")
+        if not isinstance(self.extras, dict):  # a list was an AttributeError at the first .get
+            raise WoodcamError(f"extras of face {self.name!r} must be a dict (e.g. {{'knot_mask': mask}}); got "
+                               f"{type(self.extras).__name__}")
 
     @property
     def has_rings(self) -> bool:
@@ -152,6 +155,15 @@ def _check_image(im, shape, channels: int, what: str) -> np.ndarray:
     want = tuple(shape) + ((channels,) if channels else ())
     if a.shape != want:
         raise WoodcamError(f"{what} must have shape {want} like the face; got {a.shape}")
+    # a NaN ring map or a float photo in 0..255 was taken and read as rings/wood everywhere
+    if a.dtype != np.uint8:
+        if not np.issubdtype(a.dtype, np.floating):
+            raise WoodcamError(f"{what} must be uint8 (0..255) or float (0..1); got dtype {a.dtype}")
+        finite = np.isfinite(a)
+        if not finite.all() or a.min() < -1e-3 or a.max() > 1 + 1e-3:
+            lo, hi = (float(a[finite].min()), float(a[finite].max())) if finite.any() else (np.nan, np.nan)
+            raise WoodcamError(f"{what} must hold finite values in [0, 1]; got range [{lo:g}, {hi:g}] with "
+                               f"{int(np.sum(~finite))} non-finite; divide a 0..255 image by 255 (or pass uint8)")
     return a
 
 
@@ -188,6 +200,8 @@ class Block:
                                f"(woodcam.limits.MAX_BLOCK_SIZE_MM); got {self.size_mm}")
         if not isinstance(self.faces, dict):
             raise WoodcamError(f"Block.faces must be a dict face name -> Face; got {type(self.faces).__name__}")
+        if not isinstance(self.meta, dict):  # a list was taken and failed at write_block or the fit
+            raise WoodcamError(f"Block.meta must be a dict of block metadata; got {type(self.meta).__name__}")
         faces = {}
         for key, face in self.faces.items():
             if not isinstance(face, Face):
