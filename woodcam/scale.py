@@ -247,6 +247,10 @@ def _attempt(fn: Callable[[str], Any], key: str, retries: int, memory_limit_mb: 
 # -- the driver -----------------------------------------------------------------------------------
 
 def _check_keys(keys: Iterable) -> list[str]:
+    # a string was run as one key per letter, None was a bare "'NoneType' object is not iterable"
+    if isinstance(keys, (str, bytes)) or not isinstance(keys, Iterable):
+        raise WoodcamError(f"keys must be an iterable of keys (a list of str); got {keys!r:.60}"
+                           + (f"; pass [{keys!r}]" if isinstance(keys, str) else ""))
     keys = [str(k) for k in keys]
     bad = [k for k in keys if not _KEY_RE.match(k)]
     if bad:
@@ -298,6 +302,8 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
     -------
     RunSummary
     """
+    if not callable(fn):  # None ran and wrote a 'failed' record ("'NoneType' object is not callable") per key
+        raise WoodcamError(f"fn must be a callable key (str) -> JSON-serialisable; got {type(fn).__name__}")
     if engine not in ENGINES:
         raise WoodcamError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
     if not isinstance(retries, int) or retries < 0:

@@ -424,6 +424,13 @@ def _library_door_sweep():
          r"photo of face 'top' must hold finite values in \[0, 1\]; got range \[200, 200\]"),
         ("face photo of ints", lambda: w.Face("top", (8, 8), photo=np.full((8, 8, 3), 200)),
          "photo of face 'top' must be uint8 .*got dtype int64"),
+        ("arf str", lambda: w.arf("a"), "years must be growth times .*got 'a'"),
+        ("run_many fn None *", lambda: w.run_many(None, ["a"], "runs", progress=False), "fn must be a callable .*got NoneType"),
+        ("run_many keys None", lambda: w.run_many(str, None, "runs", progress=False), "keys must be an iterable of keys .*got None"),
+        ("run_many keys str *", lambda: w.run_many(str, "abc", "runs", progress=False),
+         r"keys must be an iterable .*got 'abc'; pass \['abc'\]"),
+        ("load_scan NaN mask *", lambda: w.load_scan(_scan_file(), dpi=300, mask=np.full((40, 40), np.nan)),
+         "load_scan: mask must be an \\(h, w\\) bool array .*got dtype float64 with NaN/inf"),
     ]
 
 
@@ -585,6 +592,9 @@ def _library_door_valid_calls():
         ("face of a uint8 photo and a float ring map", lambda: w.Face("top", [8, 8], photo=np.full((8, 8, 3), 200, np.uint8),
                                                                      ring_map=np.full((8, 8), 0.5, np.float32), extras={"k": 1}),
          lambda f: f.shape == (8, 8) and f.has_rings and f.photo.dtype == np.uint8),
+        ("arf of a list", lambda: w.arf([0.5, 2.25]), lambda r: np.allclose(r, [0.25, 0.0625])),
+        ("load_scan of a list mask", lambda: w.load_scan(_scan_file(), px_per_mm=4, mask=[[i < 20] * 40 for i in range(40)]).mask,
+         lambda m: m.shape == (40, 40) and m[:20].all() and not m[20:].any()),
         ("read_gcode of a list start", lambda: w.read_gcode("G1 X1 F100\n", start_mm=[0, 0, 5]).start_mm.tolist(),
          lambda r: r == [[0.0, 0.0, 5.0]]),
     ]

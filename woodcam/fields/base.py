@@ -99,7 +99,9 @@ def arf(years: ArrayLike) -> np.ndarray:
     Always apply it to a (possibly interpolated) growth time, never interpolate its output:
     interpolating the ARF would blur the sharp latewood -> earlywood step at ring boundaries.
     """
-    g = np.asarray(years, dtype=float)
+    g = as_floats(years)
+    if g is None:  # 'a' was numpy's bare "could not convert string to float"
+        raise WoodcamError(f"years must be growth times (numbers); got {years!r:.60}")
     return np.mod(g, 1.0) ** 2
 
 

@@ -182,8 +182,13 @@ def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | 
     rgb = read_image(path, "veneer scan")
     if mask is None:
         m = np.ones(rgb.shape[:2], bool)
-    elif isinstance(mask, np.ndarray):
-        m = mask.astype(bool)
+    elif isinstance(mask, (np.ndarray, list)):
+        m = np.asarray(mask)
+        if m.dtype != bool and not (np.issubdtype(m.dtype, np.number) and np.all(np.isfinite(m))):
+            # NaN was True (usable wood) silently, a list Path()'s TypeError
+            raise WoodcamError(f"load_scan: mask must be an (h, w) bool array (True = usable wood) or an image file; "
+                               f"got dtype {m.dtype}" + (" with NaN/inf" if np.issubdtype(m.dtype, np.number) else ""))
+        m = m.astype(bool)
     else:
         # white where the mean of R, G, B over 255 is above 0.5, on the 8-bit values: the float
         # image (12 bytes a pixel) of a scan-sized mask was made only to be thresholded
