@@ -38,6 +38,7 @@ block and sample folders are only read, never written (they are often read-only 
 
 from __future__ import annotations
 
+import os
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -129,6 +130,10 @@ def open_stock(spec: str, *, species: str | None = None,
     """
     if appearance not in ("colormap", "neural"):
         raise WoodcamError(f"appearance must be one of ['colormap', 'neural']; got {appearance!r}")
+    # None was read as the spec 'None' and '' as the folder '.', neither the value given
+    if not isinstance(spec, (str, os.PathLike)) or not str(spec).strip():
+        raise WoodcamError(f"spec must be a block spec (str): 'builtin:NAME', 'log:LOG@KNOT', 'woodify:PATH' or "
+                           f"a block folder; got {spec!r}; e.g. open_stock('builtin:flat-sawn')")
     parsed = parse_spec(spec)
     # built-in, log and woodify blocks have no photos: their colour map is the constructor's
     # (a folder's photos are known once it is read: _real_block_stock checks again)

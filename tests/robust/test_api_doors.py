@@ -431,6 +431,9 @@ def _library_door_sweep():
          r"keys must be an iterable .*got 'abc'; pass \['abc'\]"),
         ("load_scan NaN mask *", lambda: w.load_scan(_scan_file(), dpi=300, mask=np.full((40, 40), np.nan)),
          "load_scan: mask must be an \\(h, w\\) bool array .*got dtype float64 with NaN/inf"),
+        ("open_stock None !", lambda: w.open_stock(None), "spec must be a block spec .*got None"),
+        ("open_stock empty !", lambda: w.open_stock(""), "spec must be a block spec .*got ''"),
+        ("open_stock int !", lambda: w.open_stock(5), "spec must be a block spec .*got 5"),
     ]
 
 
