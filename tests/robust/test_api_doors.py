@@ -434,6 +434,16 @@ def _library_door_sweep():
         ("open_stock None !", lambda: w.open_stock(None), "spec must be a block spec .*got None"),
         ("open_stock empty !", lambda: w.open_stock(""), "spec must be a block spec .*got ''"),
         ("open_stock int !", lambda: w.open_stock(5), "spec must be a block spec .*got 5"),
+        ("read_glb_metadata None", lambda: w.read_glb_metadata(None), "read_glb_metadata: path must be a file path .*got None"),
+        ("written_by_woodcam None", lambda: w.written_by_woodcam(None), "written_by_woodcam: path must be a file path .*got None"),
+        ("read_gran1 5", lambda: w.read_gran1(5), "read_gran1: folder must be a file path .*got 5"),
+        ("placed rotation str", lambda: w.PlacedField(fld, (0, 0, 0), "abc"), "rotation must be a proper 3x3 .*got 'abc'"),
+        ("placed origin str", lambda: w.PlacedField(fld, "abc"), "origin_mm must be a 3-vector .*got 'abc'"),
+        ("evaluate a field of the wrong count", lambda: w.evaluate(lambda p: np.zeros(5), pts),
+         r"field must return one growth time per point, \(n,\) = \(2,\); it returned shape \(5,\)"),
+        ("evaluate a field of text", lambda: w.evaluate(lambda p: "a", pts),
+         "field must return one growth time per point.*returned something that is not numbers"),
+        ("wood normals str", lambda: w.Wood(fld).color(pts, "b"), r"normals must have the shape of points_mm \(2, 3\); got 'b'"),
     ]
 
 

@@ -201,9 +201,13 @@ class Wood:
         chunks on ``threads`` threads.
         """
         p = check_points(points_mm)
-        n = np.asarray(normals, dtype=np.float32)
-        if n.shape != p.shape:
-            raise WoodcamError(f"normals must have the shape of points_mm {p.shape}; got {n.shape}")
+        try:  # float32 as given (no copy on the bake's hot path); a string was numpy's bare ValueError
+            n = np.asarray(normals, dtype=np.float32)
+        except (TypeError, ValueError):
+            n = None
+        if n is None or n.shape != p.shape:
+            raise WoodcamError(f"normals must have the shape of points_mm {p.shape}; got "
+                               f"{n.shape if n is not None else repr(normals)[:40]}")
         p, n = self._to_source(p, n)
         out = np.empty((len(p), 3), np.float32)
         starts = range(0, len(p), _CHUNK)

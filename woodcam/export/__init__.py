@@ -487,7 +487,7 @@ def load_textured(path: PathLike) -> Mesh:
 def written_by_woodcam(path: PathLike) -> bool:
     """True for a GLB or OBJ written by :func:`export_glb` / :func:`export_obj` (then
     :func:`load_textured` returns it in the block frame); False for any other file."""
-    path = Path(path)
+    path = check_path(path, "written_by_woodcam: path", fix="a .glb file")
     suffix = path.suffix.lower()
     try:
         if suffix == ".glb":
@@ -504,7 +504,7 @@ def read_glb_metadata(path: PathLike) -> dict:
 
     Parses the GLB header and JSON chunk directly (glTF 2.0 spec, "GLB File Format").
     """
-    path = Path(path)
+    path = check_path(path, "read_glb_metadata: path", fix="a .glb file")
     try:
         data = path.read_bytes()
     except OSError as err:

@@ -67,11 +67,22 @@ def evaluate(field: GrowthFieldLike, points_mm: ArrayLike, batch: int = MAX_BATC
         rest, first = beside(lambda: evaluate(field, p[cut:], batch), lambda: evaluate(field, p[:cut], batch))
         return np.concatenate([first, rest])
     if len(p) <= batch:
-        return np.asarray(field(p), dtype=float).reshape(len(p))
+        return _years_of(field, p)
     out = np.empty(len(p))
     for i in range(0, len(p), batch):
-        out[i:i + batch] = field(p[i:i + batch])
+        out[i:i + batch] = _years_of(field, p[i:i + batch])
     return out
+
+
+def _years_of(field, p: np.ndarray) -> np.ndarray:
+    """``field(p)`` as ``(n,)`` float years: a field returning the wrong count or text was a
+    bare reshape/float ValueError, naming neither the field nor what it returned."""
+    g = as_floats(field(p))
+    if g is None or g.size != len(p):
+        got = "something that is not numbers" if g is None else f"shape {g.shape}"
+        raise WoodcamError(f"field must return one growth time per point, (n,) = ({len(p)},); it returned {got}; "
+                           f"check the field's __call__ ({type(field).__name__})")
+    return g.reshape(len(p))
 
 
 #: Points below which :func:`evaluate` does not fork: a fork and the copy of the result back

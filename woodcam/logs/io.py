@@ -80,7 +80,7 @@ def read_gran1(folder: PathLike | None = None, *, centre: bool = True) -> LogSke
             raise WoodcamError("the real log needs the shared data folder; set "
                                "WOODCAM_SHARED_DATA=/path/to/shared/data or pass folder=")
         folder = base / "trees"
-    folder = Path(folder)
+    folder = check_path(folder, "read_gran1: folder", fix="shared/data/trees, or None for the shared data folder's")
     try:
         pith = np.asarray(json.loads((folder / "Gran_1_pith.json").read_text()), float)
         radii = np.asarray(json.loads((folder / "Gran_1_radii.json").read_text()), float)
