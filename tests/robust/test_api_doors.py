@@ -444,7 +444,24 @@ def _library_door_sweep():
         ("evaluate a field of text", lambda: w.evaluate(lambda p: "a", pts),
          "field must return one growth time per point.*returned something that is not numbers"),
         ("wood normals str", lambda: w.Wood(fld).color(pts, "b"), r"normals must have the shape of points_mm \(2, 3\); got 'b'"),
+        ("synth faces str !", lambda: w.synth_block(fld, (20, 20, 20), face_px=16, faces="top"),
+         r"faces must be a list of face names; got the string 'top'; pass \['top'\]"),
+        ("synth px_per_mm str", lambda: w.synth_block(fld, (20, 20, 20), px_per_mm="2"), "px_per_mm must be > 0; got '2'"),
+        ("woodify brush of 5", lambda: _woodify(brushes=[5]), r"brushes must be a list of woodcam.woodify.Brush; got \[5\]"),
+        ("woodified speed None", lambda: w.WoodifiedField(np.zeros((3, 3, 3)), (0, 0, 0), 1.0, None, 1.0),
+         "speed must be a GrowthSpeed; got NoneType"),
+        ("woodified spacing 0 !", lambda: w.WoodifiedField(np.zeros((3, 3, 3)), (0, 0, 0), 0.0, w.GrowthSpeed(1, 1), 1.0),
+         "spacing_mm must be a finite number > 0; got 0.0"),
     ]
+
+
+def _woodify(**kw):
+    """woodify() of a 5 mm ball, 2 years, on a 16-node grid (a fraction of a second)."""
+    import trimesh
+
+    from woodcam.woodify import woodify
+
+    return woodify(trimesh.creation.icosphere(radius=5), 2.0, resolution=16, **kw)
 
 
 @functools.lru_cache(maxsize=1)
@@ -608,6 +625,8 @@ def _library_door_valid_calls():
         ("arf of a list", lambda: w.arf([0.5, 2.25]), lambda r: np.allclose(r, [0.25, 0.0625])),
         ("load_scan of a list mask", lambda: w.load_scan(_scan_file(), px_per_mm=4, mask=[[i < 20] * 40 for i in range(40)]).mask,
          lambda m: m.shape == (40, 40) and m[:20].all() and not m[20:].any()),
+        ("woodify of one brush", lambda: _woodify(brushes=w.Brush((0, 0, 5), 2, gain=2)).field(np.array([[0.0, 0.0, 0.0]])),
+         lambda r: r.shape == (1,) and np.isfinite(r).all()),
         ("read_gcode of a list start", lambda: w.read_gcode("G1 X1 F100\n", start_mm=[0, 0, 5]).start_mm.tolist(),
          lambda r: r == [[0.0, 0.0, 5.0]]),
     ]

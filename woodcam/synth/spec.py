@@ -11,6 +11,7 @@ which it still accepts and :meth:`SynthSpec.replace_flat` applies.
 from __future__ import annotations
 
 import json
+import numbers
 from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 
@@ -126,13 +127,17 @@ class SynthSpec:
     ring_map: RingMapSpec = field(default_factory=RingMapSpec)
 
     def __post_init__(self):
+        for name in ("faces", "trace_faces", "ring_map_faces"):  # 'top' was read letter by letter ('t')
+            if isinstance(getattr(self, name), str):
+                raise WoodcamError(f"{name} must be a list of face names; got the string {getattr(self, name)!r}; "
+                                   f"pass [{getattr(self, name)!r}]")
         object.__setattr__(self, "faces", tuple(check_face(f) for f in self.faces))
         object.__setattr__(self, "trace_faces", _faces_or_none("trace_faces", self.trace_faces))
         object.__setattr__(self, "ring_map_faces", _faces_or_none("ring_map_faces", self.ring_map_faces))
         if self.px_per_mm is None and not (isinstance(self.face_px, int) and self.face_px >= 2):
             raise WoodcamError(f"face_px must be >= 2 pixels; got {self.face_px!r}")
-        if self.px_per_mm is not None and not self.px_per_mm > 0:
-            raise WoodcamError(f"px_per_mm must be > 0; got {self.px_per_mm!r}")
+        if self.px_per_mm is not None and not (isinstance(self.px_per_mm, numbers.Real) and self.px_per_mm > 0):
+            raise WoodcamError(f"px_per_mm must be > 0; got {self.px_per_mm!r}")  # '2' was a TypeError of '>'
         if self.seed is not None:  # 'a' was numpy's SeedSequence TypeError when rendering
             object.__setattr__(self, "seed", int(check_number(self.seed, "seed", lo=0, integer=True,
                                                               fix="same seed, same block; or None")))

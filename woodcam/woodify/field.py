@@ -35,6 +35,7 @@ from numpy.typing import ArrayLike
 from scipy import ndimage
 
 from .._atomic import atomic_path
+from .._checks import check_number, check_vector
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, check_points
 from .speed import GrowthSpeed
@@ -86,8 +87,11 @@ class WoodifiedField:
             raise WoodcamError("arrival_mm has no finite value; the front never started")
         self.t_cap_mm = float(T[finite].max())
         self.arrival_mm = np.where(finite, T, self.t_cap_mm).astype(np.float32)
-        self.origin_mm = np.asarray(origin_mm, float).reshape(3)
-        self.spacing_mm = float(spacing_mm)
+        if not isinstance(speed, GrowthSpeed):  # None was an AttributeError ('years')
+            raise WoodcamError(f"speed must be a GrowthSpeed; got {type(speed).__name__}")
+        self.origin_mm = check_vector(origin_mm, "origin_mm", fix="the mm position of node (0, 0, 0)")
+        # 0 was refused as 'block_size_mm ... got None', a string was float()'s ValueError
+        self.spacing_mm = check_number(spacing_mm, "spacing_mm", lo=0, lo_open=True, fix="the grid's node spacing, mm")
         self.speed = speed
         self.years_final = float(years_final)
         # beyond the velocity scale the front never arrives (W < 1): cap where W = 1 - 1e-6

@@ -161,7 +161,11 @@ def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: 
         velocity_mm = g_mm / float(weibull_cdf(years / lam, shape))
     speed = GrowthSpeed(float(velocity_mm), lam, shape, float(eccentricity), tuple(up))
     tau_end = float(speed.tau(years))
-    strokes = list(brushes)
+    # one Brush (not in a list) was "'Brush' object is not iterable", a number an AttributeError
+    strokes = [brushes] if isinstance(brushes, Brush) else list(brushes) if isinstance(brushes, (list, tuple)) else None
+    if strokes is None or not all(isinstance(b, Brush) for b in strokes):
+        raise WoodcamError(f"brushes must be a list of woodcam.woodify.Brush; got {brushes!r:.80}; "
+                           "e.g. brushes=[Brush((0, 0, 10), radius_mm=5, gain=2)]")
     gmax = float(np.prod([max(b.gain, 1.0) for b in strokes])) if strokes else 1.0
     if vertex_gain is not None:
         gmax *= float(np.max(vertex_gain))
