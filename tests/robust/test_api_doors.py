@@ -452,6 +452,12 @@ def _library_door_sweep():
          "speed must be a GrowthSpeed; got NoneType"),
         ("woodified spacing 0 !", lambda: w.WoodifiedField(np.zeros((3, 3, 3)), (0, 0, 0), 0.0, w.GrowthSpeed(1, 1), 1.0),
          "spacing_mm must be a finite number > 0; got 0.0"),
+        ("knotted params dict", lambda: w.KnottedLogField(_small_log(), params={}), "params must be a KnotParams or None; got dict"),
+        ("colormap knots dict", lambda: w.ColorMapAppearance(knots={}), "knots must be a KnotShading; got dict"),
+        ("mokume_veneers size 0", lambda: w.mokume_veneers(_scan_file().parent, size_mm=0), "size_mm must be a finite number > 0; got 0"),
+        ("mokume_veneers NaN size !", lambda: w.mokume_veneers(_scan_file().parent, size_mm=np.nan),
+         "size_mm must be a finite number > 0; got nan"),
+        ("mokume_veneers None", lambda: w.mokume_veneers(None), "mokume_veneers: folder must be a file path .*got None"),
     ]
 
 

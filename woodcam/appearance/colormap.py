@@ -263,6 +263,9 @@ class ColorMapAppearance:
         object.__setattr__(self, "seed", int(check_number(self.seed, "seed", lo=0, hi=2**62, integer=True,
                                                           fix="the colour noise's seed, e.g. seed=0")))
         check_texture_frame(self.texture_frame)
+        if not isinstance(self.knots, KnotShading):  # a dict was an AttributeError at the first colour
+            raise WoodcamError(f"knots must be a KnotShading; got {type(self.knots).__name__}; pass "
+                               "KnotShading(alive_darkening=..., ...) or the knot_darkening_* keywords")
         changes = {k: v for k, v in (("alive_darkening", knot_darkening_alive),
                                      ("dead_darkening", knot_darkening_dead),
                                      ("outline_rgb", dead_outline_rgb)) if v is not None}

@@ -256,6 +256,9 @@ class KnottedLogField:
                                f"{surface_smoothing!r}; e.g. (11, 5), or (1, 1) for none")
         self.log = log
         self.ring_width_mm = float(ring_width_mm)
+        if params is not None and not isinstance(params, KnotParams):  # a dict was an AttributeError at the first call
+            raise WoodcamError(f"params must be a KnotParams or None; got {type(params).__name__}; pass "
+                               "KnotParams(...) or replace(KnotParams(), name=value)")
         self.params = params if params is not None else KnotParams()
         self.backend = _pick_backend(backend)
         self.chunk = int(chunk or 2048)

@@ -203,7 +203,9 @@ def mokume_veneers(folder: str | Path, size_mm: float = 50.0) -> list[Veneer]:
     The cubes are ``size_mm`` on a side (the dataset does not store it; woodcam's Mokume
     default is 50 mm), so a 256 px photo is ``256 / size_mm`` px/mm.
     """
-    folder = Path(folder)
+    folder = check_path(folder, "mokume_veneers: folder", fix="a Mokume sample folder such as shared/data/mokume/H11")
+    # 0 was a ZeroDivisionError, NaN refused as the veneer's 'px_per_mm'
+    size_mm = check_number(size_mm, "size_mm", lo=0, lo_open=True, fix="the cube's side in mm, e.g. 50")
     files = sorted(folder.glob("?_col.png"))
     if not files:
         raise WoodcamError(f"Mokume folder {str(folder)!r} holds no face photos (A_col.png .. "
