@@ -703,3 +703,17 @@ def test_a_block_and_a_job_written_to_a_path_like_read_back(tmp_path):
     job = ParquetryJob([], [], [], [], _small_params())
     again = w.read_job(str(w.write_job(job, str(tmp_path / "j.json"))))
     assert again.params.patch_mm == 4 and again.params.n_rot == 2
+
+
+def test_a_tool_table_names_the_key_a_tool_type_needs(tmp_path):
+    """A vbit without angle_deg was read as NaN and refused as "VBit: angle_deg ... got nan" (a
+    value never written); the valid table beside it reads as the tools it describes."""
+    import woodcam as w
+
+    (tmp_path / "t.toml").write_text('[tools.1]\ntype = "vbit"\ndiameter_mm = 6\n')
+    with pytest.raises(WoodcamError, match=r"\[tools.1\] \(type 'vbit'\) needs \['angle_deg'\]"):
+        w.load_tool_table(tmp_path / "t.toml")
+    (tmp_path / "t.toml").write_text('[tools.1]\ntype = "vbit"\ndiameter_mm = 6\nangle_deg = 90\n'
+                                     '[tools.2]\ntype = "bull"\ndiameter_mm = 6\ncorner_radius_mm = 1\n')
+    tools = w.load_tool_table(str(tmp_path / "t.toml"))
+    assert tools[1].spec() == "vbit:90:6" and tools[2].spec() == w.parse_tool_spec("bull:6:1").spec()

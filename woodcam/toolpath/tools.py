@@ -537,6 +537,10 @@ def load_tool_table(path: PathLike) -> dict[int, Tool]:
         if unknown:
             raise WoodcamError(f"load_tool_table: {path}: [tools.{key}] (type {kind!r}) has unknown "
                                f"key(s) {unknown}; known: {sorted(known)}")
+        missing = [k for k in _TYPE_KEYS.get(kind, ()) if k not in entry]
+        if missing:  # read as NaN, the tool then said "angle_deg ... got nan" of a key never written
+            raise WoodcamError(f"load_tool_table: {path}: [tools.{key}] (type {kind!r}) needs {missing}; "
+                               f"e.g. angle_deg = 60 for a vbit")
         num = lambda k: _number(entry.get(k, math.nan), path, key, k)  # noqa: E731
         d = num("diameter_mm")
         reach = {name: num(name) for name in REACH_FIELDS.values() if name in entry}
