@@ -9,7 +9,7 @@ import pytest
 from PIL import Image
 
 from woodcam.cli import main
-from woodcam.errors import WoodcamWarning
+from woodcam.errors import WoodcamError, WoodcamWarning
 
 
 @pytest.fixture
@@ -292,6 +292,35 @@ def test_a_job_file_texture_without_an_id_is_named_by_its_file(scans, capsys):
     assert main(["parquetry", "--config", str(scans / "job.json"), "--out", str(out), "--quiet"]) == 1
     assert "source_textures[0].id must be a name (a string, it names veneer_<id>.svg); got 5" in \
         capsys.readouterr().err
+
+
+@pytest.mark.parametrize("bad", ["x/../../escape", "..\\escape", "a\nb"])
+def test_a_veneer_id_that_is_no_file_name_part_is_refused(scans, capsys, bad):
+    """A veneer's id names its cut files veneer_<id>.svg/.dxf in the output folder: a job file's
+    "id": "x/../../escape" wrote them in its parent folder (making veneer_x/ on the way).
+    Refused at the door, the job file's entry named and nothing written; the library door (build_parquetry) refuses the same; a dotted id
+    that is one file-name part is fine."""
+    from woodcam.parquetry import build_parquetry, load_scan
+
+    job = {"source_textures": [{"texture": "light.png", "dpi": 50.8, "id": bad},
+                               {"texture": "dark.png", "dpi": 50.8, "id": "dark"}],
+           "targets": [{"filename": "coffee.png", "scale": 1.0}]}
+    (scans / "job.json").write_text(json.dumps(job))
+    out = scans / "deep" / "out"
+    assert main(["parquetry", "--config", str(scans / "job.json"), "--image-size-mm", "42", "--px-per-mm",
+                 "2", "--no-seams", "--no-glb", "--out", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "source_textures[0].id must be one file-name part" in err, err
+    assert not (scans / "deep").exists() and not list(scans.rglob("*escape*"))
+    light = load_scan(scans / "light.png", dpi=50.8, id="light")
+    light.id = bad
+    with pytest.raises(WoodcamError, match=r"veneers\[0\]\.id must be one file-name part"):
+        build_parquetry([np.full((8, 8), 0.5, np.float32)], [light])
+    job["source_textures"][0]["id"] = "oak.v2-1"
+    (scans / "job.json").write_text(json.dumps(job))
+    assert main(["parquetry", "--config", str(scans / "job.json"), "--image-size-mm", "42", "--px-per-mm",
+                 "2", "--no-seams", "--no-glb", "--out", str(out), "--quiet"]) == 0
+    assert [v["id"] for v in json.loads((out / "result.json").read_text())["veneers"]] == ["oak.v2-1", "dark"]
 
 
 def test_the_job_file_of_a_run_with_relative_paths_reruns_from_anywhere(scans, capsys, monkeypatch):

@@ -20,7 +20,7 @@ from ..units import say_length
 from .features import edge, features, intensity, match_histogram
 from .job import ParquetryParams
 from .matching import Match, SheetBank, edge_margin_px
-from .veneers import Veneer
+from .veneers import Veneer, check_veneer_id
 
 
 @dataclass
@@ -253,7 +253,7 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
                                "load_scan(path, dpi=...) or slice_veneers(stock, ...)")
     if names is not None and (isinstance(names, str) or len(names) != len(targets)):  # an IndexError
         raise WoodcamError(f"names must be one name per target ({len(targets)}); got {names!r:.80}")
-    ids = [v.id for v in veneers]
+    ids = [check_veneer_id(v.id, f"veneers[{i}].id") for i, v in enumerate(veneers)]
     if len(set(ids)) != len(ids):
         twice = sorted({i for i in ids if ids.count(i) > 1})
         raise WoodcamError(f"veneer ids must be unique (each names its cut files veneer_<id>.svg/.dxf); "

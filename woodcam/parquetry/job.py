@@ -373,9 +373,10 @@ def read_job(path: str | Path) -> ParquetryJob:
     for i, t in enumerate(scans):
         if t.get("mask") is not None and not isinstance(t["mask"], str):
             raise WoodcamError(f"{where} source_textures[{i}].mask must be a path or null; got {t['mask']!r}")
-        if t.get("id") is not None and not (isinstance(t["id"], str) and t["id"]):
-            raise WoodcamError(f"{where} source_textures[{i}].id must be a name (a string, it names "
-                               f"veneer_<id>.svg); got {t['id']!r}")
+        if t.get("id") is not None:
+            from .veneers import check_veneer_id
+
+            check_veneer_id(t["id"], f"{where} source_textures[{i}].id")
     # found at the door, each named by its entry: a missing file was 'cannot decode the image ...
     # the file is damaged' after the job's other files were read
     named = [(f"source_textures[{i}].{k}", t.get(k)) for i, t in enumerate(scans) for k in ("texture", "mask")]

@@ -104,7 +104,25 @@ class Veneer:
                       self.size_mm)
 
 
+def check_veneer_id(value, where: str) -> str:
+    """``value`` as a veneer id: it names the sheet's cut files ``veneer_<id>.svg`` / ``.dxf`` in
+    the output folder, so it must be a non-empty string that is one file-name part: no ``/`` or
+    ``\\`` and no control character (a job file's ``"id": "x/../../x"`` wrote its cut files
+    in the output folder's parent, making ``veneer_x/`` on the way).
+    ``where`` names the value in the message."""
+    if not isinstance(value, str) or not value:
+        raise WoodcamError(f"{where} must be a name (a string, it names veneer_<id>.svg); "
+                           f"got {value!r}")
+    bad = sorted({c for c in value if c in "/\\" or ord(c) < 32 or ord(c) == 127})
+    if bad:
+        raise WoodcamError(f"{where} must be one file-name part (it names veneer_<id>.svg in the output "
+                           f"folder): no '/', '\\' or control characters; got {value!r}, which has "
+                           f"{''.join(bad)!r}; use letters, digits, '-', '_' or '.'")
+    return value
+
+
 def _check(v: Veneer) -> Veneer:
+    check_veneer_id(v.id, "veneer id")
     if v.rgb.ndim != 3 or v.rgb.shape[2] != 3:
         raise WoodcamError(f"veneer {v.id!r}: rgb must be (h, w, 3); got shape {v.rgb.shape}")
     if v.mask.shape != v.rgb.shape[:2]:
@@ -286,7 +304,7 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
     pitch = thickness_mm + kerf_mm
     start = stock.size_mm[ax] / 2.0 if start_mm is None else float(start_mm)
     top = stock.size_mm[down_axis] if down_axis == 2 else 0.0
-    prefix = id_prefix or stock.spec.replace(":", "-").replace("/", "-").strip("-.")
+    prefix = id_prefix or stock.spec.replace(":", "-").replace("/", "-").replace("\\", "-").strip("-.")
     sheets = []
     it = range(n_sheets)
     if progress:
