@@ -474,3 +474,33 @@ def test_a_ctrl_c_while_baking_leaves_the_earlier_deviation_map_with_its_glb(tmp
     monkeypatch.setattr(woodcam.pipeline, "preview_heightfield", interrupted)
     assert main([*gcode[:-1], str(tmp_path / "box.stl"), "--until-line", "12"]) == 130
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def test_a_ctrl_c_while_the_deviation_map_is_drawn_leaves_no_earlier_map_beside_the_new_glb(
+        tmp_path, capsys, monkeypatch):
+    """Review of 8b54610: the map is drawn once the new GLB set is in place, so a Ctrl-C while
+    it was drawn left the earlier run's NAME_deviation.png (another cut's) beside the new GLB,
+    passing for its map until the next run, the fault 6825aa1 fixed for NAME_view.png. The
+    earlier map is gone once the new GLB has landed."""
+    import trimesh
+
+    import woodcam.toolpath.deviation as deviation_module
+    from woodcam.export import read_glb_metadata
+
+    box = trimesh.creation.box((20, 20, 20))
+    box.apply_translation((50, 40, 25))
+    box.export(tmp_path / "box.stl")
+    gcode = ["gcode", str(REPO / "toolpaths" / "drilling.nc"), "--tool", "flat:6", "--block",
+             "builtin:flat-sawn", "--cell-size", "1", "--out", str(tmp_path / "g.glb"), "--no-obj",
+             "--part", str(tmp_path / "box.stl")]
+    assert main(gcode) == 0
+    dev = tmp_path / "g_deviation.png"
+    assert dev.is_file() and "until_line" not in read_glb_metadata(tmp_path / "g.glb")
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(deviation_module, "deviation_png", interrupted)
+    assert main([*gcode, "--until-line", "12"]) == 130
+    assert read_glb_metadata(tmp_path / "g.glb")["until_line"] == 12  # the new cut's GLB landed
+    assert not dev.exists()  # and no earlier cut's map beside it

@@ -14,7 +14,7 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
 from .options import (BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
-                      allow_negative_values, camera_of, drop_earlier_view, remove_stale_outputs, sizes_type,
+                      allow_negative_values, camera_of, drop_earlier_output, remove_stale_outputs, sizes_type,
                       stock_options, vector_type)
 
 _EXAMPLES = """\
@@ -306,7 +306,9 @@ def run(args) -> int:
         t_bake = time.perf_counter() - t1
         if design is not None:
             # drawn once the GLB set is in place: written before it, a Ctrl-C while meshing and
-            # baking left this cut's map beside the earlier run's GLB
+            # baking left this cut's map beside the earlier run's GLB; the earlier run's map goes
+            # first, or a Ctrl-C while drawing left it beside this run's GLB
+            drop_earlier_output(png, Path(args.out))
             deviation_png(dev, png, title=f"{Path(args.part).name}:\n{dev.summary(gouges=False)}"
                           + (f", {len(dev.gouges)} gouging lines" if dev.gouges else ""))
             out.files["deviation"] = png
@@ -376,7 +378,7 @@ def _screenshot(args, stock, program, offset, made, heightmap) -> None:
 
     out = Path(args.out)
     png = screenshot_path(args.screenshot, out)
-    drop_earlier_view(png, out)
+    drop_earlier_output(png, out)
     overlay = None
     if not args.no_overlay and len(program):
         off = np.asarray(offset if offset else (0.0, 0.0, stock.size_mm[2]), float)

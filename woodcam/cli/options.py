@@ -626,21 +626,22 @@ def write_screenshot(args, files: dict, stock) -> None:
     from ..view import preview
 
     png = screenshot_path(args.screenshot, Path(args.out))
-    drop_earlier_view(png, Path(args.out))
+    drop_earlier_output(png, Path(args.out))
     preview(files["glb"], wood=stock.wood, size_mm=stock.size_mm, screenshot=png,
             camera=camera_of(args))
     files["png"] = png
 
 
-def drop_earlier_view(png: Path, out_glb: Path) -> None:
-    """Remove the view ``png`` an earlier run listed for ``out_glb``, once this run's GLB has
-    landed and before its own view is drawn: a Ctrl-C while drawing (seconds) left the earlier
-    part's view beside the new GLB, passing for its own until the next run. A file no run
-    listed (the user's) is left alone, as :func:`remove_stale_outputs` leaves it."""
+def drop_earlier_output(path: Path, out_glb: Path) -> None:
+    """Remove the file ``path`` (a NAME_view.png, gcode's NAME_deviation.png) an earlier run
+    listed for ``out_glb``, once this run's GLB has landed and before its own is drawn: a
+    Ctrl-C while drawing (seconds) left the earlier part's view or cut's map beside the new
+    GLB, passing for its own until the next run. A file no run listed (the user's) is left
+    alone, as :func:`remove_stale_outputs` leaves it."""
     from .._atomic import listed_outputs
 
-    if png.parent.resolve() == out_glb.parent.resolve() and png.name in listed_outputs(out_glb.parent, out_glb.name):
-        png.unlink(missing_ok=True)
+    if path.parent.resolve() == out_glb.parent.resolve() and path.name in listed_outputs(out_glb.parent, out_glb.name):
+        path.unlink(missing_ok=True)
 
 
 def remove_stale_outputs(out_glb, files: dict, inputs=()) -> None:
