@@ -175,13 +175,7 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
 
         warnings.warn(hint, WoodcamWarning, stacklevel=2)
     # the part's long axis and how long-and-thin it is (principal axes of the surface sample)
-    evals, evecs = np.linalg.eigh(np.cov((pts - pts.mean(axis=0)).T))
-    # eigh's sign is arbitrary: the same bowl baked at 5 and at 10 texels/mm had its knots in the
-    # "last third" and then the "first", with nothing to say which end was which. Pointed to
-    # + along the block axis it runs nearest, the thirds are named by the block's ends.
-    ax = int(np.argmax(np.abs(evecs[:, -1])))
-    long_axis = evecs[:, -1] * np.sign(evecs[ax, -1])
-    elongation = float(1.0 - math.sqrt(max(evals[1], 0.0) / max(evals[2], 1e-12)))
+    long_axis, _, elongation = _long_axis(pts)
     size = np.asarray(stock.size_mm, dtype=float)
     # the candidates are split over the orientations the part fits in: split over all of them,
     # a long part scored a fraction of what was asked (the spoon blank in the knotty block, 2 of 4
@@ -263,6 +257,20 @@ SHORT_GRAIN_DEG = 30.0
 REPORT_REGIONS = 3
 
 
+def _long_axis(pts: np.ndarray) -> tuple[np.ndarray, int, float]:
+    """The long axis of points ``pts`` ((n, 3) mm; principal axes of their covariance) ->
+    ``(axis, block_axis, elongation)``: the unit ``axis`` (3,) pointed + along the block axis it
+    runs nearest, that axis' index ``block_axis`` (0 x, 1 y, 2 z) and how long-and-thin the
+    points are (1 - sqrt(second eigenvalue / largest), in [0, 1])."""
+    evals, evecs = np.linalg.eigh(np.cov((pts - pts.mean(axis=0)).T))
+    # eigh's sign is arbitrary: the same bowl baked at 5 and at 10 texels/mm had its knots in the
+    # "last third" and then the "first", with nothing to say which end was which. Pointed to
+    # + along the block axis it runs nearest, part_report's thirds are named by the block's ends.
+    ax = int(np.argmax(np.abs(evecs[:, -1])))
+    elongation = float(1.0 - math.sqrt(max(evals[1], 0.0) / max(evals[2], 1e-12)))
+    return evecs[:, -1] * np.sign(evecs[ax, -1]), ax, elongation
+
+
 def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
     """What the wood will do in ``mesh`` (a carved part, block frame, mm) as placed.
 
@@ -283,13 +291,7 @@ def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
     grain = feats["grain"][:len(pts)]
     knot = feats["knot"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) > 0.5
     pith = (feats["years"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) < PITH_YEARS) & ~knot
-    evals, evecs = np.linalg.eigh(np.cov((pts - pts.mean(axis=0)).T))
-    # eigh's sign is arbitrary: the same bowl baked at 5 and at 10 texels/mm had its knots in the
-    # "last third" and then the "first", with nothing to say which end was which. Pointed to
-    # + along the block axis it runs nearest, the thirds are named by the block's ends.
-    ax = int(np.argmax(np.abs(evecs[:, -1])))
-    long_axis = evecs[:, -1] * np.sign(evecs[ax, -1])
-    elongation = float(1.0 - math.sqrt(max(evals[1], 0.0) / max(evals[2], 1e-12)))
+    long_axis, ax, elongation = _long_axis(pts)
     end = np.abs(np.einsum("ij,ij->i", grain, nrm)) > math.cos(math.radians(45))
     t = (pts - pts.mean(axis=0)) @ long_axis
     edges = np.quantile(t, np.linspace(0, 1, REPORT_REGIONS + 1))
