@@ -380,6 +380,20 @@ def test_lines_are_numbered_and_blanks_read_as_linuxcnc_does(tmp_path):
     assert moves[-1][1:3] == (2, (2, 1, 1)) and "CR alone" in warnings[0][1]
 
 
+def test_a_percent_line_with_a_form_feed_is_no_delimiter_as_linuxcnc_reads_it():
+    # Review of 6f01841: only space, tab and CR are blanks (a form feed, vertical tab or
+    # no-break space is LinuxCNC's "Bad character"), yet a '%' line was told by str.strip(),
+    # which also strips those: "\x0c%" opened or closed a %-delimited program, the moves after
+    # a closing one silently dropped, where LinuxCNC refuses the line
+    for bad, shown in (("\x0c", r"\\x0c"), ("\x0b", r"\\x0b"), ("\xa0", r"\\xa0")):
+        with pytest.raises(GcodeError, match=f"line 4: '{shown}': bad character"):
+            _ends(f"%\nG21 G90\nG0 X0 Y0 Z5\n{bad}%\nG1 Z-1 F100\n%\n")
+        with pytest.raises(GcodeError, match=f"line 1: '{shown}': bad character"):
+            _ends(f"{bad}%\nG21 G90\nG0 X0 Y0 Z5\n%\n")
+    # blanks LinuxCNC skips still leave a delimiter: space, tab, the CR of a CRLF line end
+    assert _ends("% \t\r\nG21 G90\r\nG0 X1 Y2 Z5\r\n\t%\r\nG0 X9\r\n")[-1] == (1, 2, 5)
+
+
 def test_a_byte_order_mark_is_refused_naming_it(tmp_path):
     # Notepad's "UTF-8 with BOM" puts EF BB BF before the first line; LinuxCNC refuses it
     # ("Bad character '\\357' used"), and woodcam did too, as "bad character '\\ufeff'"

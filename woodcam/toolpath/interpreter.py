@@ -821,8 +821,11 @@ class Interpreter:
                     grbl_percent.append(no)
                     continue
             else:
-                bare = raw.strip() == "%"
-                if first and raw.strip():
+                # blanks as LinuxCNC's (_BLANKS): str.strip() also took a form feed, vertical
+                # tab or no-break space, which LinuxCNC refuses ("Bad character"), for one
+                stripped = raw.strip(" \t\r")
+                bare = stripped == "%"
+                if first and stripped:
                     first = False
                     if bare:
                         percent = True
