@@ -182,6 +182,20 @@ def test_feed_spindle_and_tool_agree_with_linuxcnc():
     assert prog.spindle_rpm.tolist()[1:] == [12000, 12000, 12000, 0, 0]
 
 
+def test_the_spindle_started_on_a_move_line_before_a_blank_line_is_read_on():
+    """Review of a81646d: the driver gave a line's moves the spindle state LinuxCNC reports at
+    the next line only when that line came next by number; LinuxCNC reports no blank line, so
+    'S1000 M3 G1 X5' followed by a blank line cut with the spindle off (a false spindle_off
+    warning, --strict failed) where woodcam's interpreter, and the machine, cut at 1000 rpm.
+    Blank lines between (CRLF too) now count as no line."""
+    for end in ("\n", "\r\n"):
+        text = end.join(["G21 G90 F100", "G0 X0 Y0 Z5", "S1000 M3 G1 X5", "", " \t", "G1 X6",
+                         "M5 G1 X7", "", "G1 X8", "M2", ""])
+        prog = read_gcode(text, interpreter="linuxcnc")
+        assert prog.spindle_rpm[prog.kind != 0].tolist() == [1000, 1000, 0, 0], repr(end)
+        assert prog.spindle_rpm.tolist() == read_gcode(text).spindle_rpm.tolist()
+
+
 def test_machine_zero_agrees_with_linuxcnc_g54_offset(tmp_path):
     """A machine zero M in the G-code frame is LinuxCNC with the G54 offset -M (the work zero in
     machine coordinates), moves shifted back by M: G53 moves, G10 L2 offsets, G28 homes and arcs

@@ -74,9 +74,12 @@ class _Canon:
         # the spindle: the interpreter's state reaches Python only through next_line, as it
         # was after the last block it finished (S and M3/M4/M5 of a line come before its
         # motion, so a move's own line sets it): a line's moves take the state read at the
-        # next line's first call when that is the very next line, else the one before them
+        # next line's first call when that is the very next line or only blank lines lie
+        # between (LinuxCNC reports no blank line), else the one before them (a line it does
+        # not report, an 'M5' or an o-word, may have changed it since)
         self.rpm = 0.0
         self.pending = None  # (line, index of its first move) awaiting the state after it
+        self.blank: set[int] = set()  # the file's blank lines (1-based), set per file
 
     def __getattr__(self, name):  # every other canon call has no effect on the moves
         if name.startswith("__"):
@@ -85,7 +88,8 @@ class _Canon:
 
     def next_line(self, st):
         rpm = float(st.speed) if st.spindle in (3, 4) else 0.0  # st.spindle: its M code
-        if self.pending is not None and st.sequence_number == self.pending[0] + 1:
+        if self.pending is not None and st.sequence_number > self.pending[0] and all(
+                k in self.blank for k in range(self.pending[0] + 1, st.sequence_number)):
             for m in self.moves[self.pending[1]:]:
                 m[7] = rpm
         self.pending = None
@@ -207,6 +211,9 @@ def _run(job, work, result_fd):
                 f.write(f"{5221 + i}\t{-m:.15f}\n")
         canon = _Canon(var, time.time() + job.get("timeout_s", 10.0))
         canon.mzero = mzero
+        with open(path, newline="", errors="replace") as f:  # numbered as LinuxCNC: at '\n' only
+            canon.blank = {no for no, line in enumerate(f.read().split("\n"), 1)
+                           if not line.strip(" \t\r")}
         # G49: the interpreter keeps a G43.1 tool length offset from one file to the next;
         # G80: the G0 that places the start must not be the program's motion mode (LinuxCNC
         # starts in G80: a bare "X10" first is refused, and was read as a G0 here)
