@@ -127,3 +127,14 @@ def test_ops_as_typed_must_match_the_ops_one_for_one():
     with pytest.raises(WoodcamError, match=r"--place 'translate:1,2': expected translate:X,Y,Z "
                                            r"\(in --units on the command line, mm in the library\)"):
         placement_matrix(["translate:1,2"], box, (50, 50, 50))
+
+
+def test_a_negative_fit_margin_is_refused_with_the_fix():
+    """Review of f41a6cd: parse_place said 'a margin must be >= 0; got -0.1 mm' and no fix; it
+    names the two that work (no margin, the default one)."""
+    from woodcam.cad.place import parse_place
+
+    with pytest.raises(WoodcamError, match=r"--place 'fit:-0.1': a margin must be >= 0; got -0.1 mm; "
+                                           r"write fit:0 for none, or fit for 2 mm"):
+        parse_place(["center", "fit:-0.1"])
+    assert parse_place(["fit:0", "fit"]) == [("fit", 0.0, "fit:0"), ("fit", 2.0, "fit")]

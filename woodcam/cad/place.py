@@ -148,7 +148,8 @@ def parse_place(ops: Sequence[str], *, as_typed: Sequence[str] | None = None) ->
         elif name == "fit":
             value = _number(arg, op) if arg else FIT_MARGIN_MM
             if value < 0:
-                raise WoodcamError(f"--place {op!r}: a margin must be >= 0; got {say_length(value, 'g')}")
+                raise WoodcamError(f"--place {op!r}: a margin must be >= 0; got {say_length(value, 'g')}; "
+                                   f"write fit:0 for none, or fit for {say_length(FIT_MARGIN_MM, 'g')}")
         else:
             raise WoodcamError(f"--place {op!r} is not a placement operation; use {_HELP}")
         out.append((name, value, op))
