@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -244,6 +245,21 @@ def test_a_block_made_again_in_its_folder_keeps_its_corrected_svgs(synth_photos,
     assert rc == 0 and "kept the corrected front_traces.svg" in out and "top_traces" not in out
     assert (blk / "front_traces.svg").read_text() == mine
     assert len(read_block(blk).faces["top"].traces) > 1  # detected afresh on the new top photo
+
+
+def test_a_block_made_into_a_folder_with_an_unreadable_manifest_is_written(synth_photos, tmp_path, capsys):
+    """Review of 1507a56: 'block from-photos' reads the detection record of the block folder it
+    writes into, and a block.json there that is not a block manifest (cut short, or another
+    JSON) ended the command as an internal error, where it was overwritten before. It is
+    overwritten again, with a warning that no SVG correction could be kept from it."""
+    for text in ('{"format": "woodcam-block", "faces": {', "[1, 2]", '{"meta": [], "faces": []}'):
+        blk = tmp_path / f"blk{len(text)}"
+        blk.mkdir()
+        (blk / "block.json").write_text(text)
+        rc, _out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)
+        assert rc == 0, err
+        assert re.search(r"woodcam: warning: '.*block.json' is no readable block manifest .*no corrected SVG", err), err
+        assert sorted(read_block(blk).faces) == ["back", "bottom", "front", "left", "right", "top"]
 
 
 def test_the_detection_cache_stays_in_the_cache_whatever_the_block_is_named(synth_photos, tmp_path, monkeypatch):

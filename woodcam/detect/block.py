@@ -141,9 +141,14 @@ def _detection_record(folder: Path) -> dict:
     from ..block.io import MANIFEST
 
     m = json.loads((folder / MANIFEST).read_text())
-    meta = m.get("meta", {})
+    meta = m.get("meta", {}) if isinstance(m, dict) else None
+    faces = m.get("faces", {}) if isinstance(m, dict) else None
+    if not (isinstance(meta, dict) and isinstance(faces, dict)
+            and all(isinstance(e, dict) for e in faces.values())
+            and isinstance(meta.get("detection") or {}, dict) and isinstance(meta.get("detection_before") or {}, dict)):
+        raise ValueError("not an object with a 'meta' object and a 'faces' object of faces")
     if meta.get("detection"):
-        return {**meta["detection"], "traces_svg": {n: e["traces_svg"] for n, e in m.get("faces", {}).items()
+        return {**meta["detection"], "traces_svg": {n: e["traces_svg"] for n, e in faces.items()
                                                      if e.get("traces_svg")}}
     return meta.get("detection_before") or {}
 
@@ -162,8 +167,16 @@ def detection_record(folder) -> dict | None:
     folder = Path(folder)
     if not (folder / MANIFEST).is_file():
         return None
-    rec = _detection_record(folder)
-    svgs = {n: svg for n, svg in rec.get("traces_svg", {}).items() if (folder / svg).is_file()}
+    try:
+        rec = _detection_record(folder)
+    except ValueError as err:  # cut short, another JSON (was an internal error; it is overwritten)
+        warnings.warn(f"{str(folder / MANIFEST)!r} is no readable block manifest ({err}): it is "
+                      "overwritten, and no corrected SVG it recorded is kept (the next 'rings detect' "
+                      "draws every <face>_traces.svg there afresh; move a corrected one out first)",
+                      WoodcamWarning, stacklevel=2)
+        return None
+    svgs = {n: svg for n, svg in (rec.get("traces_svg") or {}).items()
+            if isinstance(svg, str) and (folder / svg).is_file()}
     if not svgs:
         return None
     return {"traces_svg": svgs, "svg_sha256": rec.get("svg_sha256", {}),
