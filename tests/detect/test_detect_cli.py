@@ -11,7 +11,7 @@ import pytest
 from PIL import Image
 
 from woodcam.block import read_block
-from woodcam.cli import EXIT_ERROR, main
+from woodcam.cli import EXIT_ERROR, EXIT_USAGE, main
 from woodcam.errors import WoodcamWarning
 from woodcam.frames import FACES
 
@@ -313,7 +313,7 @@ def test_bad_photo_folders_give_one_clear_line(synth_photos, tmp_path, capsys):
     rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50x50x50", "--out", tmp_path / "o")
     assert rc == EXIT_ERROR and "face 'right'" in err and "over-exposed" in err
     rc, _out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50x0x50", "--out", tmp_path / "o")
-    assert rc == EXIT_ERROR and "--size-mm" in err
+    assert rc == EXIT_USAGE and "--size-mm" in err  # a wrong command line, before any photo is read
 
 
 def test_phone_photos_are_read_upright_by_their_exif_orientation(synth_photos, tmp_path, capsys):

@@ -47,6 +47,9 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["block", "from-photos", "OUT/none", "--size-mm", "50", "--out", "OUT/fp", "--max-px-per-mm=-5"],
      r"--max-px-per-mm must be in \(0, 1000\]"),
     (["block", "from-photos", "OUT/none", "--size-mm", "1e300", "--out", "OUT/fp"], r"--size-mm takes WxDxH in mm"),
+    # a malformed size is a wrong command line like any malformed number (it exited 1)
+    (["block", "from-photos", "OUT/none", "--size-mm", "2in", "--out", "OUT/fp"],
+     r"--size-mm takes WxDxH in mm, .*; got '2in'"),
     # empty or repeated lists were taken as the default (an empty benchmark table, exit 0)
     (["fit", "/nonexistent", "--faces", "", "--out", "OUT/f.npz"], r"--faces must be 'all' or a comma list"),
     (["fit", "/nonexistent", "--faces", "front,front", "--out", "OUT/f.npz"], r"--faces must be 'all'"),
@@ -91,7 +94,8 @@ def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monk
     argv = [a.replace("OUT", str(out)) for a in argv]
     t0 = time.perf_counter()
     # a wrong command line exits 2 (the --out rule, a number out of range), failed work 1
-    usage = "--out of" in match or "is a FILE" in match or __import__("re").match(r"--[a-z0-9-]+ must be (in|a finite)", match)
+    usage = ("--out of" in match or "is a FILE" in match
+             or __import__("re").match(r"--[a-z0-9-]+ (must be (in|a finite)|takes )", match))
     assert main(argv) == (EXIT_USAGE if usage else EXIT_ERROR)
     assert time.perf_counter() - t0 < 30.0  # refused before any fitting or baking (minutes)
     err = capsys.readouterr().err

@@ -416,14 +416,15 @@ def allow_negative_values(p: argparse.ArgumentParser) -> None:
 def parse_sizes(text: str, option: str, n: int = 3, *, cube: bool = False) -> tuple[float, ...]:
     """``"WxDxH"`` (``x``, ``×`` or ``,`` between them) -> ``n`` sizes in mm, each finite and in
     (0, :data:`~woodcam.limits.MAX_BLOCK_SIZE_MM`]; with ``cube`` one number is a cube's side.
-    Otherwise a WoodcamError naming ``option`` (``--sheet-size 1e300x10`` reached an allocation
-    and ``--size-mm 1e300`` a block of 0 px/mm)."""
+    Otherwise a UsageError (exit 2: the command line is wrong, as argparse says of a malformed
+    number; ``--size-mm 2in`` exited 1) naming ``option`` (``--sheet-size 1e300x10`` reached an
+    allocation and ``--size-mm 1e300`` a block of 0 px/mm)."""
     from ..units import parse_lengths
 
     vals = parse_lengths(text, n, max_mm=MAX_BLOCK_SIZE_MM, cube=cube)
     dims = "x".join("WDH"[:n]) if n == 3 else "x".join("WH"[:n])
     if vals is None:
-        raise WoodcamError(f"{option} takes {dims} in mm, {n} numbers in (0, {MAX_BLOCK_SIZE_MM:g}]"
+        raise UsageError(f"{option} takes {dims} in mm, {n} numbers in (0, {MAX_BLOCK_SIZE_MM:g}]"
                            + (" (or one, a cube's side)" if cube else "") + ", e.g. "
                            + "x".join(["50"] * n) + f"; got {text!r}")
     return vals
