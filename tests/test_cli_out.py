@@ -106,6 +106,18 @@ def test_a_folder_that_cannot_be_made_is_refused_before_work(path, p, tmp_path, 
     assert len(err) == 1 and f"cannot make the folder '{blocker / 'sub'}'" in err[0] and "is a file" in err[0], err
 
 
+@pytest.mark.parametrize("path,p", FOLDER_COMMANDS, ids=[" ".join(c[0]) for c in FOLDER_COMMANDS])
+def test_an_existing_folder_that_cannot_be_written_is_refused_in_bakes_words(path, p, capsys):
+    """Sweep h8 item 3: ``rings detect BLOCK --out EXISTING_READ_ONLY_FOLDER`` said 'cannot make
+    the folder', of a folder that exists; it is not writable, said as a FILE --out's folder is
+    (test_a_file_in_a_folder_that_cannot_be_written_is_refused_before_work), exit 1 as there."""
+    capsys.readouterr()
+    assert main(_argv(path, p, "/proc/self")) == 1  # read-only even for root
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"woodcam: error: --out of 'woodcam {' '.join(path)}': the folder '/proc/self' is not "
+                   "writable (No such file or directory); choose an output folder you can write to"], err
+
+
 def test_a_refusal_by_the_system_is_one_line_not_a_traceback(monkeypatch, capsys):
     import errno
 

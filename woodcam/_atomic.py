@@ -47,7 +47,8 @@ from typing import IO
 from . import _interrupt
 from .errors import WoodcamError, WoodcamWarning
 
-__all__ = ["all_or_nothing", "apart", "atomic_files", "atomic_path", "atomic_write", "check_output_path",
+__all__ = ["all_or_nothing", "apart", "atomic_files", "atomic_path", "atomic_write", "check_folder_writable",
+           "check_output_path",
            "listed_outputs", "manifest_path", "remove_stale", "run_outputs", "write_bytes", "write_figure", "write_text"]
 
 
@@ -451,10 +452,29 @@ def check_output_path(path, *, suffixes: Iterable[str] | None = None, what: str 
     if not parent.is_dir():
         raise WoodcamError(f"{what}: {str(parent)!r} (the parent of {str(path)!r}) is a file, not "
                            "a folder; choose another output path")
-    try:  # a real probe: os.access() says yes to root even on read-only mounts
-        probe = _temp_in(path)
+    check_folder_writable(parent, what=what, name=path.name)
+    return path
+
+
+def check_folder_writable(folder, *, what: str = "--out", name: str = ".woodcam-write-check") -> Path:
+    """Check that files can be made in the existing folder ``folder`` *before* any work; return
+    it as a ``Path``. The one home of the "not writable" refusal: a FILE ``--out``'s folder
+    (:func:`check_output_path`) and an existing FOLDER ``--out`` are refused in the same words.
+
+    A real probe, a temporary file named after ``name`` (the file the caller will write; its
+    temporaries left by a killed writer are swept), made and removed: ``os.access()`` says yes to
+    root even on read-only mounts.
+
+    Raises
+    ------
+    WoodcamError
+        ``what``: the folder is not writable (the system's reason); choose another.
+    """
+    folder = Path(folder)
+    try:
+        probe = _temp_in(folder / name)
     except OSError as err:
-        raise WoodcamError(f"{what}: the folder {str(parent)!r} is not writable ({err.strerror}); "
+        raise WoodcamError(f"{what}: the folder {str(folder)!r} is not writable ({err.strerror}); "
                            "choose an output folder you can write to") from err
     _discard(probe)
-    return path
+    return folder

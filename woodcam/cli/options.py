@@ -159,10 +159,18 @@ def check_screenshot(args: argparse.Namespace) -> None:
 
 def _check_folder_can_be_made(folder: Path, command: str, option: str = "--out") -> None:
     """A folder made later (``--out`` itself, or a FILE ``--out``'s missing parent): its nearest
-    existing ancestor must be a folder one may write in, else a UsageError before any work."""
+    existing ancestor must be a folder one may write in, else a UsageError before any work. An
+    ``--out`` folder that exists already is made by no one: it must be writable
+    (:func:`woodcam._atomic.check_folder_writable`, the words of bake's ``--out`` into a
+    read-only folder; it was 'cannot make the folder')."""
     from ..errors import UsageError
 
     base = folder.absolute()
+    if base.is_dir():
+        from .._atomic import check_folder_writable
+
+        check_folder_writable(folder, what=f"{option} of 'woodcam {command}'")
+        return
     while not base.exists() and base != base.parent:
         base = base.parent
     if not base.is_dir() or not os.access(base, os.W_OK | os.X_OK):
