@@ -437,6 +437,22 @@ def test_codes_linuxcnc_runs_but_woodcam_does_not_simulate_say_what_they_are(cod
         _ends(f"G0 X0 Y0 Z10 F100 S1000 M3\n{code} X1 Z-3 R2 P1 Q1 I1 J1 K1 H1\nM2\n")
 
 
+def test_g53_g0_without_axis_words_moves_nothing_as_in_linuxcnc():
+    # LinuxCNC 2.9 runs "G53 G0" and "G53 G1" without axis words (no move; the line's motion
+    # mode is set), which woodcam refused as "G53 needs G0 or G1 and axis words"; it refuses a
+    # G53 whose line has no G0/G1 to use ("Must use g0 or g1 with g53"), and woodcam alike
+    # (test_g53_without_axis_words_agrees_with_linuxcnc compares both on these)
+    start = "G21 G90 F100\nG0 X1 Y1 Z5\n"
+    assert _ends(start + "G53 G0\nG0 X2\nM2\n") == [(1, 1, 5), (2, 1, 5)]
+    assert _ends(start + "G53 G1\nX4\nM2\n") == [(1, 1, 5), (4, 1, 5)]  # X4 in G1, from the G53 line
+    for line in ("G53", "G0 X3\nG53", "G2 X3 Y1 I1 J0\nG53", "G80\nG53", "G53 G2"):
+        with pytest.raises(GcodeError, match=r"'G53': G53 needs G0 or G1 on its line, or axis words "
+                                             r"in G0 or G1 mode \(LinuxCNC: 'Must use g0 or g1 with g53'\)"):
+            _ends(start + line + "\nM2\n")
+    with pytest.raises(GcodeError, match=r"'G53': G53 in incremental mode"):
+        _ends(start + "G91\nG53 G0\nM2\n")
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

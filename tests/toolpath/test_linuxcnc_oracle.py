@@ -432,3 +432,18 @@ def test_o_words_after_a_comment_open_and_close_nothing_as_in_linuxcnc(tmp_path)
     with pytest.raises(GcodeError, match=r"line 4: 'o1 endsub': .*without it the O words do not match "
                        r"\(line 2: o1 sub is never closed\)"):
         Interpreter(texts[0], start_mm=START).run()
+
+
+def test_g53_without_axis_words_agrees_with_linuxcnc(tmp_path):
+    """LinuxCNC runs ``G53 G0`` (and ``G53 G1``) without axis words, moving nothing; woodcam
+    refused it. Both refuse a G53 whose line has no G0/G1 to use (a bare G53 in any mode, G53 G2,
+    G53 after G80) and G53 in G91."""
+    body = "G21 G90 F100\nG0 X1 Y1 Z5\n"
+    ran = [body + "G53 G0\nG0 X2\nM2\n", body + "G53 G1\nX4\nM2\n", body + "G53 G0 F200\nG1 X2\nM2\n"]
+    refused = [body + t + "\nM2\n" for t in ("G53", "G0 X3\nG53", "G1 X3\nG53", "G53 G2",
+                                             "G2 X3 Y1 I1 J0\nG53", "G80\nG53", "G91\nG53 G0")]
+    texts = ran + refused
+    counts = {}
+    agree, bad = _differences(_written(tmp_path, texts), texts, counts, same_line=True)
+    assert not bad and agree == len(texts), bad
+    assert counts["ran"] == len(ran) and counts["refused"] == len(refused), counts

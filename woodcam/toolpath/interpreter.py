@@ -1672,8 +1672,12 @@ class Interpreter:
         if self.motion not in _CYCLES:
             self.cycle_il = None
         if 53.0 in g:
-            if self.motion not in (0.0, 1.0) or not axis:
-                raise self.err("G53", "G53 needs G0 or G1 and axis words", "write G53 G0 Z0")
+            # LinuxCNC's rule ("Must use g0 or g1 with g53"): the line's motion is G0 or G1, a
+            # code on the line or the modal one that its axis words use; "G53 G0" without axis
+            # words moves nothing and is accepted (it was refused), a bare "G53" is not
+            if self.motion not in (0.0, 1.0) or not (axis or motion_here):
+                raise self.err("G53", "G53 needs G0 or G1 on its line, or axis words in G0 or G1 "
+                               "mode (LinuxCNC: 'Must use g0 or g1 with g53')", "write G53 G0 Z0")
             if self.incremental:
                 raise self.err("G53", "G53 in incremental mode (G91)", "use G90")
         full_circle = modal_arc or (bool(motion_here) and self.motion in (2.0, 3.0) and not axis
