@@ -453,6 +453,20 @@ def test_g53_g0_without_axis_words_moves_nothing_as_in_linuxcnc():
         _ends(start + "G91\nG53 G0\nM2\n")
 
 
+@pytest.mark.parametrize("code, what, fix", [
+    ("M70", "saves the modal state for an M72", "write the modes M72 restores"),
+    ("M71", "invalidates the modal state M70 or M73 saved", "remove it with the M70/M72 or M73"),
+    ("M72", "restores the modal state M70 saved", "write the modes it restores"),
+    ("M73", "saves the modal state, restored when the subroutine returns", "write the modes the caller needs")])
+def test_modal_state_save_and_restore_say_what_they_are(code, what, fix):
+    # LinuxCNC runs M70-M73; woodcam refuses them on purpose (the modes they restore would have
+    # to be restored exactly), and said "unsupported M code ...; remove it or post-process for
+    # a 3-axis mill", which names neither what the code does nor how to do without it
+    with pytest.raises(GcodeError, match=rf"line 2: '{code}': {code} \({re.escape(what)}\) is not "
+                                         rf"simulated by woodcam \(LinuxCNC runs it\); {re.escape(fix)}"):
+        _ends(f"G0 X0 Y0 Z10 F100\n{code}\nG0 X1\nM2\n")
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

@@ -240,6 +240,19 @@ _G_NOT_SIMULATED = {
     43.2: ("an added tool length offset", "remove it (woodcam measures tools from the tip)"),
 }
 _M_KNOWN = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 30, 48, 49, 50, 51, 52, 53, 60, 61}
+#: M codes LinuxCNC runs that woodcam does not simulate: (what it is, the fix). The modal state
+#: M70-M73 keep (units, distance mode, plane, feed, spindle ...) would have to be restored
+#: exactly as LinuxCNC does, or a part is cut in the wrong units or mode without a word.
+_M_NOT_SIMULATED = {
+    70: ("saves the modal state for an M72", "write the modes M72 restores (G20/G21, G90/G91, "
+         "G17-G19, F, S ...) where it restores them, and remove M70 and M72"),
+    71: ("invalidates the modal state M70 or M73 saved", "remove it with the M70/M72 or M73 it "
+         "belongs to, writing their modes out"),
+    72: ("restores the modal state M70 saved", "write the modes it restores (G20/G21, G90/G91, "
+         "G17-G19, F, S ...) in its place, and remove M70 and M72"),
+    73: ("saves the modal state, restored when the subroutine returns", "write the modes the "
+         "caller needs (G20/G21, G90/G91, G17-G19, F, S ...) after the call, and remove M73"),
+}
 #: LinuxCNC's M modal groups: two M codes of one group on a line are refused ("Two m codes used
 #: from same modal group"; grbl refuses its M0/M1/M2/M30, M3-M5 and M7-M9 pairs the same way,
 #: error 21), as are more than :data:`MAX_M_PER_LINE` M codes on one line.
@@ -1529,6 +1542,10 @@ class Interpreter:
                                    "line (after its N word)", f"put M{v:g} on a line of its own")
                 mset.add(99)  # the main program's M99: ends the pass (see below)
                 continue
+            if v == math.floor(v) and int(v) in _M_NOT_SIMULATED:
+                what, fix = _M_NOT_SIMULATED[int(v)]
+                raise self.err(f"M{v:g}", f"M{v:g} ({what}) is not simulated by woodcam "
+                               "(LinuxCNC runs it)", fix)
             if v != math.floor(v) or int(v) not in _M_KNOWN:
                 raise self.err(f"M{v:g}", "unsupported M code (woodcam reads M0-M9, M30, "
                                "M48-M53, M60, M61; M19, M62-M68 and M100-M199 with a warning)", "remove it or post-process for a 3-axis mill")
