@@ -319,15 +319,19 @@ def _set_aside(hypotheses: list[Hypothesis], scores: dict) -> dict[str, str]:
         # a plain hypothesis built on this one (named after it: "stem + knot bend + residual")
         # is not a rival it must beat: on a block bent exactly as the bend models, both score
         # 100 % and the gain rule would set the bend aside for its own copy with a residual
-        rivals = [n for n in plain if not n.startswith(h.name + " + ")]
+        rivals = [n for n in plain if not _built_on(n, h.name)]
         if not rivals:
             continue
-        best = max(scores[n]["mean"] for n in rivals)
+        # named: a plain hypothesis built on this one may score above it ("the best (62.1 %)"
+        # beside a chosen bend + residual at 63.0 read as a contradiction)
+        top = max(rivals, key=lambda n: scores[n]["mean"])
+        best = scores[top]["mean"]
         base = scores.get(h.refines, {}).get("mean", float("nan"))
         own = scores[h.name]["mean"]
         if not base >= best - EVIDENCE_REFINE_BASE_MARGIN:  # also when the base is missing (nan)
             out[h.name] = (f"its base {h.refines} scores {base:.1f} %, more than "
-                           f"{EVIDENCE_REFINE_BASE_MARGIN:.0f} points below the best ({best:.1f} %)")
+                           f"{EVIDENCE_REFINE_BASE_MARGIN:.0f} points below the best plain hypothesis, "
+                           f"{top} ({best:.1f} %)")
         elif base >= best:
             # the base is the best plain hypothesis: the refinement takes its place (choose)
             if 100.0 - own > EVIDENCE_REFINE_MISS_RATIO * (100.0 - base):
@@ -336,8 +340,14 @@ def _set_aside(hypotheses: list[Hypothesis], scores: dict) -> dict[str, str]:
                                f"than {EVIDENCE_REFINE_MISS_RATIO:g} times as much")
         elif not own > best + EVIDENCE_REFINE_GAIN_MARGIN:
             out[h.name] = (f"it scores {own:.1f} %, not more than {EVIDENCE_REFINE_GAIN_MARGIN:.0f} "
-                           f"points above the best plain hypothesis ({best:.1f} %)")
+                           f"points above the best plain hypothesis, {top} ({best:.1f} %)")
     return out
+
+
+def _built_on(name: str, other: str) -> bool:
+    """Whether hypothesis ``name`` is ``other`` with a term added and named after it
+    (``"stem + knot bend + residual"`` on ``"stem + knot bend"``)."""
+    return name.startswith(other + " + ")
 
 
 def choose(hypotheses: list[Hypothesis], evidence: dict) -> EvidenceFit:
@@ -376,6 +386,14 @@ def choose(hypotheses: list[Hypothesis], evidence: dict) -> EvidenceFit:
         if takes is not None:
             msg += f"; {best} takes the place of {base}, the best plain hypothesis, which it refines"
         msg += "".join(f"; {n} set aside: {why}" for n, why in aside.items())
+        # the rules above set aside refinements only: a plain hypothesis built on one set aside
+        # ("stem + knot bend + residual") still competes, and the message said it was chosen
+        # beside the reason its own base was set aside without a word on why that did not count
+        under = [n for n in aside if _built_on(best, n)]
+        if under:
+            msg += (f"; {best} is built on {' and '.join(under)} but competes as a plain hypothesis: "
+                    f"the rules that set {'them' if len(under) > 1 else 'it'} aside apply to "
+                    "refinements only")
         if contradicted:
             msg += ("; CONTRADICTED by held-out faces " + ", ".join(
                 f"{face} ({v:.0f} % within 2 mm)" for face, v in bad.items())
