@@ -39,7 +39,9 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--sheet-size", "1e300x10"],
      r"--sheet-size takes WxH in mm"),
     (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--image-size-mm", "1e300"],
-     r"image_size_mm \(--image-size-mm\) must be in \[patch_mm = 14, 10000\] mm"),
+     r"--image-size-mm must be in \(0, 10000\]"),  # at the door since 2a3e399: a usage error
+    (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--image-size-mm", "5"],
+     r"image_size_mm \(--image-size-mm\) must be in \[patch_mm = 14, 10000\] mm"),  # the patch rule: later
     (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--sheets", "1000000"],
      r"--sheets must be in \[1, 1000\]"),
     (["rings", "show", "OUT/none", "--out", "OUT/x.png", "--zoom", "1000000"], r"--zoom must be in \[1, 64\]"),
