@@ -106,30 +106,39 @@ def _check_then_rerun(cmd, env, out, timeout_s: float = 900) -> dict:
             "complete": all((out / n).exists() for n in OUTPUTS)}
 
 
-def _real_kill_then_rerun(make_cmd, folder: Path, full_s: float, share: float,
-                          tries: int = 4, shrink: float = 0.6) -> dict:
-    """One kill point that is a real kill: ``make_cmd(out)`` killed at ``share`` of the
-    calibrated run time ``full_s`` (s), then its outputs checked and rerun (:func:`_check_then_rerun`).
-
-    Each try runs cold, on a fresh cache and output folder under ``folder`` (as the calibration
-    run did: a warm cache or earlier outputs would make the run shorter or hide a partial file).
-    A run that ends before its kill (a loaded machine that sped up, a calibration that was slow:
-    a cold first run reads every module from disk) is tried again at ``share`` of the time that
-    run took, or ``shrink`` x the kill time if that is earlier, up to ``tries`` times; then the
-    point fails, with the timings, rather than passing without having killed anything."""
+def _real_kill(make_try, full_s: float, share: float, tries: int = 4, shrink: float = 0.6):
+    """Try ``i`` runs ``make_try(i) -> (cmd, env, out)`` and SIGKILLs it at ``share`` of the
+    calibrated run time ``full_s`` (s); returns ``(cmd, env, out, kill_s, tried)`` of the first
+    try that was a real kill. Each try runs cold, on its own fresh cache and output (as the
+    calibration run did: a warm cache or earlier outputs would make the run shorter or hide a
+    partial file). A run that ends before its kill (a loaded machine that sped up, a calibration
+    that was slow: a cold first run reads every module from disk) is tried again at ``share`` of
+    the time that run took, or ``shrink`` x the kill time if that is earlier, up to ``tries``
+    times; then the point fails, with the timings, rather than passing without having killed
+    anything."""
     kill_s, tried = share * full_s, []
     for i in range(tries):
-        out, cache = folder / f"out{i}", folder / f"cache{i}"
-        out.mkdir(parents=True)
-        cmd, env = make_cmd(out), _env(cache)
+        cmd, env, out = make_try(i)
         killed, ran_s = _start_and_kill(cmd, env, kill_s)
         tried.append(f"kill at {kill_s:.2f} s: " + ("killed" if killed else
                                                     f"ended by itself after {ran_s:.2f} s"))
         if killed:
-            return {"kill_s": round(kill_s, 2), "killed": True, "tries": tried,
-                    **_check_then_rerun(cmd, env, out)}
+            return cmd, env, out, kill_s, tried
         kill_s = min(kill_s * shrink, share * ran_s)
     pytest.fail(f"never killed: the calibration run took {full_s:.2f} s; {'; '.join(tried)}")
+
+
+def _real_kill_then_rerun(make_cmd, folder: Path, full_s: float, share: float) -> dict:
+    """One kill point that is a real kill (:func:`_real_kill`): ``make_cmd(out)`` on a fresh
+    output folder and cache under ``folder``, then its outputs checked and rerun
+    (:func:`_check_then_rerun`)."""
+    def make_try(i):
+        out = folder / f"out{i}"
+        out.mkdir(parents=True)
+        return make_cmd(out), _env(folder / f"cache{i}"), out
+
+    cmd, env, out, kill_s, tried = _real_kill(make_try, full_s, share)
+    return {"kill_s": round(kill_s, 2), "killed": True, "tries": tried, **_check_then_rerun(cmd, env, out)}
 
 
 def _ctrl_c(cmd, env, after_s: float, cwd=None) -> tuple[int, str, bool]:
@@ -277,20 +286,11 @@ def test_kill_points_on_a_mokume_fit(shared_data, tmp_path):
     cold_s = time.perf_counter() - t0
     bad = []
     for i in range(n):
-        share = float(rng.uniform(0.02, 0.9))
-        kill_s, tried = share * cold_s, []
-        for j in range(4):  # a run that ends before its kill point is tried again earlier
+        def make_try(j, i=i):
             out = tmp_path / f"f{i}_{j}.npz"
-            run = [c.replace("OUT", str(out)) for c in cmd]
-            env = _env(tmp_path / f"cache{i}_{j}")
-            killed, ran_s = _start_and_kill(run, env, kill_s)
-            if killed:
-                break
-            tried.append(f"kill at {kill_s:.2f} s: ended by itself after {ran_s:.2f} s")
-            kill_s = min(kill_s * 0.6, share * ran_s)  # as _real_kill_then_rerun
-        else:
-            bad.append((i, "never killed", "; ".join(tried)))
-            continue
+            return [c.replace("OUT", str(out)) for c in cmd], _env(tmp_path / f"cache{i}_{j}"), out
+
+        run, env, out, _, _ = _real_kill(make_try, cold_s, float(rng.uniform(0.02, 0.9)))
         if out.exists():
             try:
                 GridField.load(out)
