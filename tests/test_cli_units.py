@@ -335,10 +335,12 @@ def test_an_inch_place_error_quotes_the_op_as_typed(tmp_path, capsys):
 
     part = tmp_path / "p.stl"
     trimesh.creation.box((10.0, 10.0, 10.0)).apply_translation((20, 20, 20)).export(part)
-    for op, said in (("fit:1.5", "--place 'fit:1.5': a margin of 1.5 in leaves no room in the 2x2x2 in block"),
-                     ("translate:1e5,0,0", "--place 'translate:1e5,0,0': a move must stay within 100 m")):
+    # a margin too wide for this block is failed work (exit 1); a move out of range, a malformed
+    # command line (exit 2, at the door)
+    for op, said, rc in (("fit:1.5", "--place 'fit:1.5': a margin of 1.5 in leaves no room in the 2x2x2 in block", 1),
+                         ("translate:1e5,0,0", "--place 'translate:1e5,0,0': a move must stay within 100 m", 2)):
         assert main(["bake", str(part), "--units", "inch", "--block", "builtin:knotty:2x2x2",
-                     "--place", "center", "--place", op, "--out", str(tmp_path / "b.glb")]) == 1
+                     "--place", "center", "--place", op, "--out", str(tmp_path / "b.glb")]) == rc
         err = capsys.readouterr().err
         assert said in err and "38.1" not in err and "2540000" not in err, err
 
@@ -471,7 +473,8 @@ def test_an_inch_spec_is_the_block_its_mm_spelling_is(inch, mm, tmp_path, capsys
 def test_a_malformed_place_is_refused_before_the_block_is_opened(tmp_path, capsys, monkeypatch):
     """'bake --place fit:abc' (or rotate:q:90, or a negative fit margin) was refused only when the
     part was placed: after the block was opened (a photographed block's fit, 20-30 s the first
-    time) and the part loaded. It is refused first now, quoting the op as typed."""
+    time) and the part loaded. It is refused first now, quoting the op as typed, as a usage error
+    (exit 2: a wrong command line; it exited 1)."""
     import trimesh
 
     import woodcam.stock
@@ -485,7 +488,7 @@ def test_a_malformed_place_is_refused_before_the_block_is_opened(tmp_path, capsy
                      ("rotate:q:90", "--place 'rotate:q:90': expected rotate:AXIS:DEG"),
                      ("fit:-0.1", "--place 'fit:-0.1': a margin must be >= 0; got -0.1 in")):
         assert main(["bake", str(part), "--units", "inch", "--block", "builtin:knotty:2x2x2",
-                     "--place", "center", "--place", op, "--out", str(tmp_path / "b.glb")]) == 1
+                     "--place", "center", "--place", op, "--out", str(tmp_path / "b.glb")]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and said in err, err
     assert opened == []

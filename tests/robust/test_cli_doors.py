@@ -86,6 +86,19 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["woodify", "x.stl", "--years", "3", "--relief", "2", "--out", "OUT/w"], r"--relief must be in \[0, 1\]"),
     # a bad spec after a good tool number was reported as a bad number
     ([*GCODE, "--tool", "5=flat:6:7"], r"--tool '5=flat:6:7': tool spec 'flat:6:7': flat takes 1 number"),
+    # a malformed --place or --tool value, read by the library's parser after the door, exited 1
+    ([*BAKE, "--out", "OUT/x.glb", "--place", "fit:abc"], r"--place 'fit:abc': 'abc' is not a finite number"),
+    ([*BAKE, "--out", "OUT/x.glb", "--place", "rotate:q:90"], r"--place 'rotate:q:90': expected rotate:AXIS:DEG"),
+    ([*BAKE, "--out", "OUT/x.glb", "--place", "center", "--place", "fit:-0.1"],
+     r"--place 'fit:-0.1': a margin must be >= 0; got -0.1 mm"),
+    ([*BAKE, "--out", "OUT/x.glb", "--place", "spin"], r"--place 'spin' is not a placement operation"),
+    ([*GCODE, "--tool", "flat:abc"], r"--tool 'flat:abc': tool spec 'flat:abc': numbers expected after the type"),
+    ([*GCODE, "--tool", "x=ball:3"], r"--tool 'x=ball:3': the part before '=' must be a tool number"),
+    ([*GCODE, "--tool", "flat:-1"], r"--tool 'flat:-1': FlatEndMill: diameter_mm must be a positive number"),
+    ([*GCODE, "--tool", "flat:6", "--tool", "2=bull:6:9"], r"--tool '2=bull:6:9': BullNoseMill: corner_radius_mm"),
+    # in inches: the spec as typed, and as read in mm where only that breaks a rule
+    ([*GCODE[:-1], "0.02", "--units", "inch", "--tool", "flat:50"],
+     r"--tool 'flat:50' \(read as 'flat:1270' in mm\): FlatEndMill: diameter_mm must be a positive number in \(0, 1000\] mm"),
 ])
 def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(__import__("pathlib").Path(__file__).resolve().parents[2])
@@ -95,9 +108,10 @@ def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monk
     (out / "objdir" / "x.obj").mkdir(parents=True)
     argv = [a.replace("OUT", str(out)) for a in argv]
     t0 = time.perf_counter()
-    # a wrong command line exits 2 (the --out rule, a number out of range), failed work 1
+    # a wrong command line exits 2 (the --out rule, a number out of range, a malformed value
+    # quoted: "--tool 'flat:abc': ..."), failed work 1
     usage = ("--out of" in match or "is a FILE" in match
-             or __import__("re").match(r"--[a-z0-9-]+ (must be (in|a finite)|takes )", match))
+             or __import__("re").match(r"--[a-z0-9-]+ (must be (in|a finite)|takes |')", match))
     assert main(argv) == (EXIT_USAGE if usage else EXIT_ERROR)
     assert time.perf_counter() - t0 < 30.0  # refused before any fitting or baking (minutes)
     err = capsys.readouterr().err

@@ -260,14 +260,15 @@ def test_programs_and_tools_are_refused_before_the_block_is_opened(tmp_path, cap
     prog = tmp_path / "p.nc"
     prog.write_text("G0 X20 Y20 Z2 M3 S9000\nG1 Z-3 F600\nX40\nG0 Z2\nM2\n")
     base = ["--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb")]
-    for argv, said in (
+    for argv, said, rc in (
             ([str(tmp_path / "nope.nc"), "--tool", "flat:6"],
-             f"woodcam gcode: program {str(tmp_path / 'nope.nc')!r} is not a file; pass the G-code file(s)"),
+             f"woodcam gcode: program {str(tmp_path / 'nope.nc')!r} is not a file; pass the G-code file(s)", 1),
             ([str(prog), "--tools", str(tmp_path / "t.toml")],
-             f"--tools {str(tmp_path / 't.toml')!r} is not a file; pass a TOML tool table"),
-            ([str(prog), "--tool", "1=flat:abc"], "--tool '1=flat:abc': tool spec 'flat:abc'"),
-            ([str(prog)], "no tools given; pass --tool SPEC")):
-        assert main(["gcode", *argv, *base]) == 1
+             f"--tools {str(tmp_path / 't.toml')!r} is not a file; pass a TOML tool table", 1),
+            # a malformed --tool is a wrong command line (exit 2, at the door)
+            ([str(prog), "--tool", "1=flat:abc"], "--tool '1=flat:abc': tool spec 'flat:abc'", 2),
+            ([str(prog)], "no tools given; pass --tool SPEC", 1)):
+        assert main(["gcode", *argv, *base]) == rc
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and said in err, err
         assert "text_or_path" not in err and "path=" not in err

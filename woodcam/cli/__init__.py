@@ -211,12 +211,15 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     with warnings.catch_warnings(record=True) as caught, message_units(getattr(args, "units", None)):
         warnings.simplefilter("always")
         try:
-            from .options import check_numbers, check_out, check_screenshot, lengths_to_mm
+            from .options import check_numbers, check_out, check_screenshot, check_values, lengths_to_mm
 
             check_out(args)  # the --out rule, before any work
             check_screenshot(args)  # and a named --screenshot PNG's
             lengths_to_mm(args, parser)  # --units inch: every length in mm from here on
             check_numbers(args)  # every numeric option finite and in range, before any work
+            # the values a library parser reads (--place, --tool): a malformed one is a usage
+            # error, before the block is opened (a fit of minutes) and the part loaded
+            check_values(args)
             rc = args.func(args)
             _interrupt.check()  # a Ctrl-C a library swallowed: the run did not end as asked
             sys.stdout.flush()  # here, not at exit: a closed pipe is then caught below

@@ -117,12 +117,6 @@ def run_bake(args: argparse.Namespace) -> int:
     from ..cad.parts import check_part_path
 
     check_part_path(args.part)  # a missing part was said after the block was opened (its fit: 20-30 s)
-    if args.place:
-        # a malformed --place was refused only when the part was placed, after the block was
-        # opened (a photographed block's fit: 20-30 s) and the part loaded
-        from ..cad.place import parse_place
-
-        parse_place(args.place, as_typed=as_typed(args, "place"))
     apply_workers(args)
     shot = bool(getattr(args, "screenshot", None))
     camera_of(args, shot)  # a --camera without --screenshot warns before the work

@@ -126,7 +126,8 @@ def register(subparsers) -> None:
 
 
 def _tools_from_args(args, program) -> dict:
-    from ..toolpath.tools import load_tool_table, parse_tool_spec
+    from ..toolpath.tools import load_tool_table
+    from .options import parse_tool_option
 
     if args.tools and not Path(args.tools).is_file():  # load_tool_table named its parameter: "path='x'"
         raise WoodcamError(f"--tools {str(args.tools)!r} is not a file; pass a TOML tool table "
@@ -134,20 +135,12 @@ def _tools_from_args(args, program) -> dict:
                            "JSON tool table")
     tools = dict(load_tool_table(args.tools)) if args.tools else {}
     unnumbered = []
-    for item in args.tool:
-        if "=" in item.split(":", 1)[0]:  # N=SPEC (a spec's own key=value parts follow ':')
-            num, spec = item.split("=", 1)
-            try:
-                number = int(num)
-            except ValueError as err:
-                raise WoodcamError(f"--tool {item!r}: the part before '=' must be a tool "
-                                   "number, e.g. 2=ball:3") from err
-            try:
-                tools[number] = parse_tool_spec(spec)
-            except WoodcamError as err:  # what is wrong with the spec, not with the number
-                raise WoodcamError(f"--tool {item!r}: {err}") from err
+    for item in args.tool:  # read at the door already (options.check_values): a usage error there
+        number, tool = parse_tool_option(item)
+        if number is None:
+            unnumbered.append(tool)
         else:
-            unnumbered.append(parse_tool_spec(item))
+            tools[number] = tool
     if unnumbered:
         used = [t for t in dict.fromkeys(program.tool.tolist()) if t not in tools]
         if len(used) > 1 and 0 in used and program.tool_of_leading_rapids() is not None:

@@ -356,6 +356,73 @@ def as_typed(args: argparse.Namespace, dest: str):
     return getattr(args, dest, None) if typed is None else typed[0]
 
 
+def parse_tool_option(item: str):
+    """One ``--tool [N=]SPEC`` -> ``(N or None, the tool)`` (:func:`woodcam.toolpath.tools.parse_tool_spec`
+    reads the spec); a WoodcamError quoting ``item`` for a malformed one. A spec's own reach
+    parts (``flat:6:flute=22``) are key=value after a ':', so only an '=' before the first ':'
+    gives the tool number."""
+    from ..toolpath.tools import parse_tool_spec
+
+    number = None
+    spec = item
+    if "=" in item.split(":", 1)[0]:
+        num, spec = item.split("=", 1)
+        try:
+            number = int(num)
+        except ValueError as err:
+            raise WoodcamError(f"--tool {item!r}: the part before '=' must be a tool "
+                               "number, e.g. 2=ball:3") from err
+    try:
+        return number, parse_tool_spec(spec)
+    except WoodcamError as err:  # what is wrong with the spec, not with the number
+        if str(err).startswith("--tool "):
+            raise
+        raise WoodcamError(f"--tool {item!r}: {err}") from err
+
+
+def _check_places(ops, typed) -> None:
+    from ..cad.place import parse_place
+
+    parse_place(ops, as_typed=typed)
+
+
+def _check_tools(items, typed) -> None:
+    for item, as_typed_item in zip(items, typed):
+        # as typed first: its grammar errors quote what was typed (an inch run's spec in mm,
+        # "flat:152.4:7", beside a help in inches read as another spec); the spec in mm then
+        # for the rules in mm (the largest diameter)
+        parse_tool_option(as_typed_item)
+        if item != as_typed_item:
+            try:
+                parse_tool_option(item)
+            except WoodcamError as err:
+                said = str(err).removeprefix(f"--tool {item!r}: ")
+                raise WoodcamError(f"--tool {as_typed_item!r} (read as {item!r} in mm): {said}") from err
+
+
+#: Options whose values a library parser reads (the --units lengths in mm, the errors quoting
+#: the value as typed): checked at the door by :func:`check_values`.
+_PARSED_OPTIONS = {("bake", "place"): _check_places, ("gcode", "tool"): _check_tools}
+
+
+def check_values(args: argparse.Namespace) -> None:
+    """Read every option of :data:`_PARSED_OPTIONS` before any work; a malformed value (``--place
+    fit:abc``, ``--tool flat:abc``) is a UsageError (exit 2: a wrong command line, as argparse
+    says of a malformed number), with the parser's words. The library's parsers raise a plain
+    WoodcamError (a script's wrong value is no command line); the commands parse them again."""
+    command = getattr(args, "command", None)
+    for (cmd, dest), check in _PARSED_OPTIONS.items():
+        value = getattr(args, dest, None)
+        if cmd != command or not value:
+            continue
+        try:
+            check(value, as_typed(args, dest))
+        except UsageError:
+            raise
+        except WoodcamError as err:
+            raise UsageError(str(err)) from err
+
+
 def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction:
     """The sub-commands of command ``name``, created on first call (``kwargs`` go to
     ``add_parser``), shared by later calls: ``eval rings`` and ``eval appearance`` live in two
