@@ -262,6 +262,24 @@ def test_a_block_made_into_a_folder_with_an_unreadable_manifest_is_written(synth
         assert sorted(read_block(blk).faces) == ["back", "bottom", "front", "left", "right", "top"]
 
 
+def test_rings_detect_into_a_folder_with_an_unreadable_manifest_writes_over_it(synth_photos, tmp_path, capsys):
+    """'rings detect BLOCK --out OUT' looks for SVG corrections in OUT, and a block.json there cut
+    short or another JSON ended the command as an internal error (JSONDecodeError from
+    user_edited_faces). As 'block from-photos' does (574bdb5): a warning, and the block written."""
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
+    for text in ('{"format": "woodcam-block", "faces": {', "[1, 2]"):
+        out = tmp_path / f"out{len(text)}"
+        out.mkdir()
+        (out / "block.json").write_text(text)
+        rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", out, "--no-knots")
+        assert rc == 0, err
+        assert re.search(r"woodcam: warning: '.*block.json' is no readable block manifest .*no corrected SVG", err), err
+        b = read_block(out)
+        assert sorted(b.faces) == ["back", "bottom", "front", "left", "right", "top"]
+        assert all((out / f"{n}_traces.svg").is_file() for n in b.faces)
+
+
 def test_the_detection_cache_stays_in_the_cache_whatever_the_block_is_named(synth_photos, tmp_path, monkeypatch):
     """A block named "../../escaped/evil" cached its detection outside the cache folder, and a
     name of 250 characters failed with 'File name too long'."""

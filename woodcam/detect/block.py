@@ -153,6 +153,22 @@ def _detection_record(folder: Path) -> dict:
     return meta.get("detection_before") or {}
 
 
+def _readable_record(folder: Path) -> dict | None:
+    """:func:`_detection_record` of a folder about to be written over; None, with a warning that
+    it is overwritten, when its manifest is cut short or another JSON (it was an internal error
+    of 'block from-photos' and of 'rings detect ... --out FOLDER')."""
+    from ..block.io import MANIFEST
+
+    try:
+        return _detection_record(folder)
+    except ValueError as err:
+        warnings.warn(f"{str(folder / MANIFEST)!r} is no readable block manifest ({err}): it is "
+                      "overwritten, and no corrected SVG it recorded is kept (the next 'rings detect' "
+                      "draws every <face>_traces.svg there afresh; move a corrected one out first)",
+                      WoodcamWarning, stacklevel=3)
+        return None
+
+
 def detection_record(folder) -> dict | None:
     """The detection record of the block folder ``folder`` (its SVGs' and photos' digests and
     the SVGs' names, those still in the folder), for ``block from-photos`` to keep in the
@@ -167,13 +183,8 @@ def detection_record(folder) -> dict | None:
     folder = Path(folder)
     if not (folder / MANIFEST).is_file():
         return None
-    try:
-        rec = _detection_record(folder)
-    except ValueError as err:  # cut short, another JSON (was an internal error; it is overwritten)
-        warnings.warn(f"{str(folder / MANIFEST)!r} is no readable block manifest ({err}): it is "
-                      "overwritten, and no corrected SVG it recorded is kept (the next 'rings detect' "
-                      "draws every <face>_traces.svg there afresh; move a corrected one out first)",
-                      WoodcamWarning, stacklevel=2)
+    rec = _readable_record(folder)
+    if rec is None:
         return None
     svgs = {n: svg for n, svg in (rec.get("traces_svg") or {}).items()
             if isinstance(svg, str) and (folder / svg).is_file()}
@@ -187,7 +198,9 @@ def user_edited_faces(folder) -> dict[str, Path]:
     """Faces of a block folder whose ``<face>_traces.svg`` differs from what the detector wrote
     (a user corrected it) -> the SVG path."""
     folder = Path(folder)
-    rec = _detection_record(folder)
+    rec = _readable_record(folder)
+    if rec is None:  # an --out folder whose manifest is unreadable: written over, as from-photos does
+        return {}
     written = rec.get("svg_sha256", {})
     out = {}
     for name, svg in rec.get("traces_svg", {}).items():
