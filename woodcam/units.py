@@ -87,6 +87,12 @@ def message_units(units: Units | None) -> Iterator[None]:
         _message_units = before
 
 
+def message_unit() -> str:
+    """The symbol of the message units (:func:`message_units`): ``"mm"``, or ``"in"`` under
+    ``--units inch``, for a message that names the unit lengths are read in."""
+    return _SYMBOL[_message_units]
+
+
 def say_length(mm, spec: str = ".3g", sep: str = "x", form: str | None = None, *,
                units: Units | None = None) -> str:
     """A length (or several) given in mm, for a message, in the message units

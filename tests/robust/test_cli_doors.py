@@ -97,6 +97,11 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     ([*GCODE, "--tool", "flat:-1"], r"--tool 'flat:-1': FlatEndMill: diameter_mm must be a positive number"),
     ([*GCODE, "--tool", "flat:6", "--tool", "2=bull:6:9"], r"--tool '2=bull:6:9': BullNoseMill: corner_radius_mm"),
     # in inches: the spec as typed, and as read in mm where only that breaks a rule
+    ([*GCODE[:-1], "0.02", "--units", "inch", "--tool", "flat:0.25:0.5"],
+     r"--tool 'flat:0.25:0.5': tool spec 'flat:0.25:0.5': flat takes 1 number\(s\), got 2; .*\(in, degrees\)"),
+    ([*GCODE[:-1], "0.02", "--units", "inch", "--tool", "flat:0.25:flute=x"],
+     r"--tool 'flat:0.25:flute=x': tool spec 'flat:0.25:flute=x': flute= needs a number of in, got 'x'"),
+    ([*GCODE, "--tool", "flat:6:7"], r"--tool 'flat:6:7': tool spec 'flat:6:7': flat takes 1 number\(s\), got 2; .*\(mm, degrees\)"),
     ([*GCODE[:-1], "0.02", "--units", "inch", "--tool", "flat:50"],
      r"--tool 'flat:50' \(read as 'flat:1270' in mm\): FlatEndMill: diameter_mm must be a positive number in \(0, 1000\] mm"),
 ])

@@ -53,6 +53,7 @@ import numpy as np
 from .._checks import check_path
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
+from ..units import message_unit
 
 ToolType = Literal["flat", "ball", "bull", "vbit", "snub", "chamfer", "taperball"]
 TOOL_TYPES: tuple[str, ...] = ("flat", "ball", "bull", "vbit", "snub", "chamfer", "taperball")
@@ -443,9 +444,12 @@ class TaperedBallMill(Tool):
         return f"taperball:{self.diameter_mm:g}:{self.tip_diameter_mm:g}:{self.taper_deg:g}" + self._reach_spec()
 
 
-_SPEC_HELP = ("write flat:D, ball:D, bull:D:RC, vbit:ANGLE:D, snub:ANGLE:D:TIP, "
-              "chamfer:ANGLE:D:TIP or taperball:D:TIP:TAPER (mm, degrees), e.g. ball:3; "
-              "reach as :flute=L:shank=D:stickout=L:holder=D")
+def _spec_help() -> str:
+    # the lengths' unit is the message units': the CLI reads a --tool spec in --units
+    # (it said "(mm, degrees)" under --units inch)
+    return ("write flat:D, ball:D, bull:D:RC, vbit:ANGLE:D, snub:ANGLE:D:TIP, "
+            f"chamfer:ANGLE:D:TIP or taperball:D:TIP:TAPER ({message_unit()}, degrees), e.g. ball:3; "
+            "reach as :flute=L:shank=D:stickout=L:holder=D")
 
 
 def parse_tool_spec(spec: str) -> Tool:
@@ -457,26 +461,26 @@ def parse_tool_spec(spec: str) -> Tool:
         key, _, val = item.partition("=")
         if key not in REACH_FIELDS:
             raise WoodcamError(f"tool spec {spec!r}: {key!r} is not one of {list(REACH_FIELDS)} "
-                               f"(e.g. flat:6:flute=22:stickout=30:holder=35); {_SPEC_HELP}")
+                               f"(e.g. flat:6:flute=22:stickout=30:holder=35); {_spec_help()}")
         try:
             reach[REACH_FIELDS[key]] = float(val)
         except ValueError as err:
-            raise WoodcamError(f"tool spec {spec!r}: {key}= needs a number of mm, got {val!r}"
+            raise WoodcamError(f"tool spec {spec!r}: {key}= needs a number of {message_unit()}, got {val!r}"
                                ) from err
     parts = [p for p in parts if "=" not in p]
     try:
         nums = [float(p) for p in parts[1:]]
     except ValueError as err:
-        raise WoodcamError(f"tool spec {spec!r}: numbers expected after the type; {_SPEC_HELP}"
+        raise WoodcamError(f"tool spec {spec!r}: numbers expected after the type; {_spec_help()}"
                            ) from err
     want = {"flat": 1, "ball": 1, "bull": 2, "vbit": 2, "snub": 3, "chamfer": 3,
             "taperball": 3}
     if kind not in want:
         raise WoodcamError(f"tool spec {spec!r}: type must be one of {TOOL_TYPES}, got "
-                           f"{kind!r}; {_SPEC_HELP}")
+                           f"{kind!r}; {_spec_help()}")
     if len(nums) != want[kind]:
         raise WoodcamError(f"tool spec {spec!r}: {kind} takes {want[kind]} number(s), got "
-                           f"{len(nums)}; {_SPEC_HELP}")
+                           f"{len(nums)}; {_spec_help()}")
     if kind == "flat":
         return FlatEndMill(nums[0], **reach)
     if kind == "ball":
