@@ -454,18 +454,24 @@ def test_a_rerun_removes_the_deviation_map_and_the_bakes_report_it_does_not_writ
     assert sorted(p.name for p in tmp_path.iterdir()) == [".woodcam-g.glb-files.json", "box.stl", "g.glb"]
 
 
-def test_a_ctrl_c_while_baking_leaves_the_earlier_deviation_map_with_its_glb(tmp_path, capsys, monkeypatch):
-    """The deviation map was written before the stock was meshed and baked: a Ctrl-C there left
-    the new cut's map beside the earlier run's GLB (a map of another cut). It is drawn once the
-    GLB set is in place: interrupted, the folder is the earlier run's."""
+def _drilling_with_part(tmp_path) -> list[str]:
+    """The gcode command line of drilling.nc on builtin:flat-sawn with a 20 mm box as --part
+    (a deviation map), written to tmp_path/g.glb."""
     import trimesh
 
     box = trimesh.creation.box((20, 20, 20))
     box.apply_translation((50, 40, 25))
     box.export(tmp_path / "box.stl")
-    gcode = ["gcode", str(REPO / "toolpaths" / "drilling.nc"), "--tool", "flat:6", "--block",
-             "builtin:flat-sawn", "--cell-size", "1", "--out", str(tmp_path / "g.glb"), "--no-obj",
-             "--part", str(tmp_path / "box.stl")]
+    return ["gcode", str(REPO / "toolpaths" / "drilling.nc"), "--tool", "flat:6", "--block",
+            "builtin:flat-sawn", "--cell-size", "1", "--out", str(tmp_path / "g.glb"), "--no-obj",
+            "--part", str(tmp_path / "box.stl")]
+
+
+def test_a_ctrl_c_while_baking_leaves_the_earlier_deviation_map_with_its_glb(tmp_path, capsys, monkeypatch):
+    """The deviation map was written before the stock was meshed and baked: a Ctrl-C there left
+    the new cut's map beside the earlier run's GLB (a map of another cut). It is drawn once the
+    GLB set is in place: interrupted, the folder is the earlier run's."""
+    gcode = _drilling_with_part(tmp_path)
     assert main(gcode) == 0
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
 
@@ -483,17 +489,10 @@ def test_a_ctrl_c_while_the_deviation_map_is_drawn_leaves_no_earlier_map_beside_
     it was drawn left the earlier run's NAME_deviation.png (another cut's) beside the new GLB,
     passing for its map until the next run, the fault 6825aa1 fixed for NAME_view.png. The
     earlier map is gone once the new GLB has landed."""
-    import trimesh
-
     import woodcam.toolpath.deviation as deviation_module
     from woodcam.export import read_glb_metadata
 
-    box = trimesh.creation.box((20, 20, 20))
-    box.apply_translation((50, 40, 25))
-    box.export(tmp_path / "box.stl")
-    gcode = ["gcode", str(REPO / "toolpaths" / "drilling.nc"), "--tool", "flat:6", "--block",
-             "builtin:flat-sawn", "--cell-size", "1", "--out", str(tmp_path / "g.glb"), "--no-obj",
-             "--part", str(tmp_path / "box.stl")]
+    gcode = _drilling_with_part(tmp_path)
     assert main(gcode) == 0
     dev = tmp_path / "g_deviation.png"
     assert dev.is_file() and "until_line" not in read_glb_metadata(tmp_path / "g.glb")
