@@ -391,13 +391,26 @@ def _check_tools(items, typed) -> None:
         # as typed first: its grammar errors quote what was typed (an inch run's spec in mm,
         # "flat:152.4:7", beside a help in inches read as another spec); the spec in mm then
         # for the rules in mm (the largest diameter)
-        parse_tool_option(as_typed_item)
+        try:
+            parse_tool_option(as_typed_item)
+        except WoodcamError as err:
+            # a tool's own rule broken by the inch numbers is said of the spec in mm: it said
+            # "--tool 'flat:2000': ... in (0, 1000] mm, got 2000.0" of 2000 in (50800 mm)
+            if item == as_typed_item or _is_grammar_error(err, as_typed_item):
+                raise
         if item != as_typed_item:
             try:
                 parse_tool_option(item)
             except WoodcamError as err:
                 said = str(err).removeprefix(f"--tool {item!r}: ")
                 raise WoodcamError(f"--tool {as_typed_item!r} (read as {item!r} in mm): {said}") from err
+
+
+def _is_grammar_error(err: WoodcamError, item: str) -> bool:
+    """Whether ``err`` of :func:`parse_tool_option` ``(item)`` is about the ``[N=]SPEC`` grammar
+    (the same in any units), not a tool's rule on its numbers (a tool class's, in mm)."""
+    said = str(err).removeprefix(f"--tool {item!r}: ")
+    return said.startswith(("tool spec ", "the part before '='"))
 
 
 #: Options whose values a library parser reads (the --units lengths in mm, the errors quoting
