@@ -427,18 +427,26 @@ def test_a_no_obj_rerun_removes_the_earlier_runs_obj(tmp_path, capsys):
     assert "removed 3 file(s) of an earlier run" in capsys.readouterr().err
 
 
-def test_a_rerun_removes_the_deviation_map_and_the_bakes_report_it_does_not_write(tmp_path, capsys):
-    """gcode without --part left the earlier run's NAME_deviation.png (a map of another cut),
-    and gcode into a GLB bake wrote left bake's NAME_report.* (a part's volume and yield) beside
-    the simulated stock: both passed for this run's. Only files an earlier run listed go."""
+def _drilling_with_part(tmp_path) -> list[str]:
+    """The gcode command line of drilling.nc on builtin:flat-sawn with a 20 mm box as --part
+    (a deviation map), written to tmp_path/g.glb."""
     import trimesh
 
     box = trimesh.creation.box((20, 20, 20))
     box.apply_translation((50, 40, 25))
     box.export(tmp_path / "box.stl")
-    gcode = ["gcode", str(REPO / "toolpaths" / "drilling.nc"), "--tool", "flat:6", "--block",
-             "builtin:flat-sawn", "--cell-size", "1", "--out", str(tmp_path / "g.glb"), "--no-obj"]
-    assert main([*gcode, "--part", str(tmp_path / "box.stl")]) == 0
+    return ["gcode", str(REPO / "toolpaths" / "drilling.nc"), "--tool", "flat:6", "--block",
+            "builtin:flat-sawn", "--cell-size", "1", "--out", str(tmp_path / "g.glb"), "--no-obj",
+            "--part", str(tmp_path / "box.stl")]
+
+
+def test_a_rerun_removes_the_deviation_map_and_the_bakes_report_it_does_not_write(tmp_path, capsys):
+    """gcode without --part left the earlier run's NAME_deviation.png (a map of another cut),
+    and gcode into a GLB bake wrote left bake's NAME_report.* (a part's volume and yield) beside
+    the simulated stock: both passed for this run's. Only files an earlier run listed go."""
+    with_part = _drilling_with_part(tmp_path)
+    gcode = with_part[:with_part.index("--part")]  # the same run without the part
+    assert main(with_part) == 0
     assert (tmp_path / "g_deviation.png").is_file()
     capsys.readouterr()
     assert main(gcode) == 0
@@ -452,19 +460,6 @@ def test_a_rerun_removes_the_deviation_map_and_the_bakes_report_it_does_not_writ
     assert re.search(r"warning: removed 2 file\(s\) .*: g_report.txt, g_report.json$",
                      capsys.readouterr().err, re.M)
     assert sorted(p.name for p in tmp_path.iterdir()) == [".woodcam-g.glb-files.json", "box.stl", "g.glb"]
-
-
-def _drilling_with_part(tmp_path) -> list[str]:
-    """The gcode command line of drilling.nc on builtin:flat-sawn with a 20 mm box as --part
-    (a deviation map), written to tmp_path/g.glb."""
-    import trimesh
-
-    box = trimesh.creation.box((20, 20, 20))
-    box.apply_translation((50, 40, 25))
-    box.export(tmp_path / "box.stl")
-    return ["gcode", str(REPO / "toolpaths" / "drilling.nc"), "--tool", "flat:6", "--block",
-            "builtin:flat-sawn", "--cell-size", "1", "--out", str(tmp_path / "g.glb"), "--no-obj",
-            "--part", str(tmp_path / "box.stl")]
 
 
 def test_a_ctrl_c_while_baking_leaves_the_earlier_deviation_map_with_its_glb(tmp_path, capsys, monkeypatch):
