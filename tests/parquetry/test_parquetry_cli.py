@@ -323,6 +323,17 @@ def test_a_veneer_id_that_is_no_file_name_part_is_refused(scans, capsys, bad):
     assert [v["id"] for v in json.loads((out / "result.json").read_text())["veneers"]] == ["oak.v2-1", "dark"]
 
 
+def test_veneer_ids_that_differ_only_in_case_are_refused(scans):
+    """'Oak' and 'oak' passed the uniqueness check, yet name one veneer_oak.svg on a
+    case-insensitive file system (one sheet's cut files over the other's)."""
+    from woodcam.parquetry import build_parquetry, load_scan
+
+    a = load_scan(scans / "light.png", dpi=50.8, id="Oak")
+    b = load_scan(scans / "dark.png", dpi=50.8, id="oak")
+    with pytest.raises(WoodcamError, match=r"unique, letter case aside .* got \['Oak', 'oak'\]"):
+        build_parquetry([np.full((8, 8), 0.5, np.float32)], [a, b])
+
+
 def test_the_job_file_of_a_run_with_relative_paths_reruns_from_anywhere(scans, capsys, monkeypatch):
     """job.json kept the paths as typed (coffee.png, relative to the working folder) and a job
     file's paths are read relative to its own folder: --config out/job.json looked for

@@ -254,9 +254,12 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     if names is not None and (isinstance(names, str) or len(names) != len(targets)):  # an IndexError
         raise WoodcamError(f"names must be one name per target ({len(targets)}); got {names!r:.80}")
     ids = [check_veneer_id(v.id, f"veneers[{i}].id") for i, v in enumerate(veneers)]
-    if len(set(ids)) != len(ids):
-        twice = sorted({i for i in ids if ids.count(i) > 1})
-        raise WoodcamError(f"veneer ids must be unique (each names its cut files veneer_<id>.svg/.dxf); "
+    # unique up to case: 'A' and 'a' name one veneer_A.svg on a case-insensitive file system
+    folded = [i.casefold() for i in ids]
+    if len(set(folded)) != len(folded):
+        twice = sorted({i for i in ids if folded.count(i.casefold()) > 1})
+        raise WoodcamError(f"veneer ids must be unique, letter case aside (each names its cut files "
+                           f"veneer_<id>.svg/.dxf); "
                            f"got {twice} more than once; give the sheets their own ids (a job file's "
                            "source_textures 'id'), and slice a block once, with more --sheets")
     sheets = [v.resampled(params.px_per_mm) for v in veneers]
