@@ -375,8 +375,6 @@ def parse_tool_option(item: str):
     try:
         return number, parse_tool_spec(spec)
     except WoodcamError as err:  # what is wrong with the spec, not with the number
-        if str(err).startswith("--tool "):
-            raise
         raise WoodcamError(f"--tool {item!r}: {err}") from err
 
 
