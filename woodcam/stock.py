@@ -49,6 +49,7 @@ import numpy as np
 from ._specs import ParsedSpec, format_op, parse_spec, split_spec
 from .appearance import ColorMapAppearance, NeuralAppearance, Wood
 from .errors import WoodcamError, WoodcamWarning
+from .fields.base import has_uncertainty
 from .fields.builtin import BUILTIN_NAMES, builtin_block
 
 AppearanceKind = Literal["colormap", "neural"]
@@ -413,7 +414,7 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
                                save=lambda f, tmp: f.save(tmp), what=f"fitted field of block {block.name!r}")
     meta = getattr(field, "meta", None)
     meta = meta if isinstance(meta, dict) else {}
-    if "uncertainty" in getattr(field, "layers", {}) and "size_mm" not in meta:
+    if has_uncertainty(field) and "size_mm" not in meta:
         # an evidence fit cached before bake_evidence recorded the box its faces are named in
         # (the same cache key): the block it is keyed by. uncertainty_report measured a cut
         # stock's nearest face in the stock's own box without it, and named the wrong one.
