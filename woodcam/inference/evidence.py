@@ -935,13 +935,13 @@ def uncertainty_report(wood, points_mm, size_mm, what: str = "part", *,
     # With every face photographed there is no face left to ask for: the hypotheses disagree
     # there, so the advice is to check (or trace) the rings found on the nearest face instead.
     face = min(unseen or FACES, key=dist.__getitem__)
+    face_word = f"{face} face"
     if not wood.in_source_frame:  # the photos' name, and this block's where a turn renamed it
         mine = next(f for f in FACES if wood.source_face(f) == face)
-        face = f"fitted block's {face}" + (f" face (this block's {mine})" if mine != face else "")
+        face_word = f"fitted block's {face_word}" + (f" (this block's {mine})" if mine != face else "")
     place = "middle" if t == 1 else AXIS_ENDS[ax][t // 2]
     axis_word = ("left-right", "front-back", "bottom-top")[ax]
     # a face outside the fit may be missing or photographed with no rings found: ask for both
-    face_word = face if face.endswith(")") else f"{face} face"
     advice = (f"photograph the {face_word} or trace its rings" if unseen else
               f"every face was used: check the rings found on the {face_word} "
               "(woodcam rings show) or trace more of them")
