@@ -527,6 +527,12 @@ class Interpreter:
     def err(self, word, rule, fix):
         return GcodeError(self.line_no, word, rule, fix)
 
+    def _not_simulated(self, word, what_fix):
+        """The error of a code LinuxCNC runs and woodcam refuses on purpose
+        (:data:`_G_NOT_SIMULATED`, :data:`_M_NOT_SIMULATED` give ``(what it does, the fix)``)."""
+        what, fix = what_fix
+        return self.err(word, f"{word} ({what}) is not simulated by woodcam (LinuxCNC runs it)", fix)
+
     def warn(self, msg):
         self.warnings.append((self.line_no, msg))
 
@@ -1496,9 +1502,7 @@ class Interpreter:
                                f"the program has G{20 if v == 70 else 21} already), or post "
                                "for LinuxCNC")
             if abs(v - c) <= 1e-4 and c in _G_NOT_SIMULATED:
-                what, fix = _G_NOT_SIMULATED[c]
-                raise self.err(f"G{v:g}", f"G{v:g} ({what}) is not simulated by woodcam "
-                               "(LinuxCNC runs it)", fix)
+                raise self._not_simulated(f"G{v:g}", _G_NOT_SIMULATED[c])
             if (abs(v - c) > 1e-4 or c not in _G_KNOWN) and c not in _G_REFUSED:
                 raise self.err(f"G{v:g}", "unsupported G code (woodcam reads the G codes "
                                "listed in woodcam.toolpath.interpreter)",
@@ -1543,9 +1547,7 @@ class Interpreter:
                 mset.add(99)  # the main program's M99: ends the pass (see below)
                 continue
             if v == math.floor(v) and int(v) in _M_NOT_SIMULATED:
-                what, fix = _M_NOT_SIMULATED[int(v)]
-                raise self.err(f"M{v:g}", f"M{v:g} ({what}) is not simulated by woodcam "
-                               "(LinuxCNC runs it)", fix)
+                raise self._not_simulated(f"M{v:g}", _M_NOT_SIMULATED[int(v)])
             if v != math.floor(v) or int(v) not in _M_KNOWN:
                 raise self.err(f"M{v:g}", "unsupported M code (woodcam reads M0-M9, M30, "
                                "M48-M53, M60, M61; M19, M62-M68 and M100-M199 with a warning)", "remove it or post-process for a 3-axis mill")
