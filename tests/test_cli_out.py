@@ -110,9 +110,10 @@ def test_a_folder_that_cannot_be_made_is_refused_before_work(path, p, tmp_path, 
 def test_an_existing_folder_that_cannot_be_written_is_refused_in_bakes_words(path, p, capsys):
     """Sweep h8 item 3: ``rings detect BLOCK --out EXISTING_READ_ONLY_FOLDER`` said 'cannot make
     the folder', of a folder that exists; it is not writable, said as a FILE --out's folder is
-    (test_a_file_in_a_folder_that_cannot_be_written_is_refused_before_work), exit 1 as there."""
+    (test_a_file_in_a_folder_that_cannot_be_written_is_refused_before_work). It exited 1 where
+    a folder that cannot be made exited 2, the same fix (another --out): a usage error, exit 2."""
     capsys.readouterr()
-    assert main(_argv(path, p, "/proc/self")) == 1  # read-only even for root
+    assert main(_argv(path, p, "/proc/self")) == EXIT_USAGE  # read-only even for root
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"woodcam: error: --out of 'woodcam {' '.join(path)}': the folder '/proc/self' is not "
                    "writable (No such file or directory); choose an output folder you can write to"], err
@@ -139,10 +140,11 @@ FILE_COMMANDS = [c for c in COMMANDS if c[1].get_default("_out_suffixes")]
 @pytest.mark.parametrize("path,p", FILE_COMMANDS, ids=[" ".join(c[0]) for c in FILE_COMMANDS])
 def test_a_file_in_a_folder_that_cannot_be_written_is_refused_before_work(path, p, capsys):
     """Sweep h5 item 8: ``block show --out /proc/k.png`` did the work, then failed naming its
-    temporary file ('/proc/.k.png.13252-6nk58k2c.tmp.png')."""
+    temporary file ('/proc/.k.png.13252-6nk58k2c.tmp.png'). Exit 2, as a folder that cannot be
+    made (it was 1)."""
     out = "/proc/self/k" + p.get_default("_out_suffixes")[0]  # read-only even for root
     capsys.readouterr()
-    assert main(_argv(path, p, out)) == 1
+    assert main(_argv(path, p, out)) == EXIT_USAGE
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"woodcam: error: --out of 'woodcam {' '.join(path)}': the folder '/proc/self' is not "
                    "writable (No such file or directory); choose an output folder you can write to"], err
@@ -200,3 +202,21 @@ def test_previews_name_less_screenshot_beside_mesh_is_checked_before_work(tmp_pa
     assert err == [f"woodcam: error: --screenshot of 'woodcam preview' is a FILE ending in .png; got "
                    f"{str(tmp_path / 'part_view.png')!r}, an existing folder (--screenshot without a "
                    f"name writes MESH_view.png); give e.g. {str(tmp_path / 'part_view.png' / 'view.png')!r}"]
+
+
+@pytest.mark.parametrize("argv, beside", [
+    (["gcode", "x.nc", "--block", "builtin:flat-sawn", "--tool", "flat:6", "--part", "p.stl", "--out",
+      "OUT/g.glb"], "g_deviation.png"),
+    (["place", "p.py", "--block", "builtin:flat-sawn", "--out", "OUT"], "placements.json"),
+    (["bake", "x.py", "--block", "builtin:flat-sawn", "--out", "OUT/b.glb"], "b.mtl"),
+])
+def test_a_file_written_beside_out_that_cannot_be_written_is_a_usage_error(argv, beside, tmp_path, capsys):
+    """The files a command writes beside its --out (gcode's deviation PNG, place's
+    placements.json, bake's OBJ set) are checked before any work; one that is a folder exited 1
+    where --out itself exited 2 for the same fix (another --out)."""
+    (tmp_path / beside).mkdir()
+    capsys.readouterr()
+    assert main([a.replace("OUT", str(tmp_path)) for a in argv]) == EXIT_USAGE
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("woodcam: error: --out") and "is an existing folder" in err[0], err
+    assert sorted(p.name for p in tmp_path.iterdir()) == [beside]  # nothing was done

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
-from .options import (BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
+from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
                       add_workers_option, allow_negative_values, apply_workers, as_typed, camera_of,
                       remove_stale_outputs, stock_options, vector_type, write_screenshot)
 
@@ -113,7 +113,8 @@ def run_bake(args: argparse.Namespace) -> int:
     from .._progress import StageBar
     from ..pipeline import part_stages
 
-    check_outputs(args.out, obj=not args.no_obj, screenshot=getattr(args, "screenshot", None) or False)
+    with output_refused_at_the_door():  # the OBJ set beside the GLB, its view PNG
+        check_outputs(args.out, obj=not args.no_obj, screenshot=getattr(args, "screenshot", None) or False)
     from ..cad.parts import check_part_path
 
     check_part_path(args.part)  # a missing part was said after the block was opened (its fit: 20-30 s)

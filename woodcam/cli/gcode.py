@@ -13,7 +13,7 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
-from .options import (BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
+from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
                       allow_negative_values, camera_of, drop_earlier_output, remove_stale_outputs, sizes_type,
                       stock_options, vector_type)
 
@@ -175,14 +175,16 @@ def run(args) -> int:
     if not (math.isfinite(args.rapid_rate) and args.rapid_rate > 0):
         raise WoodcamError(f"--rapid-rate {args.rapid_rate}: give a rate > 0 in mm/min, e.g. "
                            "5000")
-    check_outputs(args.out, obj=not args.no_obj, screenshot=args.screenshot or False)
+    with output_refused_at_the_door():  # the OBJ set beside the GLB, its view PNG
+        check_outputs(args.out, obj=not args.no_obj, screenshot=args.screenshot or False)
     camera_of(args, bool(args.screenshot))  # a --camera without --screenshot warns before the work
     design = None
     if args.part:  # a missing or unreadable design part failed only after the whole simulation
         from .._atomic import check_output_path
         from ..cad import load_part
 
-        check_output_path(_deviation_png(args.out), what="--out (its deviation PNG, with --part)")
+        with output_refused_at_the_door():
+            check_output_path(_deviation_png(args.out), what="--out (its deviation PNG, with --part)")
         try:
             design = load_part(args.part)
         except WoodcamError as err:

@@ -23,6 +23,8 @@ import argparse
 import math
 import os
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from .._types import CAMERAS
@@ -111,7 +113,8 @@ def check_out(args: argparse.Namespace) -> None:
         if out.parent.is_dir():  # a real write probe: as root os.access() says yes even to /proc
             from .._atomic import check_output_path
 
-            check_output_path(out, what=f"--out of 'woodcam {command}'")
+            with output_refused_at_the_door():
+                check_output_path(out, what=f"--out of 'woodcam {command}'")
         else:  # the missing folder is made when the file is written: under a file it failed after the work
             _check_folder_can_be_made(out.parent, command)
     elif suffix in FILE_SUFFIXES or out.is_file():
@@ -152,9 +155,25 @@ def check_screenshot(args: argparse.Namespace) -> None:
     if shot.parent.is_dir():
         from .._atomic import check_output_path
 
-        check_output_path(shot, what=f"--screenshot of 'woodcam {command}'")
+        with output_refused_at_the_door():
+            check_output_path(shot, what=f"--screenshot of 'woodcam {command}'")
     else:
         _check_folder_can_be_made(shot.parent, command, "--screenshot")
+
+
+@contextmanager
+def output_refused_at_the_door() -> Iterator[None]:
+    """An output path the library's checks (:func:`woodcam._atomic.check_output_path`,
+    :func:`woodcam.pipeline.check_outputs`) refuse before any work is a usage error (exit 2,
+    one line), whatever the reason: a folder that cannot be made and one that exists but cannot
+    be written were told apart (exit 2 and exit 1) though the fix is the same, another
+    ``--out``. The library raises a plain WoodcamError (a script's path is no command line)."""
+    try:
+        yield
+    except UsageError:
+        raise
+    except WoodcamError as err:
+        raise UsageError(str(err)) from err
 
 
 def _check_folder_can_be_made(folder: Path, command: str, option: str = "--out") -> None:
@@ -162,14 +181,15 @@ def _check_folder_can_be_made(folder: Path, command: str, option: str = "--out")
     existing ancestor must be a folder one may write in, else a UsageError before any work. An
     ``--out`` folder that exists already is made by no one: it must be writable
     (:func:`woodcam._atomic.check_folder_writable`, the words of bake's ``--out`` into a
-    read-only folder; it was 'cannot make the folder')."""
+    read-only folder; it was 'cannot make the folder'). Either refusal exits 2."""
     from ..errors import UsageError
 
     base = folder.absolute()
     if base.is_dir():
         from .._atomic import check_folder_writable
 
-        check_folder_writable(folder, what=f"{option} of 'woodcam {command}'")
+        with output_refused_at_the_door():
+            check_folder_writable(folder, what=f"{option} of 'woodcam {command}'")
         return
     while not base.exists() and base != base.parent:
         base = base.parent
