@@ -495,3 +495,46 @@ def test_a_malformed_place_is_refused_before_the_block_is_opened(tmp_path, capsy
     assert main(["bake", str(part), "--block", "builtin:flat-sawn", "--place", "center", "--place", "fit:1",
                  "--out", str(tmp_path / "b.glb"), "--no-obj", "--texels-per-mm", "1"]) == 0
     assert len(opened) == 1
+
+
+@pytest.mark.parametrize("tool, says", [
+    ("flat:2000", "FlatEndMill: the diameter must be a positive number in (0, 39.37] in, got 2000 in; give the "
+                  "cutting diameter in inches"),
+    ("ball:-0.5", "BallEndMill: the diameter must be a positive number in (0, 39.37] in, got -0.5 in; give the "
+                  "cutting diameter in inches"),
+    ("bull:0.25:0.2", "BullNoseMill: the corner radius must be in (0, diameter/2 = 0.125] in, got 0.2 in; use "
+                      "ball for rc = R or flat for rc = 0"),
+    ("snub:60:0.5:0.6", "SnubNoseVBit: the tip diameter must be in [0, diameter = 0.5) in, got 0.6 in"),
+    ("chamfer:90:0.5:0.5", "ChamferMill: the tip diameter must be in [0, diameter = 0.5) in, got 0.5 in"),
+    ("taperball:0.1:0.2:3", "TaperedBallMill: the tip diameter must be in (0, diameter = 0.1] in, got 0.2 in"),
+    ("flat:0.25:shank=-1", "FlatEndMill: shank= must be a positive length in (0, 393.7] in, got -1 in"),
+    ("vbit:60:0.5:flute=0.1:stickout=0.05:holder=1",
+     "VBit: stickout=0.05 in (tip to holder) is shorter than flute=0.1 in; the holder would cover the flutes"),
+    ("flat:0.25:holder=1", "FlatEndMill: holder= and stickout= go together (the holder's size and where it "
+                           "starts above the tip); got 1 in and None"),
+])
+def test_a_tools_rule_under_units_inch_speaks_inches(tool, says, tmp_path, capsys):
+    """Tool-building errors spoke mm under --units inch: "--tool 'flat:2000' (read as 'flat:50800'
+    in mm): FlatEndMill: diameter_mm must be a positive number in (0, 1000] mm, got 50800", of a
+    spec typed in inches; a bull's corner, a tip, the reach likewise."""
+    argv = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--out", str(tmp_path / "g.glb"),
+            "--units", "inch", "--tool", tool]
+    capsys.readouterr()
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"woodcam: error: --tool {tool!r}: {says}"], err
+    assert not re.search(r"\bmm\b|_mm", err[0]), err
+
+
+def test_a_tool_tables_rule_stays_mm_under_units_inch_and_names_its_entry(tmp_path, capsys):
+    """A tool table's keys and numbers are mm whatever --units says (files stay mm): its refusal
+    speaks mm and its keys, and names the table and the entry (it named neither)."""
+    table = tmp_path / "tools.toml"
+    table.write_text('[tools.3]\ntype = "bull"\ndiameter_mm = 6\ncorner_radius_mm = 4\n')
+    argv = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--out", str(tmp_path / "g.glb"),
+            "--units", "inch", "--tools", str(table)]
+    capsys.readouterr()
+    assert main(argv) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"woodcam: error: load_tool_table: {table}: [tools.3]: BullNoseMill: corner_radius_mm must be "
+                   "in (0, diameter/2 = 3] mm, got 4 mm; use ball for rc = R or flat for rc = 0"], err

@@ -104,16 +104,16 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     ([*GCODE[:-1], "0.02", "--units", "inch", "--tool", "flat:0.25:flute=x"],
      r"--tool 'flat:0.25:flute=x': tool spec 'flat:0.25:flute=x': flute= needs a number of in, got 'x'"),
     ([*GCODE, "--tool", "flat:6:7"], r"--tool 'flat:6:7': tool spec 'flat:6:7': flat takes 1 number\(s\), got 2; .*\(mm, degrees\)"),
+    # a tool's rule in inches is said in inches, of the spec as typed (it compared 2000 in with
+    # 1000 mm, "got 2000.0"; then said it of the spec read in mm, "(read as 'flat:50800' in mm)
+    # ... (0, 1000] mm, got 50800", beside a spec the user typed in inches)
     ([*GCODE[:-1], "0.02", "--units", "inch", "--tool", "flat:50"],
-     r"--tool 'flat:50' \(read as 'flat:1270' in mm\): FlatEndMill: diameter_mm must be a positive number in \(0, 1000\] mm"),
-    # a rule broken by the inch numbers themselves is said of the spec in mm too (it compared
-    # 2000 in with 1000 mm, "got 2000.0"), and of a bull's corner in mm beside its diameter in mm
+     r"--tool 'flat:50': FlatEndMill: the diameter must be a positive number in \(0, 39.37\] in, got 50 in; "
+     r"give the cutting diameter in inches$"),
     ([*GCODE[:-1], "0.02", "--units", "inch", "--tool", "flat:2000"],
-     r"--tool 'flat:2000' \(read as 'flat:50800' in mm\): FlatEndMill: diameter_mm must be a positive number in "
-     r"\(0, 1000\] mm, got 50800"),
+     r"--tool 'flat:2000': FlatEndMill: the diameter must be a positive number in \(0, 39.37\] in, got 2000 in"),
     ([*GCODE[:-1], "0.02", "--units", "inch", "--tool", "bull:0.5:0.3"],
-     r"--tool 'bull:0.5:0.3' \(read as 'bull:12.7:7.62' in mm\): BullNoseMill: corner_radius_mm must be in "
-     r"\(0, diameter/2 = 6.35\], got 7.62"),
+     r"--tool 'bull:0.5:0.3': BullNoseMill: the corner radius must be in \(0, diameter/2 = 0.25\] in, got 0.3 in;"),
 ])
 def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(__import__("pathlib").Path(__file__).resolve().parents[2])

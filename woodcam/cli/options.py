@@ -420,8 +420,10 @@ def _check_tools(items, typed) -> None:
             try:
                 parse_tool_option(item)
             except WoodcamError as err:
+                # the tool's rule in the message units (--units): its lengths as typed (it said
+                # "(read as 'flat:50800' in mm): ... (0, 1000] mm, got 50800" of flat:2000 inches)
                 said = str(err).removeprefix(f"--tool {item!r}: ")
-                raise WoodcamError(f"--tool {as_typed_item!r} (read as {item!r} in mm): {said}") from err
+                raise WoodcamError(f"--tool {as_typed_item!r}: {said}") from err
 
 
 def _is_grammar_error(err: WoodcamError, item: str) -> bool:

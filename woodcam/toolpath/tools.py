@@ -53,7 +53,7 @@ import numpy as np
 from .._checks import check_path
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
-from ..units import message_unit
+from ..units import message_unit, message_units, say_length
 
 ToolType = Literal["flat", "ball", "bull", "vbit", "snub", "chamfer", "taperball"]
 TOOL_TYPES: tuple[str, ...] = ("flat", "ball", "bull", "vbit", "snub", "chamfer", "taperball")
@@ -67,6 +67,29 @@ MAX_TOOL_DIAMETER_MM = 1000.0
 #: The reach fields of a tool (keyword-only, all optional, mm) and their spec/TOML names.
 REACH_FIELDS = {"flute": "flute_length_mm", "shank": "shank_diameter_mm",
                 "stickout": "stickout_mm", "holder": "holder_diameter_mm"}
+
+#: A length field as a tool spec (``--tool``) names it, for messages in other units than mm.
+_SPEC_WORDS = {"diameter_mm": "the diameter", "corner_radius_mm": "the corner radius",
+               "tip_diameter_mm": "the tip diameter",
+               **{f: f"{k}=" for k, f in REACH_FIELDS.items()}}
+
+
+def _field(name: str) -> str:
+    """A length field of a tool in a message: its keyword (``diameter_mm``) where messages speak
+    mm (a library caller, a tool table, ``--units mm``), else as a ``--tool`` spec has it (``the
+    diameter``, ``flute=``): ``diameter_mm`` beside a length in inches contradicted it."""
+    return name if message_unit() == "mm" else _SPEC_WORDS.get(name, name)
+
+
+def _got(v) -> str:
+    """A value received for a length field, in the message units (:func:`say_length`)."""
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        return repr(v)
+    return say_length(float(v), "g")
+
+
+def _unit_word() -> str:
+    return "mm" if message_unit() == "mm" else "inches"
 
 
 @dataclass(frozen=True)
@@ -96,29 +119,30 @@ class Tool:
         for f in fields(self):  # the subclasses' range checks compare: "60" was a bare TypeError
             v = getattr(self, f.name)
             if f.type == "float" and (isinstance(v, bool) or not isinstance(v, numbers.Real)):
-                raise WoodcamError(f"{type(self).__name__}: {f.name} must be a number; got {v!r}; "
-                                   "give it in mm (angles in degrees)")
+                raise WoodcamError(f"{type(self).__name__}: {_field(f.name)} must be a number; got {v!r}; "
+                                   f"give it in {_unit_word()} (angles in degrees)")
         d = self.diameter_mm
         if (isinstance(d, bool) or not isinstance(d, (int, float, np.number))
                 or not (0 < d <= MAX_TOOL_DIAMETER_MM)):
-            raise WoodcamError(f"{type(self).__name__}: diameter_mm must be a positive number in "
-                               f"(0, {MAX_TOOL_DIAMETER_MM:g}] mm, got {d!r}; give the cutting "
-                               "diameter in mm")
+            raise WoodcamError(f"{type(self).__name__}: {_field('diameter_mm')} must be a positive number in "
+                               f"{say_length(MAX_TOOL_DIAMETER_MM, 'g', form='(0, {}]')}, got {_got(d)}; give "
+                               f"the cutting diameter in {_unit_word()}")
         for name in REACH_FIELDS.values():
             v = getattr(self, name)
             if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float, np.number))
                                   or not 0 < v <= 10 * MAX_TOOL_DIAMETER_MM):
-                raise WoodcamError(f"{type(self).__name__}: {name} must be None or a positive "
-                                   f"number of mm, got {v!r}")
+                raise WoodcamError(f"{type(self).__name__}: {_field(name)} must be "
+                                   f"{'None or ' if _field(name) == name else ''}a positive length in "
+                                   f"{say_length(10 * MAX_TOOL_DIAMETER_MM, 'g', form='(0, {}]')}, got {_got(v)}")
         fl, so = self.flute_length_mm, self.stickout_mm
         if fl is not None and so is not None and so < fl:
-            raise WoodcamError(f"{type(self).__name__}: stickout_mm={so:g} (tip to holder) is "
-                               f"shorter than flute_length_mm={fl:g}; the holder would cover "
-                               "the flutes")
+            raise WoodcamError(f"{type(self).__name__}: {_field('stickout_mm').rstrip('=')}={_got(so)} (tip "
+                               f"to holder) is shorter than {_field('flute_length_mm').rstrip('=')}={_got(fl)}; "
+                               "the holder would cover the flutes")
         if (self.holder_diameter_mm is None) != (so is None):
-            raise WoodcamError(f"{type(self).__name__}: holder_diameter_mm and stickout_mm go "
-                               f"together (the holder's size and where it starts above the "
-                               f"tip); got {self.holder_diameter_mm!r} and {so!r}")
+            raise WoodcamError(f"{type(self).__name__}: {_field('holder_diameter_mm')} and "
+                               f"{_field('stickout_mm')} go together (the holder's size and where it "
+                               f"starts above the tip); got {_got(self.holder_diameter_mm)} and {_got(so)}")
 
     def with_reach(self, **reach) -> "Tool":
         """This tool with reach fields replaced, e.g. ``with_reach(flute_length_mm=22)``."""
@@ -297,9 +321,9 @@ class BullNoseMill(Tool):
     def __post_init__(self):
         super().__post_init__()
         if not 0 < self.corner_radius_mm <= self.radius_mm:
-            raise WoodcamError(f"BullNoseMill: corner_radius_mm must be in (0, diameter/2 = "
-                               f"{self.radius_mm:g}], got {self.corner_radius_mm!r}; use "
-                               "ball for rc = R or flat for rc = 0")
+            raise WoodcamError(f"BullNoseMill: {_field('corner_radius_mm')} must be in "
+                               f"{say_length(self.radius_mm, 'g', form='(0, diameter/2 = {}]')}, got "
+                               f"{_got(self.corner_radius_mm)}; use ball for rc = R or flat for rc = 0")
 
     def _h(self, r):
         rc = self.corner_radius_mm
@@ -373,9 +397,9 @@ class SnubNoseVBit(Tool):
             raise WoodcamError(f"{type(self).__name__}: angle_deg (included angle) must be in "
                                f"(0, 180), got {self.angle_deg!r}; e.g. 60 or 90")
         if not 0 <= self.tip_diameter_mm < self.diameter_mm:
-            raise WoodcamError(f"{type(self).__name__}: tip_diameter_mm must be in [0, "
-                               f"diameter_mm = {self.diameter_mm:g}), got "
-                               f"{self.tip_diameter_mm!r}")
+            raise WoodcamError(f"{type(self).__name__}: {_field('tip_diameter_mm')} must be in "
+                               f"{say_length(self.diameter_mm, 'g', form='[0, diameter = {})')}, got "
+                               f"{_got(self.tip_diameter_mm)}")
 
     @property
     def _k(self):
@@ -413,8 +437,9 @@ class TaperedBallMill(Tool):
     def __post_init__(self):
         super().__post_init__()
         if not 0 < self.tip_diameter_mm <= self.diameter_mm:
-            raise WoodcamError(f"TaperedBallMill: tip_diameter_mm must be in (0, diameter_mm], "
-                               f"got {self.tip_diameter_mm!r}")
+            raise WoodcamError(f"TaperedBallMill: {_field('tip_diameter_mm')} must be in "
+                               f"{say_length(self.diameter_mm, 'g', form='(0, diameter = {}]')}, got "
+                               f"{_got(self.tip_diameter_mm)}")
         if not 0 < self.taper_deg < 90:
             raise WoodcamError(f"TaperedBallMill: taper_deg (per side) must be in (0, 90), got "
                                f"{self.taper_deg!r}; e.g. 3.6")
@@ -545,25 +570,35 @@ def load_tool_table(path: PathLike) -> dict[int, Tool]:
         if missing:  # read as NaN, the tool then said "angle_deg ... got nan" of a key never written
             raise WoodcamError(f"load_tool_table: {path}: [tools.{key}] (type {kind!r}) needs {missing}; "
                                f"e.g. angle_deg = 60 for a vbit")
-        num = lambda k: _number(entry.get(k, math.nan), path, key, k)  # noqa: E731
-        d = num("diameter_mm")
-        reach = {name: num(name) for name in REACH_FIELDS.values() if name in entry}
-        if kind == "flat":
-            tool: Tool = FlatEndMill(d)
-        elif kind == "ball":
-            tool = BallEndMill(d)
-        elif kind == "bull":
-            tool = BullNoseMill(d, num("corner_radius_mm"))
-        elif kind in ("snub", "chamfer"):
-            cls = SnubNoseVBit if kind == "snub" else ChamferMill
-            tool = cls(d, angle_deg=num("angle_deg"), tip_diameter_mm=num("tip_diameter_mm"))
-        elif kind == "taperball":
-            tool = TaperedBallMill(d, tip_diameter_mm=num("tip_diameter_mm"),
-                                   taper_deg=num("taper_deg"))
-        else:
-            tool = VBit(d, num("angle_deg"))
-        out[number] = tool.with_reach(**reach) if reach else tool
+        nums = {k: _number(entry[k], path, key, k) for k in ("diameter_mm", *REACH_FIELDS.values(),
+                                                                 *_TYPE_KEYS.get(kind, ())) if k in entry}
+        try:
+            # the table's keys and numbers are mm whatever --units says: its errors too
+            with message_units("mm"):
+                out[number] = _table_tool(kind, nums)
+        except WoodcamError as err:  # which entry of which table: the tool's words alone did not say
+            raise WoodcamError(f"load_tool_table: {path}: [tools.{key}]: {err}") from None
     return out
+
+
+def _table_tool(kind: str, nums: dict) -> "Tool":
+    """The tool of one tool-table entry: its ``type`` and numbers by key (mm, degrees)."""
+    d = nums["diameter_mm"]
+    reach = {name: nums[name] for name in REACH_FIELDS.values() if name in nums}
+    if kind == "flat":
+        tool: Tool = FlatEndMill(d)
+    elif kind == "ball":
+        tool = BallEndMill(d)
+    elif kind == "bull":
+        tool = BullNoseMill(d, nums["corner_radius_mm"])
+    elif kind in ("snub", "chamfer"):
+        cls = SnubNoseVBit if kind == "snub" else ChamferMill
+        tool = cls(d, angle_deg=nums["angle_deg"], tip_diameter_mm=nums["tip_diameter_mm"])
+    elif kind == "taperball":
+        tool = TaperedBallMill(d, tip_diameter_mm=nums["tip_diameter_mm"], taper_deg=nums["taper_deg"])
+    else:
+        tool = VBit(d, nums["angle_deg"])
+    return tool.with_reach(**reach) if reach else tool
 
 
 #: Keys a tool table may carry for people (read by no one).
