@@ -382,7 +382,7 @@ def _synthetic_stock(spec, field, size_mm, species, description, appearance, par
     return Stock(spec, tuple(size_mm), Wood(field, app), description, meta)
 
 
-def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
+def fitted_field(block, folder: Path | None = None, method: str = "evidence", faces=None):
     """The growth field fitted to a block's rings, fitted once and cached.
 
     The cache entry lives in the user cache folder (:func:`woodcam._cache.cache_dir`
@@ -394,6 +394,8 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
     runs fit once (a lock) and share the result.
 
     folder : the block folder, only named in errors (None for a Mokume sample).
+    faces : the faces to fit to (:func:`~woodcam.inference.fit_block`'s ``faces``, part of the
+        key); None, every face (the field ``bake``, ``preview`` and ``woodcam fit`` share).
     """
 
     from . import __version__
@@ -408,9 +410,13 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence"):
             f"block {folder or block.name} has neither a true field nor traced rings or ring maps "
             "to fit one to; trace rings on at least one face (or use 'woodcam block synth')"
         )
-    key = digest(block_fingerprint(block), method, FIT_VERSION, __version__)
+    # every face: the key it always had (the entries fitted before stay valid)
+    key = digest(block_fingerprint(block), method, FIT_VERSION, __version__,
+                 *(() if faces is None else ("faces", list(faces))))
     path = entry_path(cache_dir("fields"), block.name, f"{method}-{key}")
-    field, hit = load_or_build(path, load=GridField.load, build=lambda: fit_block(block, method=method),
+    field, hit = load_or_build(path, load=GridField.load,
+                               build=lambda: (fit_block(block, method=method) if faces is None
+                                              else fit_block(block, method=method, faces=faces)),
                                save=lambda f, tmp: f.save(tmp), what=f"fitted field of block {block.name!r}")
     meta = getattr(field, "meta", None)
     meta = meta if isinstance(meta, dict) else {}

@@ -266,7 +266,9 @@ def test_ctrl_c_during_the_forked_refits_ends_the_fit_at_once(block_dir, tmp_pat
     folder, _, _ = block_dir
     mark, out = tmp_path / "mark", tmp_path / "out"
     out.mkdir()
-    env = dict(os.environ, WOODCAM_WORKERS="2")
+    # a cache of its own: fit reads the fitted-field cache, where an earlier run's fit of the
+    # same block (the same content) would answer without any refit
+    env = dict(os.environ, WOODCAM_WORKERS="2", WOODCAM_CACHE_DIR=str(tmp_path / "cache"))
     proc = subprocess.Popen([sys.executable, "-c", _SLOW_SHARE, str(mark), str(folder), str(out / "f.npz")],
                             env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     try:
@@ -296,3 +298,40 @@ def test_fit_draws_one_stage_bar_over_the_block_and_the_fit(block_dir, tmp_path,
     assert bar.enabled and bar.unit == "stage" and bar.total == 3
     assert bar.shown[1:4] == ["fit: open block", "fit: fit", "fit: write"]
     assert bar.n == 3 and bar.closed
+
+
+def test_fit_reads_and_fills_the_fitted_field_cache_bake_uses(block_dir, tmp_path, monkeypatch, capsys):
+    """``woodcam fit`` fitted on every run (a photographed block's evidence fit: ~30 s each time)
+    and never filled the content-keyed cache bake and preview fit through
+    (woodcam.stock.fitted_field), so bake then fitted the same block again. Now one fit for
+    both, the same field; --faces is part of the key (another fit, cached too)."""
+    import woodcam.inference as inference
+    import woodcam.inference.fit as inference_fit
+    from woodcam.block.io import read_block_folder
+    from woodcam.stock import fitted_field
+
+    folder, _, _ = block_dir
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    real_fit, calls = inference_fit.fit_block, []
+
+    def counted(*args, **kwargs):
+        calls.append(kwargs.get("faces"))
+        return real_fit(*args, **kwargs)
+
+    monkeypatch.setattr(inference_fit, "fit_block", counted)  # where each caller finds it
+    monkeypatch.setattr(inference, "fit_block", counted)
+    fits = []
+    for k in range(2):
+        out = tmp_path / f"f{k}.npz"
+        assert main(["fit", str(folder), "--method", "radial", "--out", str(out)]) == 0
+        fits.append(GridField.load(out))
+    assert calls == [None]  # the second run read the first one's fit
+    np.testing.assert_array_equal(fits[0].years, fits[1].years)
+    field = fitted_field(read_block_folder(folder), folder, "radial")  # what bake and preview open
+    assert calls == [None]
+    np.testing.assert_array_equal(field.years, fits[0].years)
+    for k in range(2):
+        assert main(["fit", str(folder), "--method", "radial", "--faces", "front,top",
+                     "--out", str(tmp_path / f"p{k}.npz")]) == 0
+    assert calls == [None, ["front", "top"]]
+    assert not np.array_equal(GridField.load(tmp_path / "p0.npz").years, fits[0].years)
