@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 
 from .._atomic import write_text
-from .options import add_block_argument, add_out_option, add_size_option, command_group, open_block
+from .options import QUALITY_EPOCHS_HELP, add_block_argument, add_out_option, add_size_option, command_group, open_block
 
 
 def register(subparsers) -> None:
@@ -31,7 +31,8 @@ def register(subparsers) -> None:
     p.add_argument("--resolution", type=int, default=128, help="grid cells along the longest side (default 128)")
     p.add_argument("--quality", choices=("draft", "normal", "high"), default="normal",
                    help="training effort of the neural appearance (default normal)")
-    p.add_argument("--epochs", type=int, default=None, help="training epochs (overrides --quality's)")
+    p.add_argument("--epochs", type=int, default=None,
+                   help=f"training epochs (default: --quality's, {QUALITY_EPOCHS_HELP})")
     p.add_argument("--finetune-epochs", type=int, default=None, metavar="N",
                    help="per-axis networks fine-tuned N epochs from the all-faces network "
                    "(default 2; 0 trains each axis from scratch, as seed 000 does)")

@@ -35,14 +35,15 @@ def register(subparsers) -> None:
     r.add_argument("--supersample", type=int, default=2,
                    help="samples per pixel side, averaged (default 2; knot rings alias)")
     r.add_argument("--board", nargs=3, type=float, metavar=("Z_MM", "AZIMUTH_DEG", "OFFSET_MM"),
-                   help="tangential board centre height, facing azimuth and distance from "
-                        "the pith (default: the board through the most knots at 60 mm)")
+                   help="tangential board: centre height along the log (mm), facing azimuth "
+                        "(degrees) and distance from the pith (mm) (default: the board through the "
+                        "most knots, 60 mm from the pith)")
     r.add_argument("--disc", type=float, metavar="Z_MM",
                    help="height along the log of the end-grain disc, mm (default: the log's biggest "
                    "whorl, where most knots leave the pith; the middle of a log without knots)")
     r.add_argument("--radial", nargs=2, type=float, metavar=("Z_MM", "AZIMUTH_DEG"),
                    help="also a quarter-sawn section through the pith at height Z_MM (mm) and azimuth "
-                   "AZIMUTH_DEG (degrees); knots show as spikes")
+                   "AZIMUTH_DEG (degrees); knots show as spikes (default: none)")
     r.add_argument("--k-stem", type=float, default=1.5,
                    help="smoothness exponent k of the rings' smooth minimum outside knots, a number in "
                    "(0, 1000], no unit; low: wide distortion round a knot (seed 003 sec. 4.2.1; default 1.5)")

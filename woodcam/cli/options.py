@@ -42,6 +42,11 @@ SPECIES_HELP = (f"colour preset: cited (README 'Species presets'): {', '.join(CI
                 f"legacy, uncited: {', '.join(LEGACY_SPECIES)}")
 
 
+#: The epochs of each --quality preset (woodcam.appearance.translation.QUALITY_SPECS, spelled
+#: out so that --help imports no numpy; tests/test_cli_help.py checks the two agree).
+QUALITY_EPOCHS_HELP = "3 draft, 4 normal, 8 high"
+
+
 def species_type(text: str) -> str:
     """argparse ``type`` of ``--species``: a preset name, else a usage error (exit 2; the
     library's refusal came after parsing, with exit 1)."""
@@ -610,7 +615,8 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                    "learnt from the block's photos per axis (seed 000 sec. 3.3, cached on disk)")
     p.add_argument("--quality", choices=("draft", "normal", "high"), default=None,
                    help="training effort of the neural appearance (default normal)")
-    p.add_argument("--epochs", type=int, default=None, help="override the neural training epochs")
+    p.add_argument("--epochs", type=int, default=None, help="training epochs of the neural appearance "
+                   f"(default: --quality's, {QUALITY_EPOCHS_HELP})")
     add_knot_options(p)
     add_max_atlas_option(p)
     p.add_argument("--no-obj", action="store_true", help="write only the GLB, not OBJ+MTL+PNG")
