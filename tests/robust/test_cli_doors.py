@@ -60,6 +60,19 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["eval", "rings", "/nonexistent", "--methods", "", "--out", "OUT/e"], r"--methods must be 'all'"),
     (["eval", "realistic", "--seed", "5", "--methods", "", "--out", "OUT/e"], r"--methods must be 'all' or a comma list from"),
     (["bench", "report", "OUT", "--gallery", "-1", "--out", "OUT/r"], r"--gallery must be in \[0, 1000\]"),
+    # a name that is no face or method was the library's words, naming no option, exit 1, some
+    # after the block was opened ('face must be one of ...; got 'bogus'')
+    (["fit", "builtin:flat-sawn", "--faces", "front,bogus", "--out", "OUT/f.npz"],
+     r"--faces must be 'all' or a comma list of faces from front, top, left, bottom, right, back \(or Mokume "
+     r"letters A-F\); got 'bogus'$"),
+    (["eval", "rings", "builtin:flat-sawn", "--partial-faces", "top,X", "--out", "OUT/e"],
+     r"--partial-faces must be 'all' or a comma list of faces from .*; got 'X'$"),
+    (["eval", "appearance", "builtin:flat-sawn", "--end-grain", "A,sides", "--out", "OUT/ea"],
+     r"--end-grain must be a comma list of faces from .*; got 'sides'$"),
+    (["bench", "run", "--blocks", "1", "--methods", "rbf,bogus", "--out", "OUT/b"],
+     r"--methods must be from evidence, rbf, radial, neural; got \['bogus'\]"),
+    (["eval", "realistic", "--seed", "1", "--scenarios", "bogus", "--out", "OUT/e"],
+     r"--scenarios must be from clean, noisy, ring-maps; got \['bogus'\]"),
     (["eval", "realistic", "--seed", "5", "--faces", "full,full", "--out", "OUT/e"],
      r"--faces must be a comma list from full, three, each name once; got 'full,full'"),
     # eval realistic dropped empty names ('rbf,,radial') where fit refused them: one parser now
@@ -126,7 +139,7 @@ def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monk
     # a wrong command line exits 2 (the --out rule, a number out of range, a malformed value
     # quoted: "--tool 'flat:abc': ..."), failed work 1
     usage = ("--out of" in match or "is a FILE" in match or match.startswith(r"--out \(")
-             or __import__("re").match(r"--[a-z0-9-]+ (must be (in|a finite)|takes |')", match))
+             or __import__("re").match(r"--[a-z0-9-]+ (must be (in|a finite|'all'|a comma|from)|takes |')", match))
     assert main(argv) == (EXIT_USAGE if usage else EXIT_ERROR)
     assert time.perf_counter() - t0 < 30.0  # refused before any fitting or baking (minutes)
     err = capsys.readouterr().err

@@ -12,7 +12,8 @@ from __future__ import annotations
 import json
 
 from .._atomic import write_text
-from .options import QUALITY_EPOCHS_HELP, add_block_argument, add_out_option, add_size_option, command_group, open_block
+from .options import (QUALITY_EPOCHS_HELP, add_block_argument, add_out_option, add_size_option, command_group,
+                      face_names, open_block)
 
 
 def register(subparsers) -> None:
@@ -49,6 +50,8 @@ def run(args) -> int:
     """Run ``eval appearance``; returns the exit status."""
     from .._atomic import run_outputs
 
+    if args.end_grain:  # before any block is read
+        face_names(args.end_grain, "--end-grain")
     args.out.mkdir(parents=True, exist_ok=True)
     with run_outputs(args.out, kind="eval-appearance"):  # one set; an earlier run's other blocks go
         _run(args)
@@ -71,7 +74,7 @@ def _run(args) -> None:
         block, field = open_block(spec, args.size_mm)
         end_grain = None
         if args.end_grain:
-            eg = {check_face(f.strip()) for f in args.end_grain.split(",")}
+            eg = {check_face(f) for f in face_names(args.end_grain, "--end-grain") or ()}
             end_grain = {f: f in eg for f in block.faces}
         res = leave_one_face_out(block, field, resolution=args.resolution, quality=args.quality,
                                  epochs=args.epochs, seed=args.seed, end_grain=end_grain,

@@ -58,8 +58,13 @@ def register(subparsers) -> None:
 
 def _run(args) -> int:
     from ..benchmark import run_bench
+    from .fit import METHODS
+    from .options import comma_names
 
-    settings = {"methods": args.methods, "knotted_fraction": args.knotted_fraction,
+    # read as fit's and eval's --methods are: a name that is no method was the library's
+    # "methods must be ...; got 'bogus'" (exit 1, naming no option)
+    methods = None if args.methods is None else comma_names(args.methods, "--methods", METHODS)
+    settings = {"methods": methods, "knotted_fraction": args.knotted_fraction,
                 "face_px": args.face_px, "trace_jitter_mm": args.jitter_mm,
                 "trace_dropout": args.dropout}
     s = run_bench(args.out, args.blocks, args.seed, {k: v for k, v in settings.items() if v is not None},

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 from .options import (add_block_argument, add_confidence_option, add_out_option, add_size_option, add_workers_option,
-                      apply_workers, comma_names, command_group, open_block)
+                      apply_workers, comma_names, command_group, face_names, open_block)
 
 #: Faces used for "partial annotation": three faces meeting at the front-top-left corner, half
 #: of the block's surface (seed 000, section 4.3 traces "half of the block only").
@@ -73,7 +73,7 @@ def run_fit(args) -> int:
     from .._progress import StageBar
     from ..stock import fitted_field
 
-    faces = None if args.faces is None else comma_names(args.faces, "--faces", all_=True)  # before the block is read
+    faces = None if args.faces is None else face_names(args.faces, "--faces", all_=True)  # before the block is read
     apply_workers(args)
     # one bar for the run, as bake's: the evidence fit of a real cube lasts 20-30 s (H11 from its
     # photos, 2 cores) and a photo-only block is detected first; it ran without a bar
@@ -101,7 +101,7 @@ def run_eval(args) -> int:
     # 'all' is every method (it gave the default rbf,radial)
     methods = comma_names(args.methods, "--methods", METHODS, all_=True) or list(METHODS)
     partial = (None if args.partial_faces.lower() == "none"
-               else comma_names(args.partial_faces, "--partial-faces", all_=True))
+               else face_names(args.partial_faces, "--partial-faces", all_=True))
     blocks = [open_block(p, args.size_mm)[0] for p in args.block]
     if args.truth:
         if len(args.truth) != len(blocks):

@@ -580,7 +580,7 @@ def comma_names(text: str, option: str, choices: tuple[str, ...] = (), *,
                 all_: bool = False) -> list[str] | None:
     """The names of a comma list option (``--methods``, ``--faces`` ...): each non-empty, each
     once and, with ``choices``, each one of them; with ``all_`` the word ``all`` gives None (every
-    name, the command's default). Else a WoodcamError naming ``option``: an empty list or a
+    name, the command's default). Else a UsageError (exit 2: the command line is wrong) naming ``option``: an empty list or a
     repeated name was taken as the default, or counted twice, without a word. The one parser of
     such lists."""
     if all_ and text == "all":
@@ -589,10 +589,34 @@ def comma_names(text: str, option: str, choices: tuple[str, ...] = (), *,
     if not all(names) or len(set(names)) != len(names):
         whole = "'all' or " if all_ else ""
         among = f" from {', '.join(choices)}" if choices else ""
-        raise WoodcamError(f"{option} must be {whole}a comma list{among}, each name once; got {text!r}")
+        raise UsageError(f"{option} must be {whole}a comma list{among}, each name once; got {text!r}")
     bad = [n for n in names if choices and n not in choices]
     if bad:
-        raise WoodcamError(f"{option} must be from {', '.join(choices)}; got {bad}")
+        raise UsageError(f"{option} must be from {', '.join(choices)}; got {bad}")
+    return names
+
+
+def face_names(text: str, option: str, *, all_: bool = False) -> list[str] | None:
+    """A comma list of faces (``--faces``, ``--partial-faces``, ``--end-grain``): :func:`comma_names`
+    whose names are faces (front ... back, or Mokume letters A-F, as
+    :func:`woodcam.frames.check_face` reads them), read before any block is opened. A name that is
+    no face was the library's "face must be one of ...; got 'bogus'" (exit 1, after the block was
+    opened, naming no option); now a usage error naming the option."""
+    names = comma_names(text, option, all_=all_)
+    if names is None:
+        return None
+    from ..frames import FACES, check_face
+
+    bad = []
+    for name in names:
+        try:
+            check_face(name)
+        except WoodcamError:
+            bad.append(name)
+    if bad:
+        whole = "'all' or " if all_ else ""
+        raise UsageError(f"{option} must be {whole}a comma list of faces from "
+                         f"{', '.join(FACES)} (or Mokume letters A-F); got {', '.join(map(repr, bad))}")
     return names
 
 
