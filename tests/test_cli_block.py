@@ -95,10 +95,24 @@ def test_block_synth_noise_options(tmp_path):
     b = read_block(maps / "block_0000")
     assert all(not f.traces and f.ring_map is not None for f in b.faces.values())
     assert json.loads((maps / "index.json").read_text())["count"] == 1
-    from woodcam.cli import EXIT_ERROR
 
-    assert main(["block", "synth", "--count", "1", "--out", str(tmp_path / "x"),
-                 "--size-range-mm", "80,30"]) == EXIT_ERROR
+
+
+@pytest.mark.parametrize("value", ["80,30", "nan,30", "-1,30", "0,30", "30", "30,1e300", "a,b"])
+def test_block_synth_refuses_a_size_range_at_the_door(value, tmp_path, capsys):
+    """--size-range-mm was read in the command: '80,30' and 'nan,30' exited 1, '-1,30' was
+    argparse's 'expected one argument', '30,1e300' was taken. Now one usage line (exit 2) naming
+    the rule, before any block is made."""
+    from woodcam.cli import EXIT_USAGE
+
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as exc:  # argparse's own exit
+        main(["block", "synth", "--count", "1", "--out", str(tmp_path / "x"), "--size-range-mm", value])
+    assert exc.value.code == EXIT_USAGE
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and ("--size-range-mm takes MIN,MAX in mm with 0 < MIN <= MAX <= 10000, e.g. 30,80; "
+                              f"got {value!r}") in err[0], err
+    assert not (tmp_path / "x").exists()
 
 
 def test_block_synth_noise_options_on_an_engine_write_the_same_blocks(tmp_path, capsys):

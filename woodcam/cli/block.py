@@ -8,7 +8,27 @@ from __future__ import annotations
 from pathlib import Path
 
 from .options import (add_block_argument, add_check_layout_option, add_engine_options, add_out_option,
-                      add_size_option, engine_options, engine_requested, open_block, report_layout)
+                      add_size_option, allow_negative_values, engine_options, engine_requested, open_block,
+                      report_layout)
+
+
+def _size_range(text: str) -> tuple[float, float]:
+    """argparse ``type`` of ``--size-range-mm``: ``MIN,MAX`` in mm, finite, 0 < MIN <= MAX <=
+    :data:`~woodcam.limits.MAX_BLOCK_SIZE_MM`, else a usage error (exit 2). It was read in the
+    command (exit 1: '80,30', 'nan,30'; '-1,30' was argparse's 'expected one argument')."""
+    import argparse
+    import math
+
+    from ..limits import MAX_BLOCK_SIZE_MM
+
+    try:
+        lo, hi = (float(v) for v in text.split(","))
+    except ValueError:
+        lo = hi = math.nan
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi <= MAX_BLOCK_SIZE_MM):
+        raise argparse.ArgumentTypeError(f"--size-range-mm takes MIN,MAX in mm with 0 < MIN <= MAX <= "
+                                         f"{MAX_BLOCK_SIZE_MM:g}, e.g. 30,80; got {text!r}")
+    return lo, hi
 
 
 def register(subparsers) -> None:
@@ -35,9 +55,10 @@ def register(subparsers) -> None:
                    help="no traces: faces carry ring maps only (unlabelled rings, as Mokume's cubes)")
     s.add_argument("--knotted-fraction", type=float, default=0.5,
                    help="share of blocks cut from knotted logs, each with a knot crossing it (default 0.5)")
-    s.add_argument("--size-range-mm", default="30,80",
+    s.add_argument("--size-range-mm", default="30,80", type=_size_range, metavar="MIN,MAX",
                    help="MIN,MAX block side in mm, each side uniform in it (default 30,80)")
     add_engine_options(s)
+    allow_negative_values(s)  # --size-range-mm -1,30: the range's words, not 'expected one argument'
 
     v = sub.add_parser("show", help="draw a block's faces as one unfolded-cross PNG")
     add_block_argument(v, option=False)
@@ -62,13 +83,7 @@ def run(args) -> int:
         from ..errors import WoodcamError
         from ..synth import knotted_log_field, synth_benchmark_set
 
-        try:
-            lo, hi = (float(v) for v in args.size_range_mm.split(","))
-        except ValueError:
-            raise WoodcamError(f"--size-range-mm must be MIN,MAX in mm, e.g. 30,80; got "
-                               f"{args.size_range_mm!r}") from None
-        if not 0 < lo <= hi:
-            raise WoodcamError(f"--size-range-mm needs 0 < MIN <= MAX; got {lo:g},{hi:g}")
+        lo, hi = args.size_range_mm  # read at the door (_size_range)
         if args.jitter_mm < 0 or args.dropout_chunk_mm <= 0:
             raise WoodcamError(f"--jitter-mm must be >= 0 and --dropout-chunk-mm > 0; got "
                                f"{args.jitter_mm:g} and {args.dropout_chunk_mm:g}")
