@@ -60,6 +60,17 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["eval", "rings", "/nonexistent", "--methods", "", "--out", "OUT/e"], r"--methods must be 'all'"),
     (["eval", "realistic", "--seed", "5", "--methods", "", "--out", "OUT/e"], r"--methods must be 'all' or a comma list from"),
     (["bench", "report", "OUT", "--gallery", "-1", "--out", "OUT/r"], r"--gallery must be in \[0, 1000\]"),
+    # options that contradict each other, or one missing: a wrong command line (they exited 1,
+    # eval rings --truth after opening every block, gcode after reading the programs)
+    (["log", "render", "--out", "OUT/lr"], r"give exactly one log: a LOG_FILE, --real or --maps DIR; got 0"),
+    (["log", "render", "--real", "OUT/nope.json", "--out", "OUT/lr"], r"give exactly one log: .*; got 2"),
+    (["eval", "rings", "builtin:flat-sawn", "--truth", "a.npz", "b.npz", "--out", "OUT/e"],
+     r"--truth needs one field file per block: got 2 for 1 blocks"),
+    (["block", "synth", "--count", "1", "--engine", "local", "--address", "tcp://127.0.0.1:1", "--out", "OUT/b"],
+     r"--address needs --engine dask; got --engine local"),
+    (["train", "rings", "--no-resume", "--out", "OUT/t"], r"train rings runs in this process and always from scratch"),
+    (["gcode", "OUT/nope.nc", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb"],
+     r"woodcam gcode: no tools given; pass --tool SPEC"),
     # a name that is no face or method was the library's words, naming no option, exit 1, some
     # after the block was opened ('face must be one of ...; got 'bogus'')
     (["fit", "builtin:flat-sawn", "--faces", "front,bogus", "--out", "OUT/f.npz"],
@@ -138,7 +149,9 @@ def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monk
     t0 = time.perf_counter()
     # a wrong command line exits 2 (the --out rule, a number out of range, a malformed value
     # quoted: "--tool 'flat:abc': ..."), failed work 1
-    usage = ("--out of" in match or "is a FILE" in match or match.startswith(r"--out \(")
+    usage = ("--out of" in match or "is a FILE" in match or match.startswith((r"--out \(", "give exactly",
+                                                                                 "--truth", "--address", "train rings",
+                                                                                 "woodcam gcode: no tools"))
              or __import__("re").match(r"--[a-z0-9-]+ (must be (in|a finite|'all'|a comma|from)|takes |')", match))
     assert main(argv) == (EXIT_USAGE if usage else EXIT_ERROR)
     assert time.perf_counter() - t0 < 30.0  # refused before any fitting or baking (minutes)

@@ -267,7 +267,7 @@ def test_programs_and_tools_are_refused_before_the_block_is_opened(tmp_path, cap
              f"--tools {str(tmp_path / 't.toml')!r} is not a file; pass a TOML tool table", 1),
             # a malformed --tool is a wrong command line (exit 2, at the door)
             ([str(prog), "--tool", "1=flat:abc"], "--tool '1=flat:abc': tool spec 'flat:abc'", 2),
-            ([str(prog)], "no tools given; pass --tool SPEC", 1)):
+            ([str(prog)], "no tools given; pass --tool SPEC", 2)):  # a missing option: usage
         assert main(["gcode", *argv, *base]) == rc
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and said in err, err

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import WoodcamError
+from ..errors import UsageError
 from .options import (add_block_argument, add_confidence_option, add_out_option, add_size_option, add_workers_option,
                       apply_workers, comma_names, command_group, face_names, open_block)
 
@@ -102,12 +102,11 @@ def run_eval(args) -> int:
     methods = comma_names(args.methods, "--methods", METHODS, all_=True) or list(METHODS)
     partial = (None if args.partial_faces.lower() == "none"
                else face_names(args.partial_faces, "--partial-faces", all_=True))
+    if args.truth and len(args.truth) != len(args.block):  # before the blocks are opened (a fit each)
+        raise UsageError(f"--truth needs one field file per block: got {len(args.truth)} for "
+                         f"{len(args.block)} blocks")
     blocks = [open_block(p, args.size_mm)[0] for p in args.block]
     if args.truth:
-        if len(args.truth) != len(blocks):
-            raise WoodcamError(
-                f"--truth needs one field file per block: got {len(args.truth)} for {len(blocks)} blocks"
-            )
         for b, t in zip(blocks, args.truth):
             b.true_field = GridField.load(t)
     from .._atomic import run_outputs

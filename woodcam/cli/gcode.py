@@ -11,7 +11,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..errors import WoodcamError
+from ..errors import UsageError, WoodcamError
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
 from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
                       allow_negative_values, camera_of, drop_earlier_output, remove_stale_outputs, sizes_type,
@@ -175,6 +175,9 @@ def run(args) -> int:
     if not (math.isfinite(args.rapid_rate) and args.rapid_rate > 0):
         raise WoodcamError(f"--rapid-rate {args.rapid_rate}: give a rate > 0 in mm/min, e.g. "
                            "5000")
+    if not args.tool and not args.tools:  # a usage error, before any program is read
+        raise UsageError("woodcam gcode: no tools given; pass --tool SPEC (e.g. --tool flat:6.35) or "
+                         "--tools TABLE.toml")
     with output_refused_at_the_door():  # the OBJ set beside the GLB, its view PNG
         check_outputs(args.out, obj=not args.no_obj, screenshot=args.screenshot or False)
     camera_of(args, bool(args.screenshot))  # a --camera without --screenshot warns before the work

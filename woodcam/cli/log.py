@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import WoodcamError
+from ..errors import UsageError
 from .options import SPECIES_HELP, add_knot_options, add_out_option, knot_shading, species_type
 
 
@@ -73,7 +73,7 @@ def _load(args):
 
     given = [x for x in (args.log_file, args.real or None, args.maps) if x]
     if len(given) != 1:
-        raise WoodcamError("give exactly one log: a LOG_FILE, --real or --maps DIR; got "
+        raise UsageError("give exactly one log: a LOG_FILE, --real or --maps DIR; got "
                            f"{len(given)}")
     if args.real:
         return read_gran1()

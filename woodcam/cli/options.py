@@ -1131,7 +1131,7 @@ def engine_requested(args) -> bool:
 def engine_options(args) -> dict:
     """The keyword arguments of :func:`woodcam.scale.run_many` from :func:`add_engine_options`."""
     if args.address is not None and args.engine not in (None, "dask"):
-        raise WoodcamError(f"--address needs --engine dask; got --engine {args.engine}")
+        raise UsageError(f"--address needs --engine dask; got --engine {args.engine}")
     out = {"engine": "dask" if args.address is not None else (args.engine or "local"),
            "address": args.address, "workers": args.workers}
     if args.memory_limit_mb is not None:

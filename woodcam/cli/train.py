@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import WoodcamError
+from ..errors import UsageError
 from .options import add_engine_options, add_out_option, engine_options, engine_requested
 
 
@@ -34,7 +34,7 @@ def run(args) -> int:
         from ..detect.learned import RingNetSpec, check_member, train_ring_net
 
         if engine_requested(args) or args.no_resume:  # they were accepted and ignored
-            raise WoodcamError("train rings runs in this process and always from scratch: the engine "
+            raise UsageError("train rings runs in this process and always from scratch: the engine "
                                "options (--engine, --address, --workers, ...) and --no-resume are for "
                                "'train gtf'")
 
@@ -56,7 +56,7 @@ def run(args) -> int:
               f"final loss {r['final_loss']:.4f}; wrote {args.out}")
         return 0
     if args.member is not None:        # accepted by the parser, no effect on gtf
-        raise WoodcamError(f"--member {args.member} is for 'train rings' (the ring net's members); "
+        raise UsageError(f"--member {args.member} is for 'train rings' (the ring net's members); "
                            f"'train gtf' trains one model: leave it out")
     from ..fields.neural import GTFSpec, train_gtf
 
