@@ -247,3 +247,15 @@ def test_trace_noise_with_ring_maps_only_is_named(tmp_path, capsys):
     assert main(["block", "synth", "--count", "1", "--seed", "3", "--out", str(tmp_path / "b"), "--face-px", "32",
                  "--quiet", "--knotted-fraction", "0", "--ring-maps-only", "--jitter-mm", "0.3"]) == 0
     assert "--jitter-mm act on traced rings; with --ring-maps-only" in capsys.readouterr().err
+
+
+def test_size_mm_given_with_a_block_that_is_no_folder_is_said_to_be_ignored(tmp_path, capsys):
+    """``block show builtin:flat-sawn --size-mm 30`` (fit, eval likewise) drew the 100 mm block
+    without a word: --size-mm sizes Mokume sample folders only. Now a warning says it was
+    ignored and how to size such a block."""
+    capsys.readouterr()
+    assert main(["block", "show", "builtin:flat-sawn", "--size-mm", "30", "--out", str(tmp_path / "s.png")]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["woodcam: warning: --size-mm 30 sizes Mokume sample folders only; 'builtin:flat-sawn' is no "
+                   "folder and keeps its own size: ignored (a built-in or log block takes its size in the spec, "
+                   "e.g. builtin:flat-sawn:40x40x40)"], err

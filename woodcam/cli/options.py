@@ -511,9 +511,20 @@ def report_layout(block) -> None:
 
 
 def open_block(spec, size_mm: float | None = None, face_px: int = 256):
-    """``(block, field or None)`` for a block argument: :func:`woodcam.stock.open_block`."""
+    """``(block, field or None)`` for a block argument: :func:`woodcam.stock.open_block`.
+    ``size_mm`` (``--size-mm``) sizes a Mokume sample folder only; given with a spec that is no
+    folder (``builtin:flat-sawn``, ``log:...``) it was dropped without a word and the block kept
+    its own size: a warning says so (a block folder's own size is warned of by its reader)."""
     from ..stock import open_block as _open_block
 
+    if size_mm is not None and not Path(str(spec)).exists():
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        warnings.warn(f"--size-mm {size_mm:g} sizes Mokume sample folders only; {str(spec)!r} is no folder "
+                      "and keeps its own size: ignored (a built-in or log block takes its size in the spec, "
+                      "e.g. builtin:flat-sawn:40x40x40)", WoodcamWarning, stacklevel=2)
     return _open_block(str(spec), size_mm=size_mm, face_px=face_px)
 
 
