@@ -120,6 +120,10 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     ([*BAKE, "--out", "OUT/x.glb", "--place", "spin"], r"--place 'spin' is not a placement operation"),
     ([*GCODE, "--tool", "flat:abc"], r"--tool 'flat:abc': tool spec 'flat:abc': numbers expected after the type"),
     ([*GCODE, "--tool", "x=ball:3"], r"--tool 'x=ball:3': the part before '=' must be a tool number"),
+    # a tool number out of a tool table's range, or one given twice (the last was taken silently)
+    ([*GCODE, "--tool", "1000000=flat:6"], r"--tool '1000000=flat:6': the tool number must be in \[0, 99999\]; got 1000000"),
+    ([*GCODE, "--tool", "1=flat:6", "--tool", "2=ball:3", "--tool", "1=ball:3"],
+     r"--tool '1=ball:3': tool 1 is given twice \(also --tool '1=flat:6'\); give each tool number once"),
     ([*GCODE, "--tool", "flat:-1"], r"--tool 'flat:-1': FlatEndMill: diameter_mm must be a positive number"),
     ([*GCODE, "--tool", "flat:6", "--tool", "2=bull:6:9"], r"--tool '2=bull:6:9': BullNoseMill: corner_radius_mm"),
     # in inches: the spec as typed, and as read in mm where only that breaks a rule

@@ -397,6 +397,8 @@ def parse_tool_option(item: str):
         except ValueError as err:
             raise WoodcamError(f"--tool {item!r}: the part before '=' must be a tool "
                                "number, e.g. 2=ball:3") from err
+        if not 0 <= number <= 99999:  # a tool table's range (load_tool_table): 1000000= was taken
+            raise WoodcamError(f"--tool {item!r}: the tool number must be in [0, 99999]; got {number}")
     try:
         return number, parse_tool_spec(spec)
     except WoodcamError as err:  # what is wrong with the spec, not with the number
@@ -410,6 +412,7 @@ def _check_places(ops, typed) -> None:
 
 
 def _check_tools(items, typed) -> None:
+    numbers: dict[int, str] = {}
     for item, as_typed_item in zip(items, typed):
         # as typed first: its grammar errors quote what was typed (an inch run's spec in mm,
         # "flat:152.4:7", beside a help in inches read as another spec); the spec in mm then
@@ -429,6 +432,12 @@ def _check_tools(items, typed) -> None:
                 # "(read as 'flat:50800' in mm): ... (0, 1000] mm, got 50800" of flat:2000 inches)
                 said = str(err).removeprefix(f"--tool {item!r}: ")
                 raise WoodcamError(f"--tool {as_typed_item!r}: {said}") from err
+        number = parse_tool_option(item)[0]
+        if number is not None and number in numbers:  # the last one was taken without a word
+            raise WoodcamError(f"--tool {as_typed_item!r}: tool {number} is given twice (also "
+                               f"--tool {numbers[number]!r}); give each tool number once")
+        if number is not None:
+            numbers[number] = as_typed_item
 
 
 def _is_grammar_error(err: WoodcamError, item: str) -> bool:
