@@ -71,6 +71,9 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["train", "rings", "--no-resume", "--out", "OUT/t"], r"train rings runs in this process and always from scratch"),
     (["gcode", "OUT/nope.nc", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb"],
      r"woodcam gcode: no tools given; pass --tool SPEC"),
+    # LinuxCNC's own interpreter read the program as LinuxCNC's, the --dialect dropped silently
+    ([*GCODE, "--tool", "flat:6", "--interpreter", "linuxcnc", "--dialect", "grbl"],
+     r"--dialect must be linuxcnc with --interpreter linuxcnc .*; got --dialect grbl; leave out --interpreter"),
     # a name that is no face or method was the library's words, naming no option, exit 1, some
     # after the block was opened ('face must be one of ...; got 'bogus'')
     (["fit", "builtin:flat-sawn", "--faces", "front,bogus", "--out", "OUT/f.npz"],
@@ -155,7 +158,8 @@ def test_bad_options_fail_fast_with_one_line(argv, match, tmp_path, capsys, monk
     # quoted: "--tool 'flat:abc': ..."), failed work 1
     usage = ("--out of" in match or "is a FILE" in match or match.startswith((r"--out \(", "give exactly",
                                                                                  "--truth", "--address", "train rings",
-                                                                                 "woodcam gcode: no tools"))
+                                                                                 "woodcam gcode: no tools",
+                                                                                 "--dialect must be"))
              or __import__("re").match(r"--[a-z0-9-]+ (must be (in|a finite|'all'|a comma|from)|takes |')", match))
     assert main(argv) == (EXIT_USAGE if usage else EXIT_ERROR)
     assert time.perf_counter() - t0 < 30.0  # refused before any fitting or baking (minutes)

@@ -175,6 +175,10 @@ def run(args) -> int:
     if not (math.isfinite(args.rapid_rate) and args.rapid_rate > 0):
         raise WoodcamError(f"--rapid-rate {args.rapid_rate}: give a rate > 0 in mm/min, e.g. "
                            "5000")
+    if args.interpreter == "linuxcnc" and args.dialect != "linuxcnc":  # it was dropped without a word
+        raise UsageError(f"--dialect must be linuxcnc with --interpreter linuxcnc (LinuxCNC's own interpreter "
+                         f"reads LinuxCNC's G-code only); got --dialect {args.dialect}; leave out --interpreter "
+                         f"to read the program as {args.dialect} does")
     if not args.tool and not args.tools:  # a usage error, before any program is read
         raise UsageError("woodcam gcode: no tools given; pass --tool SPEC (e.g. --tool flat:6.35) or "
                          "--tools TABLE.toml")
