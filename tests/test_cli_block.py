@@ -185,14 +185,15 @@ def test_a_benchmark_set_resumes_with_its_defaults_spelled_out(tmp_path):
 
 def test_engine_options_alone_run_on_the_engine_and_train_rings_refuses_them(tmp_path, capsys):
     """'block synth --workers 2' ran serially in this process, as if --workers were not given;
-    'train rings' accepted --address, --workers and --no-resume and used none of them."""
-    from woodcam.cli import EXIT_ERROR
+    'train rings' accepted --address, --workers and --no-resume and used none of them. Refused as
+    a wrong command line (exit 2; it was 1)."""
+    from woodcam.cli import EXIT_USAGE
 
     assert main(["block", "synth", "--count", "1", "--seed", "3", "--out", str(tmp_path / "b"), "--face-px", "32",
                  "--quiet", "--workers", "1", "--knotted-fraction", "0"]) == 0
     assert "on local with 1 worker(s)" in capsys.readouterr().out
     for extra in (["--workers", "7"], ["--address", "tcp://127.0.0.1:9"], ["--no-resume"]):
-        assert main(["train", "rings", "--out", str(tmp_path / "t"), *extra]) == EXIT_ERROR
+        assert main(["train", "rings", "--out", str(tmp_path / "t"), *extra]) == EXIT_USAGE
         assert "are for 'train gtf'" in capsys.readouterr().err
     assert not (tmp_path / "t").exists()
 
