@@ -90,7 +90,7 @@ def test_a_cached_fit_repeats_its_warning(tmp_path, monkeypatch):
     block = synth_block(builtin_block("flat-sawn").field, (20, 20, 20), face_px=32, seed=0)
     said = "fit CONTRADICTED by the held-out faces: front 12 %"
 
-    def fake_fit(block, method):
+    def fake_fit(block, method, faces=None):
         warnings.warn(said, WoodcamWarning)
         return GridField(np.zeros((3, 3, 3)), (0, 0, 0), 10.0, meta={"contradicted": True, "message": said})
 
@@ -121,7 +121,7 @@ def test_a_cached_fit_from_before_size_mm_names_the_fitted_blocks_faces(tmp_path
     block = synth_block(builtin_block("flat-sawn").field, size, face_px=32, seed=0)
     x = np.stack(np.meshgrid(*[np.linspace(0, s, k) for s, k in zip(size, (21, 7, 5))], indexing="ij"), -1)
 
-    def old_fit(block, method):  # an evidence fit as made before meta["size_mm"]: a guess further right
+    def old_fit(block, method, faces=None):  # an evidence fit as made before meta["size_mm"]: a guess further right
         return GridField(x[..., 0] / 3.0, (0.0, 0.0, 0.0), (5.0, 5.0, 5.0),
                          layers={"uncertainty": 0.02 * x[..., 0]},
                          meta={"method": "evidence", "faces": ["front", "back", "top", "bottom"]})

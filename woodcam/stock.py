@@ -415,8 +415,7 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence", fa
                  *(() if faces is None else ("faces", list(faces))))
     path = entry_path(cache_dir("fields"), block.name, f"{method}-{key}")
     field, hit = load_or_build(path, load=GridField.load,
-                               build=lambda: (fit_block(block, method=method) if faces is None
-                                              else fit_block(block, method=method, faces=faces)),
+                               build=lambda: fit_block(block, method=method, faces=faces),
                                save=lambda f, tmp: f.save(tmp), what=f"fitted field of block {block.name!r}")
     meta = getattr(field, "meta", None)
     meta = meta if isinstance(meta, dict) else {}
