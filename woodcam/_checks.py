@@ -58,6 +58,14 @@ def check_number(value, name: str, *, lo: float | None = None, hi: float | None 
     return v
 
 
+def check_bool(value, name: str, *, fix: str = "") -> bool:
+    """``value`` as a ``bool``: ``True``/``False`` or a numpy bool. A string (``"false"`` is
+    truthy), a number or None is refused: each was taken as its truth value without a word."""
+    if not isinstance(value, (bool, np.bool_)):
+        _fail(name, "True or False", value, fix or f"pass {name}=True or {name}=False")
+    return bool(value)
+
+
 def check_vector(value, name: str, *, n: int = 3, unit: bool = False, fix: str = "") -> np.ndarray:
     """``value`` as a float ``(n,)`` array of finite numbers; ``unit=True``: a non-zero
     direction, returned normalised to length 1."""

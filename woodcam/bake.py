@@ -52,6 +52,7 @@ from typing import Any, Literal, get_args
 
 import numpy as np
 
+from woodcam._checks import check_bool
 from woodcam._types import Mesh, WoodLike
 from woodcam.errors import WoodcamError, WoodcamWarning
 from woodcam.limits import MAX_BLOCK_SIZE_MM
@@ -218,6 +219,7 @@ def bake(
 
     t_start = time.perf_counter()
     _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals)
+    progress = check_bool(progress, "bake: progress")
     if unwrap not in get_args(UnwrapMode):
         raise WoodcamError(f"bake: unwrap must be one of {get_args(UnwrapMode)}; got {unwrap!r}")
     verts_in = np.asarray(mesh.vertices, dtype=np.float64)

@@ -31,6 +31,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from ._checks import check_bool
 from .errors import WoodcamError
 
 Scenario = Literal["clean", "noisy", "ring-maps"]
@@ -107,6 +108,8 @@ def score_block(seed: int, index: int, methods: tuple[str, ...] | list[str] = ("
     from .inference.evaluate import DEFAULT_PLANES, evaluate_fits
     from .inference.fit import METHODS, fit_block
 
+    keep_lines, knot_bend, knot_cones, residual = (check_bool(v, n) for n, v in (
+        ("keep_lines", keep_lines), ("knot_bend", knot_bend), ("knot_cones", knot_cones), ("residual", residual)))
     bad = [m for m in methods if m not in METHODS]
     if bad:
         raise WoodcamError(f"methods must be from {', '.join(METHODS)}; got {bad}")

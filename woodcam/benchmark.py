@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._atomic import all_or_nothing, atomic_path, remove_stale, write_figure, write_text
+from ._checks import check_bool
 from .errors import WoodcamError
 
 if TYPE_CHECKING:
@@ -441,6 +442,7 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
     (of other blocks) are removed. Returns the summary dict."""
     from .scale import read_records, record_path, write_json_atomic
 
+    progress = check_bool(progress, "bench_report: progress")
     run_dir, out = Path(run_dir), Path(out_dir)
     mpath = run_dir / RUN_MANIFEST
     if not mpath.is_file():

@@ -122,6 +122,18 @@ def check_outputs(out_glb, *, obj: bool = True, screenshot: bool | str | Path = 
     return out_glb
 
 
+def _check_flags(obj, screenshot, progress) -> tuple[bool, bool | Path, bool]:
+    """A preview's switches: ``obj`` and ``progress`` True or False (``"false"`` was truthy),
+    ``screenshot`` True, False or a ``.png`` path (a number was Path's bare TypeError)."""
+    from ._checks import check_bool, check_path
+
+    if isinstance(screenshot, bool) or type(screenshot).__name__ == "bool_":
+        screenshot = bool(screenshot)
+    else:
+        screenshot = check_path(screenshot, "screenshot", fix="True (a *_view.png beside the GLB), False, or a .png path")
+    return check_bool(obj, "obj"), screenshot, check_bool(progress, "progress")
+
+
 def _check_stock(stock) -> None:
     """``stock`` must be a :class:`Stock` (None was an AttributeError, 'size_mm' or 'wood')."""
     if not isinstance(stock, Stock):
@@ -154,6 +166,7 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
     from .tolerances import MAX_PART_TRIANGLES
 
     _check_stock(stock)
+    obj, screenshot, progress = _check_flags(obj, screenshot, progress)
     if isinstance(place, str):  # 'center' was read letter by letter: "--place 'c' is not a placement"
         raise WoodcamError(f"place must be a list of placement operations; got the string {place!r}; pass [{place!r}]")
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)  # before minutes of work
@@ -204,6 +217,10 @@ def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: 
     if not isinstance(mesh, trimesh.Trimesh):  # None was an AttributeError ('volume')
         raise WoodcamError(f"mesh must be a trimesh.Trimesh (a carved part's surface); got {type(mesh).__name__}; "
                            "pass carve(part, stock.size_mm).mesh")
+    obj, screenshot, progress = _check_flags(obj, screenshot, progress)
+    from ._checks import check_bool
+
+    part_report = check_bool(part_report, "part_report")
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
     result = result or PartPreview(out_glb.stem)
     result.volume_mm3 = abs(float(mesh.volume))  # as the part report's (advise.part_report)

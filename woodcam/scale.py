@@ -49,7 +49,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, Literal, get_args
 
-from ._checks import check_path
+from ._checks import check_bool, check_path
 from .errors import WoodcamError
 
 Engine = Literal["local", "dask"]
@@ -313,6 +313,7 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
     if memory_limit_mb is not None and memory_limit_mb < 256:
         raise WoodcamError(f"memory_limit_mb must be >= 256 MiB (a Python worker alone needs "
                            f"~100 MiB) or None; got {memory_limit_mb!r}")
+    progress = check_bool(progress, "run_many: progress")
     if address is not None:
         if engine != "dask":
             raise WoodcamError(f"address applies to engine='dask' only; got engine={engine!r} "

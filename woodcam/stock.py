@@ -46,6 +46,7 @@ from typing import Literal
 
 import numpy as np
 
+from ._checks import check_bool
 from ._specs import ParsedSpec, format_op, parse_spec, split_spec
 from .appearance import ColorMapAppearance, NeuralAppearance, Wood
 from .errors import WoodcamError, WoodcamWarning
@@ -131,6 +132,7 @@ def open_stock(spec: str, *, species: str | None = None,
     """
     if appearance not in ("colormap", "neural"):
         raise WoodcamError(f"appearance must be one of ['colormap', 'neural']; got {appearance!r}")
+    species_given = check_bool(species_given, "species_given")
     # None was read as the spec 'None' and '' as the folder '.', neither the value given
     if not isinstance(spec, (str, os.PathLike)) or not str(spec).strip():
         raise WoodcamError(f"spec must be a block spec (str): 'builtin:NAME', 'log:LOG@KNOT', 'woodify:PATH' or "

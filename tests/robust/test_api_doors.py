@@ -717,3 +717,89 @@ def test_a_tool_table_names_the_key_a_tool_type_needs(tmp_path):
                                      '[tools.2]\ntype = "bull"\ndiameter_mm = 6\ncorner_radius_mm = 1\n')
     tools = w.load_tool_table(str(tmp_path / "t.toml"))
     assert tools[1].spec() == "vbit:90:6" and tools[2].spec() == w.parse_tool_spec("bull:6:1").spec()
+
+
+def _bool_doors():
+    """``(id, call with the bool option given as "false")``: every bool option of the public API.
+    Each took the string as its truth value (True) without a word; read_block's allow_outside
+    so read files outside the block folder."""
+    import numpy as np
+
+    import woodcam as w
+
+    fld = w.builtin_block("flat-sawn").field
+    pts = np.array([[5.0, 5.0, 5.0]])
+    no = "false"
+    return [
+        ("KnottedLogField.evaluate directions", lambda: w.KnottedLogField(_small_log()).evaluate([[0, 0, 50]], directions=no)),
+        ("WoodifiedField.evaluate directions", lambda: _woodify().field.evaluate(pts * 0, directions=no)),
+        ("bake progress", lambda: w.bake(_cube(), w.Wood(fld), texels_per_mm=1, progress=no)),
+        ("bench_report progress", lambda: w.bench_report("no-run", "no-out", progress=no)),
+        ("benchmark confidence", lambda: w.benchmark([], confidence=no)),
+        ("build_parquetry progress", lambda: w.build_parquetry(_target(), [_veneer()], _small_params(), progress=no)),
+        ("build_parquetry seams", lambda: w.build_parquetry(_target(), [_veneer()], _small_params(), seams=no)),
+        ("build_parquetry repair", lambda: w.build_parquetry(_target(), [_veneer()], _small_params(), repair=no)),
+        ("detect_rings curved", lambda: w.detect_rings(_photo(), px_per_mm=5, curved=no)),
+        ("evaluate_fit keep_lines", lambda: w.evaluate_fit(fld, fld, (40, 30, 20), keep_lines=no)),
+        ("fit_block baked", lambda: w.fit_block(w.Block((10, 10, 10)), "radial", baked=no)),
+        ("fit_block knot_bend", lambda: w.fit_block(w.Block((10, 10, 10)), "radial", knot_bend=no)),
+        ("fit_block knot_cones", lambda: w.fit_block(w.Block((10, 10, 10)), "radial", knot_cones=no)),
+        ("fit_block residual", lambda: w.fit_block(w.Block((10, 10, 10)), "radial", residual=no)),
+        ("fit_evidence warn", lambda: w.fit_evidence(_obs(), (40, 30, 20), warn=no)),
+        ("fit_evidence residual", lambda: w.fit_evidence(_obs(), (40, 30, 20), residual=no)),
+        ("fit_stem history", lambda: w.fit_stem(_obs(), (40, 30, 20), history=no)),
+        ("fit_stem outward", lambda: w.fit_stem(_obs(), (40, 30, 20), outward=no)),
+        ("open_stock species_given", lambda: w.open_stock("builtin:flat-sawn", species_given=no)),
+        ("preview_mesh obj", lambda: w.preview_mesh(_cube(), _stock(), "p.glb", obj=no)),
+        ("preview_mesh progress", lambda: w.preview_mesh(_cube(), _stock(), "p.glb", progress=no)),
+        ("preview_mesh part_report", lambda: w.preview_mesh(_cube(), _stock(), "p.glb", part_report=no)),
+        ("preview_part obj", lambda: w.preview_part(_cube(), _stock(), "p.glb", obj=no)),
+        ("preview_part progress", lambda: w.preview_part(_cube(), _stock(), "p.glb", progress=no)),
+        ("read_block allow_outside", lambda: w.read_block("no-block", allow_outside=no)),
+        ("read_gran1 centre", lambda: w.read_gran1("no-trees", centre=no)),
+        ("run_many progress", lambda: w.run_many(str, ["a"], "no-runs", progress=no)),
+        ("score_block keep_lines", lambda: w.score_block(0, 0, keep_lines=no)),
+        ("score_block knot_bend", lambda: w.score_block(0, 0, knot_bend=no)),
+        ("score_block knot_cones", lambda: w.score_block(0, 0, knot_cones=no)),
+        ("score_block residual", lambda: w.score_block(0, 0, residual=no)),
+        ("simulate progress", lambda: w.simulate(w.read_gcode("G1 X5 F100\n"), w.parse_tool_spec("flat:3"), (10, 10, 10),
+                                                 progress=no)),
+        ("simulate track_lines", lambda: w.simulate(w.read_gcode("G1 X5 F100\n"), w.parse_tool_spec("flat:3"),
+                                                    (10, 10, 10), track_lines=no)),
+        ("slice_veneers progress", lambda: w.slice_veneers(_stock(), 2, (10, 10), px_per_mm=1, progress=no)),
+        ("slice_veneers adaptive", lambda: w.slice_veneers(_stock(), 2, (10, 10), px_per_mm=1, adaptive=no)),
+        ("synth_block knot_masks", lambda: w.synth_block(fld, (20, 20, 20), face_px=16, knot_masks=no)),
+        ("write_block overwrite", lambda: w.write_block(w.Block((10, 10, 10)), "no-block", overwrite=no)),
+        ("write_parquetry progress", lambda: w.write_parquetry(_small_run(), "no-out", progress=no)),
+        ("SceneOptions cut_plane", lambda: w.SceneOptions(cut_plane=no)),
+        ("ParquetryParams single_use", lambda: w.ParquetryParams(single_use=no).check()),
+    ]
+
+
+@functools.lru_cache(maxsize=1)
+def _small_run():
+    import woodcam as w
+
+    return w.build_parquetry(_target(), [_veneer()], _small_params())
+
+
+@pytest.mark.parametrize("name, call", _bool_doors(), ids=lambda v: v if isinstance(v, str) else "")
+def test_bool_options_refuse_a_truthy_string(name, call, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # a door that let the call through would write here
+    option = name.split()[-1]
+    with pytest.raises(WoodcamError, match=rf"{option} must be (True or False|true or false); got 'false'"):
+        call()
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # refused before anything was made
+
+
+def test_bool_options_take_numpy_bools():
+    """The valid call beside the refused ones: a numpy bool is a bool (a mask's .any(), a
+    table's column), and the option does what it says."""
+    import numpy as np
+
+    import woodcam as w
+
+    assert w.SceneOptions(cut_plane=np.bool_(False)).cut_plane is False
+    out = w.KnottedLogField(_small_log()).evaluate([[0, 0, 50]], directions=np.bool_(True))
+    assert out["direction"].shape == (1, 3)
+    assert "direction" not in w.KnottedLogField(_small_log()).evaluate([[0, 0, 50]], directions=False)

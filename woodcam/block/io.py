@@ -53,7 +53,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._checks import check_path
+from .._checks import check_bool, check_path
 from .._types import ArrayLike, PathLike
 from .._atomic import all_or_nothing, atomic_path, write_text
 from .._readers import photo_rgb8, read_image_file
@@ -106,6 +106,7 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
         raise WoodcamError(f"block must be a woodcam.block.Block; got {type(block).__name__}; pass read_block(...), "
                            "builtin_block(...) or synth_block(...)")
     folder = check_path(folder, "write_block: folder", fix="the block folder to write, e.g. 'blocks/oak1'")
+    overwrite = check_bool(overwrite, "write_block: overwrite")
     folder.mkdir(parents=True, exist_ok=True)
     manifest_path = folder / MANIFEST
     if manifest_path.exists() and not overwrite:
@@ -170,6 +171,9 @@ def read_block(folder: PathLike, *, allow_outside: bool | None = None) -> Block:
     from ._schema import check_manifest
 
     folder = check_path(folder, "read_block: folder", fix="a folder written by write_block, or its block.json")
+    if allow_outside is not None:  # "false" was truthy: files outside the folder were read
+        allow_outside = check_bool(allow_outside, "read_block: allow_outside",
+                                   fix="pass True to trust this manifest, False, or None ($WOODCAM_ALLOW_OUTSIDE_PATHS)")
     if not folder.exists():
         raise WoodcamError(f"block folder {str(folder)!r} does not exist; pass a folder written by "
                            "write_block or 'woodcam block synth/from-photos' (or its block.json)")

@@ -74,7 +74,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._checks import as_floats
+from .._checks import as_floats, check_bool
 from ..block.block import RingTrace
 from ..errors import WoodcamError
 
@@ -802,6 +802,8 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     """
     if rule not in BOUNDARY_RULES:
         raise WoodcamError(f"rule must be one of {', '.join(BOUNDARY_RULES)}; got {rule!r}")
+    if curved is not None:
+        curved = check_bool(curved, "curved", fix="pass True, False or None (the default, CURVED_GABOR)")
     lum = luminance(photo)
     h, w = lum.shape
     if min(h, w) < 16:

@@ -47,7 +47,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._checks import check_number
+from .._checks import check_bool, check_number
 from .._types import ArrayLike
 from ..errors import WoodcamError
 from .base import check_points
@@ -354,6 +354,7 @@ class KnottedLogField:
         ``directions=True``, ``direction (n, 3)``.
         """
         p = check_points(points_mm)
+        directions = check_bool(directions, "directions")
         n = len(p)
         if self.backend == "numba" and n:
             return self._evaluate_numba(p, directions)

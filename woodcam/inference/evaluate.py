@@ -22,7 +22,7 @@ from dataclasses import dataclass, field as dc_field
 import numpy as np
 
 from .._atomic import write_figure, write_text
-from .._checks import check_number
+from .._checks import check_bool, check_number
 from .._types import ArrayLike, GrowthFieldLike, PathLike
 from ..errors import WoodcamError, require
 from ..fields.base import evaluate, has_uncertainty
@@ -257,6 +257,7 @@ def evaluate_fits(true_field, fitted: dict, size_mm, planes=DEFAULT_PLANES,
     # pixel_mm=0 or NaN was np.arange's ValueError, a plane that is not a CutPlane an AttributeError
     pixel_mm = check_number(pixel_mm, "pixel_mm", lo=0, lo_open=True,
                             fix=f"the cut planes' sample spacing in mm, e.g. {EVAL_PIXEL_MM}")
+    keep_lines = check_bool(keep_lines, "keep_lines")
     check_size(size_mm)
     for p in planes:
         if not isinstance(p, CutPlane):
@@ -299,6 +300,7 @@ def benchmark(blocks: Sequence[Block], methods: Sequence[str] = ("rbf", "radial"
 
     from .fit import fit_block
 
+    confidence = check_bool(confidence, "confidence")
     face_sets = {"full": None} if face_sets is None else face_sets
     result, tables = {}, []
     for label, faces in face_sets.items():

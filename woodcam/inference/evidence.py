@@ -50,6 +50,7 @@ from dataclasses import field as dc_field
 
 import numpy as np
 
+from .._checks import check_bool
 from .._parallel import fit_workers, share
 from .._types import ArrayLike
 
@@ -721,6 +722,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     if not isinstance(obs, RingObservations):  # None was an AttributeError ('labelled')
         raise WoodcamError(f"obs must be RingObservations (woodcam.inference.observations.gather_observations "
                            f"of a block); got {type(obs).__name__}")
+    warn, residual = check_bool(warn, "warn"), check_bool(residual, "residual")
     if blend not in BLEND_MODES:
         raise WoodcamError(f"blend must be one of {', '.join(BLEND_MODES)}; got {blend!r}")
     if residual and blend == "everywhere":

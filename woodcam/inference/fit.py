@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Literal, get_args
 
 import numpy as np
 
+from .._checks import check_bool
 from .._types import GrowthFieldLike
 from ..errors import WoodcamError
 from .baked import bake
@@ -136,6 +137,8 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         raise WoodcamError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise WoodcamError(f"seed must be an integer >= 0 (the evidence fit's random seed); got {seed!r}")
+    baked, knot_bend, knot_cones, residual = (check_bool(v, n) for n, v in (
+        ("baked", baked), ("knot_bend", knot_bend), ("knot_cones", knot_cones), ("residual", residual)))
     if isinstance(faces, str):  # 'top' was read letter by letter: "face must be ...; got 't'"
         raise WoodcamError(f"faces must be a list of face names or None; got the string {faces!r}; "
                            f"pass [{faces!r}]")

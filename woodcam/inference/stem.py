@@ -50,7 +50,7 @@ from itertools import islice
 
 import numpy as np
 
-from .._checks import check_number
+from .._checks import check_bool, check_number
 from .._parallel import map_processes
 from .._types import ArrayLike
 from ..errors import WoodcamError
@@ -358,6 +358,7 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
     n_starts, n_final, workers = (int(check_number(v, name, lo=1, integer=True, fix="e.g. 2"))
                                   for v, name in ((n_starts, "n_starts"), (n_final, "n_final"), (workers, "workers")))
     seed = int(check_number(seed, "seed", lo=0, integer=True, fix="same seed, same fit"))
+    history, outward = check_bool(history, "history"), check_bool(outward, "outward")
     if init is not None and not isinstance(init, StemField):
         raise WoodcamError(f"init must be a StemField (an earlier fit_stem) or None; got {type(init).__name__}")
     tilt_prior_deg, curve_prior_mm = (check_number(v, name, lo=0, lo_open=True, fix="a prior's standard deviation")

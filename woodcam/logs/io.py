@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_path
+from .._checks import check_bool, check_path
 from .._types import PathLike
 from ..errors import WoodcamError
 from ..fields.skeleton import BranchStrand, LogSkeleton
@@ -81,6 +81,7 @@ def read_gran1(folder: PathLike | None = None, *, centre: bool = True) -> LogSke
                                "WOODCAM_SHARED_DATA=/path/to/shared/data or pass folder=")
         folder = base / "trees"
     folder = check_path(folder, "read_gran1: folder", fix="shared/data/trees, or None for the shared data folder's")
+    centre = check_bool(centre, "read_gran1: centre")
     try:
         pith = np.asarray(json.loads((folder / "Gran_1_pith.json").read_text()), float)
         radii = np.asarray(json.loads((folder / "Gran_1_radii.json").read_text()), float)

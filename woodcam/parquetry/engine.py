@@ -15,6 +15,7 @@ from typing import Literal
 
 import numpy as np
 
+from .._checks import check_bool
 from ..errors import WoodcamError
 from ..units import say_length
 from .features import edge, features, intensity, match_histogram
@@ -237,6 +238,8 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
         raise WoodcamError(f"params must be a ParquetryParams or None; got {type(params).__name__}; "
                            "pass ParquetryParams(**settings)")
     params = (params or ParquetryParams()).check()
+    progress, seams, repair = (check_bool(v, f"build_parquetry: {n}") for n, v in
+                               (("progress", progress), ("seams", seams), ("repair", repair)))
     if isinstance(targets, np.ndarray):
         targets = [targets]
     if not targets:

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic import all_or_nothing, manifest_path, remove_stale, write_text
-from .._checks import check_path
+from .._checks import check_bool, check_path
 from ._io import atomic_write_png
 from .cutpaths import (
     Piece,
@@ -142,6 +142,7 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
     from PIL import Image
 
     _check_run(run, "write_parquetry")
+    progress = check_bool(progress, "write_parquetry: progress")
     out = check_path(out_dir, "write_parquetry: out_dir", fix="the folder to write the panels and cut files to")
     out.mkdir(parents=True, exist_ok=True)
     prm = run.params

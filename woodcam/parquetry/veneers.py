@@ -22,7 +22,7 @@ from typing import Literal, Protocol
 
 import numpy as np
 
-from .._checks import check_number, check_path, check_vector
+from .._checks import check_bool, check_number, check_path, check_vector
 from .._readers import PHOTO_ALPHA_FIX, read_photo_rgb
 from ..errors import WoodcamError
 
@@ -287,6 +287,7 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
     if axis not in ("x", "y", "z"):
         raise WoodcamError(f"axis must be one of ['x', 'y', 'z']; got {axis!r}")
     ss = int(check_number(supersample, "supersample", lo=1, hi=16, integer=True, fix="e.g. 3"))
+    progress, adaptive = check_bool(progress, "progress"), check_bool(adaptive, "adaptive")
     size = check_vector(size_mm, "size_mm", n=2, fix="(width, height) of each sheet in mm, e.g. (200, 100)")
     w_mm, h_mm = float(size[0]), float(size[1])
     nw, nh = round(w_mm * px_per_mm), round(h_mm * px_per_mm)

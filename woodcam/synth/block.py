@@ -6,6 +6,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from .._checks import check_bool
 from .._types import ArrayLike, GrowthFieldLike, WoodLike
 from ..block import Block, Face
 from ..errors import WoodcamError
@@ -75,6 +76,7 @@ def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | No
                            "np.random.default_rng(seed), or seed=... to let the spec make one")
     if meta is not None and not isinstance(meta, Mapping):
         raise WoodcamError(f"meta must be a dict of extra block metadata or None; got {type(meta).__name__}")
+    knot_masks = check_bool(knot_masks, "knot_masks")
     spec = (SynthSpec() if spec is None else spec).replace_flat(**settings)
     size = check_size(size_mm)
     if not callable(field):

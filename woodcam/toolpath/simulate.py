@@ -43,7 +43,7 @@ from typing import Literal, Mapping
 
 import numpy as np
 
-from .._checks import as_floats
+from .._checks import as_floats, check_bool
 from .._types import ArrayLike, Mesh
 from ..errors import WoodcamError
 from ..tolerances import SIM_CONTACT_TOL_MM
@@ -242,6 +242,8 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
         raise WoodcamError(f"simulate: work_offset_mm must be three finite numbers (X, Y, Z) in mm; "
                            f"got {work_offset_mm!r}")
     resolution_mm = res_mm
+    progress = check_bool(progress, "simulate: progress")
+    track_lines = check_bool(track_lines, "simulate: track_lines")
     _reuse_freed_memory()
     W, D, H = size
     off = np.array([0.0, 0.0, H]) if off_in is None else off_in

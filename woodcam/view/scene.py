@@ -33,7 +33,7 @@ import numpy as np
 
 from .._types import ArrayLike, Mesh, PathLike, WoodLike
 from ..errors import WoodcamError, require
-from .._checks import check_number, check_vector
+from .._checks import check_bool, check_number, check_vector
 from ..frames import check_size
 from ..tolerances import ON_FACE_TOL_MM
 from ..units import say_length
@@ -560,6 +560,7 @@ class SceneOptions:
     max_samples: int | None = None
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "cut_plane", check_bool(self.cut_plane, "cut_plane"))
         check_camera(self.camera)
         if self.cut_origin is not None:
             object.__setattr__(self, "cut_origin",

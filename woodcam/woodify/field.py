@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 from scipy import ndimage
 
 from .._atomic import atomic_path
-from .._checks import check_number, check_vector
+from .._checks import check_bool, check_number, check_vector
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, check_points
 from .speed import GrowthSpeed
@@ -158,6 +158,7 @@ class WoodifiedField:
     def evaluate(self, points_mm: ArrayLike, *, directions: bool = False) -> dict:
         """Years with the colour map's knot channels in one pass (see module docstring)."""
         p = check_points(points_mm)
+        directions = check_bool(directions, "directions")
         out = {"years": self(p)}
         n = len(p)
         zero = np.zeros(n, np.float32)
