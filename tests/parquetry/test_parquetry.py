@@ -736,6 +736,39 @@ def test_parameters_of_the_wrong_type_are_refused_by_name():
     assert prm.n_rot == 9 and type(prm.n_rot) is int
 
 
+def test_parameters_are_checked_when_made_and_flat_rerank_has_one_floor():
+    """ParquetryParams(patch_mm='14') or n_rot=0 was taken and failed only when a run called
+    check(); flat_rerank's floor is rerank, the candidates every patch re-ranks (the CLI refused
+    --flat-rerank below a fixed 4, so a job file's rerank 2 could not be turned off with 2)."""
+    import dataclasses
+
+    for kw, said in ((dict(patch_mm="14"), "patch_mm must be a finite number; got '14'"),
+                     (dict(n_rot=0), r"n_rot must be in \[1, 360\]"),
+                     (dict(flat_rerank=3), r"flat_rerank \(--flat-rerank\) must be >= rerank = 4 .*got 3; use 4"),
+                     (dict(flat_detail=0.5), r"flat_detail \(--flat-detail\) must be >= 1; got 0.5")):
+        with pytest.raises(WoodcamError, match=said):
+            ParquetryParams(**kw)
+    with pytest.raises(WoodcamError, match=r"flat_rerank \(--flat-rerank\) must be >= rerank = 6"):
+        dataclasses.replace(ParquetryParams(), rerank=6, flat_rerank=5)
+    off = ParquetryParams(rerank=2, flat_rerank=2)  # the flat-window re-rank off at rerank 2
+    assert (off.rerank, off.flat_rerank) == (2, 2)
+
+
+def test_the_cli_leaves_flat_reranks_floor_to_the_parameters(tmp_path, capsys):
+    """--flat-rerank 2 is refused by the parameters' rule, naming the option and the rerank it
+    must reach (exit 1, as the other rules between parameters), not by a fixed 4 of the CLI's."""
+    from woodcam.cli import main
+    from woodcam.cli.options import RANGES
+
+    assert RANGES[("parquetry", "flat_rerank")][0] == 1  # rerank's own floor; the rest is check()'s
+    argv = ["parquetry", str(tmp_path / "t.png"), "--veneer", str(tmp_path / "v.png"), "--flat-rerank", "2",
+            "--out", str(tmp_path / "o"), "--quiet"]
+    assert main(argv) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "flat_rerank (--flat-rerank) must be >= rerank = 4 (the candidates" in err
+    assert not (tmp_path / "o").exists()
+
+
 def test_unreadable_image(tmp_path):
     bad = tmp_path / "scan.png"
     bad.write_text("not an image")

@@ -1036,7 +1036,7 @@ RANGES: dict = {
     ("parquetry", "coarse_factor"): (1, 1024, False),
     ("parquetry", "w_struct"): (0.0, 1e6, False),
     ("parquetry", "flat_detail"): (1.0, 1e6, False),
-    ("parquetry", "flat_rerank"): (4, 1_000_000, False),  # >= the structural re-rank's 4
+    ("parquetry", "flat_rerank"): (1, 1_000_000, False),  # its floor, rerank: ParquetryParams.check
     ("parquetry", "overlap_mm"): (0.0, 10_000.0, False),
     ("woodify", "relief"): (0.0, 1.0, False),
     ("woodify", "eccentricity"): (-1.0, 1.0, True, True),  # speed (1 + delta n.up) stays > 0

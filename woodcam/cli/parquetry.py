@@ -116,8 +116,9 @@ def register(subparsers) -> None:
                    help="where the target is flat, the fast search weighs the wood's fine detail "
                    "up to X times more, so calm wood is found (unitless, >= 1; default 3; 1 = off)")
     f.add_argument("--flat-rerank", type=int, default=None, metavar="N",
-                   help="where the target is flat, up to N candidate placements per patch (>= 4) get "
-                   "the structural re-rank instead of 4 (default 12; 4 = off)")
+                   help="where the target is flat, up to N candidate placements per patch get the "
+                   "structural re-rank instead of its 4 (woodcam.params.rerank of a job file; N >= "
+                   "that count; default 12; 4 = off)")
     f.add_argument("--overlap-mm", type=float, default=None,
                    help="patch overlap for seam cutting in mm (default min(patch/4, "
                    "(patch - min-piece)/2) = 3.5); 0 = square pieces")

@@ -103,8 +103,13 @@ class ParquetryParams:
     flat_detail: float = 3.0
     flat_rerank: int = 12
 
+    def __post_init__(self) -> None:
+        # checked when made, as every door: ParquetryParams(patch_mm='14') or n_rot=0 was taken
+        # and failed (or ran) only when a run called check()
+        self.check()
+
     def check(self) -> ParquetryParams:
-        """Validate at the door; returns self."""
+        """Validate (done when made; call again after changing a field); returns self."""
         for f in fields(self):  # the types first: a job file's "abc" or NaN fails here, by name
             setattr(self, f.name, _check_type(f"parquetry parameter {f.name}", getattr(self, f.name), str(f.type)))
         if not 1 <= self.n_rot <= 360:  # 1e9 filled the memory before the search's own estimate
@@ -139,12 +144,17 @@ class ParquetryParams:
         if self.px_per_mm <= 0 or self.tool_diameter_mm < 0 or (self.kerf_mm or 0) < 0:
             raise WoodcamError("px_per_mm must be > 0, tool_diameter_mm and kerf_mm >= 0; got "
                                f"{self.px_per_mm}, {self.tool_diameter_mm}, {self.kerf_mm}")
-        if self.flat_detail < 1.0 or self.flat_rerank < self.rerank:
-            raise WoodcamError(f"flat_detail must be >= 1 and flat_rerank >= rerank ({self.rerank}); "
-                               f"got {self.flat_detail}, {self.flat_rerank}; use 1 and {self.rerank} to turn "
-                               "the flat-window weighting off")
         if self.w_struct < 0 or self.rerank < 1:
             raise WoodcamError(f"w_struct must be >= 0 and rerank >= 1; got {self.w_struct}, {self.rerank}")
+        if self.flat_detail < 1.0:
+            raise WoodcamError(f"flat_detail (--flat-detail) must be >= 1; got {self.flat_detail}; use 1 to turn "
+                               "the flat-window weighting off")
+        # the one floor of flat_rerank (the CLI's range leaves it here): the candidates the
+        # structural re-rank takes anyway, rerank
+        if self.flat_rerank < self.rerank:
+            raise WoodcamError(f"flat_rerank (--flat-rerank) must be >= rerank = {self.rerank} (the candidates "
+                               f"every patch re-ranks); got {self.flat_rerank}; use {self.rerank} to turn the "
+                               "flat-window re-rank off")
         if (self.coarse_factor is not None and self.coarse_factor < 1) or self.top_k < 1:
             raise WoodcamError(f"coarse_factor and top_k must be >= 1; got {self.coarse_factor}, {self.top_k}")
         if self.patch_px < 4:
