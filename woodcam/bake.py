@@ -61,6 +61,7 @@ from woodcam.tolerances import (
     ATLAS_PADDING_PX,
     DEFAULT_MAX_ATLAS_PX,
     MAX_BATCH_POINTS,
+    MIN_NORMAL_LENGTH,
     MIN_UV_AREA_TEXELS2,
     RASTER_MARGIN_TEXELS,
 )
@@ -231,9 +232,8 @@ def bake(
     def colours(vmap, faces, xy):
         # xatlas keeps face order, so output face i is input face i.
         point_map = _affine_maps(xy, faces, verts_in[vmap])
-        if vertex_normals is None:
-            face_normals = np.asarray(mesh.face_normals, dtype=np.float64)
-        else:
+        face_normals = np.asarray(mesh.face_normals, dtype=np.float64)
+        if vertex_normals is not None:
             normal_map = _affine_maps(xy, faces, vertex_normals[vmap])
 
         def paint(t, cx, cy):
@@ -242,7 +242,12 @@ def bake(
                 nrm = face_normals[t]
             else:
                 nrm = _apply_affine(normal_map, t, cx, cy)
-                nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-12)
+                length = np.linalg.norm(nrm, axis=1, keepdims=True)
+                # vertex normals that cancel (a thin fin's two sides) interpolate to no
+                # direction, which the wood refuses: the triangle's own normal there
+                flat = length[:, 0] < MIN_NORMAL_LENGTH
+                nrm /= np.maximum(length, 1e-12)
+                nrm[flat] = face_normals[t[flat]]
             rgb = wood_colors(wood, points, nrm)
             return np.round(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
         return paint

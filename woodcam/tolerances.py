@@ -185,6 +185,11 @@ RING_MAP_QUANT_8BIT = 0.5 / 255
 #: transforms) and are clipped; a larger excursion is an error (e.g. 0..255 colours passed).
 COLOR_RANGE_TOL = 1e-3
 
+#: A surface normal given to ``Wood.color`` must be at least this long (any unit: it only
+#: weighs the block axes, eq. 10): shorter is no direction (a NaN or a zero normal was coloured
+#: as an equal blend of the three axes' colourings without a word).
+MIN_NORMAL_LENGTH = 1e-6
+
 #: A point counts as on a knot's surface (the envelope of its elliptic cross-sections) when its
 #: signed distance is above -this (mm): the projection onto the knot's centre curve converges
 #: to ~1e-5 mm, and cross-section points truly inside a sharply bent knot are >= 0.01 mm in.

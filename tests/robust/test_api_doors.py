@@ -803,3 +803,48 @@ def test_bool_options_take_numpy_bools():
     out = w.KnottedLogField(_small_log()).evaluate([[0, 0, 50]], directions=np.bool_(True))
     assert out["direction"].shape == (1, 3)
     assert "direction" not in w.KnottedLogField(_small_log()).evaluate([[0, 0, 50]], directions=False)
+
+
+def test_wood_color_refuses_normals_that_are_no_direction():
+    """Wood.color with a NaN, inf or zero normal returned colours (eq. 10's equal blend of the
+    three axes' colourings) without a word; wood_colors, the seam of bake and view, did for any
+    wood. A normal of any length > 0 is a direction: the same colour as the unit one."""
+    import numpy as np
+
+    import woodcam as w
+    from woodcam.appearance.wood import wood_colors
+
+    wood = w.Wood(w.builtin_block("flat-sawn").field)
+    pts = np.array([[5.0, 5.0, 5.0], [1.0, 2.0, 3.0]])
+    for bad, said in (([[np.nan, 0, 1], [0, 0, 1]], r"normal 0 is \[nan, 0.0, 1.0\] \(1 of 2"),
+                      ([[0, 0, 1], [0, 0, 0]], r"normal 1 is \[0.0, 0.0, 0.0\] \(1 of 2"),
+                      ([[0, 0, 1e-30]] * 2, r"normal 0 is .*\(2 of 2 are NaN/inf or shorter than 1e-06\)"),
+                      ([[np.inf, 0, 0], [0, 0, 1]], r"normal 0 is \[inf, 0.0, 0.0\]")):
+        with pytest.raises(WoodcamError, match="normals must be finite, non-zero directions .*" + said):
+            wood.color(pts, bad)
+
+    class Grey:
+        def color(self, points_mm, normals):
+            return np.full((len(points_mm), 3), 0.5)
+
+    with pytest.raises(WoodcamError, match=r"normals must be finite, non-zero directions .*normal 0 is \[0.0, 0.0, 0.0\]"):
+        wood_colors(Grey(), pts, (0, 0, 0))
+    assert np.array_equal(wood.color(pts, [[0, 0, 5], [3, 0, 0]]), wood.color(pts, [[0, 0, 1], [1, 0, 0]]))
+    assert np.array_equal(wood_colors(wood, pts, (0, 0, 1)), wood.color(pts, [[0, 0, 1]] * 2))
+
+
+def test_a_smooth_bake_where_vertex_normals_cancel_takes_the_triangles_normal():
+    """Vertex normals that cancel (the two sides of a fin share vertices) interpolate to no
+    direction, which the wood now refuses: the smooth bake takes the triangle's own normal
+    there, so it paints what the face bake paints."""
+    import numpy as np
+    import trimesh
+
+    import woodcam as w
+
+    wood = w.Wood(w.builtin_block("flat-sawn").field)
+    fin = trimesh.Trimesh(np.array([[5, 5, 5], [15, 5, 5], [5, 15, 5]], float), [[0, 1, 2], [0, 2, 1]], process=False)
+    assert np.allclose(fin.vertex_normals, 0)
+    smooth = w.bake(fin, wood, texels_per_mm=2, normals="smooth").atlas
+    face = w.bake(fin, wood, texels_per_mm=2, normals="face").atlas
+    assert smooth.shape == face.shape and np.array_equal(smooth, face)

@@ -7,12 +7,12 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .._checks import check_number, check_vector
+from .._checks import as_floats, check_number, check_vector
 from .._types import AppearanceLike, ArrayLike, GrowthFieldLike, WoodLike
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, evaluate, grain_direction, has_uncertainty
 from ..frames import FACE_NORMAL, FACES, check_face, check_size
-from ..tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS
+from ..tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS, MIN_NORMAL_LENGTH
 from .colormap import ColorMapAppearance
 
 #: Points per work item when colouring in parallel: big enough to amortise numpy's call
@@ -201,13 +201,7 @@ class Wood:
         chunks on ``threads`` threads.
         """
         p = check_points(points_mm)
-        try:  # float32 as given (no copy on the bake's hot path); a string was numpy's bare ValueError
-            n = np.asarray(normals, dtype=np.float32)
-        except (TypeError, ValueError):
-            n = None
-        if n is None or n.shape != p.shape:
-            raise WoodcamError(f"normals must have the shape of points_mm {p.shape}; got "
-                               f"{n.shape if n is not None else repr(normals)[:40]}")
+        n = check_normals(normals, p.shape)
         p, n = self._to_source(p, n)
         out = np.empty((len(p), 3), np.float32)
         starts = range(0, len(p), _CHUNK)
@@ -223,6 +217,29 @@ class Wood:
             with ThreadPoolExecutor(self.threads) as pool:
                 list(pool.map(work, starts))
         return out
+
+
+def check_normals(normals, shape: tuple, dtype=np.float32) -> np.ndarray:
+    """``normals`` as a ``shape`` (the points', ``(n, 3)``) array of ``dtype``, each finite and at
+    least :data:`~woodcam.tolerances.MIN_NORMAL_LENGTH` long, or a WoodcamError naming the first
+    that is not (a NaN or zero normal was coloured as an equal blend of the axes' colourings).
+    float32 as given is not copied (the bake's hot path)."""
+    try:  # a string was numpy's bare ValueError
+        n = np.asarray(normals, dtype=dtype)
+    except (TypeError, ValueError):
+        n = None
+    if n is None or n.shape != shape:
+        raise WoodcamError(f"normals must have the shape of points_mm {shape}; got "
+                           f"{n.shape if n is not None else repr(normals)[:40]}")
+    length2 = np.einsum("ij,ij->i", n, n, dtype=np.float64)
+    bad = ~(np.isfinite(length2) & (length2 >= MIN_NORMAL_LENGTH ** 2))
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise WoodcamError(f"normals must be finite, non-zero directions (outward surface normals, "
+                           f"block frame); normal {i} is {n[i].tolist()} ({int(bad.sum())} of {len(n)} are "
+                           f"NaN/inf or shorter than {MIN_NORMAL_LENGTH:g}); pass the surface's normals "
+                           "(trimesh: mesh.face_normals; drop degenerate triangles first)")
+    return n
 
 
 def check_rgb(rgb, n: int, who: str = "wood.color") -> np.ndarray:
@@ -254,11 +271,10 @@ def wood_colors(wood: WoodLike, points_mm: ArrayLike, normals: ArrayLike) -> np.
         raise WoodcamError("wood must have a method color(points_mm (n, 3), normals (n, 3)) -> "
                            f"rgb (n, 3); got {type(wood).__name__}; pass a woodcam Wood")
     p = check_points(points_mm)
-    nrm = np.asarray(normals, dtype=np.float64)
-    if nrm.shape == (3,):
+    nrm = as_floats(normals)
+    if nrm is not None and nrm.shape == (3,):
         nrm = np.broadcast_to(nrm, p.shape)
-    if nrm.shape != p.shape:
-        raise WoodcamError(f"normals must have the shape of points_mm {p.shape} or (3,); got {nrm.shape}")
+    nrm = check_normals(normals if nrm is None else nrm, p.shape, np.float64)
     if isinstance(wood, Wood):
         return wood.color(p, nrm)
     out = np.empty((len(p), 3), np.float32)
