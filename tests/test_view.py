@@ -501,6 +501,24 @@ def test_preview_rejects_bad_arguments(tmp_path, kwargs, match):
         preview(_textured_box(), **kwargs)
 
 
+@pytest.mark.parametrize("bad", [None, 5, float("nan"), (np.nan, 0, 0), (0.5, 0.5), (1.5, 0, 0), (-1, 0, 0),
+                                 (True, 0, 0), ""])
+def test_scene_background_is_a_colour_when_the_options_are_made(bad):
+    """SceneOptions(background=) was not checked: None drew pyvista's default blue, a number, NaN
+    or (0.5, 0.5) failed in VTK's renderer as pyvista's bare TypeError/ValueError."""
+    with pytest.raises(WoodcamError, match=r"background must be a colour; got .*; give a colour name \('white'\)"):
+        view.SceneOptions(background=bad)
+
+
+def test_a_background_name_pyvista_does_not_know_is_refused_before_drawing(tmp_path):
+    with pytest.raises(WoodcamError, match="background must be a colour; got 'nope'"):
+        preview(_textured_box(), screenshot=tmp_path / "p.png", window_size=SMALL, background="nope")
+    assert not (tmp_path / "p.png").exists()
+    ok = [view.SceneOptions(background=b).background for b in ("white", "#202020", [0.1, 0.2, 0.3],
+                                                                (255, 255, 255), np.array([0.0, 0.5, 1.0]))]
+    assert ok == ["white", "#202020", (0.1, 0.2, 0.3), (255, 255, 255), (0.0, 0.5, 1.0)]
+
+
 def test_preview_rejects_bad_meshes(tmp_path):
     with pytest.raises(WoodcamError, match="no file at"):
         preview(tmp_path / "missing.glb", screenshot=tmp_path / "p.png")

@@ -33,7 +33,7 @@ import numpy as np
 
 from .._types import ArrayLike, Mesh, PathLike, WoodLike
 from ..errors import WoodcamError, require
-from .._checks import check_bool, check_number, check_vector
+from .._checks import as_floats, check_bool, check_number, check_vector
 from ..frames import check_size
 from ..tolerances import ON_FACE_TOL_MM
 from ..units import say_length
@@ -522,6 +522,36 @@ def _prefer_egl_off_screen() -> None:
         os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"
 
 
+_BACKGROUND_FIX = ("give a colour name ('white'), a hex string ('#202020'), (r, g, b) in 0..1 or whole "
+                   "numbers in 0..255")
+
+
+def check_background(value, pv=None):
+    """The scene's ``background`` checked at the door: a colour name or hex string, or 3-4
+    numbers (floats in [0, 1], or whole numbers in 0..255 as pyvista reads them); ``pv`` (the
+    pyvista module, when loaded) also resolves a name. Returns ``value`` (a sequence as a
+    tuple). None, a number, NaN, (0.5, 0.5) or 'nope' reached VTK's renderer as pyvista's bare
+    TypeError/ValueError, or (None) its default blue."""
+    if isinstance(value, str):
+        ok = bool(value.strip())
+    else:
+        v = None if isinstance(value, (bool, np.bool_)) else as_floats(value)
+        ok = (v is not None and v.shape in ((3,), (4,)) and bool(np.all(np.isfinite(v)))
+              and not any(isinstance(x, (bool, np.bool_)) for x in value))
+        if ok:
+            whole = all(isinstance(x, (int, np.integer)) for x in value)
+            ok = bool(np.all((v >= 0) & (v <= (255 if whole else 1))))
+            value = tuple(int(x) if whole else float(x) for x in value)
+    if ok and pv is not None:
+        try:
+            pv.Color(value)
+        except (TypeError, ValueError):
+            ok = False
+    if not ok:
+        raise WoodcamError(f"background must be a colour; got {value!r:.60}; {_BACKGROUND_FIX}")
+    return value
+
+
 @dataclass(frozen=True)
 class SceneOptions:
     """How the scene is drawn: the keywords :func:`preview` and :func:`build_scene` share.
@@ -562,6 +592,7 @@ class SceneOptions:
     def __post_init__(self) -> None:
         object.__setattr__(self, "cut_plane", check_bool(self.cut_plane, "cut_plane"))
         check_camera(self.camera)
+        object.__setattr__(self, "background", check_background(self.background))
         if self.cut_origin is not None:
             object.__setattr__(self, "cut_origin",
                                tuple(check_vector(self.cut_origin, "cut_origin", unit=False)))
@@ -626,6 +657,7 @@ def build_scene(
         The cut-plane callback when a cut is shown, else None.
     """
     opt = SceneOptions.merged(options, scene_options)
+    check_background(opt.background, _pyvista())  # a name pyvista does not know, before any drawing
     _check_wood(wood)
     camera, cut_origin, cut_normal = opt.camera, opt.cut_origin, opt.cut_normal
     size = None if size_mm is None else check_size(size_mm)
@@ -739,6 +771,7 @@ def preview(
         )
     # Check the mesh and options before a window opens.
     opt = SceneOptions.merged(options, scene_options)
+    check_background(opt.background, pv)  # a name pyvista does not know, before a window opens
     _check_wood(wood)
     _check_size_with_wood(wood, None if size_mm is None else check_size(size_mm))
     mesh = _load_mesh(mesh_or_path)
