@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 
+import numpy as np
 import pytest
 
 from woodcam.errors import WoodcamError
@@ -848,3 +849,46 @@ def test_a_smooth_bake_where_vertex_normals_cancel_takes_the_triangles_normal():
     smooth = w.bake(fin, wood, texels_per_mm=2, normals="smooth").atlas
     face = w.bake(fin, wood, texels_per_mm=2, normals="face").atlas
     assert smooth.shape == face.shape and np.array_equal(smooth, face)
+
+
+@pytest.mark.parametrize("kw, said", [
+    (dict(rgb=np.zeros((10, 10))), r"rgb must be an \(h, w, 3\) RGB image; got shape \(10, 10\)"),
+    (dict(rgb="abc"), r"rgb must be an \(h, w, 3\) RGB image; got 'abc'"),
+    (dict(rgb=np.zeros((0, 0, 3))), r"rgb must be an \(h, w, 3\) RGB image; got shape \(0, 0, 3\)"),
+    (dict(rgb=np.full((10, 10, 3), 200.0)), r"rgb must hold finite values in \[0, 1\]; got range \[200, 200\]; divide"),
+    (dict(rgb=np.full((10, 10, 3), np.nan)), r"rgb must hold finite values in \[0, 1\]; got range \[nan, nan\]"),
+    (dict(px_per_mm=0), r"veneer 'v': px_per_mm must be a finite number > 0; got 0"),
+    (dict(px_per_mm="4"), r"veneer 'v': px_per_mm must be a finite number > 0; got '4'"),
+    (dict(mask=np.ones((5, 5), bool)), r"the mask must have the image's size 10x10 px; got 5x5"),
+    (dict(mask=np.ones(100, bool)), r"the mask must have the image's size 10x10 px; got shape \(100,\)"),
+    (dict(mask=np.full((10, 10), np.nan)), r"mask must be an \(h, w\) bool array .*got dtype float64"),
+    (dict(id=""), "veneer id must be a name"),
+    (dict(id="a/b"), "veneer id must be one file-name part"),
+    (dict(source=5), "source must be a string .*got 5"),
+    (dict(sheet_mm=(10, -1)), r"sheet_mm must be \(width, height\) > 0 mm; got \(10.0, -1.0\)"),
+    (dict(sheet_mm=(10,)), r"sheet_mm must be 2 finite numbers; got \(10,\)"),
+])
+def test_a_veneer_is_checked_when_made(kw, said):
+    """Veneer(...) of a user's own arrays was not checked (only the loaders checked theirs): a grey
+    (h, w) image, 0..255 floats, NaN, a mask of another size or px_per_mm=0 reached the matcher
+    as OpenCV's or numpy's bare errors, or ran on colours out of range."""
+    import numpy as np
+
+    from woodcam.parquetry import Veneer
+
+    args = dict(id="v", rgb=np.full((10, 10, 3), 0.5, np.float32), px_per_mm=4.0, mask=np.ones((10, 10), bool)) | kw
+    with pytest.raises(WoodcamError, match=said):
+        Veneer(**args)
+
+
+def test_a_veneer_of_lists_and_numbers_is_made_as_arrays():
+    """The valid call beside the refused ones: lists and a 0/1 mask are taken as the arrays they
+    are, a float32 sheet is not copied."""
+    import numpy as np
+
+    from woodcam.parquetry import Veneer
+
+    rgb = np.full((4, 6, 3), 0.25, np.float32)
+    v = Veneer("v", rgb, np.int64(2), [[1, 0, 1, 1, 1, 1]] * 4, "mine", [3, 2])
+    assert v.rgb is rgb and v.mask.dtype == bool and v.mask.sum() == 20 and v.px_per_mm == 2.0
+    assert v.size_mm == (3.0, 2.0) and Veneer("w", rgb.tolist(), 2, np.ones((4, 6), bool)).rgb.dtype == np.float32

@@ -22,7 +22,7 @@ from typing import Literal, Protocol
 
 import numpy as np
 
-from .._checks import check_bool, check_number, check_path, check_vector
+from .._checks import as_floats, check_bool, check_number, check_path, check_vector
 from .._readers import PHOTO_ALPHA_FIX, read_photo_rgb
 from ..errors import WoodcamError
 
@@ -68,6 +68,43 @@ class Veneer:
     mask: np.ndarray
     source: str = ""
     sheet_mm: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        # checked when made (a veneer of a user's own arrays too): a (h, w) grey rgb, 0..255
+        # floats, NaN, a mask of another size or px_per_mm=0 reached the matcher as OpenCV's
+        # or numpy's bare errors, or ran on colours out of range
+        check_veneer_id(self.id, "veneer id")
+        who = f"veneer {self.id!r}"
+        rgb = (self.rgb if isinstance(self.rgb, np.ndarray) and self.rgb.dtype == np.float32  # no copy of a scan
+               else as_floats(self.rgb))
+        if rgb is None or rgb.ndim != 3 or rgb.shape[2] != 3 or 0 in rgb.shape:
+            raise WoodcamError(f"{who}: rgb must be an (h, w, 3) RGB image; got "
+                               f"{'shape ' + str(rgb.shape) if rgb is not None else repr(self.rgb)[:40]}; "
+                               "repeat a grey image into three channels (np.dstack([grey] * 3))")
+        rgb = rgb.astype(np.float32, copy=False)
+        lo, hi = float(rgb.min()), float(rgb.max())
+        if not (np.isfinite(lo) and np.isfinite(hi) and lo >= 0.0 and hi <= 1.0):
+            raise WoodcamError(f"{who}: rgb must hold finite values in [0, 1]; got range [{lo:.4g}, {hi:.4g}]; "
+                               "divide 0..255 colours by 255")
+        self.rgb = rgb
+        self.px_per_mm = check_number(self.px_per_mm, f"{who}: px_per_mm", lo=0, lo_open=True,
+                                      fix="the sheet's resolution, e.g. 4 (dpi / 25.4)")
+        mask = np.asarray(self.mask)
+        if mask.dtype != bool and not (np.issubdtype(mask.dtype, np.number) and np.all(np.isfinite(mask))):
+            raise WoodcamError(f"{who}: mask must be an (h, w) bool array (True = usable wood); got dtype {mask.dtype}")
+        if mask.shape != rgb.shape[:2]:
+            got = f"{mask.shape[1]}x{mask.shape[0]}" if mask.ndim == 2 else f"shape {mask.shape}"
+            raise WoodcamError(
+                f"{who}: the mask must have the image's size {rgb.shape[1]}x{rgb.shape[0]} px; got {got}; "
+                "resample the mask to the scan")
+        self.mask = mask.astype(bool, copy=False)
+        if not isinstance(self.source, str):
+            raise WoodcamError(f"{who}: source must be a string (where the sheet came from); got {self.source!r:.40}")
+        if self.sheet_mm is not None:
+            self.sheet_mm = tuple(float(v) for v in check_vector(
+                self.sheet_mm, f"{who}: sheet_mm", n=2, fix="(width, height) in mm, or None"))
+            if min(self.sheet_mm) <= 0:
+                raise WoodcamError(f"{who}: sheet_mm must be (width, height) > 0 mm; got {self.sheet_mm}")
 
     @property
     def size_mm(self) -> tuple[float, float]:
@@ -122,15 +159,7 @@ def check_veneer_id(value, where: str) -> str:
 
 
 def _check(v: Veneer) -> Veneer:
-    check_veneer_id(v.id, "veneer id")
-    if v.rgb.ndim != 3 or v.rgb.shape[2] != 3:
-        raise WoodcamError(f"veneer {v.id!r}: rgb must be (h, w, 3); got shape {v.rgb.shape}")
-    if v.mask.shape != v.rgb.shape[:2]:
-        raise WoodcamError(
-            f"veneer {v.id!r}: the mask must have the image's size {v.rgb.shape[1]}x{v.rgb.shape[0]} "
-            f"px; got {v.mask.shape[1]}x{v.mask.shape[0]} px; resample the mask to the scan")
-    if not np.isfinite(v.px_per_mm) or v.px_per_mm <= 0:
-        raise WoodcamError(f"veneer {v.id!r}: px_per_mm must be > 0; got {v.px_per_mm}")
+    """A veneer a loader made (its arrays checked when made): one with usable wood."""
     if not v.mask.any():
         raise WoodcamError(f"veneer {v.id!r} has zero usable wood (its mask is empty); "
                            "check the mask (white = usable wood)")
