@@ -892,3 +892,21 @@ def test_a_veneer_of_lists_and_numbers_is_made_as_arrays():
     v = Veneer("v", rgb, np.int64(2), [[1, 0, 1, 1, 1, 1]] * 4, "mine", [3, 2])
     assert v.rgb is rgb and v.mask.dtype == bool and v.mask.sum() == 20 and v.px_per_mm == 2.0
     assert v.size_mm == (3.0, 2.0) and Veneer("w", rgb.tolist(), 2, np.ones((4, 6), bool)).rgb.dtype == np.float32
+
+
+def test_brush_weight_and_direction_are_checked():
+    """Brush.weight took one point (3,) as a scalar, broadcast an (n, 2) array, gave NaN weights
+    for NaN points and numpy's bare ValueError for 'a'; direction (inf, 0, 0) was kept as
+    (nan, nan, nan). The valid call: exp(-d^2 / 2 r^2) at distance d, a direction made unit."""
+    import woodcam as w
+
+    b = w.Brush((0, 0, 0), 5)
+    for pts, said in (([1, 2, 3], r"got shape \(3,\)"), ([[1, 2]], r"got shape \(1, 2\)"),
+                      ([[np.nan, 0, 0]], r"be finite; point 0 is \[nan, 0.0, 0.0\]"),
+                      ("a", "got 'a'")):
+        with pytest.raises(WoodcamError, match="points_mm must .*" + said):
+            b.weight(pts)
+    with pytest.raises(WoodcamError, match=r"brush direction must be three finite numbers .*got \(inf, 0, 0\)"):
+        w.Brush((0, 0, 0), 5, direction=(np.inf, 0, 0))
+    assert np.allclose(b.weight([[5, 0, 0], [0, 0, 0]]), [np.exp(-0.5), 1.0])
+    assert w.Brush((0, 0, 0), 5, direction=(0, 0, 2)).direction == (0.0, 0.0, 1.0)

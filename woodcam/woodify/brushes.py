@@ -27,7 +27,9 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._checks import check_vector
 from ..errors import WoodcamError
+from ..fields.base import check_points
 
 
 @dataclass(frozen=True)
@@ -54,14 +56,15 @@ class Brush:
             raise WoodcamError(f"brush gain must be > 0 (1 = unchanged speed); got {self.gain!r}")
         if not 0.0 <= self.strength < 1.0:
             raise WoodcamError(f"brush strength must lie in [0, 1); got {self.strength!r}")
-        d = np.asarray(self.direction, float)
-        if d.shape != (3,) or not np.linalg.norm(d) > 0:
-            raise WoodcamError(f"brush direction must be a non-zero 3-vector; got {self.direction!r}")
-        object.__setattr__(self, "direction", tuple(d / np.linalg.norm(d)))
+        # (inf, 0, 0) was taken as the direction (nan, nan, nan)
+        d = check_vector(self.direction, "brush direction", unit=True, fix="e.g. direction=(0, 0, 1)")
+        object.__setattr__(self, "direction", tuple(float(v) for v in d))
 
     def weight(self, points_mm: ArrayLike) -> np.ndarray:
         """Gaussian fall-off ``(n,)`` in [0, 1] at surface points ``(n, 3)`` (mm)."""
-        d2 = np.sum((np.asarray(points_mm, float) - np.asarray(self.centre_mm)) ** 2, axis=-1)
+        # one point (3,) or a (n, 2) array broadcast into nonsense, NaN gave NaN weights, 'a'
+        # was numpy's bare ValueError
+        d2 = np.sum((check_points(points_mm) - np.asarray(self.centre_mm)) ** 2, axis=-1)
         return np.exp(-0.5 * d2 / self.radius_mm ** 2)
 
 
