@@ -519,6 +519,25 @@ def test_a_background_name_pyvista_does_not_know_is_refused_before_drawing(tmp_p
     assert ok == ["white", "#202020", (0.1, 0.2, 0.3), (255, 255, 255), (0.0, 0.5, 1.0)]
 
 
+@pytest.mark.parametrize("overlay, said", [
+    ((np.zeros((2, 2, 3)), "red", 2.0), r"overlay must be a list of \(segments, colour, width\) tuples; got one tuple"),
+    (5, "overlay must be a list of .*got 5"),
+    ([(np.zeros((2, 2, 3)), "red")], r"overlay\[0\] must be \(segments \(k, 2, 3\) mm, colour, width px\)"),
+    ([(np.zeros((2, 3)), "red", 2.0)], r"overlay\[0\] segments must be a \(k, 2, 3\) array .*got shape \(2, 3\)"),
+    ([(np.full((1, 2, 3), np.nan), "red", 2.0)], r"overlay\[0\] segments must be .*finite mm"),
+    ([(np.zeros((1, 2, 3)), "nope", 2.0)], r"overlay\[0\] colour must be a colour; got 'nope'"),
+    ([(np.zeros((1, 2, 3)), "red", 0)], r"overlay\[0\] width must be a finite number > 0; got 0"),
+    ([(np.zeros((1, 2, 3)), "red", "a")], r"overlay\[0\] width must be a finite number > 0; got 'a'"),
+])
+def test_preview_overlay_is_checked_before_drawing(tmp_path, overlay, said):
+    """preview(overlay=) was not checked: one tuple, a pair, segments of another shape were bare
+    unpacking/reshape errors, NaN segments and a width of 0 were drawn, 'nope' failed in VTK,
+    all after the scene was built."""
+    with pytest.raises(WoodcamError, match=said):
+        preview(_textured_box(), screenshot=tmp_path / "p.png", window_size=SMALL, overlay=overlay)
+    assert not (tmp_path / "p.png").exists()
+
+
 def test_preview_rejects_bad_meshes(tmp_path):
     with pytest.raises(WoodcamError, match="no file at"):
         preview(tmp_path / "missing.glb", screenshot=tmp_path / "p.png")

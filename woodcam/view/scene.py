@@ -526,7 +526,7 @@ _BACKGROUND_FIX = ("give a colour name ('white'), a hex string ('#202020'), (r, 
                    "numbers in 0..255")
 
 
-def check_background(value, pv=None):
+def check_background(value, pv=None, name: str = "background"):
     """The scene's ``background`` checked at the door: a colour name or hex string, or 3-4
     numbers (floats in [0, 1], or whole numbers in 0..255 as pyvista reads them); ``pv`` (the
     pyvista module, when loaded) also resolves a name. Returns ``value`` (a sequence as a
@@ -548,7 +548,7 @@ def check_background(value, pv=None):
         except (TypeError, ValueError):
             ok = False
     if not ok:
-        raise WoodcamError(f"background must be a colour; got {value!r:.60}; {_BACKGROUND_FIX}")
+        raise WoodcamError(f"{name} must be a colour; got {value!r:.60}; {_BACKGROUND_FIX}")
     return value
 
 
@@ -708,6 +708,38 @@ def build_scene(
     return callback
 
 
+def check_overlay(overlay, pv=None) -> list[tuple[np.ndarray, object, float]]:
+    """``overlay`` of :func:`preview` checked before a window opens: a list of ``(segments (k, 2, 3)
+    finite mm, colour, width px > 0)``; returned with the segments as float arrays. A tuple of
+    two, segments of another shape or NaN, a colour pyvista does not know or a width of 0 or 'a'
+    were bare unpacking/reshape errors or VTK's, after the scene was built."""
+    if overlay is None:
+        return []
+    if isinstance(overlay, tuple) and len(overlay) == 3 and not isinstance(overlay[0], tuple):
+        raise WoodcamError("overlay must be a list of (segments, colour, width) tuples; got one tuple; "
+                           "pass [(segments, colour, width)]")
+    try:
+        items = list(overlay)
+    except TypeError:
+        items = None
+    if items is None:
+        raise WoodcamError(f"overlay must be a list of (segments, colour, width) tuples; got {overlay!r:.60}")
+    out = []
+    for i, item in enumerate(items):
+        if not (isinstance(item, (tuple, list)) and len(item) == 3):
+            raise WoodcamError(f"overlay[{i}] must be (segments (k, 2, 3) mm, colour, width px); got {item!r:.60}")
+        segments, colour, width = item
+        seg = as_floats(segments)
+        if seg is None or (seg.size and (seg.ndim != 3 or seg.shape[1:] != (2, 3))) or not np.all(np.isfinite(seg)):
+            got = f"shape {seg.shape}" if seg is not None and np.all(np.isfinite(seg)) else f"{segments!r:.60}"
+            raise WoodcamError(f"overlay[{i}] segments must be a (k, 2, 3) array of finite mm (k line segments, "
+                               f"start and end points in the block frame); got {got}")
+        colour = check_background(colour, pv, f"overlay[{i}] colour") if colour is not None else colour
+        width = check_number(width, f"overlay[{i}] width", lo=0, lo_open=True, fix="line width in pixels, e.g. 2")
+        out.append((seg.reshape(-1, 2, 3), colour, width))
+    return out
+
+
 def preview(
     mesh_or_path: Mesh | PathLike,
     *,
@@ -772,6 +804,7 @@ def preview(
     # Check the mesh and options before a window opens.
     opt = SceneOptions.merged(options, scene_options)
     check_background(opt.background, pv)  # a name pyvista does not know, before a window opens
+    overlay = check_overlay(overlay, pv)
     _check_wood(wood)
     _check_size_with_wood(wood, None if size_mm is None else check_size(size_mm))
     mesh = _load_mesh(mesh_or_path)
@@ -783,8 +816,7 @@ def preview(
                          title="woodcam preview")
     try:
         build_scene(plotter, mesh, wood=wood, size_mm=size_mm, widget=not off_screen, options=opt)
-        for segments, colour, width in overlay or ():
-            seg = np.asarray(segments, dtype=float).reshape(-1, 2, 3)
+        for seg, colour, width in overlay:
             if len(seg):
                 n = len(seg)
                 cells = np.column_stack([np.full(n, 2), 2 * np.arange(n), 2 * np.arange(n) + 1])
