@@ -97,6 +97,15 @@ def _sweep_orphans(path: Path) -> None:
             continue
 
 
+def _not_a_folder(path: Path, what: str) -> None:
+    """The one refusal of an output path that is an existing folder (:func:`check_output_path`
+    before the work; every atomic writer at its start: the writer ran, then the rename failed
+    with IsADirectoryError naming the temporary file)."""
+    if path.is_dir():
+        raise WoodcamError(f"{what}: {str(path)!r} is an existing folder, not a file; "
+                           f"give a file name inside it, e.g. '{path / ('part' + path.suffix)}'")
+
+
 def _fsync_path(path: Path) -> None:
     fd = os.open(path, os.O_RDONLY)
     try:
@@ -213,6 +222,7 @@ def atomic_path(path, *, fsync: bool = True, mkdir: bool = False) -> Iterator[Pa
     block raises, or the writer wrote nothing under that name, nothing is renamed.
     """
     path = Path(path)
+    _not_a_folder(path, "atomic_path")
     if mkdir:
         path.parent.mkdir(parents=True, exist_ok=True)
     tmp = _temp_in(path)
@@ -387,6 +397,8 @@ def atomic_files(paths: Iterable, *, fsync: bool = True, mkdir: bool = False) ->
             t_obj.write_text(text); t_mtl.write_bytes(...); t_png.write_bytes(...)
     """
     targets = [Path(p) for p in paths]
+    for p in targets:
+        _not_a_folder(p, "atomic_files")
     if len({p.resolve() for p in targets}) != len(targets):
         raise WoodcamError(f"atomic_files: targets must be distinct; got {[str(p) for p in targets]}")
     if mkdir:
@@ -436,9 +448,7 @@ def check_output_path(path, *, suffixes: Iterable[str] | None = None, what: str 
         if path.suffix.lower() not in allowed:
             raise WoodcamError(f"{what} must end in {' or '.join(allowed)}; got {str(path)!r}; "
                                f"give a file name such as 'part{allowed[0]}'")
-    if path.is_dir():
-        raise WoodcamError(f"{what}: {str(path)!r} is an existing folder, not a file; "
-                           f"give a file name inside it, e.g. '{path / ('part' + path.suffix)}'")
+    _not_a_folder(path, what)
     parent = path.parent
     if mkdir and not parent.exists():
         try:

@@ -372,3 +372,34 @@ def test_all_or_nothing_names_what_it_wrote_and_a_cache_entry_stays_apart(tmp_pa
         assert not (tmp_path / "a.png").exists() and written == []
         write_bytes(tmp_path / "table.md", b"t")
     assert written == [tmp_path / "a.png", tmp_path / "table.md"]
+
+
+def test_every_atomic_writer_refuses_a_folder_before_writing(tmp_path):
+    """A path that is a folder: the writer ran (the whole GLB or log made), then the rename
+    failed with IsADirectoryError naming the temporary file. Now a WoodcamError naming the
+    folder before anything is written; the folder and its contents stay as they were."""
+    from woodcam import generate_log, write_log
+    from woodcam._atomic import atomic_files, atomic_path, atomic_write, write_bytes, write_text
+
+    folder = tmp_path / "out.json"
+    folder.mkdir()
+    (folder / "keep.txt").write_text("mine")
+    ran = []
+
+    def body(make):
+        with make() as handle:
+            ran.append(handle)
+
+    for who, call in (("atomic_path", lambda: write_text(folder, "x")),
+                      ("atomic_path", lambda: write_bytes(folder, b"x")),
+                      ("atomic_path", lambda: body(lambda: atomic_write(folder, "w"))),
+                      ("atomic_path", lambda: body(lambda: atomic_path(folder))),
+                      ("atomic_files", lambda: body(lambda: atomic_files([tmp_path / "a.txt", folder])))):
+        with pytest.raises(WoodcamError, match=rf"{who}: '{folder}' is an existing folder, not a file; give a "
+                                               rf"file name inside it, e.g. '{folder}/part.json'"):
+            call()
+    assert ran == [] and sorted(p.name for p in tmp_path.iterdir()) == ["out.json"]
+    assert [p.name for p in folder.iterdir()] == ["keep.txt"]
+    with pytest.raises(WoodcamError, match="is an existing folder, not a file"):  # a public writer
+        write_log(generate_log(1, length_mm=200).to_skeleton(), folder)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.json"]
