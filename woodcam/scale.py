@@ -49,7 +49,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, Literal, get_args
 
-from ._checks import check_bool, check_path
+from ._checks import check_bool, check_number, check_path
 from .errors import WoodcamError
 
 Engine = Literal["local", "dask"]
@@ -306,13 +306,13 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
         raise WoodcamError(f"fn must be a callable key (str) -> JSON-serialisable; got {type(fn).__name__}")
     if engine not in ENGINES:
         raise WoodcamError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
-    if not isinstance(retries, int) or retries < 0:
-        raise WoodcamError(f"retries must be an integer >= 0; got {retries!r}")
-    if workers is not None and (not isinstance(workers, int) or workers < 1):
-        raise WoodcamError(f"workers must be an integer >= 1; got {workers!r}")
-    if memory_limit_mb is not None and memory_limit_mb < 256:
-        raise WoodcamError(f"memory_limit_mb must be >= 256 MiB (a Python worker alone needs "
-                           f"~100 MiB) or None; got {memory_limit_mb!r}")
+    # retries=True and workers=True were taken as 1, memory_limit_mb='1e3' was a bare TypeError
+    retries = int(check_number(retries, "retries", lo=0, integer=True, fix="tries after a failure, e.g. 2"))
+    if workers is not None:
+        workers = int(check_number(workers, "workers", lo=1, integer=True, fix="worker processes, or None"))
+    if memory_limit_mb is not None:
+        check_number(memory_limit_mb, "memory_limit_mb", lo=256,
+                     fix="MiB per worker (a Python worker alone needs ~100 MiB), or None")
     progress = check_bool(progress, "run_many: progress")
     if address is not None:
         if engine != "dask":
