@@ -191,7 +191,7 @@ def test_program_from_arrays_and_errors():
     assert res.removed_volume_mm3 == pytest.approx(math.pi, rel=2e-2)
     with pytest.raises(WoodcamError, match="size_mm must be"):
         simulate(prog, FlatEndMill(2), (10, 10))
-    with pytest.raises(WoodcamError, match="resolution_mm must be finite and > 0"):
+    with pytest.raises(WoodcamError, match="resolution_mm must be a finite number > 0; got 0"):
         simulate(prog, FlatEndMill(2), SIZE, resolution_mm=0)
     with pytest.raises(WoodcamError, match="tools must be a Tool"):
         simulate(prog, "flat:2", SIZE)

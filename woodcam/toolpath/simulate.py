@@ -43,7 +43,7 @@ from typing import Literal, Mapping
 
 import numpy as np
 
-from .._checks import as_floats, check_bool
+from .._checks import as_floats, check_bool, check_number
 from .._types import ArrayLike, Mesh
 from ..errors import WoodcamError
 from ..tolerances import SIM_CONTACT_TOL_MM
@@ -226,6 +226,8 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     SimResult
         ``heightmap (ny, nx)``, ``report`` (issues with line numbers), ``stats`` (timings).
     """
+    # resolution_mm=True or '0.5' was float()'s 1.0 and 0.5 without a word
+    check_number(resolution_mm, "simulate: resolution_mm", lo=0, lo_open=True, fix="use e.g. 0.1")
     try:  # strings, inf and short vectors were bare ValueError/TypeError/OverflowError
         size = np.asarray(size_mm, float).reshape(-1)
         res_mm = float(resolution_mm)
@@ -235,9 +237,6 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
                            f"{size_mm!r}, {resolution_mm!r}, {work_offset_mm!r}") from err
     if size.shape != (3,) or not np.all(np.isfinite(size) & (size > 0)):
         raise WoodcamError(f"simulate: size_mm must be (W, D, H) finite and > 0 in mm, got {size_mm!r}")
-    if not (np.isfinite(res_mm) and res_mm > 0):
-        raise WoodcamError(f"simulate: resolution_mm must be finite and > 0, got {resolution_mm!r}; "
-                           "use e.g. 0.1")
     if off_in is not None and (off_in.shape != (3,) or not np.isfinite(off_in).all()):
         raise WoodcamError(f"simulate: work_offset_mm must be three finite numbers (X, Y, Z) in mm; "
                            f"got {work_offset_mm!r}")
