@@ -733,3 +733,53 @@ def test_the_scene_samples_its_section_at_the_resolution_asked():
                 < (SIZE[1] / res + 1) * (SIZE[2] / res + 1) + 4 * (SIZE[1] + SIZE[2]) / res
     finally:
         plotter.close()
+
+
+def _dirty_meshes():
+    """A 10 mm box in a 30 mm block made slightly dirty four ways a user's mesh can be: an
+    unreferenced vertex, a zero-area triangle (a sliver on a box edge, its own vertex on the
+    edge's middle), a duplicated face, and a fin (one triangle both ways round: the vertex
+    normals cancel)."""
+    box = trimesh.creation.box(extents=(10.0, 10.0, 10.0))
+    box.apply_translation((15.0, 15.0, 15.0))
+    v, f = np.asarray(box.vertices), np.asarray(box.faces)
+    a, b = f[0, 0], f[0, 1]
+    mid = (v[a] + v[b]) / 2
+    return {"unreferenced vertex": trimesh.Trimesh(np.vstack([v, [[3.0, 3.0, 3.0]]]), f, process=False),
+            "zero-area triangle": trimesh.Trimesh(np.vstack([v, [mid]]), np.vstack([f, [[a, 8, b]]]),
+                                                  process=False),
+            "duplicate face": trimesh.Trimesh(v, np.vstack([f, f[:1]]), process=False),
+            "fin": trimesh.Trimesh(np.array([[5.0, 5, 5], [15, 5, 5], [5, 15, 5]]), [[0, 1, 2], [0, 2, 1]],
+                                   process=False)}
+
+
+def test_a_dirty_mesh_gets_a_direction_at_every_vertex():
+    """vertex_color_normals: trimesh's vertex normals where they are a direction, the vertex's
+    largest triangle's normal where they cancel (a fin, a zero-area triangle's vertex), +Z where
+    no triangle of any area uses the vertex."""
+    from woodcam.appearance.wood import vertex_color_normals
+
+    for name, mesh in _dirty_meshes().items():
+        n = vertex_color_normals(mesh)
+        assert n.shape == (len(mesh.vertices), 3) and np.allclose(np.linalg.norm(n, axis=1), 1.0), name
+        good = np.linalg.norm(mesh.vertex_normals, axis=1) > 0.5
+        assert np.array_equal(n[good], np.asarray(mesh.vertex_normals)[good]), name
+    meshes = _dirty_meshes()
+    assert np.array_equal(vertex_color_normals(meshes["unreferenced vertex"])[8], [0.0, 0.0, 1.0])
+    fin = meshes["fin"]
+    assert all(any(np.allclose(n, fn) for fn in fin.face_normals) for n in vertex_color_normals(fin))
+
+
+def test_placement_panels_colour_a_users_slightly_dirty_mesh(tmp_path):
+    """Since the wood refuses a zero normal, the placement panels (render_side_by_side) refused
+    a mesh with an unreferenced vertex, a zero-area triangle or a fin (trimesh gives such
+    vertices a zero normal): each is drawn, coloured by the wood."""
+    import woodcam as w
+    from woodcam.view.compare import render_side_by_side
+
+    meshes = _dirty_meshes()
+    wood = w.Wood(w.builtin_block("flat-sawn").field)
+    png = render_side_by_side(list(meshes.values()), [wood] * len(meshes), (30.0, 30.0, 30.0),
+                              list(meshes), tmp_path / "panels.png", panel_px=96)
+    with Image.open(png) as im:
+        assert im.size == (96 * len(meshes), 96)

@@ -175,3 +175,33 @@ def test_done_feeds_are_blue_rapids_red_and_the_stock_wears_its_wood():
                                       np.round(pts / np.array(_Stock.size_mm) * 255).astype(np.uint8))
     finally:
         plotter.close()
+
+
+def test_the_stock_is_coloured_when_its_mesh_has_a_vertex_without_a_normal(monkeypatch):
+    """The stock's vertices are coloured with normals the wood accepts (it refuses a zero one)
+    whatever the height-field mesh holds: an unreferenced vertex (trimesh's normal there is
+    zero) takes +Z; the others keep trimesh's."""
+    import trimesh
+
+    import woodcam as w
+    import woodcam.toolpath.mesh
+    from woodcam.view.scrub import _stock_polydata
+
+    real = woodcam.toolpath.mesh.heightfield_mesh
+
+    def with_a_stray_vertex(*args, **kwargs):
+        mesh = real(*args, **kwargs)
+        return trimesh.Trimesh(np.vstack([mesh.vertices, [[1.0, 1.0, 1.0]]]), mesh.faces, process=False)
+
+    monkeypatch.setattr(woodcam.toolpath.mesh, "heightfield_mesh", with_a_stray_vertex)
+    seen = []
+
+    class Recording(w.Wood):
+        def color(self, points_mm, normals):
+            seen.append(np.array(normals))
+            return super().color(points_mm, normals)
+
+    wood = Recording(w.builtin_block("flat-sawn").field)
+    poly = _stock_polydata(pv, np.full((8, 12), 20.0), _Stock.size_mm, wood)
+    assert poly.n_points == len(seen[0]) and poly.point_data["rgb"].shape == (poly.n_points, 3)
+    np.testing.assert_array_equal(seen[0][-1], [0.0, 0.0, 1.0])

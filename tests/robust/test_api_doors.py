@@ -922,3 +922,25 @@ def test_brush_weight_and_direction_are_checked():
         w.Brush((0, 0, 0), 5, direction=(np.inf, 0, 0))
     assert np.allclose(b.weight([[5, 0, 0], [0, 0, 0]]), [np.exp(-0.5), 1.0])
     assert w.Brush((0, 0, 0), 5, direction=(0, 0, 2)).direction == (0.0, 0.0, 1.0)
+
+
+@pytest.mark.parametrize("normals", ["face", "smooth"])
+def test_a_slightly_dirty_mesh_still_bakes(normals):
+    """The wood refuses a zero normal; trimesh gives one to an unreferenced vertex and to a
+    zero-area triangle. Neither reaches the wood from the bake (a zero-area triangle paints no
+    texel, an unreferenced vertex none either): the dirty mesh bakes as the clean one."""
+    import numpy as np
+    import trimesh
+
+    import woodcam as w
+
+    wood = w.Wood(w.builtin_block("flat-sawn").field)
+    box = trimesh.creation.box(extents=(10.0, 10.0, 10.0))
+    box.apply_translation((15.0, 15.0, 15.0))
+    v, f = np.asarray(box.vertices), np.asarray(box.faces)
+    a, b = f[0, 0], f[0, 1]
+    dirty = trimesh.Trimesh(np.vstack([v, [(v[a] + v[b]) / 2, [3.0, 3.0, 3.0]]]),
+                            np.vstack([f, [[a, 8, b]], f[:1]]), process=False)
+    assert (np.linalg.norm(dirty.vertex_normals, axis=1) == 0).sum() == 2
+    baked = w.bake(dirty, wood, texels_per_mm=1, normals=normals)
+    assert baked.coverage_mask.any() and len(baked.mesh.faces) == len(dirty.faces)

@@ -242,6 +242,40 @@ def check_normals(normals, shape: tuple, dtype=np.float32) -> np.ndarray:
     return n
 
 
+def vertex_color_normals(mesh) -> np.ndarray:
+    """Unit normals ``(n, 3)`` float64 at the vertices of a triangle ``mesh`` (trimesh), one a
+    direction at every vertex, for colouring the vertices with ``wood.color`` (which refuses
+    a zero normal, :func:`check_normals`).
+
+    trimesh's ``vertex_normals`` where they are a direction; where they are not, the normal of
+    the vertex's largest triangle (the two sides of a fin, whose normals cancel, or a vertex
+    whose other triangles are degenerate), and +Z at a vertex no triangle of non-zero area uses
+    (an unreferenced vertex, or one of zero-area triangles only: its colour is never drawn).
+    A user's slightly dirty mesh (unreferenced vertices, a zero-area triangle, duplicate faces)
+    is still coloured."""
+    normals = np.array(mesh.vertex_normals, dtype=np.float64).reshape(-1, 3)
+    length2 = np.einsum("ij,ij->i", normals, normals)
+    bad = ~(np.isfinite(length2) & (length2 >= MIN_NORMAL_LENGTH ** 2))
+    if not bad.any():
+        return normals
+    faces = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
+    face_normals = np.asarray(mesh.face_normals, dtype=np.float64).reshape(-1, 3)
+    area = np.nan_to_num(np.asarray(mesh.area_faces, dtype=np.float64))
+    fallback = np.zeros_like(normals)
+    fallback[:, 2] = 1.0
+    if len(faces):
+        corner_vertex = faces.ravel()
+        corner_face = np.repeat(np.arange(len(faces)), 3)
+        order = np.lexsort((area[corner_face], corner_vertex))  # by vertex, then area
+        v, f = corner_vertex[order], corner_face[order]
+        largest = np.r_[v[1:] != v[:-1], True]                  # each vertex's last corner
+        usable = largest & (area[f] > 0) & np.all(np.isfinite(face_normals[f]), axis=1) \
+            & (np.einsum("ij,ij->i", face_normals[f], face_normals[f]) >= MIN_NORMAL_LENGTH ** 2)
+        fallback[v[usable]] = face_normals[f[usable]]
+    normals[bad] = fallback[bad]
+    return normals
+
+
 def check_rgb(rgb, n: int, who: str = "wood.color") -> np.ndarray:
     """The colour contract, checked in one place: ``(n, 3)`` finite, in [0, 1] (within
     :data:`~woodcam.tolerances.COLOR_RANGE_TOL`, then clipped). Returns float32 ``(n, 3)``."""

@@ -38,6 +38,7 @@ def render_side_by_side(meshes, woods, size_mm, titles, png, *, panel_px: int = 
     """Render ``meshes[i]`` (trimesh, block frame, mm) coloured by ``woods[i].color`` at its
     vertices in panel ``i`` of one PNG, with the block outline and ``titles[i]`` above it;
     ``progress``: a bar over the panels."""
+    from ..appearance.wood import vertex_color_normals
     from ..errors import require
     from .scene import _prefer_egl_off_screen
 
@@ -60,7 +61,9 @@ def render_side_by_side(meshes, woods, size_mm, titles, png, *, panel_px: int = 
                 np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces), _EDGE_MM,
                 max_iter=12)
             fine = trimesh.Trimesh(verts, tris, process=False)
-            rgb = wood.color(verts, np.asarray(fine.vertex_normals, dtype=float))
+            # a direction at every vertex: an unreferenced one or a degenerate triangle's
+            # has none, which the wood refuses
+            rgb = wood.color(verts, vertex_color_normals(fine))
             faces = np.column_stack([np.full(len(tris), 3), tris]).ravel()
             surf = pv.PolyData(verts, faces)
             surf["rgb"] = (np.clip(rgb, 0, 1) * 255).astype(np.uint8)
