@@ -261,3 +261,21 @@ def test_a_program_file_without_a_gcode_suffix_is_read_as_a_file(tmp_path):
     p.write_text("G21 G90\nG0 X1 Y2 Z3\n")
     prog = read_gcode(str(p))
     assert prog.source == str(p) and np.allclose(prog.end_mm[-1], (1, 2, 3))
+
+
+def test_a_program_is_sliced_as_a_list_of_moves():
+    """program[0:1] was a bare TypeError (numpy's 'only 0-dimensional arrays can be converted'),
+    program[1.0] an IndexError about numpy indices: a slice is now a Program of those moves (its
+    tools, source and warnings with them), an integer (a numpy one too) a Move, anything else a
+    WoodcamError naming the index."""
+    prog = read_gcode("T1 M6\nG0 X10 Y20 Z5\nG1 Z-2 F300\nT2 M6\nG1 X30\nG0 Z5\n")
+    moves = prog.moves
+    for sl in (slice(0, 1), slice(1, None), slice(None, None, -1), slice(-2, None), slice(3, 3)):
+        part = prog[sl]
+        assert isinstance(part, type(prog)) and part.moves == moves[sl], sl
+        assert part.tool_numbers == sorted({m.tool for m in moves[sl]}) and part.source == prog.source
+    assert prog[:2].tool_numbers == [1] and prog[1:].line.tolist() == [3, 5, 6]
+    assert prog[np.int64(1)] == moves[1] and prog[-1] == moves[-1]
+    for bad in (1.0, "a", True, None):
+        with pytest.raises(WoodcamError, match=r"Program: a move index must be an integer or a slice; got "):
+            prog[bad]

@@ -27,6 +27,7 @@ import math
 import numbers
 import os
 from dataclasses import dataclass, field
+from typing import overload
 from pathlib import Path
 
 import numpy as np
@@ -82,10 +83,29 @@ class Program:
     def __len__(self) -> int:
         return len(self.kind)
 
-    def __getitem__(self, i: int) -> Move:
+    @overload
+    def __getitem__(self, i: int) -> Move: ...
+
+    @overload
+    def __getitem__(self, i: slice) -> Program: ...
+
+    def __getitem__(self, i):
+        """``program[i]``: move ``i`` as a :class:`Move`; ``program[a:b]``: those moves as a
+        :class:`Program` (a list's slice: ``program[:10]`` is the first ten moves)."""
+        if isinstance(i, slice):
+            return self._subset(i)
+        if isinstance(i, bool) or not isinstance(i, numbers.Integral):
+            raise WoodcamError(f"Program: a move index must be an integer or a slice; got {i!r:.60}; "
+                               "e.g. program[0] (a Move) or program[0:10] (a Program of ten moves)")
         return Move(tuple(map(float, self.start_mm[i])), tuple(map(float, self.end_mm[i])),
                     _KIND_NAMES[int(self.kind[i])], int(self.tool[i]), int(self.line[i]),
                     float(self.feed_mm_min[i]), float(self.spindle_rpm[i]))
+
+    def _subset(self, k) -> Program:
+        """The moves ``k`` (a slice or a boolean mask) as a program of the same source."""
+        return Program(self.start_mm[k], self.end_mm[k], self.kind[k], self.tool[k],
+                       self.line[k], self.feed_mm_min[k], self.spindle_rpm[k], self.source,
+                       sorted(set(self.tool[k].tolist())), list(self.warnings))
 
     def __iter__(self):
         return (self[i] for i in range(len(self)))
@@ -193,9 +213,7 @@ class Program:
         k = self.line <= int(until)
         if after is not None:
             k &= self.line > int(after)
-        return Program(self.start_mm[k], self.end_mm[k], self.kind[k], self.tool[k],
-                       self.line[k], self.feed_mm_min[k], self.spindle_rpm[k], self.source,
-                       sorted(set(self.tool[k].tolist())), list(self.warnings))
+        return self._subset(k)
 
     @classmethod
     def from_arrays(cls, start_mm, end_mm, *, kind=FEED, tool=1, line=0, feed_mm_min=1000.0,
