@@ -151,8 +151,23 @@ def test_crease_normals_split_sharp_edges_and_smooth_flat_ones():
     radial = c.vertices[side, :2] / np.linalg.norm(c.vertices[side, :2], axis=1, keepdims=True)
     np.testing.assert_allclose(c.vertex_normals[side, :2], radial, atol=1e-3)  # smooth sides
     np.testing.assert_allclose(np.abs(c.vertex_normals[~side, 2]), 1.0, atol=1e-12)  # flat caps
-    with pytest.raises(WoodcamError, match="crease_angle_deg must be in"):
+    with pytest.raises(WoodcamError, match=r"crease_angle_deg must be a finite number in \[0, 180\]"):
         crease_normals(box, -1.0)
+
+
+def test_the_crease_angle_is_a_number_not_a_string():
+    """crease_normals(mesh, "30") took float("30") without a word (as every other number door
+    refuses a string): refused naming the argument; an int and a numpy float are numbers."""
+    from woodcam.export import crease_normals
+
+    box = trimesh.creation.box()
+    for bad in ("30", True, [30.0], float("nan")):
+        with pytest.raises(WoodcamError, match=r"crease_normals: crease_angle_deg must be a finite number in "
+                                               r"\[0, 180\]; got .*; use e.g. 30 \(degrees"):
+            crease_normals(box, bad)
+    want = crease_normals(box, 30.0)
+    for same in (30, np.float32(30.0)):
+        assert np.array_equal(crease_normals(box, same).vertex_normals, want.vertex_normals)
 
 
 def test_the_crease_angle_is_in_degrees_a_45_degree_hinge_splits_at_30_and_not_at_60():
@@ -422,7 +437,7 @@ def test_damaged_files_and_bad_arguments_are_one_error(baked, tmp_path):
 
     with pytest.raises(WoodcamError, match="mesh has no triangles"):
         crease_normals(trimesh.Trimesh())
-    with pytest.raises(WoodcamError, match="crease_angle_deg must be in"):
+    with pytest.raises(WoodcamError, match=r"crease_angle_deg must be a finite number in \[0, 180\]"):
         crease_normals(trimesh.creation.box(), "abc")
     with pytest.raises(WoodcamError, match=r"metadata may not change \['frame'\]"):
         export_glb(baked.mesh, tmp_path / "a.glb", metadata={"frame": "x"})

@@ -40,7 +40,7 @@ from typing import get_args
 import numpy as np
 
 from woodcam._atomic import atomic_files, check_output_path, write_bytes
-from woodcam._checks import check_path
+from woodcam._checks import check_number, check_path
 from woodcam.errors import WoodcamError
 from woodcam.frames import (BLOCK_TO_GLTF, GLTF_ROOT_NODE, OBJ_HEADER, ObjUnits, ObjUp,
                             foreign_gltf_in_block_frame, obj_header_transform, obj_transform)
@@ -149,15 +149,10 @@ def crease_normals(mesh: Mesh, crease_angle_deg: float | None = None) -> Mesh:
 
     if not isinstance(mesh, trimesh.Trimesh):
         raise WoodcamError(f"mesh must be a trimesh.Trimesh; got {type(mesh).__name__}")
-    try:
-        angle = CREASE_ANGLE_DEG if crease_angle_deg is None else float(crease_angle_deg)
-    except (TypeError, ValueError):
-        angle = math.nan
-    if not (math.isfinite(angle) and 0.0 <= angle <= 180.0):
-        raise WoodcamError(
-            f"crease_normals: crease_angle_deg must be in [0, 180]; got {crease_angle_deg!r}; "
-            "use e.g. 30 (0 = flat shading, 180 = smooth everywhere)"
-        )
+    # a string ('30') was float()'s number without a word
+    angle = CREASE_ANGLE_DEG if crease_angle_deg is None else check_number(
+        crease_angle_deg, "crease_normals: crease_angle_deg", lo=0.0, hi=180.0,
+        fix="use e.g. 30 (degrees; 0 = flat shading, 180 = smooth everywhere)")
     if len(mesh.faces) == 0:
         raise WoodcamError("crease_normals: mesh has no triangles; pass a surface with at least one")
     verts = np.asarray(mesh.vertices, dtype=np.float64)
