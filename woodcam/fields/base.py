@@ -109,10 +109,16 @@ def arf(years: ArrayLike) -> np.ndarray:
 
     Always apply it to a (possibly interpolated) growth time, never interpolate its output:
     interpolating the ARF would blur the sharp latewood -> earlywood step at ring boundaries.
+    ``years``: numbers of any shape (a NaN year, where a field is not defined, stays NaN).
     """
-    g = as_floats(years)
-    if g is None:  # 'a' was numpy's bare "could not convert string to float"
-        raise WoodcamError(f"years must be growth times (numbers); got {years!r:.60}")
+    try:
+        kind = np.asarray(years).dtype.kind
+    except (TypeError, ValueError):  # a ragged list
+        kind = "O"
+    g = as_floats(years) if kind in "iuf" else None
+    if g is None:  # 'a' was numpy's bare "could not convert string to float"; None was NaN, '0.5' 0.25
+        raise WoodcamError(f"years must be growth times (numbers, any shape); got {years!r:.60}; "
+                           "pass field(points_mm) or evaluate(field, points_mm)")
     return np.mod(g, 1.0) ** 2
 
 
