@@ -255,6 +255,13 @@ def unfold_cross(images: dict, size_mm: ArrayLike, background: float | ArrayLike
     if not faces:
         raise WoodcamError("images must hold at least one face image; got an empty dict")
     f0, im0 = next(iter(faces.items()))
+    for face, im in faces.items():
+        # a NaN image was laid out as it was; one of strings or None failed deep in numpy
+        if im.dtype.kind not in "buif" or (im.dtype.kind == "f" and not np.all(np.isfinite(im))):
+            bad = int(np.sum(~np.isfinite(im))) if im.dtype.kind == "f" else None
+            raise WoodcamError(f"image of face {face!r} must hold finite numbers; got " + (
+                f"{bad} NaN/inf of {im.size} values; fill the missing pixels first (e.g. np.nan_to_num(image))"
+                if bad is not None else f"dtype {im.dtype}; pass a numeric image array (uint8 or floats)"))
     for face, im in faces.items():  # a 1-D image, or grey beside RGB, failed deep in numpy
         if im.ndim not in (2, 3) or im.shape[2:] != im0.shape[2:]:
             raise WoodcamError(f"image of face {face!r} must be (h, w) or (h, w, c) with the channels of "

@@ -435,6 +435,13 @@ def _library_door_sweep():
         ("arf None *", lambda: w.arf(None), r"years must be growth times \(numbers, any shape\); got None; pass field"),
         ("arf str number *", lambda: w.arf("0.5"), "years must be growth times .*got '0.5'"),
         ("arf list with None *", lambda: w.arf([1.0, None]), r"years must be growth times .*got \[1.0, None\]"),
+        ("unfold_cross NaN image *", lambda: w.unfold_cross({"front": np.full((4, 10), np.nan)}, (50, 20, 20)),
+         "image of face 'front' must hold finite numbers; got 40 NaN/inf of 40 values; fill the missing pixels"),
+        ("unfold_cross one inf value *", lambda: w.unfold_cross(
+            {"top": np.zeros((8, 10, 3)), "front": np.where(np.arange(240).reshape(8, 10, 3) == 70, np.inf, 0.0)},
+            (50, 40, 40)), "image of face 'front' must hold finite numbers; got 1 NaN/inf of 240 values"),
+        ("unfold_cross image of strings", lambda: w.unfold_cross({"front": np.full((4, 10), "a")}, (50, 20, 20)),
+         r"image of face 'front' must hold finite numbers; got dtype <U1; pass a numeric image"),
         ("run_many fn None *", lambda: w.run_many(None, ["a"], "runs", progress=False), "fn must be a callable .*got NoneType"),
         ("run_many retries True *", lambda: w.run_many(str, ["a"], "runs", retries=True, progress=False),
          "retries must be an integer >= 0; got True"),
