@@ -304,8 +304,33 @@ def test_brush_file_round_trip_and_errors(tmp_path):
     assert a == Brush((1, 2, 3), 4.0, 1.5, (0.0, 0.0, 1.0), 0.25) and b.gain == 1.0
     assert a.weight(np.array([[1.0, 2.0, 3.0], [5.0, 2.0, 3.0]])) == pytest.approx([1.0, np.exp(-0.5)])
     p.write_text('{"brushes": [{"radius_mm": 4}]}')
-    with pytest.raises(WoodcamError, match="brushes file .* must be JSON like"):
+    with pytest.raises(WoodcamError, match="brushes file .*: brush 0 .* must be like .*: missing 'centre_mm'"):
         load_brushes(p)
+
+
+def test_a_brush_file_is_read_as_every_json_file_is(tmp_path):
+    """load_brushes read its JSON with json.loads of read_text, not the project's reader: a file
+    nested too deep was a bare RecursionError, a missing file read "must be JSON like ...: [Errno
+    2]", and float() took "radius_mm": "4" and "gain": true as 4.0 and 1.0. Now read_json_file
+    (the file named, NaN refused), and the numbers as Brush checks them."""
+    from woodcam.woodify import load_brushes
+
+    p = tmp_path / "brushes.json"
+    for text, said in (("[" * 100000 + "]" * 100000, "brushes file '.*' must be valid JSON with finite numbers; maximum recursion"),
+                       ('[{"centre_mm": [1, 2, 3], "radius_mm": NaN}]', "must be valid JSON with finite numbers; non-finite number NaN"),
+                       ('[{"centre_mm": [1, 2, 3], "radius_mm": "4"}]', "brush 0 .*: brush radius_mm must be a number; got '4'"),
+                       ('[{"centre_mm": [1, 2, 3], "radius_mm": 4, "gain": true}]', "brush 0 .*: brush gain must be a number; got True"),
+                       ('{"brush": []}', "must hold a list of brushes .*; got no 'brushes'; write it like"),
+                       ('[{"centre_mm": [1, 2, 3], "radius_mm": 4}, 5]', "brush 1 must be a JSON object; got 5")):
+        p.write_text(text)
+        with pytest.raises(WoodcamError, match=said):
+            load_brushes(p)
+    with pytest.raises(WoodcamError, match=r"brushes file: cannot read '.*none.json' \(No such file"):
+        load_brushes(tmp_path / "none.json")
+    with pytest.raises(WoodcamError, match="load_brushes: path must be a file path .*got None"):
+        load_brushes(None)
+    p.write_text('[{"centre_mm": [1, 2, 3], "radius_mm": 4}]')
+    assert load_brushes(str(p)) == [Brush((1, 2, 3), 4.0)]
 
 
 def test_corner_uv_gives_each_face_the_corners_textured_mesh_gives_it():

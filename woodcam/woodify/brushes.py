@@ -22,12 +22,12 @@ from __future__ import annotations
 import json
 import numbers
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._checks import check_vector
+from .._checks import check_path, check_vector
+from .._readers import read_json_file
 from ..errors import WoodcamError
 from ..fields.base import check_points
 
@@ -69,19 +69,29 @@ class Brush:
 
 
 def load_brushes(path) -> list[Brush]:
-    """Read a JSON brush file (module docstring)."""
-    path = Path(path)
-    try:
-        doc = json.loads(path.read_text())
-        items = doc["brushes"] if isinstance(doc, dict) else doc
-        return [Brush(tuple(b["centre_mm"]), float(b["radius_mm"]), float(b.get("gain", 1.0)),
-                      tuple(b.get("direction", (0.0, 0.0, 1.0))), float(b.get("strength", 0.0)))
-                for b in items]
-    except (OSError, ValueError, KeyError, TypeError) as err:
-        raise WoodcamError(
-            f"brushes file {str(path)!r} must be JSON like {{\"brushes\": [{{\"centre_mm\": [x, y, z], "
-            f"\"radius_mm\": r, \"gain\": 1.5, \"direction\": [0, 0, 1], \"strength\": 0.3}}]}}: {err}"
-        ) from err
+    """Read a JSON brush file (module docstring): ``{"brushes": [...]}`` or the list alone."""
+    path = check_path(path, "load_brushes: path", fix="pass the brush file, e.g. brushes.json")
+    like = ('{"brushes": [{"centre_mm": [x, y, z], "radius_mm": r, "gain": 1.5, "direction": [0, 0, 1], '
+            '"strength": 0.3}]}')
+    doc = read_json_file(path, "brushes file")  # strict JSON, its errors naming the file
+    items = doc.get("brushes") if isinstance(doc, dict) else doc
+    if not isinstance(items, list):
+        got = "no 'brushes'" if items is None else type(items).__name__
+        raise WoodcamError(f"brushes file {str(path)!r} must hold a list of brushes (or an object whose "
+                           f"'brushes' is one); got {got}; write it like {like}")
+    out = []
+    for i, b in enumerate(items):
+        if not isinstance(b, dict):
+            raise WoodcamError(f"brushes file {str(path)!r}: brush {i} must be a JSON object; got "
+                               f"{json.dumps(b)[:80]}; write it like {like}")
+        try:  # numbers as written: "4" or true for a number were float()'s 4.0 and 1.0
+            out.append(Brush(tuple(b["centre_mm"]), b["radius_mm"], b.get("gain", 1.0),
+                             tuple(b.get("direction", (0.0, 0.0, 1.0))), b.get("strength", 0.0)))
+        except (KeyError, TypeError, WoodcamError) as err:
+            why = f"missing {err}" if isinstance(err, KeyError) else str(err)
+            raise WoodcamError(f"brushes file {str(path)!r}: brush {i} ({json.dumps(b)[:80]}) must be like "
+                               f"{like}: {why}") from err
+    return out
 
 
 def paint(origin_mm, brushes=(), *, vertex_gain=None, vertex_direction=None, mesh=None, tri=None):
