@@ -954,3 +954,17 @@ def test_a_slightly_dirty_mesh_still_bakes(normals):
     assert (np.linalg.norm(dirty.vertex_normals, axis=1) == 0).sum() == 2
     baked = w.bake(dirty, wood, texels_per_mm=1, normals=normals)
     assert baked.coverage_mask.any() and len(baked.mesh.faces) == len(dirty.faces)
+
+
+def test_read_gran1_checks_its_arguments_before_seeking_the_shared_data(monkeypatch):
+    """read_gran1(centre='false') on a machine without the shared data folder said "the real
+    log needs the shared data folder" (the centre was checked only after): the argument's own
+    mistake comes first."""
+    import woodcam as w
+    import woodcam.logs.io
+
+    monkeypatch.setattr(woodcam.logs.io, "shared_data_dir", lambda: None)
+    with pytest.raises(WoodcamError, match="read_gran1: centre must be True or False; got 'false'"):
+        w.read_gran1(centre="false")
+    with pytest.raises(WoodcamError, match="the real log needs the shared data folder"):
+        w.read_gran1(centre=False)

@@ -74,6 +74,7 @@ def read_gran1(folder: PathLike | None = None, *, centre: bool = True) -> LogSke
     ``atan(x, y)`` reading 6.6 mm. The radii are therefore flipped to this module's
     counter-clockwise convention. The knot coefficients are in radians and mm.
     """
+    centre = check_bool(centre, "read_gran1: centre")  # the arguments before the data folder is sought
     if folder is None:
         base = shared_data_dir()
         if base is None:
@@ -81,7 +82,6 @@ def read_gran1(folder: PathLike | None = None, *, centre: bool = True) -> LogSke
                                "WOODCAM_SHARED_DATA=/path/to/shared/data or pass folder=")
         folder = base / "trees"
     folder = check_path(folder, "read_gran1: folder", fix="shared/data/trees, or None for the shared data folder's")
-    centre = check_bool(centre, "read_gran1: centre")
     try:
         pith = np.asarray(json.loads((folder / "Gran_1_pith.json").read_text()), float)
         radii = np.asarray(json.loads((folder / "Gran_1_radii.json").read_text()), float)
