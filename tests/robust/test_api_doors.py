@@ -968,3 +968,33 @@ def test_read_gran1_checks_its_arguments_before_seeking_the_shared_data(monkeypa
         w.read_gran1(centre="false")
     with pytest.raises(WoodcamError, match="the real log needs the shared data folder"):
         w.read_gran1(centre=False)
+
+
+def test_read_gran1_reads_its_files_as_every_json_file_is(tmp_path):
+    """read_gran1 read its three files with json.loads(read_text()): bad JSON was a bare
+    JSONDecodeError, knot rows of 3 numbers a TypeError of from_model, a file given as the folder
+    a NotADirectoryError, a NaN in the knots was taken. Now read_json_file and a check of each
+    table's form, naming the file; a log of no knots is read."""
+    import json
+
+    import woodcam as w
+
+    files = {"Gran_1_pith.json": [[0, 0, 0], [1, 1, 100]], "Gran_1_radii.json": [[50] * 8] * 2,
+             "Gran_1_knots.json": []}
+    for name, value in files.items():
+        (tmp_path / name).write_text(json.dumps(value))
+    log = w.read_gran1(tmp_path)
+    assert log.knots == () and log.radii_mm.shape == (2, 8)
+    np.testing.assert_array_equal(log.pith_xy_mm, [[-1, -1], [0, 0]])
+    for name, text, said in (("Gran_1_pith.json", "[[0, 0", "read_gran1: file '.*Gran_1_pith.json' must be valid JSON"),
+                             ("Gran_1_knots.json", "[[1, 2, 3]]", r"read_gran1: '.*Gran_1_knots.json' must hold one row "
+                                                                  r"\[A, B, .* per knot \(finite numbers\); got shape \(1, 3\)"),
+                             ("Gran_1_knots.json", "[[1, 2, 3, 4, 5, 6, 7, 8, NaN]]", "must be valid JSON with finite numbers; non-finite"),
+                             ("Gran_1_pith.json", '{"z": 1}', "Gran_1_pith.json' must hold rows .*; got other JSON"),
+                             ("Gran_1_pith.json", "[[0, 0, 0]]", r"must hold rows \[x, y, z\] mm of the pith, two or more .*got shape \(1, 3\)")):
+        with pytest.raises(WoodcamError, match=said):
+            (tmp_path / name).write_text(text)
+            w.read_gran1(tmp_path)
+        (tmp_path / name).write_text(json.dumps(files[name]))
+    with pytest.raises(WoodcamError, match="folder '.*Gran_1_pith.json' lacks Gran_1_pith.json; point it at shared/data/trees"):
+        w.read_gran1(tmp_path / "Gran_1_pith.json")

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_bool, check_path
+from .._checks import as_floats, check_bool, check_path
+from .._readers import read_json_file
 from .._types import PathLike
 from ..errors import WoodcamError
 from ..fields.skeleton import BranchStrand, LogSkeleton
@@ -49,8 +50,6 @@ def read_log(path: PathLike) -> LogSkeleton:
     if not path.is_file():
         raise WoodcamError(f"log file {str(path)!r} does not exist; give a path to a JSON file "
                            "written by woodcam (or use the real log: --real)")
-    from .._readers import read_json_file  # strict: no NaN/Infinity, every failure our error
-
     return LogSkeleton.from_json(read_json_file(path, "log file"))
 
 
@@ -82,13 +81,24 @@ def read_gran1(folder: PathLike | None = None, *, centre: bool = True) -> LogSke
                                "WOODCAM_SHARED_DATA=/path/to/shared/data or pass folder=")
         folder = base / "trees"
     folder = check_path(folder, "read_gran1: folder", fix="shared/data/trees, or None for the shared data folder's")
-    try:
-        pith = np.asarray(json.loads((folder / "Gran_1_pith.json").read_text()), float)
-        radii = np.asarray(json.loads((folder / "Gran_1_radii.json").read_text()), float)
-        rows = np.asarray(json.loads((folder / "Gran_1_knots.json").read_text()), float)
-    except FileNotFoundError as err:
-        raise WoodcamError(f"folder {str(folder)!r} lacks {Path(err.filename).name}; point it at "
-                           "shared/data/trees") from err
+    def table(name: str, what: str, columns: int | None, min_rows: int) -> np.ndarray:
+        # read as every JSON file is (bad JSON, NaN or a folder given as the file were bare errors)
+        path = folder / name
+        if not path.is_file():
+            raise WoodcamError(f"folder {str(folder)!r} lacks {name}; point it at shared/data/trees")
+        a = as_floats(read_json_file(path, "read_gran1: file"))
+        if a is not None and a.size == 0 and min_rows == 0 and columns is not None:  # a log without knots
+            a = a.reshape(0, columns)
+        if a is None or a.ndim != 2 or len(a) < min_rows or (columns is not None and a.shape[1] != columns) \
+                or not np.all(np.isfinite(a)):
+            raise WoodcamError(f"read_gran1: {str(path)!r} must hold {what} (finite numbers); got "
+                               f"{'shape ' + str(a.shape) if a is not None else 'other JSON'}; point the "
+                               "folder at shared/data/trees")
+        return a
+
+    pith = table("Gran_1_pith.json", "rows [x, y, z] mm of the pith, two or more", 3, 2)
+    radii = table("Gran_1_radii.json", "one row of radii (mm) per pith row", None, 2)
+    rows = table("Gran_1_knots.json", "one row [A, B, z0, D, E, w0, G, r_end, r_death] per knot", 9, 0)
     xy = pith[:, :2].copy()
     if centre:
         xy -= xy[len(xy) // 2]
