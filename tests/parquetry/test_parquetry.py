@@ -939,6 +939,25 @@ def test_adaptive_patches_with_seams_cover_once_and_use_wood_once(tmp_path):
             assert rasterise(read_svg_pieces(f), v.mask.shape, PPM).max() == 1
 
 
+@pytest.mark.parametrize("n_adaptive", [1, 2])
+def test_adaptive_patches_cover_a_panel_of_whole_cells_not_a_multiple_of_the_top_square(sheets, tmp_path, n_adaptive):
+    """A 5 x 7 cell panel with top squares of 2 or 4 cells: the last row and column were one
+    square of their short side each, leaving 5 cells (n_adaptive 1) uncovered, the run
+    incomplete with no message. Every cell is covered, the cut files tile the panel once."""
+    from skimage import data
+
+    img = data.astronaut()[:256, :360].astype(np.float32) / 255
+    run = build_parquetry(img, sheets, ParquetryParams(image_size_mm=70, px_per_mm=PPM,
+                                                       n_adaptive=n_adaptive, w_adaptive=50.0))
+    p = run.panels[0]
+    assert p.cells.shape == (5, 7)
+    assert run.complete and run.placed == run.planned == 35 and (p.cells >= 0).all()
+    res = write_parquetry(run, tmp_path)
+    assert res["problems"] == {}
+    n = rasterise(read_svg_pieces(tmp_path / "assembly.svg"), p.matched.shape, PPM)
+    assert (n == 1).all(), f"{(n == 0).sum()} pixels uncovered, {(n > 1).sum()} covered twice"
+
+
 def test_planted_violation_is_repaired_and_files_pass(sheets, tmp_path):
     """A seam given a sharp zig-zag (bends far tighter than the 1 mm tool radius) is caught by
     the checker, repaired by straightening, and the written files then pass the checks when

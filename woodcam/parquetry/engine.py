@@ -293,23 +293,25 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     names = names or [f"target{k}" for k in range(len(targets))]
     panels = [prepare_target(t, params, src_vals, k, names[k]) for k, t in enumerate(targets)]
 
-    # Priority queue (sec. 3.3, Fig. 6): top-level squares of 2**n_adaptive cells.
+    # Priority queue (sec. 3.3, Fig. 6): top-level squares of 2**n_adaptive cells; where the
+    # panel's last rows or columns leave a rectangle narrower than that, squares tile it
+    # (_squares: one square of its short side left the rest of it uncovered)
     queue = []
     for p in panels:
         rows, cols = p.cells.shape
         sal = saliency(p.matched)
         cy, cx = rows * p.cell_px / 2.0, cols * p.cell_px / 2.0
-        for r in range(0, rows, top_cells):
-            for c in range(0, cols, top_cells):
-                n = min(top_cells, rows - r, cols - c)
-                y0, x0 = r * p.cell_px, c * p.cell_px
-                y1, x1 = y0 + n * p.cell_px, x0 + n * p.cell_px
-                if params.priority == "saliency":
-                    key = -float(sal[y0:y1, x0:x1].mean())
-                else:
-                    key = float(np.hypot((y0 + y1) / 2 - cy, (x0 + x1) / 2 - cx))
-                queue.append(((p.index, key) if params.queue == "sequential" else (key, p.index),
-                              p.index, r, c, n))
+        tops = [sq for r in range(0, rows, top_cells) for c in range(0, cols, top_cells)
+                for sq in _squares(r, c, min(top_cells, rows - r), min(top_cells, cols - c))]
+        for r, c, n in tops:
+            y0, x0 = r * p.cell_px, c * p.cell_px
+            y1, x1 = y0 + n * p.cell_px, x0 + n * p.cell_px
+            if params.priority == "saliency":
+                key = -float(sal[y0:y1, x0:x1].mean())
+            else:
+                key = float(np.hypot((y0 + y1) / 2 - cy, (x0 + x1) / 2 - cx))
+            queue.append(((p.index, key) if params.queue == "sequential" else (key, p.index),
+                          p.index, r, c, n))
     queue.sort(key=lambda q: q[0])
     planned_cells = sum(p.cells.size for p in panels)
 
@@ -391,6 +393,22 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     if repair:
         repair_fabricability(run)
     return run
+
+
+def _squares(r: int, c: int, h: int, w: int) -> list[tuple[int, int, int]]:
+    """Squares ``(row, col, side)`` (cells) that tile the ``h x w`` rectangle of cells whose
+    corner is cell ``(r, c)`` exactly once: squares of the short side along the long one, then
+    the rest the same way."""
+    out: list[tuple[int, int, int]] = []
+    while h > 0 and w > 0:
+        s = min(h, w)
+        if h <= w:
+            out += [(r, c + k * s, s) for k in range(w // s)]
+            c, w = c + (w // s) * s, w % s
+        else:
+            out += [(r + k * s, c, s) for k in range(h // s)]
+            r, h = r + (h // s) * s, h % s
+    return out
 
 
 def finish_panel(p: Parquetry, patches: list[Patch], bank: SheetBank, sheets: list[Veneer],
