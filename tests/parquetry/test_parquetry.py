@@ -276,6 +276,25 @@ def test_render_beats_mean_colour_baseline_on_feature_cost(finished):
     assert feature_cost(p, p.render, run.params) < feature_cost(p, p.baseline, run.params)
 
 
+def test_the_default_leaves_pass_the_memory_guard_and_absurd_ones_do_not(monkeypatch):
+    """The README's '--veneer-from builtin:flat-sawn' with the default leaves (two of 600 x
+    400 mm at 4 px/mm) was refused as a 9600x7200x3 grid over MAX_GRID_CELLS: the guard counted
+    every supersample as held, though they are summed as they come (23 M values held)."""
+    import woodcam.parquetry.veneers as veneers
+    from woodcam.parquetry.job import job_veneers
+    from woodcam.stock import open_stock
+
+    monkeypatch.setattr(veneers, "_supersampled",  # the guard, not minutes of sampling
+                        lambda colour, nh, nw, *a: np.full((nh, nw, 3), 0.5, np.float32))
+    leaves = job_veneers(ParquetryJob(blocks=[{"spec": "builtin:flat-sawn"}]), open_stock=open_stock)
+    assert [v.rgb.shape for v in leaves] == [(1600, 2400, 3)] * 2
+    with pytest.raises(WoodcamError, match="1000 leaves of 600 x 400 mm at 4 px/mm .* MAX_GRID_CELLS"):
+        slice_veneers(open_stock("builtin:flat-sawn"), 1000, (600, 400))
+    # one 2 x 1.5 m leaf: 144 M values held, under the cell limit, but 5 GB with its sampling
+    with pytest.raises(WoodcamError, match=r"1 leaves of 2000 x 1500 mm .*\(memory, bytes\).* MAX_ALLOC_BYTES"):
+        slice_veneers(open_stock("builtin:flat-sawn"), 1, (2000, 1500))
+
+
 def test_sliced_leaf_pixels_are_the_mean_of_their_point_samples():
     """supersample=s: each pixel is the mean of the s x s point samples inside it, i.e. the
     s-times finer single-sample leaf averaged over s x s blocks (also on the turned leaf)."""

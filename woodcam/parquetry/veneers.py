@@ -322,11 +322,17 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
     nw, nh = round(w_mm * px_per_mm), round(h_mm * px_per_mm)
     if nw < 1 or nh < 1:
         raise WoodcamError(f"size_mm must give at least one pixel at {px_per_mm} px/mm; got {size_mm}")
-    from ..limits import check_grid
+    from ..limits import check_grid, check_limit
 
-    # every leaf is an RGB float image, sampled ss x ss times (1e300 mm sheets were a traceback)
-    check_grid((n_sheets * nh * ss, nw * ss, 3), f"{n_sheets} leaves of {w_mm:g} x {h_mm:g} mm at "
-               f"{px_per_mm:g} px/mm", itemsize=4, fix="use smaller or fewer sheets (--sheet-size, --sheets)")
+    # what is held: every leaf an RGB float32 image, and one leaf's working arrays while it is
+    # sampled (1e300 mm sheets were a traceback). The ss x ss samples of a pixel are summed as
+    # they come, never held: counting them as cells refused the README's own default (two
+    # 600 x 400 mm leaves at 4 px/mm, 207 M 'cells' for 23 M held)
+    what = f"{n_sheets} leaves of {w_mm:g} x {h_mm:g} mm at {px_per_mm:g} px/mm"
+    fix = "use smaller or fewer sheets (--sheet-size, --sheets) or a lower px_per_mm"
+    check_grid((n_sheets, nh, nw, 3), what, itemsize=4, fix=fix)
+    check_limit("MAX_ALLOC_BYTES", float(nh) * nw * (n_sheets * 12 + _WORK_BYTES_PER_PX),
+                f"{what} (memory, bytes)", fix)
     ax = "xyz".index(axis)
     # In-plane directions: sheet x (right) and sheet y (down) as block axes, chosen so the
     # sheet reads like the block face with that normal in docs/conventions.md.
@@ -372,6 +378,11 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
                                     + (" (turned over)" if turned else ""), (float(w_mm), float(h_mm)))))
     return sheets
 
+
+#: Bytes per pixel of the one leaf :func:`slice_veneers` is sampling, beside the leaves kept
+#: (12 a pixel): the centres' coordinates (float64, 16), their colours (12), the pixels to
+#: refine and their sums (float64, up to 24 and 16 of index), the variation maps (~24).
+_WORK_BYTES_PER_PX = 96
 
 #: Points per ``Wood.color`` call in :func:`slice_veneers` (positions, normals and colours of
 #: a call take ~70 MB).
