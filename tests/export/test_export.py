@@ -447,6 +447,25 @@ def test_damaged_files_and_bad_arguments_are_one_error(baked, tmp_path):
     assert read_glb_metadata(tmp_path / "a.glb")["kind"] == "k"
 
 
+@pytest.mark.parametrize("normals", ["crease", "mesh"])
+def test_an_empty_or_nan_mesh_is_one_error_and_writes_nothing(baked, tmp_path, normals):
+    """An empty mesh was numpy's ValueError under normals='mesh'; a NaN vertex was written
+    without a word (a GLB and an OBJ of NaN positions no viewer reads back)."""
+    nan = baked.mesh.copy()
+    nan.vertices[3, 1] = np.nan
+    empty = baked.mesh.copy()
+    empty.update_faces(np.zeros(len(empty.faces), bool))
+    for write, suffix in ((export_glb, "glb"), (export_obj, "obj")):
+        with pytest.raises(WoodcamError, match=f"{write.__name__}: mesh has 1 of .* vertices that are not finite"):
+            write(nan, tmp_path / f"nan.{suffix}", normals=normals)
+        with pytest.raises(WoodcamError, match=f"{write.__name__}: mesh has no triangles"):
+            write(empty, tmp_path / f"empty.{suffix}", normals=normals)
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "empty.obj").write_text("")
+    with pytest.raises(WoodcamError, match="holds no triangle mesh"):
+        load_textured(tmp_path / "empty.obj")
+
+
 def test_an_export_refused_by_its_folder_names_the_file_asked_for(baked, monkeypatch):
     """export_obj / export_glb (atomic_files) failed naming their temporary
     ('/proc/self/.a.obj.30286-xnsxkkqg.tmp.obj') when the folder refused the write after the

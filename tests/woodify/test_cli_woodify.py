@@ -139,6 +139,35 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
         open_stock(f"woodify:{tmp_path / 'missing.npz'}")
 
 
+def test_an_empty_or_nan_mesh_is_one_error_naming_the_file(tmp_path, capsys):
+    """An empty STL was an internal error (TypeError unpacking its bounds); a NaN vertex in an
+    OBJ or STL was welded away with its triangles and the rest refused as not watertight
+    ('1 triangles'), naming neither the NaN nor the file; the library grew on a NaN box."""
+    import struct
+
+    from woodcam.woodify import woodify
+
+    (tmp_path / "empty.stl").write_text("solid e\nendsolid e\n")
+    (tmp_path / "nan.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 nan\n"
+                                      "f 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n")
+    tris = [(0, 0, 0, 1, 0, 0, 0, 1, 0), (0, 0, 0, 1, 0, 0, 0, 0, np.nan),
+            (0, 0, 0, 0, 1, 0, 0, 0, np.nan), (1, 0, 0, 0, 1, 0, 0, 0, np.nan)]
+    (tmp_path / "nan.stl").write_bytes(b"\0" * 80 + struct.pack("<I", 4) + b"".join(
+        struct.pack("<12fH", 0, 0, 0, *t, 0) for t in tris))
+    for name, said in (("empty.stl", "holds no triangles"), ("nan.obj", "1 of 4 vertices that are not finite"),
+                       ("nan.stl", "vertices that are not finite numbers (NaN or inf)")):
+        assert main(["woodify", str(tmp_path / name), "--years", "2", "--resolution", "16",
+                     "--out", str(tmp_path / "o")]) == 1, name
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"part {str(tmp_path / name)!r} " in err and said in err, err
+    assert not (tmp_path / "o").exists()
+    box = trimesh.creation.box((10.0, 10.0, 10.0))
+    v = box.vertices.copy()
+    v[0, 2] = np.inf
+    with pytest.raises(WoodcamError, match="mesh has 1 of 8 vertices that are not finite"):
+        woodify(trimesh.Trimesh(v, box.faces, process=False), 2.0, resolution=16)
+
+
 def test_vectors_and_sizes_are_refused_at_the_door_as_typed(tmp_path, capsys):
     """woodify parsed --up, --block-centre and --crack-region with its own _vec (exit 1, after
     --units had converted them: --block-size 1000x10x10 --units inch said '25400x254x254'); --up

@@ -103,11 +103,12 @@ def _load_mesh(path: str, what: str = "part"):
             elif pth.suffix.lower() == ".ply":
                 loaded = trimesh.load(pth, force="mesh", process=False)  # keep vertex order
             else:
-                loaded = trimesh.load(pth, force="mesh")
+                loaded = trimesh.load(pth, force="mesh", process=False)  # NaN kept: named below
         except WoodcamError:
             raise
         except Exception as err:  # trimesh raises many kinds for unreadable files
             raise WoodcamError(f"{what} {path!r} could not be read as a mesh: {err}") from err
+        _check_mesh_values(loaded, path, what)
         textured = loaded if getattr(loaded.visual, "uv", None) is not None else None
         _warn_units(loaded, path, what)
         paint = _ply_paint(loaded, path)
@@ -127,6 +128,23 @@ def _load_mesh(path: str, what: str = "part"):
     solid = load_part(path)
     m = solid.to_mesh()
     return trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts)), None, {}
+
+
+def _check_mesh_values(mesh, path: str, what: str) -> None:
+    """One error for a mesh file with no triangles (an empty STL was an internal error) or a
+    vertex that is not a number (its triangles were dropped as the mesh was welded, and the rest
+    refused as not watertight, naming neither the NaN nor the file)."""
+    import numpy as np
+
+    faces = getattr(mesh, "faces", None)
+    if faces is None or len(faces) == 0:
+        raise WoodcamError(f"{what} {path!r} holds no triangles (an empty file, or points only); "
+                           "give a closed (watertight) triangle mesh")
+    bad = ~np.isfinite(np.asarray(mesh.vertices, float)).all(axis=1)
+    if bad.any():
+        raise WoodcamError(f"{what} {path!r} has {int(bad.sum())} of {len(bad)} vertices that are not "
+                           "finite numbers (NaN or inf); fix the mesh in the program that wrote it "
+                           "and export it again")
 
 
 def _warn_units(mesh, path: str, what: str = "part") -> None:

@@ -107,6 +107,20 @@ def _with_encoded_texture(mesh, attribute: str):
 
 
 def _require_textured(mesh, func: str):
+    """The door of both writers: a textured trimesh with at least one triangle and finite
+    vertices (an empty mesh was numpy's ValueError under ``normals="mesh"``, a NaN vertex a
+    file written without a word, NaN in its positions)."""
+    import trimesh
+
+    if not isinstance(mesh, trimesh.Trimesh):
+        raise WoodcamError(f"{func}: mesh must be a trimesh.Trimesh; got {type(mesh).__name__}")
+    if len(mesh.faces) == 0:
+        raise WoodcamError(f"{func}: mesh has no triangles ({len(mesh.vertices)} vertices); nothing to "
+                           "write; pass a surface with at least one triangle")
+    bad = ~np.isfinite(np.asarray(mesh.vertices, float)).all(axis=1)
+    if bad.any():
+        raise WoodcamError(f"{func}: mesh has {int(bad.sum())} of {len(bad)} vertices that are not finite "
+                           "numbers (NaN or inf); no viewer can read them back; fix or drop those vertices")
     visual = getattr(mesh, "visual", None)
     material = getattr(visual, "material", None)
     uv = getattr(visual, "uv", None)
@@ -446,7 +460,8 @@ def load_textured(path: PathLike) -> Mesh:
         raise WoodcamError(f"load_textured: {str(path)!r} cannot be read as a mesh ({type(err).__name__}: "
                            f"{str(err)[:200]}); is it a GLB or OBJ written by woodcam?") from err
     if not isinstance(loaded, (trimesh.Trimesh, trimesh.Scene)) or (
-            isinstance(loaded, trimesh.Trimesh) and len(loaded.faces) == 0):
+            isinstance(loaded, trimesh.Trimesh) and len(loaded.faces) == 0) or (
+            isinstance(loaded, trimesh.Scene) and not loaded.geometry):
         raise WoodcamError(f"load_textured: {str(path)!r} holds no triangle mesh (a "
                            f"{type(loaded).__name__}); pass a GLB or OBJ written by woodcam")
     if path.suffix.lower() == ".obj" and not isinstance(loaded, trimesh.Scene):

@@ -130,6 +130,10 @@ def check_watertight(mesh, name: str):
         raise WoodcamError(f"{name} must be a trimesh.Trimesh; got {type(mesh).__name__}")
     if len(mesh.faces) == 0:
         raise WoodcamError(f"{name} has no triangles; give a closed (watertight) mesh")
+    bad = ~np.isfinite(np.asarray(mesh.vertices, float)).all(axis=1)
+    if bad.any():  # a NaN corner made the grid's box NaN: an error about the grid, or none
+        raise WoodcamError(f"{name} has {int(bad.sum())} of {len(bad)} vertices that are not finite "
+                           "numbers (NaN or inf); fix or drop them (a mesh must be closed and finite)")
     if not mesh.is_watertight:
         raise WoodcamError(
             f"{name} must be watertight (every edge shared by exactly two triangles) so its inside "
