@@ -96,6 +96,8 @@ def _load_mesh(path: str, what: str = "part"):
         if not pth.is_file():
             raise WoodcamError(f"{what} {path!r} does not exist")
         try:
+            if pth.suffix.lower() in (".glb", ".gltf", ".obj") and _mesh_count(pth) > 1:
+                return _several_meshes(pth, what)
             if pth.suffix.lower() in (".glb", ".gltf", ".obj"):
                 from ..export import load_textured  # undoes woodcam's glTF/OBJ frame
 
@@ -145,6 +147,39 @@ def _check_mesh_values(mesh, path: str, what: str) -> None:
         raise WoodcamError(f"{what} {path!r} has {int(bad.sum())} of {len(bad)} vertices that are not "
                            "finite numbers (NaN or inf); fix the mesh in the program that wrote it "
                            "and export it again")
+
+
+def _mesh_count(path: Path) -> int:
+    """Placed mesh instances in a GLB/glTF/OBJ file (a mesh placed twice counts twice)."""
+    import trimesh
+
+    scene = trimesh.load_scene(str(path), file_type=path.suffix.lower().lstrip("."))
+    return sum(isinstance(scene.geometry.get(scene.graph[n][1]), trimesh.Trimesh)
+               for n in scene.graph.nodes_geometry)
+
+
+def _several_meshes(path: Path, what: str):
+    """(geometry, None, {}) of a file of several meshes: their union as one closed solid, read
+    as a part (:func:`woodcam.cad.load_part`, woodcam's own glTF/OBJ frame undone); only the
+    first of them grew before (load_textured's refusal for a GLB, a mesh placed twice read as
+    its first placement). Their pictures are not carried (one bark picture, one set of UVs)."""
+    import warnings
+
+    import numpy as np
+    import trimesh
+
+    from ..cad import load_part
+    from ..errors import WoodcamWarning
+
+    scene = trimesh.load_scene(str(path), file_type=path.suffix.lower().lstrip("."))
+    if any(getattr(getattr(g, "visual", None), "uv", None) is not None for g in scene.geometry.values()):
+        warnings.warn(f"{what} {str(path)!r} holds {_mesh_count(path)} meshes: they grow as one solid "
+                      "(their union), and their pictures are not carried to the bark (procedural bark "
+                      "instead); join them into one textured mesh to keep a picture", WoodcamWarning, stacklevel=3)
+    m = load_part(path).to_mesh()
+    geom = trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts))
+    _warn_units(geom, str(path), what)
+    return geom, None, {}
 
 
 def _warn_units(mesh, path: str, what: str = "part") -> None:

@@ -474,10 +474,14 @@ def load_textured(path: PathLike) -> Mesh:
         return loaded
     if isinstance(loaded, trimesh.Scene):
         geoms = list(loaded.geometry.values())
-        if len(geoms) != 1:
+        # placed instances, not stored meshes: one mesh placed twice came back as its first
+        # placement alone, the other dropped without a word
+        placed = len(loaded.graph.nodes_geometry)
+        if len(geoms) != 1 or placed != 1:
             raise WoodcamError(
-                f"load_textured: {str(path)!r} holds {len(geoms)} meshes; expected exactly one "
-                "(files from woodcam.export hold one)"
+                f"load_textured: {str(path)!r} holds {len(geoms)} meshes placed {placed} times; "
+                "expected exactly one mesh placed once (files from woodcam.export hold one); "
+                "join them into one mesh in your modelling program"
             )
         node = loaded.graph.nodes_geometry[0]
         transform = loaded.graph[node][0]
