@@ -267,8 +267,21 @@ def _open_base_stock(parsed: ParsedSpec, species, appearance, appearance_params,
                                 appearance, appearance_params, frame)
     if parsed.kind == "woodify":
         field, size_mm, description = _woodify_field(parsed)
-        return _synthetic_stock(spec, field, size_mm, species or "oak", description,
-                                appearance, appearance_params, _texture_frame(parsed, field))
+        if np.allclose(field.rotation, np.eye(3)):
+            return _synthetic_stock(spec, field, size_mm, species or "oak", description,
+                                    appearance, appearance_params, _texture_frame(parsed, field))
+        # A block placed turned in the grown object (WoodifiedField.placed(rotation=)): its wood
+        # is that of the object-aligned box round it, seen turned (Wood.rotated). Coloured in its
+        # own frame, eq. 10's per-axis blend and end grain followed the turned block's axes: the
+        # same object point 4/255 off at a 30 degree turn about the stem and up to 40/255 tilted.
+        R, o = field.rotation, field.block_origin_mm
+        corners = np.array(np.meshgrid(*[(0.0, v) for v in size_mm], indexing="ij")).reshape(3, -1).T
+        pts = o + corners @ R.T
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        box = field.placed(tuple(hi - lo), tuple((lo + hi) / 2))
+        aligned = _synthetic_stock(spec, box, tuple(float(v) for v in hi - lo), species or "oak", description,
+                                   appearance, appearance_params, _texture_frame(parsed, box))
+        return Stock(spec, tuple(size_mm), aligned.wood.rotated(R, o - lo), description, aligned.meta)
     path = _existing_folder(spec)
     if (path / "block.json").is_file():
         return _open_block_folder(path, species, appearance, appearance_params, species_given)

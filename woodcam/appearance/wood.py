@@ -109,6 +109,24 @@ class Wood:
         out._turn = (rot, shift - o)  # source = rot^T (p + o - shift)
         return out
 
+    def rotated(self, rotation: ArrayLike, origin_mm: ArrayLike) -> "Wood":
+        """The same wood seen from a block turned any way inside this one: its point ``p`` is
+        this wood's ``origin_mm + rotation @ p`` (mm), its normals and fibres turned alike, for
+        the growth field, the features and the colours (the appearance sees this wood's frame,
+        so a cut turned by any angle shows this block's colours where it overlaps it).
+
+        rotation : (3, 3) proper rotation; origin_mm : (3,) mm, in this wood's block frame."""
+        R = np.asarray(rotation, dtype=float)
+        if R.shape != (3, 3) or not np.all(np.isfinite(R)) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6) \
+                or np.linalg.det(R) < 0:
+            raise WoodcamError(f"rotated: rotation must be a proper 3x3 rotation matrix; got {R.tolist()!r:.120}")
+        o = check_vector(origin_mm, "rotated: origin_mm", fix="the turned block's corner in this block, mm")
+        out = Wood(self.field, self.appearance, threads=self.threads)
+        r0, t0 = self._turn if self._turn is not None else (np.eye(3), np.zeros(3))
+        # source = r0^T (R p + o - t0) = rot^T (p - shift)
+        out._turn = (R.T @ r0, R.T @ (t0 - o))
+        return out
+
     @property
     def in_source_frame(self) -> bool:
         """Whether this block is the source block itself (the one the field was fitted or grown
