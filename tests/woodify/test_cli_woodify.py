@@ -199,6 +199,38 @@ def test_a_file_of_several_meshes_grows_all_of_them(tmp_path, capsys):
         assert f.block_size_mm[0] > 40.0, "the grown object spans both boxes"
 
 
+def test_surface_and_crack_years_are_usage_errors_before_the_growth(tmp_path, capsys, monkeypatch):
+    """--surface-years out of range or not numbers exited 1 (a failed run, not a wrong command
+    line); a year given twice was grown, written and listed twice; --crack-years beyond --years
+    was clamped to year 0 without a word (8 crack years of a 3-year growth)."""
+    import woodcam.woodify as wf
+
+    grown = []
+    monkeypatch.setattr(wf, "woodify", lambda *a, **k: grown.append(a) or pytest.fail("grew"))
+    ball = tmp_path / "ball.stl"
+    trimesh.creation.icosphere(subdivisions=1, radius=5.0).export(ball)
+    for extra, said in ((["--surface-years", "1,abc"], "--surface-years takes comma-separated years in [0, 3]"),
+                        (["--surface-years", "1,4"], "got '1,4'"),
+                        (["--surface-years", "1,1.0000001"], "would both be written as surface_y1.stl"),
+                        (["--crack-years", "8"], "--crack-years must be at most --years (3): it simulates the "
+                                                 "last years of the growth; got 8; give --crack-years 3 or fewer")):
+        assert _rc(["woodify", str(ball), "--years", "3", "--out", str(tmp_path / "o"), *extra]) == 2, extra
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and said in err, err
+    assert grown == []
+    # under a year: no --crack-years fits, and the default grows the cracks from the input on
+    assert _rc(["woodify", str(ball), "--years", "0.5", "--crack-years", "1", "--out", str(tmp_path / "o")]) == 2
+    assert "leave --crack-years out" in capsys.readouterr().err
+    assert grown == []
+    monkeypatch.undo()
+    out = tmp_path / "twice"
+    assert main(["woodify", str(ball), "--years", "3", "--resolution", "16", "--cracks", "none",
+                 "--surface-years", "1,1,2", "--out", str(out)]) == 0
+    summary = capsys.readouterr().out
+    assert summary.count("surface_y1.stl") == 1 and sorted(p.name for p in out.glob("surface_y*.stl")) == [
+        "surface_y1.stl", "surface_y2.stl"]
+
+
 def test_vectors_and_sizes_are_refused_at_the_door_as_typed(tmp_path, capsys):
     """woodify parsed --up, --block-centre and --crack-region with its own _vec (exit 1, after
     --units had converted them: --block-size 1000x10x10 --units inch said '25400x254x254'); --up

@@ -70,8 +70,9 @@ def register(subparsers) -> argparse.ArgumentParser:
                    type=vector_type("--crack-region", "X,Y,Z,R", "0,0,50,10"),
                    help="only crack within this sphere (centre and radius in --units)")
     add_units_option(p, "woodify")
-    p.add_argument("--crack-years", type=int, default=5,
-                   help="last years simulated for cracks (default 5)")
+    p.add_argument("--crack-years", type=int, default=None,
+                   help="last years simulated for cracks, at most --years (default 5, or the whole "
+                   "years grown when fewer; under a year's growth, from the input on)")
     p.add_argument("--crack-render", choices=("groove", "material"), default="material",
                    help="draw cracks into the bark texture (material, default) or cut them as grooves")
     p.add_argument("--crack-threshold", type=float, default=None,
@@ -400,17 +401,35 @@ def run(args) -> int:
     t0 = time.perf_counter()
     if not (np.isfinite(args.years) and args.years > 0):
         raise WoodcamError(f"--years must be > 0 (years to grow); got {args.years:g}")
-    # every option checked before the growth (minutes on a fine grid)
+    # every option checked before the growth (minutes on a fine grid); a wrong one is a wrong
+    # command line (exit 2, as the ranges of RANGES), not a failed run
     if args.surface_years:
         try:
             years = [float(v) for v in args.surface_years.split(",")]
         except ValueError:
             years = [-1.0]
         if not all(0 <= y <= args.years for y in years):
-            raise WoodcamError(f"--surface-years takes comma-separated years in [0, {args.years:g}]; "
-                               f"got {args.surface_years!r}")
+            raise UsageError(f"--surface-years takes comma-separated years in [0, {args.years:g}]; "
+                             f"got {args.surface_years!r}")
+        # one file a year (surface_y<year:g>.stl): a year given twice was grown and written twice
+        # and listed twice; two years of one name overwrote each other
+        names = {}
+        for y in years:
+            if names.setdefault(f"{y:g}", y) != y:
+                raise UsageError(f"--surface-years {names[f'{y:g}']!r} and {y!r} would both be written as "
+                                 f"surface_y{y:g}.stl; give years that differ in their first 6 digits")
+        years = list(names.values())
     else:
         years = [args.years * k / 4 for k in (1, 2, 3)]
+    # the crack stage simulates the last --crack-years of the growth: more than were grown began
+    # before the input existed (silently clamped to year 0); the default is 5 or every year grown
+    if args.crack_years is None:
+        args.crack_years = min(5, max(1, int(args.years)))
+    elif args.cracks != "none" and args.crack_years > args.years:
+        fix = (f"give --crack-years {int(args.years)} or fewer, or grow longer" if args.years >= 1 else
+               "leave --crack-years out (under a year's growth the cracks grow from the input on)")
+        raise UsageError(f"--crack-years must be at most --years ({args.years:g}): it simulates the last "
+                         f"years of the growth; got {args.crack_years}; {fix}")
     region = args.crack_region
     if region is not None and not region[3] > 0:
         raise UsageError(f"--crack-region X,Y,Z,R needs a radius R > 0; got R = {say_length(region[3], 'g')}")
