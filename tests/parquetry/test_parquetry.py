@@ -748,7 +748,10 @@ def test_parameters_of_the_wrong_type_are_refused_by_name():
         ParquetryParams(n_rot=2.5).check()
     for kw, said in ((dict(n_rot=10**9), r"n_rot must be in \[1, 360\]"),  # a MemoryError
                      (dict(px_per_mm=200.0), r"px_per_mm must be in \(0, 50\]"),  # OpenCV: 1.6 GB
-                     (dict(min_piece_mm=-100.0), "min_piece_mm must be >= 0")):
+                     (dict(min_piece_mm=-100.0), "min_piece_mm must be >= 0"),
+                     # 0 was taken: tool paths on the outlines, no kerf between the pieces
+                     (dict(tool_diameter_mm=0.0), r"tool_diameter_mm \(--tool-diameter\) must be > 0 mm"),
+                     (dict(tool_diameter_mm=-1.0), r"must be > 0 mm.*got -1")):
         with pytest.raises(WoodcamError, match=said):
             ParquetryParams(**kw).check()
     prm = ParquetryParams(n_rot=9.0, overlap_mm=None).check()  # a whole float (JSON may write 9.0)

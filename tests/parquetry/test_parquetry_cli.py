@@ -88,6 +88,8 @@ def test_cli_bad_input_is_one_line(scans, capsys, args, message):
     ("--w-struct", "-1", "--w-struct must be in [0, 1e+06]; got -1.0"),
     ("--flat-detail", "0.5", "--flat-detail must be in [1, 1e+06]; got 0.5"),
     ("--overlap-mm", "-1", "--overlap-mm must be in [0, 10000]; got -1.0"),
+    # a bit of no width: tool paths on the outlines and no kerf between the pieces (exit 0)
+    ("--tool-diameter", "0", "--tool-diameter must be in (0, 100]"),
 ])
 def test_a_table_1_parameter_out_of_range_is_a_usage_error_naming_the_option(scans, capsys, option, value, said):
     """Sweep h6: these exited 1 (a failed work, where the README's exit statuses give 2 for a wrong

@@ -1022,7 +1022,7 @@ RANGES: dict = {
     ("parquetry", "saw_kerf"): (0.0, 100.0, False),
     ("parquetry", "patch_mm"): (0.0, 10_000.0, True),
     ("parquetry", "min_piece_mm"): (0.0, 1000.0, False),
-    ("parquetry", "tool_diameter"): (0.0, 100.0, False),
+    ("parquetry", "tool_diameter"): (0.0, 100.0, True),  # a bit of no width cuts nothing
     ("parquetry", "kerf_mm"): (0.0, 100.0, False),
     # Table 1's parameters and the search's: ParquetryParams.check's bounds (exit 1 there, naming
     # w_intens, n_rot ...); the bounds it sets relative to other options (image size >= patch,

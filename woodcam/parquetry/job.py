@@ -141,9 +141,14 @@ class ParquetryParams:
             raise WoodcamError(f"queue must be one of ['interleaved', 'sequential']; got {self.queue!r}")
         if self.mode not in ("fast", "exhaustive"):
             raise WoodcamError(f"mode must be one of ['fast', 'exhaustive']; got {self.mode!r}")
-        if self.px_per_mm <= 0 or self.tool_diameter_mm < 0 or (self.kerf_mm or 0) < 0:
-            raise WoodcamError("px_per_mm must be > 0, tool_diameter_mm and kerf_mm >= 0; got "
-                               f"{self.px_per_mm}, {self.tool_diameter_mm}, {self.kerf_mm}")
+        if self.px_per_mm <= 0 or (self.kerf_mm or 0) < 0:
+            raise WoodcamError("px_per_mm must be > 0 and kerf_mm >= 0; got "
+                               f"{self.px_per_mm}, {self.kerf_mm}")
+        if not self.tool_diameter_mm > 0:  # 0: tool paths on the outlines, no kerf between pieces
+            raise WoodcamError(f"tool_diameter_mm (--tool-diameter) must be > 0 mm: the router bit cuts a "
+                               f"groove that wide, and its paths are offset by half of it; got "
+                               f"{self.tool_diameter_mm:g}; give the bit's diameter, e.g. 2 (set kerf_mm "
+                               "apart for the wood lost between pieces)")
         if self.w_struct < 0 or self.rerank < 1:
             raise WoodcamError(f"w_struct must be >= 0 and rerank >= 1; got {self.w_struct}, {self.rerank}")
         if self.flat_detail < 1.0:
