@@ -68,7 +68,6 @@ def test_cli_run_writes_everything(scans, capsys):
 @pytest.mark.parametrize("args, message", [
     (["{d}/nope.png", "--veneer", "{d}/light.png"], "target image: no such file '{d}/nope.png'; check the path"),
     (["{d}/coffee.png", "--veneer", "{d}/light.png:300:{d}/coffee.png"], "mask must have the image's size"),
-    (["{d}/coffee.png", "--veneer", "{d}/light.png", "--patch-mm", "4"], "patch_mm must be at least min_piece_mm"),
     (["{d}/coffee.png", "--veneer", "{d}/light.png:2000"], "smaller than one patch"),
     (["{d}/coffee.png"], "parquetry needs veneers"),
     (["{d}/coffee.png", "--veneer", "{d}/light.png:abc"], "resolution must be DPI"),
@@ -90,6 +89,8 @@ def test_cli_bad_input_is_one_line(scans, capsys, args, message):
     ("--overlap-mm", "-1", "--overlap-mm must be in [0, 10000]; got -1.0"),
     # a bit of no width: tool paths on the outlines and no kerf between the pieces (exit 0)
     ("--tool-diameter", "0", "--tool-diameter must be in (0, 100]"),
+    # options that contradict each other (errors.UsageError) exited 1, as a failed run
+    ("--patch-mm", "4", "patch_mm must be at least min_piece_mm"),
 ])
 def test_a_table_1_parameter_out_of_range_is_a_usage_error_naming_the_option(scans, capsys, option, value, said):
     """Sweep h6: these exited 1 (a failed work, where the README's exit statuses give 2 for a wrong

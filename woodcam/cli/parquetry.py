@@ -191,7 +191,7 @@ def run(args) -> int:
     import dataclasses
     from collections import Counter
 
-    from ..errors import WoodcamError
+    from ..errors import UsageError, WoodcamError
     from ..parquetry.engine import build_parquetry
     from ..parquetry.job import (
         ParquetryJob,
@@ -206,7 +206,10 @@ def run(args) -> int:
             if getattr(args, opt) is not None}
     if args.reuse_wood:
         over["single_use"] = False
-    job.params = dataclasses.replace(job.params, **over).check()
+    try:  # a job file's own parameters were checked as it was read: what fails now, the options made
+        job.params = dataclasses.replace(job.params, **over).check()
+    except WoodcamError as err:  # options that contradict each other: a wrong command line (exit 2)
+        raise UsageError(str(err)) from err
     if args.target:
         job.targets = [{"filename": str(t), "scale": 1.0} for t in args.target]
     scans = [_scan_entry(s) for s in args.veneer]
