@@ -276,7 +276,28 @@ def test_a_target_of_a_few_pixels_is_made_and_its_ssim_said_to_have_no_value(sca
     assert "SSIM n/a (fewer pixels than its 7 x 7 window)" in text
     panel = json.loads((out / "result.json").read_text())["summary"]["panels"][0]
     assert panel["ssim_native"] is None and panel["ssim_native_baseline"] is None
+    assert panel["native_grid"] == "target" and panel["native_px"] == panel["target_px"] == [4, 4]
     assert 0 < panel["ssim"] <= 1 and len(panel["cells"]) == 2 and panel["patches"] == 16
+
+
+def test_a_target_finer_than_the_working_grid_is_not_said_measured_on_its_own_pixels(scans, capsys):
+    """coffee.png (400 x 600 px) on a 56 mm panel at 2 px/mm (a 112 px working grid): the
+    'native' figures fall back to the working grid, yet the summary said they were 'on the
+    target's own 600 x 400 pixels' and result.json's native_px gave the target's pixels. Now
+    the line says its pixels are finer than the working grid, and native_px is the grid measured."""
+    out = scans / "out"
+    assert main(["parquetry", str(scans / "coffee.png"), "--veneer", f"{scans / 'light.png'}:2px/mm",
+                 "--veneer", f"{scans / 'dark.png'}:2px/mm", "--image-size-mm", "56", "--px-per-mm",
+                 "2", "--no-glb", "--out", str(out), "--quiet"]) == 0
+    text = capsys.readouterr().out
+    panel = json.loads((out / "result.json").read_text())["summary"]["panels"][0]
+    working = [panel["cells"][0] * 28, panel["cells"][1] * 28]  # 14 mm patches at 2 px/mm
+    assert panel["native_grid"] == "working" and panel["native_px"] == working
+    assert panel["target_px"][0] == 400 and panel["target_px"][0] > working[0]
+    assert panel["feature_cost_native"] == panel["feature_cost"] and panel["ssim_native"] == panel["ssim"]
+    assert "on the target's own" not in text
+    assert (f"the target's own {panel['target_px'][1]} x 400 pixels are finer than the "
+            f"{working[1]} x {working[0]} px working grid") in text
 
 
 def test_a_job_file_texture_without_an_id_is_named_by_its_file(scans, capsys):

@@ -19,7 +19,7 @@ from .cutpaths import (
     transform_outline,
     write_dxf,
 )
-from .engine import ParquetryRun, _check_run, feature_cost, ssim_vs_matched
+from .engine import ParquetryRun, _check_run, _native, feature_cost, ssim_vs_matched
 from .job import ParquetryJob, write_job
 
 #: Thickness (mm) of the board in panel.glb: 0.6 mm veneer on a 1.5 mm birch ply substrate,
@@ -99,12 +99,17 @@ def summary(run: ParquetryRun) -> dict:
         d = {"name": p.name, "size_mm": [p.cells.shape[1] * prm.patch_mm, p.cells.shape[0] * prm.patch_mm],
              "cells": list(p.cells.shape), "patches": len(p.patches)}
         if ok.all():
+            # the grid the 'native' figures are measured on: the target's own pixels, or the
+            # working grid where those are finer (the summary called it the target's own)
+            own = tuple(p.native_shape or p.matched.shape)
+            measured = _native(p, "native") or p.matched.shape
+            native_grid = "target" if _native(p, "native") or own[0] <= measured[0] else "working"
             d.update(feature_cost=feature_cost(p, p.render, prm),
                      feature_cost_baseline=feature_cost(p, p.baseline, prm),
                      ssim=ssim_vs_matched(p, p.render), ssim_baseline=ssim_vs_matched(p, p.baseline),
                      ssim_1mm=ssim_vs_matched(p, p.render, round(prm.px_per_mm)),
                      ssim_1mm_baseline=ssim_vs_matched(p, p.baseline, round(prm.px_per_mm)),
-                     native_px=list(p.native_shape or p.matched.shape),
+                     native_px=list(measured), native_grid=native_grid, target_px=list(own),
                      feature_cost_native=feature_cost(p, p.render, prm, "native"),
                      feature_cost_native_baseline=feature_cost(p, p.baseline, prm, "native"),
                      ssim_native=ssim_vs_matched(p, p.render, grid="native"),
@@ -232,10 +237,15 @@ def format_summary(summ: dict, problems: dict) -> str:
                         else f"{d[key]:.3f} (baseline {d[key + '_baseline']:.3f})")
             line += (f"; feature cost/px {d['feature_cost']:.5f} (mean-colour baseline "
                      f"{d['feature_cost_baseline']:.5f}), SSIM {ssim('ssim')}, at 1 mm pixels "
-                     f"{ssim('ssim_1mm')}; on the target's own "
-                     f"{d['native_px'][1]} x {d['native_px'][0]} pixels feature cost "
-                     f"{d['feature_cost_native']:.5f} (baseline {d['feature_cost_native_baseline']:.5f}), "
-                     f"SSIM {ssim('ssim_native')}")
+                     f"{ssim('ssim_1mm')}")
+            if d.get("native_grid", "target") == "target":
+                line += (f"; on the target's own {d['native_px'][1]} x {d['native_px'][0]} pixels feature "
+                         f"cost {d['feature_cost_native']:.5f} (baseline {d['feature_cost_native_baseline']:.5f}), "
+                         f"SSIM {ssim('ssim_native')}")
+            else:  # no grid coarser than the working one: its figures above are the finest measured
+                line += (f"; the target's own {d['target_px'][1]} x {d['target_px'][0]} pixels are finer than "
+                         f"the {d['native_px'][1]} x {d['native_px'][0]} px working grid, so the working "
+                         f"grid's figures stand for them (raise --px-per-mm to measure finer)")
         lines.append(line)
     lines.append(f"matching: {summ['match_seconds']:.1f} s wall, {summ['match_cpu_seconds']:.1f} CPU-s, "
                  f"{summ['seconds_per_patch']:.3f} s per patch")
