@@ -350,8 +350,21 @@ def _woodify_field(parsed: ParsedSpec):
     """``woodify:PATH/field.npz`` -> (field, size_mm, description): the block stored in it."""
     from .woodify.field import WoodifiedField
 
+    from .fields.base import rings_crossed
+
     path = parsed.source
     field = WoodifiedField.load(path)
+    # a block inside one growth layer was one flat colour without a word: its years on a
+    # 9 x 9 x 9 lattice of the block (corners and faces included) cross no whole year
+    lattice = np.stack(np.meshgrid(*[np.linspace(0.0, v, 9) for v in field.block_size_mm], indexing="ij"), -1)
+    years = field(lattice.reshape(-1, 3))
+    if rings_crossed(years) == 0:
+        size = " x ".join(f"{v:.4g}" for v in field.block_size_mm)
+        warnings.warn(f"block {parsed.base}: its {size} mm of wood lie in one growth layer (years "
+                      f"{years.min():.3g} to {years.max():.3g} of the {field.years_final:g} grown), so it shows no "
+                      "ring, one flat colour; cut a block that reaches across a ring (woodcam woodify --block-size "
+                      "larger, or --block-centre nearer the bark) or grow more years (--years)",
+                      WoodcamWarning, stacklevel=3)
     return field, field.block_size_mm, f"block cut from an object grown {field.years_final:g} years ({path})"
 
 

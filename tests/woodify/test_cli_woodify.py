@@ -576,3 +576,36 @@ def test_seed_help_names_what_it_seeds(capsys):
         main(["woodify", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "random seed of the procedural bark and random cracks" in text and "bark picture" not in text
+
+
+def test_wood_that_shows_no_ring_is_said_so(tmp_path):
+    """Wood grown under a year (a 5 mm ball grown 0.5 years), a block cut inside one growth
+    layer (here the ungrown core, year 0), and a veneer leaf lying in one layer were each one
+    flat colour without a word. Now each warns, naming why and what to change; wood with rings
+    (the ball grown 3 years, a block across them) says nothing."""
+    import warnings
+
+    from woodcam.errors import WoodcamWarning
+    from woodcam.parquetry import slice_veneers
+    from woodcam.woodify import woodify
+
+    ball = trimesh.creation.icosphere(subdivisions=2, radius=5.0)
+    with pytest.warns(WoodcamWarning, match=r"years \(--years\) = 0.5: .* has none inside its bark: .* one flat "
+                                            r"colour; grow more than one year \(e.g. --years 5"):
+        woodify(ball, 0.5, resolution=16)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        grown = woodify(ball, 3.0, growth_mm=3.0, resolution=24)
+        grown.field.placed(grown.field.block_size_mm).save(tmp_path / "ringed.npz")  # the grown box
+        ringed = open_stock(f"woodify:{tmp_path / 'ringed.npz'}")
+        W, _, H = ringed.size_mm
+        slice_veneers(ringed, 1, (W, H), px_per_mm=1.0)  # the block's middle plane: across the rings
+    grown.field.placed((4.0, 4.0, 4.0), (0.0, 0.0, 0.0)).save(tmp_path / "core.npz")
+    with pytest.warns(WoodcamWarning, match=r"block woodify:.*core.npz: its 4 x 4 x 4 mm of wood lie in one growth "
+                                            r"layer \(years 0 to 0 of the 3 grown\), so it shows no ring, one flat colour; "
+                                            r"cut a block that reaches across a ring"):
+        core = open_stock(f"woodify:{tmp_path / 'core.npz'}")
+    with pytest.warns(WoodcamWarning, match=r"veneers of woodify:.*core.npz: 2 of 2 leaves lie in one growth layer "
+                                            r"and show no ring, one flat colour: leaf 0 at y=2 mm \(years 0 to 0\); "
+                                            r"leaf 1 .*slice across the rings"):
+        slice_veneers(core, 2, (4.0, 4.0), px_per_mm=2.0)

@@ -122,6 +122,18 @@ def arf(years: ArrayLike) -> np.ndarray:
     return np.mod(g, 1.0) ** 2
 
 
+def rings_crossed(years: ArrayLike) -> int:
+    """How many ring boundaries (whole years, where one year's wood meets the next: the ARF's
+    latewood -> earlywood step) the growth times ``years (n,)`` cross: the integers ``k`` with
+    ``min < k <= max`` over the finite values. 0: all of them lie in one growth layer, a
+    surface there shows no ring, one flat colour (NaNs ignored; none finite: 0)."""
+    g = as_floats(years)
+    if g is None:
+        raise WoodcamError(f"years must be growth times (numbers); got {years!r:.60}")
+    g = g[np.isfinite(g)]
+    return int(np.floor(g.max()) - np.floor(g.min())) if g.size else 0
+
+
 def central_gradient(field: GrowthFieldLike, points_mm: ArrayLike,
                      step_mm: float) -> tuple[np.ndarray, np.ndarray]:
     """``(years (n,), gradient (n, 3) years/mm)`` of ``field`` at ``points_mm`` ``(n, 3)``:

@@ -25,6 +25,7 @@ import numpy as np
 from .._checks import as_floats, check_bool, check_number, check_path, check_vector
 from .._readers import PHOTO_ALPHA_FIX, read_photo_rgb
 from ..errors import WoodcamError
+from ..fields.base import rings_crossed
 
 
 class StockLike(Protocol):
@@ -341,7 +342,18 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
     start = stock.size_mm[ax] / 2.0 if start_mm is None else float(start_mm)
     top = stock.size_mm[down_axis] if down_axis == 2 else 0.0
     prefix = id_prefix or stock.spec.replace(":", "-").replace("/", "-").replace("\\", "-").strip("-.")
-    sheets = []
+    sheets, flat = [], []
+
+    def plane_points(s, u_mm, v_mm):
+        """Block-frame points ``(n, 3)`` of sheet points ``(u, v)`` mm (1-d arrays) of plane ``s``."""
+        pts = np.empty((u_mm.size, 3), np.float64)
+        pts[:, ax] = s
+        pts[:, right] = u_mm
+        # Z grows up while sheet rows grow down; other axes run with the rows.
+        pts[:, down_axis] = (top - v_mm) if down_axis == 2 else v_mm
+        return pts
+
+    years_of = getattr(stock.wood, "years", None)
     it = range(n_sheets)
     if progress:
         from .._progress import progress_bar
@@ -359,11 +371,7 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
             normal[ax] = 1.0 if turned else -1.0
             for a in range(0, u_mm.size, _SAMPLES_PER_CALL):
                 b = min(u_mm.size, a + _SAMPLES_PER_CALL)
-                pts = np.empty((b - a, 3), np.float64)
-                pts[:, ax] = s
-                pts[:, right] = u_mm[a:b]
-                # Z grows up while sheet rows grow down; other axes run with the rows.
-                pts[:, down_axis] = (top - v_mm[a:b]) if down_axis == 2 else v_mm[a:b]
+                pts = plane_points(s, u_mm[a:b], v_mm[a:b])
                 normals = np.broadcast_to(normal, pts.shape)
                 out[a:b] = np.asarray(stock.wood.color(pts, normals), np.float32)
             return out
@@ -372,10 +380,24 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
         rgb = _supersampled(colour, nh, nw, (w_mm / nw, h_mm / nh), ss, adaptive)
         if turned:
             rgb = rgb[:, ::-1]
+        if callable(years_of):  # a leaf in one growth layer is one flat colour: said below
+            u, v = (g.ravel() for g in np.meshgrid(np.linspace(0, w_mm, 33), np.linspace(0, h_mm, 33)))
+            years = np.asarray(years_of(plane_points(s, u, v)), float)
+            if rings_crossed(years) == 0:
+                flat.append(f"leaf {k} at {axis}={s:g} mm (years {np.nanmin(years):.3g} to {np.nanmax(years):.3g})")
         sheets.append(_check(Veneer(f"{prefix}-{k:02d}", np.ascontiguousarray(rgb, np.float32),
                                     float(px_per_mm), np.ones((nh, nw), bool),
                                     f"{stock.spec} leaf {k} at {axis}={s:g} mm"
                                     + (" (turned over)" if turned else ""), (float(w_mm), float(h_mm)))))
+    if flat:  # the wood the user slices should show its rings, or say why it does not
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        warnings.warn(f"veneers of {stock.spec}: {len(flat)} of {n_sheets} leaves lie in one growth layer and show "
+                      f"no ring, one flat colour: {'; '.join(flat[:3])}{'; ...' if len(flat) > 3 else ''}; slice "
+                      f"across the rings (another axis than {axis}, --slice-axis), larger leaves (--sheet-size), or "
+                      "from wood of more years", WoodcamWarning, stacklevel=2)
     return sheets
 
 

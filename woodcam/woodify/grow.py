@@ -146,6 +146,15 @@ def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: 
         raise WoodcamError(f"years must be a number > 0 (years to grow); got {years!r}; e.g. 40")
     mesh = check_watertight(mesh, "mesh")
     resolution = check_resolution(resolution)
+    if years <= 1:  # its wood, blocks, sections and leaves were one flat colour without a word
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        warnings.warn(f"years (--years) = {years:g}: a ring is where one year's wood meets the next, so wood "
+                      f"grown {years:g} year{'' if years == 1 else 's'} has none inside its bark: its sections, "
+                      "and the blocks and veneers cut from it, show one flat colour; grow more than one year "
+                      "(e.g. --years 5; --growth keeps the thickness grown)", WoodcamWarning, stacklevel=2)
     vertex_gain, vertex_direction = check_vertex_paint(vertex_gain, vertex_direction, len(mesh.vertices))
     lam = float(years) if time_scale_years is None else float(time_scale_years)
     if growth_mm is not None and velocity_mm is not None:
