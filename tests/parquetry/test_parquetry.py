@@ -286,7 +286,9 @@ def test_the_default_leaves_pass_the_memory_guard_and_absurd_ones_do_not(monkeyp
 
     monkeypatch.setattr(veneers, "_supersampled",  # the guard, not minutes of sampling
                         lambda colour, nh, nw, *a: np.full((nh, nw, 3), 0.5, np.float32))
-    leaves = job_veneers(ParquetryJob(blocks=[{"spec": "builtin:flat-sawn"}]), open_stock=open_stock)
+    # the default leaves of a block whose face holds them (builtin:flat-sawn's own 100 x 50 mm
+    # face gets leaves of its size: wood beyond it is refused, see test_parquetry_cli)
+    leaves = job_veneers(ParquetryJob(blocks=[{"spec": "builtin:flat-sawn:600x80x400"}]), open_stock=open_stock)
     assert [v.rgb.shape for v in leaves] == [(1600, 2400, 3)] * 2
     with pytest.raises(WoodcamError, match="1000 leaves of 600 x 400 mm at 4 px/mm .* MAX_GRID_CELLS"):
         slice_veneers(open_stock("builtin:flat-sawn"), 1000, (600, 400))

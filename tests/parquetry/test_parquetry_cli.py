@@ -172,14 +172,14 @@ def test_leaf_slicing_options_reach_the_job_file_blocks_or_are_named(scans, caps
     err = capsys.readouterr().err
     assert "--sheets, --species slice leaves from blocks" in err and "scans (--veneer)" in err
     job = json.loads((out / "job.json").read_text())
-    job["woodcam"]["blocks"] = [{"spec": "builtin:flat-sawn", "sheets": 2, "width_mm": 80, "height_mm": 60}]
+    job["woodcam"]["blocks"] = [{"spec": "builtin:flat-sawn", "sheets": 2, "width_mm": 80, "height_mm": 48}]
     (scans / "job.json").write_text(json.dumps(job))
     assert main(["parquetry", "--config", str(scans / "job.json"), "--species", "walnut", "--sheets", "1",
-                 "--sheet-size", "70x56", "--out", str(scans / "out2"), "--quiet", "--no-glb"]) == 0
+                 "--sheet-size", "70x46", "--out", str(scans / "out2"), "--quiet", "--no-glb"]) == 0
     assert "change nothing" not in capsys.readouterr().err
     sliced = [v for v in json.loads((scans / "out2" / "result.json").read_text())["veneers"]
               if v["id"].startswith("builtin")]
-    assert [(v["id"], v["size_mm"]) for v in sliced] == [("builtin-flat-sawn-walnut-00", [70.0, 56.0])]
+    assert [(v["id"], v["size_mm"]) for v in sliced] == [("builtin-flat-sawn-walnut-00", [70.0, 46.0])]
 
 
 def test_a_slicing_option_typed_at_its_default_still_overrides_the_job_file(scans, capsys):
@@ -188,7 +188,7 @@ def test_a_slicing_option_typed_at_its_default_still_overrides_the_job_file(scan
     out = scans / "out"
     assert _small_run(scans, out) == 0
     job = json.loads((out / "job.json").read_text())
-    job["woodcam"]["blocks"] = [{"spec": "builtin:flat-sawn", "sheets": 1, "width_mm": 70, "height_mm": 56}]
+    job["woodcam"]["blocks"] = [{"spec": "builtin:flat-sawn", "sheets": 1, "width_mm": 70, "height_mm": 46}]
     (scans / "job.json").write_text(json.dumps(job))
     assert main(["parquetry", "--config", str(scans / "job.json"), "--sheets", "2",
                  "--out", str(scans / "out2"), "--quiet", "--no-glb"]) == 0
@@ -375,3 +375,36 @@ def test_the_job_file_of_a_run_with_relative_paths_reruns_from_anywhere(scans, c
     first, again = (json.loads((scans / d / "result.json").read_text())["patches"]
                     for d in ("out", "elsewhere/again"))
     assert [p["anchor_px"] for p in again] == [p["anchor_px"] for p in first]
+
+
+def test_leaves_beyond_their_block_are_refused_naming_the_sizes(scans, capsys):
+    """'--veneer-from builtin:flat-sawn' sliced the default 600 x 400 mm leaves from its
+    100 x 80 x 50 mm block, and any --sheet-size or --sheets past the block ran without a word:
+    wood of the field outside the block, which the block does not hold (for a fitted or grown
+    block an extrapolation). Now a leaf larger than the block's face, or leaves past its back
+    face, are refused naming the sizes and the fix (also from a job file), and the default
+    leaf is 600 x 400 mm or the block's face where smaller."""
+    out = scans / "out"
+    flat = ["--veneer-from", "builtin:flat-sawn", "--no-glb"]
+    assert _small_run(scans, out, *flat, "--sheet-size", "120x40") == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and ("leaves of 120 x 40 mm (--sheet-size; width_mm, height_mm in a job file) do not fit "
+                                     "builtin:flat-sawn: its 100 x 80 x 50 mm block's face normal to y (--slice-axis) is "
+                                     "100 x 50 mm") in err
+    assert "give --sheet-size 100x40 mm or smaller, or a block of 120 x 80 x 50 mm that holds them " \
+           "(builtin:flat-sawn:120x80x50)" in err
+    assert _small_run(scans, out, *flat, "--sheet-size", "40x60", "--slice-axis", "z") == 0  # face 100 x 80
+    capsys.readouterr()
+    assert _small_run(scans, out, *flat, "--sheets", "60") == 1
+    assert ("60 leaves (--sheets) of 0.6 mm + 0.4 mm kerf, sliced from the middle of builtin:flat-sawn along y, "
+            "reach 99.6 mm into its 80 mm: past its back face") in capsys.readouterr().err
+    job = json.loads((out / "job.json").read_text())
+    job["woodcam"]["blocks"] = [{"spec": "builtin:flat-sawn", "sheets": 1, "width_mm": 80, "height_mm": 60}]
+    (scans / "job.json").write_text(json.dumps(job))
+    assert main(["parquetry", "--config", str(scans / "job.json"), "--out", str(scans / "out2"), "--quiet",
+                 "--no-glb"]) == 1
+    assert "leaves of 80 x 60 mm" in capsys.readouterr().err
+    # the default: the block's 100 x 50 mm face, not 600 x 400 mm of wood round it
+    assert _small_run(scans, out, *flat) == 0
+    result = json.loads((out / "result.json").read_text())
+    assert [v["size_mm"] for v in result["veneers"] if v["id"].startswith("builtin")] == [[100.0, 50.0]] * 2

@@ -38,8 +38,8 @@ result.json, panel.glb and job.json (the run as a job file) into --out, and list
 #: The options that slice leaves from a --veneer-from block, and their defaults (mm): the
 #: parser's defaults are None (not typed), so a value typed equal to its default still
 #: overrides a --config job's blocks; these fill in the rest.
-_SLICING = {"sheets": 2, "sheet_size": "600x400", "leaf_thickness": 0.6, "saw_kerf": 0.4, "slice_axis": "y",
-            "species": None}
+_SLICING = {"sheets": 2, "sheet_size": None, "leaf_thickness": 0.6, "saw_kerf": 0.4, "slice_axis": "y",
+            "species": None}  # sheet_size None: 600x400 mm, or the block's face where smaller (job_veneers)
 
 
 def register(subparsers) -> None:
@@ -69,7 +69,8 @@ def register(subparsers) -> None:
                    help="Mokume sample folder, or block spec to slice leaves from (repeatable)")
     v.add_argument("--sheets", type=int, default=None, help="leaves per --veneer-from block (default 2)")
     v.add_argument("--sheet-size", default=None, metavar="WxH",
-                   help="size of each sliced leaf in --units (default 600x400 mm)")
+                   help="size of each sliced leaf in --units (default 600x400 mm, or the block's face where "
+                   "smaller; a leaf larger than that face is refused: every sheet is wood of the block)")
     v.add_argument("--leaf-thickness", type=float, default=None, metavar="LEN",
                    help="sliced leaf thickness in --units (default 0.6 mm)")
     v.add_argument("--saw-kerf", type=float, default=None, metavar="LEN",
@@ -226,7 +227,7 @@ def run(args) -> int:
     for d, default in _SLICING.items():
         if getattr(args, d) is None:
             setattr(args, d, default)
-    w, h = parse_sizes(args.sheet_size, "--sheet-size", n=2)
+    w, h = parse_sizes(args.sheet_size, "--sheet-size", n=2) if args.sheet_size is not None else (None, None)
     # the slicing options given here override the job file's blocks too (--config's rule: options
     # given here override it); they were ignored there
     leaf = {"sheets": args.sheets, "width_mm": w, "height_mm": h, "thickness_mm": args.leaf_thickness,
@@ -239,7 +240,7 @@ def run(args) -> int:
         if sp.is_dir() and any(sp.glob("?_col.png")):
             job.mokume.append(str(sp))
         else:
-            job.blocks.append({"spec": spec, **leaf})
+            job.blocks.append({"spec": spec, **{k: v for k, v in leaf.items() if v is not None or k == "species"}})
     if given and not job.blocks:  # nothing silently dropped
         sources = " and ".join(n for n, on in (("scans (--veneer)", job.scans),
                                                ("Mokume sample folders", job.mokume)) if on)

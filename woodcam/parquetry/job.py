@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import math
 import numbers
+import re
 import warnings
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
@@ -440,6 +441,59 @@ def write_job(job: ParquetryJob, path: str | Path) -> Path:
     return write_text(path, json.dumps(d, indent=2), mkdir=True)
 
 
+#: Size (width, height) mm of a sliced leaf when none is given: this, or the block's face
+#: where it is smaller.
+DEFAULT_LEAF_MM = (600.0, 400.0)
+
+
+def check_leaves_in_block(stock, n_sheets: int, width_mm: float | None, height_mm: float | None,
+                          thickness_mm: float, kerf_mm: float, axis: str) -> tuple[float, float]:
+    """The ``(width, height)`` mm of ``n_sheets`` leaves sliced from ``stock`` normal to
+    ``axis`` (as :func:`~woodcam.parquetry.veneers.slice_veneers` lays them: from the block's
+    middle plane, ``thickness + kerf`` apart), refused where they would run past the block.
+
+    Every sheet is wood of the block: a leaf larger than the block's face normal to ``axis``,
+    or leaves reaching past its back face, would be wood of the field outside it (for a fitted
+    or grown block an extrapolation, wood the user does not have). A size not given (None) is
+    :data:`DEFAULT_LEAF_MM`, or the face where it is smaller. Numbers are checked by
+    ``slice_veneers``; an axis other than x, y, z is left to it."""
+    from .veneers import PLANE_AXES
+
+    if axis not in ("x", "y", "z"):
+        return (float(width_mm or DEFAULT_LEAF_MM[0]), float(height_mm or DEFAULT_LEAF_MM[1]))
+    size = [float(v) for v in stock.size_mm]
+    ax = "xyz".index(axis)
+    right, down = PLANE_AXES[ax]
+    face = (size[right], size[down])
+    w = min(DEFAULT_LEAF_MM[0], face[0]) if width_mm is None else float(width_mm)
+    h = min(DEFAULT_LEAF_MM[1], face[1]) if height_mm is None else float(height_mm)
+    block = " x ".join(f"{v:g}" for v in size)
+    tol = 1e-6 * max(size)
+    if w > face[0] + tol or h > face[1] + tol:
+        need = list(size)
+        need[right], need[down] = max(size[right], w), max(size[down], h)
+        bigger = " x ".join(f"{v:g}" for v in need)
+        raise WoodcamError(
+            f"leaves of {w:g} x {h:g} mm (--sheet-size; width_mm, height_mm in a job file) do not fit "
+            f"{stock.spec}: its {block} mm block's face normal to {axis} (--slice-axis) is {face[0]:g} x "
+            f"{face[1]:g} mm, and every sheet must be wood of the block, not of the field outside it; give "
+            f"--sheet-size {min(w, face[0]):g}x{min(h, face[1]):g} mm or smaller"
+            + (f", or a block of {bigger} mm that holds them ({spec}:{bigger.replace(' x ', 'x')})"
+               if re.fullmatch(r"builtin:[a-z-]+", spec := str(stock.spec))
+               else f", or a block of {bigger} mm that holds them" if spec.startswith(("builtin:", "log:"))
+               else " (a block folder or a grown block holds only its own wood)"))
+    pitch = thickness_mm + kerf_mm
+    reach = size[ax] / 2 + (n_sheets - 1) * pitch + thickness_mm
+    if n_sheets >= 1 and thickness_mm > 0 and pitch > 0 and reach > size[ax] + tol:
+        most = max(0, int((size[ax] / 2 - thickness_mm) // pitch) + 1)
+        raise WoodcamError(
+            f"{n_sheets} leaves (--sheets) of {thickness_mm:g} mm + {kerf_mm:g} mm kerf, sliced from the middle "
+            f"of {stock.spec} along {axis}, reach {reach:g} mm into its {size[ax]:g} mm: past its back face, "
+            f"wood of the field outside the {block} mm block; give --sheets {most} or fewer, thinner leaves "
+            f"or kerf, or a deeper block")
+    return w, h
+
+
 def job_veneers(job: ParquetryJob, open_stock=None, progress: bool = False) -> list:
     """The job's veneer sheets: scans (``dpi / 25.4 * scale`` px/mm), Mokume photos and leaves
     sliced from woodcam blocks (``{"spec", "sheets", "width_mm", "height_mm", "thickness_mm",
@@ -470,11 +524,11 @@ def job_veneers(job: ParquetryJob, open_stock=None, progress: bool = False) -> l
         if "spec" not in b:
             raise WoodcamError(f"woodcam.blocks entry {b} needs a 'spec' (e.g. builtin:flat-sawn)")
         stock = open_stock(b["spec"], species=b.get("species"))
-        out += slice_veneers(stock, int(b.get("sheets", 2)),
-                             (float(b.get("width_mm", 600)), float(b.get("height_mm", 400))),
-                             thickness_mm=float(b.get("thickness_mm", 0.6)),
-                             kerf_mm=float(b.get("kerf_mm", 0.4)), px_per_mm=job.params.px_per_mm,
-                             axis=b.get("axis", "y"), progress=progress,
+        n, axis = int(b.get("sheets", 2)), b.get("axis", "y")
+        thickness, kerf = float(b.get("thickness_mm", 0.6)), float(b.get("kerf_mm", 0.4))
+        size = check_leaves_in_block(stock, n, b.get("width_mm"), b.get("height_mm"), thickness, kerf, axis)
+        out += slice_veneers(stock, n, size, thickness_mm=thickness, kerf_mm=kerf, px_per_mm=job.params.px_per_mm,
+                             axis=axis, progress=progress,
                              id_prefix=b.get("id") or (stock.spec.replace(":", "-").replace("/", "-").strip("-.")
                                                        + (f"-{b['species']}" if b.get("species") else "")))
     return out

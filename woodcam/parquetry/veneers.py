@@ -40,6 +40,11 @@ MM_PER_INCH = 25.4
 
 SliceAxis = Literal["x", "y", "z"]
 
+#: Block axes of a sliced sheet's x (right) and y (down), by the index of the slicing
+#: planes' normal (0, 1, 2 = x, y, z): the sheet reads like the block face with that normal
+#: in docs/conventions.md.
+PLANE_AXES = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
+
 
 @dataclass
 class Veneer:
@@ -277,9 +282,12 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
     along ``axis`` (block frame). Even leaves show the face at ``s_k`` (looking along +axis),
     odd leaves are turned over and show the face at ``s_k + thickness`` mirrored left-right:
     neighbours are book-matched, as a veneer slicer's leaves are laid out. The sheet covers
-    ``size_mm = (width, height)`` mm of the plane starting at the block's origin corner; the
-    wood's field is defined beyond the block's faces, so a sheet may be larger than the block
-    (it is then the veneer of a larger flitch of the same tree).
+    ``size_mm = (width, height)`` mm of the plane starting at the block's origin corner. It
+    slices where it is told: a sheet larger than the block's face, or a plane past its back
+    face, is wood of the field beyond the block (for a ``builtin:`` or ``log:`` field the same
+    tree's larger flitch; for a fitted or grown block an extrapolation, wood the block does
+    not hold). ``woodcam parquetry`` and job files refuse such leaves
+    (:func:`woodcam.parquetry.job.check_leaves_in_block`): every sheet is wood of the block.
 
     Parameters
     ----------
@@ -337,7 +345,7 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
     ax = "xyz".index(axis)
     # In-plane directions: sheet x (right) and sheet y (down) as block axes, chosen so the
     # sheet reads like the block face with that normal in docs/conventions.md.
-    right, down_axis = {0: (1, 2), 1: (0, 2), 2: (0, 1)}[ax]
+    right, down_axis = PLANE_AXES[ax]
     pitch = thickness_mm + kerf_mm
     start = stock.size_mm[ax] / 2.0 if start_mm is None else float(start_mm)
     top = stock.size_mm[down_axis] if down_axis == 2 else 0.0
