@@ -68,7 +68,8 @@ def register(subparsers) -> argparse.ArgumentParser:
                    default="stress", help="bark crack pattern (default stress: natural directions)")
     p.add_argument("--crack-region", default=None, metavar="X,Y,Z,R",
                    type=vector_type("--crack-region", "X,Y,Z,R", "0,0,50,10"),
-                   help="only crack within this sphere (centre and radius in --units)")
+                   help="only crack within this sphere (centre and radius in --units; default: none, cracks "
+                   "anywhere on the bark)")
     add_units_option(p, "woodify")
     p.add_argument("--crack-years", type=int, default=None,
                    help="last years simulated for cracks, at most --years (default 5, or the whole "
@@ -76,8 +77,8 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--crack-render", choices=("groove", "material"), default="material",
                    help="draw cracks into the bark texture (material, default) or cut them as grooves")
     p.add_argument("--crack-threshold", type=float, default=None,
-                   help="separation eigenvalue that opens a crack (default 2x the median of the "
-                   "first simulated year)")
+                   help="separation eigenvalue that opens a crack (a triangle's area times its bark strain per "
+                   "length at unit stiffness, so in mm; default 2x the median of the first simulated year)")
     p.add_argument("--relief", type=float, default=0.3,
                    help="stress left next to a new crack, in [0, 1] (0 removes all; default 0.3)")
     p.add_argument("--seed", type=int, default=0, help="random seed of the procedural bark and random cracks (default 0)")
