@@ -780,14 +780,15 @@ def test_parameters_are_checked_when_made_and_flat_rerank_has_one_floor():
 
 def test_the_cli_leaves_flat_reranks_floor_to_the_parameters(tmp_path, capsys):
     """--flat-rerank 2 is refused by the parameters' rule, naming the option and the rerank it
-    must reach (exit 1, as the other rules between parameters), not by a fixed 4 of the CLI's."""
+    must reach (exit 2, a wrong command line, as the other rules between the options'
+    parameters), not by a fixed 4 of the CLI's."""
     from woodcam.cli import main
     from woodcam.cli.options import RANGES
 
     assert RANGES[("parquetry", "flat_rerank")][0] == 1  # rerank's own floor; the rest is check()'s
     argv = ["parquetry", str(tmp_path / "t.png"), "--veneer", str(tmp_path / "v.png"), "--flat-rerank", "2",
             "--out", str(tmp_path / "o"), "--quiet"]
-    assert main(argv) == 1
+    assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "flat_rerank (--flat-rerank) must be >= rerank = 4 (the candidates" in err
     assert not (tmp_path / "o").exists()
