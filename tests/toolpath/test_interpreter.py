@@ -478,6 +478,21 @@ def test_canned_cycles_retract_planes():
                                               -1.746, -3, 1]
 
 
+def test_g98_holes_travel_at_the_tools_z_and_retract_to_the_higher_of_initial_level_and_r():
+    # LinuxCNC 2.9 (measured): each hole is reached at the tool's own Z (raised to R first when
+    # below it) and G98 retracts to max(initial level, R). woodcam travelled at the initial
+    # level: after a hole with R3 above the initial Z1 it dropped from Z3 to Z1 and crossed to
+    # the next hole there (LinuxCNC stays at Z3), and after one with R10 it dropped to Z8
+    ends = _ends("G0 X0 Y0 Z1\nG98 G81 X1 Y1 Z-3 R3 F100\nX4 R0\nG80\nM2\n")
+    assert ends[-4:] == [(4, 1, 3), (4, 1, 0), (4, 1, -3), (4, 1, 1)]
+    ends = _ends("G0 X0 Y0 Z8\nG98 G81 X1 Y1 Z-3 R3 F100\nX5 R10\nX6 R1\nG80\nM2\n")
+    assert ends[5:] == [(1, 1, 10), (5, 1, 10), (5, 1, -3), (5, 1, 10),
+                        (6, 1, 10), (6, 1, 1), (6, 1, -3), (6, 1, 8)]
+    # at or below R the hole is reached at the retract plane (G98 after G99: the initial level)
+    ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nG98 X3 R2.5\nG80\nM2\n")
+    assert ends[-4:] == [(3, 1, 10), (3, 1, 2.5), (3, 1, -2), (3, 1, 10)]
+
+
 def test_a_cycle_code_after_another_mode_needs_its_own_words():
     # LinuxCNC 2.9 carries R, Z, Q (G73/G83) and P (G82/G86/G89) over only from lines of the
     # same cycle code; woodcam kept them from any earlier cycle (and P = 0 when never given),

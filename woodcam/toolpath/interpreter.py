@@ -2047,11 +2047,18 @@ class Interpreter:
                            "than 100,000)", "give a larger Q")
         rapid_delta = _RAPID_DELTA_IN * (1.0 if self.inch else MM_PER_INCH)
         x, y = prog[0], prog[1]
-        old_z = self.cycle_il if self.retract_old_z else cur_z
-        if cur_z < r:  # preliminary move up to the R plane
+        # LinuxCNC 2.9's convert_cycle_xy (and measured): old = the initial level; below R it
+        # is raised to R by a rapid at the tool's X/Y (the tool then at R); the retract plane
+        # is R (G99) or old (G98); the first hole is reached at the tool's Z when above R,
+        # else at the retract plane, the next repeats (L) at the retract plane. woodcam
+        # travelled at the initial level in G98: after a hole with R3 above the initial Z1 it
+        # dropped to Z1 to cross to the next hole (LinuxCNC stays at Z3)
+        old = self.cycle_il
+        if old < r:  # preliminary move up to the R plane
             self._cyc(TRAVERSE, x, y, r)
-        old_z = max(old_z, r)
-        clear = old_z if self.retract_old_z else r
+            old = cur_z = r
+        clear = old if self.retract_old_z else r
+        old_z = cur_z if cur_z > r else clear
         for _ in range(reps):
             if self.incremental:
                 x += w.get("x", 0.0)
