@@ -493,6 +493,17 @@ def test_g98_holes_travel_at_the_tools_z_and_retract_to_the_higher_of_initial_le
     assert ends[-4:] == [(3, 1, 10), (3, 1, 2.5), (3, 1, -2), (3, 1, 10)]
 
 
+def test_g86_with_the_spindle_stopped_is_refused_as_linuxcnc_does():
+    # G86 stops the spindle at the bottom and restarts it: LinuxCNC refuses it with the spindle
+    # stopped ("Spindle not turning in g86"); woodcam bored the hole
+    with pytest.raises(GcodeError, match=r"line 2: 'G86': G86 .* spindle stopped: LinuxCNC "
+                                         r"refuses it .*; start the spindle"):
+        _ends("G0 X0 Y0 Z5\nG86 X1 Y1 Z-3 R2 P0.5 F100\nG80\nM2\n")
+    with pytest.raises(GcodeError, match=r"line 4: 'G86'"):
+        _ends("G0 X0 Y0 Z5\nM3 S1000\nG86 X1 Y1 Z-3 R2 P0.5 F100\nM5 X2\nG80\nM2\n")
+    assert len(_ends("G0 X0 Y0 Z5\nM3 S1000\nG86 X1 Y1 Z-3 R2 P0.5 F100\nG80\nM2\n")) == 5
+
+
 def test_a_cycle_code_after_another_mode_needs_its_own_words():
     # LinuxCNC 2.9 carries R, Z, Q (G73/G83) and P (G82/G86/G89) over only from lines of the
     # same cycle code; woodcam kept them from any earlier cycle (and P = 0 when never given),

@@ -1988,6 +1988,12 @@ class Interpreter:
                            "switch to G17")
         if self.feed <= 0:
             raise self.err(code, "drilling with feed rate 0 (no F yet)", "set F")
+        if self.motion == 86.0 and not self.spindle_on and self.dialect == "linuxcnc":
+            # G86 stops the spindle at the bottom and starts it again: LinuxCNC refuses it with
+            # the spindle stopped ("Spindle not turning in g86")
+            raise self.err(code, "G86 (bore, spindle stop, rapid out) with the spindle stopped: "
+                           "LinuxCNC refuses it ('Spindle not turning in g86')",
+                           "start the spindle (M3 S...) before the G86 line")
         c = self.cyc
         if self.dialect == "linuxcnc" and self.motion_before != self.motion:
             # LinuxCNC carries R, Z, Q (G73/G83) and P (G82/G86/G89) over only from lines of
