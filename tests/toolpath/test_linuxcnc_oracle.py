@@ -196,6 +196,24 @@ def test_the_spindle_started_on_a_move_line_before_a_blank_line_is_read_on():
         assert prog.spindle_rpm.tolist() == read_gcode(text).spindle_rpm.tolist()
 
 
+def test_the_spindle_set_on_a_move_line_before_o_words_and_loops_is_read_on():
+    """The driver gave a move line's moves the spindle state LinuxCNC reports at the next
+    reported line only when blank lines alone lay between, else the state before the line:
+    'S1000 M3 G1 X5' followed by an 'o1 if' cut with the spindle off, and so did every move
+    line with its own M3/S before a loop's endwhile (LinuxCNC reports no o-word line, nor an
+    'M5' alone). A move now takes the state before its line with the line's own S, M3/M4/M5,
+    M6 and M19 applied (an expression S waits for the next reported line, as before)."""
+    text = "\n".join(["G21 G90 F100", "#1=0", "S1000 M3 G1 X5", "o1 if [1]", "o1 endif",
+                      "G1 X6", "o2 while [#1 lt 2]", "#1=[#1+1]", "M5", "G1 Y#1",
+                      "S300 M4 G1 Z[5-#1]", "o2 endwhile", "G1 X7", "S2000 M3 G1 X8",
+                      "M5", "G1 X9", "T2 M6 M3 G1 X10", "T3 M6 G1 X11", "#2=800",
+                      "S#2 M3 G1 X12", "o3 repeat [1]", "o3 endrepeat", "G1 X13", "M2", ""])
+    prog = read_gcode(text, interpreter="linuxcnc")
+    assert prog.spindle_rpm[prog.kind != 0].tolist() == [1000, 1000, 0, 300, 0, 300, 300, 2000, 0,
+                                                          2000, 0, 800, 800]
+    assert prog.spindle_rpm.tolist() == read_gcode(text).spindle_rpm.tolist()
+
+
 def test_machine_zero_agrees_with_linuxcnc_g54_offset(tmp_path):
     """A machine zero M in the G-code frame is LinuxCNC with the G54 offset -M (the work zero in
     machine coordinates), moves shifted back by M: G53 moves, G10 L2 offsets, G28 homes and arcs

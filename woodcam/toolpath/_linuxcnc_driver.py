@@ -21,12 +21,14 @@ frame the start position is given in (as woodcam's interpreter does). The machin
 import ctypes
 import json
 import os
+import re
 import shutil
 import sys
 import tempfile
 import time
 
 MM = 25.4
+_BLANKS = str.maketrans("", "", " \t\r")  # what LinuxCNC skips between words
 _PLANE = {1: 17, 2: 19, 3: 18}  # CANON_PLANE_XY, YZ, XZ -> G17, G19, G18
 # first/second axis (x=0, y=1, z=2) of an arc in each canon plane; the third is the normal
 _AXES = {1: (0, 1, 2), 2: (1, 2, 0), 3: (2, 0, 1)}
@@ -56,6 +58,56 @@ def _tool_table(work):
     lib._Z23tooldata_last_index_seti(99)
 
 
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
+
+
+def _spindle_words(line):
+    """The S and M words of source ``line`` as ``[(letter, value), ...]`` (letters 'm', 's'),
+    ``None`` when one's value is not a plain number (``S#1``, ``M[3]``): only the interpreter
+    knows it; a call (``o1 call``, ``M98``) ``None`` too: the lines it runs may set it. Other
+    O-word lines and M99 set no spindle. Comments are ``( )`` and ``;``."""
+    text = re.sub(r"\([^)]*\)?", "", line.split(";", 1)[0]).lower().translate(_BLANKS)
+    start = re.match(r"/?(?:n\d+(?:\.\d+)?)?(?:(o(?:<[^>]*>|\d*)call)|o|m0*99(?![\d.])"
+                     r"|(m0*98(?![\d.])))", text)
+    if start:
+        return None if start.group(1) or start.group(2) else []
+    text = re.sub(r"#<[^>]*>", "#", text)
+    out, depth = [], 0
+    for i, c in enumerate(text):
+        depth += (c == "[") - (c == "]")
+        if depth or c not in "ms" or (i and text[i - 1].isalpha()):
+            continue  # (a word's letter stands outside brackets, after no other letter)
+        m = _NUMBER.match(text, i + 1)
+        if not m or m.end() < len(text) and text[m.end()] not in "abcdefghijklmnopqrstuvwxyz#":
+            return None
+        out.append((c, float(m.group(0))))
+    return out
+
+
+def _after(spindle, words):
+    """The spindle ``(M code, speed)`` after a line's ``words`` (_spindle_words), in LinuxCNC's
+    order: S, the tool change (M6 stops the spindle), then M3/M4/M5 (M19, an orientation,
+    leaves it stopped: the interpreter reports M5 after it)."""
+    code, speed = spindle
+    for letter, v in words:
+        if letter == "s":
+            speed = v
+    ms = [v for letter, v in words if letter == "m"]
+    if 6 in ms:
+        code = 5
+    for v in ms:
+        if v in (3, 4, 5):
+            code = int(v)
+        elif v == 19:
+            code = 5
+    return code, speed
+
+
+def _rpm(spindle):
+    code, speed = spindle
+    return speed if code in (3, 4) else 0.0
+
+
 class _Canon:
     def __init__(self, param_file, deadline):
         self.parameter_file = param_file
@@ -71,15 +123,22 @@ class _Canon:
         self.mzero = [0.0] * 3  # the output shift: machine origin in the G54 frame, mm
         self.feed = 0.0  # mm/min (set_feed_rate: inch/min, as the module converts lengths)
         self.tool = 0  # the loaded tool (change_tool: M6)
-        # the spindle: the interpreter's state reaches Python only through next_line, as it
-        # was after the last block it finished (S and M3/M4/M5 of a line come before its
-        # motion, so a move's own line sets it): a line's moves take the state read at the
-        # next line's first call when that is the very next line or only blank lines lie
-        # between (LinuxCNC reports no blank line), else the one before them (a line it does
-        # not report, an 'M5' or an o-word, may have changed it since)
+        # the spindle: the interpreter's state reaches Python only through next_line, called
+        # at a line's first canon call with the state as it was after the last block the
+        # interpreter finished, so before the line's own S and M3/M4/M5/M6/M19, which take
+        # effect before its motion. A move's spindle is that state with its own line's words
+        # applied (_spindle_words). Only where a word's value is an expression ("S#1") is the
+        # state read at the next line's first call, when that line comes later in the file and
+        # no line between sets the spindle or calls a subroutine, else the state before the
+        # line (a move line with an expression S, repeated by a loop, takes the value after
+        # the loop's last pass for every pass). (It
+        # waited for the next reported line every time and took it only after blank lines:
+        # after a move line with 'S1000 M3' followed by o-word lines, a loop or an 'M5' alone,
+        # which LinuxCNC does not report, its moves cut with the spindle off.)
+        self.spindle = (0, 0.0)  # (M code 3/4/5, speed) at the last next_line
         self.rpm = 0.0
         self.pending = None  # (line, index of its first move) awaiting the state after it
-        self.blank: set[int] = set()  # the file's blank lines (1-based), set per file
+        self.words: dict[int, list | None] = {}  # line -> its spindle words, None: not known
 
     def __getattr__(self, name):  # every other canon call has no effect on the moves
         if name.startswith("__"):
@@ -87,14 +146,18 @@ class _Canon:
         return lambda *a: None
 
     def next_line(self, st):
-        rpm = float(st.speed) if st.spindle in (3, 4) else 0.0  # st.spindle: its M code
+        self.spindle = (st.spindle, float(st.speed))  # st.spindle: its M code
+        rpm = _rpm(self.spindle)
         if self.pending is not None and st.sequence_number > self.pending[0] and all(
-                k in self.blank for k in range(self.pending[0] + 1, st.sequence_number)):
+                k not in self.words for k in range(self.pending[0] + 1, st.sequence_number)):
             for m in self.moves[self.pending[1]:]:
                 m[7] = rpm
         self.pending = None
-        self.rpm = rpm
         self.line = st.sequence_number
+        words = self.words.get(self.line, [])
+        self.rpm = rpm if words is None else _rpm(_after(self.spindle, words))
+        if words is None:
+            self.pending = (self.line, len(self.moves))
 
     def set_feed_rate(self, rate):
         self.feed = rate * MM
@@ -103,8 +166,6 @@ class _Canon:
         self.tool = int(tool)
 
     def _append(self, move):
-        if self.pending is None:
-            self.pending = (self.line, len(self.moves))
         self.moves.append(move + [self.feed, self.rpm, self.tool])
 
     def get_external_angular_units(self):
@@ -212,8 +273,9 @@ def _run(job, work, result_fd):
         canon = _Canon(var, time.time() + job.get("timeout_s", 10.0))
         canon.mzero = mzero
         with open(path, newline="", errors="replace") as f:  # numbered as LinuxCNC: at '\n' only
-            canon.blank = {no for no, line in enumerate(f.read().split("\n"), 1)
-                           if not line.strip(" \t\r")}
+            lines = f.read().split("\n")
+        canon.words = {no: w for no, line in enumerate(lines, 1) if "m" in line.lower()
+                       or "s" in line.lower() for w in [_spindle_words(line)] if w != []}
         # G49: the interpreter keeps a G43.1 tool length offset from one file to the next;
         # G80: the G0 that places the start must not be the program's motion mode (LinuxCNC
         # starts in G80: a bare "X10" first is refused, and was read as a G0 here)
