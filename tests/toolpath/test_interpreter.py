@@ -467,6 +467,20 @@ def test_modal_state_save_and_restore_say_what_they_are(code, what, fix):
         _ends(f"G0 X0 Y0 Z10 F100\n{code}\nG0 X1\nM2\n")
 
 
+def test_m19_orients_the_spindle_which_then_stands_until_m3_or_m4():
+    # LinuxCNC reads M19's R (angle), Q (timeout) and P (direction) and reports the spindle
+    # stopped after it (the oracle's spindle state, LinuxCNC's standalone rs274 prints
+    # ORIENT_SPINDLE and no restart); woodcam refused 'M19 R90' ("R word with no G or M code")
+    # and cut on at the old speed after a bare M19
+    text = ("G21 G90 F100\nS1000 M3\nG1 X5\nM19 R90 Q2 P1\nG1 X6\nM3 G1 X7\nM19\nG1 X8\n"
+            "M4 G1 X9\nM19 R45 G1 X10\nM2\n")
+    prog = read_gcode(text)
+    assert prog.spindle_rpm.tolist() == [1000, 0, 1000, 0, 1000, 0]
+    assert [w.split(":")[0] for w in prog.warnings if "M19" in w] == ["line 4", "line 7",
+                                                                     "line 10"]
+    assert prog.end_mm[:, 0].tolist() == [5, 6, 7, 8, 9, 10]
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

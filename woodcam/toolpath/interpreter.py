@@ -262,7 +262,7 @@ _M_GROUPS = {"stopping": {0, 1, 2, 30, 60, 99}, "spindle": {3, 4, 5, 19}, "tool 
 #: LinuxCNC refuses a fifth M code on one line ("Too many m codes on line").
 MAX_M_PER_LINE = 4
 #: M codes that switch I/O or call user programs: read, not simulated, warned about.
-_M_WARN = {19: "spindle orientation", 62: "digital output", 63: "digital output",
+_M_WARN = {19: "spindle orientation: the spindle stands until M3/M4", 62: "digital output", 63: "digital output",
            64: "digital output", 65: "digital output", 66: "wait on input",
            67: "analog output", 68: "analog output", **{k: "user-defined M code (runs a "
                                                          "program of the machine)"
@@ -1590,7 +1590,7 @@ class Interpreter:
             self.p.pop(5399, None)
         if mset & {3, 4}:
             self.spindle_on = True
-        if 5 in mset:
+        if mset & {5, 19}:  # M19 orients the spindle: it stands until M3/M4 (LinuxCNC)
             self.spindle_on = False
         if 4.0 in g:
             if "p" not in w or w["p"] < 0:
@@ -1639,6 +1639,9 @@ class Interpreter:
                            "both read P (dwell seconds, arc turns); LinuxCNC refuses the line",
                            "put the dwell on a line of its own")
         self._unused_words(g, mset, w, motion_here, axis or modal_arc)
+        eff = motion_here[0] if motion_here else self.motion
+        if 19 in mset and "r" in w and not (eff in (2.0, 3.0) or eff in _CYCLES or 10.0 in g):
+            w = {k: v for k, v in w.items() if k != "r"}  # M19's R: the angle, no arc
         if 10.0 in g:
             self.g10(w)
         elif nonmodal & {28.0, 30.0}:
@@ -1772,10 +1775,11 @@ class Interpreter:
         under a modal arc)."""
         eff = motion_here[0] if motion_here else (self.motion if axis else None)
         uses = {
-            "q": bool(g & {10.0, 64.0}) or eff in (73.0, 83.0) or bool(mset & {61, 66, 67, 68}),
-            "r": 10.0 in g or eff in (2.0, 3.0) or eff in _CYCLES,
+            "q": bool(g & {10.0, 64.0}) or eff in (73.0, 83.0)
+            or bool(mset & {19, 61, 66, 67, 68}),
+            "r": 10.0 in g or eff in (2.0, 3.0) or eff in _CYCLES or 19 in mset,
             "p": bool(g & {4.0, 10.0, 64.0}) or eff in (2.0, 3.0, 82.0, 86.0, 89.0)
-            or bool(mset & {50, 51, 52, 53, 62, 63, 64, 65, 66, 67, 68}),
+            or bool(mset & {19, 50, 51, 52, 53, 62, 63, 64, 65, 66, 67, 68}),
             "l": 10.0 in g or eff in _CYCLES or 66 in mset,
             "e": bool(mset & {66, 67, 68}),
             "h": 43.0 in g,
