@@ -481,6 +481,19 @@ def test_m19_orients_the_spindle_which_then_stands_until_m3_or_m4():
     assert prog.end_mm[:, 0].tolist() == [5, 6, 7, 8, 9, 10]
 
 
+def test_break_and_continue_in_a_repeat_loop_are_refused_as_linuxcnc_does():
+    # LinuxCNC 2.9 leaves or restarts only while and do loops: "o1 break" in an "o1 repeat" is
+    # "no matching while/do label: 'o1 break' (found 'repeat' ...)" when reached; woodcam left
+    # the loop (and "o1 continue" skipped to the next pass)
+    for k in ("break", "continue"):
+        text = (f"G0 X0 Y0 Z1\n#1=0\no1 repeat [3]\n#1=[#1+1]\no2 if [#1 eq 2]\no1 {k}\n"
+                f"o2 endif\nG0 X#1\no1 endrepeat\nM2\n")
+        with pytest.raises(GcodeError, match=rf"line 6: 'o1 {k}': {k} in an o1 repeat loop: "
+                                             r"LinuxCNC leaves or restarts only while and do"):
+            _ends(text)
+        assert _ends(text.replace("[#1 eq 2]", "[#1 eq 9]"))[-1] == (3, 0, 1)  # not reached
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

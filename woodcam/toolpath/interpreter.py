@@ -1156,13 +1156,16 @@ class Interpreter:
                     pc = self.match[pc] + 1
             elif k == "endrepeat":
                 pc = self.match[pc]
-            elif k == "break":
-                op = self.owner[pc]
-                repeat_left.pop(op, None)
-                pc = self.match[op] + 1
+            elif k in ("break", "continue") and lines[self.owner[pc]].okey == "repeat":
+                raise self.err(f"o{ln.olabel} {k}", f"{k} in an o{ln.olabel} repeat loop: "
+                               f"LinuxCNC leaves or restarts only while and do loops ('no "
+                               f"matching while/do label')", f"write the loop as o{ln.olabel} "
+                               f"while, or guard the rest of the body with an o-if")
+            elif k == "break":  # (of a while or do loop: a repeat's is refused above)
+                pc = self.match[self.owner[pc]] + 1
             elif k == "continue":
                 op = self.owner[pc]
-                pc = op if lines[op].okey in ("while", "repeat") else self.match[op]
+                pc = op if lines[op].okey == "while" else self.match[op]
             else:  # pragma: no cover - _prepare only lets the keys above through
                 raise self.err(k, "unknown O-word", "fix it")
         if not self.ended and frames and frames[-1][1] is None:
