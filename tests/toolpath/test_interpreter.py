@@ -494,6 +494,37 @@ def test_break_and_continue_in_a_repeat_loop_are_refused_as_linuxcnc_does():
         assert _ends(text.replace("[#1 eq 2]", "[#1 eq 9]"))[-1] == (3, 0, 1)  # not reached
 
 
+def test_a_break_read_in_a_while_loop_ends_the_next_do_loop_as_in_linuxcnc():
+    # LinuxCNC 2.9 (measured) sets a flag for every break it reads and clears it only at a do
+    # loop's test: after a break out of a while loop, or one it runs while skipping to the end
+    # of a while loop (its condition false, or after a continue), the next do loop ends after
+    # one pass. A continue in a do loop followed by that loop's break ends the loop. woodcam
+    # ran the do loops to their conditions
+    do = "#<c> = 0\no7 do\n#<c> = [#<c> + 1]\nG1 X#<c> Y2\no7 while [#<c> LT 3]\nM2\n"
+    start = "G0 X0 Y0 Z1 F100\n#<a> = 0\n"
+    cases = {  # loop before the do loop -> X of its moves (LinuxCNC's)
+        "o1 while [1]\no1 break\no1 endwhile\n": [1],
+        "o2 while [#<a> LT 1]\n#<a> = [#<a> + 1]\no4 if [#<a> EQ 9]\no2 break\no4 endif\n"
+        "o2 endwhile\n": [1],  # the break inside an if not taken, read on the way out
+        "o2 while [0]\no2 break\no2 endwhile\n": [1],
+        "o2 while [#<a> LT 2]\n#<a> = [#<a> + 1]\no3 if [#<a> EQ 1]\no2 continue\no3 endif\n"
+        "o4 if [#<a> EQ 9]\no2 break\no4 endif\no2 endwhile\n": [1],
+        "o2 while [#<a> LT 2]\n#<a> = [#<a> + 1]\no2 endwhile\n": [1, 2, 3],
+        "o2 do\no2 break\no2 while [1]\n": [1, 2, 3],  # a do loop's test clears it
+        "o1 sub\no2 while [1]\no2 break\no2 endwhile\no1 endsub\n": [1, 2, 3],  # not called
+    }
+    for loop, xs in cases.items():
+        moves, warnings = Interpreter(start + loop + do, start_mm=(0, 0, 0)).run()
+        assert [m[2][0] for m in moves if m[2][1] == 2] == xs, loop
+        assert any("LinuxCNC 2.9 still carries the break" in w for _, w in warnings) == (
+            len(xs) == 1), loop
+    # a continue, then the do loop's own break: the loop ends there (LinuxCNC: X1, then Y1)
+    ends = _ends("G0 X0 Y0 Z1 F100\n#<a> = 0\no2 do\n#<a> = [#<a> + 1]\no3 if [#<a> EQ 2]\n"
+                 "o2 continue\no3 endif\nG1 X#<a>\no4 if [#<a> EQ 9]\no2 break\no4 endif\n"
+                 "o2 while [#<a> LT 4]\nG1 Y1\nM2\n")
+    assert ends[1:] == [(1, 0, 1), (1, 1, 1)]
+
+
 def test_canned_cycles_retract_planes():
     # G99 returns to R, G98 to the initial level of the cycle series (LinuxCNC)
     ends = _ends("G0 X0 Y0 Z10\nG99 G81 X1 Y1 Z-2 R2 F100\nX2\nG98 G81 X3\nG80\nM2\n")

@@ -970,6 +970,7 @@ class Interpreter:
         self.branches: dict[int, list[int]] = {}  # if index -> [elseif/else..., endif]
         self.owner: dict[int, int] = {}  # break/continue/elseif/else/return index -> opener
         self.subs: dict[str, int] = {}
+        self._breaks: dict[int, list[int]] = {}  # loop opener index -> its break lines' indices
         stack: list[tuple[str, str, int]] = []
         self.olabels: dict[str, list[int]] = {}  # bare O label -> its line indices
         for idx, ln in enumerate(lines):
@@ -1028,6 +1029,8 @@ class Interpreter:
                     raise GcodeError(ln.no, f"o{ln.olabel} {k}", f"{k} outside an o{ln.olabel} "
                                    "loop", "match the O-word labels")
                 self.owner[idx] = loop[2]
+                if k == "break":
+                    self._breaks.setdefault(loop[2], []).append(idx)
             elif k == "return":
                 sub = next((s for s in reversed(stack) if s[0] == "sub"), None)
                 if sub is None:
@@ -1049,6 +1052,7 @@ class Interpreter:
         self._m98_left: dict[int, int] = {}  # M98 L repeats left, by calling depth
         self._m98_target: dict[str, int] = {}  # O label -> line index, once an M98 found it
         repeat_left: dict[int, int] = {}
+        stale_break: int | None = None  # line of a break out of a while loop, still "set"
         pc = 0
         blocks = 0
         n = len(lines)
@@ -1136,6 +1140,10 @@ class Interpreter:
                 pc += 1
             elif k == "while":
                 v, _ = self._cond(ln)
+                if v == 0 and self._breaks.get(pc):
+                    # LinuxCNC skips to the loop's end by its label and so runs the loop's own
+                    # break on the way (a break it reads sets the flag a do loop reads below)
+                    stale_break = lines[self._breaks[pc][0]].no
                 pc = pc + 1 if v != 0 else self.match[pc] + 1
             elif k == "endwhile":
                 pc = self.match[pc]
@@ -1143,6 +1151,16 @@ class Interpreter:
                 pc += 1
             elif k == "dowhile":
                 v, _ = self._cond(ln)
+                if v != 0 and stale_break is not None:
+                    # LinuxCNC 2.9 leaves the flag of a break out of a while loop set, and the
+                    # next do loop's test reads it (and clears it): that loop ends here
+                    self.warn(f"the o{ln.olabel} do loop ends after this pass though its "
+                              f"condition holds: LinuxCNC 2.9 still carries the break of line "
+                              f"{stale_break} (out of a while loop) and reads it here, and "
+                              "woodcam does as LinuxCNC; write the do loop as a while loop, or "
+                              "end the while loop by its condition instead of a break")
+                    v = 0.0
+                stale_break = None
                 pc = self.match[pc] + 1 if v != 0 else pc + 1
             elif k == "repeat":
                 if pc not in repeat_left:
@@ -1162,10 +1180,24 @@ class Interpreter:
                                f"matching while/do label')", f"write the loop as o{ln.olabel} "
                                f"while, or guard the rest of the body with an o-if")
             elif k == "break":  # (of a while or do loop: a repeat's is refused above)
+                if lines[self.owner[pc]].okey == "while":
+                    stale_break = ln.no
                 pc = self.match[self.owner[pc]] + 1
             elif k == "continue":
                 op = self.owner[pc]
-                pc = op if lines[op].okey == "while" else self.match[op]
+                later = [i for i in self._breaks.get(op, []) if i > pc]
+                if lines[op].okey == "while":
+                    if later:  # LinuxCNC skips to the loop's end by its label and runs the
+                        # loop's own break on the way: the loop goes on, the flag stays set
+                        stale_break = lines[later[0]].no
+                    pc = op
+                elif later:  # a do loop: the break's flag ends it at its while line
+                    self.warn(f"o{ln.olabel} continue on line {ln.no} ends the do loop: "
+                              f"LinuxCNC skips to the next o{ln.olabel} line, the break on line "
+                              f"{lines[later[0]].no}, and runs it; woodcam does as LinuxCNC")
+                    pc = self.match[op] + 1
+                else:
+                    pc = self.match[op]
             else:  # pragma: no cover - _prepare only lets the keys above through
                 raise self.err(k, "unknown O-word", "fix it")
         if not self.ended and frames and frames[-1][1] is None:
