@@ -131,3 +131,106 @@ def program(seed: int, n_lines: int = 30, *, valid_share: float = 0.9) -> str:
                                    "G83 X1 Y1 Z-3 R1 Q0", "G1 X[SQRT[-1]]", "M123"]))
     out.append("M2")
     return "\n".join(out) + "\n"
+
+
+def oword_program(seed: int, n_blocks: int = 8) -> str:
+    """One random program of O-word control flow (LinuxCNC dialect): subroutines with
+    arguments and return values, nested while/do/repeat loops with break and continue (in
+    while/do only, as LinuxCNC), if/elseif/else, numbered, local and global named parameters,
+    and moves (G0/G1/G2/G3, a canned cycle) whose words read them. Labels are unique and every
+    loop is bounded, so LinuxCNC and woodcam both run it to the end unless a move is invalid."""
+    rng = np.random.default_rng(seed)
+    labels = iter(range(100, 10_000))
+    subs: list[tuple[int, int]] = []  # (label, number of arguments)
+    head = ["G21 G90 G17 F500", "G0 X0 Y0 Z10", "#1 = 2", "#<_g> = 1.5"]
+
+    def val() -> str:
+        """A value: a number or an expression over #1, #2, #<_g>, #<k> (always defined)."""
+        r = rng.random()
+        a = f"{rng.uniform(-5, 20):.3f}"
+        if r < 0.4:
+            return a
+        if r < 0.6:
+            return f"[#1 * {rng.uniform(0.5, 3):.2f} + {a}]"
+        if r < 0.75:
+            return f"[#<_g> + {a}]"
+        if r < 0.88:
+            return f"[[#2 MOD 4] + {a}]"
+        return f"[ABS[{a}] - #<_x> * 0]"
+
+    def cond() -> str:
+        return rng.choice([f"[#1 LT {rng.integers(1, 6)}]", f"[#2 GT {rng.integers(0, 4)}]",
+                           "[#<_g> EQ 1.5]", f"[[#1 MOD 2] EQ {rng.integers(0, 2)}]",
+                           f"[#<_x> GE {rng.integers(0, 10)}]"])
+
+    def move() -> list[str]:
+        r = rng.random()
+        if r < 0.45:
+            return [f"G{rng.integers(0, 2)} X{val()} Y{val()}"]
+        if r < 0.6:
+            return [f"G1 Z{rng.uniform(-2, 5):.3f}"]
+        if r < 0.8:  # a full circle (I/J only) or a half circle, both always valid
+            rad = rng.uniform(1, 5)
+            code = rng.choice(["G2", "G3"])
+            if rng.random() < 0.5:
+                return [f"{code} I{rad:.3f} J0"]
+            return [f"{code} X[#<_x> + {2 * rad:.3f}] I{rad:.3f} J0"]
+        if r < 0.9:
+            return ["#2 = [#2 + 1]", f"#<k> = {val()}", "G0 X#<k> Y[#2 * 0.5]"]
+        return [f"G{rng.choice([98, 99])} G81 X{val()} Y{val()} Z-1 R2", "G80", "G0 Z5"]
+
+    def block(depth: int, loop: int | None) -> list[str]:
+        r = rng.random()
+        if depth >= 3 or r < 0.35:
+            return move()
+        lab = next(labels)
+        if r < 0.5:  # if / elseif / else
+            out = [f"o{lab} if {cond()}"] + block(depth + 1, loop)
+            if rng.random() < 0.5:
+                out += [f"o{lab} elseif {cond()}"] + block(depth + 1, loop)
+            if rng.random() < 0.5:
+                out += [f"o{lab} else"] + block(depth + 1, loop)
+            return out + [f"o{lab} endif"]
+        if r < 0.62:  # while with its own counter
+            c = f"#<c{lab}>"
+            body = [f"{c} = [{c} + 1]"] + block(depth + 1, lab)
+            if rng.random() < 0.5:  # break or continue inside an if inside the loop
+                k = next(labels)
+                body += [f"o{k} if [{c} EQ {rng.integers(1, 3)}]",
+                         f"o{lab} {rng.choice(['break', 'continue'])}", f"o{k} endif"]
+            body += block(depth + 1, lab)
+            return [f"{c} = 0", f"o{lab} while [{c} LT {rng.integers(1, 4)}]"] + body + [
+                f"o{lab} endwhile"]
+        if r < 0.72:  # do / while
+            c = f"#<c{lab}>"
+            return ([f"{c} = 0", f"o{lab} do", f"{c} = [{c} + 1]"] + block(depth + 1, lab)
+                    + [f"o{lab} while [{c} LT {rng.integers(1, 3)}]"])
+        if r < 0.82:
+            return [f"o{lab} repeat [{rng.integers(0, 3)}]"] + block(depth + 1, None) + [
+                f"o{lab} endrepeat"]
+        if subs:
+            s, n = subs[int(rng.integers(len(subs)))]
+            args = " ".join(f"[{val()}]" for _ in range(n))
+            out = [f"o{s} call {args}".rstrip()]
+            if rng.random() < 0.5:
+                out.append("G0 X[#<_value> + 1] Y#<_value_returned>")
+            return out
+        return move()
+
+    defs: list[str] = []
+    for _ in range(int(rng.integers(0, 3))):  # subroutines, defined before the main program
+        lab, n = next(labels), int(rng.integers(0, 3))
+        body = [f"#<a> = [#1 + {rng.uniform(0, 3):.2f}]"] if n else []
+        for _ in range(int(rng.integers(1, 3))):
+            body += block(1, None)
+        if rng.random() < 0.3:
+            k = next(labels)
+            body += [f"o{k} if [#<a> GT 10]" if n else f"o{k} if [#1 GT 1]",
+                     f"o{lab} return [{rng.integers(1, 9)}]", f"o{k} endif"]
+        end = f"o{lab} endsub [{val()}]" if rng.random() < 0.5 else f"o{lab} endsub"
+        defs += [f"o{lab} sub"] + ["  " + b for b in body] + [end]
+        subs.append((lab, n))
+    main: list[str] = []
+    for _ in range(n_blocks):
+        main += block(0, None)
+    return "\n".join(defs + head + main + ["M2"]) + "\n"

@@ -15,7 +15,7 @@ from woodcam.toolpath.interpreter import GcodeError, Interpreter
 from woodcam.toolpath.linuxcnc import (NO_END, canonical, compare_canonical, linuxcnc_missing,
                                        run_batch)
 
-from .gcode_fuzz import program
+from .gcode_fuzz import oword_program, program
 
 REPO = Path(__file__).resolve().parents[2]
 CORPUS = sorted((REPO / "toolpaths" / "corpus").glob("*.*[!y]")) + sorted(
@@ -117,6 +117,28 @@ def test_fuzzed_campaign_agrees_with_linuxcnc(tmp_path):
     agree, bad = _differences(paths, texts, same_line=True)
     print(f"fuzz campaign: {agree} of {len(paths)} agree with LinuxCNC")
     assert not bad, bad[:3]
+
+
+def test_random_o_word_programs_agree_with_linuxcnc(tmp_path):
+    """Seeded random programs of subroutines (arguments, return values), nested while/do/repeat
+    loops with break and continue inside ifs, if/elseif/else, numbered and named parameters and
+    moves that read them (gcode_fuzz.oword_program): LinuxCNC and woodcam run each to the end
+    with the same moves. They found LinuxCNC's break flag that ends the next do loop
+    (test_a_break_read_in_a_while_loop_ends_the_next_do_loop_as_in_linuxcnc)."""
+    texts = [oword_program(seed) for seed in range(200)]  # ~5 s
+    counts = {}
+    agree, bad = _differences(_written(tmp_path, texts), texts, counts)
+    assert not bad, bad[:2]
+    assert counts["ran"] == 200 and counts["moves"] >= 3800, counts  # measured: 200, 3919
+
+
+@pytest.mark.slow
+def test_random_o_word_campaign_agrees_with_linuxcnc(tmp_path):
+    texts = [oword_program(seed, n_blocks=12) for seed in range(1000, 3000)]
+    counts = {}
+    agree, bad = _differences(_written(tmp_path, texts), texts, counts)
+    print(f"o-word campaign: {agree} of {len(texts)} agree with LinuxCNC, {counts}")
+    assert not bad, bad[:2]
 
 
 # LinuxCNC's own examples that use what woodcam refuses on purpose: cutter compensation
