@@ -156,6 +156,36 @@ def test_o_word_structure_errors():
         _ends("o<elsewhere> call\nM2\n")
 
 
+_SUB = "o100 sub\nG0 X{}\no100 endsub\n"
+
+
+def test_a_subroutine_is_defined_where_linuxcnc_passes_it_and_never_twice():
+    # LinuxCNC 2.9 (measured; tests/toolpath/test_linuxcnc_oracle.py runs the same programs):
+    # a second definition of a label is refused when reached ('redefining sub'), where woodcam
+    # ran the calls with the second one
+    with pytest.raises(GcodeError, match=r"line 4: 'o100 sub': subroutine o100 is defined a "
+                                         r"second time \(first on line 1\)"):
+        _ends(_SUB.format(1) + _SUB.format(2) + "o100 call\nM2\n")
+    # a call before any definition searches forward and runs the first one after it (X1, not X2)
+    assert _ends("o100 call\nM2\n" + _SUB.format(1) + _SUB.format(2)) == [(1, 0, 0)]
+    # the definition a call found that way, passed over afterwards, is refused ('found in
+    # illegal location'), as is one a loop passes over twice: after the moves before
+    for text, line, before in (
+            ("o100 call\nG0 X5\n" + _SUB.format(1) + "M2\n", 3, [(1, 0, 0), (5, 0, 0)]),
+            ("o1 while [#1 lt 2]\n#1=[#1+1]\n" + _SUB.format(1) + "o100 call\no1 endwhile\nM2\n",
+             3, [(1, 0, 0)])):
+        interp = Interpreter(text, start_mm=(0, 0, 0))
+        with pytest.raises(GcodeError, match=rf"line {line}: 'o100 sub': the o100 sub "
+                                             "definition is reached a second time"):
+            interp.run()
+        assert [m[2] for m in interp.moves] == before
+    # a definition in a branch not taken is never defined: the call finds none after it
+    with pytest.raises(GcodeError, match=r"line 6: 'o100 call': the o100 sub definition "
+                                         r"\(line\(s\) 2\) was never passed over"):
+        _ends("o1 if [0]\n" + _SUB.format(1) + "o1 endif\no100 call\nM2\n")
+    assert _ends("o1 if [1]\n" + _SUB.format(1) + "o1 endif\no100 call\nM2\n") == [(1, 0, 0)]
+
+
 def test_work_offsets_g10_g5x_g92():
     # (expected values checked against LinuxCNC 2.9's own interpreter)
     ends = _ends("G0 X1 Y1 Z1\nG10 L20 P1 X0\nG0 X2\nG10 L2 P2 X10 Y10\nG55 G0 X1 Y1\n"

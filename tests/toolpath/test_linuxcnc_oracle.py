@@ -141,6 +141,35 @@ def test_random_o_word_campaign_agrees_with_linuxcnc(tmp_path):
     assert not bad, bad[:2]
 
 
+_SUB = "o100 sub\nG0 X{}\no100 endsub\n"
+#: Hand programs whose o-word labels repeat: (program, refused by LinuxCNC 2.9).
+_REPEATED_LABELS = [
+    # a sub defined twice: refused when the second definition is reached ('redefining sub'),
+    # never when it lies after M2 (calls run the first)
+    (_SUB.format(1) + _SUB.format(2) + "o100 call\nM2\n", True),
+    (_SUB.format(1) + "o100 call\nM2\n" + _SUB.format(2), False),
+    ("o100 call\nM2\n" + _SUB.format(1) + _SUB.format(2), False),
+    # a definition found by a forward call, or passed twice in a loop, is reached again
+    ("o100 call\nG0 X5\n" + _SUB.format(1) + "G0 X6\nM2\n", True),
+    ("o1 while [#1 lt 2]\n#1=[#1+1]\n" + _SUB.format(1) + "o100 call\no1 endwhile\nM2\n", True),
+    ("o1 repeat [2]\no100 call\no1 endrepeat\nM2\n" + _SUB.format(1), False),
+    # in a branch not taken: never defined, the call searches forward in vain
+    ("o1 if [0]\n" + _SUB.format(1) + "o1 endif\no100 call\nM2\n", True),
+    ("o1 if [1]\n" + _SUB.format(1) + "o1 endif\no100 call\nM2\n", False),
+]
+
+
+def test_repeated_o_word_labels_agree_with_linuxcnc(tmp_path):
+    """Programs reusing an o-word label (_REPEATED_LABELS): LinuxCNC and woodcam refuse the
+    same ones, after the same moves, and run the others alike. Woodcam ran a sub defined twice
+    with its second definition and ran every repeated label."""
+    texts = [t for t, _ in _REPEATED_LABELS]
+    counts = {}
+    agree, bad = _differences(_written(tmp_path, texts), texts, counts)
+    assert not bad, bad[:2]
+    assert counts["refused"] == sum(r for _, r in _REPEATED_LABELS), counts
+
+
 # LinuxCNC's own examples that use what woodcam refuses on purpose: cutter compensation
 # (changes the path), probing, lathe modes, threading, splines, polar words, state save (M70),
 # rotary axes, subroutines in other files.

@@ -31,7 +31,10 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   after any N word: after a comment LinuxCNC reads none, so such a line opens or closes
   nothing, is refused when reached and warned about when skipped); at most
   :data:`MAX_CALL_DEPTH` nested calls (LinuxCNC's limit) and :data:`MAX_BLOCKS` executed lines
-  (woodcam's guard against endless loops);
+  (woodcam's guard against endless loops); a subroutine is defined where the program passes
+  over its definition, a call before that runs the first definition after the call (LinuxCNC
+  searches the file forward), and a definition reached for a label already defined (a second
+  definition, or the one a call found or a loop passed) is refused, as LinuxCNC 2.9 does;
 - Fanuc-style subprograms (LinuxCNC 2.9's "Fanuc-Style Numbered Programs", measured against
   its interpreter): ``M98 P1000 L2`` (the first word of its line, before any comment, as
   ``O`` words and the returning ``M99``; only P and L on it) calls
@@ -969,7 +972,8 @@ class Interpreter:
         self.match: dict[int, int] = {}   # opener index -> closer index (and back)
         self.branches: dict[int, list[int]] = {}  # if index -> [elseif/else..., endif]
         self.owner: dict[int, int] = {}  # break/continue/elseif/else/return index -> opener
-        self.subs: dict[str, int] = {}
+        self.subs: dict[str, int] = {}  # sub label -> its first definition's index
+        self.sub_defs: dict[str, list[int]] = {}  # sub label -> every definition's index
         self._breaks: dict[int, list[int]] = {}  # loop opener index -> its break lines' indices
         stack: list[tuple[str, str, int]] = []
         self.olabels: dict[str, list[int]] = {}  # bare O label -> its line indices
@@ -1002,7 +1006,8 @@ class Interpreter:
                     if any(s[0] == "sub" for s in stack):
                         raise GcodeError(ln.no, f"o{ln.olabel} sub", "subroutine defined inside "
                                        "another", "move it out")
-                    self.subs[ln.olabel] = idx
+                    self.subs.setdefault(ln.olabel, idx)
+                    self.sub_defs.setdefault(ln.olabel, []).append(idx)
                 stack.append((k, ln.olabel, idx))
                 if k == "if":
                     self.branches[idx] = []
@@ -1051,6 +1056,9 @@ class Interpreter:
         self._frames = frames
         self._m98_left: dict[int, int] = {}  # M98 L repeats left, by calling depth
         self._m98_target: dict[str, int] = {}  # O label -> line index, once an M98 found it
+        # sub label -> the index of the definition LinuxCNC has for it: the first one passed
+        # over, or the one a call found searching forward (_sub_target)
+        self._defined: dict[str, int] = {}
         repeat_left: dict[int, int] = {}
         stale_break: int | None = None  # line of a break out of a while loop, still "set"
         pc = 0
@@ -1081,6 +1089,7 @@ class Interpreter:
                 pc += 1
                 continue
             if k == "sub":
+                self._define_sub(pc, ln)
                 # LinuxCNC reads the definition's endsub as it passes over the body (not a
                 # return in it): #<_value> becomes its value, 0 without one, though no call ran
                 self._returned(lines[self.match[pc]], definition=True)
@@ -1113,14 +1122,14 @@ class Interpreter:
                                    "defined in this file (woodcam reads one file; LinuxCNC "
                                    "would search its SUBROUTINE_PATH)",
                                    "define it in the program")
+                target = self._sub_target(pc, ln)
                 args = self._call_args(ln.oexpr)
                 saved = {i: self.p.get(i, 0.0) for i in range(1, 31)}
-                frames.append((pc + 1, saved, self.locals, self.subs[ln.olabel], ln.olabel,
-                               ln.no))
+                frames.append((pc + 1, saved, self.locals, target, ln.olabel, ln.no))
                 self.locals = {}
                 for i in range(1, 31):
                     self.p[i] = args[i - 1] if i <= len(args) else 0.0
-                pc = self.subs[ln.olabel] + 1
+                pc = target + 1
             elif k in ("endsub", "return"):
                 self._returned(ln)
                 if not frames:  # a sub body reached without a call: LinuxCNC skips it
@@ -1212,6 +1221,46 @@ class Interpreter:
         if self.mzero and any(self.mzero):
             self.moves = [_shifted(m, self.mzero) for m in self.moves]
         return self.moves, self.warnings
+
+    def _define_sub(self, pc: int, ln: _Line) -> None:
+        """The sub definition on line index ``pc`` is passed over: LinuxCNC 2.9 defines the
+        subroutine there, and refuses a label it has defined before: by another definition
+        ('redefining sub'), or by this one, found by an earlier call that searched forward to
+        it or passed over before by a loop ('found in illegal location')."""
+        label = ln.olabel
+        first = self._defined.get(label)
+        if first is None:
+            self._defined[label] = pc
+            return
+        if first == pc:
+            raise self.err(f"o{label} sub", f"the o{label} sub definition is reached a second "
+                           "time (a call before it found it by searching the file forward, or a "
+                           "loop passes over it again): LinuxCNC 2.9 refuses it here ('sub: "
+                           f"o|{label}| found in illegal location')", f"define o{label} before "
+                           "its first call and outside every loop, or after the program's M2")
+        raise self.err(f"o{label} sub", f"subroutine o{label} is defined a second time (first "
+                       f"on line {self.lines[first].no}): LinuxCNC 2.9 refuses the second "
+                       "definition when it reaches it ('redefining sub'), and calls before it "
+                       "run the first", "give one of the two subroutines another label")
+
+    def _sub_target(self, pc: int, ln: _Line) -> int:
+        """The index of the definition the ``oN call`` on line index ``pc`` runs, as LinuxCNC
+        2.9 finds it: the one it has defined (passed over, or found by an earlier call), else
+        the first definition after the call (it searches the file forward from there)."""
+        label = ln.olabel
+        target = self._defined.get(label)
+        if target is None:
+            target = next((i for i in self.sub_defs.get(label, ()) if i > pc), None)
+            if target is None:
+                where = line_list([self.lines[i].no for i in self.sub_defs[label]])
+                raise self.err(f"o{label} call", f"the o{label} sub definition (line(s) {where}) "
+                               "was never passed over before this call (it lies in a branch or "
+                               "loop not run) and none follows the call: LinuxCNC searches the "
+                               f"file forward for it ('EOF ... seeking o-word: o<{label}>')",
+                               f"define o{label} before the main program, outside every if and "
+                               "loop")
+            self._defined[label] = target
+        return target
 
     def _warn_g53_unplaced(self):
         """One warning per kind of G53 move placed without the machine zero, naming its lines."""
