@@ -133,14 +133,26 @@ def program(seed: int, n_lines: int = 30, *, valid_share: float = 0.9) -> str:
     return "\n".join(out) + "\n"
 
 
-def oword_program(seed: int, n_blocks: int = 8) -> str:
+def oword_program(seed: int, n_blocks: int = 8, *, reuse: float = 0.0) -> str:
     """One random program of O-word control flow (LinuxCNC dialect): subroutines with
     arguments and return values, nested while/do/repeat loops with break and continue (in
     while/do only, as LinuxCNC), if/elseif/else, numbered, local and global named parameters,
     and moves (G0/G1/G2/G3, a canned cycle) whose words read them. Labels are unique and every
-    loop is bounded, so LinuxCNC and woodcam both run it to the end unless a move is invalid."""
+    loop is bounded, so LinuxCNC and woodcam both run it to the end unless a move is invalid.
+
+    ``reuse`` > 0: each if, while and repeat takes one of the labels o10-o13 with that
+    probability (do loops keep their own: a second do's test would jump back to the first),
+    a subroutine repeats an earlier one's label with a quarter of it, and with 0.3 the
+    subroutines follow the M2 (found by the calls searching forward); LinuxCNC refuses a label
+    reused within one subroutine or the main program when it is reached."""
     rng = np.random.default_rng(seed)
     labels = iter(range(100, 10_000))
+
+    def label() -> int:
+        """An if/while/repeat label: new, or with ``reuse`` one of o10-o13."""
+        if reuse and rng.random() < reuse:
+            return int(rng.integers(10, 14))
+        return next(labels)
     subs: list[tuple[int, int]] = []  # (label, number of arguments)
     head = ["G21 G90 G17 F500", "G0 X0 Y0 Z10", "#1 = 2", "#<_g> = 1.5"]
 
@@ -183,7 +195,7 @@ def oword_program(seed: int, n_blocks: int = 8) -> str:
         r = rng.random()
         if depth >= 3 or r < 0.35:
             return move()
-        lab = next(labels)
+        lab = label() if r < 0.62 or 0.72 <= r < 0.82 else next(labels)  # (a do: its own)
         if r < 0.5:  # if / elseif / else
             out = [f"o{lab} if {cond()}"] + block(depth + 1, loop)
             if rng.random() < 0.5:
@@ -195,7 +207,7 @@ def oword_program(seed: int, n_blocks: int = 8) -> str:
             c = f"#<c{lab}>"
             body = [f"{c} = [{c} + 1]"] + block(depth + 1, lab)
             if rng.random() < 0.5:  # break or continue inside an if inside the loop
-                k = next(labels)
+                k = label()
                 body += [f"o{k} if [{c} EQ {rng.integers(1, 3)}]",
                          f"o{lab} {rng.choice(['break', 'continue'])}", f"o{k} endif"]
             body += block(depth + 1, lab)
@@ -220,11 +232,13 @@ def oword_program(seed: int, n_blocks: int = 8) -> str:
     defs: list[str] = []
     for _ in range(int(rng.integers(0, 3))):  # subroutines, defined before the main program
         lab, n = next(labels), int(rng.integers(0, 3))
+        if subs and reuse and rng.random() < reuse / 4:  # a second definition of a label
+            lab = subs[int(rng.integers(len(subs)))][0]
         body = [f"#<a> = [#1 + {rng.uniform(0, 3):.2f}]"] if n else []
         for _ in range(int(rng.integers(1, 3))):
             body += block(1, None)
         if rng.random() < 0.3:
-            k = next(labels)
+            k = label()
             body += [f"o{k} if [#<a> GT 10]" if n else f"o{k} if [#1 GT 1]",
                      f"o{lab} return [{rng.integers(1, 9)}]", f"o{k} endif"]
         end = f"o{lab} endsub [{val()}]" if rng.random() < 0.5 else f"o{lab} endsub"
@@ -233,4 +247,6 @@ def oword_program(seed: int, n_blocks: int = 8) -> str:
     main: list[str] = []
     for _ in range(n_blocks):
         main += block(0, None)
+    if reuse and rng.random() < 0.3:
+        return "\n".join(head + main + ["M2"] + defs) + "\n"
     return "\n".join(defs + head + main + ["M2"]) + "\n"

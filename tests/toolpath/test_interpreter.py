@@ -186,6 +186,65 @@ def test_a_subroutine_is_defined_where_linuxcnc_passes_it_and_never_twice():
     assert _ends("o1 if [1]\n" + _SUB.format(1) + "o1 endif\no100 call\nM2\n") == [(1, 0, 0)]
 
 
+def _x_before(text, line, rule):
+    """The moves ``text`` made before it was refused on ``line`` with ``rule`` (a regex)."""
+    interp = Interpreter(text, start_mm=(0, 0, 0))
+    with pytest.raises(GcodeError, match=rf"line {line}: .*{rule}"):
+        interp.run()
+    return [m[2][0] for m in interp.moves]
+
+
+_IF = "o{} if [1]\nG0 X{}\no{} endif\n"
+_SUB2 = "o2 sub\n" + _IF.format(1, 1, 1) + "o2 endsub\n"
+
+
+def test_a_label_reused_in_one_scope_is_refused_when_reached_as_linuxcnc_does():
+    # LinuxCNC 2.9 (measured; the same programs in test_linuxcnc_oracle.py): the first
+    # if/while/do/repeat line reached with a label keeps it, per subroutine or main program and
+    # across calls; another line with it is refused when reached ('duplicate O-word label').
+    # woodcam ran them all
+    dup = "labels the o1 {} on line {} already, in {}"
+    assert _x_before(_IF.format(1, 1, 1) + _IF.format(1, 2, 1) + "M2\n", 4,
+                    dup.format("if", 1, "the main program")) == [1]
+    assert _x_before("o1 while [#1 lt 2]\n#1=[#1+1]\nG0 X#1\no1 endwhile\n"
+                    "o1 repeat [2]\nG0 X5\no1 endrepeat\nM2\n", 5,
+                    dup.format("while", 1, "the main program")) == [1, 2]
+    # in a subroutine: across its calls (a branch of the second call), not across subroutines
+    sub = ("o2 sub\no3 if [#1 eq 1]\n" + _IF.format(1, 1, 1) + "o3 else\n" + _IF.format(1, 2, 1)
+           + "o3 endif\no2 endsub\n")
+    assert _x_before(sub + "o2 call [1]\no2 call [2]\nM2\n", 7,
+                    dup.format("if", 3, "subroutine o2")) == [1]
+    assert _ends(_SUB2 + "o3 sub\n" + _IF.format(1, 2, 1) + "o3 endsub\n" + _IF.format(1, 3, 1)
+                 + "o2 call\no3 call\no2 call\nM2\n") == [(3, 0, 0), (1, 0, 0), (2, 0, 0),
+                                                          (1, 0, 0)]
+    # a do keeps the first: a second do loop with the label runs while its test is false ...
+    assert _ends("o1 do\nG0 X1\no1 while [0]\no1 do\nG0 X2\no1 while [0]\nM2\n") == [
+        (1, 0, 0), (2, 0, 0)]
+    # ... and is refused where LinuxCNC loops back to the first do (it hangs here), as is a
+    # while loop reusing a do's label (LinuxCNC reads its while as the do's end)
+    assert _x_before("o1 do\nG0 X1\no1 while [0]\n#2=0\no1 do\n#2=[#2+1]\nG0 X[#2+10]\n"
+                    "o1 while [#2 lt 2]\nM2\n", 8, "goes back to the o1 do it reached first, "
+                    "on line 1") == [1, 11]
+    assert _x_before("o1 do\nG0 X1\no1 while [0]\no1 while [1]\no1 endwhile\nM2\n", 4,
+                    "reads this o1 while as the end of that do loop") == [1]
+    # a do loop's while after an if with its label is refused after the loop's first pass
+    assert _x_before(_IF.format(1, 1, 1) + "o1 do\nG0 X2\no1 while [0]\nM2\n", 6,
+                    dup.format("if", 1, "the main program")) == [1, 2]
+    # skipping to the end of an if or loop by its label, LinuxCNC reads the lines with that
+    # label on the way: a nested if/while/repeat with it is refused there though not run
+    assert _x_before("o10 if [0]\no10 if [1]\nG0 X1\no10 endif\nG0 X2\no10 endif\nM2\n", 2,
+                    "lies inside the o10 if of line 1") == []
+    assert _x_before("o10 while [1]\nG0 X3\no10 break\no10 if [1]\no10 endif\no10 endwhile\n"
+                    "M2\n", 4, "lies inside the o10 while of line 1") == [3]
+    assert _x_before(_IF.format(10, 1, 10).replace("endif", "else") + _IF.format(10, 5, 10)
+                    + "o10 endif\nM2\n", 4, "lies inside the o10 if of line 1") == [1]
+    # a label in a branch not taken, or skipped for another label, was never reached
+    assert _ends("o1 if [0]\n" + _IF.format(2, 1, 2) + "o1 endif\n" + _IF.format(2, 2, 2)
+                 + "M2\n") == [(2, 0, 0)]
+    assert _ends("o20 while [1]\no10 if [1]\no20 break\n" + _IF.format(10, 1, 10)
+                 + "o10 endif\no20 endwhile\nG0 X4\nM2\n") == [(4, 0, 0)]
+
+
 def test_work_offsets_g10_g5x_g92():
     # (expected values checked against LinuxCNC 2.9's own interpreter)
     ends = _ends("G0 X1 Y1 Z1\nG10 L20 P1 X0\nG0 X2\nG10 L2 P2 X10 Y10\nG55 G0 X1 Y1\n"

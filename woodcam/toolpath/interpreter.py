@@ -35,6 +35,9 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   over its definition, a call before that runs the first definition after the call (LinuxCNC
   searches the file forward), and a definition reached for a label already defined (a second
   definition, or the one a call found or a loop passed) is refused, as LinuxCNC 2.9 does;
+  so is an if/while/do/repeat line reached with a label another such line reached before holds
+  (labels are kept per subroutine, subprogram or main program, across calls: 'duplicate O-word
+  label'; a second do loop's test would go back to the first do);
 - Fanuc-style subprograms (LinuxCNC 2.9's "Fanuc-Style Numbered Programs", measured against
   its interpreter): ``M98 P1000 L2`` (the first word of its line, before any comment, as
   ``O`` words and the returning ``M99``; only P and L on it) calls
@@ -975,6 +978,8 @@ class Interpreter:
         self.subs: dict[str, int] = {}  # sub label -> its first definition's index
         self.sub_defs: dict[str, list[int]] = {}  # sub label -> every definition's index
         self._breaks: dict[int, list[int]] = {}  # loop opener index -> its break lines' indices
+        # if/while/do/repeat index -> the indices of those nested in it with its label
+        self._inner_same: dict[int, list[int]] = {}
         stack: list[tuple[str, str, int]] = []
         self.olabels: dict[str, list[int]] = {}  # bare O label -> its line indices
         for idx, ln in enumerate(lines):
@@ -1002,6 +1007,10 @@ class Interpreter:
                 self.match[op], self.match[idx] = idx, op
                 ln.okey = "dowhile"
             elif k in ("sub", "if", "while", "do", "repeat"):
+                if k != "sub":
+                    for s in stack:
+                        if s[1] == ln.olabel and s[0] != "sub":
+                            self._inner_same.setdefault(s[2], []).append(idx)
                 if k == "sub":
                     if any(s[0] == "sub" for s in stack):
                         raise GcodeError(ln.no, f"o{ln.olabel} sub", "subroutine defined inside "
@@ -1059,6 +1068,10 @@ class Interpreter:
         # sub label -> the index of the definition LinuxCNC has for it: the first one passed
         # over, or the one a call found searching forward (_sub_target)
         self._defined: dict[str, int] = {}
+        # (scope, label) -> the index of the first if/while/do/repeat line reached with that
+        # label; scope: the label of the subroutine or subprogram running it, None for the main
+        # program (LinuxCNC keeps them by subroutine name, across calls: _label_reached)
+        self._olabels_reached: dict[tuple[str | None, str], int] = {}
         repeat_left: dict[int, int] = {}
         stale_break: int | None = None  # line of a break out of a while loop, still "set"
         pc = 0
@@ -1142,24 +1155,40 @@ class Interpreter:
                 self.locals = loc
                 pc = ret
             elif k == "if":
-                pc = self._if(pc)
+                self._label_reached(pc, ln)
+                target = self._if(pc)
+                self._skipping(pc, pc, target)
+                pc = target
             elif k in ("elseif", "else"):  # reached the end of a taken branch
-                pc = self.branches[self.owner[pc]][-1] + 1
+                target = self.branches[self.owner[pc]][-1]
+                self._skipping(self.owner[pc], pc, target)
+                pc = target + 1
             elif k == "endif":
                 pc += 1
             elif k == "while":
+                self._label_reached(pc, ln)
                 v, _ = self._cond(ln)
                 if v == 0 and self._breaks.get(pc):
                     # LinuxCNC skips to the loop's end by its label and so runs the loop's own
                     # break on the way (a break it reads sets the flag a do loop reads below)
                     stale_break = lines[self._breaks[pc][0]].no
+                if v == 0:
+                    self._skipping(pc, pc, self.match[pc])
                 pc = pc + 1 if v != 0 else self.match[pc] + 1
             elif k == "endwhile":
                 pc = self.match[pc]
             elif k == "do":
+                self._label_reached(pc, ln)
                 pc += 1
             elif k == "dowhile":
+                other_do = self._label_reached(pc, ln)
                 v, _ = self._cond(ln)
+                if v != 0 and stale_break is None and other_do is not None:
+                    raise self.err(f"o{ln.olabel} while", f"the o{ln.olabel} do loop of "
+                                   f"line {lines[self.match[pc]].no} loops back here, and "
+                                   f"LinuxCNC 2.9 goes back to the o{ln.olabel} do it reached "
+                                   f"first, on line {lines[other_do].no}, and runs the lines "
+                                   "from there again", "give each do loop its own label")
                 if v != 0 and stale_break is not None:
                     # LinuxCNC 2.9 leaves the flag of a break out of a while loop set, and the
                     # next do loop's test reads it (and clears it): that loop ends here
@@ -1172,6 +1201,7 @@ class Interpreter:
                 stale_break = None
                 pc = self.match[pc] + 1 if v != 0 else pc + 1
             elif k == "repeat":
+                self._label_reached(pc, ln)
                 if pc not in repeat_left:
                     v, _ = self._cond(ln)
                     repeat_left[pc] = int(round(v))
@@ -1180,6 +1210,7 @@ class Interpreter:
                     pc += 1
                 else:
                     del repeat_left[pc]
+                    self._skipping(pc, pc, self.match[pc])
                     pc = self.match[pc] + 1
             elif k == "endrepeat":
                 pc = self.match[pc]
@@ -1191,9 +1222,11 @@ class Interpreter:
             elif k == "break":  # (of a while or do loop: a repeat's is refused above)
                 if lines[self.owner[pc]].okey == "while":
                     stale_break = ln.no
+                self._skipping(self.owner[pc], pc, self.match[self.owner[pc]])
                 pc = self.match[self.owner[pc]] + 1
             elif k == "continue":
                 op = self.owner[pc]
+                self._skipping(op, pc, self.match[op])
                 later = [i for i in self._breaks.get(op, []) if i > pc]
                 if lines[op].okey == "while":
                     if later:  # LinuxCNC skips to the loop's end by its label and runs the
@@ -1221,6 +1254,60 @@ class Interpreter:
         if self.mzero and any(self.mzero):
             self.moves = [_shifted(m, self.mzero) for m in self.moves]
         return self.moves, self.warnings
+
+    def _label_reached(self, pc: int, ln: _Line) -> int | None:
+        """LinuxCNC 2.9's check of an if, while, do or repeat line (index ``pc``) reached: it
+        keeps the first line reached with each label, per subroutine (or subprogram, or the
+        main program) and across its calls, and refuses another line with that label
+        ('duplicate O-word label'), except a do line (it keeps the first) and a do loop's own
+        while line. Returns, for a do loop's while line whose label an earlier, other do loop
+        holds, that do's index (LinuxCNC loops back there), else None."""
+        frames = self._frames
+        key = (frames[-1][4] if frames else None, ln.olabel)
+        first = self._olabels_reached.get(key)
+        if first is None or first == pc:
+            if first is None and ln.okey != "dowhile":
+                self._olabels_reached[key] = pc
+            return None
+        k, seen = ln.okey, self.lines[first]
+        if k == "do":
+            return None
+        if seen.okey == "do" and k == "dowhile":
+            return None if first == self.match[pc] else first
+        scope = ("the main program" if key[0] is None else f"subprogram O{key[0]}"
+                 if frames[-1][1] is None else f"subroutine o{key[0]}")
+        word = "while" if k == "dowhile" else k
+        if seen.okey == "do" and k == "while":
+            rule = (f"o{ln.olabel} labels the o{ln.olabel} do loop on line {seen.no} already: "
+                    f"LinuxCNC 2.9 reads this o{ln.olabel} while as the end of that do loop "
+                    "(it loops back there, or runs on into this loop's body)")
+        else:
+            rule = (f"o{ln.olabel} labels the o{ln.olabel} {seen.okey} on line {seen.no} "
+                    f"already, in {scope}: LinuxCNC 2.9 refuses a label used by a second "
+                    "if/while/do/repeat there when it is reached ('duplicate O-word label')")
+        raise self.err(f"o{ln.olabel} {word}", rule, "give each if, while, do and repeat its "
+                       "own label (a label may repeat only in different subroutines)")
+
+    def _skipping(self, owner: int, frm: int, to: int) -> None:
+        """The program skips from line index ``frm`` to ``to`` (exclusive) out of the if, loop
+        or branch opened at index ``owner``: LinuxCNC skips to the next line with its label and
+        reads every such line on the way, so an if/while/do/repeat nested in it with the same
+        label is refused there though it is not run ('duplicate O-word label'; at a do it stops
+        skipping and runs on into that loop, which woodcam refuses)."""
+        inner = self._inner_same.get(owner)
+        i = next((j for j in inner if frm < j < to), None) if inner else None
+        if i is None:
+            return
+        ln, outer = self.lines[i], self.lines[owner]
+        self.line_no = ln.no
+        label = ln.olabel
+        why = ("stops skipping here, running this do loop (woodcam refuses it instead)"
+               if ln.okey == "do" else "refuses it ('duplicate O-word label')")
+        raise self.err(f"o{label} {ln.okey}", f"this o{label} {ln.okey} lies inside the "
+                       f"o{label} {outer.okey} of line {outer.no}, under the same label: "
+                       f"LinuxCNC 2.9 skips to that {outer.okey}'s end by the label, reads this "
+                       f"line on the way and {why}", "give each if, while, do and repeat its "
+                       "own label")
 
     def _define_sub(self, pc: int, ln: _Line) -> None:
         """The sub definition on line index ``pc`` is passed over: LinuxCNC 2.9 defines the
