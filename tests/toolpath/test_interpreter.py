@@ -80,6 +80,51 @@ def test_named_parameter_errors():
     assert _ends("G0 X5\nG0 Y#<_x>\nM2\n")[1] == (5, 5, 0)  # system parameter: current X
 
 
+def _read(names, setup=""):
+    """The values of the predefined parameters ``names`` after the lines ``setup``."""
+    reads = "".join(f"#{100 + i} = #<{n}>\n" for i, n in enumerate(names))
+    moves = "".join(f"G0 X[1000 + #{100 + i}]\nG0 X0\n" for i in range(len(names)))
+    ends = _ends(setup + reads + "G21 G90 G80\n" + moves + "M2\n")
+    return [e[0] - 1000 for e in ends if e[0] > 500]
+
+
+def test_predefined_named_parameters_read_as_in_linuxcnc():
+    """LinuxCNC 2.9's predefined named parameters (its values, measured; all of them against
+    its interpreter in 52 states in test_linuxcnc_oracle.py): woodcam read only #<_x>,
+    #<_metric> ... and refused #<_call_level>, #<_motion_mode>, #<_vmajor> ... as 'not
+    defined; assign it' (a program cannot assign them); #<_coord_system> read 600-620 for
+    G59.1-G59.3 (591-593)."""
+    names = ["_task", "_call_level", "_remap_level", "_motion_mode", "_plane", "_ccomp",
+             "_units_per_minute", "_retract_r_plane", "_retract_old_z", "_spindle_on",
+             "_spindle_cw", "_mist", "_flood", "_feed_override", "_speed_override",
+             "_adaptive_feed", "_feed_hold", "_ijk_absolute_mode", "_tool_offset",
+             "_coord_system", "_vmajor"]
+    assert _read(names) == pytest.approx(
+        [1, 0, 0, 800, 170, 400, 1, 1, 0, 0, 0, 0, 0, 1, 1, 0, 1, 0, 0, 540, 2.9])
+    after = ("G98 G18 G90.1 G43.1 Z1 G59.1\nS100 M4\nM7\nM50 P0\nM52\nM53 P0\n"
+             "G1 X1 F100\n")
+    assert _read(names, after) == pytest.approx(
+        [1, 0, 0, 10, 180, 400, 1, 0, 1, 1, 0, 1, 0, 0, 1, 1, 0, 1, 1, 591, 2.9])
+    assert _read(["_spindle_cw", "_mist", "_flood", "_feed_override", "_speed_override"],
+                 "S1 M3\nM8\nM9\nM49\n") == [1, 0, 0, 0, 0]
+    assert _read(["_motion_mode"], "G81 X1 Y1 Z-1 R2 F9\n") == [810]
+    # the call level inside a subroutine, two deep, and in an M98 subprogram
+    assert _ends("o1 sub\nG0 X#<_call_level>\no2 call\no1 endsub\no2 sub\n"
+                 "G0 X#<_call_level>\no2 endsub\no1 call\nM98 P5\nM30\nO5\n"
+                 "G0 X[#<_call_level> + 4]\nM99\n") == [(1, 0, 0), (2, 0, 0), (5, 0, 0)]
+    # what the machine knows and woodcam does not is refused with the reason
+    for name, why in (("_current_pocket", "the tool changer pocket of the loaded tool"),
+                      ("_vminor", "the patch release"),
+                      ("_ini[traj]linear_units", "INI file value"),
+                      ("_hal[motion.spindle-speed-out]", "HAL pin")):
+        with pytest.raises(GcodeError, match=rf"#<{re.escape(name)}> .*{why}.*woodcam "
+                                             "cannot know"):
+            _ends(f"G0 X#<{name}>\nM2\n")
+    for name in ("_task", "_vmajor", "_motion_mode", "_current_pocket"):  # read-only, as LinuxCNC
+        with pytest.raises(GcodeError, match=rf"#<{name}> is a read-only predefined"):
+            _ends(f"#<{name}> = 3\nM2\n")
+
+
 def test_nested_calls_return_values_and_recursion_limit():
     text = ("o<sq> sub\no<sq> return [#1 * #1]\no<sq> endsub\n"
             "o<sum> sub\no<sq> call [#1]\n#<s> = #<_value>\no<sq> call [#2]\n"

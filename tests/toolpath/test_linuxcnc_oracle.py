@@ -205,6 +205,56 @@ def test_repeated_o_word_labels_agree_with_linuxcnc(tmp_path):
     assert counts["refused"] == sum(r for _, r in _REPEATED_LABELS), counts
 
 
+#: Machine states (the lines that set them) in which every predefined named parameter is read.
+_STATES = ["", "M7", "M8", "M8\nM9", "M7\nM8", "M49", "M48", "M50 P0", "M50", "M49\nM50",
+           "M51 P0", "M49\nM51 P1", "M49\nM51 P2", "M52 P1", "M52", "M52 P1\nM52 P0",
+           "M53 P0", "M53 P0\nM53", "M53 P0.5", "S1000 M3", "S1000 M4", "M4 S100\nM5",
+           "S1000 M3\nT3 M6", "S1000 M4\nM19", "T3", "G43.1 Z1", "G43.1 Z1\nG49", "G91.1",
+           "G90.1", "G98", "G98\nG99", "G20", "G18", "G19", "G1 X1 F10", "G2 X0 Y0 I1 J0 F10",
+           "G3 X0 Y0 I1 J0 F10", "G81 X1 Y1 Z-1 R2 F10\nG0 X0", "G73 X1 Y1 Z-1 R2 Q1 F10",
+           "G83 X1 Y1 Z-1 R2 Q1 F10", "G0 X1\nG80", "G55", "G59.1", "G59.3", "G91",
+           "o1 sub\no1 endsub [3]\no1 call", "G20 G1 X1 F10", "G20 G1 X1 F10\nG21",
+           "G21 G1 X1 F10\nG20", "G92 X5", "G20\nG0 X1 Y2 Z3", "G1 X3 F100\nG0 X1"]
+
+
+def test_predefined_named_parameters_agree_with_linuxcnc(tmp_path):
+    """Every predefined named parameter woodcam reads (interpreter._PREDEFINED, with
+    #<_value> and #<_value_returned>) in 52 machine states (_STATES), read by woodcam and by
+    LinuxCNC's interpreter: the same values but where woodcam is the machine and the oracle
+    its preview (the gcode module of AXIS): #<_task> (1 against 0), #<_feed> (the preview's
+    canon starts it at 1 and sets it to 1 again on G20/G21; woodcam 0 before any F, and the
+    feed in the new units) and #<_current_tool> after M6 (the preview never completes a tool
+    change). Woodcam refused all but 20 of them as 'not defined'."""
+    from woodcam.toolpath.interpreter import _PREDEFINED
+
+    names = [n for n, v in _PREDEFINED.items() if not isinstance(v, str)] + ["_value",
+                                                                             "_value_returned"]
+    reads = "".join(f"#{100 + i} = #<{n}>\n" for i, n in enumerate(names))
+    moves = "".join(f"G0 X[1000 + #{100 + i}] Y0\nG0 X0 Y7\n" for i in range(len(names)))
+    texts = [f"{state}\n{reads}G90 G21 G80 G92.1 G54\n{moves}M2\n" for state in _STATES]
+    compared = 0
+    for state, text, res in zip(_STATES, texts, run_batch(_written(tmp_path, texts),
+                                                          start_mm=START)):
+        assert res["error"] is None, (state, res["error"])
+        theirs = [m[2][0] - 1000 for m in res["moves"] if m[2][0] > 500]
+        mine = [m[2][0] - 1000 for m in Interpreter(text, start_mm=START).run()[0]
+                if m[2][0] > 500]
+        assert len(mine) == len(theirs) == len(names), state
+        for name, a, b in zip(names, mine, theirs):
+            if name == "_task":
+                assert (a, b) == (1, pytest.approx(0, abs=1e-6))
+            elif not (name == "_feed" and abs(b - 1) < 1e-6
+                      or name == "_current_tool" and "M6" in state):
+                assert a == pytest.approx(b, abs=1e-6), (state, name)
+                compared += 1
+    assert compared > 2300  # measured: 2,346 values
+    # the call level in subroutines and an M98 subprogram
+    text = ("o1 sub\nG0 X#<_call_level>\no2 call\no1 endsub\no2 sub\nG0 X#<_call_level>\n"
+            "o2 endsub\no1 call\nM98 P5\nM30\nO5\nG0 X[#<_call_level> + 4]\nM99\n")
+    agree, bad = _differences(_written(tmp_path, [text]), [text])
+    assert not bad, bad
+
+
 def test_random_programs_reusing_labels_agree_with_linuxcnc(tmp_path):
     """Seeded random o-word programs (gcode_fuzz.oword_program) whose ifs, whiles and repeats
     half the time take one of four labels, some subroutines defined twice or after the M2:

@@ -10,8 +10,11 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   as ``#<_x>``...; A-W read 0: woodcam has no such axes), ``#5599`` (1), ``#5600``/``#5601``
   (0: no tool-changer faults), ``#<_value>`` and ``#<_value_returned>`` (the value of the last
   ``return [v]`` or ``endsub [v]``, and 1 if it had one; LinuxCNC reads a definition's
-  ``endsub [v]`` as it passes over it, and so does woodcam); read-only ones (``#5400``-``#5413``,
-  ``#5420``-``#5428``, ``#<_value>``, ``#<_value_returned>``) cannot be assigned, as in
+  ``endsub [v]`` as it passes over it, and so does woodcam), LinuxCNC 2.9's other predefined
+  named parameters (:data:`_PREDEFINED`: modes, spindle, coolant, overrides, tools, call
+  level, version; ``#<_task>`` is 1, the machine's value; the tool changer's pockets and
+  ``#<_vminor>`` are refused: woodcam cannot know them); read-only ones (``#5400``-``#5413``,
+  ``#5420``-``#5428``, the predefined named ones) cannot be assigned, as in
   LinuxCNC, nor can ``#5600``/``#5601`` (LinuxCNC takes the assignment and reads the machine's
   value over it: the value would be dropped); reading what woodcam cannot know is refused: the tool table's offsets and diameter ``#5401``-``#5413``, and
   probe (``#5061``-``#5070``) or input (``#5399``) results the program did not assign (the
@@ -107,7 +110,7 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Literal
+from typing import Callable, Literal
 
 from ..errors import WoodcamError
 from ..units import say_length
@@ -311,12 +314,69 @@ _TOOLCHANGER_FAULT = {5600: "flag", 5601: "reason"}
 #: did not assign is refused (LinuxCNC would read the last probe's or input's value).
 _MEASURED = {**{k: "a G38 probe result" for k in range(5061, 5071)}, 5399: "an M66 input"}
 
-#: LinuxCNC 2.9's predefined read-only named parameters that woodcam knows.
-_READ_ONLY = {"_x", "_y", "_z", "_a", "_b", "_c", "_u", "_v", "_w", "_metric", "_imperial",
-              "_absolute", "_incremental", "_feed", "_rpm", "_current_tool", "_selected_tool",
-              "_line", "_coord_system"}
-#: What the last return or endsub left (LinuxCNC: read-only, 0 before any).
+#: What the last return or endsub left (LinuxCNC: read-only, 0 before any; the interpreter
+#: keeps them among its globals).
 _RETURNED = ("_value", "_value_returned")
+
+
+def _unknown(what: str) -> str:
+    return f"{what}, which woodcam cannot know"
+
+
+#: LinuxCNC 2.9's predefined named parameters (its manual's "Predefined Named Parameters", the
+#: table of interp_namedparams.cc) but #<_value> and #<_value_returned> (:data:`_RETURNED`):
+#: read-only (assigning one is refused, as LinuxCNC does), all defined (``EXISTS[]`` gives 1).
+#: Each reads woodcam's state (program units, as LinuxCNC), or is a ``str``: what the machine
+#: knows and woodcam does not, the reason reading it is refused. The constant ones follow from
+#: what woodcam refuses (G41/G42, G93, G95, G96, G7/G8, remapped codes).
+_PREDEFINED: dict[str, Callable[[Interpreter], float] | str] = {
+    "_vmajor": lambda s: 2.9,  # the language woodcam reads is LinuxCNC 2.9's
+    "_vminor": _unknown("the patch release of the machine's LinuxCNC (0.x of 2.9.x)"),
+    # 1: running under LinuxCNC's task, as on the machine that cuts the part (its preview, the
+    # oracle's gcode module, reads 0): a program's "o1 if [#<_task> eq 0]" branch, which posts
+    # use to skip probing and tool measuring in the preview, is the machine's, not the cut's
+    "_task": lambda s: 1.0,
+    "_call_level": lambda s: float(len(s._frames)),  # o-word calls and M98 subprograms
+    "_remap_level": lambda s: 0.0,
+    "_line": lambda s: float(s.line_no),
+    "_motion_mode": lambda s: 800.0 if s.motion is None else round(s.motion * 10),
+    "_plane": lambda s: s.plane * 10.0,
+    "_ccomp": lambda s: 400.0,
+    "_metric": lambda s: float(not s.inch),
+    "_imperial": lambda s: float(s.inch),
+    "_absolute": lambda s: float(not s.incremental),
+    "_incremental": lambda s: float(s.incremental),
+    "_inverse_time": lambda s: 0.0,
+    "_units_per_minute": lambda s: 1.0,
+    "_units_per_rev": lambda s: 0.0,
+    "_coord_system": lambda s: round(_CS[s.cs - 1] * 10.0),  # G54 540 ... G59.1 591 ... 593
+    "_tool_offset": lambda s: float(any(s.tlo)),
+    "_retract_r_plane": lambda s: float(not s.retract_old_z),  # G99
+    "_retract_old_z": lambda s: float(s.retract_old_z),  # G98
+    "_spindle_rpm_mode": lambda s: 1.0,
+    "_spindle_css_mode": lambda s: 0.0,
+    "_ijk_absolute_mode": lambda s: float(not s.arc_incremental),
+    "_lathe_diameter_mode": lambda s: 0.0,
+    "_lathe_radius_mode": lambda s: 1.0,
+    "_spindle_on": lambda s: float(s.spindle_on),
+    "_spindle_cw": lambda s: float(s.spindle_on and s.spindle_cw),
+    "_mist": lambda s: float(s.coolant["mist"]),
+    "_flood": lambda s: float(s.coolant["flood"]),
+    "_speed_override": lambda s: float(s.overrides["speed"]),
+    "_feed_override": lambda s: float(s.overrides["feed"]),
+    "_adaptive_feed": lambda s: float(s.overrides["adaptive"]),
+    "_feed_hold": lambda s: float(s.overrides["hold"]),
+    "_feed": lambda s: s.feed / s.scale,
+    "_rpm": lambda s: s.spindle,
+    "_current_tool": lambda s: float(s.tool),
+    "_selected_tool": lambda s: float(s.selected),
+    "_current_pocket": _unknown("the tool changer pocket of the loaded tool, from the "
+                                "machine's tool table"),
+    "_selected_pocket": _unknown("the tool changer pocket of the selected tool, from the "
+                                 "machine's tool table"),
+    **{f"_{a}": (lambda s, i=i: s.to_program(s.pos)[i]) for i, a in enumerate("xyz")},
+    **{f"_{a}": (lambda s: 0.0) for a in "abcuvw"},  # woodcam has no such axes
+}
 
 
 class _Unread(Exception):
@@ -512,6 +572,11 @@ class Interpreter:
         self.feed = 0.0
         self.spindle = 0.0
         self.spindle_on = False
+        self.spindle_cw = True  # M3 (False: M4), read while the spindle turns
+        # M7/M8/M9 and M48-M53: read, no effect on the cut (#<_mist>, #<_feed_hold> ... read
+        # them; LinuxCNC starts with both overrides and feed hold enabled, adaptive feed off)
+        self.coolant = {"mist": False, "flood": False}
+        self.overrides = {"speed": True, "feed": True, "adaptive": False, "hold": True}
         self.tool = 0
         self.selected = 0
         self.cs = int(self.p[5220])
@@ -610,8 +675,13 @@ class Interpreter:
         return k
 
     def get_named(self, name, word):
-        if name in _READ_ONLY:
-            return self._system(name)
+        known = _PREDEFINED.get(name)
+        if known is not None:
+            if isinstance(known, str):
+                raise self.err(word, f"#<{name}> is LinuxCNC's {known}",
+                               f"replace #<{name}> by the value the machine would read, or "
+                               "by a parameter of the program's own")
+            return known(self)
         if name == "_value" and self._value_unknown:
             raise self.err(word, self._value_unknown, "call the subroutine before reading "
                            "#<_value>")
@@ -622,17 +692,14 @@ class Interpreter:
             return 0.0
         if self._defining:
             raise _Unread(word)
+        if name.startswith(("_ini[", "_hal[")):
+            what = "INI file value" if name.startswith("_ini[") else "HAL pin or signal"
+            raise self.err(word, f"#<{name}> reads the machine's {what} (LinuxCNC with "
+                           "[RS274NGC]FEATURES 4 or 8; without, it is not defined there "
+                           "either), which woodcam cannot know", f"replace #<{name}> by the "
+                           "value, or by a parameter the program assigns")
         raise self.err(word, f"named parameter #<{name}> not defined",
                        "assign it before reading it")
-
-    def _system(self, name):
-        prog = self.to_program(self.pos)
-        return {"_x": prog[0], "_y": prog[1], "_z": prog[2], "_metric": float(not self.inch),
-                "_imperial": float(self.inch), "_absolute": float(not self.incremental),
-                "_incremental": float(self.incremental), "_feed": self.feed / self.scale,
-                "_rpm": self.spindle, "_current_tool": float(self.tool),
-                "_selected_tool": float(self.selected), "_line": float(self.line_no),
-                "_coord_system": float(540 + 10 * (self.cs - 1))}.get(name, 0.0)
 
     # -- expression reader ------------------------------------------------------------------
     # Works on the normalised line text ``s`` with an index; returns (value, next index).
@@ -1630,8 +1697,9 @@ class Interpreter:
                                    "one line", "keep one")
                 words[letter] = v
         for ref, v in pending:  # the end-of-line assignment rule
-            if ref[0] == "n" and (ref[1] in _READ_ONLY or ref[1] in _RETURNED):
-                raise self.err(f"#<{ref[1]}>", f"#<{ref[1]}> is a read-only system parameter",
+            if ref[0] == "n" and (ref[1] in _PREDEFINED or ref[1] in _RETURNED):
+                raise self.err(f"#<{ref[1]}>", f"#<{ref[1]}> is a read-only predefined "
+                               "parameter (LinuxCNC: 'Cannot assign to read-only parameter')",
                                "use another name")
             if ref[0] == "i" and ref[1] in _READ_ONLY_NUM:
                 raise self.err(f"#{ref[1]}", f"#{ref[1]} is a read-only system parameter "
@@ -1761,6 +1829,15 @@ class Interpreter:
             self.p.pop(5399, None)
         if mset & {3, 4}:
             self.spindle_on = True
+            self.spindle_cw = 3 in mset
+        if 7 in mset:
+            self.coolant["mist"] = True
+        if 8 in mset:
+            self.coolant["flood"] = True
+        if 9 in mset:
+            self.coolant.update(mist=False, flood=False)
+        if mset & set(range(48, 54)):
+            self._override_codes(mset, w)
         if mset & {5, 19}:  # M19 orients the spindle: it stands until M3/M4 (LinuxCNC)
             self.spindle_on = False
         if 4.0 in g:
@@ -1920,6 +1997,17 @@ class Interpreter:
         return self.err(word, "grbl system command (a settings, state or build report), not "
                         "G-code: woodcam does not simulate it",
                         "remove the line (it does not move the machine)")
+
+    def _override_codes(self, mset, w):
+        """M48/M49 switch both overrides on/off; M50 (feed override), M51 (speed override),
+        M52 (adaptive feed) and M53 (feed hold) switch theirs off with P0, else on (as
+        LinuxCNC 2.9: no P is on)."""
+        if 48 in mset or 49 in mset:
+            self.overrides.update(feed=48 in mset, speed=48 in mset)
+        on = w.get("p", 1.0) != 0
+        for code, key in ((50, "feed"), (51, "speed"), (52, "adaptive"), (53, "hold")):
+            if code in mset:
+                self.overrides[key] = on
 
     def _analog_io(self, mset, w):
         """LinuxCNC's checks of M66 (wait on digital input P or analog input E, wait type L,
