@@ -125,6 +125,25 @@ def test_predefined_named_parameters_read_as_in_linuxcnc():
             _ends(f"#<{name}> = 3\nM2\n")
 
 
+#: EXISTS[] of predefined, unset, assigned, sub-local and INI/HAL names, one move each (Y = n).
+EXISTS_PROGRAM = (
+    "".join(f"G0 X[EXISTS[#<{n}>]] Y{i}\n" for i, n in enumerate(
+        ["_x", "_task", "_vminor", "_current_pocket", "_value", "_value_returned",
+         "_motion_mode", "_foo"], 1))
+    + "#<_foo> = 2\nG0 X[EXISTS[#<_foo>]] Y9\nG0 X[EXISTS[#<a>]] Y10\n#<a> = 1\n"
+    "G0 X[EXISTS[#<a>]] Y11\no1 sub\nG0 X[EXISTS[#<a>]] Y12\n"
+    "G0 X[EXISTS[#<_call_level>]] Y13\no1 endsub\no1 call\n"
+    "G0 X[EXISTS[#<_ini[traj]linear_units>]] Y14\nG0 X[EXISTS[#<_hal[x.y]>]] Y15\nM2\n")
+
+
+def test_exists_is_1_for_the_predefined_parameters_as_in_linuxcnc():
+    """EXISTS[#<_task>], EXISTS[#<_x>], EXISTS[#<_value>] ... read 0 (only names a program
+    assigned counted), where LinuxCNC defines every predefined parameter, those woodcam cannot
+    read too (the same program against LinuxCNC in test_linuxcnc_oracle.py)."""
+    assert [e[0] for e in _ends(EXISTS_PROGRAM)] == [1, 1, 1, 1, 1, 1, 1, 0, 1, 0, 1, 0, 1,
+                                                     0, 0]
+
+
 def test_nested_calls_return_values_and_recursion_limit():
     text = ("o<sq> sub\no<sq> return [#1 * #1]\no<sq> endsub\n"
             "o<sum> sub\no<sq> call [#1]\n#<s> = #<_value>\no<sq> call [#2]\n"

@@ -255,6 +255,17 @@ def test_predefined_named_parameters_agree_with_linuxcnc(tmp_path):
     assert not bad, bad
 
 
+def test_exists_agrees_with_linuxcnc(tmp_path):
+    """EXISTS[] of predefined parameters (woodcam read 0), of names unset, assigned, local to
+    a sub, and of INI/HAL names (test_interpreter.EXISTS_PROGRAM): the same moves."""
+    from .test_interpreter import EXISTS_PROGRAM
+
+    counts = {}
+    agree, bad = _differences(_written(tmp_path, [EXISTS_PROGRAM]), [EXISTS_PROGRAM], counts)
+    assert not bad, bad
+    assert counts["ran"] == 1 and counts["moves"] == 15, counts
+
+
 def test_random_programs_reusing_labels_agree_with_linuxcnc(tmp_path):
     """Seeded random o-word programs (gcode_fuzz.oword_program) whose ifs, whiles and repeats
     half the time take one of four labels, some subroutines defined twice or after the M2:

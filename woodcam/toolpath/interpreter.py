@@ -766,7 +766,8 @@ class Interpreter:
                 raise self.err(s[i:], "exists needs [#<name>]", "write exists[#<name>]")
             name = m.group(1)
             d = self.globals if name.startswith("_") else self.locals
-            return float(name in d), m.end()
+            # the predefined ones exist, those woodcam cannot read too (LinuxCNC defines them)
+            return float(name in d or name in _PREDEFINED or name in _RETURNED), m.end()
         a, i = self.value(s, i)
         w = f"{f}[{a:g}]"
         if f == "atan":
