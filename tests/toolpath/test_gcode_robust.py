@@ -3,6 +3,8 @@ finite result, never another exception and never a hang; huge numbers cut what t
 
 from __future__ import annotations
 
+import functools
+import inspect
 import math
 import signal
 from collections import Counter
@@ -15,7 +17,9 @@ from hypothesis import strategies as st
 
 from woodcam.errors import WoodcamError
 from woodcam.toolpath import GcodeError, parse_tool_spec, read_gcode, simulate
+from woodcam.toolpath import gcode as gcode_module
 from woodcam.toolpath.gcode import MAX_CHORDS_PER_ARC
+from woodcam.toolpath.interpreter import MAX_BLOCKS, Interpreter
 
 from .gcode_fuzz import program
 
@@ -46,7 +50,6 @@ def _deadline(seconds: float):
     (f"N{DIGITS_400} G0 X1\nM2\n", "out of range"),
     (f"T{DIGITS_400} M6\nM2\n", "out of range"),
     ("G0 X0 Y0 Z5\nG91 G81 X1 Z-1 R-1 L1000000 F100\nM2\n", "cycle repeats"),
-    ("o1 repeat [1000000]\nG0 X1\nG0 X2\no1 endrepeat\nM2\n", "endless loop"),
     (f"G0 X0 Y0\nG2 X1 Y0 R{DIGITS_400} F100\nM2\n", "out of range"),
     (f"G0 X[{DIGITS_400[:300]} * {DIGITS_400[:300]}]\nM2\n", "out of range"),
     ("G1.04 X1 F100\nM2\n", "unsupported G code"),
@@ -56,6 +59,29 @@ def _deadline(seconds: float):
 def test_hostile_numbers_are_errors_with_the_line(text, rule):
     with _deadline(10), pytest.raises(GcodeError, match=rule):
         read_gcode(text)
+
+
+ENDLESS = "o1 repeat [1000000]\nG0 X1\nG0 X2\no1 endrepeat\nM2\n"  # 2,000,000 moves asked
+
+
+def test_an_endless_loop_is_stopped_after_a_count_of_lines(monkeypatch):
+    """The guard against endless loops counts executed lines (MAX_BLOCKS), so where it stops
+    is deterministic, not a matter of time. This program ran in the list above under the
+    10 CPU-second deadline with the default 500,000 lines, which take ~10 CPU-s on a loaded
+    machine (~50,000 lines/s): it failed at random. Here read_gcode runs it with a 10,000-line
+    guard: stopped on the 10,001st line executed (line 1, the repeat), after exactly the 5,000
+    moves of 2,500 passes."""
+    small = functools.partial(Interpreter, max_blocks=10_000)
+    monkeypatch.setattr(gcode_module, "Interpreter", small)
+    with _deadline(10), pytest.raises(GcodeError, match=r"line 1: 'program': more than 10000 "
+                                                        r"lines executed \(an endless loop\?\)"):
+        read_gcode(ENDLESS)
+    interp = small(ENDLESS)
+    with pytest.raises(GcodeError, match="endless loop"):
+        interp.run()
+    assert len(interp.moves) == 5_000
+    # without the test's guard, read_gcode's interpreter stops after MAX_BLOCKS lines
+    assert inspect.signature(Interpreter).parameters["max_blocks"].default == MAX_BLOCKS
 
 
 def test_large_but_sane_arc_is_chorded_within_the_limit():
