@@ -309,6 +309,14 @@ def test_a_label_reused_in_one_scope_is_refused_when_reached_as_linuxcnc_does():
                  + "o10 endif\no20 endwhile\nG0 X4\nM2\n") == [(4, 0, 0)]
 
 
+def test_an_error_in_an_elseif_condition_names_its_line():
+    # it named the if's line (LinuxCNC: the elseif's; checked against its interpreter)
+    for text, line in (("o1 if [0]\no1 elseif [#<undefined>]\no1 endif\nM2\n", 2),
+                       ("o1 if [0]\no1 elseif [0]\nG0 X1\no1 elseif [1/0]\no1 endif\nM2\n", 4)):
+        with pytest.raises(GcodeError, match=rf"line {line}: "):
+            _ends(text)
+
+
 def test_work_offsets_g10_g5x_g92():
     # (expected values checked against LinuxCNC 2.9's own interpreter)
     ends = _ends("G0 X1 Y1 Z1\nG10 L20 P1 X0\nG0 X2\nG10 L2 P2 X10 Y10\nG55 G0 X1 Y1\n"

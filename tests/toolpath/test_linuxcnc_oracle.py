@@ -266,6 +266,14 @@ def test_exists_agrees_with_linuxcnc(tmp_path):
     assert counts["ran"] == 1 and counts["moves"] == 15, counts
 
 
+def test_an_error_in_an_elseif_condition_is_refused_on_its_line_as_linuxcnc(tmp_path):
+    texts = ["o1 if [0]\no1 elseif [#<undefined>]\no1 endif\nM2\n",
+             "o1 if [0]\no1 elseif [0]\nG0 X1\no1 elseif [1/0]\no1 endif\nM2\n"]
+    counts = {}
+    agree, bad = _differences(_written(tmp_path, texts), texts, counts, same_line=True)
+    assert not bad and counts["refused"] == 2, (bad, counts)
+
+
 def test_random_programs_reusing_labels_agree_with_linuxcnc(tmp_path):
     """Seeded random o-word programs (gcode_fuzz.oword_program) whose ifs, whiles and repeats
     half the time take one of four labels, some subroutines defined twice or after the M2:

@@ -1600,6 +1600,7 @@ class Interpreter:
             ln = self.lines[b]
             if ln.okey == "else":
                 return b + 1
+            self.line_no = ln.no  # (an error in an elseif's condition names its line)
             v, _ = self._cond(ln)
             if v != 0:
                 return b + 1
