@@ -232,7 +232,7 @@ def bake(
     def colours(vmap, faces, xy):
         # xatlas keeps face order, so output face i is input face i.
         point_map = _affine_maps(xy, faces, verts_in[vmap])
-        face_normals = np.asarray(mesh.face_normals, dtype=np.float64)
+        face_normals = _face_directions(mesh)
         if vertex_normals is not None:
             normal_map = _affine_maps(xy, faces, vertex_normals[vmap])
 
@@ -432,6 +432,25 @@ def rebake_texture(mesh, corner_uv, image, *, texels_per_mm: float, max_atlas_px
 
 # ------------------------------------------------------------------------------------------------
 # helpers
+
+
+def _face_directions(mesh) -> np.ndarray:
+    """A direction per triangle ``(f, 3)`` float64 for the colour lookup, which refuses a zero
+    normal: trimesh's face normal, or for a degenerate triangle (zero area: its normal is zero,
+    yet the atlas gives it texels, e.g. the slivers of woodify's crack insertion) the mean of its
+    corners' normals (:func:`~woodcam.appearance.wood.vertex_color_normals`), or +Z where even
+    those cancel. Such a triangle covers no surface, so its colour is only seen by filtering."""
+    from .appearance.wood import vertex_color_normals
+
+    normals = np.array(mesh.face_normals, dtype=np.float64).reshape(-1, 3)
+    length = np.linalg.norm(normals, axis=1)
+    bad = ~(np.isfinite(length) & (length >= MIN_NORMAL_LENGTH))
+    if bad.any():
+        corners = vertex_color_normals(mesh)[np.asarray(mesh.faces)[bad]].sum(axis=1)
+        size = np.linalg.norm(corners, axis=1, keepdims=True)
+        normals[bad] = np.where(size >= MIN_NORMAL_LENGTH, corners / np.maximum(size, 1e-300),
+                                (0.0, 0.0, 1.0))
+    return normals
 
 
 def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals, *,
