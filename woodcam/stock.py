@@ -348,9 +348,8 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
 
 def _woodify_field(parsed: ParsedSpec):
     """``woodify:PATH/field.npz`` -> (field, size_mm, description): the block stored in it."""
-    from .woodify.field import WoodifiedField
-
     from .fields.base import rings_crossed
+    from .woodify.field import WoodifiedField
 
     path = parsed.source
     field = WoodifiedField.load(path)
