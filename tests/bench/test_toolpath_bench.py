@@ -200,7 +200,7 @@ def test_relief_job_167x208_end_to_end(tmp_path):
             "print('CPU', r.ru_utime + r.ru_stime, 'RSS', r.ru_maxrss); sys.exit(rc)")
     for camera in ("top", "iso"):
         run = subprocess.run([sys.executable, "-c", code, "gcode",
-                              str(tmp_path / "relief_panel.ngc"), "--block", "builtin:flat-sawn",
+                              str(tmp_path / "relief_panel.ngc"), "--block", "builtin:flat-sawn:167x208x50",
                               "--stock", "167x208x25", "--tool", "1=ball:3", "--out",
                               str(tmp_path / f"panel_{camera}.glb"), "--screenshot", "--camera",
                               camera], capture_output=True, text=True,

@@ -157,7 +157,7 @@ def test_programs_in_sequence_until_line_stock_and_strict(tmp_path, monkeypatch,
     finish = tmp_path / "finish.nc"
     finish.write_text("G0 X20 Y30 Z2 M3 S9000\nG1 Z-3 F600\nX40\nG0 Z2\nM2\n")
     base = ["--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"), "--tool", "flat:6",
-            "--cell-size", "0.5", "--stock", "60x50x20", "--stock-origin", "-5,-5,0"]
+            "--cell-size", "0.5", "--stock", "60x50x20", "--stock-origin", "5,5,0"]
     args = _parse([str(rough), str(finish), *base])
     assert args.func(args) == 0
     hm = seen["heightmap"]
@@ -178,6 +178,43 @@ def test_programs_in_sequence_until_line_stock_and_strict(tmp_path, monkeypatch,
     args = _parse([str(off), *base, "--strict"])
     assert args.func(args) == 3
     assert "spindle_off" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("extra, said, fix, fixed", [
+    (["--stock", "167x208x25"], "runs from (0, 0, 0) mm to (167, 208, 25) mm",
+     "give --stock 100x80x25 or smaller, or a block that holds it: --block builtin:flat-sawn:167x208x50",
+     ["--block", "builtin:flat-sawn:167x208x50", "--stock", "167x208x25"]),
+    (["--stock", "60x50x20", "--stock-origin", "50,5,0"], "to (110, 55, 20) mm",
+     "give --stock 50x50x20 or smaller at that corner, or a block that holds it: "
+     "--block builtin:flat-sawn:110x80x50", ["--stock", "50x50x20", "--stock-origin", "50,5,0"]),
+    (["--stock", "60x50x20", "--stock-origin=-5,-5,0"], "runs from (-5, -5, 0) mm",
+     "give --stock-origin 0,0,0 (in the block) and --stock 60x50x20 or smaller",
+     ["--stock", "60x50x20", "--stock-origin", "0,0,0"]),
+    (["--units", "inch", "--stock", "5x2x1"], "past the 3.937x3.15x1.969 in block",
+     "or a block that holds it: --block builtin:flat-sawn:5x3.15x1.969",
+     ["--units", "inch", "--stock", "5x2x1", "--block", "builtin:flat-sawn:5x3.15x1.969"]),
+])
+def test_a_stock_past_its_block_is_a_usage_error_naming_the_sizes(tmp_path, monkeypatch, capsys,
+                                                                   extra, said, fix, fixed):
+    """'gcode --stock 167x208x25 --block builtin:flat-sawn' (a 100 x 80 x 50 mm block), or a
+    --stock-origin putting the stock partly outside the block, simulated wood of the field
+    outside the block without a word (for a fitted block an extrapolation, wood the user does
+    not have): a usage error, one line, naming both sizes and the fix, before any simulation;
+    the fix it gives runs."""
+    seen: dict = {}
+    _stub_preview(monkeypatch, seen)
+    prog = tmp_path / "p.nc"
+    prog.write_text("G0 X20 Y20 Z2 M3 S9000\nG1 Z-0.1 F600\nX40\nG0 Z2\nM2\n")
+    cell = "0.08" if "--units" in extra else "2"  # in --units
+    base = [str(prog), "--out", str(tmp_path / "o.glb"), "--tool", "flat:6", "--cell-size", cell]
+    assert main(["gcode", *base, "--block", "builtin:flat-sawn", *extra]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err and not seen, err
+    assert "the stock must be wood of the block, not of the field outside it" in err, err
+    assert said in err and err.rstrip().endswith(fix), err
+    assert main(["gcode", *base, "--block", "builtin:flat-sawn", *fixed]) == 0, capsys.readouterr().err
+    k = 25.4 if "inch" in fixed else 1.0
+    assert seen["stock"].size_mm == pytest.approx([float(v) * k for v in fixed[fixed.index("--stock") + 1].split("x")])
 
 
 def test_machining_time_estimate():

@@ -14,7 +14,7 @@ from pathlib import Path
 from ..errors import UsageError, WoodcamError
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
 from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
-                      allow_negative_values, camera_of, drop_earlier_output, remove_stale_outputs, sizes_type,
+                      allow_negative_values, as_typed, camera_of, drop_earlier_output, remove_stale_outputs, sizes_type,
                       stock_options, vector_type)
 
 _EXAMPLES = """\
@@ -86,7 +86,7 @@ def register(subparsers) -> None:
                    "LinuxCNC's own (needs Debian's linuxcnc-uspace)")
     p.add_argument("--stock", default=None, metavar="WxDxH", type=sizes_type("--stock"),
                    help="stock size in --units cut from the block's wood (default: the block's "
-                   "own size), e.g. 167x208x25")
+                   "own size), e.g. 167x208x25; it must lie in the block (with --stock-origin)")
     p.add_argument("--stock-origin", default=None, metavar="X,Y,Z",
                    type=vector_type("--stock-origin"),
                    help="block-frame position (in --units) of the --stock's corner in the block's wood "
@@ -247,6 +247,7 @@ def run(args) -> int:
         with bar.stage("open block"):
             stock = open_stock(args.block, **stock_options(args))
             if args.stock or args.stock_origin:
+                _check_stock_in_block(args, stock)
                 stock = resize_stock(stock, args.stock or stock.size_mm, args.stock_origin or (0, 0, 0))
         offset = list(args.work_offset) if args.work_offset else None
         hm = None
@@ -329,6 +330,45 @@ def run(args) -> int:
                      initial_heightmap=hm_before, until_line=args.until_line,
                      heightmap=res.heightmap)  # the stock it opens on: simulated already
     return 3 if args.strict and n_warn else 0
+
+
+def _check_stock_in_block(args, block) -> None:
+    """Refuse a ``--stock`` / ``--stock-origin`` that runs past ``block`` (the opened Stock,
+    mm): the stock is wood of the block, ``[0,W] x [0,D] x [0,H]`` of its frame, not of the
+    field outside it (for a fitted or grown block an extrapolation, wood the user does not
+    have), as parquetry's leaves (:func:`woodcam.parquetry.job.check_leaves_in_block`). A usage
+    error (exit 2) naming the sizes in ``--units`` and the fix."""
+    from .._specs import parse_spec
+    from ..units import fmt_point, fmt_size
+
+    have = [float(v) for v in block.size_mm]
+    size = [float(v) for v in (args.stock or have)]
+    origin = [float(v) for v in (args.stock_origin or (0.0, 0.0, 0.0))]
+    far = [o + s for o, s in zip(origin, size)]
+    tol = 1e-6 * max(have)
+    if all(o >= -tol for o in origin) and all(f <= h + tol for f, h in zip(far, have)):
+        return
+    u = args.units
+    k = MM_PER_UNIT[u]
+
+    def typed(values, sep):  # as the option is typed: in --units, no unit symbol
+        return sep.join(f"{v / k:.4g}" for v in values)
+
+    fits = [h - max(o, 0.0) for h, o in zip(have, origin)]
+    fix = (f"--stock {typed([min(s, f) for s, f in zip(size, fits)], 'x')} or smaller"
+           + (" at that corner" if any(o > tol for o in origin) else "")
+           if all(f > tol for f in fits) else "a --stock-origin inside the block")
+    if any(o < -tol for o in origin):
+        fix = f"--stock-origin {typed([max(o, 0.0) for o in origin], ',')} (in the block) and " + fix
+    parsed = parse_spec(block.spec)
+    if parsed.kind in ("builtin", "log") and not parsed.ops and all(o >= -tol for o in origin):
+        base = parsed.base if parsed.size_mm is None else parsed.base[:parsed.base.rfind(":")]
+        fix += f", or a block that holds it: --block {base}:{typed([max(h, f) for h, f in zip(have, far)], 'x')}"
+    raise UsageError(
+        f"--stock {fmt_size(size, u)} at --stock-origin {fmt_point(origin, u)} runs from "
+        f"{fmt_point(origin, u)} to {fmt_point(far, u)}, past the {fmt_size(have, u)} block "
+        f"{as_typed(args, 'block')} (its wood is (0, 0, 0) to {fmt_point(have, u)}): the stock must be wood of "
+        f"the block, not of the field outside it; give {fix}")
 
 
 def _issue_spots(program, issues, size_mm, offset, name: str) -> list[dict]:
