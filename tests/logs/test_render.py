@@ -1,5 +1,6 @@
 """Planar sections through a log and the `woodcam log` command."""
 
+import re
 
 import numpy as np
 import pytest
@@ -152,6 +153,25 @@ def test_cli_maps_and_export_round_trip(tmp_path):
     assert abs(kb.z0_mm - k.z0_mm) < 3.0 and abs(kb.r_death_mm - k.r_death_mm) < 3.0
     r = np.array([20.0, 40.0])
     np.testing.assert_allclose(kb.axis_at(r)[0], k.axis_at(r)[0], atol=3.0)
+
+
+@pytest.mark.parametrize("option, said", [
+    (["--disc", "5000"], r"the disc's height z_mm \(--disc\) must lie in the log, \[0, 600\] mm along it; got 5000"),
+    (["--radial", "-5", "0"], r"\(--radial Z AZ\) must lie in the log, \[0, 600\] mm along it; got -5"),
+    (["--board", "700", "0", "60"], r"\(--board Z AZ OFF\) must lie in the log, \[0, 600\] mm along it; got 700"),
+])
+def test_cli_a_section_outside_the_log_is_a_usage_error(tmp_path, capsys, option, said):
+    """'log render LOG --disc 5000' (or a --radial / --board height) outside the log's
+    [0, 600] mm exited 1, as a failure of the work, after the log was read: a value out of the
+    log's range is a wrong command line, exit 2, one line naming the range; nothing written."""
+    from woodcam.cli import main
+
+    path = write_log(_log(), tmp_path / "log.json")
+    assert main(["log", "render", str(path), "--out", str(tmp_path / "out"), "--px-per-mm", "0.5",
+                 *option]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err and re.search(said, err), err
+    assert not list(tmp_path.glob("out/*.png"))
 
 
 def test_cli_needs_exactly_one_log(tmp_path):

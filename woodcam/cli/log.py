@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import UsageError
+from ..errors import UsageError, WoodcamError
 from .options import SPECIES_HELP, add_knot_options, add_out_option, knot_shading, species_type
 
 
@@ -106,14 +106,18 @@ def run(args) -> int:
     knots = knot_shading(args)
     field = KnottedLogField(log, ring_width_mm=args.ring_width, params=params)
     secs = lr.default_sections(log, px_per_mm=args.px_per_mm)
-    if args.board:
-        z, az, off = args.board
-        secs[0] = lr.tangential_board(log, z, np.radians(az), off, px_per_mm=args.px_per_mm)
-    if args.disc is not None:
-        secs[1] = lr.end_grain_disc(log, args.disc, px_per_mm=args.px_per_mm)
-    if args.radial:
-        z, az = args.radial
-        secs.append(lr.radial_section(log, z, np.radians(az), px_per_mm=args.px_per_mm))
+    try:  # a --board, --disc or --radial height (or offset) out of the log's range: a wrong command
+        # line, known once the log is read (it exited 1, as a failure of the work)
+        if args.board:
+            z, az, off = args.board
+            secs[0] = lr.tangential_board(log, z, np.radians(az), off, px_per_mm=args.px_per_mm)
+        if args.disc is not None:
+            secs[1] = lr.end_grain_disc(log, args.disc, px_per_mm=args.px_per_mm)
+        if args.radial:
+            z, az = args.radial
+            secs.append(lr.radial_section(log, z, np.radians(az), px_per_mm=args.px_per_mm))
+    except WoodcamError as err:
+        raise UsageError(f"{log.name}: {err}") from err
     from .._progress import progress_bar, write
 
     for s in progress_bar(secs, desc="rendering sections", unit="section"):  # ~9 s each at 8 px/mm
