@@ -217,6 +217,17 @@ def test_a_stock_past_its_block_is_a_usage_error_naming_the_sizes(tmp_path, monk
     assert seen["stock"].size_mm == pytest.approx([float(v) * k for v in fixed[fixed.index("--stock") + 1].split("x")])
 
 
+@pytest.mark.parametrize("tool", ["-1=flat:6", "-25=ball:3"])
+def test_a_negative_tool_number_is_refused_naming_the_range(tool, capsys):
+    """'gcode --tool -1=flat:6' was argparse's 'argument --tool: expected one argument' (it took
+    '-1=flat:6' for an option): the tool number's own rule, one line, exit 2 (as --tool=-1=flat:6)."""
+    for argv in (["--tool", tool], [f"--tool={tool}"]):
+        assert main(["gcode", "p.nc", "--block", "builtin:flat-sawn", "--out", "o.glb", *argv]) == 2
+        err = capsys.readouterr().err
+        assert err == (f"woodcam: error: --tool {tool!r}: the tool number must be in [0, 99999]; "
+                       f"got {tool.split('=')[0]}\n"), err
+
+
 def test_machining_time_estimate():
     prog = read_gcode("G0 X0 Y0 Z10\nG1 X100 F600\nG0 X0\nT2 M6\nG1 Y60 F1200\nM2\n",
                       start_mm=(0, 0, 10))

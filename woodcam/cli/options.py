@@ -537,8 +537,10 @@ def open_block(spec, size_mm: float | None = None, face_px: int = 256):
     return _open_block(str(spec), size_mm=size_mm, face_px=face_px)
 
 
-#: A value that looks like numbers ("-14,5,3", "-1e3") is a value, not an option.
-_NEGATIVE_VALUES = re.compile(r"^-[\d.][\d.,eE+-]*$")
+#: A value that looks like numbers ("-14,5,3", "-1e3") is a value, not an option; so is a
+#: negative tool number ("--tool -1=flat:6" was argparse's "expected one argument", not the
+#: tool number's range).
+_NEGATIVE_VALUES = re.compile(r"^-(?:[\d.][\d.,eE+-]*|\d+=\S*)$")
 
 
 def allow_negative_values(p: argparse.ArgumentParser) -> None:
