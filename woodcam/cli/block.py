@@ -80,13 +80,9 @@ def run(args) -> int:
     if args.block_command == "synth":
         import json
 
-        from ..errors import WoodcamError
         from ..synth import knotted_log_field, synth_benchmark_set
 
         lo, hi = args.size_range_mm  # read at the door (_size_range)
-        if args.jitter_mm < 0 or args.dropout_chunk_mm <= 0:
-            raise WoodcamError(f"--jitter-mm must be >= 0 and --dropout-chunk-mm > 0; got "
-                               f"{args.jitter_mm:g} and {args.dropout_chunk_mm:g}")
         noise = {"trace_jitter_mm": args.jitter_mm, "trace_dropout": args.dropout,
                  "trace_dropout_chunk_mm": args.dropout_chunk_mm, "mislabel_fraction": args.mislabel}
         if args.ring_maps_only:

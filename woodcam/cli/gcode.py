@@ -172,9 +172,6 @@ def run(args) -> int:
     from ..toolpath.gcode import GcodeError, read_gcode
     from ..toolpath.simulate import simulate
 
-    if not (math.isfinite(args.rapid_rate) and args.rapid_rate > 0):
-        raise WoodcamError(f"--rapid-rate {args.rapid_rate}: give a rate > 0 in mm/min, e.g. "
-                           "5000")
     if args.interpreter == "linuxcnc" and args.dialect != "linuxcnc":  # it was dropped without a word
         raise UsageError(f"--dialect must be linuxcnc with --interpreter linuxcnc (LinuxCNC's own interpreter "
                          f"reads LinuxCNC's G-code only); got --dialect {args.dialect}; leave out --interpreter "
