@@ -19,7 +19,7 @@ from .cutpaths import (
     transform_outline,
     write_dxf,
 )
-from .engine import ParquetryRun, _check_run, _native, feature_cost, ssim_vs_matched
+from .engine import Parquetry, ParquetryRun, _check_run, _native, feature_cost, ssim_vs_matched
 from .job import ParquetryJob, write_job
 
 #: Thickness (mm) of the board in panel.glb: 0.6 mm veneer on a 1.5 mm birch ply substrate,
@@ -85,6 +85,18 @@ def panel_mesh(render: np.ndarray, px_per_mm: float, thickness_mm: float = PANEL
     return trimesh.Trimesh(np.array(verts, float), np.array(faces), visual=vis, process=False)
 
 
+def native_grid(p: Parquetry) -> dict:
+    """Which grid a panel's 'native' figures (``feature_cost(..., "native")``,
+    ``ssim_vs_matched(..., grid="native")``) are measured on: ``native_px`` its ``[h, w]`` (the
+    target's own pixels, or the working grid where those are finer), ``native_grid`` "target" or
+    "working", ``target_px`` the target's own ``[h, w]``. The one convention of result.json and
+    the benches (the summary called a working grid the target's own)."""
+    own = tuple(p.native_shape or p.matched.shape)
+    measured = _native(p, "native") or p.matched.shape
+    grid = "target" if _native(p, "native") or own[0] <= measured[0] else "working"
+    return {"native_px": list(measured), "native_grid": grid, "target_px": list(own)}
+
+
 def summary(run: ParquetryRun) -> dict:
     """The figures printed and stored in result.json."""
     prm = run.params
@@ -99,17 +111,12 @@ def summary(run: ParquetryRun) -> dict:
         d = {"name": p.name, "size_mm": [p.cells.shape[1] * prm.patch_mm, p.cells.shape[0] * prm.patch_mm],
              "cells": list(p.cells.shape), "patches": len(p.patches)}
         if ok.all():
-            # the grid the 'native' figures are measured on: the target's own pixels, or the
-            # working grid where those are finer (the summary called it the target's own)
-            own = tuple(p.native_shape or p.matched.shape)
-            measured = _native(p, "native") or p.matched.shape
-            native_grid = "target" if _native(p, "native") or own[0] <= measured[0] else "working"
             d.update(feature_cost=feature_cost(p, p.render, prm),
                      feature_cost_baseline=feature_cost(p, p.baseline, prm),
                      ssim=ssim_vs_matched(p, p.render), ssim_baseline=ssim_vs_matched(p, p.baseline),
                      ssim_1mm=ssim_vs_matched(p, p.render, round(prm.px_per_mm)),
                      ssim_1mm_baseline=ssim_vs_matched(p, p.baseline, round(prm.px_per_mm)),
-                     native_px=list(measured), native_grid=native_grid, target_px=list(own),
+                     **native_grid(p),
                      feature_cost_native=feature_cost(p, p.render, prm, "native"),
                      feature_cost_native_baseline=feature_cost(p, p.baseline, prm, "native"),
                      ssim_native=ssim_vs_matched(p, p.render, grid="native"),
