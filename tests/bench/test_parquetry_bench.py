@@ -30,9 +30,30 @@ pytestmark = pytest.mark.bench
 MOKUME = Path("/work/shared/data/mokume")
 
 
-def _sheets(size_mm, ppm, leaves=2, mokume=True, n_species=6, blocks=None):
-    from woodcam.parquetry import mokume_veneers, slice_veneers
+def _leaves(spec, sp, leaves, size_mm, ppm, prefix=None):
+    """``leaves`` leaves of ``size_mm = (width, height)`` mm sliced normal to y (the CLI's
+    default --slice-axis) from the built-in block ``spec`` grown to hold them: its face normal
+    to y (width x height) at least the leaf, its depth its own (``builtin:flat-sawn`` for
+    600 x 400 mm leaves: ``builtin:flat-sawn:600x80x400``, the same wood round the same
+    centre). The leaves pass the CLI's door (``check_leaves_in_block``): every sheet is wood of
+    the block (the 100 x 80 x 50 mm blocks were sliced 600 x 400 mm, wood of the field beyond
+    them)."""
+    from woodcam._specs import parse_spec
+    from woodcam.parquetry import slice_veneers
+    from woodcam.parquetry.job import check_leaves_in_block
     from woodcam.stock import open_stock
+
+    parsed = parse_spec(spec)
+    assert parsed.kind == "builtin" and not parsed.ops, spec
+    w, d, h = open_stock(spec).size_mm
+    name = f"builtin:{parsed.source}:{max(w, size_mm[0]):g}x{d:g}x{max(h, size_mm[1]):g}"
+    stock = open_stock(name, species=sp)
+    size = check_leaves_in_block(stock, leaves, *size_mm, 0.6, 0.4, "y")
+    return slice_veneers(stock, leaves, size, px_per_mm=ppm, axis="y", id_prefix=prefix)
+
+
+def _sheets(size_mm, ppm, leaves=2, mokume=True, n_species=6, blocks=None):
+    from woodcam.parquetry import mokume_veneers
 
     out = []
     if mokume:
@@ -45,14 +66,15 @@ def _sheets(size_mm, ppm, leaves=2, mokume=True, n_species=6, blocks=None):
     for spec, sp in (blocks or SPECIES_BLOCKS[:n_species]):
         # the fast-grown leaves get their own ids (the same species also comes from SPECIES_BLOCKS)
         prefix = f"{sp}-fast" if spec == FAST_GROWN else sp
-        out += slice_veneers(open_stock(spec, species=sp), leaves, size_mm, px_per_mm=ppm, id_prefix=prefix)
+        out += _leaves(spec, sp, leaves, size_mm, ppm, prefix)
     return out
 
 
 #: Leaves of a fast-grown flitch (woodcam's ``builtin:fast-grown``: 10 mm rings, the leaves
 #: flat-sawn 500 mm from the pith, bands of even earlywood tens of mm wide), 600 x 400 mm: the
-#: calm wood a parquetry maker keeps for plain areas.
-FAST_GROWN = "builtin:fast-grown:600x400x50"
+#: calm wood a parquetry maker keeps for plain areas. The block holds them: its 600 x 400 mm
+#: front face (normal to y, the slicing axis), as the README's --veneer-from example.
+FAST_GROWN = "builtin:fast-grown:600x80x400"
 
 
 #: Six colour presets on four grain layouts: a continuum of tones from walnut to maple (two
@@ -166,13 +188,12 @@ def fig14(size_mm=70.0, ppm=2.0, copies=7):
     after the other) vs interleaved (all at once by saliency), Fig. 14."""
     from skimage import data
 
-    from woodcam.parquetry import ParquetryParams, build_parquetry, slice_veneers
-    from woodcam.stock import open_stock
+    from woodcam.parquetry import ParquetryParams, build_parquetry
 
-    sheet = slice_veneers(open_stock("builtin:knotty", species="walnut"), 1, (400, 300), px_per_mm=ppm)
+    sheet = _leaves("builtin:knotty", "walnut", 1, (400, 300), ppm)
     img = data.camera()[30:330, 100:400].astype(np.float32) / 255
     out = {"workload": f"camera crop at {size_mm:g} mm (5 x 5 patches of 14 mm), {copies} copies, one "
-           f"400x300 mm walnut leaf (builtin:knotty) at {ppm:g} px/mm", "runs": {}}
+           f"400x300 mm walnut leaf (builtin:knotty:400x80x300) at {ppm:g} px/mm", "runs": {}}
     for label, prm in (("sequential", ParquetryParams(image_size_mm=size_mm, px_per_mm=ppm, queue="sequential",
                                                       priority="center")),
                        ("interleaved", ParquetryParams(image_size_mm=size_mm, px_per_mm=ppm,
