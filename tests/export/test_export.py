@@ -505,3 +505,37 @@ def test_another_programs_glb_comes_back_where_its_node_transform_places_it(tmp_
     (tmp_path / "other.glb").write_bytes(scene.export(file_type="glb"))
     loaded = load_textured(tmp_path / "other.glb")  # 1 unit or more: no metres guess, no warning
     np.testing.assert_allclose(loaded.bounds, [[95.0, 35.0, 15.0], [105.0, 65.0, 35.0]], atol=1e-9)
+
+
+def _dirty_textured_mesh():
+    """A textured box with a zero-area triangle along its top front edge, an unreferenced
+    vertex and two duplicate faces (a user's slightly dirty mesh)."""
+    from PIL import Image
+
+    box = trimesh.creation.box((10.0, 10.0, 10.0))
+    n = len(box.vertices)
+    verts = np.vstack([box.vertices, [[-5.0, -5.0, 5.0], [0.0, -5.0, 5.0], [5.0, -5.0, 5.0]],
+                       [[99.0, 99.0, 99.0]]])
+    faces = np.vstack([box.faces, [[n, n + 1, n + 2]], box.faces[:2]])
+    uv = np.random.default_rng(0).random((len(verts), 2))
+    material = trimesh.visual.material.PBRMaterial(baseColorTexture=Image.new("RGB", (8, 8), (200, 150, 100)))
+    return trimesh.Trimesh(verts, faces, visual=trimesh.visual.TextureVisuals(uv=uv, material=material),
+                           process=False)
+
+
+@pytest.mark.parametrize("normals", ["crease", "mesh"])
+def test_a_dirty_mesh_is_written_with_unit_normals_the_validator_accepts(tmp_path, normals):
+    """normals="mesh" wrote trimesh's zero vertex normals of the unreferenced vertex and the
+    zero-area triangle's middle corner: 4 ACCESSOR_VECTOR3_NON_UNIT errors (glTF's NORMAL must
+    be unit length)."""
+    mesh = _dirty_textured_mesh()
+    assert (np.linalg.norm(mesh.vertex_normals, axis=1) < 0.5).sum() >= 2  # the input has zeros
+    path = export_glb(mesh, tmp_path / "dirty.glb", normals=normals)
+    issues = _validate(path)["issues"]
+    assert issues["numErrors"] == 0, [m for m in issues["messages"] if m["severity"] == 0]
+    loaded = load_textured(path)
+    np.testing.assert_allclose(np.linalg.norm(loaded.vertex_normals, axis=1), 1.0, atol=1e-6)
+    obj = load_textured(export_obj(mesh, tmp_path / "dirty.obj", normals=normals))
+    np.testing.assert_allclose(np.linalg.norm(obj.vertex_normals, axis=1), 1.0, atol=1e-6)
+    if normals == "mesh":  # the box's own normals are written as they are
+        np.testing.assert_allclose(loaded.vertex_normals[:8], mesh.vertex_normals[:8], atol=1e-6)

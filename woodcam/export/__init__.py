@@ -305,12 +305,18 @@ def export_glb(mesh: Mesh, path: PathLike, metadata: dict | None = None, *,
 
 
 def _shaded(mesh, crease_angle_deg, normals: str, what: str):
-    """The mesh to write with its shading normals: crease normals, or the mesh's own."""
+    """The mesh to write with its shading normals: crease normals, or the mesh's own made unit
+    (glTF requires a unit NORMAL, ACCESSOR_VECTOR3_NON_UNIT: a dirty mesh's unreferenced vertex
+    or one of zero-area triangles only has trimesh's zero normal, which
+    :func:`~woodcam.appearance.wood.vertex_color_normals` replaces with a direction)."""
     if normals == "crease":
         return crease_normals(mesh, crease_angle_deg)
     if normals != "mesh":
         raise WoodcamError(f"{what}: normals must be 'crease' or 'mesh'; got {normals!r}")
-    vn = np.asarray(mesh.vertex_normals, dtype=np.float64)
+    from woodcam.appearance.wood import vertex_color_normals
+
+    vn = vertex_color_normals(mesh)
+    vn = vn / np.linalg.norm(vn, axis=1)[:, None]
     out = mesh.copy()
     out.vertex_normals = vn
     return out
