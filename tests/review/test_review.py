@@ -680,3 +680,59 @@ def test_review_and_preview_draw_a_bar_while_the_block_opens(tmp_path, capsys, b
     [bar] = [b for b in bars if b.desc == "preview"]
     assert bar.enabled and bar.shown[1] == "preview: open block" and bar.n == bar.total == 1
     assert opened == [[True]]  # the window opened after the bar was gone
+
+
+def _foreign_textured_box_glb(path: Path) -> Path:
+    """A GLB that trimesh (not woodcam) writes of an 80 x 60 x 40 mm textured box at block
+    (10..90, 10..70, 5..45) mm, its vertices in mm, Z up: no root transform, no woodcam metadata."""
+    box = trimesh.creation.box((80.0, 60.0, 40.0))
+    box.apply_translation([50.0, 40.0, 25.0])
+    uv = (box.vertices[:, :2] - [10.0, 10.0]) / [80.0, 60.0]
+    material = trimesh.visual.material.PBRMaterial(baseColorTexture=Image.new("RGB", (16, 16), (180, 120, 60)))
+    box.visual = trimesh.visual.TextureVisuals(uv=uv, material=material)
+    box.export(path)
+    return path
+
+
+def _page_glb(html: Path, tmp_path: Path) -> Path:
+    """The part GLB embedded in a review page, written to a file."""
+    b64 = re.search(r'id="woodcam-glb">(.*?)</script>', html.read_text(), re.S).group(1)
+    out = tmp_path / "embedded.glb"
+    out.write_bytes(base64.b64decode(b64.strip()))
+    return out
+
+
+def test_another_programs_glb_is_shown_where_woodcam_reads_it_or_refused_without_a_texture(page, tmp_path):
+    """A trimesh GLB in mm (another program's, no root transform) was embedded as it was: the
+    page took its numbers for metres and drew the box 1000 times too large, while review's
+    hotspots (load_textured: mm, Z up) stood in mm. One without a texture drew a blank view that
+    said 'ready'. Now the textured one is written again in the block frame (export_glb of
+    load_textured), the untextured one is an error that says to bake it."""
+    from woodcam.export import load_textured, read_glb_metadata
+
+    stock = page[0]
+    glb = _foreign_textured_box_glb(tmp_path / "box from elsewhere.glb")
+    out = write_review(glb, tmp_path / "r.html", wood=stock.wood, size_mm=stock.size_mm, voxels=1000)
+    shown = _page_glb(out, tmp_path)
+    assert read_glb_metadata(shown)["frame"] == "block"  # the page's frame: mm under BLOCK_TO_GLTF
+    np.testing.assert_allclose(load_textured(shown).bounds, [[10.0, 10.0, 5.0], [90.0, 70.0, 45.0]], atol=1e-4)
+    bare = trimesh.creation.box((80.0, 60.0, 40.0))
+    bare.apply_translation([50.0, 40.0, 25.0])
+    bare.export(tmp_path / "bare.glb")
+    with pytest.raises(WoodcamError, match=r"review: '.*bare\.glb' was not written by woodcam and carries no "
+                       r"texture: .* bake it first, e\.g\. woodcam bake .*bare\.glb --block SPEC"):
+        write_review(tmp_path / "bare.glb", tmp_path / "bare.html", wood=stock.wood, size_mm=stock.size_mm,
+                     voxels=1000)
+    assert not (tmp_path / "bare.html").exists()
+
+
+def test_three_js_shows_another_programs_glb_at_its_size_in_mm(page, browser, tmp_path):
+    stock = page[0]
+    glb = _foreign_textured_box_glb(tmp_path / "elsewhere.glb")
+    out = write_review(glb, tmp_path / "r.html", wood=stock.wood, size_mm=stock.size_mm, voxels=1000)
+    assert browser.load(f"file://{out}#bare") == "elsewhere: ready"
+    probe = browser.evaluate("document.getElementById('probe').outerHTML")
+    lo = np.array(re.search(r'data-bbox-min="([^"]+)"', probe).group(1).split(","), float)
+    hi = np.array(re.search(r'data-bbox-max="([^"]+)"', probe).group(1).split(","), float)
+    np.testing.assert_allclose(lo, [0.010, 0.005, -0.070], atol=1e-6)  # as the woodcam box above
+    np.testing.assert_allclose(hi, [0.090, 0.045, -0.010], atol=1e-6)

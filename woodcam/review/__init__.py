@@ -32,6 +32,7 @@ import html
 import io
 import json
 import math
+import shlex
 from pathlib import Path
 
 import numpy as np
@@ -151,6 +152,7 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
     if not (isinstance(voxels, int) and lo <= voxels <= hi):
         raise WoodcamError(f"review: voxels must be an integer in [{lo}, {hi:g}]; got {voxels!r}")
     size = [float(v) for v in size_mm]
+    part_glb = _part_glb_bytes(glb_path)  # before the seconds of colour volumes
     cell = volume_cell_mm(size, voxels)
     from .._progress import progress_bar
 
@@ -167,10 +169,33 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
         "photos": _photo_urls(photos),
         "volumes": volumes,
     }
-    page = _page(data, base64.b64encode(glb_path.read_bytes()).decode("ascii"),
+    page = _page(data, base64.b64encode(part_glb).decode("ascii"),
                  bundle.read_text(encoding="utf-8"))
     write_bytes(out_html, page.encode("utf-8"))
     return out_html
+
+
+def _part_glb_bytes(glb_path: Path) -> bytes:
+    """The GLB the page shows: ``glb_path``'s bytes when woodcam wrote it (block-frame mm under
+    the root transform :data:`woodcam.frames.BLOCK_TO_GLTF`); another program's textured GLB
+    written again by :func:`woodcam.export.export_glb` from :func:`woodcam.export.load_textured`,
+    so the page places it where every other command reads it (a trimesh GLB in mm was shown
+    1000 times too large, as metres, while its hotspots stood in mm); an untextured one is an
+    error (it drew a blank view that said 'ready')."""
+    import tempfile
+
+    from ..export import export_glb, load_textured, written_by_woodcam
+
+    if written_by_woodcam(glb_path):
+        return glb_path.read_bytes()
+    mesh = load_textured(glb_path)
+    if getattr(mesh.visual, "kind", None) != "texture" or getattr(mesh.visual, "uv", None) is None:
+        raise WoodcamError(
+            f"review: {str(glb_path)!r} was not written by woodcam and carries no texture: the "
+            "page shows a baked part; bake it first, e.g. woodcam bake "
+            f"{shlex.quote(str(glb_path))} --block SPEC --out baked.glb")
+    with tempfile.TemporaryDirectory(prefix="woodcam-review-") as tmp:
+        return export_glb(mesh, Path(tmp) / "part.glb").read_bytes()
 
 
 def _page(data: dict, glb_b64: str, bundle: str) -> str:
