@@ -46,6 +46,12 @@ def test_woodify_writes_field_surfaces_sections_and_bark(grown_dir):
     assert not list(grown_dir.glob("tmp*")), "temporary files left behind"
     s = trimesh.load(grown_dir / "surface_y4.stl")
     assert s.is_watertight
+    # STL has no unit field: the header states it (it was 80 zero bytes)
+    header = (grown_dir / "surface_y4.stl").read_bytes()[:80]
+    assert header.startswith(b"woodcam: units=mm woodify surface at year 4, in the input mesh's frame"), header
+    # ... and the input's frame it is: the grown trunk straddles the input's origin (its centre)
+    # on every axis, where the block frame's coordinates are all >= 0
+    assert (s.bounds[0] < 0).all() and (s.bounds[1] > 0).all(), s.bounds
     f = WoodifiedField.load(grown_dir / "field.npz")
     assert f.block_size_mm == (100.0, 80.0, 50.0)
     # block centre (5, 0, 0) in the object: the block's centre point is 5 mm off the trunk axis

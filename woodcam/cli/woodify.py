@@ -2,9 +2,10 @@
 
 Writes into ``--out``: ``field.npz`` (the grown object's growth field; a block spec
 ``woodify:OUT/field.npz`` for ``bake``/``gcode``/``preview``), ``grown.glb`` (final surface,
-bark-textured, with cracks), ``surface_yNN.stl`` (watertight grown surfaces at chosen years),
-``section_xz.png`` / ``section_xy.png`` (ring sections through the block centre, seed Fig. 5.1)
-and ``woodify.json`` (parameters, grid, solver, timings). Every file is written atomically.
+bark-textured, with cracks), ``surface_yNN.stl`` (watertight grown surfaces at chosen years, mm
+in the input mesh's frame, as their STL headers say), ``section_xz.png`` / ``section_xy.png``
+(ring sections through the block centre, seed Fig. 5.1) and ``woodify.json`` (parameters, grid,
+solver, timings). Every file is written atomically.
 """
 
 from __future__ import annotations
@@ -242,7 +243,7 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
     import numpy as np
     from PIL import Image
 
-    from ..export import export_glb
+    from ..export import export_glb, stl_bytes
     from ..woodify.bark import (
         BARK_TEXELS_PER_VOXEL,
         CRACK_WIDTH_VOXELS,
@@ -367,7 +368,9 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
         summary["block"] = {"size_mm": list(size), "centre_mm": list(centre)}
         for y in surface_years:
             surf = res.surface(float(y))
-            files.append(atomic(out / f"surface_y{float(y):g}.stl", lambda p, s=surf: s.export(p)))
+            note = f"woodify surface at year {float(y):g}, in the input mesh's frame"
+            files.append(atomic(out / f"surface_y{float(y):g}.stl",
+                                lambda p, s=surf, n=note: p.write_bytes(stl_bytes(s, n))))
     with stage("ring sections"):
         # ring sections through the block centre (seed Fig. 5.1)
         g = res.front.grid

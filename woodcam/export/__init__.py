@@ -441,6 +441,22 @@ def export_obj(mesh: Mesh, path: PathLike, *, units: ObjUnits = "m", up: ObjUp =
     return path
 
 
+#: First bytes of the 80-byte header of a binary STL written by :func:`stl_bytes`.
+STL_HEADER = b"woodcam: units=mm"
+
+
+def stl_bytes(mesh: Mesh, note: str = "") -> bytes:
+    """``mesh`` (trimesh, mm) as a binary STL whose 80-byte header states its unit:
+    ``woodcam: units=mm <note>`` (STL has no unit field; trimesh leaves the header zeros, and a
+    reader then guesses; the header must not start with ``solid``, which marks ASCII STL).
+    ``note`` (ASCII, e.g. the frame) is cut to fit."""
+    from trimesh.exchange.stl import export_stl
+
+    data = export_stl(mesh)
+    text = (STL_HEADER + b" " + note.encode("ascii", "replace")).strip()[:80]
+    return text.ljust(80, b" ") + data[80:]
+
+
 def load_textured(path: PathLike) -> Mesh:
     """Load a GLB or OBJ written by this module as ONE textured ``trimesh.Trimesh`` in the block
     frame (mm, Z up): the GLB root transform and the OBJ's recorded units/up axis are undone.
