@@ -539,3 +539,21 @@ def test_a_dirty_mesh_is_written_with_unit_normals_the_validator_accepts(tmp_pat
     np.testing.assert_allclose(np.linalg.norm(obj.vertex_normals, axis=1), 1.0, atol=1e-6)
     if normals == "mesh":  # the box's own normals are written as they are
         np.testing.assert_allclose(loaded.vertex_normals[:8], mesh.vertex_normals[:8], atol=1e-6)
+
+
+def test_a_moved_folder_with_unicode_names_reloads_in_mm_with_its_texture(baked, tmp_path):
+    """The OBJ's mtllib/map_Kd and the GLB's embedded texture take no absolute path: a folder
+    moved (and renamed) after export, its files named with spaces and non-ASCII letters, reloads
+    in the block frame (mm, Z up) with the texture, OBJ in m/Y up and mm/Z up alike."""
+    folder = tmp_path / "exports ö"
+    files = [export_obj(baked.mesh, folder / "pièce 木 m.obj"),
+             export_obj(baked.mesh, folder / "pièce 木 mm.obj", units="mm", up="z"),
+             export_glb(baked.mesh, folder / "pièce 木.glb")]
+    moved = tmp_path / "elsewhere" / "déplacé"
+    moved.parent.mkdir()
+    folder.rename(moved)
+    assert "exports" not in (moved / "pièce_木_m.mtl").read_text()
+    for path in files:
+        loaded = load_textured(moved / path.name)
+        np.testing.assert_allclose(loaded.bounds, baked.mesh.bounds, atol=1e-4)
+        _same_texture(loaded, baked)
