@@ -736,3 +736,41 @@ def test_three_js_shows_another_programs_glb_at_its_size_in_mm(page, browser, tm
     hi = np.array(re.search(r'data-bbox-max="([^"]+)"', probe).group(1).split(","), float)
     np.testing.assert_allclose(lo, [0.010, 0.005, -0.070], atol=1e-6)  # as the woodcam box above
     np.testing.assert_allclose(hi, [0.090, 0.045, -0.010], atol=1e-6)
+
+
+def _failure_box(browser) -> str | None:
+    return browser.evaluate("document.getElementById('failure')?.textContent ?? null")
+
+
+def test_a_browser_without_webgl_2_is_told_so_not_left_loading_for_ever(page, tmp_path, monkeypatch):
+    """three.js' renderer throws before the viewer's main() runs where the browser gives no
+    WebGL 2 (turned off, no hardware acceleration): the page said 'loading' for ever over an
+    empty view. It now says why, in the title and over the view."""
+    _, _, out, _ = page
+    monkeypatch.setitem(globals(), "_CHROMIUM_FLAGS", [*_CHROMIUM_FLAGS, "--disable-3d-apis"])
+    monkeypatch.setitem(globals(), "_READY_TIMEOUT_S", 60)  # the old page never got there
+    chrome = _DevTools(tmp_path)
+    try:
+        title = chrome.load(f"file://{out}")
+        box = _failure_box(chrome)
+    finally:
+        chrome.close()
+    assert title.startswith("error: this browser gives the page no WebGL 2, which its 3-D view needs"), title
+    assert box == title
+
+
+def test_a_damaged_page_is_an_error_over_the_view(page, browser, tmp_path):
+    """An error outside the viewer's main() (here its data, damaged) left 'loading' for ever;
+    one inside it (an unreadable colour volume) was said only at the foot of the side panel."""
+    _, _, out, _ = page
+    text = out.read_text()
+    damaged = tmp_path / "damaged.html"
+    damaged.write_text(text.replace('id="woodcam-data">', 'id="woodcam-data">{', 1))
+    title = browser.load(f"file://{damaged}")
+    assert title.startswith("error: SyntaxError") and _failure_box(browser) == title, title
+    bad = tmp_path / "bad.html"
+    bad.write_text(re.sub(r'"image": "data:image/webp;base64,[^"]*"', '"image": "data:image/webp;base64,AAAA"',
+                          text, count=1))
+    title = browser.load(f"file://{bad}")
+    assert title.startswith("error: Error: this browser cannot read") and _failure_box(browser) == title
+    assert browser.load(f"file://{out}") == "box: ready" and _failure_box(browser) is None

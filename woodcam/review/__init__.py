@@ -198,6 +198,43 @@ def _part_glb_bytes(glb_path: Path) -> bytes:
         return export_glb(mesh, Path(tmp) / "part.glb").read_bytes()
 
 
+#: Runs before the viewer: an error the viewer does not catch itself (no WebGL 2: three.js'
+#: renderer throws before the viewer's main() runs; a damaged page) left the page saying
+#: "loading" for ever over an empty view. Every error, the viewer's own included (its main()
+#: writes "error: ..." into #status), is shown over the view and in the title.
+_FAILURE_SCRIPT = """
+(() => {
+  const status = document.getElementById('status');
+  const show = (text) => {
+    let box = document.getElementById('failure');
+    if (!box) {
+      box = document.createElement('p');
+      box.id = 'failure';
+      box.style.cssText = 'position:fixed;top:12px;left:12px;max-width:45%;margin:0;padding:10px;'
+        + 'background:#fff0ee;border:1px solid #c03020;color:#601010;z-index:9';
+      document.body.appendChild(box);
+    }
+    box.textContent = text;
+  };
+  const fail = (msg) => {
+    if (status.textContent.startsWith('error')) return;  // the first error says why
+    status.textContent = `error: ${msg}`;
+    document.title = `error: ${msg}`;
+  };
+  new MutationObserver(() => {
+    if (status.textContent.startsWith('error')) show(status.textContent);
+  }).observe(status, { childList: true, characterData: true, subtree: true });
+  window.addEventListener('error', (e) => fail(e.error || e.message));
+  window.addEventListener('unhandledrejection', (e) => fail(e.reason));
+  if (!document.createElement('canvas').getContext('webgl2')) {
+    fail('this browser gives the page no WebGL 2, which its 3-D view needs: turn on hardware '
+         + 'acceleration (or WebGL) in the browser settings, or open the page in a current '
+         + 'Chrome, Edge, Firefox or Safari');
+  }
+})();
+"""
+
+
 def _page(data: dict, glb_b64: str, bundle: str) -> str:
     title = html.escape(data["title"])
     report_rows = "".join(
@@ -262,6 +299,7 @@ def _page(data: dict, glb_b64: str, bundle: str) -> str:
 <script type="application/json" id="woodcam-data">{payload}</script>
 <script type="text/plain" id="woodcam-glb">{glb_b64}</script>
 <script>if (new URLSearchParams(location.hash.slice(1)).has('bare')) document.body.classList.add('bare');</script>
+<script>{_FAILURE_SCRIPT}</script>
 <!-- three.js r{THREE_VERSION[2:5]} (MIT licence below), bundled with the woodcam viewer by esbuild.
 {html.escape(licence)}-->
 <script>{bundle}</script>
