@@ -774,3 +774,28 @@ def test_a_damaged_page_is_an_error_over_the_view(page, browser, tmp_path):
     title = browser.load(f"file://{bad}")
     assert title.startswith("error: Error: this browser cannot read") and _failure_box(browser) == title
     assert browser.load(f"file://{out}") == "box: ready" and _failure_box(browser) is None
+
+
+def test_a_part_too_large_for_the_browser_is_refused_before_the_page_is_written(page, tmp_path, monkeypatch):
+    """A GLB over ~402 MB (a 16k atlas at fine texels) was written into a page Chrome cannot
+    read: its base64 string passes V8's 2^29 - 24 character limit. The limit is checked (here
+    lowered to the fixture part's size) before the colour volumes and the page."""
+    import math
+
+    import woodcam.review as review
+
+    stock, glb, _, _ = page
+    assert review.MAX_PAGE_STRING == 2**29 - 24
+    node = shutil.which("node")
+    if node:  # node's V8 has Chrome's limit
+        run = subprocess.run([node, "-e", "console.log(require('buffer').constants.MAX_STRING_LENGTH)"],
+                             capture_output=True, text=True, timeout=60)
+        assert int(run.stdout) == review.MAX_PAGE_STRING
+    monkeypatch.setattr(review, "MAX_PAGE_STRING", 4 * math.ceil(glb.stat().st_size / 3) - 1)
+    with pytest.raises(WoodcamError, match=r"review: '.*box\.glb' is 0 MiB; the page holds it as one base64 "
+                       r"string, which browsers cap at .* characters \(Chrome\), .* bake the part with a "
+                       r"smaller texture \(--max-atlas, --texels-per-mm\)"):
+        write_review(glb, tmp_path / "big.html", wood=stock.wood, size_mm=stock.size_mm, voxels=1000)
+    assert not (tmp_path / "big.html").exists()
+    monkeypatch.setattr(review, "MAX_PAGE_STRING", 4 * math.ceil(glb.stat().st_size / 3))
+    assert write_review(glb, tmp_path / "fits.html", wood=stock.wood, size_mm=stock.size_mm, voxels=1000).is_file()

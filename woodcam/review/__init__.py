@@ -47,6 +47,10 @@ THREE_VERSION = "0.187.0"
 #: page near 2 MB (lossless WebP) with ~1 mm voxels on a 100 x 80 x 50 mm block, 0.7 mm on a
 #: 50 mm cube.
 VOLUME_VOXELS = 400_000
+#: Longest string Chrome's JavaScript can hold (V8's String::kMaxLength on 64-bit, 2^29 - 24
+#: characters; Firefox allows 2^30 - 2): the page reads its part as one base64 string, so a GLB
+#: over ~402 MB (4/3 of it in base64) can never be shown.
+MAX_PAGE_STRING = 2**29 - 24
 
 
 def volume_cell_mm(size_mm, voxels: int = VOLUME_VOXELS) -> float:
@@ -153,6 +157,12 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
         raise WoodcamError(f"review: voxels must be an integer in [{lo}, {hi:g}]; got {voxels!r}")
     size = [float(v) for v in size_mm]
     part_glb = _part_glb_bytes(glb_path)  # before the seconds of colour volumes
+    if 4 * math.ceil(len(part_glb) / 3) > MAX_PAGE_STRING:
+        raise WoodcamError(
+            f"review: {str(glb_path)!r} is {len(part_glb) / 2**20:.0f} MiB; the page holds it as one "
+            f"base64 string, which browsers cap at {MAX_PAGE_STRING:,} characters (Chrome), so at most "
+            f"{MAX_PAGE_STRING // 4 * 3 / 2**20:.0f} MiB; bake the part with a smaller texture "
+            "(--max-atlas, --texels-per-mm)")
     cell = volume_cell_mm(size, voxels)
     from .._progress import progress_bar
 
