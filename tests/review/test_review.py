@@ -799,3 +799,44 @@ def test_a_part_too_large_for_the_browser_is_refused_before_the_page_is_written(
     assert not (tmp_path / "big.html").exists()
     monkeypatch.setattr(review, "MAX_PAGE_STRING", 4 * math.ceil(glb.stat().st_size / 3))
     assert write_review(glb, tmp_path / "fits.html", wood=stock.wood, size_mm=stock.size_mm, voxels=1000).is_file()
+
+
+def _page_data(html: Path) -> dict:
+    return json.loads(re.search(r'id="woodcam-data">(.*?)</script>', html.read_text(), re.S)
+                      .group(1).replace("<\\/", "</"))
+
+
+def test_hotspots_are_three_finite_numbers_or_an_error(page, tmp_path):
+    """A NaN position was written as a bare NaN that the page's JSON.parse refused (a page that
+    said only 'error: SyntaxError'); a numpy array was json's TypeError."""
+    stock, glb, _, _ = page
+    kw = {"wood": stock.wood, "size_mm": stock.size_mm, "voxels": 1000}
+    out = write_review(glb, tmp_path / "np.html", **kw,
+                       hotspots=[{"kind": "knot", "label": 7, "at_mm": np.float32([50, 40, 25])}])
+    assert _page_data(out)["hotspots"] == [{"kind": "knot", "label": "7", "at_mm": [50.0, 40.0, 25.0]}]
+    for spots, said in (([{"kind": "knot", "label": "k", "at_mm": [float("nan"), 2, 3]}],
+                         r"hotspots\[0\]\['at_mm'\] must be three finite numbers \(x, y, z\); got \[nan, 2, 3\]"),
+                        ([{"kind": "knot", "at_mm": [1, 2, 3]}, "here"], r"hotspots\[1\] must be a dict"),
+                        ({"at_mm": [1, 2, 3]}, "hotspots must be a list of dicts; got dict")):
+        with pytest.raises(WoodcamError, match=said):
+            write_review(glb, tmp_path / "bad.html", **kw, hotspots=spots)
+    assert not (tmp_path / "bad.html").exists()
+
+
+def test_a_malformed_gcode_warning_in_the_glb_is_left_out_with_a_warning(page, tmp_path, capsys):
+    """A G-code warning whose at_mm was not three numbers (GLB metadata is untrusted) went into
+    the page as it was, and the viewer's list of hotspots threw: 'error: TypeError: s.toFixed is
+    not a function', no part shown."""
+    from woodcam.cli import main
+    from woodcam.export import load_textured
+
+    stock, glb, _, _ = page
+    part = export_glb(load_textured(glb), tmp_path / "part.glb", metadata={
+        "block": stock.spec, "warnings": [{"message": "edited", "at_mm": ["a", 2, 3]},
+                                          {"message": "short", "at_mm": [1, 2]},
+                                          {"message": "gouge", "at_mm": [20, 30, 40]}]})
+    assert main(["review", str(part), "--out", str(tmp_path / "r.html"), "--voxels", "1000"]) == 0
+    err = capsys.readouterr().err
+    assert f"warning: {str(part)!r}: 2 G-code warning(s) in its metadata have no position as three numbers" in err
+    gcode = [h for h in _page_data(tmp_path / "r.html")["hotspots"] if h["kind"] == "gcode"]
+    assert gcode == [{"kind": "gcode", "label": "gouge", "at_mm": [20.0, 30.0, 40.0]}]

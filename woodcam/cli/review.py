@@ -80,8 +80,7 @@ def _page(args: argparse.Namespace, meta: dict, stock, bar) -> Path:
 
     with bar.stage("hotspots"):
         hotspots = knot_spots(load_textured(args.part), stock.wood)
-        hotspots += [{"kind": "gcode", "label": str(w.get("message", "")), "at_mm": w["at_mm"]}
-                     for w in meta.get("warnings", []) if isinstance(w, dict) and "at_mm" in w]
+        hotspots += _gcode_spots(meta, args.part)
     with bar.stage("page"):
         photos = None
         if Path(spec).is_dir():  # a block or Mokume folder: show its face photos
@@ -93,6 +92,34 @@ def _page(args: argparse.Namespace, meta: dict, stock, bar) -> Path:
         return write_review(args.part, args.out, wood=stock.wood, size_mm=stock.size_mm,
                             report=report, photos=photos, hotspots=hotspots,
                             voxels=args.voxels or VOLUME_VOXELS, progress=True)
+
+
+def _gcode_spots(meta: dict, glb: Path) -> list[dict]:
+    """The G-code warnings with a position recorded in the GLB's metadata, as hotspots; those
+    whose ``at_mm`` is not three finite numbers (GLB metadata is untrusted: an edited or foreign
+    file; one such warning broke the whole page) are left out with a warning."""
+    import warnings
+
+    import numpy as np
+
+    from .._checks import as_floats
+    from ..errors import WoodcamWarning
+
+    recorded = meta.get("warnings")
+    spots, bad = [], 0
+    for w in recorded if isinstance(recorded, list) else []:
+        if not (isinstance(w, dict) and "at_mm" in w):
+            continue
+        at = as_floats(w["at_mm"])
+        if at is None or at.shape != (3,) or not np.all(np.isfinite(at)):
+            bad += 1
+            continue
+        spots.append({"kind": "gcode", "label": str(w.get("message", "")), "at_mm": at.tolist()})
+    if bad:
+        warnings.warn(f"{str(glb)!r}: {bad} G-code warning(s) in its metadata have no position as three "
+                      "numbers (at_mm); the page leaves them out. Run woodcam gcode again to have them",
+                      WoodcamWarning, stacklevel=2)
+    return spots
 
 
 def _report_rows(bake_report: dict, glb: Path) -> dict:

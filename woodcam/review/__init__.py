@@ -156,6 +156,7 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
     if not (isinstance(voxels, int) and lo <= voxels <= hi):
         raise WoodcamError(f"review: voxels must be an integer in [{lo}, {hi:g}]; got {voxels!r}")
     size = [float(v) for v in size_mm]
+    hotspots = _checked_hotspots(hotspots)
     part_glb = _part_glb_bytes(glb_path)  # before the seconds of colour volumes
     if 4 * math.ceil(len(part_glb) / 3) > MAX_PAGE_STRING:
         raise WoodcamError(
@@ -175,7 +176,7 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
         "title": title or glb_path.stem,
         "block": {"size_mm": size, "voxel_mm": cell},
         "report": {str(k): v for k, v in (report or {}).items()},
-        "hotspots": hotspots or [],
+        "hotspots": hotspots,
         "photos": _photo_urls(photos),
         "volumes": volumes,
     }
@@ -183,6 +184,28 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
                  bundle.read_text(encoding="utf-8"))
     write_bytes(out_html, page.encode("utf-8"))
     return out_html
+
+
+def _checked_hotspots(hotspots) -> list[dict]:
+    """``hotspots`` as the page reads them: ``kind`` and ``label`` strings, ``at_mm`` three finite
+    floats (a NaN was written as a bare NaN, which the page's JSON.parse refused, and a string
+    broke the viewer's list: either left a page that said only 'error')."""
+    from .._checks import check_vector
+
+    if hotspots is None:
+        return []
+    if not isinstance(hotspots, (list, tuple)):
+        raise WoodcamError(f"review: hotspots must be a list of dicts; got {type(hotspots).__name__}")
+    out = []
+    for i, spot in enumerate(hotspots):
+        if not isinstance(spot, dict):
+            raise WoodcamError(f"review: hotspots[{i}] must be a dict with 'kind', 'label' and "
+                               f"'at_mm'; got {type(spot).__name__}")
+        at = check_vector(spot.get("at_mm"), f"review: hotspots[{i}]['at_mm']",
+                          fix="a point in the block frame, mm, e.g. [50, 40, 25]")
+        out.append({"kind": str(spot.get("kind", "")), "label": str(spot.get("label", "")),
+                    "at_mm": [float(v) for v in at]})
+    return out
 
 
 def _part_glb_bytes(glb_path: Path) -> bytes:
