@@ -840,3 +840,18 @@ def test_a_malformed_gcode_warning_in_the_glb_is_left_out_with_a_warning(page, t
     assert f"warning: {str(part)!r}: 2 G-code warning(s) in its metadata have no position as three numbers" in err
     gcode = [h for h in _page_data(tmp_path / "r.html")["hotspots"] if h["kind"] == "gcode"]
     assert gcode == [{"kind": "gcode", "label": "gouge", "at_mm": [20.0, 30.0, 40.0]}]
+
+
+def test_a_report_is_plain_json_or_an_error(page, tmp_path):
+    """A NaN in the report was written as a bare NaN that the page's JSON.parse refused; a numpy
+    array was json's TypeError, after the seconds of colour volumes."""
+    stock, glb, _, _ = page
+    kw = {"wood": stock.wood, "size_mm": stock.size_mm, "voxels": 1000}
+    for report, said in (({"yield": float("nan")}, "Out of range float values are not JSON compliant"),
+                         ({"size": np.zeros(3)}, "Object of type ndarray is not JSON serializable"),
+                         ([("a", 1)], "report must be a dict of rows; got list")):
+        with pytest.raises(WoodcamError, match=f"review: .*{said}"):
+            write_review(glb, tmp_path / "bad.html", **kw, report=report)
+    assert not (tmp_path / "bad.html").exists()
+    out = write_review(glb, tmp_path / "ok.html", **kw, report={1: "one", "sizes": [1, 2.5]})
+    assert _page_data(out)["report"] == {"1": "one", "sizes": [1, 2.5]}

@@ -157,6 +157,7 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
         raise WoodcamError(f"review: voxels must be an integer in [{lo}, {hi:g}]; got {voxels!r}")
     size = [float(v) for v in size_mm]
     hotspots = _checked_hotspots(hotspots)
+    report = _checked_report(report)
     part_glb = _part_glb_bytes(glb_path)  # before the seconds of colour volumes
     if 4 * math.ceil(len(part_glb) / 3) > MAX_PAGE_STRING:
         raise WoodcamError(
@@ -175,7 +176,7 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
     data = {
         "title": title or glb_path.stem,
         "block": {"size_mm": size, "voxel_mm": cell},
-        "report": {str(k): v for k, v in (report or {}).items()},
+        "report": report,
         "hotspots": hotspots,
         "photos": _photo_urls(photos),
         "volumes": volumes,
@@ -184,6 +185,21 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
                  bundle.read_text(encoding="utf-8"))
     write_bytes(out_html, page.encode("utf-8"))
     return out_html
+
+
+def _checked_report(report) -> dict:
+    """``report`` as plain JSON with string keys: a NaN was written as a bare NaN that the
+    page's JSON.parse refused, and a numpy array was json's TypeError after the colour volumes."""
+    if report is None:
+        return {}
+    if not isinstance(report, dict):
+        raise WoodcamError(f"review: report must be a dict of rows; got {type(report).__name__}")
+    try:  # strict, as export_glb's metadata
+        return json.loads(json.dumps({str(k): v for k, v in report.items()}, allow_nan=False))
+    except (TypeError, ValueError) as err:
+        raise WoodcamError(f"review: report must hold JSON values (strings, finite numbers, lists, "
+                           f"dicts); got {err}; convert arrays with .tolist() and write NaN as "
+                           "a string") from err
 
 
 def _checked_hotspots(hotspots) -> list[dict]:
