@@ -855,3 +855,14 @@ def test_a_report_is_plain_json_or_an_error(page, tmp_path):
     assert not (tmp_path / "bad.html").exists()
     out = write_review(glb, tmp_path / "ok.html", **kw, report={1: "one", "sizes": [1, 2.5]})
     assert _page_data(out)["report"] == {"1": "one", "sizes": [1, 2.5]}
+
+
+def test_the_block_size_is_three_positive_lengths_or_an_error(page, tmp_path):
+    """A zero or negative block size wrote a page (colour volumes over an empty or inverted
+    block); two numbers were an IndexError, a string float()'s ValueError."""
+    stock, glb, _, _ = page
+    for size in ((0, 80, 50), (-100, 80, 50), (100, 80), "abc", (100, float("nan"), 50)):
+        with pytest.raises(WoodcamError, match=r"size_mm must be three positive finite lengths \(W, D, H\) in mm; "
+                           r"got .*; pass the block size"):
+            write_review(glb, tmp_path / "bad.html", wood=stock.wood, size_mm=size, voxels=1000)
+    assert not (tmp_path / "bad.html").exists()

@@ -155,7 +155,9 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
     lo, hi = REVIEW_VOXELS_RANGE
     if not (isinstance(voxels, int) and lo <= voxels <= hi):
         raise WoodcamError(f"review: voxels must be an integer in [{lo}, {hi:g}]; got {voxels!r}")
-    size = [float(v) for v in size_mm]
+    from ..frames import check_size
+
+    size = [float(v) for v in check_size(size_mm)]  # a 0 or negative size wrote a page
     hotspots = _checked_hotspots(hotspots)
     report = _checked_report(report)
     part_glb = _part_glb_bytes(glb_path)  # before the seconds of colour volumes
