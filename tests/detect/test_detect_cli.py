@@ -111,8 +111,8 @@ def test_corrected_svg_wins_over_detection(synth_photos, tmp_path, capsys):
     svg = blk / "front_traces.svg"
     svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
                    '<path d="M 10.5,20.5 L 150.5,20.5" data-year="3"/></svg>')
-    rc, out, _err = _run(capsys, "rings", "detect", blk, "--out", blk)
-    assert rc == 0 and "kept the corrected front_traces.svg" in out
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and "kept the corrected front_traces.svg" in err
     b = read_block(blk)
     tr = b.faces["front"].traces
     assert len(tr) == 1 and tr[0].year == 3 and np.allclose(tr[0].points_px, [[20, 10], [20, 150]])
@@ -143,8 +143,8 @@ def test_a_corrected_svg_survives_an_interrupted_detection(synth_photos, tmp_pat
     monkeypatch.setattr(svg_mod, "write_traces_svg", interrupted)
     assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 130
     monkeypatch.setattr(svg_mod, "write_traces_svg", real)
-    rc, out, _err = _run(capsys, "rings", "detect", blk, "--out", blk)
-    assert rc == 0 and "kept the corrected front_traces.svg" in out
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and "kept the corrected front_traces.svg" in err
     assert (blk / "front_traces.svg").read_text() == mine
 
 
@@ -157,8 +157,8 @@ def test_a_corrected_svg_in_another_out_folder_is_kept(synth_photos, tmp_path, c
     mine = ('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
             '<path d="M 10.5,20.5 L 150.5,20.5" data-year="3"/></svg>')
     (det / "front_traces.svg").write_text(mine)
-    rc, out, _err = _run(capsys, "rings", "detect", blk, "--out", det)
-    assert rc == 0 and "kept the corrected front_traces.svg" in out
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", det)
+    assert rc == 0 and "kept the corrected front_traces.svg" in err
     assert (det / "front_traces.svg").read_text() == mine
 
 
@@ -178,14 +178,14 @@ def test_a_corrected_svg_drawn_over_another_photo_is_refused(synth_photos, tmp_p
     (det / "front_traces.svg").write_text(mine)
     before = {p.name: p.read_bytes() for p in det.iterdir()}
     rc, out, err = _run(capsys, "rings", "detect", new, "--out", det)
-    assert rc == EXIT_ERROR and "kept the corrected" not in out
+    assert rc == EXIT_ERROR and "kept the corrected" not in out + err
     assert (f"face 'front': the corrected {det / 'front_traces.svg'} was traced over another front photo "
             "than this block's") in err
     assert "move front_traces.svg out of" in err and "detect into another --out" in err
     assert {p.name: p.read_bytes() for p in det.iterdir()} == before
     # the photos it was drawn over: kept, as before
-    rc, out, _err = _run(capsys, "rings", "detect", old, "--out", det)
-    assert rc == 0 and "kept the corrected front_traces.svg" in out
+    rc, _out, err = _run(capsys, "rings", "detect", old, "--out", det)
+    assert rc == 0 and "kept the corrected front_traces.svg" in err
     assert (det / "front_traces.svg").read_text() == mine
 
 
@@ -241,8 +241,8 @@ def test_a_block_made_again_in_its_folder_keeps_its_corrected_svgs(synth_photos,
     assert rc == EXIT_ERROR and "face 'top': the corrected" in err and "traced over another top photo" in err
     assert (blk / "front_traces.svg").read_text() == mine and (blk / "top_traces.svg").read_text() == mine
     (blk / "top_traces.svg").unlink()  # as the error says
-    rc, out, _err = _run(capsys, "rings", "detect", blk, "--out", blk)
-    assert rc == 0 and "kept the corrected front_traces.svg" in out and "top_traces" not in out
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and "kept the corrected front_traces.svg" in err and "top_traces" not in err
     assert (blk / "front_traces.svg").read_text() == mine
     assert len(read_block(blk).faces["top"].traces) > 1  # detected afresh on the new top photo
 
@@ -459,10 +459,24 @@ def test_face_without_rings_is_named(synth_photos, tmp_path, capsys):
     Image.fromarray(np.clip(np.broadcast_to(grad, (160, 160, 3)), 0, 255).astype(np.uint8)).save(d / "bottom.png")
     blk = tmp_path / "blk"
     assert _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", blk)[0] == 0
-    rc, out, _err = _run(capsys, "rings", "detect", blk, "--out", blk)
-    assert rc == 0 and "face 'bottom'" in out
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and "face 'bottom'" in err
     b = read_block(blk)
     assert b.faces["bottom"].ring_map is None or not b.faces["bottom"].traces
+
+
+def test_rings_detect_warns_on_stderr_as_every_command(synth_photos, tmp_path, capsys):
+    """rings detect printed its warnings (a face without rings, a kept SVG, a turned face) on
+    stdout among its output, where from-photos, block show and every other command print them
+    on stderr: 'rings detect ... > log' hid nothing and kept them out of the log."""
+    d = _copy(synth_photos, tmp_path / "p")
+    grad = np.linspace(90, 170, 160)[None, :, None] + 4 * np.random.default_rng(0).standard_normal((160, 160, 3))
+    Image.fromarray(np.clip(np.broadcast_to(grad, (160, 160, 3)), 0, 255).astype(np.uint8)).save(d / "bottom.png")
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", blk)[0] == 0
+    rc, out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and out == f"wrote {blk} (ring maps, <face>_traces.svg, knot masks)\n", out
+    assert "woodcam: warning: face 'bottom': no rings found" in err
 
 
 def test_curved_option_reaches_the_detector(synth_photos, tmp_path, capsys):
@@ -744,18 +758,18 @@ def test_rings_detect_warns_of_a_face_photographed_turned(tmp_path, capsys, synt
     top.rotate(-90).save(photos / "top.png")          # PIL: negative angles turn clockwise
     blk = tmp_path / "blk"
     assert _run(capsys, "block", "from-photos", photos, "--size-mm", "50", "--out", blk)[0] == 0
-    rc, out, _ = _run(capsys, "rings", "detect", blk, "--out", blk)
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
     assert rc == 0
     assert ("woodcam: warning: face 'top' looks turned 90 degrees clockwise: its rings meet its "
-            "neighbours' along its 4 edges only when corrected") in out
-    assert "turn its photo top.png 90 degrees counter-clockwise" in out
+            "neighbours' along its 4 edges only when corrected") in err
+    assert "turn its photo top.png 90 degrees counter-clockwise" in err
     rc, _, err = _run(capsys, "block", "show", blk, "--check-layout", "--out", tmp_path / "x.png")
     assert rc == 0 and "woodcam: warning: face 'top' looks turned 90 degrees clockwise" in err
     top.save(photos / "top.png")
     good = tmp_path / "good"
     assert _run(capsys, "block", "from-photos", photos, "--size-mm", "50", "--out", good)[0] == 0
-    rc, out, _ = _run(capsys, "rings", "detect", good, "--out", good)
-    assert rc == 0 and "looks turned" not in out
+    rc, out, err = _run(capsys, "rings", "detect", good, "--out", good)
+    assert rc == 0 and "looks turned" not in out + err
     rc, out, _ = _run(capsys, "block", "show", good, "--check-layout", "--out", tmp_path / "y.png")
     assert rc == 0 and "layout: 6 faces checked, none looks turned or mirrored" in out
 

@@ -103,8 +103,9 @@ def run(args) -> int:
         manifest, msgs = detect_folder(args.block, args.out, rule=args.rule, knots=not args.no_knots,
                                        size_mm=(args.size_mm,) * 3 if args.size_mm else None, progress=True,
                                        detector=args.detector or DEFAULT_DETECTOR, curved=True if args.curved else None)
-        for m in msgs:
-            print(f"woodcam: warning: {m}")
+        from . import print_warnings
+
+        print_warnings(msgs)  # on stderr as every command's (they were on stdout, among its output)
         print(f"wrote {manifest.parent} (ring maps, <face>_traces.svg, knot masks)")
         return 0
     if args.rings_command == "show":
