@@ -452,6 +452,19 @@ def test_a_16_bit_photo_is_scaled_not_clipped(synth_photos, tmp_path, capsys):
     assert np.abs(got[..., 0].astype(int) - grey).max() <= 1
 
 
+def test_rings_detect_and_show_on_a_folder_of_photos_say_to_make_a_block_first(synth_photos, tmp_path, capsys):
+    """'rings detect PHOTOS' (the user's own front.jpg ..., before 'block from-photos') was 'must
+    hold a block.json or Mokume files; found neither' and 'rings show PHOTOS' 'must hold Mokume
+    files like A_col.png': no word of the command that makes a block of them. Both read folders
+    through block.io.read_block_folder now, which names the photos and the command."""
+    for argv in (("detect", synth_photos, "--out", tmp_path / "o"), ("show", synth_photos, "--out", tmp_path / "o.png")):
+        rc, out, err = _run(capsys, "rings", *argv)
+        assert rc == EXIT_ERROR and out == "" and err.count("\n") == 1, err
+        assert "holds face photos (back.png, bottom.png, front.png" in err and "but no block.json" in err, err
+        assert f"make a block of them first: woodcam block from-photos '{synth_photos}' --size-mm WxDxH" in err, err
+    assert not (tmp_path / "o").exists() and not (tmp_path / "o.png").exists()
+
+
 def test_face_without_rings_is_named(synth_photos, tmp_path, capsys):
     d = _copy(synth_photos, tmp_path / "p")
     rng = np.random.default_rng(0)

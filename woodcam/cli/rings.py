@@ -113,21 +113,21 @@ def run(args) -> int:
         from PIL import Image
 
         from .._atomic import atomic_path
-        from ..block.io import MANIFEST, read_block_folder, read_mokume
+        from ..block.io import MANIFEST, read_block_folder
         from ..detect.block import with_detected_rings
         from ..detect.show import rings_picture
 
         folder = Path(args.block)
-        if not folder.is_dir():
-            raise WoodcamError(f"block folder {str(folder)!r} does not exist")
         refs = None
-        if (folder / MANIFEST).exists():
-            block = read_block_folder(folder, (args.size_mm,) * 3 if args.size_mm else None)
+        # the one reader of folders: a folder of the user's own photos was 'must hold Mokume
+        # files like A_col.png', no word of 'block from-photos'
+        block = read_block_folder(folder, (args.size_mm,) * 3 if args.size_mm else None)
+        if (folder / MANIFEST).is_file() or folder.name == MANIFEST:
             if not any(f.has_rings for f in block.faces.values()):
                 raise WoodcamError(f"block {str(folder)!r} has no rings yet; run 'woodcam rings detect "
                                    f"{folder} --out {folder}' first")
         else:
-            mok = read_mokume(folder, (args.size_mm or 50.0,) * 3)
+            mok = block
             refs = {n: f.ring_map for n, f in mok.faces.items() if f.ring_map is not None}
             for f in mok.faces.values():
                 f.ring_map, f.traces = None, []

@@ -243,25 +243,23 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     ``out`` may be ``src`` itself. ``curved``: as :func:`detect_face`. Returns the manifest path
     and the warnings.
     """
-    from ..block.io import MANIFEST, read_block_folder, read_mokume, write_block
+    from ..block.io import MANIFEST, read_block_folder, write_block
     from ..block.svg import read_traces_svg, write_traces_svg
 
     src, out = Path(src), Path(out)
     if not src.is_dir():
         raise WoodcamError(f"block folder {str(src)!r} does not exist; pass a block folder made by "
                            f"'woodcam block from-photos' or a Mokume sample folder")
-    mokume = not (src / MANIFEST).exists() and any(src.glob("A_*.png"))
-    if mokume:
-        block = read_mokume(src, size_mm or (50.0, 50.0, 50.0))
-        for f in block.faces.values():     # re-detect from the photos alone
+    # the one reader of folders: a folder of the user's own photos (front.jpg ...) was 'must hold a
+    # block.json or Mokume files; found neither', no word of 'block from-photos'; it says so now.
+    # It warns that a size_mm given for a block folder is not used.
+    block = read_block_folder(src, size_mm)
+    if not (src / MANIFEST).is_file():  # a Mokume sample: re-detected from its photos alone
+        for f in block.faces.values():
             f.ring_map, f.traces = None, []
             f.extras.pop("knot_mask", None)
         edited = {}
     else:
-        if not (src / MANIFEST).exists():
-            raise WoodcamError(f"folder {str(src)!r} must hold a {MANIFEST} (a block folder) or Mokume "
-                               f"files (A_col.png ...); found neither")
-        block = read_block_folder(src, size_mm)  # it warns that a size_mm given is not used
         edited = user_edited_faces(src)
     if out.resolve() != src.resolve() and (out / MANIFEST).is_file():
         # corrections made in the output folder of an earlier run win too (only the source's
