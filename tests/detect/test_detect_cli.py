@@ -763,6 +763,29 @@ def test_photos_named_for_no_face_are_said(synth_photos, tmp_path, capsys):
         assert "top" not in block_from_photos(d, (50, 50, 50), partial=True).faces
 
 
+def test_a_block_folder_given_as_photos_is_named_and_its_own_images_are_no_strays(synth_photos, tmp_path, capsys):
+    """'block from-photos BLOCK' (a block folder, whose photos are front_photo.png ...) was 'no face
+    photos found; back_photo.png, ... are named for no face: name them front.jpg ...', and a block
+    made into its photos folder (--out PHOTOS) and made again warned that its own front_photo.png
+    ... were 'named for no face, so not read; rename a face's photo front.jpg'."""
+    photos = _copy(synth_photos, tmp_path / "photos")
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", photos, "--size-mm", "50", "--out", blk)[0] == 0
+    rc, out, err = _run(capsys, "block", "from-photos", blk, "--size-mm", "50", "--out", tmp_path / "again")
+    assert rc == EXIT_ERROR and out == "" and err.count("\n") == 1, err
+    assert (f"PHOTOS_DIR '{blk}' is a block folder (block.json, back_photo.png ...), not a folder of face photos: "
+            f"detect its rings with woodcam rings detect {blk} --out {blk}, or give the folder of the original "
+            "photos") in err, err
+    assert "named for no face" not in err
+    for _ in range(2):  # the second run reads a folder holding the first's block too
+        rc, _out, err = _run(capsys, "block", "from-photos", photos, "--size-mm", "50", "--out", photos)
+        assert rc == 0 and err == "", err
+    assert set(read_block(photos).faces) == set(FACES)
+    (photos / "IMG_0001.png").write_bytes((photos / "top.png").read_bytes())  # a user's stray is still said
+    rc, _out, err = _run(capsys, "block", "from-photos", photos, "--size-mm", "50", "--out", photos)
+    assert rc == 0 and "IMG_0001.png is named for no face" in err and "_photo" not in err, err
+
+
 def test_rings_detect_warns_of_a_face_photographed_turned(tmp_path, capsys, synth_photos):
     """A cube's top photo turned 90 degrees passes the aspect check; rings detect names it and the
     fix, and block show --check-layout does too (and says so when all is well)."""

@@ -22,6 +22,7 @@ original, so a face's pixels depend on the other photos only through that densit
 
 from __future__ import annotations
 
+import shlex
 import warnings
 from pathlib import Path
 
@@ -79,16 +80,31 @@ def _face_of(path: Path) -> str | None:
     return stem if stem in FACES else FACE_OF_LETTER.get(stem.upper()) if len(stem) == 1 else None
 
 
+def _block_files(folder: Path) -> list[Path]:
+    """The images a block folder's manifest names in ``folder`` (``front_photo.png``,
+    ``front_ring_map.png``, ``front_knot_mask.png`` ...: ``<face>_<what>.png`` beside a
+    ``block.json``); none without a manifest."""
+    from .io import MANIFEST
+
+    if not (folder / MANIFEST).is_file():
+        return []
+    return [p for p in _image_files(folder) if p.suffix == ".png" and p.stem.partition("_")[0] in FACES
+            and p.stem.partition("_")[2]]
+
+
 def stray_photos(folder) -> list[Path]:
     """Image files in ``folder`` named for no face (``IMG_1234.jpg``, ``front face.jpg``); a
-    Mokume sample's maps and masks (``A_arl-unet.png``, ``A_ann.png``, ``A_knot.png``) are not."""
+    Mokume sample's maps and masks (``A_arl-unet.png``, ``A_ann.png``, ``A_knot.png``) and a
+    block folder's own images (:func:`_block_files`: the photos folder made the block's ``--out``)
+    are not."""
     from .io import MOKUME_MAP_KINDS
 
     def mokume_map(p: Path) -> bool:
         letter, _, kind = p.stem.partition("_")
         return letter.upper() in FACE_OF_LETTER and kind in MOKUME_MAP_KINDS
 
-    return [p for p in _image_files(Path(folder)) if _face_of(p) is None and not mokume_map(p)]
+    block = set(_block_files(Path(folder)))
+    return [p for p in _image_files(Path(folder)) if _face_of(p) is None and not mokume_map(p) and p not in block]
 
 
 def find_face_photos(folder) -> dict[str, Path]:
@@ -240,6 +256,11 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
     stray = [p.name for p in stray_photos(folder)]
     # a photo named for no face was passed over without a word (with --partial, its face was left out)
     unnamed = f"{', '.join(stray)} {'is' if len(stray) == 1 else 'are'} named for no face"
+    if not photos and _block_files(Path(folder)):  # its front_photo.png ... were 'named for no face: rename'
+        raise WoodcamError(
+            f"PHOTOS_DIR {str(folder)!r} is a block folder (block.json, {_block_files(Path(folder))[0].name} ...), not a "
+            f"folder of face photos: detect its rings with woodcam rings detect {shlex.quote(str(folder))} --out "
+            f"{shlex.quote(str(folder))}, or give the folder of the original photos (front.jpg ...) to make it again")
     if not photos:
         raise WoodcamError(f"no face photos found in {str(folder)!r}{'; ' + unnamed if stray else ''}: name them front.jpg, top.jpg, "
                            f"left.jpg, bottom.jpg, right.jpg, back.jpg (or A..F, or Mokume A_col.png ...)")
