@@ -103,6 +103,27 @@ def test_size_mm_on_a_block_folder_is_said_to_be_unused(synth_photos, tmp_path, 
     assert read_block(blk).size_mm == (50.0, 50.0, 50.0)
 
 
+def test_a_mokume_cube_size_typed_as_from_photos_takes_it_is_read_or_refused_with_the_rule(tmp_path, capsys):
+    """'rings detect SAMPLE --size-mm 50x50x50' (a size as block from-photos takes it) was
+    argparse's 'invalid float value: '50x50x50'', no word of what the option takes: a cube's
+    sides read as its side; another size is a usage error saying the option sizes a cube."""
+    from woodcam.cli import build_parser
+
+    parser = build_parser()
+    for cmd in (("rings", "detect", "s", "--out", "o"), ("rings", "show", "s", "--out", "o.png"),
+                ("fit", "s", "--out", "f.npz")):
+        assert parser.parse_args([*cmd, "--size-mm", "50x50x50"]).size_mm == 50.0
+        assert parser.parse_args([*cmd, "--size-mm", "30"]).size_mm == 30.0
+    for size in ("50x50", "abc", "50x40x30"):
+        with pytest.raises(SystemExit) as exc:  # argparse's usage error
+            main(["rings", "detect", str(tmp_path / "s"), "--out", str(tmp_path / "o"), "--size-mm", size])
+        out, err = capsys.readouterr()
+        assert exc.value.code == EXIT_USAGE and out == "" and err.count("\n") == 1, err
+        assert (f"--size-mm sizes a Mokume sample folder, a cube: give its side in mm, one number in (0, 10000], "
+                f"e.g. 50; got {size!r}") in err, err
+    assert "(50x40x30 mm is no cube; a block folder records its own size)" in err
+
+
 def test_corrected_svg_wins_over_detection(synth_photos, tmp_path, capsys):
     blk = tmp_path / "blk"
     assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0

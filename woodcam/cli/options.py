@@ -30,7 +30,7 @@ from pathlib import Path
 from .._types import CAMERAS
 from ..errors import UsageError, WoodcamError
 from ..limits import MAX_BLOCK_SIZE_MM, REVIEW_VOXELS_RANGE, WOODIFY_RESOLUTION_RANGE
-from ..units import MM_PER_UNIT, Units, fmt_length, fmt_size
+from ..units import MM_PER_UNIT, Units, fmt_length, fmt_size, parse_lengths
 
 #: The --species presets (woodcam.appearance.SPECIES, listed here so that --help imports no
 #: numba; tests/appearance/test_species.py checks the two agree). README: "Species presets".
@@ -490,8 +490,27 @@ def add_block_argument(p: argparse.ArgumentParser, *, option: bool = True, nargs
         p.add_argument("block", nargs=nargs, help=BLOCK_READ_HELP)
 
 
+def _cube_side(text: str) -> float:
+    """argparse ``type`` of :func:`add_size_option`: a Mokume sample's cube side in mm, one number
+    (or ``SxSxS``, the cube as ``block from-photos --size-mm`` takes a size), else a usage error
+    saying so: ``--size-mm 50x50x50`` copied from ``block from-photos`` was argparse's 'invalid
+    float value', no word of what the option takes. One number's range is checked with the other
+    options' (:data:`RANGES`)."""
+    try:
+        return float(text)
+    except ValueError:
+        pass
+    sides = parse_lengths(text, 3, max_mm=MAX_BLOCK_SIZE_MM, cube=True)
+    if sides is None or len(set(sides)) != 1:
+        what = "" if sides is None else f"{'x'.join(f'{s:g}' for s in sides)} mm is no cube; "
+        raise argparse.ArgumentTypeError(
+            f"--size-mm sizes a Mokume sample folder, a cube: give its side in mm, one number in (0, "
+            f"{MAX_BLOCK_SIZE_MM:g}], e.g. 50; got {text!r} ({what}a block folder records its own size)")
+    return sides[0]
+
+
 def add_size_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--size-mm", type=float, default=None, metavar="MM",
+    p.add_argument("--size-mm", type=_cube_side, default=None, metavar="MM",
                    help="cube side in mm of a Mokume sample folder (its files carry no size; "
                    "default 50)")
 
