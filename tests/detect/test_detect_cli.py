@@ -268,6 +268,29 @@ def test_a_block_made_again_in_its_folder_keeps_its_corrected_svgs(synth_photos,
     assert len(read_block(blk).faces["top"].traces) > 1  # detected afresh on the new top photo
 
 
+def test_a_corrected_svg_of_a_face_the_block_no_longer_has_is_left_and_said(synth_photos, tmp_path, capsys):
+    """A block made again into its folder with --partial and without a face whose SVG was
+    corrected, or 'rings detect NEW --out OLD' where OLD holds such a face's correction, ended
+    'rings detect' as an internal error (KeyError: 'back'). The SVG is left untouched and said."""
+    mine = ('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
+            '<path d="M 10.5,20.5 L 150.5,20.5"/></svg>')
+    five = _copy(synth_photos, tmp_path / "five", skip=("back",))
+    new = tmp_path / "new"
+    assert _run(capsys, "block", "from-photos", five, "--size-mm", "50", "--partial", "--out", new)[0] == 0
+    for again in (True, False):
+        blk = tmp_path / f"blk{again}"
+        assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
+        assert _run(capsys, "rings", "detect", blk, "--out", blk, "--no-knots")[0] == 0
+        (blk / "back_traces.svg").write_text(mine)
+        if again:  # made again in its folder without the back photo
+            assert _run(capsys, "block", "from-photos", five, "--size-mm", "50", "--partial", "--out", blk)[0] == 0
+        rc, _out, err = _run(capsys, "rings", "detect", blk if again else new, "--out", blk, "--no-knots")
+        assert rc == 0, err
+        assert (f"woodcam: warning: face 'back': the corrected {blk / 'back_traces.svg'} is not used: the block "
+                f"has no back face (made without its photo); move it out of '{blk}' to keep it") in err, err
+        assert (blk / "back_traces.svg").read_text() == mine and "back" not in read_block(blk).faces
+
+
 def test_a_block_made_into_a_folder_with_an_unreadable_manifest_is_written(synth_photos, tmp_path, capsys):
     """Review of 1507a56: 'block from-photos' reads the detection record of the block folder it
     writes into, and a block.json there that is not a block manifest (cut short, or another

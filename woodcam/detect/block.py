@@ -265,12 +265,19 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
         # corrections made in the output folder of an earlier run win too (only the source's
         # were looked for, and detection overwrote the ones in --out)
         edited.update(user_edited_faces(out))
+    # a corrected SVG of a face the block no longer has (made again with --partial without it) was
+    # an internal error (KeyError): it is left where it is, unused, and said
+    unused = {n: svg for n, svg in edited.items() if n not in block.faces}
+    edited = {n: svg for n, svg in edited.items() if n in block.faces}
     _check_corrections_match_photos(block, edited)
     todo = [n for n, f in block.faces.items() if f.photo is not None and n not in edited]
-    msgs: list[str] = []
+    msgs: list[str] = [f"face {n!r}: the corrected {svg} is not used: the block has no {n} face (made "
+                       f"without its photo); move it out of {str(svg.parent)!r} to keep it (a later detection "
+                       f"of a {n} face writes over it)" for n, svg in unused.items()]
     if todo:
-        block, msgs = detect_block(block, rule=rule, knots=knots, faces=todo, progress=progress,
-                                   detector=detector, curved=curved)
+        block, found = detect_block(block, rule=rule, knots=knots, faces=todo, progress=progress,
+                                    detector=detector, curved=curved)
+        msgs += found
     else:
         block.meta = dict(block.meta)
     sigma_mm = RING_MAP_SIGMA_MM
