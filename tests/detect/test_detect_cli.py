@@ -291,6 +291,30 @@ def test_a_corrected_svg_of_a_face_the_block_no_longer_has_is_left_and_said(synt
         assert (blk / "back_traces.svg").read_text() == mine and "back" not in read_block(blk).faces
 
 
+def test_a_face_too_large_to_detect_is_refused_before_allocating_with_the_density_that_fits(
+        synth_photos, tmp_path, capsys, monkeypatch):
+    """A block of phone photos under a high --max-px-per-mm (8000x6000 px faces) made rings detect
+    ask for ~60 GB and be killed, a 1500x2000 px face took 4 GB and minutes, nothing said ahead.
+    Now a face over MAX_ALLOC_BYTES (DETECT_BYTES_PER_PX a pixel) is refused before any work,
+    naming the face, its size and density, and the --max-px-per-mm that fits; that one passes."""
+    from woodcam.detect.block import DETECT_BYTES_PER_PX
+
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
+    monkeypatch.setenv("WOODCAM_MAX_ALLOC_BYTES", "2e7")  # 160 x 160 px faces need 33 MB
+    assert 160 * 160 * DETECT_BYTES_PER_PX > 2e7 > 120 * 120 * DETECT_BYTES_PER_PX
+    rc, out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == EXIT_ERROR and out == "" and err.count("\n") == 1, err
+    assert ("ring detection on face 'front' (160x160 px at 3.2 px/mm; memory, bytes) needs 3.328e+07, more than "
+            "the limit MAX_ALLOC_BYTES = 2e+07; make the block again with 'woodcam block from-photos ... "
+            "--max-px-per-mm 2.4' or lower") in err, err
+    assert not (blk / "front_traces.svg").exists()
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--max-px-per-mm", "2.4",
+                "--out", blk)[0] == 0
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk, "--no-knots")
+    assert rc == 0, err
+
+
 def test_a_block_made_into_a_folder_with_an_unreadable_manifest_is_written(synth_photos, tmp_path, capsys):
     """Review of 1507a56: 'block from-photos' reads the detection record of the block folder it
     writes into, and a block.json there that is not a block manifest (cut short, or another

@@ -50,6 +50,15 @@ from .rings import DEFAULT_RULE, RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, 
 DETECT_VERSION = 7
 
 
+#: Peak memory of the classical detector (:func:`~woodcam.detect.rings.detect_rings` and the knot
+#: masks) per face pixel, bytes: measured (peak RSS over the imported package) on H11's front
+#: face resampled to 512, 1024 and about 1500x2000 px at the Mokume scale (10-25 px/mm):
+#: 360 MB, 1.33 GB and 3.9 GB; the bank's scales span a fixed ring-spacing ratio, so it does not
+#: grow with the density. A 8000x6000 face (phone photos under --max-px-per-mm 100) asked for
+#: ~60 GB and was killed, a 1500x2000 one took ~2 minutes.
+DETECT_BYTES_PER_PX = 1300
+
+
 Detector = Literal["classical", "learned"]
 DETECTORS: tuple[str, ...] = ("classical", "learned")
 #: The default detector, picked by the figures in README ("From photos alone").
@@ -82,6 +91,8 @@ def detect_face(face: Face, px_per_mm: float, rule: BoundaryRule = DEFAULT_RULE,
     if curved and detector != "classical":
         raise WoodcamError(f"curved=True is an option of the classical detector; got detector={detector!r}: "
                            f"drop curved or use detector='classical'")
+    if detector == "classical":
+        _check_face_memory(face, px_per_mm)
     if detector == "learned":
         from .learned import detect_rings_learned
 
@@ -97,6 +108,23 @@ def detect_face(face: Face, px_per_mm: float, rule: BoundaryRule = DEFAULT_RULE,
     ring_map = det.ring_map if det.traces else None
     return Face(face.name, face.shape, photo=face.photo, traces=list(det.traces), ring_map=ring_map,
                 extras=extras), list(det.warnings)
+
+
+def _check_face_memory(face: Face, px_per_mm: float) -> None:
+    """Refuse, before any allocation, a face whose detection would need more memory than
+    ``MAX_ALLOC_BYTES`` (:data:`DETECT_BYTES_PER_PX`): it was killed by the system or swapped for
+    minutes, with nothing said. The fix names the density that fits."""
+    import math
+
+    from ..limits import check_limit, limit
+
+    rows, cols = face.shape
+    need = float(rows) * cols * DETECT_BYTES_PER_PX
+    fits = math.floor(10 * px_per_mm * math.sqrt(limit("MAX_ALLOC_BYTES") / need)) / 10
+    check_limit("MAX_ALLOC_BYTES", need,
+                f"ring detection on face {face.name!r} ({cols}x{rows} px at {px_per_mm:.3g} px/mm; memory, bytes)",
+                fix=f"make the block again with 'woodcam block from-photos ... --max-px-per-mm {fits:g}' or lower "
+                "(the default 10 keeps rings 0.8 mm apart at 8 px)")
 
 
 def detect_block(block: Block, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = True,
