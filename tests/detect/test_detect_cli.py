@@ -904,6 +904,38 @@ def test_a_photo_only_block_with_a_turned_face_warns_wherever_it_is_detected(tmp
     assert rc == 0 and err.count("face 'top' looks turned 90 degrees clockwise") == 1, err
 
 
+def test_rings_detect_again_detects_only_the_faces_whose_photo_changed(synth_photos, tmp_path, capsys, monkeypatch):
+    """'rings detect' detected every face afresh on every run: run again (after correcting one SVG,
+    or one photo changed) it took as long as the first (a minute or two a large face). Each face
+    is cached by its photo, density, rule and options; the folder written is byte for byte the
+    same as a fresh detection's."""
+    import woodcam.detect.block as det
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    calls = []
+    real = det.detect_rings
+    monkeypatch.setattr(det, "detect_rings", lambda photo, **kw: calls.append(kw["name"]) or real(photo, **kw))
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
+
+    def detect(out, *extra):
+        calls.clear()
+        rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", tmp_path / out, *extra)
+        assert rc == 0, err
+        return {p.name: p.read_bytes() for p in (tmp_path / out).iterdir()}
+
+    first = detect("o1")
+    assert sorted(calls) == sorted(FACES)
+    assert detect("o2") == first and calls == []  # nothing new: nothing detected, the same files
+    with Image.open(blk / "front_photo.png") as im:
+        im.transpose(Image.Transpose.FLIP_LEFT_RIGHT).save(blk / "front_photo.png")
+    changed = detect("o3")
+    assert calls == ["front"] and changed["front_traces.svg"] != first["front_traces.svg"]
+    assert all(changed[n] == first[n] for n in first if n.startswith(("top", "left", "bottom", "right", "back")))
+    detect("o4", "--rule", "dark-line")
+    assert sorted(calls) == sorted(FACES)  # another rule: detected afresh
+
+
 def test_the_detection_cache_is_keyed_by_the_photos_and_the_rule(tmp_path, monkeypatch):
     """The cached detection of a photo-only block is the detection of these photos with this rule:
     a block whose photo changed, or asked with another rule, is detected afresh (its own entry),

@@ -20,7 +20,10 @@ corrected SVG drawn over another photo than the face's now is refused, not kept.
 detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
 folder of woodcam's cache (:mod:`woodcam._cache`: ``$WOODCAM_CACHE_DIR`` or platformdirs' user
 cache), one ``.npz`` keyed by a digest of the photos, the block size, the rule, the detector and
-:data:`DETECT_VERSION`; the user's folder is never written to.
+:data:`DETECT_VERSION`; the user's folder is never written to. :func:`detect_folder` (``rings
+detect``) caches each face of the classical detector there too (its photo, density, rule and
+options): detecting a folder again, after one SVG was corrected or one photo changed, detects
+only the faces whose photo is new.
 """
 
 from __future__ import annotations
@@ -127,13 +130,43 @@ def _check_face_memory(face: Face, px_per_mm: float) -> None:
                 "(the default 10 keeps rings 0.8 mm apart at 8 px)")
 
 
+def _detect_face_cached(face: Face, px_per_mm: float, rule: BoundaryRule, knots: bool,
+                        curved: bool | None) -> tuple[Face, list[str]]:
+    """:func:`detect_face` (classical detector) of ``face``, cached by content: one entry per
+    face photo, density, rule, curved, knots and :data:`DETECT_VERSION` in the ``detect`` cache.
+    The face's other extras are kept as :func:`detect_face` keeps them."""
+    _check_face_memory(face, px_per_mm)  # a cached face too: the limit holds whatever the cache holds
+
+    def build():
+        found, msgs = detect_face(Face(face.name, face.shape, photo=face.photo), px_per_mm, rule, knots,
+                                  "classical", curved)
+        return {face.name: found}, msgs
+
+    key = digest("detect-face", DETECT_VERSION, rule, _curved(curved), "classical", bool(knots), float(px_per_mm),
+                 np.asarray(face.photo))
+    raw, hit = load_or_build(entry_path(cache_dir("detect"), face.name, key), load=_load_detection, build=build,
+                             save=_save_detection, what="ring detection")
+    if hit:
+        traces, ring_map, found = raw[0][face.name]
+    else:
+        f = raw[0][face.name]
+        traces, ring_map, found = f.traces, f.ring_map, f.extras
+    extras = dict(face.extras)
+    if knots:
+        extras.pop("knot_mask", None)
+    return Face(face.name, face.shape, photo=face.photo, traces=list(traces), ring_map=ring_map,
+                extras={**extras, **found}), list(raw[1])
+
+
 def detect_block(block: Block, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = True,
                  faces=None, progress: bool = False,
-                 detector: Detector = DEFAULT_DETECTOR, curved: bool | None = None) -> tuple[Block, list[str]]:
+                 detector: Detector = DEFAULT_DETECTOR, curved: bool | None = None,
+                 cache: bool = False) -> tuple[Block, list[str]]:
     """A copy of ``block`` whose faces with photos carry detected rings and knot masks.
 
     ``faces``: only these faces (default all with a photo); the others are copied unchanged.
-    ``curved``: as :func:`detect_face`.
+    ``curved``: as :func:`detect_face`. ``cache``: each face of the classical detector read from
+    woodcam's cache when detected before (:func:`_detect_face_cached`).
     Returns the block and the warnings (each names its face).
     """
     from .._progress import progress_bar
@@ -148,7 +181,10 @@ def detect_block(block: Block, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool
     msgs: list[str] = []
     for name in progress_bar(names, desc="detecting rings", unit="face", enabled=progress):
         px_mm = block.face_pixel_size_mm(name)
-        out.faces[name], w = detect_face(block.faces[name], 1.0 / min(px_mm), rule, knots, detector, curved)
+        if cache and detector == "classical":
+            out.faces[name], w = _detect_face_cached(block.faces[name], 1.0 / min(px_mm), rule, knots, curved)
+        else:
+            out.faces[name], w = detect_face(block.faces[name], 1.0 / min(px_mm), rule, knots, detector, curved)
         msgs += w
     out.meta["detection"] = {"detector": detector, "version": DETECT_VERSION, "rule": rule,
                              "curved": _curved(curved), "faces": names}
@@ -303,8 +339,10 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
                        f"without its photo); move it out of {str(svg.parent)!r} to keep it (a later detection "
                        f"of a {n} face writes over it)" for n, svg in unused.items()]
     if todo:
+        # cached by content: a second run, or one after a single SVG was corrected or a single
+        # photo changed, detected every face afresh (a minute or two a large face)
         block, found = detect_block(block, rule=rule, knots=knots, faces=todo, progress=progress,
-                                    detector=detector, curved=curved)
+                                    detector=detector, curved=curved, cache=True)
         msgs += found
     else:
         block.meta = dict(block.meta)
