@@ -74,6 +74,10 @@ def read_image_file(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_AL
         return WoodcamError(f"{what}: {str(path)!r} is {size}, more than the limit MAX_IMAGE_PIXELS = "
                             f"{cap:.0f}; downscale it, or raise the limit with WOODCAM_MAX_IMAGE_PIXELS=N")
 
+    def damaged(err: Exception) -> WoodcamError:
+        return WoodcamError(f"{what}: cannot decode the image {str(path)!r} ({err}); the file is damaged or "
+                            "cannot be read as an image: pass a PNG, JPEG or TIFF file")
+
     # PIL's own bomb guard (89 Mpx, an error above 179 Mpx) came before woodcam's: a 200 Mpx
     # target within woodcam's limit was refused as "damaged", whatever WOODCAM_MAX_IMAGE_PIXELS
     # said; woodcam's limit is the guard (checked below from the header), PIL's set to it
@@ -108,11 +112,17 @@ def read_image_file(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_AL
         raise too_big(f"{n.group(1) if n else 'too many'} pixels") from err
     except FileNotFoundError as err:  # not 'the file is damaged'
         raise WoodcamError(f"{what}: no such file {str(path)!r}; check the path") from err
-    except (OSError, SyntaxError, ValueError) as err:
-        # PIL raises UnidentifiedImageError (an OSError) for 0-byte/unknown files, OSError for
+    except OSError as err:
+        if err.errno is None:  # PIL's own: unknown format, truncated data
+            raise damaged(err) from err
+        # the system's (no permission, a failing card or network share): the file may be fine,
+        # and 'the file is damaged' sent the user to retake a good photo
+        raise WoodcamError(f"{what}: cannot read {str(path)!r} ({err.strerror}); check the file's permissions "
+                           "and that its disk or share is readable, or copy it elsewhere") from err
+    except (SyntaxError, ValueError) as err:
+        # PIL raises UnidentifiedImageError (an OSError, above) for 0-byte/unknown files, OSError for
         # truncated data, SyntaxError/ValueError for some malformed headers
-        raise WoodcamError(f"{what}: cannot decode the image {str(path)!r} ({err}); the file is damaged or "
-                           "cannot be read as an image: pass a PNG, JPEG or TIFF file") from err
+        raise damaged(err) from err
 
 
 def read_photo_rgb(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_ALPHA_FIX):

@@ -606,6 +606,33 @@ def test_a_photo_too_small_for_rings_is_refused(synth_photos, tmp_path, capsys):
     assert rc == EXIT_ERROR and "face 'top'" in err and "8x8 px: too small to hold rings" in err
 
 
+def test_a_photo_the_system_cannot_read_is_not_called_damaged(synth_photos, tmp_path, capsys, monkeypatch):
+    """A photo the system would not let be read (no permission: copied off a camera card or a
+    locked share; an I/O error of a failing card) was 'cannot decode the image ... the file is
+    damaged or cannot be read as an image: pass a PNG, JPEG or TIFF file', sending the user to
+    retake a good photo. Now the system's reason and the fix; a damaged file is still damaged."""
+    import builtins
+
+    import woodcam._readers as readers
+
+    def locked(path, *args, **kwargs):
+        if Path(path).name == "front.png":
+            raise PermissionError(13, "Permission denied", str(path))
+        return builtins.open(path, *args, **kwargs)
+
+    monkeypatch.setattr(readers, "open", locked, raising=False)
+    rc, out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and out == "" and err.count("\n") == 1, err
+    assert (f"photo of face 'front': cannot read '{synth_photos / 'front.png'}' (Permission denied); check the "
+            "file's permissions and that its disk or share is readable") in err, err
+    assert "damaged" not in err
+    monkeypatch.undo()
+    d = _copy(synth_photos, tmp_path / "d")
+    (d / "front.png").write_bytes((d / "front.png").read_bytes()[:300])
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and "photo of face 'front': cannot decode the image" in err and "damaged" in err, err
+
+
 def test_an_animated_photo_is_refused_naming_face_and_file(synth_photos, tmp_path, capsys):
     """An animated GIF or WebP (a phone's burst or live-photo export) was read as its first
     frame without a word: here a grey frame, refused as 'blank', and a first frame of another
