@@ -633,6 +633,19 @@ def test_a_photo_the_system_cannot_read_is_not_called_damaged(synth_photos, tmp_
     assert rc == EXIT_ERROR and "photo of face 'front': cannot decode the image" in err and "damaged" in err, err
 
 
+def test_two_photos_of_one_face_are_named_with_why_a_letter_is_that_face(synth_photos, tmp_path, capsys):
+    """front.png beside A.png (a Mokume letter, which is the front) was 'found several for
+    {'front': ['A.png', 'front.png']}', a dict repr with no word of why A.png is the front."""
+    d = _copy(synth_photos, tmp_path / "d")
+    (d / "A.png").write_bytes((d / "front.png").read_bytes())
+    (d / "Top.PNG").write_bytes((d / "top.png").read_bytes())
+    rc, out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and out == "" and err.count("\n") == 1, err
+    assert (f"each face needs exactly one photo in '{d}'; found 2 for front: A.png (Mokume's letter A for front), "
+            "front.png; 2 for top: Top.PNG, top.png; keep one photo per face and move the others out of the "
+            "folder") in err, err
+
+
 def test_an_animated_photo_is_refused_naming_face_and_file(synth_photos, tmp_path, capsys):
     """An animated GIF or WebP (a phone's burst or live-photo export) was read as its first
     frame without a word: here a grey frame, refused as 'blank', and a first frame of another

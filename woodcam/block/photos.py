@@ -117,9 +117,17 @@ def find_face_photos(folder) -> dict[str, Path]:
         face = _face_of(p)
         if face:
             found.setdefault(face, []).append(p)
-    dup = {f: [q.name for q in ps] for f, ps in found.items() if len(ps) > 1}
+    dup = {f: ps for f, ps in found.items() if len(ps) > 1}
     if dup:
-        raise WoodcamError(f"each face needs exactly one photo; found several for {dup}; keep one per face")
+        # a face's files said as a dict repr ({'front': ['A.png', 'front.png']}), no word of why
+        # A.png is the front's: a Mokume letter beside a face name is the usual cause
+        def why(p: Path) -> str:
+            stem = p.stem.lower().removesuffix("_col")
+            return f" (Mokume's letter {stem.upper()} for {_face_of(p)})" if len(stem) == 1 else ""
+
+        said = "; ".join(f"{len(ps)} for {f}: {', '.join(q.name + why(q) for q in ps)}" for f, ps in dup.items())
+        raise WoodcamError(f"each face needs exactly one photo in {str(folder)!r}; found {said}; keep one photo "
+                           "per face and move the others out of the folder")
     return {f: ps[0] for f, ps in found.items()}
 
 
