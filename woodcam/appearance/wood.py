@@ -326,9 +326,10 @@ def wood_colors(wood: WoodLike, points_mm: ArrayLike, normals: ArrayLike) -> np.
     nrm = as_floats(normals)
     if nrm is not None and nrm.shape == (3,):
         nrm = np.broadcast_to(nrm, p.shape)
-    nrm = check_normals(normals if nrm is None else nrm, p.shape, np.float64)
     if isinstance(wood, Wood):
-        return wood.color(p, nrm)
+        # Wood.color checks the normals itself; checking here too doubled the bake's hot path.
+        return wood.color(p, normals if nrm is None else nrm)
+    nrm = check_normals(normals if nrm is None else nrm, p.shape, np.float64)
     out = np.empty((len(p), 3), np.float32)
     for s in range(0, len(p), MAX_BATCH_POINTS):
         q = p[s:s + MAX_BATCH_POINTS]
