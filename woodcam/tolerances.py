@@ -164,6 +164,14 @@ EVAL_THRESHOLDS_MM = (1.0, 2.0)
 #: (a wrong size_mm or an uncropped photo). 5 % allows a pixel of rounding on a 20 px face.
 FACE_PIXEL_ASPECT_RTOL = 0.05
 
+#: Fewest pixels a face photo may have on its shorter side (``block from-photos``): fewer hold no
+#: rings the detector can find, and detection then reads noise (a 20 x 20 px photo set gave a
+#: false 'looks mirrored' on a face with no rings). Measured on Mokume CN03 and H11 resized to
+#: N px a side (a 50 mm cube): at 20-32 px no ring is found on 3 of CN03's 6 faces, at 48 px
+#: rings are found on all 12 faces; 48 px holds ten of the detector's shortest ring spacing
+#: (4.5 px, :data:`woodcam.detect.rings.WAVELENGTH_RANGE_PX`), a phone photo thousands.
+MIN_FACE_PHOTO_PX = 48
+
 #: Largest error (years) allowed between a refined synthetic ring trace vertex and its integer
 #: iso-line. Newton refinement on the true field reaches ~1e-9 years in three steps; vertices that
 #: do not (on a field kink or where the gradient vanishes, e.g. at the pith) are dropped.

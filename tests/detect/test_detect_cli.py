@@ -606,6 +606,22 @@ def test_a_photo_too_small_for_rings_is_refused(synth_photos, tmp_path, capsys):
     assert rc == EXIT_ERROR and "face 'top'" in err and "8x8 px: too small to hold rings" in err
 
 
+def test_a_photo_too_small_to_hold_rings_is_refused_with_the_minimum(synth_photos, tmp_path, capsys):
+    """A 20 x 20 px face photo (0.4 px/mm on a 50 mm cube, rings under a pixel apart) passed the
+    door; detection then read its noise and warned that a face with no rings 'looks mirrored'.
+    Now one line names the face, the size received and the minimum, and nothing is written."""
+    d = _copy(synth_photos, tmp_path / "t")
+    with Image.open(d / "left.png") as im:
+        im.resize((20, 20), Image.LANCZOS).save(d / "left.png")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and err.count("\n") == 1, err
+    assert "face 'left' (left.png) is 20x20 px: too small to hold rings" in err
+    from woodcam.tolerances import MIN_FACE_PHOTO_PX
+
+    assert f"give at least {MIN_FACE_PHOTO_PX} px a side" in err and MIN_FACE_PHOTO_PX > 20
+    assert not (tmp_path / "o").exists()
+
+
 def test_a_photo_the_system_cannot_read_is_not_called_damaged(synth_photos, tmp_path, capsys, monkeypatch):
     """A photo the system would not let be read (no permission: copied off a camera card or a
     locked share; an I/O error of a failing card) was 'cannot decode the image ... the file is

@@ -86,3 +86,27 @@ def test_faces_without_neighbours_or_images_are_not_scored(cube):
     lone = Block(cube.size_mm, faces={"top": cube.faces["top"], "bottom": cube.faces["bottom"]})
     report = check_face_layout(lone)
     assert report.faces == {} and report.warnings == []
+
+
+def test_a_face_with_no_rings_found_is_not_called_mirrored(cube, capsys):
+    """After detection, a face with no rings found (no ring map, no traces: a 20 x 20 px photo's)
+    was still judged from its photo, and was said to 'look mirrored'. Its edges hold no rings to
+    meet its neighbours': it is not scored, and is listed as not checked, with why."""
+    from woodcam.cli.options import report_layout
+
+    faces = {n: Face(n, f.shape, photo=f.photo, ring_map=np.zeros(f.shape, np.float32))
+             for n, f in cube.faces.items()}
+    meta = {"detection": {"faces": sorted(faces)}}  # detected: every face read from its photo
+    # a face whose photo meets its neighbours only mirrored: with rings found on it, it is flagged
+    mirrored = np.ascontiguousarray(cube.faces["right"].photo[:, ::-1])
+    faces["right"] = Face("right", mirrored.shape[:2], photo=mirrored, ring_map=np.zeros(mirrored.shape[:2], np.float32))
+    assert check_face_layout(Block(cube.size_mm, faces=dict(faces), meta=meta)).corrections == {"right": "flip-lr"}
+    faces["right"] = Face("right", mirrored.shape[:2], photo=mirrored)  # no rings found on it
+    detected = Block(cube.size_mm, faces=faces, meta=meta)
+    report = check_face_layout(detected)
+    assert report.warnings == [] and report.corrections == {}
+    assert "right" not in report.faces and set(report.faces) == set(faces) - {"right"}
+    assert report.unchecked == {"right": "no rings found on it"}
+    report_layout(detected)
+    assert capsys.readouterr().out == ("layout: 5 faces checked, none looks turned or mirrored; "
+                                       "not checked: right (no rings found on it)\n")

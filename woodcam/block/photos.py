@@ -9,7 +9,8 @@ the face's edges, seen from outside, oriented as ``docs/conventions.md`` says).
 Checks, each failing with one message naming the faces at fault: every face present (or
 ``partial``); one file per face; the image's aspect (rows / cols) within
 :data:`~woodcam.tolerances.FACE_PIXEL_ASPECT_RTOL` of the face's in ``size_mm`` (every misfit in
-one message: photos not cropped to their face are seldom alone); not blank (luminance spread
+one message: photos not cropped to their face are seldom alone); at least
+:data:`~woodcam.tolerances.MIN_FACE_PHOTO_PX` px a side; not blank (luminance spread
 below :data:`BLANK_STD`), not over- or under-exposed (more than :data:`CLIPPED_SHARE` of the
 pixels at the ends of the range). An image file named for no face is named in a warning (or in
 the error when faces are missing), never passed over silently; so is a photo with a near-uniform
@@ -37,7 +38,7 @@ from ..frames import (
     check_size,
     face_image_size_mm,
 )
-from ..tolerances import FACE_PIXEL_ASPECT_RTOL
+from ..tolerances import FACE_PIXEL_ASPECT_RTOL, MIN_FACE_PHOTO_PX
 from .block import Block, Face
 
 # .jfif and .jpe: JPEGs as browsers and some phones save them (a front.jfif was passed over
@@ -236,9 +237,12 @@ def _read_face_photo(face: str, path: Path, size, max_px_per_mm: float) -> tuple
     want, got = h_mm / w_mm, a.shape[0] / a.shape[1]
     if abs(got - want) > FACE_PIXEL_ASPECT_RTOL * want:
         return _aspect_misfit(face, path, a.shape, h_mm, w_mm)
-    if min(a.shape[:2]) < 16:  # an 8 x 8 px photo was enlarged and recorded at a density it lacks
+    # an 8 x 8 px photo was enlarged and recorded at a density it lacks; a 20 x 20 px one passed
+    # and detection read its noise as rings (a false 'looks mirrored')
+    if min(a.shape[:2]) < MIN_FACE_PHOTO_PX:
         raise WoodcamError(f"photo of face {face!r} ({path.name}) is {a.shape[1]}x{a.shape[0]} px: too small to "
-                           "hold rings; give at least 16 px a side (a phone photo has thousands)")
+                           f"hold rings; give at least {MIN_FACE_PHOTO_PX} px a side (MIN_FACE_PHOTO_PX; a phone "
+                           "photo has thousands)")
     px_mm = min(a.shape[0] / h_mm, a.shape[1] / w_mm)
     return (_resampled(a, _face_shape(face, size, max_px_per_mm)) if px_mm > max_px_per_mm else a), px_mm
 

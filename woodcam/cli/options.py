@@ -533,9 +533,13 @@ def report_layout(block) -> None:
     report = check_face_layout(block)
     for w in report.warnings:
         warnings.warn(w, WoodcamWarning, stacklevel=2)
+    # a face detection found no rings on is not judged (its edges hold no rings to meet): said, so
+    # 'none looks turned' is not read as covering it
+    skipped = (f"; not checked: {', '.join(report.unchecked)} ({', '.join(sorted(set(report.unchecked.values())))})"
+               if report.unchecked else "")
     if not report.warnings:
-        print(f"layout: {len(report.faces)} faces checked, none looks turned or mirrored"
-              if report.faces else "layout: not checked (no two neighbouring faces with a photo or ring map)")
+        print(f"layout: {len(report.faces)} faces checked, none looks turned or mirrored{skipped}"
+              if report.faces else f"layout: not checked (no two neighbouring faces with a photo or ring map){skipped}")
 
 
 def open_block(spec, size_mm: float | None = None, face_px: int = 256):

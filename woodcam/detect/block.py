@@ -391,7 +391,8 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     det["photo_digest"] = {n: _photo_digest(f.photo) for n, f in block.faces.items() if f.photo is not None}
     det["user_svg"] = sorted(kept)
     block.meta["detection"] = det
-    # a face photographed turned or mirrored ruins the fit without a word otherwise
+    # a face photographed turned or mirrored ruins the fit without a word otherwise; a face with no
+    # rings found is not judged (its report.unchecked), and its 'no rings found' above says so
     msgs += check_face_layout(block).warnings
     manifest = write_block(block, out, traces_svg={n: f"{n}_traces.svg" for n in block.faces})
     return manifest, msgs
