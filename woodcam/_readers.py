@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import re
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -91,20 +92,32 @@ def read_image_file(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_AL
                 from pillow_heif import register_heif_opener
 
                 register_heif_opener()  # libheif turns the pixels by the file's own rotation and resets the tag
-        with Image.open(path) as im:
-            if im.width * im.height > cap:
-                raise too_big(f"{im.width}x{im.height} px")
-            # an animation's first frame was taken without a word; a phone's MPO JPEG (a depth
-            # or gain map as its second image) is one photo and is read as such
-            if getattr(im, "is_animated", False) and im.format in ("GIF", "PNG", "WEBP"):
-                raise WoodcamError(
-                    f"{what}: {str(path)!r} is an animated {im.format} of {im.n_frames} frames, not one "
-                    "photo; save the frame that shows the face as a still JPEG or PNG")
-            im.load()  # decode now: a truncated file fails here, inside the try
-            # in place: a copy of an upright 48 MP photo (PIL's 4 bytes a pixel, 190 MB) made
-            # for nothing raised a read's peak by a third
-            ImageOps.exif_transpose(im, in_place=True)
-            return _image_array(im, f"{what}: {str(path)!r}", alpha_fix)
+        with warnings.catch_warnings(record=True) as said:
+            # PIL says a damaged EXIF block (as the file opens, and again as it is turned) in
+            # UserWarnings, which the CLI drops (it prints woodcam's own): said again below,
+            # naming the file (:func:`_say_pil_warnings`); other warnings pass through as they were
+            warnings.simplefilter("always", UserWarning)
+            with Image.open(path) as im:
+                if im.width * im.height > cap:
+                    raise too_big(f"{im.width}x{im.height} px")
+                # an animation's first frame was taken without a word; a phone's MPO JPEG (a depth
+                # or gain map as its second image) is one photo and is read as such
+                if getattr(im, "is_animated", False) and im.format in ("GIF", "PNG", "WEBP"):
+                    raise WoodcamError(
+                        f"{what}: {str(path)!r} is an animated {im.format} of {im.n_frames} frames, not one "
+                        "photo; save the frame that shows the face as a still JPEG or PNG")
+                im.load()  # decode now: a truncated file fails here, inside the try
+                exif = im.getexif()
+                # an EXIF block PIL read nothing from, and said nothing of
+                unread = len(im.info.get("exif") or b"") if im.info.get("exif") and not exif else 0
+                orientation = exif.get(_EXIF_ORIENTATION)
+                # in place: a copy of an upright 48 MP photo (PIL's 4 bytes a pixel, 190 MB) made
+                # for nothing raised a read's peak by a third
+                ImageOps.exif_transpose(im, in_place=True)
+                image = _image_array(im, f"{what}: {str(path)!r}", alpha_fix)
+                fmt = im.format
+        _say_pil_warnings(said, f"{what}: {str(path)!r}", fmt, orientation, unread)
+        return image
     except WoodcamError:
         raise
     except (Image.DecompressionBombError, Image.DecompressionBombWarning) as err:  # over the cap
@@ -123,6 +136,40 @@ def read_image_file(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_AL
         # PIL raises UnidentifiedImageError (an OSError, above) for 0-byte/unknown files, OSError for
         # truncated data, SyntaxError/ValueError for some malformed headers
         raise damaged(err) from err
+
+
+#: The EXIF tag that says how a photo's pixels are to be turned to show it upright.
+_EXIF_ORIENTATION = 0x0112
+
+
+def _say_pil_warnings(said, where: str, fmt: str | None, orientation, unread: int) -> None:
+    """The warnings recorded while an image was read (``said``), each once: PIL's own (UserWarnings
+    the CLI would drop) as WoodcamWarnings naming ``where`` (what and the file), those of a damaged
+    EXIF block (and an EXIF block of ``unread`` bytes PIL read nothing from) in one saying what
+    became of its orientation tag (a phone photo's only record of which way is up); others as
+    they were."""
+    from .errors import WoodcamWarning
+
+    exif, other = [], []
+    for w in said:
+        if issubclass(w.category, UserWarning) and not issubclass(w.category, WoodcamWarning):
+            text = str(w.message)
+            # EXIF is a TIFF directory, parsed by PIL's TIFF reader: its words on a JPEG are the EXIF's
+            mine = exif if fmt != "TIFF" and ("TiffImagePlugin" in w.filename or "exif" in text.lower()) else other
+            if text not in mine:  # read as the file opens and again as it is turned: said twice
+                mine.append(text)
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if unread:
+        exif.append(f"none of its {unread} bytes could be read")
+    if exif:
+        turned = (f"its orientation tag ({orientation}) was read and applied" if orientation is not None else
+                  "no orientation tag could be read from it, so the pixels are used as stored")
+        warnings.warn(f"{where} has damaged EXIF data ({'; '.join(exif)}); {turned}: check that the image shows "
+                      "the right way up, or save it again from a photo editor to rewrite its EXIF",
+                      WoodcamWarning, stacklevel=3)
+    for text in other:
+        warnings.warn(f"{where}: {text} (said by the image library, Pillow)", WoodcamWarning, stacklevel=3)
 
 
 def read_photo_rgb(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_ALPHA_FIX):

@@ -423,6 +423,36 @@ def test_phone_photos_are_read_upright_by_their_exif_orientation(synth_photos, t
     assert np.abs(got - np.rot90(upright)).mean() > 10.0
 
 
+def test_a_photo_with_damaged_exif_is_named_in_a_warning(synth_photos, tmp_path, capsys):
+    """A photo whose EXIF block is damaged: Pillow's warning ('Tag data larger than file') was a
+    UserWarning, which the CLI drops, so the user never heard that the photo's record of which
+    way is up may be lost. Now a warning on stderr names the face's file and what became of its
+    orientation tag: read and applied (here, tag 6 before the damaged description), or not read
+    at all (an EXIF block Pillow reads nothing from, and says nothing of)."""
+    d = _copy(synth_photos, tmp_path / "exif", skip=("front", "top"))
+    with Image.open(synth_photos / "front.png") as im:
+        upright = np.asarray(im.convert("RGB"))
+    exif = Image.Exif()
+    exif[0x0112] = 6  # Orientation: rotate 90 degrees clockwise to display
+    exif[0x010E] = "x" * 200  # ImageDescription, stored after the tags: cut off below
+    Image.fromarray(np.rot90(upright).copy()).save(d / "front.jpg", quality=95, exif=exif.tobytes()[:-150])
+    with Image.open(synth_photos / "top.png") as im:
+        im.convert("RGB").save(d / "top.jpg", quality=95, exif=b"Exif\x00\x00" + b"\x13" * 40)
+    blk = tmp_path / "blk"
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", blk)
+    assert rc == 0, err
+    lines = err.splitlines()
+    front = [w for w in lines if "front.jpg" in w]
+    assert front == [f"woodcam: warning: photo of face 'front': {str(d / 'front.jpg')!r} has damaged EXIF data "
+                     "(Tag data larger than file. Skipping tag 270); its orientation tag (6) was read and applied: "
+                     "check that the image shows the right way up, or save it again from a photo editor to "
+                     "rewrite its EXIF"], err
+    (top,) = [w for w in lines if "top.jpg" in w]
+    assert "has damaged EXIF data (none of its 46 bytes could be read); no orientation tag could be read" in top
+    # the orientation still applied: the front reads back upright
+    assert np.abs(read_block(blk).faces["front"].photo.astype(float) - upright).mean() < 3.0
+
+
 def test_heic_photos_are_read(synth_photos, tmp_path, capsys):
     """HEIC, a phone camera's default format, is read (pillow-heif's opener; libheif applies the
     file's own rotation). Checked by breaking it: without ``.heic`` among the photo suffixes the
