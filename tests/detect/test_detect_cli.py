@@ -652,6 +652,38 @@ def test_a_photo_too_small_to_hold_rings_is_refused_with_the_minimum(synth_photo
     assert not (tmp_path / "o").exists()
 
 
+def test_a_rerun_clears_its_own_stale_knot_masks_and_keeps_a_users(synth_photos, tmp_path, capsys, monkeypatch):
+    """A face's knot mask from an earlier detection (left_knot_mask.png) stayed in the block
+    folder after the block was remade from new photos and detected again with no knot on that
+    face: a file of the old run beside the new manifest. Now the detector's own mask (its digest
+    recorded) is removed; a mask the user put there (top_knot_mask.png) is kept and said."""
+    from .test_detect_knots import _face_with_knot
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    knotted = _copy(synth_photos, tmp_path / "knotted")
+    Image.fromarray(_face_with_knot(160)[0]).save(knotted / "left.png")
+    blk = tmp_path / "blk"
+    size = ("--size-mm", "32")  # 5 px/mm, where the analytic knot is found
+    assert _run(capsys, "block", "from-photos", knotted, *size, "--out", blk)[0] == 0
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0, err
+    assert (blk / "left_knot_mask.png").is_file() and "knot_mask" in read_block(blk).faces["left"].extras
+    mine = np.zeros((160, 160), np.uint8)
+    mine[20:40, 30:60] = 255
+    Image.fromarray(mine).save(blk / "top_knot_mask.png")  # the user's own
+    # the block made again from knot-free photos into its folder, and detected again
+    assert _run(capsys, "block", "from-photos", synth_photos, *size, "--out", blk)[0] == 0
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0, err
+    assert not (blk / "left_knot_mask.png").exists()
+    assert not any("knot_mask" in f.extras for f in read_block(blk).faces.values())
+    with Image.open(blk / "top_knot_mask.png") as im:
+        assert np.array_equal(np.asarray(im), mine)
+    said = [w for w in err.splitlines() if "knot_mask.png" in w]
+    assert len(said) == 1 and said[0].startswith("woodcam: warning: face 'top': top_knot_mask.png in ")
+    assert "is not read (no knot was found on it this time" in said[0] and "is kept" in said[0]
+
+
 def test_a_photo_the_system_cannot_read_is_not_called_damaged(synth_photos, tmp_path, capsys, monkeypatch):
     """A photo the system would not let be read (no permission: copied off a camera card or a
     locked share; an I/O error of a failing card) was 'cannot decode the image ... the file is

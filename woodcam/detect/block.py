@@ -16,6 +16,12 @@ the ring map from them; only faces whose SVG is untouched (or missing) are detec
 also records a digest of each face photo traced (``meta["detection"]["photo_digest"]``): a
 corrected SVG drawn over another photo than the face's now is refused, not kept.
 
+**Its own knot masks, and no others, are cleared.** The manifest records a digest of each knot
+mask the detector made (``meta["detection"]["knot_digest"]``). Detecting again into the folder,
+a ``<face>_knot_mask.png`` the new detection names no more (no knot found on the face now, or
+no such face) is removed when it is still the recorded mask; a mask that is not (edited, made by
+hand, or left by a run before the digests were recorded) is kept, unread, and said.
+
 **Photo-only blocks elsewhere** (``fit``, ``bake``, ``eval``): :func:`with_detected_rings`
 detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
 folder of woodcam's cache (:mod:`woodcam._cache`: ``$WOODCAM_CACHE_DIR`` or platformdirs' user
@@ -252,10 +258,13 @@ def detection_record(folder) -> dict | None:
         return None
     svgs = {n: svg for n, svg in (rec.get("traces_svg") or {}).items()
             if isinstance(svg, str) and (folder / svg).is_file()}
-    if not svgs:
+    # the knot masks the detection made stay on disk under a remade manifest (which names none):
+    # their digests kept, the next detection clears those it finds no knot for
+    knots = _knot_digests(rec)
+    if not svgs and not knots:
         return None
     return {"traces_svg": svgs, "svg_sha256": rec.get("svg_sha256", {}),
-            "photo_digest": rec.get("photo_digest", {})}
+            "photo_digest": rec.get("photo_digest", {}), "knot_digest": knots}
 
 
 def user_edited_faces(folder) -> dict[str, Path]:
@@ -276,6 +285,60 @@ def user_edited_faces(folder) -> dict[str, Path]:
 def _photo_digest(photo) -> str:
     """Digest of a face photo's pixels as stored in a block folder (what a traced SVG is drawn over)."""
     return digest(np.asarray(photo))
+
+
+def _mask_digest(mask) -> str:
+    """Digest of a knot mask's pixels ((h, w) bool), as the detector made it."""
+    return digest(np.asarray(mask, bool))
+
+
+def _knot_digests(rec: dict | None) -> dict[str, str]:
+    """face -> digest of the knot mask a detection record says the detector made (``knot_digest``)."""
+    got = (rec or {}).get("knot_digest")
+    return {n: d for n, d in got.items() if isinstance(d, str)} if isinstance(got, dict) else {}
+
+
+def _prior_knot_digests(folder: Path) -> dict[str, str]:
+    """:func:`_knot_digests` of the block folder ``folder``'s manifest; empty without one (an
+    unreadable one is said by :func:`_readable_record` where it is read)."""
+    from ..block.io import MANIFEST
+
+    if not (folder / MANIFEST).is_file():
+        return {}
+    try:
+        return _knot_digests(_detection_record(folder))
+    except (ValueError, OSError):
+        return {}
+
+
+def _clear_stale_knot_masks(out: Path, block: Block, ours: dict[str, str]) -> list[str]:
+    """Remove each ``<face>_knot_mask.png`` in ``out`` that ``block`` (just written there) has no
+    knot mask for, when its pixels are those the detector made (``ours``: face -> digest, from
+    the folder's record before this run): a previous run's mask of a face where this run finds
+    no knot stayed beside the new manifest. Any other such file is kept and said; returns the
+    warnings."""
+    from .._readers import read_image_file
+    from ..frames import FACES
+
+    msgs = []
+    for name in FACES:
+        path = out / f"{name}_knot_mask.png"
+        face = block.faces.get(name)
+        if not path.is_file() or (face is not None and "knot_mask" in face.extras):
+            continue  # none, or this detection's own (written over)
+        try:
+            mine = name in ours and _mask_digest(read_image_file(path, "knot mask") > 127) == ours[name]
+        except WoodcamError:
+            mine = False  # unreadable: not the detector's PNG
+        if mine:
+            path.unlink()
+            continue
+        why = "no knot was found on it" if face is not None else "the block has no such face"
+        msgs.append(f"face {name!r}: {path.name} in {str(out)!r} is not read ({why} this time, and block.json does not "
+                    f"name it), and is kept: it is not the mask an earlier detection made (edited, made by hand, or from "
+                    f"before woodcam recorded its masks); delete it, or to use it name it in block.json as the face's "
+                    f"extras knot_mask and detect with --no-knots")
+    return msgs
 
 
 def _check_corrections_match_photos(block: Block, edited: dict[str, Path]) -> None:
@@ -334,6 +397,9 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     unused = {n: svg for n, svg in edited.items() if n not in block.faces}
     edited = {n: svg for n, svg in edited.items() if n in block.faces}
     _check_corrections_match_photos(block, edited)
+    # the knot masks the detector made, as the source and --out recorded them (before either is overwritten)
+    src_knots = _prior_knot_digests(src)
+    out_knots = src_knots if out.resolve() == src.resolve() else _prior_knot_digests(out)
     todo = [n for n, f in block.faces.items() if f.photo is not None and n not in edited]
     msgs: list[str] = [f"face {n!r}: the corrected {svg} is not used: the block has no {n} face (made "
                        f"without its photo); move it out of {str(svg.parent)!r} to keep it (a later detection "
@@ -390,11 +456,18 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     det["svg_sha256"] = hashes
     det["photo_digest"] = {n: _photo_digest(f.photo) for n, f in block.faces.items() if f.photo is not None}
     det["user_svg"] = sorted(kept)
+    # the detector's knot masks: this run's, and earlier ones kept unchanged (--no-knots, a
+    # corrected SVG's face): a mask of the user's is never recorded, so never cleared
+    det["knot_digest"] = {n: d for n, f in block.faces.items() if "knot_mask" in f.extras
+                          for d in [_mask_digest(f.extras["knot_mask"])]
+                          if (knots and n in todo) or src_knots.get(n) == d}
     block.meta["detection"] = det
     # a face photographed turned or mirrored ruins the fit without a word otherwise; a face with no
     # rings found is not judged (its report.unchecked), and its 'no rings found' above says so
     msgs += check_face_layout(block).warnings
     manifest = write_block(block, out, traces_svg={n: f"{n}_traces.svg" for n in block.faces})
+    # after the manifest: interrupted before, a stale mask is unnamed, never read
+    msgs += _clear_stale_knot_masks(out, block, out_knots)
     return manifest, msgs
 
 
