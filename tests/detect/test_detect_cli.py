@@ -684,6 +684,24 @@ def test_a_rerun_clears_its_own_stale_knot_masks_and_keeps_a_users(synth_photos,
     assert "is not read (no knot was found on it this time" in said[0] and "is kept" in said[0]
 
 
+def test_a_missing_or_file_input_is_one_line_that_says_which(synth_photos, tmp_path, capsys):
+    """A photo given where the block folder goes ('rings detect front.png', 'rings show
+    front.png') was said not to exist, though it is right there; a missing folder is still said
+    missing. Each is one line and the work-failed exit of every command's missing input (bake,
+    preview, gcode, fit, block show exit 1 too)."""
+    photo = synth_photos / "front.png"
+    missing = tmp_path / "nope"
+    for argv, says in (
+            (("rings", "detect", photo, "--out", tmp_path / "o"), f"block folder {str(photo)!r} is a file, not a folder"),
+            (("rings", "show", photo, "--out", tmp_path / "o.png"), f"{str(photo)!r} is a file, not a folder"),
+            (("rings", "detect", missing, "--out", tmp_path / "o"), f"block folder {str(missing)!r} does not exist"),
+            (("rings", "show", missing, "--out", tmp_path / "o.png"), f"{str(missing)!r} does not exist"),
+            (("block", "from-photos", missing, "--size-mm", "50", "--out", tmp_path / "o"), f"{str(missing)!r} is not a folder")):
+        rc, _out, err = _run(capsys, *argv)
+        assert rc == EXIT_ERROR and err.count("\n") == 1 and says in err, (argv, err)
+    assert not (tmp_path / "o").exists() and not (tmp_path / "o.png").exists()
+
+
 def test_a_photo_the_system_cannot_read_is_not_called_damaged(synth_photos, tmp_path, capsys, monkeypatch):
     """A photo the system would not let be read (no permission: copied off a camera card or a
     locked share; an I/O error of a failing card) was 'cannot decode the image ... the file is

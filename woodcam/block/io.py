@@ -352,9 +352,9 @@ def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | No
     folder = Path(folder)
     if folder.name == MANIFEST and folder.is_file():
         folder = folder.parent
-    if not folder.is_dir():
+    if not folder.is_dir():  # a photo given for its folder was said 'does not exist'
         raise WoodcamError(f"folder must be a block folder (with {MANIFEST}) or a Mokume sample "
-                           f"folder; {str(folder)!r} does not exist")
+                           f"folder; {str(folder)!r} {'is a file, not a folder' if folder.exists() else 'does not exist'}")
     if (folder / MANIFEST).is_file():
         block = read_block(folder)
         if size_mm is not None and tuple(map(float, size_mm)) != tuple(block.size_mm):

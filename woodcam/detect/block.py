@@ -374,9 +374,9 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     from ..block.svg import read_traces_svg, write_traces_svg
 
     src, out = Path(src), Path(out)
-    if not src.is_dir():
-        raise WoodcamError(f"block folder {str(src)!r} does not exist; pass a block folder made by "
-                           f"'woodcam block from-photos' or a Mokume sample folder")
+    if not src.is_dir():  # a photo given for its folder was said 'does not exist'
+        raise WoodcamError(f"block folder {str(src)!r} {'is a file, not a folder' if src.exists() else 'does not exist'}; "
+                           f"pass a block folder made by 'woodcam block from-photos' or a Mokume sample folder")
     # the one reader of folders: a folder of the user's own photos (front.jpg ...) was 'must hold a
     # block.json or Mokume files; found neither', no word of 'block from-photos'; it says so now.
     # It warns that a size_mm given for a block folder is not used.
