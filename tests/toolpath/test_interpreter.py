@@ -338,6 +338,29 @@ def test_units_incremental_g53_g28():
     assert [m[2] for m in moves] == [(6, 0, 30), (1, 0, 30), (0, 0, 30)]
 
 
+def test_m61_loads_a_tool_and_keeps_the_selected_one_for_the_next_m6():
+    """M61 Qn says tool n is loaded and leaves the T word's selection as it was (LinuxCNC sets
+    only its loaded tool; checked against its interpreter in test_linuxcnc_oracle): a later M6
+    loads the selected tool. Woodcam made M61's tool the selected one too, so "T5 / M61 Q3 /
+    M6" cut with T3 where the machine loads T5, and #<_selected_tool> read 3."""
+    def run(text):
+        moves, warns = Interpreter(text + "\nM2\n", start_mm=(0, 0, 10)).run()
+        return ([(m[2][:2], m[8]) for m in moves],
+                [w for _, w in warns if "selected without M6" in w])
+
+    moves, warns = run("T5\nM61 Q3\nG0 X#<_selected_tool> Y#<_current_tool>\nM6\n"
+                       "G1 X1 Y1 Z0 F100")
+    assert moves == [((5, 3), 3), ((1, 1), 5)] and warns == []
+    # the selected T5 not loaded: the cut goes on with M61's T3, and says so
+    assert run("T5\nM61 Q3\nG1 X1 Y1 Z0 F100") == ([((1, 1), 3)], [
+        "T5 was selected without M6: the cut goes on with the loaded tool T3, as the "
+        "controller does"])
+    # no T word pending (none, or changed by M6 before M61): no such warning
+    assert run("M61 Q3\nG1 X1 Y1 Z0 F100") == ([((1, 1), 3)], [])
+    assert run("T5 M6\nM61 Q3\nG1 X1 Y1 Z0 F100\nG0 X#<_selected_tool>") == (
+        [((1, 1), 3), ((5, 1), 3)], [])
+
+
 def test_position_and_tool_parameters_read_as_linuxcnc():
     """#5420-#5422 are the current position in the program's units and frame (checked against
     LinuxCNC's interpreter); they read 0. #5400 missed M61. The read-only ones could be

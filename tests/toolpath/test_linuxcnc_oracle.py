@@ -13,7 +13,7 @@ import pytest
 from woodcam.toolpath import read_gcode
 from woodcam.toolpath.interpreter import GcodeError, Interpreter
 from woodcam.toolpath.linuxcnc import (NO_END, canonical, compare_canonical, linuxcnc_missing,
-                                       run_batch)
+                                       run_batch, run_linuxcnc)
 
 from .gcode_fuzz import oword_program, program
 
@@ -348,6 +348,20 @@ def test_feed_spindle_and_tool_agree_with_linuxcnc():
     assert prog.feed_mm_min[prog.kind != 0].tolist() == pytest.approx([300, 300, 200, 10])
     # (LinuxCNC stops the spindle at a tool change: T2's cuts report it off)
     assert prog.spindle_rpm.tolist()[1:] == [12000, 12000, 12000, 0, 0]
+
+
+def test_m61_keeps_the_selected_tool_for_the_next_m6_as_linuxcnc():
+    """After "T5 / M61 Q3" LinuxCNC's #<_selected_tool> reads 5 and the M6 that follows loads
+    T5 (M61 sets only the loaded tool); woodcam read 3 and cut with T3. (The tool of the
+    moves between M61 and M6 is not compared: the oracle, AXIS's preview, reports the tool of
+    the last M6, T7, where the machine has M61's T3 loaded.)"""
+    text = ("T7 M6\nT5\nM61 Q3\nG0 X[1000 + #<_selected_tool>] Y0\nG0 X0\nM6\n"
+            "G1 X1 Y1 Z0 F100\nM2\n")
+    theirs, _ = run_linuxcnc(text, start_mm=START)
+    mine, _ = Interpreter(text, start_mm=START).run()
+    assert [m[2] for m in mine] == [pytest.approx(t[2]) for t in theirs]
+    assert mine[-1][8] == theirs[-1][8] == 5
+    assert [(m[2][0], m[8]) for m in mine] == [(1005, 3), (0, 3), (1, 5)]
 
 
 def test_the_spindle_started_on_a_move_line_before_a_blank_line_is_read_on():

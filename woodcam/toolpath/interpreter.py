@@ -579,6 +579,9 @@ class Interpreter:
         self.overrides = {"speed": True, "feed": True, "adaptive": False, "hold": True}
         self.tool = 0
         self.selected = 0
+        # a T word read and no M6 since: its tool is not the loaded one (M61 loads another
+        # without touching the selection, as LinuxCNC)
+        self._t_pending = False
         self.cs = int(self.p[5220])
         self.g5x = [self.p.get(_cs_base(self.cs) + i, 0.0) for i in range(3)]
         self.g92 = [self.p.get(5211 + i, 0.0) for i in range(3)] if self.p.get(5210) else [0.0] * 3
@@ -634,7 +637,8 @@ class Interpreter:
             x, y, z = (v + m for v, m in zip(self.pos, self.mzero or (0, 0, 0)))  # G-code frame
             self.warn(f"the first cut starts before the program set {miss}: it starts from "
                       f"the start position {say_length((x, y, z), 'g', form='X{} Y{} Z{}')} (--start)")
-        if kind != TRAVERSE and self.selected != self.tool and self.selected not in self._t_warned:
+        if (kind != TRAVERSE and self._t_pending and self.selected != self.tool
+                and self.selected not in self._t_warned):
             self._t_warned.add(self.selected)
             self.warn(f"T{self.selected} was selected without M6: the cut goes on with the "
                       f"loaded tool T{self.tool}, as the controller does")
@@ -1816,12 +1820,16 @@ class Interpreter:
             self.spindle = w["s"]
         if "t" in w:
             self.selected = int(w["t"])
+            self._t_pending = True
         if 61 in mset:  # M61 Qn: the loaded tool is n, no change
             if "q" not in w or w["q"] != math.floor(w["q"]) or w["q"] < 0:
                 raise self.err("M61", "M61 needs Q = a tool number", "write M61 Q1")
-            self.tool = self.selected = int(w["q"])
+            # the selected tool stays (LinuxCNC sets only the loaded one): a later M6 loads the
+            # T word's tool, not M61's
+            self.tool = int(w["q"])
         if 6 in mset:
             self.tool = self.selected
+            self._t_pending = False
             if self.dialect == "linuxcnc":
                 # LinuxCNC stops the spindle for a tool change (TOOL_CHANGE_WITH_SPINDLE_ON
                 # is off by default); an M3/M4 on the same line starts it again (step 7 of its
