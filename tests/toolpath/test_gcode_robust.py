@@ -6,13 +6,14 @@ from __future__ import annotations
 import functools
 import inspect
 import math
+import os
 import signal
 from collections import Counter
 from contextlib import contextmanager
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from woodcam.errors import WoodcamError
@@ -104,6 +105,28 @@ def test_moves_far_outside_the_stock_cut_what_they_say(text, volume):
     assert res.report  # the moves outside the stock are reported
 
 
+#: The costliest fuzzed program that is no defect: a loop of moves the interpreter stops at its
+#: guard, after MAX_BLOCKS executed lines (the token grammar writes it: o3 while, [, 1, ], ...).
+_GUARDED_LOOP = "o3 while [1]\nG1 F100 X1\nG1 F100 X-1\no3 endwhile\nM2\n"
+
+
+@functools.cache
+def _fuzz_deadline() -> float:
+    """CPU seconds (user, as SIGVTALRM counts) one fuzzed program may take before it counts as
+    a hang: twice what _GUARDED_LOOP costs on this machine now, predicted from the CPU per
+    line of 20,000 of its lines (measured, in this process, 27-33 us a line on a loaded
+    2-core machine: 13.5-16.5 s for MAX_BLOCKS lines, 14.2 s run whole), and at least 10 s.
+    A fixed 10 s was the guard's own budget (MAX_BLOCKS is sized for ~10 s at 50,000
+    lines/s), so on a slower or loaded machine a program stopped as it should failed the
+    test. A hang (work no guard bounds) still fails: it never ends."""
+    n = 20_000
+    start = os.times().user
+    with pytest.raises(GcodeError, match="endless loop"):
+        Interpreter(_GUARDED_LOOP, max_blocks=n).run()
+    per_line = (os.times().user - start) / n
+    return max(10.0, 2.0 * per_line * MAX_BLOCKS)
+
+
 def _check(text):
     """The invariant: a WoodcamError, or a program of finite moves that simulates. Returns
     ``"error"``, ``"simulated"`` or ``"read"`` (no moves, or too many to simulate here)."""
@@ -150,7 +173,7 @@ def test_fuzzed_token_programs_keep_the_invariant():
     @settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck))
     @given(_PROGRAM)
     def one(text):
-        with _deadline(10):
+        with _deadline(_fuzz_deadline()):
             outcomes.append(_check(text))
 
     one()
@@ -169,8 +192,9 @@ def test_fuzzed_structured_programs_keep_the_invariant():
 @pytest.mark.slow
 @settings(max_examples=20_000, deadline=None, suppress_health_check=list(HealthCheck))
 @given(_PROGRAM)
+@example(_GUARDED_LOOP)  # the worst case the deadline is sized for, run to the guard
 def test_fuzz_campaign_token_programs(text):
-    with _deadline(10):
+    with _deadline(_fuzz_deadline()):
         _check(text)
 
 
@@ -178,7 +202,7 @@ def test_fuzz_campaign_token_programs(text):
 def test_fuzz_campaign_structured_programs():
     outcomes = []
     for seed in range(5000, 7000):
-        with _deadline(10):
+        with _deadline(_fuzz_deadline()):
             outcomes.append(_check(program(seed, n_lines=60, valid_share=0.99)))
     print(f"structured fuzz: {outcomes.count('simulated')} simulated, "
           f"{outcomes.count('error')} refused")
