@@ -117,3 +117,26 @@ def glb_with():
     """``glb_with(meta, path) -> path``: a minimal GLB carrying only woodcam's metadata ``meta``
     (what ``stock_of_glb`` and ``preview`` read), for tests of the block a GLB names."""
     return _glb_with
+
+
+def _glb_placed_twice(path: Path) -> Path:
+    """A GLB of one 10 mm box (mesh "a") placed by two nodes, at x = 30 ("moved") and at the
+    origin ("at_zero"): one mesh, two placements, as an exporter writes an instanced part."""
+    import trimesh
+
+    box = trimesh.creation.box((10.0, 10.0, 10.0))
+    moved = np.eye(4)
+    moved[0, 3] = 30.0
+    scene = trimesh.Scene()
+    scene.add_geometry(box, geom_name="a", node_name="moved", transform=moved)
+    scene.graph.update(frame_to="at_zero", frame_from=scene.graph.base_frame, geometry="a",
+                       matrix=np.eye(4))
+    scene.export(path)
+    return path
+
+
+@pytest.fixture
+def glb_placed_twice():
+    """``glb_placed_twice(path) -> path``: writes :func:`_glb_placed_twice` (one box mesh placed
+    at x = 0 and x = 30), for the readers that must take or refuse both placements."""
+    return _glb_placed_twice

@@ -466,18 +466,11 @@ def test_an_empty_or_nan_mesh_is_one_error_and_writes_nothing(baked, tmp_path, n
         load_textured(tmp_path / "empty.obj")
 
 
-def test_a_mesh_placed_twice_is_refused_not_read_as_its_first_placement(tmp_path):
+def test_a_mesh_placed_twice_is_refused_not_read_as_its_first_placement(tmp_path, glb_placed_twice):
     """load_textured returns one mesh: a file of one mesh placed by two nodes came back as the
     first placement alone, the second dropped without a word."""
-    box = trimesh.creation.box((10.0, 10.0, 10.0))
-    moved = np.eye(4)
-    moved[0, 3] = 30.0
-    scene = trimesh.Scene()
-    scene.add_geometry(box, geom_name="a", node_name="moved", transform=moved)
-    scene.graph.update(frame_to="at_zero", frame_from=scene.graph.base_frame, geometry="a", matrix=np.eye(4))
-    scene.export(tmp_path / "twice.glb")
     with pytest.raises(WoodcamError, match="holds 1 meshes placed 2 times; expected exactly one mesh placed once"):
-        load_textured(tmp_path / "twice.glb")
+        load_textured(glb_placed_twice(tmp_path / "twice.glb"))
 
 
 def test_an_export_refused_by_its_folder_names_the_file_asked_for(baked, monkeypatch):

@@ -174,7 +174,7 @@ def test_an_empty_or_nan_mesh_is_one_error_naming_the_file(tmp_path, capsys):
         woodify(trimesh.Trimesh(v, box.faces, process=False), 2.0, resolution=16)
 
 
-def _two_box_scenes(tmp_path):
+def _two_box_scenes(tmp_path, glb_placed_twice):
     """A GLB of two boxes (centres x = 0 and 30) and a GLB of one box placed at both."""
     a, b = trimesh.creation.box((10.0, 10.0, 10.0)), trimesh.creation.box((10.0, 10.0, 10.0))
     b.apply_translation((30.0, 0.0, 0.0))
@@ -182,20 +182,14 @@ def _two_box_scenes(tmp_path):
     two.add_geometry(a, geom_name="a")
     two.add_geometry(b, geom_name="b")
     two.export(tmp_path / "two.glb")
-    moved = np.eye(4)
-    moved[0, 3] = 30.0
-    twice = trimesh.Scene()
-    twice.add_geometry(a, geom_name="a", node_name="moved", transform=moved)
-    twice.graph.update(frame_to="at_zero", frame_from=twice.graph.base_frame, geometry="a", matrix=np.eye(4))
-    twice.export(tmp_path / "twice.glb")
-    return tmp_path / "two.glb", tmp_path / "twice.glb"
+    return tmp_path / "two.glb", glb_placed_twice(tmp_path / "twice.glb")
 
 
-def test_a_file_of_several_meshes_grows_all_of_them(tmp_path, capsys):
+def test_a_file_of_several_meshes_grows_all_of_them(tmp_path, capsys, glb_placed_twice):
     """A GLB of two meshes was refused by load_textured ('holds 2 meshes'), and a GLB of one mesh
     placed twice grew its first placement alone, the other dropped without a word: both boxes
     grow now (their union, as a part file's meshes), year 0 inside each."""
-    for path in _two_box_scenes(tmp_path):
+    for path in _two_box_scenes(tmp_path, glb_placed_twice):
         out = tmp_path / f"o_{path.stem}"
         assert main(["woodify", str(path), "--years", "2", "--resolution", "24", "--cracks", "none",
                      "--out", str(out)]) == 0, capsys.readouterr().err
