@@ -431,12 +431,12 @@ def test_a_resized_stock_is_its_parents_wood_from_its_origin():
     np.testing.assert_allclose(turned.wood.years(r),
                                parent.wood.years(np.column_stack([r[:, 1] + 5, 80 - (r[:, 0] + 6), r[:, 2] + 7])),
                                atol=1e-9)
-    same = resize_stock(parent, (300.0, 20.0, 10.0))
-    assert same.spec == "builtin:knotty[300x20x10]"
+    same = resize_stock(parent, (60.0, 20.0, 10.0))
+    assert same.spec == "builtin:knotty[60x20x10]"
     np.testing.assert_allclose(same.wood.color(p, n), parent.wood.color(p, n), atol=1e-9)
 
 
-@pytest.mark.parametrize("base", ["builtin:knotty", "builtin:knotty~z90", "builtin:flat-sawn:60x50x30~x-90"])
+@pytest.mark.parametrize("base", ["builtin:knotty", "builtin:knotty~z90", "builtin:flat-sawn:60x50x40~x-90"])
 def test_every_spec_woodcam_writes_reopens_as_the_same_wood(base, tmp_path):
     """A resized stock's spec (``gcode --stock 40x30x20 --stock-origin 5,5,5`` writes
     'builtin:knotty[40x30x20@5,5,5]' into its GLB) was refused by open_stock, so 'woodcam
@@ -527,10 +527,10 @@ def test_a_resize_reads_the_numbers_a_size_reads_and_what_resize_stock_writes():
         cut = resize_stock(whole, (40.0, 30.0, 20.0), origin)
         again = open_stock(cut.spec)
         assert again.size_mm == cut.size_mm and again.meta["origin_mm"] == list(origin), cut.spec
-    odd = "builtin:knotty[1e1x3E1x+20@+5,-5e-1,5]"
+    odd = "builtin:knotty[1e1x3E1x+20@+5,+5e-1,5]"
     got = open_stock(odd)
-    assert got.size_mm == (10.0, 30.0, 20.0) and got.meta["origin_mm"] == [5.0, -0.5, 5.0]
-    assert spec_digest(odd) == spec_digest("builtin:knotty[10x30x20@5,-0.5,5]")
+    assert got.size_mm == (10.0, 30.0, 20.0) and got.meta["origin_mm"] == [5.0, 0.5, 5.0]
+    assert spec_digest(odd) == spec_digest("builtin:knotty[10x30x20@5,0.5,5]")
     with pytest.raises(WoodcamError, match=r"the size must be WxDxH in mm, each > 0 .* got '-40x30x20'"):
         open_stock("builtin:knotty[-40x30x20]")  # a resize, its size refused as such
 
@@ -558,3 +558,48 @@ def test_a_log_file_in_a_folder_with_an_at_sign_is_read(tmp_path, monkeypatch):
     p = np.random.default_rng(1).uniform(0, 1, (500, 3)) * got.size_mm
     assert got.size_mm == want.size_mm == (30.0, 40.0, 20.0)
     np.testing.assert_array_equal(got.wood.years(p), want.wood.years(p))
+
+
+@pytest.mark.parametrize("spec, asked, block, fix", [
+    # past the far side of the 100 x 80 x 50 mm block
+    ("builtin:flat-sawn[120x80x50]", "runs from (0, 0, 0) mm to (120, 80, 50) mm", "100x80x50 mm",
+     "give a resize that fits, [100x80x50] or smaller, or a block that holds it: "
+     "builtin:flat-sawn:120x80x50[120x80x50]"),
+    # a corner before the block's own
+    ("builtin:flat-sawn[40x30x20@-10,0,0]", "runs from (-10, 0, 0) mm to (30, 30, 20) mm", "100x80x50 mm",
+     "give a resize that fits, [40x30x20] or smaller"),
+    # cut in the turned frame: the turned block is 80 x 100 x 50 mm
+    ("builtin:flat-sawn~z90[40x30x20@50,0,0]", "runs from (50, 0, 0) mm to (90, 30, 20) mm", "80x100x50 mm",
+     "give a resize that fits, [30x30x20@50,0,0] or smaller"),
+    # a resize of a resize: the second is cut from the first's 40 x 30 x 20 mm
+    ("builtin:knotty[40x30x20@5,5,5][10x10x10@35,0,0]", "runs from (35, 0, 0) mm to (45, 10, 10) mm",
+     "40x30x20 mm", "give a resize that fits, [5x10x10@35,0,0] or smaller"),
+])
+def test_a_resize_past_its_block_is_refused_naming_the_extents_and_the_fix(spec, asked, block, fix, capsys,
+                                                                          tmp_path):
+    """A resize '[WxDxH@X,Y,Z]' reaching past the block before it ('builtin:flat-sawn[120x80x50]'
+    of a 100 x 80 x 50 mm block) was opened without a word: wood of the field outside the block
+    (for a fitted block an extrapolation, wood the user does not have), where 'gcode --stock'
+    past the block is refused. Now open_stock and resize_stock refuse it naming the spec, the
+    extent asked, the block's and the fix, and a --block typed so is a usage error (exit 2, one
+    line); the fix given opens."""
+    from woodcam.cli import main
+    from woodcam.errors import BlockSpecError
+    from woodcam.stock import resize_stock
+
+    with pytest.raises(BlockSpecError) as got:
+        open_stock(spec)
+    msg = str(got.value)
+    assert msg.startswith(f"block spec {spec!r}: the resize ") and asked in msg, msg
+    assert f"past the {block} block before it" in msg and msg.endswith(fix), msg
+    assert "not of the field outside it" in msg
+    fixed = fix.split(", ")[1].split(" ")[0]
+    base = spec[:spec.rindex("[")]
+    assert open_stock(base + fixed).size_mm == tuple(float(v) for v in fixed[1:].split("@")[0].rstrip("]").split("x"))
+    # the API's own door, resize_stock
+    with pytest.raises(BlockSpecError, match=r"past the 100x80x50 mm block before it"):
+        resize_stock(open_stock("builtin:knotty"), (60.0, 20.0, 10.0), (50.0, 0.0, 0.0))
+    # the command line: typed in --block, a usage error before the part is read (it is not there)
+    assert main(["place", str(tmp_path / "no-part.stl"), "--block", spec, "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err == f"woodcam: error: --block {spec}: {msg.split(': ', 1)[1]}\n", err

@@ -21,11 +21,13 @@ class BlockSpecError(WoodcamError):
     names the spec in mm. ``part`` says which part ("size": the base's ``:WxDxH``; "resize",
     "turn", "op": an operation not in the grammar; "log": ``log:LOG@KNOT``), ``text`` is that
     part as written and ``rule`` the message without the spec, so the command line can say it
-    of its ``--block`` in the units typed."""
+    of its ``--block`` in the units typed; ``spec`` is the whole spec where the error knows it
+    (a resize past its block, found when the block is opened: the command line tells a spec
+    typed there, a usage error, from one a GLB recorded)."""
 
-    def __init__(self, message: str, *, part: str = "", text: str = "", rule: str = ""):
+    def __init__(self, message: str, *, part: str = "", text: str = "", rule: str = "", spec: str = ""):
         super().__init__(message)
-        self.part, self.text, self.rule = part, text, rule
+        self.part, self.text, self.rule, self.spec = part, text, rule, spec
 
 
 class MissingDependencyError(WoodcamError, ImportError):

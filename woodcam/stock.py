@@ -24,7 +24,8 @@ Any spec may end in turns of the block under the part, ``~AXIS90`` (a multiple o
 about the block axis ``x``, ``y`` or ``z``; chainable, e.g. ``builtin:flat-sawn~z90`` runs the
 grain along Y): the block's size axes swap accordingly and the wood turns with it. It may also
 end in resizes, ``[WxDxH]`` or ``[WxDxH@X,Y,Z]``: a ``W x D x H`` mm block cut from the block
-before it with its corner at ``X, Y, Z`` mm of that block's frame (:func:`resize_stock`, what
+before it with its corner at ``X, Y, Z`` mm of that block's frame, inside that block
+(:func:`check_resize_in_block`; :func:`resize_stock`, what
 ``woodcam gcode --stock --stock-origin`` records in its GLB, so ``woodcam preview`` reopens
 it). Turns and resizes apply in the order written. Their numbers are plain numbers (a sign and
 an exponent allowed, as in ``:WxDxH``), with no spaces. One reader parses this grammar,
@@ -38,6 +39,7 @@ block and sample folders are only read, never written (they are often read-only 
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import warnings
 from dataclasses import dataclass, field
@@ -49,7 +51,7 @@ import numpy as np
 from ._checks import check_bool
 from ._specs import ParsedSpec, format_op, parse_spec, split_spec
 from .appearance import ColorMapAppearance, NeuralAppearance, Wood
-from .errors import WoodcamError, WoodcamWarning
+from .errors import BlockSpecError, WoodcamError, WoodcamWarning
 from .fields.base import has_uncertainty
 from .fields.builtin import BUILTIN_NAMES, builtin_block
 
@@ -79,8 +81,9 @@ class Stock:
 
 def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:
     """A ``W x D x H`` stock cut from ``stock``'s wood with its corner at ``origin_mm`` (block
-    frame, mm): any size and position, not only the built-in blocks' (the wood's growth field
-    is defined everywhere). ``size_mm`` > 0 and ``origin_mm`` finite, in mm."""
+    frame, mm): any size and position in the block, ``[0,W] x [0,D] x [0,H]`` of ``stock``
+    (:func:`check_resize_in_block`; a larger block is a larger base, ``builtin:NAME:WxDxH``).
+    ``size_mm`` > 0 and ``origin_mm`` finite, in mm."""
     size = np.asarray(size_mm, float).reshape(-1)
     origin = np.asarray(origin_mm, float).reshape(-1)
     if size.shape != (3,) or not (np.isfinite(size).all() and (size > 0).all()):
@@ -89,6 +92,11 @@ def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:
     if origin.shape != (3,) or not np.isfinite(origin).all():
         raise WoodcamError(f"resize_stock: origin_mm must be three finite numbers (mm), got "
                            f"{origin_mm!r}; e.g. (0, 0, 0)")
+    try:  # what the block is, for the fix a refusal names ('test' or the like: a folder, no fix)
+        parsed: ParsedSpec | None = parse_spec(stock.spec)
+    except WoodcamError:
+        parsed = None
+    check_resize_in_block(stock.spec, stock.size_mm, size, origin, parsed)
     W, D, H = size.tolist()
     # written as the spec reader reads it back (12 digits: ':g' rounded 0.1234567 to 0.123457,
     # and its '1e-05' was no operation to the reader)
@@ -104,6 +112,49 @@ def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:
     return Stock(spec, (W, D, H), wood, stock.description,
                  {**stock.meta, "parent_size_mm": list(stock.size_mm),
                   "origin_mm": origin.tolist()})
+
+
+def check_resize_in_block(spec: str, block_size_mm, size_mm, origin_mm,
+                          parsed: ParsedSpec | None = None) -> None:
+    """Refuse a resize of ``size_mm`` at ``origin_mm`` (mm) that runs past the block before it,
+    ``[0,W] x [0,D] x [0,H]`` of ``block_size_mm``: a resize is wood of that block, not of the
+    field outside it (for a fitted block an extrapolation, wood the user does not have), as
+    ``gcode --stock`` and parquetry's leaves. A :class:`~woodcam.errors.BlockSpecError`
+    (``part`` "resize", ``spec``) naming ``spec``, the resize's extent, the block's and the fix;
+    ``parsed``: the spec of the block before the resize, where a larger base may hold it."""
+    have = np.asarray(block_size_mm, float)
+    size, origin = np.asarray(size_mm, float), np.asarray(origin_mm, float)
+    far = origin + size
+    tol = 1e-6 * float(have.max())  # a stock written back with 12 digits still fits
+    if (origin >= -tol).all() and (far <= have + tol).all():
+        return
+    from .units import message_mm_per_unit, say_length
+
+    def point(v):
+        return say_length(tuple(float(x) for x in v), ".4g", form="(" + ", ".join("{}" for _ in v) + ")")
+
+    k = message_mm_per_unit()  # a spec's numbers as the user types them (--units inch)
+
+    def typed(size_, origin_):
+        return format_op(("resize", tuple((size_ / k).tolist()), tuple((origin_ / k).tolist())))
+
+    op = typed(size, origin)
+    corner = np.maximum(origin, 0.0)
+    fits = have - corner
+    if (fits > tol).all():
+        fix = f"a resize that fits, {typed(np.minimum(size, fits), corner)} or smaller"
+    else:
+        fix = "a resize whose corner is inside the block"
+    if parsed is not None and parsed.kind in ("builtin", "log") and not parsed.ops and (origin >= -tol).all():
+        bigger = "x".join(f"{v:.12g}" for v in np.maximum(have, far) / k)
+        base = parsed.base if parsed.size_mm is None else parsed.base[:parsed.base.rfind(":")]
+        fix += f", or a block that holds it: {base}:{bigger}{op}"
+    elif parsed is not None and parsed.kind in ("folder", "woodify"):
+        fix += " (a block folder or a grown block holds only its own wood)"
+    rule = (f"the resize {op} runs from {point(origin)} to {point(far)}, past the "
+            f"{say_length(tuple(have.tolist()), '.4g')} block before it (its wood is (0, 0, 0) to "
+            f"{point(have)}): a resize is wood of the block, not of the field outside it; give {fix}")
+    raise BlockSpecError(f"block spec {spec!r}: {rule}", part="resize", text=op, rule=rule, spec=spec)
 
 
 def open_stock(spec: str, *, species: str | None = None,
@@ -157,8 +208,10 @@ def open_stock(spec: str, *, species: str | None = None,
     if not parsed.ops:
         return stock
     turns = []
-    for op in parsed.ops:  # in the order written: a resize of a turned block is cut in the turned frame
-        if op[0] == "resize":
+    for i, op in enumerate(parsed.ops):  # in the order written: a resize of a turned block is cut in the turned frame
+        if op[0] == "resize":  # named as given (the stock's own spec lacks the turns before it)
+            check_resize_in_block(str(spec), stock.size_mm, op[1], op[2],
+                                  dataclasses.replace(parsed, ops=parsed.ops[:i]))
             stock = resize_stock(stock, op[1], op[2])
         else:
             wood, size = stock.wood.turned(op[1], op[2], stock.size_mm)

@@ -93,6 +93,12 @@ def message_unit() -> str:
     return _SYMBOL[_message_units]
 
 
+def message_mm_per_unit() -> float:
+    """Millimetres per message unit (:func:`message_units`): 1, or 25.4 under ``--units inch``,
+    for a message that writes a spec's plain numbers as the user types them."""
+    return MM_PER_UNIT[_message_units]
+
+
 def say_length(mm, spec: str = ".3g", sep: str = "x", form: str | None = None, *,
                units: Units | None = None) -> str:
     """A length (or several) given in mm, for a message, in the message units

@@ -239,6 +239,10 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             if isinstance(err, UsageError):
                 print(f"woodcam: error: {err}", file=sys.stderr)
                 return EXIT_USAGE
+            typed = _typed_spec(args, err)
+            if typed:  # a spec typed here broke a rule only its block knows: the command line is wrong
+                print(f"woodcam: error: {typed}: {err.rule}", file=sys.stderr)
+                return EXIT_USAGE
             if isinstance(err, WoodcamError):
                 print(f"woodcam: error: {err}", file=sys.stderr)
                 return EXIT_ERROR
@@ -257,6 +261,23 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             if not interrupted:  # an interrupted run is one line: its work is dropped anyway
                 print_warnings(str(w.message) for w in caught if _is_ours(w))
     return rc
+
+
+def _typed_spec(args: argparse.Namespace, err: BaseException) -> str:
+    """``"--block SPEC"`` (as typed) where ``err`` is a :class:`~woodcam.errors.BlockSpecError`
+    of a spec given on this command line (``--block``, ``--veneer-from``): a resize past its
+    block, found when the block is opened (:func:`woodcam.stock.check_resize_in_block`), after
+    the door. "" otherwise: a spec a GLB or a job file recorded is a file's, not the command's."""
+    from ..errors import BlockSpecError
+    from .options import as_typed
+
+    if not isinstance(err, BlockSpecError) or not err.spec:
+        return ""
+    if getattr(args, "block", None) == err.spec:  # in mm once read at the door (lengths_to_mm)
+        return f"--block {as_typed(args, 'block')}"
+    if err.spec in (getattr(args, "veneer_from", None) or []):
+        return f"--veneer-from {err.spec}"
+    return ""
 
 
 def _interrupted(err: BaseException) -> bool:
