@@ -383,10 +383,12 @@ def test_leaves_beyond_their_block_are_refused_naming_the_sizes(scans, capsys):
     wood of the field outside the block, which the block does not hold (for a fitted or grown
     block an extrapolation). Now a leaf larger than the block's face, or leaves past its back
     face, are refused naming the sizes and the fix (also from a job file), and the default
-    leaf is 600 x 400 mm or the block's face where smaller."""
+    leaf is 600 x 400 mm or the block's face where smaller. Leaves the command line sized
+    (--veneer-from, --sheet-size, --sheets, also over a job's blocks) are a usage error, exit 2
+    and one line, as gcode --stock past its block (they exited 1); a job file's own, 1."""
     out = scans / "out"
     flat = ["--veneer-from", "builtin:flat-sawn", "--no-glb"]
-    assert _small_run(scans, out, *flat, "--sheet-size", "120x40") == 1
+    assert _small_run(scans, out, *flat, "--sheet-size", "120x40") == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and ("leaves of 120 x 40 mm (--sheet-size; width_mm, height_mm in a job file) do not fit "
                                      "builtin:flat-sawn: its 100 x 80 x 50 mm block's face normal to y (--slice-axis) is "
@@ -395,7 +397,7 @@ def test_leaves_beyond_their_block_are_refused_naming_the_sizes(scans, capsys):
            "(builtin:flat-sawn:120x80x50)" in err
     assert _small_run(scans, out, *flat, "--sheet-size", "40x60", "--slice-axis", "z") == 0  # face 100 x 80
     capsys.readouterr()
-    assert _small_run(scans, out, *flat, "--sheets", "60") == 1
+    assert _small_run(scans, out, *flat, "--sheets", "60") == 2
     assert ("60 leaves (--sheets) of 0.6 mm + 0.4 mm kerf, sliced from the middle of builtin:flat-sawn along y, "
             "reach 99.6 mm into its 80 mm: past its back face") in capsys.readouterr().err
     job = json.loads((out / "job.json").read_text())
@@ -404,6 +406,11 @@ def test_leaves_beyond_their_block_are_refused_naming_the_sizes(scans, capsys):
     assert main(["parquetry", "--config", str(scans / "job.json"), "--out", str(scans / "out2"), "--quiet",
                  "--no-glb"]) == 1
     assert "leaves of 80 x 60 mm" in capsys.readouterr().err
+    # the job's block given leaf options here: the command line sized them
+    assert main(["parquetry", "--config", str(scans / "job.json"), "--out", str(scans / "out2"), "--quiet",
+                 "--no-glb", "--sheets", "60", "--sheet-size", "40x40"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "60 leaves (--sheets)" in err, err
     # the default: the block's 100 x 50 mm face, not 600 x 400 mm of wood round it
     assert _small_run(scans, out, *flat) == 0
     result = json.loads((out / "result.json").read_text())

@@ -195,6 +195,7 @@ def run(args) -> int:
     from ..errors import UsageError, WoodcamError
     from ..parquetry.engine import build_parquetry
     from ..parquetry.job import (
+        LeavesPastBlockError,
         ParquetryJob,
         job_targets,
         job_veneers,
@@ -235,12 +236,16 @@ def run(args) -> int:
     keys = {"sheets": ["sheets"], "sheet_size": ["width_mm", "height_mm"], "leaf_thickness": ["thickness_mm"],
             "saw_kerf": ["kerf_mm"], "slice_axis": ["axis"], "species": ["species"]}
     job.blocks = [{**b, **{k: leaf[k] for d in given for k in keys[d]}} for b in job.blocks]
+    # the blocks whose leaves this command line sized (--veneer-from, or a job's blocks given
+    # leaf options here): leaves past such a block are a wrong command line, exit 2
+    sized_here = [b for b in job.blocks if set(given) - {"species"}]
     for spec in args.veneer_from:
         sp = Path(spec)
         if sp.is_dir() and any(sp.glob("?_col.png")):
             job.mokume.append(str(sp))
         else:
             job.blocks.append({"spec": spec, **{k: v for k, v in leaf.items() if v is not None or k == "species"}})
+            sized_here.append(job.blocks[-1])
     if given and not job.blocks:  # nothing silently dropped
         sources = " and ".join(n for n, on in (("scans (--veneer)", job.scans),
                                                ("Mokume sample folders", job.mokume)) if on)
@@ -256,7 +261,12 @@ def run(args) -> int:
     targets, names = job_targets(job)
     from ..stock import open_stock
 
-    veneers = job_veneers(job, open_stock=open_stock, progress=progress)
+    try:
+        veneers = job_veneers(job, open_stock=open_stock, progress=progress)
+    except LeavesPastBlockError as err:  # a job file's own leaves: the file is wrong (exit 1)
+        if any(err.entry is b for b in sized_here):
+            raise UsageError(str(err)) from err
+        raise
     run_ = build_parquetry(targets, veneers, job.params, names=names, progress=progress,
                            seams=not args.no_seams)
     glb_writer = None

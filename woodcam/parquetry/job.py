@@ -446,6 +446,15 @@ def write_job(job: ParquetryJob, path: str | Path) -> Path:
 DEFAULT_LEAF_MM = (600.0, 400.0)
 
 
+class LeavesPastBlockError(WoodcamError):
+    """Leaves that run past the block they are sliced from (:func:`check_leaves_in_block`);
+    ``entry`` is the job's ``woodcam.blocks`` entry they were asked by (set by
+    :func:`job_veneers`), so the command line tells leaves its options sized (a usage error)
+    from a job file's own."""
+
+    entry: dict | None = None
+
+
 def check_leaves_in_block(stock, n_sheets: int, width_mm: float | None, height_mm: float | None,
                           thickness_mm: float, kerf_mm: float, axis: str) -> tuple[float, float]:
     """The ``(width, height)`` mm of ``n_sheets`` leaves sliced from ``stock`` normal to
@@ -473,7 +482,7 @@ def check_leaves_in_block(stock, n_sheets: int, width_mm: float | None, height_m
         need = list(size)
         need[right], need[down] = max(size[right], w), max(size[down], h)
         bigger = " x ".join(f"{v:g}" for v in need)
-        raise WoodcamError(
+        raise LeavesPastBlockError(
             f"leaves of {w:g} x {h:g} mm (--sheet-size; width_mm, height_mm in a job file) do not fit "
             f"{stock.spec}: its {block} mm block's face normal to {axis} (--slice-axis) is {face[0]:g} x "
             f"{face[1]:g} mm, and every sheet must be wood of the block, not of the field outside it; give "
@@ -486,7 +495,7 @@ def check_leaves_in_block(stock, n_sheets: int, width_mm: float | None, height_m
     reach = size[ax] / 2 + (n_sheets - 1) * pitch + thickness_mm
     if n_sheets >= 1 and thickness_mm > 0 and pitch > 0 and reach > size[ax] + tol:
         most = max(0, int((size[ax] / 2 - thickness_mm) // pitch) + 1)
-        raise WoodcamError(
+        raise LeavesPastBlockError(
             f"{n_sheets} leaves (--sheets) of {thickness_mm:g} mm + {kerf_mm:g} mm kerf, sliced from the middle "
             f"of {stock.spec} along {axis}, reach {reach:g} mm into its {size[ax]:g} mm: past its back face, "
             f"wood of the field outside the {block} mm block; give --sheets {most} or fewer, thinner leaves "
@@ -526,7 +535,11 @@ def job_veneers(job: ParquetryJob, open_stock=None, progress: bool = False) -> l
         stock = open_stock(b["spec"], species=b.get("species"))
         n, axis = int(b.get("sheets", 2)), b.get("axis", "y")
         thickness, kerf = float(b.get("thickness_mm", 0.6)), float(b.get("kerf_mm", 0.4))
-        size = check_leaves_in_block(stock, n, b.get("width_mm"), b.get("height_mm"), thickness, kerf, axis)
+        try:
+            size = check_leaves_in_block(stock, n, b.get("width_mm"), b.get("height_mm"), thickness, kerf, axis)
+        except LeavesPastBlockError as err:
+            err.entry = b  # whose leaves: the command line's options or a job file's own
+            raise
         out += slice_veneers(stock, n, size, thickness_mm=thickness, kerf_mm=kerf, px_per_mm=job.params.px_per_mm,
                              axis=axis, progress=progress,
                              id_prefix=b.get("id") or (stock.spec.replace(":", "-").replace("/", "-").strip("-.")
