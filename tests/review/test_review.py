@@ -866,3 +866,39 @@ def test_the_block_size_is_three_positive_lengths_or_an_error(page, tmp_path):
                            r"got .*; pass the block size"):
             write_review(glb, tmp_path / "bad.html", wood=stock.wood, size_mm=size, voxels=1000)
     assert not (tmp_path / "bad.html").exists()
+
+
+def test_a_part_outside_its_block_is_said_how_far_or_refused(page, tmp_path, capsys):
+    """A part reaching past its block (a GLB reviewed with a smaller --block than it was baked
+    from, another program's GLB) made a page without a word, though that part of it would be
+    carved from air and the section shows no wood there; one wholly outside made a page of
+    nothing. bake warns of a part sticking out and refuses one that misses the block
+    (woodcam.cad.carve): review now says so too, face by face in mm, or refuses it before the
+    colour volumes."""
+    import warnings
+
+    from woodcam.cli import main
+    from woodcam.errors import WoodcamWarning
+
+    stock, glb, _, _ = page  # an 80 x 60 x 40 mm box at (10, 10, 5) to (90, 70, 45) mm
+    with pytest.warns(WoodcamWarning) as said:
+        write_review(glb, tmp_path / "r.html", wood=stock.wood, size_mm=(60, 80, 40), voxels=1000)
+    (w,) = [str(m.message) for m in said]
+    assert ("reaches outside its block, 30 mm past its right face (x = 60 mm), 5 mm past its top face "
+            "(z = 40 mm): the part's bounding box is (10, 10, 5) mm to (90, 70, 45) mm, the block's "
+            "(0, 0, 0) mm to (60, 80, 40) mm; the part there would be carved from air") in w, w
+    assert (tmp_path / "r.html").is_file()
+    # a part in the 100 x 80 x 50 mm block it was baked from, to its faces: nothing said
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        write_review(glb, tmp_path / "ok.html", wood=stock.wood, size_mm=(90, 70, 45), voxels=1000)
+    # wholly outside (it only touches the block's top face at z = 5): refused, no page
+    with pytest.raises(WoodcamError, match=r"lies outside its block: the part's bounding box is \(10, 10, 5\) mm "
+                       r"to \(90, 70, 45\) mm, the block's \(0, 0, 0\) mm to \(100, 80, 5\) mm"):
+        write_review(glb, tmp_path / "none.html", wood=stock.wood, size_mm=(100, 80, 5), voxels=1000)
+    assert not (tmp_path / "none.html").exists()
+    # the command line: one warning line on stderr, in --units
+    assert main(["review", str(glb), "--block", "builtin:flat-sawn:60x80x40", "--out",
+                 str(tmp_path / "c.html"), "--voxels", "1000"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("woodcam: warning: review:") == 1 and "30 mm past its right face (x = 60 mm)" in err, err

@@ -161,6 +161,7 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
     hotspots = _checked_hotspots(hotspots)
     report = _checked_report(report)
     part_glb = _part_glb_bytes(glb_path)  # before the seconds of colour volumes
+    _check_part_in_block(glb_path, part_glb, size)
     if 4 * math.ceil(len(part_glb) / 3) > MAX_PAGE_STRING:
         raise WoodcamError(
             f"review: {str(glb_path)!r} is {len(part_glb) / 2**20:.0f} MiB; the page holds it as one "
@@ -224,6 +225,70 @@ def _checked_hotspots(hotspots) -> list[dict]:
         out.append({"kind": str(spot.get("kind", "")), "label": str(spot.get("label", "")),
                     "at_mm": [float(v) for v in at]})
     return out
+
+
+def _part_bounds(glb_path: Path, part_glb: bytes) -> np.ndarray:
+    """``(2, 3)`` bounds (mm, block frame) of the part the page shows, ``part_glb`` (a woodcam
+    GLB: block-frame mm in its vertex buffer under the root transform): its POSITION accessors'
+    min and max, which glTF requires, read from the JSON chunk without decoding the texture;
+    :func:`woodcam.export.load_textured` where a file lacks them."""
+    import struct
+
+    try:
+        (n,) = struct.unpack_from("<I", part_glb, 12)
+        tree = json.loads(part_glb[20:20 + n].decode("utf-8"))
+        accessors = [tree["accessors"][p["attributes"]["POSITION"]]
+                     for m in tree["meshes"] for p in m["primitives"]]
+        lo = np.min([a["min"] for a in accessors], axis=0)
+        hi = np.max([a["max"] for a in accessors], axis=0)
+        bounds = np.array([lo, hi], dtype=float)
+        if bounds.shape == (2, 3) and np.isfinite(bounds).all():
+            return bounds
+    except (struct.error, ValueError, KeyError, TypeError, IndexError, UnicodeDecodeError):
+        pass  # no min/max: read the mesh itself
+    from ..export import load_textured
+
+    return np.asarray(load_textured(glb_path).bounds, dtype=float)
+
+
+def _check_part_in_block(glb_path: Path, part_glb: bytes, size: list[float]) -> None:
+    """Refuse a part wholly outside the ``size`` mm block, and warn of one reaching past it (a
+    GLB reviewed with another, smaller --block than it was baked from; another program's GLB),
+    as :func:`woodcam.cad.carve.carve` does for bake: the page's section has no wood there, the
+    part would be carved from air. Where it reaches, face by face, in mm."""
+    import warnings
+
+    from ..errors import WoodcamWarning
+    from ..tolerances import ON_FACE_TOL_MM
+    from ..units import say_length
+
+    lo, hi = _part_bounds(glb_path, part_glb)
+    block = np.asarray(size, dtype=float)
+
+    def box(a, b):
+        return f"{say_length(tuple(a.tolist()), '.4g', form='({}, {}, {})')} to " \
+               f"{say_length(tuple(b.tolist()), '.4g', form='({}, {}, {})')}"
+
+    where = f"the part's bounding box is {box(lo, hi)}, the block's {box(np.zeros(3), block)}"
+    if (lo >= block - ON_FACE_TOL_MM).any() or (hi <= ON_FACE_TOL_MM).any():
+        raise WoodcamError(
+            f"review: {str(glb_path)!r} lies outside its block: {where} (block frame: origin at the "
+            "bottom-front-left corner); it has no wood of this block to show: give the block it was "
+            "baked from (--block), or bake it from this one (woodcam bake, which carves it from the block)")
+    past = []  # (mm, face) for each face the part reaches beyond
+    for axis, (low, high) in enumerate((("left", "right"), ("front", "back"), ("bottom", "top"))):
+        c = "xyz"[axis]
+        if -lo[axis] > ON_FACE_TOL_MM:
+            past.append((-lo[axis], f"its {low} face ({c} = 0)"))
+        if hi[axis] - block[axis] > ON_FACE_TOL_MM:
+            past.append((hi[axis] - block[axis], f"its {high} face ({c} = {say_length(block[axis], '.4g')})"))
+    if past:
+        said = ", ".join(f"{say_length(d, '.3g')} past {face}" for d, face in past)
+        warnings.warn(
+            f"review: {str(glb_path)!r} reaches outside its block, {said}: {where}; the part there "
+            "would be carved from air, and the page's section shows no wood of it; give the block it was "
+            "baked from (--block), or bake it from this one (woodcam bake carves it from the block)",
+            WoodcamWarning, stacklevel=3)
 
 
 def _part_glb_bytes(glb_path: Path) -> bytes:
