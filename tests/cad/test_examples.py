@@ -102,19 +102,36 @@ def test_example_runs_standalone_and_its_stl_loads(tmp_path, name, bd, cq):
     assert proc.returncode == 0, proc.stderr
     assert out.is_file() and f"wrote {out}" in proc.stdout
     namespace = runpy.run_path(str(EXAMPLES_DIR / f"{name}.py"), run_name="__test__")
-    # the script's STL is tessellated by the CAD library's exporter, not by woodcam: on the
-    # spoon's B-spline hollow it loses 0.3 % of the volume, so only "same part" is checked
+    _assert_stl_says_mm(out, name)
+    # the script's STL is meshed by woodcam's load_part (0.05 mm chords), as woodcam carves it
     assert load_part(out).volume() == pytest.approx(
         _brep_volume(namespace["part"]), rel=STANDALONE_STL_RTOL)
 
 
+def _assert_stl_says_mm(path, name: str) -> None:
+    """A binary STL written by woodcam.export.write_stl: its 80-byte header states units=mm and
+    what it is (the CAD kernels' exporters wrote 'STL Exported by Open CASCADE Technology', no
+    unit), not 'solid' (ASCII STL), and its triangle count matches its length."""
+    import struct
+
+    from woodcam.export import STL_HEADER
+
+    data = path.read_bytes()
+    assert data[:80] == f"woodcam: units=mm {name}.py part, block frame, Z up".encode().ljust(80), data[:80]
+    assert data.startswith(STL_HEADER) and not data.startswith(b"solid")
+    (n,) = struct.unpack_from("<I", data, 80)
+    assert n > 100 and len(data) == 84 + 50 * n
+
+
 def test_tray_runs_standalone_into_the_current_directory(tmp_path, cq):
-    """One subprocess run in the default suite (each costs a cadquery import, seconds)."""
+    """One subprocess run in the default suite (each costs a cadquery import, seconds); its STL
+    says its unit in its header (sweep h2: 'STL Exported by Open CASCADE Technology', no unit)."""
     proc = subprocess.run([sys.executable, str(EXAMPLES_DIR / "tray.py")], cwd=tmp_path,
                           capture_output=True, text=True, timeout=300, check=False)
     assert proc.returncode == 0, proc.stderr
     out = tmp_path / "tray.stl"
     assert out.is_file()
+    _assert_stl_says_mm(out, "tray")
     namespace = runpy.run_path(str(EXAMPLES_DIR / "tray.py"), run_name="__test__")
     assert load_part(out).volume() == pytest.approx(
         _brep_volume(namespace["part"]), rel=CARVE_VOLUME_RTOL)

@@ -20,7 +20,6 @@ from build123d import (
     Pos,
     Rectangle,
     RectangleRounded,
-    export_stl,
     extrude,
     fillet,
     loft,
@@ -75,6 +74,11 @@ part = make_lid()
 
 if __name__ == "__main__":
     out = sys.argv[1] if len(sys.argv) > 1 else "lid.stl"
-    export_stl(part, out, tolerance=0.05, angular_tolerance=0.1)
+    from woodcam.cad import load_part
+    from woodcam.export import write_stl
+
+    # woodcam's STL writer: the part meshed as woodcam carves it, the file's 80-byte header
+    # saying units=mm (STL has no unit field; the CAD kernel's own exporter said none)
+    write_stl(load_part(part, tolerance_mm=0.05), out, note="lid.py part, block frame, Z up")
     bb = part.bounding_box()
     print(f"wrote {out}: volume {part.volume:.1f} mm^3, bounds {bb.min} .. {bb.max}")

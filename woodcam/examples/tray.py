@@ -61,7 +61,12 @@ part = make_tray()
 
 if __name__ == "__main__":
     out = sys.argv[1] if len(sys.argv) > 1 else "tray.stl"
-    cq.exporters.export(part, out, tolerance=0.05, angularTolerance=0.1)
+    from woodcam.cad import load_part
+    from woodcam.export import write_stl
+
+    # woodcam's STL writer: the part meshed as woodcam carves it, the file's 80-byte header
+    # saying units=mm (STL has no unit field; the CAD kernel's own exporter said none)
+    write_stl(load_part(part, tolerance_mm=0.05), out, note="tray.py part, block frame, Z up")
     bb = part.val().BoundingBox()
     print(f"wrote {out}: volume {part.val().Volume():.1f} mm^3, bounds "
           f"({bb.xmin:.2f}, {bb.ymin:.2f}, {bb.zmin:.2f}) .. "

@@ -457,6 +457,25 @@ def stl_bytes(mesh: Mesh, note: str = "") -> bytes:
     return text.ljust(80, b" ") + data[80:]
 
 
+def write_stl(mesh, path: PathLike, note: str = "") -> Path:
+    """Write ``mesh`` (mm) atomically to ``path`` as :func:`stl_bytes` makes it, its header
+    stating ``units=mm``: the one STL writer of woodcam and its example scripts (a CAD kernel's
+    own exporter wrote 'STL Exported by Open CASCADE Technology', no unit). ``mesh`` is a
+    trimesh mesh or a manifold3d ``Manifold`` (what :func:`woodcam.cad.load_part` returns: the
+    part as woodcam carves it)."""
+    import trimesh
+
+    path = check_output_path(path, suffixes=(".stl",), what="write_stl: path")
+    if hasattr(mesh, "to_mesh64"):  # a manifold3d Manifold
+        out = mesh.to_mesh64()
+        mesh = trimesh.Trimesh(vertices=np.array(out.vert_properties[:, :3], dtype=np.float64),
+                               faces=np.array(out.tri_verts, dtype=np.int64), process=False)
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise WoodcamError(f"write_stl: mesh must be a trimesh.Trimesh or manifold3d.Manifold with "
+                           f"triangles; got {type(mesh).__name__}; e.g. write_stl(load_part(part), 'part.stl')")
+    return write_bytes(path, stl_bytes(mesh, note))
+
+
 def load_textured(path: PathLike) -> Mesh:
     """Load a GLB or OBJ written by this module as ONE textured ``trimesh.Trimesh`` in the block
     frame (mm, Z up): the GLB root transform and the OBJ's recorded units/up axis are undone.
