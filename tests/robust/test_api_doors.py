@@ -856,6 +856,95 @@ def test_wood_color_refuses_normals_that_are_no_direction():
     assert np.array_equal(wood_colors(wood, pts, (0, 0, 1)), wood.color(pts, [[0, 0, 1]] * 2))
 
 
+def _bad_woods():
+    """User woods breaking the colour contract: 0..255 colours, NaN, one value a point."""
+    import numpy as np
+
+    class Wood255:
+        def color(self, points_mm, normals):
+            return np.full((len(points_mm), 3), 200.0)
+
+    class WoodNaN:
+        def color(self, points_mm, normals):
+            return np.full((len(points_mm), 3), np.nan)
+
+    class WoodFlat:
+        def color(self, points_mm, normals):
+            return np.zeros(len(points_mm))
+
+    return [(Wood255(), r"wood\.color must return rgb in \[0, 1\]; got values in \[0, 200\]"),
+            (WoodNaN(), r"wood\.color returned non-finite colours"),
+            (WoodFlat(), r"wood\.color must return rgb of shape \(n, 3\) = \(\d+, 3\); got \(\d+,\)")]
+
+
+def _colour_consumers():
+    """Every consumer of a wood outside bake/view/export, each given ``wood``: the G-code
+    window's stock, the placement panels, the review's colour volumes, veneers, synthetic
+    photos, the appearance evaluation's pictures."""
+    import tempfile
+    from pathlib import Path
+
+    import numpy as np
+
+    def scrub(wood):
+        import pyvista as pv
+
+        from woodcam.view.scrub import _stock_polydata
+
+        return _stock_polydata(pv, np.full((8, 12), 20.0), (60.0, 40.0, 20.0), wood)
+
+    def compare(wood):
+        from woodcam.view.compare import render_side_by_side
+
+        png = Path(tempfile.mkdtemp(prefix="woodcam-doors-")) / "panels.png"
+        box = _cube()
+        box.apply_translation((10.0, 10.0, 10.0))
+        return render_side_by_side([box], [wood], (20.0, 20.0, 20.0), ["box"], png, panel_px=48)
+
+    def review(wood):
+        from woodcam.review import colour_volume
+
+        return colour_volume(wood, (20.0, 20.0, 20.0), "x", 5.0)
+
+    def veneers(wood):
+        import woodcam as w
+
+        return w.slice_veneers(w.Stock("mine", (20.0, 20.0, 20.0), wood), 1, (10.0, 10.0), px_per_mm=1.0)
+
+    def synth(wood):
+        import woodcam as w
+
+        cut = w.cut_block(lambda p: np.hypot(p[:, 0], p[:, 1]) / 2.0, (20, 20, 20), "rift")
+        return w.synth_block(cut, (20, 20, 20), face_px=16, seed=1, wood=wood)
+
+    def sphere(wood):
+        from woodcam.appearance.evaluation import render_sphere
+
+        return render_sphere(wood, (20.0, 20.0, 20.0), px=16)
+
+    def plane(wood):
+        from woodcam.appearance.evaluation import render_plane
+
+        return render_plane(wood, (20.0, 20.0, 20.0), px=16)
+
+    return {f.__name__: f for f in (scrub, compare, review, veneers, synth, sphere, plane)}
+
+
+@pytest.mark.parametrize("bad", range(3), ids=["0..255", "nan", "flat"])
+@pytest.mark.parametrize("consumer", ["scrub", "compare", "review", "veneers", "synth", "sphere", "plane"])
+def test_every_consumer_of_a_users_wood_checks_its_colours(consumer, bad):
+    """The G-code window, the placement panels, the review page, veneers, synthetic photos and
+    the evaluation pictures called wood.color directly, not the checked seam wood_colors of
+    bake/view/export: a user's wood's 0..255 colours were drawn white, NaN black (or numpy's
+    cast warning), a wrong shape was numpy's or pyvista's ValueError. Each now refuses as
+    wood_colors does."""
+    if consumer in ("scrub", "compare"):
+        pytest.importorskip("pyvista")
+    wood, said = _bad_woods()[bad]
+    with pytest.raises(WoodcamError, match=said):
+        _colour_consumers()[consumer](wood)
+
+
 def test_a_smooth_bake_where_vertex_normals_cancel_takes_the_triangles_normal():
     """Vertex normals that cancel (the two sides of a fin share vertices) interpolate to no
     direction, which the wood now refuses: the smooth bake takes the triangle's own normal

@@ -32,6 +32,7 @@ from .colormap import ColorMapAppearance
 from .neural import photo_faces
 from .translation import Quality, train_translation, translation_spec
 from .volumes import VolumeGrid, face_pair
+from .wood import wood_colors
 
 MODELS: tuple[str, ...] = ("neural", "agnostic", "colormap")
 METRICS: tuple[str, ...] = ("histogram", "spectrum", "patch", "l1")
@@ -361,7 +362,7 @@ def render_sphere(wood, size_mm, px: int = 256, view=(1.0, -1.3, 0.9), radius_fr
     depth = np.sqrt(np.clip(1 - u ** 2 - w ** 2, 0, 1))
     n = u[..., None] * e1 + w[..., None] * e2 + depth[..., None] * v
     pts = c + r * n[inside]
-    rgb = wood.color(pts, n[inside])
+    rgb = wood_colors(wood, pts, n[inside])
     lgt = np.asarray(light, float) / np.linalg.norm(light)
     shade = 0.65 + 0.35 * np.clip(n[inside] @ lgt, 0, 1)
     out = np.ones((px, px, 3))
@@ -380,5 +381,5 @@ def render_plane(wood, size_mm, normal=(1.0, 1.0, 1.0), px: int = 256) -> np.nda
     pts = size / 2 + u[..., None] * e1 + w[..., None] * e2
     inside = np.all((pts >= 0) & (pts <= size), axis=-1)
     out = np.ones((px, px, 3))
-    out[inside] = wood.color(pts[inside], np.broadcast_to(v, (int(inside.sum()), 3)))
+    out[inside] = wood_colors(wood, pts[inside], v)
     return out

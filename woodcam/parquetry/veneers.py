@@ -361,6 +361,8 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
         pts[:, down_axis] = (top - v_mm) if down_axis == 2 else v_mm
         return pts
 
+    from ..appearance.wood import wood_colors  # the checked seam: a user's wood's colours
+
     years_of = getattr(stock.wood, "years", None)
     it = range(n_sheets)
     if progress:
@@ -381,7 +383,7 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
                 b = min(u_mm.size, a + _SAMPLES_PER_CALL)
                 pts = plane_points(s, u_mm[a:b], v_mm[a:b])
                 normals = np.broadcast_to(normal, pts.shape)
-                out[a:b] = np.asarray(stock.wood.color(pts, normals), np.float32)
+                out[a:b] = wood_colors(stock.wood, pts, normals)
             return out
 
         # nw x nh pixels span the sheet exactly (8 in at 4 px/mm: 813 px of 0.24993 mm)

@@ -73,7 +73,11 @@ def colour_volume(wood, size_mm, axis: str, cell_mm: float) -> np.ndarray:
     points = np.column_stack([x.ravel(), y.ravel(), z.ravel()])
     normals = np.zeros_like(points)
     normals[:, "xyz".index(axis)] = 1.0
-    rgb = np.asarray(wood.color(points, normals), dtype=np.float64)
+    from ..appearance.wood import wood_colors
+
+    # the checked seam: a user's wood's NaN or 0..255 colours were written as black or white
+    # voxels, a wrong shape was numpy's reshape error
+    rgb = np.asarray(wood_colors(wood, points, normals), dtype=np.float64)
     return np.round(np.clip(rgb, 0.0, 1.0) * 255).astype(np.uint8).reshape(*shape[::-1], 3)
 
 

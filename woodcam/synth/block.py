@@ -8,6 +8,7 @@ import numpy as np
 
 from .._checks import check_bool
 from .._types import ArrayLike, GrowthFieldLike, WoodLike
+from ..appearance.wood import wood_colors
 from ..block import Block, Face
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, evaluate
@@ -120,7 +121,8 @@ def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | No
             gr, gc = np.gradient(g.reshape(shape))
             rgb = wood.color(pts, normals, years=g, years_per_px=np.hypot(gr, gc).ravel())
         else:
-            rgb = np.asarray(wood.color(pts, normals), dtype=float)
+            # the checked seam: a user's wood's NaN or 0..255 colours made photos of them
+            rgb = np.asarray(wood_colors(wood, pts, normals), dtype=float)
         photo = _camera(rgb.reshape(shape + (3,)), rng, ph.noise, ph.variation, ph.blur_px)
         g = g.reshape(shape)
         rmap = None

@@ -38,7 +38,7 @@ def render_side_by_side(meshes, woods, size_mm, titles, png, *, panel_px: int = 
     """Render ``meshes[i]`` (trimesh, block frame, mm) coloured by ``woods[i].color`` at its
     vertices in panel ``i`` of one PNG, with the block outline and ``titles[i]`` above it;
     ``progress``: a bar over the panels."""
-    from ..appearance.wood import vertex_color_normals
+    from ..appearance.wood import vertex_color_normals, wood_colors
     from ..errors import require
     from .scene import _prefer_egl_off_screen
 
@@ -62,8 +62,9 @@ def render_side_by_side(meshes, woods, size_mm, titles, png, *, panel_px: int = 
                 max_iter=12)
             fine = trimesh.Trimesh(verts, tris, process=False)
             # a direction at every vertex: an unreferenced one or a degenerate triangle's
-            # has none, which the wood refuses
-            rgb = wood.color(verts, vertex_color_normals(fine))
+            # has none, which the wood refuses; wood_colors checks a user's wood's colours
+            # (a NaN was drawn black, 0..255 white, a wrong shape was pyvista's ValueError)
+            rgb = wood_colors(wood, verts, vertex_color_normals(fine))
             faces = np.column_stack([np.full(len(tris), 3), tris]).ravel()
             surf = pv.PolyData(verts, faces)
             surf["rgb"] = (np.clip(rgb, 0, 1) * 255).astype(np.uint8)

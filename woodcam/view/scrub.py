@@ -115,7 +115,7 @@ def _lines(pv, seg):
 def _stock_polydata(pv, heightmap, size_mm, wood):
     """The stock below ``heightmap`` meshed at :data:`WINDOW_GRID_CELLS` cells across, its
     vertices coloured by ``wood`` (point array ``"rgb"``, uint8)."""
-    from ..appearance.wood import vertex_color_normals
+    from ..appearance.wood import vertex_color_normals, wood_colors
     from ..toolpath.mesh import heightfield_mesh
 
     hm = np.asarray(heightmap, float)
@@ -127,7 +127,8 @@ def _stock_polydata(pv, heightmap, size_mm, wood):
     # no planar merging: vertex colours interpolated over a merged fan would draw stars
     mesh = heightfield_mesh(hm, size_mm, flat_tol_mm=-1.0)
     v = np.asarray(mesh.vertices)
-    rgb = np.asarray(wood.color(v, vertex_color_normals(mesh)), float)
+    # the checked seam: a user's wood's NaN or 0..255 colours were drawn black or white
+    rgb = np.asarray(wood_colors(wood, v, vertex_color_normals(mesh)), float)
     faces = np.column_stack([np.full(len(mesh.faces), 3), mesh.faces]).ravel()
     poly = pv.PolyData(v, faces)
     poly.point_data["rgb"] = np.round(np.clip(rgb, 0, 1) * 255).astype(np.uint8)
