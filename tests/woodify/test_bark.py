@@ -308,6 +308,29 @@ def test_brush_file_round_trip_and_errors(tmp_path):
         load_brushes(p)
 
 
+def test_a_brush_file_with_a_misspelt_key_is_refused_naming_it(tmp_path):
+    """load_brushes dropped keys it did not know: 'stregth': 0.3 painted a brush of strength 0
+    and a file's 'brushes' beside a 'brushez' list lost the second without a word. Now the key
+    is named with the nearest known one and all of them."""
+    from woodcam.woodify import load_brushes
+
+    p = tmp_path / "brushes.json"
+    for text, said in (('[{"centre_mm": [1, 2, 3], "radius_mm": 4, "stregth": 0.3}]',
+                        r"brush 0 has an unknown key 'stregth'; did you mean 'strength'\? the keys are "
+                        r"centre_mm, direction, gain, radius_mm, strength; write it like"),
+                       ('[{"centre_mm": [1, 2, 3], "radius_mm": 4}, {"centre_mm": [0, 0, 0], "radius": 4, "colour": 1}]',
+                        r"brush 1 has an unknown key 'radius' \(of 2\); did you mean 'radius_mm'\?"),
+                       ('[{"centre_mm": [1, 2, 3], "radius_mm": 4, "zzz": 1}]',
+                        r"brush 0 has an unknown key 'zzz'; the keys are centre_mm,"),
+                       ('{"brushes": [], "brushez": [{"centre_mm": [1, 2, 3], "radius_mm": 4}]}',
+                        r"brushes file '.*' has an unknown key 'brushez'; did you mean 'brushes'\? the keys are brushes;")):
+        p.write_text(text)
+        with pytest.raises(WoodcamError, match=said):
+            load_brushes(p)
+    p.write_text('{"brushes": [{"centre_mm": [1, 2, 3], "radius_mm": 4, "strength": 0.3}]}')
+    assert load_brushes(p) == [Brush((1, 2, 3), 4.0, strength=0.3)]
+
+
 def test_a_brush_file_is_read_as_every_json_file_is(tmp_path):
     """load_brushes read its JSON with json.loads of read_text, not the project's reader: a file
     nested too deep was a bare RecursionError, a missing file read "must be JSON like ...: [Errno

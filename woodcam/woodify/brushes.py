@@ -19,9 +19,10 @@ optional).
 
 from __future__ import annotations
 
+import difflib
 import json
 import numbers
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -75,6 +76,8 @@ def load_brushes(path) -> list[Brush]:
             '"strength": 0.3}]}')
     doc = read_json_file(path, "brushes file")  # strict JSON, its errors naming the file
     items = doc.get("brushes") if isinstance(doc, dict) else doc
+    if isinstance(doc, dict) and items is not None:
+        _refuse_unknown_keys(doc, ("brushes",), f"brushes file {str(path)!r}", like)
     if not isinstance(items, list):
         got = "no 'brushes'" if items is None else type(items).__name__
         raise WoodcamError(f"brushes file {str(path)!r} must hold a list of brushes (or an object whose "
@@ -84,6 +87,8 @@ def load_brushes(path) -> list[Brush]:
         if not isinstance(b, dict):
             raise WoodcamError(f"brushes file {str(path)!r}: brush {i} must be a JSON object; got "
                                f"{json.dumps(b)[:80]}; write it like {like}")
+        # a misspelt key ('stregth') was dropped: the brush painted with the default instead
+        _refuse_unknown_keys(b, [x.name for x in fields(Brush)], f"brushes file {str(path)!r}: brush {i}", like)
         try:  # numbers as written: "4" or true for a number were float()'s 4.0 and 1.0
             out.append(Brush(tuple(b["centre_mm"]), b["radius_mm"], b.get("gain", 1.0),
                              tuple(b.get("direction", (0.0, 0.0, 1.0))), b.get("strength", 0.0)))
@@ -92,6 +97,18 @@ def load_brushes(path) -> list[Brush]:
             raise WoodcamError(f"brushes file {str(path)!r}: brush {i} ({json.dumps(b)[:80]}) must be like "
                                f"{like}: {why}") from err
     return out
+
+
+def _refuse_unknown_keys(obj: dict, known, where: str, like: str) -> None:
+    """A WoodcamError naming the first key of ``obj`` not in ``known``, the nearest known key and
+    all of them: nothing a user wrote is silently dropped."""
+    unknown = [k for k in obj if k not in known]
+    if unknown:
+        key = unknown[0]
+        near = difflib.get_close_matches(key, known, n=1)
+        hint = f"did you mean {near[0]!r}? " if near else ""
+        raise WoodcamError(f"{where} has an unknown key {key!r}" + (f" (of {len(unknown)})" if len(unknown) > 1 else "")
+                           + f"; {hint}the keys are {', '.join(sorted(known))}; write it like {like}")
 
 
 def paint(origin_mm, brushes=(), *, vertex_gain=None, vertex_direction=None, mesh=None, tri=None):
