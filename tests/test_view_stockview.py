@@ -110,9 +110,10 @@ def test_png_and_errors(tmp_path, bowl):
         stock_view(hm[0], (W, D, H), atlas, charts)
     with pytest.raises(WoodcamError, match="charts lacks"):
         stock_view(hm, (W, D, H), atlas, {"top": charts["top"]})
-    with pytest.raises(WoodcamError, match="overlay colour"):
-        stock_view(hm, (W, D, H), atlas, charts, window_size=WIN,
-                   overlay=[(np.zeros((1, 2, 3)), "mauve", 1.0)])
+    for colour in ("mauve", (1000, 0, 0), ("a", "b", "c")):  # one rule with top_view's (overlay_rgb)
+        with pytest.raises(WoodcamError, match="stock_view: overlay colour must be one of .* in 0..255"):
+            stock_view(hm, (W, D, H), atlas, charts, window_size=WIN,
+                       overlay=[(np.zeros((1, 2, 3)), colour, 1.0)])
     with pytest.raises(WoodcamError, match="supersample"):
         stock_view(hm, (W, D, H), atlas, charts, supersample=0)
     with pytest.raises(WoodcamError, match="camera must be"):

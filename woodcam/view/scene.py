@@ -81,6 +81,19 @@ WASTE_OPACITY = 0.3
 #: :mod:`woodcam.view.stockview`) draw the toolpath as this preview does.
 OVERLAY_COLORS = {"red": (255, 0, 0), "royalblue": (65, 105, 225)}
 
+
+def overlay_rgb(colour, who: str) -> np.ndarray:
+    """An overlay colour of the numpy views (``who``: the function, named in the error) as RGB
+    0..255 ``(3,)`` float: a name of :data:`OVERLAY_COLORS` or three numbers in 0..255. The one
+    rule of both views: out of range was blended as given (top_view's uint8 cast wrapped
+    (1000, 0, 0) to a green-grey), a string triple was numpy's bare ValueError."""
+    rgb = (as_floats(OVERLAY_COLORS[colour]) if colour in OVERLAY_COLORS else None) if isinstance(colour, str) \
+        else None if isinstance(colour, (bool, np.bool_)) else as_floats(colour)
+    if rgb is None or rgb.shape != (3,) or not np.all(np.isfinite(rgb) & (rgb >= 0) & (rgb <= 255)):
+        raise WoodcamError(f"{who}: overlay colour must be one of {sorted(OVERLAY_COLORS)} or an RGB "
+                           f"triple of numbers in 0..255; got {colour!r:.60}; e.g. 'red' or (65, 105, 225)")
+    return rgb
+
 #: Colour and width (pixels) of the part's outline drawn on the cut plane.
 OUTLINE_COLOR = (0.20, 0.12, 0.06)
 OUTLINE_WIDTH = 3.0

@@ -180,8 +180,8 @@ def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, ch
         RGB 0..255 where no stock, block or section is seen.
     """
     from . import _zbuffer as zb
-    from .scene import (BLOCK_COLOR, BLOCK_EDGE_COLOR, BLOCK_OPACITY, OUTLINE_COLOR,
-                        OVERLAY_COLORS, WASTE_OPACITY)
+    from .scene import (BLOCK_COLOR, BLOCK_EDGE_COLOR, BLOCK_OPACITY, OUTLINE_COLOR, WASTE_OPACITY,
+                        overlay_rgb)
 
     hm = np.ascontiguousarray(heightmap, dtype=np.float64)
     size = check_size(size_mm)
@@ -236,12 +236,7 @@ def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, ch
     if outline is not None and len(outline):
         lines.append((outline, 255 * np.asarray(OUTLINE_COLOR), 3, _EDGE_BIAS_MM))
     for segments, colour, width in overlay or ():
-        rgb = np.asarray(OVERLAY_COLORS.get(colour, (np.nan,)) if isinstance(colour, str) else colour,
-                         float)
-        if rgb.shape != (3,) or not np.isfinite(rgb).all():
-            raise WoodcamError(f"stock_view: overlay colour must be one of {sorted(OVERLAY_COLORS)} or "
-                               f"an RGB triple; got {colour!r}")
-        lines.append((np.asarray(segments, float).reshape(-1, 2, 3), rgb,
+        lines.append((np.asarray(segments, float).reshape(-1, 2, 3), overlay_rgb(colour, "stock_view"),
                       max(1, int(round(float(width)))), _LINE_BIAS_MM))
     for seg, rgb, width, bias in lines:
         if len(seg):

@@ -76,15 +76,11 @@ def top_view(heightmap, size_mm, top_texels, *, overlay=None,
 
 def _draw_segments(img, seg, colour, width, scale, D, ox, oy) -> None:
     """Blend XY segments (mm) into ``img`` as dots every half pixel, ``width`` px wide."""
-    from .scene import OVERLAY_COLORS
+    from .scene import overlay_rgb
 
+    rgb = overlay_rgb(colour, "top_view").astype(np.float32)  # checked even with no segments
     if not len(seg):
         return
-    rgb = np.asarray(OVERLAY_COLORS.get(colour, (np.nan,)) if isinstance(colour, str) else colour,
-                     np.float32)
-    if rgb.shape != (3,) or not np.isfinite(rgb).all():
-        raise WoodcamError(f"top_view: overlay colour must be one of {sorted(OVERLAY_COLORS)} or an "
-                           f"RGB triple; got {colour!r}")
     p0 = np.column_stack([ox + seg[:, 0, 0] * scale, oy + (D - seg[:, 0, 1]) * scale])
     p1 = np.column_stack([ox + seg[:, 1, 0] * scale, oy + (D - seg[:, 1, 1]) * scale])
     steps = np.maximum(np.ceil(2 * np.linalg.norm(p1 - p0, axis=1)).astype(int), 1)
