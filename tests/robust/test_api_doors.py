@@ -481,6 +481,10 @@ def _library_door_sweep():
         ("mokume_veneers NaN size !", lambda: w.mokume_veneers(_scan_file().parent, size_mm=np.nan),
          "size_mm must be a finite number > 0; got nan"),
         ("mokume_veneers None", lambda: w.mokume_veneers(None), "mokume_veneers: folder must be a file path .*got None"),
+        ("woodification origins NaN", lambda: _woodify().origins([[np.nan, 0.0, 6.0]]),
+         r"points_mm must be finite; point 0 is \[nan, 0.0, 6.0\]"),
+        ("woodification origins (n, 2)", lambda: _woodify().origins(np.zeros((2, 2))),
+         r"points_mm must have shape \(n, 3\) in mm; got shape \(2, 2\)"),
     ]
 
 

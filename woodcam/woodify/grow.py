@@ -82,9 +82,11 @@ class Woodification:
     def origins(self, points_mm: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Origins ``(n, 3)`` on the input surface and their input triangles ``(n,)`` of grown
         points (characteristic back-trace, :func:`woodcam.woodify.surfaces.trace_back`)."""
+        from ..fields.base import check_points
         from .surfaces import trace_back
 
-        return trace_back(self.front, points_mm, wind=self.speed.wind)
+        # a NaN point was numpy's cast warning, (n, 2) a broadcast error inside the back-trace
+        return trace_back(self.front, check_points(points_mm), wind=self.speed.wind)
 
     def engulf_year(self, obstacle_index: int = 0, inside_box: ArrayLike | None = None) -> float:
         """Year by which the wood has closed round obstacle ``obstacle_index`` within the grid
