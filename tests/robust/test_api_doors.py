@@ -485,7 +485,22 @@ def _library_door_sweep():
          r"points_mm must be finite; point 0 is \[nan, 0.0, 6.0\]"),
         ("woodification origins (n, 2)", lambda: _woodify().origins(np.zeros((2, 2))),
          r"points_mm must have shape \(n, 3\) in mm; got shape \(2, 2\)"),
+        ("evidence uncertainty NaN *", lambda: _evidence_fit(1).uncertainty_years([[np.nan, 1.0, 1.0]]),
+         r"points_mm must be finite; point 0 is \[nan, 1.0, 1.0\]"),
+        ("evidence uncertainty (n, 2) *", lambda: _evidence_fit(1).uncertainty_years(np.zeros((2, 2))),
+         r"points_mm must have shape \(n, 3\) in mm; got shape \(2, 2\)"),
+        ("evidence uncertainty str", lambda: _evidence_fit(2).uncertainty_years("a"),
+         "points_mm must have shape \\(n, 3\\) in mm; got 'a'"),
     ]
+
+
+def _evidence_fit(accepted: int):
+    """An EvidenceFit of two built-in fields with ``accepted`` (1 or 2) hypotheses accepted
+    (one: the uncertainty is 0 everywhere without evaluating the fields)."""
+    import woodcam as w
+
+    a, b = w.builtin_block("flat-sawn").field, w.builtin_block("rift").field
+    return w.EvidenceFit(a, "a", {}, False, accepted < 2, ["a", "b"][:accepted], "", {"a": a, "b": b})
 
 
 def _woodify(**kw):

@@ -55,7 +55,7 @@ from .._parallel import fit_workers, share
 from .._types import ArrayLike
 
 from ..errors import WoodcamError, WoodcamWarning
-from ..fields.base import central_gradient
+from ..fields.base import central_gradient, check_points
 from ..fields.residual import ResidualField
 from ..frames import AXIS_ENDS, FACES
 from ..tolerances import (
@@ -156,7 +156,8 @@ class EvidenceFit:
     def uncertainty_years(self, points_mm: ArrayLike) -> np.ndarray:
         """``(n,)`` years: standard deviation of the accepted hypotheses' growth time at
         ``points_mm (n, 3)`` (0 where they agree, or where only one was accepted)."""
-        p = np.asarray(points_mm, float)
+        # checked here: with one hypothesis accepted NaN or (n, 2) points read 0 years, 'sure'
+        p = check_points(points_mm)
         if len(self.accepted) < 2:
             return np.zeros(len(p))
         return np.std(np.stack([self.hypotheses[n](p) for n in self.accepted]), axis=0)
@@ -820,7 +821,7 @@ def uncertainty_years(ev: EvidenceFit, points_mm, size_mm, faces) -> np.ndarray:
     """Per-point uncertainty (years) of an evidence fit, issue 12 part 5: the spread of the
     accepted hypotheses plus :data:`EVIDENCE_UNSEEN_YEARS_PER_MM` per mm from the nearest
     observed face (what no face shows is a guess even when the hypotheses agree)."""
-    p = np.asarray(points_mm, float)
+    p = check_points(points_mm)
     return ev.uncertainty_years(p) + EVIDENCE_UNSEEN_YEARS_PER_MM * distance_to_faces_mm(p, size_mm, faces)
 
 
