@@ -1127,3 +1127,23 @@ def test_a_call_is_told_of_a_commented_sub_only():
              r"^G-code line 7: 'o5 call': subroutine o5 is not defined in this file")
     _refused(_BODY + "o5 call\nM2\n(c) o5 sub\nG1 X2\n(c) o5 endsub\n", 4, "o5 call",
              r"the o5 on line 6 follows a comment: .* no o5 sub")
+
+
+def _messages(text):
+    """The ``(line, message)`` of each operator message ``text`` says, in order."""
+    interp = Interpreter(text, start_mm=(0, 0, 0))
+    interp.run()
+    return interp.messages
+
+
+def test_a_msg_comment_says_its_message_only_where_linuxcnc_runs_its_line():
+    """LinuxCNC keeps a line's last ( ) comment only, and reads no comment of an O-word, M98,
+    M99 or O program number line (its flow control); woodcam said every (MSG,...) of every line
+    it passed, so an o-word loop's (MSG,...) came once a pass and a sub's header once, where the
+    machine shows none (checked against its interpreter in test_linuxcnc_oracle.py)."""
+    text = ("o2 sub (MSG,sub line)\n(MSG,in sub)\no2 endsub (MSG,endsub line)\n"
+            "o2 call (MSG,call line)\no3 while [#1 lt 1] (MSG,while line)\n#1=1\n"
+            "o3 endwhile (MSG,endwhile line)\n(MSG,a) ;(MSG,b)\n(MSG,c) G0 X2 (plain)\n"
+            "(plain) (MSG, last)\nM98 P1000 (MSG,m98 line)\nM2\nO1000 (MSG,o1000 line)\n"
+            "(MSG,in o1000)\nM99 (MSG,m99 line)\n")
+    assert _messages(text) == [(2, "in sub"), (8, "a"), (10, "last"), (14, "in o1000")]

@@ -647,3 +647,29 @@ def test_g53_without_axis_words_agrees_with_linuxcnc(tmp_path):
     agree, bad = _differences(_written(tmp_path, texts), texts, counts, same_line=True)
     assert not bad and agree == len(texts), bad
     assert counts["ran"] == len(ran) and counts["refused"] == len(refused), counts
+
+
+def _said(tmp_path, text):
+    """``(LinuxCNC's operator messages, woodcam's)`` of program ``text``, each ``[(line,
+    message)]`` (LinuxCNC's stripped of the blanks around them, as woodcam shows them)."""
+    path = tmp_path / "said.ngc"
+    path.write_text(text)
+    res, = run_batch([path], start_mm=START)
+    assert res["error"] is None, res["error"]
+    interp = Interpreter(text, start_mm=START)
+    interp.run()
+    return [(ln, m.strip()) for ln, m in res["messages"]], interp.messages
+
+
+def test_msg_comments_say_what_linuxcnc_says(tmp_path):
+    """LinuxCNC shows a line's last ( ) comment only, and none of an O-word, M98 or M99 line;
+    woodcam said every (MSG,...) it passed (test_a_msg_comment_says_its_message_only_where_
+    linuxcnc_runs_its_line)."""
+    text = ("o2 sub (MSG,sub line)\n(MSG,in sub)\no2 endsub (MSG,endsub line)\n"
+            "o2 call (MSG,call line)\no3 while [#1 lt 1] (MSG,while line)\n#1=1\n"
+            "o3 endwhile (MSG,endwhile line)\n(MSG,a) ;(MSG,b)\n(MSG,c) G0 X2 (plain)\n"
+            "(plain) (MSG, last)\nM98 P1000 (MSG,m98 line)\nG0 X1 (msg,Lower Case)\nM2\n"
+            "O1000 (MSG,o1000 line)\n(MSG,in o1000)\nM99 (MSG,m99 line)\n")
+    theirs, mine = _said(tmp_path, text)
+    assert mine == theirs == [(2, "in sub"), (8, "a"), (10, "last"), (15, "in o1000"),
+                              (12, "Lower Case")]

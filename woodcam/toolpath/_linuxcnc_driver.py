@@ -5,7 +5,8 @@ Run by :mod:`woodcam.toolpath.linuxcnc` with Debian's ``/usr/bin/python3`` (the 
 for it, not for woodcam's virtualenv); never imported by woodcam. Input (stdin, JSON):
 ``{"files": [path, ...], "start_mm": [x, y, z], "timeout_s": t, "machine_zero_mm": [x, y, z]}``
 (the last optional, default zero); output (stdout, JSON): one
-``{"moves": [...], "error": null | [line, message], "result": code}`` per file, moves as
+``{"moves": [...], "messages": [[line, text], ...], "error": null | [line, message],
+"result": code}`` per file (messages: the operator messages, ``(MSG,...)``/``(DEBUG,...)``), moves as
 woodcam's canonical tuples ``[kind, line, [x, y, z], [c1, c2] | null, rotation, plane,
 feed_mm_min, spindle_rpm, tool]`` in the
 machine frame, mm, tool tip (LinuxCNC's canon reports program coordinates before the G5x/G92
@@ -113,6 +114,7 @@ class _Canon:
         self.parameter_file = param_file
         self.deadline = deadline
         self.moves = []
+        self.messages = []  # [line, text] of each MESSAGE call
         self.line = 0
         self.plane = 1
         self.g5x = [0.0] * 3
@@ -158,6 +160,9 @@ class _Canon:
         self.rpm = rpm if words is None else _rpm(_after(self.spindle, words))
         if words is None:
             self.pending = (self.line, len(self.moves))
+
+    def message(self, text):  # (MSG,...) and (DEBUG,...): what the operator's screen shows
+        self.messages.append([self.line, text])
 
     def set_feed_rate(self, rate):
         self.feed = rate * MM
@@ -289,7 +294,7 @@ def _run(job, work, result_fd):
         except Exception as e:  # noqa: BLE001 - LinuxCNC raises plain RuntimeError
             result, err = -1, [0, f"{type(e).__name__}: {e}"]
         moves = [m for m in canon.moves if m[1] > 0]  # line 0: the init codes
-        out.append({"moves": moves, "error": err, "result": result,
+        out.append({"moves": moves, "messages": canon.messages, "error": err, "result": result,
                     "seconds": time.perf_counter() - t0, "cpu_seconds": time.process_time() - c0})
     with os.fdopen(result_fd, "w") as f:
         json.dump(out, f)

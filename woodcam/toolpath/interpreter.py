@@ -477,7 +477,9 @@ def source_lines(text: str) -> list[str]:
 
 def split_comments(raw: str, no: int) -> tuple[str, list[str]]:
     """Source line ``raw`` (1-based number ``no``) -> ``(text, messages)``: the text outside
-    comments, lowercase, without whitespace, and the ``(MSG, ...)`` comments' messages.
+    comments, lowercase, without whitespace, and the message of its ``(MSG, ...)`` comment
+    (a list of none or one). LinuxCNC keeps only a line's last ``( )`` comment (a ``;``
+    comment is none): ``(MSG,a) (note)`` says nothing, ``(note) (MSG,b)`` says ``b``.
     Raises :class:`GcodeError` for an unclosed, nested or unopened comment."""
     if "(" not in raw and ")" not in raw and ";" not in raw:  # most lines: no comment
         return raw.translate(_BLANKS).lower(), []
@@ -496,8 +498,7 @@ def split_comments(raw: str, no: int) -> tuple[str, list[str]]:
             if "(" in body:
                 raise GcodeError(no, raw[i:j + 1], "nested comment", "remove the inner '('")
             low = body.strip().lower()
-            if low.startswith("msg,"):
-                msgs.append(body.strip()[4:].strip())
+            msgs = [body.strip()[4:].strip()] if low.startswith("msg,") else []
             i = j + 1
             continue
         if c == ")":
@@ -1156,8 +1157,6 @@ class Interpreter:
             if blocks > self.max_blocks:
                 raise self.err("program", f"more than {self.max_blocks} lines executed (an "
                                "endless loop?)", "check the loop conditions")
-            for m in ln.msg:
-                self.messages.append((ln.no, m))
             # refused when reached, as LinuxCNC (an uncalled sub's line is not); the main
             # program's M99 is an ordinary line there too (below)
             if ln.late and (not ln.late.startswith("M99") or frames):
@@ -1167,6 +1166,10 @@ class Interpreter:
                 if pc == self.closing:
                     self.ended = True
                     break
+                # a line LinuxCNC runs as a block says its message; an O-word line, M98, M99
+                # in a call and an O program number are read by its flow control, which
+                # never looks at their comments
+                self.messages += [(ln.no, m) for m in ln.msg]
                 if ln.text:
                     self.block(ln.text)
                     if self.ended:
@@ -1186,6 +1189,7 @@ class Interpreter:
                 pc = self._m98(pc, ln)
             elif k == "m99":
                 if not frames:  # the main program's M99: an ordinary line (LinuxCNC's read_m)
+                    self.messages += [(ln.no, m) for m in ln.msg]
                     self.block(ln.text)
                     if self.ended:
                         break
