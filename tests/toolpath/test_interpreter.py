@@ -1147,3 +1147,50 @@ def test_a_msg_comment_says_its_message_only_where_linuxcnc_runs_its_line():
             "(plain) (MSG, last)\nM98 P1000 (MSG,m98 line)\nM2\nO1000 (MSG,o1000 line)\n"
             "(MSG,in o1000)\nM99 (MSG,m99 line)\n")
     assert _messages(text) == [(2, "in sub"), (8, "a"), (10, "last"), (14, "in o1000")]
+
+
+def test_debug_and_print_comments_say_the_parameters_values_where_the_line_runs():
+    """LinuxCNC shows (DEBUG,...) as it shows (MSG,...), with each #n and #<name> replaced by
+    its value as C's %lf when the line runs (after the line's assignments, before its move;
+    each pass of a loop, a sub's locals), and writes (PRINT,...) to its terminal; woodcam read
+    both as plain comments and said nothing. Known answers from LinuxCNC 2.9's rs274."""
+    text = ("#1=2.5\n#<foo>=3\nG0 X1.25 Y2\n"
+            "(DEBUG, x=#<_X> one=#1 foo=#< F o O > bad=#<nope> end)\n"
+            "#1=5 G0 X4 (debug,#1 x=#<_x> #5420 ##1 #a # x #2 #1.5)\n"
+            "G0 X6 (DEBUG,fast path x=#<_x>)\n"
+            "o100 do\n(DEBUG, pass #1)\n#1=[#1+1]\no100 while [#1 LT 7]\n"
+            "o2 sub\n(DEBUG,in sub #1 #<loc>)\n#<loc>=4\n(DEBUG,in sub #<loc>)\no2 endsub\n"
+            "o2 call [9]\n(DEBUG,after #<loc>)\n"
+            "#3=0.0001\n#4=-0.000099\n#5=-0.00015\n#6=[-10**21]\n#7=[10**21]\n"
+            "(DEBUG,#3 #4 #5 #6 #7 #5601 #5602 #0)\n"
+            "(PRINT, p=#1)\n#5599=0\n(DEBUG,hidden)\n(PRINT,shown #5599)\nM2\n")
+    interp = Interpreter(text, start_mm=(0, 0, 0))
+    interp.run()
+    on_terminal = " (PRINT: LinuxCNC writes it to its terminal, not its screen)"
+    assert interp.messages == [
+        (4, "x=1.250000 one=2.500000 foo=3.000000 bad=###### end"),
+        (5, "5.000000 x=1.250000 1.250000 #5.000000 #a # x 0.000000 5.000000.5"),
+        (6, "fast path x=4.000000"),
+        (8, "pass 5.000000"), (8, "pass 6.000000"),
+        (12, "in sub 9.000000 ######"), (14, "in sub 4.000000"), (17, "after ######"),
+        (23, "0.000100 0.000000 -0.000150 ###### 1000000000000000000000.000000 0.000000 "
+             "###### 0.000000"),
+        (24, "p=7.000000" + on_terminal), (27, "shown 0.000000" + on_terminal)]
+    assert interp.warnings == []
+
+
+def test_debug_text_woodcam_cannot_fill_in_is_marked_and_warned():
+    """A value woodcam does not know (the tool table's #5401, an unset probe result) shows as
+    '#5401?' with a warning; a '#' or '#<name' left open at the end, where LinuxCNC shows left
+    over text of an earlier message, ends the text with a warning; grbl and Fanuc read DEBUG as
+    a plain comment."""
+    interp = Interpreter("(DEBUG,tlo=#5403 z=#5063 end)\n(DEBUG,open #)\n(DEBUG,x #<_x)\nM2\n")
+    interp.run()
+    assert interp.messages == [(1, "tlo=#5403? z=#5063? end"), (2, "open"), (3, "x")]
+    assert [w[0] for w in interp.warnings] == [1, 1, 2, 3]
+    assert "#5403, which woodcam cannot know" in interp.warnings[0][1]
+    assert "unfinished parameter '#<_x'" in interp.warnings[3][1]
+    for dialect in ("grbl", "fanuc"):
+        interp = Interpreter("G0 X1 (DEBUG,x)\n(MSG,m)\n", dialect=dialect)
+        interp.run()
+        assert interp.messages == [(2, "m")]

@@ -673,3 +673,23 @@ def test_msg_comments_say_what_linuxcnc_says(tmp_path):
     theirs, mine = _said(tmp_path, text)
     assert mine == theirs == [(2, "in sub"), (8, "a"), (10, "last"), (15, "in o1000"),
                               (12, "Lower Case")]
+
+
+def test_debug_comments_say_what_linuxcnc_says(tmp_path):
+    """(DEBUG,...) says its text with the parameters' values as LinuxCNC's own interpreter puts
+    them (after the line's assignments, before its move, each loop pass, a sub's locals, %lf,
+    its zero tolerance, ###### for none or too long, #5599 off); woodcam said nothing
+    (test_debug_and_print_comments_say_the_parameters_values_where_the_line_runs)."""
+    text = ("#1=2.5\n#<foo>=3\nG0 X1.25 Y2\n"
+            "(DEBUG, x=#<_X> one=#1 foo=#< F o O > bad=#<nope> end)\n"
+            "#1=5 G0 X4 (debug,#1 x=#<_x> #5420 ##1 #a # x #2 #1.5)\n"
+            "G0 X6 (DEBUG,fast path x=#<_x> z=#<_z>)\n"
+            "o100 do\n(DEBUG, pass #1)\n#1=[#1+1]\no100 while [#1 LT 7]\n"
+            "o2 sub\n(DEBUG,in sub #1 #<loc>)\n#<loc>=4\n(DEBUG,in sub #<loc>)\no2 endsub\n"
+            "o2 call [9]\n(DEBUG,after #<loc>)\n"
+            "#3=0.0001\n#4=-0.000099\n#5=-0.00015\n#6=[-10**21]\n#7=[10**21]\n"
+            "(DEBUG,#3 #4 #5 #6 #7 #5601 #5602 #0)\n"
+            "#5599=0\n(DEBUG,hidden)\n#5599=1\n(DEBUG,shown)\nM2\n")
+    theirs, mine = _said(tmp_path, text)
+    assert mine == theirs
+    assert len(mine) == 10 and mine[2] == (6, "fast path x=4.000000 z=10.000000")

@@ -71,7 +71,8 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60`` (one of each modal group a line; in
   ``linuxcnc`` M6 stops the spindle, as LinuxCNC's tool change does);
   ``F S T``, ``E`` (beside ``M66``-``M68``), ``N`` (digits, the first word of a line, before any comment; grbl: anywhere); ``( )``/``;`` comments,
-  ``(msg,...)``, block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
+  ``(msg,...)``, ``(debug,...)`` and ``(print,...)`` (the parameters' values put in, as
+  LinuxCNC: :attr:`Interpreter.messages`), block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
   of its own: the first non-blank line opens, the next ends the program; any other ``%`` is an
   error, as in LinuxCNC).
 
@@ -379,6 +380,21 @@ _PREDEFINED: dict[str, Callable[[Interpreter], float] | str] = {
 }
 
 
+_DIGITS = re.compile(r"[0-9]+")
+#: C's isspace: the blanks LinuxCNC skips inside a #<name> of a DEBUG/PRINT text
+_C_SPACE = " \t\n\v\f\r"
+
+
+def _lf(value: float | None) -> str:
+    """A parameter's value in a DEBUG/PRINT text as LinuxCNC 2.9 writes it: C's ``%lf`` of the
+    value (within its 1e-4 'equal' of 0: 0, never -0.000000), ``######`` for none or for
+    text of 30 characters or more (its buffer)."""
+    if value is None:
+        return "######"
+    text = f"{0.0 if abs(value) < 1e-4 else value:f}"
+    return text if len(text) < 30 else "######"
+
+
 class _Unread(Exception):
     """A parameter without a value read by a sub definition's ``endsub [...]``: LinuxCNC reads
     that expression as it passes over the definition and takes undefined memory for it."""
@@ -475,11 +491,14 @@ def source_lines(text: str) -> list[str]:
     return lines
 
 
-def split_comments(raw: str, no: int) -> tuple[str, list[str]]:
+def split_comments(raw: str, no: int) -> tuple[str, list[tuple[str, str]]]:
     """Source line ``raw`` (1-based number ``no``) -> ``(text, messages)``: the text outside
-    comments, lowercase, without whitespace, and the message of its ``(MSG, ...)`` comment
-    (a list of none or one). LinuxCNC keeps only a line's last ``( )`` comment (a ``;``
-    comment is none): ``(MSG,a) (note)`` says nothing, ``(note) (MSG,b)`` says ``b``.
+    comments, lowercase, without whitespace, and its message comment as ``[(kind, text)]``
+    (none or one): ``("msg", message)`` of ``(MSG, ...)``, ``("debug", text)`` of
+    ``(DEBUG, ...)`` and ``("print", text)`` of ``(PRINT, ...)``, whose text names parameters
+    the interpreter puts the values of when the line runs (:meth:`Interpreter._expand`). LinuxCNC
+    keeps only a line's last ``( )`` comment (a ``;`` comment is none): ``(MSG,a) (note)`` says
+    nothing, ``(note) (MSG,b)`` says ``b``.
     Raises :class:`GcodeError` for an unclosed, nested or unopened comment."""
     if "(" not in raw and ")" not in raw and ";" not in raw:  # most lines: no comment
         return raw.translate(_BLANKS).lower(), []
@@ -497,8 +516,15 @@ def split_comments(raw: str, no: int) -> tuple[str, list[str]]:
             body = raw[i + 1:j]
             if "(" in body:
                 raise GcodeError(no, raw[i:j + 1], "nested comment", "remove the inner '('")
-            low = body.strip().lower()
-            msgs = [body.strip()[4:].strip()] if low.startswith("msg,") else []
+            # the keyword as LinuxCNC reads it: after leading blanks, any case, the comma next
+            head = body.lstrip()
+            low = head[:6].lower()
+            if low.startswith("msg,"):
+                msgs = [("msg", head[4:].strip())]
+            elif low.startswith(("debug,", "print,")):
+                msgs = [(low[:5], head[6:])]
+            else:
+                msgs = []
             i = j + 1
             continue
         if c == ")":
@@ -1169,11 +1195,12 @@ class Interpreter:
                 # a line LinuxCNC runs as a block says its message; an O-word line, M98, M99
                 # in a call and an O program number are read by its flow control, which
                 # never looks at their comments
-                self.messages += [(ln.no, m) for m in ln.msg]
                 if ln.text:
-                    self.block(ln.text)
+                    self.block(ln.text, ln.msg)
                     if self.ended:
                         break
+                elif ln.msg:
+                    self._say(ln.msg)
                 pc += 1
                 continue
             if k == "sub":
@@ -1189,8 +1216,7 @@ class Interpreter:
                 pc = self._m98(pc, ln)
             elif k == "m99":
                 if not frames:  # the main program's M99: an ordinary line (LinuxCNC's read_m)
-                    self.messages += [(ln.no, m) for m in ln.msg]
-                    self.block(ln.text)
+                    self.block(ln.text, ln.msg)
                     if self.ended:
                         break
                     pc += 1
@@ -1615,13 +1641,18 @@ class Interpreter:
         return chain[-1] + 1
 
     # -- one block --------------------------------------------------------------------------
-    def block(self, s: str):
+    def block(self, s: str, notes=()):
+        """Run the normalised line ``s``; ``notes``: its message comment (split_comments),
+        said after the line's parameter assignments and before its codes, as LinuxCNC does
+        (``#1=5 (DEBUG,#1)`` says 5, ``G0 X5 (DEBUG,#<_x>)`` the X before the move)."""
         if s.startswith("/"):
             s = s[1:]  # block delete switch off (LinuxCNC's default): the line runs
         if _PLAIN_LINE.fullmatch(s):
             pairs = _PLAIN_WORD.findall(s)
             plain = {a: float(v) for a, v in pairs}
             if len(plain) == len(pairs) and all(map(math.isfinite, plain.values())):
+                if notes:
+                    self._say(notes)
                 self.execute((), (), plain)
                 return
         words: dict[str, float] = {}
@@ -1725,8 +1756,88 @@ class Interpreter:
                 (self.globals if ref[1].startswith("_") else self.locals)[ref[1]] = v
             else:
                 self.p[ref[1]] = v
+        if notes:
+            self._say(notes)
         if gs or ms or words:
             self.execute(gs, ms, words)
+
+    def _say(self, notes) -> None:
+        """Say the line's message comment ``notes`` (``[(kind, text)]``, split_comments) into
+        :attr:`messages`: MSG as written, DEBUG (while #5599 is on, as LinuxCNC) and PRINT
+        with the parameters' values put in. LinuxCNC shows MSG and DEBUG on the operator's
+        screen and writes PRINT to its standard output (the terminal it was started from),
+        which the message says."""
+        for kind, text in notes:
+            if kind != "msg" and self.dialect != "linuxcnc":
+                continue  # grbl and Fanuc read (DEBUG,...) and (PRINT,...) as comments
+            if kind == "msg":
+                self.messages.append((self.line_no, text))
+            elif kind == "print":
+                self.messages.append((self.line_no, f"{self._expand(text, 'PRINT').strip()} "
+                                      "(PRINT: LinuxCNC writes it to its terminal, not its "
+                                      "screen)"))
+            elif self.p.get(5599, 0.0) > 0:
+                self.messages.append((self.line_no, self._expand(text, "DEBUG").strip()))
+
+    def _expand(self, text: str, kind: str) -> str:
+        """``text`` of a (DEBUG,...) or (PRINT,...) comment with each ``#n``, ``#<name>`` put
+        as LinuxCNC 2.9 puts it (its convert_param_comment): the value as C's ``%lf`` (six
+        decimals; within 1e-4 of 0 as 0.000000, its 'equal'), ``######`` for a parameter it
+        does not have (an unset name, a number over 5601) or a value over 29 characters; a
+        name is read to its ``>`` without blanks, in lower case; a ``#`` followed by neither
+        stays. A value woodcam cannot know (the tool table, a probe result) shows as ``#n?``
+        with a warning."""
+        out = []
+        i, n = 0, len(text)
+        while i < n:
+            j = text.find("#", i)
+            if j < 0:
+                out.append(text[i:])
+                break
+            out.append(text[i:j])
+            i = j + 1
+            ref = None
+            if i < n and text[i] in "0123456789":
+                m = _DIGITS.match(text, i)
+                i = m.end()
+                ref = "#" + m.group(0)
+                k = int(m.group(0))
+                value = (None if k > 5601 else 0.0 if k == 0 else
+                         lambda k=k, ref=ref: self.get_num(k, ref))
+            elif i < n and text[i] == "<" and ">" in text[i:]:
+                close = text.find(">", i)
+                name = "".join(c for c in text[i + 1:close] if c not in _C_SPACE).lower()
+                ref, i = f"#<{name}>", close + 1
+                value = self._named_in_message(name, ref)
+            elif i < n and text[i] != "<":
+                out.append("#")  # (the character after it is read as text)
+                continue
+            else:
+                # LinuxCNC stops there and shows what an earlier message left in its buffer
+                self.warn(f"({kind},...) ends in an unfinished parameter '{text[j:]}': LinuxCNC "
+                          "shows left-over text of an earlier message after the text before it; "
+                          "write #1 or #<name>, or remove the '#'")
+                break
+            if callable(value):
+                try:
+                    value = value()
+                except GcodeError as e:
+                    self.warn(f"({kind},...) reads {ref}, which woodcam cannot know ({e.rule}): "
+                              f"the message shows {ref}? for it")
+                    out.append(f"{ref}?")
+                    continue
+            out.append(_lf(value))
+        return "".join(out)
+
+    def _named_in_message(self, name: str, word: str):
+        """The value of ``#<name>`` in a DEBUG/PRINT text: a number, ``None`` where LinuxCNC
+        has no such parameter, or a function that reads it or raises :class:`GcodeError`
+        where woodcam cannot know it."""
+        known = _PREDEFINED.get(name)
+        if known is not None or name in _RETURNED:
+            return lambda: self.get_named(name, word)
+        d = self.globals if name.startswith("_") else self.locals
+        return d.get(name)
 
     def execute(self, gs, ms, w):
         if (not gs and not ms and self.motion in (0.0, 1.0) and _PLAIN_WORDS.issuperset(w)):
