@@ -1194,3 +1194,16 @@ def test_debug_text_woodcam_cannot_fill_in_is_marked_and_warned():
         interp = Interpreter("G0 X1 (DEBUG,x)\n(MSG,m)\n", dialect=dialect)
         interp.run()
         assert interp.messages == [(2, "m")]
+
+
+def test_an_abort_comment_stops_the_program_where_it_runs():
+    """LinuxCNC ends the program at a reached (ABORT,...) with its text (parameters put in) as
+    the error; woodcam read it as a comment and previewed the moves after it, which the
+    machine never makes. One in a branch not taken stops nothing; grbl and Fanuc: a comment."""
+    text = ("G0 X1\n#1=3\no1 if [#1 gt 5]\n(ABORT, too big #1)\no1 endif\n"
+            "o2 if [#1 gt 2]\n(ABORT, limit #1 over 2)\no2 endif\nG0 X2\nM2\n")
+    with pytest.raises(GcodeError) as e:
+        Interpreter(text).run()
+    assert e.value.line == 7 and "'limit 3.000000 over 2'" in e.value.rule
+    for dialect in ("grbl", "fanuc"):
+        assert _ends("G0 X1\n(ABORT,x)\nG0 X2\nM2\n", dialect=dialect)[-1][0] == 2

@@ -693,3 +693,20 @@ def test_debug_comments_say_what_linuxcnc_says(tmp_path):
     theirs, mine = _said(tmp_path, text)
     assert mine == theirs
     assert len(mine) == 10 and mine[2] == (6, "fast path x=4.000000 z=10.000000")
+
+
+def test_an_abort_comment_stops_the_program_as_linuxcnc(tmp_path):
+    """LinuxCNC refuses the program at the reached (ABORT,...) with its expanded text, after
+    the moves before it; woodcam previewed the move after it
+    (test_an_abort_comment_stops_the_program_where_it_runs)."""
+    text = "G0 X1\n#1=3\no1 if [#1 gt 5]\n(ABORT, big)\no1 endif\n(ABORT, x=#1)\nG0 X2\nM2\n"
+    path = tmp_path / "abort.ngc"
+    path.write_text(text)
+    res, = run_batch([path], start_mm=START)
+    interp = Interpreter(text, start_mm=START)
+    with pytest.raises(GcodeError) as e:
+        interp.run()
+    assert res["error"] == [6, " x=3.000000"] and e.value.line == 6
+    assert f"'{res['error'][1].strip()}'" in e.value.rule
+    assert not compare_canonical(canonical(interp.moves, START), canonical(res["moves"], START))
+    assert [m[2][0] for m in interp.moves] == [1.0]

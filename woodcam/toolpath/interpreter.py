@@ -72,7 +72,7 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``linuxcnc`` M6 stops the spindle, as LinuxCNC's tool change does);
   ``F S T``, ``E`` (beside ``M66``-``M68``), ``N`` (digits, the first word of a line, before any comment; grbl: anywhere); ``( )``/``;`` comments,
   ``(msg,...)``, ``(debug,...)`` and ``(print,...)`` (the parameters' values put in, as
-  LinuxCNC: :attr:`Interpreter.messages`), block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
+  LinuxCNC: :attr:`Interpreter.messages`), ``(abort,...)`` (an error, as LinuxCNC), block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
   of its own: the first non-blank line opens, the next ends the program; any other ``%`` is an
   error, as in LinuxCNC).
 
@@ -495,7 +495,8 @@ def split_comments(raw: str, no: int) -> tuple[str, list[tuple[str, str]]]:
     """Source line ``raw`` (1-based number ``no``) -> ``(text, messages)``: the text outside
     comments, lowercase, without whitespace, and its message comment as ``[(kind, text)]``
     (none or one): ``("msg", message)`` of ``(MSG, ...)``, ``("debug", text)`` of
-    ``(DEBUG, ...)`` and ``("print", text)`` of ``(PRINT, ...)``, whose text names parameters
+    ``(DEBUG, ...)``, ``("print", text)`` of ``(PRINT, ...)`` and ``("abort", text)`` of
+    ``(ABORT, ...)`` (LinuxCNC stops the program there with that text), whose text names parameters
     the interpreter puts the values of when the line runs (:meth:`Interpreter._expand`). LinuxCNC
     keeps only a line's last ``( )`` comment (a ``;`` comment is none): ``(MSG,a) (note)`` says
     nothing, ``(note) (MSG,b)`` says ``b``.
@@ -521,7 +522,7 @@ def split_comments(raw: str, no: int) -> tuple[str, list[tuple[str, str]]]:
             low = head[:6].lower()
             if low.startswith("msg,"):
                 msgs = [("msg", head[4:].strip())]
-            elif low.startswith(("debug,", "print,")):
+            elif low.startswith(("debug,", "print,", "abort,")):
                 msgs = [(low[:5], head[6:])]
             else:
                 msgs = []
@@ -1769,9 +1770,15 @@ class Interpreter:
         which the message says."""
         for kind, text in notes:
             if kind != "msg" and self.dialect != "linuxcnc":
-                continue  # grbl and Fanuc read (DEBUG,...) and (PRINT,...) as comments
+                continue  # grbl and Fanuc read (DEBUG,...), (PRINT,...) and (ABORT,...) as comments
             if kind == "msg":
                 self.messages.append((self.line_no, text))
+            elif kind == "abort":
+                said = self._expand(text, "ABORT").strip()
+                raise self.err(f"(ABORT,{text})", f"the program stops itself here: LinuxCNC "
+                               f"ends it with the error '{said}' (its moves up to this line are "
+                               "cut, none after)", "this is the program's own (ABORT,...): "
+                               "satisfy the condition that leads to it, or remove it")
             elif kind == "print":
                 self.messages.append((self.line_no, f"{self._expand(text, 'PRINT').strip()} "
                                       "(PRINT: LinuxCNC writes it to its terminal, not its "
