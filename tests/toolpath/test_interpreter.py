@@ -1094,7 +1094,8 @@ def test_an_o_word_after_a_comment_is_refused_at_the_first_such_line():
              r"the o1 on line 6 follows a comment: .* no o1 sub .*; move the comment after the o1")
     _refused(_BODY + "(c) o1 sub\nG1 X2\n(c) o1 endsub\nM2\n", 4, "o1 sub", "after a comment")
     _refused(_BODY + "o1 sub\nG1 X2\n(c) o1 endsub\nG1 X5\nM2\n", 6, "o1 endsub",
-             r"without it the O words do not match \(line 4: o1 sub is never closed\)")
+             r"without it the O words do not match \(line 4: o1 sub is never closed by an o1 "
+             r"endsub: LinuxCNC reads the rest of the file as its definition")
     prog = read_gcode(_BODY + "o1 if [0]\nG1 X2\n(c) o1 else\nG1 X3\no1 endif\nM2\n")
     assert len(prog) == 2 and prog.warnings == [  # the body's two moves: G1 X3 skipped as LinuxCNC does
         "line 6: 'o1 else' follows a comment, so it is no O word (LinuxCNC reads one only as the first "
@@ -1207,3 +1208,25 @@ def test_an_abort_comment_stops_the_program_where_it_runs():
     assert e.value.line == 7 and "'limit 3.000000 over 2'" in e.value.rule
     for dialect in ("grbl", "fanuc"):
         assert _ends("G0 X1\n(ABORT,x)\nG0 X2\nM2\n", dialect=dialect)[-1][0] == 2
+
+
+def test_an_endsub_with_another_label_inside_a_sub_returns_from_it_as_in_linuxcnc():
+    """LinuxCNC passes over 'o101 sub' to 'o101 endsub' and, when a call reaches an 'o100
+    endsub' inside it (a renamed or copied sub), returns from o101 there, with its value, in a
+    loop too: the lines after it never run. woodcam refused the program ('endsub without a
+    matching o100 sub'); it now runs it as LinuxCNC and warns. Without an o101 endsub at all
+    LinuxCNC reads the rest of the file as the definition and runs none of it: refused, saying
+    so."""
+    text = ("o100 sub\nG1 X1 F100\no100 endsub\no101 sub\no1 while [1]\nG1 X2 F100\n"
+            "o100 endsub [7]\no1 endwhile\nG1 X3\no101 endsub [3]\no101 call\nG1 Y#<_value>\n"
+            "o100 call\nM2\n")
+    moves, warnings = Interpreter(text, start_mm=(0, 0, 0)).run()
+    assert [m[2] for m in moves] == [(2, 0, 0), (2, 7, 0), (1, 7, 0)]
+    assert [w for w in warnings if "endsub" in w[1]] == [(7, (
+        "o100 endsub inside the o101 sub of line 4: LinuxCNC reads it as o101's return (a call "
+        "of o101 ends here, its lines after it never run), and so does woodcam; write o101 "
+        "return (or fix the label)"))]
+    with pytest.raises(GcodeError) as e:
+        Interpreter("G1 X1 F100\no100 sub\no100 endsub\no101 sub\nG1 X2\no100 endsub\n"
+                    "o101 call\nM2\n").run()
+    assert e.value.line == 4 and "reads the rest of the file as its definition" in e.value.rule

@@ -630,7 +630,8 @@ def test_o_words_after_a_comment_open_and_close_nothing_as_in_linuxcnc(tmp_path)
     res = run_batch(_written(tmp_path, texts), start_mm=START)[0]
     assert res["moves"] == [] and res["error"][1] == NO_END
     with pytest.raises(GcodeError, match=r"line 4: 'o1 endsub': .*without it the O words do not match "
-                       r"\(line 2: o1 sub is never closed\)"):
+                       r"\(line 2: o1 sub is never closed by an o1 endsub: LinuxCNC reads the rest "
+                       r"of the file as its definition, runs none of it"):
         Interpreter(texts[0], start_mm=START).run()
 
 
@@ -710,3 +711,25 @@ def test_an_abort_comment_stops_the_program_as_linuxcnc(tmp_path):
     assert f"'{res['error'][1].strip()}'" in e.value.rule
     assert not compare_canonical(canonical(interp.moves, START), canonical(res["moves"], START))
     assert [m[2][0] for m in interp.moves] == [1.0]
+
+
+def test_an_endsub_with_another_label_inside_a_sub_agrees_with_linuxcnc(tmp_path):
+    """An 'o100 endsub' inside 'o101 sub ... o101 endsub' ends a call of o101 in LinuxCNC, with
+    its value, in a loop too; woodcam refused the program. Without an o101 endsub LinuxCNC runs
+    nothing after 'o101 sub' and stops at the file's end, where woodcam refuses the o101 sub
+    (test_an_endsub_with_another_label_inside_a_sub_returns_from_it_as_in_linuxcnc)."""
+    texts = ["o101 sub\nG1 X2 F100\no100 endsub\nG1 X5\no101 endsub\no101 call\nG1 X7\nM2\n",
+             "o101 sub\no1 while [1]\nG1 X2 F100\no100 endsub [7]\no1 endwhile\n"
+             "o101 endsub [3]\no101 call\nG1 X#<_value>\no101 call\nG1 Y#<_value>\nM2\n",
+             "o100 sub\nG1 X1 F100\no100 endsub\no101 sub\nG1 X2 F100\no100 endsub\nG1 X3\n"
+             "o101 endsub\no101 call\no100 call\nG1 Z-1\nM2\n"]
+    counts = {}
+    agree, bad = _differences(_written(tmp_path, texts), texts, counts)
+    assert not bad, bad
+    assert counts == {"ran": 3, "refused": 0, "moves": 9}
+    text = "G1 X1 F100\no100 sub\no100 endsub\no101 sub\nG1 X2\no100 endsub\no101 call\nM2\n"
+    res, = run_batch(_written(tmp_path, [text]), start_mm=START)
+    assert res["error"][1] == NO_END and [m[2][0] for m in res["moves"]] == [pytest.approx(1)]
+    with pytest.raises(GcodeError, match="rest of the file as its definition") as e:
+        Interpreter(text, start_mm=START).run()
+    assert e.value.line == 4

@@ -1120,6 +1120,18 @@ class Interpreter:
                 stack.append((k, ln.olabel, idx))
                 if k == "if":
                     self.branches[idx] = []
+            elif k == "endsub" and any(s[0] == "sub" and s[1] != ln.olabel for s in stack):
+                # inside another sub's definition (o101 sub ... o100 endsub): LinuxCNC passes
+                # over a definition to the endsub with its label, and when a call reaches this
+                # line it returns as from 'o101 return' (checked: the lines after it never run)
+                sub = next(s for s in reversed(stack) if s[0] == "sub")
+                ln.okey = "return"
+                self.owner[idx] = sub[2]
+                self.warnings.append((ln.no, f"o{ln.olabel} endsub inside the o{sub[1]} sub "
+                                      f"of line {lines[sub[2]].no}: LinuxCNC reads it as "
+                                      f"o{sub[1]}'s return (a call of o{sub[1]} ends here, "
+                                      f"its lines after it never run), and so does woodcam; "
+                                      f"write o{sub[1]} return (or fix the label)"))
             elif k in ("endsub", "endif", "endwhile", "endrepeat"):
                 want = {"endsub": "sub", "endif": "if", "endwhile": "while",
                         "endrepeat": "repeat"}[k]
@@ -1153,6 +1165,14 @@ class Interpreter:
                 self.owner[idx] = sub[2]
         if stack:
             k, label, idx = stack[-1]
+            sub = next((s for s in stack if s[0] == "sub"), None)
+            if sub is not None:  # LinuxCNC passes over a definition to its endsub: to the end
+                k, label, idx = sub
+                raise GcodeError(lines[idx].no, f"o{label} sub", f"o{label} sub is never "
+                                 f"closed by an o{label} endsub: LinuxCNC reads the rest of the "
+                                 "file as its definition, runs none of it and stops at the end "
+                                 "('File ended with no percent sign or program end')",
+                                 f"end the definition with o{label} endsub")
             raise GcodeError(lines[idx].no, f"o{label} {k}", f"o{label} {k} is never closed",
                            "close it")
 
