@@ -1230,3 +1230,26 @@ def test_an_endsub_with_another_label_inside_a_sub_returns_from_it_as_in_linuxcn
         Interpreter("G1 X1 F100\no100 sub\no100 endsub\no101 sub\nG1 X2\no100 endsub\n"
                     "o101 call\nM2\n").run()
     assert e.value.line == 4 and "reads the rest of the file as its definition" in e.value.rule
+
+
+def test_a_do_loop_reached_while_skipping_is_run_into_with_a_warning():
+    """LinuxCNC skips a false 'o1 if' to the next o1 line; an 'o1 do' there stops the skip and
+    the program runs on into it: the body is cut (X3), then the do's 'o1 while' is refused as
+    a second use of the label (line 6). Inside an outer do left by a break the program runs to
+    the end. woodcam refused at the do line with no cut, also where LinuxCNC runs to the end
+    (the same programs against LinuxCNC: test_a_do_loop_reached_while_skipping_runs_as_in_
+    linuxcnc)."""
+    text = "G1 F100 X1\no1 if [0]\nG1 X2\no1 do\nG1 X3\no1 while [0]\nG1 X4\no1 endif\nG1 X5\nM2\n"
+    interp = Interpreter(text, start_mm=(0, 0, 0))
+    with pytest.raises(GcodeError, match="duplicate O-word label") as e:
+        interp.run()
+    assert e.value.line == 6 and [m[2][0] for m in interp.moves] == [1, 3]
+    assert any(w[0] == 4 and "stops at this do and runs on into it" in w[1]
+               for w in interp.warnings)
+    text = ("G1 F100 X1\no1 do\nG1 Y1\no1 break\no1 do\nG1 X3\no1 while [0]\nG1 X4\n"
+            "o1 while [0]\nG1 X5\nM2\n")
+    assert [e[:2] for e in _ends(text)] == [(1, 0), (1, 1), (3, 1), (4, 1), (5, 1)]
+    # an if nested under the label is refused where the skip reads it, as before
+    with pytest.raises(GcodeError, match="duplicate O-word label") as e:
+        _ends("o1 if [0]\no1 if [1]\no1 endif\no1 endif\nM2\n")
+    assert e.value.line == 2

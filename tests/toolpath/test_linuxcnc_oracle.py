@@ -733,3 +733,37 @@ def test_an_endsub_with_another_label_inside_a_sub_agrees_with_linuxcnc(tmp_path
     with pytest.raises(GcodeError, match="rest of the file as its definition") as e:
         Interpreter(text, start_mm=START).run()
     assert e.value.line == 4
+
+
+#: A do loop whose label an if, while, do or repeat being skipped holds: LinuxCNC stops
+#: skipping at it and runs on into it (refused at the do's while as a duplicate label, or, in
+#: an outer do, runs to the end). Shared with test_interpreter's known answers.
+_DO_REACHED_WHILE_SKIPPING = [
+    "G1 F100 X1\no1 if [0]\nG1 X2\no1 do\nG1 X3\no1 while [0]\nG1 X4\no1 endif\nG1 X5\nM2\n",
+    "G1 F100 X1\n#1=0\no1 while [#1 lt 1]\n#1=[#1+1]\nG1 X2\no1 break\no1 do\nG1 X3\n"
+    "o1 while [0]\nG1 X4\no1 endwhile\nG1 X5\nM2\n",
+    "G1 F100 X1\no1 do\nG1 Y1\no1 break\no1 do\nG1 X3\no1 while [0]\nG1 X4\no1 while [0]\n"
+    "G1 X5\nM2\n",
+    "G1 F100 X1\no1 repeat [0]\nG1 Y1\no1 do\nG1 X3\no1 while [0]\nG1 X4\no1 endrepeat\n"
+    "G1 X5\nM2\n",
+    "G1 F100 X1\no1 if [1]\nG1 X2\no1 else\no1 do\nG1 X3\nM2\no1 while [0]\no1 endif\n",
+    "G1 F100 X1\no1 do\nG1 Y1\no1 continue\no1 do\nG1 X3\no1 while [0]\nG1 X4\no1 while [0]\n"
+    "G1 X5\nM2\n",
+    # a break of the loop skipped lies before the do (LinuxCNC runs it on the way)
+    "G1 F100 X1\no1 while [0]\no1 break\no1 do\nG1 X3\no1 while [0]\nG1 X4\no1 endwhile\n"
+    "G1 X5\nM2\n",
+    "G1 F100 X1\no1 do\nG1 Y1\no1 continue\no1 break\no1 do\nG1 X3\no1 while [0]\nG1 X4\n"
+    "o1 while [0]\nG1 X5\nM2\n",
+]
+
+
+def test_a_do_loop_reached_while_skipping_runs_as_in_linuxcnc(tmp_path):
+    """LinuxCNC cuts the body of a do loop a skip under the same label stops at and refuses at
+    its while line (or runs to the end inside an outer do, or to a body's M2); woodcam refused
+    the program at the do line, before the body, also programs LinuxCNC runs to the end
+    (test_a_do_loop_reached_while_skipping_is_run_into_with_a_warning)."""
+    texts = _DO_REACHED_WHILE_SKIPPING
+    counts = {}
+    agree, bad = _differences(_written(tmp_path, texts), texts, counts, same_line=True)
+    assert not bad, bad
+    assert counts == {"ran": 4, "refused": 4, "moves": 27}, counts

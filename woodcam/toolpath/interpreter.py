@@ -1280,24 +1280,23 @@ class Interpreter:
             elif k == "if":
                 self._label_reached(pc, ln)
                 target = self._if(pc)
-                self._skipping(pc, pc, target)
-                pc = target
+                stop = self._skipping(pc, pc, target)
+                pc = target if stop is None else stop
             elif k in ("elseif", "else"):  # reached the end of a taken branch
                 target = self.branches[self.owner[pc]][-1]
-                self._skipping(self.owner[pc], pc, target)
-                pc = target + 1
+                stop = self._skipping(self.owner[pc], pc, target)
+                pc = target + 1 if stop is None else stop
             elif k == "endif":
                 pc += 1
             elif k == "while":
                 self._label_reached(pc, ln)
                 v, _ = self._cond(ln)
-                if v == 0 and self._breaks.get(pc):
+                stop = self._skipping(pc, pc, self.match[pc]) if v == 0 else None
+                if v == 0 and self._breaks.get(pc) and stop is None:
                     # LinuxCNC skips to the loop's end by its label and so runs the loop's own
                     # break on the way (a break it reads sets the flag a do loop reads below)
                     stale_break = lines[self._breaks[pc][0]].no
-                if v == 0:
-                    self._skipping(pc, pc, self.match[pc])
-                pc = pc + 1 if v != 0 else self.match[pc] + 1
+                pc = pc + 1 if v != 0 else self.match[pc] + 1 if stop is None else stop
             elif k == "endwhile":
                 pc = self.match[pc]
             elif k == "do":
@@ -1333,8 +1332,8 @@ class Interpreter:
                     pc += 1
                 else:
                     del repeat_left[pc]
-                    self._skipping(pc, pc, self.match[pc])
-                    pc = self.match[pc] + 1
+                    stop = self._skipping(pc, pc, self.match[pc])
+                    pc = self.match[pc] + 1 if stop is None else stop
             elif k == "endrepeat":
                 pc = self.match[pc]
             elif k in ("break", "continue") and lines[self.owner[pc]].okey == "repeat":
@@ -1345,13 +1344,15 @@ class Interpreter:
             elif k == "break":  # (of a while or do loop: a repeat's is refused above)
                 if lines[self.owner[pc]].okey == "while":
                     stale_break = ln.no
-                self._skipping(self.owner[pc], pc, self.match[self.owner[pc]])
-                pc = self.match[self.owner[pc]] + 1
+                stop = self._skipping(self.owner[pc], pc, self.match[self.owner[pc]])
+                pc = self.match[self.owner[pc]] + 1 if stop is None else stop
             elif k == "continue":
                 op = self.owner[pc]
-                self._skipping(op, pc, self.match[op])
+                stop = self._skipping(op, pc, self.match[op])
                 later = [i for i in self._breaks.get(op, []) if i > pc]
-                if lines[op].okey == "while":
+                if stop is not None:  # a do loop under the label: the program runs on there
+                    pc = stop
+                elif lines[op].okey == "while":
                     if later:  # LinuxCNC skips to the loop's end by its label and runs the
                         # loop's own break on the way: the loop goes on, the flag stays set
                         stale_break = lines[later[0]].no
@@ -1411,21 +1412,32 @@ class Interpreter:
         raise self.err(f"o{ln.olabel} {word}", rule, "give each if, while, do and repeat its "
                        "own label (a label may repeat only in different subroutines)")
 
-    def _skipping(self, owner: int, frm: int, to: int) -> None:
+    def _skipping(self, owner: int, frm: int, to: int) -> int | None:
         """The program skips from line index ``frm`` to ``to`` (exclusive) out of the if, loop
         or branch opened at index ``owner``: LinuxCNC skips to the next line with its label and
         reads every such line on the way, so an if/while/do/repeat nested in it with the same
-        label is refused there though it is not run ('duplicate O-word label'; at a do it stops
-        skipping and runs on into that loop, which woodcam refuses)."""
+        label is refused there though it is not run ('duplicate O-word label'). At a do it
+        stops skipping and runs on into that loop (checked: its body is cut, then its while
+        line is refused as a duplicate of the outer label, or, inside an outer do, the program
+        runs on): the do's index is returned, where the program goes on, with a warning; else
+        None. (A break of the loop skipped that LinuxCNC runs on the way sets the flag that
+        ends a do loop at its while line: where that matters, the do's while has a true
+        condition, which woodcam refuses as a second do loop under one label.)"""
         inner = self._inner_same.get(owner)
         i = next((j for j in inner if frm < j < to), None) if inner else None
         if i is None:
-            return
+            return None
         ln, outer = self.lines[i], self.lines[owner]
-        self.line_no = ln.no
         label = ln.olabel
-        why = ("stops skipping here, running this do loop (woodcam refuses it instead)"
-               if ln.okey == "do" else "refuses it ('duplicate O-word label')")
+        self.line_no = ln.no
+        if ln.okey == "do":
+            self.warn(f"the o{label} do on line {ln.no} lies inside the o{label} {outer.okey} "
+                      f"of line {outer.no}, under the same label: LinuxCNC 2.9 skips to that "
+                      f"{outer.okey}'s end by the label, stops at this do and runs on into "
+                      "it (lines the program skips are cut), and woodcam does as LinuxCNC; "
+                      "give each if, while, do and repeat its own label")
+            return i
+        why = "refuses it ('duplicate O-word label')"
         raise self.err(f"o{label} {ln.okey}", f"this o{label} {ln.okey} lies inside the "
                        f"o{label} {outer.okey} of line {outer.no}, under the same label: "
                        f"LinuxCNC 2.9 skips to that {outer.okey}'s end by the label, reads this "
