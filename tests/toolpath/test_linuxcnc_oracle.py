@@ -767,3 +767,14 @@ def test_a_do_loop_reached_while_skipping_runs_as_in_linuxcnc(tmp_path):
     agree, bad = _differences(_written(tmp_path, texts), texts, counts, same_line=True)
     assert not bad, bad
     assert counts == {"ran": 4, "refused": 4, "moves": 27}, counts
+
+
+def test_read_gcode_gives_the_same_messages_with_either_interpreter():
+    """Program.messages of read_gcode: LinuxCNC's own operator messages with
+    interpreter='linuxcnc', woodcam's with its own, the same (test_the_programs_messages_are_
+    shown_as_the_machine_would_show_them)."""
+    text = ("G0 X1 Y2 Z3\n(MSG, start)\n#1=0\no1 while [#1 lt 2]\n(DEBUG,pass #1 x=#<_x>)\n"
+            "G1 X[2+#1] F100\n#1=[#1+1]\no1 endwhile\nM2\n")
+    mine = read_gcode(text).messages
+    assert read_gcode(text, interpreter="linuxcnc").messages == mine == [
+        "line 2: start", "line 5: pass 0.000000 x=1.000000", "line 5: pass 1.000000 x=2.000000"]

@@ -547,3 +547,29 @@ def test_a_ctrl_c_while_the_deviation_map_is_drawn_leaves_no_earlier_map_beside_
     assert main([*gcode, "--until-line", "12"]) == 130
     assert read_glb_metadata(tmp_path / "g.glb")["until_line"] == 12  # the new cut's GLB landed
     assert not dev.exists()  # and no earlier cut's map beside it
+
+
+def test_the_programs_messages_are_shown_as_the_machine_would_show_them(tmp_path, monkeypatch,
+                                                                         capsys):
+    """A program's (MSG,...) and (DEBUG,...) messages, which LinuxCNC shows its operator as the
+    program runs (DEBUG with the parameters' values at that point), were read into the
+    interpreter and shown nowhere: read_gcode's Program had no place for them and woodcam
+    gcode said nothing. They are Program.messages now, printed one a line; not warnings
+    (--strict passes)."""
+    _stub_preview(monkeypatch, {})
+    text = ("G21 G90\nT1 M6\nG0 X10 Y10 Z5 M3 S9000\n(MSG, roughing)\n#1=0\no1 while [#1 lt 2]\n"
+            "G1 Z[-1-#1] F600\n(DEBUG, pass #1 at z=#<_z>)\nG1 X30\nG0 Z5\nG0 X10\n#1=[#1+1]\n"
+            "o1 endwhile\nM2\n")
+    said = ["line 4: roughing", "line 8: pass 0.000000 at z=-1.000000",
+            "line 8: pass 1.000000 at z=-2.000000"]
+    prog = read_gcode(text)
+    assert prog.messages == said and prog.warnings == []
+    assert prog.until_line(8).messages == said  # as its warnings: the whole program's
+    path = tmp_path / "msg.nc"
+    path.write_text(text)
+    args = _parse([str(path), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+                   "--tool", "flat:6", "--cell-size", "0.5", "--strict"])
+    assert args.func(args) == 0
+    err = capsys.readouterr().err
+    assert [ln for ln in err.splitlines() if "message" in ln] == [
+        f"woodcam: message: msg.nc {m}" for m in said]

@@ -220,6 +220,10 @@ def run(args) -> int:
         for w in program.warnings:
             print(f"woodcam: warning: {path.name} {w}", file=sys.stderr)
         n_warn += len(program.warnings)
+        # what the machine's screen would show the operator as the program runs: information,
+        # not a warning (--strict does not count them)
+        for m in program.messages:
+            print(f"woodcam: message: {path.name} {m}", file=sys.stderr)
         if not (program.kind == 1).any() and args.until_line is None:
             raise WoodcamError(f"woodcam gcode: {path} has no cutting move (G1/G2/G3 or a "
                                "drilling cycle); nothing to simulate. Check that it is the "

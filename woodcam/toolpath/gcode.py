@@ -10,7 +10,10 @@ feed ``G1/G2/G3``), ``tool : (n,) int`` (the tool number loaded by the last ``M6
 any), ``line : (n,) int`` (1-based source line) and ``feed_mm_min, spindle_rpm : (n,) float``
 (``spindle_rpm`` is 0 while the spindle is off). Arcs are split into chords whose sagitta is at
 most ``chord_tol_mm`` (default :data:`woodcam.tolerances.ARC_CHORD_TOL_MM`), so every arc vertex
-lies exactly on the analytic circle (helix). ``warnings`` lists ``"line N: ..."`` strings.
+lies exactly on the analytic circle (helix). ``warnings`` lists ``"line N: ..."`` strings;
+``messages`` the operator messages the program says as it runs, ``"line N: ..."`` too (its
+``(MSG,...)``, ``(DEBUG,...)`` and ``(PRINT,...)`` comments, the parameters' values put in, as
+LinuxCNC shows them).
 
 The language (parameters, expressions, O-word subroutines and loops, work offsets, canned
 cycles, dialects) is :mod:`woodcam.toolpath.interpreter`; ``interpreter="linuxcnc"`` runs
@@ -79,6 +82,7 @@ class Program:
     source: str = "<string>"
     tool_numbers: list[int] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    messages: list[str] = field(default_factory=list)
 
     def __len__(self) -> int:
         return len(self.kind)
@@ -105,7 +109,8 @@ class Program:
         """The moves ``k`` (a slice or a boolean mask) as a program of the same source."""
         return Program(self.start_mm[k], self.end_mm[k], self.kind[k], self.tool[k],
                        self.line[k], self.feed_mm_min[k], self.spindle_rpm[k], self.source,
-                       sorted(set(self.tool[k].tolist())), list(self.warnings))
+                       sorted(set(self.tool[k].tolist())), list(self.warnings),
+                       list(self.messages))
 
     def __iter__(self):
         return (self[i] for i in range(len(self)))
@@ -299,23 +304,27 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
     if machine_zero_mm is not None:
         mzero = tuple(check_vector(machine_zero_mm, "read_gcode: machine_zero_mm",
                                    fix="give millimetres, e.g. (0, 0, 80), or None").tolist())
+    said: list[tuple[int, str]] = []
     if interpreter == "linuxcnc":
         from .linuxcnc import run_linuxcnc
 
         moves, warnings = run_linuxcnc(text, start_mm=tuple(start.tolist()),
-                                       machine_zero_mm=mzero)
+                                       machine_zero_mm=mzero, said=said)
     elif interpreter == "woodcam":
-        moves, warnings = Interpreter(text, dialect=dialect, start_mm=start.tolist(),
-                                      machine_zero_mm=mzero).run()
+        interp = Interpreter(text, dialect=dialect, start_mm=start.tolist(),
+                             machine_zero_mm=mzero)
+        moves, warnings = interp.run()
+        said = interp.messages
     else:
         raise WoodcamError(f"read_gcode: interpreter must be 'woodcam' or 'linuxcnc', got "
                            f"{interpreter!r}")
     return program_from_canonical(moves, start.tolist(), chord_tol_mm, source,
-                                  [f"line {ln}: {m}" for ln, m in warnings])
+                                  [f"line {ln}: {m}" for ln, m in warnings],
+                                  [f"line {ln}: {m}" for ln, m in said])
 
 
 def program_from_canonical(moves, start_mm, chord_tol_mm, source="<string>",
-                           warnings=()) -> Program:
+                           warnings=(), messages=()) -> Program:
     """Canonical moves (:mod:`.interpreter`'s form) -> a :class:`Program`: arcs become chords
     with sagitta <= ``chord_tol_mm`` whose vertices lie on the analytic circle/helix."""
     pos = list(map(float, start_mm))
@@ -342,7 +351,8 @@ def program_from_canonical(moves, start_mm, chord_tol_mm, source="<string>",
     s, e, m = s[keep], e[keep], m[keep]
     tools = m[:, 1].astype(int)
     return Program(s, e, m[:, 0].astype(np.uint8), tools, m[:, 2].astype(int), m[:, 3],
-                   m[:, 4], source, sorted(set(tools.tolist())), list(warnings))
+                   m[:, 4], source, sorted(set(tools.tolist())), list(warnings),
+                   list(messages))
 
 
 _PLANE_AXES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}

@@ -69,13 +69,15 @@ def run_batch(paths, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 10.0,
 
 
 def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.0,
-                 machine_zero_mm=(0.0, 0.0, 0.0)):
+                 machine_zero_mm=(0.0, 0.0, 0.0), said: list | None = None):
     """LinuxCNC's canonical moves of program ``text`` in woodcam's canonical form
     (:mod:`.interpreter`): ``(moves, warnings)``; a refusal raises :class:`GcodeError` with
     LinuxCNC's message and line. ``machine_zero_mm``: the machine origin in the G54 frame
     (mm); ``None`` (not known) refuses a program with G53 lines: LinuxCNC has no "not known"
     and would take machine zero at G-code zero (a ``G53 G0 Z-5`` retract 5 mm into the stock),
-    where woodcam's interpreter takes a G53 Z move as a retract to the start height."""
+    where woodcam's interpreter takes a G53 Z move as a retract to the start height. ``said``,
+    when given, receives LinuxCNC's operator messages (``(MSG,...)``, ``(DEBUG,...)``) as
+    ``(line, text)``, those before a refusal too."""
     g53 = _g53_lines(text) if machine_zero_mm is None else []
     if g53:
         raise GcodeError(g53[0], "G53", f"machine coordinates (G53, on line(s) {line_list(g53)}) "
@@ -90,6 +92,8 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
         res = run_batch([p], start_mm=start_mm, timeout_s=timeout_s,
                         machine_zero_mm=machine_zero_mm)[0]
     warnings = []
+    if said is not None:
+        said += [(int(ln), m.strip()) for ln, m in res["messages"]]
     if res["error"]:
         line, msg = res["error"]
         if msg != NO_END:
