@@ -172,6 +172,19 @@ FACE_PIXEL_ASPECT_RTOL = 0.05
 #: (4.5 px, :data:`woodcam.detect.rings.WAVELENGTH_RANGE_PX`), a phone photo thousands.
 MIN_FACE_PHOTO_PX = 48
 
+#: Fewest pixels a mm (along its coarser axis) a face image must have for the face-layout check
+#: (:func:`woodcam.detect.layout.check_face_layout`) to judge it; a coarser face is listed as not
+#: checked. Measured on correct layouts resized (a 50 mm cube), with rings found on every face:
+#: Mokume CN03 scored a turned 'back' past the 0.15 margin at 0.64-1.28 px/mm (32-64 px a side;
+#: its best wrong variant +0.27, +0.20, +0.15), +0.12 at 1.6 and +0.07 at 1.92; H11 stayed under
+#: (+0.14 at 0.64); synthetic cubes of 1.5 mm rings (flat- and quarter-sawn) gave false alarms
+#: up to 1.92 px/mm (+0.22, +0.29; 2.9 px a ring) and none from 2.56 (+0.04, +0.08). From
+#: 2.56 px/mm the real faces' wrong layouts (each face turned 90, 180, mirrored) are still found:
+#: CN03 15 of 18, H11 17 of 18. Not px per ring alone: CN03's rings are 5-13 mm apart (over 6 px a
+#: ring at 1.28 px/mm) and it still misread, the check's filters being in mm (0.2 mm smoothing,
+#: 1 mm shift).
+LAYOUT_MIN_PX_PER_MM = 2.5
+
 #: Largest error (years) allowed between a refined synthetic ring trace vertex and its integer
 #: iso-line. Newton refinement on the true field reaches ~1e-9 years in three steps; vertices that
 #: do not (on a field kink or where the gradient vanishes, e.g. at the pith) are dropped.

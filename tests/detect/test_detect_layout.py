@@ -110,3 +110,52 @@ def test_a_face_with_no_rings_found_is_not_called_mirrored(cube, capsys):
     report_layout(detected)
     assert capsys.readouterr().out == ("layout: 5 faces checked, none looks turned or mirrored; "
                                        "not checked: right (no rings found on it)\n")
+
+
+def _resized(block: Block, px: int) -> Block:
+    from PIL import Image
+
+    faces = {n: Face(n, (px, px), photo=np.asarray(Image.fromarray(f.photo).resize((px, px), Image.LANCZOS)))
+             for n, f in block.faces.items()}
+    return Block(block.size_mm, faces=faces, name=block.name, meta={})
+
+
+def test_a_face_too_coarse_to_judge_is_listed_not_called_turned(capsys):
+    """Mokume CN03 resized to 64 px a side (1.28 px/mm), laid out right and with rings found on
+    every face, was said to have its 'back' turned 90 degrees: at such a density the check's
+    evidence is noise (LAYOUT_MIN_PX_PER_MM). Its faces are listed as not checked, with why and
+    the size that would be; at 160 px (3.2 px/mm) it is checked and passes."""
+    from woodcam.block.io import read_mokume
+    from woodcam.cli.options import report_layout
+    from woodcam.detect.block import photos_only
+
+    from .test_detect_rings import _mokume
+
+    cn03 = photos_only(read_mokume(_mokume("CN03"), (50.0, 50.0, 50.0)))
+    small = _resized(cn03, 64)
+    report = check_face_layout(small)
+    assert report.corrections == {} and report.warnings == [] and report.faces == {}
+    assert set(report.unchecked) == set(small.faces)
+    assert report.unchecked["back"] == ("64 px a side is 1.28 px/mm, under the 2.5 px/mm the check needs "
+                                        "(LAYOUT_MIN_PX_PER_MM): give its photo at least 125 px a side")
+    report_layout(small)
+    out = capsys.readouterr().out
+    assert out.startswith("layout: not checked (no two neighbouring faces with a photo or ring map); "
+                          "not checked: front (64 px a side is 1.28 px/mm"), out
+    fine = check_face_layout(_resized(cn03, 160))
+    assert fine.unchecked == {} and fine.corrections == {} and len(fine.faces) == 6
+
+
+def test_a_coarse_face_is_no_neighbour_but_the_others_are_still_judged(cube):
+    """One face under the floor is listed; a turned face beside it is still found by its other edges."""
+    from PIL import Image
+
+    faces = dict(cube.faces)
+    coarse = np.asarray(Image.fromarray(cube.faces["front"].photo).resize((64, 64), Image.LANCZOS))
+    faces["front"] = Face("front", (64, 64), photo=coarse)
+    turned = np.ascontiguousarray(np.rot90(cube.faces["top"].photo, -1))
+    faces["top"] = Face("top", turned.shape[:2], photo=turned)
+    report = check_face_layout(Block(cube.size_mm, faces=faces, meta={}))
+    assert set(report.unchecked) == {"front"} and "front" not in report.faces
+    assert report.corrections == {"top": "rot90ccw"}
+    assert report.faces["top"].edges == 3

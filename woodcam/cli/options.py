@@ -535,7 +535,7 @@ def report_layout(block) -> None:
         warnings.warn(w, WoodcamWarning, stacklevel=2)
     # a face detection found no rings on is not judged (its edges hold no rings to meet): said, so
     # 'none looks turned' is not read as covering it
-    skipped = (f"; not checked: {', '.join(report.unchecked)} ({', '.join(sorted(set(report.unchecked.values())))})"
+    skipped = (f"; not checked: {', '.join(f'{n} ({why})' for n, why in report.unchecked.items())}"
                if report.unchecked else "")
     if not report.warnings:
         print(f"layout: {len(report.faces)} faces checked, none looks turned or mirrored{skipped}"

@@ -48,7 +48,7 @@ from .._cache import cache_dir, digest, entry_path, load_or_build
 from ..block.block import Block, Face
 from ..errors import WoodcamError, WoodcamWarning
 from .knots import detect_knots
-from .layout import check_face_layout
+from .layout import NO_RINGS, check_face_layout
 from .rings import DEFAULT_RULE, RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, ring_map_from_traces
 
 #: Bumped whenever detection results change, so cached detections are recomputed (3: traces
@@ -464,7 +464,11 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     block.meta["detection"] = det
     # a face photographed turned or mirrored ruins the fit without a word otherwise; a face with no
     # rings found is not judged (its report.unchecked), and its 'no rings found' above says so
-    msgs += check_face_layout(block).warnings
+    layout = check_face_layout(block)
+    msgs += layout.warnings
+    # a face too coarse to judge is said, so the silence is not read as its layout holding
+    msgs += [f"face {n!r}: not checked for a turned or mirrored photo: {why}"
+             for n, why in layout.unchecked.items() if why != NO_RINGS]
     manifest = write_block(block, out, traces_svg={n: f"{n}_traces.svg" for n in block.faces})
     # after the manifest: interrupted before, a stale mask is unnamed, never read
     msgs += _clear_stale_knot_masks(out, block, out_knots)

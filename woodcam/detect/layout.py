@@ -25,6 +25,7 @@ import numpy as np
 
 from ..block.block import Block
 from ..frames import FACE_AXIS, FACE_NORMAL, FaceName, block_to_pixel
+from ..tolerances import LAYOUT_MIN_PX_PER_MM
 from .rings import luminance
 
 #: Depths (pixels of the face image) inside a face at which its edge strip is read, averaged:
@@ -117,7 +118,8 @@ class LayoutReport:
     source : face -> ``"ring map"`` or ``"photo"``: what the face was read from.
     corrections : face -> key of :data:`VARIANTS` to apply to it, for each face flagged.
     warnings : one line per face flagged, clearest first.
-    unchecked : face -> why it was not scored though it has a photo (detection found no rings on it).
+    unchecked : face -> why it was not scored though it has a photo or ring map (detection found no
+        rings on it; its image is too coarse for the check, under :data:`LAYOUT_MIN_PX_PER_MM`).
     """
 
     faces: dict[FaceName, FaceLayout]
@@ -127,9 +129,30 @@ class LayoutReport:
     unchecked: dict[FaceName, str] = field(default_factory=dict)
 
 
+#: Why a face detection found no rings on is not checked (:attr:`LayoutReport.unchecked`).
+NO_RINGS = "no rings found on it"
+
+
 def _no_ring_evidence(face, detected: bool) -> bool:
     """Detection ran (``detected``) and found no rings on ``face``'s photo: no ring map, no trace."""
     return detected and face.photo is not None and face.ring_map is None and not face.traces
+
+
+def _too_coarse(block: Block, name: FaceName) -> str | None:
+    """Why face ``name``'s image is too coarse for its edges to be compared, or None: fewer than
+    :data:`LAYOUT_MIN_PX_PER_MM` pixels a mm along its coarser axis. Below it, correct faces of
+    Mokume CN03 and synthetic cubes scored a turned or mirrored variant past
+    :data:`LAYOUT_MARGIN` (CN03 resized to 64 px a side: 'back looks turned 90 degrees'), with
+    rings found on every face: a false alarm, where 'not checked' is the truth."""
+    f = block.faces[name]
+    if f.photo is None and f.ring_map is None:
+        return None
+    px_mm = 1.0 / max(block.face_pixel_size_mm(name))
+    if px_mm >= LAYOUT_MIN_PX_PER_MM:
+        return None
+    need = int(np.ceil(LAYOUT_MIN_PX_PER_MM / px_mm * min(f.shape)))
+    return (f"{min(f.shape)} px a side is {px_mm:.2f} px/mm, under the {LAYOUT_MIN_PX_PER_MM:g} px/mm "
+            f"the check needs (LAYOUT_MIN_PX_PER_MM): give its photo at least {need} px a side")
 
 
 def _face_signal(face, detected: bool) -> tuple[np.ndarray, str] | None:
@@ -205,13 +228,18 @@ def check_face_layout(block: Block, margin: float = LAYOUT_MARGIN) -> LayoutRepo
 
     Faces are read from their ring maps, or their photos' luminance (without a ring map, or when
     the block's maps were drawn from detected traces: ``block.meta["detection"]``); faces with
-    neither, faces detection found no rings on (listed in ``unchecked``), and faces with no
-    neighbour to compare with, are not scored.
+    neither, faces detection found no rings on and faces under :data:`LAYOUT_MIN_PX_PER_MM`
+    (both listed in ``unchecked``, with why), and faces with no neighbour to compare with, are
+    not scored.
     Returns a :class:`LayoutReport`; it warns nothing itself (the caller prints or warns).
     """
     size = np.asarray(block.size_mm, float)
     detected = bool(block.meta.get("detection"))
-    signal = {n: s for n, f in block.faces.items() if (s := _face_signal(f, detected)) is not None}
+    unchecked = {n: NO_RINGS for n, f in block.faces.items() if _no_ring_evidence(f, detected)}
+    # a face too coarse to judge is no neighbour to judge others by either
+    unchecked.update({n: why for n in block.faces if n not in unchecked and (why := _too_coarse(block, n))})
+    signal = {n: s for n, f in block.faces.items()
+              if n not in unchecked and (s := _face_signal(f, detected)) is not None}
     images = {n: s[0] for n, s in signal.items()}
     first = _score_faces(images, size)
     # One turned face lowers its neighbours' scores too (one edge of their four): correct the
@@ -236,7 +264,6 @@ def check_face_layout(block: Block, margin: float = LAYOUT_MARGIN) -> LayoutRepo
         corrections[fl.face] = variant
         images[fl.face] = np.ascontiguousarray(VARIANTS[variant][0](images[fl.face]))
         layouts = {n: v for n, v in _score_faces(images, size).items() if n not in corrections}
-    unchecked = {n: "no rings found on it" for n, f in block.faces.items() if _no_ring_evidence(f, detected)}
     return LayoutReport(first, {n: s[1] for n, s in signal.items()}, corrections, warnings, unchecked)
 
 
