@@ -684,6 +684,32 @@ def test_a_rerun_clears_its_own_stale_knot_masks_and_keeps_a_users(synth_photos,
     assert "is not read (no knot was found on it this time" in said[0] and "is kept" in said[0]
 
 
+def test_a_rerun_clears_its_own_stale_ring_maps_and_svgs_and_keeps_a_users(synth_photos, tmp_path, capsys, monkeypatch):
+    """The block remade into its folder without its back photo (--partial) and detected again:
+    back_ring_map.png and back_traces.svg of the earlier detection stayed beside the new manifest,
+    as knot masks did. Every file detection writes is recorded and cleared alike; a ring map the
+    user edited (front's, whose face is gone too in the second remake) is kept and said."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
+    assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 0
+    assert (blk / "back_ring_map.png").is_file() and (blk / "front_ring_map.png").is_file()
+    mine = np.zeros((160, 160), np.uint8)
+    mine[::8] = 255
+    Image.fromarray(mine).save(blk / "front_ring_map.png")  # the user's own rings, drawn over it
+    five = _copy(synth_photos, tmp_path / "five", skip=("back", "front"))
+    assert _run(capsys, "block", "from-photos", five, "--size-mm", "50", "--partial", "--out", blk)[0] == 0
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0, err
+    assert not (blk / "back_ring_map.png").exists() and not (blk / "back_traces.svg").exists()
+    assert set(read_block(blk).faces) == {"top", "bottom", "left", "right"}
+    with Image.open(blk / "front_ring_map.png") as im:
+        assert np.array_equal(np.asarray(im), mine)
+    said = [w for w in err.splitlines() if "_ring_map.png" in w or "_traces.svg" in w]
+    assert len(said) == 1 and said[0].startswith("woodcam: warning: face 'front': front_ring_map.png in "), said
+    assert "is not read (the block has no such face this time" in said[0] and "is kept" in said[0]
+
+
 def test_a_missing_or_file_input_is_one_line_that_says_which(synth_photos, tmp_path, capsys):
     """A photo given where the block folder goes ('rings detect front.png', 'rings show
     front.png') was said not to exist, though it is right there; a missing folder is still said

@@ -16,10 +16,12 @@ the ring map from them; only faces whose SVG is untouched (or missing) are detec
 also records a digest of each face photo traced (``meta["detection"]["photo_digest"]``): a
 corrected SVG drawn over another photo than the face's now is refused, not kept.
 
-**Its own knot masks, and no others, are cleared.** The manifest records a digest of each knot
-mask the detector made (``meta["detection"]["knot_digest"]``). Detecting again into the folder,
-a ``<face>_knot_mask.png`` the new detection names no more (no knot found on the face now, or
-no such face) is removed when it is still the recorded mask; a mask that is not (edited, made by
+**Its own files, and no others, are cleared.** Detection writes per face
+``<face>_traces.svg``, ``<face>_ring_map.png`` and ``<face>_knot_mask.png``; the manifest records
+a digest of each (the SVGs' ``svg_sha256`` above, the images' ``meta["detection"]["file_digest"]``:
+file name -> digest of its pixels as read back; :data:`DETECTED_IMAGES`). Detecting again into
+the folder, such a file the new detection names no more (no rings or knot found on the face now,
+or no such face) is removed when it is still the recorded one; one that is not (edited, made by
 hand, or left by a run before the digests were recorded) is kept, unread, and said.
 
 **Photo-only blocks elsewhere** (``fit``, ``bake``, ``eval``): :func:`with_detected_rings`
@@ -47,6 +49,7 @@ from .._atomic import atomic_path, write_bytes
 from .._cache import cache_dir, digest, entry_path, load_or_build
 from ..block.block import Block, Face
 from ..errors import WoodcamError, WoodcamWarning
+from ..frames import FACES
 from .knots import detect_knots
 from .layout import NO_RINGS, check_face_layout
 from .rings import DEFAULT_RULE, RING_MAP_SIGMA_MM, BoundaryRule, detect_rings, ring_map_from_traces
@@ -258,13 +261,13 @@ def detection_record(folder) -> dict | None:
         return None
     svgs = {n: svg for n, svg in (rec.get("traces_svg") or {}).items()
             if isinstance(svg, str) and (folder / svg).is_file()}
-    # the knot masks the detection made stay on disk under a remade manifest (which names none):
-    # their digests kept, the next detection clears those it finds no knot for
-    knots = _knot_digests(rec)
-    if not svgs and not knots:
+    # the images the detection made stay on disk under a remade manifest (which names none):
+    # their digests kept, the next detection clears those it does not write again
+    images = _file_digests(rec)
+    if not svgs and not images:
         return None
     return {"traces_svg": svgs, "svg_sha256": rec.get("svg_sha256", {}),
-            "photo_digest": rec.get("photo_digest", {}), "knot_digest": knots}
+            "photo_digest": rec.get("photo_digest", {}), "file_digest": images}
 
 
 def user_edited_faces(folder) -> dict[str, Path]:
@@ -287,57 +290,92 @@ def _photo_digest(photo) -> str:
     return digest(np.asarray(photo))
 
 
-def _mask_digest(mask) -> str:
-    """Digest of a knot mask's pixels ((h, w) bool), as the detector made it."""
-    return digest(np.asarray(mask, bool))
+#: The images detection writes per face (:mod:`woodcam.block.io` names them ``<face>_<kind>.png``),
+#: recorded by digest so a rerun clears or writes over only its own (module docstring): kind ->
+#: (what it is, in words; why a face has none after a detection).
+DETECTED_IMAGES = {"ring_map": ("ring map", "no rings were found on it"),
+                   "knot_mask": ("knot mask", "no knot was found on it")}
 
 
-def _knot_digests(rec: dict | None) -> dict[str, str]:
-    """face -> digest of the knot mask a detection record says the detector made (``knot_digest``)."""
-    got = (rec or {}).get("knot_digest")
+def _image(face: Face | None, kind: str):
+    """Face ``face``'s image of ``kind`` (:data:`DETECTED_IMAGES`), or None."""
+    if face is None:
+        return None
+    return face.ring_map if kind == "ring_map" else face.extras.get(kind)
+
+
+def _pixels_digest(kind: str, image) -> str:
+    """Digest of ``image`` of ``kind`` as :func:`~woodcam.block.io.write_block` stores it (a ring
+    map 16-bit, a knot mask 0/255 read back as bool), what :func:`_file_digest` reads back."""
+    from ..block.io import _quantise
+
+    if kind == "ring_map":
+        return digest(_quantise(image, 16, "ring map"))
+    return digest(np.asarray(image, bool))
+
+
+def _file_digest(path: Path, kind: str) -> str | None:
+    """:func:`_pixels_digest` of the image file ``path``; None when it cannot be read as one."""
+    from .._readers import read_image_file
+
+    try:
+        raw = read_image_file(path, DETECTED_IMAGES[kind][0])
+    except WoodcamError:
+        return None
+    return digest(raw) if kind == "ring_map" else digest(np.asarray(raw > 127, bool))
+
+
+def _file_digests(rec: dict | None) -> dict[str, str]:
+    """file name -> digest of each image a detection record says the detector wrote (``file_digest``)."""
+    got = (rec or {}).get("file_digest")
     return {n: d for n, d in got.items() if isinstance(d, str)} if isinstance(got, dict) else {}
 
 
-def _prior_knot_digests(folder: Path) -> dict[str, str]:
-    """:func:`_knot_digests` of the block folder ``folder``'s manifest; empty without one (an
+def _prior_record(folder: Path) -> dict:
+    """The detection record of the block folder ``folder``'s manifest; empty without one (an
     unreadable one is said by :func:`_readable_record` where it is read)."""
     from ..block.io import MANIFEST
 
     if not (folder / MANIFEST).is_file():
         return {}
     try:
-        return _knot_digests(_detection_record(folder))
+        return _detection_record(folder)
     except (ValueError, OSError):
         return {}
 
 
-def _clear_stale_knot_masks(out: Path, block: Block, ours: dict[str, str]) -> list[str]:
-    """Remove each ``<face>_knot_mask.png`` in ``out`` that ``block`` (just written there) has no
-    knot mask for, when its pixels are those the detector made (``ours``: face -> digest, from
-    the folder's record before this run): a previous run's mask of a face where this run finds
-    no knot stayed beside the new manifest. Any other such file is kept and said; returns the
-    warnings."""
-    from .._readers import read_image_file
-    from ..frames import FACES
-
+def _clear_stale_files(out: Path, block: Block, before: dict) -> list[str]:
+    """Remove each file of detection (``<face>_traces.svg``, :data:`DETECTED_IMAGES`) in ``out``
+    that ``block`` (just written there) does not name, when it is the one the detector wrote
+    (``before``: the folder's detection record before this run): a previous run's file of a face
+    with no rings or knot found now, or no such face, stayed beside the new manifest. Any other
+    such file is kept and said, but a corrected SVG (said by its caller); returns the warnings."""
+    ours_img, ours_svg = _file_digests(before), before.get("svg_sha256") or {}
+    corrected = set((before.get("traces_svg") or {}).values())
     msgs = []
     for name in FACES:
-        path = out / f"{name}_knot_mask.png"
         face = block.faces.get(name)
-        if not path.is_file() or (face is not None and "knot_mask" in face.extras):
-            continue  # none, or this detection's own (written over)
-        try:
-            mine = name in ours and _mask_digest(read_image_file(path, "knot mask") > 127) == ours[name]
-        except WoodcamError:
-            mine = False  # unreadable: not the detector's PNG
-        if mine:
-            path.unlink()
-            continue
-        why = "no knot was found on it" if face is not None else "the block has no such face"
-        msgs.append(f"face {name!r}: {path.name} in {str(out)!r} is not read ({why} this time, and block.json does not "
-                    f"name it), and is kept: it is not the mask an earlier detection made (edited, made by hand, or from "
-                    f"before woodcam recorded its masks); delete it, or to use it name it in block.json as the face's "
-                    f"extras knot_mask and detect with --no-knots")
+        svg = out / f"{name}_traces.svg"
+        if face is None and svg.is_file():
+            if isinstance(ours_svg, dict) and ours_svg.get(name) == _sha256(svg):
+                svg.unlink()
+            elif svg.name not in corrected:
+                msgs.append(f"face {name!r}: {svg.name} in {str(out)!r} is not read (the block has no such face, "
+                            f"and block.json does not name it), and is kept: it is not the SVG an earlier "
+                            f"detection wrote; delete it, or move it out to keep it")
+        for kind, (what, why) in DETECTED_IMAGES.items():
+            path = out / f"{name}_{kind}.png"
+            if not path.is_file() or _image(face, kind) is not None:
+                continue  # none, or this detection's own (written over)
+            if ours_img.get(path.name) is not None and _file_digest(path, kind) == ours_img[path.name]:
+                path.unlink()
+                continue
+            why = why if face is not None else "the block has no such face"
+            use = ("name it in block.json as the face's extras knot_mask and detect with --no-knots"
+                   if kind == "knot_mask" else "name it in block.json as the face's ring_map")
+            msgs.append(f"face {name!r}: {path.name} in {str(out)!r} is not read ({why} this time, and block.json does "
+                        f"not name it), and is kept: it is not the {what} an earlier detection made (edited, made by "
+                        f"hand, or from before woodcam recorded them); delete it, or to use it {use}")
     return msgs
 
 
@@ -397,9 +435,9 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     unused = {n: svg for n, svg in edited.items() if n not in block.faces}
     edited = {n: svg for n, svg in edited.items() if n in block.faces}
     _check_corrections_match_photos(block, edited)
-    # the knot masks the detector made, as the source and --out recorded them (before either is overwritten)
-    src_knots = _prior_knot_digests(src)
-    out_knots = src_knots if out.resolve() == src.resolve() else _prior_knot_digests(out)
+    # the files the detector wrote, as the source and --out recorded them (before either is overwritten)
+    src_rec = _prior_record(src)
+    out_rec = src_rec if out.resolve() == src.resolve() else _prior_record(out)
     todo = [n for n, f in block.faces.items() if f.photo is not None and n not in edited]
     msgs: list[str] = [f"face {n!r}: the corrected {svg} is not used: the block has no {n} face (made "
                        f"without its photo); move it out of {str(svg.parent)!r} to keep it (a later detection "
@@ -456,11 +494,15 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     det["svg_sha256"] = hashes
     det["photo_digest"] = {n: _photo_digest(f.photo) for n, f in block.faces.items() if f.photo is not None}
     det["user_svg"] = sorted(kept)
-    # the detector's knot masks: this run's, and earlier ones kept unchanged (--no-knots, a
-    # corrected SVG's face): a mask of the user's is never recorded, so never cleared
-    det["knot_digest"] = {n: d for n, f in block.faces.items() if "knot_mask" in f.extras
-                          for d in [_mask_digest(f.extras["knot_mask"])]
-                          if (knots and n in todo) or src_knots.get(n) == d}
+    # the detector's images: this run's (ring maps of faces detected or drawn from a corrected
+    # SVG, knot masks detected), and earlier ones kept unchanged (--no-knots, a corrected SVG's
+    # face) that were its own; a user's is never recorded, so never cleared
+    fresh = {"ring_map": set(todo) | set(kept), "knot_mask": set(todo) if knots else set()}
+    before = _file_digests(src_rec)
+    det["file_digest"] = {fname: d for n, f in block.faces.items() for kind in DETECTED_IMAGES
+                          if (image := _image(f, kind)) is not None
+                          for fname, d in [(f"{n}_{kind}.png", _pixels_digest(kind, image))]
+                          if n in fresh[kind] or before.get(fname) == d}
     block.meta["detection"] = det
     # a face photographed turned or mirrored ruins the fit without a word otherwise; a face with no
     # rings found is not judged (its report.unchecked), and its 'no rings found' above says so
@@ -471,7 +513,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
              for n, why in layout.unchecked.items() if why != NO_RINGS]
     manifest = write_block(block, out, traces_svg={n: f"{n}_traces.svg" for n in block.faces})
     # after the manifest: interrupted before, a stale mask is unnamed, never read
-    msgs += _clear_stale_knot_masks(out, block, out_knots)
+    msgs += _clear_stale_files(out, block, out_rec)
     return manifest, msgs
 
 
