@@ -710,6 +710,57 @@ def test_a_rerun_clears_its_own_stale_ring_maps_and_svgs_and_keeps_a_users(synth
     assert "is not read (the block has no such face this time" in said[0] and "is kept" in said[0]
 
 
+def test_an_edited_knot_mask_or_ring_map_wins_over_a_rerun_as_a_corrected_svg_does(synth_photos, tmp_path, capsys,
+                                                                                     monkeypatch):
+    """A knot mask the user edited (left_knot_mask.png: the knot drawn larger) was written over
+    without a word by a rerun that found the knot again, where a corrected SVG is kept. Now an
+    edited mask or ring map is kept and read as the face's, said with how to let detection
+    replace it; it stays the user's on later runs, one made over another photo is refused, and
+    once deleted detection writes its own."""
+    from .test_detect_knots import _face_with_knot
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    knotted = _copy(synth_photos, tmp_path / "knotted")
+    Image.fromarray(_face_with_knot(160)[0]).save(knotted / "left.png")
+    blk = tmp_path / "blk"
+    size = ("--size-mm", "32")  # 5 px/mm, where the analytic knot is found
+    assert _run(capsys, "block", "from-photos", knotted, *size, "--out", blk)[0] == 0
+    assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 0
+    detected = read_block(blk).faces
+    mask = np.zeros((160, 160), np.uint8)
+    mask[60:140, 20:120] = 255
+    Image.fromarray(mask).save(blk / "left_knot_mask.png")
+    rings = np.zeros((160, 160), np.uint16)
+    rings[:, ::10] = 65535
+    Image.fromarray(rings).save(blk / "top_ring_map.png")
+    for _ in range(2):  # kept, and not taken for the detector's the next time
+        rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+        assert rc == 0, err
+        faces = read_block(blk).faces
+        assert np.array_equal(faces["left"].extras["knot_mask"], mask > 127), err
+        assert np.array_equal(faces["top"].ring_map, rings / 65535.0)
+        for f in ("left_knot_mask.png", "top_ring_map.png"):
+            (line,) = [w for w in err.splitlines() if f in w]
+            assert f"kept the edited {blk / f} (it is not the " in line, line
+            assert "it wins over detection; to let detection replace it, delete it" in line
+    (blk / "left_knot_mask.png").unlink()  # the manifest names them: detection writes them again
+    (blk / "top_ring_map.png").unlink()
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and "kept the edited" not in err, err
+    faces = read_block(blk).faces
+    assert np.array_equal(faces["left"].extras["knot_mask"], detected["left"].extras["knot_mask"])
+    assert np.allclose(faces["top"].ring_map, detected["top"].ring_map)
+    # an edit made over another photo than the face's now is refused, as a corrected SVG is
+    Image.fromarray(mask).save(blk / "left_knot_mask.png")
+    turned = _copy(knotted, tmp_path / "turned")
+    Image.open(turned / "left.png").rotate(180).save(turned / "left.png")
+    assert _run(capsys, "block", "from-photos", turned, *size, "--out", blk)[0] == 0
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == EXIT_ERROR and f"face 'left': the edited {blk / 'left_knot_mask.png'} was made over another left photo" in err
+    with Image.open(blk / "left_knot_mask.png") as im:
+        assert np.array_equal(np.asarray(im), mask)
+
+
 def test_a_missing_or_file_input_is_one_line_that_says_which(synth_photos, tmp_path, capsys):
     """A photo given where the block folder goes ('rings detect front.png', 'rings show
     front.png') was said not to exist, though it is right there; a missing folder is still said

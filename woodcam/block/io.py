@@ -48,6 +48,7 @@ from __future__ import annotations
 import json
 import os
 import warnings
+from collections.abc import Collection
 from pathlib import Path
 from typing import Literal
 
@@ -158,8 +159,12 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
     return manifest_path
 
 
-def read_block(folder: PathLike, *, allow_outside: bool | None = None) -> Block:
+def read_block(folder: PathLike, *, allow_outside: bool | None = None, regenerated: Collection[str] = ()) -> Block:
     """Read a block folder written by :func:`write_block` (or made by hand for a real block).
+
+    ``regenerated``: names of image files (a ring map, a PNG extra) the manifest may name though
+    they are gone, read as absent: ring detection's own images, which it writes again (a user
+    deletes an edited one to let detection replace it); any other missing file is an error.
 
     Faces missing from the manifest are absent from the block; ``true_field`` is None unless the
     manifest says it was saved and its class can be restored. The manifest is checked at the
@@ -193,7 +198,11 @@ def read_block(folder: PathLike, *, allow_outside: bool | None = None) -> Block:
         if entry.get("photo"):
             photo = photo_rgb8(_read_png(files[f"faces.{name}.photo"], f"photo of face {name!r}"))
             _check_shape(photo, shape, f"photo of face {name!r} ({entry['photo']})")
-        if entry.get("ring_map"):
+        def gone(key: str) -> bool:
+            path = files.get(key)
+            return path is not None and path.name in regenerated and not path.is_file()
+
+        if entry.get("ring_map") and not gone(f"faces.{name}.ring_map"):
             raw = _read_png(files[f"faces.{name}.ring_map"], f"ring map of face {name!r}")
             bits = int(entry.get("ring_map_bits", 16 if raw.dtype == np.uint16 else 8))
             if raw.ndim == 3:
@@ -213,7 +222,7 @@ def read_block(folder: PathLike, *, allow_outside: bool | None = None) -> Block:
             traces += read_traces_svg(files[f"faces.{name}.traces_svg"], shape)
         extras = {k: _read_extra(files.get(f"faces.{name}.extras.{k}.png"), v, shape,
                                  f"extras[{k!r}] of face {name!r}")
-                  for k, v in entry.get("extras", {}).items()}
+                  for k, v in entry.get("extras", {}).items() if not gone(f"faces.{name}.extras.{k}.png")}
         faces[name] = Face(name, shape, photo=photo, traces=traces, ring_map=ring_map, extras=extras)
     return Block(
         tuple(float(v) for v in m["size_mm"]), faces=faces,
@@ -336,13 +345,15 @@ def _check_shape(a: np.ndarray, shape, what: str) -> None:
 
 # -- Mokume sample folders -----------------------------------------------------------------------
 
-def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | None = None) -> Block:
+def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | None = None, *,
+                      regenerated: Collection[str] = ()) -> Block:
     """Read a block folder of either kind: the one rule every reader of a folder uses.
 
     A folder with a ``block.json`` manifest (or the manifest's own path) is read by
     :func:`read_block`; any other folder is read as a Mokume sample folder by
     :func:`read_mokume`, with cube size ``size_mm`` (default :data:`MOKUME_DEFAULT_SIZE_MM`;
-    ignored for a manifest folder, whose manifest records its size).
+    ignored for a manifest folder, whose manifest records its size); ``regenerated`` as
+    :func:`read_block`.
 
     Raises
     ------
@@ -356,7 +367,7 @@ def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | No
         raise WoodcamError(f"folder must be a block folder (with {MANIFEST}) or a Mokume sample "
                            f"folder; {str(folder)!r} {'is a file, not a folder' if folder.exists() else 'does not exist'}")
     if (folder / MANIFEST).is_file():
-        block = read_block(folder)
+        block = read_block(folder, regenerated=regenerated)
         if size_mm is not None and tuple(map(float, size_mm)) != tuple(block.size_mm):
             # nothing silently dropped: --size-mm was accepted and ignored
             warnings.warn(f"--size-mm (size_mm {tuple(size_mm)}) is for Mokume sample folders; {str(folder)!r} "

@@ -16,13 +16,17 @@ the ring map from them; only faces whose SVG is untouched (or missing) are detec
 also records a digest of each face photo traced (``meta["detection"]["photo_digest"]``): a
 corrected SVG drawn over another photo than the face's now is refused, not kept.
 
-**Its own files, and no others, are cleared.** Detection writes per face
+**Its own files, and no others, are cleared or written over.** Detection writes per face
 ``<face>_traces.svg``, ``<face>_ring_map.png`` and ``<face>_knot_mask.png``; the manifest records
 a digest of each (the SVGs' ``svg_sha256`` above, the images' ``meta["detection"]["file_digest"]``:
 file name -> digest of its pixels as read back; :data:`DETECTED_IMAGES`). Detecting again into
 the folder, such a file the new detection names no more (no rings or knot found on the face now,
 or no such face) is removed when it is still the recorded one; one that is not (edited, made by
-hand, or left by a run before the digests were recorded) is kept, unread, and said.
+hand, or left by a run before the digests were recorded) is kept, unread, and said. An image
+the user edited since it was recorded, of a face the new detection writes that file for, wins
+as a corrected SVG does: it is kept and read as the face's, and said, with how to let detection
+replace it, and it stays the user's on later runs (not recorded as the detector's); a folder
+whose record has no digests (detected before they were recorded) has its images written over.
 
 **Photo-only blocks elsewhere** (``fit``, ``bake``, ``eval``): :func:`with_detected_rings`
 detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
@@ -325,6 +329,20 @@ def _file_digest(path: Path, kind: str) -> str | None:
     return digest(raw) if kind == "ring_map" else digest(np.asarray(raw > 127, bool))
 
 
+def _read_users_image(path: Path, kind: str, shape) -> np.ndarray:
+    """A user's image of ``kind`` as :func:`~woodcam.block.io.read_block` reads the face's."""
+    from .._readers import read_image_file
+    from ..block.io import _check_shape
+
+    raw = read_image_file(path, f"the edited {path.name}")
+    if raw.ndim == 3:
+        raw = raw[..., 0]
+    _check_shape(raw, shape, f"the edited {path}")
+    if kind == "knot_mask":
+        return raw > 127
+    return (raw.astype(np.float64) / (65535 if raw.dtype == np.uint16 else 255)).astype(np.float32)
+
+
 def _file_digests(rec: dict | None) -> dict[str, str]:
     """file name -> digest of each image a detection record says the detector wrote (``file_digest``)."""
     got = (rec or {}).get("file_digest")
@@ -342,6 +360,57 @@ def _prior_record(folder: Path) -> dict:
         return _detection_record(folder)
     except (ValueError, OSError):
         return {}
+
+
+def _edited_images(block: Block, folders: list[tuple[Path, dict]]) -> dict[tuple[str, str], Path]:
+    """(face, kind) -> the file of each image of ``block``'s faces in one of ``folders`` (folder,
+    its record before this run; the output first) that is no longer the one the detector wrote
+    there: a user edited it (or made it by hand beside a recorded detection). A record without
+    digests (made before they were) has its images written over, as they were then.
+
+    Refused, as a corrected SVG is (:func:`_check_corrections_match_photos`), when the record
+    says it was made over another photo than the face's now: it is not this photo's."""
+    found: dict[tuple[str, str], Path] = {}
+    for name, f in block.faces.items():
+        for kind, (what, _) in DETECTED_IMAGES.items():
+            for folder, rec in folders:
+                path = folder / f"{name}_{kind}.png"
+                if ("file_digest" not in rec or not path.is_file()
+                        or _file_digest(path, kind) == _file_digests(rec).get(path.name)):
+                    continue
+                was = (rec.get("photo_digest") or {}).get(name)
+                if was is not None and f.photo is not None and was != _photo_digest(f.photo):
+                    raise WoodcamError(
+                        f"face {name!r}: the edited {path} was made over another {name} photo than this block's "
+                        f"(the photo changed since, or --out holds an earlier block's detection): it is not this "
+                        f"photo's {what}, and detecting would write over it; move {path.name} out of "
+                        f"{str(folder)!r} (or detect into another --out) and run again")
+                found[name, kind] = path
+                break
+    return found
+
+
+def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path]) -> tuple[set[str], list[str]]:
+    """Each image ``block`` (just detected) has whose file the user edited (``edited``:
+    :func:`_edited_images`): the user's is read into ``block`` in its place, so it is what is
+    written and read, as a corrected SVG wins. Returns the names of the files kept and the
+    warnings. (An edited image of a face now without one is left to :func:`_clear_stale_files`.)"""
+    kept: set[str] = set()
+    msgs = []
+    for (name, kind), path in edited.items():
+        f = block.faces[name]
+        if _image(f, kind) is None:
+            continue
+        mine = _read_users_image(path, kind, f.shape)
+        block.faces[name] = (Face(name, f.shape, photo=f.photo, traces=f.traces, ring_map=mine, extras=f.extras)
+                             if kind == "ring_map" else
+                             Face(name, f.shape, photo=f.photo, traces=f.traces, ring_map=f.ring_map,
+                                  extras={**f.extras, kind: mine}))
+        kept.add(path.name)
+        msgs.append(f"face {name!r}: kept the edited {path} (it is not the {DETECTED_IMAGES[kind][0]} detection wrote "
+                    f"there): it wins over detection; to let detection replace it, delete it (or move it out of "
+                    f"{str(path.parent)!r}) and run 'rings detect' again")
+    return kept, msgs
 
 
 def _clear_stale_files(out: Path, block: Block, before: dict) -> list[str]:
@@ -366,7 +435,7 @@ def _clear_stale_files(out: Path, block: Block, before: dict) -> list[str]:
         for kind, (what, why) in DETECTED_IMAGES.items():
             path = out / f"{name}_{kind}.png"
             if not path.is_file() or _image(face, kind) is not None:
-                continue  # none, or this detection's own (written over)
+                continue  # none, or this detection's own (written over), or the user's kept (read in)
             if ours_img.get(path.name) is not None and _file_digest(path, kind) == ours_img[path.name]:
                 path.unlink()
                 continue
@@ -418,7 +487,9 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     # the one reader of folders: a folder of the user's own photos (front.jpg ...) was 'must hold a
     # block.json or Mokume files; found neither', no word of 'block from-photos'; it says so now.
     # It warns that a size_mm given for a block folder is not used.
-    block = read_block_folder(src, size_mm)
+    # an image of detection's the user deleted (to let detection replace an edited one) is
+    # written again, not 'listed but missing'
+    block = read_block_folder(src, size_mm, regenerated={f"{n}_{k}.png" for n in FACES for k in DETECTED_IMAGES})
     if not (src / MANIFEST).is_file():  # a Mokume sample: re-detected from its photos alone
         for f in block.faces.values():
             f.ring_map, f.traces = None, []
@@ -438,6 +509,8 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     # the files the detector wrote, as the source and --out recorded them (before either is overwritten)
     src_rec = _prior_record(src)
     out_rec = src_rec if out.resolve() == src.resolve() else _prior_record(out)
+    # images the user edited since the detector wrote them, checked before any work as the SVGs are
+    images = _edited_images(block, [(out, out_rec)] + ([(src, src_rec)] if out.resolve() != src.resolve() else []))
     todo = [n for n, f in block.faces.items() if f.photo is not None and n not in edited]
     msgs: list[str] = [f"face {n!r}: the corrected {svg} is not used: the block has no {n} face (made "
                        f"without its photo); move it out of {str(svg.parent)!r} to keep it (a later detection "
@@ -494,15 +567,19 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     det["svg_sha256"] = hashes
     det["photo_digest"] = {n: _photo_digest(f.photo) for n, f in block.faces.items() if f.photo is not None}
     det["user_svg"] = sorted(kept)
+    # an image the user edited since the detector wrote it wins as a corrected SVG does (it was
+    # written over without a word): read in, written back as read, never recorded as the detector's
+    users, said = _keep_users_images(block, images)
+    msgs += said
     # the detector's images: this run's (ring maps of faces detected or drawn from a corrected
     # SVG, knot masks detected), and earlier ones kept unchanged (--no-knots, a corrected SVG's
-    # face) that were its own; a user's is never recorded, so never cleared
+    # face) that were its own; a user's is never recorded, so never cleared nor written over
     fresh = {"ring_map": set(todo) | set(kept), "knot_mask": set(todo) if knots else set()}
     before = _file_digests(src_rec)
     det["file_digest"] = {fname: d for n, f in block.faces.items() for kind in DETECTED_IMAGES
                           if (image := _image(f, kind)) is not None
                           for fname, d in [(f"{n}_{kind}.png", _pixels_digest(kind, image))]
-                          if n in fresh[kind] or before.get(fname) == d}
+                          if fname not in users and (n in fresh[kind] or before.get(fname) == d)}
     block.meta["detection"] = det
     # a face photographed turned or mirrored ruins the fit without a word otherwise; a face with no
     # rings found is not judged (its report.unchecked), and its 'no rings found' above says so
