@@ -140,8 +140,10 @@ def test_a_face_too_coarse_to_judge_is_listed_not_called_turned(capsys):
                                         "(LAYOUT_MIN_PX_PER_MM): give its photo at least 125 px a side")
     report_layout(small)
     out = capsys.readouterr().out
-    assert out.startswith("layout: not checked (no two neighbouring faces with a photo or ring map); "
-                          "not checked: front (64 px a side is 1.28 px/mm"), out
+    assert out == ("layout: not checked (no two neighbouring faces with a photo or ring map); not checked: "
+                   f"{', '.join(small.faces)} ({report.unchecked['back']})\n"), out
+    # at 48 px the size it needs is still 125 px (not a float's 126)
+    assert check_face_layout(_resized(cn03, 48)).unchecked["top"].endswith("at least 125 px a side")
     fine = check_face_layout(_resized(cn03, 160))
     assert fine.unchecked == {} and fine.corrections == {} and len(fine.faces) == 6
 

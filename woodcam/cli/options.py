@@ -535,8 +535,11 @@ def report_layout(block) -> None:
         warnings.warn(w, WoodcamWarning, stacklevel=2)
     # a face detection found no rings on is not judged (its edges hold no rings to meet): said, so
     # 'none looks turned' is not read as covering it
-    skipped = (f"; not checked: {', '.join(f'{n} ({why})' for n, why in report.unchecked.items())}"
-               if report.unchecked else "")
+    why: dict[str, list[str]] = {}  # faces grouped by reason, in the report's order
+    for n, reason in report.unchecked.items():
+        why.setdefault(reason, []).append(n)
+    groups = "; ".join(f"{', '.join(names)} ({reason})" for reason, names in why.items())
+    skipped = f"; not checked: {groups}" if why else ""
     if not report.warnings:
         print(f"layout: {len(report.faces)} faces checked, none looks turned or mirrored{skipped}"
               if report.faces else f"layout: not checked (no two neighbouring faces with a photo or ring map){skipped}")

@@ -150,9 +150,12 @@ def _too_coarse(block: Block, name: FaceName) -> str | None:
     px_mm = 1.0 / max(block.face_pixel_size_mm(name))
     if px_mm >= LAYOUT_MIN_PX_PER_MM:
         return None
-    need = int(np.ceil(LAYOUT_MIN_PX_PER_MM / px_mm * min(f.shape)))
-    return (f"{min(f.shape)} px a side is {px_mm:.2f} px/mm, under the {LAYOUT_MIN_PX_PER_MM:g} px/mm "
-            f"the check needs (LAYOUT_MIN_PX_PER_MM): give its photo at least {need} px a side")
+    # rounded first: 2.5 px/mm over a 50 mm side is 125 px, not the 126 of a float's last bit
+    need = int(np.ceil(round(LAYOUT_MIN_PX_PER_MM / px_mm * min(f.shape), 6)))
+    h, w = f.shape[:2]
+    side = f"{h} px a side" if h == w else f"{h}x{w} px"
+    return (f"{side} is {px_mm:.2f} px/mm, under the {LAYOUT_MIN_PX_PER_MM:g} px/mm the check needs "
+            f"(LAYOUT_MIN_PX_PER_MM): give its photo at least {need} px {'a' if h == w else 'on its shorter'} side")
 
 
 def _face_signal(face, detected: bool) -> tuple[np.ndarray, str] | None:
