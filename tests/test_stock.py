@@ -563,11 +563,12 @@ def test_a_log_file_in_a_folder_with_an_at_sign_is_read(tmp_path, monkeypatch):
 @pytest.mark.parametrize("spec, asked, block, fix", [
     # past the far side of the 100 x 80 x 50 mm block
     ("builtin:flat-sawn[120x80x50]", "runs from (0, 0, 0) mm to (120, 80, 50) mm", "100x80x50 mm",
-     "give a resize that fits, [100x80x50] or smaller, or a block that holds it: "
-     "builtin:flat-sawn:120x80x50[120x80x50]"),
+     "give a resize that fits, [100x80x50] or smaller, or a block that holds the same wood: "
+     "builtin:flat-sawn:140x80x50[120x80x50@20,0,0]"),
     # a corner before the block's own
     ("builtin:flat-sawn[40x30x20@-10,0,0]", "runs from (-10, 0, 0) mm to (30, 30, 20) mm", "100x80x50 mm",
-     "give a resize that fits, [40x30x20] or smaller"),
+     "give a resize that fits, [40x30x20] or smaller, or a block that holds the same wood: "
+     "builtin:flat-sawn:120x80x50[40x30x20]"),
     # cut in the turned frame: the turned block is 80 x 100 x 50 mm
     ("builtin:flat-sawn~z90[40x30x20@50,0,0]", "runs from (50, 0, 0) mm to (90, 30, 20) mm", "80x100x50 mm",
      "give a resize that fits, [30x30x20@50,0,0] or smaller"),
@@ -603,3 +604,54 @@ def test_a_resize_past_its_block_is_refused_naming_the_extents_and_the_fix(spec,
     assert main(["place", str(tmp_path / "no-part.stl"), "--block", spec, "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert err == f"woodcam: error: --block {spec}: {msg.split(': ', 1)[1]}\n", err
+
+
+def _larger_base_offered(spec: str) -> str:
+    """The larger base a refused resize's message offers (after 'holds the same wood: ')."""
+    from woodcam.errors import BlockSpecError
+
+    with pytest.raises(BlockSpecError) as got:
+        open_stock(spec)
+    msg = str(got.value)
+    assert "holds the same wood: " in msg, msg
+    return msg.rsplit("holds the same wood: ", 1)[1]
+
+
+@pytest.mark.parametrize("spec, offered", [
+    # the suggestion was 'builtin:flat-sawn:110x80x50[40x30x20@70,10,5]': the 110 mm block is
+    # centred where the 100 mm one was, so its x = 70 is the whole block's 65, 5 mm off
+    ("builtin:flat-sawn[40x30x20@70,10,5]", "builtin:flat-sawn:120x80x50[40x30x20@80,10,5]"),
+    ("builtin:flat-sawn[120x80x50]", "builtin:flat-sawn:140x80x50[120x80x50@20,0,0]"),
+    # a sized base, a corner before it (no larger base was offered): it grows round the same centre
+    ("builtin:knotty:60x40x30[40x30x20@-10,20,15]", "builtin:knotty:80x60x40[40x30x20@0,30,20]"),
+])
+def test_the_larger_base_a_refused_resize_offers_cuts_the_wood_asked_for(spec, offered):
+    """A built-in block of another size is cut round the same centre: the larger base the
+    refusal offered ('builtin:flat-sawn:110x80x50[40x30x20@70,10,5]') kept the resize's numbers
+    and so cut wood 5 mm off what the user pointed at. Now its corner is moved into the larger
+    block's frame: the offered stock's wood at its points is the asked block's at origin + p."""
+    from woodcam._specs import parse_spec
+
+    assert _larger_base_offered(spec) == offered
+    parsed = parse_spec(spec)
+    size, origin = parsed.ops[-1][1], np.asarray(parsed.ops[-1][2])
+    block, got = open_stock(spec[:spec.rindex("[")]), open_stock(offered)
+    assert got.size_mm == size
+    p = np.random.default_rng(3).uniform(0, 1, (400, 3)) * np.asarray(size)
+    np.testing.assert_allclose(got.wood.years(p), block.wood.years(p + origin), rtol=0, atol=1e-9)
+    n = np.random.default_rng(4).normal(size=p.shape)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    np.testing.assert_allclose(got.wood.color(p, n), block.wood.color(p + origin, n), rtol=0, atol=1e-6)
+
+
+def test_a_refused_resize_of_a_log_block_offers_no_larger_base(shared_data):
+    """A larger log block is placed anew through its knot (its front face at a depth that
+    follows its size), not round this one: the larger base offered cut other wood. Only the
+    resize that fits is offered, and the message says why no larger block is."""
+    from woodcam.errors import BlockSpecError
+
+    with pytest.raises(BlockSpecError) as got:
+        open_stock("log:gran1@0[120x80x50]")
+    msg = str(got.value)
+    assert msg.endswith("give a resize that fits, [100x80x50] or smaller (a larger log block is cut "
+                        "anew through its knot, not round this one)"), msg

@@ -126,29 +126,54 @@ def check_resize_in_block(spec: str, block_size_mm, size_mm, origin_mm,
     size, origin = np.asarray(size_mm, float), np.asarray(origin_mm, float)
     far = origin + size
     tol = 1e-6 * float(have.max())  # a stock written back with 12 digits still fits
-    if (origin >= -tol).all() and (far <= have + tol).all():
+
+    def inside(lo, hi, block) -> bool:
+        return bool((lo >= -tol).all() and (hi <= block + tol).all())
+
+    if inside(origin, far, have):
         return
+    from .limits import MAX_BLOCK_SIZE_MM
     from .units import message_mm_per_unit, say_length
 
     def point(v):
         return say_length(tuple(float(x) for x in v), ".4g", form="(" + ", ".join("{}" for _ in v) + ")")
 
-    k = message_mm_per_unit()  # a spec's numbers as the user types them (--units inch)
+    def typed(values) -> tuple[list[str], np.ndarray]:
+        """Each length (mm) as the user types it, and the mm values they read back, what the
+        suggested spec opens to."""
+        k = message_mm_per_unit()
+        texts = [f"{float(v) / k:.12g}" for v in values]
+        return texts, np.array([float(t) for t in texts]) * k
 
-    def typed(size_, origin_):
-        return format_op(("resize", tuple((size_ / k).tolist()), tuple((origin_ / k).tolist())))
+    def op_text(size_texts, origin_texts) -> str:  # format_op's grammar, numbers as typed
+        at = "@" + ",".join(origin_texts) if any(float(t) for t in origin_texts) else ""
+        return f"[{'x'.join(size_texts)}{at}]"
 
-    op = typed(size, origin)
-    corner = np.maximum(origin, 0.0)
-    fits = have - corner
+    size_t, size_b = typed(size)
+    op = op_text(size_t, typed(origin)[0])
+    corner_t, corner_b = typed(np.maximum(origin, 0.0))
+    fits = have - corner_b
     if (fits > tol).all():
-        fix = f"a resize that fits, {typed(np.minimum(size, fits), corner)} or smaller"
+        fit_t, _ = typed(np.minimum(size, fits))
+        fix = f"a resize that fits, {op_text(fit_t, corner_t)} or smaller"
     else:
         fix = "a resize whose corner is inside the block"
-    if parsed is not None and parsed.kind in ("builtin", "log") and not parsed.ops and (origin >= -tol).all():
-        bigger = "x".join(f"{v:.12g}" for v in np.maximum(have, far) / k)
-        base = parsed.base if parsed.size_mm is None else parsed.base[:parsed.base.rfind(":")]
-        fix += f", or a block that holds it: {base}:{bigger}{op}"
+    if parsed is not None and parsed.kind == "builtin" and not parsed.ops:
+        # A sized built-in block is cut round the whole block's centre (_builtin), so its
+        # corner moves by half the change of size: a base of S1 holds the wood asked, origin..far
+        # of the S0 block, where S1/2 reaches both ends from the shared centre, and the resize's
+        # corner in it is origin + (S1 - S0) / 2 (the same wood, not the same numbers).
+        need = np.maximum(have, 2 * np.maximum(have / 2 - origin, far - have / 2))
+        base_t, base_b = typed(need)
+        at = origin + (base_b - have) / 2
+        at_t, at_b = typed(at)
+        if (base_b <= MAX_BLOCK_SIZE_MM).all() and inside(at_b, at_b + size_b, base_b):
+            base = parsed.base if parsed.size_mm is None else parsed.base[:parsed.base.rfind(":")]
+            fix += f", or a block that holds the same wood: {base}:{'x'.join(base_t)}{op_text(size_t, at_t)}"
+    elif parsed is not None and parsed.kind == "log" and not parsed.ops:
+        # a larger log block is placed anew through its knot (its front face, at a depth that
+        # follows its size): no larger base holds this block's wood where it is
+        fix += " (a larger log block is cut anew through its knot, not round this one)"
     elif parsed is not None and parsed.kind in ("folder", "woodify"):
         fix += " (a block folder or a grown block holds only its own wood)"
     rule = (f"the resize {op} runs from {point(origin)} to {point(far)}, past the "
