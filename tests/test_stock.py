@@ -644,6 +644,46 @@ def test_the_larger_base_a_refused_resize_offers_cuts_the_wood_asked_for(spec, o
     np.testing.assert_allclose(got.wood.color(p, n), block.wood.color(p + origin, n), rtol=0, atol=1e-6)
 
 
+def test_a_refused_resize_fix_in_inches_is_short_and_opens_to_what_it_says(capsys, tmp_path):
+    """Under --units inch the fix was written with 12 digits ('3.93700787402'). Now each number
+    is the shortest that reads back within ON_FACE_TOL_MM and keeps the fix inside its block:
+    typed back (in inches) the resize that fits opens to the block's far side and the larger
+    base to the resize asked, the same wood."""
+    from woodcam._specs import format_spec, parse_spec
+    from woodcam.cli import main
+    from woodcam.errors import BlockSpecError
+    from woodcam.tolerances import ON_FACE_TOL_MM
+    from woodcam.units import message_units
+
+    typed = "builtin:flat-sawn[1.5x1x0.75@2.75,0.5,0.25]"  # 38.1 x 25.4 x 19.05 mm at 69.85 mm
+    spec = format_spec(parse_spec(typed, mm_per_unit=25.4))
+    with message_units("inch"), pytest.raises(BlockSpecError) as got:
+        open_stock(spec)
+    msg = str(got.value)
+    fit = msg.split("a resize that fits, ")[1].split(" ")[0]
+    offered = msg.rsplit("holds the same wood: ", 1)[1]
+    # the resize asked as typed; the fit to the 100 mm block's far side (3.93701 in, not 3.93700787402)
+    assert "the resize [1.5x1x0.75@2.75,0.5,0.25] runs" in msg, msg
+    assert fit == "[1.18701x1x0.75@2.75,0.5,0.25]", msg
+    # 2 x (4.25 - 1.9685) in round the block's centre, the corner moved by half the growth
+    assert offered == "builtin:flat-sawn:4.56299x3.14961x1.968504[1.5x1x0.75@3.06299,0.5,0.25]", msg
+
+    def opened(text):
+        return open_stock(format_spec(parse_spec(text, mm_per_unit=25.4)))
+
+    cut = opened("builtin:flat-sawn" + fit)
+    np.testing.assert_allclose(cut.size_mm, (100 - 69.85, 25.4, 19.05), rtol=0, atol=ON_FACE_TOL_MM)
+    block, got = open_stock("builtin:flat-sawn"), opened(offered)
+    np.testing.assert_allclose(got.size_mm, (38.1, 25.4, 19.05), rtol=0, atol=ON_FACE_TOL_MM)
+    p = np.random.default_rng(4).uniform(0, 1, (400, 3)) * np.asarray(got.size_mm)
+    np.testing.assert_allclose(got.wood.years(p), block.wood.years(p + (69.85, 12.7, 6.35)), rtol=0, atol=1e-4)
+    # the command line says the same numbers
+    assert main(["place", str(tmp_path / "no-part.stl"), "--block", typed, "--units", "inch",
+                 "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert fit in err and offered in err and "3.93700787402" not in err, err
+
+
 def test_a_refused_resize_of_a_log_block_offers_no_larger_base(shared_data):
     """A larger log block is placed anew through its knot (its front face at a depth that
     follows its size), not round this one: the larger base offered cut other wood. Only the

@@ -133,17 +133,18 @@ def check_resize_in_block(spec: str, block_size_mm, size_mm, origin_mm,
     if inside(origin, far, have):
         return
     from .limits import MAX_BLOCK_SIZE_MM
-    from .units import message_mm_per_unit, say_length
+    from .tolerances import ON_FACE_TOL_MM
+    from .units import message_mm_per_unit, say_length, typed_length
 
     def point(v):
         return say_length(tuple(float(x) for x in v), ".4g", form="(" + ", ".join("{}" for _ in v) + ")")
 
-    def typed(values) -> tuple[list[str], np.ndarray]:
-        """Each length (mm) as the user types it, and the mm values they read back, what the
-        suggested spec opens to."""
-        k = message_mm_per_unit()
-        texts = [f"{float(v) / k:.12g}" for v in values]
-        return texts, np.array([float(t) for t in texts]) * k
+    def typed(values, ok=lambda i, v: True) -> tuple[list[str], np.ndarray]:
+        """Each length (mm) as the user types it (--units inch: the shortest number that reads
+        back within ON_FACE_TOL_MM, not 12 digits) and ``ok(axis, mm read back)``; and the mm
+        values they read back, what the suggested spec opens to."""
+        texts = [typed_length(float(v), ON_FACE_TOL_MM, lambda b, i=i: ok(i, b)) for i, v in enumerate(values)]
+        return texts, np.array([float(t) for t in texts]) * message_mm_per_unit()
 
     def op_text(size_texts, origin_texts) -> str:  # format_op's grammar, numbers as typed
         at = "@" + ",".join(origin_texts) if any(float(t) for t in origin_texts) else ""
@@ -151,10 +152,11 @@ def check_resize_in_block(spec: str, block_size_mm, size_mm, origin_mm,
 
     size_t, size_b = typed(size)
     op = op_text(size_t, typed(origin)[0])
-    corner_t, corner_b = typed(np.maximum(origin, 0.0))
+    # a fix must open to what it says: each number chosen so the read-back resize is inside
+    corner_t, corner_b = typed(np.maximum(origin, 0.0), lambda i, b: b >= 0.0)
     fits = have - corner_b
     if (fits > tol).all():
-        fit_t, _ = typed(np.minimum(size, fits))
+        fit_t, _ = typed(np.minimum(size, fits), lambda i, b: 0 < b <= fits[i] + tol)
         fix = f"a resize that fits, {op_text(fit_t, corner_t)} or smaller"
     else:
         fix = "a resize whose corner is inside the block"
@@ -164,9 +166,9 @@ def check_resize_in_block(spec: str, block_size_mm, size_mm, origin_mm,
         # of the S0 block, where S1/2 reaches both ends from the shared centre, and the resize's
         # corner in it is origin + (S1 - S0) / 2 (the same wood, not the same numbers).
         need = np.maximum(have, 2 * np.maximum(have / 2 - origin, far - have / 2))
-        base_t, base_b = typed(need)
+        base_t, base_b = typed(need, lambda i, b: b <= MAX_BLOCK_SIZE_MM)
         at = origin + (base_b - have) / 2
-        at_t, at_b = typed(at)
+        at_t, at_b = typed(at, lambda i, b: b >= -tol and b + size_b[i] <= base_b[i] + tol)
         if (base_b <= MAX_BLOCK_SIZE_MM).all() and inside(at_b, at_b + size_b, base_b):
             base = parsed.base if parsed.size_mm is None else parsed.base[:parsed.base.rfind(":")]
             fix += f", or a block that holds the same wood: {base}:{'x'.join(base_t)}{op_text(size_t, at_t)}"

@@ -112,6 +112,23 @@ def say_length(mm, spec: str = ".3g", sep: str = "x", form: str | None = None, *
     return _lengths(mm, units, spec if units == "mm" else ".4g", sep, form)
 
 
+def typed_length(mm: float, tol_mm: float, ok: Callable[[float], bool] | None = None) -> str:
+    """A length given in mm as a number the user types in the message units
+    (:func:`message_units`), as a spec a message offers: the shortest that reads back (times
+    :func:`message_mm_per_unit`) within ``tol_mm`` of ``mm`` and, with ``ok``, whose read-back
+    mm value ``ok`` accepts (a fix's resize must still fit its block); 12 significant digits
+    when none does (``typed_length(100, 1e-4)`` under ``--units inch`` is
+    ``"3.93701"``, not ``"3.93700787402"``; ``typed_length(38.1, 1e-4)`` ``"1.5"``)."""
+    k = message_mm_per_unit()
+    for decimals in range(13):  # fixed, never '4e+01' nor '1e-07' for 40 and about 0
+        text = f"{mm / k:.{decimals}f}"
+        text = "0" if float(text) == 0 else text  # not '-0'
+        back = float(text) * k
+        if abs(back - mm) <= tol_mm and (ok is None or ok(back)):
+            return text
+    return f"{mm / k:.12g}"
+
+
 def say_volume(mm3: float, spec: str = ".4g", *, units: Units | None = None) -> str:
     """A volume given in mm^3, for a message, in the message units (:func:`message_units`) or
     ``units``: in mm^3 with the message's ``spec``, else :func:`fmt_volume`'s inches^3."""
