@@ -78,6 +78,15 @@ class Stock:
     description: str = ""
     meta: dict = field(default_factory=dict)
 
+    def __post_init__(self):
+        # the door of a stock built by hand: None or a name ('oak') was taken and failed far
+        # away, an AttributeError in placement ('features') or a refusal in the first drawing.
+        # A user's analytic wood is drawn (color, the seam) or read (features), not both.
+        if not any(callable(getattr(self.wood, m, None)) for m in ("color", "features")):
+            raise WoodcamError(f"Stock: wood must be a woodcam Wood (or have a method color(points_mm (n, 3), "
+                               f"normals (n, 3)) -> rgb (n, 3) or features(points_mm (n, 3)) -> dict); got "
+                               f"{type(self.wood).__name__}; pass Wood(field) or open the stock with open_stock")
+
 
 def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:
     """A ``W x D x H`` stock cut from ``stock``'s wood with its corner at ``origin_mm`` (block

@@ -1106,3 +1106,28 @@ def test_read_gran1_reads_its_files_as_every_json_file_is(tmp_path):
         (tmp_path / name).write_text(json.dumps(files[name]))
     with pytest.raises(WoodcamError, match="folder '.*Gran_1_pith.json' lacks Gran_1_pith.json; point it at shared/data/trees"):
         w.read_gran1(tmp_path / "Gran_1_pith.json")
+
+
+@pytest.mark.parametrize("wood", [None, "oak", 3.0, object()], ids=["None", "str", "number", "object"])
+def test_a_stock_built_by_hand_refuses_what_is_no_wood(wood):
+    """Stock(...) took any wood: None or a name ('oak') failed far away, in placement an
+    AttributeError ('features'), in a drawing a refusal naming no Stock. Now the stock itself
+    refuses it naming the argument, the kind given and the fix; a user's wood that is drawn
+    (color) or read (features) only is still a stock."""
+    import woodcam as w
+    from woodcam.stock import Stock
+
+    with pytest.raises(WoodcamError, match=rf"Stock: wood must be a woodcam Wood .*; got {type(wood).__name__}; "
+                                           r"pass Wood\(field\) or open the stock with open_stock"):
+        Stock("mine", (20.0, 20.0, 20.0), wood)
+
+    class Drawn:
+        def color(self, p, n):
+            return np.full((len(p), 3), 0.5)
+
+    class Read:
+        def features(self, p):
+            return {"years": np.zeros(len(p))}
+
+    for ok in (Drawn(), Read(), w.open_stock("builtin:flat-sawn").wood):
+        assert Stock("mine", (20.0, 20.0, 20.0), ok).wood is ok
