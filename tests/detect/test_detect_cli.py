@@ -1184,3 +1184,30 @@ def test_the_detection_cache_is_keyed_by_the_photos_and_the_rule(tmp_path, monke
     assert traces(first, rule="dark-line") == traces(first, rule="dark-line", cache=False) != base
     assert len(entries()) == 3
     assert traces(photos_only(first)) == base and len(entries()) == 3  # the same content: read back
+
+
+def test_a_partial_rerun_removes_the_photo_it_wrote_of_a_face_left_out(synth_photos, tmp_path, capsys):
+    """'block from-photos --partial' into the folder of an earlier run with the face left out:
+    its left_photo.png stayed beside the new manifest, unread (read_block named five faces), a
+    face the folder seemed to have. Now the rerun removes it when it is the photo woodcam wrote
+    (its recorded digest), and keeps and says one it did not write (an edited photo)."""
+    five = _copy(synth_photos, tmp_path / "five", skip=("left",))
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
+    assert (blk / "left_photo.png").is_file()
+    rc, _out, err = _run(capsys, "block", "from-photos", five, "--size-mm", "50", "--out", blk, "--partial")
+    assert rc == 0 and "left_photo.png" not in err, err
+    assert not (blk / "left_photo.png").exists()
+    assert sorted(read_block(blk).faces) == sorted(f for f in FACES if f != "left")
+    assert sorted(p.name for p in blk.iterdir()) == sorted(["block.json"] + [f"{f}_photo.png" for f in FACES
+                                                                              if f != "left"])
+    # a photo woodcam did not write (edited since) is kept, and said
+    again = tmp_path / "again"
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", again)[0] == 0
+    edited = np.asarray(Image.open(again / "left_photo.png")).copy()
+    edited[:10] = 0
+    Image.fromarray(edited).save(again / "left_photo.png")
+    rc, _out, err = _run(capsys, "block", "from-photos", five, "--size-mm", "50", "--out", again, "--partial")
+    assert rc == 0 and (again / "left_photo.png").is_file()
+    assert (f"woodcam: warning: face 'left': left_photo.png in {str(again)!r} is not read (the block has no left "
+            "face now, and block.json does not name it), and is kept: it is not the photo an earlier run wrote") in err

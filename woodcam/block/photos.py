@@ -323,5 +323,69 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
                 "to the face's edges, the wood alone", WoodcamWarning, stacklevel=2)
     meta = {"source": "photos", "photos_dir": str(Path(folder).resolve()), "px_per_mm": float(ppm),
             "photos_px_per_mm": float(min(density.values())),
-            "photos": {f: p.name for f, p in photos.items()}}
+            "photos": {f: p.name for f, p in photos.items()},
+            # what this run writes as <face>_photo.png: a rerun with a face fewer removes only its own
+            "photo_digest": {f: _photo_digest(face.photo) for f, face in faces.items()}}
     return Block(tuple(size), faces=faces, name=name or Path(folder).name, meta=meta)
+
+
+def _photo_digest(photo) -> str:
+    """Digest of a face photo's pixels as stored in a block folder: the same as a detection's
+    ``photo_digest`` (:func:`woodcam.detect.block._photo_digest`), so either record tells a
+    photo woodcam wrote."""
+    from .._cache import digest
+
+    return digest(np.asarray(photo))
+
+
+def written_photos(folder) -> dict[str, str]:
+    """Face -> recorded digest of each ``<face>_photo.png`` the manifest of block folder
+    ``folder`` names and woodcam recorded writing (``block from-photos``' ``meta["photo_digest"]``
+    or a detection's ``photo_digest``); {} without a readable manifest. Read before the folder
+    is written over, for :func:`clear_stale_photos`."""
+    import json
+
+    from .io import MANIFEST
+
+    try:
+        m = json.loads((Path(folder) / MANIFEST).read_text())
+    except (OSError, ValueError):  # none, or one 'block from-photos' overwrites (it says so)
+        return {}
+    meta, faces = (m.get("meta"), m.get("faces")) if isinstance(m, dict) else (None, None)
+    if not (isinstance(meta, dict) and isinstance(faces, dict)):
+        return {}
+    said = {}
+    for rec in (meta.get("photo_digest"), (meta.get("detection") or {}).get("photo_digest"),
+                (meta.get("detection_before") or {}).get("photo_digest")):
+        said.update({f: d for f, d in (rec if isinstance(rec, dict) else {}).items()
+                     if isinstance(d, str) and f not in said})
+    return {f: said.get(f, "") for f, e in faces.items()
+            if f in FACES and isinstance(e, dict) and e.get("photo") == f"{f}_photo.png"}
+
+
+def clear_stale_photos(folder, block: Block, before: dict[str, str]) -> list[str]:
+    """Remove each ``<face>_photo.png`` in block folder ``folder`` (``block`` just written there)
+    of a face ``block`` has no more (``block from-photos --partial`` after a run with that face)
+    when it is still the photo woodcam wrote (``before``: :func:`written_photos` of the folder
+    before this run, its pixels' digest the recorded one): it stayed beside the new manifest,
+    unread, a face the block seemed to have. One woodcam did not write (edited, or from before
+    the digests were recorded) is kept and said; returns those warnings."""
+    from .io import _read_png
+    from .._readers import photo_rgb8
+
+    msgs = []
+    for face in FACES:
+        path = Path(folder) / f"{face}_photo.png"
+        if face in block.faces or face not in before or not path.is_file():
+            continue
+        try:
+            ours = bool(before[face]) and _photo_digest(photo_rgb8(_read_png(path, f"photo of face {face!r}"))) == before[face]
+        except WoodcamError:  # no longer an image: not the one woodcam wrote
+            ours = False
+        if ours:
+            path.unlink()
+            continue
+        msgs.append(f"face {face!r}: {path.name} in {str(folder)!r} is not read (the block has no {face} face now, "
+                    f"and block.json does not name it), and is kept: it is not the photo an earlier run wrote "
+                    f"(edited, or from before woodcam recorded them); delete it, or move it out to keep it")
+    return msgs

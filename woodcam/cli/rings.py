@@ -35,7 +35,7 @@ def add_from_photos(sub) -> None:
 
 def run_from_photos(args) -> int:
     from ..block.io import write_block
-    from ..block.photos import MAX_PX_PER_MM, block_from_photos
+    from ..block.photos import MAX_PX_PER_MM, block_from_photos, clear_stale_photos, written_photos
     from ..detect.block import detection_record
 
     block = block_from_photos(args.photos_dir, _size(args.size_mm), partial=args.partial,
@@ -44,7 +44,11 @@ def run_from_photos(args) -> int:
     prior = detection_record(args.out)  # the block made again into its folder: its SVG corrections kept
     if prior:
         block.meta["detection_before"] = prior
+    written = written_photos(args.out)  # an earlier run's photos, read before its manifest is written over
     write_block(block, args.out)
+    from . import print_warnings
+
+    print_warnings(clear_stale_photos(args.out, block, written))
     shapes = ", ".join(f"{n} {f.shape[1]}x{f.shape[0]}" for n, f in block.faces.items())
     ppm, photos_ppm = block.meta["px_per_mm"], block.meta["photos_px_per_mm"]
     # say when the photos held more: a 12 MP phone photo of a 50 mm face is 60 px/mm, stored at 10
