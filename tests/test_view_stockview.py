@@ -111,13 +111,104 @@ def test_png_and_errors(tmp_path, bowl):
     with pytest.raises(WoodcamError, match="charts lacks"):
         stock_view(hm, (W, D, H), atlas, {"top": charts["top"]})
     for colour in ("mauve", (1000, 0, 0), ("a", "b", "c")):  # one rule with top_view's (overlay_rgb)
-        with pytest.raises(WoodcamError, match="stock_view: overlay colour must be one of .* in 0..255"):
+        with pytest.raises(WoodcamError, match="stock_view: overlay colour must be one of .* in 0..255"
+                                               ".* floats in 0..1"):
             stock_view(hm, (W, D, H), atlas, charts, window_size=WIN,
                        overlay=[(np.zeros((1, 2, 3)), colour, 1.0)])
     with pytest.raises(WoodcamError, match="supersample"):
         stock_view(hm, (W, D, H), atlas, charts, supersample=0)
     with pytest.raises(WoodcamError, match="camera must be"):
         stock_view(hm, (W, D, H), atlas, charts, camera="up")
+
+
+def _preview_overlay_colour(tmp_path, colour):
+    """The colour :func:`woodcam.view.preview` hands pyvista for an overlay of ``colour``: its
+    overlay's add_mesh is caught (and the render stopped there)."""
+    pv = pytest.importorskip("pyvista")
+    import trimesh
+
+    from woodcam.view import preview
+
+    class Caught(Exception):
+        pass
+
+    seen = []
+    add_mesh = pv.Plotter.add_mesh
+
+    def catch(self, mesh, *args, **kwargs):
+        if "render_lines_as_tubes" in kwargs:  # the overlay's lines
+            seen.append(kwargs["color"])
+            raise Caught
+        return add_mesh(self, mesh, *args, **kwargs)
+
+    box = trimesh.creation.box(extents=(W, D, H))
+    box.apply_translation((W / 2, D / 2, H / 2))
+    segments = np.array([[[5.0, 15.0, H + 3], [35.0, 15.0, H + 3]]])
+    mp = pytest.MonkeyPatch()
+    mp.setattr(pv.Plotter, "add_mesh", catch)
+    try:
+        with pytest.raises(Caught):
+            preview(box, size_mm=(W, D, H), screenshot=tmp_path / "p.png", window_size=(64, 48),
+                    cut_plane=False, overlay=[(segments, colour, 1.0)])
+    finally:
+        mp.undo()
+    return pv.Color(seen[0]).int_rgb
+
+
+@pytest.mark.parametrize("colour, rgb", [((1.0, 0.0, 0.0), (255, 0, 0)), ((0.25, 0.5, 1.0), (64, 128, 255)),
+                                         ((65, 105, 225), (65, 105, 225))])
+def test_an_overlay_triple_is_one_colour_in_every_view(bowl, tmp_path, colour, rgb):
+    """preview handed (1.0, 0.0, 0.0) to pyvista, which reads floats in 0..1: red; top_view and
+    stock_view read the same triple in 0..255: nearly black (top_view blended (1, 0, 0) into
+    its texture, a grey (68, 68, 68) where "red" is (208, 68, 68)). One rule now
+    (woodcam.view.scene.overlay_rgb: whole numbers 0..255, floats 0..1) for all three: the
+    stock view draws a line over the stock in exactly that RGB, the top view draws the same
+    pixels as for that whole-number triple, and preview hands pyvista that RGB."""
+    from woodcam.view.topview import top_view
+
+    hm, atlas, charts = bowl
+    flat = np.full_like(hm, H)
+    above = np.array([[[5.0, 15.0, H + 3], [35.0, 15.0, H + 3]]])
+    img = stock_view(flat, (W, D, H), atlas, charts, window_size=WIN, supersample=1,
+                     overlay=[(above, colour, 1.0)])
+    r, c = _pixel([20.0, 15.0, H + 3])
+    assert tuple(img[r[0], c[0]]) == rgb
+    tex = np.full((40, 50, 3), 150, np.uint8)
+    seg = np.array([[[0.0, 20.0, 1.0], [50.0, 20.0, 1.0]]])
+    top = [top_view(np.zeros((40, 50)), (50.0, 40.0, 10.0), tex, window_size=(100, 80), margin_px=0,
+                    overlay=[(seg, col, 1.0)]) for col in (colour, rgb)]
+    assert tuple(top[1][40, 50]) != (150, 150, 150)  # the line is drawn there
+    np.testing.assert_array_equal(top[0], top[1])
+    assert _preview_overlay_colour(tmp_path, colour) == rgb
+
+
+@pytest.mark.parametrize("colour", [(255.0, 0, 0), (1, 0, 0), (1000, 0, 0), (-0.5, 0.0, 0.0),
+                                    (0.5, float("nan"), 0.2), ("1", "0", "0"), (255, 0),
+                                    (1.0, 0.0, 0.0, 1.0), True, np.array([1.5, 0.0, 0.0])])
+def test_an_overlay_triple_refused_is_refused_by_every_view(bowl, tmp_path, colour):
+    """A triple whose scale is a guess ((255.0, 0, 0): a float above 1; (1, 0, 0): whole
+    numbers reading nearly black that meant red in 0..1), out of range, not three numbers:
+    refused by preview, top_view and stock_view alike, each naming itself, the argument, the
+    rule and the value (preview drew (1.0, 0, 0, 1.0) and top_view (255.0, 0, 0) as red,
+    stock_view took ('1', '0', '0') as near black)."""
+    pytest.importorskip("pyvista")
+    import trimesh
+
+    from woodcam.view import preview
+    from woodcam.view.topview import top_view
+
+    hm, atlas, charts = bowl
+    seg = np.zeros((1, 2, 3))
+    rule = r"RGB triple: whole numbers in 0\.\.255, .*floats in 0\.\.1.*; got "
+    with pytest.raises(WoodcamError, match=r"preview: overlay\[0\] colour must be a colour name pyvista "
+                                           r"knows or an " + rule):
+        preview(trimesh.creation.box(), screenshot=tmp_path / "p.png", window_size=(64, 48),
+                overlay=[(seg, colour, 1.0)])
+    with pytest.raises(WoodcamError, match="top_view: overlay colour must be .*" + rule):
+        top_view(hm, (W, D, H), atlas, window_size=(100, 80), overlay=[(seg, colour, 1.0)])
+    with pytest.raises(WoodcamError, match="stock_view: overlay colour must be .*" + rule):
+        stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), overlay=[(seg, colour, 1.0)])
+    assert not (tmp_path / "p.png").exists()
 
 
 def test_it_frames_the_stock_as_the_vtk_screenshot_does(bowl, tmp_path):

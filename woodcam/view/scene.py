@@ -81,18 +81,54 @@ WASTE_OPACITY = 0.3
 #: :mod:`woodcam.view.stockview`) draw the toolpath as this preview does.
 OVERLAY_COLORS = {"red": (255, 0, 0), "royalblue": (65, 105, 225)}
 
+#: The overlay colour rule of every view for a triple (pyvista's and matplotlib's), said in errors.
+OVERLAY_COLOUR_RULE = ("an RGB triple: whole numbers in 0..255, e.g. (65, 105, 225), or floats in "
+                       "0..1, e.g. (0.25, 0.41, 0.88) (a float anywhere in the triple makes it 0..1)")
 
-def overlay_rgb(colour, who: str) -> np.ndarray:
-    """An overlay colour of the numpy views (``who``: the function, named in the error) as RGB
-    0..255 ``(3,)`` float: a name of :data:`OVERLAY_COLORS` or three numbers in 0..255. The one
-    rule of both views: out of range was blended as given (top_view's uint8 cast wrapped
-    (1000, 0, 0) to a green-grey), a string triple was numpy's bare ValueError."""
-    rgb = (as_floats(OVERLAY_COLORS[colour]) if colour in OVERLAY_COLORS else None) if isinstance(colour, str) \
-        else None if isinstance(colour, (bool, np.bool_)) else as_floats(colour)
-    if rgb is None or rgb.shape != (3,) or not np.all(np.isfinite(rgb) & (rgb >= 0) & (rgb <= 255)):
-        raise WoodcamError(f"{who}: overlay colour must be one of {sorted(OVERLAY_COLORS)} or an RGB "
-                           f"triple of numbers in 0..255; got {colour!r:.60}; e.g. 'red' or (65, 105, 225)")
-    return rgb
+
+def overlay_rgb(colour, who: str, name: str = "overlay colour", names: str | None = None) -> np.ndarray:
+    """An overlay colour as RGB 0..255 ``(3,)`` float: the one rule of every view (``who``: the
+    function, ``name`` the argument and ``names`` the names the view takes, said in the error;
+    default those of :data:`OVERLAY_COLORS`), :data:`OVERLAY_COLOUR_RULE`:
+
+    - a name of :data:`OVERLAY_COLORS` (:func:`preview` also takes any name or hex string pyvista
+      knows, and resolves it there: :func:`check_overlay`);
+    - three whole numbers (int, numpy integer) in 0..255, as given;
+    - three numbers with a float among them, in 0..1, times 255: (1.0, 0.0, 0.0) is red.
+
+    pyvista read a float triple in 0..1 and the numpy views in 0..255, so (1.0, 0, 0) was red in
+    :func:`preview` and nearly black in top_view/stock_view. Refused (WoodcamError naming the
+    view, the argument, the rule, the value and a fix): a float above 1 ((255.0, 0, 0): no
+    guess at which scale was meant), whole numbers of 0 and 1 only with a 1 among them ((1, 0, 0)
+    is nearly black in 0..255 but reads as red in 0..1), out of range, not three numbers, a bool.
+    """
+    if isinstance(colour, str):
+        if colour in OVERLAY_COLORS:
+            return np.asarray(OVERLAY_COLORS[colour], float)
+        fix = f"give one of {sorted(OVERLAY_COLORS)} or a triple, e.g. (65, 105, 225)"
+    else:
+        values = list(colour) if isinstance(colour, (tuple, list, np.ndarray)) else []
+        numbers = len(values) == 3 and all(isinstance(v, (int, float, np.integer, np.floating))
+                                           and not isinstance(v, (bool, np.bool_)) for v in values)
+        rgb = np.asarray(values, float) if numbers else None
+        whole = numbers and all(isinstance(v, (int, np.integer)) for v in values)
+        fix = "give three numbers in one of those ranges, e.g. (255, 0, 0) or (1.0, 0.0, 0.0)"
+        if rgb is not None and np.all(np.isfinite(rgb) & (rgb >= 0)):
+            if whole and rgb.max() == 1:
+                fix = ("ambiguous: whole numbers are read in 0..255 (nearly black here); for 0..1 "
+                       f"write floats, e.g. {tuple(float(v) for v in rgb)}, for 0..255 e.g. "
+                       f"{tuple(int(255 * v) for v in rgb)}")
+            elif whole and rgb.max() <= 255:
+                return rgb
+            elif not whole and rgb.max() <= 1:
+                return 255 * rgb
+            elif not whole and rgb.max() <= 255:
+                fix = (f"a triple with a float is read in 0..1; for 0..255 give whole numbers, e.g. "
+                       f"{tuple(int(round(v)) for v in rgb)}, or divide by 255")
+    names = f"one of {sorted(OVERLAY_COLORS)}" if names is None else names
+    raise WoodcamError(f"{who}: {name} must be {names} or {OVERLAY_COLOUR_RULE}; got {colour!r:.60}; "
+                       f"{fix}")
+
 
 #: Colour and width (pixels) of the part's outline drawn on the cut plane.
 OUTLINE_COLOR = (0.20, 0.12, 0.06)
@@ -723,7 +759,8 @@ def build_scene(
 
 def check_overlay(overlay, pv=None) -> list[tuple[np.ndarray, object, float]]:
     """``overlay`` of :func:`preview` checked before a window opens: a list of ``(segments (k, 2, 3)
-    finite mm, colour, width px > 0)``; returned with the segments as float arrays. A tuple of
+    finite mm, colour, width px > 0)``; returned with the segments as float arrays and a triple
+    colour as floats in 0..1 (read by :func:`overlay_rgb`, the numpy views' rule). A tuple of
     two, segments of another shape or NaN, a colour pyvista does not know or a width of 0 or 'a'
     were bare unpacking/reshape errors or VTK's, after the scene was built."""
     if overlay is None:
@@ -747,7 +784,13 @@ def check_overlay(overlay, pv=None) -> list[tuple[np.ndarray, object, float]]:
             got = f"shape {seg.shape}" if seg is not None and np.all(np.isfinite(seg)) else f"{segments!r:.60}"
             raise WoodcamError(f"overlay[{i}] segments must be a (k, 2, 3) array of finite mm (k line segments, "
                                f"start and end points in the block frame); got {got}")
-        colour = check_background(colour, pv, f"overlay[{i}] colour") if colour is not None else colour
+        if isinstance(colour, str):  # any name or hex string pyvista knows
+            colour = check_background(colour, pv, f"overlay[{i}] colour")
+        elif colour is not None:
+            # a triple by the numpy views' rule (overlay_rgb), handed to pyvista as floats in
+            # 0..1: pyvista took (1.0, 0, 0) as red where top_view drew it nearly black
+            colour = tuple(float(c) / 255 for c in overlay_rgb(colour, "preview", f"overlay[{i}] colour",
+                                                               "a colour name pyvista knows"))
         width = check_number(width, f"overlay[{i}] width", lo=0, lo_open=True, fix="line width in pixels, e.g. 2")
         out.append((seg.reshape(-1, 2, 3), colour, width))
     return out
@@ -785,7 +828,9 @@ def preview(
         ``cut_plane=False``) replace its fields.
     overlay : list of (segments (k, 2, 3) mm, colour, width px), optional
         Line segments drawn over the scene in the block frame (e.g. a toolpath: rapids and
-        feeds in two colours, :func:`woodcam.toolpath.gcode.Program` moves).
+        feeds in two colours, :func:`woodcam.toolpath.gcode.Program` moves). ``colour``: a
+        name or hex string pyvista knows, or a triple by :func:`overlay_rgb`'s rule (whole
+        numbers in 0..255, floats in 0..1), the same colour as top_view and stock_view draw.
 
     Returns
     -------

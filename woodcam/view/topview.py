@@ -34,8 +34,9 @@ def top_view(heightmap, size_mm, top_texels, *, overlay=None,
     top_texels : (th, tw, 3) uint8
         The atlas's top chart, row 0 at ``Y = D`` (the chart's own orientation).
     overlay : list of (segments (k, 2, 3) mm, colour, width px), optional
-        Block-frame segments drawn over the stock (``colour`` "red" or "royalblue" or an RGB
-        triple), as :func:`woodcam.view.preview` takes them.
+        Block-frame segments drawn over the stock (``colour`` "red" or "royalblue", or an RGB
+        triple: whole numbers in 0..255 or floats in 0..1, :func:`woodcam.view.scene.overlay_rgb`),
+        as :func:`woodcam.view.preview` takes them and in the same colour.
     window_size : (width, height) px
         The image size; the stock is fitted inside with ``margin_px``, the rest white.
     """
