@@ -652,19 +652,26 @@ def test_a_photo_too_small_to_hold_rings_is_refused_with_the_minimum(synth_photo
     assert not (tmp_path / "o").exists()
 
 
-def test_a_rerun_clears_its_own_stale_knot_masks_and_keeps_a_users(synth_photos, tmp_path, capsys, monkeypatch):
-    """A face's knot mask from an earlier detection (left_knot_mask.png) stayed in the block
-    folder after the block was remade from new photos and detected again with no knot on that
-    face: a file of the old run beside the new manifest. Now the detector's own mask (its digest
-    recorded) is removed; a mask the user put there (top_knot_mask.png) is kept and said."""
+def _knotted_block_folder(synth_photos, tmp_path, capsys):
+    """A block folder ``tmp_path/blk`` made by 'block from-photos' of the synthetic photos with
+    an analytic knot on the left face (its photos in ``tmp_path/knotted``); returns it and the --size-mm arguments that made it."""
     from .test_detect_knots import _face_with_knot
 
-    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
     knotted = _copy(synth_photos, tmp_path / "knotted")
     Image.fromarray(_face_with_knot(160)[0]).save(knotted / "left.png")
     blk = tmp_path / "blk"
     size = ("--size-mm", "32")  # 5 px/mm, where the analytic knot is found
     assert _run(capsys, "block", "from-photos", knotted, *size, "--out", blk)[0] == 0
+    return blk, size
+
+
+def test_a_rerun_clears_its_own_stale_knot_masks_and_keeps_a_users(synth_photos, tmp_path, capsys, monkeypatch):
+    """A face's knot mask from an earlier detection (left_knot_mask.png) stayed in the block
+    folder after the block was remade from new photos and detected again with no knot on that
+    face: a file of the old run beside the new manifest. Now the detector's own mask (its digest
+    recorded) is removed; a mask the user put there (top_knot_mask.png) is kept and said."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    blk, size = _knotted_block_folder(synth_photos, tmp_path, capsys)
     rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
     assert rc == 0, err
     assert (blk / "left_knot_mask.png").is_file() and "knot_mask" in read_block(blk).faces["left"].extras
@@ -717,14 +724,8 @@ def test_an_edited_knot_mask_or_ring_map_wins_over_a_rerun_as_a_corrected_svg_do
     edited mask or ring map is kept and read as the face's, said with how to let detection
     replace it; it stays the user's on later runs, one made over another photo is refused, and
     once deleted detection writes its own."""
-    from .test_detect_knots import _face_with_knot
-
     monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
-    knotted = _copy(synth_photos, tmp_path / "knotted")
-    Image.fromarray(_face_with_knot(160)[0]).save(knotted / "left.png")
-    blk = tmp_path / "blk"
-    size = ("--size-mm", "32")  # 5 px/mm, where the analytic knot is found
-    assert _run(capsys, "block", "from-photos", knotted, *size, "--out", blk)[0] == 0
+    blk, size = _knotted_block_folder(synth_photos, tmp_path, capsys)
     assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 0
     detected = read_block(blk).faces
     mask = np.zeros((160, 160), np.uint8)
@@ -752,7 +753,7 @@ def test_an_edited_knot_mask_or_ring_map_wins_over_a_rerun_as_a_corrected_svg_do
     assert np.allclose(faces["top"].ring_map, detected["top"].ring_map)
     # an edit made over another photo than the face's now is refused, as a corrected SVG is
     Image.fromarray(mask).save(blk / "left_knot_mask.png")
-    turned = _copy(knotted, tmp_path / "turned")
+    turned = _copy(tmp_path / "knotted", tmp_path / "turned")
     Image.open(turned / "left.png").rotate(180).save(turned / "left.png")
     assert _run(capsys, "block", "from-photos", turned, *size, "--out", blk)[0] == 0
     rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
