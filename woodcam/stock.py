@@ -106,6 +106,12 @@ def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:
     except WoodcamError:
         parsed = None
     check_resize_in_block(stock.spec, stock.size_mm, size, origin, parsed)
+    return _cut(stock, size, origin)
+
+
+def _cut(stock: Stock, size: np.ndarray, origin: np.ndarray) -> Stock:
+    """:func:`resize_stock` past its doors: ``size`` (3,) and ``origin`` (3,) mm, checked and
+    inside the block (open_stock checks its spec's resizes itself, naming the spec as typed)."""
     W, D, H = size.tolist()
     # written as the spec reader reads it back (12 digits: ':g' rounded 0.1234567 to 0.123457,
     # and its '1e-05' was no operation to the reader)
@@ -246,9 +252,10 @@ def open_stock(spec: str, *, species: str | None = None,
     turns = []
     for i, op in enumerate(parsed.ops):  # in the order written: a resize of a turned block is cut in the turned frame
         if op[0] == "resize":  # named as given (the stock's own spec lacks the turns before it)
-            check_resize_in_block(str(spec), stock.size_mm, op[1], op[2],
+            size, origin = np.asarray(op[1], float), np.asarray(op[2], float)  # checked by parse_spec
+            check_resize_in_block(str(spec), stock.size_mm, size, origin,
                                   dataclasses.replace(parsed, ops=parsed.ops[:i]))
-            stock = resize_stock(stock, op[1], op[2])
+            stock = _cut(stock, size, origin)  # not resize_stock: its spec parsed and checked again
         else:
             wood, size = stock.wood.turned(op[1], op[2], stock.size_mm)
             turns.append(op[1:])
