@@ -554,6 +554,33 @@ def written_by_woodcam(path: PathLike) -> bool:
     return False
 
 
+def glb_json(data: bytes, where: str) -> dict:
+    """The glTF JSON of the GLB file bytes ``data`` (glTF 2.0 spec, "GLB File Format": a 12-byte
+    header, then the JSON chunk's length and type), read without decoding its binary chunk (a
+    texture's megabytes); a :class:`WoodcamError` beginning with ``where`` (what reads, the file)
+    for anything that is no glTF 2.0 binary or a malformed JSON chunk."""
+    if len(data) < 20:
+        raise WoodcamError(f"{where} is {len(data)} bytes, too short to be a GLB file "
+                           f"(its headers alone take 20); pass a .glb written by woodcam bake or another glTF exporter")
+    magic, version, _length = struct.unpack_from("<III", data, 0)
+    chunk_len, chunk_type = struct.unpack_from("<II", data, 12)
+    if magic != _GLB_MAGIC or version != 2 or chunk_type != _GLB_CHUNK_JSON:
+        raise WoodcamError(
+            f"{where} is not a glTF 2.0 binary (magic {magic:#x}, "
+            f"version {version}); pass a .glb written by woodcam.export.export_glb"
+        )
+    bad = f"{where} has a malformed glTF JSON chunk"
+    if 20 + chunk_len > len(data):
+        raise WoodcamError(f"{bad}: it claims {chunk_len} bytes but the file ends first")
+    try:
+        tree = json.loads(data[20:20 + chunk_len].decode("utf-8"))
+    except (UnicodeDecodeError, ValueError, RecursionError) as err:
+        raise WoodcamError(f"{bad} ({err})") from err
+    if not isinstance(tree, dict):
+        raise WoodcamError(f"{bad}: a JSON object is required, got {type(tree).__name__}")
+    return tree
+
+
 def read_glb_metadata(path: PathLike) -> dict:
     """Return the ``woodcam`` metadata stored by :func:`export_glb` (``{}`` if none).
 
@@ -564,25 +591,8 @@ def read_glb_metadata(path: PathLike) -> dict:
         data = path.read_bytes()
     except OSError as err:
         raise WoodcamError(f"read_glb_metadata: cannot read {str(path)!r} ({err.strerror})") from err
-    if len(data) < 20:
-        raise WoodcamError(f"read_glb_metadata: {str(path)!r} is {len(data)} bytes, too short to be a GLB file "
-                           f"(its headers alone take 20); pass a .glb written by woodcam bake or another glTF exporter")
-    magic, version, _length = struct.unpack_from("<III", data, 0)
-    chunk_len, chunk_type = struct.unpack_from("<II", data, 12)
-    if magic != _GLB_MAGIC or version != 2 or chunk_type != _GLB_CHUNK_JSON:
-        raise WoodcamError(
-            f"read_glb_metadata: {str(path)!r} is not a glTF 2.0 binary (magic {magic:#x}, "
-            f"version {version}); pass a .glb written by woodcam.export.export_glb"
-        )
+    tree = glb_json(data, f"read_glb_metadata: {str(path)!r}")
     bad = f"read_glb_metadata: {str(path)!r} has a malformed glTF JSON chunk"
-    if 20 + chunk_len > len(data):
-        raise WoodcamError(f"{bad}: it claims {chunk_len} bytes but the file ends first")
-    try:
-        tree = json.loads(data[20:20 + chunk_len].decode("utf-8"))
-    except (UnicodeDecodeError, ValueError, RecursionError) as err:
-        raise WoodcamError(f"{bad} ({err})") from err
-    if not isinstance(tree, dict):
-        raise WoodcamError(f"{bad}: a JSON object is required, got {type(tree).__name__}")
     scenes = tree.get("scenes") or [{}]
     index = tree.get("scene", 0)
     if (not isinstance(scenes, list) or isinstance(index, bool) or not isinstance(index, int)

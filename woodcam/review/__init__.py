@@ -236,11 +236,10 @@ def _part_bounds(glb_path: Path, part_glb: bytes) -> np.ndarray:
     GLB: block-frame mm in its vertex buffer under the root transform): its POSITION accessors'
     min and max, which glTF requires, read from the JSON chunk without decoding the texture;
     :func:`woodcam.export.load_textured` where a file lacks them."""
-    import struct
+    from ..export import glb_json
 
     try:
-        (n,) = struct.unpack_from("<I", part_glb, 12)
-        tree = json.loads(part_glb[20:20 + n].decode("utf-8"))
+        tree = glb_json(part_glb, f"review: {str(glb_path)!r}")
         accessors = [tree["accessors"][p["attributes"]["POSITION"]]
                      for m in tree["meshes"] for p in m["primitives"]]
         lo = np.min([a["min"] for a in accessors], axis=0)
@@ -248,7 +247,7 @@ def _part_bounds(glb_path: Path, part_glb: bytes) -> np.ndarray:
         bounds = np.array([lo, hi], dtype=float)
         if bounds.shape == (2, 3) and np.isfinite(bounds).all():
             return bounds
-    except (struct.error, ValueError, KeyError, TypeError, IndexError, UnicodeDecodeError):
+    except (WoodcamError, ValueError, KeyError, TypeError, IndexError):
         pass  # no min/max: read the mesh itself
     from ..export import load_textured
 
