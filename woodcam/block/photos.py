@@ -325,14 +325,14 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
             "photos_px_per_mm": float(min(density.values())),
             "photos": {f: p.name for f, p in photos.items()},
             # what this run writes as <face>_photo.png: a rerun with a face fewer removes only its own
-            "photo_digest": {f: _photo_digest(face.photo) for f, face in faces.items()}}
+            "photo_digest": {f: photo_digest(face.photo) for f, face in faces.items()}}
     return Block(tuple(size), faces=faces, name=name or Path(folder).name, meta=meta)
 
 
-def _photo_digest(photo) -> str:
-    """Digest of a face photo's pixels as stored in a block folder: the same as a detection's
-    ``photo_digest`` (:func:`woodcam.detect.block._photo_digest`), so either record tells a
-    photo woodcam wrote."""
+def photo_digest(photo) -> str:
+    """Digest of a face photo's pixels as stored in a block folder: what ``block from-photos``
+    records of the photos it writes, and a detection of the photos it traces (what a corrected
+    SVG is drawn over), so either record tells a photo woodcam wrote."""
     from .._cache import digest
 
     return digest(np.asarray(photo))
@@ -379,7 +379,7 @@ def clear_stale_photos(folder, block: Block, before: dict[str, str]) -> list[str
         if face in block.faces or face not in before or not path.is_file():
             continue
         try:
-            ours = bool(before[face]) and _photo_digest(photo_rgb8(_read_png(path, f"photo of face {face!r}"))) == before[face]
+            ours = bool(before[face]) and photo_digest(photo_rgb8(_read_png(path, f"photo of face {face!r}"))) == before[face]
         except WoodcamError:  # no longer an image: not the one woodcam wrote
             ours = False
         if ours:

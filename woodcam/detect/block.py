@@ -52,6 +52,7 @@ import numpy as np
 from .._atomic import atomic_path, write_bytes
 from .._cache import cache_dir, digest, entry_path, load_or_build
 from ..block.block import Block, Face
+from ..block.photos import photo_digest
 from ..errors import WoodcamError, WoodcamWarning
 from ..frames import FACES
 from .knots import detect_knots
@@ -289,11 +290,6 @@ def user_edited_faces(folder) -> dict[str, Path]:
     return out
 
 
-def _photo_digest(photo) -> str:
-    """Digest of a face photo's pixels as stored in a block folder (what a traced SVG is drawn over)."""
-    return digest(np.asarray(photo))
-
-
 #: The images detection writes per face (:mod:`woodcam.block.io` names them ``<face>_<kind>.png``),
 #: recorded by digest so a rerun clears or writes over only its own (module docstring): kind ->
 #: (what it is, in words; why a face has none after a detection).
@@ -379,7 +375,7 @@ def _edited_images(block: Block, folders: list[tuple[Path, dict]]) -> dict[tuple
                         or _file_digest(path, kind) == _file_digests(rec).get(path.name)):
                     continue
                 was = (rec.get("photo_digest") or {}).get(name)
-                if was is not None and f.photo is not None and was != _photo_digest(f.photo):
+                if was is not None and f.photo is not None and was != photo_digest(f.photo):
                     raise WoodcamError(
                         f"face {name!r}: the edited {path} was made over another {name} photo than this block's "
                         f"(the photo changed since, or --out holds an earlier block's detection): it is not this "
@@ -459,7 +455,7 @@ def _check_corrections_match_photos(block: Block, edited: dict[str, Path]) -> No
     for name, svg in edited.items():
         was = _detection_record(svg.parent).get("photo_digest", {}).get(name)
         photo = block.faces[name].photo
-        if was is not None and photo is not None and was != _photo_digest(photo):
+        if was is not None and photo is not None and was != photo_digest(photo):
             raise WoodcamError(
                 f"face {name!r}: the corrected {svg} was traced over another {name} photo than this "
                 f"block's (the photo changed since, or --out holds an earlier block's detection): its "
@@ -565,7 +561,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     det = dict(block.meta.get("detection") or {"detector": detector, "version": DETECT_VERSION, "rule": rule,
                                                "curved": _curved(curved)})
     det["svg_sha256"] = hashes
-    det["photo_digest"] = {n: _photo_digest(f.photo) for n, f in block.faces.items() if f.photo is not None}
+    det["photo_digest"] = {n: photo_digest(f.photo) for n, f in block.faces.items() if f.photo is not None}
     det["user_svg"] = sorted(kept)
     # an image the user edited since the detector wrote it wins as a corrected SVG does (it was
     # written over without a word): read in, written back as read, never recorded as the detector's
