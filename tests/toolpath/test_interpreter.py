@@ -1167,7 +1167,6 @@ def test_debug_and_print_comments_say_the_parameters_values_where_the_line_runs(
             "(PRINT, p=#1)\n#5599=0\n(DEBUG,hidden)\n(PRINT,shown #5599)\nM2\n")
     interp = Interpreter(text, start_mm=(0, 0, 0))
     interp.run()
-    on_terminal = " (PRINT: LinuxCNC writes it to its terminal, not its screen)"
     assert interp.messages == [
         (4, "x=1.250000 one=2.500000 foo=3.000000 bad=###### end"),
         (5, "5.000000 x=1.250000 1.250000 #5.000000 #a # x 0.000000 5.000000.5"),
@@ -1175,9 +1174,26 @@ def test_debug_and_print_comments_say_the_parameters_values_where_the_line_runs(
         (8, "pass 5.000000"), (8, "pass 6.000000"),
         (12, "in sub 9.000000 ######"), (14, "in sub 4.000000"), (17, "after ######"),
         (23, "0.000100 0.000000 -0.000150 ###### 1000000000000000000000.000000 0.000000 "
-             "###### 0.000000"),
-        (24, "p=7.000000" + on_terminal), (27, "shown 0.000000" + on_terminal)]
+             "###### 0.000000")]
+    assert interp.printed == [(24, "p=7.000000"), (27, "shown 0.000000")]
     assert interp.warnings == []
+
+
+def test_print_comments_are_printed_not_said_to_the_operator():
+    """LinuxCNC writes (PRINT,...) to its standard output (rs274's stdout, the terminal the
+    machine was started from) and never shows it on the operator's screen, where MSG and DEBUG
+    go; woodcam put it among the operator messages with a note ('p=2.000000 (PRINT: LinuxCNC
+    writes it to its terminal, not its screen)'). It is Interpreter.printed now, values put in
+    as DEBUG's, whatever #5599 says (checked against rs274 in test_linuxcnc_oracle.py)."""
+    interp = Interpreter("#1=2\n(MSG,m)\n(PRINT, p=#1)\n#5599=0\n(print,low #<_x>)\n"
+                         "(DEBUG,hidden)\nM2\n", start_mm=(1, 0, 0))
+    interp.run()
+    assert interp.messages == [(2, "m")]
+    assert interp.printed == [(3, "p=2.000000"), (5, "low 1.000000")]
+    for dialect in ("grbl", "fanuc"):  # a plain comment there
+        interp = Interpreter("(PRINT,p)\nG0 X1\n", dialect=dialect)
+        interp.run()
+        assert interp.printed == interp.messages == []
 
 
 def test_debug_text_woodcam_cannot_fill_in_is_marked_and_warned():

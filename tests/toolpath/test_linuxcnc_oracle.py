@@ -6,6 +6,8 @@ Skipped with the reason when LinuxCNC's interpreter is not installed (``make lin
 
 from __future__ import annotations
 
+import re
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -23,6 +25,11 @@ CORPUS = sorted((REPO / "toolpaths" / "corpus").glob("*.*[!y]")) + sorted(
 LINUXCNC_SAMPLES = Path("/usr/share/linuxcnc/ncfiles")
 START = (0.0, 0.0, 10.0)
 TOL_MM = 1e-6
+#: LinuxCNC's standalone interpreter (the same package): it prints the canon calls and, between
+#: them, what a program's (PRINT,...) writes to standard output
+RS274 = Path("/usr/bin/rs274")
+_RS274_CALL = re.compile(r"^\s*\d+ N\S* [A-Z][A-Z0-9_]*\(")
+_RS274_MESSAGE = re.compile(r'^\s*\d+ N\S* MESSAGE\("(.*)"\)$')
 
 pytestmark = pytest.mark.skipif(bool(linuxcnc_missing()), reason=f"LinuxCNC's interpreter "
                                 f"is not available: {linuxcnc_missing()}")
@@ -778,3 +785,47 @@ def test_read_gcode_gives_the_same_messages_with_either_interpreter():
     mine = read_gcode(text).messages
     assert read_gcode(text, interpreter="linuxcnc").messages == mine == [
         "line 2: start", "line 5: pass 0.000000 x=1.000000", "line 5: pass 1.000000 x=2.000000"]
+
+
+def _rs274(tmp_path, text, *args):
+    """``(operator messages, printed lines)`` of program ``text`` run by rs274 (``-g``, batch),
+    each stripped of the blanks around it, as woodcam keeps them: a MESSAGE canon call is what
+    the operator's screen shows, any other line of its standard output a (PRINT,...)'s."""
+    path = tmp_path / "rs274.ngc"
+    path.write_text(text)
+    r = subprocess.run([str(RS274), *args, "-g", str(path)], capture_output=True, text=True,
+                       timeout=60, cwd=tmp_path)
+    assert r.returncode == 0, r.stdout + r.stderr
+    said, printed = [], []
+    for line in r.stdout.splitlines():
+        m = _RS274_MESSAGE.match(line)
+        if m:
+            said.append(m.group(1).strip())
+        elif not _RS274_CALL.match(line):
+            printed.append(line.strip())
+    return said, printed
+
+
+@pytest.mark.skipif(not RS274.exists(), reason=f"{RS274} (LinuxCNC's standalone interpreter, "
+                    "linuxcnc-uspace) is not installed")
+def test_print_comments_are_printed_where_rs274_prints_them_not_said(tmp_path):
+    """rs274 shows (MSG,...) and (DEBUG,...) as MESSAGE calls, what the operator's screen
+    shows, and writes (PRINT,...) to its standard output between the canon calls; the gcode
+    module (AXIS, --interpreter linuxcnc) shows no PRINT either. woodcam said PRINT among the
+    operator messages, so read_gcode's messages differed between the two interpreters
+    (test_print_comments_are_printed_not_said_to_the_operator)."""
+    text = ("#1=2.5\n(MSG, hello)\nG0 X1.5 (DEBUG, dbg #1 x=#<_x>)\n(PRINT, prt #1 x=#<_x>)\n"
+            "#1=0\no1 while [#1 lt 2]\n(print,pass #1)\n#1=[#1+1]\no1 endwhile\n#5599=0\n"
+            "(DEBUG,hidden)\n(PRINT,after #5599)\nG0 X2\nM2\n")
+    said, printed = _rs274(tmp_path, text)
+    interp = Interpreter(text, start_mm=START)
+    interp.run()
+    assert [m for _, m in interp.messages] == said == ["hello", "dbg 2.500000 x=0.000000"]
+    assert [m for _, m in interp.printed] == printed == [
+        "prt 2.500000 x=1.500000", "pass 0.000000", "pass 1.000000", "after 0.000000"]
+    assert [ln for ln, _ in interp.printed] == [4, 7, 7, 12]
+    mine = read_gcode(text)
+    assert read_gcode(text, interpreter="linuxcnc").messages == mine.messages == [
+        "line 2: hello", "line 3: dbg 2.500000 x=0.000000"]
+    assert mine.printed == ["line 4: prt 2.500000 x=1.500000", "line 7: pass 0.000000",
+                            "line 7: pass 1.000000", "line 12: after 0.000000"]

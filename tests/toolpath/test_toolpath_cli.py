@@ -555,11 +555,12 @@ def test_the_programs_messages_are_shown_as_the_machine_would_show_them(tmp_path
     program runs (DEBUG with the parameters' values at that point), were read into the
     interpreter and shown nowhere: read_gcode's Program had no place for them and woodcam
     gcode said nothing. They are Program.messages now, printed one a line; not warnings
-    (--strict passes)."""
+    (--strict passes). A (PRINT,...), which LinuxCNC writes to its terminal and never shows
+    the operator, was printed as a 'message' too; it is labelled 'print' now."""
     _stub_preview(monkeypatch, {})
     text = ("G21 G90\nT1 M6\nG0 X10 Y10 Z5 M3 S9000\n(MSG, roughing)\n#1=0\no1 while [#1 lt 2]\n"
             "G1 Z[-1-#1] F600\n(DEBUG, pass #1 at z=#<_z>)\nG1 X30\nG0 Z5\nG0 X10\n#1=[#1+1]\n"
-            "o1 endwhile\nM2\n")
+            "o1 endwhile\n(PRINT, done #1)\nM2\n")
     said = ["line 4: roughing", "line 8: pass 0.000000 at z=-1.000000",
             "line 8: pass 1.000000 at z=-2.000000"]
     prog = read_gcode(text)
@@ -573,3 +574,6 @@ def test_the_programs_messages_are_shown_as_the_machine_would_show_them(tmp_path
     err = capsys.readouterr().err
     assert [ln for ln in err.splitlines() if "message" in ln] == [
         f"woodcam: message: msg.nc {m}" for m in said]
+    assert prog.printed == ["line 14: done 2.000000"]
+    assert [ln for ln in err.splitlines() if "done" in ln] == [
+        "woodcam: print: msg.nc line 14: done 2.000000"]

@@ -224,6 +224,10 @@ def run(args) -> int:
         # not a warning (--strict does not count them)
         for m in program.messages:
             print(f"woodcam: message: {path.name} {m}", file=sys.stderr)
+        # (PRINT,...): what LinuxCNC writes to the terminal it runs from, for the program's
+        # author, never shown to the operator: its own label, so it is not read as a message
+        for m in program.printed:
+            print(f"woodcam: print: {path.name} {m}", file=sys.stderr)
         if not (program.kind == 1).any() and args.until_line is None:
             raise WoodcamError(f"woodcam gcode: {path} has no cutting move (G1/G2/G3 or a "
                                "drilling cycle); nothing to simulate. Check that it is the "

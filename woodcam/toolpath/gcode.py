@@ -12,8 +12,11 @@ any), ``line : (n,) int`` (1-based source line) and ``feed_mm_min, spindle_rpm :
 most ``chord_tol_mm`` (default :data:`woodcam.tolerances.ARC_CHORD_TOL_MM`), so every arc vertex
 lies exactly on the analytic circle (helix). ``warnings`` lists ``"line N: ..."`` strings;
 ``messages`` the operator messages the program says as it runs, ``"line N: ..."`` too (its
-``(MSG,...)``, ``(DEBUG,...)`` and ``(PRINT,...)`` comments, the parameters' values put in, as
-LinuxCNC shows them).
+``(MSG,...)`` and ``(DEBUG,...)`` comments, the parameters' values put in, as LinuxCNC shows
+them); ``printed`` its ``(PRINT,...)`` texts, in the same form: LinuxCNC writes those to the
+terminal it was started from, never to the operator's screen (woodcam's interpreter only:
+``interpreter="linuxcnc"`` leaves it empty: LinuxCNC's module writes them to its own standard
+output, without their lines).
 
 The language (parameters, expressions, O-word subroutines and loops, work offsets, canned
 cycles, dialects) is :mod:`woodcam.toolpath.interpreter`; ``interpreter="linuxcnc"`` runs
@@ -83,6 +86,7 @@ class Program:
     tool_numbers: list[int] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
     messages: list[str] = field(default_factory=list)
+    printed: list[str] = field(default_factory=list)
 
     def __len__(self) -> int:
         return len(self.kind)
@@ -110,7 +114,7 @@ class Program:
         return Program(self.start_mm[k], self.end_mm[k], self.kind[k], self.tool[k],
                        self.line[k], self.feed_mm_min[k], self.spindle_rpm[k], self.source,
                        sorted(set(self.tool[k].tolist())), list(self.warnings),
-                       list(self.messages))
+                       list(self.messages), list(self.printed))
 
     def __iter__(self):
         return (self[i] for i in range(len(self)))
@@ -305,6 +309,7 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
         mzero = tuple(check_vector(machine_zero_mm, "read_gcode: machine_zero_mm",
                                    fix="give millimetres, e.g. (0, 0, 80), or None").tolist())
     said: list[tuple[int, str]] = []
+    printed: list[tuple[int, str]] = []
     if interpreter == "linuxcnc":
         from .linuxcnc import run_linuxcnc
 
@@ -314,17 +319,18 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
         interp = Interpreter(text, dialect=dialect, start_mm=start.tolist(),
                              machine_zero_mm=mzero)
         moves, warnings = interp.run()
-        said = interp.messages
+        said, printed = interp.messages, interp.printed
     else:
         raise WoodcamError(f"read_gcode: interpreter must be 'woodcam' or 'linuxcnc', got "
                            f"{interpreter!r}")
     return program_from_canonical(moves, start.tolist(), chord_tol_mm, source,
                                   [f"line {ln}: {m}" for ln, m in warnings],
-                                  [f"line {ln}: {m}" for ln, m in said])
+                                  [f"line {ln}: {m}" for ln, m in said],
+                                  [f"line {ln}: {m}" for ln, m in printed])
 
 
 def program_from_canonical(moves, start_mm, chord_tol_mm, source="<string>",
-                           warnings=(), messages=()) -> Program:
+                           warnings=(), messages=(), printed=()) -> Program:
     """Canonical moves (:mod:`.interpreter`'s form) -> a :class:`Program`: arcs become chords
     with sagitta <= ``chord_tol_mm`` whose vertices lie on the analytic circle/helix."""
     pos = list(map(float, start_mm))
@@ -352,7 +358,7 @@ def program_from_canonical(moves, start_mm, chord_tol_mm, source="<string>",
     tools = m[:, 1].astype(int)
     return Program(s, e, m[:, 0].astype(np.uint8), tools, m[:, 2].astype(int), m[:, 3],
                    m[:, 4], source, sorted(set(tools.tolist())), list(warnings),
-                   list(messages))
+                   list(messages), list(printed))
 
 
 _PLANE_AXES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}

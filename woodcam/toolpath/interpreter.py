@@ -71,8 +71,9 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60`` (one of each modal group a line; in
   ``linuxcnc`` M6 stops the spindle, as LinuxCNC's tool change does);
   ``F S T``, ``E`` (beside ``M66``-``M68``), ``N`` (digits, the first word of a line, before any comment; grbl: anywhere); ``( )``/``;`` comments,
-  ``(msg,...)``, ``(debug,...)`` and ``(print,...)`` (the parameters' values put in, as
-  LinuxCNC: :attr:`Interpreter.messages`), ``(abort,...)`` (an error, as LinuxCNC), block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
+  ``(msg,...)`` and ``(debug,...)`` (operator messages, the parameters' values put in, as
+  LinuxCNC: :attr:`Interpreter.messages`), ``(print,...)`` (the same, but what LinuxCNC writes
+  to its terminal, not its screen: :attr:`Interpreter.printed`), ``(abort,...)`` (an error, as LinuxCNC), block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
   of its own: the first non-blank line opens, the next ends the program; any other ``%`` is an
   error, as in LinuxCNC).
 
@@ -585,6 +586,9 @@ class Interpreter:
                                   "them as lines, LinuxCNC reads the file as one line and "
                                   "refuses it; convert the line ends to LF or CRLF"))
         self.messages: list[tuple[int, str]] = []
+        # (PRINT,...) texts: LinuxCNC writes them to its standard output (the terminal it was
+        # started from, rs274's stdout), not to the operator's screen as MSG and DEBUG
+        self.printed: list[tuple[int, str]] = []
         # modal state
         self.inch = False
         self.incremental = False
@@ -1795,11 +1799,11 @@ class Interpreter:
             self.execute(gs, ms, words)
 
     def _say(self, notes) -> None:
-        """Say the line's message comment ``notes`` (``[(kind, text)]``, split_comments) into
-        :attr:`messages`: MSG as written, DEBUG (while #5599 is on, as LinuxCNC) and PRINT
-        with the parameters' values put in. LinuxCNC shows MSG and DEBUG on the operator's
-        screen and writes PRINT to its standard output (the terminal it was started from),
-        which the message says."""
+        """Say the line's message comment ``notes`` (``[(kind, text)]``, split_comments):
+        into :attr:`messages` MSG as written and DEBUG (while #5599 is on, as LinuxCNC) with
+        the parameters' values put in, which LinuxCNC shows on the operator's screen; into
+        :attr:`printed` PRINT, values put in too, which LinuxCNC writes to its standard output
+        (the terminal it was started from) and never shows the operator."""
         for kind, text in notes:
             if kind != "msg" and self.dialect != "linuxcnc":
                 continue  # grbl and Fanuc read (DEBUG,...), (PRINT,...) and (ABORT,...) as comments
@@ -1812,9 +1816,7 @@ class Interpreter:
                                "cut, none after)", "this is the program's own (ABORT,...): "
                                "satisfy the condition that leads to it, or remove it")
             elif kind == "print":
-                self.messages.append((self.line_no, f"{self._expand(text, 'PRINT').strip()} "
-                                      "(PRINT: LinuxCNC writes it to its terminal, not its "
-                                      "screen)"))
+                self.printed.append((self.line_no, self._expand(text, "PRINT").strip()))
             elif self.p.get(5599, 0.0) > 0:
                 self.messages.append((self.line_no, self._expand(text, "DEBUG").strip()))
 
