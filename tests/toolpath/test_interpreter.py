@@ -1203,14 +1203,40 @@ def test_debug_text_woodcam_cannot_fill_in_is_marked_and_warned():
     a plain comment."""
     interp = Interpreter("(DEBUG,tlo=#5403 z=#5063 end)\n(DEBUG,open #)\n(DEBUG,x #<_x)\nM2\n")
     interp.run()
-    assert interp.messages == [(1, "tlo=#5403? z=#5063? end"), (2, "open"), (3, "x")]
+    assert interp.messages == [(1, "tlo=[#5403: T0's Z offset, from the machine's tool table] "
+                                   "z=#5063? end"), (2, "open"), (3, "x")]
     assert [w[0] for w in interp.warnings] == [1, 1, 2, 3]
-    assert "#5403, which woodcam cannot know" in interp.warnings[0][1]
+    assert "#5403, T0's Z offset in the machine's tool table" in interp.warnings[0][1]
+    assert "#5063, which woodcam cannot know" in interp.warnings[1][1]
     assert "unfinished parameter '#<_x'" in interp.warnings[3][1]
     for dialect in ("grbl", "fanuc"):
         interp = Interpreter("G0 X1 (DEBUG,x)\n(MSG,m)\n", dialect=dialect)
         interp.run()
         assert interp.messages == [(2, "m")]
+
+
+def test_tool_table_entries_in_a_message_say_what_they_are_or_the_users_diameter():
+    """LinuxCNC shows the loaded tool's entry of the machine's tool table for #5401-#5413 in a
+    DEBUG/PRINT (the table's values, whatever G20; rs274 -t in test_linuxcnc_oracle.py);
+    woodcam showed '#5410?' even where the user's tool table gives the tool's diameter, and
+    '#5403?' said neither what the value is nor why it is missing. Now #5410 is the user's
+    diameter of the loaded tool; any other entry, or a tool the user did not give, says what it
+    is, with a warning; an expression still may not read them (the machine's table may
+    differ)."""
+    text = ("T1 M6\n(DEBUG,d=#5410 z=#5403 o=#5413)\nG20\nT2 M6\n(PRINT,d=#5410 x=#5401)\n"
+            "T3 M6\n(DEBUG,d=#5410 front=#5411)\nM2\n")
+    interp = Interpreter(text, tool_diameters_mm={1: 6.35, 2: 3, 4: 8})
+    interp.run()
+    table = "from the machine's tool table]"
+    assert interp.messages == [
+        (2, f"d=6.350000 z=[#5403: T1's Z offset, {table} o=[#5413: T1's orientation, {table}"),
+        (7, f"d=[#5410: T3's diameter, {table} front=[#5411: T3's front angle, {table}")]
+    assert interp.printed == [(5, f"d=3.000000 x=[#5401: T2's X offset, {table}")]
+    said = [(ln, w.split(",...) shows ")[1].split(",")[0]) for ln, w in interp.warnings]
+    assert said == [(2, "#5403"), (2, "#5413"), (5, "#5401"), (7, "#5410"), (7, "#5411")]
+    assert "--tool 3=SPEC" in interp.warnings[3][1]
+    _refused("T1 M6\nG0 X#5410\nM2\n", 2, "#5410", "#5410 is the loaded tool's offset, "
+             "diameter", tool_diameters_mm={1: 6.35})
 
 
 def test_an_abort_comment_stops_the_program_where_it_runs():

@@ -829,3 +829,23 @@ def test_print_comments_are_printed_where_rs274_prints_them_not_said(tmp_path):
         "line 2: hello", "line 3: dbg 2.500000 x=0.000000"]
     assert mine.printed == ["line 4: prt 2.500000 x=1.500000", "line 7: pass 0.000000",
                             "line 7: pass 1.000000", "line 12: after 0.000000"]
+
+
+@pytest.mark.skipif(not RS274.exists(), reason=f"{RS274} (LinuxCNC's standalone interpreter, "
+                    "linuxcnc-uspace) is not installed")
+def test_tool_table_entries_in_messages_are_the_machines_table_as_rs274_shows_them(tmp_path):
+    """rs274 -t TABLE shows #5401-#5413 in a DEBUG/PRINT as the loaded tool's entry in that
+    table (its values, whatever G20); woodcam showed '#5410?' even for a tool whose diameter
+    the user gave. With the same diameters woodcam shows the same #5410; the entries only the
+    machine's table holds (the Z offset here) say what they are instead
+    (test_tool_table_entries_in_a_message_say_what_they_are_or_the_users_diameter)."""
+    (tmp_path / "tools.tbl").write_text("T1 P1 Z12.5 D6.35 Q3 ;flat\nT2 P2 Z30 D3 ;ball\n")
+    text = ("T1 M6\n(DEBUG,d=#5410 z=#5403)\nG20\nT2 M6\n(PRINT,d=#5410)\nG0 X1\nM2\n")
+    said, printed = _rs274(tmp_path, text, "-t", "tools.tbl")
+    assert said == ["d=6.350000 z=12.500000"] and printed == ["d=3.000000"]
+    interp = Interpreter(text, start_mm=START, tool_diameters_mm={1: 6.35, 2: 3})
+    interp.run()
+    assert interp.messages == [(2, "d=6.350000 z=[#5403: T1's Z offset, from the machine's "
+                                   "tool table]")]
+    assert interp.printed == [(5, printed[0])]
+    assert said[0].startswith(interp.messages[0][1].split(" z=")[0] + " z=")

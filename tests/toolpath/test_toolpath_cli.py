@@ -577,3 +577,20 @@ def test_the_programs_messages_are_shown_as_the_machine_would_show_them(tmp_path
     assert prog.printed == ["line 14: done 2.000000"]
     assert [ln for ln in err.splitlines() if "done" in ln] == [
         "woodcam: print: msg.nc line 14: done 2.000000"]
+
+
+def test_a_message_shows_the_diameter_of_the_users_tool_table(tmp_path, monkeypatch, capsys):
+    """A (DEBUG,...) of #5410, the loaded tool's diameter in the machine's tool table, showed
+    '#5410?' though --tools (or --tool N=SPEC) gives that tool; it shows its diameter now."""
+    _stub_preview(monkeypatch, {})
+    path = tmp_path / "dia.nc"
+    path.write_text("G21 G90\nT1 M6\n(DEBUG, dia #5410)\nG0 X10 Y10 Z5 M3 S9000\nG1 Z-1 F600\n"
+                    "G1 X30\nG0 Z5\nT7 M6\n(DEBUG, dia #5410)\nG1 Z-1\nM2\n")
+    args = _parse([str(path), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+                   "--tools", str(REPO / "toolpaths" / "tools.toml"), "--tool", "7=ball:3.5",
+                   "--cell-size", "0.5"])
+    assert args.func(args) == 0
+    err = capsys.readouterr().err
+    assert [ln for ln in err.splitlines() if "message" in ln] == [
+        "woodcam: message: dia.nc line 3: dia 6.350000",
+        "woodcam: message: dia.nc line 9: dia 3.500000"]

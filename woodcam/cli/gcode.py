@@ -125,7 +125,8 @@ def register(subparsers) -> None:
 
 
 
-def _tools_from_args(args, program) -> dict:
+def _numbered_tools(args) -> dict:
+    """The tools the command line numbers: the --tools table, then each --tool N=SPEC."""
     from ..toolpath.tools import load_tool_table
     from .options import parse_tool_option
 
@@ -134,13 +135,18 @@ def _tools_from_args(args, program) -> dict:
                            "([tools.N] type/diameter_mm/..., e.g. toolpaths/tools.toml) or a CAMotics "
                            "JSON tool table")
     tools = dict(load_tool_table(args.tools)) if args.tools else {}
-    unnumbered = []
     for item in args.tool:  # read at the door already (options.check_values): a usage error there
         number, tool = parse_tool_option(item)
-        if number is None:
-            unnumbered.append(tool)
-        else:
+        if number is not None:
             tools[number] = tool
+    return tools
+
+
+def _tools_from_args(args, program) -> dict:
+    from .options import parse_tool_option
+
+    tools = _numbered_tools(args)
+    unnumbered = [tool for number, tool in map(parse_tool_option, args.tool) if number is None]
     if unnumbered:
         used = [t for t in dict.fromkeys(program.tool.tolist()) if t not in tools]
         if len(used) > 1 and 0 in used and program.tool_of_leading_rapids() is not None:
@@ -202,6 +208,8 @@ def run(args) -> int:
     # 20-30 s the first time).
     n_warn = 0
     programs = []  # (path, program as simulated, the whole program, seconds to read, tools)
+    # what a (DEBUG,...) shows for #5410, the loaded tool's diameter in the machine's table
+    diameters = {n: t.diameter_mm for n, t in _numbered_tools(args).items()}
     for k, path in enumerate(args.program):
         if not Path(path).is_file():  # read_gcode named its parameter: "text_or_path='x.nc'"
             raise WoodcamError(f"woodcam gcode: program {str(path)!r} is not a file; pass the G-code "
@@ -210,7 +218,8 @@ def run(args) -> int:
         try:
             program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
                                  interpreter=args.interpreter,
-                                 machine_zero_mm=args.machine_zero)
+                                 machine_zero_mm=args.machine_zero,
+                                 tool_diameters_mm=diameters)
         except GcodeError as err:  # which of the programs: "G-code line 5" alone does not say
             raise GcodeError(err.line, err.word, err.rule, err.fix, source=str(path)) from None
         t_read = time.perf_counter() - t0

@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import overload
 from pathlib import Path
@@ -248,7 +249,8 @@ def _names_a_file(text: str) -> bool:
 
 def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_TOL_MM,
                start_mm: ArrayLike | None = None, dialect: str = "linuxcnc",
-               interpreter: str = "woodcam", machine_zero_mm: ArrayLike | None = None) -> Program:
+               interpreter: str = "woodcam", machine_zero_mm: ArrayLike | None = None,
+               tool_diameters_mm: Mapping[int, float] | None = None) -> Program:
     """Read G-code text or a file path into a :class:`Program` of straight moves (G-code
     frame, mm).
 
@@ -271,6 +273,11 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
         LinuxCNC's G54 offset negated. ``None``: not known; a ``G53`` Z move is then taken as a
         retract to the start height and a warning names those lines
         (:mod:`woodcam.toolpath.interpreter`). ``(0, 0, 0)`` is LinuxCNC with every offset zero.
+    tool_diameters_mm : {int: float} | None
+        The cutters' diameters (mm) by tool number, as the user's tool table gives them: what
+        a ``(DEBUG,...)``/``(PRINT,...)`` shows for ``#5410`` (the loaded tool's diameter in
+        the machine's tool table; woodcam's interpreter only). Without the loaded tool there,
+        it says what LinuxCNC would show, with a warning.
 
     Raises
     ------
@@ -308,6 +315,15 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
     if machine_zero_mm is not None:
         mzero = tuple(check_vector(machine_zero_mm, "read_gcode: machine_zero_mm",
                                    fix="give millimetres, e.g. (0, 0, 80), or None").tolist())
+    if tool_diameters_mm is not None and not isinstance(tool_diameters_mm, Mapping):
+        raise WoodcamError(f"read_gcode: tool_diameters_mm must be a dict of tool number -> "
+                           f"diameter (mm) or None; got {tool_diameters_mm!r:.60}; e.g. {{1: 6.35}}")
+    diameters = {}
+    for number, d in (tool_diameters_mm or {}).items():
+        n = int(check_number(number, "read_gcode: tool_diameters_mm's tool number", lo=0,
+                             hi=99999, integer=True, fix="key the diameters by tool number"))
+        diameters[n] = check_number(d, f"read_gcode: tool_diameters_mm[{n}]", lo=0, lo_open=True,
+                                    fix="give the cutter's diameter in mm, e.g. 6.35")
     said: list[tuple[int, str]] = []
     printed: list[tuple[int, str]] = []
     if interpreter == "linuxcnc":
@@ -317,7 +333,7 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
                                        machine_zero_mm=mzero, said=said)
     elif interpreter == "woodcam":
         interp = Interpreter(text, dialect=dialect, start_mm=start.tolist(),
-                             machine_zero_mm=mzero)
+                             machine_zero_mm=mzero, tool_diameters_mm=diameters)
         moves, warnings = interp.run()
         said, printed = interp.messages, interp.printed
     else:

@@ -17,7 +17,10 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``#5420``-``#5428``, the predefined named ones) cannot be assigned, as in
   LinuxCNC, nor can ``#5600``/``#5601`` (LinuxCNC takes the assignment and reads the machine's
   value over it: the value would be dropped); reading what woodcam cannot know is refused: the tool table's offsets and diameter ``#5401``-``#5413``, and
-  probe (``#5061``-``#5070``) or input (``#5399``) results the program did not assign (the
+  probe (``#5061``-``#5070``) or input (``#5399``) results the program did not assign (in a
+  DEBUG/PRINT text a tool-table entry shows as ``[#5403: T1's Z offset, from the machine's
+  tool table]``, ``#5410`` as the loaded tool's diameter where ``tool_diameters_mm`` has it;
+  the
   ``params`` argument may supply them; the machine's state, ``#5400``-``#5413``,
   ``#5420``-``#5428``, ``#5600``/``#5601``, it refuses); lengths
   are millimetres whatever
@@ -308,6 +311,10 @@ def _cs_base(n: int) -> int:
 #: LinuxCNC's read-only numbered parameters (assigning one is refused there, "Parameter is
 #: readonly"): #5400 the loaded tool, #5401-#5413 its tool-table entry, #5420-#5428 the position.
 _READ_ONLY_NUM = frozenset(range(5400, 5414)) | frozenset(range(5420, 5429))
+#: What #5401-#5413 hold: the loaded tool's entry in the machine's tool table (the values as
+#: the table has them, in the machine's units, whatever G20/G21; LinuxCNC 2.9's rs274 -t).
+_TOOL_ENTRY = {**{5401 + i: f"{a} offset" for i, a in enumerate("XYZABCUVW")},
+               5410: "diameter", 5411: "front angle", 5412: "back angle", 5413: "orientation"}
 #: The tool changer's fault flag and reason, set by the machine (0 here: no fault). LinuxCNC
 #: lets a program assign them but reads the machine's value over the assignment.
 _TOOLCHANGER_FAULT = {5600: "flag", 5601: "reason"}
@@ -542,7 +549,8 @@ class Interpreter:
 
     def __init__(self, text: str, *, dialect: Dialect = "linuxcnc", start_mm=(0.0, 0.0, 0.0),
                  params: dict[int, float] | None = None, max_blocks: int = MAX_BLOCKS,
-                 max_moves: int = MAX_MOVES, machine_zero_mm=(0.0, 0.0, 0.0)):
+                 max_moves: int = MAX_MOVES, machine_zero_mm=(0.0, 0.0, 0.0),
+                 tool_diameters_mm: dict[int, float] | None = None):
         if dialect not in DIALECTS:
             raise WoodcamError(f"dialect must be one of {DIALECTS}, got {dialect!r}")
         self.dialect = dialect
@@ -586,6 +594,10 @@ class Interpreter:
                                   "them as lines, LinuxCNC reads the file as one line and "
                                   "refuses it; convert the line ends to LF or CRLF"))
         self.messages: list[tuple[int, str]] = []
+        # the user's tools by number (mm): what a DEBUG/PRINT shows for #5410, the tool
+        # table's diameter of the loaded tool (a program's expression still may not read it:
+        # the machine's own table may differ)
+        self.tool_diameters_mm = dict(tool_diameters_mm or {})
         # (PRINT,...) texts: LinuxCNC writes them to its standard output (the terminal it was
         # started from, rs274's stdout), not to the operator's screen as MSG and DEBUG
         self.printed: list[tuple[int, str]] = []
@@ -1826,8 +1838,8 @@ class Interpreter:
         decimals; within 1e-4 of 0 as 0.000000, its 'equal'), ``######`` for a parameter it
         does not have (an unset name, a number over 5601) or a value over 29 characters; a
         name is read to its ``>`` without blanks, in lower case; a ``#`` followed by neither
-        stays. A value woodcam cannot know (the tool table, a probe result) shows as ``#n?``
-        with a warning."""
+        stays. A value woodcam cannot know shows as ``#n?`` (a probe result) or says what it
+        is (the tool table, :meth:`_tool_entry_in_message`), with a warning."""
         out = []
         i, n = 0, len(text)
         while i < n:
@@ -1844,6 +1856,7 @@ class Interpreter:
                 ref = "#" + m.group(0)
                 k = int(m.group(0))
                 value = (None if k > 5601 else 0.0 if k == 0 else
+                         self._tool_entry_in_message(k, ref, kind) if k in _TOOL_ENTRY else
                          lambda k=k, ref=ref: self.get_num(k, ref))
             elif i < n and text[i] == "<" and ">" in text[i:]:
                 close = text.find(">", i)
@@ -1859,6 +1872,9 @@ class Interpreter:
                           "shows left-over text of an earlier message after the text before it; "
                           "write #1 or #<name>, or remove the '#'")
                 break
+            if isinstance(value, str):
+                out.append(value)
+                continue
             if callable(value):
                 try:
                     value = value()
@@ -1869,6 +1885,22 @@ class Interpreter:
                     continue
             out.append(_lf(value))
         return "".join(out)
+
+    def _tool_entry_in_message(self, k: int, ref: str, kind: str) -> float | str:
+        """``#k`` (5401-5413) in a DEBUG/PRINT text: LinuxCNC shows the loaded tool's entry
+        in the machine's tool table. The diameter ``#5410`` where the user's tools
+        (``tool_diameters_mm``) have the loaded tool, else a text that says what LinuxCNC
+        would show there, with a warning: ``#5403?`` said neither what nor why."""
+        if k == 5410 and self.tool in self.tool_diameters_mm:
+            return float(self.tool_diameters_mm[self.tool])
+        what = f"T{self.tool}'s {_TOOL_ENTRY[k]}"
+        shown = f"[{ref}: {what}, from the machine's tool table]"
+        give = (f"; give the tool (--tools TABLE, --tool {self.tool}=SPEC; read_gcode's "
+                "tool_diameters_mm) to see its diameter" if k == 5410 else "")
+        self.warn(f"({kind},...) shows {ref}, {what} in the machine's tool table, which woodcam "
+                  f"does not know: the message says '{shown}' where LinuxCNC shows the table's "
+                  f"value{give}")
+        return shown
 
     def _named_in_message(self, name: str, word: str):
         """The value of ``#<name>`` in a DEBUG/PRINT text: a number, ``None`` where LinuxCNC
