@@ -525,7 +525,7 @@ def test_a_background_name_pyvista_does_not_know_is_refused_before_drawing(tmp_p
     ([(np.zeros((2, 2, 3)), "red")], r"overlay\[0\] must be \(segments \(k, 2, 3\) mm, colour, width px\)"),
     ([(np.zeros((2, 3)), "red", 2.0)], r"overlay\[0\] segments must be a \(k, 2, 3\) array .*got shape \(2, 3\)"),
     ([(np.full((1, 2, 3), np.nan), "red", 2.0)], r"overlay\[0\] segments must be .*finite mm"),
-    ([(np.zeros((1, 2, 3)), "nope", 2.0)], r"overlay\[0\] colour must be a colour; got 'nope'"),
+    ([(np.zeros((1, 2, 3)), "nope", 2.0)], r"overlay\[0\] colour must be a colour name .*; got 'nope'"),
     ([(np.zeros((1, 2, 3)), "red", 0)], r"overlay\[0\] width must be a finite number > 0; got 0"),
     ([(np.zeros((1, 2, 3)), "red", "a")], r"overlay\[0\] width must be a finite number > 0; got 'a'"),
 ])

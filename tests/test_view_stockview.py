@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -111,7 +113,7 @@ def test_png_and_errors(tmp_path, bowl):
     with pytest.raises(WoodcamError, match="charts lacks"):
         stock_view(hm, (W, D, H), atlas, {"top": charts["top"]})
     for colour in ("mauve", (1000, 0, 0), ("a", "b", "c")):  # one rule with top_view's (overlay_rgb)
-        with pytest.raises(WoodcamError, match="stock_view: overlay colour must be one of .* in 0..255"
+        with pytest.raises(WoodcamError, match="stock_view: overlay colour must be a colour name .* in 0..255"
                                                ".* floats in 0..1"):
             stock_view(hm, (W, D, H), atlas, charts, window_size=WIN,
                        overlay=[(np.zeros((1, 2, 3)), colour, 1.0)])
@@ -164,6 +166,12 @@ def test_an_overlay_triple_is_one_colour_in_every_view(bowl, tmp_path, colour, r
     (woodcam.view.scene.overlay_rgb: whole numbers 0..255, floats 0..1) for all three: the
     stock view draws a line over the stock in exactly that RGB, the top view draws the same
     pixels as for that whole-number triple, and preview hands pyvista that RGB."""
+    _one_colour_in_every_view(bowl, tmp_path, colour, rgb)
+
+
+def _one_colour_in_every_view(bowl, tmp_path, colour, rgb):
+    """stock_view draws ``colour`` as exactly ``rgb`` over the stock, top_view draws the same
+    pixels as for the whole-number triple ``rgb``, and preview hands pyvista ``rgb``."""
     from woodcam.view.topview import top_view
 
     hm, atlas, charts = bowl
@@ -180,6 +188,56 @@ def test_an_overlay_triple_is_one_colour_in_every_view(bowl, tmp_path, colour, r
     assert tuple(top[1][40, 50]) != (150, 150, 150)  # the line is drawn there
     np.testing.assert_array_equal(top[0], top[1])
     assert _preview_overlay_colour(tmp_path, colour) == rgb
+
+
+@pytest.mark.parametrize("colour, rgb", [("orange", (255, 165, 0)), ("tab:blue", (31, 119, 180)),
+                                         ("xkcd:sky blue", (117, 187, 253)), ("#ff8000", (255, 128, 0)),
+                                         ("RoyalBlue", (65, 105, 225)), ("red", (255, 0, 0))])
+def test_a_colour_name_is_one_colour_in_every_view(bowl, tmp_path, colour, rgb):
+    """top_view and stock_view knew two names, "red" and "royalblue", and refused "orange",
+    "tab:blue" or "#ff8000", which preview drew by pyvista's table. One name table now,
+    matplotlib's (woodcam.view.scene.overlay_rgb), for all three views: the same RGB."""
+    _one_colour_in_every_view(bowl, tmp_path, colour, rgb)
+
+
+def test_the_cli_overlay_colours_are_the_name_tables():
+    """OVERLAY_COLORS resolves the CLI's two names without importing matplotlib: its values
+    are the table's."""
+    import matplotlib.colors
+
+    from woodcam.view.scene import OVERLAY_COLORS
+
+    for name, rgb in OVERLAY_COLORS.items():
+        assert tuple(round(255 * v) for v in matplotlib.colors.to_rgb(name)) == rgb
+
+
+@pytest.mark.parametrize("colour, fix", [("royal_blue", "did you mean 'royalblue'"),
+                                         ("banana", "did you mean 'xkcd:banana'"),
+                                         ("nope", r"give a CSS4 name, e.g. 'royalblue'"),
+                                         ("C0", "style cycle"), ("none", "opaque"),
+                                         ("#ff000080", "opaque"), ("", "give a CSS4 name")])
+def test_a_colour_name_not_in_the_table_is_refused_by_every_view(bowl, tmp_path, colour, fix):
+    """preview took pyvista's own names and spellings ('banana', 'royal_blue') and an alpha
+    ('#ff000080'), which the numpy views refused with the two names they knew. Every view
+    refuses a name outside matplotlib's table, the style cycle and a transparent colour alike,
+    naming itself, the argument, the value and a fix (the close matches)."""
+    pytest.importorskip("pyvista")
+    import trimesh
+
+    from woodcam.view import preview
+    from woodcam.view.topview import top_view
+
+    hm, atlas, charts = bowl
+    seg = np.zeros((1, 2, 3))
+    said = f"colour must be a colour name matplotlib knows .*; got {re.escape(repr(colour))}; .*{fix}"
+    with pytest.raises(WoodcamError, match=r"preview: overlay\[0\] " + said):
+        preview(trimesh.creation.box(), screenshot=tmp_path / "p.png", window_size=(64, 48),
+                overlay=[(seg, colour, 1.0)])
+    with pytest.raises(WoodcamError, match="top_view: overlay " + said):
+        top_view(hm, (W, D, H), atlas, window_size=(100, 80), overlay=[(seg, colour, 1.0)])
+    with pytest.raises(WoodcamError, match="stock_view: overlay " + said):
+        stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), overlay=[(seg, colour, 1.0)])
+    assert not (tmp_path / "p.png").exists()
 
 
 @pytest.mark.parametrize("colour", [(255.0, 0, 0), (1, 0, 0), (1000, 0, 0), (-0.5, 0.0, 0.0),
@@ -200,8 +258,8 @@ def test_an_overlay_triple_refused_is_refused_by_every_view(bowl, tmp_path, colo
     hm, atlas, charts = bowl
     seg = np.zeros((1, 2, 3))
     rule = r"RGB triple: whole numbers in 0\.\.255, .*floats in 0\.\.1.*; got "
-    with pytest.raises(WoodcamError, match=r"preview: overlay\[0\] colour must be a colour name pyvista "
-                                           r"knows or an " + rule):
+    with pytest.raises(WoodcamError, match=r"preview: overlay\[0\] colour must be a colour name matplotlib "
+                                           r"knows .* or an " + rule):
         preview(trimesh.creation.box(), screenshot=tmp_path / "p.png", window_size=(64, 48),
                 overlay=[(seg, colour, 1.0)])
     with pytest.raises(WoodcamError, match="top_view: overlay colour must be .*" + rule):

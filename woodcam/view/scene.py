@@ -77,35 +77,68 @@ UNTEXTURED_PART_COLOR = (0.78, 0.62, 0.42)
 WASTE_OPACITY = 0.3
 
 #: Overlay colours (RGB 0..255) by the names the CLI gives them (rapids red, feeds royalblue):
-#: VTK's own values of those names, so the numpy views (:mod:`woodcam.view.topview`,
-#: :mod:`woodcam.view.stockview`) draw the toolpath as this preview does.
+#: the name table's (matplotlib's, :func:`_named_rgb`) values, kept here so that `woodcam gcode`'s
+#: numpy screenshot draws them without importing matplotlib (tests pin them to the table).
 OVERLAY_COLORS = {"red": (255, 0, 0), "royalblue": (65, 105, 225)}
 
-#: The overlay colour rule of every view for a triple (pyvista's and matplotlib's), said in errors.
-OVERLAY_COLOUR_RULE = ("an RGB triple: whole numbers in 0..255, e.g. (65, 105, 225), or floats in "
-                       "0..1, e.g. (0.25, 0.41, 0.88) (a float anywhere in the triple makes it 0..1)")
+#: The colour rule of every view (pyvista's and matplotlib's), said in errors.
+OVERLAY_COLOUR_RULE = ("a colour name matplotlib knows ('royalblue', 'tab:blue', 'xkcd:sky blue'), a hex "
+                       "string ('#4169e1') or an RGB triple: whole numbers in 0..255, e.g. (65, 105, 225), "
+                       "or floats in 0..1, e.g. (0.25, 0.41, 0.88) (a float anywhere in the triple makes "
+                       "it 0..1)")
 
 
-def overlay_rgb(colour, who: str, name: str = "overlay colour", names: str | None = None) -> np.ndarray:
+def _named_rgb(colour: str, who: str, name: str) -> tuple[np.ndarray | None, str]:
+    """A colour name or hex string as RGB 0..255 ``(3,)`` float by the one name table,
+    matplotlib's (:func:`matplotlib.colors.to_rgba`: CSS4 names in any case, 'tab:' and 'xkcd:'
+    names, '#rgb' / '#rrggbb' hex, grey levels '0.5'), or None and the fix to say. pyvista's
+    own table gives the CSS4 names the same values; the numpy views knew only two names."""
+    import re
+
+    colors = require("matplotlib.colors", "view", f"{who}: the {name} {colour!r:.40}")
+    if re.fullmatch(r"\s*C\d+\s*", colour):  # not a table entry: the style's colour cycle
+        return None, ("'C0', 'C1', ... are the colours of matplotlib's style cycle, which the style "
+                      "in use decides; give the colour's name, e.g. 'tab:blue'")
+    try:
+        rgba = colors.to_rgba(colour)
+    except ValueError:
+        import difflib
+
+        table = [*colors.CSS4_COLORS, *colors.TABLEAU_COLORS, *colors.XKCD_COLORS]
+        close = difflib.get_close_matches("".join(colour.lower().replace("_", " ").split()), table, 3)
+        if not close:  # 'royal blue', 'Royal_Blue': pyvista's spellings of matplotlib's names
+            close = difflib.get_close_matches(colour.lower(), table, 3)
+        return None, (f"did you mean {' or '.join(map(repr, close))}?" if close else
+                      "give a CSS4 name, e.g. 'royalblue' (matplotlib.colors.CSS4_COLORS), or a triple")
+    if rgba[3] < 1:  # 'none', '#ff000080': the views draw colours opaque
+        return None, "the views draw colours opaque; give one without transparency, e.g. '#ff0000'"
+    return 255 * np.asarray(rgba[:3], float), ""
+
+
+def overlay_rgb(colour, who: str, name: str = "overlay colour") -> np.ndarray:
     """An overlay colour as RGB 0..255 ``(3,)`` float: the one rule of every view (``who``: the
-    function, ``name`` the argument and ``names`` the names the view takes, said in the error;
-    default those of :data:`OVERLAY_COLORS`), :data:`OVERLAY_COLOUR_RULE`:
+    function and ``name`` the argument, said in the error), :data:`OVERLAY_COLOUR_RULE`:
 
-    - a name of :data:`OVERLAY_COLORS` (:func:`preview` also takes any name or hex string pyvista
-      knows, and resolves it there: :func:`check_overlay`);
+    - a name or hex string of the one name table, matplotlib's (:func:`_named_rgb`), so a name
+      draws the same colour in :func:`preview` and the numpy views (top_view and stock_view knew
+      only "red" and "royalblue"; preview also took pyvista's own names and spellings, e.g.
+      'banana', 'royal_blue', now refused with the close matches);
     - three whole numbers (int, numpy integer) in 0..255, as given;
     - three numbers with a float among them, in 0..1, times 255: (1.0, 0.0, 0.0) is red.
 
     pyvista read a float triple in 0..1 and the numpy views in 0..255, so (1.0, 0, 0) was red in
     :func:`preview` and nearly black in top_view/stock_view. Refused (WoodcamError naming the
-    view, the argument, the rule, the value and a fix): a float above 1 ((255.0, 0, 0): no
-    guess at which scale was meant), whole numbers of 0 and 1 only with a 1 among them ((1, 0, 0)
-    is nearly black in 0..255 but reads as red in 0..1), out of range, not three numbers, a bool.
+    view, the argument, the rule, the value and a fix): a name not in the table (with close
+    matches), a float above 1 ((255.0, 0, 0): no guess at which scale was meant), whole numbers
+    of 0 and 1 only with a 1 among them ((1, 0, 0) is nearly black in 0..255 but reads as red in
+    0..1), out of range, not three numbers, a bool.
     """
     if isinstance(colour, str):
         if colour in OVERLAY_COLORS:
             return np.asarray(OVERLAY_COLORS[colour], float)
-        fix = f"give one of {sorted(OVERLAY_COLORS)} or a triple, e.g. (65, 105, 225)"
+        named, fix = _named_rgb(colour, who, name)
+        if named is not None:
+            return named
     else:
         values = list(colour) if isinstance(colour, (tuple, list, np.ndarray)) else []
         numbers = len(values) == 3 and all(isinstance(v, (int, float, np.integer, np.floating))
@@ -125,9 +158,7 @@ def overlay_rgb(colour, who: str, name: str = "overlay colour", names: str | Non
             elif not whole and rgb.max() <= 255:
                 fix = (f"a triple with a float is read in 0..1; for 0..255 give whole numbers, e.g. "
                        f"{tuple(int(round(v)) for v in rgb)}, or divide by 255")
-    names = f"one of {sorted(OVERLAY_COLORS)}" if names is None else names
-    raise WoodcamError(f"{who}: {name} must be {names} or {OVERLAY_COLOUR_RULE}; got {colour!r:.60}; "
-                       f"{fix}")
+    raise WoodcamError(f"{who}: {name} must be {OVERLAY_COLOUR_RULE}; got {colour!r:.60}; {fix}")
 
 
 #: Colour and width (pixels) of the part's outline drawn on the cut plane.
@@ -757,11 +788,11 @@ def build_scene(
     return callback
 
 
-def check_overlay(overlay, pv=None) -> list[tuple[np.ndarray, object, float]]:
+def check_overlay(overlay) -> list[tuple[np.ndarray, object, float]]:
     """``overlay`` of :func:`preview` checked before a window opens: a list of ``(segments (k, 2, 3)
     finite mm, colour, width px > 0)``; returned with the segments as float arrays and a triple
     colour as floats in 0..1 (read by :func:`overlay_rgb`, the numpy views' rule). A tuple of
-    two, segments of another shape or NaN, a colour pyvista does not know or a width of 0 or 'a'
+    two, segments of another shape or NaN, a colour name pyvista did not know or a width of 0 or 'a'
     were bare unpacking/reshape errors or VTK's, after the scene was built."""
     if overlay is None:
         return []
@@ -784,13 +815,11 @@ def check_overlay(overlay, pv=None) -> list[tuple[np.ndarray, object, float]]:
             got = f"shape {seg.shape}" if seg is not None and np.all(np.isfinite(seg)) else f"{segments!r:.60}"
             raise WoodcamError(f"overlay[{i}] segments must be a (k, 2, 3) array of finite mm (k line segments, "
                                f"start and end points in the block frame); got {got}")
-        if isinstance(colour, str):  # any name or hex string pyvista knows
-            colour = check_background(colour, pv, f"overlay[{i}] colour")
-        elif colour is not None:
-            # a triple by the numpy views' rule (overlay_rgb), handed to pyvista as floats in
-            # 0..1: pyvista took (1.0, 0, 0) as red where top_view drew it nearly black
-            colour = tuple(float(c) / 255 for c in overlay_rgb(colour, "preview", f"overlay[{i}] colour",
-                                                               "a colour name pyvista knows"))
+        if colour is not None:
+            # by the numpy views' rule and name table (overlay_rgb), handed to pyvista as floats
+            # in 0..1: pyvista took (1.0, 0, 0) as red where top_view drew it nearly black, and
+            # names of its own table the numpy views refused
+            colour = tuple(float(c) / 255 for c in overlay_rgb(colour, "preview", f"overlay[{i}] colour"))
         width = check_number(width, f"overlay[{i}] width", lo=0, lo_open=True, fix="line width in pixels, e.g. 2")
         out.append((seg.reshape(-1, 2, 3), colour, width))
     return out
@@ -828,9 +857,9 @@ def preview(
         ``cut_plane=False``) replace its fields.
     overlay : list of (segments (k, 2, 3) mm, colour, width px), optional
         Line segments drawn over the scene in the block frame (e.g. a toolpath: rapids and
-        feeds in two colours, :func:`woodcam.toolpath.gcode.Program` moves). ``colour``: a
-        name or hex string pyvista knows, or a triple by :func:`overlay_rgb`'s rule (whole
-        numbers in 0..255, floats in 0..1), the same colour as top_view and stock_view draw.
+        feeds in two colours, :func:`woodcam.toolpath.gcode.Program` moves). ``colour``: by
+        :func:`overlay_rgb`'s rule (a name or hex string of matplotlib's table, whole numbers
+        in 0..255, floats in 0..1), the same colour as top_view and stock_view draw.
 
     Returns
     -------
@@ -862,7 +891,7 @@ def preview(
     # Check the mesh and options before a window opens.
     opt = SceneOptions.merged(options, scene_options)
     check_background(opt.background, pv)  # a name pyvista does not know, before a window opens
-    overlay = check_overlay(overlay, pv)
+    overlay = check_overlay(overlay)
     _check_wood(wood)
     _check_size_with_wood(wood, None if size_mm is None else check_size(size_mm))
     mesh = _load_mesh(mesh_or_path)

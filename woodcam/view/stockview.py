@@ -170,9 +170,10 @@ def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, ch
         Colours the cut plane; without it the stock is drawn whole.
     camera : "iso" | "top" | "front" | "back" | "left" | "right" | "bottom"
     overlay : list of (segments (k, 2, 3) mm, colour, width px), optional
-        Block-frame segments (e.g. the toolpath), ``colour`` "red", "royalblue" or an RGB
-        triple (whole numbers in 0..255 or floats in 0..1, as :func:`woodcam.view.preview`
-        reads them: :func:`woodcam.view.scene.overlay_rgb`); widths in pixels of the
+        Block-frame segments (e.g. the toolpath), ``colour`` a name or hex string of
+        matplotlib's table (e.g. "royalblue") or an RGB triple (whole numbers in 0..255 or
+        floats in 0..1), as :func:`woodcam.view.preview` reads them
+        (:func:`woodcam.view.scene.overlay_rgb`); widths in pixels of the
         supersampled picture, as VTK's SSAA draws them (1 px there is half a pixel of the image).
     window_size : (width, height) px
     supersample : int

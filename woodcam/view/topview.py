@@ -17,7 +17,7 @@ from ..errors import WoodcamError
 #: Direction towards the light (block frame), upper left and above; and the ambient share.
 _LIGHT = np.array([-0.4, 0.4, 1.0]) / np.linalg.norm([-0.4, 0.4, 1.0])
 _AMBIENT = 0.35
-#: Overlay opacity (colours: :data:`woodcam.view.scene.OVERLAY_COLORS`, as the VTK overlay).
+#: Overlay opacity (colours: :func:`woodcam.view.scene.overlay_rgb`, as the VTK overlay).
 _OVERLAY_ALPHA = 0.55
 _OVERLAY_COVER = 0.08
 
@@ -34,9 +34,10 @@ def top_view(heightmap, size_mm, top_texels, *, overlay=None,
     top_texels : (th, tw, 3) uint8
         The atlas's top chart, row 0 at ``Y = D`` (the chart's own orientation).
     overlay : list of (segments (k, 2, 3) mm, colour, width px), optional
-        Block-frame segments drawn over the stock (``colour`` "red" or "royalblue", or an RGB
-        triple: whole numbers in 0..255 or floats in 0..1, :func:`woodcam.view.scene.overlay_rgb`),
-        as :func:`woodcam.view.preview` takes them and in the same colour.
+        Block-frame segments drawn over the stock (``colour`` a name or hex string of
+        matplotlib's table, e.g. "royalblue", or an RGB triple: whole numbers in 0..255 or floats
+        in 0..1, :func:`woodcam.view.scene.overlay_rgb`), as :func:`woodcam.view.preview` takes
+        them and in the same colour.
     window_size : (width, height) px
         The image size; the stock is fitted inside with ``margin_px``, the rest white.
     """
