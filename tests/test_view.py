@@ -506,12 +506,13 @@ def test_preview_rejects_bad_arguments(tmp_path, kwargs, match):
 def test_scene_background_is_a_colour_when_the_options_are_made(bad):
     """SceneOptions(background=) was not checked: None drew pyvista's default blue, a number, NaN
     or (0.5, 0.5) failed in VTK's renderer as pyvista's bare TypeError/ValueError."""
-    with pytest.raises(WoodcamError, match=r"background must be a colour; got .*; give a colour name \('white'\)"):
+    with pytest.raises(WoodcamError, match=r"preview: background must be a colour name matplotlib knows .* or an "
+                                           r"RGB triple: .*; got "):
         view.SceneOptions(background=bad)
 
 
 def test_a_background_name_pyvista_does_not_know_is_refused_before_drawing(tmp_path):
-    with pytest.raises(WoodcamError, match="background must be a colour; got 'nope'"):
+    with pytest.raises(WoodcamError, match="preview: background must be a colour name .*; got 'nope'"):
         preview(_textured_box(), screenshot=tmp_path / "p.png", window_size=SMALL, background="nope")
     assert not (tmp_path / "p.png").exists()
     ok = [view.SceneOptions(background=b).background for b in ("white", "#202020", [0.1, 0.2, 0.3],

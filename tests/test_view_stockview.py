@@ -112,7 +112,7 @@ def test_png_and_errors(tmp_path, bowl):
         stock_view(hm[0], (W, D, H), atlas, charts)
     with pytest.raises(WoodcamError, match="charts lacks"):
         stock_view(hm, (W, D, H), atlas, {"top": charts["top"]})
-    for colour in ("mauve", (1000, 0, 0), ("a", "b", "c")):  # one rule with top_view's (overlay_rgb)
+    for colour in ("mauve", (1000, 0, 0), ("a", "b", "c")):  # one rule with top_view's (colour_rgb)
         with pytest.raises(WoodcamError, match="stock_view: overlay colour must be a colour name .* in 0..255"
                                                ".* floats in 0..1"):
             stock_view(hm, (W, D, H), atlas, charts, window_size=WIN,
@@ -163,7 +163,7 @@ def test_an_overlay_triple_is_one_colour_in_every_view(bowl, tmp_path, colour, r
     """preview handed (1.0, 0.0, 0.0) to pyvista, which reads floats in 0..1: red; top_view and
     stock_view read the same triple in 0..255: nearly black (top_view blended (1, 0, 0) into
     its texture, a grey (68, 68, 68) where "red" is (208, 68, 68)). One rule now
-    (woodcam.view.scene.overlay_rgb: whole numbers 0..255, floats 0..1) for all three: the
+    (woodcam.view.scene.colour_rgb: whole numbers 0..255, floats 0..1) for all three: the
     stock view draws a line over the stock in exactly that RGB, the top view draws the same
     pixels as for that whole-number triple, and preview hands pyvista that RGB."""
     _one_colour_in_every_view(bowl, tmp_path, colour, rgb)
@@ -196,7 +196,7 @@ def _one_colour_in_every_view(bowl, tmp_path, colour, rgb):
 def test_a_colour_name_is_one_colour_in_every_view(bowl, tmp_path, colour, rgb):
     """top_view and stock_view knew two names, "red" and "royalblue", and refused "orange",
     "tab:blue" or "#ff8000", which preview drew by pyvista's table. One name table now,
-    matplotlib's (woodcam.view.scene.overlay_rgb), for all three views: the same RGB."""
+    matplotlib's (woodcam.view.scene.colour_rgb), for all three views: the same RGB."""
     _one_colour_in_every_view(bowl, tmp_path, colour, rgb)
 
 
@@ -266,6 +266,58 @@ def test_an_overlay_triple_refused_is_refused_by_every_view(bowl, tmp_path, colo
         top_view(hm, (W, D, H), atlas, window_size=(100, 80), overlay=[(seg, colour, 1.0)])
     with pytest.raises(WoodcamError, match="stock_view: overlay colour must be .*" + rule):
         stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), overlay=[(seg, colour, 1.0)])
+    assert not (tmp_path / "p.png").exists()
+
+
+@pytest.mark.parametrize("background, rgb", [((1.0, 0.5, 0.0), (255, 128, 0)), ((30, 60, 90), (30, 60, 90)),
+                                             ("white", (255, 255, 255)), ("tab:green", (44, 160, 44))])
+def test_a_background_is_one_colour_in_every_view(bowl, tmp_path, background, rgb):
+    """stock_view read its background in 0..255 whatever it was: (1.0, 0.5, 0.0) drew (1, 0, 0),
+    nearly black, and "white" was numpy's bare ValueError, where preview (pyvista) drew orange
+    and white. Both read a background by the overlays' one rule (colour_rgb) now: the corner
+    pixel is that RGB in stock_view and in preview's screenshot."""
+    pytest.importorskip("pyvista")
+    import trimesh
+    from PIL import Image
+
+    from woodcam.view import preview
+
+    hm, atlas, charts = bowl
+    img = stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), supersample=1,
+                     background=background)
+    assert tuple(img[0, 0]) == rgb
+    box = trimesh.creation.box(extents=(W, D, H))
+    box.apply_translation((W / 2, D / 2, H / 2))
+    png = preview(box, size_mm=(W, D, H), screenshot=tmp_path / "p.png", window_size=(64, 48),
+                  cut_plane=False, background=background)
+    with Image.open(png) as im:
+        corner = np.asarray(im.convert("RGB"))[0, 0].astype(int)
+    assert np.abs(corner - rgb).max() <= 1, corner
+
+
+@pytest.mark.parametrize("background, fix", [((1, 0, 0), "ambiguous"), ((255.0, 0.0, 0.0), "whole numbers"),
+                                             ((0.0, 0.0, 0.0, 1.0), "three numbers"),
+                                             ("nope", "give a CSS4 name"),
+                                             ("royal_blue", "did you mean 'royalblue'")])
+def test_a_background_refused_is_refused_by_every_view(bowl, tmp_path, background, fix):
+    """preview read a whole (1, 0, 0) background as pyvista does, in 0..255: nearly black, where
+    the same triple as an overlay colour is refused as ambiguous; stock_view drew (255.0, 0, 0)
+    red and (0, 0, 0, 1) was numpy's broadcast error. The one rule refuses them in both (and in
+    SceneOptions), naming the view, the argument, the value and a fix."""
+    pytest.importorskip("pyvista")
+    import trimesh
+
+    from woodcam.view import SceneOptions, preview
+
+    hm, atlas, charts = bowl
+    said = f"background must be a colour name matplotlib knows .*; got {re.escape(repr(background))}; .*{fix}"
+    with pytest.raises(WoodcamError, match="preview: " + said):
+        preview(trimesh.creation.box(), screenshot=tmp_path / "p.png", window_size=(64, 48),
+                background=background)
+    with pytest.raises(WoodcamError, match="preview: " + said):
+        SceneOptions(background=background)
+    with pytest.raises(WoodcamError, match="stock_view: " + said):
+        stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), background=background)
     assert not (tmp_path / "p.png").exists()
 
 

@@ -94,7 +94,7 @@ def test_an_overlay_colour_that_is_no_rgb_0_255_is_refused_by_both_numpy_views(c
     """top_view and stock_view each had their own copy of the overlay colour rule, which took
     any finite triple: top_view blended (1000, 0, 0) into a pixel its uint8 cast wrapped to
     (106, 68, 68), (-100, 0, 0) into a darker grey, and ('a', 'b', 'c') was numpy's bare
-    ValueError. One rule now (woodcam.view.scene.overlay_rgb) refuses them in both, naming
+    ValueError. One rule now (woodcam.view.scene.colour_rgb) refuses them in both, naming
     the view; the names and 0..255 triples draw the same pixels as before. A float triple is
     0..1 (pyvista's rule, as preview draws it): (255.0, 0, 0) and the ambiguous whole (1, 0, 0)
     are refused."""
@@ -105,15 +105,15 @@ def test_an_overlay_colour_that_is_no_rgb_0_255_is_refused_by_both_numpy_views(c
     with pytest.raises(WoodcamError, match="top_view: " + said):
         top_view(np.zeros((40, 50)), (50.0, 40.0, 10.0), tex, window_size=(100, 80), margin_px=0,
                  overlay=[(seg, colour, 1.0)])
-    from woodcam.view.scene import overlay_rgb
+    from woodcam.view.scene import colour_rgb
 
     with pytest.raises(WoodcamError, match="stock_view: " + said):
-        overlay_rgb(colour, "stock_view")
-    np.testing.assert_array_equal(overlay_rgb("royalblue", "top_view"), [65, 105, 225])
-    np.testing.assert_array_equal(overlay_rgb((0, 255, 7), "top_view"), [0, 255, 7])
-    np.testing.assert_array_equal(overlay_rgb(np.array([0, 255, 7], np.uint8), "top_view"), [0, 255, 7])
-    np.testing.assert_array_equal(overlay_rgb((0.0, 1.0, 0.5), "top_view"), [0, 255, 127.5])
-    np.testing.assert_array_equal(overlay_rgb((0, 1.0, 0), "top_view"), [0, 255, 0])  # a float: 0..1
+        colour_rgb(colour, "stock_view")
+    np.testing.assert_array_equal(colour_rgb("royalblue", "top_view"), [65, 105, 225])
+    np.testing.assert_array_equal(colour_rgb((0, 255, 7), "top_view"), [0, 255, 7])
+    np.testing.assert_array_equal(colour_rgb(np.array([0, 255, 7], np.uint8), "top_view"), [0, 255, 7])
+    np.testing.assert_array_equal(colour_rgb((0.0, 1.0, 0.5), "top_view"), [0, 255, 127.5])
+    np.testing.assert_array_equal(colour_rgb((0, 1.0, 0), "top_view"), [0, 255, 0])  # a float: 0..1
 
 
 def test_shading_and_overlay_on_cells_that_are_not_square_and_a_stock_off_centre():

@@ -81,11 +81,11 @@ WASTE_OPACITY = 0.3
 #: numpy screenshot draws them without importing matplotlib (tests pin them to the table).
 OVERLAY_COLORS = {"red": (255, 0, 0), "royalblue": (65, 105, 225)}
 
-#: The colour rule of every view (pyvista's and matplotlib's), said in errors.
-OVERLAY_COLOUR_RULE = ("a colour name matplotlib knows ('royalblue', 'tab:blue', 'xkcd:sky blue'), a hex "
-                       "string ('#4169e1') or an RGB triple: whole numbers in 0..255, e.g. (65, 105, 225), "
-                       "or floats in 0..1, e.g. (0.25, 0.41, 0.88) (a float anywhere in the triple makes "
-                       "it 0..1)")
+#: The colour rule of every view (pyvista's and matplotlib's), overlays and backgrounds alike,
+#: said in errors.
+COLOUR_RULE = ("a colour name matplotlib knows ('royalblue', 'tab:blue', 'xkcd:sky blue'), a hex string "
+               "('#4169e1') or an RGB triple: whole numbers in 0..255, e.g. (65, 105, 225), or floats in "
+               "0..1, e.g. (0.25, 0.41, 0.88) (a float anywhere in the triple makes it 0..1)")
 
 
 def _named_rgb(colour: str, who: str, name: str) -> tuple[np.ndarray | None, str]:
@@ -115,9 +115,10 @@ def _named_rgb(colour: str, who: str, name: str) -> tuple[np.ndarray | None, str
     return 255 * np.asarray(rgba[:3], float), ""
 
 
-def overlay_rgb(colour, who: str, name: str = "overlay colour") -> np.ndarray:
-    """An overlay colour as RGB 0..255 ``(3,)`` float: the one rule of every view (``who``: the
-    function and ``name`` the argument, said in the error), :data:`OVERLAY_COLOUR_RULE`:
+def colour_rgb(colour, who: str, name: str = "overlay colour") -> np.ndarray:
+    """A view's colour (an overlay's, a background's) as RGB 0..255 ``(3,)`` float: the one rule
+    of every view (``who``: the function and ``name`` the argument, said in the error),
+    :data:`COLOUR_RULE`:
 
     - a name or hex string of the one name table, matplotlib's (:func:`_named_rgb`), so a name
       draws the same colour in :func:`preview` and the numpy views (top_view and stock_view knew
@@ -158,7 +159,7 @@ def overlay_rgb(colour, who: str, name: str = "overlay colour") -> np.ndarray:
             elif not whole and rgb.max() <= 255:
                 fix = (f"a triple with a float is read in 0..1; for 0..255 give whole numbers, e.g. "
                        f"{tuple(int(round(v)) for v in rgb)}, or divide by 255")
-    raise WoodcamError(f"{who}: {name} must be {OVERLAY_COLOUR_RULE}; got {colour!r:.60}; {fix}")
+    raise WoodcamError(f"{who}: {name} must be {COLOUR_RULE}; got {colour!r:.60}; {fix}")
 
 
 #: Colour and width (pixels) of the part's outline drawn on the cut plane.
@@ -602,34 +603,24 @@ def _prefer_egl_off_screen() -> None:
         os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"
 
 
-_BACKGROUND_FIX = ("give a colour name ('white'), a hex string ('#202020'), (r, g, b) in 0..1 or whole "
-                   "numbers in 0..255")
-
-
-def check_background(value, pv=None, name: str = "background"):
-    """The scene's ``background`` checked at the door: a colour name or hex string, or 3-4
-    numbers (floats in [0, 1], or whole numbers in 0..255 as pyvista reads them); ``pv`` (the
-    pyvista module, when loaded) also resolves a name. Returns ``value`` (a sequence as a
-    tuple). None, a number, NaN, (0.5, 0.5) or 'nope' reached VTK's renderer as pyvista's bare
-    TypeError/ValueError, or (None) its default blue."""
+def check_background(value, who: str = "preview", name: str = "background"):
+    """The scene's ``background`` checked at the door by the views' one colour rule
+    (:func:`colour_rgb`), as stock_view's: returned as given (a sequence as a tuple; pyvista is
+    handed :func:`_pyvista_rgb`'s floats). It had a rule of its own, pyvista's read of the
+    value: whole (1, 0, 0) drew nearly black where the same triple is refused as an overlay
+    colour, and a name went to pyvista's table. None, a number, NaN, (0.5, 0.5) or 'nope'
+    reached VTK's renderer as pyvista's bare TypeError/ValueError, or (None) its default blue."""
+    colour_rgb(value, who, name)
     if isinstance(value, str):
-        ok = bool(value.strip())
-    else:
-        v = None if isinstance(value, (bool, np.bool_)) else as_floats(value)
-        ok = (v is not None and v.shape in ((3,), (4,)) and bool(np.all(np.isfinite(v)))
-              and not any(isinstance(x, (bool, np.bool_)) for x in value))
-        if ok:
-            whole = all(isinstance(x, (int, np.integer)) for x in value)
-            ok = bool(np.all((v >= 0) & (v <= (255 if whole else 1))))
-            value = tuple(int(x) if whole else float(x) for x in value)
-    if ok and pv is not None:
-        try:
-            pv.Color(value)
-        except (TypeError, ValueError):
-            ok = False
-    if not ok:
-        raise WoodcamError(f"{name} must be a colour; got {value!r:.60}; {_BACKGROUND_FIX}")
-    return value
+        return value
+    return tuple(int(x) if isinstance(x, (int, np.integer)) else float(x) for x in value)
+
+
+def _pyvista_rgb(colour, who: str, name: str) -> tuple[float, float, float]:
+    """``colour`` by :func:`colour_rgb` as the floats in 0..1 handed to pyvista: a view's colour
+    is read by the one rule, never by pyvista's own."""
+    r, g, b = (float(c) / 255 for c in colour_rgb(colour, who, name))
+    return r, g, b
 
 
 @dataclass(frozen=True)
@@ -645,7 +636,9 @@ class SceneOptions:
     camera : "iso" | "top" | "front" | "back" | "left" | "right" | "bottom"
         View direction; "iso" looks from front-right-above.
     background : colour
-        Any colour pyvista accepts ("white", "#202020", (r, g, b) in 0..1).
+        By the views' one colour rule (:func:`colour_rgb`: a name or hex string of matplotlib's
+        table, "white", "#202020", whole numbers in 0..255 or floats in 0..1), as
+        :func:`woodcam.view.stockview.stock_view`'s.
     cut_origin, cut_normal : (3,) float mm / direction, optional
         The initial cut plane; default the block centre and the block's longest axis facing
         the camera, signed toward it (the part's half on the camera side is cut away, so the
@@ -737,7 +730,6 @@ def build_scene(
         The cut-plane callback when a cut is shown, else None.
     """
     opt = SceneOptions.merged(options, scene_options)
-    check_background(opt.background, _pyvista())  # a name pyvista does not know, before any drawing
     _check_wood(wood)
     camera, cut_origin, cut_normal = opt.camera, opt.cut_origin, opt.cut_normal
     size = None if size_mm is None else check_size(size_mm)
@@ -764,7 +756,7 @@ def build_scene(
                           f"{say_length(b[:, 1], '.4g')} along X, Y, Z), so nothing is cut; "
                           "give --cut-origin (cut_origin) a point inside the block", WoodcamWarning,
                           stacklevel=3)
-    plotter.set_background(opt.background)
+    plotter.set_background(_pyvista_rgb(opt.background, "build_scene", "background"))
     if size is not None:
         _add_block(plotter, size)
     callback = None
@@ -791,7 +783,7 @@ def build_scene(
 def check_overlay(overlay) -> list[tuple[np.ndarray, object, float]]:
     """``overlay`` of :func:`preview` checked before a window opens: a list of ``(segments (k, 2, 3)
     finite mm, colour, width px > 0)``; returned with the segments as float arrays and a triple
-    colour as floats in 0..1 (read by :func:`overlay_rgb`, the numpy views' rule). A tuple of
+    colour as floats in 0..1 (read by :func:`colour_rgb`, the numpy views' rule). A tuple of
     two, segments of another shape or NaN, a colour name pyvista did not know or a width of 0 or 'a'
     were bare unpacking/reshape errors or VTK's, after the scene was built."""
     if overlay is None:
@@ -816,10 +808,10 @@ def check_overlay(overlay) -> list[tuple[np.ndarray, object, float]]:
             raise WoodcamError(f"overlay[{i}] segments must be a (k, 2, 3) array of finite mm (k line segments, "
                                f"start and end points in the block frame); got {got}")
         if colour is not None:
-            # by the numpy views' rule and name table (overlay_rgb), handed to pyvista as floats
+            # by the numpy views' rule and name table (colour_rgb), handed to pyvista as floats
             # in 0..1: pyvista took (1.0, 0, 0) as red where top_view drew it nearly black, and
             # names of its own table the numpy views refused
-            colour = tuple(float(c) / 255 for c in overlay_rgb(colour, "preview", f"overlay[{i}] colour"))
+            colour = _pyvista_rgb(colour, "preview", f"overlay[{i}] colour")
         width = check_number(width, f"overlay[{i}] width", lo=0, lo_open=True, fix="line width in pixels, e.g. 2")
         out.append((seg.reshape(-1, 2, 3), colour, width))
     return out
@@ -858,7 +850,7 @@ def preview(
     overlay : list of (segments (k, 2, 3) mm, colour, width px), optional
         Line segments drawn over the scene in the block frame (e.g. a toolpath: rapids and
         feeds in two colours, :func:`woodcam.toolpath.gcode.Program` moves). ``colour``: by
-        :func:`overlay_rgb`'s rule (a name or hex string of matplotlib's table, whole numbers
+        :func:`colour_rgb`'s rule (a name or hex string of matplotlib's table, whole numbers
         in 0..255, floats in 0..1), the same colour as top_view and stock_view draw.
 
     Returns
@@ -890,7 +882,6 @@ def preview(
         )
     # Check the mesh and options before a window opens.
     opt = SceneOptions.merged(options, scene_options)
-    check_background(opt.background, pv)  # a name pyvista does not know, before a window opens
     overlay = check_overlay(overlay)
     _check_wood(wood)
     _check_size_with_wood(wood, None if size_mm is None else check_size(size_mm))

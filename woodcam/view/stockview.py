@@ -153,7 +153,7 @@ def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, ch
                wood: WoodLike | None = None, camera: Camera = "iso",
                overlay: list[tuple] | None = None, window_size: tuple[int, int] = (1280, 960),
                supersample: int = 2,
-               background: tuple[float, float, float] = (255, 255, 255)) -> np.ndarray:
+               background: object = (255, 255, 255)) -> np.ndarray:
     """The stock seen from ``camera``: an ``(h, w, 3) uint8`` image (module docstring).
 
     Parameters
@@ -173,17 +173,19 @@ def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, ch
         Block-frame segments (e.g. the toolpath), ``colour`` a name or hex string of
         matplotlib's table (e.g. "royalblue") or an RGB triple (whole numbers in 0..255 or
         floats in 0..1), as :func:`woodcam.view.preview` reads them
-        (:func:`woodcam.view.scene.overlay_rgb`); widths in pixels of the
+        (:func:`woodcam.view.scene.colour_rgb`); widths in pixels of the
         supersampled picture, as VTK's SSAA draws them (1 px there is half a pixel of the image).
     window_size : (width, height) px
     supersample : int
         Render at this many times the size and average down (1 = no anti-aliasing).
-    background : (3,) float
-        RGB 0..255 where no stock, block or section is seen.
+    background : colour
+        Where no stock, block or section is seen; by the views' one colour rule
+        (:func:`woodcam.view.scene.colour_rgb`, as preview's background): a name or hex string
+        of matplotlib's table, whole numbers in 0..255 or floats in 0..1; default white.
     """
     from . import _zbuffer as zb
     from .scene import (BLOCK_COLOR, BLOCK_EDGE_COLOR, BLOCK_OPACITY, OUTLINE_COLOR, WASTE_OPACITY,
-                        overlay_rgb)
+                        colour_rgb)
 
     hm = np.ascontiguousarray(heightmap, dtype=np.float64)
     size = check_size(size_mm)
@@ -207,6 +209,9 @@ def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, ch
                            f"{window_size!r}; e.g. (1280, 960)")
     if not (isinstance(supersample, (int, np.integer)) and 1 <= supersample <= 4):
         raise WoodcamError(f"supersample must be an integer 1..4; got {supersample!r}; e.g. 2")
+    # read as 0..255 whatever it was: (1.0, 1.0, 1.0) drew nearly black, "white" was numpy's
+    # bare ValueError, where preview drew both white
+    bg = colour_rgb(background, "stock_view", "background")
     window = (int(ws[0]), int(ws[1]))
     s = int(supersample)
     w, h = window[0] * s, window[1] * s
@@ -228,7 +233,7 @@ def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, ch
     out = np.empty((w * h, 3), np.float32)
     block = np.array([*(255 * np.asarray(BLOCK_COLOR)), BLOCK_OPACITY])
     zb.shade(depth, pos, sid, w, h, cam, hm, size, tex, rect, _lights(cam), _MATERIAL, section,
-             axis, at, span, block, WASTE_OPACITY, np.asarray(background, float), out)
+             axis, at, span, block, WASTE_OPACITY, bg, out)
     del pos, sid
     bits = (np.arange(8)[:, None] >> np.arange(3)[None, :]) & 1
     corners = bits * size
@@ -238,7 +243,7 @@ def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, ch
     if outline is not None and len(outline):
         lines.append((outline, 255 * np.asarray(OUTLINE_COLOR), 3, _EDGE_BIAS_MM))
     for segments, colour, width in overlay or ():
-        lines.append((np.asarray(segments, float).reshape(-1, 2, 3), overlay_rgb(colour, "stock_view"),
+        lines.append((np.asarray(segments, float).reshape(-1, 2, 3), colour_rgb(colour, "stock_view"),
                       max(1, int(round(float(width)))), _LINE_BIAS_MM))
     for seg, rgb, width, bias in lines:
         if len(seg):

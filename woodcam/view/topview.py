@@ -17,7 +17,7 @@ from ..errors import WoodcamError
 #: Direction towards the light (block frame), upper left and above; and the ambient share.
 _LIGHT = np.array([-0.4, 0.4, 1.0]) / np.linalg.norm([-0.4, 0.4, 1.0])
 _AMBIENT = 0.35
-#: Overlay opacity (colours: :func:`woodcam.view.scene.overlay_rgb`, as the VTK overlay).
+#: Overlay opacity (colours: :func:`woodcam.view.scene.colour_rgb`, as the VTK overlay).
 _OVERLAY_ALPHA = 0.55
 _OVERLAY_COVER = 0.08
 
@@ -36,7 +36,7 @@ def top_view(heightmap, size_mm, top_texels, *, overlay=None,
     overlay : list of (segments (k, 2, 3) mm, colour, width px), optional
         Block-frame segments drawn over the stock (``colour`` a name or hex string of
         matplotlib's table, e.g. "royalblue", or an RGB triple: whole numbers in 0..255 or floats
-        in 0..1, :func:`woodcam.view.scene.overlay_rgb`), as :func:`woodcam.view.preview` takes
+        in 0..1, :func:`woodcam.view.scene.colour_rgb`), as :func:`woodcam.view.preview` takes
         them and in the same colour.
     window_size : (width, height) px
         The image size; the stock is fitted inside with ``margin_px``, the rest white.
@@ -78,9 +78,9 @@ def top_view(heightmap, size_mm, top_texels, *, overlay=None,
 
 def _draw_segments(img, seg, colour, width, scale, D, ox, oy) -> None:
     """Blend XY segments (mm) into ``img`` as dots every half pixel, ``width`` px wide."""
-    from .scene import overlay_rgb
+    from .scene import colour_rgb
 
-    rgb = overlay_rgb(colour, "top_view").astype(np.float32)  # checked even with no segments
+    rgb = colour_rgb(colour, "top_view").astype(np.float32)  # checked even with no segments
     if not len(seg):
         return
     p0 = np.column_stack([ox + seg[:, 0, 0] * scale, oy + (D - seg[:, 0, 1]) * scale])
