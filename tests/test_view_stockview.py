@@ -269,6 +269,35 @@ def test_an_overlay_triple_refused_is_refused_by_every_view(bowl, tmp_path, colo
     assert not (tmp_path / "p.png").exists()
 
 
+def test_a_colour_of_none_is_refused_by_every_view(bowl, tmp_path):
+    """colour=None meant two things: preview handed it to pyvista, which drew its theme's colour
+    (light blue (173, 216, 230) by default, changed by any pyvista.global_theme.color), while
+    top_view and stock_view refused it, as every view refuses a background of None. One
+    meaning now: None is no colour, refused by every view for an overlay and a background."""
+    pytest.importorskip("pyvista")
+    import trimesh
+
+    from woodcam.view import preview
+    from woodcam.view.topview import top_view
+
+    hm, atlas, charts = bowl
+    seg = np.zeros((1, 2, 3))
+    said = r"colour must be a colour name matplotlib knows .*; got None; None is no colour .*'royalblue'"
+    with pytest.raises(WoodcamError, match=r"preview: overlay\[0\] " + said):
+        preview(trimesh.creation.box(), screenshot=tmp_path / "p.png", window_size=(64, 48),
+                overlay=[(seg, None, 1.0)])
+    with pytest.raises(WoodcamError, match="top_view: overlay " + said):
+        top_view(hm, (W, D, H), atlas, window_size=(100, 80), overlay=[(seg, None, 1.0)])
+    with pytest.raises(WoodcamError, match="stock_view: overlay " + said):
+        stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), overlay=[(seg, None, 1.0)])
+    for view_of in (lambda: preview(trimesh.creation.box(), screenshot=tmp_path / "p.png", window_size=(64, 48),
+                                    background=None),
+                    lambda: stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), background=None)):
+        with pytest.raises(WoodcamError, match="background must be .*; got None; None is no colour"):
+            view_of()
+    assert not (tmp_path / "p.png").exists()
+
+
 @pytest.mark.parametrize("background, rgb", [((1.0, 0.5, 0.0), (255, 128, 0)), ((30, 60, 90), (30, 60, 90)),
                                              ("white", (255, 255, 255)), ("tab:green", (44, 160, 44))])
 def test_a_background_is_one_colour_in_every_view(bowl, tmp_path, background, rgb):

@@ -129,12 +129,16 @@ def colour_rgb(colour, who: str, name: str = "overlay colour") -> np.ndarray:
 
     pyvista read a float triple in 0..1 and the numpy views in 0..255, so (1.0, 0, 0) was red in
     :func:`preview` and nearly black in top_view/stock_view. Refused (WoodcamError naming the
-    view, the argument, the rule, the value and a fix): a name not in the table (with close
-    matches), a float above 1 ((255.0, 0, 0): no guess at which scale was meant), whole numbers
+    view, the argument, the rule, the value and a fix): None (no colour, in every view: there is
+    no default colour; preview drew pyvista's theme colour, light blue by default, where the
+    numpy views refused it), a name not in the table (with close matches), a float above 1 ((255.0, 0, 0): no guess at which scale was meant), whole numbers
     of 0 and 1 only with a 1 among them ((1, 0, 0) is nearly black in 0..255 but reads as red in
     0..1), out of range, not three numbers, a bool.
     """
-    if isinstance(colour, str):
+    if colour is None:
+        fix = ("None is no colour (there is no default: a view would have to guess one); give one, "
+               "e.g. 'royalblue' or (65, 105, 225)")
+    elif isinstance(colour, str):
         if colour in OVERLAY_COLORS:
             return np.asarray(OVERLAY_COLORS[colour], float)
         named, fix = _named_rgb(colour, who, name)
@@ -807,11 +811,10 @@ def check_overlay(overlay) -> list[tuple[np.ndarray, object, float]]:
             got = f"shape {seg.shape}" if seg is not None and np.all(np.isfinite(seg)) else f"{segments!r:.60}"
             raise WoodcamError(f"overlay[{i}] segments must be a (k, 2, 3) array of finite mm (k line segments, "
                                f"start and end points in the block frame); got {got}")
-        if colour is not None:
-            # by the numpy views' rule and name table (colour_rgb), handed to pyvista as floats
-            # in 0..1: pyvista took (1.0, 0, 0) as red where top_view drew it nearly black, and
-            # names of its own table the numpy views refused
-            colour = _pyvista_rgb(colour, "preview", f"overlay[{i}] colour")
+        # by the numpy views' rule and name table (colour_rgb), handed to pyvista as floats in
+        # 0..1: pyvista took (1.0, 0, 0) as red where top_view drew it nearly black, names of
+        # its own table the numpy views refused, and None as its theme's colour
+        colour = _pyvista_rgb(colour, "preview", f"overlay[{i}] colour")
         width = check_number(width, f"overlay[{i}] width", lo=0, lo_open=True, fix="line width in pixels, e.g. 2")
         out.append((seg.reshape(-1, 2, 3), colour, width))
     return out
@@ -851,7 +854,8 @@ def preview(
         Line segments drawn over the scene in the block frame (e.g. a toolpath: rapids and
         feeds in two colours, :func:`woodcam.toolpath.gcode.Program` moves). ``colour``: by
         :func:`colour_rgb`'s rule (a name or hex string of matplotlib's table, whole numbers
-        in 0..255, floats in 0..1), the same colour as top_view and stock_view draw.
+        in 0..255, floats in 0..1; None refused, as there), the same colour as top_view and
+        stock_view draw.
 
     Returns
     -------
