@@ -56,17 +56,18 @@ def test_bake_and_preview_from_the_command_line(tmp_path, capsys):
     assert "wrote" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["bake", "missing.py", "--block", "builtin:flat-sawn", "--out", "x.glb"], "missing.py"),
+@pytest.mark.parametrize("argv, message, code", [
+    # a part or block folder that is not there is a wrong command line (exit 2, was 1)
+    (["bake", "missing.py", "--block", "builtin:flat-sawn", "--out", "x.glb"], "missing.py", 2),
     (["bake", "cad_examples/tray.py", "--block", "builtin:oak-burl", "--out", "x.glb"],
-     "unknown built-in block 'oak-burl'"),
+     "unknown built-in block 'oak-burl'", 1),
     (["bake", "cad_examples/tray.py", "--block", "nowhere/", "--out", "x.glb"],
-     "neither 'builtin:NAME'"),
+     "(block spec 'nowhere/'): 'nowhere' does not exist; it must be an existing FOLDER (a block spec is", 2),
 ])
-def test_errors_are_one_clean_line(argv, message, tmp_path):
+def test_errors_are_one_clean_line(argv, message, code, tmp_path):
     res = subprocess.run([sys.executable, "-m", "woodcam.cli", *argv], cwd=REPO,
                          capture_output=True, text=True)
-    assert res.returncode == 1  # a runtime error; 2 is for usage errors
+    assert res.returncode == code
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("woodcam: error:") and message in lines[0]
     assert "Traceback" not in res.stderr
@@ -336,11 +337,15 @@ def test_bake_refuses_a_missing_or_unreadable_part_before_the_block_is_opened(tm
     opened = []
     monkeypatch.setattr(woodcam.stock, "open_stock", lambda *a, **k: opened.append(a))
     (tmp_path / "part.dwg").write_text("x")
-    for part, said in ((tmp_path / "nope.stl", "does not exist or is not a file; check the path"),
-                       (tmp_path / "part.dwg", "has unsupported suffix '.dwg'; use one of")):
-        assert main(["bake", str(part), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "b.glb")]) == 1
+    # a missing part is a wrong command line, refused at the input door (exit 2); a part of a
+    # suffix no reader takes is the work failing (exit 1)
+    for part, said, code in ((tmp_path / "nope.stl", f"PART of 'woodcam bake': {str(tmp_path / 'nope.stl')!r} "
+                              "does not exist", 2),
+                             (tmp_path / "part.dwg", f"part file {str(tmp_path / 'part.dwg')!r} has unsupported "
+                              "suffix '.dwg'; use one of", 1)):
+        assert main(["bake", str(part), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "b.glb")]) == code
         err = capsys.readouterr().err
-        assert err.count("\n") == 1 and f"part file {str(part)!r} " in err and said in err, err
+        assert err.count("\n") == 1 and said in err, err
     assert opened == []
 
 

@@ -71,8 +71,8 @@ def test_a_folder_of_face_photos_is_told_to_become_a_block(tmp_path, capsys):
 
 
 def test_show_of_a_missing_folder_says_what_it_wants(tmp_path, capsys):
-    assert main(["block", "show", str(tmp_path / "nope"), "--out", str(tmp_path / "x.png")]) == 1
-    assert "block folder (with block.json) or a Mokume sample folder" in capsys.readouterr().err
+    assert main(["block", "show", str(tmp_path / "nope"), "--out", str(tmp_path / "x.png")]) == 2  # the input door's
+    assert "a block folder with block.json or a Mokume sample folder" in capsys.readouterr().err
 
 
 def test_block_synth_noise_options(tmp_path):

@@ -205,18 +205,22 @@ def test_previews_name_less_screenshot_beside_mesh_is_checked_before_work(tmp_pa
 
 
 @pytest.mark.parametrize("argv, beside", [
-    (["gcode", "x.nc", "--block", "builtin:flat-sawn", "--tool", "flat:6", "--part", "p.stl", "--out",
-      "OUT/g.glb"], "g_deviation.png"),
-    (["place", "p.py", "--block", "builtin:flat-sawn", "--out", "OUT"], "placements.json"),
-    (["bake", "x.py", "--block", "builtin:flat-sawn", "--out", "OUT/b.glb"], "b.mtl"),
+    (["gcode", "REPO/toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--tool", "flat:6", "--part",
+      "REPO/cad_examples/bowl.py", "--out", "OUT/g.glb"], "g_deviation.png"),
+    (["place", "REPO/cad_examples/bowl.py", "--block", "builtin:flat-sawn", "--out", "OUT"], "placements.json"),
+    (["bake", "REPO/cad_examples/bowl.py", "--block", "builtin:flat-sawn", "--out", "OUT/b.glb"], "b.mtl"),
 ])
 def test_a_file_written_beside_out_that_cannot_be_written_is_a_usage_error(argv, beside, tmp_path, capsys):
     """The files a command writes beside its --out (gcode's deviation PNG, place's
     placements.json, bake's OBJ set) are checked before any work; one that is a folder exited 1
-    where --out itself exited 2 for the same fix (another --out)."""
+    where --out itself exited 2 for the same fix (another --out). The inputs exist: a missing
+    one is refused before (the input door, tests/test_cli_inputs.py)."""
+    from pathlib import Path
+
+    repo = str(Path(__file__).resolve().parents[1])
     (tmp_path / beside).mkdir()
     capsys.readouterr()
-    assert main([a.replace("OUT", str(tmp_path)) for a in argv]) == EXIT_USAGE
+    assert main([a.replace("OUT", str(tmp_path)).replace("REPO", repo) for a in argv]) == EXIT_USAGE
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("woodcam: error: --out") and "is an existing folder" in err[0], err
     assert sorted(p.name for p in tmp_path.iterdir()) == [beside]  # nothing was done

@@ -108,8 +108,8 @@ def test_preview_names_its_own_arguments_and_ignores_nothing_silently(tmp_path, 
     monkeypatch.setattr(view, "preview", lambda mesh, **kw: got.append(kw))
     monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block, **kw: None)
     monkeypatch.setattr("woodcam.cli.options.recorded_block_size", lambda mesh: None)
-    assert cli.main(["preview", str(tmp_path / "nope.glb"), "--screenshot"]) == 1
-    assert f"preview: no file at {str(tmp_path / 'nope.glb')!r}" in capsys.readouterr().err
+    assert cli.main(["preview", str(tmp_path / "nope.glb"), "--screenshot"]) == 2  # the input door's
+    assert f"MESH of 'woodcam preview': {str(tmp_path / 'nope.glb')!r} does not exist" in capsys.readouterr().err
     with pytest.raises(SystemExit) as exc:
         cli.main(["preview", "x.glb", "--cut-normal", "0,0,0"])
     assert exc.value.code == 2

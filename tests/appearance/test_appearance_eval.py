@@ -140,8 +140,9 @@ def test_cli_parser_wires_run(capsys, tmp_path):
     a = build_parser().parse_args(["eval", "appearance", "builtin:rift", "--out", "x", "--quality",
                                    "draft", "--epochs", "2"])
     assert a.func is appearance.run and a.epochs == 2 and a.quality == "draft"
-    assert main(["eval-appearance", "/nonexistent/folder", "--out", str(tmp_path)]) == 1  # old name
-    assert "is neither 'builtin:NAME'" in capsys.readouterr().err
+    # old name; a block folder that is not there: a wrong command line, the input door's (exit 2)
+    assert main(["eval-appearance", "/nonexistent/folder", "--out", str(tmp_path)]) == 2
+    assert "BLOCK of 'woodcam eval appearance' (block spec '/nonexistent/folder')" in capsys.readouterr().err
 
 
 def test_a_grid_too_coarse_to_learn_from_names_resolution(capsys, tmp_path):

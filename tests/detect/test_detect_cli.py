@@ -765,18 +765,21 @@ def test_an_edited_knot_mask_or_ring_map_wins_over_a_rerun_as_a_corrected_svg_do
 def test_a_missing_or_file_input_is_one_line_that_says_which(synth_photos, tmp_path, capsys):
     """A photo given where the block folder goes ('rings detect front.png', 'rings show
     front.png') was said not to exist, though it is right there; a missing folder is still said
-    missing. Each is one line and the work-failed exit of every command's missing input (bake,
-    preview, gcode, fit, block show exit 1 too)."""
+    missing. Each is one line and, as every command's missing input or one of the wrong kind, a
+    wrong command line (exit 2; it was 1, the work failing)."""
     photo = synth_photos / "front.png"
     missing = tmp_path / "nope"
+    is_file = f"{str(photo)!r} is a file; it must be an existing FOLDER; did you mean its folder {str(synth_photos)!r}?"
     for argv, says in (
-            (("rings", "detect", photo, "--out", tmp_path / "o"), f"block folder {str(photo)!r} is a file, not a folder"),
-            (("rings", "show", photo, "--out", tmp_path / "o.png"), f"{str(photo)!r} is a file, not a folder"),
-            (("rings", "detect", missing, "--out", tmp_path / "o"), f"block folder {str(missing)!r} does not exist"),
+            (("rings", "detect", photo, "--out", tmp_path / "o"), f"BLOCK of 'woodcam rings detect': {is_file}"),
+            (("rings", "show", photo, "--out", tmp_path / "o.png"), f"BLOCK of 'woodcam rings show': {is_file}"),
+            (("rings", "detect", missing, "--out", tmp_path / "o"), f"{str(missing)!r} does not exist; it must be an "
+             "existing FOLDER"),
             (("rings", "show", missing, "--out", tmp_path / "o.png"), f"{str(missing)!r} does not exist"),
-            (("block", "from-photos", missing, "--size-mm", "50", "--out", tmp_path / "o"), f"{str(missing)!r} is not a folder")):
+            (("block", "from-photos", missing, "--size-mm", "50", "--out", tmp_path / "o"),
+             f"PHOTOS_DIR of 'woodcam block from-photos': {str(missing)!r} does not exist")):
         rc, _out, err = _run(capsys, *argv)
-        assert rc == EXIT_ERROR and err.count("\n") == 1 and says in err, (argv, err)
+        assert rc == EXIT_USAGE and err.count("\n") == 1 and says in err, (argv, err)
     assert not (tmp_path / "o").exists() and not (tmp_path / "o.png").exists()
 
 

@@ -65,16 +65,17 @@ def test_cli_run_writes_everything(scans, capsys):
     assert [p["anchor_px"] for p in again["patches"]] == [p["anchor_px"] for p in result["patches"]]
 
 
-@pytest.mark.parametrize("args, message", [
-    (["{d}/nope.png", "--veneer", "{d}/light.png"], "target image: no such file '{d}/nope.png'; check the path"),
-    (["{d}/coffee.png", "--veneer", "{d}/light.png:300:{d}/coffee.png"], "mask must have the image's size"),
-    (["{d}/coffee.png", "--veneer", "{d}/light.png:2000"], "smaller than one patch"),
-    (["{d}/coffee.png"], "parquetry needs veneers"),
-    (["{d}/coffee.png", "--veneer", "{d}/light.png:abc"], "resolution must be DPI"),
+@pytest.mark.parametrize("args, message, code", [
+    # a missing target is a wrong command line, refused at the input door (exit 2; it was 1)
+    (["{d}/nope.png", "--veneer", "{d}/light.png"], "TARGET of 'woodcam parquetry': '{d}/nope.png' does not exist", 2),
+    (["{d}/coffee.png", "--veneer", "{d}/light.png:300:{d}/coffee.png"], "mask must have the image's size", 1),
+    (["{d}/coffee.png", "--veneer", "{d}/light.png:2000"], "smaller than one patch", 1),
+    (["{d}/coffee.png"], "parquetry needs veneers", 1),
+    (["{d}/coffee.png", "--veneer", "{d}/light.png:abc"], "resolution must be DPI", 1),
 ])
-def test_cli_bad_input_is_one_line(scans, capsys, args, message):
+def test_cli_bad_input_is_one_line(scans, capsys, args, message, code):
     argv = ["parquetry"] + [a.format(d=scans) for a in args] + ["--out", str(scans / "o"), "--quiet"]
-    assert main(argv) == 1
+    assert main(argv) == code
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and err.startswith("woodcam: error:") and message.format(d=scans) in err
 

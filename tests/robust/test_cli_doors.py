@@ -15,7 +15,9 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
 
 # each case with the exit status it gives: 2 (EXIT_USAGE) for a wrong command line (the --out
 # rule, a number out of range, a malformed value quoted: "--tool 'flat:abc': ...", options that
-# contradict each other), 1 (EXIT_ERROR) for failed work (a file that is not there)
+# contradict each other, an input file that is not there), 1 (EXIT_ERROR) for failed work. The
+# inputs named exist where a case is about another option: a missing one is refused first
+# (woodcam.cli.options.check_inputs, tests/test_cli_inputs.py)
 @pytest.mark.parametrize("argv, code, match", [
     (["gcode", "toolpaths/vcarve_text.nc", "--tool", "vbit:60:12", "--block", "builtin:flat-sawn",
       "--out", "OUT/x.glb", "--resolution", "1e-9"], EXIT_USAGE, r"--cell-size must be in \[0.005, 10\]"),
@@ -41,38 +43,38 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     ([*GCODE, "--tool", "flat:6", "--start=1e300,0,0"], EXIT_USAGE, r"--start must be in \[-100000, 100000\]; got 1e\+300"),
     ([*GCODE, "--tool", "flat:6", "--rapid-rate", "1e-320"], EXIT_USAGE, r"--rapid-rate must be in \[0.1, 1e\+06\]"),
     # tracebacks (an allocation, OpenCV's assertion) or a run that never ended
-    (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--sheet-size", "1e300x10"], EXIT_USAGE,
+    (["parquetry", "toolpaths/img/drilling.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--sheet-size", "1e300x10"], EXIT_USAGE,
      r"--sheet-size takes WxH in mm"),
-    (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--image-size-mm", "1e300"], EXIT_USAGE,
+    (["parquetry", "toolpaths/img/drilling.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--image-size-mm", "1e300"], EXIT_USAGE,
      r"--image-size-mm must be in \(0, 10000\]"),  # at the door since 2a3e399: a usage error
-    (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--image-size-mm", "5"], EXIT_USAGE,
+    (["parquetry", "toolpaths/img/drilling.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--image-size-mm", "5"], EXIT_USAGE,
      r"image_size_mm \(--image-size-mm\) must be in \[patch_mm = 14, 10000\] mm"),  # the patch rule: a usage error
-    (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--sheets", "1000000"], EXIT_USAGE,
+    (["parquetry", "toolpaths/img/drilling.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--sheets", "1000000"], EXIT_USAGE,
      r"--sheets must be in \[1, 1000\]"),
     (["rings", "show", "OUT/none", "--out", "OUT/x.png", "--zoom", "1000000"], EXIT_USAGE, r"--zoom must be in \[1, 64\]"),
     # accepted: a block at -5 px/mm, or at 0 px/mm for a 1e300 mm cube
-    (["block", "from-photos", "OUT/none", "--size-mm", "50", "--out", "OUT/fp", "--max-px-per-mm=-5"], EXIT_USAGE,
+    (["block", "from-photos", "OUT", "--size-mm", "50", "--out", "OUT/fp", "--max-px-per-mm=-5"], EXIT_USAGE,
      r"--max-px-per-mm must be in \(0, 1000\]"),
-    (["block", "from-photos", "OUT/none", "--size-mm", "1e300", "--out", "OUT/fp"], EXIT_USAGE, r"--size-mm takes WxDxH in mm"),
+    (["block", "from-photos", "OUT", "--size-mm", "1e300", "--out", "OUT/fp"], EXIT_USAGE, r"--size-mm takes WxDxH in mm"),
     # a malformed size is a wrong command line like any malformed number (it exited 1)
-    (["block", "from-photos", "OUT/none", "--size-mm", "2in", "--out", "OUT/fp"], EXIT_USAGE,
+    (["block", "from-photos", "OUT", "--size-mm", "2in", "--out", "OUT/fp"], EXIT_USAGE,
      r"--size-mm takes WxDxH in mm, .*; got '2in'"),
     # empty or repeated lists were taken as the default (an empty benchmark table, exit 0)
-    (["fit", "/nonexistent", "--faces", "", "--out", "OUT/f.npz"], EXIT_USAGE, r"--faces must be 'all' or a comma list"),
-    (["fit", "/nonexistent", "--faces", "front,front", "--out", "OUT/f.npz"], EXIT_USAGE, r"--faces must be 'all'"),
-    (["eval", "rings", "/nonexistent", "--methods", "", "--out", "OUT/e"], EXIT_USAGE, r"--methods must be 'all'"),
+    (["fit", "builtin:flat-sawn", "--faces", "", "--out", "OUT/f.npz"], EXIT_USAGE, r"--faces must be 'all' or a comma list"),
+    (["fit", "builtin:flat-sawn", "--faces", "front,front", "--out", "OUT/f.npz"], EXIT_USAGE, r"--faces must be 'all'"),
+    (["eval", "rings", "builtin:flat-sawn", "--methods", "", "--out", "OUT/e"], EXIT_USAGE, r"--methods must be 'all'"),
     (["eval", "realistic", "--seed", "5", "--methods", "", "--out", "OUT/e"], EXIT_USAGE, r"--methods must be 'all' or a comma list from"),
     (["bench", "report", "OUT", "--gallery", "-1", "--out", "OUT/r"], EXIT_USAGE, r"--gallery must be in \[0, 1000\]"),
     # options that contradict each other, or one missing: a wrong command line (they exited 1,
     # eval rings --truth after opening every block, gcode after reading the programs)
     (["log", "render", "--out", "OUT/lr"], EXIT_USAGE, r"give exactly one log: a LOG_FILE, --real or --maps DIR; got 0"),
-    (["log", "render", "--real", "OUT/nope.json", "--out", "OUT/lr"], EXIT_USAGE, r"give exactly one log: .*; got 2"),
-    (["eval", "rings", "builtin:flat-sawn", "--truth", "a.npz", "b.npz", "--out", "OUT/e"], EXIT_USAGE,
+    (["log", "render", "--real", "OUT/file.txt", "--out", "OUT/lr"], EXIT_USAGE, r"give exactly one log: .*; got 2"),
+    (["eval", "rings", "builtin:flat-sawn", "--truth", "OUT/file.txt", "OUT/file.txt", "--out", "OUT/e"], EXIT_USAGE,
      r"--truth needs one field file per block: got 2 for 1 blocks"),
     (["block", "synth", "--count", "1", "--engine", "local", "--address", "tcp://127.0.0.1:1", "--out", "OUT/b"], EXIT_USAGE,
      r"--address needs --engine dask; got --engine local"),
     (["train", "rings", "--no-resume", "--out", "OUT/t"], EXIT_USAGE, r"train rings runs in this process and always from scratch"),
-    (["gcode", "OUT/nope.nc", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb"], EXIT_USAGE,
+    (["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb"], EXIT_USAGE,
      r"woodcam gcode: no tools given; pass --tool SPEC"),
     # LinuxCNC's own interpreter read the program as LinuxCNC's, the --dialect dropped silently
     ([*GCODE, "--tool", "flat:6", "--interpreter", "linuxcnc", "--dialect", "grbl"], EXIT_USAGE,
@@ -95,7 +97,7 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     # eval realistic dropped empty names ('rbf,,radial') where fit refused them: one parser now
     (["eval", "realistic", "--seed", "5", "--methods", "rbf,,radial", "--scenarios", "bogus", "--out", "OUT/e"], EXIT_USAGE,
      r"--methods must be 'all' or a comma list from evidence, rbf, radial, neural, each name once; got 'rbf,,radial'"),
-    (["eval", "rings", "/nonexistent", "--methods", "radial,radial", "--out", "OUT/e"], EXIT_USAGE,
+    (["eval", "rings", "builtin:flat-sawn", "--methods", "radial,radial", "--out", "OUT/e"], EXIT_USAGE,
      r"--methods must be 'all' or a comma list from evidence, rbf, radial, neural, each name once"),
     (["block", "synth", "--count", "1", "--face-px", "8", "--out", "OUT/b"], EXIT_USAGE, r"--face-px must be in \[16,"),
     # they named the Python parameters (face_px, blocks, retries), exit 1, after writing run.json
@@ -105,15 +107,15 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["eval", "realistic", "--seed", "1", "--eq79", "-1", "--out", "OUT/e"], EXIT_USAGE, r"--eq79 must be in \[0, 1000\]"),
     # 100 mm of jitter failed every block with an unrelated message in its record
     (["block", "synth", "--count", "1", "--jitter-mm", "100", "--out", "OUT/b"], EXIT_USAGE, r"--jitter-mm must be in \[0, 10\]"),
-    # it blamed the block spec for a missing file
-    (["review", "OUT/nope.glb", "--out", "OUT/r.html"], EXIT_ERROR, r"review: no file at"),
+    # it blamed the block spec for a missing file; then said so with exit 1, as the work failing
+    (["review", "OUT/nope.glb", "--out", "OUT/r.html"], EXIT_USAGE, r"PART of 'woodcam review': '.*nope.glb' does not exist"),
     # in inches the error showed the value converted ("got 12.7" for 0.5 against a mm range)
     (["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb", "--tool", "flat:6",
       "--units", "inch", "--mesh-tol", "0.5"], EXIT_USAGE,
      r"--mesh-tol must be in \(0, 10\] mm; got 0.5 inch = 12.7 mm"),
     # the errors named the Python parameters (trace_dropout (traces.dropout), thickness_mm, relief)
     (["block", "synth", "--count", "1", "--dropout", "2", "--out", "OUT/b"], EXIT_USAGE, r"--dropout must be in \[0, 1\]"),
-    (["parquetry", "t.png", "--veneer-from", "builtin:flat-sawn", "--leaf-thickness", "-1", "--out", "OUT/pq"], EXIT_USAGE,
+    (["parquetry", "toolpaths/img/drilling.png", "--veneer-from", "builtin:flat-sawn", "--leaf-thickness", "-1", "--out", "OUT/pq"], EXIT_USAGE,
      r"--leaf-thickness must be in \(0, 100\]"),
     (["woodify", "x.stl", "--years", "3", "--relief", "2", "--out", "OUT/w"], EXIT_USAGE, r"--relief must be in \[0, 1\]"),
     # a bad spec after a good tool number was reported as a bad number

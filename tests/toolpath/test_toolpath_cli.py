@@ -309,10 +309,11 @@ def test_programs_and_tools_are_refused_before_the_block_is_opened(tmp_path, cap
     prog.write_text("G0 X20 Y20 Z2 M3 S9000\nG1 Z-3 F600\nX40\nG0 Z2\nM2\n")
     base = ["--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb")]
     for argv, said, rc in (
+            # a missing program or table: a wrong command line, refused at the input door (exit 2, was 1)
             ([str(tmp_path / "nope.nc"), "--tool", "flat:6"],
-             f"woodcam gcode: program {str(tmp_path / 'nope.nc')!r} is not a file; pass the G-code file(s)", 1),
+             f"PROGRAM of 'woodcam gcode': {str(tmp_path / 'nope.nc')!r} does not exist", 2),
             ([str(prog), "--tools", str(tmp_path / "t.toml")],
-             f"--tools {str(tmp_path / 't.toml')!r} is not a file; pass a TOML tool table", 1),
+             f"--tools of 'woodcam gcode': {str(tmp_path / 't.toml')!r} does not exist", 2),
             # a malformed --tool is a wrong command line (exit 2, at the door)
             ([str(prog), "--tool", "1=flat:abc"], "--tool '1=flat:abc': tool spec 'flat:abc'", 2),
             ([str(prog)], "no tools given; pass --tool SPEC", 2)):  # a missing option: usage
@@ -424,18 +425,22 @@ def test_review_with_another_block_than_the_baked_one_says_so(tmp_path, capsys):
     assert "is not the block" not in capsys.readouterr().err  # the same block: no word
 
 
-@pytest.mark.parametrize("part,says", [("nope.stl", "does not exist"), ("design.jpg", "unsupported suffix")])
-def test_a_bad_design_part_is_refused_before_the_simulation(part, says, tmp_path, capsys):
+# a missing part is a wrong command line (the input door, exit 2; it was 1), a part no reader
+# takes the work failing (exit 1)
+@pytest.mark.parametrize("part,says,code", [("nope.stl", "woodcam: error: --part of 'woodcam gcode': ", 2),
+                                            ("design.jpg", "woodcam: error: --part: part file", 1)])
+def test_a_bad_design_part_is_refused_before_the_simulation(part, says, code, tmp_path, capsys):
     """``--part nope.stl`` simulated the whole program (minutes on a real job), then failed
     naming 'part file', not the option."""
+    (tmp_path / "design.jpg").write_bytes(b"\xff\xd8")
     capsys.readouterr()
     assert main(["gcode", str(REPO / "toolpaths" / "drilling.nc"), "--tool", "flat:6", "--block",
                  "builtin:flat-sawn", "--cell-size", "0.5", "--out", str(tmp_path / "g.glb"),
-                 "--part", str(tmp_path / part)]) == 1
+                 "--part", str(tmp_path / part)]) == code
     out = capsys.readouterr()
     assert "moves read" not in out.out  # nothing was simulated
     err = out.err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("woodcam: error: --part: part file") and says in err[0], err
+    assert len(err) == 1 and err[0].startswith(says) and part in err[0], err
     assert not (tmp_path / "g.glb").exists()
 
 

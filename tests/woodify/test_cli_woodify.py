@@ -258,7 +258,7 @@ def test_eccentricity_is_refused_by_its_option_name(tmp_path, capsys):
                     f"--eccentricity={value}"]) == 2
         assert f"--eccentricity must be in (-1, 1); got {float(value)!r}" in capsys.readouterr().err
     assert _rc(["woodify", str(tmp_path / "p.stl"), "--years", "3", "--out", str(tmp_path / "o"),
-                "--eccentricity=0.999"]) == 1  # in range: on to the missing part file
+                "--eccentricity=0.999"]) == 2  # in range: on to the missing part file, a wrong command line
     assert "p.stl" in capsys.readouterr().err
 
 

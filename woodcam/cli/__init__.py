@@ -71,7 +71,8 @@ examples:
       --out out/eye/
 
 exit status: 0 done; 1 the work failed (a one-line 'woodcam: error: ...' says why); 2 the
-command line is wrong (usage); 3 the work was done but a check failed (e.g. gcode --strict);
+command line is wrong (usage; an input path that is not there, or a file where a folder is read
+or the other way round, too); 3 the work was done but a check failed (e.g. gcode --strict);
 130 interrupted; 141 the pipe it printed to was closed (woodcam blocks | head), quietly, as git
 and ls.
 """
@@ -211,7 +212,14 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     with warnings.catch_warnings(record=True) as caught, message_units(getattr(args, "units", None)):
         warnings.simplefilter("always")
         try:
-            from .options import check_numbers, check_out, check_screenshot, check_values, lengths_to_mm
+            from .options import (
+                check_inputs,
+                check_numbers,
+                check_out,
+                check_screenshot,
+                check_values,
+                lengths_to_mm,
+            )
 
             check_out(args)  # the --out rule, before any work
             check_screenshot(args)  # and a named --screenshot PNG's
@@ -220,6 +228,9 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             # the values a library parser reads (--place, --tool): a malformed one is a usage
             # error, before the block is opened (a fit of minutes) and the part loaded
             check_values(args)
+            # every input path there and of its kind, last: the value checks above say what is
+            # wrong with the options first (a missing part is no reason to hide a bad --tool)
+            check_inputs(args)
             rc = args.func(args)
             _interrupt.check()  # a Ctrl-C a library swallowed: the run did not end as asked
             sys.stdout.flush()  # here, not at exit: a closed pipe is then caught below

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
-from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
+from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_input, add_camera_option, add_out_option, add_units_option,
                       add_workers_option, allow_negative_values, apply_workers, as_typed, camera_of,
                       remove_stale_outputs, stock_options, vector_type, write_screenshot)
 
@@ -32,8 +32,8 @@ def register(subparsers) -> None:
                               "can read, write or delete your files, so only bake scripts you "
                               "wrote or have read (--timeout bounds its run time; it is not a "
                               "sandbox).")
-    p.add_argument("part", help="part file (.py script, .step, .stl, .obj, .glb)")
-    p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
+    add_input(p, "part", kind="file", help="part file (.py script, .step, .stl, .obj, .glb)")
+    add_input(p, "--block", kind="block", required=True, help=BLOCK_SPEC_HELP)
     add_out_option(p, "the baked part; beside it PART.obj/.mtl, PART_texture.png, the "
                    "part report PART_report.txt/.json and, with --screenshot, PART_view.png",
                    suffixes=(".glb",))
@@ -63,12 +63,12 @@ def register(subparsers) -> None:
                               description="Open a baked GLB/OBJ in a window with a cut-plane "
                               "widget that shows the wood inside the block; --screenshot renders "
                               "off-screen.")
-    p.add_argument("mesh", type=Path, help="baked .glb (or .obj)")
+    add_input(p, "mesh", kind="file", type=Path, help="baked .glb (or .obj)")
     # the same [PNG] form as bake's and gcode's --screenshot (issue 17)
     p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
                    help="render off-screen to this PNG instead of opening a window (default "
                    "name: MESH with _view.png)")
-    p.add_argument("--block", default=None,
+    add_input(p, "--block", kind="block", default=None,
                    help=BLOCK_SPEC_HELP + ", for the cut plane (default: the one stored in the GLB)")
     add_camera_option(p)
     p.add_argument("--no-cut", action="store_true",
@@ -175,9 +175,6 @@ def run_preview(args: argparse.Namespace) -> int:
     from ..view import preview
     from .options import recorded_block_size, stock_of_glb
 
-    if not args.mesh.is_file():  # the viewer named its parameter: "mesh_or_path: no file at ..."
-        raise WoodcamError(f"preview: no file at {str(args.mesh)!r}; pass a .glb or .obj written by "
-                           "woodcam bake or gcode")
     if args.no_cut and (args.cut_origin is not None or args.cut_normal is not None):
         import warnings
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .options import add_engine_options, add_out_option, engine_options
+from .options import add_input, add_engine_options, add_out_option, engine_options
 
 
 def register(subparsers) -> None:
@@ -46,7 +46,7 @@ def register(subparsers) -> None:
                        "worst blocks and a gallery of their cut planes",
                        description="Reads a run folder; writes report.md, report.json, table1.png "
                        "and gallery/ (worst blocks and sample faces, regenerated from the seed).")
-    t.add_argument("run_dir", type=Path, help="a folder written by `woodcam bench run`")
+    add_input(t, "run_dir", kind="folder", type=Path, help="a folder written by `woodcam bench run`")
     add_out_option(t, "report.md, report.json, table1.png and gallery/")
     t.add_argument("--gallery", type=int, default=3, metavar="N",
                    help="worst blocks to redraw (default 3; each is refitted, ~40 CPU-s)")

@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import UsageError
-from .options import (add_block_argument, add_confidence_option, add_out_option, add_size_option, add_workers_option,
+from .options import (add_input, add_block_argument, add_confidence_option, add_out_option, add_size_option, add_workers_option,
                       apply_workers, comma_names, command_group, face_names, open_block)
 
 #: Faces used for "partial annotation": three faces meeting at the front-top-left corner, half
@@ -52,7 +52,7 @@ def register(subparsers) -> None:
         "both ways).")
     add_block_argument(e, option=False, nargs="+")
     add_size_option(e)
-    e.add_argument("--truth", type=Path, nargs="*", default=None,
+    add_input(e, "--truth", kind="file", type=Path, nargs="*", default=None,
                    help="true field files (.npz), one per block; default: each block's own")
     e.add_argument("--methods", default="rbf,radial",
                    help=f"comma list of {', '.join(METHODS)}, or all (default rbf,radial)")

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from ..errors import UsageError, WoodcamError
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
-from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
+from .options import (add_input, output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
                       allow_negative_values, as_typed, camera_of, drop_earlier_output, remove_stale_outputs, sizes_type,
                       stock_options, vector_type)
 
@@ -41,10 +41,10 @@ def register(subparsers) -> None:
         description="Read a 3-axis G-code program, remove the swept tools from the block on a "
         "height field, mesh the remaining stock and bake its wood texture.",
         epilog=_EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("program", type=Path, nargs="+",
+    add_input(p, "program", kind="file", type=Path, nargs="+",
                    help="G-code file(s) (.nc, .gcode, .ngc, .tap); several files of one job "
                    "(e.g. roughing then finishing) are simulated in sequence on the same stock")
-    p.add_argument("--block", required=True, help=BLOCK_SPEC_HELP)
+    add_input(p, "--block", kind="block", required=True, help=BLOCK_SPEC_HELP)
     add_out_option(p, "the carved stock; beside it OUT.obj/.mtl, OUT_texture.png and, "
                    "with --screenshot, OUT_view.png", suffixes=(".glb",))
     p.add_argument("--tool", action="append", default=[], metavar="[N=]SPEC",
@@ -53,7 +53,7 @@ def register(subparsers) -> None:
                    "order of first use); the reach for the flute/shank/holder checks as "
                    "flat:6:flute=22:shank=6:stickout=30:holder=35 (lengths in --units, "
                    "default mm). Default: none; give --tool or --tools")
-    p.add_argument("--tools", type=Path, default=None, metavar="TOML",
+    add_input(p, "--tools", kind="file", type=Path, default=None, metavar="TOML",
                    help="tool table file: TOML ([tools.N] type/diameter_mm/...) or a CAMotics "
                    "JSON tool table (.json)")
     # --cell-size, not --resolution: elsewhere --resolution is a cell COUNT (issue 17); the old
@@ -108,7 +108,7 @@ def register(subparsers) -> None:
                    "of the (last) program")
     p.add_argument("--no-overlay", action="store_true",
                    help="leave the toolpath (rapids red, feeds blue) out of the screenshot")
-    p.add_argument("--part", default=None, metavar="PART",
+    add_input(p, "--part", kind="file", default=None, metavar="PART",
                    help="design part (STL/STEP/OBJ/GLB or a part script, block frame, mm): "
                    "report leftover and overcut volumes, gouges by line, and write a "
                    "deviation map (OUT with _deviation.png)")
@@ -130,10 +130,6 @@ def _numbered_tools(args) -> dict:
     from ..toolpath.tools import load_tool_table
     from .options import parse_tool_option
 
-    if args.tools and not Path(args.tools).is_file():  # load_tool_table named its parameter: "path='x'"
-        raise WoodcamError(f"--tools {str(args.tools)!r} is not a file; pass a TOML tool table "
-                           "([tools.N] type/diameter_mm/..., e.g. toolpaths/tools.toml) or a CAMotics "
-                           "JSON tool table")
     tools = dict(load_tool_table(args.tools)) if args.tools else {}
     for item in args.tool:  # read at the door already (options.check_values): a usage error there
         number, tool = parse_tool_option(item)
@@ -211,9 +207,6 @@ def run(args) -> int:
     # what a (DEBUG,...) shows for #5410, the loaded tool's diameter in the machine's table
     diameters = {n: t.diameter_mm for n, t in _numbered_tools(args).items()}
     for k, path in enumerate(args.program):
-        if not Path(path).is_file():  # read_gcode named its parameter: "text_or_path='x.nc'"
-            raise WoodcamError(f"woodcam gcode: program {str(path)!r} is not a file; pass the G-code "
-                               "file(s) to simulate (.nc, .gcode, .ngc, .tap)")
         t0 = time.perf_counter()
         try:
             program = read_gcode(path, start_mm=args.start, dialect=args.dialect,

@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import UsageError, WoodcamError
-from .options import SPECIES_HELP, add_knot_options, add_out_option, knot_shading, species_type
+from .options import add_input, SPECIES_HELP, add_knot_options, add_out_option, knot_shading, species_type
 
 
 def register(subparsers) -> None:
@@ -21,10 +21,10 @@ def register(subparsers) -> None:
     sub = p.add_subparsers(dest="log_command", required=True)
 
     def source(sp):
-        sp.add_argument("log_file", nargs="?", help="woodcam log file (JSON, mm)")
+        add_input(sp, "log_file", kind="file", nargs="?", help="woodcam log file (JSON, mm)")
         sp.add_argument("--real", action="store_true",
                         help="the CT-measured spruce log Gran_1 of the shared data")
-        sp.add_argument("--maps", metavar="DIR",
+        add_input(sp, "--maps", kind="folder", metavar="DIR",
                         help="a folder of seed image maps (stem_map.png, knot_*_map.png, ...)")
 
     r = sub.add_parser("render", help="PNG sections: a tangential board and an end-grain disc")

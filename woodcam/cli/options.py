@@ -11,6 +11,9 @@
 - :func:`add_out_option` / :func:`check_out` / :data:`OUT_RULE`: the one ``--out`` rule of
   every command (a file when the path ends in a known file suffix, a folder otherwise),
   checked by :func:`woodcam.cli.main` before a command runs.
+- :func:`add_input` / :func:`check_inputs`: every input path of every command (a file, a
+  folder, a block spec's folder or file) there and of its kind, checked by
+  :func:`woodcam.cli.main` before a command runs (exit 2).
 - :func:`add_units_option` / :func:`lengths_to_mm`: ``--units mm|inch``, the lengths of a
   command line read in it (:data:`LENGTH_OPTIONS`); summaries print with :mod:`woodcam.units`.
 
@@ -104,9 +107,7 @@ def check_out(args: argparse.Namespace) -> None:
         return
     out = Path(out)
     suffix = out.suffix.lower()
-    command = " ".join(str(getattr(args, k)) for k in vars(args)
-                       if k == "command" or k.endswith("_command")
-                       if getattr(args, k) is not None)
+    command = _command_name(args)
     if suffixes:
         if out.is_dir() or suffix not in FILE_SUFFIXES:
             raise UsageError(f"--out of 'woodcam {command}' is a FILE ending in "
@@ -129,6 +130,99 @@ def check_out(args: argparse.Namespace) -> None:
                          f"{str(out.with_name(out.stem + '_out' if out.is_file() else out.stem))!r}")
     else:
         _check_folder_can_be_made(out, command)
+
+
+def _command_name(args: argparse.Namespace) -> str:
+    """The command as typed, sub-command included (``block show``), for the doors' messages."""
+    return " ".join(str(getattr(args, k)) for k in vars(args)
+                    if k == "command" or k.endswith("_command")
+                    if getattr(args, k) is not None)
+
+
+# -- input paths: one door for every command ---------------------------------------------------
+#: What an input path argument names (:func:`add_input`): an existing FILE, an existing FOLDER,
+#: or a block spec (a block or Mokume sample folder, a ``woodify:`` field or ``log:`` JSON file;
+#: a built-in block and the shared ``gran1`` log name none).
+INPUT_KINDS = ("file", "folder", "block")
+
+
+def add_input(p, *flags: str, kind: str, paths=None, **kwargs) -> argparse.Action:
+    """An input path argument of ``p`` (``add_argument``'s ``flags`` and ``kwargs``) that
+    :func:`check_inputs` checks before the command runs: ``kind`` is one of
+    :data:`INPUT_KINDS`; ``paths`` maps a value to the paths it names when it holds more than a
+    path (``--veneer SCAN:DPI:MASK``). ``tests/test_cli_inputs.py`` runs every command against it
+    and fails a path argument added without it."""
+    assert kind in INPUT_KINDS, kind  # a contributor's mistake
+    action = p.add_argument(*flags, **kwargs)
+    name = next((f for f in action.option_strings if f.startswith("--")), action.dest.upper())
+    p.set_defaults(_inputs=(*(p.get_default("_inputs") or ()), (action.dest, name, kind, paths)))
+    return action
+
+
+def check_inputs(args: argparse.Namespace) -> None:
+    """Refuse an input path (:func:`add_input`) that does not exist or is of the wrong kind,
+    before any work: a UsageError (exit 2) naming the argument, the path, the rule and a fix.
+    A missing part, program or block folder was the command's own error (exit 1), some after the
+    block was opened; an input that exists but whose contents are bad still is (exit 1)."""
+    for dest, name, kind, paths in getattr(args, "_inputs", ()):
+        value = getattr(args, dest, None)
+        for item in value if isinstance(value, list) else [] if value is None else [value]:
+            for text in paths(str(item)) if paths else [str(item)]:
+                _check_input(str(text), name, kind, args)
+
+
+#: What a block spec's path may be, said after the kind it names (a FOLDER, a FILE).
+_SPEC_KINDS = (" (a block spec is builtin:NAME, log:LOG@KNOT, woodify:DIR/field.npz, a block folder "
+               "with block.json or a Mokume sample folder)")
+
+
+def _check_input(text: str, name: str, kind: str, args: argparse.Namespace) -> None:
+    """One input path ``text`` of argument ``name`` (:func:`check_inputs`)."""
+    spec = ""
+    if kind == "block":
+        from .._specs import split_spec, spec_path
+
+        path = spec_path(text)
+        if path is None:  # a built-in block or the shared log: no path
+            return
+        spec, kind = text, "file" if split_spec(text)[0].startswith(("woodify:", "log:")) else "folder"
+        if kind == "folder" and path.name == "block.json" and path.is_file():
+            return  # the block is read from its folder (woodcam.stock)
+    else:
+        path = Path(text)
+    if path.is_dir() if kind == "folder" else path.is_file():
+        return
+    where = f"{name} of 'woodcam {_command_name(args)}'" + (f" (block spec {spec!r})" if spec else "")
+    if path.exists():
+        fix = ("give the file itself, not the folder it is in" if kind == "file" else
+               f"did you mean its folder {str(path.parent)!r}?")
+        raise UsageError(f"{where}: {str(path)!r} is a {'folder' if path.is_dir() else 'file'}; it must "
+                         f"be an existing {kind.upper()}{_SPEC_KINDS if spec else ''}; {fix}")
+    raise UsageError(f"{where}: {str(path)!r} does not exist; it must be an existing "
+                     f"{kind.upper()}{_SPEC_KINDS if spec else ''}; {_did_you_mean(path, spec)}")
+
+
+def _did_you_mean(path: Path, spec: str) -> str:
+    """The fix of a missing input ``path``: a near name in its folder, a built-in block the spec
+    may have meant, or where the path stops existing."""
+    import difflib
+
+    if spec and not spec.startswith(("woodify:", "log:")):
+        from ..fields.builtin import BUILTIN_NAMES  # here only: --help imports no numpy
+
+        near = difflib.get_close_matches(spec, BUILTIN_NAMES, n=1)
+        if near:
+            return f"did you mean 'builtin:{near[0]}'? ('woodcam blocks' lists the built-in blocks)"
+    base = path.parent
+    while not base.is_dir() and base != base.parent:
+        base = base.parent
+    if base != path.parent:  # its folder is missing too: say which part of the path is wrong
+        return f"no folder {str(path.parent)!r} either; check the path"
+    try:
+        near = difflib.get_close_matches(path.name, [p.name for p in base.iterdir()], n=1)
+    except OSError:  # an unreadable folder: no suggestion
+        near = []
+    return f"did you mean {str(base / near[0])!r}?" if near else "check the path"
 
 
 def check_screenshot(args: argparse.Namespace) -> None:
@@ -485,9 +579,9 @@ def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction
 def add_block_argument(p: argparse.ArgumentParser, *, option: bool = True, nargs=None) -> None:
     """``--block SPEC`` (required) or, with ``option=False``, a positional ``block``."""
     if option:
-        p.add_argument("--block", required=True, help=BLOCK_READ_HELP)
+        add_input(p, "--block", kind="block", required=True, help=BLOCK_READ_HELP)
     else:  # read, not carved from: no ~x90 turn (it was offered here and refused)
-        p.add_argument("block", nargs=nargs, help=BLOCK_READ_HELP)
+        add_input(p, "block", kind="block", nargs=nargs, help=BLOCK_READ_HELP)
 
 
 def _cube_side(text: str) -> float:

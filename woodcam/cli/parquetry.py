@@ -12,7 +12,7 @@ import warnings
 from pathlib import Path
 
 from ..errors import WoodcamWarning
-from .options import SPECIES_HELP, add_out_option, add_units_option, parse_sizes, species_type
+from .options import add_input, SPECIES_HELP, add_out_option, add_units_option, parse_sizes, species_type
 
 _EPILOG = """\
 veneer sources (any number, mixed):
@@ -51,21 +51,21 @@ def register(subparsers) -> None:
         "used once), cut seams, and write the panel, the cut files and a report.",
         epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.set_defaults(func=run)
-    p.add_argument("target", nargs="*", type=Path, help="target image(s); several are queued "
+    add_input(p, "target", kind="file", nargs="*", type=Path, help="target image(s); several are queued "
                    "together on the same wood (--queue)")
-    p.add_argument("--config", type=Path, default=None, metavar="JOB.json",
+    add_input(p, "--config", kind="file", type=Path, default=None, metavar="JOB.json",
                    help="a job file in the paper's layout (source_textures, targets, Table 1 keys); "
                    "options given here override it")
     add_out_option(p, "render.png, baseline.png, target_matched.png, assembly.svg, the cut files "
                       "veneer_<id>.svg/.dxf, result.json, panel.glb and job.json, listed in "
                       ".woodcam-parquetry-files.json")
     v = p.add_argument_group("veneers")
-    v.add_argument("--veneer", action="append", default=[], metavar="SCAN[:DPI][:MASK]",
+    add_input(v, "--veneer", kind="file", paths=_scan_paths, action="append", default=[], metavar="SCAN[:DPI][:MASK]",
                    help="scanned veneer image (repeatable; its id, in veneer_<id>.svg, is the file's "
                    "stem, numbered when two share one: oak-1, oak-2); resolution in dpi (default 300, with a warning "
                    "when the file states another, other than the 72/96 dpi cameras and editors write unmeasured) or "
                    "'Npx/mm'")
-    v.add_argument("--veneer-from", action="append", default=[], metavar="SPEC",
+    add_input(v, "--veneer-from", kind="block", action="append", default=[], metavar="SPEC",
                    help="Mokume sample folder, or block spec to slice leaves from (repeatable)")
     v.add_argument("--sheets", type=int, default=None, help="leaves per --veneer-from block (default 2)")
     v.add_argument("--sheet-size", default=None, metavar="WxH",
@@ -145,6 +145,14 @@ _OPTION_PARAMS = {"w_intens": "w_intens", "w_edge": "w_edge", "w_hist": "w_hist"
                   "overlap_mm": "overlap_mm",
                   "min_piece_mm": "min_piece_mm", "tool_diameter": "tool_diameter_mm",
                   "kerf_mm": "kerf_mm"}
+
+
+def _scan_paths(text: str) -> list[str]:
+    """The files a ``--veneer SCAN[:DPI][:MASK]`` names, the scan and its mask, for the input door
+    (:func:`~woodcam.cli.options.check_inputs`); a value of another form is :func:`_scan_entry`'s
+    to refuse."""
+    parts = text.split(":")
+    return [f for f in (parts[0], *parts[2:3]) if f] if len(parts) <= 3 else []
 
 
 def _scan_entry(text: str) -> dict:

@@ -6,7 +6,7 @@ import argparse
 import shlex
 from pathlib import Path
 
-from .options import BLOCK_SPEC_HELP, add_out_option, add_units_option
+from .options import add_input, BLOCK_SPEC_HELP, add_out_option, add_units_option
 
 
 def register(subparsers) -> None:
@@ -18,8 +18,8 @@ def register(subparsers) -> None:
         "with WebGL 2): the part, orbit/pan/zoom and front/top/iso views, a section plane whose "
         "cut face shows the wood inside the block, two-click measurement in mm, the block's face "
         "photos and the bake report, knot and G-code hotspots; printable as a shop sheet.")
-    p.add_argument("part", type=Path, help="baked .glb (from woodcam bake or woodcam gcode)")
-    p.add_argument("--block", default=None,
+    add_input(p, "part", kind="file", type=Path, help="baked .glb (from woodcam bake or woodcam gcode)")
+    add_input(p, "--block", kind="block", default=None,
                    help=BLOCK_SPEC_HELP + " (default: the one stored in the GLB)")
     add_out_option(p, "one self-contained page", suffixes=(".html",))
     p.add_argument("--voxels", type=int, default=None, metavar="N",
@@ -36,8 +36,6 @@ def run_review(args: argparse.Namespace) -> int:
     from ..export import read_glb_metadata
     from .options import as_typed, stock_of_glb
 
-    if not args.part.is_file():  # it said "records no block spec", blaming the spec for a missing file
-        raise WoodcamError(f"review: no file at {str(args.part)!r}; pass a GLB written by woodcam bake or gcode")
     meta = read_glb_metadata(args.part)
     if meta.get("kind") == "parquetry panel":  # --block would put one block's wood under the cut
         raise WoodcamError(

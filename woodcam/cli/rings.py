@@ -10,7 +10,7 @@ import shlex
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_check_layout_option, add_out_option, add_size_option, parse_sizes, report_layout
+from .options import add_input, add_check_layout_option, add_out_option, add_size_option, parse_sizes, report_layout
 
 
 def _size(text: str) -> tuple[float, float, float]:
@@ -24,7 +24,7 @@ def add_from_photos(sub) -> None:
                        "right.jpg, back.jpg (or A..F / Mokume A_col.png ...), each cropped to its face and "
                        "seen from outside; check them against --size-mm; write a block folder with the "
                        "photos. Then run 'woodcam rings detect'.")
-    p.add_argument("photos_dir", type=Path, help="folder with the six face photos")
+    add_input(p, "photos_dir", kind="folder", type=Path, help="folder with the six face photos")
     p.add_argument("--size-mm", required=True, help="block size WxDxH in mm (width x depth x height), "
                    "or one number for a cube")
     add_out_option(p, "the block folder: block.json and the face photos")
@@ -71,7 +71,7 @@ def register(subparsers) -> None:
                        "SVG over the photo (<face>_traces.svg, editable in Inkscape: a corrected SVG is "
                        "kept and wins over detection next time) and knot masks. BLOCK is a block "
                        "folder or a Mokume sample folder (its U-Net maps are ignored: re-detected).")
-    d.add_argument("block", type=Path, help="block folder (block.json) or Mokume sample folder")
+    add_input(d, "block", kind="folder", type=Path, help="block folder (block.json) or Mokume sample folder")
     add_out_option(d, "the block folder with ring maps, SVG traces and knot masks (may be "
                    "BLOCK itself)")
     d.add_argument("--rule", choices=("dark-edge", "dark-line", "sharp-edge", "dark-centre"),
@@ -93,7 +93,7 @@ def register(subparsers) -> None:
                        "ring share a colour), knot "
                        "outlines (yellow) and, for a Mokume folder, the U-Net map's ridge (cyan). A "
                        "Mokume folder is detected first (cached).")
-    s.add_argument("block", type=Path, help="block folder (after 'rings detect') or Mokume sample folder")
+    add_input(s, "block", kind="folder", type=Path, help="block folder (after 'rings detect') or Mokume sample folder")
     add_out_option(s, "the photos with the rings and knots found", suffixes=(".png",))
     s.add_argument("--zoom", type=int, default=2, help="enlargement: picture pixels per face pixel, a whole number (default 2)")
     add_check_layout_option(s)

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import UsageError
-from .options import add_engine_options, add_out_option, engine_options, engine_requested
+from .options import add_input, add_engine_options, add_out_option, engine_options, engine_requested
 
 
 def register(subparsers) -> None:
@@ -14,7 +14,7 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("train", help="train a learned model (gtf: the generic neural growth field; "
                               "rings: the small ring detector)")
     p.add_argument("what", choices=["gtf", "rings"], help="which model to train")
-    p.add_argument("--spec", type=Path, default=None,
+    add_input(p, "--spec", kind="file", type=Path, default=None,
                    help="JSON spec of hyper-parameters (default: the built-in defaults)")
     add_out_option(p, "the spec, weights and training log (gtf: gtf_spec.json, gtf.pt, "
                    "gtf_train_log.csv and the checkpoint; rings: rings_spec.json, rings.pt, "

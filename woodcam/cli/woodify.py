@@ -18,7 +18,7 @@ from pathlib import Path
 from ..errors import UsageError, WoodcamError
 from ..tolerances import DEFAULT_MAX_ATLAS_PX
 from ..units import say_length
-from .options import add_max_atlas_option, add_out_option, add_units_option, sizes_type, vector_type
+from .options import add_input, add_max_atlas_option, add_out_option, add_units_option, sizes_type, vector_type
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -29,7 +29,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         "eccentricity, obstacles, brushes), then write its growth field (usable as --block "
         "woodify:OUT/field.npz), grown surfaces, ring sections and a bark-textured grown.glb. "
         "Lengths in mm (the options' in --units), time in years.")
-    p.add_argument("part", help="input: a .py part script, .step, or a closed .stl/.obj/.ply/.glb mesh "
+    add_input(p, "part", kind="file", help="input: a .py part script, .step, or a closed .stl/.obj/.ply/.glb mesh "
                    "(mesh files are read as mm whatever --units says; one under 1 mm long gets a warning that it "
                    "looks saved in metres); a PLY may paint growth per vertex: properties gain (speed gain) and "
                    "dir_x, dir_y, dir_z (growth direction, length = strength < 1)")
@@ -46,9 +46,9 @@ def register(subparsers) -> argparse.ArgumentParser:
                    help="delta in (-1, 1): speed (1 + delta n.up) (default 0)")
     p.add_argument("--up", default="0,0,1", metavar="X,Y,Z",
                    type=vector_type("--up", example="0,0,1", nonzero=True), help="direction the eccentric growth favours (unit-normalised; default 0,0,1)")
-    p.add_argument("--obstacle", type=Path, action="append", default=[], metavar="MESH",
+    add_input(p, "--obstacle", kind="file", type=Path, action="append", default=[], metavar="MESH",
                    help="closed obstacle mesh or part (read as mm); repeatable")
-    p.add_argument("--brushes", type=Path, default=None, metavar="JSON",
+    add_input(p, "--brushes", kind="file", type=Path, default=None, metavar="JSON",
                    help="growth brushes (centre_mm, radius_mm, gain, direction, strength)")
     p.add_argument("--resolution", type=int, default=128,
                    help="grid nodes along the longest side, 16 to 1024 (default 128); a run takes about "
@@ -96,8 +96,6 @@ def _load_mesh(path: str, what: str = "part"):
 
     pth = Path(path)
     if pth.suffix.lower() in (".stl", ".obj", ".ply", ".glb", ".gltf", ".off"):
-        if not pth.is_file():
-            raise WoodcamError(f"{what} {path!r} does not exist")
         try:
             if pth.suffix.lower() in (".glb", ".gltf", ".obj") and _mesh_count(pth) > 1:
                 return _several_meshes(pth, what)

@@ -1,0 +1,129 @@
+"""Every input path of every command goes through one door (``woodcam.cli.options.add_input`` /
+``check_inputs``): a path that is not there, or a folder where a file is read (a file where a
+folder is), is a wrong command line, exit 2, one line naming the argument and the path, before
+any work. They exited 1, each command's own message, some after the block was opened."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import pytest
+
+import woodcam.cli as cli
+
+REPO = Path(__file__).resolve().parents[1]
+
+#: (command, argument) -> a command line whose argument ARG is the path under test; FILE is an
+#: existing file (the other inputs, there), OUT an output folder.
+CASES: dict[tuple[str, str], list[str]] = {
+    ("bake", "PART"): ["bake", "ARG", "--block", "builtin:flat-sawn", "--out", "OUT/b.glb"],
+    ("bake", "--block"): ["bake", "FILE", "--block", "ARG", "--out", "OUT/b.glb"],
+    ("preview", "MESH"): ["preview", "ARG", "--screenshot", "OUT/p.png"],
+    ("preview", "--block"): ["preview", "FILE", "--block", "ARG", "--screenshot", "OUT/p.png"],
+    ("gcode", "PROGRAM"): ["gcode", "FILE", "ARG", "--tool", "flat:6", "--block", "builtin:flat-sawn",
+                           "--out", "OUT/g.glb"],
+    ("gcode", "--block"): ["gcode", "FILE", "--tool", "flat:6", "--block", "ARG", "--out", "OUT/g.glb"],
+    ("gcode", "--tools"): ["gcode", "FILE", "--tools", "ARG", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb"],
+    ("gcode", "--part"): ["gcode", "FILE", "--tool", "flat:6", "--part", "ARG", "--block", "builtin:flat-sawn",
+                          "--out", "OUT/g.glb"],
+    ("review", "PART"): ["review", "ARG", "--out", "OUT/r.html"],
+    ("review", "--block"): ["review", "FILE", "--block", "ARG", "--out", "OUT/r.html"],
+    ("place", "PART"): ["place", "ARG", "--block", "builtin:flat-sawn", "--out", "OUT/p"],
+    ("place", "--block"): ["place", "FILE", "--block", "ARG", "--out", "OUT/p"],
+    ("block show", "BLOCK"): ["block", "show", "ARG", "--out", "OUT/s.png"],
+    ("block from-photos", "PHOTOS_DIR"): ["block", "from-photos", "ARG", "--size-mm", "50", "--out", "OUT/fp"],
+    ("rings detect", "BLOCK"): ["rings", "detect", "ARG", "--out", "OUT/rd"],
+    ("rings show", "BLOCK"): ["rings", "show", "ARG", "--out", "OUT/rs.png"],
+    ("log render", "LOG_FILE"): ["log", "render", "ARG", "--out", "OUT/lr"],
+    ("log render", "--maps"): ["log", "render", "--maps", "ARG", "--out", "OUT/lr"],
+    ("log maps", "LOG_FILE"): ["log", "maps", "ARG", "--out", "OUT/lm"],
+    ("log maps", "--maps"): ["log", "maps", "--maps", "ARG", "--out", "OUT/lm"],
+    ("log export", "LOG_FILE"): ["log", "export", "ARG", "--out", "OUT/le.json"],
+    ("log export", "--maps"): ["log", "export", "--maps", "ARG", "--out", "OUT/le.json"],
+    ("fit", "BLOCK"): ["fit", "ARG", "--out", "OUT/f.npz"],
+    ("eval rings", "BLOCK"): ["eval", "rings", "builtin:rift", "ARG", "--out", "OUT/e"],
+    ("eval rings", "--truth"): ["eval", "rings", "builtin:rift", "--truth", "ARG", "--out", "OUT/e"],
+    ("eval appearance", "BLOCK"): ["eval", "appearance", "ARG", "--out", "OUT/ea"],
+    ("train", "--spec"): ["train", "gtf", "--spec", "ARG", "--out", "OUT/t"],
+    ("bench report", "RUN_DIR"): ["bench", "report", "ARG", "--out", "OUT/br"],
+    ("woodify", "PART"): ["woodify", "ARG", "--years", "3", "--out", "OUT/w"],
+    ("woodify", "--obstacle"): ["woodify", "FILE", "--years", "3", "--obstacle", "FILE", "--obstacle", "ARG",
+                                "--out", "OUT/w"],
+    ("woodify", "--brushes"): ["woodify", "FILE", "--years", "3", "--brushes", "ARG", "--out", "OUT/w"],
+    ("parquetry", "TARGET"): ["parquetry", "FILE", "ARG", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq"],
+    ("parquetry", "--config"): ["parquetry", "--config", "ARG", "--out", "OUT/pq"],
+    ("parquetry", "--veneer"): ["parquetry", "FILE", "--veneer", "ARG:300", "--out", "OUT/pq"],
+    ("parquetry", "--veneer-from"): ["parquetry", "FILE", "--veneer-from", "ARG", "--out", "OUT/pq"],
+}
+
+
+def _leaf_parsers():
+    """(command, parser) of every command that runs (no sub-commands of its own)."""
+    for path, _help, sp in cli._commands(cli.build_parser()):
+        if not any(isinstance(a, argparse._SubParsersAction) for a in sp._actions):
+            yield " ".join(path), sp
+
+
+def _registered() -> dict[tuple[str, str], str]:
+    """(command, argument) -> kind of every input path that goes through the door."""
+    return {(command, name): kind for command, sp in _leaf_parsers()
+            for _dest, name, kind, _paths in sp.get_default("_inputs") or ()}
+
+
+def _looks_like_a_path(action: argparse.Action) -> bool:
+    """An argument that reads a path: a positional that is no choice (``train gtf``), a Path,
+    a block spec, or one whose metavar names a file or folder. Outputs have their own door."""
+    if action.dest in ("out", "screenshot", "help"):
+        return False
+    metavar = str(action.metavar or "")
+    return ((not action.option_strings and not action.choices) or action.type is Path or action.dest == "block"
+            or metavar in ("DIR", "FILE", "JSON", "TOML", "MESH", "PART", "SPEC", "JOB.json") or "SCAN" in metavar)
+
+
+def test_every_input_path_goes_through_the_door_and_has_a_case():
+    """A command added with a path argument that skips add_input fails here, as one added with
+    no case below."""
+    registered = _registered()
+    paths = {(command, next((f for f in a.option_strings if f.startswith("--")), a.dest.upper()))
+             for command, sp in _leaf_parsers() for a in sp._actions if _looks_like_a_path(a)}
+    assert paths - set(registered) == set(), "path arguments not added with options.add_input"
+    assert set(registered) == set(CASES), "add a case to CASES for each input path"
+
+
+@pytest.mark.parametrize("wrong", ["missing", "wrong kind"])
+@pytest.mark.parametrize("key", sorted(CASES), ids=lambda k: f"{k[0]} {k[1]}")
+def test_a_missing_or_wrong_kind_input_is_a_usage_error_before_any_work(key, wrong, tmp_path, capsys, monkeypatch):
+    kind = _registered().get(key, "file")
+    given = tmp_path / "in" / ("nope" if wrong == "missing" else "there")
+    given.parent.mkdir()
+    if wrong == "wrong kind" and kind == "file":  # a folder where a file is read
+        given.mkdir()
+    elif wrong == "wrong kind":  # a file where a folder (a block folder) is
+        given.write_text("x")
+    (tmp_path / "in" / "file.txt").write_text("x")
+    out = tmp_path / "out"
+    argv = [a.replace("ARG", str(given)).replace("OUT", str(out)).replace("FILE", str(tmp_path / "in" / "file.txt"))
+            for a in CASES[key]]
+    build = cli.build_parser
+
+    def no_work(args):  # the door refuses the path before the command runs
+        pytest.fail(f"{key} ran with {given}")
+
+    def parser_that_does_no_work():
+        parser = build()
+        for _path, _help, sp in cli._commands(parser):
+            if sp.get_default("func") is not None:
+                sp.set_defaults(func=no_work)
+        return parser
+
+    monkeypatch.setattr(cli, "build_parser", parser_that_does_no_work)
+    capsys.readouterr()
+    assert cli.main(argv) == cli.EXIT_USAGE
+    got = capsys.readouterr()
+    command, name = key
+    assert got.out == "" and got.err.count("\n") == 1 and "Traceback" not in got.err, got.err
+    assert got.err.startswith(f"woodcam: error: {name} of 'woodcam {command}'"), got.err
+    said = "does not exist" if wrong == "missing" else f"is a {'folder' if kind == 'file' else 'file'}"
+    assert f"{str(given)!r} {said}; it must be an existing " in got.err, got.err
+    assert not out.exists()  # nothing written
