@@ -306,3 +306,30 @@ def test_the_report_names_its_thirds_by_the_blocks_ends_whatever_the_eigenvector
     eigh = np.linalg.eigh
     monkeypatch.setattr(np.linalg, "eigh", lambda a: (eigh(a)[0], -eigh(a)[1]))
     assert part_report(stick, _slab_stock(), samples=6000) == rep
+
+
+def test_a_wood_that_only_draws_colours_is_refused_by_placement_advice_naming_it():
+    """A Stock of a user's colour-only wood (a method color, no features) is a stock (baked,
+    viewed), but advise_placement failed deep in its scoring with AttributeError "'Grey' object
+    has no attribute 'features'" (part_report and knot_spots the same). Each refuses it at its
+    door naming the argument, the rule, the kind given and the fix."""
+    import trimesh
+
+    from woodcam.advise import knot_spots, part_report
+    from woodcam.stock import Stock
+
+    class Grey:
+        def color(self, points_mm, normals):
+            return np.full((len(points_mm), 3), 0.5)
+
+    stock = Stock("mine", (50.0, 50.0, 30.0), Grey())
+    box = trimesh.creation.box((10, 10, 10))
+    box.apply_translation((25, 25, 15))
+    said = (r"{}: {} must read the wood, a method features\(points_mm \(n, 3\)\) -> dict with 'knot', 'years' "
+            r"and 'grain' .*; got Grey, which only draws colours; open the stock with open_stock or pass Wood\(field\)")
+    with pytest.raises(WoodcamError, match=said.format("advise_placement", r"stock\.wood")):
+        advise_placement(manifold3d.Manifold.cube([10.0, 10.0, 10.0]), stock, candidates=4, samples=50)
+    with pytest.raises(WoodcamError, match=said.format("part_report", r"stock\.wood")):
+        part_report(box, stock, samples=50)
+    with pytest.raises(WoodcamError, match=said.format("knot_spots", "wood")):
+        knot_spots(box, Grey(), samples=50)

@@ -110,6 +110,20 @@ def _part_mesh(part):
                            process=False)
 
 
+def _features_of(wood, who: str, arg: str):
+    """``wood.features``, the growth field every placement term is read from (knots, years,
+    grain), or a refusal: a user's wood that only draws (``color``) is a stock to bake and view,
+    but it has no knots, pith or fibres to score, and failed deep in the scoring as an
+    AttributeError ('features')."""
+    features = getattr(wood, "features", None)
+    if not callable(features):
+        raise WoodcamError(f"{who}: {arg} must read the wood, a method features(points_mm (n, 3)) -> dict with "
+                           f"'knot', 'years' and 'grain' (the knots, pith and fibres it scores); got "
+                           f"{type(wood).__name__}, which only draws colours; open the stock with open_stock "
+                           "or pass Wood(field)")
+    return features
+
+
 def _sample(mesh, count: int, rng):
     """Area-weighted surface points and normals of ``mesh`` (block frame, mm)."""
     areas = np.asarray(mesh.area_faces, dtype=float)
@@ -161,6 +175,7 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
     if not (math.isfinite(margin_mm) and margin_mm >= 0):
         raise WoodcamError(f"margin_mm must be a finite number >= 0; got {margin_mm!r}")
     w = {**DEFAULT_WEIGHTS, **(weights or {})}
+    features = _features_of(stock.wood, "advise_placement", "stock.wood")  # before the part is loaded
     mesh = _part_mesh(part)
     rng = np.random.default_rng(seed)
     pts, nrm = _sample(mesh, samples, rng)
@@ -198,7 +213,7 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
         n_rot = nrm @ rot.T
         axis_rot = rot @ long_axis
         points = (turned[None] + centres[:, None]).reshape(-1, 3)
-        feats = stock.wood.features(points)
+        feats = features(points)
         n_pts = len(turned)
         knot = feats["knot"].reshape(len(centres), n_pts) > 0.5
         # inside a knot, years count along the branch: its own pith is knot, not stem pith
@@ -284,10 +299,11 @@ def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
     surface and the wood under it, as ``knots``); plus ``warnings`` in words (short grain,
     knots or pith on the surface). Shares are fractions in [0, 1].
     """
+    features = _features_of(stock.wood, "part_report", "stock.wood")
     rng = np.random.default_rng(seed)
     pts, nrm = _sample(mesh, samples, rng)
     depth = np.concatenate([pts] + [pts - d * nrm for d in SUBSURFACE_MM])
-    feats = stock.wood.features(depth)
+    feats = features(depth)
     grain = feats["grain"][:len(pts)]
     knot = feats["knot"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) > 0.5
     pith = (feats["years"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) < PITH_YEARS) & ~knot
@@ -375,9 +391,10 @@ def knot_spots(mesh, wood, *, samples: int = 20000, link_mm: float = 2.0, seed: 
     from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
 
+    features = _features_of(wood, "knot_spots", "wood")
     rng = np.random.default_rng(seed)
     pts, _ = _sample(mesh, samples, rng)
-    inside = wood.features(pts)["knot"] > 0.5
+    inside = features(pts)["knot"] > 0.5
     p = pts[inside]
     if len(p) == 0:
         return []
