@@ -140,7 +140,9 @@ def check_resize_in_block(spec: str, block_size_mm, size_mm, origin_mm,
     have = np.asarray(block_size_mm, float)
     size, origin = np.asarray(size_mm, float), np.asarray(origin_mm, float)
     far = origin + size
-    tol = 1e-6 * float(have.max())  # a stock written back with 12 digits still fits
+    from .tolerances import IN_BLOCK_RTOL
+
+    tol = IN_BLOCK_RTOL * float(have.max())  # a stock written back with 12 digits still fits
 
     def inside(lo, hi, block) -> bool:
         return bool((lo >= -tol).all() and (hi <= block + tol).all())

@@ -44,6 +44,12 @@ OUTSIDE_VOLUME_EPS_MM3 = 1e-3
 #: of a 100 mm block carry ~1e-5 mm of round-off.
 ON_FACE_TOL_MM = 1e-4
 
+#: A resize, a ``gcode --stock`` or a parquetry leaf is inside its block within this fraction of
+#: the block's largest side: a stock written back as a spec (12 significant digits,
+#: :func:`woodcam._specs.format_op`) reads back ~1e-12 relative off its block, and origin + size
+#: adds round-off; 1e-6 of a side (0.1 um of a 100 mm block) is no wood past the block.
+IN_BLOCK_RTOL = 1e-6
+
 #: Pixels of padding ("dilation") added around every chart in a baked atlas, so bilinear
 #: filtering and mip levels up to 2^3 never reach unpainted texels.
 ATLAS_PADDING_PX = 8

@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 from ..errors import UsageError, WoodcamError
+from ..tolerances import IN_BLOCK_RTOL
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
 from .options import (add_input, output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
                       allow_negative_values, as_typed, camera_of, drop_earlier_output, remove_stale_outputs, sizes_type,
@@ -352,7 +353,7 @@ def _check_stock_in_block(args, block) -> None:
     size = [float(v) for v in (args.stock or have)]
     origin = [float(v) for v in (args.stock_origin or (0.0, 0.0, 0.0))]
     far = [o + s for o, s in zip(origin, size)]
-    tol = 1e-6 * max(have)
+    tol = IN_BLOCK_RTOL * max(have)
     if all(o >= -tol for o in origin) and all(f <= h + tol for f, h in zip(far, have)):
         return
     u = args.units

@@ -31,6 +31,7 @@ from .._checks import check_path
 from .._specs import absolute_spec
 from ..errors import WoodcamError, WoodcamWarning
 from ..limits import MAX_BLOCK_SIZE_MM
+from ..tolerances import IN_BLOCK_RTOL
 
 Priority = Literal["saliency", "center"]
 
@@ -477,7 +478,7 @@ def check_leaves_in_block(stock, n_sheets: int, width_mm: float | None, height_m
     w = min(DEFAULT_LEAF_MM[0], face[0]) if width_mm is None else float(width_mm)
     h = min(DEFAULT_LEAF_MM[1], face[1]) if height_mm is None else float(height_mm)
     block = " x ".join(f"{v:g}" for v in size)
-    tol = 1e-6 * max(size)
+    tol = IN_BLOCK_RTOL * max(size)
     if w > face[0] + tol or h > face[1] + tol:
         need = list(size)
         need[right], need[down] = max(size[right], w), max(size[down], h)
