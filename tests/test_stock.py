@@ -695,3 +695,28 @@ def test_a_refused_resize_of_a_log_block_offers_no_larger_base(shared_data):
     msg = str(got.value)
     assert msg.endswith("give a resize that fits, [100x80x50] or smaller (a larger log block is cut "
                         "anew through its knot, not round this one)"), msg
+
+
+@pytest.mark.parametrize("spec, fix, need", [
+    # the corner 9 m off a 100 mm block: the base round its centre would be 17980 mm long
+    ("builtin:flat-sawn[40x30x20@9000,0,0]", "a resize whose corner is inside the block", "17980x80x50 mm"),
+    # a corner 9.9 m before a sized 300 mm block
+    ("builtin:flat-sawn:300x120x40[200x100x30@-9900,0,0]", "a resize that fits, [200x100x30] or smaller",
+     "20100x120x40 mm"),
+])
+def test_a_refused_resize_says_when_no_built_in_block_is_large_enough(spec, fix, need):
+    """A resize past its built-in block is offered the larger base that holds the same wood;
+    when that base would pass MAX_BLOCK_SIZE_MM (10 m a side) the offer was dropped without a
+    word, and the message read as if a larger block were never an option. Now it says no
+    built-in block holds that wood, the size it would need and the limit by name."""
+    from woodcam.errors import BlockSpecError
+
+    with pytest.raises(BlockSpecError) as got:
+        open_stock(spec)
+    msg = str(got.value)
+    assert msg.endswith(f"give {fix} (no built-in block holds the same wood: it would be {need}, past the "
+                        "10000 mm limit of a block's side, woodcam.limits.MAX_BLOCK_SIZE_MM)"), msg
+    # just inside the limit the larger base is still offered
+    with pytest.raises(BlockSpecError) as got:
+        open_stock("builtin:flat-sawn[40x30x20@4990,0,0]")
+    assert str(got.value).endswith("holds the same wood: builtin:flat-sawn:9960x80x50[40x30x20@9920,0,0]")

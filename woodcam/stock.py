@@ -186,7 +186,12 @@ def check_resize_in_block(spec: str, block_size_mm, size_mm, origin_mm,
         base_t, base_b = typed(need, lambda i, b: b <= MAX_BLOCK_SIZE_MM)
         at = origin + (base_b - have) / 2
         at_t, at_b = typed(at, lambda i, b: b >= -tol and b + size_b[i] <= base_b[i] + tol)
-        if (base_b <= MAX_BLOCK_SIZE_MM).all() and inside(at_b, at_b + size_b, base_b):
+        if (need > MAX_BLOCK_SIZE_MM).any():
+            # said, not dropped: the user looking for the larger base learns there is none
+            fix += (f" (no built-in block holds the same wood: it would be {say_length(tuple(need.tolist()), '.6g')}, "
+                    f"past the {say_length(MAX_BLOCK_SIZE_MM, 'g')} limit of a block's side, "
+                    "woodcam.limits.MAX_BLOCK_SIZE_MM)")
+        elif (base_b <= MAX_BLOCK_SIZE_MM).all() and inside(at_b, at_b + size_b, base_b):
             base = parsed.base if parsed.size_mm is None else parsed.base[:parsed.base.rfind(":")]
             fix += f", or a block that holds the same wood: {base}:{'x'.join(base_t)}{op_text(size_t, at_t)}"
     elif parsed is not None and parsed.kind == "log" and not parsed.ops:
