@@ -23,6 +23,7 @@ LAYERS: dict[str, int] = {
     "_progress": 1,                    # progress bars (tqdm only), on a terminal
     "_xatlas_worker": 1,               # xatlas in a worker process (numpy + xatlas only)
     "_raster": 1,                      # numba rasteriser of the bake (numpy + numba only)
+    "_manifold": 1,                    # a manifold3d Manifold -> its triangles (numpy + trimesh only)
     "frames": 3,                       # block frame, faces, pixel <-> block
     "fields": 4,                       # growth fields behind one protocol
     "block": 5,                        # Block, its faces, readers/writers (stores fields)

@@ -101,13 +101,10 @@ def _orientations(rotations: str) -> list[tuple[list[str], np.ndarray]]:
 
 def _part_mesh(part):
     """Any part source -> its surface as a ``trimesh.Trimesh`` (block frame, mm)."""
-    import trimesh
-
+    from ._manifold import manifold_to_trimesh
     from .cad import load_part
 
-    data = load_part(part).to_mesh()
-    return trimesh.Trimesh(np.asarray(data.vert_properties)[:, :3], np.asarray(data.tri_verts),
-                           process=False)
+    return manifold_to_trimesh(load_part(part))
 
 
 def _features_of(wood, who: str, arg: str):

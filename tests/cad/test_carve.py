@@ -162,3 +162,23 @@ def test_result_figures_agree_with_its_mesh():
     assert result.outside_volume_mm3 == pytest.approx(4000, rel=1e-6)
     assert result.mesh.bounds[0][0] == pytest.approx(0.0) and result.size_mm == tuple(DEMO_BLOCK_MM)
     assert len(result.warnings) == 1 and "sticks out" in result.warnings[0]
+
+
+def test_every_manifold_to_mesh_conversion_keeps_manifold3ds_double_vertices(tmp_path):
+    """A manifold3d Manifold was turned into triangles in five places, carve and write_stl in
+    float64 (to_mesh64), placement advice, woodify's parts and the toolpath reference in float32
+    (to_mesh: a 10.7 mm top read as 10.6999998 mm). Now one conversion (woodcam._manifold), in
+    float64: the same solid is the same vertices, to the last bit, wherever it is read."""
+    from woodcam.advise import _part_mesh
+    from woodcam.cli.woodify import _load_mesh
+    from woodcam.toolpath.reference import manifold_heightmap
+
+    size = (30.1, 20.3, 10.7)  # none of them a float32
+    solid = manifold3d.Manifold.cube(size)
+    exact = np.asarray(solid.to_mesh64().vert_properties)[:, :3]
+    script = tmp_path / "box.py"
+    script.write_text(f"import manifold3d\npart = manifold3d.Manifold.cube({size})\n")
+    for what, mesh in (("carve", carve(solid, (40.0, 30.0, 20.0)).mesh), ("advise", _part_mesh(solid)),
+                       ("woodify", _load_mesh(str(script))[0])):
+        assert np.array_equal(np.sort(mesh.vertices, axis=0), np.sort(exact, axis=0)), what
+    assert np.array_equal(manifold_heightmap(solid, size, (4, 4)), np.full((4, 4), 10.7))

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from .._manifold import manifold_to_trimesh
 from .._types import ArrayLike
 from ..errors import WoodcamError, WoodcamWarning
 from ..frames import FOREIGN_GLTF_METRES_BELOW, check_size
@@ -107,7 +108,6 @@ def carve(
         as mm): the message says how to scale it.
     """
     import manifold3d
-    import trimesh
 
     size = tuple(float(v) for v in check_size(size_mm))
     # load_part also validates a Manifold (status, emptiness, orientation) without copying it
@@ -148,13 +148,7 @@ def carve(
         messages.append(message)
         warnings.warn(message, WoodcamWarning, stacklevel=2)
 
-    mesh_out = carved.to_mesh64()
-    # copies, so the arrays do not keep manifold3d's Mesh64 buffers alive (nanobind reports
-    # such buffers as leaks at interpreter exit)
-    vertices = np.array(mesh_out.vert_properties[:, :3], dtype=np.float64, copy=True)
-    faces = np.array(mesh_out.tri_verts, dtype=np.int64, copy=True)
-    del mesh_out
-    mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+    mesh = manifold_to_trimesh(carved)
     return CarveResult(
         mesh=mesh,
         manifold=carved,

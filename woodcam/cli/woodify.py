@@ -91,7 +91,6 @@ def register(subparsers) -> argparse.ArgumentParser:
 def _load_mesh(path: str, what: str = "part"):
     """(watertight geometry, textured original or None) from a part or mesh file; ``what`` names
     it in messages (``part``, ``--obstacle``)."""
-    import numpy as np
     import trimesh
 
     pth = Path(path)
@@ -126,11 +125,10 @@ def _load_mesh(path: str, what: str = "part"):
         if textured is not None and len(geom.faces) != len(textured.faces):
             textured = None
         return geom, textured, {}
+    from .._manifold import manifold_to_trimesh
     from ..cad import load_part
 
-    solid = load_part(path)
-    m = solid.to_mesh()
-    return trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts)), None, {}
+    return manifold_to_trimesh(load_part(path), process=True), None, {}
 
 
 def _check_mesh_values(mesh, path: str, what: str) -> None:
@@ -166,9 +164,9 @@ def _several_meshes(path: Path, what: str):
     its first placement). Their pictures are not carried (one bark picture, one set of UVs)."""
     import warnings
 
-    import numpy as np
     import trimesh
 
+    from .._manifold import manifold_to_trimesh
     from ..cad import load_part
     from ..errors import WoodcamWarning
 
@@ -177,8 +175,7 @@ def _several_meshes(path: Path, what: str):
         warnings.warn(f"{what} {str(path)!r} holds {_mesh_count(path)} meshes: they grow as one solid "
                       "(their union), and their pictures are not carried to the bark (procedural bark "
                       "instead); join them into one textured mesh to keep a picture", WoodcamWarning, stacklevel=3)
-    m = load_part(path).to_mesh()
-    geom = trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts))
+    geom = manifold_to_trimesh(load_part(path), process=True)
     _warn_units(geom, str(path), what)
     return geom, None, {}
 

@@ -467,9 +467,9 @@ def write_stl(mesh, path: PathLike, note: str = "") -> Path:
 
     path = check_output_path(path, suffixes=(".stl",), what="write_stl: path")
     if hasattr(mesh, "to_mesh64"):  # a manifold3d Manifold
-        out = mesh.to_mesh64()
-        mesh = trimesh.Trimesh(vertices=np.array(out.vert_properties[:, :3], dtype=np.float64),
-                               faces=np.array(out.tri_verts, dtype=np.int64), process=False)
+        from .._manifold import manifold_to_trimesh
+
+        mesh = manifold_to_trimesh(mesh)
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise WoodcamError(f"write_stl: mesh must be a trimesh.Trimesh or manifold3d.Manifold with "
                            f"triangles; got {type(mesh).__name__}; e.g. write_stl(load_part(part), 'part.stl')")

@@ -54,9 +54,9 @@ def manifold_heightmap(solid, size_mm, shape) -> np.ndarray:
     Rasterises the solid's upward-facing triangles (vectorised barycentric test); cells no
     triangle covers (cut through) get 0.
     """
-    mesh = solid.to_mesh()
-    v = np.asarray(mesh.vert_properties, float)[:, :3]
-    f = np.asarray(mesh.tri_verts, np.int64)
+    from .._manifold import manifold_arrays
+
+    v, f = manifold_arrays(solid)
     ny, nx = shape
     W, D, _ = map(float, size_mm)
     dx, dy = W / nx, D / ny
