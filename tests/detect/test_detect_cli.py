@@ -762,6 +762,55 @@ def test_an_edited_knot_mask_or_ring_map_wins_over_a_rerun_as_a_corrected_svg_do
         assert np.array_equal(np.asarray(im), mask)
 
 
+def test_hand_made_files_in_a_folder_never_detected_are_kept_and_used(synth_photos, tmp_path, capsys, monkeypatch):
+    """A knot mask, ring map and traced SVG the user put beside the photos before ever running
+    detection (block.json records none) were written over without a word: only files whose
+    digest a detection recorded were told from the user's. Now, with no detection recorded in
+    --out, such a file is the user's: kept, read as the face's, said in one line with how to let
+    detection replace it; it stays the user's on a rerun; deleted, detection writes its own. The
+    same holds in another --out folder with no block.json."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    blk, _size = _knotted_block_folder(synth_photos, tmp_path, capsys)
+    fresh = tmp_path / "fresh"  # the detector's own files, for comparison
+    assert _run(capsys, "rings", "detect", blk, "--out", fresh)[0] == 0
+    detected = read_block(fresh).faces
+    assert "knot_mask" in detected["left"].extras  # the rerun finds the knot: the mask is its to write
+    mask = np.zeros((160, 160), np.uint8)
+    mask[60:140, 20:120] = 255
+    rings = np.zeros((160, 160), np.uint16)
+    rings[:, ::10] = 65535
+    svg = ('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
+           '<path d="M 10.5,20.5 L 150.5,20.5"/></svg>')
+    other = tmp_path / "other"
+    other.mkdir()
+    for folder in (blk, other):
+        Image.fromarray(mask).save(folder / "left_knot_mask.png")
+        Image.fromarray(rings).save(folder / "top_ring_map.png")
+        (folder / "front_traces.svg").write_text(svg)
+    mine = {f: (blk / f).read_bytes() for f in ("left_knot_mask.png", "top_ring_map.png", "front_traces.svg")}
+    for out in (blk, blk, other):  # the first run, a rerun (now recorded), and another --out
+        rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", out)
+        assert rc == 0, err
+        assert {f: (out / f).read_bytes() for f in mine} == mine
+        faces = read_block(out).faces
+        assert np.array_equal(faces["left"].extras["knot_mask"], mask > 127)
+        assert np.array_equal(faces["top"].ring_map, rings / 65535.0)
+        assert len(faces["front"].traces) == 1 and len(faces["top"].traces) > 1
+        for f in mine:
+            (line,) = [w for w in err.splitlines() if f in w]
+            assert line.startswith("woodcam: warning: face '") and " kept " in line, line
+            assert ("it wins over detection; to let detection replace it, delete it (or move it out of "
+                    f"{str(out)!r}) and run 'rings detect' again") in line, line
+    for f in mine:
+        (blk / f).unlink()
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and " kept " not in err, err
+    faces = read_block(blk).faces
+    assert np.array_equal(faces["left"].extras["knot_mask"], detected["left"].extras["knot_mask"])
+    assert np.allclose(faces["top"].ring_map, detected["top"].ring_map)
+    assert len(faces["front"].traces) == len(detected["front"].traces)
+
+
 def test_a_missing_or_file_input_is_one_line_that_says_which(synth_photos, tmp_path, capsys):
     """A photo given where the block folder goes ('rings detect front.png', 'rings show
     front.png') was said not to exist, though it is right there; a missing folder is still said

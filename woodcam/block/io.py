@@ -162,9 +162,9 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
 def read_block(folder: PathLike, *, allow_outside: bool | None = None, regenerated: Collection[str] = ()) -> Block:
     """Read a block folder written by :func:`write_block` (or made by hand for a real block).
 
-    ``regenerated``: names of image files (a ring map, a PNG extra) the manifest may name though
-    they are gone, read as absent: ring detection's own images, which it writes again (a user
-    deletes an edited one to let detection replace it); any other missing file is an error.
+    ``regenerated``: names of files (a ring map, a PNG extra, a traces SVG) the manifest may name
+    though they are gone, read as absent: ring detection's own files, which it writes again (a
+    user deletes an edited one to let detection replace it); any other missing file is an error.
 
     Faces missing from the manifest are absent from the block; ``true_field`` is None unless the
     manifest says it was saved and its class can be restored. The manifest is checked at the
@@ -216,7 +216,7 @@ def read_block(folder: PathLike, *, allow_outside: bool | None = None, regenerat
             ring_map = (raw.astype(np.float64) / (2 ** bits - 1)).astype(np.float32)
         traces = [RingTrace(np.asarray(t["points_px"], dtype=float), t.get("year"), t.get("ring"))
                   for t in entry.get("traces", [])]
-        if entry.get("traces_svg"):
+        if entry.get("traces_svg") and not gone(f"faces.{name}.traces_svg"):
             from .svg import read_traces_svg
 
             traces += read_traces_svg(files[f"faces.{name}.traces_svg"], shape)

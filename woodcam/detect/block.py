@@ -27,6 +27,10 @@ the user edited since it was recorded, of a face the new detection writes that f
 as a corrected SVG does: it is kept and read as the face's, and said, with how to let detection
 replace it, and it stays the user's on later runs (not recorded as the detector's); a folder
 whose record has no digests (detected before they were recorded) has its images written over.
+An output folder with no detection recorded at all (no manifest, or one 'block from-photos'
+wrote and no detection since) holds none of the detector's files: a ring map, knot mask or
+``<face>_traces.svg`` there (made by hand beside the photos before detecting) is the user's,
+kept and used as an edited one is, and said the same way.
 
 **Photo-only blocks elsewhere** (``fit``, ``bake``, ``eval``): :func:`with_detected_rings`
 detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
@@ -290,6 +294,34 @@ def user_edited_faces(folder) -> dict[str, Path]:
     return out
 
 
+def _unrecorded(folder: Path) -> bool:
+    """Whether no detection is recorded in the block folder ``folder``: no manifest, or one with
+    no detection record (kept or not; :func:`_detection_record`). Detection did not write the
+    files of its names there (a user put hand-made ones beside the photos before ever detecting,
+    or a sample came with them), so they are the user's (:func:`detect_folder`). An unreadable
+    manifest is not: it is written over, as :func:`_readable_record` says."""
+    from ..block.io import MANIFEST
+
+    if not (folder / MANIFEST).is_file():
+        return True
+    try:
+        return not _detection_record(folder)
+    except (ValueError, OSError):
+        return False
+
+
+#: Why a file of detection's name in a folder with no detection recorded is the user's (:func:`_unrecorded`).
+_NO_RECORD = "no detection is recorded in that folder, so detection did not write it"
+
+
+def _kept_users_line(name: str, kept: str, folder: Path, why: str) -> str:
+    """The one line saying face ``name``'s file of the user's (``kept``: "the edited PATH" ...),
+    found in ``folder``, was kept over detection, ``why`` it is the user's, and how to let
+    detection replace it: said alike of corrected SVGs, edited images and hand-made files."""
+    return (f"face {name!r}: kept {kept} ({why}): it wins over detection; to let detection replace it, delete it "
+            f"(or move it out of {str(folder)!r}) and run 'rings detect' again")
+
+
 #: The images detection writes per face (:mod:`woodcam.block.io` names them ``<face>_<kind>.png``),
 #: recorded by digest so a rerun clears or writes over only its own (module docstring): kind ->
 #: (what it is, in words; why a face has none after a detection).
@@ -358,11 +390,14 @@ def _prior_record(folder: Path) -> dict:
         return {}
 
 
-def _edited_images(block: Block, folders: list[tuple[Path, dict]]) -> dict[tuple[str, str], Path]:
+def _edited_images(block: Block, folders: list[tuple[Path, dict]],
+                   unrecorded: Path | None = None) -> dict[tuple[str, str], Path]:
     """(face, kind) -> the file of each image of ``block``'s faces in one of ``folders`` (folder,
     its record before this run; the output first) that is no longer the one the detector wrote
     there: a user edited it (or made it by hand beside a recorded detection). A record without
-    digests (made before they were) has its images written over, as they were then.
+    digests (made before they were) has its images written over, as they were then. In the
+    folder ``unrecorded`` (the output when no detection is recorded there, :func:`_unrecorded`)
+    every such image is the user's: detection wrote none there.
 
     Refused, as a corrected SVG is (:func:`_check_corrections_match_photos`), when the record
     says it was made over another photo than the face's now: it is not this photo's."""
@@ -371,7 +406,7 @@ def _edited_images(block: Block, folders: list[tuple[Path, dict]]) -> dict[tuple
         for kind, (what, _) in DETECTED_IMAGES.items():
             for folder, rec in folders:
                 path = folder / f"{name}_{kind}.png"
-                if ("file_digest" not in rec or not path.is_file()
+                if (("file_digest" not in rec and folder != unrecorded) or not path.is_file()
                         or _file_digest(path, kind) == _file_digests(rec).get(path.name)):
                     continue
                 was = (rec.get("photo_digest") or {}).get(name)
@@ -386,11 +421,13 @@ def _edited_images(block: Block, folders: list[tuple[Path, dict]]) -> dict[tuple
     return found
 
 
-def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path]) -> tuple[set[str], list[str]]:
+def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path],
+                       unrecorded: Path | None = None) -> tuple[set[str], list[str]]:
     """Each image ``block`` (just detected) has whose file the user edited (``edited``:
-    :func:`_edited_images`): the user's is read into ``block`` in its place, so it is what is
-    written and read, as a corrected SVG wins. Returns the names of the files kept and the
-    warnings. (An edited image of a face now without one is left to :func:`_clear_stale_files`.)"""
+    :func:`_edited_images`; in ``unrecorded``, made by hand): the user's is read into ``block``
+    in its place, so it is what is written and read, as a corrected SVG wins. Returns the names
+    of the files kept and the warnings. (An edited image of a face now without one is left to
+    :func:`_clear_stale_files`.)"""
     kept: set[str] = set()
     msgs = []
     for (name, kind), path in edited.items():
@@ -403,9 +440,9 @@ def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path]) -> tup
                              Face(name, f.shape, photo=f.photo, traces=f.traces, ring_map=f.ring_map,
                                   extras={**f.extras, kind: mine}))
         kept.add(path.name)
-        msgs.append(f"face {name!r}: kept the edited {path} (it is not the {DETECTED_IMAGES[kind][0]} detection wrote "
-                    f"there): it wins over detection; to let detection replace it, delete it (or move it out of "
-                    f"{str(path.parent)!r}) and run 'rings detect' again")
+        msgs.append(_kept_users_line(name, f"your {path}" if path.parent == unrecorded else f"the edited {path}",
+                                     path.parent, _NO_RECORD if path.parent == unrecorded else
+                                     f"it is not the {DETECTED_IMAGES[kind][0]} detection wrote there"))
     return kept, msgs
 
 
@@ -453,7 +490,7 @@ def _check_corrections_match_photos(block: Block, edited: dict[str, Path]) -> No
     Its manifest records the digest of each face photo it traced (``photo_digest``); folders
     written before it was recorded cannot be checked."""
     for name, svg in edited.items():
-        was = _detection_record(svg.parent).get("photo_digest", {}).get(name)
+        was = _prior_record(svg.parent).get("photo_digest", {}).get(name)
         photo = block.faces[name].photo
         if was is not None and photo is not None and was != photo_digest(photo):
             raise WoodcamError(
@@ -483,9 +520,10 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     # the one reader of folders: a folder of the user's own photos (front.jpg ...) was 'must hold a
     # block.json or Mokume files; found neither', no word of 'block from-photos'; it says so now.
     # It warns that a size_mm given for a block folder is not used.
-    # an image of detection's the user deleted (to let detection replace an edited one) is
-    # written again, not 'listed but missing'
-    block = read_block_folder(src, size_mm, regenerated={f"{n}_{k}.png" for n in FACES for k in DETECTED_IMAGES})
+    # a file of detection's the user deleted (to let detection replace an edited one, as the line
+    # that kept it says) is written again, not 'listed but missing'
+    block = read_block_folder(src, size_mm, regenerated={f"{n}_{k}.png" for n in FACES for k in DETECTED_IMAGES}
+                              | {f"{n}_traces.svg" for n in FACES})
     if not (src / MANIFEST).is_file():  # a Mokume sample: re-detected from its photos alone
         for f in block.faces.values():
             f.ring_map, f.traces = None, []
@@ -497,6 +535,11 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
         # corrections made in the output folder of an earlier run win too (only the source's
         # were looked for, and detection overwrote the ones in --out)
         edited.update(user_edited_faces(out))
+    # with no detection recorded in --out, a file of detection's names there is the user's (traced
+    # by hand beside the photos before ever detecting): it was written over without a word
+    unrecorded = out if _unrecorded(out) else None
+    if unrecorded is not None:
+        edited.update({n: out / f"{n}_traces.svg" for n in block.faces if (out / f"{n}_traces.svg").is_file()})
     # a corrected SVG of a face the block no longer has (made again with --partial without it) was
     # an internal error (KeyError): it is left where it is, unused, and said
     unused = {n: svg for n, svg in edited.items() if n not in block.faces}
@@ -506,7 +549,8 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     src_rec = _prior_record(src)
     out_rec = src_rec if out.resolve() == src.resolve() else _prior_record(out)
     # images the user edited since the detector wrote them, checked before any work as the SVGs are
-    images = _edited_images(block, [(out, out_rec)] + ([(src, src_rec)] if out.resolve() != src.resolve() else []))
+    images = _edited_images(block, [(out, out_rec)] + ([(src, src_rec)] if out.resolve() != src.resolve() else []),
+                            unrecorded)
     todo = [n for n, f in block.faces.items() if f.photo is not None and n not in edited]
     msgs: list[str] = [f"face {n!r}: the corrected {svg} is not used: the block has no {n} face (made "
                        f"without its photo); move it out of {str(svg.parent)!r} to keep it (a later detection "
@@ -528,8 +572,10 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
         ring_map = ring_map_from_traces(traces, f.shape, sigma_mm * px) if traces else None
         block.faces[name] = Face(name, f.shape, photo=f.photo, traces=[], ring_map=ring_map, extras=f.extras)
         kept[name] = traces
-        msgs.append(f"face {name!r}: kept the corrected {svg.name} ({len(traces)} traces); "
-                    f"it wins over detection")
+        msgs.append(_kept_users_line(name, f"{'your' if svg.parent == unrecorded else 'the corrected'} {svg.name}",
+                                     svg.parent, f"{len(traces)} traces; " + (
+                                         _NO_RECORD if svg.parent == unrecorded
+                                         else "it is not the SVG detection wrote there")))
     for name, f in block.faces.items():
         if f.photo is not None and not f.traces and name not in kept:
             msgs.append(f"face {name!r}: no rings found; the face is left without a ring map "
@@ -565,7 +611,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     det["user_svg"] = sorted(kept)
     # an image the user edited since the detector wrote it wins as a corrected SVG does (it was
     # written over without a word): read in, written back as read, never recorded as the detector's
-    users, said = _keep_users_images(block, images)
+    users, said = _keep_users_images(block, images, unrecorded)
     msgs += said
     # the detector's images: this run's (ring maps of faces detected or drawn from a corrected
     # SVG, knot masks detected), and earlier ones kept unchanged (--no-knots, a corrected SVG's
