@@ -74,7 +74,8 @@ def test_a_non_square_face_is_tried_only_in_variants_keeping_its_shape(cube):
     from woodcam.synth import AnalyticLogField, cut_block, synth_block
 
     field = cut_block(AnalyticLogField(ring_width_mm=3.0), (60, 40, 30), "flat-sawn")
-    block = synth_block(field, (60, 40, 30), face_px=150, seed=1, ring_map_faces=())
+    # 3 px/mm along its 60 mm side, above LAYOUT_MIN_PX_PER_MM (150 px was 2.5: no longer judged)
+    block = synth_block(field, (60, 40, 30), face_px=180, seed=1, ring_map_faces=())
     report = check_face_layout(block)
     assert report.warnings == []
     assert set(report.faces["top"].scores) == {"as laid out", "rot180", "flip-lr", "flip-tb"}
@@ -136,15 +137,33 @@ def test_a_face_too_coarse_to_judge_is_listed_not_called_turned(capsys):
     report = check_face_layout(small)
     assert report.corrections == {} and report.warnings == [] and report.faces == {}
     assert set(report.unchecked) == set(small.faces)
-    assert report.unchecked["back"] == ("64 px a side is 1.28 px/mm, under the 2.5 px/mm the check needs "
-                                        "(LAYOUT_MIN_PX_PER_MM): give its photo at least 125 px a side")
+    assert report.unchecked["back"] == ("64 px a side is 1.28 px/mm, under the 2.75 px/mm the check needs "
+                                        "(LAYOUT_MIN_PX_PER_MM): give its photo at least 138 px a side")
     report_layout(small)
     out = capsys.readouterr().out
     assert out == ("layout: not checked (no two neighbouring faces with a photo or ring map); not checked: "
                    f"{', '.join(small.faces)} ({report.unchecked['back']})\n"), out
-    # at 48 px the size it needs is still 125 px (not a float's 126)
-    assert check_face_layout(_resized(cn03, 48)).unchecked["top"].endswith("at least 125 px a side")
+    # a 40 mm cube at 48 px needs 110 px (not a float's 111)
+    cube40 = Block((40.0, 40.0, 40.0), faces=_resized(cn03, 48).faces, meta={})
+    assert check_face_layout(cube40).unchecked["top"].endswith("at least 110 px a side")
     fine = check_face_layout(_resized(cn03, 160))
+    assert fine.unchecked == {} and fine.corrections == {} and len(fine.faces) == 6
+
+
+def test_a_correct_synthetic_cube_at_2_5_px_per_mm_is_not_called_mirrored():
+    """A quarter-sawn synthetic cube of 3 mm rings, laid out right and brought down to 125 px a
+    side (2.50 px/mm, LANCZOS as 'block from-photos' resamples), had its 'right' face said to look
+    mirrored top-bottom (+0.16 over its layout): the floor of 2.5 px/mm let it be judged
+    (LAYOUT_MIN_PX_PER_MM, measured on 3 and 6 mm-ring cubes). It is listed as not checked; at
+    138 px (2.76 px/mm) it is checked and passes."""
+    from woodcam.synth import AnalyticLogField, cut_block, synth_block
+
+    field = cut_block(AnalyticLogField(ring_width_mm=3.0, eccentricity=0.05), (50, 50, 50), "quarter-sawn")
+    big = synth_block(field, (50, 50, 50), face_px=320, seed=29837, ring_map_faces=())
+    report = check_face_layout(_resized(big, 125))
+    assert report.corrections == {} and report.warnings == [], report.warnings
+    assert set(report.unchecked) == set(big.faces) and "under the 2.75 px/mm" in report.unchecked["right"]
+    fine = check_face_layout(_resized(big, 138))
     assert fine.unchecked == {} and fine.corrections == {} and len(fine.faces) == 6
 
 

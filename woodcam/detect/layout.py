@@ -150,7 +150,7 @@ def _too_coarse(block: Block, name: FaceName) -> str | None:
     px_mm = 1.0 / max(block.face_pixel_size_mm(name))
     if px_mm >= LAYOUT_MIN_PX_PER_MM:
         return None
-    # rounded first: 2.5 px/mm over a 50 mm side is 125 px, not the 126 of a float's last bit
+    # rounded first: 2.75 px/mm over a 40 mm side is 110 px, not the 111 of a float's last bit
     need = int(np.ceil(round(LAYOUT_MIN_PX_PER_MM / px_mm * min(f.shape), 6)))
     h, w = f.shape[:2]
     side = f"{h} px a side" if h == w else f"{h}x{w} px"
