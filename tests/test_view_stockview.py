@@ -211,6 +211,26 @@ def test_the_cli_overlay_colours_are_the_name_tables():
         assert tuple(round(255 * v) for v in matplotlib.colors.to_rgb(name)) == rgb
 
 
+def _every_view_refuses(bowl, tmp_path, colour, said):
+    """preview, top_view and stock_view each refuse an overlay of ``colour`` with a WoodcamError
+    naming the view and the argument, then ``said`` (a regex); no picture is written."""
+    import trimesh
+
+    from woodcam.view import preview
+    from woodcam.view.topview import top_view
+
+    hm, atlas, charts = bowl
+    seg = np.zeros((1, 2, 3))
+    with pytest.raises(WoodcamError, match=r"preview: overlay\[0\] " + said):
+        preview(trimesh.creation.box(), screenshot=tmp_path / "p.png", window_size=(64, 48),
+                overlay=[(seg, colour, 1.0)])
+    with pytest.raises(WoodcamError, match="top_view: overlay " + said):
+        top_view(hm, (W, D, H), atlas, window_size=(100, 80), overlay=[(seg, colour, 1.0)])
+    with pytest.raises(WoodcamError, match="stock_view: overlay " + said):
+        stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), overlay=[(seg, colour, 1.0)])
+    assert not (tmp_path / "p.png").exists()
+
+
 @pytest.mark.parametrize("colour, fix", [("royal_blue", "did you mean 'royalblue'"),
                                          ("banana", "did you mean 'xkcd:banana'"),
                                          ("nope", r"give a CSS4 name, e.g. 'royalblue'"),
@@ -222,22 +242,8 @@ def test_a_colour_name_not_in_the_table_is_refused_by_every_view(bowl, tmp_path,
     refuses a name outside matplotlib's table, the style cycle and a transparent colour alike,
     naming itself, the argument, the value and a fix (the close matches)."""
     pytest.importorskip("pyvista")
-    import trimesh
-
-    from woodcam.view import preview
-    from woodcam.view.topview import top_view
-
-    hm, atlas, charts = bowl
-    seg = np.zeros((1, 2, 3))
-    said = f"colour must be a colour name matplotlib knows .*; got {re.escape(repr(colour))}; .*{fix}"
-    with pytest.raises(WoodcamError, match=r"preview: overlay\[0\] " + said):
-        preview(trimesh.creation.box(), screenshot=tmp_path / "p.png", window_size=(64, 48),
-                overlay=[(seg, colour, 1.0)])
-    with pytest.raises(WoodcamError, match="top_view: overlay " + said):
-        top_view(hm, (W, D, H), atlas, window_size=(100, 80), overlay=[(seg, colour, 1.0)])
-    with pytest.raises(WoodcamError, match="stock_view: overlay " + said):
-        stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), overlay=[(seg, colour, 1.0)])
-    assert not (tmp_path / "p.png").exists()
+    _every_view_refuses(bowl, tmp_path, colour,
+                        f"colour must be a colour name matplotlib knows .*; got {re.escape(repr(colour))}; .*{fix}")
 
 
 @pytest.mark.parametrize("colour", [(255.0, 0, 0), (1, 0, 0), (1000, 0, 0), (-0.5, 0.0, 0.0),
@@ -250,23 +256,8 @@ def test_an_overlay_triple_refused_is_refused_by_every_view(bowl, tmp_path, colo
     rule and the value (preview drew (1.0, 0, 0, 1.0) and top_view (255.0, 0, 0) as red,
     stock_view took ('1', '0', '0') as near black)."""
     pytest.importorskip("pyvista")
-    import trimesh
-
-    from woodcam.view import preview
-    from woodcam.view.topview import top_view
-
-    hm, atlas, charts = bowl
-    seg = np.zeros((1, 2, 3))
-    rule = r"RGB triple: whole numbers in 0\.\.255, .*floats in 0\.\.1.*; got "
-    with pytest.raises(WoodcamError, match=r"preview: overlay\[0\] colour must be a colour name matplotlib "
-                                           r"knows .* or an " + rule):
-        preview(trimesh.creation.box(), screenshot=tmp_path / "p.png", window_size=(64, 48),
-                overlay=[(seg, colour, 1.0)])
-    with pytest.raises(WoodcamError, match="top_view: overlay colour must be .*" + rule):
-        top_view(hm, (W, D, H), atlas, window_size=(100, 80), overlay=[(seg, colour, 1.0)])
-    with pytest.raises(WoodcamError, match="stock_view: overlay colour must be .*" + rule):
-        stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), overlay=[(seg, colour, 1.0)])
-    assert not (tmp_path / "p.png").exists()
+    _every_view_refuses(bowl, tmp_path, colour, r"colour must be a colour name matplotlib knows .* or an "
+                        r"RGB triple: whole numbers in 0\.\.255, .*floats in 0\.\.1.*; got ")
 
 
 def test_a_colour_of_none_is_refused_by_every_view(bowl, tmp_path):
@@ -278,18 +269,10 @@ def test_a_colour_of_none_is_refused_by_every_view(bowl, tmp_path):
     import trimesh
 
     from woodcam.view import preview
-    from woodcam.view.topview import top_view
 
+    _every_view_refuses(bowl, tmp_path, None,
+                        r"colour must be a colour name matplotlib knows .*; got None; None is no colour .*'royalblue'")
     hm, atlas, charts = bowl
-    seg = np.zeros((1, 2, 3))
-    said = r"colour must be a colour name matplotlib knows .*; got None; None is no colour .*'royalblue'"
-    with pytest.raises(WoodcamError, match=r"preview: overlay\[0\] " + said):
-        preview(trimesh.creation.box(), screenshot=tmp_path / "p.png", window_size=(64, 48),
-                overlay=[(seg, None, 1.0)])
-    with pytest.raises(WoodcamError, match="top_view: overlay " + said):
-        top_view(hm, (W, D, H), atlas, window_size=(100, 80), overlay=[(seg, None, 1.0)])
-    with pytest.raises(WoodcamError, match="stock_view: overlay " + said):
-        stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), overlay=[(seg, None, 1.0)])
     for view_of in (lambda: preview(trimesh.creation.box(), screenshot=tmp_path / "p.png", window_size=(64, 48),
                                     background=None),
                     lambda: stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), background=None)):
