@@ -609,3 +609,32 @@ def test_wood_that_shows_no_ring_is_said_so(tmp_path):
                                             r"and show no ring, one flat colour: leaf 0 at y=2 mm \(years 0 to 0\); "
                                             r"leaf 1 .*slice across the rings"):
         slice_veneers(core, 2, (4.0, 4.0), px_per_mm=2.0)
+
+
+def test_a_block_centred_outside_the_grown_object_is_refused(tmp_path, capsys):
+    """--block-centre=1000,0,0 (or 0,40,0 by a 40 mm box grown 5 mm) was taken without a word: the
+    block was cut from the air round the object (a bake from its field.npz: "years 18.6 to 18.6
+    of the 5 grown"), and section_xz.png through that centre was a blank white picture. Now a
+    usage error after the growth, before anything is written, naming the value as typed, the
+    grown box in --units and a centre inside it."""
+    box = tmp_path / "box.stl"
+    trimesh.creation.box((40, 30, 20)).export(box)
+    out = tmp_path / "o"
+    base = ["woodify", str(box), "--years", "3", "--resolution", "24", "--cracks", "none", "--out", str(out)]
+    for centre, units, said in (("1000,0,0", "mm", "--block-centre 1000,0,0: the block's centre lies outside"),
+                                ("0,40,0", "mm", "its block would be cut from the air round the object"),
+                                ("0,1.6,0", "inch", "--block-centre 0,1.6,0: the block's centre lies outside")):
+        growth = "0.2" if units == "inch" else "5"  # 5 mm, 5.08 mm
+        assert _rc([*base, "--growth", growth, f"--block-centre={centre}", "--units", units]) == 2, centre
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and said in err, err
+        unit = "in" if units == "inch" else "mm"
+        assert "z [" in err and f"] {unit})" in err and "--block-centre=0," in err, err
+        assert not out.exists() or not any(out.iterdir()), list(out.iterdir())
+    # a centre inside the grown box, even off the input (its bark), is a block of the grown wood
+    assert _rc([*base, "--growth", "5", "--block-centre=0,0,12"]) == 0
+    capsys.readouterr()
+    from PIL import Image
+
+    section = np.asarray(Image.open(out / "section_xz.png").convert("RGB"))
+    assert (section.min(axis=-1) < 200).mean() > 0.2  # wood, not a white page

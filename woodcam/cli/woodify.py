@@ -17,8 +17,8 @@ from pathlib import Path
 
 from ..errors import UsageError, WoodcamError
 from ..tolerances import DEFAULT_MAX_ATLAS_PX
-from ..units import say_length
-from .options import add_input, add_max_atlas_option, add_out_option, add_units_option, sizes_type, vector_type
+from ..units import say_length, typed_length
+from .options import add_input, add_max_atlas_option, add_out_option, add_units_option, as_typed, sizes_type, vector_type
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -63,8 +63,8 @@ def register(subparsers) -> argparse.ArgumentParser:
                    "object's bounding box")
     p.add_argument("--block-centre", default=None, metavar="X,Y,Z", type=vector_type("--block-centre"),
                    help="centre of that block in the input's frame (in --units); default the grown "
-                   "object's bounding-box centre (write --block-centre=-9,0,35 when the first "
-                   "value is negative)")
+                   "object's bounding-box centre; one outside the grown object's box is refused (write "
+                   "--block-centre=-9,0,35 when the first value is negative)")
     p.add_argument("--cracks", choices=("none", "stress", "vertical", "horizontal", "random"),
                    default="stress", help="bark crack pattern (default stress: natural directions)")
     p.add_argument("--crack-region", default=None, metavar="X,Y,Z,R",
@@ -390,6 +390,42 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
     return files, summary
 
 
+def _check_block_centre(res, args) -> None:
+    """A ``--block-centre`` outside the grown object's box is refused (exit 2): its block was cut
+    from the air round the object, a ``field.npz`` of wood never grown (a bake from it said
+    "years 18.6 to 18.6 of the 5 grown"), and the ring sections drawn through that centre were
+    blank PNGs. Checked after the growth, the only time the grown box is known, before the
+    crack stage and any file is written."""
+    import numpy as np
+
+    if args.block_centre is None:  # the default is the grown object's own centre
+        return
+    g = res.front.grid
+    wood = res.front.arrival_mm <= res.tau(res.years)
+    if not wood.any():  # nothing grown to cut from: the growth's own checks say why
+        return
+    lo, hi = np.empty(3), np.empty(3)
+    for ax in range(3):
+        idx = np.flatnonzero(wood.any(axis=tuple(a for a in range(3) if a != ax)))
+        lo[ax] = g.origin_mm[ax] + idx[0] * g.spacing_mm
+        hi[ax] = g.origin_mm[ax] + idx[-1] * g.spacing_mm
+    # the grown surface lies between the outermost wood node and the next node out: said half
+    # a spacing out, a centre taken up to a whole spacing out (the surface may reach that far)
+    c = np.asarray(args.block_centre, float)
+    if np.all((c >= lo - g.spacing_mm) & (c <= hi + g.spacing_mm)):
+        return
+    lo, hi = lo - g.spacing_mm / 2, hi + g.spacing_mm / 2
+    typed = ",".join(f"{v:g}" for v in as_typed(args, "block_centre"))
+    box = say_length([v for pair in zip(lo, hi) for v in pair], ".4g",
+                     form="x [{}, {}], y [{}, {}], z [{}, {}]")
+    centre = ",".join(typed_length(v, 0.5 * g.spacing_mm) for v in (lo + hi) / 2)
+    raise UsageError(f"--block-centre {typed}: the block's centre lies outside the grown object's "
+                     f"box ({box}), so its block would be cut from the air round the object, wood "
+                     f"never grown, and the ring sections through it would show none; give a centre "
+                     f"within that box, e.g. --block-centre={centre} near its middle, or leave --block-centre "
+                     "out for the grown object's own centre")
+
+
 def run(args) -> int:
     """Run a parsed ``woodify`` command; returns the exit status."""
     import numpy as np
@@ -447,6 +483,7 @@ def run(args) -> int:
                           shape=args.shape, eccentricity=args.eccentricity, up=args.up,
                           obstacles=obstacles, brushes=brushes, resolution=args.resolution,
                           method=args.method, **painted)
+            _check_block_centre(res, args)
         # one unit: a Ctrl-C leaves the last run's products, never new ones beside old ones (a
         # grown.glb of 13 years beside a woodify.json of 11)
         with all_or_nothing():
