@@ -71,7 +71,6 @@ def test_cli_run_writes_everything(scans, capsys):
     (["{d}/coffee.png", "--veneer", "{d}/light.png:300:{d}/coffee.png"], "mask must have the image's size", 1),
     (["{d}/coffee.png", "--veneer", "{d}/light.png:2000"], "smaller than one patch", 1),
     (["{d}/coffee.png"], "parquetry needs veneers", 1),
-    (["{d}/coffee.png", "--veneer", "{d}/light.png:abc"], "resolution must be DPI", 1),
 ])
 def test_cli_bad_input_is_one_line(scans, capsys, args, message, code):
     argv = ["parquetry"] + [a.format(d=scans) for a in args] + ["--out", str(scans / "o"), "--quiet"]
@@ -79,6 +78,21 @@ def test_cli_bad_input_is_one_line(scans, capsys, args, message, code):
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and err.startswith("woodcam: error:") and message.format(d=scans) in err
 
+
+
+@pytest.mark.parametrize("resolution", ["abc", "0", "-300", "nan", "0px/mm", "-2px/mm"])
+def test_a_veneer_resolution_typed_wrong_is_a_usage_error_naming_it(scans, capsys, resolution):
+    """--veneer SCAN:abc exited 1 (a failed run, not a wrong command line); SCAN:0 and SCAN:-300
+    reached the scan reader, which said 'px_per_mm must be a finite number > 0; got
+    -11.811023622047244' of a typed -300 dpi, naming neither --veneer nor what was typed."""
+    argv = ["parquetry", str(scans / "coffee.png"), "--veneer", f"{scans / 'light.png'}:{resolution}",
+            "--out", str(scans / "o"), "--quiet"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith("woodcam: error: --veneer "), err
+    assert (f"light.png:{resolution}': the resolution must be DPI (a number > 0, e.g. 300) or Npx/mm "
+            f"(e.g. 4px/mm); got {resolution!r}") in err, err
+    assert not (scans / "o").exists()
 
 
 @pytest.mark.parametrize("option, value, said", [

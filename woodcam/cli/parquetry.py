@@ -156,23 +156,34 @@ def _scan_paths(text: str) -> list[str]:
 
 
 def _scan_entry(text: str) -> dict:
-    from ..errors import WoodcamError
+    """One ``--veneer SCAN[:DPI][:MASK]`` as a job's source texture. Its text is the command
+    line's: a malformed one is a usage error (exit 2), as argparse's are; a resolution of 0 or
+    below reached the scan reader, which said 'px_per_mm must be ... > 0; got -11.81...' of a
+    typed '-300' and exited 1."""
+    import math
+
+    from ..errors import UsageError
 
     parts = text.split(":")
     entry = {"texture": parts[0], "dpi": 300.0, "id": Path(parts[0]).stem}
     if len(parts) > 3:
-        raise WoodcamError(f"--veneer takes SCAN[:DPI][:MASK]; got {text!r}")
+        raise UsageError(f"--veneer takes SCAN[:DPI][:MASK]; got {text!r}")
     if len(parts) >= 2 and parts[1]:
         res = parts[1].lower()
+        per_mm = res.endswith("px/mm")
         try:
-            if res.endswith("px/mm"):
-                entry.pop("dpi")
-                entry["px_per_mm"] = float(res[:-5])
-            else:
-                entry["dpi"] = float(res)
-        except ValueError as err:
-            raise WoodcamError(f"--veneer resolution must be DPI (e.g. 300) or Npx/mm (e.g. 4px/mm); "
-                               f"got {parts[1]!r}") from err
+            value = float(res[:-5] if per_mm else res)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and value > 0):
+            raise UsageError(f"--veneer {text!r}: the resolution must be DPI (a number > 0, e.g. 300) "
+                             f"or Npx/mm (e.g. 4px/mm); got {parts[1]!r}; give the resolution the sheet "
+                             f"was scanned at, e.g. {parts[0]}:300")
+        if per_mm:
+            entry.pop("dpi")
+            entry["px_per_mm"] = value
+        else:
+            entry["dpi"] = value
     if len(parts) == 3:
         entry["mask"] = parts[2]
     if len(parts) < 2 or not parts[1]:
