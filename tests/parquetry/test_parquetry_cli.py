@@ -392,6 +392,32 @@ def test_the_job_file_of_a_run_with_relative_paths_reruns_from_anywhere(scans, c
     assert [p["anchor_px"] for p in again] == [p["anchor_px"] for p in first]
 
 
+def test_sheet_size_errors_speak_the_units_it_was_typed_in(scans, capsys):
+    """Under --units inch, '--sheet-size 0x1' said "takes WxH in mm ...; got '0x25.4'" (the size
+    --units had turned into mm), and leaves past the block said "give --sheet-size 100x50 mm or
+    smaller": typed as said, read as inches, 2540 x 1270 mm, refused again. Now the text as
+    typed, the rule, the sizes and the fix in --units (a block spec's size, read in mm, says
+    so), and the fix it gives is taken."""
+    out = scans / "out"
+    inch = ["--veneer-from", "builtin:flat-sawn", "--no-glb", "--units", "inch"]
+    assert _small_run(scans, out, *inch, "--sheet-size", "0x1") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and ("--sheet-size takes WxH in inches (--units inch), 2 numbers in (0, 393.701], "
+                                     "e.g. 2x2; got '0x1'") in err, err
+    assert _small_run(scans, out, *inch, "--sheet-size", "100x50") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "leaves of 100 x 50 in (--sheet-size" in err, err
+    assert "its 3.937 x 3.15 x 1.969 in block's face normal to y (--slice-axis) is 3.937 x 1.969 in" in err, err
+    assert "(builtin:flat-sawn:2540x80x1270, its size in mm)" in err, err
+    fix = err.split("give --sheet-size ")[1].split(" in or smaller")[0]
+    assert fix == "3.93701x1.968504", fix
+    assert _small_run(scans, out, *inch, "--sheet-size", fix) == 0
+    capsys.readouterr()
+    assert _small_run(scans, out, *inch, "--sheets", "30", "--leaf-thickness", "0.1") == 2
+    assert ("30 leaves (--sheets) of 0.1 in + 0.01575 in kerf, sliced from the middle of builtin:flat-sawn along y, "
+            "reach 5.031 in into its 3.15 in: past its back face") in capsys.readouterr().err
+
+
 def test_leaves_beyond_their_block_are_refused_naming_the_sizes(scans, capsys):
     """'--veneer-from builtin:flat-sawn' sliced the default 600 x 400 mm leaves from its
     100 x 80 x 50 mm block, and any --sheet-size or --sheets past the block ran without a word:

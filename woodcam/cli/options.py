@@ -668,21 +668,26 @@ def allow_negative_values(p: argparse.ArgumentParser) -> None:
     p._negative_number_matcher = _NEGATIVE_VALUES
 
 
-def parse_sizes(text: str, option: str, n: int = 3, *, cube: bool = False) -> tuple[float, ...]:
-    """``"WxDxH"`` (``x``, ``×`` or ``,`` between them) -> ``n`` sizes in mm, each finite and in
-    (0, :data:`~woodcam.limits.MAX_BLOCK_SIZE_MM`]; with ``cube`` one number is a cube's side.
-    Otherwise a UsageError (exit 2: the command line is wrong, as argparse says of a malformed
-    number; ``--size-mm 2in`` exited 1) naming ``option`` (``--sheet-size 1e300x10`` reached an
-    allocation and ``--size-mm 1e300`` a block of 0 px/mm)."""
+def parse_sizes(text: str, option: str, n: int = 3, *, cube: bool = False,
+                units: Units = "mm") -> tuple[float, ...]:
+    """``"WxDxH"`` (``x``, ``×`` or ``,`` between them), typed in ``units`` -> ``n`` sizes in
+    mm, each finite and in (0, :data:`~woodcam.limits.MAX_BLOCK_SIZE_MM`]; with ``cube`` one
+    number is a cube's side. Otherwise a UsageError (exit 2: the command line is wrong, as
+    argparse says of a malformed number; ``--size-mm 2in`` exited 1) naming ``option``
+    (``--sheet-size 1e300x10`` reached an allocation and ``--size-mm 1e300`` a block of 0
+    px/mm) with the text as typed and its rule in ``units`` (``--sheet-size 0x1 --units inch``
+    said "takes WxH in mm ...; got '0x25.4'")."""
     from ..units import parse_lengths
 
-    vals = parse_lengths(text, n, max_mm=MAX_BLOCK_SIZE_MM, cube=cube)
+    k = MM_PER_UNIT[units]
+    vals = parse_lengths(text, n, max_mm=MAX_BLOCK_SIZE_MM / k, cube=cube)
     dims = "x".join("WDH"[:n]) if n == 3 else "x".join("WH"[:n])
     if vals is None:
-        raise UsageError(f"{option} takes {dims} in mm, {n} numbers in (0, {MAX_BLOCK_SIZE_MM:g}]"
+        unit = "mm" if units == "mm" else f"inches (--units {units})"
+        raise UsageError(f"{option} takes {dims} in {unit}, {n} numbers in (0, {MAX_BLOCK_SIZE_MM / k:.6g}]"
                            + (" (or one, a cube's side)" if cube else "") + ", e.g. "
-                           + "x".join(["50"] * n) + f"; got {text!r}")
-    return vals
+                           + "x".join([f"{50 / k:.2g}"] * n) + f"; got {text!r}")
+    return tuple(v * k for v in vals)
 
 
 def sizes_type(option: str, n: int = 3):

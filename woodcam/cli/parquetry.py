@@ -12,7 +12,7 @@ import warnings
 from pathlib import Path
 
 from ..errors import WoodcamWarning
-from .options import add_input, SPECIES_HELP, add_out_option, add_units_option, parse_sizes, species_type
+from .options import SPECIES_HELP, add_input, add_out_option, add_units_option, as_typed, parse_sizes, species_type
 
 _EPILOG = """\
 veneer sources (any number, mixed):
@@ -247,7 +247,10 @@ def run(args) -> int:
     for d, default in _SLICING.items():
         if getattr(args, d) is None:
             setattr(args, d, default)
-    w, h = parse_sizes(args.sheet_size, "--sheet-size", n=2) if args.sheet_size is not None else (None, None)
+    # read as typed, in --units: its error then quotes what was typed (it quoted the size --units
+    # had turned into mm, '0x25.4' of a typed '0x1', and said 'in mm')
+    w, h = (parse_sizes(str(as_typed(args, "sheet_size")), "--sheet-size", n=2, units=args.units)
+            if args.sheet_size is not None else (None, None))
     # the slicing options given here override the job file's blocks too (--config's rule: options
     # given here override it); they were ignored there
     leaf = {"sheets": args.sheets, "width_mm": w, "height_mm": h, "thickness_mm": args.leaf_thickness,

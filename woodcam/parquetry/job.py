@@ -32,6 +32,7 @@ from .._specs import absolute_spec
 from ..errors import WoodcamError, WoodcamWarning
 from ..limits import MAX_BLOCK_SIZE_MM
 from ..tolerances import IN_BLOCK_RTOL
+from ..units import message_unit, say_length, typed_length
 
 Priority = Literal["saliency", "center"]
 
@@ -477,30 +478,36 @@ def check_leaves_in_block(stock, n_sheets: int, width_mm: float | None, height_m
     face = (size[right], size[down])
     w = min(DEFAULT_LEAF_MM[0], face[0]) if width_mm is None else float(width_mm)
     h = min(DEFAULT_LEAF_MM[1], face[1]) if height_mm is None else float(height_mm)
-    block = " x ".join(f"{v:g}" for v in size)
+    # lengths in the message units (--units): the fix '--sheet-size 100x50 mm', typed as it
+    # said under --units inch, was 2540 x 1270 mm, refused again; a block spec's size stays mm
+    # (--veneer-from reads its :WxDxH in mm whatever --units says)
+    block = say_length(size, "g", sep=" x ")
     tol = IN_BLOCK_RTOL * max(size)
     if w > face[0] + tol or h > face[1] + tol:
         need = list(size)
         need[right], need[down] = max(size[right], w), max(size[down], h)
-        bigger = " x ".join(f"{v:g}" for v in need)
+        bigger = "x".join(f"{v:g}" for v in need)
+        fits = [typed_length(min(v, f), tol, lambda back, f=f: back <= f + tol) for v, f in ((w, face[0]), (h, face[1]))]
         raise LeavesPastBlockError(
-            f"leaves of {w:g} x {h:g} mm (--sheet-size; width_mm, height_mm in a job file) do not fit "
-            f"{stock.spec}: its {block} mm block's face normal to {axis} (--slice-axis) is {face[0]:g} x "
-            f"{face[1]:g} mm, and every sheet must be wood of the block, not of the field outside it; give "
-            f"--sheet-size {min(w, face[0]):g}x{min(h, face[1]):g} mm or smaller"
-            + (f", or a block of {bigger} mm that holds them ({spec}:{bigger.replace(' x ', 'x')})"
+            f"leaves of {say_length((w, h), 'g', sep=' x ')} (--sheet-size; width_mm, height_mm in a job file) "
+            f"do not fit {stock.spec}: its {block} block's face normal to {axis} (--slice-axis) is "
+            f"{say_length(face, 'g', sep=' x ')}, and every sheet must be wood of the block, not of the field "
+            f"outside it; give --sheet-size {'x'.join(fits)} {message_unit()} or smaller"
+            + (f", or a block of {say_length(need, 'g', sep=' x ')} that holds them ({spec}:{bigger}"
+               + (", its size in mm" if message_unit() != "mm" else "") + ")"
                if re.fullmatch(r"builtin:[a-z-]+", spec := str(stock.spec))
-               else f", or a block of {bigger} mm that holds them" if spec.startswith(("builtin:", "log:"))
+               else f", or a block of {say_length(need, 'g', sep=' x ')} that holds them"
+               if spec.startswith(("builtin:", "log:"))
                else " (a block folder or a grown block holds only its own wood)"))
     pitch = thickness_mm + kerf_mm
     reach = size[ax] / 2 + (n_sheets - 1) * pitch + thickness_mm
     if n_sheets >= 1 and thickness_mm > 0 and pitch > 0 and reach > size[ax] + tol:
         most = max(0, int((size[ax] / 2 - thickness_mm) // pitch) + 1)
         raise LeavesPastBlockError(
-            f"{n_sheets} leaves (--sheets) of {thickness_mm:g} mm + {kerf_mm:g} mm kerf, sliced from the middle "
-            f"of {stock.spec} along {axis}, reach {reach:g} mm into its {size[ax]:g} mm: past its back face, "
-            f"wood of the field outside the {block} mm block; give --sheets {most} or fewer, thinner leaves "
-            f"or kerf, or a deeper block")
+            f"{n_sheets} leaves (--sheets) of {say_length(thickness_mm, 'g')} + {say_length(kerf_mm, 'g')} kerf, "
+            f"sliced from the middle of {stock.spec} along {axis}, reach {say_length(reach, 'g')} into its "
+            f"{say_length(size[ax], 'g')}: past its back face, wood of the field outside the {block} block; "
+            f"give --sheets {most} or fewer, thinner leaves or kerf, or a deeper block")
     return w, h
 
 
