@@ -638,3 +638,23 @@ def test_a_block_centred_outside_the_grown_object_is_refused(tmp_path, capsys):
 
     section = np.asarray(Image.open(out / "section_xz.png").convert("RGB"))
     assert (section.min(axis=-1) < 200).mean() > 0.2  # wood, not a white page
+
+
+def test_crack_options_with_no_cracks_are_said_to_do_nothing(tmp_path, capsys):
+    """--cracks none dropped --crack-years, --crack-region, --crack-render, --crack-threshold and
+    --relief without a word (exit 0, the same files as without them): a warning names those
+    typed; with cracks, or with none typed, there is none."""
+    ball = tmp_path / "ball.stl"
+    trimesh.creation.icosphere(subdivisions=1, radius=5.0).export(ball)
+    base = ["woodify", str(ball), "--years", "2", "--resolution", "16", "--out", str(tmp_path / "o")]
+    assert main([*base, "--cracks", "none", "--crack-years", "1", "--relief", "0.5",
+                 "--crack-render", "groove", "--crack-region=0,0,0,3", "--crack-threshold", "2"]) == 0
+    err = capsys.readouterr().err
+    assert ("woodcam: warning: --crack-years, --crack-region, --crack-render, --crack-threshold, --relief shape "
+            "the bark's cracks, and --cracks none draws none, so they change nothing here; drop them, or give a "
+            "crack pattern (--cracks stress, the default)") in err, err
+    for extra in (["--cracks", "none"], ["--crack-years", "1", "--relief", "0.5"]):
+        assert main([*base, *extra]) == 0
+        assert "change nothing" not in capsys.readouterr().err, extra
+    assert _rc([*base, "--cracks", "none", "--relief", "2"]) == 2  # its range still checked
+    assert "--relief must be in [0, 1]" in capsys.readouterr().err

@@ -75,12 +75,12 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--crack-years", type=int, default=None,
                    help="last years simulated for cracks, at most --years (default 5, or the whole "
                    "years grown when fewer; under a year's growth, from the input on)")
-    p.add_argument("--crack-render", choices=("groove", "material"), default="material",
+    p.add_argument("--crack-render", choices=("groove", "material"), default=None,
                    help="draw cracks into the bark texture (material, default) or cut them as grooves")
     p.add_argument("--crack-threshold", type=float, default=None,
                    help="separation eigenvalue that opens a crack (a triangle's area times its bark strain per "
                    "length at unit stiffness, so in mm; default 2x the median of the first simulated year)")
-    p.add_argument("--relief", type=float, default=0.3,
+    p.add_argument("--relief", type=float, default=None,
                    help="stress left next to a new crack, in [0, 1] (0 removes all; default 0.3)")
     p.add_argument("--seed", type=int, default=0, help="random seed of the procedural bark and random cracks (default 0)")
     add_max_atlas_option(p, given_only=True)  # None unless typed: a kept picture warns
@@ -456,6 +456,20 @@ def run(args) -> int:
         years = list(names.values())
     else:
         years = [args.years * k / 4 for k in (1, 2, 3)]
+    # the options that shape the cracks (None: not typed) were dropped without a word by
+    # --cracks none, which draws none: a user who typed them took them to have done something
+    crack_opts = ("crack_years", "crack_region", "crack_render", "crack_threshold", "relief")
+    if args.cracks == "none" and any(getattr(args, d) is not None for d in crack_opts):
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        typed = ", ".join("--" + d.replace("_", "-") for d in crack_opts if getattr(args, d) is not None)
+        warnings.warn(f"{typed} shape the bark's cracks, and --cracks none draws none, so they change "
+                      "nothing here; drop them, or give a crack pattern (--cracks stress, the default)",
+                      WoodcamWarning, stacklevel=2)
+    args.crack_render = args.crack_render or "material"
+    args.relief = 0.3 if args.relief is None else args.relief
     # the crack stage simulates the last --crack-years of the growth: more than were grown began
     # before the input existed (silently clamped to year 0); the default is 5 or every year grown
     if args.crack_years is None:
