@@ -247,8 +247,9 @@ def test_a_scan_that_states_its_dpi_is_not_sized_by_the_default_without_a_word(s
     third of its size, silently): the tag is named with the fix; a typed :DPI says nothing."""
     Image.open(scans / "light.png").save(scans / "tagged.png", dpi=(101.6, 101.6))
     argv = ["parquetry", str(scans / "coffee.png"), "--image-size-mm", "28", "--px-per-mm", "2",
-            "--no-seams", "--no-glb", "--quiet", "--veneer", f"{scans / 'dark.png'}:2px/mm"]
-    # sized at 300 dpi the sheet is too small for a patch: the warning says why
+            "--no-glb", "--quiet", "--veneer", f"{scans / 'dark.png'}:2px/mm"]
+    # sized at 300 dpi (27 x 20 mm) the sheet is too small for a patch with its overlap (25 mm;
+    # a square piece of --no-seams, 18 mm, would fit): the warning says why
     assert main(argv + ["--veneer", str(scans / "tagged.png"), "--out", str(scans / "a")]) == 1
     err = capsys.readouterr().err
     assert "the file states 101.6 dpi, but no resolution was given, so the default 300 dpi was used; " \
@@ -456,3 +457,30 @@ def test_leaves_beyond_their_block_are_refused_naming_the_sizes(scans, capsys):
     assert _small_run(scans, out, *flat) == 0
     result = json.loads((out / "result.json").read_text())
     assert [v["size_mm"] for v in result["veneers"] if v["id"].startswith("builtin")] == [[100.0, 50.0]] * 2
+
+
+def test_no_seams_pieces_take_no_overlap_of_wood(scans, capsys):
+    """--no-seams (README: '--no-seams or 0: square pieces') cut square 14 mm pieces but matched
+    each with its 3.5 mm overlap, so every piece took 21 mm + kerf of the sheet: on the two
+    100 x 50 mm leaves of builtin:flat-sawn the wood ran out at 10 of 16 cells where
+    --overlap-mm 0, the same square pieces, placed 15. Now --no-seams is overlap 0 (job.json
+    replays it), and an --overlap-mm given with it is said to change nothing."""
+    Image.open(scans / "coffee.png").crop((100, 0, 500, 400)).save(scans / "square.png")
+
+    def run(out, *extra):
+        rc = main(["parquetry", str(scans / "square.png"), "--veneer-from", "builtin:flat-sawn",
+                   "--image-size-mm", "56", "--no-glb", "--quiet", "--out", str(scans / out), *extra])
+        return rc, json.loads((scans / out / "result.json").read_text())
+
+    rc, seams = run("seams")
+    rc_square, square = run("square", "--overlap-mm", "0")
+    assert run("no_seams", "--no-seams")[0] == rc_square
+    no_seams = json.loads((scans / "no_seams" / "result.json").read_text())
+    assert no_seams["params"]["overlap_mm_used"] == 0
+    assert no_seams["summary"]["placed_cells"] == square["summary"]["placed_cells"] > seams["summary"]["placed_cells"]
+    assert [p["anchor_px"] for p in no_seams["patches"]] == [p["anchor_px"] for p in square["patches"]]
+    assert json.loads((scans / "no_seams" / "job.json").read_text())["woodcam"]["params"]["overlap_mm"] == 0
+    capsys.readouterr()
+    run("no_seams", "--no-seams", "--overlap-mm", "2")
+    assert ("woodcam: warning: --overlap-mm 2 changes nothing with --no-seams: square pieces are matched and "
+            "cut without an overlap; drop one of them") in capsys.readouterr().err

@@ -123,7 +123,8 @@ def register(subparsers) -> None:
     f.add_argument("--overlap-mm", type=float, default=None,
                    help="patch overlap for seam cutting in mm (default min(patch/4, "
                    "(patch - min-piece)/2) = 3.5); 0 = square pieces")
-    f.add_argument("--no-seams", action="store_true", help="square pieces, no seam optimisation")
+    f.add_argument("--no-seams", action="store_true", help="square pieces, no seam optimisation: matched and cut "
+                   "with no overlap (--overlap-mm 0)")
     f.add_argument("--min-piece-mm", type=float, default=None,
                    help="narrowest piece in mm (default 5, the paper's bound)")
     f.add_argument("--tool-diameter", type=float, default=None, metavar="LEN",
@@ -227,6 +228,12 @@ def run(args) -> int:
             if getattr(args, opt) is not None}
     if args.reuse_wood:
         over["single_use"] = False
+    if args.no_seams:  # square pieces: no overlap to match or cut (job.json then replays it)
+        if over.get("overlap_mm"):
+            warnings.warn(f"--overlap-mm {over['overlap_mm']:g} changes nothing with --no-seams: square "
+                          "pieces are matched and cut without an overlap; drop one of them",
+                          WoodcamWarning, stacklevel=2)
+        over["overlap_mm"] = 0.0
     try:  # a job file's own parameters were checked as it was read: what fails now, the options made
         job.params = dataclasses.replace(job.params, **over).check()
     except WoodcamError as err:  # options that contradict each other: a wrong command line (exit 2)

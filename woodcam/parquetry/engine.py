@@ -225,7 +225,10 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     veneers : list of :class:`Veneer` (any resolution; resampled to ``params.px_per_mm``)
     params : :class:`ParquetryParams` (Table 1 defaults)
     progress : progress bars over the sheets' rotations and the patches
-    seams : cut optimal seams in the overlaps (eq. 8-9); False keeps square patches
+    seams : cut optimal seams in the overlaps (eq. 8-9); False keeps square patches, matched
+        and placed with their overlap all the same (the matching of a seamed run, as the bench
+        times it); ``overlap_mm=0`` matches and places them square, spending no wood round
+        them, as ``woodcam parquetry --no-seams`` does
     repair : straighten the seams round pieces a router cannot cut (see
         :func:`repair_fabricability`); False leaves them to be reported
 
