@@ -337,12 +337,12 @@ def test_bake_refuses_a_missing_or_unreadable_part_before_the_block_is_opened(tm
     opened = []
     monkeypatch.setattr(woodcam.stock, "open_stock", lambda *a, **k: opened.append(a))
     (tmp_path / "part.dwg").write_text("x")
-    # a missing part is a wrong command line, refused at the input door (exit 2); a part of a
-    # suffix no reader takes is the work failing (exit 1)
+    # a missing part, or one of a suffix no reader takes, is a wrong command line, refused at the
+    # input door (exit 2; the suffix was the work failing, exit 1)
     for part, said, code in ((tmp_path / "nope.stl", f"PART of 'woodcam bake': {str(tmp_path / 'nope.stl')!r} "
                               "does not exist", 2),
-                             (tmp_path / "part.dwg", f"part file {str(tmp_path / 'part.dwg')!r} has unsupported "
-                              "suffix '.dwg'; use one of", 1)):
+                             (tmp_path / "part.dwg", f"PART of 'woodcam bake': {str(tmp_path / 'part.dwg')!r} "
+                              "has suffix '.dwg', which it cannot read; it must end in .step", 2)):
         assert main(["bake", str(part), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "b.glb")]) == code
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and said in err, err

@@ -6,6 +6,7 @@ any work. They exited 1, each command's own message, some after the block was op
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 import pytest
@@ -18,7 +19,7 @@ REPO = Path(__file__).resolve().parents[1]
 #: existing file (the other inputs, there), OUT an output folder.
 CASES: dict[tuple[str, str], list[str]] = {
     ("bake", "PART"): ["bake", "ARG", "--block", "builtin:flat-sawn", "--out", "OUT/b.glb"],
-    ("bake", "--block"): ["bake", "FILE", "--block", "ARG", "--out", "OUT/b.glb"],
+    ("bake", "--block"): ["bake", "FILE.stl", "--block", "ARG", "--out", "OUT/b.glb"],
     ("preview", "MESH"): ["preview", "ARG", "--screenshot", "OUT/p.png"],
     ("preview", "--block"): ["preview", "FILE", "--block", "ARG", "--screenshot", "OUT/p.png"],
     ("gcode", "PROGRAM"): ["gcode", "FILE", "ARG", "--tool", "flat:6", "--block", "builtin:flat-sawn",
@@ -28,9 +29,9 @@ CASES: dict[tuple[str, str], list[str]] = {
     ("gcode", "--part"): ["gcode", "FILE", "--tool", "flat:6", "--part", "ARG", "--block", "builtin:flat-sawn",
                           "--out", "OUT/g.glb"],
     ("review", "PART"): ["review", "ARG", "--out", "OUT/r.html"],
-    ("review", "--block"): ["review", "FILE", "--block", "ARG", "--out", "OUT/r.html"],
+    ("review", "--block"): ["review", "FILE.glb", "--block", "ARG", "--out", "OUT/r.html"],
     ("place", "PART"): ["place", "ARG", "--block", "builtin:flat-sawn", "--out", "OUT/p"],
-    ("place", "--block"): ["place", "FILE", "--block", "ARG", "--out", "OUT/p"],
+    ("place", "--block"): ["place", "FILE.stl", "--block", "ARG", "--out", "OUT/p"],
     ("block show", "BLOCK"): ["block", "show", "ARG", "--out", "OUT/s.png"],
     ("block from-photos", "PHOTOS_DIR"): ["block", "from-photos", "ARG", "--size-mm", "50", "--out", "OUT/fp"],
     ("rings detect", "BLOCK"): ["rings", "detect", "ARG", "--out", "OUT/rd"],
@@ -48,9 +49,9 @@ CASES: dict[tuple[str, str], list[str]] = {
     ("train", "--spec"): ["train", "gtf", "--spec", "ARG", "--out", "OUT/t"],
     ("bench report", "RUN_DIR"): ["bench", "report", "ARG", "--out", "OUT/br"],
     ("woodify", "PART"): ["woodify", "ARG", "--years", "3", "--out", "OUT/w"],
-    ("woodify", "--obstacle"): ["woodify", "FILE", "--years", "3", "--obstacle", "FILE", "--obstacle", "ARG",
+    ("woodify", "--obstacle"): ["woodify", "FILE.stl", "--years", "3", "--obstacle", "FILE.stl", "--obstacle", "ARG",
                                 "--out", "OUT/w"],
-    ("woodify", "--brushes"): ["woodify", "FILE", "--years", "3", "--brushes", "ARG", "--out", "OUT/w"],
+    ("woodify", "--brushes"): ["woodify", "FILE.stl", "--years", "3", "--brushes", "ARG", "--out", "OUT/w"],
     ("parquetry", "TARGET"): ["parquetry", "FILE", "ARG", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq"],
     ("parquetry", "--config"): ["parquetry", "--config", "ARG", "--out", "OUT/pq"],
     ("parquetry", "--veneer"): ["parquetry", "FILE", "--veneer", "ARG:300", "--out", "OUT/pq"],
@@ -91,19 +92,18 @@ def test_every_input_path_goes_through_the_door_and_has_a_case():
     assert set(registered) == set(CASES), "add a case to CASES for each input path"
 
 
-@pytest.mark.parametrize("wrong", ["missing", "wrong kind"])
-@pytest.mark.parametrize("key", sorted(CASES), ids=lambda k: f"{k[0]} {k[1]}")
-def test_a_missing_or_wrong_kind_input_is_a_usage_error_before_any_work(key, wrong, tmp_path, capsys, monkeypatch):
-    kind = _registered().get(key, "file")
-    given = tmp_path / "in" / ("nope" if wrong == "missing" else "there")
-    given.parent.mkdir()
-    if wrong == "wrong kind" and kind == "file":  # a folder where a file is read
-        given.mkdir()
-    elif wrong == "wrong kind":  # a file where a folder (a block folder) is
-        given.write_text("x")
-    (tmp_path / "in" / "file.txt").write_text("x")
+def _refused_at_the_door(key, given: Path, tmp_path: Path, capsys, monkeypatch) -> str:
+    """Run CASES[key] with ARG = ``given`` (FILE.SUFFIX an existing file of that suffix, FILE a
+    .txt); assert it is refused before any work, exit 2, one line naming the argument and
+    nothing written; returns the line."""
     out = tmp_path / "out"
-    argv = [a.replace("ARG", str(given)).replace("OUT", str(out)).replace("FILE", str(tmp_path / "in" / "file.txt"))
+
+    def existing(match: re.Match) -> str:
+        path = tmp_path / "in" / f"file{match.group(1) or '.txt'}"
+        path.write_text("x")
+        return str(path)
+
+    argv = [re.sub(r"FILE(\.\w+)?", existing, a.replace("ARG", str(given)).replace("OUT", str(out)))
             for a in CASES[key]]
     build = cli.build_parser
 
@@ -124,6 +124,58 @@ def test_a_missing_or_wrong_kind_input_is_a_usage_error_before_any_work(key, wro
     command, name = key
     assert got.out == "" and got.err.count("\n") == 1 and "Traceback" not in got.err, got.err
     assert got.err.startswith(f"woodcam: error: {name} of 'woodcam {command}'"), got.err
-    said = "does not exist" if wrong == "missing" else f"is a {'folder' if kind == 'file' else 'file'}"
-    assert f"{str(given)!r} {said}; it must be an existing " in got.err, got.err
     assert not out.exists()  # nothing written
+    return got.err
+
+
+@pytest.mark.parametrize("wrong", ["missing", "wrong kind"])
+@pytest.mark.parametrize("key", sorted(CASES), ids=lambda k: f"{k[0]} {k[1]}")
+def test_a_missing_or_wrong_kind_input_is_a_usage_error_before_any_work(key, wrong, tmp_path, capsys, monkeypatch):
+    kind = _registered().get(key, "file")
+    given = tmp_path / "in" / ("nope" if wrong == "missing" else "there")
+    given.parent.mkdir()
+    if wrong == "wrong kind" and kind == "file":  # a folder where a file is read
+        given.mkdir()
+    elif wrong == "wrong kind":  # a file where a folder (a block folder) is
+        given.write_text("x")
+    err = _refused_at_the_door(key, given, tmp_path, capsys, monkeypatch)
+    said = "does not exist" if wrong == "missing" else f"is a {'folder' if kind == 'file' else 'file'}"
+    assert f"{str(given)!r} {said}; it must be an existing " in err, err
+
+
+def _suffixed() -> dict[tuple[str, str], tuple[str, ...]]:
+    """(command, argument) -> the suffixes its reader takes, each from the reader's own list:
+    every input FILE whose reader refuses a suffix (the audit: the others read any name, their
+    contents decide, as a G-code program, a TOML tool table or a JSON file)."""
+    from woodcam.cad.parts import SUPPORTED_SUFFIXES
+    from woodcam.cli.woodify import _MESH_SUFFIXES
+    from woodcam.review import PART_SUFFIXES
+
+    woodify = (*_MESH_SUFFIXES, *(s for s in SUPPORTED_SUFFIXES if s not in _MESH_SUFFIXES))
+    return {("bake", "PART"): SUPPORTED_SUFFIXES, ("place", "PART"): SUPPORTED_SUFFIXES,
+            ("gcode", "--part"): SUPPORTED_SUFFIXES, ("woodify", "PART"): woodify,
+            ("woodify", "--obstacle"): woodify, ("review", "PART"): PART_SUFFIXES}
+
+
+def test_every_input_file_whose_reader_takes_some_suffixes_says_which_at_the_door():
+    """The door's list of each argument is its reader's, no second list."""
+    registered = {(command, name): sp.get_default("_input_suffixes")[dest]()
+                  for command, sp in _leaf_parsers()
+                  for dest, name, _kind, _paths in sp.get_default("_inputs") or ()
+                  if sp.get_default("_input_suffixes")[dest]}
+    assert registered == _suffixed()
+
+
+@pytest.mark.parametrize("key", sorted(_suffixed()), ids=lambda k: f"{k[0]} {k[1]}")
+def test_an_input_file_of_a_suffix_its_command_cannot_read_is_a_usage_error_before_any_work(
+        key, tmp_path, capsys, monkeypatch):
+    """'woodcam bake part.dwg' exited 1 from the part loader, once the command ran (place and
+    gcode --part after the block was opened, woodify after its checks): a file the command
+    cannot read by its suffix is a wrong command line. The refusal names the argument, the
+    suffix and the suffixes the reader takes."""
+    given = tmp_path / "in" / "there.dwg"
+    given.parent.mkdir()
+    given.write_text("x")
+    err = _refused_at_the_door(key, given, tmp_path, capsys, monkeypatch)
+    assert f"{str(given)!r} has suffix '.dwg', which it cannot read; it must end in " \
+           f"{', '.join(_suffixed()[key])}; " in err, err

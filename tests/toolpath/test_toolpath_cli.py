@@ -425,10 +425,10 @@ def test_review_with_another_block_than_the_baked_one_says_so(tmp_path, capsys):
     assert "is not the block" not in capsys.readouterr().err  # the same block: no word
 
 
-# a missing part is a wrong command line (the input door, exit 2; it was 1), a part no reader
-# takes the work failing (exit 1)
+# a missing part, or a part of a suffix no reader takes, is a wrong command line (the input
+# door, exit 2; they were 1)
 @pytest.mark.parametrize("part,says,code", [("nope.stl", "woodcam: error: --part of 'woodcam gcode': ", 2),
-                                            ("design.jpg", "woodcam: error: --part: part file", 1)])
+                                            ("design.jpg", "woodcam: error: --part of 'woodcam gcode': ", 2)])
 def test_a_bad_design_part_is_refused_before_the_simulation(part, says, code, tmp_path, capsys):
     """``--part nope.stl`` simulated the whole program (minutes on a real job), then failed
     naming 'part file', not the option."""

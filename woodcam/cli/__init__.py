@@ -71,8 +71,8 @@ examples:
       --out out/eye/
 
 exit status: 0 done; 1 the work failed (a one-line 'woodcam: error: ...' says why); 2 the
-command line is wrong (usage; an input path that is not there, or a file where a folder is read
-or the other way round, too); 3 the work was done but a check failed (e.g. gcode --strict);
+command line is wrong (usage; an input path that is not there, a file where a folder is read
+or the other way round, or a file of a suffix the command cannot read, too); 3 the work was done but a check failed (e.g. gcode --strict);
 130 interrupted; 141 the pipe it printed to was closed (woodcam blocks | head), quietly, as git
 and ls.
 """

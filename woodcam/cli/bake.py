@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
-from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_input, add_camera_option, add_out_option, add_units_option,
+from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_input, part_suffixes, add_camera_option, add_out_option, add_units_option,
                       add_workers_option, allow_negative_values, apply_workers, as_typed, camera_of,
                       remove_stale_outputs, stock_options, vector_type, write_screenshot)
 
@@ -32,7 +32,7 @@ def register(subparsers) -> None:
                               "can read, write or delete your files, so only bake scripts you "
                               "wrote or have read (--timeout bounds its run time; it is not a "
                               "sandbox).")
-    add_input(p, "part", kind="file", help="part file (.py script, .step, .stl, .obj, .glb)")
+    add_input(p, "part", kind="file", suffixes=part_suffixes, help="part file (.py script, .step, .stl, .obj, .glb)")
     add_input(p, "--block", kind="block", required=True, help=BLOCK_SPEC_HELP)
     add_out_option(p, "the baked part; beside it PART.obj/.mtl, PART_texture.png, the "
                    "part report PART_report.txt/.json and, with --screenshot, PART_view.png",

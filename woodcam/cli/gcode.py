@@ -14,7 +14,7 @@ from pathlib import Path
 from ..errors import UsageError, WoodcamError
 from ..tolerances import IN_BLOCK_RTOL
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
-from .options import (add_input, output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
+from .options import (add_input, part_suffixes, output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
                       allow_negative_values, as_typed, camera_of, drop_earlier_output, remove_stale_outputs, sizes_type,
                       stock_options, vector_type)
 
@@ -109,7 +109,7 @@ def register(subparsers) -> None:
                    "of the (last) program")
     p.add_argument("--no-overlay", action="store_true",
                    help="leave the toolpath (rapids red, feeds blue) out of the screenshot")
-    add_input(p, "--part", kind="file", default=None, metavar="PART",
+    add_input(p, "--part", kind="file", suffixes=part_suffixes, default=None, metavar="PART",
                    help="design part (STL/STEP/OBJ/GLB or a part script, block frame, mm): "
                    "report leftover and overcut volumes, gouges by line, and write a "
                    "deviation map (OUT with _deviation.png)")

@@ -146,29 +146,59 @@ def _command_name(args: argparse.Namespace) -> str:
 INPUT_KINDS = ("file", "folder", "block")
 
 
-def add_input(p, *flags: str, kind: str, paths=None, **kwargs) -> argparse.Action:
+def add_input(p, *flags: str, kind: str, paths=None, suffixes=None, **kwargs) -> argparse.Action:
     """An input path argument of ``p`` (``add_argument``'s ``flags`` and ``kwargs``) that
     :func:`check_inputs` checks before the command runs: ``kind`` is one of
     :data:`INPUT_KINDS`; ``paths`` maps a value to the paths it names when it holds more than a
-    path (``--veneer SCAN:DPI:MASK``). ``tests/test_cli_inputs.py`` runs every command against it
-    and fails a path argument added without it."""
+    path (``--veneer SCAN:DPI:MASK``); ``suffixes`` (a FILE's) returns the suffixes its reader
+    takes, the reader's own list (called at the door only: ``--help`` imports no reader).
+    ``tests/test_cli_inputs.py`` runs every command against it and fails a path argument added
+    without it."""
     assert kind in INPUT_KINDS, kind  # a contributor's mistake
+    assert suffixes is None or kind == "file", kind  # a folder or block spec has no suffix rule
     action = p.add_argument(*flags, **kwargs)
     name = next((f for f in action.option_strings if f.startswith("--")), action.dest.upper())
-    p.set_defaults(_inputs=(*(p.get_default("_inputs") or ()), (action.dest, name, kind, paths)))
+    p.set_defaults(_inputs=(*(p.get_default("_inputs") or ()), (action.dest, name, kind, paths)),
+                   _input_suffixes={**(p.get_default("_input_suffixes") or {}), action.dest: suffixes})
     return action
 
 
 def check_inputs(args: argparse.Namespace) -> None:
     """Refuse an input path (:func:`add_input`) that does not exist or is of the wrong kind,
     before any work: a UsageError (exit 2) naming the argument, the path, the rule and a fix.
+    A FILE of a suffix its reader does not take (``add_input(suffixes=)``) is refused too.
     A missing part, program or block folder was the command's own error (exit 1), some after the
     block was opened; an input that exists but whose contents are bad still is (exit 1)."""
+    suffixes = getattr(args, "_input_suffixes", {})
     for dest, name, kind, paths in getattr(args, "_inputs", ()):
         value = getattr(args, dest, None)
         for item in value if isinstance(value, list) else [] if value is None else [value]:
             for text in paths(str(item)) if paths else [str(item)]:
                 _check_input(str(text), name, kind, args)
+                if suffixes.get(dest):
+                    _check_suffix(Path(text), name, suffixes[dest](), args)
+
+
+def _check_suffix(path: Path, name: str, accepted: tuple[str, ...], args: argparse.Namespace) -> None:
+    """Refuse an input FILE whose suffix its reader does not take (``accepted``, lower case with
+    the dot): the reader refused it (exit 1) only once the command ran, some after the block was
+    opened."""
+    suffix = path.suffix.lower()
+    if suffix in accepted:
+        return
+    said = f"has suffix {path.suffix!r}" if suffix else "has no suffix"
+    cad = " (a part: export it from your CAD program as STEP or STL)" if ".step" in accepted else ""
+    raise UsageError(f"{name} of 'woodcam {_command_name(args)}': {str(path)!r} {said}, which it "
+                     f"cannot read; it must end in {', '.join(accepted)}; save the file as one of "
+                     f"them{cad}")
+
+
+def part_suffixes() -> tuple[str, ...]:
+    """The suffixes a part file may have (:data:`woodcam.cad.parts.SUPPORTED_SUFFIXES`, what
+    :func:`woodcam.cad.load_part` reads), for :func:`add_input`'s ``suffixes``."""
+    from ..cad.parts import SUPPORTED_SUFFIXES  # here only: --help imports no numpy
+
+    return SUPPORTED_SUFFIXES
 
 
 #: What a block spec's path may be, said after the kind it names (a FOLDER, a FILE).

@@ -9,6 +9,13 @@ from pathlib import Path
 from .options import add_input, BLOCK_SPEC_HELP, add_out_option, add_units_option
 
 
+def _glb_suffixes() -> tuple[str, ...]:
+    """What review reads (:data:`woodcam.review.PART_SUFFIXES`), for the input door."""
+    from ..review import PART_SUFFIXES  # here only: --help imports no numpy
+
+    return PART_SUFFIXES
+
+
 def register(subparsers) -> None:
     """Add ``review``."""
     p = subparsers.add_parser(
@@ -18,7 +25,7 @@ def register(subparsers) -> None:
         "with WebGL 2): the part, orbit/pan/zoom and front/top/iso views, a section plane whose "
         "cut face shows the wood inside the block, two-click measurement in mm, the block's face "
         "photos and the bake report, knot and G-code hotspots; printable as a shop sheet.")
-    add_input(p, "part", kind="file", type=Path, help="baked .glb (from woodcam bake or woodcam gcode)")
+    add_input(p, "part", kind="file", suffixes=_glb_suffixes, type=Path, help="baked .glb (from woodcam bake or woodcam gcode)")
     add_input(p, "--block", kind="block", default=None,
                    help=BLOCK_SPEC_HELP + " (default: the one stored in the GLB)")
     add_out_option(p, "one self-contained page", suffixes=(".html",))

@@ -18,7 +18,8 @@ from pathlib import Path
 from ..errors import UsageError, WoodcamError
 from ..tolerances import DEFAULT_MAX_ATLAS_PX
 from ..units import say_length, typed_length
-from .options import add_input, add_max_atlas_option, add_out_option, add_units_option, as_typed, sizes_type, vector_type
+from .options import (add_input, add_max_atlas_option, add_out_option, add_units_option, as_typed, part_suffixes,
+                      sizes_type, vector_type)
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -29,7 +30,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         "eccentricity, obstacles, brushes), then write its growth field (usable as --block "
         "woodify:OUT/field.npz), grown surfaces, ring sections and a bark-textured grown.glb. "
         "Lengths in mm (the options' in --units), time in years.")
-    add_input(p, "part", kind="file", help="input: a .py part script, .step, or a closed .stl/.obj/.ply/.glb mesh "
+    add_input(p, "part", kind="file", suffixes=_part_suffixes, help="input: a .py part script, .step, or a closed .stl/.obj/.ply/.glb mesh "
                    "(mesh files are read as mm whatever --units says; one under 1 mm long gets a warning that it "
                    "looks saved in metres); a PLY may paint growth per vertex: properties gain (speed gain) and "
                    "dir_x, dir_y, dir_z (growth direction, length = strength < 1)")
@@ -46,7 +47,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                    help="delta in (-1, 1): speed (1 + delta n.up) (default 0)")
     p.add_argument("--up", default="0,0,1", metavar="X,Y,Z",
                    type=vector_type("--up", example="0,0,1", nonzero=True), help="direction the eccentric growth favours (unit-normalised; default 0,0,1)")
-    add_input(p, "--obstacle", kind="file", type=Path, action="append", default=[], metavar="MESH",
+    add_input(p, "--obstacle", kind="file", suffixes=_part_suffixes, type=Path, action="append", default=[], metavar="MESH",
                    help="closed obstacle mesh or part (read as mm); repeatable")
     add_input(p, "--brushes", kind="file", type=Path, default=None, metavar="JSON",
                    help="growth brushes (centre_mm, radius_mm, gain, direction, strength)")
@@ -88,13 +89,24 @@ def register(subparsers) -> argparse.ArgumentParser:
     return p
 
 
+#: The mesh files :func:`_load_mesh` reads with trimesh (painted PLYs and OFFs included); any
+#: other part goes to :func:`woodcam.cad.load_part`.
+_MESH_SUFFIXES = (".stl", ".obj", ".ply", ".glb", ".gltf", ".off")
+
+
+def _part_suffixes() -> tuple[str, ...]:
+    """The suffixes a part or ``--obstacle`` may have: :data:`_MESH_SUFFIXES` and
+    :func:`~woodcam.cli.options.part_suffixes` (the input door's list)."""
+    return tuple(dict.fromkeys((*_MESH_SUFFIXES, *part_suffixes())))
+
+
 def _load_mesh(path: str, what: str = "part"):
     """(watertight geometry, textured original or None) from a part or mesh file; ``what`` names
     it in messages (``part``, ``--obstacle``)."""
     import trimesh
 
     pth = Path(path)
-    if pth.suffix.lower() in (".stl", ".obj", ".ply", ".glb", ".gltf", ".off"):
+    if pth.suffix.lower() in _MESH_SUFFIXES:
         try:
             if pth.suffix.lower() in (".glb", ".gltf", ".obj") and _mesh_count(pth) > 1:
                 return _several_meshes(pth, what)

@@ -41,6 +41,8 @@ from ..errors import WoodcamError
 from ..limits import REVIEW_VOXELS_RANGE
 
 _HERE = Path(__file__).resolve().parent
+#: What :func:`write_review` reads: the GLB woodcam bake (or gcode) wrote, with its metadata.
+PART_SUFFIXES = (".glb",)
 #: three.js version the committed bundle was built from (``make review-bundle``).
 THREE_VERSION = "0.187.0"
 #: Voxels per colour volume (one per cut axis): three volumes of this many RGB voxels keep the
@@ -147,7 +149,7 @@ def write_review(glb_path, out_html, *, wood, size_mm, title: str | None = None,
     from .._atomic import check_output_path, write_bytes
 
     glb_path = Path(glb_path)
-    if not glb_path.is_file() or glb_path.suffix.lower() != ".glb":
+    if not glb_path.is_file() or glb_path.suffix.lower() not in PART_SUFFIXES:
         raise WoodcamError(
             f"review: the part must be an existing .glb file written by woodcam bake; got "
             f"{str(glb_path)!r}")
