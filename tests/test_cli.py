@@ -57,10 +57,11 @@ def test_bake_and_preview_from_the_command_line(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv, message, code", [
-    # a part or block folder that is not there is a wrong command line (exit 2, was 1)
+    # a part or block folder that is not there, or a built-in block no one has, is a wrong command
+    # line (exit 2, was 1)
     (["bake", "missing.py", "--block", "builtin:flat-sawn", "--out", "x.glb"], "missing.py", 2),
     (["bake", "cad_examples/tray.py", "--block", "builtin:oak-burl", "--out", "x.glb"],
-     "unknown built-in block 'oak-burl'", 1),
+     "unknown built-in block 'oak-burl'", 2),
     (["bake", "cad_examples/tray.py", "--block", "nowhere/", "--out", "x.glb"],
      "(block spec 'nowhere/'): 'nowhere' does not exist; it must be an existing FOLDER (a block spec is", 2),
 ])

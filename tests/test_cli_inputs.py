@@ -92,7 +92,7 @@ def test_every_input_path_goes_through_the_door_and_has_a_case():
     assert set(registered) == set(CASES), "add a case to CASES for each input path"
 
 
-def _refused_at_the_door(key, given: Path, tmp_path: Path, capsys, monkeypatch) -> str:
+def _refused_at_the_door(key, given: Path | str, tmp_path: Path, capsys, monkeypatch) -> str:
     """Run CASES[key] with ARG = ``given`` (FILE.SUFFIX an existing file of that suffix, FILE a
     .txt); assert it is refused before any work, exit 2, one line naming the argument and
     nothing written; returns the line."""
@@ -179,3 +179,28 @@ def test_an_input_file_of_a_suffix_its_command_cannot_read_is_a_usage_error_befo
     err = _refused_at_the_door(key, given, tmp_path, capsys, monkeypatch)
     assert f"{str(given)!r} has suffix '.dwg', which it cannot read; it must end in " \
            f"{', '.join(_suffixed()[key])}; " in err, err
+
+
+@pytest.mark.parametrize("key", sorted(k for k, kind in _registered().items() if kind == "block"),
+                         ids=lambda k: f"{k[0]} {k[1]}")
+@pytest.mark.parametrize("spec, said", [
+    ("builtin:knoty", "unknown built-in block 'knoty'; choose one of: flat-sawn, quarter-sawn, rift, "
+                      "pith-inside, fast-grown, knotty; did you mean 'builtin:knotty'? ('woodcam blocks' lists them)"),
+    ("builtin:oak-burl", "unknown built-in block 'oak-burl'; choose one of: "),
+])
+def test_a_block_spec_of_no_path_that_names_no_block_is_a_usage_error_before_any_work(
+        key, spec, said, tmp_path, capsys, monkeypatch):
+    """'--block builtin:knoty' (and a 'log:' spec without its knot) passed the door, which checks
+    paths only, and exited 1 when the block was opened, after the part was loaded or the run
+    begun, with no near name: a wrong command line (exit 2), with the built-in block meant."""
+    (tmp_path / "in").mkdir()
+    err = _refused_at_the_door(key, spec, tmp_path, capsys, monkeypatch)
+    assert f"(block spec {spec!r}): {said}" in err, err
+
+
+def test_a_malformed_block_spec_of_no_path_is_a_usage_error_where_no_units_read_it(tmp_path, capsys, monkeypatch):
+    """A command without --units had no door read its spec ('fit log:gran1' exited 1 when the
+    block was opened); those with --units read it in lengths_to_mm (exit 2 already)."""
+    (tmp_path / "in").mkdir()
+    err = _refused_at_the_door(("fit", "BLOCK"), "log:gran1", tmp_path, capsys, monkeypatch)
+    assert "(block spec 'log:gran1'): a log block must read 'log:LOG@KNOT' or 'log:LOG@KNOT:WxDxH'" in err, err

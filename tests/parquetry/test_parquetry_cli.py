@@ -80,19 +80,29 @@ def test_cli_bad_input_is_one_line(scans, capsys, args, message, code):
 
 
 
-@pytest.mark.parametrize("resolution", ["abc", "0", "-300", "nan", "0px/mm", "-2px/mm"])
-def test_a_veneer_resolution_typed_wrong_is_a_usage_error_naming_it(scans, capsys, resolution):
-    """--veneer SCAN:abc exited 1 (a failed run, not a wrong command line); SCAN:0 and SCAN:-300
-    reached the scan reader, which said 'px_per_mm must be a finite number > 0; got
-    -11.811023622047244' of a typed -300 dpi, naming neither --veneer nor what was typed."""
-    argv = ["parquetry", str(scans / "coffee.png"), "--veneer", f"{scans / 'light.png'}:{resolution}",
-            "--out", str(scans / "o"), "--quiet"]
-    assert main(argv) == 2
+@pytest.mark.parametrize("value, said", [
+    ("{d}/light.png:abc", "the resolution must be a DPI (e.g. 300) or Npx/mm (e.g. 4px/mm), finite and > 0; got 'abc'"),
+    ("{d}/light.png:0", "finite and > 0; got '0'"),
+    ("{d}/light.png:-300", "finite and > 0; got '-300'"),
+    ("{d}/light.png:inf", "finite and > 0; got 'inf'"),
+    ("{d}/light.png:nan", "finite and > 0; got 'nan'"),
+    ("{d}/light.png:-2px/mm", "finite and > 0; got '-2px/mm'"),
+    ("{d}/light.png:0px/mm", "finite and > 0; got '0px/mm'"),
+    ("{d}/light.png:300:{d}/coffee.png:x", "has 4 ':' parts, at most 3"),
+    (":300", "names no scan image"),
+])
+def test_a_malformed_veneer_is_a_usage_error_before_any_work(scans, capsys, value, said):
+    """``--veneer SCAN:abc`` and ``SCAN:300:MASK:x`` exited 1 once the run had begun, and
+    ``SCAN:0`` / ``SCAN:-300`` passed the command line and were refused only when the job was
+    read (exit 1): a malformed value is a wrong command line (exit 2), said at the door."""
+    argv = ["parquetry", str(scans / "coffee.png"), "--veneer", value.format(d=scans), "--out", str(scans / "o"),
+            "--quiet"]
+    with pytest.raises(SystemExit) as ended:  # argparse's door
+        main(argv)
+    assert ended.value.code == 2
     err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and err.startswith("woodcam: error: --veneer "), err
-    assert (f"light.png:{resolution}': the resolution must be DPI (a number > 0, e.g. 300) or Npx/mm "
-            f"(e.g. 4px/mm); got {resolution!r}") in err, err
-    assert not (scans / "o").exists()
+    assert err.count("\n") == 0 and err.startswith("woodcam parquetry: error: argument --veneer: ") and said in err, err
+    assert "SCAN[:DPI][:MASK]" in err and not (scans / "o").exists()
 
 
 @pytest.mark.parametrize("option, value, said", [

@@ -214,6 +214,7 @@ def _check_input(text: str, name: str, kind: str, args: argparse.Namespace) -> N
 
         path = spec_path(text)
         if path is None:  # a built-in block or the shared log: no path
+            _check_builtin(text, name, args)
             return
         spec, kind = text, "file" if split_spec(text)[0].startswith(("woodify:", "log:")) else "folder"
         if kind == "folder" and path.name == "block.json" and path.is_file():
@@ -230,6 +231,24 @@ def _check_input(text: str, name: str, kind: str, args: argparse.Namespace) -> N
                          f"be an existing {kind.upper()}{_SPEC_KINDS if spec else ''}; {fix}")
     raise UsageError(f"{where}: {str(path)!r} does not exist; it must be an existing "
                      f"{kind.upper()}{_SPEC_KINDS if spec else ''}; {_did_you_mean(path, spec)}")
+
+
+def _check_builtin(spec: str, name: str, args: argparse.Namespace) -> None:
+    """Refuse a block ``spec`` of argument ``name`` that names no path (``builtin:NAME``,
+    ``log:gran1@K``) when it is malformed or its NAME no built-in block has (exit 2; they were
+    the block's opening errors, exit 1)."""
+    from .._specs import parse_spec
+
+    try:
+        parsed = parse_spec(spec)  # in mm: lengths_to_mm has read it in --units already
+        if parsed.kind == "builtin":
+            from ..fields.builtin import check_builtin_name  # here only: --help imports no numpy
+
+            check_builtin_name(parsed.source)
+    except WoodcamError as err:
+        raise UsageError(f"{name} of 'woodcam {_command_name(args)}' (block spec {spec!r}): "
+                         f"{str(err).removeprefix(f'block spec {spec!r}: ')}"
+                         + (" ('woodcam blocks' lists them)" if spec.startswith("builtin:") else "")) from None
 
 
 def _did_you_mean(path: Path, spec: str) -> str:

@@ -8,6 +8,7 @@ Table 1.
 from __future__ import annotations
 
 import argparse
+import math
 import warnings
 from pathlib import Path
 
@@ -60,7 +61,8 @@ def register(subparsers) -> None:
                       "veneer_<id>.svg/.dxf, result.json, panel.glb and job.json, listed in "
                       ".woodcam-parquetry-files.json")
     v = p.add_argument_group("veneers")
-    add_input(v, "--veneer", kind="file", paths=_scan_paths, action="append", default=[], metavar="SCAN[:DPI][:MASK]",
+    add_input(v, "--veneer", kind="file", paths=_scan_paths, type=_scan_value, action="append", default=[],
+              metavar="SCAN[:DPI][:MASK]",
                    help="scanned veneer image (repeatable; its id, in veneer_<id>.svg, is the file's "
                    "stem, numbered when two share one: oak-1, oak-2); resolution in dpi (default 300, with a warning "
                    "when the file states another, other than the 72/96 dpi cameras and editors write unmeasured) or "
@@ -148,60 +150,67 @@ _OPTION_PARAMS = {"w_intens": "w_intens", "w_edge": "w_edge", "w_hist": "w_hist"
                   "kerf_mm": "kerf_mm"}
 
 
-def _scan_paths(text: str) -> list[str]:
-    """The files a ``--veneer SCAN[:DPI][:MASK]`` names, the scan and its mask, for the input door
-    (:func:`~woodcam.cli.options.check_inputs`); a value of another form is :func:`_scan_entry`'s
-    to refuse."""
+def _scan_form(text: str) -> tuple[str, str, float | None, str | None]:
+    """``--veneer SCAN[:DPI][:MASK]`` -> (scan, ``"dpi"`` or ``"px_per_mm"``, its value or None
+    when not given, mask or None): the one reader of its form, for argparse (:func:`_scan_value`),
+    the input door (:func:`_scan_paths`) and the job (:func:`_scan_entry`). A malformed value is
+    an ``argparse.ArgumentTypeError``: a wrong command line (exit 2), before any work; too many
+    ':' parts, a resolution that is no number, or not finite and > 0, were the run's error
+    (exit 1, 0 and -300 dpi refused only when the job was read)."""
     parts = text.split(":")
-    return [f for f in (parts[0], *parts[2:3]) if f] if len(parts) <= 3 else []
-
-
-def _scan_entry(text: str) -> dict:
-    """One ``--veneer SCAN[:DPI][:MASK]`` as a job's source texture. Its text is the command
-    line's: a malformed one is a usage error (exit 2), as argparse's are; a resolution of 0 or
-    below reached the scan reader, which said 'px_per_mm must be ... > 0; got -11.81...' of a
-    typed '-300' and exited 1."""
-    import math
-
-    from ..errors import UsageError
-
-    parts = text.split(":")
-    entry = {"texture": parts[0], "dpi": 300.0, "id": Path(parts[0]).stem}
+    form = "give SCAN[:DPI][:MASK], e.g. oak.png:300 or oak.png:4px/mm:oak_mask.png"
     if len(parts) > 3:
-        raise UsageError(f"--veneer takes SCAN[:DPI][:MASK]; got {text!r}")
-    if len(parts) >= 2 and parts[1]:
-        res = parts[1].lower()
-        per_mm = res.endswith("px/mm")
+        raise argparse.ArgumentTypeError(f"{text!r} has {len(parts)} ':' parts, at most 3 "
+                                         f"(a path with ':' cannot be given here: rename it); {form}")
+    if not parts[0]:
+        raise argparse.ArgumentTypeError(f"{text!r} names no scan image; {form}")
+    res = parts[1].lower() if len(parts) >= 2 else ""
+    key = "px_per_mm" if res.endswith("px/mm") else "dpi"
+    value = None
+    if res:
         try:
-            value = float(res[:-5] if per_mm else res)
+            value = float(res.removesuffix("px/mm"))
         except ValueError:
             value = math.nan
         if not (math.isfinite(value) and value > 0):
-            raise UsageError(f"--veneer {text!r}: the resolution must be DPI (a number > 0, e.g. 300) "
-                             f"or Npx/mm (e.g. 4px/mm); got {parts[1]!r}; give the resolution the sheet "
-                             f"was scanned at, e.g. {parts[0]}:300")
-        if per_mm:
-            entry.pop("dpi")
-            entry["px_per_mm"] = value
-        else:
-            entry["dpi"] = value
-    if len(parts) == 3:
-        entry["mask"] = parts[2]
-    if len(parts) < 2 or not parts[1]:
-        import warnings
+            raise argparse.ArgumentTypeError(
+                f"{text!r}: the resolution must be a DPI (e.g. 300) or Npx/mm (e.g. 4px/mm), "
+                f"finite and > 0; got {parts[1]!r}; {form}")
+    return parts[0], key, value, (parts[2] or None) if len(parts) == 3 else None
 
-        from ..errors import WoodcamWarning
+
+def _scan_value(text: str) -> str:
+    """argparse ``type`` of ``--veneer``: ``text`` as given once :func:`_scan_form` reads it."""
+    _scan_form(text)
+    return text
+
+
+def _scan_paths(text: str) -> list[str]:
+    """The files a ``--veneer SCAN[:DPI][:MASK]`` names, the scan and its mask, for the input door
+    (:func:`~woodcam.cli.options.check_inputs`)."""
+    scan, _key, _value, mask = _scan_form(text)
+    return [scan, *([mask] if mask else [])]
+
+
+def _scan_entry(text: str) -> dict:
+    """The job's scan entry of a ``--veneer`` value (:func:`_scan_form`), at 300 dpi when it
+    gives no resolution."""
+    scan, key, value, mask = _scan_form(text)
+    entry: dict = {"texture": scan, "id": Path(scan).stem, key: 300.0 if value is None else value}
+    if mask:
+        entry["mask"] = mask
+    if value is None:
         from ..parquetry.veneers import dpi_tag
 
         # the default 300 dpi over a scan that states its own resolution sized every piece
         # wrongly without a word (a 150 dpi scan cut at half size); a camera's or editor's
         # placeholder (72, 96 dpi) is no resolution, so never named as the fix
-        tag = dpi_tag(parts[0])
+        tag = dpi_tag(scan)
         if tag is not None and abs(tag - entry["dpi"]) > 0.01 * entry["dpi"]:
-            warnings.warn(f"--veneer {parts[0]!r}: the file states {tag:.4g} dpi, but no resolution was "
+            warnings.warn(f"--veneer {scan!r}: the file states {tag:.4g} dpi, but no resolution was "
                           f"given, so the default {entry['dpi']:g} dpi was used; give the resolution the "
-                          f"sheet was scanned at: {parts[0]}:{tag:.4g} if the file's is right, "
-                          f"{parts[0]}:{entry['dpi']:g} to keep the default",
+                          f"sheet was scanned at: {scan}:{tag:.4g} if the file's is right, "
+                          f"{scan}:{entry['dpi']:g} to keep the default",
                           WoodcamWarning, stacklevel=2)
     return entry
 

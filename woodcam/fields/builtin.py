@@ -86,14 +86,24 @@ def _knotty_block() -> BuiltinBlock:
                         "tangential spruce board through a whorl: alive and dead knots")
 
 
+def check_builtin_name(name: str) -> None:
+    """A WoodcamError for a ``name`` no built-in block has: the names, and the nearest one when
+    it looks like a typo (``knoty``); the one message of :func:`builtin_block` and of the
+    command line's door (:func:`woodcam.cli.options.check_inputs`)."""
+    if name in BUILTIN_NAMES:
+        return
+    import difflib
+
+    near = difflib.get_close_matches(str(name), BUILTIN_NAMES, n=1)
+    raise WoodcamError(f"unknown built-in block {name!r}; choose one of: {', '.join(BUILTIN_NAMES)}"
+                       + (f"; did you mean 'builtin:{near[0]}'?" if near else ""))
+
+
 def builtin_block(name: str) -> BuiltinBlock:
     """Return the built-in block ``name`` (see :data:`BUILTIN_NAMES`)."""
+    check_builtin_name(name)
     if name == "knotty":
         return _knotty_block()
-    if name not in _SPECS:
-        raise WoodcamError(
-            f"unknown built-in block {name!r}; choose one of: {', '.join(BUILTIN_NAMES)}"
-        )
     pith, axis, ring_w, species, seed, desc = _SPECS[name]
     rng = np.random.default_rng(seed)
     frame = LogFrame(pith, axis)
