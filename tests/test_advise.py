@@ -333,3 +333,34 @@ def test_a_wood_that_only_draws_colours_is_refused_by_placement_advice_naming_it
         part_report(box, stock, samples=50)
     with pytest.raises(WoodcamError, match=said.format("knot_spots", "wood")):
         knot_spots(box, Grey(), samples=50)
+
+
+def test_a_part_previewed_in_a_wood_that_only_draws_colours_is_baked_without_its_report(tmp_path):
+    """preview_part of a Stock whose wood only draws colours (a user's, no features) failed with
+    "field must be callable as field(points_mm) -> years; got Grey", from the rings' uncertainty
+    line (Wood(wood)), nothing written, though such a stock is one to bake and view. The part is
+    baked in its colours and written; the part report, which reads knots, pith and fibres the
+    wood has not got, is left out with a WoodcamWarning saying why and how to have it; the
+    uncertainty line, of a fitted field, is not asked of a wood that holds none."""
+    import trimesh
+
+    from woodcam.errors import WoodcamWarning
+    from woodcam.pipeline import preview_part
+    from woodcam.stock import Stock
+
+    class Grey:
+        def color(self, points_mm, normals):
+            return np.full((len(points_mm), 3), 0.5)
+
+    stock = Stock("mine", (50.0, 50.0, 30.0), Grey())
+    box = trimesh.creation.box((10, 10, 10))
+    box.apply_translation((25, 25, 15))
+    with pytest.warns(WoodcamWarning, match=r"p: no part report \(knots, pith, end grain, grain runout\): "
+                      r"stock\.wood \(Grey\) only draws colours, .*open the stock with open_stock or pass "
+                      r"Wood\(field\)") as said:
+        result = preview_part(box, stock, tmp_path / "p.glb", texels_per_mm=2, obj=False, screenshot=False)
+    assert said[0].filename == __file__  # the caller's line
+    assert set(result.files) == {"glb"} and result.files["glb"].is_file() and result.report == {}
+    assert not list(tmp_path.glob("p_report.*"))
+    texture = trimesh.load(result.files["glb"], force="mesh").visual.material.baseColorTexture
+    assert np.isin(np.asarray(texture.convert("RGB")), (127, 128)).mean() > 0.5  # the wood's grey

@@ -107,13 +107,20 @@ def _part_mesh(part):
     return manifold_to_trimesh(load_part(part))
 
 
+def reads_wood(wood) -> bool:
+    """Whether ``wood`` has the growth field the advice reads (``features``: knots, years,
+    grain): False for a user's wood that only draws colours (``color``), a stock to bake and
+    view that :func:`part_report` and :func:`advise_placement` refuse."""
+    return callable(getattr(wood, "features", None))
+
+
 def _features_of(wood, who: str, arg: str):
     """``wood.features``, the growth field every placement term is read from (knots, years,
     grain), or a refusal: a user's wood that only draws (``color``) is a stock to bake and view,
     but it has no knots, pith or fibres to score, and failed deep in the scoring as an
     AttributeError ('features')."""
     features = getattr(wood, "features", None)
-    if not callable(features):
+    if not reads_wood(wood):
         raise WoodcamError(f"{who}: {arg} must read the wood, a method features(points_mm (n, 3)) -> dict with "
                            f"'knot', 'years' and 'grain' (the knots, pith and fibres it scores); got "
                            f"{type(wood).__name__}, which only draws colours; open the stock with open_stock "

@@ -322,16 +322,33 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
     ``report_mesh`` when given) with the stock's metadata."""
     from .export import export_glb, export_obj
 
+    from .advise import reads_wood
+    from .appearance.wood import Wood
+
     mesh = report_mesh
     part_report = report_mesh is not None
+    if part_report and not reads_wood(stock.wood):
+        # a user's wood that only draws colours is a stock to bake and view; the report reads
+        # knots, pith and fibres it has not got (it failed as the uncertainty line's "field must
+        # be callable ... got Grey", nothing written)
+        import warnings
+
+        from .errors import WoodcamWarning
+
+        warnings.warn(f"{result.name}: no part report (knots, pith, end grain, grain runout): stock.wood "
+                      f"({type(stock.wood).__name__}) only draws colours, it has no features(points_mm) to "
+                      "read them from; the part is baked with its colours; for the report open the stock "
+                      "with open_stock or pass Wood(field)", WoodcamWarning, stacklevel=4)
+        part_report = False
     result.atlas_px = tuple(baked.atlas.shape[:2])
     result.atlas = baked.summary()
     from .inference.evidence import uncertainty_report
 
     surface = mesh if mesh is not None else baked.mesh  # the part, else what was baked
-    # a fitted field says where its rings are a guess (issue 12 part 5); only that is a warning
+    # a fitted field says where its rings are a guess (issue 12 part 5); only that is a warning.
+    # A user's own wood (no Wood: its colours or features) holds no fit to doubt
     rings_line = uncertainty_report(stock.wood, surface.vertices, stock.size_mm, result.name,
-                                    confident_line=False)
+                                    confident_line=False) if isinstance(stock.wood, Wood) else None
     if rings_line:
         result.warnings.append(rings_line)
     filed_report = result.report
