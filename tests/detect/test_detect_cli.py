@@ -669,7 +669,8 @@ def test_a_rerun_clears_its_own_stale_knot_masks_and_keeps_a_users(synth_photos,
     """A face's knot mask from an earlier detection (left_knot_mask.png) stayed in the block
     folder after the block was remade from new photos and detected again with no knot on that
     face: a file of the old run beside the new manifest. Now the detector's own mask (its digest
-    recorded) is removed; a mask the user put there (top_knot_mask.png) is kept and said."""
+    recorded) is removed; a mask the user put there (top_knot_mask.png) is kept, said, and read as
+    the face's though no knot is found on it (the user's wins)."""
     monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
     blk, size = _knotted_block_folder(synth_photos, tmp_path, capsys)
     rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
@@ -683,12 +684,15 @@ def test_a_rerun_clears_its_own_stale_knot_masks_and_keeps_a_users(synth_photos,
     rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
     assert rc == 0, err
     assert not (blk / "left_knot_mask.png").exists()
-    assert not any("knot_mask" in f.extras for f in read_block(blk).faces.values())
     with Image.open(blk / "top_knot_mask.png") as im:
         assert np.array_equal(np.asarray(im), mine)
+    # the user's, on a face with no knot found, is the face's (it was kept unread)
+    assert [n for n, f in read_block(blk).faces.items() if "knot_mask" in f.extras] == ["top"]
+    assert np.array_equal(read_block(blk).faces["top"].extras["knot_mask"], mine > 127)
     said = [w for w in err.splitlines() if "knot_mask.png" in w]
-    assert len(said) == 1 and said[0].startswith("woodcam: warning: face 'top': top_knot_mask.png in ")
-    assert "is not read (no knot was found on it this time" in said[0] and "is kept" in said[0]
+    assert len(said) == 1, said
+    assert said[0].startswith(f"woodcam: warning: face 'top': kept the edited {blk / 'top_knot_mask.png'} ("), said
+    assert "detection made none for the face this time" in said[0], said
 
 
 def test_a_rerun_clears_its_own_stale_ring_maps_and_svgs_and_keeps_a_users(synth_photos, tmp_path, capsys, monkeypatch):
@@ -809,6 +813,43 @@ def test_hand_made_files_in_a_folder_never_detected_are_kept_and_used(synth_phot
     assert np.array_equal(faces["left"].extras["knot_mask"], detected["left"].extras["knot_mask"])
     assert np.allclose(faces["top"].ring_map, detected["top"].ring_map)
     assert len(faces["front"].traces) == len(detected["front"].traces)
+
+
+def test_a_users_knot_mask_or_ring_map_on_a_face_detection_finds_none_on_is_used(synth_photos, tmp_path, capsys,
+                                                                                  monkeypatch):
+    """A knot mask (ring map) of the user's, hand-made or edited, on a face where detection finds
+    no knot (no rings) was kept but not read: the user was told to name it in block.json and
+    detect with --no-knots, where on a face with a knot found it wins. Now it wins there too:
+    kept, named by the manifest as the face's (so 'fit' reads it), said in the one line, and not
+    said to leave the face without a ring map; on a rerun it is still the user's."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    d = _copy(synth_photos, tmp_path / "p")
+    rng = np.random.default_rng(0)
+    grad = np.linspace(90, 170, 160)[None, :, None] + 4 * rng.standard_normal((160, 160, 3))
+    Image.fromarray(np.clip(np.broadcast_to(grad, (160, 160, 3)), 0, 255).astype(np.uint8)).save(d / "bottom.png")
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", d, "--size-mm", "32", "--out", blk)[0] == 0
+    mask = np.zeros((160, 160), np.uint8)
+    mask[60:140, 20:120] = 255
+    Image.fromarray(mask).save(blk / "top_knot_mask.png")
+    rings = np.zeros((160, 160), np.uint16)
+    rings[:, ::10] = 65535
+    Image.fromarray(rings).save(blk / "bottom_ring_map.png")
+    for how in ("your", "the edited"):  # hand-made before any detection, then the user's on a rerun
+        rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+        assert rc == 0, err
+        faces = read_block(blk).faces
+        assert np.array_equal(faces["top"].extras["knot_mask"], mask > 127), err
+        assert np.array_equal(faces["bottom"].ring_map, rings / 65535.0) and not faces["bottom"].traces
+        entries = json.loads((blk / "block.json").read_text())["faces"]
+        assert entries["top"]["extras"]["knot_mask"]["png"] == "top_knot_mask.png"
+        assert entries["bottom"]["ring_map"] == "bottom_ring_map.png"
+        for f in ("top_knot_mask.png", "bottom_ring_map.png"):
+            (line,) = [w for w in err.splitlines() if f in w]
+            assert f" kept {how} {blk / f} (" in line and "detection made none for the face this time" in line, line
+            assert "it wins over detection; to let detection replace it, delete it" in line, line
+        assert "is not read" not in err and "no rings found" not in err, err
+    assert "knot_mask" not in json.loads((blk / "block.json").read_text())["meta"]["detection"]["file_digest"]
 
 
 def test_a_missing_or_file_input_is_one_line_that_says_which(synth_photos, tmp_path, capsys):

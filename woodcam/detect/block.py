@@ -22,11 +22,13 @@ a digest of each (the SVGs' ``svg_sha256`` above, the images' ``meta["detection"
 file name -> digest of its pixels as read back; :data:`DETECTED_IMAGES`). Detecting again into
 the folder, such a file the new detection names no more (no rings or knot found on the face now,
 or no such face) is removed when it is still the recorded one; one that is not (edited, made by
-hand, or left by a run before the digests were recorded) is kept, unread, and said. An image
-the user edited since it was recorded, of a face the new detection writes that file for, wins
-as a corrected SVG does: it is kept and read as the face's, and said, with how to let detection
-replace it, and it stays the user's on later runs (not recorded as the detector's); a folder
-whose record has no digests (detected before they were recorded) has its images written over.
+hand, or left by a run before the digests were recorded) is kept and said, unread only when the
+block has no such face or it is one of those older runs'. An image the user edited since it was
+recorded wins as a corrected SVG does, on a face where detection finds a knot (rings) again and
+on one where it finds none (the user's is then the face's only one): it is kept and read as the
+face's, and said, with how to let detection replace it, and it stays the user's on later runs
+(not recorded as the detector's); a folder whose record has no digests (detected before they
+were recorded) has its images written over.
 An output folder with no detection recorded at all (no manifest, or one 'block from-photos'
 wrote and no detection since) holds none of the detector's files: a ring map, knot mask or
 ``<face>_traces.svg`` there (made by hand beside the photos before detecting) is the user's,
@@ -423,17 +425,18 @@ def _edited_images(block: Block, folders: list[tuple[Path, dict]],
 
 def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path],
                        unrecorded: Path | None = None) -> tuple[set[str], list[str]]:
-    """Each image ``block`` (just detected) has whose file the user edited (``edited``:
+    """Each image of ``block``'s faces (just detected) whose file the user edited (``edited``:
     :func:`_edited_images`; in ``unrecorded``, made by hand): the user's is read into ``block``
-    in its place, so it is what is written and read, as a corrected SVG wins. Returns the names
-    of the files kept and the warnings. (An edited image of a face now without one is left to
-    :func:`_clear_stale_files`.)"""
+    as the face's, so it is what is written and read, as a corrected SVG wins; also on a face
+    where detection made none of that kind (no knot or rings found, ``--no-knots``), where it was
+    kept unread and the user told to name it in block.json. Returns the names of the files kept
+    and the warnings."""
     kept: set[str] = set()
     msgs = []
     for (name, kind), path in edited.items():
         f = block.faces[name]
-        if _image(f, kind) is None:
-            continue
+        # on a face detection made none for, the user's is the only one: said, as it is all there is
+        none = "" if _image(f, kind) is not None else "; detection made none for the face this time"
         mine = _read_users_image(path, kind, f.shape)
         block.faces[name] = (Face(name, f.shape, photo=f.photo, traces=f.traces, ring_map=mine, extras=f.extras)
                              if kind == "ring_map" else
@@ -441,8 +444,8 @@ def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path],
                                   extras={**f.extras, kind: mine}))
         kept.add(path.name)
         msgs.append(_kept_users_line(name, f"your {path}" if path.parent == unrecorded else f"the edited {path}",
-                                     path.parent, _NO_RECORD if path.parent == unrecorded else
-                                     f"it is not the {DETECTED_IMAGES[kind][0]} detection wrote there"))
+                                     path.parent, (_NO_RECORD if path.parent == unrecorded else
+                                                   f"it is not the {DETECTED_IMAGES[kind][0]} detection wrote there") + none))
     return kept, msgs
 
 
@@ -577,7 +580,8 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
                                          _NO_RECORD if svg.parent == unrecorded
                                          else "it is not the SVG detection wrote there")))
     for name, f in block.faces.items():
-        if f.photo is not None and not f.traces and name not in kept:
+        # a face with the user's ring map is not left without one (said as kept below)
+        if f.photo is not None and not f.traces and name not in kept and (name, "ring_map") not in images:
             msgs.append(f"face {name!r}: no rings found; the face is left without a ring map "
                         f"(trace its rings in {name}_traces.svg if it has some)")
     det_traces = {n: f.traces for n, f in block.faces.items()}
