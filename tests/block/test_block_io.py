@@ -59,6 +59,30 @@ def test_round_trip(tmp_path, block, bits, tol):
     assert np.array_equal(back.true_field(p), block.true_field(p))
 
 
+def test_images_already_in_the_folder_are_named_not_written(tmp_path, block):
+    """write_block(existing=...) names a face's ring map or PNG extra already in the folder (ring
+    detection keeps a user's under the name block.json gave it), leaving the file as it is; the
+    reader takes an 8-bit ring map's depth from the file; a name of no file is refused."""
+    shape = block.faces["left"].shape
+    rings = (np.arange(np.prod(shape)).reshape(shape) % 255).astype(np.uint8)
+    Image.fromarray(rings).save(tmp_path / "mine.png")
+    mask = np.zeros(shape, np.uint8)
+    mask[10:20] = 255
+    Image.fromarray(mask).save(tmp_path / "knots.png")
+    before = {f: (tmp_path / f).read_bytes() for f in ("mine.png", "knots.png")}
+    b = Block(block.size_mm, faces=dict(block.faces), name=block.name)
+    f = b.faces["left"]
+    b.faces["left"] = Face("left", f.shape, photo=f.photo, traces=f.traces, ring_map=rings / 255.0,
+                           extras={**f.extras, "knot_mask": mask > 127})
+    write_block(b, tmp_path, existing={"left": {"ring_map": "mine.png", "knot_mask": "knots.png"}})
+    assert {f: (tmp_path / f).read_bytes() for f in before} == before
+    assert not (tmp_path / "left_ring_map.png").exists() and not (tmp_path / "left_knot_mask.png").exists()
+    back = read_block(tmp_path).faces["left"]
+    assert np.allclose(back.ring_map, rings / 255.0, atol=1e-7) and np.array_equal(back.extras["knot_mask"], mask > 127)
+    with pytest.raises(WoodcamError, match="existing ring_map of face 'left': 'gone.png' is not a file in"):
+        write_block(b, tmp_path, existing={"left": {"ring_map": "gone.png"}})
+
+
 def test_16bit_is_finer_than_8bit(tmp_path, block):
     errs = []
     for bits in (8, 16):

@@ -852,6 +852,74 @@ def test_a_users_knot_mask_or_ring_map_on_a_face_detection_finds_none_on_is_used
     assert "knot_mask" not in json.loads((blk / "block.json").read_text())["meta"]["detection"]["file_digest"]
 
 
+def test_files_block_json_names_under_other_names_are_the_users_and_kept(synth_photos, tmp_path, capsys, monkeypatch):
+    """block.json naming a face's ring map, knot mask or traces SVG under another name than
+    detection's (top_rings.png, left_knot.png, front_mine.svg) had detection replace them in the
+    manifest without a word (the files left unnamed), and a kept SVG named front_traces.svg in
+    the manifest whatever it was called (the detector's old one, when there). Now such a file is
+    the user's, as one under detection's name is: kept untouched, still named, read as the face's,
+    said in one line; the detector's own files of those faces are cleared; detected into another
+    --out it is carried over under its name; deleted, detection writes its own."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    blk, _size = _knotted_block_folder(synth_photos, tmp_path, capsys)
+    mask = np.zeros((160, 160), np.uint8)
+    mask[60:140, 20:120] = 255
+    rings = np.zeros((160, 160), np.uint16)
+    rings[:, ::10] = 65535
+    svg = ('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
+           '<path d="M 10.5,20.5 L 150.5,20.5"/></svg>')
+    names = {("left", "knot"): "left_knot.png", ("top", "rings"): "top_rings.png", ("front", "svg"): "front_mine.svg"}
+
+    def point_at_mine(folder):
+        Image.fromarray(mask).save(folder / "left_knot.png")
+        Image.fromarray(rings).save(folder / "top_rings.png")
+        (folder / "front_mine.svg").write_text(svg)
+        m = json.loads((folder / "block.json").read_text())
+        m["faces"]["left"]["extras"]["knot_mask"] = {"png": "left_knot.png", "dtype": "bool"}
+        m["faces"]["top"].update(ring_map="top_rings.png", ring_map_bits=16)
+        m["faces"]["front"]["traces_svg"] = "front_mine.svg"
+        (folder / "block.json").write_text(json.dumps(m))
+        return {f: (folder / f).read_bytes() for f in names.values()}
+
+    def check(folder, err, mine):
+        assert {f: (folder / f).read_bytes() for f in mine} == mine
+        entries = json.loads((folder / "block.json").read_text())["faces"]
+        assert entries["left"]["extras"]["knot_mask"]["png"] == "left_knot.png"
+        assert entries["top"]["ring_map"] == "top_rings.png" and entries["front"]["traces_svg"] == "front_mine.svg"
+        faces = read_block(folder).faces
+        assert np.array_equal(faces["left"].extras["knot_mask"], mask > 127), err
+        assert np.array_equal(faces["top"].ring_map, rings / 65535.0)
+        assert len(faces["front"].traces) == 1 and len(faces["top"].traces) > 1
+        for f in mine:
+            (line,) = [w for w in err.splitlines() if f in w]
+            assert " kept your " in line and "block.json names it for the face, and detection writes only " in line
+            assert "it wins over detection; to let detection replace it, delete it" in line, line
+        assert not any((folder / f).exists() for f in ("left_knot_mask.png", "top_ring_map.png", "front_traces.svg"))
+
+    fresh = tmp_path / "fresh"  # never detected: block.json from 'block from-photos'
+    _copy(blk, fresh)
+    mine = point_at_mine(fresh)
+    rc, _out, err = _run(capsys, "rings", "detect", fresh, "--out", fresh)
+    assert rc == 0, err
+    check(fresh, err, mine)
+    # detected before: the detector's own files of those faces are cleared, the user's named
+    assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 0
+    detected = read_block(blk).faces
+    mine = point_at_mine(blk)
+    for out in (blk, blk, tmp_path / "other"):  # twice in place (the user's still on the second), another --out
+        rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", out)
+        assert rc == 0, err
+        check(out, err, mine)
+    for f in mine:
+        (blk / f).unlink()
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and " kept " not in err, err
+    faces = read_block(blk).faces
+    assert np.array_equal(faces["left"].extras["knot_mask"], detected["left"].extras["knot_mask"])
+    assert np.allclose(faces["top"].ring_map, detected["top"].ring_map)
+    assert len(faces["front"].traces) == len(detected["front"].traces)
+
+
 def test_a_missing_or_file_input_is_one_line_that_says_which(synth_photos, tmp_path, capsys):
     """A photo given where the block folder goes ('rings detect front.png', 'rings show
     front.png') was said not to exist, though it is right there; a missing folder is still said

@@ -80,7 +80,8 @@ MOKUME_MAP_KINDS = ("arl-unet", "ann", "knot")
 # -- woodcam manifest folders --------------------------------------------------------------------
 
 def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16] = 16,
-                overwrite: bool = True, traces_svg: dict[str, str] | None = None) -> Path:
+                overwrite: bool = True, traces_svg: dict[str, str] | None = None,
+                existing: dict[str, dict[str, str]] | None = None) -> Path:
     """Write ``block`` to ``folder`` as ``block.json`` plus PNG images (see module docstring).
 
     Parameters
@@ -96,6 +97,10 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
         face -> the name of an SVG of its traces already in ``folder``, recorded as the face's
         ``traces_svg`` (ring detection writes its SVGs first, so the manifest, written last,
         is complete in one step).
+    existing : dict, optional
+        face -> {``"ring_map"`` or an extras key: the name of an image already in ``folder``},
+        named as the face's instead of written (ring detection keeps a user's image under the
+        name block.json gave it, untouched); its ``ring_map_bits`` is left to the file's depth.
 
     Returns
     -------
@@ -118,9 +123,15 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
     # a Ctrl-C of 'block from-photos' (or 'rings detect') into a block folder of an earlier run
     # left the new front photo beside the old faces and the old manifest's rings: a block of two
     # runs, read without a word.
+    for name, named in (existing or {}).items():
+        for key, fname in named.items():
+            if not (folder / fname).is_file():
+                raise WoodcamError(f"existing {key} of face {name!r}: {fname!r} is not a file in {str(folder)!r}; "
+                                   "write the image first, or leave it out of existing")
     with all_or_nothing():
         faces = {}
         for name, face in block.faces.items():
+            named = (existing or {}).get(name, {})
             entry: dict = {"shape": list(face.shape), "photo": None, "ring_map": None}
             if face.photo is not None:
                 photo = np.asarray(face.photo)
@@ -131,7 +142,9 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
                     )
                 entry["photo"] = f"{name}_photo.png"
                 _write_png(folder / entry["photo"], photo)
-            if face.ring_map is not None:
+            if face.ring_map is not None and "ring_map" in named:
+                entry["ring_map"] = named["ring_map"]  # the reader takes the bit depth of the file
+            elif face.ring_map is not None:
                 entry["ring_map"] = f"{name}_ring_map.png"
                 entry["ring_map_bits"] = int(ring_map_bits)
                 _write_png(folder / entry["ring_map"], _quantise(face.ring_map, ring_map_bits, name))
@@ -142,7 +155,8 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
             ]
             extras = {}
             for key, value in face.extras.items():
-                extras[key] = _write_extra(folder, name, key, value)
+                extras[key] = ({"png": named[key], "dtype": str(np.asarray(value).dtype)} if key in named
+                               else _write_extra(folder, name, key, value))
             entry["extras"] = extras
             if traces_svg and name in traces_svg:
                 if not (folder / traces_svg[name]).is_file():

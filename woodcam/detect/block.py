@@ -32,7 +32,10 @@ were recorded) has its images written over.
 An output folder with no detection recorded at all (no manifest, or one 'block from-photos'
 wrote and no detection since) holds none of the detector's files: a ring map, knot mask or
 ``<face>_traces.svg`` there (made by hand beside the photos before detecting) is the user's,
-kept and used as an edited one is, and said the same way.
+kept and used as an edited one is, and said the same way. A ring map, knot mask or traces SVG
+block.json names under another name than detection's (``top_rings.png``) is the user's wherever
+it is (detection writes none of that name): kept untouched, still named by the manifest, read
+as the face's and said alike (carried over under its name into another ``--out``).
 
 **Photo-only blocks elsewhere** (``fit``, ``bake``, ``eval``): :func:`with_detected_rings`
 detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
@@ -50,6 +53,7 @@ import copy
 import hashlib
 import json
 import warnings
+from collections.abc import Collection
 from pathlib import Path
 from typing import Literal
 
@@ -312,6 +316,48 @@ def _unrecorded(folder: Path) -> bool:
         return False
 
 
+#: The files of a face detection writes, by kind, under their default names (:func:`_named_users_files`).
+_DEFAULT_NAMES = {"traces_svg": "{}_traces.svg", "ring_map": "{}_ring_map.png", "knot_mask": "{}_knot_mask.png"}
+
+
+def _named_users_files(folder: Path) -> dict[tuple[str, str], str]:
+    """(face, kind) -> the name block.json in ``folder`` gives a face's traces SVG, ring map or
+    knot mask (:data:`_DEFAULT_NAMES`) when it is not the name detection writes: detection never
+    wrote such a file, so it is the user's, kept and used as one under the default name is
+    (it was replaced in the manifest without a word). Empty without a readable manifest."""
+    from ..block.io import MANIFEST
+
+    try:
+        m = json.loads((folder / MANIFEST).read_text())
+    except (OSError, ValueError):
+        return {}
+    faces = m.get("faces") if isinstance(m, dict) else None
+    found = {}
+    for name, e in (faces.items() if isinstance(faces, dict) else ()):
+        if not isinstance(e, dict):
+            continue
+        knot = (e.get("extras") or {}).get("knot_mask") if isinstance(e.get("extras"), dict) else None
+        for kind, rel in (("traces_svg", e.get("traces_svg")), ("ring_map", e.get("ring_map")),
+                          ("knot_mask", knot.get("png") if isinstance(knot, dict) else None)):
+            if isinstance(rel, str) and rel and rel != _DEFAULT_NAMES[kind].format(name):
+                found[name, kind] = rel
+    return found
+
+
+def _name_in(out: Path, path: Path) -> str:
+    """The name the manifest in ``out`` gives the user's file ``path`` it keeps: its own, relative,
+    when it lies in ``out``; else its file name, the copy's (:func:`detect_folder`)."""
+    try:
+        return path.resolve().relative_to(out.resolve()).as_posix()
+    except ValueError:
+        return path.name
+
+
+def _named_why(default: str) -> str:
+    """Why a file block.json names under another name than detection's is the user's."""
+    return f"block.json names it for the face, and detection writes only {default}"
+
+
 #: Why a file of detection's name in a folder with no detection recorded is the user's (:func:`_unrecorded`).
 _NO_RECORD = "no detection is recorded in that folder, so detection did not write it"
 
@@ -392,24 +438,28 @@ def _prior_record(folder: Path) -> dict:
         return {}
 
 
-def _edited_images(block: Block, folders: list[tuple[Path, dict]],
+def _edited_images(block: Block, folders: list[tuple[Path, dict, dict[tuple[str, str], str]]],
                    unrecorded: Path | None = None) -> dict[tuple[str, str], Path]:
     """(face, kind) -> the file of each image of ``block``'s faces in one of ``folders`` (folder,
     its record before this run; the output first) that is no longer the one the detector wrote
     there: a user edited it (or made it by hand beside a recorded detection). A record without
     digests (made before they were) has its images written over, as they were then. In the
     folder ``unrecorded`` (the output when no detection is recorded there, :func:`_unrecorded`)
-    every such image is the user's: detection wrote none there.
+    every such image is the user's: detection wrote none there, nor any the folder's block.json
+    names under another name than its own (each folder's third item, :func:`_named_users_files`).
 
     Refused, as a corrected SVG is (:func:`_check_corrections_match_photos`), when the record
     says it was made over another photo than the face's now: it is not this photo's."""
     found: dict[tuple[str, str], Path] = {}
     for name, f in block.faces.items():
         for kind, (what, _) in DETECTED_IMAGES.items():
-            for folder, rec in folders:
-                path = folder / f"{name}_{kind}.png"
-                if (("file_digest" not in rec and folder != unrecorded) or not path.is_file()
-                        or _file_digest(path, kind) == _file_digests(rec).get(path.name)):
+            for folder, rec, named in folders:
+                path = folder / named.get((name, kind), f"{name}_{kind}.png")
+                if not path.is_file():  # one named and deleted: detection writes its own
+                    path = folder / f"{name}_{kind}.png"
+                mine = (name, kind) in named and path != folder / f"{name}_{kind}.png"
+                if not mine and (("file_digest" not in rec and folder != unrecorded) or not path.is_file()
+                                 or _file_digest(path, kind) == _file_digests(rec).get(path.name)):
                     continue
                 was = (rec.get("photo_digest") or {}).get(name)
                 if was is not None and f.photo is not None and was != photo_digest(f.photo):
@@ -424,14 +474,15 @@ def _edited_images(block: Block, folders: list[tuple[Path, dict]],
 
 
 def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path],
-                       unrecorded: Path | None = None) -> tuple[set[str], list[str]]:
+                       unrecorded: Path | None = None, named: Collection[Path] = ()) -> tuple[set[tuple[str, str]], list[str]]:
     """Each image of ``block``'s faces (just detected) whose file the user edited (``edited``:
-    :func:`_edited_images`; in ``unrecorded``, made by hand): the user's is read into ``block``
+    :func:`_edited_images`; in ``unrecorded``, or ``named`` by block.json under another name than
+    detection's (:func:`_named_users_files`), made by hand): the user's is read into ``block``
     as the face's, so it is what is written and read, as a corrected SVG wins; also on a face
     where detection made none of that kind (no knot or rings found, ``--no-knots``), where it was
     kept unread and the user told to name it in block.json. Returns the names of the files kept
     and the warnings."""
-    kept: set[str] = set()
+    kept: set[tuple[str, str]] = set()
     msgs = []
     for (name, kind), path in edited.items():
         f = block.faces[name]
@@ -442,18 +493,23 @@ def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path],
                              if kind == "ring_map" else
                              Face(name, f.shape, photo=f.photo, traces=f.traces, ring_map=f.ring_map,
                                   extras={**f.extras, kind: mine}))
-        kept.add(path.name)
-        msgs.append(_kept_users_line(name, f"your {path}" if path.parent == unrecorded else f"the edited {path}",
-                                     path.parent, (_NO_RECORD if path.parent == unrecorded else
-                                                   f"it is not the {DETECTED_IMAGES[kind][0]} detection wrote there") + none))
+        kept.add((name, kind))
+        why = (_named_why(_DEFAULT_NAMES[kind].format(name)) if path in named else
+               _NO_RECORD if path.parent == unrecorded else
+               f"it is not the {DETECTED_IMAGES[kind][0]} detection wrote there")
+        mine = path in named or path.parent == unrecorded
+        msgs.append(_kept_users_line(name, f"your {path}" if mine else f"the edited {path}", path.parent, why + none))
     return kept, msgs
 
 
-def _clear_stale_files(out: Path, block: Block, before: dict) -> list[str]:
+def _clear_stale_files(out: Path, block: Block, before: dict, svgs: dict[str, str] | None = None,
+                       existing: dict[str, dict[str, str]] | None = None) -> list[str]:
     """Remove each file of detection (``<face>_traces.svg``, :data:`DETECTED_IMAGES`) in ``out``
     that ``block`` (just written there) does not name, when it is the one the detector wrote
     (``before``: the folder's detection record before this run): a previous run's file of a face
-    with no rings or knot found now, or no such face, stayed beside the new manifest. Any other
+    with no rings or knot found now, or no such face, or whose manifest names the user's file
+    under another name (``svgs``: face -> its SVG's name, ``existing``: face -> {kind: name}, as
+    given to :func:`~woodcam.block.io.write_block`), stayed beside the new manifest. Any other
     such file is kept and said, but a corrected SVG (said by its caller); returns the warnings."""
     ours_img, ours_svg = _file_digests(before), before.get("svg_sha256") or {}
     corrected = set((before.get("traces_svg") or {}).values())
@@ -461,19 +517,30 @@ def _clear_stale_files(out: Path, block: Block, before: dict) -> list[str]:
     for name in FACES:
         face = block.faces.get(name)
         svg = out / f"{name}_traces.svg"
-        if face is None and svg.is_file():
+        other = (svgs or {}).get(name, svg.name) if face is not None else svg.name
+        if (face is None or other != svg.name) and svg.is_file():
             if isinstance(ours_svg, dict) and ours_svg.get(name) == _sha256(svg):
                 svg.unlink()
+            elif face is not None:
+                msgs.append(f"face {name!r}: {svg.name} in {str(out)!r} is not read (block.json names {other} for "
+                            f"the face), and is kept: it is not the SVG an earlier detection wrote; delete it, "
+                            f"or move it out to keep it")
             elif svg.name not in corrected:
                 msgs.append(f"face {name!r}: {svg.name} in {str(out)!r} is not read (the block has no such face, "
                             f"and block.json does not name it), and is kept: it is not the SVG an earlier "
                             f"detection wrote; delete it, or move it out to keep it")
         for kind, (what, why) in DETECTED_IMAGES.items():
             path = out / f"{name}_{kind}.png"
-            if not path.is_file() or _image(face, kind) is not None:
+            elsewhere = ((existing or {}).get(name) or {}).get(kind)
+            if not path.is_file() or (_image(face, kind) is not None and elsewhere is None):
                 continue  # none, or this detection's own (written over), or the user's kept (read in)
             if ours_img.get(path.name) is not None and _file_digest(path, kind) == ours_img[path.name]:
                 path.unlink()
+                continue
+            if elsewhere is not None:
+                msgs.append(f"face {name!r}: {path.name} in {str(out)!r} is not read (block.json names {elsewhere} "
+                            f"for the face), and is kept: it is not the {what} an earlier detection made; delete "
+                            f"it, or move it out to keep it")
                 continue
             why = why if face is not None else "the block has no such face"
             use = ("name it in block.json as the face's extras knot_mask and detect with --no-knots"
@@ -525,8 +592,14 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     # It warns that a size_mm given for a block folder is not used.
     # a file of detection's the user deleted (to let detection replace an edited one, as the line
     # that kept it says) is written again, not 'listed but missing'
+    # files block.json names under other names than detection's are the user's, as its own-named
+    # ones are (they were replaced in the manifest without a word); one deleted is written again
+    same = out.resolve() == src.resolve()
+    named_src = _named_users_files(src)
+    named_out = named_src if same else _named_users_files(out)
     block = read_block_folder(src, size_mm, regenerated={f"{n}_{k}.png" for n in FACES for k in DETECTED_IMAGES}
-                              | {f"{n}_traces.svg" for n in FACES})
+                              | {f"{n}_traces.svg" for n in FACES} | {Path(r).name for r in named_src.values()})
+    named = {folder / rel for folder, names in ((src, named_src), (out, named_out)) for rel in names.values()}
     if not (src / MANIFEST).is_file():  # a Mokume sample: re-detected from its photos alone
         for f in block.faces.values():
             f.ring_map, f.traces = None, []
@@ -534,15 +607,20 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
         edited = {}
     else:
         edited = user_edited_faces(src)
-    if out.resolve() != src.resolve() and (out / MANIFEST).is_file():
+    edited.update({n: src / rel for (n, kind), rel in named_src.items() if kind == "traces_svg" and (src / rel).is_file()})
+    if not same and (out / MANIFEST).is_file():
         # corrections made in the output folder of an earlier run win too (only the source's
         # were looked for, and detection overwrote the ones in --out)
         edited.update(user_edited_faces(out))
+        edited.update({n: out / rel for (n, kind), rel in named_out.items()
+                       if kind == "traces_svg" and (out / rel).is_file()})
     # with no detection recorded in --out, a file of detection's names there is the user's (traced
     # by hand beside the photos before ever detecting): it was written over without a word
     unrecorded = out if _unrecorded(out) else None
     if unrecorded is not None:
-        edited.update({n: out / f"{n}_traces.svg" for n in block.faces if (out / f"{n}_traces.svg").is_file()})
+        # (but where block.json names another SVG of the face: that one is the face's)
+        edited.update({n: out / f"{n}_traces.svg" for n in block.faces if (out / f"{n}_traces.svg").is_file()
+                       and not ((n, "traces_svg") in named_out and (out / named_out[n, "traces_svg"]).is_file())})
     # a corrected SVG of a face the block no longer has (made again with --partial without it) was
     # an internal error (KeyError): it is left where it is, unused, and said
     unused = {n: svg for n, svg in edited.items() if n not in block.faces}
@@ -550,9 +628,9 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     _check_corrections_match_photos(block, edited)
     # the files the detector wrote, as the source and --out recorded them (before either is overwritten)
     src_rec = _prior_record(src)
-    out_rec = src_rec if out.resolve() == src.resolve() else _prior_record(out)
+    out_rec = src_rec if same else _prior_record(out)
     # images the user edited since the detector wrote them, checked before any work as the SVGs are
-    images = _edited_images(block, [(out, out_rec)] + ([(src, src_rec)] if out.resolve() != src.resolve() else []),
+    images = _edited_images(block, [(out, out_rec, named_out)] + ([] if same else [(src, src_rec, named_src)]),
                             unrecorded)
     todo = [n for n, f in block.faces.items() if f.photo is not None and n not in edited]
     msgs: list[str] = [f"face {n!r}: the corrected {svg} is not used: the block has no {n} face (made "
@@ -575,9 +653,11 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
         ring_map = ring_map_from_traces(traces, f.shape, sigma_mm * px) if traces else None
         block.faces[name] = Face(name, f.shape, photo=f.photo, traces=[], ring_map=ring_map, extras=f.extras)
         kept[name] = traces
-        msgs.append(_kept_users_line(name, f"{'your' if svg.parent == unrecorded else 'the corrected'} {svg.name}",
+        mine = svg in named or svg.parent == unrecorded
+        msgs.append(_kept_users_line(name, f"{'your' if mine else 'the corrected'} {svg.name}",
                                      svg.parent, f"{len(traces)} traces; " + (
-                                         _NO_RECORD if svg.parent == unrecorded
+                                         _named_why(f"{name}_traces.svg") if svg in named
+                                         else _NO_RECORD if svg.parent == unrecorded
                                          else "it is not the SVG detection wrote there")))
     for name, f in block.faces.items():
         # a face with the user's ring map is not left without one (said as kept below)
@@ -589,9 +669,11 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     for f in block.faces.values():
         f.traces = []
     out.mkdir(parents=True, exist_ok=True)
-    if out.resolve() != src.resolve():
-        for name, svg in edited.items():     # carry the user's SVG over unchanged
-            write_bytes(out / svg.name, svg.read_bytes())
+    # the user's SVG carried over unchanged, and named by the manifest as it was (under any name)
+    svg_names = {n: _name_in(out, svg) for n, svg in edited.items()}
+    for name, svg in edited.items():
+        if (out / svg_names[name]).resolve() != svg.resolve():
+            write_bytes(out / svg_names[name], svg.read_bytes())
     # The SVGs first, the manifest last and in one step: a manifest written before its SVGs
     # (as it was) named no SVG until they were done, so a Ctrl-C in between made the next run
     # take the user's corrected SVG for the detector's and overwrite it. Interrupted now, the old
@@ -615,8 +697,16 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     det["user_svg"] = sorted(kept)
     # an image the user edited since the detector wrote it wins as a corrected SVG does (it was
     # written over without a word): read in, written back as read, never recorded as the detector's
-    users, said = _keep_users_images(block, images, unrecorded)
+    users, said = _keep_users_images(block, images, unrecorded, named)
     msgs += said
+    # a user's image block.json names under its own name stays named so, untouched (carried over
+    # unchanged into another --out); one of detection's name is written back as read
+    existing: dict[str, dict[str, str]] = {}
+    for (name, kind), path in images.items():
+        if (name, kind) in users and path in named:
+            existing.setdefault(name, {})[kind] = rel = _name_in(out, path)
+            if (out / rel).resolve() != path.resolve():
+                write_bytes(out / rel, path.read_bytes())
     # the detector's images: this run's (ring maps of faces detected or drawn from a corrected
     # SVG, knot masks detected), and earlier ones kept unchanged (--no-knots, a corrected SVG's
     # face) that were its own; a user's is never recorded, so never cleared nor written over
@@ -625,7 +715,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     det["file_digest"] = {fname: d for n, f in block.faces.items() for kind in DETECTED_IMAGES
                           if (image := _image(f, kind)) is not None
                           for fname, d in [(f"{n}_{kind}.png", _pixels_digest(kind, image))]
-                          if fname not in users and (n in fresh[kind] or before.get(fname) == d)}
+                          if (n, kind) not in users and (n in fresh[kind] or before.get(fname) == d)}
     block.meta["detection"] = det
     # a face photographed turned or mirrored ruins the fit without a word otherwise; a face with no
     # rings found is not judged (its report.unchecked), and its 'no rings found' above says so
@@ -634,9 +724,10 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     # a face too coarse to judge is said, so the silence is not read as its layout holding
     msgs += [f"face {n!r}: not checked for a turned or mirrored photo: {why}"
              for n, why in layout.unchecked.items() if why != NO_RINGS]
-    manifest = write_block(block, out, traces_svg={n: f"{n}_traces.svg" for n in block.faces})
+    manifest = write_block(block, out, traces_svg={n: svg_names.get(n, f"{n}_traces.svg") for n in block.faces},
+                           existing=existing)
     # after the manifest: interrupted before, a stale mask is unnamed, never read
-    msgs += _clear_stale_files(out, block, out_rec)
+    msgs += _clear_stale_files(out, block, out_rec, svg_names, existing)
     return manifest, msgs
 
 
