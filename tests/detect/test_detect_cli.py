@@ -133,7 +133,8 @@ def test_corrected_svg_wins_over_detection(synth_photos, tmp_path, capsys):
     svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
                    '<path d="M 10.5,20.5 L 150.5,20.5" data-year="3"/></svg>')
     rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
-    assert rc == 0 and "kept the corrected front_traces.svg" in err
+    # named by its path as an edited image is, its one trace in the singular
+    assert rc == 0 and f"kept the corrected {svg} (1 trace; it is not the SVG detection wrote there)" in err, err
     b = read_block(blk)
     tr = b.faces["front"].traces
     assert len(tr) == 1 and tr[0].year == 3 and np.allclose(tr[0].points_px, [[20, 10], [20, 150]])
@@ -165,7 +166,7 @@ def test_a_corrected_svg_survives_an_interrupted_detection(synth_photos, tmp_pat
     assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 130
     monkeypatch.setattr(svg_mod, "write_traces_svg", real)
     rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
-    assert rc == 0 and "kept the corrected front_traces.svg" in err
+    assert rc == 0 and f"kept the corrected {blk / 'front_traces.svg'} (1 trace; " in err
     assert (blk / "front_traces.svg").read_text() == mine
 
 
@@ -179,7 +180,7 @@ def test_a_corrected_svg_in_another_out_folder_is_kept(synth_photos, tmp_path, c
             '<path d="M 10.5,20.5 L 150.5,20.5" data-year="3"/></svg>')
     (det / "front_traces.svg").write_text(mine)
     rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", det)
-    assert rc == 0 and "kept the corrected front_traces.svg" in err
+    assert rc == 0 and f"kept the corrected {det / 'front_traces.svg'} (1 trace; " in err
     assert (det / "front_traces.svg").read_text() == mine
 
 
@@ -206,7 +207,7 @@ def test_a_corrected_svg_drawn_over_another_photo_is_refused(synth_photos, tmp_p
     assert {p.name: p.read_bytes() for p in det.iterdir()} == before
     # the photos it was drawn over: kept, as before
     rc, _out, err = _run(capsys, "rings", "detect", old, "--out", det)
-    assert rc == 0 and "kept the corrected front_traces.svg" in err
+    assert rc == 0 and f"kept the corrected {det / 'front_traces.svg'} (1 trace; " in err
     assert (det / "front_traces.svg").read_text() == mine
 
 
@@ -263,7 +264,7 @@ def test_a_block_made_again_in_its_folder_keeps_its_corrected_svgs(synth_photos,
     assert (blk / "front_traces.svg").read_text() == mine and (blk / "top_traces.svg").read_text() == mine
     (blk / "top_traces.svg").unlink()  # as the error says
     rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
-    assert rc == 0 and "kept the corrected front_traces.svg" in err and "top_traces" not in err
+    assert rc == 0 and f"kept the corrected {blk / 'front_traces.svg'} (1 trace; " in err and "top_traces" not in err
     assert (blk / "front_traces.svg").read_text() == mine
     assert len(read_block(blk).faces["top"].traces) > 1  # detected afresh on the new top photo
 
@@ -893,6 +894,7 @@ def test_files_block_json_names_under_other_names_are_the_users_and_kept(synth_p
         for f in mine:
             (line,) = [w for w in err.splitlines() if f in w]
             assert " kept your " in line and "block.json names it for the face, and detection writes only " in line
+            assert f"/{f} (" in line, line  # by its path, an SVG as an image
             assert "it wins over detection; to let detection replace it, delete it" in line, line
         assert not any((folder / f).exists() for f in ("left_knot_mask.png", "top_ring_map.png", "front_traces.svg"))
 

@@ -654,8 +654,9 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
         block.faces[name] = Face(name, f.shape, photo=f.photo, traces=[], ring_map=ring_map, extras=f.extras)
         kept[name] = traces
         mine = svg in named or svg.parent == unrecorded
-        msgs.append(_kept_users_line(name, f"{'your' if mine else 'the corrected'} {svg.name}",
-                                     svg.parent, f"{len(traces)} traces; " + (
+        # the full path, as an image's: which of two folders (source, --out) it was kept from
+        msgs.append(_kept_users_line(name, f"{'your' if mine else 'the corrected'} {svg}",
+                                     svg.parent, f"{len(traces)} trace{'' if len(traces) == 1 else 's'}; " + (
                                          _named_why(f"{name}_traces.svg") if svg in named
                                          else _NO_RECORD if svg.parent == unrecorded
                                          else "it is not the SVG detection wrote there")))
