@@ -786,6 +786,10 @@ def test_the_cli_leaves_flat_reranks_floor_to_the_parameters(tmp_path, capsys):
     from woodcam.cli.options import RANGES
 
     assert RANGES[("parquetry", "flat_rerank")][0] == 1  # rerank's own floor; the rest is check()'s
+    # inputs that are there (the input door refuses missing ones first), never read: the rule is
+    # the command line's, before any work
+    for name in ("t.png", "v.png"):
+        (tmp_path / name).write_bytes(b"")
     argv = ["parquetry", str(tmp_path / "t.png"), "--veneer", str(tmp_path / "v.png"), "--flat-rerank", "2",
             "--out", str(tmp_path / "o"), "--quiet"]
     assert main(argv) == 2
