@@ -29,6 +29,7 @@ import re
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Literal, get_args
 
 from .._types import CAMERAS
 from ..errors import UsageError, WoodcamError
@@ -143,10 +144,11 @@ def _command_name(args: argparse.Namespace) -> str:
 #: What an input path argument names (:func:`add_input`): an existing FILE, an existing FOLDER,
 #: or a block spec (a block or Mokume sample folder, a ``woodify:`` field or ``log:`` JSON file;
 #: a built-in block and the shared ``gran1`` log name none).
-INPUT_KINDS = ("file", "folder", "block")
+InputKind = Literal["file", "folder", "block"]
+INPUT_KINDS: tuple[str, ...] = get_args(InputKind)
 
 
-def add_input(p, *flags: str, kind: str, paths=None, suffixes=None, **kwargs) -> argparse.Action:
+def add_input(p, *flags: str, kind: InputKind, paths=None, suffixes=None, **kwargs) -> argparse.Action:
     """An input path argument of ``p`` (``add_argument``'s ``flags`` and ``kwargs``) that
     :func:`check_inputs` checks before the command runs: ``kind`` is one of
     :data:`INPUT_KINDS`; ``paths`` maps a value to the paths it names when it holds more than a
