@@ -308,23 +308,38 @@ def test_the_report_names_its_thirds_by_the_blocks_ends_whatever_the_eigenvector
     assert part_report(stick, _slab_stock(), samples=6000) == rep
 
 
+class Grey:
+    """A user's wood that only draws colours (grey): a method color, no features."""
+
+    def color(self, points_mm, normals):
+        return np.full((len(points_mm), 3), 0.5)
+
+
+def _colour_only_stock():
+    """A 50 x 50 x 30 mm Stock of :class:`Grey`."""
+    from woodcam.stock import Stock
+
+    return Stock("mine", (50.0, 50.0, 30.0), Grey())
+
+
+def _box_in_it():
+    """A 10 mm cube in the middle of :func:`_colour_only_stock`."""
+    import trimesh
+
+    box = trimesh.creation.box((10, 10, 10))
+    box.apply_translation((25, 25, 15))
+    return box
+
+
 def test_a_wood_that_only_draws_colours_is_refused_by_placement_advice_naming_it():
     """A Stock of a user's colour-only wood (a method color, no features) is a stock (baked,
     viewed), but advise_placement failed deep in its scoring with AttributeError "'Grey' object
     has no attribute 'features'" (part_report and knot_spots the same). Each refuses it at its
     door naming the argument, the rule, the kind given and the fix."""
-    import trimesh
 
     from woodcam.advise import knot_spots, part_report
-    from woodcam.stock import Stock
 
-    class Grey:
-        def color(self, points_mm, normals):
-            return np.full((len(points_mm), 3), 0.5)
-
-    stock = Stock("mine", (50.0, 50.0, 30.0), Grey())
-    box = trimesh.creation.box((10, 10, 10))
-    box.apply_translation((25, 25, 15))
+    stock, box = _colour_only_stock(), _box_in_it()
     said = (r"{}: {} must read the wood, a method features\(points_mm \(n, 3\)\) -> dict with 'knot', 'years' "
             r"and 'grain' .*; got Grey, which only draws colours; open the stock with open_stock or pass Wood\(field\)")
     with pytest.raises(WoodcamError, match=said.format("advise_placement", r"stock\.wood")):
@@ -332,7 +347,7 @@ def test_a_wood_that_only_draws_colours_is_refused_by_placement_advice_naming_it
     with pytest.raises(WoodcamError, match=said.format("part_report", r"stock\.wood")):
         part_report(box, stock, samples=50)
     with pytest.raises(WoodcamError, match=said.format("knot_spots", "wood")):
-        knot_spots(box, Grey(), samples=50)
+        knot_spots(box, stock.wood, samples=50)
 
 
 def test_a_part_previewed_in_a_wood_that_only_draws_colours_is_baked_without_its_report(tmp_path):
@@ -346,15 +361,8 @@ def test_a_part_previewed_in_a_wood_that_only_draws_colours_is_baked_without_its
 
     from woodcam.errors import WoodcamWarning
     from woodcam.pipeline import preview_part
-    from woodcam.stock import Stock
 
-    class Grey:
-        def color(self, points_mm, normals):
-            return np.full((len(points_mm), 3), 0.5)
-
-    stock = Stock("mine", (50.0, 50.0, 30.0), Grey())
-    box = trimesh.creation.box((10, 10, 10))
-    box.apply_translation((25, 25, 15))
+    stock, box = _colour_only_stock(), _box_in_it()
     with pytest.warns(WoodcamWarning, match=r"p: no part report \(knots, pith, end grain, grain runout\): "
                       r"stock\.wood \(Grey\) only draws colours, .*open the stock with open_stock or pass "
                       r"Wood\(field\)") as said:

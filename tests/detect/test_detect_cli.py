@@ -767,6 +767,32 @@ def test_an_edited_knot_mask_or_ring_map_wins_over_a_rerun_as_a_corrected_svg_do
         assert np.array_equal(np.asarray(im), mask)
 
 
+def _hand_made_files():
+    """A user's hand-made files of a 160 px face: a knot mask (a rectangle, uint8 0/255), a ring
+    map (16-bit, a ring every 10 px) and a traces SVG of one line."""
+    mask = np.zeros((160, 160), np.uint8)
+    mask[60:140, 20:120] = 255
+    rings = np.zeros((160, 160), np.uint16)
+    rings[:, ::10] = 65535
+    svg = ('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
+           '<path d="M 10.5,20.5 L 150.5,20.5"/></svg>')
+    return mask, rings, svg
+
+
+def _deleted_are_detected_again(capsys, blk, mine, detected):
+    """The user's files ``mine`` (names in ``blk``) deleted, as the kept line says: a rerun keeps
+    nothing and the left knot mask, top ring map and front traces are the detector's
+    (``detected``: the faces of a detection of the same photos)."""
+    for f in mine:
+        (blk / f).unlink()
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and " kept " not in err, err
+    faces = read_block(blk).faces
+    assert np.array_equal(faces["left"].extras["knot_mask"], detected["left"].extras["knot_mask"])
+    assert np.allclose(faces["top"].ring_map, detected["top"].ring_map)
+    assert len(faces["front"].traces) == len(detected["front"].traces)
+
+
 def test_hand_made_files_in_a_folder_never_detected_are_kept_and_used(synth_photos, tmp_path, capsys, monkeypatch):
     """A knot mask, ring map and traced SVG the user put beside the photos before ever running
     detection (block.json records none) were written over without a word: only files whose
@@ -780,12 +806,7 @@ def test_hand_made_files_in_a_folder_never_detected_are_kept_and_used(synth_phot
     assert _run(capsys, "rings", "detect", blk, "--out", fresh)[0] == 0
     detected = read_block(fresh).faces
     assert "knot_mask" in detected["left"].extras  # the rerun finds the knot: the mask is its to write
-    mask = np.zeros((160, 160), np.uint8)
-    mask[60:140, 20:120] = 255
-    rings = np.zeros((160, 160), np.uint16)
-    rings[:, ::10] = 65535
-    svg = ('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
-           '<path d="M 10.5,20.5 L 150.5,20.5"/></svg>')
+    mask, rings, svg = _hand_made_files()
     other = tmp_path / "other"
     other.mkdir()
     for folder in (blk, other):
@@ -806,14 +827,7 @@ def test_hand_made_files_in_a_folder_never_detected_are_kept_and_used(synth_phot
             assert line.startswith("woodcam: warning: face '") and " kept " in line, line
             assert ("it wins over detection; to let detection replace it, delete it (or move it out of "
                     f"{str(out)!r}) and run 'rings detect' again") in line, line
-    for f in mine:
-        (blk / f).unlink()
-    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
-    assert rc == 0 and " kept " not in err, err
-    faces = read_block(blk).faces
-    assert np.array_equal(faces["left"].extras["knot_mask"], detected["left"].extras["knot_mask"])
-    assert np.allclose(faces["top"].ring_map, detected["top"].ring_map)
-    assert len(faces["front"].traces) == len(detected["front"].traces)
+    _deleted_are_detected_again(capsys, blk, mine, detected)
 
 
 def test_a_users_knot_mask_or_ring_map_on_a_face_detection_finds_none_on_is_used(synth_photos, tmp_path, capsys,
@@ -863,12 +877,7 @@ def test_files_block_json_names_under_other_names_are_the_users_and_kept(synth_p
     --out it is carried over under its name; deleted, detection writes its own."""
     monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
     blk, _size = _knotted_block_folder(synth_photos, tmp_path, capsys)
-    mask = np.zeros((160, 160), np.uint8)
-    mask[60:140, 20:120] = 255
-    rings = np.zeros((160, 160), np.uint16)
-    rings[:, ::10] = 65535
-    svg = ('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
-           '<path d="M 10.5,20.5 L 150.5,20.5"/></svg>')
+    mask, rings, svg = _hand_made_files()
     names = {("left", "knot"): "left_knot.png", ("top", "rings"): "top_rings.png", ("front", "svg"): "front_mine.svg"}
 
     def point_at_mine(folder):
@@ -912,14 +921,7 @@ def test_files_block_json_names_under_other_names_are_the_users_and_kept(synth_p
         rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", out)
         assert rc == 0, err
         check(out, err, mine)
-    for f in mine:
-        (blk / f).unlink()
-    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
-    assert rc == 0 and " kept " not in err, err
-    faces = read_block(blk).faces
-    assert np.array_equal(faces["left"].extras["knot_mask"], detected["left"].extras["knot_mask"])
-    assert np.allclose(faces["top"].ring_map, detected["top"].ring_map)
-    assert len(faces["front"].traces) == len(detected["front"].traces)
+    _deleted_are_detected_again(capsys, blk, mine, detected)
 
 
 def test_a_missing_or_file_input_is_one_line_that_says_which(synth_photos, tmp_path, capsys):
