@@ -564,13 +564,20 @@ def test_rings_detect_and_show_on_a_folder_of_photos_say_to_make_a_block_first(s
     assert not (tmp_path / "o").exists() and not (tmp_path / "o.png").exists()
 
 
-def test_face_without_rings_is_named(synth_photos, tmp_path, capsys):
+def _ringless_bottom_block(synth_photos, tmp_path, capsys, size_mm: str):
+    """A block folder ``tmp_path/blk`` from the synthetic photos ('block from-photos', cube side
+    ``size_mm``) whose bottom photo is a noisy grey gradient: no rings to find there."""
     d = _copy(synth_photos, tmp_path / "p")
     rng = np.random.default_rng(0)
     grad = np.linspace(90, 170, 160)[None, :, None] + 4 * rng.standard_normal((160, 160, 3))
     Image.fromarray(np.clip(np.broadcast_to(grad, (160, 160, 3)), 0, 255).astype(np.uint8)).save(d / "bottom.png")
     blk = tmp_path / "blk"
-    assert _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", blk)[0] == 0
+    assert _run(capsys, "block", "from-photos", d, "--size-mm", size_mm, "--out", blk)[0] == 0
+    return blk
+
+
+def test_face_without_rings_is_named(synth_photos, tmp_path, capsys):
+    blk = _ringless_bottom_block(synth_photos, tmp_path, capsys, "50")
     rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
     assert rc == 0 and "face 'bottom'" in err
     b = read_block(blk)
@@ -838,17 +845,9 @@ def test_a_users_knot_mask_or_ring_map_on_a_face_detection_finds_none_on_is_used
     kept, named by the manifest as the face's (so 'fit' reads it), said in the one line, and not
     said to leave the face without a ring map; on a rerun it is still the user's."""
     monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
-    d = _copy(synth_photos, tmp_path / "p")
-    rng = np.random.default_rng(0)
-    grad = np.linspace(90, 170, 160)[None, :, None] + 4 * rng.standard_normal((160, 160, 3))
-    Image.fromarray(np.clip(np.broadcast_to(grad, (160, 160, 3)), 0, 255).astype(np.uint8)).save(d / "bottom.png")
-    blk = tmp_path / "blk"
-    assert _run(capsys, "block", "from-photos", d, "--size-mm", "32", "--out", blk)[0] == 0
-    mask = np.zeros((160, 160), np.uint8)
-    mask[60:140, 20:120] = 255
+    blk = _ringless_bottom_block(synth_photos, tmp_path, capsys, "32")
+    mask, rings, _svg = _hand_made_files()
     Image.fromarray(mask).save(blk / "top_knot_mask.png")
-    rings = np.zeros((160, 160), np.uint16)
-    rings[:, ::10] = 65535
     Image.fromarray(rings).save(blk / "bottom_ring_map.png")
     for how in ("your", "the edited"):  # hand-made before any detection, then the user's on a rerun
         rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
