@@ -407,8 +407,8 @@ def test_sheet_size_errors_speak_the_units_it_was_typed_in(scans, capsys):
     """Under --units inch, '--sheet-size 0x1' said "takes WxH in mm ...; got '0x25.4'" (the size
     --units had turned into mm), and leaves past the block said "give --sheet-size 100x50 mm or
     smaller": typed as said, read as inches, 2540 x 1270 mm, refused again. Now the text as
-    typed, the rule, the sizes and the fix in --units (a block spec's size, read in mm, says
-    so), and the fix it gives is taken."""
+    typed, the rule, the sizes and the fix in --units (a block spec's size too: --veneer-from
+    reads it in --units), and the fix it gives is taken."""
     out = scans / "out"
     inch = ["--veneer-from", "builtin:flat-sawn", "--no-glb", "--units", "inch"]
     assert _small_run(scans, out, *inch, "--sheet-size", "0x1") == 2
@@ -419,7 +419,7 @@ def test_sheet_size_errors_speak_the_units_it_was_typed_in(scans, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "leaves of 100 x 50 in (--sheet-size" in err, err
     assert "its 3.937 x 3.15 x 1.969 in block's face normal to y (--slice-axis) is 3.937 x 1.969 in" in err, err
-    assert "(builtin:flat-sawn:2540x80x1270, its size in mm)" in err, err
+    assert "(builtin:flat-sawn:100x3.14961x50)" in err, err  # in inches, as --veneer-from reads it
     fix = err.split("give --sheet-size ")[1].split(" in or smaller")[0]
     assert fix == "3.93701x1.968504", fix
     assert _small_run(scans, out, *inch, "--sheet-size", fix) == 0
@@ -427,6 +427,27 @@ def test_sheet_size_errors_speak_the_units_it_was_typed_in(scans, capsys):
     assert _small_run(scans, out, *inch, "--sheets", "30", "--leaf-thickness", "0.1") == 2
     assert ("30 leaves (--sheets) of 0.1 in + 0.01575 in kerf, sliced from the middle of builtin:flat-sawn along y, "
             "reach 5.031 in into its 3.15 in: past its back face") in capsys.readouterr().err
+
+
+def test_a_veneer_from_spec_size_is_read_in_units_as_bake_reads_its_block(scans, capsys):
+    """'--veneer-from builtin:flat-sawn:4x3x2 --units inch' sliced a 4 x 3 x 2 mm block (the
+    spec's :WxDxH read in mm whatever --units said) where 'bake --block' reads the same spec
+    in inches. Now the spec is read in --units at the door, as bake's: its block is 4 x 3 x 2
+    in, job.json keeps it in mm, its errors quote it as typed and speak inches."""
+    out = scans / "out"
+    inch = ["--no-glb", "--units", "inch"]
+    assert _small_run(scans, out, *inch, "--veneer-from", "builtin:flat-sawn:4x3x2", "--sheet-size", "5x1") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and ("do not fit builtin:flat-sawn:4x3x2: its 4 x 3 x 2 in block's face normal "
+                                     "to y (--slice-axis) is 4 x 2 in") in err, err
+    assert _small_run(scans, out, *inch, "--veneer-from", "builtin:flat-sawn:4x3x2", "--sheet-size", "1x1") == 0
+    capsys.readouterr()
+    blocks = json.loads((out / "job.json").read_text())["woodcam"]["blocks"]
+    assert [b["spec"] for b in blocks] == ["builtin:flat-sawn:101.6x76.2x50.8"], blocks
+    assert _small_run(scans, out, *inch, "--veneer-from", "builtin:flat-sawn:0x1x1") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and ("--veneer-from builtin:flat-sawn:0x1x1: the size must be WxDxH in "
+                                     "--units inch") in err, err
 
 
 def test_leaves_beyond_their_block_are_refused_naming_the_sizes(scans, capsys):

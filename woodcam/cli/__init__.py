@@ -286,8 +286,9 @@ def _typed_spec(args: argparse.Namespace, err: BaseException) -> str:
         return ""
     if getattr(args, "block", None) == err.spec:  # in mm once read at the door (lengths_to_mm)
         return f"--block {as_typed(args, 'block')}"
-    if err.spec in (getattr(args, "veneer_from", None) or []):
-        return f"--veneer-from {err.spec}"
+    specs = getattr(args, "veneer_from", None) or []
+    if err.spec in specs:  # as typed: in mm once read at the door, as --block
+        return f"--veneer-from {as_typed(args, 'veneer_from')[specs.index(err.spec)]}"
     return ""
 
 

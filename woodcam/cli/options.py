@@ -370,6 +370,7 @@ LENGTH_OPTIONS: dict[tuple[str, str], str] = {
     ("woodify", "block_centre"): "vector", ("woodify", "crack_region"): "vector",
     ("parquetry", "sheet_size"): "sizes", ("parquetry", "leaf_thickness"): "number",
     ("parquetry", "saw_kerf"): "number", ("parquetry", "tool_diameter"): "number",
+    ("parquetry", "veneer_from"): "spec",
 }
 
 #: Positions of the lengths among a tool spec's numbers (``vbit:ANGLE:D`` -> D only).
@@ -387,7 +388,8 @@ _MESHES_IN_MM = {"woodify"}
 def add_units_option(p: argparse.ArgumentParser, command: str) -> None:
     """``--units mm|inch`` for ``command``; its help names the options :data:`LENGTH_OPTIONS`
     converts for that command."""
-    names = [("a block spec's WxDxH" if d == "block" else _option(d))
+    names = [("a block spec's WxDxH" if d == "block" else f"a {_option(d)} spec's WxDxH"
+              if LENGTH_OPTIONS[c, d] == "spec" else _option(d))
              for (c, d) in LENGTH_OPTIONS if c == command]
     assert names, command  # a contributor's mistake: list the command's lengths first
     p.add_argument("--units", choices=("mm", "inch"), default="mm",
@@ -464,11 +466,10 @@ def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
     everything below the CLI takes); called by :func:`woodcam.cli.main` before the range checks.
     Defaults are millimetres already (the help states them in mm) and are left alone: argparse
     stores a default as the very object of the parser, a typed value as a new one."""
-    from .._specs import format_spec
-
     units = getattr(args, "units", None)
     command = getattr(args, "command", None)
-    specs = {dest: _read_spec(str(getattr(args, dest)), units or "mm")  # in every unit
+    # in every unit; an option given many times (parquetry --veneer-from) is a list of specs
+    specs = {dest: _read_specs(getattr(args, dest), _option(dest), units or "mm")
              for (cmd, dest), kind in LENGTH_OPTIONS.items()
              if kind == "spec" and cmd == command and getattr(args, dest, None) is not None}
     if units in (None, "mm"):
@@ -479,44 +480,59 @@ def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
         value = getattr(args, dest, None)
         if cmd == command and value is not None and value is not sub.get_default(dest):
             # a spec as read at the door, written back in mm: its text is not split again
-            setattr(args, dest, format_spec(specs[dest]) if kind == "spec" else _value_to_mm(kind, value, k))
+            setattr(args, dest, _specs_in_mm(specs[dest]) if kind == "spec" else _value_to_mm(kind, value, k))
             # what was typed, for the range errors: "--mesh-tol 0.5" (inch) said "got 12.7"
             args.__dict__.setdefault("_typed", {})[dest] = (value, units)
 
 
-def _read_spec(spec: str, units: Units):
+def _read_specs(value, option: str, units: Units):
+    """``value`` (a spec, or a list of them) read by :func:`_read_spec`, as given."""
+    if isinstance(value, list):
+        return [_read_spec(str(v), units, option) for v in value]
+    return _read_spec(str(value), units, option)
+
+
+def _specs_in_mm(parsed):
+    """:func:`_read_specs`' specs written back in mm (:func:`woodcam._specs.format_spec`)."""
+    from .._specs import format_spec
+
+    return [format_spec(p) for p in parsed] if isinstance(parsed, list) else format_spec(parsed)
+
+
+def _read_spec(spec: str, units: Units, option: str = "--block"):
     """A typed block spec read in ``units`` by the stock's own reader
     (:func:`woodcam._specs.parse_spec`): what the stock would refuse is refused here, at the
-    door, a usage error in every unit that names the spec as typed (the stock's error, after
-    the conversion, named it in mm: '1000x1x1' inches said "got '25400x25.4x25.4' ... in mm";
-    and a door of its own grammar let through what the stock refused)."""
+    door, a usage error in every unit that names ``option`` and the spec as typed (the
+    stock's error, after the conversion, named it in mm: '1000x1x1' inches said "got
+    '25400x25.4x25.4' ... in mm"; and a door of its own grammar let through what the stock
+    refused)."""
     from .._specs import parse_spec
     from ..errors import BlockSpecError
 
     try:
         return parse_spec(spec, mm_per_unit=MM_PER_UNIT[units])
     except BlockSpecError as err:
-        raise UsageError(_spec_usage(spec, units, err)) from err
+        raise UsageError(_spec_usage(spec, units, err, option)) from err
 
 
-def _spec_usage(spec: str, units: Units, err) -> str:
-    """The door's words for ``err`` (a BlockSpecError of ``spec`` read in ``units``): its
-    lengths' rules in ``units``, the rest as the stock says it."""
+def _spec_usage(spec: str, units: Units, err, option: str = "--block") -> str:
+    """The door's words for ``err`` (a BlockSpecError of ``spec``, given as ``option``, read
+    in ``units``): its lengths' rules in ``units``, the rest as the stock says it."""
     said = "mm" if units == "mm" else f"--units {units}"
     cap = fmt_length(MAX_BLOCK_SIZE_MM, units, 5)
     if err.part == "size":
-        return (f"--block {spec}: the size must be WxDxH in {said}, each > 0 and <= {cap}; got "
+        return (f"{option} {spec}: the size must be WxDxH in {said}, each > 0 and <= {cap}; got "
                 f"{err.text!r}, e.g. {fmt_size((300, 120, 40), units, 3)}")
     e = 1 / MM_PER_UNIT[units]
     example = f"'builtin:knotty[{40 * e:.3g}x{30 * e:.3g}x{20 * e:.3g}@{5 * e:.2g},{5 * e:.2g},{5 * e:.2g}]'"
     # a bracket the grammar does not read ([40x30]) is a resize typed wrong, as the stock reads it
     if err.part == "resize" or (err.part == "op" and err.text.startswith("[")):
-        return (f"--block {spec}: a resize must be [WxDxH] or [WxDxH@X,Y,Z] in {said} (X,Y,Z the "
+        return (f"{option} {spec}: a resize must be [WxDxH] or [WxDxH@X,Y,Z] in {said} (X,Y,Z the "
                 f"corner in the block before it), each side > 0 and <= {cap}; got {err.text}, e.g. {example}")
     if err.part == "op":
-        return (f"--block {spec}: {err.text!r} is neither a turn ~AXIS then degrees nor a resize "
+        return (f"{option} {spec}: {err.text!r} is neither a turn ~AXIS then degrees nor a resize "
                 f"[WxDxH] or [WxDxH@X,Y,Z] (plain numbers, in {said}), e.g. {example}")
-    return f"--block {spec}: {err.rule}"  # a turn, a log's knot: no lengths
+    return f"{option} {spec}: {err.rule}"  # a turn, a log's knot: no lengths
 
 
 def as_typed(args: argparse.Namespace, dest: str):

@@ -68,7 +68,8 @@ def register(subparsers) -> None:
                    "when the file states another, other than the 72/96 dpi cameras and editors write unmeasured) or "
                    "'Npx/mm'")
     add_input(v, "--veneer-from", kind="block", action="append", default=[], metavar="SPEC",
-                   help="Mokume sample folder, or block spec to slice leaves from (repeatable)")
+                   help="Mokume sample folder, or block spec to slice leaves from (repeatable; its "
+                   ":WxDxH in --units, as bake --block)")
     v.add_argument("--sheets", type=int, default=None, help="leaves per --veneer-from block (default 2)")
     v.add_argument("--sheet-size", default=None, metavar="WxH",
                    help="size of each sliced leaf in --units (default 600x400 mm, or the block's face where "
@@ -303,7 +304,11 @@ def run(args) -> int:
         veneers = job_veneers(job, open_stock=open_stock, progress=progress)
     except LeavesPastBlockError as err:  # a job file's own leaves: the file is wrong (exit 1)
         if any(err.entry is b for b in sized_here):
-            raise UsageError(str(err)) from err
+            # the spec as typed, not as --units turned it into mm (builtin:oak:4x3x2, inches)
+            said = str(err)
+            for mm, typed in zip(args.veneer_from, as_typed(args, "veneer_from")):
+                said = said.replace(f"{mm}:", f"{typed}:").replace(f"{mm} ", f"{typed} ")
+            raise UsageError(said) from err
         raise
     run_ = build_parquetry(targets, veneers, job.params, names=names, progress=progress,
                            seams=not args.no_seams)

@@ -479,22 +479,21 @@ def check_leaves_in_block(stock, n_sheets: int, width_mm: float | None, height_m
     w = min(DEFAULT_LEAF_MM[0], face[0]) if width_mm is None else float(width_mm)
     h = min(DEFAULT_LEAF_MM[1], face[1]) if height_mm is None else float(height_mm)
     # lengths in the message units (--units): the fix '--sheet-size 100x50 mm', typed as it
-    # said under --units inch, was 2540 x 1270 mm, refused again; a block spec's size stays mm
-    # (--veneer-from reads its :WxDxH in mm whatever --units says)
+    # said under --units inch, was 2540 x 1270 mm, refused again; so is a block spec's size
+    # (--veneer-from reads its :WxDxH in --units, as bake --block does)
     block = say_length(size, "g", sep=" x ")
     tol = IN_BLOCK_RTOL * max(size)
     if w > face[0] + tol or h > face[1] + tol:
         need = list(size)
         need[right], need[down] = max(size[right], w), max(size[down], h)
-        bigger = "x".join(f"{v:g}" for v in need)
+        bigger = "x".join(typed_length(v, tol) for v in need)
         fits = [typed_length(min(v, f), tol, lambda back, f=f: back <= f + tol) for v, f in ((w, face[0]), (h, face[1]))]
         raise LeavesPastBlockError(
             f"leaves of {say_length((w, h), 'g', sep=' x ')} (--sheet-size; width_mm, height_mm in a job file) "
             f"do not fit {stock.spec}: its {block} block's face normal to {axis} (--slice-axis) is "
             f"{say_length(face, 'g', sep=' x ')}, and every sheet must be wood of the block, not of the field "
             f"outside it; give --sheet-size {'x'.join(fits)} {message_unit()} or smaller"
-            + (f", or a block of {say_length(need, 'g', sep=' x ')} that holds them ({spec}:{bigger}"
-               + (", its size in mm" if message_unit() != "mm" else "") + ")"
+            + (f", or a block of {say_length(need, 'g', sep=' x ')} that holds them ({spec}:{bigger})"
                if re.fullmatch(r"builtin:[a-z-]+", spec := str(stock.spec))
                else f", or a block of {say_length(need, 'g', sep=' x ')} that holds them"
                if spec.startswith(("builtin:", "log:"))
