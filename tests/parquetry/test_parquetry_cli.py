@@ -450,6 +450,33 @@ def test_a_veneer_from_spec_size_is_read_in_units_as_bake_reads_its_block(scans,
                                      "--units inch") in err, err
 
 
+def test_a_sheet_smaller_than_a_patch_names_what_the_user_set(scans, capsys):
+    """'--tool-diameter 90' made every sheet smaller than one patch and the kerf round it, and
+    the error said 'use ... a smaller patch_mm or a smaller kerf_mm': a job file's keys, and a
+    kerf never typed (it defaults to the tool diameter). Now the options as typed (in
+    --units), the job file's keys where it set them, and the defaults said as such."""
+    out = scans / "out"
+    assert _small_run(scans, out, "--no-glb", "--tool-diameter", "90") == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "patch_mm" not in err and "kerf_mm" not in err, err
+    assert ("smaller than one patch (--patch-mm default 14) and the kerf round it (--kerf-mm not given: the "
+            "tool diameter, --tool-diameter 90)") in err, err
+    assert "use larger sheets, a smaller --patch-mm, or a smaller kerf (--kerf-mm, in mm)" in err, err
+    assert _small_run(scans, out, "--no-glb", "--units", "inch", "--tool-diameter", "3.5") == 1
+    err = capsys.readouterr().err
+    assert "--tool-diameter 3.5)" in err and "veneer 'light' is 6.299 x 4.724 in" in err, err
+    job = scans / "job.json"
+    job.write_text(json.dumps({"targets": [{"filename": str(scans / "coffee.png")}],
+                               "source_textures": [{"texture": str(scans / "light.png"), "px_per_mm": 2}],
+                               "woodcam": {"params": {"kerf_mm": 90, "overlap_mm": 3, "image_size_mm": 42,
+                                                      "px_per_mm": 2}}}))
+    assert main(["parquetry", "--config", str(job), "--out", str(out), "--quiet", "--no-glb",
+                 "--patch-mm", "20"]) == 1
+    err = capsys.readouterr().err
+    assert (f"one patch (--patch-mm 20) with its overlap (woodcam.params.overlap_mm 3 in {job}) and the kerf "
+            f"round it (woodcam.params.kerf_mm 90 in {job})") in err, err
+
+
 def test_leaves_beyond_their_block_are_refused_naming_the_sizes(scans, capsys):
     """'--veneer-from builtin:flat-sawn' sliced the default 600 x 400 mm leaves from its
     100 x 80 x 50 mm block, and any --sheet-size or --sheets past the block ran without a word:

@@ -216,6 +216,47 @@ def _scan_entry(text: str) -> dict:
     return entry
 
 
+def _setting(args, params, dest: str, key: str) -> str | None:
+    """How this run set parameter ``key`` (option ``dest``): the option as typed on the command
+    line (in --units where it takes them), the job file's key and value (mm), or None: its
+    default."""
+    from ..parquetry.job import ParquetryParams
+    from .options import as_typed
+
+    if getattr(args, dest, None) is not None:
+        return f"--{dest.replace('_', '-')} {as_typed(args, dest):g}"
+    value = getattr(params, key)
+    if args.config and value != getattr(ParquetryParams(), key):
+        return f"woodcam.params.{key} {value:g} in {args.config}"
+    return None
+
+
+def _sheet_too_small(err, args, params) -> str:
+    """The engine's too-small-sheet error in the words of this run: the patch, overlap and
+    kerf named as the user set them (the engine named the job file's patch_mm and kerf_mm,
+    'a smaller kerf_mm' of a kerf the user never typed, --tool-diameter 100's), lengths in
+    --units; the fix names the options (they override a job file's keys)."""
+    from ..units import say_length
+
+    patch = _setting(args, params, "patch_mm", "patch_mm") or f"--patch-mm default {params.patch_mm:g}"
+    parts = [f"one patch ({patch})"]
+    smaller = ["--patch-mm"]
+    if params.overlap > 0:  # --no-seams, --overlap-mm 0: no overlap to name
+        overlap = _setting(args, params, "overlap_mm", "overlap_mm") or f"--overlap-mm default {params.overlap:g}"
+        parts.append(f"its overlap ({overlap})")
+        smaller.append("--overlap-mm")
+    kerf = _setting(args, params, "kerf_mm", "kerf_mm")
+    if kerf is None:  # the kerf defaults to the bit's diameter: say so, and whose it is
+        tool = (_setting(args, params, "tool_diameter", "tool_diameter_mm")
+                or f"--tool-diameter default {say_length(params.tool_diameter_mm, 'g')}")
+        kerf = f"--kerf-mm not given: the tool diameter, {tool}"
+    parts.append(f"the kerf round it ({kerf})")
+    return (f"veneer {err.veneer_id!r} is {say_length(err.size_mm, '.1f', ' x ')}, smaller than "
+            f"{' with '.join(parts[:2]) if len(parts) == 3 else parts[0]} and {parts[-1]}: "
+            f"{say_length(err.need_mm, 'g')} a side; use larger sheets, a smaller {' or '.join(smaller)}, "
+            "or a smaller kerf (--kerf-mm, in mm)")
+
+
 def run(args) -> int:
     """Run a parsed ``parquetry`` command; returns the exit status: 0, or
     :data:`~woodcam.cli.EXIT_CHECKS` when the wood ran out (what was made is written)."""
@@ -223,7 +264,7 @@ def run(args) -> int:
     from collections import Counter
 
     from ..errors import UsageError, WoodcamError
-    from ..parquetry.engine import build_parquetry
+    from ..parquetry.engine import SheetTooSmallError, build_parquetry
     from ..parquetry.job import (
         LeavesPastBlockError,
         ParquetryJob,
@@ -310,8 +351,11 @@ def run(args) -> int:
                 said = said.replace(f"{mm}:", f"{typed}:").replace(f"{mm} ", f"{typed} ")
             raise UsageError(said) from err
         raise
-    run_ = build_parquetry(targets, veneers, job.params, names=names, progress=progress,
-                           seams=not args.no_seams)
+    try:
+        run_ = build_parquetry(targets, veneers, job.params, names=names, progress=progress,
+                               seams=not args.no_seams)
+    except SheetTooSmallError as err:
+        raise WoodcamError(_sheet_too_small(err, args, job.params)) from err
     glb_writer = None
     if not args.no_glb:
         from ..export import export_glb as glb_writer

@@ -210,6 +210,17 @@ def _check_run(run, where: str) -> None:
                            "build_parquetry(...) returned")
 
 
+class SheetTooSmallError(WoodcamError):
+    """A veneer sheet smaller than one patch with its overlap and the kerf round it
+    (:func:`build_parquetry`): ``veneer_id``, its ``size_mm`` (W, H) and the ``need_mm`` a side
+    must reach, so a caller can name its own settings of the patch, overlap and kerf (the
+    command line's options, not these parameters' names)."""
+
+    def __init__(self, message: str, veneer_id: str, size_mm: tuple[float, float], need_mm: float):
+        super().__init__(message)
+        self.veneer_id, self.size_mm, self.need_mm = veneer_id, size_mm, need_mm
+
+
 class _OutOfWood(Exception):
     pass
 
@@ -278,10 +289,12 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     for v in sheets:
         h, w = v.rgb.shape[:2]
         if min(h, w) < need_px:
-            raise WoodcamError(
-                f"veneer {v.id!r} is {say_length((w / params.px_per_mm, h / params.px_per_mm), '.1f', ' x ')}, "
-                f"smaller than one patch with its overlap and the kerf round it ({say_length(need_px / params.px_per_mm, 'g')}); "
-                "use larger sheets, a smaller patch_mm or a smaller kerf_mm")
+            size = (w / params.px_per_mm, h / params.px_per_mm)
+            raise SheetTooSmallError(
+                f"veneer {v.id!r} is {say_length(size, '.1f', ' x ')}, smaller than one patch with its "
+                f"overlap and the kerf round it ({say_length(need_px / params.px_per_mm, 'g')}); "
+                "use larger sheets, a smaller patch_mm or overlap_mm, or a smaller kerf_mm",
+                v.id, size, need_px / params.px_per_mm)
     grey = [intensity(v.rgb) for v in sheets]
     src_vals = np.concatenate([g[v.mask] for g, v in zip(grey, sheets)])
     if src_vals.size > 2_000_000:   # the CDF needs no more samples than this
