@@ -138,9 +138,15 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
         assert time.perf_counter() - t0 < 10.0, f"{opt}: refused only after the growth (a minute at 256)"
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and said in err, err
+    # an open mesh is named with its option and file (the growth said 'obstacles[0] must be
+    # watertight' of an --obstacle, and 'mesh must be ...' of the part)
     trimesh.Trimesh(m.vertices, m.faces[:-4]).export(tmp_path / "open.stl")
     assert main(["woodify", str(tmp_path / "open.stl"), "--years", "3", "--out", str(tmp_path / "o")]) == 1
-    assert "must be watertight" in capsys.readouterr().err
+    assert f"part {str(tmp_path / 'open.stl')!r} must be watertight" in capsys.readouterr().err
+    assert main(["woodify", str(tmp_path / "ball.stl"), "--obstacle", str(tmp_path / "open.stl"), "--years", "3",
+                 "--out", str(tmp_path / "o")]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"--obstacle {str(tmp_path / 'open.stl')!r} must be watertight" in err, err
     with pytest.raises(WoodcamError, match="does not exist"):
         open_stock(f"woodify:{tmp_path / 'missing.npz'}")
 

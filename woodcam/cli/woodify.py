@@ -134,6 +134,11 @@ def _load_mesh(path: str, what: str = "part"):
             return loaded, None, paint
         geom = trimesh.Trimesh(loaded.vertices, loaded.faces, process=True)
         geom.merge_vertices(merge_tex=True, merge_norm=True)
+        # here, naming the option and the file: the growth said 'obstacles[0] must be
+        # watertight' of an open --obstacle, and 'mesh ...' of the part, naming neither
+        from ..woodify.front import check_watertight
+
+        check_watertight(geom, f"{what} {path!r}")
         if textured is not None and len(geom.faces) != len(textured.faces):
             textured = None
         return geom, textured, {}
