@@ -42,6 +42,12 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     # an infinite machining time was an OverflowError traceback
     ([*GCODE, "--tool", "flat:6", "--start=1e300,0,0"], EXIT_USAGE, r"--start must be in \[-100000, 100000\]; got 1e\+300"),
     ([*GCODE, "--tool", "flat:6", "--rapid-rate", "1e-320"], EXIT_USAGE, r"--rapid-rate must be in \[0.1, 1e\+06\]"),
+    # a stock of 1e300 mm: the message printed a 300-digit grid (read at the door in --units)
+    ([*GCODE, "--tool", "flat:6", "--stock", "1e300x10x10"], EXIT_USAGE,
+     r"--stock takes WxDxH in mm, 3 numbers in \(0, 10000\], e.g. 50x50x50; got '1e300x10x10'$"),
+    # in the units typed: it said 'in mm', read before --units was known
+    ([*GCODE, "--tool", "flat:0.25", "--units", "inch", "--stock", "0x1x1"], EXIT_USAGE,
+     r"--stock takes WxDxH in inches \(--units inch\), 3 numbers in \(0, 393.701\], e.g. 2x2x2; got '0x1x1'$"),
     # tracebacks (an allocation, OpenCV's assertion) or a run that never ended
     (["parquetry", "toolpaths/img/drilling.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--sheet-size", "1e300x10"], EXIT_USAGE,
      r"--sheet-size takes WxH in mm"),
@@ -181,8 +187,6 @@ def test_work_offset_must_be_three_finite_numbers(value, capsys):
     (["bake", "x.py", "--block", "builtin:flat-sawn", "--out", "x.glb", "--tolerance", "abc"], "woodcam bake"),
     (["nosuch"], "woodcam"),  # an unknown command
     (["block", "synth", "--count", "x"], "woodcam block synth"),
-    (["gcode", "x.nc", "--block", "builtin:flat-sawn", "--out", "x.glb", "--stock", "1e300x10x10"],
-     "woodcam gcode"),  # a stock of 1e300 mm: the message printed a 300-digit grid
 ])
 def test_usage_errors_are_one_line_with_a_pointer_to_help(argv, prog, capsys):
     """argparse's own errors printed the whole usage block (up to 15 lines) before the error."""

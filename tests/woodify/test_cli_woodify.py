@@ -241,7 +241,8 @@ def test_vectors_and_sizes_are_refused_at_the_door_as_typed(tmp_path, capsys):
     """woodify parsed --up, --block-centre and --crack-region with its own _vec (exit 1, after
     --units had converted them: --block-size 1000x10x10 --units inch said '25400x254x254'); --up
     0,0,0 reached the library, which named its parameter 'up'. They are the shared vector_type /
-    sizes_type and RANGES now: exit 2, the option and the value as typed."""
+    sizes_type and RANGES now: exit 2, the option and the value as typed; a size read in the
+    units typed (--block-size 0x1x1 --units inch said 'in mm')."""
     ball = tmp_path / "ball.stl"
     trimesh.creation.icosphere(subdivisions=1, radius=5.0).export(ball)
     for extra, said in (
@@ -249,7 +250,12 @@ def test_vectors_and_sizes_are_refused_at_the_door_as_typed(tmp_path, capsys):
             (["--crack-region", "0,0,0"], "--crack-region '0,0,0': give 4 finite numbers X,Y,Z,R"),
             (["--crack-region=1,2,3,0"], "--crack-region X,Y,Z,R needs a radius R > 0; got R = 0 mm"),
             (["--block-size", "1000x10x10", "--units", "inch"],
-             "--block-size must be in (0, 10000] mm; got 1000.0 inch = 25400 mm"),
+             "--block-size takes WxDxH in inches (--units inch), 3 numbers in (0, 393.701], e.g. 2x2x2; "
+             "got '1000x10x10'"),
+            # read in the units typed: it said 'takes WxDxH in mm', read before --units was known
+            (["--block-size", "0x1x1", "--units", "inch"],
+             "--block-size takes WxDxH in inches (--units inch), 3 numbers in (0, 393.701], e.g. 2x2x2; "
+             "got '0x1x1'"),
             (["--block-centre=5000,0,0", "--units", "inch"],
              "--block-centre must be in [-100000, 100000] mm; got 5000.0 inch = 127000 mm")):
         assert _rc(["woodify", str(ball), "--years", "3", "--out", str(tmp_path / "o"), *extra]) == 2, extra

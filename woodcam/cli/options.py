@@ -351,7 +351,8 @@ def _check_folder_can_be_made(folder: Path, command: str, option: str = "--out")
 
 # -- --units: lengths on the command line and in printed summaries ------------------------------
 #: ``(command, option dest)`` -> how the value holds lengths: "number" (float), "vector" (a
-#: tuple of floats), "sizes" (a text "WxH" of lengths), "spec" (a block
+#: tuple of floats), "sizes" (a "WxH" or "WxDxH" of :func:`sizes_type`: its text read again in
+#: every unit, a tuple of mm), "spec" (a block
 #: spec's :WxDxH size and its resizes, read by :func:`woodcam._specs.parse_spec`), "place" (``--place`` operations: translate:X,Y,Z and fit:MARGIN),
 #: "tools" (``--tool`` specs: diameters, corner radii, tips; angles stay degrees). ``--rapid-rate`` reads unit/min. Options whose name carries a unit
 #: (``--texels-per-mm``, ``--size-mm``) keep it; files stay mm.
@@ -363,10 +364,10 @@ LENGTH_OPTIONS: dict[tuple[str, str], str] = {
     ("gcode", "block"): "spec", ("gcode", "cell_size"): "number",
     ("gcode", "work_offset"): "vector", ("gcode", "start"): "vector",
     ("gcode", "machine_zero"): "vector",
-    ("gcode", "stock"): "vector", ("gcode", "stock_origin"): "vector",
+    ("gcode", "stock"): "sizes", ("gcode", "stock_origin"): "vector",
     ("gcode", "rapid_rate"): "number", ("gcode", "mesh_tol"): "number",
     ("gcode", "tool"): "tools",
-    ("woodify", "growth"): "number", ("woodify", "block_size"): "vector",
+    ("woodify", "growth"): "number", ("woodify", "block_size"): "sizes",
     ("woodify", "block_centre"): "vector", ("woodify", "crack_region"): "vector",
     ("parquetry", "sheet_size"): "sizes", ("parquetry", "leaf_thickness"): "number",
     ("parquetry", "saw_kerf"): "number", ("parquetry", "tool_diameter"): "number",
@@ -422,8 +423,6 @@ def _value_to_mm(kind: str, value, k: float):
         return value * k
     if kind == "vector":
         return tuple(v * k for v in value)
-    if kind == "sizes":
-        return _scaled_numbers(str(value).lower(), "x", k)
     if kind == "place":
         return [place_op_in(op, k) for op in value]
     if kind == "tools":
@@ -472,7 +471,13 @@ def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
     specs = {dest: _read_specs(getattr(args, dest), _option(dest), units or "mm")
              for (cmd, dest), kind in LENGTH_OPTIONS.items()
              if kind == "spec" and cmd == command and getattr(args, dest, None) is not None}
+    # sizes (WxDxH) read again as typed, in every unit, their rule and example in it: argparse
+    # read them before --units was known
+    sizes = {dest: parse_sizes(typed.text, _option(dest), len(typed), units=units or "mm")
+             for (cmd, dest), kind in LENGTH_OPTIONS.items()
+             if kind == "sizes" and cmd == command and isinstance(typed := getattr(args, dest, None), _TypedSizes)}
     if units in (None, "mm"):
+        vars(args).update(sizes)
         return
     k = MM_PER_UNIT[units]
     sub = parser.get_default("_commands").choices[command]
@@ -480,7 +485,8 @@ def lengths_to_mm(args: argparse.Namespace, parser: argparse.ArgumentParser) -> 
         value = getattr(args, dest, None)
         if cmd == command and value is not None and value is not sub.get_default(dest):
             # a spec as read at the door, written back in mm: its text is not split again
-            setattr(args, dest, _specs_in_mm(specs[dest]) if kind == "spec" else _value_to_mm(kind, value, k))
+            setattr(args, dest, _specs_in_mm(specs[dest]) if kind == "spec"
+                    else sizes.get(dest, value) if kind == "sizes" else _value_to_mm(kind, value, k))
             # what was typed, for the range errors: "--mesh-tol 0.5" (inch) said "got 12.7"
             args.__dict__.setdefault("_typed", {})[dest] = (value, units)
 
@@ -757,13 +763,28 @@ def parse_sizes(text: str, option: str, n: int = 3, *, cube: bool = False,
     return tuple(v * k for v in vals)
 
 
+class _TypedSizes(tuple):
+    """A size option's value from argparse (:func:`sizes_type`): the numbers read in mm, or NaN
+    where the text broke the rule in mm, and the ``text`` as typed, which :func:`lengths_to_mm`
+    reads again in ``--units``."""
+
+    text: str
+
+
 def sizes_type(option: str, n: int = 3):
-    """argparse ``type`` of :func:`parse_sizes` (a usage error, exit 2)."""
+    """argparse ``type`` of a size ``WxDxH`` (``n`` numbers) of ``option``: read by
+    :func:`parse_sizes` in mm, its text kept (:class:`_TypedSizes`) and read again, in ``--units``
+    with its rule and example in them, at the door (:func:`lengths_to_mm`, a kind "sizes" of
+    :data:`LENGTH_OPTIONS`); argparse reads before --units is known, so a size refused here
+    ('--block-size 0x1x1 --units inch' said 'takes WxDxH in mm') is refused there."""
     def parse(text: str) -> tuple[float, ...]:
         try:
-            return parse_sizes(text, option, n)
-        except WoodcamError as err:
-            raise argparse.ArgumentTypeError(str(err)) from err
+            vals = parse_sizes(text, option, n)
+        except WoodcamError:
+            vals = (math.nan,) * n  # refused at the door, in the units typed
+        sizes = _TypedSizes(vals)
+        sizes.text = text
+        return sizes
     return parse
 
 

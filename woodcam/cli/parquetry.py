@@ -13,7 +13,7 @@ import warnings
 from pathlib import Path
 
 from ..errors import WoodcamWarning
-from .options import SPECIES_HELP, add_input, add_out_option, add_units_option, as_typed, parse_sizes, species_type
+from .options import SPECIES_HELP, add_input, add_out_option, add_units_option, as_typed, sizes_type, species_type
 
 _EPILOG = """\
 veneer sources (any number, mixed):
@@ -71,7 +71,7 @@ def register(subparsers) -> None:
                    help="Mokume sample folder, or block spec to slice leaves from (repeatable; its "
                    ":WxDxH in --units, as bake --block)")
     v.add_argument("--sheets", type=int, default=None, help="leaves per --veneer-from block (default 2)")
-    v.add_argument("--sheet-size", default=None, metavar="WxH",
+    v.add_argument("--sheet-size", default=None, metavar="WxH", type=sizes_type("--sheet-size", 2),
                    help="size of each sliced leaf in --units (default 600x400 mm, or the block's face where "
                    "smaller; a leaf larger than that face is refused: every sheet is wood of the block)")
     v.add_argument("--leaf-thickness", type=float, default=None, metavar="LEN",
@@ -305,10 +305,8 @@ def run(args) -> int:
     for d, default in _SLICING.items():
         if getattr(args, d) is None:
             setattr(args, d, default)
-    # read as typed, in --units: its error then quotes what was typed (it quoted the size --units
-    # had turned into mm, '0x25.4' of a typed '0x1', and said 'in mm')
-    w, h = (parse_sizes(str(as_typed(args, "sheet_size")), "--sheet-size", n=2, units=args.units)
-            if args.sheet_size is not None else (None, None))
+    # read as typed, in --units, at the door (sizes_type): its error quotes what was typed
+    w, h = args.sheet_size or (None, None)
     # the slicing options given here override the job file's blocks too (--config's rule: options
     # given here override it); they were ignored there
     leaf = {"sheets": args.sheets, "width_mm": w, "height_mm": h, "thickness_mm": args.leaf_thickness,
