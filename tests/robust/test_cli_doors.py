@@ -29,6 +29,8 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["fit", "/nonexistent", "--size-mm", "1e9", "--out", "OUT/f.npz"], EXIT_USAGE, r"--size-mm must be in \(0, 10000\]"),
     (["fit", "/nonexistent", "--size-mm=-inf", "--out", "OUT/f.npz"], EXIT_USAGE, r"--size-mm must be a finite"),
     (["block", "synth", "--count", "0", "--out", "OUT/b"], EXIT_USAGE, r"--count must be in \[1,"),
+    # the whole largest seed, not '4.29497e+09'
+    (["block", "synth", "--count", "1", "--seed=-1", "--out", "OUT/b"], EXIT_USAGE, r"--seed must be in \[0, 4294967295\]; got -1;"),
     (["block", "synth", "--count", "1", "--face-px", "100000000", "--out", "OUT/b"], EXIT_USAGE, r"--face-px must be in"),
     (["train", "gtf", "--steps", "0", "--out", "OUT/t"], EXIT_USAGE, r"--steps must be in \[1,"),
     ([*BAKE, "--out", "OUT/x.stl"], EXIT_USAGE, r"--out of 'woodcam bake' must end in .glb"),

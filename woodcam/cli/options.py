@@ -1267,6 +1267,12 @@ def _option(dest: str) -> str:
     return "--" + dest.replace("_", "-")
 
 
+def _bound(v) -> str:
+    """A range's end as short as :g writes it where that is the number (1e+06), else whole: --seed's
+    2**32 - 1 was '4.29497e+09', a number one cannot type as the largest seed."""
+    return f"{v:g}" if float(f"{v:g}") == v else (f"{v:d}" if isinstance(v, int) else repr(v))
+
+
 def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND") -> None:
     # a UsageError (exit 2): a number out of range is a wrong command line, as the exit statuses
     # in 'woodcam --help' say (it exited 1, as a failed work)
@@ -1281,7 +1287,7 @@ def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND") 
     lo, hi, lo_open, hi_open = (*rng, False)[:4]
     if value < lo or value > hi or (lo_open and value <= lo) or (hi_open and value >= hi):
         got = f"{value!r}" if typed is None else f"{typed[0]!r} {typed[1]} = {value:g} mm"
-        raise UsageError(f"{option} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}"
+        raise UsageError(f"{option} must be in {'(' if lo_open else '['}{_bound(lo)}, {_bound(hi)}"
                          f"{')' if hi_open else ']'}"
                          f"{' mm' if typed is not None else ''}; got {got}; see 'woodcam {command} --help' "
                          "for its meaning and default")
