@@ -1215,6 +1215,28 @@ def test_debug_text_woodcam_cannot_fill_in_is_marked_and_warned():
         assert interp.messages == [(2, "m")]
 
 
+def test_a_message_in_a_loop_is_said_every_pass_and_warned_once():
+    """A (DEBUG,...)/(PRINT,...) in an o-word loop reading what woodcam cannot know warned on
+    every pass: a 1000-pass while loop gave 1000 identical warnings a value. Now each line and
+    value is warned once, saying how many times the line ran; the messages stay one a pass, as
+    LinuxCNC shows them (do and repeat loops the same)."""
+    text = ("#1=0\no100 while [#1 lt 1000]\n(DEBUG,z=#5403 p=#5063 #5063)\n(PRINT,#1 x #)\n"
+            "#1=[#1+1]\no100 endwhile\n"
+            "o200 do\n(DEBUG,q=#5063)\n#1=[#1-1]\no200 while [#1 gt 997]\n"
+            "o300 repeat [2]\n(PRINT,t=#5401)\no300 endrepeat\n(DEBUG,once #5063)\nM2\n")
+    interp = Interpreter(text)
+    interp.run()
+    assert len(interp.messages) == 1000 + 3 + 1 and len(interp.printed) == 1000 + 2
+    assert interp.messages[999] == (3, "z=[#5403: T0's Z offset, from the machine's tool "
+                                       "table] p=#5063? #5063?")
+    assert interp.printed[999] == (4, "999.000000 x")
+    said = [(ln, w.split(",...) ")[1].split(",")[0].split(":")[0]) for ln, w in interp.warnings]
+    assert said == [(3, "shows #5403"), (3, "reads #5063"), (4, "ends in an unfinished "
+                    "parameter '#'"), (8, "reads #5063"), (12, "shows #5401"), (14, "reads #5063")]
+    ran = [re.findall(r"\(warned once; the line ran (\d+) times\)$", w) for _, w in interp.warnings]
+    assert ran == [["1000"], ["1000"], ["1000"], ["3"], ["2"], []]
+
+
 def test_tool_table_entries_in_a_message_say_what_they_are_or_the_users_diameter():
     """LinuxCNC shows the loaded tool's entry of the machine's tool table for #5401-#5413 in a
     DEBUG/PRINT (the table's values, whatever G20; rs274 -t in test_linuxcnc_oracle.py);

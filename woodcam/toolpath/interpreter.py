@@ -76,7 +76,8 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``F S T``, ``E`` (beside ``M66``-``M68``), ``N`` (digits, the first word of a line, before any comment; grbl: anywhere); ``( )``/``;`` comments,
   ``(msg,...)`` and ``(debug,...)`` (operator messages, the parameters' values put in, as
   LinuxCNC: :attr:`Interpreter.messages`), ``(print,...)`` (the same, but what LinuxCNC writes
-  to its terminal, not its screen: :attr:`Interpreter.printed`), ``(abort,...)`` (an error, as LinuxCNC), block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
+  to its terminal, not its screen: :attr:`Interpreter.printed`; one a pass in a loop, a value
+  woodcam cannot know in it warned once for its line), ``(abort,...)`` (an error, as LinuxCNC), block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
   of its own: the first non-blank line opens, the next ends the program; any other ``%`` is an
   error, as in LinuxCNC).
 
@@ -637,6 +638,10 @@ class Interpreter:
         self.known = [False, False, False]
         self._warned_start = False
         self._t_warned: set[int] = set()
+        # a message's warning by (line, text) -> [its index in warnings, passes, the last
+        # pass]: a DEBUG/PRINT in a loop or a subroutine is said on every pass, warned once
+        self._message_warned: dict[tuple[int, str], list[int]] = {}
+        self._message_pass = 0  # counts the DEBUG/PRINT texts put together (_expand)
         self._g53_unplaced: dict[str, list[int]] = {"z": [], "xy": []}  # lines, machine zero unknown
         self._frames: list[tuple] = []  # the active calls while run() runs
         self.line_no = 0
@@ -653,6 +658,20 @@ class Interpreter:
 
     def warn(self, msg):
         self.warnings.append((self.line_no, msg))
+
+    def _warn_message(self, msg: str) -> None:
+        """Warn ``msg`` about a DEBUG/PRINT text once per line: a 1000-pass loop gave 1000
+        identical warnings (its messages stay one a pass, as LinuxCNC shows them); a line
+        said again counts its passes in the one warning."""
+        key = (self.line_no, msg)
+        seen = self._message_warned.get(key)
+        if seen is None:
+            self._message_warned[key] = [len(self.warnings), 1, self._message_pass]
+            self.warn(msg)
+        elif seen[2] != self._message_pass:  # (not the same value twice in one text)
+            seen[1:] = [seen[1] + 1, self._message_pass]
+            self.warnings[seen[0]] = (self.line_no, f"{msg} (warned once; the line ran "
+                                                    f"{seen[1]} times)")
 
     @property
     def scale(self):
@@ -1840,6 +1859,7 @@ class Interpreter:
         name is read to its ``>`` without blanks, in lower case; a ``#`` followed by neither
         stays. A value woodcam cannot know shows as ``#n?`` (a probe result) or says what it
         is (the tool table, :meth:`_tool_entry_in_message`), with a warning."""
+        self._message_pass += 1
         out = []
         i, n = 0, len(text)
         while i < n:
@@ -1868,9 +1888,10 @@ class Interpreter:
                 continue
             else:
                 # LinuxCNC stops there and shows what an earlier message left in its buffer
-                self.warn(f"({kind},...) ends in an unfinished parameter '{text[j:]}': LinuxCNC "
-                          "shows left-over text of an earlier message after the text before it; "
-                          "write #1 or #<name>, or remove the '#'")
+                self._warn_message(f"({kind},...) ends in an unfinished parameter "
+                                   f"'{text[j:]}': LinuxCNC shows left-over text of an earlier "
+                                   "message after the text before it; write #1 or #<name>, or "
+                                   "remove the '#'")
                 break
             if isinstance(value, str):
                 out.append(value)
@@ -1879,8 +1900,8 @@ class Interpreter:
                 try:
                     value = value()
                 except GcodeError as e:
-                    self.warn(f"({kind},...) reads {ref}, which woodcam cannot know ({e.rule}): "
-                              f"the message shows {ref}? for it")
+                    self._warn_message(f"({kind},...) reads {ref}, which woodcam cannot know "
+                                       f"({e.rule}): the message shows {ref}? for it")
                     out.append(f"{ref}?")
                     continue
             out.append(_lf(value))
@@ -1897,9 +1918,9 @@ class Interpreter:
         shown = f"[{ref}: {what}, from the machine's tool table]"
         give = (f"; give the tool (--tools TABLE, --tool {self.tool}=SPEC; read_gcode's "
                 "tool_diameters_mm) to see its diameter" if k == 5410 else "")
-        self.warn(f"({kind},...) shows {ref}, {what} in the machine's tool table, which woodcam "
-                  f"does not know: the message says '{shown}' where LinuxCNC shows the table's "
-                  f"value{give}")
+        self._warn_message(f"({kind},...) shows {ref}, {what} in the machine's tool table, "
+                           f"which woodcam does not know: the message says '{shown}' where "
+                           f"LinuxCNC shows the table's value{give}")
         return shown
 
     def _named_in_message(self, name: str, word: str):
