@@ -205,6 +205,36 @@ def test_a_file_of_several_meshes_grows_all_of_them(tmp_path, capsys, glb_placed
         assert f.block_size_mm[0] > 40.0, "the grown object spans both boxes"
 
 
+def test_an_open_mesh_in_a_file_of_several_is_named_with_its_option_and_file(tmp_path, capsys):
+    """A file of several meshes skipped the open-mesh check of a one-mesh file: two boxes
+    touching along an edge were refused by the growth as 'mesh must be watertight' (an
+    --obstacle: 'obstacles[0] ...'), naming neither the option nor the file; a box missing a
+    side was capped flat with a warning (a one-mesh file is refused) and a sphere missing
+    triangles refused as 'mesh file ...', without the option. Now each mesh and their union go
+    through the same check, naming the option, the file and the mesh."""
+    a = trimesh.creation.box((10.0, 10.0, 10.0))
+    ball = trimesh.creation.icosphere(subdivisions=2, radius=5.0)
+    ball.export(tmp_path / "ball.stl")
+    touching, lidless, holed = a.copy(), trimesh.Trimesh(a.vertices, a.faces[:-2]), \
+        trimesh.Trimesh(ball.vertices, ball.faces[:-4])
+    touching.apply_translation((10.0, 10.0, 0.0))
+    for m in (lidless, holed):
+        m.apply_translation((30.0, 0.0, 0.0))
+    for name, b, said in (("touching", touching, "(the union of its 2 meshes)"),
+                          ("lidless", lidless, "(its mesh 'b')"), ("holed", holed, "(its mesh 'b')")):
+        scene = trimesh.Scene()
+        scene.add_geometry(a, geom_name="a")
+        scene.add_geometry(b, geom_name="b")
+        path = str(tmp_path / f"{name}.glb")
+        scene.export(path)
+        for what, args in (("part", [path]), ("--obstacle", [str(tmp_path / "ball.stl"), "--obstacle", path])):
+            assert main(["woodify", *args, "--years", "2", "--resolution", "16", "--cracks", "none",
+                         "--out", str(tmp_path / "o")]) == 1, (name, what)
+            err = capsys.readouterr().err
+            assert err.count("\n") == 1 and f"error: {what} {path!r} {said} must be watertight" in err, err
+    assert not (tmp_path / "o").exists()
+
+
 def test_surface_and_crack_years_are_usage_errors_before_the_growth(tmp_path, capsys, monkeypatch):
     """--surface-years out of range or not numbers exited 1 (a failed run, not a wrong command
     line); a year given twice was grown, written and listed twice; --crack-years beyond --years

@@ -132,13 +132,7 @@ def _load_mesh(path: str, what: str = "part"):
                     f"{what} {path!r} carries growth attributes per vertex, so it must be watertight "
                     "as stored (shared vertices), without merging; weld its vertices first")
             return loaded, None, paint
-        geom = trimesh.Trimesh(loaded.vertices, loaded.faces, process=True)
-        geom.merge_vertices(merge_tex=True, merge_norm=True)
-        # here, naming the option and the file: the growth said 'obstacles[0] must be
-        # watertight' of an open --obstacle, and 'mesh ...' of the part, naming neither
-        from ..woodify.front import check_watertight
-
-        check_watertight(geom, f"{what} {path!r}")
+        geom = _welded_closed(loaded, f"{what} {path!r}")
         if textured is not None and len(geom.faces) != len(textured.faces):
             textured = None
         return geom, textured, {}
@@ -146,6 +140,20 @@ def _load_mesh(path: str, what: str = "part"):
     from ..cad import load_part
 
     return manifold_to_trimesh(load_part(path), process=True), None, {}
+
+
+def _welded_closed(mesh, name: str):
+    """``mesh`` welded (by position, texture and normal seams too) as the growth reads it,
+    refused unless closed (the growth's own check_watertight) with ``name`` (the option and
+    the file): the growth said 'obstacles[0] must be watertight' of an open --obstacle, and
+    'mesh ...' of the part, naming neither. The one check of a file's meshes, one or several."""
+    import trimesh
+
+    from ..woodify.front import check_watertight
+
+    geom = trimesh.Trimesh(mesh.vertices, mesh.faces, process=True)
+    geom.merge_vertices(merge_tex=True, merge_norm=True)
+    return check_watertight(geom, name)
 
 
 def _check_mesh_values(mesh, path: str, what: str) -> None:
@@ -188,11 +196,21 @@ def _several_meshes(path: Path, what: str):
     from ..errors import WoodcamWarning
 
     scene = trimesh.load_scene(str(path), file_type=path.suffix.lower().lstrip("."))
-    if any(getattr(getattr(g, "visual", None), "uv", None) is not None for g in scene.geometry.values()):
+    placed = dict.fromkeys(scene.graph[n][1] for n in scene.graph.nodes_geometry)
+    meshes = {k: scene.geometry[k] for k in placed
+              if isinstance(scene.geometry.get(k), trimesh.Trimesh)}
+    # each as a one-mesh file is checked: load_part capped an open one's flat hole (a
+    # one-mesh file is refused) and refused another as 'mesh file ...', not naming the option
+    for key, mesh in meshes.items():
+        _welded_closed(mesh, f"{what} {str(path)!r} (its mesh {key!r})")
+    if any(getattr(getattr(g, "visual", None), "uv", None) is not None for g in meshes.values()):
         warnings.warn(f"{what} {str(path)!r} holds {_mesh_count(path)} meshes: they grow as one solid "
                       "(their union), and their pictures are not carried to the bark (procedural bark "
                       "instead); join them into one textured mesh to keep a picture", WoodcamWarning, stacklevel=3)
-    geom = manifold_to_trimesh(load_part(path), process=True)
+    # the union too: two closed meshes touching along an edge share it four times, which the
+    # growth refused as 'mesh must be watertight' / 'obstacles[0] ...'
+    geom = _welded_closed(manifold_to_trimesh(load_part(path), process=True),
+                          f"{what} {str(path)!r} (the union of its {len(meshes)} meshes)")
     _warn_units(geom, str(path), what)
     return geom, None, {}
 
