@@ -12,6 +12,7 @@ from woodcam.pipeline import bake_heightfield
 from woodcam.toolpath.mesh import HeightfieldCharts
 from woodcam.view.scene import BLOCK_COLOR, BLOCK_OPACITY
 from woodcam.view.stockview import _camera_array, stock_view, write_stock_view
+from woodcam.view.topview import top_view
 
 W, D, H = 40.0, 30.0, 20.0
 WIN = (320, 240)
@@ -172,8 +173,6 @@ def test_an_overlay_triple_is_one_colour_in_every_view(bowl, tmp_path, colour, r
 def _one_colour_in_every_view(bowl, tmp_path, colour, rgb):
     """stock_view draws ``colour`` as exactly ``rgb`` over the stock, top_view draws the same
     pixels as for the whole-number triple ``rgb``, and preview hands pyvista ``rgb``."""
-    from woodcam.view.topview import top_view
-
     hm, atlas, charts = bowl
     flat = np.full_like(hm, H)
     above = np.array([[[5.0, 15.0, H + 3], [35.0, 15.0, H + 3]]])
@@ -287,7 +286,8 @@ def test_a_background_is_one_colour_in_every_view(bowl, tmp_path, background, rg
     """stock_view read its background in 0..255 whatever it was: (1.0, 0.5, 0.0) drew (1, 0, 0),
     nearly black, and "white" was numpy's bare ValueError, where preview (pyvista) drew orange
     and white. Both read a background by the overlays' one rule (colour_rgb) now: the corner
-    pixel is that RGB in stock_view and in preview's screenshot."""
+    pixel is that RGB in stock_view and in preview's screenshot; and in top_view, which took no
+    background (always white)."""
     pytest.importorskip("pyvista")
     import trimesh
     from PIL import Image
@@ -298,6 +298,9 @@ def test_a_background_is_one_colour_in_every_view(bowl, tmp_path, background, rg
     img = stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), supersample=1,
                      background=background)
     assert tuple(img[0, 0]) == rgb
+    top = top_view(hm, (W, D, H), _top_texels(atlas, charts), window_size=(64, 48), margin_px=8,
+                   background=background)
+    assert tuple(top[0, 0]) == rgb and tuple(top[-1, -1]) == rgb
     box = trimesh.creation.box(extents=(W, D, H))
     box.apply_translation((W / 2, D / 2, H / 2))
     png = preview(box, size_mm=(W, D, H), screenshot=tmp_path / "p.png", window_size=(64, 48),
@@ -330,7 +333,15 @@ def test_a_background_refused_is_refused_by_every_view(bowl, tmp_path, backgroun
         SceneOptions(background=background)
     with pytest.raises(WoodcamError, match="stock_view: " + said):
         stock_view(hm, (W, D, H), atlas, charts, window_size=(64, 48), background=background)
+    with pytest.raises(WoodcamError, match="top_view: " + said):
+        top_view(hm, (W, D, H), _top_texels(atlas, charts), window_size=(64, 48), margin_px=8, background=background)
     assert not (tmp_path / "p.png").exists()
+
+
+def _top_texels(atlas, charts):
+    """The atlas's top chart, as top_view takes it."""
+    x0, y0, w, h = (int(v) for v in charts["top"][:4])
+    return atlas[y0:y0 + h, x0:x0 + w]
 
 
 def test_it_frames_the_stock_as_the_vtk_screenshot_does(bowl, tmp_path):

@@ -73,6 +73,23 @@ def test_top_view_png_and_errors(tmp_path):
                  overlay=[(np.zeros((1, 2, 3)), "mauve", 1.0)])
 
 
+def test_the_margin_is_the_background_by_the_views_one_rule():
+    """top_view had no background (always white) where stock_view and preview take one: the
+    margin is now ``background`` read by colour_rgb (floats in 0..1, a name), white by default;
+    the stock inside is unchanged (test_view_stockview's one-colour test: the same RGB as
+    stock_view's)."""
+    tex = np.full((40, 60, 3), 90, np.uint8)
+    args = (np.full((8, 12), 5.0), (60.0, 40.0, 10.0), tex)
+    white = top_view(*args, window_size=(160, 120), margin_px=20)
+    for background, rgb in (((1.0, 0.5, 0.0), (255, 128, 0)), ("tab:green", (44, 160, 44))):
+        img = top_view(*args, window_size=(160, 120), margin_px=20, background=background)
+        assert (img[:20] == rgb).all() and (img[:, 140:] == rgb).all()
+        np.testing.assert_array_equal(img[20:100, 20:140], white[20:100, 20:140])
+    assert (white[:20] == 255).all()
+    with pytest.raises(WoodcamError, match="top_view: background must be .*; got None"):
+        top_view(*args, background=None)
+
+
 def test_the_toolpath_reds_and_blues_are_the_stock_views_and_the_vtk_previews():
     """One set of overlay colours (woodcam.view.scene.OVERLAY_COLORS, VTK's values of the
     names): a sparse line is blended over the texture at the overlay opacity."""

@@ -23,7 +23,8 @@ _OVERLAY_COVER = 0.08
 
 
 def top_view(heightmap, size_mm, top_texels, *, overlay=None,
-             window_size: tuple[int, int] = (1280, 960), margin_px: int = 24) -> np.ndarray:
+             window_size: tuple[int, int] = (1280, 960), margin_px: int = 24,
+             background: object = (255, 255, 255)) -> np.ndarray:
     """The stock seen from +Z: an ``(h, w, 3) uint8`` image, +X right, +Y up.
 
     Parameters
@@ -39,8 +40,14 @@ def top_view(heightmap, size_mm, top_texels, *, overlay=None,
         in 0..1, :func:`woodcam.view.scene.colour_rgb`), as :func:`woodcam.view.preview` takes
         them and in the same colour.
     window_size : (width, height) px
-        The image size; the stock is fitted inside with ``margin_px``, the rest white.
+        The image size; the stock is fitted inside with ``margin_px``, the rest ``background``.
+    background : colour
+        Round the stock; by the views' one colour rule (:func:`woodcam.view.scene.colour_rgb`,
+        as stock_view's and preview's background): a name or hex string of matplotlib's table,
+        whole numbers in 0..255 or floats in 0..1; default white.
     """
+    from .scene import colour_rgb
+
     hm = np.asarray(heightmap, float)
     tex = np.asarray(top_texels)
     if hm.ndim != 2 or tex.ndim != 3 or tex.shape[2] != 3:
@@ -68,7 +75,8 @@ def top_view(heightmap, size_mm, top_texels, *, overlay=None,
     lit = _AMBIENT + (1 - _AMBIENT) * np.clip(n @ _LIGHT, 0.0, None)
     shade = (lit / (_AMBIENT + (1 - _AMBIENT) * _LIGHT[2]))[np.ix_(cy, cx)]  # flat -> 1
     rgb = tex[np.ix_(ty, tx)].astype(np.float32) * shade[..., None].astype(np.float32)
-    img = np.full((wh, ww, 3), 255.0, np.float32)
+    # stock_view's and preview's rule: top_view was always white, the others took a colour
+    img = np.full((wh, ww, 3), colour_rgb(background, "top_view", "background"), np.float32)
     img[oy:oy + ph, ox:ox + pw] = np.clip(rgb, 0, 255)
     for segments, colour, width in overlay or ():
         _draw_segments(img, np.asarray(segments, float).reshape(-1, 2, 3), colour,
