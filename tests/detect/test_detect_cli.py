@@ -1376,3 +1376,50 @@ def test_a_partial_rerun_removes_the_photo_it_wrote_of_a_face_left_out(synth_pho
     assert rc == 0 and (again / "left_photo.png").is_file()
     assert (f"woodcam: warning: face 'left': left_photo.png in {str(again)!r} is not read (the block has no left "
             "face now, and block.json does not name it), and is kept: it is not the photo an earlier run wrote") in err
+
+
+def test_a_block_made_again_in_its_folder_keeps_the_users_named_images(synth_photos, tmp_path, capsys, monkeypatch):
+    """'block from-photos' remaking a block folder kept the record of its detection (so a
+    corrected SVG, under any name, stayed the face's) but not the ring maps and knot masks
+    block.json named under other names than detection's (top_rings.png, left_knot.png): the
+    next 'rings detect' named the detector's top_ring_map.png and left_knot_mask.png, the
+    user's files left unnamed, dropped from the block without a word. Now the record carries
+    their names, and detection keeps them named, read as the face's and said; a user's
+    default-named one (an edited bottom_ring_map.png) stays the face's too."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    blk, size = _knotted_block_folder(synth_photos, tmp_path, capsys)
+    assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 0
+    mask, rings, svg = _hand_made_files()
+    Image.fromarray(mask).save(blk / "left_knot.png")
+    Image.fromarray(rings).save(blk / "top_rings.png")
+    (blk / "front_mine.svg").write_text(svg)
+    edited = rings[:, ::-1].copy()
+    Image.fromarray(edited).save(blk / "bottom_ring_map.png")  # the detector's, edited by the user
+    m = json.loads((blk / "block.json").read_text())
+    m["faces"]["left"]["extras"]["knot_mask"] = {"png": "left_knot.png", "dtype": "bool"}
+    m["faces"]["top"].update(ring_map="top_rings.png", ring_map_bits=16)
+    m["faces"]["front"]["traces_svg"] = "front_mine.svg"
+    (blk / "block.json").write_text(json.dumps(m))
+    mine = {f: (blk / f).read_bytes() for f in ("left_knot.png", "top_rings.png", "front_mine.svg",
+                                                 "bottom_ring_map.png")}
+    for remake in (False, True, True):  # detected, then the block made again (twice) and detected
+        if remake:
+            rc, _out, err = _run(capsys, "block", "from-photos", tmp_path / "knotted", *size, "--out", blk)
+            assert rc == 0, err
+        rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+        assert rc == 0, err
+        assert {f: (blk / f).read_bytes() for f in mine} == mine
+        entries = json.loads((blk / "block.json").read_text())["faces"]
+        assert entries["left"]["extras"]["knot_mask"]["png"] == "left_knot.png", err
+        assert entries["top"]["ring_map"] == "top_rings.png" and entries["front"]["traces_svg"] == "front_mine.svg"
+        assert entries["bottom"]["ring_map"] == "bottom_ring_map.png"
+        faces = read_block(blk).faces
+        assert np.array_equal(faces["left"].extras["knot_mask"], mask > 127)
+        assert np.array_equal(faces["top"].ring_map, rings / 65535.0)
+        assert np.array_equal(faces["bottom"].ring_map, edited / 65535.0)
+        assert len(faces["front"].traces) == 1
+        for f in mine:
+            (line,) = [w for w in err.splitlines() if f in w]
+            how = "the edited" if f.startswith("bottom") else "your"
+            assert f" kept {how} {blk / f} (" in line and "it wins over detection" in line, line
+        assert not any((blk / f).exists() for f in ("left_knot_mask.png", "top_ring_map.png", "front_traces.svg"))

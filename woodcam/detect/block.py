@@ -35,7 +35,8 @@ wrote and no detection since) holds none of the detector's files: a ring map, kn
 kept and used as an edited one is, and said the same way. A ring map, knot mask or traces SVG
 block.json names under another name than detection's (``top_rings.png``) is the user's wherever
 it is (detection writes none of that name): kept untouched, still named by the manifest, read
-as the face's and said alike (carried over under its name into another ``--out``).
+as the face's and said alike (carried over under its name into another ``--out``, and kept named
+through 'block from-photos' making the block again into its folder: its record keeps the names).
 
 **Photo-only blocks elsewhere** (``fit``, ``bake``, ``eval``): :func:`with_detected_rings`
 detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
@@ -258,8 +259,9 @@ def _readable_record(folder: Path) -> dict | None:
 
 
 def detection_record(folder) -> dict | None:
-    """The detection record of the block folder ``folder`` (its SVGs' and photos' digests and
-    the SVGs' names, those still in the folder), for ``block from-photos`` to keep in the
+    """The detection record of the block folder ``folder`` (its SVGs' and photos' digests, the
+    SVGs' names and, as ``named``, the files of the user's block.json names under other names than
+    detection's; those still in the folder), for ``block from-photos`` to keep in the
     manifest it writes there (``meta["detection_before"]``); None without one.
 
     A block remade into its own folder (a photo turned, as the layout check asks) dropped the
@@ -279,10 +281,17 @@ def detection_record(folder) -> dict | None:
     # the images the detection made stay on disk under a remade manifest (which names none):
     # their digests kept, the next detection clears those it does not write again
     images = _file_digests(rec)
-    if not svgs and not images:
+    # the files block.json names under other names than detection's are the user's: the remade
+    # manifest names none, so without their names here the next detection named its own ring
+    # maps and knot masks and dropped the user's from the block without a word
+    named: dict[str, dict[str, str]] = {}
+    for (face, kind), rel in _named_users_files(folder).items():
+        if (folder / rel).is_file():
+            named.setdefault(face, {})[kind] = rel
+    if not svgs and not images and not named:
         return None
     return {"traces_svg": svgs, "svg_sha256": rec.get("svg_sha256", {}),
-            "photo_digest": rec.get("photo_digest", {}), "file_digest": images}
+            "photo_digest": rec.get("photo_digest", {}), "file_digest": images, "named": named}
 
 
 def user_edited_faces(folder) -> dict[str, Path]:
@@ -324,7 +333,9 @@ def _named_users_files(folder: Path) -> dict[tuple[str, str], str]:
     """(face, kind) -> the name block.json in ``folder`` gives a face's traces SVG, ring map or
     knot mask (:data:`_DEFAULT_NAMES`) when it is not the name detection writes: detection never
     wrote such a file, so it is the user's, kept and used as one under the default name is
-    (it was replaced in the manifest without a word). Empty without a readable manifest."""
+    (it was replaced in the manifest without a word). A manifest 'block from-photos' remade names
+    them in its record of the earlier detection (``meta["detection_before"]["named"]``, face ->
+    {kind: name}; :func:`detection_record`). Empty without a readable manifest."""
     from ..block.io import MANIFEST
 
     try:
@@ -332,13 +343,19 @@ def _named_users_files(folder: Path) -> dict[tuple[str, str], str]:
     except (OSError, ValueError):
         return {}
     faces = m.get("faces") if isinstance(m, dict) else None
+    meta = m.get("meta") if isinstance(m, dict) else None
+    before = (meta.get("detection_before") or {}) if isinstance(meta, dict) else {}
+    kept = before.get("named") if isinstance(before, dict) else None
     found = {}
     for name, e in (faces.items() if isinstance(faces, dict) else ()):
         if not isinstance(e, dict):
             continue
         knot = (e.get("extras") or {}).get("knot_mask") if isinstance(e.get("extras"), dict) else None
+        was = kept.get(name) if isinstance(kept, dict) else None
         for kind, rel in (("traces_svg", e.get("traces_svg")), ("ring_map", e.get("ring_map")),
                           ("knot_mask", knot.get("png") if isinstance(knot, dict) else None)):
+            if rel is None and isinstance(was, dict):
+                rel = was.get(kind)
             if isinstance(rel, str) and rel and rel != _DEFAULT_NAMES[kind].format(name):
                 found[name, kind] = rel
     return found
