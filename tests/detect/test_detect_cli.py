@@ -716,6 +716,7 @@ def test_a_rerun_clears_its_own_stale_ring_maps_and_svgs_and_keeps_a_users(synth
     mine = np.zeros((160, 160), np.uint8)
     mine[::8] = 255
     Image.fromarray(mine).save(blk / "front_ring_map.png")  # the user's own rings, drawn over it
+    Image.fromarray(mine).save(blk / "front_knot_mask.png")  # and a knot mask of the user's
     five = _copy(synth_photos, tmp_path / "five", skip=("back", "front"))
     assert _run(capsys, "block", "from-photos", five, "--size-mm", "50", "--partial", "--out", blk)[0] == 0
     rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
@@ -727,6 +728,11 @@ def test_a_rerun_clears_its_own_stale_ring_maps_and_svgs_and_keeps_a_users(synth
     said = [w for w in err.splitlines() if "_ring_map.png" in w or "_traces.svg" in w]
     assert len(said) == 1 and said[0].startswith("woodcam: warning: face 'front': front_ring_map.png in "), said
     assert "is not read (the block has no such face this time" in said[0] and "is kept" in said[0]
+    # a face the block lacks has no entry to name a file in: the fix fits (it said to name it in
+    # block.json, a knot mask 'and detect with --no-knots')
+    (knot,) = [w for w in err.splitlines() if "front_knot_mask.png" in w]
+    for line in (said[0], knot):
+        assert line.endswith("; delete it, or move it out to keep it") and "block.json as" not in line, line
 
 
 def test_an_edited_knot_mask_or_ring_map_wins_over_a_rerun_as_a_corrected_svg_does(synth_photos, tmp_path, capsys,

@@ -559,12 +559,15 @@ def _clear_stale_files(out: Path, block: Block, before: dict, svgs: dict[str, st
                             f"for the face), and is kept: it is not the {what} an earlier detection made; delete "
                             f"it, or move it out to keep it")
                 continue
+            # of a face the block lacks, naming it in block.json (and detecting with --no-knots) was
+            # the fix said, which cannot be done: no face entry to name it in
+            use = ("move it out to keep it" if face is None else
+                   "to use it name it in block.json as the face's extras knot_mask and detect with --no-knots"
+                   if kind == "knot_mask" else "to use it name it in block.json as the face's ring_map")
             why = why if face is not None else "the block has no such face"
-            use = ("name it in block.json as the face's extras knot_mask and detect with --no-knots"
-                   if kind == "knot_mask" else "name it in block.json as the face's ring_map")
             msgs.append(f"face {name!r}: {path.name} in {str(out)!r} is not read ({why} this time, and block.json does "
                         f"not name it), and is kept: it is not the {what} an earlier detection made (edited, made by "
-                        f"hand, or from before woodcam recorded them); delete it, or to use it {use}")
+                        f"hand, or from before woodcam recorded them); delete it, or {use}")
     return msgs
 
 
