@@ -1429,3 +1429,33 @@ def test_a_block_made_again_in_its_folder_keeps_the_users_named_images(synth_pho
             how = "the edited" if f.startswith("bottom") else "your"
             assert f" kept {how} {blk / f} (" in line and "it wins over detection" in line, line
         assert not any((blk / f).exists() for f in ("left_knot_mask.png", "top_ring_map.png", "front_traces.svg"))
+
+
+def test_hand_made_files_beside_the_photos_win_whatever_the_out_folder(synth_photos, tmp_path, capsys, monkeypatch):
+    """'rings detect BLK --out OUT' with OUT another folder looked for hand-made files (no
+    detection ever recorded) in OUT alone: a knot mask, ring map and traced SVG the user made
+    beside the photos in BLK were passed over, OUT given the detector's. Now a folder of either
+    with no detection recorded holds the user's files: BLK's win (over OUT's own detection too)
+    and are carried into OUT as edited ones are, said by their path in BLK."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    blk, _size = _knotted_block_folder(synth_photos, tmp_path, capsys)
+    out = tmp_path / "out"
+    assert _run(capsys, "rings", "detect", blk, "--out", out)[0] == 0  # OUT detected, BLK never
+    assert "knot_mask" in read_block(out).faces["left"].extras
+    mask, rings, svg = _hand_made_files()
+    Image.fromarray(mask).save(blk / "left_knot_mask.png")
+    Image.fromarray(rings).save(blk / "top_ring_map.png")
+    (blk / "front_traces.svg").write_text(svg)
+    mine = {f: (blk / f).read_bytes() for f in ("left_knot_mask.png", "top_ring_map.png", "front_traces.svg")}
+    for folder in (out, tmp_path / "new"):  # over OUT's earlier detection, and into a new OUT
+        rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", folder)
+        assert rc == 0, err
+        assert {f: (blk / f).read_bytes() for f in mine} == mine
+        faces = read_block(folder).faces
+        assert np.array_equal(faces["left"].extras["knot_mask"], mask > 127), err
+        assert np.array_equal(faces["top"].ring_map, rings / 65535.0)
+        assert len(faces["front"].traces) == 1 and len(faces["top"].traces) > 1
+        for f in mine:
+            (line,) = [w for w in err.splitlines() if f in w]
+            assert f" kept your {blk / f} (" in line and "no detection is recorded in that folder" in line, line
+            assert f"(or move it out of {str(blk)!r})" in line, line

@@ -29,10 +29,11 @@ on one where it finds none (the user's is then the face's only one): it is kept 
 face's, and said, with how to let detection replace it, and it stays the user's on later runs
 (not recorded as the detector's); a folder whose record has no digests (detected before they
 were recorded) has its images written over.
-An output folder with no detection recorded at all (no manifest, or one 'block from-photos'
-wrote and no detection since) holds none of the detector's files: a ring map, knot mask or
-``<face>_traces.svg`` there (made by hand beside the photos before detecting) is the user's,
-kept and used as an edited one is, and said the same way. A ring map, knot mask or traces SVG
+A block folder with no detection recorded at all (the output with no manifest, or either the
+source or the output with one 'block from-photos' wrote and no detection since) holds none of
+the detector's files: a ring map, knot mask or ``<face>_traces.svg`` there (made by hand beside
+the photos before detecting) is the user's, kept and used as an edited one is (the source's
+carried into another ``--out``, over a detection recorded there), and said the same way. A ring map, knot mask or traces SVG
 block.json names under another name than detection's (``top_rings.png``) is the user's wherever
 it is (detection writes none of that name): kept untouched, still named by the manifest, read
 as the face's and said alike (carried over under its name into another ``--out``, and kept named
@@ -456,12 +457,12 @@ def _prior_record(folder: Path) -> dict:
 
 
 def _edited_images(block: Block, folders: list[tuple[Path, dict, dict[tuple[str, str], str]]],
-                   unrecorded: Path | None = None) -> dict[tuple[str, str], Path]:
+                   unrecorded: Collection[Path] = ()) -> dict[tuple[str, str], Path]:
     """(face, kind) -> the file of each image of ``block``'s faces in one of ``folders`` (folder,
     its record before this run; the output first) that is no longer the one the detector wrote
     there: a user edited it (or made it by hand beside a recorded detection). A record without
     digests (made before they were) has its images written over, as they were then. In the
-    folder ``unrecorded`` (the output when no detection is recorded there, :func:`_unrecorded`)
+    folders ``unrecorded`` (the source and output with no detection recorded, :func:`_unrecorded`)
     every such image is the user's: detection wrote none there, nor any the folder's block.json
     names under another name than its own (each folder's third item, :func:`_named_users_files`).
 
@@ -475,7 +476,7 @@ def _edited_images(block: Block, folders: list[tuple[Path, dict, dict[tuple[str,
                 if not path.is_file():  # one named and deleted: detection writes its own
                     path = folder / f"{name}_{kind}.png"
                 mine = (name, kind) in named and path != folder / f"{name}_{kind}.png"
-                if not mine and (("file_digest" not in rec and folder != unrecorded) or not path.is_file()
+                if not mine and (("file_digest" not in rec and folder not in unrecorded) or not path.is_file()
                                  or _file_digest(path, kind) == _file_digests(rec).get(path.name)):
                     continue
                 was = (rec.get("photo_digest") or {}).get(name)
@@ -491,7 +492,7 @@ def _edited_images(block: Block, folders: list[tuple[Path, dict, dict[tuple[str,
 
 
 def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path],
-                       unrecorded: Path | None = None, named: Collection[Path] = ()) -> tuple[set[tuple[str, str]], list[str]]:
+                       unrecorded: Collection[Path] = (), named: Collection[Path] = ()) -> tuple[set[tuple[str, str]], list[str]]:
     """Each image of ``block``'s faces (just detected) whose file the user edited (``edited``:
     :func:`_edited_images`; in ``unrecorded``, or ``named`` by block.json under another name than
     detection's (:func:`_named_users_files`), made by hand): the user's is read into ``block``
@@ -512,9 +513,9 @@ def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path],
                                   extras={**f.extras, kind: mine}))
         kept.add((name, kind))
         why = (_named_why(_DEFAULT_NAMES[kind].format(name)) if path in named else
-               _NO_RECORD if path.parent == unrecorded else
+               _NO_RECORD if path.parent in unrecorded else
                f"it is not the {DETECTED_IMAGES[kind][0]} detection wrote there")
-        mine = path in named or path.parent == unrecorded
+        mine = path in named or path.parent in unrecorded
         msgs.append(_kept_users_line(name, f"your {path}" if mine else f"the edited {path}", path.parent, why + none))
     return kept, msgs
 
@@ -627,20 +628,28 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
         edited = {}
     else:
         edited = user_edited_faces(src)
+    # with no detection recorded in a block folder, the source or --out, a file of detection's
+    # names there is the user's (traced by hand beside the photos before ever detecting): it was
+    # written over without a word in --out, and passed over in the source of another --out (a
+    # Mokume sample, no block.json, is re-detected from its photos alone, as documented)
+    unrecorded = {f for f in {src, out} if _unrecorded(f) and (f == out or (f / MANIFEST).is_file())}
+
+    def hand_made_svgs(folder: Path, named: dict[tuple[str, str], str]) -> dict[str, Path]:
+        # (but where block.json names another SVG of the face: that one is the face's)
+        return {n: folder / f"{n}_traces.svg" for n in block.faces if folder in unrecorded
+                and (folder / f"{n}_traces.svg").is_file()
+                and not ((n, "traces_svg") in named and (folder / named[n, "traces_svg"]).is_file())}
+
     edited.update({n: src / rel for (n, kind), rel in named_src.items() if kind == "traces_svg" and (src / rel).is_file()})
+    edited.update(hand_made_svgs(src, named_src))
     if not same and (out / MANIFEST).is_file():
         # corrections made in the output folder of an earlier run win too (only the source's
         # were looked for, and detection overwrote the ones in --out)
         edited.update(user_edited_faces(out))
         edited.update({n: out / rel for (n, kind), rel in named_out.items()
                        if kind == "traces_svg" and (out / rel).is_file()})
-    # with no detection recorded in --out, a file of detection's names there is the user's (traced
-    # by hand beside the photos before ever detecting): it was written over without a word
-    unrecorded = out if _unrecorded(out) else None
-    if unrecorded is not None:
-        # (but where block.json names another SVG of the face: that one is the face's)
-        edited.update({n: out / f"{n}_traces.svg" for n in block.faces if (out / f"{n}_traces.svg").is_file()
-                       and not ((n, "traces_svg") in named_out and (out / named_out[n, "traces_svg"]).is_file())})
+    if not same:
+        edited.update(hand_made_svgs(out, named_out))
     # a corrected SVG of a face the block no longer has (made again with --partial without it) was
     # an internal error (KeyError): it is left where it is, unused, and said
     unused = {n: svg for n, svg in edited.items() if n not in block.faces}
@@ -673,12 +682,12 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
         ring_map = ring_map_from_traces(traces, f.shape, sigma_mm * px) if traces else None
         block.faces[name] = Face(name, f.shape, photo=f.photo, traces=[], ring_map=ring_map, extras=f.extras)
         kept[name] = traces
-        mine = svg in named or svg.parent == unrecorded
+        mine = svg in named or svg.parent in unrecorded
         # the full path, as an image's: which of two folders (source, --out) it was kept from
         msgs.append(_kept_users_line(name, f"{'your' if mine else 'the corrected'} {svg}",
                                      svg.parent, f"{len(traces)} trace{'' if len(traces) == 1 else 's'}; " + (
                                          _named_why(f"{name}_traces.svg") if svg in named
-                                         else _NO_RECORD if svg.parent == unrecorded
+                                         else _NO_RECORD if svg.parent in unrecorded
                                          else "it is not the SVG detection wrote there")))
     for name, f in block.faces.items():
         # a face with the user's ring map is not left without one (said as kept below)
