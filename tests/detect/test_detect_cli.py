@@ -1458,4 +1458,15 @@ def test_hand_made_files_beside_the_photos_win_whatever_the_out_folder(synth_pho
         for f in mine:
             (line,) = [w for w in err.splitlines() if f in w]
             assert f" kept your {blk / f} (" in line and "no detection is recorded in that folder" in line, line
-            assert f"(or move it out of {str(blk)!r})" in line, line
+            # its copy in OUT is the user's too (never recorded as the detector's): deleting the
+            # one in BLK alone, as the line said, let the copy win the next run
+            assert (f"to let detection replace it, delete it and its copy {folder / f} (or move them out of "
+                    f"{str(blk)!r} and {str(folder)!r}) and run 'rings detect' again") in line, line
+    for f in mine:  # as the line says: both deleted, detection writes its own
+        (blk / f).unlink()
+        (out / f).unlink()
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", out)
+    assert rc == 0 and " kept " not in err, err
+    faces = read_block(out).faces
+    assert not np.array_equal(faces["left"].extras["knot_mask"], mask > 127)
+    assert len(faces["front"].traces) > 1

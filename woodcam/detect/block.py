@@ -380,12 +380,24 @@ def _named_why(default: str) -> str:
 _NO_RECORD = "no detection is recorded in that folder, so detection did not write it"
 
 
-def _kept_users_line(name: str, kept: str, folder: Path, why: str) -> str:
+def _kept_users_line(name: str, kept: str, folder: Path, why: str, copy: Path | None = None) -> str:
     """The one line saying face ``name``'s file of the user's (``kept``: "the edited PATH" ...),
     found in ``folder``, was kept over detection, ``why`` it is the user's, and how to let
-    detection replace it: said alike of corrected SVGs, edited images and hand-made files."""
-    return (f"face {name!r}: kept {kept} ({why}): it wins over detection; to let detection replace it, delete it "
-            f"(or move it out of {str(folder)!r}) and run 'rings detect' again")
+    detection replace it: said alike of corrected SVGs, edited images and hand-made files.
+    ``copy``: where it was carried into another ``--out``, which is never the detector's either,
+    so it wins the next time unless deleted too (deleting the source's alone did nothing)."""
+    where = (f"delete it (or move it out of {str(folder)!r})" if copy is None else
+             f"delete it and its copy {copy} (or move them out of {str(folder)!r} and {str(copy.parent)!r})")
+    return (f"face {name!r}: kept {kept} ({why}): it wins over detection; to let detection replace it, {where} "
+            "and run 'rings detect' again")
+
+
+def _copy_in(out: Path | None, path: Path, name: str) -> Path | None:
+    """The copy in ``out`` of the user's file ``path`` kept under ``name`` there; None when it is
+    that file itself (or no ``out``)."""
+    if out is None or (out / name).resolve() == path.resolve():
+        return None
+    return out / name
 
 
 #: The images detection writes per face (:mod:`woodcam.block.io` names them ``<face>_<kind>.png``),
@@ -492,7 +504,8 @@ def _edited_images(block: Block, folders: list[tuple[Path, dict, dict[tuple[str,
 
 
 def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path],
-                       unrecorded: Collection[Path] = (), named: Collection[Path] = ()) -> tuple[set[tuple[str, str]], list[str]]:
+                       unrecorded: Collection[Path] = (), named: Collection[Path] = (),
+                       out: Path | None = None) -> tuple[set[tuple[str, str]], list[str]]:
     """Each image of ``block``'s faces (just detected) whose file the user edited (``edited``:
     :func:`_edited_images`; in ``unrecorded``, or ``named`` by block.json under another name than
     detection's (:func:`_named_users_files`), made by hand): the user's is read into ``block``
@@ -516,7 +529,10 @@ def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path],
                _NO_RECORD if path.parent in unrecorded else
                f"it is not the {DETECTED_IMAGES[kind][0]} detection wrote there")
         mine = path in named or path.parent in unrecorded
-        msgs.append(_kept_users_line(name, f"your {path}" if mine else f"the edited {path}", path.parent, why + none))
+        # carried into another --out: a named one under its own name, any other as the face's image
+        copy = _copy_in(out, path, _name_in(out, path) if path in named and out is not None else f"{name}_{kind}.png")
+        msgs.append(_kept_users_line(name, f"your {path}" if mine else f"the edited {path}", path.parent, why + none,
+                                     copy))
     return kept, msgs
 
 
@@ -688,7 +704,8 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
                                      svg.parent, f"{len(traces)} trace{'' if len(traces) == 1 else 's'}; " + (
                                          _named_why(f"{name}_traces.svg") if svg in named
                                          else _NO_RECORD if svg.parent in unrecorded
-                                         else "it is not the SVG detection wrote there")))
+                                         else "it is not the SVG detection wrote there"),
+                                     _copy_in(out, svg, _name_in(out, svg))))
     for name, f in block.faces.items():
         # a face with the user's ring map is not left without one (said as kept below)
         if f.photo is not None and not f.traces and name not in kept and (name, "ring_map") not in images:
@@ -727,7 +744,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     det["user_svg"] = sorted(kept)
     # an image the user edited since the detector wrote it wins as a corrected SVG does (it was
     # written over without a word): read in, written back as read, never recorded as the detector's
-    users, said = _keep_users_images(block, images, unrecorded, named)
+    users, said = _keep_users_images(block, images, unrecorded, named, out)
     msgs += said
     # a user's image block.json names under its own name stays named so, untouched (carried over
     # unchanged into another --out); one of detection's name is written back as read
