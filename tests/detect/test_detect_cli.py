@@ -1429,6 +1429,16 @@ def test_a_block_made_again_in_its_folder_keeps_the_users_named_images(synth_pho
             how = "the edited" if f.startswith("bottom") else "your"
             assert f" kept {how} {blk / f} (" in line and "it wins over detection" in line, line
         assert not any((blk / f).exists() for f in ("left_knot_mask.png", "top_ring_map.png", "front_traces.svg"))
+    # made again without its left photo: the left face's named mask is not the block's now, said
+    # (it was left unnamed without a word), and kept
+    five = _copy(tmp_path / "knotted", tmp_path / "five", skip=("left",))
+    assert _run(capsys, "block", "from-photos", five, *size, "--partial", "--out", blk)[0] == 0
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0, err
+    assert (blk / "left_knot.png").read_bytes() == mine["left_knot.png"]
+    (line,) = [w for w in err.splitlines() if "left_knot.png" in w]
+    assert line == (f"woodcam: warning: face 'left': your {blk / 'left_knot.png'} is not used: the block has no left "
+                    f"face (made without its photo); move it out of {str(blk)!r} to keep it"), line
 
 
 def test_hand_made_files_beside_the_photos_win_whatever_the_out_folder(synth_photos, tmp_path, capsys, monkeypatch):

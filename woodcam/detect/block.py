@@ -348,7 +348,11 @@ def _named_users_files(folder: Path) -> dict[tuple[str, str], str]:
     before = (meta.get("detection_before") or {}) if isinstance(meta, dict) else {}
     kept = before.get("named") if isinstance(before, dict) else None
     found = {}
-    for name, e in (faces.items() if isinstance(faces, dict) else ()):
+    faces = faces if isinstance(faces, dict) else {}
+    # a face the remade block lacks (--partial without its photo) too: its files are said unused,
+    # where they were left unnamed without a word
+    gone = {n: {} for n in (kept if isinstance(kept, dict) else {}) if n in FACES and n not in faces}
+    for name, e in [*faces.items(), *gone.items()]:
         if not isinstance(e, dict):
             continue
         knot = (e.get("extras") or {}).get("knot_mask") if isinstance(e.get("extras"), dict) else None
@@ -669,6 +673,9 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     # a corrected SVG of a face the block no longer has (made again with --partial without it) was
     # an internal error (KeyError): it is left where it is, unused, and said
     unused = {n: svg for n, svg in edited.items() if n not in block.faces}
+    unused_images = [(n, folder / rel) for folder, names in ((src, named_src), (out, named_out))
+                     for (n, kind), rel in names.items()
+                     if kind != "traces_svg" and n not in block.faces and (folder / rel).is_file()]
     edited = {n: svg for n, svg in edited.items() if n in block.faces}
     _check_corrections_match_photos(block, edited)
     # the files the detector wrote, as the source and --out recorded them (before either is overwritten)
@@ -681,6 +688,8 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     msgs: list[str] = [f"face {n!r}: the corrected {svg} is not used: the block has no {n} face (made "
                        f"without its photo); move it out of {str(svg.parent)!r} to keep it (a later detection "
                        f"of a {n} face writes over it)" for n, svg in unused.items()]
+    msgs += [f"face {n!r}: your {path} is not used: the block has no {n} face (made without its photo); move it "
+             f"out of {str(path.parent)!r} to keep it" for n, path in dict.fromkeys(unused_images)]
     if todo:
         # cached by content: a second run, or one after a single SVG was corrected or a single
         # photo changed, detected every face afresh (a minute or two a large face)
