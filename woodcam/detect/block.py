@@ -33,11 +33,12 @@ A block folder with no detection recorded at all (the output with no manifest, o
 source or the output with one 'block from-photos' wrote and no detection since) holds none of
 the detector's files: a ring map, knot mask or ``<face>_traces.svg`` there (made by hand beside
 the photos before detecting) is the user's, kept and used as an edited one is (the source's
-carried into another ``--out``, over a detection recorded there), and said the same way. A ring map, knot mask or traces SVG
-block.json names under another name than detection's (``top_rings.png``) is the user's wherever
-it is (detection writes none of that name): kept untouched, still named by the manifest, read
-as the face's and said alike (carried over under its name into another ``--out``, and kept named
-through 'block from-photos' making the block again into its folder: its record keeps the names).
+carried into another ``--out``, over a detection recorded there), and said the same way. A ring
+map, knot mask or traces SVG block.json names under another name than detection's
+(``top_rings.png``) is the user's wherever it is (detection writes none of that name): kept
+untouched, still named by the manifest, read as the face's and said alike (carried over under
+its name into another ``--out``, and kept named through 'block from-photos' making the block
+again into its folder: its record keeps the names).
 
 **Photo-only blocks elsewhere** (``fit``, ``bake``, ``eval``): :func:`with_detected_rings`
 detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
