@@ -792,6 +792,15 @@ def _hand_made_files():
     return mask, rings, svg
 
 
+def _reads_hand_made(faces, err):
+    """``faces`` (read back after a detection) hold :func:`_hand_made_files`' knot mask on the
+    left, ring map on the top and one-line traces on the front; the top's traces are detected."""
+    mask, rings, _svg = _hand_made_files()
+    assert np.array_equal(faces["left"].extras["knot_mask"], mask > 127), err
+    assert np.array_equal(faces["top"].ring_map, rings / 65535.0), err
+    assert len(faces["front"].traces) == 1 and len(faces["top"].traces) > 1, err
+
+
 def _deleted_are_detected_again(capsys, blk, mine, detected):
     """The user's files ``mine`` (names in ``blk``) deleted, as the kept line says: a rerun keeps
     nothing and the left knot mask, top ring map and front traces are the detector's
@@ -832,9 +841,7 @@ def test_hand_made_files_in_a_folder_never_detected_are_kept_and_used(synth_phot
         assert rc == 0, err
         assert {f: (out / f).read_bytes() for f in mine} == mine
         faces = read_block(out).faces
-        assert np.array_equal(faces["left"].extras["knot_mask"], mask > 127)
-        assert np.array_equal(faces["top"].ring_map, rings / 65535.0)
-        assert len(faces["front"].traces) == 1 and len(faces["top"].traces) > 1
+        _reads_hand_made(faces, err)
         for f in mine:
             (line,) = [w for w in err.splitlines() if f in w]
             assert line.startswith("woodcam: warning: face '") and " kept " in line, line
@@ -902,9 +909,7 @@ def test_files_block_json_names_under_other_names_are_the_users_and_kept(synth_p
         assert entries["left"]["extras"]["knot_mask"]["png"] == "left_knot.png"
         assert entries["top"]["ring_map"] == "top_rings.png" and entries["front"]["traces_svg"] == "front_mine.svg"
         faces = read_block(folder).faces
-        assert np.array_equal(faces["left"].extras["knot_mask"], mask > 127), err
-        assert np.array_equal(faces["top"].ring_map, rings / 65535.0)
-        assert len(faces["front"].traces) == 1 and len(faces["top"].traces) > 1
+        _reads_hand_made(faces, err)
         for f in mine:
             (line,) = [w for w in err.splitlines() if f in w]
             assert " kept your " in line and "block.json names it for the face, and detection writes only " in line
@@ -1462,9 +1467,7 @@ def test_hand_made_files_beside_the_photos_win_whatever_the_out_folder(synth_pho
         assert rc == 0, err
         assert {f: (blk / f).read_bytes() for f in mine} == mine
         faces = read_block(folder).faces
-        assert np.array_equal(faces["left"].extras["knot_mask"], mask > 127), err
-        assert np.array_equal(faces["top"].ring_map, rings / 65535.0)
-        assert len(faces["front"].traces) == 1 and len(faces["top"].traces) > 1
+        _reads_hand_made(faces, err)
         for f in mine:
             (line,) = [w for w in err.splitlines() if f in w]
             assert f" kept your {blk / f} (" in line and "no detection is recorded in that folder" in line, line
