@@ -70,7 +70,9 @@ def test_cli_run_writes_everything(scans, capsys):
     (["{d}/nope.png", "--veneer", "{d}/light.png"], "TARGET of 'woodcam parquetry': '{d}/nope.png' does not exist", 2),
     (["{d}/coffee.png", "--veneer", "{d}/light.png:300:{d}/coffee.png"], "mask must have the image's size", 1),
     (["{d}/coffee.png", "--veneer", "{d}/light.png:2000"], "smaller than one patch", 1),
-    (["{d}/coffee.png"], "parquetry needs veneers", 1),
+    # no veneers on the command line and no job file: a wrong command line (exit 2; it was 1,
+    # after the run had begun), as test_no_target_or_no_veneers_is_a_usage_error_before_any_work
+    (["{d}/coffee.png"], "parquetry needs veneers", 2),
 ])
 def test_cli_bad_input_is_one_line(scans, capsys, args, message, code):
     argv = ["parquetry"] + [a.format(d=scans) for a in args] + ["--out", str(scans / "o"), "--quiet"]
@@ -78,6 +80,27 @@ def test_cli_bad_input_is_one_line(scans, capsys, args, message, code):
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and err.startswith("woodcam: error:") and message.format(d=scans) in err
 
+
+
+@pytest.mark.parametrize("args, said", [
+    (["--veneer-from", "builtin:flat-sawn"], "parquetry needs a target image (TARGET or a --config job with targets)"),
+    (["{d}/coffee.png"], "parquetry needs veneers: --veneer SCAN[:DPI], --veneer-from SPEC, or a --config job"),
+    (["--config", "{d}/job.json"], "parquetry needs veneers: "),  # the job file gives a target only
+])
+def test_no_target_or_no_veneers_is_a_usage_error_before_any_work(scans, capsys, monkeypatch, args, said):
+    """``woodcam parquetry TARGET`` with no veneer, and no TARGET, exited 1 as a failed run,
+    after the scans were read: what to rebuild and from what is the command line's (or a
+    --config job file's) to give, so neither given is a wrong command line (exit 2), said before
+    the job's sources are read."""
+    (scans / "job.json").write_text(json.dumps({"targets": [{"filename": "coffee.png"}], "source_textures": []}))
+    import woodcam.parquetry.job as job_module
+
+    monkeypatch.setattr(job_module, "job_veneers", lambda *a, **k: pytest.fail("the veneers were read"))
+    argv = ["parquetry"] + [a.format(d=scans) for a in args] + ["--out", str(scans / "o"), "--quiet"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith("woodcam: error: ") and said in err, err
+    assert not (scans / "o").exists()
 
 
 @pytest.mark.parametrize("value, said", [

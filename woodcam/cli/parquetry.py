@@ -275,6 +275,14 @@ def run(args) -> int:
     from ..parquetry.output import format_summary, write_parquetry
 
     job = read_job(args.config) if args.config else ParquetryJob()
+    # what to rebuild and from what, given by neither the command line nor a job file: a wrong
+    # command line (exit 2), said before any work (it was exit 1, after the scans were read)
+    if not (args.target or job.targets):
+        raise UsageError("parquetry needs a target image (TARGET or a --config job with targets); "
+                         "e.g. woodcam parquetry eye.png --veneer oak.png:300 --out out/eye/")
+    if not (args.veneer or args.veneer_from or job.scans or job.mokume or job.blocks):
+        raise UsageError("parquetry needs veneers: --veneer SCAN[:DPI], --veneer-from SPEC, or a "
+                         "--config job with source_textures; e.g. --veneer-from builtin:flat-sawn")
     over = {name: getattr(args, opt) for opt, name in _OPTION_PARAMS.items()
             if getattr(args, opt) is not None}
     if args.reuse_wood:
@@ -330,11 +338,6 @@ def run(args) -> int:
         warnings.warn(f"{', '.join('--' + d.replace('_', '-') for d in given)} slice leaves from blocks "
                       f"(--veneer-from BLOCK_SPEC) and none is given; the {sources or 'veneers'} are used "
                       "as they are, so these options change nothing here", WoodcamWarning, stacklevel=2)
-    if not job.targets:
-        raise WoodcamError("parquetry needs a target image (TARGET or a --config job with targets)")
-    if not (job.scans or job.mokume or job.blocks):
-        raise WoodcamError("parquetry needs veneers: --veneer SCAN[:DPI], --veneer-from SPEC, or a "
-                           "--config job with source_textures")
     progress = not args.quiet
     targets, names = job_targets(job)
     from ..stock import open_stock
