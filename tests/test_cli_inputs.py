@@ -204,3 +204,34 @@ def test_a_malformed_block_spec_of_no_path_is_a_usage_error_where_no_units_read_
     (tmp_path / "in").mkdir()
     err = _refused_at_the_door(("fit", "BLOCK"), "log:gran1", tmp_path, capsys, monkeypatch)
     assert "(block spec 'log:gran1'): a log block must read 'log:LOG@KNOT' or 'log:LOG@KNOT:WxDxH'" in err, err
+
+
+#: The block arguments of the commands that read a block as it is (no turn, no resize).
+_READ_AS_IS = {("fit", "BLOCK"), ("eval rings", "BLOCK"), ("eval appearance", "BLOCK"), ("block show", "BLOCK")}
+
+
+def test_the_commands_that_read_a_block_as_it_is_say_so_at_the_door():
+    """Every block argument is either carved from (a turn, a resize taken) or read as it is."""
+    as_is = {(command, name) for command, sp in _leaf_parsers()
+             for dest, name, _kind, _paths in sp.get_default("_inputs") or ()
+             if dest in (sp.get_default("_input_as_is") or ())}
+    assert as_is == _READ_AS_IS
+
+
+@pytest.mark.parametrize("key", sorted(_READ_AS_IS), ids=lambda k: f"{k[0]} {k[1]}")
+@pytest.mark.parametrize("spec, said", [
+    ("builtin:flat-sawn~z90", "a turn ('~z90') is for the commands that carve a part from the block (bake, gcode, "
+                              "place, preview, review and parquetry's --veneer-from); this one reads the block as "
+                              "it is: give 'builtin:flat-sawn'"),
+    ("builtin:knotty[40x30x20]", "a resize ('[40x30x20]') is for the commands that carve a part"),
+    ("{in}/blk~x90[10x10x10]", "a turn and a resize ('~x90[10x10x10]') is for the commands"),
+])
+def test_a_turn_or_resize_on_a_block_read_as_it_is_is_a_usage_error_before_any_work(
+        key, spec, said, tmp_path, capsys, monkeypatch):
+    """'woodcam fit builtin:flat-sawn~z90' (eval, block show) exited 1 when the block was opened
+    (the stock's words, after the run began): a turn or resize such a command cannot take is a
+    wrong command line, exit 2 at the door, in the same words."""
+    (tmp_path / "in").mkdir()
+    spec = spec.format(**{"in": tmp_path / "in"})
+    err = _refused_at_the_door(key, spec, tmp_path, capsys, monkeypatch)
+    assert f"(block spec {spec!r}): {said}" in err, err

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
-from .errors import BlockSpecError
+from .errors import BlockSpecError, WoodcamError
 from .limits import MAX_BLOCK_SIZE_MM
 from .units import parse_lengths
 
@@ -109,6 +109,22 @@ def split_spec(spec: str) -> tuple[str, list[str]]:
             return text[:end], ops[k:]
         end -= len(ops[k - 1])
     return text[:end], ops
+
+
+def check_read_as_is(spec: str) -> None:
+    """Refuse a turn or resize on ``spec`` given to a command that reads the block as it is
+    (``fit``, ``eval``, ``block show``): a WoodcamError naming them and the spec to give. The one
+    home of the rule: the stock's :func:`woodcam.stock.open_block` and the command line's door
+    (:func:`woodcam.cli.options.check_inputs`, exit 2) both call it. Named before the operations
+    are read: such a command takes none, however written ("unknown built-in block
+    'flat-sawn~z90'" was said)."""
+    base, ops = split_spec(spec)
+    if ops:
+        kinds = sorted({"a turn" if op.startswith("~") else "a resize" for op in ops}, reverse=True)
+        raise WoodcamError(
+            f"block spec {spec!r}: {' and '.join(kinds)} ('{''.join(ops)}') is for the commands "
+            f"that carve a part from the block (bake, gcode, place, preview, review and parquetry's "
+            f"--veneer-from); this one reads the block as it is: give {base!r}")
 
 
 def spec_path(spec: str) -> Path | None:

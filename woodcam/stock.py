@@ -49,7 +49,7 @@ from typing import Literal
 import numpy as np
 
 from ._checks import check_bool
-from ._specs import ParsedSpec, format_op, parse_spec, split_spec
+from ._specs import ParsedSpec, check_read_as_is, format_op, parse_spec
 from .appearance import ColorMapAppearance, NeuralAppearance, Wood
 from .errors import BlockSpecError, WoodcamError, WoodcamWarning
 from .fields.base import has_uncertainty
@@ -413,15 +413,7 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         The field is the block's true field where one is known (synthetic blocks, block
         folders that store one), else None: no field is fitted here.
     """
-    base, ops = split_spec(spec)
-    if ops:  # "unknown built-in block 'flat-sawn~z90'" (or 'knotty[40x30x20]') said only; named
-        # before the operations are read: this command takes none, however written
-        kinds = sorted({"a turn" if op.startswith("~") else "a resize" for op in ops}, reverse=True)
-        raise WoodcamError(
-            f"block spec {spec!r}: {' and '.join(kinds)} ('{''.join(ops)}') is for the commands "
-            f"that carve a part from the block (bake, gcode, place, preview, review and parquetry's "
-            f"--veneer-from); this one reads the "
-            f"block as it is: give {base!r}")
+    check_read_as_is(spec)  # no turn or resize: this command reads the block as it is
     parsed = parse_spec(spec)  # a loose end ('[40x30]') named as the bad operation it is
     if parsed.kind != "folder":
         from .synth import synth_block

@@ -148,35 +148,42 @@ InputKind = Literal["file", "folder", "block"]
 INPUT_KINDS: tuple[str, ...] = get_args(InputKind)
 
 
-def add_input(p, *flags: str, kind: InputKind, paths=None, suffixes=None, **kwargs) -> argparse.Action:
+def add_input(p, *flags: str, kind: InputKind, paths=None, suffixes=None, as_is: bool = False,
+              **kwargs) -> argparse.Action:
     """An input path argument of ``p`` (``add_argument``'s ``flags`` and ``kwargs``) that
     :func:`check_inputs` checks before the command runs: ``kind`` is one of
     :data:`INPUT_KINDS`; ``paths`` maps a value to the paths it names when it holds more than a
     path (``--veneer SCAN:DPI:MASK``); ``suffixes`` (a FILE's) returns the suffixes its reader
-    takes, the reader's own list (called at the door only: ``--help`` imports no reader).
+    takes, the reader's own list (called at the door only: ``--help`` imports no reader);
+    ``as_is`` (a block spec's) says the command reads the block as it is, so a turn or resize
+    on it is refused (:func:`woodcam._specs.check_read_as_is`).
     ``tests/test_cli_inputs.py`` runs every command against it and fails a path argument added
     without it."""
     assert kind in INPUT_KINDS, kind  # a contributor's mistake
     assert suffixes is None or kind == "file", kind  # a folder or block spec has no suffix rule
+    assert not as_is or kind == "block", kind  # only a block spec has turns and resizes
     action = p.add_argument(*flags, **kwargs)
     name = next((f for f in action.option_strings if f.startswith("--")), action.dest.upper())
     p.set_defaults(_inputs=(*(p.get_default("_inputs") or ()), (action.dest, name, kind, paths)),
-                   _input_suffixes={**(p.get_default("_input_suffixes") or {}), action.dest: suffixes})
+                   _input_suffixes={**(p.get_default("_input_suffixes") or {}), action.dest: suffixes},
+                   _input_as_is={*(p.get_default("_input_as_is") or ()), *([action.dest] if as_is else [])})
     return action
 
 
 def check_inputs(args: argparse.Namespace) -> None:
     """Refuse an input path (:func:`add_input`) that does not exist or is of the wrong kind,
     before any work: a UsageError (exit 2) naming the argument, the path, the rule and a fix.
-    A FILE of a suffix its reader does not take (``add_input(suffixes=)``) is refused too.
+    A FILE of a suffix its reader does not take (``add_input(suffixes=)``) is refused too, and a
+    turn or resize on a block a command reads as it is (``add_input(as_is=True)``).
     A missing part, program or block folder was the command's own error (exit 1), some after the
     block was opened; an input that exists but whose contents are bad still is (exit 1)."""
     suffixes = getattr(args, "_input_suffixes", {})
+    as_is = getattr(args, "_input_as_is", set())
     for dest, name, kind, paths in getattr(args, "_inputs", ()):
         value = getattr(args, dest, None)
         for item in value if isinstance(value, list) else [] if value is None else [value]:
             for text in paths(str(item)) if paths else [str(item)]:
-                _check_input(str(text), name, kind, args)
+                _check_input(str(text), name, kind, args, as_is=dest in as_is)
                 if suffixes.get(dest):
                     _check_suffix(Path(text), name, suffixes[dest](), args)
 
@@ -208,12 +215,19 @@ _SPEC_KINDS = (" (a block spec is builtin:NAME, log:LOG@KNOT, woodify:DIR/field.
                "with block.json or a Mokume sample folder)")
 
 
-def _check_input(text: str, name: str, kind: str, args: argparse.Namespace) -> None:
-    """One input path ``text`` of argument ``name`` (:func:`check_inputs`)."""
+def _check_input(text: str, name: str, kind: str, args: argparse.Namespace, *, as_is: bool = False) -> None:
+    """One input path ``text`` of argument ``name`` (:func:`check_inputs`); ``as_is``: a block
+    read as it is, no turn or resize on it."""
     spec = ""
     if kind == "block":
-        from .._specs import split_spec, spec_path
+        from .._specs import check_read_as_is, split_spec, spec_path
 
+        if as_is:  # 'fit builtin:flat-sawn~z90' exited 1 when the block was opened
+            try:
+                check_read_as_is(text)
+            except WoodcamError as err:
+                raise UsageError(f"{name} of 'woodcam {_command_name(args)}' (block spec {text!r}): "
+                                 f"{str(err).removeprefix(f'block spec {text!r}: ')}") from None
         path = spec_path(text)
         if path is None:  # a built-in block or the shared log: no path
             _check_builtin(text, name, args)
@@ -652,9 +666,9 @@ def command_group(subparsers, name: str, **kwargs) -> argparse._SubParsersAction
 def add_block_argument(p: argparse.ArgumentParser, *, option: bool = True, nargs=None) -> None:
     """``--block SPEC`` (required) or, with ``option=False``, a positional ``block``."""
     if option:
-        add_input(p, "--block", kind="block", required=True, help=BLOCK_READ_HELP)
+        add_input(p, "--block", kind="block", as_is=True, required=True, help=BLOCK_READ_HELP)
     else:  # read, not carved from: no ~x90 turn (it was offered here and refused)
-        add_input(p, "block", kind="block", nargs=nargs, help=BLOCK_READ_HELP)
+        add_input(p, "block", kind="block", as_is=True, nargs=nargs, help=BLOCK_READ_HELP)
 
 
 def _cube_side(text: str) -> float:
