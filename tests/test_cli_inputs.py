@@ -235,3 +235,19 @@ def test_a_turn_or_resize_on_a_block_read_as_it_is_is_a_usage_error_before_any_w
     spec = spec.format(**{"in": tmp_path / "in"})
     err = _refused_at_the_door(key, spec, tmp_path, capsys, monkeypatch)
     assert f"(block spec {spec!r}): {said}" in err, err
+
+
+@pytest.mark.parametrize("key", sorted(k for k, kind in _registered().items() if kind == "block"),
+                         ids=lambda k: f"{k[0]} {k[1]}")
+def test_a_woodify_spec_naming_the_folder_of_a_field_offers_the_field_file(key, tmp_path, capsys, monkeypatch):
+    """'--block woodify:DIR' (woodcam woodify's --out folder) said only "give the file itself, not
+    the folder it is in": the door names the file woodify wrote there, as the spec to give; a
+    folder without one keeps the general words."""
+    grown = tmp_path / "in" / "grown"
+    grown.mkdir(parents=True)
+    err = _refused_at_the_door(key, f"woodify:{grown}", tmp_path, capsys, monkeypatch)
+    assert err.rstrip().endswith("give the file itself, not the folder it is in"), err
+    (grown / "field.npz").write_bytes(b"")  # what woodcam woodify writes (_specs.WOODIFY_FIELD_FILE)
+    err = _refused_at_the_door(key, f"woodify:{grown}", tmp_path, capsys, monkeypatch)
+    assert f"{str(grown)!r} is a folder; it must be an existing FILE" in err, err
+    assert err.rstrip().endswith(f"did you mean 'woodify:{grown / 'field.npz'}'?"), err

@@ -32,6 +32,10 @@ _OP = re.compile(_ONE_OP)
 #: named as a bad operation unless the base is an existing path.
 _LOOSE_OP = re.compile(r"(?:~[^~\[\]/]*|\[[^\[\]/]*\])$")
 
+#: The file ``woodcam woodify`` writes its field to, in its --out folder: what a
+#: ``woodify:DIR/field.npz`` spec names (the input door offers it for a spec naming DIR).
+WOODIFY_FIELD_FILE = "field.npz"
+
 SpecKind = Literal["builtin", "log", "woodify", "folder"]
 #: What part of a spec broke its grammar (:class:`woodcam.errors.BlockSpecError` ``part``).
 SpecPart = Literal["size", "resize", "turn", "op", "log"]

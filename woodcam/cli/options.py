@@ -31,6 +31,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Literal, get_args
 
+from .._specs import WOODIFY_FIELD_FILE
 from .._types import CAMERAS
 from ..errors import UsageError, WoodcamError
 from ..limits import MAX_BLOCK_SIZE_MM, REVIEW_VOXELS_RANGE, WOODIFY_RESOLUTION_RANGE
@@ -243,6 +244,11 @@ def _check_input(text: str, name: str, kind: str, args: argparse.Namespace, *, a
     if path.exists():
         fix = ("give the file itself, not the folder it is in" if kind == "file" else
                f"did you mean its folder {str(path.parent)!r}?")
+        if spec.startswith("woodify:") and path.is_dir() and (path / WOODIFY_FIELD_FILE).is_file():
+            # woodcam woodify's --out folder: the field file it wrote there, the spec as typed else
+            from .._specs import split_spec
+
+            fix = f"did you mean 'woodify:{path / WOODIFY_FIELD_FILE}{spec[len(split_spec(spec)[0]):]}'?"
         raise UsageError(f"{where}: {str(path)!r} is a {'folder' if path.is_dir() else 'file'}; it must "
                          f"be an existing {kind.upper()}{_SPEC_KINDS if spec else ''}; {fix}")
     raise UsageError(f"{where}: {str(path)!r} does not exist; it must be an existing "

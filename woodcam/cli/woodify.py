@@ -15,6 +15,7 @@ import json
 import time
 from pathlib import Path
 
+from .._specs import WOODIFY_FIELD_FILE
 from ..errors import UsageError, WoodcamError
 from ..tolerances import DEFAULT_MAX_ATLAS_PX
 from ..units import say_length, typed_length
@@ -394,7 +395,7 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
             "woodify": {"years": Y, "speed": res.speed.to_dict(),
                         "block_origin_mm": placed.block_origin_mm.tolist(),
                         "block_rotation": placed.rotation.tolist()}}))
-        files.append(placed.save(out / "field.npz"))
+        files.append(placed.save(out / WOODIFY_FIELD_FILE))
         summary["block"] = {"size_mm": list(size), "centre_mm": list(centre)}
         for y in surface_years:
             surf = res.surface(float(y))
@@ -554,5 +555,5 @@ def run(args) -> int:
     print(f"grew {args.part} for {args.years:g} years on a {'x'.join(map(str, res.front.grid.shape))} "
           f"grid ({res.front.method}, {summary['total_s']:.1f} s); wrote "
           + ", ".join(str(f) for f in files))
-    print(f"carve from it with: woodcam bake PART --block woodify:{Path(args.out) / 'field.npz'} --out PART.glb")
+    print(f"carve from it with: woodcam bake PART --block woodify:{Path(args.out) / WOODIFY_FIELD_FILE} --out PART.glb")
     return 0
