@@ -1245,3 +1245,15 @@ def test_transparent_pixels_are_named_with_the_fix_for_what_the_image_is_for(tmp
     with pytest.warns(WoodcamWarning, match=r"veneer scan: .*grey16.png' has transparent pixels \(10 % of them, "
                       r"a cut-out\?\), .*; crop the image so every pixel is opaque"):
         load_scan(tmp_path / "grey16.png", dpi=100)
+
+
+def test_adaptive_levels_are_bounded_by_the_panel():
+    """n_adaptive took any int: the top squares of 2^n cells are clipped to the panel's shorter
+    side, so a level past it made no patch of patch_mm * 2^n (a job file's 10^9 asked for
+    2^(10^9)-cell squares). The most is the panel's: 4 on the default 364 mm (26 patches)."""
+    assert ParquetryParams().max_adaptive == 4 and ParquetryParams(n_adaptive=4).n_adaptive == 4
+    assert ParquetryParams(image_size_mm=70, n_adaptive=2).max_adaptive == 2  # 5 patches
+    for n in (5, 10 ** 9):
+        with pytest.raises(WoodcamError, match=r"n_adaptive \(--n-adaptive\) must be in \[0, 4\] here: its "
+                           r"largest patch, .* must fit the panel's shorter side, 364 mm \(26 patches"):
+            ParquetryParams(n_adaptive=n)

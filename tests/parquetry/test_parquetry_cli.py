@@ -139,6 +139,12 @@ def test_a_malformed_veneer_is_a_usage_error_before_any_work(scans, capsys, valu
     ("--tool-diameter", "0", "--tool-diameter must be in (0, 100]"),
     # options that contradict each other (errors.UsageError) exited 1, as a failed run
     ("--patch-mm", "4", "patch_mm must be at least min_piece_mm"),
+    # up to 32 passed: 14 * 2^5 = 448 mm patches on a 364 mm panel made none of that size (the top
+    # squares are clipped to the panel), and 2^32-cell squares were asked for
+    ("--n-adaptive", "5", "n_adaptive (--n-adaptive) must be in [0, 4] here: its largest patch, patch_mm * "
+                          "2^n_adaptive = 14 * 2^5 = 448 mm, must fit the panel's shorter side, 364 mm (26 patches: "
+                          "image_size_mm 360 in whole patches); got 5; use --n-adaptive 4 or less"),
+    ("--n-adaptive", "32", "must be in [0, 4] here"),
 ])
 def test_a_table_1_parameter_out_of_range_is_a_usage_error_naming_the_option(scans, capsys, option, value, said):
     """Sweep h6: these exited 1 (a failed work, where the README's exit statuses give 2 for a wrong

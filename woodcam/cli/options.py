@@ -1261,8 +1261,9 @@ RANGES: dict = {
     ("parquetry", "kerf_mm"): (0.0, 100.0, False),
     # Table 1's parameters and the search's: ParquetryParams.check's bounds (exit 1 there, naming
     # w_intens, n_rot ...); the bounds it sets relative to other options (image size >= patch,
-    # overlap <= (patch - min piece) / 2) stay its own. The tops ParquetryParams leaves open are
-    # far beyond use: 2^32 adaptive levels, a cost ratio or weight of 1e6
+    # overlap <= (patch - min piece) / 2, 2^n_adaptive patches <= the panel's shorter side) stay
+    # its own. The tops ParquetryParams leaves open are far beyond use: a cost ratio or weight of
+    # 1e6; n_adaptive's 32 only bounds what argparse takes (the panel's rule says at most 16)
     **{("parquetry", d): (0.0, 1.0, False) for d in ("w_intens", "w_edge", "w_hist")},
     ("parquetry", "image_size_mm"): (0.0, 10_000.0, True),  # woodcam.limits.MAX_BLOCK_SIZE_MM
     ("parquetry", "n_adaptive"): (0, 32, False),

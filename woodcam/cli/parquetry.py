@@ -93,7 +93,9 @@ def register(subparsers) -> None:
                    help="panel's shorter side in mm (default 360)")
     t.add_argument("--patch-mm", type=float, default=None, help="patch side in mm (default 14)")
     t.add_argument("--n-adaptive", type=int, default=None,
-                   help="adaptive levels: patches of patch-mm * 2^L split in four (default 0)")
+                   help="adaptive levels: patches of patch-mm * 2^L split in four; the largest must fit "
+                   "the panel's shorter side (at most 4 levels at the defaults: 16 patches of the 26; "
+                   "default 0)")
     t.add_argument("--w-adaptive", type=float, default=None,
                    help="cost ratio: split when w_adaptive * (cost of the four) < cost of one "
                    "(default 1.2)")

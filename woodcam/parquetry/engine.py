@@ -164,7 +164,7 @@ def prepare_target(rgb: np.ndarray, params: ParquetryParams, source_values: np.n
         rgb = np.repeat(rgb[..., None], 3, axis=2)
     cell = params.patch_px
     h, w = rgb.shape[:2]
-    short_cells = max(1, round(params.image_size_mm / params.patch_mm))
+    short_cells = params.short_cells
     scale = short_cells * cell / min(h, w)
     if h <= w:
         rows, cols = short_cells, max(1, int(w * scale + 1e-6) // cell)

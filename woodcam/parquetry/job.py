@@ -168,6 +168,15 @@ class ParquetryParams:
         if self.patch_px < 4:
             raise WoodcamError(f"patch_mm * px_per_mm must give at least 4 px; got {self.patch_px}; "
                                "raise px_per_mm")
+        # after patch_px: a patch of no size has no cells to count
+        if self.n_adaptive > self.max_adaptive:  # compared in levels: a job file may hold any int
+            largest = f"{self.patch_mm * 2.0 ** self.n_adaptive:g} mm" if self.n_adaptive <= 64 else "beyond any panel"
+            raise WoodcamError(
+                f"n_adaptive (--n-adaptive) must be in [0, {self.max_adaptive}] here: its largest patch, patch_mm * "
+                f"2^n_adaptive = {self.patch_mm:g} * 2^{self.n_adaptive} = {largest}, must fit the panel's shorter "
+                f"side, {self.short_side_mm:g} mm ({self.short_cells} patches: image_size_mm {self.image_size_mm:g} "
+                f"in whole patches); got {self.n_adaptive}; use --n-adaptive {self.max_adaptive} or less, or a larger "
+                "--image-size-mm")
         o = self.overlap
         if o < 0 or 2 * o > self.patch_mm - self.min_piece_mm + 1e-9:
             raise WoodcamError(
@@ -198,6 +207,25 @@ class ParquetryParams:
     @property
     def patch_px(self) -> int:
         return round(self.patch_mm * self.px_per_mm)
+
+    @property
+    def short_cells(self) -> int:
+        """Patches along the panel's shorter side: ``image_size_mm`` rounded to whole patches
+        (the panel is made of whole cells: :func:`woodcam.parquetry.engine.prepare_target`)."""
+        return max(1, round(self.image_size_mm / self.patch_mm))
+
+    @property
+    def short_side_mm(self) -> float:
+        """The panel's shorter side as made: :attr:`short_cells` cells of :attr:`patch_px`
+        working pixels (``image_size_mm`` 60 of 14 mm patches makes 56)."""
+        return self.short_cells * self.patch_px / self.px_per_mm
+
+    @property
+    def max_adaptive(self) -> int:
+        """The most adaptive levels the panel holds: the engine's top squares, ``2**n_adaptive``
+        cells a side, are at most the panel's shorter side (:attr:`short_cells`), so a level
+        beyond makes no patch of ``patch_mm * 2**n_adaptive``."""
+        return self.short_cells.bit_length() - 1
 
     @property
     def overlap_px(self) -> int:
