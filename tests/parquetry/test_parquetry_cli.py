@@ -571,3 +571,31 @@ def test_no_seams_pieces_take_no_overlap_of_wood(scans, capsys):
     run("no_seams", "--no-seams", "--overlap-mm", "2")
     assert ("woodcam: warning: --overlap-mm 2 changes nothing with --no-seams: square pieces are matched and "
             "cut without an overlap; drop one of them") in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("extra, said", [
+    (["--image-size-mm", "60"], "--image-size-mm 60 makes a panel whose shorter side is 56 mm: 4 whole patches of "
+                                "--patch-mm default 14; give --image-size-mm 56 or 70 (mm, whole patches)"),
+    (["--image-size-mm", "60", "--units", "inch"], "--image-size-mm 60 makes a panel whose shorter side is 2.205 in: "),
+    (["--patch-mm", "25"], "--image-size-mm default 360 makes a panel whose shorter side is 350 mm: 14 whole patches "
+                           "of --patch-mm 25; give --image-size-mm 350 or 375"),
+    (["--image-size-mm", "56"], None),  # whole patches: nothing to say
+    (["--patch-mm", "20"], None),       # 360 = 18 patches of 20
+])
+def test_a_panel_rounded_to_whole_patches_is_said(scans, capsys, monkeypatch, extra, said):
+    """'--image-size-mm 60' made a 56 mm panel (whole 14 mm patches) without a word: a warning
+    names the option as set, the size made (in --units) and the whole-patch sizes to give."""
+    import woodcam.parquetry.job as job_module
+
+    def stop(*_a, **_k):  # the panel's size is known before the veneers are read: no run needed
+        raise WoodcamError("stopped before the veneers")
+
+    monkeypatch.setattr(job_module, "job_veneers", stop)
+    assert main(["parquetry", str(scans / "coffee.png"), "--veneer", str(scans / "light.png"), *extra,
+                 "--out", str(scans / "o"), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    warned = [line for line in err.splitlines() if "makes a panel" in line]
+    if said is None:
+        assert warned == [], err
+    else:
+        assert len(warned) == 1 and warned[0].startswith(f"woodcam: warning: {said}"), err

@@ -90,7 +90,8 @@ def register(subparsers) -> None:
     t.add_argument("--w-hist", type=float, default=None,
                    help="histogram-matching blend of eq. 2, in [0, 1] (default 0.5)")
     t.add_argument("--image-size-mm", type=float, default=None,
-                   help="panel's shorter side in mm (default 360)")
+                   help="panel's shorter side in mm, rounded to whole patches of --patch-mm (60 makes 56, "
+                   "with a warning; default 360, which makes 364)")
     t.add_argument("--patch-mm", type=float, default=None, help="patch side in mm (default 14)")
     t.add_argument("--n-adaptive", type=int, default=None,
                    help="adaptive levels: patches of patch-mm * 2^L split in four; the largest must fit "
@@ -233,6 +234,29 @@ def _setting(args, params, dest: str, key: str) -> str | None:
     return None
 
 
+def _say_panel_rounding(args, params) -> None:
+    """A WoodcamWarning when the panel's shorter side as made (whole patches,
+    :attr:`~woodcam.parquetry.job.ParquetryParams.short_side_mm`) is not the one this run asked
+    for: '--image-size-mm 60' made a 56 mm panel without a word. Said where the image size or
+    the patch was set (an option, a job file's key); the paper's defaults (360 mm of 14 mm
+    patches: 364) are the help's to say."""
+    from ..units import say_length
+
+    size = _setting(args, params, "image_size_mm", "image_size_mm")
+    patch = _setting(args, params, "patch_mm", "patch_mm")
+    made = params.short_side_mm
+    if (size is None and patch is None) or math.isclose(made, params.image_size_mm):
+        return
+    n = params.short_cells
+    other = n + 1 if made < params.image_size_mm else n - 1
+    near = sorted({n, other} - {0})
+    warnings.warn(f"{size or f'--image-size-mm default {params.image_size_mm:g}'} makes a panel whose shorter "
+                  f"side is {say_length(made, 'g')}: {n} whole patch{'es' if n > 1 else ''} of "
+                  f"{patch or f'--patch-mm default {params.patch_mm:g}'}; give --image-size-mm "
+                  f"{' or '.join(f'{k * params.patch_mm:g}' for k in near)} (mm, whole patches) to say the size made",
+                  WoodcamWarning, stacklevel=2)
+
+
 def _sheet_too_small(err, args, params) -> str:
     """The engine's too-small-sheet error in the words of this run: the patch, overlap and
     kerf named as the user set them (the engine named the job file's patch_mm and kerf_mm,
@@ -299,6 +323,7 @@ def run(args) -> int:
         job.params = dataclasses.replace(job.params, **over).check()
     except WoodcamError as err:  # options that contradict each other: a wrong command line (exit 2)
         raise UsageError(str(err)) from err
+    _say_panel_rounding(args, job.params)
     if args.target:
         job.targets = [{"filename": str(t), "scale": 1.0} for t in args.target]
     scans = [_scan_entry(s) for s in args.veneer]
