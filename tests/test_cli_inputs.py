@@ -68,8 +68,8 @@ def _leaf_parsers():
 
 def _registered() -> dict[tuple[str, str], str]:
     """(command, argument) -> kind of every input path that goes through the door."""
-    return {(command, name): kind for command, sp in _leaf_parsers()
-            for _dest, name, kind, _paths in sp.get_default("_inputs") or ()}
+    return {(command, arg.name): arg.kind for command, sp in _leaf_parsers()
+            for arg in sp.get_default("_inputs") or ()}
 
 
 def _looks_like_a_path(action: argparse.Action) -> bool:
@@ -159,10 +159,8 @@ def _suffixed() -> dict[tuple[str, str], tuple[str, ...]]:
 
 def test_every_input_file_whose_reader_takes_some_suffixes_says_which_at_the_door():
     """The door's list of each argument is its reader's, no second list."""
-    registered = {(command, name): sp.get_default("_input_suffixes")[dest]()
-                  for command, sp in _leaf_parsers()
-                  for dest, name, _kind, _paths in sp.get_default("_inputs") or ()
-                  if sp.get_default("_input_suffixes")[dest]}
+    registered = {(command, arg.name): arg.suffixes() for command, sp in _leaf_parsers()
+                  for arg in sp.get_default("_inputs") or () if arg.suffixes}
     assert registered == _suffixed()
 
 
@@ -212,9 +210,8 @@ _READ_AS_IS = {("fit", "BLOCK"), ("eval rings", "BLOCK"), ("eval appearance", "B
 
 def test_the_commands_that_read_a_block_as_it_is_say_so_at_the_door():
     """Every block argument is either carved from (a turn, a resize taken) or read as it is."""
-    as_is = {(command, name) for command, sp in _leaf_parsers()
-             for dest, name, _kind, _paths in sp.get_default("_inputs") or ()
-             if dest in (sp.get_default("_input_as_is") or ())}
+    as_is = {(command, arg.name) for command, sp in _leaf_parsers()
+             for arg in sp.get_default("_inputs") or () if arg.as_is}
     assert as_is == _READ_AS_IS
 
 

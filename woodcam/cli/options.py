@@ -26,10 +26,10 @@ import argparse
 import math
 import os
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Literal, get_args
+from typing import Literal, NamedTuple, get_args
 
 from .._specs import WOODIFY_FIELD_FILE
 from .._types import CAMERAS
@@ -149,6 +149,18 @@ InputKind = Literal["file", "folder", "block"]
 INPUT_KINDS: tuple[str, ...] = get_args(InputKind)
 
 
+class InputArgument(NamedTuple):
+    """One input path argument as :func:`add_input` registers it on its parser (the parser's
+    ``_inputs`` default, a tuple of them) and :func:`check_inputs` reads it."""
+
+    dest: str  #: argparse's attribute
+    name: str  #: as the messages name it: ``--block``, or the positional's ``PART``
+    kind: InputKind
+    paths: Callable[[str], list[str]] | None  #: the paths a value names, when more than itself
+    suffixes: Callable[[], tuple[str, ...]] | None  #: a FILE's reader's suffixes
+    as_is: bool  #: a block spec the command reads as it is: no turn or resize
+
+
 def add_input(p, *flags: str, kind: InputKind, paths=None, suffixes=None, as_is: bool = False,
               **kwargs) -> argparse.Action:
     """An input path argument of ``p`` (``add_argument``'s ``flags`` and ``kwargs``) that
@@ -165,9 +177,8 @@ def add_input(p, *flags: str, kind: InputKind, paths=None, suffixes=None, as_is:
     assert not as_is or kind == "block", kind  # only a block spec has turns and resizes
     action = p.add_argument(*flags, **kwargs)
     name = next((f for f in action.option_strings if f.startswith("--")), action.dest.upper())
-    p.set_defaults(_inputs=(*(p.get_default("_inputs") or ()), (action.dest, name, kind, paths)),
-                   _input_suffixes={**(p.get_default("_input_suffixes") or {}), action.dest: suffixes},
-                   _input_as_is={*(p.get_default("_input_as_is") or ()), *([action.dest] if as_is else [])})
+    p.set_defaults(_inputs=(*(p.get_default("_inputs") or ()), InputArgument(action.dest, name, kind, paths,
+                                                                          suffixes, as_is)))
     return action
 
 
@@ -178,15 +189,13 @@ def check_inputs(args: argparse.Namespace) -> None:
     turn or resize on a block a command reads as it is (``add_input(as_is=True)``).
     A missing part, program or block folder was the command's own error (exit 1), some after the
     block was opened; an input that exists but whose contents are bad still is (exit 1)."""
-    suffixes = getattr(args, "_input_suffixes", {})
-    as_is = getattr(args, "_input_as_is", set())
-    for dest, name, kind, paths in getattr(args, "_inputs", ()):
-        value = getattr(args, dest, None)
+    for arg in getattr(args, "_inputs", ()):
+        value = getattr(args, arg.dest, None)
         for item in value if isinstance(value, list) else [] if value is None else [value]:
-            for text in paths(str(item)) if paths else [str(item)]:
-                _check_input(str(text), name, kind, args, as_is=dest in as_is)
-                if suffixes.get(dest):
-                    _check_suffix(Path(text), name, suffixes[dest](), args)
+            for text in arg.paths(str(item)) if arg.paths else [str(item)]:
+                _check_input(str(text), arg.name, arg.kind, args, as_is=arg.as_is)
+                if arg.suffixes:
+                    _check_suffix(Path(text), arg.name, arg.suffixes(), args)
 
 
 def _check_suffix(path: Path, name: str, accepted: tuple[str, ...], args: argparse.Namespace) -> None:
