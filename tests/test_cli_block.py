@@ -209,9 +209,11 @@ def test_options_that_would_change_nothing_are_named(tmp_path, capsys, shared_da
     assert main(["block", "show", str(tmp_path / "b" / "block_0000"), "--size-mm", "30",
                  "--out", str(tmp_path / "s.png")]) == 0
     assert "--size-mm (size_mm (30.0, 30.0, 30.0)) is for Mokume sample folders" in capsys.readouterr().err
-    # no target: the run stops before any work, after the warning
-    assert main(["parquetry", "--veneer-from", str(shared_data / "mokume" / "CN03"), "--sheets", "3",
-                 "--slice-axis", "x", "--out", str(tmp_path / "pq")]) == EXIT_ERROR
+    # a target that is no image: the run stops as it reads it, after the warning (no target at
+    # all is now a wrong command line, refused before it: 260e4e0)
+    (tmp_path / "t.png").write_bytes(b"no image")
+    assert main(["parquetry", str(tmp_path / "t.png"), "--veneer-from", str(shared_data / "mokume" / "CN03"),
+                 "--sheets", "3", "--slice-axis", "x", "--out", str(tmp_path / "pq")]) == EXIT_ERROR
     assert "--sheets, --slice-axis slice leaves from blocks" in capsys.readouterr().err
 
 
