@@ -434,10 +434,11 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
 
     from .detect.block import with_detected_rings
 
-    block = read_block_folder(_existing_folder(spec),
-                              None if size_mm is None else (float(size_mm),) * 3)
-    # A block of photos only: rings detected once, cached by content outside the folder.
-    block = with_detected_rings(block, progress=True)
+    folder = _existing_folder(spec)
+    block = read_block_folder(folder, None if size_mm is None else (float(size_mm),) * 3)
+    # A block of photos only: rings detected once, cached by content outside the folder (the
+    # user's files a 'block from-photos' remake left unnamed in it read in)
+    block = with_detected_rings(block, progress=True, folder=folder)
     return block, block.true_field
 
 
@@ -566,8 +567,9 @@ def _open_block_folder(path: Path, species, appearance, appearance_params, speci
 
     from .detect.block import with_detected_rings
 
-    # A block of photos only: rings detected once, cached by content outside the folder.
-    block = with_detected_rings(read_block_folder(path), progress=True)
+    # A block of photos only: rings detected once, cached by content outside the folder (the
+    # user's files a 'block from-photos' remake left unnamed in it read in)
+    block = with_detected_rings(read_block_folder(path), progress=True, folder=path)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
     return _real_block_stock(str(path), block, field, species, appearance, appearance_params,
                              cache_dir=None, species_given=species_given)

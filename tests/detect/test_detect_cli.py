@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -1483,3 +1484,47 @@ def test_hand_made_files_beside_the_photos_win_whatever_the_out_folder(synth_pho
     faces = read_block(out).faces
     assert not np.array_equal(faces["left"].extras["knot_mask"], mask > 127)
     assert len(faces["front"].traces) > 1
+
+
+def test_fit_right_after_a_remake_reads_the_users_files(synth_photos, tmp_path, capsys, monkeypatch):
+    """Between 'block from-photos' making a block again into its folder and the next 'rings
+    detect', the remade manifest names none of the user's files: 'fit BLK' (bake, eval) detected
+    every face itself and used none of them (a corrected front_traces.svg, a knot mask block.json
+    named left_knot.png, an edited bottom_ring_map.png), without a word. Now the photo-only path
+    reads the saved record: the user's files of a face whose photo is unchanged win, as the next
+    'rings detect' would have them."""
+    from woodcam.stock import open_block
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    blk, size = _knotted_block_folder(synth_photos, tmp_path, capsys)
+    assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 0
+    mask, rings, svg = _hand_made_files()
+    Image.fromarray(mask).save(blk / "left_knot.png")
+    (blk / "front_traces.svg").write_text(svg)  # the detector's, corrected
+    Image.fromarray(rings).save(blk / "bottom_ring_map.png")  # the detector's, edited
+    m = json.loads((blk / "block.json").read_text())
+    m["faces"]["left"]["extras"]["knot_mask"] = {"png": "left_knot.png", "dtype": "bool"}
+    (blk / "block.json").write_text(json.dumps(m))
+    assert _run(capsys, "block", "from-photos", tmp_path / "knotted", *size, "--out", blk)[0] == 0
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        block, _field = open_block(str(blk))
+    lines = [str(w.message) for w in said]
+    assert len(block.faces["front"].traces) == 1, lines
+    assert np.array_equal(block.faces["left"].extras["knot_mask"], mask > 127)
+    assert np.array_equal(block.faces["bottom"].ring_map, rings / 65535.0)
+    assert len(block.faces["top"].traces) > 1  # detected, as before
+    for kept in (f"the corrected {blk / 'front_traces.svg'} (1 trace; ", f"your {blk / 'left_knot.png'} (",
+                 f"the edited {blk / 'bottom_ring_map.png'} ("):
+        (line,) = [w for w in lines if f" kept {kept}" in w]
+        assert "it wins over detection" in line, line
+    # a face photo changed since (turned): its correction is not this photo's, so not used (the
+    # next 'rings detect' refuses it, as it did)
+    turned = _copy(tmp_path / "knotted", tmp_path / "turned")
+    Image.open(turned / "front.png").rotate(90).save(turned / "front.png")
+    assert _run(capsys, "block", "from-photos", turned, *size, "--out", blk)[0] == 0
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        block, _field = open_block(str(blk))
+    assert len(block.faces["front"].traces) > 1 and not any("front_traces" in str(w.message) for w in said)
+    assert np.array_equal(block.faces["left"].extras["knot_mask"], mask > 127)

@@ -44,7 +44,11 @@ again into its folder: its record keeps the names).
 detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
 folder of woodcam's cache (:mod:`woodcam._cache`: ``$WOODCAM_CACHE_DIR`` or platformdirs' user
 cache), one ``.npz`` keyed by a digest of the photos, the block size, the rule, the detector and
-:data:`DETECT_VERSION`; the user's folder is never written to. :func:`detect_folder` (``rings
+:data:`DETECT_VERSION`; the user's folder is never written to. In a folder 'block from-photos'
+made again (its manifest names none of the user's files; its record of the earlier detection
+keeps them), the user's corrected SVGs and edited or named images of a face whose photo is
+unchanged are read in over the detected ones and said, as the next detection keeps them
+(:func:`_users_files_of_a_remade_block`). :func:`detect_folder` (``rings
 detect``) caches each face of the classical detector there too (its photo, density, rule and
 options): detecting a folder again, after one SVG was corrected or one photo changed, detects
 only the faces whose photo is new.
@@ -612,6 +616,55 @@ def _check_corrections_match_photos(block: Block, edited: dict[str, Path]) -> No
                 f"{svg.name} out of {str(svg.parent)!r} (or detect into another --out) and run again")
 
 
+def _keep_users_svg(block: Block, name: str, svg: Path, named: bool, unrecorded: bool,
+                    out: Path | None = None) -> tuple[list, str]:
+    """Face ``name`` of ``block`` takes its rings from the user's SVG ``svg`` (corrected, made by
+    hand, or ``named`` by block.json under another name; found in a folder with no detection
+    ``unrecorded``): its traces and the ring map drawn from them, in place. Returns the traces and
+    the line that says it (carried into ``out`` when another folder, :func:`_copy_in`)."""
+    from ..block.svg import read_traces_svg
+
+    f = block.faces[name]
+    traces = read_traces_svg(svg, f.shape)
+    px = 1.0 / min(block.face_pixel_size_mm(name))
+    ring_map = ring_map_from_traces(traces, f.shape, RING_MAP_SIGMA_MM * px) if traces else None
+    block.faces[name] = Face(name, f.shape, photo=f.photo, traces=list(traces), ring_map=ring_map, extras=f.extras)
+    # the full path, as an image's: which of two folders (source, --out) it was kept from
+    return traces, _kept_users_line(name, f"{'your' if named or unrecorded else 'the corrected'} {svg}",
+                                    svg.parent, f"{len(traces)} trace{'' if len(traces) == 1 else 's'}; " + (
+                                        _named_why(f"{name}_traces.svg") if named
+                                        else _NO_RECORD if unrecorded
+                                        else "it is not the SVG detection wrote there"),
+                                    None if out is None else _copy_in(out, svg, _name_in(out, svg)))
+
+
+def _users_files_of_a_remade_block(block: Block, folder: Path) -> list[str]:
+    """The user's files in the block folder ``folder`` read into ``block`` (its faces just
+    detected on their photos), as the next :func:`detect_folder` would keep them: a manifest
+    'block from-photos' made again names none of them (its record of the earlier detection keeps
+    them, :func:`detection_record`), so fit, bake and eval right after the remake detected every
+    face and passed them over without a word. A corrected SVG (or one block.json named under
+    another name) and an edited or named ring map or knot mask win, each face whose photo is the
+    one they were made over (a changed photo's are left to 'rings detect', which refuses them).
+    Returns the lines that say each."""
+    rec = _prior_record(folder)
+    if not rec:
+        return []
+    was = rec.get("photo_digest") or {}
+    same = copy.copy(block)
+    same.faces = {n: f for n, f in block.faces.items()
+                  if f.photo is not None and was.get(n) in (None, photo_digest(f.photo))}
+    named = _named_users_files(folder)
+    svgs = {**user_edited_faces(folder), **{n: folder / rel for (n, kind), rel in named.items()
+                                            if kind == "traces_svg" and (folder / rel).is_file()}}
+    msgs = [_keep_users_svg(same, n, svg, (n, "traces_svg") in named, False)[1]
+            for n, svg in svgs.items() if n in same.faces]
+    images = _edited_images(same, [(folder, rec, named)])
+    msgs += _keep_users_images(same, images, (), {folder / rel for rel in named.values()})[1]
+    block.faces.update(same.faces)
+    return msgs
+
+
 def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = True,
                   size_mm=None, progress: bool = False,
                   detector: Detector = DEFAULT_DETECTOR, curved: bool | None = None) -> tuple[Path, list[str]]:
@@ -623,7 +676,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     and the warnings.
     """
     from ..block.io import MANIFEST, read_block_folder, write_block
-    from ..block.svg import read_traces_svg, write_traces_svg
+    from ..block.svg import write_traces_svg
 
     src, out = Path(src), Path(out)
     if not src.is_dir():  # a photo given for its folder was said 'does not exist'
@@ -699,23 +752,11 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
         msgs += found
     else:
         block.meta = dict(block.meta)
-    sigma_mm = RING_MAP_SIGMA_MM
     kept = {}
     for name, svg in edited.items():
-        f = block.faces[name]
-        traces = read_traces_svg(svg, f.shape)
-        px = 1.0 / min(block.face_pixel_size_mm(name))
-        ring_map = ring_map_from_traces(traces, f.shape, sigma_mm * px) if traces else None
-        block.faces[name] = Face(name, f.shape, photo=f.photo, traces=[], ring_map=ring_map, extras=f.extras)
-        kept[name] = traces
-        mine = svg in named or svg.parent in unrecorded
-        # the full path, as an image's: which of two folders (source, --out) it was kept from
-        msgs.append(_kept_users_line(name, f"{'your' if mine else 'the corrected'} {svg}",
-                                     svg.parent, f"{len(traces)} trace{'' if len(traces) == 1 else 's'}; " + (
-                                         _named_why(f"{name}_traces.svg") if svg in named
-                                         else _NO_RECORD if svg.parent in unrecorded
-                                         else "it is not the SVG detection wrote there"),
-                                     _copy_in(out, svg, _name_in(out, svg))))
+        kept[name], said = _keep_users_svg(block, name, svg, svg in named, svg.parent in unrecorded, out)
+        block.faces[name].traces = []  # written to the SVG, not the manifest (below)
+        msgs.append(said)
     for name, f in block.faces.items():
         # a face with the user's ring map is not left without one (said as kept below)
         if f.photo is not None and not f.traces and name not in kept and (name, "ring_map") not in images:
@@ -846,9 +887,11 @@ def _load_detection(path: Path):
 
 
 def with_detected_rings(block: Block, rule: BoundaryRule = DEFAULT_RULE, *, cache: bool = True,
-                        progress: bool = False) -> Block:
+                        progress: bool = False, folder=None) -> Block:
     """``block`` itself when it has rings; otherwise a copy with rings and knots detected on its
     photos, computed once and cached by content (module docstring; :mod:`woodcam._cache`).
+    ``folder``: the block folder ``block`` was read from; the user's files a 'block from-photos'
+    remake left unnamed there win over detection (:func:`_users_files_of_a_remade_block`).
     Warnings naming faces, and a face that looks turned or mirrored
     (:func:`~woodcam.detect.layout.check_face_layout`), are issued as
     :class:`~woodcam.errors.WoodcamWarning` each time."""
@@ -879,6 +922,8 @@ def with_detected_rings(block: Block, rule: BoundaryRule = DEFAULT_RULE, *, cach
                             extras={**f.extras, **extras})
     out.meta = {**block.meta, "detection": {"detector": DEFAULT_DETECTOR, "version": DETECT_VERSION,
                                             "rule": rule, "faces": sorted(faces)}}
+    # read from a block folder 'block from-photos' made again: the user's files there win
+    msgs = [*msgs, *([] if folder is None else _users_files_of_a_remade_block(out, Path(folder)))]
     # A face photographed turned or mirrored ruins the fit without a word otherwise (detect_folder
     # checked; fit, bake, eval and open_stock came here). Checked on every call, cache hit too (a
     # cached entry made before the check would say nothing); the CLI prints a warning once.
