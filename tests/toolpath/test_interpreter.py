@@ -1237,6 +1237,21 @@ def test_a_message_in_a_loop_is_said_every_pass_and_warned_once():
     assert ran == [["1000"], ["1000"], ["1000"], ["3"], ["2"], []]
 
 
+
+def test_a_warned_line_in_a_loop_is_warned_once_with_its_passes():
+    """An I/O M code or a G43 without H in an o-word loop warned on every pass: a 500-pass
+    while loop around M62 P1 gave 500 identical warnings. Now each line and text is warned
+    once, saying how many times the line ran, as a message's warning is (while and repeat)."""
+    text = ("#1=0\no100 while [#1 lt 500]\nM62 P1\nM66 P0 L0\n#1=[#1+1]\no100 endwhile\n"
+            "o200 repeat [3]\nG43\no200 endrepeat\nM2\n")
+    interp = Interpreter(text)
+    interp.run()
+    assert [(ln, w.split(" (")[0].split(" without")[0]) for ln, w in interp.warnings] == [
+        (3, "M62"), (4, "M66"), (8, "G43")]
+    ran = [re.findall(r"\(warned once; the line ran (\d+) times\)$", w) for _, w in interp.warnings]
+    assert ran == [["500"], ["500"], ["3"]]
+    assert len(read_gcode("G0 X0 Y0 Z5\n" + text).warnings) == 3  # (the public reader too)
+
 def test_tool_table_entries_in_a_message_say_what_they_are_or_the_users_diameter():
     """LinuxCNC shows the loaded tool's entry of the machine's tool table for #5401-#5413 in a
     DEBUG/PRINT (the table's values, whatever G20; rs274 -t in test_linuxcnc_oracle.py);

@@ -82,7 +82,9 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   error, as in LinuxCNC).
 
 Everything else is an error naming the line and the word; what is read but has no effect on the
-cut is silent, what is read and could matter but is not simulated is a warning with its line.
+cut is silent, what is read and could matter but is not simulated is a warning with its line
+(once per line in a loop or a subroutine, counting the passes: ``(warned once; the line ran
+500 times)``).
 
 Dialects: ``linuxcnc`` (the default) is the reference. ``grbl`` has no parameters, expressions,
 O-words or subprograms (they are errors there, ``O1234`` and ``M98`` too), needs no ``M2``.
@@ -638,9 +640,10 @@ class Interpreter:
         self.known = [False, False, False]
         self._warned_start = False
         self._t_warned: set[int] = set()
-        # a message's warning by (line, text) -> [its index in warnings, passes, the last
-        # pass]: a DEBUG/PRINT in a loop or a subroutine is said on every pass, warned once
-        self._message_warned: dict[tuple[int, str], list[int]] = {}
+        # a warning by (line, text) -> [its index in warnings, passes, the last pass]: a
+        # line in a loop or a subroutine runs on every pass, warned once (warn)
+        self._warned: dict[tuple[int, str], list[int]] = {}
+        self._warn_calls = 0
         self._message_pass = 0  # counts the DEBUG/PRINT texts put together (_expand)
         self._g53_unplaced: dict[str, list[int]] = {"z": [], "xy": []}  # lines, machine zero unknown
         self._frames: list[tuple] = []  # the active calls while run() runs
@@ -656,22 +659,28 @@ class Interpreter:
         what, fix = what_fix
         return self.err(word, f"{word} ({what}) is not simulated by woodcam (LinuxCNC runs it)", fix)
 
-    def warn(self, msg):
-        self.warnings.append((self.line_no, msg))
-
-    def _warn_message(self, msg: str) -> None:
-        """Warn ``msg`` about a DEBUG/PRINT text once per line: a 1000-pass loop gave 1000
-        identical warnings (its messages stay one a pass, as LinuxCNC shows them); a line
-        said again counts its passes in the one warning."""
+    def warn(self, msg: str, pass_id: int | None = None) -> None:
+        """Warn ``msg`` once per line and text: a line in a loop or a subroutine runs again
+        and again (a 500-pass while loop around ``M62 P1`` gave 500 identical warnings); a
+        line warned again counts its passes in the one warning. ``pass_id`` (a DEBUG/PRINT
+        text, :meth:`_warn_message`) makes a value read twice in one text one pass."""
+        if pass_id is None:
+            self._warn_calls += 1
+            pass_id = -self._warn_calls  # (apart from the message passes, which count up)
         key = (self.line_no, msg)
-        seen = self._message_warned.get(key)
+        seen = self._warned.get(key)
         if seen is None:
-            self._message_warned[key] = [len(self.warnings), 1, self._message_pass]
-            self.warn(msg)
-        elif seen[2] != self._message_pass:  # (not the same value twice in one text)
-            seen[1:] = [seen[1] + 1, self._message_pass]
+            self._warned[key] = [len(self.warnings), 1, pass_id]
+            self.warnings.append((self.line_no, msg))
+        elif seen[2] != pass_id:
+            seen[1:] = [seen[1] + 1, pass_id]
             self.warnings[seen[0]] = (self.line_no, f"{msg} (warned once; the line ran "
                                                     f"{seen[1]} times)")
+
+    def _warn_message(self, msg: str) -> None:
+        """Warn ``msg`` about a DEBUG/PRINT text once per line (its messages stay one a pass,
+        as LinuxCNC shows them), a value read twice in one text once."""
+        self.warn(msg, self._message_pass)
 
     @property
     def scale(self):
