@@ -211,7 +211,8 @@ def test_an_open_mesh_in_a_file_of_several_is_named_with_its_option_and_file(tmp
     --obstacle: 'obstacles[0] ...'), naming neither the option nor the file; a box missing a
     side was capped flat with a warning (a one-mesh file is refused) and a sphere missing
     triangles refused as 'mesh file ...', without the option. Now each mesh and their union go
-    through the same check, naming the option, the file and the mesh."""
+    through the same check, naming the option, the file and the mesh; the touching union says
+    why and its fix (it suggested trimesh.repair.fill_holes, for meshes each closed)."""
     a = trimesh.creation.box((10.0, 10.0, 10.0))
     ball = trimesh.creation.icosphere(subdivisions=2, radius=5.0)
     ball.export(tmp_path / "ball.stl")
@@ -232,6 +233,8 @@ def test_an_open_mesh_in_a_file_of_several_is_named_with_its_option_and_file(tmp
                          "--out", str(tmp_path / "o")]) == 1, (name, what)
             err = capsys.readouterr().err
             assert err.count("\n") == 1 and f"error: {what} {path!r} {said} must be watertight" in err, err
+            touch = "touch along an edge or at a vertex" in err and "non-manifold union" in err
+            assert touch == (name == "touching") and ("fill_holes" in err) == (name != "touching"), err
     assert not (tmp_path / "o").exists()
 
 

@@ -143,18 +143,19 @@ def _load_mesh(path: str, what: str = "part"):
     return manifold_to_trimesh(load_part(path), process=True), None, {}
 
 
-def _welded_closed(mesh, name: str):
+def _welded_closed(mesh, name: str, fix: str | None = None):
     """``mesh`` welded (by position, texture and normal seams too) as the growth reads it,
     refused unless closed (the growth's own check_watertight) with ``name`` (the option and
     the file): the growth said 'obstacles[0] must be watertight' of an open --obstacle, and
-    'mesh ...' of the part, naming neither. The one check of a file's meshes, one or several."""
+    'mesh ...' of the part, naming neither. The one check of a file's meshes, one or several;
+    ``fix`` replaces the growth's repair hint where the caller knows the cause."""
     import trimesh
 
     from ..woodify.front import check_watertight
 
     geom = trimesh.Trimesh(mesh.vertices, mesh.faces, process=True)
     geom.merge_vertices(merge_tex=True, merge_norm=True)
-    return check_watertight(geom, name)
+    return check_watertight(geom, name) if fix is None else check_watertight(geom, name, fix=fix)
 
 
 def _check_mesh_values(mesh, path: str, what: str) -> None:
@@ -209,9 +210,14 @@ def _several_meshes(path: Path, what: str):
                       "(their union), and their pictures are not carried to the bark (procedural bark "
                       "instead); join them into one textured mesh to keep a picture", WoodcamWarning, stacklevel=3)
     # the union too: two closed meshes touching along an edge share it four times, which the
-    # growth refused as 'mesh must be watertight' / 'obstacles[0] ...'
+    # growth refused as 'mesh must be watertight' / 'obstacles[0] ...'; each mesh is closed
+    # here, so hole filling is not the fix (it suggested trimesh.repair.fill_holes)
     geom = _welded_closed(manifold_to_trimesh(load_part(path), process=True),
-                          f"{what} {str(path)!r} (the union of its {len(meshes)} meshes)")
+                          f"{what} {str(path)!r} (the union of its {len(meshes)} meshes)",
+                          fix="each mesh is closed, but they touch along an edge or at a vertex, "
+                          "so their union is not a manifold solid (non-manifold union); separate "
+                          "them (leave a gap) or merge them into one solid in the CAD program, "
+                          "and export again")
     _warn_units(geom, str(path), what)
     return geom, None, {}
 

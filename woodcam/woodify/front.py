@@ -122,8 +122,10 @@ class Front:
     _trace_cache: tuple | None = dc_field(default=None, init=False, repr=False, compare=False)
 
 
-def check_watertight(mesh, name: str):
-    """Return ``mesh`` as a trimesh if it is a closed, consistently oriented volume, else raise."""
+def check_watertight(mesh, name: str, *, fix: str = "repair it first (e.g. trimesh.repair."
+                     "fill_holes, or export a closed solid)"):
+    """Return ``mesh`` as a trimesh if it is a closed, consistently oriented volume, else raise
+    (``fix`` ends the message: a caller that knows why it is open says the fix that is)."""
     import trimesh
 
     if not isinstance(mesh, trimesh.Trimesh):
@@ -138,7 +140,7 @@ def check_watertight(mesh, name: str):
         raise WoodcamError(
             f"{name} must be watertight (every edge shared by exactly two triangles) so its inside "
             f"is defined; this one has {len(mesh.faces)} triangles and open or non-manifold "
-            "edges; repair it first (e.g. trimesh.repair.fill_holes, or export a closed solid)")
+            f"edges; {fix}")
     return mesh
 
 
