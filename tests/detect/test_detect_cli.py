@@ -1519,12 +1519,18 @@ def test_fit_right_after_a_remake_reads_the_users_files(synth_photos, tmp_path, 
         (line,) = [w for w in lines if f" kept {kept}" in w]
         assert "it wins over detection" in line, line
     # a face photo changed since (turned): its correction is not this photo's, so not used (the
-    # next 'rings detect' refuses it, as it did)
+    # next 'rings detect' refuses it, as it did), and said so, with 'rings detect''s fix
     turned = _copy(tmp_path / "knotted", tmp_path / "turned")
     Image.open(turned / "front.png").rotate(90).save(turned / "front.png")
     assert _run(capsys, "block", "from-photos", turned, *size, "--out", blk)[0] == 0
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         block, _field = open_block(str(blk))
-    assert len(block.faces["front"].traces) > 1 and not any("front_traces" in str(w.message) for w in said)
+    assert len(block.faces["front"].traces) > 1
+    (line,) = [str(w.message) for w in said if "front_traces" in str(w.message)]
+    assert line.startswith(f"face 'front': the corrected {blk / 'front_traces.svg'} was traced over another front "
+                           f"photo than this block's (the photo changed since)"), line
+    assert "not used here" in line and line.endswith(
+        f"move front_traces.svg out of {str(blk)!r} (or detect into another --out) and run again"), line
+    assert all(issubclass(w.category, WoodcamWarning) for w in said)
     assert np.array_equal(block.faces["left"].extras["knot_mask"], mask > 127)

@@ -505,8 +505,7 @@ def _edited_images(block: Block, folders: list[tuple[Path, dict, dict[tuple[str,
                     raise WoodcamError(
                         f"face {name!r}: the edited {path} was made over another {name} photo than this block's "
                         f"(the photo changed since, or --out holds an earlier block's detection): it is not this "
-                        f"photo's {what}, and detecting would write over it; move {path.name} out of "
-                        f"{str(folder)!r} (or detect into another --out) and run again")
+                        f"photo's {what}, and detecting would write over it; {_move_out_fix(path)}")
                 found[name, kind] = path
                 break
     return found
@@ -612,8 +611,13 @@ def _check_corrections_match_photos(block: Block, edited: dict[str, Path]) -> No
             raise WoodcamError(
                 f"face {name!r}: the corrected {svg} was traced over another {name} photo than this "
                 f"block's (the photo changed since, or --out holds an earlier block's detection): its "
-                f"rings are not this photo's, and detecting would overwrite the correction; move "
-                f"{svg.name} out of {str(svg.parent)!r} (or detect into another --out) and run again")
+                f"rings are not this photo's, and detecting would overwrite the correction; {_move_out_fix(svg)}")
+
+
+def _move_out_fix(path: Path) -> str:
+    """The fix for the user's file ``path`` made over another photo than its face's now (refused
+    by 'rings detect', said by fit, bake and eval): one wording wherever it is given."""
+    return f"move {path.name} out of {str(path.parent)!r} (or detect into another --out) and run again"
 
 
 def _keep_users_svg(block: Block, name: str, svg: Path, named: bool, unrecorded: bool,
@@ -645,8 +649,8 @@ def _users_files_of_a_remade_block(block: Block, folder: Path) -> list[str]:
     them, :func:`detection_record`), so fit, bake and eval right after the remake detected every
     face and passed them over without a word. A corrected SVG (or one block.json named under
     another name) and an edited or named ring map or knot mask win, each face whose photo is the
-    one they were made over (a changed photo's are left to 'rings detect', which refuses them).
-    Returns the lines that say each."""
+    one they were made over; a changed photo's corrected SVG is said unused, with the fix 'rings
+    detect' gives when it refuses it (:func:`_move_out_fix`). Returns the lines that say each."""
     rec = _prior_record(folder)
     if not rec:
         return []
@@ -659,6 +663,12 @@ def _users_files_of_a_remade_block(block: Block, folder: Path) -> list[str]:
                                             if kind == "traces_svg" and (folder / rel).is_file()}}
     msgs = [_keep_users_svg(same, n, svg, (n, "traces_svg") in named, False)[1]
             for n, svg in svgs.items() if n in same.faces]
+    # a changed photo's correction is not read in, and not passed over without a word either
+    msgs += [f"face {n!r}: {'your' if (n, 'traces_svg') in named else 'the corrected'} {svg} was traced "
+             f"over another {n} photo than this block's (the photo changed since): its rings are not this photo's, so they are not used here ({n}'s "
+             f"rings are detected) and 'rings detect' will refuse it; {_move_out_fix(svg)}"
+             for n, svg in svgs.items()
+             if n in block.faces and block.faces[n].photo is not None and n not in same.faces]
     images = _edited_images(same, [(folder, rec, named)])
     msgs += _keep_users_images(same, images, (), {folder / rel for rel in named.values()})[1]
     block.faces.update(same.faces)
