@@ -230,8 +230,9 @@ def test_predefined_named_parameters_agree_with_linuxcnc(tmp_path):
     LinuxCNC's interpreter: the same values but where woodcam is the machine and the oracle
     its preview (the gcode module of AXIS): #<_task> (1 against 0), #<_feed> (the preview's
     canon starts it at 1 and sets it to 1 again on G20/G21; woodcam 0 before any F, and the
-    feed in the new units) and #<_current_tool> after M6 (the preview never completes a tool
-    change). Woodcam refused all but 20 of them as 'not defined'."""
+    feed in the new units). (#<_current_tool> after M6 differed too: the preview never completes
+    a tool change; the driver's tool table now holds the loaded tool in pocket 0, as the
+    machine's does.) Woodcam refused all but 20 of them as 'not defined'."""
     from woodcam.toolpath.interpreter import _PREDEFINED
 
     names = [n for n, v in _PREDEFINED.items() if not isinstance(v, str)] + ["_value",
@@ -250,8 +251,7 @@ def test_predefined_named_parameters_agree_with_linuxcnc(tmp_path):
         for name, a, b in zip(names, mine, theirs):
             if name == "_task":
                 assert (a, b) == (1, pytest.approx(0, abs=1e-6))
-            elif not (name == "_feed" and abs(b - 1) < 1e-6
-                      or name == "_current_tool" and "M6" in state):
+            elif not (name == "_feed" and abs(b - 1) < 1e-6):
                 assert a == pytest.approx(b, abs=1e-6), (state, name)
                 compared += 1
     assert compared > 2300  # measured: 2,346 values
@@ -829,6 +829,35 @@ def test_print_comments_are_printed_where_rs274_prints_them_not_said(tmp_path):
         "line 2: hello", "line 3: dbg 2.500000 x=0.000000"]
     assert mine.printed == ["line 4: prt 2.500000 x=1.500000", "line 7: pass 0.000000",
                             "line 7: pass 1.000000", "line 12: after 0.000000"]
+    assert read_gcode(text, interpreter="linuxcnc").printed == mine.printed
+
+
+def test_linuxcnc_prints_and_shows_the_users_diameters_as_woodcam(tmp_path):
+    """--interpreter linuxcnc left Program.printed empty (the module writes a PRINT's text to
+    its standard output, without its line) and showed #5410 as 0 for a tool whose diameter the
+    user gave, where woodcam's interpreter prints each text with its line and shows the
+    diameter. Now both read the same program alike: PRINTs in a loop and a subroutine, after
+    another comment, on a line too long for the mark the driver puts in, #5410 after each M6
+    (whatever G20) from the user's diameters."""
+    long = "(PRINT,long " + "x" * 237 + ")"
+    assert len(long) == 250  # LinuxCNC reads lines of up to 252: no room for the mark
+    text = ("G21\n(PRINT,start)\nT1 M6\n(DEBUG,d=#5410)\n(PRINT,d=#5410 t=#5400)\n"
+            "o10 sub\n(PRINT,in sub #1)\no10 endsub\n#2=0\no1 while [#2 lt 3]\n"
+            "(print, pass #2)\no10 call [#2]\n#2=[#2+1]\no1 endwhile\nG20\nT2 M6\n"
+            "(note) ( Print,last d=#5410)\n(PRINT,not said) (note)\nG0 X1 ; (PRINT,no)\n"
+            f"{long}\nT3 M6\nG21 G0 X2 (DEBUG,t3 #5400)\nM2\n")
+    tools = {1: 6.35, 2: 3.0}
+    mine = read_gcode(text, tool_diameters_mm=tools)
+    theirs = read_gcode(text, interpreter="linuxcnc", tool_diameters_mm=tools)
+    assert theirs.printed == mine.printed == [
+        "line 2: start", "line 5: d=6.350000 t=1.000000",
+        *[f"line {ln}: {t}" for i in range(3) for ln, t in
+          ((11, f"pass {i}.000000"), (7, f"in sub {i}.000000"))],
+        "line 17: last d=3.000000", "line 20: long " + "x" * 237]
+    assert theirs.messages == mine.messages == ["line 4: d=6.350000", "line 22: t3 3.000000"]
+    assert not mine.warnings and not theirs.warnings
+    # without the diameters LinuxCNC's table holds 0 (woodcam says so, with a warning)
+    assert read_gcode(text, interpreter="linuxcnc").messages[0] == "line 4: d=0.000000"
 
 
 @pytest.mark.skipif(not RS274.exists(), reason=f"{RS274} (LinuxCNC's standalone interpreter, "

@@ -3,10 +3,12 @@ the one its AXIS preview uses) on G-code files and prints canonical moves as JSO
 
 Run by :mod:`woodcam.toolpath.linuxcnc` with Debian's ``/usr/bin/python3`` (the module is built
 for it, not for woodcam's virtualenv); never imported by woodcam. Input (stdin, JSON):
-``{"files": [path, ...], "start_mm": [x, y, z], "timeout_s": t, "machine_zero_mm": [x, y, z]}``
-(the last optional, default zero); output (stdout, JSON): one
-``{"moves": [...], "messages": [[line, text], ...], "error": null | [line, message],
-"result": code}`` per file (messages: the operator messages, ``(MSG,...)``/``(DEBUG,...)``), moves as
+``{"files": [path, ...], "start_mm": [x, y, z], "timeout_s": t, "machine_zero_mm": [x, y, z],
+"tool_diameters_mm": {"n": d, ...}}`` (the last two optional: zero, no diameters); output (stdout,
+JSON): one ``{"moves": [...], "messages": [[line, text], ...], "printed": [[line, text], ...],
+"error": null | [line, message], "result": code}`` per file (messages: the operator messages,
+``(MSG,...)``/``(DEBUG,...)``; printed: the ``(PRINT,...)`` texts, which the interpreter writes to
+its standard output, not through the canon: :func:`_mark_prints`), moves as
 woodcam's canonical tuples ``[kind, line, [x, y, z], [c1, c2] | null, rotation, plane,
 feed_mm_min, spindle_rpm, tool]`` in the
 machine frame, mm, tool tip (LinuxCNC's canon reports program coordinates before the G5x/G92
@@ -17,6 +19,11 @@ with that length offset has its tip the offset lower; woodcam simulates the tip)
 frame the start position is given in (as woodcam's interpreter does). The machine is metric
 (external length units mm, the parameter file in mm), as woodcam's interpreter: a program reads
 ``#5161`` or ``#5221`` in mm (the canon calls still come in inches: the module converts them).
+The tool table the interpreter reads (``get_tool``, again after each M6) has zero offsets and
+the diameters of ``tool_diameters_mm`` (mm, the machine's units: a DEBUG/PRINT of ``#5410``
+shows them whatever G20/G21, as ``rs274 -t``); its pocket 0 is the loaded tool's entry, as a
+machine's is after a tool change (``#5400``, ``#<_current_tool>`` and ``#5401``-``#5413`` read
+it; before, pocket 0 held no tool and they read 0 after an M6).
 """
 
 import ctypes
@@ -29,6 +36,10 @@ import tempfile
 import time
 
 MM = 25.4
+#: LinuxCNC's longest line (its LINELEN less the end): a longer one is "Command too long"
+MAX_LINE = 252
+_PRINT = re.compile(rb"\(([ \t]*print,)", re.IGNORECASE)  # LinuxCNC: blanks, any case, comma
+_MARKED = re.compile(r"\x01(\d+)\x02(.*)")
 _BLANKS = str.maketrans("", "", " \t\r")  # what LinuxCNC skips between words
 _PLANE = {1: 17, 2: 19, 3: 18}  # CANON_PLANE_XY, YZ, XZ -> G17, G19, G18
 # first/second axis (x=0, y=1, z=2) of an arc in each canon plane; the third is the normal
@@ -125,6 +136,7 @@ class _Canon:
         self.mzero = [0.0] * 3  # the output shift: machine origin in the G54 frame, mm
         self.feed = 0.0  # mm/min (set_feed_rate: inch/min, as the module converts lengths)
         self.tool = 0  # the loaded tool (change_tool: M6)
+        self.diameters: dict[int, float] = {}  # the user's tools by number, mm (get_tool)
         # the spindle: the interpreter's state reaches Python only through next_line, called
         # at a line's first canon call with the state as it was after the last block the
         # interpreter finished, so before the line's own S and M3/M4/M5/M6/M19, which take
@@ -189,7 +201,9 @@ class _Canon:
         return time.time() > self.deadline
 
     def get_tool(self, n):
-        return (n,) + (0.0,) * 12 + (0,)
+        # pocket 0: the loaded tool's entry (change_tool, M6), read again after each change
+        number = self.tool if n == 0 else n
+        return (number,) + (0.0,) * 9 + (self.diameters.get(number, 0.0), 0.0, 0.0, 0)
 
     def set_g5x_offset(self, index, x, y, z, *rest):
         self.g5x = [x * MM, y * MM, z * MM]
@@ -253,6 +267,42 @@ def main():
         shutil.rmtree(work, ignore_errors=True)
 
 
+def _mark_prints(data):
+    """Program ``data`` (bytes) with each ``(PRINT,`` comment's text led by its line number
+    between ``\\x01`` and ``\\x02`` (lines numbered at ``\\n``, as LinuxCNC does): the interpreter
+    writes a PRINT's text, parameters put in, to its standard output and nothing says which line
+    it ran; with the mark the text tells (:func:`_printed`). Returns ``(data, lines)``, ``lines``
+    those left unmarked: the mark would make them longer than LinuxCNC reads (MAX_LINE)."""
+    lines = data.split(b"\n")
+    long = []
+    for i, line in enumerate(lines):
+        if b"(" in line and _PRINT.search(line):
+            marked = _PRINT.sub(lambda m: b"(" + m.group(1) + b"\x01%d\x02" % (i + 1), line)
+            if len(marked) > MAX_LINE:
+                long.append(i + 1)
+            else:
+                lines[i] = marked
+        # (a print, comment LinuxCNC does not print, one not last on its line or after a ';',
+        # prints nothing marked either)
+    return b"\n".join(lines), long
+
+
+def _printed(text, long):
+    """The ``[line, text]`` of each PRINT in ``text``, the interpreter's standard output of a
+    program marked by :func:`_mark_prints` (``long``: its lines left unmarked, whose texts
+    come unmarked: given the first of them); any other line goes to stderr, as before."""
+    out = []
+    for line in text.split("\n")[:-1]:
+        m = _MARKED.match(line)
+        if m:
+            out.append([int(m.group(1)), m.group(2)])
+        elif long:
+            out.append([long[0], line])
+        else:
+            sys.stderr.write(line + "\n")
+    return out
+
+
 def _run(job, work, result_fd):
     import gcode  # after main() took woodcam's own gcode.py off the path
 
@@ -263,6 +313,13 @@ def _run(job, work, result_fd):
         f.write("[RS274NGC]\nPARAMETER_FILE = sim.var\n[TRAJ]\nLINEAR_UNITS = mm\n"
                 "SPINDLES = 1\n")
     os.environ["INI_FILE_NAME"] = ini
+    # the interpreter's standard output: the PRINT texts (_printed), read after each file
+    said = os.path.join(work, "stdout.txt")
+    fd = os.open(said, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    os.dup2(fd, 1)
+    os.close(fd)
+    libc, said_at = ctypes.CDLL(None), 0
+    diameters = {int(k): float(v) for k, v in (job.get("tool_diameters_mm") or {}).items()}
     mzero = [float(v) for v in job.get("machine_zero_mm") or (0.0, 0.0, 0.0)]
     # the start in machine coordinates: G54 frame minus the machine origin's place in it
     sx, sy, sz = (v - m for v, m in zip(job["start_mm"], mzero))
@@ -277,8 +334,17 @@ def _run(job, work, result_fd):
                 f.write(f"{5221 + i}\t{-m:.15f}\n")
         canon = _Canon(var, time.time() + job.get("timeout_s", 10.0))
         canon.mzero = mzero
+        canon.diameters = diameters
         with open(path, newline="", errors="replace") as f:  # numbered as LinuxCNC: at '\n' only
             lines = f.read().split("\n")
+        with open(path, "rb") as f:
+            raw = f.read()
+        data, long = _mark_prints(raw)
+        run = path
+        if data != raw:  # a PRINT comment: run the marked copy
+            run = os.path.join(work, "program.ngc")
+            with open(run, "wb") as f:
+                f.write(data)
         canon.words = {no: w for no, line in enumerate(lines, 1) if "m" in line.lower()
                        or "s" in line.lower() for w in [_spindle_words(line)] if w != []}
         # G49: the interpreter keeps a G43.1 tool length offset from one file to the next;
@@ -287,14 +353,20 @@ def _run(job, work, result_fd):
         init = ["G21", "G90", "G49", f"G53 G0 X{sx:.12f} Y{sy:.12f} Z{sz:.12f}", "G80"]
         t0, c0 = time.perf_counter(), time.process_time()
         try:
-            result, seq = gcode.parse(path, canon, init, "")
+            result, seq = gcode.parse(run, canon, init, "")
             err = [seq, gcode.strerror(result)] if result > gcode.MIN_ERROR else None
         except KeyboardInterrupt:  # check_abort() said the time is up
             result, err = -2, [canon.line, "aborted: over the time limit"]
         except Exception as e:  # noqa: BLE001 - LinuxCNC raises plain RuntimeError
             result, err = -1, [0, f"{type(e).__name__}: {e}"]
         moves = [m for m in canon.moves if m[1] > 0]  # line 0: the init codes
-        out.append({"moves": moves, "messages": canon.messages, "error": err, "result": result,
+        libc.fflush(None)  # C's stdout, a file: buffered
+        with open(said, "rb") as f:
+            f.seek(said_at)
+            text = f.read().decode(errors="replace")
+            said_at = f.tell()
+        out.append({"moves": moves, "messages": canon.messages,
+                    "printed": _printed(text, long), "error": err, "result": result,
                     "seconds": time.perf_counter() - t0, "cpu_seconds": time.process_time() - c0})
     with os.fdopen(result_fd, "w") as f:
         json.dump(out, f)

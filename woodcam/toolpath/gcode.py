@@ -14,9 +14,8 @@ lies exactly on the analytic circle (helix). ``warnings`` lists ``"line N: ..."`
 ``messages`` the operator messages the program says as it runs, ``"line N: ..."`` too (its
 ``(MSG,...)`` and ``(DEBUG,...)`` comments, the parameters' values put in, as LinuxCNC shows
 them); ``printed`` its ``(PRINT,...)`` texts, in the same form: LinuxCNC writes those to the
-terminal it was started from, never to the operator's screen (woodcam's interpreter only:
-``interpreter="linuxcnc"`` leaves it empty: LinuxCNC's module writes them to its own standard
-output, without their lines).
+terminal it was started from, never to the operator's screen (``interpreter="linuxcnc"``
+too: the texts it writes to its standard output, each with the line it ran).
 
 The language (parameters, expressions, O-word subroutines and loops, work offsets, canned
 cycles, dialects) is :mod:`woodcam.toolpath.interpreter`; ``interpreter="linuxcnc"`` runs
@@ -276,8 +275,10 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
     tool_diameters_mm : {int: float} | None
         The cutters' diameters (mm) by tool number, as the user's tool table gives them: what
         a ``(DEBUG,...)``/``(PRINT,...)`` shows for ``#5410`` (the loaded tool's diameter in
-        the machine's tool table; woodcam's interpreter only). Without the loaded tool there,
-        it says what LinuxCNC would show, with a warning.
+        the machine's tool table). Without the loaded tool there, woodcam's interpreter says
+        what LinuxCNC would show, with a warning; ``interpreter="linuxcnc"`` runs LinuxCNC
+        with these diameters in its tool table, and shows 0 for a tool not there and before
+        the first ``M6`` (no tool loaded: LinuxCNC has no tool 0).
 
     Raises
     ------
@@ -330,7 +331,8 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
         from .linuxcnc import run_linuxcnc
 
         moves, warnings = run_linuxcnc(text, start_mm=tuple(start.tolist()),
-                                       machine_zero_mm=mzero, said=said)
+                                       machine_zero_mm=mzero, said=said, printed=printed,
+                                       tool_diameters_mm=diameters)
     elif interpreter == "woodcam":
         interp = Interpreter(text, dialect=dialect, start_mm=start.tolist(),
                              machine_zero_mm=mzero, tool_diameters_mm=diameters)

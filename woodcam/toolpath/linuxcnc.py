@@ -42,34 +42,41 @@ def linuxcnc_missing() -> str | None:
 
 
 def run_batch(paths, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 10.0,
-              machine_zero_mm=(0.0, 0.0, 0.0)) -> list[dict]:
+              machine_zero_mm=(0.0, 0.0, 0.0), tool_diameters_mm=None) -> list[dict]:
     """Run LinuxCNC's interpreter on each file of ``paths`` in one subprocess.
 
     Returns one dict per file: ``moves`` (canonical ``[kind, line, end, centre, rotation,
     plane]``, mm, in the frame of ``start_mm``: the G54 frame, whose offset is
-    ``-machine_zero_mm``; the default zero, or ``None``, is the machine frame), ``error`` (``None`` or
-    ``[line, message]``), ``seconds``.
+    ``-machine_zero_mm``; the default zero, or ``None``, is the machine frame), ``messages``
+    (the operator messages, ``[line, text]``), ``printed`` (the ``(PRINT,...)`` texts,
+    ``[line, text]``), ``error`` (``None`` or ``[line, message]``), ``seconds``.
+    ``tool_diameters_mm``: the tool table's diameters by tool number (mm), what a DEBUG/PRINT
+    shows for ``#5410`` (LinuxCNC's table otherwise holds 0).
     """
     why = linuxcnc_missing()
     if why:
         raise WoodcamError(f"--interpreter linuxcnc: {why}; or use --interpreter woodcam")
     job = {"files": [str(Path(p).resolve()) for p in paths], "start_mm": list(start_mm),
            "timeout_s": float(timeout_s),
-           "machine_zero_mm": [0.0, 0.0, 0.0] if machine_zero_mm is None else list(machine_zero_mm)}
+           "machine_zero_mm": [0.0, 0.0, 0.0] if machine_zero_mm is None else list(machine_zero_mm),
+           "tool_diameters_mm": {str(int(n)): float(d) for n, d in
+                                 (tool_diameters_mm or {}).items()}}
     r = subprocess.run([LINUXCNC_PYTHON, "-I", str(_DRIVER)], input=json.dumps(job),
                        capture_output=True, text=True,
                        timeout=timeout_s * max(1, len(job["files"])) + 60)
     if r.returncode:
         if len(job["files"]) > 1:  # one program crashed the interpreter: run them one by one
             return [run_batch([p], start_mm=start_mm, timeout_s=timeout_s,
-                              machine_zero_mm=machine_zero_mm)[0] for p in paths]
-        return [{"moves": [], "error": [0, f"LinuxCNC's interpreter crashed (exit "
-                                           f"{r.returncode})"], "seconds": 0.0}]
+                              machine_zero_mm=machine_zero_mm,
+                              tool_diameters_mm=tool_diameters_mm)[0] for p in paths]
+        return [{"moves": [], "messages": [], "printed": [], "error": [
+            0, f"LinuxCNC's interpreter crashed (exit {r.returncode})"], "seconds": 0.0}]
     return json.loads(r.stdout)
 
 
 def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.0,
-                 machine_zero_mm=(0.0, 0.0, 0.0), said: list | None = None):
+                 machine_zero_mm=(0.0, 0.0, 0.0), said: list | None = None,
+                 printed: list | None = None, tool_diameters_mm=None):
     """LinuxCNC's canonical moves of program ``text`` in woodcam's canonical form
     (:mod:`.interpreter`): ``(moves, warnings)``; a refusal raises :class:`GcodeError` with
     LinuxCNC's message and line. ``machine_zero_mm``: the machine origin in the G54 frame
@@ -77,7 +84,10 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
     and would take machine zero at G-code zero (a ``G53 G0 Z-5`` retract 5 mm into the stock),
     where woodcam's interpreter takes a G53 Z move as a retract to the start height. ``said``,
     when given, receives LinuxCNC's operator messages (``(MSG,...)``, ``(DEBUG,...)``) as
-    ``(line, text)``, those before a refusal too."""
+    ``(line, text)``, those before a refusal too; ``printed`` its ``(PRINT,...)`` texts, which
+    it writes to its standard output, the same way. ``tool_diameters_mm``: the diameters of
+    its tool table by tool number (mm), what a DEBUG/PRINT shows for ``#5410`` of the loaded
+    tool (none loaded before an M6: LinuxCNC shows 0, as it does for a tool not given)."""
     g53 = _g53_lines(text) if machine_zero_mm is None else []
     if g53:
         raise GcodeError(g53[0], "G53", f"machine coordinates (G53, on line(s) {line_list(g53)}) "
@@ -90,10 +100,12 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
         p = Path(d) / "program.ngc"
         p.write_text(text)
         res = run_batch([p], start_mm=start_mm, timeout_s=timeout_s,
-                        machine_zero_mm=machine_zero_mm)[0]
+                        machine_zero_mm=machine_zero_mm, tool_diameters_mm=tool_diameters_mm)[0]
     warnings = []
     if said is not None:
         said += [(int(ln), m.strip()) for ln, m in res["messages"]]
+    if printed is not None:
+        printed += [(int(ln), m.strip()) for ln, m in res["printed"]]
     if res["error"]:
         line, msg = res["error"]
         if msg != NO_END:
