@@ -599,3 +599,31 @@ def test_a_message_shows_the_diameter_of_the_users_tool_table(tmp_path, monkeypa
     assert [ln for ln in err.splitlines() if "message" in ln] == [
         "woodcam: message: dia.nc line 3: dia 6.350000",
         "woodcam: message: dia.nc line 9: dia 3.500000"]
+
+
+def test_a_message_shows_the_diameter_of_a_tool_without_a_number(tmp_path, monkeypatch, capsys):
+    """A --tool SPEC without a number cuts the program's tool numbers no other --tool gives,
+    in the order it uses them (one alone: also a program without a T word), but a (DEBUG,...)
+    or (PRINT,...) of #5410 said '[#5410: T1's diameter, from the machine's tool table]' with a
+    warning to give the tool it was given. It shows that tool's diameter now."""
+    _stub_preview(monkeypatch, {})
+    two = tmp_path / "two.nc"
+    two.write_text("G21 G90\nT1 M6\n(DEBUG, dia #5410)\nG0 X10 Y10 Z5 M3 S9000\nG1 Z-1 F600\n"
+                   "G1 X30\nG0 Z5\nT7 M6\n(PRINT, dia #5410)\nG1 Z-1\nT9 M6\n"
+                   "(DEBUG, dia #5410)\nG1 X40\nM2\n")
+    none = tmp_path / "none.nc"
+    none.write_text("G21 G90\n(DEBUG, dia #5410)\nG0 X10 Y10 Z5 M3 S9000\nG1 Z-1 F600\nG1 X30\n"
+                    "M2\n")
+    for path, tools, said in (
+            (two, ["flat:4", "7=ball:3.5", "flat:2"], ["line 3: dia 4.000000",
+                                                       "line 12: dia 2.000000"]),
+            (none, ["flat:6.35"], ["line 2: dia 6.350000"])):
+        args = _parse([str(path), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+                       *[w for t in tools for w in ("--tool", t)], "--cell-size", "0.5"])
+        assert args.func(args) == 0
+        err = capsys.readouterr().err
+        assert [ln for ln in err.splitlines() if "message" in ln] == [
+            f"woodcam: message: {path.name} {m}" for m in said], err
+        assert "#5410" not in err
+        if path == two:
+            assert f"woodcam: print: {path.name} line 9: dia 3.500000" in err

@@ -139,6 +139,25 @@ def _numbered_tools(args) -> dict:
     return tools
 
 
+def _unnumbered_diameters(args, program, diameters) -> dict:
+    """The diameters (mm) of the tools without a number (--tool SPEC) by the tool numbers
+    ``program`` gets them for (:func:`_tools_from_args`: the numbers it uses without a tool,
+    in order; one tool alone is the tool of a program without a T word, tool 0), those not in
+    ``diameters``; empty when the program says and prints nothing, where they would show
+    (a DEBUG/PRINT of #5410, the loaded tool's diameter), or when they do not fit (refused
+    later, after its messages, by _tools_from_args)."""
+    from .options import parse_tool_option
+
+    if not (program.messages or program.printed) or all(
+            parse_tool_option(item)[0] is not None for item in args.tool):
+        return {}
+    try:
+        tools = _tools_from_args(args, program)
+    except WoodcamError:
+        return {}
+    return {n: t.diameter_mm for n, t in tools.items() if n not in diameters}
+
+
 def _tools_from_args(args, program) -> dict:
     from .options import parse_tool_option
 
@@ -214,6 +233,12 @@ def run(args) -> int:
                                  interpreter=args.interpreter,
                                  machine_zero_mm=args.machine_zero,
                                  tool_diameters_mm=diameters)
+            more = _unnumbered_diameters(args, program, diameters)
+            if more:  # what its messages show for #5410: read again with the tools it is given
+                program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
+                                     interpreter=args.interpreter,
+                                     machine_zero_mm=args.machine_zero,
+                                     tool_diameters_mm={**diameters, **more})
         except GcodeError as err:  # which of the programs: "G-code line 5" alone does not say
             raise GcodeError(err.line, err.word, err.rule, err.fix, source=str(path)) from None
         t_read = time.perf_counter() - t0
