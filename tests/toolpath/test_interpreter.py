@@ -1252,6 +1252,23 @@ def test_a_warned_line_in_a_loop_is_warned_once_with_its_passes():
     assert ran == [["500"], ["500"], ["3"]]
     assert len(read_gcode("G0 X0 Y0 Z5\n" + text).warnings) == 3  # (the public reader too)
 
+
+def test_the_warnings_not_warned_per_pass_are_one_in_a_100_pass_loop():
+    """The warnings interpreter.py appends to its list itself, not through Interpreter.warn
+    (the once-per-line-and-text warning with a pass count), are said once in a 100-pass
+    o100 while loop: an O word after a comment in a branch not taken (read before the run),
+    the G53 moves placed without the machine zero (summed up after it, naming their lines
+    once), and a T without M6 (once per tool)."""
+    text = ("G0 X0 Y0 Z5\n#1=0\no100 while [#1 lt 100]\nG53 G0 Z-5\nG53 G0 X1\nT2\n"
+            "G1 Z-1 F100\no200 if [#1 lt 0]\n(note) o7 if [1]\no200 endif\n#1=[#1+1]\n"
+            "o100 endwhile\nM2\n")
+    interp = Interpreter(text, start_mm=(0, 0, 10), machine_zero_mm=None)
+    interp.run()
+    assert [(ln, w.split(" ")[0]) for ln, w in interp.warnings] == [
+        (9, "'o7"), (7, "T2"), (4, "G53"), (5, "G53")]
+    assert [w.split(":")[0] for _, w in interp.warnings[2:]] == [
+        "G53 (machine coordinates) on line(s) 4", "G53 (machine coordinates) on line(s) 5"]
+
 def test_tool_table_entries_in_a_message_say_what_they_are_or_the_users_diameter():
     """LinuxCNC shows the loaded tool's entry of the machine's tool table for #5401-#5413 in a
     DEBUG/PRINT (the table's values, whatever G20; rs274 -t in test_linuxcnc_oracle.py);
