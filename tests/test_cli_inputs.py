@@ -21,7 +21,7 @@ CASES: dict[tuple[str, str], list[str]] = {
     ("bake", "PART"): ["bake", "ARG", "--block", "builtin:flat-sawn", "--out", "OUT/b.glb"],
     ("bake", "--block"): ["bake", "FILE.stl", "--block", "ARG", "--out", "OUT/b.glb"],
     ("preview", "MESH"): ["preview", "ARG", "--screenshot", "OUT/p.png"],
-    ("preview", "--block"): ["preview", "FILE", "--block", "ARG", "--screenshot", "OUT/p.png"],
+    ("preview", "--block"): ["preview", "FILE.glb", "--block", "ARG", "--screenshot", "OUT/p.png"],
     ("gcode", "PROGRAM"): ["gcode", "FILE", "ARG", "--tool", "flat:6", "--block", "builtin:flat-sawn",
                            "--out", "OUT/g.glb"],
     ("gcode", "--block"): ["gcode", "FILE", "--tool", "flat:6", "--block", "ARG", "--out", "OUT/g.glb"],
@@ -150,11 +150,13 @@ def _suffixed() -> dict[tuple[str, str], tuple[str, ...]]:
     from woodcam.cad.parts import SUPPORTED_SUFFIXES
     from woodcam.cli.woodify import _MESH_SUFFIXES
     from woodcam.review import PART_SUFFIXES
+    from woodcam.view.scene import MESH_SUFFIXES
 
     woodify = (*_MESH_SUFFIXES, *(s for s in SUPPORTED_SUFFIXES if s not in _MESH_SUFFIXES))
     return {("bake", "PART"): SUPPORTED_SUFFIXES, ("place", "PART"): SUPPORTED_SUFFIXES,
             ("gcode", "--part"): SUPPORTED_SUFFIXES, ("woodify", "PART"): woodify,
-            ("woodify", "--obstacle"): woodify, ("review", "PART"): PART_SUFFIXES}
+            ("woodify", "--obstacle"): woodify, ("review", "PART"): PART_SUFFIXES,
+            ("preview", "MESH"): MESH_SUFFIXES}
 
 
 def test_every_input_file_whose_reader_takes_some_suffixes_says_which_at_the_door():
@@ -168,7 +170,8 @@ def test_every_input_file_whose_reader_takes_some_suffixes_says_which_at_the_doo
 def test_an_input_file_of_a_suffix_its_command_cannot_read_is_a_usage_error_before_any_work(
         key, tmp_path, capsys, monkeypatch):
     """'woodcam bake part.dwg' exited 1 from the part loader, once the command ran (place and
-    gcode --part after the block was opened, woodify after its checks): a file the command
+    gcode --part after the block was opened, woodify after its checks; 'woodcam preview
+    some.dwg' from the mesh reader, '... could not read a mesh ...'): a file the command
     cannot read by its suffix is a wrong command line. The refusal names the argument, the
     suffix and the suffixes the reader takes."""
     given = tmp_path / "in" / "there.dwg"

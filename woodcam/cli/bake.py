@@ -13,6 +13,13 @@ from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_opti
                       remove_stale_outputs, stock_options, vector_type, write_screenshot)
 
 
+def _mesh_suffixes() -> tuple[str, ...]:
+    """What preview reads (:data:`woodcam.view.scene.MESH_SUFFIXES`), for the input door."""
+    from ..view.scene import MESH_SUFFIXES  # here only: --help imports no numpy
+
+    return MESH_SUFFIXES
+
+
 def register(subparsers) -> None:
     """Add ``demo``, ``bake``, ``preview``, ``blocks`` and ``species``."""
     p = subparsers.add_parser("demo", help="carve the example parts out of built-in blocks into --out",
@@ -63,7 +70,9 @@ def register(subparsers) -> None:
                               description="Open a baked GLB/OBJ in a window with a cut-plane "
                               "widget that shows the wood inside the block; --screenshot renders "
                               "off-screen.")
-    add_input(p, "mesh", kind="file", type=Path, help="baked .glb (or .obj)")
+    # its reader's suffixes at the door: 'preview some.dwg' exited 1 from the mesh reader
+    add_input(p, "mesh", kind="file", suffixes=_mesh_suffixes, type=Path,
+              help="baked .glb (or .obj; another program's .gltf, .ply, .stl or .off)")
     # the same [PNG] form as bake's and gcode's --screenshot (issue 17)
     p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
                    help="render off-screen to this PNG instead of opening a window (default "

@@ -3,7 +3,7 @@
 Data form. The part is a ``trimesh.Trimesh`` in the block frame (mm, ``docs/conventions.md``:
 origin bottom-front-left, ``+X`` width ``W``, ``+Y`` depth ``D``, ``+Z`` up ``H``), usually with
 ``TextureVisuals`` (``uv : (n_vertices, 2)`` with ``v = 1`` at the top row of the image, and a
-PIL material image), or a path to a ``.glb`` / ``.obj`` / ``.ply`` / ``.stl`` holding one. The
+PIL material image), or a path to a file of :data:`MESH_SUFFIXES` holding one. The
 block is the box ``[0, W] x [0, D] x [0, H]`` given by ``size_mm = (W, D, H)``. The optional
 ``wood`` answers ``wood.color(points_mm (n, 3), normals (n, 3)) -> rgb (n, 3)`` floats in
 ``[0, 1]`` (``docs/architecture.md``); the view never looks inside it.
@@ -66,6 +66,11 @@ BLOCK_OPACITY = 0.15
 #: block, half a pixel in the 1280 px preview, and some 3x the 24-bit depth buffer's step at
 #: the framed distance even with the near plane at far / 1000 (VTK keeps it much nearer).
 BLOCK_OUTSET = 5e-4
+
+#: The suffixes of the mesh files :func:`preview` reads (woodcam's own GLB/OBJ, another
+#: program's file through trimesh): the one list of its reader and of ``woodcam preview``'s
+#: input door (:func:`woodcam.cli.options.add_input`).
+MESH_SUFFIXES = (".glb", ".gltf", ".obj", ".ply", ".stl", ".off")
 
 #: Colours (RGB 0..1) of the block box, its edges, and a part that carries no texture.
 BLOCK_COLOR = (0.80, 0.70, 0.55)
@@ -209,7 +214,7 @@ def _load_mesh(mesh_or_path):
         path = Path(mesh_or_path)
         if not path.is_file():
             raise WoodcamError(
-                f"mesh_or_path: no file at {str(path)!r}; pass a .glb/.obj/.ply/.stl file "
+                f"mesh_or_path: no file at {str(path)!r}; pass a {'/'.join(MESH_SUFFIXES)} file "
                 "written by woodcam (e.g. out/part.glb) or a trimesh.Trimesh"
             )
         from woodcam.export import load_textured, written_by_woodcam
@@ -223,7 +228,7 @@ def _load_mesh(mesh_or_path):
         except Exception as err:  # trimesh raises many types for unreadable files
             raise WoodcamError(
                 f"mesh_or_path: could not read a mesh from {str(path)!r} ({err}); "
-                "pass a .glb/.obj/.ply/.stl file"
+                f"pass a {'/'.join(MESH_SUFFIXES)} file"
             ) from err
         mesh_or_path = loaded if ours else foreign_gltf_in_block_frame(loaded, path, stacklevel=2)
     if isinstance(mesh_or_path, trimesh.Scene):
