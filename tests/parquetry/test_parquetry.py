@@ -652,6 +652,10 @@ def test_a_job_files_block_specs_are_written_absolute_and_read_from_its_folder(t
     (tmp_path / "jobs" / "job.json").write_text(json.dumps(
         {"targets": [{"filename": "t.png"}], "woodcam": {"blocks": [{"spec": s} for s in specs]}}))
     monkeypatch.chdir(tmp_path / "out")
+    for name in ("blk", "logs", "grown"):  # there, as read_job refuses a path that is not
+        (tmp_path / "jobs" / name).mkdir()
+    (tmp_path / "jobs" / "logs" / "l.json").touch()
+    (tmp_path / "jobs" / "grown" / "field.npz").touch()
     read = [b["spec"] for b in read_job(tmp_path / "jobs" / "job.json").blocks]
     jobs = tmp_path / "jobs"
     assert read == [f"{jobs}/blk~z90", f"log:{jobs}/logs/l.json@2:60x40x20", f"woodify:{jobs}/grown/field.npz",

@@ -103,6 +103,44 @@ def test_no_target_or_no_veneers_is_a_usage_error_before_any_work(scans, capsys,
     assert not (scans / "o").exists()
 
 
+@pytest.mark.parametrize("key, missing, entries, typed", [
+    ("targets[0].filename", "nope.png", {"targets": [{"filename": "nope.png"}], "source_textures": [
+        {"texture": "light.png", "dpi": 300}]}, ["{d}/nope.png", "--veneer", "{d}/light.png"]),
+    ("source_textures[0].texture", "nope.png", {"source_textures": [{"texture": "nope.png", "dpi": 300}]},
+     ["{d}/coffee.png", "--veneer", "{d}/nope.png:300"]),
+    ("source_textures[0].mask", "nope.png", {"source_textures": [{"texture": "light.png", "dpi": 300, "mask": "nope.png"}]},
+     ["{d}/coffee.png", "--veneer", "{d}/light.png:300:{d}/nope.png"]),
+    ("woodcam.mokume[0]", "nope", {"woodcam": {"mokume": ["nope"]}}, ["{d}/coffee.png", "--veneer-from", "{d}/nope"]),
+    ("woodcam.blocks[0].spec", "nope", {"woodcam": {"blocks": [{"spec": "nope"}]}},
+     ["{d}/coffee.png", "--veneer-from", "{d}/nope"]),
+    ("woodcam.blocks[0].spec", "nope/field.npz", {"woodcam": {"blocks": [{"spec": "woodify:nope/field.npz"}]}},
+     ["{d}/coffee.png", "--veneer-from", "woodify:{d}/nope/field.npz"]),
+])
+def test_a_missing_path_in_a_config_job_is_a_usage_error_as_on_the_command_line(
+        scans, capsys, monkeypatch, key, missing, entries, typed):
+    """A --config job file naming a target, texture, mask, Mokume folder or block that is not
+    there exited 1 (a block's after the job's scans were read) where the same path typed on the
+    command line exits 2: the job file is part of the command line, so it is a usage error too,
+    one line naming --config, the job file, the entry and the path, before any work."""
+    import woodcam.parquetry.job as job_module
+
+    job = scans / "job.json"
+    job.write_text(json.dumps({"targets": [{"filename": "coffee.png"}], **entries}))
+    monkeypatch.setattr(job_module, "job_veneers", lambda *a, **k: pytest.fail("the veneers were read"))
+    out = scans / "o"
+    for argv, said in ((typed, "does not exist"), (["--config", str(job)], f"--config of 'woodcam parquetry': job file "
+                                                   f"{str(job)!r}: {key} ")):
+        argv = ["parquetry"] + [a.format(d=scans) for a in argv] + ["--out", str(out), "--quiet"]
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith("woodcam: error: ") and said in err, err
+        assert not out.exists()
+    assert f"no such file {str(scans / missing)!r}" in err, err
+    with pytest.raises(job_module.JobPathError) as raised:  # the library's: a plain WoodcamError
+        job_module.read_job(job)
+    assert isinstance(raised.value, WoodcamError) and raised.value.key == key
+
+
 @pytest.mark.parametrize("value, said", [
     ("{d}/light.png:abc", "the resolution must be a DPI (e.g. 300) or Npx/mm (e.g. 4px/mm), finite and > 0; got 'abc'"),
     ("{d}/light.png:0", "finite and > 0; got '0'"),

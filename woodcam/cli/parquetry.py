@@ -292,6 +292,7 @@ def run(args) -> int:
     from ..errors import UsageError, WoodcamError
     from ..parquetry.engine import SheetTooSmallError, build_parquetry
     from ..parquetry.job import (
+        JobPathError,
         LeavesPastBlockError,
         ParquetryJob,
         job_targets,
@@ -300,7 +301,11 @@ def run(args) -> int:
     )
     from ..parquetry.output import format_summary, write_parquetry
 
-    job = read_job(args.config) if args.config else ParquetryJob()
+    try:
+        job = read_job(args.config) if args.config else ParquetryJob()
+    except JobPathError as err:  # the job file is part of the command line: a path it names that
+        # is not there is refused as the same path typed here (exit 2; it was exit 1)
+        raise UsageError(f"--config of 'woodcam parquetry': {err}") from err
     # what to rebuild and from what, given by neither the command line nor a job file: a wrong
     # command line (exit 2), said before any work (it was exit 1, after the scans were read)
     if not (args.target or job.targets):

@@ -28,7 +28,7 @@ from typing import Literal
 import numpy as np
 
 from .._checks import check_path
-from .._specs import absolute_spec
+from .._specs import absolute_spec, spec_path
 from ..errors import WoodcamError, WoodcamWarning
 from ..limits import MAX_BLOCK_SIZE_MM
 from ..tolerances import IN_BLOCK_RTOL
@@ -357,6 +357,18 @@ class ParquetryJob:
     params: ParquetryParams = field(default_factory=ParquetryParams)
 
 
+class JobPathError(WoodcamError):
+    """A path a job file names (a target, a texture or its mask, a Mokume folder, a block spec's
+    folder or file) that does not exist (:func:`read_job`): ``job`` the job file, ``key`` the
+    entry (``source_textures[0].texture``), ``path`` as written. ``woodcam parquetry --config``
+    says it as a wrong command line (exit 2), as the same path typed there; a script's job file
+    is no command line, so the library raises this plain WoodcamError."""
+
+    def __init__(self, message: str, *, job: str = "", key: str = "", path: str = ""):
+        super().__init__(message)
+        self.job, self.key, self.path = job, key, path
+
+
 def read_job(path: str | Path) -> ParquetryJob:
     """Read a job file (paper layout + ``"woodcam"`` extras); paths resolved against its folder."""
     from .._readers import read_json_object
@@ -425,15 +437,20 @@ def read_job(path: str | Path) -> ParquetryJob:
             check_veneer_id(t["id"], f"{where} source_textures[{i}].id")
     # found at the door, each named by its entry: a missing file was 'cannot decode the image ...
     # the file is damaged' after the job's other files were read
-    named = [(f"source_textures[{i}].{k}", t.get(k)) for i, t in enumerate(scans) for k in ("texture", "mask")]
-    named += [(f"targets[{i}].filename", t["filename"]) for i, t in enumerate(targets)]
-    named += [(f"woodcam.mokume[{i}]", m) for i, m in enumerate(mokume)]
-    for key, s in named:
-        if s and not Path(_abs(s)).exists():
-            here = (f"; {s!r} is there from the working folder: give the path from the job file's folder, "
-                    "or an absolute one") if not Path(s).is_absolute() and Path(s).exists() else ""
-            raise WoodcamError(f"{where} {key} {s!r}: no such file {_abs(s)!r} (a job file's paths are "
-                               f"relative to its folder){here or '; check the path'}")
+    named = [(f"source_textures[{i}].{k}", t.get(k), t.get(k)) for i, t in enumerate(scans)
+             for k in ("texture", "mask")]
+    named += [(f"targets[{i}].filename", t["filename"], t["filename"]) for i, t in enumerate(targets)]
+    named += [(f"woodcam.mokume[{i}]", m, m) for i, m in enumerate(mokume)]
+    # a block spec's folder, log or woodify file: it was the block's opening error, after the
+    # job's scans were read (a built-in block or the shared log names none)
+    named += [(f"woodcam.blocks[{i}].spec", b["spec"], str(spec_path(str(b["spec"])) or ""))
+              for i, b in enumerate(blocks)]
+    for key, s, p_ in named:
+        if p_ and not Path(_abs(p_)).exists():
+            here = (f"; {p_!r} is there from the working folder: give the path from the job file's folder, "
+                    "or an absolute one") if not Path(p_).is_absolute() and Path(p_).exists() else ""
+            raise JobPathError(f"{where} {key} {s!r}: no such file {_abs(p_)!r} (a job file's paths are "
+                               f"relative to its folder){here or '; check the path'}", job=str(p), key=key, path=s)
 
     # the reference code's id is optional: the file's stem, as for --veneer (a texture without
     # one was a KeyError from the CLI)
