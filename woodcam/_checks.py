@@ -13,11 +13,29 @@ from __future__ import annotations
 import math
 import numbers
 import os
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 import numpy as np
 
 from .errors import WoodcamError
+
+
+def did_you_mean(given: str | Iterable[str], names: Iterable[str], *, n: int = 1,
+                 show: Callable[[str], str] = repr) -> str:
+    """``"did you mean X?"`` (``n`` > 1: ``"X or Y?"``) of the ``names`` closest to ``given``
+    (:func:`difflib.get_close_matches`, its 0.6 cutoff), each written by ``show``, or ``""``
+    when none is close: the one home of every near-name suggestion (a built-in block, a file
+    beside a missing one, a colour, a brush key). ``given`` may be several spellings, tried in
+    turn until one has a close name."""
+    import difflib
+
+    names = list(names)
+    for text in [given] if isinstance(given, str) else given:
+        near = difflib.get_close_matches(text, names, n=n)
+        if near:
+            return f"did you mean {' or '.join(map(show, near))}?"
+    return ""
 
 
 def _fail(name: str, rule: str, value, fix: str):

@@ -285,24 +285,24 @@ def _check_builtin(spec: str, name: str, args: argparse.Namespace) -> None:
 def _did_you_mean(path: Path, spec: str) -> str:
     """The fix of a missing input ``path``: a near name in its folder, a built-in block the spec
     may have meant, or where the path stops existing."""
-    import difflib
+    from .._checks import did_you_mean  # here only: --help imports no numpy
 
     if spec and not spec.startswith(("woodify:", "log:")):
-        from ..fields.builtin import BUILTIN_NAMES  # here only: --help imports no numpy
+        from ..fields.builtin import BUILTIN_NAMES
 
-        near = difflib.get_close_matches(spec, BUILTIN_NAMES, n=1)
+        near = did_you_mean(spec, BUILTIN_NAMES, show=lambda name: f"'builtin:{name}'")
         if near:
-            return f"did you mean 'builtin:{near[0]}'? ('woodcam blocks' lists the built-in blocks)"
+            return f"{near} ('woodcam blocks' lists the built-in blocks)"
     base = path.parent
     while not base.is_dir() and base != base.parent:
         base = base.parent
     if base != path.parent:  # its folder is missing too: say which part of the path is wrong
         return f"no folder {str(path.parent)!r} either; check the path"
     try:
-        near = difflib.get_close_matches(path.name, [p.name for p in base.iterdir()], n=1)
+        names = [p.name for p in base.iterdir()]
     except OSError:  # an unreadable folder: no suggestion
-        near = []
-    return f"did you mean {str(base / near[0])!r}?" if near else "check the path"
+        names = []
+    return did_you_mean(path.name, names, show=lambda name: repr(str(base / name))) or "check the path"
 
 
 def check_screenshot(args: argparse.Namespace) -> None:

@@ -92,11 +92,11 @@ def check_builtin_name(name: str) -> None:
     command line's door (:func:`woodcam.cli.options.check_inputs`)."""
     if name in BUILTIN_NAMES:
         return
-    import difflib
+    from .._checks import did_you_mean
 
-    near = difflib.get_close_matches(str(name), BUILTIN_NAMES, n=1)
+    near = did_you_mean(str(name), BUILTIN_NAMES, show=lambda b: f"'builtin:{b}'")
     raise WoodcamError(f"unknown built-in block {name!r}; choose one of: {', '.join(BUILTIN_NAMES)}"
-                       + (f"; did you mean 'builtin:{near[0]}'?" if near else ""))
+                       + (f"; {near}" if near else ""))
 
 
 def builtin_block(name: str) -> BuiltinBlock:

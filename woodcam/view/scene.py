@@ -33,7 +33,7 @@ import numpy as np
 
 from .._types import ArrayLike, Mesh, PathLike, WoodLike
 from ..errors import WoodcamError, require
-from .._checks import as_floats, check_bool, check_number, check_vector
+from .._checks import as_floats, check_bool, check_number, check_vector, did_you_mean
 from ..frames import check_size
 from ..tolerances import ON_FACE_TOL_MM
 from ..units import say_length
@@ -107,14 +107,10 @@ def _named_rgb(colour: str, who: str, name: str) -> tuple[np.ndarray | None, str
     try:
         rgba = colors.to_rgba(colour)
     except ValueError:
-        import difflib
-
         table = [*colors.CSS4_COLORS, *colors.TABLEAU_COLORS, *colors.XKCD_COLORS]
-        close = difflib.get_close_matches("".join(colour.lower().replace("_", " ").split()), table, 3)
-        if not close:  # 'royal blue', 'Royal_Blue': pyvista's spellings of matplotlib's names
-            close = difflib.get_close_matches(colour.lower(), table, 3)
-        return None, (f"did you mean {' or '.join(map(repr, close))}?" if close else
-                      "give a CSS4 name, e.g. 'royalblue' (matplotlib.colors.CSS4_COLORS), or a triple")
+        # 'royal blue', 'Royal_Blue' (pyvista's spellings of matplotlib's names) joined first
+        close = did_you_mean(("".join(colour.lower().replace("_", " ").split()), colour.lower()), table, n=3)
+        return None, (close or "give a CSS4 name, e.g. 'royalblue' (matplotlib.colors.CSS4_COLORS), or a triple")
     if rgba[3] < 1:  # 'none', '#ff000080': the views draw colours opaque
         return None, "the views draw colours opaque; give one without transparency, e.g. '#ff0000'"
     return 255 * np.asarray(rgba[:3], float), ""

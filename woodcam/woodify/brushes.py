@@ -19,7 +19,6 @@ optional).
 
 from __future__ import annotations
 
-import difflib
 import json
 import numbers
 from dataclasses import dataclass, fields
@@ -27,7 +26,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._checks import check_path, check_vector
+from .._checks import check_path, check_vector, did_you_mean
 from .._readers import read_json_file
 from ..errors import WoodcamError
 from ..fields.base import check_points
@@ -105,8 +104,8 @@ def _refuse_unknown_keys(obj: dict, known, where: str, like: str) -> None:
     unknown = [k for k in obj if k not in known]
     if unknown:
         key = unknown[0]
-        near = difflib.get_close_matches(key, known, n=1)
-        hint = f"did you mean {near[0]!r}? " if near else ""
+        near = did_you_mean(key, known)
+        hint = f"{near} " if near else ""
         raise WoodcamError(f"{where} has an unknown key {key!r}" + (f" (of {len(unknown)})" if len(unknown) > 1 else "")
                            + f"; {hint}the keys are {', '.join(sorted(known))}; write it like {like}")
 
