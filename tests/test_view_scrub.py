@@ -177,6 +177,52 @@ def test_done_feeds_are_blue_rapids_red_and_the_stock_wears_its_wood():
         plotter.close()
 
 
+@pytest.mark.parametrize("colours, said", [
+    ({"feeds": "royalblu"}, "gcode_window: colours['feeds'] must be a colour name matplotlib knows ('royalblue', "
+                            "'tab:blue', 'xkcd:sky blue'), a hex string ('#4169e1') or an RGB triple"),
+    ({"feeds": "royalblu"}, "; got 'royalblu'; did you mean 'royalblue' or 'xkcd:royal blue'?"),
+    # pyvista's own spelling, which the other views refuse: refused here too, not drawn
+    ({"tip": "royal_blue"}, "colours['tip'] must be a colour name matplotlib knows"),
+    ({"tip": "royal_blue"}, "did you mean 'royalblue' or 'xkcd:royal blue' or 'aliceblue'?"),
+    ({"todo": (1, 0, 0)}, "ambiguous: whole numbers are read in 0..255"),
+    ({"rapid": "red"}, "gcode_window: colours has an unknown key 'rapid'; did you mean 'rapids'? the keys are "
+                       "feeds, rapids, todo, tip"),
+])
+def test_the_windows_colours_are_read_by_the_views_one_colour_rule(colours, said):
+    """The window handed its colour names straight to pyvista, whose table is not the views'
+    (matplotlib's, woodcam.view.scene.colour_rgb): a typo was pyvista's bare ValueError, a name
+    only pyvista knows was drawn where every other view refuses it, one only matplotlib knows
+    ('xkcd:sky blue') refused. Now every colour goes through colour_rgb, before any window."""
+    from woodcam.view.scrub import gcode_window
+
+    with pytest.raises(WoodcamError) as err:
+        gcode_window(read_gcode(PROG), parse_tool_spec("flat:6"), _Stock(), resolution_mm=0.5, off_screen=True,
+                     window_size=(160, 120), colours=colours)
+    assert said in str(err.value), err.value
+
+
+def test_the_windows_colours_are_drawn_as_the_other_views_draw_them():
+    """A name matplotlib knows and pyvista does not, a hex string and a 0..1 triple are drawn in
+    colour_rgb's colour; the keys not given keep PATH_COLOURS."""
+    from woodcam.view.scene import colour_rgb
+    from woodcam.view.scrub import DONE_ACTORS, PATH_COLOURS, TIP_ACTOR, TODO_ACTOR, ScrubCallback, gcode_window
+
+    colours = {"feeds": "xkcd:sky blue", "rapids": "#00ff00", "tip": (0.5, 0.25, 1.0)}
+    plotter, cb = gcode_window(read_gcode(PROG), parse_tool_spec("flat:6"), _Stock(), resolution_mm=0.5,
+                               off_screen=True, window_size=(160, 120), colours=colours)
+    try:
+        cb(8)
+        for name, key in ((DONE_ACTORS[0], "feeds"), (DONE_ACTORS[1], "rapids"), (TODO_ACTOR, "todo"),
+                          (TIP_ACTOR, "tip")):
+            want = colour_rgb(colours.get(key, PATH_COLOURS[key]), "test")
+            np.testing.assert_allclose(np.asarray(plotter.actors[name].GetProperty().GetColor()) * 255, want,
+                                       atol=0.5, err_msg=name)
+    finally:
+        plotter.close()
+    with pytest.raises(WoodcamError, match=r"^ScrubCallback: colours\['feeds'\] must be .*did you mean 'royalblue'"):
+        ScrubCallback(None, read_gcode(PROG), parse_tool_spec("flat:6"), _Stock(), colours={"feeds": "royalblu"})
+
+
 def test_the_stock_is_coloured_when_its_mesh_has_a_vertex_without_a_normal(monkeypatch):
     """The stock's vertices are coloured with normals the wood accepts (it refuses a zero one)
     whatever the height-field mesh holds: an unreferenced vertex (trimesh's normal there is

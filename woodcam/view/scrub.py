@@ -25,6 +25,34 @@ TODO_ACTOR = "woodcam-path-todo"
 TIP_ACTOR = "woodcam-tool-tip"
 #: Cells across the stock mesh of the window (a 1280-pixel window shows about this many).
 WINDOW_GRID_CELLS = 400
+#: The window's colours (``colours=`` replaces any of them), read by the views' one colour rule
+#: (:func:`woodcam.view.scene.colour_rgb`), never by pyvista's own: done feeds and rapids (as
+#: the screenshots' overlay), the moves still to come (drawn half transparent), the tool tip.
+PATH_COLOURS = {"feeds": "royalblue", "rapids": "red", "todo": "lightgrey", "tip": "orange"}
+
+
+def _path_colours(colours, who: str) -> dict[str, tuple[float, float, float]]:
+    """:data:`PATH_COLOURS` with ``colours`` (a dict of some of its keys, or None) in their
+    place, each as the 0..1 floats handed to pyvista by :func:`woodcam.view.scene.colour_rgb`'s
+    rule (a name pyvista alone knows, 'royal_blue', is refused with the close matches, as in
+    the other views; one matplotlib alone knows, 'xkcd:sky blue', is drawn). A WoodcamError
+    naming ``who``, the key and the value, with the close key for one not in the table. The
+    window handed its names straight to pyvista."""
+    from .._checks import did_you_mean
+    from .scene import _pyvista_rgb
+
+    if colours is None:
+        colours = {}
+    if not isinstance(colours, dict):
+        raise WoodcamError(f"{who}: colours must be a dict of some of {', '.join(PATH_COLOURS)} to a colour, "
+                           f"e.g. {{'feeds': 'tab:blue'}}; got {colours!r:.60}")
+    unknown = [k for k in colours if k not in PATH_COLOURS]
+    if unknown:
+        near = did_you_mean(str(unknown[0]), PATH_COLOURS)
+        raise WoodcamError(f"{who}: colours has an unknown key {unknown[0]!r}; "
+                           + (f"{near} " if near else "") + f"the keys are {', '.join(PATH_COLOURS)}")
+    return {key: _pyvista_rgb(colours.get(key, default), who, f"colours[{key!r}]")
+            for key, default in PATH_COLOURS.items()}
 
 
 class ScrubCallback:
@@ -36,14 +64,16 @@ class ScrubCallback:
     ``initial_heightmap`` is the stock earlier programs of the job left; ``heightmap``, when
     given, the stock already simulated up to source line ``line`` (the last line when None; the
     CLI has it), so a first call at that line draws it without simulating the program again.
+    ``colours`` replaces some of :data:`PATH_COLOURS` (:func:`_path_colours`).
     After a call, :attr:`line` is the line shown and :attr:`heightmap` its stock.
     """
 
     def __init__(self, plotter, program, tools, stock, *, work_offset_mm=None,
                  resolution_mm: float = 0.1, initial_heightmap=None, heightmap=None,
-                 line: int | None = None):
+                 line: int | None = None, colours: dict | None = None):
         if not len(program):
             raise WoodcamError("ScrubCallback: the program has no moves; nothing to scrub")
+        self.colours = _path_colours(colours, "ScrubCallback")
         self.plotter = plotter
         self.program = program
         self.tools = tools
@@ -89,9 +119,9 @@ class ScrubCallback:
                    diffuse=0.7, specular=0.05)
         done = self.program.line <= self.line
         feed = self.program.kind == 1
-        for name, sel, colour in ((DONE_ACTORS[0], done & feed, "royalblue"),
-                                  (DONE_ACTORS[1], done & ~feed, "red"),
-                                  (TODO_ACTOR, ~done, "lightgrey")):
+        for name, sel, colour in ((DONE_ACTORS[0], done & feed, self.colours["feeds"]),
+                                  (DONE_ACTORS[1], done & ~feed, self.colours["rapids"]),
+                                  (TODO_ACTOR, ~done, self.colours["todo"])):
             if sel.any():
                 p.add_mesh(_lines(pv, self._seg[sel]), color=colour, line_width=1.0,
                            name=name, opacity=1.0 if name != TODO_ACTOR else 0.5)
@@ -100,7 +130,7 @@ class ScrubCallback:
         k = np.flatnonzero(done)
         if len(k):
             tip = self._seg[k[-1], 1]
-            p.add_mesh(pv.Sphere(radius=0.01 * max(self.size_mm), center=tip), color="orange",
+            p.add_mesh(pv.Sphere(radius=0.01 * max(self.size_mm), center=tip), color=self.colours["tip"],
                        name=TIP_ACTOR)
         else:
             p.remove_actor(TIP_ACTOR)
@@ -157,23 +187,26 @@ def check_display() -> None:
 
 def gcode_window(program, tools, stock, *, work_offset_mm=None, resolution_mm: float = 0.1,
                  initial_heightmap=None, until_line: int | None = None, heightmap=None,
-                 window_size: tuple[int, int] = (1280, 960), off_screen: bool = False):
+                 window_size: tuple[int, int] = (1280, 960), off_screen: bool = False,
+                 colours: dict | None = None):
     """Open the G-code window (stock, toolpath, line slider, view keys) at ``until_line`` (the
     last line when None); returns ``(plotter, callback)`` after it closes. ``heightmap``: the
     stock already simulated up to ``until_line``, shown first without simulating again
     (:class:`ScrubCallback`). ``off_screen`` builds it without showing (tests drive the
-    :class:`ScrubCallback` as the slider would)."""
+    :class:`ScrubCallback` as the slider would). ``colours`` replaces some of
+    :data:`PATH_COLOURS`, checked before the window opens (:func:`_path_colours`)."""
     from .camera import set_camera
     from .scene import _pyvista, add_view_keys
 
     pv = _pyvista()
+    colours = _path_colours(colours, "gcode_window")  # before any window
     if not off_screen:
         check_display()
     plotter = pv.Plotter(off_screen=off_screen, window_size=window_size,
                          title="woodcam gcode")
     callback = ScrubCallback(plotter, program, tools, stock, work_offset_mm=work_offset_mm,
                              resolution_mm=resolution_mm, initial_heightmap=initial_heightmap,
-                             heightmap=heightmap, line=until_line)
+                             heightmap=heightmap, line=until_line, colours=colours)
     add_line_slider(plotter, callback, value=until_line)
     W, D, H = callback.size_mm
     set_camera(plotter, "iso", (0.0, W, 0.0, D, 0.0, H))
