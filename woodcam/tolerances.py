@@ -266,6 +266,12 @@ RING_HISTORY_MIN_STEP = 1e-3
 #: nodes) with a node to spare, which both fast marchers start from.
 WOODIFY_BAND_NODES = 2
 
+#: Distance (voxels) within which a grid node lies ON the input surface for the isotropic fast
+#: march, which then starts it as just inside (at minus this distance). Floating point puts the
+#: nodes of a face on a node plane 0 or ~1e-15 voxel from it, on either side; 1e-6 voxel is far
+#: above that noise and moves the surface by nothing a section or a mesh can show.
+WOODIFY_ON_SURFACE_VOXELS = 1e-6
+
 #: Clearance (voxels) the grown solid keeps from obstacles. The signed distance of a convex
 #: obstacle is convex, so its linear interpolation between two nodes crosses zero slightly
 #: INSIDE the obstacle (by the sagitta, h^2 / 8a for a rod of radius a: 0.04 h at a = 3 h);

@@ -36,7 +36,7 @@ import numpy as np
 from .._checks import check_number
 from ..errors import WoodcamError
 from ..limits import WOODIFY_RESOLUTION_RANGE
-from ..tolerances import WOODIFY_BAND_NODES, WOODIFY_OBSTACLE_CLEARANCE_VOXELS
+from ..tolerances import WOODIFY_BAND_NODES, WOODIFY_OBSTACLE_CLEARANCE_VOXELS, WOODIFY_ON_SURFACE_VOXELS
 from ..units import say_length
 
 Method = Literal["auto", "fmm", "offset", "anisotropic"]
@@ -61,12 +61,22 @@ class VoxelGrid:
 
     @classmethod
     def around(cls, lo_mm, hi_mm, resolution: int) -> VoxelGrid:
-        """Grid covering the box ``[lo_mm, hi_mm]`` with ``resolution`` nodes on its longest side."""
+        """Grid covering the box ``[lo_mm, hi_mm]`` with ``resolution`` nodes on its longest side,
+        centred on the box: a shorter side's whole number of steps overshoots it by under one
+        step, split evenly between its two ends.
+
+        That overshoot was all on the high end (origin at ``lo_mm``): a box centred in the grid's
+        box then met the nodes differently at its two ends (one face on a node plane, the other
+        between two), and the front's error there differs, so a centred 40x22x30 box grew 0.27
+        of a step off-centre (``woodcam woodify`` at resolution 27). Centred, a mirror-symmetric
+        input meets the nodes the same way at both ends and grows as symmetric."""
         lo, hi = np.asarray(lo_mm, float), np.asarray(hi_mm, float)
         resolution = check_resolution(resolution)
         h = float(np.max(hi - lo)) / (resolution - 1)
-        shape = tuple(int(np.ceil((hi[d] - lo[d]) / h)) + 1 for d in range(3))
-        return cls(tuple(lo), h, shape)
+        # the longest side is resolution - 1 steps exactly (a last-bit excess is no extra node)
+        steps = np.maximum(np.ceil((hi - lo) / h - 1e-9), 0)
+        origin = (lo + hi) / 2 - steps * h / 2
+        return cls(tuple(float(v) for v in origin), h, tuple(int(n) + 1 for n in steps))
 
     def axes(self) -> list[np.ndarray]:
         """Node coordinates (mm) along X, Y, Z."""
@@ -246,13 +256,21 @@ def propagate(mesh, grid: VoxelGrid, *, wind=None, gain=None, obstacles=(), meth
         raise WoodcamError("method 'fmm' (scikit-fmm) solves the isotropic case only; with "
                            "eccentricity or brushed directions use method 'anisotropic' or 'auto'")
     d_in = np.where(np.isfinite(dist), dist, WOODIFY_BAND_NODES * h)
+    # The march starts from the nodes inside AND those on the surface (a face on a node plane:
+    # an axis-aligned box's, wherever the grid puts one). Those were inside or outside as the
+    # parity test's nudge fell: inside on the faces met from below, outside on those met from
+    # above (distance 0 or ~1e-15 either way). Started outside, such a face grew half a step too
+    # far (scikit-fmm's second-order start; the anisotropic march's exact first layer began a
+    # layer late), so a 40x30x20 box centred in its grid grew 0.18 of a step off-centre; started
+    # from, each face grows the same at both ends, within 0.1 step of the exact offset.
+    start = inside | ((d_in <= WOODIFY_ON_SURFACE_VOXELS * h) & ~obstacle)
     if method == "fmm":
-        T = _fmm(d_in, inside, obstacle, g, h, stop_mm)
+        T = _fmm(d_in, start, obstacle, g, h, stop_mm)
     elif method == "offset":
-        T = _offset(d_in, inside, w, grid, stop_mm)
+        T = _offset(d_in, start, w, grid, stop_mm)
     else:
-        T = _anisotropic(d_in, closest, inside, obstacle, g, w, grid, stop_mm)
-    T[inside] = -d_in[inside]
+        T = _anisotropic(d_in, closest, start, obstacle, g, w, grid, stop_mm)
+    T[start] = -d_in[start]
     if obstacles:
         T = _fill_obstacle(T, obstacle)
     return Front(grid, T, inside, obstacle, obst_sdf, closest, tri, method)
@@ -261,7 +279,8 @@ def propagate(mesh, grid: VoxelGrid, *, wind=None, gain=None, obstacles=(), meth
 def _fmm(d_in, inside, obstacle, g, h, stop_mm):
     import skfmm
 
-    phi = np.where(inside, -d_in, d_in)
+    # ``inside``: the march's start (inside or on the surface, see propagate), just inside
+    phi = np.where(inside, -np.maximum(d_in, WOODIFY_ON_SURFACE_VOXELS * h), d_in)
     phi = np.ma.MaskedArray(phi, obstacle)
     speed = np.broadcast_to(g, phi.shape).astype(float)
     narrow = float(stop_mm) if np.isfinite(stop_mm) else 0.0
