@@ -238,6 +238,42 @@ def test_an_open_mesh_in_a_file_of_several_is_named_with_its_option_and_file(tmp
     assert not (tmp_path / "o").exists()
 
 
+def test_meshes_touching_at_a_single_vertex_are_refused_as_a_non_manifold_union(tmp_path, capsys):
+    """Two closed tetrahedra in one GLB sharing exactly one corner (no edge): their welded union
+    has every edge shared by two triangles, so trimesh calls it watertight, and it grew without
+    a word, while the union's refusal says 'they touch along an edge or at a vertex'. Now the
+    pinched vertex is found (the triangles round it form two fans) and refused with that
+    refusal's fix, as an --obstacle too; one mesh (an STL) pinched the same way is refused with
+    its own fix, naming the point."""
+    tet = trimesh.Trimesh([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [0.0, 10.0, 0.0], [0.0, 0.0, 10.0]],
+                          [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    other = trimesh.Trimesh(-tet.vertices, tet.faces[:, ::-1])  # mirrored through the shared corner
+    assert tet.is_watertight and other.is_watertight and tet.volume > 0 and other.volume > 0
+    scene = trimesh.Scene()
+    scene.add_geometry(tet, geom_name="a")
+    scene.add_geometry(other, geom_name="b")
+    path = str(tmp_path / "corner.glb")
+    scene.export(path)
+    trimesh.creation.icosphere(subdivisions=2, radius=5.0).export(tmp_path / "ball.stl")
+    for what, args in (("part", [path]), ("--obstacle", [str(tmp_path / "ball.stl"), "--obstacle", path])):
+        assert main(["woodify", *args, "--years", "2", "--resolution", "16", "--cracks", "none",
+                     "--out", str(tmp_path / "o")]) == 1, what
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1, err
+        assert f"error: {what} {path!r} (the union of its 2 meshes) must be a manifold solid" in err, err
+        assert "1 vertex (the first at (0, 0, 0) mm)" in err and "non-manifold vertex" in err, err
+        assert "touch along an edge or at a vertex" in err and "non-manifold union" in err, err
+        assert "fill_holes" not in err, err
+    one = str(tmp_path / "corner.stl")
+    trimesh.util.concatenate([tet, other]).export(one)
+    assert main(["woodify", one, "--years", "2", "--resolution", "16", "--cracks", "none",
+                 "--out", str(tmp_path / "o")]) == 1
+    err = capsys.readouterr().err
+    assert f"error: part {one!r} must be a manifold solid" in err and "(0, 0, 0) mm" in err, err
+    assert "move those parts apart" in err and "fill_holes" not in err, err
+    assert not (tmp_path / "o").exists()
+
+
 def test_surface_and_crack_years_are_usage_errors_before_the_growth(tmp_path, capsys, monkeypatch):
     """--surface-years out of range or not numbers exited 1 (a failed run, not a wrong command
     line); a year given twice was grown, written and listed twice; --crack-years beyond --years

@@ -155,7 +155,7 @@ def _welded_closed(mesh, name: str, fix: str | None = None):
 
     geom = trimesh.Trimesh(mesh.vertices, mesh.faces, process=True)
     geom.merge_vertices(merge_tex=True, merge_norm=True)
-    return check_watertight(geom, name) if fix is None else check_watertight(geom, name, fix=fix)
+    return check_watertight(geom, name, fix=fix)
 
 
 def _check_mesh_values(mesh, path: str, what: str) -> None:

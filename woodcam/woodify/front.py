@@ -132,10 +132,38 @@ class Front:
     _trace_cache: tuple | None = dc_field(default=None, init=False, repr=False, compare=False)
 
 
-def check_watertight(mesh, name: str, *, fix: str = "repair it first (e.g. trimesh.repair."
-                     "fill_holes, or export a closed solid)"):
-    """Return ``mesh`` as a trimesh if it is a closed, consistently oriented volume, else raise
-    (``fix`` ends the message: a caller that knows why it is open says the fix that is)."""
+def pinched_vertices(mesh) -> np.ndarray:
+    """Indices ``(k,) int`` of the vertices of a watertight trimesh round which the triangles form
+    more than one fan (triangles joined by edges through the vertex): where two parts of it
+    touch at a single point, such as two closed meshes sharing one corner once welded. Every
+    edge of such a mesh is shared by exactly two triangles, so trimesh calls it watertight."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    faces = np.asarray(mesh.faces, np.int64)
+    pairs = np.asarray(mesh.face_adjacency, np.int64).reshape(-1, 2)
+    shared = np.asarray(mesh.face_adjacency_edges, np.int64).reshape(-1, 2)
+    # a triangle corner is node 3 f + k; two triangles sharing edge (a, b) join their corners at
+    # a and at b, so the corners round a vertex fall into one component per fan
+    ends = []
+    for side in (0, 1):
+        f = pairs[:, side]
+        ends.append(np.concatenate([3 * f + np.argmax(faces[f] == shared[:, e:e + 1], axis=1)
+                                    for e in (0, 1)]))
+    n = 3 * len(faces)
+    graph = coo_matrix((np.ones(len(ends[0]), np.int8), (ends[0], ends[1])), shape=(n, n))
+    _, fan = connected_components(graph, directed=False)
+    vertex_fans = np.unique(np.stack([faces.ravel(), fan], axis=1), axis=0)[:, 0]
+    vertex, count = np.unique(vertex_fans, return_counts=True)
+    return vertex[count > 1]
+
+
+def check_watertight(mesh, name: str, *, fix: str | None = None):
+    """Return ``mesh`` as a trimesh if it is a closed, consistently oriented manifold volume,
+    else raise: open or non-manifold edges, or a vertex where parts of it touch at one point
+    (:func:`pinched_vertices`, which trimesh's watertight test passes). ``fix`` ends the message
+    (default: the repair hint of each case): a caller that knows why it is not a manifold solid
+    says the fix that is."""
     import trimesh
 
     if not isinstance(mesh, trimesh.Trimesh):
@@ -150,7 +178,16 @@ def check_watertight(mesh, name: str, *, fix: str = "repair it first (e.g. trime
         raise WoodcamError(
             f"{name} must be watertight (every edge shared by exactly two triangles) so its inside "
             f"is defined; this one has {len(mesh.faces)} triangles and open or non-manifold "
-            f"edges; {fix}")
+            f"edges; {fix or 'repair it first (e.g. trimesh.repair.fill_holes, or export a closed solid)'}")
+    pinched = pinched_vertices(mesh)
+    if len(pinched):
+        at = say_length(np.asarray(mesh.vertices, float)[pinched[0]], ".4g", form="({}, {}, {})")
+        raise WoodcamError(
+            f"{name} must be a manifold solid (the triangles round each vertex forming one fan); this "
+            f"one has {len(mesh.faces)} triangles, and at {len(pinched)} "
+            f"vert{'ex' if len(pinched) == 1 else 'ices'} (the first at {at}) parts of it touch at a "
+            "single point (non-manifold vertex); "
+            f"{fix or 'move those parts apart (leave a gap) or merge them into one solid in the CAD program, and export again'}")
     return mesh
 
 
