@@ -238,6 +238,50 @@ def test_an_open_mesh_in_a_file_of_several_is_named_with_its_option_and_file(tmp
     assert not (tmp_path / "o").exists()
 
 
+def _longest_black_run(rows) -> int:
+    """Longest run of black pixels along any row of ``rows`` (r, c, 3) uint8."""
+    black = np.pad(rows.max(axis=-1) < 60, ((0, 0), (1, 1)))
+    edges = np.diff(black.astype(np.int8), axis=1)
+    return max(int((np.flatnonzero(e == -1) - np.flatnonzero(e == 1)).max(initial=0)) for e in edges)
+
+
+def test_scale_bar_is_a_round_length_in_the_units_drawn_under_the_picture():
+    from woodcam.woodify.surfaces import scale_bar_mm, with_scale_bar
+
+    # the longest 1-2-5 length at most a fifth of the width, in the units asked for
+    assert scale_bar_mm(72.0) == 10.0 and scale_bar_mm(100.0) == 20.0 and scale_bar_mm(30.0) == 5.0
+    assert scale_bar_mm(72.0, "inch") == pytest.approx(12.7)  # 0.5 in of a 2.83 in picture
+    assert scale_bar_mm(254.0, "inch") == pytest.approx(50.8)  # 2 in of 10 in
+    with pytest.raises(WoodcamError, match="width_mm must be a length > 0"):
+        scale_bar_mm(0.0)
+    picture = np.full((50, 640, 3), 200, np.uint8)
+    out, length = with_scale_bar(picture, 0.1)  # 64 mm wide: a 10 mm bar, 100 px
+    assert length == 10.0 and out.shape[0] > 50 and out.shape[1:] == (640, 3)
+    np.testing.assert_array_equal(out[:50], picture)  # the picture itself is untouched
+    assert _longest_black_run(out[50:]) == 100
+
+
+def test_section_pictures_carry_a_scale_bar_in_the_runs_units(tmp_path):
+    """section_xz.png / section_xy.png had no scale: nothing in them told their size. Now a strip
+    under each holds a bar of a round length in --units (its label says it), as long as that
+    length at the picture's scale: the grid's width (32.1 mm here) over the 640 columns."""
+    from PIL import Image
+
+    ball = tmp_path / "ball.stl"
+    trimesh.creation.icosphere(subdivisions=1, radius=5.0).export(ball)
+    for units, bar_mm in (("mm", 5.0), ("inch", 5.08)):  # 5 mm, 0.2 in
+        out = tmp_path / units
+        assert main(["woodify", str(ball), "--years", "2", "--resolution", "16", "--cracks", "none",
+                     "--units", units, "--out", str(out)]) == 0
+        grid = json.loads((out / "woodify.json").read_text())["grid"]
+        mm_per_px = (grid["shape"][0] - 1) * grid["spacing_mm"] / 640
+        for name, axis in (("section_xz.png", 2), ("section_xy.png", 1)):
+            img = np.asarray(Image.open(out / name).convert("RGB"))
+            rows = max(int(640 * (grid["shape"][axis] - 1) / (grid["shape"][0] - 1)), 16)
+            assert img.shape[0] > rows and img.shape[1] == 640, (name, img.shape)
+            assert abs(_longest_black_run(img[rows:]) - bar_mm / mm_per_px) <= 1, (units, name)
+
+
 def test_meshes_touching_at_a_single_vertex_are_refused_as_a_non_manifold_union(tmp_path, capsys):
     """Two closed tetrahedra in one GLB sharing exactly one corner (no edge): their welded union
     has every edge shared by two triangles, so trimesh calls it watertight, and it grew without

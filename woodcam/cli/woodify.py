@@ -4,7 +4,7 @@ Writes into ``--out``: ``field.npz`` (the grown object's growth field; a block s
 ``woodify:OUT/field.npz`` for ``bake``/``gcode``/``preview``), ``grown.glb`` (final surface,
 bark-textured, with cracks), ``surface_yNN.stl`` (watertight grown surfaces at chosen years, mm
 in the input mesh's frame, as their STL headers say), ``section_xz.png`` / ``section_xy.png``
-(ring sections through the block centre, seed Fig. 5.1) and ``woodify.json`` (parameters, grid,
+(ring sections through the block centre, seed Fig. 5.1, a scale bar in --units below each) and ``woodify.json`` (parameters, grid,
 solver, timings). Every file is written atomically.
 """
 
@@ -269,11 +269,12 @@ def _atomic(path: Path, write) -> Path:
 def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=None,
                   block_centre_mm=None, cracks="stress", crack_region=None, crack_years=5,
                   crack_render="material", crack_threshold=None, relief=0.3, seed=0,
-                  max_atlas_px=None, atomic=_atomic, stage=None):
+                  max_atlas_px=None, units="mm", atomic=_atomic, stage=None):
     """Write the products of a :class:`~woodcam.woodify.Woodification` into ``out`` (module
     docstring); returns (files written, summary dict). ``max_atlas_px``: the bark atlas's
     largest side, None for :data:`~woodcam.tolerances.DEFAULT_MAX_ATLAS_PX` (a value given where
-    no atlas is baked warns). ``stage(name)``: a context manager round
+    no atlas is baked warns). ``units``: of the ring sections' scale bars ("mm" or "inch", the
+    run's --units). ``stage(name)``: a context manager round
     each of "surface and cracks", "bark and surfaces" and "ring sections" (a
     :meth:`woodcam._progress.StageBar.stage`; default none)."""
     from contextlib import nullcontext
@@ -292,7 +293,7 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
         textured_mesh,
     )
     from ..woodify.cracks import simulate_cracks
-    from ..woodify.surfaces import barycentric_on, carry, section_image
+    from ..woodify.surfaces import barycentric_on, carry, section_image, with_scale_bar
 
     stage = stage or (lambda name: nullcontext())
     out = Path(out)
@@ -428,6 +429,8 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
             u[a], v[b] = ext[a], ext[b]
             rows = max(int(px * ext[b] / ext[a]), 16)
             img = section_image(f, f.no_wood, inside, origin, u, v, (rows, px), years_final=Y)
+            # a scale bar below it (a round length in --units): the picture alone told no size
+            img, _ = with_scale_bar(img, ext[a] / px, units)
             files.append(atomic(out / f"section_{name}.png", lambda p, im=img: Image.fromarray(im).save(p, format="PNG")))
     return files, summary
 
@@ -548,7 +551,7 @@ def run(args) -> int:
                 block_centre_mm=args.block_centre, cracks=args.cracks, crack_region=region,
                 crack_years=args.crack_years, crack_render=args.crack_render,
                 crack_threshold=args.crack_threshold, relief=args.relief, seed=args.seed,
-                max_atlas_px=args.max_atlas,
+                max_atlas_px=args.max_atlas, units=args.units,
                 atomic=_atomic, stage=bar.stage)
             summary["total_s"] = time.perf_counter() - t0
             summary["input"] = str(args.part)

@@ -10,7 +10,8 @@
   the closest input triangle. Texture coordinates and vertex attributes are interpolated there
   with barycentric weights, so an input texture stays put while the object grows (Fig. 4.6).
 - :func:`section_image`: a plane cut through the field as an RGB image with the rings
-  (integer years) drawn, the input in grey and obstacles black (seed Fig. 5.1).
+  (integer years) drawn, the input in grey and obstacles black (seed Fig. 5.1);
+  :func:`with_scale_bar` puts a scale bar of a round length (:func:`scale_bar_mm`) under it.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from scipy import ndimage
 
 from ..errors import WoodcamError
 from ..tolerances import WOODIFY_OBSTACLE_CLEARANCE_VOXELS
+from ..units import MM_PER_UNIT, Units, fmt_length
 
 
 def _solid_level(front, tau_mm: float) -> np.ndarray:
@@ -198,3 +200,42 @@ def section_image(field_years, no_wood, inside, plane_origin_mm, u_mm, v_mm, siz
     img[inside(pts).reshape(rows, cols)] = (170, 170, 170)
     img[no_wood(pts).reshape(rows, cols)] = (20, 20, 20)
     return img.astype(np.uint8)
+
+
+def scale_bar_mm(width_mm: float, units: Units = "mm") -> float:
+    """Length (mm) of the scale bar of a picture ``width_mm`` wide: the longest round length in
+    ``units`` (1, 2 or 5 times a power of ten: 10 mm, 20 mm, 0.5 in, 1 in) at most a fifth of
+    the width, so the bar spans 8 % to 20 % of it."""
+    if not (np.isfinite(width_mm) and width_mm > 0):
+        raise WoodcamError(f"width_mm must be a length > 0 (the picture's width, mm); got {width_mm!r}")
+    k = MM_PER_UNIT[units]
+    most = width_mm / 5 / k
+    power = 10.0 ** np.floor(np.log10(most))
+    step = max(m for m in (1, 2, 5) if m * power <= most * (1 + 1e-9))
+    return float(step * power * k)
+
+
+def with_scale_bar(img, mm_per_px: float, units: Units = "mm") -> tuple[np.ndarray, float]:
+    """``img`` (rows, cols, 3) uint8 with a white strip added below it holding a scale bar: a
+    black bar :func:`scale_bar_mm` long (``mm_per_px`` mm a pixel along the rows) from column
+    12, end ticks, its length written above it in ``units`` ("10 mm", "1 in"). The picture's
+    own pixels are unchanged (the strip covers none of it). Returns (new image, bar length mm).
+    """
+    from PIL import Image, ImageDraw, ImageFont
+
+    img = np.asarray(img, np.uint8)
+    rows, cols = img.shape[:2]
+    length_mm = scale_bar_mm(cols * mm_per_px, units)
+    bar_px = int(round(length_mm / mm_per_px))
+    label = fmt_length(length_mm, units)
+    font = ImageFont.load_default()
+    text_h = int(np.ceil(ImageDraw.Draw(Image.new("RGB", (1, 1))).textbbox((0, 0), label, font=font)[3]))
+    pad, bar_h, tick = 6, 4, 4
+    strip = Image.new("RGB", (cols, pad + text_h + 3 + tick + bar_h + pad), (255, 255, 255))
+    draw = ImageDraw.Draw(strip)
+    x0, y_bar = 12, pad + text_h + 3 + tick
+    draw.text((x0, pad), label, fill=(0, 0, 0), font=font)
+    draw.rectangle((x0, y_bar, x0 + bar_px - 1, y_bar + bar_h - 1), fill=(0, 0, 0))
+    for x in (x0, x0 + bar_px - 1):  # end ticks, so the bar's two ends read exactly
+        draw.line((x, y_bar - tick, x, y_bar + bar_h - 1), fill=(0, 0, 0))
+    return np.concatenate([img, np.asarray(strip, np.uint8)], axis=0), length_mm
