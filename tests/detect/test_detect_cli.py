@@ -1519,9 +1519,11 @@ def test_fit_right_after_a_remake_reads_the_users_files(synth_photos, tmp_path, 
         (line,) = [w for w in lines if f" kept {kept}" in w]
         assert "it wins over detection" in line, line
     # a face photo changed since (turned): its correction is not this photo's, so not used (the
-    # next 'rings detect' refuses it, as it did), and said so, with 'rings detect''s fix
+    # next 'rings detect' refuses it, as it did), and said so, with 'rings detect''s fix; an
+    # edited ring map of a turned face alike (it was passed over without a word)
     turned = _copy(tmp_path / "knotted", tmp_path / "turned")
     Image.open(turned / "front.png").rotate(90).save(turned / "front.png")
+    Image.open(turned / "bottom.png").rotate(90).save(turned / "bottom.png")
     assert _run(capsys, "block", "from-photos", turned, *size, "--out", blk)[0] == 0
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
@@ -1532,5 +1534,11 @@ def test_fit_right_after_a_remake_reads_the_users_files(synth_photos, tmp_path, 
                            f"photo than this block's (the photo changed since)"), line
     assert "not used here" in line and line.endswith(
         f"move front_traces.svg out of {str(blk)!r} (or detect into another --out) and run again"), line
+    assert not np.array_equal(block.faces["bottom"].ring_map, rings / 65535.0)  # detected
+    (line,) = [str(w.message) for w in said if "bottom_ring_map" in str(w.message)]
+    assert line.startswith(f"face 'bottom': the edited {blk / 'bottom_ring_map.png'} was made over another bottom "
+                           f"photo than this block's (the photo changed since): it is not this photo's ring map"), line
+    assert "not used here" in line and line.endswith(
+        f"move bottom_ring_map.png out of {str(blk)!r} (or detect into another --out) and run again"), line
     assert all(issubclass(w.category, WoodcamWarning) for w in said)
     assert np.array_equal(block.faces["left"].extras["knot_mask"], mask > 127)

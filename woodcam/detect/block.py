@@ -47,7 +47,8 @@ cache), one ``.npz`` keyed by a digest of the photos, the block size, the rule, 
 :data:`DETECT_VERSION`; the user's folder is never written to. In a folder 'block from-photos'
 made again (its manifest names none of the user's files; its record of the earlier detection
 keeps them), the user's corrected SVGs and edited or named images of a face whose photo is
-unchanged are read in over the detected ones and said, as the next detection keeps them
+unchanged are read in over the detected ones and said, as the next detection keeps them, and
+those of a face whose photo changed since are said unused, as the next detection refuses them
 (:func:`_users_files_of_a_remade_block`). :func:`detect_folder` (``rings
 detect``) caches each face of the classical detector there too (its photo, density, rule and
 options): detecting a folder again, after one SVG was corrected or one photo changed, detects
@@ -478,7 +479,8 @@ def _prior_record(folder: Path) -> dict:
 
 
 def _edited_images(block: Block, folders: list[tuple[Path, dict, dict[tuple[str, str], str]]],
-                   unrecorded: Collection[Path] = ()) -> dict[tuple[str, str], Path]:
+                   unrecorded: Collection[Path] = (),
+                   changed: list[tuple[str, str, Path]] | None = None) -> dict[tuple[str, str], Path]:
     """(face, kind) -> the file of each image of ``block``'s faces in one of ``folders`` (folder,
     its record before this run; the output first) that is no longer the one the detector wrote
     there: a user edited it (or made it by hand beside a recorded detection). A record without
@@ -488,7 +490,9 @@ def _edited_images(block: Block, folders: list[tuple[Path, dict, dict[tuple[str,
     names under another name than its own (each folder's third item, :func:`_named_users_files`).
 
     Refused, as a corrected SVG is (:func:`_check_corrections_match_photos`), when the record
-    says it was made over another photo than the face's now: it is not this photo's."""
+    says it was made over another photo than the face's now: it is not this photo's; with
+    ``changed`` (fit, bake and eval of a remade block, :func:`_users_files_of_a_remade_block`)
+    such an image is not refused but left out and listed there as (face, kind, file)."""
     found: dict[tuple[str, str], Path] = {}
     for name, f in block.faces.items():
         for kind, (what, _) in DETECTED_IMAGES.items():
@@ -502,6 +506,9 @@ def _edited_images(block: Block, folders: list[tuple[Path, dict, dict[tuple[str,
                     continue
                 was = (rec.get("photo_digest") or {}).get(name)
                 if was is not None and f.photo is not None and was != photo_digest(f.photo):
+                    if changed is not None:
+                        changed.append((name, kind, path))
+                        break
                     raise WoodcamError(
                         f"face {name!r}: the edited {path} was made over another {name} photo than this block's "
                         f"(the photo changed since, or --out holds an earlier block's detection): it is not this "
@@ -614,6 +621,18 @@ def _check_corrections_match_photos(block: Block, edited: dict[str, Path]) -> No
                 f"rings are not this photo's, and detecting would overwrite the correction; {_move_out_fix(svg)}")
 
 
+def _changed_photo_line(name: str, kept: str, path: Path, what: str) -> str:
+    """The one line saying face ``name``'s file of the user's (``kept``: "the corrected PATH" ...;
+    ``what``: "rings", "ring map" or "knot mask"), made over another photo than the face's now,
+    is not used by fit, bake and eval (the face's are detected), with the fix 'rings detect' gives
+    when it refuses it (:func:`_move_out_fix`): said alike of corrected SVGs and edited images."""
+    made, its = (("traced", "its rings are not this photo's, so they are") if what == "rings" else
+                 ("made", f"it is not this photo's {what}, so it is"))
+    return (f"face {name!r}: {kept} was {made} over another {name} photo than this block's (the photo changed "
+            f"since): {its} not used here ({name}'s {what} {'are' if what == 'rings' else 'is'} detected) and "
+            f"'rings detect' will refuse it; {_move_out_fix(path)}")
+
+
 def _move_out_fix(path: Path) -> str:
     """The fix for the user's file ``path`` made over another photo than its face's now (refused
     by 'rings detect', said by fit, bake and eval): one wording wherever it is given."""
@@ -649,8 +668,9 @@ def _users_files_of_a_remade_block(block: Block, folder: Path) -> list[str]:
     them, :func:`detection_record`), so fit, bake and eval right after the remake detected every
     face and passed them over without a word. A corrected SVG (or one block.json named under
     another name) and an edited or named ring map or knot mask win, each face whose photo is the
-    one they were made over; a changed photo's corrected SVG is said unused, with the fix 'rings
-    detect' gives when it refuses it (:func:`_move_out_fix`). Returns the lines that say each."""
+    one they were made over; a changed photo's corrected SVG, edited ring map or knot mask is
+    said unused, with the fix 'rings detect' gives when it refuses it (:func:`_changed_photo_line`).
+    Returns the lines that say each."""
     rec = _prior_record(folder)
     if not rec:
         return []
@@ -663,14 +683,19 @@ def _users_files_of_a_remade_block(block: Block, folder: Path) -> list[str]:
                                             if kind == "traces_svg" and (folder / rel).is_file()}}
     msgs = [_keep_users_svg(same, n, svg, (n, "traces_svg") in named, False)[1]
             for n, svg in svgs.items() if n in same.faces]
-    # a changed photo's correction is not read in, and not passed over without a word either
-    msgs += [f"face {n!r}: {'your' if (n, 'traces_svg') in named else 'the corrected'} {svg} was traced "
-             f"over another {n} photo than this block's (the photo changed since): its rings are not this photo's, so they are not used here ({n}'s "
-             f"rings are detected) and 'rings detect' will refuse it; {_move_out_fix(svg)}"
+    # a changed photo's correction or edited image is not read in, and not passed over without a
+    # word either (an edited ring map or knot mask was)
+    msgs += [_changed_photo_line(n, f"{'your' if (n, 'traces_svg') in named else 'the corrected'} {svg}", svg, "rings")
              for n, svg in svgs.items()
              if n in block.faces and block.faces[n].photo is not None and n not in same.faces]
-    images = _edited_images(same, [(folder, rec, named)])
-    msgs += _keep_users_images(same, images, (), {folder / rel for rel in named.values()})[1]
+    photos = copy.copy(block)
+    photos.faces = {n: f for n, f in block.faces.items() if f.photo is not None}
+    changed: list[tuple[str, str, Path]] = []
+    images = _edited_images(photos, [(folder, rec, named)], changed=changed)
+    mine = {folder / rel for rel in named.values()}
+    msgs += _keep_users_images(same, images, (), mine)[1]
+    msgs += [_changed_photo_line(n, f"{'your' if path in mine else 'the edited'} {path}", path,
+                                 DETECTED_IMAGES[kind][0]) for n, kind, path in changed]
     block.faces.update(same.faces)
     return msgs
 
