@@ -846,8 +846,11 @@ def test_hand_made_files_in_a_folder_never_detected_are_kept_and_used(synth_phot
         for f in mine:
             (line,) = [w for w in err.splitlines() if f in w]
             assert line.startswith("woodcam: warning: face '") and " kept " in line, line
-            assert ("it wins over detection; to let detection replace it, delete it (or move it out of "
-                    f"{str(out)!r}) and run 'rings detect' again") in line, line
+            # in another --out the same file in both is BLK's with its copy: deleting OTHER's alone
+            # (as was said) let BLK's win the next run
+            where = (f"delete it (or move it out of {str(out)!r})" if out == blk else
+                     f"delete it and its copy {out / f} (or move them out of {str(blk)!r} and {str(out)!r})")
+            assert f"it wins over detection; to let detection replace it, {where} and run 'rings detect' again" in line, line
     _deleted_are_detected_again(capsys, blk, mine, detected)
 
 
@@ -1542,3 +1545,59 @@ def test_fit_right_after_a_remake_reads_the_users_files(synth_photos, tmp_path, 
         f"move bottom_ring_map.png out of {str(blk)!r} (or detect into another --out) and run again"), line
     assert all(issubclass(w.category, WoodcamWarning) for w in said)
     assert np.array_equal(block.faces["left"].extras["knot_mask"], mask > 127)
+
+
+def _svg_of(n: int) -> str:
+    """A user's traces SVG of a 160 px face: ``n`` straight lines, 10 px apart."""
+    return ('<svg xmlns="http://www.w3.org/2000/svg" width="160" height="160" viewBox="0 0 160 160">'
+            + "".join(f'<path d="M 10.5,{20.5 + 10 * k} L 150.5,{20.5 + 10 * k}"/>' for k in range(n)) + "</svg>")
+
+
+def test_the_users_file_edited_since_it_was_carried_into_another_out_wins(synth_photos, tmp_path, capsys, monkeypatch):
+    """'rings detect SRC --out OTHER' carries the user's corrected SVG and edited ring map of SRC
+    into OTHER; the copies then won every later run, so the user's next edit in SRC was passed over
+    (reproduced: front_traces.svg of SRC corrected again to 2 traces, OTHER kept 1, said as 'kept
+    the corrected OTHER/front_traces.svg'). Now the one edited since the carry wins: SRC's is
+    carried again, OTHER's copy edited there is kept; both edited since is refused in one line
+    naming both, and deleting one (as it says) settles it."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    blk, _size = _knotted_block_folder(synth_photos, tmp_path, capsys)
+    other = tmp_path / "other"
+    assert _run(capsys, "rings", "detect", blk, "--out", blk)[0] == 0
+    maps = [np.zeros((160, 160), np.uint8) for _ in range(3)]  # 8-bit: its 16-bit copy in OTHER is the same map
+    for k, m in enumerate(maps):
+        m[:, k::7] = 255
+    svg, ring_map = blk / "front_traces.svg", blk / "bottom_ring_map.png"
+    svg.write_text(_svg_of(1))
+    Image.fromarray(maps[0]).save(ring_map)
+
+    def detect(n_traces, bottom):
+        rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", other)
+        assert rc == 0, err
+        faces = read_block(other).faces
+        assert len(faces["front"].traces) == n_traces, err
+        assert np.array_equal(faces["bottom"].ring_map, maps[bottom] / 255.0), err
+        return err
+
+    err = detect(1, 0)
+    # the user edits the source: its files win, carried again over the copies
+    svg.write_text(_svg_of(2))
+    Image.fromarray(maps[1]).save(ring_map)
+    err = detect(2, 1)
+    for f in (svg, ring_map):
+        (line,) = [w for w in err.splitlines() if " kept the " in w and f.name in w]
+        assert f" {f} (" in line and f"delete it and its copy {other / f.name} " in line, line
+    # the user edits the copies in OTHER: they win, the source's (unchanged since) is not carried
+    (other / svg.name).write_text(_svg_of(3))
+    Image.fromarray(maps[2]).save(other / ring_map.name)
+    err = detect(3, 2)
+    assert f"kept the corrected {other / svg.name} (3 traces;" in err and svg.read_text() == _svg_of(2), err
+    # both edited since the carry: refused, one line naming both, nothing written
+    svg.write_text(_svg_of(4))
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", other)
+    assert rc == EXIT_ERROR and err.count("\n") == 1, err
+    assert (f"face 'front': your {svg} and {other / svg.name} in --out are both your traces SVG of the face and "
+            f"differ (both were edited since an earlier 'rings detect' carried the one into the other)") in err, err
+    assert "delete (or move out) the other and run again" in err and (other / svg.name).read_text() == _svg_of(3)
+    (other / svg.name).unlink()  # as it says: the source's then wins
+    detect(4, 2)

@@ -38,7 +38,10 @@ map, knot mask or traces SVG block.json names under another name than detection'
 (``top_rings.png``) is the user's wherever it is (detection writes none of that name): kept
 untouched, still named by the manifest, read as the face's and said alike (carried over under
 its name into another ``--out``, and kept named through 'block from-photos' making the block
-again into its folder: its record keeps the names).
+again into its folder: its record keeps the names). A user's file carried from the source into
+another ``--out`` is recorded there by content (``meta["detection"]["carried"]``: name in
+``--out`` -> digest): the next run into that ``--out`` takes whichever of the source's and the
+copy was edited since, and refuses both edited since (:func:`_source_or_copy`).
 
 **Photo-only blocks elsewhere** (``fit``, ``bake``, ``eval``): :func:`with_detected_rings`
 detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
@@ -298,7 +301,8 @@ def detection_record(folder) -> dict | None:
     if not svgs and not images and not named:
         return None
     return {"traces_svg": svgs, "svg_sha256": rec.get("svg_sha256", {}),
-            "photo_digest": rec.get("photo_digest", {}), "file_digest": images, "named": named}
+            "photo_digest": rec.get("photo_digest", {}), "file_digest": images, "named": named,
+            **({"carried": rec["carried"]} if isinstance(rec.get("carried"), dict) else {})}
 
 
 def user_edited_faces(folder) -> dict[str, Path]:
@@ -400,6 +404,51 @@ def _kept_users_line(name: str, kept: str, folder: Path, why: str, copy: Path | 
              f"delete it and its copy {copy} (or move them out of {str(folder)!r} and {str(copy.parent)!r})")
     return (f"face {name!r}: kept {kept} ({why}): it wins over detection; to let detection replace it, {where} "
             "and run 'rings detect' again")
+
+
+def _copy_name(out: Path, path: Path, name: str, kind: str, named: Collection[Path]) -> str:
+    """The name in ``out`` of face ``name``'s image of ``kind`` of the user's, ``path``: one
+    block.json names under another name than detection's (``named``) under that name
+    (:func:`_name_in`), any other as the face's ``<face>_<kind>.png``."""
+    return _name_in(out, path) if path in named else f"{name}_{kind}.png"
+
+
+def _users_digest(path: Path, kind: str, shape) -> str:
+    """Digest of the user's file ``path`` of ``kind`` (``"traces_svg"`` or :data:`DETECTED_IMAGES`)
+    as the face takes it: an SVG's bytes (carried as they are), an image's pixels as read
+    (:func:`_read_users_image`: an 8-bit map and its 16-bit copy in --out alike)."""
+    if kind == "traces_svg":
+        return _sha256(path)
+    return digest(_read_users_image(path, kind, shape))
+
+
+def _source_or_copy(block: Block, name: str, kind: str, source: Path | None, copy: Path, out: Path,
+                    out_rec: dict) -> Path:
+    """Which of face ``name``'s two files of ``kind`` of the user's wins: ``source`` (in the
+    source folder; None when it holds none) or ``copy`` (in another ``--out`` folder ``out``, of
+    record ``out_rec``). A copy an earlier run carried there won every run after, so an edit the user
+    made in the source since was passed over without a word. Now the run's record of what it
+    carried (``carried``: name in --out -> :func:`_users_digest`) tells which was edited since:
+    that one wins (the source's is carried again); the same content, the source's (said with its
+    copy). Both edited since, or two different files with no carry recorded, are refused in one
+    line naming both: either may be the one the user means, and the source's would write over the
+    other."""
+    if source is None or name not in block.faces:
+        return copy
+    shape = block.faces[name].shape
+    now_src, now_copy = _users_digest(source, kind, shape), _users_digest(copy, kind, shape)
+    carried = out_rec.get("carried")
+    was = carried.get(_name_in(out, copy)) if isinstance(carried, dict) else None
+    if now_src == now_copy or now_copy == was:
+        return source
+    if now_src == was:
+        return copy
+    what = "traces SVG" if kind == "traces_svg" else DETECTED_IMAGES[kind][0]
+    why = ("both were edited since an earlier 'rings detect' carried the one into the other" if was is not None else
+           "no earlier 'rings detect' recorded carrying the one into the other")
+    raise WoodcamError(f"face {name!r}: your {source} and {copy} in --out are both your {what} of the face and differ "
+                       f"({why}): which is the face's? keep the one you mean: delete (or move out) the other and run "
+                       "again")
 
 
 def _copy_in(out: Path | None, path: Path, name: str) -> Path | None:
@@ -545,7 +594,7 @@ def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path],
                f"it is not the {DETECTED_IMAGES[kind][0]} detection wrote there")
         mine = path in named or path.parent in unrecorded
         # carried into another --out: a named one under its own name, any other as the face's image
-        copy = _copy_in(out, path, _name_in(out, path) if path in named and out is not None else f"{name}_{kind}.png")
+        copy = None if out is None else _copy_in(out, path, _copy_name(out, path, name, kind, named))
         msgs.append(_kept_users_line(name, f"your {path}" if mine else f"the edited {path}", path.parent, why + none,
                                      copy))
     return kept, msgs
@@ -751,14 +800,19 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
 
     edited.update({n: src / rel for (n, kind), rel in named_src.items() if kind == "traces_svg" and (src / rel).is_file()})
     edited.update(hand_made_svgs(src, named_src))
-    if not same and (out / MANIFEST).is_file():
-        # corrections made in the output folder of an earlier run win too (only the source's
-        # were looked for, and detection overwrote the ones in --out)
-        edited.update(user_edited_faces(out))
-        edited.update({n: out / rel for (n, kind), rel in named_out.items()
-                       if kind == "traces_svg" and (out / rel).is_file()})
+    # the files the detector wrote, as the source and --out recorded them (before either is overwritten)
+    src_rec = _prior_record(src)
+    out_rec = src_rec if same else _prior_record(out)
     if not same:
-        edited.update(hand_made_svgs(out, named_out))
+        # corrections made in the output folder of an earlier run win too (only the source's
+        # were looked for, and detection overwrote the ones in --out); where the source has the
+        # user's own too, the one edited since the last carry wins (the copy won, stale)
+        outs = user_edited_faces(out) if (out / MANIFEST).is_file() else {}
+        outs.update({n: out / rel for (n, kind), rel in named_out.items()
+                     if kind == "traces_svg" and (out / rel).is_file()})
+        outs.update(hand_made_svgs(out, named_out))
+        edited.update({n: _source_or_copy(block, n, "traces_svg", edited.get(n), svg, out, out_rec)
+                       for n, svg in outs.items()})
     # a corrected SVG of a face the block no longer has (made again with --partial without it) was
     # an internal error (KeyError): it is left where it is, unused, and said
     unused = {n: svg for n, svg in edited.items() if n not in block.faces}
@@ -767,12 +821,15 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
                      if kind != "traces_svg" and n not in block.faces and (folder / rel).is_file()]
     edited = {n: svg for n, svg in edited.items() if n in block.faces}
     _check_corrections_match_photos(block, edited)
-    # the files the detector wrote, as the source and --out recorded them (before either is overwritten)
-    src_rec = _prior_record(src)
-    out_rec = src_rec if same else _prior_record(out)
-    # images the user edited since the detector wrote them, checked before any work as the SVGs are
-    images = _edited_images(block, [(out, out_rec, named_out)] + ([] if same else [(src, src_rec, named_src)]),
-                            unrecorded)
+    # images the user edited since the detector wrote them, checked before any work as the SVGs
+    # are; the source's and --out's of a face resolved as the SVGs are
+    images = _edited_images(block, [(out, out_rec, named_out)], unrecorded)
+    if not same:
+        srcs = _edited_images(block, [(src, src_rec, named_src)], unrecorded)
+        images = {(n, kind): (srcs[n, kind] if (n, kind) not in images else
+                              _source_or_copy(block, n, kind, srcs.get((n, kind)), images[n, kind], out,
+                                              out_rec))
+                  for n in block.faces for kind in DETECTED_IMAGES if (n, kind) in images or (n, kind) in srcs}
     todo = [n for n, f in block.faces.items() if f.photo is not None and n not in edited]
     msgs: list[str] = [f"face {n!r}: the corrected {svg} is not used: the block has no {n} face (made "
                        f"without its photo); move it out of {str(svg.parent)!r} to keep it (a later detection "
@@ -840,6 +897,18 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
             existing.setdefault(name, {})[kind] = rel = _name_in(out, path)
             if (out / rel).resolve() != path.resolve():
                 write_bytes(out / rel, path.read_bytes())
+    # the user's files carried from the source into another --out, by their content then: the
+    # next run tells which of the two was edited since (:func:`_source_or_copy`); a copy that won
+    # (edited since) keeps the record of its carry, so the source's edited since too is refused
+    users_in_out = {_name_in(out, p) for p in [*edited.values(), *(images[k] for k in users)]
+                    if (out / _name_in(out, p)).resolve() == p.resolve()}
+    was_carried = out_rec.get("carried") if isinstance(out_rec.get("carried"), dict) else {}
+    det["carried"] = {**{k: d for k, d in was_carried.items() if k in users_in_out and isinstance(d, str)},
+                      **{svg_names[n]: _users_digest(svg, "traces_svg", block.faces[n].shape)
+                         for n, svg in edited.items() if _copy_in(out, svg, svg_names[n]) is not None},
+                      **{_copy_name(out, path, n, kind, named): _users_digest(path, kind, block.faces[n].shape)
+                         for (n, kind), path in images.items()
+                         if (n, kind) in users and _copy_in(out, path, _copy_name(out, path, n, kind, named))}}
     # the detector's images: this run's (ring maps of faces detected or drawn from a corrected
     # SVG, knot masks detected), and earlier ones kept unchanged (--no-knots, a corrected SVG's
     # face) that were its own; a user's is never recorded, so never cleared nor written over
