@@ -83,6 +83,28 @@ def test_images_already_in_the_folder_are_named_not_written(tmp_path, block):
         write_block(b, tmp_path, existing={"left": {"ring_map": "gone.png"}})
 
 
+@pytest.mark.parametrize("written, saved", [(16, 8), (8, 16)])
+def test_a_ring_map_saved_at_another_depth_is_read_at_its_own(tmp_path, block, written, saved):
+    """A ring map the user saved over the block's at another bit depth than block.json's
+    ring_map_bits (an editor's 8-bit export over a 16-bit map) was scaled by the manifest's: an
+    8-bit map under 16 came back 257 times too dark (white 0.0039) without a word, a 16-bit one
+    under 8 was refused. The PNG's own depth is read, and a block written again from it and read
+    back is the same map (within the written depth's half step)."""
+    write_block(block, tmp_path / "a", ring_map_bits=written)
+    shape = block.faces["top"].shape
+    levels = (np.arange(np.prod(shape)).reshape(shape) * 7) % 256
+    mine = levels.astype(np.uint8) if saved == 8 else (levels * 257).astype(np.uint16)
+    Image.fromarray(mine).save(tmp_path / "a" / "top_ring_map.png")
+    assert json.loads((tmp_path / "a" / "block.json").read_text())["faces"]["top"]["ring_map_bits"] == written
+    back = read_block(tmp_path / "a")
+    assert back.faces["top"].ring_map.dtype == np.float32
+    assert np.array_equal(back.faces["top"].ring_map, (levels / 255.0).astype(np.float32))  # exact: k/255 = 257k/65535
+    write_block(back, tmp_path / "b", ring_map_bits=written)
+    again = read_block(tmp_path / "b").faces["top"].ring_map
+    tol = RING_MAP_QUANT_16BIT if written == 16 else RING_MAP_QUANT_8BIT
+    assert np.abs(again.astype(float) - levels / 255.0).max() <= tol + 1e-7
+
+
 def test_16bit_is_finer_than_8bit(tmp_path, block):
     errs = []
     for bits in (8, 16):

@@ -166,10 +166,12 @@ def test_sixteen_bit_photo_is_scaled_not_wrapped(folder):
     assert photo[5, 5, 0] == 128 and photo[0, 0, 0] == 255 and photo[0, 1, 0] == 1
 
 
-def test_sixteen_bit_ring_map_with_8_bit_label_is_refused(folder):
+def test_sixteen_bit_ring_map_with_8_bit_label_is_read_at_its_own_depth(folder):
+    """It was refused ('more than ring_map_bits = 8 allows'): the PNG's own depth is read now
+    (tests/block/test_block_io.py, test_a_ring_map_saved_at_another_depth_is_read_at_its_own)."""
+    before = read_block(folder).faces["top"].ring_map
     _edit(folder, lambda m: m["faces"]["top"].update(ring_map_bits=8))
-    with pytest.raises(WoodcamError, match="more than ring_map_bits = 8 allows"):
-        read_block(folder)
+    assert np.array_equal(read_block(folder).faces["top"].ring_map, before)
 
 
 def test_oversized_image_is_refused_before_decoding(folder, monkeypatch):

@@ -14,7 +14,7 @@ Manifest (``"format": "woodcam-block"``, ``"version": 1``)::
      "faces": {"front": {"shape": [n_rows, n_cols],
                          "photo": "front_photo.png" | null,
                          "ring_map": "front_ring_map.png" | null,
-                         "ring_map_bits": 16 | 8,
+                         "ring_map_bits": 16 | 8,             (the depth written; read: the PNG's own)
                          "traces": [{"year": int | null, "points_px": [[row, col], ...],
                                      "ring": int (optional)}, ...],
                          "traces_svg": "front_traces.svg",    (optional, read only: see below)
@@ -30,7 +30,9 @@ adds those traces to the JSON ones. :func:`write_block` always writes traces as 
 
 Precision: photos and traces round-trip exactly (PNG is lossless; JSON floats are written with
 ``repr`` precision); a ring map in [0, 1] is quantised to ``ring_map_bits`` bits, so it comes
-back within ``0.5 / (2**bits - 1)`` (:data:`woodcam.tolerances.RING_MAP_QUANT_16BIT`).
+back within ``0.5 / (2**bits - 1)`` (:data:`woodcam.tolerances.RING_MAP_QUANT_16BIT`). It is read
+back by the PNG's own bit depth (white = 255 or 65535), whatever ``ring_map_bits`` says: a map
+the user saved since at another depth (an 8-bit export over a 16-bit map) is read as saved.
 
 **True field.** A growth field is in general arbitrary code and is not serialised. It is saved
 only when it has ``to_dict() -> dict`` (JSON-serialisable) and its class, which must live in a
@@ -218,16 +220,10 @@ def read_block(folder: PathLike, *, allow_outside: bool | None = None, regenerat
 
         if entry.get("ring_map") and not gone(f"faces.{name}.ring_map"):
             raw = _read_png(files[f"faces.{name}.ring_map"], f"ring map of face {name!r}")
-            bits = int(entry.get("ring_map_bits", 16 if raw.dtype == np.uint16 else 8))
             if raw.ndim == 3:
                 raw = raw[..., 0]
             _check_shape(raw, shape, f"ring map of face {name!r} ({entry['ring_map']})")
-            if raw.size and int(raw.max()) > 2 ** bits - 1:
-                raise WoodcamError(
-                    f"ring map of face {name!r} ({entry['ring_map']}) holds values up to "
-                    f"{int(raw.max())}, more than ring_map_bits = {bits} allows; set "
-                    f"\"ring_map_bits\": 16 for a 16-bit PNG")
-            ring_map = (raw.astype(np.float64) / (2 ** bits - 1)).astype(np.float32)
+            ring_map = _ring_map_of(raw)
         traces = [RingTrace(np.asarray(t["points_px"], dtype=float), t.get("year"), t.get("ring"))
                   for t in entry.get("traces", [])]
         if entry.get("traces_svg") and not gone(f"faces.{name}.traces_svg"):
@@ -243,6 +239,16 @@ def read_block(folder: PathLike, *, allow_outside: bool | None = None, regenerat
         true_field=_read_field(m.get("true_field"), files.get("true_field.file")),
         name=m.get("name", folder.name), meta=m.get("meta", {}),
     )
+
+
+def _ring_map_of(raw: np.ndarray) -> np.ndarray:
+    """A ring map ``(h, w)`` float32 in [0, 1] of a grey PNG's pixels ``raw`` (uint8 or uint16),
+    scaled by the PNG's own bit depth (white = 255 or 65535). The manifest's ``ring_map_bits``
+    says the depth :func:`write_block` wrote; a map the user saved since at another depth (an
+    editor's 8-bit export over a 16-bit map) was scaled by the manifest's: an 8-bit map under 16
+    was read 257 times too dark (white 0.0039) without a word, a 16-bit one under 8 refused."""
+    top = 65535.0 if raw.dtype == np.uint16 else 255.0
+    return (raw.astype(np.float64) / top).astype(np.float32)
 
 
 def _quantise(ring_map, bits: int, name: str) -> np.ndarray:
@@ -459,9 +465,7 @@ def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *
             photo = photo_rgb8(images["col"])
         if "arl-unet" in images:
             a = images["arl-unet"]
-            a = a[..., 0] if a.ndim == 3 else a
-            top = 65535.0 if a.dtype == np.uint16 else 255.0
-            ring_map = (a.astype(np.float64) / top).astype(np.float32)
+            ring_map = _ring_map_of(a[..., 0] if a.ndim == 3 else a)
         if "knot" in images:
             a = images["knot"]
             a = a.mean(axis=2) if a.ndim == 3 else a.astype(float)
@@ -546,9 +550,7 @@ def block_from_images(size_mm, photos: dict | None = None, ring_maps: dict | Non
             else:
                 if a.ndim == 3:
                     a = a[..., :3].mean(axis=2).astype(a.dtype)
-                if a.dtype in (np.uint8, np.uint16):
-                    a = (a.astype(np.float64) / (255.0 if a.dtype == np.uint8 else 65535.0))
-                a = np.asarray(a, dtype=np.float32)
+                a = _ring_map_of(a) if a.dtype in (np.uint8, np.uint16) else np.asarray(a, dtype=np.float32)
             images.setdefault(face, {})[kind] = a
     faces = {}
     for face, imgs in images.items():

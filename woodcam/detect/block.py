@@ -497,7 +497,7 @@ def _file_digest(path: Path, kind: str) -> str | None:
 def _read_users_image(path: Path, kind: str, shape) -> np.ndarray:
     """A user's image of ``kind`` as :func:`~woodcam.block.io.read_block` reads the face's."""
     from .._readers import read_image_file
-    from ..block.io import _check_shape
+    from ..block.io import _check_shape, _ring_map_of
 
     raw = read_image_file(path, f"the edited {path.name}")
     if raw.ndim == 3:
@@ -505,7 +505,7 @@ def _read_users_image(path: Path, kind: str, shape) -> np.ndarray:
     _check_shape(raw, shape, f"the edited {path}")
     if kind == "knot_mask":
         return raw > 127
-    return (raw.astype(np.float64) / (65535 if raw.dtype == np.uint16 else 255)).astype(np.float32)
+    return _ring_map_of(raw)
 
 
 def _file_digests(rec: dict | None) -> dict[str, str]:
