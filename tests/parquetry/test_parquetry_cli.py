@@ -637,3 +637,23 @@ def test_a_panel_rounded_to_whole_patches_is_said(scans, capsys, monkeypatch, ex
         assert warned == [], err
     else:
         assert len(warned) == 1 and warned[0].startswith(f"woodcam: warning: {said}"), err
+
+
+def test_two_targets_of_the_same_file_name_get_names_one_can_foresee(scans, capsys):
+    """a/cam64.png and b/cam64.png were written as render_cam640.png and render_cam641.png (the
+    index glued to the stem), names no user could foresee, without a word. Now they are
+    numbered as --veneer numbers its scans, cam64-1 and cam64-2, and a warning names each."""
+    for name in ("a", "b"):
+        (scans / name).mkdir()
+        Image.open(scans / "coffee.png").resize((32, 24)).save(scans / name / "cam64.png")
+    out = scans / "out"
+    rc = main(["parquetry", str(scans / "a" / "cam64.png"), str(scans / "b" / "cam64.png"),
+               "--veneer", f"{scans / 'light.png'}:2px/mm", "--image-size-mm", "14", "--px-per-mm", "2",
+               "--n-rot", "1", "--no-seams", "--no-glb", "--out", str(out), "--quiet"])
+    text = capsys.readouterr().err
+    assert rc == 0, text
+    assert "woodcam: warning: targets share a file name" in text and (f"{scans / 'a' / 'cam64.png'} as cam64-1; {scans / 'b' / 'cam64.png'} as cam64-2; rename the "
+            "files to choose the names") in text, text
+    assert sorted(f.name for f in out.glob("render_*.png")) == ["render_cam64-1.png", "render_cam64-2.png"]
+    assert [p["name"] for p in json.loads((out / "result.json").read_text())["summary"]["panels"]] == \
+        ["cam64-1", "cam64-2"]

@@ -600,7 +600,14 @@ def job_veneers(job: ParquetryJob, open_stock=None, progress: bool = False) -> l
 
 
 def job_targets(job: ParquetryJob) -> tuple[list, list[str]]:
-    """The job's target images ``(h, w, 3)`` float RGB and their names (file stems)."""
+    """The job's target images ``(h, w, 3)`` float RGB and their names (file stems, in the
+    output files' names: ``render_<name>.png``). Targets of the same stem in two folders
+    (``a/cam.png``, ``b/cam.png``) are numbered in the order given, ``cam-1``, ``cam-2`` (as
+    ``--veneer`` numbers its scans; a number another target's stem already holds is skipped),
+    said in a WoodcamWarning; the index was glued to the stem of all of them, ``cam640`` and
+    ``cam641`` of two ``cam64.png``, names no user could foresee."""
+    from collections import Counter
+
     from .veneers import TARGET_ALPHA_FIX, read_image
 
     imgs, names = [], []
@@ -609,6 +616,18 @@ def job_targets(job: ParquetryJob) -> tuple[list, list[str]]:
             raise WoodcamError(f"targets entry {t} needs a 'filename'")
         imgs.append(read_image(t["filename"], "target image", TARGET_ALPHA_FIX))
         names.append(Path(t["filename"]).stem)
-    if len(set(names)) != len(names):
-        names = [f"{n}{k}" for k, n in enumerate(names)]
+    count, taken = Counter(names), set(names)
+    renamed = []
+    for i, n in enumerate(names):
+        if count[n] > 1:
+            k = 1
+            while f"{n}-{k}" in taken:
+                k += 1
+            names[i] = f"{n}-{k}"
+            taken.add(names[i])
+            renamed.append(f"{job.targets[i]['filename']} as {names[i]}")
+    if renamed:
+        warnings.warn(f"targets share a file name, so each is named with a number (render_<name>.png, "
+                      f"assembly_<name>.svg, result.json): {'; '.join(renamed)}; rename the files to choose "
+                      "the names", WoodcamWarning, stacklevel=2)
     return imgs, names
