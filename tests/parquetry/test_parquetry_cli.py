@@ -657,3 +657,23 @@ def test_two_targets_of_the_same_file_name_get_names_one_can_foresee(scans, caps
     assert sorted(f.name for f in out.glob("render_*.png")) == ["render_cam64-1.png", "render_cam64-2.png"]
     assert [p["name"] for p in json.loads((out / "result.json").read_text())["summary"]["panels"]] == \
         ["cam64-1", "cam64-2"]
+
+
+def test_every_parquetry_option_says_its_default_and_unit():
+    """'--veneer-from SPEC ... (default: not set)' and '--config JOB.json ... (default: not set)'
+    said nothing of what the run takes without them; '--n-rot' ('rotations of each sheet') named
+    no angle, '--overlap-mm's default '= 3.5' held only at the defaults of two other options."""
+    import argparse
+
+    from woodcam.cli import _walk_options, build_parser
+
+    helps = {a.option_strings[-1]: " ".join((a.help or "").split())
+             for path, a in _walk_options(build_parser()) if path == ["parquetry"]
+             and not isinstance(a, (argparse._StoreTrueAction, argparse._HelpAction)) and not a.required}
+    assert {"--config", "--veneer-from", "--n-rot", "--overlap-mm", "--kerf-mm"} <= set(helps), sorted(helps)
+    unsaid = {o: h for o, h in helps.items() if "default" not in h.lower() or "not set" in h}
+    assert not unsaid, unsaid
+    assert "(default: none, the targets and veneers given here)" in helps["--config"]
+    assert "default: none, the veneers are the --veneer scans and the --config job's" in helps["--veneer-from"]
+    assert "360/N degrees apart (default 15: every 24 degrees)" in helps["--n-rot"]
+    assert "3.5 mm at their defaults" in helps["--overlap-mm"]

@@ -53,10 +53,10 @@ def register(subparsers) -> None:
         epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.set_defaults(func=run)
     add_input(p, "target", kind="file", nargs="*", type=Path, help="target image(s); several are queued "
-                   "together on the same wood (--queue)")
+                   "together on the same wood (--queue); none: the --config job's targets")
     add_input(p, "--config", kind="file", type=Path, default=None, metavar="JOB.json",
                    help="a job file in the paper's layout (source_textures, targets, Table 1 keys); "
-                   "options given here override it")
+                   "options given here override it (default: none, the targets and veneers given here)")
     add_out_option(p, "render.png, baseline.png, target_matched.png, assembly.svg, the cut files "
                       "veneer_<id>.svg/.dxf, result.json, panel.glb and job.json, listed in "
                       ".woodcam-parquetry-files.json")
@@ -69,8 +69,10 @@ def register(subparsers) -> None:
                    "'Npx/mm'")
     add_input(v, "--veneer-from", kind="block", action="append", default=[], metavar="SPEC",
                    help="Mokume sample folder, or block spec to slice leaves from (repeatable; its "
-                   ":WxDxH in --units, as bake --block)")
-    v.add_argument("--sheets", type=int, default=None, help="leaves per --veneer-from block (default 2)")
+                   ":WxDxH in --units, as bake --block; default: none, the veneers are the --veneer scans "
+                   "and the --config job's)")
+    v.add_argument("--sheets", type=int, default=None, metavar="N",
+                   help="leaves per --veneer-from block (default 2)")
     v.add_argument("--sheet-size", default=None, metavar="WxH", type=sizes_type("--sheet-size", 2),
                    help="size of each sliced leaf in --units (default 600x400 mm, or the block's face where "
                    "smaller; a leaf larger than that face is refused: every sheet is wood of the block)")
@@ -83,30 +85,34 @@ def register(subparsers) -> None:
                    "parallel to the front face)")
     add_units_option(v, "parquetry")
     v.add_argument("--species", default=None, type=species_type,
-                   help=SPECIES_HELP + " (default: the block's own)")
+                   help=SPECIES_HELP + "; of the --veneer-from leaves (default: each block's own)")
     t = p.add_argument_group("parameters (seed 002, Table 1)")
-    t.add_argument("--w-intens", type=float, default=None, help="intensity weight of eq. 1, in [0, 1] (default 0.5)")
-    t.add_argument("--w-edge", type=float, default=None, help="Sobel edge weight of eq. 1, in [0, 1] (default 0.5)")
-    t.add_argument("--w-hist", type=float, default=None,
+    t.add_argument("--w-intens", type=float, default=None, metavar="W",
+                   help="intensity weight of eq. 1, in [0, 1] (default 0.5)")
+    t.add_argument("--w-edge", type=float, default=None, metavar="W",
+                   help="Sobel edge weight of eq. 1, in [0, 1] (default 0.5)")
+    t.add_argument("--w-hist", type=float, default=None, metavar="W",
                    help="histogram-matching blend of eq. 2, in [0, 1] (default 0.5)")
-    t.add_argument("--image-size-mm", type=float, default=None,
+    t.add_argument("--image-size-mm", type=float, default=None, metavar="MM",
                    help="panel's shorter side in mm, rounded to whole patches of --patch-mm (60 makes 56, "
                    "with a warning; default 360, which makes 364)")
-    t.add_argument("--patch-mm", type=float, default=None, help="patch side in mm (default 14)")
-    t.add_argument("--n-adaptive", type=int, default=None,
+    t.add_argument("--patch-mm", type=float, default=None, metavar="MM",
+                   help="patch side in mm, the smallest with --n-adaptive (default 14)")
+    t.add_argument("--n-adaptive", type=int, default=None, metavar="L",
                    help="adaptive levels: patches of patch-mm * 2^L split in four; the largest must fit "
                    "the panel's shorter side (at most 4 levels at the defaults: 16 patches of the 26; "
                    "default 0)")
-    t.add_argument("--w-adaptive", type=float, default=None,
+    t.add_argument("--w-adaptive", type=float, default=None, metavar="W",
                    help="cost ratio: split when w_adaptive * (cost of the four) < cost of one "
                    "(default 1.2)")
-    t.add_argument("--n-rot", type=int, default=None, help="rotations of each sheet (default 15)")
+    t.add_argument("--n-rot", type=int, default=None, metavar="N",
+                   help="rotations of each sheet searched, 360/N degrees apart (default 15: every 24 degrees)")
     t.add_argument("--priority", choices=("saliency", "center"), default=None,
                    help="patch order: salient first (default) or from the centre out (Fig. 6)")
     t.add_argument("--queue", choices=("interleaved", "sequential"), default=None,
                    help="several targets: interleaved by priority (default) or one after the other")
     f = p.add_argument_group("matching and fabrication")
-    f.add_argument("--px-per-mm", type=float, default=None,
+    f.add_argument("--px-per-mm", type=float, default=None, metavar="PX",
                    help="working resolution of matching and render.png (default 4 px/mm)")
     f.add_argument("--mode", choices=("fast", "exhaustive"), default=None,
                    help="fast: coarse-to-fine with exact re-ranking (default); exhaustive: every "
@@ -126,18 +132,19 @@ def register(subparsers) -> None:
                    help="where the target is flat, up to N candidate placements per patch get the "
                    "structural re-rank instead of its 4 (woodcam.params.rerank of a job file; N >= "
                    "that count; default 12; 4 = off)")
-    f.add_argument("--overlap-mm", type=float, default=None,
-                   help="patch overlap for seam cutting in mm (default min(patch/4, "
-                   "(patch - min-piece)/2) = 3.5); 0 = square pieces")
+    f.add_argument("--overlap-mm", type=float, default=None, metavar="MM",
+                   help="patch overlap for seam cutting in mm (default min(--patch-mm / 4, "
+                   "(--patch-mm - --min-piece-mm) / 2): 3.5 mm at their defaults); 0 = square pieces")
     f.add_argument("--no-seams", action="store_true", help="square pieces, no seam optimisation: matched and cut "
                    "with no overlap (--overlap-mm 0)")
-    f.add_argument("--min-piece-mm", type=float, default=None,
+    f.add_argument("--min-piece-mm", type=float, default=None, metavar="MM",
                    help="narrowest piece in mm (default 5, the paper's bound)")
     f.add_argument("--tool-diameter", type=float, default=None, metavar="LEN",
                    help="router bit diameter in --units: concave bends >= its radius, tool paths offset "
-                   "by it (default 2 mm)")
-    f.add_argument("--kerf-mm", type=float, default=None,
-                   help="wood lost between pieces on a sheet in mm (default: the tool diameter)")
+                   "by its radius (default 2 mm)")
+    f.add_argument("--kerf-mm", type=float, default=None, metavar="MM",
+                   help="wood lost between pieces on a sheet in mm (default: the --tool-diameter, 2 mm at "
+                   "its default)")
     f.add_argument("--reuse-wood", action="store_true",
                    help="let pieces overlap on the sheets (an upper bound on quality; not cuttable)")
     f.add_argument("--no-glb", action="store_true", help="do not write panel.glb")
