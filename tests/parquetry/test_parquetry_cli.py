@@ -677,3 +677,27 @@ def test_every_parquetry_option_says_its_default_and_unit():
     assert "default: none, the veneers are the --veneer scans and the --config job's" in helps["--veneer-from"]
     assert "360/N degrees apart (default 15: every 24 degrees)" in helps["--n-rot"]
     assert "3.5 mm at their defaults" in helps["--overlap-mm"]
+
+
+def test_a_job_file_spec_is_read_in_mm_under_units_inch_and_said(scans, capsys):
+    """A --config job file's 'builtin:flat-sawn:80x40x60' was read in mm under --units inch,
+    where the same spec given as --veneer-from is read in inches, without a word. A job file's
+    lengths are mm (its *_mm keys, its specs as job.json writes them): read so, and said under
+    --units inch with the spec in mm of the inches it may have meant; nothing said in mm."""
+    job = scans / "job.json"
+    job.write_text(json.dumps({"targets": [{"filename": "coffee.png"}],
+                               "woodcam": {"blocks": [{"spec": "builtin:flat-sawn:80x40x60"},
+                                                      {"spec": "builtin:flat-sawn"}]}}))
+    out = scans / "out"
+    run = ["--config", str(job), "--sheets", "1", "--sheet-size", "1.5x1.5", "--no-glb"]
+    assert _small_run(scans, out, *run, "--units", "inch") == 0
+    err = capsys.readouterr().err
+    assert err.count("woodcam: warning:") == 1, err
+    assert (f"--config {str(job)!r}: woodcam.blocks[0].spec 'builtin:flat-sawn:80x40x60' is read in mm, not in "
+            "--units inch: a job file's lengths are mm (its *_mm keys, its block specs' sizes, as job.json is "
+            "written); --units reads the command line's only; if it means inches, write it in mm: "
+            "'builtin:flat-sawn:2032x1016x1524'") in err, err
+    blocks = json.loads((out / "job.json").read_text())["woodcam"]["blocks"]
+    assert blocks[0]["spec"] == "builtin:flat-sawn:80x40x60" and blocks[0]["width_mm"] == pytest.approx(38.1)
+    assert _small_run(scans, scans / "out-mm", *run[:-3], "--sheet-size", "40x40", "--no-glb") == 0
+    assert "warning" not in capsys.readouterr().err

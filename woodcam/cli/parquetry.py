@@ -56,7 +56,9 @@ def register(subparsers) -> None:
                    "together on the same wood (--queue); none: the --config job's targets")
     add_input(p, "--config", kind="file", type=Path, default=None, metavar="JOB.json",
                    help="a job file in the paper's layout (source_textures, targets, Table 1 keys); "
-                   "options given here override it (default: none, the targets and veneers given here)")
+                   "options given here override it; its lengths are mm whatever --units (its *_mm keys, "
+                   "its block specs' :WxDxH, as job.json is written) (default: none, the targets and "
+                   "veneers given here)")
     add_out_option(p, "render.png, baseline.png, target_matched.png, assembly.svg, the cut files "
                       "veneer_<id>.svg/.dxf, result.json, panel.glb and job.json, listed in "
                       ".woodcam-parquetry-files.json")
@@ -264,6 +266,37 @@ def _say_panel_rounding(args, params) -> None:
                   WoodcamWarning, stacklevel=2)
 
 
+def _say_job_lengths_in_mm(args, job) -> None:
+    """A WoodcamWarning for each block spec of a ``--config`` job file whose lengths (its
+    ``:WxDxH``, its resizes) are read in mm while ``--units`` is not mm: a job file's lengths
+    are mm whatever ``--units`` (its ``*_mm`` keys, and its specs as ``job.json`` writes them,
+    which ``--units inch`` would read 25.4 times too large), and ``--units`` reads the command
+    line's only; 'builtin:flat-sawn:4x2x3' in a job file sliced a 4 x 2 x 3 mm block under
+    ``--units inch`` without a word. The fix names the spec in mm of the inches meant."""
+    from .._specs import format_spec, parse_spec
+    from ..errors import BlockSpecError
+    from ..units import MM_PER_UNIT
+
+    if not args.config or args.units == "mm":
+        return
+    for i, b in enumerate(job.blocks):
+        try:
+            parsed = parse_spec(b["spec"])
+        except BlockSpecError:  # refused, by the stock, as the block is opened
+            continue
+        if parsed.size_mm is None and not any(op[0] == "resize" for op in parsed.ops):
+            continue  # no length in it: the same block in every unit
+        try:
+            in_mm = format_spec(parse_spec(b["spec"], mm_per_unit=MM_PER_UNIT[args.units]))
+            meant = f"; if it means {'inches' if args.units == 'inch' else args.units}, write it in mm: {in_mm!r}"
+        except BlockSpecError:
+            meant = ""
+        warnings.warn(f"--config {str(args.config)!r}: woodcam.blocks[{i}].spec {b['spec']!r} is read in mm, "
+                      f"not in --units {args.units}: a job file's lengths are mm (its *_mm keys, its block "
+                      f"specs' sizes, as job.json is written); --units reads the command line's only{meant}",
+                      WoodcamWarning, stacklevel=2)
+
+
 def _sheet_too_small(err, args, params) -> str:
     """The engine's too-small-sheet error in the words of this run: the patch, overlap and
     kerf named as the user set them (the engine named the job file's patch_mm and kerf_mm,
@@ -313,6 +346,7 @@ def run(args) -> int:
     except JobPathError as err:  # the job file is part of the command line: a path it names that
         # is not there is refused as the same path typed here (exit 2; it was exit 1)
         raise UsageError(f"--config of 'woodcam parquetry': {err}") from err
+    _say_job_lengths_in_mm(args, job)
     # what to rebuild and from what, given by neither the command line nor a job file: a wrong
     # command line (exit 2), said before any work (it was exit 1, after the scans were read)
     if not (args.target or job.targets):
