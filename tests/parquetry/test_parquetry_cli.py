@@ -701,3 +701,33 @@ def test_a_job_file_spec_is_read_in_mm_under_units_inch_and_said(scans, capsys):
     assert blocks[0]["spec"] == "builtin:flat-sawn:80x40x60" and blocks[0]["width_mm"] == pytest.approx(38.1)
     assert _small_run(scans, scans / "out-mm", *run[:-3], "--sheet-size", "40x40", "--no-glb") == 0
     assert "warning" not in capsys.readouterr().err
+
+
+def test_the_default_panel_size_is_said_and_too_little_wood_up_front(scans, capsys):
+    """A run with no --image-size-mm made a 364 mm panel (the paper's 360 in whole 14 mm
+    patches) said only as '364 x 546 mm' in the summary, in mm under --units inch, and a scan
+    far too small for it went on to 'ran out of free wood' with no word of how much wood the
+    panel takes. Now the default size is said as the run's choice, in --units, and the wood
+    short of the panel is said before the matching, with what it takes."""
+    out = scans / "out"
+    rc = main(["parquetry", str(scans / "coffee.png"), "--veneer", f"{scans / 'light.png'}:2px/mm",
+               "--px-per-mm", "2", "--n-rot", "1", "--no-glb", "--units", "inch", "--out", str(out), "--quiet"])
+    cap = capsys.readouterr()
+    assert rc == 3, cap
+    assert ("panel: shorter side 14.33 in (364 mm), the default --image-size-mm 360 (the paper's) in whole patches "
+            "of 14 mm, the target's aspect kept; give --image-size-mm (mm) to choose it") in cap.out, cap.out
+    assert "coffee: 39 x 26 cells, 546 x 364 mm (21.5 x 14.33 in)," in cap.out, cap.out
+    # the wood: 320 x 240 px at 2 px/mm, 19200 mm^2; the panel's 39 x 26 cells of 28 px, each
+    # window 7 px (3.5 mm) wider on the sides inside the panel: (37 * 42 + 2 * 35) x (24 * 42 +
+    # 2 * 35) px = 437668 mm^2
+    wood, need = 19200 / 25.4 ** 2, (37 * 42 + 2 * 35) * (24 * 42 + 2 * 35) / 4 / 25.4 ** 2
+    assert (f"woodcam: warning: the veneers cannot cover the panel (coffee 21.5 x 14.33 in): they hold {wood:.4g} "
+            "in^2 of usable wood, and the 1014 patches of 0.5512 in, each piece with its 0.1378 in overlap and every "
+            f"piece of wood used once, take at least {need:.4g} in^2, so at most {100 * wood / need:.2g}% of it can be "
+            f"made; add at least {need - wood:.4g} in^2 of veneer, or make the panel smaller (image_size_mm, "
+            "--image-size-mm)") in cap.err, cap.err
+    assert "make the panel smaller (image_size_mm, --image-size-mm)" in cap.out
+    # a size given, and wood enough: neither line
+    assert _small_run(scans, out, "--no-glb") == 0
+    cap = capsys.readouterr()
+    assert "panel:" not in cap.out and "cannot cover" not in cap.err, cap

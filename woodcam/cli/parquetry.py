@@ -297,6 +297,22 @@ def _say_job_lengths_in_mm(args, job) -> None:
                       WoodcamWarning, stacklevel=2)
 
 
+def _default_panel_line(args, params) -> str | None:
+    """The printed line that says the panel's size when neither the command line nor a job file
+    set it (``--image-size-mm``, ``woodcam.params.image_size_mm``): the paper's 360 mm made
+    every target a 364 mm panel, said only as a size in the summary, never as a choice the run
+    made for the user; in ``--units`` (and mm, the summary's), None where the size was set
+    (:func:`_say_panel_rounding` says that one where it differs)."""
+    from ..units import message_unit, say_length
+
+    if _setting(args, params, "image_size_mm", "image_size_mm") is not None:
+        return None
+    made = params.short_side_mm
+    size = say_length(made, "g") + (f" ({made:g} mm)" if message_unit() != "mm" else "")
+    return (f"panel: shorter side {size}, the default --image-size-mm {params.image_size_mm:g} (the paper's) in whole "
+            f"patches of {params.patch_mm:g} mm, the target's aspect kept; give --image-size-mm (mm) to choose it")
+
+
 def _sheet_too_small(err, args, params) -> str:
     """The engine's too-small-sheet error in the words of this run: the patch, overlap and
     kerf named as the user set them (the engine named the job file's patch_mm and kerf_mm,
@@ -434,6 +450,8 @@ def run(args) -> int:
     if not args.no_glb:
         from ..export import export_glb as glb_writer
     res = write_parquetry(run_, args.out, glb_writer=glb_writer, progress=progress, job=job)
+    if line := _default_panel_line(args, job.params):
+        print(line)
     print(format_summary(res["summary"], res["problems"]))
     print(f"wrote {len(res['files'])} files to {args.out}")
     from . import EXIT_CHECKS, EXIT_OK

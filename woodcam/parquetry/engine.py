@@ -344,6 +344,10 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
         y1, x1 = (r + n) * p.cell_px + o, (c + n) * p.cell_px + o
         return max(0, y0), max(0, x0), min(H, y1), min(W, x1)
 
+    if params.single_use:
+        _say_too_little_wood(panels, sheets, params,
+                             sum((y1 - y0) * (x1 - x0) for _, k, r, c, n in queue
+                                 for y0, x0, y1, x1 in [window(panels[k], r, c, n)]))
     def place(p: Parquetry, r: int, c: int, n: int) -> None:
         g = window(p, r, c, n)
         tmpl = np.ascontiguousarray(p.target_feats[g[0]:g[2], g[1]:g[3]])
@@ -396,7 +400,8 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
         placed = sum(int((p.cells >= 0).sum()) for p in panels)
         message = (f"the veneers ran out of free wood: placed {len(patches)} patches covering "
                    f"{placed} of {planned_cells} cells; the rest of the panel is left empty. "
-                   "Add veneer sheets or use fewer/larger patches")
+                   "Add veneer sheets, make the panel smaller (image_size_mm, --image-size-mm) or use "
+                   "larger patches")
     finally:
         if bar is not None:
             bar.close()
@@ -409,6 +414,36 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
     if repair:
         repair_fabricability(run)
     return run
+
+
+def _say_too_little_wood(panels: list[Parquetry], sheets: list[Veneer], params: ParquetryParams,
+                         need_px: float) -> None:
+    """A WoodcamWarning, before any matching, when the sheets' usable wood is less than
+    ``need_px`` (working pixels): what the panels' top-level patches take with their overlap,
+    each the least wood its square takes (its four children's windows cover its own), every
+    piece of wood used once. The run went on to 'ran out of free wood' with no word of why: a
+    default 364 mm panel from a 51 mm scan placed 2 of 676 cells. The kerf round each piece
+    and the sheets' edges are left out, so the bound is short of the wood a run needs."""
+    from ..errors import WoodcamWarning
+    from ..units import say_area
+
+    wood_px = float(sum(int(np.count_nonzero(v.mask)) for v in sheets))
+    if wood_px >= 0.98 * need_px:  # a rotated footprint's pixels may fall a little short of its area
+        return
+    import warnings
+
+    px2 = params.px_per_mm ** 2
+    sizes = ", ".join(f"{p.name} {say_length(tuple(v / params.px_per_mm for v in p.matched.shape[::-1]), 'g', ' x ')}"
+                      for p in panels)
+    warnings.warn(
+        f"the veneers cannot cover the panel{'s' if len(panels) > 1 else ''} ({sizes}): they hold "
+        f"{say_area(wood_px / px2, '.0f')} of usable wood, and the {sum(p.cells.size for p in panels)} patches of "
+        f"{say_length(params.patch_mm, 'g')}, each piece with its {say_length(params.overlap, 'g')} overlap and "
+        f"every piece of wood used once, take at least {say_area(need_px / px2, '.0f')}, so at most "
+        f"{100 * wood_px / need_px:.2g}% of it can be made; add at least "
+        f"{say_area((need_px - wood_px) / px2, '.0f')} of veneer, or make the panel smaller (image_size_mm, "
+        "--image-size-mm)",
+        WoodcamWarning, stacklevel=3)
 
 
 def _squares(r: int, c: int, h: int, w: int) -> list[tuple[int, int, int]]:

@@ -20,6 +20,7 @@ from .cutpaths import (
     write_dxf,
 )
 from .engine import Parquetry, ParquetryRun, _check_run, _native, feature_cost, ssim_vs_matched
+from ..units import message_unit, say_length
 from .job import ParquetryJob, write_job
 
 #: Thickness (mm) of the board in panel.glb: 0.6 mm veneer on a 1.5 mm birch ply substrate,
@@ -236,8 +237,10 @@ def format_summary(summ: dict, problems: dict) -> str:
     """The lines ``woodcam parquetry`` prints."""
     lines = []
     for d in summ["panels"]:
+        # in the message units (--units) too: the panel's size is the one length of the summary
+        inch = f" ({say_length(d['size_mm'], sep=' x ')})" if message_unit() != "mm" else ""
         line = (f"{d['name']}: {d['cells'][1]} x {d['cells'][0]} cells, {d['size_mm'][0]:g} x "
-                f"{d['size_mm'][1]:g} mm, {d['patches']} patches")
+                f"{d['size_mm'][1]:g} mm{inch}, {d['patches']} patches")
         if "feature_cost" in d:
             def ssim(key):  # None: the grid is narrower than SSIM's 7 x 7 window
                 return ("n/a (fewer pixels than its 7 x 7 window)" if d[key] is None
