@@ -76,6 +76,16 @@ def test_run_is_complete_with_seams(finished):
     assert result["fabricability"]["problems"] == {}
 
 
+def test_panel_size_mm_is_in_mm(finished):
+    """Parquetry.size_mm is the panel's (width, height) in mm, not its pixels: the 70 mm panel of
+    5 x 5 patches of 14 mm at 2 px/mm is 70 x 70 mm (140 x 140 px)."""
+    run, out, _res = finished
+    p = run.panels[0]
+    assert p.matched.shape == (140, 140)
+    assert p.size_mm == pytest.approx((70.0, 70.0))
+    assert p.size_mm == pytest.approx(json.loads((out / "result.json").read_text())["summary"]["panels"][0]["size_mm"])
+
+
 def test_single_use_on_every_sheet_from_svg_and_dxf(finished):
     """Rasterise every parsed-back cut path onto its sheet: no sheet pixel is used twice, and
     only usable wood is used; the kerf keeps pieces apart by at least kerf - 1 px. The DXF's

@@ -76,6 +76,7 @@ class Parquetry:
     seams_v, seams_h : seam curves (see :mod:`woodcam.parquetry.seams`) or None
     native_shape : (h, w) the panel in the target image's own pixels (what it was resampled
         from): the finest grid on which the target carries information
+    px_per_mm : the working resolution the panel's pixels are at (``params.px_per_mm``)
     """
 
     index: int
@@ -85,6 +86,7 @@ class Parquetry:
     target_feats: np.ndarray
     cell_px: int
     cells: np.ndarray
+    px_per_mm: float
     patches: list[Patch] = field(default_factory=list)
     labels: np.ndarray | None = None
     render: np.ndarray | None = None
@@ -114,7 +116,9 @@ class Parquetry:
 
     @property
     def size_mm(self) -> tuple[float, float]:
-        return self.cells.shape[1] * self.cell_px, self.cells.shape[0] * self.cell_px
+        """The panel's ``(width, height)`` in mm: its pixels over ``px_per_mm``, the size its
+        cut files have."""
+        return self.cells.shape[1] * self.cell_px / self.px_per_mm, self.cells.shape[0] * self.cell_px / self.px_per_mm
 
     @property
     def complete(self) -> bool:
@@ -180,7 +184,7 @@ def prepare_target(rgb: np.ndarray, params: ParquetryParams, source_values: np.n
     f = np.stack([params.w_intens * matched, params.w_edge * edge(grey)], axis=-1).astype(np.float32)
     native = (max(1, round(rows * cell / scale)), max(1, round(cols * cell / scale)))
     return Parquetry(index, name, img, matched, f, cell, np.full((rows, cols), -1, np.int64),
-                     native_shape=native)
+                     px_per_mm=params.px_per_mm, native_shape=native)
 
 
 def _check_target(t, k: int) -> np.ndarray:
@@ -433,8 +437,7 @@ def _say_too_little_wood(panels: list[Parquetry], sheets: list[Veneer], params: 
     import warnings
 
     px2 = params.px_per_mm ** 2
-    sizes = ", ".join(f"{p.name} {say_length(tuple(v / params.px_per_mm for v in p.matched.shape[::-1]), 'g', ' x ')}"
-                      for p in panels)
+    sizes = ", ".join(f"{p.name} {say_length(p.size_mm, 'g', ' x ')}" for p in panels)
     warnings.warn(
         f"the veneers cannot cover the panel{'s' if len(panels) > 1 else ''} ({sizes}): they hold "
         f"{say_area(wood_px / px2, '.0f')} of usable wood, and the {sum(p.cells.size for p in panels)} patches of "
