@@ -1495,7 +1495,8 @@ def test_fit_right_after_a_remake_reads_the_users_files(synth_photos, tmp_path, 
     every face itself and used none of them (a corrected front_traces.svg, a knot mask block.json
     named left_knot.png, an edited bottom_ring_map.png), without a word. Now the photo-only path
     reads the saved record: the user's files of a face whose photo is unchanged win, as the next
-    'rings detect' would have them."""
+    'rings detect' would have them, and the kept lines' fix is theirs ('run again', not 'rings
+    detect''s)."""
     from woodcam.stock import open_block
 
     monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
@@ -1521,6 +1522,9 @@ def test_fit_right_after_a_remake_reads_the_users_files(synth_photos, tmp_path, 
                  f"the edited {blk / 'bottom_ring_map.png'} ("):
         (line,) = [w for w in lines if f" kept {kept}" in w]
         assert "it wins over detection" in line, line
+        # the fix is the command's own: deleted, the next fit (bake, eval) detects the face itself
+        # (it said "run 'rings detect' again", the advice of 'rings detect')
+        assert line.endswith(f"delete it (or move it out of {str(blk)!r}) and run again"), line
     # a face photo changed since (turned): its correction is not this photo's, so not used (the
     # next 'rings detect' refuses it, as it did), and said so, with 'rings detect''s fix; an
     # edited ring map of a turned face alike (it was passed over without a word)

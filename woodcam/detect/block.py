@@ -394,16 +394,24 @@ def _named_why(default: str) -> str:
 _NO_RECORD = "no detection is recorded in that folder, so detection did not write it"
 
 
-def _kept_users_line(name: str, kept: str, folder: Path, why: str, copy: Path | None = None) -> str:
+#: The end of the kept line's fix in 'rings detect' (:func:`_kept_users_line`); fit, bake and
+#: eval detect a photo-only face themselves, so theirs is :data:`_RUN_AGAIN`.
+_DETECT_AGAIN = "run 'rings detect' again"
+_RUN_AGAIN = "run again"
+
+
+def _kept_users_line(name: str, kept: str, folder: Path, why: str, copy: Path | None = None,
+                     again: str = _DETECT_AGAIN) -> str:
     """The one line saying face ``name``'s file of the user's (``kept``: "the edited PATH" ...),
     found in ``folder``, was kept over detection, ``why`` it is the user's, and how to let
-    detection replace it: said alike of corrected SVGs, edited images and hand-made files.
+    detection replace it (delete it and ``again``, what the command that says it takes):
+    said alike of corrected SVGs, edited images and hand-made files.
     ``copy``: where it was carried into another ``--out``, which is never the detector's either,
     so it wins the next time unless deleted too (deleting the source's alone did nothing)."""
     where = (f"delete it (or move it out of {str(folder)!r})" if copy is None else
              f"delete it and its copy {copy} (or move them out of {str(folder)!r} and {str(copy.parent)!r})")
     return (f"face {name!r}: kept {kept} ({why}): it wins over detection; to let detection replace it, {where} "
-            "and run 'rings detect' again")
+            f"and {again}")
 
 
 def _copy_name(out: Path, path: Path, name: str, kind: str, named: Collection[Path]) -> str:
@@ -569,7 +577,7 @@ def _edited_images(block: Block, folders: list[tuple[Path, dict, dict[tuple[str,
 
 def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path],
                        unrecorded: Collection[Path] = (), named: Collection[Path] = (),
-                       out: Path | None = None) -> tuple[set[tuple[str, str]], list[str]]:
+                       out: Path | None = None, again: str = _DETECT_AGAIN) -> tuple[set[tuple[str, str]], list[str]]:
     """Each image of ``block``'s faces (just detected) whose file the user edited (``edited``:
     :func:`_edited_images`; in ``unrecorded``, or ``named`` by block.json under another name than
     detection's (:func:`_named_users_files`), made by hand): the user's is read into ``block``
@@ -596,7 +604,7 @@ def _keep_users_images(block: Block, edited: dict[tuple[str, str], Path],
         # carried into another --out: a named one under its own name, any other as the face's image
         copy = None if out is None else _copy_in(out, path, _copy_name(out, path, name, kind, named))
         msgs.append(_kept_users_line(name, f"your {path}" if mine else f"the edited {path}", path.parent, why + none,
-                                     copy))
+                                     copy, again))
     return kept, msgs
 
 
@@ -689,7 +697,7 @@ def _move_out_fix(path: Path) -> str:
 
 
 def _keep_users_svg(block: Block, name: str, svg: Path, named: bool, unrecorded: bool,
-                    out: Path | None = None) -> tuple[list, str]:
+                    out: Path | None = None, again: str = _DETECT_AGAIN) -> tuple[list, str]:
     """Face ``name`` of ``block`` takes its rings from the user's SVG ``svg`` (corrected, made by
     hand, or ``named`` by block.json under another name; found in a folder with no detection
     ``unrecorded``): its traces and the ring map drawn from them, in place. Returns the traces and
@@ -707,7 +715,7 @@ def _keep_users_svg(block: Block, name: str, svg: Path, named: bool, unrecorded:
                                         _named_why(f"{name}_traces.svg") if named
                                         else _NO_RECORD if unrecorded
                                         else "it is not the SVG detection wrote there"),
-                                    None if out is None else _copy_in(out, svg, _name_in(out, svg)))
+                                    None if out is None else _copy_in(out, svg, _name_in(out, svg)), again)
 
 
 def _users_files_of_a_remade_block(block: Block, folder: Path) -> list[str]:
@@ -730,7 +738,8 @@ def _users_files_of_a_remade_block(block: Block, folder: Path) -> list[str]:
     named = _named_users_files(folder)
     svgs = {**user_edited_faces(folder), **{n: folder / rel for (n, kind), rel in named.items()
                                             if kind == "traces_svg" and (folder / rel).is_file()}}
-    msgs = [_keep_users_svg(same, n, svg, (n, "traces_svg") in named, False)[1]
+    # deleted, the next fit (bake, eval) detects the face itself: no 'rings detect' needed
+    msgs = [_keep_users_svg(same, n, svg, (n, "traces_svg") in named, False, again=_RUN_AGAIN)[1]
             for n, svg in svgs.items() if n in same.faces]
     # a changed photo's correction or edited image is not read in, and not passed over without a
     # word either (an edited ring map or knot mask was)
@@ -742,7 +751,7 @@ def _users_files_of_a_remade_block(block: Block, folder: Path) -> list[str]:
     changed: list[tuple[str, str, Path]] = []
     images = _edited_images(photos, [(folder, rec, named)], changed=changed)
     mine = {folder / rel for rel in named.values()}
-    msgs += _keep_users_images(same, images, (), mine)[1]
+    msgs += _keep_users_images(same, images, (), mine, again=_RUN_AGAIN)[1]
     msgs += [_changed_photo_line(n, f"{'your' if path in mine else 'the edited'} {path}", path,
                                  DETECTED_IMAGES[kind][0]) for n, kind, path in changed]
     block.faces.update(same.faces)
