@@ -119,6 +119,61 @@ def test_background_colour_is_used(tmp_path):
     assert np.any(img != 0, axis=-1).mean() > 0.2
 
 
+@pytest.fixture
+def users_theme():
+    """``pyvista.global_theme`` changed as a user's script may (dark background, red default
+    colour, no lighting, edges, half opacity, transparent screenshots); restored afterwards."""
+    import copy
+
+    kept = copy.deepcopy(pv.global_theme)
+    try:
+        for attr, value in (("background", "black"), ("color", "red"), ("lighting", False),
+                            ("show_edges", True), ("edge_color", "blue"), ("opacity", 0.5),
+                            ("transparent_background", True)):
+            setattr(pv.global_theme, attr, value)
+        yield pv.global_theme
+    finally:
+        pv.global_theme.load_theme(kept)
+
+
+def _read_as_written(path) -> np.ndarray:
+    """The PNG's pixels as written: RGB (an RGBA one, a transparent background, is refused)."""
+    img = Image.open(path)
+    assert img.mode == "RGB", img.mode
+    return np.asarray(img).astype(int)
+
+
+def test_a_users_pyvista_theme_does_not_change_the_pictures(tmp_path, request):
+    """The views draw woodcam's colours, background and shading whatever ``pyvista.global_theme``
+    a user's script set: its lighting, edges, opacity and transparent background reached
+    preview's picture (an RGBA PNG, a flat see-through part with blue edges) and its background
+    the placement pictures' (black)."""
+    from woodcam.view.compare import render_side_by_side
+    from woodcam.view.scene import UNTEXTURED_PART_COLOR
+
+    plain = _textured_box()
+    plain.visual = trimesh.visual.ColorVisuals(plain)
+    box = trimesh.creation.box((60.0, 40.0, 20.0))
+    box.apply_translation((50.0, 40.0, 20.0))
+
+    def pictures(tag):
+        return (_read_as_written(preview(plain, size_mm=SIZE, screenshot=tmp_path / f"{tag}.png", window_size=SMALL)),
+                _read_as_written(render_side_by_side([box], [GreenWood()], SIZE, ["a"], tmp_path / f"{tag}_s.png",
+                                                     progress=False)))
+
+    ours, ours_side = pictures("ours")
+    request.getfixturevalue("users_theme")
+    theirs, theirs_side = pictures("theirs")
+    # the corner is the scene's background (white), the middle the untextured part, shaded
+    assert np.all(theirs[0, 0] == 255) and np.all(theirs[-1, -1] == 255), theirs[0, 0]
+    mid = theirs[SMALL[1] // 2, SMALL[0] // 2]
+    part = np.asarray(UNTEXTURED_PART_COLOR) * 255
+    assert np.allclose(mid / mid.max(), part / part.max(), atol=0.05), mid
+    assert np.abs(theirs - ours).max() <= 2
+    assert np.all(theirs_side[0, 0] == ours_side[0, 0]) and np.abs(theirs_side - ours_side).max() <= 2
+    assert pv.global_theme.background.name == "black"  # the user's theme is left as it was
+
+
 def test_checker_texture_shows_red_and_blue(tmp_path):
     img = _read(preview(_textured_box(), size_mm=SIZE, screenshot=tmp_path / "p.png",
                         window_size=SMALL))

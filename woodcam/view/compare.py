@@ -40,7 +40,7 @@ def render_side_by_side(meshes, woods, size_mm, titles, png, *, panel_px: int = 
     ``progress``: a bar over the panels."""
     from ..appearance.wood import vertex_color_normals, wood_colors
     from ..errors import require
-    from .scene import _prefer_egl_off_screen
+    from .scene import _plotter, _prefer_egl_off_screen
 
     pv = require("pyvista", "view", "rendering placement pictures")
     import trimesh
@@ -49,8 +49,7 @@ def render_side_by_side(meshes, woods, size_mm, titles, png, *, panel_px: int = 
 
     _prefer_egl_off_screen()
     n = len(meshes)
-    plotter = pv.Plotter(off_screen=True, shape=(1, n), window_size=(panel_px * n, panel_px),
-                         border=False)
+    plotter = _plotter(pv, off_screen=True, shape=(1, n), window_size=(panel_px * n, panel_px), border=False)
     try:
         W, D, H = (float(v) for v in size_mm)
         for i, (mesh, wood, title) in enumerate(progress_bar(list(zip(meshes, woods, titles)), desc="rendering",

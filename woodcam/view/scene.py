@@ -182,6 +182,15 @@ def _pyvista():
     return require("pyvista", "view", "the preview")
 
 
+def _plotter(pv, **kwargs):
+    """A ``pv.Plotter(**kwargs)`` of woodcam's views, drawn with pyvista's own default theme
+    (its DocumentTheme), never ``pyvista.global_theme``: a user's script that set
+    ``pyvista.global_theme.lighting = False``, ``.show_edges``, ``.opacity`` or
+    ``.transparent_background`` (or PYVISTA_PLOT_THEME) changed woodcam's pictures (flat, edged,
+    see-through parts, a PNG of RGBA with no background) and the placement pictures' background."""
+    return pv.Plotter(theme=pv.themes.DocumentTheme(), **kwargs)
+
+
 # ---------------------------------------------------------------------------- input checks
 
 
@@ -895,8 +904,7 @@ def preview(
     off_screen = screenshot is not None
     if off_screen:
         _prefer_egl_off_screen()
-    plotter = pv.Plotter(off_screen=off_screen, window_size=window_size,
-                         title="woodcam preview")
+    plotter = _plotter(pv, off_screen=off_screen, window_size=window_size, title="woodcam preview")
     try:
         build_scene(plotter, mesh, wood=wood, size_mm=size_mm, widget=not off_screen, options=opt)
         for seg, colour, width in overlay:

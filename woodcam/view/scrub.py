@@ -196,14 +196,13 @@ def gcode_window(program, tools, stock, *, work_offset_mm=None, resolution_mm: f
     :class:`ScrubCallback` as the slider would). ``colours`` replaces some of
     :data:`PATH_COLOURS`, checked before the window opens (:func:`_path_colours`)."""
     from .camera import set_camera
-    from .scene import _pyvista, add_view_keys
+    from .scene import _plotter, _pyvista, add_view_keys
 
     pv = _pyvista()
     colours = _path_colours(colours, "gcode_window")  # before any window
     if not off_screen:
         check_display()
-    plotter = pv.Plotter(off_screen=off_screen, window_size=window_size,
-                         title="woodcam gcode")
+    plotter = _plotter(pv, off_screen=off_screen, window_size=window_size, title="woodcam gcode")
     callback = ScrubCallback(plotter, program, tools, stock, work_offset_mm=work_offset_mm,
                              resolution_mm=resolution_mm, initial_heightmap=initial_heightmap,
                              heightmap=heightmap, line=until_line, colours=colours)
