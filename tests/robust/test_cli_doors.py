@@ -174,6 +174,37 @@ def test_bad_options_fail_fast_with_one_line(argv, code, match, tmp_path, capsys
     assert __import__("re").search(match, err), err
 
 
+@pytest.mark.parametrize("argv, said", [
+    (["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb"],
+     "woodcam gcode: no tools given; pass --tool SPEC"),
+    (["log", "export", "--real", "--maps", "toolpaths", "--out", "OUT/l.json"],
+     "give exactly one log: a LOG_FILE, --real or --maps DIR; got 2"),
+    (["log", "maps", "--out", "OUT/m"], "give exactly one log: a LOG_FILE, --real or --maps DIR; got 0"),
+    (["block", "from-photos", "toolpaths", "--size-mm", "50x0x3", "--out", "OUT/b"],
+     "--size-mm takes WxDxH in mm, 3 numbers in (0, 10000]"),
+])
+def test_a_commands_own_usage_checks_come_before_any_work(argv, said, tmp_path, capsys, monkeypatch):
+    """Test only: the usage checks the commands make themselves (gcode's no tools, log's one log,
+    block from-photos' --size-mm) refuse the command line (exit 2, one line) before the program,
+    the block, the log or the photos are read, and write nothing: the steps that read them fail
+    the test if reached."""
+    from importlib import import_module
+
+    def reached(*_a, **_k):
+        raise AssertionError("work done before the usage check")
+
+    for mod, name in (("toolpath.gcode", "read_gcode"), ("toolpath.simulate", "simulate"),
+                      ("stock", "open_stock"), ("logs.io", "read_log"), ("logs.io", "read_gran1"),
+                      ("logs.maps", "read_maps"), ("block.photos", "block_from_photos")):
+        monkeypatch.setattr(import_module(f"woodcam.{mod}"), name, reached)
+    monkeypatch.chdir(__import__("pathlib").Path(__file__).resolve().parents[2])
+    out = tmp_path / "out"
+    assert main([a.replace("OUT", str(out)) for a in argv]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and said in err, err
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("value", ["nan,nan,nan", "0,0,inf", "1,2"])
 def test_work_offset_must_be_three_finite_numbers(value, capsys):
     """Issue 15: `--work-offset nan,nan,nan` exited 0 (and cut nothing)."""
