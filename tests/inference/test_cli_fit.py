@@ -50,6 +50,17 @@ def test_fit_makes_a_missing_out_folder(block_dir, tmp_path, capsys):
     assert GridField.load(out).years.size
 
 
+def test_fit_writes_the_out_file_it_was_given_whatever_the_suffix_case(block_dir, tmp_path, capsys):
+    """--out takes .npz in any case (check_out); the field was then written to 'f.NPZ.npz' (numpy's
+    rule, case-sensitive) and the named file never appeared."""
+    folder, _, _ = block_dir
+    out = tmp_path / "f.NPZ"
+    assert main(["fit", str(folder), "--method", "radial", "--out", str(out)]) == 0
+    assert f"wrote {out} " in capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.NPZ"]
+    assert GridField.load(out).years.size
+
+
 def test_eval_writes_table_and_images(block_dir, tmp_path):
     folder, truth, _ = block_dir
     out = tmp_path / "ev"

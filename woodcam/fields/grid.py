@@ -192,9 +192,11 @@ class GridField:
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     def save(self, path: PathLike) -> Path:
-        """Write the grid to an ``.npz`` file; :meth:`load` restores it exactly."""
+        """Write the grid to an ``.npz`` file; :meth:`load` restores it exactly. A ``path``
+        without the suffix gets ``.npz`` appended; one ending in it in any case (``F.NPZ``, which
+        ``woodcam fit --out`` takes) is written as named."""
         path = Path(path)
-        if path.suffix != ".npz":
+        if path.suffix.lower() != ".npz":  # '.NPZ' became 'f.NPZ.npz' beside the name asked for
             path = path.with_suffix(path.suffix + ".npz")
         import json
 
