@@ -81,6 +81,21 @@ def test_eval_seed_on_blocks_with_a_truth_is_said_to_change_nothing(block_dir, t
     assert "--seed 3 seeds the held-out scoring of real blocks only; eq79 have a true field" in capsys.readouterr().err
 
 
+def test_eval_seed_without_the_evidence_method_is_said_to_change_nothing(tmp_path, capsys):
+    """--seed seeds only the evidence fit (fit_block: other methods ignore it); with the default
+    --methods rbf,radial a real block's scores were the same for every seed, without a word."""
+    block = make_block(random_field(np.random.default_rng(104)), px_per_mm=3, traces=False, ring_map=True,
+                       faces=("front", "top", "left"))
+    block.true_field = None  # a real block: held-out scoring, where --seed is meant
+    folder = tmp_path / "real"
+    write_block(block, folder)
+    assert main(["eval", "rings", str(folder), "--methods", "radial", "--seed", "4294967295",
+                 "--out", str(tmp_path / "ev")]) == 0
+    err = capsys.readouterr().err
+    assert ("--seed 4294967295 seeds the evidence fit only, and --methods radial has none: every score is "
+            "the one any seed gives; add evidence to --methods (e.g. --methods evidence,radial) or drop --seed") in err
+
+
 @pytest.mark.slow
 def test_eval_confidence_overlay_and_summary(block_dir, tmp_path):
     """`eval rings --confidence` (issue 12 part 5): the evidence fit's confidence drawn under its

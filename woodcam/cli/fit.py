@@ -63,7 +63,8 @@ def register(subparsers) -> None:
                    "against the block's own ring maps (e.g. the Mokume U-Net maps) as the reference")
     e.add_argument("--seed", type=int, default=None,
                    help="real blocks: the evidence fit's random seed (held-out points, fitting subsets; "
-                   "default 0); a real cube's held-out score can swing with it, so compare several")
+                   "default 0; the other methods draw nothing at random, and --seed without evidence in "
+                   "--methods is warned of); a real cube's held-out score can swing with it, so compare several")
     add_confidence_option(e)
     add_out_option(e, "table.md and cut-plane PNGs")
     e.set_defaults(func=run_eval)
@@ -135,6 +136,15 @@ def _run_eval(args, blocks, methods, partial) -> None:
         warnings.warn(f"--seed {args.seed} seeds the held-out scoring of real blocks only; "
                       f"{', '.join(b.name for b in known)} have a true field and are scored on cut "
                       "planes, which it does not change", WoodcamWarning, stacklevel=2)
+    elif args.seed is not None and "evidence" not in methods:  # the other fitters draw nothing at random
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        warnings.warn(f"--seed {args.seed} seeds the evidence fit only, and --methods "
+                      f"{','.join(methods)} has none: every score is the one any seed gives; add "
+                      f"evidence to --methods (e.g. --methods evidence,{','.join(methods)}) or drop --seed",
+                      WoodcamWarning, stacklevel=2)
     if known:
         sets = {"full": None}
         if args.partial_faces.lower() != "none":
