@@ -80,6 +80,17 @@ def test_sections_off_the_log_are_refused_by_name():
     assert lr.radial_section(log, 300.0, np.radians(-90.0)).name == "radial_z300_az270"
 
 
+def test_a_section_too_fine_names_the_px_per_mm_and_supersample_given():
+    """'log render --px-per-mm 50 --supersample 4' was refused as 'the section ... at 200 px/mm',
+    a number nobody typed, with 'lower --px-per-mm' as the only way out."""
+    section = lr.radial_section(_log(), 300.0, 0.0, px_per_mm=50.0)
+    with pytest.raises(WoodcamError, match=r"at 50 px/mm with 4x4 samples a pixel \(--supersample 4\) "
+                       r"\(a 42000x60000x3 grid\).*MAX_GRID_CELLS.*; lower --px-per-mm or --supersample;"):
+        lr.render_section(KnottedLogField(_log()), section, supersample=4)
+    with pytest.raises(WoodcamError, match=r"at 50 px/mm \(a 10500x15000x3 grid\).*; lower --px-per-mm;"):
+        lr.render_section(KnottedLogField(_log()), section)
+
+
 def test_a_section_past_the_logs_end_says_which_part_is_background():
     """--board 3900 0 60 on the 3990 mm log drew its last 210 mm as background without a word."""
     from woodcam.errors import WoodcamWarning

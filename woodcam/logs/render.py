@@ -45,13 +45,23 @@ class Section:
         return (max(1, int(round(self.size_mm[1] * self.px_per_mm))),
                 max(1, int(round(self.size_mm[0] * self.px_per_mm))))
 
-    def points(self) -> np.ndarray:
-        """Pixel-centre points ``(rows, cols, 3)`` in the log frame, mm."""
+    def check_size(self, supersample: int = 1) -> None:
+        """Refuse, before any allocation, a section whose points at ``supersample`` x
+        ``supersample`` samples a pixel pass :data:`woodcam.limits.MAX_GRID_CELLS`, naming the
+        ``--px-per-mm`` and ``--supersample`` given (a 4 m board at 1000 px/mm asked for 1.57 TiB,
+        3 floats a point; ``--px-per-mm 50 --supersample 4`` was said as '200 px/mm')."""
         from ..limits import check_grid
 
-        # a 4 m board at 1000 px/mm asked for 1.57 TiB (3 floats a point)
-        check_grid((self.size_mm[1] * self.px_per_mm, self.size_mm[0] * self.px_per_mm, 3),
-                   f"the section {self.name!r} at {self.px_per_mm:g} px/mm", fix="lower --px-per-mm")
+        s = int(supersample)
+        what = f"the section {self.name!r} at {self.px_per_mm:g} px/mm"
+        if s > 1:
+            what += f" with {s}x{s} samples a pixel (--supersample {s})"
+        check_grid((self.size_mm[1] * self.px_per_mm * s, self.size_mm[0] * self.px_per_mm * s, 3),
+                   what, fix="lower --px-per-mm" + (" or --supersample" if s > 1 else ""))
+
+    def points(self) -> np.ndarray:
+        """Pixel-centre points ``(rows, cols, 3)`` in the log frame, mm."""
+        self.check_size()
         rows, cols = self.shape()
         o, u, v = (np.asarray(a, float) for a in (self.origin_mm, self.u, self.v))
         j = (np.arange(cols) + 0.5) / self.px_per_mm
@@ -193,6 +203,7 @@ def render_section(field: KnottedLogField, section: Section, *, background=BACKG
     """
     s = int(supersample)
     if s > 1:
+        section.check_size(s)  # in the numbers typed: the fine section's own check said ppm * s
         rows, cols = section.shape()
         ppm = section.px_per_mm
         fine = Section(section.origin_mm, section.u, section.v, (cols / ppm, rows / ppm),
