@@ -59,6 +59,26 @@ def test_no_orientation_fits_is_a_clear_error(knotty):
         advise_placement(manifold3d.Manifold.cube([10.0, 10.0, 10.0]), knotty, rotations="any")
 
 
+def test_no_fit_offers_only_the_fixes_that_make_the_part_fit(knotty):
+    """A 200 mm stick in the 100x80x50 mm block was told to 'allow more rotations (--rotations
+    all90), a smaller margin (--margin) or a bigger block': the first two cannot help (it is
+    longer than every side). Now each fix offered makes it fit: all90 where an orientation of the
+    24 fits, the largest margin that fits, and the block that holds the part as modelled."""
+    def no_fit(size, **kw):
+        with pytest.raises(WoodcamError) as err:
+            advise_placement(manifold3d.Manifold.cube(size), knotty, candidates=4, **kw)
+        return str(err.value).partition("margin; ")[2]
+
+    assert no_fit([200.0, 20.0, 10.0]) == ("a bigger block (at least 202x80x50 mm for the part as modelled "
+                                          "with the margin; a built-in block takes it as builtin:NAME:WxDxH)")
+    assert no_fit([10.0, 10.0, 60.0]).startswith("allow more rotations (--rotations all90) or a bigger block "
+                                                  "(at least 100x80x62 mm ")
+    assert no_fit([90.0, 60.0, 10.0], margin_mm=8.0).startswith("a margin of at most 5 mm (--margin) or a "
+                                                                 "bigger block (at least 106x80x50 mm ")
+    assert no_fit([10.0, 10.0, 60.0], rotations="all90", margin_mm=30.0).startswith(
+        "a margin of at most 20 mm (--margin) or a bigger block (at least 100x80x120 mm ")
+
+
 def test_place_warns_of_a_part_in_inches_and_advises_only_what_is_left(knotty):
     """A part file in inches (read as mm: 25.4 x too small) was ranked as a speck without a
     word; a part too long in every one of the 24 orientations was told to 'allow more
@@ -68,10 +88,10 @@ def test_place_warns_of_a_part_in_inches_and_advises_only_what_is_left(knotty):
     with pytest.warns(WoodcamWarning, match=r"25.4 times larger it would still fit.*in inches scale it first: "
                                            r"woodcam.cad.place.place_part\(part, \['scale:25.4'\]"):
         advise_placement(manifold3d.Manifold.cube([3.0, 2.0, 0.5]), knotty, candidates=8)
-    with pytest.raises(WoodcamError, match="with a 1 mm margin; a smaller margin .--margin. or a bigger block"):
+    with pytest.raises(WoodcamError, match=r"with a 1 mm margin; a bigger block \(at least 122x80x50 mm"):
         advise_placement(manifold3d.Manifold.cube([120.0, 10.0, 10.0]), knotty, rotations="all90")
-    with pytest.raises(WoodcamError, match="allow more rotations .--rotations all90."):
-        advise_placement(manifold3d.Manifold.cube([120.0, 10.0, 10.0]), knotty, rotations="z90")
+    with pytest.raises(WoodcamError, match=r"'z90' orientations with a 1 mm margin; a bigger block \(at least 122x80x50"):
+        advise_placement(manifold3d.Manifold.cube([120.0, 10.0, 10.0]), knotty, rotations="z90")  # no all90: none fits
 
 
 def test_the_part_report_warns_of_short_grain_only_across_the_fibres():

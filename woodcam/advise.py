@@ -241,14 +241,37 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
                 matrix=matrix, terms={n: float(v[i]) for n, v in terms.items()},
                 score=float(score[i])))
     if not ranked:
-        more = "" if rotations == "all90" else "allow more rotations (--rotations all90), "
         raise WoodcamError(
             f"advise_placement: the part ({say_length(hi - lo, '.1f')}) fits the "
             f"{say_length(size, 'g')} block in none of the '{rotations}' "
-            f"orientations with a {say_length(margin_mm, 'g')} margin; {more}a smaller margin (--margin) or "
-            "a bigger block")
+            f"orientations with a {say_length(margin_mm, 'g')} margin; {_no_fit_fixes(hi - lo, size, rotations, margin_mm)}")
     ranked.sort(key=lambda p: p.score)
     return PlacementAdvice(ranked, len(ranked), elongation, w)
+
+
+def _no_fit_fixes(extent, size, rotations: str, margin_mm: float) -> str:
+    """The fixes of a part (bounding box ``extent``, mm) that fits the block ``size`` in none of
+    the ``rotations`` orientations with ``margin_mm``, those only that make it fit: more
+    rotations where one of all 24 fits, a margin where a smaller one fits (the largest, as a
+    number to type), and always the block that holds the part as modelled. The error offered
+    all90 and a smaller margin to a part longer than every side of the block."""
+    from .units import message_unit, typed_length
+
+    def room(rot):  # the margin the part has in orientation rot (negative: it sticks out)
+        return float(np.min((size - np.abs(rot) @ extent) / 2))
+
+    fixes = []
+    if rotations != "all90" and max(room(rot) for _, rot in _orientations("all90")) >= margin_mm - 1e-9:
+        fixes.append("allow more rotations (--rotations all90)")
+    best = max(room(rot) for _, rot in _orientations(rotations))
+    if best >= 0:
+        fixes.append(f"a margin of at most {typed_length(best, 0.05, ok=lambda v: v <= best)} "
+                     f"{message_unit()} (--margin)")
+    need = np.maximum(size, extent + 2 * margin_mm)
+    block = "x".join(typed_length(n, 0.05, ok=lambda v, n=n: v >= n) for n in need)
+    fixes.append(f"a bigger block (at least {block} {message_unit()} for the part as modelled with the "
+                 "margin; a built-in block takes it as builtin:NAME:WxDxH)")
+    return ", ".join(fixes[:-1]) + (" or " if len(fixes) > 1 else "") + fixes[-1]
 
 
 def render_advice(advice: PlacementAdvice, part, stock, png, *, top: int = 3, progress: bool = False):
