@@ -78,6 +78,25 @@ def test_file_command_refuses_wrong_suffix_and_existing_folder(tmp_path, capsys)
         check_out(build_parser().parse_args(["bake", "x.py", "--block", "b", "--out", str(folder)]))
 
 
+def test_a_file_out_whose_suffix_slipped_is_offered_the_right_suffix(tmp_path, capsys):
+    """'fit --out f.npy' and 'review --out page.htm' were told they named a folder, with
+    'f.npy/part.npz' as the fix; a name with a suffix-like end is offered its name with the
+    command's suffix first, the folder reading second. A name without one stays a folder."""
+    out = tmp_path / "f.npy"
+    assert main(["fit", "builtin:rift", "--out", str(out)]) == EXIT_USAGE
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"woodcam: error: --out of 'woodcam fit' must end in .npz; got {str(out)!r}, whose suffix "
+                   f"'.npy' is none of them; give e.g. {str(tmp_path / 'f.npz')!r} (or "
+                   f"{str(out / 'part.npz')!r} to write into a folder {str(out)!r})"], err
+    assert list(tmp_path.iterdir()) == []
+    for name in ("page.htm", "page.HTM"):
+        with pytest.raises(UsageError, match=r"must end in .html; got .*, whose suffix '\.(htm|HTM)' .* e\.g\. '.*page\.html'"):
+            check_out(build_parser().parse_args(["review", "p.glb", "--out", str(tmp_path / name)]))
+    for name in ("run.2", "a_folder"):  # no suffix a user types for a file: a folder, as before
+        with pytest.raises(UsageError, match="is a FILE ending in .html; got .*a folder"):
+            check_out(build_parser().parse_args(["review", "p.glb", "--out", str(tmp_path / name)]))
+
+
 def test_folder_command_refuses_an_existing_file(tmp_path):
     f = tmp_path / "place_here"
     f.write_text("")

@@ -98,6 +98,13 @@ def add_out_option(p: argparse.ArgumentParser, writes: str, *, suffixes: tuple[s
     p.set_defaults(_out_suffixes=tuple(suffixes))
 
 
+def _looks_like_a_suffix(suffix: str) -> bool:
+    """``suffix`` (lower case, with its dot) reads as a file type a user meant: 1-5 letters or
+    digits, at least one a letter (``.npy``, ``.htm``, ``.jpeg``; not ``.2`` of ``run.2``)."""
+    tail = suffix[1:]
+    return 1 <= len(tail) <= 5 and tail.isascii() and tail.isalnum() and not tail.isdigit()
+
+
 def check_out(args: argparse.Namespace) -> None:
     """Refuse an ``--out`` that breaks :data:`OUT_RULE` for this command, before any work:
     a UsageError (exit 2) naming the command, what it wants, the value and a fix."""
@@ -111,6 +118,13 @@ def check_out(args: argparse.Namespace) -> None:
     suffix = out.suffix.lower()
     command = _command_name(args)
     if suffixes:
+        if not out.is_dir() and suffix not in FILE_SUFFIXES and _looks_like_a_suffix(suffix):
+            # 'fit --out f.npy', 'review --out page.htm': a file name with a slip in its suffix was
+            # told it named a folder, and offered 'f.npy/part.npz'
+            raise UsageError(f"--out of 'woodcam {command}' must end in {' or '.join(suffixes)}; "
+                             f"got {str(out)!r}, whose suffix {out.suffix!r} is none of them; give e.g. "
+                             f"{str(out.with_suffix(suffixes[0]))!r} (or "
+                             f"{str(out / ('part' + suffixes[0]))!r} to write into a folder {str(out)!r})")
         if out.is_dir() or suffix not in FILE_SUFFIXES:
             raise UsageError(f"--out of 'woodcam {command}' is a FILE ending in "
                              f"{' or '.join(suffixes)}; got {str(out)!r}, a folder; give a file "
