@@ -169,6 +169,17 @@ def test_block_synth_on_an_engine_into_a_set_of_another_seed_is_refused(tmp_path
     assert "1 already done, 1 computed" in capsys.readouterr().out
 
 
+def test_block_synth_says_why_a_block_failed(tmp_path, capsys):
+    """'block synth --size-range-mm 10000,10000 --workers 1' printed '1 keys: ... 1 failed; ...'
+    and exit 3 with no reason: the error was in OUT/.synth/records only."""
+    out = tmp_path / "set"
+    assert main(["block", "synth", "--count", "1", "--face-px", "16", "--quiet", "--knotted-fraction", "1",
+                 "--workers", "1", "--size-range-mm", "10000,10000", "--out", str(out)]) == 3
+    said = capsys.readouterr().out
+    assert "1 failed" in said and "; block_0000 failed: WoodcamError: no knot of this log crosses a " \
+        "10000 x 10000 mm block after 60 tries; use a smaller block" in said, said
+
+
 def test_a_benchmark_set_resumes_with_its_defaults_spelled_out(tmp_path):
     """block_options were stored as given: a rerun spelling out a default (size_range_mm
     [30, 80], as 'block synth --engine' does) was refused as a set of other settings."""

@@ -77,7 +77,8 @@ _THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "B
 
 @dataclass(frozen=True)
 class RunSummary:
-    """What :func:`run_many` did: counts of keys and the wall time (s) of this call."""
+    """What :func:`run_many` did: counts of keys and the wall time (s) of this call;
+    ``first_failure`` is ``"KEY failed: ERROR"`` of the first key that failed in it ('' if none)."""
 
     out_dir: Path
     engine: str
@@ -87,11 +88,19 @@ class RunSummary:
     done: int
     failed: int
     wall_s: float
+    first_failure: str = ""
 
     def line(self) -> str:
+        """One line for a command to print; with failures, the first one's error (a run whose
+        every key failed said '1 failed' and no why: the error was in a hidden record only)."""
+        why = ""
+        if self.failed and self.first_failure:
+            more = self.failed - 1
+            why = (f"; {self.first_failure}" + (f" ({more} more failed: each error is in its record)"
+                                                 if more else ""))
         return (f"{self.total} keys: {self.skipped} already done, {self.done} computed, "
                 f"{self.failed} failed; {self.wall_s:.1f} s on {self.engine} with "
-                f"{self.workers} worker(s); records in {self.out_dir / RECORDS_DIR}")
+                f"{self.workers} worker(s); records in {self.out_dir / RECORDS_DIR}{why}")
 
 
 # -- records --------------------------------------------------------------------------------------
@@ -340,10 +349,13 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
     bar = progress_bar(total=len(keys), initial=skipped, desc=desc, unit="task", smoothing=0.1,
                        enabled=progress, dynamic_ncols=True)
     counts = {"ok": 0, "failed": 0}
+    first_failure: list[str] = []
 
     def finish(rec: dict) -> None:
         write_json_atomic(record_path(out_dir, rec["key"]), rec)
         counts[rec["status"]] += 1
+        if rec["status"] == "failed" and not first_failure:
+            first_failure.append(f"{rec['key']} failed: {rec.get('error', 'no error recorded')}")
         bar.update(1)
         if counts["failed"]:
             bar.set_postfix(failed=counts["failed"], refresh=False)
@@ -367,7 +379,7 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
         if scratch is not None:
             shutil.rmtree(scratch, ignore_errors=True)
     return RunSummary(out_dir, engine, n_workers, len(keys), skipped, counts["ok"],
-                      counts["failed"], time.perf_counter() - t0)
+                      counts["failed"], time.perf_counter() - t0, "".join(first_failure))
 
 
 def _run_local(fn, todo, n_workers, retries, memory_limit_mb, finish) -> None:

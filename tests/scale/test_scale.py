@@ -130,6 +130,10 @@ def test_kill9_mid_run_then_rerun_recomputes_nothing_and_loses_nothing(tmp_path)
 
 # -- failures -------------------------------------------------------------------------------------
 
+#: The line of _scale_tasks.py whose raise a failed record names.
+_FLAKY_RAISES_AT = next(i for i, line in enumerate(Path(tasks.__file__).read_text().splitlines(), 1)
+                        if "refuses on purpose" in line)
+
 @pytest.mark.parametrize("engine,workers", [("local", 1), ("local", 2)])
 def test_raising_task_is_retried_then_recorded_failed_and_the_run_goes_on(tmp_path, engine, workers):
     log = tmp_path / "log"
@@ -148,6 +152,9 @@ def test_raising_task_is_retried_then_recorded_failed_and_the_run_goes_on(tmp_pa
     s2 = run_many(partial(tasks.flaky, log_dir=str(log)), keys, tmp_path / "run", engine=engine,
                   workers=workers, retries=0, progress=False)
     assert (s2.skipped, s2.done, s2.failed) == (5, 0, 1)
+    # the summary line says why, not only how many: the error was in the hidden record only
+    assert s.line().endswith(f"records in {tmp_path / 'run' / RECORDS_DIR}; k3 failed: ValueError: task k3 "
+                             f"refuses on purpose (at _scale_tasks.py:{_FLAKY_RAISES_AT})"), s.line()
 
 
 def test_memory_limit_per_local_worker(tmp_path):
