@@ -90,6 +90,29 @@ def test_eval_realistic_takes_methods_all_as_eval_rings_does(tmp_path, monkeypat
     assert asked == [list(METHODS)]
 
 
+def test_eval_realistic_says_the_evidence_only_options_change_nothing_without_evidence(tmp_path, monkeypatch,
+                                                                                     capsys):
+    """--no-knot-bend, --no-knot-cones and --residual act on the evidence fit only (fit_block);
+    'eval realistic --methods radial --residual --no-knot-bend' ran and said nothing of them."""
+    import woodcam.bench_realistic
+    from woodcam.cli import main
+
+    def score_block(seed, index, methods, *args, **kwargs):
+        raise SystemExit(0)  # the warning comes before the work: no block is needed
+
+    monkeypatch.setattr(woodcam.bench_realistic, "score_block", score_block)
+    with pytest.raises(SystemExit):
+        main(["eval", "realistic", "--seed", "1", "--count", "1", "--methods", "rbf,radial", "--residual",
+              "--no-knot-bend", "--out", str(tmp_path / "out")])
+    assert ("woodcam: warning: --no-knot-bend and --residual act on the evidence fit only, and --methods "
+            "rbf,radial has none: they change nothing; add evidence to --methods (e.g. --methods "
+            "evidence,rbf,radial) or drop them") in capsys.readouterr().err
+    with pytest.raises(SystemExit):  # with evidence they act: no word
+        main(["eval", "realistic", "--seed", "1", "--count", "1", "--methods", "evidence", "--residual",
+              "--out", str(tmp_path / "out2")])
+    assert "evidence fit only" not in capsys.readouterr().err
+
+
 def test_eval_realistic_outputs_land_as_one_set_and_a_rerun_removes_the_earlier_runs(tmp_path, monkeypatch,
                                                                                      capsys):
     """records.json was rewritten after every block and the PNGs drawn as they came, table.md at

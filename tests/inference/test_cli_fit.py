@@ -92,8 +92,8 @@ def test_eval_seed_without_the_evidence_method_is_said_to_change_nothing(tmp_pat
     assert main(["eval", "rings", str(folder), "--methods", "radial", "--seed", "4294967295",
                  "--out", str(tmp_path / "ev")]) == 0
     err = capsys.readouterr().err
-    assert ("--seed 4294967295 seeds the evidence fit only, and --methods radial has none: every score is "
-            "the one any seed gives; add evidence to --methods (e.g. --methods evidence,radial) or drop --seed") in err
+    assert ("--seed 4294967295 acts on the evidence fit only, and --methods radial has none: it changes "
+            "nothing; add evidence to --methods (e.g. --methods evidence,radial) or drop it") in err
 
 
 @pytest.mark.slow

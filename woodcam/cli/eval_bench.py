@@ -57,10 +57,12 @@ def run_realistic(args) -> int:
     from .._progress import progress_bar, write
     from ..bench_realistic import FACE_SETS, SCENARIOS, confidence_markdown, markdown, score_block, summarise
 
-    from .fit import METHODS
+    from .fit import METHODS, warn_evidence_only
 
     # 'all' is every method, as in eval rings
     methods = comma_names(args.methods, "--methods", METHODS, all_=True) or list(METHODS)
+    warn_evidence_only([o for o, on in (("--no-knot-bend", not args.knot_bend), ("--no-knot-cones", not args.knot_cones),
+                                        ("--residual", args.residual)) if on], methods)
     scenarios = comma_names(args.scenarios, "--scenarios", tuple(SCENARIOS))
     faces = comma_names(args.faces, "--faces", tuple(FACE_SETS))
     out = Path(args.out)

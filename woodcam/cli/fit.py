@@ -70,6 +70,25 @@ def register(subparsers) -> None:
     e.set_defaults(func=run_eval)
 
 
+def warn_evidence_only(given: list[str], methods) -> None:
+    """Warn, before the work, that the options ``given`` (as typed: ``--seed 3``, ``--residual``)
+    act on the evidence fit only (:func:`woodcam.inference.fit.fit_block`'s ``seed``,
+    ``knot_bend``, ``knot_cones``, ``residual``) when ``methods`` lacks it: they were accepted
+    and changed nothing, without a word (``eval rings --seed`` with the default rbf,radial,
+    ``eval realistic --methods radial --residual``)."""
+    if not given or "evidence" in methods:
+        return
+    import warnings
+
+    from ..errors import WoodcamWarning
+
+    one = len(given) == 1
+    warnings.warn(f"{' and '.join(given)} act{'s' if one else ''} on the evidence fit only, and --methods "
+                  f"{','.join(methods)} has none: {'it changes' if one else 'they change'} nothing; add "
+                  f"evidence to --methods (e.g. --methods evidence,{','.join(methods)}) or drop "
+                  f"{'it' if one else 'them'}", WoodcamWarning, stacklevel=3)
+
+
 def run_fit(args) -> int:
     from .._progress import StageBar
     from ..stock import fitted_field
@@ -136,15 +155,8 @@ def _run_eval(args, blocks, methods, partial) -> None:
         warnings.warn(f"--seed {args.seed} seeds the held-out scoring of real blocks only; "
                       f"{', '.join(b.name for b in known)} have a true field and are scored on cut "
                       "planes, which it does not change", WoodcamWarning, stacklevel=2)
-    elif args.seed is not None and "evidence" not in methods:  # the other fitters draw nothing at random
-        import warnings
-
-        from ..errors import WoodcamWarning
-
-        warnings.warn(f"--seed {args.seed} seeds the evidence fit only, and --methods "
-                      f"{','.join(methods)} has none: every score is the one any seed gives; add "
-                      f"evidence to --methods (e.g. --methods evidence,{','.join(methods)}) or drop --seed",
-                      WoodcamWarning, stacklevel=2)
+    elif args.seed is not None:  # the other fitters draw nothing at random
+        warn_evidence_only([f"--seed {args.seed}"], methods)
     if known:
         sets = {"full": None}
         if args.partial_faces.lower() != "none":
