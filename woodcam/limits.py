@@ -64,8 +64,18 @@ def limit(name: str) -> float:
     except ValueError:
         value = math.nan
     if not (math.isfinite(value) and value > 0):
-        raise WoodcamError(f"WOODCAM_{name} must be a positive number; got {raw!r}")
+        raise WoodcamError(f"WOODCAM_{name} must be a positive number; got {raw!r}; e.g. export "
+                           f"WOODCAM_{name}={2 * _DEFAULTS[name]:.0f}, or unset it for the default "
+                           f"{_DEFAULTS[name]:g}")
     return type(_DEFAULTS[name])(value)
+
+
+def check_all() -> None:
+    """Read every limit's ``$WOODCAM_<NAME>`` (:func:`limit`): a malformed one raises its error
+    now. ``woodcam`` calls it before a command's work: read only when a guard ran, after the
+    work before it (a fit of seconds to minutes), 'WOODCAM_MAX_GRID_CELLS=abc' failed late."""
+    for name in _DEFAULTS:
+        limit(name)
 
 
 def check_limit(name: str, value: float, what: str, fix: str = "") -> None:

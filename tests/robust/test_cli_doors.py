@@ -361,3 +361,30 @@ def test_the_interrupt_flag_lives_for_one_command_only(monkeypatch, capsys):
     monkeypatch.setattr(bake_cli, "run_blocks", lambda args: 0)
     assert main(["blocks"]) == 0
     capsys.readouterr()
+
+
+@pytest.mark.parametrize("var,value,message", [
+    ("WOODCAM_CACHE_MAX_MB", "abc", "WOODCAM_CACHE_MAX_MB must be a number of MiB > 0; got 'abc'; e.g. export "
+     "WOODCAM_CACHE_MAX_MB=4096"),
+    ("WOODCAM_MAX_GRID_CELLS", "abc", "WOODCAM_MAX_GRID_CELLS must be a positive number; got 'abc'; e.g. export "
+     "WOODCAM_MAX_GRID_CELLS=400000000, or unset it for the default 2e+08"),
+    ("WOODCAM_WORKERS", "0", "WOODCAM_WORKERS must be an integer >= 1"),
+])
+def test_a_malformed_woodcam_setting_is_refused_before_the_work(var, value, message, tmp_path, monkeypatch, capsys):
+    """Each WOODCAM_* setting was read where it is used: 'WOODCAM_CACHE_MAX_MB=abc woodcam fit
+    builtin:rift --method radial --out f.npz' fitted for seconds, stored the field in the cache,
+    then failed and wrote no --out (and passed silently once the field was cached)."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv(var, value)
+    out = tmp_path / "f.npz"
+    assert main(["fit", "builtin:rift", "--method", "radial", "--out", str(out)]) == EXIT_ERROR
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith(f"woodcam: error: {message}"), err
+    assert not out.exists() and not (tmp_path / "cache").exists()  # no work was done
+
+
+def test_workers_on_the_command_line_overrides_a_malformed_woodcam_workers(tmp_path, monkeypatch):
+    """--workers sets the fit's cores for the run (apply_workers): the environment's is not read."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv("WOODCAM_WORKERS", "0")
+    assert main(["fit", "builtin:rift", "--method", "radial", "--workers", "1", "--out", str(tmp_path / "f.npz")]) == 0

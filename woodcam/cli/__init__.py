@@ -213,6 +213,7 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         warnings.simplefilter("always")
         try:
             from .options import (
+                check_environment,
                 check_inputs,
                 check_numbers,
                 check_out,
@@ -231,6 +232,7 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             # every input path there and of its kind, last: the value checks above say what is
             # wrong with the options first (a missing part is no reason to hide a bad --tool)
             check_inputs(args)
+            check_environment(args)  # the WOODCAM_* settings, read before the work, not after it
             rc = args.func(args)
             _interrupt.check()  # a Ctrl-C a library swallowed: the run did not end as asked
             sys.stdout.flush()  # here, not at exit: a closed pipe is then caught below

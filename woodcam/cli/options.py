@@ -196,6 +196,24 @@ def add_input(p, *flags: str, kind: InputKind, paths=None, suffixes=None, as_is:
     return action
 
 
+def check_environment(args: argparse.Namespace) -> None:
+    """Read woodcam's settings from the environment before any work: the resource limits
+    (``$WOODCAM_MAX_*``, :func:`woodcam.limits.check_all`), the cache's size
+    (``$WOODCAM_CACHE_MAX_MB``) and, where ``--workers`` does not set it, a fit's cores
+    (``$WOODCAM_WORKERS``); a malformed one raises its own error (exit 1). Each was read where
+    it is used: 'WOODCAM_CACHE_MAX_MB=abc woodcam fit builtin:rift --method radial --out f.npz'
+    fitted, stored the field in the cache, then failed and wrote no --out (a second run, the
+    field cached, passed without a word)."""
+    from .._cache import cache_max_bytes
+    from .._parallel import fit_workers
+    from ..limits import check_all
+
+    check_all()
+    cache_max_bytes()
+    if getattr(args, "workers", None) is None:  # --workers sets it for the run (apply_workers)
+        fit_workers()
+
+
 def check_inputs(args: argparse.Namespace) -> None:
     """Refuse an input path (:func:`add_input`) that does not exist or is of the wrong kind,
     before any work: a UsageError (exit 2) naming the argument, the path, the rule and a fix.
