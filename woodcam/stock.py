@@ -619,7 +619,11 @@ def _log_block_field(parsed: ParsedSpec):
     size_mm = parsed.size_mm or _LOG_BLOCK_SIZE_MM
     log = read_gran1() if source == "gran1" else read_log(source)
     if not 0 <= knot < len(log.knots):
-        raise WoodcamError(f"knot index in {spec!r} must be 0..{len(log.knots) - 1}; got {knot}")
+        # a spec that names no block: the command line says it of its --block, exit 2 (it exited 1)
+        rule = (f"the knot index must be 0..{len(log.knots) - 1} (log {source} has {len(log.knots)} "
+                f"knot{'' if len(log.knots) == 1 else 's'}); got {knot}; e.g. '{spec[:spec.rfind('@')]}@0'")
+        raise BlockSpecError(f"knot index in {spec!r} must be 0..{len(log.knots) - 1}; got {knot}",
+                             part="log", text=f"@{knot}", rule=rule, spec=parsed.spec)
     log_field = KnottedLogField(log)
     field = place_block_in_log(log_field, *block_at_knot(log, knot, size_mm))
     frame = None

@@ -388,3 +388,25 @@ def test_workers_on_the_command_line_overrides_a_malformed_woodcam_workers(tmp_p
     monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.setenv("WOODCAM_WORKERS", "0")
     assert main(["fit", "builtin:rift", "--method", "radial", "--workers", "1", "--out", str(tmp_path / "f.npz")]) == 0
+
+
+def test_a_log_blocks_knot_the_log_lacks_is_a_wrong_command_line(tmp_path, monkeypatch, capsys):
+    """'bake PART --block log:gran1@999' exited 1 ('knot index in ... must be 0..107; got 999'):
+    a spec that names no block is a wrong command line (exit 2, README), said of the argument
+    that gave it: --block, or the positional BLOCK of fit, eval rings and block show."""
+    from woodcam.fields.skeleton import BranchStrand, simple_log
+    from woodcam.logs.io import write_log
+
+    knot = BranchStrand.from_model(0.25, 0.0, 300.0, 0.0, 0.0, 0.0, 0.0, 100.0, 45.0)
+    write_log(simple_log(knots=[knot]), tmp_path / "l.json")
+    monkeypatch.chdir(tmp_path)
+    rule = "the knot index must be 0..0 (log l.json has 1 knot); got 3; e.g. 'log:l.json@0'"
+    (tmp_path / "p.stl").write_text("solid p\nendsolid p\n")
+    for argv, said in [
+        (["preview", "p.stl", "--block", "log:l.json@3~z90", "--screenshot", "s.png"], "--block log:l.json@3~z90"),
+        (["fit", "log:l.json@3", "--method", "radial", "--out", "f.npz"], "BLOCK of 'woodcam fit' (block spec 'log:l.json@3')"),
+        (["eval", "rings", "builtin:rift", "log:l.json@3", "--out", "ev"],
+         "BLOCK of 'woodcam eval rings' (block spec 'log:l.json@3')"),
+    ]:
+        assert main(argv) == EXIT_USAGE, argv
+        assert capsys.readouterr().err.splitlines() == [f"woodcam: error: {said}: {rule}"], argv

@@ -282,12 +282,18 @@ def _typed_spec(args: argparse.Namespace, err: BaseException) -> str:
     block, found when the block is opened (:func:`woodcam.stock.check_resize_in_block`), after
     the door. "" otherwise: a spec a GLB or a job file recorded is a file's, not the command's."""
     from ..errors import BlockSpecError
-    from .options import as_typed
+    from .options import _command_name, as_typed
 
     if not isinstance(err, BlockSpecError) or not err.spec:
         return ""
-    if getattr(args, "block", None) == err.spec:  # in mm once read at the door (lengths_to_mm)
-        return f"--block {as_typed(args, 'block')}"
+    block = getattr(args, "block", None)
+    if block == err.spec or (isinstance(block, list) and err.spec in block):  # in mm once read at the door
+        typed = as_typed(args, "block")
+        # the name the door gives it: fit's, eval's and block show's positional BLOCK is no --block
+        name = next((a.name for a in getattr(args, "_inputs", ()) if a.dest == "block"), "--block")
+        if isinstance(block, list):
+            typed = typed[block.index(err.spec)] if isinstance(typed, list) else err.spec
+        return f"--block {typed}" if name == "--block" else f"{name} of 'woodcam {_command_name(args)}' (block spec {typed!r})"
     specs = getattr(args, "veneer_from", None) or []
     if err.spec in specs:  # as typed: in mm once read at the door, as --block
         return f"--veneer-from {as_typed(args, 'veneer_from')[specs.index(err.spec)]}"
