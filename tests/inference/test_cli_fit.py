@@ -94,6 +94,12 @@ def test_eval_seed_without_the_evidence_method_is_said_to_change_nothing(tmp_pat
     err = capsys.readouterr().err
     assert ("--seed 4294967295 acts on the evidence fit only, and --methods radial has none: it changes "
             "nothing; add evidence to --methods (e.g. --methods evidence,radial) or drop it") in err
+    # --confidence draws the evidence fit's per-point confidence: no other fit carries one
+    assert main(["eval", "rings", str(folder), "--methods", "radial", "--seed", "2", "--confidence",
+                 "--out", str(tmp_path / "ev2")]) == 0
+    assert ("--seed 2 and --confidence act on the evidence fit only, and --methods radial has none: they "
+            "change nothing; add evidence to --methods (e.g. --methods evidence,radial) or drop them") in \
+        capsys.readouterr().err
 
 
 @pytest.mark.slow

@@ -73,7 +73,8 @@ def register(subparsers) -> None:
 def warn_evidence_only(given: list[str], methods) -> None:
     """Warn, before the work, that the options ``given`` (as typed: ``--seed 3``, ``--residual``)
     act on the evidence fit only (:func:`woodcam.inference.fit.fit_block`'s ``seed``,
-    ``knot_bend``, ``knot_cones``, ``residual``) when ``methods`` lacks it: they were accepted
+    ``knot_bend``, ``knot_cones``, ``residual``; ``--confidence`` draws its per-point confidence,
+    which no other fit carries) when ``methods`` lacks it: they were accepted
     and changed nothing, without a word (``eval rings --seed`` with the default rbf,radial,
     ``eval realistic --methods radial --residual``)."""
     if not given or "evidence" in methods:
@@ -155,8 +156,9 @@ def _run_eval(args, blocks, methods, partial) -> None:
         warnings.warn(f"--seed {args.seed} seeds the held-out scoring of real blocks only; "
                       f"{', '.join(b.name for b in known)} have a true field and are scored on cut "
                       "planes, which it does not change", WoodcamWarning, stacklevel=2)
-    elif args.seed is not None:  # the other fitters draw nothing at random
-        warn_evidence_only([f"--seed {args.seed}"], methods)
+    # the other fitters draw nothing at random and carry no per-point confidence
+    warn_evidence_only(([f"--seed {args.seed}"] if args.seed is not None and real else [])
+                       + (["--confidence"] if args.confidence else []), methods)
     if known:
         sets = {"full": None}
         if args.partial_faces.lower() != "none":
