@@ -219,7 +219,11 @@ def atomic_path(path, *, fsync: bool = True, mkdir: bool = False) -> Iterator[Pa
         Create missing parent folders first (default False: a missing folder is an error).
 
     The temporary file exists (empty) when the block starts; writers may overwrite it. If the
-    block raises, or the writer wrote nothing under that name, nothing is renamed.
+    block raises, or the writer wrote nothing under that name, nothing is renamed. A writer
+    that appends its own suffix to the path it is given (``np.savez`` adds ``.npz`` to a path
+    not ending in it) wrote nothing under that name: a WoodcamError, and its file is removed
+    (the empty temporary landed as a 0-byte ``path`` and the data stayed behind as a hidden
+    ``.<name>...tmp.bin.npz``).
     """
     path = Path(path)
     _not_a_folder(path, "atomic_path")
@@ -228,13 +232,30 @@ def atomic_path(path, *, fsync: bool = True, mkdir: bool = False) -> Iterator[Pa
     tmp = _temp_in(path)
     try:
         yield tmp
-        if not tmp.exists():
+        appended = _appended_to(tmp)
+        if not tmp.exists() or (appended and tmp.stat().st_size == 0):
+            elsewhere = f" (it wrote {str(appended[0])!r} instead)" if appended else ""
             raise WoodcamError(f"atomic_path: the writer for {str(path)!r} wrote no file at "
-                               f"{str(tmp)!r}; write to the yielded path exactly")
+                               f"{str(tmp)!r}{elsewhere}; write to the yielded path exactly "
+                               "(give a writer that appends its own suffix an open file: "
+                               "atomic_write)")
         _commit(tmp, path, fsync)
     except BaseException:
         _discard(tmp)
         raise
+    finally:
+        for stray in _appended_to(tmp):
+            _discard(stray)
+
+
+def _appended_to(tmp: Path) -> list[Path]:
+    """Files named ``tmp``'s (unique) name plus more: written by a library that appended its own
+    suffix to the path it was given."""
+    try:
+        return sorted(tmp.parent / n for n in os.listdir(tmp.parent)
+                      if n.startswith(tmp.name) and n != tmp.name)
+    except OSError:
+        return []
 
 
 @contextlib.contextmanager

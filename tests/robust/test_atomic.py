@@ -65,6 +65,17 @@ def test_atomic_path_keeps_suffix_for_numpy(tmp_path):
     assert _leftovers(tmp_path) == []
 
 
+def test_atomic_path_refuses_a_writer_that_appends_its_own_suffix(tmp_path):
+    # np.savez adds .npz to a path not ending in it: the empty temporary landed as a 0-byte
+    # target and the data stayed behind as a hidden .a.bin...tmp.bin.npz
+    target = tmp_path / "a.bin"
+    target.write_bytes(b"old")
+    with pytest.raises(WoodcamError, match=r"wrote no file at .*\.npz' instead"), atomic_path(target) as tmp:
+        np.savez(tmp, a=np.arange(3))
+    assert target.read_bytes() == b"old"
+    assert _leftovers(tmp_path) == []
+
+
 def test_atomic_files_all_or_nothing(tmp_path):
     obj, mtl, png = tmp_path / "p.obj", tmp_path / "p.mtl", tmp_path / "p.png"
     with (pytest.raises(OSError, match="disk full"),
