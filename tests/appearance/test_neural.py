@@ -337,6 +337,17 @@ def test_detail_round_trips_through_the_cache_file(tmp_path, rng):
         ColorVolumes(grid, vols, {}, guides[:1], slopes)
 
 
+def test_volumes_save_under_any_name(tmp_path, rng):
+    # np.savez given a path not ending in .npz writes <path>.npz: save('v.bin') left a 0-byte
+    # v.bin (load: EOFError) and its data in a hidden temporary
+    grid = VolumeGrid((10.0, 8.0, 6.0), 10)
+    vols = rng.integers(0, 256, (3,) + grid.shape + (3,), dtype=np.uint8)
+    path = ColorVolumes(grid, vols, {"a": 1}).save(tmp_path / "v.bin")
+    assert path == tmp_path / "v.bin"
+    np.testing.assert_array_equal(ColorVolumes.load(path).volumes, vols)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["v.bin"]
+
+
 def test_mirror_augmentation_keeps_patch_and_photo_aligned(rng):
     import torch
 

@@ -288,14 +288,16 @@ class ColorVolumes:
         return idx, w
 
     def save(self, path) -> Path:
-        from .._atomic import atomic_path
+        from .._atomic import atomic_write
 
         path = Path(path)
         extra = {} if not self.has_detail else {"guides": self.guides.astype(np.float16),
                                                  "slopes": self.slopes.astype(np.float16)}
-        # unique temporary + rename: a reader never sees half a file, two writers never mix
-        with atomic_path(path, mkdir=True) as tmp:
-            np.savez(tmp, volumes=self.volumes, grid=json.dumps(self.grid.to_dict()),
+        # unique temporary + rename: a reader never sees half a file, two writers never mix;
+        # an open file, so np.savez writes at ``path`` whatever its suffix (given a path not
+        # ending in .npz it wrote ``<path>.npz``)
+        with atomic_write(path, "wb", mkdir=True) as fh:
+            np.savez(fh, volumes=self.volumes, grid=json.dumps(self.grid.to_dict()),
                      meta=json.dumps(self.meta), **extra)
         return path
 
