@@ -141,11 +141,25 @@ def _commit(tmp: Path, path: Path, fsync: bool) -> None:
         _fsync_path(tmp)
     deferred = _PENDING.get()
     if deferred is not None:  # inside all_or_nothing(): renamed when the whole block succeeds
-        deferred[0].append((tmp, path))
+        _defer(deferred[0], tmp, path)
         return
     os.replace(tmp, path)
     if fsync:
         _fsync_dir(path.parent)
+
+
+def _defer(pending: list, tmp: Path, path: Path) -> None:
+    """Add ``tmp`` (bound for ``path``) to an :func:`all_or_nothing` set. A target written again
+    in the same set takes the place of its earlier write (whose temporary goes): both were
+    renamed in turn, and the first file written is renamed last, so a primary file written
+    twice landed its *first* content."""
+    same = path.parent.resolve() / path.name
+    for i, (old_tmp, old_path) in enumerate(pending):
+        if old_path.parent.resolve() / old_path.name == same:
+            _discard(old_tmp)
+            pending[i] = (tmp, path)
+            return
+    pending.append((tmp, path))
 
 
 @contextlib.contextmanager

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from woodcam._atomic import (
+    all_or_nothing,
     atomic_files,
     atomic_path,
     atomic_write,
@@ -73,6 +74,19 @@ def test_atomic_path_refuses_a_writer_that_appends_its_own_suffix(tmp_path):
     with pytest.raises(WoodcamError, match=r"wrote no file at .*\.npz' instead"), atomic_path(target) as tmp:
         np.savez(tmp, a=np.arange(3))
     assert target.read_bytes() == b"old"
+    assert _leftovers(tmp_path) == []
+
+
+def test_a_file_written_twice_in_one_set_keeps_its_last_content(tmp_path):
+    # the writes were renamed in turn, the first one (the primary) last: a primary file written
+    # again later in the set landed its first content
+    first, other = tmp_path / "a.json", tmp_path / "b.txt"
+    with all_or_nothing() as written:
+        write_text(first, "first")
+        write_text(other, "b")
+        write_text(tmp_path / "." / "a.json", "second")
+    assert first.read_text() == "second" and other.read_text() == "b"
+    assert written == [first, other]
     assert _leftovers(tmp_path) == []
 
 
