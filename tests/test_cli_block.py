@@ -1,6 +1,7 @@
 """``woodcam block synth`` and ``woodcam block show`` through the parser the CLI uses."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -192,6 +193,29 @@ def test_a_benchmark_set_resumes_with_its_defaults_spelled_out(tmp_path):
     assert (summary.skipped, summary.done) == (1, 0) and index["size_range_mm"] == [30.0, 80.0]
     with pytest.raises(WoodcamError, match=r"block_options.trace_dropout 0.0 there, 0.2 now"):
         write_benchmark_set(tmp_path / "set", 1, 4, block_options={"trace_dropout": 0.2}, **kw)
+
+
+def test_a_stopped_benchmark_set_block_leaves_no_folder(tmp_path, monkeypatch):
+    """The block was written into .block_0000.<pid>.tmp and renamed: a Ctrl-C (or an error)
+    part way left that folder, half written, for good (a rerun's pid differs)."""
+    import woodcam.block.io as block_io
+    from woodcam.benchmark import _synth_set_task
+
+    real = block_io.write_block
+
+    def half_then_stop(block, folder, **kw):
+        Path(folder).mkdir(parents=True, exist_ok=True)  # as write_block does
+        (Path(folder) / "front_photo.png").write_bytes(b"\x89PNG half")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(block_io, "write_block", half_then_stop)
+    with pytest.raises(KeyboardInterrupt):
+        _synth_set_task("block_0000", 4, str(tmp_path), 32, False)
+    assert list(tmp_path.iterdir()) == []
+    monkeypatch.setattr(block_io, "write_block", real)
+    _synth_set_task("block_0000", 4, str(tmp_path), 32, False)
+    assert [p.name for p in tmp_path.iterdir()] == ["block_0000"]
+    assert read_block(tmp_path / "block_0000").faces
 
 
 def test_engine_options_alone_run_on_the_engine_and_train_rings_refuses_them(tmp_path, capsys):

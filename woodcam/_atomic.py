@@ -11,6 +11,8 @@ middle of a write never leaves a truncated GLB, a 0-byte OBJ or a half cache beh
   (``np.savez``, ``PIL.Image.save``, ``torch.save``): ``with atomic_path(p) as tmp: np.savez(tmp,
   ...)``. The temporary path keeps ``p``'s suffix, so libraries that pick a format from it (or
   append ``.npz``) behave.
+* :func:`atomic_folder` -- the same for a folder written whole (a benchmark set's block):
+  ``with atomic_folder(p) as tmp: write_block(block, tmp)``.
 * :func:`write_bytes` / :func:`write_text` -- one-liners over :func:`atomic_write`.
 * :func:`atomic_files` -- several files that belong together (OBJ + MTL + PNG, GLB + side files):
   all are written to temporaries first and renamed only when every one succeeded; the *first*
@@ -47,7 +49,7 @@ from typing import IO
 from . import _interrupt
 from .errors import WoodcamError, WoodcamWarning
 
-__all__ = ["all_or_nothing", "apart", "atomic_files", "atomic_path", "atomic_write", "check_folder_writable",
+__all__ = ["all_or_nothing", "apart", "atomic_files", "atomic_folder", "atomic_path", "atomic_write", "check_folder_writable",
            "check_output_path",
            "listed_outputs", "manifest_path", "remove_stale", "run_outputs", "write_bytes", "write_figure", "write_text"]
 
@@ -92,7 +94,13 @@ def _sweep_orphans(path: Path) -> None:
         try:
             os.kill(int(pid_text), 0)  # signal 0: does the writer still run?
         except ProcessLookupError:
-            _discard(path.parent / name)
+            orphan = path.parent / name
+            if orphan.is_dir() and not orphan.is_symlink():  # an atomic_folder's
+                import shutil
+
+                shutil.rmtree(orphan, ignore_errors=True)
+            else:
+                _discard(orphan)
         except OSError:  # e.g. another user's live process: leave it
             continue
 
@@ -292,6 +300,31 @@ def atomic_write(path, mode: str = "wb", *, fsync: bool = True, mkdir: bool = Fa
             os.fsync(fh.fileno())
     if fsync:
         _fsync_dir(Path(path).parent)
+
+
+@contextlib.contextmanager
+def atomic_folder(path) -> Iterator[Path]:
+    """Yield a new, empty temporary folder next to ``path`` (named as :func:`atomic_path`'s
+    temporaries); when the block ends without error it replaces ``path`` (a folder already
+    there is removed first: a folder cannot be renamed over a full one), else it is removed.
+    A writer killed mid-way leaves its hidden folder behind; the next write of the same
+    ``path`` removes it (its process is gone), as it does a file's temporary."""
+    import shutil
+
+    path = Path(path)
+    _sweep_orphans(path)
+    tmp = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}-",
+                                suffix=f".tmp{path.suffix}"))
+    try:
+        yield tmp
+        _interrupt.check()
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path)
+        os.replace(tmp, path)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    _fsync_dir(path.parent)
 
 
 def write_bytes(path, data: bytes, **kwargs) -> Path:

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._atomic import all_or_nothing, atomic_path, remove_stale, write_figure, write_text
+from ._atomic import all_or_nothing, atomic_folder, atomic_path, remove_stale, write_figure, write_text
 from ._checks import check_bool
 from .errors import WoodcamError
 
@@ -498,9 +498,6 @@ def _synth_set_task(key: str, seed: int, out_dir: str, face_px: int, knotted: bo
     """Write block ``key`` (``block_0042``) of set ``seed`` to ``out_dir/key`` atomically;
     ``block_options`` go to :func:`woodcam.synth.benchmark_set_block` (sizes, knotted share,
     trace noise)."""
-    import os
-    import shutil
-
     from .block.io import write_block
     from .synth import benchmark_set_block, knotted_log_field
 
@@ -510,13 +507,10 @@ def _synth_set_task(key: str, seed: int, out_dir: str, face_px: int, knotted: bo
         opts["size_range_mm"] = tuple(opts["size_range_mm"])
     block, info = benchmark_set_block(seed, index, face_px=face_px,
                                       log_fields=knotted_log_field if knotted else None, **opts)
-    final = Path(out_dir) / key
-    tmp = Path(out_dir) / f".{key}.{os.getpid()}.tmp"
-    shutil.rmtree(tmp, ignore_errors=True)
-    write_block(block, tmp)
-    if final.exists():  # a folder from an earlier run without its record: replace it whole
-        shutil.rmtree(final)
-    os.replace(tmp, final)
+    # a folder from an earlier run without its record is replaced whole; a stopped write leaves
+    # nothing (a Ctrl-C left an empty .block_0000.<pid>.tmp, a kill a half one, for good)
+    with atomic_folder(Path(out_dir) / key) as tmp:
+        write_block(block, tmp)
     return info
 
 

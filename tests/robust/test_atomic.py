@@ -16,6 +16,7 @@ import pytest
 from woodcam._atomic import (
     all_or_nothing,
     atomic_files,
+    atomic_folder,
     atomic_path,
     atomic_write,
     check_output_path,
@@ -88,6 +89,27 @@ def test_a_file_written_twice_in_one_set_keeps_its_last_content(tmp_path):
     assert first.read_text() == "second" and other.read_text() == "b"
     assert written == [first, other]
     assert _leftovers(tmp_path) == []
+
+
+def test_atomic_folder_is_whole_or_absent_and_a_killed_writers_folder_goes(tmp_path):
+    target = tmp_path / "block_0000"
+    target.mkdir()
+    (target / "old.txt").write_text("old")
+    with pytest.raises(RuntimeError, match="boom"), atomic_folder(target) as tmp:
+        (tmp / "half.png").write_bytes(b"half")
+        raise RuntimeError("boom")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block_0000"]  # no temporary folder
+    assert [p.name for p in target.iterdir()] == ["old.txt"]
+    # a writer killed mid-way left its hidden folder: the next write of the target removes it
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True).stdout.strip()
+    orphan = tmp_path / f".block_0000.{dead}-x1y2z3.tmp"
+    orphan.mkdir()
+    (orphan / "half.png").write_bytes(b"half")
+    with atomic_folder(target) as tmp:
+        (tmp / "new.txt").write_text("new")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["block_0000"]
+    assert [p.name for p in target.iterdir()] == ["new.txt"]
 
 
 def test_atomic_files_all_or_nothing(tmp_path):
