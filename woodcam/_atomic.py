@@ -50,7 +50,7 @@ from . import _interrupt
 from .errors import WoodcamError, WoodcamWarning
 
 __all__ = ["all_or_nothing", "apart", "atomic_files", "atomic_folder", "atomic_path", "atomic_write", "check_folder_writable",
-           "check_output_path",
+           "check_output_path", "in_flight",
            "listed_outputs", "manifest_path", "remove_stale", "run_outputs", "write_bytes", "write_figure", "write_text"]
 
 
@@ -89,20 +89,39 @@ def _sweep_orphans(path: Path) -> None:
         return
     for name in names:
         pid_text = name[len(prefix):].split("-", 1)[0]
-        if not pid_text.isdigit() or int(pid_text) == os.getpid():
+        if not pid_text.isdigit() or _writer_runs(int(pid_text)):
             continue
-        try:
-            os.kill(int(pid_text), 0)  # signal 0: does the writer still run?
-        except ProcessLookupError:
-            orphan = path.parent / name
-            if orphan.is_dir() and not orphan.is_symlink():  # an atomic_folder's
-                import shutil
+        orphan = path.parent / name
+        if orphan.is_dir() and not orphan.is_symlink():  # an atomic_folder's
+            import shutil
 
-                shutil.rmtree(orphan, ignore_errors=True)
-            else:
-                _discard(orphan)
-        except OSError:  # e.g. another user's live process: leave it
-            continue
+            shutil.rmtree(orphan, ignore_errors=True)
+        else:
+            _discard(orphan)
+
+
+def _writer_runs(pid: int) -> bool:
+    """Whether the process ``pid`` named in a temporary still runs (this one does)."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)  # signal 0: does the writer still run?
+    except ProcessLookupError:
+        return False
+    except OSError:  # e.g. another user's live process
+        return True
+    return True
+
+
+def in_flight(path) -> bool:
+    """Whether ``path`` is the temporary of an atomic write still under way: named
+    ``.<name>.<pid>-<random>.tmp<suffix>`` by a process that still runs. It is no file of its
+    own yet (it becomes ``<name>`` when renamed), so whoever lists, counts or clears files
+    (the cache's prune and clear) leaves it; one whose writer is gone is litter."""
+    import re
+
+    m = re.fullmatch(r"\..+\.(\d+)-[a-z0-9_]+\.tmp(\.[^.]*)?", Path(path).name)
+    return m is not None and _writer_runs(int(m.group(1)))
 
 
 def _not_a_folder(path: Path, what: str) -> None:

@@ -32,7 +32,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, TypeVar
 
-from ._atomic import apart, atomic_path
+from ._atomic import apart, atomic_path, in_flight
 from .errors import WoodcamError, WoodcamWarning
 
 __all__ = ["CacheWarning", "cache_dir", "cache_root", "digest", "entry_path", "file_lock", "load_or_build"]
@@ -261,11 +261,14 @@ def cache_max_bytes() -> int:
 
 
 def entries(kind: str | None = None) -> list[Path]:
-    """Cache entry files (lock files left out), of one ``kind`` or all, oldest use first."""
+    """Cache entry files, of one ``kind`` or all, oldest use first. Lock files are left out, and
+    so is the temporary of an entry another run is writing (:func:`woodcam._atomic.in_flight`):
+    a prune or clear deleted it under that run, whose build then failed with "the writer ...
+    wrote no file" (a killed writer's temporary is litter, and counted)."""
     root = cache_root() if kind is None else cache_dir(kind)
     if not root.is_dir():
         return []
-    files = [p for p in root.rglob("*") if p.is_file() and p.suffix != ".lock"]
+    files = [p for p in root.rglob("*") if p.is_file() and p.suffix != ".lock" and not in_flight(p)]
     return sorted(files, key=lambda p: max(p.stat().st_atime, p.stat().st_mtime))
 
 

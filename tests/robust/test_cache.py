@@ -243,3 +243,43 @@ def test_read_only_block_folder_is_never_written(traced_block, tmp_path, monkeyp
     assert {p: p.stat().st_mtime_ns for p in folder.rglob("*")} == before
     assert len(_field_entries(tmp_path / "cache")) == 1
     assert np.isfinite(stock.wood.field(np.array([[20.0, 15.0, 10.0]]))).all()
+
+
+def test_a_prune_or_clear_leaves_the_entry_another_run_is_writing(tmp_path, monkeypatch):
+    """entries() listed the hidden temporary of an entry being written: another run's prune
+    (or a 'cache clear') deleted it, and the writing run, its build done, failed with
+    "atomic_path: the writer ... wrote no file". A killed writer's temporary is still cleared."""
+    import threading
+
+    from woodcam._cache import cache_dir, clear, entries, prune
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    path = cache_dir("fields") / "b-key.npz"
+    seen, writing, pruned = [], threading.Event(), threading.Event()
+
+    def slow_save(value, tmp):
+        with open(tmp, "wb") as fh:
+            np.save(fh, value)
+        writing.set()  # the writer half way; another run prunes meanwhile
+        assert pruned.wait(30)
+
+    def another_run():
+        assert writing.wait(30)
+        seen.append([p.name for p in entries()])
+        prune(0)
+        clear("fields")
+        pruned.set()
+
+    other = threading.Thread(target=another_run)
+    other.start()
+    value, hit = load_or_build(path, load=np.load, build=lambda: np.arange(10.0), save=slow_save,
+                               what="test cache")
+    other.join()
+    assert not hit and seen == [[]]
+    np.testing.assert_array_equal(np.load(path), np.arange(10.0))
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True).stdout.strip()
+    orphan = path.parent / f".b-other.npz.{dead}-x1y2.tmp.npz"
+    orphan.write_bytes(b"half")
+    assert orphan in entries("fields")
+    assert clear("fields")[0] == 2 and not orphan.exists() and not path.exists()
