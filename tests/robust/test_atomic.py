@@ -112,6 +112,30 @@ def test_atomic_folder_is_whole_or_absent_and_a_killed_writers_folder_goes(tmp_p
     assert [p.name for p in target.iterdir()] == ["new.txt"]
 
 
+def test_a_ctrl_c_while_a_set_is_renamed_lands_after_the_whole_set(tmp_path, monkeypatch):
+    # the renames ran one by one: a Ctrl-C after the first raised there, the rest of the set
+    # was discarded, and the new side file stood beside the earlier run's primary
+    from woodcam import _interrupt
+
+    files = [tmp_path / "p.glb", tmp_path / "p.obj", tmp_path / "p.png"]
+    for f in files:
+        f.write_text("old")
+    real_replace = os.replace
+
+    def replace_then_ctrl_c(src, dst):
+        real_replace(src, dst)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    with _interrupt.handling(), pytest.raises(KeyboardInterrupt):
+        with all_or_nothing():
+            for f in files:
+                write_text(f, "new")
+            monkeypatch.setattr(os, "replace", replace_then_ctrl_c)
+    monkeypatch.undo()
+    assert [f.read_text() for f in files] == ["new", "new", "new"]
+    assert _leftovers(tmp_path) == []
+
+
 def test_atomic_files_all_or_nothing(tmp_path):
     obj, mtl, png = tmp_path / "p.obj", tmp_path / "p.mtl", tmp_path / "p.png"
     with (pytest.raises(OSError, match="disk full"),
