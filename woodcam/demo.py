@@ -91,16 +91,21 @@ def run_demo(out_dir, *, quick: bool = False, texels_per_mm: float | None = None
 
 def render_overview(parts: list[PartPreview], png, *, tile_px: tuple[int, int] = (640, 520)) -> Path:
     """One picture of all demo parts side by side, whole (no cut plane), for a quick look."""
+    import tempfile
+
     from PIL import Image
 
     from .view import preview
 
     tiles = []
-    for p in parts:
-        tile = Path(png).with_name(f"_{p.name}_tile.png")
-        preview(p.files["glb"], screenshot=tile, window_size=tile_px, cut_plane=False)
-        tiles.append(Image.open(tile).convert("RGB"))
-        tile.unlink()
+    # the tiles in a scratch folder of their own: drawn beside demo.png as _<part>_tile.png they
+    # wrote over and then deleted a file of that name there, and a stop left one behind
+    with tempfile.TemporaryDirectory(prefix="woodcam-demo-") as scratch:
+        for p in parts:
+            tile = Path(scratch) / f"{p.name}_tile.png"
+            preview(p.files["glb"], screenshot=tile, window_size=tile_px, cut_plane=False)
+            with Image.open(tile) as im:
+                tiles.append(im.convert("RGB"))
     strip = Image.new("RGB", (sum(t.width for t in tiles), max(t.height for t in tiles)), "white")
     x = 0
     for t in tiles:
