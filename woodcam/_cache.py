@@ -260,15 +260,22 @@ def cache_max_bytes() -> int:
     return int(value * 2**20)
 
 
+def _kind_folders(kind: str | None) -> list[Path]:
+    """The existing folders of one ``kind`` of entry, or of every kind (:data:`CACHE_KINDS`):
+    only these hold woodcam's files. The cache root is the user's to choose
+    (``WOODCAM_CACHE_DIR=~/.cache``, a shared scratch folder), and walking all of it, the
+    size limit's prune deleted other programs' and the user's files there, oldest first, and
+    ``woodcam cache clear`` every file under it."""
+    return [d for d in (cache_dir(k) for k in (CACHE_KINDS if kind is None else (kind,))) if d.is_dir()]
+
+
 def entries(kind: str | None = None) -> list[Path]:
     """Cache entry files, of one ``kind`` or all, oldest use first. Lock files are left out, and
     so is the temporary of an entry another run is writing (:func:`woodcam._atomic.in_flight`):
     a prune or clear deleted it under that run, whose build then failed with "the writer ...
     wrote no file" (a killed writer's temporary is litter, and counted)."""
-    root = cache_root() if kind is None else cache_dir(kind)
-    if not root.is_dir():
-        return []
-    files = [p for p in root.rglob("*") if p.is_file() and p.suffix != ".lock" and not in_flight(p)]
+    files = [p for root in _kind_folders(kind) for p in root.rglob("*")
+             if p.is_file() and p.suffix != ".lock" and not in_flight(p)]
     return sorted(files, key=lambda p: max(p.stat().st_atime, p.stat().st_mtime))
 
 
@@ -289,21 +296,20 @@ def prune(max_bytes: int | None = None, *, keep: Path | None = None) -> int:
             p.unlink()
             freed += size
     if freed:
-        _drop_idle_locks(cache_root())
+        _drop_idle_locks()
     return freed
 
 
-def _drop_idle_locks(root: Path) -> None:
-    """Delete the ``.lock`` files under ``root`` whose entry is gone and that nobody holds: one
-    was left per entry ever built, and neither clearing nor pruning removed them. A lock being
-    built under is held, so it stays (taking the lock without waiting tells which)."""
+def _drop_idle_locks(kind: str | None = None) -> None:
+    """Delete the ``.lock`` files of one ``kind`` of entry (or of all) whose entry is gone and
+    that nobody holds: one was left per entry ever built, and neither clearing nor pruning
+    removed them. A lock being built under is held, so it stays (taking the lock without
+    waiting tells which)."""
     try:
         import fcntl
     except ImportError:  # pragma: no cover - Windows: no lock files
         return
-    if not root.is_dir():
-        return
-    for lock in root.rglob("*.lock"):
+    for lock in (lk for root in _kind_folders(kind) for lk in root.rglob("*.lock")):
         if Path(str(lock)[:-len(".lock")]).exists():
             continue
         with contextlib.suppress(OSError):
@@ -324,6 +330,6 @@ def clear(kind: str | None = None) -> tuple[int, int]:
             b = p.stat().st_size
             p.unlink()
             n, size = n + 1, size + b
-    _drop_idle_locks(cache_root() if kind is None else cache_dir(kind))
+    _drop_idle_locks(kind)
     return n, size
 

@@ -283,3 +283,27 @@ def test_a_prune_or_clear_leaves_the_entry_another_run_is_writing(tmp_path, monk
     orphan.write_bytes(b"half")
     assert orphan in entries("fields")
     assert clear("fields")[0] == 2 and not orphan.exists() and not path.exists()
+
+
+def test_prune_and_clear_touch_only_woodcams_folders_under_the_cache_root(tmp_path, monkeypatch, capsys):
+    """The whole cache root was walked: with WOODCAM_CACHE_DIR=~/.cache (or a shared scratch
+    folder) the size limit's prune, run after every entry written, deleted other programs' and
+    the user's files there, oldest first, and 'woodcam cache clear' every file under it."""
+    from woodcam._cache import cache_dir, entries, prune
+    from woodcam.cli import main
+
+    root = tmp_path / "dot-cache"
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(root))
+    monkeypatch.setenv("WOODCAM_CACHE_MAX_MB", "0.1")
+    theirs = [root / "pip" / "wheel.whl", root / "thesis.tex", root / "other-app" / "db.lock"]
+    for f in theirs:
+        f.parent.mkdir(parents=True, exist_ok=True)
+        f.write_bytes(os.urandom(200_000))
+    ours = cache_dir("fields") / "b-key.npy"
+    load_or_build(ours, load=np.load, build=lambda: np.zeros(10), save=lambda v, tmp: np.save(tmp, v))
+    assert entries() == [ours]
+    assert all(f.is_file() for f in theirs)  # the prune after the save left them
+    prune(0)
+    assert main(["cache", "clear"]) == 0
+    capsys.readouterr()
+    assert all(f.is_file() for f in theirs)
