@@ -292,20 +292,20 @@ def atomic_path(path, *, fsync: bool = True, mkdir: bool = False) -> Iterator[Pa
     tmp = _temp_in(path)
     try:
         yield tmp
-        appended = _appended_to(tmp)
-        if not tmp.exists() or (appended and tmp.stat().st_size == 0):
-            elsewhere = f" (it wrote {str(appended[0])!r} instead)" if appended else ""
-            raise WoodcamError(f"atomic_path: the writer for {str(path)!r} wrote no file at "
-                               f"{str(tmp)!r}{elsewhere}; write to the yielded path exactly "
-                               "(give a writer that appends its own suffix an open file: "
-                               "atomic_write)")
+        if not tmp.exists() or tmp.stat().st_size == 0:  # the folder is listed only then
+            appended = _appended_to(tmp)
+            if not tmp.exists() or appended:
+                elsewhere = f" (it wrote {str(appended[0])!r} instead)" if appended else ""
+                raise WoodcamError(f"atomic_path: the writer for {str(path)!r} wrote no file at "
+                                   f"{str(tmp)!r}{elsewhere}; write to the yielded path exactly "
+                                   "(give a writer that appends its own suffix an open file: "
+                                   "atomic_write)")
         _commit(tmp, path, fsync)
     except BaseException:
         _discard(tmp)
-        raise
-    finally:
-        for stray in _appended_to(tmp):
+        for stray in _appended_to(tmp):  # a writer that appended a suffix, stopped part way
             _discard(stray)
+        raise
 
 
 def _appended_to(tmp: Path) -> list[Path]:
