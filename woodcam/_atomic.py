@@ -180,9 +180,9 @@ def _defer(pending: list, tmp: Path, path: Path) -> None:
     in the same set takes the place of its earlier write (whose temporary goes): both were
     renamed in turn, and the first file written is renamed last, so a primary file written
     twice landed its *first* content."""
-    same = path.parent.resolve() / path.name
     for i, (old_tmp, old_path) in enumerate(pending):
-        if old_path.parent.resolve() / old_path.name == same:
+        # the name first: a set of hundreds of files resolves no folder twice over
+        if old_path.name == path.name and old_path.parent.resolve() == path.parent.resolve():
             _discard(old_tmp)
             pending[i] = (tmp, path)
             return
