@@ -190,24 +190,6 @@ def _defer(pending: list, tmp: Path, path: Path) -> None:
 
 
 @contextlib.contextmanager
-def _ctrl_c_held() -> Iterator[None]:
-    """Hold a Ctrl-C (SIGINT) back for the block: it is raised as it ends, once the renames
-    of a set are all done (they take microseconds), so a set lands whole or not at all. Only
-    on the main thread, where Python handles signals; a no-op without ``pthread_sigmask``."""
-    import signal
-    import threading
-
-    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
-
-
-@contextlib.contextmanager
 def all_or_nothing() -> Iterator[list[Path]]:
     """Defer every atomic write made inside the block and rename them together at its end.
 
@@ -236,7 +218,7 @@ def all_or_nothing() -> Iterator[list[Path]]:
     order = pending[1:] + pending[:1]
     try:
         _interrupt.check()
-        with _ctrl_c_held():  # a Ctrl-C between two renames left part of a new set by an old one
+        with _interrupt.held():  # a Ctrl-C between two renames left part of a new set by an old one
             for tmp, path in order:
                 os.replace(tmp, path)
     except BaseException:
@@ -520,7 +502,7 @@ def atomic_files(paths: Iterable, *, fsync: bool = True, mkdir: bool = False) ->
                 raise WoodcamError(f"atomic_files: nothing was written for {str(p)!r}")
         # side files first, the primary last: its presence means the group is complete
         _interrupt.check()
-        with _ctrl_c_held():
+        with _interrupt.held():
             for tmp, p in list(zip(temps, targets))[1:] + [(temps[0], targets[0])]:
                 _commit(tmp, p, fsync)
     except BaseException:

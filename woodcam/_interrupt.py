@@ -69,4 +69,32 @@ def handling() -> Iterator[None]:
         _requested = False
 
 
+@contextlib.contextmanager
+def held() -> Iterator[None]:
+    """Hold a Ctrl-C back for a short block that must finish whole (the renames of a set of
+    outputs: microseconds): one arriving inside it is raised as the block ends, through the
+    SIGINT handler that was in place (so :func:`handling` records it as before).
+
+    The Python handler is swapped rather than the signal masked: ``pthread_sigmask`` blocks
+    SIGINT for the calling thread only, and the kernel hands a process-wide SIGINT to any thread
+    that has it unblocked (numba, OpenMP, torch, progress-bar threads); Python then runs its
+    handler on the main thread mid-block all the same (seen: a set left as old, new, new).
+    A no-op off the main thread, and where the handler was set outside Python (None: it could
+    not be put back)."""
+    previous = signal.getsignal(signal.SIGINT)
+    if threading.current_thread() is not threading.main_thread() or previous is None:
+        yield
+        return
+    caught: list = []
+    signal.signal(signal.SIGINT, lambda signum, frame: caught.append(frame))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        if caught and callable(previous):
+            previous(signal.SIGINT, caught[0])
+        elif caught and previous == signal.SIG_DFL:
+            signal.raise_signal(signal.SIGINT)
+
+
 __all__: list[str] = []

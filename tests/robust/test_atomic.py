@@ -8,6 +8,8 @@ import signal
 import subprocess
 import sys
 import textwrap
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -121,17 +123,27 @@ def test_a_ctrl_c_while_a_set_is_renamed_lands_after_the_whole_set(tmp_path, mon
     for f in files:
         f.write_text("old")
     real_replace = os.replace
+    # the Ctrl-C lands on another thread of the process, as the kernel may deliver it to any
+    # thread not blocking it (numba, OpenMP, progress bars): a SIGINT masked on the main thread
+    # alone still ran Python's handler mid-set (seen: old, new, new)
+    idle = threading.Event()
+    other = threading.Thread(target=idle.wait, daemon=True)
+    other.start()
 
     def replace_then_ctrl_c(src, dst):
         real_replace(src, dst)
-        os.kill(os.getpid(), signal.SIGINT)
+        signal.pthread_kill(other.ident, signal.SIGINT)
+        time.sleep(0.01)  # that thread's C handler has run: Python's runs on the main thread next
 
-    with _interrupt.handling(), pytest.raises(KeyboardInterrupt):
-        with all_or_nothing():
-            for f in files:
-                write_text(f, "new")
-            monkeypatch.setattr(os, "replace", replace_then_ctrl_c)
-    monkeypatch.undo()
+    try:
+        with _interrupt.handling(), pytest.raises(KeyboardInterrupt):
+            with all_or_nothing():
+                for f in files:
+                    write_text(f, "new")
+                monkeypatch.setattr(os, "replace", replace_then_ctrl_c)
+    finally:
+        monkeypatch.undo()
+        idle.set()
     assert [f.read_text() for f in files] == ["new", "new", "new"]
     assert _leftovers(tmp_path) == []
 
