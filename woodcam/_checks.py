@@ -106,3 +106,11 @@ def check_path(value, name: str, *, fix: str = "") -> Path:
     if isinstance(value, bool) or not isinstance(value, (str, os.PathLike)) or str(value) == "":
         _fail(name, "a file path (str or pathlib.Path)", value, fix)
     return Path(value)
+
+
+def npz_path(path) -> Path:
+    """``path`` as the ``.npz`` file numpy writes: ``.npz`` appended to a name without that
+    suffix; one ending in it in any case (``F.NPZ``, which ``--out`` takes) kept as named (it
+    became ``F.NPZ.npz`` beside the name asked for). The one rule of every ``.npz`` writer."""
+    path = Path(path)
+    return path if path.suffix.lower() == ".npz" else path.with_suffix(path.suffix + ".npz")

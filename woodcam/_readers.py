@@ -9,15 +9,18 @@ veneer scans, parquetry targets); it sits at the bottom of the import layering s
 
 from __future__ import annotations
 
+import contextlib
 import json
 import re
 import warnings
+import zipfile
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 from .errors import WoodcamError
 
-__all__ = ["photo_rgb8", "read_image_file", "read_json_file", "read_json_object", "read_photo_rgb",
+__all__ = ["photo_rgb8", "read_image_file", "read_json_file", "read_json_object", "read_npz", "read_photo_rgb",
            "strict_json_loads"]
 
 
@@ -50,6 +53,28 @@ def read_json_object(path, what: str) -> dict:
     if not isinstance(d, dict):
         raise WoodcamError(f"{what} {str(path)!r} must hold a JSON object; got {type(d).__name__}")
     return d
+
+
+@contextlib.contextmanager
+def read_npz(path, what: str, fix: str = "") -> Iterator[Any]:
+    """The open ``.npz`` archive of ``path`` (numpy's ``NpzFile``, no pickles) for the body of a
+    ``with``. A missing, truncated or garbage file, a missing array or one the body refuses
+    (``KeyError``, ``ValueError``, ``TypeError``) is a WoodcamError: ``PATH: not WHAT: why; FIX``.
+    ``what`` names the kind of file and its rule, ``fix`` how to write it again. A truncated
+    archive was numpy's ``BadZipFile`` (an internal error), a text file its "pickled data"
+    message."""
+    try:
+        with open(path, "rb") as fh:  # our own handle: np.load leaks it when the zip is truncated
+            if not zipfile.is_zipfile(fh):
+                raise ValueError("not a zip (.npz) archive: truncated by a crash or copy, or another kind of file")
+            fh.seek(0)
+            import numpy as np
+
+            with np.load(fh, allow_pickle=False) as z:
+                yield z
+    except (OSError, KeyError, ValueError, TypeError, EOFError, zipfile.BadZipFile) as err:
+        why = err.strerror if isinstance(err, OSError) and err.strerror else err
+        raise WoodcamError(f"{path}: not {what}: {why}" + (f"; {fix}" if fix else "")) from err
 
 
 #: What a photo's transparent pixels most likely are, and the fix (:func:`read_image_file`).

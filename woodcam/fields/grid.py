@@ -10,7 +10,6 @@ always computed from the interpolated growth time, never interpolated itself.
 
 from __future__ import annotations
 
-import zipfile
 from collections.abc import Mapping
 from dataclasses import dataclass
 from dataclasses import field as dc_field
@@ -19,7 +18,8 @@ from typing import Literal
 
 import numpy as np
 
-from .._checks import as_floats, check_number, check_vector
+from .._checks import as_floats, check_number, check_vector, npz_path
+from .._readers import read_npz
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from .base import check_points, evaluate
@@ -195,9 +195,7 @@ class GridField:
         """Write the grid to an ``.npz`` file; :meth:`load` restores it exactly. A ``path``
         without the suffix gets ``.npz`` appended; one ending in it in any case (``F.NPZ``, which
         ``woodcam fit --out`` takes) is written as named."""
-        path = Path(path)
-        if path.suffix.lower() != ".npz":  # '.NPZ' became 'f.NPZ.npz' beside the name asked for
-            path = path.with_suffix(path.suffix + ".npz")
+        path = npz_path(path)
         import json
 
         from .._atomic import atomic_write
@@ -211,15 +209,10 @@ class GridField:
 
     @classmethod
     def load(cls, path) -> GridField:
-        try:
-            import json
+        import json
 
-            # our own handle: np.load leaks it when the zip is truncated
-            with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as z:
-                meta = json.loads(str(z["meta"])) if "meta" in z.files else {}
-                layers = {k[len("layer_"):]: z[k] for k in z.files if k.startswith("layer_")}
-                return cls(z["years"], tuple(z["origin_mm"]), tuple(z["spacing_mm"]),
-                           str(z["interpolation"]), tuple(z["axis"]), layers, meta)
-        except (OSError, KeyError, ValueError, TypeError, EOFError, zipfile.BadZipFile) as err:
-            raise WoodcamError(f"{path}: not a woodcam grid field (.npz with 'years', "
-                               f"'origin_mm', 'spacing_mm'): {err}") from err
+        with read_npz(path, "a woodcam grid field (.npz with 'years', 'origin_mm', 'spacing_mm')") as z:
+            meta = json.loads(str(z["meta"])) if "meta" in z.files else {}
+            layers = {k[len("layer_"):]: z[k] for k in z.files if k.startswith("layer_")}
+            return cls(z["years"], tuple(z["origin_mm"]), tuple(z["spacing_mm"]),
+                       str(z["interpolation"]), tuple(z["axis"]), layers, meta)

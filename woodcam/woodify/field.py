@@ -34,8 +34,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy import ndimage
 
-from .._atomic import atomic_path
-from .._checks import check_bool, check_number, check_vector
+from .._atomic import atomic_write
+from .._checks import check_bool, check_number, check_vector, npz_path
+from .._readers import read_npz
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, check_points
 from .speed import GrowthSpeed
@@ -193,20 +194,20 @@ class WoodifiedField:
                               tuple(size), self.interpolation, self.stem_axis)
 
     def save(self, path: str | Path) -> Path:
-        """Write ``field.npz`` atomically (temp file in the same folder, then ``os.replace``)."""
-        path = Path(path)
-        if path.suffix != ".npz":
-            raise WoodcamError(f"path must end in .npz; got {str(path)!r}")
-        path.parent.mkdir(parents=True, exist_ok=True)
+        """Write ``field.npz`` atomically (temp file in the same folder, then ``os.replace``).
+        A ``path`` without the suffix gets ``.npz`` appended; one ending in it in any case
+        (``F.NPZ``) is written as named (:func:`woodcam._checks.npz_path`, the rule of every
+        ``.npz`` writer). Returns the path written."""
+        path = npz_path(path)
         arrays = {"format": FORMAT, "arrival_mm": self.arrival_mm, "origin_mm": self.origin_mm,
-                      "spacing_mm": self.spacing_mm, "speed": json.dumps(self.speed.to_dict()),
-                      "years_final": self.years_final, "block_origin_mm": self.block_origin_mm,
-                      "block_rotation": self.rotation, "block_size_mm": np.asarray(self.block_size_mm),
-                      "stem_axis": self.stem_axis}
+                  "spacing_mm": self.spacing_mm, "speed": json.dumps(self.speed.to_dict()),
+                  "years_final": self.years_final, "block_origin_mm": self.block_origin_mm,
+                  "block_rotation": self.rotation, "block_size_mm": np.asarray(self.block_size_mm),
+                  "stem_axis": self.stem_axis}
         if self.obstacle_sdf_mm is not None:
             arrays["obstacle_sdf_mm"] = self.obstacle_sdf_mm
-        with atomic_path(path) as tmp:
-            np.savez_compressed(tmp, **arrays)
+        with atomic_write(path, mkdir=True) as fh:  # a handle: numpy appends .npz to a path not ending in it
+            np.savez_compressed(fh, **arrays)
         return path
 
     @classmethod
@@ -216,15 +217,13 @@ class WoodifiedField:
         if not path.is_file():
             raise WoodcamError(f"woodify field {str(path)!r} does not exist; write one with "
                                "'woodcam woodify MESH --out DIR' (it writes DIR/field.npz)")
-        try:
-            with np.load(path) as z:
-                if str(z["format"]) != FORMAT:
-                    raise ValueError(f"format {z['format']!s}")
-                return cls(z["arrival_mm"], z["origin_mm"], float(z["spacing_mm"]),
-                           GrowthSpeed.from_dict(json.loads(str(z["speed"]))),
-                           float(z["years_final"]),
-                           z["obstacle_sdf_mm"] if "obstacle_sdf_mm" in z.files else None,
-                           z["block_origin_mm"], z["block_rotation"], tuple(z["block_size_mm"]),
-                           interpolation, z["stem_axis"])
-        except (OSError, KeyError, ValueError) as err:
-            raise WoodcamError(f"{path}: not a woodcam woodify field ({FORMAT} .npz): {err}") from err
+        with read_npz(path, f"a woodcam woodify field ({FORMAT} .npz, written by 'woodcam woodify')",
+                      "write it again with 'woodcam woodify MESH --out DIR' (it writes DIR/field.npz)") as z:
+            if str(z["format"]) != FORMAT:
+                raise ValueError(f"its format is {z['format']!s}")
+            return cls(z["arrival_mm"], z["origin_mm"], float(z["spacing_mm"]),
+                       GrowthSpeed.from_dict(json.loads(str(z["speed"]))),
+                       float(z["years_final"]),
+                       z["obstacle_sdf_mm"] if "obstacle_sdf_mm" in z.files else None,
+                       z["block_origin_mm"], z["block_rotation"], tuple(z["block_size_mm"]),
+                       interpolation, z["stem_axis"])

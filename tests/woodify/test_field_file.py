@@ -1,0 +1,68 @@
+"""``field.npz`` of a woodified object: the file's suffix rule and refusing a broken file."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+import trimesh
+
+from woodcam.cli import main
+from woodcam.errors import WoodcamError
+from woodcam.woodify import WoodifiedField
+from woodcam.woodify.speed import GrowthSpeed
+
+FIX = "write it again with 'woodcam woodify MESH --out DIR' (it writes DIR/field.npz)"
+
+
+def _field() -> WoodifiedField:
+    return WoodifiedField(np.arange(27.0).reshape(3, 3, 3), (0, 0, 0), 1.0, GrowthSpeed(10, 5), 3.0)
+
+
+@pytest.mark.parametrize("name, written", [("F.NPZ", "F.NPZ"), ("f.npz", "f.npz"), ("f", "f.npz"),
+                                           ("f.bin", "f.bin.npz")])
+def test_save_takes_the_npz_suffix_rule_of_every_npz_writer(tmp_path, name, written):
+    """'.NPZ' was refused ('path must end in .npz'); the grid field's writer keeps it as named."""
+    f = _field()
+    out = f.save(tmp_path / "sub" / name)
+    assert out == tmp_path / "sub" / written
+    assert sorted(p.name for p in (tmp_path / "sub").iterdir()) == [written]
+    back = WoodifiedField.load(out)
+    np.testing.assert_array_equal(back.arrival_mm, f.arrival_mm)
+    assert back.years_final == f.years_final
+
+
+@pytest.mark.parametrize("kind, why", [
+    ("truncated", "not a zip \\(.npz\\) archive: truncated"),
+    ("garbage", "not a zip \\(.npz\\) archive: truncated"),
+    ("another npz", "'format is not a file in the archive'"),
+])
+def test_a_broken_field_file_is_one_error_naming_it_the_rule_and_the_fix(tmp_path, kind, why):
+    """A truncated field.npz was numpy's BadZipFile (an internal error), a text file its
+    'pickled data' message."""
+    path = _field().save(tmp_path / "field.npz")
+    if kind == "truncated":
+        data = path.read_bytes()
+        path.write_bytes(data[: len(data) // 2])
+    elif kind == "garbage":
+        path.write_text("not a field")
+    else:
+        np.savez(path, a=np.zeros(3))
+    with pytest.raises(WoodcamError) as err:
+        WoodifiedField.load(path)
+    msg = str(err.value)
+    assert msg.startswith(f"{path}: not a woodcam woodify field (woodcam-woodify-field-1 .npz")
+    assert msg.endswith(FIX)
+    assert re.search(why, msg)
+
+
+def test_bake_from_a_truncated_field_is_one_line(tmp_path, capsys):
+    path = _field().save(tmp_path / "field.npz")
+    path.write_bytes(path.read_bytes()[:100])
+    trimesh.creation.box((1, 1, 1)).export(tmp_path / "part.stl")
+    rc = main(["bake", str(tmp_path / "part.stl"), "--block", f"woodify:{path}", "--out", str(tmp_path / "o.glb")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc != 0
+    assert len(err) == 1 and "internal error" not in err[0]
+    assert err[0].startswith(f"woodcam: error: {path}: not a woodcam woodify field") and err[0].endswith(FIX)
