@@ -1366,6 +1366,58 @@ def test_the_detection_cache_is_keyed_by_the_photos_and_the_rule(tmp_path, monke
     assert traces(photos_only(first)) == base and len(entries()) == 3  # the same content: read back
 
 
+@pytest.mark.parametrize("cache, damage", [(c, d) for c in ("per face", "per block")
+                                           for d in ("ring_map rows", "ring ids", "knot_mask", "trace lengths")]
+                         + [("per block", "another face")])
+def test_a_detection_entry_that_does_not_fit_its_faces_is_rebuilt(tmp_path, monkeypatch, damage, cache):
+    """A cached detection that is a valid .npz but holds arrays of other shapes than its faces
+    (a ring map of 5 rows) failed every run ('ring_map of face 'top' must have shape (64, 64)
+    like the face; got (5, 64)') until 'woodcam cache clear', and fewer ring ids than traces
+    dropped the traces past them without a word; an entry of the block holding a face the block
+    has not was a KeyError (an internal error). Now such an entry is broken like a truncated
+    one: one CacheWarning, detected again, the fresh detection's answer, then read back."""
+    from woodcam._cache import CacheWarning, cache_dir
+    from woodcam.detect.block import detect_block, photos_only, with_detected_rings
+    from woodcam.synth import AnalyticLogField, cut_block, synth_block
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    field = cut_block(AnalyticLogField(ring_width_mm=3.0), (30, 30, 30), "rift")
+    block = photos_only(synth_block(field, (30, 30, 30), face_px=64, seed=4, ring_map_faces=()))
+    block.faces = {"top": block.faces["top"]}
+
+    def detect():
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            out = (detect_block(block, cache=True)[0] if cache == "per face" else with_detected_rings(block))
+        f = out.faces["top"]
+        seen = ([t.points_px.tolist() for t in f.traces], [t.ring for t in f.traces], f.ring_map.tolist(),
+                np.asarray(f.extras.get("knot_mask", False)).tolist())
+        return seen, [str(w.message) for w in said if issubclass(w.category, CacheWarning)]
+
+    fresh, said = detect()
+    assert said == [] and len(fresh[0]) > 2
+    read_back = detect()  # the ring map is kept as uint16 levels
+    assert read_back[1] == [] and read_back[0][:2] == fresh[:2]
+    [entry] = sorted(cache_dir("detect").glob("*.npz"))
+    with np.load(entry) as z:
+        arrays = dict(z)
+    if damage == "ring_map rows":
+        arrays["top.ring_map"] = arrays["top.ring_map"][:5]
+    elif damage == "ring ids":
+        arrays["top.rings"] = arrays["top.rings"][:2]
+    elif damage == "knot_mask":
+        arrays["top.knot_mask"] = np.zeros((5, 64), bool)
+    elif damage == "trace lengths":
+        arrays["top.lengths"] = arrays["top.lengths"][:-1]
+    else:
+        arrays.update({k.replace("top.", "left."): v for k, v in arrays.items() if k.startswith("top.")})
+    np.savez(entry, **arrays)
+    again, said = detect()
+    assert len(said) == 1 and said[0].startswith(f"ring detection: discarded the unreadable cache entry {str(entry)!r}")
+    assert again == fresh
+    assert detect() == read_back  # the rebuilt entry is read back
+
+
 def test_a_partial_rerun_removes_the_photo_it_wrote_of_a_face_left_out(synth_photos, tmp_path, capsys):
     """'block from-photos --partial' into the folder of an earlier run with the face left out:
     its left_photo.png stayed beside the new manifest, unread (read_block named five faces), a

@@ -179,7 +179,8 @@ def _detect_face_cached(face: Face, px_per_mm: float, rule: BoundaryRule, knots:
 
     key = digest("detect-face", DETECT_VERSION, rule, _curved(curved), "classical", bool(knots), float(px_per_mm),
                  np.asarray(face.photo))
-    raw, hit = load_or_build(entry_path(cache_dir("detect"), face.name, key), load=_load_detection, build=build,
+    raw, hit = load_or_build(entry_path(cache_dir("detect"), face.name, key),
+                             load=lambda p: _load_detection(p, {face.name: face.shape}), build=build,
                              save=_save_detection, what="ring detection")
     if hit:
         traces, ring_map, found = raw[0][face.name]
@@ -981,20 +982,40 @@ def _save_detection(value, tmp: Path) -> None:
         np.savez_compressed(fh, **arrays)
 
 
-def _load_detection(path: Path):
+def _load_detection(path: Path, shapes: dict[str, tuple[int, int]]):
+    """The faces (traces, ring map, knot mask) and warnings of a detection entry written by
+    :func:`_save_detection`, for the faces ``shapes`` names (face -> its image's ``(rows, cols)``).
+    An entry that does not fit them is broken (a ValueError or WoodcamError, so
+    :func:`~woodcam._cache.load_or_build` discards it with a CacheWarning and detects again):
+    other faces, a ring map or knot mask of another shape than its face's (every run failed on
+    it, 'ring_map of face ... must have shape', until the cache was cleared), traces whose
+    lengths do not add up to their points, or fewer ring ids than traces (the traces past them
+    were dropped without a word). Each face is checked by :class:`Face`'s own rules."""
     from ..block.block import RingTrace
 
     with np.load(path) as z:
         msgs = json.loads(str(z["warnings"]))
         names = sorted({k.split(".")[0] for k in z.files if "." in k})
+        if names != sorted(shapes):
+            raise ValueError(f"it holds the faces {names}, not the {sorted(shapes)} detected")
         faces = {}
         for n in names:
-            cuts = np.cumsum(z[f"{n}.lengths"])[:-1]
-            rings = z[f"{n}.rings"] if f"{n}.rings" in z.files else np.full(len(z[f"{n}.lengths"]), -1)
+            points, lengths = np.asarray(z[f"{n}.points"], float), np.asarray(z[f"{n}.lengths"])
+            rings = np.asarray(z[f"{n}.rings"]) if f"{n}.rings" in z.files else np.full(len(lengths), -1)
+            if (points.ndim != 2 or points.shape[1] != 2 or lengths.ndim != 1 or rings.shape != lengths.shape
+                    or not np.issubdtype(lengths.dtype, np.integer) or not np.issubdtype(rings.dtype, np.integer)
+                    or np.any(lengths < 2) or int(lengths.sum()) != len(points)):
+                raise ValueError(f"face {n!r}: {len(lengths)} traces of lengths adding up to "
+                                 f"{int(np.sum(lengths))}, {len(rings)} ring ids and points of shape {points.shape} "
+                                 "do not match")
             traces = [RingTrace(q, ring=None if k < 0 else int(k))
-                      for q, k in zip(np.split(z[f"{n}.points"], cuts), rings) if len(q) >= 2]
+                      for q, k in zip(np.split(points, np.cumsum(lengths)[:-1]), rings)]
             rm = z[f"{n}.ring_map"].astype(np.float32) / 65535 if f"{n}.ring_map" in z.files else None
             extras = {"knot_mask": z[f"{n}.knot_mask"]} if f"{n}.knot_mask" in z.files else {}
+            if "knot_mask" in extras and np.shape(extras["knot_mask"]) != tuple(shapes[n]):
+                raise ValueError(f"knot_mask of face {n!r} has shape {np.shape(extras['knot_mask'])}, not the "
+                                 f"face's {tuple(shapes[n])}")
+            Face(n, shapes[n], traces=traces, ring_map=rm)  # the face's own rules: ring map shape, trace bounds
             faces[n] = (traces, rm, extras)
     return faces, msgs
 
@@ -1017,7 +1038,8 @@ def with_detected_rings(block: Block, rule: BoundaryRule = DEFAULT_RULE, *, cach
 
     if cache:
         path = entry_path(cache_dir("detect"), block.name, _detection_key(block, rule))
-        raw, hit = load_or_build(path, load=_load_detection, build=build, save=_save_detection,
+        shapes = {n: f.shape for n, f in block.faces.items() if f.photo is not None}  # detect_block's faces
+        raw, hit = load_or_build(path, load=lambda p: _load_detection(p, shapes), build=build, save=_save_detection,
                                  what="ring detection")
         if not hit:
             raw = ({n: (f.traces, f.ring_map, {k: v for k, v in f.extras.items() if k == "knot_mask"})
