@@ -86,6 +86,25 @@ def test_panel_size_mm_is_in_mm(finished):
     assert p.size_mm == pytest.approx(json.loads((out / "result.json").read_text())["summary"]["panels"][0]["size_mm"])
 
 
+def test_result_json_size_is_the_cut_files_size_when_a_patch_is_not_whole_pixels(sheets, tmp_path):
+    """result.json's size_mm was cells x patch_mm, the cut files' size pixels / px_per_mm: a
+    patch is a whole number of pixels (patch_px, rounded), so 6.8 mm patches at 2 px/mm are
+    14 px (7 mm) and the 3 x 3 panel 21 mm, where result.json said 20.4. Both are
+    Parquetry.size_mm now."""
+    import re
+
+    prm = ParquetryParams(image_size_mm=20, patch_mm=6.8, px_per_mm=PPM)
+    assert prm.patch_px == 14 and prm.patch_mm * PPM != prm.patch_px
+    run = build_parquetry(np.full((40, 40), 0.5, np.float32), sheets[:1], prm)
+    write_parquetry(run, tmp_path)
+    p = run.panels[0]
+    assert p.size_mm == pytest.approx((21.0, 21.0))
+    summary = json.loads((tmp_path / "result.json").read_text())["summary"]
+    assert summary["panels"][0]["size_mm"] == pytest.approx(list(p.size_mm))
+    svg = (tmp_path / "assembly.svg").read_text()
+    assert re.search(r'width="([\d.]+)mm" height="([\d.]+)mm"', svg).groups() == ("21.000", "21.000")
+
+
 def test_single_use_on_every_sheet_from_svg_and_dxf(finished):
     """Rasterise every parsed-back cut path onto its sheet: no sheet pixel is used twice, and
     only usable wood is used; the kerf keeps pieces apart by at least kerf - 1 px. The DXF's

@@ -109,7 +109,9 @@ def summary(run: ParquetryRun) -> dict:
            "panels": []}
     for p in run.panels:
         ok = p.labels >= 0
-        d = {"name": p.name, "size_mm": [p.cells.shape[1] * prm.patch_mm, p.cells.shape[0] * prm.patch_mm],
+        # the size its cut files have (pixels over px_per_mm), not cells x patch_mm: a patch is
+        # a whole number of pixels (ParquetryParams.patch_px, rounded)
+        d = {"name": p.name, "size_mm": list(p.size_mm),
              "cells": list(p.cells.shape), "patches": len(p.patches)}
         if ok.all():
             d.update(feature_cost=feature_cost(p, p.render, prm),
@@ -171,7 +173,7 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
             files.append(atomic_write_png(out / f"render{sfx}.png", p.render))
             files.append(atomic_write_png(out / f"baseline{sfx}.png", p.baseline))
             files.append(atomic_write_png(out / f"target_matched{sfx}.png", np.repeat(p.matched[..., None], 3, 2)))
-            W, H = p.matched.shape[1] / ppm, p.matched.shape[0] / ppm
+            W, H = p.size_mm
             buf = io.BytesIO()
             Image.fromarray((np.clip(p.render, 0, 1) * 255 + 0.5).astype(np.uint8)).save(buf, format="PNG")
             uri = "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode()
