@@ -683,7 +683,11 @@ def test_a_job_file_spec_is_read_in_mm_under_units_inch_and_said(scans, capsys):
     """A --config job file's 'builtin:flat-sawn:80x40x60' was read in mm under --units inch,
     where the same spec given as --veneer-from is read in inches, without a word. A job file's
     lengths are mm (its *_mm keys, its specs as job.json writes them): read so, and said under
-    --units inch with the spec in mm of the inches it may have meant; nothing said in mm."""
+    --units inch with the spec in mm of the inches it may have meant; nothing said in mm. The
+    job.json woodcam writes says its unit (woodcam.units "mm"): its replay under --units inch
+    warned of each spec too, and is silent now."""
+    from woodcam.parquetry.job import read_job
+
     job = scans / "job.json"
     job.write_text(json.dumps({"targets": [{"filename": "coffee.png"}],
                                "woodcam": {"blocks": [{"spec": "builtin:flat-sawn:80x40x60"},
@@ -701,6 +705,23 @@ def test_a_job_file_spec_is_read_in_mm_under_units_inch_and_said(scans, capsys):
     assert blocks[0]["spec"] == "builtin:flat-sawn:80x40x60" and blocks[0]["width_mm"] == pytest.approx(38.1)
     assert _small_run(scans, scans / "out-mm", *run[:-3], "--sheet-size", "40x40", "--no-glb") == 0
     assert "warning" not in capsys.readouterr().err
+    # woodcam's own job.json says its lengths are mm: its replay under --units inch has nothing
+    # to warn of (it warned of each spec, as the hand-written file's)
+    written = json.loads((out / "job.json").read_text())
+    assert main(["parquetry", "--config", str(out / "job.json"), "--out", str(scans / "out-replay"),
+                 "--quiet", "--units", "inch", "--no-glb"]) == 0
+    assert "warning" not in capsys.readouterr().err
+    assert written["woodcam"]["units"] == "mm"
+    assert (json.loads((scans / "out-replay" / "job.json").read_text())["woodcam"]["blocks"]
+            == written["woodcam"]["blocks"])
+    # a hand-written file that says so is read alike; any other unit is refused
+    said = scans / "said.json"
+    said.write_text(json.dumps({"targets": [{"filename": "coffee.png"}],
+                                "woodcam": {"units": "mm", "blocks": [{"spec": "builtin:flat-sawn:80x40x60"}]}}))
+    assert read_job(said).units_said and not read_job(job).units_said
+    said.write_text(json.dumps({"targets": [{"filename": "coffee.png"}], "woodcam": {"units": "inch"}}))
+    with pytest.raises(WoodcamError, match=r"woodcam.units must be 'mm' .*; got 'inch'"):
+        read_job(said)
 
 
 def test_the_default_panel_size_is_said_and_too_little_wood_up_front(scans, capsys):

@@ -277,7 +277,7 @@ def _say_job_lengths_in_mm(args, job) -> None:
     from ..errors import BlockSpecError
     from ..units import MM_PER_UNIT
 
-    if not args.config or args.units == "mm":
+    if not args.config or args.units == "mm" or job.units_said:  # woodcam.units: "mm" said it
         return
     for i, b in enumerate(job.blocks):
         try:

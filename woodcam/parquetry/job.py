@@ -11,7 +11,8 @@ The job layout is WoodPixel's JSON::
 
 with woodcam's own keys (Table 1 names in mm, fabrication, veneers sliced from blocks) under
 ``"woodcam"``. Relative paths are relative to the job file. A texture's resolution is
-``dpi / 25.4 * scale`` px/mm.
+``dpi / 25.4 * scale`` px/mm. A job file's lengths are mm; ``"woodcam": {"units": "mm"}``
+(the only unit it may name; :func:`write_job` writes it) says so.
 """
 
 from __future__ import annotations
@@ -355,6 +356,9 @@ class ParquetryJob:
     mokume: list[str] = field(default_factory=list)
     targets: list[dict] = field(default_factory=list)
     params: ParquetryParams = field(default_factory=ParquetryParams)
+    #: whether the job file says its lengths are mm (``woodcam.units``, which :func:`write_job`
+    #: writes): nothing in it is ambiguous under ``--units inch``
+    units_said: bool = False
 
 
 class JobPathError(WoodcamError):
@@ -382,10 +386,15 @@ def read_job(path: str | Path) -> ParquetryJob:
     extra = d.get("woodcam", {}) or {}
     if not isinstance(extra, dict) or not isinstance(extra.get("params", {}), dict):
         raise WoodcamError(f"{where} 'woodcam' and 'woodcam.params' must be objects; got {extra!r}")
-    unknown = sorted(set(extra) - {"params", "blocks", "mokume"})
+    unknown = sorted(set(extra) - {"params", "blocks", "mokume", "units"})
     if unknown:  # {"woodcam": {"image_size_mm": 50}} was ignored: a parameter belongs in params
         raise WoodcamError(f"{where} key woodcam.{unknown[0]} is unknown; the 'woodcam' object holds "
-                           "params, blocks and mokume (parameters go in woodcam.params)")
+                           "params, blocks, mokume and units (parameters go in woodcam.params)")
+    # the unit of the file's lengths, said (write_job writes it): mm, the only one a job file has
+    if "units" in extra and extra["units"] != "mm":
+        raise WoodcamError(f"{where} woodcam.units must be 'mm' (a job file's lengths are mm: its *_mm keys, "
+                           f"its block specs' sizes); got {extra['units']!r}; write the lengths in mm and "
+                           "'units': 'mm', or leave the key out")
     mokume = extra.get("mokume", [])
     if not isinstance(mokume, list) or not all(isinstance(m, str) for m in mokume):
         raise WoodcamError(f"{where} 'woodcam.mokume' must be a list of folder paths; got {mokume!r}")
@@ -460,7 +469,7 @@ def read_job(path: str | Path) -> ParquetryJob:
     mokume = [_abs(m) for m in mokume]
     # a block folder, log:PATH or woodify:PATH as the textures: from the job file's folder
     blocks = [dict(b, spec=absolute_spec(b["spec"], base)) for b in blocks]
-    return ParquetryJob(scans, blocks, mokume, targets, params)
+    return ParquetryJob(scans, blocks, mokume, targets, params, units_said="units" in extra)
 
 
 def write_job(job: ParquetryJob, path: str | Path) -> Path:
@@ -483,7 +492,9 @@ def write_job(job: ParquetryJob, path: str | Path) -> Path:
     for k, name in _PAPER_KEYS.items():
         d[k] = prm[name]
     d["sort_patches_saliency"] = job.params.priority == "saliency"
-    d["woodcam"] = {"params": prm, "blocks": [dict(b, spec=absolute_spec(b["spec"])) for b in job.blocks],
+    # "units": its lengths (the *_mm keys, the block specs' :WxDxH and resizes) are mm, said so a
+    # replay under --units inch has nothing to warn of
+    d["woodcam"] = {"units": "mm", "params": prm, "blocks": [dict(b, spec=absolute_spec(b["spec"])) for b in job.blocks],
                     "mokume": [_abs(m) for m in job.mokume]}
     return write_text(path, json.dumps(d, indent=2), mkdir=True)
 
