@@ -1200,13 +1200,13 @@ def test_debug_text_woodcam_cannot_fill_in_is_marked_and_warned():
     """A value woodcam does not know (the tool table's #5401, an unset probe result) shows as
     '#5401?' with a warning; a '#' or '#<name' left open at the end, where LinuxCNC shows left
     over text of an earlier message, ends the text with a warning; grbl and Fanuc read DEBUG as
-    a plain comment."""
-    interp = Interpreter("(DEBUG,tlo=#5403 z=#5063 end)\n(DEBUG,open #)\n(DEBUG,x #<_x)\nM2\n")
+    a plain comment. (A tool loaded: with none, before the first M6, the entry is 0.)"""
+    interp = Interpreter("T1 M6\n(DEBUG,tlo=#5403 z=#5063 end)\n(DEBUG,open #)\n(DEBUG,x #<_x)\nM2\n")
     interp.run()
-    assert interp.messages == [(1, "tlo=[#5403: T0's Z offset, from the machine's tool table] "
-                                   "z=#5063? end"), (2, "open"), (3, "x")]
-    assert [w[0] for w in interp.warnings] == [1, 1, 2, 3]
-    assert "#5403, T0's Z offset in the machine's tool table" in interp.warnings[0][1]
+    assert interp.messages == [(2, "tlo=[#5403: T1's Z offset, from the machine's tool table] "
+                                   "z=#5063? end"), (3, "open"), (4, "x")]
+    assert [w[0] for w in interp.warnings] == [2, 2, 3, 4]
+    assert "#5403, T1's Z offset in the machine's tool table" in interp.warnings[0][1]
     assert "#5063, which woodcam cannot know" in interp.warnings[1][1]
     assert "unfinished parameter '#<_x'" in interp.warnings[3][1]
     for dialect in ("grbl", "fanuc"):
@@ -1220,19 +1220,19 @@ def test_a_message_in_a_loop_is_said_every_pass_and_warned_once():
     every pass: a 1000-pass while loop gave 1000 identical warnings a value. Now each line and
     value is warned once, saying how many times the line ran; the messages stay one a pass, as
     LinuxCNC shows them (do and repeat loops the same)."""
-    text = ("#1=0\no100 while [#1 lt 1000]\n(DEBUG,z=#5403 p=#5063 #5063)\n(PRINT,#1 x #)\n"
+    text = ("T1 M6\n#1=0\no100 while [#1 lt 1000]\n(DEBUG,z=#5403 p=#5063 #5063)\n(PRINT,#1 x #)\n"
             "#1=[#1+1]\no100 endwhile\n"
             "o200 do\n(DEBUG,q=#5063)\n#1=[#1-1]\no200 while [#1 gt 997]\n"
             "o300 repeat [2]\n(PRINT,t=#5401)\no300 endrepeat\n(DEBUG,once #5063)\nM2\n")
     interp = Interpreter(text)
     interp.run()
     assert len(interp.messages) == 1000 + 3 + 1 and len(interp.printed) == 1000 + 2
-    assert interp.messages[999] == (3, "z=[#5403: T0's Z offset, from the machine's tool "
+    assert interp.messages[999] == (4, "z=[#5403: T1's Z offset, from the machine's tool "
                                        "table] p=#5063? #5063?")
-    assert interp.printed[999] == (4, "999.000000 x")
+    assert interp.printed[999] == (5, "999.000000 x")
     said = [(ln, w.split(",...) ")[1].split(",")[0].split(":")[0]) for ln, w in interp.warnings]
-    assert said == [(3, "shows #5403"), (3, "reads #5063"), (4, "ends in an unfinished "
-                    "parameter '#'"), (8, "reads #5063"), (12, "shows #5401"), (14, "reads #5063")]
+    assert said == [(4, "shows #5403"), (4, "reads #5063"), (5, "ends in an unfinished "
+                    "parameter '#'"), (9, "reads #5063"), (13, "shows #5401"), (15, "reads #5063")]
     ran = [re.findall(r"\(warned once; the line ran (\d+) times\)$", w) for _, w in interp.warnings]
     assert ran == [["1000"], ["1000"], ["1000"], ["3"], ["2"], []]
 

@@ -856,8 +856,10 @@ def test_linuxcnc_prints_and_shows_the_users_diameters_as_woodcam(tmp_path):
         "line 17: last d=3.000000", "line 20: long " + "x" * 237]
     assert theirs.messages == mine.messages == ["line 4: d=6.350000", "line 22: t3 3.000000"]
     assert not mine.warnings and not theirs.warnings
-    # without the diameters LinuxCNC's table holds 0 (woodcam says so, with a warning)
-    assert read_gcode(text, interpreter="linuxcnc").messages[0] == "line 4: d=0.000000"
+    # without the diameters LinuxCNC's table holds 0: both say what it is, with a warning
+    bare = read_gcode(text, interpreter="linuxcnc")
+    assert bare.messages[0] == "line 4: d=[#5410: T1's diameter, from the machine's tool table]"
+    assert bare.messages == read_gcode(text).messages
 
 
 @pytest.mark.skipif(not RS274.exists(), reason=f"{RS274} (LinuxCNC's standalone interpreter, "
@@ -878,3 +880,35 @@ def test_tool_table_entries_in_messages_are_the_machines_table_as_rs274_shows_th
                                    "tool table]")]
     assert interp.printed == [(5, printed[0])]
     assert said[0].startswith(interp.messages[0][1].split(" z=")[0] + " z=")
+
+
+@pytest.mark.skipif(not RS274.exists(), reason=f"{RS274} (LinuxCNC's standalone interpreter, "
+                    "linuxcnc-uspace) is not installed")
+def test_tool_entries_before_the_first_m6_and_of_a_tool_not_given_agree(tmp_path):
+    """Before the first M6 no tool is loaded: rs274 -t shows #5410 (any entry) as 0, a T0 in
+    its table too, and --interpreter linuxcnc did; woodcam's interpreter showed the diameter
+    the user gave for tool 0 (the one --tool SPEC of a program without a T word), or warned
+    '[#5410: T0's diameter ...]'. And a #5410 of a tool the user did not give was 0 with no
+    word under --interpreter linuxcnc, where woodcam's interpreter says what it is with a
+    warning (once for its line in a loop). Both interpreters now read the program alike."""
+    (tmp_path / "tools.tbl").write_text("T0 P0 D5 ;none\nT1 P1 D6.35 ;flat\n")
+    first = "G21\n(PRINT,d=#5410 z=#5403 t=#5400)\nT0 M6\n(PRINT,d=#5410)\nM2\n"
+    assert _rs274(tmp_path, first, "-t", "tools.tbl")[1] == [
+        "d=0.000000 z=0.000000 t=0.000000", "d=0.000000"]
+    for tools in ({0: 6.35}, {1: 6.35}, {}):
+        for interpreter in ("woodcam", "linuxcnc"):
+            p = read_gcode(first, interpreter=interpreter, tool_diameters_mm=tools)
+            assert p.printed == ["line 2: d=0.000000 z=0.000000 t=0.000000", "line 4: d=0.000000"]
+            assert not p.warnings, (interpreter, tools)
+    text = ("G21\nT2 M6\n#1=0\no1 while [#1 lt 3]\n(DEBUG,d=#5410 z=#5403)\n#1=[#1+1]\n"
+            "o1 endwhile\n(PRINT,again #05410)\nT1 M6\n(PRINT,d=#5410)\nG0 X0 Y0 Z5\nG1 X1 F100\nM2\n")
+    mine = read_gcode(text, tool_diameters_mm={1: 6.35})
+    theirs = read_gcode(text, interpreter="linuxcnc", tool_diameters_mm={1: 6.35})
+    table = "from the machine's tool table]"
+    assert theirs.messages == mine.messages == 3 * [
+        f"line 5: d=[#5410: T2's diameter, {table} z=[#5403: T2's Z offset, {table}"]
+    assert theirs.printed == mine.printed == [f"line 8: again [#05410: T2's diameter, {table}",
+                                              "line 10: d=6.350000"]
+    assert theirs.warnings == mine.warnings
+    assert [w.split(":")[0] for w in theirs.warnings] == ["line 5", "line 5", "line 8"]
+    assert theirs.warnings[0].endswith("to see its diameter (warned once; the line ran 3 times)")

@@ -605,7 +605,9 @@ def test_a_message_shows_the_diameter_of_a_tool_without_a_number(tmp_path, monke
     """A --tool SPEC without a number cuts the program's tool numbers no other --tool gives,
     in the order it uses them (one alone: also a program without a T word), but a (DEBUG,...)
     or (PRINT,...) of #5410 said '[#5410: T1's diameter, from the machine's tool table]' with a
-    warning to give the tool it was given. It shows that tool's diameter now."""
+    warning to give the tool it was given. It shows that tool's diameter now. A program without
+    a T word (the one tool cuts it) has no tool loaded, so #5410 shows 0, as LinuxCNC shows it
+    (rs274 -t; woodcam showed the tool's diameter there)."""
     _stub_preview(monkeypatch, {})
     two = tmp_path / "two.nc"
     two.write_text("G21 G90\nT1 M6\n(DEBUG, dia #5410)\nG0 X10 Y10 Z5 M3 S9000\nG1 Z-1 F600\n"
@@ -617,7 +619,7 @@ def test_a_message_shows_the_diameter_of_a_tool_without_a_number(tmp_path, monke
     for path, tools, said in (
             (two, ["flat:4", "7=ball:3.5", "flat:2"], ["line 3: dia 4.000000",
                                                        "line 12: dia 2.000000"]),
-            (none, ["flat:6.35"], ["line 2: dia 6.350000"])):
+            (none, ["flat:6.35"], ["line 2: dia 0.000000"])):
         args = _parse([str(path), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
                        *[w for t in tools for w in ("--tool", t)], "--cell-size", "0.5"])
         assert args.func(args) == 0

@@ -145,7 +145,8 @@ def _unnumbered_diameters(args, program, diameters) -> dict:
     in order; one tool alone is the tool of a program without a T word, tool 0), those not in
     ``diameters``; empty when the program says and prints nothing, where they would show
     (a DEBUG/PRINT of #5410, the loaded tool's diameter), or when they do not fit (refused
-    later, after its messages, by _tools_from_args)."""
+    later, after its messages, by _tools_from_args). Not tool 0's: before the first M6 no tool
+    is loaded and #5410 shows 0, as on LinuxCNC (interpreter.tool_entry_in_message)."""
     from .options import parse_tool_option
 
     if not (program.messages or program.printed) or all(
@@ -155,7 +156,7 @@ def _unnumbered_diameters(args, program, diameters) -> dict:
         tools = _tools_from_args(args, program)
     except WoodcamError:
         return {}
-    return {n: t.diameter_mm for n, t in tools.items() if n not in diameters}
+    return {n: t.diameter_mm for n, t in tools.items() if n not in diameters and n != 0}
 
 
 def _tools_from_args(args, program) -> dict:

@@ -275,10 +275,10 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
     tool_diameters_mm : {int: float} | None
         The cutters' diameters (mm) by tool number, as the user's tool table gives them: what
         a ``(DEBUG,...)``/``(PRINT,...)`` shows for ``#5410`` (the loaded tool's diameter in
-        the machine's tool table). Without the loaded tool there, woodcam's interpreter says
-        what LinuxCNC would show, with a warning; ``interpreter="linuxcnc"`` runs LinuxCNC
-        with these diameters in its tool table, and shows 0 for a tool not there and before
-        the first ``M6`` (no tool loaded: LinuxCNC has no tool 0).
+        the machine's tool table). Without the loaded tool there, it says what LinuxCNC would
+        show, with a warning; before the first ``M6`` (no tool loaded: LinuxCNC's T0 is no
+        tool) it shows 0, as LinuxCNC. ``interpreter="linuxcnc"`` runs LinuxCNC with these
+        diameters in its tool table and shows and warns the same.
 
     Raises
     ------

@@ -19,7 +19,8 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   value over it: the value would be dropped); reading what woodcam cannot know is refused: the tool table's offsets and diameter ``#5401``-``#5413``, and
   probe (``#5061``-``#5070``) or input (``#5399``) results the program did not assign (in a
   DEBUG/PRINT text a tool-table entry shows as ``[#5403: T1's Z offset, from the machine's
-  tool table]``, ``#5410`` as the loaded tool's diameter where ``tool_diameters_mm`` has it;
+  tool table]``, ``#5410`` as the loaded tool's diameter where ``tool_diameters_mm`` has it,
+  every entry as 0 with no tool loaded, before the first M6, as LinuxCNC;
   the
   ``params`` argument may supply them; the machine's state, ``#5400``-``#5413``,
   ``#5420``-``#5428``, ``#5600``/``#5601``, it refuses); lengths
@@ -396,6 +397,44 @@ _DIGITS = re.compile(r"[0-9]+")
 _C_SPACE = " \t\n\v\f\r"
 
 
+def tool_entry_in_message(k: int, ref: str, kind: str, tool: int,
+                          diameters: dict[int, float]) -> tuple[float | str, str | None]:
+    """``#k`` (5401-5413, written ``ref``) in a ``kind`` (DEBUG/PRINT) text with tool ``tool``
+    loaded: ``(what the text shows, the warning or None)``. LinuxCNC shows the loaded tool's
+    entry in the machine's tool table: 0 with no tool loaded (T0, before the first M6:
+    LinuxCNC's T0 is no tool, its entry empty, as ``rs274 -t TABLE`` shows), the diameter
+    ``#5410`` where the user's tools (``diameters``, mm by number) have the loaded tool, else
+    a text that says what LinuxCNC would show there, with a warning (``#5403?`` said neither
+    what nor why). Woodcam's interpreter and ``--interpreter linuxcnc`` (:mod:`.linuxcnc`)
+    both show and warn by it."""
+    if tool == 0:
+        return 0.0, None
+    if k == 5410 and tool in diameters:
+        return float(diameters[tool]), None
+    what = f"T{tool}'s {_TOOL_ENTRY[k]}"
+    shown = f"[{ref}: {what}, from the machine's tool table]"
+    give = (f"; give the tool (--tools TABLE, --tool {tool}=SPEC; read_gcode's "
+            "tool_diameters_mm) to see its diameter" if k == 5410 else "")
+    return shown, (f"({kind},...) shows {ref}, {what} in the machine's tool table, which "
+                   f"woodcam does not know: the message says '{shown}' where LinuxCNC shows "
+                   f"the table's value{give}")
+
+
+def add_line_warning(warnings: list, warned: dict, line: int, msg: str, pass_id: object) -> None:
+    """Append ``(line, msg)`` to ``warnings`` once per line and text: a line in a loop or a
+    subroutine runs again and again; a line warned again in another pass (``pass_id``)
+    counts its passes in the one warning. ``warned`` keeps ``(line, msg) -> [index, passes,
+    last pass]`` between calls (:meth:`Interpreter.warn`, ``--interpreter linuxcnc``)."""
+    key = (line, msg)
+    seen = warned.get(key)
+    if seen is None:
+        warned[key] = [len(warnings), 1, pass_id]
+        warnings.append((line, msg))
+    elif seen[2] != pass_id:
+        seen[1:] = [seen[1] + 1, pass_id]
+        warnings[seen[0]] = (line, f"{msg} (warned once; the line ran {seen[1]} times)")
+
+
 def _lf(value: float | None) -> str:
     """A parameter's value in a DEBUG/PRINT text as LinuxCNC 2.9 writes it: C's ``%lf`` of the
     value (within its 1e-4 'equal' of 0: 0, never -0.000000), ``######`` for none or for
@@ -667,15 +706,7 @@ class Interpreter:
         if pass_id is None:
             self._warn_calls += 1
             pass_id = -self._warn_calls  # (apart from the message passes, which count up)
-        key = (self.line_no, msg)
-        seen = self._warned.get(key)
-        if seen is None:
-            self._warned[key] = [len(self.warnings), 1, pass_id]
-            self.warnings.append((self.line_no, msg))
-        elif seen[2] != pass_id:
-            seen[1:] = [seen[1] + 1, pass_id]
-            self.warnings[seen[0]] = (self.line_no, f"{msg} (warned once; the line ran "
-                                                    f"{seen[1]} times)")
+        add_line_warning(self.warnings, self._warned, self.line_no, msg, pass_id)
 
     def _warn_message(self, msg: str) -> None:
         """Warn ``msg`` about a DEBUG/PRINT text once per line (its messages stay one a pass,
@@ -1917,19 +1948,11 @@ class Interpreter:
         return "".join(out)
 
     def _tool_entry_in_message(self, k: int, ref: str, kind: str) -> float | str:
-        """``#k`` (5401-5413) in a DEBUG/PRINT text: LinuxCNC shows the loaded tool's entry
-        in the machine's tool table. The diameter ``#5410`` where the user's tools
-        (``tool_diameters_mm``) have the loaded tool, else a text that says what LinuxCNC
-        would show there, with a warning: ``#5403?`` said neither what nor why."""
-        if k == 5410 and self.tool in self.tool_diameters_mm:
-            return float(self.tool_diameters_mm[self.tool])
-        what = f"T{self.tool}'s {_TOOL_ENTRY[k]}"
-        shown = f"[{ref}: {what}, from the machine's tool table]"
-        give = (f"; give the tool (--tools TABLE, --tool {self.tool}=SPEC; read_gcode's "
-                "tool_diameters_mm) to see its diameter" if k == 5410 else "")
-        self._warn_message(f"({kind},...) shows {ref}, {what} in the machine's tool table, "
-                           f"which woodcam does not know: the message says '{shown}' where "
-                           f"LinuxCNC shows the table's value{give}")
+        """``#k`` (5401-5413) in a DEBUG/PRINT text (:func:`tool_entry_in_message`), its
+        warning warned once for the line."""
+        shown, warning = tool_entry_in_message(k, ref, kind, self.tool, self.tool_diameters_mm)
+        if warning:
+            self._warn_message(warning)
         return shown
 
     def _named_in_message(self, name: str, word: str):

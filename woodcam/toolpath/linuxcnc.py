@@ -18,7 +18,14 @@ import tempfile
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .interpreter import GcodeError, line_list, source_lines, split_comments
+from .interpreter import (
+    GcodeError,
+    add_line_warning,
+    line_list,
+    source_lines,
+    split_comments,
+    tool_entry_in_message,
+)
 
 #: Debian's interpreter, for which the ``gcode`` module is built.
 LINUXCNC_PYTHON = "/usr/bin/python3"
@@ -87,7 +94,9 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
     ``(line, text)``, those before a refusal too; ``printed`` its ``(PRINT,...)`` texts, which
     it writes to its standard output, the same way. ``tool_diameters_mm``: the diameters of
     its tool table by tool number (mm), what a DEBUG/PRINT shows for ``#5410`` of the loaded
-    tool (none loaded before an M6: LinuxCNC shows 0, as it does for a tool not given)."""
+    tool (none loaded before an M6: 0); a tool-table entry LinuxCNC's table here does not
+    hold (a tool not given, an offset) is shown and warned of as woodcam's interpreter does
+    (:func:`_mark_tool_entries`), where LinuxCNC shows 0."""
     g53 = _g53_lines(text) if machine_zero_mm is None else []
     if g53:
         raise GcodeError(g53[0], "G53", f"machine coordinates (G53, on line(s) {line_list(g53)}) "
@@ -98,14 +107,22 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
                          "which takes a G53 Z move as a retract to the --start height")
     with tempfile.TemporaryDirectory(prefix="woodcam-lcnc-") as d:
         p = Path(d) / "program.ngc"
-        p.write_text(text)
+        p.write_text(_mark_tool_entries(text))
         res = run_batch([p], start_mm=start_mm, timeout_s=timeout_s,
                         machine_zero_mm=machine_zero_mm, tool_diameters_mm=tool_diameters_mm)[0]
-    warnings = []
+    # the tool-table entries in the texts, shown and warned as woodcam's interpreter does;
+    # each text is one pass of its line (a line in a loop is warned once)
+    warnings: list[tuple[int, str]] = []
+    warned: dict = {}
+    texts = [[(int(ln), _tool_entries_shown(m, kind, int(ln), tool_diameters_mm or {}, warnings,
+                                            warned, (key, k)))
+              for k, (ln, m) in enumerate(res[key])]
+             for key, kind in (("messages", "DEBUG"), ("printed", "PRINT"))]
+    warnings.sort(key=lambda w: w[0])  # (the texts said and printed come apart: in line order)
     if said is not None:
-        said += [(int(ln), m.strip()) for ln, m in res["messages"]]
+        said += [(ln, m.strip()) for ln, m in texts[0]]
     if printed is not None:
-        printed += [(int(ln), m.strip()) for ln, m in res["printed"]]
+        printed += [(ln, m.strip()) for ln, m in texts[1]]
     if res["error"]:
         line, msg = res["error"]
         if msg != NO_END:
@@ -118,6 +135,52 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
 
 
 _G53 = re.compile(r"g0*53(?![\d.])")
+#: LinuxCNC's longest line, less room for the driver's mark of a PRINT (its line number)
+_ROOM = 252 - 12
+#: a (DEBUG,...) or (PRINT,...) comment, as LinuxCNC knows them (blanks first, any case)
+_SHOWN = re.compile(r"\([ \t]*(?:debug|print),[^)]*\)", re.IGNORECASE)
+#: a reference to the loaded tool's tool-table entry, #5401-#5413, in such a comment
+_ENTRY_REF = re.compile(r"#(0*54(?:0[1-9]|1[0-3]))(?![0-9])")
+#: the same put in by LinuxCNC, as marked by _mark_tool_entries: ref, loaded tool, value
+_ENTRY_SHOWN = re.compile(r"\x03([0-9]+)\x05(-?[0-9.]+)\x04(-?[0-9.]+|#+)")
+
+
+def _mark_tool_entries(text: str) -> str:
+    """``text`` with each ``#5401``-``#5413`` of a DEBUG/PRINT comment led by a mark that has
+    LinuxCNC put in the loaded tool (``#5400``): ``\\x03REF\\x05#5400\\x04#REF``. LinuxCNC shows
+    the entry of its tool table (the user's diameters, zero offsets), 0 for a tool the user did
+    not give; with the mark :func:`_tool_entries_shown` knows the tool and shows and warns as
+    woodcam's interpreter does. A line the marks would make too long for LinuxCNC keeps none."""
+    lines = text.split("\n")
+    for i, line in enumerate(lines):
+        if "54" in line and _SHOWN.search(line):
+            marked = _SHOWN.sub(lambda c: _ENTRY_REF.sub(
+                lambda m: f"\x03{m.group(1)}\x05#5400\x04#{m.group(1)}", c.group(0)), line)
+            if len(marked.encode()) <= _ROOM:
+                lines[i] = marked
+    return "\n".join(lines)
+
+
+def _tool_entries_shown(text: str, kind: str, line: int, diameters, warnings: list,
+                        warned: dict, pass_id) -> str:
+    """``text`` (a DEBUG/PRINT text of ``line`` LinuxCNC put together from a program marked by
+    :func:`_mark_tool_entries`) with each marked tool-table entry shown as woodcam's
+    interpreter shows it (:func:`.interpreter.tool_entry_in_message`: LinuxCNC's value where
+    the user gave the loaded tool's diameter or no tool is loaded, else what it is), its
+    warnings added to ``warnings`` once per line (``warned``, ``pass_id``: the text's pass,
+    :func:`add_line_warning`)."""
+    if "\x03" not in text:
+        return text
+
+    def shown(m: re.Match) -> str:
+        ref = "#" + m.group(1)
+        value, warning = tool_entry_in_message(int(m.group(1)), ref, kind,
+                                               int(round(float(m.group(2)))), diameters)
+        if warning:
+            add_line_warning(warnings, warned, line, warning, pass_id)
+        return m.group(3) if isinstance(value, float) else value
+
+    return _ENTRY_SHOWN.sub(shown, text)
 
 
 def _g53_lines(text: str) -> list[int]:
