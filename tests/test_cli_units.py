@@ -337,7 +337,9 @@ def test_an_inch_place_error_quotes_the_op_as_typed(tmp_path, capsys):
     trimesh.creation.box((10.0, 10.0, 10.0)).apply_translation((20, 20, 20)).export(part)
     # a margin too wide for this block is failed work (exit 1); a move out of range, a malformed
     # command line (exit 2, at the door)
-    for op, said, rc in (("fit:1.5", "--place 'fit:1.5': a margin of 1.5 in leaves no room in the 2x2x2 in block", 1),
+    for op, said, rc in (("fit:1.5", "--place 'fit:1.5': a margin of 1.5 in leaves no room in the 2x2x2 in block; "
+                                     "a margin must be less than half its smallest side: write fit:MARGIN with "
+                                     "MARGIN below 1 in, or fit for 0.07874 in", 1),
                          ("translate:1e5,0,0", "--place 'translate:1e5,0,0': a move must stay within 100 m", 2)):
         assert main(["bake", str(part), "--units", "inch", "--block", "builtin:knotty:2x2x2",
                      "--place", "center", "--place", op, "--out", str(tmp_path / "b.glb")]) == rc
@@ -486,7 +488,8 @@ def test_a_malformed_place_is_refused_before_the_block_is_opened(tmp_path, capsy
     trimesh.creation.box((10.0, 10.0, 10.0)).apply_translation((20, 20, 20)).export(part)
     for op, said in (("fit:abc", "--place 'fit:abc': 'abc' is not a finite number"),
                      ("rotate:q:90", "--place 'rotate:q:90': expected rotate:AXIS:DEG"),
-                     ("fit:-0.1", "--place 'fit:-0.1': a margin must be >= 0; got -0.1 in")):
+                     ("fit:-0.1", "--place 'fit:-0.1': a margin must be >= 0; got -0.1 in"),
+                     ("rotate:z:1e308", "--place 'rotate:z:1e308': an angle must be within a full turn")):
         assert main(["bake", str(part), "--units", "inch", "--block", "builtin:knotty:2x2x2",
                      "--place", "center", "--place", op, "--out", str(tmp_path / "b.glb")]) == 2
         err = capsys.readouterr().err

@@ -138,3 +138,21 @@ def test_a_negative_fit_margin_is_refused_with_the_fix():
                                            r"write fit:0 for none, or fit for 2 mm"):
         parse_place(["center", "fit:-0.1"])
     assert parse_place(["fit:0", "fit"]) == [("fit", 0.0, "fit:0"), ("fit", 2.0, "fit")]
+
+
+def test_an_absurd_angle_is_refused_and_a_too_wide_fit_margin_says_the_largest():
+    """Walkthrough: 'rotate:z:1e308' was taken (the part turned by float noise: a typo, surely),
+    and 'fit:1000' said the margin 'leaves no room' without the margin that does."""
+    from woodcam.cad.place import parse_place
+
+    for deg in ("1e308", "-361", "720"):
+        with pytest.raises(WoodcamError, match=rf"--place 'rotate:z:{deg}': an angle must be within a full "
+                                               r"turn, -360 to 360 degrees; got .*; write it modulo 360"):
+            parse_place([f"rotate:z:{deg}"])
+    assert parse_place(["rotate:z:-360", "rotate:x:360"])[0][1] == (2, -360.0)
+    with pytest.raises(WoodcamError, match=r"--place 'fit:1000': a margin of 1000 mm leaves no room in the "
+                                           r"100x80x50 mm block; a margin must be less than half its smallest "
+                                           r"side: write fit:MARGIN with MARGIN below 25 mm, or fit for 2 mm$"):
+        place_part(manifold3d.Manifold.cube([1.0, 1.0, 1.0]), ["fit:1000"], (100.0, 80.0, 50.0))
+    placed, _ = place_part(manifold3d.Manifold.cube([1.0, 1.0, 1.0]), ["fit:24.9"], (100.0, 80.0, 50.0))
+    assert _bounds(placed)[1][2] == pytest.approx(25.1)

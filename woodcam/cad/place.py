@@ -7,13 +7,14 @@ A placement is a sequence of operation strings, as given to ``--place`` (repeata
 
 =====================  ==========================================================================
 ``rotate:AXIS:DEG``    rotate about the block axis ``x``, ``y`` or ``z`` through the centre of the
-                       part's bounding box, ``DEG`` degrees (right hand rule)
+                       part's bounding box, ``DEG`` degrees (right hand rule, -360 to 360)
 ``translate:X,Y,Z``    move by ``(X, Y, Z)`` mm
 ``scale:S``            scale uniformly by ``S`` (> 0) about the bounding-box centre
 ``center``             move the bounding-box centre to the block centre
 ``drop``               move down so the part rests on the block's bottom face (min z = 0)
 ``fit[:MARGIN]``       scale uniformly (down or up) so the bounding box fits the block with
-                       ``MARGIN`` mm (default 2) on every side, and centre it
+                       ``MARGIN`` mm (default 2; less than half the block's smallest side) on
+                       every side, and centre it
 =====================  ==========================================================================
 
 :func:`place_part` returns the placed solid and the 4 x 4 matrix (block frame, mm) that maps the
@@ -28,7 +29,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import WoodcamError
-from ..units import say_length
+from ..units import message_unit, say_length, typed_length
 
 #: Default margin (mm) ``fit`` keeps to every block face.
 FIT_MARGIN_MM = 2.0
@@ -100,8 +101,12 @@ def placement_matrix(ops: Sequence[str], bounds_mm, size_mm, *,
             margin = value
             room = size - 2 * margin
             if np.any(room <= 0):
+                half = float(np.min(size)) / 2  # the margin that leaves the part no size
                 raise WoodcamError(f"--place {op!r}: a margin of {say_length(margin, 'g')} leaves no room in the "
-                                   f"{say_length(size, 'g')} block")
+                                   f"{say_length(size, 'g')} block; a margin must be less than half its "
+                                   f"smallest side: write fit:MARGIN with MARGIN below "
+                                   f"{typed_length(half, 0.05, ok=lambda v: v <= half)} {message_unit()}, "
+                                   f"or fit for {say_length(FIT_MARGIN_MM, 'g')}")
             factor = float(np.min(room / np.maximum(hi - lo, 1e-12)))
             step = _translate(size / 2 - centre) @ _about(centre, np.eye(3) * factor)
         total = step @ total
@@ -130,7 +135,11 @@ def parse_place(ops: Sequence[str], *, as_typed: Sequence[str] | None = None) ->
             if axis.lower() not in _AXES or not deg:
                 raise WoodcamError(f"--place {op!r}: expected rotate:AXIS:DEG with AXIS x, y or z; "
                                    f"use {_HELP}")
-            value = (_AXES[axis.lower()], _number(deg, op))
+            angle = _number(deg, op)
+            if abs(angle) > 360:  # 1e308 was taken (and turned the part by float noise): a typo
+                raise WoodcamError(f"--place {op!r}: an angle must be within a full turn, -360 to 360 "
+                                   f"degrees; got {angle:g}; write it modulo 360 (e.g. rotate:z:90 for 450)")
+            value = (_AXES[axis.lower()], angle)
         elif name == "translate":
             parts = arg.split(",")
             if len(parts) != 3:
