@@ -150,7 +150,7 @@ def test_block_synth_noise_options_on_an_engine_write_the_same_blocks(tmp_path, 
 def test_block_synth_on_an_engine_into_a_set_of_another_seed_is_refused(tmp_path, capsys):
     """A second `block synth --engine` into the same folder with another seed found every
     block's record done, kept the first seed's blocks and wrote an index.json of the second."""
-    from woodcam.cli import EXIT_ERROR
+    from woodcam.cli import EXIT_USAGE
 
     out = tmp_path / "set"
     flags = ["--count", "1", "--face-px", "32", "--quiet", "--knotted-fraction", "0", "--workers", "1",
@@ -158,9 +158,12 @@ def test_block_synth_on_an_engine_into_a_set_of_another_seed_is_refused(tmp_path
     assert main(["block", "synth", "--seed", "1", *flags]) == 0
     first = (out / "block_0000" / "block.json").read_bytes()
     capsys.readouterr()
-    assert main(["block", "synth", "--seed", "2", *flags]) == EXIT_ERROR
+    # a wrong command line (an --out that holds another set): exit 2, one line with the fixes
+    assert main(["block", "synth", "--seed", "2", *flags]) == EXIT_USAGE
     err = capsys.readouterr().err
-    assert "another seed or settings (seed 1 there, 2 now)" in err
+    assert err.count("\n") == 1 and ("another seed or settings (seed 1 there, 2 now); pick another --out, run "
+                                     f"again with its options (--seed 1) to resume it, or delete {str(out)!r} "
+                                     "to start over") in err, err
     # the --out given, not its hidden records folder ('delete .../set/.synth' lost the set's index)
     assert f"{str(out)!r} holds a run" in err and ".synth" not in err
     assert json.loads((out / "index.json").read_text())["seed"] == 1

@@ -50,7 +50,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Literal, get_args
 
 from ._checks import check_bool, check_number, check_path
-from .errors import WoodcamError
+from .errors import UsageError, WoodcamError
 
 Engine = Literal["local", "dask"]
 ENGINES: tuple[str, ...] = get_args(Engine)
@@ -125,7 +125,8 @@ def check_run_manifest(path: str | Path, manifest: dict, out_dir: str | Path | N
     settings' name; callers whose task results depend on settings call this first. ``out_dir``
     is the folder the user gave (``--out``), named in the errors where ``path`` lies in a hidden
     folder of it (``OUT/.synth/run.json``); default ``path``'s folder. Raises
-    :class:`WoodcamError` naming each setting that differs (one level into nested dicts).
+    :class:`~woodcam.errors.UsageError` (a :class:`WoodcamError`; the CLI's exit 2) naming the
+    folder, each setting that differs (one level into nested dicts) and the fixes.
     """
     path = Path(path)
     folder = str(path.parent if out_dir is None else Path(out_dir))
@@ -149,8 +150,11 @@ def check_run_manifest(path: str | Path, manifest: dict, out_dir: str | Path | N
         elif o != v:
             diffs.append(f"{k} {o!r} there, {v!r} now")
     if diffs:
-        raise WoodcamError(f"{folder!r} holds a run with another seed or settings "
-                           f"({'; '.join(diffs)}); resume it with the same options or pick a new --out")
+        # a wrong command line (an --out that holds another set), found before any work: exit 2
+        seed = f" (--seed {old['seed']!r})" if "seed" in want and old.get("seed") != want["seed"] else ""
+        raise UsageError(f"{folder!r} holds a run with another seed or settings ({'; '.join(diffs)}); "
+                         f"pick another --out, run again with its options{seed} to resume it, or "
+                         f"delete {folder!r} to start over")
 
 
 def record_path(out_dir, key: str) -> Path:
