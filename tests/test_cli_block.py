@@ -180,8 +180,16 @@ def test_block_synth_says_why_a_block_failed(tmp_path, capsys):
     assert main(["block", "synth", "--count", "1", "--face-px", "16", "--quiet", "--knotted-fraction", "1",
                  "--workers", "1", "--size-range-mm", "10000,10000", "--out", str(out)]) == 3
     said = capsys.readouterr().out
-    assert "1 failed" in said and "; block_0000 failed: WoodcamError: no knot of this log crosses a " \
-        "10000 x 10000 mm block after 60 tries; use a smaller block" in said, said
+    # the fix names the options that change it (it said 'use a smaller block or a log with longer
+    # knots': no option of the command), and the parameters of the library call
+    fix = ("no knot of this log crosses a 10000 x 10000 mm block after 60 tries; draw smaller blocks "
+           "(size_range_mm is (10000, 10000); --size-range-mm of 'woodcam block synth', default 30,80) or "
+           "fewer knotted ones (knotted_fraction is 1; --knotted-fraction, 0 for none)")
+    assert "1 failed" in said and f"; block_0000 failed: WoodcamError: {fix}" in said, said
+    # without an engine: the command's one line
+    assert main(["block", "synth", "--count", "1", "--face-px", "16", "--quiet", "--knotted-fraction", "1",
+                 "--size-range-mm", "10000,10000", "--out", str(tmp_path / "plain")]) == 1
+    assert capsys.readouterr().err == f"woodcam: error: {fix}\n"
 
 
 def test_a_benchmark_set_resumes_with_its_defaults_spelled_out(tmp_path):

@@ -172,13 +172,15 @@ def knot_crosses(field, size_mm, n: int = 12) -> bool:
     return bool(np.any(np.asarray(field.knot_features(pts)["knot"]) > 0.5))
 
 
-def _place_through_knot(rng: np.random.Generator, log_field, placement: dict, size, tries: int = 60):
+def _place_through_knot(rng: np.random.Generator, log_field, placement: dict, size, tries: int = 60,
+                        fix: str = "use a smaller block or a log with longer knots"):
     """Move ``placement`` (kwargs of :func:`cut_block`) so that a knot of ``log_field`` crosses
     the block: its centre on a random knot's strand, at a random pith distance between the
     block's half diagonal and the knot's end (pith-inside: at the knot's base on the pith).
 
     Returns ``(block-frame field, placement)``; checked with :func:`knot_crosses` (asserted from
-    the true field), raising :class:`WoodcamError` when no knot of the log reaches a block.
+    the true field), raising :class:`WoodcamError` when no knot of the log reaches a block, its
+    fix ``fix`` (the caller's own parameters: a set's sizes and knotted share).
     """
     log = getattr(log_field, "log", None)
     if log is None or not getattr(log, "knots", None):
@@ -213,5 +215,4 @@ def _place_through_knot(rng: np.random.Generator, log_field, placement: dict, si
             continue
         if knot_crosses(field, size):
             return field, moved
-    raise WoodcamError(f"no knot of this log crosses a {W:g} x {D:g} mm block after {tries} tries; "
-                       f"use a smaller block or a log with longer knots")
+    raise WoodcamError(f"no knot of this log crosses a {W:g} x {D:g} mm block after {tries} tries; {fix}")

@@ -40,7 +40,13 @@ def benchmark_set_block(seed: int, index: int, *, face_px: int = 512, size_range
     knotted = log_fields is not None and rng.uniform() < knotted_fraction
     if knotted:
         log = log_fields(rng)
-        field, placement = _place_through_knot(rng, log, placement, size)
+        # the fix names this function's parameters and the options of 'woodcam block synth'
+        # that set them: 'a smaller block or a log with longer knots' named neither
+        lo, hi = (float(v) for v in size_range_mm)
+        fix = (f"draw smaller blocks (size_range_mm is ({lo:g}, {hi:g}); --size-range-mm of 'woodcam block "
+               f"synth', default 30,80) or fewer knotted ones (knotted_fraction is {knotted_fraction:g}; "
+               "--knotted-fraction, 0 for none)")
+        field, placement = _place_through_knot(rng, log, placement, size, fix=fix)
     else:
         field = cut_block(log, size, **placement)
     name = f"block_{i:04d}"
