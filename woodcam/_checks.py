@@ -108,6 +108,19 @@ def check_path(value, name: str, *, fix: str = "") -> Path:
     return Path(value)
 
 
+def png_path(path, name: str) -> Path:
+    """``path`` (:func:`check_path`) as a PNG file to write: ending in ``.png`` in any case,
+    refused otherwise with the name to give (PIL picks the format from the suffix: a name
+    without one failed in the temporary's ``.tmp`` as "unknown file extension: .tmp"). The one
+    rule of the PNG writers that take a path."""
+    p = check_path(path, name, fix="a .png file path")
+    if p.suffix.lower() != ".png":
+        good = p.with_suffix(".png") if p.suffix else p.with_name(p.name + ".png")
+        raise WoodcamError(f"{name} must end in .png (a PNG image is written); got {str(path)!r}; "
+                           f"e.g. {str(good)!r}")
+    return p
+
+
 def npz_path(path) -> Path:
     """``path`` as the ``.npz`` file numpy writes: ``.npz`` appended to a name without that
     suffix; one ending in it in any case (``F.NPZ``, which ``--out`` takes) kept as named (it

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from woodcam.appearance.evaluation import (
-    MODELS, histogram_distance, leave_one_face_out, patch_distance, radial_power_spectrum, side_by_side,
+    MODELS, FaceEval, histogram_distance, leave_one_face_out, patch_distance, radial_power_spectrum, side_by_side,
     spectrum_distance, summarise,
 )
 from woodcam.block import Block, Face
@@ -269,3 +269,19 @@ def test_eval_appearance_outputs_land_as_one_set_and_a_rerun_removes_the_earlier
                      capsys.readouterr().err, re.M)
     assert sorted(p.name for p in tmp_path.iterdir()) == [".woodcam-eval-appearance-files.json", "results.json",
                                                           "rift.png"]
+
+
+def test_side_by_side_refuses_a_path_that_is_no_png_at_its_door(tmp_path, rng):
+    """A path without a suffix failed in PIL, after the figure was drawn, with 'unknown file
+    extension: .tmp' (the suffix of the atomic write's temporary); it is refused first, with the
+    name to give, and a .png in any case is written."""
+    photo = rng.uniform(0, 1, (8, 12, 3))
+    res = [FaceEval("top", True, photo, {m: photo for m in MODELS},
+                    {m: {"histogram": 0.1, "spectrum": 1.0, "patch": 0.2} for m in MODELS})]
+    for name, good in (("sbs", "sbs.png"), ("sbs.jpg", "sbs.png"), ("sbs.tmp", "sbs.png")):
+        with pytest.raises(WoodcamError, match=rf"side_by_side: path must end in .png \(a PNG image is written\); "
+                                               rf"got '.*{name}'; e.g. '.*/{good}'$"):
+            side_by_side(res, tmp_path / name)
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    side_by_side(res, tmp_path / "sbs.PNG")
+    assert [p.name for p in tmp_path.iterdir()] == ["sbs.PNG"]

@@ -320,6 +320,9 @@ def side_by_side(results: list[FaceEval], path, title: str = "") -> None:
     model and scores (placed by :func:`_side_by_side_layout`)."""
     from PIL import Image, ImageDraw, ImageFont
 
+    from .._checks import png_path
+
+    path = png_path(path, "side_by_side: path")  # at the door, before the figure is drawn
     (w, h), items = _side_by_side_layout(results, title)
     canvas = np.ones((h, w, 3))
     for kind, (x0, y0, x1, y1), what in items:

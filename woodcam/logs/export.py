@@ -15,6 +15,7 @@ import numpy as np
 import trimesh
 
 from .._atomic import atomic_path, write_bytes
+from .._checks import png_path
 from ..errors import WoodcamError
 from ..frames import BLOCK_TO_GLTF, GLTF_ROOT_NODE
 from .generate import GeneratedKnot, GeneratedLog
@@ -173,9 +174,7 @@ def heightmap_png(log: GeneratedLog, path, *, mode: Literal["height", "detail"] 
     from PIL import Image, PngImagePlugin
 
     img, (lo, hi) = heightmap_image(log, mode)
-    p = Path(path)
-    if p.suffix.lower() != ".png":
-        raise WoodcamError(f"path must end in .png; got {str(p)!r}")
+    p = png_path(path, "heightmap_png: path")
     info = PngImagePlugin.PngInfo()
     info.add_text("woodcam:range_mm", f"{lo:.6f} {hi:.6f}")
     info.add_text("woodcam:mode", mode)
