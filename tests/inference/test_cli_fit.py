@@ -174,6 +174,49 @@ def test_fit_workers_option_sets_the_fit_processes_and_keeps_the_field(block_dir
     assert main(["fit", str(folder), "--workers", "0", "--out", str(tmp_path / "w0.npz")]) != 0
 
 
+@pytest.mark.parametrize("method", ["radial", "rbf"])
+def test_fit_workers_act_on_the_radial_and_rbf_fits(block_dir, tmp_path, monkeypatch, method):
+    """``woodcam fit --method radial --workers N`` ran the pith search's descents and the grid
+    bake on one process whatever N was (only the evidence fit read it): they now run on the fit's
+    workers, and the field is the one-worker field bit for bit."""
+    import woodcam._parallel as parallel
+
+    folder, _, _ = block_dir
+    asked: list = []
+    share = parallel.share
+    monkeypatch.setattr(parallel, "share", lambda tasks, here, workers: asked.append(workers) or share(tasks, here, workers))
+    fields = []
+    for n in ("1", "2"):
+        monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / f"cache{n}"))  # each fits afresh
+        asked.clear()
+        assert main(["fit", str(folder), "--method", method, "--workers", n, "--out", str(tmp_path / f"{n}.npz")]) == 0
+        assert set(asked) <= {int(n)} and (asked or n == "1"), (n, asked)  # one worker may fork nothing
+        fields.append(GridField.load(tmp_path / f"{n}.npz"))
+    assert np.array_equal(fields[0].years, fields[1].years)
+
+
+def test_fit_workers_with_the_neural_method_is_said_to_change_nothing(block_dir, tmp_path, monkeypatch, capsys):
+    """``fit --method neural --workers 4`` was accepted and changed nothing without a word (the
+    net runs in one process: torch's thread pool is not safe to fork)."""
+    import woodcam.stock
+
+    def fitted_field(*args, **kwargs):
+        raise SystemExit(0)  # the warning comes before the work: no fit (nor torch) is needed
+
+    monkeypatch.setattr(woodcam.stock, "fitted_field", fitted_field)
+    folder, _, _ = block_dir
+    with pytest.raises(SystemExit):
+        main(["fit", str(folder), "--method", "neural", "--workers", "4", "--out", str(tmp_path / "n.npz")])
+    assert ("woodcam: warning: --workers 4 acts on the evidence, radial and rbf fits only, and --method neural "
+            "runs in one process: it changes nothing; drop it or use another --method (e.g. --method radial)"
+            ) in capsys.readouterr().err
+    for method in ("neural", "radial"):  # without --workers, or with a method that uses them: no word
+        with pytest.raises(SystemExit):
+            main(["fit", str(folder), "--method", method, *(["--workers", "2"] if method == "radial" else []),
+                  "--out", str(tmp_path / "n.npz")])
+        assert "--workers" not in capsys.readouterr().err
+
+
 def test_eval_methods_all_is_every_method(block_dir, tmp_path, monkeypatch):
     """``--methods all`` ran the default rbf,radial."""
     import woodcam.inference.evaluate as evaluate

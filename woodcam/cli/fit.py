@@ -34,7 +34,7 @@ def register(subparsers) -> None:
     p.add_argument("--faces", default=None, help="comma-separated faces to use, from front, top, left, "
                    "bottom, right, back (default: all)")
     add_size_option(p)
-    add_workers_option(p)
+    add_workers_option(p, note=" (evidence, radial and rbf; neural uses one and warns)")
     add_out_option(p, "the fitted field as a grid", suffixes=(".npz",))
     p.set_defaults(func=run_fit)
 
@@ -96,6 +96,15 @@ def run_fit(args) -> int:
 
     faces = None if args.faces is None else face_names(args.faces, "--faces", all_=True)  # before the block is read
     apply_workers(args)
+    if args.workers is not None and args.method == "neural":  # before the work: nothing silently dropped
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        # torch's own thread pool is not safe to fork (woodcam.fields.base.evaluate)
+        warnings.warn(f"--workers {args.workers} acts on the evidence, radial and rbf fits only, and "
+                      "--method neural runs in one process: it changes nothing; drop it or use another "
+                      "--method (e.g. --method radial)", WoodcamWarning, stacklevel=2)
     # one bar for the run, as bake's: the evidence fit of a real cube lasts 20-30 s (H11 from its
     # photos, 2 cores) and a photo-only block is detected first; it ran without a bar
     with StageBar(["open block", "fit", "write"], desc="fit", leave=False) as bar:

@@ -1374,11 +1374,11 @@ def check_numbers(args: argparse.Namespace) -> None:
             _check_value(v, _option(dest), rng, item, name or "COMMAND")
 
 
-def add_workers_option(p: argparse.ArgumentParser) -> None:
-    """``--workers N`` of the commands that run an evidence fit (``fit``, ``bake``): the
-    processes it may use (:mod:`woodcam._parallel`); applied by :func:`apply_workers`."""
+def add_workers_option(p: argparse.ArgumentParser, note: str = "") -> None:
+    """``--workers N`` of the commands that run a fit (``fit``, ``bake``): the processes it may
+    use (:mod:`woodcam._parallel`); applied by :func:`apply_workers`; ``note`` says which fits."""
     p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="workers (processes) one evidence fit may use (default: $WOODCAM_WORKERS, else "
+                   help=f"workers (processes) one fit may use{note} (default: $WOODCAM_WORKERS, else "
                    "min(2, CPU cores)); the fitted field is the same for any N, 1 is slowest")
 
 

@@ -166,13 +166,19 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
         if strands is None:
             ev.field, strands = with_knots(block, ev.field, faces, knot_cones, exits)  # knots from the masks (part 3)
         return bake_evidence(ev, block.size_mm, used, strands) if baked else ev
+    # the radial fit's start and basin descents and the grid bake on the fit's cores, as the
+    # evidence fit's (woodcam._parallel, the same field bit for bit): 'fit --method radial
+    # --workers N' ran them on one whatever N was
+    from .._parallel import fit_workers
+
+    workers = fit_workers()
     if method == "rbf":
         if not obs.labelled:  # the seed's RBF needs years: number the rings as the radial fit does
-            obs = number_observations(obs, fit_radial(obs, block.size_mm))
+            obs = number_observations(obs, fit_radial(obs, block.size_mm, workers=workers))
         field = fit_rbf(obs)
     else:
-        field = fit_radial(obs, block.size_mm)
-    return bake(field, block.size_mm) if baked else field
+        field = fit_radial(obs, block.size_mm, workers=workers)
+    return bake(field, block.size_mm, workers=workers) if baked else field
 
 
 __all__ = ["FIT_VERSION", "METHODS", "Method", "fit_block"]
