@@ -203,3 +203,45 @@ def test_h11_held_out_faces_beat_chance_twice_whatever_the_seed(shared_data):
         ratios.append(ok / np.mean([s.shares["ridge_2"] for s in res[CONTROL]["evidence"]]))
     print("H11 held out / chance, seeds 0-3:", np.round(ratios, 2))
     assert np.mean(ratios) >= 2.0, ratios
+
+
+def test_eval_rings_confidence_draws_and_summarises_the_held_out_faces_confidence(field, mapped, tmp_path,
+                                                                                 monkeypatch):
+    """``eval rings REAL --methods evidence --confidence`` passed --confidence to the cut-plane
+    scoring only: on a real block (no true field) held-out faces were scored and drawn without
+    the evidence fit's confidence, and table/pictures were the same with and without it. The
+    held-out faces now carry the fit's confidence: the table summarises it either way (its
+    confident line points against its unsure ones), --confidence draws it under the overlays."""
+    import copy
+
+    import woodcam.inference.holdout as holdout
+    from woodcam.block.io import write_block
+    from woodcam.cli import main
+    from woodcam.fields import GridField
+    from woodcam.inference import bake
+
+    grid = bake(field, mapped.size_mm)
+    x = grid.origin_mm[0] + grid.spacing_mm[0] * np.arange(grid.years.shape[0])
+    unsure = np.broadcast_to((x > 25.0)[:, None, None], grid.years.shape).astype(float)  # 1 year beyond x = 25 mm
+    fit = GridField(grid.years, grid.origin_mm, grid.spacing_mm, grid.interpolation, grid.axis,
+                    {"uncertainty": unsure})
+    monkeypatch.setattr(holdout, "fit_block", lambda block, method, faces=None, seed=0: fit)  # the truth, half sure
+    real = copy.copy(mapped)
+    real.true_field = None
+    real.faces = {k: mapped.faces[k] for k in ("front", "top", "right")}
+    write_block(real, tmp_path / "blk")
+    pngs = {}
+    for flag in ([], ["--confidence"]):
+        out = tmp_path / f"ev{len(flag)}"
+        assert main(["eval", "rings", str(tmp_path / "blk"), "--methods", "evidence", *flag, "--out", str(out)]) == 0
+        table = (out / "eq79_holdout.md").read_text()
+        assert "Confidence on the held-out predicted ring lines" in table
+        rows = {r.split("|")[1].strip(): [float(v) for v in r.split("|")[3:7]] for r in table.splitlines()
+                if r.startswith("| ") and "| evidence |" in r}
+        assert rows["right"][:2] == [0.02, 0.0]  # x = 50 mm: all unsure
+        assert 30 < rows["front"][1] < 70 and 30 < rows["top"][1] < 70  # half sure
+        assert rows["front"][2] > 90  # the truth: its sure lines lie on the ridge
+        pngs[len(flag)] = (out / "eq79_evidence.png").read_bytes()
+    assert pngs[0] != pngs[1]  # --confidence draws it
+    res = leave_one_face_out(real, ["evidence"], confidence=True)
+    assert all(sc.confidence_img is not None for sc in res["held_out"]["evidence"])

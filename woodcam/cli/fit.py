@@ -65,7 +65,8 @@ def register(subparsers) -> None:
                    help="real blocks: the evidence fit's random seed (held-out points, fitting subsets; "
                    "default 0; the other methods draw nothing at random, and --seed without evidence in "
                    "--methods is warned of); a real cube's held-out score can swing with it, so compare several")
-    add_confidence_option(e)
+    add_confidence_option(e, where="the cut-plane PNGs and, for real blocks, under each held-out face's overlay",
+                          tables="table.md and BLOCK_holdout.md summarise")
     add_out_option(e, "table.md and cut-plane PNGs")
     e.set_defaults(func=run_eval)
 
@@ -194,5 +195,5 @@ def _run_eval(args, blocks, methods, partial) -> None:
                 fit_on.name = f"{b.name}-detected"
                 print(f"{b.name}: fitting from rings detected on its photos, scored against its own maps")
             res = leave_one_face_out(fit_on, methods, out_dir=args.out, progress=print, reference=ref,
-                                     seed=0 if args.seed is None else args.seed)
+                                     seed=0 if args.seed is None else args.seed, confidence=args.confidence)
             print(res["table"])

@@ -1393,13 +1393,14 @@ def apply_workers(args: argparse.Namespace) -> None:
         os.environ[WORKERS_ENV] = str(args.workers)
 
 
-def add_confidence_option(p: argparse.ArgumentParser, note: str = "") -> None:
+def add_confidence_option(p: argparse.ArgumentParser, note: str = "", where: str = "the cut-plane PNGs",
+                          tables: str = "table.md summarises") -> None:
     """``--confidence`` of ``eval rings`` / ``eval realistic``: the evidence fit's per-point
-    confidence drawn on the cut planes; ``note`` adds what else it implies."""
+    confidence drawn on the cut planes (``where``, ``tables``: and on real blocks' held-out
+    faces); ``note`` adds what else it implies."""
     p.add_argument("--confidence", action="store_true",
-                   help="draw the evidence fit's per-point confidence under its ring lines in the "
-                   f"cut-plane PNGs (red unsure, green sure{note}); table.md summarises it either "
-                   "way (default off)")
+                   help=f"draw the evidence fit's per-point confidence under its ring lines in {where} "
+                   f"(red unsure, green sure{note}); {tables} it either way (default off)")
 
 
 def add_engine_options(p: argparse.ArgumentParser) -> None:

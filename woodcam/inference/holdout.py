@@ -22,7 +22,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field as dc_field
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +30,8 @@ import numpy as np
 from .._atomic import write_figure, write_text
 from .._types import PathLike
 from ..errors import WoodcamError, require
-from ..fields.base import arf
+from .._checks import check_bool
+from ..fields.base import arf, has_uncertainty
 from ..fields.rings import ring_lines
 from ..frames import face_pixel_points
 from ..tolerances import HOLDOUT_LINE_STEP_PX, HOLDOUT_THRESHOLDS_PX, RING_MAP_THRESHOLD
@@ -134,6 +135,21 @@ class FaceScore:
     years: np.ndarray       # (h, w) fitted growth time on the face
     ridge: np.ndarray       # (k, 2) ridge pixels
     lines: np.ndarray       # (m, 2) predicted line points
+    #: (h, w) confidence in [0, 1] of the fit on the face (:func:`~.evidence.confidence`), or
+    #: None when the fit carries no uncertainty (only the evidence fit does)
+    confidence_img: np.ndarray | None = dc_field(default=None, repr=False)
+
+    def confidence_summary(self) -> dict | None:
+        """:func:`~woodcam.inference.evaluate.confidence_summary` of the predicted line points:
+        their confidence against whether a ring-map ridge pixel lies within 2 px of them (does
+        the fit know where its held-out rings are wrong?); None without a confidence image."""
+        if self.confidence_img is None:
+            return None
+        from .evaluate import confidence_summary
+
+        h, w = self.confidence_img.shape
+        conf = self.confidence_img[_pixel_index(self.lines[:, 0], h), _pixel_index(self.lines[:, 1], w)]
+        return confidence_summary(conf, _nearest(self.lines, self.ridge.astype(float)))
 
 
 def score_face(field, block, face: str, thresholds=HOLDOUT_THRESHOLDS_PX) -> FaceScore:
@@ -169,7 +185,7 @@ def _score(face: str, years: np.ndarray, ridge: np.ndarray, excl, thresholds) ->
 def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
                        out_dir: PathLike | None = None,
                        progress: Callable[[str], object] | None = None,
-                       reference: Block | None = None, seed: int = 0) -> dict:
+                       reference: Block | None = None, seed: int = 0, confidence: bool = False) -> dict:
     """Fit ``block`` on all faces but one for each face with a ring map, score the held-out face.
 
     Parameters
@@ -185,6 +201,9 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
     progress : optional callable taking one line of text per fit.
     seed : the evidence fit's random seed (:func:`~woodcam.inference.fit.fit_block`; other
         methods ignore it): a real cube's held-out score can swing with it (H11, README).
+    confidence : draw the held-out fits' per-point confidence under the overlay of each face in
+        the PNGs (:func:`plot_holdout`); the table summarises it for the methods whose fits carry
+        one (the evidence fit) either way, as :func:`~woodcam.inference.evaluate.benchmark` does.
 
     Returns
     -------
@@ -202,6 +221,7 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
         raise WoodcamError(f"methods must be a list of method names; got the string {methods!r}; pass [{methods!r}]")
     if progress is not None and not callable(progress):
         raise WoodcamError(f"progress must be a callable taking one line of text, or None; got {type(progress).__name__}")
+    confidence = check_bool(confidence, "confidence")
     ref_block = block if reference is None else reference
     faces = [n for n, f in block.faces.items() if f.has_rings and n in ref_block.faces
              and ref_block.faces[n].ring_map is not None]
@@ -226,6 +246,11 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
             shape = block.faces[face].shape
             years = face_years(fit, face, shape, block.size_mm)
             held[m].append(_score(face, years, ridge, excl, HOLDOUT_THRESHOLDS_PX))
+            if has_uncertainty(fit):  # the evidence fit says where its rings are a guess
+                from .evidence import confidence as confidence_of
+
+                pts = face_pixel_points(face, shape, block.size_mm).reshape(-1, 3)
+                held[m][-1].confidence_img = confidence_of(fit.uncertainty_years(pts)).reshape(shape)
             control[m].append(_score(face, years + 0.5, ridge, excl, HOLDOUT_THRESHOLDS_PX))
             plane = straight_rings(years)  # the STRAIGHT control at its best phase and at the prediction's own
             straight[m].append(_best_phase_score(face, plane, ridge, excl, HOLDOUT_THRESHOLDS_PX))
@@ -247,7 +272,7 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
         write_text(out / f"{block.name}_holdout.md", res["table"])
         for m in methods:
             plot_holdout(out / f"{block.name}_{m}.png", block, held[m],
-                         title=f"{block.name}, {m}: each face predicted from the other five")
+                         title=f"{block.name}, {m}: each face predicted from the other five", confidence=confidence)
     return res
 
 
@@ -278,12 +303,29 @@ def holdout_table(name: str, res: dict, methods: list[str], thresholds=HOLDOUT_T
                                  for m in methods}))
     lines.append("")
     lines.append("Mean held-out fit time: " + ", ".join(f"{m} {res['fit_s'][m]:.1f} s" for m in methods))
+    sums = {m: [sc.confidence_summary() for sc in held[m]] for m in methods}
+    with_conf = [m for m in methods if sums[m] and all(c is not None for c in sums[m])]
+    if with_conf:  # as eval rings' cut-plane table: does the fit know where it is wrong?
+        from .evaluate import CONFIDENT_AT
+
+        head = ["face", "method", "mean confidence", "confident points %", "≤2 px, confident", "≤2 px, unsure"]
+        lines += ["", f"Confidence on the held-out predicted ring lines (confident at >= {CONFIDENT_AT:g}; "
+                  "line points within 2 px of a ring-map ridge pixel):", "",
+                  "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        for m in with_conf:
+            for sc, c in zip(held[m], sums[m]):
+                lines.append(f"| {sc.face} | {m} | {c['confidence_mean']:.2f} | {c['confident_share']:.1f} | "
+                             f"{c['matched_2_confident']:.1f} | {c['matched_2_unsure']:.1f} |")
     return "\n".join(lines) + "\n"
 
 
-def plot_holdout(path, block, scores: list[FaceScore], title: str = ""):
+def plot_holdout(path, block, scores: list[FaceScore], title: str = "", confidence: bool = False):
     """PNG, one row per face: photo, ring map, predicted ARF (eq. 6), overlay (grey ring map,
-    blue ridge pixels, red predicted ring lines, knot margin hatched out)."""
+    blue ridge pixels, red predicted ring lines, knot margin hatched out).
+
+    confidence : draw the fit's confidence under the overlay where it carries one (red unsure,
+        yellow, green sure: as the cut planes of :func:`~woodcam.inference.evaluate.plot_planes`),
+        with the within-2 px shares of its confident and unsure line points under it."""
     matplotlib = require("matplotlib", "view", "drawing leave-one-face-out images")
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -307,14 +349,22 @@ def plot_holdout(path, block, scores: list[FaceScore], title: str = ""):
             if r == 0:
                 ax.set_title(label, fontsize=8)
         ax = axes[r, 3]
+        label = ""
+        if confidence and sc.confidence_img is not None:
+            ax.imshow(sc.confidence_img, cmap="RdYlGn", vmin=0, vmax=1, interpolation="nearest", zorder=0)
+            cs = sc.confidence_summary()
+            label = (f"\nsure {cs['confident_share']:.0f}%: {cs['matched_2_confident']:.0f}% / "
+                     f"unsure {cs['matched_2_unsure']:.0f}% line <2px")
+            if r == 0:
+                ax.set_title("overlay on confidence", fontsize=8)
         ax.plot(sc.ridge[:, 1], sc.ridge[:, 0], ",", color="tab:blue")
         ax.plot(sc.lines[:, 1], sc.lines[:, 0], ",", color="tab:red")
         excl = knot_exclusion(f, min(block.face_pixel_size_mm(sc.face)))
         if excl is not None:
             ax.contour(excl, levels=[0.5], colors="yellow", linewidths=0.6)
         s = sc.shares
-        ax.set_xlabel(f"ridge {s['ridge_1']:.0f}/{s['ridge_2']:.0f}%  line {s['line_1']:.0f}/{s['line_2']:.0f}%",
-                      fontsize=7)
+        ax.set_xlabel(f"ridge {s['ridge_1']:.0f}/{s['ridge_2']:.0f}%  line {s['line_1']:.0f}/{s['line_2']:.0f}%"
+                      + label, fontsize=7)
         ax.set_xlim(0, f.shape[1] - 1)
         ax.set_ylim(f.shape[0] - 1, 0)
     if title:
