@@ -541,3 +541,17 @@ def test_a_tool_tables_rule_stays_mm_under_units_inch_and_names_its_entry(tmp_pa
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"woodcam: error: load_tool_table: {table}: [tools.3]: BullNoseMill: corner_radius_mm must be "
                    "in (0, diameter/2 = 3] mm, got 4 mm; use ball for rc = R or flat for rc = 0"], err
+
+
+def test_the_units_help_says_the_messages_speak_it():
+    """With no length typed, 'review PART --block FOLDER --units inch' changed only its warnings'
+    lengths ('45 mm past its right face' -> '1.772 in past ...'; the page byte for byte the same),
+    and every command's --units help named only the options it reads and what stays mm. The help
+    now says the warnings and errors speak it, and review's that its page measures in mm."""
+    commands = build_parser().get_default("_commands").choices
+    with_units = sorted({c for c, _ in LENGTH_OPTIONS})
+    for command in with_units:
+        action = next(a for a in commands[command]._actions if a.dest == "units")
+        assert "the lengths in warnings and errors" in action.help, (command, action.help)
+    review = next(a for a in commands["review"]._actions if a.dest == "units")
+    assert "files written (the page's measurements too) stay mm" in review.help

@@ -445,21 +445,28 @@ _SUMMARY_IN_UNITS = {"bake", "gcode", "place"}
 #: Commands that read every mesh file as mm whatever --units says (woodify: the mesh to grow and
 #: its obstacles; a user reading "--units inch" took it for the mesh's unit).
 _MESHES_IN_MM = {"woodify"}
+#: What else a command writes that stays mm, named in its --units help (review's page measures
+#: in mm whatever --units says).
+_WRITTEN_IN_MM = {"review": " (the page's measurements too)"}
 
 
 def add_units_option(p: argparse.ArgumentParser, command: str) -> None:
     """``--units mm|inch`` for ``command``; its help names the options :data:`LENGTH_OPTIONS`
-    converts for that command."""
+    converts for that command, and says the run's warnings and errors speak it
+    (:func:`woodcam.units.message_units`, set for every command that has ``--units``): with no
+    length typed, ``review``/``preview --units inch`` changed only those, and the help said nothing
+    of them."""
     names = [("a block spec's WxDxH" if d == "block" else f"a {_option(d)} spec's WxDxH"
               if LENGTH_OPTIONS[c, d] == "spec" else _option(d))
              for (c, d) in LENGTH_OPTIONS if c == command]
     assert names, command  # a contributor's mistake: list the command's lengths first
     p.add_argument("--units", choices=("mm", "inch"), default="mm",
                    help=f"unit of {', '.join(names)}"
-                   + (" and of the printed summary" if command in _SUMMARY_IN_UNITS else "")
-                   + "; options whose names carry their unit (-mm, -per-mm), defaults"
+                   + (", of the printed summary" if command in _SUMMARY_IN_UNITS else "")
+                   + " and of the lengths in warnings and errors; options whose names carry their "
+                   "unit (-mm, -per-mm), defaults"
                    + (", the meshes read" if command in _MESHES_IN_MM else "")
-                   + " and the files written stay mm (default mm)")
+                   + " and the files written" + _WRITTEN_IN_MM.get(command, "") + " stay mm (default mm)")
 
 
 def _num(v: float) -> str:
