@@ -173,6 +173,40 @@ def test_block_synth_on_an_engine_into_a_set_of_another_seed_is_refused(tmp_path
     assert "1 already done, 1 computed" in capsys.readouterr().out
 
 
+def test_block_synth_without_an_engine_into_an_engine_set_of_another_seed_is_refused(tmp_path, capsys):
+    """'block synth --seed 2' (no engine) into a folder an engine run of seed 1 made overwrote its
+    blocks and index.json without a word and left seed 1's records: a later engine run of seed 1
+    found them done and kept seed 2's blocks as its own."""
+    from woodcam.cli import EXIT_USAGE
+
+    out = tmp_path / "set"
+    flags = ["--count", "1", "--face-px", "32", "--quiet", "--knotted-fraction", "0", "--out", str(out)]
+    assert main(["block", "synth", "--seed", "1", *flags, "--workers", "1"]) == 0
+    first = (out / "block_0000" / "block.json").read_bytes()
+    capsys.readouterr()
+    # the engine path's rule, before any work: exit 2, one line naming the seed there and the fixes
+    assert main(["block", "synth", "--seed", "2", *flags]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and (f"{str(out)!r} holds a run with another seed or settings (seed 1 there, "
+                                     "2 now); pick another --out, run again with its options (--seed 1)") in err, err
+    assert json.loads((out / "index.json").read_text())["seed"] == 1
+    assert (out / "block_0000" / "block.json").read_bytes() == first
+    # the same seed and settings without an engine rewrite the same set (bit for bit), the
+    # engine's records still true of it
+    assert main(["block", "synth", "--seed", "1", *flags]) == 0
+    assert (out / "block_0000" / "block.json").read_bytes() == first
+    # the reverse: an engine run into a folder the serial path filled with another seed holds no
+    # record, so it makes every block anew
+    other = tmp_path / "serial"
+    flags2 = [*flags[:-1], str(other)]
+    assert main(["block", "synth", "--seed", "2", *flags2]) == 0
+    capsys.readouterr()
+    assert main(["block", "synth", "--seed", "1", *flags2, "--workers", "1"]) == 0
+    assert "0 already done, 1 computed" in capsys.readouterr().out
+    assert (other / "block_0000" / "block.json").read_bytes() == first
+    assert json.loads((other / "index.json").read_text())["seed"] == 1
+
+
 def test_block_synth_says_why_a_block_failed(tmp_path, capsys):
     """'block synth --size-range-mm 10000,10000 --workers 1' printed '1 keys: ... 1 failed; ...'
     and exit 3 with no reason: the error was in OUT/.synth/records only."""

@@ -534,19 +534,9 @@ def _block_option_defaults() -> dict:
     return {k: own[k].default if k in own else flat[k] for k in BLOCK_OPTIONS}
 
 
-def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, knotted: bool = True,
-                        block_options: dict | None = None, **run_options):
-    """:func:`woodcam.synth.synth_benchmark_set` with the knotted generator, one task per block on
-    an engine (the same blocks, bit for bit), resumable; writes ``index.json`` at the end.
-    ``block_options`` (names in :data:`BLOCK_OPTIONS`: sizes, knotted share, trace noise as
-    ``woodcam block synth`` takes them) are passed to every block, so a noisy set is the same
-    on every engine as without one. With a Dask ``address`` the workers write the block folders,
-    so they need ``out_dir`` on a shared disk. ``run_options`` go to
-    :func:`woodcam.scale.run_many`. Returns ``(RunSummary, index dict)``."""
-    from .scale import check_run_manifest, read_records, run_many, write_json_atomic
-
-    if not isinstance(count, int) or count < 1:
-        raise WoodcamError(f"count must be an integer >= 1; got {count!r}")
+def _benchmark_set_manifest(seed: int, face_px: int, knotted: bool, block_options: dict | None) -> dict:
+    """The settings a block set's ``.synth/run.json`` records (:func:`write_benchmark_set`,
+    :func:`check_benchmark_set_out`): ``block_options`` checked, every default filled in."""
     opts = dict(block_options or {})
     bad = sorted(set(opts) - set(BLOCK_OPTIONS))
     if bad:
@@ -562,13 +552,46 @@ def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, k
     opts["size_range_mm"] = [float(v) for v in opts["size_range_mm"]]  # JSON-friendly in the task
     if opts["trace_faces"] is not None:
         opts["trace_faces"] = list(opts["trace_faces"])
+    return {"format": "woodcam-benchmark-set", "seed": int(seed), "face_px": int(face_px),
+            "knotted": bool(knotted), "block_options": opts}
+
+
+def check_benchmark_set_out(out_dir, seed: int, *, face_px: int = 512, knotted: bool = True,
+                            block_options: dict | None = None) -> None:
+    """Refuse, before any work, to write the set ``seed`` (settings as
+    :func:`write_benchmark_set` takes them) without an engine into ``out_dir`` when an engine
+    run left a set of another seed or settings there (``out_dir/.synth/run.json``): the serial
+    writer (:func:`woodcam.synth.synth_benchmark_set`) replaced its blocks and ``index.json``
+    and left its records, so a later engine run of the old seed kept the new seed's blocks as
+    done. The rule is :func:`woodcam.scale.check_run_manifest`'s (a
+    :class:`~woodcam.errors.UsageError`); a folder without one is left as it is."""
+    from .scale import check_run_manifest
+
+    path = Path(out_dir) / ".synth" / RUN_MANIFEST
+    if path.is_file():
+        check_run_manifest(path, _benchmark_set_manifest(seed, face_px, knotted, block_options), out_dir)
+
+
+def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, knotted: bool = True,
+                        block_options: dict | None = None, **run_options):
+    """:func:`woodcam.synth.synth_benchmark_set` with the knotted generator, one task per block on
+    an engine (the same blocks, bit for bit), resumable; writes ``index.json`` at the end.
+    ``block_options`` (names in :data:`BLOCK_OPTIONS`: sizes, knotted share, trace noise as
+    ``woodcam block synth`` takes them) are passed to every block, so a noisy set is the same
+    on every engine as without one. With a Dask ``address`` the workers write the block folders,
+    so they need ``out_dir`` on a shared disk. ``run_options`` go to
+    :func:`woodcam.scale.run_many`. Returns ``(RunSummary, index dict)``."""
+    from .scale import check_run_manifest, read_records, run_many, write_json_atomic
+
+    if not isinstance(count, int) or count < 1:
+        raise WoodcamError(f"count must be an integer >= 1; got {count!r}")
+    manifest = _benchmark_set_manifest(seed, face_px, knotted, block_options)
+    opts = manifest["block_options"]
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     # the records say which blocks are done, not of which set: a rerun with another seed kept the
     # old seed's blocks under an index.json of the new one
-    check_run_manifest(out / ".synth" / RUN_MANIFEST, {
-        "format": "woodcam-benchmark-set", "seed": int(seed), "face_px": int(face_px),
-        "knotted": bool(knotted), "block_options": opts}, out)
+    check_run_manifest(out / ".synth" / RUN_MANIFEST, manifest, out)
     keys = [f"block_{i:04d}" for i in range(count)]
     summary = run_many(partial(_synth_set_task, seed=int(seed), out_dir=str(out.resolve()),
                                face_px=int(face_px), knotted=bool(knotted), block_options=opts),
@@ -636,5 +659,5 @@ def make_training_set_many(spec, out_dir, *, shard_fields: int = TRAINING_SHARD_
 
 
 __all__ = ["DEFAULT_METHODS", "DEFAULT_SETTINGS", "METRICS", "PARTIAL_FACES", "bench_block",
-           "bench_gallery", "bench_report", "bench_settings", "make_bench_block", "run_bench",
+           "bench_gallery", "bench_report", "bench_settings", "check_benchmark_set_out", "make_bench_block", "run_bench",
            "make_training_set_many", "summarise_bench", "write_benchmark_set"]

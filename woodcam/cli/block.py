@@ -96,12 +96,12 @@ def run(args) -> int:
 
                 warnings.warn(f"{', '.join(given)} act on traced rings; with --ring-maps-only no trace is written, "
                               "so they change nothing", WoodcamWarning, stacklevel=2)
+        opts = {"size_range_mm": (lo, hi), "knotted_fraction": args.knotted_fraction, **noise}
         if engine_requested(args):
             # one task per block: the same blocks as without an engine (noise included),
             # resumable (a record per block), on an engine
             from ..benchmark import write_benchmark_set
 
-            opts = {"size_range_mm": (lo, hi), "knotted_fraction": args.knotted_fraction, **noise}
             summary, index = write_benchmark_set(args.out, args.count, args.seed, face_px=args.face_px,
                                                  block_options=opts, progress=not args.quiet,
                                                  **engine_options(args))
@@ -111,6 +111,10 @@ def run(args) -> int:
             from . import EXIT_CHECKS
 
             return 0 if summary.failed == 0 else EXIT_CHECKS  # some blocks failed
+        from ..benchmark import check_benchmark_set_out
+
+        # an engine run's set of another seed there: its records would keep these blocks as its own
+        check_benchmark_set_out(args.out, args.seed, face_px=args.face_px, block_options=opts)
         folders = synth_benchmark_set(args.out, args.count, args.seed, face_px=args.face_px,
                                       size_range_mm=(lo, hi), log_fields=knotted_log_field,
                                       knotted_fraction=args.knotted_fraction,
