@@ -343,7 +343,6 @@ def run(args) -> int:
     """Run a parsed ``parquetry`` command; returns the exit status: 0, or
     :data:`~woodcam.cli.EXIT_CHECKS` when the wood ran out (what was made is written)."""
     import dataclasses
-    from collections import Counter
 
     from ..errors import UsageError, WoodcamError
     from ..parquetry.engine import SheetTooSmallError, build_parquetry
@@ -353,6 +352,7 @@ def run(args) -> int:
         ParquetryJob,
         job_targets,
         job_veneers,
+        numbered_names,
         read_job,
     )
     from ..parquetry.output import format_summary, write_parquetry
@@ -391,11 +391,8 @@ def run(args) -> int:
     scans = [_scan_entry(s) for s in args.veneer]
     # scans of the same file name in two folders (a/oak.png, b/oak.png) were both 'oak', refused
     # as duplicate ids with no way to name them here: number them, oak-1 and oak-2
-    count, seen = Counter(e["id"] for e in job.scans + scans), Counter()
-    for e in scans:
-        if count[e["id"]] > 1:
-            seen[e["id"]] += 1
-            e["id"] = f"{e['id']}-{seen[e['id']]}"
+    for e, n in zip(scans, numbered_names([e["id"] for e in scans], [e["id"] for e in job.scans])):
+        e["id"] = n
     job.scans = job.scans + scans
     # None: not typed (a value typed equal to its default, --sheets 2, is given all the same)
     given = [d for d in _SLICING if getattr(args, d) is not None]

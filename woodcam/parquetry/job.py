@@ -22,6 +22,7 @@ import math
 import numbers
 import re
 import warnings
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Literal
@@ -610,6 +611,26 @@ def job_veneers(job: ParquetryJob, open_stock=None, progress: bool = False) -> l
     return out
 
 
+def numbered_names(names: Sequence[str], kept: Sequence[str] = ()) -> list[str]:
+    """``names`` with each one that occurs more than once, among them or in ``kept`` (names kept
+    as they are: a job file's scan ids), numbered in the order given, ``oak-1``, ``oak-2``,
+    skipping a number a name here or in ``kept`` already holds: the one rule of the targets'
+    names (:func:`job_targets`) and of the ``--veneer`` scans' ids."""
+    from collections import Counter
+
+    count, taken = Counter([*names, *kept]), {*names, *kept}
+    out = []
+    for n in names:
+        if count[n] > 1:
+            k = 1
+            while f"{n}-{k}" in taken:
+                k += 1
+            n = f"{n}-{k}"
+            taken.add(n)
+        out.append(n)
+    return out
+
+
 def job_targets(job: ParquetryJob) -> tuple[list, list[str]]:
     """The job's target images ``(h, w, 3)`` float RGB and their names (file stems, in the
     output files' names: ``render_<name>.png``). Targets of the same stem in two folders
@@ -617,26 +638,16 @@ def job_targets(job: ParquetryJob) -> tuple[list, list[str]]:
     ``--veneer`` numbers its scans; a number another target's stem already holds is skipped),
     said in a WoodcamWarning; the index was glued to the stem of all of them, ``cam640`` and
     ``cam641`` of two ``cam64.png``, names no user could foresee."""
-    from collections import Counter
-
     from .veneers import TARGET_ALPHA_FIX, read_image
 
-    imgs, names = [], []
+    imgs, stems = [], []
     for t in job.targets:
         if "filename" not in t:
             raise WoodcamError(f"targets entry {t} needs a 'filename'")
         imgs.append(read_image(t["filename"], "target image", TARGET_ALPHA_FIX))
-        names.append(Path(t["filename"]).stem)
-    count, taken = Counter(names), set(names)
-    renamed = []
-    for i, n in enumerate(names):
-        if count[n] > 1:
-            k = 1
-            while f"{n}-{k}" in taken:
-                k += 1
-            names[i] = f"{n}-{k}"
-            taken.add(names[i])
-            renamed.append(f"{job.targets[i]['filename']} as {names[i]}")
+        stems.append(Path(t["filename"]).stem)
+    names = numbered_names(stems)
+    renamed = [f"{t['filename']} as {n}" for t, s, n in zip(job.targets, stems, names) if n != s]
     if renamed:
         warnings.warn(f"targets share a file name, so each is named with a number (render_<name>.png, "
                       f"assembly_<name>.svg, result.json): {'; '.join(renamed)}; rename the files to choose "
