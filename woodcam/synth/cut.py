@@ -172,8 +172,8 @@ def knot_crosses(field, size_mm, n: int = 12) -> bool:
     return bool(np.any(np.asarray(field.knot_features(pts)["knot"]) > 0.5))
 
 
-def _place_through_knot(rng: np.random.Generator, log_field, placement: dict, size, tries: int = 60,
-                        fix: str = "use a smaller block or a log with longer knots"):
+def _place_through_knot(rng: np.random.Generator, log_field, placement: dict, size, fix: str,
+                        tries: int = 60):
     """Move ``placement`` (kwargs of :func:`cut_block`) so that a knot of ``log_field`` crosses
     the block: its centre on a random knot's strand, at a random pith distance between the
     block's half diagonal and the knot's end (pith-inside: at the knot's base on the pith).
