@@ -629,3 +629,39 @@ def test_a_message_shows_the_diameter_of_a_tool_without_a_number(tmp_path, monke
         assert "#5410" not in err
         if path == two:
             assert f"woodcam: print: {path.name} line 9: dia 3.500000" in err
+
+
+def test_a_program_is_read_once_though_its_tools_without_numbers_read_it_twice(tmp_path, monkeypatch,
+                                                                               capsys):
+    """With a --tool SPEC without a number and a (DEBUG,...) of #5410 the program is read a
+    second time with that tool's diameter; it opened the file again for it, so a program
+    saved between the two reads was simulated as the new file with the old one's messages. It
+    is read once now: the second reading reads the same text, and the messages and moves are
+    the first file's."""
+    import pathlib
+
+    _stub_preview(monkeypatch, {})
+    prog = tmp_path / "p.nc"
+    prog.write_text("G21 G90\nT1 M6\n(DEBUG, dia #5410)\nG0 X10 Y10 Z5 M3 S9000\nG1 Z-1 F600\n"
+                    "G1 X30\nM2\n")
+    opened = []
+    real_open = pathlib.Path.open
+
+    def counting_open(self, *a, **kw):
+        if self.name == prog.name:
+            opened.append(self)
+            if len(opened) == 2:  # saved again while woodcam reads it: a longer program
+                with open(prog, "w") as f:
+                    f.write("G21 G90\nT1 M6\n(DEBUG, changed #5410)\nG0 X10 Y10 Z5 M3 S9000\n"
+                            "G1 Z-2 F600\nG1 X80\nG1 Y20\nM2\n")
+        return real_open(self, *a, **kw)
+
+    monkeypatch.setattr(pathlib.Path, "open", counting_open)
+    args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+                   "--tool", "flat:4", "--cell-size", "0.5"])
+    assert args.func(args) == 0
+    captured = capsys.readouterr()
+    assert len(opened) == 1, opened
+    assert "woodcam: message: p.nc line 3: dia 4.000000" in captured.err, captured.err
+    assert "changed" not in captured.err
+    assert "p.nc: 3 moves read" in captured.out, captured.out

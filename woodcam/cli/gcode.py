@@ -192,7 +192,7 @@ def run(args) -> int:
     from .._progress import StageBar, write
     from ..pipeline import check_outputs, preview_heightfield
     from ..stock import open_stock, resize_stock
-    from ..toolpath.gcode import GcodeError, read_gcode
+    from ..toolpath.gcode import GcodeError, gcode_text, read_gcode
     from ..toolpath.simulate import simulate
 
     if args.interpreter == "linuxcnc" and args.dialect != "linuxcnc":  # it was dropped without a word
@@ -229,15 +229,17 @@ def run(args) -> int:
     diameters = {n: t.diameter_mm for n, t in _numbered_tools(args).items()}
     for k, path in enumerate(args.program):
         t0 = time.perf_counter()
+        # read once: a program read again (below) is the same bytes, not the file as it is then
+        text = gcode_text(path)
         try:
-            program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
-                                 interpreter=args.interpreter,
+            program = read_gcode(text, source=str(path), start_mm=args.start,
+                                 dialect=args.dialect, interpreter=args.interpreter,
                                  machine_zero_mm=args.machine_zero,
                                  tool_diameters_mm=diameters)
             more = _unnumbered_diameters(args, program, diameters)
             if more:  # what its messages show for #5410: read again with the tools it is given
-                program = read_gcode(path, start_mm=args.start, dialect=args.dialect,
-                                     interpreter=args.interpreter,
+                program = read_gcode(text, source=str(path), start_mm=args.start,
+                                     dialect=args.dialect, interpreter=args.interpreter,
                                      machine_zero_mm=args.machine_zero,
                                      tool_diameters_mm={**diameters, **more})
         except GcodeError as err:  # which of the programs: "G-code line 5" alone does not say

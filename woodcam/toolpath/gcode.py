@@ -46,7 +46,7 @@ from ..units import say_length
 from .interpreter import ARC, MM_PER_INCH, GcodeError, Interpreter
 
 __all__ = ["DEFAULT_START_MM", "FEED", "MAX_CHORDS_PER_ARC", "MM_PER_INCH", "RAPID", "GcodeError",
-           "Move", "Program", "program_from_canonical", "read_gcode"]
+           "Move", "Program", "gcode_text", "program_from_canonical", "read_gcode"]
 
 RAPID, FEED = 0, 1
 _KIND_NAMES = ("rapid", "feed")
@@ -246,10 +246,20 @@ def _names_a_file(text: str) -> bool:
         return False
 
 
+def gcode_text(path: PathLike) -> str:
+    """The text of the G-code file ``path`` as :func:`read_gcode` reads it: the line ends as
+    written (``newline=""``: numbered as LinuxCNC numbers them, :func:`.interpreter.source_lines`),
+    bytes that are no UTF-8 replaced. Read a file once with it and pass the text with
+    ``source=`` to read it more than once as the same bytes."""
+    with Path(path).open(errors="replace", newline="") as f:
+        return f.read()
+
+
 def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_TOL_MM,
                start_mm: ArrayLike | None = None, dialect: str = "linuxcnc",
                interpreter: str = "woodcam", machine_zero_mm: ArrayLike | None = None,
-               tool_diameters_mm: Mapping[int, float] | None = None) -> Program:
+               tool_diameters_mm: Mapping[int, float] | None = None,
+               source: str | None = None) -> Program:
     """Read G-code text or a file path into a :class:`Program` of straight moves (G-code
     frame, mm).
 
@@ -279,29 +289,36 @@ def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_
         show, with a warning; before the first ``M6`` (no tool loaded: LinuxCNC's T0 is no
         tool) it shows 0, as LinuxCNC. ``interpreter="linuxcnc"`` runs LinuxCNC with these
         diameters in its tool table and shows and warns the same.
+    source : str | None
+        The file ``text_or_path`` is the text of (:func:`gcode_text`): the text is then read as
+        program text, never taken as a path (a one-line program can name a file), and
+        :attr:`Program.source` names the file. ``None``: as above.
 
     Raises
     ------
     GcodeError
         For an unsupported or malformed line, naming the line number and the word.
     """
-    source = "<string>"
+    if source is not None and not (isinstance(source, str) and isinstance(text_or_path, str)):
+        raise WoodcamError(f"read_gcode: source names the file the program text was read from, "
+                           f"so it takes the text (str) and a str; got {type(text_or_path).__name__} "
+                           f"and {source!r:.60}; pass read_gcode(gcode_text(path), source=str(path))")
     if not isinstance(text_or_path, (str, os.PathLike)):  # None was parsed as the program 'None'
         raise WoodcamError(f"read_gcode: text_or_path must be the program text (str) or a file path; got "
                            f"{text_or_path!r:.60}; pass read_gcode(Path('part.nc')) or the text itself")
     one_line = isinstance(text_or_path, str) and "\n" not in text_or_path
-    if isinstance(text_or_path, os.PathLike) or (one_line and (
+    if source is not None:
+        text = str(text_or_path)
+    elif isinstance(text_or_path, os.PathLike) or (one_line and (
             Path(text_or_path).suffix.lower() in {".nc", ".gcode", ".ngc", ".tap", ".cnc", ".txt"}
             or _names_a_file(text_or_path))):
         path = Path(text_or_path)
         if not path.is_file():
             raise WoodcamError(f"read_gcode: text_or_path={str(path)!r} is not a file; "
                                "pass an existing G-code file or the program text")
-        # newline="": the line ends as written, numbered as LinuxCNC does (source_lines)
-        with path.open(errors="replace", newline="") as f:
-            source, text = str(path), f.read()
+        source, text = str(path), gcode_text(path)
     else:
-        text = str(text_or_path)
+        source, text = "<string>", str(text_or_path)
     if not (isinstance(chord_tol_mm, numbers.Real) and math.isfinite(chord_tol_mm)
             and chord_tol_mm > 0):
         raise WoodcamError(f"read_gcode: chord_tol_mm must be a finite number > 0, got "
