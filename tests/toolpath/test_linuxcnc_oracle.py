@@ -912,3 +912,19 @@ def test_tool_entries_before_the_first_m6_and_of_a_tool_not_given_agree(tmp_path
     assert theirs.warnings == mine.warnings
     assert [w.split(":")[0] for w in theirs.warnings] == ["line 5", "line 5", "line 8"]
     assert theirs.warnings[0].endswith("to see its diameter (warned once; the line ran 3 times)")
+
+
+def test_the_two_interpreters_warn_in_the_order_the_program_runs(tmp_path):
+    """A subroutine defined before the line that calls it runs after it: woodcam's interpreter
+    warns of the tool-table entries its DEBUG/PRINT texts show in that order, but
+    --interpreter linuxcnc sorted its warnings by line number (line 3 before line 6). Both
+    warn in the order the program runs now, the DEBUG and PRINT texts of one run interleaved
+    as said."""
+    text = ("G21 G90\no100 sub\n  (PRINT,in sub #5410)\no100 endsub\nT2 M6\n"
+            "(DEBUG,before call #5410)\no100 call\n(PRINT,after call #5403)\n"
+            "(DEBUG,last #5410)\no100 call\nM2\n")
+    mine = read_gcode(text)
+    theirs = read_gcode(text, interpreter="linuxcnc")
+    assert [w.split(":")[0] for w in mine.warnings] == ["line 6", "line 3", "line 8", "line 9"]
+    assert theirs.warnings == mine.warnings
+    assert theirs.messages == mine.messages and theirs.printed == mine.printed

@@ -6,9 +6,11 @@ for it, not for woodcam's virtualenv); never imported by woodcam. Input (stdin, 
 ``{"files": [path, ...], "start_mm": [x, y, z], "timeout_s": t, "machine_zero_mm": [x, y, z],
 "tool_diameters_mm": {"n": d, ...}}`` (the last two optional: zero, no diameters); output (stdout,
 JSON): one ``{"moves": [...], "messages": [[line, text], ...], "printed": [[line, text], ...],
-"error": null | [line, message], "result": code}`` per file (messages: the operator messages,
-``(MSG,...)``/``(DEBUG,...)``; printed: the ``(PRINT,...)`` texts, which the interpreter writes to
-its standard output, not through the canon: :func:`_mark_prints`), moves as
+"said_order": [0 | 1, ...], "error": null | [line, message], "result": code}`` per file
+(messages: the operator messages, ``(MSG,...)``/``(DEBUG,...)``; printed: the ``(PRINT,...)``
+texts, which the interpreter writes to its standard output, not through the canon:
+:func:`_mark_prints`; said_order: the two as the program said them, 0 a message, 1 a PRINT
+text, :func:`_said_order`), moves as
 woodcam's canonical tuples ``[kind, line, [x, y, z], [c1, c2] | null, rotation, plane,
 feed_mm_min, spindle_rpm, tool]`` in the
 machine frame, mm, tool tip (LinuxCNC's canon reports program coordinates before the G5x/G92
@@ -153,6 +155,8 @@ class _Canon:
         self.rpm = 0.0
         self.pending = None  # (line, index of its first move) awaiting the state after it
         self.words: dict[int, list | None] = {}  # line -> its spindle words, None: not known
+        self.message_at = []  # the interpreter's standard output's length at each message
+        self.printed_at = lambda: 0  # that length now (_run sets it)
 
     def __getattr__(self, name):  # every other canon call has no effect on the moves
         if name.startswith("__"):
@@ -175,6 +179,8 @@ class _Canon:
 
     def message(self, text):  # (MSG,...) and (DEBUG,...): what the operator's screen shows
         self.messages.append([self.line, text])
+        # where the PRINT texts stand then: the order the two came in (_said_order)
+        self.message_at.append(self.printed_at())
 
     def set_feed_rate(self, rate):
         self.feed = rate * MM
@@ -287,12 +293,15 @@ def _mark_prints(data):
     return b"\n".join(lines), long
 
 
-def _printed(text, long):
-    """The ``[line, text]`` of each PRINT in ``text``, the interpreter's standard output of a
-    program marked by :func:`_mark_prints` (``long``: its lines left unmarked, whose texts
-    come unmarked: given the first of them); any other line goes to stderr, as before."""
-    out = []
-    for line in text.split("\n")[:-1]:
+def _printed(data, long):
+    """The ``[line, text]`` of each PRINT in ``data`` (bytes), the interpreter's standard
+    output of a program marked by :func:`_mark_prints` (``long``: its lines left unmarked,
+    whose texts come unmarked: given the first of them), and the offset in ``data`` where each
+    ends; any other line goes to stderr, as before."""
+    out, ends, at = [], [], 0
+    for raw in data.split(b"\n")[:-1]:
+        at += len(raw) + 1
+        line = raw.decode(errors="replace")
         m = _MARKED.match(line)
         if m:
             out.append([int(m.group(1)), m.group(2)])
@@ -300,7 +309,22 @@ def _printed(text, long):
             out.append([long[0], line])
         else:
             sys.stderr.write(line + "\n")
-    return out
+            continue
+        ends.append(at)
+    return out, ends
+
+
+def _said_order(message_at, printed_ends):
+    """The messages (0) and PRINT texts (1) in the order the program said them: a PRINT text
+    that ended in the standard output before a message was said (``message_at``, the output's
+    length then) came before it; each list of texts keeps its own order."""
+    order, k = [], 0
+    for at in message_at:
+        while k < len(printed_ends) and printed_ends[k] <= at:
+            order.append(1)
+            k += 1
+        order.append(0)
+    return order + [1] * (len(printed_ends) - k)
 
 
 def _run(job, work, result_fd):
@@ -335,6 +359,7 @@ def _run(job, work, result_fd):
         canon = _Canon(var, time.time() + job.get("timeout_s", 10.0))
         canon.mzero = mzero
         canon.diameters = diameters
+        canon.printed_at = lambda: (libc.fflush(None), os.lseek(1, 0, os.SEEK_CUR))[1] - said_at
         with open(path, newline="", errors="replace") as f:  # numbered as LinuxCNC: at '\n' only
             lines = f.read().split("\n")
         with open(path, "rb") as f:
@@ -363,10 +388,12 @@ def _run(job, work, result_fd):
         libc.fflush(None)  # C's stdout, a file: buffered
         with open(said, "rb") as f:
             f.seek(said_at)
-            text = f.read().decode(errors="replace")
+            text = f.read()
             said_at = f.tell()
-        out.append({"moves": moves, "messages": canon.messages,
-                    "printed": _printed(text, long), "error": err, "result": result,
+        printed, ends = _printed(text, long)
+        out.append({"moves": moves, "messages": canon.messages, "printed": printed,
+                    "said_order": _said_order(canon.message_at, ends), "error": err,
+                    "result": result,
                     "seconds": time.perf_counter() - t0, "cpu_seconds": time.process_time() - c0})
     with os.fdopen(result_fd, "w") as f:
         json.dump(out, f)

@@ -56,7 +56,8 @@ def run_batch(paths, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 10.0,
     plane]``, mm, in the frame of ``start_mm``: the G54 frame, whose offset is
     ``-machine_zero_mm``; the default zero, or ``None``, is the machine frame), ``messages``
     (the operator messages, ``[line, text]``), ``printed`` (the ``(PRINT,...)`` texts,
-    ``[line, text]``), ``error`` (``None`` or ``[line, message]``), ``seconds``.
+    ``[line, text]``), ``said_order`` (the two as the program said them: 0 the next message,
+    1 the next PRINT text), ``error`` (``None`` or ``[line, message]``), ``seconds``.
     ``tool_diameters_mm``: the tool table's diameters by tool number (mm), what a DEBUG/PRINT
     shows for ``#5410`` (LinuxCNC's table otherwise holds 0).
     """
@@ -76,7 +77,7 @@ def run_batch(paths, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 10.0,
             return [run_batch([p], start_mm=start_mm, timeout_s=timeout_s,
                               machine_zero_mm=machine_zero_mm,
                               tool_diameters_mm=tool_diameters_mm)[0] for p in paths]
-        return [{"moves": [], "messages": [], "printed": [], "error": [
+        return [{"moves": [], "messages": [], "printed": [], "said_order": [], "error": [
             0, f"LinuxCNC's interpreter crashed (exit {r.returncode})"], "seconds": 0.0}]
     return json.loads(r.stdout)
 
@@ -110,15 +111,19 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
         p.write_text(_mark_tool_entries(text))
         res = run_batch([p], start_mm=start_mm, timeout_s=timeout_s,
                         machine_zero_mm=machine_zero_mm, tool_diameters_mm=tool_diameters_mm)[0]
-    # the tool-table entries in the texts, shown and warned as woodcam's interpreter does;
+    # the tool-table entries in the texts, shown and warned as woodcam's interpreter does, in
+    # the order the program said them (a subroutine's text after the line that called it);
     # each text is one pass of its line (a line in a loop is warned once)
     warnings: list[tuple[int, str]] = []
     warned: dict = {}
-    texts = [[(int(ln), _tool_entries_shown(m, kind, int(ln), tool_diameters_mm or {}, warnings,
-                                            warned, (key, k)))
-              for k, (ln, m) in enumerate(res[key])]
-             for key, kind in (("messages", "DEBUG"), ("printed", "PRINT"))]
-    warnings.sort(key=lambda w: w[0])  # (the texts said and printed come apart: in line order)
+    texts: list[list[tuple[int, str]]] = [[], []]
+    kinds = (("messages", "DEBUG"), ("printed", "PRINT"))
+    for which in res["said_order"]:
+        key, kind = kinds[which]
+        k = len(texts[which])
+        ln, m = res[key][k]
+        texts[which].append((int(ln), _tool_entries_shown(
+            m, kind, int(ln), tool_diameters_mm or {}, warnings, warned, (key, k))))
     if said is not None:
         said += [(ln, m.strip()) for ln, m in texts[0]]
     if printed is not None:
