@@ -928,3 +928,32 @@ def test_the_two_interpreters_warn_in_the_order_the_program_runs(tmp_path):
     assert [w.split(":")[0] for w in mine.warnings] == ["line 6", "line 3", "line 8", "line 9"]
     assert theirs.warnings == mine.warnings
     assert theirs.messages == mine.messages and theirs.printed == mine.printed
+
+
+def test_lines_too_long_for_the_marks_are_placed_or_warned_of():
+    """--interpreter linuxcnc marks each (PRINT,...) with its line number and each tool-table
+    entry of a DEBUG/PRINT with the loaded tool; a line the marks would take past LinuxCNC's
+    252 characters keeps none. Its PRINT texts were all given the first such line (a second
+    long PRINT line's text said 'line 3' for line 5), and its #5410 showed LinuxCNC's 0 with no
+    word where woodcam's interpreter says what it is; a DEBUG line within 252 characters lost
+    its tool mark at 240 already. Now a text goes to the long line whose text it can be, a
+    text that more than one could have printed is warned of, an unmarked entry is warned of
+    naming the line, and a DEBUG line is marked up to 252 characters."""
+    pad = "x" * 231
+    text = (f"G21\nT2 M6\n(PRINT,first {pad} #5410)\nG0 Z5\n(PRINT,second {pad}#5410)\n"
+            f"(DEBUG,{'z' * 220} #5410)\nM2\n")
+    assert [len(line) for line in text.split("\n")[2:6]] == [251, 5, 251, 234]
+    mine = read_gcode(text)
+    theirs = read_gcode(text, interpreter="linuxcnc")
+    assert [t.split(":")[0] for t in theirs.printed] == ["line 3", "line 5"]
+    assert theirs.messages == mine.messages  # the DEBUG line of 234: marked, shown as woodcam
+    assert [w.split(":")[0] for w in theirs.warnings] == ["line 3", "line 5", "line 6"]
+    for w in theirs.warnings[:2]:
+        assert "shows #5410 as LinuxCNC's tool table here holds it, unchecked: the line is " \
+               "too long for woodcam to mark which tool is loaded (251 characters" in w, w
+    assert theirs.warnings[2] == mine.warnings[2]
+    same = f"G21\n(PRINT,same {'y' * 236} #1)\n#1=2\n(PRINT,same {'y' * 236} #1)\nM2\n"
+    theirs = read_gcode(same, interpreter="linuxcnc")
+    assert [t.split(":")[0] for t in theirs.printed] == ["line 2", "line 2"]
+    assert len(theirs.warnings) == 1 and theirs.warnings[0].startswith(
+        "line 2: a (PRINT,...) text that any of lines 2, 4 could have printed"), theirs.warnings

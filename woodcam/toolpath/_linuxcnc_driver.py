@@ -6,11 +6,12 @@ for it, not for woodcam's virtualenv); never imported by woodcam. Input (stdin, 
 ``{"files": [path, ...], "start_mm": [x, y, z], "timeout_s": t, "machine_zero_mm": [x, y, z],
 "tool_diameters_mm": {"n": d, ...}}`` (the last two optional: zero, no diameters); output (stdout,
 JSON): one ``{"moves": [...], "messages": [[line, text], ...], "printed": [[line, text], ...],
-"said_order": [0 | 1, ...], "error": null | [line, message], "result": code}`` per file
-(messages: the operator messages, ``(MSG,...)``/``(DEBUG,...)``; printed: the ``(PRINT,...)``
+"said_order": [0 | 1, ...], "printed_unplaced": [...], "error": null | [line, message],
+"result": code}`` per file (messages: the operator messages, ``(MSG,...)``/``(DEBUG,...)``; printed: the ``(PRINT,...)``
 texts, which the interpreter writes to its standard output, not through the canon:
 :func:`_mark_prints`; said_order: the two as the program said them, 0 a message, 1 a PRINT
-text, :func:`_said_order`), moves as
+text, :func:`_said_order`; printed_unplaced: ``[[index, lines], ...]``, the PRINT texts whose
+line is not known, each with the lines that could have printed it, :func:`_printed`), moves as
 woodcam's canonical tuples ``[kind, line, [x, y, z], [c1, c2] | null, rotation, plane,
 feed_mm_min, spindle_rpm, tool]`` in the
 machine frame, mm, tool tip (LinuxCNC's canon reports program coordinates before the G5x/G92
@@ -277,15 +278,17 @@ def _mark_prints(data):
     """Program ``data`` (bytes) with each ``(PRINT,`` comment's text led by its line number
     between ``\\x01`` and ``\\x02`` (lines numbered at ``\\n``, as LinuxCNC does): the interpreter
     writes a PRINT's text, parameters put in, to its standard output and nothing says which line
-    it ran; with the mark the text tells (:func:`_printed`). Returns ``(data, lines)``, ``lines``
-    those left unmarked: the mark would make them longer than LinuxCNC reads (MAX_LINE)."""
+    it ran; with the mark the text tells (:func:`_printed`). Returns ``(data, long)``, ``long``
+    the lines left unmarked, the mark would make them longer than LinuxCNC reads (MAX_LINE),
+    each with the patterns of the texts its PRINT comments can write (:func:`_print_pattern`)."""
     lines = data.split(b"\n")
-    long = []
+    long = {}
     for i, line in enumerate(lines):
         if b"(" in line and _PRINT.search(line):
             marked = _PRINT.sub(lambda m: b"(" + m.group(1) + b"\x01%d\x02" % (i + 1), line)
             if len(marked) > MAX_LINE:
-                long.append(i + 1)
+                long[i + 1] = [_print_pattern(line[m.end():].split(b")", 1)[0])
+                               for m in _PRINT.finditer(line)]
             else:
                 lines[i] = marked
         # (a print, comment LinuxCNC does not print, one not last on its line or after a ';',
@@ -293,12 +296,47 @@ def _mark_prints(data):
     return b"\n".join(lines), long
 
 
+#: a parameter's value in a PRINT text: C's %lf, or LinuxCNC's ###### for none
+_VALUE = r"(?:-?[0-9]+\.[0-9]{6}|-?inf|-?nan|#+)"
+
+
+def _print_pattern(text):
+    """The pattern of what a ``(PRINT,`` comment of text ``text`` (bytes, after the comma)
+    writes: its text with each ``#n`` and ``#<name>`` any value (as LinuxCNC 2.9 puts them in:
+    woodcam's interpreter's ``Interpreter._expand`` says how); an unfinished ``#<`` ends in
+    anything (LinuxCNC shows left-over text there)."""
+    text = text.decode(errors="replace")
+    out, i, n = [], 0, len(text)
+    while True:
+        j = text.find("#", i)
+        if j < 0:
+            out.append(re.escape(text[i:]))
+            break
+        out.append(re.escape(text[i:j]))
+        i = j + 1
+        if i < n and text[i].isdigit():
+            while i < n and text[i].isdigit():
+                i += 1
+            out.append(_VALUE)
+        elif i < n and text[i] == "<" and ">" in text[i:]:
+            i = text.index(">", i) + 1
+            out.append(_VALUE)
+        elif i < n and text[i] != "<":
+            out.append("#")
+        else:
+            out.append(".*")
+            break
+    return re.compile("".join(out), re.S)
+
+
 def _printed(data, long):
     """The ``[line, text]`` of each PRINT in ``data`` (bytes), the interpreter's standard
-    output of a program marked by :func:`_mark_prints` (``long``: its lines left unmarked,
-    whose texts come unmarked: given the first of them), and the offset in ``data`` where each
-    ends; any other line goes to stderr, as before."""
-    out, ends, at = [], [], 0
+    output of a program marked by :func:`_mark_prints`, the offset in ``data`` where each ends,
+    and ``[[index, lines], ...]``, the texts whose line is not known. ``long``: the lines left
+    unmarked, whose texts come unmarked: given the one line whose texts' patterns match, else
+    the first of those that do (or of them all), and listed with those lines as not known. Any
+    other line goes to stderr, as before."""
+    out, ends, unknown, at = [], [], [], 0
     for raw in data.split(b"\n")[:-1]:
         at += len(raw) + 1
         line = raw.decode(errors="replace")
@@ -306,12 +344,16 @@ def _printed(data, long):
         if m:
             out.append([int(m.group(1)), m.group(2)])
         elif long:
-            out.append([long[0], line])
+            lines = [no for no, patterns in long.items()
+                     if any(p.fullmatch(line) for p in patterns)] if len(long) > 1 else list(long)
+            if len(lines) != 1:
+                unknown.append([len(out), lines or list(long)])
+            out.append([(lines or list(long))[0], line])
         else:
             sys.stderr.write(line + "\n")
             continue
         ends.append(at)
-    return out, ends
+    return out, ends, unknown
 
 
 def _said_order(message_at, printed_ends):
@@ -390,9 +432,10 @@ def _run(job, work, result_fd):
             f.seek(said_at)
             text = f.read()
             said_at = f.tell()
-        printed, ends = _printed(text, long)
+        printed, ends, unknown = _printed(text, long)
         out.append({"moves": moves, "messages": canon.messages, "printed": printed,
-                    "said_order": _said_order(canon.message_at, ends), "error": err,
+                    "said_order": _said_order(canon.message_at, ends),
+                    "printed_unplaced": unknown, "error": err,
                     "result": result,
                     "seconds": time.perf_counter() - t0, "cpu_seconds": time.process_time() - c0})
     with os.fdopen(result_fd, "w") as f:

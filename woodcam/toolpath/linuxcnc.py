@@ -108,7 +108,8 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
                          "which takes a G53 Z move as a retract to the --start height")
     with tempfile.TemporaryDirectory(prefix="woodcam-lcnc-") as d:
         p = Path(d) / "program.ngc"
-        p.write_text(_mark_tool_entries(text))
+        marked, unmarked = _mark_tool_entries(text)
+        p.write_text(marked)
         res = run_batch([p], start_mm=start_mm, timeout_s=timeout_s,
                         machine_zero_mm=machine_zero_mm, tool_diameters_mm=tool_diameters_mm)[0]
     # the tool-table entries in the texts, shown and warned as woodcam's interpreter does, in
@@ -117,6 +118,7 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
     warnings: list[tuple[int, str]] = []
     warned: dict = {}
     texts: list[list[tuple[int, str]]] = [[], []]
+    unplaced = {int(k): [int(ln) for ln in lines] for k, lines in res["printed_unplaced"]}
     kinds = (("messages", "DEBUG"), ("printed", "PRINT"))
     for which in res["said_order"]:
         key, kind = kinds[which]
@@ -124,6 +126,22 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
         ln, m = res[key][k]
         texts[which].append((int(ln), _tool_entries_shown(
             m, kind, int(ln), tool_diameters_mm or {}, warnings, warned, (key, k))))
+        if int(ln) in unmarked:
+            add_line_warning(warnings, warned, int(ln), (
+                f"({kind},...) shows {unmarked[int(ln)][0]} as LinuxCNC's tool table here "
+                "holds it, unchecked: the line is too long for woodcam to mark which tool is "
+                f"loaded ({unmarked[int(ln)][1]} characters; LinuxCNC reads {MAX_LINE}, the "
+                "marks need more), so it shows the diameter given for the loaded tool, 0 for a "
+                "tool not given (--tools, --tool N=SPEC) and for every other entry, where "
+                "woodcam's interpreter says what the entry is; shorten the line (the comment "
+                "on a line of its own)"), (key, k))
+        if which == 1 and k in unplaced:
+            add_line_warning(warnings, warned, int(ln), (
+                f"a (PRINT,...) text that any of lines {line_list(unplaced[k])} could have "
+                "printed: they are too long for woodcam to mark which line prints "
+                f"(LinuxCNC reads {MAX_LINE} characters, the mark needs 3 or more) and the "
+                f"texts are alike; it is given line {ln}; shorten the lines or make their "
+                "texts differ"), (key, k))
     if said is not None:
         said += [(ln, m.strip()) for ln, m in texts[0]]
     if printed is not None:
@@ -140,30 +158,42 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
 
 
 _G53 = re.compile(r"g0*53(?![\d.])")
-#: LinuxCNC's longest line, less room for the driver's mark of a PRINT (its line number)
-_ROOM = 252 - 12
+#: LinuxCNC's longest line (its LINELEN less the end; the driver's MAX_LINE)
+MAX_LINE = 252
 #: a (DEBUG,...) or (PRINT,...) comment, as LinuxCNC knows them (blanks first, any case)
 _SHOWN = re.compile(r"\([ \t]*(?:debug|print),[^)]*\)", re.IGNORECASE)
+#: a (PRINT, comment's start, which the driver marks with the line's number (_mark_prints)
+_PRINT = re.compile(r"\([ \t]*print,", re.IGNORECASE)
 #: a reference to the loaded tool's tool-table entry, #5401-#5413, in such a comment
 _ENTRY_REF = re.compile(r"#(0*54(?:0[1-9]|1[0-3]))(?![0-9])")
 #: the same put in by LinuxCNC, as marked by _mark_tool_entries: ref, loaded tool, value
 _ENTRY_SHOWN = re.compile(r"\x03([0-9]+)\x05(-?[0-9.]+)\x04(-?[0-9.]+|#+)")
 
 
-def _mark_tool_entries(text: str) -> str:
+def _mark_tool_entries(text: str) -> tuple[str, dict[int, tuple[str, int]]]:
     """``text`` with each ``#5401``-``#5413`` of a DEBUG/PRINT comment led by a mark that has
     LinuxCNC put in the loaded tool (``#5400``): ``\\x03REF\\x05#5400\\x04#REF``. LinuxCNC shows
     the entry of its tool table (the user's diameters, zero offsets), 0 for a tool the user did
     not give; with the mark :func:`_tool_entries_shown` knows the tool and shows and warns as
-    woodcam's interpreter does. A line the marks would make too long for LinuxCNC keeps none."""
+    woodcam's interpreter does. A line the marks would make too long for LinuxCNC (with the
+    driver's mark of a PRINT, its line number) keeps none: returned with its first such
+    reference and its length, ``{line: (ref, characters)}``, for a warning."""
     lines = text.split("\n")
+    unmarked = {}
     for i, line in enumerate(lines):
         if "54" in line and _SHOWN.search(line):
             marked = _SHOWN.sub(lambda c: _ENTRY_REF.sub(
                 lambda m: f"\x03{m.group(1)}\x05#5400\x04#{m.group(1)}", c.group(0)), line)
-            if len(marked.encode()) <= _ROOM:
+            if marked == line:
+                continue
+            room = MAX_LINE - len(_PRINT.findall(line)) * (2 + len(str(i + 1)))
+            if len(marked.encode()) <= room:
                 lines[i] = marked
-    return "\n".join(lines)
+            else:
+                ref = next(m.group(0) for c in _SHOWN.finditer(line)
+                           for m in _ENTRY_REF.finditer(c.group(0)))
+                unmarked[i + 1] = (ref, len(line.encode()))
+    return "\n".join(lines), unmarked
 
 
 def _tool_entries_shown(text: str, kind: str, line: int, diameters, warnings: list,
