@@ -665,3 +665,29 @@ def test_a_program_is_read_once_though_its_tools_without_numbers_read_it_twice(t
     assert "woodcam: message: p.nc line 3: dia 4.000000" in captured.err, captured.err
     assert "changed" not in captured.err
     assert "p.nc: 3 moves read" in captured.out, captured.out
+
+
+def test_linuxcnc_cutter_compensation_offsets_by_a_tool_without_a_number(tmp_path, monkeypatch,
+                                                                         capsys):
+    """--interpreter linuxcnc runs G41/G42 as LinuxCNC does, offsetting the path by the radius
+    of its tool table's diameter. A --tool SPEC without a number gave the table no diameter
+    (the program was read again with it only where it said or printed something), so the
+    profile was cut on the programmed line, 3 mm off, where --tool 1=SPEC cut it offset: the
+    same tool cut two parts. Both cut the offset profile now."""
+    from woodcam.toolpath.linuxcnc import linuxcnc_missing
+
+    if linuxcnc_missing():
+        pytest.skip(f"LinuxCNC's interpreter is not available: {linuxcnc_missing()}")
+    _stub_preview(monkeypatch, {})
+    prog = tmp_path / "comp.ngc"
+    prog.write_text("G21 G90\nT1 M6\nS10000 M3\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG41\nG1 X20 Y10\n"
+                    "G1 X40\nG1 Y40\nG1 X20\nG1 Y10\nG40\nG0 Z5\nM2\n")
+    removed = []
+    for tool in ("flat:6", "1=flat:6"):
+        args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out",
+                       str(tmp_path / "o.glb"), "--tool", tool, "--cell-size", "0.5",
+                       "--interpreter", "linuxcnc"])
+        assert args.func(args) == 0
+        out = capsys.readouterr().out
+        removed.append(re.search(r"removed ([0-9.]+ mm\^3)", out).group(1))
+    assert removed[0] == removed[1], removed

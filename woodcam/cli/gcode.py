@@ -144,12 +144,14 @@ def _unnumbered_diameters(args, program, diameters) -> dict:
     ``program`` gets them for (:func:`_tools_from_args`: the numbers it uses without a tool,
     in order; one tool alone is the tool of a program without a T word, tool 0), those not in
     ``diameters``; empty when the program says and prints nothing, where they would show
-    (a DEBUG/PRINT of #5410, the loaded tool's diameter), or when they do not fit (refused
-    later, after its messages, by _tools_from_args). Not tool 0's: before the first M6 no tool
-    is loaded and #5410 shows 0, as on LinuxCNC (interpreter.tool_entry_in_message)."""
+    (a DEBUG/PRINT of #5410, the loaded tool's diameter), unless LinuxCNC's interpreter reads
+    it (its cutter compensation, G41/G42, offsets the path by the radius of its tool table's
+    diameter: without it by none), or when they do not fit (refused later, after its
+    messages, by _tools_from_args). Not tool 0's: before the first M6 no tool is loaded and
+    #5410 shows 0, as on LinuxCNC (interpreter.tool_entry_in_message)."""
     from .options import parse_tool_option
 
-    if not (program.messages or program.printed) or all(
+    if not (program.messages or program.printed or args.interpreter == "linuxcnc") or all(
             parse_tool_option(item)[0] is not None for item in args.tool):
         return {}
     try:
@@ -237,7 +239,8 @@ def run(args) -> int:
                                  machine_zero_mm=args.machine_zero,
                                  tool_diameters_mm=diameters)
             more = _unnumbered_diameters(args, program, diameters)
-            if more:  # what its messages show for #5410: read again with the tools it is given
+            if more:  # what its messages show for #5410 and LinuxCNC's G41/G42 offset: read
+                # again with the tools it is given
                 program = read_gcode(text, source=str(path), start_mm=args.start,
                                      dialect=args.dialect, interpreter=args.interpreter,
                                      machine_zero_mm=args.machine_zero,
