@@ -957,3 +957,22 @@ def test_lines_too_long_for_the_marks_are_placed_or_warned_of():
     assert [t.split(":")[0] for t in theirs.printed] == ["line 2", "line 2"]
     assert len(theirs.warnings) == 1 and theirs.warnings[0].startswith(
         "line 2: a (PRINT,...) text that any of lines 2, 4 could have printed"), theirs.warnings
+
+
+def test_a_refusal_of_linuxcnc_says_which_lines_it_can_be():
+    """LinuxCNC names the line after one it could not read (its AXIS preview: 'near line N'),
+    and --interpreter linuxcnc said 'G-code line 6: ...; fix the line' of an 'M2' where line 5
+    held the E word; an arc it could not run it names exactly. The error now says the line may
+    be the one before it, and that --interpreter woodcam names the line itself."""
+    text = "G21 G90\nT1 M6\nG0 X1 Y1 Z1\nG1 Z-1 F100\nG1 X1e1\nM2\n"
+    with pytest.raises(GcodeError) as e:
+        read_gcode(text, interpreter="linuxcnc")
+    assert e.value.line == 6
+    assert str(e.value).endswith(
+        "near this line: the line itself, or the one before it where LinuxCNC could not read "
+        "that one (a bad word or character, an expression), or for a line of a subroutine its "
+        "call or the line after the call; fix that line (--interpreter woodcam names the line "
+        "itself)")
+    with pytest.raises(GcodeError) as e:
+        read_gcode(text, interpreter="woodcam")
+    assert e.value.line == 5

@@ -32,6 +32,12 @@ LINUXCNC_PYTHON = "/usr/bin/python3"
 _DRIVER = Path(__file__).with_name("_linuxcnc_driver.py")
 #: LinuxCNC's message for a file without M2/M30/%: woodcam reads that as a warning.
 NO_END = "File ended with no percent sign or program end"
+#: What a refusal of LinuxCNC's asks: the line it names is not always the one refused
+#: (``parse`` adds 1 where reading a line failed; its AXIS preview says 'near line N')
+REFUSED_FIX = ("LinuxCNC's own interpreter refused it near this line: the line itself, or the "
+               "one before it where LinuxCNC could not read that one (a bad word or character, "
+               "an expression), or for a line of a subroutine its call or the line after the "
+               "call; fix that line (--interpreter woodcam names the line itself)")
 
 
 @functools.lru_cache(maxsize=1)
@@ -149,8 +155,7 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
     if res["error"]:
         line, msg = res["error"]
         if msg != NO_END:
-            raise GcodeError(int(line), "LinuxCNC", msg, "fix the line (LinuxCNC's own "
-                             "interpreter refused it)")
+            raise GcodeError(int(line), "LinuxCNC", msg, REFUSED_FIX)
         warnings.append((int(line), msg))
     moves = [(k, ln, tuple(e), tuple(c) if c else None, rot, plane, feed, rpm, tool)
              for k, ln, e, c, rot, plane, feed, rpm, tool in res["moves"]]
