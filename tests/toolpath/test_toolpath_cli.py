@@ -691,3 +691,16 @@ def test_linuxcnc_cutter_compensation_offsets_by_a_tool_without_a_number(tmp_pat
         out = capsys.readouterr().out
         removed.append(re.search(r"removed ([0-9.]+ mm\^3)", out).group(1))
     assert removed[0] == removed[1], removed
+
+
+def test_a_run_scrubbed_before_the_first_move_says_its_machining_time(tmp_path, monkeypatch, capsys):
+    """--until-line before the program's first move simulates no move, and the report ended in
+    a dangling 'machining time ' with nothing after it. It says 0:00:00 (no moves) now."""
+    _stub_preview(monkeypatch, {})
+    prog = tmp_path / "p.nc"
+    prog.write_text("G21 G90\nT1 M6\nG0 X10 Y10 Z5\nG1 Z-1 F600\nG1 X30\nM2\n")
+    args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+                   "--tool", "flat:4", "--cell-size", "0.5", "--until-line", "2"])
+    assert args.func(args) == 0
+    out = capsys.readouterr().out
+    assert "p.nc: 0 moves read" in out and "issue(s); machining time 0:00:00 (no moves)\n" in out, out

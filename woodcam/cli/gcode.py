@@ -307,8 +307,9 @@ def run(args) -> int:
                 write(f"{path.name}: {len(program)} moves read in {t_read:.2f} s, simulated on "
                       f"{s['grid'][1]}x{s['grid'][0]} cells in {s['wall_s']:.2f} s "
                       f"({s['moves_per_s']:.0f} moves/s), removed {fmt_volume(res.removed_volume_mm3, args.units)}, "
-                      f"{len(res.report)} issue(s); machining time " + ", ".join(
-                          f"T{t}: {fmt_hms(f + r)} ({fmt_hms(f)} feeding)" for t, (f, r) in times.items()))
+                      f"{len(res.report)} issue(s); machining time " + (", ".join(
+                          f"T{t}: {fmt_hms(f + r)} ({fmt_hms(f)} feeding)" for t, (f, r) in times.items())
+                          or f"{fmt_hms(0)} (no moves)"))  # (--until-line before the first move)
                 # resolved, as the block spec (_specs.absolute_spec): the review page of the GLB, opened
                 # from another folder, names the program that cut it (as typed it was relative to a
                 # working folder the GLB does not record)
