@@ -976,3 +976,11 @@ def test_a_refusal_of_linuxcnc_says_which_lines_it_can_be():
     with pytest.raises(GcodeError) as e:
         read_gcode(text, interpreter="woodcam")
     assert e.value.line == 5
+
+
+def test_an_empty_file_is_warned_of_on_its_line_1():
+    """An empty program ends without M2, M30 or '%': LinuxCNC says so on line 1, woodcam's
+    interpreter said 'line 0', a line no file has."""
+    for interpreter in ("woodcam", "linuxcnc"):
+        warnings = read_gcode("", interpreter=interpreter).warnings
+        assert len(warnings) == 1 and warnings[0].startswith("line 1: "), (interpreter, warnings)

@@ -1447,6 +1447,7 @@ class Interpreter:
                       "(LinuxCNC: 'File ended with no percent sign or program end')")
         elif not self.ended:
             if self.dialect == "linuxcnc":
+                self.line_no = max(self.line_no, 1)  # an empty file: its line 1, as LinuxCNC
                 self.warn("the file ends without M2, M30 or '%' (LinuxCNC stops here with "
                           "'File ended with no percent sign or program end')")
         self._warn_g53_unplaced()
