@@ -279,3 +279,28 @@ def test_a_program_is_sliced_as_a_list_of_moves():
     for bad in (1.0, "a", True, None):
         with pytest.raises(WoodcamError, match=r"Program: a move index must be an integer or a slice; got "):
             prog[bad]
+
+
+def test_a_file_that_is_not_gcode_text_is_refused_saying_what_it_is(tmp_path, capsys):
+    """A PNG, an executable or a file saved as UTF-16 passed as the program was read as text:
+    'woodcam gcode pic.nc' said "G-code line 6: '(\\x89...' ...: unclosed comment" with a wall of
+    bytes, an ELF program the same at line 4. A file with a NUL byte (no G-code text has one)
+    is refused now, saying what it starts with and what to pass instead."""
+    from woodcam.cli import main
+
+    png = tmp_path / "pic.nc"
+    png.write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR" + bytes(range(256)) * 4)
+    utf16 = tmp_path / "u16.nc"
+    utf16.write_bytes("G21\nG1 X1 F100\nM2\n".encode("utf-16"))
+    for path, what in ((png, "a binary file (an image, a program, a CAM project?); pass the "
+                              "G-code file the CAM software's post-processor wrote"),
+                       (utf16, "saved as UTF-16 (Windows' 'Unicode'); save it as UTF-8 or ASCII")):
+        with pytest.raises(WoodcamError, match="is not G-code text") as e:
+            read_gcode(path)
+        assert str(e.value).startswith(f"{str(path)!r} is not G-code text: it holds NUL bytes "
+                                       "(it starts b'") and what in str(e.value), str(e.value)
+        assert main(["gcode", str(path), "--tool", "flat:3", "--block", "builtin:flat-sawn",
+                     "--out", str(tmp_path / "o.glb")]) == 1
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "is not G-code text" in err and len(err) < 400, err
+    assert not (tmp_path / "o.glb").exists()

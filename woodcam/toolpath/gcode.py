@@ -250,9 +250,19 @@ def gcode_text(path: PathLike) -> str:
     """The text of the G-code file ``path`` as :func:`read_gcode` reads it: the line ends as
     written (``newline=""``: numbered as LinuxCNC numbers them, :func:`.interpreter.source_lines`),
     bytes that are no UTF-8 replaced. Read a file once with it and pass the text with
-    ``source=`` to read it more than once as the same bytes."""
-    with Path(path).open(errors="replace", newline="") as f:
-        return f.read()
+    ``source=`` to read it more than once as the same bytes. A file with a NUL byte is no
+    G-code text (an image, a program, a CAM project, a file saved as UTF-16) and is refused
+    (its first line showed as a wall of bytes in a 'bad character' or 'unclosed comment'
+    error)."""
+    data = Path(path).read_bytes()
+    if b"\x00" in data:
+        what = ("saved as UTF-16 (Windows' 'Unicode'); save it as UTF-8 or ASCII"
+                if data[:2] in (b"\xff\xfe", b"\xfe\xff") else
+                "a binary file (an image, a program, a CAM project?); pass the G-code file "
+                "the CAM software's post-processor wrote (.nc, .ngc, .tap, .gcode)")
+        raise WoodcamError(f"{str(path)!r} is not G-code text: it holds NUL bytes "
+                           f"(it starts {data[:8]!r}): {what}")
+    return data.decode(errors="replace")
 
 
 def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_TOL_MM,
