@@ -304,3 +304,17 @@ def test_a_file_that_is_not_gcode_text_is_refused_saying_what_it_is(tmp_path, ca
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "is not G-code text" in err and len(err) < 400, err
     assert not (tmp_path / "o.glb").exists()
+
+
+def test_a_byte_that_is_no_utf8_outside_a_comment_says_so(tmp_path):
+    """A degree sign saved as Latin-1 ('G0 X1 Y1 Z1 \\xb0') was refused as "bad character '\\ufffd'
+    (a word is a letter and a value)", which says nothing of the byte; now the error says the
+    file holds a byte of another encoding and how to fix it. In a comment it stays allowed."""
+    prog = tmp_path / "deg.ngc"
+    prog.write_bytes(b"G21 G90\nT1 M6\nG0 X1 Y1 Z1 \xb0\nG1 Z-1 F100\nM2\n")
+    with pytest.raises(GcodeError, match=r"line 3: .*a byte that is no UTF-8 text, read as "
+                       r"U\+FFFD .* Latin-1 or Windows-1252.*remove the character, or save the "
+                       r"file as UTF-8"):
+        read_gcode(prog)
+    prog.write_bytes(b"G21 G90\nT1 M6\nG0 X1 Y1 Z1 (90\xb0)\nG1 Z-1 F100\nM2\n")
+    assert len(read_gcode(prog)) == 2

@@ -1807,6 +1807,12 @@ class Interpreter:
                                    "file, or one pasted into it, was saved as 'UTF-8 with "
                                    "BOM'), which LinuxCNC refuses too", "save the file as "
                                    "UTF-8 without BOM (or ASCII)")
+                if c == "\ufffd":  # what a byte that is no UTF-8 was read as (gcode_text)
+                    raise self.err(c, "a byte that is no UTF-8 text, read as U+FFFD (the "
+                                   "file, or a line pasted into it, was saved in another "
+                                   "encoding such as Latin-1 or Windows-1252), which LinuxCNC "
+                                   "refuses too ('Bad character')", "outside comments G-code "
+                                   "is ASCII: remove the character, or save the file as UTF-8")
                 if not c.isalpha():
                     raise self.err(c, f"bad character {c!r} (a word is a letter and a value)",
                                    "fix or remove it")
