@@ -984,3 +984,17 @@ def test_an_empty_file_is_warned_of_on_its_line_1():
     for interpreter in ("woodcam", "linuxcnc"):
         warnings = read_gcode("", interpreter=interpreter).warnings
         assert len(warnings) == 1 and warnings[0].startswith("line 1: "), (interpreter, warnings)
+
+
+def test_m61_loads_its_tool_with_both_interpreters():
+    """M61 Q sets the tool in the spindle without a change (a machine without a changer: 'M61
+    Q1 G43 H1' instead of an M6 prompt). LinuxCNC's module reports no canon call for it, so
+    --interpreter linuxcnc kept the tool before it: a program starting 'M61 Q1' cut with tool 0
+    (the report's machining time said T0), where woodcam's interpreter cuts with T1. Both cut with the M61's tool now; an M61 in a comment loads nothing. (An
+    M61 whose Q is an expression only LinuxCNC knows: --interpreter linuxcnc keeps the tool
+    before it there.)"""
+    text = ("G21 G90\nM61 Q1\nG43 H1\nG0 X1 Y1 Z5\nG1 Z-1 F100 (M61 Q9)\nT2 M6\nG1 X2\n"
+            "M61 Q3 G1 X3\nm61q04\nG1 X4\nM2\n")
+    mine = read_gcode(text)
+    theirs = read_gcode(text, interpreter="linuxcnc")
+    assert theirs.tool.tolist() == mine.tool.tolist() == [1, 1, 2, 3, 4], theirs.tool

@@ -99,6 +99,22 @@ def _spindle_words(line):
     return out
 
 
+_M61 = re.compile(r"(?<![a-z])m0*61(?![\d.])")
+_Q = re.compile(r"(?<![a-z])q(\+?[0-9]+(?:\.0*)?)(?![0-9.#\[])")
+
+
+def _m61_tool(line):
+    """The tool an ``M61 Q`` on source ``line`` makes the loaded one (the module reports no
+    canon call for M61, only for M6: its moves kept the tool before it), ``None`` where the
+    line has no M61 or its Q is no plain number (only the interpreter knows it then)."""
+    text = re.sub(r"\([^)]*\)?", "", line.split(";", 1)[0]).lower().translate(_BLANKS)
+    text = re.sub(r"#<[^>]*>", "#", text)
+    if not _M61.search(text):
+        return None
+    q = _Q.search(text)
+    return int(float(q.group(1))) if q else None
+
+
 def _after(spindle, words):
     """The spindle ``(M code, speed)`` after a line's ``words`` (_spindle_words), in LinuxCNC's
     order: S, the tool change (M6 stops the spindle), then M3/M4/M5 (M19, an orientation,
@@ -156,6 +172,7 @@ class _Canon:
         self.rpm = 0.0
         self.pending = None  # (line, index of its first move) awaiting the state after it
         self.words: dict[int, list | None] = {}  # line -> its spindle words, None: not known
+        self.m61: dict[int, int] = {}  # line -> the tool its M61 Q loads (_m61_tool)
         self.message_at = []  # the interpreter's standard output's length at each message
         self.printed_at = lambda: 0  # that length now (_run sets it)
 
@@ -173,6 +190,8 @@ class _Canon:
                 m[7] = rpm
         self.pending = None
         self.line = st.sequence_number
+        if self.line in self.m61:  # M61 Q: the tool the line says is loaded (before its moves)
+            self.tool = self.m61[self.line]
         words = self.words.get(self.line, [])
         self.rpm = rpm if words is None else _rpm(_after(self.spindle, words))
         if words is None:
@@ -414,6 +433,8 @@ def _run(job, work, result_fd):
                 f.write(data)
         canon.words = {no: w for no, line in enumerate(lines, 1) if "m" in line.lower()
                        or "s" in line.lower() for w in [_spindle_words(line)] if w != []}
+        canon.m61 = {no: t for no, line in enumerate(lines, 1) if "61" in line
+                     for t in [_m61_tool(line)] if t is not None}
         # G49: the interpreter keeps a G43.1 tool length offset from one file to the next;
         # G80: the G0 that places the start must not be the program's motion mode (LinuxCNC
         # starts in G80: a bare "X10" first is refused, and was read as a G0 here)
