@@ -35,7 +35,7 @@ from typing import Any, TypeVar
 from ._atomic import apart, atomic_path, in_flight
 from .errors import WoodcamError, WoodcamWarning
 
-__all__ = ["CacheWarning", "cache_dir", "cache_root", "digest", "entry_path", "file_lock", "load_or_build"]
+__all__ = ["CacheWarning", "cache_dir", "cache_root", "check_cache_root", "digest", "entry_path", "file_lock", "load_or_build"]
 
 T = TypeVar("T")
 
@@ -53,6 +53,22 @@ def cache_root() -> Path:
     import platformdirs
 
     return Path(platformdirs.user_cache_dir("woodcam", appauthor=False))
+
+
+def check_cache_root() -> Path:
+    """:func:`cache_root`, refused where it is not a folder: ``$WOODCAM_CACHE_DIR`` naming a
+    file made every fit warn and redo its work, and ``woodcam cache info``/``clear`` report
+    "0 entries" of the file. The one rule of the setting (a folder not made yet is fine)."""
+    root = cache_root()
+    if root.exists() and not root.is_dir():
+        given = os.environ.get("WOODCAM_CACHE_DIR")
+        if given:
+            raise WoodcamError(f"WOODCAM_CACHE_DIR must be a folder (woodcam keeps its caches in it); got "
+                               f"{given!r}, which is a file; export WOODCAM_CACHE_DIR=FOLDER (one "
+                               "that is not there is made), or unset it for the default user cache folder")
+        raise WoodcamError(f"the cache folder {str(root)!r} must be a folder; it is a file; move the file "
+                           "away, or export WOODCAM_CACHE_DIR=FOLDER")
+    return root
 
 
 #: The kinds of cache entry, one folder each: fitted fields (``woodcam.stock``), neural colour

@@ -383,6 +383,39 @@ def test_a_malformed_woodcam_setting_is_refused_before_the_work(var, value, mess
     assert not out.exists() and not (tmp_path / "cache").exists()  # no work was done
 
 
+@pytest.mark.parametrize("var,value,works,refused", [
+    ("WOODCAM_WORKERS", "abc", [["cache", "clear"], ["cache", "info"], ["blocks"], ["species"]], []),
+    ("WOODCAM_MAX_GRID_CELLS", "abc", [["cache", "clear"], ["cache", "info"], ["blocks"]], []),
+    ("WOODCAM_CACHE_MAX_MB", "abc", [["cache", "clear"], ["blocks"]], [["cache", "info"]]),
+    ("WOODCAM_CACHE_DIR", "FILE", [["blocks"]], [["cache", "clear"], ["cache", "info"],
+                                                 ["fit", "builtin:rift", "--method", "radial", "--out", "OUT"]]),
+])
+def test_a_malformed_woodcam_setting_is_refused_only_by_the_commands_that_read_it(
+        var, value, works, refused, tmp_path, monkeypatch, capsys):
+    """Every command read every WOODCAM_* setting: 'WOODCAM_WORKERS=abc woodcam cache clear'
+    (and 'blocks', 'cache info') exited 1 on a setting it never reads, so a broken fit setting
+    kept the cache from being cleared; a WOODCAM_CACHE_DIR naming a file was read by none
+    ('cache clear' said "deleted 0 entries (0.0 MiB) from FILE", a fit warned and refitted
+    every run). Now each command checks the settings it reads (uses_settings), and those one
+    line naming the variable, its rule, its value and a fix."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    if value == "FILE":
+        value = str(tmp_path / "file")
+        (tmp_path / "file").write_text("x")
+    monkeypatch.setenv(var, value)
+    for argv in works:
+        assert main(argv) == 0, argv
+        assert capsys.readouterr().err == "", argv
+    for argv in refused:
+        argv = [str(tmp_path / "f.npz") if a == "OUT" else a for a in argv]
+        assert main(argv) == EXIT_ERROR, argv
+        err = capsys.readouterr().err.splitlines()
+        assert len(err) == 1 and err[0].startswith(f"woodcam: error: {var} must be ") and repr(value) in err[0], err
+    assert not (tmp_path / "f.npz").exists()
+    if var == "WOODCAM_CACHE_DIR":
+        assert "must be a folder" in err[0] and "unset it" in err[0], err
+
+
 def test_workers_on_the_command_line_overrides_a_malformed_woodcam_workers(tmp_path, monkeypatch):
     """--workers sets the fit's cores for the run (apply_workers): the environment's is not read."""
     monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))

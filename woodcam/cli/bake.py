@@ -10,7 +10,7 @@ from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
 from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_input, part_suffixes, add_camera_option, add_out_option, add_units_option,
                       add_workers_option, allow_negative_values, apply_workers, as_typed, camera_of,
-                      remove_stale_outputs, stock_options, vector_type, write_screenshot)
+                      remove_stale_outputs, stock_options, uses_settings, vector_type, write_screenshot)
 
 
 def _mesh_suffixes() -> tuple[str, ...]:
@@ -98,9 +98,12 @@ def register(subparsers) -> None:
 
     p = subparsers.add_parser("blocks", help="list the built-in synthetic blocks")
     p.set_defaults(func=run_blocks)
+    uses_settings(p)  # no WOODCAM_* setting: it lists, opens no block
+
 
     p = subparsers.add_parser("species", help="list the --species colour presets and their sources")
     p.set_defaults(func=run_species)
+    uses_settings(p)
 
 
 def run_demo(args: argparse.Namespace) -> int:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from .options import uses_settings
+
 
 def register(subparsers) -> None:
     """Add ``cache info`` and ``cache clear``."""
@@ -17,6 +19,7 @@ def register(subparsers) -> None:
     sub.required = True
     info = sub.add_parser("info", help="where the cache is and how much it holds")
     info.set_defaults(func=run_info)
+    uses_settings(info, "cache_dir", "cache_max")  # a malformed WOODCAM_WORKERS must not hide the cache
     clear = sub.add_parser("clear", help="delete cache entries (they are rebuilt when needed)")
     from .._cache import CACHE_KINDS
 
@@ -24,6 +27,7 @@ def register(subparsers) -> None:
                        help="only this kind of entry: fitted fields, neural colour volumes "
                        "(appearance) or ring detections (detect) (default: all)")
     clear.set_defaults(func=run_clear)
+    uses_settings(clear, "cache_dir")  # a cache can be cleared whatever the other settings say
 
 
 def run_info(args: argparse.Namespace) -> int:

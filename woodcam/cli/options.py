@@ -196,22 +196,62 @@ def add_input(p, *flags: str, kind: InputKind, paths=None, suffixes=None, as_is:
     return action
 
 
-def check_environment(args: argparse.Namespace) -> None:
-    """Read woodcam's settings from the environment before any work: the resource limits
-    (``$WOODCAM_MAX_*``, :func:`woodcam.limits.check_all`), the cache's size
-    (``$WOODCAM_CACHE_MAX_MB``) and, where ``--workers`` does not set it, a fit's cores
-    (``$WOODCAM_WORKERS``); a malformed one raises its own error (exit 1). Each was read where
-    it is used: 'WOODCAM_CACHE_MAX_MB=abc woodcam fit builtin:rift --method radial --out f.npz'
-    fitted, stored the field in the cache, then failed and wrote no --out (a second run, the
-    field cached, passed without a word)."""
-    from .._cache import cache_max_bytes
-    from .._parallel import fit_workers
+def _check_limits(args: argparse.Namespace) -> None:
     from ..limits import check_all
 
     check_all()
+
+
+def _check_cache_dir(args: argparse.Namespace) -> None:
+    from .._cache import check_cache_root
+
+    check_cache_root()
+
+
+def _check_cache_max(args: argparse.Namespace) -> None:
+    from .._cache import cache_max_bytes
+
     cache_max_bytes()
+
+
+def _check_workers(args: argparse.Namespace) -> None:
     if getattr(args, "workers", None) is None:  # --workers sets it for the run (apply_workers)
+        from .._parallel import fit_workers
+
         fit_workers()
+
+
+#: woodcam's settings in the environment, by the name a command declares them with
+#: (:func:`uses_settings`), each read by the function of its one home (its rule and message):
+#: the resource limits ``$WOODCAM_MAX_*`` (:func:`woodcam.limits.check_all`), the cache folder
+#: ``$WOODCAM_CACHE_DIR`` (:func:`woodcam._cache.check_cache_root`), its size
+#: ``$WOODCAM_CACHE_MAX_MB`` (:func:`woodcam._cache.cache_max_bytes`) and a fit's cores
+#: ``$WOODCAM_WORKERS`` (:func:`woodcam._parallel.fit_workers`; not read under ``--workers``).
+SETTINGS: dict[str, Callable[[argparse.Namespace], None]] = {
+    "limits": _check_limits, "cache_dir": _check_cache_dir, "cache_max": _check_cache_max,
+    "workers": _check_workers}
+
+
+def uses_settings(p: argparse.ArgumentParser, *names: str) -> None:
+    """Declare the :data:`SETTINGS` command ``p`` reads (none: ``uses_settings(p)``); a command
+    that declares none reads them all (it opens blocks, fits, caches). Only these are checked
+    before it runs: a malformed setting it never reads refused ``woodcam blocks`` and ``woodcam
+    cache clear`` too."""
+    unknown = set(names) - set(SETTINGS)
+    if unknown:  # a contributor's mistake: say the names there are
+        raise TypeError(f"uses_settings: unknown setting(s) {sorted(unknown)}; one of {', '.join(SETTINGS)}")
+    p.set_defaults(_settings=names)
+
+
+def check_environment(args: argparse.Namespace) -> None:
+    """Read the woodcam settings of the environment the command uses (:func:`uses_settings`,
+    :data:`SETTINGS`) before any work; a malformed one raises its own error (exit 1) naming
+    the variable, its rule, its value and a fix. Each was read where it is used:
+    'WOODCAM_CACHE_MAX_MB=abc woodcam fit builtin:rift --method radial --out f.npz' fitted,
+    stored the field in the cache, then failed and wrote no --out (a second run, the field
+    cached, passed without a word)."""
+    for name in getattr(args, "_settings", tuple(SETTINGS)):
+        SETTINGS[name](args)
 
 
 def check_inputs(args: argparse.Namespace) -> None:
