@@ -115,6 +115,10 @@ def test_place_ops_round_trip_and_printing():
         assert place_op_in(place_op_in(op, 1 / k), k) == op
     assert place_op_in("translate:25.4,-12.7,0", 1 / k) == "translate:1,-0.5,0"
     assert place_op_in("rotate:z:25.4", 1 / k) == "rotate:z:25.4"  # degrees are no length
+    # printed for the user: rounded for the unit (TYPED_DECIMALS), no -0; read back: 12 digits
+    assert place_op_in("translate:50,-23.7,-0.001", 1 / k, 4) == "translate:1.9685,-0.9331,0.0000"
+    assert place_op_in("fit:1", 1 / k, 4) == "fit:0.0394"
+    assert place_op_in("translate:50,-23.7,0", 1 / k) == "translate:1.96850393701,-0.933070866142,0"
     assert fmt_length(50.8, "inch") == "2 in" and fmt_length(50.8) == "50.8 mm"
     assert fmt_volume(25.4 ** 3 * 2, "inch") == "2 in^3" and fmt_volume(1234.4) == "1234 mm^3"
 
@@ -173,7 +177,12 @@ def test_place_in_inches_ranks_what_the_mm_run_ranks_and_prints_inches(tmp_path,
     mm = [float(v) for v in move.split(":")[1].split(",")]
     assert f"--place {move}" in out_mm
     printed = out_inch.split("--place translate:")[1].split()[0]
-    assert [float(v) for v in printed.split(",")] == pytest.approx([v / 25.4 for v in mm])
+    assert [float(v) for v in printed.split(",")] == pytest.approx([v / 25.4 for v in mm], abs=5e-5)
+    # sweep h2 item 3: printed to 0.0001 in (it was 12 significant digits: 1.96850393701), the
+    # JSON's ops in mm as they were
+    assert printed == ",".join(f"{v / 25.4:.4f}" for v in mm), printed
+    assert all(len(op.split(":")[1].split(",")[0].split(".")[1]) == 3
+               for r in rec["in"]["ranked"] for op in r["ops"] if op.startswith("translate:"))
 
 
 def test_gcode_deviation_and_gouges_print_in_inches(tmp_path, monkeypatch, capsys):

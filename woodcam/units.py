@@ -23,6 +23,11 @@ Units = Literal["mm", "inch"]
 #: Millimetres per unit (the inch is exactly 25.4 mm since 1959).
 MM_PER_UNIT: dict[str, float] = {"mm": 1.0, "inch": 25.4}
 _SYMBOL = {"mm": "mm", "inch": "in"}
+#: Decimals of a length printed for the user to type back (``woodcam place``'s ``--place``
+#: operations): mm to the micron (0.001 mm, the rounding of the placements themselves), inches to
+#: the ten-thousandth (0.0001 in = 2.5 um), the last digit a machinist reads in each. Files written
+#: keep their own precision.
+TYPED_DECIMALS: dict[str, int] = {"mm": 3, "inch": 4}
 
 
 def _lengths(mm, units: Units, spec: str, sep: str = "x", form: str | None = None) -> str:

@@ -513,14 +513,22 @@ def _num(v: float) -> str:
     return f"{v:.12g}"
 
 
-def _scaled_numbers(text: str, sep: str, k: float, where=None) -> str:
-    """``text``'s ``sep``-separated numbers times ``k`` (only positions ``where``); a
-    non-number is left as written for the command's own check to name."""
+def _fixed(v: float, decimals: int) -> str:
+    """``v`` with ``decimals`` decimals, never ``-0.000``."""
+    text = f"{v:.{decimals}f}"
+    return f"{0:.{decimals}f}" if float(text) == 0 else text
+
+
+def _scaled_numbers(text: str, sep: str, k: float, where=None, decimals: int | None = None) -> str:
+    """``text``'s ``sep``-separated numbers times ``k`` (only positions ``where``), written with
+    12 significant digits or, for printing, ``decimals`` decimals; a non-number is left as
+    written for the command's own check to name."""
     parts = text.split(sep)
     out = []
+    write = _num if decimals is None else (lambda v: _fixed(v, decimals))
     for i, part in enumerate(parts):
         try:
-            out.append(_num(float(part) * k) if where is None or i in where else part)
+            out.append(write(float(part) * k) if where is None or i in where else part)
         except ValueError:
             out.append(part)
     return sep.join(out)
@@ -558,13 +566,13 @@ def _value_to_mm(kind: str, value, k: float):
     # "spec" is read once at the door and written back in mm: lengths_to_mm)
 
 
-def place_op_in(op: str, k: float) -> str:
-    """A ``--place`` operation with its lengths (translate:X,Y,Z, fit:MARGIN) times ``k``."""
+def place_op_in(op: str, k: float, decimals: int | None = None) -> str:
+    """A ``--place`` operation with its lengths (translate:X,Y,Z, fit:MARGIN) times ``k``, with
+    12 significant digits (a typed op read in mm: nothing lost) or, to print one for the user,
+    ``decimals`` decimals (:data:`woodcam.units.TYPED_DECIMALS` of the unit)."""
     name, _, arg = op.partition(":")
-    if name.lower() == "translate":
-        return f"{name}:{_scaled_numbers(arg, ',', k)}"
-    if name.lower() == "fit" and arg:
-        return f"{name}:{_scaled_numbers(arg, ',', k)}"
+    if name.lower() == "translate" or (name.lower() == "fit" and arg):
+        return f"{name}:{_scaled_numbers(arg, ',', k, decimals=decimals)}"
     return op
 
 

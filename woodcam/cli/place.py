@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..units import MM_PER_UNIT
+from ..units import MM_PER_UNIT, TYPED_DECIMALS
 from .options import (add_input, part_suffixes, output_refused_at_the_door, BLOCK_SPEC_HELP, add_out_option, add_units_option,
                       place_op_in)
 
@@ -68,6 +68,7 @@ def run_place(args: argparse.Namespace) -> int:
         write_bytes(out / "placements.json", json.dumps(record, indent=1).encode())
         with bar.stage("render"):
             png = render_advice(advice, part, stock, out / "placements.png", top=args.top, progress=True)
-    print(advice.table(args.top, op_text=str if k == 1 else (lambda op: place_op_in(op, k))))
+    # the --place ops to type back, rounded for the unit (--units inch: 1.9685, not 1.96850393701)
+    print(advice.table(args.top, op_text=lambda op: place_op_in(op, k, TYPED_DECIMALS[args.units])))
     print(f"scored {advice.candidates} placements; wrote {png} and {out / 'placements.json'}")
     return 0
