@@ -678,8 +678,21 @@ def test_review_and_preview_draw_a_bar_while_the_block_opens(tmp_path, capsys, b
     monkeypatch.setattr(view, "preview", lambda mesh, **kw: opened.append([b.closed for b in bars]))
     assert main(["preview", str(glb)]) == 0
     [bar] = [b for b in bars if b.desc == "preview"]
-    assert bar.enabled and bar.shown[1] == "preview: open block" and bar.n == bar.total == 1
+    assert bar.enabled and bar.shown[1:3] == ["preview: open block", "preview: load viewer"]
+    assert bar.n == bar.total == 2
     assert opened == [[True]]  # the window opened after the bar was gone
+    # sweep h2 item 4: a screenshot spent 6-7 s importing pyvista/VTK and rendering after the
+    # bar had closed, with no word; the bar now runs on over both, and --quiet draws none
+    del bars[:], opened[:]
+    monkeypatch.setattr(view, "preview", lambda mesh, **kw: opened.append([b.closed for b in bars]))
+    assert main(["preview", str(glb), "--screenshot", str(tmp_path / "v.png")]) == 0
+    [bar] = [b for b in bars if b.desc == "preview"]
+    assert bar.enabled and bar.shown[1:4] == ["preview: open block", "preview: load viewer", "preview: render"]
+    assert bar.n == bar.total == 3 and bar.closed and opened == [[False]]  # rendered under the bar
+    del bars[:]
+    assert main(["preview", str(glb), "--screenshot", str(tmp_path / "v.png"), "--no-cut", "--quiet"]) == 0
+    [bar] = [b for b in bars if b.desc == "preview"]
+    assert not bar.enabled and bar.total == 2 and bar.closed  # no block opened without a cut
 
 
 def _foreign_textured_box_glb(path: Path) -> Path:

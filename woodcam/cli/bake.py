@@ -94,6 +94,7 @@ def register(subparsers) -> None:
                    help="colour the part by the fit's per-point confidence (red 0, yellow 0.5, green "
                    "1; spread of the accepted hypotheses and distance from observed faces) "
                    "instead of its wood")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run_preview)
 
     p = subparsers.add_parser("blocks", help="list the built-in synthetic blocks")
@@ -197,33 +198,44 @@ def run_preview(args: argparse.Namespace) -> int:
         warnings.warn(f"{' and '.join(given)} place{'s' if len(given) == 1 else ''} the cut plane, which "
                       "--no-cut leaves out: "
                       "ignored; drop --no-cut to see that cut", WoodcamWarning, stacklevel=2)
-    if args.no_cut and not args.block and not args.confidence:
-        # no cut plane, no wood shown inside: the baked texture and the block's recorded size
-        # are all it needs (the block folder it was baked from may be gone, or slow to fit)
-        size = recorded_block_size(args.mesh)
-        out = preview(args.mesh, size_mm=size, screenshot=screenshot_path(args.screenshot, args.mesh),
-                      camera=camera_of(args), cut_plane=False)
-        if out:
-            print(f"wrote {out}")
-        return 0
     from .._progress import StageBar
+    from ..view.scene import load_viewer
 
-    # a bar while the block opens: its field is fitted again where the cache lacks it (H11: 20-30 s
-    # with none); closed before the window opens
-    with StageBar(["open block"], desc="preview", leave=False) as bar, bar.stage("open block"):
-        stock = stock_of_glb(args.mesh, args.block, units=args.units, typed=as_typed(args, "block"))
-    wood = stock.wood if stock else None
-    if args.confidence:
-        from ..inference.evidence import ConfidenceWood
+    # no cut plane, no wood shown inside: the baked texture and the block's recorded size are
+    # all it needs (the block folder it was baked from may be gone, or slow to fit)
+    bare = args.no_cut and not args.block and not args.confidence
+    shot = screenshot_path(args.screenshot, args.mesh)
+    # one bar over the run: the block's field is fitted again where the cache lacks it (H11:
+    # 20-30 s), pyvista and VTK import in seconds and a screenshot renders in seconds more (it
+    # was 6-7 s with no word); closed before a window opens
+    stages = [*([] if bare else ["open block"]), "load viewer", *(["render"] if shot else [])]
+    with StageBar(stages, desc="preview", leave=False, enabled=not args.quiet) as bar:
+        if bare:
+            stock, size = None, recorded_block_size(args.mesh)
+        else:
+            with bar.stage("open block"):
+                stock = stock_of_glb(args.mesh, args.block, units=args.units, typed=as_typed(args, "block"))
+            size = stock.size_mm if stock else None
+        wood = stock.wood if stock else None
+        if args.confidence:
+            from ..inference.evidence import ConfidenceWood
 
-        if stock is None or not getattr(stock.wood, "has_uncertainty", False):
-            raise WoodcamError("--confidence needs a block whose field was fitted (a block folder "
-                               "without a true field, or a Mokume folder); pass --block")
-        wood = ConfidenceWood(stock.wood)  # read where its years are (turned, resized)
-    out = preview(args.mesh, wood=wood, size_mm=stock.size_mm if stock else None,
-                  screenshot=screenshot_path(args.screenshot, args.mesh),
-                  camera=camera_of(args), cut_plane=not args.no_cut, cut_origin=args.cut_origin,
-                  cut_normal=args.cut_normal)
+            if stock is None or not getattr(stock.wood, "has_uncertainty", False):
+                raise WoodcamError("--confidence needs a block whose field was fitted (a block folder "
+                                   "without a true field, or a Mokume folder); pass --block")
+            wood = ConfidenceWood(stock.wood)  # read where its years are (turned, resized)
+        with bar.stage("load viewer"):
+            load_viewer()
+
+        def show():
+            return preview(args.mesh, wood=wood, size_mm=size, screenshot=shot, camera=camera_of(args),
+                           cut_plane=not args.no_cut, cut_origin=args.cut_origin, cut_normal=args.cut_normal)
+
+        if shot:
+            with bar.stage("render"):
+                out = show()
+    if not shot:
+        out = show()  # the window, once the bar is gone
     if out:
         print(f"wrote {out}")
     return 0

@@ -182,6 +182,13 @@ def _pyvista():
     return require("pyvista", "view", "the preview")
 
 
+def load_viewer() -> None:
+    """Import pyvista and VTK now, as :func:`preview` does first: seconds on a cold start (6-7 s
+    measured), which a command shows a bar over (``woodcam preview``); missing, the error
+    names the install command."""
+    _pyvista()
+
+
 def _plotter(pv, **kwargs):
     """A ``pv.Plotter(**kwargs)`` of woodcam's views, drawn with pyvista's own default theme
     (its DocumentTheme), never ``pyvista.global_theme``: a user's script that set
