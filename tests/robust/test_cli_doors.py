@@ -97,9 +97,15 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["eval", "appearance", "builtin:flat-sawn", "--end-grain", "A,sides", "--out", "OUT/ea"], EXIT_USAGE,
      r"--end-grain must be a comma list of faces from .*; got 'sides'$"),
     (["bench", "run", "--blocks", "1", "--methods", "rbf,bogus", "--out", "OUT/b"], EXIT_USAGE,
-     r"--methods must be from evidence, rbf, radial, neural; got \['bogus'\]"),
+     r"--methods must be from evidence, rbf, radial, neural; got 'rbf,bogus', in which 'bogus' is none of "
+     r"them; e.g. --methods evidence,rbf$"),
     (["eval", "realistic", "--seed", "1", "--scenarios", "bogus", "--out", "OUT/e"], EXIT_USAGE,
-     r"--scenarios must be from clean, noisy, ring-maps; got \['bogus'\]"),
+     r"--scenarios must be from clean, noisy, ring-maps; got 'bogus', in which 'bogus' is none of them; "
+     r"e.g. --scenarios clean,noisy$"),
+    # sweep h2: the names as typed (it was a Python list, "got ['evidnce']"), the near one offered
+    (["eval", "rings", "builtin:flat-sawn", "--methods", "evidnce,rbf", "--out", "OUT/e"], EXIT_USAGE,
+     r"--methods must be from evidence, rbf, radial, neural, or all; got 'evidnce,rbf', in which 'evidnce' is "
+     r"none of them; did you mean 'evidence'\?$"),
     (["eval", "realistic", "--seed", "5", "--faces", "full,full", "--out", "OUT/e"], EXIT_USAGE,
      r"--faces must be a comma list from full, three, each name once; got 'full,full'"),
     # eval realistic dropped empty names ('rbf,,radial') where fit refused them: one parser now

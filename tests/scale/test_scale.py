@@ -469,4 +469,5 @@ def test_cli_bench_run_and_report(tmp_path, capsys):
     # 'methods must be a comma-separated subset ...', exit 1)
     assert main(["bench", "run", "--blocks", "1", "--methods", "radial,splines", "--out", run]) == EXIT_USAGE
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["woodcam: error: --methods must be from evidence, rbf, radial, neural; got ['splines']"]
+    assert err == ["woodcam: error: --methods must be from evidence, rbf, radial, neural; got 'radial,splines', "
+                   "in which 'splines' is none of them; e.g. --methods evidence,rbf"]

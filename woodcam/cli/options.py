@@ -942,8 +942,13 @@ def comma_names(text: str, option: str, choices: tuple[str, ...] = (), *,
         among = f" from {', '.join(choices)}" if choices else ""
         raise UsageError(f"{option} must be {whole}a comma list{among}, each name once; got {text!r}")
     bad = [n for n in names if choices and n not in choices]
-    if bad:
-        raise UsageError(f"{option} must be from {', '.join(choices)}; got {bad}")
+    if bad:  # said as typed, with the names it is not (it was a Python list: "got ['foo']")
+        from .._checks import did_you_mean
+
+        fix = did_you_mean(bad[0], choices) or f"e.g. {option} {','.join(choices[:2])}"
+        raise UsageError(f"{option} must be from {', '.join(choices)}{', or all' if all_ else ''}; got "
+                         f"{text!r}, in which {', '.join(map(repr, bad))} {'is' if len(bad) == 1 else 'are'} "
+                         f"none of them; {fix}")
     return names
 
 
