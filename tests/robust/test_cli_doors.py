@@ -22,7 +22,9 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["gcode", "toolpaths/vcarve_text.nc", "--tool", "vbit:60:12", "--block", "builtin:flat-sawn",
       "--out", "OUT/x.glb", "--resolution", "1e-9"], EXIT_USAGE, r"--cell-size must be in \[0.005, 10\]"),
     ([*BAKE, "--out", "OUT/x.glb", "--tolerance", "0"], EXIT_USAGE, r"--tolerance must be in \(0, 10\]; got 0.0"),
-    ([*BAKE, "--out", "OUT/x.glb", "--tolerance", "nan"], EXIT_USAGE, r"--tolerance must be a finite number"),
+    # sweep h2: a non-finite number was told neither the range nor the help ("got nan" and no fix)
+    ([*BAKE, "--out", "OUT/x.glb", "--tolerance", "nan"], EXIT_USAGE,
+     r"--tolerance must be a finite number in \(0, 10\]; got nan; see 'woodcam bake --help' for its meaning and default$"),
     ([*BAKE, "--out", "OUT/x.glb", "--texels-per-mm", "inf"], EXIT_USAGE, r"--texels-per-mm must be a finite"),
     ([*BAKE, "--out", "OUT/x.glb", "--texels-per-mm", "1e6"], EXIT_USAGE, r"--texels-per-mm must be in"),
     ([*BAKE, "--out", "OUT/x.glb", "--timeout=-1"], EXIT_USAGE, r"--timeout must be in \(0"),

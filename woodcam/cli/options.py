@@ -1402,17 +1402,18 @@ def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND") 
 
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return
-    if isinstance(value, float) and not math.isfinite(value):
-        raise UsageError(f"{option} must be a finite number; got {value!r}")
+    help_ = f"see 'woodcam {command} --help' for its meaning and default"
+    lo, hi, lo_open, hi_open = (*rng, False)[:4] if rng is not None else (None, None, False, False)
+    span = "" if rng is None else (f"{'(' if lo_open else '['}{_bound(lo)}, {_bound(hi)}{')' if hi_open else ']'}"
+                                   f"{' mm' if typed is not None else ''}")
+    if isinstance(value, float) and not math.isfinite(value):  # the range and the help too (it said neither)
+        got = repr(value) if typed is None else f"{typed[0]!r} {typed[1]}"
+        raise UsageError(f"{option} must be a finite number{' in ' + span if span else ''}; got {got}; {help_}")
     if rng is None:
         return
-    lo, hi, lo_open, hi_open = (*rng, False)[:4]
     if value < lo or value > hi or (lo_open and value <= lo) or (hi_open and value >= hi):
         got = f"{value!r}" if typed is None else f"{typed[0]!r} {typed[1]} = {value:g} mm"
-        raise UsageError(f"{option} must be in {'(' if lo_open else '['}{_bound(lo)}, {_bound(hi)}"
-                         f"{')' if hi_open else ']'}"
-                         f"{' mm' if typed is not None else ''}; got {got}; see 'woodcam {command} --help' "
-                         "for its meaning and default")
+        raise UsageError(f"{option} must be in {span}; got {got}; {help_}")
 
 
 def check_numbers(args: argparse.Namespace) -> None:
