@@ -228,6 +228,11 @@ def test_work_offset_must_be_three_finite_numbers(value, capsys):
     (["bake", "x.py", "--block", "builtin:flat-sawn", "--out", "x.glb", "--tolerance", "abc"], "woodcam bake"),
     (["nosuch"], "woodcam"),  # an unknown command
     (["block", "synth", "--count", "x"], "woodcam block synth"),
+    # sweep h2: an argument no parser takes was said by the top parser, pointing at 'woodcam
+    # --help', which lists none of the command's options; now the command's, with the near option
+    (["block", "show", "builtin:rift", "--out", "x.png", "--bogus"], "woodcam block show"),
+    (["cache", "info", "extra"], "woodcam cache info"),
+    (["bake", "x.py", "--block", "builtin:rift", "--out", "x.glb", "--tolerence", "0.1"], "woodcam bake"),
 ])
 def test_usage_errors_are_one_line_with_a_pointer_to_help(argv, prog, capsys):
     """argparse's own errors printed the whole usage block (up to 15 lines) before the error."""
@@ -237,6 +242,10 @@ def test_usage_errors_are_one_line_with_a_pointer_to_help(argv, prog, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1, err
     assert err.startswith(f"{prog}: error: ") and err.rstrip().endswith(f"(see '{prog} --help')"), err
+    if "--tolerence" in argv:
+        assert "unrecognized arguments: --tolerence 0.1; did you mean --tolerance? (see" in err, err
+    if "--bogus" in argv:
+        assert "did you mean" not in err, err  # every option shares its dashes: no false match
 
 
 def test_an_unexpected_error_is_one_line_and_a_wrapped_ctrl_c_is_an_interrupt(monkeypatch, capsys):

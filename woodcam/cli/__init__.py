@@ -194,11 +194,33 @@ def main(argv: list[str] | None = None) -> int:
     with _interrupt.handling():
         try:
             parser = build_parser()
-            args = parser.parse_args(_apply_aliases(list(sys.argv[1:] if argv is None else argv), parser))
+            args, extra = parser.parse_known_args(_apply_aliases(list(sys.argv[1:] if argv is None else argv), parser))
+            if extra:  # said by the command's own parser: its --help lists its options
+                _unrecognized(parser, args, extra)
         except KeyboardInterrupt:
             print("woodcam: interrupted", file=sys.stderr)
             return EXIT_INTERRUPTED
         return _run(args, parser)
+
+
+def _unrecognized(parser: argparse.ArgumentParser, args: argparse.Namespace, extra: list[str]) -> None:
+    """Exit 2 for the arguments ``extra`` no parser took, said by the parser of the command run
+    and with the option nearest a mistyped one: argparse says it of the top parser, so
+    'woodcam block show B --out x.png --bogus' pointed at 'woodcam --help', which lists no option
+    of ``block show``."""
+    path = tuple(str(getattr(args, k)) for k in vars(args)
+                 if (k == "command" or k.endswith("_command")) and getattr(args, k) is not None)
+    own = next((sp for p, _help, sp in _commands(parser) if p == path), parser)
+    message = f"unrecognized arguments: {' '.join(extra)}"
+    # compared without the dashes: every option shares them ('--bogus' was near '--out')
+    options = [o[2:] for a in own._actions for o in a.option_strings if o.startswith("--")]
+    typed = [e.split("=")[0][2:] for e in extra if e.startswith("--")]
+    if typed:
+        from .._checks import did_you_mean
+
+        near = did_you_mean(typed, options, show=lambda o: f"--{o}")
+        message += f"; {near}" if near else ""
+    own.error(message)
 
 
 def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
