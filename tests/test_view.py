@@ -611,6 +611,26 @@ def test_interactive_without_display_says_use_screenshot(monkeypatch):
         preview(_textured_box(), size_mm=SIZE)
 
 
+def test_preview_without_display_says_so_before_the_work(monkeypatch, tmp_path, glb_with, bars, capsys):
+    """'woodcam preview PART.glb' without a display opened the block (a fit where the cache
+    lacks it: seconds to minutes) and loaded pyvista before saying it needs one; it now says so
+    first, with the command that renders a picture instead."""
+    from woodcam.cli import EXIT_ERROR, main
+
+    monkeypatch.setattr(view.scene.sys, "platform", "linux")
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    opened = []
+    monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda *a, **k: opened.append(a))
+    glb = glb_with({"block": "builtin:rift"}, tmp_path / "p.glb")
+    assert main(["preview", str(glb)]) == EXIT_ERROR
+    err = capsys.readouterr().err.splitlines()
+    assert err == [f"woodcam: error: preview: an interactive window needs a display, but neither DISPLAY nor "
+                   f"WAYLAND_DISPLAY is set; render a picture instead with: woodcam preview {glb} --screenshot "
+                   f"(writes {tmp_path / 'p_view.png'})"], err
+    assert not opened and not [b for b in bars if b.desc == "preview"]  # no work began
+
+
 @pytest.mark.parametrize(
     "wood, match",
     [

@@ -4,6 +4,7 @@ wood, look at it."""
 from __future__ import annotations
 
 import argparse
+import shlex
 from pathlib import Path
 
 from ..errors import WoodcamError
@@ -199,12 +200,15 @@ def run_preview(args: argparse.Namespace) -> int:
                       "--no-cut leaves out: "
                       "ignored; drop --no-cut to see that cut", WoodcamWarning, stacklevel=2)
     from .._progress import StageBar
-    from ..view.scene import load_viewer
+    from ..view.scene import check_display, load_viewer
 
+    shot = screenshot_path(args.screenshot, args.mesh)
+    if not shot:  # before the block opens (a fit: seconds to minutes) and pyvista loads
+        check_display("preview", "render a picture instead with: woodcam preview "
+                      f"{shlex.quote(str(args.mesh))} --screenshot (writes {shlex.quote(str(screenshot_path(True, args.mesh)))})")
     # no cut plane, no wood shown inside: the baked texture and the block's recorded size are
     # all it needs (the block folder it was baked from may be gone, or slow to fit)
     bare = args.no_cut and not args.block and not args.confidence
-    shot = screenshot_path(args.screenshot, args.mesh)
     # one bar over the run: the block's field is fitted again where the cache lacks it (H11:
     # 20-30 s), pyvista and VTK import in seconds and a screenshot renders in seconds more (it
     # was 6-7 s with no word); closed before a window opens

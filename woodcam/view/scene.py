@@ -613,6 +613,16 @@ def _display_available() -> bool:
     return True
 
 
+def check_display(who: str, fix: str) -> None:
+    """Raise a :class:`WoodcamError` when no interactive window can open (Linux without
+    DISPLAY or WAYLAND_DISPLAY), before the work: ``who`` wants the window, ``fix`` says how to
+    render a picture instead. The one rule of every window (:func:`preview`, ``woodcam gcode
+    --view``, ``woodcam preview``, which opened its block and loaded pyvista before it was told)."""
+    if not _display_available():
+        raise WoodcamError(f"{who}: an interactive window needs a display, but neither DISPLAY nor "
+                           f"WAYLAND_DISPLAY is set; {fix}")
+
+
 def _prefer_egl_off_screen() -> None:
     """Off screen on Linux without a display, make VTK pick its EGL window directly.
 
@@ -895,12 +905,9 @@ def preview(
         from .._atomic import check_output_path
 
         check_output_path(screenshot, what="screenshot", mkdir=True)
-    if screenshot is None and not _display_available():
-        raise WoodcamError(
-            "preview: an interactive window needs a display, but neither DISPLAY nor "
-            "WAYLAND_DISPLAY is set; render off-screen instead with screenshot='part.png' "
-            "(CLI: woodcam preview PART --screenshot part.png)"
-        )
+    if screenshot is None:
+        check_display("preview", "render off-screen instead with screenshot='part.png' "
+                      "(CLI: woodcam preview PART --screenshot part.png)")
     # Check the mesh and options before a window opens.
     opt = SceneOptions.merged(options, scene_options)
     overlay = check_overlay(overlay)

@@ -177,12 +177,10 @@ def add_line_slider(plotter, callback: ScrubCallback, *, value: int | None = Non
 
 def check_display() -> None:
     """Raise a :class:`WoodcamError` when no window can open (no display): before the work."""
-    from .scene import _display_available
+    from .scene import check_display as check
 
-    if not _display_available():
-        raise WoodcamError("woodcam gcode --view: the window needs a display, but neither "
-                           "DISPLAY nor WAYLAND_DISPLAY is set; render a picture instead with "
-                           "--screenshot (and --until-line N for a scrubbed frame)")
+    check("woodcam gcode --view", "render a picture instead with --screenshot (and --until-line N "
+          "for a scrubbed frame)")
 
 
 def gcode_window(program, tools, stock, *, work_offset_mm=None, resolution_mm: float = 0.1,
