@@ -94,3 +94,18 @@ def test_a_folder_where_an_entry_belongs_is_replaced_by_the_entry(tmp_path, monk
             warnings.simplefilter("ignore")
             load_or_build(entry, load=lambda p: p.read_bytes(), build=build, save=lambda v, p: p.write_bytes(v))
     assert entry.is_file() and len(builds) == 1
+
+
+def test_the_cache_help_names_every_kind_it_holds():
+    """'woodcam cache --help' and the command list said "fitted fields, colour volumes" while
+    'cache info' counts ring detections too (the detect folder) and 'cache clear --kind' takes
+    it: each help now names every kind of CACHE_KINDS, with its folder's name."""
+    from woodcam._cache import CACHE_KINDS
+    from woodcam.cli import _commands, build_parser
+
+    helps = {path: (text, sp) for path, text, sp in _commands(build_parser())}
+    text, cache = helps[("cache",)]
+    clear = " ".join(helps[("cache", "clear")][1].format_help().split())
+    for kind in CACHE_KINDS:
+        assert f"({kind})" in cache.description and f"({kind})" in clear, (kind, cache.description, clear)
+    assert "ring detections" in text and "ring detections (detect)" in cache.description, text

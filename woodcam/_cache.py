@@ -74,6 +74,9 @@ def check_cache_root() -> Path:
 #: The kinds of cache entry, one folder each: fitted fields (``woodcam.stock``), neural colour
 #: volumes (``woodcam.appearance.neural``) and ring detections (``woodcam.detect.block``).
 CACHE_KINDS: tuple[str, ...] = ("appearance", "detect", "fields")
+#: What each kind's entries are, for ``woodcam cache``'s help.
+CACHE_KIND_TEXT: dict[str, str] = {"fields": "fitted growth fields", "appearance": "neural colour volumes",
+                                   "detect": "ring detections"}
 
 
 def cache_dir(kind: str) -> Path:

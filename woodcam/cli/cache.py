@@ -9,23 +9,24 @@ from .options import uses_settings
 
 def register(subparsers) -> None:
     """Add ``cache info`` and ``cache clear``."""
+    from .._cache import CACHE_KIND_TEXT, CACHE_KINDS
+
+    kinds = [f"{CACHE_KIND_TEXT[k]} ({k})" for k in CACHE_KINDS]
+    listed = f"{', '.join(kinds[:-1])} and {kinds[-1]}"
     p = subparsers.add_parser(
-        "cache", help="show or clear woodcam's caches (fitted fields, colour volumes)",
-        description="woodcam caches fitted growth fields and neural colour volumes under "
-        "$WOODCAM_CACHE_DIR or the user cache folder ($XDG_CACHE_HOME/woodcam, ~/.cache/woodcam), "
-        "keyed by content; the least recently used entries are dropped above "
-        "$WOODCAM_CACHE_MAX_MB (default 2048 MiB).")
+        "cache", help=f"show or clear woodcam's caches ({', '.join(CACHE_KIND_TEXT[k] for k in CACHE_KINDS)})",
+        description=f"woodcam caches {listed} under $WOODCAM_CACHE_DIR (a folder) or the user cache "
+        "folder ($XDG_CACHE_HOME/woodcam, ~/.cache/woodcam), keyed by content; the least recently used "
+        "entries are dropped above $WOODCAM_CACHE_MAX_MB (default 2048 MiB).")
     sub = p.add_subparsers(dest="cache_command", metavar="ACTION")
     sub.required = True
     info = sub.add_parser("info", help="where the cache is and how much it holds")
     info.set_defaults(func=run_info)
     uses_settings(info, "cache_dir", "cache_max")  # a malformed WOODCAM_WORKERS must not hide the cache
     clear = sub.add_parser("clear", help="delete cache entries (they are rebuilt when needed)")
-    from .._cache import CACHE_KINDS
-
     clear.add_argument("--kind", default=None, choices=CACHE_KINDS,
-                       help="only this kind of entry: fitted fields, neural colour volumes "
-                       "(appearance) or ring detections (detect) (default: all)")
+                       help=f"only this kind of entry: {' or '.join([', '.join(kinds[:-1]), kinds[-1]])} "
+                       "(default: all)")
     clear.set_defaults(func=run_clear)
     uses_settings(clear, "cache_dir")  # a cache can be cleared whatever the other settings say
 
