@@ -548,7 +548,7 @@ def test_running_out_of_wood_stops_with_a_message_and_writes(sheets, tmp_path):
     prm = ParquetryParams(image_size_mm=140, px_per_mm=PPM)
     # said before the matching: the sheet holds less wood than the panel takes
     with pytest.warns(WoodcamWarning, match=r"^the veneers cannot cover the panel \(target0 210 x 140 mm\): they hold "
-                      r"9600 mm\^2 of usable wood, .* so at most 15% of it can be made"):
+                      r"9204 mm\^2 of usable wood half the kerf in from its edges, .* so at most 12% of it can be made"):
         run = build_parquetry(data.coffee().astype(np.float32) / 255, sheets[:1], prm)
     assert not run.complete
     assert f"placed {len(run.patches)} patches" in run.message
@@ -558,6 +558,29 @@ def test_running_out_of_wood_stops_with_a_message_and_writes(sheets, tmp_path):
     v = run.veneers[0]
     n = rasterise(read_svg_pieces(tmp_path / f"veneer_{v.id}.svg"), v.mask.shape, v.px_per_mm)
     assert n.max() == 1 and len(run.patches) > 5
+
+
+def test_too_little_wood_counts_the_kerf():
+    """The too-little-wood warning left the kerf out, so a job that fitted only without it was
+    not warned of and ran out: four 10 mm patches from a 20 x 30 mm sheet at a 2 mm kerf (600
+    mm^2 against 400) placed 2. Each piece now takes its window grown by half the kerf (10 x 10
+    + 2 x 20 + pi = 143.1 mm^2) from the wood half the kerf in from the sheet's edges (18 x 28
+    mm); without a kerf the same job fits, and a sheet with room for the kerf is not warned of."""
+    target = np.zeros((20, 20, 3), np.float32)
+
+    def run(kerf_mm, h, w):
+        prm = ParquetryParams(px_per_mm=1.0, patch_mm=10, overlap_mm=0, kerf_mm=kerf_mm, image_size_mm=20, n_rot=1)
+        v = Veneer("s", np.full((h, w, 3), 0.5, np.float32), 1.0, np.ones((h, w), bool))
+        return build_parquetry(target, [v], prm, seams=False)
+
+    assert run(0.0, 20, 30).complete  # no warning (an error here)
+    with pytest.warns(WoodcamWarning, match=r"^the veneers cannot cover the panel \(target0 20 x 20 mm\): they hold "
+                      r"504 mm\^2 of usable wood half the kerf in from its edges, and the 4 patches of 10 mm, each "
+                      r"piece with its 0 mm overlap and the 2 mm kerf round it, every piece of wood used once, take "
+                      r"at least 573 mm\^2, so at most 88% of it can be made; add at least 69 mm\^2 of veneer"):
+        short = run(2.0, 20, 30)
+    assert not short.complete and len(short.patches) == 2
+    assert run(2.0, 14, 60).complete  # 12 x 58 = 696 mm^2 clear of the kerf: no warning
 
 
 def test_a_rerun_without_a_job_removes_the_old_job_file_and_says_what_it_removed(sheets, tmp_path):

@@ -738,13 +738,17 @@ def test_the_default_panel_size_is_said_and_too_little_wood_up_front(scans, caps
     assert ("panel: shorter side 14.33 in (364 mm), the default --image-size-mm 360 (the paper's) in whole patches "
             "of 14 mm, the target's aspect kept; give --image-size-mm (mm) to choose it") in cap.out, cap.out
     assert "coffee: 39 x 26 cells, 546 x 364 mm (21.5 x 14.33 in)," in cap.out, cap.out
-    # the wood: 320 x 240 px at 2 px/mm, 19200 mm^2; the panel's 39 x 26 cells of 28 px, each
-    # window 7 px (3.5 mm) wider on the sides inside the panel: (37 * 42 + 2 * 35) x (24 * 42 +
-    # 2 * 35) px = 437668 mm^2
-    wood, need = 19200 / 25.4 ** 2, (37 * 42 + 2 * 35) * (24 * 42 + 2 * 35) / 4 / 25.4 ** 2
+    # the wood: 320 x 240 px at 2 px/mm less 2 px (half the default 2 mm kerf, the tool
+    # diameter) at each edge, 316 x 236 px = 18644 mm^2; the panel's 39 x 26 cells of 28 px,
+    # each window 7 px (3.5 mm) wider on the sides inside the panel: (37 * 42 + 2 * 35) x (24 *
+    # 42 + 2 * 35) px, each window also grown by half the 4 px kerf: + 4 (h + w) + pi 4 px^2
+    sw, sh = 37 * 42 + 2 * 35, 24 * 42 + 2 * 35
+    wood = 316 * 236 / 4 / 25.4 ** 2
+    need = (sw * sh + 4 * (39 * sh + 26 * sw) + 1014 * np.pi * 4) / 4 / 25.4 ** 2
     assert (f"woodcam: warning: the veneers cannot cover the panel (coffee 21.5 x 14.33 in): they hold {wood:.4g} "
-            "in^2 of usable wood, and the 1014 patches of 0.5512 in, each piece with its 0.1378 in overlap and every "
-            f"piece of wood used once, take at least {need:.4g} in^2, so at most {100 * wood / need:.2g}% of it can be "
+            "in^2 of usable wood half the kerf in from its edges, and the 1014 patches of 0.5512 in, each piece with "
+            "its 0.1378 in overlap and the 0.07874 in kerf round it, every piece of wood used once, take at least "
+            f"{need:.4g} in^2, so at most {100 * wood / need:.2g}% of it can be "
             f"made; add at least {need - wood:.4g} in^2 of veneer, or make the panel smaller (image_size_mm, "
             "--image-size-mm)") in cap.err, cap.err
     assert "make the panel smaller (image_size_mm, --image-size-mm)" in cap.out

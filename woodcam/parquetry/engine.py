@@ -350,8 +350,8 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
 
     if params.single_use:
         _say_too_little_wood(panels, sheets, params,
-                             sum((y1 - y0) * (x1 - x0) for _, k, r, c, n in queue
-                                 for y0, x0, y1, x1 in [window(panels[k], r, c, n)]))
+                             [(y1 - y0, x1 - x0) for _, k, r, c, n in queue
+                              for y0, x0, y1, x1 in [window(panels[k], r, c, n)]])
     def place(p: Parquetry, r: int, c: int, n: int) -> None:
         g = window(p, r, c, n)
         tmpl = np.ascontiguousarray(p.target_feats[g[0]:g[2], g[1]:g[3]])
@@ -421,27 +421,46 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
 
 
 def _say_too_little_wood(panels: list[Parquetry], sheets: list[Veneer], params: ParquetryParams,
-                         need_px: float) -> None:
-    """A WoodcamWarning, before any matching, when the sheets' usable wood is less than
-    ``need_px`` (working pixels): what the panels' top-level patches take with their overlap,
-    each the least wood its square takes (its four children's windows cover its own), every
-    piece of wood used once. The run went on to 'ran out of free wood' with no word of why: a
-    default 364 mm panel from a 51 mm scan placed 2 of 676 cells. The kerf round each piece
-    and the sheets' edges are left out, so the bound is short of the wood a run needs."""
+                         windows: list[tuple[int, int]]) -> None:
+    """A WoodcamWarning, before any matching, when the sheets' usable wood is less than the
+    panels' top-level patches take: ``windows`` their ``(h, w)`` working pixels with the
+    overlap, each the least wood its square takes (its four children's windows cover its own),
+    every piece of wood used once. The run went on to 'ran out of free wood' with no word of
+    why: a default 364 mm panel from a 51 mm scan placed 2 of 676 cells.
+
+    The kerf counts (a job that passed without it ran out: two 10 mm pieces of four on a 14 x
+    30 mm sheet at a 2 mm kerf): two pieces stay ``kerf`` apart and a piece that far from the
+    sheet's edge and unusable wood (``SheetBank.clears_edges``), so each piece grown by half
+    the kerf (``h w + k (h + w) + pi k^2 / 4``) is wood no other piece's takes, and it lies on
+    the usable wood shrunk by half the kerf (pixels whose centres lie that far inside it). A
+    lower bound still: the wood between rotated pieces and round the sheets' corners is not
+    counted."""
+    from scipy.ndimage import distance_transform_edt
+
     from ..errors import WoodcamWarning
     from ..units import say_area
 
-    wood_px = float(sum(int(np.count_nonzero(v.mask)) for v in sheets))
+    k = params.kerf * params.px_per_mm
+    if k > 0:  # centre to the nearest off-wood pixel's centre: its side is half a pixel nearer
+        wood_px = float(sum(int(np.count_nonzero(
+            distance_transform_edt(np.pad(v.mask, 1, constant_values=False))[1:-1, 1:-1] >= k / 2 + 0.5))
+            for v in sheets))
+    else:
+        wood_px = float(sum(int(np.count_nonzero(v.mask)) for v in sheets))
+    hw = np.asarray(windows, float).reshape(-1, 2)
+    need_px = float((hw[:, 0] * hw[:, 1] + k * hw.sum(1) + np.pi * k * k / 4).sum())
     if wood_px >= 0.98 * need_px:  # a rotated footprint's pixels may fall a little short of its area
         return
     import warnings
 
     px2 = params.px_per_mm ** 2
     sizes = ", ".join(f"{p.name} {say_length(p.size_mm, 'g', ' x ')}" for p in panels)
+    kerf = f" and the {say_length(params.kerf, 'g')} kerf round it" if k > 0 else ""
     warnings.warn(
         f"the veneers cannot cover the panel{'s' if len(panels) > 1 else ''} ({sizes}): they hold "
-        f"{say_area(wood_px / px2, '.0f')} of usable wood, and the {sum(p.cells.size for p in panels)} patches of "
-        f"{say_length(params.patch_mm, 'g')}, each piece with its {say_length(params.overlap, 'g')} overlap and "
+        f"{say_area(wood_px / px2, '.0f')} of usable wood{' half the kerf in from its edges' if k > 0 else ''}, and the "
+        f"{sum(p.cells.size for p in panels)} patches of "
+        f"{say_length(params.patch_mm, 'g')}, each piece with its {say_length(params.overlap, 'g')} overlap{kerf}, "
         f"every piece of wood used once, take at least {say_area(need_px / px2, '.0f')}, so at most "
         f"{100 * wood_px / need_px:.2g}% of it can be made; add at least "
         f"{say_area((need_px - wood_px) / px2, '.0f')} of veneer, or make the panel smaller (image_size_mm, "
