@@ -12,7 +12,9 @@ axes ``S`` used, ``p_d = (T - T_d) / (o_d h)`` (neighbour at ``x + o_d h e_d``) 
 components are those that keep the characteristic ``v = p / |p| + w`` inside the simplex
 (``p_j = -w_j |p|``), giving one quadratic in ``T``. A solution counts only when its
 characteristic points from the neighbours into the node (causality); the smallest valid one
-wins. For one axis it is the exact Randers length of the grid step. Obstacle nodes never
+wins. For one axis it is the exact Randers length of the grid step. Along an axis with two
+marched (or first-layer) nodes the difference is second order; a start node inside the input
+is only ever the near node (see ``SOURCE``). Obstacle nodes never
 accept a value, so fronts wrap round them; disjoint fronts merge by the min of the heap.
 """
 
@@ -23,7 +25,13 @@ import heapq
 import numba
 import numpy as np
 
-FAR, TRIAL, ACCEPTED, BLOCKED, FIXED = 0, 1, 2, 3, 4
+FAR, TRIAL, ACCEPTED, BLOCKED, FIXED, SOURCE = 0, 1, 2, 3, 4, 5
+# SOURCE: a start node inside the input, fixed at ``T = -distance``. That is no smooth function
+# across the surface (a kink where the nearest face changes: a box's edges, its medial planes),
+# so a SOURCE node may be the near node of an update but never the far node of a second-order
+# difference: a node on a box's face plane past its edge holds 0, not the -2.7 mm the line
+# through it wants, and every node beyond that edge arrived 0.4 of a step early (the box grew
+# 0.39 of a step too far at resolution 27).
 
 
 @numba.njit(cache=True, nogil=True)
@@ -107,7 +115,7 @@ def _node_update(T, state, i, j, k, g, wx, wy, wz, h, order, slack, nb, nb2, av,
                 else:
                     kk = c
                 st = state[ii, jj, kk]
-                if st != ACCEPTED and st != FIXED:
+                if st != ACCEPTED and st != FIXED and (st != SOURCE or step > 1):
                     break
                 if step == 1:
                     nb[d, s] = T[ii, jj, kk]
@@ -157,7 +165,8 @@ def _node_update(T, state, i, j, k, g, wx, wy, wz, h, order, slack, nb, nb2, av,
 @numba.njit(cache=True, nogil=True)
 def march(T, state, gain, wind, h, order=2, reopen_tol=1e-3, slack_nodes=1.0):  # pragma: no cover - compiled
     """Fast marching in place. ``T (nx, ny, nz) float64`` holds the accepted start values;
-    ``state (nx, ny, nz) int8`` is FIXED there, BLOCKED on obstacles, FAR elsewhere.
+    ``state (nx, ny, nz) int8`` is SOURCE inside the input, FIXED on the first layer outside
+    it (exact values), BLOCKED on obstacles, FAR elsewhere.
     ``gain`` is ``(nx, ny, nz)`` or ``(1, 1, 1)`` (constant); ``wind`` ``(.., 3)`` likewise.
     Unreached nodes keep ``inf``."""
     nx, ny, nz = T.shape
@@ -175,7 +184,7 @@ def march(T, state, gain, wind, h, order=2, reopen_tol=1e-3, slack_nodes=1.0):  
     for i in range(nx):
         for j in range(ny):
             for k in range(nz):
-                if state[i, j, k] != FIXED:
+                if state[i, j, k] != FIXED and state[i, j, k] != SOURCE:
                     continue
                 for o in offs:
                     a, b, c = i + o[0], j + o[1], k + o[2]
@@ -213,7 +222,7 @@ def march(T, state, gain, wind, h, order=2, reopen_tol=1e-3, slack_nodes=1.0):  
             if a < 0 or b < 0 or c < 0 or a >= nx or b >= ny or c >= nz:
                 continue
             st = state[a, b, c]
-            if st == BLOCKED or st == FIXED:
+            if st == BLOCKED or st == FIXED or st == SOURCE:
                 continue
             gi = gain[0, 0, 0] if gconst else gain[a, b, c]
             # the accepted node sits at -o from (a, b, c): axis fa, choice 1 (-1 side) or 2 (+1)
