@@ -517,6 +517,27 @@ def test_a_veneer_from_spec_size_is_read_in_units_as_bake_reads_its_block(scans,
                                      "--units inch") in err, err
 
 
+def test_a_scan_given_no_resolution_and_too_small_says_it_was_read_at_300_dpi(scans, capsys):
+    """A --veneer given no resolution (a photo's file states none) is read at 300 dpi, and one
+    then smaller than a patch was refused as '21.8 x 21.8 mm' (a Mokume face photo, 256 px of
+    a 50 mm face) with no word that the size came of a default, not of the wood. Now its pixels
+    and the default are said, with the fix; a resolution given says neither."""
+    from skimage import data
+
+    small = scans / "small.png"
+    Image.fromarray(data.coffee()[:128, :96]).save(small)  # 96 x 128 px: 8.1 x 10.8 mm at 300 dpi (8.2 on the 4 px/mm grid)
+    out = scans / "out"
+    args = ["parquetry", str(scans / "coffee.png"), "--image-size-mm", "42", "--no-glb", "--quiet", "--out", str(out)]
+    assert main([*args, "--veneer", str(small), "--veneer", f"{scans / 'light.png'}:2px/mm"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and (f"veneer 'small' is 8.2 x 10.8 mm (96 x 128 px at the default 300 dpi, as its "
+                                     f"--veneer gives no resolution; give the one it was scanned at: --veneer "
+                                     f"{small}:DPI), smaller than one patch") in err, err
+    assert main([*args, "--veneer", f"{small}:300"]) == 1
+    err = capsys.readouterr().err
+    assert "veneer 'small' is 8.2 x 10.8 mm, smaller than one patch" in err and "default 300 dpi" not in err, err
+
+
 def test_a_sheet_smaller_than_a_patch_names_what_the_user_set(scans, capsys):
     """'--tool-diameter 90' made every sheet smaller than one patch and the kerf round it, and
     the error said 'use ... a smaller patch_mm or a smaller kerf_mm': a job file's keys, and a

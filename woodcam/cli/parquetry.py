@@ -205,11 +205,15 @@ def _scan_paths(text: str) -> list[str]:
     return [scan, *([mask] if mask else [])]
 
 
+#: The resolution of a --veneer scan given none (and a file that states none).
+_DEFAULT_DPI = 300.0
+
+
 def _scan_entry(text: str) -> dict:
     """The job's scan entry of a ``--veneer`` value (:func:`_scan_form`), at 300 dpi when it
     gives no resolution."""
     scan, key, value, mask = _scan_form(text)
-    entry: dict = {"texture": scan, "id": Path(scan).stem, key: 300.0 if value is None else value}
+    entry: dict = {"texture": scan, "id": Path(scan).stem, key: _DEFAULT_DPI if value is None else value}
     if mask:
         entry["mask"] = mask
     if value is None:
@@ -313,11 +317,14 @@ def _default_panel_line(args, params) -> str | None:
             f"patches of {params.patch_mm:g} mm, the target's aspect kept; give --image-size-mm (mm) to choose it")
 
 
-def _sheet_too_small(err, args, params) -> str:
+def _sheet_too_small(err, args, params, defaulted: dict[str, tuple[str, str]]) -> str:
     """The engine's too-small-sheet error in the words of this run: the patch, overlap and
     kerf named as the user set them (the engine named the job file's patch_mm and kerf_mm,
     'a smaller kerf_mm' of a kerf the user never typed, --tool-diameter 100's), lengths in
-    --units; the fix names the options (they override a job file's keys)."""
+    --units; the fix names the options (they override a job file's keys). ``defaulted``: the
+    ids of the --veneer scans given no resolution, to their paths and pixels ('256 x 256'):
+    such a sheet's size is its pixels at the default 300 dpi, and a photo of a 50 mm face (256
+    px, 130 dpi) was refused as 21.8 mm with no word that the size was a guess."""
     from ..units import say_length
 
     patch = _setting(args, params, "patch_mm", "patch_mm") or f"--patch-mm default {params.patch_mm:g}"
@@ -333,7 +340,12 @@ def _sheet_too_small(err, args, params) -> str:
                 or f"--tool-diameter default {say_length(params.tool_diameter_mm, 'g')}")
         kerf = f"--kerf-mm not given: the tool diameter, {tool}"
     parts.append(f"the kerf round it ({kerf})")
-    return (f"veneer {err.veneer_id!r} is {say_length(err.size_mm, '.1f', ' x ')}, smaller than "
+    scan = defaulted.get(err.veneer_id)
+    size = say_length(err.size_mm, '.1f', ' x ')
+    if scan is not None:
+        size += (f" ({scan[1]} px at the default {_DEFAULT_DPI:g} dpi, as its --veneer gives no resolution; "
+                 f"give the one it was scanned at: --veneer {scan[0]}:DPI)")
+    return (f"veneer {err.veneer_id!r} is {size}, smaller than "
             f"{' with '.join(parts[:2]) if len(parts) == 3 else parts[0]} and {parts[-1]}: "
             f"{say_length(err.need_mm, 'g')} a side; use larger sheets, a smaller {' or '.join(smaller)}, "
             "or a smaller kerf (--kerf-mm, in mm)")
@@ -394,6 +406,7 @@ def run(args) -> int:
     for e, n in zip(scans, numbered_names([e["id"] for e in scans], [e["id"] for e in job.scans])):
         e["id"] = n
     job.scans = job.scans + scans
+    no_dpi = {e["id"]: _scan_form(t)[0] for e, t in zip(scans, args.veneer) if _scan_form(t)[2] is None}
     # None: not typed (a value typed equal to its default, --sheets 2, is given all the same)
     given = [d for d in _SLICING if getattr(args, d) is not None]
     for d, default in _SLICING.items():
@@ -442,7 +455,8 @@ def run(args) -> int:
         run_ = build_parquetry(targets, veneers, job.params, names=names, progress=progress,
                                seams=not args.no_seams)
     except SheetTooSmallError as err:
-        raise WoodcamError(_sheet_too_small(err, args, job.params)) from err
+        defaulted = {v.id: (no_dpi[v.id], f"{v.rgb.shape[1]} x {v.rgb.shape[0]}") for v in veneers if v.id in no_dpi}
+        raise WoodcamError(_sheet_too_small(err, args, job.params, defaulted)) from err
     glb_writer = None
     if not args.no_glb:
         from ..export import export_glb as glb_writer
