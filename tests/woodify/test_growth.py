@@ -224,6 +224,31 @@ def test_inside_out_or_reordered_corners_grow_the_same_field():
         assert np.array_equal(s.vertices, grown.vertices) and np.array_equal(s.faces, grown.faces)
 
 
+def test_a_grid_too_big_names_the_finest_resolution_within_both_limits(monkeypatch):
+    """A refused grid said only 'lower the resolution', and the raise of MAX_GRID_CELLS it
+    offered at 1024 (a cube: 1.07e9 nodes) ran into MAX_ALLOC_BYTES next (180 B a node). The
+    fix now names the finest resolution within both: it passes, one more is refused."""
+    import re
+
+    import woodcam.woodify.grow as grow_module
+
+    def no_growth(*args, **kwargs):
+        raise AssertionError("the grid was allocated")
+
+    monkeypatch.setattr(grow_module, "propagate", no_growth)
+    box = trimesh.creation.box((40.0, 40.0, 40.0))
+    with pytest.raises(WoodcamError, match=r"MAX_GRID_CELLS .*; lower the resolution to \d+ or less \(--resolution") as e:
+        woodify(box, 20, resolution=1024)
+    best = int(re.search(r"to (\d+) or less", str(e.value)).group(1))
+    with pytest.raises(AssertionError, match="allocated"):  # within both limits: it grows
+        woodify(box, 20, resolution=best)
+    with pytest.raises(WoodcamError, match=rf"resolution {best + 1} .*MAX_ALLOC_BYTES.*lower the resolution to {best} or"):
+        woodify(box, 20, resolution=best + 1)
+    monkeypatch.setenv("WOODCAM_MAX_ALLOC_BYTES", "1000")  # not even the lowest: no number to name
+    with pytest.raises(WoodcamError, match=r"; lower the resolution \(--resolution"):
+        woodify(box, 20, resolution=24)
+
+
 def test_a_grid_too_big_for_memory_is_refused_before_it_is_allocated(monkeypatch):
     """A fine grid ran into the OOM killer, not an error: about 180 B a node live at once (1.83 GB
     on 200^3), so a cube at the top resolution, 1024, asked ~190 GB. The grid is sized against

@@ -54,7 +54,8 @@ def register(subparsers) -> argparse.ArgumentParser:
                    help="growth brushes (centre_mm, radius_mm, gain, direction, strength)")
     p.add_argument("--resolution", type=int, default=128,
                    help="grid nodes along the longest side, 16 to 1024 (default 128); a run takes about "
-                   "180 bytes a grid node, and a grid over WOODCAM_MAX_ALLOC_BYTES (4 GiB) is refused")
+                   "180 bytes a grid node, and a grid over WOODCAM_MAX_ALLOC_BYTES (4 GiB) is refused, naming the finest "
+                   "resolution that fits")
     p.add_argument("--method", choices=("auto", "fmm", "offset", "anisotropic"), default="auto",
                    help="front solver (default auto: fmm if isotropic, offset for eccentricity "
                    "without obstacles, anisotropic otherwise)")

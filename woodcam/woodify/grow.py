@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import WoodcamError
-from ..limits import MAX_BLOCK_SIZE_MM, check_grid
+from ..limits import MAX_BLOCK_SIZE_MM, WOODIFY_RESOLUTION_RANGE, check_grid, limit
 from .brushes import Brush, check_vertex_paint, paint
 from .field import WoodifiedField
 from .front import Front, Method, VoxelGrid, check_resolution, check_watertight, propagate
@@ -112,6 +112,26 @@ class Woodification:
         return float(self.speed.years(np.max(self.front.arrival_mm[rim])))
 
 
+def _grid_fits(grid: VoxelGrid) -> bool:
+    """True when ``grid`` is within both limits :func:`~woodcam.limits.check_grid` applies to a
+    woodify grid (its nodes, and their bytes at :data:`WOODIFY_BYTES_PER_NODE`)."""
+    nodes = float(np.prod(np.asarray(grid.shape, float)))
+    return nodes <= limit("MAX_GRID_CELLS") and nodes * WOODIFY_BYTES_PER_NODE <= limit("MAX_ALLOC_BYTES")
+
+
+def _finest_fitting(top: int, fits) -> int | None:
+    """The largest resolution ``n < top`` (at least the lowest allowed) with ``fits(n)``, by
+    bisection (the grid grows with it); None when even the lowest does not fit."""
+    lo = WOODIFY_RESOLUTION_RANGE[0]
+    if not fits(lo):
+        return None
+    hi = top  # fits(lo), not fits(hi)
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        lo, hi = (mid, hi) if fits(mid) else (lo, mid)
+    return lo
+
+
 def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: float | None = None,
             time_scale_years: float | None = None, shape: float = 2.0, eccentricity: float = 0.0,
             up=(0.0, 0.0, 1.0), obstacles=(), brushes: tuple[Brush, ...] | list = (),
@@ -187,13 +207,20 @@ def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: 
         raise WoodcamError(f"eccentricity plus brush strengths must stay below 1; got {wmax:.3g}")
     reach = tau_end * gmax * (1.0 + wmax)
     ext = float(np.max(hi - lo)) + 2 * reach
-    h_est = ext / (resolution - 1 - 2 * _MARGIN_NODES)
-    pad = reach + _MARGIN_NODES * h_est
-    grid = VoxelGrid.around(lo - pad, hi + pad, resolution)
-    # refused before any of it is allocated: the OOM killer, not an error, ended a fine grid
-    check_grid(grid.shape, f"woodify's grid at resolution {resolution}",
-               itemsize=WOODIFY_BYTES_PER_NODE,
-               fix="lower the resolution (--resolution on the command line; default 128)")
+
+    def grid_at(n: int) -> VoxelGrid:
+        pad = reach + _MARGIN_NODES * ext / (n - 1 - 2 * _MARGIN_NODES)
+        return VoxelGrid.around(lo - pad, hi + pad, n)
+
+    grid = grid_at(resolution)
+    # refused before any of it is allocated: the OOM killer, not an error, ended a fine grid;
+    # the fix names the finest resolution within both limits (it said only 'lower the
+    # resolution', and the raise of the limit it offered ran into the other one)
+    if not _grid_fits(grid):
+        best = _finest_fitting(resolution, lambda n: _grid_fits(grid_at(n)))
+        fix = (f"lower the resolution to {best} or less" if best is not None else "lower the resolution")
+        check_grid(grid.shape, f"woodify's grid at resolution {resolution}",
+                   itemsize=WOODIFY_BYTES_PER_NODE, fix=f"{fix} (--resolution on the command line; default 128)")
     obstacles = [check_watertight(o, f"obstacles[{i}]") for i, o in enumerate(obstacles)]
     paint_fn = None
     if strokes or vertex_gain is not None or vertex_direction is not None:
