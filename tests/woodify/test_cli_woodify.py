@@ -783,3 +783,27 @@ def test_crack_options_with_no_cracks_are_said_to_do_nothing(tmp_path, capsys):
         assert "change nothing" not in capsys.readouterr().err, extra
     assert _rc([*base, "--cracks", "none", "--relief", "2"]) == 2  # its range still checked
     assert "--relief must be in [0, 1]" in capsys.readouterr().err
+
+
+def test_a_block_reaching_past_the_grown_object_is_warned_of(tmp_path, capsys):
+    """--block-size 1000x1000x1000 of a ball grown to 30 mm was taken without a word: the block
+    was air round the object, wood never grown, which field.npz fills with years past those
+    grown, so a part carved out there baked as plain wood. Now a block more than a grid step
+    past the grown object's box is warned of, with the box and the largest block about that
+    centre; the default block (the grown box) and one within it say nothing."""
+    trimesh.creation.icosphere(subdivisions=2, radius=5.0).export(tmp_path / "ball.stl")
+    base = ["woodify", str(tmp_path / "ball.stl"), "--years", "4", "--growth", "3", "--resolution", "24",
+            "--cracks", "none", "--out", str(tmp_path / "out")]
+    assert main([*base, "--block-size", "100x16x16"]) == 0
+    err = capsys.readouterr().err
+    # the ball grown 3 mm: 7.87 mm, the surface's facets a little inside the sphere; 16 mm
+    # across reaches 0.13 mm past it, within a grid step: no word of it
+    assert err == ("woodcam: warning: the block cut from the grown object (100 x 16 x 16 mm about 0,0,0 mm, "
+                   "--block-size) reaches 42.13 mm past the grown object's box (x [-7.874, 7.874], y [-7.874, "
+                   "7.874], z [-7.874, 7.874] mm): that part of it is air round the object, wood never grown, which "
+                   "field.npz fills with years past the 4 grown (a bake shows wood there); keep the block within "
+                   "that box (--block-size at most 15.75x15.75x15.75 mm about that centre), or leave --block-size "
+                   "out for the grown object's own box\n"), err
+    for within in ([], ["--block-size", "10x10x10"]):
+        assert main([*base, *within]) == 0
+        assert "past the grown object's box" not in capsys.readouterr().err

@@ -392,6 +392,8 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
         lo, hi = mesh.bounds
         size = tuple(hi - lo) if block_size_mm is None else tuple(block_size_mm)
         centre = tuple((lo + hi) / 2) if block_centre_mm is None else tuple(block_centre_mm)
+        _say_block_past_the_wood(lo, hi, size, centre, res.front.grid.spacing_mm, Y,
+                                 block_size_mm is not None, block_centre_mm is not None)
         placed = res.field.placed(size, centre)
         # a woodcam GLB is in the block frame (its metadata says so, and `review --block
         # woodify:field.npz` reads it so): object = block_origin + R @ block, so block = R^T (object
@@ -434,6 +436,36 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
             img, _ = with_scale_bar(img, ext[a] / px, units)
             files.append(atomic(out / f"section_{name}.png", lambda p, im=img: Image.fromarray(im).save(p, format="PNG")))
     return files, summary
+
+
+def _say_block_past_the_wood(lo, hi, size, centre, spacing_mm: float, years: float, size_given: bool,
+                             centre_given: bool) -> None:
+    """A WoodcamWarning when the block cut from the grown object (``size`` about ``centre``, mm)
+    reaches more than a grid step past the grown object's box ``lo``..``hi``: that part of it is
+    air round the object, wood never grown, which field.npz fills with years past those grown (a
+    100 mm part carved 500 mm out in a --block-size 1000x1000x1000 of a 30 mm grown ball baked
+    as plain straight grain, with no word). The centre's own check (``_check_block_centre``)
+    refuses a centre outside the box."""
+    import warnings
+
+    import numpy as np
+
+    from ..errors import WoodcamWarning
+
+    lo, hi, c, half = (np.asarray(v, float) for v in (lo, hi, centre, np.asarray(size, float) / 2))
+    past = float(np.max(np.maximum(lo - (c - half), (c + half) - hi)))
+    if past <= spacing_mm:
+        return
+    room = 2 * np.maximum(np.minimum(c - lo, hi - c), 0.0)
+    opts = " and ".join(o for o, on in (("--block-size", size_given), ("--block-centre", centre_given)) if on)
+    box = say_length([v for pair in zip(lo, hi) for v in pair], ".4g", form="x [{}, {}], y [{}, {}], z [{}, {}]")
+    warnings.warn(
+        f"the block cut from the grown object ({say_length(size, '.4g', ' x ')} about "
+        f"{say_length(np.round(c, 3) + 0.0, '.4g', ',')}, {opts}) reaches {say_length(past, '.4g')} past the grown object's box "
+        f"({box}): that part of it is air round the object, wood never grown, which field.npz fills with years "
+        f"past the {years:g} grown (a bake shows wood there); keep the block within that box (--block-size at "
+        f"most {say_length(room, '.4g', 'x')} about that centre), or leave {opts} out for the grown object's own "
+        "box", WoodcamWarning, stacklevel=2)
 
 
 def _check_block_centre(res, args) -> None:
