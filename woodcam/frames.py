@@ -357,6 +357,16 @@ def foreign_gltf_in_block_frame(geometry: _G, path, *, stacklevel: int = 2) -> _
 #: Name of the GLB root node that carries :data:`BLOCK_TO_GLTF` above the block-frame mesh.
 GLTF_ROOT_NODE = "woodcam_block_frame"
 
+
+def stamp_gltf_asset(tree: dict) -> None:
+    """Name woodcam (and its version) as ``asset.generator`` of the glTF JSON ``tree``, in place:
+    the glTF 2.0 spec's "tool that generated this glTF model", which viewers and the Khronos
+    validator show (trimesh, which serialises it, put its own project URL there). Every GLB
+    woodcam writes passes its tree through here (a trimesh ``tree_postprocessor``)."""
+    from . import __version__
+
+    tree.setdefault("asset", {"version": "2.0"})["generator"] = f"woodcam {__version__}"
+
 #: First-line marker of an OBJ written by woodcam: ``# woodcam: units=m up=y ...``.
 OBJ_HEADER = "# woodcam:"
 

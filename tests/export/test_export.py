@@ -348,6 +348,10 @@ def test_glb_passes_the_khronos_validator(baked, tmp_path, normals):
     assert issues["numHints"] == 0, [m for m in issues["messages"] if m["severity"] == 3]
     info = report["info"]
     assert info["materialCount"] == 1 and info["hasTextures"]
+    # the asset names the program that wrote the file (it named trimesh, which serialised it)
+    import woodcam
+
+    assert info["generator"] == f"woodcam {woodcam.__version__}"
 
 
 @pytest.mark.parametrize("suffix", [".glb", ".obj"])

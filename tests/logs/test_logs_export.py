@@ -43,6 +43,12 @@ def test_glb_round_trip_holds_surface_and_coloured_knots(log, tmp_path):
     assert lo[1] == pytest.approx(0.0, abs=1e-9) and hi[1] == pytest.approx(1.2, rel=1e-6)
     assert hi[0] - lo[0] < 0.5 and hi[2] - lo[2] < 0.5
     assert scene.metadata.get("units") == "mm" and "extras" not in scene.metadata
+    # the asset names woodcam, as export_glb's do (it named trimesh, which serialised it)
+    import woodcam
+    from woodcam.export import glb_json
+
+    asset = glb_json(p.read_bytes(), "log.glb")["asset"]
+    assert asset == {"version": "2.0", "generator": f"woodcam {woodcam.__version__}"}
 
 
 def test_heightmap_png_decodes_back_to_mm(log, tmp_path):

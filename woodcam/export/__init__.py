@@ -43,7 +43,8 @@ from woodcam._atomic import atomic_files, check_output_path, write_bytes
 from woodcam._checks import check_number, check_path
 from woodcam.errors import WoodcamError
 from woodcam.frames import (BLOCK_TO_GLTF, GLTF_ROOT_NODE, OBJ_HEADER, ObjUnits, ObjUp,
-                            foreign_gltf_in_block_frame, obj_header_transform, obj_transform)
+                            foreign_gltf_in_block_frame, obj_header_transform, obj_transform,
+                            stamp_gltf_asset)
 
 #: Key under the glTF scene ``extras`` that holds woodcam's metadata.
 GLB_METADATA_KEY = "woodcam"
@@ -275,6 +276,7 @@ def export_glb(mesh: Mesh, path: PathLike, metadata: dict | None = None, *,
             ) from err
 
     def _add_extras(tree: dict) -> None:
+        stamp_gltf_asset(tree)
         scene = tree["scenes"][tree.get("scene", 0)]
         extras = scene.setdefault("extras", {})
         extras[GLB_METADATA_KEY] = payload

@@ -17,7 +17,7 @@ import trimesh
 from .._atomic import atomic_path, write_bytes
 from .._checks import png_path
 from ..errors import WoodcamError
-from ..frames import BLOCK_TO_GLTF, GLTF_ROOT_NODE
+from ..frames import BLOCK_TO_GLTF, GLTF_ROOT_NODE, stamp_gltf_asset
 from .generate import GeneratedKnot, GeneratedLog
 
 #: Colours (RGBA, 0-255): debarked sapwood, a live (intergrown) knot, a dead (loose) knot.
@@ -138,7 +138,7 @@ def export_log_glb(log: GeneratedLog, path, *, surface_alpha: float = 1.0, max_r
     scene.metadata.update({"units": "mm", "frame": "log frame, z along the log", "seed": log.seed,
                            "block_to_gltf": BLOCK_TO_GLTF.tolist()})
     p.parent.mkdir(parents=True, exist_ok=True)
-    write_bytes(p, scene.export(file_type="glb"))
+    write_bytes(p, scene.export(file_type="glb", tree_postprocessor=stamp_gltf_asset))
     return p
 
 
