@@ -108,6 +108,18 @@ def test_glb_is_metres_and_y_up_for_every_viewer(baked, tmp_path):
     assert read_glb_metadata(path)["block_to_gltf"][1] == [0.0, 0.0, 0.001, 0.0]
 
 
+def test_the_glb_mesh_is_named_after_its_file_as_the_objs_object_is(baked, tmp_path):
+    """Blender names an imported object after its glTF node (an OBJ's after its file): every GLB
+    named its mesh 'part', so a bowl and a lid imported together were 'part' and 'part.001'."""
+    from woodcam.export import glb_json
+
+    path = export_glb(baked.mesh, tmp_path / "walnut bowl.glb")
+    tree = glb_json(path.read_bytes(), "walnut bowl.glb")
+    assert [m["name"] for m in tree["meshes"]] == ["walnut bowl"]
+    assert sorted(n["name"] for n in tree["nodes"]) == ["walnut bowl", "woodcam_block_frame"]
+    assert len(load_textured(path).faces) == len(baked.mesh.faces)  # read back all the same
+
+
 def test_obj_names_with_spaces_stay_one_token(baked, tmp_path):
     """'my tray.obj' wrote 'mtllib my tray.mtl' and 'usemtl my tray_texture': OBJ readers split
     those at whitespace (two files 'my' and 'tray.mtl')."""

@@ -252,7 +252,8 @@ def export_glb(mesh: Mesh, path: PathLike, metadata: dict | None = None, *,
     -------
     Path
         The written file. Its scene has one root node ``woodcam_block_frame`` with matrix
-        :data:`BLOCK_TO_GLTF` above the mesh node (vertices in block-frame mm).
+        :data:`BLOCK_TO_GLTF` above the mesh node (vertices in block-frame mm); the mesh and its
+        node are named after the file's stem (``bowl`` for ``bowl.glb``).
     """
     import trimesh
     from trimesh.exchange.gltf import export_glb as _trimesh_export_glb
@@ -300,7 +301,9 @@ def export_glb(mesh: Mesh, path: PathLike, metadata: dict | None = None, *,
             else _GL_CLAMP_TO_EDGE for k in (0, 1)]
     _with_encoded_texture(shaded, "baseColorTexture")
     scene = trimesh.Scene()
-    scene.add_geometry(shaded, geom_name="part", node_name="part")
+    # named after the file, as an OBJ's object is (it has no 'o' line: importers take the file
+    # name): two parts imported into one Blender scene were 'part' and 'part.001'
+    scene.add_geometry(shaded, geom_name=path.stem, node_name=path.stem)
     data = _trimesh_export_glb(scene, include_normals=True, tree_postprocessor=_add_extras)
     write_bytes(path, data)  # atomic: a complete GLB or none
     return path
