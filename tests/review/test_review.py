@@ -641,6 +641,32 @@ def test_the_pages_report_rows_are_in_mm_as_the_page_says(page, tmp_path):
         re.search(r"<th>part</th><td>[^<]*", text)
 
 
+def test_the_recorded_settings_are_rows_a_reader_takes_in(page, tmp_path):
+    """The GLB's texels_per_mm, G-code programs and placement were shown as stored: a row named
+    'texels_per_mm', and the placement as one JSON blob of 16-digit matrix entries."""
+    from woodcam.cli import main
+    from woodcam.export import load_textured
+
+    stock, glb, _, _ = page
+    s = 0.6216216216216216
+    matrix = [[s, 0.0, 0.0, -6.081081081081081], [0.0, s, 0.0, 0.13513513513513686],
+              [0.0, 0.0, s, 9.45945945945946], [0.0, 0.0, 0.0, 1.0]]
+    part = export_glb(load_textured(glb), tmp_path / "part.glb", metadata={
+        "block": stock.spec, "texels_per_mm": 3.0, "gcode": ["/jobs/rough.nc", "/jobs/finish.nc"],
+        "placement": {"ops": ["rotate:z:90", "fit"], "matrix": matrix}})
+    assert main(["review", str(part), "--out", str(tmp_path / "r.html"), "--voxels", "1000"]) == 0
+    rows = dict(re.findall(r"<tr><th>([^<]*)</th><td>([^<]*)</td></tr>", (tmp_path / "r.html").read_text()))
+    assert rows["texture"] == "3 texels/mm" and "texels_per_mm" not in rows
+    assert rows["G-code"] == "/jobs/rough.nc, /jobs/finish.nc"
+    assert rows["placement"] == ("--place rotate:z:90 --place fit (part to block, mm: [0.6216, 0, 0, -6.081]; "
+                                 "[0, 0.6216, 0, 0.1351]; [0, 0, 0.6216, 9.459])")
+    # a placement of another form (the metadata is untrusted) is shown as the JSON it is
+    odd = export_glb(load_textured(glb), tmp_path / "odd.glb", metadata={
+        "block": stock.spec, "placement": {"ops": "fit"}})
+    assert main(["review", str(odd), "--out", str(tmp_path / "o.html"), "--voxels", "1000"]) == 0
+    assert "<th>placement</th><td>{&quot;ops&quot;: &quot;fit&quot;}</td>" in (tmp_path / "o.html").read_text()
+
+
 def test_a_malformed_bake_report_in_the_glb_is_warned_not_a_traceback(page, tmp_path, capsys):
     """report_rows({}) raised KeyError 'knots' out of woodcam review: GLB metadata is
     untrusted (an edited or another program's file)."""

@@ -76,9 +76,7 @@ def _page(args: argparse.Namespace, meta: dict, stock, bar) -> Path:
     report = {"block spec": spec, "species": stock.meta.get("species", "")}
     if isinstance(meta.get("report"), dict):  # the bake's part report (volume, yield, warnings)
         report.update(_report_rows(meta["report"], args.part))
-    for key in ("texels_per_mm", "gcode", "placement"):
-        if key in meta:
-            report[key] = meta[key]
+    report.update(_recorded_rows(meta))
     report.update(_gcode_run_rows(meta))
     from ..advise import knot_spots
     from ..export import load_textured
@@ -143,6 +141,43 @@ def _report_rows(bake_report: dict, glb: Path) -> dict:
                       f"{err}); the page shows no report rows. Re-bake the part to have them",
                       WoodcamWarning, stacklevel=2)
         return {}
+
+
+def _recorded_rows(meta: dict) -> dict:
+    """The bake's settings recorded in its GLB as rows a reader takes in (they were the metadata
+    as stored: a row 'texels_per_mm', and the placement as one JSON blob of 16-digit matrix
+    entries): ``texture`` in texels/mm, ``G-code`` the program(s), ``placement`` the ``--place``
+    operations (in mm, as recorded) and the part-to-block matrix's rows to 4 significant digits.
+    A value of another form (GLB metadata is untrusted) is shown as the JSON it is."""
+    rows: dict = {}
+    t = meta.get("texels_per_mm")
+    if isinstance(t, (int, float)) and not isinstance(t, bool):
+        rows["texture"] = f"{t:g} texels/mm"
+    elif "texels_per_mm" in meta:
+        rows["texels_per_mm"] = meta["texels_per_mm"]
+    g = meta.get("gcode")
+    if isinstance(g, list) and all(isinstance(v, str) for v in g):
+        rows["G-code"] = ", ".join(g)
+    elif "gcode" in meta:
+        rows["G-code"] = g
+    place = meta.get("placement")
+    ops = place.get("ops") if isinstance(place, dict) else None
+    matrix = place.get("matrix") if isinstance(place, dict) else None
+    try:
+        import numpy as np
+
+        m = np.asarray(matrix, dtype=float)
+        ok = (isinstance(ops, list) and all(isinstance(o, str) for o in ops)
+              and m.shape == (4, 4) and bool(np.isfinite(m).all()))
+    except (TypeError, ValueError):
+        ok = False
+    if ok:
+        lines = "; ".join("[" + ", ".join(f"{v:.4g}" for v in row) + "]" for row in m[:3] + 0.0)
+        rows["placement"] = (" ".join(f"--place {o}" for o in ops)
+                             + f" (part to block, mm: {lines})")
+    elif place is not None:
+        rows["placement"] = place
+    return rows
 
 
 def _gcode_run_rows(meta: dict) -> dict:
