@@ -120,6 +120,19 @@ def test_the_glb_mesh_is_named_after_its_file_as_the_objs_object_is(baked, tmp_p
     assert len(load_textured(path).faces) == len(baked.mesh.faces)  # read back all the same
 
 
+def test_write_stl_makes_its_folder_as_the_glb_and_obj_writers_do(tmp_path):
+    """'python cad_examples/bowl.py out/bowl.stl' with no out/ yet ended in a traceback ('the
+    folder ... does not exist'), while export_glb and export_obj of the same run made theirs."""
+    from woodcam.export import STL_HEADER, write_stl
+
+    box = trimesh.creation.box((30.0, 20.0, 10.0))
+    path = write_stl(box, tmp_path / "new" / "deeper" / "box.stl", note="box, block frame")
+    assert path.read_bytes().startswith(STL_HEADER)
+    back = trimesh.load(path)
+    assert back.is_watertight and back.volume == pytest.approx(6000.0)  # outward: volume > 0
+    np.testing.assert_allclose(back.extents, (30.0, 20.0, 10.0))  # mm, as written
+
+
 def test_obj_names_with_spaces_stay_one_token(baked, tmp_path):
     """'my tray.obj' wrote 'mtllib my tray.mtl' and 'usemtl my tray_texture': OBJ readers split
     those at whitespace (two files 'my' and 'tray.mtl')."""

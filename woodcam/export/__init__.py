@@ -467,10 +467,12 @@ def write_stl(mesh, path: PathLike, note: str = "") -> Path:
     stating ``units=mm``: the one STL writer of woodcam and its example scripts (a CAD kernel's
     own exporter wrote 'STL Exported by Open CASCADE Technology', no unit). ``mesh`` is a
     trimesh mesh or a manifold3d ``Manifold`` (what :func:`woodcam.cad.load_part` returns: the
-    part as woodcam carves it)."""
+    part as woodcam carves it). Missing parent folders are created, as :func:`export_glb` and
+    :func:`export_obj` create theirs."""
     import trimesh
 
-    path = check_output_path(path, suffixes=(".stl",), what="write_stl: path")
+    path = check_output_path(check_path(path, "write_stl: path", fix="e.g. 'out/part.stl'"),
+                             suffixes=(".stl",), what="write_stl: path", mkdir=True)
     if hasattr(mesh, "to_mesh64"):  # a manifold3d Manifold
         from .._manifold import manifold_to_trimesh
 
