@@ -1002,9 +1002,10 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
     p.add_argument("--no-obj", action="store_true", help="write only the GLB, not OBJ+MTL+PNG")
     p.add_argument("--obj-units", choices=("m", "mm"), default="m",
                    help="length unit of the OBJ's coordinates (default m, what Blender and most "
-                   "viewers assume; mm for CAM tools). The GLB is always metres, Y up (glTF)")
+                   "viewers assume; mm for CAM tools and slicers). The GLB is always metres, Y up (glTF)")
     p.add_argument("--obj-up", choices=("y", "z"), default="y",
-                   help="up axis of the OBJ (default y, the OBJ habit; z keeps the block frame)")
+                   help="up axis of the OBJ (default y, the OBJ habit and what Blender's importer "
+                   "expects; z keeps the block frame, as CAM tools and slicers read an OBJ)")
     if screenshot:
         p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
                        help="also render the result off-screen to PNG (default name: OUT with "
