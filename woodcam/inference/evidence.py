@@ -50,14 +50,14 @@ from dataclasses import field as dc_field
 
 import numpy as np
 
-from .._checks import check_bool
+from .._checks import check_bool, check_number
 from .._parallel import fit_workers, share
 from .._types import ArrayLike
 
 from ..errors import WoodcamError, WoodcamWarning
 from ..fields.base import central_gradient, check_points
 from ..fields.residual import ResidualField
-from ..frames import AXIS_ENDS, FACES
+from ..frames import AXIS_ENDS, FACES, check_size
 from ..tolerances import (
     EVIDENCE_ACCEPT_MARGIN,
     EVIDENCE_BLEND_DEPTH_MM,
@@ -724,6 +724,14 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
         raise WoodcamError(f"obs must be RingObservations (woodcam.inference.observations.gather_observations "
                            f"of a block); got {type(obs).__name__}")
     warn, residual = check_bool(warn, "warn"), check_bool(residual, "residual")
+    # a NaN or (2,) size, a NaN n_basins or a string seed failed deep in the radial search as
+    # numpy's or SeedSequence's bare ValueError/TypeError; n_basins=0 fitted one basin anyway
+    size_mm = check_size(size_mm)
+    n_basins = int(check_number(n_basins, "n_basins", lo=1, integer=True,
+                                fix="the pith-axis basins to try as hypotheses, e.g. n_basins=3"))
+    seed = int(check_number(seed, "seed", lo=0, integer=True, fix="same seed, same fit"))
+    if workers is not None:
+        workers = int(check_number(workers, "workers", lo=1, integer=True, fix="e.g. workers=2, or None for the default"))
     if blend not in BLEND_MODES:
         raise WoodcamError(f"blend must be one of {', '.join(BLEND_MODES)}; got {blend!r}")
     if residual and blend == "everywhere":
@@ -732,7 +740,7 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     bad = [c for c in candidates if c not in CANDIDATES]
     if bad or "radial" not in candidates:
         raise WoodcamError(f"candidates must include 'radial' and come from {CANDIDATES}; got {list(candidates)}")
-    workers = fit_workers() if workers is None else int(workers)
+    workers = fit_workers() if workers is None else workers
     with _one_blas_thread():
         radials, numbered = fit_radial_hypotheses(obs, size_mm, n_basins=n_basins, seed=seed, workers=workers)
         # the rings every hypothesis is fitted and judged on. Years given: those. The radial
