@@ -50,7 +50,7 @@ from itertools import islice
 
 import numpy as np
 
-from .._checks import check_bool, check_number
+from .._checks import as_floats, check_bool, check_number
 from .._parallel import map_processes
 from .._types import ArrayLike
 from ..errors import WoodcamError
@@ -247,13 +247,21 @@ def _refine(prob: _StemProblem, theta0, max_nfev: int):
     return res.x, float(res.cost)
 
 
-def _base_axes(size_mm, base_axes):
+def _base_axes(base_axes) -> list[np.ndarray]:
+    """``base_axes`` (one ``(3,)`` direction or ``(k, 3)`` of them) as unit vectors; the three
+    block axes for None. A ``(k, 2)`` was an IndexError in the frame, a zero axis numpy's
+    divide warning, a string its bare ValueError."""
     if base_axes is None:
         return [np.eye(3)[i] for i in range(3)]
-    out = [np.asarray(a, float) / np.linalg.norm(a) for a in np.atleast_2d(np.asarray(base_axes, float))]
-    if not out or not all(np.all(np.isfinite(a)) for a in out):
-        raise WoodcamError(f"base_axes must be non-zero 3-vectors; got {base_axes!r}")
-    return out
+    a = as_floats(base_axes)
+    if a is not None and a.ndim == 1:
+        a = a[None]
+    norms = None if a is None or a.ndim != 2 or a.shape[1] != 3 or not len(a) or not np.all(np.isfinite(a)) \
+        else np.linalg.norm(a, axis=1)
+    if norms is None or np.any(norms < 1e-12):
+        raise WoodcamError(f"base_axes must be finite non-zero directions, one (3,) or (k, 3); got {base_axes!r:.80}; "
+                           "e.g. base_axes=[(0, 0, 1)], or None for the three block axes")
+    return [r / np.linalg.norm(r) for r in a]  # row by row, as before: the same bits
 
 
 def _starts(prob: _StemProblem, obs: RingObservations, sel: np.ndarray, size, n_keep: int):
@@ -363,10 +371,13 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
         raise WoodcamError(f"init must be a StemField (an earlier fit_stem) or None; got {type(init).__name__}")
     tilt_prior_deg, curve_prior_mm = (check_number(v, name, lo=0, lo_open=True, fix="a prior's standard deviation")
                                       for v, name in ((tilt_prior_deg, "tilt_prior_deg"), (curve_prior_mm, "curve_prior_mm")))
+    axes = _base_axes(base_axes) if init is None else []
     n = len(obs.points_mm)
-    off = np.zeros(n) if offset_years is None else np.asarray(offset_years, float).reshape(-1)
-    if off.shape != (n,) or not np.all(np.isfinite(off)):
-        raise WoodcamError(f"offset_years must be {n} finite years, one per observation; got shape {off.shape}")
+    off = np.zeros(n) if offset_years is None else as_floats(offset_years)
+    if off is None or off.reshape(-1).shape != (n,) or not np.all(np.isfinite(off)):
+        raise WoodcamError(f"offset_years must be {n} finite years, one per observation; got "
+                           f"{'shape ' + str(off.shape) if off is not None else repr(offset_years)[:60]}")
+    off = off.reshape(-1)
     size = np.asarray(size_mm, float)
     centre = size / 2
     L = float(np.linalg.norm(size) / 2)
@@ -387,7 +398,7 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
     if init is not None:  # warm start: one start, the given centreline
         coarse.append((0.0, np.asarray(init.curve, float).T.reshape(-1), np.asarray(init.base_axis, float), None))
     starts = []  # (problem, start, axis) of every base axis, each descent independent of the others
-    for d0 in (_base_axes(size, base_axes) if init is None else []):
+    for d0 in axes:
         prob = problem(i_s, d0, min(K, 2), 0)
         starts += [(prob, th, d0) for _, th in _starts(prob, obs, i_s, size, n_starts)]
     coarse += [(cost, th, d0, prob) for (th, cost), (prob, _, d0)
