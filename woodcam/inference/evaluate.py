@@ -259,6 +259,14 @@ def evaluate_fits(true_field, fitted: dict, size_mm, planes=DEFAULT_PLANES,
                             fix=f"the cut planes' sample spacing in mm, e.g. {EVAL_PIXEL_MM}")
     keep_lines = check_bool(keep_lines, "keep_lines")
     check_size(size_mm)
+    try:  # [] scored no plane and returned 0 % everywhere, as if no ring were missed
+        plane_list = [] if isinstance(planes, (str, CutPlane)) else list(planes)
+    except TypeError:
+        plane_list = []
+    if not plane_list:
+        raise WoodcamError(f"planes must be a non-empty list of CutPlanes; got {planes!r:.60}; e.g. "
+                           "[CutPlane('z=0.5', (0.5, 0.5, 0.5), (0, 0, 1))] or leave planes out for the seven of Table 1")
+    planes = plane_list
     for p in planes:
         if not isinstance(p, CutPlane):
             raise WoodcamError(f"planes must be CutPlanes; got {p!r:.60}; e.g. CutPlane('z=0.5', (0.5, 0.5, 0.5), "
