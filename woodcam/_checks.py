@@ -100,6 +100,28 @@ def check_vector(value, name: str, *, n: int = 3, unit: bool = False, fix: str =
     return v
 
 
+def check_names(value, name: str, *, what: str, known: Iterable[str] | None = None) -> list[str]:
+    """``value`` as a non-empty list of names (each a ``str``; with ``known``: each one of
+    them). A string was read letter by letter (``'radial'`` as ``'r'``, ``'a'``...), an empty
+    list or None ran no work and returned an empty table or failed on an IndexError later."""
+    if isinstance(value, str):
+        raise WoodcamError(f"{name} must be a list of {what}; got the string {value!r}; pass [{value!r}]")
+    try:
+        names = list(value)
+    except TypeError:
+        names = []
+    choices = list(known) if known is not None else []
+    example = f"e.g. {name}=[{choices[0]!r}]" if choices else ""
+    if not names or not all(isinstance(n, str) for n in names):
+        _fail(name, f"a non-empty list of {what}", value, example)
+    unknown = [n for n in names if known is not None and n not in choices]
+    if unknown:
+        near = did_you_mean(unknown[0], choices)
+        raise WoodcamError(f"{name} must be {what} from {', '.join(choices)}; got {unknown[0]!r}"
+                           + (f"; {near}" if near else ""))
+    return names
+
+
 def check_path(value, name: str, *, fix: str = "") -> Path:
     """``value`` (a ``str`` or ``os.PathLike``, not empty) as a ``Path``. None, a number or a
     list was ``Path()``'s bare TypeError ("expected str, bytes or os.PathLike object")."""

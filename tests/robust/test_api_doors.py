@@ -423,6 +423,19 @@ def _library_door_sweep():
          r"planes must be a non-empty list of CutPlanes; got \[\]; e.g. \[CutPlane\("),
         ("evaluate_fit planes None", lambda: w.evaluate_fit(fld, fld, (40, 30, 20), planes=None),
          "planes must be a non-empty list of CutPlanes; got None"),
+        ("benchmark no blocks", lambda: w.benchmark([]), r"blocks must be a non-empty list of woodcam.block.Block; got \[\]"),
+        ("benchmark blocks None", lambda: w.benchmark(None), "blocks must be a non-empty list of woodcam.block.Block; got None"),
+        ("benchmark one block", lambda: w.benchmark(w.Block((9, 9, 9))), "blocks must be a non-empty list of woodcam.block.Block"),
+        ("benchmark no methods *", lambda: w.benchmark([_synth()], methods=[]),
+         r"methods must be a non-empty list of method names; got \[\]; e.g. methods=\['evidence'\]"),
+        ("benchmark unknown method", lambda: w.benchmark([_synth()], methods=["radial", "radiall"]),
+         "methods must be method names from evidence, rbf, radial, neural; got 'radiall'; did you mean 'radial'"),
+        ("benchmark face_sets list", lambda: w.benchmark([_synth()], methods=["radial"], face_sets=[None]),
+         "face_sets must be a dict label -> list of faces .*got list"),
+        ("leave_one_face_out no methods", lambda: w.leave_one_face_out(_synth(), methods=[]),
+         r"methods must be a non-empty list of method names; got \[\]"),
+        ("leave_one_face_out methods None", lambda: w.leave_one_face_out(_synth(), methods=None),
+         "methods must be a non-empty list of method names; got None"),
         ("leave_one_face_out None", lambda: w.leave_one_face_out(None), "block must be a woodcam.block.Block; got NoneType"),
         ("leave_one_face_out reference 5", lambda: w.leave_one_face_out(w.Block((9, 9, 9)), reference=5),
          "reference must be a woodcam.block.Block; got int"),
@@ -531,6 +544,14 @@ def _woodify(**kw):
     from woodcam.woodify import woodify
 
     return woodify(trimesh.creation.icosphere(radius=5), 2.0, resolution=16, **kw)
+
+
+@functools.lru_cache(maxsize=1)
+def _synth():
+    """A small synthetic flat-sawn block with its true field (one render)."""
+    import woodcam as w
+
+    return w.synth_block(w.builtin_block("flat-sawn").field, (40, 30, 20), face_px=32, seed=0)
 
 
 @functools.lru_cache(maxsize=1)

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field as dc_field
 import numpy as np
 
 from .._atomic import write_figure, write_text
-from .._checks import check_bool, check_number
+from .._checks import check_bool, check_names, check_number
 from .._types import ArrayLike, GrowthFieldLike, PathLike
 from ..errors import WoodcamError, require
 from ..fields.base import evaluate, has_uncertainty
@@ -306,9 +306,23 @@ def benchmark(blocks: Sequence[Block], methods: Sequence[str] = ("rbf", "radial"
     import time
     from pathlib import Path
 
-    from .fit import fit_block
+    from ..block.block import Block
+    from .fit import METHODS, fit_block
 
     confidence = check_bool(confidence, "confidence")
+    # [] was an IndexError at the mean row, None a TypeError; methods [] a table of no method
+    try:
+        block_list = [] if isinstance(blocks, (str, Block)) else list(blocks)
+    except TypeError:
+        block_list = []
+    if not block_list or not all(isinstance(b, Block) for b in block_list):
+        raise WoodcamError(f"blocks must be a non-empty list of woodcam.block.Block; got {blocks!r:.60}; "
+                           "e.g. [synth_block(...)] or [read_block('BLOCK')] with a true_field")
+    blocks = block_list
+    methods = check_names(methods, "methods", what="method names", known=METHODS)
+    if face_sets is not None and not isinstance(face_sets, dict):
+        raise WoodcamError(f"face_sets must be a dict label -> list of faces (or None for all), or None; "
+                           f"got {type(face_sets).__name__}; e.g. {{'full': None, 'top+front': ['top', 'front']}}")
     face_sets = {"full": None} if face_sets is None else face_sets
     result, tables = {}, []
     for label, faces in face_sets.items():

@@ -30,12 +30,12 @@ import numpy as np
 from .._atomic import write_figure, write_text
 from .._types import PathLike
 from ..errors import WoodcamError, require
-from .._checks import check_bool
+from .._checks import check_bool, check_names
 from ..fields.base import arf, has_uncertainty
 from ..fields.rings import ring_lines
 from ..frames import face_pixel_points
 from ..tolerances import HOLDOUT_LINE_STEP_PX, HOLDOUT_THRESHOLDS_PX, RING_MAP_THRESHOLD
-from .fit import fit_block
+from .fit import METHODS, fit_block
 from .observations import _pixel_index, knot_exclusion
 
 if TYPE_CHECKING:
@@ -217,8 +217,8 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
         if not isinstance(b, Block) and not (name == "reference" and b is None):
             raise WoodcamError(f"{name} must be a woodcam.block.Block; got {type(b).__name__}; pass read_block(...)"
                                + (" or None" if name == "reference" else ""))
-    if isinstance(methods, str):  # 'radial' was read letter by letter: "method must be ...; got 'r'"
-        raise WoodcamError(f"methods must be a list of method names; got the string {methods!r}; pass [{methods!r}]")
+    # 'radial' was read letter by letter ("method must be ...; got 'r'"), [] an IndexError at the table
+    methods = check_names(methods, "methods", what="method names", known=METHODS)
     if progress is not None and not callable(progress):
         raise WoodcamError(f"progress must be a callable taking one line of text, or None; got {type(progress).__name__}")
     confidence = check_bool(confidence, "confidence")
