@@ -556,6 +556,27 @@ def check_output_path(path, *, suffixes: Iterable[str] | None = None, what: str 
     return path
 
 
+def output_folder(folder, what: str, *, make: bool = True) -> Path:
+    """``folder`` as an output folder: made with its parents (``make=False``: only checked to
+    be a folder or makeable, before the work that fills it). A file at ``folder`` or in its
+    way is refused naming ``what``; it was ``Path.mkdir``'s bare FileExistsError or
+    NotADirectoryError (after the work, where the folder was made last)."""
+    folder = Path(folder)
+    base = folder
+    while not base.exists() and base != base.parent:
+        base = base.parent
+    if base.exists() and not base.is_dir():
+        raise WoodcamError(f"{what}: cannot make the folder {str(folder)!r}: {str(base)!r} is a file; "
+                           "choose an output folder")
+    if make:
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise WoodcamError(f"{what}: cannot make the folder {str(folder)!r} ({err.strerror}); "
+                               "choose an output folder you can write to") from err
+    return folder
+
+
 def check_folder_writable(folder, *, what: str = "--out", name: str = ".woodcam-write-check") -> Path:
     """Check that files can be made in the existing folder ``folder`` *before* any work; return
     it as a ``Path``. The one home of the "not writable" refusal: a FILE ``--out``'s folder

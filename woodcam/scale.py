@@ -336,8 +336,10 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
             raise WoodcamError(f"workers cannot be set with an address: the cluster at {address} "
                                f"has its own workers; got workers={workers!r}")
     keys = _check_keys(keys)
-    out_dir = Path(out_dir)
-    (out_dir / RECORDS_DIR).mkdir(parents=True, exist_ok=True)
+    from ._atomic import output_folder
+
+    out_dir = check_path(out_dir, "run_many: out_dir", fix="the run folder, e.g. 'runs/bench'")
+    output_folder(out_dir / RECORDS_DIR, "run_many: out_dir")
     for stale in (out_dir / RECORDS_DIR).glob(".*.tmp*"):  # temp files of a killed run
         stale.unlink(missing_ok=True)
     done_before = _finished_keys(out_dir)

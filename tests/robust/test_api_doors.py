@@ -1173,3 +1173,21 @@ def test_a_stock_built_by_hand_refuses_what_is_no_wood(wood):
 
     for ok in (Drawn(), Read(), w.open_stock("builtin:flat-sawn").wood):
         assert Stock("mine", (20.0, 20.0, 20.0), ok).wood is ok
+
+
+@pytest.mark.parametrize("writer", ["write_block", "leave_one_face_out", "benchmark", "run_many"])
+def test_an_output_folder_that_is_a_file_is_refused_naming_it(writer, tmp_path):
+    """A file given as the folder to write (or a file in its way) was Path.mkdir's bare
+    FileExistsError / NotADirectoryError; leave_one_face_out raised it after all its fits."""
+    import woodcam as w
+
+    (tmp_path / "photo.png").write_bytes(b"x")
+    for out in (tmp_path / "photo.png", tmp_path / "photo.png" / "sub"):
+        call = {"write_block": lambda: w.write_block(_synth(), out),
+                "leave_one_face_out": lambda: w.leave_one_face_out(_synth(), ["radial"], out_dir=out),
+                "benchmark": lambda: w.benchmark([_synth()], ["radial"], out_dir=out),
+                "run_many": lambda: w.run_many(str, ["a"], out, progress=False)}[writer]
+        with pytest.raises(WoodcamError, match=f"{writer}: (folder|out_dir): cannot make the folder .*photo.png.* is a file; "
+                                               "choose an output folder"):
+            call()
+

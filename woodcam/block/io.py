@@ -58,7 +58,7 @@ import numpy as np
 
 from .._checks import check_bool, check_path
 from .._types import ArrayLike, PathLike
-from .._atomic import all_or_nothing, atomic_path, write_text
+from .._atomic import all_or_nothing, atomic_path, output_folder, write_text
 from .._readers import photo_rgb8, read_image_file
 from ..errors import WoodcamError, WoodcamWarning
 from ..fields.state import field_from_state, field_type, jsonable
@@ -115,7 +115,7 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
                            "builtin_block(...) or synth_block(...)")
     folder = check_path(folder, "write_block: folder", fix="the block folder to write, e.g. 'blocks/oak1'")
     overwrite = check_bool(overwrite, "write_block: overwrite")
-    folder.mkdir(parents=True, exist_ok=True)
+    output_folder(folder, "write_block: folder")
     manifest_path = folder / MANIFEST
     if manifest_path.exists() and not overwrite:
         raise WoodcamError(

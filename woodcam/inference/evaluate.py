@@ -21,8 +21,8 @@ from dataclasses import dataclass, field as dc_field
 
 import numpy as np
 
-from .._atomic import write_figure, write_text
-from .._checks import check_bool, check_names, check_number
+from .._atomic import output_folder, write_figure, write_text
+from .._checks import check_bool, check_names, check_number, check_path
 from .._types import ArrayLike, GrowthFieldLike, PathLike
 from ..errors import WoodcamError, require
 from ..fields.base import evaluate, has_uncertainty
@@ -323,6 +323,8 @@ def benchmark(blocks: Sequence[Block], methods: Sequence[str] = ("rbf", "radial"
     if face_sets is not None and not isinstance(face_sets, dict):
         raise WoodcamError(f"face_sets must be a dict label -> list of faces (or None for all), or None; "
                            f"got {type(face_sets).__name__}; e.g. {{'full': None, 'top+front': ['top', 'front']}}")
+    if out_dir is not None:  # a file there was a FileExistsError after the first block's fits
+        output_folder(check_path(out_dir, "out_dir"), "benchmark: out_dir", make=False)
     face_sets = {"full": None} if face_sets is None else face_sets
     result, tables = {}, []
     for label, faces in face_sets.items():
@@ -348,7 +350,7 @@ def benchmark(blocks: Sequence[Block], methods: Sequence[str] = ("rbf", "radial"
                 progress(f"{label} {b.name}: " + ", ".join(
                     f"{m} {row[m]['matched_1']:.1f}/{row[m]['matched_2']:.1f}% {times[m]:.1f}s" for m in methods))
             if out_dir is not None:
-                Path(out_dir).mkdir(parents=True, exist_ok=True)
+                output_folder(out_dir, "benchmark: out_dir")
                 plot_planes(Path(out_dir) / f"{b.name}_{label}.png", {m: scored[m][1] for m in methods},
                             title=f"{b.name} ({label}): black = true rings, colour = fitted",
                             confidence=confidence)

@@ -23,14 +23,13 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 import time
 from dataclasses import dataclass, field as dc_field
-from pathlib import Path
 
 import numpy as np
 
-from .._atomic import write_figure, write_text
+from .._atomic import output_folder, write_figure, write_text
 from .._types import PathLike
 from ..errors import WoodcamError, require
-from .._checks import check_bool, check_names
+from .._checks import check_bool, check_names, check_path
 from ..fields.base import arf, has_uncertainty
 from ..fields.rings import ring_lines
 from ..frames import face_pixel_points
@@ -222,6 +221,8 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
     if progress is not None and not callable(progress):
         raise WoodcamError(f"progress must be a callable taking one line of text, or None; got {type(progress).__name__}")
     confidence = check_bool(confidence, "confidence")
+    if out_dir is not None:  # a file there was a FileExistsError after all the fits
+        output_folder(check_path(out_dir, "out_dir"), "leave_one_face_out: out_dir", make=False)
     ref_block = block if reference is None else reference
     faces = [n for n, f in block.faces.items() if f.has_rings and n in ref_block.faces
              and ref_block.faces[n].ring_map is not None]
@@ -267,8 +268,7 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
            "fit_s": {m: float(np.mean(t)) for m, t in times.items()}}
     res["table"] = holdout_table(block.name, res, list(methods))
     if out_dir is not None:
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
+        out = output_folder(out_dir, "leave_one_face_out: out_dir")
         write_text(out / f"{block.name}_holdout.md", res["table"])
         for m in methods:
             plot_holdout(out / f"{block.name}_{m}.png", block, held[m],
