@@ -83,6 +83,22 @@ def test_bad_inputs_name_the_rule(tmp_path):
         simple_log(-1)
 
 
+@pytest.mark.parametrize("kw, said", [
+    ({"pith_z_mm": "abc"}, "Log.pith_z_mm must be \\(h,\\) heights in mm \\(numbers\\); got 'abc'"),
+    ({"pith_xy_mm": "ab"}, "Log.pith_xy_mm must be \\(h, 2\\) pith points in mm \\(numbers\\); got 'ab'"),
+    ({"radii_mm": [[1, "a"]]}, "Log.radii_mm must be \\(h, a\\) radii in mm \\(numbers\\); got \\[\\[1, 'a'\\]\\]"),
+    ({"knots": 5}, "Log.knots must be a sequence of woodcam.fields.skeleton.BranchStrand; got 5; pass \\(\\)"),
+    ({"knots": [1]}, "Log.knots must be a sequence of .*BranchStrand; got \\[1\\]"),
+], ids=["z str", "xy str", "radii str", "knots int", "knots of ints"])
+def test_a_log_of_what_is_not_numbers_or_knots_is_refused_naming_it(kw, said):
+    """A string was numpy's bare ValueError, knots=5 tuple()'s TypeError and
+    knots=[1] was taken (an AttributeError in the first knot field)."""
+    args = {"pith_z_mm": [0.0, 10.0, 20.0], "pith_xy_mm": np.zeros((3, 2)), "radii_mm": np.ones((3, 8))} | kw
+    knots = args.pop("knots", ())
+    with pytest.raises(WoodcamError, match=said):
+        LogSkeleton(**args, knots=knots)
+
+
 def test_diameter_model_against_the_bark_bumps(gran1):
     """Where a knot leaves through the bark the measured radius has a bump; its width along
     the azimuth follows the power law ``A r^(1+B)`` better than the quadratic ``A r + B r^2/100``

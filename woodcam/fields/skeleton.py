@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._checks import as_floats
 from .._types import ArrayLike
 from ..errors import WoodcamError
 
@@ -203,9 +204,20 @@ class LogSkeleton:
     name: str = "log"
 
     def __post_init__(self):
-        z = np.asarray(self.pith_z_mm, float)
-        xy = np.asarray(self.pith_xy_mm, float)
-        rad = np.asarray(self.radii_mm, float)
+        # a string or None was numpy's bare "could not convert" ValueError / TypeError, knots=5
+        # tuple()'s TypeError, knots=[1] taken and an AttributeError in the first knot field
+        z, xy, rad = (as_floats(getattr(self, name)) for name in ("pith_z_mm", "pith_xy_mm", "radii_mm"))
+        for name, v, shape in (("pith_z_mm", z, "(h,) heights"), ("pith_xy_mm", xy, "(h, 2) pith points"),
+                               ("radii_mm", rad, "(h, a) radii")):
+            if v is None:
+                raise WoodcamError(f"Log.{name} must be {shape} in mm (numbers); got {getattr(self, name)!r:.60}")
+        try:
+            knots = tuple(self.knots)
+        except TypeError:
+            knots = None
+        if knots is None or not all(isinstance(k, BranchStrand) for k in knots):
+            raise WoodcamError(f"Log.knots must be a sequence of woodcam.fields.skeleton.BranchStrand; got "
+                               f"{self.knots!r:.60}; pass () for a log without knots")
         if z.ndim != 1 or len(z) < 2 or np.any(np.diff(z) <= 0):
             raise WoodcamError(f"Log.pith_z_mm must be 1-D, >= 2 samples, strictly increasing; "
                                f"got shape {z.shape}; sort the pith samples by height")
@@ -225,7 +237,7 @@ class LogSkeleton:
         object.__setattr__(self, "pith_z_mm", z)
         object.__setattr__(self, "pith_xy_mm", xy)
         object.__setattr__(self, "radii_mm", rad)
-        object.__setattr__(self, "knots", tuple(self.knots))
+        object.__setattr__(self, "knots", knots)
 
     @property
     def length_mm(self) -> float:
