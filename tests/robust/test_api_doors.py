@@ -509,6 +509,19 @@ def _library_door_sweep():
          "speed must be a GrowthSpeed; got NoneType"),
         ("woodified spacing 0 !", lambda: w.WoodifiedField(np.zeros((3, 3, 3)), (0, 0, 0), 0.0, w.GrowthSpeed(1, 1), 1.0),
          "spacing_mm must be a finite number > 0; got 0.0"),
+        ("woodified NaN years_final *", lambda: _woodified(years_final=np.nan),
+         "years_final must be a finite number >= 0; got nan; the last simulated year"),
+        ("woodified str years_final", lambda: _woodified(years_final="a"), "years_final must be a finite number >= 0; got 'a'"),
+        ("woodified NaN block origin *", lambda: _woodified(block_origin_mm=(np.nan, 0, 0)),
+         r"block_origin_mm must be three finite numbers \(x, y, z\); got \(nan, 0, 0\)"),
+        ("woodified str block origin", lambda: _woodified(block_origin_mm="abc"), "block_origin_mm must be three finite numbers"),
+        ("woodified zero stem axis", lambda: _woodified(stem_axis=(0, 0, 0)),
+         r"stem_axis must be a non-zero direction; got \(0, 0, 0\)"),
+        ("woodified NaN stem axis *", lambda: _woodified(stem_axis=(np.nan, 0, 1)), "stem_axis must be three finite numbers"),
+        ("woodified NaN block size *", lambda: _woodified(block_size_mm=(np.nan, 1, 1)),
+         r"block_size_mm must be three finite sizes > 0 \(W, D, H mm\); got \(nan, 1, 1\)"),
+        ("woodified obstacles of another grid *", lambda: _woodified(obstacle_sdf_mm=np.zeros((2, 2, 2))),
+         r"obstacle_sdf_mm must be the signed distances on the arrival grid's nodes, shape \(3, 3, 3\); got shape \(2, 2, 2\)"),
         ("knotted params dict", lambda: w.KnottedLogField(_small_log(), params={}), "params must be a KnotParams or None; got dict"),
         ("colormap knots dict", lambda: w.ColorMapAppearance(knots={}), "knots must be a KnotShading; got dict"),
         ("mokume_veneers size 0", lambda: w.mokume_veneers(_scan_file().parent, size_mm=0), "size_mm must be a finite number > 0; got 0"),
@@ -535,6 +548,16 @@ def _evidence_fit(accepted: int):
 
     a, b = w.builtin_block("flat-sawn").field, w.builtin_block("rift").field
     return w.EvidenceFit(a, "a", {}, False, accepted < 2, ["a", "b"][:accepted], "", {"a": a, "b": b})
+
+
+def _woodified(**kw):
+    """A WoodifiedField of a 3 x 3 x 3 arrival grid, 1 mm apart, ``kw`` changed."""
+    import numpy as np
+
+    import woodcam as w
+
+    args = dict(years_final=1.0) | kw
+    return w.WoodifiedField(np.arange(27.0).reshape(3, 3, 3), (0, 0, 0), 1.0, w.GrowthSpeed(10, 1), **args)
 
 
 def _woodify(**kw):

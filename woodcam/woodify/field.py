@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 from scipy import ndimage
 
 from .._atomic import atomic_write
-from .._checks import check_bool, check_number, check_vector, npz_path
+from .._checks import as_floats, check_bool, check_number, check_vector, npz_path
 from .._readers import read_npz
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, check_points
@@ -94,22 +94,30 @@ class WoodifiedField:
         # 0 was refused as 'block_size_mm ... got None', a string was float()'s ValueError
         self.spacing_mm = check_number(spacing_mm, "spacing_mm", lo=0, lo_open=True, fix="the grid's node spacing, mm")
         self.speed = speed
-        self.years_final = float(years_final)
+        # NaN was kept (a report of 'nan years'), a string float()'s ValueError; a NaN block
+        # origin made every year NaN, a zero stem axis numpy's divide warning and a NaN axis
+        self.years_final = check_number(years_final, "years_final", lo=0, fix="the last simulated year")
         # beyond the velocity scale the front never arrives (W < 1): cap where W = 1 - 1e-6
         self.years_cap = float(speed.years(min(self.t_cap_mm, speed.velocity_mm * (1 - 1e-6))))
-        self.obstacle_sdf_mm = None if obstacle_sdf_mm is None else np.asarray(obstacle_sdf_mm, np.float32)
+        sdf = None if obstacle_sdf_mm is None else as_floats(obstacle_sdf_mm)
+        if obstacle_sdf_mm is not None and (sdf is None or sdf.shape != T.shape):
+            raise WoodcamError(f"obstacle_sdf_mm must be the signed distances on the arrival grid's nodes, shape "
+                               f"{T.shape}; got {'shape ' + str(sdf.shape) if sdf is not None else repr(obstacle_sdf_mm)[:60]}")
+        self.obstacle_sdf_mm = None if sdf is None else sdf.astype(np.float32)
         self.interpolation = interpolation
-        ax = np.asarray(speed.up if stem_axis is None else stem_axis, float).reshape(3)
-        self.stem_axis = ax / np.linalg.norm(ax)
+        self.stem_axis = check_vector(speed.up if stem_axis is None else stem_axis, "stem_axis", unit=True,
+                                      fix="the fibre direction in the object frame, or None for speed.up")
         R = np.eye(3) if rotation is None else np.asarray(rotation, float)
         if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
             raise WoodcamError(f"rotation must be a proper 3x3 rotation matrix; got {R.tolist()}")
         self.rotation = R
-        self.block_origin_mm = np.asarray(block_origin_mm, float).reshape(3)
+        self.block_origin_mm = check_vector(block_origin_mm, "block_origin_mm",
+                                            fix="the object-frame position of the block's origin corner")
         extent = (np.asarray(self.arrival_mm.shape) - 1) * self.spacing_mm
-        self.block_size_mm = tuple(float(v) for v in (extent if block_size_mm is None else block_size_mm))
-        if len(self.block_size_mm) != 3 or min(self.block_size_mm) <= 0:
-            raise WoodcamError(f"block_size_mm must be three sizes > 0 (W, D, H mm); got {block_size_mm!r}")
+        size = as_floats(extent if block_size_mm is None else block_size_mm)
+        if size is None or size.shape != (3,) or not np.all(np.isfinite(size)) or np.any(size <= 0):
+            raise WoodcamError(f"block_size_mm must be three finite sizes > 0 (W, D, H mm); got {block_size_mm!r}")
+        self.block_size_mm = tuple(float(v) for v in size)
         order = _ORDER[interpolation]
         self._coeffs = (ndimage.spline_filter(self.arrival_mm, order=order, mode="nearest",
                                               output=np.float32) if order > 1 else self.arrival_mm)
