@@ -35,8 +35,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._atomic import all_or_nothing, atomic_folder, atomic_path, remove_stale, write_figure, write_text
-from ._checks import check_bool
+from ._atomic import all_or_nothing, atomic_folder, atomic_path, output_folder, remove_stale, write_figure, write_text
+from ._checks import as_floats, check_bool, check_number, check_path
 from .errors import WoodcamError
 
 if TYPE_CHECKING:
@@ -82,7 +82,7 @@ def key_index(key: str) -> int:
 def bench_settings(**overrides) -> dict:
     """:data:`DEFAULT_SETTINGS` with ``overrides`` checked: unknown names and bad values raise."""
     from .inference.fit import METHODS
-    from .frames import check_face
+    from .frames import check_face, check_size
 
     unknown = set(overrides) - set(DEFAULT_SETTINGS)
     if unknown:
@@ -94,16 +94,25 @@ def bench_settings(**overrides) -> dict:
     if bad or not s["methods"]:
         raise WoodcamError(f"methods must be a comma-separated subset of {', '.join(METHODS)}; got "
                            f"{','.join(s['methods'])!r}")
+    # a list of face sets was an AttributeError, knotted_fraction='a' a TypeError; a NaN, zero or
+    # text size_mm and a NaN or reversed ring-width range were taken, and every block of the run
+    # then failed in its task
+    if not isinstance(s["face_sets"], dict):
+        raise WoodcamError(f"face_sets must be a dict label -> list of faces (or None for all); got "
+                           f"{s['face_sets']!r:.60}; e.g. {{'full': None, 'partial': ['front', 'top', 'left']}}")
     for faces in s["face_sets"].values():
         for f in faces or ():
             check_face(f)
-    if not 0.0 <= s["knotted_fraction"] <= 1.0:
-        raise WoodcamError(f"knotted_fraction must be in [0, 1]; got {s['knotted_fraction']!r}")
+    check_number(s["knotted_fraction"], "knotted_fraction", lo=0, hi=1, fix="the share of knotted blocks")
+    check_size(s["size_mm"])
+    widths = as_floats(s["ring_width_range_mm"])
+    if widths is None or widths.shape != (2,) or not np.all(np.isfinite(widths)) or not 0 < widths[0] <= widths[1]:
+        raise WoodcamError(f"ring_width_range_mm must be two ring widths 0 < min <= max in mm; got "
+                           f"{s['ring_width_range_mm']!r:.60}; e.g. [2.0, 5.0]")
     if not (isinstance(s["face_px"], int) and s["face_px"] >= 32):
         raise WoodcamError(f"face_px must be an integer >= 32 pixels; got {s['face_px']!r}")
-    if s["trace_jitter_mm"] < 0 or not 0.0 <= s["trace_dropout"] <= 1.0:
-        raise WoodcamError(f"trace_jitter_mm must be >= 0 mm and trace_dropout in [0, 1]; got "
-                           f"{s['trace_jitter_mm']!r}, {s['trace_dropout']!r}")
+    check_number(s["trace_jitter_mm"], "trace_jitter_mm", lo=0, fix="the traces' noise in mm, e.g. 0.1")
+    check_number(s["trace_dropout"], "trace_dropout", lo=0, hi=1, fix="the share of trace points dropped")
     return s
 
 
@@ -185,12 +194,24 @@ def bench_block(seed: int, index: int, settings: dict) -> dict:
     (face set -> method -> :data:`METRICS` percentages and ``n_points``, or ``{"error": msg}``
     when the method refused the block) and ``timing`` (seconds; not deterministic).
     """
+    # seed='a' was int()'s ValueError, index=-1 numpy's, settings=None a TypeError
+    seed, index = _check_seed_index(seed, index)
+    if not isinstance(settings, dict) or set(DEFAULT_SETTINGS) - set(settings):
+        raise WoodcamError(f"settings must be the dict of every bench setting (bench_settings(...)); got "
+                           f"{settings!r:.60}; pass bench_settings() or bench_settings(face_px=64)")
     t0 = time.perf_counter()
     block, kind, params = make_bench_block(seed, index, settings)
     synth_s = time.perf_counter() - t0
     metrics, timing, _ = _fit_all(block, settings)
     return {"seed": int(seed), "index": int(index), "kind": kind, "params": params,
             "metrics": metrics, "timing": {"synth_s": synth_s, **timing}}
+
+
+def _check_seed_index(seed, index) -> tuple[int, int]:
+    """The bench seed and a block index (or the first one, ``start``), each an integer >= 0
+    (numpy's generator refuses a negative one)."""
+    return (int(check_number(seed, "seed", lo=0, integer=True, fix="the bench's seed, e.g. 1")),
+            int(check_number(index, "index", lo=0, integer=True, fix="the block's number in the bench, from 0")))
 
 
 def _bench_task(key: str, seed: int, settings: dict) -> dict:
@@ -213,11 +234,17 @@ def run_bench(out_dir: str | Path, blocks: int, seed: int, settings: dict | None
     """
     from .scale import check_run_manifest, run_many
 
-    if not isinstance(blocks, int) or blocks < 1:
-        raise WoodcamError(f"blocks must be an integer >= 1; got {blocks!r}")
+    # seed='a' was int()'s ValueError and start=-1 a run of failed blocks (numpy refuses a negative
+    # index), settings=[1] a TypeError, blocks=True a run of one block, a file as out_dir mkdir's error
+    blocks = int(check_number(blocks, "blocks", lo=1, integer=True, fix="how many blocks to bench, e.g. 10"))
+    seed = _check_seed_index(seed, 0)[0]
+    start = int(check_number(start, "start", lo=0, integer=True, fix="the first block's number, from 0"))
+    if settings is not None and not isinstance(settings, dict):
+        raise WoodcamError(f"settings must be a dict of bench settings to override, or None; got {settings!r:.60}; "
+                           "e.g. {'face_px': 64}")
     settings = bench_settings() if settings is None else bench_settings(**settings)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_folder(check_path(out_dir, "run_bench: out_dir", fix="the run folder, e.g. 'runs/bench'"),
+                        "run_bench: out_dir")
     settings = _recorded_method_order(out / RUN_MANIFEST, settings)
     check_run_manifest(out / RUN_MANIFEST, {"format": "woodcam-bench-run", "version": 1,
                                             "seed": int(seed), "settings": settings})

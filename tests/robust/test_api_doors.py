@@ -476,6 +476,29 @@ def _library_door_sweep():
             (50, 40, 40)), "image of face 'front' must hold finite numbers; got 1 NaN/inf of 240 values"),
         ("unfold_cross image of strings", lambda: w.unfold_cross({"front": np.full((4, 10), "a")}, (50, 20, 20)),
          r"image of face 'front' must hold finite numbers; got dtype <U1; pass a numeric image"),
+        ("run_bench seed str", lambda: w.run_bench(_tmp() / "rb", 1, "a", progress=False),
+         "seed must be an integer >= 0; got 'a'; the bench's seed"),
+        ("run_bench start -1 *", lambda: w.run_bench(_tmp() / "rb", 1, 1, start=-1, progress=False),
+         "start must be an integer >= 0; got -1"),
+        ("run_bench blocks True *", lambda: w.run_bench(_tmp() / "rb", True, 1, progress=False),
+         "blocks must be an integer >= 1; got True"),
+        ("run_bench settings list", lambda: w.run_bench(_tmp() / "rb", 1, 1, [1], progress=False),
+         r"settings must be a dict of bench settings to override, or None; got \[1\]"),
+        ("run_bench NaN size *", lambda: w.run_bench(_tmp() / "rb", 1, 1, {"size_mm": [np.nan, 20, 20]}, progress=False),
+         r"size_mm must be three positive finite lengths \(W, D, H\) in mm; got \[nan, 20, 20\]"),
+        ("run_bench reversed ring widths *", lambda: w.run_bench(_tmp() / "rb", 1, 1, {"ring_width_range_mm": [3, 1]},
+                                                                 progress=False),
+         r"ring_width_range_mm must be two ring widths 0 < min <= max in mm; got \[3, 1\]"),
+        ("run_bench knotted_fraction str", lambda: w.run_bench(_tmp() / "rb", 1, 1, {"knotted_fraction": "a"}, progress=False),
+         r"knotted_fraction must be a finite number in \[0, 1\]; got 'a'"),
+        ("run_bench face_sets list", lambda: w.run_bench(_tmp() / "rb", 1, 1, {"face_sets": [1]}, progress=False),
+         r"face_sets must be a dict label -> list of faces .*got \[1\]"),
+        ("run_bench jitter str", lambda: w.run_bench(_tmp() / "rb", 1, 1, {"trace_jitter_mm": "a"}, progress=False),
+         "trace_jitter_mm must be a finite number >= 0; got 'a'"),
+        ("bench_block seed str", lambda: w.bench_block("a", 0, {}), "seed must be an integer >= 0; got 'a'"),
+        ("bench_block index -1", lambda: w.bench_block(1, -1, {}), "index must be an integer >= 0; got -1"),
+        ("bench_block settings None", lambda: w.bench_block(1, 0, None),
+         r"settings must be the dict of every bench setting \(bench_settings\(...\)\); got None"),
         ("run_many fn None *", lambda: w.run_many(None, ["a"], "runs", progress=False), "fn must be a callable .*got NoneType"),
         ("run_many retries True *", lambda: w.run_many(str, ["a"], "runs", retries=True, progress=False),
          "retries must be an integer >= 0; got True"),
@@ -548,6 +571,14 @@ def _evidence_fit(accepted: int):
 
     a, b = w.builtin_block("flat-sawn").field, w.builtin_block("rift").field
     return w.EvidenceFit(a, "a", {}, False, accepted < 2, ["a", "b"][:accepted], "", {"a": a, "b": b})
+
+
+def _tmp():
+    """A new empty temporary folder of this process."""
+    import tempfile
+    from pathlib import Path
+
+    return Path(tempfile.mkdtemp(prefix="woodcam-doors-"))
 
 
 def _woodified(**kw):
