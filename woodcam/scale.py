@@ -327,6 +327,9 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
         check_number(memory_limit_mb, "memory_limit_mb", lo=256,
                      fix="MiB per worker (a Python worker alone needs ~100 MiB), or None")
     progress = check_bool(progress, "run_many: progress")
+    # NaN or -1 was taken, and handed to Dask's Client(timeout=...) as it was
+    connect_timeout_s = check_number(connect_timeout_s, "connect_timeout_s", lo=0, lo_open=True,
+                                     fix=f"seconds to wait for a Dask scheduler, e.g. {CONNECT_TIMEOUT_S:g}")
     if address is not None:
         if engine != "dask":
             raise WoodcamError(f"address applies to engine='dask' only; got engine={engine!r} "
