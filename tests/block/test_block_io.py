@@ -207,7 +207,7 @@ def test_write_block_refuses_what_read_block_would_refuse(tmp_path):
         Face("top", (0, 0))
     with pytest.raises(WoodcamError, match="lies beyond its 4x4 px image"):
         Face("top", (4, 4), traces=[RingTrace([[0, 0], [100, 100]])])
-    with pytest.raises(WoodcamError, match="Block.name must be a string"):
+    with pytest.raises(WoodcamError, match="Block.name must be a plain name, no path .*got 5"):
         Block((10, 10, 10), name=5)
     rgba = Face("top", (4, 4), extras={"paint": np.zeros((4, 4, 4), np.uint8)})
     with pytest.raises(WoodcamError, match=r"grey \(h, w\) or RGB \(h, w, 3\)"):
@@ -240,3 +240,17 @@ def test_a_ragged_saved_field_is_refused_with_one_fix_naming_the_file(tmp_path):
     assert msg.startswith(f"true field {str(saved)!r}: the saved state of field type") and "ValueError" in msg
     assert msg.endswith(f"; write the block again (woodcam.block.write_block) to replace {saved.name}")
     assert msg.count("; ") == 1 and "drop the file" not in msg and "returned for it" not in msg
+
+
+@pytest.mark.parametrize("name", ["../escaped", "a/b", "..\\x"])
+def test_a_block_name_that_is_a_path_is_refused_before_it_names_a_file(tmp_path, name):
+    """A block's name makes its output files' names (leave_one_face_out's NAME_holdout.md): a
+    block.json "name" of '../escaped' wrote them outside out_dir."""
+    with pytest.raises(WoodcamError, match=r"Block.name must be a plain name, no path .*got '.*'; e.g. 'oak1'"):
+        Block((10, 10, 10), name=name)
+    write_block(Block((10, 10, 10), name="plain"), tmp_path / "b")
+    manifest = json.loads((tmp_path / "b" / "block.json").read_text())
+    (tmp_path / "b" / "block.json").write_text(json.dumps({**manifest, "name": name}))
+    with pytest.raises(WoodcamError, match="Block.name must be a plain name"):
+        read_block(tmp_path / "b")
+

@@ -193,8 +193,11 @@ class Block:
         self.size_mm = tuple(float(s) for s in check_size(self.size_mm))
         from ..limits import limit
 
-        if not isinstance(self.name, str):
-            raise WoodcamError(f"Block.name must be a string; got {self.name!r}")
+        # the name makes the file names of its outputs (leave_one_face_out's NAME_holdout.md,
+        # benchmark's NAME_full.png): a name '../x' (a block.json's "name") wrote outside out_dir
+        if not isinstance(self.name, str) or any(c in self.name for c in "/\\\0"):
+            raise WoodcamError(f"Block.name must be a plain name, no path (it names the block's output files, "
+                               f"e.g. NAME_holdout.md); got {self.name!r}; e.g. 'oak1'")
         if max(self.size_mm) > limit("MAX_BLOCK_SIZE_MM"):  # read_block refuses it
             raise WoodcamError(f"Block.size_mm must be at most {limit('MAX_BLOCK_SIZE_MM'):g} mm a side "
                                f"(woodcam.limits.MAX_BLOCK_SIZE_MM); got {self.size_mm}")
