@@ -54,6 +54,7 @@ from .appearance import ColorMapAppearance, NeuralAppearance, Wood
 from .errors import BlockSpecError, WoodcamError, WoodcamWarning
 from .fields.base import has_uncertainty
 from .fields.builtin import BUILTIN_NAMES, builtin_block
+from .frames import check_size
 
 AppearanceKind = Literal["colormap", "neural"]
 
@@ -86,6 +87,15 @@ class Stock:
             raise WoodcamError(f"Stock: wood must be a woodcam Wood (or have a method color(points_mm (n, 3), "
                                f"normals (n, 3)) -> rgb (n, 3) or features(points_mm (n, 3)) -> dict); got "
                                f"{type(self.wood).__name__}; pass Wood(field) or open the stock with open_stock")
+        # a NaN, zero or (2,) size was taken and failed (or drew NaN) in the carve or the bake; a
+        # spec that is no text was written into the GLB's metadata, a meta list failed there
+        check_size(self.size_mm)
+        if not isinstance(self.spec, str):
+            raise WoodcamError(f"Stock: spec must be the block spec text (e.g. 'builtin:flat-sawn'); got {self.spec!r:.60}")
+        if not isinstance(self.description, str):
+            raise WoodcamError(f"Stock: description must be a string; got {self.description!r:.60}")
+        if not isinstance(self.meta, dict):
+            raise WoodcamError(f"Stock: meta must be a dict of stock metadata; got {type(self.meta).__name__}")
 
 
 def resize_stock(stock: Stock, size_mm, origin_mm=(0.0, 0.0, 0.0)) -> Stock:

@@ -1250,3 +1250,21 @@ def test_an_output_folder_that_is_a_file_is_refused_naming_it(writer, tmp_path):
                                                "choose an output folder"):
             call()
 
+
+@pytest.mark.parametrize("kw, said", [
+    ({"size_mm": (np.nan, 1, 1)}, r"size_mm must be three positive finite lengths \(W, D, H\) in mm; got \(nan, 1, 1\)"),
+    ({"size_mm": (0, 1, 1)}, r"size_mm must be three positive .*got \(0, 1, 1\)"),
+    ({"size_mm": (1, 1)}, r"size_mm must be three positive .*got \(1, 1\)"),
+    ({"spec": 5}, r"Stock: spec must be the block spec text \(e.g. 'builtin:flat-sawn'\); got 5"),
+    ({"meta": [1]}, "Stock: meta must be a dict of stock metadata; got list"),
+    ({"description": None}, "Stock: description must be a string; got None"),
+], ids=["NaN size", "zero size", "size of 2", "spec int", "meta list", "description None"])
+def test_a_stock_built_by_hand_refuses_a_size_or_text_it_cannot_use(kw, said):
+    """Stock(...) took a NaN, zero or (2,) size, a spec that is no text and a meta list without a
+    word; each failed (or drew NaN) far away, in the carve, the bake or the GLB's metadata."""
+    from woodcam import Stock, Wood, builtin_block
+
+    args = {"spec": "mine", "size_mm": (20.0, 20.0, 20.0), "wood": Wood(builtin_block("flat-sawn").field)} | kw
+    with pytest.raises(WoodcamError, match=said):
+        Stock(**args)
+
