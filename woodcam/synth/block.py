@@ -13,6 +13,7 @@ from ..block import Block, Face
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, evaluate
 from ..fields.rings import MOKUME_RING_SIGMA_MM, ring_map
+from ..limits import check_limit
 from ..frames import (
     FACE_NORMAL,
     CrossLayout,
@@ -98,6 +99,11 @@ def synth_block(field: GrowthFieldLike, size_mm: ArrayLike, spec: SynthSpec | No
     # width, so this keeps all six face shapes consistent with it.
     px_per_mm = max(1, round(size[0] * float(px_per_mm))) / size[0]
     layout = CrossLayout(tuple(size), px_per_mm)
+    # face_px=10**7 (or px_per_mm=1e7) was numpy's MemoryError of a 2 PiB pixel grid; a block
+    # face holds at most MAX_FACE_PX a side (Face and read_block refuse more)
+    side = max((max(layout.face_shape(f)) for f in faces), default=0)
+    check_limit("MAX_FACE_PX", side, f"a face image of {side} px a side ({px_per_mm:.4g} px/mm on a "
+                f"{float(size.max()):g} mm block)", fix="lower face_px or px_per_mm")
     sigma_px = spec.ring_map.sigma_px
     if sigma_px is None:
         sigma_px = MOKUME_RING_SIGMA_MM * px_per_mm
