@@ -123,6 +123,10 @@ class Face:
             raise WoodcamError(f"shape of face {self.name!r} must be two pixel counts (n_rows, n_cols), whole "
                                f"in [1, {top}]; got {self.shape!r}; pass the face image's shape[:2]")
         self.shape = (int(shape[0]), int(shape[1]))
+        if isinstance(self.traces, (str, bytes, RingTrace, np.ndarray)) or not hasattr(self.traces, "__iter__"):
+            # 5 was list()'s TypeError, an (n, 2) array a list of its rows refused as 'trace 0'
+            raise WoodcamError(f"traces of face {self.name!r} must be a list of RingTrace; got "
+                               f"{type(self.traces).__name__}; e.g. traces=[RingTrace(points_px)]")
         self.traces = list(self.traces)
         for k, t in enumerate(self.traces):
             if not isinstance(t, RingTrace):
