@@ -457,6 +457,8 @@ def _library_door_sweep():
         ("scene resolution 0 *", lambda: w.SceneOptions(resolution_mm=0), "resolution_mm must be a finite number > 0; got 0"),
         ("scene resolution NaN *", lambda: w.SceneOptions(resolution_mm=np.nan), "resolution_mm must be a finite number > 0; got nan"),
         ("scene max_samples 0 *", lambda: w.SceneOptions(max_samples=0), "max_samples must be an integer >= 1; got 0"),
+        ("block true_field an int *", lambda: w.Block((10, 10, 10), true_field=5),
+         r"Block.true_field must be a growth field \(\(n, 3\) mm -> years\) or None; got int"),
         ("block meta list *", lambda: w.Block((10, 10, 10), meta=[1]), "Block.meta must be a dict of block metadata; got list"),
         ("face traces an int", lambda: w.Face("top", (8, 8), traces=5),
          r"traces of face 'top' must be a list of RingTrace; got int; e.g. traces=\[RingTrace\(points_px\)\]"),

@@ -207,6 +207,9 @@ class Block:
                                f"(woodcam.limits.MAX_BLOCK_SIZE_MM); got {self.size_mm}")
         if not isinstance(self.faces, dict):
             raise WoodcamError(f"Block.faces must be a dict face name -> Face; got {type(self.faces).__name__}")
+        if self.true_field is not None and not callable(self.true_field):  # 5 was saved as "truth not saved"
+            raise WoodcamError(f"Block.true_field must be a growth field ((n, 3) mm -> years) or None; got "
+                               f"{type(self.true_field).__name__}; e.g. builtin_block('flat-sawn').field")
         if not isinstance(self.meta, dict):  # a list was taken and failed at write_block or the fit
             raise WoodcamError(f"Block.meta must be a dict of block metadata; got {type(self.meta).__name__}")
         faces = {}
