@@ -100,6 +100,17 @@ def check_vector(value, name: str, *, n: int = 3, unit: bool = False, fix: str =
     return v
 
 
+def check_rotation(value, name: str, *, fix: str = "build it with scipy Rotation (.as_matrix())") -> np.ndarray:
+    """``value`` as a proper rotation, a float ``(3, 3)`` array: finite, orthonormal (to 1e-6)
+    and of determinant +1. The one rule of every rotation a user passes (a string was numpy's
+    bare ValueError, a reflection turned the wood inside out)."""
+    R = as_floats(value)
+    if R is None or R.shape != (3, 3) or not np.all(np.isfinite(R)) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6) \
+            or np.linalg.det(R) < 0:
+        _fail(name, "a proper 3x3 rotation matrix (orthonormal, det +1)", value, fix)
+    return R
+
+
 def check_names(value, name: str, *, what: str, known: Iterable[str] | None = None) -> list[str]:
     """``value`` as a non-empty list of names (each a ``str``; with ``known``: each one of
     them). A string was read letter by letter (``'radial'`` as ``'r'``, ``'a'``...), an empty

@@ -7,7 +7,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .._checks import as_floats, check_number, check_vector
+from .._checks import as_floats, check_number, check_rotation, check_vector
 from .._types import AppearanceLike, ArrayLike, GrowthFieldLike, WoodLike
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, evaluate, grain_direction, has_uncertainty
@@ -116,10 +116,7 @@ class Wood:
         so a cut turned by any angle shows this block's colours where it overlaps it).
 
         rotation : (3, 3) proper rotation; origin_mm : (3,) mm, in this wood's block frame."""
-        R = np.asarray(rotation, dtype=float)
-        if R.shape != (3, 3) or not np.all(np.isfinite(R)) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6) \
-                or np.linalg.det(R) < 0:
-            raise WoodcamError(f"rotated: rotation must be a proper 3x3 rotation matrix; got {R.tolist()!r:.120}")
+        R = check_rotation(rotation, "rotated: rotation")
         o = check_vector(origin_mm, "rotated: origin_mm", fix="the turned block's corner in this block, mm")
         out = Wood(self.field, self.appearance, threads=self.threads)
         r0, t0 = self._turn if self._turn is not None else (np.eye(3), np.zeros(3))

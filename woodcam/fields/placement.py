@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_floats
+from .._checks import as_floats, check_rotation
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from .base import LogFrame, check_points, grain_direction
@@ -31,12 +31,8 @@ class PlacedField:
             raise WoodcamError(
                 f"log_field must be callable (n, 3) mm -> years; got {type(log_field).__name__}")
         # a string was numpy's bare ValueError
-        R = np.eye(3) if rotation is None else as_floats(rotation)
+        R = np.eye(3) if rotation is None else check_rotation(rotation, "rotation")
         o = as_floats(origin_mm)
-        if R is None or R.shape != (3, 3) or not np.all(np.isfinite(R)) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6) \
-                or np.linalg.det(R) < 0:
-            raise WoodcamError("rotation must be a proper 3x3 rotation matrix (orthonormal, "
-                               f"det +1); got {rotation!r:.80}; build it with scipy Rotation")
         if o is None or o.shape != (3,):
             raise WoodcamError(f"origin_mm must be a 3-vector (mm, log frame); got {origin_mm!r:.80}")
         self.log_field = log_field

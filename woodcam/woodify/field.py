@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 from scipy import ndimage
 
 from .._atomic import atomic_write
-from .._checks import as_floats, check_bool, check_number, check_vector, npz_path
+from .._checks import as_floats, check_bool, check_number, check_rotation, check_vector, npz_path
 from .._readers import read_npz
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, check_points
@@ -107,9 +107,7 @@ class WoodifiedField:
         self.interpolation = interpolation
         self.stem_axis = check_vector(speed.up if stem_axis is None else stem_axis, "stem_axis", unit=True,
                                       fix="the fibre direction in the object frame, or None for speed.up")
-        R = np.eye(3) if rotation is None else np.asarray(rotation, float)
-        if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
-            raise WoodcamError(f"rotation must be a proper 3x3 rotation matrix; got {R.tolist()}")
+        R = np.eye(3) if rotation is None else check_rotation(rotation, "rotation")
         self.rotation = R
         self.block_origin_mm = check_vector(block_origin_mm, "block_origin_mm",
                                             fix="the object-frame position of the block's origin corner")
