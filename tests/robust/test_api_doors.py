@@ -454,6 +454,8 @@ def _library_door_sweep():
         ("preview_part place str !", lambda: w.preview_part(_cube(), _stock(), "p.glb", place="center", obj=False,
                                                             screenshot=False),
          r"place must be a list of placement operations; got the string 'center'; pass \['center'\]"),
+        ("preview options a dict", lambda: w.preview(_cube(), screenshot=_tmp() / "s.png", options={"camera": "top"}),
+         r"options must be a woodcam.view.SceneOptions or None; got dict; pass SceneOptions\(\*\*\{...\}\)"),
         ("scene resolution 0 *", lambda: w.SceneOptions(resolution_mm=0), "resolution_mm must be a finite number > 0; got 0"),
         ("scene resolution NaN *", lambda: w.SceneOptions(resolution_mm=np.nan), "resolution_mm must be a finite number > 0; got nan"),
         ("scene max_samples 0 *", lambda: w.SceneOptions(max_samples=0), "max_samples must be an integer >= 1; got 0"),

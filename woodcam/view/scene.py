@@ -718,6 +718,9 @@ class SceneOptions:
         if unknown:
             raise WoodcamError(f"unknown scene option(s) {unknown}; the options are "
                                f"{sorted(names)} (woodcam.view.SceneOptions)")
+        if options is not None and not isinstance(options, cls):  # a dict was an AttributeError ('camera')
+            raise WoodcamError(f"options must be a woodcam.view.SceneOptions or None; got {type(options).__name__}; "
+                               f"pass SceneOptions(**{{...}}) or the options as keywords (camera='top')")
         base = options if options is not None else cls()
         return replace(base, **keywords) if keywords else base
 
