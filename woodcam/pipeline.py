@@ -141,6 +141,14 @@ def _check_stock(stock) -> None:
                            "woodcam.open_stock('builtin:flat-sawn')")
 
 
+def _check_metadata(metadata) -> None:
+    """``metadata`` (extra GLB metadata) a dict or None: a list was a TypeError of ``**``
+    after the whole bake."""
+    if metadata is not None and not isinstance(metadata, dict):
+        raise WoodcamError(f"metadata must be a dict of extra GLB metadata or None; got {type(metadata).__name__}; "
+                           "e.g. metadata={'part': 'bowl'}")
+
+
 def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_mm: float = 10.0,
                  tolerance_mm: float | None = None, obj: bool = True,
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
@@ -221,6 +229,10 @@ def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: 
     from ._checks import check_bool
 
     part_report = check_bool(part_report, "part_report")
+    _check_metadata(metadata)
+    if result is not None and not isinstance(result, PartPreview):  # 5 was an AttributeError after the checks
+        raise WoodcamError(f"result must be a PartPreview to fill (its timings, warnings) or None; got "
+                           f"{type(result).__name__}")
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
     result = result or PartPreview(out_glb.stem)
     result.volume_mm3 = abs(float(mesh.volume))  # as the part report's (advise.part_report)
@@ -244,6 +256,7 @@ def preview_heightfield(heightmap, stock: Stock, out_glb, *, texels_per_mm: floa
     iso view with :func:`woodcam.view.stockview.write_stock_view` (no VTK)."""
     import numpy as np
 
+    _check_metadata(metadata)
     out_glb = check_outputs(out_glb, obj=obj, screenshot=screenshot)
     result = PartPreview(out_glb.stem)
     with result.stage("bake"):
