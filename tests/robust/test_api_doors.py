@@ -684,6 +684,14 @@ def _veneer():
     return Veneer("v", rgb, 4.0, np.ones((40, 40), bool), "noise")
 
 
+@functools.lru_cache(maxsize=1)
+def _parquetry_run():
+    """A run of one 20 x 20 px target from one noise sheet (small parameters)."""
+    import woodcam as w
+
+    return w.build_parquetry(_target(), [_veneer()], _small_params())
+
+
 def _small_params():
     import woodcam as w
 
@@ -1260,7 +1268,7 @@ def test_a_stock_built_by_hand_refuses_what_is_no_wood(wood):
         assert Stock("mine", (20.0, 20.0, 20.0), ok).wood is ok
 
 
-@pytest.mark.parametrize("writer", ["write_block", "leave_one_face_out", "benchmark", "run_many"])
+@pytest.mark.parametrize("writer", ["write_block", "leave_one_face_out", "benchmark", "run_many", "write_parquetry"])
 def test_an_output_folder_that_is_a_file_is_refused_naming_it(writer, tmp_path):
     """A file given as the folder to write (or a file in its way) was Path.mkdir's bare
     FileExistsError / NotADirectoryError; leave_one_face_out raised it after all its fits."""
@@ -1271,7 +1279,8 @@ def test_an_output_folder_that_is_a_file_is_refused_naming_it(writer, tmp_path):
         call = {"write_block": lambda: w.write_block(_synth(), out),
                 "leave_one_face_out": lambda: w.leave_one_face_out(_synth(), ["radial"], out_dir=out),
                 "benchmark": lambda: w.benchmark([_synth()], ["radial"], out_dir=out),
-                "run_many": lambda: w.run_many(str, ["a"], out, progress=False)}[writer]
+                "run_many": lambda: w.run_many(str, ["a"], out, progress=False),
+                "write_parquetry": lambda: w.write_parquetry(_parquetry_run(), out)}[writer]
         with pytest.raises(WoodcamError, match=f"{writer}: (folder|out_dir): cannot make the folder .*photo.png.* is a file; "
                                                "choose an output folder"):
             call()

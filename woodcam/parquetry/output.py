@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import all_or_nothing, manifest_path, remove_stale, write_text
+from .._atomic import all_or_nothing, manifest_path, output_folder, remove_stale, write_text
 from .._checks import check_bool, check_path
 from ._io import atomic_write_png
 from .cutpaths import (
@@ -159,7 +159,7 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
     _check_run(run, "write_parquetry")
     progress = check_bool(progress, "write_parquetry: progress")
     out = check_path(out_dir, "write_parquetry: out_dir", fix="the folder to write the panels and cut files to")
-    out.mkdir(parents=True, exist_ok=True)
+    output_folder(out, "write_parquetry: out_dir")
     prm = run.params
     ppm = prm.px_per_mm
     files = []
