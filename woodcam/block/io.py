@@ -115,6 +115,15 @@ def write_block(block: Block, folder: PathLike, *, ring_map_bits: Literal[8, 16]
                            "builtin_block(...) or synth_block(...)")
     folder = check_path(folder, "write_block: folder", fix="the block folder to write, e.g. 'blocks/oak1'")
     overwrite = check_bool(overwrite, "write_block: overwrite")
+    # a list of SVGs was ignored without a word, a list as existing an AttributeError ('items')
+    if traces_svg is not None and not (isinstance(traces_svg, dict)
+                                       and all(isinstance(v, str) for v in traces_svg.values())):
+        raise WoodcamError(f"write_block: traces_svg must be a dict face -> SVG file name in the folder, or None; "
+                           f"got {traces_svg!r:.60}; e.g. {{'front': 'front_traces.svg'}}")
+    if existing is not None and not (isinstance(existing, dict) and all(
+            isinstance(v, dict) and all(isinstance(f, str) for f in v.values()) for v in existing.values())):
+        raise WoodcamError(f"write_block: existing must be a dict face -> {{'ring_map' or an extras key: file name}}, "
+                           f"or None; got {existing!r:.60}; e.g. {{'front': {{'ring_map': 'front_rings.png'}}}}")
     output_folder(folder, "write_block: folder")
     manifest_path = folder / MANIFEST
     if manifest_path.exists() and not overwrite:
