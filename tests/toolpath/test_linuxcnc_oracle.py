@@ -998,3 +998,23 @@ def test_m61_loads_its_tool_with_both_interpreters():
     mine = read_gcode(text)
     theirs = read_gcode(text, interpreter="linuxcnc")
     assert theirs.tool.tolist() == mine.tool.tolist() == [1, 1, 2, 3, 4], theirs.tool
+
+
+def test_linuxcnc_reads_no_subroutine_file_of_the_folder_woodcam_runs_in(tmp_path, monkeypatch):
+    """An 'o<name> call' of a subroutine the file does not define: LinuxCNC looks for name.ngc
+    in its working folder, which was the one woodcam was started from, so a stale mysub.ngc
+    there was cut (Z-3 to X9) and the same command elsewhere refused the program. Woodcam's
+    interpreter reads one file and refuses it; --interpreter linuxcnc runs in its scratch
+    folder now and refuses it too, naming 'the program', not its scratch copy."""
+    (tmp_path / "prog").mkdir()
+    (tmp_path / "here").mkdir()
+    main = tmp_path / "prog" / "main.ngc"
+    main.write_text("G21 G90\nT1 M6\n(PRINT,hi)\nG0 X1 Y1 Z5\no<mysub> call\nG0 Z5\nM2\n")
+    (tmp_path / "here" / "mysub.ngc").write_text("o<mysub> sub\nG1 Z-3 F100\nG1 X9\n"
+                                                 "o<mysub> endsub\nM2\n")
+    monkeypatch.chdir(tmp_path / "here")
+    with pytest.raises(GcodeError, match=r"EOF in the program seeking o-word: o<mysub>") as e:
+        read_gcode(main, interpreter="linuxcnc")
+    assert "woodcam-lcnc" not in str(e.value)
+    with pytest.raises(GcodeError, match="subroutine omysub is not defined in this file"):
+        read_gcode(main)

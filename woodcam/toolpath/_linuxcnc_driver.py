@@ -287,9 +287,15 @@ def main():
     result_fd = os.dup(1)
     os.dup2(2, 1)  # the interpreter prints debugging lines to stdout: send them to stderr
     work = tempfile.mkdtemp(prefix="woodcam-lcnc-")
+    # run in the scratch folder: the interpreter looks for an 'o<name> call' it does not find
+    # in the file as name.ngc in the working folder (no PROGRAM_PREFIX or SUBROUTINE_PATH here),
+    # so the folder woodcam was started from gave the program its subroutines (a stale file of
+    # that name there was cut); now none, as woodcam's interpreter, which reads one file
+    os.chdir(work)
     try:  # the scratch folder (tool map, ini, parameter files) goes whatever happens
         _run(job, work, result_fd)
     finally:
+        os.chdir("/")
         shutil.rmtree(work, ignore_errors=True)
 
 

@@ -155,7 +155,9 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
     if res["error"]:
         line, msg = res["error"]
         if msg != NO_END:
-            raise GcodeError(int(line), "LinuxCNC", msg, REFUSED_FIX)
+            # (its messages name the file it read: a scratch copy, not the user's)
+            raise GcodeError(int(line), "LinuxCNC", _SCRATCH.sub("the program", msg),
+                             REFUSED_FIX)
         warnings.append((int(line), msg))
     moves = [(k, ln, tuple(e), tuple(c) if c else None, rot, plane, feed, rpm, tool)
              for k, ln, e, c, rot, plane, feed, rpm, tool in res["moves"]]
@@ -163,6 +165,8 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
 
 
 _G53 = re.compile(r"g0*53(?![\d.])")
+#: the scratch copy of a program LinuxCNC ran (run_linuxcnc's, the driver's marked one)
+_SCRATCH = re.compile(r"\S*woodcam-lcnc-[^/\s]*/program\.ngc")
 #: LinuxCNC's longest line (its LINELEN less the end; the driver's MAX_LINE)
 MAX_LINE = 252
 #: a (DEBUG,...) or (PRINT,...) comment, as LinuxCNC knows them (blanks first, any case)
