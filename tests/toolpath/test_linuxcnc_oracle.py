@@ -1018,3 +1018,27 @@ def test_linuxcnc_reads_no_subroutine_file_of_the_folder_woodcam_runs_in(tmp_pat
     assert "woodcam-lcnc" not in str(e.value)
     with pytest.raises(GcodeError, match="subroutine omysub is not defined in this file"):
         read_gcode(main)
+
+
+def test_a_crash_of_linuxcncs_interpreter_is_one_error_that_says_so(monkeypatch):
+    """When LinuxCNC's interpreter crashes (its process killed) run_batch returns an error of
+    line 0; run_linuxcnc then failed with KeyError 'printed_unplaced' (the crash's result
+    lacked the key), and before that said 'fix the line' of line 0. It is a GcodeError that
+    says LinuxCNC failed and what to do."""
+    import subprocess
+
+    import woodcam.toolpath.linuxcnc as lcnc
+
+    real = subprocess.run
+
+    def crashing(cmd, **kw):
+        if cmd[0] == lcnc.LINUXCNC_PYTHON and str(cmd[-1]).endswith("_linuxcnc_driver.py"):
+            return subprocess.CompletedProcess(cmd, -11, "", "")
+        return real(cmd, **kw)
+
+    monkeypatch.setattr(lcnc.subprocess, "run", crashing)
+    with pytest.raises(GcodeError) as e:
+        read_gcode("G21\nG1 X1 F100\nM2\n", interpreter="linuxcnc")
+    assert str(e.value) == ("G-code line 0: 'LinuxCNC': LinuxCNC's interpreter crashed (exit -11); "
+                            "LinuxCNC's interpreter failed, naming no line of the program; read "
+                            "it with --interpreter woodcam")

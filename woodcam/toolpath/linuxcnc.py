@@ -63,7 +63,9 @@ def run_batch(paths, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 10.0,
     ``-machine_zero_mm``; the default zero, or ``None``, is the machine frame), ``messages``
     (the operator messages, ``[line, text]``), ``printed`` (the ``(PRINT,...)`` texts,
     ``[line, text]``), ``said_order`` (the two as the program said them: 0 the next message,
-    1 the next PRINT text), ``error`` (``None`` or ``[line, message]``), ``seconds``.
+    1 the next PRINT text), ``printed_unplaced`` (``[[index, lines], ...]``: the PRINT texts
+    whose line is not known, with the lines that could have printed them), ``error`` (``None``
+    or ``[line, message]``), ``seconds``.
     ``tool_diameters_mm``: the tool table's diameters by tool number (mm), what a DEBUG/PRINT
     shows for ``#5410`` (LinuxCNC's table otherwise holds 0).
     """
@@ -83,8 +85,9 @@ def run_batch(paths, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 10.0,
             return [run_batch([p], start_mm=start_mm, timeout_s=timeout_s,
                               machine_zero_mm=machine_zero_mm,
                               tool_diameters_mm=tool_diameters_mm)[0] for p in paths]
-        return [{"moves": [], "messages": [], "printed": [], "said_order": [], "error": [
-            0, f"LinuxCNC's interpreter crashed (exit {r.returncode})"], "seconds": 0.0}]
+        return [{"moves": [], "messages": [], "printed": [], "said_order": [],
+                 "printed_unplaced": [], "error": [
+                     0, f"LinuxCNC's interpreter crashed (exit {r.returncode})"], "seconds": 0.0}]
     return json.loads(r.stdout)
 
 
@@ -157,7 +160,8 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
         if msg != NO_END:
             # (its messages name the file it read: a scratch copy, not the user's)
             raise GcodeError(int(line), "LinuxCNC", _SCRATCH.sub("the program", msg),
-                             REFUSED_FIX)
+                             REFUSED_FIX if int(line) else "LinuxCNC's interpreter failed, "
+                             "naming no line of the program; read it with --interpreter woodcam")
         warnings.append((int(line), msg))
     moves = [(k, ln, tuple(e), tuple(c) if c else None, rot, plane, feed, rpm, tool)
              for k, ln, e, c, rot, plane, feed, rpm, tool in res["moves"]]
