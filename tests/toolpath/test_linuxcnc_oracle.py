@@ -1042,3 +1042,18 @@ def test_a_crash_of_linuxcncs_interpreter_is_one_error_that_says_so(monkeypatch)
     assert str(e.value) == ("G-code line 0: 'LinuxCNC': LinuxCNC's interpreter crashed (exit -11); "
                             "LinuxCNC's interpreter failed, naming no line of the program; read "
                             "it with --interpreter woodcam")
+
+
+def test_a_file_opened_with_percent_that_stops_short_is_a_warning_with_both_interpreters():
+    """A program that opens with a '%' line and ends with neither M2/M30 nor the closing '%' (a
+    post's file cut short in the transfer): LinuxCNC stops at its end with 'File ended with no
+    percent sign', after cutting its moves. Woodcam's interpreter warned (quoting LinuxCNC's
+    message of a file without the opening '%'), but --interpreter linuxcnc refused the whole
+    program. Both simulate its moves now and warn with LinuxCNC's own words."""
+    text = "%\nG21 G90\nT1 M6\nG0 X1 Y1 Z1\nG1 Z-1 F100\n"
+    mine = read_gcode(text)
+    theirs = read_gcode(text, interpreter="linuxcnc")
+    assert len(mine) == len(theirs) == 2
+    assert mine.warnings == ["line 5: the file ends without M2, M30 or '%' (LinuxCNC stops here "
+                             "with 'File ended with no percent sign')"]
+    assert theirs.warnings == ["line 6: File ended with no percent sign"]

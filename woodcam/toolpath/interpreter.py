@@ -127,6 +127,11 @@ from ..units import say_length
 Dialect = Literal["linuxcnc", "grbl", "fanuc"]
 DIALECTS: tuple[str, ...] = ("linuxcnc", "grbl", "fanuc")
 
+#: LinuxCNC's error at the end of a file without M2/M30 (``NO_PERCENT``: one that opened with a
+#: '%' line and has no closing one); woodcam warns of it and keeps the moves before it, which
+#: the machine has cut by then
+NO_END = "File ended with no percent sign or program end"
+NO_PERCENT = "File ended with no percent sign"
 #: LinuxCNC refuses a tenth nested subroutine call ("Too many subroutine levels").
 MAX_CALL_DEPTH = 9
 #: Executed lines before woodcam stops a program as an endless loop (a 35,000-line relief runs
@@ -687,6 +692,7 @@ class Interpreter:
         self._g53_unplaced: dict[str, list[int]] = {"z": [], "xy": []}  # lines, machine zero unknown
         self._frames: list[tuple] = []  # the active calls while run() runs
         self.line_no = 0
+        self._opened_with_percent = False  # a '%' line first: LinuxCNC wants the closing one
 
     # -- helpers ----------------------------------------------------------------------------
     def err(self, word, rule, fix):
@@ -1028,7 +1034,7 @@ class Interpreter:
                 if first and stripped:
                     first = False
                     if bare:
-                        percent = True
+                        percent = self._opened_with_percent = True
                         continue
                 if bare and percent:
                     closing = len(lines)
@@ -1448,8 +1454,9 @@ class Interpreter:
         elif not self.ended:
             if self.dialect == "linuxcnc":
                 self.line_no = max(self.line_no, 1)  # an empty file: its line 1, as LinuxCNC
-                self.warn("the file ends without M2, M30 or '%' (LinuxCNC stops here with "
-                          "'File ended with no percent sign or program end')")
+                said = NO_PERCENT if self._opened_with_percent else NO_END
+                self.warn(f"the file ends without M2, M30 or '%' (LinuxCNC stops here with "
+                          f"'{said}')")
         self._warn_g53_unplaced()
         if self.mzero and any(self.mzero):
             self.moves = [_shifted(m, self.mzero) for m in self.moves]

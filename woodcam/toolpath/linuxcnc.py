@@ -19,6 +19,8 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 from .interpreter import (
+    NO_END,
+    NO_PERCENT,
     GcodeError,
     add_line_warning,
     line_list,
@@ -30,8 +32,6 @@ from .interpreter import (
 #: Debian's interpreter, for which the ``gcode`` module is built.
 LINUXCNC_PYTHON = "/usr/bin/python3"
 _DRIVER = Path(__file__).with_name("_linuxcnc_driver.py")
-#: LinuxCNC's message for a file without M2/M30/%: woodcam reads that as a warning.
-NO_END = "File ended with no percent sign or program end"
 #: What a refusal of LinuxCNC's asks: the line it names is not always the one refused
 #: (``parse`` adds 1 where reading a line failed; its AXIS preview says 'near line N')
 REFUSED_FIX = ("LinuxCNC's own interpreter refused it near this line: the line itself, or the "
@@ -157,7 +157,7 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
         printed += [(ln, m.strip()) for ln, m in texts[1]]
     if res["error"]:
         line, msg = res["error"]
-        if msg != NO_END:
+        if msg not in (NO_END, NO_PERCENT):  # (the end of a file: a warning, as woodcam's)
             # (its messages name the file it read: a scratch copy, not the user's)
             raise GcodeError(int(line), "LinuxCNC", _SCRATCH.sub("the program", msg),
                              REFUSED_FIX if int(line) else "LinuxCNC's interpreter failed, "
