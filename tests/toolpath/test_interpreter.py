@@ -1054,8 +1054,12 @@ def test_words_no_code_uses_are_refused_and_io_warned():
 @pytest.mark.parametrize("text", ["G0 X" + "[" * 400 + "1" + "]" * 400, "G0 X[" + "-" * 3000 + "1]",
                                   "G0 X" + "abs[" * 400 + "1" + "]" * 400])
 def test_an_expression_nested_too_deep_is_one_error(text):
-    """G-code is untrusted input: these were RecursionError tracebacks."""
+    """G-code is untrusted input: these were RecursionError tracebacks. (Read as Fanuc's
+    control reads them: LinuxCNC refuses a line this long before its expression, 'Command too
+    long', as woodcam's linuxcnc dialect does.)"""
     with pytest.raises(GcodeError, match="line 1: .*nested deeper than 100 levels"):
+        read_gcode(text + "\n", dialect="fanuc")
+    with pytest.raises(GcodeError, match="line 1: .*Command too long"):
         read_gcode(text + "\n")
     assert len(read_gcode("G0 X" + "[" * 50 + "1" + "]" * 50 + "\n")) == 1  # deep but sane
 

@@ -1057,3 +1057,33 @@ def test_a_file_opened_with_percent_that_stops_short_is_a_warning_with_both_inte
     assert mine.warnings == ["line 5: the file ends without M2, M30 or '%' (LinuxCNC stops here "
                              "with 'File ended with no percent sign')"]
     assert theirs.warnings == ["line 6: File ended with no percent sign"]
+
+
+@pytest.mark.parametrize("length, line_end, refused", [
+    (252, "\n", False), (253, "\n", True), (252, "\r\n", True), (253, "", False), (254, "", True)])
+def test_a_line_too_long_for_linuxcnc_is_refused_by_both(tmp_path, length, line_end, refused):
+    """LinuxCNC refuses a line longer than 252 bytes before its line end ('Command too long',
+    the \\r of a Windows line end counted; a last line without one may have 253), stopping the
+    program there; woodcam's interpreter read any length, so a program the machine stops
+    half-way was simulated whole. It refuses such a line when it reaches it now, as rs274 and
+    --interpreter linuxcnc do."""
+    line = "G1 X5 (" + "c" * (length - 8) + ")"
+    assert len(line) == length
+    text = "G21 G90\nT1 M6\nG0 X0 Y0 Z1\nG1 Z-1 F100\n".replace("\n", line_end or "\n") + line
+    text += line_end + ("M2" + line_end if line_end else "")
+    path = tmp_path / "long.ngc"
+    path.write_bytes(text.encode())
+    rs274 = subprocess.run([str(RS274), "-g", str(path)], capture_output=True, text=True,
+                           timeout=60)
+    assert ("Command too long" in rs274.stdout + rs274.stderr) == refused
+    for interpreter in ("woodcam", "linuxcnc"):
+        if refused:
+            with pytest.raises(GcodeError) as e:
+                read_gcode(path, interpreter=interpreter)
+            assert "Command too long" in str(e.value)
+            if interpreter == "woodcam":
+                assert str(e.value).startswith("G-code line 5: 'line 5': the line is "
+                                               f"{length + (line_end == chr(13) + chr(10))} "
+                                               "bytes long: LinuxCNC reads at most 252")
+        else:
+            assert len(read_gcode(path, interpreter=interpreter)) == 3

@@ -546,6 +546,24 @@ def source_lines(text: str) -> list[str]:
     return lines
 
 
+#: LinuxCNC's longest line in bytes (its LINELEN, 255, less the line end and the NUL)
+MAX_LINE = 252
+
+
+def _too_long_lines(lines: list[str], text: str) -> dict[int, int]:
+    """``{line number: bytes}`` of the source ``lines`` (of ``text``, :func:`source_lines`)
+    LinuxCNC refuses as 'Command too long': over :data:`MAX_LINE` bytes, a ``\\r`` of a
+    Windows line end counted; a last line without a line end may be one longer (LinuxCNC's
+    fgets reads 254 bytes, the line end among them). None for a file of ``\\r`` line ends,
+    which LinuxCNC reads as one line (:class:`Interpreter` warns of it)."""
+    if "\n" not in text:
+        return {} if "\r" in text or len(text.encode()) <= MAX_LINE + 1 else {1: len(text.encode())}
+    last = len(lines) - 1
+    ended = text.endswith("\n")
+    return {i + 1: b for i, raw in enumerate(lines) if len(raw) * 4 > MAX_LINE
+            for b in [len(raw.encode())] if b > MAX_LINE + (i == last and not ended)}
+
+
 def split_comments(raw: str, no: int) -> tuple[str, list[tuple[str, str]]]:
     """Source line ``raw`` (1-based number ``no``) -> ``(text, messages)``: the text outside
     comments, lowercase, without whitespace, and its message comment as ``[(kind, text)]``
@@ -603,6 +621,7 @@ class Interpreter:
         self.dialect = dialect
         self.max_blocks, self.max_moves = int(max_blocks), int(max_moves)
         self.src = source_lines(text)
+        self._too_long = _too_long_lines(self.src, text) if dialect == "linuxcnc" else {}
         # machine origin in the G-code frame (mm), None: not known (module docstring)
         self.mzero = None if machine_zero_mm is None else [float(v) for v in machine_zero_mm]
         shift = self.mzero or [0.0, 0.0, 0.0]
@@ -1278,9 +1297,16 @@ class Interpreter:
         pc = 0
         blocks = 0
         n = len(lines)
+        too_long = self._too_long
         while pc < n:
             ln = lines[pc]
             self.line_no = ln.no
+            if too_long and ln.no in too_long:  # refused when reached (LinuxCNC reads it then)
+                raise self.err(f"line {ln.no}", f"the line is {too_long[ln.no]} "
+                               f"bytes long: LinuxCNC reads at most {MAX_LINE} before a line end "
+                               f"({MAX_LINE + 1} on a last line without one) and refuses a "
+                               "longer one ('Command too long'), stopping the program here",
+                               "shorten it: split a long expression or comment over lines")
             blocks += 1
             if blocks > self.max_blocks:
                 raise self.err("program", f"more than {self.max_blocks} lines executed (an "
