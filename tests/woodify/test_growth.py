@@ -269,3 +269,28 @@ def test_a_grid_too_big_for_memory_is_refused_before_it_is_allocated(monkeypatch
     monkeypatch.setenv("WOODCAM_MAX_ALLOC_BYTES", str(200 * 24 ** 3))
     with pytest.raises(AssertionError, match="allocated"):  # within the limit: it grows
         woodify(box, 20, resolution=24)
+
+
+def test_overlapping_shells_are_one_solid_and_a_cavity_stays_hollow():
+    """Two closed shells of one file that overlap (two bodies exported unmerged) were inside by
+    ray parity only, so their overlap counted as outside: wood grew inside the part, rings
+    round a hole at its middle. The inside test now also counts the shells' winding (the union),
+    while a cavity (an inner shell wound inward) stays hollow, and a mesh wound inside out is
+    the same solid."""
+    a = trimesh.creation.icosphere(subdivisions=3, radius=10.0)
+    b = a.copy()
+    b.apply_translation((5.0, 0, 0))
+    def arrival(r, p):  # T (mm) at the grid node nearest p (object frame)
+        g = r.front.grid
+        return r.front.arrival_mm[tuple(np.round((np.asarray(p) - g.origin_mm) / g.spacing_mm).astype(int))]
+
+    both = trimesh.util.concatenate([a, b])
+    for mesh in (both, trimesh.Trimesh(both.vertices, both.faces[:, ::-1])):
+        r = woodify(mesh, 5, growth_mm=4.0, resolution=40)
+        assert arrival(r, (2.5, 0, 0)) < 0, "the overlap of the two shells is the part's own"  # year 0
+        assert arrival(r, (-10.5, 0, 0)) > 0 and arrival(r, (-8, 0, 0)) < 0
+    inner = trimesh.creation.icosphere(subdivisions=3, radius=5.0)
+    inner.invert()
+    r = woodify(trimesh.util.concatenate([trimesh.creation.icosphere(subdivisions=3, radius=10.0), inner]),
+                5, growth_mm=4.0, resolution=40)
+    assert arrival(r, (0, 0, 0)) > 0 and arrival(r, (7.5, 0, 0)) < 0, "the cavity is no part of the solid"

@@ -100,17 +100,40 @@ def band_distance(verts, faces, origin, h, shape, band):  # pragma: no cover - c
     return dist, closest, tri
 
 
-@numba.njit(cache=True, nogil=True)
-def inside_parity(verts, faces, origin, h, shape):  # pragma: no cover - compiled
-    """Inside test of a closed mesh on the grid nodes by ray parity along +X.
+def inside_parity(verts, faces, origin, h, shape, face_sign=None):
+    """Inside test of a closed mesh on the grid nodes: a node is inside where a ray along +X
+    crosses its triangles an odd number of times, or where the shells it lies in wind round it
+    (winding number > 0).
 
-    Every node line ``(j, k)`` is a ray along X; each triangle it crosses flips the inside
-    state from the crossing on. The line is nudged by an irrational fraction of a node so
-    that vertices and edges on grid lines (an axis-aligned box) are never hit exactly.
-    Meshes may extend beyond the grid. Returns ``inside (nx, ny, nz) bool``.
-    """
+    Every node line ``(j, k)`` is a ray along X; each triangle it crosses flips the parity, and
+    adds its orientation (``face_sign`` (m,) +-1 times the side it is crossed from: +1 entering
+    a shell wound outward) to the winding, from the crossing on. Parity alone made the overlap
+    of two closed shells (two bodies of one file, unmerged: a mug and its handle) outside, wood
+    grown inside the part; the winding alone would drop a shell wound inside out among others.
+    A cavity (an inner shell wound inward) stays outside by both. ``face_sign`` None: the faces'
+    own winding, the mesh turned outward where its volume is negative. The line is nudged by an
+    irrational fraction of a node so that vertices and edges on grid lines (an axis-aligned box)
+    are never hit exactly. Meshes may extend beyond the grid. Returns ``inside (nx, ny, nz)
+    bool``."""
+    verts = np.ascontiguousarray(verts, np.float64)
+    faces = np.ascontiguousarray(faces, np.int64)
+    if face_sign is None:
+        face_sign = np.full(len(faces), -1 if _signed_volume(verts, faces) < 0 else 1, np.int64)
+    return _inside(verts, faces, np.ascontiguousarray(face_sign, np.int64), np.asarray(origin, np.float64),
+                   float(h), np.asarray(shape, np.int64))
+
+
+def _signed_volume(verts: np.ndarray, faces: np.ndarray) -> float:
+    """The volume a closed mesh's winding encloses (negative when wound inside out)."""
+    a, b, c = (verts[faces[:, i]] for i in range(3))
+    return float(np.einsum("ij,ij->", a, np.cross(b, c)) / 6.0)
+
+
+@numba.njit(cache=True, nogil=True)
+def _inside(verts, faces, face_sign, origin, h, shape):  # pragma: no cover - compiled
     nx, ny, nz = shape[0], shape[1], shape[2]
     flips = np.zeros((nx + 1, ny, nz), np.int32)
+    wind = np.zeros((nx + 1, ny, nz), np.int32)
     ey = h * 1.2345e-6
     ez = h * 2.7183e-6
     for f in range(faces.shape[0]):
@@ -137,13 +160,16 @@ def inside_parity(verts, faces, origin, h, shape):  # pragma: no cover - compile
                 i = max(i, 0)
                 if i <= nx:
                     flips[i, j, k] += 1
+                    wind[i, j, k] += face_sign[f] * (-1 if s > 0 else 1)
     inside = np.zeros((nx, ny, nz), np.bool_)
     for j in range(ny):
         for k in range(nz):
             acc = 0
+            w = 0
             for i in range(nx):
                 acc += flips[i, j, k]
-                inside[i, j, k] = (acc & 1) == 1
+                w += wind[i, j, k]
+                inside[i, j, k] = (acc & 1) == 1 or w > 0
     return inside
 
 

@@ -205,11 +205,17 @@ def _rasterise(mesh, grid: VoxelGrid, band: int):
     # 20x20x80 box wound inside out, or its corners listed from another one, at resolution 24).
     rank = np.empty(len(v), np.int64)
     rank[np.lexsort(v.T[::-1])] = np.arange(len(v))
-    f = np.ascontiguousarray(np.take_along_axis(f, np.argsort(rank[f], axis=1), axis=1))
+    order = np.argsort(rank[f], axis=1)
+    # the winding the reorder drops, kept for the inside test: +1 where the order is a rotation
+    # of (0, 1, 2), -1 where it swaps two corners; and the mesh turned outward if wound inside out
+    turn = np.where((order == (order[:, :1] + np.arange(3)) % 3).all(axis=1), 1, -1)
+    if float(mesh.volume) < 0:
+        turn = -turn
+    f = np.ascontiguousarray(np.take_along_axis(f, order, axis=1))
     o = np.asarray(grid.origin_mm, np.float64)
     shape = np.asarray(grid.shape, np.int64)
     dist, closest, tri = band_distance(v, f, o, grid.spacing_mm, shape, band)
-    inside = inside_parity(v, f, o, grid.spacing_mm, shape)
+    inside = inside_parity(v, f, o, grid.spacing_mm, shape, turn)
     return dist, closest, tri, inside
 
 
