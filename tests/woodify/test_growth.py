@@ -43,8 +43,9 @@ def test_growth_speed_separates_time():
     assert np.isclose(sp.speed(10.0, up)[0], 1.3 * sp.speed(10.0))
 
 
-@pytest.mark.parametrize("method", ["fmm", "anisotropic"])
-def test_sphere_grows_to_r0_plus_v_w_t(method):
+@pytest.mark.parametrize("method, tol", [("fmm", 0.4), ("anisotropic", 0.1)])
+def test_sphere_grows_to_r0_plus_v_w_t(method, tol):
+    """Within tol grid steps h: measured 0.33 h with scikit-fmm, 0.05 h with the own march."""
     m = trimesh.creation.icosphere(subdivisions=4, radius=10.0)
     r = woodify(m, 10, growth_mm=12.0, resolution=56, method=method)
     h = r.front.grid.spacing_mm
@@ -53,11 +54,13 @@ def test_sphere_grows_to_r0_plus_v_w_t(method):
         assert s.is_watertight
         rad = np.linalg.norm(s.vertices, axis=1)
         expect = 10.0 + r.speed.velocity_mm * weibull_cdf(year / r.speed.time_scale_years, 2.0)
-        assert np.abs(rad - expect).max() < 0.5 * h, (year, rad.min(), rad.max(), expect)
+        assert np.abs(rad - expect).max() < tol * h, (year, rad.min(), rad.max(), expect)
 
 
-@pytest.mark.parametrize("method", ["offset", "anisotropic"])
-def test_eccentric_sphere_centre_moves_by_delta_tau(method):
+@pytest.mark.parametrize("method, tol_r, tol_v", [("offset", 0.15, 0.35), ("anisotropic", 0.1, 0.3)])
+def test_eccentric_sphere_centre_moves_by_delta_tau(method, tol_r, tol_v):
+    """Within grid steps h: the centre 0.02 h (measured 0.002 h both), the radius tol_r
+    (measured 0.10 h offset, 0.03 h anisotropic), every vertex tol_v (0.28 h, 0.23 h)."""
     m = trimesh.creation.icosphere(subdivisions=4, radius=8.0)
     up = np.array([0.6, 0.0, 0.8])
     r = woodify(m, 20, growth_mm=14.0, resolution=56, eccentricity=0.4, up=up, method=method)
@@ -66,11 +69,11 @@ def test_eccentric_sphere_centre_moves_by_delta_tau(method):
         tau = r.tau(year)
         s = r.surface(year)
         c, rad = _fit_sphere(s.vertices)
-        assert np.linalg.norm(c - 0.4 * tau * up) < 0.5 * h, (c, 0.4 * tau * up)
-        assert abs(rad - (8.0 + tau)) < 0.5 * h
+        assert np.linalg.norm(c - 0.4 * tau * up) < 0.02 * h, (c, 0.4 * tau * up)
+        assert abs(rad - (8.0 + tau)) < tol_r * h
         # every vertex on the exact offset (|x - c - w tau| = r0 + tau)
         T = sphere_arrival(s.vertices, (0, 0, 0), 8.0, 0.4 * up)
-        assert np.abs(T - tau).max() < 0.5 * h
+        assert np.abs(T - tau).max() < tol_v * h
 
 
 def test_eccentric_front_of_a_box_is_the_shifted_offset():
