@@ -297,3 +297,16 @@ def test_overlapping_shells_are_one_solid_and_a_cavity_stays_hollow():
     r = woodify(trimesh.util.concatenate([trimesh.creation.icosphere(subdivisions=3, radius=10.0), inner]),
                 5, growth_mm=4.0, resolution=40)
     assert arrival(r, (0, 0, 0)) > 0 and arrival(r, (7.5, 0, 0)) < 0, "the cavity is no part of the solid"
+
+
+def test_an_obstacle_of_overlapping_shells_is_solid_where_they_overlap():
+    """Obstacles are read by the same inside test: two posts in one file that overlap left their
+    overlap out of the obstacle (the wood could grow into it); now it is the post's."""
+    ball = trimesh.creation.icosphere(subdivisions=3, radius=5.0)
+    a = trimesh.creation.box((6.0, 6.0, 40.0))
+    a.apply_translation((14.0, 0, 0))
+    b = a.copy()
+    b.apply_translation((3.0, 0, 0))
+    r = woodify(ball, 10, growth_mm=15.0, resolution=48, obstacles=[trimesh.util.concatenate([a, b])])
+    g = r.front.grid
+    assert r.front.obstacle[tuple(np.round((np.array([15.5, 0, 0]) - g.origin_mm) / g.spacing_mm).astype(int))]
