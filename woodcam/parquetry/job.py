@@ -361,6 +361,24 @@ class ParquetryJob:
     #: writes): nothing in it is ambiguous under ``--units inch``
     units_said: bool = False
 
+    def __post_init__(self):
+        # a string of scans, a dict of params or a target that is no dict was taken and failed in
+        # write_job or the run as a bare TypeError ('string indices must be integers', 'asdict()')
+        import os
+
+        for name, key, example in (("scans", "texture", "{'texture': 'oak.png', 'dpi': 300}"),
+                                   ("blocks", "spec", "{'spec': 'builtin:flat-sawn', 'sheets': 4}"),
+                                   ("targets", "filename", "{'filename': 'moon.png', 'dpi': 300}")):
+            value = getattr(self, name)
+            if not isinstance(value, list) or not all(isinstance(d, dict) and key in d for d in value):
+                raise WoodcamError(f"ParquetryJob.{name} must be a list of dicts, each with {key!r}; got "
+                                   f"{value!r:.60}; e.g. [{example}]")
+        if not isinstance(self.mokume, list) or not all(isinstance(m, (str, os.PathLike)) for m in self.mokume):
+            raise WoodcamError(f"ParquetryJob.mokume must be a list of Mokume sample folders; got {self.mokume!r:.60}")
+        if not isinstance(self.params, ParquetryParams):
+            raise WoodcamError(f"ParquetryJob.params must be a ParquetryParams; got {type(self.params).__name__}; "
+                               "e.g. ParquetryParams(patch_mm=10)")
+
 
 class JobPathError(WoodcamError):
     """A path a job file names (a target, a texture or its mask, a Mokume folder, a block spec's
