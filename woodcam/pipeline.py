@@ -187,7 +187,8 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
         with result.stage("load"):
             part = load_part(source, tolerance_mm=tolerance_mm, texels_per_mm=texels_per_mm,
                              timeout_s=timeout_s,
-                             max_triangles=max_triangles or MAX_PART_TRIANGLES,
+                             # 0 fell back to the default budget without a word (load_part refuses it)
+                             max_triangles=MAX_PART_TRIANGLES if max_triangles is None else max_triangles,
                              report=result.tessellation)
         result.warnings += list(result.tessellation.get("notes", []))
         metadata = None
