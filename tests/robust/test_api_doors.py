@@ -269,6 +269,8 @@ def _library_door_sweep():
         ("grid years str", lambda: w.GridField("abc", (0, 0, 0), 1), "years must be a finite .*got 'abc'"),
         ("grid years NaN", lambda: w.GridField(np.full((3, 3, 3), np.nan), (0, 0, 0), 1),
          r"years must be a finite .*got shape \(3, 3, 3\) with 27 non-finite"),
+        ("grid meta list *", lambda: w.GridField(np.zeros((3, 3, 3)), (0, 0, 0), 1, meta=[1]),
+         "meta must be a dict of field metadata; got list"),
         ("grid layers list", lambda: w.GridField(np.zeros((3, 3, 3)), (0, 0, 0), 1, layers=[np.zeros((3, 3, 3))]),
          "layers must be a dict .*got list"),
         ("wood appearance a species name", lambda: w.Wood(fld, appearance="oak"),

@@ -86,6 +86,9 @@ class GridField:
         if not isinstance(self.layers, Mapping):  # a list was dict()'s bare TypeError
             raise WoodcamError(f"layers must be a dict {{name: grid shaped like years}}; got "
                                f"{type(self.layers).__name__}; e.g. layers={{'uncertainty': grid}} or leave it out")
+        if not isinstance(self.meta, dict):  # a list was saved and read back, and failed at meta.get
+            raise WoodcamError(f"meta must be a dict of field metadata; got {type(self.meta).__name__}; "
+                               "e.g. meta={'method': 'radial'} or leave it out")
         if self.interpolation not in _ORDER:
             raise WoodcamError(f"interpolation must be one of {list(_ORDER)}; got {self.interpolation!r}")
         sp = _spacing(self.spacing_mm)
