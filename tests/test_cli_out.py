@@ -243,3 +243,38 @@ def test_a_file_written_beside_out_that_cannot_be_written_is_a_usage_error(argv,
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("woodcam: error: --out") and "is an existing folder" in err[0], err
     assert sorted(p.name for p in tmp_path.iterdir()) == [beside]  # nothing was done
+
+
+@pytest.mark.parametrize("path,p", COMMANDS, ids=[" ".join(c[0]) for c in COMMANDS])
+def test_an_empty_out_is_refused_not_taken_as_the_current_folder(path, p, tmp_path, monkeypatch, capsys):
+    """Path('') is '.': 'woodcam place PART --block B --out ""' wrote placements.png and
+    placements.json into the current folder with exit 0, and a FILE --out said "got '.', a
+    folder". An empty --out is now a wrong command line (exit 2), one line, nothing written."""
+    monkeypatch.chdir(tmp_path)
+    argv = _argv(path, p, "X")
+    argv[-1] = ""
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    err = capsys.readouterr().err
+    assert exc.value.code == EXIT_USAGE and err.count("\n") == 1, err
+    assert "argument --out: got an empty value ''; give the output " in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("argv,name,what", [
+    (["place", "", "--block", "builtin:rift", "--out", "pl"], "part", "a FILE path"),
+    (["fit", "", "--out", "f.npz"], "block", "a block spec"),
+    (["bake", "p.stl", "--block", "", "--out", "t.glb"], "--block", "a block spec"),
+    (["preview", "p.glb", "--screenshot", ""], "--screenshot", "a .png file name"),
+    (["rings", "detect", " ", "--out", "r"], "block", "a FOLDER path"),
+])
+def test_an_empty_input_path_or_spec_is_refused(argv, name, what, tmp_path, monkeypatch, capsys):
+    """'fit ""' read the current folder as a block ('folder '.' is not a block', exit 1), 'bake
+    --block ""' failed in the library in the API's words ('spec must be a block spec (str) ...
+    e.g. open_stock(...)', exit 1): an empty path or spec is a wrong command line."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    err = capsys.readouterr().err
+    assert exc.value.code == EXIT_USAGE and err.count("\n") == 1, err
+    assert f"argument {name}: got an empty value " in err and f"; give {what}" in err, err

@@ -11,7 +11,7 @@ from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
 from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_input, part_suffixes, add_camera_option, add_out_option, add_units_option,
                       add_workers_option, allow_negative_values, apply_workers, as_typed, camera_of,
-                      remove_stale_outputs, stock_options, uses_settings, vector_type, write_screenshot)
+                      not_empty, remove_stale_outputs, stock_options, uses_settings, vector_type, write_screenshot)
 
 
 def _mesh_suffixes() -> tuple[str, ...]:
@@ -76,7 +76,7 @@ def register(subparsers) -> None:
               help="baked .glb (or .obj; another program's .gltf, .ply, .stl or .off)")
     # the same [PNG] form as bake's and gcode's --screenshot (issue 17)
     p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
-                   help="render off-screen to this PNG instead of opening a window (default "
+                   type=not_empty(str, "a .png file name, or no value for the default"), help="render off-screen to this PNG instead of opening a window (default "
                    "name: MESH with _view.png)")
     add_input(p, "--block", kind="block", default=None,
                    help=BLOCK_SPEC_HELP + ", for the cut plane (default: the one stored in the GLB)")

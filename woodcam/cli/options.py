@@ -85,6 +85,21 @@ OUT_RULE = ("--out is a FILE when it ends in a file suffix (.glb, .png, .json, .
             "before any work (exit 2).")
 
 
+def not_empty(convert: Callable = str, what: str = "a path") -> Callable:
+    """argparse ``type`` of a path or block-spec argument: ``convert(text)``, an empty (or
+    blank) ``text`` refused as a usage error (exit 2). ``Path('')`` is the current folder, so
+    'place PART --block B --out ""' wrote into it with exit 0, 'fit ""' read it as a block, and
+    'bake PART --block "" ...' failed in the library (exit 1, in the API's words). ``what``
+    says what to give."""
+    def parse(text: str):
+        if not text.strip():
+            raise argparse.ArgumentTypeError(f"got an empty value {text!r}; give {what}")
+        return convert(text)
+
+    parse.__name__ = getattr(convert, "__name__", "value")  # argparse's 'invalid NAME value'
+    return parse
+
+
 def add_out_option(p: argparse.ArgumentParser, writes: str, *, suffixes: tuple[str, ...] = (),
                    default: Path | None = None) -> None:
     """``--out`` under :data:`OUT_RULE`: a FILE ending in one of ``suffixes``, or (no
@@ -92,7 +107,8 @@ def add_out_option(p: argparse.ArgumentParser, writes: str, *, suffixes: tuple[s
     the option optional. :func:`check_out` applies the rule before the command runs."""
     assert all(s in FILE_SUFFIXES for s in suffixes), suffixes  # a contributor's mistake
     kind = f"FILE ending in {' or '.join(suffixes)}" if suffixes else "FOLDER (created)"
-    p.add_argument("--out", type=Path, required=default is None, default=default,
+    p.add_argument("--out", type=not_empty(Path, f"the output {kind.removesuffix(' (created)')}"),
+                   required=default is None, default=default,
                    metavar="FILE" if suffixes else "DIR", help=f"output {kind}: {writes}"
                    + (f" (default {default}{'' if suffixes else '/'})" if default else ""))
     p.set_defaults(_out_suffixes=tuple(suffixes))
@@ -189,6 +205,8 @@ def add_input(p, *flags: str, kind: InputKind, paths=None, suffixes=None, as_is:
     assert kind in INPUT_KINDS, kind  # a contributor's mistake
     assert suffixes is None or kind == "file", kind  # a folder or block spec has no suffix rule
     assert not as_is or kind == "block", kind  # only a block spec has turns and resizes
+    what = {"file": "a FILE path", "folder": "a FOLDER path", "block": "a block spec such as builtin:flat-sawn or a block folder"}[kind]
+    kwargs["type"] = not_empty(kwargs.get("type", str), what)  # '' is no path: Path('') is '.'
     action = p.add_argument(*flags, **kwargs)
     name = next((f for f in action.option_strings if f.startswith("--")), action.dest.upper())
     p.set_defaults(_inputs=(*(p.get_default("_inputs") or ()), InputArgument(action.dest, name, kind, paths,
@@ -1008,7 +1026,7 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                    "expects; z keeps the block frame, as CAM tools and slicers read an OBJ)")
     if screenshot:
         p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
-                       help="also render the result off-screen to PNG (default name: OUT with "
+                       type=not_empty(str, "a .png file name, or no value for the default"), help="also render the result off-screen to PNG (default name: OUT with "
                        "_view.png; no display needed)")
 
 
