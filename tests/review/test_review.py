@@ -702,6 +702,7 @@ def test_review_and_preview_draw_a_bar_while_the_block_opens(tmp_path, capsys, b
     del bars[:]
     opened = []
     monkeypatch.setattr(view, "preview", lambda mesh, **kw: opened.append([b.closed for b in bars]))
+    monkeypatch.setenv("DISPLAY", ":0")  # the window is asked for before the work (it opens none here)
     assert main(["preview", str(glb)]) == 0
     [bar] = [b for b in bars if b.desc == "preview"]
     assert bar.enabled and bar.shown[1:3] == ["preview: open block", "preview: load viewer"]
