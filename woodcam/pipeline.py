@@ -399,6 +399,9 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
             "size_mm": list(stock.size_mm),
             "appearance": {"kind": stock.meta.get("appearance", "colormap"),
                            "species": stock.meta.get("species"),
+                           # False: the species is only the default preset's colours (a block
+                           # nobody gave one); stock_of_glb reopens it so (stock.species_text)
+                           "species_stated": stock.meta.get("species_stated", True) is not False,
                            "params": stock.meta.get("appearance_params", {})},
             **(metadata or {}),
             "texels_per_mm": float(baked.texels_per_mm)}

@@ -59,6 +59,22 @@ from .frames import check_size
 AppearanceKind = Literal["colormap", "neural"]
 
 
+#: The colour preset of a block whose species nobody gave (a block or Mokume folder, a woodify
+#: block): its colours only, never a claim about the wood (:func:`species_text`).
+DEFAULT_SPECIES = "oak"
+
+
+def species_text(meta: dict) -> str:
+    """A stock's species as the review page and the bake's metadata say it (the one wording):
+    the preset's name, or, for a block nobody gave a species (``meta["species_stated"]`` False),
+    ``"not given (oak colours)"``: the default preset colours it, it is no claim about the wood.
+    ``""`` where no species is recorded (a neural appearance)."""
+    species = meta.get("species")
+    if not species:
+        return ""
+    return str(species) if meta.get("species_stated", True) is not False else f"not given ({species} colours)"
+
+
 @dataclass
 class Stock:
     """A block to carve from.
@@ -381,8 +397,9 @@ def _open_base_stock(parsed: ParsedSpec, species, appearance, appearance_params,
     if parsed.kind == "woodify":
         field, size_mm, description = _woodify_field(parsed)
         if np.allclose(field.rotation, np.eye(3)):
-            return _synthetic_stock(spec, field, size_mm, species or "oak", description,
-                                    appearance, appearance_params, _texture_frame(parsed, field))
+            return _synthetic_stock(spec, field, size_mm, species or DEFAULT_SPECIES, description,
+                                    appearance, appearance_params, _texture_frame(parsed, field),
+                                    stated=species is not None)
         # A block placed turned in the grown object (WoodifiedField.placed(rotation=)): its wood
         # is that of the object-aligned box round it, seen turned (Wood.rotated). Coloured in its
         # own frame, eq. 10's per-axis blend and end grain followed the turned block's axes: the
@@ -392,8 +409,9 @@ def _open_base_stock(parsed: ParsedSpec, species, appearance, appearance_params,
         pts = o + corners @ R.T
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         box = field.placed(tuple(hi - lo), tuple((lo + hi) / 2))
-        aligned = _synthetic_stock(spec, box, tuple(float(v) for v in hi - lo), species or "oak", description,
-                                   appearance, appearance_params, _texture_frame(parsed, box))
+        aligned = _synthetic_stock(spec, box, tuple(float(v) for v in hi - lo), species or DEFAULT_SPECIES,
+                                   description, appearance, appearance_params, _texture_frame(parsed, box),
+                                   stated=species is not None)
         return Stock(spec, tuple(size_mm), aligned.wood.rotated(R, o - lo), description, aligned.meta)
     path = _existing_folder(spec)
     if (path / "block.json").is_file():
@@ -489,10 +507,11 @@ def _existing_folder(spec: str) -> Path:
 
 
 def _synthetic_stock(spec, field, size_mm, species, description, appearance, params,
-                     texture_frame=None) -> Stock:
+                     texture_frame=None, stated=True) -> Stock:
     """A stock whose true field is known but which has no photos of its own; ``texture_frame``
     (a :class:`~woodcam.fields.base.LogFrame` or None, :func:`_texture_frame`) is the colour
-    map's (:class:`ColorMapAppearance`) and the neural appearance's synthetic photos'."""
+    map's (:class:`ColorMapAppearance`) and the neural appearance's synthetic photos'.
+    stated : False where ``species`` is only :data:`DEFAULT_SPECIES` (:func:`species_text`)."""
     from .fields.state import is_saveable
 
     meta = {"appearance": appearance}
@@ -512,6 +531,7 @@ def _synthetic_stock(spec, field, size_mm, species, description, appearance, par
     else:
         app = ColorMapAppearance(species, **params, texture_frame=texture_frame)
         meta["species"] = app.species.name
+        meta["species_stated"] = bool(stated)
     return Stock(spec, tuple(size_mm), Wood(field, app), description, meta)
 
 
@@ -592,7 +612,7 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
 
         if cache_dir is not None:
             appearance_params.setdefault("cache_dir", cache_dir)
-        app = block_appearance(block, field, "neural", species=species or "oak", **appearance_params)
+        app = block_appearance(block, field, "neural", species=species or DEFAULT_SPECIES, **appearance_params)
     elif any(f.photo is not None for f in block.faces.values()):
         from .frames import FACE_AXIS
 
@@ -601,12 +621,12 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
             warnings.warn(f"--species {species}: block {block.name!r} has photos along all three axes, and its "
                           "colours are fitted to them; the species changes nothing here (it colours the axes "
                           "without photos)", WoodcamWarning, stacklevel=2)
-        app = ColorMapAppearance.fit_to_block(block, field, species or "oak", **appearance_params)
+        app = ColorMapAppearance.fit_to_block(block, field, species or DEFAULT_SPECIES, **appearance_params)
     else:
         _check_appearance_params(appearance, appearance_params, photos=False, where=f"block {block.name!r}")
-        app = ColorMapAppearance(species or "oak", **appearance_params)
+        app = ColorMapAppearance(species or DEFAULT_SPECIES, **appearance_params)
     # the kind used, not the one asked for: "neural" falls back to the colour map without photos
-    meta = {**dict(block.meta), "species": species or "oak",
+    meta = {**dict(block.meta), "species": species or DEFAULT_SPECIES, "species_stated": species is not None,
             "appearance": "neural" if isinstance(app, NeuralAppearance) else "colormap"}
     return Stock(spec, block.size_mm, Wood(field, app), block.name, meta)
 

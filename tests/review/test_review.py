@@ -561,6 +561,13 @@ def test_review_of_a_photographed_block_shows_its_photos_and_names_no_species_no
                      "--voxels", "20000"]) == 0
     said = [str(w.message) for w in caught] + [capsys.readouterr().err]
     assert not any("--species" in m for m in said), said
+    # nobody gave this block a species: the default preset colours it, and the page (and the
+    # GLB's metadata) said "species oak" as if a claim about the wood (sweep h6 item 1)
+    assert "<th>species</th><td>not given (oak colours)</td>" in (tmp_path / "r.html").read_text()
+    from woodcam.export import read_glb_metadata
+
+    app = read_glb_metadata(tmp_path / "part.glb")["appearance"]
+    assert app["species"] == "oak" and app["species_stated"] is False, app  # the colours kept
     # the page shows the block's own face photos, each under its face's name
     import io
 

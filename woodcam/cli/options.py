@@ -1240,8 +1240,8 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
                           "differs from the part's surface", WoodcamWarning, stacklevel=2)
         # the recorded species (the bake's, default oak) was not asked for now: no note that
         # it changes nothing
-        return open_stock(block, **{**kwargs, "species": species or kwargs["species"]},
-                          species_given=species is not None)
+        return _recorded_species_stated(open_stock(block, **{**kwargs, "species": species or kwargs["species"]},
+                                                   species_given=species is not None), app, species)
     spec = meta.get("block")
     if not spec:
         return None
@@ -1256,7 +1256,16 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
     if meta.get("block_digest") and spec_digest(spec) != meta["block_digest"]:
         warnings.warn(f"the block {spec!r} changed since {glb.name} was baked (its files differ); "
                       "the wood shown is today's", WoodcamWarning, stacklevel=2)
-    return open_stock(spec, **kwargs, species_given=species is not None)
+    return _recorded_species_stated(open_stock(spec, **kwargs, species_given=species is not None), app, species)
+
+
+def _recorded_species_stated(stock, app: dict, species: str | None):
+    """``stock`` reopened with the species a GLB recorded: where the bake recorded it as only the
+    default preset (``species_stated`` false, a block nobody gave a species) and none is asked
+    for now, still not a claim about the wood (:func:`woodcam.stock.species_text`)."""
+    if species is None and app.get("species_stated") is False and "species" in stock.meta:
+        stock.meta["species_stated"] = False
+    return stock
 
 
 #: Appearance parameters a GLB's metadata may carry, with their rules. A GLB is untrusted input:

@@ -73,7 +73,9 @@ def _page(args: argparse.Namespace, meta: dict, stock, bar) -> Path:
                 f"--block woodify:{field} (the growth field woodify wrote beside it)")
         raise WoodcamError(f"review: {str(args.part)!r} records no block spec; pass --block SPEC")
     spec = stock.spec
-    report = {"block spec": spec, "species": stock.meta.get("species", "")}
+    from ..stock import species_text
+
+    report = {"block spec": spec, "species": species_text(stock.meta)}
     if isinstance(meta.get("report"), dict):  # the bake's part report (volume, yield, warnings)
         report.update(_report_rows(meta["report"], args.part))
     report.update(_recorded_rows(meta))
