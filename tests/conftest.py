@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import json
 import os
+import shutil
 import signal
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -140,3 +143,34 @@ def glb_placed_twice():
     """``glb_placed_twice(path) -> path``: writes :func:`_glb_placed_twice` (one box mesh placed
     at x = 0 and x = 30), for the readers that must take or refuse both placements."""
     return _glb_placed_twice
+
+
+#: The Khronos glTF validator (npm package gltf-validator, which make test installs) and the
+#: node script that runs it on one file.
+_VALIDATOR_JS = REPO / "tests" / "_gltf_validate.js"
+_NODE_MODULES = Path(os.environ.get("WOODCAM_NODE_MODULES", REPO / ".cache" / "node" / "node_modules"))
+
+
+def _gltf_validate(path: Path) -> dict:
+    node = shutil.which("node")
+    if node is None:
+        pytest.skip("node is not installed; the Khronos glTF validator runs on node")
+    if not (_NODE_MODULES / "gltf-validator").is_dir():
+        pytest.skip(
+            f"npm package gltf-validator missing under {_NODE_MODULES}; install with "
+            "npm install --prefix .cache/node gltf-validator (make test does)"
+        )
+    run = subprocess.run(
+        [node, str(_VALIDATOR_JS), str(path)],
+        capture_output=True, text=True, timeout=120,
+        env={**os.environ, "NODE_PATH": str(_NODE_MODULES)},
+    )
+    assert run.returncode == 0, run.stderr
+    return json.loads(run.stdout)
+
+
+@pytest.fixture
+def gltf_validate():
+    """``gltf_validate(path) -> report``: the Khronos validator's JSON report of a glTF/GLB file
+    (skips where node or the validator is missing)."""
+    return _gltf_validate

@@ -2,10 +2,6 @@
 
 from __future__ import annotations
 
-import json
-import os
-import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -16,11 +12,6 @@ from woodcam.bake import bake
 from woodcam.errors import WoodcamError
 from woodcam.export import export_glb, export_obj, load_textured, read_glb_metadata
 
-_REPO = Path(__file__).resolve().parents[2]
-_VALIDATOR_JS = _REPO / "tests" / "_gltf_validate.js"
-_NODE_MODULES = Path(
-    os.environ.get("WOODCAM_NODE_MODULES", _REPO / ".cache" / "node" / "node_modules")
-)
 
 
 class _Wood:
@@ -338,33 +329,15 @@ def test_export_errors_are_clear(baked, tmp_path):
         load_textured(tmp_path / "missing.glb")
 
 
-def _validate(path: Path) -> dict:
-    node = shutil.which("node")
-    if node is None:
-        pytest.skip("node is not installed; the Khronos glTF validator runs on node")
-    if not (_NODE_MODULES / "gltf-validator").is_dir():
-        pytest.skip(
-            f"npm package gltf-validator missing under {_NODE_MODULES}; install with "
-            "npm install --prefix .cache/node gltf-validator (make test does)"
-        )
-    run = subprocess.run(
-        [node, str(_VALIDATOR_JS), str(path)],
-        capture_output=True, text=True, timeout=120,
-        env={**os.environ, "NODE_PATH": str(_NODE_MODULES)},
-    )
-    assert run.returncode == 0, run.stderr
-    return json.loads(run.stdout)
-
-
 @pytest.mark.parametrize("normals", ["face", "smooth"])
-def test_glb_passes_the_khronos_validator(baked, tmp_path, normals):
+def test_glb_passes_the_khronos_validator(baked, tmp_path, normals, gltf_validate):
     if normals == "face":
         mesh = baked.mesh  # no NORMAL attribute: viewers shade flat
     else:
         sphere = trimesh.creation.icosphere(subdivisions=2, radius=10.0)
         mesh = bake(sphere, _Wood(), texels_per_mm=2.0, normals="smooth").mesh  # with NORMAL
     path = export_glb(mesh, tmp_path / "valid.glb", metadata={"block": {"size_mm": [30, 20, 16]}})
-    report = _validate(path)
+    report = gltf_validate(path)
     issues = report["issues"]
     errors = [m for m in issues["messages"] if m["severity"] == 0]
     assert issues["numErrors"] == 0, errors
@@ -546,14 +519,14 @@ def _dirty_textured_mesh():
 
 
 @pytest.mark.parametrize("normals", ["crease", "mesh"])
-def test_a_dirty_mesh_is_written_with_unit_normals_the_validator_accepts(tmp_path, normals):
+def test_a_dirty_mesh_is_written_with_unit_normals_the_validator_accepts(tmp_path, normals, gltf_validate):
     """normals="mesh" wrote trimesh's zero vertex normals of the unreferenced vertex and the
     zero-area triangle's middle corner: 4 ACCESSOR_VECTOR3_NON_UNIT errors (glTF's NORMAL must
     be unit length)."""
     mesh = _dirty_textured_mesh()
     assert (np.linalg.norm(mesh.vertex_normals, axis=1) < 0.5).sum() >= 2  # the input has zeros
     path = export_glb(mesh, tmp_path / "dirty.glb", normals=normals)
-    issues = _validate(path)["issues"]
+    issues = gltf_validate(path)["issues"]
     assert issues["numErrors"] == 0, [m for m in issues["messages"] if m["severity"] == 0]
     loaded = load_textured(path)
     np.testing.assert_allclose(np.linalg.norm(loaded.vertex_normals, axis=1), 1.0, atol=1e-6)
