@@ -358,14 +358,36 @@ def foreign_gltf_in_block_frame(geometry: _G, path, *, stacklevel: int = 2) -> _
 GLTF_ROOT_NODE = "woodcam_block_frame"
 
 
+#: GL buffer-view targets of vertex attributes and of indices (glTF 2.0 ``bufferView.target``).
+_GL_ARRAY_BUFFER = 34962
+_GL_ELEMENT_ARRAY_BUFFER = 34963
+
+
 def stamp_gltf_asset(tree: dict) -> None:
-    """Name woodcam (and its version) as ``asset.generator`` of the glTF JSON ``tree``, in place:
-    the glTF 2.0 spec's "tool that generated this glTF model", which viewers and the Khronos
-    validator show (trimesh, which serialises it, put its own project URL there). Every GLB
-    woodcam writes passes its tree through here (a trimesh ``tree_postprocessor``)."""
+    """Finish the glTF JSON ``tree`` of a GLB woodcam writes, in place. Every GLB woodcam writes
+    passes its tree through here (a trimesh ``tree_postprocessor``): export_glb's (the bake's, the
+    G-code's) and the log's (:func:`woodcam.logs.export_log_glb`, which lacked the targets below).
+
+    - ``asset.generator`` names woodcam (and its version): the glTF 2.0 spec's "tool that
+      generated this glTF model", which viewers and the Khronos validator show (trimesh, which
+      serialises it, put its own project URL there);
+    - every vertex-attribute and index buffer view gets its GL target (ARRAY_BUFFER /
+      ELEMENT_ARRAY_BUFFER), which the Khronos validator asks for (BUFFER_VIEW_TARGET_MISSING).
+    """
     from . import __version__
 
     tree.setdefault("asset", {"version": "2.0"})["generator"] = f"woodcam {__version__}"
+    accessors = tree.get("accessors", [])
+    views = tree.get("bufferViews", [])
+    for mesh in tree.get("meshes", []):
+        for prim in mesh.get("primitives", []):
+            pairs = [(a, _GL_ARRAY_BUFFER) for a in prim.get("attributes", {}).values()]
+            if "indices" in prim:
+                pairs.append((prim["indices"], _GL_ELEMENT_ARRAY_BUFFER))
+            for acc, target in pairs:
+                view = accessors[acc].get("bufferView")
+                if view is not None:
+                    views[view]["target"] = target
 
 #: First-line marker of an OBJ written by woodcam: ``# woodcam: units=m up=y ...``.
 OBJ_HEADER = "# woodcam:"

@@ -81,3 +81,13 @@ def test_exports_refuse_wrong_suffixes_and_modes(log, tmp_path):
         heightmap_image(log, "relief")
     with pytest.raises(WoodcamError, match="surface_alpha must lie in"):
         export_log_glb(log, tmp_path / "log.glb", surface_alpha=0.0)
+
+
+@pytest.mark.parametrize("alpha", [1.0, 0.4])
+def test_log_glb_passes_the_khronos_validator_without_hints(log, tmp_path, alpha, gltf_validate):
+    """The log GLB's buffer views named no GL target: the Khronos validator hinted
+    BUFFER_VIEW_TARGET_MISSING on each of them, where the bake's GLB (export_glb) has none."""
+    issues = gltf_validate(export_log_glb(log, tmp_path / "log.glb", surface_alpha=alpha))["issues"]
+    assert issues["numErrors"] == 0 and issues["numWarnings"] == 0, issues["messages"]
+    assert not [m for m in issues["messages"] if m["code"] == "BUFFER_VIEW_TARGET_MISSING"], issues["messages"]
+    assert issues["numHints"] == 0, issues["messages"]

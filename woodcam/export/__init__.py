@@ -51,8 +51,6 @@ GLB_METADATA_KEY = "woodcam"
 
 _GLB_MAGIC = 0x46546C67  # b"glTF" little-endian
 _GLB_CHUNK_JSON = 0x4E4F534A  # b"JSON"
-_GL_ARRAY_BUFFER = 34962
-_GL_ELEMENT_ARRAY_BUFFER = 34963
 _GL_LINEAR = 9729
 _GL_LINEAR_MIPMAP_LINEAR = 9987
 _GL_CLAMP_TO_EDGE, _GL_REPEAT = 33071, 10497
@@ -290,7 +288,6 @@ def export_glb(mesh: Mesh, path: PathLike, metadata: dict | None = None, *,
                              "wrapS": wrap[0], "wrapT": wrap[1]}]
         for texture in tree.get("textures", []):
             texture["sampler"] = 0
-        _set_buffer_view_targets(tree)
 
     shaded = _shaded(mesh, crease_angle_deg, normals, "export_glb")
     # an atlas (a bake) lies in [0, 1] and is clamped, so its border texels never bleed across;
@@ -325,22 +322,6 @@ def _shaded(mesh, crease_angle_deg, normals: str, what: str):
     out = mesh.copy()
     out.vertex_normals = vn
     return out
-
-
-def _set_buffer_view_targets(tree: dict) -> None:
-    """Mark vertex-attribute and index buffer views with their GL target (ARRAY_BUFFER /
-    ELEMENT_ARRAY_BUFFER), which the Khronos validator asks for (BUFFER_VIEW_TARGET_MISSING)."""
-    accessors = tree.get("accessors", [])
-    views = tree.get("bufferViews", [])
-    for mesh in tree.get("meshes", []):
-        for prim in mesh.get("primitives", []):
-            pairs = [(a, _GL_ARRAY_BUFFER) for a in prim.get("attributes", {}).values()]
-            if "indices" in prim:
-                pairs.append((prim["indices"], _GL_ELEMENT_ARRAY_BUFFER))
-            for acc, target in pairs:
-                view = accessors[acc].get("bufferView")
-                if view is not None:
-                    views[view]["target"] = target
 
 
 def obj_siblings(obj_path: PathLike) -> tuple[Path, Path]:
