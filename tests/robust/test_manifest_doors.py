@@ -262,7 +262,7 @@ def test_tool_table_bytes_that_are_not_utf8(tmp_path):
 
 
 @pytest.mark.parametrize("edit, match", [
-    (lambda d: d.update(pith_z_mm="abc"), r"wrong type or shape"),
+    (lambda d: d.update(pith_z_mm="abc"), r"pith_z_mm must be \(h,\) heights in mm \(numbers\); got 'abc'"),
     (lambda d: d.update(radii_mm=[[1, 2]]), r"radii_mm"),
     (lambda d: d["radii_mm"][0].__setitem__(0, 1e400), r"finite numbers|must be finite"),
     (lambda d: d["pith_xy_mm"][0].__setitem__(0, None), r"wrong type|must be finite"),
