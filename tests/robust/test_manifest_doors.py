@@ -277,5 +277,8 @@ def test_log_file_types_are_checked(tmp_path, edit, match):
     d = simple_log(100.0, 30.0, z_step_mm=20.0, azimuths=6).to_json()
     edit(d)
     (tmp_path / "log.json").write_text(json.dumps(d))
-    with pytest.raises(WoodcamError, match=match):
+    with pytest.raises(WoodcamError, match=match) as err:
         read_log(tmp_path / "log.json")
+    # the file is named (sweep h6: "log file format must be 'woodcam-log'; got None" left the
+    # user of 'woodcam log render a.json b.json'-style scripts guessing which file)
+    assert repr(str(tmp_path / "log.json")) in str(err.value), str(err.value)

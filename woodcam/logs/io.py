@@ -50,7 +50,11 @@ def read_log(path: PathLike) -> LogSkeleton:
     if not path.is_file():
         raise WoodcamError(f"log file {str(path)!r} does not exist; give a path to a JSON file "
                            "written by woodcam (or use the real log: --real)")
-    return LogSkeleton.from_json(read_json_file(path, "log file"))
+    d = read_json_file(path, "log file")  # its errors name the file
+    try:
+        return LogSkeleton.from_json(d)
+    except WoodcamError as err:  # from_json's do not: it reads a dict, from anywhere
+        raise WoodcamError(f"{str(path)!r}: {err}") from err
 
 
 def read_gran1(folder: PathLike | None = None, *, centre: bool = True) -> LogSkeleton:
