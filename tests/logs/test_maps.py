@@ -81,8 +81,10 @@ def test_maps_without_diameter_channel_and_list_params(gran1):
 
 
 def test_missing_maps_are_named(tmp_path):
-    with pytest.raises(WoodcamError, match="knot_state_map.png"):
+    with pytest.raises(WoodcamError, match="knot_state_map.png") as err:
         read_maps(tmp_path)
+    # and how to make one (sweep h6: the folder's lack alone was said)
+    assert "write such a folder with 'woodcam log maps (LOG_FILE | --real) --out DIR'" in str(err.value)
     with pytest.raises(WoodcamError, match="height_mm"):
         decode_maps({}, {"r_min_mm": 1, "r_max_mm": 2})
 

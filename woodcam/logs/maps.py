@@ -197,7 +197,8 @@ def read_maps(folder) -> LogSkeleton:
     missing = [f for f in MAP_FILES.values() if not (folder / f).is_file()]
     if missing:
         raise WoodcamError(f"map folder {str(folder)!r} lacks {missing}; it needs "
-                           f"{sorted(MAP_FILES.values())}")
+                           f"{sorted(MAP_FILES.values())}; write such a folder with 'woodcam log maps "
+                           "(LOG_FILE | --real) --out DIR' (woodcam.logs.write_maps)")
     maps = {}
     for k, f in MAP_FILES.items():
         if k != "params":
