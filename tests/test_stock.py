@@ -723,3 +723,32 @@ def test_a_refused_resize_says_when_no_built_in_block_is_large_enough(spec, fix,
     with pytest.raises(BlockSpecError) as got:
         open_stock("builtin:flat-sawn[40x30x20@4990,0,0]")
     assert str(got.value).endswith("holds the same wood: builtin:flat-sawn:9960x80x50[40x30x20@9920,0,0]")
+
+
+def test_a_log_block_outside_its_log_is_refused_or_warned_of(tmp_path, capsys):
+    """'log:LOG@K:1000x1000x1000' of a log 100 mm in radius was opened and drawn without a word:
+    most of it extrapolated rings outside the bark (sweep h6). Mostly outside: refused, naming
+    the share and the log's size; partly outside: a warning; inside: silent."""
+    import warnings
+
+    from woodcam.cli import main
+    from woodcam.errors import BlockSpecError, WoodcamWarning
+    from woodcam.fields.skeleton import BranchStrand, simple_log
+    from woodcam.logs.io import write_log
+
+    knot = BranchStrand.from_model(0.25, 0.0, 300.0, 0.0, 0.0, 0.0, 0.0, 100.0, 45.0)
+    write_log(simple_log(knots=[knot]), tmp_path / "l.json")
+    log = f"log:{tmp_path / 'l.json'}@0"
+    with pytest.raises(BlockSpecError, match=r"the block must lie mostly inside the log; (9\d) % of the 1000 x "
+                       r"1000 x 1000 mm block through knot 0 lies outside log .*l.json \(radius 100-100 mm, "
+                       r"600 mm long\)"):
+        open_stock(f"{log}:1000x1000x1000")
+    # the command line: one line, exit 2 (a spec typed wrong), nothing written
+    assert main(["block", "show", f"{log}:1000x1000x1000", "--out", str(tmp_path / "b.png")]) == 2
+    assert "must lie mostly inside the log" in capsys.readouterr().err
+    assert not (tmp_path / "b.png").exists()
+    with pytest.warns(WoodcamWarning, match=r"\d+ % of the 240 x 80 x 50 mm block through knot 0 lies outside"):
+        open_stock(f"{log}:240x80x50")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        open_stock(f"{log}:60x40x20")

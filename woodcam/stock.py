@@ -654,13 +654,42 @@ def _log_block_field(parsed: ParsedSpec):
                 f"knot{'' if len(log.knots) == 1 else 's'}); got {knot}; e.g. '{spec[:spec.rfind('@')]}@0'")
         raise BlockSpecError(f"knot index in {spec!r} must be 0..{len(log.knots) - 1}; got {knot}",
                              part="log", text=f"@{knot}", rule=rule, spec=parsed.spec)
+    placement = block_at_knot(log, knot, size_mm)
+    _check_block_in_log(parsed, log, placement, size_mm)
     log_field = KnottedLogField(log)
-    field = place_block_in_log(log_field, *block_at_knot(log, knot, size_mm))
+    field = place_block_in_log(log_field, *placement)
     frame = None
     if parsed.size_mm is not None:  # the same log, read once: the default block's placement through the knot
         default = place_block_in_log(log_field, *block_at_knot(log, knot, _LOG_BLOCK_SIZE_MM))
         frame = _frame_in(field.frame, default.frame)
     return field, size_mm, f"block through knot {knot} of log {source}", frame
+
+
+#: Share of a log block outside its log (past the bark or the log's ends) above which the spec
+#: is refused (most of it would be extrapolated wood) or warned of (a corner in the bark is wane).
+_LOG_BLOCK_OUTSIDE_REFUSED, _LOG_BLOCK_OUTSIDE_WARNED = 0.5, 0.05
+
+
+def _check_block_in_log(parsed: ParsedSpec, log, placement, size_mm) -> None:
+    """Refuse a ``log:LOG@K:WxDxH`` block mostly outside its log, warn of one partly outside:
+    the field there is extrapolated, wood no log holds (a 1000 mm cube through a knot of the
+    143 mm-radius Gran_1 was drawn without a word, 97 % of it made-up rings)."""
+    from .fields.knots import share_outside_log
+
+    share = share_outside_log(log, *placement, size_mm)
+    if share <= _LOG_BLOCK_OUTSIDE_WARNED:
+        return
+    W, D, H = (float(v) for v in size_mm)
+    where = (f"{100 * share:.0f} % of the {W:g} x {D:g} x {H:g} mm block through knot {parsed.knot} lies "
+             f"outside log {parsed.source} (radius {log.r_min_mm:.0f}-{log.r_max_mm:.0f} mm, "
+             f"{log.length_mm:.0f} mm long): the wood there is extrapolated")
+    if share > _LOG_BLOCK_OUTSIDE_REFUSED:
+        rule = (f"the block must lie mostly inside the log; {where}; give a smaller WxDxH "
+                f"(e.g. the default {'x'.join(f'{v:g}' for v in _LOG_BLOCK_SIZE_MM)})")
+        raise BlockSpecError(f"block spec {parsed.spec!r}: {rule}", part="size", text=f"{W:g}x{D:g}x{H:g}",
+                             rule=rule, spec=parsed.spec)
+    warnings.warn(f"block spec {parsed.spec!r}: {where}; a smaller WxDxH stays inside it",
+                  WoodcamWarning, stacklevel=4)
 
 
 def _texture_frame(parsed: ParsedSpec, field):

@@ -611,3 +611,18 @@ def block_at_knot(log, knot_index: int, size_mm, *, front_r_mm: float | None = N
     return origin, R
 
 
+def share_outside_log(log, origin, rotation, size_mm, *, samples: int = 9) -> float:
+    """Share in [0, 1] of a ``W x D x H`` block placed at ``(origin, rotation)`` in ``log``
+    (:func:`block_at_knot`) that lies outside the log: past its bark (:meth:`LogSkeleton.radius_at`)
+    or beyond its ends, measured on a ``samples``-cubed grid of points through the block. The
+    field there is extrapolated, wood no log holds."""
+    axes = [np.linspace(0.0, float(s), samples) for s in size_mm]
+    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    p = np.asarray(origin, float) + grid @ np.asarray(rotation, float).T
+    z0, z1 = float(log.pith_z_mm[0]), float(log.pith_z_mm[-1])
+    d = p[:, :2] - log.pith_at(p[:, 2])
+    r = np.hypot(d[:, 0], d[:, 1])
+    bark = log.radius_at(np.clip(p[:, 2], z0, z1), np.arctan2(d[:, 1], d[:, 0]))
+    return float(np.mean((r > bark) | (p[:, 2] < z0) | (p[:, 2] > z1)))
+
+
