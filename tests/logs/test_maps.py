@@ -128,3 +128,15 @@ def test_the_written_maps_hold_the_documented_layout(tmp_path):
     assert (h[:, 2] == 0).all()                         # the knot rises: no fall in B
     assert np.abs(o[:, 1] - np.rint(np.interp(d, r, [0, 0.3, 0.6]) / (np.pi / 2) * 255)).max() <= 1
     assert (o[:, 2] == 0).all()                         # the twist is counter-clockwise: G, not B
+
+
+def test_a_log_without_knots_writes_and_reads_back_its_maps(tmp_path):
+    """'woodcam log maps' of a knotless log was an internal error ("cannot write empty image":
+    its knot maps had no row), after writing the stem map alone (sweep h6)."""
+    from woodcam.fields.skeleton import simple_log
+
+    log = simple_log(300.0, 80.0)
+    write_maps(log, tmp_path / "m")
+    back = read_maps(tmp_path / "m")
+    assert back.knots == ()
+    assert back.r_min_mm == pytest.approx(80.0, abs=0.5) and back.length_mm == pytest.approx(300.0)

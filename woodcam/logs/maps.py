@@ -82,7 +82,9 @@ def encode_maps(log: LogSkeleton, *, stem_shape=(512, 128), knot_columns: int = 
     n = len(log.knots)
     d = np.arange(knot_columns) * r_max / (knot_columns - 1)
     dmax = float(max([k.diameter_mm.max() for k in log.knots] + [1.0]))
-    H = np.zeros((n * row_height, knot_columns, 3))
+    # a log without knots keeps one blank row: a PNG has at least one (map_params' n_knots 0 says
+    # it holds no knot; 'woodcam log maps' of a knotless log was "cannot write empty image")
+    H = np.zeros((max(n, 1) * row_height, knot_columns, 3))
     O = np.zeros_like(H)
     S = np.zeros_like(H)
     for i, k in enumerate(log.knots):
@@ -160,6 +162,12 @@ def decode_maps(maps: dict, params: dict) -> LogSkeleton:
         raise WoodcamError(f"knot maps must share one shape (knots x columns x 3); got "
                            f"{H.shape}, {O.shape}, {S.shape}")
     n = H.shape[0] // rh
+    if "n_knots" in params:  # fewer rows than knots is the maps' own; more: a knotless log's blank row
+        nk = params["n_knots"]
+        if isinstance(nk, bool) or not isinstance(nk, (int, float)) or not nk >= 0 or nk != int(nk):
+            raise WoodcamError(f"map parameters' n_knots must be a whole number >= 0 (the knot rows); "
+                               f"got {nk!r}")
+        n = min(n, int(nk))
     kc = H.shape[1]
     d = np.arange(kc) * r_max / (kc - 1)
     dmax = float(params.get("diameter_max_mm", 1.0))
