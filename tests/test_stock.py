@@ -752,3 +752,21 @@ def test_a_log_block_outside_its_log_is_refused_or_warned_of(tmp_path, capsys):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         open_stock(f"{log}:60x40x20")
+
+
+def test_a_block_of_a_log_without_knots_says_so(tmp_path, capsys):
+    """'log:L@0' of a knotless log said "the knot index must be 0..-1 (log has 0 knots); got 0;
+    e.g. 'log:L@0'", offering the index it refused (sweep h6)."""
+    from woodcam.cli import main
+    from woodcam.errors import BlockSpecError
+    from woodcam.fields.skeleton import simple_log
+    from woodcam.logs.io import write_log
+
+    write_log(simple_log(), tmp_path / "nok.json")
+    spec = f"log:{tmp_path / 'nok.json'}@0"
+    with pytest.raises(BlockSpecError, match=r"has no knots, and a log block is cut through one; give a log "
+                       r"with knots \(e\.g\. 'log:gran1@0'\)"):
+        open_stock(spec)
+    assert main(["block", "show", spec, "--out", str(tmp_path / "b.png")]) == 2
+    err = capsys.readouterr().err
+    assert "has no knots" in err and "0..-1" not in err, err

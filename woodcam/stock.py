@@ -650,6 +650,11 @@ def _log_block_field(parsed: ParsedSpec):
     log = read_gran1() if source == "gran1" else read_log(source)
     if not 0 <= knot < len(log.knots):
         # a spec that names no block: the command line says it of its --block, exit 2 (it exited 1)
+        if not log.knots:  # "must be 0..-1 ...; e.g. '@0'" offered the index it refused
+            rule = (f"log {source} has no knots, and a log block is cut through one; give a log with "
+                    "knots (e.g. 'log:gran1@0') or cut a builtin block (e.g. 'builtin:flat-sawn')")
+            raise BlockSpecError(f"block spec {spec!r}: {rule}", part="log", text=f"@{knot}", rule=rule,
+                                 spec=parsed.spec)
         rule = (f"the knot index must be 0..{len(log.knots) - 1} (log {source} has {len(log.knots)} "
                 f"knot{'' if len(log.knots) == 1 else 's'}); got {knot}; e.g. '{spec[:spec.rfind('@')]}@0'")
         raise BlockSpecError(f"knot index in {spec!r} must be 0..{len(log.knots) - 1}; got {knot}",
