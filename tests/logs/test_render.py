@@ -200,3 +200,22 @@ def test_supersampling_keeps_the_shape_for_odd_sizes():
     assert a.shape == b.shape
     # away from rings' sharp steps the average matches the single sample closely
     assert np.median(np.abs(a.astype(int) - b.astype(int))) <= 12
+
+
+def test_the_default_board_of_a_thin_short_log_lies_in_it(tmp_path, capsys):
+    """A log 40 mm in radius was refused by a --board nobody typed ('|offset| < 40 mm; got 60'),
+    and one 300 mm long got a 600 mm board, half background, warned of as '--board' (sweep h6)."""
+    import warnings
+
+    path = write_log(simple_log(300.0, 40.0), tmp_path / "thin.json")
+    args = _parse(["log", "render", str(path), "--out", str(tmp_path / "out"), "--px-per-mm", "1"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no past-the-end warning either
+        assert args.func(args) == 0
+    board = next((tmp_path / "out").glob("*_board_*.png"))
+    assert board.name == "simple_board_z150_az0_off24.png"  # 0.6 x 40 mm from the pith, mid-log
+    with Image.open(board) as im:
+        assert im.size == (300, 120)  # the log's 300 mm at 1 px/mm, 120 mm wide
+    # a log thicker than 100 mm keeps the 60 mm, 600 mm board
+    board = lr.default_sections(simple_log(1000.0, 120.0))[0]
+    assert board.name.endswith("_off60") and board.size_mm == (600.0, 120.0)

@@ -37,7 +37,8 @@ def register(subparsers) -> None:
     r.add_argument("--board", nargs=3, type=float, metavar=("Z_MM", "AZIMUTH_DEG", "OFFSET_MM"),
                    help="tangential board: centre height along the log (mm), facing azimuth "
                         "(degrees) and distance from the pith (mm) (default: the board through the "
-                        "most knots, 60 mm from the pith)")
+                        "most knots, 60 mm from the pith or 0.6 of a thinner log's smallest radius, "
+                        "600 mm long or a shorter log's length)")
     r.add_argument("--disc", type=float, metavar="Z_MM",
                    help="height along the log of the end-grain disc, mm (default: the log's biggest "
                    "whorl, where most knots leave the pith; the middle of a log without knots)")

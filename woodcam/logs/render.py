@@ -237,11 +237,24 @@ def save_png(image: np.ndarray, path) -> Path:
     return path
 
 
+#: The default board's distance from the pith (mm), for a log thicker than 100 mm; a thinner
+#: log's is 0.6 of its smallest radius (:func:`default_sections`).
+DEFAULT_BOARD_OFFSET_MM = 60.0
+
+
 def default_sections(log: LogSkeleton, *, px_per_mm: float = 2.0) -> list[Section]:
-    """A tangential board through the most knots and an end-grain disc through the log's
-    biggest whorl (the height where most knot axes pass 50 mm from the pith, +-12 mm)."""
-    zc, az, _ = busiest_board(log)
-    secs = [tangential_board(log, zc, az, 60.0, px_per_mm=px_per_mm)]
+    """A tangential board through the most knots (:data:`DEFAULT_BOARD_OFFSET_MM` from the pith,
+    or 0.6 of a thinner log's smallest radius; 600 mm long, or the log's length) and an
+    end-grain disc through the log's biggest whorl (the height where most knot axes pass 50 mm
+    from the pith, +-12 mm)."""
+    # 60 mm from the pith, or 0.6 of a thinner log's smallest radius (a board of a log 40 mm in
+    # radius was refused as '--board ... |offset| < 40 mm; got 60', a --board nobody typed)
+    # and 600 mm long, or a shorter log's length (one 300 mm long was drawn half background,
+    # warned of as a '--board' past its end)
+    offset = min(DEFAULT_BOARD_OFFSET_MM, 0.6 * log.r_min_mm)
+    length = min(600.0, log.length_mm)
+    zc, az, _ = busiest_board(log, offset_mm=offset, length_mm=length)
+    secs = [tangential_board(log, zc, az, offset, length_mm=length, px_per_mm=px_per_mm)]
     if log.knots:
         zk = np.array([log.knot_point(i, [50.0])[0, 2] for i in range(len(log.knots))])
         cands = np.arange(log.pith_z_mm[0], log.pith_z_mm[-1], 5.0)
