@@ -372,3 +372,23 @@ def test_synth_spec_round_trips_through_json_and_matches_the_flat_keywords(tmp_p
     assert any(t.year is None for t in by_spec.faces["top"].traces)
     # keywords override a spec's settings
     assert synth_block(field, SIZE, spec, seed=4).meta["seed"] == 4
+
+
+def test_a_smaller_set_into_a_folder_of_a_larger_one_is_refused(tmp_path, capsys):
+    """'block synth --count 1 --seed 5' into a folder of 2 blocks of seed 0 replaced block_0000
+    and index.json and left block_0001 of seed 0 beside them, unlisted (sweep h6)."""
+    from woodcam.cli import main
+
+    out = tmp_path / "set"
+    assert main(["block", "synth", "--count", "2", "--out", str(out), "--face-px", "32", "--quiet"]) == 0
+    before = (out / "block_0000" / "block.json").read_bytes()
+    capsys.readouterr()
+    assert main(["block", "synth", "--count", "1", "--seed", "5", "--out", str(out), "--face-px", "32",
+                 "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert (f"{str(out)!r} holds a set of 2 synthetic blocks (seed 0); 1 block of seed 5 written there "
+            "would leave block_0001 of the old set beside them") in err, err
+    assert (out / "block_0000" / "block.json").read_bytes() == before  # refused before any work
+    # as many blocks or more replace every one listed: written
+    assert main(["block", "synth", "--count", "2", "--seed", "5", "--out", str(out), "--face-px", "32",
+                 "--quiet"]) == 0

@@ -61,6 +61,31 @@ def benchmark_set_block(seed: int, index: int, *, face_px: int = 512, size_range
     return block, info
 
 
+def _check_no_stale_blocks(out_dir: Path, count: int, seed: int) -> None:
+    """Refuse, before any work, a set of ``count`` blocks into a folder whose ``index.json`` lists
+    blocks it would not replace: they stayed beside the new ones, under an index that no longer
+    named them (``--count 1 --seed 5`` into a folder of 2 blocks of seed 0 left block_0001 of
+    seed 0 there, which a ``block_*`` glob still found). A set as large or larger replaces every
+    block listed, so a rerun, or one with another seed, is written."""
+    from ..errors import UsageError
+
+    path = out_dir / "index.json"
+    try:
+        old = json.loads(path.read_text()) if path.is_file() else {}
+    except (OSError, ValueError):
+        return  # not one of our indexes: nothing known to go stale
+    blocks = old.get("blocks") if isinstance(old, dict) else None
+    names = [b.get("name") for b in blocks if isinstance(b, dict)] if isinstance(blocks, list) else []
+    kept = sorted(n for n in names if isinstance(n, str) and n.startswith("block_")
+                  and n[6:].isdigit() and int(n[6:]) >= count and (out_dir / n).is_dir())
+    if kept:
+        raise UsageError(
+            f"{str(out_dir)!r} holds a set of {len(names)} synthetic blocks (seed {old.get('seed')!r}); "
+            f"{count} block{'' if count == 1 else 's'} of seed {seed} written there would leave "
+            f"{', '.join(kept[:3])}{' ...' if len(kept) > 3 else ''} of the old set beside them; "
+            f"choose an empty output folder, or delete {str(out_dir)!r} first")
+
+
 def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
                         size_range_mm=(30.0, 80.0), ring_width_range_mm=(1.5, 6.0),
                         log_fields: Callable[[np.random.Generator], object] | None = None,
@@ -96,6 +121,7 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
         raise WoodcamError(f"count must be >= 1; got {count!r}")
     _check_fraction("knotted_fraction", knotted_fraction)
     out_dir = Path(out_dir)
+    _check_no_stale_blocks(out_dir, count, seed)
     out_dir.mkdir(parents=True, exist_ok=True)
     index = {"format": "woodcam-benchmark", "version": 1, "seed": int(seed), "count": int(count),
              "face_px": int(face_px), "size_range_mm": list(size_range_mm),
