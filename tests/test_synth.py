@@ -392,3 +392,13 @@ def test_a_smaller_set_into_a_folder_of_a_larger_one_is_refused(tmp_path, capsys
     # as many blocks or more replace every one listed: written
     assert main(["block", "synth", "--count", "2", "--seed", "5", "--out", str(out), "--face-px", "32",
                  "--quiet"]) == 0
+    assert capsys.readouterr().out.startswith(f"wrote 2 blocks to {out} (")
+
+
+def test_the_summary_line_counts_one_block_in_the_singular(tmp_path, capsys):
+    """'block synth --count 1' said "wrote 1 blocks to ..." (sweep h6)."""
+    from woodcam.cli import main
+
+    assert main(["block", "synth", "--count", "1", "--out", str(tmp_path / "one"), "--face-px", "32",
+                 "--quiet"]) == 0
+    assert capsys.readouterr().out.startswith(f"wrote 1 block to {tmp_path / 'one'} (")

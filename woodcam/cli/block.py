@@ -106,7 +106,7 @@ def run(args) -> int:
                                                  block_options=opts, progress=not args.quiet,
                                                  **engine_options(args))
             knotted = sum(b["knotted"] for b in index["blocks"])
-            print(f"wrote {len(index['blocks'])} blocks to {args.out} ({knotted} knotted; "
+            print(f"wrote {_blocks(len(index['blocks']))} to {args.out} ({knotted} knotted; "
                   f"index.json lists them); {summary.line()}")
             from . import EXIT_CHECKS
 
@@ -121,7 +121,7 @@ def run(args) -> int:
                                       progress=not args.quiet, **noise)
         index = json.loads((Path(args.out) / "index.json").read_text())
         knotted = sum(b["knotted"] for b in index["blocks"])
-        print(f"wrote {len(folders)} blocks to {args.out} ({knotted} knotted; index.json lists them)")
+        print(f"wrote {_blocks(len(folders))} to {args.out} ({knotted} knotted; index.json lists them)")
         return 0
     if args.block_command == "show":
         from ..block.render import save_cross_png
@@ -137,3 +137,8 @@ def run(args) -> int:
 
         return run_from_photos(args)
     raise AssertionError(args.block_command)  # argparse restricts the choices
+
+
+def _blocks(n: int) -> str:
+    """``"1 block"``, ``"2 blocks"``: block synth's summary line said "wrote 1 blocks"."""
+    return f"{n} block{'' if n == 1 else 's'}"
