@@ -392,3 +392,36 @@ def test_a_part_previewed_in_a_wood_that_only_draws_colours_is_baked_without_its
     assert not list(tmp_path.glob("p_report.*"))
     texture = trimesh.load(result.files["glb"], force="mesh").visual.material.baseColorTexture
     assert np.isin(np.asarray(texture.convert("RGB")), (127, 128)).mean() > 0.5  # the wood's grey
+
+
+def test_a_woodified_object_has_no_pith_to_warn_of(tmp_path):
+    """A block of a woodified object (``woodify:DIR/field.npz``, set straight or turned in the
+    grown object) whose year 0 is the surface of the mesh it grew from: a part across year 0 is
+    not warned of a pith and scores none, in the report and the placement terms alike (it was
+    'the pith (within 2 years) reaches the part: expect checks' of the input mesh); the same
+    wood read as a stem's still is."""
+    import trimesh
+
+    from woodcam.advise import part_report
+    from woodcam.woodify.field import WoodifiedField
+    from woodcam.woodify.speed import GrowthSpeed
+
+    g = np.mgrid[0:41, 0:41, 0:41].astype(float) * 2.0 - 40.0
+    grown = WoodifiedField(np.hypot(g[0], g[1]), (-40.0, -40.0, -40.0), 2.0,
+                           GrowthSpeed(velocity_mm=100.0, time_scale_years=30.0), 20.0)
+    turn = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    box = trimesh.creation.box((20.0, 20.0, 10.0))
+    box.apply_translation((20.0, 20.0, 10.0))  # across the block's centre, year 0 there
+    for name, rot in (("straight", None), ("turned", turn)):
+        grown.placed((40.0, 40.0, 20.0), (0.0, 0.0, 0.0), rot).save(tmp_path / f"{name}.npz")
+        stock = open_stock(f"woodify:{tmp_path / f'{name}.npz'}")
+        assert not stock.wood.has_pith
+        assert stock.wood.years(np.array([[20.0, 20.0, 10.0]]))[0] < 2  # year 0 crosses the part
+        rep = part_report(box, stock, samples=2000)
+        assert rep["pith"] == 0.0 and not any("pith" in w for w in rep["warnings"]), (name, rep)
+        advice = advise_placement(box, stock, rotations="none", candidates=8, margin_mm=0.5)
+        assert all(p.terms["pith"] == 0.0 for p in advice.ranked), name
+    # the same years as a stem's: its year 0 is a pith
+    stock.wood.field.has_pith = True
+    rep = part_report(box, stock, samples=2000)
+    assert rep["pith"] > 0 and "the pith (within 2 years) reaches the part: expect checks" in rep["warnings"]

@@ -6,7 +6,8 @@ woodworker cares about, each term reported on its own (all in [0, 1], lower is b
 
 ``knots``      share of the part's surface (and the wood 1 and 3 mm under it) inside a knot
 ``pith``       share of the same points within :data:`PITH_YEARS` of the pith (the pith
-               splits and checks as it dries)
+               splits and checks as it dries); none in wood without a pith (a woodified
+               object, whose year 0 is the mesh it grew from: :func:`_pith`)
 ``end_grain``  share of the surface area whose normal is within 45 degrees of the fibres:
                end grain finishes darker and rougher
 ``runout``     for long thin parts only: the angle between the part's long axis and the mean
@@ -128,6 +129,17 @@ def _features_of(wood, who: str, arg: str):
     return features
 
 
+def _pith(wood, years: np.ndarray, knot: np.ndarray) -> np.ndarray:
+    """Where points of ``years`` (any shape) are pith: within :data:`PITH_YEARS` of year 0 and
+    not in a knot ``knot`` (same shape; inside a knot, years count along the branch: its own
+    pith is knot, not stem pith). Nowhere in wood without a pith (``wood.has_pith`` False: a
+    woodified object, whose year 0 is the surface it grew from; its part report warned 'the
+    pith reaches the part: expect checks' of the input mesh)."""
+    if not getattr(wood, "has_pith", True):  # a user's Wood-like without the property: a stem's
+        return np.zeros(years.shape, dtype=bool)
+    return (years < PITH_YEARS) & ~knot
+
+
 def _sample(mesh, count: int, rng):
     """Area-weighted surface points and normals of ``mesh`` (block frame, mm)."""
     areas = np.asarray(mesh.area_faces, dtype=float)
@@ -220,8 +232,7 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
         feats = features(points)
         n_pts = len(turned)
         knot = feats["knot"].reshape(len(centres), n_pts) > 0.5
-        # inside a knot, years count along the branch: its own pith is knot, not stem pith
-        pith = (feats["years"].reshape(len(centres), n_pts) < PITH_YEARS) & ~knot
+        pith = _pith(stock.wood, feats["years"].reshape(len(centres), n_pts), knot)
         grain = feats["grain"].reshape(len(centres), n_pts, 3)[:, :len(pts)]
         end = np.abs(np.einsum("cij,ij->ci", grain, n_rot)) > math.cos(math.radians(45))
         mean_grain = grain.mean(axis=1)
@@ -333,7 +344,7 @@ def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
     feats = features(depth)
     grain = feats["grain"][:len(pts)]
     knot = feats["knot"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) > 0.5
-    pith = (feats["years"].reshape(len(SUBSURFACE_MM) + 1, len(pts)) < PITH_YEARS) & ~knot
+    pith = _pith(stock.wood, feats["years"].reshape(len(SUBSURFACE_MM) + 1, len(pts)), knot)
     long_axis, ax, elongation = _long_axis(pts)
     end = np.abs(np.einsum("ij,ij->i", grain, nrm)) > math.cos(math.radians(45))
     t = (pts - pts.mean(axis=0)) @ long_axis

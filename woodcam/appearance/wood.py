@@ -10,7 +10,7 @@ import numpy as np
 from .._checks import as_floats, check_number, check_rotation, check_vector
 from .._types import AppearanceLike, ArrayLike, GrowthFieldLike, WoodLike
 from ..errors import WoodcamError
-from ..fields.base import arf, check_points, evaluate, grain_direction, has_uncertainty
+from ..fields.base import arf, check_points, evaluate, grain_direction, has_pith, has_uncertainty
 from ..frames import FACE_NORMAL, FACES, check_face, check_size
 from ..tolerances import COLOR_RANGE_TOL, MAX_BATCH_POINTS, MIN_NORMAL_LENGTH
 from .colormap import ColorMapAppearance
@@ -171,6 +171,12 @@ class Wood:
         """Growth time ``(n,)`` in years at ``points_mm : (n, 3)``."""
         p, _ = self._to_source(check_points(points_mm))
         return evaluate(self.field, p)
+
+    @property
+    def has_pith(self) -> bool:
+        """Whether the growth field's year 0 is a pith (not a grown object's input surface):
+        :func:`woodcam.fields.base.has_pith`."""
+        return has_pith(self.field)
 
     @property
     def has_uncertainty(self) -> bool:

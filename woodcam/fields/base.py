@@ -104,6 +104,14 @@ def has_uncertainty(field) -> bool:
     return bool(layers) and "uncertainty" in layers and callable(getattr(field, "uncertainty_years", None))
 
 
+def has_pith(field) -> bool:
+    """Whether ``field``'s year 0 is a pith, the line its rings grow round (a stem's, a log's, a
+    fitted block's): True unless the field says ``has_pith = False``. A woodified object's year 0
+    is the surface of the mesh it grew from (:class:`woodcam.woodify.field.WoodifiedField`),
+    not a pith that splits as it dries. The one test of it (Wood.has_pith, the part report)."""
+    return bool(getattr(field, "has_pith", True))
+
+
 def arf(years: ArrayLike) -> np.ndarray:
     """Annual-ring field from growth time: ``(years mod 1)^2`` (eq. 6 of seed 000).
 

@@ -73,6 +73,10 @@ class WoodifiedField:
         Fibre direction in the object frame; default ``speed.up``.
     """
 
+    #: Year 0 is the surface of the mesh the object grew from, not a pith: a part cut next to it
+    #: is not warned of checks (:func:`woodcam.fields.base.has_pith`).
+    has_pith = False
+
     def __init__(self, arrival_mm: ArrayLike, origin_mm: ArrayLike, spacing_mm: float,
                  speed: GrowthSpeed, years_final: float, obstacle_sdf_mm: ArrayLike | None = None,
                  block_origin_mm: ArrayLike = (0.0, 0.0, 0.0), rotation: ArrayLike | None = None,
