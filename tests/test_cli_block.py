@@ -342,3 +342,32 @@ def test_size_mm_given_with_a_block_that_is_no_folder_is_said_to_be_ignored(tmp_
     assert err == ["woodcam: warning: --size-mm 30 sizes Mokume sample folders only; 'builtin:flat-sawn' is no "
                    "folder and keeps its own size: ignored (a built-in or log block takes its size in the spec, "
                    "e.g. builtin:flat-sawn:40x40x40)"], err
+
+
+def test_the_real_log_without_shared_data_is_pointed_at_each_callers_way(tmp_path, capsys, monkeypatch):
+    """Without the shared data folder, the real log's error ended in "or pass folder=" on the
+    command line too, which has no such option: a 'log:gran1@K' block says the spec's way (a log
+    file of one's own), 'log render --real' its options, and read_gran1 keeps its folder=."""
+    import woodcam.logs.io
+    from woodcam.logs.io import read_gran1
+    from woodcam.stock import open_stock
+
+    monkeypatch.setattr(woodcam.logs.io, "shared_data_dir", lambda: None)
+    need = "the real log needs the shared data folder (its trees/Gran_1_*.json), and none was found; " \
+           "set WOODCAM_SHARED_DATA=/path/to/shared/data "
+    with pytest.raises(WoodcamError) as err:
+        read_gran1()
+    assert str(err.value) == need + "or pass folder="
+    spec_fix = "or cut the block from a log file of your own: 'log:LOG.json@10'"
+    with pytest.raises(WoodcamError) as err:
+        open_stock("log:gran1@10")
+    assert str(err.value) == need + spec_fix
+    for argv, fix in ((["fit", "log:gran1@10", "--out", str(tmp_path / "f.npz")], spec_fix),
+                      (["bake", str(Path(__file__).parents[1] / "cad_examples" / "bowl.py"), "--block", "log:gran1@10", "--out",
+                        str(tmp_path / "b.glb")], spec_fix),
+                      (["log", "render", "--real", "--out", str(tmp_path / "r")],
+                       "or give a LOG_FILE or --maps DIR instead of --real")):
+        assert main(argv) == 1, argv
+        err_text = capsys.readouterr().err
+        assert err_text == f"woodcam: error: {need}{fix}\n", argv
+        assert "folder=" not in err_text

@@ -642,12 +642,15 @@ def _log_block_field(parsed: ParsedSpec):
     a knot draws the default block's texture, so the same piece of the log has the same colours
     in each."""
     from .fields import KnottedLogField, block_at_knot, place_block_in_log
-    from .logs.io import read_gran1, read_log
+    from .logs.io import gran1_folder, read_gran1, read_log
 
     source, knot, spec = parsed.source, parsed.knot, parsed.base
     assert knot is not None  # parse_spec reads a log block's knot
     size_mm = parsed.size_mm or _LOG_BLOCK_SIZE_MM
-    log = read_gran1() if source == "gran1" else read_log(source)
+    # a spec has no folder= to pass (read_gran1's own fix): it says the spec's way
+    log = read_gran1(gran1_folder(f"or cut the block from a log file of your own: "
+                                  f"'log:LOG.json@{knot}'")) \
+        if source == "gran1" else read_log(source)
     if not 0 <= knot < len(log.knots):
         # a spec that names no block: the command line says it of its --block, exit 2 (it exited 1)
         if not log.knots:  # "must be 0..-1 ...; e.g. '@0'" offered the index it refused

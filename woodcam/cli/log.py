@@ -69,7 +69,7 @@ def register(subparsers) -> None:
 
 
 def _load(args):
-    from ..logs.io import read_gran1, read_log
+    from ..logs.io import gran1_folder, read_gran1, read_log
     from ..logs.maps import read_maps
 
     given = [x for x in (args.log_file, args.real or None, args.maps) if x]
@@ -77,7 +77,7 @@ def _load(args):
         raise UsageError("give exactly one log: a LOG_FILE, --real or --maps DIR; got "
                            f"{len(given)}")
     if args.real:
-        return read_gran1()
+        return read_gran1(gran1_folder("or give a LOG_FILE or --maps DIR instead of --real"))
     if args.maps:
         return read_maps(args.maps)
     return read_log(args.log_file)

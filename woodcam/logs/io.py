@@ -33,6 +33,18 @@ def shared_data_dir() -> Path | None:
     return None
 
 
+def gran1_folder(fix: str) -> Path:
+    """The folder of the real log's files (``<shared data>/trees``, read by :func:`read_gran1`),
+    or the error that there is no shared data folder, ending in ``fix``: how the caller's user
+    points at the files otherwise (``read_gran1``'s ``folder=``; on the command line, which has
+    no such option, a log file of their own), so each says its own way."""
+    base = shared_data_dir()
+    if base is None:
+        raise WoodcamError(f"the real log needs the shared data folder (its trees/Gran_1_*.json), and none "
+                           f"was found; set WOODCAM_SHARED_DATA=/path/to/shared/data {fix}")
+    return base / "trees"
+
+
 def write_log(log: LogSkeleton, path: PathLike) -> Path:
     """Write ``log`` as a woodcam log file (JSON, mm); returns the path."""
     from .._atomic import write_text
@@ -79,11 +91,7 @@ def read_gran1(folder: PathLike | None = None, *, centre: bool = True) -> LogSke
     """
     centre = check_bool(centre, "read_gran1: centre")  # the arguments before the data folder is sought
     if folder is None:
-        base = shared_data_dir()
-        if base is None:
-            raise WoodcamError("the real log needs the shared data folder; set "
-                               "WOODCAM_SHARED_DATA=/path/to/shared/data or pass folder=")
-        folder = base / "trees"
+        folder = gran1_folder("or pass folder=")
     folder = check_path(folder, "read_gran1: folder", fix="shared/data/trees, or None for the shared data folder's")
     def table(name: str, what: str, columns: int | None, min_rows: int) -> np.ndarray:
         # read as every JSON file is (bad JSON, NaN or a folder given as the file were bare errors)
