@@ -54,10 +54,28 @@ def test_block_synth_then_show(tmp_path, capsys):
 
 
 def test_block_errors_are_one_line(tmp_path, capsys):
+    """An empty folder given as a block: one line naming the argument that gave it (the folder
+    alone left a command of several block inputs to guess which), exit 1 as the README's exit
+    statuses say of an input that is there and of its kind but whose contents are bad."""
     assert main(["block", "show", str(tmp_path), "--out", str(tmp_path / "x.png")]) == 1
     err = capsys.readouterr().err
-    assert err.startswith("woodcam: error: folder") and "is not a block" in err and err.count("\n") == 1
+    assert err.startswith(f"woodcam: error: BLOCK of 'woodcam block show': folder {str(tmp_path)!r} is not a block")
+    assert err.count("\n") == 1
     assert "block.json" in err and "Mokume files" in err and "face photos" in err
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    Image.fromarray(np.full((32, 32, 3), 100, np.uint8)).save(tmp_path / "x.png")  # parquetry's design
+    part = Path(__file__).parents[1] / "cad_examples" / "bowl.py"
+    for argv, given in ((["bake", str(part), "--block", str(empty), "--out", str(tmp_path / "b.glb")],
+                         "--block of 'woodcam bake'"),
+                        (["fit", str(empty), "--out", str(tmp_path / "f.npz")], "BLOCK of 'woodcam fit'"),
+                        (["parquetry", str(tmp_path / "x.png"), "--veneer-from", "builtin:flat-sawn",
+                          "--veneer-from", str(empty), "--out", str(tmp_path / "pq")],
+                         "--veneer-from of 'woodcam parquetry'")):
+        assert main(argv) == 1, argv
+        err = capsys.readouterr().err
+        assert err.startswith(f"woodcam: error: {given}: folder {str(empty)!r} is not a block"), err
+        assert err.count("\n") == 1
 
 
 def test_a_folder_of_face_photos_is_told_to_become_a_block(tmp_path, capsys):

@@ -30,6 +30,18 @@ class BlockSpecError(WoodcamError):
         self.part, self.text, self.rule, self.spec = part, text, rule, spec
 
 
+class BlockFolderError(WoodcamError):
+    """A folder given as a block that is none (no ``block.json``, no Mokume files: an empty
+    folder, or one of face photos not yet made a block); ``folder`` is that folder, as given,
+    so the command line names the argument that gave it (``--block``, ``--veneer-from``). The
+    folder is there and a folder, so the door let it through: its contents are wrong (exit 1,
+    as any input whose contents are bad)."""
+
+    def __init__(self, message: str, *, folder=None):
+        super().__init__(message)
+        self.folder = folder
+
+
 class MissingDependencyError(WoodcamError, ImportError):
     """An optional dependency is not installed; the message gives the install command."""
 

@@ -60,7 +60,7 @@ from .._checks import check_bool, check_path
 from .._types import ArrayLike, PathLike
 from .._atomic import all_or_nothing, atomic_path, output_folder, write_text
 from .._readers import photo_rgb8, read_image_file
-from ..errors import WoodcamError, WoodcamWarning
+from ..errors import BlockFolderError, WoodcamError, WoodcamWarning
 from ..fields.state import field_from_state, field_type, jsonable
 from ..frames import FACES, MOKUME_LETTER
 from ..tolerances import KNOT_POINT_MAX_PX, KNOT_REGION_SMOOTH_PX
@@ -407,14 +407,14 @@ def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | No
 
         photos = find_face_photos(folder)
         if photos:  # a user's own photos, not yet a block: say how to make one
-            raise WoodcamError(
+            raise BlockFolderError(
                 f"folder {str(folder)!r} holds face photos ({', '.join(p.name for p in photos.values())}) but no "
                 f"{MANIFEST}: make a block of them first: woodcam block from-photos {str(folder)!r} --size-mm "
-                "WxDxH --out BLOCK_DIR")
-        raise WoodcamError(
+                "WxDxH --out BLOCK_DIR", folder=folder)
+        raise BlockFolderError(
             f"folder {str(folder)!r} is not a block: no {MANIFEST} (a block folder), no Mokume files like "
             "A_col.png or A_arl-unet.png, no face photos (front.jpg ...); make a block with woodcam block "
-            "from-photos or woodcam block synth")
+            "from-photos or woodcam block synth", folder=folder)
     return read_mokume(folder, MOKUME_DEFAULT_SIZE_MM if size_mm is None else tuple(size_mm))
 
 

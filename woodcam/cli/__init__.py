@@ -279,7 +279,8 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
                 print(f"woodcam: error: {typed}: {err.rule}", file=sys.stderr)
                 return EXIT_USAGE
             if isinstance(err, WoodcamError):
-                print(f"woodcam: error: {err}", file=sys.stderr)
+                given = _given_by(args, err)
+                print(f"woodcam: error: {given + ': ' if given else ''}{err}", file=sys.stderr)
                 return EXIT_ERROR
             if isinstance(err, OSError):  # the system refused a read or write (disk full, no permission)
                 where = f" ({err.filename})" if err.filename else ""
@@ -319,6 +320,30 @@ def _typed_spec(args: argparse.Namespace, err: BaseException) -> str:
     specs = getattr(args, "veneer_from", None) or []
     if err.spec in specs:  # as typed: in mm once read at the door, as --block
         return f"--veneer-from {as_typed(args, 'veneer_from')[specs.index(err.spec)]}"
+    return ""
+
+
+def _given_by(args: argparse.Namespace, err: BaseException) -> str:
+    """``"--veneer-from of 'woodcam parquetry'"``: the input argument that gave the folder a
+    :class:`~woodcam.errors.BlockFolderError` is about (an empty folder as a block), "" if none
+    did (the error said the folder alone, which a command of several block inputs left the user
+    to match)."""
+    from pathlib import Path
+
+    from .._specs import spec_path
+    from ..errors import BlockFolderError
+    from .options import _command_name
+
+    if not isinstance(err, BlockFolderError) or err.folder is None:
+        return ""
+    folder = Path(err.folder).resolve()
+    for arg in getattr(args, "_inputs", ()):
+        value = getattr(args, arg.dest, None)
+        for item in value if isinstance(value, list) else [] if value is None else [value]:
+            for text in arg.paths(str(item)) if arg.paths else [str(item)]:
+                path = spec_path(str(text)) if arg.kind == "block" else Path(str(text))
+                if path is not None and path.resolve() == folder:
+                    return f"{arg.name} of 'woodcam {_command_name(args)}'"
     return ""
 
 
