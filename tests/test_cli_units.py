@@ -417,6 +417,25 @@ def test_say_length_and_say_volume_take_a_summarys_units():
     assert say_volume(16387.064, ".0f", units="inch") == "1 in^3"
 
 
+def test_a_large_volume_or_area_is_said_without_an_exponent():
+    """A part of 120000 mm^3 sticking 110000 mm^3 out of its block was warned of as
+    '1.1e+05 mm^3 (91.7 % of the part's 120000 mm^3)': a message's volumes and areas are
+    written out, rounded to the spec's significant digits, in one form."""
+    import trimesh
+
+    from woodcam.cad.carve import carve
+    from woodcam.errors import WoodcamWarning
+    from woodcam.units import say_area, say_volume
+
+    assert say_volume(110000.0) == "110000 mm^3" and say_volume(123456.7) == "123500 mm^3"
+    assert say_area(2.5e6) == "2500000 mm^2" and say_volume(1.518) == "1.518 mm^3"
+    with pytest.warns(WoodcamWarning) as caught:
+        carve(trimesh.creation.box((300.0, 20.0, 20.0)), (100.0, 80.0, 50.0))
+    said = [str(w.message) for w in caught if "sticks out" in str(w.message)]
+    assert said and said[0].startswith("part sticks out of the block: 110000 mm^3 (91.7 % of the part's "
+                                       "120000 mm^3) lies outside"), said
+
+
 @pytest.mark.parametrize("units, spec", [
     (["--units", "inch"], "builtin:knotty[4x3]"),          # three sides wanted
     (["--units", "inch"], "builtin:knotty[1000x1x1]"),     # over the cap once in inches

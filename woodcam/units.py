@@ -138,7 +138,15 @@ def say_volume(mm3: float, spec: str = ".4g", *, units: Units | None = None) -> 
     """A volume given in mm^3, for a message, in the message units (:func:`message_units`) or
     ``units``: in mm^3 with the message's ``spec``, else :func:`fmt_volume`'s inches^3."""
     units = units or _message_units
-    return f"{mm3:{spec}} mm^3" if units == "mm" else fmt_volume(mm3, units)
+    return f"{_no_exponent(mm3, spec)} mm^3" if units == "mm" else fmt_volume(mm3, units)
+
+
+def _no_exponent(value: float, spec: str) -> str:
+    """``value`` with ``spec``, a large one written out as the rounded whole number it is, never
+    in exponent form: ``.4g`` of 110000 mm^3 was '1.1e+05' beside '120000 mm^3' in one message
+    (the part sticking out of its block)."""
+    text = f"{value:{spec}}"
+    return f"{float(text):.0f}" if "e+" in text else text
 
 
 def say_area(mm2: float, spec: str = ".4g", *, units: Units | None = None) -> str:
@@ -147,7 +155,7 @@ def say_area(mm2: float, spec: str = ".4g", *, units: Units | None = None) -> st
     ``say_area(645.16) == "645.2 mm^2"``, under ``--units inch`` ``"1 in^2"``."""
     units = units or _message_units
     if units == "mm":
-        return f"{mm2:{spec}} mm^2"
+        return f"{_no_exponent(mm2, spec)} mm^2"
     return f"{mm2 / MM_PER_UNIT[units] ** 2:.4g} {_SYMBOL[units]}^2"
 
 
