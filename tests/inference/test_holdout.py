@@ -245,3 +245,19 @@ def test_eval_rings_confidence_draws_and_summarises_the_held_out_faces_confidenc
     assert pngs[0] != pngs[1]  # --confidence draws it
     res = leave_one_face_out(real, ["evidence"], confidence=True)
     assert all(sc.confidence_img is not None for sc in res["held_out"]["evidence"])
+
+
+def test_the_held_out_picture_says_its_colours_and_shares(field, mapped, tmp_path, monkeypatch):
+    """The leave-one-face-out PNG drew blue, red and yellow on its overlay and 'ridge 8/13%  line
+    9/15%' under it with no word of what they are: its title carries the key."""
+    import woodcam.inference.holdout as holdout
+
+    figures = []
+    real = holdout.write_figure
+    monkeypatch.setattr(holdout, "write_figure", lambda fig, path, **kw: (figures.append(fig), real(fig, path, **kw))[1])
+    scores = [score_face(field, mapped, face) for face in ("front", "top")]
+    holdout.plot_holdout(tmp_path / "h.png", mapped, scores, title="b, radial: each face predicted")
+    said = figures[0]._suptitle.get_text()
+    assert said == "b, radial: each face predicted\n" + holdout.HOLDOUT_KEY
+    assert "blue its ridge" in said and "red the predicted ring lines" in said and "within 1 / 2 px" in said
+    assert (tmp_path / "h.png").stat().st_size > 0

@@ -319,6 +319,12 @@ def holdout_table(name: str, res: dict, methods: list[str], thresholds=HOLDOUT_T
     return "\n".join(lines) + "\n"
 
 
+#: The key of :func:`plot_holdout`'s overlay and the shares under it, drawn under its title: the
+#: PNG said none of it (what blue and red are, what "ridge 8/13%" counts).
+HOLDOUT_KEY = ("overlay: grey ring map, blue its ridge, red the predicted ring lines, yellow round the knots "
+               "(not scored)\nunder it: % of ridge / line points within 1 / 2 px of the other")
+
+
 def plot_holdout(path, block, scores: list[FaceScore], title: str = "", confidence: bool = False):
     """PNG, one row per face: photo, ring map, predicted ARF (eq. 6), overlay (grey ring map,
     blue ridge pixels, red predicted ring lines, knot margin hatched out).
@@ -367,8 +373,8 @@ def plot_holdout(path, block, scores: list[FaceScore], title: str = "", confiden
                       + label, fontsize=7)
         ax.set_xlim(0, f.shape[1] - 1)
         ax.set_ylim(f.shape[0] - 1, 0)
-    if title:
-        fig.suptitle(title, fontsize=9)
+    key = HOLDOUT_KEY + (" (confidence under it: red unsure, green sure)" if confidence else "")
+    fig.suptitle(f"{title}\n{key}" if title else key, fontsize=7 if not title else 8)
     fig.tight_layout()
     write_figure(fig, path, dpi=100)
     plt.close(fig)
