@@ -102,3 +102,20 @@ def test_confidence_summary_splits_right_and_wrong_lines(tmp_path):
     assert confidence_summary(np.array([1.0, 0.0]), np.array([0.1, 3.0]))["matched_2_unsure"] == 0
     png = plot_planes(tmp_path / "c.png", {"evidence": scores}, confidence=True)
     assert png.stat().st_size > 1000
+
+
+def test_the_cut_plane_picture_says_what_its_planes_and_shares_are(tmp_path, monkeypatch):
+    """'eval rings' cut-plane PNG titled its panels 'radial z=0.5 / 100% <1mm' with no word that
+    0.5 is a fraction of the block's height nor of what the % counts: its title carries the key."""
+    import woodcam.inference.evaluate as evaluate
+
+    figures = []
+    real = evaluate.write_figure
+    monkeypatch.setattr(evaluate, "write_figure", lambda fig, path, **kw: (figures.append(fig), real(fig, path, **kw))[1])
+    _, scores = evaluate_fit(_Cylinder(), _Cylinder(), (50, 50, 50), planes=PLANE, pixel_mm=0.5, keep_lines=True)
+    for title in ("b (full): black = true rings, colour = fitted", ""):
+        evaluate.plot_planes(tmp_path / "p.png", {"radial": scores}, title=title)
+        said = figures[-1]._suptitle.get_text()
+        assert said == (f"{title}\n" if title else "") + evaluate.PLANES_KEY
+        assert "fractions of the block's width x, depth y, height z" in said
+        assert "within 1 mm of the true line of the same year" in said
