@@ -689,13 +689,15 @@ def _target():
 
 
 def _veneer():
-    """A 40 x 40 px sheet at 4 px/mm (seeded noise)."""
+    """A 80 x 80 px sheet at 4 px/mm (seeded noise): 20 x 20 mm, enough wood for the 8 x 8 mm
+    panel of :func:`_small_params` with each piece's overlap and kerf, so a valid job is not
+    warned of too little wood."""
     import numpy as np
 
     from woodcam.parquetry import Veneer
 
-    rgb = np.random.default_rng(0).random((40, 40, 3)).astype(np.float32)
-    return Veneer("v", rgb, 4.0, np.ones((40, 40), bool), "noise")
+    rgb = np.random.default_rng(0).random((80, 80, 3)).astype(np.float32)
+    return Veneer("v", rgb, 4.0, np.ones((80, 80), bool), "noise")
 
 
 @functools.lru_cache(maxsize=1)
