@@ -254,3 +254,30 @@ def test_a_block_name_that_is_a_path_is_refused_before_it_names_a_file(tmp_path,
     with pytest.raises(WoodcamError, match="Block.name must be a plain name"):
         read_block(tmp_path / "b")
 
+
+
+def test_rings_show_and_block_show_name_each_face():
+    """'rings show' and 'block show' drew six photos in a cross with no word of which face was
+    which (the user had to work it out from docs/conventions.md): each face present now carries
+    its name and Mokume letter at its top-left corner, and an absent face's slot stays empty."""
+    from woodcam.block import Block, Face
+    from woodcam.block.render import cross_image
+    from woodcam.detect.show import rings_picture
+    from woodcam.frames import FACES, CrossLayout
+
+    grey = np.full((64, 64, 3), 150, np.uint8)
+    block = Block((10.0, 10.0, 10.0), faces={f: Face(f, (64, 64), photo=grey) for f in FACES if f != "back"})
+    for pic, zoom in ((rings_picture(block, zoom=2), 2), (cross_image(block), 1)):
+        layout = CrossLayout((10.0, 10.0, 10.0), 6.4 * zoom)
+        corners = {}
+        for f in FACES:
+            r, c = layout.origin[f]
+            corner = pic[r:r + 16 * zoom // 2 + 8, c:c + 64 * zoom // 2]
+            corners[f] = corner
+        for f in FACES:
+            if f == "back":
+                assert np.ptp(corners[f]) == 0, "an absent face is not labelled"
+                continue
+            assert (corners[f] > 200).all(axis=2).any(), f"face {f!r} has no white label"
+            assert (corners[f] < 40).all(axis=2).any(), f"face {f!r} has no dark label box"
+        assert not np.array_equal(corners["front"], corners["top"]), "labels differ by face"

@@ -13,7 +13,7 @@ import numpy as np
 
 from .._atomic import atomic_path
 from ..errors import WoodcamError
-from ..frames import CrossLayout, FACES, face_image_size_mm, unfold_cross
+from ..frames import MOKUME_LETTER, CrossLayout, FACES, face_image_size_mm, unfold_cross
 from .block import Block
 
 Layer = Literal["photo", "ring_map", "both"]
@@ -23,6 +23,30 @@ _PALETTE = np.array([
     (230, 25, 75), (60, 180, 75), (0, 130, 200), (245, 130, 48), (145, 30, 180),
     (70, 240, 240), (240, 50, 230), (210, 245, 60),
 ], dtype=np.uint8)
+
+
+#: Height of a face's name on its picture, as a share of the face's shorter side (at least
+#: :data:`LABEL_MIN_PX`): read at a glance on a 256 px face at --zoom 2, covering little of it.
+LABEL_SHARE = 1 / 16
+LABEL_MIN_PX = 10
+
+
+def label_face(rgb: np.ndarray, face: str) -> np.ndarray:
+    """``rgb`` (rows, cols, 3) uint8, a picture of ``face``, with the face's name and Mokume
+    letter (``front (A)``) in white on a dark box at its top-left corner: six unlabelled faces
+    in a cross left the user to work out from ``docs/conventions.md`` which photo was which."""
+    from PIL import Image, ImageDraw, ImageFont
+
+    im = Image.fromarray(np.asarray(rgb, np.uint8))
+    size = max(LABEL_MIN_PX, round(min(im.size) * LABEL_SHARE))
+    font = ImageFont.load_default(size=size)
+    draw = ImageDraw.Draw(im)
+    pad = max(2, size // 4)
+    text = f"{face} ({MOKUME_LETTER[face]})" if face in MOKUME_LETTER else face
+    x0, y0, x1, y1 = draw.textbbox((pad, pad), text, font=font)
+    draw.rectangle((0, 0, x1 + pad, y1 + pad), fill=(24, 24, 24))
+    draw.text((pad, pad), text, fill=(255, 255, 255), font=font)
+    return np.asarray(im)
 
 
 def _face_rgb(face, layer: str) -> np.ndarray | None:
@@ -45,6 +69,7 @@ def cross_image(block: Block, layer: Layer = "photo", *, traces: bool = True,
         Face photos, ring maps, or both crosses stacked (photos above).
     traces : bool
         Draw the traced rings, coloured by year (white when unlabelled).
+        Each face present is named at its top-left corner (:func:`label_face`).
     px_per_mm : float, optional
         Picture density; default the densest face's. Faces at another density are resampled.
     background : int
@@ -82,7 +107,7 @@ def cross_image(block: Block, layer: Layer = "photo", *, traces: bool = True,
                 xy = ((t.points_px[:, ::-1] + 0.5) * (sc, sr)).ravel().tolist()
                 col = (255, 255, 255) if t.year is None else tuple(int(v) for v in _PALETTE[t.year % len(_PALETTE)])
                 draw.line(xy, fill=col, width=line_width)
-        images[name] = np.asarray(im)
+        images[name] = label_face(np.asarray(im), name) if face is not None else np.asarray(im)
     return unfold_cross(images, block.size_mm, background=background)
 
 

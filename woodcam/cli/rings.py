@@ -92,7 +92,8 @@ def register(subparsers) -> None:
                        description="Unfolded cross of the face photos (2x) with ring traces (the pieces of one "
                        "ring share a colour), knot "
                        "outlines (yellow) and, for a Mokume folder, the U-Net map's ridge (cyan). A "
-                       "Mokume folder is detected first (cached).")
+                       "Mokume folder is detected first (cached). Each face is named at its top-left corner "
+                       "(front (A) ...).")
     add_input(s, "block", kind="folder", type=Path, help="block folder (after 'rings detect') or Mokume sample folder")
     add_out_option(s, "the photos with the rings and knots found", suffixes=(".png",))
     s.add_argument("--zoom", type=int, default=2, help="enlargement: picture pixels per face pixel, a whole number (default 2)")

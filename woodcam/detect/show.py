@@ -5,7 +5,8 @@ top above front, bottom below front), enlarged ``zoom`` times so one-pixel lines
 Drawn on each photo: the ring traces (red; pieces the detector linked into one ring,
 ``RingTrace.ring``, share one of :data:`RING_RGBS`, neighbouring ids differ, so a wrong link
 shows as a colour jumping between lines), the knot masks' outlines (yellow) and, when a
-reference ring map is given (e.g. Mokume's U-Net map), its ridge (cyan dots).
+reference ring map is given (e.g. Mokume's U-Net map), its ridge (cyan dots); the face's name
+and Mokume letter at its top-left corner (:func:`woodcam.block.render.label_face`).
 """
 
 from __future__ import annotations
@@ -24,9 +25,12 @@ REFERENCE_RGB = (0, 230, 255)
 
 
 def face_picture(face, zoom: int = 2, reference_map: np.ndarray | None = None) -> np.ndarray:
-    """``(h * zoom, w * zoom, 3)`` uint8: one face's photo with its traces, knots and reference."""
+    """``(h * zoom, w * zoom, 3)`` uint8: one face's photo with its traces, knots and reference,
+    named at its top-left corner."""
     from PIL import Image, ImageDraw
     from scipy import ndimage
+
+    from ..block.render import label_face
 
     from .score import reference_ridge
 
@@ -48,7 +52,7 @@ def face_picture(face, zoom: int = 2, reference_map: np.ndarray | None = None) -
         xy = ((t.points_px[:, ::-1] + 0.5) * zoom).ravel().tolist()
         rgb = TRACE_RGB if t.ring is None else RING_RGBS[t.ring % len(RING_RGBS)]
         draw.line(xy, fill=rgb, width=max(1, zoom // 2))
-    return np.asarray(im)
+    return label_face(np.asarray(im), face.name)
 
 
 def rings_picture(block, zoom: int = 2, references: dict | None = None) -> np.ndarray:
