@@ -65,12 +65,16 @@ def test_a_path_of_several_subpaths_is_one_trace_each(tmp_path):
 
 
 def test_bad_files_are_refused(tmp_path):
+    """A file cut short and a data-year that is no integer are refused naming a fix (they named
+    none: 'must be a readable SVG file; unclosed token: line 2, column 43848', of an Inkscape
+    save cut short)."""
     (tmp_path / "bad.svg").write_text("<svg")
-    with pytest.raises(WoodcamError, match="must be a readable SVG"):
+    with pytest.raises(WoodcamError, match="must be a readable SVG.*save it again from your SVG editor.*or "
+                                           "delete it to have 'woodcam rings detect' trace the face afresh"):
         read_traces_svg(tmp_path / "bad.svg", (10, 10))
     (tmp_path / "y.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 10 10">'
                                     '<polyline data-year="x" points="0,0 1,1"/></svg>')
-    with pytest.raises(WoodcamError, match="data-year must be an integer"):
+    with pytest.raises(WoodcamError, match="data-year must be an integer.*fix or delete the attribute"):
         read_traces_svg(tmp_path / "y.svg", (10, 10))
 
 

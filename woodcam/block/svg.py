@@ -90,7 +90,10 @@ def read_traces_svg(path, shape) -> list[RingTrace]:
     try:
         svg = svgelements.SVG.parse(str(path), reify=True)
     except (ET.ParseError, OSError, ValueError) as err:
-        raise WoodcamError(f"{str(path)!r} must be a readable SVG file; {err}") from err
+        # a file cut short (an editor's crash, a copy interrupted) was named with no way out
+        raise WoodcamError(f"{str(path)!r} must be a readable SVG file; {err}; save it again from your SVG "
+                           "editor (Inkscape: File > Save), or delete it to have 'woodcam rings detect' trace "
+                           "the face afresh") from err
     rows, cols = int(shape[0]), int(shape[1])
     if not (svg.width and svg.height and svg.width > 0 and svg.height > 0):
         raise WoodcamError(f"{str(path)!r} has no drawing size: give the <svg> a viewBox or a "
@@ -188,5 +191,6 @@ def _year(attributes: dict) -> int | None:
         if m:
             return int(m.group(1))
         if key == "data-year":
-            raise WoodcamError(f"data-year must be an integer; got {v!r}")
+            raise WoodcamError(f"data-year must be an integer (the ring's year); got {v!r}: fix or delete the "
+                               "attribute")
     return None
