@@ -1181,7 +1181,7 @@ def test_a_face_is_resampled_once_whatever_the_other_photos_densities(synth_phot
     with Image.open(d / "top.png") as im:    # 3 px/mm, below it: the set's density
         im.resize((150, 150), Image.LANCZOS).save(d / "top.png")
     capped = block_from_photos(d, (50, 50, 50), max_px_per_mm=4.0)
-    free = block_from_photos(d, (50, 50, 50), max_px_per_mm=100.0)
+    free = block_from_photos(d, (50, 50, 50), max_px_per_mm=100.0)  # one photo denser than the rest: no warning
     assert capped.meta["px_per_mm"] == free.meta["px_per_mm"] == 3.0
     once = np.asarray(Image.fromarray(big).resize((150, 150), Image.LANCZOS))
     for face in FACES:
@@ -1199,6 +1199,29 @@ def test_from_photos_says_when_the_photos_are_brought_down_to_the_cap(synth_phot
     assert read_block(tmp_path / "o").meta["photos_px_per_mm"] == pytest.approx(3.2)
     rc, out, err = _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", tmp_path / "p")
     assert rc == 0 and "faces at 3.20 px/mm:" in out and "down from" not in out, out + err
+
+
+def test_from_photos_names_the_photo_that_brings_every_face_down(synth_photos, tmp_path, capsys):
+    """One photo taken from afar (or at a low resolution) brought all six faces down to its
+    density without a word of which (reproduced: CN03's front resized to 100 px beside five of
+    256 px -> 'wrote o (6 faces at 2.00 px/mm: front 100x100, top 100x100, ...)', nothing
+    else). Now a warning names the face, its photo and density; a spread within DENSITY_SPREAD,
+    the other photos brought down to the cap anyway, or one photo denser than the rest (test
+    above) is not said."""
+    from woodcam.block.photos import DENSITY_SPREAD
+
+    d = _copy(synth_photos, tmp_path / "low")
+    with Image.open(d / "front.png") as im:  # 1.6 px/mm beside the others' 3.2
+        im.resize((80, 80), Image.LANCZOS).save(d / "front.png")
+    rc, out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == 0 and "faces at 1.60 px/mm" in out, out + err
+    assert err.count("warning") == 1 and ("photo of face 'front' (front.png, 1.60 px/mm) holds far less than the "
+                                          "other photos' 3.20 px/mm (their median): all faces are stored at one density, "
+                                          "1.60 px/mm, so the others lose their detail; retake it closer") in err, err
+    assert 3.2 / 1.6 > DENSITY_SPREAD
+    rc, out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--max-px-per-mm", "2",
+                        "--out", tmp_path / "p")  # the others brought down to the cap of 2 anyway
+    assert rc == 0 and "warning" not in err, err
 
 
 def test_photos_named_for_no_face_are_said(synth_photos, tmp_path, capsys):

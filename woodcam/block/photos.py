@@ -18,7 +18,8 @@ border unlike the wood on any side (:func:`_uniform_border`: background round th
 the face's proportions keeps its aspect, a strip beside a face cropped off its centre too).
 Faces are resampled to one density (the lowest of the photos', at most ``max_px_per_mm``), so
 the faces unfold into one cross and ring widths are alike in pixels; each once, from its
-original, so a face's pixels depend on the other photos only through that density.
+original, so a face's pixels depend on the other photos only through that density. A photo
+that brings the others down by more than :data:`DENSITY_SPREAD` is named in a warning.
 """
 
 from __future__ import annotations
@@ -63,6 +64,10 @@ BORDER_COLOUR_TOL = 10.0
 #: (of 255, any channel): a band of the wood's own colour is wood to the eye as to the detector,
 #: and at 15 no calibration face above (BORDER_COLOUR_TOL) was flagged.
 BORDER_COLOUR_STEP = 15.0
+#: A photo whose density is under the photos' median (at most the cap) by more than this factor
+#: is warned of: every face is stored at the lowest density, so one photo taken from afar or
+#: at a low resolution brought the other five down with it, without a word of which.
+DENSITY_SPREAD = 1.5
 #: Default upper density (px/mm): 10 px/mm keeps 0.1 mm detail (rings are >= 0.8 mm) and a
 #: 50 mm face at 500 px, which the ring detector handles in about a second.
 MAX_PX_PER_MM = 10.0
@@ -297,6 +302,17 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
             "edges, the wood alone with no table or background round it (a photo editor's perspective crop also "
             "squares up a face taken at an angle), or check --size-mm")
     ppm = min(min(density.values()), max_px_per_mm)
+    # against the photos' median (at most the cap): one photo denser than the rest is no fault of theirs
+    typical = min(float(np.median(list(density.values()))), max_px_per_mm)
+    low = [f for f in images if density[f] * DENSITY_SPREAD < typical]
+    if low:
+        said = ", ".join(f"{f!r} ({photos[f].name}, {density[f]:.2f} px/mm)" for f in low)
+        one = len(low) == 1
+        warnings.warn(
+            f"{'photo of face' if one else 'photos of faces'} {said} {'holds' if one else 'hold'} far less "
+            f"than the other photos' {typical:.2f} px/mm (their median): all faces are stored at one density, {ppm:.2f} px/mm, "
+            f"so the others lose their detail; retake {'it' if one else 'them'} closer or at a higher "
+            "resolution", WoodcamWarning, stacklevel=2)
     # a photo brought down to the cap while another lies below it is read again and resampled
     # once, from its original: resampled twice (to the cap, then to ppm), a face's pixels
     # depended on the other photos' densities beyond the common target density
