@@ -191,3 +191,21 @@ def test_bad_attributes_name_the_file_and_nan_in_a_path_is_refused(tmp_path):
                                     '<path d="M 0,0 L nan,1 2,2"/></svg>')
     with pytest.raises(WoodcamError, match="a path's data must hold finite numbers"):
         read_traces_svg(tmp_path / "p.svg", (10, 10))
+
+
+def test_a_stroke_past_the_face_is_refused_naming_the_svg_and_the_stroke(tmp_path):
+    """A stroke drawn far past the face in Inkscape was refused only later, by the Face, as
+    "trace 20 of face 'front' lies beyond its 256x256 px image (more than half a face past an
+    edge); check its (row, col) pixel coordinates": no word of the SVG, the stroke or where it
+    runs. Now the reader refuses it in the SVG's terms; a stroke within half a face of slack
+    (drawn a little over an edge) is read."""
+    svg = tmp_path / "front_traces.svg"
+    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="40" height="20" viewBox="0 0 40 20">'
+                   '<path id="over" d="M -5,-5 L 45,25"/><path id="far" d="M 1,1 L 70,1"/></svg>')
+    with pytest.raises(WoodcamError, match=r"front_traces.svg', element far: a stroke runs to \(70, 1\), more than "
+                                           r"half the drawing past its edge \(the drawing spans 0..40 x 0..20, over "
+                                           r"the 40x20 px face photo\); move the stroke onto the face or delete it"):
+        read_traces_svg(svg, (20, 40))
+    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="40" height="20" viewBox="0 0 40 20">'
+                   '<path id="over" d="M -5,-5 L 45,25"/></svg>')
+    assert len(read_traces_svg(svg, (20, 40))) == 1

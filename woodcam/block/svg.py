@@ -28,7 +28,7 @@ import numpy as np
 
 from .._atomic import atomic_path
 from ..errors import WoodcamError
-from .block import Face, RingTrace
+from .block import Face, RingTrace, trace_bounds_px
 
 _SVG_NS = "http://www.w3.org/2000/svg"
 _INKSCAPE_LABEL = "{http://www.inkscape.org/namespaces/inkscape}label"
@@ -99,6 +99,7 @@ def read_traces_svg(path, shape) -> list[RingTrace]:
         raise WoodcamError(f"{str(path)!r} has no drawing size: give the <svg> a viewBox or a "
                            "width and height")
     scale = np.array([cols / svg.width, rows / svg.height])  # document units -> image pixels
+    lo, hi = trace_bounds_px((rows, cols))
     traces: list[RingTrace] = []
     for el in svg.elements():
         if not isinstance(el, (svgelements.Path, svgelements.Polyline, svgelements.SimpleLine)):
@@ -118,7 +119,18 @@ def read_traces_svg(path, shape) -> list[RingTrace]:
         for xy in _polylines(path_, scale):
             if len(xy) >= 2:
                 px = xy * scale
-                traces.append(RingTrace(np.stack([px[:, 1] - 0.5, px[:, 0] - 0.5], axis=1), year, ring))
+                rc = np.stack([px[:, 1] - 0.5, px[:, 0] - 0.5], axis=1)
+                # the Face's rule (trace_bounds_px), said here in the SVG's terms: it was 'trace 20 of
+                # face 'front' lies beyond its 256x256 px image; check its (row, col) pixel coordinates'
+                out = ((rc < lo) | (rc > hi)).any(axis=1)
+                if out.any():
+                    x, y = xy[int(np.argmax(out))]
+                    raise WoodcamError(
+                        f"{str(path)!r}, element {el.values.get('id') or type(el).__name__}: a stroke runs to "
+                        f"({x:.6g}, {y:.6g}), more than half the drawing past its edge (the drawing spans 0..{svg.width:g} "
+                        f"x 0..{svg.height:g}, over the {cols}x{rows} px face photo); move the stroke onto the face "
+                        "or delete it")
+                traces.append(RingTrace(rc, year, ring))
     return traces
 
 
