@@ -1224,6 +1224,30 @@ def test_from_photos_names_the_photo_that_brings_every_face_down(synth_photos, t
     assert rc == 0 and "warning" not in err, err
 
 
+def test_a_face_photo_in_a_format_woodcam_cannot_read_is_named(synth_photos, tmp_path, capsys):
+    """A face's photo in a format woodcam does not read (a phone's RAW front.dng, a front.psd) was
+    passed over without a word (reproduced: CN03's photos with A.jpg renamed front.dng -> 'missing
+    face photos: front (found top, ...); add front.jpg (or Mokume letters A), or pass --partial',
+    front.dng right there; with --partial the face was left out silently). Now the error names
+    the file and the formats read, and --partial warns that its face is left out; a file of that
+    name beside a face's readable photo (a front.xmp sidecar) is no matter."""
+    d = _copy(synth_photos, tmp_path / "raw", skip=("front",))
+    (d / "front.dng").write_bytes(b"II*\0raw")
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and err.count("\n") == 1, err
+    assert "missing face photos: front (found " in err, err
+    assert ("); front.dng is named for face front but not in a format woodcam reads (.jpg .jpeg") in err, err
+    assert "export it as JPEG or PNG (front.jpg)" in err, err
+    rc, out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--partial", "--out", tmp_path / "p")
+    assert rc == 0 and "5 faces" in out, out + err
+    assert err.count("warning") == 1 and "front.dng is named for face front but not in a format" in err, err
+    assert "its face is left out" in err, err
+    (d / "front.dng").unlink()
+    (d / "top.xmp").write_text("<x/>")  # a sidecar beside top.png
+    rc, out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--partial", "--out", tmp_path / "q")
+    assert rc == 0 and "warning" not in err, err
+
+
 def test_photos_named_for_no_face_are_said(synth_photos, tmp_path, capsys):
     """'top face.jpg' or IMG_1234.JPG beside the face photos were passed over without a word: the
     missing-face error did not say they were there, and with --partial the face was just left out.

@@ -113,6 +113,23 @@ def stray_photos(folder) -> list[Path]:
     return [p for p in _image_files(Path(folder)) if _face_of(p) is None and not mokume_map(p) and p not in block]
 
 
+def unreadable_photos(folder, photos: dict[str, Path]) -> list[Path]:
+    """Files in ``folder`` named for a face that ``photos`` (:func:`find_face_photos`) has no photo
+    of, in a format woodcam does not read (``front.dng``, ``front.psd``: a suffix not in
+    :data:`PHOTO_SUFFIXES`); hidden ones left out. Such a face was 'missing: add front.jpg' with
+    its photo right there, or left out without a word under ``--partial``."""
+    return [p for p in sorted(Path(folder).iterdir()) if p.is_file() and not p.name.startswith(".")
+            and p.suffix.lower() not in PHOTO_SUFFIXES and _face_of(p) not in (None, *photos)]
+
+
+def _unreadable_said(paths: list[Path]) -> str:
+    """What is wrong with :func:`unreadable_photos` ``paths`` and the fix, for a message."""
+    one, faces = len(paths) == 1, sorted({str(_face_of(p)) for p in paths}, key=FACES.index)
+    return (f"{', '.join(p.name for p in paths)} {'is' if one else 'are'} named for face{'s' if len(faces) > 1 else ''} "
+            f"{', '.join(faces)} but not in a format woodcam reads ({' '.join(PHOTO_SUFFIXES)}): export "
+            f"{'it' if one else 'them'} as JPEG or PNG ({', '.join(f + '.jpg' for f in faces)})")
+
+
 def find_face_photos(folder) -> dict[str, Path]:
     """Face name -> photo path for the photos in ``folder`` (module docstring for the names)."""
     folder = Path(folder)
@@ -281,10 +298,16 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
     if not photos:
         raise WoodcamError(f"no face photos found in {str(folder)!r}{'; ' + unnamed if stray else ''}: name them front.jpg, top.jpg, "
                            f"left.jpg, bottom.jpg, right.jpg, back.jpg (or A..F, or Mokume A_col.png ...)")
+    unreadable = unreadable_photos(folder, photos)
     if missing and not partial:
-        raise WoodcamError(f"missing face photos: {', '.join(missing)} (found {', '.join(photos)}){'; ' + unnamed if stray else ''}; add "
+        raise WoodcamError(f"missing face photos: {', '.join(missing)} (found {', '.join(photos)})"
+                           f"{'; ' + _unreadable_said(unreadable) if unreadable else ''}{'; ' + unnamed if stray else ''}; add "
                            f"{', '.join(f + '.jpg' for f in missing)} (or Mokume letters "
                            f"{', '.join(MOKUME_LETTER[f] for f in missing)}), or pass --partial")
+    if unreadable:  # with --partial: their faces left out
+        left = "its face is" if len(unreadable) == 1 else "their faces are"
+        warnings.warn(f"{str(folder)!r}: {_unreadable_said(unreadable)}; {left} left out", WoodcamWarning,
+                      stacklevel=2)
     if stray:
         warnings.warn(f"{str(folder)!r}: {unnamed}, so not read; rename a face's photo front.jpg, top.jpg, "
                       "left.jpg, bottom.jpg, right.jpg or back.jpg (or A..F)", WoodcamWarning, stacklevel=2)
