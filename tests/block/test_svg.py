@@ -203,9 +203,27 @@ def test_a_stroke_past_the_face_is_refused_naming_the_svg_and_the_stroke(tmp_pat
     svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="40" height="20" viewBox="0 0 40 20">'
                    '<path id="over" d="M -5,-5 L 45,25"/><path id="far" d="M 1,1 L 70,1"/></svg>')
     with pytest.raises(WoodcamError, match=r"front_traces.svg', element far: a stroke runs to \(70, 1\), more than "
-                                           r"half the drawing past its edge \(the drawing spans 0..40 x 0..20, over "
-                                           r"the 40x20 px face photo\); move the stroke onto the face or delete it"):
+                                           r"half the face past its edge \(the face spans 0..40 x 0..20 in the "
+                                           r"drawing, its photo 40x20 px\); move the stroke onto the face or delete it"):
         read_traces_svg(svg, (20, 40))
     svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="40" height="20" viewBox="0 0 40 20">'
                    '<path id="over" d="M -5,-5 L 45,25"/></svg>')
     assert len(read_traces_svg(svg, (20, 40))) == 1
+
+
+def test_a_page_grown_round_the_photo_moves_no_stroke(tmp_path):
+    """The drawing's page was taken for the face: a page an editor grew round the photo
+    (Inkscape's 'resize page to drawing' with a stroke past the photo's edge: viewBox
+    '-10 -10 276 276') moved every stroke (reproduced: a stroke drawn at (20, 20) over the photo
+    read at pixel (27.3, 27.3), not (19.5, 19.5)). Now the one <image>, the face photo the
+    strokes are drawn over, is the face, its transforms applied; without one the page is."""
+    svg = tmp_path / "front_traces.svg"
+    strokes = '<g transform="translate(0,0)"><path d="M 20,20 L 60,60"/></g>'
+    for page, image in (('width="276" height="276" viewBox="-10 -10 276 276"', 'x="0" y="0" width="256" height="256"'),
+                        ('width="300mm" height="200mm" viewBox="0 0 300 200"',
+                         'x="5" y="0" width="128" height="128" transform="scale(2)"')):
+        svg.write_text(f'<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" {page}>'
+                       f'<image xlink:href="front_photo.png" {image}/>{strokes}</svg>')
+        (t,) = read_traces_svg(svg, (256, 256))
+        want = [[19.5, 19.5], [59.5, 59.5]] if "-10" in page else [[19.5, 9.5], [59.5, 49.5]]
+        np.testing.assert_allclose(t.points_px, want, atol=1e-9, err_msg=page)

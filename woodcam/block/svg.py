@@ -9,8 +9,9 @@ Reading goes through svgelements (a maintained SVG library), so whatever an edit
 where it is drawn: ``<path>`` (every command, curves ``C S Q T A`` included, sampled every
 :data:`~woodcam.tolerances.SVG_CURVE_STEP_PX` image pixels), ``<polyline>``, ``<polygon>`` and
 ``<line>``; transforms on the shapes and on the layer groups around them; ``width``/``height``
-in any unit (``mm``, ``in``, ``px``) with or without a ``viewBox``. The drawing's width and
-height are mapped onto the face image. A stroke's year comes from its own ``data-year``
+in any unit (``mm``, ``in``, ``px``) with or without a ``viewBox``. The face photo's ``<image>``
+(the SVG's one image, as written) is mapped onto the face image, so a page an editor grew or
+moved round it changes nothing; without one image, the drawing's width and height are. A stroke's year comes from its own ``data-year``
 attribute, or an ``id`` / ``inkscape:label`` such as ``year-12`` or ``12``; otherwise the trace
 is unlabelled (a layer's label is not a year of the strokes in it). A stroke's ``data-ring``
 (written by the ring detector: pieces of one ring share it, see :class:`RingTrace`) is kept;
@@ -75,9 +76,10 @@ def write_traces_svg(face: Face, path, *, photo_href: str | None = None, stroke_
 def read_traces_svg(path, shape) -> list[RingTrace]:
     """Read ring traces drawn over a face image of ``shape = (rows, cols)`` pixels.
 
-    The SVG's drawing area (``width``/``height`` in any unit, through its ``viewBox``) is
-    mapped onto the image, so an SVG drawn at another scale or in mm still lands on the right
-    pixels.
+    The face photo's ``<image>`` (the SVG's one image; without one, its drawing area:
+    ``width``/``height`` in any unit, through its ``viewBox``) is mapped onto the image, so an
+    SVG drawn at another scale or in mm, or whose page was grown round the photo, still lands on
+    the right pixels.
 
     Returns
     -------
@@ -98,7 +100,16 @@ def read_traces_svg(path, shape) -> list[RingTrace]:
     if not (svg.width and svg.height and svg.width > 0 and svg.height > 0):
         raise WoodcamError(f"{str(path)!r} has no drawing size: give the <svg> a viewBox or a "
                            "width and height")
-    scale = np.array([cols / svg.width, rows / svg.height])  # document units -> image pixels
+    # document units -> image pixels: the face photo's rectangle where the SVG holds one image (the
+    # photo the strokes are drawn over), else the drawing's page. The page alone misplaced every
+    # stroke once an editor grew the page round the photo (Inkscape's 'resize page to drawing'
+    # with a stroke past the photo's edge): a stroke drawn at (20, 20) on the photo was read at
+    # pixel (27.3, 27.3) of a page grown by 10 on each side.
+    origin, extent = np.zeros(2), np.array([svg.width, svg.height], float)
+    photo = _photo_rect([el for el in svg.elements() if isinstance(el, svgelements.Image)])
+    if photo is not None:
+        origin, extent = photo
+    scale = np.array([cols, rows]) / extent
     lo, hi = trace_bounds_px((rows, cols))
     traces: list[RingTrace] = []
     for el in svg.elements():
@@ -118,7 +129,7 @@ def read_traces_svg(path, shape) -> list[RingTrace]:
         path_ = el if isinstance(el, svgelements.Path) else svgelements.Path(el)
         for xy in _polylines(path_, scale):
             if len(xy) >= 2:
-                px = xy * scale
+                px = (xy - origin) * scale
                 rc = np.stack([px[:, 1] - 0.5, px[:, 0] - 0.5], axis=1)
                 # the Face's rule (trace_bounds_px), said here in the SVG's terms: it was 'trace 20 of
                 # face 'front' lies beyond its 256x256 px image; check its (row, col) pixel coordinates'
@@ -127,11 +138,27 @@ def read_traces_svg(path, shape) -> list[RingTrace]:
                     x, y = xy[int(np.argmax(out))]
                     raise WoodcamError(
                         f"{str(path)!r}, element {el.values.get('id') or type(el).__name__}: a stroke runs to "
-                        f"({x:.6g}, {y:.6g}), more than half the drawing past its edge (the drawing spans 0..{svg.width:g} "
-                        f"x 0..{svg.height:g}, over the {cols}x{rows} px face photo); move the stroke onto the face "
-                        "or delete it")
+                        f"({x:.6g}, {y:.6g}), more than half the face past its edge (the face spans "
+                        f"{origin[0]:g}..{origin[0] + extent[0]:g} x {origin[1]:g}..{origin[1] + extent[1]:g} in the "
+                        f"drawing, its photo {cols}x{rows} px); move the stroke onto the face or delete it")
                 traces.append(RingTrace(rc, year, ring))
     return traces
+
+
+def _photo_rect(images: list) -> tuple[np.ndarray, np.ndarray] | None:
+    """``(origin, extent)`` ``(2,)`` (x, y) in document units of the one image of an SVG (the face
+    photo :func:`write_traces_svg` puts under the strokes), its transforms applied; None without
+    exactly one image of positive size, or for one turned or skewed (the page is then the face)."""
+    if len(images) != 1:
+        return None
+    im = images[0]
+    w, h = float(im.width or 0), float(im.height or 0)
+    m = im.transform
+    if not (w > 0 and h > 0) or abs(m.b) > 1e-9 or abs(m.c) > 1e-9 or m.a <= 0 or m.d <= 0:
+        return None
+    x0, y0 = float(im.x or 0), float(im.y or 0)
+    origin = np.array([m.a * x0 + m.e, m.d * y0 + m.f])
+    return origin, np.array([m.a * w, m.d * h])
 
 
 def _check_points_attribute(points, path) -> None:
