@@ -1704,3 +1704,16 @@ def test_the_users_file_edited_since_it_was_carried_into_another_out_wins(synth_
     assert "delete (or move out) the other and run again" in err and (other / svg.name).read_text() == _svg_of(3)
     (other / svg.name).unlink()  # as it says: the source's then wins
     detect(4, 2)
+
+
+def test_rings_detect_help_names_every_file_it_writes(capsys):
+    """'rings detect --help' named the ring map and SVG files but only 'knot masks' (no file
+    name, no word of which value is the knot: Mokume's masks are dark where the knot is, the
+    detector's white) nor block.json, and said of a Mokume folder only that its U-Net maps are
+    re-detected (its knot masks are too)."""
+    with pytest.raises(SystemExit):
+        main(["rings", "detect", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    for said in ("<face>_ring_map.png", "<face>_traces.svg", "<face>_knot_mask.png, white = knot", "block.json",
+                 "its U-Net maps and knot masks are ignored: re-detected"):
+        assert said in text, said

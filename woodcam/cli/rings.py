@@ -69,8 +69,9 @@ def register(subparsers) -> None:
     d = sub.add_parser("detect", help="detect rings and knots on every face photo of a block",
                        description="Writes per face a ring map (<face>_ring_map.png), the ring traces as "
                        "SVG over the photo (<face>_traces.svg, editable in Inkscape: a corrected SVG is "
-                       "kept and wins over detection next time) and knot masks. BLOCK is a block "
-                       "folder or a Mokume sample folder (its U-Net maps are ignored: re-detected).")
+                       "kept and wins over detection next time) and, where a knot is found, a knot mask "
+                       "(<face>_knot_mask.png, white = knot), and records them in block.json. BLOCK is a block "
+                       "folder or a Mokume sample folder (its U-Net maps and knot masks are ignored: re-detected).")
     add_input(d, "block", kind="folder", type=Path, help="block folder (block.json) or Mokume sample folder")
     add_out_option(d, "the block folder with ring maps, SVG traces and knot masks (may be "
                    "BLOCK itself)")
