@@ -138,3 +138,69 @@ def test_every_readme_command_is_one_the_cli_takes():
     wrong = [f"{doc}: {command}: {problem}" for doc, kind, command in commands
              for problem in _command_problems(kind, command, parser)]
     assert not wrong, "\n".join(wrong)
+
+
+# --- every WOODCAM_* setting the package reads is the README's, and no other --------------------
+
+def _env_problems(readme: str) -> list[str]:
+    """The ``WOODCAM_*`` environment variables the package reads (a ``"WOODCAM_..."`` literal, and
+    ``WOODCAM_<NAME>`` of each ``MAX_`` limit of :mod:`woodcam.limits`, which ``limit`` reads) that ``readme`` never names, and those
+    it names that the package does not read (a variable renamed in the code only)."""
+    from woodcam import limits
+
+    code = {name for path in (REPO / "woodcam").rglob("*.py")
+            for name in re.findall(r"[\"'](WOODCAM_[A-Z][A-Z_]*[A-Z])[\"']", path.read_text())}
+    code |= {f"WOODCAM_{name}" for name in dir(limits) if name.startswith("MAX_")}
+    named = set(re.findall(r"WOODCAM_[A-Z][A-Z_]*[A-Z]", readme))
+    return ([f"README never names {v}, which woodcam reads" for v in sorted(code - named)]
+            + [f"README names {v}, which woodcam does not read" for v in sorted(named - code)])
+
+
+def test_the_readme_names_every_environment_setting_and_only_those():
+    """A setting added to the code, or renamed in it, is named in the README under its name."""
+    problems = _env_problems((REPO / "README.md").read_text())
+    assert not problems, "\n".join(problems)
+
+
+# --- every command and option `woodcam ... --help` lists is in the README -----------------------
+
+def _undocumented(readme: str, parser) -> list[str]:
+    """Each command of ``parser`` (``block show``) no README section names (as ``woodcam block
+    show`` or a backtick span starting ``block show``), and each ``--option`` of a command that
+    no section naming that command mentions (an alias of the option does); sections are the
+    README's ``##``/``###`` headings."""
+    import argparse
+
+    def walk(p, path):
+        children = next((a.choices for a in p._actions
+                         if isinstance(a, argparse._SubParsersAction)), {})
+        if not children:
+            yield path, p
+        for name, child in children.items():
+            yield from walk(child, [*path, name])
+
+    sections = re.split(r"\n(?=#{2,3} )", readme)
+    problems = []
+    for path, p in walk(parser, []):
+        name = " ".join(path)
+        naming = re.compile(r"(?:woodcam |`)" + re.escape(name) + r"(?![\w-])")
+        mine = [s for s in sections if naming.search(s)]
+        if not mine:
+            problems.append(f"woodcam {name}: no README section names it")
+            continue
+        for action in p._actions:
+            spellings = [s for s in action.option_strings if s.startswith("--") and s != "--help"]
+            if spellings and not any(re.search(re.escape(o) + r"(?![\w-])", s)
+                                     for s in mine for o in spellings):
+                problems.append(f"woodcam {name} {spellings[0]}: no README section naming "
+                                f"'{name}' mentions it")
+    return problems
+
+
+def test_every_command_and_option_of_the_cli_is_in_the_readme():
+    """A command or option added to the CLI (or an option renamed) is documented in a README
+    section that names its command, not only in ``--help``."""
+    from woodcam.cli import build_parser
+
+    problems = _undocumented((REPO / "README.md").read_text(), build_parser())
+    assert not problems, "\n".join(problems)
