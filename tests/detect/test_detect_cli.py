@@ -595,7 +595,7 @@ def test_rings_detect_warns_on_stderr_as_every_command(synth_photos, tmp_path, c
     blk = tmp_path / "blk"
     assert _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", blk)[0] == 0
     rc, out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
-    assert rc == 0 and out == f"wrote {blk} (ring maps, <face>_traces.svg, knot masks)\n", out
+    assert rc == 0 and out == f"wrote {blk} (ring maps, <face>_traces.svg, no knot mask: no knot found)\n", out
     assert "woodcam: warning: face 'bottom': no rings found" in err
 
 
@@ -672,6 +672,24 @@ def _knotted_block_folder(synth_photos, tmp_path, capsys):
     size = ("--size-mm", "32")  # 5 px/mm, where the analytic knot is found
     assert _run(capsys, "block", "from-photos", knotted, *size, "--out", blk)[0] == 0
     return blk, size
+
+
+def test_rings_detect_says_which_faces_got_a_knot_mask(synth_photos, tmp_path, capsys, monkeypatch):
+    """rings detect's summary said 'knot masks' of every block, also of one where no knot was
+    found and no mask written, and under --no-knots. Now it names the faces whose mask block.json
+    lists, or says there is none and why."""
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    blk, _size = _knotted_block_folder(synth_photos, tmp_path, capsys)
+    rc, out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0, err
+    masked = [n for n, f in read_block(blk).faces.items() if "knot_mask" in f.extras]
+    assert masked and sorted(p.name for p in blk.glob("*_knot_mask.png")) == sorted(f"{n}_knot_mask.png" for n in masked)
+    assert out == f"wrote {blk} (ring maps, <face>_traces.svg, knot masks of {', '.join(masked)})\n", out
+    clear = tmp_path / "clear"
+    assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", clear)[0] == 0
+    rc, out, err = _run(capsys, "rings", "detect", clear, "--out", clear, "--no-knots")
+    assert rc == 0 and not list(clear.glob("*_knot_mask.png")), err
+    assert out == f"wrote {clear} (ring maps, <face>_traces.svg, no knot mask: --no-knots)\n", out
 
 
 def test_a_rerun_clears_its_own_stale_knot_masks_and_keeps_a_users(synth_photos, tmp_path, capsys, monkeypatch):

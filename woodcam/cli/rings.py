@@ -102,6 +102,18 @@ def register(subparsers) -> None:
     add_size_option(s)
 
 
+def _knot_masks_said(manifest: Path, no_knots: bool) -> str:
+    """The knot masks the written ``block.json`` lists, for the summary line: ``knot masks of
+    left, top``, else why there is none (it said 'knot masks' of a block where no knot was found)."""
+    import json
+
+    faces = json.loads(manifest.read_text()).get("faces", {})
+    with_mask = [name for name, face in faces.items() if "knot_mask" in (face.get("extras") or {})]
+    if with_mask:
+        return f"knot masks of {', '.join(with_mask)}"
+    return "no knot mask: --no-knots" if no_knots else "no knot mask: no knot found"
+
+
 def run(args) -> int:
     if args.rings_command == "detect":
         from ..detect.block import DEFAULT_DETECTOR, detect_folder
@@ -112,7 +124,7 @@ def run(args) -> int:
         from . import print_warnings
 
         print_warnings(msgs)  # on stderr as every command's (they were on stdout, among its output)
-        print(f"wrote {manifest.parent} (ring maps, <face>_traces.svg, knot masks)")
+        print(f"wrote {manifest.parent} (ring maps, <face>_traces.svg, {_knot_masks_said(manifest, args.no_knots)})")
         return 0
     if args.rings_command == "show":
         import numpy as np
