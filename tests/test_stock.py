@@ -770,3 +770,13 @@ def test_a_block_of_a_log_without_knots_says_so(tmp_path, capsys):
     assert main(["block", "show", spec, "--out", str(tmp_path / "b.png")]) == 2
     err = capsys.readouterr().err
     assert "has no knots" in err and "0..-1" not in err, err
+
+
+@pytest.mark.parametrize("species", ["", "bogus"])
+def test_an_empty_or_unknown_species_is_refused(species):
+    """open_stock(..., species='') used the default preset without a word."""
+    with pytest.raises(WoodcamError, match=r"species must be one of the presets oak, .*got "
+                       + repr(species) + r".*woodcam species"):
+        open_stock("builtin:flat-sawn", species=species)
+    # a species recorded earlier ('' where a bake recorded none) is the bake's, not refused
+    assert open_stock("builtin:flat-sawn", species="", species_given=False).meta["species"] == "oak"
