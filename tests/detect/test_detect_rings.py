@@ -202,6 +202,16 @@ def test_bad_arguments_are_refused():
         detect_rings(np.zeros((64, 64, 2), np.uint8))
 
 
+@pytest.mark.parametrize("channels", [4, 5])
+def test_a_photo_of_other_than_three_channels_or_a_non_str_name_is_refused(channels):
+    """A 5-channel array was read by its first three channels, and name=3 taken, without a word."""
+    with pytest.raises(WoodcamError, match=rf"photo must be \(h, w, 3\) RGB .*got shape \(64, 64, {channels}\).*"
+                       r"photo\[\.\.\., :3\]"):
+        detect_rings(np.zeros((64, 64, channels), np.uint8))
+    with pytest.raises(WoodcamError, match=r"name must be the face's name \(str\).*got 3 \(int\)"):
+        detect_rings(np.zeros((64, 64, 3), np.uint8), name=3)
+
+
 def test_scores_are_exact_on_a_known_case():
     ref = np.array([[10, c] for c in range(20)])
     det = np.array([[11.0, c] for c in range(10)] + [[30.0, c] for c in range(10)])   # half right

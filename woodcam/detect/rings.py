@@ -233,10 +233,11 @@ def luminance(photo: np.ndarray) -> np.ndarray:
                                f"{int(np.sum(~np.isfinite(a)))} non-finite; divide by 255 or pass uint8")
     if a.ndim == 2:
         return a.astype(np.float32) / (255.0 if a.dtype == np.uint8 else 1.0)
-    if a.ndim != 3 or a.shape[2] < 3:
-        raise WoodcamError(f"photo must be (h, w, 3) RGB; got shape {a.shape}")
+    if a.ndim != 3 or a.shape[2] != 3:  # a 4- or 5-channel array was read by its first three without a word
+        raise WoodcamError(f"photo must be (h, w, 3) RGB or (h, w) grey; got shape {a.shape}; pass its RGB "
+                           "channels (photo[..., :3] where the first three are red, green, blue)")
     scale = 255.0 if a.dtype == np.uint8 else 1.0
-    return (a[..., :3].astype(np.float32) @ np.array([0.299, 0.587, 0.114], np.float32)) / scale
+    return (a.astype(np.float32) @ np.array([0.299, 0.587, 0.114], np.float32)) / scale
 
 
 def _normalise(lum: np.ndarray, sigma: float) -> np.ndarray:
@@ -800,6 +801,9 @@ def detect_rings(photo: np.ndarray, *, px_per_mm: float | None = None, rule: Bou
     WoodcamError
         For a photo too small to hold a ring (< 16 px a side), or a bad ``rule``.
     """
+    if not isinstance(name, str):  # it names the face in every message and warning
+        raise WoodcamError(f"name must be the face's name (str), e.g. 'front'; got {name!r} "
+                           f"({type(name).__name__})")
     if rule not in BOUNDARY_RULES:
         raise WoodcamError(f"rule must be one of {', '.join(BOUNDARY_RULES)}; got {rule!r}")
     if curved is not None:
