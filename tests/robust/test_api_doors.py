@@ -199,6 +199,7 @@ def _wrong_types_and_shapes():
         ("auto tolerance 0 texels", lambda: auto_tolerance_mm(10, texels_per_mm=0), "texels_per_mm must be"),
         ("auto tolerance NaN *", lambda: auto_tolerance_mm(np.nan), "diagonal_mm must be"),
         ("auto tolerance < 0 *", lambda: auto_tolerance_mm(-5), "diagonal_mm must be"),
+        ("auto tolerance 0 *", lambda: auto_tolerance_mm(0), r"diagonal_mm must be a finite number > 0; got 0"),
         ("turned size of 2", lambda: w.Wood(fld).turned("z", 1, (1, 1)), "size_mm must be three"),
         ("turned quarter_turns str", lambda: w.Wood(fld).turned("z", "a", (9, 9, 9)), "quarter_turns must be"),
         ("open_stock unknown keyword", lambda: w.open_stock("builtin:flat-sawn", foo=1),

@@ -79,8 +79,14 @@ def auto_tolerance_mm(diagonal_mm: float, texels_per_mm: float = _DEFAULT_TEXELS
     texels/mm: 0.125 mm."""
     texels_per_mm = check_number(texels_per_mm, "auto_tolerance_mm: texels_per_mm", lo=0, lo_open=True,
                                  fix="the bake's texel density, e.g. 10")
-    diagonal_mm = check_number(diagonal_mm, "auto_tolerance_mm: diagonal_mm", lo=0,
+    # 0 gave the floor, 0.002 mm, for a part of no size: no part, a size of the wrong thing
+    diagonal_mm = check_number(diagonal_mm, "auto_tolerance_mm: diagonal_mm", lo=0, lo_open=True,
                                fix="the part's bounding-box diagonal in mm")
+    return _auto_tolerance(diagonal_mm, texels_per_mm)
+
+
+def _auto_tolerance(diagonal_mm: float, texels_per_mm: float) -> float:
+    """:func:`auto_tolerance_mm`'s rule, unchecked (a B-rep with no box measures 0: the floor)."""
     texel_limit = TESSELLATION_TEXEL_FRACTION / texels_per_mm
     return max(TESSELLATION_MIN_TOL_MM, min(texel_limit, TESSELLATION_REL_TOL * diagonal_mm))
 
@@ -716,7 +722,7 @@ class _Tessellation:
     def mesh_solids(self, solids, origin: str):
         if self.tol_mm is None:
             diagonal = _diagonal_mm(solids)
-            tol_mm = auto_tolerance_mm(diagonal, self.texels_per_mm)
+            tol_mm = _auto_tolerance(diagonal, self.texels_per_mm)
             self.rule = (f"auto: min({TESSELLATION_TEXEL_FRACTION:g} texel = "
                          f"{say_length(TESSELLATION_TEXEL_FRACTION / self.texels_per_mm, '.3g')}, "
                          f"{TESSELLATION_REL_TOL:g} x the {say_length(diagonal, '.4g')} diagonal = "
