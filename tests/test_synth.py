@@ -395,6 +395,22 @@ def test_a_smaller_set_into_a_folder_of_a_larger_one_is_refused(tmp_path, capsys
     assert capsys.readouterr().out.startswith(f"wrote 2 blocks to {out} (")
 
 
+def test_a_smaller_set_on_an_engine_into_a_folder_of_a_larger_one_is_refused(tmp_path, capsys):
+    """The engine path (write_benchmark_set) wrote '--count 1' into a folder of 2 blocks of the
+    same seed (its records matched) and left block_0001 there, unlisted in index.json."""
+    from woodcam.cli import main
+
+    out = tmp_path / "set"
+    engine = ["--engine", "local", "--workers", "1"]
+    assert main(["block", "synth", "--count", "2", "--out", str(out), "--face-px", "32", "--quiet", *engine]) == 0
+    capsys.readouterr()
+    assert main(["block", "synth", "--count", "1", "--out", str(out), "--face-px", "32", "--quiet", *engine]) == 2
+    err = capsys.readouterr().err
+    assert (f"{str(out)!r} holds a set of 2 synthetic blocks (seed 0); 1 block of seed 0 written there "
+            "would leave block_0001 of the old set beside them") in err, err
+    assert len(json.loads((out / "index.json").read_text())["blocks"]) == 2  # refused before any work
+
+
 def test_the_summary_line_counts_one_block_in_the_singular(tmp_path, capsys):
     """'block synth --count 1' said "wrote 1 blocks to ..." (sweep h6)."""
     from woodcam.cli import main

@@ -609,6 +609,7 @@ def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, k
     so they need ``out_dir`` on a shared disk. ``run_options`` go to
     :func:`woodcam.scale.run_many`. Returns ``(RunSummary, index dict)``."""
     from .scale import check_run_manifest, read_records, run_many, write_json_atomic
+    from .synth.dataset import check_no_stale_blocks
 
     if not isinstance(count, int) or count < 1:
         raise WoodcamError(f"count must be an integer >= 1; got {count!r}")
@@ -619,6 +620,8 @@ def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, k
     # the records say which blocks are done, not of which set: a rerun with another seed kept the
     # old seed's blocks under an index.json of the new one
     check_run_manifest(out / ".synth" / RUN_MANIFEST, manifest, out)
+    # the serial writer's rule: a smaller set left the larger one's last blocks there, unlisted
+    check_no_stale_blocks(out, count, int(seed))
     keys = [f"block_{i:04d}" for i in range(count)]
     summary = run_many(partial(_synth_set_task, seed=int(seed), out_dir=str(out.resolve()),
                                face_px=int(face_px), knotted=bool(knotted), block_options=opts),

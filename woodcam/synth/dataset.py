@@ -61,7 +61,7 @@ def benchmark_set_block(seed: int, index: int, *, face_px: int = 512, size_range
     return block, info
 
 
-def _check_no_stale_blocks(out_dir: Path, count: int, seed: int) -> None:
+def check_no_stale_blocks(out_dir: Path, count: int, seed: int) -> None:
     """Refuse, before any work, a set of ``count`` blocks into a folder whose ``index.json`` lists
     blocks it would not replace: they stayed beside the new ones, under an index that no longer
     named them (``--count 1 --seed 5`` into a folder of 2 blocks of seed 0 left block_0001 of
@@ -121,7 +121,7 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
         raise WoodcamError(f"count must be >= 1; got {count!r}")
     _check_fraction("knotted_fraction", knotted_fraction)
     out_dir = Path(out_dir)
-    _check_no_stale_blocks(out_dir, count, seed)
+    check_no_stale_blocks(out_dir, count, seed)
     out_dir.mkdir(parents=True, exist_ok=True)
     index = {"format": "woodcam-benchmark", "version": 1, "seed": int(seed), "count": int(count),
              "face_px": int(face_px), "size_range_mm": list(size_range_mm),
