@@ -99,3 +99,13 @@ def test_a_block_spec_read_in_units_says_so():
              if path and LENGTH_OPTIONS.get((path[0], a.dest)) == "spec"
              and ("WxDxH] (mm)" in (a.help or "") or "--units" not in (a.help or ""))]
     assert not wrong, wrong
+
+
+def test_block_synth_help_states_the_ranges_of_count_seed_and_face_px():
+    """'block synth --help' said 'number of blocks' and 'random seed', and the ranges came out
+    only in the error ('--count must be in [1, 1e+06]; got 0')."""
+    helps = {a.option_strings[-1]: " ".join((a.help or "").split())
+             for path, a in _walk_options(build_parser()) if path[-2:] == ["block", "synth"]}
+    assert "in [1, 1e+06]" in helps["--count"], helps["--count"]
+    assert "in [0, 4294967295]" in helps["--seed"], helps["--seed"]
+    assert "in [16, 16384]" in helps["--face-px"], helps["--face-px"]

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from .options import (add_block_argument, add_check_layout_option, add_engine_options, add_out_option,
                       add_size_option, allow_negative_values, engine_options, engine_requested, open_block,
-                      report_layout)
+                      option_range, report_layout)
 
 
 def _size_range(text: str) -> tuple[float, float]:
@@ -38,10 +38,13 @@ def register(subparsers) -> None:
     sub = p.add_subparsers(dest="block_command", required=True, metavar="{synth,show,from-photos}")
 
     s = sub.add_parser("synth", help="write a reproducible set of synthetic blocks")
-    s.add_argument("--count", type=int, required=True, help="number of blocks")
-    s.add_argument("--seed", type=int, default=0, help="random seed (same seed, same set)")
+    # the ranges said in the help, as the other options' (a fraction, a side in mm) are
+    s.add_argument("--count", type=int, required=True, help=f"number of blocks, {option_range('count')}")
+    s.add_argument("--seed", type=int, default=0,
+                   help=f"random seed (same seed, same set), an integer {option_range('seed')}")
     add_out_option(s, "one block sub-folder per block and index.json")
-    s.add_argument("--face-px", type=int, default=512, help="pixels along the largest face side")
+    s.add_argument("--face-px", type=int, default=512,
+                   help=f"pixels along the largest face side, {option_range('face_px')}")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--jitter-mm", type=float, default=0.0,
                    help="std (mm) of the traces' perpendicular jitter, smoothed over 1 mm (default 0)")

@@ -1423,6 +1423,19 @@ def _bound(v) -> str:
     return f"{v:g}" if float(f"{v:g}") == v else (f"{v:d}" if isinstance(v, int) else repr(v))
 
 
+def _span(rng, mm: bool = False) -> str:
+    """A RANGES entry as the errors and the help say it: ``[1, 1e+06]``, ``(0, 100]``."""
+    lo, hi, lo_open, hi_open = (*rng, False)[:4]
+    return (f"{'(' if lo_open else '['}{_bound(lo)}, {_bound(hi)}{')' if hi_open else ']'}"
+            f"{' mm' if mm else ''}")
+
+
+def option_range(dest: str, command: str | None = None) -> str:
+    """The range of option ``dest`` (of ``command``, where it has its own) for its help, from
+    :data:`RANGES`, the one table the values are checked against: ``"in [1, 1e+06]"``."""
+    return "in " + _span(RANGES[(command, dest)] if (command, dest) in RANGES else RANGES[dest])
+
+
 def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND") -> None:
     # a UsageError (exit 2): a number out of range is a wrong command line, as the exit statuses
     # in 'woodcam --help' say (it exited 1, as a failed work)
@@ -1432,8 +1445,7 @@ def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND") 
         return
     help_ = f"see 'woodcam {command} --help' for its meaning and default"
     lo, hi, lo_open, hi_open = (*rng, False)[:4] if rng is not None else (None, None, False, False)
-    span = "" if rng is None else (f"{'(' if lo_open else '['}{_bound(lo)}, {_bound(hi)}{')' if hi_open else ']'}"
-                                   f"{' mm' if typed is not None else ''}")
+    span = "" if rng is None else _span(rng, typed is not None)
     if isinstance(value, float) and not math.isfinite(value):  # the range and the help too (it said neither)
         got = repr(value) if typed is None else f"{typed[0]!r} {typed[1]}"
         raise UsageError(f"{option} must be a finite number{' in ' + span if span else ''}; got {got}; {help_}")
