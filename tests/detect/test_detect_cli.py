@@ -377,6 +377,14 @@ def test_mokume_folder_is_redetected(tmp_path, capsys):
     assert {n for n, f in b.faces.items() if "knot_mask" in f.extras} >= {"left", "back"}
 
 
+def test_the_missing_face_error_lists_the_found_faces_in_the_conventions_order(synth_photos, tmp_path, capsys):
+    """'found back, bottom, left, right, top': the files' order, not the faces' (frames.FACES)."""
+    rc, _out, err = _run(capsys, "block", "from-photos", _copy(synth_photos, tmp_path / "a", skip=("front",)),
+                        "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and "missing face photos: front (found top, left, bottom, right, back);" in err, err
+    assert FACES == ("front", "top", "left", "bottom", "right", "back")  # the order said above
+
+
 def test_bad_photo_folders_give_one_clear_line(synth_photos, tmp_path, capsys):
     rc, _out, err = _run(capsys, "block", "from-photos", _copy(synth_photos, tmp_path / "a", skip=("back",)),
                         "--size-mm", "50x50x50", "--out", tmp_path / "o")

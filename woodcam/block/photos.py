@@ -151,7 +151,8 @@ def find_face_photos(folder) -> dict[str, Path]:
         said = "; ".join(f"{len(ps)} for {f}: {', '.join(q.name + why(q) for q in ps)}" for f, ps in dup.items())
         raise WoodcamError(f"each face needs exactly one photo in {str(folder)!r}; found {said}; keep one photo "
                            "per face and move the others out of the folder")
-    return {f: ps[0] for f, ps in found.items()}
+    # in the conventions' order (frames.FACES), not the files' ('found back, bottom, left ...')
+    return {f: found[f][0] for f in FACES if f in found}
 
 
 def _check_exposure(face: str, photo: np.ndarray, path: Path) -> None:
