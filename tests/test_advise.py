@@ -146,6 +146,23 @@ def test_every_placement_panel_names_the_same_terms(knotty, monkeypatch, tmp_pat
                                                     "runout")), title
 
 
+def test_the_picture_draws_at_most_max_panels_best_placements(knotty, monkeypatch, tmp_path):
+    """'place --top 100000' drew a panel per placement (about 1.5 s each: minutes) into a
+    picture too wide to read; --top is the table's, the picture stops at MAX_PANELS."""
+    import woodcam.view.compare
+    from woodcam.advise import MAX_PANELS, render_advice
+
+    titles = []
+    monkeypatch.setattr(woodcam.view.compare, "render_side_by_side",
+                        lambda meshes, woods, size, t, png, **kw: titles.extend(t))
+    part = manifold3d.Manifold.cube([20.0, 10.0, 8.0])
+    advice = advise_placement(part, knotty, rotations="none", candidates=50)
+    assert len(advice.ranked) > MAX_PANELS + 1
+    render_advice(advice, part, knotty, tmp_path / "p.png", top=100)
+    assert len(titles) == MAX_PANELS + 1 == 11, len(titles)
+    assert titles[MAX_PANELS - 1].startswith(f"#{MAX_PANELS} ") and titles[-1].startswith("worst:")
+
+
 def test_the_report_quotes_the_surface_knot_share_its_warning_gives(knotty):
     """The report's line gave the knot share of the surface and the wood 1-3 mm under it
     (19.8 %) beside a warning 'knots show on 15.3 % of the surface': two numbers for one thing."""

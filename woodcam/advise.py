@@ -285,14 +285,19 @@ def _no_fit_fixes(extent, size, rotations: str, margin_mm: float) -> str:
     return ", ".join(fixes[:-1]) + (" or " if len(fixes) > 1 else "") + fixes[-1]
 
 
+#: The most best placements :func:`render_advice` draws (and the worst beside them): ``place
+#: --top 100000`` drew a panel per placement, about 1.5 s each, into a picture too wide to read.
+MAX_PANELS = 10
+
+
 def render_advice(advice: PlacementAdvice, part, stock, png, *, top: int = 3, progress: bool = False):
-    """The ``top`` placements side by side in one PNG (see :mod:`woodcam.view.compare`);
-    ``progress``: a bar over the panels (about 1.5 s each)."""
+    """The ``top`` best placements (at most :data:`MAX_PANELS`) and the worst side by side in one
+    PNG (see :mod:`woodcam.view.compare`); ``progress``: a bar over the panels (about 1.5 s each)."""
     from .view.compare import render_side_by_side
 
     base = _part_mesh(part)
     meshes, titles = [], []
-    shown = [(f"#{i}", p) for i, p in enumerate(advice.ranked[:top], 1)]
+    shown = [(f"#{i}", p) for i, p in enumerate(advice.ranked[:min(top, MAX_PANELS)], 1)]
     for label, p in [*shown, ("worst:", advice.ranked[-1])]:
         m = base.copy()
         m.apply_transform(p.matrix)

@@ -31,7 +31,8 @@ def register(subparsers) -> None:
     p.add_argument("--margin", type=float, default=1.0, metavar="LEN",
                    help="distance kept from the block faces, in --units (default 1 mm)")
     p.add_argument("--top", type=int, default=3, metavar="K",
-                   help="placements shown in the picture and table (default 3)")
+                   help="placements printed in the table (and, at least ten, in placements.json); "
+                   "the picture shows the best K, at most 10, and the worst (default 3)")
     add_units_option(p, "place")
     p.set_defaults(func=run_place)
 
@@ -42,7 +43,7 @@ def run_place(args: argparse.Namespace) -> int:
     from .._atomic import check_output_path, write_bytes
     from .._progress import StageBar
     from ..cad import load_part
-    from ..advise import advise_placement, render_advice
+    from ..advise import MAX_PANELS, advise_placement, render_advice
     from ..stock import open_stock
 
     out = Path(args.out)
@@ -70,5 +71,8 @@ def run_place(args: argparse.Namespace) -> int:
             png = render_advice(advice, part, stock, out / "placements.png", top=args.top, progress=True)
     # the --place ops to type back, rounded for the unit (--units inch: 1.9685, not 1.96850393701)
     print(advice.table(args.top, op_text=lambda op: place_op_in(op, k, TYPED_DECIMALS[args.units])))
-    print(f"scored {advice.candidates} placements; wrote {png} and {out / 'placements.json'}")
+    # a panel per placement up to --top 100000 took minutes: the picture stops at MAX_PANELS
+    listed = min(args.top, len(advice.ranked))
+    drawn = f" (the best {MAX_PANELS} and the worst; the table lists {listed})" if listed > MAX_PANELS else ""
+    print(f"scored {advice.candidates} placements; wrote {png}{drawn} and {out / 'placements.json'}")
     return 0
