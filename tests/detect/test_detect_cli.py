@@ -568,7 +568,7 @@ def test_rings_detect_and_show_on_a_folder_of_photos_say_to_make_a_block_first(s
     for argv in (("detect", synth_photos, "--out", tmp_path / "o"), ("show", synth_photos, "--out", tmp_path / "o.png")):
         rc, out, err = _run(capsys, "rings", *argv)
         assert rc == EXIT_ERROR and out == "" and err.count("\n") == 1, err
-        assert "holds face photos (back.png, bottom.png, front.png" in err and "but no block.json" in err, err
+        assert "holds face photos (front.png, top.png, left.png, bottom.png, right.png, back.png)" in err and "but no block.json" in err, err
         assert f"make a block of them first: woodcam block from-photos '{synth_photos}' --size-mm WxDxH" in err, err
     assert not (tmp_path / "o").exists() and not (tmp_path / "o.png").exists()
 
