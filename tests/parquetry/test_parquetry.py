@@ -1318,3 +1318,33 @@ def test_adaptive_levels_are_bounded_by_the_panel():
         with pytest.raises(WoodcamError, match=r"n_adaptive \(--n-adaptive\) must be in \[0, 4\] here: its "
                            r"largest patch, .* must fit the panel's shorter side, 364 mm \(26 patches"):
             ParquetryParams(n_adaptive=n)
+
+
+def test_flatten_gives_the_per_curve_loops_points_bit_for_bit():
+    """Refactor check: cutpaths.flatten, all curves at once, gives the very points (and dtype)
+    of the loop it replaced (one numpy sum per segment) on outlines of lines and cubic Béziers,
+    lines only and curves only."""
+    from woodcam.parquetry.cutpaths import flatten
+
+    def loop(segs, n=8):
+        ts = np.linspace(0, 1, n, endpoint=False)
+        pts = []
+        for s in segs:
+            if s[0] == "L":
+                pts.append(s[1][None])
+            else:
+                p0, p1, p2, p3 = s[1:]
+                u = 1 - ts
+                pts.append((u ** 3)[:, None] * p0 + (3 * u * u * ts)[:, None] * p1
+                           + (3 * u * ts * ts)[:, None] * p2 + (ts ** 3)[:, None] * p3)
+        return np.concatenate(pts)
+
+    rng = np.random.default_rng(0)
+    for share_lines in (0.3, 0.0, 1.0):
+        for _ in range(200):
+            segs = [("L", rng.uniform(0, 300, 2), rng.uniform(0, 300, 2)) if rng.random() < share_lines
+                    else ("C", *rng.uniform(-50, 300, (4, 2))) for _ in range(rng.integers(1, 40))]
+            for n in (8, 3):
+                want, got = loop(segs, n), flatten(segs, n)
+                assert got.dtype == want.dtype and got.shape == want.shape
+                assert np.array_equal(got, want)
