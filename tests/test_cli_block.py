@@ -133,7 +133,8 @@ def test_block_synth_refuses_a_size_range_at_the_door(value, tmp_path, capsys):
         main(["block", "synth", "--count", "1", "--out", str(tmp_path / "x"), "--size-range-mm", value])
     assert exc.value.code == EXIT_USAGE
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and ("--size-range-mm takes MIN,MAX in mm with 0 < MIN <= MAX <= 10000, e.g. 30,80; "
+    assert len(err) == 1 and ("--size-range-mm takes MIN,MAX in mm with 0 < MIN <= MAX <= 10000 "
+                              "(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 30,80; "
                               f"got {value!r}") in err[0], err
     assert not (tmp_path / "x").exists()
 
@@ -393,3 +394,27 @@ def test_the_real_log_without_shared_data_is_pointed_at_each_callers_way(tmp_pat
         err_text = capsys.readouterr().err
         assert err_text == f"woodcam: error: {need}{fix}\n", argv
         assert "folder=" not in err_text
+
+
+def test_the_block_size_limit_variable_raises_a_typed_block_spec_at_the_door(monkeypatch):
+    """$WOODCAM_MAX_BLOCK_SIZE_MM raised the limit for block.json only: a spec typed on the
+    command line (and --size-range-mm) stayed within a fixed 10000 mm, the refusal not naming the
+    variable. Now each reads the one limit when it checks, and its refusal names the variable."""
+    import argparse
+
+    from woodcam.cli.block import _size_range
+    from woodcam.cli.options import _read_spec
+    from woodcam.errors import UsageError
+
+    spec = "builtin:flat-sawn:20000x80x50"
+    monkeypatch.delenv("WOODCAM_MAX_BLOCK_SIZE_MM", raising=False)
+    with pytest.raises(UsageError, match=r"<= 10000 mm \(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N\)"):
+        _read_spec(spec, "mm")
+    with pytest.raises(argparse.ArgumentTypeError, match="WOODCAM_MAX_BLOCK_SIZE_MM"):
+        _size_range("30,20000")
+    monkeypatch.setenv("WOODCAM_MAX_BLOCK_SIZE_MM", "30000")
+    assert _read_spec(spec, "mm").size_mm == (20000.0, 80.0, 50.0)
+    assert _size_range("30,20000") == (30.0, 20000.0)
+    from woodcam.cli.options import option_bounds
+
+    assert option_bounds("block_size", "woodify")[1] == option_bounds("stock", "gcode")[1] == 30000.0

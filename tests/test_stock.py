@@ -46,7 +46,7 @@ def test_a_block_specs_size_has_the_one_block_size_limit():
     from woodcam.limits import MAX_BLOCK_SIZE_MM
 
     assert open_stock("builtin:flat-sawn:6000x100x100").size_mm == (6000.0, 100.0, 100.0)
-    with pytest.raises(WoodcamError, match=f"<= {MAX_BLOCK_SIZE_MM:g}; got '10001x1x1'"):
+    with pytest.raises(WoodcamError, match=fr"<= {MAX_BLOCK_SIZE_MM:g} \(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N\); got '10001x1x1'"):
         open_stock("builtin:flat-sawn:10001x1x1")
 
 
@@ -718,7 +718,7 @@ def test_a_refused_resize_says_when_no_built_in_block_is_large_enough(spec, fix,
         open_stock(spec)
     msg = str(got.value)
     assert msg.endswith(f"give {fix} (no built-in block holds the same wood: it would be {need}, past the "
-                        "10000 mm limit of a block's side, woodcam.limits.MAX_BLOCK_SIZE_MM)"), msg
+                        "10000 mm limit of a block's side, raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N)"), msg
     # just inside the limit the larger base is still offered
     with pytest.raises(BlockSpecError) as got:
         open_stock("builtin:flat-sawn[40x30x20@4990,0,0]")

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Literal
 
 from .errors import BlockSpecError, WoodcamError
-from .limits import MAX_BLOCK_SIZE_MM
+from .limits import limit
 from .units import parse_lengths
 
 #: A number of an operation, signed, as a block's ``:WxDxH`` reads it (``+40``, ``1e2``, ``.5``)
@@ -218,10 +218,11 @@ def _parse_size(text: str, spec: str, mm_per_unit: float, part: SpecPart, part_t
                 ) -> tuple[float, float, float]:
     """A spec's ``WxDxH`` read in ``mm_per_unit`` mm -> mm, each side at most
     :data:`woodcam.limits.MAX_BLOCK_SIZE_MM` mm."""
-    size = parse_lengths(text, 3, max_mm=MAX_BLOCK_SIZE_MM / mm_per_unit)
+    cap = limit("MAX_BLOCK_SIZE_MM")
+    size = parse_lengths(text, 3, max_mm=cap / mm_per_unit)
     if size is None:
-        raise _error(spec, f"the size must be WxDxH in mm, each > 0 and <= {MAX_BLOCK_SIZE_MM:g}; "
-                             f"got {text!r}, e.g. 300x120x40", part=part, text=part_text)
+        raise _error(spec, f"the size must be WxDxH in mm, each > 0 and <= {cap:g} "
+                             f"(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N); got {text!r}, e.g. 300x120x40", part=part, text=part_text)
     W, D, H = (v * mm_per_unit for v in size)
     return W, D, H
 

@@ -55,7 +55,7 @@ import numpy as np
 from woodcam._checks import check_bool
 from woodcam._types import Mesh, WoodLike
 from woodcam.errors import WoodcamError, WoodcamWarning
-from woodcam.limits import MAX_BLOCK_SIZE_MM
+from woodcam.limits import limit
 from woodcam.units import say_area, say_length
 from woodcam.tolerances import (
     ATLAS_PADDING_PX,
@@ -466,11 +466,12 @@ def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals, *,
         )
     verts = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=float)
     span = float(np.ptp(verts, axis=0).max()) if len(verts) else 0.0  # NaN with a NaN vertex
-    if not span <= MAX_BLOCK_SIZE_MM:
+    cap = limit("MAX_BLOCK_SIZE_MM")
+    if not span <= cap:
         raise WoodcamError(
-            f"bake: the mesh's vertices must be finite and span at most {say_length(MAX_BLOCK_SIZE_MM, 'g')} (the "
+            f"bake: the mesh's vertices must be finite and span at most {say_length(cap, 'g')} (the "
             f"largest block); got a span of {say_length(span, '.4g')} or NaN/inf; check the part's units and "
-            "coordinates (one far vertex made a 7 GB atlas)"
+            "coordinates (one far vertex made a 7 GB atlas), or raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N"
         )
     if not picture and not callable(getattr(wood, "color", None)):
         raise WoodcamError(

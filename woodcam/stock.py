@@ -175,7 +175,7 @@ def check_resize_in_block(spec: str, block_size_mm, size_mm, origin_mm,
 
     if inside(origin, far, have):
         return
-    from .limits import MAX_BLOCK_SIZE_MM
+    from .limits import limit
     from .tolerances import ON_FACE_TOL_MM
     from .units import message_mm_per_unit, say_length, typed_length
 
@@ -209,15 +209,16 @@ def check_resize_in_block(spec: str, block_size_mm, size_mm, origin_mm,
         # of the S0 block, where S1/2 reaches both ends from the shared centre, and the resize's
         # corner in it is origin + (S1 - S0) / 2 (the same wood, not the same numbers).
         need = np.maximum(have, 2 * np.maximum(have / 2 - origin, far - have / 2))
-        base_t, base_b = typed(need, lambda i, b: b <= MAX_BLOCK_SIZE_MM)
+        cap = limit("MAX_BLOCK_SIZE_MM")
+        base_t, base_b = typed(need, lambda i, b: b <= cap)
         at = origin + (base_b - have) / 2
         at_t, at_b = typed(at, lambda i, b: b >= -tol and b + size_b[i] <= base_b[i] + tol)
-        if (need > MAX_BLOCK_SIZE_MM).any():
+        if (need > cap).any():
             # said, not dropped: the user looking for the larger base learns there is none
             fix += (f" (no built-in block holds the same wood: it would be {say_length(tuple(need.tolist()), '.6g')}, "
-                    f"past the {say_length(MAX_BLOCK_SIZE_MM, 'g')} limit of a block's side, "
-                    "woodcam.limits.MAX_BLOCK_SIZE_MM)")
-        elif (base_b <= MAX_BLOCK_SIZE_MM).all() and inside(at_b, at_b + size_b, base_b):
+                    f"past the {say_length(cap, 'g')} limit of a block's side, "
+                    "raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N)")
+        elif (base_b <= cap).all() and inside(at_b, at_b + size_b, base_b):
             base = parsed.base if parsed.size_mm is None else parsed.base[:parsed.base.rfind(":")]
             fix += f", or a block that holds the same wood: {base}:{'x'.join(base_t)}{op_text(size_t, at_t)}"
     elif parsed is not None and parsed.kind == "log" and not parsed.ops:

@@ -120,8 +120,8 @@ def test_a_mokume_cube_size_typed_as_from_photos_takes_it_is_read_or_refused_wit
             main(["rings", "detect", str(tmp_path / "s"), "--out", str(tmp_path / "o"), "--size-mm", size])
         out, err = capsys.readouterr()
         assert exc.value.code == EXIT_USAGE and out == "" and err.count("\n") == 1, err
-        assert (f"--size-mm sizes a Mokume sample folder, a cube: give its side in mm, one number in (0, 10000], "
-                f"e.g. 50; got {size!r}") in err, err
+        assert (f"--size-mm sizes a Mokume sample folder, a cube: give its side in mm, one number in (0, 10000] "
+                f"(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 50; got {size!r}") in err, err
     assert "(50x40x30 mm is no cube; a block folder records its own size)" in err
 
 

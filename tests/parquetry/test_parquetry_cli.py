@@ -480,8 +480,8 @@ def test_sheet_size_errors_speak_the_units_it_was_typed_in(scans, capsys):
     inch = ["--veneer-from", "builtin:flat-sawn", "--no-glb", "--units", "inch"]
     assert _small_run(scans, out, *inch, "--sheet-size", "0x1") == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and ("--sheet-size takes WxH in inches (--units inch), 2 numbers in (0, 393.701], "
-                                     "e.g. 2x2; got '0x1'") in err, err
+    assert err.count("\n") == 1 and ("--sheet-size takes WxH in inches (--units inch), 2 numbers in (0, 393.701] "
+                                     "(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 2x2; got '0x1'") in err, err
     assert _small_run(scans, out, *inch, "--sheet-size", "100x50") == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "leaves of 100 x 50 in (--sheet-size" in err, err

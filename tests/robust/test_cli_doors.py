@@ -48,10 +48,10 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     ([*GCODE, "--tool", "flat:6", "--rapid-rate", "1e-320"], EXIT_USAGE, r"--rapid-rate must be in \[0.1, 1e\+06\]"),
     # a stock of 1e300 mm: the message printed a 300-digit grid (read at the door in --units)
     ([*GCODE, "--tool", "flat:6", "--stock", "1e300x10x10"], EXIT_USAGE,
-     r"--stock takes WxDxH in mm, 3 numbers in \(0, 10000\], e.g. 50x50x50; got '1e300x10x10'$"),
+     r"--stock takes WxDxH in mm, 3 numbers in \(0, 10000\] \(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N\), e.g. 50x50x50; got '1e300x10x10'$"),
     # in the units typed: it said 'in mm', read before --units was known
     ([*GCODE, "--tool", "flat:0.25", "--units", "inch", "--stock", "0x1x1"], EXIT_USAGE,
-     r"--stock takes WxDxH in inches \(--units inch\), 3 numbers in \(0, 393.701\], e.g. 2x2x2; got '0x1x1'$"),
+     r"--stock takes WxDxH in inches \(--units inch\), 3 numbers in \(0, 393.701\] \(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N\), e.g. 2x2x2; got '0x1x1'$"),
     # tracebacks (an allocation, OpenCV's assertion) or a run that never ended
     (["parquetry", "toolpaths/img/drilling.png", "--veneer-from", "builtin:flat-sawn", "--out", "OUT/pq", "--sheet-size", "1e300x10"], EXIT_USAGE,
      r"--sheet-size takes WxH in mm"),

@@ -330,7 +330,7 @@ def _cli_case(data):
     import argparse
 
     from woodcam.cli import build_parser
-    from woodcam.cli.options import RANGES, check_numbers
+    from woodcam.cli.options import check_numbers, option_bounds
 
     base, options = data.draw(st.sampled_from(CLI_CASES))
     option = data.draw(st.sampled_from(options))
@@ -349,7 +349,7 @@ def _cli_case(data):
             v = getattr(args, option[2:].replace("-", "_"))
             assert math.isfinite(v)
             name = option[2:].replace("-", "_")  # a command's own range first, as check_numbers reads them
-            lo, hi, lo_open = RANGES.get((args.command, name)) or RANGES[name]
+            lo, hi, lo_open = option_bounds(name, args.command)
             assert lo <= v <= hi and not (lo_open and v <= lo)
 
         return own_error_or_valid(lambda: check_numbers(args), check)

@@ -363,11 +363,11 @@ def test_vectors_and_sizes_are_refused_at_the_door_as_typed(tmp_path, capsys):
             (["--crack-region", "0,0,0"], "--crack-region '0,0,0': give 4 finite numbers X,Y,Z,R"),
             (["--crack-region=1,2,3,0"], "--crack-region X,Y,Z,R needs a radius R > 0; got R = 0 mm"),
             (["--block-size", "1000x10x10", "--units", "inch"],
-             "--block-size takes WxDxH in inches (--units inch), 3 numbers in (0, 393.701], e.g. 2x2x2; "
+             "--block-size takes WxDxH in inches (--units inch), 3 numbers in (0, 393.701] (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 2x2x2; "
              "got '1000x10x10'"),
             # read in the units typed: it said 'takes WxDxH in mm', read before --units was known
             (["--block-size", "0x1x1", "--units", "inch"],
-             "--block-size takes WxDxH in inches (--units inch), 3 numbers in (0, 393.701], e.g. 2x2x2; "
+             "--block-size takes WxDxH in inches (--units inch), 3 numbers in (0, 393.701] (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 2x2x2; "
              "got '0x1x1'"),
             (["--block-centre=5000,0,0", "--units", "inch"],
              "--block-centre must be in [-100000, 100000] mm; got 5000.0 inch = 127000 mm")):

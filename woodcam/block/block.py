@@ -204,7 +204,7 @@ class Block:
                                f"e.g. NAME_holdout.md); got {self.name!r}; e.g. 'oak1'")
         if max(self.size_mm) > limit("MAX_BLOCK_SIZE_MM"):  # read_block refuses it
             raise WoodcamError(f"Block.size_mm must be at most {limit('MAX_BLOCK_SIZE_MM'):g} mm a side "
-                               f"(woodcam.limits.MAX_BLOCK_SIZE_MM); got {self.size_mm}")
+                               f"(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N); got {self.size_mm}")
         if not isinstance(self.faces, dict):
             raise WoodcamError(f"Block.faces must be a dict face name -> Face; got {type(self.faces).__name__}")
         if self.true_field is not None and not callable(self.true_field):  # 5 was saved as "truth not saved"

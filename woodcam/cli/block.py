@@ -19,15 +19,16 @@ def _size_range(text: str) -> tuple[float, float]:
     import argparse
     import math
 
-    from ..limits import MAX_BLOCK_SIZE_MM
+    from ..limits import limit
 
     try:
         lo, hi = (float(v) for v in text.split(","))
     except ValueError:
         lo = hi = math.nan
-    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi <= MAX_BLOCK_SIZE_MM):
+    cap = limit("MAX_BLOCK_SIZE_MM")
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi <= cap):
         raise argparse.ArgumentTypeError(f"--size-range-mm takes MIN,MAX in mm with 0 < MIN <= MAX <= "
-                                         f"{MAX_BLOCK_SIZE_MM:g}, e.g. 30,80; got {text!r}")
+                                         f"{cap:g} (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 30,80; got {text!r}")
     return lo, hi
 
 

@@ -34,7 +34,7 @@ from typing import Literal, NamedTuple, get_args
 from .._specs import WOODIFY_FIELD_FILE
 from .._types import CAMERAS
 from ..errors import UsageError, WoodcamError
-from ..limits import MAX_BLOCK_SIZE_MM, REVIEW_VOXELS_RANGE, WOODIFY_RESOLUTION_RANGE
+from ..limits import REVIEW_VOXELS_RANGE, limit, WOODIFY_RESOLUTION_RANGE
 from ..units import MM_PER_UNIT, Units, fmt_length, fmt_size, parse_lengths
 
 #: The --species presets (woodcam.appearance.SPECIES, listed here so that --help imports no
@@ -659,9 +659,10 @@ def _spec_usage(spec: str, units: Units, err, option: str = "--block") -> str:
     """The door's words for ``err`` (a BlockSpecError of ``spec``, given as ``option``, read
     in ``units``): its lengths' rules in ``units``, the rest as the stock says it."""
     said = "mm" if units == "mm" else f"--units {units}"
-    cap = fmt_length(MAX_BLOCK_SIZE_MM, units, 5)
+    cap = fmt_length(limit("MAX_BLOCK_SIZE_MM"), units, 5)
     if err.part == "size":
-        return (f"{option} {spec}: the size must be WxDxH in {said}, each > 0 and <= {cap}; got "
+        return (f"{option} {spec}: the size must be WxDxH in {said}, each > 0 and <= {cap} ("
+                f"raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N); got "
                 f"{err.text!r}, e.g. {fmt_size((300, 120, 40), units, 3)}")
     e = 1 / MM_PER_UNIT[units]
     example = f"'builtin:knotty[{40 * e:.3g}x{30 * e:.3g}x{20 * e:.3g}@{5 * e:.2g},{5 * e:.2g},{5 * e:.2g}]'"
@@ -801,12 +802,13 @@ def _cube_side(text: str) -> float:
         return float(text)
     except ValueError:
         pass
-    sides = parse_lengths(text, 3, max_mm=MAX_BLOCK_SIZE_MM, cube=True)
+    cap = limit("MAX_BLOCK_SIZE_MM")
+    sides = parse_lengths(text, 3, max_mm=cap, cube=True)
     if sides is None or len(set(sides)) != 1:
         what = "" if sides is None else f"{'x'.join(f'{s:g}' for s in sides)} mm is no cube; "
         raise argparse.ArgumentTypeError(
             f"--size-mm sizes a Mokume sample folder, a cube: give its side in mm, one number in (0, "
-            f"{MAX_BLOCK_SIZE_MM:g}], e.g. 50; got {text!r} ({what}a block folder records its own size)")
+            f"{cap:g}] (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 50; got {text!r} ({what}a block folder records its own size)")
     return sides[0]
 
 
@@ -887,11 +889,13 @@ def parse_sizes(text: str, option: str, n: int = 3, *, cube: bool = False,
     from ..units import parse_lengths
 
     k = MM_PER_UNIT[units]
-    vals = parse_lengths(text, n, max_mm=MAX_BLOCK_SIZE_MM / k, cube=cube)
+    cap = limit("MAX_BLOCK_SIZE_MM")
+    vals = parse_lengths(text, n, max_mm=cap / k, cube=cube)
     dims = "x".join("WDH"[:n]) if n == 3 else "x".join("WH"[:n])
     if vals is None:
         unit = "mm" if units == "mm" else f"inches (--units {units})"
-        raise UsageError(f"{option} takes {dims} in {unit}, {n} numbers in (0, {MAX_BLOCK_SIZE_MM / k:.6g}]"
+        raise UsageError(f"{option} takes {dims} in {unit}, {n} numbers in (0, {cap / k:.6g}] "
+                           f"(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N)"
                            + (" (or one, a cube's side)" if cube else "") + ", e.g. "
                            + "x".join([f"{50 / k:.2g}"] * n) + f"; got {text!r}")
     return tuple(v * k for v in vals)
@@ -1317,10 +1321,14 @@ def _trusted_appearance_params(params, glb) -> dict:
 
 #: option dest -> (low, high, low_is_open[, high_is_open]). ``(command, dest)`` keys override a
 #: plain ``dest`` for commands where the same option name means another quantity.
+#: A RANGES bound that is the limit of that name (woodcam.limits), read when the option is
+#: checked (:func:`option_bounds`), so ``$WOODCAM_MAX_BLOCK_SIZE_MM`` raises the options that size a block.
+BLOCK_SIZE_CAP = "MAX_BLOCK_SIZE_MM"
+
 RANGES: dict = {
     "texels_per_mm": (0.0, 100.0, True),       # 100 texels/mm = 0.01 mm texels, far below a cutter
     "tolerance": (0.0, 10.0, True),            # tessellation chord, mm
-    "size_mm": (0.0, 10_000.0, True),          # a block side, mm (woodcam.limits.MAX_BLOCK_SIZE_MM)
+    "size_mm": (0.0, BLOCK_SIZE_CAP, True),          # a block side, mm (woodcam.limits.MAX_BLOCK_SIZE_MM)
     "mesh_tol": (0.0, 10.0, True),             # mm
     "resolution": (8, 256, False),             # colour-volume cells along the longest side
     ("woodify", "resolution"): (*WOODIFY_RESOLUTION_RANGE, False),  # grid nodes: the library's range
@@ -1359,7 +1367,7 @@ RANGES: dict = {
     ("gcode", "work_offset"): (-1e5, 1e5, False),
     ("gcode", "machine_zero"): (-1e5, 1e5, False),  # mm, G-code frame
     # woodify: --growth 1e20 divided by zero deep in the rasteriser; --crack-years 0 became 1
-    ("woodify", "growth"): (0.0, 10_000.0, True),       # mm (woodcam.limits.MAX_BLOCK_SIZE_MM)
+    ("woodify", "growth"): (0.0, BLOCK_SIZE_CAP, True),       # mm (woodcam.limits.MAX_BLOCK_SIZE_MM)
     ("woodify", "years"): (0.0, 10_000.0, True),        # the oldest trees are ~5000 years old
     ("woodify", "time_scale"): (0.0, 1e6, True),        # years
     ("woodify", "shape"): (0.0, 100.0, True),           # Weibull shape c
@@ -1394,7 +1402,7 @@ RANGES: dict = {
     # its own. The tops ParquetryParams leaves open are far beyond use: a cost ratio or weight of
     # 1e6; n_adaptive's 32 only bounds what argparse takes (the panel's rule says at most 16)
     **{("parquetry", d): (0.0, 1.0, False) for d in ("w_intens", "w_edge", "w_hist")},
-    ("parquetry", "image_size_mm"): (0.0, 10_000.0, True),  # woodcam.limits.MAX_BLOCK_SIZE_MM
+    ("parquetry", "image_size_mm"): (0.0, BLOCK_SIZE_CAP, True),  # woodcam.limits.MAX_BLOCK_SIZE_MM
     ("parquetry", "n_adaptive"): (0, 32, False),
     ("parquetry", "w_adaptive"): (0.0, 1e6, True),
     ("parquetry", "n_rot"): (1, 360, False),
@@ -1406,8 +1414,8 @@ RANGES: dict = {
     ("woodify", "relief"): (0.0, 1.0, False),
     ("woodify", "eccentricity"): (-1.0, 1.0, True, True),  # speed (1 + delta n.up) stays > 0
     # sizes and places typed as vectors (vector_type, sizes_type): limits in mm, after --units
-    ("woodify", "block_size"): (0.0, 10_000.0, True),     # woodcam.limits.MAX_BLOCK_SIZE_MM
-    ("gcode", "stock"): (0.0, 10_000.0, True),
+    ("woodify", "block_size"): (0.0, BLOCK_SIZE_CAP, True),     # woodcam.limits.MAX_BLOCK_SIZE_MM
+    ("gcode", "stock"): (0.0, BLOCK_SIZE_CAP, True),   # a block's size
     ("woodify", "block_centre"): (-1e5, 1e5, False),      # 100 m: 1e300 is a typo, not a place
     ("woodify", "crack_region"): (-1e5, 1e5, False),
 }
@@ -1433,10 +1441,17 @@ def _span(rng, mm: bool = False) -> str:
 def option_range(dest: str, command: str | None = None) -> str:
     """The range of option ``dest`` (of ``command``, where it has its own) for its help, from
     :data:`RANGES`, the one table the values are checked against: ``"in [1, 1e+06]"``."""
-    return "in " + _span(RANGES[(command, dest)] if (command, dest) in RANGES else RANGES[dest])
+    return "in " + _span(option_bounds(dest, command))
 
 
-def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND") -> None:
+def option_bounds(dest: str, command: str | None = None) -> tuple | None:
+    """The RANGES entry of option ``dest`` (``command``'s own first), a bound that names a limit
+    (:data:`BLOCK_SIZE_CAP`) read now through :func:`woodcam.limits.limit`; None without one."""
+    rng = RANGES.get((command, dest), RANGES.get(dest))
+    return None if rng is None else tuple(limit(b) if isinstance(b, str) else b for b in rng)
+
+
+def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND", cap: str = "") -> None:
     # a UsageError (exit 2): a number out of range is a wrong command line, as the exit statuses
     # in 'woodcam --help' say (it exited 1, as a failed work)
     from ..errors import UsageError
@@ -1453,7 +1468,8 @@ def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND") 
         return
     if value < lo or value > hi or (lo_open and value <= lo) or (hi_open and value >= hi):
         got = f"{value!r}" if typed is None else f"{typed[0]!r} {typed[1]} = {value:g} mm"
-        raise UsageError(f"{option} must be in {span}; got {got}; {help_}")
+        raise UsageError(f"{option} must be in {span}; got {got}; {help_}"
+                         + (f"; raise it with WOODCAM_{cap}=N" if cap and value > hi else ""))
 
 
 def check_numbers(args: argparse.Namespace) -> None:
@@ -1464,7 +1480,9 @@ def check_numbers(args: argparse.Namespace) -> None:
     for dest, value in vars(args).items():
         if dest.startswith("_") or value is None:
             continue
-        rng = RANGES.get((command, dest), RANGES.get(dest))
+        rng = option_bounds(dest, command)
+        raw = RANGES.get((command, dest), RANGES.get(dest))
+        cap = raw[1] if raw is not None and isinstance(raw[1], str) else ""  # a limit's name
         values = value if isinstance(value, (list, tuple)) else [value]
         typed = vars(args).get("_typed", {}).get(dest)
         for i, v in enumerate(values):
@@ -1472,7 +1490,7 @@ def check_numbers(args: argparse.Namespace) -> None:
                 item = (typed[0][i], typed[1]) if isinstance(typed[0][i], (int, float)) else None
             else:
                 item = typed
-            _check_value(v, _option(dest), rng, item, name or "COMMAND")
+            _check_value(v, _option(dest), rng, item, name or "COMMAND", cap)
 
 
 def add_workers_option(p: argparse.ArgumentParser, note: str = "") -> None:

@@ -32,7 +32,7 @@ import numpy as np
 from .._checks import check_path
 from .._specs import absolute_spec, spec_path
 from ..errors import WoodcamError, WoodcamWarning
-from ..limits import MAX_BLOCK_SIZE_MM
+from ..limits import limit
 from ..tolerances import IN_BLOCK_RTOL
 from ..units import message_unit, say_length, typed_length
 
@@ -135,9 +135,10 @@ class ParquetryParams:
                 f"patch_mm must be at least min_piece_mm = {self.min_piece_mm:g} mm (the smallest "
                 f"piece that can be cut and assembled); got {self.patch_mm:g} mm; use a larger "
                 "--patch-mm or lower --min-piece-mm")
-        if not self.patch_mm <= self.image_size_mm <= MAX_BLOCK_SIZE_MM:  # 1e300 reached OpenCV's assertion
+        cap = limit("MAX_BLOCK_SIZE_MM")
+        if not self.patch_mm <= self.image_size_mm <= cap:  # 1e300 reached OpenCV's assertion
             raise WoodcamError(f"image_size_mm (--image-size-mm) must be in [patch_mm = {self.patch_mm:g}, "
-                               f"{MAX_BLOCK_SIZE_MM:g}] mm; got {self.image_size_mm:g}")
+                               f"{cap:g}] mm; got {self.image_size_mm:g}; raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N")
         if self.n_adaptive < 0 or self.w_adaptive <= 0:
             raise WoodcamError(f"n_adaptive must be >= 0 and w_adaptive > 0; got {self.n_adaptive}, {self.w_adaptive}")
         if self.priority not in ("saliency", "center"):

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import WoodcamError
-from ..limits import MAX_BLOCK_SIZE_MM, WOODIFY_RESOLUTION_RANGE, check_grid, limit
+from ..limits import WOODIFY_RESOLUTION_RANGE, check_grid, limit
 from .brushes import Brush, check_vertex_paint, paint
 from .field import WoodifiedField
 from .front import Front, Method, VoxelGrid, check_resolution, check_watertight, propagate
@@ -184,8 +184,9 @@ def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: 
     lo, hi = mesh.bounds
     if velocity_mm is None:
         g_mm = 0.25 * float(np.max(hi - lo)) if growth_mm is None else float(growth_mm)
-        if not (np.isfinite(g_mm) and 0 < g_mm <= MAX_BLOCK_SIZE_MM):  # 1e20 divided by zero further on
-            raise WoodcamError(f"growth_mm must be in (0, {MAX_BLOCK_SIZE_MM:g}] (mm grown in `years`); "
+        cap = limit("MAX_BLOCK_SIZE_MM")
+        if not (np.isfinite(g_mm) and 0 < g_mm <= cap):  # 1e20 divided by zero further on
+            raise WoodcamError(f"growth_mm must be in (0, {cap:g}] (mm grown in `years`; raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N); "
                                f"got {growth_mm!r}")
         if not lam > 0:
             raise WoodcamError(f"time_scale_years must be > 0; got {time_scale_years!r}")
