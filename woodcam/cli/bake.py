@@ -76,7 +76,8 @@ def register(subparsers) -> None:
               help="baked .glb (or .obj; another program's .gltf, .ply, .stl or .off)")
     # the same [PNG] form as bake's and gcode's --screenshot (issue 17)
     p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
-                   type=not_empty(str, "a .png file name, or no value for the default"), help="render off-screen to this PNG instead of opening a window (default "
+                   type=not_empty(str, "a .png file name, or no value for the default"),
+                   help="render off-screen to this PNG instead of opening a window (default "
                    "name: MESH with _view.png)")
     add_input(p, "--block", kind="block", default=None,
                    help=BLOCK_SPEC_HELP + ", for the cut plane (default: the one stored in the GLB)")
@@ -101,7 +102,6 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("blocks", help="list the built-in synthetic blocks")
     p.set_defaults(func=run_blocks)
     uses_settings(p)  # no WOODCAM_* setting: it lists, opens no block
-
 
     p = subparsers.add_parser("species", help="list the --species colour presets and their sources")
     p.set_defaults(func=run_species)

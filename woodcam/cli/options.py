@@ -1030,7 +1030,8 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                    "expects; z keeps the block frame, as CAM tools and slicers read an OBJ)")
     if screenshot:
         p.add_argument("--screenshot", nargs="?", const=True, default=None, metavar="PNG",
-                       type=not_empty(str, "a .png file name, or no value for the default"), help="also render the result off-screen to PNG (default name: OUT with "
+                       type=not_empty(str, "a .png file name, or no value for the default"),
+                       help="also render the result off-screen to PNG (default name: OUT with "
                        "_view.png; no display needed)")
 
 
