@@ -242,14 +242,15 @@ def test_messages_of_an_inch_run_quote_what_was_typed_and_speak_inches(tmp_path,
                  "--out", str(tmp_path / "x.glb")]) == 2  # at the door: a usage error
     err = capsys.readouterr().err
     assert "--block builtin:knotty:1000x1x1: the size must be WxDxH in --units inch" in err
-    assert "<= 393.7 in; got '1000x1x1', e.g. 11.8x4.72x1.57 in" in err and "25400" not in err
+    assert ("<= 393.7 in (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N); got '1000x1x1', e.g. 11.8x4.72x1.57 in"
+            in err) and "25400" not in err
     # the same rule, at the door, in mm (it was the stock's error there: exit 1, other words)
     for units in ([], ["--units", "mm"]):
         assert main(["bake", "p.stl", *units, "--block", "builtin:knotty:20000x1x1",
                      "--out", str(tmp_path / "x.glb")]) == 2
         assert capsys.readouterr().err == (
             "woodcam: error: --block builtin:knotty:20000x1x1: the size must be WxDxH in mm, each "
-            "> 0 and <= 10000 mm; got '20000x1x1', e.g. 300x120x40 mm\n")
+            "> 0 and <= 10000 mm (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N); got '20000x1x1', e.g. 300x120x40 mm\n")
     report = {"volume_mm3": 16387.064, "yield": 0.1, "knots": 0.02, "knots_surface": 0.0, "pith": 0.0,
               "end_grain": 0.2, "elongation": 0.3, "warnings": [
                   "a knot lies 1-3 mm under the surface (it may show after sanding)"],
