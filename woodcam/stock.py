@@ -50,7 +50,7 @@ import numpy as np
 
 from ._checks import check_bool
 from ._specs import ParsedSpec, check_read_as_is, format_op, parse_spec
-from .appearance import SPECIES, ColorMapAppearance, NeuralAppearance, Species, Wood
+from .appearance import ColorMapAppearance, NeuralAppearance, Wood, get_species
 from .errors import BlockSpecError, WoodcamError, WoodcamWarning
 from .fields.base import has_uncertainty
 from .fields.builtin import BUILTIN_NAMES, builtin_block
@@ -263,7 +263,7 @@ def open_stock(spec: str, *, species: str | None = None,
     if species is not None and species_given:
         # '' was read as "no species" and the default preset used without a word; a species
         # recorded earlier (species_given False: a baked GLB's, '' where none) is the bake's own
-        _check_species(species)
+        get_species(species)
     # None was read as the spec 'None' and '' as the folder '.', neither the value given
     if not isinstance(spec, (str, os.PathLike)) or not str(spec).strip():
         raise WoodcamError(f"spec must be a block spec (str): 'builtin:NAME', 'log:LOG@KNOT', 'woodify:PATH' or "
@@ -300,16 +300,6 @@ def open_stock(spec: str, *, species: str | None = None,
             stock = Stock(stock.spec, size, wood, stock.description, {**stock.meta, "turns": list(turns)})
     stock.spec = spec  # as given (resize_stock writes its numbers with :g)
     return stock
-
-
-def _check_species(species) -> None:
-    """Refuse a species asked for that is not a preset (``''`` included) at the door."""
-    if isinstance(species, Species):
-        return
-    if not isinstance(species, str) or species not in SPECIES:
-        raise WoodcamError(f"species must be one of the presets {', '.join(SPECIES)}; got {species!r}; "
-                           "pass one of them (woodcam species lists them), or species=None for the "
-                           "block's own")
 
 
 def _check_appearance_params(appearance: str, params: dict, *, photos: bool = True,

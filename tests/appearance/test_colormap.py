@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from woodcam.appearance import ColorMapAppearance, Wood, axis_weights, blend_axis_colors
+from woodcam.appearance import ColorMapAppearance, Wood, axis_weights, blend_axis_colors, get_species
 from woodcam.appearance.colormap import LUT_BINS
 from woodcam.block import Block, Face
 from woodcam.errors import WoodcamError
@@ -87,8 +87,6 @@ def test_threads_give_identical_colours(rng):
 def _untextured(name, **changes):
     """Preset ``name`` without streaks and end-grain mottling (and with ``changes``)."""
     from dataclasses import replace
-
-    from woodcam.appearance import get_species
 
     return replace(get_species(name), streak_contrast=0.0, endgrain_roughness=0.0, **changes)
 
@@ -255,6 +253,9 @@ def test_fit_without_photos_is_a_clear_error():
 def test_bad_species_and_normals():
     with pytest.raises(WoodcamError, match="species must be one of"):
         ColorMapAppearance("balsa-wood")
+    # the one species rule (open_stock calls it too): an unhashable value is refused, not a TypeError
+    with pytest.raises(WoodcamError, match=r"species must be one of the presets .*got \['oak'\].*species=None"):
+        get_species(["oak"])
     with pytest.raises(WoodcamError, match="normals must have the shape"):
         Wood(AXIS_Z).color(np.zeros((3, 3)), np.zeros((2, 3)))
 

@@ -189,8 +189,11 @@ def get_species(species) -> Species:
     """Return a :class:`Species` from a preset name or a Species."""
     if isinstance(species, Species):
         return species
-    if species not in SPECIES:
-        raise WoodcamError(f"species must be one of {', '.join(SPECIES)}; got {species!r}")
+    # a list or dict asked with `in` raised a bare TypeError (unhashable)
+    if not isinstance(species, str) or species not in SPECIES:
+        raise WoodcamError(f"species must be one of the presets {', '.join(SPECIES)}; got {species!r}; "
+                           "pass one of them (woodcam species lists them), or species=None for the "
+                           "block's own")
     return SPECIES[species]
 
 
