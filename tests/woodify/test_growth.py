@@ -310,3 +310,20 @@ def test_an_obstacle_of_overlapping_shells_is_solid_where_they_overlap():
     r = woodify(ball, 10, growth_mm=15.0, resolution=48, obstacles=[trimesh.util.concatenate([a, b])])
     g = r.front.grid
     assert r.front.obstacle[tuple(np.round((np.array([15.5, 0, 0]) - g.origin_mm) / g.spacing_mm).astype(int))]
+
+
+def test_the_inside_test_reads_overlapping_shells_wound_inside_out_as_the_same_solid():
+    """``inside_parity`` without ``face_sign`` (obstacles, ``engulf_year``) turns a mesh whose
+    winding encloses a negative volume outward: two overlapping boxes wound inside out are the
+    same solid as wound outward, their overlap included (parity alone leaves it out)."""
+    from woodcam.woodify._voxel import inside_parity
+
+    a = trimesh.creation.box((6.5, 6.5, 6.5))
+    b = a.copy()
+    b.apply_translation((2.0, 0, 0))
+    both = trimesh.util.concatenate([a, b])
+    v, f = np.asarray(both.vertices, float), np.asarray(both.faces, np.int64)
+    grid = (np.full(3, -5.0), 1.0, np.array([13, 11, 11]))
+    outward = inside_parity(v, f, *grid)
+    assert outward.sum() == 9 * 7 * 7  # nodes -3..5 mm along x, -3..3 across
+    assert (inside_parity(v, np.ascontiguousarray(f[:, ::-1]), *grid) == outward).all()

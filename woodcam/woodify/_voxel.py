@@ -118,15 +118,12 @@ def inside_parity(verts, faces, origin, h, shape, face_sign=None):
     verts = np.ascontiguousarray(verts, np.float64)
     faces = np.ascontiguousarray(faces, np.int64)
     if face_sign is None:
-        face_sign = np.full(len(faces), -1 if _signed_volume(verts, faces) < 0 else 1, np.int64)
+        from trimesh.triangles import mass_properties  # the winding's signed volume, < 0 inside out
+
+        volume = mass_properties(verts[faces], skip_inertia=True)["volume"]
+        face_sign = np.full(len(faces), -1 if volume < 0 else 1, np.int64)
     return _inside(verts, faces, np.ascontiguousarray(face_sign, np.int64), np.asarray(origin, np.float64),
                    float(h), np.asarray(shape, np.int64))
-
-
-def _signed_volume(verts: np.ndarray, faces: np.ndarray) -> float:
-    """The volume a closed mesh's winding encloses (negative when wound inside out)."""
-    a, b, c = (verts[faces[:, i]] for i in range(3))
-    return float(np.einsum("ij,ij->", a, np.cross(b, c)) / 6.0)
 
 
 @numba.njit(cache=True, nogil=True)
