@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 from woodcam.errors import WoodcamError
@@ -111,3 +112,166 @@ def test_each_move_meets_the_stock_the_earlier_moves_left():
     again = simulate(read_gcode(alone), tool, SIZE, resolution_mm=0.2,
                      initial_heightmap=faced.heightmap)
     assert again.report == []
+
+
+def _old_reach_issues(p0, p1, tool_of, lookup, lines, size_mm, initial_heightmap=None):
+    """The reach check as it was before its inner loops were compiled (8a31f68): a Python loop
+    over the moves, numpy over each window, batches cut with the simulation's _sweep_batch."""
+    from woodcam.tolerances import REACH_GRID_MM, REACH_TOL_MM
+    from woodcam.toolpath.gcode import FEED
+    from woodcam.toolpath.reach import _cell_window
+    from woodcam.toolpath.simulate import _BATCH_CELLS, _sweep_batch
+    from woodcam.units import say_length
+
+    def frame(a, b, x, y):
+        ex, ey = b[0] - a[0], b[1] - a[1]
+        L = float(np.hypot(ex, ey))
+        cx, cy = (x - a[0])[None, :], (y - a[1])[:, None]
+        if L < 1e-9:
+            return cx + 0 * cy, cx * cx + cy * cy, 0.0, 0.0, float(min(a[2], b[2]))
+        ux, uy = ex / L, ey / L
+        perp = cx * uy - cy * ux
+        return cx * ux + cy * uy, perp * perp, L, float((b[2] - a[2]) / L), float(a[2])
+
+    def lowest_tip(along, d2, L, s, z0, r):
+        re = np.sqrt(np.maximum(r * r - d2, 0.0))
+        lo, hi = np.maximum(along - re, 0.0), np.minimum(along + re, L)
+        z = z0 + s * np.where(s > 0, lo, hi)
+        return np.where((d2 <= r * r) & (lo <= hi), z, np.inf)
+
+    def cut_batch(hm, moves, dx, dy):
+        if not moves:
+            return
+        ny, nx = hm.shape
+        idx = np.asarray(moves)
+        for t in np.unique(tool_of[idx]):
+            sel = idx[tool_of[idx] == t]
+            tool = lookup[int(t)]
+            a, b = p0[sel], p1[sel]
+            fi0, fi1, fj0, fj1 = _cell_window(a, b, tool.radius_mm, dx, dy)
+            i0, i1 = np.clip(fi0, 0, nx).astype(int), np.clip(fi1, -1, nx - 1).astype(int)
+            j0, j1 = np.clip(fj0, 0, ny).astype(int), np.clip(fj1, -1, ny - 1).astype(int)
+            ok = (i1 >= i0) & (j1 >= j0)
+            sel, a, b, i0, i1, j0, j1 = sel[ok], a[ok], b[ok], i0[ok], i1[ok], j0[ok], j1[ok]
+            if not len(sel):
+                continue
+            wy, wx = int((j1 - j0).max()) + 1, int((i1 - i0).max()) + 1
+            per = max(1, _BATCH_CELLS // (wy * wx))
+            kinds = np.full(len(sel), FEED, np.uint8)
+            for st in range(0, len(sel), per):
+                q = slice(st, st + per)
+                _sweep_batch(hm, None, tool, a[q], b[q], i0[q], j0[q], i1[q], j1[q], wy, wx,
+                             dx, dy, kinds[q], sel[q], {})
+
+    parts_of = {t: tool.reach_parts() for t, tool in lookup.items()}
+    if not any(parts_of.values()):
+        return []
+    W, D, H = (float(v) for v in size_mm)
+    nx, ny = max(1, round(W / REACH_GRID_MM)), max(1, round(D / REACH_GRID_MM))
+    dx, dy = W / nx, D / ny
+    xc, yc = (np.arange(nx) + 0.5) * dx, (np.arange(ny) + 0.5) * dy
+    if initial_heightmap is None:
+        hm = np.full((ny, nx), H)
+    else:
+        fine = np.asarray(initial_heightmap, float)
+        fi = np.minimum((xc / W * fine.shape[1]).astype(int), fine.shape[1] - 1)
+        fj = np.minimum((yc / D * fine.shape[0]).astype(int), fine.shape[0] - 1)
+        hm = fine[np.ix_(fj, fi)].copy()
+    out, pending = [], []
+    reach = np.zeros(len(p0))
+    for t, tool in lookup.items():
+        reach[tool_of == t] = max([tool.radius_mm] + [r for _, r, _ in parts_of[t]]) + max(dx, dy)
+    fi0, fi1, fj0, fj1 = _cell_window(p0, p1, reach, dx, dy)
+    wi0, wi1 = np.clip(fi0, 0, nx).astype(int), np.clip(fi1, -1, nx - 1).astype(int)
+    wj0, wj1 = np.clip(fj0, 0, ny).astype(int), np.clip(fj1, -1, ny - 1).astype(int)
+    for k in range(len(p0)):
+        a, b = p0[k], p1[k]
+        if min(a[2], b[2]) >= H or (b[2] > a[2] and a[0] == b[0] and a[1] == b[1]):
+            continue
+        if wi1[k] < wi0[k] or wj1[k] < wj0[k]:
+            continue
+        R = lookup[int(tool_of[k])].radius_mm
+        parts = parts_of[int(tool_of[k])]
+        js, is_ = slice(wj0[k], wj1[k] + 1), slice(wi0[k], wi1[k] + 1)
+        lowest = min(a[2], b[2])
+        if all(lowest + bottom >= float(hm[js, is_].max()) - REACH_TOL_MM
+               for _, _, bottom in parts):
+            pending.append(k)
+            continue
+        cut_batch(hm, pending, dx, dy)
+        pending.clear()
+        cur = hm[js, is_]
+        along, d2, L, s, z0 = frame(a, b, xc[is_], yc[js])
+        top = float(cur.max())
+        for name, r, bottom in parts:
+            if lowest + bottom >= top - REACH_TOL_MM:
+                continue
+            zlow = lowest_tip(along, d2, L, s, z0,
+                              max(r, R) + max(dx, dy) if name == "shank" else r)
+            excess = np.where(np.isfinite(zlow), cur - (zlow + bottom), -np.inf)
+            worst = np.unravel_index(int(np.argmax(excess)), excess.shape)
+            e = float(excess[worst])
+            if e <= REACH_TOL_MM:
+                continue
+            if name == "holder":
+                out.append(("holder_collision", int(lines[k]),
+                            f"the {say_length(2 * r, 'g')} holder ({say_length(bottom, 'g')} above the tip) "
+                            f"meets the stock {say_length(e, '.2f')} deep"))
+            elif d2[worst] <= (R + max(dx, dy)) ** 2:
+                out.append(("deeper_than_flute", int(lines[k]),
+                            f"cuts {say_length(e + bottom, '.2f')} deep with {say_length(bottom, 'g')} of "
+                            f"flute: the shank rubs {say_length(e, '.2f')} of stock above the flutes"))
+            else:
+                out.append(("shank_collision", int(lines[k]),
+                            f"the {say_length(2 * r, 'g')} shank meets the stock {say_length(e, '.2f')} "
+                            f"above the flutes ({say_length(bottom, 'g')})"))
+        pending.append(k)
+    return out
+
+
+def test_the_compiled_reach_replay_reports_what_the_per_move_loop_reported(monkeypatch):
+    """The reach check's compiled scan and excess (woodcam.toolpath._reach_kernel) and its
+    batched cuts give the per-move loop's issues and messages exactly (their depths to the
+    bit, via the 2-decimal messages and the count of hits), on programs where the shank and
+    holder hit and where they do not: a relief raster (ball, flat with holder, V-bit on the
+    numpy sweep), the stepped slot, two tools with a tool change, and a second program on the
+    stock an earlier one left."""
+    import importlib
+    import importlib.util
+    from pathlib import Path
+
+    sim = importlib.import_module("woodcam.toolpath.simulate")
+    calls = []
+
+    def compare(*args):
+        got, old = sim_reach(*args), _old_reach_issues(*args)
+        assert got == old
+        calls.append(len(got))
+        return got
+
+    sim_reach = sim.reach_issues
+    monkeypatch.setattr(sim, "reach_issues", compare)
+    repo = Path(__file__).resolve().parents[2]
+    spec = importlib.util.spec_from_file_location("make_samples",
+                                                  repo / "toolpaths" / "make_samples.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    raster = read_gcode(mod.relief_raster(40.0, 30.0, stepover=1.0, n_seg=40))
+    for spec_ in ("ball:6:flute=5", "ball:6:flute=20",
+                  "flat:6:flute=5:shank=8:stickout=12:holder=30", "vbit:60:6:flute=3:shank=6"):
+        simulate(raster, parse_tool_spec(spec_), (40.0, 30.0, 30.0), resolution_mm=0.5)
+    for spec_ in ("flat:6:flute=10", "flat:6:flute=11:stickout=11.5:holder=30",
+                  "vbit:60:3:flute=3:shank=6", "ball:4:flute=5:shank=5"):
+        simulate(read_gcode(SLOT), parse_tool_spec(spec_), SIZE, resolution_mm=0.5)
+    two = ("T1 M6\nM3 S10000\nG0 X20 Y20 Z5\nG1 Z-6 F300\nG1 X40\nG0 Z5\nT2 M6\nM3 S10000\n"
+           "G0 X10 Y10 Z5\nG1 Z-9 F300\nG1 X50 Y30\nG1 Z-14\nG1 X10 Y10\nG0 Z5\nM2\n")
+    tools = {1: parse_tool_spec("flat:6:flute=5"),
+             2: parse_tool_spec("vbit:90:4:flute=2:shank=6:stickout=8:holder=20")}
+    simulate(read_gcode(two), tools, SIZE, resolution_mm=0.5)
+    first = simulate(read_gcode(two), {1: tools[1], 2: parse_tool_spec("flat:3")}, SIZE,
+                     resolution_mm=0.5)
+    simulate(read_gcode(SLOT), parse_tool_spec("flat:6:flute=7:shank=8"), SIZE,
+             resolution_mm=0.5, initial_heightmap=first.heightmap)
+    assert min(calls[:1] + calls[2:4]) > 100 and calls[1] == 0  # the raster's hits, misses
+    assert len(calls) == 11 and all(calls[4:])  # each slot and two-tool program hits
+    assert all(calls[4:])  # each slot and the two-tool program hit something
