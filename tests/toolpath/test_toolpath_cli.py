@@ -693,6 +693,50 @@ def test_linuxcnc_cutter_compensation_offsets_by_a_tool_without_a_number(tmp_pat
     assert removed[0] == removed[1], removed
 
 
+def test_linuxcnc_reads_a_program_once_unless_its_tool_table_can_change_it(tmp_path, monkeypatch,
+                                                                          capsys):
+    """With --interpreter linuxcnc and a --tool SPEC without a number every program was read
+    twice by LinuxCNC (the second time with that tool's diameter in its table: +1.2 s on the
+    16,434-line raster), though only a parameter or G41/G42 reads the table. A program with
+    neither is read once now and reads the same moves, warnings and messages with any table
+    (the samples, read with and without diameters); one with G41 or a #5410 is still read
+    again (test_linuxcnc_cutter_compensation_offsets_by_a_tool_without_a_number)."""
+    import woodcam.toolpath.linuxcnc as lcnc
+
+    assert not lcnc.may_read_tool_diameters("G21 G90\nT1 M6\nG4 P1\nG1 X41 Y42 F300\nG40\n"
+                                            "(MSG, cut)\nG2 X1 Y1 R4.2\nM2\n")
+    for text in ("G1 X#1", "G1 X[1+2]", "G41", "G42 D1", "g 4 1", "G041", "G+42", "G41.1 D3",
+                 "(G41 in a comment)", "(DEBUG, #5410)", "O100 sub\nG1 X##2\nO100 endsub"):
+        assert lcnc.may_read_tool_diameters(text), text
+    if lcnc.linuxcnc_missing():
+        pytest.skip(f"LinuxCNC's interpreter is not available: {lcnc.linuxcnc_missing()}")
+    for name in ("drilling.nc", "pocket_islands.nc", "profile_tabs.nc", "vcarve_text.nc"):
+        text = (REPO / "toolpaths" / name).read_text()
+        assert not lcnc.may_read_tool_diameters(text), name
+        a, b = (read_gcode(text, interpreter="linuxcnc", tool_diameters_mm=d)
+                for d in ({}, {1: 6.35, 2: 3.0, 3: 12.0, 4: 25.0}))
+        assert (a.warnings, a.messages, a.printed) == (b.warnings, b.messages, b.printed)
+        for field in ("start_mm", "end_mm", "kind", "tool", "line", "feed_mm_min", "spindle_rpm"):
+            assert np.array_equal(getattr(a, field), getattr(b, field)), (name, field)
+    _stub_preview(monkeypatch, {})
+    runs = []
+    real = lcnc.run_batch
+    monkeypatch.setattr(lcnc, "run_batch", lambda *a, **k: runs.append(k) or real(*a, **k))
+    plain, comp = tmp_path / "plain.ngc", tmp_path / "comp.ngc"
+    plain.write_text("G21 G90\nT1 M6\nS10000 M3\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X40\nG0 Z5\n"
+                     "M2\n")
+    comp.write_text("G21 G90\nT1 M6\nS10000 M3\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG42\nG1 X20\n"
+                    "G1 X40\nG40\nG0 Z5\nM2\n")
+    for prog, reads in ((plain, 1), (comp, 2)):
+        runs.clear()
+        args = _parse([str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+                       "--tool", "flat:6", "--cell-size", "0.5", "--interpreter", "linuxcnc"])
+        assert args.func(args) == 0
+        assert f"{prog.name}: " in capsys.readouterr().out
+        assert len(runs) == reads, (prog.name, runs)
+    assert runs[-1]["tool_diameters_mm"] == {1: 6.0}
+
+
 def test_a_run_scrubbed_before_the_first_move_says_its_machining_time(tmp_path, monkeypatch, capsys):
     """--until-line before the program's first move simulates no move, and the report ended in
     a dangling 'machining time ' with nothing after it. It says 0:00:00 (no moves) now."""

@@ -139,19 +139,22 @@ def _numbered_tools(args) -> dict:
     return tools
 
 
-def _unnumbered_diameters(args, program, diameters) -> dict:
+def _unnumbered_diameters(args, program, diameters, text) -> dict:
     """The diameters (mm) of the tools without a number (--tool SPEC) by the tool numbers
     ``program`` gets them for (:func:`_tools_from_args`: the numbers it uses without a tool,
     in order; one tool alone is the tool of a program without a T word, tool 0), those not in
     ``diameters``; empty when the program says and prints nothing, where they would show
     (a DEBUG/PRINT of #5410, the loaded tool's diameter), unless LinuxCNC's interpreter reads
-    it (its cutter compensation, G41/G42, offsets the path by the radius of its tool table's
-    diameter: without it by none), or when they do not fit (refused later, after its
-    messages, by _tools_from_args). Not tool 0's: before the first M6 no tool is loaded and
-    #5410 shows 0, as on LinuxCNC (interpreter.tool_entry_in_message)."""
+    its ``text`` and may read its tool table (its cutter compensation, G41/G42, offsets the
+    path by the radius of the table's diameter: without it by none; a parameter such as
+    #5410 in an expression: linuxcnc.may_read_tool_diameters), or when they do not fit
+    (refused later, after its messages, by _tools_from_args). Not tool 0's: before the first
+    M6 no tool is loaded and #5410 shows 0, as on LinuxCNC (interpreter.tool_entry_in_message)."""
+    from ..toolpath.linuxcnc import may_read_tool_diameters
     from .options import parse_tool_option
 
-    if not (program.messages or program.printed or args.interpreter == "linuxcnc") or all(
+    if not (program.messages or program.printed or (
+            args.interpreter == "linuxcnc" and may_read_tool_diameters(text))) or all(
             parse_tool_option(item)[0] is not None for item in args.tool):
         return {}
     try:
@@ -238,7 +241,7 @@ def run(args) -> int:
                                  dialect=args.dialect, interpreter=args.interpreter,
                                  machine_zero_mm=args.machine_zero,
                                  tool_diameters_mm=diameters)
-            more = _unnumbered_diameters(args, program, diameters)
+            more = _unnumbered_diameters(args, program, diameters, text)
             if more:  # what its messages show for #5410 and LinuxCNC's G41/G42 offset: read
                 # again with the tools it is given
                 program = read_gcode(text, source=str(path), start_mm=args.start,

@@ -168,6 +168,21 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
     return moves, warnings
 
 
+def may_read_tool_diameters(text: str) -> bool:
+    """Whether LinuxCNC's reading of ``text`` can depend on the diameters in its tool table
+    (``run_linuxcnc``'s ``tool_diameters_mm``): only a parameter (``#5410``, ``#5401``-``#5413``,
+    shown or computed with, also indirectly: ``##1``) and cutter compensation (G41/G42, its
+    offset, also ``G[41]``) read them, so a program without a ``#``, a ``[`` and a G41/G42
+    word (blanks taken out and any case, as LinuxCNC reads words; in a comment too) reads the
+    same moves, messages and warnings whatever the table holds (the driver runs the one file:
+    no subroutine files). ``True`` where it may."""
+    if "#" in text or "[" in text:
+        return True
+    return _G41_G42.search(_BLANKS.sub("", text).lower()) is not None
+
+
+_G41_G42 = re.compile(r"g\+?0*4[12]")
+_BLANKS = re.compile(r"[ \t\r]+")
 _G53 = re.compile(r"g0*53(?![\d.])")
 #: the scratch copy of a program LinuxCNC ran (run_linuxcnc's, the driver's marked one)
 _SCRATCH = re.compile(r"\S*woodcam-lcnc-[^/\s]*/program\.ngc")
