@@ -737,6 +737,36 @@ def test_linuxcnc_reads_a_program_once_unless_its_tool_table_can_change_it(tmp_p
     assert runs[-1]["tool_diameters_mm"] == {1: 6.0}
 
 
+def test_a_tool_number_without_a_tool_is_refused_before_the_block_naming_its_file(tmp_path,
+                                                                                monkeypatch,
+                                                                                capsys):
+    """A program using a tool number no --tool/--tools gives (a Fusion post's T2 M6 with only
+    --tool 1=SPEC) was refused by the simulation: after the block was opened (20-30 s for a
+    photographed one) and every program before it simulated, with a message naming no file.
+    It is refused with the programs' other checks now, naming the file and the line."""
+    import woodcam.stock
+
+    _stub_preview(monkeypatch, {})
+    opened = []
+    real = woodcam.stock.open_stock
+    monkeypatch.setattr(woodcam.stock, "open_stock", lambda *a, **k: opened.append(a) or real(*a, **k))
+    one, two = tmp_path / "one.nc", tmp_path / "two.nc"
+    one.write_text("G21 G90\nT1 M6\nM3 S9000\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X30\nM30\n")
+    two.write_text("G21 G90\nT1 M6\nM3 S9000\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG0 Z5\nT2 M6\n"
+                   "M3 S9000\nG1 Z-1 F300\nG1 X30\nM30\n")
+    base = ["--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"), "--cell-size", "0.5"]
+    assert main(["gcode", str(one), str(two), *base, "--tool", "1=flat:6"]) == 1
+    out, err = capsys.readouterr()
+    assert err.strip() == ("woodcam: error: woodcam gcode two.nc: the program uses tool 2 (first "
+                           "at line 9) but tools has [1]; add T2 to the tool table or pass --tool "
+                           "2=SPEC"), err
+    assert opened == [] and "moves read" not in out, out
+    assert main(["gcode", str(one), str(two), *base, "--tool", "1=flat:6", "--until-line",
+                 "6"]) == 0  # two.nc simulated up to before its T2: no tool 2 needed
+    assert main(["gcode", str(two), *base, "--tool", "flat:6", "--tool", "ball:3"]) == 0
+    assert len(opened) == 2
+
+
 def test_a_run_scrubbed_before_the_first_move_says_its_machining_time(tmp_path, monkeypatch, capsys):
     """--until-line before the program's first move simulates no move, and the report ended in
     a dangling 'machining time ' with nothing after it. It says 0:00:00 (no moves) now."""

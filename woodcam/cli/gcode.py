@@ -198,7 +198,7 @@ def run(args) -> int:
     from ..pipeline import check_outputs, preview_heightfield
     from ..stock import open_stock, resize_stock
     from ..toolpath.gcode import GcodeError, gcode_text, read_gcode
-    from ..toolpath.simulate import simulate
+    from ..toolpath.simulate import simulate, tool_lookup
 
     if args.interpreter == "linuxcnc" and args.dialect != "linuxcnc":  # it was dropped without a word
         raise UsageError(f"--dialect must be linuxcnc with --interpreter linuxcnc (LinuxCNC's own interpreter "
@@ -270,6 +270,9 @@ def run(args) -> int:
                                "drilling cycle); nothing to simulate. Check that it is the "
                                "program you meant")
         tools = _tools_from_args(args, program)
+        # a tool number without a tool was refused by simulate, after the block was opened and
+        # the programs before it simulated, naming no file
+        tool_lookup(program, tools, who=f"woodcam gcode {path.name}")
         step = program.stepover_mm(spacing_mm=args.cell_size)
         if step is not None and args.cell_size > step / 2:
             print(f"woodcam: warning: {path.name}: the grid ({fmt_length(args.cell_size, args.units)}) "

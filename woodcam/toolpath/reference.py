@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .gcode import Program
-from .simulate import _tool_lookup
+from .simulate import tool_lookup
 
 
 def reference_stock(program: Program, tools, size_mm, *, work_offset_mm=None, segments: int = 96):
@@ -25,7 +25,7 @@ def reference_stock(program: Program, tools, size_mm, *, work_offset_mm=None, se
 
     W, D, H = map(float, size_mm)
     off = np.array([0.0, 0.0, H]) if work_offset_mm is None else np.asarray(work_offset_mm, float)
-    lookup = _tool_lookup(program, tools)
+    lookup = tool_lookup(program, tools)
     p0, p1 = program.start_mm + off, program.end_mm + off
     zmin = np.minimum(p0[:, 2], p1[:, 2])
     hulls = []

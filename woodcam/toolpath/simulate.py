@@ -144,7 +144,11 @@ class SimResult:
         return heightfield_mesh(self.heightmap, self.size_mm, flat_tol_mm=flat_tol_mm)
 
 
-def _tool_lookup(program: Program, tools) -> dict[int, Tool]:
+def tool_lookup(program: Program, tools, who: str = "simulate") -> dict[int, Tool]:
+    """The tool of each tool number ``program`` uses, from ``tools`` (one :class:`Tool` for all,
+    or ``{number: Tool}``: the only one for a program that loads none, the first loaded for
+    the rapids before the first M6); a number without a tool is refused, naming its first line
+    (``who``: what the message says refused it)."""
     if not isinstance(program, Program):  # G-code text or None was an AttributeError ('tool')
         raise WoodcamError(f"simulate: program must be a Program; got {type(program).__name__}; "
                            "read it first: simulate(read_gcode(text_or_path), tools, size_mm)")
@@ -165,7 +169,7 @@ def _tool_lookup(program: Program, tools) -> dict[int, Tool]:
             out[t] = tools[program.tool_of_leading_rapids()]
         else:
             line = int(program.line[np.argmax(program.tool == t)])
-            raise WoodcamError(f"simulate: the program uses tool {t} (first at line {line}) "
+            raise WoodcamError(f"{who}: the program uses tool {t} (first at line {line}) "
                                f"but tools has {sorted(tools)}; add T{t} to the tool table or "
                                f"pass --tool {t}=SPEC")
     return out
@@ -251,7 +255,7 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
         raise WoodcamError(f"simulate: {nx} x {ny} cells is too many for resolution_mm="
                            f"{resolution_mm}; use a coarser resolution")
     dx, dy = W / nx, D / ny
-    lookup = _tool_lookup(program, tools)
+    lookup = tool_lookup(program, tools)
     t0 = time.perf_counter()
     line_map = np.zeros((ny, nx), np.int64) if track_lines else None
     if initial_heightmap is None:
