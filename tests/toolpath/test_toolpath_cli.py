@@ -767,6 +767,33 @@ def test_a_tool_number_without_a_tool_is_refused_before_the_block_naming_its_fil
     assert len(opened) == 2
 
 
+def test_a_grid_coarser_than_half_a_tool_is_warned(tmp_path, monkeypatch, capsys):
+    """A 0.4 mm slot on a 0.5 mm grid ran along a row of cell edges: it removed 0 mm^3 with no
+    word. A grid coarser than half a used tool's diameter is warned now (the fix named in
+    --units), and fails --strict; a fine enough grid, or a small tool the program does not
+    use, is not."""
+    _stub_preview(monkeypatch, {})
+    prog = tmp_path / "slot.nc"
+    prog.write_text("G21 G90\nT1 M6\nM3 S9000\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X50\nG0 Z5\nM30\n")
+    base = [str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb")]
+    assert main(["gcode", *base, "--tool", "flat:0.4", "--cell-size", "0.5"]) == 0
+    out, err = capsys.readouterr()
+    assert "removed 0 mm^3" in out  # what the warning is about
+    assert err == ("woodcam: warning: slot.nc: the grid (0.5 mm) is coarser than half the "
+                   "diameter of T1 (0.4 mm): its cuts can fall between the cell centres and "
+                   "vanish; use --cell-size 0.2 or finer\n"), err
+    assert main(["gcode", *base, "--tool", "flat:0.4", "--cell-size", "0.5", "--strict"]) == 3
+    capsys.readouterr()
+    assert main(["gcode", *base, "--tool", "flat:0.4", "--cell-size", "0.2", "--strict"]) == 0
+    assert main(["gcode", *base, "--tool", "1=flat:3", "--tool", "2=flat:0.4", "--cell-size",
+                 "0.5", "--strict"]) == 0
+    assert capsys.readouterr().err == ""
+    assert main(["gcode", *base, "--units", "inch", "--tool", "flat:0.015", "--cell-size",
+                 "0.02"]) == 0
+    assert "the grid (0.02 in) is coarser than half the diameter of T1 (0.015 in)" in \
+        capsys.readouterr().err
+
+
 def test_a_run_scrubbed_before_the_first_move_says_its_machining_time(tmp_path, monkeypatch, capsys):
     """--until-line before the program's first move simulates no move, and the report ended in
     a dangling 'machining time ' with nothing after it. It says 0:00:00 (no moves) now."""

@@ -272,7 +272,16 @@ def run(args) -> int:
         tools = _tools_from_args(args, program)
         # a tool number without a tool was refused by simulate, after the block was opened and
         # the programs before it simulated, naming no file
-        tool_lookup(program, tools, who=f"woodcam gcode {path.name}")
+        used = tool_lookup(program, tools, who=f"woodcam gcode {path.name}")
+        # a cut narrower than two cells can fall between the cell centres and vanish (a 0.4 mm
+        # slot on a 0.5 mm grid removed nothing, with no word)
+        for t, tool in sorted(used.items()):
+            if args.cell_size > tool.diameter_mm / 2:
+                print(f"woodcam: warning: {path.name}: the grid ({fmt_length(args.cell_size, args.units)}) "
+                      f"is coarser than half the diameter of T{t} ({fmt_length(tool.diameter_mm, args.units)}): its cuts can "
+                      f"fall between the cell centres and vanish; use --cell-size "
+                      f"{tool.diameter_mm / 2 / MM_PER_UNIT[args.units]:.2g} or finer", file=sys.stderr)
+                n_warn += 1
         step = program.stepover_mm(spacing_mm=args.cell_size)
         if step is not None and args.cell_size > step / 2:
             print(f"woodcam: warning: {path.name}: the grid ({fmt_length(args.cell_size, args.units)}) "
