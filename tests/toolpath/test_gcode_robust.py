@@ -213,3 +213,18 @@ def test_fuzz_campaign_structured_programs():
             outcomes.append(_check(program(seed, n_lines=60, valid_share=0.99)))
     print(f"structured fuzz: {outcomes.count('simulated')} simulated, "
           f"{outcomes.count('error')} refused")
+
+
+@pytest.mark.parametrize("word, fix", [("L-2", "L2"), ("L2.4", "L2"), ("T-3", "T3"),
+                                       ("H-1", "H1")])
+def test_a_negative_or_fractional_count_names_a_fix_that_reads(word, fix):
+    """T, L and H must be whole numbers >= 0; the fix named for a negative one was the word
+    at 0 ('L-2' of a drilling cycle: 'write L0'), which is refused in turn (cycle repeats L
+    must be 1 or more; T0 unloads the tool). It names the whole number without the sign now,
+    and the line written so reads."""
+    line = ("G81 X10 Y10 Z-3 R1 {} F200\nG80" if word[0] == "L" else
+            "{} M6" if word[0] == "T" else "G43 {}")
+    head = "G21 G90\nT1 M6\nM3 S9000\nG0 X10 Y10 Z5\n"
+    with pytest.raises(GcodeError, match=f"'{word}': must be a non-negative integer; write {fix}$"):
+        read_gcode(head + line.format(word) + "\nG1 Z-1 F100\nM2\n")
+    read_gcode(head + line.format(fix) + "\nG1 Z-1 F100\nM2\n")

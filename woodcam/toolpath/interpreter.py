@@ -2080,8 +2080,10 @@ class Interpreter:
             mset.add(int(v))
         for k in ("t", "l", "h"):
             if k in w and (w[k] != math.floor(w[k]) or w[k] < 0 or w[k] > 1e9):
+                # (the nearest whole number without its sign: "write L0" for a cycle's L-2 was
+                # refused again, as cycle repeats L must be 1 or more)
                 raise self.err(f"{k.upper()}{w[k]:g}", "must be a non-negative integer",
-                               f"write {k.upper()}{max(0, round(w[k])):d}" if abs(w[k]) < 1e9
+                               f"write {k.upper()}{abs(round(w[k])):d}" if abs(w[k]) < 1e9
                                else "fix the number")
         if mset & {66, 67, 68}:
             self._analog_io(mset, w)
