@@ -40,7 +40,9 @@ def reach_issues(p0, p1, tool_of, lookup, lines, size_mm, initial_heightmap=None
     """Replay the moves ``p0 -> p1 : (n, 3)`` (tool tip, block frame, mm, program order) with
     tools ``lookup[tool_of[k]]`` on a coarse height field of the ``size_mm`` stock (starting
     from ``initial_heightmap`` resampled, or the full block) and return
-    ``[(kind, line, message)]`` for every move whose shank or holder meets stock."""
+    ``[(kind, line, message, excess)]`` for every move whose shank or holder meets stock
+    (``excess``: how far, mm, above the part's bottom; a line of several moves, an arc's
+    chords or a cycle's pecks, has an entry for each move that meets it)."""
     parts_of = {t: tool.reach_parts() for t, tool in lookup.items()}
     if not any(parts_of.values()):
         return []
@@ -107,15 +109,15 @@ def reach_issues(p0, p1, tool_of, lookup, lines, size_mm, initial_heightmap=None
             if name == "holder":
                 out.append(("holder_collision", int(lines[k]),
                             f"the {say_length(2 * r, 'g')} holder ({say_length(bottom, 'g')} above the tip) "
-                            f"meets the stock {say_length(e, '.2f')} deep"))
+                            f"meets the stock {say_length(e, '.2f')} deep", e))
             elif d2 <= (R + max(dx, dy)) ** 2:
                 out.append(("deeper_than_flute", int(lines[k]),
                             f"cuts {say_length(e + bottom, '.2f')} deep with {say_length(bottom, 'g')} of "
-                            f"flute: the shank rubs {say_length(e, '.2f')} of stock above the flutes"))
+                            f"flute: the shank rubs {say_length(e, '.2f')} of stock above the flutes", e))
             else:
                 out.append(("shank_collision", int(lines[k]),
                             f"the {say_length(2 * r, 'g')} shank meets the stock {say_length(e, '.2f')} "
-                            f"above the flutes ({say_length(bottom, 'g')})"))
+                            f"above the flutes ({say_length(bottom, 'g')})", e))
     return out
 
 

@@ -86,9 +86,12 @@ class Issue:
         return f"{where}: {self.kind}: {self.message}"
 
 
-def _summarise(issues: dict, move_lines: np.ndarray) -> list[Issue]:
+def _summarise(issues: dict, move_lines: np.ndarray, excess: dict | None = None) -> list[Issue]:
     """Merge runs of one kind on consecutive moving lines (lines without a move in between,
-    such as a lone ``F`` word, do not break a run); cap each kind at MAX_ISSUES_PER_KIND."""
+    such as a lone ``F`` word, do not break a run); cap each kind at MAX_ISSUES_PER_KIND. A
+    run says its first line's message, or with ``excess`` (``{(kind, line): mm}``, the reach
+    kinds) the message of its worst line (the first of equals)."""
+    excess = excess or {}
     ranks = {int(v): k for k, v in enumerate(np.unique(move_lines))}
     out = []
     for kind in ("rapid_through_stock", "below_stock_bottom", "cut_outside_stock", "spindle_off",
@@ -100,7 +103,9 @@ def _summarise(issues: dict, move_lines: np.ndarray) -> list[Issue]:
                 runs[-1].append(it)
             else:
                 runs.append([it])
-        merged = [Issue(kind, r[0].line, r[0].message, r[-1].line, r[0].at_mm) for r in runs]
+        said = [max(r, key=lambda i: excess.get((kind, i.line), -np.inf)) for r in runs]
+        merged = [Issue(kind, r[0].line, w.message, r[-1].line, r[0].at_mm)
+                  for r, w in zip(runs, said)]
         if len(merged) > MAX_ISSUES_PER_KIND:
             rest = merged[MAX_ISSUES_PER_KIND:]
             n_lines = sum(len(r) for r in runs[MAX_ISSUES_PER_KIND:])
@@ -319,9 +324,15 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
              "in LinuxCNC): the controller would cut with a still tool",
              mid[k])
     # tools with reach data: the stock each move meets must not reach the shank or holder
-    for rkind, rline, message in reach_issues(p0, p1, tool_of, lookup, lines, size,
-                                              initial_heightmap):
-        _add(issues, rkind, rline, message)
+    # (each line and run of lines says its worst hit: the first said 'cuts 10.10 mm deep' of a
+    # helix going 15 mm deep with 10 mm of flute)
+    excess: dict[tuple[str, int], float] = {}
+    for rkind, rline, message, e in reach_issues(p0, p1, tool_of, lookup, lines, size,
+                                                 initial_heightmap):
+        key = (rkind, int(rline))
+        if e > excess.get(key, -np.inf):
+            excess[key] = e
+            issues[key] = Issue(rkind, int(rline), message)
     act = np.flatnonzero(below_top & over)  # program order
     # Runs in program order, broken at tool changes and before/after every rapid that reaches
     # below the stock top: the rapid check must see the stock as cut by all earlier moves.
@@ -361,7 +372,7 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     n_active = len(act)
     np.clip(hm, 0.0, H, out=hm)
     wall = time.perf_counter() - t0
-    report = _summarise(issues, program.line)
+    report = _summarise(issues, program.line, excess)
     stats = {"moves": len(program), "moves_cutting_window": n_active, "cell_updates": cells,
              "wall_s": wall, "moves_per_s": len(program) / max(wall, 1e-12),
              "cell_updates_per_s": cells / max(wall, 1e-12), "grid": (ny, nx)}
