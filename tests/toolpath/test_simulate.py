@@ -288,3 +288,23 @@ def test_a_program_of_t0_rapids_only_is_refused_clearly():
     assert lead.tool_of_leading_rapids() == 2
     res = simulate(lead, {1: FlatEndMill(2), 2: FlatEndMill(4)}, SIZE, resolution_mm=0.1)
     assert res.removed_volume_mm3 == pytest.approx(4 * math.pi, rel=2e-2)
+
+
+def test_a_cut_through_the_bottom_says_how_far_below_it_goes_at_worst():
+    """A helix and the lines after it going 2-2.5 mm through the stock's bottom (a through
+    cut into the spoilboard) were warned with the first chord that went through: '0.016 mm
+    below the stock bottom'. The run of lines says its deepest point now, and still marks
+    where the tool first went through."""
+    prog = ("G21 G90\nT1 M6\nM3 S9000\nG0 X30 Y20 Z5\nG1 Z-18 F300\nG2 X30 Y20 Z-22 I0 J-4 P4\n"
+            "G1 X40 Z-21\nG1 X50 Z-22.5\nG0 Z5\nM30\n")
+    res = simulate(read_gcode(prog), parse_tool_spec("flat:3"), (60.0, 40.0, 20.0),
+                   resolution_mm=0.2)
+    (issue,) = res.report
+    assert (issue.kind, issue.line, issue.last_line) == ("below_stock_bottom", 6, 8)
+    assert issue.message == ("tool tip at z = -22.500 mm (G-code frame), 2.500 mm below the "
+                             "stock bottom")
+    assert issue.at_mm is not None and abs(issue.at_mm[2]) < 1e-9  # where it first went through
+    one = simulate(read_gcode(prog.replace("G1 X40 Z-21\nG1 X50 Z-22.5\n", "")),
+                   parse_tool_spec("flat:3"), (60.0, 40.0, 20.0), resolution_mm=0.2).report
+    assert [(i.line, i.message) for i in one] == [
+        (6, "tool tip at z = -22.000 mm (G-code frame), 2.000 mm below the stock bottom")]

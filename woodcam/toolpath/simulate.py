@@ -308,12 +308,16 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     kind, lines = program.kind, program.line
     # a move ending below the bottom (the retract out of it is not reported again)
     mid = 0.5 * (p0 + p1)
+    # (each line and run of lines says its worst: the first said 0.016 mm below the bottom of a
+    # helix going 2 mm below it; see _add_worst)
+    excess: dict[tuple[str, int], float] = {}
     for k in np.flatnonzero((p1[:, 2] < -SIM_CONTACT_TOL_MM) & over):
         # where the tip goes through the bottom (z = 0), or the start if it is below already
         t = p0[k, 2] / (p0[k, 2] - p1[k, 2]) if p0[k, 2] > 0 else 0.0
-        _add(issues, "below_stock_bottom", lines[k],
-             said(lambda: f"tool tip at z = {say_length(p1[k, 2] - off[2], '.3f')} (G-code frame), "
-                  f"{say_length(-p1[k, 2], '.3f')} below the stock bottom"), p0[k] + t * (p1[k] - p0[k]))
+        _add_worst(issues, excess, "below_stock_bottom", lines[k], -p1[k, 2],
+                   lambda: said(lambda: f"tool tip at z = {say_length(p1[k, 2] - off[2], '.3f')} "
+                                f"(G-code frame), {say_length(-p1[k, 2], '.3f')} below the stock "
+                                "bottom"), p0[k] + t * (p1[k] - p0[k]))
     for k in np.flatnonzero(below_top & outside & (kind == FEED)):
         _add(issues, "cut_outside_stock", lines[k],
              said(lambda: f"tool T{tool_of[k]} is below the stock top (z = "
@@ -326,13 +330,9 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     # tools with reach data: the stock each move meets must not reach the shank or holder
     # (each line and run of lines says its worst hit: the first said 'cuts 10.10 mm deep' of a
     # helix going 15 mm deep with 10 mm of flute)
-    excess: dict[tuple[str, int], float] = {}
     for rkind, rline, message, e in reach_issues(p0, p1, tool_of, lookup, lines, size,
                                                  initial_heightmap):
-        key = (rkind, int(rline))
-        if e > excess.get(key, -np.inf):
-            excess[key] = e
-            issues[key] = Issue(rkind, int(rline), message)
+        _add_worst(issues, excess, rkind, rline, e, lambda m=message: m)
     act = np.flatnonzero(below_top & over)  # program order
     # Runs in program order, broken at tool changes and before/after every rapid that reaches
     # below the stock top: the rapid check must see the stock as cut by all earlier moves.
@@ -423,6 +423,19 @@ def _add(issues, kind, line, message, at=None):
     if key not in issues:
         issues[key] = Issue(kind, int(line), message,
                             at_mm=None if at is None else tuple(float(v) for v in at))
+
+
+def _add_worst(issues, excess, kind, line, e, message, at=None):
+    """Keep the worst ``e`` (mm: how deep, how far) of ``(kind, line)``: its ``message()``
+    (made only when it is kept), with the first one's ``at`` (where it first happened);
+    ``excess`` keeps the ``e`` of each, for :func:`_summarise` to say a run's worst line."""
+    key = (kind, int(line))
+    if e <= excess.get(key, -np.inf):
+        return
+    excess[key] = float(e)
+    first = issues.get(key)
+    issues[key] = Issue(kind, int(line), message(), at_mm=first.at_mm if first else (
+        None if at is None else tuple(float(v) for v in at)))
 
 
 def _first_contact(tool, a, b, window, j0, i0, dx, dy):
