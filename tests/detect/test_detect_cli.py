@@ -377,6 +377,32 @@ def test_mokume_folder_is_redetected(tmp_path, capsys):
     assert {n for n, f in b.faces.items() if "knot_mask" in f.extras} >= {"left", "back"}
 
 
+def test_from_photos_of_a_mokume_folder_names_the_maps_it_does_not_read(tmp_path, capsys):
+    """'block from-photos H11' read the six A_col.png ... and passed over Mokume's six ring maps
+    (A_arl-unet.png ...) and two knot masks (C_knot.png, F_knot.png) without a word; the block
+    holds the photos alone. One warning names them, what is used instead and how to use them."""
+    from .test_detect_rings import _mokume
+
+    src = _mokume("H11")
+    rc, out, err = _run(capsys, "block", "from-photos", src, "--size-mm", "50", "--out", tmp_path / "b")
+    assert rc == 0 and out.startswith("wrote "), err
+    (line,) = err.splitlines()
+    assert line.startswith(f"woodcam: warning: '{src}': Mokume's ring maps A_arl-unet.png, B_arl-unet.png, "
+                           "C_arl-unet.png, D_arl-unet.png, E_arl-unet.png, F_arl-unet.png and knot masks "
+                           "C_knot.png, F_knot.png are not read"), line
+    assert "'woodcam rings detect' finds the rings and knots on them" in line
+    assert f"give the sample folder itself to fit, bake or eval ({src} --size-mm WxDxH)" in line
+    b = read_block(tmp_path / "b")
+    assert all(f.photo is not None and f.ring_map is None and not f.extras for f in b.faces.values())
+    # a folder of photos alone says nothing
+    photos = tmp_path / "photos"
+    photos.mkdir()
+    for p in src.glob("*_col.png"):
+        (photos / p.name).write_bytes(p.read_bytes())
+    rc, _out, err = _run(capsys, "block", "from-photos", photos, "--size-mm", "50", "--out", tmp_path / "c")
+    assert rc == 0 and err == "", err
+
+
 def test_the_missing_face_error_lists_the_found_faces_in_the_conventions_order(synth_photos, tmp_path, capsys):
     """'found back, bottom, left, right, top': the files' order, not the faces' (frames.FACES)."""
     rc, _out, err = _run(capsys, "block", "from-photos", _copy(synth_photos, tmp_path / "a", skip=("front",)),
@@ -1289,12 +1315,17 @@ def test_photos_named_for_no_face_are_said(synth_photos, tmp_path, capsys):
     assert "missing face photos: top" in err and "top face.png is named for no face" in err
     assert "._front" not in err and "arl-unet" not in err
     rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--partial", "--out", tmp_path / "o")
-    assert rc == 0 and err.count("warning") == 1, err
+    # the Mokume map in a warning of its own (not read: the block holds the photos alone)
+    assert rc == 0 and err.count("warning") == 2, err
     assert "top face.png is named for no face, so not read" in err and "._front" not in err
+    assert "Mokume's ring map A_arl-unet.png is not read" in err and "named for no face, so not read; " \
+        "rename" in [w for w in err.splitlines() if "top face" in w][0]
     from woodcam.block.photos import block_from_photos
 
-    with pytest.warns(WoodcamWarning, match=r"top face\.png is named for no face"):
+    with pytest.warns(WoodcamWarning) as said:
         assert "top" not in block_from_photos(d, (50, 50, 50), partial=True).faces
+    assert [str(w.message).split(": ", 1)[1][:40] for w in said] == [
+        "top face.png is named for no face, so no", "Mokume's ring map A_arl-unet.png is not "]
 
 
 def test_a_block_folder_given_as_photos_is_named_and_its_own_images_are_no_strays(synth_photos, tmp_path, capsys):

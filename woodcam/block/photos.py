@@ -15,7 +15,8 @@ below :data:`BLANK_STD`), not over- or under-exposed (more than :data:`CLIPPED_S
 pixels at the ends of the range). An image file named for no face is named in a warning (or in
 the error when faces are missing), never passed over silently; so is a photo with a near-uniform
 border unlike the wood on any side (:func:`_uniform_border`: background round the face in
-the face's proportions keeps its aspect, a strip beside a face cropped off its centre too).
+the face's proportions keeps its aspect, a strip beside a face cropped off its centre too); so
+are a Mokume sample's ring maps and knot masks beside its photos (:func:`mokume_maps`), not read.
 Faces are resampled to one density (the lowest of the photos', at most ``max_px_per_mm``), so
 the faces unfold into one cross and ring widths are alike in pixels; each once, from its
 original, so a face's pixels depend on the other photos only through that density. A photo
@@ -98,19 +99,41 @@ def _block_files(folder: Path) -> list[Path]:
             and p.stem.partition("_")[2]]
 
 
-def stray_photos(folder) -> list[Path]:
-    """Image files in ``folder`` named for no face (``IMG_1234.jpg``, ``front face.jpg``); a
-    Mokume sample's maps and masks (``A_arl-unet.png``, ``A_ann.png``, ``A_knot.png``) and a
-    block folder's own images (:func:`_block_files`: the photos folder made the block's ``--out``)
-    are not."""
+def _mokume_map_kind(path: Path) -> str | None:
+    """The kind (:data:`~woodcam.block.io.MOKUME_MAP_KINDS`) of a Mokume sample's map or mask
+    ``A_arl-unet.png``, ``A_ann.png``, ``A_knot.png``; None for any other file."""
     from .io import MOKUME_MAP_KINDS
 
-    def mokume_map(p: Path) -> bool:
-        letter, _, kind = p.stem.partition("_")
-        return letter.upper() in FACE_OF_LETTER and kind in MOKUME_MAP_KINDS
+    letter, _, kind = path.stem.partition("_")
+    return kind if letter.upper() in FACE_OF_LETTER and kind in MOKUME_MAP_KINDS else None
 
+
+def mokume_maps(folder) -> list[Path]:
+    """A Mokume sample's ring maps, annotations and knot masks in ``folder`` (``A_arl-unet.png``,
+    ``A_ann.png``, ``A_knot.png``): ``block from-photos`` reads the photos alone, and said nothing
+    of them (:func:`block_from_photos` now names them)."""
+    return [p for p in _image_files(Path(folder)) if _mokume_map_kind(p)]
+
+
+def _mokume_maps_said(folder, paths: list[Path]) -> str:
+    """The warning for :func:`mokume_maps` ``paths``: which are not read, what is used instead, how
+    to use them."""
+    what = {"arl-unet": "ring map", "knot": "knot mask", "ann": "annotation"}
+    kinds = [(what[k], [p.name for p in paths if _mokume_map_kind(p) == k]) for k in what]
+    said = " and ".join(f"{kind}{'s' if len(names) > 1 else ''} {', '.join(names)}" for kind, names in kinds if names)
+    return (f"{str(folder)!r}: Mokume's {said} {'is' if len(paths) == 1 else 'are'} not read: a block made from photos holds the photos "
+            f"alone, and 'woodcam rings detect' finds the rings and knots on them; to use Mokume's maps "
+            f"instead, give the sample folder itself to fit, bake or eval ({shlex.quote(str(folder))} --size-mm "
+            "WxDxH)")
+
+
+def stray_photos(folder) -> list[Path]:
+    """Image files in ``folder`` named for no face (``IMG_1234.jpg``, ``front face.jpg``); a
+    Mokume sample's maps and masks (:func:`mokume_maps`) and a block folder's own images
+    (:func:`_block_files`: the photos folder made the block's ``--out``) are not."""
     block = set(_block_files(Path(folder)))
-    return [p for p in _image_files(Path(folder)) if _face_of(p) is None and not mokume_map(p) and p not in block]
+    return [p for p in _image_files(Path(folder))
+            if _face_of(p) is None and not _mokume_map_kind(p) and p not in block]
 
 
 def unreadable_photos(folder, photos: dict[str, Path]) -> list[Path]:
@@ -312,6 +335,9 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
     if stray:
         warnings.warn(f"{str(folder)!r}: {unnamed}, so not read; rename a face's photo front.jpg, top.jpg, "
                       "left.jpg, bottom.jpg, right.jpg or back.jpg (or A..F)", WoodcamWarning, stacklevel=2)
+    maps = mokume_maps(folder)
+    if maps:  # passed over without a word: a Mokume folder's ring maps and knot masks seemed read
+        warnings.warn(_mokume_maps_said(folder, maps), WoodcamWarning, stacklevel=2)
     images, density, misfit = {}, {}, []
     for face, path in progress_bar(photos.items(), desc="reading photos", unit="photo", enabled=progress):
         got = _read_face_photo(face, path, size, max_px_per_mm)
