@@ -227,3 +227,36 @@ def test_a_page_grown_round_the_photo_moves_no_stroke(tmp_path):
         (t,) = read_traces_svg(svg, (256, 256))
         want = [[19.5, 19.5], [59.5, 59.5]] if "-10" in page else [[19.5, 9.5], [59.5, 49.5]]
         np.testing.assert_allclose(t.points_px, want, atol=1e-9, err_msg=page)
+
+
+def test_strokes_an_editor_hides_are_no_traces(tmp_path):
+    """A stroke hidden in the editor (visibility:hidden, display:none, opacity 0, stroke:none, a
+    transparent stroke or one of width 0; on itself or on a group round it) was read as a ring
+    trace: a ring hidden instead of deleted still counted. Only the strokes shown are traces; a
+    path with no stroke attribute at all (hand-written) still is one, as is a stroke made visible
+    again inside a hidden group."""
+    (tmp_path / "h.svg").write_text("""<?xml version="1.0"?>
+<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100" viewBox="0 0 100 100">
+ <style>.gone { visibility: hidden }</style>
+ <polyline data-year="1" points="10,10 90,10" stroke="#000" fill="none"/>
+ <polyline data-year="90" points="10,15 90,15" stroke="#000" visibility="hidden"/>
+ <polyline data-year="91" points="10,20 90,20" style="stroke:#000;visibility:hidden"/>
+ <polyline data-year="92" points="10,25 90,25" class="gone" stroke="#000"/>
+ <polyline data-year="93" points="10,30 90,30" style="display:none;stroke:#000"/>
+ <polyline data-year="94" points="10,35 90,35" stroke="#000" opacity="0"/>
+ <polyline data-year="95" points="10,40 90,40" stroke="#000" stroke-opacity="0%"/>
+ <polyline data-year="96" points="10,45 90,45" style="stroke:none;fill:none"/>
+ <polyline data-year="97" points="10,50 90,50" stroke="transparent"/>
+ <polyline data-year="98" points="10,55 90,55" stroke="#000" stroke-width="0"/>
+ <path data-year="2" d="M 10,60 L 90,60"/>
+ <g style="display:none"><polyline data-year="80" points="10,65 90,65" stroke="#000"/></g>
+ <g visibility="hidden"><polyline data-year="81" points="10,70 90,70" stroke="#000"/>
+   <polyline data-year="3" points="10,72 90,72" stroke="#000" visibility="visible"/></g>
+ <g opacity="0"><polyline data-year="82" points="10,75 90,75" stroke="#000" opacity="1"/></g>
+ <g stroke="none"><path data-year="83" d="M 10,80 L 90,80"/>
+   <path data-year="4" d="M 10,82 L 90,82" stroke="red"/></g>
+ <g opacity="0.5"><polyline data-year="5" points="10,85 90,85" stroke="#000"/></g>
+</svg>""")
+    traces = read_traces_svg(tmp_path / "h.svg", (100, 100))
+    assert [t.year for t in traces] == [1, 2, 3, 4, 5]
+    np.testing.assert_allclose([t.points_px[0, 0] for t in traces], [9.5, 59.5, 71.5, 81.5, 84.5])

@@ -11,7 +11,9 @@ where it is drawn: ``<path>`` (every command, curves ``C S Q T A`` included, sam
 ``<line>``; transforms on the shapes and on the layer groups around them; ``width``/``height``
 in any unit (``mm``, ``in``, ``px``) with or without a ``viewBox``. The face photo's ``<image>``
 (the SVG's one image, as written) is mapped onto the face image, so a page an editor grew or
-moved round it changes nothing; without one image, the drawing's width and height are. A stroke's year comes from its own ``data-year``
+moved round it changes nothing; without one image, the drawing's width and height are. Strokes
+the editor hides (``visibility:hidden``, ``display:none``, ``opacity:0``, ``stroke:none``, ...:
+:func:`_shown_shapes`) are no traces. A stroke's year comes from its own ``data-year``
 attribute, or an ``id`` / ``inkscape:label`` such as ``year-12`` or ``12``; otherwise the trace
 is unlabelled (a layer's label is not a year of the strokes in it). A stroke's ``data-ring``
 (written by the ring detector: pieces of one ring share it, see :class:`RingTrace`) is kept;
@@ -112,7 +114,7 @@ def read_traces_svg(path, shape) -> list[RingTrace]:
     scale = np.array([cols, rows]) / extent
     lo, hi = trace_bounds_px((rows, cols))
     traces: list[RingTrace] = []
-    for el in svg.elements():
+    for el in _shown_shapes(svg):
         if not isinstance(el, (svgelements.Path, svgelements.Polyline, svgelements.SimpleLine)):
             continue  # Polygon is a Polyline; rects, circles, images and text are no traces
         try:  # the file and the element in the message: a folder has six SVGs
@@ -143,6 +145,50 @@ def read_traces_svg(path, shape) -> list[RingTrace]:
                         f"drawing, its photo {cols}x{rows} px); move the stroke onto the face or delete it")
                 traces.append(RingTrace(rc, year, ring))
     return traces
+
+
+def _opacity(value, what: float) -> float:
+    """An ``opacity`` / ``stroke-opacity`` value (``0.5``, ``50%``) as a number; ``what`` when
+    there is none or it is no number (a browser ignores it too)."""
+    if value is None:
+        return what
+    text = str(value).strip()
+    try:
+        v = float(text[:-1]) / 100.0 if text.endswith("%") else float(text)
+    except ValueError:
+        return what
+    return v if math.isfinite(v) else what
+
+
+def _shown_shapes(group, stroke: str | None = None, opacity: float = 1.0):
+    """The shapes under svgelements ``group`` (document order) whose stroke an editor shows: not
+    ``visibility:hidden`` (or ``collapse``), not at ``opacity`` 0 (its own times its groups'),
+    nor with ``stroke:none`` given (its own or its group's), a transparent stroke
+    (``stroke-opacity:0``, ``transparent``) or ``stroke-width:0``. Strokes an editor hides were
+    read as ring traces (a ring hidden instead of deleted counted). svgelements itself leaves out
+    ``display:none`` (the element or a group round it, Inkscape's hidden layers) and ``<defs>``.
+    A stroke with no ``stroke`` at all (a hand-written ``<path d="..."/>``) is a trace, as before:
+    svgelements says ``none`` for it too, so only a ``stroke`` the file gives is read here."""
+    import svgelements
+
+    for el in group:
+        attributes = getattr(el, "values", {}).get("attributes", {})
+        own_stroke = attributes.get("stroke", stroke)
+        own_opacity = opacity * _opacity(attributes.get("opacity"), 1.0)
+        if isinstance(el, (svgelements.Group, svgelements.Use)):
+            yield from _shown_shapes(el, own_stroke, own_opacity)
+            continue
+        values = getattr(el, "values", {})
+        colour = getattr(el, "stroke", None)
+        width = getattr(el, "stroke_width", None)
+        if (str(values.get("visibility", "visible")).strip().lower() in ("hidden", "collapse")
+                or own_opacity <= 0.0
+                or (own_stroke is not None and own_stroke.strip().lower() == "none")
+                or _opacity(values.get("stroke-opacity"), 1.0) <= 0.0
+                or (own_stroke is not None and colour is not None and colour.value is not None and colour.alpha == 0)
+                or (width is not None and width <= 0.0)):
+            continue
+        yield el
 
 
 def _photo_rect(images: list) -> tuple[np.ndarray, np.ndarray] | None:
