@@ -1102,6 +1102,32 @@ def test_photos_not_cropped_to_their_faces_are_all_named_with_the_fix(synth_phot
     assert "turned 90 degrees" in err
 
 
+def test_photos_of_sides_typed_in_another_order_are_told_the_order(synth_photos, tmp_path, capsys):
+    """A 60x40x30 mm block given as --size-mm 60x30x40 (height and depth swapped) was refused
+    as six photos not cropped to their faces, two of them 'turned 90 degrees', with the fix to
+    crop them. When every photo fits the sides in another order, that order is said instead."""
+    from woodcam.frames import face_image_size_mm
+
+    d = tmp_path / "p"
+    d.mkdir()
+    for f in FACES:  # each face's photo at its aspect, 4 px/mm
+        h, w = face_image_size_mm(f, (60, 40, 30))
+        with Image.open(synth_photos / f"{f}.png") as im:
+            im.resize((round(4 * w), round(4 * h))).save(d / f"{f}.png")
+    for typed in ("60x30x40", "30x40x60", "40x60x30"):
+        rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", typed, "--out", tmp_path / "o")
+        assert rc == EXIT_ERROR and err.count("\n") == 1, err
+        assert (f"6 photos do not fit the block's faces for --size-mm {typed}, but all 6 fit --size-mm 60x40x30: "
+                "were the sides typed in another order? --size-mm is WxDxH, the width (left to right seen from "
+                "the front), depth (front to back) and height") in err, err
+        assert err.rstrip().endswith("run again with --size-mm 60x40x30") and "crop" not in err, err
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "60x40x30", "--out", tmp_path / "o")
+    assert rc == 0, err
+    # photos that fit no order of the sides are told to be cropped, as before
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "60x60x30", "--out", tmp_path / "o")
+    assert rc == EXIT_ERROR and "another order" not in err and "crop each photo" in err, err
+
+
 def test_a_photo_with_background_all_round_is_said(synth_photos, tmp_path, capsys):
     """A photo not cropped to its face but with even margins of background round the block keeps
     the face's aspect and passed without a word (the table's grey became the face's edge). Now a

@@ -28,6 +28,7 @@ from __future__ import annotations
 import shlex
 import warnings
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -272,17 +273,42 @@ def _aspect_misfit(face: str, path: Path, shape, h_mm: float, w_mm: float) -> st
     return f"{what}, about {round(rows / want)}x{rows} px when cropped"
 
 
-def _read_face_photo(face: str, path: Path, size, max_px_per_mm: float) -> tuple[np.ndarray, float] | str:
+def _fits(face: str, shape, size) -> bool:
+    """Whether a photo of ``shape`` (rows, cols, ...) has the aspect of ``face`` of a block of
+    ``size`` (W, D, H) mm, within :data:`~woodcam.tolerances.FACE_PIXEL_ASPECT_RTOL`."""
+    h_mm, w_mm = face_image_size_mm(face, size)
+    want = h_mm / w_mm
+    return abs(shape[0] / shape[1] - want) <= FACE_PIXEL_ASPECT_RTOL * want
+
+
+def _sizes_the_photos_fit(shapes: dict[str, tuple[int, int]], size) -> list[tuple[float, float, float]]:
+    """The orders of ``size``'s sides, other than the given one, whose faces every photo
+    (``shapes``: face -> (rows, cols)) fits: the sides typed in another order than W x D x H made
+    every photo 'not cropped to its face', and the fix said was to crop them."""
+    from itertools import permutations
+
+    given = tuple(map(float, size))
+    return [s for s in dict.fromkeys(permutations(given)) if s != given
+            and all(_fits(face, shape, s) for face, shape in shapes.items())]
+
+
+class _Misfit(NamedTuple):
+    """A photo whose aspect does not fit its face: what is wrong (:func:`_aspect_misfit`) and its
+    (rows, cols)."""
+    said: str
+    shape: tuple[int, int]
+
+
+def _read_face_photo(face: str, path: Path, size, max_px_per_mm: float) -> tuple[np.ndarray, float] | _Misfit:
     """The checked photo of ``face`` brought down to ``max_px_per_mm`` if denser, and its own
-    density (px/mm); or, when its aspect does not fit the face, what is wrong (:func:`_aspect_misfit`).
+    density (px/mm); or, when its aspect does not fit the face, what is wrong (:class:`_Misfit`).
     A function, so the full-size photo is freed before the next is read: six 48 MP photos held
     at once took 1.8 GB."""
     a = read_photo_rgb(path, f"photo of face {face!r}")
     _check_exposure(face, a, path)
     h_mm, w_mm = face_image_size_mm(face, size)
-    want, got = h_mm / w_mm, a.shape[0] / a.shape[1]
-    if abs(got - want) > FACE_PIXEL_ASPECT_RTOL * want:
-        return _aspect_misfit(face, path, a.shape, h_mm, w_mm)
+    if not _fits(face, a.shape, size):
+        return _Misfit(_aspect_misfit(face, path, a.shape, h_mm, w_mm), (a.shape[0], a.shape[1]))
     # an 8 x 8 px photo was enlarged and recorded at a density it lacks; a 20 x 20 px one passed
     # and detection read its noise as rings (a false 'looks mirrored')
     if min(a.shape[:2]) < MIN_FACE_PHOTO_PX:
@@ -339,16 +365,29 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
     if maps:  # passed over without a word: a Mokume folder's ring maps and knot masks seemed read
         warnings.warn(_mokume_maps_said(folder, maps), WoodcamWarning, stacklevel=2)
     images, density, misfit = {}, {}, []
+    shapes: dict[str, tuple[int, int]] = {}
     for face, path in progress_bar(photos.items(), desc="reading photos", unit="photo", enabled=progress):
         got = _read_face_photo(face, path, size, max_px_per_mm)
-        if isinstance(got, str):
-            misfit.append(got)
+        if isinstance(got, _Misfit):
+            misfit.append(got.said)
+            shapes[face] = got.shape
         else:
             images[face], density[face] = got
+            shapes[face] = got[0].shape[:2]
     if misfit:  # all of them at once: photos not cropped to the face are seldom alone
+        mm = "x".join(f"{v:g}" for v in size)
+        head = (f"{'photo does' if len(misfit) == 1 else f'{len(misfit)} photos do'} not fit the block's faces for "
+                f"--size-mm {mm}")
+        # one photo alone that fits another order is more likely turned or cropped (its message says)
+        fit = _sizes_the_photos_fit(shapes, size) if len(misfit) > 1 else []
+        if fit:  # every photo fits the sides in another order: no photo to crop
+            said = " or ".join(f"--size-mm {'x'.join(f'{v:g}' for v in s)}" for s in fit)
+            raise WoodcamError(
+                f"{head}, but all {len(shapes)} fit {said}: were the sides typed in another order? --size-mm is "
+                f"WxDxH, the width (left to right seen from the front), depth (front to back) and height, as "
+                f"../shared/docs/conventions.md lays the faces out; run again with {said}")
         raise WoodcamError(
-            f"{'photo does' if len(misfit) == 1 else f'{len(misfit)} photos do'} not fit the block's faces for "
-            f"--size-mm {size[0]:g}x{size[1]:g}x{size[2]:g}: {'; '.join(misfit)}; crop each photo to its face's "
+            f"{head}: {'; '.join(misfit)}; crop each photo to its face's "
             "edges, the wood alone with no table or background round it (a photo editor's perspective crop also "
             "squares up a face taken at an angle), or check --size-mm")
     ppm = min(min(density.values()), max_px_per_mm)
@@ -370,7 +409,7 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
     for face in progress_bar(again, desc="re-reading photos", unit="photo", enabled=progress) if again else ():
         images[face] = None  # freed before its original is read again
         again_read = _read_face_photo(face, photos[face], size, ppm)
-        assert not isinstance(again_read, str)  # its aspect passed on the first read
+        assert not isinstance(again_read, _Misfit)  # its aspect passed on the first read
         images[face] = again_read[0]
     faces = {}
     for face, a in images.items():
