@@ -84,7 +84,8 @@ PHOTO_ALPHA_FIX = ("a cut-out?", "crop the image so every pixel is opaque, or fl
 def read_image_file(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_ALPHA_FIX):
     """An image file decoded as every viewer shows it (its format told by its content, not its
     name), turned by its EXIF orientation tag (a phone stores a portrait photo as landscape
-    pixels plus that tag: read raw it lies on its side, a face's rings turned 90 degrees):
+    pixels plus that tag: read raw it lies on its side, a face's rings turned 90 degrees) and
+    converted to sRGB from the ICC profile it carries (:func:`_in_srgb`):
     ``(h, w)`` or ``(h, w, 3)`` uint8 for 8-bit modes, uint16 for 16-bit ones (values kept). Files over :data:`~woodcam.limits.MAX_IMAGE_PIXELS`,
     unreadable, truncated, animated (a GIF, PNG or WebP of several frames: which is the face?)
     or of unsupported modes are WoodcamErrors naming ``what`` and the file; transparent pixels
@@ -139,7 +140,7 @@ def read_image_file(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_AL
                 # in place: a copy of an upright 48 MP photo (PIL's 4 bytes a pixel, 190 MB) made
                 # for nothing raised a read's peak by a third
                 ImageOps.exif_transpose(im, in_place=True)
-                image = _image_array(im, f"{what}: {str(path)!r}", alpha_fix)
+                image = _image_array(_in_srgb(im, f"{what}: {str(path)!r}"), f"{what}: {str(path)!r}", alpha_fix)
                 fmt = im.format
         _say_pil_warnings(said, f"{what}: {str(path)!r}", fmt, orientation, unread)
         return image
@@ -165,6 +166,39 @@ def read_image_file(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_AL
 
 #: The EXIF tag that says how a photo's pixels are to be turned to show it upright.
 _EXIF_ORIENTATION = 0x0112
+
+
+def _in_srgb(im, where: str):
+    """PIL image ``im`` in sRGB, as a viewer shows it, when it carries an ICC colour profile of
+    another space (an iPhone's Display P3, a camera's Adobe RGB, a print workflow's CMYK): its
+    numbers were read as sRGB, a P3 face's wood duller and yellower than on screen (P3 (200,
+    150, 100) is sRGB (210, 149, 91)). RGB(A) is converted in place (alpha kept), CMYK to RGB;
+    an sRGB profile, grey and 16-bit images are left as they are. A profile that cannot be read
+    is said (``where``: what and the file), the numbers read as sRGB."""
+    icc = im.info.get("icc_profile")
+    if not icc or im.mode not in ("RGB", "RGBA", "CMYK"):
+        return im
+    import io
+
+    from PIL import ImageCms
+
+    from .errors import WoodcamWarning
+
+    try:
+        profile = ImageCms.ImageCmsProfile(io.BytesIO(icc))
+        space = profile.profile.xcolor_space.strip()
+        if space != im.mode[:len(space)] or ImageCms.getProfileDescription(profile).strip().startswith("sRGB"):
+            return im  # sRGB already; or a profile not of the image's space, which no viewer applies
+        srgb = ImageCms.createProfile("sRGB")
+        if im.mode == "CMYK":
+            return ImageCms.profileToProfile(im, profile, srgb, outputMode="RGB")
+        ImageCms.profileToProfile(im, profile, srgb, inPlace=True)
+        return im
+    except (OSError, ValueError, ImageCms.PyCMSError) as err:
+        warnings.warn(f"{where} carries an ICC colour profile that cannot be read ({err}); its colours are read "
+                      "as sRGB and may differ from what a viewer shows: export it again as sRGB", WoodcamWarning,
+                      stacklevel=4)
+        return im
 
 
 def _say_pil_warnings(said, where: str, fmt: str | None, orientation, unread: int) -> None:

@@ -586,6 +586,79 @@ def test_a_16_bit_photo_is_scaled_not_clipped(synth_photos, tmp_path, capsys):
     assert np.abs(got[..., 0].astype(int) - grey).max() <= 1
 
 
+def _matrix_icc(name: str, primaries, gamma: float = 2.2) -> bytes:
+    """An ICC v2 RGB display profile: ``primaries`` ((3, 3) D50-adapted XYZ of red, green, blue),
+    one gamma for the three channels, a D50 white."""
+    import struct
+
+    def s15(v):
+        return struct.pack(">i", round(v * 65536))
+
+    def xyz(v):
+        return b"XYZ " + bytes(4) + b"".join(s15(c) for c in v)
+
+    d50 = (0.9642, 1.0, 0.8249)
+    text = name.encode() + b"\0"
+    curve = b"curv" + bytes(4) + struct.pack(">IH", 1, round(gamma * 256)) + bytes(2)
+    tags = [(b"desc", b"desc" + bytes(4) + struct.pack(">I", len(text)) + text + bytes(78)), (b"wtpt", xyz(d50)),
+            (b"rXYZ", xyz(primaries[0])), (b"gXYZ", xyz(primaries[1])), (b"bXYZ", xyz(primaries[2])),
+            (b"rTRC", curve), (b"gTRC", curve), (b"bTRC", curve), (b"cprt", b"text" + bytes(4) + b"none\0")]
+    start = 128 + 4 + 12 * len(tags)
+    table, data = b"", b""
+    for sig, body in tags:
+        body += bytes(-len(body) % 4)
+        table += sig + struct.pack(">II", start + len(data), len(body))
+        data += body
+    header = (struct.pack(">I", start + len(data)) + bytes(4) + struct.pack(">I", 0x02100000) + b"mntrRGB XYZ "
+              + struct.pack(">6H", 2024, 1, 1, 0, 0, 0) + b"acsp" + bytes(28) + b"".join(s15(c) for c in d50)
+              + bytes(48))
+    return header + struct.pack(">I", len(tags)) + table + data
+
+
+#: Display P3's primaries, D50-adapted (as Apple's profile gives them).
+_P3 = ((0.515102, 0.241196, -0.001050), (0.291965, 0.692239, 0.041882), (0.157153, 0.066574, 0.784378))
+
+
+def test_a_photo_with_a_display_p3_profile_is_read_as_a_viewer_shows_it(synth_photos, tmp_path, capsys):
+    """An iPhone stores its photos' colours as Display P3 numbers with that ICC profile; they were
+    read as sRGB numbers, the face's wood duller than every viewer shows it (the mean red of
+    H11's front, so stored, 226.3 for 233.1). Now a profile of another space is converted to
+    sRGB (RGB with alpha kept, CMYK too); an sRGB-tagged photo is read as it is, and a profile
+    that cannot be read is said, the numbers read as sRGB."""
+    import io
+
+    from PIL import ImageCms
+
+    icc = _matrix_icc("Display P3 (test)", _P3)
+    p3 = ImageCms.ImageCmsProfile(io.BytesIO(icc))
+    d = _copy(synth_photos, tmp_path / "p3")
+    for name in ("front", "top"):  # what a P3 camera stores for these colours
+        with Image.open(synth_photos / f"{name}.png") as im:
+            shown = im.convert("RGB")
+        stored = ImageCms.profileToProfile(shown, ImageCms.createProfile("sRGB"), p3)
+        if name == "top":  # with an alpha channel, all opaque
+            stored = stored.convert("RGBA")
+        stored.save(d / f"{name}.png", icc_profile=icc)
+    srgb = ImageCms.ImageCmsProfile(ImageCms.createProfile("sRGB")).tobytes()
+    with Image.open(synth_photos / "left.png") as im:
+        im.save(d / "left.png", icc_profile=srgb)
+    with Image.open(synth_photos / "right.png") as im:
+        im.save(d / "right.png", icc_profile=b"not a profile" * 20)
+    blk = tmp_path / "blk"
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", blk)
+    assert rc == 0, err
+    faces = read_block(blk).faces
+    for name in ("front", "top", "left", "right"):
+        with Image.open(synth_photos / f"{name}.png") as im:
+            shown = np.asarray(im.convert("RGB"), int)
+        diff = np.abs(faces[name].photo.astype(int) - shown)
+        # P3 and back through 8 bits: a level or two; read raw, the front was 4.7 levels off on average
+        assert diff.mean() < 0.8 and diff.max() <= 3 if name in ("front", "top") else diff.max() == 0, (name, diff.mean())
+    (line,) = err.splitlines()
+    assert line.startswith(f"woodcam: warning: photo of face 'right': '{d / 'right.png'}' carries an ICC colour "
+                           "profile that cannot be read (") and line.endswith("export it again as sRGB"), line
+
+
 def test_rings_detect_and_show_on_a_folder_of_photos_say_to_make_a_block_first(synth_photos, tmp_path, capsys):
     """'rings detect PHOTOS' (the user's own front.jpg ..., before 'block from-photos') was 'must
     hold a block.json or Mokume files; found neither' and 'rings show PHOTOS' 'must hold Mokume
