@@ -659,6 +659,30 @@ def test_a_photo_with_a_display_p3_profile_is_read_as_a_viewer_shows_it(synth_ph
                            "profile that cannot be read (") and line.endswith("export it again as sRGB"), line
 
 
+def test_a_greyscale_photo_among_colour_ones_is_said(synth_photos, tmp_path, capsys):
+    """A face photographed with a phone's mono filter, or scanned in grey, was read as grey RGB
+    beside five colour photos without a word, and the wood's colours fitted to it. Now it is
+    named (a grey image file, or grey saved as RGB); all six grey is the user's choice, unsaid."""
+    d = _copy(synth_photos, tmp_path / "g")
+    with Image.open(synth_photos / "right.png") as im:
+        im.convert("L").save(d / "right.png")
+    with Image.open(synth_photos / "top.png") as im:
+        im.convert("L").convert("RGB").save(d / "top.jpg", quality=90)
+    (d / "top.png").unlink()
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == 0, err
+    (line,) = err.splitlines()
+    assert line == ("woodcam: warning: photos of faces 'top' (top.jpg), 'right' (right.png) are greyscale, the "
+                    "other faces' in colour: the wood's colours are fitted from every face photo, these grey; "
+                    "export or retake them in colour"), line
+    for p in list(d.iterdir()):
+        with Image.open(p) as im:
+            im.convert("L").save(d / f"{p.stem}.png")
+    (d / "top.jpg").unlink()
+    rc, _out, err = _run(capsys, "block", "from-photos", d, "--size-mm", "50", "--out", tmp_path / "o")
+    assert rc == 0 and err == "", err
+
+
 def test_rings_detect_and_show_on_a_folder_of_photos_say_to_make_a_block_first(synth_photos, tmp_path, capsys):
     """'rings detect PHOTOS' (the user's own front.jpg ..., before 'block from-photos') was 'must
     hold a block.json or Mokume files; found neither' and 'rings show PHOTOS' 'must hold Mokume

@@ -20,7 +20,8 @@ are a Mokume sample's ring maps and knot masks beside its photos (:func:`mokume_
 Faces are resampled to one density (the lowest of the photos', at most ``max_px_per_mm``), so
 the faces unfold into one cross and ring widths are alike in pixels; each once, from its
 original, so a face's pixels depend on the other photos only through that density. A photo
-that brings the others down by more than :data:`DENSITY_SPREAD` is named in a warning.
+that brings the others down by more than :data:`DENSITY_SPREAD` is named in a warning; so is a greyscale
+photo among colour ones (:data:`GREY_CHROMA`).
 """
 
 from __future__ import annotations
@@ -70,6 +71,10 @@ BORDER_COLOUR_STEP = 15.0
 #: is warned of: every face is stored at the lowest density, so one photo taken from afar or
 #: at a low resolution brought the other five down with it, without a word of which.
 DENSITY_SPREAD = 1.5
+#: A photo whose pixels' channels differ (max - min, of 255) by less than this on average is
+#: greyscale: the 12 Mokume face photos differ by 45-70, woodcam's synthetic faces by 80-95,
+#: a grey photo saved as RGB (a phone's mono filter, a scanner's grey mode) by 0-1.
+GREY_CHROMA = 3.0
 #: Default upper density (px/mm): 10 px/mm keeps 0.1 mm detail (rings are >= 0.8 mm) and a
 #: 50 mm face at 500 px, which the ring detector handles in about a second.
 MAX_PX_PER_MM = 10.0
@@ -201,6 +206,12 @@ def _check_exposure(face: str, photo: np.ndarray, path: Path) -> None:
     if spread < BLANK_STD:
         raise WoodcamError(f"photo of face {face!r} ({path.name}) is blank (luminance spread "
                            f"{spread:.3f} < {BLANK_STD}); retake it with the face in view")
+
+
+def _is_grey(photo: np.ndarray) -> bool:
+    """Whether ``photo`` (rows, cols, 3) uint8 is greyscale (:data:`GREY_CHROMA`)."""
+    chroma = photo.max(axis=2).astype(np.int16) - photo.min(axis=2)
+    return float(chroma.mean()) < GREY_CHROMA
 
 
 def _line_texture(lum: np.ndarray) -> np.ndarray:
@@ -426,6 +437,14 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
                 f"photo of face {face!r} ({photos[face].name}) has a uniform border unlike the wood on {where} "
                 f"({shares}): background {'round' if len(sides) == 4 else 'beside'} the face? crop the photo "
                 "to the face's edges, the wood alone", WoodcamWarning, stacklevel=2)
+    grey = [f for f, face in faces.items() if _is_grey(face.photo)]
+    if grey and len(grey) < len(faces):  # read as grey RGB beside colour photos, without a word
+        one = len(grey) == 1
+        warnings.warn(
+            f"{'photo of face' if one else 'photos of faces'} {', '.join(f'{f!r} ({photos[f].name})' for f in grey)} "
+            f"{'is' if one else 'are'} greyscale, the other faces' in colour: the wood's colours are fitted from "
+            f"every face photo, {'this one' if one else 'these'} grey; export or retake {'it' if one else 'them'} "
+            "in colour", WoodcamWarning, stacklevel=2)
     meta = {"source": "photos", "photos_dir": str(Path(folder).resolve()), "px_per_mm": float(ppm),
             "photos_px_per_mm": float(min(density.values())),
             "photos": {f: p.name for f, p in photos.items()},
