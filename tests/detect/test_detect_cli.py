@@ -367,11 +367,18 @@ def test_the_detection_cache_stays_in_the_cache_whatever_the_block_is_named(synt
 
 
 def test_mokume_folder_is_redetected(tmp_path, capsys):
+    """... and its own ring maps and knot masks, passed over without a word (the knot masks
+    written seemed Mokume's), are named in one warning with what is used instead."""
     from .test_detect_rings import _mokume
 
     src = _mokume("H11")
     rc, _out, err = _run(capsys, "rings", "detect", src, "--out", tmp_path / "h11")
     assert rc == 0, err
+    (line,) = err.splitlines()
+    assert line == (f"woodcam: warning: '{src}': Mokume's ring maps A_arl-unet.png, B_arl-unet.png, C_arl-unet.png, "
+                    "D_arl-unet.png, E_arl-unet.png, F_arl-unet.png and knot masks C_knot.png, F_knot.png are not "
+                    "read: rings and knots are detected on its photos afresh; to use Mokume's maps instead, give the "
+                    f"sample folder itself to fit, bake or eval ({src} --size-mm WxDxH)"), line
     b = read_block(tmp_path / "h11")
     assert set(b.faces) == set(FACES)
     assert {n for n, f in b.faces.items() if "knot_mask" in f.extras} >= {"left", "back"}

@@ -121,15 +121,14 @@ def mokume_maps(folder) -> list[Path]:
     return [p for p in _image_files(Path(folder)) if _mokume_map_kind(p)]
 
 
-def _mokume_maps_said(folder, paths: list[Path]) -> str:
-    """The warning for :func:`mokume_maps` ``paths``: which are not read, what is used instead, how
-    to use them."""
+def mokume_maps_said(folder, paths: list[Path], instead: str) -> str:
+    """The warning for :func:`mokume_maps` ``paths`` of sample folder ``folder``: which are not
+    read, what is used ``instead`` (words), how to use them."""
     what = {"arl-unet": "ring map", "knot": "knot mask", "ann": "annotation"}
     kinds = [(what[k], [p.name for p in paths if _mokume_map_kind(p) == k]) for k in what]
     said = " and ".join(f"{kind}{'s' if len(names) > 1 else ''} {', '.join(names)}" for kind, names in kinds if names)
-    return (f"{str(folder)!r}: Mokume's {said} {'is' if len(paths) == 1 else 'are'} not read: a block made from photos holds the photos "
-            f"alone, and 'woodcam rings detect' finds the rings and knots on them; to use Mokume's maps "
-            f"instead, give the sample folder itself to fit, bake or eval ({shlex.quote(str(folder))} --size-mm "
+    return (f"{str(folder)!r}: Mokume's {said} {'is' if len(paths) == 1 else 'are'} not read: {instead}; to use "
+            f"Mokume's maps instead, give the sample folder itself to fit, bake or eval ({shlex.quote(str(folder))} --size-mm "
             "WxDxH)")
 
 
@@ -374,7 +373,9 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
                       "left.jpg, bottom.jpg, right.jpg or back.jpg (or A..F)", WoodcamWarning, stacklevel=2)
     maps = mokume_maps(folder)
     if maps:  # passed over without a word: a Mokume folder's ring maps and knot masks seemed read
-        warnings.warn(_mokume_maps_said(folder, maps), WoodcamWarning, stacklevel=2)
+        warnings.warn(mokume_maps_said(folder, maps, "a block made from photos holds the photos alone, and "
+                                       "'woodcam rings detect' finds the rings and knots on them"),
+                      WoodcamWarning, stacklevel=2)
     images, density, misfit = {}, {}, []
     shapes: dict[str, tuple[int, int]] = {}
     for face, path in progress_bar(photos.items(), desc="reading photos", unit="photo", enabled=progress):

@@ -770,6 +770,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     and the warnings.
     """
     from ..block.io import MANIFEST, read_block_folder, write_block
+    from ..block.photos import mokume_maps, mokume_maps_said
     from ..block.svg import write_traces_svg
 
     src, out = Path(src), Path(out)
@@ -789,11 +790,14 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
     block = read_block_folder(src, size_mm, regenerated={f"{n}_{k}.png" for n in FACES for k in DETECTED_IMAGES}
                               | {f"{n}_traces.svg" for n in FACES} | {Path(r).name for r in named_src.values()})
     named = {folder / rel for folder, names in ((src, named_src), (out, named_out)) for rel in names.values()}
+    mokume_said = []
     if not (src / MANIFEST).is_file():  # a Mokume sample: re-detected from its photos alone
         for f in block.faces.values():
             f.ring_map, f.traces = None, []
             f.extras.pop("knot_mask", None)
         edited = {}
+        maps = mokume_maps(src)  # said: the written knot masks and ring maps seemed Mokume's
+        mokume_said = [mokume_maps_said(src, maps, "rings and knots are detected on its photos afresh")] if maps else []
     else:
         edited = user_edited_faces(src)
     # with no detection recorded in a block folder, the source or --out, a file of detection's
@@ -846,6 +850,7 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
                        f"of a {n} face writes over it)" for n, svg in unused.items()]
     msgs += [f"face {n!r}: your {path} is not used: the block has no {n} face (made without its photo); move it "
              f"out of {str(path.parent)!r} to keep it" for n, path in dict.fromkeys(unused_images)]
+    msgs += mokume_said
     if todo:
         # cached by content: a second run, or one after a single SVG was corrected or a single
         # photo changed, detected every face afresh (a minute or two a large face)
