@@ -418,3 +418,22 @@ def test_the_block_size_limit_variable_raises_a_typed_block_spec_at_the_door(mon
     from woodcam.cli.options import option_bounds
 
     assert option_bounds("block_size", "woodify")[1] == option_bounds("stock", "gcode")[1] == 30000.0
+
+
+def test_a_face_without_a_photo_is_a_labelled_slot_in_both_crosses():
+    """A block made with --partial drew its missing face as a blank, unnamed hole in 'block show'
+    and 'rings show' (a dark face? a drawing fault?). The slot is now named 'back (F): no photo'."""
+    from woodcam.block.render import cross_image, missing_face
+    from woodcam.detect.show import rings_picture
+    from woodcam.synth import cut_block, synth_block
+
+    block = synth_block(cut_block(lambda p: np.hypot(p[:, 0], p[:, 1]) / 2.0, (40, 30, 20), "rift"),
+                        (40, 30, 20), face_px=40, seed=1)
+    del block.faces["back"]
+    for im, zoom in ((cross_image(block, traces=False), 1), (rings_picture(block, zoom=2), 2)):
+        layout = CrossLayout(block.size_mm, zoom * block.faces["front"].shape[1] / block.size_mm[0])
+        r0, c0 = layout.origin["back"]
+        h, w = layout.face_shape("back")
+        slot = im[r0:r0 + h, c0:c0 + w]
+        assert np.array_equal(slot, missing_face("back", (h, w), 24)), zoom
+        assert len(np.unique(slot.reshape(-1, 3), axis=0)) > 1  # the label is drawn

@@ -31,10 +31,11 @@ LABEL_SHARE = 1 / 16
 LABEL_MIN_PX = 10
 
 
-def label_face(rgb: np.ndarray, face: str) -> np.ndarray:
+def label_face(rgb: np.ndarray, face: str, note: str = "") -> np.ndarray:
     """``rgb`` (rows, cols, 3) uint8, a picture of ``face``, with the face's name and Mokume
-    letter (``front (A)``) in white on a dark box at its top-left corner: six unlabelled faces
-    in a cross left the user to work out from ``docs/conventions.md`` which photo was which."""
+    letter (``front (A)``), and ``note`` after it (``back (F): no photo``), in white on a dark box
+    at its top-left corner: six unlabelled faces in a cross left the user to work out from
+    ``docs/conventions.md`` which photo was which."""
     from PIL import Image, ImageDraw, ImageFont
 
     im = Image.fromarray(np.asarray(rgb, np.uint8))
@@ -42,11 +43,18 @@ def label_face(rgb: np.ndarray, face: str) -> np.ndarray:
     font = ImageFont.load_default(size=size)
     draw = ImageDraw.Draw(im)
     pad = max(2, size // 4)
-    text = f"{face} ({MOKUME_LETTER[face]})" if face in MOKUME_LETTER else face
+    text = (f"{face} ({MOKUME_LETTER[face]})" if face in MOKUME_LETTER else face) + (f": {note}" if note else "")
     x0, y0, x1, y1 = draw.textbbox((pad, pad), text, font=font)
     draw.rectangle((0, 0, x1 + pad, y1 + pad), fill=(24, 24, 24))
     draw.text((pad, pad), text, fill=(255, 255, 255), font=font)
     return np.asarray(im)
+
+
+def missing_face(face: str, shape: tuple[int, int], background: int) -> np.ndarray:
+    """The slot of a face the block has no photo of (``block from-photos --partial``), ``shape``
+    (rows, cols), ``background`` grey and labelled ``back (F): no photo``: it was left blank and
+    unnamed, a hole in the cross that could be a dark face or a drawing fault."""
+    return label_face(np.full((*shape, 3), background, np.uint8), face, "no photo")
 
 
 def _face_rgb(face, layer: str) -> np.ndarray | None:
@@ -69,7 +77,8 @@ def cross_image(block: Block, layer: Layer = "photo", *, traces: bool = True,
         Face photos, ring maps, or both crosses stacked (photos above).
     traces : bool
         Draw the traced rings, coloured by year (white when unlabelled).
-        Each face present is named at its top-left corner (:func:`label_face`).
+        Each face is named at its top-left corner (:func:`label_face`), a missing one as such
+        (:func:`missing_face`).
     px_per_mm : float, optional
         Picture density; default the densest face's. Faces at another density are resampled.
     background : int
@@ -107,7 +116,7 @@ def cross_image(block: Block, layer: Layer = "photo", *, traces: bool = True,
                 xy = ((t.points_px[:, ::-1] + 0.5) * (sc, sr)).ravel().tolist()
                 col = (255, 255, 255) if t.year is None else tuple(int(v) for v in _PALETTE[t.year % len(_PALETTE)])
                 draw.line(xy, fill=col, width=line_width)
-        images[name] = label_face(np.asarray(im), name) if face is not None else np.asarray(im)
+        images[name] = label_face(np.asarray(im), name) if face is not None else missing_face(name, shape, background)
     return unfold_cross(images, block.size_mm, background=background)
 
 

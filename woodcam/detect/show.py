@@ -6,7 +6,8 @@ Drawn on each photo: the ring traces (red; pieces the detector linked into one r
 ``RingTrace.ring``, share one of :data:`RING_RGBS`, neighbouring ids differ, so a wrong link
 shows as a colour jumping between lines), the knot masks' outlines (yellow) and, when a
 reference ring map is given (e.g. Mokume's U-Net map), its ridge (cyan dots); the face's name
-and Mokume letter at its top-left corner (:func:`woodcam.block.render.label_face`).
+and Mokume letter at its top-left corner (:func:`woodcam.block.render.label_face`); a face the
+block has no photo of is a labelled blank (``back (F): no photo``).
 """
 
 from __future__ import annotations
@@ -70,6 +71,12 @@ def rings_picture(block, zoom: int = 2, references: dict | None = None) -> np.nd
     # was a MemoryError traceback)
     px = 12 * max(f.shape[0] * f.shape[1] for f in block.faces.values()) * float(zoom) ** 2
     check_limit("MAX_IMAGE_PIXELS", px, f"the picture at --zoom {zoom}", fix="lower --zoom")
+    from ..block.render import missing_face
+    from ..frames import FACES, CrossLayout, face_image_size_mm
+
     refs = references or {}
     images = {n: face_picture(f, zoom, refs.get(n)) for n, f in block.faces.items()}
+    first, im = next(iter(images.items()))
+    layout = CrossLayout(block.size_mm, im.shape[1] / face_image_size_mm(first, block.size_mm)[1])
+    images.update({n: missing_face(n, layout.face_shape(n), 24) for n in FACES if n not in images})
     return unfold_cross(images, block.size_mm, background=24)
