@@ -259,7 +259,8 @@ def test_a_block_name_that_is_a_path_is_refused_before_it_names_a_file(tmp_path,
 def test_rings_show_and_block_show_name_each_face():
     """'rings show' and 'block show' drew six photos in a cross with no word of which face was
     which (the user had to work it out from docs/conventions.md): each face present now carries
-    its name and Mokume letter at its top-left corner, and an absent face's slot stays empty."""
+    its name and Mokume letter at its top-left corner, and an absent face's slot its name and
+    'no photo' (it was an empty hole)."""
     from woodcam.block import Block, Face
     from woodcam.block.render import cross_image
     from woodcam.detect.show import rings_picture
@@ -276,7 +277,12 @@ def test_rings_show_and_block_show_name_each_face():
             corners[f] = corner
         for f in FACES:
             if f == "back":
-                assert np.ptp(corners[f]) == 0, "an absent face is not labelled"
+                from woodcam.block.render import missing_face
+
+                r, c = layout.origin[f]
+                h, w = layout.face_shape(f)
+                assert np.array_equal(pic[r:r + h, c:c + w], missing_face(f, (h, w), 24)), "absent: 'no photo'"
+                assert (corners[f] > 200).all(axis=2).any(), "an absent face is labelled"
                 continue
             assert (corners[f] > 200).all(axis=2).any(), f"face {f!r} has no white label"
             assert (corners[f] < 40).all(axis=2).any(), f"face {f!r} has no dark label box"
