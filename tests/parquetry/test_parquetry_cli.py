@@ -183,6 +183,11 @@ def test_a_malformed_veneer_is_a_usage_error_before_any_work(scans, capsys, valu
                           "2^n_adaptive = 14 * 2^5 = 448 mm, must fit the panel's shorter side, 364 mm (26 patches: "
                           "image_size_mm 360 in whole patches); got 5; use --n-adaptive 4 or less"),
     ("--n-adaptive", "32", "must be in [0, 4] here"),
+    # named the job file's parameter alone and gave no fix ('overlap_mm must be in [0, (patch_mm -
+    # min_piece_mm) / 2 = 4.5] so fragments stay >= min_piece_mm wide; got 5')
+    ("--overlap-mm", "5", "overlap_mm (--overlap-mm) must be in [0, (patch_mm - min_piece_mm) / 2 = (14 - 5) / 2 "
+                          "= 4.5] mm so every piece stays >= min_piece_mm wide; got 5 mm; use --overlap-mm 4.5 or "
+                          "less, a larger --patch-mm or a smaller --min-piece-mm"),
 ])
 def test_a_table_1_parameter_out_of_range_is_a_usage_error_naming_the_option(scans, capsys, option, value, said):
     """Sweep h6: these exited 1 (a failed work, where the README's exit statuses give 2 for a wrong

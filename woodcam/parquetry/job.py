@@ -182,9 +182,11 @@ class ParquetryParams:
                 "--image-size-mm")
         o = self.overlap
         if o < 0 or 2 * o > self.patch_mm - self.min_piece_mm + 1e-9:
+            most = (self.patch_mm - self.min_piece_mm) / 2
             raise WoodcamError(
-                f"overlap_mm must be in [0, (patch_mm - min_piece_mm) / 2 = "
-                f"{(self.patch_mm - self.min_piece_mm) / 2:g}] so fragments stay >= min_piece_mm wide; got {o:g}")
+                f"overlap_mm (--overlap-mm) must be in [0, (patch_mm - min_piece_mm) / 2 = ({self.patch_mm:g} - "
+                f"{self.min_piece_mm:g}) / 2 = {most:g}] mm so every piece stays >= min_piece_mm wide; got {o:g} mm; "
+                f"use --overlap-mm {most:g} or less, a larger --patch-mm or a smaller --min-piece-mm")
         return self
 
     @property
