@@ -807,3 +807,29 @@ def test_a_block_reaching_past_the_grown_object_is_warned_of(tmp_path, capsys):
     for within in ([], ["--block-size", "10x10x10"]):
         assert main([*base, *within]) == 0
         assert "past the grown object's box" not in capsys.readouterr().err
+
+
+def test_degenerate_and_twice_written_triangles_are_dropped_as_bake_drops_them(tmp_path, capsys):
+    """A closed box STL with a zero-length sliver (a corner written twice, which welding
+    collapses to a triangle with a repeated vertex) or with one triangle written twice was
+    refused as 'must be watertight ... open or non-manifold edges; repair it first (e.g.
+    trimesh.repair.fill_holes ...)', while ``woodcam bake`` carves both (it drops those
+    triangles): woodify drops them too, the copy with bake's warning, and grows the box."""
+    box = trimesh.creation.box((40.0, 30.0, 20.0))
+    sliver = trimesh.Trimesh(np.vstack([box.vertices, box.vertices[:1]]),
+                             np.vstack([box.faces, [[0, 8, 1]]]), process=False)
+    twice = trimesh.Trimesh(box.vertices, np.vstack([box.faces, box.faces[:1]]), process=False)
+    fields = {}
+    for name, mesh in (("box", box), ("sliver", sliver), ("twice", twice)):
+        mesh.export(tmp_path / f"{name}.stl")
+        assert main(["woodify", str(tmp_path / f"{name}.stl"), "--years", "3", "--resolution", "16",
+                     "--cracks", "none", "--out", str(tmp_path / name)]) == 0, capsys.readouterr().err
+        err = capsys.readouterr().err
+        dup = [line for line in err.splitlines() if "duplicate triangles" in line]
+        assert dup == ([f"woodcam: warning: part {str(tmp_path / 'twice.stl')!r} has 1 duplicate triangles "
+                        "(the same three corners twice); woodcam dropped the copies (the solid is unchanged)"]
+                       if name == "twice" else []), err
+        with np.load(tmp_path / name / "field.npz") as z:
+            fields[name] = z["arrival_mm"].copy()
+    # the same solid grows the same wood, to the last bit
+    assert np.array_equal(fields["sliver"], fields["box"]) and np.array_equal(fields["twice"], fields["box"])

@@ -446,6 +446,40 @@ def _manifold_from_scene(scene, origin: str):
     return _union([_manifold_from_trimesh(m, origin) for m in meshes], origin)
 
 
+def drop_degenerate_faces(welded, origin: str, *, stacklevel: int = 3) -> np.ndarray:
+    """Drop from ``welded`` (a trimesh whose vertices are welded by position), in place, the
+    triangles that enclose nothing: those with a repeated corner and the copies of a triangle
+    written more than once (warned of, naming ``origin``). Returns the mask of the triangles
+    kept, ``(f,) bool`` over the triangles given (their order is kept), so that a textured copy
+    of the same triangles can drop the same ones.
+
+    Welding collapses the fans at B-rep poles (a sphere's degenerate edges) and an exporter's
+    zero-length slivers into triangles with a repeated vertex, whose edges are then used three
+    or four times; a triangle written twice (some exporters do) leaves its edges used four
+    times. Either was refused as open or non-manifold edges, with no word of the cause. The
+    one cleaning of a welded mesh: ``woodcam bake`` (:func:`load_part`) and ``woodcam woodify``
+    read a mesh file through it."""
+    f = np.asarray(welded.faces)
+    kept = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
+    if not kept.all():
+        welded.update_faces(kept)
+        welded.remove_unreferenced_vertices()
+    unique = welded.unique_faces()
+    if not unique.all():
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        warnings.warn(WoodcamWarning(
+            f"{origin} has {int(np.count_nonzero(~unique))} duplicate triangles (the same three "
+            "corners twice); woodcam dropped the copies (the solid is unchanged)"),
+            stacklevel=stacklevel)
+        welded.update_faces(unique)
+        welded.remove_unreferenced_vertices()
+        kept[np.flatnonzero(kept)[~unique]] = False
+    return kept
+
+
 def _manifold_from_trimesh(mesh, origin: str):
     """Weld, repair if needed (fill holes, fix normals) and convert a trimesh to a manifold."""
     import trimesh
@@ -461,27 +495,7 @@ def _manifold_from_trimesh(mesh, origin: str):
     # Fresh mesh without visuals: processing welds vertices by position only (UV/normal seams
     # in OBJ/GLB would otherwise split the surface) and drops degenerate faces.
     welded = trimesh.Trimesh(vertices=vertices, faces=faces, process=True)
-    # Welding collapses the fans at B-rep poles (a sphere's degenerate edges) into triangles
-    # with a repeated vertex; drop them so the edges they shared close up.
-    f = welded.faces
-    keep = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
-    if not keep.all():
-        welded.update_faces(keep)
-        welded.remove_unreferenced_vertices()
-    unique = welded.unique_faces()
-    if not unique.all():
-        # a triangle written twice (some exporters do) leaves its edges used four times:
-        # refused as '8 open or non-manifold edges' before, with no word of the cause
-        import warnings
-
-        from ..errors import WoodcamWarning
-
-        warnings.warn(WoodcamWarning(
-            f"{origin} has {int(np.count_nonzero(~unique))} duplicate triangles (the same three "
-            "corners twice); woodcam dropped the copies (the solid is unchanged)"),
-            stacklevel=3)
-        welded.update_faces(unique)
-        welded.remove_unreferenced_vertices()
+    drop_degenerate_faces(welded, origin, stacklevel=4)
     if not welded.is_watertight:
         # Closed by flat fans, one per hole, and said so: trimesh's fill_holes turned a box
         # missing one side into an 833 mm^3 solid instead of 1000 without a word (issue 15).

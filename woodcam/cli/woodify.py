@@ -134,7 +134,10 @@ def _load_mesh(path: str, what: str = "part"):
                     f"{what} {path!r} carries growth attributes per vertex, so it must be watertight "
                     "as stored (shared vertices), without merging; weld its vertices first")
             return loaded, None, paint
-        geom = _welded_closed(loaded, f"{what} {path!r}")
+        geom, kept = _welded_closed(loaded, f"{what} {path!r}", kept=True)
+        if textured is not None and not kept.all():  # its picture on the triangles that grow
+            textured = textured.copy()
+            textured.update_faces(kept)
         if textured is not None and len(geom.faces) != len(textured.faces):
             textured = None
         return geom, textured, {}
@@ -144,19 +147,26 @@ def _load_mesh(path: str, what: str = "part"):
     return manifold_to_trimesh(load_part(path), process=True), None, {}
 
 
-def _welded_closed(mesh, name: str, fix: str | None = None):
-    """``mesh`` welded (by position, texture and normal seams too) as the growth reads it,
-    refused unless closed (the growth's own check_watertight) with ``name`` (the option and
-    the file): the growth said 'obstacles[0] must be watertight' of an open --obstacle, and
-    'mesh ...' of the part, naming neither. The one check of a file's meshes, one or several;
-    ``fix`` replaces the growth's repair hint where the caller knows the cause."""
+def _welded_closed(mesh, name: str, fix: str | None = None, *, kept: bool = False):
+    """``mesh`` welded (by position, texture and normal seams too) as the growth reads it, its
+    triangles that enclose nothing dropped as ``woodcam bake`` drops them
+    (:func:`woodcam.cad.parts.drop_degenerate_faces`: a repeated corner, a triangle written
+    twice, which were refused as open edges), refused unless closed (the growth's own
+    check_watertight) with ``name`` (the option and the file): the growth said 'obstacles[0]
+    must be watertight' of an open --obstacle, and 'mesh ...' of the part, naming neither. The
+    one check of a file's meshes, one or several; ``fix`` replaces the growth's repair hint
+    where the caller knows the cause. ``kept``: also return the mask ``(f,) bool`` of
+    ``mesh``'s triangles kept."""
     import trimesh
 
+    from ..cad.parts import drop_degenerate_faces
     from ..woodify.front import check_watertight
 
     geom = trimesh.Trimesh(mesh.vertices, mesh.faces, process=True)
     geom.merge_vertices(merge_tex=True, merge_norm=True)
-    return check_watertight(geom, name, fix=fix)
+    mask = drop_degenerate_faces(geom, name, stacklevel=5)
+    closed = check_watertight(geom, name, fix=fix)
+    return (closed, mask) if kept else closed
 
 
 def _check_mesh_values(mesh, path: str, what: str) -> None:
