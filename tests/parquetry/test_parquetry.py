@@ -234,7 +234,7 @@ def test_seams_are_6_connected_and_in_their_bands(finished):
 def test_cut_files_escape_names_and_place_labels_as_the_svg(tmp_path):
     """A veneer named oak&ash<1> made an SVG title no XML reader accepts; the DXF's ids sat
     left-aligned on the inner point (the SVG centres them 1 mm lower) and its header extents
-    stayed at +-1e20."""
+    stayed at +-1e20; its TOOLPATH and ENGRAVE layers were not in the LAYER table."""
     import xml.etree.ElementTree as ET
 
     import ezdxf
@@ -255,6 +255,9 @@ def test_cut_files_escape_names_and_place_labels_as_the_svg(tmp_path):
     c = Polygon([s[1] for s in sq]).representative_point()
     assert (float(text.get("x")), float(text.get("y"))) == pytest.approx((c.x, c.y + 1.0), abs=1e-3)
     assert tuple(label.dxf.align_point)[:2] == pytest.approx((c.x, 40 - (c.y + 1.0)), abs=1e-6)  # y up
+    # TOOLPATH and ENGRAVE were used by the entities but missing from the LAYER table
+    used = {e.dxf.layer for e in dxf.modelspace()}
+    assert used == {"PIECE_7", "TOOLPATH", "ENGRAVE"} and used <= {layer.dxf.name for layer in dxf.layers}
     lo, hi = dxf.header["$EXTMIN"], dxf.header["$EXTMAX"]
     assert lo[0] == pytest.approx(9.0, abs=0.1) and hi[0] == pytest.approx(41.0, abs=0.1)  # the tool path
     assert lo[1] == pytest.approx(9.0, abs=0.1) and hi[1] == pytest.approx(31.0, abs=0.1)

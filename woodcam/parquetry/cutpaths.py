@@ -385,6 +385,10 @@ def write_dxf(path, height_mm: float, pieces: list[tuple[int, list]], tool_radiu
     def fl(q):
         return (float(q[0]), float(height_mm - q[1]))
 
+    # every layer the entities name is in the LAYER table (AUDIT in CAD programs reports the
+    # missing ones): the pieces' below, TOOLPATH and ENGRAVE here
+    for name in (["TOOLPATH"] if tool_radius_mm > 0 else []) + (["ENGRAVE"] if pieces else []):
+        doc.layers.add(name)
     for pid, segs in pieces:
         layer = f"PIECE_{pid}"
         doc.layers.add(layer)
