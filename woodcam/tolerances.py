@@ -321,6 +321,16 @@ PARQUETRY_CURVATURE_SLACK = 0.98
 #: of the pixels unsampled for two to three times the difference.
 PARQUETRY_SUPERSAMPLE_TOL = 0.01
 
+#: Histogram matching (eq. 2, ``woodcam.parquetry.features.match_histogram``): target grey
+#: levels that differ by at most this are one level and share one quantile. Resampling a target
+#: to the panel in float32 (``cv2.resize``) and its grey mix leave a flat area a few float32
+#: ulps apart (a flat 200/255 background: 0.78431356 to 0.7843139, 3e-7), and ranking those as
+#: distinct levels spread the flat area over a fifth of the wood's histogram in a fine grid
+#: pattern (std 0.058). Half the finest step an image file stores (1/65535, 16-bit): distinct
+#: levels of any 8- or 16-bit target stay distinct, and only a ramp rising less than this per
+#: pixel is read as flat (a 16-bit ramp of 0.004 over 1000 pixels, below one 8-bit step).
+PARQUETRY_GREY_LEVEL_TOL = 2.0 ** -17
+
 #: Evidence-based choice of a fit (``woodcam.inference.evidence``, issue 12 part 1).
 #: A face takes part in leave-one-face-out only with at least this many ring points: fewer
 #: (a face crossed by one short ring) scores by chance.

@@ -1351,3 +1351,34 @@ def test_flatten_gives_the_per_curve_loops_points_bit_for_bit():
                 want, got = loop(segs, n), flatten(segs, n)
                 assert got.dtype == want.dtype and got.shape == want.shape
                 assert np.array_equal(got, want)
+
+
+def test_a_flat_target_area_stays_flat_after_histogram_matching():
+    """A flat 200/255 background round a dark disc, resampled to the panel (cv2.resize in
+    float32), came out a few float32 ulps apart (0.78431356 to 0.7843139); eq. 2 ranked those
+    as distinct grey levels, and the flat area was matched to a fine grid pattern spread over a
+    fifth of the wood's histogram (std 0.058, 0.575 to 0.791; a 1 x 1 px target to five levels
+    of stripes). Levels within the tolerance are one level, which keeps one quantile."""
+    from woodcam.parquetry.engine import prepare_target
+    from woodcam.parquetry.features import match_histogram
+    from woodcam.tolerances import PARQUETRY_GREY_LEVEL_TOL
+
+    yy, xx = np.mgrid[:300, :300]
+    img = np.full((300, 300, 3), 200 / 255, np.float32)
+    img[(yy - 150) ** 2 + (xx - 150) ** 2 < 60 ** 2] = 30 / 255
+    wood = np.random.default_rng(0).uniform(0.3, 0.8, 100_000).astype(np.float32)
+    t = prepare_target(img, ParquetryParams(image_size_mm=84, px_per_mm=4).check(), wood)
+    h, w = t.matched.shape
+    y, x = np.mgrid[:h, :w]
+    far = (y - h / 2) ** 2 + (x - w / 2) ** 2 > (0.3 * h) ** 2  # away from the disc's edge
+    assert np.ptp(t.target_rgb[far]) < 1e-6  # flat, to float32 noise
+    assert np.ptp(t.matched[far]) < 1e-6  # the noise (1 - w_hist) carries, not the wood's spread
+    dark = (y - h / 2) ** 2 + (x - w / 2) ** 2 < (0.15 * h) ** 2
+    assert np.ptp(t.matched[dark]) < 1e-6 and t.matched[dark][0] < t.matched[far][0]
+    # levels a 16-bit image tells apart stay apart; exactly equal ones share their mean rank
+    step = np.float32(1 / 65535)
+    g = np.array([0.5, 0.5 + step, 0.5 + 2 * step, 0.5, 0.5 + 2 * step], np.float32)
+    assert step > PARQUETRY_GREY_LEVEL_TOL
+    m = match_histogram(g, np.linspace(0, 1, 1001, dtype=np.float32), 1.0)
+    assert m[0] == m[3] and m[2] == m[4] and m[0] < m[1] < m[2]
+    assert m[1] == pytest.approx(0.5, abs=1e-3) and m[0] == pytest.approx(0.2, abs=1e-3)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import WoodcamError
+from ..tolerances import PARQUETRY_GREY_LEVEL_TOL
 
 #: Rec. 601 luma weights: the intensity filter F_intens of eq. 1 (the paper's code uses
 #: OpenCV's grey conversion, which is the same).
@@ -61,12 +62,16 @@ def match_histogram(target_grey, source_values, w_hist: float) -> np.ndarray:
         raise WoodcamError("histogram matching needs at least one usable veneer pixel; got none")
     flat = t.ravel()
     order = np.argsort(flat, kind="stable")
-    ranks = np.empty_like(order)
-    ranks[order] = np.arange(flat.size)
-    # Equal grey levels share one quantile (their mean rank), so flat areas stay flat.
-    _uniq, inv = np.unique(flat, return_inverse=True)
-    mean_rank = np.bincount(inv, weights=ranks) / np.bincount(inv)
-    q = (mean_rank[inv] + 0.5) / flat.size
+    # Equal grey levels share one quantile (their mean rank), so flat areas stay flat; levels
+    # within PARQUETRY_GREY_LEVEL_TOL of the one before are equal (a resampled flat area is a
+    # few float32 ulps apart, and ranked apart it became a grid pattern of a fifth of the wood's
+    # histogram). Sorted levels that many ranks run in one level: its mean rank is the middle.
+    level = np.concatenate([[0], np.cumsum(np.diff(flat[order]) > PARQUETRY_GREY_LEVEL_TOL)])
+    count = np.bincount(level)
+    first = np.concatenate([[0], np.cumsum(count)[:-1]])
+    inv = np.empty_like(level)
+    inv[order] = level
+    q = (first[inv] + (count[inv] - 1) / 2.0 + 0.5) / flat.size
     eq = np.interp(q, (np.arange(s.size) + 0.5) / s.size, s).astype(np.float32)
     return ((1.0 - w_hist) * flat + w_hist * eq).reshape(t.shape).astype(np.float32)
 
