@@ -82,7 +82,17 @@ PHOTO_ALPHA_FIX = ("a cut-out?", "crop the image so every pixel is opaque, or fl
 
 
 def read_image_file(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_ALPHA_FIX):
-    """An image file decoded as every viewer shows it (its format told by its content, not its
+    """An image file decoded as every viewer shows it (:func:`read_image_file_opacity` without
+    its opacity: transparent pixels are warned of with ``alpha_fix``)."""
+    return read_image_file_opacity(path, what, alpha_fix)[0]
+
+
+def read_image_file_opacity(path: Path, what: str, alpha_fix: tuple[str, str] | None = PHOTO_ALPHA_FIX):
+    """``(image, opaque)``: ``opaque`` is ``(h, w) bool``, True where a pixel is fully opaque,
+    or None for an image without transparency; ``alpha_fix`` None: the caller uses ``opaque``,
+    so transparent pixels are not warned of.
+
+    An image file decoded as every viewer shows it (its format told by its content, not its
     name), turned by its EXIF orientation tag (a phone stores a portrait photo as landscape
     pixels plus that tag: read raw it lies on its side, a face's rings turned 90 degrees) and
     converted to sRGB from the ICC profile it carries (:func:`_in_srgb`):
@@ -140,10 +150,11 @@ def read_image_file(path: Path, what: str, alpha_fix: tuple[str, str] = PHOTO_AL
                 # in place: a copy of an upright 48 MP photo (PIL's 4 bytes a pixel, 190 MB) made
                 # for nothing raised a read's peak by a third
                 ImageOps.exif_transpose(im, in_place=True)
-                image = _image_array(_in_srgb(im, f"{what}: {str(path)!r}"), f"{what}: {str(path)!r}", alpha_fix)
+                image, opaque = _image_array(_in_srgb(im, f"{what}: {str(path)!r}"), f"{what}: {str(path)!r}",
+                                             alpha_fix)
                 fmt = im.format
         _say_pil_warnings(said, f"{what}: {str(path)!r}", fmt, orientation, unread)
-        return image
+        return image, opaque
     except WoodcamError:
         raise
     except (Image.DecompressionBombError, Image.DecompressionBombWarning) as err:  # over the cap
@@ -249,13 +260,15 @@ def photo_rgb8(a):
     return a[..., :3].astype(np.uint8, copy=False)
 
 
-def _image_array(im, where: str, alpha_fix: tuple[str, str] = PHOTO_ALPHA_FIX):
-    """A decoded PIL image as uint8 (8-bit modes) or uint16 (16-bit modes, values kept);
-    ``where`` (what and the file) starts the message of an image that cannot be."""
+def _image_array(im, where: str, alpha_fix: tuple[str, str] | None = PHOTO_ALPHA_FIX):
+    """A decoded PIL image as uint8 (8-bit modes) or uint16 (16-bit modes, values kept), and
+    its opacity (:func:`_opacity`); ``where`` (what and the file) starts the message of an image
+    that cannot be."""
     import numpy as np
 
-    share = _transparent_share(im)
-    if share:  # the alpha was dropped without a word: a cut-out's background read as wood
+    opaque = _opacity(im)
+    share = 0.0 if opaque is None else 1.0 - float(np.mean(opaque))
+    if share and alpha_fix is not None:  # the alpha was dropped without a word: a cut-out's background read as wood
         import warnings
 
         from .errors import WoodcamWarning
@@ -264,13 +277,13 @@ def _image_array(im, where: str, alpha_fix: tuple[str, str] = PHOTO_ALPHA_FIX):
                       f"the colour stored under them, the transparency dropped; {alpha_fix[1]}",
                       WoodcamWarning, stacklevel=3)
     if im.mode in ("I;16", "I;16B", "I;16L", "I;16N"):
-        return np.asarray(im).astype(np.uint16)
+        return np.asarray(im).astype(np.uint16), opaque
     if im.mode == "I":
         a = np.asarray(im)
         if a.size and (a.min() < 0 or a.max() > 65535):
             raise WoodcamError(f"{where} is a 32-bit integer image with values outside 0..65535 "
                                f"({a.min()}..{a.max()}); save it as 8- or 16-bit")
-        return a.astype(np.uint16)
+        return a.astype(np.uint16), opaque
     if im.mode in ("RGB;16", "RGBA;16") or im.mode.startswith(("F", "RGBa")):
         kind = " (floating point)" if im.mode.startswith("F") else ""
         raise WoodcamError(f"{where} has image mode {im.mode}{kind}, which is not supported; save it as an "
@@ -278,21 +291,20 @@ def _image_array(im, where: str, alpha_fix: tuple[str, str] = PHOTO_ALPHA_FIX):
     if im.mode not in ("L", "RGB"):
         im = im.convert("RGB" if im.mode in ("P", "RGBA", "CMYK", "YCbCr", "LAB", "HSV", "PA")
                         else "L")
-    return np.asarray(im)
+    return np.asarray(im), opaque
 
 
-def _transparent_share(im) -> float:
-    """The share of a PIL image's pixels not fully opaque (alpha < 255): 0 for modes without
-    alpha or a transparent colour."""
+def _opacity(im):
+    """``(h, w) bool``, True where a PIL image's pixel is fully opaque (alpha 255), or None for
+    modes without alpha or a transparent colour."""
     import numpy as np
 
     if im.mode in ("RGBA", "LA", "PA"):
         alpha = im.getchannel("A")
     elif "transparency" in im.info and im.mode.startswith("I;16"):  # a 16-bit grey's colour key
-        return float(np.mean(np.asarray(im) == im.info["transparency"]))
+        return np.asarray(im) != im.info["transparency"]
     elif "transparency" in im.info and im.mode in ("P", "L", "RGB"):  # a palette or colour key
         alpha = im.convert("RGBA").getchannel("A")
     else:
-        return 0.0
-    hist = alpha.histogram()
-    return 1.0 - hist[255] / sum(hist)
+        return None
+    return np.asarray(alpha) == 255

@@ -1285,7 +1285,8 @@ def test_preparing_the_rotated_sheets_has_a_bar(sheets, monkeypatch):
 def test_transparent_pixels_are_named_with_the_fix_for_what_the_image_is_for(tmp_path):
     """The alpha warning assumed a photo ('a cut-out? crop the image') for parquetry masks and
     target logos too, and a 16-bit grey PNG's transparent colour was dropped without a word.
-    A mask: paint unusable wood black; a target: flatten it onto the background wanted."""
+    A mask: paint unusable wood black; a target: flatten it onto the background wanted; a scan's
+    are no usable wood."""
     from PIL import Image
 
     from woodcam.parquetry.job import ParquetryJob, job_targets
@@ -1306,9 +1307,9 @@ def test_transparent_pixels_are_named_with_the_fix_for_what_the_image_is_for(tmp
     grey = np.full((20, 20), 30000, np.uint16)
     grey[:2] = 0
     Image.fromarray(grey).save(tmp_path / "grey16.png", transparency=0)
-    with pytest.warns(WoodcamWarning, match=r"veneer scan: .*grey16.png' has transparent pixels \(10 % of them, "
-                      r"a cut-out\?\), .*; crop the image so every pixel is opaque"):
-        load_scan(tmp_path / "grey16.png", dpi=100)
+    # a scan's transparent pixels (here its transparent colour) are no usable wood, not warned of
+    # (test_a_cut_out_scans_transparent_pixels_are_no_usable_wood)
+    assert np.array_equal(load_scan(tmp_path / "grey16.png", dpi=100).mask, grey != 0)
 
 
 def test_adaptive_levels_are_bounded_by_the_panel():
@@ -1382,3 +1383,28 @@ def test_a_flat_target_area_stays_flat_after_histogram_matching():
     m = match_histogram(g, np.linspace(0, 1, 1001, dtype=np.float32), 1.0)
     assert m[0] == m[3] and m[2] == m[4] and m[0] < m[1] < m[2]
     assert m[1] == pytest.approx(0.5, abs=1e-3) and m[0] == pytest.approx(0.2, abs=1e-3)
+
+
+def test_a_cut_out_scans_transparent_pixels_are_no_usable_wood(tmp_path):
+    """A veneer scan saved as a cut-out (its background transparent) was read as the colour
+    stored under the transparency, with a warning to flatten it onto its background: its
+    background was usable wood, and 4 of 16 pieces of a run were cut from it. Its pixels that
+    are not fully opaque are now no usable wood, with or without a mask (which they narrow)."""
+    from PIL import Image
+
+    from woodcam.parquetry import load_scan
+
+    rgb = (np.random.default_rng(0).random((120, 160, 3)) * 255).astype(np.uint8)
+    alpha = np.full((120, 160), 255, np.uint8)
+    alpha[:, :50] = 0  # the background
+    alpha[:10, 50:] = 128  # a soft edge: not wood either
+    Image.fromarray(np.dstack([rgb, alpha])).save(tmp_path / "cut.png")
+    want = alpha == 255
+    v = load_scan(tmp_path / "cut.png", px_per_mm=2)  # no warning (filterwarnings = error)
+    assert v.mask.shape == want.shape and np.array_equal(v.mask, want)
+    assert np.array_equal(v.rgb, rgb.astype(np.float32) / 255)  # the colours as stored
+    mask = np.ones((120, 160), bool)
+    mask[100:] = False
+    assert np.array_equal(load_scan(tmp_path / "cut.png", px_per_mm=2, mask=mask).mask, want & mask)
+    Image.fromarray(np.dstack([rgb, np.full((120, 160), 255, np.uint8)])).save(tmp_path / "opaque.png")
+    assert load_scan(tmp_path / "opaque.png", px_per_mm=2).mask.all()

@@ -23,7 +23,7 @@ from typing import Literal, Protocol
 import numpy as np
 
 from .._checks import as_floats, check_bool, check_number, check_path, check_vector
-from .._readers import PHOTO_ALPHA_FIX, read_photo_rgb
+from .._readers import PHOTO_ALPHA_FIX, photo_rgb8, read_image_file_opacity, read_photo_rgb
 from ..errors import WoodcamError
 from ..fields.base import rings_crossed
 
@@ -182,7 +182,11 @@ MASK_ALPHA_FIX = ("transparency does not mark wood as unusable",
 def read_image(path, what: str = "image", alpha_fix: tuple[str, str] = PHOTO_ALPHA_FIX) -> np.ndarray:
     """Read an image file as ``(h, w, 3)`` float32 RGB in [0, 1] (grey is repeated), upright as
     its EXIF orientation says (:func:`woodcam._readers.read_photo_rgb`; ``alpha_fix`` as there)."""
-    rgb8 = read_photo_rgb(Path(path), what, alpha_fix)
+    return _float_rgb(read_photo_rgb(Path(path), what, alpha_fix))
+
+
+def _float_rgb(rgb8: np.ndarray) -> np.ndarray:
+    """``(h, w, 3)`` uint8 as float32 in [0, 1]."""
     # one pass into one float array: astype then / 255 made two (a 100 Mpx target peaked at
     # 2.4 GB and spent 10 s there); float32 arithmetic both ways, so the same values
     out = np.empty(rgb8.shape, np.float32)
@@ -222,7 +226,8 @@ def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | 
     dpi, px_per_mm : float
         Scan resolution; exactly one of them (``px_per_mm = dpi / 25.4``).
     mask : image file or ``(h, w)`` bool array, optional
-        Usable wood (white / True); must have the scan's size. Default: the whole sheet.
+        Usable wood (white / True); must have the scan's size. Default: the whole sheet. A
+        scan's pixels that are not fully opaque (a cut-out's background) are never usable wood.
     id : str, optional
         Default: the file's stem.
     """
@@ -232,7 +237,10 @@ def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | 
                            f"dpi={dpi}, px_per_mm={px_per_mm} (e.g. SCAN.png:300 for 300 dpi)")
     ppm = (check_number(px_per_mm, "px_per_mm", lo=0, lo_open=True, fix="e.g. 11.8 (300 dpi)") if px_per_mm is not None
            else check_number(dpi, "dpi", lo=0, lo_open=True, fix="the scan's resolution, e.g. 300") / MM_PER_INCH)
-    rgb = read_image(path, "veneer scan")
+    # a cut-out scan's transparent pixels are no wood (its background): they were read as the
+    # colour stored under them, and pieces were cut from them
+    image, opaque = read_image_file_opacity(path, "veneer scan", None)
+    rgb = _float_rgb(photo_rgb8(image))
     if mask is None:
         m = np.ones(rgb.shape[:2], bool)
     elif isinstance(mask, (np.ndarray, list)):
@@ -247,6 +255,8 @@ def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | 
         # image (12 bytes a pixel) of a scan-sized mask was made only to be thresholded
         m = read_photo_rgb(check_path(mask, "load_scan: mask", fix="an image file or an (h, w) bool array"),
                            "veneer mask", MASK_ALPHA_FIX).sum(axis=2, dtype=np.uint16) > 382
+    if opaque is not None and m.shape == opaque.shape:  # a mask of another size: _check says so
+        m = m & opaque
     return _check(Veneer(id or Path(path).stem, rgb, ppm, m, str(path)))
 
 
