@@ -55,6 +55,13 @@ def test_cli_run_writes_everything(scans, capsys):
     assert "panel.png" not in help_
     result = json.loads((out / "result.json").read_text())
     assert result["summary"]["complete"] and len(result["patches"]) == 6 * 4
+    # the time per patch was wall seconds alone ('0.107 s per patch'), beside the README's and the
+    # bench's figures in CPU seconds; both are said, and stored
+    summ = result["summary"]
+    assert summ["cpu_seconds_per_patch"] == round(summ["match_cpu_seconds"] / 24, 4)
+    (said,) = [line for line in text.splitlines() if line.startswith("matching: ")]
+    assert said == (f"matching: {summ['match_seconds']:.1f} s wall, {summ['match_cpu_seconds']:.1f} CPU-s; per patch "
+                    f"{summ['seconds_per_patch']:.3f} s wall, {summ['cpu_seconds_per_patch']:.3f} CPU-s")
     # the job file written reruns the same job
     job = json.loads((out / "job.json").read_text())
     assert job["num_source_rotations"] == 15 and len(job["source_textures"]) == 2
