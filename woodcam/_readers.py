@@ -20,7 +20,7 @@ from typing import Any
 
 from .errors import WoodcamError
 
-__all__ = ["photo_rgb8", "read_image_file", "read_json_file", "read_json_object", "read_npz", "read_photo_rgb",
+__all__ = ["photo_rgb8", "read_image_file", "read_image_file_opacity", "read_json_file", "read_json_object", "read_npz", "read_photo_rgb",
            "strict_json_loads"]
 
 
