@@ -178,7 +178,7 @@ def _image_case(base, data):
         folder = Path(d) / "b"
         shutil.copytree(base, folder)
         png = folder / target
-        how = data.draw(st.sampled_from(["truncate", "flip", "random", "mode"]))
+        how = data.draw(st.sampled_from(["mode", "truncate", "flip", "random"]))  # a fresh image first: the valid half
         raw = png.read_bytes()
         if how == "truncate":
             png.write_bytes(raw[: data.draw(st.integers(0, len(raw)))])
