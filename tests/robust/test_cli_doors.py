@@ -364,6 +364,80 @@ def test_a_command_whose_parent_ignored_ctrl_c_runs_on_through_it():
     assert "interrupted" not in done.stderr
 
 
+def _run_as_the_process(tmp_path, body: str, command: str = "    return 0\n"):
+    """Run ``woodcam blocks`` as ``python -m`` runs it (the process's own command) with
+    ``command`` in place of the blocks listing, then ``body`` (which ends the module); returns
+    (exit status, stdout, stderr)."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    (tmp_path / "ctrl_c_case.py").write_text(
+        "import atexit, os, signal, sys, threading, time\n"
+        "import woodcam.cli.bake as bake_cli\n"
+        "from woodcam.cli import main\n"
+        "def command(args):\n"
+        "    print('output')\n"
+        f"{command}"
+        "bake_cli.run_blocks = command\n"
+        "sys.argv = ['woodcam', 'blocks']\n"
+        f"{body}")
+    repo = Path(__file__).resolve().parents[2]
+    env = dict(os.environ, PYTHONPATH=f"{repo}{os.pathsep}{tmp_path}")
+    done = subprocess.run([sys.executable, "-m", "ctrl_c_case"], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=120)
+    return done.returncode, done.stdout, done.stderr
+
+
+_CTRL_C = "os.kill(os.getpid(), signal.SIGINT); time.sleep(2)"
+
+
+def test_ctrl_c_inside_code_run_from_a_string_is_an_interrupt_of_python_dash_m(tmp_path):
+    """A Ctrl-C landing in code run from a string (numba's compiler, dataclasses, namedtuple:
+    exec of source) printed 'woodcam: interrupted', returned 130, and then 'python -m woodcam'
+    killed itself by SIGINT (status -2): CPython marks the process so whenever an exact
+    KeyboardInterrupt leaves such code, even one caught later. Seen in 1 of 50 Ctrl-Cs of
+    'python -m woodcam blocks'."""
+    rc, out, err = _run_as_the_process(
+        tmp_path, "sys.exit(main())\n", f"    exec({_CTRL_C!r})\n    return 0\n")
+    assert (rc, out, err) == (130, "output\n", "woodcam: interrupted\n")
+
+
+@pytest.mark.parametrize("when", ["returned", "atexit", "joined thread"])
+def test_ctrl_c_as_the_process_exits_after_its_command_is_an_interrupt(when, tmp_path):
+    """A Ctrl-C after the command returned, while the process exits (threads joined, atexit
+    callbacks, the interpreter tearing down numba, scipy and torch: 0.3-0.5 s of a 2 s
+    'woodcam blocks'), ended it by SIGINT (status -2, a traceback or nothing), or with a
+    traceback 'Exception ignored in atexit callback' and exit 0: Python's own handler was back.
+    It ends the process at once: exit 130, one line after the command's output."""
+    command = {
+        "returned": "    return 0\n",
+        "atexit": f"    atexit.register(lambda: ({_CTRL_C.replace('; ', ', ')}))\n    return 0\n",
+        "joined thread": "    threading.Thread(target=lambda: (time.sleep(0.3), os.kill(os.getpid(), "
+                         "signal.SIGINT), time.sleep(5))).start()\n    return 0\n",
+    }[when]
+    body = ("rc = main()\n" + (f"{_CTRL_C}\n" if when == "returned" else "") + "sys.exit(rc)\n")
+    t0 = time.perf_counter()
+    rc, out, err = _run_as_the_process(tmp_path, body, command)
+    assert (rc, out, err) == (130, "output\n", "woodcam: interrupted\n")
+    assert time.perf_counter() - t0 < 30  # at once: not after the thread's 5 s sleep (with slack)
+
+
+def test_ctrl_c_in_the_interpreters_last_teardown_is_ignored(tmp_path):
+    """The interpreter's last phase (its modules torn down, after every atexit callback) runs no
+    Python handler and puts SIGINT back to the kernel's default: a Ctrl-C there killed the
+    process by the signal (status -2, no line) after its output was written and flushed. From
+    woodcam's last atexit callback on SIGINT is ignored: the process exits as its command ended."""
+    command = ("    class Late:\n"
+               f"        def __del__(self): {_CTRL_C}\n"
+               "    sys.modules['late_holder'] = type(sys)('late_holder')\n"
+               "    sys.modules['late_holder'].late = Late()  # freed as the modules are torn down\n"
+               "    return 0\n")
+    rc, out, err = _run_as_the_process(tmp_path, "sys.exit(main())\n", command)
+    assert (rc, out, err) == (0, "output\n", "")
+
+
 def test_the_interrupt_flag_lives_for_one_command_only(monkeypatch, capsys):
     """The flag is clear at each command's start and after its end, so a Ctrl-C of one run never
     ends the next (main() runs many times in one process: tests, notebooks), and outside a

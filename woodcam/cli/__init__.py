@@ -22,6 +22,7 @@ import sys
 import textwrap
 import warnings
 
+from .. import _interrupt
 from ..errors import UsageError, WoodcamError
 from .options import OUT_RULE
 
@@ -78,7 +79,8 @@ and ls.
 """
 
 #: Exit statuses (documented in ``woodcam --help`` and the README).
-EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_CHECKS, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_CHECKS = 0, 1, 2, 3
+EXIT_INTERRUPTED = _interrupt.EXIT_INTERRUPTED  # 130, also where the process ends after the command
 #: Standard output was a pipe whose reader went away (``woodcam blocks | head``): 128 + SIGPIPE,
 #: what git, ls and seq end with there (killed by the signal), and like them without a word.
 EXIT_BROKEN_PIPE = 141
@@ -187,20 +189,38 @@ def print_warnings(items) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``woodcam`` console script; returns the exit status."""
-    from .. import _interrupt
+    """Entry point of the ``woodcam`` console script; returns the exit status.
 
+    Without ``argv`` it runs the process's command line as the process's own command: a Ctrl-C
+    after the command returned, while the interpreter exits, still ends the process with exit
+    130 and one line (:func:`woodcam._interrupt.handling` with ``process=True``), and the
+    handler stays in place to the process's end. Called with ``argv`` (tests, notebooks) it
+    puts the previous handler back as it returns."""
     # from the first moment: a Ctrl-C while the command modules import is an interrupt too
-    with _interrupt.handling():
+    with _interrupt.handling(process=argv is None):
         try:
-            parser = build_parser()
-            args, extra = parser.parse_known_args(_apply_aliases(list(sys.argv[1:] if argv is None else argv), parser))
-            if extra:  # said by the command's own parser: its --help lists its options
-                _unrecognized(parser, args, extra)
-        except KeyboardInterrupt:
-            print("woodcam: interrupted", file=sys.stderr)
-            return EXIT_INTERRUPTED
-        return _run(args, parser)
+            rc = _main(argv)
+            _interrupt.ended()  # from here a Ctrl-C ends the process itself: no raise to catch
+        except KeyboardInterrupt:  # one that landed as the command returned, past its own catch
+            _interrupt.ended()
+            _interrupt.say()
+            rc = EXIT_INTERRUPTED
+        except BaseException:  # argparse's SystemExit (--help, a usage error)
+            _interrupt.ended()
+            raise
+    return rc
+
+
+def _main(argv: list[str] | None) -> int:
+    try:
+        parser = build_parser()
+        args, extra = parser.parse_known_args(_apply_aliases(list(sys.argv[1:] if argv is None else argv), parser))
+        if extra:  # said by the command's own parser: its --help lists its options
+            _unrecognized(parser, args, extra)
+    except KeyboardInterrupt:
+        _interrupt.say()
+        return EXIT_INTERRUPTED
+    return _run(args, parser)
 
 
 def _unrecognized(parser: argparse.ArgumentParser, args: argparse.Namespace, extra: list[str]) -> None:
@@ -225,7 +245,6 @@ def _unrecognized(parser: argparse.ArgumentParser, args: argparse.Namespace, ext
 
 def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     """Run the parsed command; every way it ends becomes an exit status and at most one line."""
-    from .. import _interrupt
     from ..units import message_units
 
     _printed.clear()  # once per run: a second main() in one process printed none of the first's
@@ -265,7 +284,7 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             # raises ImportError: woodcam's WoodcamError about it then blamed the script)
             if _interrupt.requested() or _interrupted(err):
                 interrupted = True
-                print("woodcam: interrupted", file=sys.stderr)
+                _interrupt.say()
                 return EXIT_INTERRUPTED
             if not isinstance(err, Exception):  # SystemExit and the like: not ours to report
                 raise
