@@ -138,6 +138,24 @@ def test_an_existing_folder_that_cannot_be_written_is_refused_in_bakes_words(pat
                    "writable (No such file or directory); choose an output folder you can write to"], err
 
 
+@pytest.mark.parametrize("path,p", COMMANDS, ids=[" ".join(c[0]) for c in COMMANDS])
+def test_a_folder_to_make_under_one_that_cannot_be_written_is_refused_before_work(path, p, capsys):
+    """'woodcam review part.glb --out /proc/sub/x.html' did the work, then exited 1 ('review
+    --out: cannot create the folder ...'); 'block synth --out /proc/sub' and 'fit --out
+    /proc/sub/f.npz' said 'No such file or directory (/proc/sub)', exit 1: the door asked
+    os.access() of '/proc', which says yes to root. A real probe: exit 2, one line naming --out,
+    the folder, the reason and a fix, as every other unwritable --out."""
+    suffixes = p.get_default("_out_suffixes")
+    out = "/proc/sub/k" + suffixes[0] if suffixes else "/proc/sub/k"  # /proc: read-only even for root
+    capsys.readouterr()
+    assert main(_argv(path, p, out)) == EXIT_USAGE
+    err = capsys.readouterr().err.strip().splitlines()
+    folder = "/proc/sub" if suffixes else "/proc/sub/k"
+    assert err == [f"woodcam: error: --out of 'woodcam {' '.join(path)}': cannot make the folder '{folder}': "
+                   "'/proc' is not writable (No such file or directory); choose an output folder you can "
+                   "write to"], err
+
+
 def test_a_refusal_by_the_system_is_one_line_not_a_traceback(monkeypatch, capsys):
     import errno
 

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import re
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -462,8 +461,19 @@ def _check_folder_can_be_made(folder: Path, command: str, option: str = "--out")
         return
     while not base.exists() and base != base.parent:
         base = base.parent
-    if not base.is_dir() or not os.access(base, os.W_OK | os.X_OK):
-        why = "is a file" if not base.is_dir() else "is not writable"
+    why = "is a file" if not base.is_dir() else ""
+    if not why:  # a real probe: as root os.access() says yes even to /proc (the folder's mkdir
+        # then failed after the work: 'review --out /proc/sub/x.html' exit 1, 'block synth' and
+        # 'fit' "No such file or directory (/proc/sub)")
+        from .._atomic import check_folder_writable
+        from ..errors import WoodcamError
+
+        try:
+            check_folder_writable(base, what=option)
+        except WoodcamError as err:
+            reason = getattr(err.__cause__, "strerror", None)
+            why = "is not writable" + (f" ({reason})" if reason else "")
+    if why:
         raise UsageError(f"{option} of 'woodcam {command}': cannot make the folder {str(folder)!r}: "
                          f"{str(base)!r} {why}; choose an output folder you can write to")
 
