@@ -151,12 +151,38 @@ def handling(process: bool = False) -> Iterator[None]:
     previous = signal.signal(signal.SIGINT, _on_sigint)
     if process:
         atexit.register(_ignore_from_here)
+    stdout = sys.stdout
+    sys.stdout = _MutedAfterCtrlC(stdout)  # type: ignore[assignment]
     try:
         yield
     finally:
+        if isinstance(sys.stdout, _MutedAfterCtrlC) and sys.stdout.stream is stdout:
+            sys.stdout = stdout
         if not process:
             signal.signal(signal.SIGINT, previous)
         _requested = False
+
+
+class _MutedAfterCtrlC:
+    """Standard output inside :func:`handling`: what is written goes through until a Ctrl-C is
+    recorded, and is dropped after it. A library that swallows the Ctrl-C may say so on
+    standard output: OCP's ``IVtk`` modules (imported by ``cadquery``) wrap ``import vtk``, 2 s,
+    in a bare ``except`` that prints 'VTK not installed', so a Ctrl-C while a cadquery part
+    script imported added that line to the command's one. An interrupted command's output is
+    its one line (its work is dropped too). Everything else is the stream's own."""
+
+    def __init__(self, stream) -> None:
+        self.stream = stream
+
+    def write(self, text: str) -> int:
+        return len(text) if _requested else self.stream.write(text)
+
+    def writelines(self, lines) -> None:
+        for line in lines:
+            self.write(line)
+
+    def __getattr__(self, name: str):
+        return getattr(self.stream, name)
 
 
 @contextlib.contextmanager

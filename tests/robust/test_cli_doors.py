@@ -438,6 +438,46 @@ def test_ctrl_c_in_the_interpreters_last_teardown_is_ignored(tmp_path):
     assert (rc, out, err) == (0, "output\n", "")
 
 
+def test_what_a_library_prints_as_it_swallows_a_ctrl_c_is_not_printed(monkeypatch, capsys):
+    """A library that swallows a Ctrl-C may say so on standard output: the command's output
+    after the interrupt is dropped, its output before it kept, and its one line on stderr."""
+    import woodcam.cli.bake as bake_cli
+
+    def command(args):
+        print("output")
+        try:
+            _swallowed_ctrl_c()
+        finally:
+            print("VTK not installed")  # what OCP's IVtk modules print
+        return 0
+
+    monkeypatch.setattr(bake_cli, "run_blocks", command)
+    capsys.readouterr()
+    assert main(["blocks"]) == 130
+    assert capsys.readouterr() == ("output\n", "woodcam: interrupted\n")
+    print("after")  # standard output is the stream's own again
+    assert capsys.readouterr().out == "after\n"
+
+
+def test_ctrl_c_while_cadquery_imports_vtk_is_one_line(tmp_path):
+    """A Ctrl-C while a cadquery part script imported cadquery (its OCP.IVtkOCC imports vtk, 2 s,
+    inside a bare except) printed 'VTK not installed' on stdout besides 'woodcam: interrupted'."""
+    import importlib.util
+
+    if importlib.util.find_spec("OCP") is None or importlib.util.find_spec("vtk") is None:
+        pytest.skip("OCP and vtk are not installed (pip install woodcam[cad,view])")
+    command = ("    class Hook:\n"
+               "        def find_spec(self, name, path=None, target=None):\n"
+               "            if name == 'vtk':  # Ctrl-C as OCP's IVtk module imports vtk\n"
+               "                sys.meta_path.remove(self)\n"
+               "                os.kill(os.getpid(), signal.SIGINT)\n"
+               "    sys.meta_path.insert(0, Hook())\n"
+               "    import OCP.IVtkOCC\n"
+               "    return 0\n")
+    rc, out, err = _run_as_the_process(tmp_path, "sys.exit(main())\n", command)
+    assert (rc, out, err) == (130, "output\n", "woodcam: interrupted\n")
+
+
 def test_the_interrupt_flag_lives_for_one_command_only(monkeypatch, capsys):
     """The flag is clear at each command's start and after its end, so a Ctrl-C of one run never
     ends the next (main() runs many times in one process: tests, notebooks), and outside a
