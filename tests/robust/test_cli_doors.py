@@ -182,6 +182,24 @@ def test_bad_options_fail_fast_with_one_line(argv, code, match, tmp_path, capsys
     assert __import__("re").search(match, err), err
 
 
+@pytest.mark.parametrize("argv, module, run, said", [
+    (["block", "synth", "--count", "100001", "--out", "OUT/b"], "block", "run",
+     "--count must be in [1, 100000]; got 100001; see 'woodcam block synth --help'"),
+    (["eval", "realistic", "--seed", "1", "--count", "1001", "--out", "OUT/e"], "eval_bench", "run_realistic",
+     "--count must be in [1, 1000]; got 1001; see 'woodcam eval realistic --help'"),
+])
+def test_a_count_of_days_of_work_is_refused(argv, module, run, said, tmp_path, capsys, monkeypatch):
+    """'block synth --count' took up to 1e6 blocks: 8.5 MB and ~4 CPU-s each at the default 512 px,
+    8.5 TB and weeks; 'eval realistic --count' 1e6 blocks a row, each fitted by every method on
+    this machine: years. Refused before any work (the command's work stands in here: it ran)."""
+    import importlib
+
+    monkeypatch.setattr(importlib.import_module(f"woodcam.cli.{module}"), run, lambda args: 0)
+    assert main([a.replace("OUT", str(tmp_path)) for a in argv]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(f"woodcam: error: {said}"), err
+
+
 @pytest.mark.parametrize("argv, said", [
     (["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb"],
      "woodcam gcode: no tools given; pass --tool SPEC"),

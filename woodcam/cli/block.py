@@ -40,7 +40,7 @@ def register(subparsers) -> None:
 
     s = sub.add_parser("synth", help="write a reproducible set of synthetic blocks")
     # the ranges said in the help, as the other options' (a fraction, a side in mm) are
-    s.add_argument("--count", type=int, required=True, help=f"number of blocks, {option_range('count')}")
+    s.add_argument("--count", type=int, required=True, help=f"number of blocks, {option_range('count', 'block')}")
     s.add_argument("--seed", type=int, default=0,
                    help=f"random seed (same seed, same set), an integer {option_range('seed')}")
     add_out_option(s, "one block sub-folder per block and index.json")

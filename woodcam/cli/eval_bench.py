@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .options import add_confidence_option, add_out_option, comma_names, command_group
+from .options import add_confidence_option, add_out_option, comma_names, command_group, option_range
 
 
 def register(subparsers) -> None:
@@ -25,7 +25,8 @@ def register(subparsers) -> None:
         "records go to OUT/records.json (woodcam.benchmark.score_block).")
     r.add_argument("--seed", type=int, required=True,
                    help="benchmark seed; use seeds never used while developing a fitter")
-    r.add_argument("--count", type=int, default=6, help="blocks per row (default 6)")
+    r.add_argument("--count", type=int, default=6,
+                   help=f"blocks per row, {option_range('count', 'eval')} (default 6)")
     r.add_argument("--methods", default="rbf,radial,evidence",
                    help="comma list of fitting methods from evidence, rbf, radial, neural, or all "
                    "(default rbf,radial,evidence)")

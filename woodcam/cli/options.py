@@ -1347,7 +1347,14 @@ RANGES: dict = {
     "epochs": (1, 100_000, False),
     "finetune_epochs": (0, 100_000, False),
     "steps": (1, 100_000_000, False),
-    "count": (1, 1_000_000, False),
+    # block synth: blocks in the set, written on this machine or an engine's: 8.5 MB and ~4 CPU-s
+    # a block at the default 512 px (measured), so 1e5 are ~850 GB and ~5 CPU-days; the 1e6 it
+    # took were 8.5 TB and weeks (a typo's extra zero filled the disk first)
+    "count": (1, 100_000, False),
+    # eval realistic: blocks per row, each fitted by every method in every scenario and face set
+    # on this machine alone (no engine; ~33 CPU-s a block for three fitters): 1000 a row of the
+    # default two face sets are ~18 CPU-hours; 'bench run' is the one for thousands of blocks
+    ("eval", "count"): (1, 1000, False),
     "face_px": (16, 16_384, False),            # woodcam.limits.MAX_FACE_PX; 8 px made faces of
                                                # non-square pixels that the fit refused
     "seed": (0, 2**32 - 1, False),
