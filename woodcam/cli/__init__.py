@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import sys
 import textwrap
 import warnings
@@ -116,6 +117,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "woodcam/cli/__init__.py")
         register(sub)
     parser.set_defaults(_commands=sub)
+    _state_ranges(parser)
     _state_defaults(parser)
     _describe_commands(parser)
     return parser
@@ -147,6 +149,30 @@ def _walk_options(parser: argparse.ArgumentParser):
             if action.option_strings and not isinstance(
                     action, (argparse._HelpAction, argparse._VersionAction)):
                 yield list(path), action
+
+
+def _state_ranges(parser: argparse.ArgumentParser) -> None:
+    """Every numeric option's help states the range it is checked against (:data:`~woodcam.cli.
+    options.RANGES`), before its default: 'block synth --count' said 'in [1, 100000]' and
+    'bench run --blocks', 'review --voxels', 'place --candidates' nothing, so a user learnt the
+    range from the refusal. A help that states one itself ('in [0, 1]') is left as it is; a
+    length read in --units says mm, the unit the range is checked in."""
+    from .options import LENGTH_OPTIONS, option_range
+
+    for path, action in _walk_options(parser):
+        text = action.help or ""
+        if action.type not in (int, float) or text == argparse.SUPPRESS or re.search(r"\bin [\[(]", text):
+            continue
+        command = path[0] if path else None
+        try:
+            span = option_range(action.dest, command)
+        except TypeError:  # no RANGES entry
+            continue
+        if LENGTH_OPTIONS.get((command, action.dest)) == "number":
+            span += " mm/min" if action.dest == "rapid_rate" else " mm"
+        # before the default, said as '(default 3)', '(...; default 3)' or '; default 3'
+        said = re.search(r" \([^()]*\bdefault|; default", text)
+        action.help = f"{text}, {span}" if said is None else f"{text[:said.start()]}, {span}{text[said.start():]}"
 
 
 def _state_defaults(parser: argparse.ArgumentParser) -> None:

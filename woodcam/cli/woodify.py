@@ -35,7 +35,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                    "(mesh files are read as mm whatever --units says; one under 1 mm long gets a warning that it "
                    "looks saved in metres); a PLY may paint growth per vertex: properties gain (speed gain) and "
                    "dir_x, dir_y, dir_z (growth direction, length = strength < 1)")
-    p.add_argument("--years", type=float, required=True, help="years to grow (> 0)")
+    p.add_argument("--years", type=float, required=True, help="years to grow")
     add_out_option(p, "field.npz, grown.glb, surfaces and section PNGs, woodify.json, listed in "
                       ".woodcam-woodify-files.json")
     p.add_argument("--growth", type=float, default=None, metavar="LEN",
@@ -53,7 +53,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     add_input(p, "--brushes", kind="file", type=Path, default=None, metavar="JSON",
                    help="growth brushes (centre_mm, radius_mm, gain, direction, strength)")
     p.add_argument("--resolution", type=int, default=128,
-                   help="grid nodes along the longest side, 16 to 1024 (default 128); a run takes about "
+                   help="grid nodes along the longest side (default 128); a run takes about "
                    "180 bytes a grid node, and a grid over WOODCAM_MAX_ALLOC_BYTES (4 GiB) is refused, naming the finest "
                    "resolution that fits")
     p.add_argument("--method", choices=("auto", "fmm", "offset", "anisotropic"), default="auto",
