@@ -222,3 +222,36 @@ def test_camera_is_one_shared_option_and_bake_draws_the_one_asked(tmp_path, monk
                      "1", "--out", str(tmp_path / "o.glb"), "--camera", "top"]) == 0
     assert ("woodcam: warning: --camera top chooses the view of --screenshot, which was not asked for: "
             "ignored; add --screenshot") in capsys.readouterr().err
+
+
+def test_every_command_takes_quiet_and_it_stops_every_bar(monkeypatch):
+    """'--quiet' (no progress bars) was an option of six commands; 'bake', 'gcode', 'woodify',
+    'fit', 'review', 'place' and the others drew their bars with no way to turn them off on a
+    terminal. Every command takes it, and it stops any bar its work draws."""
+    import argparse
+    import io
+
+    import woodcam.cli.bake as bake_cli
+    from woodcam._progress import progress_bar
+    from woodcam.cli import _commands, build_parser, main
+
+    lacking = [" ".join(path) for path, _help, sp in _commands(build_parser())
+               if not any(isinstance(a, argparse._SubParsersAction) for a in sp._actions)
+               and "--quiet" not in sp._option_string_actions]
+    assert not lacking, lacking
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    drawn = {}
+
+    def command(args):  # work that draws a bar at once, as a long bake's does after 2 s
+        drawn[args.quiet] = out = Terminal()
+        for _ in progress_bar(range(3), desc="baking", unit="step", file=out, delay=0):
+            pass
+        return 0
+
+    monkeypatch.setattr(bake_cli, "run_blocks", command)
+    assert main(["blocks"]) == 0 and main(["blocks", "--quiet"]) == 0
+    assert "baking" in drawn[False].getvalue() and drawn[True].getvalue() == ""

@@ -24,16 +24,31 @@ from . import _interrupt
 #: Seconds before a bar is drawn: the brief's "progress bars on anything over ~2 s".
 PROGRESS_DELAY_S = 2.0
 
+_silenced = False  # inside silenced(True): no bar is drawn
+
+
+@contextmanager
+def silenced(on: bool = True) -> Iterator[None]:
+    """No bar is drawn inside the block when ``on`` (a command's ``--quiet``), whichever library
+    call draws it; lines of a command's own (:func:`write`) are printed as before."""
+    global _silenced
+    before, _silenced = _silenced, _silenced or on
+    try:
+        yield
+    finally:
+        _silenced = before
+
 
 def progress_bar(iterable: Iterable | None = None, *, desc: str, unit: str, enabled: bool = True,
                  **kwargs: Any):
     """A ``tqdm.auto.tqdm`` over ``iterable`` (or with ``total=`` and manual ``update``) drawn
     on a terminal after :data:`PROGRESS_DELAY_S` only (module docstring); ``enabled=False``
-    never draws it. ``kwargs`` go to tqdm (``total``, ``initial``, ``leave``, ...). Each step,
+    never draws it, nor does one inside :func:`silenced`. ``kwargs`` go to tqdm (``total``, ``initial``, ``leave``, ...). Each step,
     drawn or not, is a Ctrl-C checkpoint (:func:`woodcam._interrupt.check`)."""
     _interrupt.check()
     kwargs.setdefault("delay", PROGRESS_DELAY_S)
-    return _bar_class()(iterable, desc=desc, unit=unit, disable=None if enabled else True, **kwargs)
+    return _bar_class()(iterable, desc=desc, unit=unit,
+                        disable=None if enabled and not _silenced else True, **kwargs)
 
 
 @functools.cache

@@ -117,6 +117,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "woodcam/cli/__init__.py")
         register(sub)
     parser.set_defaults(_commands=sub)
+    _add_quiet(parser)
     _state_ranges(parser)
     _state_defaults(parser)
     _describe_commands(parser)
@@ -149,6 +150,17 @@ def _walk_options(parser: argparse.ArgumentParser):
             if action.option_strings and not isinstance(
                     action, (argparse._HelpAction, argparse._VersionAction)):
                 yield list(path), action
+
+
+def _add_quiet(parser: argparse.ArgumentParser) -> None:
+    """Every command takes ``--quiet``: no progress bars, whichever step draws them (``_run``
+    runs the command inside :func:`woodcam._progress.silenced`). Six commands had it and
+    'bake', 'gcode', 'woodify', 'fit', 'review', 'place', ... none, though their bars are drawn
+    the same way."""
+    for _path, _help, sp in _commands(parser):
+        leaf = not any(isinstance(a, argparse._SubParsersAction) for a in sp._actions)
+        if leaf and "--quiet" not in sp._option_string_actions:
+            sp.add_argument("--quiet", action="store_true", help="no progress bars")
 
 
 def _state_ranges(parser: argparse.ArgumentParser) -> None:
@@ -276,7 +288,10 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     _printed.clear()  # once per run: a second main() in one process printed none of the first's
     interrupted = False
     # the library's warnings, errors and G-code issues say their lengths in --units (mm without)
-    with warnings.catch_warnings(record=True) as caught, message_units(getattr(args, "units", None)):
+    from .._progress import silenced
+
+    with (warnings.catch_warnings(record=True) as caught, message_units(getattr(args, "units", None)),
+          silenced(bool(getattr(args, "quiet", False)))):
         warnings.simplefilter("always")
         try:
             from .options import (
