@@ -255,3 +255,16 @@ def test_every_command_takes_quiet_and_it_stops_every_bar(monkeypatch):
     monkeypatch.setattr(bake_cli, "run_blocks", command)
     assert main(["blocks"]) == 0 and main(["blocks", "--quiet"]) == 0
     assert "baking" in drawn[False].getvalue() and drawn[True].getvalue() == ""
+
+
+def test_faces_names_faces_and_eval_realistics_face_sets_say_so():
+    """'fit --faces front,top' takes faces, 'eval realistic --faces full,three' took face sets:
+    one option name, two meanings. eval realistic's is --face-sets (--faces still parses)."""
+    by_faces = sorted(name for name, parser in _commands().items() for a in parser._actions
+                      if a.option_strings[:1] == ["--faces"])
+    assert by_faces == ["fit"], by_faces
+    realistic = cli.build_parser().parse_args(["eval", "realistic", "--seed", "1", "--faces", "three",
+                                               "--out", "o"])
+    assert realistic.faces == "three"
+    help_ = next(a.help for a in _commands()["eval realistic"]._actions if "--face-sets" in a.option_strings)
+    assert "full (six faces), three (front, top, left)" in help_

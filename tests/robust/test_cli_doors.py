@@ -109,7 +109,7 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
      r"--methods must be from evidence, rbf, radial, neural, or all; got 'evidnce,rbf', in which 'evidnce' is "
      r"none of them; did you mean 'evidence'\?$"),
     (["eval", "realistic", "--seed", "5", "--faces", "full,full", "--out", "OUT/e"], EXIT_USAGE,
-     r"--faces must be a comma list from full, three, each name once; got 'full,full'"),
+     r"--face-sets must be a comma list from full, three, each name once; got 'full,full'"),
     # eval realistic dropped empty names ('rbf,,radial') where fit refused them: one parser now
     (["eval", "realistic", "--seed", "5", "--methods", "rbf,,radial", "--scenarios", "bogus", "--out", "OUT/e"], EXIT_USAGE,
      r"--methods must be 'all' or a comma list from evidence, rbf, radial, neural, each name once; got 'rbf,,radial'"),

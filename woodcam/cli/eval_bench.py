@@ -32,7 +32,11 @@ def register(subparsers) -> None:
                    "(default rbf,radial,evidence)")
     r.add_argument("--scenarios", default="noisy",
                    help="comma list of clean, noisy, ring-maps (default noisy)")
-    r.add_argument("--faces", default="full,three", help="comma list of full, three (default both)")
+    # --face-sets: sets of faces, not faces ('fit --faces front,top' names faces); the old
+    # spelling --faces still parses to it
+    r.add_argument("--face-sets", "--faces", dest="faces", default="full,three",
+                   help="comma list of face sets: full (six faces), three (front, top, left) (default both; "
+                   "the old spelling --faces still works)")
     r.add_argument("--eq79", type=int, default=2,
                    help="eq. 7-9 sanity blocks per scenario and face set (default 2; 0 skips)")
     r.add_argument("--face-px", type=int, default=256, help="face image pixels along the largest side (default 256)")
@@ -66,7 +70,7 @@ def run_realistic(args) -> int:
                                         ("--residual", args.residual), ("--confidence", args.confidence)) if on],
                        methods)
     scenarios = comma_names(args.scenarios, "--scenarios", tuple(SCENARIOS))
-    faces = comma_names(args.faces, "--faces", tuple(FACE_SETS))
+    faces = comma_names(args.faces, "--face-sets", tuple(FACE_SETS))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     tasks = [(kind, i, s, f) for s in scenarios for f in faces
