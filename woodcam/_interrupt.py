@@ -152,7 +152,8 @@ def handling(process: bool = False) -> Iterator[None]:
     if process:
         atexit.register(_ignore_from_here)
     stdout = sys.stdout
-    sys.stdout = _MutedAfterCtrlC(stdout)  # type: ignore[assignment]
+    if stdout is not None:  # None under pythonw, where print() writes nowhere
+        sys.stdout = _MutedAfterCtrlC(stdout)  # type: ignore[assignment]
     try:
         yield
     finally:

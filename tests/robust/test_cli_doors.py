@@ -592,3 +592,15 @@ def test_a_log_blocks_knot_the_log_lacks_is_a_wrong_command_line(tmp_path, monke
     ]:
         assert main(argv) == EXIT_USAGE, argv
         assert capsys.readouterr().err.splitlines() == [f"woodcam: error: {said}: {rule}"], argv
+
+
+def test_a_command_without_standard_output_runs(monkeypatch, capsys):
+    """A command started with standard output closed ('woodcam blocks >&-': sys.stdout is None)
+    ended with 'woodcam: error: internal error (AttributeError: 'NoneType' object has no
+    attribute 'flush'); this is a woodcam bug ...', exit 1. print() writes nowhere there, and so
+    does the command: exit 0."""
+    import sys
+
+    monkeypatch.setattr(sys, "stdout", None)
+    assert main(["blocks"]) == 0
+    assert sys.stdout is None

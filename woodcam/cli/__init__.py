@@ -317,7 +317,8 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             check_environment(args)  # the WOODCAM_* settings, read before the work, not after it
             rc = args.func(args)
             _interrupt.check()  # a Ctrl-C a library swallowed: the run did not end as asked
-            sys.stdout.flush()  # here, not at exit: a closed pipe is then caught below
+            if sys.stdout is not None:  # None where the command was started with it closed (>&-)
+                sys.stdout.flush()  # here, not at exit: a closed pipe is then caught below
         except BaseException as err:
             # Ctrl-C, or an error after one: a library swallowed it (trimesh's imports catch
             # BaseException) or left itself half-imported (scipy: NameError), or wrapped it
