@@ -42,13 +42,58 @@ def _fail(name: str, rule: str, value, fix: str):
     raise WoodcamError(f"{name} must be {rule}; got {value!r}" + (f"; {fix}" if fix else ""))
 
 
+def _real(x) -> bool:
+    """A real number of any Python or numpy type (int, float, Fraction, Decimal, np.float32,
+    bool): not a complex number, a string or None."""
+    return isinstance(x, numbers.Number) and (isinstance(x, numbers.Real) or not isinstance(x, numbers.Complex))
+
+
 def as_floats(value) -> np.ndarray | None:
-    """``value`` as a float array of any shape, or None where numpy cannot make one (a string
-    such as ``'a'``, a ragged list): the caller refuses it with its own message."""
+    """``value`` as a float array of any shape, or None where it is not real numbers: a string
+    such as ``'a'``, a ragged list, and (numpy converts them) complex numbers (whose imaginary
+    part was dropped with only numpy's ComplexWarning), numeric strings (``'10'`` was 10.0),
+    None (NaN) or dates. The caller refuses it with its own message, saying what it got with
+    :func:`received`."""
     try:
-        return np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+        a = np.asarray(value)
+    except (TypeError, ValueError):  # a ragged list
         return None
+    if a.dtype.kind == "O":  # Python numbers past int64, Fractions, Decimals; or None, text, complex
+        if not all(map(_real, a.flat)):
+            return None
+    elif a.dtype.kind not in "biuf":  # c complex, U/S text, M/m dates, V records
+        return None
+    try:
+        return a.astype(float, copy=False)
+    except (TypeError, ValueError, OverflowError):
+        return None
+
+
+def received(value, limit: int = 80) -> str:
+    """What the user passed, for an error's "got ...": an array's kind, dtype and shape (a
+    complex or text array of 10^5 points printed whole was the message), else its repr cut to
+    ``limit`` characters."""
+    if isinstance(value, np.ndarray):
+        kind = {"c": "complex numbers", "U": "text", "S": "bytes", "O": "Python objects",
+                "M": "dates", "m": "time spans", "V": "records"}.get(value.dtype.kind, "numbers")
+        return f"an array of {kind} (dtype {value.dtype}, shape {value.shape})"
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit] + "..."
+
+
+def numbers_fix(value, name: str) -> str:
+    """The fix of a ``value`` that :func:`as_floats` refused for its kind of elements: complex
+    numbers -> take the real parts if meant, text -> convert it; ``""`` for anything else (the
+    caller gives its own example)."""
+    try:
+        kind = np.asarray(value).dtype.kind
+    except (TypeError, ValueError):
+        return ""
+    if kind == "c":
+        return f"pass real numbers (e.g. np.real({name}) if the imaginary parts are all zero)"
+    if kind in "US":
+        return f"convert the text to numbers first, e.g. np.asarray({name}, dtype=float)"
+    return ""
 
 
 def check_number(value, name: str, *, lo: float | None = None, hi: float | None = None,

@@ -15,7 +15,7 @@ from typing import Literal, TypeVar, get_args
 
 import numpy as np
 
-from ._checks import as_floats
+from ._checks import as_floats, numbers_fix, received
 from ._types import ArrayLike
 from .errors import WoodcamError
 from .units import say_length
@@ -163,9 +163,10 @@ def block_to_pixel(face: str, points_mm: ArrayLike, image_shape: ArrayLike,
     p = as_floats(points_mm)
     if p is None or p.ndim == 0 or p.shape[-1] != 3:  # a scalar was an IndexError
         # the shape, not the points: a (100000, 2) array printed whole was the message
-        got = f"shape {p.shape}" if p is not None and p.ndim and p.size else f"{points_mm!r:.80}"
-        raise WoodcamError(f"points_mm must have shape (..., 3) in mm; got {got}; pass "
-                           "block points, e.g. [[10, 20, 5]]")
+        got = f"shape {p.shape}" if p is not None and p.ndim and p.size else received(points_mm)
+        rule = "have shape (..., 3) in mm" if p is not None else "be real numbers, shape (..., 3) in mm"
+        raise WoodcamError(f"points_mm must {rule}; got {got}; "
+                           + (numbers_fix(points_mm, "points_mm") or "pass block points, e.g. [[10, 20, 5]]"))
     if not np.all(np.isfinite(p)):  # a NaN point was a NaN pixel, passed on silently
         bad = np.argwhere(~np.isfinite(p))[0][:-1]
         raise WoodcamError(f"points_mm must be finite; point {tuple(int(i) for i in bad)} is "

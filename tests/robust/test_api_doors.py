@@ -564,7 +564,7 @@ def _library_door_sweep():
          r"field must return one growth time per point, \(n,\) = \(2,\); it returned shape \(5,\)"),
         ("evaluate a field of text", lambda: w.evaluate(lambda p: "a", pts),
          "field must return one growth time per point.*returned something that is not numbers"),
-        ("wood normals str", lambda: w.Wood(fld).color(pts, "b"), r"normals must have the shape of points_mm \(2, 3\); got 'b'"),
+        ("wood normals str", lambda: w.Wood(fld).color(pts, "b"), r"normals must be real numbers with the shape of points_mm \(2, 3\); got 'b'"),
         ("synth faces str !", lambda: w.synth_block(fld, (20, 20, 20), face_px=16, faces="top"),
          r"faces must be a list of face names; got the string 'top'; pass \['top'\]"),
         ("synth face_px past the face limit", lambda: w.synth_block(fld, (20, 20, 20), face_px=10**7),
@@ -606,7 +606,7 @@ def _library_door_sweep():
         ("evidence uncertainty (n, 2) *", lambda: _evidence_fit(1).uncertainty_years(np.zeros((2, 2))),
          r"points_mm must have shape \(n, 3\) in mm; got shape \(2, 2\)"),
         ("evidence uncertainty str", lambda: _evidence_fit(2).uncertainty_years("a"),
-         "points_mm must have shape \\(n, 3\\) in mm; got 'a'"),
+         "points_mm must be real numbers, shape \\(n, 3\\) in mm; got 'a'"),
     ]
 
 
@@ -1320,3 +1320,75 @@ def test_a_stock_built_by_hand_refuses_a_size_or_text_it_cannot_use(kw, said):
     with pytest.raises(WoodcamError, match=said):
         Stock(**args)
 
+
+
+def _points_doors():
+    """``(id, door)``: every public door that takes ``points_mm``, as a function of the points
+    (each refuses what :func:`woodcam.fields.base.check_points` refuses)."""
+    import numpy as np
+
+    import woodcam as w
+    from woodcam.appearance.wood import wood_colors
+
+    fld = w.builtin_block("flat-sawn").field
+    wood = w.Wood(fld)
+    up = np.array([[0.0, 0.0, 1.0]])
+    stem = w.StemField(np.array([20.0, 15.0, 10.0]), np.array([0.0, 0.0, 1.0]), 50.0, np.zeros((2, 3)), 0, 0, 2,
+                       np.array([0.5]), np.array([0.0]), 10.0)
+    grid = w.GridField.bake(fld, (0, 0, 0), (10, 10, 10), 4)
+    return [
+        ("evaluate", lambda p: w.evaluate(fld, p)),
+        ("grain_direction", lambda p: w.grain_direction(fld, p)),
+        ("RadialScalingField", fld),
+        ("RadialScalingField.grain_direction", fld.grain_direction),
+        ("GridField", grid),
+        ("PlacedField", w.PlacedField(fld)),
+        ("StemField", stem),
+        ("StemField.grain_direction", stem.grain_direction),
+        ("StemField.pith_distance_mm", stem.pith_distance_mm),
+        ("EvidenceFit", _evidence_fit(2)),
+        ("EvidenceFit.uncertainty_years", _evidence_fit(2).uncertainty_years),
+        ("WoodifiedField", _woodified()),
+        ("WoodifiedField.evaluate", _woodified().evaluate),
+        ("WoodifiedField.grain_direction", _woodified().grain_direction),
+        ("Wood.years", wood.years),
+        ("Wood.arf", wood.arf),
+        ("Wood.features", wood.features),
+        ("Wood.uncertainty_years", wood.uncertainty_years),
+        ("Wood.to_source", wood.to_source),
+        ("Wood.color", lambda p: wood.color(p, up)),
+        ("wood_colors", lambda p: wood_colors(wood, p, up)),
+        ("ColorMapAppearance.color", lambda p: w.ColorMapAppearance().color(fld, p, up)),
+        ("Brush.weight", w.Brush((0, 0, 0), 5).weight),
+        ("block_to_pixel", lambda p: w.block_to_pixel("top", p, (10, 10), (10, 10, 10))),
+    ]
+
+
+@pytest.mark.parametrize("name, door", _points_doors(), ids=lambda v: v if isinstance(v, str) else "")
+@pytest.mark.parametrize("points, said", [
+    (np.array([[1.0, 2.0, 3.0]]) + 1j, r"got an array of complex numbers \(dtype complex128, shape \(1, 3\)\); "
+                                       r"pass real numbers \(e\.g\. np\.real\(points_mm\)"),
+    (np.array([["1", "2", "3"]]), r"got an array of text \(dtype <U1, shape \(1, 3\)\); convert the text"),
+    ([[None, 2.0, 3.0]], r"got \[\[None, 2\.0, 3\.0\]\]"),
+], ids=["complex", "text", "None"])
+def test_every_points_door_refuses_complex_text_and_none(name, door, points, said):
+    """Complex points lost their imaginary parts with only numpy's ComplexWarning (an error under
+    this suite's filterwarnings, a warning and a wrong answer in a script), text '1' was 1.0 and
+    None a NaN point: each door now refuses them as not real numbers, saying what it got."""
+    with pytest.raises(WoodcamError, match=r"points_mm must be real numbers, shape \((n|\.\.\.), 3\) in mm; " + said):
+        door(points)
+
+
+def test_complex_normals_and_exact_object_numbers():
+    """Complex normals lost their imaginary parts like complex points; an object array of real
+    Python numbers (a Fraction, an int past int64) is still numbers."""
+    from fractions import Fraction
+
+    import woodcam as w
+
+    wood = w.Wood(w.builtin_block("flat-sawn").field)
+    with pytest.raises(WoodcamError, match=r"normals must be real numbers with the shape of points_mm \(1, 3\); "
+                                           r"got an array of complex numbers .*np\.real\(normals\)"):
+        wood.color([[1.0, 2.0, 3.0]], np.array([[0.0, 0.0, 1.0]]) + 0j)
+    exact = np.array([[Fraction(1), 2, 3]], dtype=object)
+    assert np.array_equal(w.evaluate(wood.field, exact), w.evaluate(wood.field, [[1.0, 2.0, 3.0]]))

@@ -7,7 +7,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .._checks import as_floats, check_number, check_rotation, check_vector
+from .._checks import as_floats, check_number, check_rotation, check_vector, numbers_fix, received
 from .._types import AppearanceLike, ArrayLike, GrowthFieldLike, WoodLike
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, evaluate, grain_direction, has_pith, has_uncertainty
@@ -245,13 +245,15 @@ def check_normals(normals, shape: tuple, dtype=np.float32) -> np.ndarray:
     least :data:`~woodcam.tolerances.MIN_NORMAL_LENGTH` long, or a WoodcamError naming the first
     that is not (a NaN or zero normal was coloured as an equal blend of the axes' colourings).
     float32 as given is not copied (the bake's hot path)."""
-    try:  # a string was numpy's bare ValueError
-        n = np.asarray(normals, dtype=dtype)
-    except (TypeError, ValueError):
-        n = None
+    # a string was numpy's bare ValueError, complex normals lost their imaginary parts under
+    # numpy's ComplexWarning (a float array, the hot path, is taken as it is)
+    real = normals if isinstance(normals, np.ndarray) and normals.dtype.kind in "biuf" else as_floats(normals)
+    n = None if real is None else np.asarray(real, dtype=dtype)
     if n is None or n.shape != shape:
-        raise WoodcamError(f"normals must have the shape of points_mm {shape}; got "
-                           f"{n.shape if n is not None else repr(normals)[:40]}")
+        fix = "" if n is not None else numbers_fix(normals, "normals")
+        raise WoodcamError(f"normals must {'have' if n is not None else 'be real numbers with'} the shape of "
+                           f"points_mm {shape}; got {n.shape if n is not None else received(normals, 40)}"
+                           + (f"; {fix}" if fix else ""))
     length2 = np.einsum("ij,ij->i", n, n, dtype=np.float64)
     bad = ~(np.isfinite(length2) & (length2 >= MIN_NORMAL_LENGTH ** 2))
     if bad.any():

@@ -18,7 +18,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from .._checks import as_floats, check_number, check_vector
+from .._checks import as_floats, check_number, check_vector, numbers_fix, received
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..tolerances import MAX_BATCH_POINTS
@@ -34,9 +34,12 @@ class GrowthField(Protocol):
 def check_points(points_mm, name: str = "points_mm") -> np.ndarray:
     """Return ``points_mm`` as a float64 ``(n, 3)`` array or raise a clear error."""
     p = as_floats(points_mm)
-    if p is None or p.ndim != 2 or p.shape[1] != 3:  # a ragged list was a bare ValueError
-        got = f"{points_mm!r:.80}" if p is None else f"shape {p.shape}"
-        raise WoodcamError(f"{name} must have shape (n, 3) in mm; got {got}")
+    if p is None:  # a ragged list was a bare ValueError; complex points lost their imaginary
+        # parts under numpy's ComplexWarning, text '10' was 10.0 and None a NaN
+        raise WoodcamError(f"{name} must be real numbers, shape (n, 3) in mm; got {received(points_mm)}; "
+                           + (numbers_fix(points_mm, name) or "e.g. [[10, 20, 5]]"))
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise WoodcamError(f"{name} must have shape (n, 3) in mm; got shape {p.shape}")
     if not np.isfinite(p).all():  # a NaN point was a ZeroDivisionError in a compiled kernel
         bad = int(np.argmin(np.isfinite(p).all(axis=1)))
         raise WoodcamError(f"{name} must be finite; point {bad} is {p[bad].tolist()}")
