@@ -156,20 +156,22 @@ def check_rotation(value, name: str, *, fix: str = "build it with scipy Rotation
     return R
 
 
-def check_names(value, name: str, *, what: str, known: Iterable[str] | None = None) -> list[str]:
+def check_names(value, name: str, *, what: str, known: Iterable[str] | None = None,
+                empty: bool = False, fix: str = "") -> list[str]:
     """``value`` as a non-empty list of names (each a ``str``; with ``known``: each one of
-    them). A string was read letter by letter (``'radial'`` as ``'r'``, ``'a'``...), an empty
-    list or None ran no work and returned an empty table or failed on an IndexError later."""
+    them; ``empty=True``: an empty collection too). A string was read letter by letter
+    (``'radial'`` as ``'r'``, ``'a'``...), an empty list or None ran no work and returned an
+    empty table or failed on an IndexError later."""
     if isinstance(value, str):
         raise WoodcamError(f"{name} must be a list of {what}; got the string {value!r}; pass [{value!r}]")
     try:
         names = list(value)
-    except TypeError:
-        names = []
+    except TypeError:  # None, a number
+        names = None
     choices = list(known) if known is not None else []
-    example = f"e.g. {name}=[{choices[0]!r}]" if choices else ""
-    if not names or not all(isinstance(n, str) for n in names):
-        _fail(name, f"a non-empty list of {what}", value, example)
+    example = fix or (f"e.g. {name}=[{choices[0]!r}]" if choices else "")
+    if names is None or (not names and not empty) or not all(isinstance(n, str) for n in names):
+        _fail(name, f"a {'' if empty else 'non-empty '}list of {what}", value, example)
     unknown = [n for n in names if known is not None and n not in choices]
     if unknown:
         near = did_you_mean(unknown[0], choices)

@@ -117,6 +117,22 @@ def test_absolute_and_parent_paths_are_refused_unless_trusted(folder, tmp_path, 
     assert read_block(folder).faces["top"].photo.max() == 7
 
 
+@pytest.mark.parametrize("regenerated, said", [
+    (None, "got None"), (5, "got 5"), ([3], r"got \[3\]"),
+    ("top_ring_map.png", "got the string 'top_ring_map.png'; pass \\['top_ring_map.png'\\]"),
+])
+def test_read_block_checks_its_regenerated_names(folder, regenerated, said):
+    """regenerated=None or 5 was "argument of type 'NoneType' is not iterable" at the first
+    face's file, and a string was searched as text (each file name a substring of it): the
+    names are checked at the door, an empty collection (the default) still allowed."""
+    (folder / "top_ring_map.png").unlink()
+    with pytest.raises(WoodcamError, match="read_block: regenerated must be a list of file names; " + said):
+        read_block(folder, regenerated=regenerated)
+    assert read_block(folder, regenerated=["top_ring_map.png"]).faces["top"].ring_map is None
+    with pytest.raises(WoodcamError, match="ring map of face 'top'.*listed but missing"):
+        read_block(folder, regenerated=[])
+
+
 def test_symlink_leading_out_is_refused(folder, tmp_path):
     outside = tmp_path / "secret.png"
     Image.fromarray(np.zeros((16, 20, 3), np.uint8)).save(outside)

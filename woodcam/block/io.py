@@ -56,7 +56,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._checks import check_bool, check_path
+from .._checks import check_bool, check_names, check_path
 from .._types import ArrayLike, PathLike
 from .._atomic import all_or_nothing, atomic_path, output_folder, write_text
 from .._readers import photo_rgb8, read_image_file
@@ -201,6 +201,9 @@ def read_block(folder: PathLike, *, allow_outside: bool | None = None, regenerat
     from ._schema import check_manifest
 
     folder = check_path(folder, "read_block: folder", fix="a folder written by write_block, or its block.json")
+    # None or 5 was "argument of type 'NoneType' is not iterable" at the first face's file
+    regenerated = set(check_names(regenerated, "read_block: regenerated", what="file names", empty=True,
+                                  fix="e.g. ['front_ring_map.png'], or () for none"))
     if allow_outside is not None:  # "false" was truthy: files outside the folder were read
         allow_outside = check_bool(allow_outside, "read_block: allow_outside",
                                    fix="pass True to trust this manifest, False, or None ($WOODCAM_ALLOW_OUTSIDE_PATHS)")
