@@ -107,3 +107,25 @@ def test_bake_refuses_a_box_that_is_not_two_corners(lo, hi, match):
     """'a' was a bare ValueError and a NaN corner a misleading grid-size (MAX_GRID_CELLS) message."""
     with pytest.raises(WoodcamError, match=match):
         GridField.bake(builtin_block("flat-sawn").field, lo, hi, 2.0)
+
+
+@pytest.mark.parametrize("interpolation", ["cubic", "linear"])
+def test_a_point_far_outside_the_grid_reads_the_border(interpolation):
+    """'Points beyond the grid clamp to its border', but scipy's map_coordinates turned grid
+    coordinates past 2**63 into garbage: a GridField gave ~1e230 years (memory read elsewhere)
+    at x = 1e20 mm, a cubic WoodifiedField 0, and its knot layer likewise. Now every point
+    reads what a point 1e6 mm out reads (the border), and nearer ones are untouched."""
+    import woodcam as w
+
+    years = np.add.outer(np.add.outer(np.arange(4.0), 2 * np.arange(5.0)), 3 * np.arange(6.0))
+    g = GridField(years, (0, 0, 0), 2.0, interpolation, layers={"knot": years / years.max()})
+    wf = w.WoodifiedField(years, (0, 0, 0), 2.0, w.GrowthSpeed(10, 1), years_final=1.0,
+                          interpolation=interpolation)
+    for sign in (1, -1):
+        border = np.array([[sign * 1e6, 3.0, 5.0], [1.0, sign * 1e6, 5.0], [1.0, 3.0, sign * 1e6]])
+        for far in (1e20, 1e200, 1e300):
+            pts = np.where(np.abs(border) == 1e6, sign * far, border)
+            assert np.array_equal(g(pts), g(border))
+            assert np.array_equal(g.layer("knot", pts), g.layer("knot", border))
+            assert np.array_equal(wf(pts), wf(border))
+    assert np.isfinite(g(border)).all() and np.isfinite(wf(border)).all()

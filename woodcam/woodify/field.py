@@ -39,6 +39,7 @@ from .._checks import as_floats, check_bool, check_number, check_rotation, check
 from .._readers import read_npz
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, check_points
+from ..fields.grid import grid_coords
 from .speed import GrowthSpeed
 
 Interpolation = Literal["linear", "cubic"]
@@ -148,8 +149,8 @@ class WoodifiedField:
             from ._voxel import trilinear
 
             return trilinear(grid, self.origin_mm, self.spacing_mm, np.ascontiguousarray(q, float))
-        idx = (q - self.origin_mm) / self.spacing_mm
-        return ndimage.map_coordinates(grid, idx.T, order=order, mode="nearest", prefilter=False)
+        idx = grid_coords(q, self.origin_mm, self.spacing_mm, grid.shape)
+        return ndimage.map_coordinates(grid, idx, order=order, mode="nearest", prefilter=False)
 
     def arrival(self, points_mm: ArrayLike) -> np.ndarray:
         """Interpolated arrival time ``T (n,)`` (mm) at block-frame points."""
