@@ -597,6 +597,9 @@ def _library_door_sweep():
         ("mokume_veneers NaN size !", lambda: w.mokume_veneers(_scan_file().parent, size_mm=np.nan),
          "size_mm must be a finite number > 0; got nan"),
         ("mokume_veneers None", lambda: w.mokume_veneers(None), "mokume_veneers: folder must be a file path .*got None"),
+        ("read_mokume size -1", lambda: w.read_mokume(_mokume_folder(), size_mm=-1),
+         r"size_mm must be three positive finite lengths \(W, D, H\) in mm; got -1"),
+        ("read_mokume size complex", lambda: w.read_mokume(_mokume_folder(), size_mm=1 + 1j), r"size_mm must be three .*got \(1\+1j\)"),
         ("woodification origins NaN", lambda: _woodify().origins([[np.nan, 0.0, 6.0]]),
          r"points_mm must be finite; point 0 is \[nan, 0.0, 6.0\]"),
         ("woodification origins (n, 2)", lambda: _woodify().origins(np.zeros((2, 2))),
@@ -727,6 +730,13 @@ def _scan_file():
     path = Path(tempfile.mkdtemp(prefix="woodcam-doors-")) / "scan.png"
     Image.fromarray(np.random.default_rng(0).integers(0, 255, (40, 40, 3), dtype=np.uint8)).save(path)
     return path
+
+
+def _mokume_folder():
+    """A Mokume sample folder of one face: A_col.png, the 40 x 40 px scan of :func:`_scan_file`."""
+    scan = _scan_file()
+    scan.rename(scan.with_name("A_col.png"))
+    return scan.parent
 
 
 def _baked_box():

@@ -62,7 +62,7 @@ from .._atomic import all_or_nothing, atomic_path, output_folder, write_text
 from .._readers import photo_rgb8, read_image_file
 from ..errors import BlockFolderError, WoodcamError, WoodcamWarning
 from ..fields.state import field_from_state, field_type, jsonable
-from ..frames import FACES, MOKUME_LETTER
+from ..frames import FACES, MOKUME_LETTER, check_size
 from ..tolerances import KNOT_POINT_MAX_PX, KNOT_REGION_SMOOTH_PX
 from .block import Block, Face, RingTrace
 
@@ -459,6 +459,7 @@ def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *
         When the folder has no Mokume files, or images of one face differ in size.
     """
     folder = check_path(folder, "read_mokume: folder", fix="a Mokume sample folder such as shared/data/mokume/H11")
+    size = tuple(check_size(size_mm).tolist())  # -1 was "'int' object is not iterable", after every image was read
     if not folder.is_dir():
         raise WoodcamError(f"folder must be a Mokume sample folder; {str(folder)!r} is not a directory")
     faces = {}
@@ -494,9 +495,9 @@ def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *
             f"folder {str(folder)!r} must hold Mokume files like A_col.png or A_arl-unet.png; found none"
         )
     meta = {"source": "mokume", "folder": str(folder.resolve()),
-            "size_assumed_mm": [float(s) for s in size_mm],
+            "size_assumed_mm": list(size),
             "note": "Mokume cubes are normalised; size_mm was given to read_mokume, not measured"}
-    return Block(tuple(size_mm), faces=faces, name=name or folder.name, meta=meta)
+    return Block(size, faces=faces, name=name or folder.name, meta=meta)
 
 
 # -- real blocks from image files ----------------------------------------------------------------
