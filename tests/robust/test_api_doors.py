@@ -185,6 +185,10 @@ def _wrong_types_and_shapes():
         ("block face not a Face", lambda: Block((10, 10, 10), faces={"top": 5}), r"Block.faces\['top'\] must be a Face"),
         ("missing face", lambda: Block((10, 10, 10)).face_pixel_size_mm("top"), "face 'top' is not known on block"),
         ("trace of letters", lambda: RingTrace("ab"), "points_px of a ring trace must be"),
+        ("trace of complex points *", lambda: RingTrace(np.zeros((3, 2)) + 1j),
+         r"points_px of a ring trace must be \(row, col\) real numbers, shape \(k >= 2, 2\); got an array of "
+         r"complex numbers \(dtype complex128, shape \(3, 2\)\); pass real numbers \(e\.g\. np\.real\(points_px\)"),
+        ("trace with None", lambda: RingTrace([[0, 0], [1, None]]), r"\(row, col\) real numbers.*got \[\[0, 0\], \[1, None\]\]"),
         ("image_shape scalar", lambda: frames.pixel_to_block("top", 1, 1, 5, (9, 9, 9)), "image_shape must be"),
         ("image_shape NaN", lambda: frames.pixel_to_block("top", 1, 1, (np.nan, 9), (9, 9, 9)), "image_shape must be"),
         ("image_shape 10.7 *", lambda: frames.pixel_to_block("top", 1, 1, (10.7, 9), (9, 9, 9)), "image_shape must be"),

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import as_floats, numbers_fix, received
 from ..errors import WoodcamError
 from ..frames import FACES, FaceName, check_face, check_size, face_image_size_mm, pixel_to_block
 
@@ -43,11 +44,11 @@ class RingTrace:
     def __post_init__(self):
         from ..limits import limit
 
-        try:
-            p = np.asarray(self.points_px, dtype=float)
-        except (TypeError, ValueError) as err:  # "ab": not numbers
-            raise WoodcamError(f"points_px of a ring trace must be (row, col) numbers, shape (k >= 2, 2); "
-                               f"got {self.points_px!r}") from err
+        p = as_floats(self.points_px)
+        if p is None:  # "ab"; complex points lost their imaginary parts under numpy's ComplexWarning
+            fix = numbers_fix(self.points_px, "points_px")
+            raise WoodcamError(f"points_px of a ring trace must be (row, col) real numbers, shape (k >= 2, 2); "
+                               f"got {received(self.points_px)}" + (f"; {fix}" if fix else ""))
         if p.ndim != 2 or p.shape[1] != 2 or len(p) < 2:
             raise WoodcamError(
                 f"points_px of a ring trace must have shape (k >= 2, 2) as (row, col); got {p.shape}"
