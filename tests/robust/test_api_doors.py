@@ -1406,3 +1406,25 @@ def test_complex_normals_and_exact_object_numbers():
         wood.color([[1.0, 2.0, 3.0]], np.array([[0.0, 0.0, 1.0]]) + 0j)
     exact = np.array([[Fraction(1), 2, 3]], dtype=object)
     assert np.array_equal(w.evaluate(wood.field, exact), w.evaluate(wood.field, [[1.0, 2.0, 3.0]]))
+
+
+def test_woodify_paint_refuses_complex_numbers():
+    """Brush(centre_mm=complex) and woodify(vertex_gain=/vertex_direction= complex) took the real
+    parts under numpy's ComplexWarning alone (a painted stroke where the user's numbers did not
+    put it); now each is refused naming the argument."""
+    import trimesh
+
+    import woodcam as w
+    from woodcam.woodify import woodify
+
+    with pytest.raises(WoodcamError, match=r"brush centre_mm must be three finite numbers \(x, y, z\); got "
+                                           r"array\(\[0\.\+1\.j"):
+        w.Brush(np.array([0.0, 0.0, 0.0]) + 1j, 5)
+    ball = trimesh.creation.icosphere(radius=5, subdivisions=2)
+    n = len(ball.vertices)
+    with pytest.raises(WoodcamError, match=rf"vertex_gain must be {n} finite values > 0, one per vertex of the "
+                                           rf"mesh; got an array of complex numbers \(dtype complex128, shape \({n},\)\)"):
+        woodify(ball, 2, resolution=16, vertex_gain=np.ones(n) + 1j)
+    with pytest.raises(WoodcamError, match=rf"vertex_direction must be finite real numbers with shape \({n}, 3\), "
+                                           r"one wind vector per vertex of the mesh; got an array of complex numbers"):
+        woodify(ball, 2, resolution=16, vertex_direction=np.zeros((n, 3)) + 1j)

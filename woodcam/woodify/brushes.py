@@ -26,7 +26,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._checks import check_path, check_vector, did_you_mean
+from .._checks import as_floats, check_path, check_vector, did_you_mean, received
 from .._readers import read_json_file
 from ..errors import WoodcamError
 from ..fields.base import check_points
@@ -43,9 +43,8 @@ class Brush:
     strength: float = 0.0
 
     def __post_init__(self):
-        c = np.asarray(self.centre_mm, float)
-        if c.shape != (3,) or not np.all(np.isfinite(c)):
-            raise WoodcamError(f"brush centre_mm must be 3 finite numbers (mm); got {self.centre_mm!r}")
+        # complex numbers lost their imaginary parts under numpy's ComplexWarning
+        check_vector(self.centre_mm, "brush centre_mm", fix="the stroke's centre in mm, e.g. (0, 0, 10)")
         for name in ("radius_mm", "gain", "strength"):  # '5' was a TypeError of np.isfinite
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, numbers.Real):
@@ -142,22 +141,17 @@ def check_vertex_paint(vertex_gain, vertex_direction,
     the grid sizing)."""
     vg = vd = None
     if vertex_gain is not None:
-        try:
-            vg = np.asarray(vertex_gain, float)
-        except (TypeError, ValueError):
-            vg = np.empty(0)
-        if vg.shape != (n_vertices,) or not np.all(np.isfinite(vg) & (vg > 0)):
+        vg = as_floats(vertex_gain)  # complex gains lost their imaginary parts (ComplexWarning)
+        if vg is None or vg.shape != (n_vertices,) or not np.all(np.isfinite(vg) & (vg > 0)):
+            got = received(vertex_gain) if vg is None else f"shape {vg.shape}" + (
+                "" if vg.shape != (n_vertices,) else " with a value <= 0, NaN or inf")
             raise WoodcamError(f"vertex_gain must be {n_vertices} finite values > 0, one per vertex of "
-                               f"the mesh; got shape {vg.shape}" + ("" if vg.shape != (n_vertices,) else
-                                                                   " with a value <= 0, NaN or inf")
-                               + "; e.g. np.ones(len(mesh.vertices))")
+                               f"the mesh; got {got}; e.g. np.ones(len(mesh.vertices))")
     if vertex_direction is not None:
-        try:
-            vd = np.asarray(vertex_direction, float)
-        except (TypeError, ValueError):
-            vd = np.empty(0)
-        if vd.shape != (n_vertices, 3) or not np.all(np.isfinite(vd)):
-            raise WoodcamError(f"vertex_direction must be finite with shape ({n_vertices}, 3), one wind "
-                               f"vector per vertex of the mesh; got shape {vd.shape}"
-                               + ("" if vd.shape != (n_vertices, 3) else " with NaN or inf"))
+        vd = as_floats(vertex_direction)
+        if vd is None or vd.shape != (n_vertices, 3) or not np.all(np.isfinite(vd)):
+            got = received(vertex_direction) if vd is None else f"shape {vd.shape}" + (
+                "" if vd.shape != (n_vertices, 3) else " with NaN or inf")
+            raise WoodcamError(f"vertex_direction must be finite real numbers with shape ({n_vertices}, 3), "
+                               f"one wind vector per vertex of the mesh; got {got}")
     return vg, vd
