@@ -1428,3 +1428,20 @@ def test_woodify_paint_refuses_complex_numbers():
     with pytest.raises(WoodcamError, match=rf"vertex_direction must be finite real numbers with shape \({n}, 3\), "
                                            r"one wind vector per vertex of the mesh; got an array of complex numbers"):
         woodify(ball, 2, resolution=16, vertex_direction=np.zeros((n, 3)) + 1j)
+
+
+def test_growth_speed_methods_refuse_none_and_complex():
+    """GrowthSpeed.tau(None) was NaN, .years(None) NaN and .speed(None) 0 mm/year, without a word
+    (np.asarray(None, float) is NaN); complex years lost their imaginary parts under numpy's
+    ComplexWarning. The valid calls beside them keep their answers."""
+    import woodcam as w
+
+    gs = w.GrowthSpeed(10, 2)
+    for call, name in ((lambda: gs.tau(None), "years"), (lambda: gs.years(None), "tau_mm"),
+                       (lambda: gs.speed(None), "years"), (lambda: gs.speed(1.0, [None, 0, 1]), "normals")):
+        with pytest.raises(WoodcamError, match=rf"{name} must be real numbers \(any shape\); got \[?None"):
+            call()
+    with pytest.raises(WoodcamError, match=r"years must be real numbers .*complex numbers .*np\.real\(years\)"):
+        gs.tau(np.array([1.0 + 1j]))
+    assert gs.years(gs.tau(3.0)) == pytest.approx(3.0, abs=1e-9)
+    assert np.array_equal(gs.speed([1, 2]), gs.speed(np.array([1.0, 2.0])))
