@@ -1445,3 +1445,19 @@ def test_growth_speed_methods_refuse_none_and_complex():
         gs.tau(np.array([1.0 + 1j]))
     assert gs.years(gs.tau(3.0)) == pytest.approx(3.0, abs=1e-9)
     assert np.array_equal(gs.speed([1, 2]), gs.speed(np.array([1.0, 2.0])))
+
+
+def test_simulate_refuses_a_complex_stock_size_and_work_offset():
+    """simulate(size_mm=complex) and work_offset_mm=complex were taken as their real parts under
+    numpy's ComplexWarning alone; a valid size given as a list still simulates."""
+    import woodcam as w
+
+    prog = w.read_gcode("G0 X-3 Y5 Z2\nG1 Z-1 F100\nG1 X13\n")
+    tool = w.parse_tool_spec("flat:3")
+    with pytest.raises(WoodcamError, match=r"simulate: size_mm must be \(W, D, H\) finite and > 0 in mm, got "
+                                           r"array\(\[10\.\+1\.j"):
+        w.simulate(prog, tool, np.array([10.0, 10.0, 10.0]) + 1j, resolution_mm=0.5)
+    with pytest.raises(WoodcamError, match=r"simulate: work_offset_mm must be three finite numbers \(X, Y, Z\) "
+                                           r"in mm; got array\(\[0\.\+1\.j"):
+        w.simulate(prog, tool, (10, 10, 10), resolution_mm=0.5, work_offset_mm=np.zeros(3) + 1j)
+    assert w.simulate(prog, tool, [10, 10, 10], resolution_mm=0.5).heightmap.shape == (20, 20)

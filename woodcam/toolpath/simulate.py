@@ -237,16 +237,13 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     """
     # resolution_mm=True or '0.5' was float()'s 1.0 and 0.5 without a word
     check_number(resolution_mm, "simulate: resolution_mm", lo=0, lo_open=True, fix="use e.g. 0.1")
-    try:  # strings, inf and short vectors were bare ValueError/TypeError/OverflowError
-        size = np.asarray(size_mm, float).reshape(-1)
-        res_mm = float(resolution_mm)
-        off_in = None if work_offset_mm is None else np.asarray(work_offset_mm, float).reshape(-1)
-    except (TypeError, ValueError) as err:
-        raise WoodcamError(f"simulate: size_mm, resolution_mm and work_offset_mm must be numbers; got "
-                           f"{size_mm!r}, {resolution_mm!r}, {work_offset_mm!r}") from err
-    if size.shape != (3,) or not np.all(np.isfinite(size) & (size > 0)):
+    # strings and short vectors were bare ValueError/TypeError; complex numbers were taken as
+    # their real parts under numpy's ComplexWarning
+    size, off_in = (None if v is None else v.reshape(-1) for v in (as_floats(size_mm), as_floats(work_offset_mm)))
+    res_mm = float(resolution_mm)
+    if size is None or size.shape != (3,) or not np.all(np.isfinite(size) & (size > 0)):
         raise WoodcamError(f"simulate: size_mm must be (W, D, H) finite and > 0 in mm, got {size_mm!r}")
-    if off_in is not None and (off_in.shape != (3,) or not np.isfinite(off_in).all()):
+    if work_offset_mm is not None and (off_in is None or off_in.shape != (3,) or not np.isfinite(off_in).all()):
         raise WoodcamError(f"simulate: work_offset_mm must be three finite numbers (X, Y, Z) in mm; "
                            f"got {work_offset_mm!r}")
     resolution_mm = res_mm
