@@ -1461,3 +1461,34 @@ def test_simulate_refuses_a_complex_stock_size_and_work_offset():
                                            r"in mm; got array\(\[0\.\+1\.j"):
         w.simulate(prog, tool, (10, 10, 10), resolution_mm=0.5, work_offset_mm=np.zeros(3) + 1j)
     assert w.simulate(prog, tool, [10, 10, 10], resolution_mm=0.5).heightmap.shape == (20, 20)
+
+
+@pytest.mark.parametrize("kw, match", [
+    ({"block_size_mm": "abc"}, r"block_size_mm must be three finite sizes > 0 \(W, D, H mm\); got 'abc'"),
+    ({"block_size_mm": np.ones(3) + 1j}, r"block_size_mm must be three finite sizes > 0 .*got array\(\[1\.\+1\.j"),
+    ({"block_size_mm": (1, 1, np.inf)}, r"block_size_mm must be three finite sizes > 0 .*got \(1, 1, inf\)"),
+    ({"block_size_mm": (1, 1, 1), "block_centre_mm": "a"}, r"block_centre_mm must be three finite numbers .*got 'a'"),
+    ({"block_size_mm": (1, 1, 1), "block_centre_mm": (0, 0)}, r"block_centre_mm must be three finite numbers .*got \(0, 0\)"),
+    ({"block_size_mm": (1, 1, 1), "rotation": "a"}, r"rotation must be a proper 3x3 rotation matrix .*got 'a'"),
+], ids=["size str", "size complex", "size inf", "centre str", "centre of 2", "rotation str"])
+def test_woodified_field_placed_checks_its_block(kw, match):
+    """WoodifiedField.placed parsed its block with bare numpy calls: 'abc', a 2-vector centre and a
+    string rotation were numpy's ValueErrors, a complex size its ComplexWarning (the real parts
+    taken), an infinite size a matmul warning and a NaN origin. Now the constructor's rules, at
+    the door; the valid call beside them places the block."""
+    with pytest.raises(WoodcamError, match=match):
+        _woodified().placed(**kw)
+    placed = _woodified().placed([1, 1, 1], block_centre_mm=[1, 1, 1])
+    assert placed.block_size_mm == (1.0, 1.0, 1.0) and np.array_equal(placed.block_origin_mm, [0.5, 0.5, 0.5])
+
+
+def test_woodified_field_refuses_an_arrival_grid_of_complex_numbers():
+    """arrival_mm of complex numbers was read as its real parts under numpy's ComplexWarning, and
+    'abc' was numpy's bare ValueError."""
+    import woodcam as w
+
+    for grid, got in ((np.zeros((3, 3, 3)) + 1j, r"an array of complex numbers \(dtype complex128, shape \(3, 3, 3\)\)"),
+                      ("abc", "'abc'")):
+        with pytest.raises(WoodcamError, match=r"arrival_mm must be an \(nx, ny, nz\) grid of real numbers, each >= 2; "
+                                               rf"got {got}"):
+            w.WoodifiedField(grid, (0, 0, 0), 1.0, w.GrowthSpeed(10, 1), years_final=1.0)

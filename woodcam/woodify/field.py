@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 from scipy import ndimage
 
 from .._atomic import atomic_write
-from .._checks import as_floats, check_bool, check_number, check_rotation, check_vector, npz_path
+from .._checks import as_floats, check_bool, check_number, check_rotation, check_vector, npz_path, received
 from .._readers import read_npz
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, check_points
@@ -48,6 +48,15 @@ FORMAT = "woodcam-woodify-field-1"
 
 #: Width (mm) of the scar line drawn round an engulfed obstacle in ``evaluate``'s ``outline``.
 _SCAR_MM = 0.8
+
+
+def _block_size(value) -> np.ndarray:
+    """A woodified block's ``block_size_mm`` (W, D, H) as floats: three finite sizes > 0. The one
+    rule of the constructor and :meth:`WoodifiedField.placed`."""
+    size = as_floats(value)
+    if size is None or size.shape != (3,) or not np.all(np.isfinite(size)) or np.any(size <= 0):
+        raise WoodcamError(f"block_size_mm must be three finite sizes > 0 (W, D, H mm); got {value!r}")
+    return size
 
 
 class WoodifiedField:
@@ -83,9 +92,10 @@ class WoodifiedField:
                  block_origin_mm: ArrayLike = (0.0, 0.0, 0.0), rotation: ArrayLike | None = None,
                  block_size_mm: ArrayLike | None = None, interpolation: Interpolation = "linear",
                  stem_axis: ArrayLike | None = None) -> None:
-        T = np.asarray(arrival_mm, dtype=np.float64)
-        if T.ndim != 3 or min(T.shape) < 2:
-            raise WoodcamError(f"arrival_mm must be an (nx, ny, nz) grid, each >= 2; got {T.shape}")
+        T = as_floats(arrival_mm)  # 'a' was numpy's bare ValueError, complex its ComplexWarning
+        if T is None or T.ndim != 3 or min(T.shape) < 2:
+            got = received(arrival_mm) if T is None else T.shape
+            raise WoodcamError(f"arrival_mm must be an (nx, ny, nz) grid of real numbers, each >= 2; got {got}")
         if interpolation not in _ORDER:
             raise WoodcamError(f"interpolation must be one of {list(_ORDER)}; got {interpolation!r}")
         finite = np.isfinite(T)
@@ -117,10 +127,7 @@ class WoodifiedField:
         self.block_origin_mm = check_vector(block_origin_mm, "block_origin_mm",
                                             fix="the object-frame position of the block's origin corner")
         extent = (np.asarray(self.arrival_mm.shape) - 1) * self.spacing_mm
-        size = as_floats(extent if block_size_mm is None else block_size_mm)
-        if size is None or size.shape != (3,) or not np.all(np.isfinite(size)) or np.any(size <= 0):
-            raise WoodcamError(f"block_size_mm must be three finite sizes > 0 (W, D, H mm); got {block_size_mm!r}")
-        self.block_size_mm = tuple(float(v) for v in size)
+        self.block_size_mm = tuple(float(v) for v in _block_size(extent if block_size_mm is None else block_size_mm))
         order = _ORDER[interpolation]
         self._coeffs = (ndimage.spline_filter(self.arrival_mm, order=order, mode="nearest",
                                               output=np.float32) if order > 1 else self.arrival_mm)
@@ -194,12 +201,13 @@ class WoodifiedField:
                rotation: ArrayLike | None = None) -> WoodifiedField:
         """The same grown object with a block of ``block_size_mm`` (W, D, H) centred at
         ``block_centre_mm`` (object frame; default the grid's centre)."""
-        size = np.asarray(block_size_mm, float)
-        if size.shape != (3,) or np.any(~(size > 0)):
-            raise WoodcamError(f"block_size_mm must be three sizes > 0 (W, D, H mm); got {block_size_mm!r}")
-        R = np.eye(3) if rotation is None else np.asarray(rotation, float)
+        # 'abc' and a 2-vector centre were numpy's bare errors, complex its ComplexWarning, an
+        # infinite size a NaN origin: the constructor's rules, checked before they are used
+        size = _block_size(block_size_mm)
+        R = np.eye(3) if rotation is None else check_rotation(rotation, "rotation")
         extent = (np.asarray(self.arrival_mm.shape) - 1) * self.spacing_mm
-        c = self.origin_mm + extent / 2 if block_centre_mm is None else np.asarray(block_centre_mm, float)
+        c = self.origin_mm + extent / 2 if block_centre_mm is None else check_vector(
+            block_centre_mm, "block_centre_mm", fix="the object-frame centre of the block, mm, or None for the grid's")
         return WoodifiedField(self.arrival_mm, self.origin_mm, self.spacing_mm, self.speed,
                               self.years_final, self.obstacle_sdf_mm, c - R @ size / 2, R,
                               tuple(size), self.interpolation, self.stem_axis)
