@@ -587,6 +587,21 @@ def test_exposure_settings_are_checked():
         ColorMapAppearance("spruce", knot_lut=np.ones((4, 3)))
 
 
+@pytest.mark.parametrize("name, value, got", [
+    ("axis_luts", "abc", "'abc'; convert the text to numbers first"),
+    ("axis_luts", np.zeros((3, 32, 3)) + 0j, r"an array of complex numbers \(dtype complex128, shape \(3, 32, 3\)\); "
+                                             r"pass real numbers \(e\.g\. np\.real\(axis_luts\)"),
+    ("knot_lut", np.zeros((32, 3)) + 0j, r"an array of complex numbers \(dtype complex128, shape \(32, 3\)\)"),
+    ("axis_exposure", "a", "'a'"),
+])
+def test_fitted_tables_must_be_real_numbers(name, value, got):
+    """The fitted tables were read with np.asarray(float32): a string was numpy's bare ValueError
+    and complex numbers were taken as their real parts under numpy's ComplexWarning."""
+    kw = {name: value} | ({"exposure_span_mm": np.zeros((3, 2))} if name == "axis_exposure" else {})
+    with pytest.raises(WoodcamError, match=rf"{name} must be real numbers of shape \(.*\); got {got}"):
+        ColorMapAppearance("spruce", **kw)
+
+
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore::woodcam.errors.WoodcamWarning")  # H11's folds are flagged contradicted
 def test_h11_bakes_its_knot_dark_and_ringed_and_each_face_at_its_photos_colour(shared_data, tmp_path, monkeypatch):

@@ -23,7 +23,7 @@ from typing import Literal
 import numba
 import numpy as np
 
-from .._checks import check_number
+from .._checks import as_floats, check_number, numbers_fix, received
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, arf, check_points, check_texture_frame, grain_direction
@@ -65,6 +65,18 @@ RING_BAND_PX_PER_SIDE = (1.0, 6.0)
 KNOT_PROFILE_HARMONICS = 2
 
 RampAnchor = Literal["auto", "field", "ring_map"]
+
+
+def _lut_array(value, name: str, shape: tuple[int, ...]) -> np.ndarray:
+    """A fitted table of :class:`ColorMapAppearance` (``axis_luts``, ``knot_lut``,
+    ``axis_exposure``, ``exposure_span_mm``) as float32 of ``shape``, or the error naming it."""
+    a = as_floats(value)
+    if a is None:
+        fix = numbers_fix(value, name) or "ColorMapAppearance.fit_to_block fits it"
+        raise WoodcamError(f"{name} must be real numbers of shape {shape}; got {received(value)}; {fix}")
+    if a.shape != shape:
+        raise WoodcamError(f"{name} must have shape {shape}; got {a.shape}")
+    return a.astype(np.float32)
 
 
 @dataclass(frozen=True)
@@ -274,25 +286,18 @@ class ColorMapAppearance:
                                      ("outline_rgb", dead_outline_rgb)) if v is not None}
         if changes:
             object.__setattr__(self, "knots", replace(self.knots, **changes))
+        # each parsed by _lut_array: 'abc' was numpy's bare ValueError, complex numbers were
+        # taken as their real parts under numpy's ComplexWarning
         if self.axis_luts is not None:
-            luts = np.asarray(self.axis_luts, dtype=np.float32)
-            if luts.shape != (3, LUT_BINS, 3):
-                raise WoodcamError(f"axis_luts must have shape (3, {LUT_BINS}, 3); got {luts.shape}")
-            object.__setattr__(self, "axis_luts", luts)
+            object.__setattr__(self, "axis_luts", _lut_array(self.axis_luts, "axis_luts", (3, LUT_BINS, 3)))
         if self.knot_lut is not None:
-            lut = np.asarray(self.knot_lut, dtype=np.float32)
-            if lut.shape != (LUT_BINS, 3):
-                raise WoodcamError(f"knot_lut must have shape ({LUT_BINS}, 3); got {lut.shape}")
-            object.__setattr__(self, "knot_lut", lut)
+            object.__setattr__(self, "knot_lut", _lut_array(self.knot_lut, "knot_lut", (LUT_BINS, 3)))
         if (self.axis_exposure is None) != (self.exposure_span_mm is None):
             raise WoodcamError("axis_exposure and exposure_span_mm go together; got one without the "
                                "other: give both (ColorMapAppearance.fit_to_block fits them) or neither")
         if self.axis_exposure is not None:
-            gains = np.asarray(self.axis_exposure, dtype=np.float32)
-            span = np.asarray(self.exposure_span_mm, dtype=np.float32)
-            if gains.shape != (3, 2, 3) or span.shape != (3, 2):
-                raise WoodcamError(f"axis_exposure must have shape (3, 2, 3) and exposure_span_mm (3, 2); "
-                                   f"got {gains.shape} and {span.shape}")
+            gains = _lut_array(self.axis_exposure, "axis_exposure", (3, 2, 3))
+            span = _lut_array(self.exposure_span_mm, "exposure_span_mm", (3, 2))
             if not (np.all(np.isfinite(gains)) and np.all(gains >= 0) and np.all(np.isfinite(span))):
                 raise WoodcamError("axis_exposure must hold finite gains >= 0 and exposure_span_mm finite "
                                    f"coordinates; got {gains.tolist()} and {span.tolist()}")
