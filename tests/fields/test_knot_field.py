@@ -292,10 +292,31 @@ def test_placed_field_from_log_frame():
     assert pf(p)[0] == pytest.approx(100.0 / 2.0)
 
 
+@pytest.mark.parametrize("name, value, rule", [
+    ("k_stem", "1", r"in \[0\.1, 64\]; got '1'"),
+    ("k_knot", None, r"in \[0\.1, 64\]; got None"),
+    ("death_band_mm", 1 + 1j, r"> 0; got \(1\+1j\)"),
+    ("range_d0_mm", [1], r">= 0; got \[1\]"),
+    ("knot_noise", "abc", r"in \[0, 1\]; got 'abc'; the default is 0\.08"),
+    ("outline_mm", float("nan"), ">= 0; got nan; the default is 1"),
+    ("range_d1_mm", float("inf"), ">= 0; got inf"),
+    ("k_transition_mm", 0, "> 0; got 0; the default is 30"),
+    ("death_f_min", "x", r"; got 'x'; the default is -1\.5"),
+    ("knot_edge_sharpness", True, "> 0; got True"),
+])
+def test_every_knot_param_is_a_number_in_its_range(name, value, rule):
+    """A string, None, a complex number or a list for k_stem, k_knot, death_band_mm, butterfly,
+    outline_mm or a range was a bare TypeError of a comparison; the other eight parameters were
+    kept as given ('abc', NaN, True) until a field was evaluated, NaN passed 'outline_mm < 0' and
+    inf the range check."""
+    with pytest.raises(WoodcamError, match=rf"KnotParams\.{name} must be a finite number.*{rule}"):
+        KnotParams(**{name: value})
+
+
 def test_params_are_checked():
     with pytest.raises(WoodcamError, match="k_knot"):
         KnotParams(k_knot=0.0)
-    with pytest.raises(WoodcamError, match="butterfly must be in"):
+    with pytest.raises(WoodcamError, match=r"butterfly must be a finite number in \[0, 1\]"):
         KnotParams(butterfly=2.0)
     with pytest.raises(WoodcamError, match="ring_width_mm"):
         KnottedLogField(simple_log(), ring_width_mm=0)

@@ -138,21 +138,25 @@ class KnotParams:
     knot_edge_sharpness: float = 14.0
 
     def __post_init__(self):
-        for name in ("k_stem", "k_knot"):
-            v = getattr(self, name)
-            if not (0.1 <= v <= 64):
-                raise WoodcamError(f"KnotParams.{name} must be in [0.1, 64]; got {v}; "
-                                   "typical values are 1.5 (stem) and 5 (knot)")
+        # Each a finite number in its range, checked by check_number: a string, None or a complex
+        # number was a bare TypeError of the comparisons below, and the eight fields they did not
+        # compare were kept as given ('abc', NaN, a list) until the field was evaluated; NaN
+        # passed 'outline_mm < 0' and inf the range checks.
+        for name, lo, hi, lo_open in (("k_stem", 0.1, 64, False), ("k_knot", 0.1, 64, False),
+                                      ("k_transition_mm", 0, None, True), ("death_k_rate_per_mm", 0, None, False),
+                                      ("death_f_min", None, None, False), ("death_f_max", None, None, False),
+                                      ("death_f_length_mm", 0, None, True), ("death_band_mm", 0, None, True),
+                                      ("butterfly", 0, 1, False), ("range_d0_mm", 0, None, False),
+                                      ("range_k0", 0, None, False), ("range_d1_mm", 0, None, False),
+                                      ("range_k1", 0, None, False), ("knot_noise", 0, 1, False),
+                                      ("outline_mm", 0, None, False), ("knot_edge_sharpness", 0, None, True)):
+            default = self.__dataclass_fields__[name].default
+            check_number(getattr(self, name), f"KnotParams.{name}", lo=lo, hi=hi, lo_open=lo_open,
+                         fix=f"the default is {default:g}")
         if not (self.range_d1_mm > self.range_d0_mm >= 0 and self.range_k1 >= self.range_k0 >= 0):
             raise WoodcamError("KnotParams ranges need range_d1_mm > range_d0_mm >= 0 and "
                                f"range_k1 >= range_k0 >= 0; got d0={self.range_d0_mm}, "
                                f"d1={self.range_d1_mm}, k0={self.range_k0}, k1={self.range_k1}")
-        if not (0 <= self.butterfly <= 1):
-            raise WoodcamError(f"KnotParams.butterfly must be in [0, 1]; got {self.butterfly}")
-        if not self.death_band_mm > 0:
-            raise WoodcamError(f"KnotParams.death_band_mm must be > 0; got {self.death_band_mm}")
-        if self.outline_mm < 0:
-            raise WoodcamError(f"KnotParams.outline_mm must be >= 0 mm; got {self.outline_mm}")
 
 
 # ---------------------------------------------------------------------------------------------
