@@ -1492,3 +1492,17 @@ def test_woodified_field_refuses_an_arrival_grid_of_complex_numbers():
         with pytest.raises(WoodcamError, match=r"arrival_mm must be an \(nx, ny, nz\) grid of real numbers, each >= 2; "
                                                rf"got {got}"):
             w.WoodifiedField(grid, (0, 0, 0), 1.0, w.GrowthSpeed(10, 1), years_final=1.0)
+
+
+@pytest.mark.parametrize("up, got", [
+    (np.array([0.0, 0.0, 1.0]) + 1j, r"array\(\[0\.\+1\.j"), ("abc", "'abc'"), ((0, 0, 0), r"\(0, 0, 0\)"),
+], ids=["complex", "str", "zero"])
+def test_growth_speed_up_is_a_direction(up, got):
+    """GrowthSpeed(up=complex) was float()'s bare TypeError and up='abc' numpy's ValueError (its
+    own parser, _unit3); now the one rule of a direction (check_vector), and a valid up is made
+    unit as before."""
+    import woodcam as w
+
+    with pytest.raises(WoodcamError, match=rf"up must be (three finite numbers \(x, y, z\)|a non-zero direction); got {got}"):
+        w.GrowthSpeed(10, 2, up=up)
+    assert w.GrowthSpeed(10, 2, up=(0, 0, 2)).up == (0.0, 0.0, 1.0)

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._checks import as_floats, numbers_fix, received
+from .._checks import as_floats, check_vector, numbers_fix, received
 from ..errors import WoodcamError
 
 
@@ -53,14 +53,6 @@ def weibull_cdf_inv(q, shape: float = 2.0) -> np.ndarray:
     q = np.clip(np.asarray(q, dtype=float), 0.0, 1.0)
     with np.errstate(divide="ignore"):
         return (-np.log1p(-q)) ** (1.0 / shape)
-
-
-def _unit3(v, name: str) -> np.ndarray:
-    a = np.asarray(v, dtype=float)
-    n = float(np.linalg.norm(a)) if a.shape == (3,) else 0.0
-    if a.shape != (3,) or not np.isfinite(n) or n < 1e-12:
-        raise WoodcamError(f"{name} must be a non-zero 3-vector; got {v!r}; e.g. (0, 0, 1)")
-    return a / n
 
 
 def _numbers(value, name: str) -> np.ndarray:
@@ -119,7 +111,10 @@ class GrowthSpeed:
             raise WoodcamError(
                 f"eccentricity must lie in (-1, 1) so every normal keeps growing; got "
                 f"{self.eccentricity!r}; try 0.3")
-        object.__setattr__(self, "up", tuple(_unit3(self.up, "up")))
+        # its own parser (_unit3) read complex numbers with float()'s bare TypeError and a
+        # string as numpy's ValueError: the one rule of a direction instead
+        up = check_vector(self.up, "up", unit=True, fix="the growth's up direction, e.g. (0, 0, 1)")
+        object.__setattr__(self, "up", tuple(float(v) for v in up))
 
     @property
     def wind(self) -> np.ndarray:
