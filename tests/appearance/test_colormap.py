@@ -7,7 +7,7 @@ from woodcam.appearance import ColorMapAppearance, Wood, axis_weights, blend_axi
 from woodcam.appearance.colormap import LUT_BINS
 from woodcam.block import Block, Face
 from woodcam.errors import WoodcamError
-from woodcam.fields import LogFrame, arf
+from woodcam.fields import LogFrame, arf, builtin_block
 from woodcam.fields.radial import RadialScalingField
 from woodcam.frames import FACE_NORMAL, FACES, face_image_size_mm, face_pixel_points
 
@@ -585,6 +585,27 @@ def test_exposure_settings_are_checked():
         ColorMapAppearance("spruce", axis_exposure=np.ones((3, 3)), exposure_span_mm=np.zeros((3, 2)))
     with pytest.raises(WoodcamError, match="knot_lut must have shape"):
         ColorMapAppearance("spruce", knot_lut=np.ones((4, 3)))
+
+
+@pytest.mark.parametrize("normals, said", [
+    (np.array([[0.0, 0.0, 1.0]], np.float32), r"normals must have the shape of points_mm \(5, 3\); got \(1, 3\)"),
+    ([[0.0, 0.0, 1.0]], r"must have the shape of points_mm \(5, 3\); got \(1, 3\)"),
+    (None, r"must be real numbers with the shape of points_mm \(5, 3\); got None"),
+    (np.zeros((5, 3)) + 1j, "got an array of complex numbers"),
+], ids=["one float32 normal", "one normal", "None", "complex"])
+def test_the_appearance_checks_the_normals_it_is_given(normals, said):
+    """ColorMapAppearance.color (the appearance seam, public) passed its normals to the compiled
+    kernel as np.asarray(float32): one normal for five points was read past its end (NaN and
+    another array's memory as colours, no error), None was numba's TypingError, complex normals
+    lost their imaginary parts. What Wood.color passes (float32 (n, 3), checked there) gives the
+    same colours as before."""
+    field = builtin_block("flat-sawn").field
+    app = ColorMapAppearance("oak")
+    pts = np.random.default_rng(0).uniform(0, 40, (5, 3))
+    with pytest.raises(WoodcamError, match=said):
+        app.color(field, pts, normals)
+    up = np.tile(np.float32([0, 0, 1]), (5, 1))
+    assert np.array_equal(app.color(field, pts, up), Wood(field, app).color(pts, up))
 
 
 @pytest.mark.parametrize("name, value, got", [

@@ -326,7 +326,16 @@ class ColorMapAppearance:
         The three per-axis colourings blended by eq. 10 (:func:`blend_axis_colors`), computed
         in one compiled pass per point.
         """
-        return self._shade(field, points_mm, np.asarray(normals, np.float32))
+        p = check_points(points_mm)
+        if not (isinstance(normals, np.ndarray) and normals.dtype == np.float32 and normals.shape == p.shape):
+            # Anything but what Wood.color passes (float32 (n, 3), checked there) is checked here:
+            # one normal for n points was read past its end by the compiled kernel (NaN or another
+            # array's memory as colours), None was numba's TypingError, complex normals lost their
+            # imaginary parts. wood.py imports this module, so its rule is imported here.
+            from .wood import check_normals
+
+            normals = check_normals(normals, p.shape)
+        return self._shade(field, p, normals)
 
     def _shade(self, field, points_mm, normals):
         p = check_points(points_mm)
