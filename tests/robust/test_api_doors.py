@@ -1506,3 +1506,21 @@ def test_growth_speed_up_is_a_direction(up, got):
     with pytest.raises(WoodcamError, match=rf"up must be (three finite numbers \(x, y, z\)|a non-zero direction); got {got}"):
         w.GrowthSpeed(10, 2, up=up)
     assert w.GrowthSpeed(10, 2, up=(0, 0, 2)).up == (0.0, 0.0, 1.0)
+
+
+@pytest.mark.parametrize("dirs, got", [
+    (None, "None"), ("abc", "'abc'"), (np.zeros((2, 2)), r"shape \(2, 2\)"),
+    (np.zeros((1, 3)) + 1j, r"an array of complex numbers \(dtype complex128, shape \(1, 3\)\)"),
+], ids=["None", "str", "(n, 2)", "complex"])
+def test_log_frame_rotates_only_direction_vectors(dirs, got):
+    """LogFrame.direction_to_block/direction_to_log gave einsum's bare ValueErrors for None and
+    (n, 2), numpy's for 'abc', and took complex vectors' real parts under the ComplexWarning; a
+    direction turned there and back is itself, and a NaN direction stays NaN."""
+    import woodcam as w
+
+    frame = w.LogFrame((1, 2, 3), (1, 0, 0))
+    for turn, name in ((frame.direction_to_block, "dirs_log"), (frame.direction_to_log, "dirs_mm")):
+        with pytest.raises(WoodcamError, match=rf"{name} must be direction vectors of real numbers, shape \(n, 3\); got {got}"):
+            turn(dirs)
+    assert np.allclose(frame.direction_to_log(frame.direction_to_block([[0, 0, 1]])), [[0, 0, 1]])
+    assert np.isnan(frame.direction_to_log([[np.nan, 0.0, 1.0]])).all()

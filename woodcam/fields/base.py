@@ -226,11 +226,25 @@ class LogFrame:
 
     def direction_to_block(self, dirs_log: ArrayLike) -> np.ndarray:
         """Rotate log-frame direction vectors ``(n, 3)`` into the block frame."""
-        return np.einsum("ij,jk->ik", np.asarray(dirs_log, dtype=float), self._rot)
+        return np.einsum("ij,jk->ik", _directions(dirs_log, "dirs_log"), self._rot)
 
     def direction_to_log(self, dirs_mm: ArrayLike) -> np.ndarray:
         """Rotate block-frame direction vectors ``(n, 3)`` (fibres, normals) into the log frame."""
-        return np.einsum("ij,kj->ik", np.asarray(dirs_mm, dtype=float), self._rot)
+        return np.einsum("ij,kj->ik", _directions(dirs_mm, "dirs_mm"), self._rot)
+
+
+def _directions(value, name: str) -> np.ndarray:
+    """Direction vectors ``(n, 3)`` as floats for :class:`LogFrame`'s rotations: None and (n, 2)
+    were einsum's bare ValueErrors, 'abc' numpy's, complex vectors lost their imaginary parts
+    under numpy's ComplexWarning. Not checked for finite values (a fibre direction may be NaN
+    where a field is not defined, and stays NaN)."""
+    a = as_floats(value)
+    if a is None or a.ndim != 2 or a.shape[1] != 3:
+        fix = numbers_fix(value, name) if a is None else ""
+        raise WoodcamError(f"{name} must be direction vectors of real numbers, shape (n, 3); got "
+                           f"{received(value) if a is None else f'shape {a.shape}'}; "
+                           + (fix or "e.g. [[0, 0, 1]]"))
+    return a
 
 
 def check_texture_frame(frame) -> "LogFrame | None":
