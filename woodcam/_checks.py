@@ -69,6 +69,25 @@ def as_floats(value) -> np.ndarray | None:
         return None
 
 
+def real_numbers(value, name: str, *, finite: bool = False, fix: str = "") -> np.ndarray:
+    """``value`` (real numbers of any shape: a number, a list, an array) as floats, or the
+    WoodcamError naming ``name``: the one rule of an argument that is numbers and nothing more
+    (a growth time, an axial position, a radius). ``np.asarray(value, float)`` took None as NaN
+    (a NaN answer without a word), complex numbers as their real parts (numpy's ComplexWarning
+    only) and 'abc' as numpy's bare ValueError. NaN and inf pass: each method says what they
+    give; ``finite=True`` refuses them (a value that indexes a grid: NaN was cast to an
+    integer, numpy's RuntimeWarning and another cell's value)."""
+    a = as_floats(value)
+    if a is None:
+        fix = numbers_fix(value, name) or fix or f"e.g. {name}=10.0 or an array of them"
+        raise WoodcamError(f"{name} must be real numbers (any shape); got {received(value)}; {fix}")
+    if finite and not np.all(np.isfinite(a)):
+        bad = a.ravel()[np.argmin(np.isfinite(a).ravel())]
+        raise WoodcamError(f"{name} must be finite real numbers; got {bad} among {a.size}"
+                           + (f"; {fix}" if fix else ""))
+    return a
+
+
 def received(value, limit: int = 80) -> str:
     """What the user passed, for an error's "got ...": an array's kind, dtype and shape (a
     complex or text array of 10^5 points printed whole was the message), else its repr cut to

@@ -1524,3 +1524,30 @@ def test_log_frame_rotates_only_direction_vectors(dirs, got):
             turn(dirs)
     assert np.allclose(frame.direction_to_log(frame.direction_to_block([[0, 0, 1]])), [[0, 0, 1]])
     assert np.isnan(frame.direction_to_log([[np.nan, 0.0, 1.0]])).all()
+
+
+def test_log_accessors_take_real_numbers_and_grid_lookups_finite_ones():
+    """LogSkeleton.pith_at/radius_at/knot_point and GeneratedLog.base_radius/outer_radius read
+    their numbers with np.asarray(float): None was NaN (pith_at(None) -> [nan, nan] without a
+    word), 'abc' numpy's bare ValueError, complex numbers their real parts under numpy's
+    ComplexWarning, and a NaN height or azimuth of the radius lookups was cast to a grid index
+    (numpy's RuntimeWarning and another cell's radius). The valid calls keep their answers."""
+    import woodcam as w
+
+    log = w.generate_log(1, length_mm=200)
+    sk = log.to_skeleton()
+    calls = {"pith_at": (sk.pith_at, "z_mm"), "radius_at": (lambda v: sk.radius_at(v, 0.0), "z_mm"),
+             "radius_at azimuth": (lambda v: sk.radius_at(10.0, v), "azimuth_rad"),
+             "knot_point": (lambda v: sk.knot_point(0, v), "r_mm"),
+             "base_radius": (lambda v: log.base_radius(v, 0.0), "l_mm"),
+             "outer_radius": (lambda v: log.outer_radius(v, 0.0), "l_mm")}
+    for call, name in calls.values():
+        for bad, got in ((None, "None"), ("abc", "'abc'"), (np.array([1.0 + 1j]), "an array of complex numbers")):
+            with pytest.raises(WoodcamError, match=rf"{name} must be real numbers \(any shape\); got {got}"):
+                call(bad)
+    for call, name in (calls["radius_at"], calls["radius_at azimuth"], calls["outer_radius"]):
+        with pytest.raises(WoodcamError, match=rf"{name} must be finite real numbers; got nan among 1"):
+            call(np.nan)
+    assert np.isnan(sk.pith_at(np.nan)).all()  # NaN in, NaN out: pith_at indexes no grid
+    assert np.array_equal(sk.radius_at([10.0, 20.0], 0.0), [sk.radius_at(10.0, 0.0), sk.radius_at(20.0, 0)])
+    assert np.allclose(log.outer_radius([10.0], [0.0]), sk.radius_at(10.0, 0.0))

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import as_floats
+from .._checks import as_floats, real_numbers
 from .._types import ArrayLike
 from ..errors import WoodcamError
 
@@ -253,7 +253,7 @@ class LogSkeleton:
 
     def pith_at(self, z_mm: ArrayLike) -> np.ndarray:
         """Pith ``(x, y)`` at heights ``z_mm (n,)`` -> ``(n, 2)`` mm (clamped at the ends)."""
-        z = np.asarray(z_mm, float)
+        z = real_numbers(z_mm, "z_mm")
         return np.stack([np.interp(z, self.pith_z_mm, self.pith_xy_mm[:, 0]),
                          np.interp(z, self.pith_z_mm, self.pith_xy_mm[:, 1])], axis=-1)
 
@@ -262,12 +262,13 @@ class LogSkeleton:
 
         Bilinear in (height, azimuth), periodic in azimuth, clamped in height.
         """
-        z = np.asarray(z_mm, float)
+        # None or NaN was cast to a grid index (numpy's RuntimeWarning and another row's radius)
+        z = real_numbers(z_mm, "z_mm", finite=True)
         a = self.radii_mm.shape[1]
         fz = np.interp(z, self.pith_z_mm, np.arange(len(self.pith_z_mm), dtype=float))
         iz = np.minimum(fz.astype(int), len(self.pith_z_mm) - 2)
         tz = fz - iz
-        fa = np.mod(np.asarray(azimuth_rad, float), 2 * np.pi) * (a / (2 * np.pi))
+        fa = np.mod(real_numbers(azimuth_rad, "azimuth_rad", finite=True), 2 * np.pi) * (a / (2 * np.pi))
         ia = np.floor(fa).astype(int) % a
         ta = fa - np.floor(fa)
         ia1 = (ia + 1) % a
@@ -279,7 +280,7 @@ class LogSkeleton:
     def knot_point(self, index: int, r_mm: ArrayLike) -> np.ndarray:
         """Log-frame points ``(n, 3)`` on knot ``index``'s axis at pith distances ``r_mm (n,)``."""
         k = self.knots[index]
-        r = np.atleast_1d(np.asarray(r_mm, float))
+        r = np.atleast_1d(real_numbers(r_mm, "r_mm"))
         z, w = k.axis_at(r)
         p = self.pith_at(z)
         return np.stack([p[:, 0] + r * np.cos(w), p[:, 1] + r * np.sin(w), z], axis=-1)

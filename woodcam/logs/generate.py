@@ -58,7 +58,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._checks import check_number
+from .._checks import check_number, real_numbers
 from .._types import ArrayLike
 from ..errors import WoodcamError
 from ..fields.skeleton import KNOT_TABLE_SAMPLES, BranchStrand, LogSkeleton
@@ -335,8 +335,8 @@ class GeneratedLog:
 
     def base_radius(self, l_mm: ArrayLike, theta_rad: ArrayLike) -> np.ndarray:
         """Smooth outer radius ``(n,)`` mm (thickness + base shape, no bumps or grain)."""
-        l = np.asarray(l_mm, float).reshape(-1)
-        t = np.asarray(theta_rad, float).reshape(-1)
+        l = real_numbers(l_mm, "l_mm").reshape(-1)
+        t = real_numbers(theta_rad, "theta_rad").reshape(-1)
         return self.thickness(l) + self.base.at(l, t)
 
     def outer_radius(self, l_mm: ArrayLike, theta_rad: ArrayLike,
@@ -350,8 +350,9 @@ class GeneratedLog:
             return self.base_radius(l_mm, theta_rad)
         if detail != "full":
             raise WoodcamError(f"detail must be 'full' or 'base'; got {detail!r}")
-        l = np.asarray(l_mm, float).reshape(-1)
-        t = np.asarray(theta_rad, float).reshape(-1)
+        # None or NaN was cast to a height-map index (numpy's RuntimeWarning and another cell)
+        l = real_numbers(l_mm, "l_mm", finite=True).reshape(-1)
+        t = real_numbers(theta_rad, "theta_rad", finite=True).reshape(-1)
         n_l, n_t = self.heightmap_mm.shape
         fi = np.clip(l / self.length_mm * (n_l - 1), 0, n_l - 1 - 1e-9)
         fj = np.mod(t, 2 * np.pi) / (2 * np.pi) * n_t

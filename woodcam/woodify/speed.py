@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._checks import as_floats, check_vector, numbers_fix, received
+from .._checks import check_vector, real_numbers
 from ..errors import WoodcamError
 
 
@@ -53,18 +53,6 @@ def weibull_cdf_inv(q, shape: float = 2.0) -> np.ndarray:
     q = np.clip(np.asarray(q, dtype=float), 0.0, 1.0)
     with np.errstate(divide="ignore"):
         return (-np.log1p(-q)) ** (1.0 / shape)
-
-
-def _numbers(value, name: str) -> np.ndarray:
-    """``value`` (numbers of any shape) as floats for :class:`GrowthSpeed`'s methods: None was
-    taken as NaN (``tau(None)`` nan, ``speed(None)`` 0 mm/year) and complex numbers as their
-    real parts under numpy's ComplexWarning, each without a word."""
-    a = as_floats(value)
-    if a is None:
-        fix = numbers_fix(value, name)
-        raise WoodcamError(f"{name} must be real numbers (any shape); got {received(value)}; "
-                           + (fix or f"e.g. {name}=10.0 or an array of them"))
-    return a
 
 
 @dataclass(frozen=True)
@@ -123,7 +111,7 @@ class GrowthSpeed:
 
     def tau(self, years: ArrayLike) -> np.ndarray:
         """Pseudo-time ``tau = v W(t / lambda)`` (mm) reached at ``years``."""
-        t = _numbers(years, "years")
+        t = real_numbers(years, "years")
         return self.velocity_mm * weibull_cdf(t / self.time_scale_years, self.shape)
 
     def years(self, tau_mm: ArrayLike) -> np.ndarray:
@@ -131,17 +119,17 @@ class GrowthSpeed:
 
         ``T <= 0`` (the input object itself) maps to 0; ``T >= v`` (never reached) to ``inf``.
         """
-        q = _numbers(tau_mm, "tau_mm") / self.velocity_mm
+        q = real_numbers(tau_mm, "tau_mm") / self.velocity_mm
         return self.time_scale_years * weibull_cdf_inv(q, self.shape)
 
     def speed(self, years: ArrayLike, normals: ArrayLike | None = None) -> np.ndarray:
         """Normal speed ``ds/dt`` (mm/year) at ``years`` for unit ``normals (n, 3)`` (eq. 4.1
         with the eccentric factor); without normals the isotropic speed."""
         lam = self.time_scale_years
-        s = self.velocity_mm / lam * weibull_speed(_numbers(years, "years") / lam, self.shape)
+        s = self.velocity_mm / lam * weibull_speed(real_numbers(years, "years") / lam, self.shape)
         if normals is None:
             return s
-        n = _numbers(normals, "normals")
+        n = real_numbers(normals, "normals")
         return s * (1.0 + n @ self.wind)
 
     def to_dict(self) -> dict:
