@@ -1551,3 +1551,25 @@ def test_log_accessors_take_real_numbers_and_grid_lookups_finite_ones():
     assert np.isnan(sk.pith_at(np.nan)).all()  # NaN in, NaN out: pith_at indexes no grid
     assert np.array_equal(sk.radius_at([10.0, 20.0], 0.0), [sk.radius_at(10.0, 0.0), sk.radius_at(20.0, 0)])
     assert np.allclose(log.outer_radius([10.0], [0.0]), sk.radius_at(10.0, 0.0))
+
+
+def test_stem_pith_tool_profile_and_ramp_take_real_numbers():
+    """StemField.pith_mm(None) was a NaN pith point and Tool.profile(None) +inf ('outside the
+    tool'), each without a word; ColorMapAppearance.ramp(None) an IndexError; 'a' was numpy's
+    bare ValueError and complex numbers their real parts under numpy's ComplexWarning for all
+    three. The valid calls keep their answers."""
+    import woodcam as w
+
+    stem = w.StemField(np.array([20.0, 15.0, 10.0]), np.array([0.0, 0.0, 1.0]), 50.0, np.zeros((2, 3)), 0, 0, 2,
+                       np.array([0.5]), np.array([0.0]), 10.0)
+    ball = w.parse_tool_spec("ball:6")
+    app = w.ColorMapAppearance()
+    for call, name in ((stem.pith_mm, "t_mm"), (ball.profile, "r_mm"), (app.ramp, "arf_values")):
+        for bad, got in ((None, "None"), ("a", "'a'"), (np.array([1.0 + 1j]), "an array of complex numbers")):
+            with pytest.raises(WoodcamError, match=rf"{name} must be real numbers \(any shape\); got {got}"):
+                call(bad)
+    with pytest.raises(WoodcamError, match=r"arf_values must be one ARF value per point, shape \(n,\); got shape \(\)"):
+        app.ramp(0.5)
+    assert np.array_equal(stem.pith_mm([0, 10]), [[20, 15, 10], [20, 15, 20]])
+    assert ball.profile([0.0])[0] == 0.0 and ball.profile([5.0])[0] == np.inf
+    assert app.ramp([0.0, 0.95]).shape == (2, 3)

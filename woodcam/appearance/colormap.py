@@ -23,7 +23,7 @@ from typing import Literal
 import numba
 import numpy as np
 
-from .._checks import as_floats, check_number, numbers_fix, received
+from .._checks import as_floats, check_number, numbers_fix, real_numbers, received
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, arf, check_points, check_texture_frame, grain_direction
@@ -309,7 +309,11 @@ class ColorMapAppearance:
     def ramp(self, arf_values: ArrayLike) -> np.ndarray:
         """Species colour at ARF values ``(n,)`` -> ``(n, 3)`` float32 (side grain, no noise)."""
         s = self.species
-        t = _smoothstep(s.latewood_start, 1.0, np.asarray(arf_values, np.float32))[:, None]
+        a = real_numbers(arf_values, "arf_values", fix="e.g. [0.0, 0.5, 0.9]")  # None was an IndexError, 'a' numpy's ValueError
+        if a.ndim != 1:
+            raise WoodcamError(f"arf_values must be one ARF value per point, shape (n,); got shape {a.shape}; "
+                               "e.g. [0.0, 0.5, 0.9]")
+        t = _smoothstep(s.latewood_start, 1.0, a.astype(np.float32))[:, None]
         early = np.asarray(s.earlywood_rgb, np.float32)
         late = np.asarray(s.latewood_rgb, np.float32)
         return early + t * (late - early)

@@ -50,7 +50,7 @@ from itertools import islice
 
 import numpy as np
 
-from .._checks import as_floats, check_bool, check_number
+from .._checks import as_floats, check_bool, check_number, real_numbers
 from .._parallel import map_processes
 from .._types import ArrayLike
 from ..errors import WoodcamError
@@ -94,7 +94,7 @@ class StemField:
     def pith_mm(self, t_mm: ArrayLike) -> np.ndarray:
         """``(n, 3)`` pith points (block frame) at axial positions ``t_mm (n,)`` about the centre."""
         d, b1, b2 = _frame(self.base_axis)
-        t = np.asarray(t_mm, float).reshape(-1)
+        t = real_numbers(t_mm, "t_mm").reshape(-1)  # None was a NaN pith point, 'a' numpy's ValueError
         tau = t / self.half_length_mm
         pw = tau[:, None] ** np.arange(3)
         return (np.asarray(self.centre_mm, float) + t[:, None] * d

@@ -50,7 +50,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._checks import check_path
+from .._checks import check_path, real_numbers
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from ..units import message_unit, message_units, say_length
@@ -180,7 +180,7 @@ class Tool:
 
         ``+inf`` outside the tool (``r > radius_mm``).
         """
-        r = np.abs(np.asarray(r_mm, float))
+        r = np.abs(real_numbers(r_mm, "r_mm"))  # None was NaN: +inf, 'outside the tool', without a word
         out = self._h(np.minimum(r, self.radius_mm))
         return np.where(r <= self.radius_mm * (1 + 1e-12), out, np.inf)
 
