@@ -1375,6 +1375,13 @@ def _points_doors():
         ("ColorMapAppearance.color", lambda p: w.ColorMapAppearance().color(fld, p, up)),
         ("Brush.weight", w.Brush((0, 0, 0), 5).weight),
         ("block_to_pixel", lambda p: w.block_to_pixel("top", p, (10, 10), (10, 10, 10))),
+        ("LogFrame.to_log", w.LogFrame().to_log),
+        ("WoodifiedField.arrival", _woodified().arrival),
+        ("WoodifiedField.no_wood", _woodified().no_wood),
+        ("WoodifiedField.to_object", _woodified().to_object),
+        # built when called: a log and a woodify run are not made while the tests are collected
+        ("KnottedLogField", lambda p: w.KnottedLogField(_small_log())(p)),
+        ("Woodification.origins", lambda p: _woodify().origins(p)),
     ]
 
 
