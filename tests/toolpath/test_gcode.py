@@ -10,7 +10,7 @@ import pytest
 
 from woodcam.errors import WoodcamError
 from woodcam.toolpath import GcodeError, read_gcode
-from woodcam.toolpath.gcode import DEFAULT_START_MM, FEED, RAPID
+from woodcam.toolpath.gcode import DEFAULT_START_MM, FEED, RAPID, Program
 
 
 def test_moves_kinds_feeds_lines():
@@ -109,6 +109,27 @@ def test_inch_and_incremental_equal_absolute_mm():
         np.testing.assert_allclose(other.start_mm, mm.start_mm, atol=1e-9)
         np.testing.assert_allclose(other.end_mm, mm.end_mm, atol=1e-9)
     np.testing.assert_allclose(inch.feed_mm_min, mm.feed_mm_min)
+
+
+_UNITS_PROGRAM = ("G21 G90\nG0 X1 Y1 Z1\nG20 G1 X1 F10\nG0 X2\no100 sub\nG21\nG1 X3 F100\n"
+                  "G2 X5 Y1 I1 J0\no100 endsub\no100 call\nG1 X4\nG20\nG1 Y2\nM2\n")
+#: (line, inch) of _UNITS_PROGRAM's moves: a G20 on a move's own line counts for it, a G21
+#: inside a subroutine for the rest of the call and after it, until the next G20
+_UNITS_BY_LINE = [(2, False), (3, True), (4, True), (7, False), (8, False), (11, False),
+                  (13, True)]
+
+
+def test_each_move_records_the_units_it_was_programmed_in():
+    """Program recorded no units: a G20 program given tool sizes in inches, read as mm, could
+    not be told from a G21 one (the CLI's warning). Each move's ``inch`` is the G20 mode it was
+    programmed in, and slices and ``until_line`` keep it."""
+    prog = read_gcode(_UNITS_PROGRAM)
+    assert sorted(set(zip(prog.line.tolist(), prog.inch.tolist()))) == _UNITS_BY_LINE
+    assert prog.inch.dtype == bool and len(prog.inch) == len(prog)
+    assert prog[1:3].inch.tolist() == [True, True]
+    assert prog.until_line(4).inch.tolist() == [False, True, True]
+    assert not read_gcode("G0 X1 Y1 Z1\nG1 Z-1 F100\n").inch.any()
+    assert Program.from_arrays([[0, 0, 0]], [[1, 0, 0]]).inch.tolist() == [False]
 
 
 def test_drilling_cycles_expand_to_moves():

@@ -339,12 +339,12 @@ def test_feed_spindle_and_tool_agree_with_linuxcnc():
     compared = 0
     for path, res in zip(paths, run_batch(paths, start_mm=START)):
         mine, _ = Interpreter(path.read_text(), start_mm=START).run()
-        theirs = {(m[1], tuple(round(v, 6) for v in m[2])): m[6:9] for m in res["moves"]}
+        theirs = {(m[1], tuple(round(v, 6) for v in m[2])): m[6:10] for m in res["moves"]}
         for m in mine:
             t = theirs.get((m[1], tuple(round(v, 6) for v in m[2])))
             if t is not None:  # (a rapid's feed is not used: woodcam keeps 0 before any F)
-                assert (t[0] if m[0] else 0, t[1], t[2]) == (
-                    pytest.approx(m[6] if m[0] else 0), m[7], m[8]), (path.name, m)
+                assert (t[0] if m[0] else 0, t[1], t[2], t[3]) == (
+                    pytest.approx(m[6] if m[0] else 0), m[7], m[8], m[9]), (path.name, m)
                 compared += 1
     assert compared > 15000  # measured: 19103 moves of 35 programs
     # two tools, the spindle on the line of a move, a feed before G20 (mm/min, as LinuxCNC)
@@ -355,6 +355,18 @@ def test_feed_spindle_and_tool_agree_with_linuxcnc():
     assert prog.feed_mm_min[prog.kind != 0].tolist() == pytest.approx([300, 300, 200, 10])
     # (LinuxCNC stops the spindle at a tool change: T2's cuts report it off)
     assert prog.spindle_rpm.tolist()[1:] == [12000, 12000, 12000, 0, 0]
+
+
+def test_each_move_records_the_units_it_was_programmed_in_as_linuxcnc():
+    """LinuxCNC's interpreter gives each move the G20/G21 mode it was programmed in, as
+    woodcam's: a G20 on the move's line, a G21 alone on a line in a subroutine (a line the
+    module never reports), a G20 before the last move."""
+    from .test_gcode import _UNITS_BY_LINE, _UNITS_PROGRAM
+
+    prog = read_gcode(_UNITS_PROGRAM, interpreter="linuxcnc", machine_zero_mm=(0, 0, 0))
+    assert sorted(set(zip(prog.line.tolist(), prog.inch.tolist()))) == _UNITS_BY_LINE
+    mine = read_gcode(_UNITS_PROGRAM)
+    assert prog.inch.tolist() == mine.inch.tolist()
 
 
 def test_m61_keeps_the_selected_tool_for_the_next_m6_as_linuxcnc():

@@ -794,6 +794,30 @@ def test_a_grid_coarser_than_half_a_tool_is_warned(tmp_path, monkeypatch, capsys
         capsys.readouterr().err
 
 
+def test_a_g20_program_given_tool_sizes_that_look_like_inches_is_warned(tmp_path, monkeypatch, capsys):
+    """A G20 (inch) program given --tool flat:0.25 (the user meant a quarter inch, read as
+    0.25 mm) cut a hair-thin slot with no word. It is warned, with --units inch as the fix, and
+    fails --strict; a tool of 1.6 mm or more, --units inch and a G21 program are not warned."""
+    _stub_preview(monkeypatch, {})
+    prog = tmp_path / "inch.nc"
+    prog.write_text("G20 G90\nM3 S9000\nG0 X0.5 Y0.5 Z0.1\nG1 Z-0.05 F20\nG1 X2\nG0 Z0.1\nM2\n")
+    base = [str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb")]
+    assert main(["gcode", *base, "--tool", "flat:0.25", "--cell-size", "0.1"]) == 0
+    assert capsys.readouterr().err == (
+        "woodcam: warning: inch.nc: the program moves in inches (G20, from line 3) but every "
+        "--tool is under 1.6 mm (1/16 in) across, read as mm (flat:0.25); if its sizes are "
+        "inches, pass --units inch (it reads the --tool sizes and the other lengths typed in "
+        "inches)\n")
+    assert main(["gcode", *base, "--tool", "flat:0.25", "--strict"]) == 3
+    capsys.readouterr()
+    for more in (["--tool", "flat:1.6"], ["--units", "inch", "--tool", "flat:0.25"],
+                 ["--tool", "1=flat:0.5", "--tool", "0=flat:3"]):
+        assert main(["gcode", *base, *more, "--cell-size", "0.1", "--strict"]) == 0, more
+    prog.write_text(prog.read_text().replace("G20", "G21"))
+    assert main(["gcode", *base, "--tool", "flat:0.25", "--cell-size", "0.1", "--strict"]) == 0
+    assert capsys.readouterr().err == ""
+
+
 def test_a_run_scrubbed_before_the_first_move_says_its_machining_time(tmp_path, monkeypatch, capsys):
     """--until-line before the program's first move simulates no move, and the report ended in
     a dangling 'machining time ' with nothing after it. It says 0:00:00 (no moves) now."""

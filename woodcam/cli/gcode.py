@@ -164,6 +164,29 @@ def _unnumbered_diameters(args, program, diameters, text) -> dict:
     return {n: t.diameter_mm for n, t in tools.items() if n not in diameters and n != 0}
 
 
+#: A --tool under this diameter (1/16 in) in a G20 program was likely typed in inches.
+_INCH_TOOL_BELOW_MM = 1.6
+
+
+def _warn_inch_sizes_read_as_mm(args, program, name: str) -> int:
+    """Warn (and return 1) when ``program`` moves in inches (G20) and every ``--tool`` given
+    is under 1.6 mm (1/16 in) across while ``--units`` is mm: the sizes were likely typed in
+    the program's inches (``--tool flat:0.25`` read as 0.25 mm cut nothing to speak of, with no
+    word); else 0. A --tools table says its own units (``diameter_mm``) and is not questioned."""
+    from .options import parse_tool_option
+
+    if args.units != "mm" or not args.tool or not program.inch.any():
+        return 0
+    if any(parse_tool_option(item)[1].diameter_mm >= _INCH_TOOL_BELOW_MM for item in args.tool):
+        return 0
+    first = int(program.line[program.inch][0])
+    print(f"woodcam: warning: {name}: the program moves in inches (G20, from line {first}) but "
+          f"every --tool is under {_INCH_TOOL_BELOW_MM} mm (1/16 in) across, read as mm "
+          f"({', '.join(args.tool)}); if its sizes are inches, pass --units inch (it reads the "
+          "--tool sizes and the other lengths typed in inches)", file=sys.stderr)
+    return 1
+
+
 def _tools_from_args(args, program) -> dict:
     from .options import parse_tool_option
 
@@ -282,6 +305,7 @@ def run(args) -> int:
                       f"fall between the cell centres and vanish; use --cell-size "
                       f"{tool.diameter_mm / 2 / MM_PER_UNIT[args.units]:.2g} or finer", file=sys.stderr)
                 n_warn += 1
+        n_warn += _warn_inch_sizes_read_as_mm(args, program, path.name)
         step = program.stepover_mm(spacing_mm=args.cell_size)
         if step is not None and args.cell_size > step / 2:
             print(f"woodcam: warning: {path.name}: the grid ({fmt_length(args.cell_size, args.units)}) "

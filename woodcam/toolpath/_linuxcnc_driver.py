@@ -13,7 +13,7 @@ texts, which the interpreter writes to its standard output, not through the cano
 text, :func:`_said_order`; printed_unplaced: ``[[index, lines], ...]``, the PRINT texts whose
 line is not known, each with the lines that could have printed it, :func:`_printed`), moves as
 woodcam's canonical tuples ``[kind, line, [x, y, z], [c1, c2] | null, rotation, plane,
-feed_mm_min, spindle_rpm, tool]`` in the
+feed_mm_min, spindle_rpm, tool, inch]`` in the
 machine frame, mm, tool tip (LinuxCNC's canon reports program coordinates before the G5x/G92
 offsets, which are added back here as AXIS does, and without the tool length offset, which is
 not: AXIS adds it too and draws the controlled point, the spindle's gauge line, where a tool
@@ -21,7 +21,8 @@ with that length offset has its tip the offset lower; woodcam simulates the tip)
 ``machine_zero_mm``: the G54 offset is ``-machine_zero_mm``, so the moves come out in the G54
 frame the start position is given in (as woodcam's interpreter does). The machine is metric
 (external length units mm, the parameter file in mm), as woodcam's interpreter: a program reads
-``#5161`` or ``#5221`` in mm (the canon calls still come in inches: the module converts them).
+``#5161`` or ``#5221`` in mm (the canon calls still come in inches: the module converts them);
+a move's ``inch`` is the G20/G21 mode it was programmed in (:meth:`_Canon.next_line`).
 The tool table the interpreter reads (``get_tool``, again after each M6) has zero offsets and
 the diameters of ``tool_diameters_mm`` (mm, the machine's units: a DEBUG/PRINT of ``#5410``
 shows them whatever G20/G21, as ``rs274 -t``); its pocket 0 is the loaded tool's entry, as a
@@ -100,6 +101,15 @@ def _spindle_words(line):
 
 
 _M61 = re.compile(r"(?<![a-z])m0*61(?![\d.])")
+_UNITS = re.compile(r"(?<![a-z])g0*2([01])(?![\d.])")
+
+
+def _units_word(line):
+    """``True`` (G20, inches) or ``False`` (G21, mm) when source ``line`` has a plain G20 or
+    G21 word (it takes effect before the line's motion), else ``None``."""
+    text = re.sub(r"\([^)]*\)?", "", line.split(";", 1)[0]).lower().translate(_BLANKS)
+    m = _UNITS.findall(re.sub(r"#<[^>]*>", "#", text))
+    return m[-1] == "0" if m else None
 _Q = re.compile(r"(?<![a-z])q(\+?[0-9]+(?:\.0*)?)(?![0-9.#\[])")
 
 
@@ -173,6 +183,10 @@ class _Canon:
         self.pending = None  # (line, index of its first move) awaiting the state after it
         self.words: dict[int, list | None] = {}  # line -> its spindle words, None: not known
         self.m61: dict[int, int] = {}  # line -> the tool its M61 Q loads (_m61_tool)
+        # the G20/G21 mode of a line's moves: the state before the line (next_line's, after the
+        # last block finished, reported or not) unless the line's own G20/G21 word changes it
+        self.inch = False
+        self.units: dict[int, bool] = {}  # line -> its own G20 (True) / G21 (False) word
         self.message_at = []  # the interpreter's standard output's length at each message
         self.printed_at = lambda: 0  # that length now (_run sets it)
 
@@ -190,6 +204,7 @@ class _Canon:
                 m[7] = rpm
         self.pending = None
         self.line = st.sequence_number
+        self.inch = self.units.get(self.line, st.gcodes[5] == 200)  # 200: G20, 210: G21
         if self.line in self.m61:  # M61 Q: the tool the line says is loaded (before its moves)
             self.tool = self.m61[self.line]
         words = self.words.get(self.line, [])
@@ -209,7 +224,7 @@ class _Canon:
         self.tool = int(tool)
 
     def _append(self, move):
-        self.moves.append(move + [self.feed, self.rpm, self.tool])
+        self.moves.append(move + [self.feed, self.rpm, self.tool, self.inch])
 
     def get_external_angular_units(self):
         return 1.0
@@ -441,6 +456,8 @@ def _run(job, work, result_fd):
                        or "s" in line.lower() for w in [_spindle_words(line)] if w != []}
         canon.m61 = {no: t for no, line in enumerate(lines, 1) if "61" in line
                      for t in [_m61_tool(line)] if t is not None}
+        canon.units = {no: u for no, line in enumerate(lines, 1) if "2" in line
+                       for u in [_units_word(line)] if u is not None}
         # G49: the interpreter keeps a G43.1 tool length offset from one file to the next;
         # G80: the G0 that places the start must not be the program's motion mode (LinuxCNC
         # starts in G80: a bare "X10" first is refused, and was read as a G0 here)

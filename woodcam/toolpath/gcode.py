@@ -8,7 +8,9 @@ the G-code frame (the G54 work frame as the machine has it before the program ru
 millimetres, whatever ``G20/G21`` the program used; ``kind : (n,) uint8`` (0 = rapid ``G0``, 1 =
 feed ``G1/G2/G3``), ``tool : (n,) int`` (the tool number loaded by the last ``M6``, 0 before
 any), ``line : (n,) int`` (1-based source line) and ``feed_mm_min, spindle_rpm : (n,) float``
-(``spindle_rpm`` is 0 while the spindle is off). Arcs are split into chords whose sagitta is at
+(``spindle_rpm`` is 0 while the spindle is off), ``inch : (n,) bool`` (the move was programmed
+in ``G20``, inches: the lengths as the program wrote them; all ``False`` for a program built
+from arrays). Arcs are split into chords whose sagitta is at
 most ``chord_tol_mm`` (default :data:`woodcam.tolerances.ARC_CHORD_TOL_MM`), so every arc vertex
 lies exactly on the analytic circle (helix). ``warnings`` lists ``"line N: ..."`` strings;
 ``messages`` the operator messages the program says as it runs, ``"line N: ..."`` too (its
@@ -87,6 +89,12 @@ class Program:
     warnings: list[str] = field(default_factory=list)
     messages: list[str] = field(default_factory=list)
     printed: list[str] = field(default_factory=list)
+    #: per move: programmed in G20 (inches); None (the default) is all False (mm, G21)
+    inch: np.ndarray = None  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        if self.inch is None:
+            self.inch = np.zeros(len(self.kind), bool)
 
     def __len__(self) -> int:
         return len(self.kind)
@@ -114,7 +122,7 @@ class Program:
         return Program(self.start_mm[k], self.end_mm[k], self.kind[k], self.tool[k],
                        self.line[k], self.feed_mm_min[k], self.spindle_rpm[k], self.source,
                        sorted(set(self.tool[k].tolist())), list(self.warnings),
-                       list(self.messages), list(self.printed))
+                       list(self.messages), list(self.printed), self.inch[k])
 
     def __iter__(self):
         return (self[i] for i in range(len(self)))
@@ -380,11 +388,11 @@ def program_from_canonical(moves, start_mm, chord_tol_mm, source="<string>",
     with sagitta <= ``chord_tol_mm`` whose vertices lie on the analytic circle/helix."""
     pos = list(map(float, start_mm))
     starts, ends, meta = [], [], []
-    for kind, line, end, centre, rot, plane, feed, spindle, tool in moves:
+    for kind, line, end, centre, rot, plane, feed, spindle, tool, inch in moves:
         if kind != ARC:
             starts.append(pos)
             ends.append(list(end))
-            meta.append((RAPID if kind == 0 else FEED, tool, line, feed, spindle))
+            meta.append((RAPID if kind == 0 else FEED, tool, line, feed, spindle, inch))
             pos = list(end)
             continue
         pts = _arc_chords(pos, end, centre, rot, plane, chord_tol_mm, line)
@@ -392,10 +400,10 @@ def program_from_canonical(moves, start_mm, chord_tol_mm, source="<string>",
         starts.append(pos)
         starts.extend(pts[:-1].tolist())
         ends.extend(pts.tolist())
-        meta.extend([(FEED, tool, line, feed, spindle)] * k)
+        meta.extend([(FEED, tool, line, feed, spindle, inch)] * k)
         pos = list(end)
     n = len(meta)
-    m = np.array(meta, float).reshape(n, 5)
+    m = np.array(meta, float).reshape(n, 6)
     s = np.array(starts, float).reshape(n, 3)
     e = np.array(ends, float).reshape(n, 3)
     keep = np.any(s != e, axis=1)  # chords of zero length carry no cut
@@ -403,7 +411,7 @@ def program_from_canonical(moves, start_mm, chord_tol_mm, source="<string>",
     tools = m[:, 1].astype(int)
     return Program(s, e, m[:, 0].astype(np.uint8), tools, m[:, 2].astype(int), m[:, 3],
                    m[:, 4], source, sorted(set(tools.tolist())), list(warnings),
-                   list(messages), list(printed))
+                   list(messages), list(printed), m[:, 5] != 0)
 
 
 _PLANE_AXES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}

@@ -104,9 +104,10 @@ start height (``start_mm`` Z, or the tool's Z if higher; posts write ``G53 G0 Z-
 G0 Z0`` for "near the top of Z travel", which in machine coordinates is no place in the work
 frame) and a ``G53`` X/Y with machine zero at G-code zero, each warned once with its lines.
 A canonical move is
-``(kind, line, end (3,), centre (2,) | None, rotation, plane, feed_mm_min, spindle_rpm, tool)``:
-``kind`` 0 = traverse, 1 = feed, 2 = arc (``centre`` in the plane's first/second axes,
-``rotation`` = +/-turns, + counter-clockwise, as LinuxCNC's ``ARC_FEED``).
+``(kind, line, end (3,), centre (2,) | None, rotation, plane, feed_mm_min, spindle_rpm, tool,
+inch)``: ``kind`` 0 = traverse, 1 = feed, 2 = arc (``centre`` in the plane's first/second axes,
+``rotation`` = +/-turns, + counter-clockwise, as LinuxCNC's ``ARC_FEED``); ``inch``: the move
+was programmed in ``G20`` (its lengths as written are inches; the move is in mm all the same).
 
 Why hand-written: no maintained PyPI package interprets this language. ``pygcode`` (0.2.1,
 2017, unmaintained) and ``gcodeparser`` parse words but have no parameters, expressions or
@@ -772,7 +773,7 @@ class Interpreter:
                       f"loaded tool T{self.tool}, as the controller does")
         feed = self.feed
         self.moves.append((kind, self.line_no, tuple(end), centre, rotation, self.plane, feed,
-                           self.spindle if self.spindle_on else 0.0, self.tool))
+                           self.spindle if self.spindle_on else 0.0, self.tool, self.inch))
         self.pos = list(end)
 
     # -- parameters -------------------------------------------------------------------------

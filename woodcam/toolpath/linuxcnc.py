@@ -163,8 +163,8 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
                              REFUSED_FIX if int(line) else "LinuxCNC's interpreter failed, "
                              "naming no line of the program; read it with --interpreter woodcam")
         warnings.append((int(line), msg))
-    moves = [(k, ln, tuple(e), tuple(c) if c else None, rot, plane, feed, rpm, tool)
-             for k, ln, e, c, rot, plane, feed, rpm, tool in res["moves"]]
+    moves = [(k, ln, tuple(e), tuple(c) if c else None, rot, plane, feed, rpm, tool, bool(inch))
+             for k, ln, e, c, rot, plane, feed, rpm, tool, inch in res["moves"]]
     return moves, warnings
 
 
