@@ -541,6 +541,31 @@ def test_old_units_codes_g70_g71_are_refused_naming_g20_g21(dialect):
             _ends(f"G00G21G17G90G40G49G80\n{code}G91.1\nG0 X1 Y1 Z1\nM2\n", dialect=dialect)
 
 
+@pytest.mark.parametrize("dialect, controller, read", [
+    ("linuxcnc", "LinuxCNC", "LinuxCNC reads it as a lathe cycle and refuses it"),
+    ("fanuc", "a Fanuc control", "a Fanuc control reads the units as G20/G21"),
+    ("grbl", "grbl", "grbl refuses it")])
+def test_a_dialect_s_messages_name_its_own_controller(dialect, controller, read):
+    """--dialect fanuc's G71 said "LinuxCNC reads it as a lathe cycle ...; ... or post for
+    LinuxCNC", and a code woodcam does not simulate "(LinuxCNC runs it)", to a Fanuc user. Each
+    dialect's messages name its own controller; an M98 line's rules are woodcam's (as LinuxCNC)."""
+    with pytest.raises(GcodeError) as e:
+        _ends("G21 G90\nG71\nG0 X1 Y1 Z1\nM2\n", dialect=dialect)
+    assert f"units code (Mach3, old Fanuc posts); {read}" in str(e.value), str(e.value)
+    assert str(e.value).endswith(f"or post for {controller}"), str(e.value)
+    with pytest.raises(GcodeError) as e:
+        _ends("G0 X0 Y0 Z10 F100\nG38.2 X1 Z-3\nM2\n", dialect=dialect)
+    assert ("(LinuxCNC runs it)" in str(e.value)) == (dialect == "linuxcnc"), str(e.value)
+    if dialect != "grbl":
+        for line, said in (("X1 M98 P100", "M98 after other words: woodcam reads a subprogram "
+                            "call or return only as the first word of its line (after its N "
+                            "word), as LinuxCNC does"),
+                           ("M98 P100 X1", "only: woodcam reads no other word on it (LinuxCNC "
+                            "skips them without a word)")):
+            with pytest.raises(GcodeError, match=re.escape(said)):
+                _ends(f"G0 X0 Y0 Z10\n{line}\nM30\nO100\nG1 X2 F100\nM99\n", dialect=dialect)
+
+
 def test_lines_are_numbered_and_blanks_read_as_linuxcnc_does(tmp_path):
     # LinuxCNC and editors break lines at "\n" only and skip only spaces, tabs and the CR of a
     # line end. woodcam read files with universal newlines and split with str.splitlines, so

@@ -296,6 +296,15 @@ _PLANES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}  # (first, second, norma
 _CENTRE = {17: "ij", 18: "ki", 19: "jk"}
 
 
+#: The controller each dialect stands for, as a message names it ("post for ...").
+_CONTROLLER = {"linuxcnc": "LinuxCNC", "grbl": "grbl", "fanuc": "a Fanuc control"}
+#: What each dialect's controller does with G70/G71, the old units codes.
+_OLD_UNITS_READ = {
+    "linuxcnc": "LinuxCNC reads it as a lathe cycle and refuses it ('G7x.x requires a Q word')",
+    "grbl": "grbl refuses it (error:20, an unsupported G code)",
+    "fanuc": "a Fanuc control reads the units as G20/G21 (G70/G71 are its lathe cycles)"}
+
+
 def _shifted(move, d):
     """A canonical move moved by ``d`` (3,) mm: its end and, for an arc, its centre (which holds
     the plane's first and second axes)."""
@@ -722,7 +731,9 @@ class Interpreter:
         """The error of a code LinuxCNC runs and woodcam refuses on purpose
         (:data:`_G_NOT_SIMULATED`, :data:`_M_NOT_SIMULATED` give ``(what it does, the fix)``)."""
         what, fix = what_fix
-        return self.err(word, f"{word} ({what}) is not simulated by woodcam (LinuxCNC runs it)", fix)
+        # (LinuxCNC runs them all; a Fanuc control or grbl may not: their dialects say no more)
+        runs = " (LinuxCNC runs it)" if self.dialect == "linuxcnc" else ""
+        return self.err(word, f"{word} ({what}) is not simulated by woodcam{runs}", fix)
 
     def warn(self, msg: str, pass_id: int | None = None) -> None:
         """Warn ``msg`` once per line and text: a line in a loop or a subroutine runs again
@@ -1704,8 +1715,9 @@ class Interpreter:
             c = s[i]
             if c not in "pl":
                 raise self.err(f"M98 {s[i:].upper()}", "an M98 line holds P (the subprogram) "
-                               "and L (how many times) only: LinuxCNC skips any other word on "
-                               "it without a word", "put the other words on a line of their own")
+                               "and L (how many times) only: woodcam reads no other word on it "
+                               "(LinuxCNC skips them without a word)",
+                               "put the other words on a line of their own")
             if c in w:
                 raise self.err(c.upper(), f"word {c.upper()} twice on one line", "keep one")
             w[c], i = self.value(s, i + 1)
@@ -2023,11 +2035,10 @@ class Interpreter:
             c = round(v, 1)
             if v in (70.0, 71.0):  # Vectric's Mach3 posts open with "G00G21G17G90G40G49G80 G71"
                 raise self.err(f"G{v:g}", f"G{v:g} is an old {'inch' if v == 70 else 'mm'} units "
-                               "code (Mach3, old Fanuc posts); LinuxCNC reads it as a lathe "
-                               "cycle and refuses it ('G7x.x requires a Q word')",
+                               f"code (Mach3, old Fanuc posts); {_OLD_UNITS_READ[self.dialect]}",
                                f"replace it by G{20 if v == 70 else 21} (or remove it where "
                                f"the program has G{20 if v == 70 else 21} already), or post "
-                               "for LinuxCNC")
+                               f"for {_CONTROLLER[self.dialect]}")
             if abs(v - c) <= 1e-4 and c in _G_NOT_SIMULATED:
                 raise self._not_simulated(f"G{v:g}", _G_NOT_SIMULATED[c])
             if (abs(v - c) > 1e-4 or c not in _G_KNOWN) and c not in _G_REFUSED:
@@ -2068,9 +2079,10 @@ class Interpreter:
                     raise self.err(f"M{v:g}", "grbl has no subprograms (M98 calls, M99 returns)",
                                    "pass --dialect fanuc or linuxcnc, whose controls run them")
                 if v == 98.0 or self._frames:
-                    raise self.err(f"M{v:g}", f"M{v:g} after other words: LinuxCNC reads a "
+                    raise self.err(f"M{v:g}", f"M{v:g} after other words: woodcam reads a "
                                    "subprogram call or return only as the first word of its "
-                                   "line (after its N word)", f"put M{v:g} on a line of its own")
+                                   "line (after its N word), as LinuxCNC does",
+                                   f"put M{v:g} on a line of its own")
                 mset.add(99)  # the main program's M99: ends the pass (see below)
                 continue
             if v == math.floor(v) and int(v) in _M_NOT_SIMULATED:
