@@ -290,6 +290,24 @@ def test_a_program_of_t0_rapids_only_is_refused_clearly():
     assert res.removed_volume_mm3 == pytest.approx(4 * math.pi, rel=2e-2)
 
 
+@pytest.mark.parametrize("spec, deepest", [("flat:3", "5.000"),  # the compiled sweep
+                                           ("vbit:90:6", "4.671")])  # numpy's (its tip between cells)
+def test_a_rapid_through_the_stock_and_a_cut_outside_it_quote_their_worst_line(spec, deepest):
+    """A run of rapids into the stock and a run of cuts outside it quoted their first line:
+    'cuts up to 1.000 mm' of rapids going 5 mm deep, 'z = -1.000 mm' of cuts going to -4 mm.
+    Each says its worst line now (as below_stock_bottom), at its first line's place."""
+    prog = read_gcode("G21 G90\nM3 S9000\nG0 X10 Y10 Z5\nG0 Z-1\nG0 X20 Z-5\nG0 Z5\n"
+                      "G0 X-5 Y20\nG1 Z-1 F300\nG1 Y25 Z-4\nG1 Y30 Z-2\nG0 Z5\nM2\n")
+    res = simulate(prog, {0: parse_tool_spec(spec)}, (60.0, 40.0, 20.0), resolution_mm=0.5)
+    rapid, outside = res.report
+    assert (str(rapid), str(outside)) == (
+        f"lines 4-5: rapid_through_stock: rapid move (G0) cuts up to {deepest} mm into the stock",
+        "lines 8-10: cut_outside_stock: tool T0 is below the stock top (z = -4.000 mm) with its "
+        "footprint outside the stock")
+    assert rapid.at_mm is not None and rapid.at_mm[:2] == pytest.approx((10, 10))  # line 4's
+    assert outside.at_mm == pytest.approx((-5, 20, 22))  # the middle of line 8's plunge
+
+
 def test_a_cut_through_the_bottom_says_how_far_below_it_goes_at_worst():
     """A helix and the lines after it going 2-2.5 mm through the stock's bottom (a through
     cut into the spoilboard) were warned with the first chord that went through: '0.016 mm

@@ -315,10 +315,11 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
                    lambda: said(lambda: f"tool tip at z = {say_length(p1[k, 2] - off[2], '.3f')} "
                                 f"(G-code frame), {say_length(-p1[k, 2], '.3f')} below the stock "
                                 "bottom"), p0[k] + t * (p1[k] - p0[k]))
-    for k in np.flatnonzero(below_top & outside & (kind == FEED)):
-        _add(issues, "cut_outside_stock", lines[k],
-             said(lambda: f"tool T{tool_of[k]} is below the stock top (z = "
-                  f"{say_length(zmin[k] - off[2], '.3f')}) with its footprint outside the stock"), mid[k])
+    for k in np.flatnonzero(below_top & outside & (kind == FEED)):  # its worst: the lowest
+        _add_worst(issues, excess, "cut_outside_stock", lines[k], -zmin[k],
+                   lambda: said(lambda: f"tool T{tool_of[k]} is below the stock top (z = "
+                                f"{say_length(zmin[k] - off[2], '.3f')}) with its footprint "
+                                "outside the stock"), mid[k])
     for k in np.flatnonzero(below_top & over & (kind == FEED) & ~(program.spindle_rpm > 0)):
         _add(issues, "spindle_off", lines[k], "feed move into the stock with the spindle off "
              "(no M3/M4 with S > 0 before it, or none since a tool change, which stops it "
@@ -363,7 +364,7 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
                 cells += _sweep_batch(hm, line_map, tool, p0[idx], p1[idx], i0[idx], j0[idx],
                                       i1[idx],
                                       j1[idx], int(wy[g[0]]), int(wx[g[0]]), dx, dy, kind[idx],
-                                      lines[idx], issues)
+                                      lines[idx], issues, excess)
                 bar.update(len(idx))
     bar.close()
     n_active = len(act)
@@ -435,6 +436,16 @@ def _add_worst(issues, excess, kind, line, e, message, at=None):
         None if at is None else tuple(float(v) for v in at)))
 
 
+def _rapid_cut(issues, excess, line, depth, first_contact) -> None:
+    """A rapid of ``line`` cuts ``depth`` mm into the stock: the line keeps its deepest
+    (:func:`_add_worst`; a drilling cycle's rapids, a G28's two legs) at its first rapid's
+    first contact (``first_contact()``, sampled only for that rapid)."""
+    key = ("rapid_through_stock", int(line))
+    _add_worst(issues, excess, *key, depth,
+               lambda: said(lambda: f"rapid move (G0) cuts up to {say_length(depth, '.3f')} "
+                            "into the stock"), None if key in issues else first_contact())
+
+
 def _first_contact(tool, a, b, window, j0, i0, dx, dy):
     """The first tip position (block frame, mm, (3,)) along the move ``a -> b`` where ``tool``
     reaches more than SIM_CONTACT_TOL_MM below the stock before the move, sampled every quarter
@@ -462,15 +473,18 @@ def _first_contact(tool, a, b, window, j0, i0, dx, dy):
 
 
 def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind, lines,
-                 issues):
+                 issues, excess=None):
     """Lower envelope of ``len(a)`` straight moves over their windows; min-update ``hm``.
 
     ``a, b : (n, 3)`` block-frame tip positions (mm); each window is the ``wy x wx`` cells from
     ``(j0, i0)``, shifted to lie inside the grid. Cells of a window that the swept tool does not
     cover come back from the kernel as ``+inf`` (the footprint test is part of the kernel), so
     padding needs no mask. Float32 inside the kernel: coordinates are relative to the move start
-    (|x| < ~50 mm, round-off < 1e-5 mm). Returns the number of covered cells.
+    (|x| < ~50 mm, round-off < 1e-5 mm). Returns the number of covered cells. A rapid that
+    cuts the stock goes into ``issues`` with its line's deepest cut (:func:`_rapid_cut`; ``excess``
+    keeps the depths, ``None`` where no rapid is passed: the reach replay).
     """
+    excess = {} if excess is None else excess
     n = len(a)
     ny, nx = hm.shape
     wy, wx = min(wy, ny), min(wx, nx)
@@ -490,11 +504,8 @@ def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind,
                              np.ascontiguousarray(b, float), js, is_, wy, wx, dx, dy,
                              np.asarray(lines, np.int64), depth)
         for k in np.flatnonzero((kind == RAPID) & (depth > SIM_CONTACT_TOL_MM)):
-            if ("rapid_through_stock", int(lines[k])) in issues:  # _add keeps a line's first
-                continue
-            _add(issues, "rapid_through_stock", lines[k],
-                 said(lambda: f"rapid move (G0) cuts up to {say_length(depth[k], '.3f')} into the stock"),
-                 _first_contact(tool, a[k], b[k], before[k], js[k], is_[k], dx, dy))
+            _rapid_cut(issues, excess, lines[k], float(depth[k]), lambda k=k: _first_contact(
+                tool, a[k], b[k], before[k], js[k], is_[k], dx, dy))
         return int(cells)
     f32 = np.float32
     cx = ((is_[:, None] + np.arange(wx)[None, :] + 0.5) * dx - a[:, 0, None]).astype(f32)
@@ -519,10 +530,9 @@ def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind,
         for k in np.flatnonzero(rap):
             cur = hm[js[k]:js[k] + wy, is_[k]:is_[k] + wx]
             depth = float((cur - env[k]).max())
-            if depth > SIM_CONTACT_TOL_MM and ("rapid_through_stock", int(lines[k])) not in issues:
-                _add(issues, "rapid_through_stock", lines[k],
-                     said(lambda: f"rapid move (G0) cuts up to {say_length(depth, '.3f')} into the stock"),
-                     _first_contact(tool, a[k], b[k], cur, js[k], is_[k], dx, dy))
+            if depth > SIM_CONTACT_TOL_MM:
+                _rapid_cut(issues, excess, lines[k], depth, lambda k=k, cur=cur: _first_contact(
+                    tool, a[k], b[k], cur, js[k], is_[k], dx, dy))
     for k in range(n):  # scatter: one slice per move (windows overlap, so no fancy indexing)
         view = hm[js[k]:js[k] + wy, is_[k]:is_[k] + wx]
         if line_map is not None:  # remember which line cut each cell last (deviation map)
