@@ -369,6 +369,23 @@ def test_each_move_records_the_units_it_was_programmed_in_as_linuxcnc():
     assert prog.inch.tolist() == mine.inch.tolist()
 
 
+def test_a_feed_per_revolution_is_a_feed_per_minute_at_the_spindle_speed():
+    """With --interpreter linuxcnc a G95 feed (mm or inch per revolution) was taken as mm/min:
+    a 100 mm cut at F0.1 S10000 was estimated at 16.7 hours of machining (60,000 s). It is F
+    times the spindle speed (1000 mm/min: 6 s), in G20 too, with an S read from a parameter
+    (known only after the line) too, and G94 goes back to mm/min."""
+    prog = read_gcode("G21 G90\nM3 S10000\nG0 X0 Y0 Z1\nG95 G1 X100 F0.1\nG94 G1 X50 F100\n"
+                      "M2\n", interpreter="linuxcnc", machine_zero_mm=(0, 0, 0))
+    assert prog.feed_mm_min[1:].tolist() == pytest.approx([1000, 100])
+    assert prog.machining_time_s()[0][0] == pytest.approx(36)
+    inch = read_gcode("G20 G90\nM3 S10000\nG0 X0 Y0 Z1\nG95 G1 X4 F0.004\nM2\n",
+                      interpreter="linuxcnc", machine_zero_mm=(0, 0, 0))
+    assert inch.feed_mm_min[1] == pytest.approx(1016)
+    later = read_gcode("G21 G90\nM3 S10000\n#1=20000\nG0 X0 Y0 Z1\nG95 G1 X100 F0.1 S#1\n"
+                       "G1 X0\nM2\n", interpreter="linuxcnc", machine_zero_mm=(0, 0, 0))
+    assert later.feed_mm_min[1:].tolist() == pytest.approx([2000, 2000])
+
+
 def test_m61_keeps_the_selected_tool_for_the_next_m6_as_linuxcnc():
     """After "T5 / M61 Q3" LinuxCNC's #<_selected_tool> reads 5 and the M6 that follows loads
     T5 (M61 sets only the loaded tool); woodcam read 3 and cut with T3. (The tool of the

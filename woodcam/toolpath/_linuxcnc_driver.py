@@ -164,6 +164,10 @@ class _Canon:
         self.ctrl = None  # the controlled point after the last move, mm
         self.mzero = [0.0] * 3  # the output shift: machine origin in the G54 frame, mm
         self.feed = 0.0  # mm/min (set_feed_rate: inch/min, as the module converts lengths)
+        # G95 (feed per revolution): F is mm per revolution, a move's mm/min F times its spindle
+        # speed; the interpreter says the mode only as a comment (comment())
+        self.per_rev = False
+        self.rev_feed: dict[int, float] = {}  # index of a G95 move -> its mm per revolution
         self.tool = 0  # the loaded tool (change_tool: M6)
         self.diameters: dict[int, float] = {}  # the user's tools by number, mm (get_tool)
         # the spindle: the interpreter's state reaches Python only through next_line, called
@@ -200,8 +204,10 @@ class _Canon:
         rpm = _rpm(self.spindle)
         if self.pending is not None and st.sequence_number > self.pending[0] and all(
                 k not in self.words for k in range(self.pending[0] + 1, st.sequence_number)):
-            for m in self.moves[self.pending[1]:]:
+            for k, m in enumerate(self.moves[self.pending[1]:], self.pending[1]):
                 m[7] = rpm
+                if k in self.rev_feed:
+                    m[6] = self.rev_feed[k] * rpm
         self.pending = None
         self.line = st.sequence_number
         self.inch = self.units.get(self.line, st.gcodes[5] == 200)  # 200: G20, 210: G21
@@ -223,8 +229,19 @@ class _Canon:
     def change_tool(self, tool):
         self.tool = int(tool)
 
+    def comment(self, text):
+        # how LinuxCNC's interpreter reports G93/G94/G95 ('interpreter: feed mode set to units
+        # per revolution'); a G95 feed read as mm/min made a 100 mm cut at F0.1 S10000 take
+        # 16.7 hours
+        if text.startswith("interpreter: feed mode set to "):
+            self.per_rev = text.endswith("per revolution")
+
     def _append(self, move):
-        self.moves.append(move + [self.feed, self.rpm, self.tool, self.inch])
+        feed = self.feed
+        if self.per_rev:
+            self.rev_feed[len(self.moves)] = feed
+            feed *= self.rpm
+        self.moves.append(move + [feed, self.rpm, self.tool, self.inch])
 
     def get_external_angular_units(self):
         return 1.0
