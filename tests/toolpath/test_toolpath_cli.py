@@ -238,6 +238,25 @@ def test_machining_time_estimate():
         prog.machining_time_s(0)
 
 
+def test_the_rapids_before_the_first_tool_change_count_to_its_tool(tmp_path, monkeypatch, capsys):
+    """A post's safe moves before 'T1 M6' (tool 0: no tool loaded) were timed as a tool of their
+    own, 'T0: 0:00:01 (0:00:00 feeding), T1: 0:00:04 ...', though simulate moves them with T1
+    and the GLB's tools list T1 alone. They count to T1; a program whose tool 0 feeds keeps
+    its T0 (test_machining_time_estimate)."""
+    prog = read_gcode("G21 G90\nG0 Z20\nG0 X50 Y40\nT1 M6\nG0 X10 Y10 Z5\nG1 Z-1 F300\n"
+                      "G1 X50 F1200\nG0 Z5\nM30\n")
+    t = prog.machining_time_s(rapid_mm_min=6000)
+    assert list(t) == [1] and t[1][0] == pytest.approx(60 * (6 / 300 + 40 / 1200))
+    assert t[1][1] == pytest.approx(60 * (10 + np.hypot(50, 40) + np.sqrt(40**2 + 30**2 + 15**2) + 6) / 6000)
+    _stub_preview(monkeypatch, {})
+    path = tmp_path / "t0.nc"
+    path.write_text("G21 G90\nG0 Z20\nT1 M6\nM3 S9000\nG0 X10 Y10 Z5\nG1 Z-1 F300\n"
+                    "G1 X50 F1200\nG0 Z5\nM30\n")
+    assert main(["gcode", str(path), "--block", "builtin:flat-sawn", "--out",
+                 str(tmp_path / "o.glb"), "--tool", "flat:3", "--cell-size", "0.5"]) == 0
+    assert "; machining time T1: 0:00:04 (0:00:03 feeding)\n" in capsys.readouterr().out
+
+
 def test_grid_coarser_than_half_the_stepover_warns(tmp_path, monkeypatch, capsys):
     _stub_preview(monkeypatch, {})
     prog = REPO / "toolpaths" / "corpus" / "gen_raster_fine.ngc"  # 0.5 mm step-over

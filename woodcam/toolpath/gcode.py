@@ -134,17 +134,24 @@ class Program:
     def machining_time_s(self, rapid_mm_min: float = 5000.0) -> dict[int, tuple[float, float]]:
         """Estimated time per tool: ``{tool: (feed seconds, rapid seconds)}`` from the move
         lengths (mm), the programmed feeds (mm/min) and ``rapid_mm_min`` for rapids (the
-        machine's rapid rate; no acceleration is modelled, so real jobs take longer)."""
+        machine's rapid rate; no acceleration is modelled, so real jobs take longer). Tool 0's
+        rapids before the first ``M6`` count to the tool they stand for
+        (:meth:`tool_of_leading_rapids`, the tool simulate moves them with): a post's safe-Z
+        move before the tool change was a 'T0' with seconds of rapids of its own."""
         rapid_mm_min = check_number(rapid_mm_min, "machining_time_s: rapid_mm_min", lo=0, lo_open=True,
                                     fix="the machine's rapid rate in mm/min, e.g. 5000")
         length = np.linalg.norm(self.end_mm - self.start_mm, axis=1)
         feed = self.kind == FEED
+        tool = self.tool
+        lead = self.tool_of_leading_rapids()
+        if lead is not None:
+            tool = np.where(tool == 0, lead, tool)
         with np.errstate(divide="ignore"):
             t = np.where(feed, 60.0 * length / np.maximum(self.feed_mm_min, 1e-9),
                          60.0 * length / rapid_mm_min)
-        return {int(k): (float(t[feed & (self.tool == k)].sum()),
-                         float(t[~feed & (self.tool == k)].sum()))
-                for k in np.unique(self.tool)}
+        return {int(k): (float(t[feed & (tool == k)].sum()),
+                         float(t[~feed & (tool == k)].sum()))
+                for k in np.unique(tool)}
 
     def tool_of_leading_rapids(self) -> int | None:
         """The tool that tool 0's moves stand for: the first tool the program loads (``M6``)
