@@ -60,8 +60,19 @@ def test_a_part_too_small_to_carve_says_so():
     """A 0.02 mm part inside the block was said not to intersect it, with the advice to move it by
     (0, 0, 0) mm."""
     part = manifold3d.Manifold.cube((0.02, 0.02, 0.02)).translate((50, 40, 25))
-    with pytest.raises(WoodcamError, match="the part's volume is 8e-06 mm\\^3, too small to carve; check its units"):
+    with pytest.raises(WoodcamError, match=r"the part's volume is 8e-06 mm\^3 \(it measures 0.02x0.02x0.02 mm\), too small to carve; "
+                       r"check its units"):
         carve(part, DEMO_BLOCK_MM)
+
+
+def test_a_part_in_metres_too_small_to_carve_says_its_size_and_how_to_scale_it():
+    """A 0.2 m part exported in metres is read as 0.2 mm: refused with 'check its units' alone,
+    no size, no fix; now with what it measures, in metres and inches, and the caller's fix."""
+    part = manifold3d.Manifold.cube((0.2, 0.05, 0.03)).translate((0.01, 0.04, 0.025))
+    with pytest.raises(WoodcamError, match=r"it measures 0.2x0.05x0.03 mm\), too small to carve; check its "
+                       r"units: .*modelled in metres would be 200x50x30 mm, in inches 5.08x1.27x0.762 mm: "
+                       r"add scale:1000"):
+        carve(part, DEMO_BLOCK_MM, units_fix="add scale:1000")
 
 
 def test_a_part_in_inches_read_as_mm_says_how_to_scale_it():

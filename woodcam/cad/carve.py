@@ -118,9 +118,17 @@ def carve(
     part_volume = float(solid.volume())
     volume = float(carved.volume()) if not carved.is_empty() else 0.0
     if part_volume <= OUTSIDE_VOLUME_EPS_MM3:  # it was told it misses the block, "move it by (0, 0, 0)"
-        raise WoodcamError(
-            f"the part's volume is {say_volume(part_volume, '.3g')}, too small to carve; check its units (a part "
-            "modelled in metres or inches is read as millimetres)")
+        # a 0.2 m part exported in metres is read as 0.2 mm: said with its size, what it would
+        # measure in metres and in inches, and how to scale it (only 'check its units' before)
+        lo, hi = _bounds(solid)
+        extent = hi - lo
+        with message_units("mm"):  # the file's own numbers, read as mm whatever --units says
+            raise WoodcamError(
+                f"the part's volume is {say_volume(part_volume, '.3g')} (it measures "
+                f"{say_length(extent, '.3g')}), too small to carve; check its units: part files are read as "
+                f"millimetres (STL and OBJ carry no units), so a part modelled in metres would be "
+                f"{say_length(extent * 1e3, '.3g')}, in inches {say_length(extent * MM_PER_UNIT['inch'], '.3g')}: "
+                f"{units_fix}")
     if carved.is_empty() or volume <= OUTSIDE_VOLUME_EPS_MM3:
         lo, hi = _bounds(solid)
         raise WoodcamError(
