@@ -385,7 +385,8 @@ _UNREADABLE = r"(not a valid mesh|could not be read)"
 
 @pytest.mark.parametrize(("name", "content", "pattern"), [
     ("garbage.stl", "this is not a mesh\n", r"mesh file '.*garbage\.stl'.*" + _UNREADABLE),
-    ("empty.stl", "", r"mesh file '.*empty\.stl'.*" + _UNREADABLE),
+    ("empty.stl", "", r"part file '.*empty\.stl' is empty \(0 bytes\): the export was cut short"),
+    ("empty.step", "", r"part file '.*empty\.step' is empty \(0 bytes\).*export the part"),
     ("garbage.obj", "hello\nworld\n", r"mesh file '.*garbage\.obj'.*" + _UNREADABLE),
     ("garbage.glb", "not a glb", r"mesh file '.*garbage\.glb'.*could not be read"),
     ("garbage.step", "ISO-10303-21; nonsense", r"'.*garbage\.step' is not a readable STEP file"),
@@ -404,6 +405,21 @@ def test_bad_files_raise_clear_errors(tmp_path, name, content, pattern):
     path.write_text(content)
     with pytest.raises(WoodcamError, match=pattern):
         load_part(path)
+
+
+@pytest.mark.parametrize("stated", [0, 5, 999])
+def test_a_binary_stl_whose_header_miscounts_its_triangles_is_read_by_its_size(tmp_path, stated):
+    """A binary STL whose header's count disagrees with its size (0 from some exporters) was
+    refused as 'contains no triangles' (trimesh read it as nothing); it is read by its size, said."""
+    box = trimesh.creation.box(extents=(10, 20, 30))
+    data = bytearray(box.export(file_type="stl"))
+    data[80:84] = stated.to_bytes(4, "little")
+    path = tmp_path / "box.stl"
+    path.write_bytes(bytes(data))
+    with pytest.warns(WoodcamWarning, match=rf"'.*box\.stl' is a binary STL whose header says {stated} "
+                      r"triangles but whose size holds 12; woodcam read the 12"):
+        solid = load_part(path)
+    assert solid.volume() == pytest.approx(6000, rel=1e-9)
 
 
 def test_missing_file_raises(tmp_path):

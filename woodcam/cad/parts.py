@@ -306,6 +306,10 @@ def _load_path(path: Path, tess: "_Tessellation"):
     suffix = check_part_path(path).suffix.lower()
     if suffix in SCRIPT_SUFFIXES:
         return _load_script(path, tess)
+    if path.stat().st_size == 0:  # was 'contains no triangles: ... not a valid mesh' or a parser status
+        raise WoodcamError(
+            f"part file {str(path)!r} is empty (0 bytes): the export was cut short or failed; export "
+            f"the part from your CAD program again")
     if suffix in STEP_SUFFIXES:
         return _load_step(path, tess)
     return _load_mesh_file(path)
@@ -408,8 +412,43 @@ def _load_mesh_file(path: Path):
             f"{origin} could not be read as {path.suffix.upper().lstrip('.')} "
             f"({type(err).__name__}: {err}); check that it is a mesh file and re-export it"
         ) from err
+    if path.suffix.lower() == ".stl" and not any(len(getattr(g, "faces", ())) for g in scene.geometry.values()):
+        scene = _binary_stl_miscounted(path, origin) or scene
     _undo_woodcam_export_frame(scene, path)
     return _manifold_from_scene(scene, origin)
+
+
+#: A binary STL: an 80-byte header, the triangle count (uint32), then 50 bytes a triangle.
+_STL_HEADER_BYTES = 84
+_STL_TRIANGLE = np.dtype([("normal", "<f4", (3,)), ("corners", "<f4", (3, 3)), ("attribute", "<u2")])
+
+
+def _binary_stl_miscounted(path: Path, origin: str):
+    """A binary STL whose header's triangle count disagrees with its size (some exporters write
+    0 or leave it stale), read by its size with a warning: trimesh read no triangles from it and
+    woodcam said the file held none. None if the file is not such an STL."""
+    import trimesh
+
+    size = path.stat().st_size
+    held, rest = divmod(size - _STL_HEADER_BYTES, _STL_TRIANGLE.itemsize)
+    if size < _STL_HEADER_BYTES + _STL_TRIANGLE.itemsize or rest:
+        return None
+    with open(path, "rb") as fh:
+        head = fh.read(_STL_HEADER_BYTES)
+    stated = int.from_bytes(head[80:84], "little")
+    if stated == held:
+        return None
+    corners = np.fromfile(path, dtype=_STL_TRIANGLE, count=held, offset=_STL_HEADER_BYTES)["corners"]
+    import warnings
+
+    from ..errors import WoodcamWarning
+
+    warnings.warn(WoodcamWarning(
+        f"{origin} is a binary STL whose header says {stated} triangles but whose size holds {held}; "
+        f"woodcam read the {held} (check the part, or export it again)"), stacklevel=4)
+    mesh = trimesh.Trimesh(vertices=corners.reshape(-1, 3).astype(np.float64),
+                           faces=np.arange(3 * held).reshape(-1, 3), process=False)
+    return trimesh.Scene(mesh)
 
 
 def _undo_woodcam_export_frame(scene, path: Path) -> None:
