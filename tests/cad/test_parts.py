@@ -291,6 +291,24 @@ def test_step_round_trip(tmp_path, bd):
     np.testing.assert_allclose(solid.bounding_box(), (30, 25, 15, 70, 55, 35), atol=1e-6)
 
 
+def test_a_cut_short_step_file_says_where_in_one_line(tmp_path, bd, capfd):
+    """OpenCascade's parser printed its reason to stdout, in red, after woodcam's error line,
+    which gave only the reader's status (IFSelect_ReturnStatus.IFSelect_RetFail); the reason is
+    now in the error, and nothing else is printed."""
+    whole = tmp_path / "whole.step"
+    bd.export_step(bd.Box(10, 10, 10), str(whole))
+    path = tmp_path / "cut.step"
+    path.write_bytes(whole.read_bytes()[:1500])
+    capfd.readouterr()
+    with pytest.raises(WoodcamError, match=r"'.*cut\.step' is not a readable STEP file \(OpenCascade: "
+                       r"Undefined Parsing: Line \d+: Incorrect syntax: .*\); "
+                       r"re-export it"):
+        load_part(path)
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
+    assert load_part(whole).volume() == pytest.approx(1000)  # and the messenger is back as it was
+
+
 def test_step_surface_model_of_shells_is_a_part(tmp_path, bd):
     """A STEP surface model (SHELL_BASED_SURFACE_MODEL: SketchUp, Blender, mesh tools) bounds
     the part with a closed shell and no solid: it was refused as 'contains no solid ...

@@ -385,19 +385,56 @@ def _load_step(path: Path, tess: "_Tessellation"):
     from OCP.STEPControl import STEPControl_Reader
 
     reader = STEPControl_Reader()
-    status = reader.ReadFile(str(path))
+    with _occt_messages() as said:
+        status = reader.ReadFile(str(path))
+        if status == IFSelect_RetDone:
+            reader.TransferRoots()
     if status != IFSelect_RetDone:
+        why = next((line for line in said() if "ERR" in line), None)
+        why = (f"OpenCascade: {why.replace('ERR StepFile : ', '')}" if why else
+               f"OpenCascade status {getattr(status, 'name', status)}")
         raise WoodcamError(
-            f"part file {str(path)!r} is not a readable STEP file (OpenCascade status "
-            f"{status}); re-export it from your CAD program as STEP AP203/AP214"
+            f"part file {str(path)!r} is not a readable STEP file ({why}); re-export it from your "
+            f"CAD program as STEP AP203/AP214"
         )
-    reader.TransferRoots()
     shape = reader.OneShape()
     if shape is None or shape.IsNull():
         raise WoodcamError(
             f"part file {str(path)!r} holds no shape; re-export the part as a solid"
         )
     return _manifold_from_topods(shape, tess, origin=f"STEP file {str(path)!r}")
+
+
+@contextlib.contextmanager
+def _occt_messages():
+    """Route OpenCascade's messages (its STEP parser prints them to stdout, in red, after
+    woodcam's own error line) to a temporary file meanwhile; yields a function returning their
+    lines, stripped of the ``****`` frame, once the block is over."""
+    import os
+    import re
+    import tempfile
+
+    from OCP.Message import Message, Message_Gravity, Message_PrinterOStream
+
+    messenger = Message.DefaultMessenger_s()
+    lines: list[str] = []
+    with tempfile.TemporaryDirectory(prefix="woodcam-occt-") as folder:
+        log = os.path.join(folder, "occt.log")
+        printers = list(messenger.Printers())
+        printer = Message_PrinterOStream(log, False, Message_Gravity.Message_Warning)
+        for old in printers:
+            messenger.RemovePrinter(old)
+        messenger.AddPrinter(printer)
+        try:
+            yield lambda: lines
+        finally:
+            messenger.RemovePrinter(printer)
+            for old in printers:
+                messenger.AddPrinter(old)
+            del printer  # closes (flushes) its file
+            with contextlib.suppress(OSError):
+                with open(log, encoding="utf-8", errors="replace") as fh:
+                    lines.extend(re.sub(r"\s+", " ", line.strip(" *\n")) for line in fh if line.strip(" *\n"))
 
 
 def _load_mesh_file(path: Path):
