@@ -440,6 +440,23 @@ def test_a_binary_stl_whose_header_miscounts_its_triangles_is_read_by_its_size(t
     assert solid.volume() == pytest.approx(6000, rel=1e-9)
 
 
+@pytest.mark.parametrize(("body", "fix"), [
+    ("import trimesh\nbox = trimesh.creation.box((10, 10, 10))\n", r"it defines trimesh Trimesh `box`: add `part = box`"),
+    ("import trimesh\nimport math\nbox = trimesh.creation.box((10, 10, 10))\nlid = box.copy()\nn = 3\n",
+     r"it defines trimesh Trimesh `box`, trimesh Trimesh `lid`: add `part = \[box, lid\]` \(their union\) or pass "
+     r"the one you mean to show_object"),
+    ("import math\nx = math.pi\n", r"add e\.g\. `part = Box\(10, 10, 10\)`"),
+])
+def test_a_script_without_part_is_told_which_of_its_shapes_to_name(tmp_path, body, fix):
+    """A script of `box = ...` and `lid = ...` but no `part` was told to add `part = Box(10, 10,
+    10)`, as if it built nothing; the fix names the shapes it built."""
+    path = tmp_path / "shapes.py"
+    path.write_text(body)
+    with pytest.raises(WoodcamError, match=r"does not define a module-level variable `part` nor call show_object; "
+                       + fix):
+        load_part(path)
+
+
 def test_missing_file_raises(tmp_path):
     with pytest.raises(WoodcamError, match="does not exist"):
         load_part(tmp_path / "nowhere.stl")

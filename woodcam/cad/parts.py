@@ -359,8 +359,13 @@ def _load_script(path: Path, tess: "_Tessellation"):
         part = shown[0] if len(shown) == 1 else shown
         origin = f"what script {str(path)!r} passes to show_object"
     elif "part" not in namespace:
+        shapes = _shapes_in(namespace)
         fix = ("it defines `result` (cadquery's convention): add `part = result` or "
                "`show_object(result)`" if "result" in namespace else
+               # a script of `box = ...; lid = ...` was told to add `part = Box(10, 10, 10)`
+               f"it defines {_say_shapes(namespace, shapes)}: add `part = {shapes[0]}`" if len(shapes) == 1 else
+               f"it defines {_say_shapes(namespace, shapes)}: add `part = [{', '.join(shapes)}]` (their "
+               f"union) or pass the one you mean to show_object" if shapes else
                "add e.g. `part = Box(10, 10, 10)` (a build123d/cadquery solid, trimesh mesh or "
                "manifold)")
         raise WoodcamError(
@@ -376,6 +381,27 @@ def _load_script(path: Path, tess: "_Tessellation"):
             f"load the file in the script (e.g. build123d import_step) or pass the path directly"
         )
     return _load(part, tess, origin=origin)
+
+
+#: Modules whose objects :func:`_load` takes as a part.
+_PART_MODULES = ("build123d", "cadquery", "trimesh", "manifold3d", "OCP")
+
+
+def _shapes_in(namespace: dict) -> list[str]:
+    """Names of a script's module-level objects that could be its part (from a CAD or mesh
+    library, not a module, class or function), in the order the script defines them."""
+    import inspect
+
+    return [name for name, value in namespace.items()
+            if not name.startswith("_") and not inspect.ismodule(value) and not inspect.isclass(value)
+            and not inspect.isroutine(value)
+            and (type(value).__module__ or "").split(".")[0] in _PART_MODULES][:8]
+
+
+def _say_shapes(namespace: dict, names: list[str]) -> str:
+    """``build123d Part `box`, build123d Part `lid``` (type and name of each)."""
+    return ", ".join(f"{(type(namespace[n]).__module__ or '').split('.')[0]} {type(namespace[n]).__name__} "
+                     f"`{n}`" for n in names)
 
 
 def _load_step(path: Path, tess: "_Tessellation"):
