@@ -335,8 +335,9 @@ def _load_script(path: Path, tess: "_Tessellation"):
             f"guard command-line code with `if __name__ == \"__main__\":`"
         ) from err
     except Exception as err:
+        line = _script_line(err, path)
         raise WoodcamError(
-            f"part script {str(path)!r} failed with {type(err).__name__}: {err}; run it with "
+            f"part script {str(path)!r} failed{line} with {type(err).__name__}: {err}; run it with "
             f"`python {path}` to see the traceback and fix the script"
         ) from err
     finally:
@@ -381,6 +382,18 @@ def _load_script(path: Path, tess: "_Tessellation"):
             f"load the file in the script (e.g. build123d import_step) or pass the path directly"
         )
     return _load(part, tess, origin=origin)
+
+
+def _script_line(err: BaseException, path: Path) -> str:
+    """`` at line N`` of the script ``path`` where ``err`` was raised (the last of its frames in
+    the traceback: the call into a library or a helper module), or ``""`` (a SyntaxError says
+    its own line)."""
+    import traceback
+
+    script = path.resolve()
+    lines = [frame.lineno for frame in traceback.extract_tb(err.__traceback__)
+             if frame.filename and Path(frame.filename).resolve() == script]
+    return f" at line {lines[-1]}" if lines and lines[-1] else ""
 
 
 #: Modules whose objects :func:`_load` takes as a part.
