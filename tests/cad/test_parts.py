@@ -243,7 +243,7 @@ def block_minus_cylinder_mesh():
     return trimesh.Trimesh(mesh.vert_properties[:, :3], mesh.tri_verts), solid.volume()
 
 
-@pytest.mark.parametrize("suffix", [".stl", ".obj", ".glb", ".gltf"])
+@pytest.mark.parametrize("suffix", [".stl", ".obj", ".ply", ".off", ".glb", ".gltf"])
 def test_mesh_file_round_trip(tmp_path, block_minus_cylinder_mesh, suffix):
     mesh, volume = block_minus_cylinder_mesh
     path = tmp_path / f"part{suffix}"

@@ -126,7 +126,7 @@ def carve(
             raise WoodcamError(
                 f"the part's volume is {say_volume(part_volume, '.3g')} (it measures "
                 f"{say_length(extent, '.3g')}), too small to carve; check its units: part files are read as "
-                f"millimetres (STL and OBJ carry no units), so a part modelled in metres would be "
+                f"millimetres (STL, OBJ and PLY carry no units), so a part modelled in metres would be "
                 f"{say_length(extent * 1e3, '.3g')}, in inches {say_length(extent * MM_PER_UNIT['inch'], '.3g')}: "
                 f"{units_fix}")
     if carved.is_empty() or volume <= OUTSIDE_VOLUME_EPS_MM3:
@@ -170,7 +170,7 @@ def carve(
 
 def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX) -> str | None:
     """What to say when a part with bounds ``lo, hi (3,)`` mm would still fit the block
-    ``size_mm (3,)`` 25.4 times larger (None otherwise): STL and OBJ carry no units, so a part
+    ``size_mm (3,)`` 25.4 times larger (None otherwise): STL, OBJ and PLY carry no units, so a part
     exported in inches is read 25.4 x too small and carved or placed as a speck. Its lengths
     are in mm under every ``--units``: they are the file's own numbers.
 
@@ -188,7 +188,7 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX) -> str |
             if not 0 < float(np.max(extent)) < FOREIGN_GLTF_METRES_BELOW:
                 return None
             return (f"the part is only {say_length(extent, '.3g')}: part files are read "
-                    f"as millimetres (STL and OBJ carry no units), and nothing that small is carved; "
+                    f"as millimetres (STL, OBJ and PLY carry no units), and nothing that small is carved; "
                     f"it looks modelled in metres (1000 times larger: "
                     f"{say_length(extent * 1e3, '.3g')}): {fix}")
         size = np.asarray(size_mm, dtype=float)
@@ -196,7 +196,7 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX) -> str |
             return None
         return (f"the part is only {say_length(extent, '.3g')} in the "
                 f"{say_length(size, 'g')} block: 25.4 times larger it would still fit. "
-                "Part files are read as millimetres (STL and OBJ carry no units); if it was modelled "
+                "Part files are read as millimetres (STL, OBJ and PLY carry no units); if it was modelled "
                 f"in inches {fix}, or export it in mm")
 
 

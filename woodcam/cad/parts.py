@@ -13,7 +13,7 @@ Accepted sources (:func:`load_part`):
 - a ``manifold3d.Manifold``;
 - a list or tuple of any of these (incl. a build123d ``ShapeList``): their union;
 - a path (``str`` / ``Path``) to ``.step``/``.stp`` (B-rep, read with OpenCascade),
-  ``.stl``/``.obj``/``.glb``/``.gltf`` (meshes, read with trimesh, coordinates taken as mm in the
+  ``.stl``/``.obj``/``.ply``/``.off``/``.glb``/``.gltf`` (meshes, read with trimesh, coordinates taken as mm in the
   block frame as stored: no unit or Y-up conversion; except woodcam's own GLB/OBJ, put back in
   the block frame, and another program's glTF whose part spans under 1 unit, read as the glTF
   spec's metres with +Y up, with a warning), or a ``.py`` script that defines a
@@ -65,7 +65,7 @@ _MAX_BUDGET_ANGLE_DEG = 20.0
 
 #: File suffixes :func:`load_part` reads, by kind.
 STEP_SUFFIXES = (".step", ".stp")
-MESH_SUFFIXES = (".stl", ".obj", ".glb", ".gltf")
+MESH_SUFFIXES = (".stl", ".obj", ".ply", ".off", ".glb", ".gltf")
 SCRIPT_SUFFIXES = (".py",)
 SUPPORTED_SUFFIXES = STEP_SUFFIXES + MESH_SUFFIXES + SCRIPT_SUFFIXES
 
@@ -111,7 +111,7 @@ def load_part(
     source : build123d Shape | BuildPart | cadquery Workplane | Shape | Assembly | trimesh.Trimesh
         | trimesh.Scene | manifold3d.Manifold | list of these | str | Path
         The part, modelled in the block frame in millimetres, or a path to a ``.step``/``.stp``,
-        ``.stl``, ``.obj``, ``.glb``/``.gltf`` file or a ``.py`` script defining ``part``
+        ``.stl``, ``.obj``, ``.ply``, ``.off``, ``.glb``/``.gltf`` file or a ``.py`` script defining ``part``
         or passing it to ``show_object`` (CQ-editor's convention: the union of the shown
         objects, which win over ``part``; a ``part`` not among them is named in a warning) (run with ``runpy`` under the name ``"__woodcam_part__"``, so its
         ``if __name__ == "__main__":`` block does not run; its folder is on ``sys.path``

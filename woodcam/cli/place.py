@@ -20,7 +20,7 @@ def register(subparsers) -> None:
         "grain runout along a long thin part). Writes OUT/placements.png (the best placements "
         "and the worst side by side) and OUT/placements.json; prints the table with the "
         "--place options that reproduce each placement in woodcam bake.")
-    add_input(p, "part", kind="file", suffixes=part_suffixes, help="part file (.py script, .step, .stl, .obj, .glb), block frame, mm")
+    add_input(p, "part", kind="file", suffixes=part_suffixes, help="part file (.py script, .step, .stl, .obj, .ply, .off, .glb), block frame, mm")
     add_input(p, "--block", kind="block", required=True, help=BLOCK_SPEC_HELP)
     add_out_option(p, "placements.png and placements.json")
     p.add_argument("--rotations", choices=("none", "z90", "all90"), default="z90",
