@@ -459,6 +459,18 @@ def test_a_script_without_part_is_told_which_of_its_shapes_to_name(tmp_path, bod
         load_part(path)
 
 
+def test_a_timeout_a_library_turned_into_its_own_error_is_still_the_timeout(tmp_path):
+    """The alarm of --timeout landing in build123d's import (OCP, pybind11) came back as
+    'ImportError: initialization failed', and bake said 'part script ... failed at line 2 with
+    ImportError: initialization failed; ... fix the script'. It is the timeout."""
+    path = tmp_path / "slow.py"
+    path.write_text("import time\ntry:\n    time.sleep(5)\nexcept BaseException as err:  # as pybind11 does\n"
+                    "    raise ImportError('initialization failed') from err\n")
+    with pytest.raises(WoodcamError, match=r"loading the part '.*slow\.py' took longer than the timeout of 0\.5 s; "
+                       r"raise --timeout"):
+        load_part(path, timeout_s=0.5)
+
+
 def test_missing_file_raises(tmp_path):
     with pytest.raises(WoodcamError, match="does not exist"):
         load_part(tmp_path / "nowhere.stl")

@@ -335,6 +335,8 @@ def _load_script(path: Path, tess: "_Tessellation"):
             f"guard command-line code with `if __name__ == \"__main__\":`"
         ) from err
     except Exception as err:
+        if _timed_out(err):  # a library turned the alarm into its own error (pybind11's import:
+            raise _PartTimeout from err  # 'ImportError: initialization failed', said as the script's fault)
         line = _script_line(err, path)
         raise WoodcamError(
             f"part script {str(path)!r} failed{line} with {type(err).__name__}: {err}; run it with "
@@ -382,6 +384,17 @@ def _load_script(path: Path, tess: "_Tessellation"):
             f"load the file in the script (e.g. build123d import_step) or pass the path directly"
         )
     return _load(part, tess, origin=origin)
+
+
+def _timed_out(err: BaseException | None) -> bool:
+    """Whether the timeout's alarm (:class:`_PartTimeout`) is among the causes of ``err``."""
+    seen = set()
+    while err is not None and id(err) not in seen:
+        if isinstance(err, _PartTimeout):
+            return True
+        seen.add(id(err))
+        err = err.__cause__ or err.__context__
+    return False
 
 
 def _script_line(err: BaseException, path: Path) -> str:
