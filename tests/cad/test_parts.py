@@ -157,6 +157,18 @@ def test_open_surface_raises():
         load_part(cup)
 
 
+def test_bodies_touching_along_an_edge_are_said_as_such():
+    """Two boxes sharing one edge (4 triangles on it) were refused as '1 open or non-manifold
+    edges' with 'export a solid, not surfaces': advice for a surface, not for touching bodies."""
+    a = trimesh.creation.box((20, 20, 20))
+    b = a.copy()
+    b.apply_translation((20, 20, 0))
+    with pytest.raises(WoodcamError, match=r"is not a 2-manifold mesh: 1 edge is shared by more than two triangles "
+                       r"\(bodies touching along an edge, or a surface inside the solid\), 0 open; make the "
+                       r"bodies overlap or move them apart"):
+        load_part(trimesh.util.concatenate([a, b]))
+
+
 def test_manifold_input_is_returned_as_is():
     cube = manifold3d.Manifold.cube((3, 4, 5))
     assert load_part(cube) is cube

@@ -631,9 +631,18 @@ def _manifold_from_trimesh(mesh, origin: str):
     if not welded.is_winding_consistent:
         trimesh.repair.fix_winding(welded)
     if not welded.is_watertight:
+        counts = np.bincount(welded.edges_unique_inverse, minlength=len(welded.edges_unique))
+        shared = int(np.count_nonzero(counts > 2))
+        if shared:  # two bodies touching along an edge were told to 'export a solid, not surfaces'
+            raise WoodcamError(
+                f"{origin} is not a 2-manifold mesh: {shared} edge{'s' if shared > 1 else ''} "
+                f"{'are' if shared > 1 else 'is'} shared by more than two triangles (bodies touching along "
+                f"an edge, or a surface inside the solid), {int(np.count_nonzero(counts == 1))} open; "
+                f"make the bodies overlap or move them apart in your CAD program, or repair the mesh (e.g. "
+                f"MeshLab's 'Repair non Manifold Edges')")
         raise WoodcamError(
             f"{origin} is not a closed (watertight) mesh, even after filling holes: it has "
-            f"{_count_open_edges(welded)} open or non-manifold edges; close the mesh in your CAD "
+            f"{int(np.count_nonzero(counts == 1))} open edges; close the mesh in your CAD "
             f"program (export a solid, not surfaces) or repair it (e.g. Meshmixer, MeshLab)"
         )
     return _manifold_from_shells(welded, origin)
@@ -733,12 +742,6 @@ def _close_holes(mesh, origin: str):
             f"{say_volume(vol, '.6g')}. Check that this is the part you meant, or export a closed solid"),
             stacklevel=4)
     return closed
-
-
-def _count_open_edges(mesh) -> int:
-    """Edges of ``mesh`` not shared by exactly two faces."""
-    counts = np.bincount(mesh.edges_unique_inverse, minlength=len(mesh.edges_unique))
-    return int(np.count_nonzero(counts != 2))
 
 
 def _manifold_from_arrays(vertices, faces, origin: str):
