@@ -483,6 +483,21 @@ def test_a_timeout_a_library_turned_into_its_own_error_is_still_the_timeout(tmp_
         load_part(path, timeout_s=0.5)
 
 
+def test_a_cq_editor_script_calling_debug_and_log_loads_what_it_shows(tmp_path, capsys):
+    """CQ-editor gives its scripts debug() (a helper shape drawn red, not the part) and log();
+    a script calling them failed with NameError, and one relying on its `cq` was not told why."""
+    path = tmp_path / "cqed.py"
+    path.write_text("import trimesh\nbox = trimesh.creation.box((10, 10, 10))\nhelper = trimesh.creation.box((99, 1, 1))\n"
+                    "debug(helper)\nlog('built the box')\nshow_object(box)\n")
+    capsys.readouterr()
+    assert load_part(path).volume() == pytest.approx(1000)
+    assert capsys.readouterr().err == "built the box\n"
+    path.write_text("r = cq.Workplane('XY').box(1, 1, 1)\nshow_object(r)\n")
+    with pytest.raises(WoodcamError, match=r"failed at line 1 with NameError: name 'cq' is not defined \(CQ-editor "
+                       r"imports cadquery as `cq` for its scripts: add `import cadquery as cq`\)"):
+        load_part(path)
+
+
 def test_missing_file_raises(tmp_path):
     with pytest.raises(WoodcamError, match="does not exist"):
         load_part(tmp_path / "nowhere.stl")

@@ -325,9 +325,18 @@ def _load_script(path: Path, tess: "_Tessellation"):
     def show_object(obj, *args, **kwargs):  # CQ-editor's and cq-cli's way to give the result
         shown.append(obj)
 
+    # CQ-editor's other two names for its scripts (a script calling them failed with NameError):
+    # debug() draws a helper shape in translucent red, not the part; log() writes a line to its log
+    def debug(obj, *args, **kwargs):
+        pass
+
+    def log(message, *args, **kwargs):
+        print(message, file=sys.stderr)
+
     sys.path.insert(0, folder)  # like `python script.py`: helpers next to the script import
     try:
-        namespace = runpy.run_path(str(path), init_globals={"show_object": show_object},
+        namespace = runpy.run_path(str(path), init_globals={"show_object": show_object, "debug": debug,
+                                                            "log": log},
                                    run_name="__woodcam_part__")
     except SystemExit as err:
         raise WoodcamError(
@@ -338,8 +347,10 @@ def _load_script(path: Path, tess: "_Tessellation"):
         if _timed_out(err):  # a library turned the alarm into its own error (pybind11's import:
             raise _PartTimeout from err  # 'ImportError: initialization failed', said as the script's fault)
         line = _script_line(err, path)
+        cq = (" (CQ-editor imports cadquery as `cq` for its scripts: add `import cadquery as cq`)"
+              if isinstance(err, NameError) and err.name == "cq" else "")
         raise WoodcamError(
-            f"part script {str(path)!r} failed{line} with {type(err).__name__}: {err}; run it with "
+            f"part script {str(path)!r} failed{line} with {type(err).__name__}: {err}{cq}; run it with "
             f"`python {path}` to see the traceback and fix the script"
         ) from err
     finally:
