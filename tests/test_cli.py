@@ -283,6 +283,22 @@ def test_a_part_in_inches_gets_each_commands_own_fix(tmp_path, capsys, monkeypat
     assert "--place" not in err
 
 
+def test_place_says_a_broken_part_before_opening_the_block(tmp_path, capsys, monkeypatch):
+    """`woodcam place` opened the block (a Mokume sample's fit: minutes) before it ran the part
+    script, so a typo in it was said after the wait. The part is loaded first."""
+    import woodcam.stock
+
+    def no_block(*args, **kwargs):
+        raise AssertionError("the block was opened before the part was loaded")
+
+    monkeypatch.setattr(woodcam.stock, "open_stock", no_block)
+    part = tmp_path / "typo.py"
+    part.write_text("part = Bx(10, 10, 10)\n")
+    assert main(["place", str(part), "--block", "builtin:knotty", "--out", str(tmp_path / "place")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("woodcam: error: part script") and "NameError: name 'Bx' is not defined" in err, err
+
+
 def test_a_no_obj_rerun_removes_the_earlier_runs_obj_but_never_an_input_or_a_foreign_obj(tmp_path, capsys):
     """Rerunning `bake --no-obj` into a folder left the earlier run's OBJ + MTL + PNG beside the
     new GLB, where they passed for the new part. They go (named in a warning); a baked OBJ

@@ -50,13 +50,14 @@ def run_place(args: argparse.Namespace) -> int:
     with output_refused_at_the_door():
         check_output_path(out / "placements.json", suffixes=(".json",), what="--out", mkdir=True)
     # one bar over the run, the orientations' and panels' own under it; the part is loaded
-    # once for the search and the picture (a .py part runs its CAD: seconds)
-    with StageBar(["open block", "load part", "score placements", "render"], desc="place",
+    # once for the search and the picture (a .py part runs its CAD: seconds), and first: a
+    # script's typo or a damaged STEP was said after the block was opened (a fit of minutes)
+    with StageBar(["load part", "open block", "score placements", "render"], desc="place",
                   leave=False) as bar:
-        with bar.stage("open block"):
-            stock = open_stock(args.block)
         with bar.stage("load part"):
             part = load_part(args.part)
+        with bar.stage("open block"):
+            stock = open_stock(args.block)
         with bar.stage("score placements"):
             advice = advise_placement(part, stock, rotations=args.rotations,
                                       candidates=args.candidates, margin_mm=args.margin, progress=True,
