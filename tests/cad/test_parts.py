@@ -498,6 +498,26 @@ def test_a_cq_editor_script_calling_debug_and_log_loads_what_it_shows(tmp_path, 
         load_part(path)
 
 
+def test_a_sketch_shown_beside_the_solid_is_left_out_and_said(tmp_path, cq, bd):
+    """CQ-editor scripts show the profile beside the solid made from it; the union of what is
+    shown refused the script ('cannot use an object of type cadquery.sketch.Sketch', or 'contains
+    no solid nor shell'). What holds no volume is left out, named; a script showing nothing with
+    volume is still refused."""
+    path = tmp_path / "profile.py"
+    path.write_text("import cadquery as cq\ns = cq.Sketch().rect(20, 20)\n"
+                    "show_object(s, name='profile')\nshow_object(cq.Workplane().box(10, 10, 10))\n"
+                    "show_object(cq.Workplane().rect(5, 5))\n")
+    with pytest.warns(WoodcamWarning, match=r"'.*profile\.py' shows 2 objects with no volume \(show_object\[0\] "
+                      r"\('profile'\), a cadquery Sketch; show_object\[2\], a cadquery Workplane\): left out of the part"):
+        assert load_part(path).volume() == pytest.approx(1000)
+    path.write_text("from build123d import Box, Rectangle\nshow_object(Rectangle(5, 5))\nshow_object(Box(10, 10, 10))\n")
+    with pytest.warns(WoodcamWarning, match=r"show_object\[0\], a build123d Rectangle\): left out"):
+        assert load_part(path).volume() == pytest.approx(1000)
+    path.write_text("from build123d import Rectangle\nshow_object(Rectangle(5, 5))\nshow_object(Rectangle(6, 6))\n")
+    with pytest.raises(WoodcamError, match="contains no solid nor shell"):
+        load_part(path)
+
+
 def test_missing_file_raises(tmp_path):
     with pytest.raises(WoodcamError, match="does not exist"):
         load_part(tmp_path / "nowhere.stl")

@@ -322,8 +322,11 @@ def _load_script(path: Path, tess: "_Tessellation"):
     folder = str(path.resolve().parent)
     shown: list = []
 
-    def show_object(obj, *args, **kwargs):  # CQ-editor's and cq-cli's way to give the result
+    names: list = []
+
+    def show_object(obj, name=None, *args, **kwargs):  # CQ-editor's and cq-cli's way to give the result
         shown.append(obj)
+        names.append(name)
 
     # CQ-editor's other two names for its scripts (a script calling them failed with NameError):
     # debug() draws a helper shape in translucent red, not the part; log() writes a line to its log
@@ -370,6 +373,22 @@ def _load_script(path: Path, tess: "_Tessellation"):
                 f"object{'s' if len(shown) > 1 else ''} to show_object: loaded what it shows (as "
                 f"CQ-editor does), not `part`; to load `part`, pass it to show_object too or "
                 f"remove the show_object calls"), stacklevel=5)
+        flat = [_without_volume(obj) for obj in shown]
+        if any(flat) and not all(flat):
+            # CQ-editor shows a sketch or a wire beside the solid; the union refused the script
+            # for it ('cannot use an object of type cadquery.sketch.Sketch'): left out, and said
+            import warnings
+
+            from ..errors import WoodcamWarning
+
+            left = [f"show_object[{i}]" + (f" ({names[i]!r})" if names[i] else "")
+                    + f", a {type(obj).__module__.split('.')[0]} {type(obj).__name__}"
+                    for i, (obj, f) in enumerate(zip(shown, flat)) if f]
+            warnings.warn(WoodcamWarning(
+                f"part script {str(path)!r} shows {len(left)} object{'s' if len(left) > 1 else ''} with no "
+                f"volume ({'; '.join(left)}): left out of the part, carved what it shows with volume; "
+                f"if one belongs to the part, extrude it into a solid"), stacklevel=5)
+            shown = [obj for obj, f in zip(shown, flat) if not f]
         part = shown[0] if len(shown) == 1 else shown
         origin = f"what script {str(path)!r} passes to show_object"
     elif "part" not in namespace:
@@ -395,6 +414,34 @@ def _load_script(path: Path, tess: "_Tessellation"):
             f"load the file in the script (e.g. build123d import_step) or pass the path directly"
         )
     return _load(part, tess, origin=origin)
+
+
+#: Objects of the CAD kernels that are never a solid (their names in build123d and cadquery).
+_NO_VOLUME_TYPES = frozenset({"Sketch", "BuildSketch", "BuildLine", "Location", "Vector", "Plane", "Axis"})
+
+
+def _without_volume(obj) -> bool:
+    """Whether ``obj``, something a script shows, is a build123d or cadquery object that holds no
+    solid nor shell (a sketch, face, wire, edge, point, location, or a Workplane of them); False
+    for anything else (the loader judges it)."""
+    module = (type(obj).__module__ or "").split(".")[0]
+    if module not in ("build123d", "cadquery"):
+        return False
+    if type(obj).__name__ in _NO_VOLUME_TYPES:
+        return True
+    items = obj.vals() if type(obj).__name__ == "Workplane" else [obj]
+    from OCP.TopAbs import TopAbs_SHELL, TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS_Shape
+
+    for item in items:
+        wrapped = getattr(item, "wrapped", None)
+        if type(item).__name__ in _NO_VOLUME_TYPES or (isinstance(wrapped, TopoDS_Shape) and (
+                wrapped.IsNull() or not (TopExp_Explorer(wrapped, TopAbs_SOLID).More()
+                                         or TopExp_Explorer(wrapped, TopAbs_SHELL).More()))):
+            continue
+        return False  # a solid, or something the loader judges
+    return True
 
 
 def _timed_out(err: BaseException | None) -> bool:
