@@ -518,6 +518,25 @@ def test_a_sketch_shown_beside_the_solid_is_left_out_and_said(tmp_path, cq, bd):
         load_part(path)
 
 
+def test_a_script_showing_its_part_in_the_ocp_cad_viewer_loads_what_it_shows(tmp_path):
+    """build123d's docs show parts with ocp_vscode's show(); a script importing it failed with
+    ModuleNotFoundError (or, with the viewer installed, sent its part there and woodcam got none).
+    While the script runs, ocp_vscode is woodcam's: show() and show_object() give the part, the
+    rest does nothing; the real module (or its absence) is back after."""
+    import sys
+
+    path = tmp_path / "viewed.py"
+    path.write_text("import manifold3d\nfrom ocp_vscode import show, set_port, Camera\nset_port(3939)\n"
+                    "a = manifold3d.Manifold.cube((10, 10, 10))\nb = a.translate((20, 0, 0))\n"
+                    "show(a, b, names=['a', 'b'], reset_camera=Camera.ISO)\n")
+    before = sys.modules.get("ocp_vscode")
+    assert load_part(path).volume() == pytest.approx(2000)
+    assert sys.modules.get("ocp_vscode") is before
+    path.write_text("import manifold3d\nfrom ocp_vscode import *\nset_defaults(ortho=True)\n"
+                    "show_object(manifold3d.Manifold.cube((10, 10, 10)))\n")
+    assert load_part(path).volume() == pytest.approx(1000)
+
+
 def test_missing_file_raises(tmp_path):
     with pytest.raises(WoodcamError, match="does not exist"):
         load_part(tmp_path / "nowhere.stl")

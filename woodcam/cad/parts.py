@@ -336,7 +336,16 @@ def _load_script(path: Path, tess: "_Tessellation"):
     def log(message, *args, **kwargs):
         print(message, file=sys.stderr)
 
+    def show(*objs, names=None, **kwargs):  # ocp_vscode's (the OCP CAD viewer of build123d's docs)
+        names = list(names) if isinstance(names, (list, tuple)) else [names] * len(objs)
+        for obj, name in zip(objs, names + [None] * len(objs)):
+            show_object(obj, name)
+
     sys.path.insert(0, folder)  # like `python script.py`: helpers next to the script import
+    viewer = sys.modules.get("ocp_vscode")
+    # build123d scripts import ocp_vscode's show() to see the part in VS Code: it failed with
+    # ModuleNotFoundError (or, installed, sent the part to a viewer port and woodcam got nothing)
+    sys.modules["ocp_vscode"] = _viewer_stand_in(show, show_object)
     try:
         namespace = runpy.run_path(str(path), init_globals={"show_object": show_object, "debug": debug,
                                                             "log": log},
@@ -359,6 +368,10 @@ def _load_script(path: Path, tess: "_Tessellation"):
     finally:
         if folder in sys.path:
             sys.path.remove(folder)
+        if viewer is None:
+            sys.modules.pop("ocp_vscode", None)
+        else:
+            sys.modules["ocp_vscode"] = viewer
     if shown:
         # What the script shows is what its author saw in CQ-editor: it wins over a `part`
         # variable, which may be a loop variable (`for part in parts: show_object(part)` loaded
@@ -414,6 +427,33 @@ def _load_script(path: Path, tess: "_Tessellation"):
             f"load the file in the script (e.g. build123d import_step) or pass the path directly"
         )
     return _load(part, tess, origin=origin)
+
+
+class _Anything:
+    """Whatever a script takes from the viewer besides show: a call that does nothing, with
+    attributes of its own kind (``set_defaults(...)``, ``Camera.ISO``)."""
+
+    def __call__(self, *args, **kwargs):
+        return None
+
+    def __getattr__(self, name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return self
+
+
+def _viewer_stand_in(show, show_object):
+    """A module standing in for ``ocp_vscode`` while a part script runs: its ``show`` and
+    ``show_object`` give the shapes to woodcam as CQ-editor's ``show_object`` does."""
+    import types
+
+    module = types.ModuleType("ocp_vscode", "woodcam's stand-in for the OCP CAD viewer: show() gives the part")
+    module.show = show  # type: ignore[attr-defined]
+    module.show_object = show_object  # type: ignore[attr-defined]
+    module.__all__ = ["show", "show_object", "show_all", "set_port", "set_defaults", "reset_show",  # type: ignore[attr-defined]
+                      "show_clear", "Camera", "Collapse"]
+    module.__getattr__ = lambda name: _Anything()  # type: ignore[method-assign]
+    return module
 
 
 #: Objects of the CAD kernels that are never a solid (their names in build123d and cadquery).
