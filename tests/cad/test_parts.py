@@ -460,6 +460,9 @@ def test_a_binary_stl_whose_header_miscounts_its_triangles_is_read_by_its_size(t
      r"it defines trimesh Trimesh `box`, trimesh Trimesh `lid`: add `part = \[box, lid\]` \(their union\) or pass "
      r"the one you mean to show_object"),
     ("import math\nx = math.pi\n", r"add e\.g\. `part = Box\(10, 10, 10\)`"),
+    ("import manifold3d\n\nif __name__ == '__main__':\n    part = manifold3d.Manifold.cube((1, 1, 1))\n",
+     r"its `if __name__ == \"__main__\":` block does not run when woodcam loads the script \(as when it is "
+     r"imported\): build `part` at module level, outside that block$"),
 ])
 def test_a_script_without_part_is_told_which_of_its_shapes_to_name(tmp_path, body, fix):
     """A script of `box = ...` and `lid = ...` but no `part` was told to add `part = Box(10, 10,

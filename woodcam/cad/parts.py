@@ -406,17 +406,21 @@ def _load_script(path: Path, tess: "_Tessellation"):
         origin = f"what script {str(path)!r} passes to show_object"
     elif "part" not in namespace:
         shapes = _shapes_in(namespace)
+        end = " at the end of the script"
         fix = ("it defines `result` (cadquery's convention): add `part = result` or "
-               "`show_object(result)`" if "result" in namespace else
+               f"`show_object(result)`{end}" if "result" in namespace else
                # a script of `box = ...; lid = ...` was told to add `part = Box(10, 10, 10)`
-               f"it defines {_say_shapes(namespace, shapes)}: add `part = {shapes[0]}`" if len(shapes) == 1 else
+               f"it defines {_say_shapes(namespace, shapes)}: add `part = {shapes[0]}`{end}" if len(shapes) == 1 else
                f"it defines {_say_shapes(namespace, shapes)}: add `part = [{', '.join(shapes)}]` (their "
-               f"union) or pass the one you mean to show_object" if shapes else
+               f"union) or pass the one you mean to show_object{end}" if shapes else
+               # a part built under the guard was told to add `part = Box(10, 10, 10)`
+               "its `if __name__ == \"__main__\":` block does not run when woodcam loads the script (as when "
+               "it is imported): build `part` at module level, outside that block" if _has_main_guard(path) else
                "add e.g. `part = Box(10, 10, 10)` (a build123d/cadquery solid, trimesh mesh or "
-               "manifold)")
+               f"manifold){end}")
         raise WoodcamError(
             f"part script {str(path)!r} does not define a module-level variable `part` nor "
-            f"call show_object; {fix} at the end of the script"
+            f"call show_object; {fix}"
         )
     else:
         part = namespace["part"]
@@ -493,6 +497,18 @@ def _timed_out(err: BaseException | None) -> bool:
         seen.add(id(err))
         err = err.__cause__ or err.__context__
     return False
+
+
+def _has_main_guard(path: Path) -> bool:
+    """Whether the script ``path`` has a module-level ``if __name__ == "__main__":`` block."""
+    import ast
+
+    try:
+        tree = ast.parse(path.read_bytes())
+    except (SyntaxError, ValueError, OSError):
+        return False
+    return any(isinstance(node, ast.If) and "__main__" in ast.dump(node.test) and "__name__" in ast.dump(node.test)
+               for node in tree.body)
 
 
 def _script_line(err: BaseException, path: Path) -> str:
