@@ -299,6 +299,17 @@ def test_place_says_a_broken_part_before_opening_the_block(tmp_path, capsys, mon
     assert err.startswith("woodcam: error: part script") and "NameError: name 'Bx' is not defined" in err, err
 
 
+def test_place_bounds_a_part_script_with_timeout_as_bake_does(tmp_path, capsys):
+    """`woodcam place` runs the same trusted part scripts as bake but had no --timeout: a
+    script stuck in a loop hung it."""
+    part = tmp_path / "loops.py"
+    part.write_text("while True:\n    pass\n")
+    assert main(["place", str(part), "--block", "builtin:flat-sawn", "--timeout", "0.5",
+                 "--out", str(tmp_path / "place")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("woodcam: error: loading the part") and "took longer than the timeout of 0.5 s" in err, err
+
+
 def test_a_no_obj_rerun_removes_the_earlier_runs_obj_but_never_an_input_or_a_foreign_obj(tmp_path, capsys):
     """Rerunning `bake --no-obj` into a folder left the earlier run's OBJ + MTL + PNG beside the
     new GLB, where they passed for the new part. They go (named in a warning); a baked OBJ

@@ -35,7 +35,7 @@ def register(subparsers) -> None:
 
     p = subparsers.add_parser("bake", help="carve a part out of a block and bake its wood texture",
                               description="PART is a build123d/cadquery script defining `part`, "
-                              "or a STEP/STL/OBJ/GLB file, modelled in the block frame (mm). "
+                              "or a STEP/STL/OBJ/PLY/OFF/GLB file, modelled in the block frame (mm). "
                               "A .py part script is trusted code: it runs with your rights and "
                               "can read, write or delete your files, so only bake scripts you "
                               "wrote or have read (--timeout bounds its run time; it is not a "

@@ -19,10 +19,15 @@ def register(subparsers) -> None:
         "separately (knots and pith on or just under the surface, end grain on the surface, "
         "grain runout along a long thin part). Writes OUT/placements.png (the best placements "
         "and the worst side by side) and OUT/placements.json; prints the table with the "
-        "--place options that reproduce each placement in woodcam bake.")
+        "--place options that reproduce each placement in woodcam bake. A .py part script is "
+        "trusted code: it runs with your rights, so only place scripts you wrote or have read "
+        "(--timeout bounds its run time; it is not a sandbox).")
     add_input(p, "part", kind="file", suffixes=part_suffixes, help="part file (.py script, .step, .stl, .obj, .ply, .off, .glb), block frame, mm")
     add_input(p, "--block", kind="block", required=True, help=BLOCK_SPEC_HELP)
     add_out_option(p, "placements.png and placements.json")
+    p.add_argument("--timeout", type=float, default=None, metavar="S",  # bake's; place had none
+                   help="stop loading the part (running a trusted .py script, tessellating) "
+                   "after S seconds (default: no limit)")
     p.add_argument("--rotations", choices=("none", "z90", "all90"), default="z90",
                    help="orientations to try: none, quarter turns about z (default), or all 24 "
                    "axis-aligned ones")
@@ -55,7 +60,7 @@ def run_place(args: argparse.Namespace) -> int:
     with StageBar(["load part", "open block", "score placements", "render"], desc="place",
                   leave=False) as bar:
         with bar.stage("load part"):
-            part = load_part(args.part)
+            part = load_part(args.part, timeout_s=args.timeout)
         with bar.stage("open block"):
             stock = open_stock(args.block)
         with bar.stage("score placements"):
