@@ -1906,3 +1906,53 @@ def test_rings_detect_help_names_every_file_it_writes(capsys):
     for said in ("<face>_ring_map.png", "<face>_traces.svg", "<face>_knot_mask.png, white = knot", "block.json",
                  "its U-Net maps and knot masks are ignored: re-detected"):
         assert said in text, said
+
+
+def test_a_dense_jpeg_is_decoded_reduced_turned_and_in_srgb(synth_photos, tmp_path, monkeypatch):
+    """Six 30 MP phone JPEGs took 14 s and 500 MB for faces of 0.3 MP, each decoded in full and
+    then resampled. Now a JPEG denser than the stored face is decoded at 1/2, 1/4 or 1/8 of its
+    size (the JPEG decoder's DCT scaling), keeping DRAFT_MARGIN times the face's pixels, then
+    resampled: the face within resampling error of the full decode's, still turned by its EXIF
+    orientation and converted from its ICC profile. ``least`` is asked with the upright size."""
+    import io
+
+    from PIL import ImageCms, JpegImagePlugin
+
+    from woodcam._readers import read_photo_rgb
+    from woodcam.block.photos import DRAFT_MARGIN, _resampled, block_from_photos
+
+    p3 = ImageCms.ImageCmsProfile(io.BytesIO(icc := _matrix_icc("Display P3 (test)", _P3)))
+    d = _copy(synth_photos, tmp_path / "dense")
+    with Image.open(d / "front.png") as im:  # 32 px/mm: 8 times the cap of 4
+        shown = im.convert("RGB").resize((1600, 1600), Image.BICUBIC)
+    stored = ImageCms.profileToProfile(shown, ImageCms.createProfile("sRGB"), p3)
+    exif = Image.Exif()
+    exif[0x0112] = 6  # turn clockwise to view: stored a quarter turn back
+    Image.fromarray(np.rot90(np.asarray(stored)).copy()).save(d / "front.jpg", quality=95, exif=exif,
+                                                                icc_profile=icc)
+    (d / "front.png").unlink()
+    drafts = []
+    draft = JpegImagePlugin.JpegImageFile.draft
+
+    def spy(im, mode, size):
+        drafts.append((im.size, size))
+        got = draft(im, mode, size)
+        drafts.append(im.size)
+        return got
+
+    monkeypatch.setattr(JpegImagePlugin.JpegImageFile, "draft", spy)
+    got = block_from_photos(d, (50, 50, 50), max_px_per_mm=4.0).faces["front"].photo.astype(int)
+    # read at the cap (200 px), then again at the other photos' 3.2 px/mm (160 px): both at 1/4
+    assert drafts == [((1600, 1600), (200 * DRAFT_MARGIN,) * 2), (400, 400),
+                      ((1600, 1600), (160 * DRAFT_MARGIN,) * 2), (400, 400)], drafts
+    monkeypatch.undo()
+    full = _resampled(read_photo_rgb(d / "front.jpg", "x"), (160, 160)).astype(int)  # decoded in full
+    diff = np.abs(got - full)
+    assert diff.mean() < 0.5 and diff.max() <= 4, (diff.mean(), diff.max())
+    upright = np.asarray(shown.resize((160, 160), Image.LANCZOS), int)
+    assert np.abs(got - upright).mean() < 1.0  # turned and in sRGB (0.36 levels off)
+    assert np.abs(got - np.rot90(upright)).mean() > 10.0
+    asked = []
+    Image.fromarray(np.zeros((600, 1000, 3), np.uint8)).save(tmp_path / "wide.jpg", exif=exif)
+    a = read_photo_rgb(tmp_path / "wide.jpg", "x", least=lambda rows, cols: asked.append((rows, cols)) or (250, 150))
+    assert asked == [(1000, 600)] and a.shape == (250, 150, 3)

@@ -75,6 +75,12 @@ DENSITY_SPREAD = 1.5
 #: greyscale: the 12 Mokume face photos differ by 45-70, woodcam's synthetic faces by 80-95,
 #: a grey photo saved as RGB (a phone's mono filter, a scanner's grey mode) by 0-1.
 GREY_CHROMA = 3.0
+#: A JPEG photo denser than the stored face is decoded reduced (1/2, 1/4, 1/8: the JPEG
+#: decoder's DCT scaling) to no fewer than this many times the face's pixels a side, which the
+#: Lanczos resampling then brings to the face: on six 30 MP photos stored at 0.3 MP the faces
+#: differ from the full decode's by 0.18 levels on average, 2 at most (at 1, 0.57 and 40:
+#: the DCT's box-like reduction aliases fine rings); DEVELOPERS.md has the measurement.
+DRAFT_MARGIN = 2
 #: Default upper density (px/mm): 10 px/mm keeps 0.1 mm detail (rings are >= 0.8 mm) and a
 #: 50 mm face at 500 px, which the ring detector handles in about a second.
 MAX_PX_PER_MM = 10.0
@@ -313,20 +319,31 @@ def _read_face_photo(face: str, path: Path, size, max_px_per_mm: float) -> tuple
     """The checked photo of ``face`` brought down to ``max_px_per_mm`` if denser, and its own
     density (px/mm); or, when its aspect does not fit the face, what is wrong (:class:`_Misfit`).
     A function, so the full-size photo is freed before the next is read: six 48 MP photos held
-    at once took 1.8 GB."""
-    a = read_photo_rgb(path, f"photo of face {face!r}")
-    _check_exposure(face, a, path)
+    at once took 1.8 GB. A JPEG denser than ``max_px_per_mm`` is decoded at 1/2, 1/4 or 1/8 of
+    its size where that keeps :data:`DRAFT_MARGIN` times the stored face's pixels (six 30 MP
+    photos took 14 s and 500 MB, decoded in full for 0.3 MP faces; DEVELOPERS.md)."""
     h_mm, w_mm = face_image_size_mm(face, size)
-    if not _fits(face, a.shape, size):
-        return _Misfit(_aspect_misfit(face, path, a.shape, h_mm, w_mm), (a.shape[0], a.shape[1]))
+    target = _face_shape(face, size, max_px_per_mm)
+    full: list[tuple[int, int]] = []  # the photo's own (rows, cols), whatever size it is decoded at
+
+    def least(rows: int, cols: int) -> tuple[int, int] | None:
+        full.append((rows, cols))
+        dense = min(rows / h_mm, cols / w_mm) > max_px_per_mm
+        return (DRAFT_MARGIN * target[0], DRAFT_MARGIN * target[1]) if dense and _fits(face, (rows, cols), size) else None
+
+    a = read_photo_rgb(path, f"photo of face {face!r}", least=least)
+    _check_exposure(face, a, path)
+    shape = full[0] if full else a.shape[:2]
+    if not _fits(face, shape, size):
+        return _Misfit(_aspect_misfit(face, path, shape, h_mm, w_mm), (shape[0], shape[1]))
     # an 8 x 8 px photo was enlarged and recorded at a density it lacks; a 20 x 20 px one passed
     # and detection read its noise as rings (a false 'looks mirrored')
-    if min(a.shape[:2]) < MIN_FACE_PHOTO_PX:
-        raise WoodcamError(f"photo of face {face!r} ({path.name}) is {a.shape[1]}x{a.shape[0]} px: too small to "
+    if min(shape) < MIN_FACE_PHOTO_PX:
+        raise WoodcamError(f"photo of face {face!r} ({path.name}) is {shape[1]}x{shape[0]} px: too small to "
                            f"hold rings; give at least {MIN_FACE_PHOTO_PX} px a side (MIN_FACE_PHOTO_PX; a phone "
                            "photo has thousands)")
-    px_mm = min(a.shape[0] / h_mm, a.shape[1] / w_mm)
-    return (_resampled(a, _face_shape(face, size, max_px_per_mm)) if px_mm > max_px_per_mm else a), px_mm
+    px_mm = min(shape[0] / h_mm, shape[1] / w_mm)
+    return (_resampled(a, target) if px_mm > max_px_per_mm else a), px_mm
 
 
 def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: float = MAX_PX_PER_MM,
