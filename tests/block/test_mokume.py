@@ -96,3 +96,34 @@ def test_mismatched_or_missing_images_raise(tmp_path):
         read_mokume(tmp_path / "..")
     with pytest.raises(WoodcamError, match="is not a directory"):
         read_mokume(tmp_path / "nope")
+
+
+def test_mokume_names_are_read_in_any_case(tmp_path, recwarn):
+    """A Mokume sample's files renamed or unpacked upper-case (A_COL.PNG, A_ARL-UNET.PNG: a
+    case-insensitive file system keeps them so, and opened them by the lower-case name): read on
+    a case-sensitive one they were 'must hold Mokume files ... found none', and 'block from-photos'
+    read A_COL.PNG as the front's photo but called A_ARL-UNET.PNG 'named for no face'. Now both
+    read the names in any case, at one home (block.io._mokume_kind); two files of one kind whose
+    names differ in case only are an error naming them."""
+    from woodcam.block.photos import block_from_photos
+
+    src = _mokume("H11")
+    d = tmp_path / "H11"
+    d.mkdir()
+    for p in src.iterdir():
+        (d / (p.name.upper() if p.stem[0] in "ACF" else p.name)).write_bytes(p.read_bytes())
+    want, got = read_mokume(src), read_mokume(d)
+    assert list(got.faces) == list(want.faces)
+    for name, face in want.faces.items():
+        assert np.array_equal(got.faces[name].photo, face.photo)
+        assert np.array_equal(got.faces[name].ring_map, face.ring_map)
+        assert sorted(got.faces[name].extras) == sorted(face.extras)
+    block_from_photos(d, (50, 50, 50))
+    said = [str(w.message) for w in recwarn]
+    assert not any("named for no face" in m for m in said), said
+    assert any("ring maps A_ARL-UNET.PNG, B_arl-unet.png" in m and "knot masks C_KNOT.PNG, F_KNOT.PNG are not read" in m
+               for m in said), said
+    (d / "A_col.png").write_bytes((src / "A_col.png").read_bytes())
+    with pytest.raises(WoodcamError, match=r"holds 2 col files of face 'front' \(A_COL.PNG, A_col.png\), names "
+                                           r"differing in case only; keep one, named A_col.png"):
+        read_mokume(d)

@@ -62,7 +62,7 @@ from .._atomic import all_or_nothing, atomic_path, output_folder, write_text
 from .._readers import photo_rgb8, read_image_file
 from ..errors import BlockFolderError, WoodcamError, WoodcamWarning
 from ..fields.state import field_from_state, field_type, jsonable
-from ..frames import FACES, MOKUME_LETTER, check_size
+from ..frames import FACE_OF_LETTER, FACES, MOKUME_LETTER, check_size
 from ..tolerances import KNOT_POINT_MAX_PX, KNOT_REGION_SMOOTH_PX
 from .block import Block, Face, RingTrace
 
@@ -421,10 +421,33 @@ def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | No
     return read_mokume(folder, MOKUME_DEFAULT_SIZE_MM if size_mm is None else tuple(size_mm))
 
 
+def _mokume_kind(path: Path) -> tuple[str, str] | None:
+    """(face, kind) of a Mokume sample's file ``A_col.png``, ``A_arl-unet.png``, ``A_ann.png`` or
+    ``A_knot.png`` (kind ``col`` or one of :data:`MOKUME_MAP_KINDS`), its name in any case: a
+    case-insensitive file system (Windows, macOS) keeps ``A_ARL-UNET.PNG`` as renamed or unpacked,
+    and opened it as ``A_arl-unet.png`` while the folder's listing called it named for no face;
+    None for any other file."""
+    letter, _, kind = path.stem.partition("_")
+    face = FACE_OF_LETTER.get(letter.upper())
+    kind = kind.lower()
+    return (face, kind) if face and path.suffix.lower() == ".png" and kind in ("col", *MOKUME_MAP_KINDS) else None
+
+
 def _mokume_files(folder: Path, face: str) -> dict[str, Path]:
-    """The files a Mokume sample folder may hold for ``face``, by kind (``A_col.png`` ...)."""
-    letter = MOKUME_LETTER[face]
-    return {k: folder / f"{letter}_{k}.png" for k in ("col", *MOKUME_MAP_KINDS)}
+    """The files Mokume sample folder ``folder`` holds for ``face``, by kind (``A_col.png`` ...,
+    in any case: :func:`_mokume_kind`); two of one kind (``A_col.png`` and ``A_COL.PNG`` on a
+    case-sensitive file system) are a WoodcamError naming them."""
+    found: dict[str, list[Path]] = {}
+    for p in sorted(folder.iterdir()):
+        got = _mokume_kind(p)
+        if got and got[0] == face and p.is_file():
+            found.setdefault(got[1], []).append(p)
+    for kind, paths in found.items():
+        if len(paths) > 1:
+            raise WoodcamError(f"Mokume sample folder {str(folder)!r} holds {len(paths)} {kind} files of face "
+                               f"{face!r} ({', '.join(p.name for p in paths)}), names differing in case only; keep "
+                               f"one, named {MOKUME_LETTER[face]}_{kind}.png")
+    return {k: found[k][0] for k in ("col", *MOKUME_MAP_KINDS) if k in found}  # the photo first: the shape's reference
 
 
 def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *, name: str | None = None) -> Block:

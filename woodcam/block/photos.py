@@ -113,11 +113,12 @@ def _block_files(folder: Path) -> list[Path]:
 
 def _mokume_map_kind(path: Path) -> str | None:
     """The kind (:data:`~woodcam.block.io.MOKUME_MAP_KINDS`) of a Mokume sample's map or mask
-    ``A_arl-unet.png``, ``A_ann.png``, ``A_knot.png``; None for any other file."""
-    from .io import MOKUME_MAP_KINDS
+    ``A_arl-unet.png``, ``A_ann.png``, ``A_knot.png`` (in any case: :func:`~woodcam.block.io._mokume_kind`);
+    None for any other file."""
+    from .io import _mokume_kind
 
-    letter, _, kind = path.stem.partition("_")
-    return kind if letter.upper() in FACE_OF_LETTER and kind in MOKUME_MAP_KINDS else None
+    got = _mokume_kind(path)
+    return got[1] if got and got[1] != "col" else None
 
 
 def mokume_maps(folder) -> list[Path]:
