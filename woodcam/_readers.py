@@ -190,13 +190,14 @@ _EXIF_ORIENTATION = 0x0112
 
 
 def _draft(im, least: Callable[[int, int], tuple[int, int] | None], orientation) -> None:
-    """Have PIL image ``im`` (opened, not yet loaded) decoded at the least size ``least`` asks
-    (:func:`read_image_file`): ``least`` and its answer are upright, ``im`` as stored, turned a
-    quarter by EXIF orientations 5 to 8."""
+    """Have PIL image ``im`` (opened, not yet loaded), a JPEG, decoded at the least size ``least``
+    asks (:func:`read_image_file`): ``least`` and its answer are upright, ``im`` as stored,
+    turned a quarter by EXIF orientations 5 to 8. ``least`` is called whatever the format."""
     turned = orientation in (5, 6, 7, 8)
     rows, cols = (im.width, im.height) if turned else (im.height, im.width)
     want = least(rows, cols)
-    if want is not None and (want[0] < rows or want[1] < cols):
+    # JPEG alone: pillow-heif's draft swaps in the file's embedded thumbnail, another encoding
+    if want is not None and im.format in ("JPEG", "MPO") and (want[0] < rows or want[1] < cols):
         im.draft(None, (max(1, want[0]), max(1, want[1])) if turned else (max(1, want[1]), max(1, want[0])))
 
 

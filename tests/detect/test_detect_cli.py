@@ -1956,3 +1956,21 @@ def test_a_dense_jpeg_is_decoded_reduced_turned_and_in_srgb(synth_photos, tmp_pa
     Image.fromarray(np.zeros((600, 1000, 3), np.uint8)).save(tmp_path / "wide.jpg", exif=exif)
     a = read_photo_rgb(tmp_path / "wide.jpg", "x", least=lambda rows, cols: asked.append((rows, cols)) or (250, 150))
     assert asked == [(1000, 600)] and a.shape == (250, 150, 3)
+
+
+def test_a_heic_photo_is_read_in_full_not_by_its_thumbnail(tmp_path):
+    """A JPEG is decoded reduced where fewer pixels suffice; pillow-heif's draft, asked the same,
+    swaps in the HEIC's embedded thumbnail (another, smaller encoding of the photo, an iPhone's
+    320 px, enough under a low --max-px-per-mm). A HEIC is read in full, and ``least`` is still
+    asked."""
+    import pillow_heif
+
+    from woodcam._readers import read_photo_rgb
+
+    pillow_heif.register_heif_opener()
+    rng = np.random.default_rng(0)
+    Image.fromarray((rng.random((60, 80, 3)) * 255).astype(np.uint8)).resize((1600, 1200), Image.BICUBIC).save(
+        tmp_path / "front.heic", quality=90, thumbnails=[800])
+    asked = []
+    a = read_photo_rgb(tmp_path / "front.heic", "x", least=lambda rows, cols: asked.append((rows, cols)) or (300, 400))
+    assert asked == [(1200, 1600)] and a.shape == (1200, 1600, 3)
