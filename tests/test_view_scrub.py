@@ -251,3 +251,27 @@ def test_the_stock_is_coloured_when_its_mesh_has_a_vertex_without_a_normal(monke
     poly = _stock_polydata(pv, np.full((8, 12), 20.0), _Stock.size_mm, wood)
     assert poly.n_points == len(seen[0]) and poly.point_data["rgb"].shape == (poly.n_points, 3)
     np.testing.assert_array_equal(seen[0][-1], [0.0, 0.0, 1.0])
+
+
+def test_the_slider_counts_a_subroutine_s_moves_at_the_line_that_called_it():
+    """The slider took a subroutine's moves at their lines in its body: a slot subroutine at
+    lines 1-5 called on lines 8 and 10 showed both slots cut at line 9 (and its range began at
+    line 2). Its lines are main-program lines: at 9 the first slot alone is cut and drawn done."""
+    from woodcam.view.scrub import DONE_ACTORS, gcode_window
+
+    prog = read_gcode("o100 sub\nG0 X#1 Y10 Z1\nG1 Z-3 F300\nG1 X[#1+10]\nG0 Z5\no100 endsub\n"
+                      "G21 G90 M3 S9000\no100 call [10]\nG0 X50 Y30 Z5\no100 call [30]\nM2\n")
+    tool = parse_tool_spec("flat:6")
+    plotter, cb = gcode_window(prog, tool, _Stock(), resolution_mm=0.5, off_screen=True,
+                               window_size=(160, 120), until_line=9)
+    try:
+        assert (cb.first_line, cb.last_line) == (8, 10)
+        first = simulate(prog[:4], tool, _Stock.size_mm, resolution_mm=0.5).heightmap
+        np.testing.assert_array_equal(cb.heightmap, first)
+        assert _removed(cb.heightmap) > 0
+        done = plotter.actors[DONE_ACTORS[0]].GetMapper().GetInput()
+        assert done.bounds[1] == pytest.approx(20.0)  # the done feeds end at the first slot's X20
+        cb(10)
+        np.testing.assert_allclose(_removed(cb.heightmap), 2 * _removed(first), rtol=1e-6)
+    finally:
+        plotter.close()

@@ -339,3 +339,45 @@ def test_a_byte_that_is_no_utf8_outside_a_comment_says_so(tmp_path):
         read_gcode(prog)
     prog.write_bytes(b"G21 G90\nT1 M6\nG0 X1 Y1 Z1 (90\xb0)\nG1 Z-1 F100\nM2\n")
     assert len(read_gcode(prog)) == 2
+
+
+# a slot subroutine at lines 1-5, called on line 8 (slot X10-X20), a rapid elsewhere on line 9,
+# called again on line 10 (slot X30-X40)
+SUB_SLOTS = ("o100 sub\nG0 X#1 Y10 Z1\nG1 Z-1 F300\nG1 X[#1+10]\nG0 Z5\no100 endsub\n"
+             "G21 G90\no100 call [10]\nG0 X50 Y30 Z5\no100 call [30]\nM2\n")
+
+
+def check_until_line_counts_a_call_s_moves_at_its_line(prog):
+    """The known answer of ``until_line`` on :data:`SUB_SLOTS` (both interpreters)."""
+    first = [(10.0, 10.0, 1.0), (10.0, 10.0, -1.0), (20.0, 10.0, -1.0), (20.0, 10.0, 5.0)]
+    second = [(30.0, 10.0, 1.0), (30.0, 10.0, -1.0), (40.0, 10.0, -1.0), (40.0, 10.0, 5.0)]
+    assert prog.ran_line.tolist() == [8] * 4 + [9] + [10] * 4
+    assert prog.line.tolist() == [2, 3, 4, 5, 9, 2, 3, 4, 5]  # the lines they come from stay
+    for n, want in ((7, []), (8, first), (9, first + [(50.0, 30.0, 5.0)]),
+                    (10, first + [(50.0, 30.0, 5.0)] + second), (5, []), (3, [])):
+        got = prog.until_line(n)
+        np.testing.assert_allclose(got.end_mm.reshape(-1, 3), np.reshape(want, (-1, 3)),
+                                   atol=1e-9, err_msg=str(n))
+        assert got.ran_line.tolist() == prog.ran_line[:len(want)].tolist()
+    np.testing.assert_allclose(prog.lines_between(8, 10).end_mm, [(50.0, 30.0, 5.0)] + second,
+                               atol=1e-9)
+
+
+def test_until_line_counts_a_subroutine_s_moves_at_the_line_that_called_it():
+    """until_line kept moves by the line they came from: a subroutine defined at lines 1-5 and
+    called on lines 8 and 10 had until_line(9) cut both slots (the second by the call on line
+    10). Each move records the main-program line it ran under (ran_line), nested calls and M98
+    subprograms at the outermost call's line, and until_line counts by it."""
+    check_until_line_counts_a_call_s_moves_at_its_line(read_gcode(SUB_SLOTS))
+    nested = read_gcode("o100 sub\nG1 X#1 F300\no100 endsub\no200 sub\no100 call [#1]\n"
+                        "o100 call [#1+1]\no200 endsub\nG0 X0 Y0 Z0\no200 call [5]\n"
+                        "G1 X20\no200 call [30]\nM2\n")
+    assert nested.line.tolist() == [8, 2, 2, 10, 2, 2]
+    assert nested.ran_line.tolist() == [8, 9, 9, 10, 11, 11]
+    assert nested.until_line(10).end_mm[:, 0].tolist() == [0.0, 5.0, 6.0, 20.0]
+    m98 = read_gcode("G21 G90 F300\nG0 X0 Y0 Z0\nM98 P1000\nG1 X40\nM98 P1000\nM30\n"
+                     "O1000\nG91 G1 X5\nG90\nM99\n", dialect="fanuc")
+    assert m98.line.tolist() == [2, 8, 4, 8] and m98.ran_line.tolist() == [2, 3, 4, 5]
+    assert m98.until_line(4).end_mm[:, 0].tolist() == [0.0, 5.0, 40.0]
+    assert read_gcode("G1 X1 F100\n").ran_line.tolist() == [1]
+    assert Program.from_arrays([[0, 0, 0]], [[1, 0, 0]], line=3).ran_line.tolist() == [3]

@@ -18,6 +18,7 @@ from woodcam.toolpath.linuxcnc import (NO_END, canonical, compare_canonical, lin
                                        run_batch, run_linuxcnc)
 
 from .gcode_fuzz import oword_program, program
+from .test_gcode import SUB_SLOTS, check_until_line_counts_a_call_s_moves_at_its_line
 
 REPO = Path(__file__).resolve().parents[2]
 CORPUS = sorted((REPO / "toolpaths" / "corpus").glob("*.*[!y]")) + sorted(
@@ -1116,3 +1117,35 @@ def test_a_line_too_long_for_linuxcnc_is_refused_by_both(tmp_path, length, line_
                                                "bytes long: LinuxCNC reads at most 252")
         else:
             assert len(read_gcode(path, interpreter=interpreter)) == 3
+
+
+def test_until_line_counts_a_subroutine_s_moves_at_the_line_that_called_it_as_linuxcnc(
+        monkeypatch):
+    """LinuxCNC reports a subroutine's moves at their lines in its body and nothing of the
+    call, so until_line(9) of a slot subroutine at lines 1-5 called on lines 8 and 10 cut both
+    slots. The driver takes each move's main-program line (ran_line) from woodcam's interpreter
+    where its moves come from the same lines; where they do not, it says so."""
+    prog = read_gcode(SUB_SLOTS, interpreter="linuxcnc", machine_zero_mm=(0, 0, 0))
+    check_until_line_counts_a_call_s_moves_at_its_line(prog)
+    assert not prog.warnings
+    nested = ("o100 sub\nG1 X#1 F300\no100 endsub\no200 sub\no100 call [#1]\n"
+              "o100 call [#1+1]\no200 endsub\nG0 X0 Y0 Z0\no200 call [5]\nG1 X20\n"
+              "o200 call [30]\nM2\n")
+    assert read_gcode(nested, interpreter="linuxcnc", machine_zero_mm=(0, 0, 0)).ran_line.tolist() \
+        == [8, 9, 9, 10, 11, 11]
+
+    import woodcam.toolpath.linuxcnc as lc
+
+    class Refuses:
+        def __init__(self, *a, **k):
+            pass
+
+        def run(self):
+            raise GcodeError(4, "G1", "a rule", "a fix")
+
+    monkeypatch.setattr(lc, "Interpreter", Refuses)
+    alone = read_gcode(SUB_SLOTS, interpreter="linuxcnc", machine_zero_mm=(0, 0, 0))
+    assert alone.ran_line.tolist() == alone.line.tolist() == [2, 3, 4, 5, 9, 2, 3, 4, 5]
+    assert len(alone.warnings) == 1 and alone.warnings[0].startswith(
+        "line 2: woodcam cannot tell which subroutine call ran LinuxCNC's moves") and \
+        "it refuses line 4" in alone.warnings[0]

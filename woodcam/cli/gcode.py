@@ -93,7 +93,10 @@ def register(subparsers) -> None:
                    help="block-frame position (in --units) of the --stock's corner in the block's wood "
                    "(default 0,0,0)")
     p.add_argument("--until-line", type=int, default=None, metavar="N",
-                   help="simulate the (last) program only up to source line N (default: all)")
+                   help="simulate the (last) program only as it runs up to and including line N "
+                   "of its main program (default: all): a subroutine call (o100 call, M98) on a "
+                   "line up to N brings all its moves, one after N none, wherever its body lies; "
+                   "a line inside a body moves nothing")
     p.add_argument("--rapid-rate", type=float, default=5000.0, metavar="RATE",
                    help="machine rapid rate for the machining time estimate, --units per minute "
                    "(default 5000 mm/min)")

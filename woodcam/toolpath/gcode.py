@@ -10,7 +10,9 @@ feed ``G1/G2/G3``), ``tool : (n,) int`` (the tool number loaded by the last ``M6
 any), ``line : (n,) int`` (1-based source line) and ``feed_mm_min, spindle_rpm : (n,) float``
 (``spindle_rpm`` is 0 while the spindle is off), ``inch : (n,) bool`` (the move was programmed
 in ``G20``, inches: the lengths as the program wrote them; all ``False`` for a program built
-from arrays). Arcs are split into chords whose sagitta is at
+from arrays), ``ran_line : (n,) int`` (the main-program line the move ran under: ``line``, or
+for a subroutine's move the line of the outermost call that ran it; ``until_line`` counts by
+it). Arcs are split into chords whose sagitta is at
 most ``chord_tol_mm`` (default :data:`woodcam.tolerances.ARC_CHORD_TOL_MM`), so every arc vertex
 lies exactly on the analytic circle (helix). ``warnings`` lists ``"line N: ..."`` strings;
 ``messages`` the operator messages the program says as it runs, ``"line N: ..."`` too (its
@@ -91,10 +93,15 @@ class Program:
     printed: list[str] = field(default_factory=list)
     #: per move: programmed in G20 (inches); None (the default) is all False (mm, G21)
     inch: np.ndarray = None  # type: ignore[assignment]
+    #: per move: the main-program line it ran under (a subroutine's moves: the line of the
+    #: outermost call that ran them, M98 too; :meth:`until_line`); None (the default) is ``line``
+    ran_line: np.ndarray = None  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         if self.inch is None:
             self.inch = np.zeros(len(self.kind), bool)
+        if self.ran_line is None:
+            self.ran_line = np.array(self.line, int)
 
     def __len__(self) -> int:
         return len(self.kind)
@@ -122,7 +129,7 @@ class Program:
         return Program(self.start_mm[k], self.end_mm[k], self.kind[k], self.tool[k],
                        self.line[k], self.feed_mm_min[k], self.spindle_rpm[k], self.source,
                        sorted(set(self.tool[k].tolist())), list(self.warnings),
-                       list(self.messages), list(self.printed), self.inch[k])
+                       list(self.messages), list(self.printed), self.inch[k], self.ran_line[k])
 
     def __iter__(self):
         return (self[i] for i in range(len(self)))
@@ -228,15 +235,20 @@ class Program:
         return float(np.median(d)) if len(d) >= 0.1 * len(q) else None
 
     def until_line(self, line: int) -> Program:
-        """The moves of source lines ``<= line`` (the simulation scrubbed to that line)."""
+        """The moves the program made up to and including main-program line ``line`` (the
+        simulation scrubbed to that line): those of ``ran_line <= line``, so a subroutine call
+        on a line ``<= line`` brings all its moves (nested calls too) and one after it none,
+        wherever the subroutine's body lies; a line inside a body counts as a main-program line
+        that runs no move."""
         return self.lines_between(None, line)
 
     def lines_between(self, after: int | None, until: int) -> Program:
-        """The moves of source lines ``after < line <= until`` (``after=None``: from the
-        start): the next stretch when a simulation is scrubbed forward."""
-        k = self.line <= int(until)
+        """The moves that ran under main-program lines ``after < ran_line <= until``
+        (``after=None``: from the start; :meth:`until_line`): the next stretch when a
+        simulation is scrubbed forward."""
+        k = self.ran_line <= int(until)
         if after is not None:
-            k &= self.line > int(after)
+            k &= self.ran_line > int(after)
         return self._subset(k)
 
     @classmethod
@@ -395,11 +407,12 @@ def program_from_canonical(moves, start_mm, chord_tol_mm, source="<string>",
     with sagitta <= ``chord_tol_mm`` whose vertices lie on the analytic circle/helix."""
     pos = list(map(float, start_mm))
     starts, ends, meta = [], [], []
-    for kind, line, end, centre, rot, plane, feed, spindle, tool, inch in moves:
+    for kind, line, end, centre, rot, plane, feed, spindle, tool, inch, *ran in moves:
+        ran_line = ran[0] if ran else line  # the main-program line it ran under
         if kind != ARC:
             starts.append(pos)
             ends.append(list(end))
-            meta.append((RAPID if kind == 0 else FEED, tool, line, feed, spindle, inch))
+            meta.append((RAPID if kind == 0 else FEED, tool, line, feed, spindle, inch, ran_line))
             pos = list(end)
             continue
         pts = _arc_chords(pos, end, centre, rot, plane, chord_tol_mm, line)
@@ -407,10 +420,10 @@ def program_from_canonical(moves, start_mm, chord_tol_mm, source="<string>",
         starts.append(pos)
         starts.extend(pts[:-1].tolist())
         ends.extend(pts.tolist())
-        meta.extend([(FEED, tool, line, feed, spindle, inch)] * k)
+        meta.extend([(FEED, tool, line, feed, spindle, inch, ran_line)] * k)
         pos = list(end)
     n = len(meta)
-    m = np.array(meta, float).reshape(n, 6)
+    m = np.array(meta, float).reshape(n, 7)
     s = np.array(starts, float).reshape(n, 3)
     e = np.array(ends, float).reshape(n, 3)
     keep = np.any(s != e, axis=1)  # chords of zero length carry no cut
@@ -418,7 +431,7 @@ def program_from_canonical(moves, start_mm, chord_tol_mm, source="<string>",
     tools = m[:, 1].astype(int)
     return Program(s, e, m[:, 0].astype(np.uint8), tools, m[:, 2].astype(int), m[:, 3],
                    m[:, 4], source, sorted(set(tools.tolist())), list(warnings),
-                   list(messages), list(printed), m[:, 5] != 0)
+                   list(messages), list(printed), m[:, 5] != 0, m[:, 6].astype(int))
 
 
 _PLANE_AXES = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}

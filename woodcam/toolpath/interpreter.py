@@ -105,9 +105,12 @@ G0 Z0`` for "near the top of Z travel", which in machine coordinates is no place
 frame) and a ``G53`` X/Y with machine zero at G-code zero, each warned once with its lines.
 A canonical move is
 ``(kind, line, end (3,), centre (2,) | None, rotation, plane, feed_mm_min, spindle_rpm, tool,
-inch)``: ``kind`` 0 = traverse, 1 = feed, 2 = arc (``centre`` in the plane's first/second axes,
-``rotation`` = +/-turns, + counter-clockwise, as LinuxCNC's ``ARC_FEED``); ``inch``: the move
-was programmed in ``G20`` (its lengths as written are inches; the move is in mm all the same).
+inch, ran_line)``: ``kind`` 0 = traverse, 1 = feed, 2 = arc (``centre`` in the plane's first/second
+axes, ``rotation`` = +/-turns, + counter-clockwise, as LinuxCNC's ``ARC_FEED``); ``inch``: the
+move was programmed in ``G20`` (its lengths as written are inches; the move is in mm all the
+same); ``ran_line``: the main-program line it ran under (``line`` itself, or for a move of a
+subroutine or M98 subprogram the line of the outermost call that ran it); ``ran_line`` may be
+left off (it is then ``line``).
 
 Why hand-written: no maintained PyPI package interprets this language. ``pygcode`` (0.2.1,
 2017, unmaintained) and ``gcodeparser`` parse words but have no parameters, expressions or
@@ -783,8 +786,10 @@ class Interpreter:
             self.warn(f"T{self.selected} was selected without M6: the cut goes on with the "
                       f"loaded tool T{self.tool}, as the controller does")
         feed = self.feed
+        # the main-program line it ran under: the outermost active call's, else its own
+        ran = self._frames[0][5] if self._frames else self.line_no
         self.moves.append((kind, self.line_no, tuple(end), centre, rotation, self.plane, feed,
-                           self.spindle if self.spindle_on else 0.0, self.tool, self.inch))
+                           self.spindle if self.spindle_on else 0.0, self.tool, self.inch, ran))
         self.pos = list(end)
 
     # -- parameters -------------------------------------------------------------------------

@@ -22,6 +22,7 @@ from .interpreter import (
     NO_END,
     NO_PERCENT,
     GcodeError,
+    Interpreter,
     add_line_warning,
     line_list,
     source_lines,
@@ -165,7 +166,41 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
         warnings.append((int(line), msg))
     moves = [(k, ln, tuple(e), tuple(c) if c else None, rot, plane, feed, rpm, tool, bool(inch))
              for k, ln, e, c, rot, plane, feed, rpm, tool, inch in res["moves"]]
-    return moves, warnings
+    ran = _ran_lines(text, moves, start_mm, machine_zero_mm, tool_diameters_mm, warnings)
+    return [m + (r,) for m, r in zip(moves, ran)], warnings
+
+
+def _ran_lines(text: str, moves: list, start_mm, machine_zero_mm, tool_diameters_mm,
+               warnings: list) -> list[int]:
+    """The main-program line each of LinuxCNC's ``moves`` ran under (the canonical tuple's
+    ``ran_line``): LinuxCNC reports a subroutine's move at its line in the body and nothing of
+    the call (its canon and the state it passes have no call stack, and an o-word line takes
+    no comment or marker), so a program with calls is run by woodcam's interpreter too and,
+    where its moves come from the same lines in the same order, its ``ran_line`` is taken;
+    where they do not, each move keeps its own line, with a warning (``--until-line`` then
+    counts a subroutine's moves at the lines of its body)."""
+    own = [int(m[1]) for m in moves]
+    flat = re.sub(r"\s", "", text).lower()
+    if "call" not in flat and "m98" not in flat:
+        return own
+    why = ""
+    try:
+        mine, _ = Interpreter(text, start_mm=start_mm, machine_zero_mm=machine_zero_mm,
+                              tool_diameters_mm=tool_diameters_mm).run()
+    except GcodeError as e:
+        mine, why = [], f"it refuses line {e.line}"
+    if [int(m[1]) for m in mine] == own:
+        return [int(m[10]) for m in mine]
+    at = next((i for i, (a, b) in enumerate(zip(mine, moves)) if int(a[1]) != int(b[1])),
+              min(len(mine), len(moves)))
+    line = int(moves[min(at, len(moves) - 1)][1]) if moves else 1
+    warnings.append((line, "woodcam cannot tell which subroutine call ran LinuxCNC's moves "
+                     "(LinuxCNC reports a subroutine's move at its line in the body; woodcam's "
+                     "interpreter, which tells, makes other moves here"
+                     + (f": {why}" if why else "") + "), so --until-line and the --view slider "
+                     "place each move at its own line, a subroutine's at the lines of its body; "
+                     "read the program with --interpreter woodcam to scrub it by its calls"))
+    return own
 
 
 def may_read_tool_diameters(text: str) -> bool:

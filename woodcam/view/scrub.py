@@ -56,7 +56,8 @@ def _path_colours(colours, who: str) -> dict[str, tuple[float, float, float]]:
 
 
 class ScrubCallback:
-    """Slider callback: ``callback(line)`` shows the stock as simulated up to source ``line``.
+    """Slider callback: ``callback(line)`` shows the stock as simulated up to main-program
+    ``line`` (:meth:`.Program.until_line`: a subroutine's moves at their call's line).
 
     ``program`` (a :class:`woodcam.toolpath.Program`), ``tools`` as
     :func:`woodcam.toolpath.simulate` takes them, the ``stock`` (size and wood), the G-code
@@ -87,7 +88,8 @@ class ScrubCallback:
         self.heightmap = None
         seg = np.stack([program.start_mm + self.offset, program.end_mm + self.offset], axis=1)
         self._seg = seg
-        self.first_line, self.last_line = int(program.line.min()), int(program.line.max())
+        # the slider is a main-program line: a subroutine's moves count at their call's (ran_line)
+        self.first_line, self.last_line = int(program.ran_line.min()), int(program.ran_line.max())
         if heightmap is not None:  # the stock at ``line`` (lines past the last: the last's)
             self.heightmap = np.asarray(heightmap, float)
             self.line = self.last_line if line is None else min(int(line), self.last_line)
@@ -117,7 +119,7 @@ class ScrubCallback:
         p.add_mesh(_stock_polydata(pv, self.heightmap, self.size_mm, self.wood), scalars="rgb",
                    rgb=True, name=STOCK_ACTOR, smooth_shading=False, ambient=0.3,
                    diffuse=0.7, specular=0.05)
-        done = self.program.line <= self.line
+        done = self.program.ran_line <= self.line
         feed = self.program.kind == 1
         for name, sel, colour in ((DONE_ACTORS[0], done & feed, self.colours["feeds"]),
                                   (DONE_ACTORS[1], done & ~feed, self.colours["rapids"]),
