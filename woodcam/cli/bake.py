@@ -180,7 +180,11 @@ def run_bake(args: argparse.Namespace) -> int:
     if res.report:
         from ..advise import report_text
 
-        print(report_text(res.report, res.name, units=args.units))
+        # the warnings print_warnings said on stderr above are left out of the report printed
+        # here (they stay in its files): 'part sticks out' was said twice, on stderr and stdout
+        said = set(res.warnings)
+        print(report_text({**res.report, "warnings": [w for w in res.report["warnings"] if w not in said]},
+                          res.name, units=args.units))
     return 0
 
 
