@@ -833,3 +833,36 @@ def test_degenerate_and_twice_written_triangles_are_dropped_as_bake_drops_them(t
             fields[name] = z["arrival_mm"].copy()
     # the same solid grows the same wood, to the last bit
     assert np.array_equal(fields["sliver"], fields["box"]) and np.array_equal(fields["twice"], fields["box"])
+
+
+def test_a_part_baked_into_its_own_woodify_block_with_the_printed_translate_sits_where_it_grew(tmp_path, capsys):
+    """Sweep h10 item 1: 'woodcam bake PART --block woodify:F' reads PART in the block frame (as
+    every block does), the grown input's frame moved by the block's corner, so the input baked
+    into its own field sat that corner away from where it grew (the lid example: a median of 3.2
+    years at its surface, rings across its top). woodify prints the translate that bakes it where
+    it grew: there its surface is the year-0 ring, arrival ~0 within a grid step."""
+    import re
+
+    from woodcam.export import load_textured
+
+    part = tmp_path / "part.stl"
+    trimesh.creation.box((24.0, 16.0, 10.0)).apply_translation((7.0, -3.0, 12.0)).export(part)
+    assert main(["woodify", str(part), "--years", "3", "--resolution", "32", "--cracks", "none",
+                 "--surface-years", "1", "--out", str(tmp_path / "w")]) == 0
+    said = capsys.readouterr().out
+    shift = re.search(r"add --place translate:(\S+)\)", said)
+    assert shift, said
+    f = WoodifiedField.load(tmp_path / "w" / "field.npz")
+    np.testing.assert_allclose([float(v) for v in shift[1].split(",")], -f.block_origin_mm, atol=1e-3)
+    bake = ["bake", str(part), "--block", f"woodify:{tmp_path / 'w' / 'field.npz'}", "--texels-per-mm", "1",
+            "--no-obj"]
+    assert main([*bake, "--place", f"translate:{shift[1]}", "--out", str(tmp_path / "at.glb")]) == 0
+    surface = load_textured(tmp_path / "at.glb").sample(3000, seed=0)
+    arrival = f.arrival(surface)
+    assert np.median(arrival) < 0.1 * f.spacing_mm and arrival.max() < f.spacing_mm, (np.median(arrival), arrival.max())
+    assert f(surface).max() < 1.0  # no whole ring on its surface
+    # without it: the part in the block frame, the block's corner away from where it grew
+    assert main([*bake, "--out", str(tmp_path / "as_is.glb")]) == 0
+    assert np.median(f.arrival(load_textured(tmp_path / "as_is.glb").sample(3000, seed=0))) > f.spacing_mm
+    assert json.loads((tmp_path / "w" / "woodify.json").read_text())["block"]["input_translate_mm"] == \
+        pytest.approx(-f.block_origin_mm)

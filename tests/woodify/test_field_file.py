@@ -66,3 +66,16 @@ def test_bake_from_a_truncated_field_is_one_line(tmp_path, capsys):
     assert rc != 0
     assert len(err) == 1 and "internal error" not in err[0]
     assert err[0].startswith(f"woodcam: error: {path}: not a woodcam woodify field") and err[0].endswith(FIX)
+
+
+def test_to_block_is_the_inverse_of_to_object_for_a_turned_block():
+    """to_block (object frame -> block frame: where the grown input lies in the block) undoes
+    to_object, also for a block placed turned (WoodifiedField.placed(rotation=))."""
+    from scipy.spatial.transform import Rotation
+
+    R = Rotation.from_euler("xyz", [20.0, -35.0, 70.0], degrees=True).as_matrix()
+    f = _field().placed((1.5, 1.0, 0.5), (1.0, 1.2, 0.8), R)
+    p = np.random.default_rng(0).uniform(-2.0, 3.0, (50, 3))
+    np.testing.assert_allclose(f.to_object(f.to_block(p)), p, atol=1e-12)
+    np.testing.assert_allclose(f.to_block(f.to_object(p)), p, atol=1e-12)
+    np.testing.assert_allclose(f.to_block(f.block_origin_mm[None]), 0.0, atol=1e-12)

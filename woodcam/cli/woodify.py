@@ -408,7 +408,7 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
         # a woodcam GLB is in the block frame (its metadata says so, and `review --block
         # woodify:field.npz` reads it so): object = block_origin + R @ block, so block = R^T (object
         # - block_origin); the origin is kept in the metadata to put it back over the input mesh
-        bark.vertices = (np.asarray(bark.vertices) - placed.block_origin_mm) @ placed.rotation
+        bark.vertices = placed.to_block(bark.vertices)
         # export_glb writes atomically itself (through atomic(), its temporary would be renamed
         # before export_glb's own one, inside the caller's all_or_nothing)
         files.append(export_glb(bark, out / "grown.glb", metadata={
@@ -416,7 +416,10 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
                         "block_origin_mm": placed.block_origin_mm.tolist(),
                         "block_rotation": placed.rotation.tolist()}}))
         files.append(placed.save(out / WOODIFY_FIELD_FILE))
-        summary["block"] = {"size_mm": list(size), "centre_mm": list(centre)}
+        # the input's frame -> the block frame: a part is modelled in the block frame, as for
+        # every block; this translate puts the input where it grew (WoodifiedField.to_block)
+        summary["block"] = {"size_mm": list(size), "centre_mm": list(centre),
+                            "input_translate_mm": placed.to_block(np.zeros((1, 3)))[0].tolist()}
         for y in surface_years:
             surf = res.surface(float(y))
             note = f"woodify surface at year {float(y):g}, in the input mesh's frame"
@@ -607,5 +610,10 @@ def run(args) -> int:
     print(f"grew {args.part} for {args.years:g} years on a {'x'.join(map(str, res.front.grid.shape))} "
           f"grid ({res.front.method}, {summary['total_s']:.1f} s); wrote "
           + ", ".join(str(f) for f in files))
-    print(f"carve from it with: woodcam bake PART --block woodify:{Path(args.out) / WOODIFY_FIELD_FILE} --out PART.glb")
+    # the grown input is in its own frame, the block's corner away: the translate that bakes it
+    # where it grew (its rings the ones it grew with) is said, in mm as the command printed reads it
+    shift = ",".join(f"{v + 0.0:.6g}" for v in summary["block"]["input_translate_mm"])
+    print(f"carve from it with: woodcam bake PART --block woodify:{Path(args.out) / WOODIFY_FIELD_FILE} --out "
+          f"PART.glb (PART in the block frame; to carve {args.part} where it grew, its surface the year-0 ring, "
+          f"add --place translate:{shift})")
     return 0

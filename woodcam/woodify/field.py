@@ -10,7 +10,9 @@ at the last year the march reached beyond the final surface.
 
 Placement: block-frame points ``p`` (mm, docs/conventions.md) sit at
 ``block_origin_mm + rotation @ p`` in the object frame (the input mesh's frame, mm), so a block
-of ``block_size_mm`` is cut anywhere out of the grown object.
+of ``block_size_mm`` is cut anywhere out of the grown object (:meth:`WoodifiedField.to_object`;
+its inverse :meth:`WoodifiedField.to_block` moves the input, modelled in the object frame, to
+where it grew in the block).
 
 Engulfed obstacles are no wood: :meth:`WoodifiedField.no_wood` is true inside them, and
 :meth:`WoodifiedField.evaluate` reports them as ``dead`` (darkened like dead-knot wood by the
@@ -150,6 +152,13 @@ class WoodifiedField:
         """Block-frame points ``(n, 3)`` -> object-frame points ``(n, 3)`` (mm)."""
         p = check_points(points_mm)
         return self.block_origin_mm + np.einsum("ij,kj->ik", p, self.rotation)
+
+    def to_block(self, points_mm: ArrayLike) -> np.ndarray:
+        """Object-frame points ``(n, 3)`` -> block-frame points ``(n, 3)`` (mm), the inverse of
+        :meth:`to_object`: where the grown input (a part modelled in the object frame) lies in
+        the block, so a part baked into its own woodify block sits where it grew."""
+        q = check_points(points_mm)
+        return (q - self.block_origin_mm) @ self.rotation
 
     def _sample(self, grid, q, order) -> np.ndarray:
         if order == 1:
