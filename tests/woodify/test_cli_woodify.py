@@ -866,3 +866,10 @@ def test_a_part_baked_into_its_own_woodify_block_with_the_printed_translate_sits
     assert np.median(f.arrival(load_textured(tmp_path / "as_is.glb").sample(3000, seed=0))) > f.spacing_mm
     assert json.loads((tmp_path / "w" / "woodify.json").read_text())["block"]["input_translate_mm"] == \
         pytest.approx(-f.block_origin_mm)
+    # under --units inch: the translate in inches, and the bake command printed reads it so
+    assert main(["woodify", str(part), "--years", "3", "--resolution", "32", "--cracks", "none", "--units", "inch",
+                 "--out", str(tmp_path / "wi")]) == 0
+    said = capsys.readouterr().out
+    shift = re.search(r"woodcam bake PART --units inch --block .* add --place translate:(\S+)\)", said)
+    assert shift, said
+    np.testing.assert_allclose([float(v) for v in shift[1].split(",")], -f.block_origin_mm / 25.4, atol=1e-4)

@@ -18,9 +18,9 @@ from pathlib import Path
 from .._specs import WOODIFY_FIELD_FILE
 from ..errors import UsageError, WoodcamError
 from ..tolerances import DEFAULT_MAX_ATLAS_PX
-from ..units import say_length, typed_length
+from ..units import MM_PER_UNIT, TYPED_DECIMALS, say_length, typed_length
 from .options import (add_input, add_max_atlas_option, add_out_option, add_units_option, as_typed, part_suffixes,
-                      sizes_type, vector_type)
+                      place_op_in, sizes_type, vector_type)
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -611,9 +611,11 @@ def run(args) -> int:
           f"grid ({res.front.method}, {summary['total_s']:.1f} s); wrote "
           + ", ".join(str(f) for f in files))
     # the grown input is in its own frame, the block's corner away: the translate that bakes it
-    # where it grew (its rings the ones it grew with) is said, in mm as the command printed reads it
-    shift = ",".join(f"{v + 0.0:.6g}" for v in summary["block"]["input_translate_mm"])
-    print(f"carve from it with: woodcam bake PART --block woodify:{Path(args.out) / WOODIFY_FIELD_FILE} --out "
-          f"PART.glb (PART in the block frame; to carve {args.part} where it grew, its surface the year-0 ring, "
-          f"add --place translate:{shift})")
+    # where it grew (its rings the ones it grew with) is said, in --units as place's --place ops
+    shift = place_op_in("translate:" + ",".join(f"{v:.12g}" for v in summary["block"]["input_translate_mm"]),
+                        1 / MM_PER_UNIT[args.units], TYPED_DECIMALS[args.units])
+    units = " --units inch" if args.units == "inch" else ""
+    print(f"carve from it with: woodcam bake PART{units} --block woodify:{Path(args.out) / WOODIFY_FIELD_FILE} "
+          f"--out PART.glb (PART in the block frame; to carve {args.part} where it grew, its surface the year-0 "
+          f"ring, add --place {shift})")
     return 0
