@@ -405,3 +405,17 @@ def test_a_ctrl_c_while_the_view_is_drawn_leaves_no_earlier_view_beside_the_new_
     mine.write_bytes(b"mine")
     assert main([*base[:-1], "--screenshot", str(mine), "--place", "center"]) == 130
     assert mine.read_bytes() == b"mine"
+
+
+def test_a_failed_run_says_its_warnings_first_and_its_error_last(tmp_path, capsys):
+    """A run that warned and then failed printed its warnings after the error line (a finally in
+    woodcam.cli), so the last line a user saw, or a script read from standard error, was a
+    warning, not why it failed. Now: the warnings in the order raised, then the one error line."""
+    (tmp_path / "bad.stl").write_text("solid x\nendsolid x\n")
+    argv = ["bake", str(tmp_path / "bad.stl"), "--block", "builtin:flat-sawn", "--out",
+            str(tmp_path / "x.glb"), "--camera", "front", "--quiet"]
+    assert main(argv) == 1
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert [line.split(":")[1] for line in lines] == [" warning", " error"], lines
+    assert lines[0].startswith("woodcam: warning: --camera front chooses the view of --screenshot")
+    assert lines[-1].startswith("woodcam: error: mesh file ") and "contains no triangles" in lines[-1]

@@ -328,6 +328,10 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
                 interrupted = True
                 _interrupt.say()
                 return EXIT_INTERRUPTED
+            # the warnings of the run first, in the order they came, and the line that says why
+            # it failed last: printed after it (in the finally below), a warning was the last
+            # line a user (or a script reading the last line of stderr) saw
+            _print_caught(caught)
             if not isinstance(err, Exception):  # SystemExit and the like: not ours to report
                 raise
             if _stdout_closed(err):  # the reader of a pipe went away: it wants no more lines
@@ -356,7 +360,7 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             return EXIT_ERROR
         finally:
             if not interrupted:  # an interrupted run is one line: its work is dropped anyway
-                print_warnings(str(w.message) for w in caught if _is_ours(w))
+                _print_caught(caught)  # a run that ended: after its output (once: said above on a failure)
     return rc
 
 
@@ -441,6 +445,12 @@ def _stdout_closed(err: BaseException) -> bool:
         os.dup2(devnull, fd)
         os.close(devnull)
     return gone
+
+
+def _print_caught(caught) -> None:
+    """Print the woodcam warnings of ``caught`` not printed yet (:func:`print_warnings`), in the
+    order they were raised."""
+    print_warnings(str(w.message) for w in caught if _is_ours(w))
 
 
 def _is_ours(w) -> bool:
