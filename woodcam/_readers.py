@@ -117,7 +117,7 @@ def read_image_file_opacity(path: Path, what: str, alpha_fix: tuple[str, str] | 
 
     def too_big(size: str) -> WoodcamError:
         return WoodcamError(f"{what}: {str(path)!r} is {size}, more than the limit MAX_IMAGE_PIXELS = "
-                            f"{cap:.0f}; downscale it, or raise the limit with WOODCAM_MAX_IMAGE_PIXELS=N")
+                            f"{cap:.0f} pixels; downscale it, or raise the limit with WOODCAM_MAX_IMAGE_PIXELS=N")
 
     def damaged(err: Exception) -> WoodcamError:
         return WoodcamError(f"{what}: cannot decode the image {str(path)!r} ({err}); the file is damaged or "

@@ -50,6 +50,13 @@ WOODIFY_RESOLUTION_RANGE = (16, 1024)
 
 _DEFAULTS = {name: value for name, value in globals().items() if name.startswith("MAX_")}
 
+#: What each limit counts, said after its numbers: 'needs 1.074e+09, more than the limit
+#: MAX_GRID_CELLS = 2e+08' left a user to guess whether they were nodes, bytes or pixels.
+#: A grid's cells are the values it holds (every channel of every node).
+UNITS = {"MAX_BLOCK_SIZE_MM": "mm", "MAX_FACE_PX": "px a side", "MAX_IMAGE_PIXELS": "pixels",
+         "MAX_TRACE_POINTS": "points", "MAX_RING_YEAR": "years", "MAX_GRID_CELLS": "grid cells",
+         "MAX_ALLOC_BYTES": "bytes"}
+
 
 def limit(name: str) -> float:
     """The effective value of limit ``name`` (``"MAX_GRID_CELLS"``): ``$WOODCAM_<NAME>`` if set
@@ -84,13 +91,24 @@ def check_limit(name: str, value: float, what: str, fix: str = "") -> None:
     top = limit(name)
     if not value <= top:  # also refuses NaN
         raise WoodcamError(
-            f"{what} needs {value:.4g}, more than the limit {name} = {top:.4g}"
+            f"{what} needs {_amount(name, value)}, more than the limit {name} = {_amount(name, top)}"
             + (f"; {fix}" if fix else "")
             + f"; if this is intended, raise the limit with WOODCAM_{name}={2 * value:.3g}")
+
+
+def _amount(name: str, value: float) -> str:
+    """``value`` of limit ``name`` with its unit: '1.074e+09 grid cells', '4.295e+09 bytes
+    (4 GiB)'."""
+    text = f"{value:.4g} {UNITS[name]}"
+    if name == "MAX_ALLOC_BYTES" and math.isfinite(value):
+        size, unit = next(((value / 1024**k, u) for k, u in ((4, "TiB"), (3, "GiB"), (2, "MiB"), (1, "KiB"))
+                           if value >= 1024**k), (value, "B"))
+        text += f" ({size:.3g} {unit})" if unit != "B" else ""
+    return text
 
 
 def check_grid(shape, what: str, *, itemsize: int = 8, fix: str = "") -> None:
     """Guard a grid allocation of ``shape`` (cells) before it happens: cell count and bytes."""
     cells = math.prod(float(s) for s in shape)
     check_limit("MAX_GRID_CELLS", cells, f"{what} (a {'x'.join(f'{s:.0f}' for s in shape)} grid)", fix)
-    check_limit("MAX_ALLOC_BYTES", cells * itemsize, f"{what} (memory, bytes)", fix)
+    check_limit("MAX_ALLOC_BYTES", cells * itemsize, f"{what} (memory)", fix)

@@ -307,8 +307,8 @@ def test_a_face_too_large_to_detect_is_refused_before_allocating_with_the_densit
     assert 160 * 160 * DETECT_BYTES_PER_PX > 2e7 > 120 * 120 * DETECT_BYTES_PER_PX
     rc, out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
     assert rc == EXIT_ERROR and out == "" and err.count("\n") == 1, err
-    assert ("ring detection on face 'front' (160x160 px at 3.2 px/mm; memory, bytes) needs 3.328e+07, more than "
-            "the limit MAX_ALLOC_BYTES = 2e+07; make the block again with 'woodcam block from-photos ... "
+    assert ("ring detection on face 'front' (160x160 px at 3.2 px/mm; memory) needs 3.328e+07 bytes (31.7 MiB), more than "
+            "the limit MAX_ALLOC_BYTES = 2e+07 bytes (19.1 MiB); make the block again with 'woodcam block from-photos ... "
             "--max-px-per-mm 2.4' or lower") in err, err
     assert not (blk / "front_traces.svg").exists()
     assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--max-px-per-mm", "2.4",

@@ -572,7 +572,7 @@ def _library_door_sweep():
         ("synth faces str !", lambda: w.synth_block(fld, (20, 20, 20), face_px=16, faces="top"),
          r"faces must be a list of face names; got the string 'top'; pass \['top'\]"),
         ("synth face_px past the face limit", lambda: w.synth_block(fld, (20, 20, 20), face_px=10**7),
-         "a face image of 10000000 px a side .* more than the limit MAX_FACE_PX = 1.638e\\+04; lower face_px or px_per_mm; "
+         "a face image of 10000000 px a side .* more than the limit MAX_FACE_PX = 1.638e\\+04 px a side; lower face_px or px_per_mm; "
          "if this is intended, raise the limit with WOODCAM_MAX_FACE_PX="),
         ("synth px_per_mm past the face limit", lambda: w.synth_block(fld, (20, 20, 20), px_per_mm=1e7),
          r"a face image of 200000000 px a side \(1e\+07 px/mm on a 20 mm block\) needs .*MAX_FACE_PX"),

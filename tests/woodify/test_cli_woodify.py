@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import time
 from pathlib import Path
 
@@ -873,3 +874,33 @@ def test_a_part_baked_into_its_own_woodify_block_with_the_printed_translate_sits
     shift = re.search(r"woodcam bake PART --units inch --block .* add --place translate:(\S+)\)", said)
     assert shift, said
     np.testing.assert_allclose([float(v) for v in shift[1].split(",")], -f.block_origin_mm / 25.4, atol=1e-4)
+
+
+def test_a_grid_past_a_limit_says_what_its_numbers_count(tmp_path, capsys, monkeypatch):
+    """'needs 1.074e+09, more than the limit MAX_GRID_CELLS = 2e+08' said no unit: nodes, bytes,
+    pixels? Each number now carries what it counts, bytes also in GiB, and the fix follows."""
+    trimesh.creation.box((40.0, 40.0, 40.0)).export(tmp_path / "box.stl")
+    argv = ["woodify", str(tmp_path / "box.stl"), "--years", "5", "--resolution", "1024", "--quiet",
+            "--out", str(tmp_path / "tree")]
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1, err
+    assert "(a 1024x1024x1024 grid) needs 1.074e+09 grid cells, more than the limit MAX_GRID_CELLS = 2e+08 grid cells; " \
+           "lower the resolution to " in err, err
+    monkeypatch.setenv("WOODCAM_MAX_GRID_CELLS", "2e9")
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert "resolution 1024 (memory) needs 1.933e+11 bytes (180 GiB), more than the limit MAX_ALLOC_BYTES = " \
+           "4.295e+09 bytes (4 GiB); lower the resolution to " in err, err
+
+
+def test_every_limit_says_its_unit():
+    """Every MAX_ limit's refusal says what its numbers count (woodcam.limits.UNITS)."""
+    from woodcam import limits
+
+    for name, top in limits._DEFAULTS.items():
+        with pytest.raises(WoodcamError) as e:
+            limits.check_limit(name, 3 * top, "this")
+        unit = limits.UNITS[name]
+        assert re.search(rf"needs [0-9.e+]+ {unit}( \(12 GiB\))?, more than the limit {name} = [0-9.e+]+ {unit}[ ;]",
+                         str(e.value)), str(e.value)

@@ -57,7 +57,7 @@ class RingTrace:
             raise WoodcamError("points_px of a ring trace must be finite; got NaN or inf")
         if len(p) > limit("MAX_TRACE_POINTS"):
             raise WoodcamError(f"a ring trace has {len(p)} points, more than the limit "
-                               f"MAX_TRACE_POINTS = {limit('MAX_TRACE_POINTS'):.0f}; simplify it or "
+                               f"MAX_TRACE_POINTS = {limit('MAX_TRACE_POINTS'):.0f} points; simplify it or "
                                "raise the limit with WOODCAM_MAX_TRACE_POINTS=N")
         y = self.year
         if y is not None:

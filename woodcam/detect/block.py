@@ -160,7 +160,7 @@ def _check_face_memory(face: Face, px_per_mm: float) -> None:
     need = float(rows) * cols * DETECT_BYTES_PER_PX
     fits = math.floor(10 * px_per_mm * math.sqrt(limit("MAX_ALLOC_BYTES") / need)) / 10
     check_limit("MAX_ALLOC_BYTES", need,
-                f"ring detection on face {face.name!r} ({cols}x{rows} px at {px_per_mm:.3g} px/mm; memory, bytes)",
+                f"ring detection on face {face.name!r} ({cols}x{rows} px at {px_per_mm:.3g} px/mm; memory)",
                 fix=f"make the block again with 'woodcam block from-photos ... --max-px-per-mm {fits:g}' or lower "
                 "(the default 10 keeps rings 0.8 mm apart at 8 px)")
 

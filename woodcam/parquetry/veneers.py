@@ -351,7 +351,7 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
     fix = "use smaller or fewer sheets (--sheet-size, --sheets) or a lower px_per_mm"
     check_grid((n_sheets, nh, nw, 3), what, itemsize=4, fix=fix)
     check_limit("MAX_ALLOC_BYTES", float(nh) * nw * (n_sheets * 12 + _WORK_BYTES_PER_PX),
-                f"{what} (memory, bytes)", fix)
+                f"{what} (memory)", fix)
     ax = "xyz".index(axis)
     # In-plane directions: sheet x (right) and sheet y (down) as block axes, chosen so the
     # sheet reads like the block face with that normal in docs/conventions.md.
