@@ -904,3 +904,24 @@ def test_every_limit_says_its_unit():
         unit = limits.UNITS[name]
         assert re.search(rf"needs [0-9.e+]+ {unit}( \(12 GiB\))?, more than the limit {name} = [0-9.e+]+ {unit}[ ;]",
                          str(e.value)), str(e.value)
+
+
+def test_an_obstacle_round_the_whole_part_is_named_as_its_option(tmp_path, capsys):
+    """An --obstacle holding the whole part was refused as 'obstacles must leave part of the
+    input outside them; the obstacle(s) contain ...': the library's keyword, not the option
+    typed, and no file. The CLI names '--obstacle FILE'; the library keeps 'obstacles[i]'."""
+    from woodcam.woodify import woodify
+
+    trimesh.creation.box((10.0, 10.0, 10.0)).export(tmp_path / "part.stl")
+    trimesh.creation.box((30.0, 30.0, 30.0)).export(tmp_path / "cage.stl")
+    cage = str(tmp_path / "cage.stl")
+    assert main(["woodify", str(tmp_path / "part.stl"), "--years", "5", "--resolution", "24", "--quiet",
+                 "--obstacle", cage, "--out", str(tmp_path / "tree")]) == 1
+    err = capsys.readouterr().err
+    assert err == (f"woodcam: error: --obstacle {cage!r} must leave part of the input mesh outside it; it "
+                   "contains the whole input mesh (12 triangles), so nothing can grow; move or shrink it, "
+                   "or leave it out\n"), err
+    with pytest.raises(WoodcamError, match=r"^obstacles\[0\], obstacles\[1\] must leave part of the input mesh "
+                       "outside them; together they contain"):
+        woodify(trimesh.creation.box((10.0, 10.0, 10.0)), 5, resolution=24,
+                obstacles=[trimesh.creation.box((30.0, 30.0, 30.0)), trimesh.creation.box((2.0, 2.0, 2.0))])

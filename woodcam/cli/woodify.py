@@ -587,6 +587,7 @@ def run(args) -> int:
             res = woodify(mesh, args.years, growth_mm=args.growth, time_scale_years=args.time_scale,
                           shape=args.shape, eccentricity=args.eccentricity, up=args.up,
                           obstacles=obstacles, brushes=brushes, resolution=args.resolution,
+                          obstacle_names=[f"--obstacle {str(o)!r}" for o in args.obstacle],
                           method=args.method, **painted)
             _check_block_centre(res, args)
         # one unit: a Ctrl-C leaves the last run's products, never new ones beside old ones (a

@@ -219,8 +219,20 @@ def _rasterise(mesh, grid: VoxelGrid, band: int):
     return dist, closest, tri, inside
 
 
+def obstacle_names_of(obstacles, names=None) -> list[str]:
+    """What messages call each of ``obstacles``: ``names`` (one a mesh) if given, else
+    ``obstacles[i]``, the keyword of :func:`propagate` and :func:`woodcam.woodify.woodify`."""
+    if names is None:
+        return [f"obstacles[{i}]" for i in range(len(obstacles))]
+    names = [str(n) for n in names]
+    if len(names) != len(obstacles):
+        raise WoodcamError(f"obstacle_names must name each of the {len(obstacles)} obstacles; got "
+                           f"{len(names)} names; pass one a mesh, or none")
+    return names
+
+
 def propagate(mesh, grid: VoxelGrid, *, wind=None, gain=None, obstacles=(), method: Method = "auto",
-              stop_mm: float = np.inf, paint=None) -> Front:
+              stop_mm: float = np.inf, paint=None, obstacle_names=None) -> Front:
     """Arrival time of the front grown from ``mesh`` (see module docstring).
 
     Parameters
@@ -234,6 +246,9 @@ def propagate(mesh, grid: VoxelGrid, *, wind=None, gain=None, obstacles=(), meth
         Speed gain ``g > 0`` (brushes); default 1.
     obstacles : sequence of trimesh.Trimesh
         Watertight obstacles: the front stops on contact and wraps round them.
+    obstacle_names : sequence of str, optional
+        What the messages call each obstacle (default ``obstacles[i]``; the CLI's is the option
+        and the file, ``--obstacle 'post.stl'``).
     method : "auto", "fmm" or "anisotropic"
     stop_mm : float
         March only up to this pseudo-time (mm); later nodes stay ``inf``.
@@ -252,7 +267,8 @@ def propagate(mesh, grid: VoxelGrid, *, wind=None, gain=None, obstacles=(), meth
     if obstacles:
         import trimesh
 
-        obs = [check_watertight(o, f"obstacles[{i}]") for i, o in enumerate(obstacles)]
+        names = obstacle_names_of(obstacles, obstacle_names)
+        obs = [check_watertight(o, name) for o, name in zip(obstacles, names)]
         allobs = trimesh.util.concatenate(obs) if len(obs) > 1 else obs[0]
         od, _, _, oin = _rasterise(allobs, grid, WOODIFY_BAND_NODES)
         far = WOODIFY_BAND_NODES * h
@@ -261,10 +277,12 @@ def propagate(mesh, grid: VoxelGrid, *, wind=None, gain=None, obstacles=(), meth
         # distance of a convex obstacle crosses zero slightly inside it (tolerances.py).
         obstacle = obst_sdf < WOODIFY_OBSTACLE_CLEARANCE_VOXELS * h
         if not np.any(inside & ~obstacle):
+            one = len(names) == 1
             raise WoodcamError(
-                "obstacles must leave part of the input outside them; the obstacle(s) contain "
-                f"the whole input mesh ({len(mesh.faces)} triangles), so nothing can grow; "
-                "move or shrink the obstacle")
+                f"{', '.join(names)} must leave part of the input mesh outside {'it' if one else 'them'}; "
+                f"{'it contains' if one else 'together they contain'} the whole input mesh "
+                f"({len(mesh.faces)} triangles), so nothing can grow; move or shrink "
+                f"{'it' if one else 'them'}, or leave {'it' if one else 'one'} out")
         inside &= ~obstacle
     if not np.any(inside):
         raise WoodcamError(

@@ -22,7 +22,7 @@ from ..errors import WoodcamError
 from ..limits import WOODIFY_RESOLUTION_RANGE, check_grid, limit
 from .brushes import Brush, check_vertex_paint, paint
 from .field import WoodifiedField
-from .front import Front, Method, VoxelGrid, check_resolution, check_watertight, propagate
+from .front import Front, Method, VoxelGrid, check_resolution, check_watertight, obstacle_names_of, propagate
 from .speed import GrowthSpeed, weibull_cdf
 
 if TYPE_CHECKING:
@@ -136,7 +136,7 @@ def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: 
             time_scale_years: float | None = None, shape: float = 2.0, eccentricity: float = 0.0,
             up=(0.0, 0.0, 1.0), obstacles=(), brushes: tuple[Brush, ...] | list = (),
             vertex_gain=None, vertex_direction=None, resolution: int = 128,
-            method: Method = "auto") -> Woodification:
+            method: Method = "auto", obstacle_names=None) -> Woodification:
     """Grow a watertight ``mesh`` for ``years`` (seed 004 ch. 4 on a voxel grid).
 
     Parameters
@@ -157,6 +157,9 @@ def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: 
         See :class:`~woodcam.woodify.speed.GrowthSpeed`.
     obstacles : sequence of trimesh.Trimesh
         Watertight obstacles (mm); the front stops on contact, wraps round and engulfs them.
+    obstacle_names : sequence of str, optional
+        What messages call each obstacle (default ``obstacles[i]``; ``woodcam woodify`` names
+        the option and the file, ``--obstacle 'post.stl'``).
     brushes, vertex_gain, vertex_direction :
         User-defined growth (:mod:`woodcam.woodify.brushes`).
     resolution : int
@@ -222,14 +225,15 @@ def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: 
         fix = (f"lower the resolution to {best} or less" if best is not None else "lower the resolution")
         check_grid(grid.shape, f"woodify's grid at resolution {resolution}",
                    itemsize=WOODIFY_BYTES_PER_NODE, fix=f"{fix} (--resolution on the command line; default 128)")
-    obstacles = [check_watertight(o, f"obstacles[{i}]") for i, o in enumerate(obstacles)]
+    obstacle_names = obstacle_names_of(obstacles, obstacle_names)
+    obstacles = [check_watertight(o, name) for o, name in zip(obstacles, obstacle_names)]
     paint_fn = None
     if strokes or vertex_gain is not None or vertex_direction is not None:
         def paint_fn(origin, tri):
             return paint(origin, strokes, vertex_gain=vertex_gain,
                          vertex_direction=vertex_direction, mesh=mesh, tri=tri)
     t1 = time.perf_counter()
-    front = propagate(mesh, grid, wind=speed.wind, obstacles=obstacles, method=method,
+    front = propagate(mesh, grid, wind=speed.wind, obstacles=obstacles, obstacle_names=obstacle_names, method=method,
                       stop_mm=tau_end + 2 * _MARGIN_NODES * grid.spacing_mm * gmax, paint=paint_fn)
     t2 = time.perf_counter()
     from .bark import stem_axis
