@@ -83,8 +83,11 @@ def test_errors_are_one_clean_line(argv, message, code, tmp_path):
     (["--knot-darkening", "-0.1,0.3"], "--knot-darkening takes 2 comma-separated numbers in [0, 1]; "
      "got '-0.1,0.3'"),
     (["--knot-outline", "-1,0,0"], "--knot-outline takes 3 comma-separated numbers in [0, 1]; got '-1,0,0'"),
-    (["--appearance", "neural", "--knot-darkening", "0.3,0.4"], "apply to --appearance colormap only"),
-    (["--quality", "draft"], "--quality and --epochs apply to --appearance neural only"),
+    (["--appearance", "neural", "--knot-darkening", "0.3,0.4"], "apply to --appearance colormap only (the neural "
+     "appearance learns knot colours from the photos); got --knot-darkening with --appearance neural; leave them "
+     "out, or use --appearance colormap"),
+    (["--quality", "draft"], "--quality and --epochs apply to --appearance neural only; got --quality draft with "
+     "--appearance colormap; add --appearance neural, or leave them out"),
 ])
 def test_appearance_options_out_of_range_or_contradicting_are_usage_errors(argv, message):
     """A knot darkening or outline colour out of [0, 1], or a knot option beside the neural

@@ -80,10 +80,14 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     (["log", "render", "--out", "OUT/lr"], EXIT_USAGE, r"give exactly one log: a LOG_FILE, --real or --maps DIR; got 0"),
     (["log", "render", "--real", "OUT/file.txt", "--out", "OUT/lr"], EXIT_USAGE, r"give exactly one log: .*; got 2"),
     (["eval", "rings", "builtin:flat-sawn", "--truth", "OUT/file.txt", "OUT/file.txt", "--out", "OUT/e"], EXIT_USAGE,
-     r"--truth needs one field file per block: got 2 for 1 blocks"),
+     r"--truth needs one field file per block: got 2 for 1 blocks; give one --truth FIELD.npz for each block, "
+     r"in the blocks' order, or leave --truth out$"),
     (["block", "synth", "--count", "1", "--engine", "local", "--address", "tcp://127.0.0.1:1", "--out", "OUT/b"], EXIT_USAGE,
-     r"--address needs --engine dask; got --engine local"),
-    (["train", "rings", "--no-resume", "--out", "OUT/t"], EXIT_USAGE, r"train rings runs in this process and always from scratch"),
+     r"--address needs --engine dask; got --engine local; use --engine dask, or leave --address out$"),
+    (["train", "rings", "--no-resume", "--out", "OUT/t"], EXIT_USAGE,
+     r"train rings runs in this process and always from scratch: .*; got --no-resume; leave them out$"),
+    (["train", "rings", "--workers", "2", "--no-resume", "--out", "OUT/t"], EXIT_USAGE,
+     r"train rings .*; got --workers --no-resume; leave them out$"),
     (["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--out", "OUT/g.glb"], EXIT_USAGE,
      r"woodcam gcode: no tools given; pass --tool SPEC"),
     # LinuxCNC's own interpreter read the program as LinuxCNC's, the --dialect dropped silently
@@ -93,11 +97,11 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     # after the block was opened ('face must be one of ...; got 'bogus'')
     (["fit", "builtin:flat-sawn", "--faces", "front,bogus", "--out", "OUT/f.npz"], EXIT_USAGE,
      r"--faces must be 'all' or a comma list of faces from front, top, left, bottom, right, back \(or Mokume "
-     r"letters A-F\); got 'bogus'$"),
+     r"letters A-F\); got 'bogus'; e.g. --faces front,top$"),
     (["eval", "rings", "builtin:flat-sawn", "--partial-faces", "top,X", "--out", "OUT/e"], EXIT_USAGE,
-     r"--partial-faces must be 'all' or a comma list of faces from .*; got 'X'$"),
+     r"--partial-faces must be 'all' or a comma list of faces from .*; got 'X'; e.g. --partial-faces front,top$"),
     (["eval", "appearance", "builtin:flat-sawn", "--end-grain", "A,sides", "--out", "OUT/ea"], EXIT_USAGE,
-     r"--end-grain must be a comma list of faces from .*; got 'sides'$"),
+     r"--end-grain must be a comma list of faces from .*; got 'sides'; e.g. --end-grain front,top$"),
     (["bench", "run", "--blocks", "1", "--methods", "rbf,bogus", "--out", "OUT/b"], EXIT_USAGE,
      r"--methods must be from evidence, rbf, radial, neural; got 'rbf,bogus', in which 'bogus' is none of "
      r"them; e.g. --methods evidence,rbf$"),

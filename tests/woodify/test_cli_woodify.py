@@ -329,7 +329,8 @@ def test_surface_and_crack_years_are_usage_errors_before_the_growth(tmp_path, ca
     monkeypatch.setattr(wf, "woodify", lambda *a, **k: grown.append(a) or pytest.fail("grew"))
     ball = tmp_path / "ball.stl"
     trimesh.creation.icosphere(subdivisions=1, radius=5.0).export(ball)
-    for extra, said in ((["--surface-years", "1,abc"], "--surface-years takes comma-separated years in [0, 3]"),
+    for extra, said in ((["--surface-years", "1,abc"], "--surface-years takes comma-separated years in [0, 3] (--years); "
+                                                    "got '1,abc'; e.g. --surface-years 1.5,3"),
                         (["--surface-years", "1,4"], "got '1,4'"),
                         (["--surface-years", "1,1.0000001"], "would both be written as surface_y1.stl"),
                         (["--crack-years", "8"], "--crack-years must be at most --years (3): it simulates the "
@@ -362,7 +363,8 @@ def test_vectors_and_sizes_are_refused_at_the_door_as_typed(tmp_path, capsys):
     for extra, said in (
             (["--up", "0,0,0"], "--up '0,0,0': a direction must not be zero; e.g. 0,0,1"),
             (["--crack-region", "0,0,0"], "--crack-region '0,0,0': give 4 finite numbers X,Y,Z,R"),
-            (["--crack-region=1,2,3,0"], "--crack-region X,Y,Z,R needs a radius R > 0; got R = 0 mm"),
+            (["--crack-region=1,2,3,0"], "--crack-region X,Y,Z,R needs a radius R > 0; got R = 0 mm; "
+              "e.g. --crack-region 0,0,50,10, or leave it out for cracks anywhere on the bark"),
             (["--block-size", "1000x10x10", "--units", "inch"],
              "--block-size takes WxDxH in inches (--units inch), 3 numbers in (0, 393.701] (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 2x2x2; "
              "got '1000x10x10'"),

@@ -135,7 +135,8 @@ def run_eval(args) -> int:
                else face_names(args.partial_faces, "--partial-faces", all_=True))
     if args.truth and len(args.truth) != len(args.block):  # before the blocks are opened (a fit each)
         raise UsageError(f"--truth needs one field file per block: got {len(args.truth)} for "
-                         f"{len(args.block)} blocks")
+                         f"{len(args.block)} blocks; give one --truth FIELD.npz for each block, in the "
+                         "blocks' order, or leave --truth out")
     blocks = [open_block(p, args.size_mm)[0] for p in args.block]
     if args.truth:
         for b, t in zip(blocks, args.truth):

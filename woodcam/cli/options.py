@@ -1004,7 +1004,8 @@ def face_names(text: str, option: str, *, all_: bool = False) -> list[str] | Non
     if bad:
         whole = "'all' or " if all_ else ""
         raise UsageError(f"{option} must be {whole}a comma list of faces from "
-                         f"{', '.join(FACES)} (or Mokume letters A-F); got {', '.join(map(repr, bad))}")
+                         f"{', '.join(FACES)} (or Mokume letters A-F); got {', '.join(map(repr, bad))}; "
+                         f"e.g. {option} front,top")
     return names
 
 
@@ -1102,15 +1103,20 @@ def appearance_params(args) -> dict:
     knots = args.knot_darkening is not None or args.knot_outline is not None
     if args.appearance != "neural":
         if args.quality or args.epochs:
+            given = " ".join(f"--{k} {v}" for k, v in (("quality", args.quality), ("epochs", args.epochs)) if v)
             raise UsageError("--quality and --epochs apply to --appearance neural only; "
-                               f"got --appearance {args.appearance}")
+                             f"got {given} with --appearance {args.appearance}; add --appearance neural, "
+                             "or leave them out")
         if not knots:
             return {}
         # a darkening asked for replaces the knot colour a colour map would fit to the photos
         return {"knots": knot_shading(args), **({"knot_lut": None} if args.knot_darkening is not None else {})}
     if knots:
+        given = " and ".join(o for o, v in (("--knot-darkening", args.knot_darkening),
+                                            ("--knot-outline", args.knot_outline)) if v is not None)
         raise UsageError("--knot-darkening and --knot-outline apply to --appearance colormap "
-                           "only (the neural appearance learns knot colours from the photos)")
+                         f"only (the neural appearance learns knot colours from the photos); got {given} "
+                         "with --appearance neural; leave them out, or use --appearance colormap")
     return {k: v for k, v in (("quality", args.quality), ("epochs", args.epochs)) if v is not None}
 
 
@@ -1566,13 +1572,19 @@ _ENGINE_DESTS = ("engine", "address", "workers", "memory_limit_mb", "connect_tim
 def engine_requested(args) -> bool:
     """Whether any of :func:`add_engine_options`' options was given: then the work runs on an
     engine (``--workers 4`` alone ran serially in this process, as if it had not been given)."""
-    return any(getattr(args, d, None) is not None for d in _ENGINE_DESTS)
+    return bool(engine_given(args))
+
+
+def engine_given(args) -> list[str]:
+    """The engine options given (``['--engine', '--workers']``), as typed on the command line."""
+    return [f"--{d.replace('_', '-')}" for d in _ENGINE_DESTS if getattr(args, d, None) is not None]
 
 
 def engine_options(args) -> dict:
     """The keyword arguments of :func:`woodcam.scale.run_many` from :func:`add_engine_options`."""
     if args.address is not None and args.engine not in (None, "dask"):
-        raise UsageError(f"--address needs --engine dask; got --engine {args.engine}")
+        raise UsageError(f"--address needs --engine dask; got --engine {args.engine}; use --engine dask, or "
+                         "leave --address out")
     out = {"engine": "dask" if args.address is not None else (args.engine or "local"),
            "address": args.address, "workers": args.workers}
     if args.memory_limit_mb is not None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import UsageError
-from .options import add_input, add_engine_options, add_out_option, engine_options, engine_requested
+from .options import add_input, add_engine_options, add_out_option, engine_given, engine_options, engine_requested
 
 
 def register(subparsers) -> None:
@@ -34,9 +34,10 @@ def run(args) -> int:
         from ..detect.learned import RingNetSpec, check_member, train_ring_net
 
         if engine_requested(args) or args.no_resume:  # they were accepted and ignored
+            given = [*engine_given(args), *(["--no-resume"] if args.no_resume else [])]
             raise UsageError("train rings runs in this process and always from scratch: the engine "
-                               "options (--engine, --address, --workers, ...) and --no-resume are for "
-                               "'train gtf'")
+                             "options (--engine, --address, --workers, ...) and --no-resume are for "
+                             f"'train gtf'; got {' '.join(given)}; leave them out")
 
         spec = RingNetSpec.load(args.spec) if args.spec is not None else RingNetSpec()
         if args.steps is not None:

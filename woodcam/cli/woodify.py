@@ -535,8 +535,9 @@ def run(args) -> int:
         except ValueError:
             years = [-1.0]
         if not all(0 <= y <= args.years for y in years):
-            raise UsageError(f"--surface-years takes comma-separated years in [0, {args.years:g}]; "
-                             f"got {args.surface_years!r}")
+            raise UsageError(f"--surface-years takes comma-separated years in [0, {args.years:g}] "
+                             f"(--years); got {args.surface_years!r}; e.g. --surface-years "
+                             f"{args.years / 2:g},{args.years:g}")
         # one file a year (surface_y<year:g>.stl): a year given twice was grown and written twice
         # and listed twice; two years of one name overwrote each other
         names = {}
@@ -572,7 +573,8 @@ def run(args) -> int:
                          f"years of the growth; got {args.crack_years}; {fix}")
     region = args.crack_region
     if region is not None and not region[3] > 0:
-        raise UsageError(f"--crack-region X,Y,Z,R needs a radius R > 0; got R = {say_length(region[3], 'g')}")
+        raise UsageError(f"--crack-region X,Y,Z,R needs a radius R > 0; got R = {say_length(region[3], 'g')}; "
+                         "e.g. --crack-region 0,0,50,10, or leave it out for cracks anywhere on the bark")
     from .._atomic import all_or_nothing, manifest_path, remove_stale
 
     # A bar of stages whose timer draws it 2 s in even mid-stage: the bar of plain updates this
