@@ -149,7 +149,7 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     ([*GCODE, "--tool", "flat:abc"], EXIT_USAGE, r"--tool 'flat:abc': tool spec 'flat:abc': numbers expected after the type"),
     ([*GCODE, "--tool", "x=ball:3"], EXIT_USAGE, r"--tool 'x=ball:3': the part before '=' must be a tool number"),
     # a tool number out of a tool table's range, or one given twice (the last was taken silently)
-    ([*GCODE, "--tool", "1000000=flat:6"], EXIT_USAGE, r"--tool '1000000=flat:6': the tool number must be in \[0, 99999\]; got 1000000"),
+    ([*GCODE, "--tool", "1000000=flat:6"], EXIT_USAGE, r"--tool '1000000=flat:6': the tool number must be in \[0, 99999\]; got 1000000; e.g. --tool 1=flat:6$"),
     ([*GCODE, "--tool", "1=flat:6", "--tool", "2=ball:3", "--tool", "1=ball:3"], EXIT_USAGE,
      r"--tool '1=ball:3': tool 1 is given twice \(also --tool '1=flat:6'\); give each tool number once"),
     ([*GCODE, "--tool", "flat:-1"], EXIT_USAGE, r"--tool 'flat:-1': FlatEndMill: diameter_mm must be a positive number"),

@@ -225,7 +225,27 @@ def test_a_negative_tool_number_is_refused_naming_the_range(tool, capsys):
         assert main(["gcode", "p.nc", "--block", "builtin:flat-sawn", "--out", "o.glb", *argv]) == 2
         err = capsys.readouterr().err
         assert err == (f"woodcam: error: --tool {tool!r}: the tool number must be in [0, 99999]; "
-                       f"got {tool.split('=')[0]}\n"), err
+                       f"got {tool.split('=')[0]}; e.g. --tool 1={tool.split('=')[1]}\n"), err
+
+
+def test_more_unnumbered_tools_than_the_program_has_numbers_says_how_to_number_them(capsys, tmp_path):
+    """Two --tool SPEC without numbers for a program of one tool (T1) said 'give numbers as
+    N=SPEC' with no example; now the numbers the tools would take, the rule and the fix."""
+    assert main(["gcode", str(REPO / "toolpaths" / "pocket_islands.nc"), "--block", "builtin:flat-sawn",
+                 "--out", str(tmp_path / "o.glb"), "--tool", "flat:6", "--tool", "ball:3", "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err == ("woodcam: error: --tool: 2 tools without numbers but the program uses 1 tool number(s) "
+                   "without a tool ([1]); each tool without a number takes the next of those; give numbers as "
+                   "N=SPEC, e.g. --tool 1=flat:6 --tool 2=ball:3, or leave out the tools it does not use\n"), err
+
+
+def test_a_glbs_appearance_params_not_an_object_say_the_fix():
+    """A GLB whose metadata's appearance.params is no object was refused without a fix."""
+    from woodcam.cli.options import _trusted_appearance_params
+
+    with pytest.raises(WoodcamError, match=r"^'p.glb': metadata appearance.params must be an object; got list; "
+                       r"re-bake it, or pass --block SPEC \(and the bake options\) yourself$"):
+        _trusted_appearance_params([1], "p.glb")
 
 
 def test_machining_time_estimate():

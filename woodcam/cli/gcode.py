@@ -204,9 +204,13 @@ def _tools_from_args(args, program) -> dict:
         if len(unnumbered) == 1 and len(used) <= 1:
             used = used or [0]
         if len(unnumbered) > len(used):
+            typed = [item for item in args.tool if parse_tool_option(item)[0] is None]
+            free = [n for n in range(1, 100000) if n not in tools and n not in used][:len(typed) - len(used)]
+            example = " ".join(f"--tool {n}={item}" for n, item in zip([*used, *free], typed))
             raise WoodcamError(f"--tool: {len(unnumbered)} tools without numbers but the program "
-                               f"uses {len(used)} tool number(s) without a tool ({used}); give "
-                               "numbers as N=SPEC")
+                               f"uses {len(used)} tool number(s) without a tool ({used}); each tool "
+                               f"without a number takes the next of those; give numbers as N=SPEC, "
+                               f"e.g. {example}, or leave out the tools it does not use")
         tools.update(zip(used, unnumbered))
     if not tools:
         raise WoodcamError("woodcam gcode: no tools given; pass --tool SPEC (e.g. --tool "

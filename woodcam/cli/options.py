@@ -710,7 +710,8 @@ def parse_tool_option(item: str):
             raise WoodcamError(f"--tool {item!r}: the part before '=' must be a tool "
                                "number, e.g. 2=ball:3") from err
         if not 0 <= number <= 99999:  # a tool table's range (load_tool_table): 1000000= was taken
-            raise WoodcamError(f"--tool {item!r}: the tool number must be in [0, 99999]; got {number}")
+            raise WoodcamError(f"--tool {item!r}: the tool number must be in [0, 99999]; got {number}; "
+                               f"e.g. --tool 1={spec}")
     try:
         return number, parse_tool_spec(spec)
     except WoodcamError as err:  # what is wrong with the spec, not with the number
@@ -1308,7 +1309,8 @@ def _trusted_appearance_params(params, glb) -> dict:
         return {}
     if not isinstance(params, dict):
         raise WoodcamError(f"{str(glb)!r}: metadata appearance.params must be an object; got "
-                           f"{type(params).__name__}")
+                           f"{type(params).__name__}; re-bake it, or pass --block SPEC (and the bake "
+                           "options) yourself")
     out = {}
     for key, value in params.items():
         rule = _GLB_APPEARANCE_PARAMS.get(key)
