@@ -198,7 +198,7 @@ def test_errors_are_clear():
     with pytest.raises(WoodcamError, match="must be watertight"):
         woodify(open_mesh, 5)
     big = trimesh.creation.box((40.0, 40.0, 40.0))
-    with pytest.raises(WoodcamError, match="contain the whole input"):
+    with pytest.raises(WoodcamError, match=r"^obstacles\[0\] must leave part of the input mesh outside it; it contains the whole input"):
         woodify(m, 5, obstacles=[big], resolution=32)
     with pytest.raises(WoodcamError, match="eccentricity must lie in"):
         woodify(m, 5, eccentricity=1.2)
