@@ -422,3 +422,21 @@ def test_a_failed_run_says_its_warnings_first_and_its_error_last(tmp_path, capsy
     assert [line.split(":")[1] for line in lines] == [" warning", " error"], lines
     assert lines[0].startswith("woodcam: warning: --camera front chooses the view of --screenshot")
     assert lines[-1].startswith("woodcam: error: mesh file ") and "contains no triangles" in lines[-1]
+
+
+def test_confidence_of_a_block_with_no_fit_names_the_block_and_the_fix(tmp_path, capsys):
+    """'preview --confidence' of a GLB baked from a built-in block said '--confidence needs a block
+    whose field was fitted (...); pass --block', naming neither the block it got nor one to pass."""
+    box = trimesh.creation.box((20, 20, 20))
+    box.apply_translation((50, 40, 25))
+    box.export(tmp_path / "box.stl")
+    glb = tmp_path / "b.glb"
+    assert main(["bake", str(tmp_path / "box.stl"), "--block", "builtin:flat-sawn", "--no-obj",
+                 "--texels-per-mm", "1", "--quiet", "--out", str(glb)]) == 0
+    capsys.readouterr()
+    assert main(["preview", str(glb), "--confidence", "--screenshot", str(tmp_path / "b.png"), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err == ("woodcam: error: --confidence needs a block whose field was fitted (a block folder without a "
+                   "true field, or a Mokume folder); got the block 'builtin:flat-sawn', whose field has no fit and "
+                   "so no uncertainty; pass --block with such a block (e.g. --block ../shared/data/mokume/H11), "
+                   "or leave --confidence out\n"), err

@@ -229,8 +229,12 @@ def run_preview(args: argparse.Namespace) -> int:
             from ..inference.evidence import ConfidenceWood
 
             if stock is None or not getattr(stock.wood, "has_uncertainty", False):
+                got = (f"got the block {stock.spec!r}, whose field has no fit and so no uncertainty"
+                       if stock is not None else f"got {str(args.mesh)!r}, which records no block")
                 raise WoodcamError("--confidence needs a block whose field was fitted (a block folder "
-                                   "without a true field, or a Mokume folder); pass --block")
+                                   f"without a true field, or a Mokume folder); {got}; pass --block with "
+                                   "such a block (e.g. --block ../shared/data/mokume/H11), or leave "
+                                   "--confidence out")
             wood = ConfidenceWood(stock.wood)  # read where its years are (turned, resized)
         with bar.stage("load viewer"):
             load_viewer()
