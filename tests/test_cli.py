@@ -302,6 +302,26 @@ def test_place_says_a_broken_part_before_opening_the_block(tmp_path, capsys, mon
     assert err.startswith("woodcam: error: part script") and "NameError: name 'Bx' is not defined" in err, err
 
 
+def test_place_names_the_part_that_fits_nowhere_and_the_fix(tmp_path, capsys):
+    """`woodcam place`'s error of a part that fits the block in no orientation began
+    'advise_placement:' (a Python function) and did not name the part file. It names PART as
+    typed and says the fix; the library's message keeps its function name."""
+    from woodcam import open_stock
+    from woodcam.advise import advise_placement
+    from woodcam.errors import WoodcamError
+
+    long = trimesh.creation.box((300, 20, 20)).apply_translation((50, 40, 25))
+    part = tmp_path / "long.stl"
+    long.export(part)
+    assert main(["place", str(part), "--block", "builtin:knotty", "--out", str(tmp_path / "place")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"woodcam: error: part {str(part)!r} (300.0x20.0x20.0 mm) fits the 100x80x50 mm "
+                          "block in none of the 'z90' orientations"), err
+    assert "advise_placement" not in err and "a bigger block (at least 302x80x50 mm" in err, err
+    with pytest.raises(WoodcamError, match=r"^advise_placement: the part \(300"):
+        advise_placement(long, open_stock("builtin:knotty"))
+
+
 def test_place_bounds_a_part_script_with_timeout_as_bake_does(tmp_path, capsys):
     """`woodcam place` runs the same trusted part scripts as bake but had no --timeout: a
     script stuck in a loop hung it."""

@@ -156,7 +156,7 @@ def _sample(mesh, count: int, rng):
 def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1000,
                      margin_mm: float = 1.0, samples: int = 1500,
                      weights: dict[str, float] | None = None, seed: int = 0,
-                     progress: bool = False,
+                     progress: bool = False, source: object = None,
                      units_fix: str = ("scale it first: woodcam.cad.place.place_part(part, ['scale:25.4'], "
                                        "stock.size_mm) (in metres: 'scale:1000')")) -> PlacementAdvice:
     """Rank placements of ``part`` in ``stock`` (see module docstring).
@@ -180,6 +180,10 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
         Seed of the surface sample.
     progress : bool
         A progress bar over the orientations (:func:`woodcam._progress.progress_bar`).
+    source : str, Path or None
+        The part as the user gave it (``woodcam place``: the PART path as typed), when ``part``
+        is already loaded: the error of a part that fits nowhere names it (else it says
+        ``advise_placement: the part``).
     units_fix : str
         How to scale the part, in the warning of a part in inches
         (:func:`woodcam.cad.carve.units_hint`; ``woodcam place`` names the CAD program).
@@ -253,7 +257,8 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
                 score=float(score[i])))
     if not ranked:
         raise WoodcamError(
-            f"advise_placement: the part ({say_length(hi - lo, '.1f')}) fits the "
+            f"{'advise_placement: the part' if source is None else f'part {str(source)!r}'} "
+            f"({say_length(hi - lo, '.1f')}) fits the "
             f"{say_length(size, 'g')} block in none of the '{rotations}' "
             f"orientations with a {say_length(margin_mm, 'g')} margin; {_no_fit_fixes(hi - lo, size, rotations, margin_mm)}")
     ranked.sort(key=lambda p: p.score)

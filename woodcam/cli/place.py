@@ -66,6 +66,7 @@ def run_place(args: argparse.Namespace) -> int:
         with bar.stage("score placements"):
             advice = advise_placement(part, stock, rotations=args.rotations,
                                       candidates=args.candidates, margin_mm=args.margin, progress=True,
+                                      source=args.part,  # its no-fit error named advise_placement
                                       units_fix="scale the part file by 25.4 in your CAD program (in metres: by 1000)")
         k = 1 / MM_PER_UNIT[args.units]
         record = {"block": args.block, "part": str(args.part), "candidates": advice.candidates,
