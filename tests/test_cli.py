@@ -322,6 +322,37 @@ def test_place_names_the_part_that_fits_nowhere_and_the_fix(tmp_path, capsys):
         advise_placement(long, open_stock("builtin:knotty"))
 
 
+def test_bake_says_a_broken_part_before_opening_the_block(tmp_path, capsys, monkeypatch):
+    """`woodcam bake` opened the block (a photographed block's ring fit: minutes) before it ran
+    the part script, so a typo in it was said after the wait. The part is loaded first, once."""
+    import woodcam.cad
+    import woodcam.stock
+
+    def no_block(*args, **kwargs):
+        raise AssertionError("the block was opened before the part was loaded")
+
+    monkeypatch.setattr(woodcam.stock, "open_stock", no_block)
+    part = tmp_path / "typo.py"
+    part.write_text("part = Bx(10, 10, 10)\n")
+    assert main(["bake", str(part), "--block", "builtin:knotty", "--out", str(tmp_path / "t.glb")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("woodcam: error: part script") and "NameError: name 'Bx' is not defined" in err, err
+    monkeypatch.undo()
+    loads = []
+    load_part = woodcam.cad.load_part
+
+    def counted(*args, **kwargs):
+        loads.append(args[0])
+        return load_part(*args, **kwargs)
+
+    monkeypatch.setattr(woodcam.cad, "load_part", counted)
+    box = tmp_path / "box.stl"
+    trimesh.creation.box((20, 20, 20)).apply_translation((50, 40, 25)).export(box)
+    assert main(["bake", str(box), "--block", "builtin:knotty", "--out", str(tmp_path / "b.glb"),
+                 "--texels-per-mm", "1", "--no-obj", "--place", "center"]) == 0
+    assert loads == [str(box)]  # loaded once, then carved as a manifold
+
+
 def test_place_bounds_a_part_script_with_timeout_as_bake_does(tmp_path, capsys):
     """`woodcam place` runs the same trusted part scripts as bake but had no --timeout: a
     script stuck in a loop hung it."""

@@ -6,7 +6,7 @@ Every front end (``woodcam bake``, ``woodcam demo``, ``woodcam gcode``) runs the
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -149,7 +149,7 @@ def _check_metadata(metadata) -> None:
                            "e.g. metadata={'part': 'bowl'}")
 
 
-def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_mm: float = 10.0,
+def preview_part(source: object, stock: Stock | Callable[[], Stock], out_glb: PathLike, *, texels_per_mm: float = 10.0,
                  tolerance_mm: float | None = None, obj: bool = True,
                  screenshot: bool = True, progress: bool = False, obj_units: str = "m",
                  obj_up: str = "y", max_triangles: int | None = None,
@@ -169,11 +169,16 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
     in inches, in its warning (:func:`woodcam.cad.carve.units_hint`; the CLI names ``--place``).
 
     ``progress`` draws a bar of its stages (:func:`part_stages`) on a terminal, or advances
-    ``stages`` (a :class:`woodcam._progress.StageBar` whose plan holds them) when given."""
+    ``stages`` (a :class:`woodcam._progress.StageBar` whose plan holds them) when given.
+
+    ``stock`` may be a function of no argument returning the :class:`Stock`, called once the
+    part is loaded: a script's typo or a damaged part file is then said before the block is
+    opened (a ring fit: minutes), as ``woodcam bake`` does."""
     from .cad import carve, load_part
     from .tolerances import MAX_PART_TRIANGLES
 
-    _check_stock(stock)
+    if not callable(stock):
+        _check_stock(stock)
     obj, screenshot, progress = _check_flags(obj, screenshot, progress)
     if isinstance(place, str):  # 'center' was read letter by letter: "--place 'c' is not a placement"
         raise WoodcamError(f"place must be a list of placement operations; got the string {place!r}; pass [{place!r}]")
@@ -191,6 +196,9 @@ def preview_part(source: object, stock: Stock, out_glb: PathLike, *, texels_per_
                              max_triangles=MAX_PART_TRIANGLES if max_triangles is None else max_triangles,
                              report=result.tessellation)
         result.warnings += list(result.tessellation.get("notes", []))
+        if callable(stock):  # opened after the part loaded (bake: a typo was said after the fit)
+            stock = stock()
+            _check_stock(stock)
         metadata = None
         if place:
             from .cad.place import place_part

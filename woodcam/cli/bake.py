@@ -135,12 +135,19 @@ def run_bake(args: argparse.Namespace) -> int:
     apply_workers(args)
     shot = bool(getattr(args, "screenshot", None))
     camera_of(args, shot)  # a --camera without --screenshot warns before the work
-    # one bar for the whole run: opening the block can fit its rings (minutes, once)
-    with StageBar(["open block", *part_stages(shot)],
-                  desc=f"bake {Path(args.out).stem}", leave=False) as bar:
+    # one bar for the whole run: opening the block can fit its rings (minutes, once), so it
+    # opens after the part loaded: a script's typo was said after that wait
+    stages = part_stages(shot)
+    stages.insert(stages.index("load") + 1, "open block")
+    opened = []
+
+    def open_block():
         with bar.stage("open block"):
-            stock = open_stock(args.block, **stock_options(args))
-        res = preview_part(args.part, stock, args.out, texels_per_mm=args.texels_per_mm,
+            opened.append(open_stock(args.block, **stock_options(args)))
+        return opened[0]
+
+    with StageBar(stages, desc=f"bake {Path(args.out).stem}", leave=False) as bar:
+        res = preview_part(args.part, open_block, args.out, texels_per_mm=args.texels_per_mm,
                            tolerance_mm=args.tolerance, timeout_s=args.timeout, obj=not args.no_obj,
                            screenshot=False, progress=True, obj_units=args.obj_units, obj_up=args.obj_up,
                            max_triangles=args.max_triangles, max_atlas_px=args.max_atlas,
@@ -148,7 +155,7 @@ def run_bake(args: argparse.Namespace) -> int:
                            units_fix="add --place scale:25.4 --place center (in metres: scale:1000)")
         if shot:
             with bar.stage("render"):
-                write_screenshot(args, res.files, stock)
+                write_screenshot(args, res.files, opened[0])
     remove_stale_outputs(args.out, res.files, inputs=[args.part])
     print_warnings(res.warnings)
     tess = res.tessellation
