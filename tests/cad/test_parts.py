@@ -7,6 +7,7 @@ STL/OBJ/GLB/glTF (float32 files: relative 1e-6).
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import manifold3d
@@ -319,6 +320,46 @@ def test_a_cut_short_step_file_says_where_in_one_line(tmp_path, bd, capfd):
     out, err = capfd.readouterr()
     assert out == "" and err == ""
     assert load_part(whole).volume() == pytest.approx(1000)  # and the messenger is back as it was
+
+
+def test_two_threads_reading_step_at_once_leave_occts_printers_as_they_were():
+    """OpenCascade's message printers are global; _occt_messages swapped them with no lock, so
+    a second thread reading STEP meanwhile saved the first's temporary printer as 'the old ones'
+    and put it back for good. Thread A holds the swap until thread B has entered or 0.5 s
+    passed; B leaves after A: with the lock B enters only after A left."""
+    import threading
+
+    pytest.importorskip("OCP")
+    from OCP.Message import Message
+
+    from woodcam.cad import parts
+
+    messenger = Message.DefaultMessenger_s()
+    before = len(list(messenger.Printers()))
+    a_in, a_out = threading.Event(), threading.Event()
+    both_in = threading.Barrier(2, timeout=0.5)
+
+    def a():
+        with parts._occt_messages():
+            a_in.set()
+            with contextlib.suppress(threading.BrokenBarrierError):
+                both_in.wait()
+        a_out.set()
+
+    def b():
+        with parts._occt_messages():
+            with contextlib.suppress(threading.BrokenBarrierError):
+                both_in.wait()
+            a_out.wait(5)
+
+    ta = threading.Thread(target=a)
+    ta.start()
+    assert a_in.wait(5)
+    tb = threading.Thread(target=b)
+    tb.start()
+    ta.join(10)
+    tb.join(10)
+    assert len(list(messenger.Printers())) == before
 
 
 def test_step_surface_model_of_shells_is_a_part(tmp_path, bd):

@@ -34,6 +34,7 @@ import contextlib
 import math
 import runpy
 import sys
+import threading
 from collections.abc import MutableMapping
 from dataclasses import dataclass, field
 from numbers import Integral, Real
@@ -571,6 +572,12 @@ def _load_step(path: Path, tess: "_Tessellation"):
     return _manifold_from_topods(shape, tess, origin=f"STEP file {str(path)!r}")
 
 
+#: Held over :func:`_occt_messages`' swap of OpenCascade's printers, which are global (one
+#: messenger per process): two threads reading STEP at once each took the other's temporary
+#: printer for the old ones and put it back, its file deleted, in place of the terminal's.
+_OCCT_MESSAGES_LOCK = threading.Lock()
+
+
 @contextlib.contextmanager
 def _occt_messages():
     """Route OpenCascade's messages (its STEP parser prints them to stdout, in red, after
@@ -584,7 +591,7 @@ def _occt_messages():
 
     messenger = Message.DefaultMessenger_s()
     lines: list[str] = []
-    with tempfile.TemporaryDirectory(prefix="woodcam-occt-") as folder:
+    with _OCCT_MESSAGES_LOCK, tempfile.TemporaryDirectory(prefix="woodcam-occt-") as folder:
         log = os.path.join(folder, "occt.log")
         printers = list(messenger.Printers())
         printer = Message_PrinterOStream(log, False, Message_Gravity.Message_Warning)
