@@ -284,6 +284,19 @@ def test_a_part_in_inches_gets_each_commands_own_fix(tmp_path, capsys, monkeypat
     err = capsys.readouterr().err
     assert "if it was modelled in inches scale the part file by 25.4 in your CAD program" in err
     assert "--place" not in err
+    # a script's lengths, and a STEP file's, are not 'STL, OBJ and PLY': each says its own
+    script = tmp_path / "tray_inches.py"
+    script.write_text("import trimesh\npart = trimesh.creation.box((3.0, 2.0, 0.5))"
+                      ".apply_translation((50, 40, 25))\n")
+    assert main(["place", str(script), "--block", "builtin:knotty", "--candidates", "8", "--top", "1",
+                 "--out", str(tmp_path / "place")]) == 0
+    err = capsys.readouterr().err
+    assert "Lengths in a part script or a build123d/cadquery shape carry no units" in err, err
+    assert "STL" not in err and "or write its lengths in mm" in err, err
+    assert main(["bake", str(script), "--block", "builtin:knotty", "--out", str(tmp_path / "t.glb"),
+                 "--texels-per-mm", "2", "--no-obj"]) == 0
+    err = capsys.readouterr().err
+    assert "Lengths in a part script" in err and "STL" not in err, err
 
 
 def test_place_says_a_broken_part_before_opening_the_block(tmp_path, capsys, monkeypatch):

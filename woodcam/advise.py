@@ -183,7 +183,8 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
     source : str, Path or None
         The part as the user gave it (``woodcam place``: the PART path as typed), when ``part``
         is already loaded: the error of a part that fits nowhere names it (else it says
-        ``advise_placement: the part``).
+        ``advise_placement: the part``), and the warning of a part in inches says what its
+        kind carries (:func:`woodcam.cad.carve.units_note`).
     units_fix : str
         How to scale the part, in the warning of a part in inches
         (:func:`woodcam.cad.carve.units_hint`; ``woodcam place`` names the CAD program).
@@ -204,7 +205,7 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
     centre = (lo + hi) / 2
     from .cad.carve import units_hint
 
-    hint = units_hint(lo, hi, stock.size_mm, units_fix)
+    hint = units_hint(lo, hi, stock.size_mm, units_fix, source=part if source is None else source)
     if hint:  # ranking a speck's placements is no answer for a part exported in inches
         import warnings
 

@@ -206,7 +206,7 @@ def preview_part(source: object, stock: Stock | Callable[[], Stock], out_glb: Pa
             part, matrix = place_part(part, list(place), stock.size_mm, as_typed=place_as_typed)
             metadata = {"placement": {"ops": list(place), "matrix": matrix.tolist()}}
         with result.stage("carve"):
-            carved = carve(part, stock.size_mm, units_fix=units_fix)
+            carved = carve(part, stock.size_mm, units_fix=units_fix, source=source)
         result.warnings += list(carved.warnings)
         return preview_mesh(carved.mesh, stock, out_glb, texels_per_mm=texels_per_mm, obj=obj,
                             part_report=True,

@@ -75,6 +75,25 @@ def test_a_part_in_metres_too_small_to_carve_says_its_size_and_how_to_scale_it()
         carve(part, DEMO_BLOCK_MM, units_fix="add scale:1000")
 
 
+@pytest.mark.parametrize("source, says", [
+    ("tray.step", "A STEP file names its units and is converted from them to millimetres, so it was saved "
+     "this small"),
+    ("tray.py", "Lengths in a part script or a build123d/cadquery shape carry no units and are read as "
+     "millimetres"),
+    ("tray.stl", "Part files are read as millimetres (STL, OBJ and PLY carry no units)"),
+    (None, "Part files are read as millimetres (STL, OBJ and PLY carry no units)"),
+])
+def test_the_inch_warning_says_what_the_parts_source_carries(source, says):
+    """The warning of a part in inches said '(STL, OBJ and PLY carry no units)' of a STEP part
+    (which carries its units) and of a .py script too: its note is true of the part's source."""
+    tray = manifold3d.Manifold.cube((90, 70, 18)).translate((5, 5, 2)).scale([1 / 25.4] * 3)
+    with pytest.warns(WoodcamWarning, match="25.4 times larger it would still fit") as caught:
+        carve(tray, DEMO_BLOCK_MM, source=source)
+    (message,) = [str(w.message) for w in caught]
+    assert says in message, message
+    assert ("carry no units" in message) == (source != "tray.step"), message
+
+
 def test_a_part_in_inches_read_as_mm_says_how_to_scale_it():
     """An STL carries no units: a 90 x 70 x 18 mm tray exported in inches is read as a
     3.5 x 2.8 x 0.7 mm speck, which was carved and reported ('0 mm^3') without a word."""

@@ -23,7 +23,7 @@ from ..errors import WoodcamError, WoodcamWarning
 from ..frames import FOREIGN_GLTF_METRES_BELOW, check_size
 from ..tolerances import OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG
 from ..units import MM_PER_UNIT, message_units, said, say_length, say_volume
-from .parts import load_part
+from .parts import SCRIPT_SUFFIXES, STEP_SUFFIXES, load_part
 
 
 @dataclass(frozen=True)
@@ -72,6 +72,7 @@ def carve(
     tolerance_mm: float | None = None,
     angular_tolerance_deg: float = TESSELLATION_ANGLE_DEG,
     units_fix: str = UNITS_FIX,
+    source: Any = None,
 ) -> CarveResult:
     """Carve ``part`` out of the block ``[0, W] x [0, D] x [0, H]`` (block frame, mm).
 
@@ -87,6 +88,9 @@ def carve(
     units_fix : str
         How to scale the part, in the warning of a part in inches (:func:`units_hint`; default
         for a library caller: ``place_part`` ops).
+    source : any source :func:`load_part` takes, or None
+        What ``part`` was loaded from (a path, a build123d object), when ``part`` is already
+        loaded: it words the units note (:func:`units_note`). None: ``part`` itself.
 
     Returns
     -------
@@ -110,6 +114,7 @@ def carve(
     import manifold3d
 
     size = tuple(float(v) for v in check_size(size_mm))
+    why, redo = units_note(part if source is None else source)
     # load_part also validates a Manifold (status, emptiness, orientation) without copying it
     solid = load_part(part, tolerance_mm=tolerance_mm, angular_tolerance_deg=angular_tolerance_deg)
 
@@ -125,8 +130,8 @@ def carve(
         with message_units("mm"):  # the file's own numbers, read as mm whatever --units says
             raise WoodcamError(
                 f"the part's volume is {say_volume(part_volume, '.3g')} (it measures "
-                f"{say_length(extent, '.3g')}), too small to carve; check its units: part files are read as "
-                f"millimetres (STL, OBJ and PLY carry no units), so a part modelled in metres would be "
+                f"{say_length(extent, '.3g')}), too small to carve; check its units: {why}, so a part "
+                f"modelled in metres would be "
                 f"{say_length(extent * 1e3, '.3g')}, in inches {say_length(extent * MM_PER_UNIT['inch'], '.3g')}: "
                 f"{units_fix}")
     if carved.is_empty() or volume <= OUTSIDE_VOLUME_EPS_MM3:
@@ -151,7 +156,7 @@ def carve(
         ))
         messages.append(message)
         warnings.warn(message, WoodcamWarning, stacklevel=2)
-    message = units_hint(*_bounds(solid), size, units_fix)
+    message = units_hint(*_bounds(solid), size, units_fix, source=part if source is None else source)
     if message:
         messages.append(message)
         warnings.warn(message, WoodcamWarning, stacklevel=2)
@@ -168,7 +173,32 @@ def carve(
     )
 
 
-def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX) -> str | None:
+def units_note(source: Any) -> tuple[str, str]:
+    """``(why, redo)``: why a part from ``source`` (a path, or an object :func:`load_part`
+    takes) is read as millimetres, and how to save it right, true of its kind: the inch
+    warning said 'STL, OBJ and PLY carry no units' of a STEP file (which carries its units,
+    converted to mm) and of a build123d script."""
+    from pathlib import Path
+
+    if isinstance(source, (str, Path)):
+        suffix = Path(source).suffix.lower()
+        kind = "step" if suffix in STEP_SUFFIXES else "script" if suffix in SCRIPT_SUFFIXES else "mesh"
+    else:
+        module = type(source).__module__ or ""
+        kind = "script" if module.startswith(("build123d", "cadquery", "OCP")) else "mesh"
+    if kind == "step":
+        return ("a STEP file names its units and is converted from them to millimetres, so it "
+                "was saved this small (as one drawn in inches under a millimetre setting is)",
+                "re-export it with its units set to inches")
+    if kind == "script":
+        return ("lengths in a part script or a build123d/cadquery shape carry no units and are read "
+                "as millimetres",
+                "write its lengths in mm")
+    return "part files are read as millimetres (STL, OBJ and PLY carry no units)", "export it in mm"
+
+
+def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX, *,
+               source: Any = None) -> str | None:
     """What to say when a part with bounds ``lo, hi (3,)`` mm would still fit the block
     ``size_mm (3,)`` 25.4 times larger (None otherwise): STL, OBJ and PLY carry no units, so a part
     exported in inches is read 25.4 x too small and carved or placed as a speck. Its lengths
@@ -181,14 +211,16 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX) -> str |
 
     fix : how the caller's user scales the part by 25.4 (or, without a block, by 1000: the
         command's option, or the library call); the CLI's ``--place`` is no use to
-        ``woodcam place`` or a library caller."""
+        ``woodcam place`` or a library caller.
+    source : what the part was loaded from (a path, an object), for :func:`units_note`; None:
+        a mesh."""
+    why, redo = units_note(source)
     extent = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
     with message_units("mm"):  # about the file's own numbers, read as mm whatever --units says
         if size_mm is None:
             if not 0 < float(np.max(extent)) < FOREIGN_GLTF_METRES_BELOW:
                 return None
-            return (f"the part is only {say_length(extent, '.3g')}: part files are read "
-                    f"as millimetres (STL, OBJ and PLY carry no units), and nothing that small is carved; "
+            return (f"the part is only {say_length(extent, '.3g')}: {why}, and nothing that small is carved; "
                     f"it looks modelled in metres (1000 times larger: "
                     f"{say_length(extent * 1e3, '.3g')}): {fix}")
         size = np.asarray(size_mm, dtype=float)
@@ -196,8 +228,7 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX) -> str |
             return None
         return (f"the part is only {say_length(extent, '.3g')} in the "
                 f"{say_length(size, 'g')} block: 25.4 times larger it would still fit. "
-                "Part files are read as millimetres (STL, OBJ and PLY carry no units); if it was modelled "
-                f"in inches {fix}, or export it in mm")
+                f"{why[0].upper()}{why[1:]}; if it was modelled in inches {fix}, or {redo}")
 
 
 def _bounds(solid) -> tuple[np.ndarray, np.ndarray]:

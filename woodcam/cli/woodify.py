@@ -243,7 +243,7 @@ def _warn_units(mesh, path: str, what: str = "part") -> None:
 
     lo, hi = mesh.bounds
     hint = units_hint(lo, hi, None, "scale it by 1000 in your CAD program or export it in "
-                      "mm (--units converts only the lengths typed as options, never the mesh)")
+                      "mm (--units converts only the lengths typed as options, never the mesh)", source=path)
     if hint:
         warnings.warn(f"{what} {path!r}: {hint}", WoodcamWarning, stacklevel=3)
 
