@@ -243,7 +243,7 @@ def test_bake_draws_one_stage_bar_over_the_whole_run(tmp_path, bars, capsys):
                  "--no-obj", "--texels-per-mm", "1", "--screenshot"]) == 0
     stage = [b for b in bars if b.unit == "stage"]
     assert len(stage) == 1 and stage[0].desc == "bake b" and stage[0].enabled
-    plan = ["open block", "load", "carve", "bake", "report", "export", "render"]
+    plan = ["load", "open block", "carve", "bake", "report", "export", "render"]  # the part before the block
     assert stage[0].total == len(plan) and stage[0].n == len(plan) and stage[0].closed
     assert [d.split(": ")[-1] for d in stage[0].shown[1:-1]] == plan
 

@@ -165,8 +165,8 @@ def test_place_in_inches_ranks_what_the_mm_run_ranks_and_prints_inches(tmp_path,
     # sweep h5 item 7: a bar over the whole run (opening the block, loading the part: seconds)
     (run,) = [b for b in bars if b.desc == "place"]
     assert run.total == run.n == 4 and run.closed and run.enabled
-    assert [d.split(": ")[-1] for d in run.shown[1:-1]] == ["open block", "load part", "score placements",
-                                                            "render"]
+    assert [d.split(": ")[-1] for d in run.shown[1:-1]] == ["load part", "open block", "score placements",
+                                                            "render"]  # the part first (c58d41e)
     assert main([*common, "--block", "builtin:knotty:101.6x76.2x50.8", "--margin", "1.27",
                  "--out", str(tmp_path / "mm")]) == 0
     out_mm = capsys.readouterr().out
@@ -278,7 +278,7 @@ def test_library_messages_of_an_inch_run_speak_inches(tmp_path, monkeypatch, cap
     assert main(["place", str(big), "--units", "inch", "--block", "builtin:knotty:4x3x2",
                  "--out", str(tmp_path / "pl")]) == 1
     err = capsys.readouterr().err
-    assert "the part (9.449x0.7087x0.3937 in) fits the 4x3x2 in block" in err, err
+    assert f"part {str(big)!r} (9.449x0.7087x0.3937 in) fits the 4x3x2 in block" in err, err
     assert "with a 0.03937 in margin" in err and " mm" not in err, err
     with pytest.raises(WoodcamError, match=r"\(240.0x18.0x10.0 mm\) fits the 101.6x76.2x50.8 mm "
                        r"block .* with a 1 mm margin"):  # the library's callers: mm, as before
