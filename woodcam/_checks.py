@@ -39,7 +39,7 @@ def did_you_mean(given: str | Iterable[str], names: Iterable[str], *, n: int = 1
 
 
 def _fail(name: str, rule: str, value, fix: str):
-    raise WoodcamError(f"{name} must be {rule}; got {value!r}" + (f"; {fix}" if fix else ""))
+    raise WoodcamError(f"{name} must be {rule}; got {received(value)}" + (f"; {fix}" if fix else ""))
 
 
 def _real(x) -> bool:

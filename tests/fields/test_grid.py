@@ -3,10 +3,12 @@
 import numpy as np
 import pytest
 
+from woodcam._checks import check_rotation
 from woodcam.errors import WoodcamError
 from woodcam.fields import arf
 from woodcam.fields.builtin import BUILTIN_NAMES, builtin_block
 from woodcam.fields.grid import GridField
+from woodcam.fields.radial import RadiusFunction
 
 
 def test_cubic_grid_reproduces_quadratic_exactly(rng):
@@ -129,3 +131,28 @@ def test_a_point_far_outside_the_grid_reads_the_border(interpolation):
             assert np.array_equal(g.layer("knot", pts), g.layer("knot", border))
             assert np.array_equal(wf(pts), wf(border))
     assert np.isfinite(g(border)).all() and np.isfinite(wf(border)).all()
+
+
+@pytest.mark.parametrize("make, match", [
+    (lambda: GridField(np.ones((40, 40, 40)) * (1 + 1j), (0, 0, 0), 1.0),
+     r"years must be .*; got an array of complex numbers \(dtype complex128, shape \(40, 40, 40\)\); "
+     r"pass real numbers \(e\.g\. np\.real\(years\)"),
+    (lambda: GridField(np.ones((4, 4, 4)), (0, 0, 0), 1.0, layers={"knot": np.ones((4, 4, 4)) * 1j}),
+     r"layer 'knot' must be a finite grid of real numbers .*; got an array of complex numbers "
+     r"\(dtype complex128, shape \(4, 4, 4\)\)"),
+    (lambda: GridField(np.ones((4, 4, 4)), np.zeros(1000), 1.0),
+     r"origin_mm must be three finite numbers .*; got an array of numbers \(dtype float64, shape \(1000,\)\)"),
+    (lambda: GridField(np.ones((4, 4, 4)), (0, 0, 0), 1.0, axis=np.zeros((50, 50))),
+     r"axis must be three finite numbers .*; got an array of numbers \(dtype float64, shape \(50, 50\)\)"),
+    (lambda: check_rotation(np.zeros((100, 3, 3)), "rotation"),
+     r"rotation must be a proper 3x3 rotation matrix .*; got an array of numbers \(dtype float64, shape \(100, 3, 3\)\)"),
+    (lambda: RadiusFunction.from_constraints(-np.ones(500)),
+     r"values must be positive finite radius scalings; got an array of numbers \(dtype float64, shape \(500,\)\)"),
+], ids=["complex years", "complex layer", "origin of 1000", "axis 50x50", "rotation of 100", "radius values"])
+def test_an_array_argument_refused_is_quoted_briefly(make, match):
+    """A refused array was quoted whole (its repr) or as its first 80 characters ("got
+    array([[[1.+1.j, 1.+1.j, ..."): now its kind, dtype and shape (_checks.received), and
+    complex years are told how to pass real ones."""
+    with pytest.raises(WoodcamError, match=match) as err:
+        make()
+    assert len(str(err.value)) < 300 and "array(" not in str(err.value)

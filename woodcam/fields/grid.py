@@ -18,7 +18,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._checks import as_floats, check_number, check_vector, npz_path
+from .._checks import as_floats, check_number, check_vector, npz_path, numbers_fix, received
 from .._readers import read_npz
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
@@ -97,9 +97,11 @@ class GridField:
     def __post_init__(self):
         g = as_floats(self.years)  # a string was numpy's bare "could not convert string to float"
         if g is None or g.ndim != 3 or min(g.shape) < 2 or not np.all(np.isfinite(g)):
-            got = f"{self.years!r:.80}" if g is None else f"shape {g.shape}" + (
+            got = received(self.years) if g is None else f"shape {g.shape}" + (
                 "" if g.ndim != 3 or np.all(np.isfinite(g)) else f" with {int(np.sum(~np.isfinite(g)))} non-finite")
-            raise WoodcamError(f"years must be a finite (nx, ny, nz) grid, each >= 2; got {got}")
+            fix = (numbers_fix(self.years, "years") if g is None else "") or \
+                "e.g. years=np.zeros((4, 4, 4)), a real growth time at each node"
+            raise WoodcamError(f"years must be a finite (nx, ny, nz) grid of real numbers, each >= 2; got {got}; {fix}")
         if not isinstance(self.layers, Mapping):  # a list was dict()'s bare TypeError
             raise WoodcamError(f"layers must be a dict {{name: grid shaped like years}}; got "
                                f"{type(self.layers).__name__}; e.g. layers={{'uncertainty': grid}} or leave it out")
@@ -119,10 +121,12 @@ class GridField:
         object.__setattr__(self, "axis", tuple(float(x) for x in axis))
         layers = {}
         for name, v in dict(self.layers).items():
-            u = np.asarray(v, dtype=float)
-            if u.shape != g.shape or not np.all(np.isfinite(u)):
-                raise WoodcamError(f"layer {name!r} must be a finite grid shaped like years {g.shape}; "
-                                   f"got shape {u.shape}")
+            u = as_floats(v)  # complex was numpy's ComplexWarning, text its bare ValueError
+            if u is None or u.shape != g.shape or not np.all(np.isfinite(u)):
+                got = received(v) if u is None else f"shape {u.shape}" + (
+                    "" if u.shape != g.shape else f" with {int(np.sum(~np.isfinite(u)))} non-finite")
+                raise WoodcamError(f"layer {name!r} must be a finite grid of real numbers shaped like years "
+                                   f"{g.shape}; got {got}; pass one value per node of years")
             layers[str(name)] = u
         object.__setattr__(self, "layers", layers)
         order = _ORDER[self.interpolation]

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from .._checks import check_number
+from .._checks import check_number, received
 from .._types import ArrayLike
 from ..errors import WoodcamError
 from ..tolerances import MIN_RADIUS_SCALE
@@ -84,7 +84,7 @@ class RadiusFunction:
         """
         c = np.asarray(values, dtype=float).ravel()
         if len(c) < 1 or np.any(~np.isfinite(c)) or np.any(c <= 0):
-            raise WoodcamError(f"values must be positive finite radius scalings; got {values!r}")
+            raise WoodcamError(f"values must be positive finite radius scalings; got {received(values)}")
         return cls(laplacian_smoother(len(c), m) @ c)
 
     @classmethod

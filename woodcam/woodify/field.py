@@ -57,7 +57,7 @@ def _block_size(value) -> np.ndarray:
     rule of the constructor and :meth:`WoodifiedField.placed`."""
     size = as_floats(value)
     if size is None or size.shape != (3,) or not np.all(np.isfinite(size)) or np.any(size <= 0):
-        raise WoodcamError(f"block_size_mm must be three finite sizes > 0 (W, D, H mm); got {value!r}")
+        raise WoodcamError(f"block_size_mm must be three finite sizes > 0 (W, D, H mm); got {received(value)}")
     return size
 
 
