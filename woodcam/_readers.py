@@ -18,6 +18,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+from ._checks import check_path
 from .errors import WoodcamError
 
 __all__ = ["photo_rgb8", "read_image_file", "read_image_file_opacity", "read_json_file", "read_json_object", "read_npz", "read_photo_rgb",
@@ -62,7 +63,9 @@ def read_npz(path, what: str, fix: str = "") -> Iterator[Any]:
     (``KeyError``, ``ValueError``, ``TypeError``) is a WoodcamError: ``PATH: not WHAT: why; FIX``.
     ``what`` names the kind of file and its rule, ``fix`` how to write it again. A truncated
     archive was numpy's ``BadZipFile`` (an internal error), a text file its "pickled data"
-    message."""
+    message. ``path`` None or a number is refused as the argument ``path`` (it was read as the
+    file ``None``: "None: not a woodcam grid field ...: expected str, bytes or os.PathLike")."""
+    path = check_path(path, "path", fix=f"pass the path of {what}")
     try:
         with open(path, "rb") as fh:  # our own handle: np.load leaks it when the zip is truncated
             if not zipfile.is_zipfile(fh):

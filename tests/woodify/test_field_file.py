@@ -10,6 +10,7 @@ import trimesh
 
 from woodcam.cli import main
 from woodcam.errors import WoodcamError
+from woodcam.fields.grid import GridField
 from woodcam.woodify import WoodifiedField
 from woodcam.woodify.speed import GrowthSpeed
 
@@ -79,3 +80,31 @@ def test_to_block_is_the_inverse_of_to_object_for_a_turned_block():
     np.testing.assert_allclose(f.to_object(f.to_block(p)), p, atol=1e-12)
     np.testing.assert_allclose(f.to_block(f.to_object(p)), p, atol=1e-12)
     np.testing.assert_allclose(f.to_block(f.block_origin_mm[None]), 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("load", [WoodifiedField.load, GridField.load],
+                         ids=["woodify field", "grid field"])
+@pytest.mark.parametrize("path", [None, 3])
+def test_load_refuses_a_path_that_is_not_one_naming_the_argument(load, path):
+    """GridField.load(None) was "None: not a woodcam grid field ...: expected str, bytes or
+    os.PathLike object, not NoneType" (None taken as a file name), WoodifiedField.load(None)
+    Path()'s bare TypeError."""
+    with pytest.raises(WoodcamError, match=rf"^path must be a file path \(str or pathlib\.Path\); got {path}; "
+                                           r"pass the path of .*\.npz"):
+        load(path)
+
+
+@pytest.mark.parametrize("d, match", [
+    (None, r"got None"), ([1, 2], r"got \[1, 2\]"),
+    ({"velocity_mm": 10}, r"got a dict without time_scale_years, shape, eccentricity, up"),
+])
+def test_growth_speed_from_dict_refuses_anything_but_its_dict(d, match):
+    """GrowthSpeed.from_dict(None) was a bare TypeError ("'NoneType' object is not
+    subscriptable"), a missing key a bare KeyError; '10' was read as 10.0 by float()."""
+    with pytest.raises(WoodcamError, match=r"^d must be a growth speed dict with keys velocity_mm, time_scale_years, "
+                                           r"shape, eccentricity, up \(GrowthSpeed\.to_dict\(\)\); " + match + "; e.g. {"):
+        GrowthSpeed.from_dict(d)
+    good = GrowthSpeed(10, 5, 1.5, 0.2).to_dict()
+    with pytest.raises(WoodcamError, match=r"velocity_mm must be a number; got '10'"):
+        GrowthSpeed.from_dict({**good, "velocity_mm": "10"})
+    assert GrowthSpeed.from_dict(good) == GrowthSpeed(10, 5, 1.5, 0.2)

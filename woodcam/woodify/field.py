@@ -37,7 +37,8 @@ from numpy.typing import ArrayLike
 from scipy import ndimage
 
 from .._atomic import atomic_write
-from .._checks import as_floats, check_bool, check_number, check_rotation, check_vector, npz_path, received
+from .._checks import (as_floats, check_bool, check_number, check_path, check_rotation, check_vector, npz_path,
+                       received)
 from .._readers import read_npz
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, check_points
@@ -241,7 +242,7 @@ class WoodifiedField:
     @classmethod
     def load(cls, path, interpolation: Interpolation = "linear") -> WoodifiedField:
         """Read a ``field.npz`` written by :meth:`save`."""
-        path = Path(path)
+        path = check_path(path, "path", fix="pass the path of the field.npz 'woodcam woodify MESH --out DIR' wrote")
         if not path.is_file():
             raise WoodcamError(f"woodify field {str(path)!r} does not exist; write one with "
                                "'woodcam woodify MESH --out DIR' (it writes DIR/field.npz)")

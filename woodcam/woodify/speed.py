@@ -25,12 +25,13 @@ with eccentricity its centre moves by ``delta * tau(t)`` along ``up``; it never 
 from __future__ import annotations
 
 import numbers
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._checks import check_vector, real_numbers
+from .._checks import check_vector, real_numbers, received
 from ..errors import WoodcamError
 
 
@@ -137,6 +138,14 @@ class GrowthSpeed:
                 "shape": self.shape, "eccentricity": self.eccentricity, "up": list(self.up)}
 
     @classmethod
-    def from_dict(cls, d: dict) -> GrowthSpeed:
-        return cls(float(d["velocity_mm"]), float(d["time_scale_years"]), float(d["shape"]),
-                   float(d["eccentricity"]), tuple(d["up"]))
+    def from_dict(cls, d: Mapping) -> GrowthSpeed:
+        """The speed :meth:`to_dict` wrote. Anything but a dict of its five keys is refused
+        (None was a bare "'NoneType' object is not subscriptable", a missing key a bare
+        KeyError); each value is checked as the constructor checks it (float() took '20')."""
+        keys = ("velocity_mm", "time_scale_years", "shape", "eccentricity", "up")
+        if not isinstance(d, Mapping) or any(k not in d for k in keys):
+            got = (f"a dict without {', '.join(k for k in keys if k not in d)}" if isinstance(d, Mapping)
+                   else received(d))
+            raise WoodcamError(f"d must be a growth speed dict with keys {', '.join(keys)} (GrowthSpeed.to_dict()); "
+                               f"got {got}; e.g. {cls(20.0, 30.0).to_dict()}")
+        return cls(d["velocity_mm"], d["time_scale_years"], d["shape"], d["eccentricity"], d["up"])
