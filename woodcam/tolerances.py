@@ -672,3 +672,13 @@ DPI_PLACEHOLDERS = (72.0, 96.0)
 #: rounding of PNG pHYs (2835 px/m = 72.009 dpi) and of a JPEG density in dots/cm (28/cm =
 #: 71.12 dpi, 38/cm = 96.52 dpi); a scanner's own settings (75, 100, 150 dpi) are well outside.
 DPI_PLACEHOLDER_TOL = 1.0
+
+#: Largest |coordinate| (mm) of a point a growth field is asked about
+#: (:func:`woodcam.fields.base.check_points`): 1e6 mm = 1 km, 100 times the longest block
+#: (``limits.MAX_BLOCK_SIZE_MM``) and 10 times the farthest ``--start`` or ``--block-centre``,
+#: so no real point comes near it, while the fields' powers of a radius stay finite. Points at
+#: 1e200 mm overflowed there: an analytic field answered inf years, a knotted one numpy's
+#: overflow RuntimeWarning. Not 1e9 mm: a knotted log's time grows with the distance along its
+#: axis (17 s for one point at 1e9 mm, 0.02 s at 1e6). A point that far is a unit or frame
+#: mistake, refused at the door.
+POINT_BOUND_MM = 1e6

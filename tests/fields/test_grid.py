@@ -112,21 +112,26 @@ def test_bake_refuses_a_box_that_is_not_two_corners(lo, hi, match):
 
 
 @pytest.mark.parametrize("interpolation", ["cubic", "linear"])
-def test_a_point_far_outside_the_grid_reads_the_border(interpolation):
+@pytest.mark.parametrize("spacing", [2.0, 1e-14])
+def test_a_point_far_outside_the_grid_reads_the_border(interpolation, spacing):
     """'Points beyond the grid clamp to its border', but scipy's map_coordinates turned grid
     coordinates past 2**63 into garbage: a GridField gave ~1e230 years (memory read elsewhere)
     at x = 1e20 mm, a cubic WoodifiedField 0, and its knot layer likewise. Now every point
-    reads what a point 1e6 mm out reads (the border), and nearer ones are untouched."""
+    reads what a point 1e4 nodes out reads (the border), and nearer ones are untouched. Points
+    beyond POINT_BOUND_MM (1e6 mm) are refused at the door (check_points), so 2**63 nodes out
+    is reached only on a fine grid: 1e6 mm on a 1e-14 mm grid is 1e20 nodes."""
     import woodcam as w
 
     years = np.add.outer(np.add.outer(np.arange(4.0), 2 * np.arange(5.0)), 3 * np.arange(6.0))
-    g = GridField(years, (0, 0, 0), 2.0, interpolation, layers={"knot": years / years.max()})
-    wf = w.WoodifiedField(years, (0, 0, 0), 2.0, w.GrowthSpeed(10, 1), years_final=1.0,
+    g = GridField(years, (0, 0, 0), spacing, interpolation, layers={"knot": years / years.max()})
+    wf = w.WoodifiedField(years, (0, 0, 0), spacing, w.GrowthSpeed(10, 1), years_final=1.0,
                           interpolation=interpolation)
     for sign in (1, -1):
-        border = np.array([[sign * 1e6, 3.0, 5.0], [1.0, sign * 1e6, 5.0], [1.0, 3.0, sign * 1e6]])
-        for far in (1e20, 1e200, 1e300):
-            pts = np.where(np.abs(border) == 1e6, sign * far, border)
+        out = sign * 1e4 * spacing
+        border = np.array([[out, 1.5, 2.5], [0.5, out, 2.5], [0.5, 1.5, out]]) * np.where(
+            np.eye(3, dtype=bool), 1.0, spacing)
+        for far in (1e6, 1e5):
+            pts = np.where(np.eye(3, dtype=bool), sign * far, border)
             assert np.array_equal(g(pts), g(border))
             assert np.array_equal(g.layer("knot", pts), g.layer("knot", border))
             assert np.array_equal(wf(pts), wf(border))
@@ -156,3 +161,19 @@ def test_an_array_argument_refused_is_quoted_briefly(make, match):
     with pytest.raises(WoodcamError, match=match) as err:
         make()
     assert len(str(err.value)) < 300 and "array(" not in str(err.value)
+
+
+@pytest.mark.parametrize("name", BUILTIN_NAMES)
+def test_a_point_beyond_the_physical_bound_is_refused_not_inf_years(name):
+    """A finite point 1e200 mm away overflowed the radius: the analytic blocks answered inf
+    years and the knotty one numpy's overflow RuntimeWarning. check_points refuses coordinates
+    beyond POINT_BOUND_MM (1e6 mm); points up to it give finite years."""
+    from woodcam.tolerances import POINT_BOUND_MM
+
+    field = builtin_block(name).field
+    for far in (1e200, 2 * POINT_BOUND_MM, -1e12):
+        with pytest.raises(WoodcamError, match=r"points_mm must lie within 1e\+06 mm \(1 km\) of the origin on "
+                                               r"each axis; point 1 is \[.*\]; pass block-frame points in mm"):
+            field(np.array([[1.0, 2.0, 3.0], [1.0, far, 3.0]]))
+    near = 0.999 * POINT_BOUND_MM
+    assert np.isfinite(field(np.array([[near, 0, 0], [0, -near, 0], [0, 0, near], [near, near, -near]]))).all()

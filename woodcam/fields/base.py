@@ -21,7 +21,7 @@ import numpy as np
 from .._checks import as_floats, check_number, check_vector, numbers_fix, received
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
-from ..tolerances import MAX_BATCH_POINTS
+from ..tolerances import MAX_BATCH_POINTS, POINT_BOUND_MM
 
 
 @runtime_checkable
@@ -32,7 +32,8 @@ class GrowthField(Protocol):
 
 
 def check_points(points_mm, name: str = "points_mm") -> np.ndarray:
-    """Return ``points_mm`` as a float64 ``(n, 3)`` array or raise a clear error."""
+    """Return ``points_mm`` as a float64 ``(n, 3)`` array of finite points within
+    :data:`~woodcam.tolerances.POINT_BOUND_MM` of the origin, or raise a clear error."""
     p = as_floats(points_mm)
     if p is None:  # a ragged list was a bare ValueError; complex points lost their imaginary
         # parts under numpy's ComplexWarning, text '10' was 10.0 and None a NaN
@@ -43,6 +44,13 @@ def check_points(points_mm, name: str = "points_mm") -> np.ndarray:
     if not np.isfinite(p).all():  # a NaN point was a ZeroDivisionError in a compiled kernel
         bad = int(np.argmin(np.isfinite(p).all(axis=1)))
         raise WoodcamError(f"{name} must be finite; point {bad} is {p[bad].tolist()}")
+    far = np.abs(p) > POINT_BOUND_MM  # its square overflowed in the fields: inf years
+    if far.any():
+        bad = int(np.argmax(far.any(axis=1)))
+        raise WoodcamError(f"{name} must lie within {POINT_BOUND_MM:g} mm ({POINT_BOUND_MM / 1e6:g} km) of the origin on "
+                           "each axis; "
+                           f"point {bad} is {p[bad].tolist()}; pass block-frame points in mm (a unit or frame "
+                           "mistake?)")
     return p
 
 
