@@ -103,7 +103,7 @@ def test_mokume_names_are_read_in_any_case(tmp_path, recwarn):
     case-insensitive file system keeps them so, and opened them by the lower-case name): read on
     a case-sensitive one they were 'must hold Mokume files ... found none', and 'block from-photos'
     read A_COL.PNG as the front's photo but called A_ARL-UNET.PNG 'named for no face'. Now both
-    read the names in any case, at one home (block.io._mokume_kind); two files of one kind whose
+    read the names in any case, at one home (block.io.mokume_kind); two files of one kind whose
     names differ in case only are an error naming them."""
     from woodcam.block.photos import block_from_photos
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -789,3 +790,51 @@ def test_the_default_panel_size_is_said_and_too_little_wood_up_front(scans, caps
     assert _small_run(scans, out, "--no-glb") == 0
     cap = capsys.readouterr()
     assert "panel:" not in cap.out and "cannot cover" not in cap.err, cap
+
+
+def _upper_cased_cn03(shared_data, tmp_path):
+    """A copy of the Mokume sample CN03 with every file name upper-cased (``A_COL.PNG``), as a
+    case-insensitive file system keeps a folder renamed or unpacked so."""
+    import shutil
+
+    src = shared_data / "mokume" / "CN03"
+    if not src.is_dir():
+        pytest.skip(f"Mokume sample CN03 not found under {shared_data}")
+    folder = tmp_path / "CN03"
+    folder.mkdir()
+    for f in src.iterdir():
+        shutil.copyfile(f, folder / f.name.upper())
+    return folder
+
+
+def test_mokume_veneers_read_a_sample_named_upper_case(shared_data, tmp_path):
+    """mokume_veneers globbed '?_col.png' only: an upper-cased CN03 was "holds no face photos",
+    while block folders read the names in any case (block.io.mokume_files, now the one home)."""
+    from woodcam.parquetry.veneers import mokume_veneers
+
+    got = mokume_veneers(_upper_cased_cn03(shared_data, tmp_path))
+    want = mokume_veneers(shared_data / "mokume" / "CN03")
+    assert [v.id for v in got] == [v.id for v in want] == [f"CN03-{x}" for x in "ABCDEF"]
+    assert [Path(v.source).name for v in got] == [f"{x}_COL.PNG" for x in "ABCDEF"]
+    for a, b in zip(got, want):
+        assert a.px_per_mm == b.px_per_mm and np.array_equal(a.rgb, b.rgb)
+
+
+def test_veneer_from_an_upper_case_mokume_folder_is_its_photos(shared_data, tmp_path, monkeypatch):
+    """--veneer-from of an upper-cased Mokume folder was not seen as one (its '?_col.png' glob):
+    it became a block spec, leaves sliced from the sample's fitted block instead of its six
+    photos. Now it is a Mokume folder, as its lower-case original."""
+    import woodcam.parquetry.job as job_module
+
+    folder = _upper_cased_cn03(shared_data, tmp_path)
+    seen = []
+
+    def stop(job, **kw):
+        seen.append((list(job.mokume), list(job.blocks)))
+        raise WoodcamError("stop here")
+
+    monkeypatch.setattr(job_module, "job_veneers", stop)
+    target = tmp_path / "t.png"
+    Image.fromarray(np.full((32, 32, 3), 128, np.uint8)).save(target)
+    assert main(["parquetry", str(target), "--veneer-from", str(folder), "--out", str(tmp_path / "o"), "--quiet"]) != 0
+    assert seen == [([str(folder)], [])]

@@ -405,7 +405,7 @@ def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | No
             warnings.warn(f"--size-mm (size_mm {tuple(size_mm)}) is for Mokume sample folders; {str(folder)!r} "
                           f"records its own size {block.size_mm} mm, which is used", WoodcamWarning, stacklevel=2)
         return block
-    if not any(p.exists() for face in FACES for p in _mokume_files(folder, face).values()):
+    if not any(p.exists() for face in FACES for p in mokume_files(folder, face).values()):
         from .photos import find_face_photos
 
         photos = find_face_photos(folder)
@@ -421,7 +421,7 @@ def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | No
     return read_mokume(folder, MOKUME_DEFAULT_SIZE_MM if size_mm is None else tuple(size_mm))
 
 
-def _mokume_kind(path: Path) -> tuple[str, str] | None:
+def mokume_kind(path: Path) -> tuple[str, str] | None:
     """(face, kind) of a Mokume sample's file ``A_col.png``, ``A_arl-unet.png``, ``A_ann.png`` or
     ``A_knot.png`` (kind ``col`` or one of :data:`MOKUME_MAP_KINDS`), its name in any case: a
     case-insensitive file system (Windows, macOS) keeps ``A_ARL-UNET.PNG`` as renamed or unpacked,
@@ -433,13 +433,13 @@ def _mokume_kind(path: Path) -> tuple[str, str] | None:
     return (face, kind) if face and path.suffix.lower() == ".png" and kind in ("col", *MOKUME_MAP_KINDS) else None
 
 
-def _mokume_files(folder: Path, face: str) -> dict[str, Path]:
+def mokume_files(folder: Path, face: str) -> dict[str, Path]:
     """The files Mokume sample folder ``folder`` holds for ``face``, by kind (``A_col.png`` ...,
-    in any case: :func:`_mokume_kind`); two of one kind (``A_col.png`` and ``A_COL.PNG`` on a
+    in any case: :func:`mokume_kind`); two of one kind (``A_col.png`` and ``A_COL.PNG`` on a
     case-sensitive file system) are a WoodcamError naming them."""
     found: dict[str, list[Path]] = {}
     for p in sorted(folder.iterdir()):
-        got = _mokume_kind(p)
+        got = mokume_kind(p)
         if got and got[0] == face and p.is_file():
             found.setdefault(got[1], []).append(p)
     for kind, paths in found.items():
@@ -488,7 +488,7 @@ def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *
     faces = {}
     for face in FACES:
         letter = MOKUME_LETTER[face]
-        files = _mokume_files(folder, face)
+        files = mokume_files(folder, face)
         if not any(p.exists() for p in files.values()):
             continue
         images = {k: _read_png(p, f"Mokume {k} of face {letter}") for k, p in files.items() if p.exists()}

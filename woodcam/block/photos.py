@@ -113,11 +113,11 @@ def _block_files(folder: Path) -> list[Path]:
 
 def _mokume_map_kind(path: Path) -> str | None:
     """The kind (:data:`~woodcam.block.io.MOKUME_MAP_KINDS`) of a Mokume sample's map or mask
-    ``A_arl-unet.png``, ``A_ann.png``, ``A_knot.png`` (in any case: :func:`~woodcam.block.io._mokume_kind`);
+    ``A_arl-unet.png``, ``A_ann.png``, ``A_knot.png`` (in any case: :func:`~woodcam.block.io.mokume_kind`);
     None for any other file."""
-    from .io import _mokume_kind
+    from .io import mokume_kind
 
-    got = _mokume_kind(path)
+    got = mokume_kind(path)
     return got[1] if got and got[1] != "col" else None
 
 

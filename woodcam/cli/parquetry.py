@@ -424,9 +424,11 @@ def run(args) -> int:
     # the blocks whose leaves this command line sized (--veneer-from, or a job's blocks given
     # leaf options here): leaves past such a block are a wrong command line, exit 2
     sized_here = [b for b in job.blocks if set(given) - {"species"}]
+    from ..block.io import mokume_kind  # a Mokume sample's names in any case, as block folders read them
+
     for spec in args.veneer_from:
         sp = Path(spec)
-        if sp.is_dir() and any(sp.glob("?_col.png")):
+        if sp.is_dir() and any((kind := mokume_kind(p)) and kind[1] == "col" for p in sp.iterdir()):
             job.mokume.append(str(sp))
         else:
             job.blocks.append({"spec": spec, **{k: v for k, v in leaf.items() if v is not None or k == "species"}})

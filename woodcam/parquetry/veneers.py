@@ -261,7 +261,9 @@ def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | 
 
 
 def mokume_veneers(folder: str | Path, size_mm: float = 50.0) -> list[Veneer]:
-    """The face photos ``A_col.png`` .. ``F_col.png`` of a Mokume sample as veneers.
+    """The face photos ``A_col.png`` .. ``F_col.png`` of a Mokume sample as veneers, their names
+    in any case (``A_COL.PNG``; :func:`woodcam.block.io.mokume_files`, the one reader of a
+    Mokume sample's names: only lower-case ones were found here).
 
     The cubes are ``size_mm`` on a side (the dataset does not store it; woodcam's Mokume
     default is 50 mm), so a 256 px photo is ``256 / size_mm`` px/mm.
@@ -269,14 +271,18 @@ def mokume_veneers(folder: str | Path, size_mm: float = 50.0) -> list[Veneer]:
     folder = check_path(folder, "mokume_veneers: folder", fix="a Mokume sample folder such as shared/data/mokume/H11")
     # 0 was a ZeroDivisionError, NaN refused as the veneer's 'px_per_mm'
     size_mm = check_number(size_mm, "size_mm", lo=0, lo_open=True, fix="the cube's side in mm, e.g. 50")
-    files = sorted(folder.glob("?_col.png"))
-    if not files:
+    from ..block.io import mokume_files
+    from ..frames import FACES, MOKUME_LETTER
+
+    photos = {MOKUME_LETTER[face]: files["col"] for face in FACES
+              if "col" in (files := mokume_files(folder, face) if folder.is_dir() else {})}
+    if not photos:
         raise WoodcamError(f"Mokume folder {str(folder)!r} holds no face photos (A_col.png .. "
                            "F_col.png); pass a Mokume sample folder")
     out = []
-    for f in files:
+    for letter, f in sorted(photos.items()):
         rgb = read_image(f, "Mokume photo")
-        out.append(_check(Veneer(f"{folder.name}-{f.name[0]}", rgb, rgb.shape[1] / size_mm,
+        out.append(_check(Veneer(f"{folder.name}-{letter}", rgb, rgb.shape[1] / size_mm,
                                  np.ones(rgb.shape[:2], bool), str(f))))
     return out
 
