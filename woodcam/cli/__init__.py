@@ -74,7 +74,8 @@ examples:
 
 exit status: 0 done; 1 the work failed (a one-line 'woodcam: error: ...' says why); 2 the
 command line is wrong (usage; an input path that is not there, a file where a folder is read
-or the other way round, or a file of a suffix the command cannot read, too); 3 the work was done but a check failed (e.g. gcode --strict);
+or the other way round, or a file of a suffix the command cannot read, too); 3 the work was done \
+but a check failed (e.g. gcode --strict);
 130 interrupted; 141 the pipe it printed to was closed (woodcam blocks | head), quietly, as git
 and ls.
 """
@@ -381,7 +382,8 @@ def _typed_spec(args: argparse.Namespace, err: BaseException) -> str:
         name = next((a.name for a in getattr(args, "_inputs", ()) if a.dest == "block"), "--block")
         if isinstance(block, list):
             typed = typed[block.index(err.spec)] if isinstance(typed, list) else err.spec
-        return f"--block {typed}" if name == "--block" else f"{name} of 'woodcam {_command_name(args)}' (block spec {typed!r})"
+        return (f"--block {typed}" if name == "--block"
+                else f"{name} of 'woodcam {_command_name(args)}' (block spec {typed!r})")
     specs = getattr(args, "veneer_from", None) or []
     if err.spec in specs:  # as typed: in mm once read at the door, as --block
         return f"--veneer-from {as_typed(args, 'veneer_from')[specs.index(err.spec)]}"

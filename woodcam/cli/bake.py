@@ -9,7 +9,8 @@ from pathlib import Path
 
 from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
-from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_input, part_suffixes, add_camera_option, add_out_option, add_units_option,
+from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_input, part_suffixes,
+                      add_camera_option, add_out_option, add_units_option,
                       add_workers_option, allow_negative_values, apply_workers, as_typed, camera_of,
                       not_empty, remove_stale_outputs, stock_options, uses_settings, vector_type, write_screenshot)
 
@@ -216,7 +217,8 @@ def run_preview(args: argparse.Namespace) -> int:
     shot = screenshot_path(args.screenshot, args.mesh)
     if not shot:  # before the block opens (a fit: seconds to minutes) and pyvista loads
         check_display("preview", "render a picture instead with: woodcam preview "
-                      f"{shlex.quote(str(args.mesh))} --screenshot (writes {shlex.quote(str(screenshot_path(True, args.mesh)))})")
+                      f"{shlex.quote(str(args.mesh))} --screenshot "
+                      f"(writes {shlex.quote(str(screenshot_path(True, args.mesh)))})")
     # no cut plane, no wood shown inside: the baked texture and the block's recorded size are
     # all it needs (the block folder it was baked from may be gone, or slow to fit)
     bare = args.no_cut and not args.block and not args.confidence

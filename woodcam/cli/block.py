@@ -28,7 +28,8 @@ def _size_range(text: str) -> tuple[float, float]:
     cap = limit("MAX_BLOCK_SIZE_MM")
     if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi <= cap):
         raise argparse.ArgumentTypeError(f"--size-range-mm takes MIN,MAX in mm with 0 < MIN <= MAX <= "
-                                         f"{cap:g} (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 30,80; got {text!r}")
+                                         f"{cap:g} (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 30,80; "
+                                         f"got {text!r}")
     return lo, hi
 
 

@@ -66,7 +66,8 @@ def run_realistic(args) -> int:
 
     # 'all' is every method, as in eval rings
     methods = comma_names(args.methods, "--methods", METHODS, all_=True) or list(METHODS)
-    warn_evidence_only([o for o, on in (("--no-knot-bend", not args.knot_bend), ("--no-knot-cones", not args.knot_cones),
+    warn_evidence_only([o for o, on in (("--no-knot-bend", not args.knot_bend),
+                                        ("--no-knot-cones", not args.knot_cones),
                                         ("--residual", args.residual), ("--confidence", args.confidence)) if on],
                        methods)
     scenarios = comma_names(args.scenarios, "--scenarios", tuple(SCENARIOS))

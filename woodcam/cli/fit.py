@@ -8,8 +8,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import UsageError
-from .options import (add_input, add_block_argument, add_confidence_option, add_out_option, add_size_option, add_workers_option,
-                      apply_workers, comma_names, command_group, face_names, open_block)
+from .options import (add_input, add_block_argument, add_confidence_option, add_out_option, add_size_option,
+                      add_workers_option, apply_workers, comma_names, command_group, face_names, open_block)
 
 #: Faces used for "partial annotation": three faces meeting at the front-top-left corner, half
 #: of the block's surface (seed 000, section 4.3 traces "half of the block only").

@@ -14,7 +14,8 @@ from pathlib import Path
 from ..errors import UsageError, WoodcamError
 from ..tolerances import IN_BLOCK_RTOL
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
-from .options import (add_input, part_suffixes, output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_camera_option, add_out_option, add_units_option,
+from .options import (add_input, part_suffixes, output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options,
+                      add_camera_option, add_out_option, add_units_option,
                       allow_negative_values, as_typed, camera_of, drop_earlier_output, remove_stale_outputs, sizes_type,
                       stock_options, vector_type)
 

@@ -204,7 +204,8 @@ def add_input(p, *flags: str, kind: InputKind, paths=None, suffixes=None, as_is:
     assert kind in INPUT_KINDS, kind  # a contributor's mistake
     assert suffixes is None or kind == "file", kind  # a folder or block spec has no suffix rule
     assert not as_is or kind == "block", kind  # only a block spec has turns and resizes
-    what = {"file": "a FILE path", "folder": "a FOLDER path", "block": "a block spec such as builtin:flat-sawn or a block folder"}[kind]
+    what = {"file": "a FILE path", "folder": "a FOLDER path",
+            "block": "a block spec such as builtin:flat-sawn or a block folder"}[kind]
     kwargs["type"] = not_empty(kwargs.get("type", str), what)  # '' is no path: Path('') is '.'
     action = p.add_argument(*flags, **kwargs)
     name = next((f for f in action.option_strings if f.startswith("--")), action.dest.upper())
@@ -482,8 +483,9 @@ def _check_folder_can_be_made(folder: Path, command: str, option: str = "--out")
 #: ``(command, option dest)`` -> how the value holds lengths: "number" (float), "vector" (a
 #: tuple of floats), "sizes" (a "WxH" or "WxDxH" of :func:`sizes_type`: its text read again in
 #: every unit, a tuple of mm), "spec" (a block
-#: spec's :WxDxH size and its resizes, read by :func:`woodcam._specs.parse_spec`), "place" (``--place`` operations: translate:X,Y,Z and fit:MARGIN),
-#: "tools" (``--tool`` specs: diameters, corner radii, tips; angles stay degrees). ``--rapid-rate`` reads unit/min. Options whose name carries a unit
+#: spec's :WxDxH size and its resizes, read by :func:`woodcam._specs.parse_spec`), "place" (``--place``
+#: operations: translate:X,Y,Z and fit:MARGIN), "tools" (``--tool`` specs: diameters, corner radii, tips;
+#: angles stay degrees). ``--rapid-rate`` reads unit/min. Options whose name carries a unit
 #: (``--texels-per-mm``, ``--size-mm``) keep it; files stay mm.
 LENGTH_OPTIONS: dict[tuple[str, str], str] = {
     ("bake", "block"): "spec", ("bake", "tolerance"): "number", ("bake", "place"): "place",
@@ -819,7 +821,8 @@ def _cube_side(text: str) -> float:
         what = "" if sides is None else f"{'x'.join(f'{s:g}' for s in sides)} mm is no cube; "
         raise argparse.ArgumentTypeError(
             f"--size-mm sizes a Mokume sample folder, a cube: give its side in mm, one number in (0, "
-            f"{cap:g}] (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 50; got {text!r} ({what}a block folder records its own size)")
+            f"{cap:g}] (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 50; got {text!r} "
+            f"({what}a block folder records its own size)")
     return sides[0]
 
 
@@ -964,9 +967,9 @@ def comma_names(text: str, option: str, choices: tuple[str, ...] = (), *,
                 all_: bool = False) -> list[str] | None:
     """The names of a comma list option (``--methods``, ``--faces`` ...): each non-empty, each
     once and, with ``choices``, each one of them; with ``all_`` the word ``all`` gives None (every
-    name, the command's default). Else a UsageError (exit 2: the command line is wrong) naming ``option``: an empty list or a
-    repeated name was taken as the default, or counted twice, without a word. The one parser of
-    such lists."""
+    name, the command's default). Else a UsageError (exit 2: the command line is wrong) naming
+    ``option``: an empty list or a repeated name was taken as the default, or counted twice,
+    without a word. The one parser of such lists."""
     if all_ and text == "all":
         return None
     names = [t.strip() for t in str(text).split(",")]

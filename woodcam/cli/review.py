@@ -25,7 +25,8 @@ def register(subparsers) -> None:
         "with WebGL 2): the part, orbit/pan/zoom and front/top/iso views, a section plane whose "
         "cut face shows the wood inside the block, two-click measurement in mm, the block's face "
         "photos and the bake report, knot and G-code hotspots; printable as a shop sheet.")
-    add_input(p, "part", kind="file", suffixes=_glb_suffixes, type=Path, help="baked .glb (from woodcam bake or woodcam gcode)")
+    add_input(p, "part", kind="file", suffixes=_glb_suffixes, type=Path,
+              help="baked .glb (from woodcam bake or woodcam gcode)")
     add_input(p, "--block", kind="block", default=None,
                    help=BLOCK_SPEC_HELP + " (default: the one stored in the GLB)")
     add_out_option(p, "one self-contained page", suffixes=(".html",))

@@ -53,7 +53,8 @@ def run(args) -> int:
         # the training faces come from woodcam's own synthesis (synth sits above detect)
         x, y = ring_training_faces(spec, progress=True)
         r = train_ring_net(spec, x, y, args.out, progress=True, member=member)
-        print(f"trained the ring net{'' if member == 'main' else ' member ' + member} ({r['params']} parameters) {r['steps']} steps in {r['train_s']:.0f} s; "
+        print(f"trained the ring net{'' if member == 'main' else ' member ' + member} ({r['params']} parameters) "
+              f"{r['steps']} steps in {r['train_s']:.0f} s; "
               f"final loss {r['final_loss']:.4f}; wrote {args.out}")
         return 0
     if args.member is not None:        # accepted by the parser, no effect on gtf
