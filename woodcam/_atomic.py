@@ -49,9 +49,10 @@ from typing import IO
 from . import _interrupt
 from .errors import WoodcamError, WoodcamWarning
 
-__all__ = ["all_or_nothing", "apart", "atomic_files", "atomic_folder", "atomic_path", "atomic_write", "check_folder_writable",
-           "check_output_path", "in_flight",
-           "listed_outputs", "manifest_path", "remove_stale", "run_outputs", "write_bytes", "write_figure", "write_text"]
+__all__ = ["all_or_nothing", "apart", "atomic_files", "atomic_folder", "atomic_path", "atomic_write",
+           "check_folder_writable", "check_output_path", "in_flight",
+           "listed_outputs", "manifest_path", "remove_stale", "run_outputs", "write_bytes", "write_figure",
+           "write_text"]
 
 
 def _umask() -> int:

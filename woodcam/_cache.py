@@ -35,7 +35,8 @@ from typing import Any, TypeVar
 from ._atomic import apart, atomic_path, in_flight
 from .errors import WoodcamError, WoodcamWarning
 
-__all__ = ["CacheWarning", "cache_dir", "cache_root", "check_cache_root", "digest", "entry_path", "file_lock", "load_or_build"]
+__all__ = ["CacheWarning", "cache_dir", "cache_root", "check_cache_root", "digest", "entry_path", "file_lock",
+           "load_or_build"]
 
 T = TypeVar("T")
 

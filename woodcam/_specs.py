@@ -222,7 +222,8 @@ def _parse_size(text: str, spec: str, mm_per_unit: float, part: SpecPart, part_t
     size = parse_lengths(text, 3, max_mm=cap / mm_per_unit)
     if size is None:
         raise _error(spec, f"the size must be WxDxH in mm, each > 0 and <= {cap:g} "
-                             f"(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N); got {text!r}, e.g. 300x120x40", part=part, text=part_text)
+                             f"(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N); got {text!r}, e.g. 300x120x40",
+                     part=part, text=part_text)
     W, D, H = (v * mm_per_unit for v in size)
     return W, D, H
 

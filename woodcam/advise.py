@@ -261,7 +261,8 @@ def advise_placement(part, stock, *, rotations: str = "z90", candidates: int = 1
             f"{'advise_placement: the part' if source is None else f'part {str(source)!r}'} "
             f"({say_length(hi - lo, '.1f')}) fits the "
             f"{say_length(size, 'g')} block in none of the '{rotations}' "
-            f"orientations with a {say_length(margin_mm, 'g')} margin; {_no_fit_fixes(hi - lo, size, rotations, margin_mm)}")
+            f"orientations with a {say_length(margin_mm, 'g')} margin; "
+            f"{_no_fit_fixes(hi - lo, size, rotations, margin_mm)}")
     ranked.sort(key=lambda p: p.score)
     return PlacementAdvice(ranked, len(ranked), elongation, w)
 
@@ -344,8 +345,9 @@ def part_report(mesh, stock, *, samples: int = 4000, seed: int = 0) -> dict:
     ``knots_surface`` (the knot share of the surface alone, which the warning quotes),
     ``elongation``, and ``regions``: the part cut into :data:`REPORT_REGIONS` slabs along its
     long axis, named by the block's ends along the block axis nearest it (``"left third"``,
-    ``"middle third"``, ``"right third"``; :data:`woodcam.frames.AXIS_ENDS`), each with its mean fibre direction, runout angle (degrees) and knot share (the
-    surface and the wood under it, as ``knots``); plus ``warnings`` in words (short grain,
+    ``"middle third"``, ``"right third"``; :data:`woodcam.frames.AXIS_ENDS`), each with its mean
+    fibre direction, runout angle (degrees) and knot share (the surface and the wood under it, as
+    ``knots``); plus ``warnings`` in words (short grain,
     knots or pith on the surface). Shares are fractions in [0, 1].
     """
     features = _features_of(stock.wood, "part_report", "stock.wood")

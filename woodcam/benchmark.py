@@ -459,7 +459,8 @@ def _plot(s: dict, path: Path) -> Path:
     return path
 
 
-def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, thumbnails: int = 2, progress: bool = True) -> dict:
+def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, thumbnails: int = 2,
+                 progress: bool = True) -> dict:
     """Write ``report.md``, ``report.json`` and ``table1.png`` for a bench run folder into
     ``out_dir``, plus a failure gallery: the cut planes of the ``gallery`` worst blocks (same
     year within 1 mm, over all methods and face sets) and face thumbnails of ``thumbnails``
@@ -689,5 +690,5 @@ def make_training_set_many(spec, out_dir, *, shard_fields: int = TRAINING_SHARD_
 
 
 __all__ = ["DEFAULT_METHODS", "DEFAULT_SETTINGS", "METRICS", "PARTIAL_FACES", "bench_block",
-           "bench_gallery", "bench_report", "bench_settings", "check_benchmark_set_out", "make_bench_block", "run_bench",
-           "make_training_set_many", "summarise_bench", "write_benchmark_set"]
+           "bench_gallery", "bench_report", "bench_settings", "check_benchmark_set_out", "make_bench_block",
+           "run_bench", "make_training_set_many", "summarise_bench", "write_benchmark_set"]

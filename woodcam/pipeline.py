@@ -130,7 +130,8 @@ def _check_flags(obj, screenshot, progress) -> tuple[bool, bool | Path, bool]:
     if isinstance(screenshot, bool) or type(screenshot).__name__ == "bool_":
         screenshot = bool(screenshot)
     else:
-        screenshot = check_path(screenshot, "screenshot", fix="True (a *_view.png beside the GLB), False, or a .png path")
+        screenshot = check_path(screenshot, "screenshot",
+                                fix="True (a *_view.png beside the GLB), False, or a .png path")
     return check_bool(obj, "obj"), screenshot, check_bool(progress, "progress")
 
 

@@ -107,7 +107,8 @@ class Stock:
         # spec that is no text was written into the GLB's metadata, a meta list failed there
         check_size(self.size_mm)
         if not isinstance(self.spec, str):
-            raise WoodcamError(f"Stock: spec must be the block spec text (e.g. 'builtin:flat-sawn'); got {self.spec!r:.60}")
+            raise WoodcamError(f"Stock: spec must be the block spec text (e.g. 'builtin:flat-sawn'); "
+                               f"got {self.spec!r:.60}")
         if not isinstance(self.description, str):
             raise WoodcamError(f"Stock: description must be a string; got {self.description!r:.60}")
         if not isinstance(self.meta, dict):
@@ -622,7 +623,8 @@ def _real_block_stock(spec, block, field, species, appearance, appearance_params
         from .frames import FACE_AXIS
 
         axes = {FACE_AXIS[n] for n, f in block.faces.items() if f.photo is not None}
-        if species is not None and species_given and len(axes) == 3:  # nothing silently dropped: photos set every colour
+        # nothing silently dropped: photos set every colour
+        if species is not None and species_given and len(axes) == 3:
             warnings.warn(f"--species {species}: block {block.name!r} has photos along all three axes, and its "
                           "colours are fitted to them; the species changes nothing here (it colours the axes "
                           "without photos)", WoodcamWarning, stacklevel=2)

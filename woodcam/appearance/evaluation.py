@@ -255,8 +255,9 @@ def summarise(results: list[FaceEval]) -> dict:
                 s[m] = {k: float(np.mean([r.scores[m][k] for r in have])) for k in METRICS}
         for other in ("colormap", "agnostic"):
             both = [r for r in rs if "neural" in r.scores and other in r.scores]
-            s[f"neural_beats_{other}"] = {k: f"{sum(r.scores['neural'][k] < r.scores[other][k] for r in both)}/{len(both)}"
-                                          for k in METRICS}
+            s[f"neural_beats_{other}"] = {
+                k: f"{sum(r.scores['neural'][k] < r.scores[other][k] for r in both)}/{len(both)}"
+                for k in METRICS}
         summary[subset] = s
     return summary
 

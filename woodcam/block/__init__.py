@@ -3,4 +3,5 @@
 from .block import Block, Face, RingTrace
 from .io import block_from_images, read_block, read_block_folder, read_mokume, write_block
 
-__all__ = ["Block", "Face", "RingTrace", "block_from_images", "read_block", "read_block_folder", "read_mokume", "write_block"]
+__all__ = ["Block", "Face", "RingTrace", "block_from_images", "read_block", "read_block_folder", "read_mokume",
+           "write_block"]

@@ -206,7 +206,8 @@ def read_block(folder: PathLike, *, allow_outside: bool | None = None, regenerat
                                   fix="e.g. ['front_ring_map.png'], or () for none"))
     if allow_outside is not None:  # "false" was truthy: files outside the folder were read
         allow_outside = check_bool(allow_outside, "read_block: allow_outside",
-                                   fix="pass True to trust this manifest, False, or None ($WOODCAM_ALLOW_OUTSIDE_PATHS)")
+                                   fix="pass True to trust this manifest, False, or None "
+                                       "($WOODCAM_ALLOW_OUTSIDE_PATHS)")
     if not folder.exists():
         raise WoodcamError(f"block folder {str(folder)!r} does not exist; pass a folder written by "
                            "write_block or 'woodcam block synth/from-photos' (or its block.json)")
@@ -397,7 +398,8 @@ def read_block_folder(folder: PathLike, size_mm: tuple[float, float, float] | No
         folder = folder.parent
     if not folder.is_dir():  # a photo given for its folder was said 'does not exist'
         raise WoodcamError(f"folder must be a block folder (with {MANIFEST}) or a Mokume sample "
-                           f"folder; {str(folder)!r} {'is a file, not a folder' if folder.exists() else 'does not exist'}")
+                           f"folder; {str(folder)!r} "
+                           f"{'is a file, not a folder' if folder.exists() else 'does not exist'}")
     if (folder / MANIFEST).is_file():
         block = read_block(folder, regenerated=regenerated)
         if size_mm is not None and tuple(map(float, size_mm)) != tuple(block.size_mm):

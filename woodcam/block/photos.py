@@ -160,7 +160,8 @@ def unreadable_photos(folder, photos: dict[str, Path]) -> list[Path]:
 def _unreadable_said(paths: list[Path]) -> str:
     """What is wrong with :func:`unreadable_photos` ``paths`` and the fix, for a message."""
     one, faces = len(paths) == 1, sorted({str(_face_of(p)) for p in paths}, key=FACES.index)
-    return (f"{', '.join(p.name for p in paths)} {'is' if one else 'are'} named for face{'s' if len(faces) > 1 else ''} "
+    return (f"{', '.join(p.name for p in paths)} {'is' if one else 'are'} "
+            f"named for face{'s' if len(faces) > 1 else ''} "
             f"{', '.join(faces)} but not in a format woodcam reads ({' '.join(PHOTO_SUFFIXES)}): export "
             f"{'it' if one else 'them'} as JPEG or PNG ({', '.join(f + '.jpg' for f in faces)})")
 
@@ -370,16 +371,19 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
     unnamed = f"{', '.join(stray)} {'is' if len(stray) == 1 else 'are'} named for no face"
     if not photos and _block_files(Path(folder)):  # its front_photo.png ... were 'named for no face: rename'
         raise WoodcamError(
-            f"PHOTOS_DIR {str(folder)!r} is a block folder (block.json, {_block_files(Path(folder))[0].name} ...), not a "
+            f"PHOTOS_DIR {str(folder)!r} is a block folder "
+            f"(block.json, {_block_files(Path(folder))[0].name} ...), not a "
             f"folder of face photos: detect its rings with woodcam rings detect {shlex.quote(str(folder))} --out "
             f"{shlex.quote(str(folder))}, or give the folder of the original photos (front.jpg ...) to make it again")
     if not photos:
-        raise WoodcamError(f"no face photos found in {str(folder)!r}{'; ' + unnamed if stray else ''}: name them front.jpg, top.jpg, "
+        raise WoodcamError(f"no face photos found in {str(folder)!r}{'; ' + unnamed if stray else ''}: "
+                           f"name them front.jpg, top.jpg, "
                            f"left.jpg, bottom.jpg, right.jpg, back.jpg (or A..F, or Mokume A_col.png ...)")
     unreadable = unreadable_photos(folder, photos)
     if missing and not partial:
         raise WoodcamError(f"missing face photos: {', '.join(missing)} (found {', '.join(photos)})"
-                           f"{'; ' + _unreadable_said(unreadable) if unreadable else ''}{'; ' + unnamed if stray else ''}; add "
+                           f"{'; ' + _unreadable_said(unreadable) if unreadable else ''}"
+                           f"{'; ' + unnamed if stray else ''}; add "
                            f"{', '.join(f + '.jpg' for f in missing)} (or Mokume letters "
                            f"{', '.join(MOKUME_LETTER[f] for f in missing)}), or pass --partial")
     if unreadable:  # with --partial: their faces left out
@@ -429,7 +433,8 @@ def block_from_photos(folder, size_mm, *, partial: bool = False, max_px_per_mm: 
         one = len(low) == 1
         warnings.warn(
             f"{'photo of face' if one else 'photos of faces'} {said} {'holds' if one else 'hold'} far less "
-            f"than the other photos' {typical:.2f} px/mm (their median): all faces are stored at one density, {ppm:.2f} px/mm, "
+            f"than the other photos' {typical:.2f} px/mm (their median): all faces are stored at one density, "
+            f"{ppm:.2f} px/mm, "
             f"so the others lose their detail; retake {'it' if one else 'them'} closer or at a higher "
             "resolution", WoodcamWarning, stacklevel=2)
     # a photo brought down to the cap while another lies below it is read again and resampled
@@ -522,7 +527,8 @@ def clear_stale_photos(folder, block: Block, before: dict[str, str]) -> list[str
         if face in block.faces or face not in before or not path.is_file():
             continue
         try:
-            ours = bool(before[face]) and photo_digest(photo_rgb8(_read_png(path, f"photo of face {face!r}"))) == before[face]
+            ours = (bool(before[face])
+                    and photo_digest(photo_rgb8(_read_png(path, f"photo of face {face!r}"))) == before[face])
         except WoodcamError:  # no longer an image: not the one woodcam wrote
             ours = False
         if ours:

@@ -140,7 +140,8 @@ def carve(
             f"part does not intersect the block: the part's bounding box is "
             f"{_fmt_box(lo, hi)} but the block is {_fmt_box(np.zeros(3), np.array(size))} "
             f"(block frame: origin at the bottom-front-left corner); model the part in the block "
-            f"frame, e.g. move it by {say_length(np.array(size) / 2 - (lo + hi) / 2, '.4g', form='({}, {}, {})')} to centre "
+            f"frame, e.g. move it by "
+            f"{say_length(np.array(size) / 2 - (lo + hi) / 2, '.4g', form='({}, {}, {})')} to centre "
             f"it, or give the right block size"
         )
 

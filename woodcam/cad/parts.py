@@ -114,7 +114,8 @@ def load_part(
         The part, modelled in the block frame in millimetres, or a path to a ``.step``/``.stp``,
         ``.stl``, ``.obj``, ``.ply``, ``.off``, ``.glb``/``.gltf`` file or a ``.py`` script defining ``part``
         or passing it to ``show_object`` (CQ-editor's convention: the union of the shown
-        objects, which win over ``part``; a ``part`` not among them is named in a warning) (run with ``runpy`` under the name ``"__woodcam_part__"``, so its
+        objects, which win over ``part``; a ``part`` not among them is named in a warning)
+        (run with ``runpy`` under the name ``"__woodcam_part__"``, so its
         ``if __name__ == "__main__":`` block does not run; its folder is on ``sys.path``
         meanwhile so it can import helpers next to it).
     tolerance_mm : float or None

@@ -775,7 +775,8 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
 
     src, out = Path(src), Path(out)
     if not src.is_dir():  # a photo given for its folder was said 'does not exist'
-        raise WoodcamError(f"block folder {str(src)!r} {'is a file, not a folder' if src.exists() else 'does not exist'}; "
+        raise WoodcamError(f"block folder {str(src)!r} "
+                           f"{'is a file, not a folder' if src.exists() else 'does not exist'}; "
                            f"pass a block folder made by 'woodcam block from-photos' or a Mokume sample folder")
     # the one reader of folders: a folder of the user's own photos (front.jpg ...) was 'must hold a
     # block.json or Mokume files; found neither', no word of 'block from-photos'; it says so now.
@@ -812,7 +813,8 @@ def detect_folder(src, out, *, rule: BoundaryRule = DEFAULT_RULE, knots: bool = 
                 and (folder / f"{n}_traces.svg").is_file()
                 and not ((n, "traces_svg") in named and (folder / named[n, "traces_svg"]).is_file())}
 
-    edited.update({n: src / rel for (n, kind), rel in named_src.items() if kind == "traces_svg" and (src / rel).is_file()})
+    edited.update({n: src / rel for (n, kind), rel in named_src.items()
+                   if kind == "traces_svg" and (src / rel).is_file()})
     edited.update(hand_made_svgs(src, named_src))
     # the files the detector wrote, as the source and --out recorded them (before either is overwritten)
     src_rec = _prior_record(src)
@@ -971,7 +973,8 @@ def _detection_key(block: Block, rule: str) -> str:
 
 
 def _save_detection(value, tmp: Path) -> None:
-    """One ``.npz``: per face its traces (vertices, lengths and ring ids, -1 for none), ring map (uint16) and knot mask."""
+    """One ``.npz``: per face its traces (vertices, lengths and ring ids, -1 for none), ring map
+    (uint16) and knot mask."""
     faces, msgs = value
     arrays = {"warnings": np.array(json.dumps(msgs))}
     for n, f in faces.items():
@@ -1073,5 +1076,5 @@ def with_detected_rings(block: Block, rule: BoundaryRule = DEFAULT_RULE, *, cach
     return out
 
 
-__all__ = ["DEFAULT_DETECTOR", "DETECTORS", "DETECT_VERSION", "Detector", "detect_block", "detect_face", "detect_folder",
-           "needs_detection", "photos_only", "user_edited_faces", "with_detected_rings"]
+__all__ = ["DEFAULT_DETECTOR", "DETECTORS", "DETECT_VERSION", "Detector", "detect_block", "detect_face",
+           "detect_folder", "needs_detection", "photos_only", "user_edited_faces", "with_detected_rings"]

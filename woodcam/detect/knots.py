@@ -8,12 +8,13 @@ Method: the luminance smoothed over :data:`KNOT_SMOOTH_MM` (wider than latewood 
 knot is one blob) is compared with the face's median; pixels darker by
 :data:`KNOT_DARKNESS_MAD` robust deviations (median absolute deviation of the smoothed face) form
 candidate regions; an accepted region's edge is where the smoothed luminance is halfway between
-its dark core (10th percentile) and the face's median. A region is a knot when it is large (:data:`KNOT_MIN_DIAMETER_MM`), compact
-(its fitted ellipse's axis ratio at most :data:`KNOT_MAX_AXIS_RATIO`: latewood bands and dark
-streaks are long and thin), and the rings are disturbed in it: the ring normals found by the
-ring detector point every way there (the knot's own rings circle round its centre), so the
-resultant length of their doubled angles is below :data:`KNOT_MAX_ORIENTATION_ORDER`; a dark
-stain or heartwood patch that the stem's rings run straight through keeps it near 1.
+its dark core (10th percentile) and the face's median. A region is a knot when it is large
+(:data:`KNOT_MIN_DIAMETER_MM`), compact (its fitted ellipse's axis ratio at most
+:data:`KNOT_MAX_AXIS_RATIO`: latewood bands and dark streaks are long and thin), and the rings are
+disturbed in it: the ring normals found by the ring detector point every way there (the knot's own
+rings circle round its centre), so the resultant length of their doubled angles is below
+:data:`KNOT_MAX_ORIENTATION_ORDER`; a dark stain or heartwood patch that the stem's rings run
+straight through keeps it near 1.
 """
 
 from __future__ import annotations

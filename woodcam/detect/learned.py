@@ -116,9 +116,9 @@ class RingNetSpec:
         quilted cubes in turn; ``"quilted-softwood"``: of every five cubes one plain, one
         realistic softwood and three quilted (:func:`cube_style`). The target is the true ring
         boundary on every style.
-    texture_samples : for the quilted styles (:data:`QUILTED_STYLES`) only (refused otherwise): Mokume sample folders whose six
-        face photos are the textures, relative to the shared data folder
-        (``$WOODCAM_SHARED_DATA``), cube ``i`` of the training set painted from sample
+    texture_samples : for the quilted styles (:data:`QUILTED_STYLES`) only (refused otherwise):
+        Mokume sample folders whose six face photos are the textures, relative to the shared data
+        folder (``$WOODCAM_SHARED_DATA``), cube ``i`` of the training set painted from sample
         ``i % len(texture_samples)``. Read when the training faces are made, never at run time.
     """
 
@@ -210,7 +210,8 @@ def _augment(photo: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     a = a * rng.uniform(0.6, 1.3) * rng.uniform(0.85, 1.15, 3)                 # exposure, white balance
     a = (a - a.mean()) * rng.uniform(0.5, 1.5) + a.mean()                       # contrast
     rr, cc = np.meshgrid(np.linspace(-1, 1, h), np.linspace(-1, 1, w), indexing="ij")
-    g = 1 + rng.uniform(-0.25, 0.25) * rr + rng.uniform(-0.25, 0.25) * cc - rng.uniform(0, 0.3) * (rr ** 2 + cc ** 2) / 2
+    g = (1 + rng.uniform(-0.25, 0.25) * rr + rng.uniform(-0.25, 0.25) * cc
+         - rng.uniform(0, 0.3) * (rr ** 2 + cc ** 2) / 2)
     a = a * g[..., None]
     if rng.uniform() < 0.6:                                                     # pores: dark specks
         n = int(rng.uniform(0.002, 0.02) * h * w)
@@ -341,7 +342,8 @@ def _load_ring_net(models_dir, member: str, folder_key: str):
         try:
             spec = RingNetSpec.load(Path(models_dir) / spec_name)
             if member != "main" and spec.style not in QUILTED_STYLES:
-                raise WoodcamError(f"its spec has style {spec.style!r}, not a quilted one ({', '.join(QUILTED_STYLES)})")
+                raise WoodcamError(f"its spec has style {spec.style!r}, "
+                                   f"not a quilted one ({', '.join(QUILTED_STYLES)})")
             net = _net(spec)
             state = torch.load(path, map_location="cpu", weights_only=True)
             _check_state_shapes(net.state_dict(), state)

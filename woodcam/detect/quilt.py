@@ -37,7 +37,8 @@ PROFILE_BINS = 32
 #: Smoothing (px) of the source phase field before its gradient (normal and spacing) is read.
 SOURCE_SMOOTH_PX = 1.5
 #: A source pixel is used when its smoothed phasor keeps this much of the length a clean
-#: phase ramp of its frequency would keep (the phase is locally coherent) and its spacing lies in :data:`SOURCE_SPACING_PX`.
+#: phase ramp of its frequency would keep (the phase is locally coherent) and its spacing lies in
+#: :data:`SOURCE_SPACING_PX`.
 SOURCE_COHERENCE_MIN = 0.8
 SOURCE_SPACING_PX = (4.0, 64.0)
 #: Patch side and stride (px) of the quilt; candidates tried per patch (the best phase
@@ -278,8 +279,10 @@ def quilt_face(years: np.ndarray, source: QuiltSource, rng: np.random.Generator,
         shift = np.mod(y_c - phi_s + 0.5, 1.0) - 0.5
         sr, sc = sr + shift * lam_s * ns[:, 0], sc + shift * lam_s * ns[:, 1]
         scale = lam_s / lam_t
-        qr = sr[:, None, None] + dy * lam_s[:, None, None] * ns[:, 0, None, None] + bt * scale[:, None, None] * ts[:, 0, None, None]
-        qc = sc[:, None, None] + dy * lam_s[:, None, None] * ns[:, 1, None, None] + bt * scale[:, None, None] * ts[:, 1, None, None]
+        qr = (sr[:, None, None] + dy * lam_s[:, None, None] * ns[:, 0, None, None]
+              + bt * scale[:, None, None] * ts[:, 0, None, None])
+        qc = (sc[:, None, None] + dy * lam_s[:, None, None] * ns[:, 1, None, None]
+              + bt * scale[:, None, None] * ts[:, 1, None, None])
         zq = _sample(source.phasor.real, qr, qc) + 1j * _sample(source.phasor.imag, qr, qc)
         agree = np.real(zq * np.conj(target))              # cos of the phase error times |zq|
         score = ((agree * win * inside).sum(axis=(1, 2)) / np.maximum((win * inside).sum(axis=(1, 2)), 1e-9)

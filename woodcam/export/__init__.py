@@ -257,7 +257,8 @@ def export_glb(mesh: Mesh, path: PathLike, metadata: dict | None = None, *,
     from trimesh.exchange.gltf import export_glb as _trimesh_export_glb
 
     _require_textured(mesh, "export_glb")
-    path = check_output_path(check_path(path, "export_glb: path", fix="e.g. 'out/part.glb'"),  # None: Path()'s TypeError
+    # check_path first (None: Path()'s TypeError)
+    path = check_output_path(check_path(path, "export_glb: path", fix="e.g. 'out/part.glb'"),
                              suffixes=(".glb",), what="export_glb: path", mkdir=True)
     payload = {"units": "mm", "frame": "block", "block_to_gltf": BLOCK_TO_GLTF.tolist()}
     if metadata is not None:
@@ -377,7 +378,8 @@ def export_obj(mesh: Mesh, path: PathLike, *, units: ObjUnits = "m", up: ObjUp =
         (``# woodcam: units=m up=y``) so :func:`load_textured` returns the block frame.
     """
     _require_textured(mesh, "export_obj")
-    path = check_output_path(check_path(path, "export_obj: path", fix="e.g. 'out/part.obj'"),  # None: Path()'s TypeError
+    # check_path first (None: Path()'s TypeError)
+    path = check_output_path(check_path(path, "export_obj: path", fix="e.g. 'out/part.obj'"),
                              suffixes=(".obj",), what="export_obj: path", mkdir=True)
     if units not in get_args(ObjUnits):
         raise WoodcamError(f"export_obj: units must be one of {get_args(ObjUnits)}; got {units!r}")

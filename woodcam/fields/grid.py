@@ -225,7 +225,8 @@ class GridField:
         from .._atomic import atomic_write
 
         extra = {f"layer_{k}": v for k, v in self.layers.items()}
-        with atomic_write(path, mkdir=True) as fh:  # a reader never sees half a file; `fit --out new/f.npz` failed after the fit
+        # a reader never sees half a file; `fit --out new/f.npz` failed after the fit
+        with atomic_write(path, mkdir=True) as fh:
             np.savez_compressed(fh, years=self.years, origin_mm=self.origin_mm,
                                 spacing_mm=self.spacing_mm, interpolation=self.interpolation,
                                 axis=self.axis, meta=json.dumps(self.meta), **extra)

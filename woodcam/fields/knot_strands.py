@@ -281,4 +281,5 @@ def strands_from_meta(items) -> list[KnotStrand]:
             for d in items]
 
 
-__all__ = ["DEAD_KNOT_OUTLINE_MM", "DEAD_KNOT_SMOOTHING_FACTOR", "KNOT_SMOOTH_YEARS", "KnotStrand", "StemWithKnots", "strands_from_meta", "strands_to_meta"]
+__all__ = ["DEAD_KNOT_OUTLINE_MM", "DEAD_KNOT_SMOOTHING_FACTOR", "KNOT_SMOOTH_YEARS", "KnotStrand", "StemWithKnots",
+           "strands_from_meta", "strands_to_meta"]

@@ -28,6 +28,6 @@ from .stem import StemField, fit_stem
 __all__ = [
     "CutPlane", "DEFAULT_PLANES", "EvidenceFit", "METHODS", "Method", "RadialField",
     "RingObservations", "StemField", "bake", "benchmark", "evaluate_fit", "evaluate_fits", "fit_block", "fit_evidence",
-    "fit_face_residual", "fit_radial", "fit_rbf", "fit_stem", "gather_observations", "leave_one_face_out", "number_observations",
-    "score_face",
+    "fit_face_residual", "fit_radial", "fit_rbf", "fit_stem", "gather_observations", "leave_one_face_out",
+    "number_observations", "score_face",
 ]

@@ -265,7 +265,8 @@ def evaluate_fits(true_field, fitted: dict, size_mm, planes=DEFAULT_PLANES,
         plane_list = []
     if not plane_list:
         raise WoodcamError(f"planes must be a non-empty list of CutPlanes; got {planes!r:.60}; e.g. "
-                           "[CutPlane('z=0.5', (0.5, 0.5, 0.5), (0, 0, 1))] or leave planes out for the seven of Table 1")
+                           "[CutPlane('z=0.5', (0.5, 0.5, 0.5), (0, 0, 1))] or leave planes out for the seven of "
+                           "Table 1")
     planes = plane_list
     for p in planes:
         if not isinstance(p, CutPlane):

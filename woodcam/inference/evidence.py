@@ -731,7 +731,8 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
                                 fix="the pith-axis basins to try as hypotheses, e.g. n_basins=3"))
     seed = int(check_number(seed, "seed", lo=0, integer=True, fix="same seed, same fit"))
     if workers is not None:
-        workers = int(check_number(workers, "workers", lo=1, integer=True, fix="e.g. workers=2, or None for the default"))
+        workers = int(check_number(workers, "workers", lo=1, integer=True,
+                                   fix="e.g. workers=2, or None for the default"))
     if blend not in BLEND_MODES:
         raise WoodcamError(f"blend must be one of {', '.join(BLEND_MODES)}; got {blend!r}")
     if residual and blend == "everywhere":

@@ -76,11 +76,12 @@ def fit_block(block: Block, method: Method = "evidence", faces: Sequence[str] | 
     ----------
     block : woodcam.block.Block
     method : "evidence" (the default: several hypotheses, radial pith basins, RBF, a radial
-        stem with a residual and the stem model of :mod:`woodcam.inference.stem`, chosen by how well each predicts the faces it was not fitted to;
-        a choice the held-out faces contradict raises a WoodcamWarning and is flagged in
-        ``field.meta``; the baked grid carries the per-point ``uncertainty``, see
-        :mod:`woodcam.inference.evidence`) or "rbf" (seed 000's baseline: thin-plate RBF of labelled ring points; unlabelled rings
-        are numbered by the radial fit first) or "radial"
+        stem with a residual and the stem model of :mod:`woodcam.inference.stem`, chosen by how
+        well each predicts the faces it was not fitted to; a choice the held-out faces
+        contradict raises a WoodcamWarning and is flagged in ``field.meta``; the baked grid
+        carries the per-point ``uncertainty``, see :mod:`woodcam.inference.evidence`) or "rbf"
+        (seed 000's baseline: thin-plate RBF of labelled ring points; unlabelled rings are
+        numbered by the radial fit first) or "radial"
         (ours: pith axis + smooth inverse ring width by least squares; also numbers unlabelled
         traces and ring maps) or "neural" (seed 000's eq. 5: the packaged generic neural GTF,
         latent code and cut-out transform fitted to labelled traces; unlabelled traces and ring

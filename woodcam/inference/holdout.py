@@ -219,7 +219,8 @@ def leave_one_face_out(block: Block, methods: Sequence[str] = ("rbf", "radial"),
     # 'radial' was read letter by letter ("method must be ...; got 'r'"), [] an IndexError at the table
     methods = check_names(methods, "methods", what="method names", known=METHODS)
     if progress is not None and not callable(progress):
-        raise WoodcamError(f"progress must be a callable taking one line of text, or None; got {type(progress).__name__}")
+        raise WoodcamError(f"progress must be a callable taking one line of text, or None; "
+                           f"got {type(progress).__name__}")
     confidence = check_bool(confidence, "confidence")
     if out_dir is not None:  # a file there was a FileExistsError after all the fits
         output_folder(check_path(out_dir, "out_dir"), "leave_one_face_out: out_dir", make=False)

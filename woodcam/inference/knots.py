@@ -59,8 +59,8 @@ from ..fields.knots import KnotParams
 from ..frames import FACE_NORMAL, pixel_to_block
 from ..tolerances import (DEAD_KNOT_BANDS_MM, DEAD_KNOT_MIN_OUTLINED, DEAD_KNOT_SECTORS, KNOT_BEND_MAX_BEFORE_PITH,
                           KNOT_BEND_ROUNDS, KNOT_CONE_EDGE_MM, KNOT_CONE_MAX_NFEV, KNOT_CONE_MIN_RADIUS_MM,
-                          KNOT_CONE_REACH_MM, KNOT_CONE_SAMPLE_MM, KNOT_CONE_START_REUSE_DEG, KNOT_END_MIN_SPAN_RADII, KNOT_END_TOUCH_MM,
-                          KNOT_MIN_AREA_PX, KNOT_MIN_AREA_SHARE,
+                          KNOT_CONE_REACH_MM, KNOT_CONE_SAMPLE_MM, KNOT_CONE_START_REUSE_DEG, KNOT_END_MIN_SPAN_RADII,
+                          KNOT_END_TOUCH_MM, KNOT_MIN_AREA_PX, KNOT_MIN_AREA_SHARE,
                           KNOT_MIN_ENTRY_COS, KNOT_PAIR_MIN_ANGLE_DEG, KNOT_PAIR_MISS_FLOOR_MM, KNOT_PITH_YEARS,
                           KNOT_PAIR_MAX_MISS_SHARE, KNOT_PAIRING_MIN_IOU_GAIN, KNOT_PAIRING_MIN_MISFIT_GAIN,
                           KNOT_RAY_MIN_PITH_MM, KNOT_RAY_MISFIT_CAP_MM, KNOT_RAY_REFIT_POINTS,
@@ -487,7 +487,8 @@ def _strands(exits, stem, size_mm, cones=False, workers=1, rises=None,
             c0, u = cone[0], cone[1]
         tt = (anchors - c0) @ u
         start, dist = c0 + tt.min() * u, float(np.ptp(tt))
-        if dist <= 0 or (single and (cone is None or dist < KNOT_END_MIN_SPAN_RADII * max(cone[2], KNOT_CONE_MIN_RADIUS_MM) or
+        if dist <= 0 or (single and (cone is None or
+                                     dist < KNOT_END_MIN_SPAN_RADII * max(cone[2], KNOT_CONE_MIN_RADIUS_MM) or
                                      abs(u @ axis) > np.cos(np.deg2rad(KNOT_PAIR_MIN_ANGLE_DEG)))):
             return None
         # the line's stem years: a branch grows out of the pith, so it ends where they are least
@@ -724,7 +725,8 @@ def _pairings(exits, stem, size_mm, near: frozenset | None = None, workers: int 
     else:
         alts = []
         for (a, b, _), (c, d, _) in itertools.combinations(base, 2):
-            alts += [frozenset({frozenset((a, c)), frozenset((b, d))}), frozenset({frozenset((a, d)), frozenset((b, c))})]
+            alts += [frozenset({frozenset((a, c)), frozenset((b, d))}),
+                     frozenset({frozenset((a, d)), frozenset((b, c))})]
         paired = {e for q in base for e in q[:2]}
         for a, b, _ in base:
             alts += [frozenset({frozenset((x, e))}) for x in (a, b) for e in info["ends"] if e not in paired]

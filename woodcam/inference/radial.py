@@ -471,7 +471,8 @@ def fit_axis_and_shape(obs: RingObservations, size_mm, K: int, M: int, ridge: fl
     rng = np.random.default_rng(seed)
 
     def take(n):
-        i = np.sort(rng.choice(len(obs.points_mm), n, replace=False)) if len(obs.points_mm) > n else np.arange(len(obs.points_mm))
+        i = (np.sort(rng.choice(len(obs.points_mm), n, replace=False)) if len(obs.points_mm) > n
+             else np.arange(len(obs.points_mm)))
         g = None
         if not labelled:
             _, g = np.unique(obs.group[i], return_inverse=True)
@@ -976,7 +977,8 @@ class _AxisDesign:
 
     def fits(self, obs: RingObservations, field: RadialField) -> bool:
         """Whether this is the system of ``obs`` at ``field``'s axis."""
-        return obs is self.obs and bool(np.array_equal(field.pith_mm, self.pith) and np.array_equal(field.axis, self.axis))
+        return obs is self.obs and bool(np.array_equal(field.pith_mm, self.pith)
+                                        and np.array_equal(field.axis, self.axis))
 
     def linear(self, field: RadialField) -> np.ndarray:
         """``(n,)`` ``field.linear(obs.points_mm)`` with the design at every point built once."""

@@ -370,7 +370,8 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
     if init is not None and not isinstance(init, StemField):
         raise WoodcamError(f"init must be a StemField (an earlier fit_stem) or None; got {type(init).__name__}")
     tilt_prior_deg, curve_prior_mm = (check_number(v, name, lo=0, lo_open=True, fix="a prior's standard deviation")
-                                      for v, name in ((tilt_prior_deg, "tilt_prior_deg"), (curve_prior_mm, "curve_prior_mm")))
+                                      for v, name in ((tilt_prior_deg, "tilt_prior_deg"),
+                                                      (curve_prior_mm, "curve_prior_mm")))
     axes = _base_axes(base_axes) if init is None else []
     n = len(obs.points_mm)
     off = np.zeros(n) if offset_years is None else as_floats(offset_years)

@@ -142,7 +142,8 @@ def export_log_glb(log: GeneratedLog, path, *, surface_alpha: float = 1.0, max_r
     return p
 
 
-def heightmap_image(log: GeneratedLog, mode: Literal["height", "detail"] = "height") -> tuple[np.ndarray, tuple[float, float]]:
+def heightmap_image(log: GeneratedLog,
+                    mode: Literal["height", "detail"] = "height") -> tuple[np.ndarray, tuple[float, float]]:
     """Heightmap as an image array ``(n_l, n_theta)`` in [0, 1] and its range in mm.
 
     Row 0 is the top of the log (``l = length``), so the picture stands like the log; columns

@@ -236,7 +236,8 @@ class GranFitTable:
     def summary(self) -> dict:
         """Mean and SD of the per-knot RMSE, like seed 001 Table 1."""
         e = self.rmse_mm
-        return {"knots": len(e), "rmse_mean_mm": float(e.mean()), "rmse_sd_mm": float(e.std(ddof=1)) if len(e) > 1 else 0.0,
+        return {"knots": len(e), "rmse_mean_mm": float(e.mean()),
+                "rmse_sd_mm": float(e.std(ddof=1)) if len(e) > 1 else 0.0,
                 "rmse_median_mm": float(np.median(e)), "rmse_max_mm": float(e.max())}
 
 

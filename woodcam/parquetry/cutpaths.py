@@ -302,7 +302,8 @@ def svg_document(width_mm: float, height_mm: float, pieces: list[tuple[int, list
     ``engrave`` (piece ids at the centroids)."""
     from shapely.geometry import Polygon
 
-    out = [(f'<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="{width_mm:.3f}mm" height="{height_mm:.3f}mm" '
+    out = [(f'<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" '
+           f'width="{width_mm:.3f}mm" height="{height_mm:.3f}mm" '
            f'viewBox="0 0 {width_mm:.4f} {height_mm:.4f}">'), f"<title>{escape(title)}</title>"]
     if background:
         out.append(background)
@@ -356,7 +357,8 @@ def read_svg_segments(path) -> dict[int, list]:
             segs = []
             for seg in el.segments():
                 if isinstance(seg, svgelements.CubicBezier):
-                    segs.append(("C", *[np.array([q.x, q.y]) for q in (seg.start, seg.control1, seg.control2, seg.end)]))
+                    segs.append(("C", *[np.array([q.x, q.y])
+                                        for q in (seg.start, seg.control1, seg.control2, seg.end)]))
                 elif isinstance(seg, (svgelements.Line, svgelements.Close)) and seg.start != seg.end:
                     segs.append(("L", np.array([seg.start.x, seg.start.y]), np.array([seg.end.x, seg.end.y])))
             out[int(str(el.id).split("-", 1)[1])] = segs

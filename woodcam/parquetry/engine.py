@@ -229,7 +229,8 @@ class _OutOfWood(Exception):
     pass
 
 
-def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer], params: ParquetryParams | None = None, *,
+def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer],
+                    params: ParquetryParams | None = None, *,
                     names: list[str] | None = None, progress: bool = False,
                     seams: bool = True, repair: bool = True) -> ParquetryRun:
     """Rebuild each target from the veneers (seed 002, sec. 3).
@@ -458,7 +459,8 @@ def _say_too_little_wood(panels: list[Parquetry], sheets: list[Veneer], params: 
     kerf = f" and the {say_length(params.kerf, 'g')} kerf round it" if k > 0 else ""
     warnings.warn(
         f"the veneers cannot cover the panel{'s' if len(panels) > 1 else ''} ({sizes}): they hold "
-        f"{say_area(wood_px / px2, '.0f')} of usable wood{' half the kerf in from its edges' if k > 0 else ''}, and the "
+        f"{say_area(wood_px / px2, '.0f')} of usable wood"
+        f"{' half the kerf in from its edges' if k > 0 else ''}, and the "
         f"{sum(p.cells.size for p in panels)} patches of "
         f"{say_length(params.patch_mm, 'g')}, each piece with its {say_length(params.overlap, 'g')} overlap{kerf}, "
         f"every piece of wood used once, take at least {say_area(need_px / px2, '.0f')}, so at most "
@@ -532,7 +534,8 @@ def repair_fabricability(run: ParquetryRun, max_rounds: int = 4) -> dict[int, st
     right-angle corners), so the repair always ends. The straight line lies in every grown
     window it crosses, so the wood under it was matched and is consumed already (single use
     is unchanged); labels, render and baseline are redone. Returns ``{piece id: what was
-    done}`` (also merged into ``run.repaired``); the files written afterwards are checked again by :func:`write_parquetry`.
+    done}`` (also merged into ``run.repaired``); the files written afterwards are checked again
+    by :func:`write_parquetry`.
     """
     from .cutpaths import check_piece, panel_outlines
     from .seams import labels_from_lines, straight_line

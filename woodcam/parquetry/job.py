@@ -72,8 +72,9 @@ class ParquetryParams:
         workload get 16)
     w_struct : weight of the structural term (SSIM's contrast-structure, 7 x 7 windows of the
         target image's own pixels, the wood area-averaged to them) that re-ranks the ``rerank``
-        cheapest distinct free candidates of eq. 4 (woodcam's addition; 0: eq. 4 alone). 0.02 raised SSIM by 0.01-0.02 on the skimage targets at an unchanged
-        feature cost (tests/bench/test_parquetry_bench.py)
+        cheapest distinct free candidates of eq. 4 (woodcam's addition; 0: eq. 4 alone).
+        0.02 raised SSIM by 0.01-0.02 on the skimage targets at an unchanged feature cost
+        (tests/bench/test_parquetry_bench.py)
     flat_detail, flat_rerank : where the target is flat (the share of its 7 x 7 windows on
         its own pixels with a variance below SSIM's C2), the fast coarse search weighs its
         detail-amplitude channel up to ``flat_detail`` times (calm wood is ranked in) and up to
@@ -516,7 +517,8 @@ def write_job(job: ParquetryJob, path: str | Path) -> Path:
     d["sort_patches_saliency"] = job.params.priority == "saliency"
     # "units": its lengths (the *_mm keys, the block specs' :WxDxH and resizes) are mm, said so a
     # replay under --units inch has nothing to warn of
-    d["woodcam"] = {"units": "mm", "params": prm, "blocks": [dict(b, spec=absolute_spec(b["spec"])) for b in job.blocks],
+    d["woodcam"] = {"units": "mm", "params": prm,
+                    "blocks": [dict(b, spec=absolute_spec(b["spec"])) for b in job.blocks],
                     "mokume": [_abs(m) for m in job.mokume]}
     return write_text(path, json.dumps(d, indent=2), mkdir=True)
 
@@ -565,7 +567,8 @@ def check_leaves_in_block(stock, n_sheets: int, width_mm: float | None, height_m
         need = list(size)
         need[right], need[down] = max(size[right], w), max(size[down], h)
         bigger = "x".join(typed_length(v, tol) for v in need)
-        fits = [typed_length(min(v, f), tol, lambda back, f=f: back <= f + tol) for v, f in ((w, face[0]), (h, face[1]))]
+        fits = [typed_length(min(v, f), tol, lambda back, f=f: back <= f + tol)
+                for v, f in ((w, face[0]), (h, face[1]))]
         raise LeavesPastBlockError(
             f"leaves of {say_length((w, h), 'g', sep=' x ')} (--sheet-size; width_mm, height_mm in a job file) "
             f"do not fit {stock.spec}: its {block} block's face normal to {axis} (--slice-axis) is "

@@ -13,10 +13,10 @@ cuts run straight across, so crossings are near-right-angle corners (woodcam's a
 fabricability).
 
 For a router each path is then smoothed (Gaussian, which keeps it inside its band) until its
-radius of curvature is at least the tool radius and half of ``min_piece_mm`` everywhere, and represented by a cubic spline
-through knots every ``_KNOT_PX`` pixels, i.e. exactly by cubic Bézier segments (C1, hence G1).
-Labels are taken from the smooth curves at pixel centres, so the render, the cut files and the
-piece outlines agree.
+radius of curvature is at least the tool radius and half of ``min_piece_mm`` everywhere, and
+represented by a cubic spline through knots every ``_KNOT_PX`` pixels, i.e. exactly by cubic
+Bézier segments (C1, hence G1). Labels are taken from the smooth curves at pixel centres, so the
+render, the cut files and the piece outlines agree.
 """
 
 from __future__ import annotations

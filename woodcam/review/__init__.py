@@ -411,7 +411,8 @@ def _page(data: dict, glb_b64: str, bundle: str) -> str:
  (Wood.color on {data['block']['voxel_mm']:.2f} mm voxels).</p></div>
 <h2 class="ui">Measure</h2><div class="ui"><label><input type="checkbox" id="measure"> two clicks on the
  part</label><div id="measurement"></div></div>
-<h2>Block and bake</h2><table><tr><th>block</th><td>{W:.5g} x {D:.5g} x {H:.5g} mm (x, y, z)</td></tr>{report_rows}</table>
+<h2>Block and bake</h2><table><tr><th>block</th><td>{W:.5g} x {D:.5g} x {H:.5g} mm (x, y, z)</td></tr>\
+{report_rows}</table>
 <h2>Hotspots</h2>{'<ul id="hotspots"></ul>' if data['hotspots'] else '<i id="hotspots">none</i>'}
 <h2>Face photos</h2><div>{photos or '<i>none</i>'}</div>
 <p><button id="print">print shop sheet</button> <span id="status">loading</span></p>

@@ -16,8 +16,9 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``#<_vminor>`` are refused: woodcam cannot know them); read-only ones (``#5400``-``#5413``,
   ``#5420``-``#5428``, the predefined named ones) cannot be assigned, as in
   LinuxCNC, nor can ``#5600``/``#5601`` (LinuxCNC takes the assignment and reads the machine's
-  value over it: the value would be dropped); reading what woodcam cannot know is refused: the tool table's offsets and diameter ``#5401``-``#5413``, and
-  probe (``#5061``-``#5070``) or input (``#5399``) results the program did not assign (in a
+  value over it: the value would be dropped); reading what woodcam cannot know is refused: the
+  tool table's offsets and diameter ``#5401``-``#5413``, and probe (``#5061``-``#5070``) or
+  input (``#5399``) results the program did not assign (in a
   DEBUG/PRINT text a tool-table entry shows as ``[#5403: T1's Z offset, from the machine's
   tool table]``, ``#5410`` as the loaded tool's diameter where ``tool_diameters_mm`` has it,
   every entry as 0 with no tool loaded, before the first M6, as LinuxCNC;
@@ -74,13 +75,15 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   ``G80``, ``G90/G91``, ``G90.1/G91.1``, ``G92/G92.1/G92.2/G92.3``, ``G94``, ``G97``;
   ``M0 M1 M2 M3 M4 M5 M6 M7 M8 M9 M30 M48-M53 M60`` (one of each modal group a line; in
   ``linuxcnc`` M6 stops the spindle, as LinuxCNC's tool change does);
-  ``F S T``, ``E`` (beside ``M66``-``M68``), ``N`` (digits, the first word of a line, before any comment; grbl: anywhere); ``( )``/``;`` comments,
-  ``(msg,...)`` and ``(debug,...)`` (operator messages, the parameters' values put in, as
+  ``F S T``, ``E`` (beside ``M66``-``M68``), ``N`` (digits, the first word of a line, before any
+  comment; grbl: anywhere); ``( )``/``;`` comments, ``(msg,...)`` and ``(debug,...)`` (operator
+  messages, the parameters' values put in, as
   LinuxCNC: :attr:`Interpreter.messages`), ``(print,...)`` (the same, but what LinuxCNC writes
   to its terminal, not its screen: :attr:`Interpreter.printed`; one a pass in a loop, a value
-  woodcam cannot know in it warned once for its line), ``(abort,...)`` (an error, as LinuxCNC), block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line
-  of its own: the first non-blank line opens, the next ends the program; any other ``%`` is an
-  error, as in LinuxCNC).
+  woodcam cannot know in it warned once for its line), ``(abort,...)`` (an error, as LinuxCNC),
+  block delete ``/`` (switch off, as LinuxCNC's default), ``%`` delimiters (a line of its own:
+  the first non-blank line opens, the next ends the program; any other ``%`` is an error, as in
+  LinuxCNC).
 
 Everything else is an error naming the line and the word; what is read but has no effect on the
 cut is silent, what is read and could matter but is not simulated is a warning with its line
@@ -90,8 +93,9 @@ cut is silent, what is read and could matter but is not simulated is a warning w
 Dialects: ``linuxcnc`` (the default) is the reference. ``grbl`` has no parameters, expressions,
 O-words or subprograms (they are errors there, ``O1234`` and ``M98`` too), needs no ``M2``.
 ``fanuc`` starts in ``G0`` and needs no ``M2`` either. ``O1234`` program-number lines and
-``M98``/``M99`` subprograms are read in ``linuxcnc`` and ``fanuc``, as is ``G80`` beside a motion code (Fanuc keeps canned cycles
-in their own group, as in the ``G00 G80 G40 G49`` safety line; LinuxCNC 2.9 accepts it too).
+``M98``/``M99`` subprograms are read in ``linuxcnc`` and ``fanuc``, as is ``G80`` beside a
+motion code (Fanuc keeps canned cycles in their own group, as in the ``G00 G80 G40 G49`` safety
+line; LinuxCNC 2.9 accepts it too).
 
 Output: canonical moves in the G-code frame, millimetres, tool tip: the G54 work frame as the
 machine has it before the program runs (the frame of ``start_mm``). Where the machine's own
@@ -2094,7 +2098,8 @@ class Interpreter:
                 raise self._not_simulated(f"M{v:g}", _M_NOT_SIMULATED[int(v)])
             if v != math.floor(v) or int(v) not in _M_KNOWN:
                 raise self.err(f"M{v:g}", "unsupported M code (woodcam reads M0-M9, M30, "
-                               "M48-M53, M60, M61; M19, M62-M68 and M100-M199 with a warning)", "remove it or post-process for a 3-axis mill")
+                               "M48-M53, M60, M61; M19, M62-M68 and M100-M199 with a warning)",
+                               "remove it or post-process for a 3-axis mill")
             mset.add(int(v))
         for k in ("t", "l", "h"):
             if k in w and (w[k] != math.floor(w[k]) or w[k] < 0 or w[k] > 1e9):

@@ -29,10 +29,10 @@ Moves are processed in vectorised batches: moves whose bounding boxes (in cells)
 padded window are stacked into ``(batch, wy, wx)`` float32 arrays and evaluated at once; each
 move's window is then min-merged into the height field as one slice (``np.minimum(view, env,
 out=view)``: windows of consecutive moves overlap, so a fancy-indexed assignment would lose
-updates, and a slice per move avoids the slower unbuffered ``np.minimum.at``). There is no per-cell Python loop; the per-move
-Python work is that one slice. Batches are formed within runs of the program that share a tool
-and contain no rapid below the stock top, so the rapid check sees the stock as cut by every
-earlier move.
+updates, and a slice per move avoids the slower unbuffered ``np.minimum.at``). There is no
+per-cell Python loop; the per-move Python work is that one slice. Batches are formed within runs
+of the program that share a tool and contain no rapid below the stock top, so the rapid check
+sees the stock as cut by every earlier move.
 """
 
 from __future__ import annotations
@@ -449,9 +449,10 @@ def _rapid_cut(issues, excess, line, depth, first_contact) -> None:
 def _first_contact(tool, a, b, window, j0, i0, dx, dy):
     """The first tip position (block frame, mm, (3,)) along the move ``a -> b`` where ``tool``
     reaches more than SIM_CONTACT_TOL_MM below the stock before the move, sampled every quarter
-    cell, at most 16,385 samples (a longer move more coarsely); the middle of the move when no sample does (a graze between samples). ``window``: the
-    height field's cells ``[j0:j0 + wy, i0:i0 + wx]`` before the move (they hold the move's
-    footprint). Only for the few moves reported as issues."""
+    cell, at most 16,385 samples (a longer move more coarsely); the middle of the move when no
+    sample does (a graze between samples). ``window``: the height field's cells
+    ``[j0:j0 + wy, i0:i0 + wx]`` before the move (they hold the move's footprint). Only for the
+    few moves reported as issues."""
     R = float(tool.radius_mm)
     wy, wx = window.shape
     di = np.arange(-int(np.ceil(R / dx)) - 1, int(np.ceil(R / dx)) + 2)

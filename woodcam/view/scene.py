@@ -132,9 +132,10 @@ def colour_rgb(colour, who: str, name: str = "overlay colour") -> np.ndarray:
     :func:`preview` and nearly black in top_view/stock_view. Refused (WoodcamError naming the
     view, the argument, the rule, the value and a fix): None (no colour, in every view: there is
     no default colour; preview drew pyvista's theme colour, light blue by default, where the
-    numpy views refused it), a name not in the table (with close matches), a float above 1 ((255.0, 0, 0): no guess at which scale was meant), whole numbers
-    of 0 and 1 only with a 1 among them ((1, 0, 0) is nearly black in 0..255 but reads as red in
-    0..1), out of range, not three numbers, a bool.
+    numpy views refused it), a name not in the table (with close matches), a float above 1
+    ((255.0, 0, 0): no guess at which scale was meant), whole numbers of 0 and 1 only with a 1
+    among them ((1, 0, 0) is nearly black in 0..255 but reads as red in 0..1), out of range, not
+    three numbers, a bool.
     """
     if colour is None:
         fix = ("None is no colour (there is no default: a view would have to guess one); give one, "
@@ -705,7 +706,8 @@ class SceneOptions:
                                tuple(check_vector(self.cut_normal, "cut_normal", unit=True)))
         # resolution_mm=0 or NaN and max_samples=0 were taken and reached the section sampler
         object.__setattr__(self, "resolution_mm", check_number(
-            self.resolution_mm, "resolution_mm", lo=0, lo_open=True, fix=f"the cut's sample spacing, e.g. {SECTION_RESOLUTION_MM}"))
+            self.resolution_mm, "resolution_mm", lo=0, lo_open=True,
+            fix=f"the cut's sample spacing, e.g. {SECTION_RESOLUTION_MM}"))
         if self.max_samples is not None:
             object.__setattr__(self, "max_samples", int(check_number(
                 self.max_samples, "max_samples", lo=1, integer=True, fix="a cap on the cut's samples, or None")))

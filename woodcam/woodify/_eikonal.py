@@ -204,9 +204,11 @@ def march(T, state, gain, wind, h, order=2, reopen_tol=1e-3, slack_nodes=1.0):  
         c = lin % nz
         gi = gain[0, 0, 0] if gconst else gain[a, b, c]
         if wconst:
-            t = _node_update(T, state, a, b, c, gi, wind[0, 0, 0, 0], wind[0, 0, 0, 1], wind[0, 0, 0, 2], h, order, slack, nb, nb2, av, bv, ov)
+            t = _node_update(T, state, a, b, c, gi, wind[0, 0, 0, 0], wind[0, 0, 0, 1], wind[0, 0, 0, 2],
+                             h, order, slack, nb, nb2, av, bv, ov)
         else:
-            t = _node_update(T, state, a, b, c, gi, wind[a, b, c, 0], wind[a, b, c, 1], wind[a, b, c, 2], h, order, slack, nb, nb2, av, bv, ov)
+            t = _node_update(T, state, a, b, c, gi, wind[a, b, c, 0], wind[a, b, c, 1], wind[a, b, c, 2],
+                             h, order, slack, nb, nb2, av, bv, ov)
         T[a, b, c] = min(T[a, b, c], t)
         heapq.heappush(heap, (T[a, b, c], lin))
     while len(heap) > 0:
@@ -229,9 +231,11 @@ def march(T, state, gain, wind, h, order=2, reopen_tol=1e-3, slack_nodes=1.0):  
             fa = 0 if o[0] != 0 else (1 if o[1] != 0 else 2)
             fc = 1 if o[fa] > 0 else 2
             if wconst:
-                t = _node_update(T, state, a, b, c, gi, wind[0, 0, 0, 0], wind[0, 0, 0, 1], wind[0, 0, 0, 2], h, order, slack, nb, nb2, av, bv, ov, fa, fc)
+                t = _node_update(T, state, a, b, c, gi, wind[0, 0, 0, 0], wind[0, 0, 0, 1], wind[0, 0, 0, 2],
+                                 h, order, slack, nb, nb2, av, bv, ov, fa, fc)
             else:
-                t = _node_update(T, state, a, b, c, gi, wind[a, b, c, 0], wind[a, b, c, 1], wind[a, b, c, 2], h, order, slack, nb, nb2, av, bv, ov, fa, fc)
+                t = _node_update(T, state, a, b, c, gi, wind[a, b, c, 0], wind[a, b, c, 1], wind[a, b, c, 2],
+                                 h, order, slack, nb, nb2, av, bv, ov, fa, fc)
             # an accepted node re-opens when a later neighbour improves it: with anisotropy the
             # characteristic may leave a simplex whose nodes are accepted after it (non-causal
             # for plain fast marching); label-correcting settles it at the same fixed point.

@@ -156,9 +156,10 @@ CRACK_WIDTH_VOXELS = 0.5
 
 def corner_uv(uv, faces) -> np.ndarray:
     """Per-face corner coordinates ``(f, 3, 2)`` of per-vertex ``uv (n, 2)`` that wrap in ``u``
-    (a picture wrapped round the object, as a longitude-latitude map): a face across the wrap (``u`` near 0 and 1) has ``u + 1`` on its low
-    corners (the one home of this rule: :func:`textured_mesh` splits those corners off), so the
-    picture does not smear round the object."""
+    (a picture wrapped round the object, as a longitude-latitude map): a face across the wrap
+    (``u`` near 0 and 1) has ``u + 1`` on its low corners (the one home of this rule:
+    :func:`textured_mesh` splits those corners off), so the picture does not smear round the
+    object."""
     c = np.asarray(uv, float)[np.asarray(faces)].copy()
     u = c[..., 0]
     seam = (u.max(1) - u.min(1)) > 0.5

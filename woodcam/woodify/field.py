@@ -120,7 +120,8 @@ class WoodifiedField:
         sdf = None if obstacle_sdf_mm is None else as_floats(obstacle_sdf_mm)
         if obstacle_sdf_mm is not None and (sdf is None or sdf.shape != T.shape):
             raise WoodcamError(f"obstacle_sdf_mm must be the signed distances on the arrival grid's nodes, shape "
-                               f"{T.shape}; got {'shape ' + str(sdf.shape) if sdf is not None else repr(obstacle_sdf_mm)[:60]}")
+                               f"{T.shape}; got "
+                               f"{'shape ' + str(sdf.shape) if sdf is not None else repr(obstacle_sdf_mm)[:60]}")
         self.obstacle_sdf_mm = None if sdf is None else sdf.astype(np.float32)
         self.interpolation = interpolation
         self.stem_axis = check_vector(speed.up if stem_axis is None else stem_axis, "stem_axis", unit=True,

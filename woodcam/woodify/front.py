@@ -185,12 +185,14 @@ def check_watertight(mesh, name: str, *, fix: str | None = None):
     pinched = pinched_vertices(mesh)
     if len(pinched):
         at = say_length(np.asarray(mesh.vertices, float)[pinched[0]], ".4g", form="({}, {}, {})")
+        fix = fix or ("move those parts apart (leave a gap) or merge them into one solid in the CAD program, "
+                      "and export again")
         raise WoodcamError(
             f"{name} must be a manifold solid (the triangles round each vertex forming one fan); this "
             f"one has {len(mesh.faces)} triangles, and at {len(pinched)} "
             f"vert{'ex' if len(pinched) == 1 else 'ices'} (the first at {at}) parts of it touch at a "
             "single point (non-manifold vertex); "
-            f"{fix or 'move those parts apart (leave a gap) or merge them into one solid in the CAD program, and export again'}")
+            f"{fix}")
     return mesh
 
 

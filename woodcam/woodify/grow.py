@@ -189,7 +189,8 @@ def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: 
         g_mm = 0.25 * float(np.max(hi - lo)) if growth_mm is None else float(growth_mm)
         cap = limit("MAX_BLOCK_SIZE_MM")
         if not (np.isfinite(g_mm) and 0 < g_mm <= cap):  # 1e20 divided by zero further on
-            raise WoodcamError(f"growth_mm must be in (0, {cap:g}] (mm grown in `years`; raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N); "
+            raise WoodcamError(f"growth_mm must be in (0, {cap:g}] (mm grown in `years`; "
+                               f"raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N); "
                                f"got {growth_mm!r}")
         if not lam > 0:
             raise WoodcamError(f"time_scale_years must be > 0; got {time_scale_years!r}")
