@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+import trimesh
 
 from woodcam.errors import WoodcamError
 from woodcam.fields import block_at_knot
@@ -600,10 +601,10 @@ def test_a_resize_past_its_block_is_refused_naming_the_extents_and_the_fix(spec,
     # the API's own door, resize_stock
     with pytest.raises(BlockSpecError, match=r"past the 100x80x50 mm block before it"):
         resize_stock(open_stock("builtin:knotty"), (60.0, 20.0, 10.0), (50.0, 0.0, 0.0))
-    # the command line: typed in --block, a usage error before the part is read (it is no mesh:
-    # there, as the input door wants, but never read)
-    (tmp_path / "unread.stl").write_text("never read")
-    assert main(["place", str(tmp_path / "unread.stl"), "--block", spec, "--out", str(tmp_path / "o")]) == 2
+    # the command line: typed in --block, a usage error as the block opens (place reads the part
+    # first, so a part a block holds: a broken one is said before the block, see test_cli)
+    trimesh.creation.box((10.0, 10.0, 5.0)).export(tmp_path / "part.stl")
+    assert main(["place", str(tmp_path / "part.stl"), "--block", spec, "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert err == f"woodcam: error: --block {spec}: {msg.split(': ', 1)[1]}\n", err
 
@@ -680,8 +681,8 @@ def test_a_refused_resize_fix_in_inches_is_short_and_opens_to_what_it_says(capsy
     p = np.random.default_rng(4).uniform(0, 1, (400, 3)) * np.asarray(got.size_mm)
     np.testing.assert_allclose(got.wood.years(p), block.wood.years(p + (69.85, 12.7, 6.35)), rtol=0, atol=1e-4)
     # the command line says the same numbers
-    (tmp_path / "unread.stl").write_text("never read")  # there (the input door), never read
-    assert main(["place", str(tmp_path / "unread.stl"), "--block", typed, "--units", "inch",
+    trimesh.creation.box((10.0, 10.0, 5.0)).export(tmp_path / "part.stl")  # read first, then the block
+    assert main(["place", str(tmp_path / "part.stl"), "--block", typed, "--units", "inch",
                  "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert fit in err and offered in err and "3.93700787402" not in err, err

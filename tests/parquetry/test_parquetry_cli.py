@@ -709,7 +709,7 @@ def test_every_parquetry_option_says_its_default_and_unit():
     assert not unsaid, unsaid
     assert "(default: none, the targets and veneers given here)" in helps["--config"]
     assert "default: none, the veneers are the --veneer scans and the --config job's" in helps["--veneer-from"]
-    assert "360/N degrees apart (default 15: every 24 degrees)" in helps["--n-rot"]
+    assert "360/N degrees apart, in [1, 360] (default 15: every 24 degrees)" in helps["--n-rot"]
     assert "3.5 mm at their defaults" in helps["--overlap-mm"]
 
 
