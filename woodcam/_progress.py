@@ -43,8 +43,9 @@ def progress_bar(iterable: Iterable | None = None, *, desc: str, unit: str, enab
                  **kwargs: Any):
     """A ``tqdm.auto.tqdm`` over ``iterable`` (or with ``total=`` and manual ``update``) drawn
     on a terminal after :data:`PROGRESS_DELAY_S` only (module docstring); ``enabled=False``
-    never draws it, nor does one inside :func:`silenced`. ``kwargs`` go to tqdm (``total``, ``initial``, ``leave``, ...). Each step,
-    drawn or not, is a Ctrl-C checkpoint (:func:`woodcam._interrupt.check`)."""
+    never draws it, nor does one inside :func:`silenced`. ``kwargs`` go to tqdm (``total``,
+    ``initial``, ``leave``, ...). Each step, drawn or not, is a Ctrl-C checkpoint
+    (:func:`woodcam._interrupt.check`)."""
     _interrupt.check()
     kwargs.setdefault("delay", PROGRESS_DELAY_S)
     return _bar_class()(iterable, desc=desc, unit=unit,

@@ -21,8 +21,8 @@ from typing import Any
 from ._checks import check_path
 from .errors import WoodcamError
 
-__all__ = ["photo_rgb8", "read_image_file", "read_image_file_opacity", "read_json_file", "read_json_object", "read_npz", "read_photo_rgb",
-           "strict_json_loads"]
+__all__ = ["photo_rgb8", "read_image_file", "read_image_file_opacity", "read_json_file", "read_json_object", "read_npz",
+           "read_photo_rgb", "strict_json_loads"]
 
 
 def strict_json_loads(text: str, what: str) -> Any:
@@ -101,11 +101,12 @@ def read_image_file_opacity(path: Path, what: str, alpha_fix: tuple[str, str] | 
     name), turned by its EXIF orientation tag (a phone stores a portrait photo as landscape
     pixels plus that tag: read raw it lies on its side, a face's rings turned 90 degrees) and
     converted to sRGB from the ICC profile it carries (:func:`_in_srgb`):
-    ``(h, w)`` or ``(h, w, 3)`` uint8 for 8-bit modes, uint16 for 16-bit ones (values kept). Files over :data:`~woodcam.limits.MAX_IMAGE_PIXELS`,
-    unreadable, truncated, animated (a GIF, PNG or WebP of several frames: which is the face?)
-    or of unsupported modes are WoodcamErrors naming ``what`` and the file; transparent pixels
-    (a cut-out) are read as the colour stored under them, with a WoodcamWarning saying
-    ``alpha_fix``: (what they may be, the fix) for the image's use (a photo, a mask, a target).
+    ``(h, w)`` or ``(h, w, 3)`` uint8 for 8-bit modes, uint16 for 16-bit ones (values kept).
+    Files over :data:`~woodcam.limits.MAX_IMAGE_PIXELS`, unreadable, truncated, animated (a
+    GIF, PNG or WebP of several frames: which is the face?) or of unsupported modes are
+    WoodcamErrors naming ``what`` and the file; transparent pixels (a cut-out) are read as the
+    colour stored under them, with a WoodcamWarning saying ``alpha_fix``: (what they may be,
+    the fix) for the image's use (a photo, a mask, a target).
 
     ``least``, when given, is called with the image's upright (rows, cols) before it is decoded
     and returns the least upright (rows, cols) its caller needs, or None for every pixel: a JPEG

@@ -309,7 +309,8 @@ class ColorMapAppearance:
     def ramp(self, arf_values: ArrayLike) -> np.ndarray:
         """Species colour at ARF values ``(n,)`` -> ``(n, 3)`` float32 (side grain, no noise)."""
         s = self.species
-        a = real_numbers(arf_values, "arf_values", fix="e.g. [0.0, 0.5, 0.9]")  # None was an IndexError, 'a' numpy's ValueError
+        # None was an IndexError, 'a' numpy's ValueError
+        a = real_numbers(arf_values, "arf_values", fix="e.g. [0.0, 0.5, 0.9]")
         if a.ndim != 1:
             raise WoodcamError(f"arf_values must be one ARF value per point, shape (n,); got shape {a.shape}; "
                                "e.g. [0.0, 0.5, 0.9]")

@@ -135,8 +135,8 @@ def mokume_maps_said(folder, paths: list[Path], instead: str) -> str:
     kinds = [(what[k], [p.name for p in paths if _mokume_map_kind(p) == k]) for k in what]
     said = " and ".join(f"{kind}{'s' if len(names) > 1 else ''} {', '.join(names)}" for kind, names in kinds if names)
     return (f"{str(folder)!r}: Mokume's {said} {'is' if len(paths) == 1 else 'are'} not read: {instead}; to use "
-            f"Mokume's maps instead, give the sample folder itself to fit, bake or eval ({shlex.quote(str(folder))} --size-mm "
-            "WxDxH)")
+            f"Mokume's maps instead, give the sample folder itself to fit, bake or eval "
+            f"({shlex.quote(str(folder))} --size-mm WxDxH)")
 
 
 def stray_photos(folder) -> list[Path]:
@@ -331,7 +331,8 @@ def _read_face_photo(face: str, path: Path, size, max_px_per_mm: float) -> tuple
     def least(rows: int, cols: int) -> tuple[int, int] | None:
         full.append((rows, cols))
         dense = min(rows / h_mm, cols / w_mm) > max_px_per_mm
-        return (DRAFT_MARGIN * target[0], DRAFT_MARGIN * target[1]) if dense and _fits(face, (rows, cols), size) else None
+        return ((DRAFT_MARGIN * target[0], DRAFT_MARGIN * target[1]) if dense and _fits(face, (rows, cols), size)
+                else None)
 
     a = read_photo_rgb(path, f"photo of face {face!r}", least=least)
     _check_exposure(face, a, path)

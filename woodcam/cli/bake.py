@@ -41,7 +41,8 @@ def register(subparsers) -> None:
                               "can read, write or delete your files, so only bake scripts you "
                               "wrote or have read (--timeout bounds its run time; it is not a "
                               "sandbox).")
-    add_input(p, "part", kind="file", suffixes=part_suffixes, help="part file (.py script, .step, .stl, .obj, .ply, .off, .glb)")
+    add_input(p, "part", kind="file", suffixes=part_suffixes,
+              help="part file (.py script, .step, .stl, .obj, .ply, .off, .glb)")
     add_input(p, "--block", kind="block", required=True, help=BLOCK_SPEC_HELP)
     add_out_option(p, "the baked part; beside it PART.obj/.mtl, PART_texture.png, the "
                    "part report PART_report.txt/.json and, with --screenshot, PART_view.png",

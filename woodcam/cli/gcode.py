@@ -309,8 +309,8 @@ def run(args) -> int:
         for t, tool in sorted(used.items()):
             if args.cell_size > tool.diameter_mm / 2:
                 print(f"woodcam: warning: {path.name}: the grid ({fmt_length(args.cell_size, args.units)}) "
-                      f"is coarser than half the diameter of T{t} ({fmt_length(tool.diameter_mm, args.units)}): its cuts can "
-                      f"fall between the cell centres and vanish; use --cell-size "
+                      f"is coarser than half the diameter of T{t} ({fmt_length(tool.diameter_mm, args.units)}): "
+                      f"its cuts can fall between the cell centres and vanish; use --cell-size "
                       f"{tool.diameter_mm / 2 / MM_PER_UNIT[args.units]:.2g} or finer", file=sys.stderr)
                 n_warn += 1
         n_warn += _warn_inch_sizes_read_as_mm(args, program, path.name)

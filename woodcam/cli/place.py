@@ -6,8 +6,8 @@ import argparse
 from pathlib import Path
 
 from ..units import MM_PER_UNIT, TYPED_DECIMALS
-from .options import (add_input, part_suffixes, output_refused_at_the_door, BLOCK_SPEC_HELP, add_out_option, add_units_option,
-                      place_op_in)
+from .options import (add_input, part_suffixes, output_refused_at_the_door, BLOCK_SPEC_HELP, add_out_option,
+                      add_units_option, place_op_in)
 
 
 def register(subparsers) -> None:
@@ -22,7 +22,8 @@ def register(subparsers) -> None:
         "--place options that reproduce each placement in woodcam bake. A .py part script is "
         "trusted code: it runs with your rights, so only place scripts you wrote or have read "
         "(--timeout bounds its run time; it is not a sandbox).")
-    add_input(p, "part", kind="file", suffixes=part_suffixes, help="part file (.py script, .step, .stl, .obj, .ply, .off, .glb), block frame, mm")
+    add_input(p, "part", kind="file", suffixes=part_suffixes,
+              help="part file (.py script, .step, .stl, .obj, .ply, .off, .glb), block frame, mm")
     add_input(p, "--block", kind="block", required=True, help=BLOCK_SPEC_HELP)
     add_out_option(p, "placements.png and placements.json")
     p.add_argument("--timeout", type=float, default=None, metavar="S",  # bake's; place had none

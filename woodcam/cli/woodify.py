@@ -4,8 +4,8 @@ Writes into ``--out``: ``field.npz`` (the grown object's growth field; a block s
 ``woodify:OUT/field.npz`` for ``bake``/``gcode``/``preview``), ``grown.glb`` (final surface,
 bark-textured, with cracks), ``surface_yNN.stl`` (watertight grown surfaces at chosen years, mm
 in the input mesh's frame, as their STL headers say), ``section_xz.png`` / ``section_xy.png``
-(ring sections through the block centre, seed Fig. 5.1, a scale bar in --units below each) and ``woodify.json`` (parameters, grid,
-solver, timings). Every file is written atomically.
+(ring sections through the block centre, seed Fig. 5.1, a scale bar in --units below each) and
+``woodify.json`` (parameters, grid, solver, timings). Every file is written atomically.
 """
 
 from __future__ import annotations
@@ -31,7 +31,8 @@ def register(subparsers) -> argparse.ArgumentParser:
         "eccentricity, obstacles, brushes), then write its growth field (usable as --block "
         "woodify:OUT/field.npz), grown surfaces, ring sections and a bark-textured grown.glb. "
         "Lengths in mm (the options' in --units), time in years.")
-    add_input(p, "part", kind="file", suffixes=_part_suffixes, help="input: a .py part script, .step, or a closed .stl/.obj/.ply/.glb mesh "
+    add_input(p, "part", kind="file", suffixes=_part_suffixes,
+              help="input: a .py part script, .step, or a closed .stl/.obj/.ply/.glb mesh "
                    "(mesh files are read as mm whatever --units says; one under 1 mm long gets a warning that it "
                    "looks saved in metres); a PLY may paint growth per vertex: properties gain (speed gain) and "
                    "dir_x, dir_y, dir_z (growth direction, length = strength < 1)")
@@ -47,15 +48,16 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--eccentricity", type=float, default=0.0,
                    help="delta in (-1, 1): speed (1 + delta n.up) (default 0)")
     p.add_argument("--up", default="0,0,1", metavar="X,Y,Z",
-                   type=vector_type("--up", example="0,0,1", nonzero=True), help="direction the eccentric growth favours (unit-normalised; default 0,0,1)")
-    add_input(p, "--obstacle", kind="file", suffixes=_part_suffixes, type=Path, action="append", default=[], metavar="MESH",
-                   help="closed obstacle mesh or part (read as mm); repeatable")
+                   type=vector_type("--up", example="0,0,1", nonzero=True),
+                   help="direction the eccentric growth favours (unit-normalised; default 0,0,1)")
+    add_input(p, "--obstacle", kind="file", suffixes=_part_suffixes, type=Path, action="append", default=[],
+                   metavar="MESH", help="closed obstacle mesh or part (read as mm); repeatable")
     add_input(p, "--brushes", kind="file", type=Path, default=None, metavar="JSON",
                    help="growth brushes (centre_mm, radius_mm, gain, direction, strength)")
     p.add_argument("--resolution", type=int, default=128,
                    help="grid nodes along the longest side (default 128); a run takes about "
-                   "180 bytes a grid node, and a grid over WOODCAM_MAX_ALLOC_BYTES (4 GiB) is refused, naming the finest "
-                   "resolution that fits")
+                   "180 bytes a grid node, and a grid over WOODCAM_MAX_ALLOC_BYTES (4 GiB) is refused, naming the "
+                   "finest resolution that fits")
     p.add_argument("--method", choices=("auto", "fmm", "offset", "anisotropic"), default="auto",
                    help="front solver (default auto: fmm if isotropic, offset for eccentricity "
                    "without obstacles, anisotropic otherwise)")
@@ -85,7 +87,8 @@ def register(subparsers) -> argparse.ArgumentParser:
                    "length at unit stiffness, so in mm; default 2x the median of the first simulated year)")
     p.add_argument("--relief", type=float, default=None,
                    help="stress left next to a new crack, in [0, 1] (0 removes all; default 0.3)")
-    p.add_argument("--seed", type=int, default=0, help="random seed of the procedural bark and random cracks (default 0)")
+    p.add_argument("--seed", type=int, default=0,
+                   help="random seed of the procedural bark and random cracks (default 0)")
     add_max_atlas_option(p, given_only=True)  # None unless typed: a kept picture warns
     p.set_defaults(func=run)
     return p
@@ -447,7 +450,8 @@ def _write_outputs(res, out, *, textured=None, surface_years=(), block_size_mm=N
             img = section_image(f, f.no_wood, inside, origin, u, v, (rows, px), years_final=Y)
             # a scale bar below it (a round length in --units): the picture alone told no size
             img, _ = with_scale_bar(img, ext[a] / px, units)
-            files.append(atomic(out / f"section_{name}.png", lambda p, im=img: Image.fromarray(im).save(p, format="PNG")))
+            files.append(atomic(out / f"section_{name}.png",
+                                lambda p, im=img: Image.fromarray(im).save(p, format="PNG")))
     return files, summary
 
 
@@ -474,11 +478,11 @@ def _say_block_past_the_wood(lo, hi, size, centre, spacing_mm: float, years: flo
     box = say_length([v for pair in zip(lo, hi) for v in pair], ".4g", form="x [{}, {}], y [{}, {}], z [{}, {}]")
     warnings.warn(
         f"the block cut from the grown object ({say_length(size, '.4g', ' x ')} about "
-        f"{say_length(np.round(c, 3) + 0.0, '.4g', ',')}, {opts}) reaches {say_length(past, '.4g')} past the grown object's box "
-        f"({box}): that part of it is air round the object, wood never grown, which field.npz fills with years "
-        f"past the {years:g} grown (a bake shows wood there); keep the block within that box (--block-size at "
-        f"most {say_length(room, '.4g', 'x')} about that centre), or leave {opts} out for the grown object's own "
-        "box", WoodcamWarning, stacklevel=2)
+        f"{say_length(np.round(c, 3) + 0.0, '.4g', ',')}, {opts}) reaches {say_length(past, '.4g')} past the grown "
+        f"object's box ({box}): that part of it is air round the object, wood never grown, which field.npz fills "
+        f"with years past the {years:g} grown (a bake shows wood there); keep the block within that box "
+        f"(--block-size at most {say_length(room, '.4g', 'x')} about that centre), or leave {opts} out for the "
+        "grown object's own box", WoodcamWarning, stacklevel=2)
 
 
 def _check_block_centre(res, args) -> None:

@@ -47,8 +47,8 @@ def check_points(points_mm, name: str = "points_mm") -> np.ndarray:
     far = np.abs(p) > POINT_BOUND_MM  # its square overflowed in the fields: inf years
     if far.any():
         bad = int(np.argmax(far.any(axis=1)))
-        raise WoodcamError(f"{name} must lie within {POINT_BOUND_MM:g} mm ({POINT_BOUND_MM / 1e6:g} km) of the origin on "
-                           "each axis; "
+        raise WoodcamError(f"{name} must lie within {POINT_BOUND_MM:g} mm ({POINT_BOUND_MM / 1e6:g} km) of the "
+                           "origin on each axis; "
                            f"point {bad} is {p[bad].tolist()}; pass block-frame points in mm (a unit or frame "
                            "mistake?)")
     return p

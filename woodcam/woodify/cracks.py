@@ -322,7 +322,8 @@ def simulate_cracks(woodification, years, *, pattern: Pattern = "stress", region
         raise WoodcamError(f"diffusion must lie in [0, 1); got {diffusion!r}")
     ys = [float(y) for y in years]
     if len(ys) < 2 or np.any(np.diff(ys) <= 0) or ys[0] < 0 or ys[-1] > woodification.years:
-        raise WoodcamError(f"years must be >= 2 increasing years within [0, {woodification.years:g}]; got {received(years)}")
+        raise WoodcamError(f"years must be >= 2 increasing years within [0, {woodification.years:g}]; "
+                           f"got {received(years)}")
     rng = np.random.default_rng(seed)
     wd = woodification
     h = wd.front.grid.spacing_mm
