@@ -152,7 +152,14 @@ def kill_workers(pool: ProcessPoolExecutor) -> None:
     run's results are never used."""
     for proc in list((getattr(pool, "_processes", None) or {}).values()):
         proc.kill()
+    manager = getattr(pool, "_executor_manager_thread", None)
     pool.shutdown(wait=False, cancel_futures=True)
+    # its manager thread ends as it sees the killed workers, closing its wake-up pipe; left to end
+    # on its own, it raced CPython 3.11's exit hook (concurrent.futures.process._python_exit), which
+    # wrote to that pipe as it closed: 'Exception ignored ... OSError: [Errno 9] Bad file
+    # descriptor' after the interrupt's one line. Joined here (bounded), the pipe is closed first.
+    if manager is not None:
+        manager.join(timeout=5.0)
 
 
 def map_processes(fn: Callable[[Any], Any], items: Sequence, workers: int) -> list:
