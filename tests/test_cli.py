@@ -299,9 +299,11 @@ def test_a_part_in_inches_gets_each_commands_own_fix(tmp_path, capsys, monkeypat
     assert "Lengths in a part script" in err and "STL" not in err, err
 
 
-def test_place_says_a_broken_part_before_opening_the_block(tmp_path, capsys, monkeypatch):
-    """`woodcam place` opened the block (a Mokume sample's fit: minutes) before it ran the part
-    script, so a typo in it was said after the wait. The part is loaded first."""
+@pytest.mark.parametrize("command, out", [("place", "place"), ("bake", "t.glb")])
+def test_a_broken_part_is_said_before_the_block_opens(command, out, tmp_path, capsys, monkeypatch):
+    """`woodcam place` and `woodcam bake` opened the block (a Mokume sample's or a photographed
+    block's ring fit: minutes) before they ran the part script, so a typo in it was said after
+    the wait. The part is loaded first."""
     import woodcam.stock
 
     def no_block(*args, **kwargs):
@@ -310,7 +312,7 @@ def test_place_says_a_broken_part_before_opening_the_block(tmp_path, capsys, mon
     monkeypatch.setattr(woodcam.stock, "open_stock", no_block)
     part = tmp_path / "typo.py"
     part.write_text("part = Bx(10, 10, 10)\n")
-    assert main(["place", str(part), "--block", "builtin:knotty", "--out", str(tmp_path / "place")]) == 1
+    assert main([command, str(part), "--block", "builtin:knotty", "--out", str(tmp_path / out)]) == 1
     err = capsys.readouterr().err
     assert err.startswith("woodcam: error: part script") and "NameError: name 'Bx' is not defined" in err, err
 
@@ -335,22 +337,11 @@ def test_place_names_the_part_that_fits_nowhere_and_the_fix(tmp_path, capsys):
         advise_placement(long, open_stock("builtin:knotty"))
 
 
-def test_bake_says_a_broken_part_before_opening_the_block(tmp_path, capsys, monkeypatch):
-    """`woodcam bake` opened the block (a photographed block's ring fit: minutes) before it ran
-    the part script, so a typo in it was said after the wait. The part is loaded first, once."""
+def test_bake_loads_its_part_once(tmp_path, monkeypatch):
+    """Loaded before the block opens (test_a_broken_part_is_said_before_the_block_opens), the
+    part is not loaded again to be carved."""
     import woodcam.cad
-    import woodcam.stock
 
-    def no_block(*args, **kwargs):
-        raise AssertionError("the block was opened before the part was loaded")
-
-    monkeypatch.setattr(woodcam.stock, "open_stock", no_block)
-    part = tmp_path / "typo.py"
-    part.write_text("part = Bx(10, 10, 10)\n")
-    assert main(["bake", str(part), "--block", "builtin:knotty", "--out", str(tmp_path / "t.glb")]) == 1
-    err = capsys.readouterr().err
-    assert err.startswith("woodcam: error: part script") and "NameError: name 'Bx' is not defined" in err, err
-    monkeypatch.undo()
     loads = []
     load_part = woodcam.cad.load_part
 
