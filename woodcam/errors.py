@@ -69,6 +69,20 @@ def require(module: str, extra: str, purpose: str):
         ) from err
 
 
+def caused_by(err: BaseException | None, kind: type[BaseException]) -> bool:
+    """Whether an exception of ``kind`` is ``err`` or among its causes (``__cause__``, else
+    ``__context__``, followed to the end; a cycle stops): libraries re-raise what they caught as
+    their own error (numba's compiler a Ctrl-C as a RuntimeError, pybind11's import an alarm as
+    an ImportError)."""
+    seen = set()
+    while err is not None and id(err) not in seen:
+        if isinstance(err, kind):
+            return True
+        seen.add(id(err))
+        err = err.__cause__ or err.__context__
+    return False
+
+
 class WoodcamWarning(UserWarning):
     """Something the user should know about but woodcam could carry on with (e.g. a part that
     sticks out of the block is carved anyway and the lost volume is reported)."""

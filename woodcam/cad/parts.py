@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_number
-from ..errors import WoodcamError, require
+from ..errors import WoodcamError, caused_by, require
 from ..units import said, say_length, say_volume
 from ..tolerances import (
     MAX_PART_TRIANGLES,
@@ -358,7 +358,7 @@ def _load_script(path: Path, tess: "_Tessellation"):
             f"guard command-line code with `if __name__ == \"__main__\":`"
         ) from err
     except Exception as err:
-        if _timed_out(err):  # a library turned the alarm into its own error (pybind11's import:
+        if caused_by(err, _PartTimeout):  # a library turned the alarm into its own error (pybind11's import:
             raise _PartTimeout from err  # 'ImportError: initialization failed', said as the script's fault)
         line = _script_line(err, path)
         cq = (" (CQ-editor imports cadquery as `cq` for its scripts: add `import cadquery as cq`)"
@@ -488,17 +488,6 @@ def _without_volume(obj) -> bool:
             continue
         return False  # a solid, or something the loader judges
     return True
-
-
-def _timed_out(err: BaseException | None) -> bool:
-    """Whether the timeout's alarm (:class:`_PartTimeout`) is among the causes of ``err``."""
-    seen = set()
-    while err is not None and id(err) not in seen:
-        if isinstance(err, _PartTimeout):
-            return True
-        seen.add(id(err))
-        err = err.__cause__ or err.__context__
-    return False
 
 
 def _has_main_guard(path: Path) -> bool:

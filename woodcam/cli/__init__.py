@@ -24,7 +24,7 @@ import textwrap
 import warnings
 
 from .. import _interrupt
-from ..errors import UsageError, WoodcamError
+from ..errors import UsageError, WoodcamError, caused_by
 from .options import OUT_RULE
 
 #: The command modules, in the order their commands appear in ``woodcam --help``.
@@ -325,7 +325,7 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             # BaseException) or left itself half-imported (scipy: NameError), or wrapped it
             # (numba's compiler; a pybind11 module such as OCP, imported by a part script,
             # raises ImportError: woodcam's WoodcamError about it then blamed the script)
-            if _interrupt.requested() or _interrupted(err):
+            if _interrupt.requested() or caused_by(err, KeyboardInterrupt):
                 interrupted = True
                 _interrupt.say()
                 return EXIT_INTERRUPTED
@@ -412,18 +412,6 @@ def _given_by(args: argparse.Namespace, err: BaseException) -> str:
                 if path is not None and path.resolve() == folder:
                     return f"{arg.name} of 'woodcam {_command_name(args)}'"
     return ""
-
-
-def _interrupted(err: BaseException) -> bool:
-    """Whether a KeyboardInterrupt is among the causes of ``err`` (libraries re-raise it as their
-    own error: numba's compiler as a RuntimeError)."""
-    seen = set()
-    while err is not None and id(err) not in seen:
-        if isinstance(err, KeyboardInterrupt):
-            return True
-        seen.add(id(err))
-        err = err.__cause__ or err.__context__
-    return False
 
 
 def _stdout_closed(err: BaseException) -> bool:
