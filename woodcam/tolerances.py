@@ -682,3 +682,13 @@ DPI_PLACEHOLDER_TOL = 1.0
 #: axis (17 s for one point at 1e9 mm, 0.02 s at 1e6). A point that far is a unit or frame
 #: mistake, refused at the door.
 POINT_BOUND_MM = 1e6
+
+#: A mesh grown alone (``woodcam woodify``: no block to compare it with) whose longest side is
+#: under this many mm, yet 1 mm or more (under that it looks saved in metres,
+#: :data:`woodcam.frames.FOREIGN_GLTF_METRES_BELOW`), is warned about as looking saved in inches
+#: (:func:`woodcam.cad.carve.units_hint`): 6.35 mm is the width of a 1/4-inch router bit, the
+#: common one, so nothing that short is a part a router carves round, while 25.4 times it (up to
+#: 161 mm) is a bowl, a spoon or a handle. A 4-inch bowl saved in inches was read as a 4 mm
+#: speck and grown without a word. Not higher: the woodify tests and examples grow 10 mm balls
+#: as real millimetre parts, and a 10 mm knob is one.
+INCHES_BELOW_MM = 6.35

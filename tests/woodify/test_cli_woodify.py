@@ -662,6 +662,25 @@ def test_a_mesh_saved_in_metres_is_named_as_such(tmp_path, capsys):
     assert msg.startswith("woodcam: warning: --obstacle '" + str(tmp_path / "m.stl") + "'")
 
 
+def test_a_mesh_saved_in_inches_is_named_as_such(tmp_path, capsys):
+    """A 4 x 3 x 2 inch box saved in inches is read as a 4 x 3 x 2 mm speck, and grew so
+    without a word (only a part under 1 mm, as if in metres, was warned of): it is warned about
+    from its size alone (no block to compare with), in bake's words of a mesh's units
+    (woodcam.cad.carve.units_note) with the size it would have and the fix; a 10 mm ball (a
+    real knob) grows silently."""
+    trimesh.creation.box((4.0, 3.0, 2.0)).export(tmp_path / "in.stl")
+    assert main(["woodify", str(tmp_path / "in.stl"), "--years", "5", "--resolution", "16",
+                 "--cracks", "none", "--out", str(tmp_path / "o")]) == 0
+    (msg,) = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert msg.startswith("woodcam: warning: part '" + str(tmp_path / "in.stl") + "'"), msg
+    assert "modelled in inches" in msg and "4x3x2 mm" in msg and "102x76.2x50.8 mm" in msg, msg
+    assert "STL, OBJ and PLY carry no units" in msg and "scale it by 25.4" in msg and "--units" in msg, msg
+    trimesh.creation.icosphere(subdivisions=1, radius=5.0).export(tmp_path / "ball.stl")
+    assert main(["woodify", str(tmp_path / "ball.stl"), "--years", "5", "--resolution", "16",
+                 "--cracks", "none", "--out", str(tmp_path / "o2")]) == 0
+    assert "warning" not in capsys.readouterr().err
+
+
 def test_a_bar_is_drawn_while_the_growth_runs(tmp_path, monkeypatch):
     """woodify's bar of plain updates drew nothing until a stage ended: a 13 s growth on a 160^3
     grid (a 1.3M-triangle mesh: 7 s to read, 25 s to grow at the default 128) showed no bar at

@@ -21,7 +21,7 @@ from .._manifold import manifold_to_trimesh
 from .._types import ArrayLike
 from ..errors import WoodcamError, WoodcamWarning
 from ..frames import FOREIGN_GLTF_METRES_BELOW, check_size
-from ..tolerances import OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG
+from ..tolerances import INCHES_BELOW_MM, OUTSIDE_VOLUME_EPS_MM3, TESSELLATION_ANGLE_DEG
 from ..units import MM_PER_UNIT, message_units, said, say_length, say_volume
 from .parts import SCRIPT_SUFFIXES, STEP_SUFFIXES, load_part
 
@@ -206,24 +206,33 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX, *,
     are in mm under every ``--units``: they are the file's own numbers.
 
     Without a block (``size_mm`` None: ``woodcam woodify`` grows a mesh alone) the part's own
-    size decides: under :data:`woodcam.frames.FOREIGN_GLTF_METRES_BELOW` mm along its longest
-    side (no router carves anything smaller; the size below which a foreign glTF is read as
-    metres) it is taken for a part in metres, 1000 x too small.
+    size decides, along its longest side: under :data:`woodcam.frames.FOREIGN_GLTF_METRES_BELOW`
+    mm (no router carves anything smaller; the size below which a foreign glTF is read as
+    metres) it is taken for a part in metres, 1000 x too small; under
+    :data:`woodcam.tolerances.INCHES_BELOW_MM` (a 1/4-inch router bit's width) for a part in
+    inches, 25.4 x too small (it was grown silently).
 
-    fix : how the caller's user scales the part by 25.4 (or, without a block, by 1000: the
-        command's option, or the library call); the CLI's ``--place`` is no use to
-        ``woodcam place`` or a library caller.
+    fix : how the caller's user scales the part by 25.4 (the command's option, or the library
+        call); the CLI's ``--place`` is no use to ``woodcam place`` or a library caller. Without
+        a block, where (and how else) to scale it: the message says ``scale it by 1000`` or
+        ``by 25.4`` and then ``fix``.
     source : what the part was loaded from (a path, an object), for :func:`units_note`; None:
         a mesh."""
     why, redo = units_note(source)
     extent = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
     with message_units("mm"):  # about the file's own numbers, read as mm whatever --units says
         if size_mm is None:
-            if not 0 < float(np.max(extent)) < FOREIGN_GLTF_METRES_BELOW:
+            longest = float(np.max(extent))
+            if 0 < longest < FOREIGN_GLTF_METRES_BELOW:
+                unit, factor, small = "metres", 1e3, "nothing that small is carved"
+            elif 0 < longest < INCHES_BELOW_MM:  # a 4-inch bowl saved in inches grew as a 4 mm speck
+                unit, factor = "inches", MM_PER_UNIT["inch"]
+                small = f"a {INCHES_BELOW_MM:g} mm (1/4-inch) router bit is wider than its longest side"
+            else:
                 return None
-            return (f"the part is only {say_length(extent, '.3g')}: {why}, and nothing that small is carved; "
-                    f"it looks modelled in metres (1000 times larger: "
-                    f"{say_length(extent * 1e3, '.3g')}): {fix}")
+            return (f"the part is only {say_length(extent, '.3g')}: {why}, and {small}; "
+                    f"it looks modelled in {unit} ({factor:g} times larger: "
+                    f"{say_length(extent * factor, '.3g')}): scale it by {factor:g} {fix}")
         size = np.asarray(size_mm, dtype=float)
         if not np.all(np.sort(extent) * MM_PER_UNIT["inch"] <= np.sort(size)):
             return None
