@@ -213,7 +213,8 @@ def test_an_open_mesh_in_a_file_of_several_is_named_with_its_option_and_file(tmp
     side was capped flat with a warning (a one-mesh file is refused) and a sphere missing
     triangles refused as 'mesh file ...', without the option. Now each mesh and their union go
     through the same check, naming the option, the file and the mesh; the touching union says
-    why and its fix (it suggested trimesh.repair.fill_holes, for meshes each closed)."""
+    why and its fix (it suggested trimesh.repair.fill_holes, for meshes each closed); an open
+    mesh is told how to close it in a CAD or mesh program."""
     a = trimesh.creation.box((10.0, 10.0, 10.0))
     ball = trimesh.creation.icosphere(subdivisions=2, radius=5.0)
     ball.export(tmp_path / "ball.stl")
@@ -235,7 +236,8 @@ def test_an_open_mesh_in_a_file_of_several_is_named_with_its_option_and_file(tmp
             err = capsys.readouterr().err
             assert err.count("\n") == 1 and f"error: {what} {path!r} {said} must be watertight" in err, err
             touch = "touch along an edge or at a vertex" in err and "non-manifold union" in err
-            assert touch == (name == "touching") and ("fill_holes" in err) == (name != "touching"), err
+            assert touch == (name == "touching") and ("Close Holes" in err) == (name != "touching"), err
+            assert "fill_holes" not in err, err
     assert not (tmp_path / "o").exists()
 
 

@@ -188,6 +188,30 @@ def test_field_is_the_arrival_time_mapping_monotone_and_agrees_with_surfaces():
         assert np.abs(r.field(surf.vertices) - year).max() < 1e-3
 
 
+def test_an_open_mesh_is_told_its_open_edges_and_a_fix_a_user_can_do():
+    """The open-mesh refusal said 'open or non-manifold edges; repair it first (e.g.
+    trimesh.repair.fill_holes, ...)': no count, and a Python function as the fix to someone
+    with a CAD program. Now it counts each kind of bad edge and names what to do in a CAD or
+    mesh program, per kind."""
+    from woodcam.woodify.front import check_watertight
+
+    box = trimesh.creation.box((10.0, 10.0, 10.0))
+    with pytest.raises(WoodcamError) as err:
+        check_watertight(trimesh.Trimesh(box.vertices, box.faces[:-1]), "mesh")  # one triangle off: 3 edges
+    msg = str(err.value)
+    assert "11 triangles, 3 open edges (on one triangle only" in msg, msg
+    assert "close its holes in the CAD program" in msg and "MeshLab's Close Holes" in msg, msg
+    assert "trimesh" not in msg and "more than two" not in msg, msg
+    other = box.copy()
+    other.apply_translation((10.0, 10.0, 0.0))  # touching the box along one edge
+    touching = trimesh.Trimesh(np.vstack([box.vertices, other.vertices]), np.vstack([box.faces, other.faces + 8]))
+    with pytest.raises(WoodcamError) as err:
+        check_watertight(touching, "mesh")
+    msg = str(err.value)
+    assert "24 triangles, 1 edge shared by more than two triangles" in msg, msg
+    assert "move them apart" in msg and "Repair non Manifold Edges" in msg and "open edge" not in msg, msg
+
+
 def test_errors_are_clear():
     m = trimesh.creation.icosphere(subdivisions=2, radius=5.0)
     with pytest.raises(WoodcamError, match="years must be a number > 0"):

@@ -178,10 +178,23 @@ def check_watertight(mesh, name: str, *, fix: str | None = None):
         raise WoodcamError(f"{name} has {int(bad.sum())} of {len(bad)} vertices that are not finite "
                            "numbers (NaN or inf); fix or drop them (a mesh must be closed and finite)")
     if not mesh.is_watertight:
+        # counted and named, with a fix the user can do: it said 'open or non-manifold edges;
+        # repair it first (e.g. trimesh.repair.fill_holes ...)', a Python function to a CAD user
+        uses = np.bincount(np.asarray(mesh.edges_unique_inverse), minlength=len(mesh.edges_unique))
+        n_open, n_shared = int(np.count_nonzero(uses == 1)), int(np.count_nonzero(uses > 2))
+        found = [f"{n} {what}" for n, what in (
+            (n_open, f"open edge{'' if n_open == 1 else 's'} (on one triangle only: holes in its surface)"),
+            (n_shared, f"edge{'' if n_shared == 1 else 's'} shared by more than two triangles (bodies "
+                       "touching along an edge, or a surface inside the solid)")) if n]
+        steps = " and ".join(t for t, n in (
+            ("close its holes in the CAD program (export a closed solid, not surfaces)", n_open),
+            ("make the bodies overlap or move them apart in the CAD program", n_shared)) if n)
+        tools = " and ".join(t for t, n in (("Close Holes", n_open), ("Repair non Manifold Edges", n_shared)) if n)
+        default = f"{steps}, or repair it in a mesh program (e.g. MeshLab's {tools}), and export again"
         raise WoodcamError(
             f"{name} must be watertight (every edge shared by exactly two triangles) so its inside "
-            f"is defined; this one has {len(mesh.faces)} triangles and open or non-manifold "
-            f"edges; {fix or 'repair it first (e.g. trimesh.repair.fill_holes, or export a closed solid)'}")
+            f"is defined; this one has {len(mesh.faces)} triangles, {' and '.join(found)}; "
+            f"{fix or default}")
     pinched = pinched_vertices(mesh)
     if len(pinched):
         at = say_length(np.asarray(mesh.vertices, float)[pinched[0]], ".4g", form="({}, {}, {})")
