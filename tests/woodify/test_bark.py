@@ -190,13 +190,44 @@ def test_a_crack_year_frames_its_faces_once(cylinder, monkeypatch):
     assert calls == [f for f in faces for _ in range(2)]  # each year: its surface, its old corners
 
 
-def test_vertex_neighbours_are_listed_in_trimeshs_order(cylinder):
+def test_vertex_neighbours_are_trimeshs_listed_in_ascending_order(cylinder):
+    """The neighbours were listed in the order of a Python set per vertex (trimesh's, built in
+    a Python loop: 45 ms on 41k vertices), an order nothing chose, though it decides a walk's
+    ties and which vertex gets which draw of the random pattern. Now they are trimesh's
+    neighbours in ascending order, as CSR arrays from one sort of the edges."""
     from woodcam.woodify.cracks import _neighbours
 
-    # the order decides a walk's ties and which vertex gets which draw of the random pattern
     mesh = cylinder.surface(3.0)
     expect = trimesh.Trimesh(mesh.vertices, mesh.faces, process=False).vertex_neighbors
-    assert _neighbours(mesh) == [[int(i) for i in nb] for nb in expect]
+    ptr, idx = _neighbours(mesh)
+    assert ptr.dtype == idx.dtype == np.int64 and len(ptr) == len(mesh.vertices) + 1 and ptr[-1] == len(idx)
+    assert [idx[a:b].tolist() for a, b in zip(ptr[:-1], ptr[1:])] == [sorted(int(i) for i in nb) for nb in expect]
+
+
+def test_a_walk_tie_goes_to_the_lowest_vertex_and_a_relief_ring_is_ascending():
+    """Ties were broken by the neighbour sets' order: now explicitly by the lowest index. On a
+    flat grid walked along (1, 1), a vertex's +x (v + 1) and +y (v + g) neighbours tie exactly:
+    the walk takes +x. A crack's relief ring (its path and neighbours, grown a few times) is
+    the set-based ring, as sorted unique indices (the random pattern draws in its order)."""
+    from woodcam.woodify.cracks import _grow_ring, _neighbours, _walk
+
+    g = 6
+    j, i = np.divmod(np.arange((g - 1) ** 2), g - 1)
+    a = j * g + i
+    grid = trimesh.Trimesh(np.stack([*np.divmod(np.arange(g * g), g)[::-1], np.zeros(g * g)], 1),
+                           np.concatenate([np.stack([a, a + g, a + 1], 1), np.stack([a + 1, a + g, a + g + 1], 1)]),
+                           process=False)
+    # the diagonal split runs (v + 1, v + g): with the quads split so, (1, 1) ties +x and +y
+    nb = _neighbours(grid)
+    d = np.array([1.0, 1.0, 0.0]) / np.sqrt(2.0)
+    assert _walk(np.asarray(grid.vertices, float), nb, 2, d, 1.0, set())[:2] == [2, 3]  # not 2 + g
+    lists = [set(nb[1][x:y].tolist()) for x, y in zip(nb[0][:-1], nb[0][1:])]
+    for path, steps in (([14, 8, 9], 1), ([0], 2), ([35, 35, 7], 3)):
+        ring = set(path)
+        for _ in range(steps):
+            ring |= {b for v in list(ring) for b in lists[v]}
+        got = _grow_ring(np.array(path), nb, steps)
+        assert got.tolist() == sorted(ring), (path, steps)
 
 
 def test_cracks_of_a_growing_cylinder_run_along_its_axis(cylinder):
@@ -488,7 +519,7 @@ def test_the_compiled_crack_walk_takes_the_loops_paths():
     """Refactor check: the compiled walk (cracks._walk) takes the very vertices and edges the
     per-step numpy loop took, on 3000 walks each over a noisy icosphere (13.5k steps), a
     cylinder and a flat grid whose first steps tie between two neighbours."""
-    from woodcam.woodify.cracks import _csr, _neighbours, _walk
+    from woodcam.woodify.cracks import _neighbours, _walk
 
     rng = np.random.default_rng(0)
     # a flat grid whose quads are split along (-1, 1): walked along (1, 1), a vertex's +x and +y
@@ -504,8 +535,8 @@ def test_the_compiled_crack_walk_takes_the_loops_paths():
                         (trimesh.creation.cylinder(radius=8.0, height=60.0, sections=64), 0.0),
                         (grid, 0.0)):
         V = np.asarray(mesh.vertices).view(np.ndarray) + rng.normal(0, noise, mesh.vertices.shape)
-        nb = _neighbours(mesh)
-        csr = _csr(nb)
+        csr = _neighbours(mesh)
+        nb = [csr[1][a:b].tolist() for a, b in zip(csr[0][:-1], csr[0][1:])]
         n = 3000
         starts = rng.integers(0, len(V), n)
         dirs = rng.standard_normal((n, 3))
