@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import WoodcamError
+from .tolerances import UNIT_LENGTH_TOL
 
 
 def did_you_mean(given: str | Iterable[str], names: Iterable[str], *, n: int = 1,
@@ -150,7 +151,9 @@ def check_bool(value, name: str, *, fix: str = "") -> bool:
 
 def check_vector(value, name: str, *, n: int = 3, unit: bool = False, fix: str = "") -> np.ndarray:
     """``value`` as a float ``(n,)`` array of finite numbers; ``unit=True``: a non-zero
-    direction, returned normalised to length 1."""
+    direction, returned normalised to length 1, or as given when it is of length 1 to rounding
+    (:data:`~woodcam.tolerances.UNIT_LENGTH_TOL`), so normalising a normalised vector is the
+    identity: an object that stores its normalised direction is rebuilt from it exactly."""
     what = "three finite numbers (x, y, z)" if n == 3 else f"{n} finite numbers"
     v = as_floats(value)
     if v is None or v.shape != (n,) or not np.all(np.isfinite(v)):
@@ -160,7 +163,9 @@ def check_vector(value, name: str, *, n: int = 3, unit: bool = False, fix: str =
         if length < 1e-12:
             _fail(name, "a non-zero direction", value,
                   fix or f"e.g. {name}=({', '.join(['1'] + ['0'] * (n - 1))})")
-        v = v / length
+        # of length 1 to rounding: kept, as a second division moved its last bits (a copy: not
+        # the caller's own array, as the division returned none)
+        v = v / length if abs(length - 1.0) > UNIT_LENGTH_TOL else v.copy()
     return v
 
 

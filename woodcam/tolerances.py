@@ -692,3 +692,11 @@ POINT_BOUND_MM = 1e6
 #: speck and grown without a word. Not higher: the woodify tests and examples grow 10 mm balls
 #: as real millimetre parts, and a 10 mm knob is one.
 INCHES_BELOW_MM = 6.35
+
+#: Largest ``|length - 1|`` of a direction taken as unit already (:func:`woodcam._checks.check_vector`
+#: with ``unit=True``): returned as given, not divided by its length again. A float64 3-vector
+#: divided by its own length lies within 3.4e-16 of length 1 (2e5 random vectors of lengths
+#: 1e-8..1e8, some on an axis or nearly), and dividing again moved its last bits:
+#: ``GrowthSpeed.from_dict(g.to_dict())`` differed from ``g`` for 692 of 2000 random ``up``.
+#: Four times that worst case; a direction this close to unit turns by under 1e-15 rad if kept.
+UNIT_LENGTH_TOL = 1.5e-15
