@@ -41,3 +41,27 @@ def test_carved_part_shows_the_knot(gran1):
     assert near.sum() > 10 and far.sum() > 10
     assert np.all(feats["knot"][near] > 0.8)         # knot wood where the knot crosses
     assert np.all(feats["knot"][far] < 0.2)          # clear wood elsewhere on that face
+
+
+def test_a_point_past_the_bound_in_the_log_is_quoted_as_the_caller_gave_it():
+    """A block-frame point within the 1 km bound that lands past it in the log frame (the
+    knotty block's log origin sits 95 mm across its x) was refused by the log field's own
+    door, quoting the log-frame point [95.0, -1000040.0, 315.7] and telling the caller, who
+    gave block-frame points, to 'pass block-frame points'. Now the placement refuses it,
+    quoting the block-frame point given, naming both frames; a log field called directly is
+    told to pass log-frame points."""
+    from woodcam.errors import WoodcamError
+    from woodcam.fields import builtin_block
+
+    field = builtin_block("knotty").field
+    pts = np.array([[10.0, 20.0, 5.0], [-999990.0, 0.0, 0.0]])
+    for call in (field, field.grain_direction, field.knot_features, field.evaluate):
+        with pytest.raises(WoodcamError) as err:
+            call(pts)
+        msg = str(err.value)
+        assert msg.startswith("points_mm (block frame) must lie, placed in the log, within 1e+06 mm"), msg
+        assert "point 1 is [-999990.0, 0.0, 0.0] in the block frame, [95.0, -1000040.0, 315.685] in the log " \
+               "frame" in msg, msg
+    assert np.isfinite(field(pts[:1])).all()
+    with pytest.raises(WoodcamError, match=r"point 0 is \[2000000.0, 0.0, 0.0\]; pass log-frame points in mm"):
+        field.log_field(np.array([[2e6, 0.0, 0.0]]))

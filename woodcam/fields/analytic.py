@@ -62,7 +62,7 @@ class AnalyticLogField:
 
     def __call__(self, points_log_mm) -> np.ndarray:
         """Growth time ``(n,)`` in years at log-frame points ``(n, 3)`` mm."""
-        p = check_points(points_log_mm, "points_log_mm")
+        p = check_points(points_log_mm, "points_log_mm", frame="log")
         x, y = p[:, 0], p[:, 1]
         r = np.hypot(x, y)
         th = np.arctan2(y, x)

@@ -31,9 +31,13 @@ class GrowthField(Protocol):
     def __call__(self, points_mm: np.ndarray) -> np.ndarray: ...
 
 
-def check_points(points_mm, name: str = "points_mm") -> np.ndarray:
+def check_points(points_mm, name: str = "points_mm", *, frame: str = "block") -> np.ndarray:
     """Return ``points_mm`` as a float64 ``(n, 3)`` array of finite points within
-    :data:`~woodcam.tolerances.POINT_BOUND_MM` of the origin, or raise a clear error."""
+    :data:`~woodcam.tolerances.POINT_BOUND_MM` of the origin, or raise a clear error.
+
+    ``frame`` names the frame the caller's points are in (``"block"``, or ``"log"`` for a
+    log-frame field called directly), for the bound's fix: a log field was told to pass
+    block-frame points."""
     p = as_floats(points_mm)
     if p is None:  # a ragged list was a bare ValueError; complex points lost their imaginary
         # parts under numpy's ComplexWarning, text '10' was 10.0 and None a NaN
@@ -49,7 +53,7 @@ def check_points(points_mm, name: str = "points_mm") -> np.ndarray:
         bad = int(np.argmax(far.any(axis=1)))
         raise WoodcamError(f"{name} must lie within {POINT_BOUND_MM:g} mm ({POINT_BOUND_MM / 1e6:g} km) of the "
                            "origin on each axis; "
-                           f"point {bad} is {p[bad].tolist()}; pass block-frame points in mm (a unit or frame "
+                           f"point {bad} is {p[bad].tolist()}; pass {frame}-frame points in mm (a unit or frame "
                            "mistake?)")
     return p
 
@@ -221,15 +225,29 @@ class LogFrame:
         return self._rot
 
     def to_log(self, points_mm: ArrayLike) -> np.ndarray:
-        """Block-frame points ``(n, 3)`` -> log-frame points ``(n, 3)`` (mm)."""
+        """Block-frame points ``(n, 3)`` -> log-frame points ``(n, 3)`` (mm).
+
+        Raises a :class:`~woodcam.errors.WoodcamError` quoting the caller's block-frame point
+        when one lands past :data:`~woodcam.tolerances.POINT_BOUND_MM` in the log frame: the
+        log field's own check quoted the log-frame point and told the caller, who gave
+        block-frame points, to 'pass block-frame points'."""
         p = check_points(points_mm)
         # einsum, not ``@``: OpenBLAS threading makes an (n, 3) x (3, 3) product up to 30x
         # slower on a busy 2-core machine, and this runs for every texel.
-        return np.einsum("ij,kj->ik", p - np.asarray(self.pith_point_mm, float), self._rot)
+        q = np.einsum("ij,kj->ik", p - np.asarray(self.pith_point_mm, float), self._rot)
+        if len(q) and np.abs(q).max() > POINT_BOUND_MM:  # a NaN-free p (checked): a NaN-free q
+            bad = int(np.argmax((np.abs(q) > POINT_BOUND_MM).any(axis=1)))
+            raise WoodcamError(
+                f"points_mm (block frame) must lie, placed in the log, within {POINT_BOUND_MM:g} mm "
+                f"({POINT_BOUND_MM / 1e6:g} km) of the log frame's origin on each of its axes (its pith passes "
+                f"through {np.round(self.pith_point_mm, 3).tolist()} mm of the block frame); point {bad} is "
+                f"{p[bad].tolist()} in the block frame, {np.round(q[bad], 3).tolist()} in the log frame; pass "
+                "block-frame points in mm, near the block (a unit or frame mistake?)")
+        return q
 
     def to_block(self, points_log_mm: ArrayLike) -> np.ndarray:
         """Log-frame points ``(n, 3)`` -> block-frame points ``(n, 3)`` (mm)."""
-        p = check_points(points_log_mm, "points_log_mm")
+        p = check_points(points_log_mm, "points_log_mm", frame="log")
         return np.einsum("ij,jk->ik", p, self._rot) + np.asarray(self.pith_point_mm, float)
 
     def direction_to_block(self, dirs_log: ArrayLike) -> np.ndarray:

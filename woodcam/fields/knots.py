@@ -329,7 +329,7 @@ class KnottedLogField:
 
     def stem_years(self, points_mm: ArrayLike) -> np.ndarray:
         """The stem field alone (no knots): ``years (n,)`` at log-frame points (seed eq. 1)."""
-        p = check_points(points_mm)
+        p = check_points(points_mm, frame="log")
         _, _, ds, _, sp = self._stem(p)
         return ds / sp / self.ring_width_mm
 
@@ -357,7 +357,7 @@ class KnottedLogField:
         Returns ``years``, ``knot``, ``dead``, ``outline`` (each ``(n,)``) and, with
         ``directions=True``, ``direction (n, 3)``.
         """
-        p = check_points(points_mm)
+        p = check_points(points_mm, frame="log")
         directions = check_bool(directions, "directions")
         n = len(p)
         if self.backend == "numba" and n:
