@@ -83,8 +83,11 @@ class Stock:
     ----------
     spec : str
         The block spec it was opened from (stored in exported GLBs).
-    size_mm : (W, D, H)
+    size_mm : (W, D, H) float
+        Block size in mm: width along X, depth along Y, height along Z of the block frame
+        (origin at its bottom-front-left corner, ``docs/conventions.md``).
     wood : Wood
+        Its growth field (block-frame points in mm -> years) and appearance.
     description : str
     meta : dict
     """

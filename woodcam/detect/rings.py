@@ -189,7 +189,13 @@ RING_MAP_SIGMA_MM = 0.62
 
 @dataclass
 class RingDetection:
-    """What :func:`detect_rings` found on one face (see module docstring for shapes)."""
+    """What :func:`detect_rings` found on one face (see module docstring for shapes).
+
+    Maps are ``(h, w)``, the face image's pixels (row, column; the face's own image frame,
+    :mod:`woodcam.frames`): ``ring_map`` float32 in [0, 1], ``normal_rad`` the ring normal's
+    angle (radians), ``wavelength_px`` the ring spacing (pixels), ``confidence`` in [0, 1],
+    ``evidence`` bool; ``traces`` polylines in continuous pixel coordinates ``(row, col)``.
+    """
 
     traces: list[RingTrace]
     ring_map: np.ndarray

@@ -26,7 +26,8 @@ from ..tolerances import MAX_BATCH_POINTS, POINT_BOUND_MM
 
 @runtime_checkable
 class GrowthField(Protocol):
-    """Anything callable as ``field(points_mm (n, 3)) -> years (n,)``."""
+    """Anything callable as ``field(points_mm (n, 3)) -> years (n,)``: block-frame points in
+    mm to growth time in years since the pith (see module docstring)."""
 
     def __call__(self, points_mm: np.ndarray) -> np.ndarray: ...
 
@@ -168,7 +169,9 @@ def central_gradient(field: GrowthFieldLike, points_mm: ArrayLike,
 
 
 def grain_direction(field: GrowthFieldLike, points_mm: ArrayLike) -> np.ndarray:
-    """Unit fibre directions ``(n, 3)`` of ``field`` at ``points_mm`` (see module docstring)."""
+    """Unit fibre directions ``(n, 3)`` of ``field`` at ``points_mm (n, 3)`` (mm, the field's frame:
+    the block frame for a block's field), in that frame: the field's own ``grain_direction``,
+    else its ``axis`` (else ``+Z``) at every point (see module docstring)."""
     p = check_points(points_mm)
     fn = getattr(field, "grain_direction", None)
     if fn is not None:

@@ -35,7 +35,8 @@ BUILTIN_SIZE_MM = (100.0, 80.0, 50.0)
 
 @dataclass(frozen=True)
 class BuiltinBlock:
-    """A named synthetic block: size, true growth field, suggested species, one-line summary."""
+    """A named synthetic block: size ``size_mm (3,)`` (W, D, H mm), true growth ``field``
+    (block-frame points ``(n, 3)`` mm -> ``years (n,)``), suggested species, one-line summary."""
 
     name: str
     size_mm: tuple[float, float, float]
@@ -100,7 +101,9 @@ def check_builtin_name(name: str) -> None:
 
 
 def builtin_block(name: str) -> BuiltinBlock:
-    """Return the built-in block ``name`` (see :data:`BUILTIN_NAMES`)."""
+    """Return the built-in block ``name`` (see :data:`BUILTIN_NAMES`): its ``size_mm (3,)``
+    (W, D, H mm), its true growth ``field`` (block-frame points ``(n, 3)`` mm -> ``years
+    (n,)``), suggested species and one-line description (:class:`BuiltinBlock`)."""
     check_builtin_name(name)
     if name == "knotty":
         return _knotty_block()

@@ -23,7 +23,21 @@ from .state import field_from_state, field_to_state
 
 
 class PlacedField:
-    """A log-frame growth field in block coordinates (see module docstring)."""
+    """A log-frame growth field in block coordinates (see module docstring).
+
+    Parameters
+    ----------
+    log_field : growth field
+        ``(n, 3)`` log-frame points (mm) -> ``years (n,)``.
+    origin_mm : (3,) float
+        Where the block origin (its bottom-front-left corner) sits in the log frame, mm.
+    rotation : (3, 3) float, optional
+        Proper rotation whose columns are the block's X, Y, Z axes in the log frame: block
+        point ``p`` sits at ``origin_mm + rotation @ p`` in the log; default the identity.
+
+    Calling it with block-frame points ``(n, 3)`` mm gives ``years (n,)``; ``grain_direction``
+    answers unit ``(n, 3)`` directions in the block frame.
+    """
 
     def __init__(self, log_field: GrowthFieldLike, origin_mm: ArrayLike = (0.0, 0.0, 0.0),
                  rotation: ArrayLike | None = None):

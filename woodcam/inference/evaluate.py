@@ -240,6 +240,19 @@ def evaluate_fit(true_field: GrowthFieldLike, fitted_field: GrowthFieldLike, siz
                  keep_lines: bool = False) -> dict:
     """Table-1 accuracy of ``fitted_field`` against ``true_field`` on ``planes`` of a block.
 
+    Parameters
+    ----------
+    true_field, fitted_field : growth fields
+        Block-frame points ``(n, 3)`` mm -> ``years (n,)``.
+    size_mm : (3,) float
+        The block's W, D, H (mm); the planes' points are fractions of it.
+    planes : sequence of CutPlane
+        The cuts scored (default :data:`DEFAULT_PLANES`, seven).
+    pixel_mm : float
+        Sample spacing on each cut plane, mm.
+    keep_lines : bool
+        Keep each plane's ring lines in its score (for pictures).
+
     Returns
     -------
     summary : dict (see :func:`summarise`)

@@ -46,7 +46,8 @@ def gran1_folder(fix: str) -> Path:
 
 
 def write_log(log: LogSkeleton, path: PathLike) -> Path:
-    """Write ``log`` as a woodcam log file (JSON, mm); returns the path."""
+    """Write ``log`` as a woodcam log file (JSON, every length in mm, the log's own frame: z
+    along the pith, :class:`~woodcam.fields.skeleton.LogSkeleton`); returns the path."""
     from .._atomic import write_text
 
     if not isinstance(log, LogSkeleton):  # None was an AttributeError ('to_json')
@@ -57,7 +58,8 @@ def write_log(log: LogSkeleton, path: PathLike) -> Path:
 
 
 def read_log(path: PathLike) -> LogSkeleton:
-    """Read a woodcam log file written by :func:`write_log` (or by hand, same keys)."""
+    """Read a woodcam log file written by :func:`write_log` (or by hand, same keys) as a
+    :class:`~woodcam.fields.skeleton.LogSkeleton` (log frame, mm)."""
     path = check_path(path, "read_log: path", fix="a JSON log file written by write_log")
     if not path.is_file():
         raise WoodcamError(f"log file {str(path)!r} does not exist; give a path to a JSON file "

@@ -127,7 +127,13 @@ class Parquetry:
 
 @dataclass
 class ParquetryRun:
-    """Everything a run made: the targets' panels, the sheets, the bank (consumed wood), timing."""
+    """Everything a run made: the targets' panels, the sheets, the bank (consumed wood), timing.
+
+    ``placed`` / ``planned``: patches placed of those planned; ``match_seconds`` (wall clock)
+    and ``cpu_seconds``, s; ``repaired``: piece (patch) id -> what :func:`repair_fabricability`
+    changed. Panel images and patch windows are in panel pixels at ``params.px_per_mm``
+    (:class:`Patch`), veneers in their own pixels (:class:`Veneer`).
+    """
 
     params: ParquetryParams
     veneers: list[Veneer]

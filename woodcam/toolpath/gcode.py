@@ -77,7 +77,13 @@ class Move:
 
 @dataclass
 class Program:
-    """Straight moves of a G-code program as arrays (see the module docstring for the form)."""
+    """Straight moves of a G-code program as arrays (see the module docstring for the form).
+
+    ``n`` moves: ``start_mm, end_mm (n, 3)`` float, G-code (G54 work) frame, mm whatever
+    G20/G21 the program used; ``kind (n,)`` (0 rapid, 1 feed), ``tool (n,)``, ``line (n,)``
+    (1-based source line), ``feed_mm_min (n,)`` mm/min, ``spindle_rpm (n,)``; ``inch (n,)``
+    bool and ``ran_line (n,)`` int per move as commented below.
+    """
 
     start_mm: np.ndarray
     end_mm: np.ndarray

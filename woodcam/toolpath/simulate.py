@@ -118,7 +118,13 @@ def _summarise(issues: dict, move_lines: np.ndarray, excess: dict | None = None)
 
 @dataclass
 class SimResult:
-    """Result of :func:`simulate` (see the module docstring for the height-field form)."""
+    """Result of :func:`simulate` (see the module docstring for the height-field form).
+
+    ``heightmap (ny, nx)`` float: top of the remaining stock over each cell centre, block-frame
+    Z in mm (row ``j`` along +Y, column ``i`` along +X); ``size_mm (3,)`` the stock's W, D, H
+    mm; ``cell_mm (2,)`` the cell size ``(dx, dy)`` mm; ``report``: the issues found (rapids
+    into stock, ...); ``stats``: counts and timings.
+    """
 
     heightmap: np.ndarray
     size_mm: tuple[float, float, float]

@@ -478,7 +478,9 @@ def _spec_help() -> str:
 
 
 def parse_tool_spec(spec: str) -> Tool:
-    """Parse a tool spec such as ``flat:6.35``, ``ball:3``, ``bull:6:1``, ``vbit:60:12``."""
+    """Parse a tool spec such as ``flat:6.35``, ``ball:3``, ``bull:6:1``, ``vbit:60:12``: lengths
+    in mm (diameters; a bull nose's corner radius), a V-bit's included angle in degrees
+    (module docstring)."""
     parts = str(spec).strip().lower().split(":")
     kind = parts[0]
     reach: dict[str, float] = {}
@@ -521,8 +523,8 @@ def parse_tool_spec(spec: str) -> Tool:
 
 
 def load_tool_table(path: PathLike) -> dict[int, Tool]:
-    """Read a TOML tool table (module docstring), or a CAMotics JSON tool table
-    (:func:`load_camotics_tools`), into ``{tool number: Tool}``."""
+    """Read a TOML tool table (module docstring; lengths in mm), or a CAMotics JSON tool table
+    (:func:`load_camotics_tools`, converted from its units), into ``{tool number: Tool}``."""
     path = check_path(path, "load_tool_table: path", fix="a TOML or CAMotics JSON tool table")
     if path.suffix.lower() in (".json", ".camotics"):
         return load_camotics_tools(path)

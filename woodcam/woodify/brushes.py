@@ -34,7 +34,21 @@ from ..fields.base import check_points
 
 @dataclass(frozen=True)
 class Brush:
-    """One painted stroke (see module docstring); lengths in mm, object frame."""
+    """One painted stroke (see module docstring); lengths in mm, object frame (the input mesh's).
+
+    Attributes
+    ----------
+    centre_mm : (3,) float
+        Centre of the stroke on (or near) the input surface, mm.
+    radius_mm : float
+        Gaussian fall-off radius ``r`` (mm), > 0.
+    gain : float
+        Speed gain at the centre, > 0 (1 = unchanged, 2 = twice as fast).
+    direction : (3,) float
+        Direction the front bends towards (normalised here), object frame.
+    strength : float
+        How far it bends, in [0, 1) (0 = not at all).
+    """
 
     centre_mm: tuple[float, float, float]
     radius_mm: float
