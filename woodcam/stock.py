@@ -428,7 +428,7 @@ def _open_base_stock(parsed: ParsedSpec, species, appearance, appearance_params,
     return _open_mokume_folder(path, species, appearance, appearance_params, species_given)
 
 
-def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
+def open_block(spec: str, *, size_mm: float | tuple[float, float, float] | None = None, face_px: int = 256):
     """Resolve a block spec to ``(block, field)``: the one block resolver of every command.
 
     Parameters
@@ -439,8 +439,9 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
         :func:`woodcam.synth.synth_block` (seed 0) from the true field; a folder is read by
         :func:`woodcam.block.io.read_block_folder` (block folder or Mokume sample folder); a
         folder of photos only gets its rings detected (cached, :mod:`woodcam.detect.block`).
-    size_mm : float, optional
-        Cube side of a Mokume sample folder (its files carry no size; default 50 mm).
+    size_mm : float or (W, D, H), optional
+        Size in mm of a Mokume sample folder (its files carry no size; default a 50 mm cube), one
+        number a cube's side; a Mokume sample is a cube, so another size is refused there.
     face_px : int
         Pixels along the largest face side of a synthetic block's photos.
 
@@ -472,7 +473,8 @@ def open_block(spec: str, *, size_mm: float | None = None, face_px: int = 256):
     from .detect.block import with_detected_rings
 
     folder = _existing_folder(spec)
-    block = read_block_folder(folder, None if size_mm is None else (float(size_mm),) * 3)
+    sides = None if size_mm is None else [float(v) for v in np.broadcast_to(np.asarray(size_mm, float), (3,))]
+    block = read_block_folder(folder, None if sides is None else (sides[0], sides[1], sides[2]))
     # A block of photos only: rings detected once, cached by content outside the folder (the
     # user's files a 'block from-photos' remake left unnamed in it read in)
     block = with_detected_rings(block, progress=True, folder=folder)

@@ -104,27 +104,6 @@ def test_size_mm_on_a_block_folder_is_said_to_be_unused(synth_photos, tmp_path, 
     assert read_block(blk).size_mm == (50.0, 50.0, 50.0)
 
 
-def test_a_mokume_cube_size_typed_as_from_photos_takes_it_is_read_or_refused_with_the_rule(tmp_path, capsys):
-    """'rings detect SAMPLE --size-mm 50x50x50' (a size as block from-photos takes it) was
-    argparse's 'invalid float value: '50x50x50'', no word of what the option takes: a cube's
-    sides read as its side; another size is a usage error saying the option sizes a cube."""
-    from woodcam.cli import build_parser
-
-    parser = build_parser()
-    for cmd in (("rings", "detect", "s", "--out", "o"), ("rings", "show", "s", "--out", "o.png"),
-                ("fit", "s", "--out", "f.npz")):
-        assert parser.parse_args([*cmd, "--size-mm", "50x50x50"]).size_mm == 50.0
-        assert parser.parse_args([*cmd, "--size-mm", "30"]).size_mm == 30.0
-    for size in ("50x50", "abc", "50x40x30"):
-        with pytest.raises(SystemExit) as exc:  # argparse's usage error
-            main(["rings", "detect", str(tmp_path / "s"), "--out", str(tmp_path / "o"), "--size-mm", size])
-        out, err = capsys.readouterr()
-        assert exc.value.code == EXIT_USAGE and out == "" and err.count("\n") == 1, err
-        assert (f"--size-mm sizes a Mokume sample folder, a cube: give its side in mm, one number in (0, 10000] "
-                f"(raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 50; got {size!r}") in err, err
-    assert "(50x40x30 mm is no cube; a block folder records its own size)" in err
-
-
 def test_corrected_svg_wins_over_detection(synth_photos, tmp_path, capsys):
     blk = tmp_path / "blk"
     assert _run(capsys, "block", "from-photos", synth_photos, "--size-mm", "50", "--out", blk)[0] == 0
@@ -378,7 +357,8 @@ def test_mokume_folder_is_redetected(tmp_path, capsys):
     assert line == (f"woodcam: warning: '{src}': Mokume's ring maps A_arl-unet.png, B_arl-unet.png, C_arl-unet.png, "
                     "D_arl-unet.png, E_arl-unet.png, F_arl-unet.png and knot masks C_knot.png, F_knot.png are not "
                     "read: rings and knots are detected on its photos afresh; to use Mokume's maps instead, give the "
-                    f"sample folder itself to fit, bake or eval ({src} --size-mm WxDxH)"), line
+                    f"sample folder itself to fit, bake or eval ({src} --size-mm SIDE, a Mokume sample being a cube; bake "
+                    "reads it as a 50 mm cube)"), line
     b = read_block(tmp_path / "h11")
     assert set(b.faces) == set(FACES)
     assert {n for n, f in b.faces.items() if "knot_mask" in f.extras} >= {"left", "back"}
@@ -398,7 +378,7 @@ def test_from_photos_of_a_mokume_folder_names_the_maps_it_does_not_read(tmp_path
                            "C_arl-unet.png, D_arl-unet.png, E_arl-unet.png, F_arl-unet.png and knot masks "
                            "C_knot.png, F_knot.png are not read"), line
     assert "'woodcam rings detect' finds the rings and knots on them" in line
-    assert f"give the sample folder itself to fit, bake or eval ({src} --size-mm WxDxH)" in line
+    assert f"give the sample folder itself to fit, bake or eval ({src} --size-mm SIDE, a Mokume sample" in line
     b = read_block(tmp_path / "b")
     assert all(f.photo is not None and f.ring_map is None and not f.extras for f in b.faces.values())
     # a folder of photos alone says nothing

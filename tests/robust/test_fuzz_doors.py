@@ -347,10 +347,10 @@ def _cli_case(data):
 
         def check(_):
             v = getattr(args, option[2:].replace("-", "_"))
-            assert math.isfinite(v)
             name = option[2:].replace("-", "_")  # a command's own range first, as check_numbers reads them
             lo, hi, lo_open = option_bounds(name, args.command)
-            assert lo <= v <= hi and not (lo_open and v <= lo)
+            for x in v if isinstance(v, tuple) else (v,):  # --size-mm: (W, D, H)
+                assert math.isfinite(x) and lo <= x <= hi and not (lo_open and x <= lo)
 
         return own_error_or_valid(lambda: check_numbers(args), check)
     return "argparse"

@@ -460,9 +460,9 @@ def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *
     folder : path
         A sample folder such as ``../shared/data/mokume/H11``.
     size_mm : (W, D, H)
-        Physical size of the cube in mm. Mokume cubes are normalised by their largest side and
-        the files do not record it, so it is an argument; default 50 mm cube
-        (:data:`MOKUME_DEFAULT_SIZE_MM`).
+        Physical size of the cube in mm, three equal sides (another size is refused). Mokume
+        cubes are normalised by their largest side and the files do not record it, so it is an
+        argument; default 50 mm cube (:data:`MOKUME_DEFAULT_SIZE_MM`).
     name : str, optional
         Block name; default the folder name.
 
@@ -485,6 +485,13 @@ def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *
     """
     folder = check_path(folder, "read_mokume: folder", fix="a Mokume sample folder such as shared/data/mokume/H11")
     size = tuple(check_size(size_mm).tolist())  # -1 was "'int' object is not iterable", after every image was read
+    if len(set(size)) != 1:
+        # a Mokume sample is a cube photographed square on every face: 50x40x30 (as 'block
+        # from-photos --size-mm' takes a size) gave faces of non-square pixels without a word
+        side = max(size)
+        raise WoodcamError(f"size_mm (--size-mm) {'x'.join(f'{v:g}' for v in size)} mm is no cube, and a Mokume "
+                           f"sample folder ({str(folder)!r}) is a cube, its faces square photos: give the cube's "
+                           f"side, one number, e.g. --size-mm {side:g}")
     if not folder.is_dir():
         raise WoodcamError(f"folder must be a Mokume sample folder; {str(folder)!r} is not a directory")
     faces = {}

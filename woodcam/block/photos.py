@@ -136,7 +136,8 @@ def mokume_maps_said(folder, paths: list[Path], instead: str) -> str:
     said = " and ".join(f"{kind}{'s' if len(names) > 1 else ''} {', '.join(names)}" for kind, names in kinds if names)
     return (f"{str(folder)!r}: Mokume's {said} {'is' if len(paths) == 1 else 'are'} not read: {instead}; to use "
             f"Mokume's maps instead, give the sample folder itself to fit, bake or eval "
-            f"({shlex.quote(str(folder))} --size-mm WxDxH)")
+            f"({shlex.quote(str(folder))} --size-mm SIDE, a Mokume sample being a cube; bake reads it as a 50 mm "
+            f"cube)")
 
 
 def stray_photos(folder) -> list[Path]:

@@ -805,31 +805,42 @@ def add_block_argument(p: argparse.ArgumentParser, *, option: bool = True, nargs
         add_input(p, "block", kind="block", as_is=True, nargs=nargs, help=BLOCK_READ_HELP)
 
 
-def _cube_side(text: str) -> float:
-    """argparse ``type`` of :func:`add_size_option`: a Mokume sample's cube side in mm, one number
-    (or ``SxSxS``, the cube as ``block from-photos --size-mm`` takes a size), else a usage error
-    saying so: ``--size-mm 50x50x50`` copied from ``block from-photos`` was argparse's 'invalid
-    float value', no word of what the option takes. One number's range is checked with the other
-    options' (:data:`RANGES`)."""
-    try:
-        return float(text)
-    except ValueError:
-        pass
+#: The one help of ``--size-mm`` (every command that takes it: :func:`add_size_option`).
+SIZE_MM_HELP = ("block size in mm: one number, a cube's side (e.g. 50), or W x D x H, width x depth x "
+                "height in the frame of ../shared/docs/conventions.md (e.g. 50x40x30)")
+
+
+def block_size_mm(text: str) -> tuple[float, float, float]:
+    """argparse ``type`` of ``--size-mm`` (:func:`add_size_option`), its one parser: ``"50"`` (a
+    cube's side) or ``"50x40x30"`` (W x D x H) -> (W, D, H) in mm, each finite and in (0,
+    :data:`~woodcam.limits.MAX_BLOCK_SIZE_MM`]; else a usage error naming the option, its rule
+    and the text received. ``--size-mm`` was a cube's side (one number) in five commands and W x
+    D x H in ``block from-photos``: ``50x40x30`` copied from one to the other was refused, and
+    the two refusals said different rules."""
     cap = limit("MAX_BLOCK_SIZE_MM")
     sides = parse_lengths(text, 3, max_mm=cap, cube=True)
-    if sides is None or len(set(sides)) != 1:
-        what = "" if sides is None else f"{'x'.join(f'{s:g}' for s in sides)} mm is no cube; "
+    if sides is None:
         raise argparse.ArgumentTypeError(
-            f"--size-mm sizes a Mokume sample folder, a cube: give its side in mm, one number in (0, "
-            f"{cap:g}] (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N), e.g. 50; got {text!r} "
-            f"({what}a block folder records its own size)")
-    return sides[0]
+            f"--size-mm takes a block size in mm, one number (a cube's side, e.g. 50) or W x D x H (e.g. "
+            f"50x40x30), each in (0, {cap:g}] (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N); got {text!r}")
+    return (sides[0], sides[1], sides[2])
 
 
-def add_size_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--size-mm", type=_cube_side, default=None, metavar="MM",
-                   help="cube side in mm of a Mokume sample folder (its files carry no size; "
-                   "default 50)")
+def say_size_mm(size) -> str:
+    """A ``--size-mm`` value (W, D, H) as a user types it: ``50`` for a cube, else ``50x40x30``."""
+    sides = [f"{float(v):g}" for v in size]
+    return sides[0] if len(set(sides)) == 1 else "x".join(sides)
+
+
+def add_size_option(p: argparse.ArgumentParser, *, required: bool = False) -> None:
+    """``--size-mm SIZE`` -> ``args.size_mm``, (W, D, H) mm or None: :func:`block_size_mm`.
+    ``required``: the size of a block made of photos (``block from-photos``), which carry none;
+    else a Mokume sample folder's size, its default the dataset's 50 mm cube."""
+    default = ("; required: photos carry no size" if required else
+               " (default 50, a 50 mm cube: sizes a Mokume sample folder, whose files carry no size; a block "
+               "folder records its own)")
+    p.add_argument("--size-mm", type=block_size_mm, required=required, default=None, metavar="SIZE",
+                   help=SIZE_MM_HELP + default)
 
 
 def add_check_layout_option(p: argparse.ArgumentParser) -> None:
@@ -862,7 +873,7 @@ def report_layout(block) -> None:
               if report.faces else f"layout: not checked (no two neighbouring faces with a photo or ring map){skipped}")
 
 
-def open_block(spec, size_mm: float | None = None, face_px: int = 256):
+def open_block(spec, size_mm: tuple[float, float, float] | None = None, face_px: int = 256):
     """``(block, field or None)`` for a block argument: :func:`woodcam.stock.open_block`.
     ``size_mm`` (``--size-mm``) sizes a Mokume sample folder only; given with a spec that is no
     folder (``builtin:flat-sawn``, ``log:...``) it was dropped without a word and the block kept
@@ -874,7 +885,7 @@ def open_block(spec, size_mm: float | None = None, face_px: int = 256):
 
         from ..errors import WoodcamWarning
 
-        warnings.warn(f"--size-mm {size_mm:g} sizes Mokume sample folders only; {str(spec)!r} is no folder "
+        warnings.warn(f"--size-mm {say_size_mm(size_mm)} sizes Mokume sample folders only; {str(spec)!r} is no folder "
                       "and keeps its own size: ignored (a built-in or log block takes its size in the spec, "
                       "e.g. builtin:flat-sawn:40x40x40)", WoodcamWarning, stacklevel=2)
     return _open_block(str(spec), size_mm=size_mm, face_px=face_px)

@@ -10,11 +10,7 @@ import shlex
 from pathlib import Path
 
 from ..errors import WoodcamError
-from .options import add_input, add_check_layout_option, add_out_option, add_size_option, parse_sizes, report_layout
-
-
-def _size(text: str) -> tuple[float, float, float]:
-    return parse_sizes(text, "--size-mm", cube=True)
+from .options import add_input, add_check_layout_option, add_out_option, add_size_option, report_layout
 
 
 def add_from_photos(sub) -> None:
@@ -25,8 +21,7 @@ def add_from_photos(sub) -> None:
                        "seen from outside; check them against --size-mm; write a block folder with the "
                        "photos. Then run 'woodcam rings detect'.")
     add_input(p, "photos_dir", kind="folder", type=Path, help="folder with the six face photos")
-    p.add_argument("--size-mm", required=True, help="block size WxDxH in mm (width x depth x height), "
-                   "or one number for a cube")
+    add_size_option(p, required=True)
     add_out_option(p, "the block folder: block.json and the face photos")
     p.add_argument("--partial", action="store_true", help="accept fewer than six faces (default: all six)")
     p.add_argument("--max-px-per-mm", type=float, default=None,
@@ -38,7 +33,7 @@ def run_from_photos(args) -> int:
     from ..block.photos import MAX_PX_PER_MM, block_from_photos, clear_stale_photos, written_photos
     from ..detect.block import detection_record
 
-    block = block_from_photos(args.photos_dir, _size(args.size_mm), partial=args.partial,
+    block = block_from_photos(args.photos_dir, args.size_mm, partial=args.partial,
                               max_px_per_mm=MAX_PX_PER_MM if args.max_px_per_mm is None else args.max_px_per_mm,
                               progress=True)
     prior = detection_record(args.out)  # the block made again into its folder: its SVG corrections kept
@@ -120,7 +115,7 @@ def run(args) -> int:
         from ..detect.block import DEFAULT_DETECTOR, detect_folder
 
         manifest, msgs = detect_folder(args.block, args.out, rule=args.rule, knots=not args.no_knots,
-                                       size_mm=(args.size_mm,) * 3 if args.size_mm else None, progress=True,
+                                       size_mm=args.size_mm, progress=True,
                                        detector=args.detector or DEFAULT_DETECTOR, curved=True if args.curved else None)
         from . import print_warnings
 
@@ -140,7 +135,7 @@ def run(args) -> int:
         refs = None
         # the one reader of folders: a folder of the user's own photos was 'must hold Mokume
         # files like A_col.png', no word of 'block from-photos'
-        block = read_block_folder(folder, (args.size_mm,) * 3 if args.size_mm else None)
+        block = read_block_folder(folder, args.size_mm)
         if (folder / MANIFEST).is_file() or folder.name == MANIFEST:
             if not any(f.has_rings for f in block.faces.values()):
                 raise WoodcamError(f"block {str(folder)!r} has no rings yet; run 'woodcam rings detect "
