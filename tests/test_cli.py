@@ -249,8 +249,8 @@ def test_bake_draws_one_stage_bar_over_the_whole_run(tmp_path, bars, capsys):
 
 
 def test_meshing_options_on_a_mesh_part_are_said_to_be_ignored(tmp_path, capsys):
-    """--tolerance and --max-triangles only mesh B-rep parts; on an STL they did nothing,
-    without a word."""
+    """--tolerance only meshes B-rep parts; on an STL it did nothing, without a word.
+    --max-triangles bounds a mesh too: under it, nothing is said."""
     import trimesh
 
     from woodcam.cli import main
@@ -263,10 +263,61 @@ def test_meshing_options_on_a_mesh_part_are_said_to_be_ignored(tmp_path, capsys)
     assert main([*argv, "--out", str(tmp_path / "a.glb"), "--max-triangles", "1000",
                  "--tolerance", "0.5"]) == 0
     err = capsys.readouterr().err
-    assert "--tolerance and --max-triangles set how B-rep parts" in err
-    assert "box.stl is a triangle mesh, baked as it is: ignored" in err
+    assert "--tolerance sets how B-rep parts" in err and "--max-triangles" not in err.split("ignored")[0]
+    assert "box.stl is a triangle mesh, baked as it is: ignored" in err and "simplified" not in err
     assert main([*argv, "--out", str(tmp_path / "b.glb")]) == 0
     assert "ignored" not in capsys.readouterr().err
+
+
+def test_max_triangles_simplifies_a_mesh_part_over_it(tmp_path, capsys):
+    """A 1.3 M-triangle STL baked in ~100 s and 3.5 GB: --max-triangles bounded B-rep parts
+    only. A mesh over it is simplified (manifold3d), a warning giving both counts and the
+    tolerance; a mesh within it is baked as it is. (An icosphere of 5120 triangles against a
+    budget of 1000 stands for the big one.)"""
+    import json
+
+    sphere = trimesh.creation.icosphere(subdivisions=4, radius=15.0)
+    sphere.apply_translation((50, 40, 25))
+    part = tmp_path / "ball.stl"
+    sphere.export(part)
+    argv = ["bake", str(part), "--block", "builtin:flat-sawn", "--no-obj", "--texels-per-mm", "1"]
+    assert main([*argv, "--out", str(tmp_path / "a.glb"), "--max-triangles", "1000"]) == 0
+    out, err = capsys.readouterr()
+    said = re.search(r"ball\.stl': 5120 triangles exceeded max_triangles=1000 \(--max-triangles\); simplified to "
+                     r"(\d+) triangles, surfaces moved by less than ([\d.]+) mm \(raise --max-triangles to keep more\)",
+                     err)
+    assert said and err.count("\n") == 1, err
+    made = int(said.group(1))
+    assert 100 < made <= 1000 and float(said.group(2)) < 1.0, err
+    report = json.loads((tmp_path / "a_report.json").read_text())
+    assert any("simplified to" in w for w in report["warnings"])
+    from woodcam.cad import load_part
+    from woodcam.errors import WoodcamWarning
+
+    report: dict = {}
+    solid = load_part(sphere, max_triangles=1000, report=report)  # the part baked: its shape kept
+    assert solid.num_tri() == report["simplified"]["to"] <= 1000 and report["simplified"]["from"] == 5120
+    assert abs(solid.volume() / sphere.volume - 1) < 0.035  # 2.8 %: 1000 triangles of a 30 mm ball
+    with pytest.warns(WoodcamWarning, match="5120 triangles exceeded max_triangles=1000 .* simplified to"):
+        load_part(sphere, max_triangles=1000)  # no report to fill (woodcam place, woodify): a warning
+    assert main([*argv, "--out", str(tmp_path / "b.glb"), "--max-triangles", "6000"]) == 0
+    assert "simplified" not in capsys.readouterr().err
+
+
+def test_a_mesh_part_that_cannot_be_simplified_to_the_budget_is_refused(capsys):
+    """Forty separate 1 mm boxes (480 triangles) cannot be simplified to 100 triangles: within 1 %
+    of the diagonal they vanish. One line names --max-triangles, the counts and the fix."""
+    from woodcam.cad import load_part
+    from woodcam.errors import WoodcamError
+
+    boxes = trimesh.util.concatenate([trimesh.creation.box((1, 1, 1)).apply_translation((3 * i, 0, 0))
+                                      for i in range(40)])
+    with pytest.raises(WoodcamError, match=r"the part has 480 triangles, over max_triangles \(--max-triangles\) = "
+                       r"100, and simplifying it by up to 1.18 mm \(1 % of its diagonal at most\) left 0 and lost 40 of its 40 "
+                       r"bodies; raise --max-triangles to 480 to bake it whole, or simplify it in your CAD program$"):
+        load_part(boxes, max_triangles=100)
+    report: dict = {}
+    assert load_part(boxes, max_triangles=480, report=report).num_tri() == 480 and report["simplified"] is None
 
 
 def test_a_part_in_inches_gets_each_commands_own_fix(tmp_path, capsys, monkeypatch):

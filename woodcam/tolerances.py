@@ -294,6 +294,14 @@ CREASE_WELD_MM = 1e-6
 #: other examples untouched while bounding the unwrap (xatlas is super-linear in chart size).
 MAX_PART_TRIANGLES = 120_000
 
+#: The most a mesh part's surfaces may move (a fraction of its bounding-box diagonal) when it is
+#: simplified to the triangle budget; past it the part is refused, --max-triangles named. 1 %
+#: is ten times the B-rep default chord (TESSELLATION_REL_TOL): visible on the part, and said
+#: with the tolerance used, but the shape kept (an icosphere of 5120 triangles simplified to
+#: 1000 moves 0.4 % of its diagonal and loses 2-3 % of its volume); beyond it a small body
+#: (forty 1 mm boxes in a row) is ground down until it vanishes.
+MESH_SIMPLIFY_MAX_REL_TOL = 0.01
+
 
 #: Parquetry cut files: a join between two segments counts as a corner when the tangent turns by more than this
 #: (sine of the angle): seams are C1 in theory, and 1e-5 mm rounding of handles about 0.5 mm

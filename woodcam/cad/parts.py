@@ -48,6 +48,7 @@ from ..errors import WoodcamError, caused_by, require
 from ..units import said, say_length, say_volume
 from ..tolerances import (
     MAX_PART_TRIANGLES,
+    MESH_SIMPLIFY_MAX_REL_TOL,
     TESSELLATION_ANGLE_DEG,
     TESSELLATION_MIN_TOL_MM,
     TESSELLATION_REL_TOL,
@@ -63,6 +64,11 @@ _DEFAULT_TEXELS_PER_MM = 10.0
 #: (below the 30 degree crease angle of the exported normals, so curved faces stay smooth).
 _BUDGET_TRIES = 3
 _MAX_BUDGET_ANGLE_DEG = 20.0
+#: Simplification rounds of a mesh part over the triangle budget: each loosens the tolerance by
+#: the overshoot, at least by 1.25 (1.25^24 = 211: a quarter texel to 5 mm); the tolerance's
+#: cap (MESH_SIMPLIFY_MAX_REL_TOL) ends it sooner.
+_MESH_BUDGET_TRIES = 24
+_MESH_BUDGET_MIN_STEP = 1.25  # doubling overshot: 5120 -> 1364 -> 608 triangles for a budget of 1000
 
 #: File suffixes :func:`load_part` reads, by kind.
 STEP_SUFFIXES = (".step", ".stp")
@@ -130,13 +136,16 @@ def load_part(
         WoodcamError. POSIX main thread only (``SIGALRM``); it is checked between Python
         statements, so one long OCCT call finishes before it fires. Not a sandbox.
     max_triangles : int or None
-        Triangle budget for B-rep sources (default :data:`woodcam.tolerances.MAX_PART_TRIANGLES`):
-        above it the part is re-meshed with looser tolerances (stated in ``report["notes"]``);
-        None meshes at the given tolerances whatever the count.
+        Triangle budget of the part (default :data:`woodcam.tolerances.MAX_PART_TRIANGLES`):
+        above it a B-rep source is re-meshed with looser tolerances, and a mesh source (a mesh
+        file, a trimesh or manifold3d object) is simplified by manifold3d's
+        ``Manifold.simplify`` (the solid stays a valid manifold; its surfaces move by less than
+        the tolerance said); either is stated in ``report["notes"]``. None keeps every triangle.
     report : dict or None
         Filled with the tolerances used (``tolerance_mm``, ``angular_tolerance_deg``, and
         ``tolerance_rule``: how the chord tolerance was chosen), the triangle count, the
-        budget and notes about re-meshing.
+        budget, notes about re-meshing and ``simplified``: ``{"from": n, "to": m,
+        "tolerance_mm": t}`` for a mesh simplified to the budget, else None.
     texels_per_mm : float
         Texel density of the bake the part is meant for (> 0); sets the default tolerance.
 
@@ -179,9 +188,16 @@ def load_part(
                          math.radians(angular_tolerance_deg), _check_budget(max_triangles),
                          texels_per_mm=float(texels_per_mm))
     with _time_limit(timeout_s, source):
-        solid = _load(source, tess, origin="part")
+        solid = tess.fit_mesh(_load(source, tess, origin="part"), f"part {str(source)[:200]!r}"
+                              if isinstance(source, (str, Path)) else "the part")
     if report is not None:
         report.update(tess.report())
+    elif tess.simplified:  # no report to say it in (woodcam place, woodify, gcode): a warning
+        import warnings
+
+        from ..errors import WoodcamWarning
+
+        warnings.warn(WoodcamWarning(str(tess.notes[-1])), stacklevel=2)
     return solid
 
 
@@ -236,6 +252,8 @@ def _load(source: Any, tess: "_Tessellation", origin: str):
             f"{origin} is None; the script or builder produced no shape: make sure it builds "
             f"a solid and assigns it"
         )
+    if isinstance(source, (manifold3d.Manifold, trimesh.Trimesh, trimesh.Scene)):
+        tess.mesh_input = True  # its triangles are the source's: the budget simplifies them
     if isinstance(source, manifold3d.Manifold):
         return _check_manifold(source, origin)
     if isinstance(source, trimesh.Trimesh):
@@ -314,6 +332,7 @@ def _load_path(path: Path, tess: "_Tessellation"):
             f"the part from your CAD program again")
     if suffix in STEP_SUFFIXES:
         return _load_step(path, tess)
+    tess.mesh_input = True
     return _load_mesh_file(path)
 
 
@@ -974,6 +993,8 @@ class _Tessellation:
     used_tol_mm: float = 0.0
     used_ang_rad: float = 0.0
     rule: str = ""
+    mesh_input: bool = False  # a mesh (file, trimesh, manifold) was among the sources
+    simplified: dict | None = None  # fit_mesh's {"from", "to", "tolerance_mm"}
 
     def mesh_solids(self, solids, origin: str):
         if self.tol_mm is None:
@@ -1014,6 +1035,50 @@ class _Tessellation:
         self.triangles += count
         return meshes
 
+    def fit_mesh(self, solid, origin: str):
+        """``solid`` (a manifold) within ``max_triangles`` where a mesh source gave triangles:
+        a 1.3 M-triangle STL baked in ~100 s and 3.5 GB, the budget bounding B-reps only.
+        manifold3d's ``simplify(tol)`` (the maintained simplifier at hand, fast_simplification,
+        open3d and pymeshlab not being dependencies; it keeps the solid a valid manifold, which
+        quadric decimation does not promise) from a quarter texel (:func:`_auto_tolerance`),
+        the tolerance loosened by the overshoot (triangles fall about as 1 / tolerance on a
+        curved surface), at least by :data:`_MESH_BUDGET_MIN_STEP`, until the count fits; said
+        in :meth:`report`'s notes with both counts. A part that does not fit by
+        :data:`~woodcam.tolerances.MESH_SIMPLIFY_MAX_REL_TOL` of its diagonal, or that would lose
+        a body, is a WoodcamError naming --max-triangles and the counts."""
+        count = solid.num_tri()
+        if not self.mesh_input or self.max_triangles is None or count <= self.max_triangles:
+            return solid
+        box = solid.bounding_box()
+        diagonal = math.dist(box[:3], box[3:])
+        cap = MESH_SIMPLIFY_MAX_REL_TOL * diagonal
+        tol = min(cap, _auto_tolerance(diagonal, self.texels_per_mm))
+        simple, bodies = solid, None
+        for _ in range(_MESH_BUDGET_TRIES):
+            simple = solid.simplify(tol)
+            left = simple.num_tri()
+            if left <= self.max_triangles:
+                bodies = (len(solid.decompose()), len(simple.decompose()))
+                if bodies[1] == bodies[0]:
+                    break
+            if tol >= cap or (bodies and bodies[1] != bodies[0]):
+                break
+            tol = min(cap, tol * max(_MESH_BUDGET_MIN_STEP, left / self.max_triangles))
+        if left > self.max_triangles or (bodies and bodies[1] != bodies[0]):
+            lost = f" and lost {bodies[0] - bodies[1]} of its {bodies[0]} bodies" if bodies else ""
+            raise WoodcamError(
+                f"{origin} has {count} triangles, over max_triangles (--max-triangles) = {self.max_triangles}, "
+                f"and simplifying it by up to {say_length(tol, '.3g')} ({100 * MESH_SIMPLIFY_MAX_REL_TOL:g} % of its "
+                f"diagonal at most) left {left}{lost}; raise --max-triangles to {count} to bake it whole, or "
+                "simplify it in your CAD program")
+        made = simple.num_tri()
+        self.simplified = {"from": count, "to": made, "tolerance_mm": tol}
+        self.notes.append(said(lambda: (
+            f"{origin}: {count} triangles exceeded max_triangles={self.max_triangles} (--max-triangles); "
+            f"simplified to {made} triangles, surfaces moved by less than {say_length(tol, '.3g')} "
+            f"(raise --max-triangles to keep more)")))
+        return _check_manifold(simple, origin)
+
     def report(self) -> dict:
         meshed = self.triangles > 0
         return {"tolerance_mm": self.used_tol_mm if meshed else self.tol_mm,
@@ -1021,7 +1086,7 @@ class _Tessellation:
                                                       else self.ang_rad),
                 "tolerance_rule": self.rule, "texels_per_mm": self.texels_per_mm,
                 "triangles": self.triangles, "max_triangles": self.max_triangles,
-                "notes": list(self.notes)}
+                "simplified": self.simplified, "notes": list(self.notes)}
 
 
 def _diagonal_mm(solids) -> float:

@@ -61,8 +61,9 @@ def register(subparsers) -> None:
                    "block, MARGIN in --units, default 2 mm). Turn the block instead with a spec ending in "
                    "~AXIS90 (e.g. builtin:flat-sawn~z90)")
     p.add_argument("--max-triangles", type=int, default=None, metavar="N",
-                   help="triangle budget for B-rep parts: above it the part is re-meshed with "
-                   "looser tolerances, and the summary says so (default 120000)")
+                   help="triangle budget of the part: above it a B-rep part (build123d/cadquery, STEP) is "
+                   "re-meshed with looser tolerances, and a mesh part (STL, OBJ ...) is simplified, its "
+                   "surfaces moved by a stated tolerance; a warning says so (default 120000)")
     add_units_option(p, "bake")
     add_bake_options(p)
     add_camera_option(p, "; of the --screenshot")
@@ -161,18 +162,16 @@ def run_bake(args: argparse.Namespace) -> int:
     remove_stale_outputs(args.out, res.files, inputs=[args.part])
     print_warnings(res.warnings)
     tess = res.tessellation
-    ignored = [opt for opt, value in (("--tolerance", args.tolerance),
-                                      ("--max-triangles", args.max_triangles)) if value is not None]
-    if ignored and not tess.get("triangles"):  # nothing was tessellated: the part was a mesh
+    if args.tolerance is not None and not tess.get("triangles"):  # nothing was tessellated: a mesh
         import warnings
 
         from ..errors import WoodcamWarning
 
-        warnings.warn(f"{' and '.join(ignored)} set{'s' if len(ignored) == 1 else ''} how B-rep parts "
-                      f"(build123d/cadquery solids, STEP) are meshed, but {args.part} is a triangle "
-                      "mesh, baked as it is: ignored; drop "
-                      f"{'it' if len(ignored) == 1 else 'them'} (decimate the mesh in your CAD "
-                      "program to bake it coarser)", WoodcamWarning, stacklevel=2)
+        # --max-triangles is not: it simplifies a mesh over it (said by its own warning)
+        warnings.warn(f"--tolerance sets how B-rep parts (build123d/cadquery solids, STEP) are meshed, but "
+                      f"{args.part} is a triangle mesh, baked as it is: ignored; drop it (give "
+                      "--max-triangles, or decimate the mesh in your CAD program, to bake it coarser)",
+                      WoodcamWarning, stacklevel=2)
     mesh_note = ""
     if tess.get("tolerance_mm") and tess.get("triangles"):
         from ..tolerances import TESSELLATION_REL_TOL, TESSELLATION_TEXEL_FRACTION

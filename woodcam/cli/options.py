@@ -1389,7 +1389,7 @@ RANGES: dict = {
     "dead_darkening": (0.0, 1.0, False),
     "outline_mm": (0.0, 1000.0, False),
     "timeout": (0.0, 1e7, True),               # seconds
-    "max_triangles": (100, 100_000_000, False),  # B-rep budget; 1e8 triangles is ~10 GB
+    "max_triangles": (100, 100_000_000, False),  # a part's budget (B-rep or mesh); 1e8 triangles is ~10 GB
     "max_atlas": (64, 65_536, False),          # texture side, texels
     "candidates": (1, 1_000_000, False),       # placement candidates: woodcam.advise.advise_placement's
     # bound (1e7 passed here, loaded the part, then failed with exit 1 naming 'candidates')
