@@ -527,6 +527,29 @@ def test_a_timeout_a_library_turned_into_its_own_error_is_still_the_timeout(tmp_
         load_part(path, timeout_s=0.5)
 
 
+def test_a_scripts_prints_go_to_stderr_named_apart_from_the_commands_output(tmp_path, capsys):
+    """A part script's print() shared stdout with woodcam's own output ('woodcam bake box.py ...
+    | tail -1' read the script's last print, not the summary). CQ-editor shows a script's prints
+    in its log, apart from the part: here each line goes to stderr after the script's name,
+    a print without its newline too, and stdout is woodcam's alone."""
+    from woodcam.cli import main
+
+    path = tmp_path / "box.py"
+    path.write_text("import sys, trimesh\nprint('wall', 4, 'mm')\nprint('two\\nlines')\n"
+                    "part = trimesh.creation.box((10, 10, 10))\npart.apply_translation((50, 40, 25))\n"
+                    "print('no newline', end='')\n")
+    capsys.readouterr()
+    assert load_part(path).volume() == pytest.approx(1000)
+    assert capsys.readouterr() == ("", "box.py: wall 4 mm\nbox.py: two\nbox.py: lines\nbox.py: no newline\n")
+    print("after")  # stdout is the stream's own again
+    assert capsys.readouterr().out == "after\n"
+    assert main(["bake", str(path), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "b.glb"), "--no-obj",
+                 "--texels-per-mm", "1"]) == 0
+    out, err = capsys.readouterr()
+    assert "wall 4" not in out and out.startswith("b: 12 triangles"), out
+    assert err.startswith("box.py: wall 4 mm\nbox.py: two\n"), err
+
+
 def test_a_cq_editor_script_calling_debug_and_log_loads_what_it_shows(tmp_path, capsys):
     """CQ-editor gives its scripts debug() (a helper shape drawn red, not the part) and log();
     a script calling them failed with NameError, and one relying on its `cq` was not told why."""
@@ -535,7 +558,7 @@ def test_a_cq_editor_script_calling_debug_and_log_loads_what_it_shows(tmp_path, 
                     "debug(helper)\nlog('built the box')\nshow_object(box)\n")
     capsys.readouterr()
     assert load_part(path).volume() == pytest.approx(1000)
-    assert capsys.readouterr().err == "built the box\n"
+    assert capsys.readouterr().err == "cqed.py: built the box\n"  # as the script's prints: named, on stderr
     path.write_text("r = cq.Workplane('XY').box(1, 1, 1)\nshow_object(r)\n")
     with pytest.raises(WoodcamError, match=r"failed at line 1 with NameError: name 'cq' is not defined \(CQ-editor "
                        r"imports cadquery as `cq` for its scripts: add `import cadquery as cq`\)"):

@@ -336,6 +336,36 @@ def _load_path(path: Path, tess: "_Tessellation"):
     return _load_mesh_file(path)
 
 
+class _ScriptOutput:
+    """A part script's stdout while it runs: each line to stderr, after the script's name
+    (``bowl.py: wall 4 mm``). Its prints went to stdout among the command's own output (the
+    summary line a shell script reads, ``woodcam place``'s table); CQ-editor shows them in its
+    log panel, apart from the part: here they stay on the terminal, apart from woodcam's
+    output and named. ``log()`` (CQ-editor's) writes here too."""
+
+    def __init__(self, name: str):
+        self.prefix, self.pending = f"{name}: ", ""
+
+    def write(self, text: str) -> int:
+        from .._interrupt import requested
+
+        if requested():  # a library that swallowed a Ctrl-C saying so ('VTK not installed'): dropped,
+            return len(text)  # as woodcam's stdout drops it (woodcam._interrupt._MutedAfterCtrlC)
+        *lines, self.pending = (self.pending + text).split("\n")
+        for line in lines:  # sys.stderr looked up now: the one in use (a test's capture, a redirect)
+            sys.stderr.write(f"{self.prefix}{line}\n")
+        return len(text)
+
+    def flush(self) -> None:
+        if self.pending:  # a last print without its newline (print(..., end=""))
+            sys.stderr.write(f"{self.prefix}{self.pending}\n")
+            self.pending = ""
+        sys.stderr.flush()
+
+    def isatty(self) -> bool:
+        return False
+
+
 def _load_script(path: Path, tess: "_Tessellation"):
     """Run a part script (``runpy``, not as ``__main__``) and load what it passes to
     ``show_object`` (their union), else its module-level ``part``: any object :func:`_load`
@@ -355,7 +385,7 @@ def _load_script(path: Path, tess: "_Tessellation"):
         pass
 
     def log(message, *args, **kwargs):
-        print(message, file=sys.stderr)
+        print(message)  # to the script's output, as its prints (stderr, prefixed: _ScriptOutput)
 
     def show(*objs, names=None, **kwargs):  # ocp_vscode's (the OCP CAD viewer of build123d's docs)
         names = list(names) if isinstance(names, (list, tuple)) else [names] * len(objs)
@@ -367,10 +397,12 @@ def _load_script(path: Path, tess: "_Tessellation"):
     # build123d scripts import ocp_vscode's show() to see the part in VS Code: it failed with
     # ModuleNotFoundError (or, installed, sent the part to a viewer port and woodcam got nothing)
     sys.modules["ocp_vscode"] = _viewer_stand_in(show, show_object)
+    output = _ScriptOutput(path.name)
     try:
-        namespace = runpy.run_path(str(path), init_globals={"show_object": show_object, "debug": debug,
-                                                            "log": log},
-                                   run_name="__woodcam_part__")
+        with contextlib.redirect_stdout(output):
+            namespace = runpy.run_path(str(path), init_globals={"show_object": show_object, "debug": debug,
+                                                                "log": log},
+                                       run_name="__woodcam_part__")
     except SystemExit as err:
         raise WoodcamError(
             f"part script {str(path)!r} called sys.exit({err.code!r}) while being loaded; "
@@ -387,6 +419,7 @@ def _load_script(path: Path, tess: "_Tessellation"):
             f"`python {path}` to see the traceback and fix the script"
         ) from err
     finally:
+        output.flush()
         if folder in sys.path:
             sys.path.remove(folder)
         if viewer is None:
