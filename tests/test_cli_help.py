@@ -127,3 +127,19 @@ def test_every_numeric_option_states_the_range_it_is_checked_against():
         if text.count(span) != 1:
             unsaid.append(f"{' '.join(path)} {a.option_strings[-1]}: {text!r} lacks {span!r}")
     assert not unsaid, unsaid
+
+
+def test_place_help_says_what_the_terms_are_and_which_way_is_better():
+    """'woodcam place' printed a table of score, knots, pith, end and runout, and its help said
+    neither that each is a share in [0, 1], nor that lower is better, nor how the score weighs
+    them: a user could not tell the best row from the worst. The weights and the pith's years
+    said are the ones used."""
+    from woodcam.advise import DEFAULT_WEIGHTS, PITH_YEARS
+
+    place = dict(_sub_commands(build_parser()))["place"]
+    text = " ".join(place.description.split())
+    w = DEFAULT_WEIGHTS
+    assert (f"score = {w['knots']:g} knots + {w['pith']:g} pith + {w['end_grain']:g} end + "
+            f"{w['runout']:g} runout, lower is better") in text, text
+    assert "Each term is a share in [0, 1], lower is better" in text
+    assert f"within {PITH_YEARS:g} years of the pith" in text
