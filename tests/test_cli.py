@@ -546,3 +546,29 @@ def test_confidence_of_a_block_with_no_fit_names_the_block_and_the_fix(tmp_path,
                    "true field, or a Mokume folder); got the block 'builtin:flat-sawn', whose field has no fit and "
                    "so no uncertainty; pass --block with such a block (e.g. --block ../shared/data/mokume/H11), "
                    "or leave --confidence out\n"), err
+
+
+def test_screenshot_before_the_input_leaves_the_input_to_the_command(tmp_path, monkeypatch, capsys):
+    """'woodcam preview --screenshot bowl.glb' (bake's part, gcode's program alike): --screenshot's
+    optional PNG took the input, and the command said 'the following arguments are required:
+    mesh' of a mesh typed. An existing file not named .png after --screenshot is the input, the
+    PNG its default name; a name that is no file is still refused as no .png."""
+    from pathlib import Path
+
+    import woodcam.view as view
+    from woodcam.cli import EXIT_USAGE
+
+    shots = []
+    monkeypatch.setattr(view, "preview", lambda mesh, screenshot=None, **kw: (
+        shots.append(Path(screenshot).name), Path(screenshot).write_bytes(b"png")))
+    part = tmp_path / "p.stl"
+    trimesh.creation.box((10.0, 10.0, 10.0)).apply_translation((20, 20, 20)).export(part)
+    assert main(["bake", "--screenshot", str(part), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "b.glb"),
+                 "--no-obj", "--texels-per-mm", "1", "--quiet"]) == 0
+    assert main(["preview", "--screenshot", str(tmp_path / "b.glb"), "--quiet"]) == 0
+    assert shots == ["b_view.png", "b_view.png"] and (tmp_path / "b_view.png").is_file()
+    capsys.readouterr()
+    assert main(["preview", "--screenshot", str(tmp_path / "v.png"), str(tmp_path / "b.glb"), "--quiet"]) == 0
+    assert shots[-1] == "v.png"
+    assert main(["preview", "--screenshot", "view", str(tmp_path / "b.glb")]) == EXIT_USAGE
+    assert "--screenshot of 'woodcam preview' is a FILE ending in .png; got 'view'" in capsys.readouterr().err

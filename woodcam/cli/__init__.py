@@ -213,6 +213,27 @@ def _apply_aliases(argv: list[str], parser: argparse.ArgumentParser) -> list[str
         subs = next(a for a in group._actions if isinstance(a, argparse._SubParsersAction))
         if argv[1] not in subs.choices:
             argv = [argv[0], DEFAULT_SUBCOMMAND[argv[0]], *argv[1:]]
+    return _input_after_screenshot(argv)
+
+
+def _input_after_screenshot(argv: list[str]) -> list[str]:
+    """``woodcam preview --screenshot bowl.glb``: --screenshot's optional PNG took the mesh, and
+    the command said 'the following arguments are required: mesh' of a mesh typed (bake's part,
+    gcode's program alike). A value of --screenshot that is an existing file not named .png is
+    the command's input (the PNG must end in .png, and the file is no output to write over):
+    --screenshot moves after it and takes its default name. Any other value is left to
+    --screenshot's own check ('out' is refused, naming 'out.png')."""
+    from pathlib import Path
+
+    argv = list(argv)
+    i = 0
+    while i < len(argv) - 1:
+        value = argv[i + 1]
+        if (argv[i] == "--screenshot" and not value.startswith("-") and not value.lower().endswith(".png")
+                and Path(value).is_file()):
+            argv[i], argv[i + 1] = value, "--screenshot"
+            i += 1
+        i += 1
     return argv
 
 
