@@ -9,7 +9,7 @@ import argparse
 import pytest
 
 from woodcam.cli import EXIT_USAGE, build_parser, main
-from woodcam.cli.options import FILE_SUFFIXES, OUT_RULE, check_out
+from woodcam.cli.options import FILE_SUFFIXES, OUT_RULE, block_size_mm, check_out
 from woodcam.errors import UsageError
 
 
@@ -38,7 +38,7 @@ def _argv(path, p, out):
             continue
         if isinstance(a, (argparse._HelpAction, argparse._SubParsersAction)):
             continue
-        value = (a.choices[0] if a.choices else "1" if a.type in (int, float)
+        value = (a.choices[0] if a.choices else "1" if a.type in (int, float, block_size_mm)
                  else "does-not-exist")
         argv += ([a.option_strings[-1]] if a.option_strings else []) + [str(value)]
     return argv + ["--out", str(out)]
