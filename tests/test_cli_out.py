@@ -97,6 +97,21 @@ def test_a_file_out_whose_suffix_slipped_is_offered_the_right_suffix(tmp_path, c
             check_out(build_parser().parse_args(["review", "p.glb", "--out", str(tmp_path / name)]))
 
 
+def test_a_file_out_named_without_its_suffix_is_offered_the_file_too(tmp_path, capsys):
+    """'bake bowl.py --out tray' (no folder 'tray') was told 'tray' is a folder and offered only
+    'tray/part.glb'; the file 'tray.glb' is as likely meant, and offered too. An existing
+    folder is said as before."""
+    out = tmp_path / "tray"
+    assert main(["bake", "x.py", "--block", "builtin:flat-sawn", "--out", str(out)]) == EXIT_USAGE
+    assert capsys.readouterr().err == (f"woodcam: error: --out of 'woodcam bake' is a FILE ending in .glb; got "
+                                       f"{str(out)!r}, a folder name; give a file name such as "
+                                       f"{str(out / 'part.glb')!r}, or {str(tmp_path / 'tray.glb')!r}\n")
+    out.mkdir()
+    assert main(["bake", "x.py", "--block", "builtin:flat-sawn", "--out", str(out)]) == EXIT_USAGE
+    assert capsys.readouterr().err.endswith(f"got {str(out)!r}, a folder; give a file name such as "
+                                            f"{str(out / 'part.glb')!r}\n")
+
+
 def test_folder_command_refuses_an_existing_file(tmp_path):
     f = tmp_path / "place_here"
     f.write_text("")

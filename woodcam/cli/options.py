@@ -141,9 +141,13 @@ def check_out(args: argparse.Namespace) -> None:
                              f"{str(out.with_suffix(suffixes[0]))!r} (or "
                              f"{str(out / ('part' + suffixes[0]))!r} to write into a folder {str(out)!r})")
         if out.is_dir() or suffix not in FILE_SUFFIXES:
+            # a name not there yet, 'bake ... --out tray': the file 'tray.glb' is as likely meant
+            # as a folder 'tray' (only the folder was offered)
+            also = "" if out.is_dir() else f", or {str(out.parent / (out.name + suffixes[0]))!r}"
             raise UsageError(f"--out of 'woodcam {command}' is a FILE ending in "
-                             f"{' or '.join(suffixes)}; got {str(out)!r}, a folder; give a file "
-                             f"name such as {str(out / ('part' + suffixes[0]))!r}")
+                             f"{' or '.join(suffixes)}; got {str(out)!r}, a folder"
+                             f"{'' if out.is_dir() else ' name'}; give a file "
+                             f"name such as {str(out / ('part' + suffixes[0]))!r}{also}")
         if suffix not in suffixes:
             raise UsageError(f"--out of 'woodcam {command}' must end in {' or '.join(suffixes)}; "
                              f"got {str(out)!r}; give e.g. {str(out.with_suffix(suffixes[0]))!r}")
