@@ -143,3 +143,15 @@ def test_place_help_says_what_the_terms_are_and_which_way_is_better():
             f"{w['runout']:g} runout, lower is better") in text, text
     assert "Each term is a share in [0, 1], lower is better" in text
     assert f"within {PITH_YEARS:g} years of the pith" in text
+
+
+def test_the_part_argument_lists_every_suffix_read():
+    """'bake --help' and 'place --help' listed .step and .glb, not .stp (a common STEP name)
+    nor .gltf, both read: the help lists every suffix load_part reads."""
+    from woodcam.cad.parts import SUPPORTED_SUFFIXES
+
+    commands = dict(_sub_commands(build_parser()))
+    for name in ("bake", "place"):
+        part = next(a for a in commands[name]._actions if a.dest == "part")
+        missing = [s for s in SUPPORTED_SUFFIXES if not re.search(re.escape(s) + r"\b", part.help)]
+        assert not missing, (name, part.help, missing)

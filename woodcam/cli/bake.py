@@ -42,7 +42,7 @@ def register(subparsers) -> None:
                               "wrote or have read (--timeout bounds its run time; it is not a "
                               "sandbox).")
     add_input(p, "part", kind="file", suffixes=part_suffixes,
-              help="part file (.py script, .step, .stl, .obj, .ply, .off, .glb)")
+              help="part file (.py script, .step/.stp, .stl, .obj, .ply, .off, .glb/.gltf)")
     add_input(p, "--block", kind="block", required=True, help=BLOCK_SPEC_HELP)
     add_out_option(p, "the baked part; beside it PART.obj/.mtl, PART_texture.png, the "
                    "part report PART_report.txt/.json and, with --screenshot, PART_view.png",

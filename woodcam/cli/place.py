@@ -28,7 +28,7 @@ def register(subparsers) -> None:
         "trusted code: it runs with your rights, so only place scripts you wrote or have read "
         "(--timeout bounds its run time; it is not a sandbox).")
     add_input(p, "part", kind="file", suffixes=part_suffixes,
-              help="part file (.py script, .step, .stl, .obj, .ply, .off, .glb), block frame, mm")
+              help="part file (.py script, .step/.stp, .stl, .obj, .ply, .off, .glb/.gltf), block frame, mm")
     add_input(p, "--block", kind="block", required=True, help=BLOCK_SPEC_HELP)
     add_out_option(p, "placements.png and placements.json")
     p.add_argument("--timeout", type=float, default=None, metavar="S",  # bake's; place had none
