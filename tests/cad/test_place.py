@@ -74,6 +74,21 @@ def test_bad_placements_are_clear_errors(ops, match):
         place_part(manifold3d.Manifold.cube([1.0, 1.0, 1.0]), ops, (100.0, 80.0, 50.0))
 
 
+def test_a_near_miss_of_an_operation_is_named():
+    """'--place centre' (British, as woodcam's own help writes 'the block centre') was told only
+    the list of operations; a near spelling is named first, a far one is not guessed at."""
+    from woodcam.cad.place import parse_place
+
+    with pytest.raises(WoodcamError, match=r"^--place 'centre' is not a placement operation; did you mean "
+                       r"'center'\? use rotate:AXIS:DEG, "):
+        parse_place(["centre"])
+    with pytest.raises(WoodcamError, match=r"^--place 'Rotat:z:90' is not a placement operation; did you mean "
+                       r"'rotate'\? "):
+        parse_place(["Rotat:z:90"])
+    with pytest.raises(WoodcamError, match=r"^--place 'spin' is not a placement operation; use rotate"):
+        parse_place(["spin"])
+
+
 def test_a_sized_builtin_block_is_the_same_wood_round_the_same_centre():
     small = open_stock("builtin:flat-sawn")
     big = open_stock("builtin:flat-sawn:300x120x40")

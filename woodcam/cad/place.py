@@ -159,8 +159,12 @@ def parse_place(ops: Sequence[str], *, as_typed: Sequence[str] | None = None) ->
             if value < 0:
                 raise WoodcamError(f"--place {op!r}: a margin must be >= 0; got {say_length(value, 'g')}; "
                                    f"write fit:0 for none, or fit for {say_length(FIT_MARGIN_MM, 'g')}")
-        else:
-            raise WoodcamError(f"--place {op!r} is not a placement operation; use {_HELP}")
+        else:  # 'centre', the spelling of woodcam's own help ('the block centre'), was told only the list
+            from .._checks import did_you_mean
+
+            near = did_you_mean(name, ("rotate", "translate", "scale", "center", "drop", "fit"))
+            raise WoodcamError(f"--place {op!r} is not a placement operation; {near + ' ' if near else ''}"
+                               f"use {_HELP}")
         out.append((name, value, op))
     return out
 
