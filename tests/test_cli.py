@@ -304,6 +304,27 @@ def test_max_triangles_simplifies_a_mesh_part_over_it(tmp_path, capsys):
     assert "simplified" not in capsys.readouterr().err
 
 
+def test_place_takes_the_triangle_budget_its_warning_names(tmp_path, capsys):
+    """'woodcam place' loaded a mesh over the default budget simplified, with a warning saying
+    'raise --max-triangles', an option place did not have: it has bake's now, the same help."""
+    from woodcam.cli import build_parser
+
+    commands = {name: p for a in build_parser()._actions if hasattr(a, "choices") and isinstance(a.choices, dict)
+                for name, p in a.choices.items()}
+    helps = {name: next(a.help for a in commands[name]._actions if a.dest == "max_triangles")
+             for name in ("bake", "place")}
+    assert helps["bake"] == helps["place"] and "mesh part" in helps["place"]
+    sphere = trimesh.creation.icosphere(subdivisions=4, radius=15.0)
+    sphere.apply_translation((50, 40, 25))
+    part = tmp_path / "ball.stl"
+    sphere.export(part)
+    argv = ["place", str(part), "--block", "builtin:flat-sawn", "--candidates", "1", "--rotations", "none", "--quiet"]
+    assert main([*argv, "--out", str(tmp_path / "a"), "--max-triangles", "1000"]) == 0
+    assert "5120 triangles exceeded max_triangles=1000 (--max-triangles); simplified to" in capsys.readouterr().err
+    assert main([*argv, "--out", str(tmp_path / "b")]) == 0
+    assert "simplified" not in capsys.readouterr().err
+
+
 def test_a_mesh_part_that_cannot_be_simplified_to_the_budget_is_refused(capsys):
     """Forty separate 1 mm boxes (480 triangles) cannot be simplified to 100 triangles: within 1 %
     of the diagonal they vanish. One line names --max-triangles, the counts and the fix."""

@@ -10,7 +10,7 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
 from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_input, part_suffixes,
-                      add_camera_option, add_out_option, add_units_option,
+                      add_camera_option, add_max_triangles_option, add_out_option, add_units_option,
                       add_workers_option, allow_negative_values, apply_workers, as_typed, camera_of,
                       not_empty, remove_stale_outputs, stock_options, uses_settings, vector_type, write_screenshot)
 
@@ -60,10 +60,7 @@ def register(subparsers) -> None:
                    "scale:S, center, drop (onto the bottom face), fit[:MARGIN] (scale into the "
                    "block, MARGIN in --units, default 2 mm). Turn the block instead with a spec ending in "
                    "~AXIS90 (e.g. builtin:flat-sawn~z90)")
-    p.add_argument("--max-triangles", type=int, default=None, metavar="N",
-                   help="triangle budget of the part: above it a B-rep part (build123d/cadquery, STEP) is "
-                   "re-meshed with looser tolerances, and a mesh part (STL, OBJ ...) is simplified, its "
-                   "surfaces moved by a stated tolerance; a warning says so (default 120000)")
+    add_max_triangles_option(p)
     add_units_option(p, "bake")
     add_bake_options(p)
     add_camera_option(p, "; of the --screenshot")

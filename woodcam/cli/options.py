@@ -1065,6 +1065,15 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                        "_view.png; no display needed)")
 
 
+def add_max_triangles_option(p: argparse.ArgumentParser) -> None:
+    """``--max-triangles N`` (None: :func:`woodcam.cad.load_part`'s default budget), of every
+    command that loads a part for its surface (bake, place)."""
+    p.add_argument("--max-triangles", type=int, default=None, metavar="N",
+                   help="triangle budget of the part: above it a B-rep part (build123d/cadquery, STEP) is "
+                   "re-meshed with looser tolerances, and a mesh part (STL, OBJ ...) is simplified, its "
+                   "surfaces moved by a stated tolerance; a warning says so (default 120000)")
+
+
 def add_max_atlas_option(p: argparse.ArgumentParser, *, given_only: bool = False) -> None:
     """``--max-atlas PX`` (the library's ``max_atlas_px``): every command that bakes an atlas.
     ``given_only``: its value is None unless typed (a command that bakes an atlas only for some

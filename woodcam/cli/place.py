@@ -6,8 +6,8 @@ import argparse
 from pathlib import Path
 
 from ..units import MM_PER_UNIT, TYPED_DECIMALS
-from .options import (add_input, part_suffixes, output_refused_at_the_door, BLOCK_SPEC_HELP, add_out_option,
-                      add_units_option, place_op_in)
+from .options import (add_input, part_suffixes, output_refused_at_the_door, BLOCK_SPEC_HELP, add_max_triangles_option,
+                      add_out_option, add_units_option, place_op_in)
 
 
 def register(subparsers) -> None:
@@ -44,6 +44,7 @@ def register(subparsers) -> None:
     p.add_argument("--top", type=int, default=3, metavar="K",
                    help="placements printed in the table (and, at least ten, in placements.json); "
                    "the picture shows the best K, at most 10, and the worst (default 3)")
+    add_max_triangles_option(p)  # a mesh over it was simplified, said with a fix place did not have
     add_units_option(p, "place")
     p.set_defaults(func=run_place)
 
@@ -66,7 +67,8 @@ def run_place(args: argparse.Namespace) -> int:
     with StageBar(["load part", "open block", "score placements", "render"], desc="place",
                   leave=False) as bar:
         with bar.stage("load part"):
-            part = load_part(args.part, timeout_s=args.timeout)
+            part = load_part(args.part, timeout_s=args.timeout,
+                             **({} if args.max_triangles is None else {"max_triangles": args.max_triangles}))
         with bar.stage("open block"):
             stock = open_stock(args.block)
         with bar.stage("score placements"):
