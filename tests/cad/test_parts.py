@@ -550,6 +550,20 @@ def test_a_scripts_prints_go_to_stderr_named_apart_from_the_commands_output(tmp_
     assert err.startswith("box.py: wall 4 mm\nbox.py: two\n"), err
 
 
+def test_a_scripts_prints_pass_a_progress_bar_being_drawn(tmp_path, monkeypatch):
+    """A script's line written straight to stderr landed inside a progress bar's line (the
+    bake's stage bar is drawn on stderr while the script runs): each goes through tqdm.write,
+    which clears the bar and draws it again below."""
+    import woodcam._progress as progress
+
+    said = []
+    monkeypatch.setattr(progress, "write", lambda line, file=None: said.append(line))
+    path = tmp_path / "box.py"
+    path.write_text("import trimesh\nprint('wall 4 mm')\npart = trimesh.creation.box((10, 10, 10))\n")
+    load_part(path)
+    assert said == ["box.py: wall 4 mm"]
+
+
 def test_a_cq_editor_script_calling_debug_and_log_loads_what_it_shows(tmp_path, capsys):
     """CQ-editor gives its scripts debug() (a helper shape drawn red, not the part) and log();
     a script calling them failed with NameError, and one relying on its `cq` was not told why."""

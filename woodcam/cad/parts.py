@@ -352,13 +352,20 @@ class _ScriptOutput:
         if requested():  # a library that swallowed a Ctrl-C saying so ('VTK not installed'): dropped,
             return len(text)  # as woodcam's stdout drops it (woodcam._interrupt._MutedAfterCtrlC)
         *lines, self.pending = (self.pending + text).split("\n")
-        for line in lines:  # sys.stderr looked up now: the one in use (a test's capture, a redirect)
-            sys.stderr.write(f"{self.prefix}{line}\n")
+        for line in lines:
+            self._say(line)
         return len(text)
+
+    def _say(self, line: str) -> None:
+        from .._progress import write
+
+        # past a progress bar being drawn (tqdm.write), not into its line; sys.stderr looked up
+        # now: the one in use (a test's capture, a redirect)
+        write(f"{self.prefix}{line}", file=sys.stderr)
 
     def flush(self) -> None:
         if self.pending:  # a last print without its newline (print(..., end=""))
-            sys.stderr.write(f"{self.prefix}{self.pending}\n")
+            self._say(self.pending)
             self.pending = ""
         sys.stderr.flush()
 
