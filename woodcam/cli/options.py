@@ -818,9 +818,11 @@ def block_size_mm(text: str) -> tuple[float, float, float]:
     """argparse ``type`` of ``--size-mm`` (:func:`add_size_option`), its one parser: ``"50"`` (a
     cube's side) or ``"50x40x30"`` (W x D x H) -> (W, D, H) in mm, each finite and in (0,
     :data:`~woodcam.limits.MAX_BLOCK_SIZE_MM`]; else a usage error naming the option, its rule
-    and the text received. ``--size-mm`` was a cube's side (one number) in five commands and W x
-    D x H in ``block from-photos``: ``50x40x30`` copied from one to the other was refused, and
-    the two refusals said different rules."""
+    and the text received. ``--size-mm`` was a cube's side (one number) in fit, eval rings, eval
+    appearance, block show, rings detect and rings show and W x D x H in ``block from-photos``:
+    ``50x40x30`` copied from one to another was refused, and the two refusals said different
+    rules. A Mokume sample, a cube, refuses another size where it is read
+    (:func:`woodcam.block.io.read_mokume`)."""
     cap = limit("MAX_BLOCK_SIZE_MM")
     sides = parse_lengths(text, 3, max_mm=cap, cube=True)
     if sides is None:
