@@ -289,6 +289,9 @@ def test_max_triangles_simplifies_a_mesh_part_over_it(tmp_path, capsys):
     assert said and err.count("\n") == 1, err
     made = int(said.group(1))
     assert 100 < made <= 1000 and float(said.group(2)) < 1.0, err
+    # the summary says it beside the count, as it says how a B-rep part was meshed
+    assert out.startswith(f"a: {made} triangles (simplified from 5120 within {said.group(2)} mm; budget 1000 "
+                          "triangles), "), out
     report = json.loads((tmp_path / "a_report.json").read_text())
     assert any("simplified to" in w for w in report["warnings"])
     from woodcam.cad import load_part

@@ -179,6 +179,11 @@ def run_bake(args: argparse.Namespace) -> int:
                      + (f", scaled: min({TESSELLATION_TEXEL_FRACTION:g} texel, "
                         f"{100 * TESSELLATION_REL_TOL:g} % of the part's diagonal)" if auto else "")
                      + f"; budget {tess.get('max_triangles')} triangles)")
+    simplified = tess.get("simplified")
+    if simplified:  # a mesh part over the budget: said beside the count, as a B-rep's meshing is
+        mesh_note = (f" (simplified from {simplified['from']} within "
+                     f"{fmt_length(simplified['tolerance_mm'], args.units)}; budget {tess.get('max_triangles')} "
+                     "triangles)")
     print(f"{res.name}: {res.triangles} triangles{mesh_note}, "
           f"{fmt_volume(res.volume_mm3, args.units)}, "
           f"{res.atlas}; wrote " + ", ".join(map(str, res.files.values())))
