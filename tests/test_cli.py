@@ -3,6 +3,7 @@
 import re
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -326,6 +327,30 @@ def test_place_takes_the_triangle_budget_its_warning_names(tmp_path, capsys):
     assert "5120 triangles exceeded max_triangles=1000 (--max-triangles); simplified to" in capsys.readouterr().err
     assert main([*argv, "--out", str(tmp_path / "b")]) == 0
     assert "simplified" not in capsys.readouterr().err
+
+
+def test_gcode_passes_its_budget_to_the_design_part(tmp_path, monkeypatch, capsys):
+    """'woodcam gcode --part design.stl' loads the design with load_part's budget, whose warning
+    says 'raise --max-triangles': gcode takes it for --part now, and passes it on."""
+    import woodcam.cad as cad
+    from woodcam.errors import WoodcamError
+
+    seen = []
+
+    def load_part(path, **kw):
+        seen.append(kw)
+        raise WoodcamError("stop here")
+
+    monkeypatch.setattr(cad, "load_part", load_part)
+    part = tmp_path / "design.stl"
+    trimesh.creation.box((10.0, 10.0, 10.0)).export(part)
+    argv = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--tool", "1=flat:6",
+            "--part", str(part), "--out", str(tmp_path / "g.glb")]
+    monkeypatch.chdir(Path(__file__).resolve().parents[1])
+    assert main([*argv, "--max-triangles", "5000"]) == 1
+    assert main(argv) == 1
+    assert seen == [{"max_triangles": 5000}, {}]
+    assert "--part: stop here" in capsys.readouterr().err
 
 
 def test_a_mesh_part_that_cannot_be_simplified_to_the_budget_is_refused(capsys):

@@ -15,7 +15,7 @@ from ..errors import UsageError, WoodcamError
 from ..tolerances import IN_BLOCK_RTOL
 from ..units import MM_PER_UNIT, fmt_length, fmt_volume
 from .options import (add_input, part_suffixes, output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options,
-                      add_camera_option, add_out_option, add_units_option,
+                      add_camera_option, add_max_triangles_option, add_out_option, add_units_option,
                       allow_negative_values, as_typed, camera_of, drop_earlier_output, remove_stale_outputs, sizes_type,
                       stock_options, vector_type)
 
@@ -117,6 +117,7 @@ def register(subparsers) -> None:
                    help="design part (STL/STEP/OBJ/GLB or a part script, block frame, mm): "
                    "report leftover and overcut volumes, gouges by line, and write a "
                    "deviation map (OUT with _deviation.png)")
+    add_max_triangles_option(p, "the --part design")  # a mesh over it is simplified, said naming this option
     p.add_argument("--strict", action="store_true",
                    help="exit with status 3 when the reader or the simulation warned")
     p.add_argument("--mesh-tol", type=float, default=0.05, metavar="LEN",
@@ -249,7 +250,8 @@ def run(args) -> int:
         with output_refused_at_the_door():
             check_output_path(_deviation_png(args.out), what="--out (its deviation PNG, with --part)")
         try:
-            design = load_part(args.part)
+            design = load_part(args.part, **({} if args.max_triangles is None
+                                             else {"max_triangles": args.max_triangles}))
         except WoodcamError as err:
             raise WoodcamError(f"--part: {err}") from None
     if args.view:

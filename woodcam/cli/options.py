@@ -1067,11 +1067,11 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                        "_view.png; no display needed)")
 
 
-def add_max_triangles_option(p: argparse.ArgumentParser) -> None:
+def add_max_triangles_option(p: argparse.ArgumentParser, part: str = "the part") -> None:
     """``--max-triangles N`` (None: :func:`woodcam.cad.load_part`'s default budget), of every
-    command that loads a part for its surface (bake, place)."""
+    command that loads a part (bake, place, gcode's ``--part``: ``part`` names it in the help)."""
     p.add_argument("--max-triangles", type=int, default=None, metavar="N",
-                   help="triangle budget of the part: above it a B-rep part (build123d/cadquery, STEP) is "
+                   help=f"triangle budget of {part}: above it a B-rep part (build123d/cadquery, STEP) is "
                    "re-meshed with looser tolerances, and a mesh part (STL, OBJ ...) is simplified, its "
                    "surfaces moved by a stated tolerance; a warning says so (default 120000)")
 
