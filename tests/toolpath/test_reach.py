@@ -294,3 +294,39 @@ def test_a_reach_warning_quotes_the_worst_hit_of_its_lines():
          "5.00 mm of stock above the flutes")]
     (_, _, _, msg), = _issues("flat:6:flute=10:shank=8")  # the slot's wide shank: its worst
     assert "8 mm shank meets the stock 2.00 mm above the flutes" in msg
+
+
+@pytest.mark.parametrize("spec", ["vbit:60:6:flute=3:shank=6", "bull:6:1:flute=4",
+                                  "snub:90:6:1:flute=3:stickout=9:holder=20",
+                                  "taperball:6:1:5:flute=4"])
+def test_the_reach_replay_of_every_tool_cuts_with_the_compiled_sweep(spec, monkeypatch):
+    """The replay cut V-bits, bull noses, snub noses and tapered balls with numpy's window
+    sweep a few moves per flush (a V-bit's replay of a 3,724-move raster took 4.8x a flat
+    mill's); it goes through the compiled kernel now, with the same hits and messages."""
+    import importlib
+
+    sim = importlib.import_module("woodcam.toolpath.simulate")
+    from woodcam.toolpath import reach
+
+    raster = ["M3 S10000", "G0 X5 Y5 Z5", "G1 Z-2 F600"]
+    for k, y in enumerate(np.arange(5.0, 35.0, 1.5)):
+        z = -2.0 - 0.4 * k
+        raster += [f"G1 Y{y:g} Z{z:g}", f"G1 X{55 if k % 2 == 0 else 5} Z{z - 0.3:g}"]
+    prog = read_gcode("\n".join(raster + ["G0 Z5", "M2"]) + "\n")
+    tool = parse_tool_spec(spec)
+    args = (prog.start_mm + [0, 0, SIZE[2]], prog.end_mm + [0, 0, SIZE[2]], prog.tool,
+            {0: tool}, prog.line, SIZE)
+    cuts = []
+    real = reach._Cutter.__call__
+
+    def spy(self, idx):
+        cuts.append(self.compiled[0] is not None)
+        return real(self, idx)
+
+    monkeypatch.setattr(reach._Cutter, "__call__", spy)
+    fast = reach.reach_issues(*args)
+    monkeypatch.setattr(sim, "_COMPILED", {})
+    slow = reach.reach_issues(*args)
+    assert len(fast) > 10 and [f[:3] for f in fast] == [s[:3] for s in slow]
+    np.testing.assert_allclose([f[3] for f in fast], [s[3] for s in slow], atol=1e-4)
+    assert cuts[:len(cuts) // 2] and all(cuts[:len(cuts) // 2]) and not any(cuts[len(cuts) // 2:])

@@ -241,17 +241,22 @@ def test_a_tool_change_stops_the_spindle_as_linuxcnc_does():
     assert (read_gcode(text, dialect="fanuc").spindle_rpm[prog.kind != 0] == 9000).all()
 
 
-@pytest.mark.parametrize("tool", [BallEndMill(6), FlatEndMill(4)])
-def test_compiled_ball_and_flat_sweeps_match_the_numpy_envelopes(tool, monkeypatch):
-    """Ball and flat end mills run through the one-pass numba kernel
-    (woodcam.toolpath._sweep); the numpy window path of every other tool gives the same stock
-    (within its float32 round-off), the same issues and the same covered cells on random
-    ramps, plunges, slanted moves and a rapid through the stock."""
+@pytest.mark.parametrize("tool", [BallEndMill(6), FlatEndMill(4), "vbit:60:6", "vbit:150:8",
+                                  "bull:6:1", "snub:90:6:1", "chamfer:60:8:0.5",
+                                  "taperball:6:1:5"])
+def test_compiled_sweeps_match_the_numpy_envelopes(tool, monkeypatch):
+    """Every tool type runs through the one-pass numba kernel (woodcam.toolpath._sweep); the
+    numpy window path (Tool._sweep, kept for tool types the kernel does not know) gives the
+    same stock (within its float32 round-off), the same issues and the same covered cells on
+    random ramps (some steeper than a V-bit's cone), plunges, slanted moves and a rapid
+    through the stock."""
 
     import sys
 
     # the module (woodcam.toolpath.simulate the attribute is the function)
     sim_mod = sys.modules["woodcam.toolpath.simulate"]
+    tool = parse_tool_spec(tool) if isinstance(tool, str) else tool
+    assert sim_mod._compiled_profile(tool) is not None
     rng = np.random.default_rng(3)
     pts = np.column_stack([rng.uniform(-5, 45, 120), rng.uniform(-5, 35, 120),
                            rng.uniform(-6, 1, 120)])
@@ -261,7 +266,7 @@ def test_compiled_ball_and_flat_sweeps_match_the_numpy_envelopes(tool, monkeypat
     lines += ["G0 X20 Y15 Z-1", "G0 Z5", "M2"]  # the last rapid runs through the stock
     prog = read_gcode("\n".join(lines))
     fast = simulate(prog, tool, SIZE, resolution_mm=0.2, track_lines=True)
-    monkeypatch.setattr(sim_mod, "_CLOSED_FORM", {})
+    monkeypatch.setattr(sim_mod, "_COMPILED", {})
     slow = simulate(prog, tool, SIZE, resolution_mm=0.2, track_lines=True)
     np.testing.assert_allclose(fast.heightmap, slow.heightmap, atol=1e-4)
     assert [str(i) for i in fast.report] == [str(i) for i in slow.report]
@@ -291,7 +296,7 @@ def test_a_program_of_t0_rapids_only_is_refused_clearly():
 
 
 @pytest.mark.parametrize("spec, deepest", [("flat:3", "5.000"),  # the compiled sweep
-                                           ("vbit:90:6", "4.671")])  # numpy's (its tip between cells)
+                                           ("vbit:90:6", "4.671")])  # its tip between cells
 def test_a_rapid_through_the_stock_and_a_cut_outside_it_quote_their_worst_line(spec, deepest):
     """A run of rapids into the stock and a run of cuts outside it quoted their first line:
     'cuts up to 1.000 mm' of rapids going 5 mm deep, 'z = -1.000 mm' of cuts going to -4 mm.

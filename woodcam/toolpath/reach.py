@@ -136,13 +136,13 @@ class _Cutter:
 
     def __init__(self, hm, p0, p1, tool_of, lookup, dx, dy, windows):
         from ._sweep import sweep_update
-        from .simulate import _BATCH_CELLS, _CLOSED_FORM, _sweep_batch
+        from .simulate import _BATCH_CELLS, _compiled_profile, _sweep_batch
 
         self.hm, self.p0, self.p1, self.tool_of, self.lookup = hm, p0, p1, tool_of, lookup
         self.dx, self.dy, self.windows = dx, dy, windows
         self.sweep_update, self.sweep_batch, self.batch_cells = (sweep_update, _sweep_batch,
                                                                  _BATCH_CELLS)
-        self.closed = {t: _CLOSED_FORM.get(type(tool)) for t, tool in lookup.items()}
+        self.compiled = {t: _compiled_profile(tool) for t, tool in lookup.items()}
         self.no_map = np.zeros((1, 1), np.int64)
 
     def __call__(self, idx) -> None:
@@ -160,9 +160,9 @@ class _Cutter:
             i0, i1, j0, j1 = ci0[sel], ci1[sel], cj0[sel], cj1[sel]
             wy = int((j1 - j0).max()) + 1
             wx = int((i1 - i0).max()) + 1
-            closed = self.closed[int(t)]
-            if closed is not None:  # ball / flat: the compiled kernel, all at once
-                self.sweep_update(hm, self.no_map, False, closed, float(tool.radius_mm),
+            compiled = self.compiled[int(t)]
+            if compiled is not None:  # the compiled kernel, all at once
+                self.sweep_update(hm, self.no_map, False, *compiled, float(tool.radius_mm),
                                   np.ascontiguousarray(p0[sel], float),
                                   np.ascontiguousarray(p1[sel], float), np.minimum(j0, ny - wy),
                                   np.minimum(i0, nx - wx), wy, wx, dx, dy, sel,

@@ -25,7 +25,9 @@ unconstrained one clipped to the interval; each tool solves it in closed form
 (:meth:`Tool._sweep`; bisection for the bull nose on ramps). The result is exact at every cell
 centre, so the only error of the height field is sampling (one cell) and arc chords.
 
-Moves are processed in vectorised batches: moves whose bounding boxes (in cells) fit the same
+Every tool type of :mod:`woodcam.toolpath.tools` is swept by the compiled kernel of
+:mod:`woodcam.toolpath._sweep` (the same formulas, in float64, one pass per cell). A tool of
+another type (a subclass) takes the numpy path: moves whose bounding boxes (in cells) fit the same
 padded window are stacked into ``(batch, wy, wx)`` float32 arrays and evaluated at once; each
 move's window is then min-merged into the height field as one slice (``np.minimum(view, env,
 out=view)``: windows of consecutive moves overlap, so a fancy-indexed assignment would lose
@@ -50,14 +52,30 @@ from ..tolerances import SIM_CONTACT_TOL_MM
 from ..units import said, say_length
 from .gcode import FEED, RAPID, Program
 from .reach import REACH_KINDS, _cell_window, reach_issues
-from .tools import BallEndMill, FlatEndMill, Tool
+from .tools import (BallEndMill, BullNoseMill, ChamferMill, FlatEndMill, SnubNoseVBit,
+                    TaperedBallMill, Tool, VBit)
 
 #: Cells evaluated per vectorised batch: ~20 float32 temporaries of 64k cells stay in L2/L3
 #: cache (measured 1.4x faster than 1M-cell batches on the raster benchmark).
 _BATCH_CELLS = 1 << 16
-#: Tools whose swept envelope :mod:`woodcam.toolpath._sweep` computes in closed form (exact
-#: types: a subclass may change the profile).
-_CLOSED_FORM = {BallEndMill: 0, FlatEndMill: 1}
+#: Tools whose swept envelope :mod:`woodcam.toolpath._sweep` computes (exact types: a subclass
+#: may change the profile): each type's profile there, ``(kind, params)`` (see that module).
+_COMPILED = {BallEndMill: lambda t: (0, ()), FlatEndMill: lambda t: (1, ()),
+             VBit: lambda t: (2, (t._k,)),
+             BullNoseMill: lambda t: (3, (t.corner_radius_mm,)),
+             SnubNoseVBit: lambda t: (4, (0.5 * t.tip_diameter_mm, t._k)),
+             ChamferMill: lambda t: (4, (0.5 * t.tip_diameter_mm, t._k)),
+             TaperedBallMill: lambda t: (5, t._parts())}
+
+
+def _compiled_profile(tool: Tool) -> tuple[int, np.ndarray] | None:
+    """``(kind, prm (4,) float64)`` of ``tool`` for :func:`woodcam.toolpath._sweep.sweep_update`,
+    or ``None`` for a tool it does not know (the numpy :meth:`Tool._sweep` path)."""
+    make = _COMPILED.get(type(tool))
+    if make is None:
+        return None
+    kind, prm = make(tool)
+    return kind, np.array([float(v) for v in prm] + [0.0] * (4 - len(prm)))
 
 
 IssueKind = Literal["rapid_through_stock", "below_stock_bottom", "cut_outside_stock",
@@ -497,8 +515,8 @@ def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind,
     wy, wx = min(wy, ny), min(wx, nx)
     js = np.clip(j0, 0, ny - wy)
     is_ = np.clip(i0, 0, nx - wx)
-    closed = _CLOSED_FORM.get(type(tool))
-    if closed is not None:  # ball / flat: one compiled pass, no window temporaries
+    compiled = _compiled_profile(tool)
+    if compiled is not None:  # one compiled pass, no window temporaries
         from ._sweep import sweep_update
 
         depth = np.empty(n)
@@ -507,7 +525,7 @@ def _sweep_batch(hm, line_map, tool, a, b, i0, j0, i1, j1, wy, wx, dx, dy, kind,
         before = {k: hm[js[k]:js[k] + wy, is_[k]:is_[k] + wx].copy()
                   for k in np.flatnonzero(kind == RAPID)}
         cells = sweep_update(hm, line_map if track else np.zeros((1, 1), np.int64), track,
-                             closed, float(tool.radius_mm), np.ascontiguousarray(a, float),
+                             *compiled, float(tool.radius_mm), np.ascontiguousarray(a, float),
                              np.ascontiguousarray(b, float), js, is_, wy, wx, dx, dy,
                              np.asarray(lines, np.int64), depth)
         for k in np.flatnonzero((kind == RAPID) & (depth > SIM_CONTACT_TOL_MM)):
