@@ -313,8 +313,9 @@ def test_a_file_that_is_not_gcode_text_is_refused_saying_what_it_is(tmp_path, ca
     png.write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR" + bytes(range(256)) * 4)
     utf16 = tmp_path / "u16.nc"
     utf16.write_bytes("G21\nG1 X1 F100\nM2\n".encode("utf-16"))
-    for path, what in ((png, "a binary file (an image, a program, a CAM project?); pass the "
-                              "G-code file the CAM software's post-processor wrote"),
+    for path, what in ((png, "a binary file (an image, a program, a CAM project?), or G-code "
+                              "damaged by the NUL on line 3 (LinuxCNC would drop the words after "
+                              "it); pass the G-code file the CAM software's post-processor wrote"),
                        (utf16, "saved as UTF-16 (Windows' 'Unicode'); save it as UTF-8 or ASCII")):
         with pytest.raises(WoodcamError, match="is not G-code text") as e:
             read_gcode(path)
@@ -381,3 +382,48 @@ def test_until_line_counts_a_subroutine_s_moves_at_the_line_that_called_it():
     assert m98.until_line(4).end_mm[:, 0].tolist() == [0.0, 5.0, 40.0]
     assert read_gcode("G1 X1 F100\n").ran_line.tolist() == [1]
     assert Program.from_arrays([[0, 0, 0]], [[1, 0, 0]], line=3).ran_line.tolist() == [3]
+
+
+def test_a_nul_byte_that_hides_words_is_refused_naming_its_line(tmp_path):
+    """LinuxCNC reads a line only up to a NUL byte and drops the rest without a word
+    (rs274: 'G1 X2\\0 Y3 F100' runs as 'G1 X2'): woodcam said "bad character '\\x00'" outside a
+    comment and read a NUL inside one as text, where LinuxCNC says 'Unclosed comment found'.
+    Both now name the line, the character and the words the NUL hides; NULs with nothing
+    after them (a card's zero padding, a line ending in one) are read as LinuxCNC reads them,
+    from text and from a file."""
+    for text, line, col, hidden in (("G0 X1\nG1 X2\x00 Y3 F100\nM2\n", 2, 6, "'Y3 F100'"),
+                                    ("G0 X1 (a\x00b)\nM2\n", 1, 9, "'b)'"),
+                                    ("G0 X1\nM2\n\x00G1 X9\n", 3, 1, "'G1 X9'")):
+        with pytest.raises(GcodeError) as e:
+            read_gcode(text)
+        assert e.value.line == line and e.value.word == "NUL", str(e.value)
+        assert f"a NUL byte (character {col} of the line" in str(e.value)
+        assert f"drops the rest, here {hidden}, without a word" in str(e.value)
+    plain = read_gcode("G0 X1\nG1 X2 F100\nG1 Y5\nM2\n")
+    for padded in ("G0 X1\nG1 X2 F100\x00\nG1 Y5\nM2\n", "G0 X1\nG1 X2 F100\nG1 Y5\nM2\n\x00\x00",
+                   "G0 X1\nG1 X2 F100\n\x00 \x00\nG1 Y5\nM2\n"):
+        prog = read_gcode(padded)
+        assert np.array_equal(prog.end_mm, plain.end_mm) and prog.warnings == plain.warnings
+    card = tmp_path / "card.nc"
+    card.write_bytes(b"G0 X1\nG1 X2 F100\nG1 Y5\nM2\n" + b"\x00" * 512)
+    assert np.array_equal(read_gcode(card).end_mm, plain.end_mm)
+    card.write_bytes(b"G0 X1\nG1 X2\x00 Y3 F100\nM2\n")
+    with pytest.raises(WoodcamError, match=r"or G-code damaged by the NUL on line 2 "):
+        read_gcode(card)
+
+
+def test_the_end_of_file_warning_names_the_files_last_line_as_rs274_quotes_it():
+    """A program without M2/M30/'%' is warned of at the line rs274 quotes: the file's last.
+    A repeat loop ending the file was warned at its first line (where the loop ended); a file
+    of blank lines said 'no percent sign or program end' where rs274 says 'File ended with no
+    percent sign' (it looks past blank lines for the opening '%')."""
+    def end(text):
+        w, = [w for w in read_gcode(text).warnings if "the file ends" in w]
+        return w
+
+    assert end("o1 repeat [2]\nG0 X1\no1 endrepeat\n").startswith("line 3: ")
+    assert end("G0 X1\nG1 X2 F100\n(done)\n\n").startswith("line 4: ")
+    assert end("G0 X1\nG1 X2 F100").startswith("line 2: ")
+    for blank in ("", "\n\n", " \n"):
+        assert end(blank).endswith("'File ended with no percent sign')"), blank
+    assert end("(c)\n").endswith("'File ended with no percent sign or program end')")

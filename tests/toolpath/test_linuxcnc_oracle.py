@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from woodcam.toolpath import read_gcode
-from woodcam.toolpath.interpreter import GcodeError, Interpreter
+from woodcam.toolpath.interpreter import GcodeError, Interpreter, source_lines
 from woodcam.toolpath.linuxcnc import (NO_END, canonical, compare_canonical, linuxcnc_missing,
                                        run_batch, run_linuxcnc)
 
@@ -1086,7 +1086,8 @@ def test_a_file_opened_with_percent_that_stops_short_is_a_warning_with_both_inte
     assert len(mine) == len(theirs) == 2
     assert mine.warnings == ["line 5: the file ends without M2, M30 or '%' (LinuxCNC stops here "
                              "with 'File ended with no percent sign')"]
-    assert theirs.warnings == ["line 6: File ended with no percent sign"]
+    # (LinuxCNC's parse says line 6, after the last: the file's last is named, as rs274 quotes it)
+    assert theirs.warnings == ["line 5: File ended with no percent sign"]
 
 
 @pytest.mark.parametrize("length, line_end, refused", [
@@ -1149,3 +1150,47 @@ def test_until_line_counts_a_subroutine_s_moves_at_the_line_that_called_it_as_li
     assert len(alone.warnings) == 1 and alone.warnings[0].startswith(
         "line 2: woodcam cannot tell which subroutine call ran LinuxCNC's moves") and \
         "it refuses line 4" in alone.warnings[0]
+
+
+@pytest.mark.skipif(not RS274.exists(), reason=f"{RS274} (LinuxCNC's standalone interpreter, "
+                    "linuxcnc-uspace) is not installed")
+def test_the_end_of_a_file_and_a_nul_byte_are_read_as_rs274_reads_them(tmp_path):
+    """The end-of-file warning (no M2, M30 or '%') names the line rs274 quotes with it, the
+    file's last (LinuxCNC's parse named the line after it, line 3 of a 2-line file; woodcam's
+    interpreter the first line of a repeat loop that ended the file); both interpreters say
+    rs274's words. (rs274 quotes an o-word sub's endsub where a call ends the file; both name
+    the file's last line there.) A NUL byte rs274 reads as a line's end is one for both where
+    nothing but NULs and blanks follow it, and refused by both, naming its line, where rs274
+    drops words behind it."""
+    path = tmp_path / "p.ngc"
+
+    def rs274(text):
+        path.write_bytes(text.encode())
+        r = subprocess.run([str(RS274), "-g", str(path)], capture_output=True, text=True,
+                           timeout=60, cwd=tmp_path, errors="replace")
+        ends = [ln.split("(")[1].split(",")[:3] for ln in r.stdout.splitlines()
+                if "STRAIGHT_" in ln]
+        return r.stderr.splitlines()[1:], [[float(v) for v in e] for e in ends]
+
+    for text in ("G0 X1\nG1 X2 F100\n", "G0 X1\nG1 X2 F100", "G0 X1\nG1 X2 F100\n(done)\n\n",
+                 "%\nG0 X1\n", "o1 repeat [2]\nG0 X1\no1 endrepeat\n", "G0 X1\r\n;x\r\n"):
+        (said, quoted), _ = rs274(text)
+        for interp in ("woodcam", "linuxcnc"):
+            w, = [w for w in read_gcode(text, interpreter=interp).warnings if "File ended" in w]
+            line = int(w.split(":")[0].removeprefix("line "))
+            assert source_lines(text)[line - 1].strip() == quoted.strip(), (text, interp, w)
+            assert f"'{said}')" in w if interp == "woodcam" else w.endswith(said), (w, said)
+    ok = "G0 X1\nG1 X2 F100\nG1 Y5\nM2\n"
+    for text in ("G0 X1\nG1 X2 F100\x00\nG1 Y5\nM2\n", ok + "\x00" * 64, "G0 X1\n\x00\n" + ok[6:]):
+        theirs = rs274(text)[1]
+        assert theirs == rs274(ok)[1] and len(theirs) == 3
+        for interp in ("woodcam", "linuxcnc"):
+            ends = read_gcode(text, interpreter=interp).end_mm
+            assert abs(ends - [[1, 0, 10], [2, 0, 10], [2, 5, 10]]).max() < 1e-9, (text, interp)
+    for text, line in (("G0 X1\nG1 X2\x00 Y3 F100\nM2\n", 2), ("G0 X1 (a\x00b)\nM2\n", 1)):
+        said, _ = rs274(text)
+        assert said[0] in ("Cannot do g1 with zero feed rate", "Unclosed comment found")
+        for interp in ("woodcam", "linuxcnc"):
+            with pytest.raises(GcodeError, match="LinuxCNC reads a line only up to a NUL") as e:
+                read_gcode(text, interpreter=interp)
+            assert e.value.line == line

@@ -47,7 +47,7 @@ from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from ..tolerances import ARC_CHORD_TOL_MM
 from ..units import say_length
-from .interpreter import ARC, MM_PER_INCH, GcodeError, Interpreter
+from .interpreter import ARC, MM_PER_INCH, GcodeError, Interpreter, nul_byte_error, source_lines
 
 __all__ = ["DEFAULT_START_MM", "FEED", "MAX_CHORDS_PER_ARC", "MM_PER_INCH", "RAPID", "GcodeError",
            "Move", "Program", "gcode_text", "program_from_canonical", "read_gcode"]
@@ -283,19 +283,27 @@ def gcode_text(path: PathLike) -> str:
     """The text of the G-code file ``path`` as :func:`read_gcode` reads it: the line ends as
     written (``newline=""``: numbered as LinuxCNC numbers them, :func:`.interpreter.source_lines`),
     bytes that are no UTF-8 replaced. Read a file once with it and pass the text with
-    ``source=`` to read it more than once as the same bytes. A file with a NUL byte is no
-    G-code text (an image, a program, a CAM project, a file saved as UTF-16) and is refused
-    (its first line showed as a wall of bytes in a 'bad character' or 'unclosed comment'
-    error)."""
+    ``source=`` to read it more than once as the same bytes. A file with a NUL byte that hides
+    words (:func:`.interpreter.nul_byte_error`) is no G-code text (an image, a program, a CAM
+    project, a file saved as UTF-16) or a damaged one, and is refused, naming the line (its
+    first line showed as a wall of bytes in a 'bad character' or 'unclosed comment' error);
+    NULs with only NULs and blanks after them on their lines (a card's zero padding after the
+    program) are read as LinuxCNC reads them, as the end of their lines."""
     data = Path(path).read_bytes()
-    if b"\x00" in data:
-        what = ("saved as UTF-16 (Windows' 'Unicode'); save it as UTF-8 or ASCII"
-                if data[:2] in (b"\xff\xfe", b"\xfe\xff") else
-                "a binary file (an image, a program, a CAM project?); pass the G-code file "
-                "the CAM software's post-processor wrote (.nc, .ngc, .tap, .gcode)")
-        raise WoodcamError(f"{str(path)!r} is not G-code text: it holds NUL bytes "
-                           f"(it starts {data[:8]!r}): {what}")
-    return data.decode(errors="replace")
+    if b"\x00" not in data:
+        return data.decode(errors="replace")
+    text = data.decode(errors="replace")
+    utf16 = data[:2] in (b"\xff\xfe", b"\xfe\xff")
+    err = None if utf16 else nul_byte_error(source_lines(text))
+    if not utf16 and err is None:
+        return text
+    what = ("saved as UTF-16 (Windows' 'Unicode'); save it as UTF-8 or ASCII" if utf16 else
+            "a binary file (an image, a program, a CAM project?), or G-code damaged by the "
+            f"NUL on line {err.line if err else 1} (LinuxCNC would drop the words after it); "
+            "pass the G-code file the CAM software's post-processor wrote (.nc, .ngc, .tap, "
+            ".gcode)")
+    raise WoodcamError(f"{str(path)!r} is not G-code text: it holds NUL bytes "
+                       f"(it starts {data[:8]!r}): {what}")
 
 
 def read_gcode(text_or_path: str | PathLike, *, chord_tol_mm: float = ARC_CHORD_TOL_MM,

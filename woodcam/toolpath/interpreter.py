@@ -581,6 +581,37 @@ def _too_long_lines(lines: list[str], text: str) -> dict[int, int]:
             for b in [len(raw.encode())] if b > MAX_LINE + (i == last and not ended)}
 
 
+def nul_byte_error(lines: list[str]) -> GcodeError | None:
+    """The refusal of the first of a program's source ``lines`` (:func:`source_lines`) where a
+    NUL byte (``\\x00``) hides words, or ``None``. LinuxCNC (rs274, its AXIS preview) reads a
+    line as a C string, only up to its first NUL, and drops the rest without a word:
+    ``G1 X2\\x00 Y3 F100`` runs as ``G1 X2`` (refused for its zero feed, or run with the last
+    one). Where only NULs and blanks follow (a file's zero padding, a line ending in NULs)
+    nothing is lost and woodcam reads the line up to the NUL too (:func:`nul_cut`); where
+    more follows, both of woodcam's interpreters refuse the program, naming the line, before
+    running anything (such a NUL is a damaged file)."""
+    for no, raw in enumerate(lines, start=1):
+        col = raw.find("\x00") + 1
+        if not col:
+            continue
+        rest = raw[col:].replace("\x00", "").strip(" \t\r")
+        if not rest:
+            continue
+        return GcodeError(no, "NUL", f"a NUL byte (character {col} of the line, after "
+                          f"{raw[:col - 1][-30:]!r}): LinuxCNC reads a line only up to a NUL "
+                          f"and drops the rest, here {rest[:40]!r}, without a word; a NUL in "
+                          "G-code is a damaged file (a copy cut short) or not text",
+                          "remove the NUL byte and check the line is whole, or export the "
+                          "program again")
+    return None
+
+
+def nul_cut(lines: list[str]) -> list[str]:
+    """Source ``lines`` as LinuxCNC reads them: each up to its first NUL byte (after
+    :func:`nul_byte_error` found none that hides words, only NULs and blanks are cut)."""
+    return [raw[:raw.index("\x00")] if "\x00" in raw else raw for raw in lines]
+
+
 def split_comments(raw: str, no: int) -> tuple[str, list[tuple[str, str]]]:
     """Source line ``raw`` (1-based number ``no``) -> ``(text, messages)``: the text outside
     comments, lowercase, without whitespace, and its message comment as ``[(kind, text)]``
@@ -638,6 +669,8 @@ class Interpreter:
         self.dialect = dialect
         self.max_blocks, self.max_moves = int(max_blocks), int(max_moves)
         self.src = source_lines(text)
+        self._nul = nul_byte_error(self.src)  # refused by run(), as every other fault
+        self.src = nul_cut(self.src)
         self._too_long = _too_long_lines(self.src, text) if dialect == "linuxcnc" else {}
         # machine origin in the G-code frame (mm), None: not known (module docstring)
         self.mzero = None if machine_zero_mm is None else [float(v) for v in machine_zero_mm]
@@ -1040,6 +1073,8 @@ class Interpreter:
     def _prepare(self):
         """Normalise every line and match the O-word structure once (LinuxCNC matches by label:
         ``o100 if`` ... ``o100 endif``)."""
+        if self._nul is not None:
+            raise self._nul
         lines: list[_Line] = []
         percent = False
         closing = None  # index of the line of the closing '%'
@@ -1142,6 +1177,8 @@ class Interpreter:
             lines.append(ln)
         self.lines = lines
         self.closing = closing
+        # no line but blanks: rs274 looks past them for the opening '%' and meets the end
+        self._blank_file = first and not grbl
         words = [ln.no for ln in lines if ln.text]
         inside = [no for no in grbl_percent if words and words[0] < no < words[-1]]
         if inside:
@@ -1500,8 +1537,10 @@ class Interpreter:
                       "(LinuxCNC: 'File ended with no percent sign or program end')")
         elif not self.ended:
             if self.dialect == "linuxcnc":
-                self.line_no = max(self.line_no, 1)  # an empty file: its line 1, as LinuxCNC
-                said = NO_PERCENT if self._opened_with_percent else NO_END
+                # the file's last line (1 of an empty file), the one rs274 quotes, not the last
+                # run: a loop that ends the file ended on its own first line
+                self.line_no = max(len(self.src), 1)
+                said = NO_PERCENT if self._opened_with_percent or self._blank_file else NO_END
                 self.warn(f"the file ends without M2, M30 or '%' (LinuxCNC stops here with "
                           f"'{said}')")
         self._warn_g53_unplaced()

@@ -25,6 +25,7 @@ from .interpreter import (
     Interpreter,
     add_line_warning,
     line_list,
+    nul_byte_error,
     source_lines,
     split_comments,
     tool_entry_in_message,
@@ -108,6 +109,9 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
     tool (none loaded before an M6: 0); a tool-table entry LinuxCNC's table here does not
     hold (a tool not given, an offset) is shown and warned of as woodcam's interpreter does
     (:func:`_mark_tool_entries`), where LinuxCNC shows 0."""
+    nul = nul_byte_error(source_lines(text))  # LinuxCNC drops the rest of its line unsaid
+    if nul is not None:
+        raise nul
     g53 = _g53_lines(text) if machine_zero_mm is None else []
     if g53:
         raise GcodeError(g53[0], "G53", f"machine coordinates (G53, on line(s) {line_list(g53)}) "
@@ -163,7 +167,9 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
             raise GcodeError(int(line), "LinuxCNC", _SCRATCH.sub("the program", msg),
                              REFUSED_FIX if int(line) else "LinuxCNC's interpreter failed, "
                              "naming no line of the program; read it with --interpreter woodcam")
-        warnings.append((int(line), msg))
+        # its parse names the line after the last (line 3 of a 2-line file): the file's last,
+        # the line rs274 quotes, as woodcam's interpreter
+        warnings.append((min(int(line), max(len(source_lines(text)), 1)), msg))
     moves = [(k, ln, tuple(e), tuple(c) if c else None, rot, plane, feed, rpm, tool, bool(inch))
              for k, ln, e, c, rot, plane, feed, rpm, tool, inch in res["moves"]]
     ran = _ran_lines(text, moves, start_mm, machine_zero_mm, tool_diameters_mm, warnings)
