@@ -868,3 +868,22 @@ def test_a_run_scrubbed_before_the_first_move_says_its_machining_time(tmp_path, 
     assert args.func(args) == 0
     out = capsys.readouterr().out
     assert "p.nc: 0 moves read" in out and "issue(s); machining time 0:00:00 (no moves)\n" in out, out
+
+
+def test_until_line_keeps_the_tools_of_the_whole_program(tmp_path, monkeypatch, capsys):
+    """A two-tool program run with '--tool flat:6 --tool ball:3' failed when --until-line was
+    added to scrub it before its T2 M6: the tools without numbers went to the cut-short
+    program's tool numbers ('2 tools without numbers but the program uses 1 tool number(s)'),
+    so the run's own command line was refused. They go to the whole program's numbers now."""
+    _stub_preview(monkeypatch, {})
+    prog = tmp_path / "p.nc"
+    prog.write_text("G21 G90\nT1 M6\nM3 S12000\nG0 X10 Y10 Z5\nG1 Z-3 F300\nG1 X40 Y20\nG0 Z5\n"
+                    "T2 M6\nM3 S12000\nG0 X20 Y30 Z5\nG1 Z-2 F300\nG1 X45\nG0 Z5\nM30\n")
+    base = [str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+            "--tool", "flat:6", "--tool", "ball:3", "--cell-size", "0.5"]
+    for line, moves, times in (("3", 0, "0:00:00 (no moves)"), ("6", 3, "T1: 0:00:08"),
+                               ("12", 7, "T2: 0:00:07")):
+        args = _parse([*base, "--until-line", line])
+        assert args.func(args) == 0
+        out = capsys.readouterr().out
+        assert f"p.nc: {moves} moves read" in out and times in out, out

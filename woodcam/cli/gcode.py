@@ -302,7 +302,10 @@ def run(args) -> int:
             raise WoodcamError(f"woodcam gcode: {path} has no cutting move (G1/G2/G3 or a "
                                "drilling cycle); nothing to simulate. Check that it is the "
                                "program you meant")
-        tools = _tools_from_args(args, program)
+        # the tools without a number go to the whole program's tool numbers: cut short by
+        # --until-line before its T2 M6, 'flat:6 ball:3' was '2 tools without numbers but the
+        # program uses 1', so the run's own command line failed with the option added
+        tools = _tools_from_args(args, full)
         # a tool number without a tool was refused by simulate, after the block was opened and
         # the programs before it simulated, naming no file
         used = tool_lookup(program, tools, who=f"woodcam gcode {path.name}")
