@@ -427,3 +427,19 @@ def test_the_end_of_file_warning_names_the_files_last_line_as_rs274_quotes_it():
     for blank in ("", "\n\n", " \n"):
         assert end(blank).endswith("'File ended with no percent sign')"), blank
     assert end("(c)\n").endswith("'File ended with no percent sign or program end')")
+
+
+def test_form_feed_and_vertical_tab_at_a_lines_end_are_blanks_as_in_linuxcnc():
+    """LinuxCNC takes every C blank (form feed and vertical tab too) off a line's end before
+    reading it: rs274 runs 'G0 X1\\f' and a line of a lone form feed (a page break some
+    editors keep). woodcam refused them as "bad character '\\x0c'"; inside a line they are
+    still refused, as LinuxCNC refuses them ('Bad character')."""
+    plain = read_gcode("G0 X1\nG1 X2 F100\nM2\n")
+    for text in ("G0 X1\f\nG1 X2 F100\nM2\n", "G0 X1 \v \nG1 X2 F100 (c)\f\r\nM2\n",
+                 "G0 X1\n\f\nG1 X2 F100\nM2\n"):
+        prog = read_gcode(text)
+        assert np.array_equal(prog.end_mm, plain.end_mm), text
+        assert [w.split(":", 1)[1] for w in prog.warnings] == [w.split(":", 1)[1] for w in plain.warnings]
+    for text in ("G0\fX1\nM2\n", "\vG0 X1\nM2\n"):
+        with pytest.raises(GcodeError, match="bad character"):
+            read_gcode(text)

@@ -1161,7 +1161,8 @@ def test_the_end_of_a_file_and_a_nul_byte_are_read_as_rs274_reads_them(tmp_path)
     rs274's words. (rs274 quotes an o-word sub's endsub where a call ends the file; both name
     the file's last line there.) A NUL byte rs274 reads as a line's end is one for both where
     nothing but NULs and blanks follow it, and refused by both, naming its line, where rs274
-    drops words behind it."""
+    drops words behind it. A form feed or vertical tab at a line's end is a blank to rs274 and
+    both interpreters."""
     path = tmp_path / "p.ngc"
 
     def rs274(text):
@@ -1184,6 +1185,12 @@ def test_the_end_of_a_file_and_a_nul_byte_are_read_as_rs274_reads_them(tmp_path)
     for text in ("G0 X1\nG1 X2 F100\x00\nG1 Y5\nM2\n", ok + "\x00" * 64, "G0 X1\n\x00\n" + ok[6:]):
         theirs = rs274(text)[1]
         assert theirs == rs274(ok)[1] and len(theirs) == 3
+        for interp in ("woodcam", "linuxcnc"):
+            ends = read_gcode(text, interpreter=interp).end_mm
+            assert abs(ends - [[1, 0, 10], [2, 0, 10], [2, 5, 10]]).max() < 1e-9, (text, interp)
+    # a form feed or vertical tab ends a line as a blank (woodcam refused them)
+    for text in ("G0 X1\f\nG1 X2 F100 \v\nG1 Y5\nM2\n", "G0 X1\n\f\nG1 X2 F100\nG1 Y5\nM2\n"):
+        assert rs274(text)[1] == rs274(ok)[1]
         for interp in ("woodcam", "linuxcnc"):
             ends = read_gcode(text, interpreter=interp).end_mm
             assert abs(ends - [[1, 0, 10], [2, 0, 10], [2, 5, 10]]).max() < 1e-9, (text, interp)

@@ -545,6 +545,8 @@ def _late_rule(word: str) -> tuple[str, str]:
 #: end). Python's str.split() also skips form feed, vertical tab, no-break space, ..., which
 #: LinuxCNC refuses ("Bad character '\014' used").
 _BLANKS = str.maketrans("", "", " \t\r")
+#: C's isspace() less the line end: what LinuxCNC strips off the end of a line.
+_C_SPACE = " \t\r\v\f"
 
 
 def source_lines(text: str) -> list[str]:
@@ -672,6 +674,11 @@ class Interpreter:
         self._nul = nul_byte_error(self.src)  # refused by run(), as every other fault
         self.src = nul_cut(self.src)
         self._too_long = _too_long_lines(self.src, text) if dialect == "linuxcnc" else {}
+        # LinuxCNC takes every C blank (isspace: also form feed and vertical tab) off a line's
+        # end before it reads it; inside the line they are 'Bad character' (woodcam refused
+        # 'G0 X1\f', which rs274 runs)
+        self.src = [ln.rstrip(_C_SPACE) if ln[-1:] in _C_SPACE and ("\f" in ln or "\v" in ln)
+                    else ln for ln in self.src]
         # machine origin in the G-code frame (mm), None: not known (module docstring)
         self.mzero = None if machine_zero_mm is None else [float(v) for v in machine_zero_mm]
         shift = self.mzero or [0.0, 0.0, 0.0]
