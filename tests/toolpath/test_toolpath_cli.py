@@ -887,3 +887,34 @@ def test_until_line_keeps_the_tools_of_the_whole_program(tmp_path, monkeypatch, 
         assert args.func(args) == 0
         out = capsys.readouterr().out
         assert f"p.nc: {moves} moves read" in out and times in out, out
+
+
+def test_tools_without_numbers_go_to_the_jobs_tool_numbers_across_its_files(tmp_path, monkeypatch,
+                                                                           capsys):
+    """A roughing file on T1 and a finishing file on T2 (the --help's 'several files of one
+    job') with '--tool flat:6 --tool ball:3' failed: each file matched the tools to its own
+    numbers ('2 tools without numbers but the program uses 1'); and '--tool flat:6' alone cut
+    the finishing T2 with the flat mill, without a word. The tools go to the job's numbers in
+    order of first use now; a T2 without a tool is refused naming the file."""
+    _stub_preview(monkeypatch, {})
+    rough, finish = tmp_path / "rough.nc", tmp_path / "finish.nc"
+    rough.write_text("G21 G90\nT1 M6\nM3 S12000\nG0 X10 Y10 Z5\nG1 Z-3 F300\nG1 X40 Y20\n"
+                     "G0 Z5\nM30\n")
+    finish.write_text("G21 G90\nT2 M6\nM3 S12000\nG0 X20 Y30 Z5\nG1 Z-2 F300\nG1 X45\nG0 Z5\n"
+                      "M30\n")
+    base = [str(rough), str(finish), "--block", "builtin:flat-sawn", "--out",
+            str(tmp_path / "o.glb"), "--cell-size", "0.5"]
+    args = _parse([*base, "--tool", "flat:6", "--tool", "ball:3"])
+    assert _tools_from_args(args, [read_gcode(rough), read_gcode(finish)]) == {
+        1: FlatEndMill(6), 2: BallEndMill(3)}
+    assert args.func(args) == 0
+    out = capsys.readouterr().out
+    assert "rough.nc: 4 moves" in out and "finish.nc: 4 moves" in out and "T2: 0:00:07" in out
+    args = _parse([*base, "--tool", "flat:6"])
+    with pytest.raises(WoodcamError, match=r"woodcam gcode finish.nc: the program uses tool 2 "
+                       r"\(first at line 4\) but tools has \[1\]"):
+        args.func(args)
+    args = _parse([*base, "--tool", "flat:6", "--tool", "ball:3", "--tool", "vbit:60:6"])
+    with pytest.raises(WoodcamError, match=r"3 tools without numbers but the programs use 2 "
+                       r"tool number\(s\) without a tool \(\[1, 2\]\).*they do not use"):
+        args.func(args)

@@ -52,7 +52,7 @@ def register(subparsers) -> None:
     p.add_argument("--tool", action="append", default=[], metavar="[N=]SPEC",
                    help="a tool, e.g. flat:6.35, ball:3, bull:6:1, vbit:60:12, 2=ball:3 "
                    "(repeatable; without N= the tools go to the program's tool numbers in "
-                   "order of first use); the reach for the flute/shank/holder checks as "
+                   "order of first use, across the files of a job); the reach for the flute/shank/holder checks as "
                    "flat:6:flute=22:shank=6:stickout=30:holder=35 (lengths in --units, "
                    "default mm). Default: none; give --tool or --tools")
     add_input(p, "--tools", kind="file", type=Path, default=None, metavar="TOML",
@@ -144,7 +144,7 @@ def _numbered_tools(args) -> dict:
     return tools
 
 
-def _unnumbered_diameters(args, program, diameters, text) -> dict:
+def _unnumbered_diameters(args, program, diameters, text, earlier=()) -> dict:
     """The diameters (mm) of the tools without a number (--tool SPEC) by the tool numbers
     ``program`` gets them for (:func:`_tools_from_args`: the numbers it uses without a tool,
     in order; one tool alone is the tool of a program without a T word, tool 0), those not in
@@ -162,8 +162,8 @@ def _unnumbered_diameters(args, program, diameters, text) -> dict:
             args.interpreter == "linuxcnc" and may_read_tool_diameters(text))) or all(
             parse_tool_option(item)[0] is not None for item in args.tool):
         return {}
-    try:
-        tools = _tools_from_args(args, program)
+    try:  # (``earlier``: the job's programs before it, whose tools come first)
+        tools = _tools_from_args(args, [*earlier, program], more_to_come=True)
     except WoodcamError:
         return {}
     return {n: t.diameter_mm for n, t in tools.items() if n not in diameters and n != 0}
@@ -192,27 +192,38 @@ def _warn_inch_sizes_read_as_mm(args, program, name: str) -> int:
     return 1
 
 
-def _tools_from_args(args, program) -> dict:
+def _tools_from_args(args, programs, *, more_to_come: bool = False) -> dict:
+    """The tool table of the job's ``programs`` (one Program or the job's, in order): the
+    numbered --tool/--tools entries, and the tools without a number on the tool numbers the
+    job uses without a tool, in order of first use across its programs (a roughing file's T1,
+    then a finishing file's T2: matched per file, '--tool flat:6 --tool ball:3' was '2 tools
+    without numbers but the program uses 1'). ``more_to_come``: the programs are the first of
+    the job, so more tools than numbers is no fault yet."""
     from .options import parse_tool_option
 
+    programs = list(programs) if isinstance(programs, (list, tuple)) else [programs]
     tools = _numbered_tools(args)
     unnumbered = [tool for number, tool in map(parse_tool_option, args.tool) if number is None]
     if unnumbered:
-        used = [t for t in dict.fromkeys(program.tool.tolist()) if t not in tools]
-        if len(used) > 1 and 0 in used and program.tool_of_leading_rapids() is not None:
+        used = [t for t in dict.fromkeys(t for p in programs for t in p.tool.tolist())
+                if t not in tools]
+        if len(used) > 1 and 0 in used and all(p.tool_of_leading_rapids() is not None
+                                               for p in programs if (p.tool == 0).any()):
             # T0 only rapids before the first M6 (Carbide Create's "G53 G0 Z-5", a G28): no tool
             # of its own; simulate gives those rapids the first tool loaded
             used.remove(0)
         if len(unnumbered) == 1 and len(used) <= 1:
             used = used or [0]
-        if len(unnumbered) > len(used):
+        if len(unnumbered) > len(used) and not more_to_come:
             typed = [item for item in args.tool if parse_tool_option(item)[0] is None]
             free = [n for n in range(1, 100000) if n not in tools and n not in used][:len(typed) - len(used)]
             example = " ".join(f"--tool {n}={item}" for n, item in zip([*used, *free], typed))
-            raise WoodcamError(f"--tool: {len(unnumbered)} tools without numbers but the program "
-                               f"uses {len(used)} tool number(s) without a tool ({used}); each tool "
+            raise WoodcamError(f"--tool: {len(unnumbered)} tools without numbers but the "
+                               f"{'program uses' if len(programs) == 1 else 'programs use'} "
+                               f"{len(used)} tool number(s) without a tool ({used}); each tool "
                                f"without a number takes the next of those; give numbers as N=SPEC, "
-                               f"e.g. {example}, or leave out the tools it does not use")
+                               f"e.g. {example}, or leave out the tools "
+                               f"{'it does' if len(programs) == 1 else 'they do'} not use")
         tools.update(zip(used, unnumbered))
     if not tools:
         raise WoodcamError("woodcam gcode: no tools given; pass --tool SPEC (e.g. --tool "
@@ -274,7 +285,8 @@ def run(args) -> int:
                                  dialect=args.dialect, interpreter=args.interpreter,
                                  machine_zero_mm=args.machine_zero,
                                  tool_diameters_mm=diameters)
-            more = _unnumbered_diameters(args, program, diameters, text)
+            more = _unnumbered_diameters(args, program, diameters, text,
+                                         [q[2] for q in programs])
             if more:  # what its messages show for #5410 and LinuxCNC's G41/G42 offset: read
                 # again with the tools it is given
                 program = read_gcode(text, source=str(path), start_mm=args.start,
@@ -302,10 +314,12 @@ def run(args) -> int:
             raise WoodcamError(f"woodcam gcode: {path} has no cutting move (G1/G2/G3 or a "
                                "drilling cycle); nothing to simulate. Check that it is the "
                                "program you meant")
-        # the tools without a number go to the whole program's tool numbers: cut short by
-        # --until-line before its T2 M6, 'flat:6 ball:3' was '2 tools without numbers but the
-        # program uses 1', so the run's own command line failed with the option added
-        tools = _tools_from_args(args, full)
+        programs.append((path, program, full, t_read))
+    # the tools without a number go to the whole job's tool numbers: cut short by --until-line
+    # before its T2 M6, 'flat:6 ball:3' was '2 tools without numbers but the program uses 1',
+    # so the run's own command line failed with the option added
+    tools = _tools_from_args(args, [q[2] for q in programs])
+    for k, (path, program, full, t_read) in enumerate(programs):
         # a tool number without a tool was refused by simulate, after the block was opened and
         # the programs before it simulated, naming no file
         used = tool_lookup(program, tools, who=f"woodcam gcode {path.name}")
@@ -326,7 +340,7 @@ def run(args) -> int:
                   f"aliasing waves; use --cell-size {step / 2 / MM_PER_UNIT[args.units]:.2g} or finer",
                   file=sys.stderr)
             n_warn += 1
-        programs.append((path, program, full, t_read, tools))
+        programs[k] = (path, program, full, t_read, tools)
     # one bar for the whole run, as bake's: opening a photographed block can fit its rings
     # (20-30 s, once), the simulation draws its own bar below it, and the mesh, bake and view
     # took 5-10 s more with none
