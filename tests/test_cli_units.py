@@ -121,6 +121,9 @@ def test_place_ops_round_trip_and_printing():
     assert place_op_in("translate:50,-23.7,0", 1 / k) == "translate:1.96850393701,-0.933070866142,0"
     assert fmt_length(50.8, "inch") == "2 in" and fmt_length(50.8) == "50.8 mm"
     assert fmt_volume(25.4 ** 3 * 2, "inch") == "2 in^3" and fmt_volume(1234.4) == "1234 mm^3"
+    # (the leftover of a 60x50x20 in block with --part said '6e+04 in^3')
+    assert fmt_volume(25.4 ** 3 * 60000, "inch") == "60000 in^3"
+    assert fmt_volume(25.4 ** 3 * 123456.7, "inch") == "123500 in^3"
 
 
 def test_gcode_in_inches_cuts_what_the_mm_run_cuts(tmp_path, monkeypatch, capsys):

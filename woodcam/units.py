@@ -69,10 +69,11 @@ def fmt_span(lo_mm: float, hi_mm: float, units: Units = "mm", digits: int = 2) -
 
 def fmt_volume(mm3: float, units: Units = "mm") -> str:
     """A volume given in mm^3, printed in ``units``^3: ``"1234 mm^3"`` or ``"0.07531 in^3"``;
-    under 1000 mm^3 four significant digits, as inches get (``"1.518 mm^3"``, not ``"2 mm^3"``)."""
+    under 1000 mm^3 four significant digits, as inches get (``"1.518 mm^3"``, not ``"2 mm^3"``);
+    never in exponent form (a 60x50x20 in block's leftover was '6e+04 in^3')."""
     if units == "mm":
         return f"{mm3:.0f} mm^3" if abs(mm3) >= 1000 else f"{mm3:.4g} mm^3"
-    return f"{mm3 / MM_PER_UNIT[units] ** 3:.4g} {_SYMBOL[units]}^3"
+    return f"{_no_exponent(mm3 / MM_PER_UNIT[units] ** 3, '.4g')} {_SYMBOL[units]}^3"
 
 
 #: The unit messages speak in for this run (:func:`message_units`); a plain global, not a context
