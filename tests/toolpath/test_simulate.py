@@ -331,3 +331,22 @@ def test_a_cut_through_the_bottom_says_how_far_below_it_goes_at_worst():
                    parse_tool_spec("flat:3"), (60.0, 40.0, 20.0), resolution_mm=0.2).report
     assert [(i.line, i.message) for i in one] == [
         (6, "tool tip at z = -22.000 mm (G-code frame), 2.000 mm below the stock bottom")]
+
+
+def test_too_fine_a_grid_says_the_finest_that_fits():
+    """woodcam gcode --cell-size 0.005 on a 100 x 80 mm block said 'simulate: 20000 x 16000
+    cells is too many for resolution_mm=0.005; use a coarser resolution': neither the option
+    the user typed nor how coarse. It names both, the limit, and the finest cell that fits."""
+    import re
+
+    from woodcam.toolpath.simulate import _MAX_CELLS
+
+    prog = read_gcode("G0 X1 Y1 Z1\nG1 Z-1 F100\nM2\n")
+    for (W, D), res in (((100.0, 80.0), 0.005), ((3000.0, 10.0), 1e-4), ((99.0, 99.0), 1e-4)):
+        with pytest.raises(WoodcamError, match=r"resolution_mm \(--cell-size\) .* cells of the "
+                           r".* stock, more than the 134,217,728 the height field holds") as e:
+            simulate(prog, FlatEndMill(3), (W, D, 5.0), resolution_mm=res)
+        fine = float(re.search(r"use ([0-9.]+) mm or coarser", str(e.value)).group(1))
+        cells = lambda r: max(1, round(W / r)) * max(1, round(D / r))  # noqa: E731
+        step = 10 ** (math.floor(math.log10(fine)) - 1)
+        assert cells(fine) <= _MAX_CELLS < cells(fine - step), (W, D, fine)
