@@ -242,7 +242,7 @@ def test_a_tool_change_stops_the_spindle_as_linuxcnc_does():
 
 
 @pytest.mark.parametrize("tool", [BallEndMill(6), FlatEndMill(4), "vbit:60:6", "vbit:150:8",
-                                  "bull:6:1", "snub:90:6:1", "chamfer:60:8:0.5",
+                                  "bull:6:1", "snub:90:6:1", "snub:150:8:1", "chamfer:60:8:0.5",
                                   "taperball:6:1:5"])
 def test_compiled_sweeps_match_the_numpy_envelopes(tool, monkeypatch):
     """Every tool type runs through the one-pass numba kernel (woodcam.toolpath._sweep); the

@@ -1,7 +1,9 @@
 """Swept-tool envelopes min-updated into the height field by numba, for every tool profile of
 :mod:`woodcam.toolpath.tools`: ball and flat end mills and the V-bit in closed form, the bull
-nose, snub-nose V-bit / chamfer mill and tapered ball by bisection on ramps (the formulas of
-each tool's :meth:`~woodcam.toolpath.tools.Tool._sweep`, in float64).
+nose by bisection on ramps (the formulas of each tool's
+:meth:`~woodcam.toolpath.tools.Tool._sweep`, in float64), the snub-nose V-bit / chamfer mill
+and tapered ball in closed form too (the V-bit's tangent point, or the flat tip's downhill
+edge / the tip sphere's tangent point where the minimum lies there).
 
 The numpy path (:meth:`woodcam.toolpath.tools.Tool._sweep` over ``(moves, wy, wx)`` windows,
 then one Python slice update per move) builds four float32 temporaries per window cell and
@@ -121,6 +123,28 @@ def sweep_update(hm, line_map, track, kind, prm, R, a, b, js, is_, wy, wx, dx, d
                             t = min(max(along - cone * abs(perp), lo), hi)
                         w = t - along
                         env = z0 + s * t + kv * math.sqrt(d2 + w * w)
+                    elif kind == SNUB or kind == TAPERBALL:
+                        # closed form (as the V-bit's, the profile convex and C1 but for the
+                        # snub's kink): the minimiser of s w + h(sqrt(d2 + w^2)), clipped
+                        kc = prm[1] if kind == SNUB else prm[3]
+                        if abs(s) >= kc:  # steeper than the cone: the chord's lower end
+                            t = lo if s > 0 else hi
+                        else:
+                            d = abs(perp)
+                            w = -s * d / math.sqrt(kc * kc - s * s)  # on the cone
+                            if kind == SNUB:
+                                rt = prm[0]
+                                if d * d + w * w < rt * rt:  # on the flat: its downhill edge
+                                    wf = math.sqrt(max(rt * rt - d2, 0.0))
+                                    w = -wf if s > 0 else (wf if s < 0 else 0.0)
+                            elif d < prm[1]:  # the tip's sphere, where it holds the minimum
+                                wb = -s * math.sqrt(max(prm[0] * prm[0] - d2, 0.0)) / math.sqrt(
+                                    1.0 + s * s)
+                                if d2 + wb * wb <= prm[1] * prm[1]:
+                                    w = wb
+                            t = min(max(along + w, lo), hi)
+                        w = t - along
+                        env = z0 + s * t + _h(kind, prm, R, min(math.sqrt(d2 + w * w), R))
                     else:
                         # the envelope is at least the chord's lowest tip plus the profile at
                         # the cell's distance from the line: a cell that bound leaves
