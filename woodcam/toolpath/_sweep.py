@@ -33,7 +33,7 @@ BALL, FLAT, VBIT, BULL, SNUB, TAPERBALL = 0, 1, 2, 3, 4, 5
 
 @numba.njit(nogil=True, cache=True, inline="always")
 def _h(kind, prm, R, r):
-    """Profile height (mm) above the tip at radius ``r <= R`` of the bisected kinds."""
+    """Profile height (mm) above the tip at radius ``r <= R`` of BULL, SNUB and TAPERBALL."""
     if kind == BULL:
         rc = prm[0]
         q = max(r - (R - rc), 0.0)
@@ -47,18 +47,11 @@ def _h(kind, prm, R, r):
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
-def _dh(kind, prm, R, r):
-    """The profile's slope ``dh/dr`` at radius ``r <= R`` of the bisected kinds."""
-    if kind == BULL:
-        rc = prm[0]
-        q = max(r - (R - rc), 0.0)
-        return q / math.sqrt(max(rc * rc - q * q, 1e-30))
-    if kind == SNUB:
-        return prm[1] if r > prm[0] else 0.0
-    rb, rt, k = prm[0], prm[1], prm[3]  # TAPERBALL
-    if r <= rt:
-        return r / math.sqrt(max(rb * rb - r * r, 1e-30))
-    return k
+def _dh_bull(prm, R, r):
+    """The bull nose's profile slope ``dh/dr`` at radius ``r <= R`` (its bisection)."""
+    rc = prm[0]
+    q = max(r - (R - rc), 0.0)
+    return q / math.sqrt(max(rc * rc - q * q, 1e-30))
 
 
 @numba.njit(nogil=True, cache=True)
@@ -66,7 +59,7 @@ def sweep_update(hm, line_map, track, kind, prm, R, a, b, js, is_, wy, wx, dx, d
                  depth):
     """Min-update ``hm`` with the envelopes of the ``n`` moves; ``depth[k]`` gets how far move
     ``k`` reaches below the stock it meets (``max(hm - envelope)`` over its covered cells,
-    before its own update, exact where it is > 0 (bisected kinds: an upper bound <= 0 where
+    before its own update, exact where it is > 0 (BULL: an upper bound <= 0 where
     the move cuts nothing); ``-inf`` if it covers none); with ``track`` the cells a move lowers
     get its source line in ``line_map``. Returns the number of covered cells."""
     covered = 0
@@ -145,7 +138,7 @@ def sweep_update(hm, line_map, track, kind, prm, R, a, b, js, is_, wy, wx, dx, d
                             t = min(max(along + w, lo), hi)
                         w = t - along
                         env = z0 + s * t + _h(kind, prm, R, min(math.sqrt(d2 + w * w), R))
-                    else:
+                    else:  # BULL
                         # the envelope is at least the chord's lowest tip plus the profile at
                         # the cell's distance from the line: a cell that bound leaves
                         # untouched (most of a raster's overlap with the last pass) needs no
@@ -164,7 +157,7 @@ def sweep_update(hm, line_map, track, kind, prm, R, a, b, js, is_, wy, wx, dx, d
                                 m = 0.5 * (ta + tb)
                                 w = m - along
                                 rho = math.sqrt(d2 + w * w)
-                                der = s + _dh(kind, prm, R, min(rho, R)) * (
+                                der = s + _dh_bull(prm, R, min(rho, R)) * (
                                     w / max(rho, 1e-30) if rho > 0 else 0.0)
                                 if der > 0:
                                     tb = m
