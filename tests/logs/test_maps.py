@@ -140,3 +140,39 @@ def test_a_log_without_knots_writes_and_reads_back_its_maps(tmp_path):
     back = read_maps(tmp_path / "m")
     assert back.knots == ()
     assert back.r_min_mm == pytest.approx(80.0, abs=0.5) and back.length_mm == pytest.approx(300.0)
+
+
+@pytest.mark.parametrize("params, said", [
+    ("{", "must be valid JSON"),                                    # was json's bare JSONDecodeError
+    ('{"r_min_mm": NaN, "r_max_mm": 143, "height_mm": 3990}', "finite numbers"),
+    ("5", "must be a JSON object"),                                  # was TypeError, an internal error
+    ('{"r_min_mm": "a", "r_max_mm": 1, "height_mm": 1}', "r_min_mm must be a finite number > 0; got 'a'"),
+    ('{"r_min_mm": 104, "r_max_mm": 143, "height_mm": 0}', "height_mm must be a finite number > 0"),
+    ('{"r_min_mm": 104, "r_max_mm": 90, "height_mm": 400}', "r_max_mm must be a finite number >= 104"),
+    ('{"r_min_mm": 104, "r_max_mm": 143, "height_mm": 400, "row_height": 0}', "row_height must be an integer >= 1"),
+    ('{"r_min_mm": 104, "r_max_mm": 143, "height_mm": 400, "pith_mid_xy_mm": [1]}',
+     "pith_mid_xy_mm must be 2 finite numbers; got [1]"),             # was read as (1, 1) without a word
+])
+def test_a_malformed_map_params_file_is_an_error_naming_the_folder_and_the_value(tmp_path, params, said):
+    """'woodcam log render --maps DIR' with a damaged map_params.json was an internal error
+    (JSONDecodeError; TypeError for a number; ZeroDivisionError for row_height 0), a NaN or a
+    zero height the log's own error about its pith samples, and a one-number pith_mid_xy_mm was
+    read as both coordinates (sweep h4)."""
+    from woodcam.fields.skeleton import simple_log
+
+    write_maps(simple_log(300.0, 80.0), tmp_path / "m")
+    (tmp_path / "m" / "map_params.json").write_text(params)
+    with pytest.raises(WoodcamError) as err:
+        read_maps(tmp_path / "m")
+    assert said in str(err.value) and str(tmp_path / "m") in str(err.value), err.value
+
+
+def test_a_damaged_map_image_is_an_error_naming_it(tmp_path):
+    """A map PNG that is no image was PIL's 'cannot identify image file', which the CLI's
+    generic handler told to 'check the path, its permissions and the free space' (sweep h4)."""
+    from woodcam.fields.skeleton import simple_log
+
+    write_maps(simple_log(300.0, 80.0), tmp_path / "m")
+    (tmp_path / "m" / "stem_map.png").write_text("garbage")
+    with pytest.raises(WoodcamError, match=r"cannot decode the image stem_map.png .*'woodcam log maps"):
+        read_maps(tmp_path / "m")

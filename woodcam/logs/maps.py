@@ -39,6 +39,8 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic import atomic_path, write_text
+from .._checks import check_bool, check_number, check_vector, received
+from .._readers import read_json_file
 from ..errors import WoodcamError
 from ..fields.skeleton import BranchStrand, LogSkeleton
 
@@ -128,23 +130,52 @@ def write_maps(log: LogSkeleton, folder, **kw) -> dict:
     return out
 
 
+def _map_params(params) -> dict:
+    """``map_params.json``'s numbers checked (a JSON file, from anywhere: a string, a number or a
+    text value was an internal error, NaN or a negative height the log's own error about its
+    pith samples, a one-number ``pith_mid_xy_mm`` read as both coordinates without a word):
+    ``r_min_mm``, ``r_max_mm`` (0 < r_min <= r_max) and ``height_mm`` (> 0) in mm, with
+    woodcam's optional ``z_start_mm`` (finite), ``pith_mid_xy_mm`` (two finite numbers),
+    ``diameter_max_mm`` (> 0), ``row_height`` (a whole number >= 1) and ``clockwise`` (a
+    bool) at their defaults; the seed tool's four-number list is read as its dict."""
+    if isinstance(params, (list, tuple)):
+        params = dict(zip(("r_min_mm", "r_max_mm", "height_mm", "n_knots"), params))
+    if not isinstance(params, dict):
+        raise WoodcamError(f"map parameters must be a JSON object (r_min_mm, r_max_mm, height_mm, ...) or "
+                           f"the seed's list of four numbers; got {received(params)}")
+    missing = [k for k in ("r_min_mm", "r_max_mm", "height_mm") if k not in params]
+    if missing:
+        raise WoodcamError(f"map parameters lack {missing[0]!r}; give r_min_mm, r_max_mm and "
+                           "height_mm (mm)")
+    out = dict(params)
+    r_min = out["r_min_mm"] = check_number(params["r_min_mm"], "map parameters' r_min_mm", lo=0, lo_open=True)
+    out["r_max_mm"] = check_number(params["r_max_mm"], "map parameters' r_max_mm", lo=r_min,
+                                   fix="the largest outer radius, >= r_min_mm")
+    out["height_mm"] = check_number(params["height_mm"], "map parameters' height_mm", lo=0, lo_open=True)
+    out["z_start_mm"] = check_number(params.get("z_start_mm", 0.0), "map parameters' z_start_mm")
+    out["pith_mid_xy_mm"] = check_vector(params.get("pith_mid_xy_mm", (0.0, 0.0)),
+                                         "map parameters' pith_mid_xy_mm", n=2)
+    out["diameter_max_mm"] = check_number(params.get("diameter_max_mm", 1.0), "map parameters' diameter_max_mm",
+                                          lo=0, lo_open=True)
+    rh = params.get("row_height", 1)
+    if isinstance(rh, float) and rh.is_integer():  # 3.0: a whole number, as n_knots takes it
+        rh = int(rh)
+    out["row_height"] = check_number(rh, "map parameters' row_height", lo=1, integer=True)
+    out["clockwise"] = check_bool(params.get("clockwise", False), "map parameters' clockwise",
+                                  fix="true or false")
+    return out
+
+
 def decode_maps(maps: dict, params: dict) -> LogSkeleton:
     """A :class:`Log` from map arrays (``uint8 (rows, cols, 3)``) and the parameter dict.
 
     ``params`` needs the seed's ``r_min_mm``, ``r_max_mm``, ``height_mm`` (a list
     ``[r_min, r_max, height, n_knots]``, the seed tool's ``map_params.json``, is accepted too).
     """
-    if isinstance(params, (list, tuple)):
-        params = dict(zip(("r_min_mm", "r_max_mm", "height_mm", "n_knots"), params))
-    try:
-        r_min, r_max, h = (float(params[k]) for k in ("r_min_mm", "r_max_mm", "height_mm"))
-    except KeyError as err:
-        raise WoodcamError(f"map parameters lack {err.args[0]!r}; give r_min_mm, r_max_mm and "
-                           "height_mm (mm)") from err
-    z_start = float(params.get("z_start_mm", 0.0))
-    mid = np.asarray(params.get("pith_mid_xy_mm", (0.0, 0.0)), float)
-    rh = int(params.get("row_height", 1))
-    clockwise = bool(params.get("clockwise", False))
+    params = _map_params(params)
+    r_min, r_max, h = (params[k] for k in ("r_min_mm", "r_max_mm", "height_mm"))
+    z_start, mid, rh = params["z_start_mm"], params["pith_mid_xy_mm"], params["row_height"]
+    clockwise = params["clockwise"]
     stem = np.asarray(maps["stem"], float)
     if stem.ndim != 3 or stem.shape[2] < 3 or stem.shape[0] < 2:
         raise WoodcamError(f"stem map must be an RGB image with >= 2 rows; got {stem.shape}")
@@ -169,8 +200,10 @@ def decode_maps(maps: dict, params: dict) -> LogSkeleton:
                                f"got {nk!r}")
         n = min(n, int(nk))
     kc = H.shape[1]
+    if kc < 2:  # a column is a pith distance over [0, r_max]: one column spans none (0/0)
+        raise WoodcamError(f"knot maps must have >= 2 columns (pith distances 0 .. r_max); got {kc}")
     d = np.arange(kc) * r_max / (kc - 1)
-    dmax = float(params.get("diameter_max_mm", 1.0))
+    dmax = params["diameter_max_mm"]
     knots = []
     for i in range(n):
         row = i * rh + rh // 2
@@ -207,10 +240,19 @@ def read_maps(folder) -> LogSkeleton:
         raise WoodcamError(f"map folder {str(folder)!r} lacks {missing}; it needs "
                            f"{sorted(MAP_FILES.values())}; write such a folder with 'woodcam log maps "
                            "(LOG_FILE | --real) --out DIR' (woodcam.logs.write_maps)")
+    fix = "write such a folder with 'woodcam log maps (LOG_FILE | --real) --out DIR'"
     maps = {}
     for k, f in MAP_FILES.items():
         if k != "params":
-            with Image.open(folder / f) as im:
-                maps[k] = np.asarray(im.convert("RGB"))
-    params = json.loads((folder / MAP_FILES["params"]).read_text())
-    return decode_maps(maps, params)
+            try:  # a damaged or foreign file was PIL's "cannot identify image file ... check the path"
+                with Image.open(folder / f) as im:
+                    maps[k] = np.asarray(im.convert("RGB"))
+            except (OSError, ValueError, Image.DecompressionBombError) as err:
+                raise WoodcamError(f"map folder {str(folder)!r}: cannot decode the image {f} ({err}); "
+                                   f"{fix}") from err
+    # strict JSON (NaN refused), and its errors name the file: json.loads' were internal errors
+    params = read_json_file(folder / MAP_FILES["params"], "map parameters")
+    try:
+        return decode_maps(maps, params)
+    except WoodcamError as err:  # decode_maps reads arrays and a dict, from anywhere: add the folder
+        raise WoodcamError(f"map folder {str(folder)!r}: {err}; {fix}") from err
