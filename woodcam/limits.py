@@ -48,6 +48,14 @@ REVIEW_VOXELS_RANGE = (1_000, 8_000_000)
 #: WOODIFY_BYTES_PER_NODE), so 1024 passes for a slender input and not for a cube.
 WOODIFY_RESOLUTION_RANGE = (16, 1024)
 
+#: MiB of memory per engine worker (woodcam.scale.run_many's ``memory_limit_mb``, the
+#: ``--memory-limit-mb`` of bench run, block synth and train), the one home of the range both
+#: read: a Python worker alone needs ~100 MiB and a bench task ~1 GiB, so under 256 every task
+#: dies of MemoryError (the library refuses it); 1 TiB, beyond any machine's RAM, bounds only
+#: what the CLI takes (a typo's extra zeros). The CLI said 64 and the library 256: 64..255
+#: passed the door, wrote bench run's run.json and exited 1 naming the Python parameter.
+WORKER_MEMORY_MB_RANGE = (256, 1_048_576)
+
 _DEFAULTS = {name: value for name, value in globals().items() if name.startswith("MAX_")}
 
 #: What each limit counts, said after its numbers: 'needs 1.074e+09, more than the limit

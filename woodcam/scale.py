@@ -51,6 +51,7 @@ from typing import Any, Callable, Iterable, Literal, get_args
 
 from ._checks import check_bool, check_number, check_path
 from .errors import UsageError, WoodcamError
+from .limits import WORKER_MEMORY_MB_RANGE
 
 Engine = Literal["local", "dask"]
 ENGINES: tuple[str, ...] = get_args(Engine)
@@ -275,9 +276,11 @@ def _check_keys(keys: Iterable) -> list[str]:
     return keys
 
 
-def _check_address(address: str) -> str:
-    if not re.match(r"^(tcp|tls|inproc|ucx|ws|wss)://[^\s/]+$", address):
-        raise WoodcamError(f"address must be a Dask scheduler address like tcp://HOST:8786; got "
+def check_address(address: str, name: str = "address") -> str:
+    """``address`` if it is a Dask scheduler address (``tcp://HOST:PORT``, or another of Dask's
+    protocols), else a WoodcamError naming ``name`` (the CLI's ``--address``)."""
+    if not isinstance(address, str) or not re.match(r"^(tcp|tls|inproc|ucx|ws|wss)://[^\s/]+$", address):
+        raise WoodcamError(f"{name} must be a Dask scheduler address like tcp://HOST:8786; got "
                            f"{address!r}")
     return address
 
@@ -324,7 +327,7 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
     if workers is not None:
         workers = int(check_number(workers, "workers", lo=1, integer=True, fix="worker processes, or None"))
     if memory_limit_mb is not None:
-        check_number(memory_limit_mb, "memory_limit_mb", lo=256,
+        check_number(memory_limit_mb, "memory_limit_mb", lo=WORKER_MEMORY_MB_RANGE[0],
                      fix="MiB per worker (a Python worker alone needs ~100 MiB), or None")
     progress = check_bool(progress, "run_many: progress")
     # NaN or -1 was taken, and handed to Dask's Client(timeout=...) as it was
@@ -334,7 +337,7 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
         if engine != "dask":
             raise WoodcamError(f"address applies to engine='dask' only; got engine={engine!r} "
                                f"with address={address!r}")
-        _check_address(address)
+        check_address(address)
         if workers is not None:
             raise WoodcamError(f"workers cannot be set with an address: the cluster at {address} "
                                f"has its own workers; got workers={workers!r}")
@@ -491,4 +494,4 @@ def _run_dask(client, fn, todo, retries, finish) -> int:
 
 
 __all__ = ["DEFAULT_MEMORY_LIMIT_MB", "ENGINES", "Engine", "RECORDS_DIR", "RunSummary",
-           "check_run_manifest", "read_records", "record_path", "run_many", "write_json_atomic"]
+           "check_address", "check_run_manifest", "read_records", "record_path", "run_many", "write_json_atomic"]

@@ -227,6 +227,29 @@ def test_a_commands_own_usage_checks_come_before_any_work(argv, said, tmp_path, 
     assert not out.exists()
 
 
+@pytest.mark.parametrize("argv, said", [
+    (["bench", "run", "--blocks", "1", "--out", "OUT/b", "--memory-limit-mb", "100"],
+     "--memory-limit-mb must be in [256, 1048576]; got 100; see 'woodcam bench run --help'"),
+    (["block", "synth", "--count", "1", "--out", "OUT/b", "--memory-limit-mb", "255"],
+     "--memory-limit-mb must be in [256, 1048576]; got 255; see 'woodcam block synth --help'"),
+    (["bench", "run", "--blocks", "1", "--out", "OUT/b", "--address", "foo"],
+     "--address must be a Dask scheduler address like tcp://HOST:8786; got 'foo'"),
+    (["bench", "run", "--blocks", "1", "--out", "OUT/b", "--address", "tcp://127.0.0.1:9", "--workers", "2"],
+     "--workers cannot be given with --address: the cluster at tcp://127.0.0.1:9 has its own workers; got "
+     "--workers 2; leave --workers out"),
+])
+def test_the_engine_options_are_checked_at_the_door_with_the_librarys_rules(argv, said, tmp_path, capsys):
+    """'--memory-limit-mb 100' passed the CLI's range [64, 1048576] and was refused by run_many's
+    own (>= 256); a malformed --address and --workers with --address were run_many's errors too:
+    each exited 1 naming the Python parameter (memory_limit_mb, address, workers), bench run after
+    writing its run.json (sweep h4). Now one range for both, and a usage error before any file."""
+    out = tmp_path / "out"
+    assert main([a.replace("OUT", str(out)) for a in argv]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(f"woodcam: error: {said}"), err
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("value", ["nan,nan,nan", "0,0,inf", "1,2"])
 def test_work_offset_must_be_three_finite_numbers(value, capsys):
     """Issue 15: `--work-offset nan,nan,nan` exited 0 (and cut nothing)."""

@@ -33,7 +33,7 @@ from typing import Literal, NamedTuple, get_args
 from .._specs import WOODIFY_FIELD_FILE
 from .._types import CAMERAS
 from ..errors import UsageError, WoodcamError
-from ..limits import REVIEW_VOXELS_RANGE, limit, WOODIFY_RESOLUTION_RANGE
+from ..limits import REVIEW_VOXELS_RANGE, limit, WOODIFY_RESOLUTION_RANGE, WORKER_MEMORY_MB_RANGE
 from ..units import MM_PER_UNIT, Units, fmt_length, fmt_size, parse_lengths
 
 #: The --species presets (woodcam.appearance.SPECIES, listed here so that --help imports no
@@ -1412,7 +1412,7 @@ RANGES: dict = {
     "top": (1, 100_000, False),
     "voxels": (*REVIEW_VOXELS_RANGE, False),  # per review colour volume; the library's own range
     "workers": (1, 1024, False),
-    "memory_limit_mb": (64, 1_048_576, False),
+    "memory_limit_mb": (*WORKER_MEMORY_MB_RANGE, False),  # per engine worker; the library's own range
     "connect_timeout_s": (0.0, 3600.0, True),
     # gcode: a rapid rate of 1e-320 mm/min made the machining time infinite (a traceback), a
     # start point 1e300 mm away the same; 100 m is beyond any machine's travel
@@ -1616,6 +1616,18 @@ def engine_options(args) -> dict:
     if args.address is not None and args.engine not in (None, "dask"):
         raise UsageError(f"--address needs --engine dask; got --engine {args.engine}; use --engine dask, or "
                          "leave --address out")
+    # both were run_many's errors (exit 1, naming the Python parameters) after bench run had
+    # written its run.json
+    if args.address is not None:
+        from ..scale import check_address
+
+        try:
+            check_address(args.address, "--address")
+        except WoodcamError as err:
+            raise UsageError(str(err)) from err
+        if args.workers is not None:
+            raise UsageError(f"--workers cannot be given with --address: the cluster at {args.address} has its "
+                             f"own workers; got --workers {args.workers}; leave --workers out")
     out = {"engine": "dask" if args.address is not None else (args.engine or "local"),
            "address": args.address, "workers": args.workers}
     if args.memory_limit_mb is not None:
