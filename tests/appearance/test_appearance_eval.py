@@ -102,6 +102,22 @@ def test_leave_one_face_out_on_ring_maps_without_a_field(bars):
     _assert_predictions_resemble_the_photo(res[0])
 
 
+@pytest.mark.parametrize("name, end", [
+    ("knotty", {"top", "bottom"}),          # the log upright; a knot crosses the front's centre
+    ("flat-sawn", {"left", "right"}), ("pith-inside", {"top", "bottom"}),
+])
+def test_end_grain_faces_are_the_faces_mostly_of_end_grain(name, end):
+    """builtin:knotty's front is side grain on 95 % of it, but a knot's fibres leave it at its
+    centre, the one point end_grain_faces looked at: eval appearance labelled it 'end grain'
+    and summarised it with the end-grain faces (sweep h4)."""
+    from woodcam.appearance.evaluation import end_grain_faces
+    from woodcam.stock import open_stock
+
+    stock = open_stock(f"builtin:{name}")
+    got = end_grain_faces(stock.wood.field, stock.size_mm)
+    assert {f for f, e in got.items() if e} == end, got
+
+
 def test_summarise_known_answers():
     """Mean of each measure per model over all / end-grain / side-grain faces (a face of unknown
     grain counts in "all" only), and on how many faces neural scores lower (better)."""

@@ -151,16 +151,29 @@ def _ring_lut_prediction(train_pairs, x, bins: int = 32) -> np.ndarray:
     return lut[t]
 
 
+#: Points along each side of the grid :func:`end_grain_faces` samples a face on (cell centres).
+END_GRAIN_GRID = 9
+
+
 def end_grain_faces(field, size_mm, threshold: float = 0.7) -> dict:
-    """Per face: True when the grain at the face centre runs within ~45 deg of its normal."""
+    """Per face of a block of ``size_mm`` (3,) mm: True when the grain runs within ~45 deg of
+    the face's normal (``|grain . normal| > threshold``) on more than half of a
+    :data:`END_GRAIN_GRID` x :data:`END_GRAIN_GRID` grid of points over the face (block frame).
+    The face centre alone decided: builtin:knotty's front, side grain on 95 % of it, was 'end
+    grain' because a knot, whose fibres leave the face, crosses it at the centre."""
     from ..fields.base import grain_direction
 
     size = np.asarray(size_mm, float)
+    t = (np.arange(END_GRAIN_GRID) + 0.5) / END_GRAIN_GRID
     out = {}
     for face, normal in FACE_NORMAL.items():
-        c = size / 2 + np.asarray(normal) * size / 2
-        g = grain_direction(field, c[None])[0]
-        out[face] = bool(abs(float(np.dot(g, normal))) > threshold)
+        n = np.asarray(normal, float)
+        u, v = (i for i in range(3) if n[i] == 0)  # the face's two in-plane axes
+        a, b = np.meshgrid(t * size[u], t * size[v], indexing="ij")
+        p = np.tile(size / 2 + n * size / 2, (a.size, 1))  # the face's plane
+        p[:, u], p[:, v] = a.ravel(), b.ravel()
+        g = grain_direction(field, p)
+        out[face] = bool(np.mean(np.abs(g @ n) > threshold) > 0.5)
     return out
 
 
