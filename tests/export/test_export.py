@@ -319,7 +319,10 @@ def test_export_errors_are_clear(baked, tmp_path):
         export_glb(baked.mesh, tmp_path / "x.glb", metadata={"a": object()})
     with pytest.raises(WoodcamError, match="mesh must carry a texture"):
         export_glb(trimesh.creation.box(), tmp_path / "x.glb")
-    with pytest.raises(WoodcamError, match="is not a glTF 2.0 binary"):
+    # a fix a command-line user can follow, as the short file's (sweep h4: 'woodcam review bad.glb'
+    # said "pass a .glb written by woodcam.export.export_glb", a Python function)
+    with pytest.raises(WoodcamError, match=r"bad.glb' is not a glTF 2.0 binary \(magic 0x0, version 0\); pass a "
+                       r".glb written by woodcam bake or another glTF exporter$"):
         (tmp_path / "bad.glb").write_bytes(b"\0" * 32)
         read_glb_metadata(tmp_path / "bad.glb")
     with pytest.raises(WoodcamError, match="is 7 bytes, too short to be a GLB file .* pass a .glb"):

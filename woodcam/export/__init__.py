@@ -557,7 +557,7 @@ def glb_json(data: bytes, where: str) -> dict:
     if magic != _GLB_MAGIC or version != 2 or chunk_type != _GLB_CHUNK_JSON:
         raise WoodcamError(
             f"{where} is not a glTF 2.0 binary (magic {magic:#x}, "
-            f"version {version}); pass a .glb written by woodcam.export.export_glb"
+            f"version {version}); pass a .glb written by woodcam bake or another glTF exporter"
         )
     bad = f"{where} has a malformed glTF JSON chunk"
     if 20 + chunk_len > len(data):
