@@ -112,6 +112,19 @@ def test_a_file_out_named_without_its_suffix_is_offered_the_file_too(tmp_path, c
                                             f"{str(out / 'part.glb')!r}\n")
 
 
+@pytest.mark.parametrize("argv", [["review", "p.glb"], ["log", "export", "--real"]])
+def test_a_file_out_naming_an_existing_file_without_the_suffix_is_offered_the_suffix(argv, tmp_path):
+    """'woodcam review p.glb --out notes' with a file 'notes' there: "got 'notes', a folder; give a
+    file name such as 'notes/part.html'", a path that cannot be made under the file (sweep h4)."""
+    f = tmp_path / "notes"
+    f.write_text("")
+    suffix = ".html" if argv[0] == "review" else ".json"
+    with pytest.raises(UsageError) as err:
+        check_out(build_parser().parse_args([*argv, "--out", str(f)]))
+    assert str(err.value).endswith(f"is a FILE ending in {suffix}; got {str(f)!r}, an existing file without that "
+                                   f"suffix; give e.g. {str(f) + suffix!r}"), err.value
+
+
 def test_folder_command_refuses_an_existing_file(tmp_path):
     f = tmp_path / "place_here"
     f.write_text("")

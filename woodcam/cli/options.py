@@ -140,6 +140,12 @@ def check_out(args: argparse.Namespace) -> None:
                              f"got {str(out)!r}, whose suffix {out.suffix!r} is none of them; give e.g. "
                              f"{str(out.with_suffix(suffixes[0]))!r} (or "
                              f"{str(out / ('part' + suffixes[0]))!r} to write into a folder {str(out)!r})")
+        if out.is_file() and suffix not in FILE_SUFFIXES:
+            # 'review --out notes' with a file 'notes' there was told it named a folder and offered
+            # 'notes/part.html', a path that cannot be made under a file
+            raise UsageError(f"--out of 'woodcam {command}' is a FILE ending in {' or '.join(suffixes)}; got "
+                             f"{str(out)!r}, an existing file without that suffix; give e.g. "
+                             f"{str(out.with_name(out.name + suffixes[0]))!r}")
         if out.is_dir() or suffix not in FILE_SUFFIXES:
             # a name not there yet, 'bake ... --out tray': the file 'tray.glb' is as likely meant
             # as a folder 'tray' (only the folder was offered)
