@@ -299,3 +299,19 @@ def test_log_file_types_are_checked(tmp_path, edit, match):
     # the file is named (sweep h6: "log file format must be 'woodcam-log'; got None" left the
     # user of 'woodcam log render a.json b.json'-style scripts guessing which file)
     assert repr(str(tmp_path / "log.json")) in str(err.value), str(err.value)
+    # and the fix is a command (sweep h4: 'woodcam log render' was told to "write the file with
+    # woodcam.logs.write_log", a Python function)
+    if match in (r"wrong type", r"format must be 'woodcam-log'"):
+        assert "'woodcam log export'" in str(err.value), str(err.value)
+
+
+@pytest.mark.parametrize("content", [b"", b"\x89PNG\r\n\x1a\n\xff", b"{"])
+def test_a_log_file_that_is_no_json_says_what_to_give(tmp_path, content):
+    """'woodcam log render photo.png' said "log file: 'photo.png' is not UTF-8 text (invalid
+    start byte)" and an empty file "must be valid JSON ...: Expecting value", with no fix (sweep h4)."""
+    from woodcam.logs.io import read_log
+
+    (tmp_path / "log.json").write_bytes(content)
+    with pytest.raises(WoodcamError, match=r"; give a woodcam log file \(JSON, as 'woodcam log export' writes\), "
+                       r"or --real for the measured log$"):
+        read_log(tmp_path / "log.json")

@@ -301,7 +301,7 @@ class LogSkeleton:
             raise WoodcamError(f"a log file must hold a JSON object; got {type(d).__name__}")
         if d.get("format") != "woodcam-log":
             raise WoodcamError(f"log file format must be 'woodcam-log'; got {d.get('format')!r}; "
-                               "write the file with woodcam.logs.write_log")
+                               "write the file with 'woodcam log export' (woodcam.logs.write_log)")
         if d.get("units", "mm") != "mm":  # it was read as mm whatever it said
             raise WoodcamError(f"log file units must be 'mm' (every length in millimetres); got "
                                f"{d.get('units')!r}; convert the file's lengths to mm")
@@ -317,7 +317,8 @@ class LogSkeleton:
             if isinstance(err, WoodcamError):
                 raise
             raise WoodcamError(f"log file has a value of the wrong type or shape ({type(err).__name__}: "
-                               f"{err}); numbers and lists of numbers as write_log writes them") from err
+                               f"{err}); numbers and lists of numbers as 'woodcam log export' "
+                               "(woodcam.logs.write_log) writes them") from err
 
 
 def simple_log(length_mm: float = 600.0, radius_mm: float = 100.0, knots=(), *,

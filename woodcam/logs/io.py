@@ -64,7 +64,11 @@ def read_log(path: PathLike) -> LogSkeleton:
     if not path.is_file():
         raise WoodcamError(f"log file {str(path)!r} does not exist; give a path to a JSON file "
                            "written by woodcam (or use the real log: --real)")
-    d = read_json_file(path, "log file")  # its errors name the file
+    try:
+        d = read_json_file(path, "log file")  # its errors name the file
+    except WoodcamError as err:  # but gave no fix: 'log render photo.png' said "... is not UTF-8 text"
+        raise WoodcamError(f"{err}; give a woodcam log file (JSON, as 'woodcam log export' writes), or --real "
+                           "for the measured log") from err
     try:
         return LogSkeleton.from_json(d)
     except WoodcamError as err:  # from_json's do not: it reads a dict, from anywhere
