@@ -36,7 +36,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._atomic import all_or_nothing, atomic_folder, atomic_path, output_folder, remove_stale, write_figure, write_text
-from ._checks import as_floats, check_bool, check_number, check_path
+from ._checks import as_floats, check_bool, check_number, check_path, received
+from ._readers import read_json_file
 from .errors import WoodcamError
 
 if TYPE_CHECKING:
@@ -459,6 +460,42 @@ def _plot(s: dict, path: Path) -> Path:
     return path
 
 
+def _check_bench_result(path: Path, rec: dict, shape: list) -> None:
+    """A finished record's result as :func:`summarise_bench` reads it (a record is a file, from
+    anywhere: one whose result lacked 'metrics' or held a number where a score goes was an
+    internal error, KeyError or TypeError): ``kind`` clear or knotted, ``metrics`` face set ->
+    method -> either ``error`` or every :data:`METRICS` score a finite number, the same face sets
+    and methods as the first record checked (``shape``, filled by it), and the record's
+    ``seconds``. Else a WoodcamError naming the file and the fix."""
+    res = rec["result"]
+    metrics = res.get("metrics")
+
+    def fail(why: str) -> WoodcamError:
+        return WoodcamError(f"record {path} is not a bench block result as `woodcam bench run` writes it: {why}; "
+                            "delete it and re-run `woodcam bench run` to recompute it")
+
+    if res.get("kind") not in ("clear", "knotted"):
+        raise fail(f"its kind must be 'clear' or 'knotted', got {received(res.get('kind'), 40)}")
+    if not (isinstance(metrics, dict) and metrics and all(isinstance(v, dict) and v for v in metrics.values())):
+        raise fail("its metrics must map each face set to its methods' scores")
+    got = [(label, sorted(cells)) for label, cells in metrics.items()]
+    if not shape:
+        shape += got
+    elif got != shape:
+        raise fail(f"it scores {got}, the run's first record {shape} (face sets, methods)")
+    for label, cells in metrics.items():
+        for m, cell in cells.items():
+            ok = isinstance(cell, dict) and ("error" in cell or all(
+                isinstance(cell.get(k), (int, float)) and not isinstance(cell.get(k), bool)
+                and math.isfinite(cell[k]) for k in METRICS))
+            if not ok:
+                raise fail(f"{label}/{m} must hold an error or the finite scores {', '.join(METRICS)}; got "
+                           f"{received(cell, 60)}")
+    t = rec.get("cpu_s", rec.get("seconds"))
+    if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+        raise fail(f"its seconds (or cpu_s) must be a number; got {received(t, 40)}")
+
+
 def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, thumbnails: int = 2,
                  progress: bool = True) -> dict:
     """Write ``report.md``, ``report.json`` and ``table1.png`` for a bench run folder into
@@ -476,16 +513,29 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
     if not mpath.is_file():
         raise WoodcamError(f"run_dir must be a bench run folder with {RUN_MANIFEST}; {str(run_dir)!r} "
                            f"has none (make one with `woodcam bench run --out DIR`)")
-    run = json.loads(mpath.read_text())
+    # strict, and a run's manifest: '{' or a list was an internal error (JSONDecodeError, TypeError)
+    again = f"delete the run folder {str(run_dir)!r} and run `woodcam bench run` again"
+    try:
+        run = read_json_file(mpath, "bench run manifest")
+    except WoodcamError as err:
+        raise WoodcamError(f"{err}; {again}") from err
+    if not (isinstance(run, dict) and isinstance(run.get("seed"), int) and isinstance(run.get("settings"), dict)):
+        raise WoodcamError(f"bench run manifest {str(mpath)!r} must be a JSON object with the run's seed (an "
+                           f"integer) and settings, as `woodcam bench run` writes it; got {received(run)}; {again}")
     records = read_records(run_dir)
+    shape: list = []  # the face sets and methods of the first finished record: every other's too
     for key, rec in records.items():  # a record copied in from another run would be counted
-        res = rec.get("result") or {}
-        index = res.get("index")
-        if rec["status"] == "ok" and (res.get("seed") != run["seed"] or not isinstance(index, int)
-                                      or key != bench_key(index)):
-            raise WoodcamError(f"record {record_path(run_dir, key)} is block {index} of seed "
-                               f"{res.get('seed')}, not block {key} of this run's seed {run['seed']} "
-                               f"({mpath}); delete it and re-run `woodcam bench run` to recompute it")
+        if rec["status"] != "ok":
+            continue
+        res = rec.get("result")
+        index = res.get("index") if isinstance(res, dict) else None
+        if not isinstance(res, dict) or res.get("seed") != run["seed"] or not isinstance(index, int) \
+                or key != bench_key(index):
+            what = (f"block {index} of seed {res.get('seed')}" if isinstance(res, dict)
+                    else f"no block result (a JSON object; got {received(res, 40)})")
+            raise WoodcamError(f"record {record_path(run_dir, key)} is {what}, not block {key} of this run's seed "
+                               f"{run['seed']} ({mpath}); delete it and re-run `woodcam bench run` to recompute it")
+        _check_bench_result(record_path(run_dir, key), rec, shape)
     s = summarise_bench(records)
     # the gallery: worst distinct blocks first, then a sample of each kind as thumbnails; chosen
     # before the report is written, so report.json and report.md say which blocks it draws (they

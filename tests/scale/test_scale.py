@@ -351,6 +351,37 @@ def test_a_copied_renamed_or_foreign_record_is_named_not_merged(tmp_path):
     assert "b000001" in _finished_keys(tmp_path / "no_key")
 
 
+def _spoil_record(run, key, edit):
+    path = run / RECORDS_DIR / f"{key}.json"
+    rec = json.loads(path.read_text())
+    edit(rec)
+    path.write_text(json.dumps(rec))
+
+
+@pytest.mark.parametrize("spoil, said", [
+    (lambda run: (run / "run.json").write_text("{"), r"bench run manifest '.*run.json' must be valid JSON"),
+    (lambda run: (run / "run.json").write_text("[1]"), r"must be a JSON object with the run's seed"),
+    (lambda run: _spoil_record(run, "b000001", lambda r: r.update(result=5)), r"b000001.json is no block result"),
+    (lambda run: _spoil_record(run, "b000001", lambda r: r["result"].pop("metrics")), r"its metrics must map"),
+    (lambda run: _spoil_record(run, "b000001", lambda r: r["result"]["metrics"]["full"]["rbf"].update(matched_1="x")),
+     r"full/rbf must hold an error or the finite scores matched_1, "),
+    (lambda run: _spoil_record(run, "b000001", lambda r: r["result"]["metrics"].pop("partial")),
+     r"it scores \[\('full', \['radial', 'rbf'\]\)\], the run's first record"),
+    (lambda run: _spoil_record(run, "b000001", lambda r: r["result"].update(kind="burl")), r"kind must be 'clear' or"),
+])
+def test_a_malformed_run_manifest_or_record_is_named_not_an_internal_error(tmp_path, spoil, said):
+    """'woodcam bench report' of a run whose run.json was '{' or a list, or whose record held a
+    number for its result, lacked metrics or a face set, or a word for a score: JSONDecodeError,
+    TypeError, AttributeError or KeyError, "internal error ... this is a woodcam bug" (sweep h4)."""
+    from woodcam.benchmark import bench_report
+
+    run = _fake_records(tmp_path / "run")
+    spoil(run)
+    with pytest.raises(WoodcamError, match=said) as err:
+        bench_report(run, tmp_path / "rep", gallery=0, thumbnails=0, progress=False)
+    assert "woodcam bench run" in str(err.value), err.value
+
+
 def test_report_on_a_real_run_writes_tables_and_gallery(tmp_path):
     from woodcam.benchmark import bench_report, run_bench
 
