@@ -81,7 +81,9 @@ def test_save_load_round_trip_keeps_interpolation_layers_and_meta(tmp_path, rng)
 def test_load_garbage(tmp_path):
     bad = tmp_path / "x.npz"
     bad.write_text("not a field")
-    with pytest.raises(WoodcamError, match="not a woodcam grid field"):
+    # and how to make one (sweep h4: 'woodcam eval rings --truth' of another file said no fix)
+    with pytest.raises(WoodcamError, match=r"not a woodcam grid field .*; give a field file as 'woodcam fit BLOCK "
+                       r"--out FIELD.npz' writes it \(GridField.save\)$"):
         GridField.load(bad)
 
 

@@ -236,7 +236,9 @@ class GridField:
     def load(cls, path) -> GridField:
         import json
 
-        with read_npz(path, "a woodcam grid field (.npz with 'years', 'origin_mm', 'spacing_mm')") as z:
+        # with a fix ('woodcam eval rings --truth notes.json' said what it was not, not how to make one)
+        with read_npz(path, "a woodcam grid field (.npz with 'years', 'origin_mm', 'spacing_mm')",
+                      fix="give a field file as 'woodcam fit BLOCK --out FIELD.npz' writes it (GridField.save)") as z:
             meta = json.loads(str(z["meta"])) if "meta" in z.files else {}
             layers = {k[len("layer_"):]: z[k] for k in z.files if k.startswith("layer_")}
             return cls(z["years"], tuple(z["origin_mm"]), tuple(z["spacing_mm"]),
