@@ -621,3 +621,20 @@ def test_screenshot_before_the_input_leaves_the_input_to_the_command(tmp_path, m
     assert shots[-1] == "v.png"
     assert main(["preview", "--screenshot", "view", str(tmp_path / "b.glb")]) == EXIT_USAGE
     assert "--screenshot of 'woodcam preview' is a FILE ending in .png; got 'view'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["logs", "render", "--real", "--out", "x"], "invalid choice: 'logs' (choose from "),
+    (["log", "rendr", "--real", "--out", "x"], "invalid choice: 'rendr' (choose from 'render', 'maps', 'export')"),
+    (["preview", "p.glb", "--camera", "isso"], "invalid choice: 'isso' (choose from 'iso', "),
+])
+def test_a_mistyped_command_or_choice_is_offered_the_nearest(argv, said, capsys):
+    """'woodcam logs render ...' (the package is woodcam.logs) listed the eighteen commands and
+    left 'log' to be found, though a mistyped option gets 'did you mean --out?' (sweep h4)."""
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    near = {"logs": "'log'", "rendr": "'render'", "isso": "'iso'"}[said.split("'")[1]]
+    assert err.count("\n") == 1 and said in err and err.rstrip().endswith(f"; did you mean {near}? (see "
+                                                                         f"'{err.split(':')[0]} --help')"), err

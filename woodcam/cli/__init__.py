@@ -95,6 +95,14 @@ class _Parser(argparse.ArgumentParser):
     (``add_subparsers`` makes them with ``type(self)``)."""
 
     def error(self, message: str):
+        # a mistyped command or choice gets the nearest name, as a mistyped option does
+        # ('woodcam logs render' listed the eighteen commands and left 'log' to be found)
+        bad = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)$", message)
+        if bad:
+            from .._checks import did_you_mean
+
+            near = did_you_mean(bad.group(1), re.findall(r"'([^']*)'", bad.group(2)))
+            message += f"; {near}" if near else ""
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
 
 
