@@ -825,8 +825,8 @@ def test_a_grid_coarser_than_half_a_tool_is_warned(tmp_path, monkeypatch, capsys
     capsys.readouterr()
     assert main(["gcode", *base, "--tool", "flat:0.4", "--cell-size", "0.2", "--strict"]) == 0
     assert main(["gcode", *base, "--tool", "1=flat:3", "--tool", "2=flat:0.4", "--cell-size",
-                 "0.5", "--strict"]) == 0
-    assert capsys.readouterr().err == ""
+                 "0.5"]) == 0
+    assert "the grid" not in capsys.readouterr().err  # (the unused T2 has its own warning)
     assert main(["gcode", *base, "--units", "inch", "--tool", "flat:0.015", "--cell-size",
                  "0.02"]) == 0
     assert "the grid (0.02 in) is coarser than half the diameter of T1 (0.015 in)" in \
@@ -849,9 +849,11 @@ def test_a_g20_program_given_tool_sizes_that_look_like_inches_is_warned(tmp_path
         "inches)\n")
     assert main(["gcode", *base, "--tool", "flat:0.25", "--strict"]) == 3
     capsys.readouterr()
-    for more in (["--tool", "flat:1.6"], ["--units", "inch", "--tool", "flat:0.25"],
-                 ["--tool", "1=flat:0.5", "--tool", "0=flat:3"]):
+    for more in (["--tool", "flat:1.6"], ["--units", "inch", "--tool", "flat:0.25"]):
         assert main(["gcode", *base, *more, "--cell-size", "0.1", "--strict"]) == 0, more
+    # one tool of 3 mm: not all typed in inches (T1 is unused, warned as such, not as inches)
+    assert main(["gcode", *base, "--tool", "1=flat:0.5", "--tool", "0=flat:3", "--cell-size", "0.1"]) == 0
+    assert "inches" not in capsys.readouterr().err
     prog.write_text(prog.read_text().replace("G20", "G21"))
     assert main(["gcode", *base, "--tool", "flat:0.25", "--cell-size", "0.1", "--strict"]) == 0
     assert capsys.readouterr().err == ""
@@ -918,3 +920,32 @@ def test_tools_without_numbers_go_to_the_jobs_tool_numbers_across_its_files(tmp_
     with pytest.raises(WoodcamError, match=r"3 tools without numbers but the programs use 2 "
                        r"tool number\(s\) without a tool \(\[1, 2\]\).*they do not use"):
         args.func(args)
+
+def test_a_numbered_tool_the_job_never_calls_is_warned(tmp_path, monkeypatch, capsys):
+    """'--tool 3=ball:3' for a program that calls T1 and T2 (T2 from --tools) was taken
+    without a word: the user who typed the wrong number cut with the table's T2. It is warned
+    now, one line naming the number, the numbers the job calls and the fix, and fails --strict;
+    a number the job calls, a program without a T word and its one tool, and --tools entries
+    the job does not call are not warned."""
+    _stub_preview(monkeypatch, {})
+    prog = tmp_path / "p.nc"
+    prog.write_text("G21 G90\nT1 M6\nM3 S12000\nG0 X10 Y10 Z5\nG1 Z-3 F300\nG1 X40 Y20\nG0 Z5\n"
+                    "T2 M6\nM3 S12000\nG0 X20 Y30 Z5\nG1 Z-2 F300\nG1 X45\nG0 Z5\nM30\n")
+    base = [str(prog), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"),
+            "--cell-size", "0.5", "--tools", str(REPO / "toolpaths" / "tools.toml")]
+    assert main(["gcode", *base, "--tool", "3=ball:3"]) == 0
+    assert capsys.readouterr().err == (
+        "woodcam: warning: --tool 3=ball:3: the job never calls tool 3 (it uses T1, T2), so this "
+        "tool cuts nothing; if it is meant for one of those, give it that number (e.g. --tool "
+        "1=ball:3), else leave it out\n")
+    assert main(["gcode", *base, "--tool", "3=ball:3", "--strict"]) == 3
+    capsys.readouterr()
+    assert main(["gcode", *base, "--tool", "2=ball:3", "--strict"]) == 0
+    # --until-line scrubs the job; the tools are still the whole job's
+    assert main(["gcode", *base, "--tool", "2=ball:3", "--until-line", "6", "--strict"]) == 0
+    assert capsys.readouterr().err == ""
+    one = tmp_path / "one.nc"  # no T word: tool 0, cut by the one tool given, whatever its number
+    one.write_text("G21 G90\nM3 S9000\nG0 X10 Y10 Z5\nG1 Z-1 F300\nG1 X30\nM30\n")
+    base = [str(one), "--block", "builtin:flat-sawn", "--out", str(tmp_path / "o.glb"), "--cell-size", "0.5"]
+    assert main(["gcode", *base, "--tool", "3=flat:6", "--strict"]) == 0
+    assert capsys.readouterr().err == ""

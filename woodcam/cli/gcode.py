@@ -192,6 +192,34 @@ def _warn_inch_sizes_read_as_mm(args, program, name: str) -> int:
     return 1
 
 
+def _warn_unused_numbered_tools(args, programs, tools: dict) -> int:
+    """Warn, one line each, of the ``--tool N=SPEC`` whose number N no program of the job
+    (``programs``, whole: --until-line does not cut a tool out of the job) calls; return how
+    many. A mistyped number (``--tool 3=ball:3`` for the program's T2 with T2 also in a --tools
+    table) was taken without a word, and the job cut with another tool. A --tools table's
+    entries are not questioned: a shop's table lists every tool it has."""
+    from .options import parse_tool_option
+
+    called = {t for p in programs for t in p.tool.tolist()}
+    if 0 in called and len(tools) == 1:  # a program that loads no tool: the only one (tool_lookup)
+        called |= set(tools)
+    used = ", ".join(f"T{t}" for t in sorted(called)) or "none"
+    typed = {parse_tool_option(item)[0] for item in args.tool}
+    # the number it was likely meant for: one the job calls that no --tool N= names yet
+    meant = min(called - typed - {0}, default=min(called - {0}, default=0))
+    n = 0
+    for item in args.tool:
+        number, _ = parse_tool_option(item)
+        if number is None or number in called:
+            continue
+        spec = item.split("=", 1)[1]
+        print(f"woodcam: warning: --tool {item}: the job never calls tool {number} (it uses "
+              f"{used}), so this tool cuts nothing; if it is meant for one of those, give it that "
+              f"number (e.g. --tool {meant}={spec}), else leave it out", file=sys.stderr)
+        n += 1
+    return n
+
+
 def _tools_from_args(args, programs, *, more_to_come: bool = False) -> dict:
     """The tool table of the job's ``programs`` (one Program or the job's, in order): the
     numbered --tool/--tools entries, and the tools without a number on the tool numbers the
@@ -319,6 +347,7 @@ def run(args) -> int:
     # before its T2 M6, 'flat:6 ball:3' was '2 tools without numbers but the program uses 1',
     # so the run's own command line failed with the option added
     tools = _tools_from_args(args, [q[2] for q in programs])
+    n_warn += _warn_unused_numbered_tools(args, [q[2] for q in programs], tools)
     for k, (path, program, full, t_read) in enumerate(programs):
         # a tool number without a tool was refused by simulate, after the block was opened and
         # the programs before it simulated, naming no file
