@@ -1201,3 +1201,28 @@ def test_the_end_of_a_file_and_a_nul_byte_are_read_as_rs274_reads_them(tmp_path)
             with pytest.raises(GcodeError, match="LinuxCNC reads a line only up to a NUL") as e:
                 read_gcode(text, interpreter=interp)
             assert e.value.line == line
+
+
+@pytest.mark.parametrize("text", ["", "\n\n\n", " \t\n", "\f\n\n", "%\n\n"])
+def test_a_blank_file_says_rs274s_end_of_file_message_with_both_interpreters(tmp_path, text):
+    """A file of blank lines: rs274 -g (and the machine) looks past them for an opening '%' and
+    says 'File ended with no percent sign'. Woodcam's interpreter said so; --interpreter
+    linuxcnc (the gcode module's parse, which skips that look) said 'File ended with no percent
+    sign or program end', at line 1 whatever the file's length. Both say rs274's message at the
+    file's last line now; a file with a comment still says '... or program end' with both."""
+    line = max(len(source_lines(text)), 1)
+    assert read_gcode(text, interpreter="linuxcnc").warnings == [
+        f"line {line}: File ended with no percent sign"]
+    assert read_gcode(text).warnings == [
+        f"line {line}: the file ends without M2, M30 or '%' (LinuxCNC stops here with 'File "
+        "ended with no percent sign')"]
+    if RS274.exists():  # the oracle's own words
+        path = tmp_path / "blank.ngc"
+        path.write_text(text)
+        r = subprocess.run([str(RS274), "-g", str(path)], capture_output=True, text=True,
+                           timeout=60, cwd=tmp_path)
+        out = r.stdout + r.stderr
+        assert "File ended with no percent sign\n" in out and "or program end" not in out, out
+    if "%" not in text:  # (one opened with '%' wants the closing one: 'no percent sign')
+        assert read_gcode(text + "(c)\n", interpreter="linuxcnc").warnings[-1].endswith(
+            "File ended with no percent sign or program end")

@@ -608,6 +608,15 @@ def nul_byte_error(lines: list[str]) -> GcodeError | None:
     return None
 
 
+def blank_program(lines: list[str]) -> bool:
+    """Whether source ``lines`` (:func:`source_lines` cut at NULs, :func:`nul_cut`) hold only C
+    blanks (``isspace``, form feed and vertical tab too), or none: rs274 opening such a file
+    looks past the blank lines for an opening '%' and meets the end ('File ended with no
+    percent sign', ``NO_PERCENT``, not ``NO_END``), as ``rs274 -g`` says of '', '\\n\\n',
+    '\\t\\n' or '\\f\\n' (LinuxCNC 2.9)."""
+    return all(not ln.strip(_C_SPACE + "\n") for ln in lines)
+
+
 def nul_cut(lines: list[str]) -> list[str]:
     """Source ``lines`` as LinuxCNC reads them: each up to its first NUL byte (after
     :func:`nul_byte_error` found none that hides words, only NULs and blanks are cut)."""
@@ -1185,7 +1194,8 @@ class Interpreter:
         self.lines = lines
         self.closing = closing
         # no line but blanks: rs274 looks past them for the opening '%' and meets the end
-        self._blank_file = first and not grbl
+        # (one rule with --interpreter linuxcnc's, whose parse skips that look: blank_program)
+        self._blank_file = not grbl and blank_program(self.src)
         words = [ln.no for ln in lines if ln.text]
         inside = [no for no in grbl_percent if words and words[0] < no < words[-1]]
         if inside:

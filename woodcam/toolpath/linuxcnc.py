@@ -24,8 +24,10 @@ from .interpreter import (
     GcodeError,
     Interpreter,
     add_line_warning,
+    blank_program,
     line_list,
     nul_byte_error,
+    nul_cut,
     source_lines,
     split_comments,
     tool_entry_in_message,
@@ -169,7 +171,14 @@ def run_linuxcnc(text: str, *, start_mm=(0.0, 0.0, 10.0), timeout_s: float = 30.
                              "naming no line of the program; read it with --interpreter woodcam")
         # its parse names the line after the last (line 3 of a 2-line file): the file's last,
         # the line rs274 quotes, as woodcam's interpreter
-        warnings.append((min(int(line), max(len(source_lines(text)), 1)), msg))
+        lines = source_lines(text)
+        if blank_program(nul_cut(lines)):
+            # a file of blank lines: rs274 (and the machine) opening it meets the end looking
+            # for an opening '%' ('File ended with no percent sign'); the gcode module's parse
+            # has no such look and said '... or program end', at line 1 of any blank file, where
+            # woodcam's interpreter said rs274's message at the file's last line
+            line, msg = max(len(lines), 1), NO_PERCENT
+        warnings.append((min(int(line), max(len(lines), 1)), msg))
     moves = [(k, ln, tuple(e), tuple(c) if c else None, rot, plane, feed, rpm, tool, bool(inch))
              for k, ln, e, c, rot, plane, feed, rpm, tool, inch in res["moves"]]
     ran = _ran_lines(text, moves, start_mm, machine_zero_mm, tool_diameters_mm, warnings)
