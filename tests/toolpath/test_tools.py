@@ -127,8 +127,43 @@ def test_new_profiles_specs_and_tables(tmp_path):
     tools = load_tool_table(j)
     # a cylindrical tool's length is its cutting (flute) length: 1 inch
     assert tools[1] == FlatEndMill(6.35, flute_length_mm=25.4) and tools[4] == BallEndMill(3)
-    assert tools[2] == VBit(10, angle_deg=90)
-    assert tools[3] == SnubNoseVBit(6, angle_deg=90, tip_diameter_mm=2)
+    assert tools[2] == VBit(10, angle_deg=90, flute_length_mm=5)
+    assert tools[3] == SnubNoseVBit(6, angle_deg=90, tip_diameter_mm=2, flute_length_mm=2)
     j.write_text('{"tools": {"1": {"shape": "spheroid", "diameter": 3}}}')
     with pytest.raises(WoodcamError, match="shape"):
         load_camotics_tools(j)
+
+
+def test_a_camotics_table_reads_as_camotics_reads_it(tmp_path):
+    """CAMotics' Tool::read takes units and shapes in any case, with its aliases (units mm and
+    inch, shapes cylinder and cone): woodcam refused 'Imperial', 'inch' and 'Cylinder'. Its
+    'length' is the whole cutter from the tip, a cone's too: a V-bit cutting past its cone was
+    simulated with no word, where a cylindrical tool's length already warned (the shank rubs).
+    A spheroid, which woodcam has no tool for, is refused naming the fix."""
+    j = tmp_path / "tools.json"
+    j.write_text('{"1": {"units": "Imperial", "shape": "Cylinder", "diameter": 0.25, "length": 1},'
+                 ' "2": {"units": "inch", "shape": "Cone", "diameter": 0.5, "length": 0.25},'
+                 ' "3": {"units": "MM", "shape": "BallNose", "diameter": 6, "length": 20}}')
+    tools = load_camotics_tools(j)
+    assert tools[1] == FlatEndMill(6.35, flute_length_mm=25.4)
+    assert tools[2] == VBit(12.7, angle_deg=90, flute_length_mm=6.35)
+    assert tools[3] == BallEndMill(6, flute_length_mm=20)
+    for units in ('"furlong"', "3"):
+        j.write_text('{"1": {"units": %s, "shape": "cylindrical", "diameter": 6}}' % units)
+        with pytest.raises(WoodcamError, match="units must be metric or imperial"):
+            load_camotics_tools(j)
+    j.write_text('{"1": {"shape": "Sphere", "diameter": 6}}')
+    with pytest.raises(WoodcamError, match="shape 'sphere' .*has no woodcam tool"):
+        load_camotics_tools(j)
+
+
+def test_a_v_bit_cutting_past_its_camotics_cone_is_warned(tmp_path):
+    """A CAMotics V-bit 10 mm across with a 5 mm cone (90 degrees) plunged 7 mm: the shank rubs
+    the top 2 mm; warned as a cylindrical tool's short length is (deeper_than_flute)."""
+    from woodcam.toolpath import read_gcode, simulate
+
+    j = tmp_path / "tools.json"
+    j.write_text('{"1": {"shape": "conical", "diameter": 10, "length": 5}}')
+    prog = read_gcode("G21 G90\nT1 M6\nG0 X10 Y10 Z5\nG1 Z-7 F300\nG1 X30\nG0 Z5\nM30\n")
+    res = simulate(prog, load_camotics_tools(j), (40.0, 20.0, 10.0), resolution_mm=0.5)
+    assert any("deeper_than_flute" in str(i) for i in res.report), res.report

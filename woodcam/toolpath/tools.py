@@ -618,16 +618,25 @@ def _number(value, path, key, name) -> float:
     return float(value)
 
 
-#: CAMotics tool shapes and the woodcam tool they are.
+#: CAMotics tool shapes and the woodcam tool they are (its ToolShape names, read in any case as
+#: its enumeration parse does, with its aliases cylinder and cone).
 _CAMOTICS_SHAPES = ("cylindrical", "ballnose", "conical", "snubnose")
+_CAMOTICS_ALIASES = {"cylinder": "cylindrical", "cone": "conical"}
+#: CAMotics' units (its Units names and aliases mm and inch, any case) -> mm per table unit.
+_CAMOTICS_UNITS = {"metric": 1.0, "mm": 1.0, "imperial": 25.4, "inch": 25.4}
 
 
 def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
     """Read a CAMotics tool table (the ``"tools"`` object of a ``.camotics`` project, or a JSON
     file holding it): ``{"1": {"units": "metric"|"imperial", "shape": "cylindrical"|"ballnose"|
-    "conical"|"snubnose", "diameter": D, "length": L, "snub_diameter": d}}``. CAMotics defines a
-    cone by its diameter and the length of its conical part: included angle
-    ``2 atan((D - d) / 2 / L)``. Lengths in the table's units; woodcam's tools in mm."""
+    "conical"|"snubnose", "diameter": D, "length": L, "snub_diameter": d}}`` (CAMotics' own
+    Tool::read: units and shapes in any case, units ``mm``/``inch`` and shapes ``cylinder``/
+    ``cone`` as aliases; no units: metric). CAMotics defines a cone by its diameter and the
+    length of its conical part: included angle ``2 atan((D - d) / 2 / L)``. ``length`` is the
+    cutter's length from its tip, all CAMotics' tool body: woodcam's ``flute_length_mm`` (a cut
+    deeper is warned: the shank rubs), for a cone too; without it (CAMotics then takes 10 mm)
+    a cylindrical or ball-nose tool carries no reach and a cone is refused. Lengths in the
+    table's units; woodcam's tools in mm."""
     import json
 
     path = Path(path)
@@ -647,11 +656,16 @@ def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
             raise WoodcamError(f"load_camotics_tools: {path}: tool {key!r} must be a number "
                                "with an object of shape/diameter/length")
         units = e.get("units", "metric")
-        if units not in ("metric", "imperial"):
+        scale = _CAMOTICS_UNITS.get(units.lower()) if isinstance(units, str) else None
+        if scale is None:  # 'Imperial' or 'inch', which CAMotics reads, were refused
             raise WoodcamError(f"load_camotics_tools: {path}: tool {key}: units must be "
-                               f"metric or imperial, got {units!r}")
-        scale = 25.4 if units == "imperial" else 1.0
+                               f"metric or imperial (or mm, inch), got {units!r}")
         shape = str(e.get("shape", "")).lower()
+        shape = _CAMOTICS_ALIASES.get(shape, shape)
+        if shape in ("spheroid", "sphere"):
+            raise WoodcamError(f"load_camotics_tools: {path}: tool {key}: shape {shape!r} (CAMotics' "
+                               "lollipop / undercut cutter) has no woodcam tool; a 3-axis program "
+                               "cuts with its lower half: give it as a ballnose of its diameter")
         if shape not in _CAMOTICS_SHAPES:
             raise WoodcamError(f"load_camotics_tools: {path}: tool {key}: shape {shape!r} is "
                                f"not one of {_CAMOTICS_SHAPES}")
@@ -671,7 +685,9 @@ def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
                 raise WoodcamError(f"load_camotics_tools: {path}: tool {key}: a {shape} tool "
                                    f"needs length > 0 (the cone's height), got {length!r}")
             angle = 2 * math.degrees(math.atan((d - tip) / 2 / length))
-            tool = SnubNoseVBit(d, angle_deg=angle, tip_diameter_mm=tip) if tip > 0 else \
-                VBit(d, angle_deg=angle)
+            # the cone is all of CAMotics' tool: deeper, a V-bit's shank rubs the wall (a
+            # 60-degree V-bit cutting past its cone was simulated as if it cut there, no word)
+            tool = SnubNoseVBit(d, angle_deg=angle, tip_diameter_mm=tip, **reach) if tip > 0 else \
+                VBit(d, angle_deg=angle, **reach)
         out[int(key)] = tool
     return out
