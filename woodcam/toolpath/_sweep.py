@@ -1,6 +1,6 @@
 """Swept-tool envelopes min-updated into the height field by numba, for every tool profile of
 :mod:`woodcam.toolpath.tools`: ball and flat end mills and the V-bit in closed form, the bull
-nose by bisection on ramps (the formulas of each tool's
+nose on ramps by a bracketed Newton solve of its contact quartic (the formulas of each tool's
 :meth:`~woodcam.toolpath.tools.Tool._sweep`, in float64), the snub-nose V-bit / chamfer mill
 and tapered ball in closed form too (the V-bit's tangent point, or the flat tip's downhill
 edge / the tip sphere's tangent point where the minimum lies there).
@@ -47,11 +47,45 @@ def _h(kind, prm, R, r):
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
-def _dh_bull(prm, R, r):
-    """The bull nose's profile slope ``dh/dr`` at radius ``r <= R`` (its bisection)."""
-    rc = prm[0]
-    q = max(r - (R - rc), 0.0)
-    return q / math.sqrt(max(rc * rc - q * q, 1e-30))
+def _bull_reach(rc, R, s, d):
+    """``|w|`` (mm) of the bull nose's lowest point over a cell at distance ``d <= R`` from a
+    move's line of slope ``s > 0``: the minimiser of ``-s |w| + h(sqrt(d^2 + w^2))`` (the
+    ramp's climb against the profile), unclipped to the chord.
+
+    The contact lies on the torus (on the flat the profile has no slope to meet the ramp's), at
+    ``u = sin(phi)``, ``phi`` the contact normal's angle from the axis: ``rho = a + rc u``
+    (``a = R - rc``) and ``tan(phi) sqrt(rho^2 - d^2) / rho = s``, which squared is the quartic
+    ``F(u) = rho^2 (u^2 (1 + s^2) - s^2) - d^2 u^2 = 0``. Its root in ``[u0, 1]`` (``u0``: where
+    ``rho = d``, or 0) is the only one there (the left side rises with u), ``F(u0) <= 0 <=
+    F(1) = R^2 - d^2``: a Newton solve kept in that bracket (bisection where a step leaves it)
+    takes ~5 steps where the bisection on ``t`` took 30."""
+    a = R - rc
+    s2 = s * s
+    d2 = d * d
+    lo = max((d - a) / rc, 0.0) if rc > 0 else 1.0
+    hi = 1.0
+    # start at the ball's contact (sin of the ramp's angle), which a centred cell (d <= a) nears:
+    # 5 steps on average over random cells and slopes, where the bracket's middle took 7
+    u = max(lo, s / math.sqrt(1.0 + s2))
+    for _ in range(60):
+        rho = a + rc * u
+        q = u * u * (1.0 + s2) - s2
+        f = rho * rho * q - d2 * u * u
+        if f > 0:
+            hi = u
+        else:
+            lo = u
+        df = 2.0 * rc * rho * q + rho * rho * 2.0 * u * (1.0 + s2) - 2.0 * d2 * u
+        un = u - f / df if df > 0 else -1.0
+        if not lo < un < hi:  # Newton leaves the bracket: halve it
+            un = 0.5 * (lo + hi)
+        # 1e-9 in u moves the contact ~1e-9 rc: the height, stationary there, by far less
+        if abs(un - u) < 1e-9 or hi - lo < 1e-9:
+            u = un
+            break
+        u = un
+    rho = a + rc * u
+    return math.sqrt(max(rho * rho - d2, 0.0))
 
 
 @numba.njit(nogil=True, cache=True)
@@ -142,28 +176,18 @@ def sweep_update(hm, line_map, track, kind, prm, R, a, b, js, is_, wy, wx, dx, d
                         # the envelope is at least the chord's lowest tip plus the profile at
                         # the cell's distance from the line: a cell that bound leaves
                         # untouched (most of a raster's overlap with the last pass) needs no
-                        # bisection (its depth, <= 0, is said as cur - bound >= cur - env)
+                        # solve (its depth, <= 0, is said as cur - bound >= cur - env)
                         bound = z0 + min(s * lo, s * hi) + _h(kind, prm, R, min(abs(perp), R))
                         if bound >= hm[j, i]:
                             covered += 1
                             if hm[j, i] - bound > deepest:
                                 deepest = hm[j, i] - bound
                             continue
-                        # convex in t: bisection on the sign of the derivative (30 halvings:
-                        # |t - t*| < 1e-9 (L + D), far below a cell), as Tool._sweep
+                        # convex in t: the unclipped minimiser (_bull_reach, downhill of the
+                        # foot of the perpendicular), clipped to the chord
                         if s != 0.0:
-                            ta, tb = lo, hi
-                            for _ in range(30):
-                                m = 0.5 * (ta + tb)
-                                w = m - along
-                                rho = math.sqrt(d2 + w * w)
-                                der = s + _dh_bull(prm, R, min(rho, R)) * (
-                                    w / max(rho, 1e-30) if rho > 0 else 0.0)
-                                if der > 0:
-                                    tb = m
-                                else:
-                                    ta = m
-                            t = 0.5 * (ta + tb)
+                            w = _bull_reach(prm[0], R, abs(s), min(abs(perp), R))
+                            t = min(max(along - w if s > 0 else along + w, lo), hi)
                         else:  # horizontal: the foot of the perpendicular (even in w)
                             t = min(max(along, lo), hi)
                         w = t - along

@@ -22,7 +22,8 @@ cell's coordinate along the move's XY direction, ``d`` its distance from the mov
 ``[-a, L - a] ∩ [-sqrt(R^2 - d^2), sqrt(R^2 - d^2)]``. The bracket is convex in ``w`` (``h``
 convex and non-decreasing, the distance convex), so the constrained minimiser is the
 unconstrained one clipped to the interval; each tool solves it in closed form
-(:meth:`Tool._sweep`; bisection for the bull nose on ramps). The result is exact at every cell
+(:meth:`Tool._sweep`; for the bull nose on ramps a bisection in the numpy path, a bracketed
+Newton solve of its contact quartic in the compiled one). The result is exact at every cell
 centre, so the only error of the height field is sampling (one cell) and arc chords.
 
 Every tool type of :mod:`woodcam.toolpath.tools` is swept by the compiled kernel of
