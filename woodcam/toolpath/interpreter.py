@@ -415,8 +415,6 @@ _PREDEFINED: dict[str, Callable[[Interpreter], float] | str] = {
 
 
 _DIGITS = re.compile(r"[0-9]+")
-#: C's isspace: the blanks LinuxCNC skips inside a #<name> of a DEBUG/PRINT text
-_C_SPACE = " \t\n\v\f\r"
 
 
 def tool_entry_in_message(k: int, ref: str, kind: str, tool: int,
@@ -545,7 +543,8 @@ def _late_rule(word: str) -> tuple[str, str]:
 #: end). Python's str.split() also skips form feed, vertical tab, no-break space, ..., which
 #: LinuxCNC refuses ("Bad character '\014' used").
 _BLANKS = str.maketrans("", "", " \t\r")
-#: C's isspace() less the line end: what LinuxCNC strips off the end of a line.
+#: C's isspace() less the line end: what LinuxCNC strips off the end of a line, and the blanks it
+#: skips inside a #<name> of a DEBUG/PRINT text (isspace's "\n" never occurs inside a line).
 _C_SPACE = " \t\r\v\f"
 
 
