@@ -155,3 +155,11 @@ def test_the_part_argument_lists_every_suffix_read():
         part = next(a for a in commands[name]._actions if a.dest == "part")
         missing = [s for s in SUPPORTED_SUFFIXES if not re.search(re.escape(s) + r"\b", part.help)]
         assert not missing, (name, part.help, missing)
+
+
+def test_epochs_shows_n_as_the_other_counts_do():
+    """``bake --epochs`` (and demo's, gcode's, eval appearance's) showed ``--epochs EPOCHS``
+    where the other counts show ``N`` (``--finetune-epochs N``, ``--max-triangles N``)."""
+    shown = {(" ".join(path), a.option_strings[-1]): a.metavar for path, a in _walk_options(build_parser())
+             if a.option_strings[-1] in ("--epochs", "--finetune-epochs")}
+    assert len(shown) >= 5 and set(shown.values()) == {"N"}, shown

@@ -32,7 +32,7 @@ def register(subparsers) -> None:
     p.add_argument("--resolution", type=int, default=128, help="grid cells along the longest side (default 128)")
     p.add_argument("--quality", choices=("draft", "normal", "high"), default="normal",
                    help="training effort of the neural appearance (default normal)")
-    p.add_argument("--epochs", type=int, default=None,
+    p.add_argument("--epochs", type=int, default=None, metavar="N",
                    help=f"training epochs (default: --quality's, {QUALITY_EPOCHS_HELP})")
     p.add_argument("--finetune-epochs", type=int, default=None, metavar="N",
                    help="per-axis networks fine-tuned N epochs from the all-faces network "

@@ -1055,7 +1055,7 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                    "learnt from the block's photos per axis (seed 000 sec. 3.3, cached on disk)")
     p.add_argument("--quality", choices=("draft", "normal", "high"), default=None,
                    help="training effort of the neural appearance (default normal)")
-    p.add_argument("--epochs", type=int, default=None, help="training epochs of the neural appearance "
+    p.add_argument("--epochs", type=int, default=None, metavar="N", help="training epochs of the neural appearance "
                    f"(default: --quality's, {QUALITY_EPOCHS_HELP})")
     add_knot_options(p)
     add_max_atlas_option(p)
