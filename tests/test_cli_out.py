@@ -324,3 +324,39 @@ def test_an_empty_input_path_or_spec_is_refused(argv, name, what, tmp_path, monk
     err = capsys.readouterr().err
     assert exc.value.code == EXIT_USAGE and err.count("\n") == 1, err
     assert f"argument {name}: got an empty value " in err and f"; give {what}" in err, err
+
+
+@pytest.mark.parametrize("command", ["eval appearance", "place"])
+def test_a_failed_run_leaves_no_empty_folder_it_made(tmp_path, capsys, command):
+    """'eval appearance BLOCK --out new/dir' made new/dir before reading its block, and 'place'
+    made its --out before loading its part: a failed read (an empty folder as the block, a
+    damaged STL) exited 1 and left the folders there, empty. A folder that was there before
+    stays, and so does one the run wrote a file into."""
+    empty = tmp_path / "emptyblock"
+    empty.mkdir()
+    (tmp_path / "bad.stl").write_text("solid nothing here\n")
+    out = tmp_path / "new" / "deep"
+    argv = {"eval appearance": ["eval", "appearance", str(empty), "--out", str(out)],
+            "place": ["place", str(tmp_path / "bad.stl"), "--block", "builtin:flat-sawn", "--out", str(out)]}[command]
+    assert main(argv) == 1
+    assert "woodcam: error:" in capsys.readouterr().err
+    assert not (tmp_path / "new").exists()
+    (tmp_path / "new").mkdir()  # there before the run: kept
+    assert main(argv) == 1 and (tmp_path / "new").is_dir() and not out.exists()
+
+
+def test_the_folders_a_failed_run_made_are_removed_only_where_empty(tmp_path):
+    """remove_empty_folders takes back the empty folders under those absent_output_folders
+    found absent, deepest first; a folder holding a file (written before the failure) stays."""
+    from woodcam.cli.options import absent_output_folders, remove_empty_folders
+
+    args = argparse.Namespace(out=tmp_path / "a" / "b" / "run.glb", _out_suffixes=(".glb",),
+                              screenshot=str(tmp_path / "shots" / "v.png"))
+    tops = absent_output_folders(args)
+    assert tops == [tmp_path / "a", tmp_path / "shots"]
+    (tmp_path / "a" / "b" / "c").mkdir(parents=True)
+    (tmp_path / "shots" / "x").mkdir(parents=True)
+    (tmp_path / "shots" / "x" / "kept.txt").write_text("a file the run wrote")
+    remove_empty_folders(tops)
+    assert not (tmp_path / "a").exists()
+    assert (tmp_path / "shots" / "x" / "kept.txt").is_file()

@@ -317,6 +317,8 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
 
     _printed.clear()  # once per run: a second main() in one process printed none of the first's
     interrupted = False
+    made: list = []  # output folders the run is to make: removed again, where empty, if it fails
+    done = False
     # the library's warnings, errors and G-code issues say their lengths in --units (mm without)
     from .._progress import silenced
 
@@ -325,6 +327,7 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         warnings.simplefilter("always")
         try:
             from .options import (
+                absent_output_folders,
                 check_environment,
                 check_inputs,
                 check_numbers,
@@ -345,7 +348,9 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             # wrong with the options first (a missing part is no reason to hide a bad --tool)
             check_inputs(args)
             check_environment(args)  # the WOODCAM_* settings, read before the work, not after it
+            made = absent_output_folders(args)
             rc = args.func(args)
+            done = rc == 0
             _interrupt.check()  # a Ctrl-C a library swallowed: the run did not end as asked
             if sys.stdout is not None:  # None where the command was started with it closed (>&-)
                 sys.stdout.flush()  # here, not at exit: a closed pipe is then caught below
@@ -389,6 +394,10 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
                   file=sys.stderr)
             return EXIT_ERROR
         finally:
+            if made and not done:  # 'eval appearance --out new' made new/ before reading its block
+                from .options import remove_empty_folders
+
+                remove_empty_folders(made)
             if not interrupted:  # an interrupted run is one line: its work is dropped anyway
                 _print_caught(caught)  # a run that ended: after its output (once: said above on a failure)
     return rc

@@ -173,6 +173,45 @@ def check_out(args: argparse.Namespace) -> None:
         _check_folder_can_be_made(out, command)
 
 
+def absent_output_folders(args: argparse.Namespace) -> list[Path]:
+    """The topmost folders on the way to this run's outputs that do not exist yet (absolute):
+    ``--out`` itself (a FOLDER ``--out``) or its folder (a FILE ``--out``), and a named
+    ``--screenshot``'s folder. Taken before the command runs, for
+    :func:`remove_empty_folders` to take back when it fails: ``eval appearance --out new/dir``
+    made the folder before reading its block, and a failed read left it there, empty."""
+    outs = []
+    out = getattr(args, "out", None)
+    if isinstance(out, (str, Path)) and getattr(args, "_out_suffixes", None) is not None:
+        outs.append(Path(out).parent if args._out_suffixes else Path(out))
+    shot = getattr(args, "screenshot", None)
+    if isinstance(shot, (str, Path)):
+        outs.append(Path(shot).parent)
+    tops = []
+    for folder in outs:
+        folder, top = folder.absolute(), None
+        while not folder.exists() and folder != folder.parent:
+            folder, top = folder.parent, folder
+        if top is not None and top not in tops:
+            tops.append(top)
+    return tops
+
+
+def remove_empty_folders(tops: list[Path]) -> None:
+    """Remove each folder of ``tops`` (:func:`absent_output_folders`: none of them existed when
+    the run began) and the folders in it, deepest first, where they are empty: a failed run
+    leaves no empty folders it made; a file in them (a run that wrote some before it failed)
+    keeps its folder."""
+    import os
+
+    for top in tops:
+        if not top.is_dir() or top.is_symlink():
+            continue
+        for folder, _dirs, _files in os.walk(top, topdown=False):  # links to folders not followed
+            try:
+                os.rmdir(folder)
+            except OSError:  # not empty (or gone): kept
+                pass
+
 def _command_name(args: argparse.Namespace) -> str:
     """The command as typed, sub-command included (``block show``), for the doors' messages."""
     return " ".join(str(getattr(args, k)) for k in vars(args)
