@@ -948,3 +948,29 @@ def test_an_obstacle_round_the_whole_part_is_named_as_its_option(tmp_path, capsy
                        "outside them; together they contain"):
         woodify(trimesh.creation.box((10.0, 10.0, 10.0)), 5, resolution=24,
                 obstacles=[trimesh.creation.box((30.0, 30.0, 30.0)), trimesh.creation.box((2.0, 2.0, 2.0))])
+
+
+def test_woodify_takes_the_triangle_budget_its_warning_names(tmp_path, capsys):
+    """load_part simplifies a union of meshes (a script, a STEP) over its triangle budget with a
+    warning saying 'raise --max-triangles', an option woodify did not have (exit 2, unrecognized):
+    woodify takes bake's --max-triangles, and the union of a GLB of two 1280-triangle balls is
+    simplified within 1000 triangles, said with both counts; under the default budget it is not.
+    A file of one mesh keeps every triangle (its picture, painted growth), which a warning says
+    where the budget given is below its count."""
+    scene = trimesh.Scene()
+    for name, x in (("a", 0.0), ("b", 30.0)):
+        ball = trimesh.creation.icosphere(subdivisions=3, radius=8.0)
+        ball.apply_translation((x, 0.0, 0.0))
+        scene.add_geometry(ball, geom_name=name)
+    scene.export(tmp_path / "two.glb")
+    base = ["woodify", str(tmp_path / "two.glb"), "--years", "2", "--resolution", "24", "--cracks", "none"]
+    assert main([*base, "--max-triangles", "1000", "--out", str(tmp_path / "o")]) == 0
+    (msg,) = [line for line in capsys.readouterr().err.splitlines() if "--max-triangles" in line]
+    assert "2560 triangles" in msg and "max_triangles=1000" in msg and "simplified to" in msg, msg
+    assert main([*base, "--out", str(tmp_path / "o2")]) == 0
+    assert "--max-triangles" not in capsys.readouterr().err
+    trimesh.creation.icosphere(subdivisions=3, radius=8.0).export(tmp_path / "ball.stl")
+    assert main(["woodify", str(tmp_path / "ball.stl"), "--years", "2", "--resolution", "24", "--cracks", "none",
+                 "--max-triangles", "1000", "--out", str(tmp_path / "o3")]) == 0
+    (msg,) = [line for line in capsys.readouterr().err.splitlines() if "--max-triangles" in line]
+    assert "1280 triangles, over --max-triangles 1000, and grows with every one" in msg, msg

@@ -1112,12 +1112,14 @@ def add_bake_options(p: argparse.ArgumentParser, *, texels_default: float | None
                        "_view.png; no display needed)")
 
 
-def add_max_triangles_option(p: argparse.ArgumentParser, part: str = "the part") -> None:
+def add_max_triangles_option(p: argparse.ArgumentParser, part: str = "the part",
+                             mesh: str = "a mesh part (STL, OBJ ...)") -> None:
     """``--max-triangles N`` (None: :func:`woodcam.cad.load_part`'s default budget), of every
-    command that loads a part (bake, place, gcode's ``--part``: ``part`` names it in the help)."""
+    command that loads a part (bake, place, gcode's ``--part``, woodify: ``part`` names it in the
+    help, ``mesh`` the mesh inputs it simplifies)."""
     p.add_argument("--max-triangles", type=int, default=None, metavar="N",
                    help=f"triangle budget of {part}: above it a B-rep part (build123d/cadquery, STEP) is "
-                   "re-meshed with looser tolerances, and a mesh part (STL, OBJ ...) is simplified, its "
+                   f"re-meshed with looser tolerances, and {mesh} is simplified, its "
                    "surfaces moved by a stated tolerance; a warning says so (default 120000)")
 
 

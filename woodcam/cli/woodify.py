@@ -19,8 +19,8 @@ from .._specs import WOODIFY_FIELD_FILE
 from ..errors import UsageError, WoodcamError
 from ..tolerances import DEFAULT_MAX_ATLAS_PX
 from ..units import MM_PER_UNIT, TYPED_DECIMALS, say_length, typed_length
-from .options import (add_input, add_max_atlas_option, add_out_option, add_units_option, as_typed, part_suffixes,
-                      place_op_in, sizes_type, vector_type)
+from .options import (add_input, add_max_atlas_option, add_max_triangles_option, add_out_option, add_units_option,
+                      as_typed, part_suffixes, place_op_in, sizes_type, vector_type)
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -91,6 +91,12 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0,
                    help="random seed of the procedural bark and random cracks (default 0)")
     add_max_atlas_option(p, given_only=True)  # None unless typed: a kept picture warns
+    # load_part's budget simplified a script, STEP or union over it with a warning naming this
+    # option, which woodify lacked; a file of one mesh is grown as it is (its picture, its
+    # painted growth per vertex kept), as before
+    add_max_triangles_option(p, "the part and each --obstacle read as a part (a .py script, .step, or a file of "
+                             "several meshes, grown as their union; a file of one mesh keeps every triangle, and "
+                             "its picture and painted growth with them)", mesh="such a union of meshes (GLB, OBJ)")
     p.set_defaults(func=run)
     return p
 
@@ -106,16 +112,18 @@ def _part_suffixes() -> tuple[str, ...]:
     return tuple(dict.fromkeys((*_MESH_SUFFIXES, *part_suffixes())))
 
 
-def _load_mesh(path: str, what: str = "part"):
+def _load_mesh(path: str, what: str = "part", max_triangles: int | None = None):
     """(watertight geometry, textured original or None) from a part or mesh file; ``what`` names
-    it in messages (``part``, ``--obstacle``)."""
+    it in messages (``part``, ``--obstacle``). ``max_triangles`` (``--max-triangles``; None:
+    load_part's default) bounds what :func:`woodcam.cad.load_part` reads: a script, a STEP, a
+    file of several meshes; a file of one mesh keeps every triangle."""
     import trimesh
 
     pth = Path(path)
     if pth.suffix.lower() in _MESH_SUFFIXES:
         try:
             if pth.suffix.lower() in (".glb", ".gltf", ".obj") and _mesh_count(pth) > 1:
-                return _several_meshes(pth, what)
+                return _several_meshes(pth, what, max_triangles)
             if pth.suffix.lower() in (".glb", ".gltf", ".obj"):
                 from ..export import load_textured  # undoes woodcam's glTF/OBJ frame
 
@@ -129,6 +137,16 @@ def _load_mesh(path: str, what: str = "part"):
         except Exception as err:  # trimesh raises many kinds for unreadable files
             raise WoodcamError(f"{what} {path!r} could not be read as a mesh: {err}") from err
         _check_mesh_values(loaded, path, what)
+        if max_triangles is not None and len(loaded.faces) > max_triangles:
+            import warnings
+
+            from ..errors import WoodcamWarning
+
+            # the budget bounds what load_part reads: given for one mesh, it was taken to have done so
+            warnings.warn(f"{what} {path!r} has {len(loaded.faces)} triangles, over --max-triangles {max_triangles}, "
+                          "and grows with every one: a file of one mesh is read as it is (its picture and painted "
+                          "growth kept with its triangles); simplify it in your CAD program if the growth is slow",
+                          WoodcamWarning, stacklevel=3)
         textured = loaded if getattr(loaded.visual, "uv", None) is not None else None
         _warn_units(loaded, path, what)
         paint = _ply_paint(loaded, path)
@@ -148,7 +166,13 @@ def _load_mesh(path: str, what: str = "part"):
     from .._manifold import manifold_to_trimesh
     from ..cad import load_part
 
-    return manifold_to_trimesh(load_part(path), process=True), None, {}
+    return manifold_to_trimesh(load_part(path, **_budget(max_triangles)), process=True), None, {}
+
+
+def _budget(max_triangles: int | None) -> dict:
+    """load_part's ``max_triangles`` keyword where ``--max-triangles`` was given (its own default
+    otherwise)."""
+    return {} if max_triangles is None else {"max_triangles": max_triangles}
 
 
 def _welded_closed(mesh, name: str, fix: str | None = None, *, kept: bool = False):
@@ -199,7 +223,7 @@ def _mesh_count(path: Path) -> int:
                for n in scene.graph.nodes_geometry)
 
 
-def _several_meshes(path: Path, what: str):
+def _several_meshes(path: Path, what: str, max_triangles: int | None = None):
     """(geometry, None, {}) of a file of several meshes: their union as one closed solid, read
     as a part (:func:`woodcam.cad.load_part`, woodcam's own glTF/OBJ frame undone); only the
     first of them grew before (load_textured's refusal for a GLB, a mesh placed twice read as
@@ -227,7 +251,7 @@ def _several_meshes(path: Path, what: str):
     # the union too: two closed meshes touching along an edge share it four times, which the
     # growth refused as 'mesh must be watertight' / 'obstacles[0] ...'; each mesh is closed
     # here, so hole filling is not the fix (it suggested trimesh.repair.fill_holes)
-    geom = _welded_closed(manifold_to_trimesh(load_part(path), process=True),
+    geom = _welded_closed(manifold_to_trimesh(load_part(path, **_budget(max_triangles)), process=True),
                           f"{what} {str(path)!r} (the union of its {len(meshes)} meshes)",
                           fix="each mesh is closed, but they touch along an edge or at a vertex, "
                           "so their union is not a manifold solid (non-manifold union); separate "
@@ -588,8 +612,8 @@ def run(args) -> int:
     with StageBar(["read the mesh", "grow", "surface and cracks", "bark and surfaces", "ring sections"],
                   desc="woodify", leave=False) as bar:
         with bar.stage("read the mesh"):
-            mesh, textured, painted = _load_mesh(args.part)
-            obstacles = [_load_mesh(str(o), "--obstacle")[0] for o in args.obstacle]
+            mesh, textured, painted = _load_mesh(args.part, max_triangles=args.max_triangles)
+            obstacles = [_load_mesh(str(o), "--obstacle", args.max_triangles)[0] for o in args.obstacle]
             brushes = load_brushes(args.brushes) if args.brushes else ()
         with bar.stage("grow"):
             res = woodify(mesh, args.years, growth_mm=args.growth, time_scale_years=args.time_scale,
