@@ -974,3 +974,26 @@ def test_woodify_takes_the_triangle_budget_its_warning_names(tmp_path, capsys):
                  "--max-triangles", "1000", "--out", str(tmp_path / "o3")]) == 0
     (msg,) = [line for line in capsys.readouterr().err.splitlines() if "--max-triangles" in line]
     assert "1280 triangles, over --max-triangles 1000, and grows with every one" in msg, msg
+
+
+def test_a_script_or_step_part_saved_in_inches_is_named_in_its_kinds_words(tmp_path, capsys):
+    """woodify warned of a mesh file under 6.35 mm (looks saved in inches) or 1 mm (in metres),
+    and grew a part script or STEP of that size without a word: they get the same check, in
+    the words of their kind (woodcam.cad.carve.units_note: a script's lengths carry no units, a
+    STEP names its units, to be re-exported in the unit it was drawn in), an STL its own."""
+    import build123d as bd
+
+    (tmp_path / "box.py").write_text("import trimesh\npart = trimesh.creation.box((4.0, 3.0, 2.0))\n")
+    bd.export_step(bd.Box(0.04, 0.03, 0.02), str(tmp_path / "box.step"))
+    trimesh.creation.box((4.0, 3.0, 2.0)).export(tmp_path / "box.stl")
+    says = {"box.py": ("modelled in inches", "lengths in a part script", "or write its lengths in mm"),
+            "box.step": ("modelled in metres", "a STEP file names its units",
+                         "drawn in metres under a millimetre setting", "or re-export it with its units set to metres"),
+            "box.stl": ("modelled in inches", "STL, OBJ and PLY carry no units", "or export it in mm")}
+    for name, words in says.items():
+        assert main(["woodify", str(tmp_path / name), "--years", "3", "--resolution", "16", "--cracks", "none",
+                     "--out", str(tmp_path / ("o_" + name.replace(".", "_")))]) == 0
+        (msg,) = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+        assert msg.startswith(f"woodcam: warning: part '{tmp_path / name}'"), msg
+        assert all(w in msg for w in words) and "--units" in msg, (name, msg)
+        assert ("STL, OBJ and PLY" in msg) == (name == "box.stl"), msg

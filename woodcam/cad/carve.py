@@ -174,11 +174,12 @@ def carve(
     )
 
 
-def units_note(source: Any) -> tuple[str, str]:
+def units_note(source: Any, unit: str = "inches") -> tuple[str, str]:
     """``(why, redo)``: why a part from ``source`` (a path, or an object :func:`load_part`
     takes) is read as millimetres, and how to save it right, true of its kind: the inch
     warning said 'STL, OBJ and PLY carry no units' of a STEP file (which carries its units,
-    converted to mm) and of a build123d script."""
+    converted to mm) and of a build123d script. ``unit``: the unit it looks drawn in
+    (``inches``, ``metres``), which a STEP file's words name."""
     from pathlib import Path
 
     if isinstance(source, (str, Path)):
@@ -189,8 +190,8 @@ def units_note(source: Any) -> tuple[str, str]:
         kind = "script" if module.startswith(("build123d", "cadquery", "OCP")) else "mesh"
     if kind == "step":
         return ("a STEP file names its units and is converted from them to millimetres, so it "
-                "was saved this small (as one drawn in inches under a millimetre setting is)",
-                "re-export it with its units set to inches")
+                f"was saved this small (as one drawn in {unit} under a millimetre setting is)",
+                f"re-export it with its units set to {unit}")
     if kind == "script":
         return ("lengths in a part script or a build123d/cadquery shape carry no units and are read "
                 "as millimetres",
@@ -205,7 +206,7 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX, *,
     exported in inches is read 25.4 x too small and carved or placed as a speck. Its lengths
     are in mm under every ``--units``: they are the file's own numbers.
 
-    Without a block (``size_mm`` None: ``woodcam woodify`` grows a mesh alone) the part's own
+    Without a block (``size_mm`` None: ``woodcam woodify`` grows a part alone) the part's own
     size decides, along its longest side: under :data:`woodcam.frames.FOREIGN_GLTF_METRES_BELOW`
     mm (no router carves anything smaller; the size below which a foreign glTF is read as
     metres) it is taken for a part in metres, 1000 x too small; under
@@ -214,11 +215,10 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX, *,
 
     fix : how the caller's user scales the part by 25.4 (the command's option, or the library
         call); the CLI's ``--place`` is no use to ``woodcam place`` or a library caller. Without
-        a block, where (and how else) to scale it: the message says ``scale it by 1000`` or
-        ``by 25.4`` and then ``fix``.
+        a block, where to scale it: the message says ``scale it by 1000`` or ``by 25.4``, then
+        ``fix``, then how to save it right (:func:`units_note`'s, of the unit it looks drawn in).
     source : what the part was loaded from (a path, an object), for :func:`units_note`; None:
         a mesh."""
-    why, redo = units_note(source)
     extent = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
     with message_units("mm"):  # about the file's own numbers, read as mm whatever --units says
         if size_mm is None:
@@ -230,9 +230,11 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX, *,
                 small = f"a {INCHES_BELOW_MM:g} mm (1/4-inch) router bit is wider than its longest side"
             else:
                 return None
+            why, redo = units_note(source, unit)
             return (f"the part is only {say_length(extent, '.3g')}: {why}, and {small}; "
                     f"it looks modelled in {unit} ({factor:g} times larger: "
-                    f"{say_length(extent * factor, '.3g')}): scale it by {factor:g} {fix}")
+                    f"{say_length(extent * factor, '.3g')}): scale it by {factor:g} {fix}, or {redo}")
+        why, redo = units_note(source)
         size = np.asarray(size_mm, dtype=float)
         if not np.all(np.sort(extent) * MM_PER_UNIT["inch"] <= np.sort(size)):
             return None

@@ -33,10 +33,10 @@ def register(subparsers) -> argparse.ArgumentParser:
         "Lengths in mm (the options' in --units), time in years.")
     add_input(p, "part", kind="file", suffixes=_part_suffixes,
               help="input: a .py part script, .step, or a closed .stl/.obj/.ply/.glb mesh "
-                   "(mesh files are read as mm whatever --units says; one under 1 mm long gets a warning that it "
-                   "looks saved in metres, one under 6.35 mm that it looks saved in inches); a PLY may paint "
-                   "growth per vertex: properties gain (speed gain) and dir_x, dir_y, dir_z (growth direction, "
-                   "length = strength < 1)")
+                   "(read as mm whatever --units says, a STEP from its own units; one under 1 mm long gets a "
+                   "warning that it looks saved in metres, one under 6.35 mm that it looks saved in inches); a "
+                   "PLY may paint growth per vertex: properties gain (speed gain) and dir_x, dir_y, dir_z "
+                   "(growth direction, length = strength < 1)")
     p.add_argument("--years", type=float, required=True, help="years to grow")
     add_out_option(p, "field.npz, grown.glb, surfaces and section PNGs, woodify.json, listed in "
                       ".woodcam-woodify-files.json")
@@ -166,7 +166,9 @@ def _load_mesh(path: str, what: str = "part", max_triangles: int | None = None):
     from .._manifold import manifold_to_trimesh
     from ..cad import load_part
 
-    return manifold_to_trimesh(load_part(path, **_budget(max_triangles)), process=True), None, {}
+    geom = manifold_to_trimesh(load_part(path, **_budget(max_triangles)), process=True)
+    _warn_units(geom, path, what)  # a script's or STEP's size as a mesh's (units_note's words of its kind)
+    return geom, None, {}
 
 
 def _budget(max_triangles: int | None) -> dict:
@@ -262,17 +264,18 @@ def _several_meshes(path: Path, what: str, max_triangles: int | None = None):
 
 
 def _warn_units(mesh, path: str, what: str = "part") -> None:
-    """Warn when a mesh file's size says it was saved in metres or inches: it is read as mm, and
-    a 40 mm box saved as 0.04 grew, silently, into a 0.06 mm speck, a 4-inch bowl saved as 4
-    into a 4 mm one (woodcam.cad.carve.units_hint, its size alone: there is no block)."""
+    """Warn when a part's size says it was saved in metres or inches: it is read as mm, and a
+    40 mm box saved as 0.04 grew, silently, into a 0.06 mm speck, a 4-inch bowl saved as 4
+    into a 4 mm one (woodcam.cad.carve.units_hint, its size alone: there is no block; in the
+    words of the file's kind, woodcam.cad.carve.units_note: a mesh, a script, a STEP)."""
     import warnings
 
     from ..cad.carve import units_hint
     from ..errors import WoodcamWarning
 
     lo, hi = mesh.bounds
-    hint = units_hint(lo, hi, None, "in your CAD program or export it in mm (--units converts only the "
-                      "lengths typed as options, never the mesh)", source=path)
+    hint = units_hint(lo, hi, None, "in your CAD program (--units converts only the lengths typed as options, "
+                      "never the part's own)", source=path)
     if hint:
         warnings.warn(f"{what} {path!r}: {hint}", WoodcamWarning, stacklevel=3)
 
