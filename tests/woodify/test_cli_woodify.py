@@ -997,3 +997,29 @@ def test_a_script_or_step_part_saved_in_inches_is_named_in_its_kinds_words(tmp_p
         assert msg.startswith(f"woodcam: warning: part '{tmp_path / name}'"), msg
         assert all(w in msg for w in words) and "--units" in msg, (name, msg)
         assert ("STL, OBJ and PLY" in msg) == (name == "box.stl"), msg
+
+
+def test_a_small_obstacle_is_judged_beside_the_part(tmp_path, capsys):
+    """The inch check (a part under 6.35 mm looks saved in inches) fired on --obstacle meshes
+    too: a 3 x 3 x 5 mm pin beside a 40 mm box, a real obstacle, was said to look modelled in
+    inches. An obstacle gets it only where the part does (the scene looks saved in inches); the
+    metres check (under 1 mm) stays (test_a_mesh_saved_in_metres_is_named_as_such)."""
+    def grow(part, obstacle, out):
+        assert main(["woodify", str(part), "--obstacle", str(obstacle), "--years", "3", "--resolution", "16",
+                     "--cracks", "none", "--out", str(tmp_path / out)]) == 0
+        return [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+
+    trimesh.creation.box((40.0, 40.0, 30.0)).export(tmp_path / "part.stl")
+    pin = trimesh.creation.cylinder(radius=1.5, height=5.0)
+    pin.apply_translation((30.0, 0.0, 0.0))
+    pin.export(tmp_path / "pin.stl")
+    assert grow(tmp_path / "part.stl", tmp_path / "pin.stl", "o") == []
+    # a 150 x 150 x 100 mm part and a 30 x 30 x 60 mm post saved in inches: both look so
+    trimesh.creation.box((150 / 25.4, 150 / 25.4, 100 / 25.4)).export(tmp_path / "part_in.stl")
+    post = trimesh.creation.cylinder(radius=15.0, height=60.0)
+    post.apply_translation((110.0, 0.0, 0.0))
+    post.apply_scale(1 / 25.4)
+    post.export(tmp_path / "pin_in.stl")
+    said = grow(tmp_path / "part_in.stl", tmp_path / "pin_in.stl", "o2")
+    assert len(said) == 2 and all("modelled in inches" in m for m in said), said
+    assert said[1].startswith("woodcam: warning: --obstacle '" + str(tmp_path / "pin_in.stl") + "'"), said

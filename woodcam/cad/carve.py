@@ -200,7 +200,7 @@ def units_note(source: Any, unit: str = "inches") -> tuple[str, str]:
 
 
 def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX, *,
-               source: Any = None) -> str | None:
+               source: Any = None, inches: bool = True) -> str | None:
     """What to say when a part with bounds ``lo, hi (3,)`` mm would still fit the block
     ``size_mm (3,)`` 25.4 times larger (None otherwise): STL, OBJ and PLY carry no units, so a part
     exported in inches is read 25.4 x too small and carved or placed as a speck. Its lengths
@@ -218,14 +218,17 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX, *,
         a block, where to scale it: the message says ``scale it by 1000`` or ``by 25.4``, then
         ``fix``, then how to save it right (:func:`units_note`'s, of the unit it looks drawn in).
     source : what the part was loaded from (a path, an object), for :func:`units_note`; None:
-        a mesh."""
+        a mesh.
+    inches : without a block, whether a size under :data:`~woodcam.tolerances.INCHES_BELOW_MM`
+        says inches (False: only the metres check; ``woodify --obstacle``, where a 5 mm pin is
+        a real obstacle beside a real part)."""
     extent = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
     with message_units("mm"):  # about the file's own numbers, read as mm whatever --units says
         if size_mm is None:
             longest = float(np.max(extent))
             if 0 < longest < FOREIGN_GLTF_METRES_BELOW:
                 unit, factor, small = "metres", 1e3, "nothing that small is carved"
-            elif 0 < longest < INCHES_BELOW_MM:  # a 4-inch bowl saved in inches grew as a 4 mm speck
+            elif inches and 0 < longest < INCHES_BELOW_MM:  # a 4-inch bowl saved in inches grew as a 4 mm speck
                 unit, factor = "inches", MM_PER_UNIT["inch"]
                 small = f"a {INCHES_BELOW_MM:g} mm (1/4-inch) router bit is wider than its longest side"
             else:

@@ -52,7 +52,8 @@ def register(subparsers) -> argparse.ArgumentParser:
                    type=vector_type("--up", example="0,0,1", nonzero=True),
                    help="direction the eccentric growth favours (unit-normalised; default 0,0,1)")
     add_input(p, "--obstacle", kind="file", suffixes=_part_suffixes, type=Path, action="append", default=[],
-                   metavar="MESH", help="closed obstacle mesh or part (read as mm); repeatable")
+                   metavar="MESH", help="closed obstacle mesh or part (read as mm; one under 1 mm long gets the "
+              "metres warning, one under 6.35 mm the inches one only where the part is that small too); repeatable")
     add_input(p, "--brushes", kind="file", type=Path, default=None, metavar="JSON",
                    help="growth brushes (centre_mm, radius_mm, gain, direction, strength)")
     p.add_argument("--resolution", type=int, default=128,
@@ -112,18 +113,19 @@ def _part_suffixes() -> tuple[str, ...]:
     return tuple(dict.fromkeys((*_MESH_SUFFIXES, *part_suffixes())))
 
 
-def _load_mesh(path: str, what: str = "part", max_triangles: int | None = None):
+def _load_mesh(path: str, what: str = "part", max_triangles: int | None = None, inches: bool = True):
     """(watertight geometry, textured original or None) from a part or mesh file; ``what`` names
     it in messages (``part``, ``--obstacle``). ``max_triangles`` (``--max-triangles``; None:
     load_part's default) bounds what :func:`woodcam.cad.load_part` reads: a script, a STEP, a
-    file of several meshes; a file of one mesh keeps every triangle."""
+    file of several meshes; a file of one mesh keeps every triangle. ``inches``: whether its size
+    alone may say it was saved in inches (:func:`_warn_units`)."""
     import trimesh
 
     pth = Path(path)
     if pth.suffix.lower() in _MESH_SUFFIXES:
         try:
             if pth.suffix.lower() in (".glb", ".gltf", ".obj") and _mesh_count(pth) > 1:
-                return _several_meshes(pth, what, max_triangles)
+                return _several_meshes(pth, what, max_triangles, inches)
             if pth.suffix.lower() in (".glb", ".gltf", ".obj"):
                 from ..export import load_textured  # undoes woodcam's glTF/OBJ frame
 
@@ -148,7 +150,7 @@ def _load_mesh(path: str, what: str = "part", max_triangles: int | None = None):
                           "growth kept with its triangles); simplify it in your CAD program if the growth is slow",
                           WoodcamWarning, stacklevel=3)
         textured = loaded if getattr(loaded.visual, "uv", None) is not None else None
-        _warn_units(loaded, path, what)
+        _warn_units(loaded, path, what, inches)
         paint = _ply_paint(loaded, path)
         if paint:
             if not loaded.is_watertight:
@@ -167,7 +169,7 @@ def _load_mesh(path: str, what: str = "part", max_triangles: int | None = None):
     from ..cad import load_part
 
     geom = manifold_to_trimesh(load_part(path, **_budget(max_triangles)), process=True)
-    _warn_units(geom, path, what)  # a script's or STEP's size as a mesh's (units_note's words of its kind)
+    _warn_units(geom, path, what, inches)  # a script's or STEP's size as a mesh's (units_note's words of its kind)
     return geom, None, {}
 
 
@@ -225,7 +227,7 @@ def _mesh_count(path: Path) -> int:
                for n in scene.graph.nodes_geometry)
 
 
-def _several_meshes(path: Path, what: str, max_triangles: int | None = None):
+def _several_meshes(path: Path, what: str, max_triangles: int | None = None, inches: bool = True):
     """(geometry, None, {}) of a file of several meshes: their union as one closed solid, read
     as a part (:func:`woodcam.cad.load_part`, woodcam's own glTF/OBJ frame undone); only the
     first of them grew before (load_textured's refusal for a GLB, a mesh placed twice read as
@@ -259,15 +261,17 @@ def _several_meshes(path: Path, what: str, max_triangles: int | None = None):
                           "so their union is not a manifold solid (non-manifold union); separate "
                           "them (leave a gap) or merge them into one solid in the CAD program, "
                           "and export again")
-    _warn_units(geom, str(path), what)
+    _warn_units(geom, str(path), what, inches)
     return geom, None, {}
 
 
-def _warn_units(mesh, path: str, what: str = "part") -> None:
+def _warn_units(mesh, path: str, what: str = "part", inches: bool = True) -> None:
     """Warn when a part's size says it was saved in metres or inches: it is read as mm, and a
     40 mm box saved as 0.04 grew, silently, into a 0.06 mm speck, a 4-inch bowl saved as 4
     into a 4 mm one (woodcam.cad.carve.units_hint, its size alone: there is no block; in the
-    words of the file's kind, woodcam.cad.carve.units_note: a mesh, a script, a STEP)."""
+    words of the file's kind, woodcam.cad.carve.units_note: a mesh, a script, a STEP).
+    ``inches`` False: the metres check only (an --obstacle beside a part of real size: see
+    :func:`_obstacle_inches`)."""
     import warnings
 
     from ..cad.carve import units_hint
@@ -275,9 +279,23 @@ def _warn_units(mesh, path: str, what: str = "part") -> None:
 
     lo, hi = mesh.bounds
     hint = units_hint(lo, hi, None, "in your CAD program (--units converts only the lengths typed as options, "
-                      "never the part's own)", source=path)
+                      "never the part's own)", source=path, inches=inches)
     if hint:
         warnings.warn(f"{what} {path!r}: {hint}", WoodcamWarning, stacklevel=3)
+
+
+def _obstacle_inches(part) -> bool:
+    """Whether an ``--obstacle``'s size alone may say it was saved in inches: only where the
+    part's may, its longest side under :data:`woodcam.tolerances.INCHES_BELOW_MM` (the scene
+    looks saved in inches). An obstacle is judged beside the part it stands by, not as a part
+    carved alone: a 5 mm pin by a 40 mm part is a real obstacle, and was warned of as a
+    5-inch one."""
+    import numpy as np
+
+    from ..tolerances import INCHES_BELOW_MM
+
+    lo, hi = part.bounds
+    return float(np.max(np.asarray(hi) - np.asarray(lo))) < INCHES_BELOW_MM
 
 
 def _ply_paint(mesh, path) -> dict:
@@ -616,7 +634,8 @@ def run(args) -> int:
                   desc="woodify", leave=False) as bar:
         with bar.stage("read the mesh"):
             mesh, textured, painted = _load_mesh(args.part, max_triangles=args.max_triangles)
-            obstacles = [_load_mesh(str(o), "--obstacle", args.max_triangles)[0] for o in args.obstacle]
+            inches = _obstacle_inches(mesh)  # a small obstacle by a part of real size is a real one
+            obstacles = [_load_mesh(str(o), "--obstacle", args.max_triangles, inches)[0] for o in args.obstacle]
             brushes = load_brushes(args.brushes) if args.brushes else ()
         with bar.stage("grow"):
             res = woodify(mesh, args.years, growth_mm=args.growth, time_scale_years=args.time_scale,
