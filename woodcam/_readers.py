@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from ._checks import check_path
-from .errors import WoodcamError
+from .errors import WoodcamError, require
 
 __all__ = ["photo_rgb8", "read_image_file", "read_image_file_opacity", "read_json_file", "read_json_object", "read_npz",
            "read_photo_rgb", "strict_json_loads"]
@@ -335,3 +335,47 @@ def _opacity(im):
     else:
         return None
     return np.asarray(alpha) == 255
+
+
+def check_state_shapes(expected: dict, state) -> None:
+    """Raise ``ValueError`` in one line when the weights ``state`` are not of the net ``expected``
+    (its ``state_dict()``): how many tensors are of another shape, missing or unexpected, and
+    the first of them (torch's own error lists every tensor, 66 lines for a ring net of another
+    width)."""
+    if not isinstance(state, dict):
+        raise ValueError(f"the weights are a {type(state).__name__}, not a state dict")
+    shaped = [k for k in expected if k in state and tuple(state[k].shape) != tuple(expected[k].shape)]
+    missing = [k for k in expected if k not in state]
+    extra = [k for k in state if k not in expected]
+    if not (shaped or missing or extra):
+        return
+    counts = ", ".join(f"{len(v)} {what}" for v, what in ((shaped, "of another shape"), (missing, "missing"),
+                                                          (extra, "unexpected")) if v)
+    first = (f"{shaped[0]!r} is {tuple(state[shaped[0]].shape)}, the spec's net has "
+             f"{tuple(expected[shaped[0]].shape)}" if shaped else f"{(missing or extra)[0]!r}")
+    raise ValueError(f"the weights are of another net than the spec (tensors {counts}; first {first})")
+
+
+def read_torch_state(path, what: str, expected: dict, fix: str) -> dict:
+    """The tensors of the torch weights file ``path`` (``torch.save`` of a state dict), read with
+    ``weights_only=True`` (a crafted pickle runs nothing) and checked against the net they are
+    for, ``expected`` (its ``state_dict()``: names and shapes, :func:`check_state_shapes`).
+
+    A missing, empty, truncated or foreign file, or the weights of another net, is one
+    WoodcamError line: ``WHAT PATH cannot be loaded: why; FIX``. torch said ``EOFError`` with no
+    text for an empty file, ``OSError: [Errno 22] Invalid argument`` for a truncated one and
+    listed every tensor over many lines for another net's weights."""
+    torch = require("torch", "learn", what)
+    try:
+        with open(path, "rb") as fh:
+            if not zipfile.is_zipfile(fh):   # torch.save writes a zip archive
+                raise ValueError("the file is empty" if Path(path).stat().st_size == 0 else
+                                 "not a torch weights file (a zip archive): cut short by a crash or copy, "
+                                 "or another kind of file")
+        state = torch.load(path, map_location="cpu", weights_only=True)
+        check_state_shapes(expected, state)
+    except Exception as err:  # torch raises RuntimeError, OSError, EOFError, UnpicklingError...
+        why = (err.strerror if isinstance(err, OSError) and err.strerror else
+               (str(err).strip().splitlines() or [type(err).__name__])[0])
+        raise WoodcamError(f"{what} {str(path)!r} cannot be loaded: {why}; {fix}") from err
+    return state

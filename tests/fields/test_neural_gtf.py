@@ -175,3 +175,25 @@ def test_packaged_model():
 def test_load_model_missing(tmp_path):
     with pytest.raises(WoodcamError, match="needs gtf_spec.json and gtf.pt"):
         load_model(tmp_path)
+
+
+@pytest.mark.parametrize("damage", ["truncated", "empty", "another net"])
+def test_load_model_refuses_broken_weights_in_one_line_naming_the_file(tmp_path, damage):
+    """A cut, empty or foreign gtf.pt was torch's bare EOFError, 'OSError: [Errno 22] Invalid
+    argument' or a many-line RuntimeError listing every tensor."""
+    spec = GTFSpec(**TINY)
+    spec.save(tmp_path / SPEC_NAME)
+    torch.save(build_model(spec).state_dict(), tmp_path / WEIGHTS_NAME)
+    load_model(tmp_path)                                   # the intact folder loads
+    w = tmp_path / WEIGHTS_NAME
+    if damage == "truncated":
+        w.write_bytes(w.read_bytes()[: w.stat().st_size // 2])
+    elif damage == "empty":
+        w.write_bytes(b"")
+    else:
+        torch.save(build_model(GTFSpec(**{**TINY, "hidden": 8})).state_dict(), w)
+    with pytest.raises(WoodcamError) as e:
+        load_model(tmp_path)
+    msg = str(e.value)
+    assert "\n" not in msg and str(w) in msg and "woodcam train gtf" in msg, msg
+    assert {"truncated": "cut short", "empty": "empty", "another net": "another net"}[damage] in msg, msg

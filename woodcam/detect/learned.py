@@ -37,6 +37,7 @@ from typing import Literal, get_args
 import numpy as np
 
 from .._atomic import atomic_path, atomic_write, write_text
+from .._readers import check_state_shapes
 from ..errors import WoodcamError, require
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
@@ -346,7 +347,7 @@ def _load_ring_net(models_dir, member: str, folder_key: str):
                                    f"not a quilted one ({', '.join(QUILTED_STYLES)})")
             net = _net(spec)
             state = torch.load(path, map_location="cpu", weights_only=True)
-            _check_state_shapes(net.state_dict(), state)
+            check_state_shapes(net.state_dict(), state)
             net.load_state_dict(state)
         except Exception as e:
             if member == "main" and isinstance(e, WoodcamError):
@@ -360,25 +361,6 @@ def _load_ring_net(models_dir, member: str, folder_key: str):
         net.eval()
         _CACHE[key] = net
     return _CACHE[key]
-
-
-def _check_state_shapes(expected: dict, state) -> None:
-    """Raise ``ValueError`` in one line when the weights ``state`` are not of the net ``expected``
-    (its ``state_dict()``): how many tensors are of another shape, missing or unexpected, and
-    the first of them (torch's own error lists every tensor, 66 lines for a member of another
-    width)."""
-    if not isinstance(state, dict):
-        raise ValueError(f"the weights are a {type(state).__name__}, not a state dict")
-    shaped = [k for k in expected if k in state and tuple(state[k].shape) != tuple(expected[k].shape)]
-    missing = [k for k in expected if k not in state]
-    extra = [k for k in state if k not in expected]
-    if not (shaped or missing or extra):
-        return
-    counts = ", ".join(f"{len(v)} {what}" for v, what in ((shaped, "of another shape"), (missing, "missing"),
-                                                          (extra, "unexpected")) if v)
-    first = (f"{shaped[0]!r} is {tuple(state[shaped[0]].shape)}, the spec's net has "
-             f"{tuple(expected[shaped[0]].shape)}" if shaped else f"{(missing or extra)[0]!r}")
-    raise ValueError(f"the weights are of another net than the spec (tensors {counts}; first {first})")
 
 
 def ring_members(models_dir=MODELS_DIR) -> list[tuple[str, float]]:

@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic import atomic_path, atomic_write, write_text
+from .._readers import read_torch_state
 from ..errors import WoodcamError, require
 from .radial import laplacian_smoother
 
@@ -278,15 +279,21 @@ def load_model(model_dir=None):
 
     ``model_dir`` defaults to the package's ``woodcam/models`` (``gtf_spec.json`` + ``gtf.pt``).
     """
-    torch = _torch()
     d = Path(model_dir) if model_dir is not None else MODELS_DIR
     spec_path, w_path = d / SPEC_NAME, d / WEIGHTS_NAME
     if not (spec_path.is_file() and w_path.is_file()):
         raise WoodcamError(f"model_dir {d}: needs {SPEC_NAME} and {WEIGHTS_NAME}; "
                            f"train one with 'woodcam train gtf --out {d}'")
-    spec = GTFSpec.load(spec_path)
+    # a broken file was torch's EOFError, OSError or a many-line RuntimeError (another net's
+    # weights): one line naming the file and the fix instead
+    fix = (f"restore the folder's {SPEC_NAME} and {WEIGHTS_NAME} (the packaged model: reinstall woodcam or "
+           f"check out woodcam/models) or retrain them with 'woodcam train gtf --spec SPEC --out {d}'")
+    try:
+        spec = GTFSpec.load(spec_path)
+    except WoodcamError as err:
+        raise WoodcamError(f"{err}; {fix}") from err
     net = build_model(spec)
-    state = torch.load(w_path, map_location="cpu", weights_only=True)
+    state = read_torch_state(w_path, "GTF model weights", net.state_dict(), fix)
     net.load_state_dict({k: v.float() for k, v in state.items()})
     net.eval()
     for prm in net.parameters():
