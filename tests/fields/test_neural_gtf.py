@@ -89,13 +89,38 @@ def test_spec_round_trip_and_errors(tmp_path):
     assert GTFSpec.load(spec.save(tmp_path / "s.json")) == spec
     with pytest.raises(WoodcamError, match="unknown keys"):
         GTFSpec.from_dict({**TINY, "depth": 3})
-    with pytest.raises(WoodcamError, match="spec.hidden must be a positive number"):
+    with pytest.raises(WoodcamError, match="spec.hidden must be an integer >= 1"):
         GTFSpec(**{**TINY, "hidden": 0})
     with pytest.raises(WoodcamError, match="pith_fraction"):
         GTFSpec(**{**TINY, "pith_fraction": 1.5})
     (tmp_path / "bad.json").write_text("[1, 2]")
     with pytest.raises(WoodcamError, match="JSON object"):
         GTFSpec.load(tmp_path / "bad.json")
+
+
+@pytest.mark.parametrize("key, value, rule", [
+    ("seed", -1, "spec.seed must be an integer >= 0; got -1"),
+    ("seed", "a", "spec.seed must be an integer >= 0; got 'a'"),
+    ("n_fields", 4.5, "spec.n_fields must be an integer >= 1; got 4.5"),
+    ("latent_dim", True, "spec.latent_dim must be an integer >= 1; got True"),
+    ("lr_net", True, "spec.lr_net must be a positive number; got True"),
+])
+def test_spec_file_with_a_bad_value_is_refused_naming_the_file(tmp_path, key, value, rule):
+    """A seed of -1 or 4.5 fields in a spec file passed the door and failed in numpy's words
+    ('expected non-negative integer', "'float' object cannot be interpreted as an integer")
+    after the spec had been written into OUT."""
+    path = tmp_path / "spec.json"
+    path.write_text(json.dumps({**TINY, key: value}))
+    with pytest.raises(WoodcamError) as e:
+        GTFSpec.load(path)
+    assert str(path) in str(e.value) and rule in str(e.value), e.value
+
+
+def test_training_refuses_more_batch_fields_than_fields_before_writing(tmp_path):
+    spec = GTFSpec(**{**TINY, "batch_fields": 9})      # 8 fields: numpy's "larger sample than population"
+    with pytest.raises(WoodcamError, match=r"spec.batch_fields must be at most spec.n_fields \(8\)"):
+        train_gtf(spec, tmp_path, progress=False)
+    assert not (tmp_path / SPEC_NAME).exists()
 
 
 def test_resumed_training_equals_straight_run(tmp_path):

@@ -55,6 +55,12 @@ LOG_NAME = "gtf_train_log.csv"
 _CHECKPOINT_NAME = "gtf_checkpoint.pt"
 
 
+#: The :class:`GTFSpec` fields that are counts (integers >= 1; the seed >= 0).
+_GTF_INTEGERS = ("seed", "n_fields", "points_per_field", "n_constraints", "radius_samples", "latent_dim",
+                 "hidden", "layers", "n_harmonics", "batch_fields", "batch_points", "steps",
+                 "checkpoint_every", "log_every")
+
+
 @dataclass(frozen=True)
 class GTFSpec:
     """Every hyper-parameter of the generic GTF model and its training run (JSON round trip).
@@ -105,14 +111,19 @@ class GTFSpec:
     log_every: int = 100
 
     def __post_init__(self):
+        from .._checks import check_number
+
+        # the integer counts were taken as any positive number and the seed not checked at all:
+        # a seed of -1 or 4.5 fields was numpy's error after the spec was written
+        fix = "fix it in the spec's JSON file"
         for f in dc_fields(self):
             v = getattr(self, f.name)
-            if f.name in ("seed",):
-                continue
-            if not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
-                raise WoodcamError(f"spec.{f.name} must be a positive number; got {v!r}")
+            if f.name in _GTF_INTEGERS:
+                check_number(v, f"spec.{f.name}", lo=0 if f.name == "seed" else 1, integer=True, fix=fix)
+            elif not (isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v) and v > 0):
+                raise WoodcamError(f"spec.{f.name} must be a positive number; got {v!r}; {fix}")
         if not 0 <= self.pith_fraction <= 1:
-            raise WoodcamError(f"spec.pith_fraction must be in [0, 1]; got {self.pith_fraction!r}")
+            raise WoodcamError(f"spec.pith_fraction must be in [0, 1]; got {self.pith_fraction!r}; {fix}")
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -135,7 +146,10 @@ class GTFSpec:
         from .._readers import read_json_object
 
         d = read_json_object(path, "GTF spec")
-        return cls.from_dict(d)
+        try:
+            return cls.from_dict(d)
+        except WoodcamError as err:     # which file: a spec is read from OUT or --spec
+            raise WoodcamError(f"GTF spec {str(path)!r}: {err}") from err
 
 
 # ---------------------------------------------------------------------------------------------
@@ -389,6 +403,10 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
     total = spec.steps if steps is None else int(steps)
     if total < 0:
         raise WoodcamError(f"steps must be >= 0; got {steps!r}")
+    if spec.batch_fields > spec.n_fields:  # was numpy's "Cannot take a larger sample than population"
+        raise WoodcamError(f"spec.batch_fields must be at most spec.n_fields ({spec.n_fields}) to train: each "
+                           f"step draws that many different fields; got {spec.batch_fields}; lower it or raise "
+                           "n_fields in the spec")
     ckpt = out / _CHECKPOINT_NAME
     # read (and refuse) a checkpoint before minutes of work building the training set, and before
     # the spec is written: a refused run overwrote gtf_spec.json, leaving gtf.pt with a spec
