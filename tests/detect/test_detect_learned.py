@@ -38,6 +38,48 @@ def test_spec_round_trip_and_unknown_keys(tmp_path):
             RingNetSpec.load(path)
 
 
+@pytest.mark.parametrize("key, value, rule", [
+    ("n_blocks", 0, "n_blocks must be an integer >= 1; got 0"),
+    ("n_blocks", 1.5, "n_blocks must be an integer >= 1; got 1.5"),
+    ("steps", 0, "steps must be an integer >= 1; got 0"),
+    ("width", 0, "width must be an integer >= 1; got 0"),
+    ("seed", -1, "seed must be an integer >= 0; got -1"),
+    ("log_every", 0, "log_every must be an integer >= 1; got 0"),
+    ("lr", -0.1, "lr must be a finite number > 0; got -0.1"),
+    ("crop_px", 30, "crop_px must be a multiple of 4"),
+])
+def test_train_rings_refuses_a_bad_spec_value_in_one_line_naming_the_file(tmp_path, capsys, key, value, rule):
+    """Each of these passed the spec's door and failed as an "internal error" in numpy's or
+    torch's words ('need at least one array to stack', 'integer modulo by zero', 'Sizes of
+    tensors must match', ...), most after the training faces were made."""
+    import json
+
+    from woodcam.cli import EXIT_ERROR, main
+
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps({"n_blocks": 1, "face_px": 64, "crop_px": 32, "steps": 2, key: value}))
+    assert main(["train", "rings", "--spec", str(path), "--out", str(tmp_path / "t")]) == EXIT_ERROR
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and str(path) in err and rule in err, err
+
+
+def test_train_rings_refuses_crops_larger_than_the_faces_before_making_them(tmp_path, capsys, monkeypatch):
+    """crop_px 96 on 64 px faces was numpy's 'high <= 0' after the faces were made; a spec of
+    small faces stays valid for making faces alone."""
+    import woodcam.synth.rings as synth_rings
+    from woodcam.cli import EXIT_ERROR, main
+
+    def no_faces(*a, **k):
+        raise AssertionError("faces made for a spec that cannot train")
+
+    monkeypatch.setattr(synth_rings, "ring_training_faces", no_faces)
+    spec = RingNetSpec(n_blocks=1, face_px=64, crop_px=96, steps=2)
+    spec.save(tmp_path / "s.json")
+    assert main(["train", "rings", "--spec", str(tmp_path / "s.json"), "--out", str(tmp_path / "t")]) == EXIT_ERROR
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "crop_px must be at most the training faces' size (64 x 64 px" in err, err
+
+
 @pytest.mark.slow
 def test_tiny_training_run_is_reproducible(tmp_path):
     from woodcam.detect.learned import ring_probability, train_ring_net
@@ -169,7 +211,7 @@ def test_quilted_spec_names_its_photos_and_training_without_them_fails_in_one_li
     may), and ``train rings`` without the shared data says so in one line before any work."""
     from woodcam.cli import EXIT_ERROR, main
 
-    spec = RingNetSpec(style="quilted", texture_samples=["mokume/H11"], n_blocks=1, face_px=32)
+    spec = RingNetSpec(style="quilted", texture_samples=["mokume/H11"], n_blocks=1, face_px=32, crop_px=32)
     assert spec.texture_samples == ("mokume/H11",)
     spec.save(tmp_path / "s.json")
     assert RingNetSpec.load(tmp_path / "s.json") == spec

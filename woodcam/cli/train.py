@@ -31,7 +31,7 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     if args.what == "rings":
-        from ..detect.learned import RingNetSpec, check_member, train_ring_net
+        from ..detect.learned import RingNetSpec, check_member, check_trainable, train_ring_net
 
         if engine_requested(args) or args.no_resume:  # they were accepted and ignored
             given = [*engine_given(args), *(["--no-resume"] if args.no_resume else [])]
@@ -46,6 +46,7 @@ def run(args) -> int:
             spec = replace(spec, steps=args.steps)
         member = args.member or "main"
         check_member(spec, member, what="--member")   # before minutes of training faces
+        check_trainable(spec)
         from ..synth.rings import ring_training_faces
 
         args.out.mkdir(parents=True, exist_ok=True)  # before minutes of training, not after

@@ -84,6 +84,16 @@ def member_files(member: str = "main") -> tuple[str, str, str]:
     return f"rings_{member}_spec.json", f"rings_{member}.pt", f"rings_{member}_train_log.csv"
 
 
+def check_trainable(spec: RingNetSpec, face_shape: tuple[int, int] | None = None) -> None:
+    """Refuse a ``spec`` whose training crops (``crop_px``) do not fit in its training faces
+    (``face_shape`` ``(h, w)`` px, default ``face_px`` square): numpy's "high <= 0" once the
+    faces were made. A spec of small faces is fine for making faces alone."""
+    h, w = face_shape or (spec.face_px, spec.face_px)
+    if spec.crop_px > min(h, w):
+        raise WoodcamError(f"ring net spec crop_px must be at most the training faces' size ({h} x {w} px, "
+                           f"face_px) to train; got {spec.crop_px}; lower crop_px or raise face_px in the spec")
+
+
 def check_member(spec: RingNetSpec, member: str, what: str = "member") -> None:
     """Refuse a ``member`` that ``spec`` cannot be: the quilted member is a net of a quilted style
     (its combination weight was measured for those). ``what`` names the argument in the message."""
@@ -138,6 +148,20 @@ class RingNetSpec:
     texture_samples: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
+        from .._checks import check_number
+
+        # the numbers were not checked: 'woodcam train rings --spec S' with n_blocks 0, steps 0,
+        # width 0, seed -1, log_every 0, crop_px 30 (not a multiple of 4: the U-Net's levels) or
+        # above face_px failed in numpy's or torch's words, an "internal error", after minutes of faces
+        fix = "fix it in the spec's JSON file"
+        for name in ("seed", "n_blocks", "face_px", "width", "crop_px", "batch", "steps", "log_every"):
+            check_number(getattr(self, name), f"ring net spec {name}", lo=0 if name == "seed" else 1,
+                         integer=True, fix=fix)
+        for name in ("target_sigma_px", "lr", "max_train_s"):
+            check_number(getattr(self, name), f"ring net spec {name}", lo=0, lo_open=True, fix=fix)
+        if self.crop_px % 4:
+            raise WoodcamError(f"ring net spec crop_px must be a multiple of 4 (the net halves a crop twice); "
+                               f"got {self.crop_px}; {fix}")
         if self.style not in TRAINING_STYLES:
             raise WoodcamError(f"ring net spec style must be one of {', '.join(TRAINING_STYLES)}; "
                                f"got {self.style!r}")
@@ -160,7 +184,10 @@ class RingNetSpec:
         bad = set(d) - names
         if bad:
             raise WoodcamError(f"ring net spec {str(path)!r} has unknown keys {sorted(bad)}; allowed: {sorted(names)}")
-        return cls(**d)
+        try:
+            return cls(**d)
+        except WoodcamError as err:     # which file: --spec or a models folder's
+            raise WoodcamError(f"{str(path)!r}: {err}") from err
 
     def save(self, path) -> None:
         write_text(path, json.dumps(asdict(self), indent=1))
@@ -267,6 +294,7 @@ def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, 
     from .._progress import progress_bar
 
     check_member(spec, member)
+    check_trainable(spec, x.shape[1:])
     spec_name, weights_name, log_name = member_files(member)
 
     out = Path(out_dir)
