@@ -407,3 +407,32 @@ def test_fitted_volumes_carry_detail_that_brings_them_closer_to_the_truth(fitted
     detailed = np.abs(app.color(FIELD, p, n) - truth).mean()
     assert detailed < 0.9 * plain, (detailed, plain)
 
+
+
+@pytest.mark.parametrize("damage", ["truncated", "empty", "another net", "missing"])
+def test_load_nets_refuses_broken_weights_in_one_line_naming_the_file(tmp_path, damage):
+    """A cut or empty *.weights.npz was numpy's BadZipFile / EOFError, a missing one the bare
+    FileNotFoundError, weights of a wider net than their header torch's many-line
+    load_state_dict error."""
+    from woodcam.appearance.neural import _save_nets
+    from woodcam.appearance.translation import _build_net
+
+    spec = translation_spec("draft")
+    good = tmp_path / "good.weights.npz"
+    _save_nets(good, [TranslationNet(_build_net(2, spec.channels), spec, 2, 0.0, 0.0)])
+    assert len(load_nets(good)) == 1
+    path = tmp_path / "bad.weights.npz"
+    if damage == "truncated":
+        path.write_bytes(good.read_bytes()[: good.stat().st_size // 2])
+    elif damage == "empty":
+        path.write_bytes(b"")
+    elif damage == "another net":
+        wide = replace(spec, channels=2 * spec.channels)
+        _save_nets(path, [TranslationNet(_build_net(2, wide.channels), wide, 2, 0.0, 0.0)])
+        arrays = dict(np.load(path))
+        arrays["header"] = np.load(good)["header"]       # the header of the narrower net
+        np.savez(path, **arrays)
+    with pytest.raises(WoodcamError) as e:
+        load_nets(path)
+    msg = str(e.value)
+    assert "\n" not in msg and str(path) in msg and "woodcam cache clear" in msg, msg

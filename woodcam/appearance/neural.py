@@ -21,6 +21,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from .._checks import received
 from ..errors import WoodcamError, WoodcamWarning
 from ..fields.base import check_points, evaluate
 from ..frames import FACE_AXIS
@@ -314,9 +315,20 @@ def _save_nets(path: Path, nets) -> None:
 
 
 def load_nets(path) -> list[TranslationNet]:
-    """The translation networks saved next to cached volumes (``*.weights.npz``)."""
-    with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as z:
+    """The translation networks saved next to cached volumes (``*.weights.npz``).
+
+    A missing, empty, cut or foreign file, or weights of another network than their header, is
+    one WoodcamError line naming the file (:func:`woodcam._readers.read_npz`): they were numpy's
+    ``BadZipFile`` or ``EOFError`` and torch's many-line ``load_state_dict`` error."""
+    from .._readers import read_npz
+
+    fix = ("delete it and its colour volumes (woodcam cache clear --kind appearance): the next fit "
+           "trains and saves them again")
+    with read_npz(path, "the neural appearance's network weights (*.weights.npz beside cached colour volumes)",
+                  fix) as z:
         heads = json.loads(str(z["header"]))
+        if not isinstance(heads, list) or not all(isinstance(st, dict) for st in heads):
+            raise ValueError(f"its header is not a list of networks; got {received(heads)}")
         out = []
         for i, st in enumerate(heads):
             pre = f"net{i}/"

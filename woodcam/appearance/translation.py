@@ -28,6 +28,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from .._readers import check_state_shapes
 from ..errors import WoodcamError, require
 
 Quality = Literal["draft", "normal", "high"]
@@ -202,7 +203,9 @@ class TranslationNet:
         torch = require("torch", "learn", "the neural wood appearance")
         spec = TranslationSpec(**state["spec"])
         module = _build_net(int(state["c_in"]), spec.channels)
-        module.load_state_dict({k: torch.from_numpy(np.asarray(v)) for k, v in state["weights"].items()})
+        weights = {k: torch.from_numpy(np.asarray(v)) for k, v in state["weights"].items()}
+        check_state_shapes(module.state_dict(), weights)  # one ValueError line, not torch's per-tensor list
+        module.load_state_dict(weights)
         return cls(module, spec, int(state["c_in"]), float(state.get("train_seconds", 0.0)),
                    float(state.get("final_l1", float("nan"))))
 
