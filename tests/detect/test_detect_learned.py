@@ -360,3 +360,19 @@ def test_train_writes_the_quilted_member_and_refuses_it_for_other_styles(tmp_pat
     # an option of another sub-command: a wrong command line (exit 2)
     assert main(["train", "gtf", "--member", "quilted", "--out", str(tmp_path / "g")]) == 2
     assert "is for 'train rings'" in capsys.readouterr().err and not (tmp_path / "g").exists()
+
+
+def test_a_net_retrained_into_the_same_folder_is_read_again(tmp_path):
+    """The nets were cached per folder for the life of the process: weights retrained (or
+    restored) into a folder already read gave the old net's probability, with no word."""
+    from woodcam.detect.learned import load_ring_net, ring_probability
+
+    folder = _write_member(tmp_path / "m", _TINY, seed=1)
+    photo = np.full((40, 44, 3), 128, np.uint8)
+    photo[:, ::9] = 40
+    first = ring_probability(photo, models_dir=folder)
+    assert load_ring_net(folder) is load_ring_net(folder)                 # still cached while unchanged
+    _write_member(folder, _TINY, seed=2)                                  # retrained in place
+    again = ring_probability(photo, models_dir=folder)
+    np.testing.assert_array_equal(again, ring_probability(photo, models_dir=_write_member(tmp_path / "n", _TINY, seed=2)))
+    assert np.abs(again - first).mean() > 0.02

@@ -353,7 +353,7 @@ _CACHE: dict = {}
 
 def load_ring_net(models_dir=MODELS_DIR, member: str = "main"):
     """The trained net (eval mode) ``member`` (:data:`RING_NET_MEMBERS`) of ``models_dir``;
-    cached per folder and member."""
+    cached per folder and member, read again when its spec or weights file changed."""
     return _load_ring_net(models_dir, member, str(Path(models_dir).resolve()))
 
 
@@ -363,7 +363,11 @@ def _load_ring_net(models_dir, member: str, folder_key: str):
     torch = require("torch", "learn", "the learned ring detector")
     spec_name, weights_name, _ = member_files(member)
     key = (folder_key, member)
-    if key not in _CACHE:
+    # the files' identity is part of the entry: weights retrained or restored into the folder
+    # (train_ring_net, a copy) were never read again in this process, the old net answered
+    stamp = _files_stamp(Path(models_dir), (spec_name, weights_name))
+    if key not in _CACHE or _CACHE[key][0] != stamp:
+        _CACHE.pop(key, None)
         path = Path(models_dir) / weights_name
         if member == "main" and not path.is_file():
             raise WoodcamError(f"no trained ring net at {str(path)!r}; train one with "
@@ -387,8 +391,22 @@ def _load_ring_net(models_dir, member: str, folder_key: str):
             raise WoodcamError(f"ring net {member!r} in {str(models_dir)!r} ({weights_name} with {spec_name}) cannot "
                                f"be loaded: {why}; {fix}") from e
         net.eval()
-        _CACHE[key] = net
-    return _CACHE[key]
+        _CACHE[key] = (stamp, net)
+    return _CACHE[key][1]
+
+
+def _files_stamp(folder: Path, names) -> tuple:
+    """``(inode, size, mtime ns)`` of each file (None where it cannot be read): changes when a
+    file is rewritten (written atomically: a new inode) or replaced."""
+    out = []
+    for name in names:
+        try:
+            st = (folder / name).stat()
+        except OSError:
+            out.append(None)
+        else:
+            out.append((st.st_ino, st.st_size, st.st_mtime_ns))
+    return tuple(out)
 
 
 def ring_members(models_dir=MODELS_DIR) -> list[tuple[str, float]]:
