@@ -376,3 +376,22 @@ def test_a_net_retrained_into_the_same_folder_is_read_again(tmp_path):
     again = ring_probability(photo, models_dir=folder)
     np.testing.assert_array_equal(again, ring_probability(photo, models_dir=_write_member(tmp_path / "n", _TINY, seed=2)))
     assert np.abs(again - first).mean() > 0.02
+
+
+def test_the_training_log_ends_with_the_last_step(tmp_path):
+    """The log was written every log_every steps only: the steps that made the weights (a
+    max_train_s stop ends anywhere) were in no file (the committed log ends at step 2550 of
+    2593)."""
+    import csv
+
+    from woodcam.detect.learned import LOG_NAME, train_ring_net
+
+    rng = np.random.default_rng(0)
+    x = rng.standard_normal((2, 32, 32)).astype(np.float32)
+    y = (rng.uniform(size=(2, 32, 32)) < 0.2).astype(np.float32)
+    spec = RingNetSpec(n_blocks=1, face_px=32, crop_px=16, batch=2, steps=7, log_every=5, width=2)
+    r = train_ring_net(spec, x, y, tmp_path, progress=False)
+    with open(tmp_path / LOG_NAME, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [int(row["step"]) for row in rows] == [0, 5, 6] and r["steps"] == 7
+    assert float(rows[-1]["loss_avg"]) == pytest.approx(r["final_loss"])

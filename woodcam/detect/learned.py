@@ -289,7 +289,9 @@ def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, 
     and targets ``y (n, h, w)`` in [0, 1] (made by :func:`woodcam.synth.ring_training_faces`);
     write ``rings_spec.json``, ``rings.pt`` and ``rings_train_log.csv`` to ``out_dir``
     (``member="quilted"``: ``rings_quilted_*``, :func:`member_files`; ``spec`` of a quilted style).
-    Returns ``{"steps", "train_s", "final_loss", "params"}``."""
+    The log has a row every ``spec.log_every`` steps and one for the last step (its ``step`` is
+    0-based: ``step + 1`` steps made the weights, fewer than ``spec.steps`` after a
+    ``max_train_s`` stop). Returns ``{"steps", "train_s", "final_loss", "params"}``."""
     torch = require("torch", "learn", "training the ring net")
     from .._progress import progress_bar
 
@@ -336,6 +338,10 @@ def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, 
         if time.perf_counter() - t0 > spec.max_train_s:
             break
     train_s = time.perf_counter() - t0
+    if rows and rows[-1]["step"] != step:
+        # the last step always: the log is the one record of how many steps made the weights (a
+        # max_train_s stop ends anywhere; the committed net's log ended at 2550 of its 2593)
+        rows.append({"step": step, "loss": v, "loss_avg": loss_avg, "seconds": train_s})
     spec.save(out / spec_name)
     with atomic_path(out / weights_name) as tmp:
         torch.save({k: v.detach().clone() for k, v in net.state_dict().items()}, tmp)
