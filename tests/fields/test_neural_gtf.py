@@ -147,6 +147,22 @@ def test_resumed_training_equals_straight_run(tmp_path):
     assert GTFSpec.load(tmp_path / "b" / SPEC_NAME) == spec
 
 
+def test_a_failed_run_leaves_the_spec_beside_the_weights_that_it_made(tmp_path):
+    """The spec was written when a run started: one that then failed (or was killed) left the
+    new spec beside the previous run's gtf.pt, which loaded under it without a word when only
+    the seed or a rate had changed."""
+    spec = GTFSpec(**TINY)
+    train_gtf(spec, tmp_path, progress=False)
+
+    def fails():
+        raise RuntimeError("killed while making the training set")
+
+    with pytest.raises(RuntimeError, match="killed"):
+        train_gtf(GTFSpec(**{**TINY, "seed": 1}), tmp_path, resume=False, progress=False, training_set=fails)
+    assert GTFSpec.load(tmp_path / SPEC_NAME) == spec
+    assert load_model(tmp_path)[1] == spec
+
+
 def test_training_reduces_the_error(tmp_path):
     spec = GTFSpec(**{**TINY, "steps": 300, "hidden": 32, "checkpoint_every": 300, "log_every": 50,
                       "lr_net": 3e-3, "lr_latent": 3e-2})

@@ -408,11 +408,8 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
                            f"step draws that many different fields; got {spec.batch_fields}; lower it or raise "
                            "n_fields in the spec")
     ckpt = out / _CHECKPOINT_NAME
-    # read (and refuse) a checkpoint before minutes of work building the training set, and before
-    # the spec is written: a refused run overwrote gtf_spec.json, leaving gtf.pt with a spec
-    # of another shape beside it
+    # read (and refuse) a checkpoint before minutes of work building the training set
     state = _load_checkpoint(torch, ckpt, spec) if resume and ckpt.is_file() else None
-    spec.save(out / SPEC_NAME)
 
     if callable(training_set):
         training_set = training_set()
@@ -497,8 +494,12 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
         final_l1 = float(torch.cat(errs).mean())
         final_rel = float(torch.cat(rels).mean())
     state = {k: v.detach().clone() for k, v in net.state_dict().items()}
+    # the spec with the weights, at the end: written at the start, it stood beside the previous
+    # gtf.pt for the whole run, and for good when the run failed or was killed (a new seed or
+    # learning rate loaded those weights under a spec that never made them)
     with atomic_path(out / WEIGHTS_NAME) as tmp:
         torch.save(state, tmp)
+    spec.save(out / SPEC_NAME)
     with atomic_write(out / LOG_NAME, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["step", "l1", "time_s"])
