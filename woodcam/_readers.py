@@ -356,14 +356,14 @@ def check_state_shapes(expected: dict, state) -> None:
     raise ValueError(f"the weights are of another net than the spec (tensors {counts}; first {first})")
 
 
-def read_torch_state(path, what: str, expected: dict, fix: str) -> dict:
+def torch_state(path, expected: dict, what: str = "torch weights") -> dict:
     """The tensors of the torch weights file ``path`` (``torch.save`` of a state dict), read with
     ``weights_only=True`` (a crafted pickle runs nothing) and checked against the net they are
     for, ``expected`` (its ``state_dict()``: names and shapes, :func:`check_state_shapes`).
 
-    A missing, empty, truncated or foreign file, or the weights of another net, is one
-    WoodcamError line: ``WHAT PATH cannot be loaded: why; FIX``. torch said ``EOFError`` with no
-    text for an empty file, ``OSError: [Errno 22] Invalid argument`` for a truncated one and
+    Any failure is a ``ValueError`` of one line saying why (the caller names the file and the
+    fix, :func:`read_torch_state`): torch said ``EOFError`` with no text for an empty file,
+    ``OSError: [Errno 22] Invalid argument`` or a paragraph about miniz for a cut one, and
     listed every tensor over many lines for another net's weights."""
     torch = require("torch", "learn", what)
     try:
@@ -377,5 +377,14 @@ def read_torch_state(path, what: str, expected: dict, fix: str) -> dict:
     except Exception as err:  # torch raises RuntimeError, OSError, EOFError, UnpicklingError...
         why = (err.strerror if isinstance(err, OSError) and err.strerror else
                (str(err).strip().splitlines() or [type(err).__name__])[0])
-        raise WoodcamError(f"{what} {str(path)!r} cannot be loaded: {why}; {fix}") from err
+        raise ValueError(why) from err
     return state
+
+
+def read_torch_state(path, what: str, expected: dict, fix: str) -> dict:
+    """:func:`torch_state` of ``path``, or one WoodcamError line: ``WHAT PATH cannot be loaded:
+    why; FIX``. A missing, empty, cut or foreign file, or the weights of another net."""
+    try:
+        return torch_state(path, expected, what)
+    except ValueError as err:
+        raise WoodcamError(f"{what} {str(path)!r} cannot be loaded: {err}; {fix}") from err

@@ -395,3 +395,30 @@ def test_the_training_log_ends_with_the_last_step(tmp_path):
         rows = list(csv.DictReader(fh))
     assert [int(row["step"]) for row in rows] == [0, 5, 6] and r["steps"] == 7
     assert float(rows[-1]["loss_avg"]) == pytest.approx(r["final_loss"])
+
+
+@pytest.mark.parametrize("damage", ["truncated", "empty", "another width", "spec empty", "no spec"])
+def test_a_broken_main_net_is_refused_in_one_line_with_the_fix(tmp_path, damage):
+    """The main net's spec errors were raised bare ('ring net spec: cannot read ... (No such
+    file or directory)', no fix), a cut rings.pt gave torch's paragraph about miniz."""
+    from woodcam.detect.learned import load_ring_net
+
+    folder = _write_member(tmp_path / "m", _TINY, seed=1)
+    w, s = folder / WEIGHTS_NAME, folder / SPEC_NAME
+    if damage == "truncated":
+        w.write_bytes(w.read_bytes()[: w.stat().st_size // 2])
+    elif damage == "empty":
+        w.write_bytes(b"")
+    elif damage == "another width":
+        replace(_TINY, width=8).save(s)
+    elif damage == "spec empty":
+        s.write_text("")
+    else:
+        s.unlink()
+    with pytest.raises(WoodcamError) as exc:
+        load_ring_net(folder)
+    msg = str(exc.value)
+    assert len(msg.splitlines()) == 1 and str(folder) in msg, msg
+    assert "woodcam train rings --spec SPEC --out" in msg and "check out woodcam/models" in msg, msg
+    assert {"truncated": "cut short", "empty": "the file is empty", "another width": "another net than the spec",
+            "spec empty": "valid JSON", "no spec": "No such file"}[damage] in msg, msg

@@ -37,7 +37,7 @@ from typing import Literal, get_args
 import numpy as np
 
 from .._atomic import atomic_path, atomic_write, write_text
-from .._readers import check_state_shapes
+from .._readers import torch_state
 from ..errors import WoodcamError, require
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
@@ -366,7 +366,7 @@ def load_ring_net(models_dir=MODELS_DIR, member: str = "main"):
 def _load_ring_net(models_dir, member: str, folder_key: str):
     """:func:`load_ring_net` with the folder's resolved path ``folder_key`` (the cache key) read by
     the caller: :func:`ring_probability` resolves its folder once for all its members."""
-    torch = require("torch", "learn", "the learned ring detector")
+    require("torch", "learn", "the learned ring detector")
     spec_name, weights_name, _ = member_files(member)
     key = (folder_key, member)
     # the files' identity is part of the entry: weights retrained or restored into the folder
@@ -384,15 +384,14 @@ def _load_ring_net(models_dir, member: str, folder_key: str):
                 raise WoodcamError(f"its spec has style {spec.style!r}, "
                                    f"not a quilted one ({', '.join(QUILTED_STYLES)})")
             net = _net(spec)
-            state = torch.load(path, map_location="cpu", weights_only=True)
-            check_state_shapes(net.state_dict(), state)
-            net.load_state_dict(state)
+            net.load_state_dict(torch_state(path, net.state_dict(), "the learned ring detector"))
         except Exception as e:
-            if member == "main" and isinstance(e, WoodcamError):
-                raise
             fix = (f"retrain it with 'woodcam train rings --member {member} --spec SPEC --out {models_dir}' "
                    f"or remove {spec_name} and {weights_name}" if member != "main" else
-                   f"retrain it with 'woodcam train rings --out {models_dir}'")
+                   f"restore {spec_name} and {weights_name} (the packaged net: reinstall woodcam or check out "
+                   f"woodcam/models) or retrain them with 'woodcam train rings --spec SPEC --out {models_dir}'")
+            if member == "main" and isinstance(e, WoodcamError):    # the spec's own words, and the fix
+                raise WoodcamError(f"{e}; {fix}") from e
             why = (str(e).strip().splitlines() or [type(e).__name__])[0]  # one line, never torch's per-tensor list
             raise WoodcamError(f"ring net {member!r} in {str(models_dir)!r} ({weights_name} with {spec_name}) cannot "
                                f"be loaded: {why}; {fix}") from e
