@@ -103,6 +103,42 @@ def test_a_cached_fit_repeats_its_warning(tmp_path, monkeypatch):
         assert [str(w.message) for w in caught if issubclass(w.category, WoodcamWarning)] == [said], run
 
 
+def test_a_neural_fit_is_refitted_when_the_packaged_model_changes(tmp_path, monkeypatch):
+    """The fit cache's key held the method, FIT_VERSION and the package version but not the GTF
+    model the neural fit decodes with: weights retrained into woodcam/models kept serving the
+    fit made with the old ones."""
+    import shutil
+
+    import woodcam.fields.neural as neural
+    import woodcam.inference as inference
+    from woodcam.fields.builtin import builtin_block
+    from woodcam.fields.grid import GridField
+    from woodcam.stock import fitted_field
+    from woodcam.synth import synth_block
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    models = tmp_path / "models"
+    shutil.copytree(neural.MODELS_DIR, models)
+    monkeypatch.setattr(neural, "MODELS_DIR", models)
+    block = synth_block(builtin_block("flat-sawn").field, (20, 20, 20), face_px=32, seed=0)
+    fits = []
+
+    def fake_fit(block, method, faces=None):
+        fits.append(method)
+        return GridField(np.full((3, 3, 3), float(len(fits))), (0, 0, 0), 10.0)
+
+    monkeypatch.setattr(inference, "fit_block", fake_fit)
+    fitted_field(block, method="neural")
+    fitted_field(block, method="neural")
+    assert fits == ["neural"]                                      # cached while the model is the same
+    (models / neural.WEIGHTS_NAME).write_bytes((models / neural.WEIGHTS_NAME).read_bytes() + b"retrained")
+    assert fitted_field(block, method="neural").years.max() == 2 and len(fits) == 2
+    fitted_field(block, method="radial")
+    (models / neural.SPEC_NAME).write_text((models / neural.SPEC_NAME).read_text() + " ")
+    fitted_field(block, method="radial")                           # the other methods do not read it
+    assert fits == ["neural", "neural", "radial"]
+
+
 def test_a_cached_fit_from_before_size_mm_names_the_fitted_blocks_faces(tmp_path, monkeypatch):
     """Sweep H1: bake_evidence records the fitted block's box (meta["size_mm"]) that
     uncertainty_report names the faces of a stock cut from it in; a fit cached before it did

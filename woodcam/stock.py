@@ -552,7 +552,8 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence", fa
     The cache entry lives in the user cache folder (:func:`woodcam._cache.cache_dir`
     ``("fields")``), never in the block's own folder (which may be read-only shared data), and is
     keyed by a digest of everything the fit reads: size, photos, ring maps, traces and knot masks
-    (:func:`~woodcam.appearance.volumes.block_fingerprint`), the method, and
+    (:func:`~woodcam.appearance.volumes.block_fingerprint`), the method (for ``"neural"``, with
+    the packaged GTF model's spec and weights files), and
     :data:`woodcam.inference.fit.FIT_VERSION` with the package version. An edited block is a
     new entry; an unreadable entry is discarded with a warning and refitted; concurrent first
     runs fit once (a lock) and share the result.
@@ -574,8 +575,16 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence", fa
             f"block {folder or block.name} has neither a true field nor traced rings or ring maps "
             "to fit one to; trace rings on at least one face (or use 'woodcam block synth')"
         )
+    # the neural fit decodes with the packaged GTF model: weights retrained or restored into
+    # woodcam/models are another fit (the entry made with the old weights was reused); the other
+    # methods' keys are as they were
+    model: tuple = ()
+    if method == "neural":
+        from .fields.neural import MODELS_DIR, SPEC_NAME, WEIGHTS_NAME
+
+        model = ("gtf", *(p if p.is_file() else "missing" for p in (MODELS_DIR / SPEC_NAME, MODELS_DIR / WEIGHTS_NAME)))
     # every face: the key it always had (the entries fitted before stay valid)
-    key = digest(block_fingerprint(block), method, FIT_VERSION, __version__,
+    key = digest(block_fingerprint(block), method, FIT_VERSION, __version__, *model,
                  *(() if faces is None else ("faces", list(faces))))
     path = entry_path(cache_dir("fields"), block.name, f"{method}-{key}")
     field, hit = load_or_build(path, load=GridField.load,
