@@ -15,7 +15,9 @@ def register(subparsers) -> None:
                               "rings: the small ring detector)")
     p.add_argument("what", choices=["gtf", "rings"], help="which model to train")
     add_input(p, "--spec", kind="file", type=Path, default=None,
-                   help="JSON spec of hyper-parameters (default: the built-in defaults)")
+                   help="JSON spec of hyper-parameters, every key optional (default: the built-in defaults: "
+                   "gtf's are the committed model's, 40,000 steps; rings' are a small run, 8 plain cubes and "
+                   "1,500 steps, not the committed net's: for that pass woodcam/models/rings_spec.json)")
     add_out_option(p, "the spec, weights and training log (gtf: gtf_spec.json, gtf.pt, "
                    "gtf_train_log.csv and the checkpoint; rings: rings_spec.json, rings.pt, "
                    "rings_train_log.csv)")
@@ -23,8 +25,12 @@ def register(subparsers) -> None:
                    help="rings only: which net of the OUT folder to write; main (default): rings.*; quilted: "
                    "rings_quilted.*, a second net (its --spec of a quilted style) whose probability the "
                    "learned detector averages with the main net's")
-    p.add_argument("--steps", type=int, default=None, help="stop after N steps in total (default: spec.steps)")
-    p.add_argument("--no-resume", action="store_true", help="start over instead of resuming the checkpoint")
+    p.add_argument("--steps", type=int, default=None,
+                   help="stop after N training steps in total, counting a resumed gtf checkpoint's (default: "
+                   "the spec's steps; gtf's learning-rate schedule still follows the spec's steps)")
+    p.add_argument("--no-resume", action="store_true",
+                   help="gtf only: start over instead of resuming OUT's checkpoint (gtf_checkpoint.pt); "
+                   "train rings always starts over")
     add_engine_options(p)  # with --engine: the training set is made in shards of 256 fields
     p.set_defaults(func=run)
 
