@@ -238,3 +238,18 @@ def test_load_model_refuses_broken_weights_in_one_line_naming_the_file(tmp_path,
     msg = str(e.value)
     assert "\n" not in msg and str(w) in msg and "woodcam train gtf" in msg, msg
     assert {"truncated": "cut short", "empty": "empty", "another net": "another net"}[damage] in msg, msg
+
+
+@pytest.mark.parametrize("damage", ["truncated", "empty"])
+def test_a_cut_or_empty_checkpoint_is_named_as_such(tmp_path, damage):
+    """A cut checkpoint was 'is not a woodcam training checkpoint of tensors and plain data
+    (OSError); it was refused, nothing in it was run', an empty one the same with EOFError:
+    words for a crafted file, not for a damaged one."""
+    spec = GTFSpec(**TINY)
+    train_gtf(spec, tmp_path, steps=20, progress=False)
+    ckpt = tmp_path / "gtf_checkpoint.pt"
+    ckpt.write_bytes(b"" if damage == "empty" else ckpt.read_bytes()[: ckpt.stat().st_size // 2])
+    with pytest.raises(WoodcamError) as e:
+        train_gtf(spec, tmp_path, progress=False)
+    want = "is empty" if damage == "empty" else "is cut short or another kind of file"
+    assert f"checkpoint {ckpt} {want}" in str(e.value) and "--no-resume" in str(e.value), e.value

@@ -336,7 +336,17 @@ def _load_checkpoint(torch, ckpt: Path, spec: GTFSpec) -> dict:
     """A training checkpoint, loaded with ``weights_only=True``: tensors and plain data only, so a
     crafted file cannot run code (a pickle that needs anything else is refused)."""
     import pickle
+    import zipfile
 
+    fix = "delete it or pass resume=False (CLI: --no-resume) to start afresh"
+    try:
+        with open(ckpt, "rb") as fh:
+            whole = zipfile.is_zipfile(fh)   # torch.save writes a zip archive
+    except OSError as err:
+        raise WoodcamError(f"checkpoint {ckpt} cannot be read ({err.strerror}); {fix}") from err
+    if not whole:  # a run killed mid-write never leaves this (atomic writes): a copy or a disk did
+        what = "empty" if ckpt.stat().st_size == 0 else "cut short or another kind of file (not a zip archive)"
+        raise WoodcamError(f"checkpoint {ckpt} is {what}; {fix}")
     try:
         state = torch.load(ckpt, map_location="cpu", weights_only=True)
     except (pickle.UnpicklingError, RuntimeError, EOFError, OSError, ValueError,
