@@ -115,7 +115,12 @@ class RingNetSpec:
     target_sigma_px : width of the target line ``exp(-(d / sigma)^2)``.
     width : channels of the first level (doubled per level, three levels).
     crop_px, batch, steps, lr : training crops, batch size, Adam steps and learning rate (cosine decay).
-    max_train_s : stop after this many seconds of training (the machine is shared).
+    max_train_s : stop after this many seconds of training (the machine is shared). A wall-clock
+        stop: a run it ends takes as many steps as the machine gives it, so two runs of one spec
+        give the same weights only when both end at ``steps`` (the committed net stopped at 2,593
+        of 5,000). To repeat a stopped run, set ``steps`` to its log's last ``step`` + 1 and
+        ``max_train_s`` above its time (the cosine schedule then follows the new ``steps``, so
+        it is a rerun of the same length, not of the same schedule).
     style : the training faces' colour (:data:`TRAINING_STYLES`): ``"plain"``, woodcam's built-in
         wood colour (a broad latewood band ending in a step at the boundary); ``"realistic"``,
         :class:`woodcam.synth.photos._RealisticWood` (narrow softwood latewood darkest at the
