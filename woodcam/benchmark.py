@@ -735,8 +735,37 @@ def make_training_set_many(spec, out_dir, *, shard_fields: int = TRAINING_SHARD_
     if s.failed:
         bad = {k: r.get("error") for k, r in read_records(out / ".records").items() if r["status"] != "ok"}
         raise WoodcamError(f"{s.failed} training-set shard(s) failed: {bad}; run again to retry them")
-    parts = [np.load(out / f"{k}.npz") for k in keys]
-    return (np.concatenate([p["points"] for p in parts]), np.concatenate([p["values"] for p in parts]))
+    parts = [_read_training_shard(out, k, spec, shard_fields) for k in keys]
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+
+def _read_training_shard(out: Path, key: str, spec, shard_fields: int) -> tuple[np.ndarray, np.ndarray]:
+    """Shard ``key`` of ``out`` (points, values), made again where its file is missing, cut or
+    of other shapes (a disk, a copy, a hand): its record said "ok", and numpy's BadZipFile or
+    FileNotFoundError ended the run as an internal error. A shard is a function of the spec
+    alone, so the one made again is the same."""
+    import warnings
+
+    from ._cache import CacheWarning
+    from ._readers import read_npz
+
+    start = int(key.split("_")[1]) * shard_fields
+    want = (min(start + shard_fields, spec.n_fields) - start, spec.points_per_field)
+
+    def read() -> tuple[np.ndarray, np.ndarray]:
+        with read_npz(out / f"{key}.npz", "a training-set shard") as z:
+            pts, vals = np.asarray(z["points"], np.float32), np.asarray(z["values"], np.float32)
+        if pts.shape != want + (3,) or vals.shape != want:
+            raise WoodcamError(f"{out / key}.npz: holds points {pts.shape} and values {vals.shape}, not "
+                               f"{want + (3,)} and {want}")
+        return pts, vals
+
+    try:
+        return read()
+    except WoodcamError as err:
+        warnings.warn(CacheWarning(f"{err}; made the shard again (shards depend on the spec alone)"), stacklevel=3)
+    _training_shard_task(key, spec.to_dict(), shard_fields, str(out.resolve()))
+    return read()
 
 
 __all__ = ["DEFAULT_METHODS", "DEFAULT_SETTINGS", "METRICS", "PARTIAL_FACES", "bench_block",

@@ -482,6 +482,31 @@ def test_training_set_of_another_spec_is_refused_not_reused(tmp_path):
     np.testing.assert_array_equal(vals, make_training_set(spec)[1])
 
 
+@pytest.mark.parametrize("damage", ["truncated", "missing", "another shape"])
+def test_a_broken_training_shard_is_made_again(tmp_path, damage):
+    """A shard file cut, deleted or replaced after its record said "ok" ended 'woodcam train gtf
+    --engine' as an internal error (numpy's BadZipFile, FileNotFoundError) on every rerun."""
+    from woodcam._cache import CacheWarning
+    from woodcam.benchmark import make_training_set_many
+    from woodcam.fields.neural import GTFSpec, make_training_set
+
+    spec = GTFSpec(n_fields=8, points_per_field=20, batch_fields=4)
+    kw = dict(shard_fields=4, engine="local", workers=1, progress=False)
+    make_training_set_many(spec, tmp_path / "ts", **kw)
+    shard = tmp_path / "ts" / "shard_0001.npz"
+    if damage == "truncated":
+        shard.write_bytes(shard.read_bytes()[: shard.stat().st_size // 2])
+    elif damage == "missing":
+        shard.unlink()
+    else:
+        np.savez(shard, points=np.zeros((2, 20, 3), np.float32), values=np.zeros((2, 20), np.float32))
+    with pytest.warns(CacheWarning, match=r"shard_0001.npz.*made the shard again"):
+        pts, vals = make_training_set_many(spec, tmp_path / "ts", **kw)
+    ref = make_training_set(spec)
+    np.testing.assert_array_equal(pts, ref[0])
+    np.testing.assert_array_equal(vals, ref[1])
+
+
 def test_cli_bench_run_and_report(tmp_path, capsys):
     from woodcam.cli import main
 
