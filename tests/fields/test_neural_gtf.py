@@ -253,3 +253,15 @@ def test_a_cut_or_empty_checkpoint_is_named_as_such(tmp_path, damage):
         train_gtf(spec, tmp_path, progress=False)
     want = "is empty" if damage == "empty" else "is cut short or another kind of file"
     assert f"checkpoint {ckpt} {want}" in str(e.value) and "--no-resume" in str(e.value), e.value
+
+
+def test_fewer_steps_than_the_checkpoint_says_so(tmp_path):
+    """steps=20 over a 40-step checkpoint wrote the 40-step weights without a word (the CLI
+    printed "trained 40 steps" for '--steps 20')."""
+    from woodcam.errors import WoodcamWarning
+
+    spec = GTFSpec(**TINY)
+    train_gtf(spec, tmp_path, progress=False)
+    with pytest.warns(WoodcamWarning, match=r"at step 40, past steps=20: nothing is trained.*--no-resume"):
+        r = train_gtf(spec, tmp_path, steps=20, progress=False)
+    assert int(r["step"][-1]) == 40

@@ -44,7 +44,7 @@ import numpy as np
 
 from .._atomic import atomic_path, atomic_write, write_text
 from .._readers import read_torch_state
-from ..errors import WoodcamError, require
+from ..errors import WoodcamError, WoodcamWarning, require
 from .radial import laplacian_smoother
 
 #: Where the committed model lives (package data).
@@ -420,6 +420,15 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
     ckpt = out / _CHECKPOINT_NAME
     # read (and refuse) a checkpoint before minutes of work building the training set
     state = _load_checkpoint(torch, ckpt, spec) if resume and ckpt.is_file() else None
+    if state is not None and state["step"] > total:
+        # 'train gtf --steps 20' over a 50-step checkpoint wrote the 50-step weights, said only
+        # "trained 50 steps"
+        import warnings
+
+        warnings.warn(WoodcamWarning(
+            f"the checkpoint {ckpt} is at step {state['step']}, past steps={total}: nothing is trained and its "
+            f"weights are written as they are; pass resume=False (CLI: --no-resume) to train {total} steps "
+            "afresh"), stacklevel=2)
 
     if callable(training_set):
         training_set = training_set()
