@@ -422,3 +422,19 @@ def test_a_broken_main_net_is_refused_in_one_line_with_the_fix(tmp_path, damage)
     assert "woodcam train rings --spec SPEC --out" in msg and "check out woodcam/models" in msg, msg
     assert {"truncated": "cut short", "empty": "the file is empty", "another width": "another net than the spec",
             "spec empty": "valid JSON", "no spec": "No such file"}[damage] in msg, msg
+
+
+def test_train_rings_refuses_training_faces_past_the_memory_limit(tmp_path, capsys, monkeypatch):
+    """4096 cubes of 2048 px (824 GB of faces) were synthesised until the machine ran out."""
+    import woodcam.synth.rings as synth_rings
+    from woodcam.cli import EXIT_ERROR, main
+
+    def no_faces(*a, **k):
+        raise AssertionError("faces made past the memory limit")
+
+    monkeypatch.setattr(synth_rings, "ring_training_faces", no_faces)
+    RingNetSpec(n_blocks=4096, face_px=2048).save(tmp_path / "s.json")
+    assert main(["train", "rings", "--spec", str(tmp_path / "s.json"), "--out", str(tmp_path / "t")]) == EXIT_ERROR
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "the ring net's training faces (4096 cubes x 6 faces of 2048 px)" in err
+    assert "MAX_ALLOC_BYTES" in err and "lower n_blocks or face_px" in err, err

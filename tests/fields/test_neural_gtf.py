@@ -265,3 +265,26 @@ def test_fewer_steps_than_the_checkpoint_says_so(tmp_path):
     with pytest.warns(WoodcamWarning, match=r"at step 40, past steps=20: nothing is trained.*--no-resume"):
         r = train_gtf(spec, tmp_path, steps=20, progress=False)
     assert int(r["step"][-1]) == 40
+
+
+def test_a_training_set_past_the_memory_limit_is_refused_before_any_work(tmp_path, monkeypatch):
+    """n_fields or points_per_field a digit too large (15360 x 16000: 256 GiB) ran the machine out
+    of memory while making the set, with nothing said; the engine's shards the same."""
+    from woodcam.benchmark import make_training_set_many
+
+    monkeypatch.setenv("WOODCAM_MAX_ALLOC_BYTES", "1000000")
+    big = GTFSpec(**{**TINY, "n_fields": 200, "points_per_field": 100})   # 20,000 points: 2.2 MB
+    made = []
+
+    def training_set():
+        made.append(1)
+        return make_training_set_many(big, tmp_path / "shards", engine="local", workers=1, progress=False)
+
+    for call in (lambda: train_gtf(big, tmp_path / "out", progress=False),
+                 lambda: train_gtf(big, tmp_path / "out", progress=False, training_set=training_set),
+                 lambda: make_training_set(big)):
+        with pytest.raises(WoodcamError, match=r"the GTF training set \(200 fields x 100 points\) needs .* "
+                                               r"MAX_ALLOC_BYTES.*lower n_fields or points_per_field"):
+            call()
+    assert not made and not (tmp_path / "out" / SPEC_NAME).exists()
+    make_training_set(GTFSpec(**TINY))                                     # 512 points pass

@@ -87,7 +87,16 @@ def member_files(member: str = "main") -> tuple[str, str, str]:
 def check_trainable(spec: RingNetSpec, face_shape: tuple[int, int] | None = None) -> None:
     """Refuse a ``spec`` whose training crops (``crop_px``) do not fit in its training faces
     (``face_shape`` ``(h, w)`` px, default ``face_px`` square): numpy's "high <= 0" once the
-    faces were made. A spec of small faces is fine for making faces alone."""
+    faces were made (a spec of small faces is fine for making faces alone); or whose faces
+    need more than ``MAX_ALLOC_BYTES`` or are larger than ``MAX_FACE_PX`` (:mod:`woodcam.limits`)."""
+    from ..limits import check_limit
+
+    # the faces are kept whole as inputs and targets, float32: 8 bytes a pixel at the least (each
+    # cube's synthesis needs more); 4096 cubes of 2048 px asked for 824 GB with nothing said
+    check_limit("MAX_FACE_PX", spec.face_px, "ring net spec face_px", "lower face_px in the spec")
+    check_limit("MAX_ALLOC_BYTES", 6.0 * spec.n_blocks * spec.face_px ** 2 * 8,
+                f"the ring net's training faces ({spec.n_blocks} cubes x 6 faces of {spec.face_px} px)",
+                "lower n_blocks or face_px in the spec")
     h, w = face_shape or (spec.face_px, spec.face_px)
     if spec.crop_px > min(h, w):
         raise WoodcamError(f"ring net spec crop_px must be at most the training faces' size ({h} x {w} px, "
