@@ -9,6 +9,9 @@ every ``woodcam gcode``/``bake`` run of a built-in block pays once.
 from __future__ import annotations
 
 import contextlib
+import functools
+from collections.abc import Callable
+from typing import Any, TypeVar, cast
 
 
 def one_blas_thread():
@@ -31,3 +34,25 @@ def torch_threads(torch, n: int):
         yield
     finally:
         torch.set_num_threads(old)
+
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def restores_torch_threads(fn: _F) -> _F:
+    """Decorate a trainer that sets torch's intra-op threads for its run (one thread on a shared
+    machine): the caller's setting is put back when it returns or raises. The trainers set it
+    and left it, so a notebook's torch work after ``train_gtf`` ran on one thread for good."""
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        try:
+            import torch
+        except ImportError:       # the trainer says what to install
+            return fn(*args, **kwargs)
+        old = torch.get_num_threads()
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            torch.set_num_threads(old)
+
+    return cast(_F, wrapper)

@@ -29,6 +29,7 @@ from typing import Literal, get_args
 import numpy as np
 
 from .._readers import check_state_shapes
+from .._threads import restores_torch_threads
 from ..errors import WoodcamError, require
 
 Quality = Literal["draft", "normal", "high"]
@@ -256,6 +257,7 @@ def _mirror(torch, rng: np.random.Generator, *batch):
     return out
 
 
+@restores_torch_threads
 def train_translation(pairs, spec: TranslationSpec | None = None, *, progress: bool = True,
                       desc: str = "translation", threads: int | None = 1,
                       init: TranslationNet | None = None) -> TranslationNet:

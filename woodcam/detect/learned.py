@@ -38,6 +38,7 @@ import numpy as np
 
 from .._atomic import atomic_path, atomic_write, write_text
 from .._readers import torch_state
+from .._threads import restores_torch_threads
 from ..errors import WoodcamError, require
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
@@ -297,6 +298,7 @@ def net_input(photo: np.ndarray) -> np.ndarray:
     return _normalise(lum, sigma=0.5 * max(lum.shape)).astype(np.float32)
 
 
+@restores_torch_threads
 def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, progress: bool = True,
                    member: str = "main") -> dict:
     """Train the ring net of ``spec`` from scratch on inputs ``x (n, h, w)`` (:func:`net_input`)

@@ -44,6 +44,7 @@ import numpy as np
 
 from .._atomic import atomic_path, atomic_write, write_text
 from .._readers import read_torch_state
+from .._threads import restores_torch_threads
 from ..errors import WoodcamError, WoodcamWarning, require
 from .radial import laplacian_smoother
 
@@ -394,6 +395,7 @@ def _lr_scale(step: int, total: int, floor: float) -> float:
     return floor + (1 - floor) * 0.5 * (1 + np.cos(np.pi * t))
 
 
+@restores_torch_threads
 def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool = True,
               progress: bool = True, threads: int = 1,
               training_set: tuple[np.ndarray, np.ndarray] | Callable[[], tuple[np.ndarray, np.ndarray]]
