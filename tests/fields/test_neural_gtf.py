@@ -288,3 +288,15 @@ def test_a_training_set_past_the_memory_limit_is_refused_before_any_work(tmp_pat
             call()
     assert not made and not (tmp_path / "out" / SPEC_NAME).exists()
     make_training_set(GTFSpec(**TINY))                                     # 512 points pass
+
+
+def test_loading_the_model_leaves_the_callers_random_numbers_alone(tmp_path):
+    """build_model seeded torch's global generator with the spec's seed, so every load_model
+    (each neural fit) reset the caller's torch random stream to seed 0's."""
+    torch.manual_seed(123)
+    want = torch.rand(3)
+    torch.manual_seed(123)
+    load_model()
+    np.testing.assert_array_equal(torch.rand(3).numpy(), want.numpy())
+    a, b = build_model(GTFSpec(**TINY)), build_model(GTFSpec(**TINY))       # still seeded by the spec
+    assert all(torch.equal(p, q) for p, q in zip(a.parameters(), b.parameters()))

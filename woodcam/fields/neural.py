@@ -305,8 +305,12 @@ def build_model(spec: GTFSpec):
             h = self.mlp(torch.cat([codes, g], dim=-1))[..., 0]
             return g[..., 0] * (1.0 + h)
 
-    torch.manual_seed(spec.seed)
-    return GTFNet()
+    # the spec's seed draws the initial weights, on a fork of torch's generator: seeded
+    # globally, every load_model (each neural fit) reset the caller's torch random numbers to
+    # the same stream, seed 0's
+    with torch.random.fork_rng(devices=[]):
+        torch.manual_seed(spec.seed)
+        return GTFNet()
 
 
 def load_model(model_dir=None):
