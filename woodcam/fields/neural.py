@@ -491,9 +491,10 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
                                "codes": codes.detach(), "opt": opt.state_dict(), "step": step,
                                "elapsed": elapsed, "log": [list(r) for r in log]}), tmp)
 
+    from .._progress import progress_bar
+
     bar = None
     if progress:
-        from .._progress import progress_bar
         bar = progress_bar(total=total, initial=min(step, total), desc="train gtf", unit="step")
     t0 = time.perf_counter()
     base = elapsed
@@ -527,11 +528,13 @@ def train_gtf(spec: GTFSpec, out_dir, *, steps: int | None = None, resume: bool 
         bar.close()
     save_checkpoint()
 
-    # Final error over the whole training set, each field with its own code.
+    # Final error over the whole training set, each field with its own code: 19.5 s on one
+    # thread for the committed spec (2.46 M points), after the training bar had closed at 100 %
     net.eval()
     with torch.no_grad():
         errs, rels = [], []
-        for i in range(0, n_f, 64):
+        for i in progress_bar(range(0, n_f, 64), desc="train gtf: final error", unit="batch",
+                              enabled=progress):
             pr = net(codes[i:i + 64, None, :], pts[i:i + 64])
             e = (pr - vals[i:i + 64]).abs()
             errs.append(e.mean(dim=1))
