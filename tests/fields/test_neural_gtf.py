@@ -104,6 +104,8 @@ def test_spec_round_trip_and_errors(tmp_path):
     ("n_fields", 4.5, "spec.n_fields must be an integer >= 1; got 4.5"),
     ("latent_dim", True, "spec.latent_dim must be an integer >= 1; got True"),
     ("lr_net", True, "spec.lr_net must be a positive number; got True"),
+    ("lr_floor", 5, "spec.lr_floor must be in (0, 1]"),
+    ("radius_samples", 1, "spec.n_constraints must be at most spec.radius_samples (1"),
 ])
 def test_spec_file_with_a_bad_value_is_refused_naming_the_file(tmp_path, key, value, rule):
     """A seed of -1 or 4.5 fields in a spec file passed the door and failed in numpy's words

@@ -131,6 +131,13 @@ class GTFSpec:
                 raise WoodcamError(f"spec.{f.name} must be a positive number; got {v!r}; {fix}")
         if not 0 <= self.pith_fraction <= 1:
             raise WoodcamError(f"spec.pith_fraction must be in [0, 1]; got {self.pith_fraction!r}; {fix}")
+        if self.lr_floor > 1:   # the cosine then rose from the rate to lr_floor times it
+            raise WoodcamError(f"spec.lr_floor must be in (0, 1] (the learning rates decay to lr_floor times "
+                               f"their value); got {self.lr_floor!r}; {fix}")
+        if self.n_constraints > self.radius_samples:   # was the smoother's "m=1 samples cannot hold ..."
+            raise WoodcamError(f"spec.n_constraints must be at most spec.radius_samples ({self.radius_samples}: the "
+                               f"constraints are distinct samples of each radius function); got "
+                               f"{self.n_constraints}; {fix}")
 
     def to_dict(self) -> dict:
         return asdict(self)
