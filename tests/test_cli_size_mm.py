@@ -99,3 +99,105 @@ def test_a_mokume_folder_reads_a_cube_typed_either_way(mokume):
     for text in ("40", "40x40x40"):
         args = build_parser().parse_args(_argv("rings show", mokume, "out", text))
         assert read_block_folder(args.block, args.size_mm).size_mm == (40.0,) * 3
+
+
+#: The commands that carve from a block (or show one carved) and size a Mokume folder as fit does.
+CARVING = {
+    "bake": ["bake", "part.stl", "--block", "SRC", "--out", "OUT/p.glb"],
+    "gcode": ["gcode", "p.nc", "--tool", "flat:6", "--block", "SRC", "--out", "OUT/p.glb"],
+    "place": ["place", "part.stl", "--block", "SRC", "--out", "OUT/pl"],
+    "preview": ["preview", "OUT/p.glb", "--block", "SRC"],
+}
+
+
+@pytest.mark.parametrize("name", list(CARVING))
+def test_the_carving_commands_take_the_one_size_mm(name):
+    """bake, gcode, place and preview read a Mokume folder as "a 50 mm cube" and could not size
+    it, while fit, eval, rings and block took --size-mm."""
+    from woodcam.cli.options import SIZE_MM_HELP
+
+    a = _size_action(build_parser(), [name])
+    assert a.help.startswith(SIZE_MM_HELP) and a.metavar == "SIZE" and not a.required, a.help
+    argv = [w.replace("SRC", "src").replace("OUT", "out") for w in CARVING[name]]
+    assert build_parser().parse_args([*argv, "--size-mm", "40"]).size_mm == (40.0,) * 3
+
+
+@pytest.fixture
+def cn03(shared_data, monkeypatch, tmp_path):
+    """The Mokume sample CN03, its field a built-in block's (the real fit takes ~10-30 s a size,
+    and what is tested here is which size the sample is read at, not the fit)."""
+    folder = shared_data / "mokume" / "CN03"
+    if not folder.is_dir():
+        pytest.skip(f"Mokume sample CN03 not found at {folder}")
+    from woodcam.fields.builtin import builtin_block
+
+    field = builtin_block("flat-sawn").field
+    sizes = []
+
+    def fitted(block, folder=None, *args, **kwargs):
+        sizes.append(tuple(block.size_mm))
+        return field
+
+    monkeypatch.setattr("woodcam.stock.fitted_field", fitted)
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    return folder, sizes
+
+
+def test_a_mokume_folder_is_baked_and_previewed_at_its_size_mm(cn03, tmp_path, capsys):
+    """'bake part.stl --block mokume/CN03' baked a 50 mm cube whatever the sample's size; with
+    --size-mm 40 it is a 40 mm cube, the GLB records the sample's size, and preview/review of
+    the GLB (its recorded block, or the same folder as --block) reopen the sample at 40 mm,
+    not 50 (other wood). A turn keeps the sample's size."""
+    import trimesh
+
+    from woodcam.cli.options import stock_of_glb
+    from woodcam.export import read_glb_metadata
+
+    folder, sizes = cn03
+    box = trimesh.creation.box((10, 10, 10))
+    box.apply_translation((20, 20, 20))
+    box.export(tmp_path / "part.stl")
+    glb = tmp_path / "p.glb"
+    assert main(["bake", str(tmp_path / "part.stl"), "--block", f"{folder}~z90", "--size-mm", "40",
+                 "--texels-per-mm", "0.5", "--no-obj", "--out", str(glb)]) == 0
+    capsys.readouterr()
+    meta = read_glb_metadata(glb)
+    assert meta["size_mm"] == [40.0] * 3 and meta["sample_size_mm"] == [40.0] * 3, meta
+    assert sizes == [(40.0,) * 3]
+    assert stock_of_glb(glb).size_mm == (40.0,) * 3  # the recorded block
+    assert stock_of_glb(glb, f"{folder}~z90").size_mm == (40.0,) * 3  # the same block, as --block
+    assert sizes[1:] == [(40.0,) * 3] * 2
+    # another size asked for is another block: said, as another folder is
+    with pytest.warns(Warning, match=r"is not the block p\.glb was baked from"):
+        assert stock_of_glb(glb, f"{folder}~z90", size_mm=(30.0,) * 3).size_mm == (30.0,) * 3
+
+
+def test_a_size_mm_a_command_cannot_use_is_said(cn03, tmp_path, monkeypatch, capsys):
+    """--size-mm with a built-in block is ignored with a warning (one home: fit's words); a
+    Mokume folder refuses a size that is no cube; place and gcode pass it to the stock."""
+    from woodcam import stock as stock_module
+    from woodcam.errors import WoodcamError
+
+    folder, _ = cn03
+    with pytest.raises(WoodcamError, match="sizes a Mokume sample folder only; block spec 'builtin:flat-sawn'"):
+        stock_module.open_stock("builtin:flat-sawn", size_mm=40)
+    with pytest.raises(WoodcamError, match="50x40x30 mm is no cube"):
+        stock_module.open_stock(str(folder), size_mm=(50, 40, 30))
+    seen = []
+
+    def fake_open_stock(spec, **kwargs):
+        seen.append((spec, kwargs.get("size_mm")))
+        raise WoodcamError("stop here")
+
+    monkeypatch.setattr(stock_module, "open_stock", fake_open_stock)
+    import trimesh
+
+    trimesh.creation.box((10, 10, 10)).export(tmp_path / "part.stl")
+    assert main(["place", str(tmp_path / "part.stl"), "--block", str(folder), "--size-mm", "40",
+                 "--out", str(tmp_path / "pl")]) == EXIT_ERROR
+    assert main(["bake", str(tmp_path / "part.stl"), "--block", "builtin:flat-sawn", "--size-mm", "40",
+                 "--out", str(tmp_path / "p.glb")]) == EXIT_ERROR
+    err = capsys.readouterr().err
+    assert seen == [(str(folder), (40.0,) * 3), ("builtin:flat-sawn", None)], seen
+    assert ("--size-mm 40 sizes Mokume sample folders only; 'builtin:flat-sawn' is no folder and keeps its own "
+            "size: ignored") in err, err

@@ -406,6 +406,8 @@ def _write_preview(baked, stock, out_glb, result, *, obj, screenshot, metadata, 
 
     meta = {"block": absolute_spec(stock.spec), "block_digest": spec_digest(stock.spec),
             "size_mm": list(stock.size_mm),
+            # a Mokume sample's size (its files carry none): stock_of_glb reopens it so
+            **({"sample_size_mm": stock.meta["sample_size_mm"]} if "sample_size_mm" in stock.meta else {}),
             "appearance": {"kind": stock.meta.get("appearance", "colormap"),
                            "species": stock.meta.get("species"),
                            # False: the species is only the default preset's colours (a block

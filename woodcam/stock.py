@@ -239,6 +239,7 @@ def check_resize_in_block(spec: str, block_size_mm, size_mm, origin_mm,
 
 def open_stock(spec: str, *, species: str | None = None,
                appearance: AppearanceKind = "colormap", species_given: bool = True,
+               size_mm: float | tuple[float, float, float] | None = None,
                **appearance_params) -> Stock:
     """Resolve a block spec (see module docstring) to a :class:`Stock`.
 
@@ -256,6 +257,11 @@ def open_stock(spec: str, *, species: str | None = None,
         False: ``species`` is one recorded earlier (a baked GLB's), not asked for now, so a
         block whose photos set every colour is opened without the warning that the species
         changes nothing.
+    size_mm : float or (W, D, H), optional
+        Size in mm of a Mokume sample folder, as :func:`open_block` takes it (its files carry no
+        size; default a 50 mm cube; one number a cube's side, another shape refused), before the
+        spec's turns and resizes. A block folder records its own size (a warning says so when
+        this differs); any other spec takes its size in the spec and refuses this.
     **appearance_params
         Passed to :class:`~woodcam.appearance.ColorMapAppearance` (e.g. knot darkening), or for
         ``"neural"`` to ``fit_neural_appearance`` (``resolution``, ``quality``, ``epochs``,
@@ -273,11 +279,16 @@ def open_stock(spec: str, *, species: str | None = None,
         raise WoodcamError(f"spec must be a block spec (str): 'builtin:NAME', 'log:LOG@KNOT', 'woodify:PATH' or "
                            f"a block folder; got {spec!r}; e.g. open_stock('builtin:flat-sawn')")
     parsed = parse_spec(spec)
+    if size_mm is not None and parsed.kind != "folder":
+        # the bake of a built-in block kept its own size without a word
+        raise WoodcamError(f"size_mm (--size-mm) sizes a Mokume sample folder only; block spec {str(spec)!r} is "
+                           f"a {parsed.kind} block, whose size is in the spec (e.g. builtin:flat-sawn:40x40x40); "
+                           "leave size_mm out")
     # built-in, log and woodify blocks have no photos: their colour map is the constructor's
     # (a folder's photos are known once it is read: _real_block_stock checks again)
     _check_appearance_params(appearance, appearance_params, photos=parsed.kind == "folder",
                              where=f"block spec {parsed.base!r}")
-    stock = _open_base_stock(parsed, species, appearance, appearance_params, species_given)
+    stock = _open_base_stock(parsed, species, appearance, appearance_params, species_given, size_mm)
     if species is not None and species_given and stock.meta.get("appearance") == "neural":
         # nothing silently dropped: the neural volumes take every colour from the photos
         warnings.warn(f"--species {species}: the neural appearance learns every colour from the block's "
@@ -392,8 +403,9 @@ def _builtin(parsed: ParsedSpec):
 
 
 def _open_base_stock(parsed: ParsedSpec, species, appearance, appearance_params,
-                     species_given=True) -> Stock:
-    """The stock ``parsed``'s base names, before its turns and resizes."""
+                     species_given=True, size_mm=None) -> Stock:
+    """The stock ``parsed``'s base names, before its turns and resizes; ``size_mm`` a folder's
+    (:func:`open_stock`)."""
     spec = parsed.base
     if parsed.kind == "builtin":
         b, field, size = _builtin(parsed)
@@ -424,8 +436,8 @@ def _open_base_stock(parsed: ParsedSpec, species, appearance, appearance_params,
         return Stock(spec, tuple(size_mm), aligned.wood.rotated(R, o - lo), description, aligned.meta)
     path = _existing_folder(spec)
     if (path / "block.json").is_file():
-        return _open_block_folder(path, species, appearance, appearance_params, species_given)
-    return _open_mokume_folder(path, species, appearance, appearance_params, species_given)
+        return _open_block_folder(path, species, appearance, appearance_params, species_given, size_mm)
+    return _open_mokume_folder(path, species, appearance, appearance_params, species_given, size_mm)
 
 
 def open_block(spec: str, *, size_mm: float | tuple[float, float, float] | None = None, face_px: int = 256):
@@ -473,8 +485,7 @@ def open_block(spec: str, *, size_mm: float | tuple[float, float, float] | None 
     from .detect.block import with_detected_rings
 
     folder = _existing_folder(spec)
-    sides = None if size_mm is None else [float(v) for v in np.broadcast_to(np.asarray(size_mm, float), (3,))]
-    block = read_block_folder(folder, None if sides is None else (sides[0], sides[1], sides[2]))
+    block = read_block_folder(folder, _sides(size_mm))
     # A block of photos only: rings detected once, cached by content outside the folder (the
     # user's files a 'block from-photos' remake left unnamed in it read in)
     block = with_detected_rings(block, progress=True, folder=folder)
@@ -604,22 +615,38 @@ def fitted_field(block, folder: Path | None = None, method: str = "evidence", fa
     return field
 
 
-def _open_mokume_folder(path: Path, species, appearance, appearance_params, species_given=True) -> Stock:
+def _sides(size_mm) -> tuple[float, float, float] | None:
+    """``size_mm`` (None, a cube's side or (W, D, H)) as :func:`woodcam.block.io.read_block_folder`
+    takes it; its values are checked there."""
+    if size_mm is None:
+        return None
+    sides = [float(v) for v in np.broadcast_to(np.asarray(size_mm, float), (3,))]
+    return (sides[0], sides[1], sides[2])
+
+
+def _open_mokume_folder(path: Path, species, appearance, appearance_params, species_given=True,
+                        size_mm=None) -> Stock:
     from .block.io import read_block_folder
 
-    block = read_block_folder(path)
-    return _real_block_stock(str(path), block, fitted_field(block, None), species, appearance,
-                             appearance_params, cache_dir=None, species_given=species_given)
+    block = read_block_folder(path, _sides(size_mm))
+    stock = _real_block_stock(str(path), block, fitted_field(block, None), species, appearance,
+                              appearance_params, cache_dir=None, species_given=species_given)
+    # the sample's own size (its files carry none), kept through turns and resizes: a baked GLB
+    # records it (woodcam.pipeline) so that preview and review reopen the same wood
+    stock.meta["sample_size_mm"] = [float(v) for v in block.size_mm]
+    return stock
 
 
-def _open_block_folder(path: Path, species, appearance, appearance_params, species_given=True) -> Stock:
+def _open_block_folder(path: Path, species, appearance, appearance_params, species_given=True,
+                       size_mm=None) -> Stock:
     from .block.io import read_block_folder  # imported when a folder is used
 
     from .detect.block import with_detected_rings
 
     # A block of photos only: rings detected once, cached by content outside the folder (the
-    # user's files a 'block from-photos' remake left unnamed in it read in)
-    block = with_detected_rings(read_block_folder(path), progress=True, folder=path)
+    # user's files a 'block from-photos' remake left unnamed in it read in); a size given is
+    # warned of by the reader (the folder records its own)
+    block = with_detected_rings(read_block_folder(path, _sides(size_mm)), progress=True, folder=path)
     field = block.true_field if block.true_field is not None else fitted_field(block, path)
     return _real_block_stock(str(path), block, field, species, appearance, appearance_params,
                              cache_dir=None, species_given=species_given)

@@ -12,7 +12,8 @@ from ..units import fmt_length, fmt_volume
 from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_input, part_suffixes,
                       add_camera_option, add_max_triangles_option, add_out_option, add_units_option,
                       add_workers_option, allow_negative_values, apply_workers, as_typed, camera_of,
-                      not_empty, remove_stale_outputs, stock_options, uses_settings, vector_type, write_screenshot)
+                      add_size_option, not_empty, remove_stale_outputs, stock_options, uses_settings, vector_type,
+                      write_screenshot)
 
 
 def _mesh_suffixes() -> tuple[str, ...]:
@@ -61,6 +62,7 @@ def register(subparsers) -> None:
                    "block, MARGIN in --units, default 2 mm). Turn the block instead with a spec ending in "
                    "~AXIS90 (e.g. builtin:flat-sawn~z90)")
     add_max_triangles_option(p)
+    add_size_option(p)
     add_units_option(p, "bake")
     add_bake_options(p)
     add_camera_option(p, "; of the --screenshot")
@@ -91,6 +93,7 @@ def register(subparsers) -> None:
                    help="the cut plane's normal, towards the side cut away (default: the block's "
                    "longest axis facing the camera)")
     allow_negative_values(p)
+    add_size_option(p, of_glb=True)
     add_units_option(p, "preview")
     p.add_argument("--confidence", action="store_true",
                    help="colour the part by the fit's per-point confidence (red 0, yellow 0.5, green "
@@ -233,7 +236,8 @@ def run_preview(args: argparse.Namespace) -> int:
             stock, size = None, recorded_block_size(args.mesh)
         else:
             with bar.stage("open block"):
-                stock = stock_of_glb(args.mesh, args.block, units=args.units, typed=as_typed(args, "block"))
+                stock = stock_of_glb(args.mesh, args.block, units=args.units, typed=as_typed(args, "block"),
+                                     size_mm=args.size_mm)
             size = stock.size_mm if stock else None
         wood = stock.wood if stock else None
         if args.confidence:

@@ -17,7 +17,7 @@ from ..units import MM_PER_UNIT, fmt_length, fmt_volume
 from .options import (add_input, part_suffixes, output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options,
                       add_camera_option, add_max_triangles_option, add_out_option, add_units_option,
                       allow_negative_values, as_typed, camera_of, drop_earlier_output, remove_stale_outputs, sizes_type,
-                      stock_options, vector_type)
+                      add_size_option, stock_options, vector_type)
 
 _EXAMPLES = """\
 examples:
@@ -124,6 +124,7 @@ def register(subparsers) -> None:
                    help="merge nearly planar regions of the result mesh within this length in --units (default "
                    "0.05 mm: the 20,000-move raster's mesh shrinks from 2.0 M to 0.44 M "
                    "triangles, its volume moves by 0.0006 mm on average)")
+    add_size_option(p)
     add_units_option(p, "gcode")
     add_bake_options(p)
     p.set_defaults(func=run)

@@ -64,7 +64,7 @@ def species_type(text: str) -> str:
 #: carve from it (bake, gcode, place, review) may also turn it: :data:`BLOCK_SPEC_HELP`.
 _BLOCK_HELP = ("block spec: builtin:NAME[:WxDxH] ({unit}), log:gran1@K[:WxDxH], woodify:DIR/field.npz "
                "(a block cut from a grown object), a block folder "
-               "(block.json) or a Mokume sample folder (a 50 mm cube)")
+               "(block.json) or a Mokume sample folder (a cube, --size-mm, default 50 mm)")
 BLOCK_READ_HELP = _BLOCK_HELP.format(unit="mm")
 # the carving commands read the WxDxH in --units (LENGTH_OPTIONS): "(mm)" contradicted it
 BLOCK_SPEC_HELP = (_BLOCK_HELP.format(unit="in --units, default mm")
@@ -883,13 +883,17 @@ def say_size_mm(size) -> str:
     return sides[0] if len(set(sides)) == 1 else "x".join(sides)
 
 
-def add_size_option(p: argparse.ArgumentParser, *, required: bool = False) -> None:
+def add_size_option(p: argparse.ArgumentParser, *, required: bool = False, of_glb: bool = False) -> None:
     """``--size-mm SIZE`` -> ``args.size_mm``, (W, D, H) mm or None: :func:`block_size_mm`.
     ``required``: the size of a block made of photos (``block from-photos``), which carry none;
-    else a Mokume sample folder's size, its default the dataset's 50 mm cube."""
+    else a Mokume sample folder's size, its default the dataset's 50 mm cube (``of_glb``: a
+    command reading a baked GLB, the size it records, :func:`stock_of_glb`). A spec that is no
+    folder keeps its own size (:func:`folder_size`)."""
     default = ("; required: photos carry no size" if required else
                " (default 50, a 50 mm cube: sizes a Mokume sample folder, whose files carry no size; a block "
-               "folder records its own)")
+               "folder records its own)" if not of_glb else
+               " (sizes a Mokume sample folder given with --block, whose files carry no size; default the "
+               "size the GLB was baked at, else 50)")
     p.add_argument("--size-mm", type=block_size_mm, required=required, default=None, metavar="SIZE",
                    help=SIZE_MM_HELP + default)
 
@@ -924,22 +928,34 @@ def report_layout(block) -> None:
               if report.faces else f"layout: not checked (no two neighbouring faces with a photo or ring map){skipped}")
 
 
-def open_block(spec, size_mm: tuple[float, float, float] | None = None, face_px: int = 256):
-    """``(block, field or None)`` for a block argument: :func:`woodcam.stock.open_block`.
-    ``size_mm`` (``--size-mm``) sizes a Mokume sample folder only; given with a spec that is no
-    folder (``builtin:flat-sawn``, ``log:...``) it was dropped without a word and the block kept
-    its own size: a warning says so (a block folder's own size is warned of by its reader)."""
-    from ..stock import open_block as _open_block
+def folder_size(spec, size_mm: tuple[float, float, float] | None):
+    """``size_mm`` (``--size-mm``) for the block ``spec``, the one home of its rule: it sizes a
+    Mokume sample folder only; given with a spec that is no folder (``builtin:flat-sawn``,
+    ``log:...``) it was dropped without a word and the block kept its own size: a warning says
+    so, and None is returned (a block folder's own size is warned of by its reader)."""
+    if size_mm is None:
+        return None
+    from .._specs import spec_path, split_spec
 
-    if size_mm is not None and not Path(str(spec)).exists():
+    path = spec_path(str(spec))
+    if path is None or not path.exists() or split_spec(str(spec))[0].startswith(("woodify:", "log:")):
         import warnings
 
         from ..errors import WoodcamWarning
 
         warnings.warn(f"--size-mm {say_size_mm(size_mm)} sizes Mokume sample folders only; {str(spec)!r} is no folder "
                       "and keeps its own size: ignored (a built-in or log block takes its size in the spec, "
-                      "e.g. builtin:flat-sawn:40x40x40)", WoodcamWarning, stacklevel=2)
-    return _open_block(str(spec), size_mm=size_mm, face_px=face_px)
+                      "e.g. builtin:flat-sawn:40x40x40)", WoodcamWarning, stacklevel=3)
+        return None
+    return size_mm
+
+
+def open_block(spec, size_mm: tuple[float, float, float] | None = None, face_px: int = 256):
+    """``(block, field or None)`` for a block argument: :func:`woodcam.stock.open_block`, sized
+    by ``size_mm`` (``--size-mm``) as :func:`folder_size` says."""
+    from ..stock import open_block as _open_block
+
+    return _open_block(str(spec), size_mm=folder_size(spec, size_mm), face_px=face_px)
 
 
 #: A value that looks like numbers ("-14,5,3", "-1e3") is a value, not an option; so is a
@@ -1225,9 +1241,11 @@ def camera_of(args: argparse.Namespace, shot: bool = True) -> str:
 
 
 def stock_options(args) -> dict:
-    """Every keyword of :func:`woodcam.stock.open_stock` the bake options carry."""
+    """Every keyword of :func:`woodcam.stock.open_stock` the bake options carry, and
+    ``--size-mm`` (:func:`add_size_option`, :func:`folder_size`) where the command has it."""
+    size = folder_size(args.block, args.size_mm) if getattr(args, "size_mm", None) is not None else None
     return {"species": getattr(args, "species", None), "appearance": args.appearance,
-            **appearance_params(args)}
+            **({"size_mm": size} if size is not None else {}), **appearance_params(args)}
 
 
 def write_screenshot(args, files: dict, stock) -> None:
@@ -1305,12 +1323,36 @@ def recorded_block_size(glb: Path):
         raise WoodcamError(f"{str(glb)!r}: its metadata's {err}; re-bake it or pass --block SPEC") from err
 
 
+def _recorded_sample_size(meta: dict, glb: Path) -> tuple[float, float, float] | None:
+    """The Mokume sample size ``(W, D, H)`` mm a baked GLB's metadata records
+    (``sample_size_mm``, :func:`woodcam.pipeline.bake_part`), or None; a malformed one, or one
+    past :data:`~woodcam.limits.MAX_BLOCK_SIZE_MM` (a GLB is untrusted input), is named in a
+    WoodcamError."""
+    from ..frames import check_size
+
+    size = meta.get("sample_size_mm")
+    if size is None:
+        return None
+    try:
+        sides = tuple(float(v) for v in check_size(size))
+    except WoodcamError as err:
+        raise WoodcamError(f"{str(glb)!r}: its metadata's sample {err}; re-bake it or pass --block SPEC") from err
+    cap = limit("MAX_BLOCK_SIZE_MM")
+    if max(sides) > cap:
+        raise WoodcamError(f"{str(glb)!r}: its metadata's sample_size_mm {list(sides)} is past the largest block "
+                           f"side, {cap:g} mm (raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N); re-bake it or pass "
+                           "--block SPEC")
+    return (sides[0], sides[1], sides[2])
+
+
 def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None, *,
-                 units: Units = "mm", typed: str | None = None):
+                 units: Units = "mm", typed: str | None = None,
+                 size_mm: tuple[float, float, float] | None = None):
     """The stock a baked GLB was cut from, as its metadata records it (absolute block spec,
-    content digest, species, appearance and its parameters), or ``block`` when given. The
-    messages name ``block`` as the user ``typed`` it (before ``--units``) and the recorded
-    size in ``units``.
+    content digest, species, appearance and its parameters, a Mokume sample's size), or
+    ``block`` when given, sized by ``size_mm`` (``--size-mm``, :func:`folder_size`) or else, the
+    block being the one baked, by the recorded sample size. The messages name ``block`` as the
+    user ``typed`` it (before ``--units``) and the recorded size in ``units``.
 
     Returns None for a file that records no block and no ``block`` given (``preview`` then shows
     the part alone). A recorded block that no longer exists, or whose content changed since the
@@ -1326,8 +1368,14 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
     kwargs = {"species": species or app.get("species"),
               "appearance": app.get("kind") or "colormap",
               **_trusted_appearance_params(app.get("params"), glb)}
+    sample = _recorded_sample_size(meta, glb)
     if block:
-        if meta.get("block_digest") and spec_digest(block) != meta["block_digest"]:
+        size_mm = folder_size(block, size_mm)
+        same = bool(meta.get("block_digest")) and spec_digest(block) == meta["block_digest"]
+        if size_mm is None and same:  # the block baked: at the size baked (a Mokume sample's)
+            size_mm = sample
+        if meta.get("block_digest") and (not same or (size_mm is not None and sample is not None
+                                                       and tuple(size_mm) != sample)):
             # --block of another block (another size, an edited folder) was taken without a word:
             # the section cap then shows other wood than the part's surface
             size = meta.get("size_mm")
@@ -1339,7 +1387,9 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
         # the recorded species (the bake's, default oak) was not asked for now: no note that
         # it changes nothing
         return _recorded_species_stated(open_stock(block, **{**kwargs, "species": species or kwargs["species"]},
-                                                   species_given=species is not None), app, species)
+                                                   species_given=species is not None,
+                                                   **({"size_mm": size_mm} if size_mm is not None else {})),
+                                        app, species)
     spec = meta.get("block")
     if not spec:
         return None
@@ -1354,7 +1404,14 @@ def stock_of_glb(glb: Path, block: str | None = None, species: str | None = None
     if meta.get("block_digest") and spec_digest(spec) != meta["block_digest"]:
         warnings.warn(f"the block {spec!r} changed since {glb.name} was baked (its files differ); "
                       "the wood shown is today's", WoodcamWarning, stacklevel=2)
-    return _recorded_species_stated(open_stock(spec, **kwargs, species_given=species is not None), app, species)
+    if size_mm is not None:  # the recorded block is its size: --size-mm would show other wood
+        warnings.warn(f"--size-mm {say_size_mm(size_mm)} sizes the block given with --block; {glb.name} is shown "
+                      "in the block it records, at the size it was baked: ignored (add --block SPEC to choose another)",
+                      WoodcamWarning, stacklevel=2)
+    # a Mokume sample at the size it was baked: a resized sample opened at 50 mm showed other wood
+    return _recorded_species_stated(open_stock(spec, **kwargs, species_given=species is not None,
+                                               **({"size_mm": sample} if sample is not None else {})),
+                                    app, species)
 
 
 def _recorded_species_stated(stock, app: dict, species: str | None):

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..units import MM_PER_UNIT, TYPED_DECIMALS
 from .options import (add_input, part_suffixes, output_refused_at_the_door, BLOCK_SPEC_HELP, add_max_triangles_option,
-                      add_out_option, add_units_option, place_op_in)
+                      add_out_option, add_size_option, add_units_option, folder_size, place_op_in)
 
 
 def register(subparsers) -> None:
@@ -45,6 +45,7 @@ def register(subparsers) -> None:
                    help="placements printed in the table (and, at least ten, in placements.json); "
                    "the picture shows the best K, at most 10, and the worst (default 3)")
     add_max_triangles_option(p)  # a mesh over it was simplified, said with a fix place did not have
+    add_size_option(p)
     add_units_option(p, "place")
     p.set_defaults(func=run_place)
 
@@ -70,7 +71,8 @@ def run_place(args: argparse.Namespace) -> int:
             part = load_part(args.part, timeout_s=args.timeout,
                              **({} if args.max_triangles is None else {"max_triangles": args.max_triangles}))
         with bar.stage("open block"):
-            stock = open_stock(args.block)
+            size = folder_size(args.block, args.size_mm)
+            stock = open_stock(args.block, **({"size_mm": size} if size is not None else {}))
         with bar.stage("score placements"):
             advice = advise_placement(part, stock, rotations=args.rotations,
                                       candidates=args.candidates, margin_mm=args.margin, progress=True,
