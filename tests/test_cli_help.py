@@ -163,3 +163,24 @@ def test_epochs_shows_n_as_the_other_counts_do():
     shown = {(" ".join(path), a.option_strings[-1]): a.metavar for path, a in _walk_options(build_parser())
              if a.option_strings[-1] in ("--epochs", "--finetune-epochs")}
     assert len(shown) >= 5 and set(shown.values()) == {"N"}, shown
+
+
+def test_every_int_option_shows_a_metavar_as_the_counts_do():
+    """``--count COUNT``, ``--seed SEED``, ``--face-px FACE_PX``, ``--crack-years CRACK_YEARS``
+    ... (ten options) showed argparse's upper-cased name where the other counts show ``N`` (a
+    size in pixels ``PX``): every int option has a metavar of its own, and an option has the same
+    one in every command."""
+    import collections
+
+    shown = collections.defaultdict(dict)
+    bare = []
+    for path, a in _walk_options(build_parser()):
+        if a.type is int:
+            flag = a.option_strings[-1]
+            shown[flag][" ".join(path)] = a.metavar
+            if a.metavar is None:
+                bare.append(f"{' '.join(path)} {flag}")
+    assert not bare, bare
+    assert not {f: m for f, m in shown.items() if len(set(m.values())) > 1}, dict(shown)
+    assert {shown[f][c] for f in ("--count", "--seed", "--zoom", "--crack-years") for c in shown[f]} == {"N"}
+    assert set(shown["--face-px"].values()) == {"PX"}

@@ -29,7 +29,8 @@ def register(subparsers) -> None:
     add_block_argument(p, option=False, nargs="+")
     add_out_option(p, "results.json and one side-by-side PNG per block")
     add_size_option(p)
-    p.add_argument("--resolution", type=int, default=128, help="grid cells along the longest side (default 128)")
+    p.add_argument("--resolution", type=int, metavar="N", default=128,
+                   help="grid cells along the longest side (default 128)")
     p.add_argument("--quality", choices=("draft", "normal", "high"), default="normal",
                    help="training effort of the neural appearance (default normal)")
     p.add_argument("--epochs", type=int, default=None, metavar="N",
@@ -39,7 +40,7 @@ def register(subparsers) -> None:
                    "(default 2; 0 trains each axis from scratch, as seed 000 does)")
     p.add_argument("--augment", action="store_true",
                    help="train on randomly mirrored patches too (measured on H11/CN03: no better)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=int, metavar="N", default=0, help="random seed (default 0)")
     p.add_argument("--end-grain", default=None, metavar="FACES",
                    help="comma-separated end-grain faces (default: from the field; unknown without one)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")

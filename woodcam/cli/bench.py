@@ -25,7 +25,7 @@ def register(subparsers) -> None:
                        "from front, top, left (partial), scored on seven interior cut planes. "
                        "About 40 CPU-s per block with the three methods.")
     r.add_argument("--blocks", type=int, required=True, metavar="N", help="number of blocks")
-    r.add_argument("--seed", type=int, default=0, help="seed of the block set (default 0)")
+    r.add_argument("--seed", type=int, metavar="N", default=0, help="seed of the block set (default 0)")
     r.add_argument("--methods", default="rbf,radial,neural",
                    help="comma-separated fitting methods (default rbf,radial,neural)")
     add_out_option(r, "the run: run.json and records/ (rerun to resume)")
@@ -37,7 +37,7 @@ def register(subparsers) -> None:
                    help="std of the traced rings' displacement in mm (default 0: exact traces)")
     r.add_argument("--dropout", type=float, default=None, metavar="F",
                    help="share of traced ring length missing, in [0, 1] (default 0)")
-    r.add_argument("--retries", type=int, default=2, help="extra attempts of a failing block (default 2)")
+    r.add_argument("--retries", type=int, metavar="N", default=2, help="extra attempts of a failing block (default 2)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     add_engine_options(r)
     r.set_defaults(func=_run)

@@ -41,11 +41,12 @@ def register(subparsers) -> None:
 
     s = sub.add_parser("synth", help="write a reproducible set of synthetic blocks")
     # the ranges said in the help, as the other options' (a fraction, a side in mm) are
-    s.add_argument("--count", type=int, required=True, help=f"number of blocks, {option_range('count', 'block')}")
-    s.add_argument("--seed", type=int, default=0,
+    s.add_argument("--count", type=int, metavar="N", required=True,
+                   help=f"number of blocks, {option_range('count', 'block')}")
+    s.add_argument("--seed", type=int, metavar="N", default=0,
                    help=f"random seed (same seed, same set), an integer {option_range('seed')}")
     add_out_option(s, "one block sub-folder per block and index.json")
-    s.add_argument("--face-px", type=int, default=512,
+    s.add_argument("--face-px", type=int, metavar="PX", default=512,
                    help=f"pixels along the largest face side, {option_range('face_px')}")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--jitter-mm", type=float, default=0.0,

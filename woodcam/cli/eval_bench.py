@@ -23,9 +23,9 @@ def register(subparsers) -> None:
         "cut planes. The table gives per scenario, face set and kind the mean with a 95 % "
         "bootstrap interval and the worst block; eq. 7-9 blocks are the sanity row. Per-block "
         "records go to OUT/records.json (woodcam.benchmark.score_block).")
-    r.add_argument("--seed", type=int, required=True,
+    r.add_argument("--seed", type=int, metavar="N", required=True,
                    help="benchmark seed; use seeds never used while developing a fitter")
-    r.add_argument("--count", type=int, default=6,
+    r.add_argument("--count", type=int, metavar="N", default=6,
                    help=f"blocks per row, {option_range('count', 'eval')} (default 6)")
     r.add_argument("--methods", default="rbf,radial,evidence",
                    help="comma list of fitting methods from evidence, rbf, radial, neural, or all "
@@ -37,9 +37,10 @@ def register(subparsers) -> None:
     r.add_argument("--face-sets", "--faces", dest="faces", default="full,three",
                    help="comma list of face sets: full (six faces), three (front, top, left) (default both; "
                    "the old spelling --faces still works)")
-    r.add_argument("--eq79", type=int, default=2,
+    r.add_argument("--eq79", type=int, metavar="N", default=2,
                    help="eq. 7-9 sanity blocks per scenario and face set (default 2; 0 skips)")
-    r.add_argument("--face-px", type=int, default=256, help="face image pixels along the largest side (default 256)")
+    r.add_argument("--face-px", type=int, metavar="PX", default=256,
+                   help="face image pixels along the largest side (default 256)")
     r.add_argument("--plots", action="store_true", help="also write cut-plane PNGs per block")
     r.add_argument("--no-knot-bend", dest="knot_bend", action="store_false",
                    help="leave the stem with its knots' ring bend out of the evidence fit's hypotheses "

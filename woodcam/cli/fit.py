@@ -61,7 +61,7 @@ def register(subparsers) -> None:
     e.add_argument("--detect", action="store_true",
                    help="real blocks: fit from rings detected on the photos (woodcam.detect) and score "
                    "against the block's own ring maps (e.g. the Mokume U-Net maps) as the reference")
-    e.add_argument("--seed", type=int, default=None,
+    e.add_argument("--seed", type=int, metavar="N", default=None,
                    help="real blocks: the evidence fit's random seed (held-out points, fitting subsets; "
                    "default 0; the other methods draw nothing at random, and --seed without evidence in "
                    "--methods is warned of); a real cube's held-out score can swing with it, so compare several")

@@ -32,7 +32,7 @@ def register(subparsers) -> None:
     add_out_option(r, "one PNG per section")
     r.add_argument("--ring-width", type=float, default=2.0, help="mm per year (default 2)")
     r.add_argument("--px-per-mm", type=float, default=2.0, help="resolution in pixels per mm (default 2)")
-    r.add_argument("--supersample", type=int, default=2,
+    r.add_argument("--supersample", type=int, metavar="N", default=2,
                    help="samples per pixel side, averaged (default 2; knot rings alias)")
     r.add_argument("--board", nargs=3, type=float, metavar=("Z_MM", "AZIMUTH_DEG", "OFFSET_MM"),
                    help="tangential board: centre height along the log (mm), facing azimuth "

@@ -92,7 +92,7 @@ def register(subparsers) -> None:
                        "(front (A) ...).")
     add_input(s, "block", kind="folder", type=Path, help="block folder (after 'rings detect') or Mokume sample folder")
     add_out_option(s, "the photos with the rings and knots found", suffixes=(".png",))
-    s.add_argument("--zoom", type=int, default=2,
+    s.add_argument("--zoom", type=int, metavar="N", default=2,
                    help="enlargement: picture pixels per face pixel, a whole number (default 2)")
     add_check_layout_option(s)
     add_size_option(s)

@@ -25,7 +25,7 @@ def register(subparsers) -> None:
                    help="rings only: which net of the OUT folder to write; main (default): rings.*; quilted: "
                    "rings_quilted.*, a second net (its --spec of a quilted style) whose probability the "
                    "learned detector averages with the main net's")
-    p.add_argument("--steps", type=int, default=None,
+    p.add_argument("--steps", type=int, metavar="N", default=None,
                    help="stop after N training steps in total, counting a resumed gtf checkpoint's (default: "
                    "the spec's steps; gtf's learning-rate schedule still follows the spec's steps)")
     p.add_argument("--no-resume", action="store_true",

@@ -56,7 +56,7 @@ def register(subparsers) -> argparse.ArgumentParser:
               "metres warning, one under 6.35 mm the inches one only where the part is that small too); repeatable")
     add_input(p, "--brushes", kind="file", type=Path, default=None, metavar="JSON",
                    help="growth brushes (centre_mm, radius_mm, gain, direction, strength)")
-    p.add_argument("--resolution", type=int, default=128,
+    p.add_argument("--resolution", type=int, metavar="N", default=128,
                    help="grid nodes along the longest side (default 128); a run takes about "
                    "180 bytes a grid node, and a grid over WOODCAM_MAX_ALLOC_BYTES (4 GiB) is refused, naming the "
                    "finest resolution that fits")
@@ -79,7 +79,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                    help="only crack within this sphere (centre and radius in --units; default: none, cracks "
                    "anywhere on the bark)")
     add_units_option(p, "woodify")
-    p.add_argument("--crack-years", type=int, default=None,
+    p.add_argument("--crack-years", type=int, metavar="N", default=None,
                    help="last years simulated for cracks, at most --years (default 5, or the whole "
                    "years grown when fewer; under a year's growth, from the input on)")
     p.add_argument("--crack-render", choices=("groove", "material"), default=None,
@@ -89,7 +89,7 @@ def register(subparsers) -> argparse.ArgumentParser:
                    "length at unit stiffness, so in mm; default 2x the median of the first simulated year)")
     p.add_argument("--relief", type=float, default=None,
                    help="stress left next to a new crack, in [0, 1] (0 removes all; default 0.3)")
-    p.add_argument("--seed", type=int, default=0,
+    p.add_argument("--seed", type=int, metavar="N", default=0,
                    help="random seed of the procedural bark and random cracks (default 0)")
     add_max_atlas_option(p, given_only=True)  # None unless typed: a kept picture warns
     # load_part's budget simplified a script, STEP or union over it with a warning naming this
