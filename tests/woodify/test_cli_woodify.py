@@ -661,7 +661,7 @@ def test_a_mesh_saved_in_metres_is_named_as_such(tmp_path, capsys):
     assert main(["woodify", str(tmp_path / "mm.stl"), "--years", "5", "--resolution", "16", "--cracks",
                  "none", "--obstacle", str(tmp_path / "m.stl"), "--out", str(tmp_path / "o3")]) == 0
     (msg,) = [line for line in capsys.readouterr().err.splitlines() if "metres" in line]
-    assert msg.startswith("woodcam: warning: --obstacle '" + str(tmp_path / "m.stl") + "'")
+    assert msg.startswith("woodcam: warning: --obstacle '" + str(tmp_path / "m.stl") + "': the obstacle is only "), msg
 
 
 def test_a_mesh_saved_in_inches_is_named_as_such(tmp_path, capsys):
@@ -1023,3 +1023,6 @@ def test_a_small_obstacle_is_judged_beside_the_part(tmp_path, capsys):
     said = grow(tmp_path / "part_in.stl", tmp_path / "pin_in.stl", "o2")
     assert len(said) == 2 and all("modelled in inches" in m for m in said), said
     assert said[1].startswith("woodcam: warning: --obstacle '" + str(tmp_path / "pin_in.stl") + "'"), said
+    # each named as what it is: "--obstacle 'pin_in.stl': the part is only ..." named the part
+    assert ": the part is only " in said[0] and "the obstacle" not in said[0], said
+    assert ": the obstacle is only " in said[1] and "the part is only" not in said[1], said

@@ -200,7 +200,7 @@ def units_note(source: Any, unit: str = "inches") -> tuple[str, str]:
 
 
 def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX, *,
-               source: Any = None, inches: bool = True) -> str | None:
+               source: Any = None, inches: bool = True, noun: str = "part") -> str | None:
     """What to say when a part with bounds ``lo, hi (3,)`` mm would still fit the block
     ``size_mm (3,)`` 25.4 times larger (None otherwise): STL, OBJ and PLY carry no units, so a part
     exported in inches is read 25.4 x too small and carved or placed as a speck. Its lengths
@@ -221,7 +221,9 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX, *,
         a mesh.
     inches : without a block, whether a size under :data:`~woodcam.tolerances.INCHES_BELOW_MM`
         says inches (False: only the metres check; ``woodify --obstacle``, where a 5 mm pin is
-        a real obstacle beside a real part)."""
+        a real obstacle beside a real part).
+    noun : what the message calls the thing measured without a block ("part", or "obstacle" for
+        ``woodify --obstacle``: "--obstacle 'pin.stl': the part is only ..." named the wrong one)."""
     extent = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
     with message_units("mm"):  # about the file's own numbers, read as mm whatever --units says
         if size_mm is None:
@@ -234,7 +236,7 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX, *,
             else:
                 return None
             why, redo = units_note(source, unit)
-            return (f"the part is only {say_length(extent, '.3g')}: {why}, and {small}; "
+            return (f"the {noun} is only {say_length(extent, '.3g')}: {why}, and {small}; "
                     f"it looks modelled in {unit} ({factor:g} times larger: "
                     f"{say_length(extent * factor, '.3g')}): scale it by {factor:g} {fix}, or {redo}")
         why, redo = units_note(source)

@@ -279,7 +279,8 @@ def _warn_units(mesh, path: str, what: str = "part", inches: bool = True) -> Non
 
     lo, hi = mesh.bounds
     hint = units_hint(lo, hi, None, "in your CAD program (--units converts only the lengths typed as options, "
-                      "never the part's own)", source=path, inches=inches)
+                      "never the part's own)", source=path, inches=inches,
+                      noun="obstacle" if what == "--obstacle" else "part")
     if hint:
         warnings.warn(f"{what} {path!r}: {hint}", WoodcamWarning, stacklevel=3)
 
