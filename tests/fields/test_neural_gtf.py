@@ -106,6 +106,9 @@ def test_spec_round_trip_and_errors(tmp_path):
     ("lr_net", True, "spec.lr_net must be a positive number; got True"),
     ("lr_floor", 5, "spec.lr_floor must be in (0, 1]"),
     ("radius_samples", 1, "spec.n_constraints must be at most spec.radius_samples (1"),
+    # sigma 50 was taken: every constraint clipped to 0.5 or 1.5, not N(1, sigma)
+    ("constraint_sigma", 50, "spec.constraint_sigma must be a finite number in (0, 0.5]; got 50"),
+    ("pith_fraction", -0.1, "spec.pith_fraction must be a finite number in [0, 1]; got -0.1"),
 ])
 def test_spec_file_with_a_bad_value_is_refused_naming_the_file(tmp_path, key, value, rule):
     """A seed of -1 or 4.5 fields in a spec file passed the door and failed in numpy's words
@@ -116,6 +119,13 @@ def test_spec_file_with_a_bad_value_is_refused_naming_the_file(tmp_path, key, va
     with pytest.raises(WoodcamError) as e:
         GTFSpec.load(path)
     assert str(path) in str(e.value) and rule in str(e.value), e.value
+
+
+def test_spec_takes_the_ends_of_the_documented_ranges():
+    """pith_fraction 0 (no points near the pith) was refused as 'must be a positive number'
+    although its documented range is [0, 1]."""
+    for key, value in (("pith_fraction", 0), ("pith_fraction", 1), ("constraint_sigma", 0.5)):
+        assert getattr(GTFSpec(**{**TINY, key: value}), key) == value
 
 
 def test_training_refuses_more_batch_fields_than_fields_before_writing(tmp_path):

@@ -62,6 +62,11 @@ _CHECKPOINT_NAME = "gtf_checkpoint.pt"
 #: ~270 MB; a spec asking for more than ``MAX_ALLOC_BYTES`` is refused before any is made.
 TRAINING_BYTES_PER_POINT = 112
 
+#: Largest :attr:`GTFSpec.constraint_sigma`: the constraint values are clipped to ``[0.5, 1.5]``
+#: (seed 000), so a sigma above 0.5 clips more than a third of them to the two bounds and the family
+#: is no longer ``N(1, sigma)``; from sigma ~1 up every constraint is 0.5 or 1.5.
+MAX_CONSTRAINT_SIGMA = 0.5
+
 #: The :class:`GTFSpec` fields that are counts (integers >= 1; the seed >= 0).
 _GTF_INTEGERS = ("seed", "n_fields", "points_per_field", "n_constraints", "radius_samples", "latent_dim",
                  "hidden", "layers", "n_harmonics", "batch_fields", "batch_points", "steps",
@@ -80,9 +85,10 @@ class GTFSpec:
     n_fields, points_per_field : int
         Training set size, ``N`` GTFs times ``M`` points (seed 000: 10,000 x 1,600).
     pith_fraction : float
-        Share of each field's points drawn from ``[-0.1, 0.1]^2 x [-1, 1]`` (seed: 0.2).
+        Share of each field's points drawn from ``[-0.1, 0.1]^2 x [-1, 1]``, in ``[0, 1]`` (seed: 0.2).
     n_constraints, constraint_sigma : int, float
-        Radius functions: ``N_c`` constraints from ``N(1, sigma)`` (seed: 15, 0.1).
+        Radius functions: ``N_c`` constraints from ``N(1, sigma)`` clipped to ``[0.5, 1.5]``;
+        ``sigma`` in ``(0, MAX_CONSTRAINT_SIGMA]`` (seed: 15, 0.1).
     latent_dim, hidden, layers : int
         Code size, MLP width and number of hidden layers.
     n_harmonics : int
@@ -127,10 +133,15 @@ class GTFSpec:
             v = getattr(self, f.name)
             if f.name in _GTF_INTEGERS:
                 check_number(v, f"spec.{f.name}", lo=0 if f.name == "seed" else 1, integer=True, fix=fix)
+            elif f.name == "pith_fraction":     # 0 (no pith points) is in the documented range
+                check_number(v, "spec.pith_fraction", lo=0, hi=1, fix=fix)
+            elif f.name == "constraint_sigma":
+                # 0.5 at most: the constraints are clipped to [0.5, 1.5]; sigma 50 was taken and made
+                # every constraint 0.5 or 1.5 (a two-valued family, not N(1, sigma))
+                check_number(v, "spec.constraint_sigma", lo=0, hi=MAX_CONSTRAINT_SIGMA, lo_open=True,
+                             fix=f"{fix} (the constraints are clipped to [0.5, 1.5]; seed 000 uses 0.1)")
             elif not (isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v) and v > 0):
                 raise WoodcamError(f"spec.{f.name} must be a positive number; got {v!r}; {fix}")
-        if not 0 <= self.pith_fraction <= 1:
-            raise WoodcamError(f"spec.pith_fraction must be in [0, 1]; got {self.pith_fraction!r}; {fix}")
         if self.lr_floor > 1:   # the cosine then rose from the rate to lr_floor times it
             raise WoodcamError(f"spec.lr_floor must be in (0, 1] (the learning rates decay to lr_floor times "
                                f"their value); got {self.lr_floor!r}; {fix}")
