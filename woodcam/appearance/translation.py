@@ -298,9 +298,13 @@ def train_translation(pairs, spec: TranslationSpec | None = None, *, progress: b
         torch.set_num_threads(int(threads))
     t0 = time.perf_counter()
     rng = np.random.default_rng(spec.seed)
-    torch.manual_seed(spec.seed)
     X, Y, M = (torch.from_numpy(a) for a in _crop_pool(pairs, spec, rng))
-    net = _build_net(c_in, spec.channels)
+    # the spec's seed draws the initial weights on a fork of torch's generator: seeded globally,
+    # each run (each axis of a bake's appearance) reset the caller's torch random numbers. The
+    # same draws, so the same weights; the loop takes nothing from torch's generator (rng mirrors)
+    with torch.random.fork_rng(devices=[]):
+        torch.manual_seed(spec.seed)
+        net = _build_net(c_in, spec.channels)
     if init is not None:
         net.load_state_dict(init.module.state_dict())
         spec = replace(spec, epochs=max(1, spec.finetune_epochs))

@@ -317,10 +317,15 @@ def train_ring_net(spec: RingNetSpec, x: np.ndarray, y: np.ndarray, out_dir, *, 
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    torch.manual_seed(spec.seed)
     torch.set_num_threads(1)           # the machine is shared; one thread also keeps runs repeatable
     rng = np.random.default_rng([spec.seed, 1])
-    net = _net(spec)
+    # the spec's seed draws the initial weights on a fork of torch's generator (as build_model):
+    # seeded globally, each training run reset the caller's torch random numbers to the seed's
+    # stream. The same draws, so the same weights; the loop takes nothing from torch's generator
+    # (the batches, crops and turns come from rng)
+    with torch.random.fork_rng(devices=[]):
+        torch.manual_seed(spec.seed)
+        net = _net(spec)
     n_params = sum(p.numel() for p in net.parameters())
     opt = torch.optim.Adam(net.parameters(), lr=spec.lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, spec.steps, eta_min=spec.lr * 0.05)
