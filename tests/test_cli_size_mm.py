@@ -201,3 +201,14 @@ def test_a_size_mm_a_command_cannot_use_is_said(cn03, tmp_path, monkeypatch, cap
     assert seen == [(str(folder), (40.0,) * 3), ("builtin:flat-sawn", None)], seen
     assert ("--size-mm 40 sizes Mokume sample folders only; 'builtin:flat-sawn' is no folder and keeps its own "
             "size: ignored") in err, err
+
+
+def test_library_open_block_refuses_a_size_mm_as_open_stock_does():
+    """woodcam.stock.open_block('builtin:flat-sawn', size_mm=40) returned the 50 mm block with
+    size_mm dropped without a word (open_stock refused it; the CLI warns via folder_size)."""
+    from woodcam.errors import WoodcamError
+    from woodcam.stock import open_block
+
+    with pytest.raises(WoodcamError, match=r"size_mm \(--size-mm\) sizes a Mokume sample folder only; "
+                                           r"block spec 'builtin:flat-sawn' is a builtin block"):
+        open_block("builtin:flat-sawn", size_mm=40, face_px=16)

@@ -279,11 +279,8 @@ def open_stock(spec: str, *, species: str | None = None,
         raise WoodcamError(f"spec must be a block spec (str): 'builtin:NAME', 'log:LOG@KNOT', 'woodify:PATH' or "
                            f"a block folder; got {spec!r}; e.g. open_stock('builtin:flat-sawn')")
     parsed = parse_spec(spec)
-    if size_mm is not None and parsed.kind != "folder":
-        # the bake of a built-in block kept its own size without a word
-        raise WoodcamError(f"size_mm (--size-mm) sizes a Mokume sample folder only; block spec {str(spec)!r} is "
-                           f"a {parsed.kind} block, whose size is in the spec (e.g. builtin:flat-sawn:40x40x40); "
-                           "leave size_mm out")
+    # the bake of a built-in block kept its own size without a word
+    _check_size_for_spec(spec, parsed, size_mm)
     # built-in, log and woodify blocks have no photos: their colour map is the constructor's
     # (a folder's photos are known once it is read: _real_block_stock checks again)
     _check_appearance_params(appearance, appearance_params, photos=parsed.kind == "folder",
@@ -315,6 +312,15 @@ def open_stock(spec: str, *, species: str | None = None,
             stock = Stock(stock.spec, size, wood, stock.description, {**stock.meta, "turns": list(turns)})
     stock.spec = spec  # as given (resize_stock writes its numbers with :g)
     return stock
+
+
+def _check_size_for_spec(spec, parsed: ParsedSpec, size_mm) -> None:
+    """Refuse ``size_mm`` for a spec that is no folder (:func:`open_stock`, :func:`open_block`):
+    a built-in, log or woodify block takes its size in the spec."""
+    if size_mm is not None and parsed.kind != "folder":
+        raise WoodcamError(f"size_mm (--size-mm) sizes a Mokume sample folder only; block spec {str(spec)!r} is "
+                           f"a {parsed.kind} block, whose size is in the spec (e.g. builtin:flat-sawn:40x40x40); "
+                           "leave size_mm out")
 
 
 def _check_appearance_params(appearance: str, params: dict, *, photos: bool = True,
@@ -453,7 +459,8 @@ def open_block(spec: str, *, size_mm: float | tuple[float, float, float] | None 
         folder of photos only gets its rings detected (cached, :mod:`woodcam.detect.block`).
     size_mm : float or (W, D, H), optional
         Size in mm of a Mokume sample folder (its files carry no size; default a 50 mm cube), one
-        number a cube's side; a Mokume sample is a cube, so another size is refused there.
+        number a cube's side; a Mokume sample is a cube, so another size is refused there. Any
+        other spec takes its size in the spec and refuses this, as :func:`open_stock` does.
     face_px : int
         Pixels along the largest face side of a synthetic block's photos.
 
@@ -465,6 +472,7 @@ def open_block(spec: str, *, size_mm: float | tuple[float, float, float] | None 
     """
     check_read_as_is(spec)  # no turn or resize: this command reads the block as it is
     parsed = parse_spec(spec)  # a loose end ('[40x30]') named as the bad operation it is
+    _check_size_for_spec(spec, parsed, size_mm)     # it was dropped without a word
     if parsed.kind != "folder":
         from .synth import synth_block
 
