@@ -662,6 +662,7 @@ def test_a_mesh_saved_in_metres_is_named_as_such(tmp_path, capsys):
                  "none", "--obstacle", str(tmp_path / "m.stl"), "--out", str(tmp_path / "o3")]) == 0
     (msg,) = [line for line in capsys.readouterr().err.splitlines() if "metres" in line]
     assert msg.startswith("woodcam: warning: --obstacle '" + str(tmp_path / "m.stl") + "': the obstacle is only "), msg
+    assert "never the obstacle's own" in msg and "the part's own" not in msg, msg
 
 
 def test_a_mesh_saved_in_inches_is_named_as_such(tmp_path, capsys):
@@ -1026,3 +1027,6 @@ def test_a_small_obstacle_is_judged_beside_the_part(tmp_path, capsys):
     # each named as what it is: "--obstacle 'pin_in.stl': the part is only ..." named the part
     assert ": the part is only " in said[0] and "the obstacle" not in said[0], said
     assert ": the obstacle is only " in said[1] and "the part is only" not in said[1], said
+    # and its fix too: it said "--units converts only the lengths typed as options, never the part's own"
+    assert "never the part's own" in said[0] and "never the obstacle's own" not in said[0], said
+    assert "never the obstacle's own" in said[1] and "the part's own" not in said[1], said

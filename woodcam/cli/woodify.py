@@ -278,9 +278,10 @@ def _warn_units(mesh, path: str, what: str = "part", inches: bool = True) -> Non
     from ..errors import WoodcamWarning
 
     lo, hi = mesh.bounds
+    noun = "obstacle" if what == "--obstacle" else "part"
+    # the fix names the file's own thing too: an obstacle's said "never the part's own"
     hint = units_hint(lo, hi, None, "in your CAD program (--units converts only the lengths typed as options, "
-                      "never the part's own)", source=path, inches=inches,
-                      noun="obstacle" if what == "--obstacle" else "part")
+                      f"never the {noun}'s own)", source=path, inches=inches, noun=noun)
     if hint:
         warnings.warn(f"{what} {path!r}: {hint}", WoodcamWarning, stacklevel=3)
 
