@@ -502,7 +502,33 @@ def test_default_cut_normal_faces_the_camera_along_the_longest_axis():
     np.testing.assert_array_equal(view.camera.default_cut_normal("iso", size), [1, 0, 0])
     np.testing.assert_array_equal(view.camera.default_cut_normal("iso", size[[2, 1, 0]]), [0, 0, 1])
     np.testing.assert_array_equal(view.camera.default_cut_normal("front", size), [0, -1, 0])
+    # top/bottom: the cut they get when one is asked for (--cut-origin/--cut-normal, the widget
+    # dragged); by default they show no cut (test_top_and_bottom_show_the_outside_uncut)
     np.testing.assert_array_equal(view.camera.default_cut_normal("top", size), [0, 0, 1])
+    assert view.camera.UNCUT_CAMERAS == ("top", "bottom")
+
+
+@pytest.mark.parametrize("camera", ["top", "bottom"])
+def test_top_and_bottom_show_the_outside_uncut(tmp_path, camera):
+    """'preview bowl.glb --camera bottom' showed a ring at mid-height (the default cut faced the
+    camera, along Z, and took the foot away) and '--camera top' of a pocketed tray a flat slab:
+    straight down or up the default is the uncut outside (no wood on a plane: no green), a cut
+    when asked for (--cut-origin), and the interactive widget starts on the face toward the camera."""
+    box = _textured_box()
+    plain = _read(preview(box, wood=GreenWood(), size_mm=SIZE, camera=camera,
+                          screenshot=tmp_path / "a.png", window_size=SMALL))
+    assert _green(plain).mean() == 0.0 and _light_green(plain).mean() == 0.0
+    assert (_red(plain) | _blue(plain)).mean() > 0.1      # the part's face, whole
+    asked = _read(preview(box, wood=GreenWood(), size_mm=SIZE, camera=camera, cut_origin=(50.0, 40.0, 20.0),
+                          screenshot=tmp_path / "b.png", window_size=SMALL))
+    assert _green(asked).mean() > 0.015
+    plotter = pv.Plotter(off_screen=True, window_size=SMALL)
+    try:
+        callback = build_scene(plotter, box, size_mm=SIZE, widget=True, camera=camera)
+        assert callback is not None
+        assert callback.clip_plane.GetOrigin()[2] == (40.0 if camera == "top" else 0.0)
+    finally:
+        plotter.close()
 
 
 # ---------------------------------------------------------------------------- conversion

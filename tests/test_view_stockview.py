@@ -459,15 +459,20 @@ def test_each_wall_follows_its_own_border_of_the_heightmap():
 
 
 def test_the_cut_follows_the_camera_and_the_background_is_used(bowl):
-    """From the top the cut plane is horizontal (Z = H / 2, the top camera's own axis): the
-    wood at mid-height shows through the block's translucent top; around the block the given
-    background."""
+    """From the right the cut plane is X = W / 2 (the right camera's own axis): the wood at
+    mid-width shows through the block's translucent right face; around the block the given
+    background. From the top (and bottom) no cut, as preview's: the outside, the same picture
+    as without a wood (it showed a horizontal cut at mid-height, the stock's top surface, which
+    the user asked to see, cut away; woodcam.view.camera.UNCUT_CAMERAS)."""
     hm, atlas, charts = bowl
-    img = stock_view(hm, (W, D, H), atlas, charts, wood=_CoordWood(), camera="top",
+    img = stock_view(hm, (W, D, H), atlas, charts, wood=_CoordWood(), camera="right",
                      window_size=WIN, background=(0, 0, 0)).astype(float)
     assert (img[0, 0] == 0).all() and (img[-1, -1] == 0).all()
-    p = np.array([34.0, 25.0, H / 2])
-    r, c = _pixel(p, "top")
+    p = np.array([W / 2, 25.0, H / 2])
+    r, c = _pixel(p, "right")
     tint = BLOCK_OPACITY * 255 * np.asarray(BLOCK_COLOR)
     np.testing.assert_allclose(img[r[0], c[0]], (1 - BLOCK_OPACITY) * 255 * p / np.array([W, D, H]) + tint,
                                atol=3)
+    top = stock_view(hm, (W, D, H), atlas, charts, wood=_CoordWood(), camera="top", window_size=WIN)
+    np.testing.assert_array_equal(top, stock_view(hm, (W, D, H), atlas, charts, camera="top",
+                                                  window_size=WIN))

@@ -10,7 +10,7 @@ from pathlib import Path
 from ..errors import WoodcamError
 from ..units import fmt_length, fmt_volume
 from .options import (output_refused_at_the_door, BLOCK_SPEC_HELP, add_bake_options, add_input, part_suffixes,
-                      add_camera_option, add_max_triangles_option, add_out_option, add_units_option,
+                      CUT_VIEWS_NOTE, add_camera_option, add_max_triangles_option, add_out_option, add_units_option,
                       add_workers_option, allow_negative_values, apply_workers, as_typed, camera_of,
                       add_size_option, not_empty, remove_stale_outputs, stock_options, uses_settings, vector_type,
                       write_screenshot)
@@ -65,7 +65,7 @@ def register(subparsers) -> None:
     add_size_option(p)
     add_units_option(p, "bake")
     add_bake_options(p)
-    add_camera_option(p, "; of the --screenshot")
+    add_camera_option(p, "; of the --screenshot" + CUT_VIEWS_NOTE)
     add_workers_option(p)
     p.set_defaults(func=run_bake)
 
@@ -83,7 +83,7 @@ def register(subparsers) -> None:
                    "name: MESH with _view.png)")
     add_input(p, "--block", kind="block", default=None,
                    help=BLOCK_SPEC_HELP + ", for the cut plane (default: the one stored in the GLB)")
-    add_camera_option(p)
+    add_camera_option(p, CUT_VIEWS_NOTE)
     p.add_argument("--no-cut", action="store_true",
                    help="no cut plane: the part alone in its translucent block")
     p.add_argument("--cut-origin", type=vector_type("--cut-origin"), default=None, metavar="X,Y,Z",
@@ -91,7 +91,8 @@ def register(subparsers) -> None:
     p.add_argument("--cut-normal", type=vector_type("--cut-normal", example="1,0,0", nonzero=True),
                    default=None, metavar="X,Y,Z",
                    help="the cut plane's normal, towards the side cut away (default: the block's "
-                   "longest axis facing the camera)")
+                   "longest axis facing the camera). --camera top and bottom show no cut unless "
+                   "--cut-origin or --cut-normal is given")
     allow_negative_values(p)
     add_size_option(p, of_glb=True)
     add_units_option(p, "preview")

@@ -1213,6 +1213,12 @@ def appearance_params(args) -> dict:
     return {k: v for k, v in (("quality", args.quality), ("epochs", args.epochs)) if v is not None}
 
 
+#: ``--camera``'s note where the picture is preview's (bake, preview): which views are cut
+#: (woodcam.view.camera.UNCUT_CAMERAS); gcode's stock view says its own
+CUT_VIEWS_NOTE = ("; top and bottom show the part's outside uncut, the other views cut away the half "
+                  "toward the camera to show the wood inside")
+
+
 def add_camera_option(p: argparse.ArgumentParser, note: str = "", exclude: tuple[str, ...] = ()) -> None:
     """``--camera`` of the commands that draw a view of one part the user points
     (``bake`` and ``gcode``: their ``--screenshot``; ``preview``); ``demo``'s renders and
@@ -1221,6 +1227,7 @@ def add_camera_option(p: argparse.ArgumentParser, note: str = "", exclude: tuple
     command draws them) must say why it lacks. Read it with :func:`camera_of`."""
     views = {"iso": "iso (from front-right-above, the default)",
              "bottom": "bottom (the part's underside, e.g. a bowl's foot, or where a cut went through)"}
+
     p.add_argument("--camera", choices=[c for c in CAMERAS if c not in exclude], default=None,
                    help="view direction: " + ", ".join(views.get(c, c) for c in CAMERAS if c not in exclude)
                    + note)

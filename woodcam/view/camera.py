@@ -11,7 +11,7 @@ import numpy as np
 from .._types import CAMERAS, Camera
 from ..errors import WoodcamError
 
-__all__ = ["CAMERAS", "Camera", "check_camera", "default_cut_normal", "frame_camera", "set_camera"]
+__all__ = ["CAMERAS", "UNCUT_CAMERAS", "Camera", "check_camera", "default_cut_normal", "frame_camera", "set_camera"]
 
 #: Direction from the focal point to the camera and the camera's up vector, block frame.
 #: "iso" looks from front-right-above (the viewer stands at -Y, conventions.md). "top" has +Y
@@ -35,8 +35,17 @@ def check_camera(camera: str) -> str:
 
 
 
+#: Cameras whose picture is uncut unless a cut is asked for (a cut origin or normal given, the
+#: interactive plane dragged). Looking straight down or up, the only axis facing the camera is
+#: Z, so the default cut was a horizontal one at mid-height: ``--camera bottom`` showed a ring
+#: at the middle of a bowl with its foot cut away, ``--camera top`` a flat slab with a pocket
+#: tray's pockets cut away; the user who asks for the top or the underside wants to see it.
+UNCUT_CAMERAS: tuple[str, ...] = ("top", "bottom")
+
+
 def default_cut_normal(camera: str, size: np.ndarray) -> np.ndarray:
-    """The block's longest axis, among those facing the camera, signed toward the camera."""
+    """The block's longest axis, among those facing the camera, signed toward the camera: the
+    cut a view gets when one is shown (for :data:`UNCUT_CAMERAS` only when asked for)."""
     view = np.asarray(_CAMERA_VIEW[camera][0])
     facing = np.abs(view) > 1e-9
     k = int(np.argmax(np.where(facing, size, -np.inf)))

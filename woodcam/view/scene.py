@@ -37,7 +37,7 @@ from .._checks import as_floats, check_bool, check_number, check_vector, did_you
 from ..frames import check_size
 from ..tolerances import ON_FACE_TOL_MM
 from ..units import say_length
-from .camera import Camera, check_camera, default_cut_normal, set_camera
+from .camera import UNCUT_CAMERAS, Camera, check_camera, default_cut_normal, set_camera
 from .section import (
     box_section_uv,
     cut_segments,
@@ -674,7 +674,9 @@ class SceneOptions:
     cut_origin, cut_normal : (3,) float mm / direction, optional
         The initial cut plane; default the block centre and the block's longest axis facing
         the camera, signed toward it (the part's half on the camera side is cut away, so the
-        plane shows its inside wood). The normal is normalised here.
+        plane shows its inside wood). The normal is normalised here. The "top" and "bottom"
+        cameras show the part uncut unless one of the two is given (the plane widget then
+        starts on the block face toward the camera), so that they show its top and underside.
     resolution_mm : float
         Sample spacing of the wood on the plane, mm (coarsened for very large sections).
     max_samples : int, optional
@@ -777,6 +779,12 @@ def build_scene(
               else check_vector(cut_origin, "cut_origin", unit=False))
     normal = (default_cut_normal(camera, b[:, 1] - b[:, 0]) if cut_normal is None
               else check_vector(cut_normal, "cut_normal", unit=True))
+    # top/bottom: the outside uncut unless a cut is asked for (camera.UNCUT_CAMERAS says why);
+    # the widget starts on the face toward the camera, cutting nothing until it is dragged in
+    uncut = camera in UNCUT_CAMERAS and cut_origin is None and cut_normal is None
+    if uncut and widget:
+        origin = origin.copy()
+        origin[2] = b[2, 1] if normal[2] > 0 else b[2, 0]
 
     if opt.cut_plane and wood is not None and size is not None and (cut_origin is not None or cut_normal is not None):
         corners = np.stack(np.meshgrid(*b, indexing="ij"), axis=-1).reshape(-1, 3)
@@ -796,7 +804,7 @@ def build_scene(
     if size is not None:
         _add_block(plotter, size)
     callback = None
-    if opt.cut_plane and (widget or wood is not None):
+    if opt.cut_plane and (widget or (wood is not None and not uncut)):
         callback = CutPlaneCallback(plotter, part, texture, wood, size,
                                     resolution_mm=opt.resolution_mm,
                                     max_samples=opt.samples_cap(widget))

@@ -28,7 +28,7 @@ import numpy as np
 from .._types import ArrayLike, PathLike, WoodLike
 from ..errors import WoodcamError
 from ..frames import check_size
-from .camera import Camera, check_camera, default_cut_normal, frame_camera
+from .camera import UNCUT_CAMERAS, Camera, check_camera, default_cut_normal, frame_camera
 
 #: VTK's default light kit (vtkLightKit, pyvista's default lighting) in camera coordinates:
 #: (elevation deg, azimuth deg, intensity) of the key, fill, two back lights and the headlight
@@ -218,7 +218,7 @@ def stock_view(heightmap: ArrayLike, size_mm: ArrayLike, texture: np.ndarray, ch
     cam = _camera_array(camera, size, window, s)
     clip = np.array([0.0, 0.0, 0.0, 1.0])  # 0 > 1 never holds: nothing clipped
     section, axis, at, span, outline = np.zeros((2, 2, 3), np.float32), -1, 0.0, np.ones(2), None
-    if wood is not None:
+    if wood is not None and camera not in UNCUT_CAMERAS:  # top/bottom: the outside, as preview's
         normal = default_cut_normal(camera, size)
         origin = size / 2
         clip = np.array([*normal, float(normal @ origin)])
