@@ -59,8 +59,11 @@ def test_a_glb_baked_from_a_relative_block_folder_reopens_from_another_folder(tm
     again = stock_of_glb(glb)
     assert again.meta["species"] == "walnut"  # not the block's default oak
     _same_wood(stock, again)
-    # the folder changes: a warning; the folder is gone: an error naming it
-    (work / "myblock" / "extra.txt").write_text("x")
+    # a file it reads changes: a warning (a notes.txt woodcam never reads leaves it as baked:
+    # tests/test_stock.py::test_a_file_woodcam_does_not_read_leaves_a_block_folders_digest);
+    # the folder is gone: an error naming it
+    manifest = work / "myblock" / "block.json"
+    manifest.write_text(manifest.read_text() + "\n")
     with pytest.warns(WoodcamWarning, match="changed since part.glb was baked"):
         stock_of_glb(glb)
     shutil.rmtree(work / "myblock")

@@ -817,3 +817,43 @@ def test_an_empty_or_unknown_species_is_refused(species):
         open_stock("builtin:flat-sawn", species=species)
     # a species recorded earlier ('' where a bake recorded none) is the bake's, not refused
     assert open_stock("builtin:flat-sawn", species="", species_given=False).meta["species"] == "oak"
+
+
+def test_a_file_woodcam_does_not_read_leaves_a_block_folders_digest(tmp_path):
+    """Dropping notes.txt into a block folder made bake and review say the block "changed since"
+    a part was baked: spec_digest hashed every file of the folder. It hashes the files woodcam
+    reads (the manifest, what it names, the photo/map/SVG/JSON kinds ring detection reads, a
+    Mokume folder's sample files) by content: a file of another kind changes nothing, a read
+    file's bytes or a new read file do, and a folder of read files only keeps its old digest."""
+    from PIL import Image
+
+    from woodcam._cache import digest
+    from woodcam.block.io import write_block
+    from woodcam.fields.builtin import builtin_block
+    from woodcam.stock import spec_digest
+    from woodcam.synth import synth_block
+
+    folder = tmp_path / "b"
+    write_block(synth_block(builtin_block("flat-sawn").field, (20, 20, 20), face_px=16, seed=0), folder)
+    files = sorted(p for p in folder.rglob("*") if p.is_file())
+    before = spec_digest(str(folder))
+    assert before == digest([(str(p.relative_to(folder)), p) for p in files])  # as it always was
+    (folder / "notes.txt").write_text("walnut from the 2024 storm")
+    (folder / "sub").mkdir()
+    (folder / "sub" / "README.md").write_text("x")
+    assert spec_digest(str(folder)) == before
+    (folder / "front_traces.svg").write_text("<svg/>")  # a corrected SVG detection reads
+    assert spec_digest(str(folder)) != before
+    (folder / "front_traces.svg").unlink()
+    manifest = (folder / "block.json").read_text()
+    (folder / "block.json").write_text(manifest.replace('"name"', '"name" ', 1))
+    assert spec_digest(str(folder)) != before
+    # a Mokume sample folder: its sample files only
+    mokume = tmp_path / "m"
+    mokume.mkdir()
+    Image.new("RGB", (8, 8)).save(mokume / "A_col.png")
+    m0 = spec_digest(str(mokume))
+    (mokume / "notes.txt").write_text("H11")
+    assert spec_digest(str(mokume)) == m0
+    Image.new("RGB", (8, 8), (9, 9, 9)).save(mokume / "A_col.png")
+    assert spec_digest(str(mokume)) != m0

@@ -374,17 +374,21 @@ def _check_appearance_params(appearance: str, params: dict, *, photos: bool = Tr
 
 
 def spec_digest(spec: str) -> str:
-    """Content identity of the block ``spec`` names: a digest of every file of a block or sample
-    folder (or of a log file or woodify field), or of the spec itself for synthetic blocks, and
-    of its turns and resizes: a resized block is not the block it was cut from (a block without
-    them keeps the digest it always had)."""
+    """Content identity of the block ``spec`` names: a digest of the files woodcam reads from a
+    block or sample folder (:func:`woodcam.block.io.block_folder_files`: names and contents;
+    the user's notes.txt dropped in made every part baked from it "changed since baked"), of a
+    log file or woodify field, or of the spec itself for synthetic blocks, and of its turns and
+    resizes: a resized block is not the block it was cut from (a block without them, or a folder
+    holding only files woodcam reads, keeps the digest it always had)."""
     from . import __version__
     from ._cache import digest
 
     parsed = parse_spec(spec)
     path = parsed.path
     if path is not None and path.is_dir():
-        files = sorted(p for p in path.rglob("*") if p.is_file() and not p.name.startswith("."))
+        from .block.io import block_folder_files
+
+        files = block_folder_files(path)
         content = digest([(str(p.relative_to(path)), p) for p in files])
     elif path is not None and path.is_file():
         content = digest(path)

@@ -452,6 +452,39 @@ def mokume_files(folder: Path, face: str) -> dict[str, Path]:
     return {k: found[k][0] for k in ("col", *MOKUME_MAP_KINDS) if k in found}  # the photo first: the shape's reference
 
 
+#: Suffixes of the files a block folder's readers open besides those its manifest names: the
+#: manifest and detection's record (.json), ring maps, masks and photos (the photo formats),
+#: corrected traces (.svg). A file of another kind in the folder is never read.
+_READ_SUFFIXES = (".json", ".svg")
+
+
+def block_folder_files(folder: Path) -> list[Path]:
+    """The files of the block or Mokume sample folder ``folder`` that woodcam may read, sorted:
+    what :func:`woodcam.stock.spec_digest` hashes, so that a file woodcam never reads (the
+    user's notes.txt, a README, an editor's .xcf) does not make a baked part's block "changed
+    since baked". A Mokume folder: its sample files (:func:`mokume_kind`). A manifest folder:
+    every file its ``block.json`` names (any suffix, inside the folder), and every file of a
+    kind the readers open (:data:`_READ_SUFFIXES` and the photo formats): ring detection reads
+    its record and the user's edited maps and SVGs by name. Hidden files are left out."""
+    from .photos import PHOTO_SUFFIXES
+
+    files = [p for p in folder.rglob("*") if p.is_file() and not p.name.startswith(".")]
+    if not (folder / MANIFEST).is_file():
+        return sorted(p for p in files if p.parent == folder and mokume_kind(p))
+    named: set[Path] = set()
+    try:
+        from .._readers import read_json_file
+        from ._schema import check_manifest
+
+        m = check_manifest(read_json_file(folder / MANIFEST, "block manifest"), folder,
+                           str(folder / MANIFEST), False)
+        named = {Path(p).resolve() for p in m["_paths"].values()}
+    except WoodcamError:  # reading the block says what is wrong; digest the readable kinds
+        pass
+    kinds = (*_READ_SUFFIXES, *PHOTO_SUFFIXES)
+    return sorted(p for p in files if p.suffix.lower() in kinds or p.resolve() in named)
+
+
 def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *, name: str | None = None) -> Block:
     """Read one Mokume sample folder (``X_col.png``, ``X_arl-unet.png``, ... for X = A..F).
 
