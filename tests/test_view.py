@@ -273,7 +273,11 @@ def test_screenshot_without_size_frames_the_part(tmp_path):
 
 def test_part_outside_the_block_stays_in_the_picture(tmp_path):
     far = _textured_box(center=(140.0, 40.0, 20.0))      # x in 110..170, block x in 0..100
-    img = _read(preview(far, size_mm=SIZE, screenshot=tmp_path / "p.png", window_size=SMALL))
+    from woodcam.errors import WoodcamWarning
+
+    # drawn, and said (test_preview_warns_of_a_part_reaching_outside_its_block)
+    with pytest.warns(WoodcamWarning, match="lies outside its block"):
+        img = _read(preview(far, size_mm=SIZE, screenshot=tmp_path / "p.png", window_size=SMALL))
     assert (_red(img) | _blue(img)).mean() > 0.05
 
 
@@ -885,3 +889,26 @@ def test_placement_panels_colour_a_users_slightly_dirty_mesh(tmp_path):
                               list(meshes), tmp_path / "panels.png", panel_px=96)
     with Image.open(png) as im:
         assert im.size == (96 * len(meshes), 96)
+
+
+def test_preview_warns_of_a_part_reaching_outside_its_block(tmp_path):
+    """preview drew a part reaching past a --block smaller than it was baked from (or turned)
+    without the "reaches outside its block" warning review gives; one check says it for both
+    (woodcam.frames.check_part_in_block). A part wholly outside is drawn, with a warning; a part
+    inside says nothing."""
+    import warnings
+
+    from woodcam.errors import WoodcamWarning
+
+    box = _textured_box()                              # x 20..80, y 20..60, z 10..30 mm
+    with pytest.warns(WoodcamWarning, match=r"^preview: the part reaches outside its block, 30 mm past its "
+                      r"right face \(x = 50 mm\): the part's bounding box is \(20, 20, 10\) mm to \(80, 60, 30\) "
+                      r"mm, the block's \(0, 0, 0\) mm to \(50, 80, 40\) mm; the part there would be carved from "
+                      r"air, and the cut plane shows no wood of it"):
+        preview(box, wood=GreenWood(), size_mm=(50.0, 80.0, 40.0), screenshot=tmp_path / "a.png",
+                window_size=SMALL)
+    with pytest.warns(WoodcamWarning, match=r"lies outside its block"):
+        preview(box, size_mm=(10.0, 10.0, 10.0), screenshot=tmp_path / "b.png", window_size=SMALL)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        preview(box, size_mm=SIZE, screenshot=tmp_path / "c.png", window_size=SMALL)

@@ -427,3 +427,53 @@ def obj_header_transform(path) -> np.ndarray | None:
         )
     return obj_transform(units, up)
 
+
+
+def check_part_in_block(lo: ArrayLike, hi: ArrayLike, size_mm: ArrayLike, who: str, *,
+                        shows: str, wholly_outside: Literal["error", "warn"] = "error",
+                        stacklevel: int = 3) -> None:
+    """The one check that a part drawn in its block lies in it: ``lo``, ``hi`` (3,) mm the
+    part's bounding box and ``size_mm`` (3,) the block's, block frame (origin at the block's
+    bottom-front-left corner). A part wholly outside is a WoodcamError (``wholly_outside=
+    "error"``: review has no wood to show) or a warning (``"warn"``: preview still draws it);
+    one reaching past a face by more than :data:`woodcam.tolerances.ON_FACE_TOL_MM` a
+    WoodcamWarning saying how far past which faces (a GLB opened with another, smaller --block
+    than it was baked from; another program's GLB), as :func:`woodcam.cad.carve.carve` says it
+    for bake. ``who`` starts the messages (``"review: 'part.glb'"``); ``shows`` says what the
+    view shows no wood in (``"the page's section"``, ``"the cut plane"``)."""
+    import warnings
+
+    from .errors import WoodcamWarning
+    from .tolerances import ON_FACE_TOL_MM
+
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    block = np.asarray(size_mm, dtype=float)
+
+    def box(a, b):
+        return f"{say_length(tuple(a.tolist()), '.4g', form='({}, {}, {})')} to " \
+               f"{say_length(tuple(b.tolist()), '.4g', form='({}, {}, {})')}"
+
+    where = f"the part's bounding box is {box(lo, hi)}, the block's {box(np.zeros(3), block)}"
+    if (lo >= block - ON_FACE_TOL_MM).any() or (hi <= ON_FACE_TOL_MM).any():
+        lost = "it has no wood of this block to show" if wholly_outside == "error" else \
+            f"{shows} shows no wood of this block in it"
+        said = (f"{who} lies outside its block: {where} (block frame: origin at the bottom-front-left corner); "
+                f"{lost}: give the block it was baked from (--block), or bake it from this one (woodcam bake, "
+                "which carves it from the block)")
+        if wholly_outside == "error":
+            raise WoodcamError(said)
+        warnings.warn(said, WoodcamWarning, stacklevel=stacklevel)
+        return
+    past = []  # (mm, face) for each face the part reaches beyond
+    for axis, (low, high) in enumerate((("left", "right"), ("front", "back"), ("bottom", "top"))):
+        c = "xyz"[axis]
+        if -lo[axis] > ON_FACE_TOL_MM:
+            past.append((-lo[axis], f"its {low} face ({c} = 0)"))
+        if hi[axis] - block[axis] > ON_FACE_TOL_MM:
+            past.append((hi[axis] - block[axis], f"its {high} face ({c} = {say_length(block[axis], '.4g')})"))
+    if past:
+        said = ", ".join(f"{say_length(d, '.3g')} past {face}" for d, face in past)
+        warnings.warn(
+            f"{who} reaches outside its block, {said}: {where}; the part there would be carved from air, and "
+            f"{shows} shows no wood of it; give the block it was baked from (--block), or bake it from this one "
+            "(woodcam bake carves it from the block)", WoodcamWarning, stacklevel=stacklevel)

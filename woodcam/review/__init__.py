@@ -257,43 +257,12 @@ def _part_bounds(glb_path: Path, part_glb: bytes) -> np.ndarray:
 
 
 def _check_part_in_block(glb_path: Path, part_glb: bytes, size: list[float]) -> None:
-    """Refuse a part wholly outside the ``size`` mm block, and warn of one reaching past it (a
-    GLB reviewed with another, smaller --block than it was baked from; another program's GLB),
-    as :func:`woodcam.cad.carve.carve` does for bake: the page's section has no wood there, the
-    part would be carved from air. Where it reaches, face by face, in mm."""
-    import warnings
-
-    from ..errors import WoodcamWarning
-    from ..tolerances import ON_FACE_TOL_MM
-    from ..units import say_length
+    """Refuse a part wholly outside the ``size`` mm block, and warn of one reaching past it:
+    :func:`woodcam.frames.check_part_in_block`, the check preview makes too."""
+    from ..frames import check_part_in_block
 
     lo, hi = _part_bounds(glb_path, part_glb)
-    block = np.asarray(size, dtype=float)
-
-    def box(a, b):
-        return f"{say_length(tuple(a.tolist()), '.4g', form='({}, {}, {})')} to " \
-               f"{say_length(tuple(b.tolist()), '.4g', form='({}, {}, {})')}"
-
-    where = f"the part's bounding box is {box(lo, hi)}, the block's {box(np.zeros(3), block)}"
-    if (lo >= block - ON_FACE_TOL_MM).any() or (hi <= ON_FACE_TOL_MM).any():
-        raise WoodcamError(
-            f"review: {str(glb_path)!r} lies outside its block: {where} (block frame: origin at the "
-            "bottom-front-left corner); it has no wood of this block to show: give the block it was "
-            "baked from (--block), or bake it from this one (woodcam bake, which carves it from the block)")
-    past = []  # (mm, face) for each face the part reaches beyond
-    for axis, (low, high) in enumerate((("left", "right"), ("front", "back"), ("bottom", "top"))):
-        c = "xyz"[axis]
-        if -lo[axis] > ON_FACE_TOL_MM:
-            past.append((-lo[axis], f"its {low} face ({c} = 0)"))
-        if hi[axis] - block[axis] > ON_FACE_TOL_MM:
-            past.append((hi[axis] - block[axis], f"its {high} face ({c} = {say_length(block[axis], '.4g')})"))
-    if past:
-        said = ", ".join(f"{say_length(d, '.3g')} past {face}" for d, face in past)
-        warnings.warn(
-            f"review: {str(glb_path)!r} reaches outside its block, {said}: {where}; the part there "
-            "would be carved from air, and the page's section shows no wood of it; give the block it was "
-            "baked from (--block), or bake it from this one (woodcam bake carves it from the block)",
-            WoodcamWarning, stacklevel=3)
+    check_part_in_block(lo, hi, size, f"review: {str(glb_path)!r}", shows="the page's section", stacklevel=4)
 
 
 def _part_glb_bytes(glb_path: Path) -> bytes:

@@ -927,6 +927,15 @@ def preview(
     _check_wood(wood)
     _check_size_with_wood(wood, None if size_mm is None else check_size(size_mm))
     mesh = _load_mesh(mesh_or_path)
+    if size_mm is not None:
+        # the part drawn reaching past its block (another --block than it was baked from) said
+        # nothing here where review warned: one check, frames.check_part_in_block
+        from ..frames import check_part_in_block
+
+        who = (f"preview: {str(mesh_or_path)!r}" if isinstance(mesh_or_path, (str, os.PathLike))
+               else "preview: the part")
+        check_part_in_block(*np.asarray(mesh.bounds, dtype=float), check_size(size_mm), who,
+                            shows="the cut plane", wholly_outside="warn")
 
     off_screen = screenshot is not None
     if off_screen:
