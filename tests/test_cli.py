@@ -638,3 +638,52 @@ def test_a_mistyped_command_or_choice_is_offered_the_nearest(argv, said, capsys)
     near = {"logs": "'log'", "rendr": "'render'", "isso": "'iso'"}[said.split("'")[1]]
     assert err.count("\n") == 1 and said in err and err.rstrip().endswith(f"; did you mean {near}? (see "
                                                                          f"'{err.split(':')[0]} --help')"), err
+
+
+@pytest.mark.parametrize("blob, said", [
+    (b"", "'{}' is empty (0 bytes)"),
+    (b"glT", "'{}' is 3 bytes, too short to be a GLB file"),
+    (b"PK\x03\x04" + b"\0" * 40, "'{}' is no glTF 2.0 binary (it starts b'PK\\x03\\x04', not b'glTF' version 2)"),
+])
+@pytest.mark.parametrize("argv", [["preview", "{}", "--screenshot", "{}.png"], ["review", "{}", "--out", "{}.html"]])
+def test_a_glb_that_is_no_glb_is_named_at_the_door(tmp_path, capsys, blob, said, argv):
+    """'woodcam preview notglb.glb' (3 bytes) said "read_glb_metadata: 'notglb.glb' is 3 bytes, ..."
+    (a function's name the user never typed) and exited 1, after the work began: a file of
+    another kind under the .glb suffix is refused at the door, naming the argument (exit 2, as
+    a wrong suffix is); a GLB whose JSON is bad is still the reader's (exit 1)."""
+    from woodcam.cli import EXIT_USAGE
+
+    path = tmp_path / "part.glb"
+    path.write_bytes(blob)
+    assert main([a.format(path) for a in argv]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    arg = "MESH of 'woodcam preview'" if argv[0] == "preview" else "PART of 'woodcam review'"
+    assert err.count("\n") == 1 and err.startswith(f"woodcam: error: {arg}: {said.format(path)}; give a .glb "
+                                                   "written by woodcam bake"), err
+    assert "read_glb_metadata" not in err
+
+
+def test_errors_name_what_the_user_typed_not_internal_names(tmp_path, capsys):
+    """'woodcam log' said "required: log_command", 'woodcam bench report DIR' of a folder no run
+    wrote "run_dir must be ..." (or out_dir), 'preview empty.stl' "mesh_or_path: the mesh has no
+    faces": names of the code, not of what was typed."""
+    from woodcam.cli import EXIT_ERROR
+
+    with pytest.raises(SystemExit):
+        main(["log"])
+    assert "the following arguments are required: {render,maps,export}" in capsys.readouterr().err
+    empty = tmp_path / "norun"
+    empty.mkdir()
+    assert main(["bench", "report", str(empty), "--out", str(tmp_path / "rep")]) == EXIT_ERROR
+    err = capsys.readouterr().err
+    assert f"run folder {str(empty)!r} has no run.json, so no bench run wrote it" in err and "run_dir" not in err
+    from woodcam.errors import WoodcamError
+    from woodcam.scale import read_records
+
+    with pytest.raises(WoodcamError, match=r"^run folder '.*norun' has no records/ sub-folder, so no bench run"):
+        read_records(empty)
+    stl = tmp_path / "empty.stl"
+    stl.write_bytes(b"solid x\nendsolid x\n")
+    assert main(["preview", str(stl), "--screenshot", str(tmp_path / "v.png")]) == EXIT_ERROR
+    err = capsys.readouterr().err
+    assert f"mesh file {str(stl)!r} has no faces" in err and "mesh_or_path" not in err

@@ -13,6 +13,10 @@ from woodcam.appearance.knots import KnotShading
 REPO = Path(__file__).resolve().parents[1]
 HEAVY = ("numpy", "scipy", "numba", "torch", "trimesh", "PIL", "pyvista", "cv2", "skimage")
 
+#: A GLB's 12-byte header (magic, version 2, length): enough for the input door, which refuses a
+#: .glb that is no glTF binary (an empty placeholder was let through before)
+_GLB_HEADER = b"glTF\x02\x00\x00\x00\x0c\x00\x00\x00"
+
 
 def test_help_imports_nothing_heavy():
     """``woodcam --help`` (every command registered) loads no numeric or CAD library."""
@@ -115,7 +119,7 @@ def test_preview_names_its_own_arguments_and_ignores_nothing_silently(tmp_path, 
     assert exc.value.code == 2
     assert "--cut-normal '0,0,0': a direction must not be zero" in capsys.readouterr().err
     glb = tmp_path / "part.glb"
-    glb.write_bytes(b"")
+    glb.write_bytes(_GLB_HEADER)  # the input door reads the GLB magic; preview is stubbed
     assert cli.main(["preview", str(glb), "--screenshot", "--no-cut", "--cut-origin", "1,2,3",
                      "--cut-normal", "0,0,1"]) == 0
     assert ("woodcam: warning: --cut-origin and --cut-normal place the cut plane, which --no-cut "
@@ -162,7 +166,7 @@ def test_preview_screenshot_takes_an_optional_name_like_bake_and_gcode(tmp_path,
     got = []
     monkeypatch.setattr(view, "preview", lambda mesh, **kw: got.append(kw["screenshot"]))
     glb = tmp_path / "bowl.glb"
-    glb.write_bytes(b"")
+    glb.write_bytes(_GLB_HEADER)  # the input door reads the GLB magic; preview is stubbed
     monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block, **kw: None)
     assert cli.main(["preview", str(glb), "--screenshot"]) == 0
     assert cli.main(["preview", str(glb), "--screenshot", str(tmp_path / "x.png")]) == 0
@@ -182,7 +186,7 @@ def test_a_second_run_in_one_process_prints_its_warnings_too(tmp_path, monkeypat
     monkeypatch.setattr("woodcam.cli.options.stock_of_glb", lambda mesh, block, **kw: None)
     monkeypatch.setattr("woodcam.cli.options.recorded_block_size", lambda mesh: None)
     glb = tmp_path / "part.glb"
-    glb.write_bytes(b"")
+    glb.write_bytes(_GLB_HEADER)  # the input door reads the GLB magic; preview is stubbed
     argv = ["preview", str(glb), "--screenshot", "--no-cut", "--cut-origin", "1,2,3"]
     for _ in range(2):
         assert cli.main(argv) == 0

@@ -625,12 +625,17 @@ def test_preview_overlay_is_checked_before_drawing(tmp_path, overlay, said):
 
 
 def test_preview_rejects_bad_meshes(tmp_path):
-    with pytest.raises(WoodcamError, match="no file at"):
+    # the file as given, not the parameter's name (it said "mesh_or_path: no file at ...")
+    with pytest.raises(WoodcamError, match=r"^mesh file '.*missing.glb' does not exist"):
         preview(tmp_path / "missing.glb", screenshot=tmp_path / "p.png")
     with pytest.raises(WoodcamError, match="must be a trimesh.Trimesh"):
         preview(np.zeros((3, 3)), screenshot=tmp_path / "p.png")
     with pytest.raises(WoodcamError, match="no faces"):
         preview(trimesh.Trimesh(), screenshot=tmp_path / "p.png")
+    empty = tmp_path / "empty.stl"
+    empty.write_bytes(b"solid x\nendsolid x\n")
+    with pytest.raises(WoodcamError, match=r"^mesh file '.*empty.stl' has no faces, nothing to preview"):
+        preview(empty, screenshot=tmp_path / "p.png")
 
 
 def test_interactive_without_display_says_use_screenshot(monkeypatch):

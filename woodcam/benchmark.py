@@ -511,8 +511,9 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
     run_dir, out = Path(run_dir), Path(out_dir)
     mpath = run_dir / RUN_MANIFEST
     if not mpath.is_file():
-        raise WoodcamError(f"run_dir must be a bench run folder with {RUN_MANIFEST}; {str(run_dir)!r} "
-                           f"has none (make one with `woodcam bench run --out DIR`)")
+        # the folder as given ('bench report RUN'), not the parameter's name the user never typed
+        raise WoodcamError(f"run folder {str(run_dir)!r} has no {RUN_MANIFEST}, so no bench run wrote it; "
+                           "make one with `woodcam bench run --out DIR` and give that DIR")
     # strict, and a run's manifest: '{' or a list was an internal error (JSONDecodeError, TypeError)
     again = f"delete the run folder {str(run_dir)!r} and run `woodcam bench run` again"
     try:

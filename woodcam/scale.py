@@ -169,8 +169,9 @@ def read_records(out_dir: str | Path) -> dict[str, dict]:
     """
     folder = check_path(out_dir, "read_records: out_dir", fix="the run folder given to run_many") / RECORDS_DIR
     if not folder.is_dir():
-        raise WoodcamError(f"out_dir must be a run folder with a {RECORDS_DIR}/ sub-folder; "
-                           f"{str(out_dir)!r} has none (run `woodcam bench run --out DIR` first)")
+        # the folder as given ('bench report RUN'), not the parameter's name the user never typed
+        raise WoodcamError(f"run folder {str(out_dir)!r} has no {RECORDS_DIR}/ sub-folder, so no bench run "
+                           "wrote it; run `woodcam bench run --out DIR` first and give that DIR")
     out = {}
     for p in sorted(folder.glob("[!.]*.json")):
         try:

@@ -148,14 +148,17 @@ def test_cli_renders_a_log_file(tmp_path):
             assert im.mode == "RGB"
 
 
-def test_cli_maps_and_export_round_trip(tmp_path):
+def test_cli_maps_and_export_round_trip(tmp_path, capsys):
     src = write_log(_log(), tmp_path / "log.json")
     a = _parse(["log", "maps", str(src), "--out", str(tmp_path / "maps")])
     assert a.func(a) == 0
+    capsys.readouterr()
     # into a folder not made yet, as every other FILE output (it failed: no such file)
     b = _parse(["log", "export", "--maps", str(tmp_path / "maps"), "--out",
                 str(tmp_path / "new" / "back.json")])
     assert b.func(b) == 0
+    # "wrote PATH", as bake, preview, fit and block say (it printed the bare path)
+    assert capsys.readouterr().out == f"wrote {tmp_path / 'new' / 'back.json'}\n"
     from woodcam.logs.io import read_log
 
     log, back = _log(), read_log(tmp_path / "new" / "back.json")

@@ -18,7 +18,8 @@ from .options import add_input, SPECIES_HELP, add_knot_options, add_out_option, 
 def register(subparsers) -> None:
     """Add the ``log`` command (with ``render``, ``maps``, ``export``) to ``subparsers``."""
     p = subparsers.add_parser("log", help="knotted logs: render sections, convert log files")
-    sub = p.add_subparsers(dest="log_command", required=True)
+    # named by its choices, as block's and bench's: 'woodcam log' said "required: log_command"
+    sub = p.add_subparsers(dest="log_command", required=True, metavar="{render,maps,export}")
 
     def source(sp):
         add_input(sp, "log_file", kind="file", nargs="?", help="woodcam log file (JSON, mm)")
@@ -92,7 +93,7 @@ def run(args) -> int:
     if args.log_command == "export":
         from ..logs.io import write_log
 
-        print(write_log(log, out))
+        print(f"wrote {write_log(log, out)}")  # as every command says what it wrote
         return 0
     if args.log_command == "maps":
         from ..logs.maps import write_maps

@@ -327,7 +327,9 @@ def check_inputs(args: argparse.Namespace) -> None:
     A FILE of a suffix its reader does not take (``add_input(suffixes=)``) is refused too, and a
     turn or resize on a block a command reads as it is (``add_input(as_is=True)``).
     A missing part, program or block folder was the command's own error (exit 1), some after the
-    block was opened; an input that exists but whose contents are bad still is (exit 1)."""
+    block was opened; an input that exists but whose contents are bad still is (exit 1), but a
+    ``.glb`` that is no GLB at all (:func:`_check_glb_header`), a file of another kind."""
+    glbs: list[tuple[Path, str]] = []
     for arg in getattr(args, "_inputs", ()):
         value = getattr(args, arg.dest, None)
         for item in value if isinstance(value, list) else [] if value is None else [value]:
@@ -335,6 +337,10 @@ def check_inputs(args: argparse.Namespace) -> None:
                 _check_input(str(text), arg.name, arg.kind, args, as_is=arg.as_is)
                 if arg.suffixes:
                     _check_suffix(Path(text), arg.name, arg.suffixes(), args)
+                    glbs.append((Path(text), arg.name))
+    # the files' first bytes last: every path there and of its kind first, whichever came first
+    for path, name in glbs:
+        _check_glb_header(path, name, args)
 
 
 def _check_suffix(path: Path, name: str, accepted: tuple[str, ...], args: argparse.Namespace) -> None:
@@ -349,6 +355,26 @@ def _check_suffix(path: Path, name: str, accepted: tuple[str, ...], args: argpar
     raise UsageError(f"{name} of 'woodcam {_command_name(args)}': {str(path)!r} {said}, which it "
                      f"cannot read; it must end in {', '.join(accepted)}; save the file as one of "
                      f"them{cad}")
+
+
+def _check_glb_header(path: Path, name: str, args: argparse.Namespace) -> None:
+    """Refuse a FILE named ``.glb`` that is no glTF 2.0 binary (its first 12 bytes: the magic
+    ``glTF`` and version 2, glTF 2.0 spec, "GLB File Format"): a file of another kind under the
+    suffix, the suffix check's mistake (exit 2), not a GLB whose contents are bad. It exited 1
+    from the GLB reader ("read_glb_metadata: 'x.glb' is 3 bytes, ..."), after the work began."""
+    if path.suffix.lower() != ".glb" or not path.is_file():
+        return
+    try:
+        with path.open("rb") as f:
+            head = f.read(12)
+    except OSError:  # unreadable: the reader says why (permission), exit 1
+        return
+    if len(head) == 12 and head[:4] == b"glTF" and int.from_bytes(head[4:8], "little") == 2:
+        return
+    said = ("is empty (0 bytes)" if not head else f"is {len(head)} bytes, too short to be a GLB file"
+            if len(head) < 12 else f"is no glTF 2.0 binary (it starts {head[:4]!r}, not b'glTF' version 2)")
+    raise UsageError(f"{name} of 'woodcam {_command_name(args)}': {str(path)!r} {said}; give a .glb written by "
+                     "woodcam bake or another glTF exporter, or name the file by its own kind (.obj, .stl, ...)")
 
 
 def part_suffixes() -> tuple[str, ...]:

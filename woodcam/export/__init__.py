@@ -580,9 +580,11 @@ def read_glb_metadata(path: PathLike) -> dict:
     try:
         data = path.read_bytes()
     except OSError as err:
-        raise WoodcamError(f"read_glb_metadata: cannot read {str(path)!r} ({err.strerror})") from err
-    tree = glb_json(data, f"read_glb_metadata: {str(path)!r}")
-    bad = f"read_glb_metadata: {str(path)!r} has a malformed glTF JSON chunk"
+        raise WoodcamError(f"GLB file {str(path)!r}: cannot read it ({err.strerror})") from err
+    # the file as the user gave it, not this function's name (a command-line user read
+    # "read_glb_metadata: 'x.glb' is 3 bytes ..." of the file they typed)
+    tree = glb_json(data, f"GLB file {str(path)!r}")
+    bad = f"GLB file {str(path)!r} has a malformed glTF JSON chunk"
     scenes = tree.get("scenes") or [{}]
     index = tree.get("scene", 0)
     if (not isinstance(scenes, list) or isinstance(index, bool) or not isinstance(index, int)

@@ -223,11 +223,14 @@ def _load_mesh(mesh_or_path):
     """A ``trimesh.Trimesh`` from a mesh, a scene or a path (scenes are concatenated)."""
     import trimesh
 
+    # what the messages call it: the file as given (a command-line user typed it), else the mesh
+    what = f"mesh file {str(mesh_or_path)!r}" if isinstance(mesh_or_path, (str, os.PathLike)) else \
+        "mesh_or_path (the mesh given)"
     if isinstance(mesh_or_path, (str, os.PathLike)):
         path = Path(mesh_or_path)
         if not path.is_file():
             raise WoodcamError(
-                f"mesh_or_path: no file at {str(path)!r}; pass a {'/'.join(MESH_SUFFIXES)} file "
+                f"mesh file {str(path)!r} does not exist; pass a {'/'.join(MESH_SUFFIXES)} file "
                 "written by woodcam (e.g. out/part.glb) or a trimesh.Trimesh"
             )
         from woodcam.export import load_textured, written_by_woodcam
@@ -240,14 +243,14 @@ def _load_mesh(mesh_or_path):
             loaded = load_textured(path) if ours else trimesh.load(path, force="mesh")
         except Exception as err:  # trimesh raises many types for unreadable files
             raise WoodcamError(
-                f"mesh_or_path: could not read a mesh from {str(path)!r} ({err}); "
+                f"mesh file {str(path)!r} could not be read as a mesh ({err}); "
                 f"pass a {'/'.join(MESH_SUFFIXES)} file"
             ) from err
         mesh_or_path = loaded if ours else foreign_gltf_in_block_frame(loaded, path, stacklevel=2)
     if isinstance(mesh_or_path, trimesh.Scene):
         meshes = [g for g in mesh_or_path.dump() if isinstance(g, trimesh.Trimesh)]
         if not meshes:
-            raise WoodcamError("mesh_or_path: the scene holds no triangle mesh")
+            raise WoodcamError(f"{what} holds no triangle mesh; give a part with faces")
         mesh_or_path = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
     if not isinstance(mesh_or_path, trimesh.Trimesh):
         raise WoodcamError(
@@ -255,7 +258,8 @@ def _load_mesh(mesh_or_path):
             f"got {type(mesh_or_path).__name__}"
         )
     if len(mesh_or_path.faces) == 0:
-        raise WoodcamError("mesh_or_path: the mesh has no faces; nothing to preview")
+        raise WoodcamError(f"{what} has no faces, nothing to preview; give a part with faces (an empty export: "
+                           "export it again)")
     return mesh_or_path
 
 
