@@ -261,3 +261,16 @@ def test_the_held_out_picture_says_its_colours_and_shares(field, mapped, tmp_pat
     assert said == "b, radial: each face predicted\n" + holdout.HOLDOUT_KEY
     assert "blue its ridge" in said and "red the predicted ring lines" in said and "within 1 / 2 px" in said
     assert (tmp_path / "h.png").stat().st_size > 0
+
+
+def test_picture_titles_say_arf_in_words():
+    """'eval appearance' titled its picture "held-out faces (ARF of field input)" and the
+    leave-one-face-out PNG a column "predicted ARF": the papers' abbreviation of the annual-ring
+    field, which no reader of the picture is told."""
+    from woodcam.cli.appearance import holdout_title
+    from woodcam.inference.holdout import HOLDOUT_COLUMNS
+
+    assert holdout_title("H11", True) == "H11: held-out faces (input: the rings of the field)"
+    assert holdout_title("H11", False) == "H11: held-out faces (input: the ring map)"
+    assert HOLDOUT_COLUMNS[2] == "predicted rings (annual-ring field)"
+    assert not any("ARF" in t for t in (*HOLDOUT_COLUMNS, holdout_title("b", True)))

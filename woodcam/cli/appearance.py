@@ -84,7 +84,7 @@ def _run(args) -> None:
                                  progress=not args.quiet)
         name = block.name.replace("/", "_")
         side_by_side(res, args.out / f"{name}.png",
-                     title=f"{block.name}: held-out faces ({'ARF of field' if field else 'ring map'} input)")
+                     title=holdout_title(block.name, field is not None))
         report[block.name] = {"faces": {r.face: {"end_grain": r.end_grain, "scores": r.scores} for r in res},
                               "summary": summarise(res)}
         s = report[block.name]["summary"]["all"]
@@ -92,3 +92,10 @@ def _run(args) -> None:
             f"{m} hist {s[m]['histogram']:.3f} spec {s[m]['spectrum']:.3f} patch {s[m]['patch']:.3f}"
             for m in MODELS if m in s))
     write_text(args.out / "results.json", json.dumps(report, indent=1))
+
+
+def holdout_title(name: str, field: bool) -> str:
+    """The title of 'eval appearance's picture of block ``name``, whose networks took the rings
+    of a field (``field``) or the block's ring map: in words (it said "ARF of field input", the
+    papers' abbreviation of the annual-ring field)."""
+    return f"{name}: held-out faces (input: {'the rings of the field' if field else 'the ring map'})"

@@ -326,6 +326,11 @@ HOLDOUT_KEY = ("overlay: grey ring map, blue its ridge, red the predicted ring l
                "(not scored)\nunder it: % of ridge / line points within 1 / 2 px of the other")
 
 
+#: :func:`plot_holdout`'s column titles, in words: the third said "predicted ARF" (the
+#: annual-ring field of eq. 6, (years mod 1)^2, a name from the papers no reader of the picture knows)
+HOLDOUT_COLUMNS = ("photo", "ring map", "predicted rings (annual-ring field)", "overlay")
+
+
 def plot_holdout(path, block, scores: list[FaceScore], title: str = "", confidence: bool = False):
     """PNG, one row per face: photo, ring map, predicted ARF (eq. 6), overlay (grey ring map,
     blue ridge pixels, red predicted ring lines, knot margin hatched out).
@@ -340,8 +345,8 @@ def plot_holdout(path, block, scores: list[FaceScore], title: str = "", confiden
     fig, axes = plt.subplots(len(scores), 4, figsize=(8.4, 2.2 * len(scores)), squeeze=False)
     for r, sc in enumerate(scores):
         f = block.faces[sc.face]
-        panels = [(f.photo, "photo", None), (f.ring_map, "ring map", "gray"),
-                  (arf(sc.years), "predicted ARF", "gray"), (f.ring_map, "overlay", "gray")]
+        panels = list(zip((f.photo, f.ring_map, arf(sc.years), f.ring_map), HOLDOUT_COLUMNS,
+                          (None, "gray", "gray", "gray")))
         for c, (img, label, cmap) in enumerate(panels):
             ax = axes[r, c]
             if img is None:
@@ -382,6 +387,7 @@ def plot_holdout(path, block, scores: list[FaceScore], title: str = "", confiden
     return path
 
 
-__all__ = ["ALL_FACES", "BEST_PHASE", "CONTROL", "STRAIGHT", "STRAIGHT_OWN", "FaceScore", "face_years", "holdout_table",
+__all__ = ["ALL_FACES", "BEST_PHASE", "CONTROL", "HOLDOUT_COLUMNS", "STRAIGHT", "STRAIGHT_OWN", "FaceScore",
+           "face_years", "holdout_table",
            "leave_one_face_out", "plot_holdout", "ridge_pixels", "ring_lines_px", "score_face",
            "straight_rings"]
