@@ -433,6 +433,15 @@ def test_clicking_a_hotspot_moves_the_view_to_it(page, browser, tmp_path):
     extent = np.ptp(_ndc(browser, "ndcBlock").reshape(2, 2), axis=0).max()
     items = "document.querySelectorAll('#hotspots li')"
     assert browser.evaluate(f"{items}.length") == 2
+    # the spot on the side cut away is hidden with it (it floated in the air, drawn through
+    # everything), its list item says so; the cut moved past both, both shown
+    shown = "document.getElementById('probe').dataset.hotspotsShown"
+    assert browser.evaluate(shown) == "1"
+    assert browser.evaluate(f"{items}[1].title").startswith("on the side cut away (hidden)")
+    browser.evaluate("(() => { const p = document.getElementById('cut-pos'); p.value = 5; p.oninput(); })()")
+    assert browser.evaluate(shown) == "2" and browser.evaluate(f"{items}[1].title") == "click: look at it"
+    browser.evaluate("(() => { const p = document.getElementById('cut-pos'); p.value = 40; p.oninput(); })()")
+    assert browser.evaluate(shown) == "1"
     for k, spot in enumerate(spots):
         browser.evaluate(f"{items}[{k}].click()")
         _frames(browser)
@@ -442,6 +451,7 @@ def test_clicking_a_hotspot_moves_the_view_to_it(page, browser, tmp_path):
         # the first spot lies beyond the cut, the second on the side cut away
         assert browser.evaluate("document.getElementById('cut-on').checked") is (k == 0)
     assert browser.evaluate("document.getElementById('cut-on').checked") is False
+    assert browser.evaluate(shown) == "2"  # no cut: every spot shown
     bare = write_review(glb, tmp_path / "none.html", wood=stock.wood, size_mm=stock.size_mm,
                         voxels=20000)
     assert '<h2>Hotspots</h2><i id="hotspots">none</i>' in bare.read_text()

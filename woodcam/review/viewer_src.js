@@ -191,6 +191,9 @@ const cut = { axis: cutAxis,
               on: cutArg[0] !== 'off' };
 const plane = new THREE.Plane();
 let capMesh = null, textures = {}, part = null;
+// the hotspot markers and their list items: a marker on the side cut away is hidden with it (it
+// floated in the air where the part is cut away, drawn through everything)
+const spots = [];
 const stencilGroup = new THREE.Group();
 scene.add(stencilGroup);
 
@@ -209,6 +212,13 @@ function updatePlane() {
   }
   if (part) part.traverse((o) => { if (o.material) o.material.clippingPlanes = cut.on ? [plane] : []; });
   stencilGroup.visible = cut.on;
+  for (const { marker, li } of spots) {
+    const away = cut.on && plane.distanceToPoint(marker.position) < -1e-6;
+    marker.visible = !away;
+    li.title = away ? 'on the side cut away (hidden); click: look at it, the cut turned off'
+      : 'click: look at it';
+  }
+  document.getElementById('probe').dataset.hotspotsShown = String(spots.filter((s) => s.marker.visible).length);
 }
 
 function buildCap() {
@@ -364,6 +374,7 @@ function addHotspots() {
       focusOn(h.at_mm);
     };
     list.appendChild(li);
+    spots.push({ marker: m, li });
   }
 }
 
