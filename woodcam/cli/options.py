@@ -212,6 +212,7 @@ def remove_empty_folders(tops: list[Path]) -> None:
             except OSError:  # not empty (or gone): kept
                 pass
 
+
 def _command_name(args: argparse.Namespace) -> str:
     """The command as typed, sub-command included (``block show``), for the doors' messages."""
     return " ".join(str(getattr(args, k)) for k in vars(args)
