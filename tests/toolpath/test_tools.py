@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from woodcam.errors import WoodcamError
+from woodcam.errors import WoodcamError, WoodcamWarning
 from woodcam.toolpath import (BallEndMill, BullNoseMill, ChamferMill, FlatEndMill,
                               SnubNoseVBit, TaperedBallMill, VBit, load_camotics_tools,
                               load_tool_table,
@@ -124,7 +124,8 @@ def test_new_profiles_specs_and_tables(tmp_path):
                  '"diameter": 0.25, "length": 1}, "2": {"units": "metric", "shape": "conical",'
                  ' "diameter": 10, "length": 5}, "3": {"shape": "snubnose", "diameter": 6, '
                  '"snub_diameter": 2, "length": 2}, "4": {"shape": "ballnose", "diameter": 3}}}')
-    tools = load_tool_table(j)
+    with pytest.warns(WoodcamWarning, match=r"tool 4 \(ballnose\) gives no \"length\""):
+        tools = load_tool_table(j)
     # a cylindrical tool's length is its cutting (flute) length: 1 inch
     assert tools[1] == FlatEndMill(6.35, flute_length_mm=25.4) and tools[4] == BallEndMill(3)
     assert tools[2] == VBit(10, angle_deg=90, flute_length_mm=5)
@@ -154,6 +155,45 @@ def test_a_camotics_table_reads_as_camotics_reads_it(tmp_path):
             load_camotics_tools(j)
     j.write_text('{"1": {"shape": "Sphere", "diameter": 6}}')
     with pytest.raises(WoodcamError, match="shape 'sphere' .*has no woodcam tool"):
+        load_camotics_tools(j)
+
+
+def test_a_camotics_entry_number_names_its_tool(tmp_path):
+    """CAMotics' Tool::read takes an entry's "number" over its key (ToolTable::set files the
+    tool under it): woodcam filed {"1": {"number": 3, ...}} as tool 1, so the program's T3 had
+    no tool and T1 cut with it. Two entries on one number (CAMotics keeps the later one, no
+    word) are refused, naming both keys; a number not a tool number is refused."""
+    j = tmp_path / "tools.json"
+    j.write_text('{"1": {"number": 3, "shape": "ballnose", "diameter": 6, "length": 20},'
+                 ' "2": {"shape": "cylindrical", "diameter": 3, "length": 12}}')
+    assert load_camotics_tools(j) == {3: BallEndMill(6, flute_length_mm=20),
+                                      2: FlatEndMill(3, flute_length_mm=12)}
+    j.write_text('{"1": {"number": 2, "shape": "ballnose", "diameter": 6, "length": 20},'
+                 ' "2": {"shape": "cylindrical", "diameter": 3, "length": 12}}')
+    with pytest.raises(WoodcamError, match="tool 2 and tool 1 are both tool 2 .*own number"):
+        load_camotics_tools(j)
+    for bad in ('"3"', "-1", "2.5", "true"):
+        j.write_text('{"1": {"number": %s, "shape": "ballnose", "diameter": 6, "length": 20}}' % bad)
+        with pytest.raises(WoodcamError, match='tool 1: "number" must be a tool number'):
+            load_camotics_tools(j)
+
+
+def test_a_camotics_tool_without_length_is_said(tmp_path):
+    """Without "length" CAMotics takes 10 mm; woodcam gives a cylindrical or ball-nose tool no
+    flute length (no limit) and refuses a cone. Neither was said: the tool's cuts past its
+    flutes then go unwarned, so one warning names the tools without a length; the cone's
+    refusal says "length" is missing rather than "got nan"."""
+    j = tmp_path / "tools.json"
+    j.write_text('{"1": {"shape": "cylindrical", "diameter": 3}, "2": {"shape": "ballnose",'
+                 ' "diameter": 6}, "5": {"shape": "ballnose", "diameter": 6, "length": 20}}')
+    with pytest.warns(WoodcamWarning, match=r'tools 1 \(cylindrical\), 2 \(ballnose\) give no '
+                      r'"length", so the flute length is unknown.*cannot be warned') as caught:
+        tools = load_camotics_tools(j)
+    assert len(caught) == 1 and tools[1] == FlatEndMill(3) and tools[2] == BallEndMill(6)
+    j.write_text('{"1": {"shape": "cylindrical", "diameter": 3, "length": 12}}')
+    load_camotics_tools(j)  # a length given: no word (filterwarnings = error)
+    j.write_text('{"1": {"shape": "cone", "diameter": 6}}')
+    with pytest.raises(WoodcamError, match='a conical tool needs "length" .*it has none'):
         load_camotics_tools(j)
 
 

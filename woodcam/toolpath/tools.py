@@ -52,7 +52,7 @@ import numpy as np
 
 from .._checks import check_path, real_numbers
 from .._types import ArrayLike, PathLike
-from ..errors import WoodcamError
+from ..errors import WoodcamError, WoodcamWarning
 from ..units import message_unit, message_units, say_length
 
 ToolType = Literal["flat", "ball", "bull", "vbit", "snub", "chamfer", "taperball"]
@@ -635,8 +635,12 @@ def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
     length of its conical part: included angle ``2 atan((D - d) / 2 / L)``. ``length`` is the
     cutter's length from its tip, all CAMotics' tool body: woodcam's ``flute_length_mm`` (a cut
     deeper is warned: the shank rubs), for a cone too; without it (CAMotics then takes 10 mm)
-    a cylindrical or ball-nose tool carries no reach and a cone is refused. Lengths in the
-    table's units; woodcam's tools in mm."""
+    a cylindrical or ball-nose tool carries no reach, said in one
+    :class:`~woodcam.errors.WoodcamWarning` naming those tools (no cut can then be warned as
+    deeper than its flutes), and a cone is refused. An entry's ``"number"`` is its tool number,
+    as in CAMotics (Tool::read, then ToolTable::set files it under that number), the key
+    without one; two entries on one number are refused (CAMotics keeps the later one without a
+    word). Lengths in the table's units; woodcam's tools in mm."""
     import json
 
     path = Path(path)
@@ -651,10 +655,19 @@ def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
         raise WoodcamError(f"load_camotics_tools: {path} has no tools; expected "
                            '{"tools": {"1": {"shape": "cylindrical", "diameter": 6.35, ...}}}')
     out: dict[int, Tool] = {}
+    filed: dict[int, str] = {}  # tool number -> the key of the entry that gave it
+    no_length: list[str] = []  # the tools without a length, said once below
     for key, e in table.items():
         if not isinstance(e, dict) or not str(key).isdigit():
             raise WoodcamError(f"load_camotics_tools: {path}: tool {key!r} must be a number "
                                "with an object of shape/diameter/length")
+        number = _camotics_number(e, key, path)
+        if number in filed:
+            raise WoodcamError(
+                f"load_camotics_tools: {path}: tool {key} and tool {filed[number]} are both tool "
+                f"{number} (an entry's \"number\" names its tool, the key without one; CAMotics "
+                f"keeps the later one without a word); give each entry its own number")
+        filed[number] = str(key)
         units = e.get("units", "metric")
         scale = _CAMOTICS_UNITS.get(units.lower()) if isinstance(units, str) else None
         if scale is None:  # 'Imperial' or 'inch', which CAMotics reads, were refused
@@ -674,12 +687,20 @@ def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
         # CAMotics' "length" of a cylindrical or ball-nose tool is its cutting length
         flute = num("length", 0.0)
         reach = {"flute_length_mm": flute} if flute > 0 else {}
+        if "length" not in e and shape in ("cylindrical", "ballnose"):
+            no_length.append(f"{number} ({shape})" if str(number) == str(key) else
+                             f"{number} ({shape}, key {key!r})")
         if shape == "cylindrical":
             tool: Tool = FlatEndMill(d, **reach)
         elif shape == "ballnose":
             tool = BallEndMill(d, **reach)
         else:
             tip = num("snub_diameter", 0.0) if shape == "snubnose" else 0.0
+            if "length" not in e:  # CAMotics would take 10 mm: a cone's angle is not guessed
+                raise WoodcamError(f"load_camotics_tools: {path}: tool {key}: a {shape} tool "
+                                   "needs \"length\" (the cone's height, which with the diameter "
+                                   "gives its angle), and it has none (CAMotics takes 10 mm); add "
+                                   "\"length\": L in the table's units")
             length = num("length")
             if not length > 0:
                 raise WoodcamError(f"load_camotics_tools: {path}: tool {key}: a {shape} tool "
@@ -689,5 +710,27 @@ def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
             # 60-degree V-bit cutting past its cone was simulated as if it cut there, no word)
             tool = SnubNoseVBit(d, angle_deg=angle, tip_diameter_mm=tip, **reach) if tip > 0 else \
                 VBit(d, angle_deg=angle, **reach)
-        out[int(key)] = tool
+        out[number] = tool
+    if no_length:
+        import warnings
+
+        warnings.warn(
+            f"load_camotics_tools: {path}: tool{'s' if len(no_length) > 1 else ''} "
+            f"{', '.join(no_length)} give{'' if len(no_length) > 1 else 's'} no \"length\", so "
+            "the flute length is unknown and a cut deeper than the flutes (the shank rubbing) "
+            "cannot be warned (CAMotics takes 10 mm); add \"length\": L, the cutting length in "
+            "the table's units", WoodcamWarning, stacklevel=2)
     return out
+
+
+def _camotics_number(entry: dict, key: str, path: Path) -> int:
+    """The tool number of the CAMotics tool table entry ``entry`` under ``key``: its
+    ``"number"`` where it has one (CAMotics' Tool::read reads it over the key), else the key."""
+    if "number" not in entry:
+        return int(key)
+    value = entry["number"]
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= 99999:
+        raise WoodcamError(f"load_camotics_tools: {path}: tool {key}: \"number\" must be a tool "
+                           f"number, a whole number 0..99999, got {value!r}; give the tool's "
+                           "number or leave it out (the key is then the number)")
+    return value
