@@ -663,6 +663,10 @@ def test_a_mesh_saved_in_metres_is_named_as_such(tmp_path, capsys):
     (msg,) = [line for line in capsys.readouterr().err.splitlines() if "metres" in line]
     assert msg.startswith("woodcam: warning: --obstacle '" + str(tmp_path / "m.stl") + "': the obstacle is only "), msg
     assert "never the obstacle's own" in msg and "the part's own" not in msg, msg
+    # and in an obstacle's words: it said "part files are read as millimetres ... nothing that
+    # small is carved" of a file that is grown around, not carved
+    assert "obstacle files are read as millimetres" in msg and "nothing that small bends the rings" in msg, msg
+    assert "part files" not in msg and "carved" not in msg, msg
 
 
 def test_a_mesh_saved_in_inches_is_named_as_such(tmp_path, capsys):
@@ -1030,3 +1034,25 @@ def test_a_small_obstacle_is_judged_beside_the_part(tmp_path, capsys):
     # and its fix too: it said "--units converts only the lengths typed as options, never the part's own"
     assert "never the part's own" in said[0] and "never the obstacle's own" not in said[0], said
     assert "never the obstacle's own" in said[1] and "the part's own" not in said[1], said
+    # a router bit's width is the part's reason (it is carved), the obstacle's the part's size
+    assert "router bit is wider" in said[0] and "part files are read" in said[0], said
+    assert "router bit" not in said[1] and "as the part's, is under 6.35 mm" in said[1], said
+    assert "obstacle files are read" in said[1], said
+
+
+def test_units_note_words_each_kind_of_obstacle_file():
+    """woodcam.cad.carve.units_note/units_hint in an obstacle's words for each kind of file (a
+    mesh, a script, a STEP file): "part files" / "a part script" and "nothing that small is
+    carved" were said of --obstacle files; the part's words, which bake and place share, stay."""
+    from woodcam.cad.carve import units_hint, units_note
+
+    assert units_note("p.stl")[0] == "part files are read as millimetres (STL, OBJ and PLY carry no units)"
+    assert units_note("o.stl", noun="obstacle")[0].startswith("obstacle files are read as millimetres")
+    assert units_note("p.py")[0].startswith("lengths in a part script or a build123d/cadquery shape")
+    assert units_note("o.py", noun="obstacle")[0].startswith("lengths in the obstacle's script or")
+    assert units_note("o.step", "metres", "obstacle") == units_note("p.step", "metres")  # no noun in it
+    tiny = ((0, 0, 0), (0.04, 0.04, 0.03))
+    part, obstacle = (units_hint(*tiny, None, "FIX", source="x.stl", noun=n) for n in ("part", "obstacle"))
+    assert part is not None and obstacle is not None
+    assert "nothing that small is carved" in part and "part files" in part, part
+    assert "nothing that small bends the rings" in obstacle and "carved" not in obstacle, obstacle

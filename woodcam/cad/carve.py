@@ -174,12 +174,14 @@ def carve(
     )
 
 
-def units_note(source: Any, unit: str = "inches") -> tuple[str, str]:
+def units_note(source: Any, unit: str = "inches", noun: str = "part") -> tuple[str, str]:
     """``(why, redo)``: why a part from ``source`` (a path, or an object :func:`load_part`
     takes) is read as millimetres, and how to save it right, true of its kind: the inch
     warning said 'STL, OBJ and PLY carry no units' of a STEP file (which carries its units,
     converted to mm) and of a build123d script. ``unit``: the unit it looks drawn in
-    (``inches``, ``metres``), which a STEP file's words name."""
+    (``inches``, ``metres``), which a STEP file's words name. ``noun``: what the file is
+    (``part``; ``obstacle`` for ``woodify --obstacle``, whose note said "part files are read as
+    millimetres")."""
     from pathlib import Path
 
     if isinstance(source, (str, Path)):
@@ -193,10 +195,11 @@ def units_note(source: Any, unit: str = "inches") -> tuple[str, str]:
                 f"was saved this small (as one drawn in {unit} under a millimetre setting is)",
                 f"re-export it with its units set to {unit}")
     if kind == "script":
-        return ("lengths in a part script or a build123d/cadquery shape carry no units and are read "
+        script = "a part script" if noun == "part" else f"the {noun}'s script"
+        return (f"lengths in {script} or a build123d/cadquery shape carry no units and are read "
                 "as millimetres",
                 "write its lengths in mm")
-    return "part files are read as millimetres (STL, OBJ and PLY carry no units)", "export it in mm"
+    return f"{noun} files are read as millimetres (STL, OBJ and PLY carry no units)", "export it in mm"
 
 
 def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX, *,
@@ -223,19 +226,26 @@ def units_hint(lo, hi, size_mm: ArrayLike | None, fix: str = UNITS_FIX, *,
         says inches (False: only the metres check; ``woodify --obstacle``, where a 5 mm pin is
         a real obstacle beside a real part).
     noun : what the message calls the thing measured without a block ("part", or "obstacle" for
-        ``woodify --obstacle``: "--obstacle 'pin.stl': the part is only ..." named the wrong one)."""
+        ``woodify --obstacle``: "--obstacle 'pin.stl': the part is only ..." named the wrong one),
+        and its files (:func:`units_note`) and why its size is implausible: a part is carved, an
+        obstacle grown around."""
     extent = np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float)
     with message_units("mm"):  # about the file's own numbers, read as mm whatever --units says
         if size_mm is None:
             longest = float(np.max(extent))
+            # an obstacle is grown around, not carved: its reason says so (it said "nothing that
+            # small is carved" and "a router bit is wider" of a woodify --obstacle)
+            part = noun == "part"
             if 0 < longest < FOREIGN_GLTF_METRES_BELOW:
-                unit, factor, small = "metres", 1e3, "nothing that small is carved"
+                unit, factor = "metres", 1e3
+                small = "nothing that small is carved" if part else "nothing that small bends the rings"
             elif inches and 0 < longest < INCHES_BELOW_MM:  # a 4-inch bowl saved in inches grew as a 4 mm speck
                 unit, factor = "inches", MM_PER_UNIT["inch"]
-                small = f"a {INCHES_BELOW_MM:g} mm (1/4-inch) router bit is wider than its longest side"
+                small = (f"a {INCHES_BELOW_MM:g} mm (1/4-inch) router bit is wider than its longest side" if part
+                         else f"its longest side, as the part's, is under {INCHES_BELOW_MM:g} mm (1/4 inch)")
             else:
                 return None
-            why, redo = units_note(source, unit)
+            why, redo = units_note(source, unit, noun)
             return (f"the {noun} is only {say_length(extent, '.3g')}: {why}, and {small}; "
                     f"it looks modelled in {unit} ({factor:g} times larger: "
                     f"{say_length(extent * factor, '.3g')}): scale it by {factor:g} {fix}, or {redo}")
