@@ -375,6 +375,39 @@ def test_views_frame_the_block_at_any_aspect_and_the_hash_sets_the_ui(page, brow
     assert browser.evaluate("document.getElementById('cut-label').textContent") == "x = 10.0 mm"
 
 
+
+def test_the_top_view_shows_the_part_uncut_until_the_cut_is_asked_for(page, browser):
+    """'woodcam preview --camera top' shows the part's outside uncut (view.camera.UNCUT_CAMERAS),
+    the page's top view kept the default y cut: the front half of the part and a tray's pockets
+    cut away. Now the top view turns the cut off and the other views on, until the hash names
+    the cut or the user ticks or unticks it; then the views leave it as it is."""
+    _, _, out, _ = page
+    checked = "document.getElementById('cut-on').checked"
+
+    def view(name: str) -> None:
+        browser.evaluate(f"document.querySelector('[data-view={name}]').click()")
+
+    assert browser.load(f"file://{out}#view=top") == "box: ready"
+    assert browser.evaluate(checked) is False
+    view("front")
+    assert browser.evaluate(checked) is True
+    view("top")
+    assert browser.evaluate(checked) is False
+    browser.evaluate("document.getElementById('cut-on').click()")  # the user ticks it: kept
+    assert browser.evaluate(checked) is True
+    view("front")
+    view("top")
+    assert browser.evaluate(checked) is True
+    browser.evaluate("document.getElementById('cut-on').click()")  # unticked: kept off
+    view("iso")
+    assert browser.evaluate(checked) is False
+    for arg, on in (("view=top&cut=y:40", True), ("view=top&cut=x", True), ("view=front&cut=off", False)):
+        browser.call("Page.navigate", session=True, url="about:blank")
+        assert browser.load(f"file://{out}#{arg}") == "box: ready"
+        assert browser.evaluate(checked) is on, arg
+        view("top")
+        assert browser.evaluate(checked) is on, arg  # the hash asked for it
+
 def _click_front(browser, x: float, z: float, size_mm) -> None:
     """Click the canvas where block point (x, *, z) mm is drawn in the front view."""
     W, _, H = size_mm

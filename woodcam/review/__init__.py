@@ -377,7 +377,8 @@ def _page(data: dict, glb_b64: str, bundle: str) -> str:
  <select id="cut-axis"><option>x</option><option>y</option><option>z</option></select>
  <input type="range" id="cut-pos" min="0" step="0.1" style="width:150px"> <span id="cut-label"></span>
  <p style="font-size:12px">The cut face shows the wood inside the block
- (Wood.color on {data['block']['voxel_mm']:.2f} mm voxels).</p></div>
+ (Wood.color on {data['block']['voxel_mm']:.2f} mm voxels). The top view shows the part's outside
+ uncut until you tick cut.</p></div>
 <h2 class="ui">Measure</h2><div class="ui"><label><input type="checkbox" id="measure"> two clicks on the
  part</label><div id="measurement"></div></div>
 <h2>Block and bake</h2><table><tr><th>block</th><td>{W:.5g} x {D:.5g} x {H:.5g} mm (x, y, z)</td></tr>\

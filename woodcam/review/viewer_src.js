@@ -92,6 +92,7 @@ const VIEWS = {
 };
 function setView(name) {
   viewName = Object.hasOwn(VIEWS, name) ? name : 'iso';  // not 'toString' (inherited)
+  if (!cut.asked) setCutOn(viewName !== 'top');
   const d = VIEWS[viewName];
   const dir = worldOfBlock(d[0], d[1], d[2]).normalize();
   persp.aspect = canvasAspect();  // resize() below then keeps this distance
@@ -188,7 +189,12 @@ const cutMm = cutAxis === cutArg[0] && cutArg.length > 1 ? parseFloat(cutArg[1])
 const cut = { axis: cutAxis,
               pos: Number.isFinite(cutMm) ? THREE.MathUtils.clamp(cutMm, 0, LIMITS[cutAxis])
                 : LIMITS[cutAxis] / 2,
-              on: cutArg[0] !== 'off' };
+              on: cutArg[0] !== 'off',
+              // asked: the hash named the cut (#cut=...) or the user ticked or unticked it. Until
+              // then the top view shows the part's outside uncut, as 'woodcam preview --camera
+              // top' does (woodcam.view.camera.UNCUT_CAMERAS): looking down, the default y cut
+              // hid the front half of the part, and a tray's pockets; the other views cut.
+              asked: params.has('cut') };
 const plane = new THREE.Plane();
 let capMesh = null, textures = {}, part = null;
 // the hotspot markers and their list items: a marker on the side cut away is hidden with it (it
@@ -196,6 +202,14 @@ let capMesh = null, textures = {}, part = null;
 const spots = [];
 const stencilGroup = new THREE.Group();
 scene.add(stencilGroup);
+
+// Turn the cut on or off, its checkbox with it (the views and a hotspot's click turn it).
+function setCutOn(on) {
+  cut.on = on;
+  const box = document.getElementById('cut-on');
+  if (box) box.checked = on;
+  updatePlane();
+}
 
 function updatePlane() {
   // keep the block side beyond the cut (larger coordinate) visible; the normal of the cap
@@ -348,10 +362,8 @@ function focusOn(atMm) {
   camera.lookAt(p);
   if (camera === ortho) { ortho.zoom = 2; ortho.updateProjectionMatrix(); }
   if (cut.on && plane.distanceToPoint(p) < -1e-6) {
-    cut.on = false;
-    const on = document.getElementById('cut-on');
-    if (on) on.checked = false;
-    updatePlane();
+    cut.asked = true;  // the user's click: the next view keeps the spot in sight
+    setCutOn(false);
   }
   updateProbe();
 }
@@ -413,7 +425,7 @@ function bindUi() {
   axis.value = cut.axis; on.checked = cut.on; sync();
   axis.onchange = () => { cut.axis = axis.value; cut.pos = LIMITS[cut.axis] / 2; sync(); updatePlane(); };
   pos.oninput = () => { cut.pos = parseFloat(pos.value); sync(); updatePlane(); };
-  on.onchange = () => { cut.on = on.checked; updatePlane(); };
+  on.onchange = () => { cut.asked = true; cut.on = on.checked; updatePlane(); };
   document.getElementById('print').onclick = () => { snapshot(); window.print(); };
   canvas.addEventListener('click', onClick);
 }
