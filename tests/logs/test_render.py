@@ -136,13 +136,15 @@ def _parse(argv):
     return build_parser().parse_args(argv)
 
 
-def test_cli_renders_a_log_file(tmp_path):
+def test_cli_renders_a_log_file(tmp_path, capsys):
     path = write_log(_log(), tmp_path / "log.json")
     args = _parse(["log", "render", str(path), "--out", str(tmp_path / "out"),
                    "--px-per-mm", "1", "--disc", "300", "--radial", "300", "0"])
     assert args.func(args) == 0
     pngs = sorted((tmp_path / "out").glob("*.png"))
     assert len(pngs) == 3
+    # "wrote PATH" a file, as export and every command say it (it printed the bare paths)
+    assert sorted(capsys.readouterr().out.splitlines()) == [f"wrote {p}" for p in pngs]
     for p in pngs:
         with Image.open(p) as im:
             assert im.mode == "RGB"
@@ -152,7 +154,8 @@ def test_cli_maps_and_export_round_trip(tmp_path, capsys):
     src = write_log(_log(), tmp_path / "log.json")
     a = _parse(["log", "maps", str(src), "--out", str(tmp_path / "maps")])
     assert a.func(a) == 0
-    capsys.readouterr()
+    maps = sorted((tmp_path / "maps").iterdir())  # the PNGs and map_params.json
+    assert maps and sorted(capsys.readouterr().out.splitlines()) == [f"wrote {p}" for p in maps]
     # into a folder not made yet, as every other FILE output (it failed: no such file)
     b = _parse(["log", "export", "--maps", str(tmp_path / "maps"), "--out",
                 str(tmp_path / "new" / "back.json")])

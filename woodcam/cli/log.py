@@ -85,7 +85,7 @@ def _load(args):
 
 
 def run(args) -> int:
-    """Run ``woodcam log <command>``; prints the files written, returns the exit code."""
+    """Run ``woodcam log <command>``; prints "wrote PATH" for each file written, returns the exit code."""
     import numpy as np
 
     log = _load(args)
@@ -98,8 +98,8 @@ def run(args) -> int:
     if args.log_command == "maps":
         from ..logs.maps import write_maps
 
-        for path in write_maps(log, out).values():
-            print(path)
+        for path in write_maps(log, out).values():  # a line a file, as render and export say them
+            print(f"wrote {path}")
         return 0
     from ..fields.knots import KnotParams, KnottedLogField
     from ..logs import render as lr
@@ -125,5 +125,6 @@ def run(args) -> int:
     for s in progress_bar(secs, desc="rendering sections", unit="section"):  # ~9 s each at 8 px/mm
         img = lr.render_section(field, s, supersample=args.supersample, species=args.species,
                                 knots=knots)
-        write(str(lr.save_png(img, out / f"{log.name}_{s.name}.png")))
+        # each as it lands (~9 s apart), "wrote PATH" as export, maps and every command say it
+        write(f"wrote {lr.save_png(img, out / f'{log.name}_{s.name}.png')}")
     return 0
