@@ -294,7 +294,7 @@ def test_engine_options_alone_run_on_the_engine_and_train_rings_refuses_them(tmp
 
     assert main(["block", "synth", "--count", "1", "--seed", "3", "--out", str(tmp_path / "b"), "--face-px", "32",
                  "--quiet", "--workers", "1", "--knotted-fraction", "0"]) == 0
-    assert "on local with 1 worker(s)" in capsys.readouterr().out
+    assert "on local with 1 worker;" in capsys.readouterr().out
     for extra in (["--workers", "7"], ["--address", "tcp://127.0.0.1:9"], ["--no-resume"]):
         assert main(["train", "rings", "--out", str(tmp_path / "t"), *extra]) == EXIT_USAGE
         assert "are for 'train gtf'" in capsys.readouterr().err

@@ -251,7 +251,7 @@ def run_bench(out_dir: str | Path, blocks: int, seed: int, settings: dict | None
                                             "seed": int(seed), "settings": settings})
     keys = [bench_key(i) for i in range(start, start + blocks)]
     return run_many(partial(_bench_task, seed=int(seed), settings=settings), keys, out,
-                    desc="bench blocks", **run_options)
+                    desc="bench blocks", unit="block", **run_options)
 
 
 def _recorded_method_order(manifest: Path, settings: dict) -> dict:
@@ -677,7 +677,7 @@ def write_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512, k
     keys = [f"block_{i:04d}" for i in range(count)]
     summary = run_many(partial(_synth_set_task, seed=int(seed), out_dir=str(out.resolve()),
                                face_px=int(face_px), knotted=bool(knotted), block_options=opts),
-                       keys, out / ".synth", desc="synthesising blocks", **run_options)
+                       keys, out / ".synth", desc="synthesising blocks", unit="block", **run_options)
     recs = read_records(out / ".synth")
     index = {"format": "woodcam-benchmark", "version": 1, "seed": int(seed), "count": int(count),
              "face_px": int(face_px), "size_range_mm": opts["size_range_mm"],
@@ -732,7 +732,7 @@ def make_training_set_many(spec, out_dir, *, shard_fields: int = TRAINING_SHARD_
     keys = [f"shard_{i:04d}" for i in range(n_shards)]
     s = run_many(partial(_training_shard_task, spec=spec.to_dict(), shard_fields=shard_fields,
                          out_dir=str(out.resolve())), keys, out / ".records",
-                 desc="training set shards", **run_options)
+                 desc="training set shards", unit="shard", **run_options)
     if s.failed:
         bad = {k: r.get("error") for k, r in read_records(out / ".records").items() if r["status"] != "ok"}
         raise WoodcamError(f"{s.failed} training-set shard(s) failed: {bad}; run again to retry them")

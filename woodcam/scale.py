@@ -79,7 +79,8 @@ _THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "B
 @dataclass(frozen=True)
 class RunSummary:
     """What :func:`run_many` did: counts of keys and the wall time (s) of this call;
-    ``first_failure`` is ``"KEY failed: ERROR"`` of the first key that failed in it ('' if none)."""
+    ``first_failure`` is ``"KEY failed: ERROR"`` of the first key that failed in it ('' if none);
+    ``unit`` what one key is, singular ("block", "shard"), for :meth:`line`."""
 
     out_dir: Path
     engine: str
@@ -90,18 +91,26 @@ class RunSummary:
     failed: int
     wall_s: float
     first_failure: str = ""
+    unit: str = "task"
 
     def line(self) -> str:
         """One line for a command to print; with failures, the first one's error (a run whose
-        every key failed said '1 failed' and no why: the error was in a hidden record only)."""
+        every key failed said '1 failed' and no why: the error was in a hidden record only).
+        It counts in :attr:`unit` ("2 blocks: ..."): 'bench run --blocks 2' said "2 keys: ...",
+        the record's file name, a word of this module and no user's."""
         why = ""
         if self.failed and self.first_failure:
             more = self.failed - 1
             why = (f"; {self.first_failure}" + (f" ({more} more failed: each error is in its record)"
                                                  if more else ""))
-        return (f"{self.total} keys: {self.skipped} already done, {self.done} computed, "
+        return (f"{_count(self.total, self.unit)}: {self.skipped} already done, {self.done} computed, "
                 f"{self.failed} failed; {self.wall_s:.1f} s on {self.engine} with "
-                f"{self.workers} worker(s); records in {self.out_dir / RECORDS_DIR}{why}")
+                f"{_count(self.workers, 'worker')}; records in {self.out_dir / RECORDS_DIR}{why}")
+
+
+def _count(n: int, noun: str) -> str:
+    """``"1 block"``, ``"2 blocks"``."""
+    return f"{n} {noun}" + ("" if n == 1 else "s")
 
 
 # -- records --------------------------------------------------------------------------------------
@@ -289,7 +298,8 @@ def check_address(address: str, name: str = "address") -> str:
 def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engine: Engine = "local",
              address: str | None = None, workers: int | None = None, retries: int = 2, *,
              memory_limit_mb: int | None = DEFAULT_MEMORY_LIMIT_MB, progress: bool = True,
-             connect_timeout_s: float = CONNECT_TIMEOUT_S, desc: str = "tasks") -> RunSummary:
+             connect_timeout_s: float = CONNECT_TIMEOUT_S, desc: str = "tasks",
+             unit: str = "task") -> RunSummary:
     """Run ``fn(key)`` for every key not already done, writing one record per key.
 
     Parameters
@@ -314,6 +324,9 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
         ``memory_limit`` of each LocalCluster worker. None: no cap.
     progress : bool
         A tqdm bar with rate and ETA on stderr (on a terminal: woodcam._progress).
+    desc, unit : str
+        The bar's description, and what one key is to the user, singular ("block"): the bar's
+        unit and :meth:`RunSummary.line`'s count ("2 blocks: ...").
 
     Returns
     -------
@@ -331,6 +344,8 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
         check_number(memory_limit_mb, "memory_limit_mb", lo=WORKER_MEMORY_MB_RANGE[0],
                      fix="MiB per worker (a Python worker alone needs ~100 MiB), or None")
     progress = check_bool(progress, "run_many: progress")
+    if not isinstance(unit, str) or not unit.strip():  # the summary line would count in it
+        raise WoodcamError(f"unit must be a word naming one key, e.g. 'block'; got {unit!r}")
     # NaN or -1 was taken, and handed to Dask's Client(timeout=...) as it was
     connect_timeout_s = check_number(connect_timeout_s, "connect_timeout_s", lo=0, lo_open=True,
                                      fix=f"seconds to wait for a Dask scheduler, e.g. {CONNECT_TIMEOUT_S:g}")
@@ -359,7 +374,7 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
 
     from ._progress import progress_bar
 
-    bar = progress_bar(total=len(keys), initial=skipped, desc=desc, unit="task", smoothing=0.1,
+    bar = progress_bar(total=len(keys), initial=skipped, desc=desc, unit=unit, smoothing=0.1,
                        enabled=progress, dynamic_ncols=True)
     counts = {"ok": 0, "failed": 0}
     first_failure: list[str] = []
@@ -392,7 +407,7 @@ def run_many(fn: Callable[[str], Any], keys: Iterable, out_dir: str | Path, engi
         if scratch is not None:
             shutil.rmtree(scratch, ignore_errors=True)
     return RunSummary(out_dir, engine, n_workers, len(keys), skipped, counts["ok"],
-                      counts["failed"], time.perf_counter() - t0, "".join(first_failure))
+                      counts["failed"], time.perf_counter() - t0, "".join(first_failure), unit)
 
 
 def _run_local(fn, todo, n_workers, retries, memory_limit_mb, finish) -> None:

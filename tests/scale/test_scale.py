@@ -507,16 +507,34 @@ def test_a_broken_training_shard_is_made_again(tmp_path, damage):
     np.testing.assert_array_equal(vals, ref[1])
 
 
+
+def test_the_summary_counts_in_the_users_word(tmp_path):
+    """'bench run --blocks 2' said "2 keys: ... with 2 worker(s)": keys are the records' file
+    names, no word of the user's; the line counts in the run's unit, singular or plural."""
+    from woodcam.scale import RunSummary
+
+    def line(total, workers, **unit):
+        return RunSummary(tmp_path, "local", workers, total, 0, total, 0, 1.0, **unit).line()
+
+    assert line(2, 2, unit="block").startswith("2 blocks: 0 already done, 2 computed, 0 failed; "
+                                               "1.0 s on local with 2 workers; ")
+    assert line(1, 1, unit="shard").startswith("1 shard: 0 already done, 1 computed, 0 failed; "
+                                               "1.0 s on local with 1 worker; ")
+    assert line(3, 1).startswith("3 tasks: ")  # run_many's own default
+    with pytest.raises(WoodcamError, match="unit must be a word naming one key"):
+        run_many(str, ["a"], tmp_path / "run", unit="", progress=False)
+
 def test_cli_bench_run_and_report(tmp_path, capsys):
     from woodcam.cli import main
 
     run, rep = str(tmp_path / "run"), str(tmp_path / "rep")
     assert main(["bench", "run", "--blocks", "1", "--seed", "4", "--methods", "radial", "--knotted-fraction",
                  "0", "--face-px", "64", "--workers", "1", "--quiet", "--out", run]) == 0
-    assert "1 keys: 0 already done, 1 computed, 0 failed" in capsys.readouterr().out
+    # counted in blocks, the user's word (it said "1 keys", the records' file names)
+    assert "1 block: 0 already done, 1 computed, 0 failed; " in capsys.readouterr().out
     assert main(["bench", "run", "--blocks", "1", "--seed", "4", "--methods", "radial", "--knotted-fraction",
                  "0", "--face-px", "64", "--workers", "1", "--quiet", "--out", run]) == 0
-    assert "1 keys: 1 already done, 0 computed" in capsys.readouterr().out
+    assert "1 block: 1 already done, 0 computed" in capsys.readouterr().out
     assert main(["bench", "report", run, "--out", rep, "--gallery", "0", "--thumbnails", "0", "--quiet"]) == 0
     assert "1 blocks (1 clear, 0 knotted); full same year <= 1 mm: radial" in capsys.readouterr().out
     from woodcam.cli import EXIT_USAGE
