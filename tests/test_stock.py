@@ -16,6 +16,25 @@ def test_builtin_spec_and_species_override():
     assert s.meta["field"]["type"] == "radial"
 
 
+
+def test_the_knotty_blocks_description_says_where_its_log_runs(capsys):
+    """builtin:knotty was described as a "tangential spruce board", but its log runs along the
+    block's z (the 50 mm height): a tray cut into its top floored in end grain (53 % of the
+    surface) against the description. The grain away from the knots is along z; the description
+    ('woodcam blocks') says so and calls it no board."""
+    import numpy as np
+
+    from woodcam.cli import main
+    from woodcam.fields.builtin import builtin_block
+
+    b = builtin_block("knotty")
+    away = np.array([[10.0, 40.0, 25.0], [90.0, 40.0, 25.0], [20.0, 10.0, 10.0], [80.0, 60.0, 40.0]])
+    assert np.all(np.abs(b.field.grain_direction(away)[:, 2]) > 0.99)
+    assert "log along z: end grain on top" in b.description and "board" not in b.description
+    assert main(["blocks"]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("builtin:knotty "))
+    assert line.endswith(b.description)
+
 def test_log_spec_puts_the_knot_on_the_front_face(shared_data):
     s = open_stock("log:gran1@52:60x40x30")
     assert s.size_mm == (60.0, 40.0, 30.0)

@@ -261,7 +261,7 @@ def test_bad_species_and_normals():
 
 
 def test_knots_show_darker_and_dead_knots_outlined():
-    """The built-in knotty board: knot wood is darker than the stem wood around it, and the
+    """The built-in knotty block: knot wood is darker than the stem wood around it, and the
     dead knot's outline is darker still."""
     from woodcam.stock import open_stock
 

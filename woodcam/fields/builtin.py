@@ -10,8 +10,10 @@ of seed 000 whose radius functions come from a fixed seed, so the truth is known
 - ``rift``: pith 110 mm below and in front (about 45 deg to the faces), along X.
 - ``pith-inside``: pith vertical through the block slightly off-centre (a turning blank cut
   from the heart): concentric rings on top and bottom, end grain there.
-- ``knotty``: a tangential board from a synthetic spruce log with a whorl of branches (the
-  knot model of seed 003): an alive knot through the front face and a dead one beside it.
+- ``knotty``: a block of a synthetic spruce log with a whorl of branches (the knot model of
+  seed 003), the log running up its Z (the 50 mm height): end grain on top and bottom (a tray
+  or pocket cut into the top floors in end grain), a tangential front face 95 mm from the pith
+  with an alive knot through it and a dead one beside it, near-radial left and right faces.
 - ``fast-grown``: a flitch of a fast-grown (plantation) tree, 10 mm rings, the pith 500 mm
   behind its middle plane, along X: its front-parallel leaves are flat-sawn with even bands
   tens of mm wide, the calm wood a parquetry maker keeps for plain areas (``woodcam
@@ -69,7 +71,9 @@ BUILTIN_NAMES: tuple[str, ...] = tuple(_SPECS) + ("knotty",)
 
 
 def _knotty_block() -> BuiltinBlock:
-    """A 100 x 80 x 50 mm board (Z along the log) through a whorl of a straight synthetic log."""
+    """A 100 x 80 x 50 mm block beside a whorl of a straight synthetic log, the log along its Z
+    (:func:`~woodcam.fields.knots.block_at_knot`): end grain on top and bottom, the front face
+    tangential through knot 0."""
     from .knots import KnottedLogField, block_at_knot, place_block_in_log
     from .skeleton import BranchStrand, simple_log
 
@@ -84,7 +88,7 @@ def _knotty_block() -> BuiltinBlock:
     origin, rotation = block_at_knot(log, 0, BUILTIN_SIZE_MM, front_r_mm=95.0)
     field = place_block_in_log(KnottedLogField(log, ring_width_mm=2.2), origin, rotation)
     return BuiltinBlock("knotty", BUILTIN_SIZE_MM, field, "spruce",
-                        "tangential spruce board through a whorl: alive and dead knots")
+                        "knotted log's block, log along z: end grain on top, alive and dead knots in front")
 
 
 def check_builtin_name(name: str) -> None:
