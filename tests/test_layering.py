@@ -15,6 +15,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "woodcam"
 LAYERS: dict[str, int] = {
     # foundations: errors, tolerances, limits, atomic writes, content-keyed caches
     "errors": 0, "tolerances": 0, "_types": 0, "units": 0, "limits": 1, "_checks": 1, "_atomic": 1, "_cache": 2,
+    "_repr": 0,                        # short reprs of the result classes (stdlib only)
     "_interrupt": 0,                   # Ctrl-C recorded, so one a library swallowed still ends the run
     "_specs": 2,                       # a block spec's grammar and the paths it names (errors, limits, units)
     "_readers": 2,                     # strict JSON and images of untrusted files (errors, limits)

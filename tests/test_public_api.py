@@ -49,3 +49,49 @@ def test_a_public_name_that_is_also_a_submodule_stays_the_public_object():
     from woodcam import bake
 
     assert bake is importlib.import_module("woodcam.bake").bake
+
+
+# The classes that hold arrays, meshes or long lists: their repr names shapes, not contents.
+# Parameter classes (Brush, GrowthSpeed, LogFrame, ParquetryParams, SceneOptions, Tool) keep
+# the dataclass repr, whose every value is short and which reads back as the call.
+_HOLDERS = ("BakeResult", "Block", "CarveResult", "ColorMapAppearance", "EvidenceFit", "Face",
+            "GeneratedLog", "GridField", "LogSkeleton", "ParquetryJob", "ParquetryRun", "PartPreview",
+            "Program", "RadialScalingField", "RingDetection", "RingTrace", "RunSummary", "SimResult",
+            "StemField", "Stock", "Veneer", "Woodification")
+
+
+def test_result_reprs_name_array_shapes_not_contents():
+    """A notebook showed ``bake(...)`` as thousands of atlas pixels and ``read_gcode(...)`` as every
+    segment's start point (BakeResult 'atlas=array([[[168, 134, 92], ...' over 40 lines): each
+    holder's repr is one line, an array as its shape and dtype."""
+    import dataclasses
+
+    import numpy as np
+
+    for name in _HOLDERS:
+        cls = getattr(woodcam, name)
+        obj = object.__new__(cls)  # every field a 100 x 100 array, no validation
+        for f in dataclasses.fields(cls):
+            object.__setattr__(obj, f.name, np.zeros((100, 100)))
+        text = repr(obj)
+        assert text.startswith(f"{name}(") and "\n" not in text and len(text) < 1000, (name, text[:300])
+        assert "array(shape=(100, 100), dtype=float64)" in text, (name, text[:300])
+
+
+def test_a_read_program_shows_its_shapes_and_source():
+    program = woodcam.read_gcode("G21 G90\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\n" * 20)
+    text = repr(program)
+    assert "\n" not in text and "start_mm=array(shape=(" in text and ", dtype=float64)" in text
+
+
+def test_short_repr_of_containers_and_plain_objects():
+    from woodcam._repr import short
+
+    assert short({"a": 1}) == "{'a': 1}" and short([1, 2]) == "[1, 2]"
+    assert short({str(k): k for k in range(9)}) == "<dict of 9: '0', '1', '2', '3', '4', '5', ...>"
+    assert short(list(range(50))) == "<list of 50 of int>"
+    assert short(object()) == "<builtins.object>"
+    import numpy as np
+
+    assert short(np.float64(2.5)) == repr(np.float64(2.5)) and short(np.zeros((2, 3), np.uint8)) == \
+        "array(shape=(2, 3), dtype=uint8)"

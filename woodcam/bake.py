@@ -53,6 +53,7 @@ from typing import Any, Literal, get_args
 import numpy as np
 
 from woodcam._checks import check_bool
+from woodcam._repr import summary_repr
 from woodcam._types import Mesh, WoodLike
 from woodcam.errors import WoodcamError, WoodcamWarning
 from woodcam.limits import limit
@@ -147,6 +148,8 @@ class BakeResult:
         Area-weighted mean density over ``texels_per_mm`` (>= 1): projected charts give tilted
         faces more texels than asked, never fewer; 1 for xatlas' own charts.
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     mesh: Any
     atlas: np.ndarray

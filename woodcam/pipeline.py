@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ._repr import summary_repr
 from ._types import Mesh, PathLike
 from .errors import WoodcamError
 from .stock import Stock
@@ -41,6 +42,8 @@ class PartPreview:
     timings_s : dict stage -> seconds
     warnings : list of str
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     name: str
     volume_mm3: float = 0.0

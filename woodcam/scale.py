@@ -50,6 +50,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Literal, get_args
 
 from ._checks import check_bool, check_number, check_path
+from ._repr import summary_repr
 from .errors import UsageError, WoodcamError
 from .limits import WORKER_MEMORY_MB_RANGE
 
@@ -81,6 +82,8 @@ class RunSummary:
     """What :func:`run_many` did: counts of keys and the wall time (s) of this call;
     ``first_failure`` is ``"KEY failed: ERROR"`` of the first key that failed in it ('' if none);
     ``unit`` what one key is, singular ("block", "shard"), for :meth:`line`."""
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     out_dir: Path
     engine: str

@@ -49,6 +49,7 @@ from typing import Literal
 import numpy as np
 
 from ._checks import check_bool
+from ._repr import summary_repr
 from ._specs import ParsedSpec, check_read_as_is, format_op, parse_spec
 from .appearance import ColorMapAppearance, NeuralAppearance, Wood, get_species
 from .errors import BlockSpecError, WoodcamError, WoodcamWarning
@@ -91,6 +92,8 @@ class Stock:
     description : str
     meta : dict
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     spec: str
     size_mm: tuple[float, float, float]

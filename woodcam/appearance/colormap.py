@@ -24,6 +24,7 @@ import numba
 import numpy as np
 
 from .._checks import as_floats, check_number, numbers_fix, real_numbers, received
+from .._repr import summary_repr
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, arf, check_points, check_texture_frame, grain_direction
@@ -257,6 +258,8 @@ class ColorMapAppearance:
         colours in both. ``None``: this block's frame.
         Set by the block spec, not an appearance parameter.
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     species: Species | str = "oak"
     axis_luts: np.ndarray | None = None

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import as_floats, numbers_fix, received
+from .._repr import summary_repr
 from ..errors import WoodcamError
 from ..frames import FACES, FaceName, check_face, check_size, face_image_size_mm, pixel_to_block
 
@@ -36,6 +37,8 @@ class RingTrace:
         its phase order, :mod:`woodcam.detect.rings`), so the fitter gives them one growth time.
         An id relative to its face only (not a year, not comparable across faces).
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     points_px: np.ndarray
     year: int | None = None
@@ -103,6 +106,8 @@ class Face:
         (Mokume ``X_knot.png``), or ``"annotation"``: the raw Mokume ``X_ann.png``. Array
         values are written as PNG by :func:`woodcam.block.io.write_block`, others as JSON.
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     name: FaceName
     shape: tuple[int, int]
@@ -187,6 +192,8 @@ class Block:
     meta : dict
         Free-form provenance (source folder, generator seed, sawing pattern, ...).
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     size_mm: tuple[float, float, float]
     faces: dict[str, Face] = field(default_factory=dict)

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from .._manifold import manifold_to_trimesh
+from .._repr import summary_repr
 from .._types import ArrayLike
 from ..errors import WoodcamError, WoodcamWarning
 from ..frames import FOREIGN_GLTF_METRES_BELOW, check_size
@@ -50,6 +51,8 @@ class CarveResult:
     size_mm : (3,) tuple of float
         Block size ``(W, D, H)`` in mm the part was carved from.
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     mesh: Any
     manifold: Any

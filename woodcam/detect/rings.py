@@ -76,6 +76,7 @@ from typing import Literal
 import numpy as np
 
 from .._checks import as_floats, check_bool
+from .._repr import summary_repr
 from ..block.block import RingTrace
 from ..errors import WoodcamError
 
@@ -196,6 +197,8 @@ class RingDetection:
     angle (radians), ``wavelength_px`` the ring spacing (pixels), ``confidence`` in [0, 1],
     ``evidence`` bool; ``traces`` polylines in continuous pixel coordinates ``(row, col)``.
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     traces: list[RingTrace]
     ring_map: np.ndarray

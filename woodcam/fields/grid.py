@@ -20,6 +20,7 @@ import numpy as np
 
 from .._checks import as_floats, check_number, check_vector, npz_path, numbers_fix, received
 from .._readers import read_npz
+from .._repr import summary_repr
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from .base import check_points, evaluate
@@ -84,6 +85,8 @@ class GridField:
     meta : dict
         Plain-JSON facts about how the field was made (fit method, evidence, warnings).
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     years: np.ndarray
     origin_mm: tuple[float, float, float]

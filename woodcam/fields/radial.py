@@ -21,6 +21,7 @@ import numba
 import numpy as np
 
 from .._checks import check_number, received
+from .._repr import summary_repr
 from .._types import ArrayLike
 from ..errors import WoodcamError
 from ..tolerances import MIN_RADIUS_SCALE
@@ -139,6 +140,8 @@ class RadialScalingField:
     age_offset_years : float
         Growth time at the pith (0 for a real pith).
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     frame: LogFrame
     ring_width_mm: float = 3.0

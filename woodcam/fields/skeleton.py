@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._checks import as_floats, real_numbers
+from .._repr import summary_repr
 from .._types import ArrayLike
 from ..errors import WoodcamError
 
@@ -196,6 +197,8 @@ class LogSkeleton:
     knots : tuple of Knot
     name : str
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     pith_z_mm: np.ndarray
     pith_xy_mm: np.ndarray

@@ -52,6 +52,7 @@ import numpy as np
 
 from .._checks import check_bool, check_number
 from .._parallel import fit_workers, share
+from .._repr import summary_repr
 from .._types import ArrayLike
 
 from ..errors import WoodcamError, WoodcamWarning
@@ -134,6 +135,8 @@ class EvidenceFit:
     residual : with ``fit_evidence(residual=True)``, the small-scale residual's evidence
         (:func:`residual_evidence`: ``"kept"``, ``"gain"``, per-face scores without and with it)
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     field: Callable
     chosen: str

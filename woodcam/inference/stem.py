@@ -52,6 +52,7 @@ import numpy as np
 
 from .._checks import as_floats, check_bool, check_number, real_numbers
 from .._parallel import map_processes
+from .._repr import summary_repr
 from .._types import ArrayLike
 from ..errors import WoodcamError
 from ..fields.base import check_points
@@ -76,6 +77,8 @@ class StemField:
     coef : ((2K+1)(M+1),) ``c``; rho_coef : (P-1,) ``e``; rho0_mm : ``rho_0``; offset : ``a``
     history_levels, history_years : the warp ``h`` (None: identity)
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     centre_mm: np.ndarray
     base_axis: np.ndarray

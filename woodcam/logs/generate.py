@@ -59,6 +59,7 @@ from typing import Literal
 import numpy as np
 
 from .._checks import check_number, real_numbers
+from .._repr import summary_repr
 from .._types import ArrayLike
 from ..errors import WoodcamError
 from ..fields.skeleton import KNOT_TABLE_SAMPLES, BranchStrand, LogSkeleton
@@ -288,6 +289,8 @@ class GeneratedLog:
         Full surface radius on the grid of :func:`.surface.heightmap_axes`.
     seed : int or None
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     length_mm: float
     centreline: Centreline

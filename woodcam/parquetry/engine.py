@@ -16,6 +16,7 @@ from typing import Literal
 import numpy as np
 
 from .._checks import check_bool
+from .._repr import summary_repr
 from ..errors import WoodcamError
 from ..units import say_length
 from .features import edge, features, intensity, match_histogram
@@ -134,6 +135,8 @@ class ParquetryRun:
     changed. Panel images and patch windows are in panel pixels at ``params.px_per_mm``
     (:class:`Patch`), veneers in their own pixels (:class:`Veneer`).
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     params: ParquetryParams
     veneers: list[Veneer]

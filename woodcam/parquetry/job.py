@@ -30,6 +30,7 @@ from typing import Literal
 import numpy as np
 
 from .._checks import check_path
+from .._repr import summary_repr
 from .._specs import absolute_spec, spec_path
 from ..errors import WoodcamError, WoodcamWarning
 from ..limits import limit
@@ -355,6 +356,8 @@ class ParquetryJob:
     mokume : Mokume sample folders used as veneers (their face photos)
     targets : ``[{"filename", "scale", "dpi"}]``
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     scans: list[dict] = field(default_factory=list)
     blocks: list[dict] = field(default_factory=list)

@@ -24,6 +24,7 @@ import numpy as np
 
 from .._checks import as_floats, check_bool, check_number, check_path, check_vector
 from .._readers import PHOTO_ALPHA_FIX, photo_rgb8, read_image_file_opacity, read_photo_rgb
+from .._repr import summary_repr
 from ..errors import WoodcamError
 from ..fields.base import rings_crossed
 
@@ -67,6 +68,8 @@ class Veneer:
         ``sheet_mm / (w, h)`` mm, within half a pixel of ``1 / px_per_mm``. None: ``(w, h) /
         px_per_mm`` exactly.
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     id: str
     rgb: np.ndarray

@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from .._checks import as_floats, check_number, check_vector
+from .._repr import summary_repr
 from .._types import ArrayLike, PathLike
 from ..errors import WoodcamError
 from ..tolerances import ARC_CHORD_TOL_MM
@@ -84,6 +85,8 @@ class Program:
     (1-based source line), ``feed_mm_min (n,)`` mm/min, ``spindle_rpm (n,)``; ``inch (n,)``
     bool and ``ran_line (n,)`` int per move as commented below.
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     start_mm: np.ndarray
     end_mm: np.ndarray

@@ -48,6 +48,7 @@ from typing import Literal, Mapping
 import numpy as np
 
 from .._checks import as_floats, check_bool, check_number
+from .._repr import summary_repr
 from .._types import ArrayLike, Mesh
 from ..errors import WoodcamError
 from ..tolerances import SIM_CONTACT_TOL_MM
@@ -147,6 +148,8 @@ class SimResult:
     mm; ``cell_mm (2,)`` the cell size ``(dx, dy)`` mm; ``report``: the issues found (rapids
     into stock, ...); ``stats``: counts and timings.
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     heightmap: np.ndarray
     size_mm: tuple[float, float, float]

@@ -37,6 +37,7 @@ from typing import Literal
 import numpy as np
 
 from .._checks import check_number
+from .._repr import summary_repr
 from ..errors import WoodcamError
 from ..limits import WOODIFY_RESOLUTION_RANGE
 from ..tolerances import WOODIFY_BAND_NODES, WOODIFY_OBSTACLE_CLEARANCE_VOXELS, WOODIFY_ON_SURFACE_VOXELS
@@ -123,6 +124,8 @@ class Front:
     ``_trace_cache``, checked against the array's identity (assigning a new array rebuilds
     them; writing into this one in place would not).
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     grid: VoxelGrid
     arrival_mm: np.ndarray

@@ -18,6 +18,7 @@ from dataclasses import field as dc_field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._repr import summary_repr
 from ..errors import WoodcamError
 from ..limits import WOODIFY_RESOLUTION_RANGE, check_grid, limit
 from .brushes import Brush, check_vertex_paint, paint
@@ -58,6 +59,8 @@ class Woodification:
     timings : dict
         Seconds per stage (wall clock).
     """
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     mesh: object
     speed: GrowthSpeed
