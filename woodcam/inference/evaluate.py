@@ -23,6 +23,7 @@ import numpy as np
 
 from .._atomic import output_folder, write_figure, write_text
 from .._checks import check_bool, check_names, check_number, check_path
+from .._repr import summary_repr
 from .._types import ArrayLike, GrowthFieldLike, PathLike
 from ..errors import WoodcamError, require
 from ..fields.base import evaluate, has_uncertainty
@@ -129,6 +130,8 @@ def _nearest_distance(query, qyears, ref, ryears, match_years: bool) -> np.ndarr
 @dataclass
 class PlaneScore:
     """Distances for one plane and one fitted field (mm; inf where no true line of that year)."""
+
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
     plane: str
     d_matched: np.ndarray
@@ -237,7 +240,7 @@ def confidence_summary(conf: np.ndarray, d_matched: np.ndarray) -> dict:
 
 def evaluate_fit(true_field: GrowthFieldLike, fitted_field: GrowthFieldLike, size_mm: ArrayLike,
                  planes: Sequence[CutPlane] = DEFAULT_PLANES, pixel_mm: float = EVAL_PIXEL_MM,
-                 keep_lines: bool = False) -> dict:
+                 keep_lines: bool = False) -> tuple[dict, list[PlaneScore]]:
     """Table-1 accuracy of ``fitted_field`` against ``true_field`` on ``planes`` of a block.
 
     Parameters
@@ -261,8 +264,9 @@ def evaluate_fit(true_field: GrowthFieldLike, fitted_field: GrowthFieldLike, siz
     return evaluate_fits(true_field, {"fit": fitted_field}, size_mm, planes, pixel_mm, keep_lines)["fit"]
 
 
-def evaluate_fits(true_field, fitted: dict, size_mm, planes=DEFAULT_PLANES,
-                  pixel_mm: float = EVAL_PIXEL_MM, keep_lines: bool = False) -> dict:
+def evaluate_fits(true_field: GrowthFieldLike, fitted: dict[str, GrowthFieldLike], size_mm: ArrayLike,
+                  planes: Sequence[CutPlane] = DEFAULT_PLANES, pixel_mm: float = EVAL_PIXEL_MM,
+                  keep_lines: bool = False) -> dict[str, tuple[dict, list[PlaneScore]]]:
     """:func:`evaluate_fit` for several fields (dict name -> field) sharing the true lines.
 
     Returns dict name -> ``(summary, scores)``.
