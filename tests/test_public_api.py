@@ -112,3 +112,21 @@ def test_evaluate_fit_is_annotated_as_what_it_returns():
     assert isinstance(summary, dict) and all(isinstance(s, PlaneScore) for s in scores)
     text = repr(scores[0])
     assert "\n" not in text and "d_matched=array(shape=(" in text, text[:300]
+
+
+def test_fields_and_wood_show_what_they_are():
+    """Wood and the plain field classes printed '<woodcam.appearance.wood.Wood object at 0x...>'
+    (a Stock's wood, a knotty block's PlacedField), and a radial field its two 360-sample radius
+    functions in full (some 150 lines)."""
+    import trimesh
+
+    from woodcam.woodify import woodify
+
+    texts = [repr(woodcam.open_stock("builtin:knotty").wood), repr(woodcam.builtin_block("flat-sawn").field),
+             repr(woodify(trimesh.creation.icosphere(1, 10.0), 2, growth_mm=2, resolution=16).field)]
+    for text in texts:
+        assert "\n" not in text and " at 0x" not in text and len(text) < 2000, text[:300]
+    assert texts[0].startswith("Wood(field=PlacedField(log_field=KnottedLogField(log=LogSkeleton(")
+    assert "r_minus=RadiusFunction(samples=array(shape=(360,), dtype=float64))" in texts[1]
+    assert texts[2].startswith("WoodifiedField(arrival_mm=array(shape=(16, 16, 16), dtype=float32)")
+    assert "block_origin_mm=array([0.0, 0.0, 0.0])" in texts[2]

@@ -16,13 +16,16 @@ _MAX_CHARS = 120  # a value whose repr runs longer is summarised too (a notebook
 
 
 def short(value: object) -> str:
-    """``value``'s repr in at most about a line: an array as ``array(shape=(h, w, 3), dtype=uint8)``,
+    """``value``'s repr in at most about a line: an array as ``array(shape=(h, w, 3), dtype=uint8)``
+    (one of up to 6 numbers as them, ``array([0.0, 0.0, 1.0])``),
     a long list, tuple or dict as its length (a dict with its first keys), an object whose class
     keeps ``object.__repr__`` as ``<ClassName>``."""
     shape, dtype = getattr(value, "shape", None), getattr(value, "dtype", None)
     if shape is not None and dtype is not None and hasattr(value, "__array__"):
         if getattr(value, "size", 2) == 1:
             return repr(value)
+        if len(shape) == 1 and shape[0] <= _MAX_ITEMS:  # a point or a direction: its numbers
+            return f"array({value.tolist()})"  # type: ignore[attr-defined]
         return f"array(shape={tuple(shape)}, dtype={dtype})"
     if isinstance(value, dict):
         if len(value) <= _MAX_ITEMS and len(text := repr(value)) <= _MAX_CHARS:
@@ -47,3 +50,9 @@ def summary_repr(self: object) -> str:
     parts = [f"{f.name}={short(getattr(self, f.name))}" for f in dataclasses.fields(self)  # type: ignore[arg-type]
              if f.repr]
     return f"{type(self).__qualname__}({', '.join(parts)})"
+
+
+def attrs_repr(obj: object, names: tuple[str, ...]) -> str:
+    """``Name(a=..., b=...)`` of the attributes ``names`` of a plain class, each through
+    :func:`short` (for the classes that are not dataclasses: a field, :class:`~woodcam.Wood`)."""
+    return f"{type(obj).__qualname__}({', '.join(f'{n}={short(getattr(obj, n, None))}' for n in names)})"

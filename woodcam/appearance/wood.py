@@ -8,6 +8,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from .._checks import as_floats, check_number, check_rotation, check_vector, numbers_fix, received
+from .._repr import attrs_repr
 from .._types import AppearanceLike, ArrayLike, GrowthFieldLike, WoodLike
 from ..errors import WoodcamError
 from ..fields.base import arf, check_points, evaluate, grain_direction, has_pith, has_uncertainty
@@ -55,6 +56,9 @@ class Wood:
         #: (R (3, 3), t (3,)) with source point = R^T (p - t) (turns and shifts), or None (this
         #: block's own frame)
         self._turn: tuple[np.ndarray, np.ndarray] | None = None
+
+    def __repr__(self) -> str:  # arrays as shapes: a notebook shows one line
+        return attrs_repr(self, ('field', 'appearance', 'threads'))
 
     def turned(self, axis: str, quarter_turns: int, size_mm: ArrayLike) -> tuple["Wood", tuple]:
         """The same wood with the block turned ``quarter_turns`` x 90 degrees about the block

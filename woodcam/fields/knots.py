@@ -48,6 +48,7 @@ from typing import Literal
 import numpy as np
 
 from .._checks import check_bool, check_number
+from .._repr import attrs_repr
 from .._types import ArrayLike
 from ..errors import WoodcamError
 from .base import check_points
@@ -286,6 +287,9 @@ class KnottedLogField:
         self._pith_slope = np.stack([np.gradient(self._pxy[:, 0], self._z),
                                      np.gradient(self._pxy[:, 1], self._z)], axis=1)
         self._build_knot_tables(table_samples)
+
+    def __repr__(self) -> str:  # arrays as shapes: a notebook shows one line
+        return attrs_repr(self, ('log', 'ring_width_mm', 'backend'))
 
     def _build_knot_tables(self, nr: int):
         kn = self.log.knots

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._checks import as_floats, check_rotation
+from .._repr import attrs_repr
 from .._types import ArrayLike, GrowthFieldLike
 from ..errors import WoodcamError
 from .base import LogFrame, check_points, grain_direction
@@ -53,6 +54,9 @@ class PlacedField:
         # rows of R are the log's axes in block coordinates; the pith passes through the block
         # point that maps to the log origin: origin + R p = 0
         self.frame = LogFrame(tuple(-(R.T @ o)), tuple(R[2]), tuple(R[0]))
+
+    def __repr__(self) -> str:  # arrays as shapes: a notebook shows one line
+        return attrs_repr(self, ('log_field', 'frame'))
 
     @classmethod
     def from_log_frame(cls, log_field, frame: LogFrame) -> "PlacedField":

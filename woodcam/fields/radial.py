@@ -68,6 +68,8 @@ class RadiusFunction:
         interpolation (m = 360 makes the interpolation error negligible next to the smoothing).
     """
 
+    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
+
     samples: np.ndarray
 
     @classmethod

@@ -40,6 +40,7 @@ from .._atomic import atomic_write
 from .._checks import (as_floats, check_bool, check_number, check_path, check_rotation, check_vector, npz_path,
                        received)
 from .._readers import read_npz
+from .._repr import attrs_repr
 from ..errors import WoodcamError
 from ..fields.base import LogFrame, check_points
 from ..fields.grid import grid_coords
@@ -135,6 +136,10 @@ class WoodifiedField:
         order = _ORDER[interpolation]
         self._coeffs = (ndimage.spline_filter(self.arrival_mm, order=order, mode="nearest",
                                               output=np.float32) if order > 1 else self.arrival_mm)
+
+    def __repr__(self) -> str:  # arrays as shapes: a notebook shows one line
+        return attrs_repr(self, ('arrival_mm', 'origin_mm', 'spacing_mm', 'years_final', 'block_origin_mm',
+                                 'block_size_mm', 'interpolation'))
 
     @property
     def axis(self) -> np.ndarray:
