@@ -130,3 +130,26 @@ def test_fields_and_wood_show_what_they_are():
     assert "r_minus=RadiusFunction(samples=array(shape=(360,), dtype=float64))" in texts[1]
     assert texts[2].startswith("WoodifiedField(arrival_mm=array(shape=(16, 16, 16), dtype=float32)")
     assert "block_origin_mm=array([0.0, 0.0, 0.0])" in texts[2]
+
+
+def test_the_python_entry_points_the_readme_names_are_annotated():
+    """The README sends a Python user to woodcam.woodify.woodify (and woodcam.pipeline.preview_part);
+    woodify left mesh, up, obstacles, vertex_gain, vertex_direction and obstacle_names bare."""
+    import importlib
+    import re
+
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    named = sorted(set(re.findall(r"`(woodcam(?:\.[a-z_]+){2,})\(", readme))
+                   | {"woodcam.woodify.woodify", "woodcam.pipeline.preview_part"})
+    missing = []
+    for dotted in named:
+        module, name = dotted.rsplit(".", 1)
+        f = getattr(importlib.import_module(module), name)
+        sig = inspect.signature(f)
+        bare = [p for p, v in sig.parameters.items() if v.annotation is inspect.Parameter.empty
+                and v.kind not in (v.VAR_KEYWORD, v.VAR_POSITIONAL)]
+        if bare or sig.return_annotation is inspect.Signature.empty:
+            missing.append(f"{dotted}: {bare}")
+    assert not missing, "add type hints:\n" + "\n".join(missing)

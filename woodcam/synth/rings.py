@@ -9,6 +9,7 @@ may not import ``synth`` (``tests/test_layering.py``).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Literal
 
 import numpy as np
@@ -26,7 +27,8 @@ FaceStyle = Literal["plain", "realistic"]
 
 
 def ring_eval_faces(seed: int, face_px: int = 256, size_mm: float = 50.0,
-                    ring_width_range_mm=(1.5, 6.0), faces=FACES, style: FaceStyle = "plain") -> list:
+                    ring_width_range_mm: tuple[float, float] = (1.5, 6.0), faces: Sequence[str] = FACES,
+                    style: FaceStyle = "plain") -> list:
     """Faces of one synthetic cube of ``size_mm`` drawn from ``np.random.default_rng(seed)``, as
     :class:`woodcam.detect.evaluate.SyntheticFace` (photo, true ring points every 0.5 px): a random
     eccentric, lobed log and sawing pattern, photos with camera noise, exposure variation,

@@ -9,6 +9,7 @@ frame, mm; years since the input surface.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import time
@@ -19,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._repr import summary_repr
+from .._types import Mesh
 from ..errors import WoodcamError
 from ..limits import WOODIFY_RESOLUTION_RANGE, check_grid, limit
 from .brushes import Brush, check_vertex_paint, paint
@@ -135,11 +137,12 @@ def _finest_fitting(top: int, fits) -> int | None:
     return lo
 
 
-def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: float | None = None,
+def woodify(mesh: Mesh, years: float, *, growth_mm: float | None = None, velocity_mm: float | None = None,
             time_scale_years: float | None = None, shape: float = 2.0, eccentricity: float = 0.0,
-            up=(0.0, 0.0, 1.0), obstacles=(), brushes: tuple[Brush, ...] | list = (),
-            vertex_gain=None, vertex_direction=None, resolution: int = 128,
-            method: Method = "auto", obstacle_names=None) -> Woodification:
+            up: ArrayLike = (0.0, 0.0, 1.0), obstacles: Sequence[Mesh] = (),
+            brushes: tuple[Brush, ...] | list = (), vertex_gain: ArrayLike | None = None,
+            vertex_direction: ArrayLike | None = None, resolution: int = 128,
+            method: Method = "auto", obstacle_names: Sequence[str] | None = None) -> Woodification:
     """Grow a watertight ``mesh`` for ``years`` (seed 004 ch. 4 on a voxel grid).
 
     Parameters
@@ -164,7 +167,8 @@ def woodify(mesh, years: float, *, growth_mm: float | None = None, velocity_mm: 
         What messages call each obstacle (default ``obstacles[i]``; ``woodcam woodify`` names
         the option and the file, ``--obstacle 'post.stl'``).
     brushes, vertex_gain, vertex_direction :
-        User-defined growth (:mod:`woodcam.woodify.brushes`).
+        User-defined growth (:mod:`woodcam.woodify.brushes`): a list of :class:`Brush`, a gain
+        ``(n_vertices,)`` > 0 and a direction ``(n_vertices, 3)`` per vertex of ``mesh``.
     resolution : int
         Grid nodes along the longest side of the grown object's box.
     method : "auto", "fmm", "offset" or "anisotropic" (:mod:`woodcam.woodify.front`)
